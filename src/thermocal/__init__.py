@@ -1,0 +1,24 @@
+"""thermocal: test and calibrate inertial sensors.
+
+Units and frames, declared once (STYLE rule 2):
+
+* time [s]; temperatures [°C] (raw ADC ``counts`` accepted on input);
+  temperature rate Ṫ [°C/min];
+* gyro signals are reported in [°/h], accelerometer signals in [mg];
+  angle random walk [°/√h], rate random walk [°/h/√h];
+* local frame East-North-Up (ENU); earth rate Ω = 7.292115e-5 rad/s
+  (:data:`thermocal.units.EARTH_RATE_RAD_S`);
+* turntable frames as INTERFACE.md "Turntable geometry" (``mat_nb`` body→base).
+
+See :mod:`thermocal.units` for the constants and conversions, and ``SPEC.md``
+for the methods each module implements.
+"""
+
+from __future__ import annotations
+
+__version__ = "0.1.0"
+
+from thermocal.io import read_recording, write_recording
+from thermocal.recording import Metadata, Recording
+
+__all__ = ["Metadata", "Recording", "__version__", "read_recording", "write_recording"]

@@ -1,0 +1,225 @@
+"""Shared pieces of the command line: reading options, error handling, output.
+
+INTERFACE.md common rules implemented here:
+
+* ``--json`` prints one JSON object on stdout and nothing else there
+  (:func:`emit`); NaN and infinities become ``null``.
+* Exit status 0 success; 2 bad input or usage with one line ``error: ...`` on
+  stderr and no traceback; 1 internal failure (:func:`handle_errors`).
+* Progress bars only on a terminal (:func:`progress`).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import functools
+import json
+import math
+import os
+import sys
+import warnings
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
+from pathlib import Path
+from typing import Annotated, Any, ParamSpec, TypeVar
+
+import numpy as np
+import typer
+from rich.console import Console
+from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
+
+from thermocal.errors import ThermocalInputError, ThermocalWarning
+from thermocal.io import read_recording
+from thermocal.recording import Metadata, Recording
+
+P = ParamSpec("P")
+R = TypeVar("R")
+
+stdout = Console(soft_wrap=True)
+stderr = Console(stderr=True, soft_wrap=True)
+
+# --- reusable option types ----------------------------------------------------------
+
+FileArg = Annotated[Path, typer.Argument(help="Recording (CSV or Parquet).", show_default=False)]
+TimeOpt = Annotated[str, typer.Option("--time", help="Name of the time column.")]
+TimeUnitOpt = Annotated[str, typer.Option("--time-unit", help="Time unit: s, ms or us.")]
+SignalOpt = Annotated[
+    str | None, typer.Option("--signal", help="Name of the sensor-output column.")
+]
+TempsOpt = Annotated[
+    str | None,
+    typer.Option("--temps", help="Comma-separated temperature column names."),
+]
+SignalUnitOpt = Annotated[
+    str | None,
+    typer.Option(
+        "--signal-unit",
+        help="Signal unit: deg/h, deg/s, rad/s, mg, g, m/s^2, counts (default deg/h).",
+    ),
+]
+TempUnitOpt = Annotated[
+    str | None, typer.Option("--temp-unit", help="Temperature unit: degC or counts.")
+]
+JsonOpt = Annotated[bool, typer.Option("--json", help="Print one JSON object on stdout.")]
+OutOpt = Annotated[Path, typer.Option("-o", "--output", help="Output file.")]
+
+
+def split_names(text: str | None) -> list[str] | None:
+    """``"T1, T2,T 3"`` → ``["T1", "T2", "T 3"]`` (None stays None)."""
+    if text is None:
+        return None
+    names = [t.strip() for t in text.split(",")]
+    return [n for n in names if n]
+
+
+def load_recording(
+    path: Path,
+    *,
+    time: str | None = None,
+    time_unit: str | None = None,
+    signal: str | None = None,
+    temps: str | None = None,
+    signal_unit: str | None = None,
+    temp_unit: str | None = None,
+    meta: Metadata | None = None,
+    require_signal: bool = True,
+) -> Recording:
+    """Read a recording with the command line's options (options win over the file).
+
+    A signal named with ``--signal`` becomes the first signal; without it the
+    file's sidecar roles are used.  With ``require_signal`` a recording with no
+    signal at all is an input error.
+    """
+    rec = read_recording(
+        path,
+        time=time,
+        time_unit=time_unit,
+        signals=[signal] if signal else None,
+        temperatures=split_names(temps),
+        signal_unit=signal_unit,
+        temp_unit=temp_unit,
+        meta=meta,
+    )
+    if require_signal and not rec.signals:
+        raise ThermocalInputError(
+            f"{path}: name the signal column with --signal; available: "
+            + ", ".join(repr(c) for c in rec.columns)
+        )
+    return rec
+
+
+# --- errors ----------------------------------------------------------------------------
+
+
+def one_line(text: str) -> str:
+    return " ".join(str(text).split())
+
+
+def handle_errors(fn: Callable[P, R]) -> Callable[P, R]:
+    """Map exceptions to INTERFACE.md exit statuses.
+
+    :class:`ThermocalInputError` (and ``FileNotFoundError``) → ``error: ...``, exit 2.
+    Anything else → ``error: internal: ...``, exit 1 (traceback only when the
+    environment variable ``THERMOCAL_DEBUG`` is set).  thermocal warnings are
+    printed as one ``warning: ...`` line each on stderr.
+    """
+
+    @functools.wraps(fn)
+    def wrapper(*args: P.args, **kwargs: P.kwargs) -> R:
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always", ThermocalWarning)
+            try:
+                result = fn(*args, **kwargs)
+            except (typer.Exit, typer.Abort):
+                _show_warnings(caught)
+                raise
+            except (ThermocalInputError, FileNotFoundError, IsADirectoryError) as exc:
+                _show_warnings(caught)
+                print(f"error: {one_line(str(exc))}", file=sys.stderr)
+                raise typer.Exit(2) from None
+            except Exception as exc:
+                _show_warnings(caught)
+                if os.environ.get("THERMOCAL_DEBUG"):
+                    raise
+                print(
+                    f"error: internal: {type(exc).__name__}: {one_line(str(exc))}",
+                    file=sys.stderr,
+                )
+                raise typer.Exit(1) from None
+        _show_warnings(caught)
+        return result
+
+    return wrapper
+
+
+def _show_warnings(caught: list[warnings.WarningMessage]) -> None:
+    seen: set[str] = set()
+    for w in caught:
+        msg = one_line(str(w.message))
+        if msg in seen:
+            continue
+        seen.add(msg)
+        if issubclass(w.category, ThermocalWarning):
+            print(f"warning: {msg}", file=sys.stderr)
+
+
+# --- output -------------------------------------------------------------------------------
+
+
+def jsonable(obj: Any) -> Any:
+    """Convert results to plain JSON types: dataclasses → dicts, numpy → Python,
+    NaN/inf → ``None``."""
+    if dataclasses.is_dataclass(obj) and not isinstance(obj, type):
+        return {f.name: jsonable(getattr(obj, f.name)) for f in dataclasses.fields(obj)}
+    if isinstance(obj, dict):
+        return {str(k): jsonable(v) for k, v in obj.items()}
+    if isinstance(obj, list | tuple):
+        return [jsonable(v) for v in obj]
+    if isinstance(obj, np.ndarray):
+        return jsonable(obj.tolist())
+    if isinstance(obj, np.generic):
+        return jsonable(obj.item())
+    if isinstance(obj, float):
+        return obj if math.isfinite(obj) else None
+    if isinstance(obj, Path):
+        return str(obj)
+    return obj
+
+
+def emit(obj: Any, as_json: bool, human: Callable[[], None] | None = None) -> None:
+    """Print ``obj`` as one JSON object (``--json``) or call ``human`` for rich output."""
+    if as_json:
+        sys.stdout.write(json.dumps(jsonable(obj), allow_nan=False) + "\n")
+        sys.stdout.flush()
+    elif human is not None:
+        human()
+    else:
+        stdout.print_json(json.dumps(jsonable(obj), allow_nan=False))
+
+
+def fmt(x: float | None, digits: int = 4) -> str:
+    """Number for a human table: ``—`` for None/NaN."""
+    if x is None or (isinstance(x, float) and not math.isfinite(x)):
+        return "—"
+    return f"{x:.{digits}g}"
+
+
+@contextmanager
+def progress(description: str, total: float | None = None) -> Iterator[Callable[[float], None]]:
+    """A progress bar on a terminal (stderr), silent otherwise.
+
+    Yields ``advance(amount)``.
+    """
+    if not sys.stderr.isatty():
+        yield lambda _amount: None
+        return
+    with Progress(
+        TextColumn("[bold]{task.description}"),
+        BarColumn(),
+        TextColumn("{task.percentage:>3.0f}%"),
+        TimeElapsedColumn(),
+        console=stderr,
+        transient=True,
+    ) as bar:
+        task = bar.add_task(description, total=total)
+        yield lambda amount: bar.advance(task, amount)

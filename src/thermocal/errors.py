@@ -1,0 +1,69 @@
+"""Exceptions and warnings of thermocal.
+
+Every problem with the user's input is a :class:`ThermocalInputError` (or a
+subclass) whose message names the file, column or row at fault.  The command line
+turns these into exit status 2 and a one-line ``error: ...`` on stderr
+(INTERFACE.md, "Common rules").
+"""
+
+from __future__ import annotations
+
+
+class ThermocalError(Exception):
+    """Base class of thermocal's own exceptions."""
+
+
+class ThermocalInputError(ThermocalError, ValueError):
+    """Bad input: a file, column, value, option or unit the user supplied is wrong."""
+
+
+class FileFormatError(ThermocalInputError):
+    """The file is not a readable CSV or Parquet file, or is empty."""
+
+
+class MissingColumnError(ThermocalInputError):
+    """A named column does not exist in the file."""
+
+
+class NonNumericError(ThermocalInputError):
+    """A cell that must hold a number does not."""
+
+
+class TimestampError(ThermocalInputError):
+    """Duplicate, backwards or non-finite timestamps."""
+
+
+class MissingValueError(ThermocalInputError):
+    """NaN or empty cells where a value is required."""
+
+
+class UnitError(ThermocalInputError):
+    """Unknown or inconsistent unit string."""
+
+
+class ModelFileError(ThermocalInputError):
+    """A model file that cannot be loaded: unknown family, newer format, corrupted."""
+
+
+class DesignError(ThermocalInputError):
+    """A regression or estimation problem that the data cannot determine (singular design)."""
+
+
+class ThermocalWarning(UserWarning):
+    """Base class of thermocal's warnings."""
+
+
+class GapWarning(ThermocalWarning):
+    """The recording has gaps in time; they are reported, never interpolated."""
+
+
+class ExtrapolationWarning(ThermocalWarning):
+    """A model is evaluated outside the temperature range it was fitted on."""
+
+
+class CorrelationWarning(ThermocalWarning):
+    """A validation test is not weakly correlated with the modelling test."""
+
+
+class ConditioningWarning(ThermocalWarning):
+    """A least-squares design is badly conditioned."""

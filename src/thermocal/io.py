@@ -1,0 +1,337 @@
+"""Read and write recordings as CSV or Parquet, with sidecar metadata.
+
+* Format by extension: ``.csv`` (also ``.csv.gz``, ``.txt``) or ``.parquet``/``.pq``.
+* Metadata: an optional sidecar ``FILE.meta.json`` beside the data file, or the
+  Parquet key-value metadata under the key ``thermocal``; command-line options
+  (the ``read_recording`` arguments) win over both.
+* Writers never touch an input: they write to a temporary name in the target's
+  directory and rename it over the target when complete (:func:`atomic_write`).
+
+The sidecar / Parquet metadata is a JSON object::
+
+    {"format": "thermocal-recording", "version": 1,
+     "time": "time", "time_unit": "s",
+     "signals": {"gyro": "deg/h"}, "temperatures": {"T1": "degC"},
+     "units": {"truth_bias": "deg/h"},
+     "metadata": {...Metadata.to_dict()...}}
+"""
+
+from __future__ import annotations
+
+import contextlib
+import json
+import os
+import tempfile
+from collections.abc import Callable, Iterator
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pandas as pd
+import pyarrow as pa
+import pyarrow.parquet as pq
+
+from thermocal import units
+from thermocal.errors import (
+    FileFormatError,
+    MissingColumnError,
+    NonNumericError,
+    ThermocalInputError,
+)
+from thermocal.recording import FloatArray, Metadata, Recording
+
+META_KEY = "thermocal"
+META_FORMAT = "thermocal-recording"
+META_VERSION = 1
+
+CSV_SUFFIXES = (".csv", ".txt", ".csv.gz")
+PARQUET_SUFFIXES = (".parquet", ".pq")
+
+
+def file_kind(path: str | Path) -> str:
+    """``'csv'`` or ``'parquet'`` from the extension, else :class:`FileFormatError`."""
+    name = str(path).lower()
+    if name.endswith(PARQUET_SUFFIXES):
+        return "parquet"
+    if name.endswith(CSV_SUFFIXES):
+        return "csv"
+    raise FileFormatError(
+        f"{path}: not a CSV or Parquet file (expected extension .csv or .parquet)"
+    )
+
+
+def sidecar_path(path: str | Path) -> Path:
+    """``FILE.meta.json`` beside ``FILE``."""
+    p = Path(path)
+    return p.with_name(p.name + ".meta.json")
+
+
+@contextlib.contextmanager
+def atomic_write(path: str | Path, mode: str = "wb") -> Iterator[Any]:
+    """Open a temporary file beside ``path``; rename it over ``path`` on success.
+
+    On any exception the temporary file is removed and ``path`` is untouched.
+    """
+    target = Path(path)
+    target.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=target.parent)
+    try:
+        with os.fdopen(fd, mode) as fh:
+            yield fh
+        os.replace(tmp, target)
+    except BaseException:
+        with contextlib.suppress(OSError):
+            os.unlink(tmp)
+        raise
+
+
+def atomic_write_path(path: str | Path, writer: Callable[[Path], None]) -> None:
+    """Call ``writer(tmp_path)`` then rename ``tmp_path`` over ``path`` (for libraries
+    that want a path, not a file object)."""
+    target = Path(path)
+    target.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=target.parent)
+    os.close(fd)
+    try:
+        writer(Path(tmp))
+        os.replace(tmp, target)
+    except BaseException:
+        with contextlib.suppress(OSError):
+            os.unlink(tmp)
+        raise
+
+
+def write_json(path: str | Path, obj: Any) -> None:
+    """Write JSON atomically (indent 2, UTF-8)."""
+    text = json.dumps(obj, indent=2, ensure_ascii=False, allow_nan=False)
+    with atomic_write(path, "w") as fh:
+        fh.write(text + "\n")
+
+
+def check_not_input(out: str | Path, inputs: list[str | Path]) -> None:
+    """Refuse to write an output over one of the inputs (INTERFACE.md common rules)."""
+    o = Path(out).resolve()
+    for i in inputs:
+        if Path(i).resolve() == o:
+            raise ThermocalInputError(f"{out}: refusing to write over the input file {i}")
+
+
+# --- reading -------------------------------------------------------------------------
+
+
+def _load_sidecar(path: Path) -> dict[str, Any]:
+    side = sidecar_path(path)
+    if not side.exists():
+        return {}
+    try:
+        obj = json.loads(side.read_text(encoding="utf-8"))
+    except (json.JSONDecodeError, UnicodeDecodeError) as exc:
+        raise FileFormatError(f"{side}: not valid JSON ({exc})") from None
+    if not isinstance(obj, dict):
+        raise FileFormatError(f"{side}: expected a JSON object")
+    return obj
+
+
+def _read_table(path: Path, kind: str) -> tuple[pd.DataFrame | pa.Table, dict[str, Any]]:
+    if not path.exists():
+        raise FileFormatError(f"{path}: no such file")
+    if path.stat().st_size == 0:
+        raise FileFormatError(f"{path}: the file is empty")
+    if kind == "parquet":
+        try:
+            table = pq.read_table(path)
+        except (pa.ArrowInvalid, OSError) as exc:
+            raise FileFormatError(f"{path}: not a readable Parquet file ({exc})") from None
+        meta: dict[str, Any] = {}
+        kv = table.schema.metadata or {}
+        raw = kv.get(META_KEY.encode())
+        if raw:
+            try:
+                meta = json.loads(raw.decode("utf-8"))
+            except (json.JSONDecodeError, UnicodeDecodeError):
+                raise FileFormatError(f"{path}: corrupt thermocal metadata") from None
+        return table, meta
+    try:
+        df = pd.read_csv(path, skipinitialspace=True, comment=None, low_memory=False)
+    except pd.errors.EmptyDataError:
+        raise FileFormatError(f"{path}: the file is empty (no header)") from None
+    except (pd.errors.ParserError, UnicodeDecodeError) as exc:
+        msg = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+        raise FileFormatError(f"{path}: not a readable CSV file ({msg})") from None
+    df.columns = [str(c).strip() for c in df.columns]
+    return df, {}
+
+
+def _numeric_column(obj: pd.DataFrame | pa.Table, name: str, path: Path) -> FloatArray:
+    """A column as float64; :class:`NonNumericError` names the first bad row."""
+    if isinstance(obj, pa.Table):
+        col = obj.column(name)
+        if not (pa.types.is_integer(col.type) or pa.types.is_floating(col.type)):
+            if pa.types.is_boolean(col.type) or pa.types.is_decimal(col.type):
+                return np.asarray(col.to_numpy(zero_copy_only=False), dtype=np.float64)
+            raise NonNumericError(
+                f"{path}: column {name!r} is not numeric (type {col.type})"
+            )
+        if col.null_count == 0 and col.num_chunks == 1 and pa.types.is_float64(col.type):
+            return np.asarray(col.chunk(0).to_numpy(zero_copy_only=False))
+        arr = col.to_numpy(zero_copy_only=False)
+        return np.asarray(arr, dtype=np.float64)
+    series = obj[name]
+    if pd.api.types.is_numeric_dtype(series.dtype) and not pd.api.types.is_bool_dtype(
+        series.dtype
+    ):
+        return series.to_numpy(dtype=np.float64, na_value=np.nan)
+    conv = pd.to_numeric(series, errors="coerce")
+    bad = conv.isna() & series.notna() & (series.astype(str).str.strip() != "")
+    if bad.any():
+        row = int(np.argmax(bad.to_numpy()))
+        raise NonNumericError(
+            f"{path}: non-numeric value {series.iloc[row]!r} in column {name!r} at row {row} "
+            f"(line {row + 2} of the file)"
+        )
+    return conv.to_numpy(dtype=np.float64, na_value=np.nan)
+
+
+def read_recording(
+    path: str | Path,
+    *,
+    time: str | None = None,
+    time_unit: str | None = None,
+    signals: list[str] | None = None,
+    temperatures: list[str] | None = None,
+    signal_unit: str | None = None,
+    temp_unit: str | None = None,
+    meta: Metadata | None = None,
+    keep_other: bool = True,
+) -> Recording:
+    """Read a CSV or Parquet recording.
+
+    Parameters
+    ----------
+    path : the file; its extension chooses the format.
+    time : name of the time column (default: sidecar's, else ``"time"``).
+    time_unit : ``s``, ``ms`` or ``us`` (default ``s``); converted to [s].
+    signals, temperatures : column names with those roles (default: sidecar's).
+    signal_unit, temp_unit : units of those columns (override the sidecar).
+    meta : metadata that overrides the file's.
+    keep_other : keep the other numeric columns (non-numeric ones are skipped).
+
+    Raises
+    ------
+    FileFormatError : not CSV/Parquet, unreadable or empty.
+    MissingColumnError : a named column is absent (the available ones are listed).
+    NonNumericError : a non-numeric cell in a named column (row and column named).
+    UnitError : an unknown unit string.
+    """
+    p = Path(path)
+    kind = file_kind(p)
+    obj, file_meta = _read_table(p, kind)
+    side = _load_sidecar(p)
+    info: dict[str, Any] = {**file_meta, **side}
+
+    names = list(obj.column_names) if isinstance(obj, pa.Table) else list(obj.columns)
+    if not names:
+        raise FileFormatError(f"{p}: the file has no columns")
+    n_rows = obj.num_rows if isinstance(obj, pa.Table) else len(obj)
+    if n_rows == 0:
+        raise FileFormatError(f"{p}: the file has a header but no data rows")
+
+    time_col = time or info.get("time") or "time"
+    t_unit = units.normalize_time_unit(time_unit or info.get("time_unit") or "s")
+    sig_info: dict[str, str] = dict(info.get("signals") or {})
+    tmp_info: dict[str, str] = dict(info.get("temperatures") or {})
+    sig_names = list(signals) if signals is not None else list(sig_info)
+    tmp_names = list(temperatures) if temperatures is not None else list(tmp_info)
+
+    available = ", ".join(repr(c) for c in names)
+    for c in [time_col, *sig_names, *tmp_names]:
+        if c not in names:
+            raise MissingColumnError(f"{p}: no column {c!r}; available: {available}")
+
+    t = _numeric_column(obj, time_col, p)
+    if t_unit != "s":
+        t = t * units.TIME_UNITS[t_unit]
+
+    cols: dict[str, FloatArray] = {}
+    unit_map: dict[str, str] = {}
+    extra_units: dict[str, str] = dict(info.get("units") or {})
+    for c in sig_names:
+        cols[c] = _numeric_column(obj, c, p)
+        u = signal_unit or sig_info.get(c) or extra_units.get(c) or "deg/h"
+        unit_map[c] = units.normalize_signal_unit(u)
+    for c in tmp_names:
+        cols[c] = _numeric_column(obj, c, p)
+        u = temp_unit or tmp_info.get(c) or "degC"
+        unit_map[c] = units.normalize_temperature_unit(u)
+    if keep_other:
+        for c in names:
+            if c == time_col or c in cols:
+                continue
+            try:
+                cols[c] = _numeric_column(obj, c, p)
+            except NonNumericError:
+                continue
+            unit_map[c] = extra_units.get(c, "")
+
+    md = Metadata.from_dict(dict(info.get("metadata") or {}))
+    if meta is not None:
+        md = md.merged(meta)
+    return Recording(
+        time_s=t,
+        columns=cols,
+        units=unit_map,
+        signals=tuple(sig_names),
+        temperatures=tuple(tmp_names),
+        meta=md,
+        source=str(p),
+    )
+
+
+def recording_info(rec: Recording, time: str = "time") -> dict[str, Any]:
+    """The metadata object written beside (or into) a recording file."""
+    return {
+        "format": META_FORMAT,
+        "version": META_VERSION,
+        "time": time,
+        "time_unit": "s",
+        "signals": {s: rec.units.get(s, "") for s in rec.signals},
+        "temperatures": {s: rec.units.get(s, "degC") for s in rec.temperatures},
+        "units": {
+            c: u
+            for c, u in rec.units.items()
+            if u and c not in rec.signals and c not in rec.temperatures
+        },
+        "metadata": rec.meta.to_dict(),
+    }
+
+
+def write_recording(
+    rec: Recording, path: str | Path, *, time: str = "time", sidecar: bool | None = None
+) -> Path:
+    """Write a recording as CSV or Parquet (by extension), atomically.
+
+    CSV files get a sidecar ``FILE.meta.json``; Parquet files carry the same JSON in
+    their key-value metadata (and a sidecar only if ``sidecar=True``).
+    Time is written in [s].
+    """
+    p = Path(path)
+    kind = file_kind(p)
+    info = recording_info(rec, time=time)
+    data: dict[str, FloatArray] = {time: rec.time_s}
+    for c, v in rec.columns.items():
+        if c == time:
+            raise ThermocalInputError(f"column name {c!r} clashes with the time column")
+        data[c] = v
+    if kind == "parquet":
+        table = pa.table(data)
+        table = table.replace_schema_metadata({META_KEY: json.dumps(info)})
+        atomic_write_path(p, lambda tmp: pq.write_table(table, tmp))
+        if sidecar:
+            write_json(sidecar_path(p), info)
+    else:
+        df = pd.DataFrame(data)
+        with atomic_write(p, "w") as fh:
+            df.to_csv(fh, index=False, float_format="%.17g", lineterminator="\n")
+        if sidecar is None or sidecar:
+            write_json(sidecar_path(p), info)
+    return p

@@ -1,0 +1,47 @@
+"""Temperature-compensation model families (SPEC §4) behind one contract.
+
+Importing this package registers every family in
+:data:`thermocal.models.base.MODEL_REGISTRY`: ``poly`` (SPEC §4a),
+``piecewise`` (§4b), ``warmup`` (§4c) and ``bank`` (§4d).
+"""
+
+from __future__ import annotations
+
+import importlib
+
+from thermocal.models.base import (
+    MODEL_REGISTRY,
+    Coefficient,
+    FitStats,
+    RunData,
+    TemperatureModel,
+    get_model_class,
+    load_model,
+    load_model_dict,
+    make_model,
+    register,
+    save_model,
+)
+
+FAMILY_MODULES = ("poly", "piecewise", "warmup", "bank")
+
+for _mod in FAMILY_MODULES:
+    try:
+        importlib.import_module(f"thermocal.models.{_mod}")
+    except ModuleNotFoundError as _exc:
+        if _exc.name != f"thermocal.models.{_mod}":
+            raise
+
+__all__ = [
+    "MODEL_REGISTRY",
+    "Coefficient",
+    "FitStats",
+    "RunData",
+    "TemperatureModel",
+    "get_model_class",
+    "load_model",
+    "load_model_dict",
+    "make_model",
+    "register",
+    "save_model",
+]

@@ -1,0 +1,568 @@
+"""The contract every temperature-compensation model follows, and its file format.
+
+Estimator contract (STYLE.md, after scikit-learn): ``__init__`` only stores its
+keyword arguments; ``fit(runs)`` validates, learns values whose names end in
+``_`` and returns ``self``; ``predict(run)`` returns the temperature-induced
+signal (bias, or scale-factor error, SPEC §4e) in the signal's canonical unit;
+``get_params()`` returns the constructor arguments.  Families register by name
+in :data:`MODEL_REGISTRY` with :func:`register` (STYLE rule 8).
+
+A model file is a self-describing, versioned JSON object (SPEC §8)::
+
+    {
+      "format": "thermocal-model", "format_version": 1,
+      "family": "poly", "thermocal_version": "0.1.0",
+      "created_utc": "...",
+      "signal": {"name": "gyro", "unit": "deg/h", "target": "bias"},
+      "temperatures": ["T1", "T2", "T3", "T4"], "temperature_unit": "degC",
+      "rate": {"method": "backward", "interval_s": 60.0},
+      "params": {...constructor arguments...},
+      "state": {...learned values, family specific...},
+      "coefficients": [{"name": "T1", "value": ..., "stderr": ...}, ...],
+      "range": {"temperature_c": {"T1": [lo, hi], ...},
+                "rate_c_per_min": {"T1": [lo, hi], ...}},
+      "fit": {"rms_residual": ..., "condition_number": ..., "n_samples": ..., ...},
+      "data": [{"file": "run1.csv", "sha256": "..."}],
+      "checksum": "sha256 of the canonical JSON of everything above"
+    }
+
+Loading checks the format tag, the version (a newer version is refused with a
+clear error), the family (must be registered) and the checksum (a corrupted or
+hand-edited file is refused).
+"""
+
+from __future__ import annotations
+
+import copy
+import datetime as _dt
+import hashlib
+import inspect
+import json
+import warnings
+from abc import ABC, abstractmethod
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, ClassVar, Self, TypeVar
+
+import numpy as np
+
+from thermocal.errors import (
+    ExtrapolationWarning,
+    ModelFileError,
+    ThermocalInputError,
+)
+from thermocal.io import write_json
+from thermocal.recording import FloatArray, Recording
+
+MODEL_FORMAT = "thermocal-model"
+MODEL_FORMAT_VERSION = 1
+
+
+# --- input data ------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class RunData:
+    """One run (one power-on) as a model sees it.
+
+    Attributes
+    ----------
+    time_s : sample times [s], shape (n,).
+    temps_c : temperatures [°C], shape (n, k), columns in ``temp_names`` order.
+    signal : sensor output in its canonical unit ([°/h] or [mg]), shape (n,),
+        or ``None`` when only predicting from temperatures.
+    temp_names : names of the temperature columns.
+    name : where the run came from (file name), for messages and provenance.
+    known_input : the known input to remove before fitting (earth rate [°/h],
+        gravity component [mg]); subtracted from ``signal`` by :meth:`target`.
+    """
+
+    time_s: FloatArray
+    temps_c: FloatArray
+    signal: FloatArray | None = None
+    temp_names: tuple[str, ...] = ()
+    name: str = ""
+    known_input: float = 0.0
+    extra: dict[str, Any] = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        n = self.time_s.shape[0]
+        if self.temps_c.ndim != 2 or self.temps_c.shape[0] != n:
+            raise ThermocalInputError(
+                f"{self.name or 'run'}: temperatures must be (n_samples, n_sensors); got "
+                f"{self.temps_c.shape} for {n} samples"
+            )
+        if self.signal is not None and self.signal.shape != (n,):
+            raise ThermocalInputError(
+                f"{self.name or 'run'}: signal has {self.signal.shape[0]} samples, time has {n}"
+            )
+
+    @property
+    def n_samples(self) -> int:
+        return int(self.time_s.shape[0])
+
+    def target(self) -> FloatArray:
+        """The signal minus the known input: what a model is fitted to."""
+        if self.signal is None:
+            raise ThermocalInputError(f"{self.name or 'run'}: no signal to fit")
+        return self.signal - self.known_input
+
+    @classmethod
+    def from_recording(
+        cls,
+        rec: Recording,
+        signal: str | None = None,
+        temps: Sequence[str] | None = None,
+        *,
+        known_input: float = 0.0,
+        require_signal: bool = True,
+    ) -> RunData:
+        """Pull the time, temperatures [°C] and signal (canonical unit) out of a recording.
+
+        NaN in the used columns is an input error (never silently dropped).
+        """
+        names = tuple(temps) if temps else rec.temperatures
+        if not names:
+            raise ThermocalInputError(
+                f"{rec.name}: no temperature columns named; available: "
+                + ", ".join(repr(c) for c in rec.columns)
+            )
+        temps_c = rec.temperatures_c(names)
+        sig: FloatArray | None = None
+        if require_signal or signal is not None or rec.signals:
+            try:
+                sig, _unit = rec.signal(signal)
+            except ThermocalInputError:
+                if require_signal:
+                    raise
+        for label, arr in [("time", rec.time_s), ("temperatures", temps_c)] + (
+            [("signal", sig)] if sig is not None else []
+        ):
+            bad = ~np.isfinite(arr)
+            if bad.any():
+                row = int(np.argwhere(bad)[0][0])
+                raise ThermocalInputError(
+                    f"{rec.name}: {label} has {int(bad.sum())} NaN/non-finite values "
+                    f"(first at row {row}); clean or cut the data first"
+                )
+        return cls(
+            time_s=rec.time_s,
+            temps_c=temps_c,
+            signal=sig,
+            temp_names=names,
+            name=rec.source or rec.meta.run_id or "",
+            known_input=known_input,
+        )
+
+
+# --- fitted coefficients and statistics ----------------------------------------------------
+
+
+@dataclass(frozen=True)
+class Coefficient:
+    """A learned coefficient, in physical (unscaled) units, with its standard error."""
+
+    name: str
+    value: float
+    stderr: float | None = None
+    unit: str = ""
+
+    def to_dict(self) -> dict[str, Any]:
+        d: dict[str, Any] = {"name": self.name, "value": self.value}
+        if self.stderr is not None:
+            d["stderr"] = self.stderr
+        if self.unit:
+            d["unit"] = self.unit
+        return d
+
+
+@dataclass(frozen=True)
+class FitStats:
+    """Fit statistics reported with every model.
+
+    ``rms_residual`` in the signal unit; ``condition_number`` of the scaled
+    design (2-norm, from the SVD); ``dof`` residual degrees of freedom.
+    """
+
+    n_samples: int
+    n_coefficients: int
+    rms_residual: float
+    condition_number: float | None = None
+    r_squared: float | None = None
+    dof: int | None = None
+    extra: dict[str, Any] = field(default_factory=dict)
+
+    def to_dict(self) -> dict[str, Any]:
+        d: dict[str, Any] = {
+            "n_samples": self.n_samples,
+            "n_coefficients": self.n_coefficients,
+            "rms_residual": self.rms_residual,
+            "condition_number": self.condition_number,
+            "r_squared": self.r_squared,
+            "dof": self.dof,
+        }
+        d.update(self.extra)
+        return d
+
+
+# --- the contract ----------------------------------------------------------------------------
+
+
+class TemperatureModel(ABC):
+    """Base class of every compensation model family.
+
+    Subclasses set ``family`` (registry name), implement ``fit``, ``predict``,
+    ``_state`` / ``_set_state`` (the learned values as JSON-ready dicts), and
+    ``coefficients()``.  Learned attributes end in ``_`` and exist only after fit.
+
+    Common learned attributes set by :meth:`_record_common` during ``fit``:
+    ``temp_names_``, ``temp_range_`` (k×2 [°C]), ``rate_range_`` (k×2 [°C/min] or
+    None), ``stats_`` (:class:`FitStats`), ``data_`` (provenance list).
+    """
+
+    family: ClassVar[str] = ""
+    uses_rate: ClassVar[bool] = False
+    """True when the model uses Ṫ (then ``rate_method``/``rate_interval_s`` matter)."""
+
+    temp_names_: tuple[str, ...]
+    temp_range_: FloatArray
+    rate_range_: FloatArray | None
+    stats_: FitStats
+    data_: list[dict[str, Any]]
+
+    # metadata set by the caller (CLI) before saving; not constructor params
+    signal_name: str = "signal"
+    signal_unit: str = "deg/h"
+    target: str = "bias"
+
+    # -- estimator contract --
+    @abstractmethod
+    def fit(self, runs: Sequence[RunData]) -> Self:
+        """Learn from one or several runs; returns ``self``."""
+
+    @abstractmethod
+    def predict(self, run: RunData, *, extrapolate: bool = False) -> FloatArray:
+        """Temperature-induced signal for each sample of ``run`` [signal unit]."""
+
+    @abstractmethod
+    def coefficients(self) -> list[Coefficient]:
+        """Learned coefficients with standard errors, physical units."""
+
+    @abstractmethod
+    def _state(self) -> dict[str, Any]:
+        """Learned values as a JSON-ready dict (family specific)."""
+
+    @abstractmethod
+    def _set_state(self, state: dict[str, Any]) -> None:
+        """Inverse of :meth:`_state`."""
+
+    @classmethod
+    def _param_names(cls) -> list[str]:
+        sig = inspect.signature(cls.__init__)
+        return [p for p in sig.parameters if p != "self"]
+
+    def get_params(self) -> dict[str, Any]:
+        """Constructor arguments (estimator contract)."""
+        return {p: copy.deepcopy(getattr(self, p)) for p in self._param_names()}
+
+    def set_params(self, **params: Any) -> Self:
+        for k, v in params.items():
+            if k not in self._param_names():
+                raise ThermocalInputError(f"{self.family}: unknown parameter {k!r}")
+            setattr(self, k, v)
+        return self
+
+    def clone(self) -> Self:
+        """An unfitted copy with the same parameters."""
+        return type(self)(**self.get_params())
+
+    @property
+    def is_fitted(self) -> bool:
+        return hasattr(self, "stats_")
+
+    def check_fitted(self) -> None:
+        if not self.is_fitted:
+            raise ThermocalInputError(f"{self.family} model is not fitted yet")
+
+    def residuals(self, run: RunData) -> FloatArray:
+        """``target − predict`` of a run (signal unit)."""
+        return run.target() - self.predict(run, extrapolate=True)
+
+    # -- helpers for subclasses --
+    def _record_common(
+        self,
+        runs: Sequence[RunData],
+        stats: FitStats,
+        rates: Sequence[FloatArray] | None = None,
+    ) -> None:
+        """Record temperature (and rate) ranges, names and provenance after a fit."""
+        temps = np.vstack([r.temps_c for r in runs])
+        self.temp_names_ = runs[0].temp_names or tuple(
+            f"T{i + 1}" for i in range(temps.shape[1])
+        )
+        self.temp_range_ = np.column_stack([temps.min(axis=0), temps.max(axis=0)])
+        if rates is not None:
+            rr = np.vstack(list(rates))
+            self.rate_range_ = np.column_stack([rr.min(axis=0), rr.max(axis=0)])
+        else:
+            self.rate_range_ = None
+        self.stats_ = stats
+        self.data_ = [{"file": r.name, "n_samples": r.n_samples} for r in runs]
+
+    def _check_temps(self, run: RunData) -> None:
+        if run.temps_c.shape[1] != self.temp_range_.shape[0]:
+            raise ThermocalInputError(
+                f"{self.family} model uses {self.temp_range_.shape[0]} temperature channels "
+                f"({', '.join(self.temp_names_)}); the data has {run.temps_c.shape[1]}"
+            )
+
+    def clamp(self, temps_c: FloatArray, *, extrapolate: bool = False) -> FloatArray:
+        """Clamp temperatures to the fitted range and warn (PX4/ArduPilot behaviour).
+
+        With ``extrapolate=True`` the temperatures are returned as they are, with an
+        :class:`ExtrapolationWarning` if they leave the range.
+        """
+        lo = self.temp_range_[:, 0]
+        hi = self.temp_range_[:, 1]
+        below = temps_c < lo
+        above = temps_c > hi
+        if below.any() or above.any():
+            n = int(np.count_nonzero(below.any(axis=1) | above.any(axis=1)))
+            tmin = temps_c.min(axis=0)
+            tmax = temps_c.max(axis=0)
+            where = ", ".join(
+                f"{name} {tmin[i]:.2f}…{tmax[i]:.2f} °C (fitted {lo[i]:.2f}…{hi[i]:.2f})"
+                for i, name in enumerate(self.temp_names_)
+                if below[:, i].any() or above[:, i].any()
+            )
+            action = "extrapolating" if extrapolate else "clamped to the fitted range"
+            warnings.warn(
+                f"{n} samples outside the model's temperature range: {where}; {action}",
+                ExtrapolationWarning,
+                stacklevel=3,
+            )
+            if not extrapolate:
+                return np.clip(temps_c, lo, hi)
+        return temps_c
+
+    # -- files --
+    def to_dict(self) -> dict[str, Any]:
+        """The model file's content (without checksum)."""
+        from thermocal import __version__
+
+        self.check_fitted()
+        params = _jsonify(self.get_params())
+        d: dict[str, Any] = {
+            "format": MODEL_FORMAT,
+            "format_version": MODEL_FORMAT_VERSION,
+            "family": self.family,
+            "thermocal_version": __version__,
+            "created_utc": _dt.datetime.now(_dt.UTC).strftime("%Y-%m-%dT%H:%M:%SZ"),
+            "signal": {"name": self.signal_name, "unit": self.signal_unit, "target": self.target},
+            "temperatures": list(self.temp_names_),
+            "temperature_unit": "degC",
+            "rate": (
+                {
+                    "method": params.get("rate_method", "backward"),
+                    "interval_s": params.get("rate_interval_s", 60.0),
+                }
+                if self.uses_rate
+                else None
+            ),
+            "params": params,
+            "state": _jsonify(self._state()),
+            "coefficients": [c.to_dict() for c in self.coefficients()],
+            "range": {
+                "temperature_c": {
+                    n: [float(a), float(b)]
+                    for n, (a, b) in zip(self.temp_names_, self.temp_range_, strict=True)
+                },
+                "rate_c_per_min": (
+                    {
+                        n: [float(a), float(b)]
+                        for n, (a, b) in zip(self.temp_names_, self.rate_range_, strict=True)
+                    }
+                    if self.rate_range_ is not None
+                    else None
+                ),
+            },
+            "fit": _jsonify(self.stats_.to_dict()),
+            "data": _jsonify(self.data_),
+        }
+        return d
+
+    @classmethod
+    def from_dict(cls, d: dict[str, Any]) -> TemperatureModel:
+        """Rebuild a fitted model from :meth:`to_dict` output (checks format and family)."""
+        check_model_header(d)
+        klass = get_model_class(str(d["family"]))
+        model = klass(**d.get("params", {}))
+        model._set_state(d["state"])
+        model.temp_names_ = tuple(d["temperatures"])
+        tr = d["range"]["temperature_c"]
+        model.temp_range_ = np.array([tr[n] for n in model.temp_names_], dtype=np.float64)
+        rr = d["range"].get("rate_c_per_min")
+        model.rate_range_ = (
+            np.array([rr[n] for n in model.temp_names_], dtype=np.float64) if rr else None
+        )
+        fit = dict(d["fit"])
+        known = {"n_samples", "n_coefficients", "rms_residual", "condition_number", "r_squared", "dof"}
+        model.stats_ = FitStats(
+            n_samples=int(fit.get("n_samples", 0)),
+            n_coefficients=int(fit.get("n_coefficients", 0)),
+            rms_residual=float(fit.get("rms_residual", float("nan"))),
+            condition_number=fit.get("condition_number"),
+            r_squared=fit.get("r_squared"),
+            dof=fit.get("dof"),
+            extra={k: v for k, v in fit.items() if k not in known},
+        )
+        model.data_ = list(d.get("data", []))
+        sig = d.get("signal") or {}
+        model.signal_name = sig.get("name", "signal")
+        model.signal_unit = sig.get("unit", "deg/h")
+        model.target = sig.get("target", "bias")
+        return model
+
+
+# --- registry --------------------------------------------------------------------------------
+
+MODEL_REGISTRY: dict[str, type[TemperatureModel]] = {}
+"""Model families by name (``poly``, ``piecewise``, ``warmup``, ``bank``)."""
+
+M = TypeVar("M", bound=type[TemperatureModel])
+
+
+def register(cls: M) -> M:
+    """Class decorator: add a family to :data:`MODEL_REGISTRY` under ``cls.family``."""
+    if not cls.family:
+        raise TypeError(f"{cls.__name__} has no family name")
+    MODEL_REGISTRY[cls.family] = cls
+    return cls
+
+
+def get_model_class(family: str) -> type[TemperatureModel]:
+    """The class of a registered family, or :class:`ModelFileError` naming the known ones."""
+    _load_families()
+    try:
+        return MODEL_REGISTRY[family]
+    except KeyError:
+        raise ModelFileError(
+            f"unknown model family {family!r}; known: {', '.join(sorted(MODEL_REGISTRY))}"
+        ) from None
+
+
+def _load_families() -> None:
+    # importing the package registers every family
+    import thermocal.models  # noqa: F401
+
+
+# --- file I/O ------------------------------------------------------------------------------
+
+
+def _jsonify(obj: Any) -> Any:
+    if isinstance(obj, dict):
+        return {str(k): _jsonify(v) for k, v in obj.items()}
+    if isinstance(obj, list | tuple):
+        return [_jsonify(v) for v in obj]
+    if isinstance(obj, np.ndarray):
+        return _jsonify(obj.tolist())
+    if isinstance(obj, np.generic):
+        return _jsonify(obj.item())
+    if isinstance(obj, float) and not np.isfinite(obj):
+        return None
+    return obj
+
+
+def _canonical(d: dict[str, Any]) -> bytes:
+    return json.dumps(
+        {k: v for k, v in d.items() if k != "checksum"},
+        sort_keys=True,
+        separators=(",", ":"),
+        ensure_ascii=True,
+        allow_nan=False,
+    ).encode("ascii")
+
+
+def checksum(d: dict[str, Any]) -> str:
+    """SHA-256 of the canonical JSON of a model dict (``checksum`` key excluded)."""
+    return hashlib.sha256(_canonical(d)).hexdigest()
+
+
+def file_sha256(path: str | Path, chunk: int = 1 << 20) -> str:
+    """SHA-256 of a data file (provenance in model files)."""
+    h = hashlib.sha256()
+    with open(path, "rb") as fh:
+        while block := fh.read(chunk):
+            h.update(block)
+    return h.hexdigest()
+
+
+def check_model_header(d: Any) -> None:
+    """Refuse foreign, newer or unknown model dicts with a clear :class:`ModelFileError`."""
+    if not isinstance(d, dict) or d.get("format") != MODEL_FORMAT:
+        raise ModelFileError("not a thermocal model file (missing 'format': 'thermocal-model')")
+    ver = d.get("format_version")
+    if not isinstance(ver, int):
+        raise ModelFileError("model file has no integer format_version")
+    if ver > MODEL_FORMAT_VERSION:
+        raise ModelFileError(
+            f"model file format version {ver} is newer than this thermocal supports "
+            f"({MODEL_FORMAT_VERSION}); upgrade thermocal"
+        )
+    for key in ("family", "params", "state", "temperatures", "range", "fit"):
+        if key not in d:
+            raise ModelFileError(f"model file is missing the {key!r} section")
+
+
+def save_model(model: TemperatureModel, path: str | Path) -> dict[str, Any]:
+    """Write a fitted model as JSON (atomically), with its checksum; returns the dict."""
+    d = model.to_dict()
+    d["checksum"] = checksum(d)
+    write_json(path, d)
+    return d
+
+
+def load_model_dict(path: str | Path) -> dict[str, Any]:
+    """Read and verify a model file (format, version, checksum) without building it."""
+    p = Path(path)
+    try:
+        text = p.read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise ModelFileError(f"{p}: no such model file") from None
+    except UnicodeDecodeError:
+        raise ModelFileError(f"{p}: not a text (JSON) model file") from None
+    try:
+        d = json.loads(text)
+    except json.JSONDecodeError as exc:
+        raise ModelFileError(f"{p}: corrupted model file (invalid JSON: {exc.msg})") from None
+    try:
+        check_model_header(d)
+    except ModelFileError as exc:
+        raise ModelFileError(f"{p}: {exc}") from None
+    stored = d.get("checksum")
+    if stored is None:
+        raise ModelFileError(f"{p}: model file has no checksum")
+    if not isinstance(d, dict) or stored != checksum(d):
+        raise ModelFileError(
+            f"{p}: checksum mismatch: the model file was corrupted or edited by hand"
+        )
+    out: dict[str, Any] = d
+    return out
+
+
+def load_model(path: str | Path) -> TemperatureModel:
+    """Load and verify a model file; returns the fitted model."""
+    d = load_model_dict(path)
+    try:
+        return TemperatureModel.from_dict(d)
+    except ModelFileError as exc:
+        raise ModelFileError(f"{path}: {exc}") from None
+    except (KeyError, TypeError, ValueError) as exc:
+        raise ModelFileError(f"{path}: malformed model file ({type(exc).__name__}: {exc})") from None
+
+
+def make_model(family: str, **params: Any) -> TemperatureModel:
+    """Instantiate a registered family with parameters."""
+    return get_model_class(family)(**params)
+

@@ -1,0 +1,471 @@
+"""The in-memory form of a test: :class:`Recording`.
+
+A recording is one row per sample: time [s] as float64, named signal channels
+with units, named temperature channels ([°C] or raw ADC ``counts``), other
+numeric columns kept as they are (e.g. the simulator's ``truth_bias``), and
+:class:`Metadata` (sample interval, scale factor K, latitude, sensitive axis,
+sensor and run ids, notes).
+
+Validation lives here too: :func:`find_problems` lists what is wrong with a
+recording without raising; :func:`find_gaps` finds gaps in time from the
+median sample interval (gaps are reported, never interpolated).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass, field
+from typing import Any, Literal
+
+import numpy as np
+import numpy.typing as npt
+
+from thermocal import units
+from thermocal.errors import (
+    MissingColumnError,
+    MissingValueError,
+    ThermocalInputError,
+    TimestampError,
+    UnitError,
+)
+
+FloatArray = npt.NDArray[np.float64]
+
+GAP_FACTOR = 1.5
+"""A time step larger than ``GAP_FACTOR`` × the median interval is a gap."""
+
+
+@dataclass
+class Metadata:
+    """What a test is, beyond its numbers.  Every field is optional.
+
+    Attributes
+    ----------
+    sample_interval_s : nominal sample interval τ [s]; the median interval of
+        the time column when not given.
+    scale_factor : scale factor K of a raw-count output (SPEC §1).
+    scale_factor_unit : unit of K, a key of :data:`thermocal.units.SCALE_FACTOR_UNITS`.
+    latitude_deg : test-site latitude φ [°], for earth-rate removal.
+    axis : sensitive-axis direction in local ENU (``"up"``, ``"north"``, ``"e,n,u"``).
+    sensor_id, run_id, notes : free text.
+    temperature_conversion : per temperature column ``(gain, offset)`` with
+        ``T[°C] = gain · counts + offset`` for raw ADC temperatures.
+    extra : any other key-value pairs (kept through read/write round-trips).
+    """
+
+    sample_interval_s: float | None = None
+    scale_factor: float | None = None
+    scale_factor_unit: str | None = None
+    latitude_deg: float | None = None
+    axis: str | None = None
+    sensor_id: str | None = None
+    run_id: str | None = None
+    notes: str | None = None
+    temperature_conversion: dict[str, tuple[float, float]] = field(default_factory=dict)
+    extra: dict[str, Any] = field(default_factory=dict)
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready dict (``None`` fields omitted)."""
+        out: dict[str, Any] = {}
+        for f in dataclasses.fields(self):
+            v = getattr(self, f.name)
+            if v is None or (isinstance(v, dict) and not v):
+                continue
+            if f.name == "temperature_conversion":
+                v = {k: [float(a), float(b)] for k, (a, b) in v.items()}
+            out[f.name] = v
+        return out
+
+    @classmethod
+    def from_dict(cls, d: dict[str, Any]) -> Metadata:
+        """Inverse of :meth:`to_dict`; unknown keys go to ``extra``."""
+        known = {f.name for f in dataclasses.fields(cls)}
+        kwargs: dict[str, Any] = {}
+        extra = dict(d.get("extra", {}))
+        for k, v in d.items():
+            if k == "extra":
+                continue
+            if k in known:
+                kwargs[k] = v
+            else:
+                extra[k] = v
+        conv = kwargs.get("temperature_conversion") or {}
+        kwargs["temperature_conversion"] = {
+            str(k): (float(v[0]), float(v[1])) for k, v in conv.items()
+        }
+        for k in ("sample_interval_s", "scale_factor", "latitude_deg"):
+            if kwargs.get(k) is not None:
+                kwargs[k] = float(kwargs[k])
+        return cls(**kwargs, extra=extra)
+
+    def merged(self, other: Metadata) -> Metadata:
+        """A copy of ``self`` with every field that ``other`` sets taken from ``other``."""
+        out = dataclasses.replace(self)
+        for f in dataclasses.fields(other):
+            v = getattr(other, f.name)
+            if v is None or (isinstance(v, dict) and not v):
+                continue
+            if isinstance(v, dict):
+                merged = dict(getattr(self, f.name))
+                merged.update(v)
+                v = merged
+            setattr(out, f.name, v)
+        return out
+
+
+@dataclass(frozen=True)
+class Gap:
+    """A gap in time: the samples at ``index`` and ``index + 1`` are ``length_s`` apart.
+
+    ``start_s`` is the time of the last sample before the gap (elapsed from the
+    first sample when reported by ``inspect``).
+    """
+
+    index: int
+    start_s: float
+    length_s: float
+
+
+@dataclass(frozen=True)
+class Problem:
+    """One thing wrong with a recording.
+
+    ``severity`` is ``"error"`` (results would be wrong) or ``"warning"``.
+    ``row`` is the 0-based data row (not counting the header), when one is at fault.
+    """
+
+    kind: str
+    message: str
+    severity: Literal["error", "warning"] = "error"
+    column: str | None = None
+    row: int | None = None
+
+    def to_dict(self) -> dict[str, Any]:
+        return {k: v for k, v in dataclasses.asdict(self).items() if v is not None}
+
+
+@dataclass
+class Recording:
+    """A test recording: time, channels with roles and units, metadata.
+
+    Attributes
+    ----------
+    time_s : sample times [s], float64, strictly increasing once validated.
+    columns : every non-time column as float64 arrays, by name.
+    units : unit string of each column (``""`` if unknown).
+    signals : names of the sensor-output columns (roles).
+    temperatures : names of the temperature columns (roles).
+    meta : :class:`Metadata`.
+    source : the file it was read from, if any.
+    """
+
+    time_s: FloatArray
+    columns: dict[str, FloatArray]
+    units: dict[str, str] = field(default_factory=dict)
+    signals: tuple[str, ...] = ()
+    temperatures: tuple[str, ...] = ()
+    meta: Metadata = field(default_factory=Metadata)
+    source: str | None = None
+
+    # --- construction ----------------------------------------------------------
+    @classmethod
+    def from_arrays(
+        cls,
+        time_s: npt.ArrayLike,
+        signals: dict[str, npt.ArrayLike] | None = None,
+        temperatures: dict[str, npt.ArrayLike] | None = None,
+        *,
+        signal_unit: str | dict[str, str] = "deg/h",
+        temperature_unit: str = "degC",
+        other: dict[str, npt.ArrayLike] | None = None,
+        other_units: dict[str, str] | None = None,
+        meta: Metadata | None = None,
+    ) -> Recording:
+        """Build a recording from arrays (all the same length)."""
+        t = np.asarray(time_s, dtype=np.float64)
+        cols: dict[str, FloatArray] = {}
+        unit_map: dict[str, str] = {}
+        for name, arr in (signals or {}).items():
+            cols[name] = np.asarray(arr, dtype=np.float64)
+            u = signal_unit if isinstance(signal_unit, str) else signal_unit[name]
+            unit_map[name] = units.normalize_signal_unit(u)
+        for name, arr in (temperatures or {}).items():
+            cols[name] = np.asarray(arr, dtype=np.float64)
+            unit_map[name] = units.normalize_temperature_unit(temperature_unit)
+        for name, arr in (other or {}).items():
+            cols[name] = np.asarray(arr, dtype=np.float64)
+            unit_map[name] = (other_units or {}).get(name, "")
+        for name, arr in cols.items():
+            if arr.shape != t.shape:
+                raise ThermocalInputError(
+                    f"column {name!r} has {arr.size} samples but time has {t.size}"
+                )
+        return cls(
+            time_s=t,
+            columns=cols,
+            units=unit_map,
+            signals=tuple((signals or {}).keys()),
+            temperatures=tuple((temperatures or {}).keys()),
+            meta=meta or Metadata(),
+        )
+
+    # --- basic properties --------------------------------------------------------
+    def __len__(self) -> int:
+        return int(self.time_s.size)
+
+    @property
+    def n_samples(self) -> int:
+        return int(self.time_s.size)
+
+    @property
+    def duration_s(self) -> float:
+        return float(self.time_s[-1] - self.time_s[0]) if self.time_s.size > 1 else 0.0
+
+    @property
+    def sample_interval_s(self) -> float:
+        """Nominal sample interval τ [s]: metadata if given, else the median time step."""
+        if self.meta.sample_interval_s is not None:
+            return float(self.meta.sample_interval_s)
+        return median_interval(self.time_s)
+
+    @property
+    def sample_rate_hz(self) -> float:
+        tau = self.sample_interval_s
+        return 1.0 / tau if tau > 0 else float("nan")
+
+    @property
+    def name(self) -> str:
+        return self.source or self.meta.run_id or "<recording>"
+
+    def column(self, name: str) -> FloatArray:
+        """A column by name; :class:`MissingColumnError` lists the available ones."""
+        try:
+            return self.columns[name]
+        except KeyError:
+            raise MissingColumnError(
+                f"{self.name}: no column {name!r}; available: "
+                + ", ".join(repr(c) for c in self.columns)
+            ) from None
+
+    def signal(self, name: str | None = None) -> tuple[FloatArray, str]:
+        """A signal in its canonical unit ([°/h] or [mg]) with that unit.
+
+        Raw ``counts`` are converted with the metadata's scale factor K when one
+        is given (SPEC §1), otherwise returned as counts.
+        """
+        name = self._default(name, self.signals, "signal")
+        values = self.column(name)
+        unit = self.units.get(name) or "deg/h"
+        if units.normalize_signal_unit(unit) == "counts" and self.meta.scale_factor is not None:
+            return units.counts_to_physical(
+                values,
+                self.meta.scale_factor,
+                self.meta.scale_factor_unit or "counts/arcsec",
+                self.sample_interval_s,
+            )
+        return units.to_canonical(values, unit)
+
+    def temperature_c(self, name: str | None = None) -> FloatArray:
+        """A temperature column in [°C], converting raw counts with the metadata's
+        ``temperature_conversion`` (``T = gain·counts + offset``)."""
+        name = self._default(name, self.temperatures, "temperature")
+        values = self.column(name)
+        unit = self.units.get(name) or "degC"
+        if units.normalize_temperature_unit(unit) == "degC":
+            return values
+        conv = self.meta.temperature_conversion.get(name)
+        if conv is None:
+            raise UnitError(
+                f"{self.name}: temperature column {name!r} is in raw counts and no "
+                "conversion to °C is given (set temperature_conversion gain, offset)"
+            )
+        gain, offset = conv
+        return values * gain + offset
+
+    def temperatures_c(self, names: list[str] | tuple[str, ...] | None = None) -> FloatArray:
+        """Temperatures as an (n_samples, n_sensors) array [°C]."""
+        names = tuple(names) if names is not None else self.temperatures
+        if not names:
+            raise MissingColumnError(f"{self.name}: no temperature columns named")
+        return np.column_stack([self.temperature_c(n) for n in names])
+
+    def _default(self, name: str | None, pool: tuple[str, ...], what: str) -> str:
+        if name is not None:
+            return name
+        if not pool:
+            raise MissingColumnError(
+                f"{self.name}: no {what} column named; available: "
+                + ", ".join(repr(c) for c in self.columns)
+            )
+        return pool[0]
+
+    def gaps(self, factor: float = GAP_FACTOR) -> list[Gap]:
+        """Gaps in time (see :func:`find_gaps`)."""
+        return find_gaps(self.time_s, factor=factor)
+
+    def segments(self, factor: float = GAP_FACTOR) -> list[slice]:
+        """Contiguous (gap-free) index ranges."""
+        return contiguous_slices(self.time_s, factor=factor)
+
+    def select(self, index: slice | npt.NDArray[np.bool_] | npt.NDArray[np.intp]) -> Recording:
+        """A recording of the selected rows (metadata and roles kept)."""
+        return dataclasses.replace(
+            self,
+            time_s=self.time_s[index],
+            columns={k: v[index] for k, v in self.columns.items()},
+        )
+
+    def with_columns(self, new: dict[str, FloatArray], new_units: dict[str, str]) -> Recording:
+        """A copy with extra (or replaced) columns; roles unchanged."""
+        cols = dict(self.columns)
+        cols.update(new)
+        u = dict(self.units)
+        u.update(new_units)
+        return dataclasses.replace(self, columns=cols, units=u)
+
+    def validate(self, required: list[str] | None = None) -> None:
+        """Raise the first error of :func:`find_problems` (warnings are not raised)."""
+        for p in find_problems(self, required=required):
+            if p.severity == "error":
+                cls = {
+                    "missing_column": MissingColumnError,
+                    "nan": MissingValueError,
+                    "duplicate_time": TimestampError,
+                    "backwards_time": TimestampError,
+                    "nonfinite_time": TimestampError,
+                }.get(p.kind, ThermocalInputError)
+                raise cls(f"{self.name}: {p.message}")
+
+
+# --- pure helpers --------------------------------------------------------------------
+
+
+def median_interval(time_s: FloatArray) -> float:
+    """Median time step [s] (NaN for fewer than 2 samples)."""
+    if time_s.size < 2:
+        return float("nan")
+    return float(np.median(np.diff(time_s)))
+
+
+def find_gaps(time_s: FloatArray, factor: float = GAP_FACTOR) -> list[Gap]:
+    """Gaps: steps longer than ``factor`` × the median step.
+
+    Returns one :class:`Gap` per gap, ``start_s`` measured from the first sample.
+    """
+    if time_s.size < 3:
+        return []
+    dt = np.diff(time_s)
+    med = float(np.median(dt))
+    if not med > 0:
+        return []
+    idx = np.flatnonzero(dt > factor * med)
+    t0 = float(time_s[0])
+    return [Gap(int(i), float(time_s[i] - t0), float(dt[i])) for i in idx]
+
+
+def contiguous_slices(time_s: FloatArray, factor: float = GAP_FACTOR) -> list[slice]:
+    """Index ranges between gaps (one slice for a gap-free recording)."""
+    bounds = [0] + [g.index + 1 for g in find_gaps(time_s, factor)] + [int(time_s.size)]
+    return [slice(a, b) for a, b in zip(bounds[:-1], bounds[1:], strict=True) if b > a]
+
+
+def find_problems(rec: Recording, required: list[str] | None = None) -> list[Problem]:
+    """Everything wrong with a recording, errors first, without raising.
+
+    Checks: required columns present; time finite, strictly increasing (duplicate
+    and backwards steps named by row); NaN counts per column with the first row;
+    gaps (warning); unknown unit strings; fewer than 2 samples.
+    """
+    probs: list[Problem] = []
+    for name in required or []:
+        if name not in rec.columns:
+            probs.append(
+                Problem(
+                    "missing_column",
+                    f"no column {name!r}; available: "
+                    + ", ".join(repr(c) for c in rec.columns),
+                    column=name,
+                )
+            )
+    t = rec.time_s
+    if t.size == 0:
+        probs.append(Problem("empty", "the recording has no samples"))
+        return probs
+    bad_t = np.flatnonzero(~np.isfinite(t))
+    if bad_t.size:
+        probs.append(
+            Problem(
+                "nonfinite_time",
+                f"time is missing or not finite in {bad_t.size} rows, first at row {bad_t[0]}",
+                column="time",
+                row=int(bad_t[0]),
+            )
+        )
+    else:
+        dt = np.diff(t)
+        dup = np.flatnonzero(dt == 0)
+        back = np.flatnonzero(dt < 0)
+        if dup.size:
+            probs.append(
+                Problem(
+                    "duplicate_time",
+                    f"duplicate timestamp {t[dup[0] + 1]!r} at row {dup[0] + 1} "
+                    f"({dup.size} duplicates in all)",
+                    column="time",
+                    row=int(dup[0] + 1),
+                )
+            )
+        if back.size:
+            probs.append(
+                Problem(
+                    "backwards_time",
+                    f"time goes backwards at row {back[0] + 1} ({t[back[0]]!r} → "
+                    f"{t[back[0] + 1]!r}; {back.size} backward steps in all)",
+                    column="time",
+                    row=int(back[0] + 1),
+                )
+            )
+    for name, arr in rec.columns.items():
+        nan = np.isnan(arr)
+        n_nan = int(np.count_nonzero(nan))
+        if n_nan:
+            first = int(np.argmax(nan))
+            sev: Literal["error", "warning"] = (
+                "error" if name in rec.signals or name in rec.temperatures else "warning"
+            )
+            probs.append(
+                Problem(
+                    "nan",
+                    f"column {name!r} has {n_nan} NaN/empty values, first at row {first}",
+                    severity=sev,
+                    column=name,
+                    row=first,
+                )
+            )
+    for name in rec.signals:
+        u = rec.units.get(name, "")
+        if u:
+            try:
+                units.normalize_signal_unit(u)
+            except UnitError as exc:
+                probs.append(Problem("unit", f"column {name!r}: {exc}", column=name))
+    if t.size < 2:
+        probs.append(Problem("too_short", "the recording has fewer than 2 samples"))
+    if not any(p.kind in ("nonfinite_time", "duplicate_time", "backwards_time") for p in probs):
+        gaps = find_gaps(t)
+        if gaps:
+            total = sum(g.length_s for g in gaps)
+            probs.append(
+                Problem(
+                    "gaps",
+                    f"{len(gaps)} gaps in time (longer than {GAP_FACTOR}× the median "
+                    f"interval {median_interval(t):.6g} s), {total:.6g} s in all; "
+                    "first after row "
+                    f"{gaps[0].index} at {gaps[0].start_s:.6g} s",
+                    severity="warning",
+                    column="time",
+                    row=gaps[0].index,
+                )
+            )
+    order = {"error": 0, "warning": 1}
+    return sorted(probs, key=lambda p: order[p.severity])
