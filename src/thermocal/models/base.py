@@ -209,6 +209,30 @@ class FitStats:
 # --- the contract ----------------------------------------------------------------------------
 
 
+class ModelStream(ABC):
+    """Sample-by-sample evaluation of a fitted model (live data, firmware twin).
+
+    ``update`` takes one sample and returns the model value (the temperature-
+    induced signal) for it; the corrected output is ``signal − value``.  It
+    carries exactly the state the model needs (Ṫ buffer of length Δt, T0/F0
+    captured at power-on, start-up selection) and resets the rate estimate after
+    a gap: a time step longer than ``GAP_FACTOR`` × ``sample_interval_s``.
+
+    Contract: for a run with nominal interval τ (the median step), feeding its
+    samples in order to ``model.stream(τ)`` gives the same values as
+    ``model.predict(run)`` to 1e-12 (relative), start-up included.
+    """
+
+    @abstractmethod
+    def update(self, time_s: float, temps_c: FloatArray, signal: float | None = None) -> float:
+        """Model value for one sample: time [s], temperatures (k,) [°C], raw signal."""
+
+    @abstractmethod
+    def reset(self) -> None:
+        """Forget everything (a new power-on)."""
+
+
+
 class TemperatureModel(ABC):
     """Base class of every compensation model family.
 
@@ -244,6 +268,10 @@ class TemperatureModel(ABC):
     @abstractmethod
     def predict(self, run: RunData, *, extrapolate: bool = False) -> FloatArray:
         """Temperature-induced signal for each sample of ``run`` [signal unit]."""
+
+    @abstractmethod
+    def stream(self, sample_interval_s: float, *, extrapolate: bool = False) -> ModelStream:
+        """A :class:`ModelStream` computing :meth:`predict` sample by sample."""
 
     @abstractmethod
     def coefficients(self) -> list[Coefficient]:
