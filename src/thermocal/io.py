@@ -169,17 +169,13 @@ def _numeric_column(obj: pd.DataFrame | pa.Table, name: str, path: Path) -> Floa
         if not (pa.types.is_integer(col.type) or pa.types.is_floating(col.type)):
             if pa.types.is_boolean(col.type) or pa.types.is_decimal(col.type):
                 return np.asarray(col.to_numpy(zero_copy_only=False), dtype=np.float64)
-            raise NonNumericError(
-                f"{path}: column {name!r} is not numeric (type {col.type})"
-            )
+            raise NonNumericError(f"{path}: column {name!r} is not numeric (type {col.type})")
         if col.null_count == 0 and col.num_chunks == 1 and pa.types.is_float64(col.type):
             return np.asarray(col.chunk(0).to_numpy(zero_copy_only=False))
         arr = col.to_numpy(zero_copy_only=False)
         return np.asarray(arr, dtype=np.float64)
     series = obj[name]
-    if pd.api.types.is_numeric_dtype(series.dtype) and not pd.api.types.is_bool_dtype(
-        series.dtype
-    ):
+    if pd.api.types.is_numeric_dtype(series.dtype) and not pd.api.types.is_bool_dtype(series.dtype):
         return series.to_numpy(dtype=np.float64, na_value=np.nan)
     conv = pd.to_numeric(series, errors="coerce")
     bad = conv.isna() & series.notna() & (series.astype(str).str.strip() != "")
@@ -203,6 +199,7 @@ def read_recording(
     temp_unit: str | None = None,
     meta: Metadata | None = None,
     keep_other: bool = True,
+    skipped: list[str] | None = None,
 ) -> Recording:
     """Read a CSV or Parquet recording.
 
@@ -215,6 +212,7 @@ def read_recording(
     signal_unit, temp_unit : units of those columns (override the sidecar).
     meta : metadata that overrides the file's.
     keep_other : keep the other numeric columns (non-numeric ones are skipped).
+    skipped : if a list is given, the names of skipped non-numeric columns are appended.
 
     Raises
     ------
@@ -270,6 +268,8 @@ def read_recording(
             try:
                 cols[c] = _numeric_column(obj, c, p)
             except NonNumericError:
+                if skipped is not None:
+                    skipped.append(c)
                 continue
             unit_map[c] = extra_units.get(c, "")
 

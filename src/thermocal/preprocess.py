@@ -18,6 +18,7 @@ works per contiguous segment.
 
 from __future__ import annotations
 
+import itertools
 import math
 import warnings
 from dataclasses import dataclass
@@ -173,7 +174,7 @@ def lowpass_first_order(
     a = math.exp(-period_s / tf)
     y0 = arr[0] if initial == "first" else 0.0
     # y[k] - a y[k-1] = (1-a) x[k-1]  →  lfilter with b = [0, 1-a], a = [1, -a]
-    zi = np.array([a * y0])
+    zi = np.array([y0])  # transposed direct form: y[0] = zi
     y, _ = sps.lfilter([0.0, 1.0 - a], [1.0, -a], arr, zi=zi)
     return np.asarray(y, dtype=np.float64)
 
@@ -295,7 +296,7 @@ def segment_holds(
         change = np.flatnonzero(h[1:] != h[:-1]) + 1
         bounds = np.r_[0, change, h.size]
         labels: list[tuple[bool, int, int]] = []
-        for a, b in zip(bounds[:-1], bounds[1:], strict=True):
+        for a, b in itertools.pairwise(bounds):
             hold = bool(h[a])
             if hold:
                 a2 = int(np.searchsorted(ts, ts[a] + settle_s, side="left"))

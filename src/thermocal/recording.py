@@ -14,6 +14,7 @@ median sample interval (gaps are reported, never interpolated).
 from __future__ import annotations
 
 import dataclasses
+import itertools
 from dataclasses import dataclass, field
 from typing import Any, Literal
 
@@ -366,7 +367,7 @@ def find_gaps(time_s: FloatArray, factor: float = GAP_FACTOR) -> list[Gap]:
 def contiguous_slices(time_s: FloatArray, factor: float = GAP_FACTOR) -> list[slice]:
     """Index ranges between gaps (one slice for a gap-free recording)."""
     bounds = [0] + [g.index + 1 for g in find_gaps(time_s, factor)] + [int(time_s.size)]
-    return [slice(a, b) for a, b in zip(bounds[:-1], bounds[1:], strict=True) if b > a]
+    return [slice(a, b) for a, b in itertools.pairwise(bounds) if b > a]
 
 
 def find_problems(rec: Recording, required: list[str] | None = None) -> list[Problem]:
@@ -382,8 +383,7 @@ def find_problems(rec: Recording, required: list[str] | None = None) -> list[Pro
             probs.append(
                 Problem(
                     "missing_column",
-                    f"no column {name!r}; available: "
-                    + ", ".join(repr(c) for c in rec.columns),
+                    f"no column {name!r}; available: " + ", ".join(repr(c) for c in rec.columns),
                     column=name,
                 )
             )

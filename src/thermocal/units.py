@@ -102,7 +102,13 @@ RAW_UNITS: Final = ("counts",)
 SIGNAL_UNITS: Final = (*RATE_UNITS, *ACCEL_UNITS, *RAW_UNITS)
 TEMPERATURE_UNITS: Final = ("degC", "counts")
 
-_TEMP_ALIASES: Final = {"degc": "degC", "c": "degC", "°c": "degC", "celsius": "degC", "counts": "counts"}
+_TEMP_ALIASES: Final = {
+    "degc": "degC",
+    "c": "degC",
+    "°c": "degC",
+    "celsius": "degC",
+    "counts": "counts",
+}
 _SIGNAL_ALIASES: Final = {
     "deg/hr": "deg/h",
     "°/h": "deg/h",
@@ -170,9 +176,7 @@ def canonical_unit(unit: str) -> str:
     return {"rate": "deg/h", "accel": "mg", "raw": "counts"}[kind]
 
 
-def to_canonical(
-    values: npt.ArrayLike, unit: str
-) -> tuple[npt.NDArray[np.float64], str]:
+def to_canonical(values: npt.ArrayLike, unit: str) -> tuple[npt.NDArray[np.float64], str]:
     """Convert a signal to its canonical unit ([°/h] for rates, [mg] for accelerations).
 
     Returns the converted float64 array and the canonical unit string.

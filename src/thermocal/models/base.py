@@ -232,7 +232,6 @@ class ModelStream(ABC):
         """Forget everything (a new power-on)."""
 
 
-
 class TemperatureModel(ABC):
     """Base class of every compensation model family.
 
@@ -326,9 +325,7 @@ class TemperatureModel(ABC):
     ) -> None:
         """Record temperature (and rate) ranges, names and provenance after a fit."""
         temps = np.vstack([r.temps_c for r in runs])
-        self.temp_names_ = runs[0].temp_names or tuple(
-            f"T{i + 1}" for i in range(temps.shape[1])
-        )
+        self.temp_names_ = runs[0].temp_names or tuple(f"T{i + 1}" for i in range(temps.shape[1]))
         self.temp_range_ = np.column_stack([temps.min(axis=0), temps.max(axis=0)])
         if rates is not None:
             rr = np.vstack(list(rates))
@@ -435,7 +432,14 @@ class TemperatureModel(ABC):
             np.array([rr[n] for n in model.temp_names_], dtype=np.float64) if rr else None
         )
         fit = dict(d["fit"])
-        known = {"n_samples", "n_coefficients", "rms_residual", "condition_number", "r_squared", "dof"}
+        known = {
+            "n_samples",
+            "n_coefficients",
+            "rms_residual",
+            "condition_number",
+            "r_squared",
+            "dof",
+        }
         model.stats_ = FitStats(
             n_samples=int(fit.get("n_samples", 0)),
             n_coefficients=int(fit.get("n_coefficients", 0)),
@@ -587,10 +591,11 @@ def load_model(path: str | Path) -> TemperatureModel:
     except ModelFileError as exc:
         raise ModelFileError(f"{path}: {exc}") from None
     except (KeyError, TypeError, ValueError) as exc:
-        raise ModelFileError(f"{path}: malformed model file ({type(exc).__name__}: {exc})") from None
+        raise ModelFileError(
+            f"{path}: malformed model file ({type(exc).__name__}: {exc})"
+        ) from None
 
 
 def make_model(family: str, **params: Any) -> TemperatureModel:
     """Instantiate a registered family with parameters."""
     return get_model_class(family)(**params)
-

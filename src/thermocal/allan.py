@@ -1,0 +1,727 @@
+"""Overlapping Allan deviation of rate data, confidence intervals and noise terms.
+
+This module is pure numpy/scipy maths (no plotting, no I/O).
+
+Definitions
+-----------
+Rate samples ``y_i`` (a gyro rate [°/h], an acceleration [mg], ...) with sample
+interval ``τ0`` [s] are integrated to the "phase" (angle) ``x_k = τ0 Σ_{i<k} y_i``
+(``x_0 = 0``, N = n + 1 phase points).  The overlapping Allan variance at
+``τ = m τ0`` is (NIST SP 1065 eq. 11, IEEE Std 952-1997 Annex C)::
+
+    σ²(τ) = 1 / (2 τ² (N − 2m)) · Σ_{k=0}^{N−2m−1} (x_{k+2m} − 2 x_{k+m} + x_k)²
+
+with ``N − 2m`` terms.  The mean rate is removed before the cumulative sum (the
+second difference cancels it exactly, and it keeps the cumulative sum small so
+rounding does not grow with the bias).
+
+Confidence intervals (SP 1065 §5.3, eq. 45): ``edf · σ̂² / χ²_{p}(edf)`` with the
+equivalent degrees of freedom of SP 1065 Table 5 ("simple" approximations of
+Howe, Allan & Barnes) for the power-law noise type α identified at each τ from
+the local log-log slope of the curve (``σ² ∝ τ^μ``, ``α = −μ − 1``; gyro terms:
+quantization ↔ α = +2, angle random walk ↔ α = 0, bias instability ↔ α = −1,
+rate random walk ↔ α = −2).
+
+Noise terms (IEEE Std 952-1997 Annex C; SPEC §1): the model ::
+
+    σ²(τ) = 3Q²/τ² + N²/τ + (2 ln2/π) B² + K² τ/3 + R² τ²/2
+
+is read two ways, both reported by :func:`noise_terms`:
+
+* slope lines: the straight line of slope −1, −½, 0, +½, +1 through the region
+  of that slope, read at τ = √3, 1 s, (÷ 0.6643), 3 s, √2 s;
+* weighted non-negative least squares of the five coefficients.
+
+A term whose slope region does not exist in the data is ``None`` with a reason.
+
+Units of the terms (native coefficient → reported unit):
+
+===================  ==================  ===========================  =========================
+term (JSON key)      rate input [°/h]    acceleration input [mg]      other input [U]
+===================  ==================  ===========================  =========================
+quantization Q       arcsec              m/s (velocity quantization)  U·s
+angle_random_walk N  °/√h                µg/√Hz (velocity r.w.)       U·√s
+bias_instability B   °/h                 µg                           U
+rate_random_walk K   °/h/√h              µg/√h (accel. random walk)   U/√s
+rate_ramp R          °/h/h               µg/h                         U/s
+===================  ==================  ===========================  =========================
+
+(``(°/h)·s`` is exactly one arcsec; ``(°/h)·√s = (°/√h)/60``.)  Rates in
+``deg/s`` or ``rad/s`` and accelerations in ``g``, ``ug``, ``m/s^2`` are first
+scaled to [°/h] / [mg].
+
+References: IEEE Std 952-1997 (R2008) Annex C; W. J. Riley, *Handbook of
+Frequency Stability Analysis*, NIST SP 1065 (2008); IEEE Std 1554-2005.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Final, Literal
+
+import numpy as np
+import numpy.typing as npt
+from scipy import linalg, optimize, stats
+
+from thermocal import units
+from thermocal.errors import MissingValueError, ThermocalInputError
+from thermocal.recording import contiguous_slices
+
+FloatArray = npt.NDArray[np.float64]
+IntArray = npt.NDArray[np.int64]
+
+TauSpec = Literal["octave", "decade", "log"] | npt.ArrayLike
+
+ONE_SIGMA_CONFIDENCE: Final = math.erf(1.0 / math.sqrt(2.0))
+"""0.6827, the confidence of a ±1σ interval (the Stable32 default)."""
+
+BIAS_INSTABILITY_FACTOR: Final = math.sqrt(2.0 * math.log(2.0) / math.pi)
+"""0.6643: flat-region Allan deviation of bias instability is 0.6643 B (IEEE 952 C.3)."""
+
+TERM_NAMES: Final = (
+    "quantization",
+    "angle_random_walk",
+    "bias_instability",
+    "rate_random_walk",
+    "rate_ramp",
+)
+"""JSON keys of the noise terms, in order of the power of τ in σ²(τ): −2 … +2."""
+
+TERM_SLOPES: Final = (-1.0, -0.5, 0.0, 0.5, 1.0)
+"""Log-log slope of σ(τ) of each term."""
+
+READ_TAU_S: Final = (math.sqrt(3.0), 1.0, float("nan"), 3.0, math.sqrt(2.0))
+"""IEEE Std 952 read-off points τ [s] of the slope lines (bias instability: the flat minimum)."""
+
+_FIT_FACTORS: Final = (3.0, 1.0, 2.0 * math.log(2.0) / math.pi, 1.0 / 3.0, 0.5)
+"""σ² = Σ_j f_j c_j² τ^(j−2): C_j = f_j · coefficient²."""
+
+_SLOPE_TOLERANCE: Final = 0.25
+"""A slope region exists where the local log-log slope is within this of the term's slope."""
+
+_LOCAL_WINDOW: Final = 4.0
+"""Local slope fitted over τ*/4 … 4τ* around the tangent point."""
+
+_CHUNK: Final = 1 << 14
+"""Block length of the fused second-difference loop (keeps blocks in the CPU cache)."""
+
+
+# --- results -------------------------------------------------------------------------
+
+
+@dataclass(frozen=True, eq=False)
+class AllanResult:
+    """Overlapping Allan deviation with confidence intervals.
+
+    Attributes
+    ----------
+    tau_s : averaging times τ = m τ0 [s].
+    m : averaging factors.
+    adev : overlapping Allan deviation [unit].
+    adev_low, adev_high : confidence interval at ``confidence`` [unit].
+    n_terms : number of second differences behind each point (summed over segments).
+    edf : equivalent degrees of freedom (summed over segments).
+    alpha : power-law noise exponent used for the EDF at each τ.
+    unit : unit of the rate data and of ``adev``.
+    confidence : confidence level of the interval (0.683 = ±1σ).
+    tau0_s : sample interval [s].
+    n_samples : rate samples used.
+    n_segments : contiguous (gap-free) segments combined.
+    """
+
+    tau_s: FloatArray
+    m: IntArray
+    adev: FloatArray
+    adev_low: FloatArray
+    adev_high: FloatArray
+    n_terms: IntArray
+    edf: FloatArray
+    alpha: IntArray
+    unit: str
+    confidence: float
+    tau0_s: float
+    n_samples: int
+    n_segments: int
+
+    @property
+    def avar(self) -> FloatArray:
+        """Allan variance σ² [unit²]."""
+        return np.asarray(self.adev**2, dtype=np.float64)
+
+
+@dataclass(frozen=True)
+class NoiseTerm:
+    """One noise coefficient.
+
+    ``value`` is ``None`` when the term is not in the data, and ``reason`` says why
+    (``reason`` is ``None`` when ``value`` is present).  ``low``/``high`` bound the
+    value at the result's confidence level; ``tau_s`` is where the slope line
+    touches the curve (slope method) or ``None`` (fit).
+    """
+
+    value: float | None
+    unit: str
+    reason: str | None = None
+    low: float | None = None
+    high: float | None = None
+    tau_s: float | None = None
+    label: str = ""
+
+
+@dataclass(frozen=True)
+class NoiseTermSet:
+    """The five IEEE 952 terms found by one method (``"slope"`` or ``"fit"``)."""
+
+    method: str
+    quantization: NoiseTerm
+    angle_random_walk: NoiseTerm
+    bias_instability: NoiseTerm
+    rate_random_walk: NoiseTerm
+    rate_ramp: NoiseTerm
+
+    def terms(self) -> dict[str, NoiseTerm]:
+        """Terms by JSON key, in order."""
+        return {name: getattr(self, name) for name in TERM_NAMES}
+
+
+@dataclass(frozen=True, eq=False)
+class NoiseTerms:
+    """Noise terms by both IEEE 952 methods.
+
+    Attributes
+    ----------
+    slope : slope-line reading.
+    fit : weighted non-negative least-squares fit.
+    fit_coefficients : C_{−2..2} of ``σ² = Σ C_p τ^p`` [unit² s^p].
+    fit_sigma : standard errors of ``fit_coefficients`` (NaN where C = 0).
+    reduced_chi2 : weighted residual sum of squares / (points − active terms).
+    """
+
+    slope: NoiseTermSet
+    fit: NoiseTermSet
+    fit_coefficients: FloatArray
+    fit_sigma: FloatArray
+    reduced_chi2: float
+
+    def fit_curve(self, tau_s: npt.ArrayLike) -> FloatArray:
+        """Fitted Allan deviation sqrt(Σ C_p τ^p) [unit] at ``tau_s``."""
+        tau = np.asarray(tau_s, dtype=np.float64)
+        powers = np.arange(-2, 3)
+        design = tau[:, None] ** powers[None, :]
+        return np.asarray(np.sqrt(np.maximum(design @ self.fit_coefficients, 0.0)))
+
+    def term_curve(self, name: str, tau_s: npt.ArrayLike) -> FloatArray:
+        """Allan deviation [unit] of one fitted term alone at ``tau_s``."""
+        j = TERM_NAMES.index(name)
+        tau = np.asarray(tau_s, dtype=np.float64)
+        return np.asarray(np.sqrt(self.fit_coefficients[j] * tau ** float(j - 2)))
+
+
+# --- tau sets ------------------------------------------------------------------------
+
+
+def max_averaging_factor(n_samples: int) -> int:
+    """Largest m with at least two second differences: ``N − 2m ≥ 2`` with N = n + 1."""
+    return max((n_samples - 1) // 2, 0)
+
+
+def averaging_factors(taus: TauSpec, tau0_s: float, n_samples: int) -> IntArray:
+    """Averaging factors m for a tau set.
+
+    ``"octave"``: 1, 2, 4, 8, …; ``"decade"``: 1, 2, 4, 10, 20, 40, …;
+    ``"log"``: about ten per decade (``round(10^(k/10))``, duplicates removed);
+    an array: τ [s] rounded to the nearest multiple of τ0.  Only m with at least
+    two terms (``m ≤ (n − 1)/2``) are kept (same set as allantools' ``oadev``).
+    """
+    m_max = max_averaging_factor(n_samples)
+    if m_max < 1:
+        raise ThermocalInputError(
+            f"Allan deviation needs at least 3 contiguous samples, got {n_samples}"
+        )
+    if isinstance(taus, str):
+        if taus == "octave":
+            m = 2 ** np.arange(int(math.floor(math.log2(m_max))) + 1)
+        elif taus == "decade":
+            dec = 10 ** np.arange(int(math.floor(math.log10(m_max))) + 1)
+            m = (dec[:, None] * np.array([1, 2, 4])[None, :]).ravel()
+        elif taus == "log":
+            k = np.arange(int(math.floor(10.0 * math.log10(m_max))) + 1)
+            m = np.round(10.0 ** (k / 10.0))
+        else:
+            raise ThermocalInputError(
+                f"unknown tau set {taus!r}; use octave, decade, log or a list of τ [s]"
+            )
+    else:
+        tau = np.asarray(taus, dtype=np.float64).ravel()
+        if tau.size == 0 or not np.all(np.isfinite(tau)) or np.any(tau <= 0):
+            raise ThermocalInputError("averaging times τ must be positive and finite")
+        m = np.round(tau / tau0_s)
+    m = np.unique(m.astype(np.int64))
+    m = m[(m >= 1) & (m <= m_max)]
+    if m.size == 0:
+        raise ThermocalInputError(
+            f"no averaging time τ fits the data: τ0 = {tau0_s:g} s, at most "
+            f"{m_max} samples per cluster"
+        )
+    return m
+
+
+# --- the estimator -------------------------------------------------------------------
+
+
+def _phase(rate: FloatArray) -> FloatArray:
+    """x_k = Σ_{i<k} (y_i − ȳ), in units of rate·τ0 (x_0 = 0)."""
+    x = np.empty(rate.size + 1, dtype=np.float64)
+    x[0] = 0.0
+    np.subtract(rate, rate.mean(), out=x[1:])
+    np.cumsum(x[1:], out=x[1:])
+    return x
+
+
+def _second_difference_sums(x: FloatArray, m: IntArray) -> FloatArray:
+    """S(m) = Σ_k (x_{k+2m} − 2 x_{k+m} + x_k)² for each m, in cache-sized blocks.
+
+    ``x_{k+2m} + x_k − (2x)_{k+m}`` uses a pre-doubled copy (doubling is exact).
+    """
+    n_phase = x.size
+    x2 = np.multiply(x, 2.0)
+    buf = np.empty(_CHUNK, dtype=np.float64)
+    out = np.zeros(m.size, dtype=np.float64)
+    for j, mm in enumerate(m.tolist()):
+        n_terms = n_phase - 2 * mm
+        total = 0.0
+        for a in range(0, n_terms, _CHUNK):
+            b = min(a + _CHUNK, n_terms)
+            t = buf[: b - a]
+            np.add(x[a + 2 * mm : b + 2 * mm], x[a:b], out=t)
+            np.subtract(t, x2[a + mm : b + mm], out=t)
+            total += float(np.dot(t, t))
+        out[j] = total
+    return out
+
+
+def edf_simple(n_phase: npt.ArrayLike, m: npt.ArrayLike, alpha: npt.ArrayLike) -> FloatArray:
+    """Equivalent degrees of freedom of the overlapping Allan variance.
+
+    NIST SP 1065 Table 5 (Howe, Allan & Barnes simple approximations), with
+    N phase points, averaging factor m and noise exponent α:
+
+    * α = +2 (white PM): ``(N+1)(N−2m) / (2(N−m))``
+    * α = +1 (flicker PM): ``exp(√(ln((N−1)/2m) · ln((2m+1)(N−1)/4)))``
+    * α =  0 (white FM): ``(3(N−1)/2m − 2(N−2)/N) · 4m²/(4m²+5)``
+    * α = −1 (flicker FM): ``2(N−2)/(2.3N−4.9)`` for m = 1, ``5N²/(4m(N+3m))`` else
+    * α = −2 (random-walk FM): ``(N−2)/(m(N−3)²) · ((N−1)² − 3m(N−1) + 4m²)``
+    """
+    N, mm, a = np.broadcast_arrays(
+        np.asarray(n_phase, dtype=np.float64),
+        np.asarray(m, dtype=np.float64),
+        np.asarray(alpha, dtype=np.int64),
+    )
+    out = np.full(N.shape, np.nan)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        wpm = (N + 1) * (N - 2 * mm) / (2 * (N - mm))
+        fpm = np.exp(
+            np.sqrt(
+                np.maximum(np.log((N - 1) / (2 * mm)), 0.0)
+                * np.log((2 * mm + 1) * (N - 1) / 4)
+            )
+        )
+        wfm = (3 * (N - 1) / (2 * mm) - 2 * (N - 2) / N) * (4 * mm**2 / (4 * mm**2 + 5))
+        ffm = np.where(mm == 1, 2 * (N - 2) / (2.3 * N - 4.9), 5 * N**2 / (4 * mm * (N + 3 * mm)))
+        rwfm = (N - 2) / (mm * (N - 3) ** 2) * ((N - 1) ** 2 - 3 * mm * (N - 1) + 4 * mm**2)
+    out = np.select([a == 2, a == 1, a == 0, a == -1, a == -2], [wpm, fpm, wfm, ffm, rwfm], out)
+    return np.asarray(out, dtype=np.float64)
+
+
+def identify_alpha(tau_s: FloatArray, adev: FloatArray) -> IntArray:
+    """Power-law noise exponent α per τ from the local log-log slope of the curve.
+
+    μ = d ln σ² / d ln τ (centred differences, one-sided at the ends), α = −μ − 1
+    rounded and clipped to [−2, 2]; μ ≤ −1.5 is taken as white PM (α = 2), the
+    quantization region of a gyro (ADEV cannot tell white from flicker PM).
+    A single point is taken as white FM (α = 0).
+    """
+    if tau_s.size < 2:
+        return np.zeros(tau_s.size, dtype=np.int64)
+    ok = adev > 0
+    logs = np.log(np.where(ok, adev, np.nan) ** 2)
+    mu = np.gradient(logs, np.log(tau_s))
+    mu = np.where(np.isfinite(mu), mu, -1.0)
+    alpha = np.clip(np.round(-mu - 1.0), -2, 2).astype(np.int64)
+    alpha[mu <= -1.5] = 2
+    return alpha
+
+
+def confidence_interval(
+    adev: npt.ArrayLike, edf: npt.ArrayLike, confidence: float = ONE_SIGMA_CONFIDENCE
+) -> tuple[FloatArray, FloatArray]:
+    """Chi-square confidence interval of a deviation (NIST SP 1065 eq. 45).
+
+    ``σ_low = σ̂ √(edf / χ²_{(1+c)/2}(edf))``, ``σ_high = σ̂ √(edf / χ²_{(1−c)/2}(edf))``.
+    """
+    if not 0.0 < confidence < 1.0:
+        raise ThermocalInputError(f"confidence must be in (0, 1), got {confidence!r}")
+    dev = np.asarray(adev, dtype=np.float64)
+    nu = np.asarray(edf, dtype=np.float64)
+    p_lo = (1.0 - confidence) / 2.0
+    chi_hi = stats.chi2.ppf(1.0 - p_lo, nu)
+    chi_lo = stats.chi2.ppf(p_lo, nu)
+    return dev * np.sqrt(nu / chi_hi), dev * np.sqrt(nu / chi_lo)
+
+
+def overlapping_adev(
+    rate: npt.ArrayLike,
+    tau0_s: float,
+    taus: TauSpec = "octave",
+    *,
+    time_s: npt.ArrayLike | None = None,
+    unit: str = "deg/h",
+    confidence: float = ONE_SIGMA_CONFIDENCE,
+    alpha: int | None = None,
+) -> AllanResult:
+    """Overlapping Allan deviation of rate data (NIST SP 1065 eq. 11, IEEE 952 C.1).
+
+    Parameters
+    ----------
+    rate : rate samples y_i [unit], each the mean over its interval τ0.
+    tau0_s : sample interval τ0 [s].
+    taus : ``"octave"``, ``"decade"``, ``"log"`` or averaging times [s]
+        (see :func:`averaging_factors`).
+    time_s : sample times [s]; when given the data are split at gaps
+        (:func:`thermocal.recording.contiguous_slices`), each segment is
+        processed alone (no difference spans a gap) and the per-τ sums of squares
+        are pooled: ``σ² = Σ_s S_s / (2 m² Σ_s L_s)`` (variances weighted by term
+        counts L_s); the EDFs add.
+    unit : unit string of ``rate`` (reported, and used by :func:`noise_terms`).
+    confidence : confidence level of ``adev_low``/``adev_high`` (default ±1σ).
+    alpha : force the noise exponent of the EDF (default: identified per τ by
+        :func:`identify_alpha`).
+
+    Raises
+    ------
+    MissingValueError : NaN or infinite rate samples.
+    ThermocalInputError : too few samples, bad τ0 or τ list, mismatched time.
+    """
+    y = np.asarray(rate, dtype=np.float64).ravel()
+    if not (math.isfinite(tau0_s) and tau0_s > 0):
+        raise ThermocalInputError(f"sample interval τ0 must be positive, got {tau0_s!r}")
+    bad = np.flatnonzero(~np.isfinite(y))
+    if bad.size:
+        raise MissingValueError(
+            f"rate has {bad.size} NaN/infinite samples (first at row {bad[0]}); "
+            "remove them or split the record"
+        )
+    if time_s is None:
+        slices = [slice(0, y.size)]
+    else:
+        t = np.asarray(time_s, dtype=np.float64).ravel()
+        if t.shape != y.shape:
+            raise ThermocalInputError(f"time has {t.size} samples but rate has {y.size}")
+        slices = contiguous_slices(t)
+    longest = max(sl.stop - sl.start for sl in slices)
+    m = averaging_factors(taus, tau0_s, longest)
+
+    sums = np.zeros(m.size)
+    n_terms = np.zeros(m.size, dtype=np.int64)
+    used = 0
+    segs = 0
+    seg_terms: list[tuple[int, IntArray]] = []
+    for sl in slices:
+        seg = y[sl]
+        n_phase = seg.size + 1
+        ok = (n_phase - 2 * m) >= 2
+        if not np.any(ok):
+            continue
+        x = _phase(seg)
+        sums[ok] += _second_difference_sums(x, m[ok])
+        n_terms[ok] += n_phase - 2 * m[ok]
+        used += seg.size
+        segs += 1
+        seg_terms.append((n_phase, np.flatnonzero(ok)))
+
+    avar = sums / (2.0 * m.astype(np.float64) ** 2 * n_terms)
+    adev = np.sqrt(avar)
+    tau = m * float(tau0_s)
+    if alpha is None:
+        alphas = identify_alpha(tau, adev)
+    else:
+        if alpha not in (-2, -1, 0, 1, 2):
+            raise ThermocalInputError(f"noise exponent alpha must be −2…2, got {alpha!r}")
+        alphas = np.full(m.size, alpha, dtype=np.int64)
+    edf = np.zeros(m.size)
+    for n_phase, idx in seg_terms:
+        edf[idx] += edf_simple(n_phase, m[idx], alphas[idx])
+    lo, hi = confidence_interval(adev, edf, confidence)
+    return AllanResult(
+        tau_s=tau,
+        m=m,
+        adev=adev,
+        adev_low=np.asarray(lo, dtype=np.float64),
+        adev_high=np.asarray(hi, dtype=np.float64),
+        n_terms=n_terms,
+        edf=edf,
+        alpha=alphas,
+        unit=unit,
+        confidence=float(confidence),
+        tau0_s=float(tau0_s),
+        n_samples=used,
+        n_segments=segs,
+    )
+
+
+# --- noise terms -----------------------------------------------------------------------
+
+
+def term_units(unit: str) -> tuple[float, tuple[tuple[float, str, str], ...]]:
+    """Scale to the base unit and, per term, (factor, unit string, label).
+
+    A native coefficient (in unit·s^k, τ in seconds) times ``scale · factor`` is
+    the reported value.  See the module docstring for the table.
+    """
+    try:
+        u = units.normalize_signal_unit(unit)
+    except ThermocalInputError:
+        u = unit
+    if u in units.RATE_UNITS:
+        return units.RATE_UNITS[u], (
+            (1.0, "arcsec", "quantization"),
+            (units.ARW_DEG_SQRT_H_PER_DEG_H_SQRT_HZ, "deg/sqrt(h)", "angle random walk"),
+            (1.0, "deg/h", "bias instability"),
+            (math.sqrt(units.SECONDS_PER_HOUR), "deg/h/sqrt(h)", "rate random walk"),
+            (units.SECONDS_PER_HOUR, "deg/h/h", "rate ramp"),
+        )
+    if u in units.ACCEL_UNITS:
+        ug = 1.0 / units.UG_TO_MG
+        return units.ACCEL_UNITS[u], (
+            (units.MG_TO_MS2, "m/s", "velocity quantization"),
+            (ug, "ug/sqrt(Hz)", "velocity random walk"),
+            (ug, "ug", "bias instability"),
+            (ug * math.sqrt(units.SECONDS_PER_HOUR), "ug/sqrt(h)", "acceleration random walk"),
+            (ug * units.SECONDS_PER_HOUR, "ug/h", "acceleration ramp"),
+        )
+    return 1.0, (
+        (1.0, f"{u}*s", "quantization"),
+        (1.0, f"{u}*sqrt(s)", "random walk"),
+        (1.0, u, "bias instability"),
+        (1.0, f"{u}/sqrt(s)", "rate random walk"),
+        (1.0, f"{u}/s", "ramp"),
+    )
+
+
+def _fit(
+    result: AllanResult, significance: float
+) -> tuple[FloatArray, FloatArray, float, list[str | None]]:
+    """Weighted NNLS of σ²(τ) = Σ_{p=−2..2} C_p τ^p (IEEE 952 C.2).
+
+    Weights 1/sd(σ̂²) with sd(σ̂²) = σ² √(2/edf) (chi-square with edf degrees of
+    freedom), iterated three times with the fitted σ² in place of the noisy σ̂²;
+    standard errors from the QR factor of the weighted active design, scaled by
+    the reduced χ² when it exceeds 1.  Returns C, sd(C), reduced χ², reasons.
+    """
+    ok = np.isfinite(result.adev) & (result.adev > 0) & (result.edf > 0)
+    tau = result.tau_s[ok]
+    s2 = result.avar[ok]
+    edf = result.edf[ok]
+    powers = np.arange(-2, 3, dtype=np.float64)
+    design = tau[:, None] ** powers[None, :]
+    model = s2.copy()
+    coef = np.zeros(5)
+    for _ in range(3):
+        w = np.sqrt(edf / 2.0) / model
+        aw = design * w[:, None]
+        scale = np.linalg.norm(aw, axis=0)
+        scale[scale == 0] = 1.0
+        sol, _ = optimize.nnls(aw / scale, s2 * w)
+        coef = sol / scale
+        fitted = design @ coef
+        model = np.where(fitted > 0, fitted, s2)
+    w = np.sqrt(edf / 2.0) / model
+    aw = design * w[:, None]
+    resid = aw @ coef - s2 * w
+    active = coef > 0
+    dof = max(tau.size - int(active.sum()), 1)
+    red_chi2 = float(resid @ resid / dof)
+    sigma = np.full(5, np.nan)
+    if active.any():
+        a_act = aw[:, active]
+        col = np.linalg.norm(a_act, axis=0)
+        _q, r = np.linalg.qr(a_act / col)
+        if np.all(np.abs(np.diag(r)) > 1e-12 * np.abs(r).max()):
+            r_inv = linalg.solve_triangular(r, np.eye(r.shape[0]))
+            cov = (r_inv @ r_inv.T) / np.outer(col, col) * max(red_chi2, 1.0)
+            sigma[active] = np.sqrt(np.diag(cov))
+    reasons: list[str | None] = []
+    for j in range(5):
+        if coef[j] <= 0:
+            reasons.append("the non-negative least-squares fit sets this term to zero")
+        elif not np.isfinite(sigma[j]):
+            reasons.append("the fit cannot separate this term from the others")
+        elif coef[j] < significance * sigma[j]:
+            reasons.append(
+                f"not significant: fitted coefficient {coef[j]:.3g} ± {sigma[j]:.2g} "
+                f"is below {significance:g} standard errors"
+            )
+        else:
+            reasons.append(None)
+    return coef, sigma, red_chi2, reasons
+
+
+def _local_slope(log_tau: FloatArray, log_dev: FloatArray, edf: FloatArray, k: int) -> float:
+    """Weighted LS slope of ln σ vs ln τ over τ*/4 … 4τ*, at least the neighbours of k."""
+    near = np.abs(log_tau - log_tau[k]) <= math.log(_LOCAL_WINDOW) + 1e-12
+    near[max(k - 1, 0) : k + 2] = True
+    if near.sum() < 2:
+        return float("nan")
+    lt, ld, w = log_tau[near], log_dev[near], np.sqrt(edf[near])
+    design = np.column_stack([np.ones_like(lt), lt]) * w[:, None]
+    sol, *_ = np.linalg.lstsq(design, ld * w, rcond=None)
+    return float(sol[1])
+
+
+
+def _read_slope(
+    j: int,
+    tau: FloatArray,
+    lt: FloatArray,
+    ld: FloatArray,
+    edf: FloatArray,
+    local: FloatArray,
+    lo_ratio: FloatArray,
+    hi_ratio: FloatArray,
+) -> tuple[float, float, float, float] | str:
+    """Read term j off its slope line; (value, low, high, τ*) in native units, or a reason.
+
+    The region of slope s: the contiguous run of points (at least two) whose local
+    slope is within ±0.25 of s and which holds the tangent point τ* (the lowest
+    line of slope s touching the curve, argmin ln σ − s ln τ over such points).
+    The line's intercept is the EDF-weighted mean of ln σ − s ln τ over the run
+    (for bias instability: over τ*/2 … 2τ* within the run, i.e. the flat minimum).
+    """
+    s = TERM_SLOPES[j]
+    inside = np.abs(local - s) <= _SLOPE_TOLERANCE
+    if not inside.any():
+        return (
+            f"no region of slope {s:+g} in the data: local slopes range from "
+            f"{np.nanmin(local):+.2f} to {np.nanmax(local):+.2f}"
+        )
+    g = ld - s * lt
+    cand = np.flatnonzero(inside)
+    k = int(cand[np.argmin(g[cand])])
+    a = k
+    while a > 0 and inside[a - 1]:
+        a -= 1
+    b = k + 1
+    while b < inside.size and inside[b]:
+        b += 1
+    if b - a < 2:
+        return (
+            f"no region of slope {s:+g} in the data: only the single point τ = {tau[k]:.4g} s "
+            f"has a local slope near {s:+g} ({local[k]:+.2f})"
+        )
+    idx = np.arange(a, b)
+    if s == 0.0:
+        idx = idx[np.abs(lt[idx] - lt[k]) <= math.log(2.0) + 1e-12]
+    intercept = float(np.average(g[idx], weights=edf[idx]))
+    best = int(idx[np.argmax(edf[idx])])
+    if j == 2:
+        val = math.exp(intercept) / BIAS_INSTABILITY_FACTOR
+    else:
+        val = math.exp(intercept + s * math.log(READ_TAU_S[j]))
+    return val, val * float(lo_ratio[best]), val * float(hi_ratio[best]), float(tau[k])
+
+
+def noise_terms(
+    result: AllanResult, *, significance: float = 3.0, confidence: float | None = None
+) -> NoiseTerms:
+    """IEEE 952 noise terms by slope-line reading and by weighted least squares.
+
+    Fit (IEEE 952 C.2, SPEC §1): ``σ²(τ) = Σ_{p=−2..2} C_p τ^p`` by weighted NNLS
+    (see :func:`_fit`); ``Q = √(C₋₂/3)``, ``N = √C₋₁``, ``B = √(C₀ π/(2 ln 2))``,
+    ``K = √(3C₁)``, ``R = √(2C₂)``.  A coefficient that is zero or below
+    ``significance`` standard errors is reported as ``None`` with a reason.
+    Interval: ``C ± z·sd(C)`` (z the normal quantile of ``confidence``), mapped
+    through the square root.
+
+    Slope lines (IEEE 952 C.3): for slope s ∈ {−1, −½, 0, +½, +1} the region of
+    that slope is the run of points whose weighted local slope (ln σ against ln τ
+    over τ/4 … 4τ) is within ±0.25 of s and which holds the tangent point τ*
+    (the lowest line of slope s touching the curve there).  The line
+    ``ln σ = c + s ln τ`` with c the EDF-weighted mean over the run is read at
+    τ = √3 s (Q), 1 s (N), 3 s (K), √2 s (R); B = σ_flat / 0.6643 with σ_flat
+    the weighted mean over τ*/2 … 2τ* (the flat minimum).  A term is reported
+    only where its region exists (at least two points) and the least-squares fit
+    also finds it significant; otherwise ``None`` with the reason.  The interval
+    applies the chi-square interval of the region's best-determined point.
+    """
+    conf = result.confidence if confidence is None else confidence
+    scale, specs = term_units(result.unit)
+    coef, sigma, red_chi2, fit_reasons = _fit(result, significance)
+    z = float(stats.norm.ppf(0.5 + conf / 2.0))
+
+    fit_terms: list[NoiseTerm] = []
+    for j, (factor, u, label) in enumerate(specs):
+        f = _FIT_FACTORS[j] * 1.0
+        conv = scale * factor
+        if fit_reasons[j] is None:
+            val = math.sqrt(coef[j] / f) * conv
+            lo = math.sqrt(max(coef[j] - z * sigma[j], 0.0) / f) * conv
+            hi = math.sqrt((coef[j] + z * sigma[j]) / f) * conv
+            fit_terms.append(NoiseTerm(val, u, None, lo, hi, None, label))
+        else:
+            fit_terms.append(NoiseTerm(None, u, fit_reasons[j], label=label))
+
+    ok = np.isfinite(result.adev) & (result.adev > 0) & (result.edf > 0)
+    tau = result.tau_s[ok]
+    dev = result.adev[ok]
+    lo_ratio = result.adev_low[ok] / dev
+    hi_ratio = result.adev_high[ok] / dev
+    edf = result.edf[ok]
+    slope_terms: list[NoiseTerm] = []
+    if tau.size < 3:
+        reason = "fewer than three Allan deviation points: no slope can be read"
+        slope_terms = [NoiseTerm(None, u, reason, label=lb) for _f, u, lb in specs]
+    else:
+        lt, ld = np.log(tau), np.log(dev)
+        local = np.array([_local_slope(lt, ld, edf, k) for k in range(tau.size)])
+        for j, (factor, u, label) in enumerate(specs):
+            term = _read_slope(j, tau, lt, ld, edf, local, lo_ratio, hi_ratio)
+            if isinstance(term, str):
+                slope_terms.append(NoiseTerm(None, u, term, label=label))
+            elif fit_reasons[j] is not None:
+                reason = (
+                    f"a slope {TERM_SLOPES[j]:+g} stretch near τ = {term[3]:.4g} s is not "
+                    f"supported by the least-squares fit ({fit_reasons[j]})"
+                )
+                slope_terms.append(NoiseTerm(None, u, reason, tau_s=term[3], label=label))
+            else:
+                conv = scale * factor
+                val, lo, hi, tau_k = term
+                slope_terms.append(
+                    NoiseTerm(val * conv, u, None, lo * conv, hi * conv, tau_k, label)
+                )
+    return NoiseTerms(
+        slope=NoiseTermSet("slope", *slope_terms),
+        fit=NoiseTermSet("fit", *fit_terms),
+        fit_coefficients=coef,
+        fit_sigma=sigma,
+        reduced_chi2=red_chi2,
+    )
+
+
+__all__ = [
+    "BIAS_INSTABILITY_FACTOR",
+    "ONE_SIGMA_CONFIDENCE",
+    "TERM_NAMES",
+    "AllanResult",
+    "NoiseTerm",
+    "NoiseTermSet",
+    "NoiseTerms",
+    "averaging_factors",
+    "confidence_interval",
+    "edf_simple",
+    "identify_alpha",
+    "noise_terms",
+    "overlapping_adev",
+    "term_units",
+]

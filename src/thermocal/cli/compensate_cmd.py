@@ -1,0 +1,92 @@
+"""``thermocal compensate MODEL.json FILE -o OUT``: apply a fitted model to a recording.
+
+OUT keeps every input column and adds ``<signal>_model`` and ``<signal>_comp``
+(INTERFACE.md).  Files of any size are processed in chunks with constant memory
+(:func:`thermocal.compensate.compensate_file`).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated
+
+import typer
+from rich.table import Table
+
+from thermocal.cli.app import app
+from thermocal.cli.common import (
+    FileArg,
+    JsonOpt,
+    OutOpt,
+    SignalUnitOpt,
+    TempUnitOpt,
+    emit,
+    fmt,
+    handle_errors,
+    progress,
+    stdout,
+)
+from thermocal.compensate import DEFAULT_CHUNK_ROWS, compensate_file
+from thermocal.models.base import load_model
+
+ModelArg = Annotated[
+    Path, typer.Argument(help="Model file (JSON) written by `thermocal fit`.", show_default=False)
+]
+
+
+@app.command("compensate")
+@handle_errors
+def compensate_cmd(
+    model_file: ModelArg,
+    file: FileArg,
+    output: OutOpt,
+    signal: Annotated[
+        str | None,
+        typer.Option("--signal", help="Signal column (default: the model's signal name)."),
+    ] = None,
+    time: Annotated[str | None, typer.Option("--time", help="Time column.")] = None,
+    time_unit: Annotated[
+        str | None, typer.Option("--time-unit", help="Time unit: s, ms or us.")
+    ] = None,
+    signal_unit: SignalUnitOpt = None,
+    temp_unit: TempUnitOpt = None,
+    extrapolate: Annotated[
+        bool,
+        typer.Option(
+            "--extrapolate",
+            help="Evaluate the model outside its fitted temperature range instead of clamping.",
+        ),
+    ] = False,
+    chunk_rows: Annotated[
+        int, typer.Option("--chunk-rows", help="Rows read and written at a time.")
+    ] = DEFAULT_CHUNK_ROWS,
+    as_json: JsonOpt = False,
+) -> None:
+    """Apply MODEL to FILE; OUT gets every input column plus <signal>_model and <signal>_comp."""
+    model = load_model(model_file)
+    with progress("compensating") as advance:
+        res = compensate_file(
+            model,
+            file,
+            output,
+            signal=signal,
+            time=time,
+            time_unit=time_unit,
+            signal_unit=signal_unit,
+            temp_unit=temp_unit,
+            chunk_rows=chunk_rows,
+            extrapolate=extrapolate,
+            on_progress=advance,
+        )
+    summary = {"model": str(model_file), "family": model.family, **res.to_dict()}
+
+    def human() -> None:
+        table = Table(title=f"{file} → {res.output}", show_header=False)
+        table.add_row("model", f"{model.family} ({model_file})")
+        table.add_row("rows", str(res.n_rows))
+        table.add_row("added columns", f"{res.model_column}, {res.comp_column} [{res.unit}]")
+        table.add_row("rms before", f"{fmt(res.rms_before)} {res.unit}")
+        table.add_row("rms after", f"{fmt(res.rms_after)} {res.unit}")
+        stdout.print(table)
+
+    emit(summary, as_json, human)

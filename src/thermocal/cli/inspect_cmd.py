@@ -1,0 +1,118 @@
+"""``thermocal inspect FILE``: what is in a recording and what is wrong with it."""
+
+from __future__ import annotations
+
+import re
+from typing import Annotated
+
+import typer
+from rich.table import Table
+
+from thermocal.cli.app import app
+from thermocal.cli.common import (
+    FileArg,
+    JsonOpt,
+    SignalUnitOpt,
+    TempsOpt,
+    TempUnitOpt,
+    TimeUnitOpt,
+    emit,
+    fmt,
+    handle_errors,
+    split_names,
+    stdout,
+)
+from thermocal.inspection import Inspection, inspect_recording
+from thermocal.io import read_recording
+from thermocal.recording import Problem
+
+_TEMP_NAME = re.compile(r"^(t\d+|t_|temp|tmp)|temperature|°c|degc", re.IGNORECASE)
+
+
+@app.command("inspect")
+@handle_errors
+def inspect_cmd(
+    file: FileArg,
+    time: Annotated[str | None, typer.Option("--time", help="Time column.")] = None,
+    time_unit: TimeUnitOpt = "s",
+    signal: Annotated[
+        str | None, typer.Option("--signal", help="Comma-separated signal columns.")
+    ] = None,
+    temps: TempsOpt = None,
+    signal_unit: SignalUnitOpt = None,
+    temp_unit: TempUnitOpt = None,
+    strict: Annotated[
+        bool, typer.Option("--strict", help="Exit with status 2 when an error is found.")
+    ] = False,
+    as_json: JsonOpt = False,
+) -> None:
+    """Sample rate, duration, gaps, column ranges, NaNs and problems of a recording.
+
+    Temperature columns are taken from --temps, else from the file's metadata,
+    else guessed from their names (T1, temp_..., ...).
+    """
+    skipped: list[str] = []
+    rec = read_recording(
+        file,
+        time=time,
+        time_unit=time_unit if time_unit != "s" else None,
+        signals=split_names(signal),
+        temperatures=split_names(temps),
+        signal_unit=signal_unit,
+        temp_unit=temp_unit,
+        skipped=skipped,
+    )
+    if not rec.temperatures and temps is None:
+        guessed = tuple(c for c in rec.columns if _TEMP_NAME.search(c) and c not in rec.signals)
+        rec.temperatures = guessed
+        for c in guessed:
+            rec.units.setdefault(c, temp_unit or "degC")
+            if not rec.units[c]:
+                rec.units[c] = temp_unit or "degC"
+    result = inspect_recording(rec)
+    for c in skipped:
+        result.problems.append(
+            Problem(
+                "non_numeric",
+                f"column {c!r} holds non-numeric values and was skipped",
+                severity="warning",
+                column=c,
+            )
+        )
+    emit(result.to_dict(), as_json, lambda: _print_human(result))
+    if strict and any(p.severity == "error" for p in result.problems):
+        raise typer.Exit(2)
+
+
+def _print_human(r: Inspection) -> None:
+    stdout.print(f"[bold]{r.file}[/bold]")
+    stdout.print(
+        f"{r.n_samples} samples over {fmt(r.duration_s, 6)} s, "
+        f"sample rate {fmt(r.sample_rate_hz, 6)} Hz, {len(r.gaps)} gaps, "
+        f"{r.n_segments} contiguous segments"
+    )
+    table = Table("column", "role", "unit", "min", "max", "mean", "NaN", "spikes")
+    for c in r.columns.values():
+        table.add_row(
+            c.name,
+            c.role,
+            c.unit,
+            fmt(c.min, 6),
+            fmt(c.max, 6),
+            fmt(c.mean, 6),
+            str(c.n_nan),
+            str(c.n_spikes),
+        )
+    stdout.print(table)
+    if r.gaps:
+        shown = r.gaps[:10]
+        stdout.print(
+            "gaps (start s, length s): "
+            + ", ".join(f"({g['start_s']:.6g}, {g['length_s']:.6g})" for g in shown)
+            + (f" … {len(r.gaps) - 10} more" if len(r.gaps) > 10 else "")
+        )
+    if not r.problems:
+        stdout.print("[green]no problems found[/green]")
+    for p in r.problems:
+        colour = "red" if p.severity == "error" else "yellow"
+        stdout.print(f"[{colour}]{p.severity}[/{colour}]: {p.message}", markup=True)

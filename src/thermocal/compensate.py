@@ -1,0 +1,791 @@
+"""Batch, chunked and streaming compensation with a fitted model (SPEC §4, §8).
+
+A model gives the temperature-induced part of the signal, ``ŷ = model(T, Ṫ, …)``;
+the compensated output is ``F' = F − ŷ`` (SPEC §4c: "output F' = F − ΔF").
+
+Three ways to apply a model, all giving the same numbers:
+
+* :func:`compensate_run` — in memory, ``model.predict(run)`` on a whole run.
+* :func:`compensate_file` — a CSV or Parquet file of any size, read and written
+  in chunks with constant memory.  Every chunk is predicted together with the
+  *context* the model needs (the samples since power-on that fix its start-up
+  state and the last Δt seconds that feed the Ṫ buffer, see
+  :data:`CONTEXT_RULES`); because ``predict`` is causal (models/base.py
+  contract) the values of the chunk's own rows equal those of a whole-file
+  ``predict``.  Families without a context rule are streamed sample by sample
+  (:class:`StreamingCompensator`), which is exact but slower.
+* :class:`StreamingCompensator` — live data, one sample at a time; it wraps the
+  family's :class:`~thermocal.models.base.ModelStream`, which carries exactly the
+  state the model needs and resets its rate estimate after a gap (a step longer
+  than ``GAP_FACTOR`` × the sample interval).
+
+Units: the model predicts in its signal unit (``model.signal_unit``); data in
+another unit of the same kind are converted with :mod:`thermocal.units`, and
+the ``<signal>_model`` / ``<signal>_comp`` columns are written in the data
+column's own unit.  A model and data of different kinds (°/h against mg) is a
+:class:`~thermocal.errors.UnitError` naming both.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import warnings
+from collections.abc import Callable, Iterator
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import numpy.typing as npt
+import pandas as pd
+import pyarrow as pa
+import pyarrow.parquet as pq
+
+from thermocal import units
+from thermocal.errors import (
+    ExtrapolationWarning,
+    FileFormatError,
+    MissingColumnError,
+    MissingValueError,
+    ThermocalInputError,
+    TimestampError,
+    UnitError,
+)
+from thermocal.io import (
+    META_FORMAT,
+    META_KEY,
+    META_VERSION,
+    atomic_write_path,
+    check_not_input,
+    file_kind,
+    sidecar_path,
+    write_json,
+)
+from thermocal.models.base import ModelStream, RunData, TemperatureModel
+from thermocal.recording import GAP_FACTOR, FloatArray, Metadata, median_interval
+
+DEFAULT_CHUNK_ROWS = 500_000
+"""Rows per chunk of :func:`compensate_file` (≈ 100 MB of working memory for a
+37-term polynomial)."""
+
+MODEL_SUFFIX = "_model"
+COMP_SUFFIX = "_comp"
+
+
+# --- unit handling ------------------------------------------------------------------------
+
+
+def unit_factor(
+    data_unit: str,
+    model_unit: str,
+    *,
+    meta: Metadata | None = None,
+    sample_interval_s: float | None = None,
+    where: str = "",
+) -> float:
+    """Factor ``f`` with ``value[model unit] = f · value[data unit]`` (all units are linear).
+
+    Raw ``counts`` data are turned into a physical unit with the metadata's scale
+    factor K (SPEC §1: ``ω = N/(τK)`` or ``N/K``, :func:`thermocal.units.counts_to_physical`).
+
+    Raises
+    ------
+    UnitError : the two units measure different kinds of quantity (the message names
+        both), or counts cannot be converted because no scale factor is given.
+    """
+    du = units.normalize_signal_unit(data_unit)
+    mu = units.normalize_signal_unit(model_unit)
+    prefix = f"{where}: " if where else ""
+    if du == mu:
+        return 1.0
+    if du == "counts":
+        if meta is None or meta.scale_factor is None:
+            raise UnitError(
+                f"{prefix}the data signal is in raw counts but the model is in {mu!r} and "
+                "no scale factor K is given to convert them"
+            )
+        tau = sample_interval_s if sample_interval_s is not None else meta.sample_interval_s
+        phys_per_count, phys_unit = units.counts_to_physical(
+            1.0, meta.scale_factor, meta.scale_factor_unit or "counts/arcsec", float(tau or 1.0)
+        )
+        return float(phys_per_count) * unit_factor(phys_unit, mu, where=where)
+    if units.signal_kind(du) != units.signal_kind(mu):
+        raise UnitError(
+            f"{prefix}the model's signal unit {mu!r} ({units.signal_kind(mu)}) does not match the "
+            f"data's unit {du!r} ({units.signal_kind(du)})"
+        )
+    return float(units.convert(1.0, du, mu))
+
+
+# --- batch -------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class Compensation:
+    """Result of :func:`compensate_run`.
+
+    ``model_value`` ŷ and ``corrected`` ``F' = F − ŷ`` [model signal unit], shape (n,).
+    """
+
+    model_value: FloatArray
+    corrected: FloatArray
+
+
+def compensate_run(
+    model: TemperatureModel, run: RunData, *, extrapolate: bool = False
+) -> Compensation:
+    """Apply a model to a whole run in memory: ``F' = F − ŷ(T, Ṫ, …)`` (SPEC §4).
+
+    ``run.signal`` must be in the model's unit.  ``known_input`` is not removed:
+    the compensated output still contains the true input (earth rate, gravity).
+    """
+    if run.signal is None:
+        raise ThermocalInputError(f"{run.name or 'run'}: no signal to compensate")
+    y = np.asarray(model.predict(run, extrapolate=extrapolate), dtype=np.float64)
+    return Compensation(model_value=y, corrected=run.signal - y)
+
+
+# --- streaming -----------------------------------------------------------------------------
+
+
+class StreamingCompensator:
+    """Compensate live data sample by sample: ``F'_i = F_i − ŷ_i``.
+
+    Wraps ``model.stream(sample_interval_s)`` (the family's
+    :class:`~thermocal.models.base.ModelStream`): the rate buffer of length Δt,
+    T0/F0 captured at power-on and any start-up selection live there; a step
+    longer than ``GAP_FACTOR`` × ``sample_interval_s`` resets the rate estimate.
+    Time must increase strictly (a :class:`~thermocal.errors.TimestampError`
+    otherwise).  Signals and results are in the model's signal unit.
+
+    The outputs equal :func:`compensate_run` to 1e-12 (relative) on the same data,
+    start-up included, when ``sample_interval_s`` is the run's median interval.
+    """
+
+    def __init__(
+        self, model: TemperatureModel, sample_interval_s: float, *, extrapolate: bool = False
+    ) -> None:
+        if not (math.isfinite(sample_interval_s) and sample_interval_s > 0):
+            raise ThermocalInputError(
+                f"sample interval must be positive and finite, got {sample_interval_s!r}"
+            )
+        model.check_fitted()
+        self.model = model
+        self.sample_interval_s = float(sample_interval_s)
+        self.extrapolate = extrapolate
+        self._stream: ModelStream = model.stream(self.sample_interval_s, extrapolate=extrapolate)
+        self._last_t: float | None = None
+        self.last_model_value: float = float("nan")
+        """ŷ of the last sample [model signal unit]."""
+        self.n_samples = 0
+
+    def update(self, time_s: float, temps_c: npt.ArrayLike, signal: float) -> float:
+        """Corrected output ``F − ŷ`` of one sample: time [s], temperatures (k,) [°C],
+        raw signal F [model unit]."""
+        t = float(time_s)
+        if self._last_t is not None and not t > self._last_t:
+            raise TimestampError(
+                f"sample {self.n_samples}: time {t!r} does not increase (previous {self._last_t!r})"
+            )
+        temps = np.asarray(temps_c, dtype=np.float64).reshape(-1)
+        y = float(self._stream.update(t, temps, float(signal)))
+        self._last_t = t
+        self.last_model_value = y
+        self.n_samples += 1
+        return float(signal) - y
+
+    def reset(self) -> None:
+        """A new power-on: forget every state."""
+        self._stream.reset()
+        self._last_t = None
+        self.last_model_value = float("nan")
+        self.n_samples = 0
+
+    def process(
+        self, time_s: npt.ArrayLike, temps_c: npt.ArrayLike, signal: npt.ArrayLike
+    ) -> Compensation:
+        """Feed arrays sample by sample (state carried on from earlier calls)."""
+        t = np.asarray(time_s, dtype=np.float64)
+        T = np.asarray(temps_c, dtype=np.float64)
+        if T.ndim == 1:
+            T = T.reshape(-1, 1)
+        f = np.asarray(signal, dtype=np.float64)
+        y = np.empty_like(t)
+        c = np.empty_like(t)
+        for i in range(t.size):
+            c[i] = self.update(float(t[i]), T[i], float(f[i]))
+            y[i] = self.last_model_value
+        return Compensation(model_value=y, corrected=c)
+
+
+# --- chunk context rules ---------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class ChunkContext:
+    """What a chunk must be predicted together with to reproduce a whole-run predict.
+
+    ``head_s`` — seconds from the first sample whose samples fix the start-up state
+    (the warm-up window of T0/F0, the bank's selection window); ``tail_s`` — seconds of
+    history before the chunk (the Ṫ interval Δt).  ``None`` for either means the
+    family needs all history (then the file is streamed sample by sample).
+    """
+
+    head_s: float | None
+    tail_s: float | None
+
+
+def _params(model: TemperatureModel) -> dict[str, Any]:
+    return model.get_params()
+
+
+def _rate_tail_s(model: TemperatureModel) -> float:
+    if not model.uses_rate:
+        return 0.0
+    p = _params(model)
+    return float(p.get("rate_interval_s", 60.0) or 60.0)
+
+
+def _first_param(model: TemperatureModel, names: tuple[str, ...], default: float) -> float:
+    p = _params(model)
+    for n in names:
+        v = p.get(n)
+        if v is not None:
+            return float(v)
+    return default
+
+
+CONTEXT_RULES: dict[str, Callable[[TemperatureModel], ChunkContext]] = {
+    "poly": lambda m: ChunkContext(head_s=0.0, tail_s=_rate_tail_s(m)),
+    "piecewise": lambda m: ChunkContext(head_s=0.0, tail_s=_rate_tail_s(m)),
+    "warmup": lambda m: ChunkContext(
+        head_s=_first_param(m, ("start_window_s", "window_s"), math.inf),
+        tail_s=_rate_tail_s(m),
+    ),
+    "bank": lambda m: ChunkContext(
+        head_s=_first_param(m, ("startup_s", "start_window_s"), math.inf),
+        tail_s=_rate_tail_s(m),
+    ),
+}
+"""Chunk context of each family (STYLE rule 8: a registry keyed by family name).
+
+A family missing here is compensated by streaming (exact, slower)."""
+
+
+def chunk_context(model: TemperatureModel) -> ChunkContext:
+    """The :class:`ChunkContext` of a model's family (``None`` fields: stream instead)."""
+    rule = CONTEXT_RULES.get(model.family)
+    if rule is None:
+        return ChunkContext(head_s=None, tail_s=None)
+    ctx = rule(model)
+    if ctx.head_s is not None and not math.isfinite(ctx.head_s):
+        return ChunkContext(head_s=None, tail_s=ctx.tail_s)
+    return ctx
+
+
+class ChunkPredictor:
+    """Predict a long run chunk by chunk with the context carried across chunks.
+
+    For chunk ``c`` the model sees ``head ∪ tail ∪ c``: ``head`` = the samples in the
+    first ``head_s`` seconds of the run, ``tail`` = the samples of the previous
+    chunks within ``tail_s`` (plus a margin of a few sample intervals) before the
+    chunk.  When head and tail meet they are one contiguous stretch; otherwise
+    the jump in time between them is a gap, which the model treats like any gap.
+    Families without a finite context are streamed sample by sample.
+    """
+
+    MARGIN_SAMPLES = 4
+
+    def __init__(
+        self, model: TemperatureModel, *, extrapolate: bool = False, name: str = ""
+    ) -> None:
+        self.model = model
+        self.extrapolate = extrapolate
+        self.name = name
+        self.context = chunk_context(model)
+        self._rows_seen = 0
+        self._head_t: FloatArray = np.zeros(0)
+        self._head_T: FloatArray = np.zeros((0, 0))
+        self._head_f: FloatArray = np.zeros(0)
+        self._head_done = False
+        self._tail_t: FloatArray = np.zeros(0)
+        self._tail_T: FloatArray = np.zeros((0, 0))
+        self._tail_f: FloatArray = np.zeros(0)
+        self._stream: StreamingCompensator | None = None
+        self._tau: float | None = None
+        self.n_outside = 0
+        """Samples outside the model's fitted temperature range (for one summary warning)."""
+
+    @property
+    def streams(self) -> bool:
+        return self.context.head_s is None or self.context.tail_s is None
+
+    def predict(self, time_s: FloatArray, temps_c: FloatArray, signal: FloatArray) -> FloatArray:
+        """ŷ for the next chunk of rows (in order) [model unit]."""
+        n = time_s.size
+        if n == 0:
+            return np.zeros(0)
+        if self._tau is None:
+            tau = median_interval(time_s) if n > 1 else float("nan")
+            self._tau = tau if math.isfinite(tau) and tau > 0 else 1.0
+        lo, hi = self.model.temp_range_[:, 0], self.model.temp_range_[:, 1]
+        self.n_outside += int(np.count_nonzero(((temps_c < lo) | (temps_c > hi)).any(axis=1)))
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", ExtrapolationWarning)
+            if self.streams:
+                y = self._predict_stream(time_s, temps_c, signal)
+            else:
+                y = self._predict_context(time_s, temps_c, signal)
+        self._rows_seen += n
+        return y
+
+    def _predict_stream(
+        self, time_s: FloatArray, temps_c: FloatArray, signal: FloatArray
+    ) -> FloatArray:
+        if self._stream is None:
+            assert self._tau is not None
+            self._stream = StreamingCompensator(self.model, self._tau, extrapolate=self.extrapolate)
+        return self._stream.process(time_s, temps_c, signal).model_value
+
+    def _predict_context(
+        self, time_s: FloatArray, temps_c: FloatArray, signal: FloatArray
+    ) -> FloatArray:
+        assert self.context.head_s is not None
+        assert self.context.tail_s is not None
+        assert self._tau is not None
+        k = temps_c.shape[1]
+        if self._head_T.shape[1] != k:
+            self._head_T = np.zeros((0, k))
+            self._tail_T = np.zeros((0, k))
+        # context rows: head (only those not also in the tail) then tail
+        t0 = self._head_t[0] if self._head_t.size else time_s[0]
+        if self._tail_t.size and self._head_t.size:
+            keep_head = self._head_t < self._tail_t[0]
+        else:
+            keep_head = np.ones(self._head_t.size, dtype=bool)
+        ct = np.concatenate([self._head_t[keep_head], self._tail_t, time_s])
+        cT = np.concatenate([self._head_T[keep_head], self._tail_T, temps_c])
+        cf = np.concatenate([self._head_f[keep_head], self._tail_f, signal])
+        m = ct.size - time_s.size
+        run = RunData(time_s=ct, temps_c=cT, signal=cf, name=self.name)
+        y_all = np.asarray(self.model.predict(run, extrapolate=self.extrapolate), dtype=np.float64)
+        y = y_all[m:].copy()
+        # carry the context on
+        if not self._head_done:
+            head_s = self.context.head_s + self.MARGIN_SAMPLES * GAP_FACTOR * self._tau
+            in_head = time_s - t0 <= head_s
+            self._head_t = np.concatenate([self._head_t, time_s[in_head]])
+            self._head_T = np.concatenate([self._head_T, temps_c[in_head]])
+            self._head_f = np.concatenate([self._head_f, signal[in_head]])
+            self._head_done = not bool(in_head.all())
+        span = self.context.tail_s + self.MARGIN_SAMPLES * GAP_FACTOR * self._tau
+        start = int(np.searchsorted(ct, ct[-1] - span, side="left"))
+        start = max(0, min(start, ct.size - self.MARGIN_SAMPLES))
+        self._tail_t = ct[start:].copy()
+        self._tail_T = cT[start:].copy()
+        self._tail_f = cf[start:].copy()
+        return y
+
+    def finish(self) -> None:
+        """Issue one :class:`ExtrapolationWarning` for the whole file, if any sample
+        was outside the fitted range."""
+        if self.n_outside:
+            action = "extrapolated" if self.extrapolate else "clamped to the fitted range"
+            rng = ", ".join(
+                f"{n} {a:.2f}…{b:.2f} °C"
+                for n, (a, b) in zip(self.model.temp_names_, self.model.temp_range_, strict=True)
+            )
+            warnings.warn(
+                f"{self.name or 'data'}: {self.n_outside} samples outside the model's "
+                f"temperature range ({rng}); {action}",
+                ExtrapolationWarning,
+                stacklevel=2,
+            )
+
+
+# --- files ---------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class CompensateFileResult:
+    """Summary of :func:`compensate_file`."""
+
+    output: str
+    n_rows: int
+    n_chunks: int
+    signal: str
+    model_column: str
+    comp_column: str
+    unit: str
+    streamed: bool
+    rms_before: float
+    """Rms of the signal about its mean, whole file, per sample [data unit]."""
+    rms_after: float
+    """Rms of the compensated signal about its mean [data unit]."""
+    extra: dict[str, Any] = field(default_factory=dict)
+
+    def to_dict(self) -> dict[str, Any]:
+        d = {k: getattr(self, k) for k in self.__dataclass_fields__ if k != "extra"}
+        d.update(self.extra)
+        return d
+
+
+class _RunningMoments:
+    """Count, mean and sum of squared deviations merged chunk by chunk (Chan et al. 1979,
+    "Updating formulae and a pairwise algorithm for computing sample variances")."""
+
+    def __init__(self) -> None:
+        self.n = 0
+        self.mean = 0.0
+        self.m2 = 0.0
+
+    def add(self, x: FloatArray) -> None:
+        nb = int(x.size)
+        if nb == 0:
+            return
+        mb = float(np.mean(x))
+        m2b = float(np.sum((x - mb) ** 2))
+        n = self.n + nb
+        delta = mb - self.mean
+        self.mean += delta * nb / n
+        self.m2 += m2b + delta * delta * self.n * nb / n
+        self.n = n
+
+    def rms(self) -> float:
+        """Root mean square about the mean, ``sqrt(Σ(x − x̄)²/n)``."""
+        return math.sqrt(self.m2 / self.n) if self.n else float("nan")
+
+
+def _file_info(path: Path, kind: str) -> tuple[list[str], dict[str, Any], int | None]:
+    """Column names, thermocal metadata (sidecar over Parquet key-value) and row count."""
+    if not path.exists():
+        raise FileFormatError(f"{path}: no such file")
+    if path.stat().st_size == 0:
+        raise FileFormatError(f"{path}: the file is empty")
+    meta: dict[str, Any] = {}
+    n_rows: int | None = None
+    if kind == "parquet":
+        try:
+            pf = pq.ParquetFile(path)
+        except (pa.ArrowInvalid, OSError) as exc:
+            raise FileFormatError(f"{path}: not a readable Parquet file ({exc})") from None
+        names = list(pf.schema_arrow.names)
+        n_rows = int(pf.metadata.num_rows)
+        raw = (pf.schema_arrow.metadata or {}).get(META_KEY.encode())
+        if raw:
+            try:
+                meta = json.loads(raw.decode("utf-8"))
+            except (json.JSONDecodeError, UnicodeDecodeError):
+                raise FileFormatError(f"{path}: corrupt thermocal metadata") from None
+    else:
+        try:
+            head = pd.read_csv(path, nrows=0, skipinitialspace=True)
+        except (pd.errors.ParserError, pd.errors.EmptyDataError, UnicodeDecodeError) as exc:
+            msg = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+            raise FileFormatError(f"{path}: not a readable CSV file ({msg})") from None
+        names = [str(c).strip() for c in head.columns]
+    side = sidecar_path(path)
+    if side.exists():
+        try:
+            obj = json.loads(side.read_text(encoding="utf-8"))
+        except (json.JSONDecodeError, UnicodeDecodeError) as exc:
+            raise FileFormatError(f"{side}: not valid JSON ({exc})") from None
+        if not isinstance(obj, dict):
+            raise FileFormatError(f"{side}: expected a JSON object")
+        meta = {**meta, **obj}
+    return names, meta, n_rows
+
+
+def _iter_chunks(path: Path, kind: str, chunk_rows: int) -> Iterator[pd.DataFrame | pa.RecordBatch]:
+    if kind == "parquet":
+        pf = pq.ParquetFile(path)
+        yield from pf.iter_batches(batch_size=chunk_rows)
+    else:
+        reader = pd.read_csv(path, chunksize=chunk_rows, skipinitialspace=True, low_memory=False)
+        with reader:
+            for df in reader:
+                df.columns = [str(c).strip() for c in df.columns]
+                yield df
+
+
+def _column(chunk: pd.DataFrame | pa.RecordBatch, name: str, path: Path, row0: int) -> FloatArray:
+    if isinstance(chunk, pa.RecordBatch):
+        col = chunk.column(name)
+        if not (
+            pa.types.is_integer(col.type)
+            or pa.types.is_floating(col.type)
+            or pa.types.is_boolean(col.type)
+        ):
+            raise ThermocalInputError(f"{path}: column {name!r} is not numeric (type {col.type})")
+        return np.asarray(col.to_numpy(zero_copy_only=False), dtype=np.float64)
+    s = chunk[name]
+    if pd.api.types.is_numeric_dtype(s.dtype) and not pd.api.types.is_bool_dtype(s.dtype):
+        return s.to_numpy(dtype=np.float64, na_value=np.nan)
+    conv = pd.to_numeric(s, errors="coerce")
+    bad = conv.isna() & s.notna() & (s.astype(str).str.strip() != "")
+    if bad.any():
+        row = int(np.argmax(bad.to_numpy()))
+        raise ThermocalInputError(
+            f"{path}: non-numeric value {s.iloc[row]!r} in column {name!r} at row {row0 + row} "
+            f"(line {row0 + row + 2} of the file)"
+        )
+    return conv.to_numpy(dtype=np.float64, na_value=np.nan)
+
+
+def _check_finite(arr: FloatArray, label: str, path: Path, row0: int) -> None:
+    bad = ~np.isfinite(arr)
+    if bad.any():
+        row = int(np.argwhere(bad)[0][0])
+        raise MissingValueError(
+            f"{path}: {label} has a NaN/non-finite value at row {row0 + row}; clean or cut the "
+            "data first"
+        )
+
+
+def _append_columns(
+    chunk: pd.DataFrame | pa.RecordBatch, new: dict[str, FloatArray]
+) -> pd.DataFrame | pa.RecordBatch:
+    if isinstance(chunk, pa.RecordBatch):
+        arrays = [*chunk.columns, *(pa.array(v, type=pa.float64()) for v in new.values())]
+        return pa.RecordBatch.from_arrays(arrays, names=[*chunk.schema.names, *new.keys()])
+    out = chunk.copy()
+    for k, v in new.items():
+        out[k] = v
+    return out
+
+
+class _Writer:
+    """Writes chunks to a CSV or Parquet file (format by extension of the output)."""
+
+    def __init__(self, tmp: Path, kind: str, info: dict[str, Any]) -> None:
+        self.tmp = tmp
+        self.kind = kind
+        self.info = info
+        self._pq: pq.ParquetWriter | None = None
+        self._schema: pa.Schema | None = None
+        self._fh: Any = None
+        self._first = True
+
+    def write(self, chunk: pd.DataFrame | pa.RecordBatch) -> None:
+        if self.kind == "parquet":
+            if isinstance(chunk, pd.DataFrame):
+                df = chunk.copy()
+                for c in df.columns:
+                    dtype = df[c].dtype
+                    if pd.api.types.is_bool_dtype(dtype):
+                        continue
+                    if pd.api.types.is_numeric_dtype(dtype):
+                        df[c] = df[c].astype(np.float64)
+                    else:
+                        df[c] = df[c].astype("string")
+                table = pa.Table.from_pandas(df, preserve_index=False)
+            else:
+                table = pa.Table.from_batches([chunk])
+            if self._pq is None:
+                meta = dict(table.schema.metadata or {})
+                meta.pop(b"pandas", None)
+                meta[META_KEY.encode()] = json.dumps(self.info).encode("utf-8")
+                self._schema = table.schema.with_metadata(meta)
+                self._pq = pq.ParquetWriter(self.tmp, self._schema)
+            assert self._schema is not None
+            self._pq.write_table(table.cast(self._schema))
+        else:
+            df = chunk.to_pandas() if isinstance(chunk, pa.RecordBatch) else chunk
+            if self._fh is None:
+                self._fh = open(self.tmp, "w", encoding="utf-8", newline="")  # noqa: SIM115
+            df.to_csv(self._fh, index=False, header=self._first, lineterminator="\n")
+            self._first = False
+
+    def close(self) -> None:
+        if self._pq is not None:
+            self._pq.close()
+        if self._fh is not None:
+            self._fh.close()
+
+
+def compensate_file(
+    model: TemperatureModel,
+    path: str | Path,
+    out: str | Path,
+    *,
+    signal: str | None = None,
+    time: str | None = None,
+    time_unit: str | None = None,
+    signal_unit: str | None = None,
+    temp_unit: str | None = None,
+    chunk_rows: int = DEFAULT_CHUNK_ROWS,
+    extrapolate: bool = False,
+    on_progress: Callable[[int], None] | None = None,
+) -> CompensateFileResult:
+    """Compensate a CSV/Parquet file into ``out`` with constant memory.
+
+    ``out`` keeps every input column and adds ``<signal>_model`` (ŷ) and
+    ``<signal>_comp`` (``F − ŷ``), both in the data column's unit.  The signal
+    column is the model's ``signal_name`` unless ``signal`` is given; the
+    temperature columns are the model's.  Units: options, then the file's sidecar
+    or Parquet metadata; a signal without a stated unit is taken to be in the
+    model's unit.  The output is written to a temporary name and renamed when
+    complete (:func:`thermocal.io.atomic_write_path`); ``out`` may not be ``path``.
+
+    Chunks are predicted with their context (:class:`ChunkPredictor`), so the
+    result equals an in-memory ``predict`` of the whole file.
+
+    Raises
+    ------
+    MissingColumnError : the signal, time or a model temperature column is absent
+        (the missing and the available columns are named).
+    UnitError : the model's and the data's signal units differ in kind.
+    TimestampError, MissingValueError : time not increasing, NaN in a used column.
+    """
+    src = Path(path)
+    dst = Path(out)
+    kind_in = file_kind(src)
+    kind_out = file_kind(dst)
+    check_not_input(dst, [src])
+    if chunk_rows < 2:
+        raise ThermocalInputError(f"chunk size must be at least 2 rows, got {chunk_rows}")
+    model.check_fitted()
+    names, info, _ = _file_info(src, kind_in)
+    sig_name = signal or model.signal_name
+    time_col = time or info.get("time") or "time"
+    temp_names = list(model.temp_names_)
+    available = ", ".join(repr(c) for c in names)
+    if time_col not in names:
+        raise MissingColumnError(f"{src}: no time column {time_col!r}; available: {available}")
+    if sig_name not in names:
+        raise MissingColumnError(
+            f"{src}: no signal column {sig_name!r} (the model's signal"
+            f"{'' if signal is None else ' given by --signal'}); available: {available}"
+        )
+    missing = [c for c in temp_names if c not in names]
+    if missing:
+        raise MissingColumnError(
+            f"{src}: the model's temperature column(s) {', '.join(repr(c) for c in missing)} "
+            f"are not in the file; available: {available}"
+        )
+    model_col = sig_name + MODEL_SUFFIX
+    comp_col = sig_name + COMP_SUFFIX
+    for c in (model_col, comp_col):
+        if c in names:
+            raise ThermocalInputError(
+                f"{src}: already has a column {c!r}; was the file compensated already?"
+            )
+    t_unit = units.normalize_time_unit(time_unit or info.get("time_unit") or "s")
+    t_factor = units.TIME_UNITS[t_unit]
+    sig_info: dict[str, str] = dict(info.get("signals") or {})
+    extra_units: dict[str, str] = dict(info.get("units") or {})
+    tmp_info: dict[str, str] = dict(info.get("temperatures") or {})
+    data_unit = units.normalize_signal_unit(
+        signal_unit or sig_info.get(sig_name) or extra_units.get(sig_name) or model.signal_unit
+    )
+    md = Metadata.from_dict(dict(info.get("metadata") or {}))
+    temp_units = {
+        c: units.normalize_temperature_unit(temp_unit or tmp_info.get(c) or "degC")
+        for c in temp_names
+    }
+    for c, u in temp_units.items():
+        if u == "counts" and c not in md.temperature_conversion:
+            raise UnitError(
+                f"{src}: temperature column {c!r} is in raw counts and no conversion to °C is "
+                "given (temperature_conversion in the metadata)"
+            )
+
+    out_info = {
+        "format": META_FORMAT,
+        "version": META_VERSION,
+        **{k: v for k, v in info.items() if k not in ("format", "version")},
+    }
+    out_info["time"] = time_col
+    out_info["time_unit"] = t_unit
+    out_info["signals"] = {**sig_info, sig_name: data_unit}
+    out_info["temperatures"] = {**tmp_info, **temp_units}
+    out_info["units"] = {**extra_units, model_col: data_unit, comp_col: data_unit}
+
+    predictor = ChunkPredictor(model, extrapolate=extrapolate, name=str(src))
+    factor: float | None = None
+    state: dict[str, Any] = {"rows": 0, "chunks": 0, "last_t": None}
+    before = _RunningMoments()
+    after = _RunningMoments()
+
+    def writer(tmp: Path) -> None:
+        nonlocal factor
+        w = _Writer(tmp, kind_out, out_info)
+        try:
+            for chunk in _iter_chunks(src, kind_in, chunk_rows):
+                row0 = int(state["rows"])
+                t = _column(chunk, time_col, src, row0) * t_factor
+                _check_finite(t, f"time column {time_col!r}", src, row0)
+                dt = np.diff(t)
+                last_t = state["last_t"]
+                if (dt <= 0).any() or (last_t is not None and t.size and t[0] <= last_t):
+                    if last_t is not None and t.size and t[0] <= last_t:
+                        r = row0
+                    else:
+                        r = row0 + int(np.argmax(dt <= 0)) + 1
+                    raise TimestampError(f"{src}: time does not increase at row {r}")
+                temps = np.empty((t.size, len(temp_names)))
+                for j, c in enumerate(temp_names):
+                    v = _column(chunk, c, src, row0)
+                    if temp_units[c] == "counts":
+                        gain, offset = md.temperature_conversion[c]
+                        v = v * gain + offset
+                    _check_finite(v, f"temperature column {c!r}", src, row0)
+                    temps[:, j] = v
+                raw = _column(chunk, sig_name, src, row0)
+                _check_finite(raw, f"signal column {sig_name!r}", src, row0)
+                if factor is None:
+                    tau = md.sample_interval_s or (median_interval(t) if t.size > 1 else None)
+                    factor = unit_factor(
+                        data_unit, model.signal_unit, meta=md, sample_interval_s=tau, where=str(src)
+                    )
+                y_model = predictor.predict(t, temps, raw * factor)
+                y_data = y_model / factor
+                comp = raw - y_data
+                w.write(_append_columns(chunk, {model_col: y_data, comp_col: comp}))
+                state["rows"] = row0 + t.size
+                state["chunks"] = int(state["chunks"]) + 1
+                before.add(raw)
+                after.add(comp)
+                state["last_t"] = float(t[-1]) if t.size else last_t
+                if on_progress is not None:
+                    on_progress(int(t.size))
+        finally:
+            w.close()
+        if state["rows"] == 0:
+            raise FileFormatError(f"{src}: the file has a header but no data rows")
+
+    atomic_write_path(dst, writer)
+    if kind_out == "csv":
+        write_json(sidecar_path(dst), out_info)
+    predictor.finish()
+    n = int(state["rows"])
+    return CompensateFileResult(
+        output=str(dst),
+        n_rows=n,
+        n_chunks=int(state["chunks"]),
+        signal=sig_name,
+        model_column=model_col,
+        comp_column=comp_col,
+        unit=data_unit,
+        streamed=predictor.streams,
+        rms_before=before.rms(),
+        rms_after=after.rms(),
+    )
+
+
+__all__ = [
+    "COMP_SUFFIX",
+    "CONTEXT_RULES",
+    "DEFAULT_CHUNK_ROWS",
+    "MODEL_SUFFIX",
+    "ChunkContext",
+    "ChunkPredictor",
+    "CompensateFileResult",
+    "Compensation",
+    "StreamingCompensator",
+    "chunk_context",
+    "compensate_file",
+    "compensate_run",
+    "unit_factor",
+]

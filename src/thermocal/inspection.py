@@ -1,0 +1,193 @@
+"""What is in a recording and what is wrong with it (``thermocal inspect``).
+
+:func:`inspect_recording` summarises a :class:`~thermocal.recording.Recording`:
+sample count, duration, sample rate (from the median interval), gaps, per-column
+range and NaN count, temperature span, spikes (Hampel test) and the problems of
+:func:`thermocal.recording.find_problems`.  Pure computation; the CLI prints it.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+from numpy.lib.stride_tricks import sliding_window_view
+
+from thermocal.errors import ThermocalInputError
+from thermocal.recording import (
+    GAP_FACTOR,
+    FloatArray,
+    Problem,
+    Recording,
+    contiguous_slices,
+    find_gaps,
+    find_problems,
+    median_interval,
+)
+
+SPIKE_THRESHOLD = 8.0
+"""Hampel test: a sample further than this many robust σ from its window median is a spike."""
+SPIKE_HALF_WINDOW = 3
+
+
+@dataclass(frozen=True)
+class ColumnSummary:
+    """Range and NaN count of one column (in its own unit)."""
+
+    name: str
+    role: str
+    unit: str
+    min: float | None
+    max: float | None
+    mean: float | None
+    n_nan: int
+    first_nan_row: int | None
+    n_spikes: int
+
+    def to_dict(self) -> dict[str, Any]:
+        return dict(self.__dict__)
+
+
+@dataclass(frozen=True)
+class Inspection:
+    """Summary of a recording (INTERFACE.md ``inspect --json`` keys)."""
+
+    file: str
+    n_samples: int
+    duration_s: float
+    sample_rate_hz: float | None
+    median_interval_s: float | None
+    gaps: list[dict[str, float]]
+    n_segments: int
+    columns: dict[str, ColumnSummary]
+    temperature_span: dict[str, list[float] | None]
+    """[min, max] [°C] per temperature column (None if raw counts with no conversion)."""
+    problems: list[Problem] = field(default_factory=list)
+
+    def to_dict(self) -> dict[str, Any]:
+        return {
+            "file": self.file,
+            "n_samples": self.n_samples,
+            "duration_s": self.duration_s,
+            "sample_rate_hz": self.sample_rate_hz,
+            "median_interval_s": self.median_interval_s,
+            "gaps": self.gaps,
+            "n_gaps": len(self.gaps),
+            "n_segments": self.n_segments,
+            "columns": {k: v.to_dict() for k, v in self.columns.items()},
+            "temperature_span": self.temperature_span,
+            "problems": [p.to_dict() for p in self.problems],
+        }
+
+
+def count_spikes(
+    time_s: FloatArray,
+    x: FloatArray,
+    *,
+    threshold: float = SPIKE_THRESHOLD,
+    half_window: int = SPIKE_HALF_WINDOW,
+) -> tuple[int, int | None]:
+    """Count spikes with a Hampel test per contiguous segment.
+
+    A sample is a spike when ``|x_i − med_i| > threshold · 1.4826 · MAD_i`` where
+    ``med_i`` and ``MAD_i`` are the median and median absolute deviation of the
+    window ``i ± half_window`` (Hampel 1974; Pearson 2002).  Windows whose MAD is
+    zero use the segment's global MAD of first differences.  Returns the count and
+    the first spike's row.
+    """
+    n_total = 0
+    first: int | None = None
+    w = 2 * half_window + 1
+    for sl in contiguous_slices(time_s):
+        xs = x[sl]
+        if xs.size < w or not np.all(np.isfinite(xs)):
+            continue
+        win = sliding_window_view(xs, w)
+        med = np.median(win, axis=1)
+        mad = np.median(np.abs(win - med[:, None]), axis=1)
+        d = np.diff(xs)
+        floor = 1.4826 * float(np.median(np.abs(d - np.median(d)))) / np.sqrt(2.0)
+        sigma = np.maximum(1.4826 * mad, floor)
+        centre = xs[half_window : xs.size - half_window]
+        hit = (np.abs(centre - med) > threshold * sigma) & (sigma > 0)
+        idx = np.flatnonzero(hit)
+        if idx.size:
+            n_total += int(idx.size)
+            row = int(sl.start) + half_window + int(idx[0])
+            first = row if first is None else min(first, row)
+    return n_total, first
+
+
+def _temperature_span_c(rec: Recording, name: str) -> list[float] | None:
+    """[min, max] of a temperature column in °C (raw counts converted when the
+    metadata gives a conversion; otherwise None)."""
+    try:
+        temp = rec.temperature_c(name)
+    except ThermocalInputError:
+        return None
+    finite = temp[np.isfinite(temp)]
+    return [float(finite.min()), float(finite.max())] if finite.size else None
+
+
+def inspect_recording(rec: Recording) -> Inspection:
+    """Summarise a recording and list its problems (never raises on bad data)."""
+    t = rec.time_s
+    problems = find_problems(rec)
+    time_ok = not any(
+        p.kind in ("nonfinite_time", "duplicate_time", "backwards_time", "empty") for p in problems
+    )
+    med = median_interval(t) if t.size > 1 else float("nan")
+    gaps = find_gaps(t) if time_ok else []
+    columns: dict[str, ColumnSummary] = {}
+    span: dict[str, list[float] | None] = {}
+    for name, arr in rec.columns.items():
+        role = (
+            "signal"
+            if name in rec.signals
+            else "temperature"
+            if name in rec.temperatures
+            else "other"
+        )
+        finite = arr[np.isfinite(arr)]
+        nan = np.isnan(arr)
+        n_spikes, first_spike = count_spikes(t, arr) if time_ok and role != "other" else (0, None)
+        if n_spikes:
+            problems.append(
+                Problem(
+                    "spikes",
+                    f"column {name!r} has {n_spikes} spike samples (Hampel test, "
+                    f"{SPIKE_THRESHOLD:g} robust σ), first at row {first_spike}",
+                    severity="warning",
+                    column=name,
+                    row=first_spike,
+                )
+            )
+        columns[name] = ColumnSummary(
+            name=name,
+            role=role,
+            unit=rec.units.get(name, ""),
+            min=float(finite.min()) if finite.size else None,
+            max=float(finite.max()) if finite.size else None,
+            mean=float(finite.mean()) if finite.size else None,
+            n_nan=int(nan.sum()),
+            first_nan_row=int(np.argmax(nan)) if nan.any() else None,
+            n_spikes=n_spikes,
+        )
+        if role == "temperature":
+            span[name] = _temperature_span_c(rec, name)
+    return Inspection(
+        file=rec.name,
+        n_samples=rec.n_samples,
+        duration_s=float(t[-1] - t[0]) if t.size > 1 and time_ok else 0.0,
+        sample_rate_hz=(1.0 / med) if np.isfinite(med) and med > 0 else None,
+        median_interval_s=med if np.isfinite(med) else None,
+        gaps=[{"start_s": g.start_s, "length_s": g.length_s, "after_row": g.index} for g in gaps],
+        n_segments=len(gaps) + 1 if time_ok else 0,
+        columns=columns,
+        temperature_span=span,
+        problems=problems,
+    )
+
+
+__all__ = ["GAP_FACTOR", "ColumnSummary", "Inspection", "count_spikes", "inspect_recording"]

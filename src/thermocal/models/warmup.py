@@ -1,0 +1,626 @@
+"""Warm-up (self-heating) model with start-temperature dependence (SPEC §4c, seed 003).
+
+For a sensor used minutes after power-on.  Each run is one power-on.  With
+``T`` the temperature of one channel [°C] and ``F`` the output (known input
+removed) [signal unit]:
+
+* ``T0``, ``F0`` — the means of the samples of the start window (the first
+  ``start_window_s`` seconds: samples with ``t − t_first < start_window_s``);
+* ``ΔT = T − T0``, ``ΔF = F − F0`` for every later sample and, per run (stage 1)::
+
+      ΔF = a0 + a1 ΔT + a2 ΔT² + … + a_N ΔT^N          (N = ``order``)
+
+* each coefficient is a polynomial in the start temperature (stage 2, over the
+  l runs)::
+
+      a_j(T0) = b_j0 + b_j1 T0 + … + b_jM T0^M          (M = ``t0_order``)
+
+In use (``predict``/``stream``): measure T0 at power-on, evaluate ``a_j(T0)``,
+compute ``ΔT = T − T0`` at every sample and return ``ΔF``; the corrected output
+is ``F' = F − ΔF``.  Causality: during the start window T0 is the running mean
+of the samples so far (``T0_i = (1/(i+1)) Σ_{k≤i} T_k``), frozen once the window
+is full (first sample with ``t − t_first ≥ start_window_s``); predict and stream
+do exactly this, so they agree to the last bit.  A gap in time does not restart
+the window (the window is measured in time from the first sample; only
+``ModelStream.reset()`` — a new power-on — does).
+
+Fitting (least squares, SVD; SPEC "our reading"): ΔT is scaled by its largest
+absolute value and T0 centred and scaled, the solution is then converted back
+to the physical ``b``.  ``method="two_stage"`` is the seed's procedure (a_j per
+run, then a_j against T0); ``method="joint"`` fits ``ΔF = Σ_j Σ_k b_jk T0^k ΔT^j``
+to all samples of all runs at once (same model, one least-squares problem).
+Stage 2 needs runs at ≥ ``t0_order + 1`` distinct start temperatures (start
+temperatures closer than :data:`DISTINCT_T0_C` count as one), otherwise
+:class:`~thermocal.errors.DesignError`.
+
+Out of range: the temperature is clamped to the channel's fitted range and T0 to
+the fitted start-temperature range, each with an
+:class:`~thermocal.errors.ExtrapolationWarning` (``extrapolate=True`` evaluates
+as is, still warning).  ΔT is not clamped separately.
+
+Learned state (``_state()``, the layout the C export reads)::
+
+    {
+      "b": [[b_00, …, b_0M], …, [b_N0, …, b_NM]],  # (order+1) × (t0_order+1), physical
+                                                  # units [unit/°C^(j+k)]; row j is the
+                                                  # ΔT^j coefficient, column k the T0^k
+                                                  # power; row 0 all zero when a0 is off
+      "order": N, "t0_order": M,
+      "start_window_s": W,                        # start window [s]
+      "sensor_name": "T1",                        # the temperature channel used
+      "t0_range_c": [lo, hi],                     # fitted start temperatures [°C]
+      "start_temps_c": [...], "start_outputs": [...],   # T0, F0 of each fitted run
+      "run_coefficients": [[a_0, …, a_N], …]      # stage-1 a_j per run (two_stage)
+    }
+
+Evaluation (firmware twin): ``a_j = Σ_k b_jk T0^k`` (Horner in T0),
+``ΔF = Σ_j a_j ΔT^j`` (Horner in ΔT).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import warnings
+from collections.abc import Sequence
+from typing import Any, ClassVar, Self
+
+import numpy as np
+import numpy.typing as npt
+from numpy.polynomial import polynomial as npoly
+
+from thermocal.errors import (
+    ConditioningWarning,
+    DesignError,
+    ExtrapolationWarning,
+    ThermocalInputError,
+)
+from thermocal.models.base import (
+    Coefficient,
+    FitStats,
+    ModelStream,
+    RunData,
+    TemperatureModel,
+    register,
+)
+from thermocal.recording import FloatArray
+
+DISTINCT_T0_C = 1.0
+"""Start temperatures closer than this [°C] count as one start temperature."""
+
+CONDITION_WARN = 1e10
+"""A scaled design with a 2-norm condition number above this gets a ConditioningWarning."""
+
+RANK_RTOL = 1e-12
+"""Singular values below ``RANK_RTOL × s_max`` make a design singular (DesignError)."""
+
+METHODS = ("two_stage", "joint")
+
+
+# --- shared numerical helpers (also used by the bank family) ------------------------------
+
+
+@dataclasses.dataclass(frozen=True)
+class LstsqResult:
+    """Solution of ``min ‖X c − y‖₂`` by SVD.
+
+    ``coef`` (p,) or (p, q); ``cov_unit`` = (XᵀX)⁻¹ = V S⁻² Vᵀ (from the SVD, no
+    explicit inverse of XᵀX), multiply by s² for the covariance; ``sigma2`` the
+    residual variance s² = ‖r‖²/(n − p) per column (NaN when n = p);
+    ``condition_number`` = s_max/s_min; ``rank``; ``singular`` the indices of the
+    columns most involved in the null space (empty when full rank).
+    """
+
+    coef: FloatArray
+    cov_unit: FloatArray
+    sigma2: FloatArray
+    condition_number: float
+    rank: int
+    dof: int
+    null_columns: tuple[int, ...]
+
+
+def lstsq_svd(x: FloatArray, y: FloatArray) -> LstsqResult:
+    """Least squares ``c = V S⁻¹ Uᵀ y`` through the thin SVD ``X = U S Vᵀ``.
+
+    Covariance of the coefficients ``cov = s² V S⁻² Vᵀ`` with
+    ``s² = ‖y − Xc‖²/(n − p)`` (Golub & Van Loan, *Matrix Computations*, §5.5).
+    A rank-deficient design is not solved: ``rank < p`` and ``null_columns``
+    tell the caller which terms to name in its :class:`DesignError`.
+    """
+    n, p = x.shape
+    u, s, vt = np.linalg.svd(x, full_matrices=False)
+    smax = float(s[0]) if s.size else 0.0
+    tol = RANK_RTOL * smax
+    rank = int(np.count_nonzero(s > tol)) if smax > 0 else 0
+    if rank < p:
+        # columns with the largest weight in the weakest right singular vectors
+        weak = vt[rank:] if rank < vt.shape[0] else vt[-1:]
+        w = np.abs(weak).max(axis=0)
+        null = tuple(int(i) for i in np.flatnonzero(w > 0.1 * w.max()))
+        nan = np.full((p,) + y.shape[1:], np.nan)
+        return LstsqResult(
+            nan, np.full((p, p), np.nan), np.full(y.shape[1:], np.nan), math.inf, rank, n - p, null
+        )
+    uty = u.T @ y
+    coef = vt.T @ (uty / s[:, None] if y.ndim == 2 else uty / s)
+    resid = y - x @ coef
+    dof = n - p
+    sigma2 = (
+        np.asarray(np.sum(resid**2, axis=0) / dof, dtype=np.float64)
+        if dof > 0
+        else np.full(y.shape[1:], np.nan)
+    )
+    vs = vt.T / s
+    cov_unit = vs @ vs.T
+    return LstsqResult(
+        np.asarray(coef, dtype=np.float64),
+        np.asarray(cov_unit, dtype=np.float64),
+        sigma2,
+        smax / float(s[-1]),
+        rank,
+        dof,
+        (),
+    )
+
+
+def channel_index(family: str, run: RunData, sensor: int, fitted_name: str | None = None) -> int:
+    """Column of ``run.temps_c`` a single-channel model uses.
+
+    The fitted channel's name when the run has it, else the only column, else
+    column ``sensor`` (0 = the first named temperature channel).
+    """
+    k = run.temps_c.shape[1]
+    if fitted_name is not None:
+        if fitted_name in run.temp_names:
+            return run.temp_names.index(fitted_name)
+        if k == 1:
+            return 0
+    if not 0 <= sensor < k:
+        names = ", ".join(run.temp_names) or f"{k} unnamed"
+        raise ThermocalInputError(
+            f"{family}: temperature channel index sensor={sensor} does not exist in "
+            f"{run.name or 'run'} (channels: {names})"
+        )
+    return sensor
+
+
+def single_channel(run: RunData, col: int) -> RunData:
+    """A copy of ``run`` holding only temperature column ``col``."""
+    name = run.temp_names[col] if col < len(run.temp_names) else f"T{col + 1}"
+    return dataclasses.replace(run, temps_c=run.temps_c[:, [col]], temp_names=(name,))
+
+
+def horner(coef: FloatArray, x: FloatArray) -> FloatArray:
+    """``Σ_k coef[k] x^k`` by Horner's rule (same operations for arrays and scalars)."""
+    out = np.full_like(x, coef[-1])
+    for c in coef[-2::-1]:
+        out = out * x + c
+    return out
+
+
+def _clamp_range(
+    values: FloatArray, lo: float, hi: float, what: str, *, extrapolate: bool
+) -> FloatArray:
+    below = values < lo
+    above = values > hi
+    if below.any() or above.any():
+        n = int(np.count_nonzero(below | above))
+        action = "extrapolating" if extrapolate else "clamped to the fitted range"
+        warnings.warn(
+            f"{n} samples with {what} {float(values.min()):.2f}…{float(values.max()):.2f} °C "
+            f"outside the fitted {lo:.2f}…{hi:.2f} °C; {action}",
+            ExtrapolationWarning,
+            stacklevel=4,
+        )
+        if not extrapolate:
+            return np.clip(values, lo, hi)
+    return values
+
+
+def _window_count(time_s: FloatArray, window_s: float) -> int:
+    """Number of samples in the start window ``t − t_first < window_s`` (≥ 1)."""
+    return max(1, int(np.count_nonzero(time_s - time_s[0] < window_s)))
+
+
+def running_start_mean(time_s: FloatArray, x: FloatArray, window_s: float) -> FloatArray:
+    """Causal start value of every sample: the running mean over the start window,
+    frozen once the window is full (SPEC §4c, MODELS_COMMON causality rule)::
+
+        x0_i = (1/(i+1)) Σ_{k≤i} x_k   for i < m,     x0_i = x0_{m−1}   for i ≥ m
+
+    with m the number of samples with ``t − t_first < window_s``.  The sums are
+    sequential (``np.cumsum``), as in the streaming twin.
+    """
+    m = _window_count(time_s, window_s)
+    cs = np.cumsum(x[:m]) / np.arange(1, m + 1, dtype=np.float64)
+    out = np.empty_like(x)
+    out[:m] = cs
+    out[m:] = cs[-1]
+    return out
+
+
+def _poly_shift_matrix(mu: float, sigma: float, n: int) -> FloatArray:
+    """M with ``Σ_k c_k ((x − μ)/σ)^k = Σ_k (M c)_k x^k`` (binomial expansion)."""
+    m = np.zeros((n, n))
+    base = np.array([-mu / sigma, 1.0 / sigma])
+    for k in range(n):
+        pk = npoly.polypow(base, k) if k else np.array([1.0])
+        m[: pk.size, k] = pk
+    return m
+
+
+# --- the model ------------------------------------------------------------------------------
+
+
+@register
+class WarmupModel(TemperatureModel):
+    """Two-stage warm-up model ``ΔF = Σ_j a_j(T0) ΔT^j``, ``a_j(T0) = Σ_k b_jk T0^k``
+    (SPEC §4c, seed 003).
+
+    Parameters
+    ----------
+    order : highest power N of ΔT (≥ 1).
+    t0_order : highest power M of T0 in each a_j (≥ 0).
+    start_window_s : start window [s] for T0 and F0 (the seed's first m samples).
+    include_a0 : keep the constant a0 (the seed does); off forces ΔF = 0 at ΔT = 0.
+    sensor : index of the temperature channel used (0 = first named channel).
+    method : ``"two_stage"`` (seed) or ``"joint"`` (one least-squares problem).
+    """
+
+    family: ClassVar[str] = "warmup"
+    uses_rate: ClassVar[bool] = False
+
+    b_: FloatArray
+    b_stderr_: FloatArray | None
+    t0_range_: tuple[float, float]
+    sensor_name_: str
+    start_temps_: FloatArray
+    start_outputs_: FloatArray
+    run_coefficients_: FloatArray | None
+
+    def __init__(
+        self,
+        order: int = 2,
+        t0_order: int = 2,
+        start_window_s: float = 10.0,
+        include_a0: bool = True,
+        sensor: int = 0,
+        method: str = "two_stage",
+    ) -> None:
+        self.order = order
+        self.t0_order = t0_order
+        self.start_window_s = start_window_s
+        self.include_a0 = include_a0
+        self.sensor = sensor
+        self.method = method
+
+    @classmethod
+    def from_cli_options(cls, opts: dict[str, Any]) -> Self:
+        """Build from ``thermocal fit`` options (``start_window_s``, ``order``,
+        ``t0_order``, ``sensor``, ``include_a0``, ``method``); other keys and
+        ``None`` values are ignored."""
+        keys = ("order", "t0_order", "start_window_s", "include_a0", "sensor", "method")
+        return cls(**{k: opts[k] for k in keys if opts.get(k) is not None})
+
+    # -- validation --
+    def _check_params(self) -> None:
+        if not (isinstance(self.order, int | np.integer) and self.order >= 1):
+            raise ThermocalInputError(f"warmup: order must be an integer ≥ 1, got {self.order!r}")
+        if not (isinstance(self.t0_order, int | np.integer) and self.t0_order >= 0):
+            raise ThermocalInputError(
+                f"warmup: t0_order must be an integer ≥ 0, got {self.t0_order!r}"
+            )
+        if not (isinstance(self.start_window_s, int | float) and self.start_window_s > 0):
+            raise ThermocalInputError(
+                f"warmup: start_window_s must be positive [s], got {self.start_window_s!r}"
+            )
+        if self.method not in METHODS:
+            raise ThermocalInputError(
+                f"warmup: unknown method {self.method!r}; use one of {', '.join(METHODS)}"
+            )
+
+    @property
+    def _j0(self) -> int:
+        return 0 if self.include_a0 else 1
+
+    def _term_name(self, j: int, k: int) -> str:
+        return f"b{j}{k} (ΔT^{j}·T0^{k})"
+
+    # -- fit --
+    def fit(self, runs: Sequence[RunData]) -> Self:
+        """Fit the b matrix to several power-on runs (SPEC §4c).
+
+        Stage 1 (per run, post-window samples): ``ΔF = Σ_j a_j ΔT^j`` by least
+        squares.  Stage 2: ``a_j = Σ_k b_jk T0^k`` over the runs by least squares.
+        """
+        self._check_params()
+        if not runs:
+            raise ThermocalInputError("warmup: no runs to fit")
+        cols = [channel_index(self.family, r, self.sensor) for r in runs]
+        one = [single_channel(r, c) for r, c in zip(runs, cols, strict=True)]
+        names = {r.temp_names[0] for r in one}
+        if len(names) > 1:
+            raise ThermocalInputError(
+                f"warmup: the runs name the temperature channel differently: {sorted(names)}"
+            )
+        order, kt = int(self.order), int(self.t0_order)
+        j0 = self._j0
+        n_j = order + 1 - j0
+        n_k = kt + 1
+
+        t0s, f0s, dts, dfs = [], [], [], []
+        for r in one:
+            temp = r.temps_c[:, 0]
+            y = r.target()
+            m = _window_count(r.time_s, self.start_window_s)
+            t0 = float(running_start_mean(r.time_s, temp, self.start_window_s)[-1])
+            f0 = float(running_start_mean(r.time_s, y, self.start_window_s)[-1])
+            if r.n_samples - m < n_j:
+                raise DesignError(
+                    f"warmup: {r.name or 'run'} has {r.n_samples - m} samples after the "
+                    f"{self.start_window_s:g} s start window; at least {n_j} are needed "
+                    f"(order {order})"
+                )
+            t0s.append(t0)
+            f0s.append(f0)
+            dts.append(temp[m:] - t0)
+            dfs.append(y[m:] - f0)
+        t0_arr = np.array(t0s)
+
+        # distinct start temperatures (greedy grouping of the sorted T0s)
+        srt = np.sort(t0_arr)
+        n_distinct = 1 + int(np.count_nonzero(np.diff(srt) >= DISTINCT_T0_C))
+        if n_distinct < n_k:
+            raise DesignError(
+                f"warmup: t0_order={kt} needs runs at ≥ {n_k} distinct start temperatures "
+                f"(≥ {DISTINCT_T0_C:g} °C apart); got {n_distinct} "
+                f"({', '.join(f'{v:.2f}' for v in srt)} °C); add runs or lower --t0-order"
+            )
+
+        all_dt = np.concatenate(dts)
+        s_dt = float(np.max(np.abs(all_dt)))
+        if not s_dt > 0:
+            raise DesignError(
+                "warmup: the temperature does not change after the start window (ΔT ≡ 0); "
+                "the ΔT terms cannot be determined"
+            )
+        mu = float(np.mean(t0_arr))
+        sig = float(np.max(np.abs(t0_arr - mu))) or 1.0
+        powers_j = np.arange(j0, order + 1)
+
+        if self.method == "two_stage":
+            a_runs = np.empty((len(one), n_j))
+            cond = 0.0
+            for i, (dt, df) in enumerate(zip(dts, dfs, strict=True)):
+                x = (dt / s_dt)[:, None] ** powers_j[None, :]
+                res = lstsq_svd(x, df)
+                if res.rank < n_j:
+                    terms = ", ".join(f"ΔT^{powers_j[c]}" for c in res.null_columns)
+                    raise DesignError(
+                        f"warmup: {one[i].name or f'run {i}'}: term(s) {terms} cannot be "
+                        f"determined (ΔT takes too few distinct values after the start window)"
+                    )
+                cond = max(cond, res.condition_number)
+                a_runs[i] = res.coef
+            v = (t0_arr - mu) / sig
+            vmat = v[:, None] ** np.arange(n_k)[None, :]
+            res2 = lstsq_svd(vmat, a_runs)
+            if res2.rank < n_k:
+                raise DesignError(
+                    f"warmup: the start temperatures cannot determine T0 terms up to "
+                    f"T0^{kt}; lower --t0-order"
+                )
+            cond = max(cond, res2.condition_number)
+            c_scaled = res2.coef.T  # (n_j, n_k)
+            # cov(vec c) block-diagonal over j (per-coefficient residual variance)
+            cov_c = np.kron(np.diag(res2.sigma2), res2.cov_unit) if res2.dof > 0 else None
+            dof = res2.dof
+            run_coefs: FloatArray | None = a_runs
+        else:
+            u = np.concatenate(
+                [np.full(dt.size, (t0 - mu) / sig) for dt, t0 in zip(dts, t0s, strict=True)]
+            )
+            w = all_dt / s_dt
+            x = np.column_stack([w**j * u**k for j in powers_j for k in range(n_k)])
+            res = lstsq_svd(x, np.concatenate(dfs))
+            if res.rank < x.shape[1]:
+                terms = ", ".join(
+                    self._term_name(int(powers_j[c // n_k]), c % n_k) for c in res.null_columns
+                )
+                raise DesignError(f"warmup: singular joint design; term(s) {terms}")
+            cond = res.condition_number
+            c_scaled = res.coef.reshape(n_j, n_k)
+            cov_c = res.sigma2 * res.cov_unit if res.dof > 0 else None
+            dof = res.dof
+            run_coefs = None
+        if cond > CONDITION_WARN:
+            warnings.warn(
+                f"warmup: badly conditioned design (condition number {cond:.3g})",
+                ConditioningWarning,
+                stacklevel=2,
+            )
+
+        # physical b: a_j = (1/s^j) Σ_k c_jk ((T0 − μ)/σ)^k
+        mshift = _poly_shift_matrix(mu, sig, n_k)
+        transform = np.zeros((n_j * n_k, n_j * n_k))
+        for jj, j in enumerate(powers_j):
+            sl = slice(jj * n_k, (jj + 1) * n_k)
+            transform[sl, sl] = mshift / s_dt ** float(j)
+        b_vec = transform @ c_scaled.reshape(-1)
+        b = np.zeros((order + 1, n_k))
+        b[j0:] = b_vec.reshape(n_j, n_k)
+        self.b_ = b
+        if cov_c is not None:
+            cov_b = transform @ cov_c @ transform.T
+            se = np.zeros((order + 1, n_k))
+            se[j0:] = np.sqrt(np.maximum(np.diag(cov_b), 0.0)).reshape(n_j, n_k)
+            self.b_stderr_ = se
+        else:
+            self.b_stderr_ = None
+        self.t0_range_ = (float(t0_arr.min()), float(t0_arr.max()))
+        self.sensor_name_ = one[0].temp_names[0]
+        self.start_temps_ = t0_arr
+        self.start_outputs_ = np.array(f0s)
+        self.run_coefficients_ = (
+            None
+            if run_coefs is None
+            else np.column_stack(
+                [np.zeros((len(one), j0)), run_coefs / s_dt ** powers_j.astype(float)]
+            )
+        )
+
+        # residuals of the full model on the post-window samples
+        resid = np.concatenate(
+            [
+                df - _evaluate(b, np.full(dt.size, t0), dt)
+                for dt, df, t0 in zip(dts, dfs, t0s, strict=True)
+            ]
+        )
+        all_df = np.concatenate(dfs)
+        sst = float(np.sum((all_df - all_df.mean()) ** 2))
+        rss = float(np.sum(resid**2))
+        self._record_common(
+            one,
+            FitStats(
+                n_samples=int(all_df.size),
+                n_coefficients=n_j * n_k,
+                rms_residual=float(np.sqrt(np.mean(resid**2))),
+                condition_number=float(cond),
+                r_squared=1.0 - rss / sst if sst > 0 else None,
+                dof=int(dof),
+                extra={
+                    "method": self.method,
+                    "n_runs": len(one),
+                    "n_start_temperatures": n_distinct,
+                    "start_temperatures_c": [float(v) for v in t0_arr],
+                },
+            ),
+        )
+        return self
+
+    # -- use --
+    def _prepare(self, run: RunData) -> FloatArray:
+        self.check_fitted()
+        col = channel_index(self.family, run, self.sensor, self.sensor_name_)
+        return np.asarray(run.temps_c[:, col], dtype=np.float64)
+
+    def predict(self, run: RunData, *, extrapolate: bool = False) -> FloatArray:
+        """ΔF of every sample: ``Σ_j a_j(T0_i) (T_i − T0_i)^j`` with the causal T0_i
+        (running mean over the start window, then frozen) [signal unit]."""
+        temp = self.clamp(self._prepare(run)[:, None], extrapolate=extrapolate)[:, 0]
+        t0 = running_start_mean(run.time_s, temp, float(self.start_window_s))
+        t0c = _clamp_range(t0, *self.t0_range_, "start temperature T0", extrapolate=extrapolate)
+        return _evaluate(self.b_, t0c, temp - t0)
+
+    def stream(self, sample_interval_s: float, *, extrapolate: bool = False) -> ModelStream:
+        """Sample-by-sample twin of :meth:`predict` (T0 captured at power-on)."""
+        self.check_fitted()
+        return WarmupStream(self, extrapolate=extrapolate)
+
+    def a_of_t0(self, t0_c: float | npt.ArrayLike) -> FloatArray:
+        """Coefficients ``a_j(T0) = Σ_k b_jk T0^k`` for start temperature(s) T0 [°C];
+        shape (order+1,) or (n, order+1)."""
+        self.check_fitted()
+        x = np.asarray(t0_c, dtype=np.float64)
+        out = np.stack(
+            [horner(self.b_[j], np.atleast_1d(x)) for j in range(self.b_.shape[0])], axis=-1
+        )
+        return out[0] if x.ndim == 0 else out
+
+    def coefficients(self) -> list[Coefficient]:
+        self.check_fitted()
+        out = []
+        unit = self.signal_unit
+        for j in range(self._j0, self.b_.shape[0]):
+            for k in range(self.b_.shape[1]):
+                p = j + k
+                out.append(
+                    Coefficient(
+                        name=f"b{j}{k}",
+                        value=float(self.b_[j, k]),
+                        stderr=None if self.b_stderr_ is None else float(self.b_stderr_[j, k]),
+                        unit=unit if p == 0 else f"{unit}/degC^{p}" if p > 1 else f"{unit}/degC",
+                    )
+                )
+        return out
+
+    def _state(self) -> dict[str, Any]:
+        return {
+            "b": self.b_.tolist(),
+            "b_stderr": None if self.b_stderr_ is None else self.b_stderr_.tolist(),
+            "order": int(self.order),
+            "t0_order": int(self.t0_order),
+            "start_window_s": float(self.start_window_s),
+            "sensor_name": self.sensor_name_,
+            "t0_range_c": list(self.t0_range_),
+            "start_temps_c": self.start_temps_.tolist(),
+            "start_outputs": self.start_outputs_.tolist(),
+            "run_coefficients": (
+                None if self.run_coefficients_ is None else self.run_coefficients_.tolist()
+            ),
+        }
+
+    def _set_state(self, state: dict[str, Any]) -> None:
+        self.b_ = np.array(state["b"], dtype=np.float64)
+        se = state.get("b_stderr")
+        self.b_stderr_ = None if se is None else np.array(se, dtype=np.float64)
+        self.sensor_name_ = str(state["sensor_name"])
+        lo, hi = state["t0_range_c"]
+        self.t0_range_ = (float(lo), float(hi))
+        self.start_temps_ = np.array(state.get("start_temps_c", []), dtype=np.float64)
+        self.start_outputs_ = np.array(state.get("start_outputs", []), dtype=np.float64)
+        rc = state.get("run_coefficients")
+        self.run_coefficients_ = None if rc is None else np.array(rc, dtype=np.float64)
+
+
+def _evaluate(b: FloatArray, t0: FloatArray, dt: FloatArray) -> FloatArray:
+    """``ΔF = Σ_j a_j(T0) ΔT^j`` with ``a_j(T0) = Σ_k b_jk T0^k`` (Horner in both)."""
+    a = [horner(b[j], t0) for j in range(b.shape[0])]
+    out = a[-1]
+    for aj in a[-2::-1]:
+        out = out * dt + aj
+    return out
+
+
+class WarmupStream(ModelStream):
+    """Streaming twin of :meth:`WarmupModel.predict`: keeps the start-window sum of
+    T (running mean T0, frozen when the window is full)."""
+
+    def __init__(self, model: WarmupModel, *, extrapolate: bool = False) -> None:
+        self.model = model
+        self.extrapolate = extrapolate
+        self.reset()
+
+    def reset(self) -> None:
+        self._t_first: float | None = None
+        self._sum = 0.0
+        self._count = 0
+        self._frozen = False
+        self._t0 = math.nan
+
+    @property
+    def t0_c(self) -> float:
+        """The start temperature T0 [°C] so far (running mean until frozen)."""
+        return self._t0
+
+    def update(self, time_s: float, temps_c: FloatArray, signal: float | None = None) -> float:
+        m = self.model
+        row = np.asarray(temps_c, dtype=np.float64).reshape(1, -1)
+        # one value: the model's channel; several: the fitted run's channels, use ``sensor``
+        col = 0 if row.shape[1] == 1 else int(m.sensor)
+        temp_raw = row[:, col]
+        temp = m.clamp(temp_raw[:, None], extrapolate=self.extrapolate)[:, 0]
+        if self._t_first is None:
+            self._t_first = float(time_s)
+        if not self._frozen and float(time_s) - self._t_first < m.start_window_s:
+            self._sum = self._sum + float(temp[0])
+            self._count += 1
+            self._t0 = self._sum / self._count
+        elif not self._frozen:
+            self._frozen = True
+            if self._count == 0:  # pragma: no cover - the first sample is always in
+                self._t0 = float(temp[0])
+        t0 = np.array([self._t0])
+        t0c = _clamp_range(t0, *m.t0_range_, "start temperature T0", extrapolate=self.extrapolate)
+        return float(_evaluate(m.b_, t0c, temp - t0)[0])

@@ -1,0 +1,726 @@
+"""Chamber test profiles, their correlation, and the weakly-correlated validation design.
+
+A :class:`Profile` is a start temperature and a list of segments (SPEC §6):
+
+* :class:`Hold` — keep the set-point for ``duration_s`` [s];
+* :class:`Ramp` — move the set-point to ``target_c`` [°C] at ``rate_c_per_min`` [°C/min];
+* :class:`Cycle` — repeat a list of segments ``repeats`` times.
+
+Expanded, a profile is a continuous piecewise-linear set-point ``setpoint_c(t)``
+(:meth:`Profile.pieces`, :meth:`Profile.knots`), written as a chamber program of
+two columns ``time_s, setpoint_c`` (:meth:`Profile.program`, :func:`write_program`).
+Ramps therefore have exactly their rate and holds exactly their duration.
+
+The built-in profiles (:data:`PROFILE_NAMES`, :func:`builtin_profile`) follow the
+seeds: ``rlg-modelling`` and ``rlg-validation`` (seed 000), ``fog-slow`` (seed 001),
+``mems-warmup`` (seed 003), ``accel-full-range`` (seed 004).
+
+:func:`correlate` is the seed-000 weak-correlation test ``r = Cov(X, Y)/(σ_X σ_Y)``
+(SPEC §5) on a common elapsed-time base, and :func:`design_validation_profile`
+searches (seeded) for a hold profile over the same temperature range with ``|r|``
+below the limit.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import numpy.typing as npt
+import pandas as pd
+
+from thermocal.errors import (
+    DesignError,
+    FileFormatError,
+    MissingColumnError,
+    NonNumericError,
+    ThermocalInputError,
+    TimestampError,
+)
+from thermocal.io import atomic_write
+from thermocal.units import SECONDS_PER_MINUTE
+
+FloatArray = npt.NDArray[np.float64]
+
+WEAK_CORRELATION_LIMIT = 0.4
+"""Seed 000: a validation test is weakly correlated with the modelling test when r < 0.4."""
+
+DEFAULT_CORRELATION_POINTS = 10_000
+"""Number of points of the common elapsed-time base used by :func:`correlate`."""
+
+# --- segments --------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class Hold:
+    """Keep the current set-point for ``duration_s`` [s]."""
+
+    duration_s: float
+    label: str = ""
+
+    def __post_init__(self) -> None:
+        if not (math.isfinite(self.duration_s) and self.duration_s >= 0):
+            raise ThermocalInputError(f"hold duration must be ≥ 0 s, got {self.duration_s!r}")
+
+
+@dataclass(frozen=True)
+class Ramp:
+    """Move the set-point linearly to ``target_c`` [°C] at ``|rate_c_per_min|`` [°C/min].
+
+    The duration is ``|target − current| / |rate| · 60`` [s]; the sign of the
+    rate is ignored (the direction follows from the target).
+    """
+
+    target_c: float
+    rate_c_per_min: float
+    label: str = ""
+
+    def __post_init__(self) -> None:
+        if not math.isfinite(self.target_c):
+            raise ThermocalInputError(f"ramp target must be finite, got {self.target_c!r}")
+        if not (math.isfinite(self.rate_c_per_min) and self.rate_c_per_min != 0):
+            raise ThermocalInputError(
+                f"ramp rate must be finite and non-zero, got {self.rate_c_per_min!r} °C/min"
+            )
+
+
+@dataclass(frozen=True)
+class Cycle:
+    """Repeat ``segments`` ``repeats`` times.
+
+    When ``label`` is set, the pieces of repetition ``i`` (1-based) are labelled
+    ``f"{label}{i}/{piece label}"``, so repetitions can be told apart
+    (e.g. ``run3/soak-low``).
+    """
+
+    segments: tuple[Segment, ...]
+    repeats: int = 1
+    label: str = ""
+
+    def __post_init__(self) -> None:
+        if int(self.repeats) != self.repeats or self.repeats < 1:
+            raise ThermocalInputError(f"cycle repeats must be an integer ≥ 1, got {self.repeats!r}")
+
+
+Segment = Hold | Ramp | Cycle
+
+
+@dataclass(frozen=True)
+class Piece:
+    """One linear piece of an expanded profile: ``start_c`` at ``start_s`` to ``end_c`` at
+    ``end_s`` ([s], [°C]); ``kind`` is ``"hold"`` or ``"ramp"``."""
+
+    start_s: float
+    end_s: float
+    start_c: float
+    end_c: float
+    kind: str
+    label: str = ""
+
+    @property
+    def duration_s(self) -> float:
+        return self.end_s - self.start_s
+
+    @property
+    def rate_c_per_min(self) -> float:
+        """Slope [°C/min] (0 for a hold)."""
+        d = self.duration_s
+        return 0.0 if d == 0 else (self.end_c - self.start_c) / d * SECONDS_PER_MINUTE
+
+
+@dataclass(frozen=True)
+class Stage:
+    """A constant-temperature stage (hold) of a program: ``start_s``..``end_s`` at ``setpoint_c``."""
+
+    start_s: float
+    end_s: float
+    setpoint_c: float
+    label: str = ""
+
+    def to_dict(self) -> dict[str, Any]:
+        return {
+            "label": self.label,
+            "start_s": float(self.start_s),
+            "end_s": float(self.end_s),
+            "setpoint_c": float(self.setpoint_c),
+        }
+
+
+def _expand(
+    segments: Sequence[Segment], t: float, temp: float, prefix: str, out: list[Piece]
+) -> tuple[float, float]:
+    for seg in segments:
+        if isinstance(seg, Hold):
+            if seg.duration_s > 0:
+                out.append(Piece(t, t + seg.duration_s, temp, temp, "hold", prefix + seg.label))
+                t += seg.duration_s
+        elif isinstance(seg, Ramp):
+            delta = seg.target_c - temp
+            if delta != 0:
+                dur = abs(delta) / abs(seg.rate_c_per_min) * SECONDS_PER_MINUTE
+                out.append(Piece(t, t + dur, temp, seg.target_c, "ramp", prefix + seg.label))
+                t += dur
+                temp = seg.target_c
+        elif isinstance(seg, Cycle):
+            for i in range(int(seg.repeats)):
+                sub = f"{prefix}{seg.label}{i + 1}/" if seg.label else prefix
+                t, temp = _expand(seg.segments, t, temp, sub, out)
+        else:  # pragma: no cover - typing guards this
+            raise ThermocalInputError(f"unknown profile segment {seg!r}")
+    return t, temp
+
+
+@dataclass(frozen=True)
+class Profile:
+    """A chamber profile: start set-point ``start_c`` [°C] and a list of segments.
+
+    ``params`` records the parameters a built-in profile was made with.
+    """
+
+    start_c: float
+    segments: tuple[Segment, ...]
+    name: str = ""
+    params: dict[str, Any] = field(default_factory=dict, compare=False)
+
+    def pieces(self) -> list[Piece]:
+        """The expanded linear pieces, in time order, from ``t = 0``."""
+        out: list[Piece] = []
+        _expand(self.segments, 0.0, float(self.start_c), "", out)
+        return out
+
+    @property
+    def duration_s(self) -> float:
+        """Total duration [s]."""
+        p = self.pieces()
+        return p[-1].end_s if p else 0.0
+
+    def knots(self) -> tuple[FloatArray, FloatArray]:
+        """Corner points ``(time_s, setpoint_c)`` of the piecewise-linear set-point."""
+        p = self.pieces()
+        if not p:
+            return np.zeros(1), np.array([float(self.start_c)])
+        t = np.array([p[0].start_s] + [q.end_s for q in p])
+        c = np.array([p[0].start_c] + [q.end_c for q in p])
+        return t, c
+
+    def program(self, dt_s: float | None = 60.0) -> tuple[FloatArray, FloatArray]:
+        """The chamber program ``(time_s, setpoint_c)``.
+
+        With ``dt_s`` the set-point is sampled every ``dt_s`` seconds from 0 (the
+        end point is appended when it is not on the grid); with ``None`` only the
+        corner points are returned.  Linear interpolation of either reproduces the
+        profile exactly at the returned times.
+        """
+        tk, ck = self.knots()
+        if dt_s is None:
+            return tk, ck
+        if not (math.isfinite(dt_s) and dt_s > 0):
+            raise ThermocalInputError(f"program step must be > 0 s, got {dt_s!r}")
+        end = float(tk[-1])
+        n = int(math.floor(end / dt_s + 1e-9)) + 1
+        t = np.arange(n, dtype=np.float64) * dt_s
+        if end - t[-1] > 1e-9 * max(1.0, end):
+            t = np.append(t, end)
+        return t, np.interp(t, tk, ck)
+
+    def setpoint_at(self, time_s: npt.ArrayLike) -> FloatArray:
+        """Set-point [°C] at the given elapsed times [s] (held at the ends)."""
+        tk, ck = self.knots()
+        return np.interp(np.asarray(time_s, dtype=np.float64), tk, ck)
+
+    def stages(self) -> list[Stage]:
+        """The holds of the profile as :class:`Stage` (with their labels)."""
+        return [
+            Stage(p.start_s, p.end_s, p.start_c, p.label) for p in self.pieces() if p.kind == "hold"
+        ]
+
+
+# --- built-in profiles (seed 000, 001, 003, 004) ---------------------------------------------
+
+
+def rlg_modelling(
+    *,
+    low_c: float = -20.0,
+    high_c: float = 50.0,
+    start_c: float = 20.0,
+    n_temperature_cycles: int = 2,
+    cycle_rate_c_per_min: float = 1.0,
+    hold_s: float = 3600.0,
+    rates_c_per_min: Sequence[float] = (2.0, 1.0, 0.5, 0.2, 0.1),
+    rate_hold_s: float = 1800.0,
+) -> Profile:
+    """Seed-000 modelling test (SPEC §6): cycles between ``low_c`` and ``high_c``, then
+    cycles with ramps of ±2, ±1, ±0.5, ±0.2 and ±0.1 °C/min.
+
+    Part 1 (label ``temperature-cycle``): ``n_temperature_cycles`` × (ramp to
+    ``high_c``, hold ``hold_s``, ramp to ``low_c``, hold ``hold_s``) at
+    ``cycle_rate_c_per_min``.  Part 2 (label ``rate ±R``): for each rate R, ramp to
+    ``high_c`` and back to ``low_c`` at R with ``rate_hold_s`` holds at the ends.
+    Finally a ramp back to ``start_c``.  The default lasts ≈ 57 h.
+    """
+    if not low_c < high_c:
+        raise ThermocalInputError(f"low_c ({low_c}) must be below high_c ({high_c})")
+    segs: list[Segment] = [
+        Cycle(
+            (
+                Ramp(high_c, cycle_rate_c_per_min, "temperature-cycle"),
+                Hold(hold_s, "temperature-cycle hold high"),
+                Ramp(low_c, cycle_rate_c_per_min, "temperature-cycle"),
+                Hold(hold_s, "temperature-cycle hold low"),
+            ),
+            repeats=int(n_temperature_cycles),
+        )
+    ]
+    for r in rates_c_per_min:
+        lab = f"rate ±{abs(r):g}"
+        segs += [
+            Ramp(high_c, r, lab),
+            Hold(rate_hold_s, lab + " hold high"),
+            Ramp(low_c, r, lab),
+            Hold(rate_hold_s, lab + " hold low"),
+        ]
+    segs.append(Ramp(start_c, cycle_rate_c_per_min, "return"))
+    return Profile(float(start_c), tuple(segs), "rlg-modelling")
+
+
+DEFAULT_VALIDATION_HOLDS_C: tuple[float, ...] = (5.0, -20.0, 35.0, -5.0, 50.0, 20.0, -10.0, 40.0)
+"""Hold temperatures of the default ``rlg-validation`` profile (|r| < 0.4 against the
+default ``rlg-modelling`` profile; checked in the tests)."""
+
+
+def rlg_validation(
+    *,
+    holds_c: Sequence[float] = DEFAULT_VALIDATION_HOLDS_C,
+    hold_s: float | Sequence[float] = 7200.0,
+    rate_c_per_min: float = 1.0,
+    start_c: float = 20.0,
+) -> Profile:
+    """Seed-000 validation test (SPEC §5, §6): holds at several temperatures.
+
+    From ``start_c``, for each temperature: ramp at ``rate_c_per_min``, hold
+    ``hold_s`` (one value or one per hold; label ``hold {T:+g}``); then ramp back
+    to ``start_c``.
+    """
+    holds = [float(h) for h in holds_c]
+    if not holds:
+        raise ThermocalInputError("rlg-validation needs at least one hold temperature")
+    durs = (
+        [float(hold_s)] * len(holds)
+        if isinstance(hold_s, int | float)
+        else [float(h) for h in hold_s]
+    )
+    if len(durs) != len(holds):
+        raise ThermocalInputError(
+            f"{len(durs)} hold durations for {len(holds)} hold temperatures"
+        )
+    segs: list[Segment] = []
+    for temp, dur in zip(holds, durs, strict=True):
+        segs += [Ramp(temp, rate_c_per_min, "ramp"), Hold(dur, f"hold {temp:+g}")]
+    segs.append(Ramp(start_c, rate_c_per_min, "return"))
+    return Profile(float(start_c), tuple(segs), "rlg-validation")
+
+
+def fog_slow(
+    *,
+    low_c: float = 15.0,
+    high_c: float = 42.0,
+    rate_c_per_min: float = 0.1,
+    hold_s: float = 3600.0,
+    n_cycles: int = 1,
+) -> Profile:
+    """Seed-001 slow drift over 15–42 °C: hold at ``low_c``, then ``n_cycles`` × (ramp
+    to ``high_c`` at ``rate_c_per_min``, hold, ramp to ``low_c``, hold); ≈ 12 h by default."""
+    if not low_c < high_c:
+        raise ThermocalInputError(f"low_c ({low_c}) must be below high_c ({high_c})")
+    segs: tuple[Segment, ...] = (
+        Hold(hold_s, "hold low"),
+        Cycle(
+            (
+                Ramp(high_c, rate_c_per_min, "ramp up"),
+                Hold(hold_s, "hold high"),
+                Ramp(low_c, rate_c_per_min, "ramp down"),
+                Hold(hold_s, "hold low"),
+            ),
+            repeats=int(n_cycles),
+        ),
+    )
+    return Profile(float(low_c), segs, "fog-slow")
+
+
+POWER_ON_LABEL = "power-on"
+"""Label prefix of the holds during which a unit is powered on (``mems-warmup``)."""
+
+
+def power_on_label(start_c: float) -> str:
+    """``'power-on T+25'`` — the label of a power-on hold at ``start_c``."""
+    return f"{POWER_ON_LABEL} T{start_c:+g}"
+
+
+def mems_warmup(
+    *,
+    start_temps_c: Sequence[float] = (-40.0, -20.0, 0.0, 20.0, 40.0, 60.0, 80.0),
+    soak_s: float = 3600.0,
+    record_s: float = 900.0,
+    transition_rate_c_per_min: float = 2.0,
+    start_c: float = 20.0,
+) -> Profile:
+    """Seed-003 warm-ups at several start temperatures (SPEC §4c, §6).
+
+    For each start temperature T0: ramp to T0, soak ``soak_s`` unpowered (label
+    ``soak T0``), then hold ``record_s`` ≥ 6 min with the unit powered (label
+    ``power-on T{T0:+g}``, see :func:`power_on_label`).
+    """
+    if record_s < 360:
+        raise ThermocalInputError(f"record_s must be ≥ 360 s (6 min, seed 003), got {record_s}")
+    segs: list[Segment] = []
+    for t0 in start_temps_c:
+        segs += [
+            Ramp(float(t0), transition_rate_c_per_min, "transition"),
+            Hold(soak_s, f"soak T{float(t0):+g}"),
+            Hold(record_s, power_on_label(float(t0))),
+        ]
+    segs.append(Ramp(start_c, transition_rate_c_per_min, "return"))
+    return Profile(float(start_c), tuple(segs), "mems-warmup")
+
+
+RUN_LABEL = "run"
+"""Cycle label of the repetitions of ``accel-full-range`` (pieces ``run1/...``)."""
+
+
+def accel_full_range(
+    *,
+    low_c: float = -40.0,
+    high_c: float = 60.0,
+    soak_s: float = 7200.0,
+    rate_c_per_min: float = 2.0,
+    step_c: float = 5.0,
+    point_hold_s: float = 1800.0,
+    repeats: int = 5,
+    start_c: float = 20.0,
+    startup_s: float = 600.0,
+) -> Profile:
+    """Seed-004 full-range test (SPEC §4d), repeated ``repeats`` times (one run each).
+
+    Each run (labels ``run{i}/...``): ``startup`` hold at ``start_c`` (power-on),
+    cool to ``low_c`` and soak ``soak_s`` (``soak-low``), ramp at ``rate_c_per_min``
+    to ``high_c`` (``ramp``, type-1 data) and soak (``soak-high``), then constant
+    points every ``step_c`` from ``low_c`` to ``high_c`` held ``point_hold_s``
+    (``point {T:+g}``, type-2 data), and return to ``start_c``.
+    """
+    if not low_c < high_c:
+        raise ThermocalInputError(f"low_c ({low_c}) must be below high_c ({high_c})")
+    if not step_c > 0:
+        raise ThermocalInputError(f"step_c must be > 0, got {step_c}")
+    n_pts = int(math.floor((high_c - low_c) / step_c + 1e-9)) + 1
+    points = [low_c + i * step_c for i in range(n_pts)]
+    run: list[Segment] = [
+        Hold(startup_s, "startup"),
+        Ramp(low_c, rate_c_per_min, "cool"),
+        Hold(soak_s, "soak-low"),
+        Ramp(high_c, rate_c_per_min, "ramp"),
+        Hold(soak_s, "soak-high"),
+    ]
+    for p in points:
+        run += [Ramp(p, rate_c_per_min, "transition"), Hold(point_hold_s, f"point {p:+g}")]
+    run.append(Ramp(start_c, rate_c_per_min, "return"))
+    return Profile(
+        float(start_c), (Cycle(tuple(run), int(repeats), RUN_LABEL),), "accel-full-range"
+    )
+
+
+PROFILE_BUILDERS: dict[str, Callable[..., Profile]] = {
+    "rlg-modelling": rlg_modelling,
+    "rlg-validation": rlg_validation,
+    "fog-slow": fog_slow,
+    "mems-warmup": mems_warmup,
+    "accel-full-range": accel_full_range,
+}
+"""Registry of the built-in profiles (name → keyword-only builder)."""
+
+PROFILE_NAMES: tuple[str, ...] = tuple(PROFILE_BUILDERS)
+
+
+def builtin_profile(name: str, **params: Any) -> Profile:
+    """A built-in profile by name (:data:`PROFILE_NAMES`) with keyword parameters.
+
+    Raises :class:`ThermocalInputError` for an unknown name or parameter.
+    """
+    try:
+        builder = PROFILE_BUILDERS[name]
+    except KeyError:
+        raise ThermocalInputError(
+            f"unknown profile {name!r}; known profiles: {', '.join(PROFILE_NAMES)}"
+        ) from None
+    try:
+        prof = builder(**params)
+    except TypeError as exc:
+        raise ThermocalInputError(f"profile {name!r}: {exc}") from None
+    return Profile(prof.start_c, prof.segments, name, dict(params))
+
+
+# --- program files -------------------------------------------------------------------------------
+
+
+def check_program(time_s: npt.ArrayLike, setpoint_c: npt.ArrayLike, what: str = "program") -> None:
+    """Raise :class:`ThermocalInputError` unless time is finite and strictly increasing and
+    the set-points are finite, with at least two points."""
+    t = np.asarray(time_s, dtype=np.float64)
+    c = np.asarray(setpoint_c, dtype=np.float64)
+    if t.ndim != 1 or t.shape != c.shape:
+        raise ThermocalInputError(f"{what}: time and set-point must be 1-D of equal length")
+    if t.size < 2:
+        raise ThermocalInputError(f"{what}: needs at least two points")
+    bad = np.flatnonzero(~np.isfinite(t) | ~np.isfinite(c))
+    if bad.size:
+        raise ThermocalInputError(f"{what}: missing or non-finite value at row {bad[0]}")
+    back = np.flatnonzero(np.diff(t) <= 0)
+    if back.size:
+        raise TimestampError(
+            f"{what}: time must increase strictly; row {back[0] + 1} ({t[back[0] + 1]!r}) "
+            f"follows {t[back[0]]!r}"
+        )
+
+
+PROGRAM_TIME = "time_s"
+PROGRAM_SETPOINT = "setpoint_c"
+
+
+def write_program(path: str | Path, time_s: npt.ArrayLike, setpoint_c: npt.ArrayLike) -> Path:
+    """Write a chamber program CSV with columns ``time_s, setpoint_c`` (atomic)."""
+    t = np.asarray(time_s, dtype=np.float64)
+    c = np.asarray(setpoint_c, dtype=np.float64)
+    check_program(t, c, str(path))
+    p = Path(path)
+    df = pd.DataFrame({PROGRAM_TIME: t, PROGRAM_SETPOINT: c})
+    with atomic_write(p, "w") as fh:
+        df.to_csv(fh, index=False, float_format="%.10g", lineterminator="\n")
+    return p
+
+
+def read_program(path: str | Path) -> tuple[FloatArray, FloatArray]:
+    """Read a chamber program CSV (columns ``time_s`` and ``setpoint_c``).
+
+    Raises :class:`FileFormatError`, :class:`MissingColumnError`,
+    :class:`NonNumericError` or :class:`TimestampError` naming the file.
+    """
+    p = Path(path)
+    if not p.exists():
+        raise FileFormatError(f"{p}: no such file")
+    try:
+        df = pd.read_csv(p, skipinitialspace=True)
+    except (pd.errors.EmptyDataError, pd.errors.ParserError, UnicodeDecodeError) as exc:
+        raise FileFormatError(f"{p}: not a readable program CSV ({exc})") from None
+    df.columns = [str(c).strip() for c in df.columns]
+    for col in (PROGRAM_TIME, PROGRAM_SETPOINT):
+        if col not in df.columns:
+            raise MissingColumnError(
+                f"{p}: no column {col!r}; a chamber program has columns time_s, setpoint_c "
+                f"(found: {', '.join(map(repr, df.columns))})"
+            )
+    out = []
+    for col in (PROGRAM_TIME, PROGRAM_SETPOINT):
+        vals = pd.to_numeric(df[col], errors="coerce")
+        bad = np.flatnonzero(vals.isna().to_numpy())
+        if bad.size:
+            raise NonNumericError(
+                f"{p}: missing or non-numeric value {df[col].iloc[bad[0]]!r} in column "
+                f"{col!r} at row {bad[0]} (line {bad[0] + 2})"
+            )
+        out.append(vals.to_numpy(dtype=np.float64))
+    check_program(out[0], out[1], str(p))
+    return out[0], out[1]
+
+
+def find_holds(
+    time_s: npt.ArrayLike,
+    setpoint_c: npt.ArrayLike,
+    min_duration_s: float = 600.0,
+    tol_c: float = 1e-6,
+) -> list[Stage]:
+    """Constant-set-point stages of a program lasting at least ``min_duration_s`` [s].
+
+    A stage is a maximal run of consecutive points whose set-point stays within
+    ``tol_c`` of its first value; the program is linear between points.
+    """
+    t = np.asarray(time_s, dtype=np.float64)
+    c = np.asarray(setpoint_c, dtype=np.float64)
+    check_program(t, c)
+    flat = np.abs(np.diff(c)) <= tol_c
+    stages: list[Stage] = []
+    i = 0
+    n = flat.size
+    while i < n:
+        if not flat[i]:
+            i += 1
+            continue
+        j = i
+        while j < n and flat[j] and abs(c[j + 1] - c[i]) <= tol_c:
+            j += 1
+        if t[j] - t[i] >= min_duration_s:
+            stages.append(Stage(float(t[i]), float(t[j]), float(c[i]), f"hold {c[i]:+g}"))
+        i = max(j, i + 1)
+    return stages
+
+
+# --- correlation (seed 000, SPEC §5) ---------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class CorrelationResult:
+    """Correlation of two temperature histories on a common elapsed-time base.
+
+    r : Pearson coefficient ``Cov(X, Y)/(σ_X σ_Y)``; weakly_correlated : ``r < r_limit``
+    (seed 000 literally; see :func:`correlate`); n : number of common points;
+    duration_s : length of the common base [s]; r_limit : the limit used.
+    """
+
+    r: float
+    weakly_correlated: bool
+    n: int
+    duration_s: float = float("nan")
+    r_limit: float = WEAK_CORRELATION_LIMIT
+
+
+def _clean_history(t: npt.ArrayLike, y: npt.ArrayLike, what: str) -> tuple[FloatArray, FloatArray]:
+    ta = np.asarray(t, dtype=np.float64).ravel()
+    ya = np.asarray(y, dtype=np.float64).ravel()
+    if ta.shape != ya.shape:
+        raise ThermocalInputError(f"{what}: time and temperature differ in length")
+    ok = np.isfinite(ta) & np.isfinite(ya)
+    ta, ya = ta[ok], ya[ok]
+    if ta.size < 2:
+        raise ThermocalInputError(f"{what}: fewer than two finite samples")
+    if np.any(np.diff(ta) <= 0):
+        raise TimestampError(f"{what}: time must increase strictly")
+    return ta - ta[0], ya
+
+
+def common_base(
+    time_a: npt.ArrayLike,
+    temp_a: npt.ArrayLike,
+    time_b: npt.ArrayLike,
+    temp_b: npt.ArrayLike,
+    n_points: int = DEFAULT_CORRELATION_POINTS,
+) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """Resample two histories on a common elapsed-time base (SPEC §5, our reading).
+
+    Both are timed from their own first sample; the base is ``n_points`` uniform
+    times over the overlap ``[0, min(duration_a, duration_b)]``; values are linearly
+    interpolated (a chamber program is linear between its points).  Returns
+    ``(elapsed_s, x, y)``.
+    """
+    ta, xa = _clean_history(time_a, temp_a, "history A")
+    tb, xb = _clean_history(time_b, temp_b, "history B")
+    dur = min(float(ta[-1]), float(tb[-1]))
+    if not dur > 0:
+        raise ThermocalInputError("the two histories do not overlap in elapsed time")
+    if n_points < 3:
+        raise ThermocalInputError(f"n_points must be ≥ 3, got {n_points}")
+    base = np.linspace(0.0, dur, int(n_points))
+    return base, np.interp(base, ta, xa), np.interp(base, tb, xb)
+
+
+def pearson_r(x: FloatArray, y: FloatArray) -> float:
+    """``r = Cov(X, Y) / (σ_X σ_Y)`` (seed 000; population moments, so the n cancels).
+
+    Raises :class:`ThermocalInputError` when either history is constant (r undefined).
+    """
+    dx = x - x.mean()
+    dy = y - y.mean()
+    sx = float(np.sqrt(np.dot(dx, dx)))
+    sy = float(np.sqrt(np.dot(dy, dy)))
+    scale = max(float(np.max(np.abs(x))), float(np.max(np.abs(y))), 1.0)
+    if sx <= 1e-12 * scale * math.sqrt(x.size) or sy <= 1e-12 * scale * math.sqrt(y.size):
+        raise ThermocalInputError(
+            "a temperature history is constant over the common time base; r is undefined"
+        )
+    return float(np.clip(np.dot(dx, dy) / (sx * sy), -1.0, 1.0))
+
+
+def correlate(
+    time_a: npt.ArrayLike,
+    temp_a: npt.ArrayLike,
+    time_b: npt.ArrayLike,
+    temp_b: npt.ArrayLike,
+    *,
+    r_limit: float = WEAK_CORRELATION_LIMIT,
+    n_points: int = DEFAULT_CORRELATION_POINTS,
+) -> CorrelationResult:
+    """Correlation of two temperature histories (seed 000, SPEC §5).
+
+    ``r = Cov(X, Y) / (σ_X σ_Y)`` with X, Y the two histories on the common
+    elapsed-time base of :func:`common_base` (non-finite samples dropped).
+    ``weakly_correlated`` is ``r < r_limit`` as the seed states it (a strongly
+    *negative* r also passes; :func:`design_validation_profile` aims at ``|r|``).
+    """
+    base, x, y = common_base(time_a, temp_a, time_b, temp_b, n_points)
+    r = pearson_r(x, y)
+    return CorrelationResult(r, bool(r < r_limit), int(base.size), float(base[-1]), r_limit)
+
+
+# --- validation-profile design ----------------------------------------------------------------------
+
+
+def design_validation_profile(
+    model_time_s: npt.ArrayLike,
+    model_setpoint_c: npt.ArrayLike,
+    seed: int,
+    r_limit: float = WEAK_CORRELATION_LIMIT,
+    *,
+    n_holds: int | None = None,
+    hold_s: float = 7200.0,
+    rate_c_per_min: float = 1.0,
+    n_candidates: int = 400,
+    n_points: int = 2000,
+) -> Profile:
+    """Design a hold profile weakly correlated with a modelling test (SPEC §5, our reading).
+
+    The hold temperatures are ``n_holds`` evenly spaced values over the modelling
+    range ``[min, max]`` (so the validation covers the same range; default: one
+    per 10 °C, at least 4).  ``n_candidates`` random orders and hold durations
+    (each in ``[0.5, 1.5]·hold_s``), drawn from ``numpy.random.default_rng(seed)``,
+    are scored by ``|r|`` against the modelling history (:func:`correlate` on
+    ``n_points``); the candidate with the smallest ``|r|`` is returned, ramps at
+    ``rate_c_per_min`` from and back to the modelling start temperature.
+
+    Raises :class:`DesignError` when no candidate reaches ``|r| < r_limit``.
+    """
+    tm = np.asarray(model_time_s, dtype=np.float64)
+    cm = np.asarray(model_setpoint_c, dtype=np.float64)
+    check_program(tm, cm, "modelling history")
+    lo, hi = float(np.min(cm)), float(np.max(cm))
+    if not hi - lo > 0:
+        raise ThermocalInputError("the modelling history is constant; nothing to correlate")
+    if n_holds is None:
+        n_holds = max(4, int(round((hi - lo) / 10.0)) + 1)
+    if n_holds < 2:
+        raise ThermocalInputError(f"n_holds must be ≥ 2, got {n_holds}")
+    temps = np.linspace(lo, hi, int(n_holds))
+    start = float(cm[0])
+    rng = np.random.default_rng(seed)
+    best: tuple[float, Profile] | None = None
+    for _ in range(int(n_candidates)):
+        order = rng.permutation(temps)
+        durs = hold_s * rng.uniform(0.5, 1.5, size=order.size)
+        prof = rlg_validation(
+            holds_c=[round(float(v), 6) for v in order],
+            hold_s=[round(float(d), 1) for d in durs],
+            rate_c_per_min=rate_c_per_min,
+            start_c=start,
+        )
+        tv, cv = prof.knots()
+        res = correlate(tm, cm, tv, cv, r_limit=r_limit, n_points=n_points)
+        if best is None or abs(res.r) < best[0]:
+            best = (abs(res.r), prof)
+    assert best is not None
+    if not best[0] < r_limit:
+        raise DesignError(
+            f"no validation profile with |r| < {r_limit} found in {n_candidates} candidates "
+            f"(best |r| = {best[0]:.3f}); try more holds or candidates"
+        )
+    params = {"seed": int(seed), "r_limit": float(r_limit), "abs_r": float(best[0])}
+    return Profile(best[1].start_c, best[1].segments, "rlg-validation", params)

@@ -1,0 +1,272 @@
+"""Figures of the HTML report, drawn with matplotlib (Agg) and returned as PNG bytes.
+
+Every function takes plain numpy arrays and returns the PNG image as ``bytes``
+(embedded in the report as a ``data:image/png;base64`` URI, so the report needs no
+network and no other file).  matplotlib is imported here only, with the
+non-interactive Agg backend, so the maths modules never depend on it
+(STYLE.md rule 1).
+
+Long time series are reduced for drawing by :func:`decimate_for_plot` (block
+means, which keep the shape of a slowly varying bias; the statistics in the
+report are always computed on the full data, never on the plotted points).
+"""
+
+from __future__ import annotations
+
+import io
+from collections.abc import Iterator, Sequence
+from contextlib import contextmanager
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+import numpy.typing as npt
+
+FloatArray = npt.NDArray[np.float64]
+
+MAX_PLOT_POINTS = 2000
+"""Time series are drawn with at most this many points (block means)."""
+
+BEFORE_COLOR = "#c0392b"
+AFTER_COLOR = "#1f6fb2"
+TEMP_COLORS = ("#d35400", "#8e44ad", "#16a085", "#2c3e50", "#7f8c8d", "#b7950b")
+CHAMBER_COLOR = "#555555"
+FIG_WIDTH_IN = 9.0
+DPI = 110
+
+
+def decimate_for_plot(
+    x: npt.ArrayLike, *ys: npt.ArrayLike, max_points: int = MAX_PLOT_POINTS
+) -> tuple[FloatArray, ...]:
+    """Block means of ``x`` and every ``y`` so that at most ``max_points`` remain.
+
+    Block length ``m = ceil(n / max_points)``; the trailing partial block is
+    averaged on its own.  With ``n ≤ max_points`` the arrays are returned unchanged.
+    """
+    arrays = [np.asarray(a, dtype=np.float64) for a in (x, *ys)]
+    n = arrays[0].size
+    if n <= max_points:
+        return tuple(arrays)
+    m = int(np.ceil(n / max_points))
+    starts = np.arange(0, n, m)
+    counts = np.diff(np.r_[starts, n])
+    out = []
+    for a in arrays:
+        out.append(np.add.reduceat(a, starts) / counts)
+    return tuple(out)
+
+
+@contextmanager
+def _figure(nrows: int = 1, height_in: float = 3.4, sharex: bool = False) -> Iterator[Any]:
+    import matplotlib
+
+    matplotlib.use("Agg", force=True)
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=(FIG_WIDTH_IN, height_in * nrows), dpi=DPI, layout="constrained")
+    axes = fig.subplots(nrows, 1, sharex=sharex, squeeze=False)[:, 0]
+    for ax in axes:
+        ax.grid(True, which="major", color="#dddddd", linewidth=0.6)
+        ax.grid(True, which="minor", color="#f0f0f0", linewidth=0.4)
+        for side in ("top", "right"):
+            ax.spines[side].set_visible(False)
+        ax.tick_params(labelsize=8.5)
+    yield fig, axes
+
+
+def _png(fig: Any) -> bytes:
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", dpi=DPI, facecolor="white")
+    return buf.getvalue()
+
+
+def _hours(time_s: FloatArray) -> FloatArray:
+    return (time_s - time_s[0]) / 3600.0
+
+
+@dataclass(frozen=True)
+class TemperaturePanel:
+    """One run's temperature channels for :func:`temperature_profile`.
+
+    ``time_s`` [s]; ``channels`` name → temperature [°C]; ``chamber`` the chamber
+    (ambient) temperature or set-point [°C], drawn dashed, if known.
+    """
+
+    title: str
+    time_s: FloatArray
+    channels: dict[str, FloatArray]
+    chamber: FloatArray | None = None
+    chamber_label: str = "chamber"
+
+
+def temperature_profile(panels: Sequence[TemperaturePanel]) -> bytes:
+    """Chamber profile and temperature channels of each run against time [h]."""
+    with _figure(len(panels), height_in=3.0) as (fig, axes):
+        for ax, p in zip(axes, panels, strict=True):
+            t = np.asarray(p.time_s, dtype=np.float64)
+            if p.chamber is not None:
+                th, ch = decimate_for_plot(_hours(t), p.chamber)
+                ax.plot(th, ch, "--", color=CHAMBER_COLOR, lw=1.2, label=p.chamber_label)
+            for i, (name, temp) in enumerate(p.channels.items()):
+                th, tc = decimate_for_plot(_hours(t), temp)
+                ax.plot(th, tc, color=TEMP_COLORS[i % len(TEMP_COLORS)], lw=1.0, label=name)
+            ax.set_title(p.title, fontsize=10, loc="left")
+            ax.set_ylabel("temperature [°C]", fontsize=9)
+            ax.legend(fontsize=8, ncol=6, loc="upper right", frameon=False)
+        axes[-1].set_xlabel("time [h]", fontsize=9)
+        return _png(fig)
+
+
+def bias_vs_time(
+    time_s: FloatArray,
+    before: FloatArray,
+    after: FloatArray,
+    *,
+    unit: str,
+    stages: Sequence[tuple[float, float]] = (),
+    temperature: FloatArray | None = None,
+    temperature_label: str = "T",
+) -> bytes:
+    """Bias before and after compensation against time [h]; hold stages shaded.
+
+    ``stages`` are (start_s, stop_s) of the temperature holds used for the
+    stability and repeatability figures.  When ``temperature`` is given it is
+    drawn on a right-hand axis.
+    """
+    t = np.asarray(time_s, dtype=np.float64)
+    with _figure(1, height_in=3.6) as (fig, axes):
+        ax = axes[0]
+        for a, b in stages:
+            ax.axvspan((a - t[0]) / 3600.0, (b - t[0]) / 3600.0, color="#e8f1e4", lw=0, zorder=0)
+        th, yb, ya = decimate_for_plot(_hours(t), before, after)
+        ax.plot(th, yb, color=BEFORE_COLOR, lw=1.0, label="before compensation")
+        ax.plot(th, ya, color=AFTER_COLOR, lw=1.0, label="after compensation")
+        ax.set_xlabel("time [h]", fontsize=9)
+        ax.set_ylabel(f"bias [{unit}]", fontsize=9)
+        if temperature is not None:
+            ax2 = ax.twinx()
+            th2, tt = decimate_for_plot(_hours(t), temperature)
+            ax2.plot(th2, tt, ":", color=CHAMBER_COLOR, lw=1.0, label=temperature_label)
+            ax2.set_ylabel(f"{temperature_label} [°C]", fontsize=9)
+            ax2.tick_params(labelsize=8.5)
+            ax2.spines["top"].set_visible(False)
+            h1, l1 = ax.get_legend_handles_labels()
+            h2, l2 = ax2.get_legend_handles_labels()
+            ax.legend(h1 + h2, l1 + l2, fontsize=8, loc="upper right", frameon=False, ncol=3)
+        else:
+            ax.legend(fontsize=8, loc="upper right", frameon=False, ncol=2)
+        return _png(fig)
+
+
+def bias_vs_temperature(
+    temperature_c: FloatArray,
+    before: FloatArray,
+    after: FloatArray,
+    *,
+    unit: str,
+    temperature_label: str = "T",
+) -> bytes:
+    """Bias before and after compensation against a temperature channel [°C]."""
+    x = np.asarray(temperature_c, dtype=np.float64)
+    with _figure(1, height_in=3.6) as (fig, axes):
+        ax = axes[0]
+        xs, yb, ya = decimate_for_plot(x, before, after)
+        ax.plot(xs, yb, ".", ms=2.0, color=BEFORE_COLOR, label="before compensation")
+        ax.plot(xs, ya, ".", ms=2.0, color=AFTER_COLOR, label="after compensation")
+        ax.set_xlabel(f"{temperature_label} [°C]", fontsize=9)
+        ax.set_ylabel(f"bias [{unit}]", fontsize=9)
+        ax.legend(fontsize=8, loc="upper right", frameon=False, markerscale=4)
+        return _png(fig)
+
+
+@dataclass(frozen=True)
+class AllanCurve:
+    """An Allan deviation curve: τ [s], σ(τ) and its confidence bounds (signal unit)."""
+
+    label: str
+    tau_s: FloatArray
+    adev: FloatArray
+    adev_low: FloatArray | None = None
+    adev_high: FloatArray | None = None
+
+
+def allan_deviation(curves: Sequence[AllanCurve], *, unit: str) -> bytes:
+    """Log-log Allan deviation σ(τ) with confidence intervals as error bars."""
+    colors = (BEFORE_COLOR, AFTER_COLOR, "#27ae60", "#8e44ad")
+    with _figure(1, height_in=4.0) as (fig, axes):
+        ax = axes[0]
+        for i, c in enumerate(curves):
+            col = colors[i % len(colors)]
+            tau = np.asarray(c.tau_s, dtype=np.float64)
+            ad = np.asarray(c.adev, dtype=np.float64)
+            ok = np.isfinite(ad) & (ad > 0)
+            if c.adev_low is not None and c.adev_high is not None:
+                lo = np.asarray(c.adev_low, dtype=np.float64)
+                hi = np.asarray(c.adev_high, dtype=np.float64)
+                ok &= np.isfinite(lo) & np.isfinite(hi)
+                yerr = np.vstack([np.maximum(ad - lo, 0.0), np.maximum(hi - ad, 0.0)])[:, ok]
+                ax.errorbar(
+                    tau[ok], ad[ok], yerr=yerr, fmt="o-", ms=3, lw=1.1, capsize=2,
+                    color=col, label=c.label,
+                )  # fmt: skip
+            else:
+                ax.plot(tau[ok], ad[ok], "o-", ms=3, lw=1.1, color=col, label=c.label)
+        ax.set_xscale("log")
+        ax.set_yscale("log")
+        ax.set_xlabel("averaging time τ [s]", fontsize=9)
+        ax.set_ylabel(f"Allan deviation σ(τ) [{unit}]", fontsize=9)
+        ax.legend(fontsize=8, frameon=False)
+        return _png(fig)
+
+
+def drift_angle(
+    time_s: FloatArray,
+    before_deg: FloatArray,
+    after_deg: FloatArray,
+) -> bytes:
+    """Drift angle [°] (integral of the bias-corrected rate) before and after compensation."""
+    t = np.asarray(time_s, dtype=np.float64)
+    with _figure(1, height_in=3.4) as (fig, axes):
+        ax = axes[0]
+        th, yb, ya = decimate_for_plot(_hours(t), before_deg, after_deg)
+        ax.plot(th, yb, color=BEFORE_COLOR, lw=1.2, label="before compensation")
+        ax.plot(th, ya, color=AFTER_COLOR, lw=1.2, label="after compensation")
+        ax.axhline(0.0, color="#999999", lw=0.6)
+        ax.set_xlabel("time [h]", fontsize=9)
+        ax.set_ylabel("drift angle [°]", fontsize=9)
+        ax.legend(fontsize=8, loc="upper left", frameon=False)
+        return _png(fig)
+
+
+def model_fit(
+    time_s: FloatArray,
+    measured: FloatArray,
+    modelled: FloatArray,
+    *,
+    unit: str,
+) -> bytes:
+    """Modelling run: measured bias, model output and residual against time [h]."""
+    t = np.asarray(time_s, dtype=np.float64)
+    with _figure(2, height_in=2.6, sharex=True) as (fig, axes):
+        th, ym, yf = decimate_for_plot(_hours(t), measured, modelled)
+        axes[0].plot(th, ym, color=BEFORE_COLOR, lw=1.0, label="measured bias")
+        axes[0].plot(th, yf, color="#111111", lw=1.0, label="model")
+        axes[0].set_ylabel(f"bias [{unit}]", fontsize=9)
+        axes[0].legend(fontsize=8, loc="upper right", frameon=False, ncol=2)
+        axes[1].plot(th, ym - yf, color=AFTER_COLOR, lw=1.0, label="residual")
+        axes[1].set_ylabel(f"residual [{unit}]", fontsize=9)
+        axes[1].set_xlabel("time [h]", fontsize=9)
+        return _png(fig)
+
+
+__all__ = [
+    "AllanCurve",
+    "TemperaturePanel",
+    "allan_deviation",
+    "bias_vs_temperature",
+    "bias_vs_time",
+    "decimate_for_plot",
+    "drift_angle",
+    "model_fit",
+    "temperature_profile",
+]

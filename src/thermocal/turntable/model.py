@@ -1,0 +1,253 @@
+"""Gyro-triad error model of the turntable calibration and its linear measurement model.
+
+Error model (SPEC §7, INTERFACE.md)::
+
+    ω_meas = (I + E) ω_true + b + n,      Δω = ω_meas − ω_true = b + E ω_true + n
+
+with ``b`` the biases δD0 [°/h], ``diag(E)`` the scale-factor errors δK [ppm] and
+the off-diagonal of ``E`` the six misalignments δE [arcsec].  The SPEC's names
+``δE_ab`` follow the source's filter rows (CN104880182, seed 002): ``δE_ab`` is the
+sensitivity of gyro *b* to a rate about axis *a*, i.e. ``E[b, a]``:
+
+=======  =============  =================================
+name     error_matrix   meaning
+=======  =============  =================================
+``yx``   ``E[0, 1]``    x gyro sensing the y rate
+``zx``   ``E[0, 2]``    x gyro sensing the z rate
+``xy``   ``E[1, 0]``    y gyro sensing the x rate
+``zy``   ``E[1, 2]``    y gyro sensing the z rate
+``xz``   ``E[2, 0]``    z gyro sensing the x rate
+``yz``   ``E[2, 1]``    z gyro sensing the y rate
+=======  =============  =================================
+
+The coefficient vector θ (12) is, in this order and in these units::
+
+    [b_x, b_y, b_z [°/h], k_x, k_y, k_z [ppm], yx, zx, xy, zy, xz, yz [arcsec]]
+
+Measurement model (SPEC §7): over a sample interval i of length τ_i the
+gyro-integrated gimbal angles minus the encoder angle changes are, eq. (4)::
+
+    y_α,i = e_z · (g_i τ_i − C_n^b ω_ie^n τ_i) − Δα_enc,i       = h_α,i θ + w_α,i
+    y_β,i = e_E^b(α) · (g_i τ_i − C_n^b ω_ie^n τ_i) − Δβ_enc,i  = h_β,i θ + w_β,i
+
+with ``g_i`` the gyro mean rate over the interval and, for a projection ``p``
+(``e_z`` or ``e_E^b``) and the true angle increment ``φ_i = ω_true τ_i`` (from the
+encoders, kinematics eq. (2)), ``h θ = Σ_j p_j (b_j τ + k_j φ_j + Σ_{m≠j} E_jm φ_m)``.
+The noise is white: ``var w = Σ_j p_j² N_j² τ`` (N_j the angle random walk of gyro j).
+Sums of ``y`` and ``h`` over a block of intervals are the block's angle
+increments Δα, Δβ; the 14-state filter's Δα, Δβ are their running sums.
+
+Weakly observable combination and the constraint taken
+--------------------------------------------------------
+A rotation ε of the triad about the inner axis changes E by ``−ε [e_z×]``
+(``E[0,1] += ε``, ``E[1,0] −= ε``), and is exactly equivalent to a zero offset ε of
+the inner-axis encoder.  With the measurements Δα, Δβ the rotations do not see it
+(``e_E^bᵀ E e_E^b`` cancels an antisymmetric xy part, and Δα does not contain the xy
+block): only the earth rate does, at the level of hundreds of arcsec.  We therefore
+report the misalignments under the **constraint** ``yx = xy`` (the body x and y axes
+are defined to lie symmetrically between the x and y gyro input axes, i.e. the
+triad's own azimuth about the inner axis defines the body frame), and report the
+antisymmetric part ``a = (yx − xy)/2`` separately as ``inner_axis_azimuth_arcsec``:
+the triad's right-handed rotation about the inner axis relative to the frame set by
+the inner encoder's zero and the base's north alignment, determined by the earth
+rate only.  Estimators work in the full 12 coefficients; :func:`to_convention`
+maps them (and their covariance) to the reported form.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Final
+
+import numpy as np
+import numpy.typing as npt
+
+from thermocal import units
+from thermocal.turntable import kinematics
+
+FloatArray = npt.NDArray[np.float64]
+
+COEFF_NAMES: Final = (
+    "bias_x",
+    "bias_y",
+    "bias_z",
+    "sf_x",
+    "sf_y",
+    "sf_z",
+    "yx",
+    "zx",
+    "xy",
+    "zy",
+    "xz",
+    "yz",
+)
+"""Names of θ, in order."""
+
+COEFF_UNITS: Final = ("deg/h",) * 3 + ("ppm",) * 3 + ("arcsec",) * 6
+
+MISALIGNMENT_NAMES: Final = ("yx", "zx", "xy", "zy", "xz", "yz")
+MISALIGNMENT_INDEX: Final[dict[str, tuple[int, int]]] = {
+    "yx": (0, 1),
+    "zx": (0, 2),
+    "xy": (1, 0),
+    "zy": (1, 2),
+    "xz": (2, 0),
+    "yz": (2, 1),
+}
+"""SPEC name → (row, column) of the error matrix E."""
+
+N_COEFFS: Final = 12
+I_YX: Final = 6
+I_XY: Final = 8
+
+
+def coeffs_from_error_matrix(
+    error_matrix: npt.ArrayLike, bias_deg_h: npt.ArrayLike
+) -> FloatArray:
+    """θ (12) from the error matrix E (dimensionless) and the biases b [°/h]."""
+    e = np.asarray(error_matrix, dtype=np.float64).reshape(3, 3)
+    b = np.asarray(bias_deg_h, dtype=np.float64).reshape(3)
+    mis = [e[MISALIGNMENT_INDEX[n]] * units.RAD_TO_ARCSEC for n in MISALIGNMENT_NAMES]
+    return np.concatenate([b, np.diag(e) / units.PPM, np.array(mis)])
+
+
+def error_matrix_from_coeffs(theta: npt.ArrayLike) -> tuple[FloatArray, FloatArray]:
+    """(E, b [°/h]) from θ (inverse of :func:`coeffs_from_error_matrix`)."""
+    th = np.asarray(theta, dtype=np.float64).reshape(N_COEFFS)
+    e = np.diag(th[3:6] * units.PPM)
+    for k, n in enumerate(MISALIGNMENT_NAMES):
+        e[MISALIGNMENT_INDEX[n]] = th[6 + k] * units.ARCSEC_TO_RAD
+    return e, th[0:3].copy()
+
+
+def convention_matrix() -> FloatArray:
+    """T (13×12): reported = T θ — θ with ``yx`` and ``xy`` replaced by their mean
+    ``s = (yx + xy)/2`` and a 13th entry ``a = (yx − xy)/2`` (inner-axis azimuth)."""
+    t = np.zeros((N_COEFFS + 1, N_COEFFS))
+    t[:N_COEFFS, :N_COEFFS] = np.eye(N_COEFFS)
+    for row in (I_YX, I_XY):
+        t[row, :] = 0.0
+        t[row, I_YX] = 0.5
+        t[row, I_XY] = 0.5
+    t[N_COEFFS, I_YX] = 0.5
+    t[N_COEFFS, I_XY] = -0.5
+    return t
+
+
+def to_convention(
+    theta: npt.ArrayLike, cov: npt.ArrayLike | None = None
+) -> tuple[FloatArray, FloatArray | None]:
+    """Map θ (12) and its covariance to the reported form (13): ``(T θ, T C Tᵀ)``.
+
+    See the module docstring: the constraint ``yx = xy`` with the antisymmetric part
+    reported as the inner-axis azimuth ``a = (yx − xy)/2`` [arcsec].
+    """
+    t = convention_matrix()
+    th = t @ np.asarray(theta, dtype=np.float64)
+    if cov is None:
+        return th, None
+    c = np.asarray(cov, dtype=np.float64)
+    return th, t @ c @ t.T
+
+
+@dataclass(frozen=True)
+class IntervalModel:
+    """Per-sample-interval measurement model, eq. (4).
+
+    Attributes
+    ----------
+    dt_s : interval lengths τ_i [s], shape (m,).
+    y_arcsec : gyro-integrated minus encoder increments, (m, 2) for (α, β) [arcsec].
+    h : regressors, (m, 2, 12) [arcsec per unit of θ].
+    proj : projections p of the two channels, (m, 2, 3) (e_z and e_E^b).
+    valid : intervals not spanning a gap in time, (m,).
+    moving : intervals where an encoder angle changes, (m,).
+    """
+
+    dt_s: FloatArray
+    y_arcsec: FloatArray
+    h: FloatArray
+    proj: FloatArray
+    valid: npt.NDArray[np.bool_]
+    moving: npt.NDArray[np.bool_]
+
+    def channel_variance(self, arw_rad_sqrt_s: npt.ArrayLike) -> FloatArray:
+        """White-noise variance of each interval's channels [arcsec²], (m, 2):
+        ``var w = Σ_j p_j² N_j² τ``."""
+        n2 = (np.asarray(arw_rad_sqrt_s, dtype=np.float64) * units.RAD_TO_ARCSEC) ** 2
+        out: FloatArray = np.einsum("mcj,j->mc", self.proj**2, n2 * np.ones(3)) * self.dt_s[
+            :, None
+        ]
+        return out
+
+
+def interval_model(
+    time_s: npt.ArrayLike,
+    gyro_rad_s: npt.ArrayLike,
+    alpha_rad: npt.ArrayLike,
+    beta_rad: npt.ArrayLike,
+    latitude_deg: float,
+    *,
+    gap_factor: float = 1.5,
+    move_threshold_rad_s: float = 1e-3,
+) -> IntervalModel:
+    """Build the measurement model eq. (4) for every sample interval.
+
+    Parameters
+    ----------
+    time_s : sample times [s], (n,).
+    gyro_rad_s : gyro mean rates over the interval ending at each sample [rad/s], (n, 3);
+        the first row (an interval before the first encoder reading) is not used.
+    alpha_rad, beta_rad : unwrapped encoder angles at the sample times [rad], (n,).
+    latitude_deg : latitude L [°].
+    gap_factor : an interval longer than this × the median is a gap (invalid).
+    move_threshold_rad_s : an interval is "moving" if an encoder rate exceeds this.
+
+    The earth rate and e_E^b are evaluated at the interval's mid angles; the true
+    increments φ = ω_true τ come from the encoders (kinematics eq. (2)).
+    """
+    t = np.asarray(time_s, dtype=np.float64)
+    g = np.asarray(gyro_rad_s, dtype=np.float64)
+    a = np.asarray(alpha_rad, dtype=np.float64)
+    b = np.asarray(beta_rad, dtype=np.float64)
+    dt = np.diff(t)
+    da = np.diff(a)
+    db = np.diff(b)
+    a_mid = 0.5 * (a[1:] + a[:-1])
+    b_mid = 0.5 * (b[1:] + b[:-1])
+    earth = kinematics.earth_rate_b(a_mid, b_mid, latitude_deg)  # (m, 3)
+    e_e = kinematics.outer_axis_b(a_mid)
+    e_z = np.zeros_like(e_e)
+    e_z[:, 2] = 1.0
+    proj = np.stack([e_z, e_e], axis=1)  # (m, 2, 3)
+    phi = earth * dt[:, None] + da[:, None] * e_z + db[:, None] * e_e  # true increments [rad]
+    inc = g[1:] * dt[:, None] - earth * dt[:, None]
+    y = np.einsum("mcj,mj->mc", proj, inc)
+    y[:, 0] -= da
+    y[:, 1] -= db
+    y *= units.RAD_TO_ARCSEC
+    # regressors: outer product p_j φ_m
+    outer = proj[:, :, :, None] * phi[:, None, None, :]  # (m, 2, 3, 3)
+    h = np.empty((dt.size, 2, N_COEFFS))
+    h[:, :, 0:3] = proj * dt[:, None, None]  # 1 °/h over τ s = τ arcsec
+    h[:, :, 3:6] = np.diagonal(outer, axis1=2, axis2=3) * (units.PPM * units.RAD_TO_ARCSEC)
+    for k, n in enumerate(MISALIGNMENT_NAMES):
+        r, c = MISALIGNMENT_INDEX[n]
+        h[:, :, 6 + k] = outer[:, :, r, c]  # arcsec → rad → arcsec
+    med = float(np.median(dt)) if dt.size else 0.0
+    valid = (dt > 0) & (dt <= gap_factor * med)
+    moving = (np.abs(da) > move_threshold_rad_s * dt) | (np.abs(db) > move_threshold_rad_s * dt)
+    return IntervalModel(dt_s=dt, y_arcsec=y, h=h, proj=proj, valid=valid, moving=moving)
+
+
+def fisher_information(model: IntervalModel, arw_rad_sqrt_s: npt.ArrayLike) -> FloatArray:
+    """Fisher information of θ from every valid interval, both channels [1/unit²]:
+    ``J = Σ_i Σ_c h_ci h_ciᵀ / var w_ci`` (white Gaussian noise, perfect encoders).
+
+    Its inverse is the Cramér–Rao bound of the design (Kay, *Fundamentals of
+    Statistical Signal Processing I*, 1993, §3.7, linear Gaussian model)."""
+    var = model.channel_variance(arw_rad_sqrt_s)[model.valid]
+    hv = model.h[model.valid] / np.sqrt(var)[:, :, None]
+    hv2 = hv.reshape(-1, N_COEFFS)
+    out: FloatArray = hv2.T @ hv2
+    return out

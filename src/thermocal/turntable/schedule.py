@@ -1,0 +1,278 @@
+"""The 16-position schedule of SPEC §7 and its recognition in recorded encoder angles.
+
+Positions (α, β) relative to the starting angles (α0, β0), in the source's order
+(CN104880182, seed 002, claim 3)::
+
+    (0,0) (90,0) (180,0) (270,0) (0,180) (90,180) (180,180) (270,180)
+    (90,90) (270,90) (0,90) (180,90) (270,270) (90,270) (180,270) (0,270)
+
+Between positions the mechanism makes single-axis moves at a set rate (inner axis
+first, then outer, with a short settle between them), the shorter way round
+(a half turn goes positive).  A dwell of at least 60 s is held at each position.
+"""
+
+from __future__ import annotations
+
+import warnings
+from dataclasses import dataclass
+from typing import Final
+
+import numpy as np
+import numpy.typing as npt
+
+from thermocal.errors import DesignError, GapWarning, ThermocalWarning
+
+FloatArray = npt.NDArray[np.float64]
+
+POSITIONS_16: Final = (
+    (0.0, 0.0),
+    (90.0, 0.0),
+    (180.0, 0.0),
+    (270.0, 0.0),
+    (0.0, 180.0),
+    (90.0, 180.0),
+    (180.0, 180.0),
+    (270.0, 180.0),
+    (90.0, 90.0),
+    (270.0, 90.0),
+    (0.0, 90.0),
+    (180.0, 90.0),
+    (270.0, 270.0),
+    (90.0, 270.0),
+    (180.0, 270.0),
+    (0.0, 270.0),
+)
+"""The sixteen (α − α0, β − β0) positions of SPEC §7 [°]."""
+
+
+class TurntableScheduleError(DesignError):
+    """The recording does not contain the turntable design the calibration needs
+    (too few positions, dwells shorter than asked, an axis that never moves)."""
+
+
+class TurntableWarning(ThermocalWarning):
+    """Something in a turntable run weakens the calibration but does not stop it."""
+
+
+@dataclass(frozen=True)
+class Schedule:
+    """A piecewise-linear gimbal trajectory.
+
+    Attributes
+    ----------
+    time_s, alpha_deg, beta_deg : knots; angles are linear between them [s], [°].
+    dwell_windows_s : (start, end) of the dwell at each position [s], (n_pos, 2).
+    positions_deg : commanded (α, β) of each position [°], (n_pos, 2).
+    """
+
+    time_s: FloatArray
+    alpha_deg: FloatArray
+    beta_deg: FloatArray
+    dwell_windows_s: FloatArray
+    positions_deg: FloatArray
+
+    @property
+    def duration_s(self) -> float:
+        return float(self.time_s[-1])
+
+    def angles_at(self, t_s: npt.ArrayLike) -> tuple[FloatArray, FloatArray]:
+        """Unwrapped (α, β) [°] at times ``t_s`` (linear interpolation of the knots)."""
+        t = np.asarray(t_s, dtype=np.float64)
+        return (
+            np.interp(t, self.time_s, self.alpha_deg),
+            np.interp(t, self.time_s, self.beta_deg),
+        )
+
+
+def _signed_step(delta_deg: float) -> float:
+    """Shortest signed rotation for a change of angle, half turns positive [°]."""
+    d = (delta_deg + 180.0) % 360.0 - 180.0
+    return 180.0 if d == -180.0 else d
+
+
+def build_schedule(
+    *,
+    alpha0_deg: float = 0.0,
+    beta0_deg: float = 0.0,
+    dwell_s: float = 60.0,
+    move_rate_deg_s: float = 10.0,
+    settle_s: float = 1.0,
+    positions_deg: tuple[tuple[float, float], ...] = POSITIONS_16,
+) -> Schedule:
+    """The SPEC §7 schedule: dwell ``dwell_s`` at each position, single-axis moves at
+    ``move_rate_deg_s`` (α first, then β, ``settle_s`` between them)."""
+    if dwell_s <= 0 or move_rate_deg_s <= 0 or settle_s < 0:
+        raise DesignError("dwell, move rate must be positive and settle non-negative")
+    t = 0.0
+    a = alpha0_deg + positions_deg[0][0]
+    b = beta0_deg + positions_deg[0][1]
+    knots = [(t, a, b)]
+    windows = []
+    cmd = []
+    for k, (pa, pb) in enumerate(positions_deg):
+        if k > 0:
+            da = _signed_step(alpha0_deg + pa - a)
+            db = _signed_step(beta0_deg + pb - b)
+            if da != 0.0:
+                t += abs(da) / move_rate_deg_s
+                a += da
+                knots.append((t, a, b))
+                if db != 0.0 and settle_s > 0:
+                    t += settle_s
+                    knots.append((t, a, b))
+            if db != 0.0:
+                t += abs(db) / move_rate_deg_s
+                b += db
+                knots.append((t, a, b))
+        windows.append((t, t + dwell_s))
+        cmd.append((alpha0_deg + pa, beta0_deg + pb))
+        t += dwell_s
+        knots.append((t, a, b))
+    arr = np.array(knots)
+    return Schedule(
+        time_s=arr[:, 0],
+        alpha_deg=arr[:, 1],
+        beta_deg=arr[:, 2],
+        dwell_windows_s=np.array(windows),
+        positions_deg=np.array(cmd),
+    )
+
+
+@dataclass(frozen=True)
+class Dwell:
+    """A static run of the recorded encoder angles.
+
+    ``start``/``stop`` index the sample intervals (``[start, stop)``), ``alpha_deg``
+    and ``beta_deg`` are the angles mod 360 [°], ``duration_s`` its length [s]."""
+
+    start: int
+    stop: int
+    start_s: float
+    duration_s: float
+    alpha_deg: float
+    beta_deg: float
+
+
+@dataclass(frozen=True)
+class Segmentation:
+    """What the recording's encoder angles show: dwells, positions and moves.
+
+    ``dwells`` are static runs at least ``pause_s`` long, ``n_positions`` the number
+    of distinct (α, β) mod 360 among them, ``alpha_travel_deg``/``beta_travel_deg``
+    the total travel of each axis [°]."""
+
+    dwells: tuple[Dwell, ...]
+    n_positions: int
+    alpha_travel_deg: float
+    beta_travel_deg: float
+
+
+def runs(mask: npt.NDArray[np.bool_]) -> list[tuple[int, int]]:
+    """Maximal runs ``[start, stop)`` where ``mask`` is true."""
+    m = np.concatenate([[False], np.asarray(mask, dtype=bool), [False]])
+    d = np.diff(m.astype(np.int8))
+    starts = np.flatnonzero(d == 1)
+    stops = np.flatnonzero(d == -1)
+    return [(int(a), int(b)) for a, b in zip(starts, stops, strict=True)]
+
+
+def segment(
+    time_s: FloatArray,
+    alpha_deg: FloatArray,
+    beta_deg: FloatArray,
+    moving: npt.NDArray[np.bool_],
+    valid: npt.NDArray[np.bool_],
+    *,
+    pause_s: float = 10.0,
+    position_tol_deg: float = 0.5,
+) -> Segmentation:
+    """Find the dwells (static runs ≥ ``pause_s``) and count distinct positions.
+
+    ``moving`` and ``valid`` are per sample interval (length n − 1)."""
+    dwells = []
+    for a, b in runs(~moving & valid):
+        dur = float(time_s[b] - time_s[a])
+        if dur < pause_s:
+            continue
+        dwells.append(
+            Dwell(
+                a,
+                b,
+                float(time_s[a] - time_s[0]),
+                dur,
+                float(np.median(alpha_deg[a : b + 1]) % 360.0),
+                float(np.median(beta_deg[a : b + 1]) % 360.0),
+            )
+        )
+    keys: list[tuple[float, float]] = []
+    for d in dwells:
+        if not any(
+            _angle_close(d.alpha_deg, ka, position_tol_deg)
+            and _angle_close(d.beta_deg, kb, position_tol_deg)
+            for ka, kb in keys
+        ):
+            keys.append((d.alpha_deg, d.beta_deg))
+    return Segmentation(
+        dwells=tuple(dwells),
+        n_positions=len(keys),
+        alpha_travel_deg=float(np.sum(np.abs(np.diff(alpha_deg)))),
+        beta_travel_deg=float(np.sum(np.abs(np.diff(beta_deg)))),
+    )
+
+
+def _angle_close(a: float, b: float, tol: float) -> bool:
+    return abs((a - b + 180.0) % 360.0 - 180.0) <= tol
+
+
+def check_design(
+    seg: Segmentation,
+    *,
+    name: str,
+    alpha_col: str,
+    beta_col: str,
+    min_positions: int = 16,
+    min_dwell_s: float = 60.0,
+    dwell_tolerance_s: float = 0.0,
+    min_travel_deg: float = 45.0,
+) -> None:
+    """Raise :class:`TurntableScheduleError` if the run cannot give the calibration.
+
+    Checks: each axis travels at least ``min_travel_deg`` (rotations are what make
+    scale factors and misalignments observable); at least ``min_positions``
+    distinct positions; every dwell at least ``min_dwell_s − dwell_tolerance_s``."""
+    for col, travel, what in (
+        (alpha_col, seg.alpha_travel_deg, "inner"),
+        (beta_col, seg.beta_travel_deg, "outer"),
+    ):
+        if travel < min_travel_deg:
+            raise TurntableScheduleError(
+                f"{name}: the {what} axis ({col!r}) never moves (total travel "
+                f"{travel:.3g}°): its scale factor and misalignments are unobservable"
+            )
+    if seg.n_positions < min_positions:
+        raise TurntableScheduleError(
+            f"{name}: only {seg.n_positions} distinct positions held (need "
+            f"{min_positions}, SPEC §7 sixteen-position sequence)"
+        )
+    short = [d for d in seg.dwells if d.duration_s < min_dwell_s - dwell_tolerance_s]
+    if short:
+        d = short[0]
+        raise TurntableScheduleError(
+            f"{name}: dwell at α={d.alpha_deg:.1f}°, β={d.beta_deg:.1f}° starting at "
+            f"{d.start_s:.6g} s lasts {d.duration_s:.3g} s, shorter than the "
+            f"{min_dwell_s:.3g} s asked ({len(short)} short dwells in all)"
+        )
+
+
+def warn_gaps(name: str, time_s: FloatArray, valid: npt.NDArray[np.bool_]) -> None:
+    """Warn (``GapWarning``) about time gaps: they split the angle integration."""
+    bad = np.flatnonzero(~valid)
+    if bad.size:
+        i = int(bad[0])
+        warnings.warn(
+            f"{name}: {bad.size} gaps in time; the first after t = "
+            f"{time_s[i] - time_s[0]:.6g} s lasts {time_s[i + 1] - time_s[i]:.6g} s; "
+            "the gyro angle integration restarts after each gap",
+            GapWarning,
+            stacklevel=2,
+        )
