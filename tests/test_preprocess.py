@@ -33,7 +33,7 @@ def test_lowpass_step_response_at_time_constant() -> None:
     tau = 0.01
     tf = pp.lowpass_time_constant_s(0.04)
     assert_allclose(tf, 1 / (2 * math.pi * 0.04))
-    n = int(round(tf / tau))
+    n = round(tf / tau)
     tf_exact = n * tau  # make T_f a whole number of samples
     x = np.r_[0.0, np.ones(2 * n + 1)]
     y = pp.lowpass_first_order(x, tau, time_constant_s=tf_exact, initial="zero")
