@@ -188,17 +188,12 @@ def test_streaming_compensator_equals_batch_with_gap_and_reset() -> None:
     sc = StreamingCompensator(m, 1.0)
     assert run.signal is not None
     out = np.array(
-        [
-            sc.update(t, T, f)
-            for t, T, f in zip(run.time_s, run.temps_c, run.signal, strict=True)
-        ]
+        [sc.update(t, T, f) for t, T, f in zip(run.time_s, run.temps_c, run.signal, strict=True)]
     )
     np.testing.assert_allclose(out, batch.corrected, rtol=1e-12, atol=1e-12)
     # a reset is a new power-on: the second half alone, streamed after reset, equals predict of it
     sc.reset()
-    half = RunData(
-        time_s=run.time_s[1000:], temps_c=run.temps_c[1000:], signal=run.signal[1000:]
-    )
+    half = RunData(time_s=run.time_s[1000:], temps_c=run.temps_c[1000:], signal=run.signal[1000:])
     res = sc.process(half.time_s, half.temps_c, half.signal)
     np.testing.assert_allclose(res.corrected, compensate_run(m, half).corrected, rtol=1e-12)
 
@@ -268,7 +263,16 @@ def test_compensate_file_chunked_equals_in_memory(
     assert res.n_chunks == math.ceil(run.n_samples / 333)
     assert not res.streamed
     df = pd.read_csv(out) if out_ext == "csv" else pq.read_table(out).to_pandas()
-    assert list(df.columns) == ["time", "gyro", "T1", "T2", "note", "truth", "gyro_model", "gyro_comp"]
+    assert list(df.columns) == [
+        "time",
+        "gyro",
+        "T1",
+        "T2",
+        "note",
+        "truth",
+        "gyro_model",
+        "gyro_comp",
+    ]
     expect = compensate_run(m, run)
     np.testing.assert_allclose(df["gyro_model"], expect.model_value, rtol=1e-12, atol=1e-12)
     np.testing.assert_allclose(df["gyro_comp"], expect.corrected, rtol=1e-12, atol=1e-12)

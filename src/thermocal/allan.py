@@ -241,12 +241,12 @@ def averaging_factors(taus: TauSpec, tau0_s: float, n_samples: int) -> IntArray:
         )
     if isinstance(taus, str):
         if taus == "octave":
-            m = 2 ** np.arange(int(math.floor(math.log2(m_max))) + 1)
+            m = 2 ** np.arange(math.floor(math.log2(m_max)) + 1)
         elif taus == "decade":
-            dec = 10 ** np.arange(int(math.floor(math.log10(m_max))) + 1)
+            dec = 10 ** np.arange(math.floor(math.log10(m_max)) + 1)
             m = (dec[:, None] * np.array([1, 2, 4])[None, :]).ravel()
         elif taus == "log":
-            k = np.arange(int(math.floor(10.0 * math.log10(m_max))) + 1)
+            k = np.arange(math.floor(10.0 * math.log10(m_max)) + 1)
             m = np.round(10.0 ** (k / 10.0))
         else:
             raise ThermocalInputError(
@@ -323,8 +323,7 @@ def edf_simple(n_phase: npt.ArrayLike, m: npt.ArrayLike, alpha: npt.ArrayLike) -
         wpm = (N + 1) * (N - 2 * mm) / (2 * (N - mm))
         fpm = np.exp(
             np.sqrt(
-                np.maximum(np.log((N - 1) / (2 * mm)), 0.0)
-                * np.log((2 * mm + 1) * (N - 1) / 4)
+                np.maximum(np.log((N - 1) / (2 * mm)), 0.0) * np.log((2 * mm + 1) * (N - 1) / 4)
             )
         )
         wfm = (3 * (N - 1) / (2 * mm) - 2 * (N - 2) / N) * (4 * mm**2 / (4 * mm**2 + 5))
@@ -340,7 +339,8 @@ def identify_alpha(tau_s: FloatArray, adev: FloatArray) -> IntArray:
     μ = d ln σ² / d ln τ (centred differences, one-sided at the ends), α = −μ − 1
     rounded and clipped to [−2, 2]; μ ≤ −1.5 is taken as white PM (α = 2), the
     quantization region of a gyro (ADEV cannot tell white from flicker PM).
-    A single point is taken as white FM (α = 0).
+    α is then made non-increasing in τ (σ² of a sum of power laws is convex in
+    ln τ).  A single point is taken as white FM (α = 0).
     """
     if tau_s.size < 2:
         return np.zeros(tau_s.size, dtype=np.int64)
@@ -350,7 +350,9 @@ def identify_alpha(tau_s: FloatArray, adev: FloatArray) -> IntArray:
     mu = np.where(np.isfinite(mu), mu, -1.0)
     alpha = np.clip(np.round(-mu - 1.0), -2, 2).astype(np.int64)
     alpha[mu <= -1.5] = 2
-    return alpha
+    # σ² of a sum of power laws is convex in ln τ: its slope μ never decreases,
+    # so α never increases with τ (this stops a noisy tail point reading as white PM).
+    return np.minimum.accumulate(alpha)
 
 
 def confidence_interval(
@@ -442,7 +444,7 @@ def overlapping_adev(
 
     avar = sums / (2.0 * m.astype(np.float64) ** 2 * n_terms)
     adev = np.sqrt(avar)
-    tau = m * float(tau0_s)
+    tau = np.asarray(m * float(tau0_s), dtype=np.float64)
     if alpha is None:
         alphas = identify_alpha(tau, adev)
     else:
@@ -577,7 +579,6 @@ def _local_slope(log_tau: FloatArray, log_dev: FloatArray, edf: FloatArray, k: i
     design = np.column_stack([np.ones_like(lt), lt]) * w[:, None]
     sol, *_ = np.linalg.lstsq(design, ld * w, rcond=None)
     return float(sol[1])
-
 
 
 def _read_slope(

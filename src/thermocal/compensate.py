@@ -157,14 +157,22 @@ class StreamingCompensator:
     T0/F0 captured at power-on and any start-up selection live there; a step
     longer than ``GAP_FACTOR`` × ``sample_interval_s`` resets the rate estimate.
     Time must increase strictly (a :class:`~thermocal.errors.TimestampError`
-    otherwise).  Signals and results are in the model's signal unit.
+    otherwise).  Signals and results are in the model's signal unit.  ``known_input``
+    (earth rate [°/h], gravity component [mg]) is removed from the signal the model
+    sees (as :meth:`RunData.target` does; it matters to the bank's start-up
+    selection) but not from the corrected output.
 
     The outputs equal :func:`compensate_run` to 1e-12 (relative) on the same data,
     start-up included, when ``sample_interval_s`` is the run's median interval.
     """
 
     def __init__(
-        self, model: TemperatureModel, sample_interval_s: float, *, extrapolate: bool = False
+        self,
+        model: TemperatureModel,
+        sample_interval_s: float,
+        *,
+        extrapolate: bool = False,
+        known_input: float = 0.0,
     ) -> None:
         if not (math.isfinite(sample_interval_s) and sample_interval_s > 0):
             raise ThermocalInputError(
@@ -174,6 +182,7 @@ class StreamingCompensator:
         self.model = model
         self.sample_interval_s = float(sample_interval_s)
         self.extrapolate = extrapolate
+        self.known_input = float(known_input)
         self._stream: ModelStream = model.stream(self.sample_interval_s, extrapolate=extrapolate)
         self._last_t: float | None = None
         self.last_model_value: float = float("nan")
@@ -189,7 +198,7 @@ class StreamingCompensator:
                 f"sample {self.n_samples}: time {t!r} does not increase (previous {self._last_t!r})"
             )
         temps = np.asarray(temps_c, dtype=np.float64).reshape(-1)
-        y = float(self._stream.update(t, temps, float(signal)))
+        y = float(self._stream.update(t, temps, float(signal) - self.known_input))
         self._last_t = t
         self.last_model_value = y
         self.n_samples += 1
@@ -298,9 +307,15 @@ class ChunkPredictor:
     MARGIN_SAMPLES = 4
 
     def __init__(
-        self, model: TemperatureModel, *, extrapolate: bool = False, name: str = ""
+        self,
+        model: TemperatureModel,
+        *,
+        extrapolate: bool = False,
+        name: str = "",
+        known_input: float = 0.0,
     ) -> None:
         self.model = model
+        self.known_input = float(known_input)
         self.extrapolate = extrapolate
         self.name = name
         self.context = chunk_context(model)
@@ -345,7 +360,9 @@ class ChunkPredictor:
     ) -> FloatArray:
         if self._stream is None:
             assert self._tau is not None
-            self._stream = StreamingCompensator(self.model, self._tau, extrapolate=self.extrapolate)
+            self._stream = StreamingCompensator(
+                self.model, self._tau, extrapolate=self.extrapolate, known_input=self.known_input
+            )
         return self._stream.process(time_s, temps_c, signal).model_value
 
     def _predict_context(
@@ -368,7 +385,14 @@ class ChunkPredictor:
         cT = np.concatenate([self._head_T[keep_head], self._tail_T, temps_c])
         cf = np.concatenate([self._head_f[keep_head], self._tail_f, signal])
         m = ct.size - time_s.size
-        run = RunData(time_s=ct, temps_c=cT, signal=cf, name=self.name)
+        run = RunData(
+            time_s=ct,
+            temps_c=cT,
+            signal=cf,
+            temp_names=tuple(self.model.temp_names_),
+            name=self.name,
+            known_input=self.known_input,
+        )
         y_all = np.asarray(self.model.predict(run, extrapolate=self.extrapolate), dtype=np.float64)
         y = y_all[m:].copy()
         # carry the context on
@@ -616,6 +640,7 @@ def compensate_file(
     temp_unit: str | None = None,
     chunk_rows: int = DEFAULT_CHUNK_ROWS,
     extrapolate: bool = False,
+    known_input: float = 0.0,
     on_progress: Callable[[int], None] | None = None,
 ) -> CompensateFileResult:
     """Compensate a CSV/Parquet file into ``out`` with constant memory.
@@ -629,7 +654,8 @@ def compensate_file(
     complete (:func:`thermocal.io.atomic_write_path`); ``out`` may not be ``path``.
 
     Chunks are predicted with their context (:class:`ChunkPredictor`), so the
-    result equals an in-memory ``predict`` of the whole file.
+    result equals an in-memory ``predict`` of the whole file.  ``known_input``
+    [model unit] is what :class:`StreamingCompensator` says.
 
     Raises
     ------
@@ -702,7 +728,9 @@ def compensate_file(
     out_info["temperatures"] = {**tmp_info, **temp_units}
     out_info["units"] = {**extra_units, model_col: data_unit, comp_col: data_unit}
 
-    predictor = ChunkPredictor(model, extrapolate=extrapolate, name=str(src))
+    predictor = ChunkPredictor(
+        model, extrapolate=extrapolate, name=str(src), known_input=known_input
+    )
     factor: float | None = None
     state: dict[str, Any] = {"rows": 0, "chunks": 0, "last_t": None}
     before = _RunningMoments()

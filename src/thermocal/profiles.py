@@ -52,7 +52,7 @@ WEAK_CORRELATION_LIMIT = 0.4
 DEFAULT_CORRELATION_POINTS = 10_000
 """Number of points of the common elapsed-time base used by :func:`correlate`."""
 
-# --- segments --------------------------------------------------------------------------
+# --- segments ------------------------------------------------------------------------------------
 
 
 @dataclass(frozen=True)
@@ -134,7 +134,7 @@ class Piece:
 
 @dataclass(frozen=True)
 class Stage:
-    """A constant-temperature stage (hold) of a program: ``start_s``..``end_s`` at ``setpoint_c``."""
+    """A constant-temperature stage (hold): ``start_s``..``end_s`` [s] at ``setpoint_c`` [°C]."""
 
     start_s: float
     end_s: float
@@ -221,7 +221,7 @@ class Profile:
         if not (math.isfinite(dt_s) and dt_s > 0):
             raise ThermocalInputError(f"program step must be > 0 s, got {dt_s!r}")
         end = float(tk[-1])
-        n = int(math.floor(end / dt_s + 1e-9)) + 1
+        n = math.floor(end / dt_s + 1e-9) + 1
         t = np.arange(n, dtype=np.float64) * dt_s
         if end - t[-1] > 1e-9 * max(1.0, end):
             t = np.append(t, end)
@@ -239,7 +239,7 @@ class Profile:
         ]
 
 
-# --- built-in profiles (seed 000, 001, 003, 004) ---------------------------------------------
+# --- built-in profiles (seed 000, 001, 003, 004) -------------------------------------------------
 
 
 def rlg_modelling(
@@ -314,9 +314,7 @@ def rlg_validation(
         else [float(h) for h in hold_s]
     )
     if len(durs) != len(holds):
-        raise ThermocalInputError(
-            f"{len(durs)} hold durations for {len(holds)} hold temperatures"
-        )
+        raise ThermocalInputError(f"{len(durs)} hold durations for {len(holds)} hold temperatures")
     segs: list[Segment] = []
     for temp, dur in zip(holds, durs, strict=True):
         segs += [Ramp(temp, rate_c_per_min, "ramp"), Hold(dur, f"hold {temp:+g}")]
@@ -415,7 +413,7 @@ def accel_full_range(
         raise ThermocalInputError(f"low_c ({low_c}) must be below high_c ({high_c})")
     if not step_c > 0:
         raise ThermocalInputError(f"step_c must be > 0, got {step_c}")
-    n_pts = int(math.floor((high_c - low_c) / step_c + 1e-9)) + 1
+    n_pts = math.floor((high_c - low_c) / step_c + 1e-9) + 1
     points = [low_c + i * step_c for i in range(n_pts)]
     run: list[Segment] = [
         Hold(startup_s, "startup"),
@@ -566,7 +564,7 @@ def find_holds(
     return stages
 
 
-# --- correlation (seed 000, SPEC §5) ---------------------------------------------------------------
+# --- correlation (seed 000, SPEC §5) -------------------------------------------------------------
 
 
 @dataclass(frozen=True)
@@ -662,7 +660,7 @@ def correlate(
     return CorrelationResult(r, bool(r < r_limit), int(base.size), float(base[-1]), r_limit)
 
 
-# --- validation-profile design ----------------------------------------------------------------------
+# --- validation-profile design -------------------------------------------------------------------
 
 
 def design_validation_profile(
@@ -696,7 +694,7 @@ def design_validation_profile(
     if not hi - lo > 0:
         raise ThermocalInputError("the modelling history is constant; nothing to correlate")
     if n_holds is None:
-        n_holds = max(4, int(round((hi - lo) / 10.0)) + 1)
+        n_holds = max(4, round((hi - lo) / 10.0) + 1)
     if n_holds < 2:
         raise ThermocalInputError(f"n_holds must be ≥ 2, got {n_holds}")
     temps = np.linspace(lo, hi, int(n_holds))

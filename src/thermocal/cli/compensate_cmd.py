@@ -57,6 +57,14 @@ def compensate_cmd(
             help="Evaluate the model outside its fitted temperature range instead of clamping.",
         ),
     ] = False,
+    known_input: Annotated[
+        float,
+        typer.Option(
+            "--known-input",
+            help="Known input in the model's unit (earth rate, gravity component), removed "
+            "from what the model sees (bank start-up selection).",
+        ),
+    ] = 0.0,
     chunk_rows: Annotated[
         int, typer.Option("--chunk-rows", help="Rows read and written at a time.")
     ] = DEFAULT_CHUNK_ROWS,
@@ -76,6 +84,7 @@ def compensate_cmd(
             temp_unit=temp_unit,
             chunk_rows=chunk_rows,
             extrapolate=extrapolate,
+            known_input=known_input,
             on_progress=advance,
         )
     summary = {"model": str(model_file), "family": model.family, **res.to_dict()}

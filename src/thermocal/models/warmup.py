@@ -138,7 +138,7 @@ def lstsq_svd(x: FloatArray, y: FloatArray) -> LstsqResult:
         weak = vt[rank:] if rank < vt.shape[0] else vt[-1:]
         w = np.abs(weak).max(axis=0)
         null = tuple(int(i) for i in np.flatnonzero(w > 0.1 * w.max()))
-        nan = np.full((p,) + y.shape[1:], np.nan)
+        nan = np.full((p, *y.shape[1:]), np.nan)
         return LstsqResult(
             nan, np.full((p, p), np.nan), np.full(y.shape[1:], np.nan), math.inf, rank, n - p, null
         )
@@ -262,7 +262,10 @@ class WarmupModel(TemperatureModel):
     ----------
     order : highest power N of ΔT (≥ 1).
     t0_order : highest power M of T0 in each a_j (≥ 0).
-    start_window_s : start window [s] for T0 and F0 (the seed's first m samples).
+    start_window_s : start window [s] for T0 and F0 (the seed's first m samples).  Keep
+        it short against the die's thermal time constant: T rising during the window
+        biases T0 (on the simulator's mems-gyro, 10 s leaves 8 % of the drift, 0.5 s
+        0.1 %, noise-free); long enough to average the noise of T.
     include_a0 : keep the constant a0 (the seed does); off forces ΔF = 0 at ΔT = 0.
     sensor : index of the temperature channel used (0 = first named channel).
     method : ``"two_stage"`` (seed) or ``"joint"`` (one least-squares problem).
@@ -283,7 +286,7 @@ class WarmupModel(TemperatureModel):
         self,
         order: int = 2,
         t0_order: int = 2,
-        start_window_s: float = 10.0,
+        start_window_s: float = 1.0,
         include_a0: bool = True,
         sensor: int = 0,
         method: str = "two_stage",

@@ -24,6 +24,7 @@ Public API: :class:`ModelEntry`, :class:`ReportInputs`, :func:`build_report`
 from __future__ import annotations
 
 import base64
+import dataclasses
 import datetime as _dt
 import hashlib
 import math
@@ -31,15 +32,19 @@ import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, TypeGuard
 
 import numpy as np
 from markupsafe import Markup, escape
 
 from thermocal import units
+from thermocal.allan import AllanResult, NoiseTerms, noise_terms, overlapping_adev
+from thermocal.compensate import unit_factor
 from thermocal.errors import ThermocalInputError
 from thermocal.io import atomic_write
-from thermocal.recording import FloatArray, Recording
+from thermocal.metrics import compute_metrics, drift_angle
+from thermocal.models.base import RunData, TemperatureModel
+from thermocal.recording import FloatArray, Metadata, Recording
 
 WEAK_CORRELATION_LIMIT = 0.4
 """Seed 000 / SPEC §5: the validation test is weakly correlated when r < 0.4."""
@@ -141,7 +146,7 @@ def num(value: Any, key: str | None = None, digits: int = 4, unit: str = "") -> 
     return Markup(f'<span class="num"{attrs}>{escape(text)}</span>{u}')
 
 
-def _is_number(v: Any) -> bool:
+def _is_number(v: Any) -> TypeGuard[float | int]:
     return isinstance(v, int | float | np.integer | np.floating) and not isinstance(v, bool)
 
 
@@ -163,11 +168,22 @@ def unit_label(unit: str) -> str:
         "degC": "°C",
         "deg/sqrt(h)": "°/√h",
         "deg/h/sqrt(h)": "°/h/√h",
+        "deg/h/h": "°/h/h",
         "deg/h^2": "°/h²",
         "deg/h/s": "°/h/s",
+        "ug/sqrt(Hz)": "µg/√Hz",
+        "ug/sqrt(h)": "µg/√h",
+        "ug/h": "µg/h",
+        "ug": "µg",
         "deg": "°",
         "C/min": "°C/min",
-    }.get(unit, unit)
+    }.get(unit) or (
+        unit.replace("degC", "°C")
+        .replace("deg", "°")
+        .replace("sqrt(h)", "√h")
+        .replace("sqrt(Hz)", "√Hz")
+        .replace("ug", "µg")
+    )
 
 
 # --- analysis of the runs --------------------------------------------------------------------
@@ -178,6 +194,8 @@ class RunSignals:
     """The bias of a run before and after compensation by one model [signal unit]."""
 
     time_s: FloatArray
+    signal: FloatArray
+    unit: str
     before: FloatArray
     model: FloatArray
     after: FloatArray
@@ -204,23 +222,25 @@ def apply_model(model_dict: dict[str, Any], rec: Recording, signal: str | None) 
     (clamped, as in compensation); :class:`~thermocal.errors.ExtrapolationWarning`
     messages are collected, not raised.
     """
-    from thermocal.models import RunData, TemperatureModel
-
     model = TemperatureModel.from_dict(model_dict)
     sig_name = signal or (model_dict.get("signal") or {}).get("name")
     if sig_name not in rec.columns:
         sig_name = None if not rec.signals else rec.signals[0]
     temp_names = tuple(model_dict["temperatures"])
     x, unit = rec.signal(sig_name)
+    factor = unit_factor(unit, model.signal_unit, meta=rec.meta, where=rec.name)
     known = known_input_of(rec, unit)
     run = RunData.from_recording(rec, sig_name, temp_names, known_input=known)
+    run = dataclasses.replace(run, signal=x * factor, known_input=known * factor)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        pred = np.asarray(model.predict(run), dtype=np.float64)
+        pred = np.asarray(model.predict(run), dtype=np.float64) / factor
     msgs = tuple(dict.fromkeys(" ".join(str(w.message).split()) for w in caught))
     before = x - known
     return RunSignals(
         time_s=rec.time_s,
+        signal=x,
+        unit=unit,
         before=before,
         model=pred,
         after=before - pred,
@@ -231,71 +251,69 @@ def apply_model(model_dict: dict[str, Any], rec: Recording, signal: str | None) 
     )
 
 
-def drift_angle_deg(time_s: FloatArray, rate: FloatArray, unit: str = "deg/h") -> FloatArray:
-    """Drift angle [°]: ``θ(t) = ∫₀ᵗ (ω(s) − ω̄) ds`` of the bias-corrected rate (SPEC §1,
-    seed 001), trapezoidal rule; ω in [°/h] and t in [s] give θ = Σ … / 3600.
-
-    The run's mean rate ω̄ (the bias B0) is removed first, so the angle shows the
-    drift of the bias, not its constant part.
-    """
-    if unit != "deg/h":
-        raise ThermocalInputError(f"drift angle needs a gyro rate in deg/h, not {unit}")
-    t = np.asarray(time_s, dtype=np.float64)
-    w = np.asarray(rate, dtype=np.float64) - float(np.mean(rate))
-    inc = 0.5 * (w[1:] + w[:-1]) * np.diff(t) / 3600.0
-    return np.r_[0.0, np.cumsum(inc)]
-
-
-def block_means(time_s: FloatArray, x: FloatArray, block_s: float) -> FloatArray:
-    """Means of consecutive blocks of ``block_s`` seconds (complete blocks only)."""
-    tau = float(np.median(np.diff(time_s))) if time_s.size > 1 else block_s
-    m = max(1, round(block_s / tau))
-    n = (x.size // m) * m
-    if n == 0:
-        return np.asarray([np.mean(x)])
-    out: FloatArray = x[:n].reshape(-1, m).mean(axis=1)
-    return out
-
-
 @dataclass(frozen=True)
 class FiguresOfMerit:
-    """SPEC §1 figures of a run [signal unit]: bias B0, bias stability at ``averaging_s``
-    (standard deviation of the block means), peak-to-peak of the block means, and
-    the final and largest drift angle [°] (gyros)."""
+    """SPEC §1 figures of a whole run [signal unit], from
+    :func:`thermocal.metrics.compute_metrics` (the numbers of ``thermocal metrics``):
+    bias B0 (earth rate removed when latitude and axis are known), bias stability
+    and peak-to-peak over ``averaging_s`` averages, temperature sensitivity over
+    the hold stages (least-squares slope and mean |ΔB/ΔT|) [unit/°C], and the
+    largest and final drift angle [°] (gyros)."""
 
     bias: float
     bias_stability: float
     averaging_s: float
     peak_to_peak: float
+    sensitivity_slope: float | None
+    sensitivity_mean_abs: float | None
+    drift_angle: FloatArray | None
     drift_angle_end_deg: float | None
     drift_angle_max_deg: float | None
 
 
 def figures_of_merit(
-    time_s: FloatArray, x: FloatArray, averaging_s: float, unit: str
+    time_s: FloatArray,
+    x: FloatArray,
+    unit: str,
+    *,
+    averaging_s: float,
+    meta: Metadata,
+    temp_name: str,
+    temp_c: FloatArray,
 ) -> FiguresOfMerit:
-    """Bias, stability (σ of the ``averaging_s`` block means, n − 1), peak-to-peak and drift
-    angle of a run (SPEC §1; IEEE Std 952 style).
+    """Figures of merit of a rate ``x`` [canonical unit, known input included] (SPEC §1).
 
-    Uses :func:`thermocal.metrics.compute_metrics` when that module provides it,
-    so the numbers match ``thermocal metrics``.
+    Runs :func:`thermocal.metrics.compute_metrics` on a recording of ``x`` with
+    ``temp_c`` as the hold-stage temperature; the drift angle
+    ``θ(t) = ∫ (ω − B0) dt`` with B0 the run's mean rate is
+    :func:`thermocal.metrics.drift_angle` (held across gaps).
     """
-    bias, stab, p2p = _metrics(time_s, x, averaging_s, unit)
+    rec = Recording.from_arrays(
+        time_s,
+        {"signal": x},
+        {temp_name: temp_c},
+        signal_unit=unit,
+        meta=dataclasses.replace(meta, scale_factor=None, scale_factor_unit=None),
+    )
+    m = compute_metrics(rec, "signal", averaging_s, temps=[temp_name])
+    sens = m.temperature_sensitivity
+    ang: FloatArray | None = None
+    end = mx = None
     if unit == "deg/h":
-        ang = drift_angle_deg(time_s, x, unit)
-        end: float | None = float(ang[-1])
-        mx: float | None = float(np.max(np.abs(ang)))
-    else:
-        end = mx = None
-    return FiguresOfMerit(bias, stab, averaging_s, p2p, end, mx)
-
-
-def _metrics(
-    time_s: FloatArray, x: FloatArray, averaging_s: float, unit: str
-) -> tuple[float, float, float]:
-    blocks = block_means(time_s, x, averaging_s)
-    stab = float(np.std(blocks, ddof=1)) if blocks.size > 1 else float("nan")
-    return float(np.mean(x)), stab, float(np.ptp(blocks))
+        ang = drift_angle(time_s, x, float(np.mean(x)))
+        end = float(ang[-1])
+        mx = float(np.max(np.abs(ang)))
+    return FiguresOfMerit(
+        bias=m.bias,
+        bias_stability=m.bias_stability,
+        averaging_s=m.averaging_s,
+        peak_to_peak=m.peak_to_peak,
+        sensitivity_slope=sens.ls_slope if sens is not None else None,
+        sensitivity_mean_abs=sens.mean_abs_adjacent if sens is not None else None,
+        drift_angle=ang,
+        drift_angle_end_deg=end,
+        drift_angle_max_deg=mx,
+    )
 
 
 NOISE_TERMS = (
@@ -311,16 +329,14 @@ NOISE_TERMS = (
 class AllanAnalysis:
     """Allan deviation of one series and its noise terms (both IEEE 952 methods)."""
 
-    result: Any  # thermocal.allan.AllanResult
-    terms: Any  # thermocal.allan.NoiseTerms
+    result: AllanResult
+    terms: NoiseTerms
 
 
 def allan_of(time_s: FloatArray, x: FloatArray, tau0_s: float, unit: str) -> AllanAnalysis:
     """Overlapping Allan deviation (octave τ, ±1σ confidence intervals, split at gaps) and
     the IEEE Std 952 noise terms, by :func:`thermocal.allan.overlapping_adev` and
     :func:`thermocal.allan.noise_terms` (NIST SP 1065 eq. 11; SPEC §1)."""
-    from thermocal.allan import noise_terms, overlapping_adev
-
     res = overlapping_adev(x, tau0_s, "octave", time_s=time_s, unit=unit)
     return AllanAnalysis(result=res, terms=noise_terms(res))
 
@@ -387,12 +403,11 @@ def _temperature_panel(title: str, rec: Recording, names: Sequence[str]) -> Any:
     from thermocal.report.figures import TemperaturePanel
 
     chamber = _chamber_column(rec, names)
-    channels = {n: rec.temperature_c(n) for n in names if n in rec.columns}
+    ordered = [*names, *(t for t in rec.temperatures if t not in names and t != chamber)]
+    channels = {n: rec.temperature_c(n) for n in ordered if n in rec.columns}
     ch = None
     if chamber is not None:
-        ch = (
-            rec.temperature_c(chamber) if chamber in rec.temperatures else rec.column(chamber)
-        )
+        ch = rec.temperature_c(chamber) if chamber in rec.temperatures else rec.column(chamber)
     return TemperaturePanel(
         title=title, time_s=rec.time_s, channels=channels, chamber=ch, chamber_label=chamber or ""
     )
@@ -418,6 +433,15 @@ def _flag(ok: bool | None) -> str:
     return "na" if ok is None else ("pass" if ok else "fail")
 
 
+def _json_improvement(v: dict[str, Any], name: str) -> float | None:
+    """The validation file's ``improvement_pct[name]`` if it has one, else computed."""
+    imp = v.get("improvement_pct")
+    if isinstance(imp, dict) and name in imp:
+        val = imp[name]
+        return float(val) if _is_number(val) else None
+    return improvement_pct(v.get(f"{name}_before"), v.get(f"{name}_after"))
+
+
 def _validation_rows(entry: ModelEntry, unit: str) -> list[dict[str, Any]]:
     v = entry.validation or {}
     key = f"validation.{entry.label}"
@@ -432,7 +456,7 @@ def _validation_rows(entry: ModelEntry, unit: str) -> list[dict[str, Any]]:
         a = v.get(f"{name}_after")
         if b is None and a is None:
             continue
-        imp = improvement_pct(b, a)
+        imp = _json_improvement(v, name)
         rows.append(
             {
                 "label": label,
@@ -441,6 +465,37 @@ def _validation_rows(entry: ModelEntry, unit: str) -> list[dict[str, Any]]:
                 "after": num(a, f"{key}.{name}_after"),
                 "improvement": num(imp, f"{key}.{name}_improvement_pct", digits=3),
                 "flag": _flag(None if imp is None else imp > 0),
+            }
+        )
+    return rows
+
+
+def _stage_rows(entry: ModelEntry) -> list[dict[str, Any]]:
+    """Per-stage rows of a validation result (``stages`` list of the JSON)."""
+    rows = []
+    key = f"validation.{entry.label}.stages"
+    for i, st in enumerate((entry.validation or {}).get("stages") or []):
+        if not isinstance(st, dict):
+            continue
+        a, b = st.get("start_s"), st.get("stop_s")
+        rows.append(
+            {
+                "index": i + 1,
+                "start_h": fmt_num(float(a) / 3600.0, 3) if _is_number(a) else "—",
+                "duration_h": (
+                    fmt_num((float(b) - float(a)) / 3600.0, 3)
+                    if _is_number(a) and _is_number(b)
+                    else "—"
+                ),
+                "temp": num(st.get("mean_temp_c"), None, 4),
+                "bias_before": num(st.get("bias_before"), f"{key}.{i}.bias_before", 5),
+                "bias_after": num(st.get("bias_after"), f"{key}.{i}.bias_after", 5),
+                "stab_before": num(
+                    st.get("bias_stability_before"), f"{key}.{i}.bias_stability_before"
+                ),
+                "stab_after": num(
+                    st.get("bias_stability_after"), f"{key}.{i}.bias_stability_after"
+                ),
             }
         )
     return rows
@@ -456,6 +511,7 @@ def _summary(
     v = primary.validation or {}
     key = f"validation.{primary.label}"
     items: list[dict[str, Any]] = []
+    ok: bool | None
     r = v.get("r")
     if r is not None:
         weak = v.get("weakly_correlated")
@@ -477,14 +533,14 @@ def _summary(
         b, a = v.get(f"{name}_before"), v.get(f"{name}_after")
         if b is None or a is None:
             continue
-        imp = improvement_pct(b, a)
+        imp = _json_improvement(v, name)
         ok = None if imp is None else imp > 0
         items.append(
             {
                 "label": label,
                 "before": num(b, f"{key}.{name}_before", unit=unit_label(unit)),
                 "after": num(a, f"{key}.{name}_after", unit=unit_label(unit)),
-                "value": num(imp, f"summary.{name}_improvement_pct", digits=3, unit="%"),
+                "value": num(imp, f"{key}.{name}_improvement_pct", digits=3, unit="%"),
                 "note": "improvement",
                 "flag": _flag(ok),
                 "flag_text": "improved" if ok else "not improved",
@@ -580,9 +636,7 @@ def _model_summary(entry: ModelEntry) -> dict[str, Any]:
     }
 
 
-def _collect_warnings(
-    inputs: ReportInputs, applied: dict[str, RunSignals]
-) -> list[dict[str, str]]:
+def _collect_warnings(inputs: ReportInputs, applied: dict[str, RunSignals]) -> list[dict[str, str]]:
     out: list[dict[str, str]] = []
     seen: set[str] = set()
 
@@ -664,10 +718,26 @@ def build_report(inputs: ReportInputs) -> str:
     averaging_s = float(v.get("averaging_s") or DEFAULT_AVERAGING_S)
     tau0 = rec.sample_interval_s
 
-    fom_before = figures_of_merit(main.time_s, main.before, averaging_s, unit)
-    fom_after = figures_of_merit(main.time_s, main.after, averaging_s, unit)
-    allan_before = allan_of(main.before, tau0)
-    allan_after = allan_of(main.after, tau0)
+    ambient = v.get("ambient")
+    stage_temp = ambient if isinstance(ambient, str) and ambient in rec.columns else temp_names[0]
+    stage_temp_c = (
+        rec.temperature_c(stage_temp) if stage_temp not in temp_names
+        else main.temps_c[:, temp_names.index(stage_temp)]
+    )  # fmt: skip
+    fom_before, fom_after = (
+        figures_of_merit(
+            main.time_s,
+            x,
+            unit,
+            averaging_s=averaging_s,
+            meta=rec.meta,
+            temp_name=stage_temp,
+            temp_c=stage_temp_c,
+        )
+        for x in (main.signal, main.signal - main.model)
+    )
+    allan_before = allan_of(main.time_s, main.before, tau0, unit)
+    allan_after = allan_of(main.time_s, main.after, tau0, unit)
 
     # --- figures
     panels = []
@@ -692,9 +762,9 @@ def build_report(inputs: ReportInputs) -> str:
         F.temperature_profile(panels),
         "Chamber profile and temperature channels",
         cap(
-            "Temperature channels used by the model ("
+            "Temperature channels of the sensor (the model uses "
             + ", ".join(temp_names)
-            + ") and the chamber temperature (dashed) against time, for "
+            + ") and the chamber air temperature (dashed) against time, for "
             + ("the modelling run (top) and " if inputs.modeling is not None else "")
             + "the validation run."
         ),
@@ -746,19 +816,16 @@ def build_report(inputs: ReportInputs) -> str:
         F.allan_deviation(
             [
                 F.AllanCurve(
-                    "before compensation",
-                    allan_before.tau_s,
-                    allan_before.adev,
-                    allan_before.adev_low,
-                    allan_before.adev_high,
-                ),
-                F.AllanCurve(
-                    "after compensation",
-                    allan_after.tau_s,
-                    allan_after.adev,
-                    allan_after.adev_low,
-                    allan_after.adev_high,
-                ),
+                    lab,
+                    al.result.tau_s,
+                    al.result.adev,
+                    al.result.adev_low,
+                    al.result.adev_high,
+                )
+                for lab, al in (
+                    ("before compensation", allan_before),
+                    ("after compensation", allan_after),
+                )
             ],
             unit=unit_label(unit),
         ),
@@ -768,14 +835,10 @@ def build_report(inputs: ReportInputs) -> str:
             "compensation; bars: confidence intervals."
         ),
     )
-    if fom_before.drift_angle_end_deg is not None:
+    if fom_before.drift_angle is not None and fom_after.drift_angle is not None:
         add_fig(
             "drift",
-            F.drift_angle(
-                main.time_s,
-                drift_angle_deg(main.time_s, main.before, unit),
-                drift_angle_deg(main.time_s, main.after, unit),
-            ),
+            F.drift_angle(main.time_s, fom_before.drift_angle, fom_after.drift_angle),
             "Drift angle before and after compensation",
             cap(
                 "Drift angle: integral of the rate with its mean (the bias B0) removed, "
@@ -786,18 +849,19 @@ def build_report(inputs: ReportInputs) -> str:
     # --- tables
     noise_rows = []
     for key, label in NOISE_TERMS:
-        b = allan_before.noise.get(key) or {}
-        a = allan_after.noise.get(key) or {}
-        if b.get("value") is None and a.get("value") is None:
-            continue
-        noise_rows.append(
-            {
-                "label": label,
-                "unit": unit_label(str(b.get("unit") or a.get("unit") or "")),
-                "before": num(b.get("value"), f"allan.before.{key}"),
-                "after": num(a.get("value"), f"allan.after.{key}"),
-            }
-        )
+        cells = []
+        term_unit = ""
+        for when, al in (("before", allan_before), ("after", allan_after)):
+            for method in ("slope", "fit"):
+                term = getattr(getattr(al.terms, method), key)
+                term_unit = term.unit or term_unit
+                cells.append(
+                    {
+                        "html": num(term.value, f"allan.{when}.{method}.{key}", 3),
+                        "reason": term.reason or "",
+                    }
+                )
+        noise_rows.append({"label": label, "unit": unit_label(term_unit), "cells": cells})
     fom_rows = []
     for name, label, u, digits in (
         ("bias", "Bias B0", unit_label(unit), 5),
@@ -805,7 +869,10 @@ def build_report(inputs: ReportInputs) -> str:
          unit_label(unit), 4),
         ("peak_to_peak", f"Peak-to-peak ({fmt_num(averaging_s)} s averages)",
          unit_label(unit), 4),
-        ("drift_angle_end_deg", "Drift angle at end of run", "°", 4),
+        ("sensitivity_slope", f"Temperature sensitivity, LS slope of stage bias on {stage_temp}",
+         f"{unit_label(unit)}/°C", 4),
+        ("sensitivity_mean_abs", "Temperature sensitivity, mean |ΔB/ΔT| of adjacent stages",
+         f"{unit_label(unit)}/°C", 4),
         ("drift_angle_max_deg", "Largest |drift angle|", "°", 4),
     ):  # fmt: skip
         b = getattr(fom_before, name)
@@ -819,7 +886,11 @@ def build_report(inputs: ReportInputs) -> str:
                 "before": num(b, f"fom.before.{name}", digits),
                 "after": num(a, f"fom.after.{name}", digits),
                 "improvement": num(
-                    improvement_pct(abs(b), abs(a)) if name != "bias" else None, None, 3
+                    improvement_pct(abs(b), abs(a))
+                    if name != "bias" and b is not None and a is not None
+                    else None,
+                    None,
+                    3,
                 ),
             }
         )
@@ -841,11 +912,7 @@ def build_report(inputs: ReportInputs) -> str:
                     f"validation.{e.label}.bias_repeatability_after",
                 ),
                 "rms_after": num(ve.get("rms_after"), f"validation.{e.label}.rms_after"),
-                "stab_imp": num(
-                    improvement_pct(ve.get("bias_stability_before"), ve.get("bias_stability_after")),
-                    None,
-                    3,
-                ),
+                "stab_imp": num(_json_improvement(ve, "bias_stability"), None, 3),
             }
         )
 
@@ -855,10 +922,9 @@ def build_report(inputs: ReportInputs) -> str:
             "rows": _validation_rows(e, unit_label(unit)),
             "r": num((e.validation or {}).get("r"), f"validation.{e.label}.r", 3),
             "weak": (e.validation or {}).get("weakly_correlated"),
-            "n_stages": num(
-                (e.validation or {}).get("n_stages"), f"validation.{e.label}.n_stages"
-            ),
+            "n_stages": num((e.validation or {}).get("n_stages"), f"validation.{e.label}.n_stages"),
             "averaging_s": (e.validation or {}).get("averaging_s"),
+            "stages": _stage_rows(e) if e is primary else [],
         }
         for e in inputs.models
         if e.validation
@@ -918,7 +984,6 @@ __all__ = [
     "ModelEntry",
     "ReportInputs",
     "build_report",
-    "drift_angle_deg",
     "figures_of_merit",
     "fmt_num",
     "improvement_pct",

@@ -81,7 +81,8 @@ def _png(fig: Any) -> bytes:
 
 
 def _hours(time_s: FloatArray) -> FloatArray:
-    return (time_s - time_s[0]) / 3600.0
+    out: FloatArray = (time_s - time_s[0]) / 3600.0
+    return out
 
 
 @dataclass(frozen=True)
@@ -175,7 +176,7 @@ def bias_vs_temperature(
         ax.plot(xs, ya, ".", ms=2.0, color=AFTER_COLOR, label="after compensation")
         ax.set_xlabel(f"{temperature_label} [°C]", fontsize=9)
         ax.set_ylabel(f"bias [{unit}]", fontsize=9)
-        ax.legend(fontsize=8, loc="upper right", frameon=False, markerscale=4)
+        ax.legend(fontsize=8, loc="best", frameon=True, framealpha=0.9, markerscale=4)
         return _png(fig)
 
 

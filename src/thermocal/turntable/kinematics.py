@@ -61,11 +61,19 @@ def mat_nb(alpha_rad: npt.ArrayLike, beta_rad: npt.ArrayLike) -> FloatArray:
     ca, sa, cb, sb = np.cos(a), np.sin(a), np.cos(b), np.sin(b)
     zero, one = np.zeros_like(a), np.ones_like(a)
     rz = np.stack(
-        [np.stack([ca, -sa, zero], -1), np.stack([sa, ca, zero], -1), np.stack([zero, zero, one], -1)],
+        [
+            np.stack([ca, -sa, zero], -1),
+            np.stack([sa, ca, zero], -1),
+            np.stack([zero, zero, one], -1),
+        ],
         -2,
     )
     rx = np.stack(
-        [np.stack([one, zero, zero], -1), np.stack([zero, cb, -sb], -1), np.stack([zero, sb, cb], -1)],
+        [
+            np.stack([one, zero, zero], -1),
+            np.stack([zero, cb, -sb], -1),
+            np.stack([zero, sb, cb], -1),
+        ],
         -2,
     )
     out: FloatArray = rx @ MAT_C0 @ rz
@@ -118,8 +126,11 @@ def omega_ib_b(
     a = np.asarray(alpha_rad, dtype=np.float64)
     ad = np.asarray(alpha_rate_rad_s, dtype=np.float64)
     bd = np.asarray(beta_rate_rad_s, dtype=np.float64)
-    w = earth_rate_b(a, beta_rad, latitude_deg)
-    w = w + ad[..., None] * np.array([0.0, 0.0, 1.0]) + bd[..., None] * outer_axis_b(a)
+    w: FloatArray = (
+        earth_rate_b(a, beta_rad, latitude_deg)
+        + ad[..., None] * np.array([0.0, 0.0, 1.0])
+        + bd[..., None] * outer_axis_b(a)
+    )
     return w
 
 

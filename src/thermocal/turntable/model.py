@@ -29,29 +29,38 @@ gyro-integrated gimbal angles minus the encoder angle changes are, eq. (4)::
 
     y_α,i = e_z · (g_i τ_i − C_n^b ω_ie^n τ_i) − Δα_enc,i       = h_α,i θ + w_α,i
     y_β,i = e_E^b(α) · (g_i τ_i − C_n^b ω_ie^n τ_i) − Δβ_enc,i  = h_β,i θ + w_β,i
+    y_γ,i = e_⊥^b(α) · (g_i τ_i − C_n^b ω_ie^n τ_i)             = h_γ,i θ + w_γ,i
 
 with ``g_i`` the gyro mean rate over the interval and, for a projection ``p``
 (``e_z`` or ``e_E^b``) and the true angle increment ``φ_i = ω_true τ_i`` (from the
 encoders, kinematics eq. (2)), ``h θ = Σ_j p_j (b_j τ + k_j φ_j + Σ_{m≠j} E_jm φ_m)``.
-The noise is white: ``var w = Σ_j p_j² N_j² τ`` (N_j the angle random walk of gyro j).
-Sums of ``y`` and ``h`` over a block of intervals are the block's angle
-increments Δα, Δβ; the 14-state filter's Δα, Δβ are their running sums.
+The noise is white: ``cov(w_c, w_d) = Σ_j p_cj p_dj N_j² τ`` (N_j the angle random
+walk of gyro j).  Sums of ``y`` and ``h`` over a block of intervals are the block's
+angle increments; the filter's Δα, Δβ, Δγ are their running sums.
 
-Weakly observable combination and the constraint taken
---------------------------------------------------------
-A rotation ε of the triad about the inner axis changes E by ``−ε [e_z×]``
-(``E[0,1] += ε``, ``E[1,0] −= ε``), and is exactly equivalent to a zero offset ε of
-the inner-axis encoder.  With the measurements Δα, Δβ the rotations do not see it
-(``e_E^bᵀ E e_E^b`` cancels an antisymmetric xy part, and Δα does not contain the xy
-block): only the earth rate does, at the level of hundreds of arcsec.  We therefore
-report the misalignments under the **constraint** ``yx = xy`` (the body x and y axes
-are defined to lie symmetrically between the x and y gyro input axes, i.e. the
-triad's own azimuth about the inner axis defines the body frame), and report the
-antisymmetric part ``a = (yx − xy)/2`` separately as ``inner_axis_azimuth_arcsec``:
-the triad's right-handed rotation about the inner axis relative to the frame set by
-the inner encoder's zero and the base's north alignment, determined by the earth
-rate only.  Estimators work in the full 12 coefficients; :func:`to_convention`
-maps them (and their covariance) to the reported form.
+The third channel (our reading): ``e_⊥^b = e_z × e_E^b = (sin α, cos α, 0)`` is the
+body direction perpendicular to both gimbal axes; the mechanism cannot turn about it,
+so the gyro-integrated rotation about it, Δγ, has true value zero.  The SPEC's
+filter measures Δα, Δβ only; then, because every outer-axis move of the 16-position
+sequence happens at α ∈ {0°, 90°, 180°, 270°} (where ``e_E^bᵀ E e_E^b`` has no xy
+term), the two xy misalignments are seen only through the earth rate (σ ≈ 100″).
+Δγ sees them during every outer-axis move (``e_⊥ᵀ E e_E^b`` = ``yx`` at α = 0,
+``−xy`` at α = 90°).  ``channels=3`` (default) uses Δα, Δβ, Δγ; ``channels=2`` is
+the SPEC's 14-state form.
+
+Unobservable combinations and the constraints taken
+---------------------------------------------------
+* A rotation ε of the triad about the inner axis changes E by ``−ε [e_z×]``
+  (``yx += ε``, ``xy −= ε``) and is exactly equivalent, in every channel and in the
+  earth-rate terms, to a zero offset of the inner-axis encoder.  **Constraint**: the
+  inner encoder's zero is taken as exact — it defines the body x azimuth — so a
+  rotation of the triad about the inner axis is reported in the misalignments, and
+  their antisymmetric part ``(yx − xy)/2`` is also given as
+  ``inner_axis_azimuth_arcsec``.
+* A zero offset of the outer-axis encoder, or a base not levelled and aligned,
+  rotates the earth-rate input only; it is not estimated (**constraint**: zero, as
+  SPEC §7 prescribes a levelled, aligned base).  Its effect is of the order of
+  Ω × offset on the static readings.
 """
 
 from __future__ import annotations
@@ -101,9 +110,7 @@ I_YX: Final = 6
 I_XY: Final = 8
 
 
-def coeffs_from_error_matrix(
-    error_matrix: npt.ArrayLike, bias_deg_h: npt.ArrayLike
-) -> FloatArray:
+def coeffs_from_error_matrix(error_matrix: npt.ArrayLike, bias_deg_h: npt.ArrayLike) -> FloatArray:
     """θ (12) from the error matrix E (dimensionless) and the biases b [°/h]."""
     e = np.asarray(error_matrix, dtype=np.float64).reshape(3, 3)
     b = np.asarray(bias_deg_h, dtype=np.float64).reshape(3)
@@ -120,34 +127,22 @@ def error_matrix_from_coeffs(theta: npt.ArrayLike) -> tuple[FloatArray, FloatArr
     return e, th[0:3].copy()
 
 
-def convention_matrix() -> FloatArray:
-    """T (13×12): reported = T θ — θ with ``yx`` and ``xy`` replaced by their mean
-    ``s = (yx + xy)/2`` and a 13th entry ``a = (yx − xy)/2`` (inner-axis azimuth)."""
-    t = np.zeros((N_COEFFS + 1, N_COEFFS))
-    t[:N_COEFFS, :N_COEFFS] = np.eye(N_COEFFS)
-    for row in (I_YX, I_XY):
-        t[row, :] = 0.0
-        t[row, I_YX] = 0.5
-        t[row, I_XY] = 0.5
-    t[N_COEFFS, I_YX] = 0.5
-    t[N_COEFFS, I_XY] = -0.5
-    return t
-
-
-def to_convention(
+def inner_axis_azimuth(
     theta: npt.ArrayLike, cov: npt.ArrayLike | None = None
-) -> tuple[FloatArray, FloatArray | None]:
-    """Map θ (12) and its covariance to the reported form (13): ``(T θ, T C Tᵀ)``.
-
-    See the module docstring: the constraint ``yx = xy`` with the antisymmetric part
-    reported as the inner-axis azimuth ``a = (yx − xy)/2`` [arcsec].
-    """
-    t = convention_matrix()
-    th = t @ np.asarray(theta, dtype=np.float64)
+) -> tuple[float, float]:
+    """Antisymmetric xy part ``a = (yx − xy)/2`` [arcsec] — the triad's rotation about
+    the inner axis relative to the encoder zero — and its σ (NaN without ``cov``)."""
+    th = np.asarray(theta, dtype=np.float64)
+    w = np.zeros(N_COEFFS)
+    w[I_YX], w[I_XY] = 0.5, -0.5
+    val = float(w @ th)
     if cov is None:
-        return th, None
+        return val, float("nan")
     c = np.asarray(cov, dtype=np.float64)
-    return th, t @ c @ t.T
+    return val, float(np.sqrt(max(float(w @ c @ w), 0.0)))
+
+
+CHANNEL_NAMES: Final = ("alpha", "beta", "gamma")
 
 
 @dataclass(frozen=True)
@@ -157,9 +152,10 @@ class IntervalModel:
     Attributes
     ----------
     dt_s : interval lengths τ_i [s], shape (m,).
-    y_arcsec : gyro-integrated minus encoder increments, (m, 2) for (α, β) [arcsec].
-    h : regressors, (m, 2, 12) [arcsec per unit of θ].
-    proj : projections p of the two channels, (m, 2, 3) (e_z and e_E^b).
+    y_arcsec : gyro-integrated minus encoder increments, (m, k) for the channels
+        (α, β[, γ]) [arcsec].
+    h : regressors, (m, k, 12) [arcsec per unit of θ].
+    proj : projections p of the channels, (m, k, 3) (e_z, e_E^b, e_⊥^b).
     valid : intervals not spanning a gap in time, (m,).
     moving : intervals where an encoder angle changes, (m,).
     """
@@ -171,13 +167,30 @@ class IntervalModel:
     valid: npt.NDArray[np.bool_]
     moving: npt.NDArray[np.bool_]
 
-    def channel_variance(self, arw_rad_sqrt_s: npt.ArrayLike) -> FloatArray:
-        """White-noise variance of each interval's channels [arcsec²], (m, 2):
-        ``var w = Σ_j p_j² N_j² τ``."""
+    @property
+    def n_channels(self) -> int:
+        return int(self.y_arcsec.shape[1])
+
+    def select_channels(self, n_channels: int) -> IntervalModel:
+        """The first ``n_channels`` channels (2: the SPEC's Δα, Δβ; 3: with Δγ)."""
+        if n_channels not in (2, 3):
+            raise ValueError("n_channels must be 2 or 3")
+        return IntervalModel(
+            dt_s=self.dt_s,
+            y_arcsec=self.y_arcsec[:, :n_channels],
+            h=self.h[:, :n_channels],
+            proj=self.proj[:, :n_channels],
+            valid=self.valid,
+            moving=self.moving,
+        )
+
+    def channel_cov(self, arw_rad_sqrt_s: npt.ArrayLike) -> FloatArray:
+        """White-noise covariance of each interval's channels [arcsec²], (m, k, k):
+        ``cov(w_c, w_d) = Σ_j p_cj p_dj N_j² τ``."""
         n2 = (np.asarray(arw_rad_sqrt_s, dtype=np.float64) * units.RAD_TO_ARCSEC) ** 2
-        out: FloatArray = np.einsum("mcj,j->mc", self.proj**2, n2 * np.ones(3)) * self.dt_s[
-            :, None
-        ]
+        n2 = n2 * np.ones(3)
+        out: FloatArray = np.einsum("mcj,mdj,j->mcd", self.proj, self.proj, n2)
+        out *= self.dt_s[:, None, None]
         return out
 
 
@@ -191,7 +204,7 @@ def interval_model(
     gap_factor: float = 1.5,
     move_threshold_rad_s: float = 1e-3,
 ) -> IntervalModel:
-    """Build the measurement model eq. (4) for every sample interval.
+    """Build the measurement model eq. (4) for every sample interval (3 channels).
 
     Parameters
     ----------
@@ -203,8 +216,8 @@ def interval_model(
     gap_factor : an interval longer than this × the median is a gap (invalid).
     move_threshold_rad_s : an interval is "moving" if an encoder rate exceeds this.
 
-    The earth rate and e_E^b are evaluated at the interval's mid angles; the true
-    increments φ = ω_true τ come from the encoders (kinematics eq. (2)).
+    The earth rate and e_E^b, e_⊥^b are evaluated at the interval's mid angles; the
+    true increments φ = ω_true τ come from the encoders (kinematics eq. (2)).
     """
     t = np.asarray(time_s, dtype=np.float64)
     g = np.asarray(gyro_rad_s, dtype=np.float64)
@@ -219,7 +232,8 @@ def interval_model(
     e_e = kinematics.outer_axis_b(a_mid)
     e_z = np.zeros_like(e_e)
     e_z[:, 2] = 1.0
-    proj = np.stack([e_z, e_e], axis=1)  # (m, 2, 3)
+    e_p = np.cross(e_z, e_e)
+    proj = np.stack([e_z, e_e, e_p], axis=1)  # (m, 3, 3)
     phi = earth * dt[:, None] + da[:, None] * e_z + db[:, None] * e_e  # true increments [rad]
     inc = g[1:] * dt[:, None] - earth * dt[:, None]
     y = np.einsum("mcj,mj->mc", proj, inc)
@@ -227,8 +241,8 @@ def interval_model(
     y[:, 1] -= db
     y *= units.RAD_TO_ARCSEC
     # regressors: outer product p_j φ_m
-    outer = proj[:, :, :, None] * phi[:, None, None, :]  # (m, 2, 3, 3)
-    h = np.empty((dt.size, 2, N_COEFFS))
+    outer = proj[:, :, :, None] * phi[:, None, None, :]  # (m, 3, 3, 3)
+    h = np.empty((dt.size, 3, N_COEFFS))
     h[:, :, 0:3] = proj * dt[:, None, None]  # 1 °/h over τ s = τ arcsec
     h[:, :, 3:6] = np.diagonal(outer, axis1=2, axis2=3) * (units.PPM * units.RAD_TO_ARCSEC)
     for k, n in enumerate(MISALIGNMENT_NAMES):
@@ -240,14 +254,34 @@ def interval_model(
     return IntervalModel(dt_s=dt, y_arcsec=y, h=h, proj=proj, valid=valid, moving=moving)
 
 
-def fisher_information(model: IntervalModel, arw_rad_sqrt_s: npt.ArrayLike) -> FloatArray:
-    """Fisher information of θ from every valid interval, both channels [1/unit²]:
-    ``J = Σ_i Σ_c h_ci h_ciᵀ / var w_ci`` (white Gaussian noise, perfect encoders).
+def whitened_regressors(model: IntervalModel, arw_rad_sqrt_s: npt.ArrayLike) -> FloatArray:
+    """``L_i⁻¹ h_i`` for every interval, (m, k, 12), with ``L_i`` the Cholesky factor of
+    the interval's channel covariance (invalid intervals are zero)."""
+    cov = model.channel_cov(arw_rad_sqrt_s)
+    cov[~model.valid] = np.eye(model.n_channels)
+    low = np.linalg.cholesky(cov)
+    hw: FloatArray = np.linalg.solve(low, model.h)
+    hw[~model.valid] = 0.0
+    return hw
+
+
+def fisher_information(
+    model: IntervalModel,
+    arw_rad_sqrt_s: npt.ArrayLike,
+    mask: npt.NDArray[np.bool_] | None = None,
+    *,
+    whitened: FloatArray | None = None,
+) -> FloatArray:
+    """Fisher information of θ from the valid intervals (and ``mask``), all channels
+    [1/unit²]: ``J = Σ_i h_iᵀ C_i⁻¹ h_i`` (white Gaussian noise, perfect encoders),
+    computed with the Cholesky factor of each interval's channel covariance C_i
+    (``whitened`` may pass :func:`whitened_regressors` computed before).
 
     Its inverse is the Cramér–Rao bound of the design (Kay, *Fundamentals of
-    Statistical Signal Processing I*, 1993, §3.7, linear Gaussian model)."""
-    var = model.channel_variance(arw_rad_sqrt_s)[model.valid]
-    hv = model.h[model.valid] / np.sqrt(var)[:, :, None]
-    hv2 = hv.reshape(-1, N_COEFFS)
+    Statistical Signal Processing I*, 1993, §3.7, linear Gaussian model).  With the
+    three channels it is the bound for the whole gyro record."""
+    hw = whitened if whitened is not None else whitened_regressors(model, arw_rad_sqrt_s)
+    sel = model.valid if mask is None else model.valid & mask
+    hv2 = hw[sel].reshape(-1, N_COEFFS)
     out: FloatArray = hv2.T @ hv2
     return out

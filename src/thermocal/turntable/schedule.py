@@ -140,10 +140,11 @@ def build_schedule(
 
 @dataclass(frozen=True)
 class Dwell:
-    """A static run of the recorded encoder angles.
+    """A static run of the recorded encoder angles (possibly split by gaps in time).
 
     ``start``/``stop`` index the sample intervals (``[start, stop)``), ``alpha_deg``
-    and ``beta_deg`` are the angles mod 360 [°], ``duration_s`` its length [s]."""
+    and ``beta_deg`` are the angles mod 360 [°], ``duration_s`` the time the
+    position was held [s] (gaps inside it included; they are warned about)."""
 
     start: int
     stop: int
@@ -189,21 +190,29 @@ def segment(
     """Find the dwells (static runs ≥ ``pause_s``) and count distinct positions.
 
     ``moving`` and ``valid`` are per sample interval (length n − 1)."""
-    dwells = []
+    # static runs; runs at one position separated only by gaps in time are one dwell
+    merged: list[list[float]] = []  # [start, stop, duration, alpha, beta]
     for a, b in runs(~moving & valid):
         dur = float(time_s[b] - time_s[a])
-        if dur < pause_s:
-            continue
-        dwells.append(
-            Dwell(
-                a,
-                b,
-                float(time_s[a] - time_s[0]),
-                dur,
-                float(np.median(alpha_deg[a : b + 1]) % 360.0),
-                float(np.median(beta_deg[a : b + 1]) % 360.0),
-            )
-        )
+        pa = float(np.median(alpha_deg[a : b + 1]) % 360.0)
+        pb = float(np.median(beta_deg[a : b + 1]) % 360.0)
+        if merged:
+            prev = merged[-1]
+            between = slice(int(prev[1]), a)
+            if (
+                not np.any(moving[between] & valid[between])
+                and _angle_close(pa, prev[3], position_tol_deg)
+                and _angle_close(pb, prev[4], position_tol_deg)
+            ):
+                prev[1] = b
+                prev[2] = float(time_s[b] - time_s[int(prev[0])])
+                continue
+        merged.append([a, b, dur, pa, pb])
+    dwells = [
+        Dwell(int(a), int(b), float(time_s[int(a)] - time_s[0]), dur, pa, pb)
+        for a, b, dur, pa, pb in merged
+        if dur >= pause_s
+    ]
     keys: list[tuple[float, float]] = []
     for d in dwells:
         if not any(

@@ -34,13 +34,13 @@ BETA_COLUMN = "beta_deg"
 
 @dataclass(frozen=True)
 class TurntableTruth:
-    """The simulated triad's errors (physical, i.e. as applied to the true rates).
+    """The simulated triad's errors, as applied to the true rates.
 
     ``misalignment_arcsec`` in the SPEC order (yx, zx, xy, zy, xz, yz), mapping to
     ``E[0,1], E[0,2], E[1,0], E[1,2], E[2,0], E[2,1]`` (see :mod:`.model`).  The
-    default is a navigation-grade triad with an antisymmetric xy part of 20″ (a
-    rotation of the triad about the inner axis), which the calibration reports
-    separately as the inner-axis azimuth.
+    default is a navigation-grade triad whose xy misalignments have an antisymmetric
+    part of 20″ (a rotation of the triad about the inner axis relative to the
+    encoder zero, ``inner_axis_azimuth_arcsec``).
     """
 
     bias_deg_h: tuple[float, float, float] = (0.02, -0.035, 0.015)
@@ -76,19 +76,14 @@ class TurntableTruth:
         return cls((b[0], b[1], b[2]), (k[0], k[1], k[2]), (m[0], m[1], m[2], m[3], m[4], m[5]))
 
     def to_dict(self) -> dict[str, Any]:
-        """JSON-ready truth in the calibration's reporting convention (``yx = xy``, the
-        antisymmetric part as ``inner_axis_azimuth_arcsec``) and physical."""
-        conv, _ = model.to_convention(self.theta)
-        e_conv, _ = model.error_matrix_from_coeffs(conv[:12])
+        """JSON-ready truth with the keys of the calibration result."""
         return {
             "bias_deg_h": [float(v) for v in self.bias_deg_h],
             "scale_factor_ppm": [float(v) for v in self.scale_factor_ppm],
-            "misalignment_arcsec": [float(v) for v in conv[6:12]],
+            "misalignment_arcsec": [float(v) for v in self.misalignment_arcsec],
             "misalignment_names": list(model.MISALIGNMENT_NAMES),
-            "error_matrix": e_conv.tolist(),
-            "inner_axis_azimuth_arcsec": float(conv[12]),
-            "misalignment_arcsec_physical": [float(v) for v in self.misalignment_arcsec],
-            "error_matrix_physical": self.error_matrix.tolist(),
+            "error_matrix": self.error_matrix.tolist(),
+            "inner_axis_azimuth_arcsec": model.inner_axis_azimuth(self.theta)[0],
         }
 
 
@@ -138,7 +133,9 @@ def simulate_turntable16(
     b_prev = np.concatenate([[b[0]], b[:-1]])
     a_mid = 0.5 * (a + a_prev)
     b_mid = 0.5 * (b + b_prev)
-    omega_true = kinematics.omega_ib_b(a_mid, b_mid, (a - a_prev) / tau, (b - b_prev) / tau, latitude_deg)
+    omega_true = kinematics.omega_ib_b(
+        a_mid, b_mid, (a - a_prev) / tau, (b - b_prev) / tau, latitude_deg
+    )
     e_mat = tr.error_matrix
     bias = np.asarray(tr.bias_deg_h) * units.DH_TO_RS
     arw_rad_sqrt_s = arw_deg_sqrt_h * units.DEG_TO_RAD / np.sqrt(units.SECONDS_PER_HOUR)
@@ -179,7 +176,7 @@ def simulate_turntable16(
             "alpha": ALPHA_COLUMN,
             "beta": BETA_COLUMN,
         },
-        "convention": "misalignments reported with yx = xy; the antisymmetric part "
-        "(yx - xy)/2 is inner_axis_azimuth_arcsec",
+        "constraint": "inner encoder zero exact (defines body x azimuth); "
+        "inner_axis_azimuth_arcsec = (yx - xy)/2",
     }
     return rec, truth_dict

@@ -1,0 +1,105 @@
+"""Benchmark: the 37-term ``poly`` (seed000) fit on 10⁷ samples (issue 5).
+
+Target: fit in < 3 s with peak memory < 1.5 GB.  Prints the figures; the
+numbers go into benchmarks/RESULTS.md.
+
+Usage::
+
+    .venv/bin/python benchmarks/bench_fit.py [--n 10000000] [--solver auto|qr|gram]
+
+Data: 10⁷ samples at 1 s, four temperature sensors following a slow chamber
+cycle with different lags, a seed000-shaped truth (T, T², Ṫ and TṪ terms) plus
+white noise.  Timed: ``PolyModel().fit([run])`` (Ṫ computation, base-variable
+scaling, feature construction in chunks, chunked reduction, SVD solve), and a
+``predict`` over the same data.  Peak memory: the process's maximum resident
+set size (``resource.getrusage``; includes the 0.5 GB of input arrays) and the
+tracemalloc peak of a separate fit (memory allocated by the fit itself).
+"""
+
+from __future__ import annotations
+
+import argparse
+import resource
+import sys
+import time
+import tracemalloc
+
+import numpy as np
+
+from thermocal.models import RunData
+from thermocal.models.poly import PolyModel
+
+
+def make_data(n: int, seed: int = 0) -> RunData:
+    """Four lagged sensors on a chamber cycle, truth of seed000 form, noise 0.01 °/h."""
+    rng = np.random.default_rng(seed)
+    t = np.arange(n, dtype=np.float64)
+    temps = np.empty((n, 4))
+    # chamber: -20..50 °C cycle of 8 h plus a faster 1.3 h component
+    amb = 15.0 + 35.0 * np.sin(2 * np.pi * t / 28800.0)
+    amb += 3.0 * np.sin(2 * np.pi * t / 4700.0)
+    for k in range(4):
+        lag = 200.0 * (k + 1)
+        temps[:, k] = np.interp(t - lag, t, amb)
+        temps[:, k] += 0.005 * rng.standard_normal(n)
+    del amb
+    y = 0.02 * temps[:, 0]
+    y += 1e-4 * (temps[:, 1] - 15.0) ** 2
+    dT = np.diff(temps[:, 2], prepend=temps[0, 2]) * 60.0
+    y += 0.3 * dT + 0.01 * temps[:, 3] * dT
+    del dT
+    y += 0.01 * rng.standard_normal(n)
+    return RunData(t, temps, y, ("T1", "T2", "T3", "T4"), "bench")
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__)
+    ap.add_argument("--n", type=int, default=10_000_000)
+    ap.add_argument("--solver", default="auto", choices=["auto", "qr", "gram"])
+    ap.add_argument("--no-tracemalloc", action="store_true")
+    args = ap.parse_args(argv)
+
+    t0 = time.perf_counter()
+    run = make_data(args.n)
+    t_data = time.perf_counter() - t0
+    rss_data = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
+
+    t0 = time.perf_counter()
+    model = PolyModel(solver=args.solver).fit([run])
+    t_fit = time.perf_counter() - t0
+    rss_fit = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
+
+    t0 = time.perf_counter()
+    pred = model.predict(run)
+    t_pred = time.perf_counter() - t0
+    resid = float(np.std(run.target() - pred))
+    rss_all = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
+    del pred
+
+    tm_peak = float("nan")
+    if not args.no_tracemalloc:
+        tracemalloc.start()
+        PolyModel(solver=args.solver).fit([run])
+        tm_peak = tracemalloc.get_traced_memory()[1] / 2**20
+        tracemalloc.stop()
+
+    st = model.stats_
+    print(f"samples                 {args.n:,}")
+    print(f"coefficients            {st.n_coefficients}")
+    print(f"solver                  {st.extra['solver']}")
+    print(f"condition number        {st.condition_number:.3g}")
+    print(f"rms residual            {st.rms_residual:.5f} (noise 0.01; predict std {resid:.5f})")
+    print(f"data generation         {t_data:.2f} s")
+    print(f"fit time                {t_fit:.2f} s   (target < 3 s)")
+    print(f"predict time            {t_pred:.2f} s")
+    print(f"peak RSS after data     {rss_data:.0f} MiB")
+    print(f"peak RSS after fit      {rss_fit:.0f} MiB   (target < 1536 MiB)")
+    print(f"peak RSS after predict  {rss_all:.0f} MiB")
+    print(f"tracemalloc peak (fit)  {tm_peak:.0f} MiB")
+    ok = t_fit < 3.0 and rss_fit < 1536.0
+    print("PASS" if ok else "FAIL")
+    return 0 if ok else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())

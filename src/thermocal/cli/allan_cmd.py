@@ -1,0 +1,157 @@
+"""``thermocal allan FILE``: overlapping Allan deviation, confidence intervals and
+IEEE 952 noise terms by slope lines and by least squares."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated, Any
+
+import typer
+from rich.table import Table
+
+from thermocal.allan import AllanResult, NoiseTerms, noise_terms, overlapping_adev
+from thermocal.cli.app import app
+from thermocal.cli.common import (
+    FileArg,
+    JsonOpt,
+    SignalOpt,
+    SignalUnitOpt,
+    TempUnitOpt,
+    TimeUnitOpt,
+    emit,
+    fmt,
+    handle_errors,
+    jsonable,
+    load_recording,
+    stdout,
+)
+from thermocal.errors import ThermocalInputError
+from thermocal.io import check_not_input
+
+
+def _terms_json(terms: dict[str, Any]) -> dict[str, Any]:
+    return {
+        name: {
+            "value": t.value,
+            "unit": t.unit,
+            "reason": t.reason,
+            "low": t.low,
+            "high": t.high,
+            "tau_s": t.tau_s,
+            "label": t.label,
+        }
+        for name, t in terms.items()
+    }
+
+
+def allan_json(res: AllanResult, noise: NoiseTerms) -> dict[str, Any]:
+    """The ``--json`` object of ``thermocal allan``: ``noise`` holds the fit-method
+    terms, ``noise_slope`` the slope-line terms (each value or null with a reason)."""
+    out: dict[str, Any] = {
+        "tau_s": res.tau_s,
+        "adev": res.adev,
+        "adev_low": res.adev_low,
+        "adev_high": res.adev_high,
+        "unit": res.unit,
+        "n_terms": res.n_terms,
+        "edf": res.edf,
+        "alpha": res.alpha,
+        "confidence": res.confidence,
+        "tau0_s": res.tau0_s,
+        "n_samples": res.n_samples,
+        "n_segments": res.n_segments,
+        "noise": _terms_json(noise.fit.terms()),
+        "noise_method": "weighted non-negative least squares (IEEE 952 C.2)",
+        "noise_slope": _terms_json(noise.slope.terms()),
+        "noise_slope_method": "slope lines (IEEE 952 C.3)",
+        "fit_coefficients": noise.fit_coefficients,
+        "fit_reduced_chi2": noise.reduced_chi2,
+    }
+    return dict(jsonable(out))
+
+
+@app.command("allan")
+@handle_errors
+def allan_cmd(
+    file: FileArg,
+    signal: SignalOpt = None,
+    taus: Annotated[
+        str, typer.Option("--taus", help="Tau set: octave, decade, log, or a list '1,10,100' [s].")
+    ] = "octave",
+    plot: Annotated[
+        Path | None, typer.Option("--plot", help="Write a log-log PNG plot here.")
+    ] = None,
+    confidence: Annotated[
+        float, typer.Option("--confidence", help="Confidence level of the intervals.")
+    ] = 0.6826894921370859,
+    time: Annotated[str | None, typer.Option("--time", help="Name of the time column.")] = None,
+    time_unit: TimeUnitOpt = "s",
+    signal_unit: SignalUnitOpt = None,
+    temp_unit: TempUnitOpt = None,
+    temps: Annotated[str | None, typer.Option("--temps", hidden=True)] = None,
+    as_json: JsonOpt = False,
+) -> None:
+    """Overlapping Allan deviation with chi-square confidence intervals and the noise
+    terms (quantization, angle random walk, bias instability, rate random walk, rate
+    ramp) by least squares and by IEEE 952 slope lines.  Gaps are never
+    differenced across: each contiguous stretch is processed alone and pooled."""
+    rec = load_recording(
+        file,
+        time=time,
+        time_unit=time_unit,
+        signal=signal,
+        temps=temps,
+        signal_unit=signal_unit,
+        temp_unit=temp_unit,
+    )
+    if plot is not None:
+        check_not_input(plot, [file])
+    values, unit = rec.signal(signal)
+    tau_spec: Any = taus
+    if taus not in ("octave", "decade", "log"):
+        try:
+            tau_spec = [float(v) for v in taus.split(",") if v.strip()]
+        except ValueError:
+            raise ThermocalInputError(
+                f"--taus {taus!r}: use octave, decade, log or a comma-separated list of τ [s]"
+            ) from None
+    res = overlapping_adev(
+        values,
+        rec.sample_interval_s,
+        tau_spec,
+        time_s=rec.time_s,
+        unit=unit,
+        confidence=confidence,
+    )
+    noise = noise_terms(res)
+    if plot is not None:
+        from thermocal.plots_allan import plot_allan
+
+        plot_allan(res, noise, plot, title=f"{file.name} — {signal or rec.signals[0]}")
+
+    def human() -> None:
+        t1 = Table(title=f"{file} — overlapping Allan deviation [{res.unit}]")
+        for col in ("τ [s]", "ADEV", "low", "high", "terms", "edf"):
+            t1.add_column(col, justify="right")
+        for i in range(res.tau_s.size):
+            t1.add_row(
+                fmt(float(res.tau_s[i])),
+                fmt(float(res.adev[i])),
+                fmt(float(res.adev_low[i])),
+                fmt(float(res.adev_high[i])),
+                str(int(res.n_terms[i])),
+                fmt(float(res.edf[i]), 3),
+            )
+        stdout.print(t1)
+        t2 = Table(title="noise terms")
+        for col in ("term", "fit", "slope lines", "unit", "note"):
+            t2.add_column(col)
+        fit, slope = noise.fit.terms(), noise.slope.terms()
+        for name in fit:
+            f, s = fit[name], slope[name]
+            t2.add_row(f.label, fmt(f.value), fmt(s.value), f.unit, f.reason or s.reason or "")
+        stdout.print(t2)
+        if plot is not None:
+            stdout.print(f"plot written to {plot}")
+
+    emit(allan_json(res, noise), as_json, human)

@@ -1,0 +1,391 @@
+"""``thermocal profile ...``: chamber programs, their correlation, validation design.
+
+* ``thermocal profile NAME -o FILE.csv [options]`` for each built-in profile
+  (``rlg-modelling``, ``rlg-validation``, ``fog-slow``, ``mems-warmup``,
+  ``accel-full-range``) writes the chamber program ``time_s, setpoint_c``.
+* ``thermocal profile correlate A B [--column C] [--json]``: r and
+  ``weakly_correlated`` of two temperature histories (SPEC §5).
+* ``thermocal profile design-validation MODEL -o VAL.csv --seed N``, or
+  ``thermocal profile rlg-validation --against MODEL --seed N``: a hold profile
+  over the modelling range with |r| below the limit.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated, Any
+
+import numpy as np
+import pandas as pd
+import typer
+
+from thermocal.cli.app import app
+from thermocal.cli.common import JsonOpt, OutOpt, emit, handle_errors, stdout
+from thermocal.errors import FileFormatError, MissingColumnError, ThermocalInputError
+from thermocal.io import check_not_input, file_kind, read_recording
+from thermocal.profiles import (
+    PROGRAM_SETPOINT,
+    PROGRAM_TIME,
+    WEAK_CORRELATION_LIMIT,
+    Profile,
+    builtin_profile,
+    correlate,
+    design_validation_profile,
+    read_program,
+    write_program,
+)
+from thermocal.recording import FloatArray
+
+profile_app = typer.Typer(
+    help="Chamber test profiles (time_s, setpoint_c programs), their correlation, and the "
+    "design of weakly correlated validation profiles.",
+    no_args_is_help=True,
+)
+app.add_typer(profile_app, name="profile")
+
+DtOpt = Annotated[
+    float,
+    typer.Option("--dt", help="Program step [s]; 0 writes only the corner points of the profile."),
+]
+ColumnOpt = Annotated[
+    str | None,
+    typer.Option(
+        "--column",
+        help="Temperature column of a recording (default: setpoint_c of a program, else the "
+        "first temperature column).",
+    ),
+]
+
+
+def _floats(text: str | None, what: str) -> list[float] | None:
+    if text is None:
+        return None
+    try:
+        return [float(v) for v in text.split(",") if v.strip()]
+    except ValueError:
+        raise ThermocalInputError(
+            f"{what}: expected comma-separated numbers, got {text!r}"
+        ) from None
+
+
+def _write_profile(prof: Profile, output: Path, dt: float, as_json: bool, **extra: Any) -> None:
+    t, c = prof.program(dt if dt > 0 else None)
+    write_program(output, t, c)
+    summary = {
+        "profile": prof.name,
+        "file": str(output),
+        "n_points": int(t.size),
+        "duration_s": float(t[-1]),
+        "min_c": float(np.min(c)),
+        "max_c": float(np.max(c)),
+        "params": prof.params,
+        **extra,
+    }
+    emit(
+        summary,
+        as_json,
+        lambda: stdout.print(
+            f"{prof.name}: {t.size} points, {t[-1] / 3600:.2f} h, "
+            f"{np.min(c):g} … {np.max(c):g} °C → {output}"
+            + (f" (r = {extra['r']:.3f})" if "r" in extra else "")
+        ),
+    )
+
+
+def _clean(params: dict[str, Any]) -> dict[str, Any]:
+    return {k: v for k, v in params.items() if v is not None}
+
+
+def load_history(path: Path, column: str | None = None) -> tuple[FloatArray, FloatArray, str]:
+    """A temperature history ``(time_s, temperature_c, column)`` from a chamber program CSV
+    (``time_s, setpoint_c``; its set-point unless ``column`` is another of its columns) or a
+    recording (``column``, default its first temperature column, else ``setpoint_c``)."""
+    if not path.exists():
+        raise FileFormatError(f"{path}: no such file")
+    time_col: str | None = None
+    if file_kind(path) == "csv":
+        try:
+            header = [str(c).strip() for c in pd.read_csv(path, nrows=0).columns]
+        except (pd.errors.EmptyDataError, pd.errors.ParserError, UnicodeDecodeError) as exc:
+            raise FileFormatError(f"{path}: not a readable CSV file ({exc})") from None
+        is_program = PROGRAM_TIME in header and PROGRAM_SETPOINT in header
+        if is_program and (column is None or column not in header):
+            t, c = read_program(path)
+            return t, c, PROGRAM_SETPOINT
+        if PROGRAM_TIME in header and "time" not in header:
+            time_col = PROGRAM_TIME
+    rec = read_recording(path, time=time_col)
+    if column is None:
+        if rec.temperatures:
+            column = rec.temperatures[0]
+        elif PROGRAM_SETPOINT in rec.columns:
+            column = PROGRAM_SETPOINT
+        else:
+            raise MissingColumnError(
+                f"{path}: no temperature column known; name one with --column (available: "
+                + ", ".join(repr(c) for c in rec.columns)
+                + ")"
+            )
+    values = rec.temperature_c(column) if column in rec.temperatures else rec.column(column)
+    return rec.time_s, values, column
+
+
+@profile_app.command("rlg-modelling")
+@handle_errors
+def rlg_modelling_cmd(
+    output: OutOpt,
+    low: Annotated[float | None, typer.Option("--low", help="Low temperature [°C].")] = None,
+    high: Annotated[float | None, typer.Option("--high", help="High temperature [°C].")] = None,
+    start: Annotated[float | None, typer.Option("--start", help="Start/end [°C].")] = None,
+    cycles: Annotated[
+        int | None, typer.Option("--cycles", help="Number of full temperature cycles.")
+    ] = None,
+    cycle_rate: Annotated[
+        float | None, typer.Option("--cycle-rate", help="Rate of the full cycles [°C/min].")
+    ] = None,
+    hold_s: Annotated[
+        float | None, typer.Option("--hold-s", help="Hold at the ends of full cycles [s].")
+    ] = None,
+    rates: Annotated[
+        str | None, typer.Option("--rates", help="Rate cycles [°C/min], e.g. 2,1,0.5,0.2,0.1.")
+    ] = None,
+    rate_hold_s: Annotated[
+        float | None, typer.Option("--rate-hold-s", help="Hold at the ends of rate cycles [s].")
+    ] = None,
+    dt: DtOpt = 60.0,
+    as_json: JsonOpt = False,
+) -> None:
+    """Seed-000 modelling test: cycles between −20 and +50 °C, then ±2…±0.1 °C/min cycles."""
+    params = _clean(
+        {
+            "low_c": low,
+            "high_c": high,
+            "start_c": start,
+            "n_temperature_cycles": cycles,
+            "cycle_rate_c_per_min": cycle_rate,
+            "hold_s": hold_s,
+            "rates_c_per_min": _floats(rates, "--rates"),
+            "rate_hold_s": rate_hold_s,
+        }
+    )
+    _write_profile(builtin_profile("rlg-modelling", **params), output, dt, as_json)
+
+
+@profile_app.command("rlg-validation")
+@handle_errors
+def rlg_validation_cmd(
+    output: OutOpt,
+    holds: Annotated[
+        str | None, typer.Option("--holds", help="Hold temperatures [°C], comma-separated.")
+    ] = None,
+    hold_s: Annotated[float | None, typer.Option("--hold-s", help="Hold duration [s].")] = None,
+    rate: Annotated[float | None, typer.Option("--rate", help="Ramp rate [°C/min].")] = None,
+    start: Annotated[float | None, typer.Option("--start", help="Start/end [°C].")] = None,
+    against: Annotated[
+        Path | None,
+        typer.Option(
+            "--against",
+            help="Modelling program or recording: design the holds (seeded) so that |r| is "
+            "below --limit.",
+        ),
+    ] = None,
+    column: ColumnOpt = None,
+    seed: Annotated[int, typer.Option("--seed", help="Seed of the design search.")] = 0,
+    limit: Annotated[
+        float, typer.Option("--limit", help="Correlation limit.")
+    ] = WEAK_CORRELATION_LIMIT,
+    n_holds: Annotated[
+        int | None, typer.Option("--n-holds", help="Number of holds of a designed profile.")
+    ] = None,
+    dt: DtOpt = 60.0,
+    as_json: JsonOpt = False,
+) -> None:
+    """Seed-000 validation test: holds at several temperatures (or designed with --against)."""
+    if against is not None:
+        if holds is not None:
+            raise ThermocalInputError("give either --holds or --against, not both")
+        check_not_input(output, [against])
+        _design(against, output, column, seed, limit, n_holds, hold_s, rate, dt, as_json)
+        return
+    params = _clean(
+        {
+            "holds_c": _floats(holds, "--holds"),
+            "hold_s": hold_s,
+            "rate_c_per_min": rate,
+            "start_c": start,
+        }
+    )
+    _write_profile(builtin_profile("rlg-validation", **params), output, dt, as_json)
+
+
+@profile_app.command("fog-slow")
+@handle_errors
+def fog_slow_cmd(
+    output: OutOpt,
+    low: Annotated[float | None, typer.Option("--low", help="Low temperature [°C].")] = None,
+    high: Annotated[float | None, typer.Option("--high", help="High temperature [°C].")] = None,
+    rate: Annotated[float | None, typer.Option("--rate", help="Ramp rate [°C/min].")] = None,
+    hold_s: Annotated[float | None, typer.Option("--hold-s", help="Hold duration [s].")] = None,
+    cycles: Annotated[int | None, typer.Option("--cycles", help="Number of cycles.")] = None,
+    dt: DtOpt = 60.0,
+    as_json: JsonOpt = False,
+) -> None:
+    """Seed-001 slow drift over 15–42 °C."""
+    params = _clean(
+        {
+            "low_c": low,
+            "high_c": high,
+            "rate_c_per_min": rate,
+            "hold_s": hold_s,
+            "n_cycles": cycles,
+        }
+    )
+    _write_profile(builtin_profile("fog-slow", **params), output, dt, as_json)
+
+
+@profile_app.command("mems-warmup")
+@handle_errors
+def mems_warmup_cmd(
+    output: OutOpt,
+    starts: Annotated[
+        str | None, typer.Option("--starts", help="Start temperatures [°C], comma-separated.")
+    ] = None,
+    soak_s: Annotated[
+        float | None, typer.Option("--soak-s", help="Soak before power-on [s].")
+    ] = None,
+    record_s: Annotated[
+        float | None, typer.Option("--record-s", help="Powered record per start (≥ 360 s).")
+    ] = None,
+    rate: Annotated[float | None, typer.Option("--rate", help="Transition rate [°C/min].")] = None,
+    start: Annotated[float | None, typer.Option("--start", help="Start/end [°C].")] = None,
+    dt: DtOpt = 60.0,
+    as_json: JsonOpt = False,
+) -> None:
+    """Seed-003 power-on warm-ups at several start temperatures."""
+    params = _clean(
+        {
+            "start_temps_c": _floats(starts, "--starts"),
+            "soak_s": soak_s,
+            "record_s": record_s,
+            "transition_rate_c_per_min": rate,
+            "start_c": start,
+        }
+    )
+    _write_profile(builtin_profile("mems-warmup", **params), output, dt, as_json)
+
+
+@profile_app.command("accel-full-range")
+@handle_errors
+def accel_full_range_cmd(
+    output: OutOpt,
+    low: Annotated[float | None, typer.Option("--low", help="Low temperature [°C].")] = None,
+    high: Annotated[float | None, typer.Option("--high", help="High temperature [°C].")] = None,
+    soak_s: Annotated[float | None, typer.Option("--soak-s", help="Soak at the ends [s].")] = None,
+    rate: Annotated[float | None, typer.Option("--rate", help="Ramp rate [°C/min].")] = None,
+    step: Annotated[
+        float | None, typer.Option("--step", help="Constant points every STEP [°C].")
+    ] = None,
+    point_hold_s: Annotated[
+        float | None, typer.Option("--point-hold-s", help="Hold at each constant point [s].")
+    ] = None,
+    repeats: Annotated[int | None, typer.Option("--repeats", help="Number of runs.")] = None,
+    start: Annotated[float | None, typer.Option("--start", help="Start/end [°C].")] = None,
+    dt: DtOpt = 60.0,
+    as_json: JsonOpt = False,
+) -> None:
+    """Seed-004 full range: −40 °C soak 2 h, 2 °C/min to +60 °C, soak 2 h; points every 5 °C."""
+    params = _clean(
+        {
+            "low_c": low,
+            "high_c": high,
+            "soak_s": soak_s,
+            "rate_c_per_min": rate,
+            "step_c": step,
+            "point_hold_s": point_hold_s,
+            "repeats": repeats,
+            "start_c": start,
+        }
+    )
+    _write_profile(builtin_profile("accel-full-range", **params), output, dt, as_json)
+
+
+@profile_app.command("correlate")
+@handle_errors
+def correlate_cmd(
+    file_a: Annotated[Path, typer.Argument(help="Modelling program or recording.")],
+    file_b: Annotated[Path, typer.Argument(help="Validation program or recording.")],
+    column: ColumnOpt = None,
+    column_b: Annotated[
+        str | None, typer.Option("--column-b", help="Column of B (default: --column's rule).")
+    ] = None,
+    limit: Annotated[
+        float, typer.Option("--limit", help="Weak-correlation limit.")
+    ] = WEAK_CORRELATION_LIMIT,
+    points: Annotated[
+        int, typer.Option("--points", help="Points of the common elapsed-time base.")
+    ] = 10_000,
+    as_json: JsonOpt = False,
+) -> None:
+    """r = Cov(X, Y)/(σX σY) of two temperature histories on a common elapsed-time base."""
+    ta, xa, ca = load_history(file_a, column)
+    tb, xb, cb = load_history(file_b, column_b if column_b is not None else column)
+    res = correlate(ta, xa, tb, xb, r_limit=limit, n_points=points)
+    out = {
+        "r": res.r,
+        "weakly_correlated": res.weakly_correlated,
+        "r_limit": res.r_limit,
+        "n": res.n,
+        "duration_s": res.duration_s,
+        "column_a": ca,
+        "column_b": cb,
+    }
+    emit(
+        out,
+        as_json,
+        lambda: stdout.print(
+            f"r = {res.r:.4f} over {res.duration_s / 3600:.2f} h ({res.n} points): "
+            + ("weakly correlated" if res.weakly_correlated else "NOT weakly correlated")
+            + f" (limit {limit:g})"
+        ),
+    )
+
+
+def _design(
+    model: Path,
+    output: Path,
+    column: str | None,
+    seed: int,
+    limit: float,
+    n_holds: int | None,
+    hold_s: float | None,
+    rate: float | None,
+    dt: float,
+    as_json: bool,
+) -> None:
+    tm, cm, _ = load_history(model, column)
+    kwargs: dict[str, Any] = _clean({"n_holds": n_holds, "hold_s": hold_s, "rate_c_per_min": rate})
+    prof = design_validation_profile(tm, cm, seed, limit, **kwargs)
+    tv, cv = prof.knots()
+    res = correlate(tm, cm, tv, cv, r_limit=limit)
+    _write_profile(prof, output, dt, as_json, r=res.r, weakly_correlated=res.weakly_correlated)
+
+
+@profile_app.command("design-validation")
+@handle_errors
+def design_validation_cmd(
+    model: Annotated[Path, typer.Argument(help="Modelling program or recording.")],
+    output: OutOpt,
+    seed: Annotated[int, typer.Option("--seed", help="Seed of the design search.")] = 0,
+    column: ColumnOpt = None,
+    limit: Annotated[
+        float, typer.Option("--limit", help="Correlation limit.")
+    ] = WEAK_CORRELATION_LIMIT,
+    n_holds: Annotated[int | None, typer.Option("--n-holds", help="Number of holds.")] = None,
+    hold_s: Annotated[float | None, typer.Option("--hold-s", help="Mean hold [s].")] = None,
+    rate: Annotated[float | None, typer.Option("--rate", help="Ramp rate [°C/min].")] = None,
+    dt: DtOpt = 60.0,
+    as_json: JsonOpt = False,
+) -> None:
+    """A hold profile over the modelling range, weakly correlated with it (seeded)."""
+    check_not_input(output, [model])
+    _design(model, output, column, seed, limit, n_holds, hold_s, rate, dt, as_json)

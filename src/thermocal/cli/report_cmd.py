@@ -1,0 +1,161 @@
+"""``thermocal report --model M.json --validation V.json --recording VAL.csv -o report.html``.
+
+Builds the self-contained HTML report (:func:`thermocal.report.write_report`)
+from the files the other commands write: one or more model files (``thermocal
+fit``), their validation results (``thermocal validate --json``, in the same
+order as the models) and the validation recording, optionally the modelling
+recording.  The first model is reported in detail; the others appear in the
+comparison table.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Annotated, Any
+
+import typer
+
+from thermocal.cli.app import app
+from thermocal.cli.common import (
+    SignalUnitOpt,
+    TempUnitOpt,
+    handle_errors,
+    load_recording,
+    progress,
+    stderr,
+)
+from thermocal.errors import FileFormatError, ThermocalInputError
+from thermocal.io import check_not_input
+from thermocal.models.base import load_model_dict
+from thermocal.recording import Recording
+from thermocal.report import ModelEntry, ReportInputs, write_report
+
+
+def read_validation_json(path: Path) -> dict[str, Any]:
+    """A validation result file (``thermocal validate --json`` output) as a dict."""
+    try:
+        obj = json.loads(path.read_text(encoding="utf-8"))
+    except FileNotFoundError:
+        raise ThermocalInputError(f"{path}: no such validation file") from None
+    except (json.JSONDecodeError, UnicodeDecodeError) as exc:
+        raise FileFormatError(f"{path}: not a JSON validation result ({exc})") from None
+    if not isinstance(obj, dict) or "bias_stability_before" not in obj:
+        raise FileFormatError(
+            f"{path}: not a validation result (expected the JSON object of "
+            "`thermocal validate --json`, with bias_stability_before, ...)"
+        )
+    return obj
+
+
+def _read_run(
+    path: Path,
+    signal: str,
+    time: str | None,
+    time_unit: str | None,
+    signal_unit: str | None,
+    temp_unit: str | None,
+) -> Recording:
+    return load_recording(
+        path,
+        time=time,
+        time_unit=time_unit,
+        signal=signal,
+        signal_unit=signal_unit,
+        temp_unit=temp_unit,
+    )
+
+
+@app.command("report")
+@handle_errors
+def report_cmd(
+    model: Annotated[
+        list[Path],
+        typer.Option("--model", help="Model file (repeat for several; the first is detailed)."),
+    ],
+    recording: Annotated[
+        Path, typer.Option("--recording", help="The validation run's recording (CSV/Parquet).")
+    ],
+    output: Annotated[Path, typer.Option("-o", "--output", help="The HTML file to write.")],
+    validation: Annotated[
+        list[Path] | None,
+        typer.Option(
+            "--validation",
+            help="`thermocal validate --json` output, one per --model, in the same order.",
+        ),
+    ] = None,
+    modeling: Annotated[
+        Path | None, typer.Option("--modeling", help="The modelling run's recording.")
+    ] = None,
+    signal: Annotated[
+        str | None,
+        typer.Option("--signal", help="Signal column (default: the model's signal name)."),
+    ] = None,
+    label: Annotated[
+        list[str] | None,
+        typer.Option("--label", help="Short name of each model (default: the file stem)."),
+    ] = None,
+    title: Annotated[
+        str, typer.Option("--title", help="Report title.")
+    ] = "Temperature compensation report",
+    sensor: Annotated[
+        str | None, typer.Option("--sensor", help="Sensor name or serial number.")
+    ] = None,
+    time: Annotated[str | None, typer.Option("--time", help="Time column.")] = None,
+    time_unit: Annotated[
+        str | None, typer.Option("--time-unit", help="Time unit: s, ms or us.")
+    ] = None,
+    signal_unit: SignalUnitOpt = None,
+    temp_unit: TempUnitOpt = None,
+) -> None:
+    """Write a self-contained HTML report (figures embedded, no network needed)."""
+    validations = list(validation or [])
+    labels = list(label or [])
+    if validations and len(validations) != len(model):
+        raise ThermocalInputError(
+            f"{len(validations)} --validation files for {len(model)} --model files; "
+            "give one validation per model, in the same order"
+        )
+    if labels and len(labels) != len(model):
+        raise ThermocalInputError(f"{len(labels)} --label values for {len(model)} --model files")
+    inputs_files: list[str | Path] = [*model, *validations, recording]
+    if modeling is not None:
+        inputs_files.append(modeling)
+    check_not_input(output, inputs_files)
+
+    with progress("building report", total=3) as advance:
+        entries = []
+        for i, mpath in enumerate(model):
+            mdict = load_model_dict(mpath)
+            vdict = read_validation_json(validations[i]) if validations else None
+            lab = labels[i] if labels else mpath.stem
+            entries.append(ModelEntry(lab, mdict, vdict, str(mpath)))
+        if len({e.label for e in entries}) != len(entries):
+            raise ThermocalInputError(
+                "two models have the same label (file stem); name them with --label"
+            )
+        sig = signal or (entries[0].model.get("signal") or {}).get("name") or None
+        if not sig:
+            raise ThermocalInputError("name the signal column with --signal")
+        val_rec = _read_run(recording, sig, time, time_unit, signal_unit, temp_unit)
+        mod_rec = (
+            _read_run(modeling, sig, time, time_unit, signal_unit, temp_unit)
+            if modeling is not None
+            else None
+        )
+        advance(1)
+        inputs = ReportInputs(
+            models=tuple(entries),
+            recording=val_rec,
+            modeling=mod_rec,
+            signal=sig,
+            recording_path=str(recording),
+            modeling_path=str(modeling) if modeling is not None else None,
+            title=title,
+            sensor=sensor,
+            generated_by="thermocal report",
+        )
+        advance(1)
+        path = write_report(output, inputs)
+        advance(1)
+    stderr.print(f"report written to [bold]{path}[/bold]")

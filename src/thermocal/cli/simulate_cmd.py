@@ -1,0 +1,165 @@
+"""``thermocal simulate SCENARIO -o OUT [--seed N] [--profile FILE.csv] [--truth TRUTH.json]``.
+
+Scenarios (:data:`thermocal.simulate.SCENARIOS`): ``rlg-modelling``,
+``rlg-validation``, ``fog-slow``, ``mems-warmup`` (one file per start
+temperature), ``accel-full-range`` (one file per run), ``turntable-16``.
+
+Output naming:
+
+* one file: ``-o run.csv`` (or ``.parquet``) writes that file (a CSV gets its
+  ``.meta.json`` sidecar);
+* several files: ``-o DIR`` (no data extension) writes
+  ``DIR/<scenario>_<label>.csv`` (``--format parquet`` for Parquet), e.g.
+  ``DIR/mems-warmup_T+25.csv``; ``-o out/warm.csv`` is a stem and writes
+  ``out/warm_T+25.csv`` …;
+* ``--truth TRUTH.json`` writes every parameter, with one entry per file under
+  ``files`` (``file`` is the path written).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated, Any
+
+import typer
+
+from thermocal.cli.app import app
+from thermocal.cli.common import JsonOpt, emit, handle_errors, stdout
+from thermocal.errors import FileFormatError, ThermocalInputError
+from thermocal.io import check_not_input, file_kind, write_json, write_recording
+from thermocal.profiles import read_program
+from thermocal.simulate import SCENARIOS, TRUTH_FORMAT, TRUTH_VERSION, run_scenario
+
+
+def output_paths(output: Path, scenario: str, labels: list[str], fmt: str) -> list[Path]:
+    """File names for the results of a scenario (see the module docstring)."""
+    try:
+        file_kind(output)
+        is_file = True
+    except FileFormatError:
+        is_file = False
+    if is_file:
+        if len(labels) == 1:
+            return [output]
+        name = output.name
+        suffix = next(
+            s for s in (".csv.gz", ".parquet", ".csv", ".txt", ".pq") if name.lower().endswith(s)
+        )
+        stem = name[: -len(suffix)]
+        return [output.with_name(f"{stem}_{lab}{suffix}") for lab in labels]
+    ext = {"csv": ".csv", "parquet": ".parquet"}.get(fmt)
+    if ext is None:
+        raise ThermocalInputError(f"--format must be csv or parquet, got {fmt!r}")
+    if output.exists() and not output.is_dir():
+        raise ThermocalInputError(f"{output}: exists and is not a directory")
+    return [output / (f"{scenario}_{lab}{ext}" if lab else f"{scenario}{ext}") for lab in labels]
+
+
+@app.command("simulate")
+@handle_errors
+def simulate_cmd(
+    scenario: Annotated[
+        str, typer.Argument(help="Scenario: " + ", ".join(SCENARIOS) + ".", show_default=False)
+    ],
+    output: Annotated[
+        Path,
+        typer.Option(
+            "-o", "--output", help="Output file (one result), directory or file stem (several)."
+        ),
+    ],
+    seed: Annotated[int, typer.Option("--seed", help="Random seed (same seed, same file).")] = 0,
+    profile: Annotated[
+        Path | None,
+        typer.Option("--profile", help="Chamber program CSV (time_s, setpoint_c) to run instead."),
+    ] = None,
+    truth: Annotated[
+        Path | None, typer.Option("--truth", help="Write every true parameter to this JSON.")
+    ] = None,
+    rate_hz: Annotated[
+        float | None, typer.Option("--rate-hz", help="Output sample rate [Hz].")
+    ] = None,
+    latitude: Annotated[
+        float | None, typer.Option("--latitude", help="Latitude [°] (gyro scenarios).")
+    ] = None,
+    axis: Annotated[
+        str | None, typer.Option("--axis", help="Sensitive axis (up, north, 'e,n,u').")
+    ] = None,
+    runs: Annotated[
+        int | None, typer.Option("--runs", help="Number of runs (accel-full-range).")
+    ] = None,
+    orientation: Annotated[
+        str | None,
+        typer.Option("--orientation", help="horizontal, up or down (accel-full-range)."),
+    ] = None,
+    record_s: Annotated[
+        float | None, typer.Option("--record-s", help="Record per power-on [s] (mems-warmup).")
+    ] = None,
+    fmt: Annotated[
+        str, typer.Option("--format", help="File format inside an output directory.")
+    ] = "csv",
+    as_json: JsonOpt = False,
+) -> None:
+    """A simulated recording (or several) with known truth."""
+    if scenario not in SCENARIOS:
+        raise ThermocalInputError(
+            f"unknown scenario {scenario!r}; known scenarios: {', '.join(SCENARIOS)}"
+        )
+    prog = None
+    if profile is not None:
+        prog = read_program(profile)
+        check_not_input(output, [profile])
+    opts: dict[str, Any] = {
+        k: v
+        for k, v in {
+            "rate_hz": rate_hz,
+            "latitude_deg": latitude,
+            "axis": axis,
+            "runs": runs,
+            "orientation": orientation,
+            "record_s": record_s,
+        }.items()
+        if v is not None
+    }
+    results = run_scenario(scenario, seed, prog, **opts)
+    labels = [str(t.get("label", "")) for _, t in results]
+    if len(set(labels)) != len(labels):
+        labels = [f"{i + 1}" for i in range(len(results))]
+    paths = output_paths(output, scenario, labels, fmt)
+    inputs: list[str | Path] = [profile] if profile is not None else []
+    for p in paths:
+        check_not_input(p, inputs)
+    if truth is not None:
+        check_not_input(truth, [*inputs, *paths])
+    for (rec, _), p in zip(results, paths, strict=True):
+        write_recording(rec, p)
+    files = [{"file": str(p), **tr} for (_, tr), p in zip(results, paths, strict=True)]
+    if truth is not None:
+        write_json(
+            truth,
+            {
+                "format": TRUTH_FORMAT,
+                "version": TRUTH_VERSION,
+                "scenario": scenario,
+                "seed": seed,
+                "profile": str(profile) if profile is not None else None,
+                "files": files,
+            },
+        )
+    summary = {
+        "scenario": scenario,
+        "seed": seed,
+        "files": [str(p) for p in paths],
+        "n_samples": [rec.n_samples for rec, _ in results],
+        "truth": str(truth) if truth is not None else None,
+    }
+
+    def human() -> None:
+        for (rec, _), p in zip(results, paths, strict=True):
+            stdout.print(
+                f"{p}: {rec.n_samples} samples, {rec.duration_s / 3600:.2f} h at "
+                f"{rec.sample_rate_hz:g} Hz"
+            )
+        if truth is not None:
+            stdout.print(f"truth → {truth}")
+
+    emit(summary, as_json, human)

@@ -1,0 +1,184 @@
+"""``thermocal validate MODEL.json FILE [--modeling FILE] [--ambient COL]``.
+
+Judges a model on an independent, weakly correlated test (SPEC §5,
+:func:`thermocal.validation.validate`).  ``r`` compares the ``--ambient`` column
+of the modelling and validation runs (default: the model's first temperature
+column).  Without ``--modeling`` the model file's recorded data file is used if
+it still exists; otherwise ``r`` is null, with a warning.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated
+
+import typer
+from rich.table import Table
+
+from thermocal.cli.app import app
+from thermocal.cli.common import (
+    FileArg,
+    JsonOpt,
+    SignalUnitOpt,
+    TempUnitOpt,
+    emit,
+    fmt,
+    handle_errors,
+    load_recording,
+    stdout,
+)
+from thermocal.compensate import unit_factor
+from thermocal.io import read_recording
+from thermocal.models.base import RunData, TemperatureModel, load_model
+from thermocal.validation import DEFAULT_AVERAGING_S, validate
+
+ModelArg = Annotated[
+    Path, typer.Argument(help="Model file (JSON) written by `thermocal fit`.", show_default=False)
+]
+
+
+def _modeling_file(model: TemperatureModel, model_file: Path) -> Path | None:
+    """The first data file recorded in the model file that still exists (relative paths are
+    tried from the current directory and from the model file's directory)."""
+    for entry in model.data_:
+        name = entry.get("file") if isinstance(entry, dict) else None
+        if not name:
+            continue
+        p = Path(str(name))
+        for cand in (p, model_file.parent / p) if not p.is_absolute() else (p,):
+            if cand.is_file():
+                return cand
+    return None
+
+
+@app.command("validate")
+@handle_errors
+def validate_cmd(
+    model_file: ModelArg,
+    file: FileArg,
+    modeling: Annotated[
+        Path | None,
+        typer.Option(
+            "--modeling",
+            help="The modelling test's recording (default: the model file's data file).",
+        ),
+    ] = None,
+    ambient: Annotated[
+        str | None,
+        typer.Option(
+            "--ambient",
+            help="Temperature column compared by r and used to find the hold stages "
+            "(default: the model's first temperature column).",
+        ),
+    ] = None,
+    averaging: Annotated[
+        float, typer.Option("--average", "--averaging", help="Averaging time [s].")
+    ] = DEFAULT_AVERAGING_S,
+    signal: Annotated[
+        str | None,
+        typer.Option("--signal", help="Signal column (default: the model's signal name)."),
+    ] = None,
+    time: Annotated[str | None, typer.Option("--time", help="Time column.")] = None,
+    time_unit: Annotated[
+        str | None, typer.Option("--time-unit", help="Time unit: s, ms or us.")
+    ] = None,
+    signal_unit: SignalUnitOpt = None,
+    temp_unit: TempUnitOpt = None,
+    stage_rate: Annotated[
+        float,
+        typer.Option("--stage-rate", help="Hold detection: |dT/dt| below this [°C/min]."),
+    ] = 0.05,
+    min_stage: Annotated[
+        float, typer.Option("--min-stage", help="Hold detection: shortest stage [s].")
+    ] = 600.0,
+    settle: Annotated[
+        float, typer.Option("--settle", help="Seconds cut from the start of each stage.")
+    ] = 0.0,
+    extrapolate: Annotated[
+        bool, typer.Option("--extrapolate", help="Do not clamp to the fitted range.")
+    ] = False,
+    as_json: JsonOpt = False,
+) -> None:
+    """Validate MODEL on FILE: correlation r, bias stability and repeatability over the
+    hold stages, rms and peak-to-peak, before and after compensation."""
+    model = load_model(model_file)
+    sig = signal or model.signal_name
+    temps = list(model.temp_names_)
+    amb = ambient or temps[0]
+    read_temps = temps if amb in temps else [*temps, amb]
+    rec = load_recording(
+        file,
+        time=time,
+        time_unit=time_unit,
+        signal=sig,
+        temps=",".join(read_temps),
+        signal_unit=signal_unit,
+        temp_unit=temp_unit,
+    )
+    run = RunData.from_recording(rec, sig, temps)
+    data_unit = rec.signal(sig)[1]
+    f = unit_factor(data_unit, model.signal_unit, meta=rec.meta, where=str(file))
+    if f != 1.0:
+        assert run.signal is not None
+        run = RunData(
+            time_s=run.time_s,
+            temps_c=run.temps_c,
+            signal=run.signal * f,
+            temp_names=run.temp_names,
+            name=run.name,
+        )
+    amb_val = rec.temperature_c(amb)
+
+    mod_path = modeling if modeling is not None else _modeling_file(model, model_file)
+    modeling_ambient = None
+    if mod_path is not None:
+        mrec = read_recording(mod_path, time=time, time_unit=time_unit, temperatures=[amb])
+        modeling_ambient = (mrec.time_s, mrec.temperature_c(amb))
+    res = validate(
+        model,
+        run,
+        modeling_ambient,
+        validation_ambient=amb_val,
+        averaging_s=averaging,
+        rate_threshold_c_per_min=stage_rate,
+        min_stage_s=min_stage,
+        settle_s=settle,
+        extrapolate=extrapolate,
+    )
+    out = res.to_dict()
+    out["model"] = str(model_file)
+    out["family"] = model.family
+    out["file"] = str(file)
+    out["modeling_file"] = str(mod_path) if mod_path is not None else None
+    out["ambient"] = amb
+
+    def human() -> None:
+        u = res.unit
+        if res.r is None:
+            head = "r not computed (no modelling data)"
+        else:
+            weak = "weakly correlated" if res.weakly_correlated else "NOT weakly correlated"
+            head = f"r = {fmt(res.r, 3)} ({weak})"
+
+        table = Table(title=f"validation of {model.family} model on {file}: {head}")
+        table.add_column("figure")
+        table.add_column(f"before [{u}]", justify="right")
+        table.add_column(f"after [{u}]", justify="right")
+        table.add_column("improvement", justify="right")
+        imp = res.improvement_pct
+        for key, label in (
+            ("bias_stability", f"bias stability ({res.averaging_s:g} s, rms over stages)"),
+            ("bias_repeatability", "bias repeatability"),
+            ("rms", "rms"),
+            ("peak_to_peak", "peak-to-peak"),
+        ):
+            pct = imp[key]
+            table.add_row(
+                label,
+                fmt(getattr(res, f"{key}_before")),
+                fmt(getattr(res, f"{key}_after")),
+                "—" if pct is None else f"{pct:.1f} %",
+            )
+        stdout.print(table)
+
+    emit(out, as_json, human)

@@ -1,0 +1,749 @@
+"""Plain C99 code computing a model's correction sample by sample (SPEC §8).
+
+"Coefficients solidified in the IMU software": :func:`generate_c` turns a model
+file's dict (:func:`thermocal.models.base.load_model_dict`) into a header and a
+source file with
+
+* no dynamic allocation, no library beyond ``<math.h>``-free C99 (``<stddef.h>``);
+* the coefficients as ``static const`` arrays, the clamp range of every input;
+* a state struct ``<p>_state`` and the functions::
+
+      void    <p>_init(<p>_state *s, double sample_interval_s);
+      <p>_real <p>_update(<p>_state *s, double time_s,
+                          const <p>_real temps_c[<P>_N_TEMPS], <p>_real signal);
+      <p>_real <p>_compensate(<p>_state *s, double time_s,
+                              const <p>_real temps_c[<P>_N_TEMPS], <p>_real signal);
+      void    <p>_set_known_input(<p>_state *s, <p>_real known_input);
+
+  ``update`` returns the model value ŷ (the temperature-induced signal, model
+  unit); ``compensate`` returns ``signal − ŷ``.  ``init`` is a power-on (it
+  forgets every state); ``sample_interval_s`` is the nominal sample interval τ:
+  a time step longer than ``GAP_FACTOR`` (1.5) × τ resets the rate estimate, as
+  in :class:`thermocal.compensate.StreamingCompensator`;
+* a comment block with the model file's identity (family, format version,
+  thermocal version, checksum, signal, temperatures, data files).
+
+The arithmetic follows the family's ``ModelStream`` operation by operation, so
+the double build agrees with the Python streaming compensator to rounding
+(tests: 1e-9 relative on 10⁵ samples with cc -O2 -std=c99).  Time is ``double``
+in both builds; ``--float`` makes every other quantity ``float`` and its
+worst-case error against double is measured (:func:`measure_float_error`).
+Temperatures are always clamped to the fitted range (the Python default,
+``extrapolate=False``).
+
+Families register a generator in :data:`GENERATORS` (STYLE rule 8); each reads
+the ``state`` layout documented in its module docstring.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+import shutil
+import subprocess
+import tempfile
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import numpy.typing as npt
+
+from thermocal.errors import ModelFileError, ThermocalInputError
+from thermocal.recording import GAP_FACTOR, FloatArray
+
+REAL_TYPES = ("double", "float")
+
+
+# --- the generated module -------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class FamilyCode:
+    """What a family generator contributes to the common skeleton.
+
+    ``state_fields`` — C declarations inside the state struct (one per line);
+    ``data`` — ``static const`` definitions and static helper functions (source file);
+    ``init`` — statements of ``<p>_init`` (``s`` and ``sample_interval_s`` in scope);
+    ``update`` — statements of ``<p>_update`` ending in ``return``;
+    ``defines`` — extra ``#define`` lines of the header; ``notes`` — comment lines.
+    """
+
+    state_fields: list[str]
+    data: str
+    init: str
+    update: str
+    defines: list[str] = field(default_factory=list)
+    notes: list[str] = field(default_factory=list)
+
+
+@dataclass(frozen=True)
+class CExport:
+    """A generated C module: ``header`` (``<prefix>.h``) and ``source`` (``<prefix>.c``)."""
+
+    prefix: str
+    real: str
+    header: str
+    source: str
+    family: str
+    n_temps: int
+
+    @property
+    def header_name(self) -> str:
+        return f"{self.prefix}.h"
+
+    @property
+    def source_name(self) -> str:
+        return f"{self.prefix}.c"
+
+    def write(self, directory: str | Path) -> list[Path]:
+        """Write header and source into ``directory`` (atomically); returns the paths."""
+        from thermocal.io import atomic_write
+
+        d = Path(directory)
+        d.mkdir(parents=True, exist_ok=True)
+        out = []
+        for name, text in ((self.header_name, self.header), (self.source_name, self.source)):
+            with atomic_write(d / name, "w") as fh:
+                fh.write(text)
+            out.append(d / name)
+        return out
+
+
+@dataclass(frozen=True)
+class ExportContext:
+    """What a family generator gets: the model dict, the C prefix and helpers."""
+
+    model: dict[str, Any]
+    prefix: str
+    real: str
+    rate_buffer_len: int
+
+    @property
+    def P(self) -> str:
+        """The C macro prefix (upper case)."""
+        return self.prefix.upper()
+
+    @property
+    def r(self) -> str:
+        """The C real type name."""
+        return f"{self.prefix}_real"
+
+    def lit(self, x: float) -> str:
+        """A C literal of the real type (17 significant digits, ``f`` suffix for float)."""
+        if not math.isfinite(x):
+            raise ModelFileError(f"non-finite coefficient {x!r} cannot be exported")
+        s = repr(float(x))
+        if "e" not in s and "." not in s and "inf" not in s:
+            s += ".0"
+        return s + ("f" if self.real == "float" else "")
+
+    def array(self, name: str, values: Sequence[float] | npt.ArrayLike) -> str:
+        """``static const <real> NAME[n] = {…};`` (1-D)."""
+        v = np.asarray(values, dtype=np.float64).ravel()
+        body = ",\n    ".join(
+            ", ".join(self.lit(x) for x in v[i : i + 4]) for i in range(0, v.size, 4)
+        )
+        return (
+            f"static const {self.r} {name}[{max(v.size, 1)}] = {{\n    {body or self.lit(0.0)}\n}};"
+        )
+
+    def array2(self, name: str, values: npt.ArrayLike) -> str:
+        """``static const <real> NAME[a][b] = {{…}, …};``."""
+        m = np.asarray(values, dtype=np.float64)
+        rows = ",\n    ".join("{" + ", ".join(self.lit(x) for x in row) + "}" for row in m)
+        return f"static const {self.r} {name}[{m.shape[0]}][{m.shape[1]}] = {{\n    {rows}\n}};"
+
+    def temp_range(self) -> FloatArray:
+        """(k, 2) fitted temperature range [°C] in the model's temperature order."""
+        tr = self.model["range"]["temperature_c"]
+        return np.array([tr[n] for n in self.model["temperatures"]], dtype=np.float64)
+
+    def clamp_arrays(self) -> str:
+        rng = self.temp_range()
+        return "\n".join(
+            [
+                "/* fitted temperature range [degC]: inputs are clamped to it */",
+                self.array(f"{self.P}_T_LO", rng[:, 0]),
+                self.array(f"{self.P}_T_HI", rng[:, 1]),
+            ]
+        )
+
+
+Generator = Callable[[ExportContext], FamilyCode]
+
+GENERATORS: dict[str, Generator] = {}
+"""C generators by model family (STYLE rule 8)."""
+
+
+def register_generator(family: str) -> Callable[[Generator], Generator]:
+    """Decorator: register the C generator of a family."""
+
+    def deco(fn: Generator) -> Generator:
+        GENERATORS[family] = fn
+        return fn
+
+    return deco
+
+
+# --- common skeleton ----------------------------------------------------------------------
+
+
+def c_identifier(text: str) -> str:
+    """A valid C identifier from a file stem (``rlg poly-v2`` → ``rlg_poly_v2``)."""
+    s = re.sub(r"[^0-9A-Za-z_]", "_", text).strip("_").lower() or "model"
+    if s[0].isdigit():
+        s = "m_" + s
+    return s
+
+
+def _identity(d: dict[str, Any]) -> list[str]:
+    sig = d.get("signal") or {}
+    lines = [
+        "Generated by thermocal export-c from a thermocal model file. Do not edit.",
+        f"family:            {d.get('family')}",
+        f"format:            {d.get('format')} version {d.get('format_version')}",
+        f"thermocal version: {d.get('thermocal_version')}",
+        f"created (UTC):     {d.get('created_utc')}",
+        f"checksum (sha256): {d.get('checksum')}",
+        f"signal:            {sig.get('name')} [{sig.get('unit')}], target {sig.get('target')}",
+        f"temperatures:      {', '.join(d.get('temperatures', []))} [degC]",
+    ]
+    rate = d.get("rate")
+    if rate:
+        lines.append(f"temperature rate:  {rate.get('method')} over {rate.get('interval_s')} s")
+    for entry in d.get("data") or []:
+        if isinstance(entry, dict) and entry.get("file"):
+            lines.append(f"fitted on:         {entry.get('file')}")
+    return [ln.replace("*/", "* /") for ln in lines]
+
+
+def _comment(lines: Sequence[str]) -> str:
+    return "/*\n" + "\n".join(f" * {ln}".rstrip() for ln in lines) + "\n */"
+
+
+def generate_c(
+    model: dict[str, Any],
+    *,
+    prefix: str = "thermocal_model",
+    real: str = "double",
+    sample_interval_s: float = 1.0,
+) -> CExport:
+    """Generate the C99 header and source of a model dict (see the module docstring).
+
+    ``sample_interval_s`` is only used to size the Ṫ ring buffer of rate models
+    (``<P>_RATE_BUF_LEN`` = ⌈Δt/τ⌉ + 8, overridable with ``-D``); the interval used at
+    run time is the argument of ``<p>_init``.
+    """
+    if real not in REAL_TYPES:
+        raise ThermocalInputError(f"real type must be one of {REAL_TYPES}, got {real!r}")
+    fam = str(model.get("family"))
+    gen = GENERATORS.get(fam)
+    if gen is None:
+        raise ModelFileError(
+            f"no C generator for model family {fam!r}; available: {', '.join(sorted(GENERATORS))}"
+        )
+    if not sample_interval_s > 0:
+        raise ThermocalInputError(f"sample interval must be positive, got {sample_interval_s}")
+    p = c_identifier(prefix)
+    rate = model.get("rate") or {}
+    interval = float(rate.get("interval_s") or 0.0)
+    buf = math.ceil(interval / sample_interval_s) + 8 if interval > 0 else 2
+    ctx = ExportContext(model=model, prefix=p, real=real, rate_buffer_len=buf)
+    code = gen(ctx)
+    P = ctx.P
+    k = len(model["temperatures"])
+    guard = f"{P}_H"
+    ident = _identity(model)
+    header = "\n".join(
+        [
+            _comment([*ident, "", *code.notes]),
+            f"#ifndef {guard}",
+            f"#define {guard}",
+            "",
+            f"typedef {real} {p}_real;",
+            "",
+            f"#define {P}_N_TEMPS {k}",
+            f"#define {P}_GAP_FACTOR {GAP_FACTOR!r}",
+            *code.defines,
+            "",
+            "/* temperature order of temps_c[]: "
+            + ", ".join(f"{i}={n}" for i, n in enumerate(model["temperatures"]))
+            + " */",
+            "",
+            "typedef struct {",
+            "    double sample_interval_s;",
+            f"    {p}_real known_input;",
+            *[f"    {f}" for f in code.state_fields],
+            f"}} {p}_state;",
+            "",
+            "/* Power-on: forget every state. sample_interval_s = nominal interval [s]. */",
+            f"void {p}_init({p}_state *s, double sample_interval_s);",
+            "/* Known input (earth rate, gravity component) removed from the signal the model",
+            "   sees (start-up selection); default 0. */",
+            f"void {p}_set_known_input({p}_state *s, {p}_real known_input);",
+            "/* Model value (temperature-induced signal) of one sample. */",
+            f"{p}_real {p}_update({p}_state *s, double time_s, "
+            f"const {p}_real temps_c[{P}_N_TEMPS], {p}_real signal);",
+            "/* Compensated output: signal - model value. */",
+            f"{p}_real {p}_compensate({p}_state *s, double time_s, "
+            f"const {p}_real temps_c[{P}_N_TEMPS], {p}_real signal);",
+            "",
+            f"#endif /* {guard} */",
+            "",
+        ]
+    )
+    source = "\n".join(
+        [
+            _comment(ident[:1] + ident[1:3] + ident[5:6]),
+            f'#include "{p}.h"',
+            "",
+            f"static {p}_real {p}_clamp({p}_real x, {p}_real lo, {p}_real hi)",
+            "{",
+            "    return x < lo ? lo : (x > hi ? hi : x);",
+            "}",
+            "",
+            code.data,
+            "",
+            f"void {p}_init({p}_state *s, double sample_interval_s)",
+            "{",
+            "    s->sample_interval_s = sample_interval_s;",
+            f"    s->known_input = {ctx.lit(0.0)};",
+            _indent(code.init),
+            "}",
+            "",
+            f"void {p}_set_known_input({p}_state *s, {p}_real known_input)",
+            "{",
+            "    s->known_input = known_input;",
+            "}",
+            "",
+            f"{p}_real {p}_update({p}_state *s, double time_s, "
+            f"const {p}_real temps_c[{P}_N_TEMPS], {p}_real signal)",
+            "{",
+            _indent(code.update),
+            "}",
+            "",
+            f"{p}_real {p}_compensate({p}_state *s, double time_s, "
+            f"const {p}_real temps_c[{P}_N_TEMPS], {p}_real signal)",
+            "{",
+            f"    return signal - {p}_update(s, time_s, temps_c, signal);",
+            "}",
+            "",
+        ]
+    )
+    return CExport(prefix=p, real=real, header=header, source=source, family=fam, n_temps=k)
+
+
+def _indent(text: str, n: int = 4) -> str:
+    pad = " " * n
+    return "\n".join(pad + ln if ln.strip() else "" for ln in text.strip("\n").splitlines())
+
+
+# --- families: warmup --------------------------------------------------------------------------
+
+
+@register_generator("warmup")
+def _gen_warmup(ctx: ExportContext) -> FamilyCode:
+    """Warm-up model (SPEC §4c, models/warmup.py ``WarmupStream``):
+
+    T = clamp(T_in); during ``t − t_first < W``: T0 = running mean of T; then frozen;
+    a_j = Σ_k b_jk clamp(T0)^k (Horner), ΔF = Σ_j a_j (T − T0)^j (Horner).
+    """
+    st = ctx.model["state"]
+    b = np.asarray(st["b"], dtype=np.float64)
+    lo, hi = (float(v) for v in st["t0_range_c"])
+    window = float(st["start_window_s"])
+    P, r, p = ctx.P, ctx.r, ctx.prefix
+    nj, nk = b.shape
+    data = "\n".join(
+        [
+            ctx.clamp_arrays(),
+            f"/* b[j][k]: coefficient of dT^j * T0^k [{ctx.model['signal']['unit']}/degC^(j+k)] */",
+            ctx.array2(f"{P}_B", b),
+            f"static const {r} {P}_T0_LO = {ctx.lit(lo)}; /* fitted start temperatures */",
+            f"static const {r} {P}_T0_HI = {ctx.lit(hi)};",
+            f"static const double {P}_START_WINDOW_S = {window!r};",
+        ]
+    )
+    init = f"""
+s->started = 0;
+s->t_first = 0.0;
+s->sum = {ctx.lit(0.0)};
+s->count = 0;
+s->frozen = 0;
+s->t0 = {ctx.lit(0.0)};
+"""
+    update = f"""
+{r} temp = {p}_clamp(temps_c[0], {P}_T_LO[0], {P}_T_HI[0]);
+{r} t0c, dt, acc = {ctx.lit(0.0)};
+int j, k;
+(void)signal;
+if (!s->started) {{
+    s->started = 1;
+    s->t_first = time_s;
+}}
+if (!s->frozen && time_s - s->t_first < {P}_START_WINDOW_S) {{
+    s->sum = s->sum + temp;
+    s->count += 1;
+    s->t0 = s->sum / ({r})s->count;
+}} else if (!s->frozen) {{
+    s->frozen = 1;
+}}
+t0c = {p}_clamp(s->t0, {P}_T0_LO, {P}_T0_HI);
+dt = temp - s->t0;
+for (j = {nj - 1}; j >= 0; --j) {{
+    {r} a = {P}_B[j][{nk - 1}];
+    for (k = {nk - 2}; k >= 0; --k) {{
+        a = a * t0c + {P}_B[j][k];
+    }}
+    acc = (j == {nj - 1}) ? a : acc * dt + a;
+}}
+return acc;
+"""
+    return FamilyCode(
+        state_fields=[
+            "int started;",
+            "double t_first;",
+            f"{r} sum;",
+            "long count;",
+            "int frozen;",
+            f"{r} t0;",
+        ],
+        data=data,
+        init=init,
+        update=update,
+        defines=[f"#define {P}_ORDER {nj - 1}", f"#define {P}_T0_ORDER {nk - 1}"],
+        notes=[
+            "Warm-up model (SPEC 4c): dF = sum_j a_j(T0) dT^j, a_j(T0) = sum_k b_jk T0^k,",
+            f"T0 = running mean of the temperature over the first {window:g} s after power-on.",
+            "Call init at power-on.",
+        ],
+    )
+
+
+# --- families: bank --------------------------------------------------------------------------
+
+
+@register_generator("bank")
+def _gen_bank(ctx: ExportContext) -> FamilyCode:
+    """Model bank (SPEC §4d, models/bank.py ``BankStream``): every piecewise-linear model
+    evaluated at the clamped T; during ``t − t_first < startup_s`` the residual sums
+    ``Σ (y − f_m)`` pick ``argmin_m |Σ_m/N|``; then the choice is frozen."""
+    st = ctx.model["state"]
+    models = st["models"]
+    P, r, p = ctx.P, ctx.r, ctx.prefix
+    m = len(models)
+    bps = [np.asarray(mm["breakpoints_c"], dtype=np.float64) for mm in models]
+    vals = [np.asarray(mm["values"], dtype=np.float64) for mm in models]
+    offsets = np.cumsum([0] + [b.size for b in bps])
+    data = "\n".join(
+        [
+            ctx.clamp_arrays(),
+            f"/* {m} piecewise-linear models; model i uses entries OFF[i] .. OFF[i+1]-1 */",
+            ctx.array(f"{P}_X", np.concatenate(bps)),
+            ctx.array(f"{P}_V", np.concatenate(vals)),
+            f"static const int {P}_OFF[{m + 1}] = {{"
+            + ", ".join(str(int(o)) for o in offsets)
+            + "};",
+            f"static const double {P}_STARTUP_S = {float(st['startup_s'])!r};",
+            "",
+            f"static {r} {p}_pwl(int i, {r} t)",
+            "{",
+            f"    const {r} *x = {P}_X + {P}_OFF[i];",
+            f"    const {r} *v = {P}_V + {P}_OFF[i];",
+            f"    int n = {P}_OFF[i + 1] - {P}_OFF[i];",
+            "    int j = 0;",
+            f"    {r} slope;",
+            "    /* largest j with x[j] <= t, clipped to 0 .. n-2 */",
+            "    while (j + 1 < n && x[j + 1] <= t) {",
+            "        ++j;",
+            "    }",
+            "    if (j > n - 2) {",
+            "        j = n - 2;",
+            "    }",
+            "    slope = (v[j + 1] - v[j]) / (x[j + 1] - x[j]);",
+            "    return v[j] + slope * (t - x[j]);",
+            "}",
+        ]
+    )
+    init = f"""
+int i;
+s->started = 0;
+s->t_first = 0.0;
+s->count = 0;
+s->frozen = 0;
+s->choice = 0;
+for (i = 0; i < {P}_N_MODELS; ++i) {{
+    s->sums[i] = {ctx.lit(0.0)};
+}}
+"""
+    update = f"""
+{r} temp = {p}_clamp(temps_c[0], {P}_T_LO[0], {P}_T_HI[0]);
+{r} f[{P}_N_MODELS];
+int i;
+for (i = 0; i < {P}_N_MODELS; ++i) {{
+    f[i] = {p}_pwl(i, temp);
+}}
+if (!s->started) {{
+    s->started = 1;
+    s->t_first = time_s;
+}}
+if (!s->frozen && time_s - s->t_first < {P}_STARTUP_S) {{
+    {r} y = signal - s->known_input;
+    {r} best = {ctx.lit(0.0)};
+    s->count += 1;
+    for (i = 0; i < {P}_N_MODELS; ++i) {{
+        {r} dev;
+        s->sums[i] = s->sums[i] + (y - f[i]);
+        dev = s->sums[i] / ({r})s->count;
+        dev = dev < {ctx.lit(0.0)} ? -dev : dev;
+        if (i == 0 || dev < best) {{
+            best = dev;
+            s->choice = i;
+        }}
+    }}
+}} else {{
+    s->frozen = 1;
+}}
+return f[s->choice];
+"""
+    return FamilyCode(
+        state_fields=[
+            "int started;",
+            "double t_first;",
+            f"{r} sums[{P}_N_MODELS];",
+            "long count;",
+            "int frozen;",
+            "int choice; /* index of the selected model */",
+        ],
+        data=data,
+        init=init,
+        update=update,
+        defines=[f"#define {P}_N_MODELS {m}"],
+        notes=[
+            "Model bank (SPEC 4d): one piecewise-linear model per characteristic curve,",
+            f"selected during the first {float(st['startup_s']):g} s after power-on by the",
+            "smallest |mean(signal - known_input - model)|; pass the raw signal to update.",
+        ],
+    )
+
+
+# --- compile and run (tests, float error) -----------------------------------------------------
+
+
+def c_harness(export: CExport) -> str:
+    """A small C main: reads ``n`` then ``n`` records of doubles ``(t, T_1..T_k, F)`` from
+    a binary file (argv[1]), calls ``init(τ = argv[3])`` and ``update`` on each sample and
+    writes the model values as doubles to argv[2]."""
+    p, P, r = export.prefix, export.prefix.upper(), f"{export.prefix}_real"
+    return f"""#include <stdio.h>
+#include <stdlib.h>
+#include "{p}.h"
+
+int main(int argc, char **argv)
+{{
+    FILE *in, *out;
+    long n, i;
+    double rec[{P}_N_TEMPS + 2];
+    {r} temps[{P}_N_TEMPS];
+    {p}_state st;
+    int j;
+    if (argc < 4) {{
+        return 2;
+    }}
+    in = fopen(argv[1], "rb");
+    out = fopen(argv[2], "wb");
+    if (in == NULL || out == NULL) {{
+        return 2;
+    }}
+    if (fread(&n, sizeof n, 1, in) != 1) {{
+        return 2;
+    }}
+    {p}_init(&st, atof(argv[3]));
+    if (argc > 4) {{
+        {p}_set_known_input(&st, ({r})atof(argv[4]));
+    }}
+    for (i = 0; i < n; ++i) {{
+        double y;
+        if (fread(rec, sizeof(double), {P}_N_TEMPS + 2, in) != {P}_N_TEMPS + 2) {{
+            return 3;
+        }}
+        for (j = 0; j < {P}_N_TEMPS; ++j) {{
+            temps[j] = ({r})rec[1 + j];
+        }}
+        y = (double){p}_update(&st, rec[0], temps, ({r})rec[{P}_N_TEMPS + 1]);
+        fwrite(&y, sizeof y, 1, out);
+    }}
+    fclose(in);
+    fclose(out);
+    return 0;
+}}
+"""
+
+
+CFLAGS = ("-O2", "-std=c99", "-Wall", "-Wextra", "-Werror", "-pedantic")
+
+
+def find_compiler() -> str | None:
+    """The system C compiler (``cc``, ``gcc`` or ``clang``), or None."""
+    for name in ("cc", "gcc", "clang"):
+        path = shutil.which(name)
+        if path:
+            return path
+    return None
+
+
+def compile_harness(export: CExport, directory: str | Path, compiler: str | None = None) -> Path:
+    """Write the module and :func:`c_harness` into ``directory`` and compile them with
+    ``cc -O2 -std=c99 -Wall -Wextra -Werror -pedantic``; returns the executable."""
+    cc = compiler or find_compiler()
+    if cc is None:
+        raise ThermocalInputError("no C compiler (cc, gcc or clang) found")
+    d = Path(directory)
+    export.write(d)
+    main = d / f"{export.prefix}_main.c"
+    main.write_text(c_harness(export))
+    exe = d / f"{export.prefix}_run"
+    cmd = [cc, *CFLAGS, "-o", str(exe), str(d / export.source_name), str(main)]
+    proc = subprocess.run(cmd, capture_output=True, text=True, check=False)
+    if proc.returncode != 0:
+        raise RuntimeError(f"C compilation failed: {' '.join(cmd)}\n{proc.stderr}")
+    return exe
+
+
+def run_harness(
+    exe: str | Path,
+    time_s: npt.ArrayLike,
+    temps_c: npt.ArrayLike,
+    signal: npt.ArrayLike,
+    sample_interval_s: float,
+    *,
+    known_input: float = 0.0,
+) -> FloatArray:
+    """Run a compiled harness on samples; returns the model values (n,)."""
+    t = np.asarray(time_s, dtype=np.float64)
+    T = np.asarray(temps_c, dtype=np.float64).reshape(t.size, -1)
+    f = np.asarray(signal, dtype=np.float64)
+    rec = np.column_stack([t, T, f])
+    with tempfile.TemporaryDirectory() as tmp:
+        fin = Path(tmp) / "in.bin"
+        fout = Path(tmp) / "out.bin"
+        with open(fin, "wb") as fh:
+            fh.write(np.int64(t.size).tobytes())
+            fh.write(np.ascontiguousarray(rec).tobytes())
+        proc = subprocess.run(
+            [
+                str(exe),
+                str(fin),
+                str(fout),
+                repr(float(sample_interval_s)),
+                repr(float(known_input)),
+            ],
+            capture_output=True,
+            check=False,
+        )
+        if proc.returncode != 0:
+            raise RuntimeError(f"C harness failed with status {proc.returncode}")
+        return np.fromfile(fout, dtype=np.float64)
+
+
+def exercise_inputs(
+    model: dict[str, Any],
+    n: int = 100_000,
+    sample_interval_s: float = 1.0,
+    seed: int = 0,
+    *,
+    gap_at: float = 0.6,
+) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """Synthetic samples over a model's fitted range, power-on included: every
+    temperature channel sweeps its fitted range ±10 % (triangle waves of different
+    periods, so rates and clamping occur), a gap of 7 τ after the fraction ``gap_at``
+    of the samples, signal = small noise.  Returns ``(time_s, temps_c (n, k), signal)``."""
+    rng = np.random.default_rng(seed)
+    t = np.arange(n, dtype=np.float64) * sample_interval_s
+    t[int(gap_at * n) :] += 7.0 * sample_interval_s
+    tr = model["range"]["temperature_c"]
+    names = model["temperatures"]
+    cols = []
+    for i, name in enumerate(names):
+        lo, hi = (float(v) for v in tr[name])
+        span = max(hi - lo, 1e-3)
+        period = (n * sample_interval_s) / (3.0 + 1.7 * i)
+        phase = (t / period + 0.13 * i) % 1.0
+        tri = 1.0 - np.abs(2.0 * phase - 1.0)
+        cols.append(lo - 0.1 * span + 1.2 * span * tri + 0.001 * span * rng.standard_normal(n))
+    sig = 0.01 * rng.standard_normal(n)
+    return t, np.column_stack(cols), sig
+
+
+@dataclass(frozen=True)
+class FloatError:
+    """Worst-case difference of the float build from the double build on :func:`exercise_inputs`:
+    ``max_abs`` [signal unit], ``max_rel`` (relative to max |ŷ|), ``n_samples``."""
+
+    max_abs: float
+    max_rel: float
+    n_samples: int
+
+
+def measure_float_error(
+    model: dict[str, Any],
+    *,
+    prefix: str = "thermocal_model",
+    n: int = 100_000,
+    sample_interval_s: float = 1.0,
+    compiler: str | None = None,
+) -> FloatError:
+    """Compile the double and float builds and compare them on the same inputs."""
+    t, T, f = exercise_inputs(model, n, sample_interval_s)
+    outs = []
+    with tempfile.TemporaryDirectory() as tmp:
+        for real in REAL_TYPES:
+            ex = generate_c(model, prefix=prefix, real=real, sample_interval_s=sample_interval_s)
+            exe = compile_harness(ex, Path(tmp) / real, compiler)
+            outs.append(run_harness(exe, t, T, f, sample_interval_s))
+    d = np.abs(outs[1] - outs[0])
+    scale = float(np.max(np.abs(outs[0]))) or 1.0
+    return FloatError(float(d.max()), float(d.max()) / scale, int(t.size))
+
+
+def export_c(
+    model_path: str | Path,
+    out_dir: str | Path,
+    *,
+    prefix: str | None = None,
+    real: str = "double",
+    sample_interval_s: float = 1.0,
+) -> tuple[CExport, list[Path]]:
+    """Read and verify a model file, generate its C module and write it into ``out_dir``."""
+    from thermocal.models.base import load_model_dict
+
+    d = load_model_dict(model_path)
+    ex = generate_c(
+        d,
+        prefix=prefix or c_identifier(Path(model_path).stem),
+        real=real,
+        sample_interval_s=sample_interval_s,
+    )
+    return ex, ex.write(out_dir)
+
+
+__all__ = [
+    "CFLAGS",
+    "GENERATORS",
+    "CExport",
+    "ExportContext",
+    "FamilyCode",
+    "FloatError",
+    "c_harness",
+    "c_identifier",
+    "compile_harness",
+    "exercise_inputs",
+    "export_c",
+    "find_compiler",
+    "generate_c",
+    "measure_float_error",
+    "register_generator",
+    "run_harness",
+]

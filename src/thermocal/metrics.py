@@ -1,0 +1,432 @@
+"""Gyro and accelerometer figures of merit (SPEC §1; IEEE Std 952/647 style).
+
+Rates are in [°/h] (gyros) or [mg] (accelerometers), times in [s], temperatures
+in [°C].  Every function here is a pure function on arrays;
+:func:`compute_metrics` runs them on a :class:`~thermocal.recording.Recording`
+for the command line and the reports.
+
+Averages over a stated time ("bias stability at 100 s") are non-overlapping
+block means of ``m = round(averaging_s / τ0)`` consecutive samples, formed
+inside each contiguous (gap-free) stretch only; an incomplete block at the end
+of a stretch is dropped.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+import numpy.typing as npt
+
+from thermocal import units
+from thermocal.errors import MissingValueError, ThermocalInputError
+from thermocal.recording import Recording, contiguous_slices
+
+FloatArray = npt.NDArray[np.float64]
+
+
+# --- results -------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class TemperatureSensitivity:
+    """Bias temperature sensitivity (SPEC §1, our reading: both figures, named).
+
+    Attributes
+    ----------
+    mean_abs_adjacent : mean of |ΔB/ΔT| between adjacent temperature points [unit/°C].
+    ls_slope : least-squares slope of B against T [unit/°C].
+    unit : e.g. ``"deg/h/degC"``.
+    n_points : number of temperature points.
+    temps_c, biases : the points, sorted by temperature.
+    """
+
+    mean_abs_adjacent: float
+    ls_slope: float
+    unit: str
+    n_points: int
+    temps_c: tuple[float, ...]
+    biases: tuple[float, ...]
+
+
+@dataclass(frozen=True)
+class Stage:
+    """A temperature-hold stage: its mean temperature [°C] and bias [unit]."""
+
+    start_s: float
+    stop_s: float
+    mean_temp_c: float
+    bias: float
+    n_samples: int
+
+
+@dataclass(frozen=True)
+class MetricsResult:
+    """Figures of merit of one signal (JSON keys of ``thermocal metrics``).
+
+    ``bias`` has the earth-rate component ``earth_rate_removed`` [°/h] taken off;
+    ``bias_stability`` and ``peak_to_peak`` are over ``averaging_s`` averages;
+    ``drift_angle`` is the final value of the integral of the bias-corrected
+    rate [°] (trapezoid rule, gaps not integrated; gyros only).
+    """
+
+    bias: float
+    bias_stability: float
+    averaging_s: float
+    peak_to_peak: float
+    unit: str
+    temperature_sensitivity: TemperatureSensitivity | None
+    bias_repeatability: float | None
+    stages: tuple[Stage, ...]
+    drift_angle: float | None
+    drift_angle_unit: str | None
+    earth_rate_removed: float
+    n_samples: int
+    n_segments: int
+    n_averages: int
+    duration_s: float
+    signal: str
+
+
+# --- helpers ---------------------------------------------------------------------------
+
+
+def _as_1d(values: npt.ArrayLike, name: str) -> FloatArray:
+    arr = np.asarray(values, dtype=np.float64).ravel()
+    if arr.size == 0:
+        raise ThermocalInputError(f"{name} is empty")
+    bad = np.flatnonzero(~np.isfinite(arr))
+    if bad.size:
+        raise MissingValueError(
+            f"{name} has {bad.size} NaN/infinite values (first at row {bad[0]})"
+        )
+    return arr
+
+
+def _samples_per_average(tau0_s: float, averaging_s: float | None) -> int:
+    if not (math.isfinite(tau0_s) and tau0_s > 0):
+        raise ThermocalInputError(f"sample interval τ0 must be positive, got {tau0_s!r}")
+    if averaging_s is None:
+        return 1
+    if not (math.isfinite(averaging_s) and averaging_s > 0):
+        raise ThermocalInputError(f"averaging time must be positive, got {averaging_s!r}")
+    return max(round(averaging_s / tau0_s), 1)
+
+
+def block_means(
+    values: npt.ArrayLike,
+    tau0_s: float,
+    averaging_s: float | None,
+    *,
+    time_s: npt.ArrayLike | None = None,
+) -> FloatArray:
+    """Non-overlapping means of ``m = round(averaging_s/τ0)`` samples, never across a gap.
+
+    Incomplete blocks at the end of each contiguous stretch are dropped.
+    ``averaging_s=None`` returns the samples themselves.
+    """
+    y = _as_1d(values, "signal")
+    m = _samples_per_average(tau0_s, averaging_s)
+    if time_s is None:
+        slices = [slice(0, y.size)]
+    else:
+        t = np.asarray(time_s, dtype=np.float64).ravel()
+        if t.shape != y.shape:
+            raise ThermocalInputError(f"time has {t.size} samples but the signal has {y.size}")
+        slices = contiguous_slices(t)
+    parts = []
+    for sl in slices:
+        seg = y[sl]
+        k = seg.size // m
+        if k:
+            parts.append(seg[: k * m].reshape(k, m).mean(axis=1))
+    return np.concatenate(parts) if parts else np.zeros(0)
+
+
+# --- figures of merit ------------------------------------------------------------------
+
+
+def bias(rate: npt.ArrayLike, *, earth_rate_deg_h: float = 0.0) -> float:
+    """Bias ``B0 = mean(ω) − Ω_axis`` [°/h] (SPEC §1).
+
+    ``earth_rate_deg_h`` is the earth rate seen by the sensitive axis
+    (:func:`thermocal.units.earth_rate_on_axis_deg_h`), 0 for accelerometers.
+    """
+    return float(np.mean(_as_1d(rate, "rate"))) - float(earth_rate_deg_h)
+
+
+def bias_from_counts(
+    counts: npt.ArrayLike,
+    scale_factor: float,
+    tau_s: float,
+    *,
+    scale_factor_unit: str = "counts/arcsec",
+    earth_rate_deg_h: float = 0.0,
+) -> float:
+    """Bias from raw pulse counts: ``B0 = (1/(τK)) · mean(N_i) − Ω_axis`` [°/h] (SPEC §1).
+
+    ``scale_factor`` K in ``scale_factor_unit`` (see
+    :data:`thermocal.units.SCALE_FACTOR_UNITS`; the default pulses per arcsec
+    gives [arcsec/s] = [°/h]), ``tau_s`` the sample interval τ [s].
+    """
+    rate, _unit = units.counts_to_physical(
+        _as_1d(counts, "counts"), scale_factor, scale_factor_unit, tau_s
+    )
+    return bias(rate, earth_rate_deg_h=earth_rate_deg_h)
+
+
+def bias_stability(
+    rate: npt.ArrayLike,
+    tau0_s: float,
+    averaging_s: float | None,
+    *,
+    time_s: npt.ArrayLike | None = None,
+) -> float:
+    """Bias stability ``Bs = sqrt(Σ (ω̄_k − mean)² / (p − 1))`` [unit] (SPEC §1).
+
+    ω̄_k are the p non-overlapping averages over ``averaging_s`` (never across a
+    gap, see :func:`block_means`); the averaging time must be reported with the
+    figure.  Needs at least two averages.
+    """
+    means = block_means(rate, tau0_s, averaging_s, time_s=time_s)
+    if means.size < 2:
+        raise ThermocalInputError(
+            f"bias stability needs at least two {averaging_s} s averages; the record "
+            f"gives {means.size} (shorten --average)"
+        )
+    return float(np.std(means, ddof=1))
+
+
+def bias_repeatability(biases: npt.ArrayLike) -> float:
+    """Bias repeatability ``Br = sqrt(Σ (B0_i − mean)² / (p − 1))`` over p runs or
+    hold stages [unit] (SPEC §1).  Needs p ≥ 2."""
+    b = _as_1d(biases, "biases")
+    if b.size < 2:
+        raise ThermocalInputError(f"bias repeatability needs at least two biases, got {b.size}")
+    return float(np.std(b, ddof=1))
+
+
+def temperature_sensitivity(
+    temps_c: npt.ArrayLike, biases: npt.ArrayLike, *, unit: str = "deg/h"
+) -> TemperatureSensitivity:
+    """Bias temperature sensitivity [unit/°C] (SPEC §1, our reading).
+
+    With the points sorted by temperature: ``mean_abs_adjacent = mean_i
+    |(B_{i+1} − B_i)/(T_{i+1} − T_i)|`` and ``ls_slope`` = slope of the
+    least-squares line ``B = a + b T`` (``numpy.linalg.lstsq``).
+    Needs two or more points at distinct temperatures.
+    """
+    T = _as_1d(temps_c, "temperatures")
+    B = _as_1d(biases, "biases")
+    if T.shape != B.shape:
+        raise ThermocalInputError(f"{T.size} temperatures but {B.size} biases")
+    if T.size < 2:
+        raise ThermocalInputError("temperature sensitivity needs at least two temperature points")
+    order = np.argsort(T, kind="stable")
+    T, B = T[order], B[order]
+    dT = np.diff(T)
+    if np.any(dT == 0):
+        raise ThermocalInputError(
+            "two temperature points have the same temperature; merge them first"
+        )
+    mean_abs = float(np.mean(np.abs(np.diff(B) / dT)))
+    design = np.column_stack([np.ones_like(T), T - T.mean()])
+    sol, *_ = np.linalg.lstsq(design, B, rcond=None)
+    return TemperatureSensitivity(
+        mean_abs_adjacent=mean_abs,
+        ls_slope=float(sol[1]),
+        unit=f"{unit}/degC",
+        n_points=int(T.size),
+        temps_c=tuple(float(v) for v in T),
+        biases=tuple(float(v) for v in B),
+    )
+
+
+def peak_to_peak(
+    rate: npt.ArrayLike,
+    tau0_s: float,
+    averaging_s: float | None,
+    *,
+    time_s: npt.ArrayLike | None = None,
+) -> float:
+    """Peak-to-peak variation ``max(ω̄_k) − min(ω̄_k)`` of the averages over
+    ``averaging_s`` [unit] (SPEC §1; blocks as in :func:`block_means`)."""
+    means = block_means(rate, tau0_s, averaging_s, time_s=time_s)
+    if means.size == 0:
+        raise ThermocalInputError(f"the record is shorter than one {averaging_s} s average")
+    return float(np.max(means) - np.min(means))
+
+
+def drift_angle(time_s: npt.ArrayLike, rate_deg_h: npt.ArrayLike, bias_deg_h: float) -> FloatArray:
+    """Drift angle ``θ(t) = ∫ (ω − B0) dt`` [°] (SPEC §1, seed 001).
+
+    Cumulative trapezoid rule: ``θ_k = θ_{k−1} + ½(e_k + e_{k−1})(t_k − t_{k−1})
+    / 3600`` with ``e = ω − B0`` [°/h] and t [s]; θ_0 = 0.  Across a gap (see
+    :func:`thermocal.recording.find_gaps`) nothing is integrated (θ is held).
+    """
+    t = _as_1d(time_s, "time")
+    e = _as_1d(rate_deg_h, "rate") - float(bias_deg_h)
+    if t.shape != e.shape:
+        raise ThermocalInputError(f"time has {t.size} samples but the rate has {e.size}")
+    inc = 0.5 * (e[1:] + e[:-1]) * np.diff(t) / units.SECONDS_PER_HOUR
+    for sl in contiguous_slices(t)[:-1]:
+        inc[sl.stop - 1] = 0.0
+    out = np.zeros(t.size)
+    np.cumsum(inc, out=out[1:])
+    return out
+
+
+# --- recording pipeline ------------------------------------------------------------------
+
+
+def hold_stages(
+    time_s: FloatArray,
+    temp_c: FloatArray,
+    values: FloatArray,
+    *,
+    rate_threshold_c_per_min: float = 0.05,
+    min_duration_s: float = 600.0,
+) -> tuple[Stage, ...]:
+    """Temperature-hold stages (:func:`thermocal.preprocess.segment_holds`) with the
+    mean temperature and mean signal of each."""
+    from thermocal.preprocess import segment_holds
+
+    segs = segment_holds(
+        time_s,
+        temp_c,
+        rate_threshold_c_per_min=rate_threshold_c_per_min,
+        min_duration_s=min_duration_s,
+    )
+    return tuple(
+        Stage(
+            start_s=float(s.start_s),
+            stop_s=float(s.stop_s),
+            mean_temp_c=float(np.mean(temp_c[s.start : s.stop])),
+            bias=float(np.mean(values[s.start : s.stop])),
+            n_samples=int(s.stop - s.start),
+        )
+        for s in segs
+        if s.kind == "hold" and s.stop > s.start
+    )
+
+
+def compute_metrics(
+    rec: Recording,
+    signal: str | None = None,
+    averaging_s: float | None = None,
+    latitude_deg: float | None = None,
+    axis: str | None = None,
+    temps: list[str] | tuple[str, ...] | None = None,
+    *,
+    rate_threshold_c_per_min: float = 0.05,
+    min_hold_s: float = 600.0,
+) -> MetricsResult:
+    """All figures of merit of one signal of a recording (SPEC §1).
+
+    Parameters
+    ----------
+    rec : the recording; the signal is read in [°/h] or [mg]
+        (:meth:`Recording.signal`).
+    signal : column name (default: the first signal).
+    averaging_s : averaging time of bias stability and peak-to-peak [s]
+        (default: the sample interval, i.e. no averaging).
+    latitude_deg, axis : remove the earth-rate component on the sensitive axis
+        (gyros only); default from the recording's metadata.
+    temps : temperature columns; the first one defines hold stages
+        (|Ṫ| < ``rate_threshold_c_per_min`` for at least ``min_hold_s``) for
+        bias repeatability and temperature sensitivity over the stages.
+    """
+    values, unit = rec.signal(signal)
+    name = signal or (rec.signals[0] if rec.signals else "")
+    values = _as_1d(values, f"column {name!r}")
+    t = rec.time_s
+    tau0 = rec.sample_interval_s
+    avg = float(averaging_s) if averaging_s is not None else tau0
+    lat = latitude_deg if latitude_deg is not None else rec.meta.latitude_deg
+    ax = axis if axis is not None else rec.meta.axis
+    earth = 0.0
+    if lat is not None or axis is not None:
+        if lat is None or ax is None:
+            raise ThermocalInputError("earth-rate removal needs both --latitude and --axis")
+        if unit != "deg/h":
+            raise ThermocalInputError(
+                f"earth-rate removal applies to gyro rates, but {name!r} is in {unit}"
+            )
+        if not -90.0 <= lat <= 90.0:
+            raise ThermocalInputError(f"latitude must be within ±90°, got {lat}")
+        earth = units.earth_rate_on_axis_deg_h(lat, units.parse_axis(ax))
+    b0 = bias(values, earth_rate_deg_h=earth)
+    means = block_means(values, tau0, avg, time_s=t)
+    if means.size < 2:
+        raise ThermocalInputError(
+            f"{rec.name}: bias stability needs at least two {avg:g} s averages; the record "
+            f"gives {means.size} (shorten --average)"
+        )
+    stab = float(np.std(means, ddof=1))
+    p2p = float(np.max(means) - np.min(means))
+    drift: float | None = None
+    drift_unit: str | None = None
+    if unit == "deg/h":
+        drift = float(drift_angle(t, values, float(np.mean(values)))[-1])
+        drift_unit = "deg"
+
+    sens: TemperatureSensitivity | None = None
+    rep: float | None = None
+    stages: tuple[Stage, ...] = ()
+    temp_names = list(temps) if temps else list(rec.temperatures)
+    if temp_names:
+        temp = rec.temperature_c(temp_names[0])
+        stages = hold_stages(
+            t,
+            temp,
+            values - earth,
+            rate_threshold_c_per_min=rate_threshold_c_per_min,
+            min_duration_s=min_hold_s,
+        )
+        if len(stages) >= 2:
+            rep = bias_repeatability([s.bias for s in stages])
+            st_temps = np.array([s.mean_temp_c for s in stages])
+            st_bias = np.array([s.bias for s in stages])
+            # hold stages at the same set-point (within 0.5 °C) are pooled
+            key = np.round(st_temps * 2.0) / 2.0
+            uniq = np.unique(key)
+            if uniq.size >= 2:
+                pt = np.array([st_temps[key == k].mean() for k in uniq])
+                pb = np.array([st_bias[key == k].mean() for k in uniq])
+                sens = temperature_sensitivity(pt, pb, unit=unit)
+    return MetricsResult(
+        bias=b0,
+        bias_stability=stab,
+        averaging_s=float(_samples_per_average(tau0, avg) * tau0),
+        peak_to_peak=p2p,
+        unit=unit,
+        temperature_sensitivity=sens,
+        bias_repeatability=rep,
+        stages=stages,
+        drift_angle=drift,
+        drift_angle_unit=drift_unit,
+        earth_rate_removed=earth,
+        n_samples=int(values.size),
+        n_segments=len(contiguous_slices(t)),
+        n_averages=int(means.size),
+        duration_s=rec.duration_s,
+        signal=name,
+    )
+
+
+__all__ = [
+    "MetricsResult",
+    "Stage",
+    "TemperatureSensitivity",
+    "bias",
+    "bias_from_counts",
+    "bias_repeatability",
+    "bias_stability",
+    "block_means",
+    "compute_metrics",
+    "drift_angle",
+    "hold_stages",
+    "peak_to_peak",
+    "temperature_sensitivity",
+]

@@ -1,0 +1,629 @@
+"""Adaptive model bank chosen at power-on (SPEC §4d, seed 004, accelerometers).
+
+Run-to-run repeatability is poor, so one model does not fit every turn-on.  The
+bank holds one continuous piecewise-linear model of the output against one
+temperature channel per *characteristic curve*, and picks one at power-on.
+
+Fit (``fit(runs)``; all thresholds are parameters, in the signal unit — mg for
+accelerometers):
+
+1. Every run is binned on a common temperature grid (``grid_step_c``, over the
+   union of the runs' ranges; every run must cover that range to within
+   2 × ``grid_step_c`` at each end, else :class:`~thermocal.errors.DesignError`):
+   its characteristic curve is the bin means of the output (known input removed).
+2. Runs are grouped by agglomerative clustering with complete (max-deviation)
+   linkage on the distance ``d_ij = max_bins |c_i − c_j|``: runs whose curves
+   differ by more than ``deviation`` at the same temperature are in distinct
+   groups (our reading of "differ by more than 1 mg at the same temperature").
+3. Per group, a continuous piecewise-linear least-squares fit to all the group's
+   samples, breakpoints every ``knot_spacing_c`` over the common range (hat-function
+   basis: the coefficients are the values at the breakpoints).
+4. Check against the group's characteristic lines: the means of its constant-
+   temperature holds (:func:`thermocal.preprocess.segment_holds`, ≥ ``hold_min_s``)
+   when they cover ≥ 3 temperatures, else the group's binned curve.  Models whose
+   fit error (``error_metric``: max or RMS of model − line) is below ``tolerance``
+   form the bank; the others are reported as rejected.  No model within tolerance
+   → :class:`~thermocal.errors.DesignError`.
+
+Selection at power-on (``select``, ``predict``, ``stream``): with ``r_i = y_i −
+f_m(T_i)`` the residual of model m on sample i (y = output, known input removed),
+the deviation of model m after N start-up samples is::
+
+    D_m(N) = | (1/N) Σ_{i<N} (y_i − f_m(T_i)) |
+
+and the chosen model is ``argmin_m D_m``.  (Our reading) the seed smooths the
+first n s of output with 1 s averages and compares with each model at the current
+temperature; averaging the residual over every start-up sample so far is the same
+comparison with stronger smoothing, and evaluates each model at each sample's own
+temperature.  The clarity of the choice is the ``margin`` = runner-up − best
+deviation.  Causality: while ``t − t_first < startup_s`` each sample uses the
+selection from the samples so far (running); from the first sample with
+``t − t_first ≥ startup_s`` the selection is frozen.  Gaps do not restart it
+(only ``ModelStream.reset()``, a new power-on, does).  ``predict`` keeps the last
+:class:`Selection` in ``selection_`` for reporting.
+
+Out of range: the temperature is clamped to the fitted range with an
+:class:`~thermocal.errors.ExtrapolationWarning`; with ``extrapolate=True`` the
+end segments are extended linearly.
+
+Learned state (``_state()``, the layout the C export reads)::
+
+    {
+      "sensor_name": "T1",                 # the temperature channel used
+      "models": [                          # the bank, in selection-index order
+        {"breakpoints_c": [x_0 … x_K],     # ascending [°C]
+         "values": [v_0 … v_K],            # model value at each breakpoint [signal unit]
+         "stderr": [...], "runs": [names], "fit_error": e, "check": "holds"|"curve",
+         "n_check_points": p},
+        ...
+      ],
+      "rejected": [{"runs": [...], "fit_error": e}, ...],
+      "groups": [[run index, ...], ...],   # every characteristic curve found
+      "startup_s": n, "deviation": d, "tolerance": tol
+    }
+
+Evaluation of model m (firmware twin): ``j`` = the segment holding T (clamped
+to ``[x_0, x_K]``; the last segment for T = x_K), ``f = v_j + (v_{j+1} − v_j)/(x_{j+1} − x_j)
+· (T − x_j)``.  Selection: keep ``Σ_i (y_i − f_m(T_i))`` and the count N per model
+during the start-up window, choose ``argmin_m |Σ/N|`` (first index on ties).
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Any, ClassVar, Self
+
+import numpy as np
+from scipy.cluster.hierarchy import fcluster, linkage
+from scipy.spatial.distance import squareform
+
+from thermocal.errors import ConditioningWarning, DesignError, ThermocalInputError
+from thermocal.models.base import (
+    Coefficient,
+    FitStats,
+    ModelStream,
+    RunData,
+    TemperatureModel,
+    register,
+)
+from thermocal.models.warmup import CONDITION_WARN, channel_index, lstsq_svd, single_channel
+from thermocal.preprocess import segment_holds
+from thermocal.recording import FloatArray
+
+ERROR_METRICS = ("max", "rms")
+
+
+# --- pure functions --------------------------------------------------------------------------
+
+
+def pwl_evaluate(breakpoints_c: FloatArray, values: FloatArray, temp_c: FloatArray) -> FloatArray:
+    """Continuous piecewise-linear function through ``(x_j, v_j)`` at ``T``::
+
+        f(T) = v_j + (v_{j+1} − v_j)/(x_{j+1} − x_j) · (T − x_j),   x_j ≤ T < x_{j+1}
+
+    with the end segments extended linearly outside ``[x_0, x_K]`` (callers clamp
+    first when they do not want to extrapolate).  SPEC §4b/§4d.
+    """
+    x = breakpoints_c
+    j = np.clip(np.searchsorted(x, temp_c, side="right") - 1, 0, x.size - 2)
+    slope = (values[j + 1] - values[j]) / (x[j + 1] - x[j])
+    out: FloatArray = values[j] + slope * (temp_c - x[j])
+    return out
+
+
+def hat_basis(breakpoints_c: FloatArray, temp_c: FloatArray) -> FloatArray:
+    """Design matrix (n, K+1) of the continuous piecewise-linear hat functions:
+    column j is 1 at x_j, 0 at the other breakpoints, linear between (so the
+    least-squares coefficients are the values at the breakpoints)."""
+    x = breakpoints_c
+    t = np.clip(temp_c, x[0], x[-1])
+    j = np.clip(np.searchsorted(x, t, side="right") - 1, 0, x.size - 2)
+    w = (t - x[j]) / (x[j + 1] - x[j])
+    basis = np.zeros((t.size, x.size))
+    rows = np.arange(t.size)
+    basis[rows, j] = 1.0 - w
+    basis[rows, j + 1] += w
+    return basis
+
+
+def binned_curve(
+    temp_c: FloatArray, y: FloatArray, edges_c: FloatArray
+) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """Bin means of ``y`` and ``T`` on temperature bins ``edges_c``: returns
+    ``(mean_y, mean_T, count)`` per bin (NaN for an empty bin)."""
+    nb = edges_c.size - 1
+    idx = np.clip(np.searchsorted(edges_c, temp_c, side="right") - 1, 0, nb - 1)
+    cnt = np.bincount(idx, minlength=nb).astype(np.float64)
+    sy = np.bincount(idx, weights=y, minlength=nb)
+    st = np.bincount(idx, weights=temp_c, minlength=nb)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return sy / cnt, st / cnt, cnt
+
+
+def curve_distance(curves: FloatArray) -> FloatArray:
+    """Pairwise max-deviation ``d_ij = max_b |c_i(b) − c_j(b)|`` over the bins where
+    both runs have data (inf when they share none)."""
+    diff = np.abs(curves[:, None, :] - curves[None, :, :])
+    both = np.isfinite(diff)
+    d = np.where(both, diff, -np.inf).max(axis=2)
+    d[~both.any(axis=2)] = np.inf
+    np.fill_diagonal(d, 0.0)
+    return np.asarray(d, dtype=np.float64)
+
+
+def cluster_runs(distance: FloatArray, threshold: float) -> list[list[int]]:
+    """Complete-linkage agglomerative clustering: every pair inside a group is
+    within ``threshold``.  Groups are ordered by their first run."""
+    n = distance.shape[0]
+    if n == 1:
+        return [[0]]
+    finite = np.where(np.isfinite(distance), distance, 1e300)
+    z = linkage(squareform(finite, checks=False), method="complete")
+    labels = fcluster(z, t=threshold, criterion="distance")
+    groups: dict[int, list[int]] = {}
+    for i, lab in enumerate(labels):
+        groups.setdefault(int(lab), []).append(i)
+    return sorted(groups.values(), key=lambda g: g[0])
+
+
+@dataclass(frozen=True)
+class Selection:
+    """The model chosen at power-on.
+
+    ``index`` of the chosen model in the bank; ``deviations`` D_m of every model
+    [signal unit]; ``margin`` runner-up − best deviation (inf with one model);
+    ``n_samples`` start-up samples used; ``complete`` True once the start-up
+    window (``startup_s``) was full.
+    """
+
+    index: int
+    deviations: tuple[float, ...]
+    margin: float
+    n_samples: int
+    complete: bool
+
+    def to_dict(self) -> dict[str, Any]:
+        return {
+            "index": self.index,
+            "deviations": list(self.deviations),
+            "margin": self.margin if math.isfinite(self.margin) else None,
+            "n_samples": self.n_samples,
+            "complete": self.complete,
+        }
+
+
+def _selection(dev: FloatArray, n: int, complete: bool) -> Selection:
+    order = np.argsort(dev, kind="stable")
+    best = int(np.argmin(dev))
+    margin = float(dev[order[1]] - dev[best]) if dev.size > 1 else math.inf
+    return Selection(best, tuple(float(v) for v in dev), margin, n, complete)
+
+
+# --- the model ------------------------------------------------------------------------------
+
+
+@register
+class BankModel(TemperatureModel):
+    """Bank of piecewise-linear models, one per characteristic curve, chosen at
+    power-on (SPEC §4d, seed 004).
+
+    Parameters
+    ----------
+    deviation : curves differing by more than this at the same temperature are
+        distinct [signal unit] (seed: 1 mg).
+    tolerance : keep a model whose fit error to its characteristic lines is below
+        this [signal unit] (seed: 0.2 mg).
+    startup_s : start-up window used to select the model [s] (seed: 20 s).
+    sensor : index of the temperature channel (0 = first named channel).
+    knot_spacing_c : breakpoint spacing of the piecewise-linear models [°C].
+    grid_step_c : bin width of the curves compared in the clustering [°C].
+    hold_min_s : shortest constant-temperature hold used as a characteristic point [s].
+    error_metric : ``"max"`` or ``"rms"`` of model − characteristic line.
+    """
+
+    family: ClassVar[str] = "bank"
+    uses_rate: ClassVar[bool] = False
+
+    breakpoints_: list[FloatArray]
+    values_: list[FloatArray]
+    stderr_: list[FloatArray | None]
+    model_info_: list[dict[str, Any]]
+    rejected_: list[dict[str, Any]]
+    groups_: list[list[int]]
+    sensor_name_: str
+    selection_: Selection
+
+    def __init__(
+        self,
+        deviation: float = 1.0,
+        tolerance: float = 0.2,
+        startup_s: float = 20.0,
+        sensor: int = 0,
+        knot_spacing_c: float = 5.0,
+        grid_step_c: float = 1.0,
+        hold_min_s: float = 600.0,
+        error_metric: str = "max",
+    ) -> None:
+        self.deviation = deviation
+        self.tolerance = tolerance
+        self.startup_s = startup_s
+        self.sensor = sensor
+        self.knot_spacing_c = knot_spacing_c
+        self.grid_step_c = grid_step_c
+        self.hold_min_s = hold_min_s
+        self.error_metric = error_metric
+
+    @classmethod
+    def from_cli_options(cls, opts: dict[str, Any]) -> Self:
+        """Build from ``thermocal fit`` options (``deviation``, ``tolerance``,
+        ``startup_s``, ``sensor``, ``knot_spacing_c``, ``grid_step_c``, ``hold_min_s``,
+        ``error_metric``); other keys and ``None`` values are ignored."""
+        keys = (
+            "deviation",
+            "tolerance",
+            "startup_s",
+            "sensor",
+            "knot_spacing_c",
+            "grid_step_c",
+            "hold_min_s",
+            "error_metric",
+        )
+        return cls(**{k: opts[k] for k in keys if opts.get(k) is not None})
+
+    def _check_params(self) -> None:
+        for name in ("deviation", "tolerance", "startup_s", "knot_spacing_c", "grid_step_c"):
+            v = getattr(self, name)
+            if not (isinstance(v, int | float) and v > 0 and math.isfinite(v)):
+                raise ThermocalInputError(f"bank: {name} must be a positive number, got {v!r}")
+        if self.error_metric not in ERROR_METRICS:
+            raise ThermocalInputError(
+                f"bank: unknown error_metric {self.error_metric!r}; use one of "
+                + ", ".join(ERROR_METRICS)
+            )
+
+    @property
+    def n_models(self) -> int:
+        """Number of models in the bank."""
+        self.check_fitted()
+        return len(self.values_)
+
+    # -- fit --
+    def fit(self, runs: Sequence[RunData]) -> Self:
+        """Group the runs into characteristic curves, fit a piecewise-linear model
+        per group and keep those within ``tolerance`` (SPEC §4d steps 1–3)."""
+        self._check_params()
+        if not runs:
+            raise ThermocalInputError("bank: no runs to fit")
+        one = [single_channel(r, channel_index(self.family, r, self.sensor)) for r in runs]
+        names = {r.temp_names[0] for r in one}
+        if len(names) > 1:
+            raise ThermocalInputError(
+                f"bank: the runs name the temperature channel differently: {sorted(names)}"
+            )
+        temps = [r.temps_c[:, 0] for r in one]
+        ys = [r.target() for r in one]
+        labels = [r.name or f"run {i}" for i, r in enumerate(one)]
+
+        lo = np.array([t.min() for t in temps])
+        hi = np.array([t.max() for t in temps])
+        t_lo, t_hi = float(lo.min()), float(hi.max())
+        slack = 2.0 * float(self.grid_step_c)
+        short = [i for i in range(len(one)) if lo[i] > t_lo + slack or hi[i] < t_hi - slack]
+        if short:
+            ranges = "; ".join(f"{labels[i]} {lo[i]:.1f}…{hi[i]:.1f} °C" for i in range(len(one)))
+            raise DesignError(
+                f"bank: the runs cover different temperature ranges ({ranges}); every run "
+                f"must cover {t_lo:.1f}…{t_hi:.1f} °C to within {slack:g} °C, because the "
+                "characteristic curves are compared at the same temperatures"
+            )
+        if not t_hi - t_lo > self.grid_step_c:
+            raise DesignError(
+                f"bank: the runs span only {t_hi - t_lo:.2f} °C; at least more than one "
+                f"grid step ({self.grid_step_c:g} °C) is needed"
+            )
+
+        # 1-2: binned curves and clustering
+        nb = max(1, math.ceil((t_hi - t_lo) / self.grid_step_c))
+        edges = np.linspace(t_lo, t_hi, nb + 1)
+        curves = np.empty((len(one), nb))
+        curve_t = np.empty((len(one), nb))
+        for i, (t, y) in enumerate(zip(temps, ys, strict=True)):
+            curves[i], curve_t[i], _ = binned_curve(t, y, edges)
+        dist = curve_distance(curves)
+        groups = cluster_runs(dist, float(self.deviation))
+
+        # 3: piecewise-linear model per group
+        nk = max(2, round((t_hi - t_lo) / self.knot_spacing_c) + 1)
+        knots = np.linspace(t_lo, t_hi, nk)
+        kept_b: list[FloatArray] = []
+        kept_v: list[FloatArray] = []
+        kept_se: list[FloatArray | None] = []
+        info: list[dict[str, Any]] = []
+        rejected: list[dict[str, Any]] = []
+        cond = 0.0
+        resid_sq = 0.0
+        n_res = 0
+        for g in groups:
+            tg = np.concatenate([temps[i] for i in g])
+            yg = np.concatenate([ys[i] for i in g])
+            x = hat_basis(knots, tg)
+            res = lstsq_svd(x, yg)
+            if res.rank < nk:
+                empty = [c for c in res.null_columns]
+                where = ", ".join(f"{knots[c]:.1f} °C" for c in empty)
+                raise DesignError(
+                    f"bank: group of {', '.join(labels[i] for i in g)}: no data to determine "
+                    f"the piecewise-linear value(s) at {where}; increase knot_spacing_c"
+                )
+            cond = max(cond, res.condition_number)
+            values = res.coef
+            se = (
+                np.sqrt(np.maximum(np.diag(res.cov_unit) * float(res.sigma2), 0.0))
+                if res.dof > 0
+                else None
+            )
+            # 4: check against the characteristic lines
+            pts_t, pts_y, check = self._characteristic_points(
+                [one[i] for i in g],
+                [temps[i] for i in g],
+                [ys[i] for i in g],
+                curves[g],
+                curve_t[g],
+            )
+            err = pts_y - pwl_evaluate(knots, values, pts_t)
+            fit_error = (
+                float(np.max(np.abs(err)))
+                if self.error_metric == "max"
+                else float(np.sqrt(np.mean(err**2)))
+            )
+            entry = {
+                "runs": [labels[i] for i in g],
+                "fit_error": fit_error,
+                "check": check,
+                "n_check_points": int(pts_t.size),
+            }
+            if fit_error < self.tolerance:
+                kept_b.append(knots.copy())
+                kept_v.append(values)
+                kept_se.append(se)
+                info.append(entry)
+                r = yg - x @ values
+                resid_sq += float(np.sum(r**2))
+                n_res += r.size
+            else:
+                rejected.append(entry)
+        if not kept_v:
+            best = min(e["fit_error"] for e in rejected)
+            raise DesignError(
+                f"bank: no characteristic curve could be modelled within the tolerance "
+                f"{self.tolerance:g} (best fit error {best:.3g}); use a smaller knot_spacing_c "
+                "or a larger tolerance"
+            )
+        if cond > CONDITION_WARN:
+            warnings.warn(
+                f"bank: badly conditioned piecewise design (condition number {cond:.3g})",
+                ConditioningWarning,
+                stacklevel=2,
+            )
+        self.breakpoints_ = kept_b
+        self.values_ = kept_v
+        self.stderr_ = kept_se
+        self.model_info_ = info
+        self.rejected_ = rejected
+        self.groups_ = groups
+        self.sensor_name_ = one[0].temp_names[0]
+        n_coef = sum(v.size for v in kept_v)
+        self._record_common(
+            one,
+            FitStats(
+                n_samples=int(sum(r.n_samples for r in one)),
+                n_coefficients=int(n_coef),
+                rms_residual=math.sqrt(resid_sq / n_res),
+                condition_number=float(cond),
+                dof=int(n_res - n_coef),
+                extra={
+                    "n_groups": len(groups),
+                    "n_models": len(kept_v),
+                    "groups": [[labels[i] for i in g] for g in groups],
+                    "fit_errors": [e["fit_error"] for e in info],
+                    "rejected": rejected,
+                    "max_within_group_deviation": float(
+                        max((dist[np.ix_(g, g)].max() for g in groups), default=0.0)
+                    ),
+                },
+            ),
+        )
+        return self
+
+    def _characteristic_points(
+        self,
+        runs: Sequence[RunData],
+        temps: Sequence[FloatArray],
+        ys: Sequence[FloatArray],
+        curves: FloatArray,
+        curve_t: FloatArray,
+    ) -> tuple[FloatArray, FloatArray, str]:
+        """Characteristic lines of a group: hold means (≥ 3 distinct temperatures)
+        or the group's mean binned curve."""
+        pts: list[tuple[float, float]] = []
+        for r, t, y in zip(runs, temps, ys, strict=True):
+            for seg in segment_holds(r.time_s, t, min_duration_s=self.hold_min_s):
+                if seg.kind == "hold":
+                    pts.append((float(np.mean(t[seg.slice])), float(np.mean(y[seg.slice]))))
+        if pts:
+            arr = np.array(sorted(pts))
+            # merge holds at the same temperature (within a grid step)
+            split = np.flatnonzero(np.diff(arr[:, 0]) > self.grid_step_c) + 1
+            groups = np.split(arr, split)
+            if len(groups) >= 3:
+                mt = np.array([g[:, 0].mean() for g in groups])
+                my = np.array([g[:, 1].mean() for g in groups])
+                return mt, my, "holds"
+        ok = np.isfinite(curves).all(axis=0)
+        return curve_t[:, ok].mean(axis=0), curves[:, ok].mean(axis=0), "curve"
+
+    # -- use --
+    def _model_matrix(self, temp_c: FloatArray) -> FloatArray:
+        """(n, M): every model evaluated at every temperature."""
+        return np.column_stack(
+            [
+                pwl_evaluate(b, v, temp_c)
+                for b, v in zip(self.breakpoints_, self.values_, strict=True)
+            ]
+        )
+
+    def _prepare(self, run: RunData, extrapolate: bool) -> FloatArray:
+        self.check_fitted()
+        col = channel_index(self.family, run, self.sensor, self.sensor_name_)
+        temp = np.asarray(run.temps_c[:, col], dtype=np.float64)
+        return self.clamp(temp[:, None], extrapolate=extrapolate)[:, 0]
+
+    def _run_selection(self, run: RunData, f: FloatArray) -> tuple[FloatArray, FloatArray, int]:
+        """Running deviations (m, M) over the start-up window and per-sample choice."""
+        if run.signal is None:
+            raise ThermocalInputError(
+                f"bank: {run.name or 'run'}: selecting a model at power-on needs the "
+                "measured signal"
+            )
+        m = max(1, int(np.count_nonzero(run.time_s - run.time_s[0] < self.startup_s)))
+        y = run.target()[:m]
+        dev = np.abs(np.cumsum(y[:, None] - f[:m], axis=0) / np.arange(1, m + 1)[:, None])
+        choice = np.argmin(dev, axis=1)
+        return dev, choice, m
+
+    def select(self, run: RunData, *, extrapolate: bool = False) -> Selection:
+        """The model chosen for a power-on from its start-up window (SPEC §4d step 4);
+        also stored in ``selection_``."""
+        temp = self._prepare(run, extrapolate)
+        f = self._model_matrix(temp)
+        dev, _choice, m = self._run_selection(run, f)
+        self.selection_ = _selection(dev[-1], m, m < run.n_samples)
+        return self.selection_
+
+    def predict(self, run: RunData, *, extrapolate: bool = False) -> FloatArray:
+        """Output of the selected model at every sample [signal unit]: running
+        selection during the start-up window, frozen after it."""
+        temp = self._prepare(run, extrapolate)
+        f = self._model_matrix(temp)
+        dev, choice, m = self._run_selection(run, f)
+        idx = np.empty(run.n_samples, dtype=np.intp)
+        idx[:m] = choice
+        idx[m:] = choice[-1]
+        self.selection_ = _selection(dev[-1], m, m < run.n_samples)
+        out: FloatArray = f[np.arange(run.n_samples), idx]
+        return out
+
+    def stream(
+        self, sample_interval_s: float, *, extrapolate: bool = False, known_input: float = 0.0
+    ) -> ModelStream:
+        """Sample-by-sample twin of :meth:`predict`; ``known_input`` (e.g. the gravity
+        component [mg]) is subtracted from the raw signal before the selection, like
+        :meth:`RunData.target`."""
+        self.check_fitted()
+        return BankStream(self, extrapolate=extrapolate, known_input=known_input)
+
+    def coefficients(self) -> list[Coefficient]:
+        self.check_fitted()
+        out = []
+        for m, (b, v, se) in enumerate(
+            zip(self.breakpoints_, self.values_, self.stderr_, strict=True)
+        ):
+            for k in range(v.size):
+                out.append(
+                    Coefficient(
+                        name=f"m{m}_v{k} (T={b[k]:.6g} degC)",
+                        value=float(v[k]),
+                        stderr=None if se is None else float(se[k]),
+                        unit=self.signal_unit,
+                    )
+                )
+        return out
+
+    def _state(self) -> dict[str, Any]:
+        return {
+            "sensor_name": self.sensor_name_,
+            "models": [
+                {
+                    "breakpoints_c": b.tolist(),
+                    "values": v.tolist(),
+                    "stderr": None if se is None else se.tolist(),
+                    **info,
+                }
+                for b, v, se, info in zip(
+                    self.breakpoints_, self.values_, self.stderr_, self.model_info_, strict=True
+                )
+            ],
+            "rejected": self.rejected_,
+            "groups": self.groups_,
+            "startup_s": float(self.startup_s),
+            "deviation": float(self.deviation),
+            "tolerance": float(self.tolerance),
+        }
+
+    def _set_state(self, state: dict[str, Any]) -> None:
+        self.sensor_name_ = str(state["sensor_name"])
+        models = state["models"]
+        self.breakpoints_ = [np.array(m["breakpoints_c"], dtype=np.float64) for m in models]
+        self.values_ = [np.array(m["values"], dtype=np.float64) for m in models]
+        self.stderr_ = [
+            None if m.get("stderr") is None else np.array(m["stderr"], dtype=np.float64)
+            for m in models
+        ]
+        skip = {"breakpoints_c", "values", "stderr"}
+        self.model_info_ = [{k: v for k, v in m.items() if k not in skip} for m in models]
+        self.rejected_ = list(state.get("rejected", []))
+        self.groups_ = [list(g) for g in state.get("groups", [])]
+
+
+class BankStream(ModelStream):
+    """Streaming twin of :meth:`BankModel.predict`: running residual sums per model
+    during the start-up window, then the frozen choice.
+
+    ``temps_c`` holds either one value (the model's channel) or the fitted run's
+    channels (``sensor`` picks).  ``signal`` (raw; ``known_input`` is subtracted) is
+    required during the start-up window.  ``selection`` is the current :class:`Selection`.
+    """
+
+    def __init__(
+        self, model: BankModel, *, extrapolate: bool = False, known_input: float = 0.0
+    ) -> None:
+        self.model = model
+        self.extrapolate = extrapolate
+        self.known_input = float(known_input)
+        self.reset()
+
+    def reset(self) -> None:
+        self._t_first: float | None = None
+        self._sums = np.zeros(len(self.model.values_))
+        self._count = 0
+        self._frozen = False
+        self._choice = 0
+        self._dev = np.full(len(self.model.values_), np.nan)
+
+    @property
+    def selection(self) -> Selection:
+        return _selection(self._dev, self._count, self._frozen)
+
+    def update(self, time_s: float, temps_c: FloatArray, signal: float | None = None) -> float:
+        m = self.model
+        row = np.asarray(temps_c, dtype=np.float64).reshape(1, -1)
+        col = 0 if row.shape[1] == 1 else int(m.sensor)
+        temp = m.clamp(row[:, [col]], extrapolate=self.extrapolate)[:, 0]
+        f = m._model_matrix(temp)[0]
+        if self._t_first is None:
+            self._t_first = float(time_s)
+        if not self._frozen and float(time_s) - self._t_first < m.startup_s:
+            if signal is None:
+                raise ThermocalInputError(
+                    "bank: selecting a model at power-on needs the measured signal"
+                )
+            self._sums = self._sums + ((float(signal) - self.known_input) - f)
+            self._count += 1
+            self._dev = np.abs(self._sums / self._count)
+            self._choice = int(np.argmin(self._dev))
+        else:
+            self._frozen = True
+        return float(f[self._choice])

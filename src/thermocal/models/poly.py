@@ -1,0 +1,605 @@
+"""Multi-sensor polynomial model with rate and coupling terms (SPEC §4a, seed 000).
+
+The temperature-induced signal (bias [°/h] or [mg], or scale-factor error,
+SPEC §4e) is
+
+.. math::
+
+    y = a_0 + \\sum_j a_j \\, u_{k_j}^{a} v_{k_j}^{b} w_{k_j}^{c}            (1)
+
+with the centred and scaled base variables of every sensor k
+(:mod:`thermocal.models.terms`, eq. 1): ``u = (T − c_T)/s_T`` [T in °C],
+``v = (Ṫ − c_R)/s_R`` [Ṫ in °C/min], ``w = (T·Ṫ − c_W)/s_W``.  The default term
+set ``seed000`` (37 coefficients for four sensors) spans exactly the seed's raw
+cubic polynomial in T, Ṫ and TṪ, but the regressors are orthogonal-ish, so the
+least-squares problem is solved accurately (column-equilibrated QR/SVD, the
+condition number is reported).  Robust default: singular values of the
+equilibrated design below ``rcond`` (1e-9) × the largest are truncated (a
+truncated-SVD solution; the count is reported as ``n_truncated``); a design
+that is singular to 1e-11 raises :class:`~thermocal.errors.DesignError` naming
+the dependent terms; ``ridge`` adds ``n·α‖γ‖²`` on the equilibrated term
+coefficients.  Options: explicit term lists, ``order`` (plain polynomial in the
+temperatures), stepwise selection (``select="bic"`` or ``"holdout"``), per-run
+turn-on offsets as nuisance parameters (``per_run_offset``; the model's constant
+is then the mean of the offsets).
+
+Ṫ is the causal backward difference over ``rate_interval_s`` (default 60 s):
+``Ṫ(t) = (T(t) − T(t_j))/(t − t_j)·60`` with ``t_j`` the first sample of the
+current contiguous segment with ``t_j ≥ t − Δt`` (0 at a segment's first
+sample; a step longer than 1.5 × the nominal interval starts a new segment);
+see :func:`thermocal.preprocess.temperature_rate`.  ``"forward"`` and
+``"centred"`` forms may be chosen for batch use (not for streaming).
+
+Evaluation, in order, for every sample (this is what :meth:`PolyModel.predict`,
+:class:`PolyStream` and the generated C code compute):
+
+1. Ṫ_k from the *raw* temperatures (rule above) [°C/min];
+2. clamp T_k to the fitted range ``range.temperature_c`` and Ṫ_k to
+   ``range.rate_c_per_min`` (unless extrapolating; an
+   :class:`~thermocal.errors.ExtrapolationWarning` is raised either way);
+3. ``u_k, v_k, w_k`` by eq. (1) of :mod:`~thermocal.models.terms`, with
+   ``w_k`` built from the clamped T_k·Ṫ_k;
+4. ``y = constant + Σ_j coef[j] · u^t_power · v^rate_power · w^coupling_power``.
+
+Model-file ``state`` layout (``"layout": "thermocal-poly-1"``), for the C export::
+
+    {
+      "layout": "thermocal-poly-1",
+      "n_sensors": k,                      # temperature columns, order of "temperatures"
+      "base": [                            # one entry per sensor, in column order
+        {"name": "T1", "t_center": °C, "t_scale": °C,
+         "rate_center": °C/min, "rate_scale": °C/min,
+         "coupling_center": °C²/min, "coupling_scale": °C²/min}, ...],
+      "terms": [                           # the kept terms, in coefficient order
+        {"name": "T1^2", "sensor": 0,      # 0-based index into "base"/"temperatures"
+         "t_power": 2, "rate_power": 0, "coupling_power": 0}, ...],
+      "coef": [...],                       # coefficient of each term [signal unit]
+      "constant": a0,                      # [signal unit] (mean of the per-run offsets)
+      "offsets": [...],                    # per-run offsets (nuisance), run order of "data"
+      "cov": [[...]],                      # covariance of [constant, coef...]
+      "uses_rate": true,
+      "rate": {"method": "backward", "interval_s": 60.0, "gap_factor": 1.5,
+               "unit": "degC/min", "clamp": true},
+      "selection": null | {"method": "bic"|"holdout", "kept": [...], "path": [...]}
+    }
+
+The ranges for step 2 are the file's ``range`` section (``temperature_c`` and
+``rate_c_per_min``, keyed by temperature name, ``[lo, hi]``).  The file's
+``coefficients`` list gives the same model expanded into raw monomials
+``T_k^P Ṫ_k^Q`` (the seed's a0…a36 for ``seed000``), with standard errors;
+those are for reading, the scaled basis above is for evaluation.
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+from collections import deque
+from collections.abc import Iterator, Sequence
+from typing import Any, ClassVar, Literal, Self, cast
+
+import numpy as np
+
+from thermocal.errors import ConditioningWarning, ExtrapolationWarning, ThermocalInputError
+from thermocal.models.base import (
+    Coefficient,
+    FitStats,
+    ModelStream,
+    RunData,
+    TemperatureModel,
+    register,
+)
+from thermocal.models.terms import (
+    CHUNK_ROWS,
+    BaseScaling,
+    Chunk,
+    Term,
+    accumulate_r,
+    backward_rates,
+    fit_base_scaling,
+    forward_select,
+    monomial_name,
+    parse_terms,
+    raw_expansion,
+    solve_r,
+    term_features,
+)
+from thermocal.preprocess import RATE_METHODS, temperature_rate
+from thermocal.recording import GAP_FACTOR, FloatArray
+from thermocal.units import SECONDS_PER_MINUTE
+
+DEFAULT_RCOND = 1.0e-9
+"""Singular values of the equilibrated design below this × the largest are truncated."""
+
+COND_WARN = 1.0e8
+"""Condition number above which a :class:`ConditioningWarning` is raised."""
+
+HOLDOUT_BLOCKS = 10
+"""Hold-out selection splits each run into this many equal blocks; odd blocks are held out."""
+
+STATE_LAYOUT = "thermocal-poly-1"
+
+
+def check_runs(runs: Sequence[RunData], family: str) -> list[RunData]:
+    """Common input checks: at least one run, a signal, the same temperature columns."""
+    rl = list(runs)
+    if not rl:
+        raise ThermocalInputError(f"{family}: no runs to fit")
+    k = rl[0].temps_c.shape[1]
+    for r in rl:
+        if r.signal is None:
+            raise ThermocalInputError(f"{r.name or 'run'}: no signal to fit")
+        if r.temps_c.shape[1] != k:
+            raise ThermocalInputError(
+                f"{r.name or 'run'}: has {r.temps_c.shape[1]} temperature columns, the first run {k}"
+            )
+        if r.temp_names and rl[0].temp_names and r.temp_names != rl[0].temp_names:
+            raise ThermocalInputError(
+                f"{r.name or 'run'}: temperature columns {list(r.temp_names)} differ from the "
+                f"first run's {list(rl[0].temp_names)}"
+            )
+        if r.n_samples < 2:
+            raise ThermocalInputError(f"{r.name or 'run'}: needs at least 2 samples")
+    return rl
+
+
+def clamp_rates(
+    rates: FloatArray,
+    rate_range: FloatArray,
+    names: Sequence[str],
+    used: Sequence[int],
+    *,
+    extrapolate: bool,
+) -> FloatArray:
+    """Clamp Ṫ [°C/min] of the used sensors to the fitted rate range (warns)."""
+    lo, hi = rate_range[:, 0], rate_range[:, 1]
+    out = rates
+    bad = [j for j in used if (rates[:, j] < lo[j]).any() or (rates[:, j] > hi[j]).any()]
+    if bad:
+        where = ", ".join(
+            f"d{names[j]} {rates[:, j].min():.3g}…{rates[:, j].max():.3g} °C/min "
+            f"(fitted {lo[j]:.3g}…{hi[j]:.3g})"
+            for j in bad
+        )
+        action = "extrapolating" if extrapolate else "clamped to the fitted range"
+        warnings.warn(
+            f"temperature rate outside the model's fitted range: {where}; {action}",
+            ExtrapolationWarning,
+            stacklevel=3,
+        )
+        if not extrapolate:
+            out = rates.copy()
+            for j in bad:
+                np.clip(out[:, j], lo[j], hi[j], out=out[:, j])
+    return out
+
+
+@register
+class PolyModel(TemperatureModel):
+    """Polynomial in T, Ṫ and TṪ of several sensors (SPEC §4a); see the module docstring.
+
+    Parameters
+    ----------
+    terms : ``"seed000"`` (default), a comma-separated term text or a list of
+        term texts (:func:`thermocal.models.terms.parse_terms`).
+    order : plain polynomial T, …, T^order per sensor (instead of ``terms``).
+    rate_interval_s : Δt of Ṫ [s] (default 60).
+    rate_method : ``"backward"`` (causal, default), ``"forward"`` or ``"centred"``.
+    select : None, ``"bic"`` or ``"holdout"`` (forward stepwise term selection).
+    ridge : ridge α on the unit-RMS term columns (0 = none).
+    rcond : truncation threshold of the SVD solution (relative to s_max).
+    per_run_offset : one turn-on offset per run, estimated as nuisance parameters.
+    solver : ``"auto"`` (Gram when well conditioned, else chunked QR), ``"qr"``, ``"gram"``.
+    """
+
+    family: ClassVar[str] = "poly"
+    uses_rate: ClassVar[bool] = True
+
+    terms_: list[Term]
+    scaling_: BaseScaling
+    coef_: FloatArray
+    constant_: float
+    offsets_: FloatArray
+    cov_: FloatArray
+    selection_: dict[str, Any] | None
+
+    def __init__(
+        self,
+        terms: str | list[str] | None = "seed000",
+        order: int | None = None,
+        rate_interval_s: float = 60.0,
+        rate_method: str = "backward",
+        select: str | None = None,
+        ridge: float = 0.0,
+        rcond: float | None = DEFAULT_RCOND,
+        per_run_offset: bool = True,
+        solver: str = "auto",
+    ) -> None:
+        self.terms = terms
+        self.order = order
+        self.rate_interval_s = rate_interval_s
+        self.rate_method = rate_method
+        self.select = select
+        self.ridge = ridge
+        self.rcond = rcond
+        self.per_run_offset = per_run_offset
+        self.solver = solver
+
+    # -- construction from the command line --
+    CLI_KEYS: ClassVar[dict[str, str]] = {
+        "terms": "terms",
+        "order": "order",
+        "rate_interval_s": "rate_interval_s",
+        "rate_method": "rate_method",
+        "select": "select",
+        "ridge": "ridge",
+        "rcond": "rcond",
+        "per_run_offset": "per_run_offset",
+        "solver": "solver",
+    }
+
+    @classmethod
+    def from_cli_options(cls, options: dict[str, Any]) -> PolyModel:
+        """Build from the ``thermocal fit`` option dict (keys in :mod:`thermocal.cli.fit_cmd`)."""
+        params: dict[str, Any] = {}
+        for key, value in options.items():
+            if value is None:
+                continue
+            if key not in cls.CLI_KEYS:
+                raise ThermocalInputError(f"option {key!r} does not apply to model 'poly'")
+            params[cls.CLI_KEYS[key]] = value
+        return cls(**params)
+
+    # -- helpers --
+    def _check_params(self) -> None:
+        if self.rate_method not in RATE_METHODS:
+            raise ThermocalInputError(
+                f"unknown rate method {self.rate_method!r}; use one of {', '.join(RATE_METHODS)}"
+            )
+        if not (isinstance(self.rate_interval_s, int | float) and self.rate_interval_s > 0):
+            raise ThermocalInputError(
+                f"rate interval must be a positive number of seconds, got {self.rate_interval_s!r}"
+            )
+        if self.select not in (None, "bic", "holdout"):
+            raise ThermocalInputError(f"unknown selection {self.select!r}; use bic or holdout")
+        if self.ridge < 0:
+            raise ThermocalInputError(f"ridge α must be ≥ 0, got {self.ridge}")
+        if self.solver not in ("auto", "qr", "gram"):
+            raise ThermocalInputError(f"unknown solver {self.solver!r}; use auto, qr or gram")
+
+    def rates(self, time_s: FloatArray, temps_c: FloatArray) -> FloatArray:
+        """Ṫ of every temperature column [°C/min] with the model's rate form."""
+        if self.rate_method == "backward":
+            return backward_rates(time_s, temps_c, float(self.rate_interval_s))
+        cols = [
+            temperature_rate(
+                time_s,
+                temps_c[:, j],
+                float(self.rate_interval_s),
+                cast(Literal["forward", "backward", "centred"], self.rate_method),
+            )
+            for j in range(temps_c.shape[1])
+        ]
+        return np.column_stack(cols) if cols else np.zeros_like(temps_c)
+
+    @property
+    def model_uses_rate(self) -> bool:
+        """True when a fitted term uses Ṫ."""
+        return any(t.uses_rate for t in self.terms_)
+
+    # -- estimator contract --
+    def fit(self, runs: Sequence[RunData]) -> Self:
+        """Least-squares fit of eq. (1) on one or several runs; returns ``self``."""
+        self._check_params()
+        rl = check_runs(runs, self.family)
+        k = rl[0].temps_c.shape[1]
+        terms = parse_terms(self.terms, k, self.order)
+        uses_rate = any(t.uses_rate for t in terms)
+        temps = [r.temps_c for r in rl]
+        rates = [self.rates(r.time_s, r.temps_c) for r in rl] if uses_rate else None
+        ys = [r.target() for r in rl]
+        n_total = sum(r.n_samples for r in rl)
+        scaling = fit_base_scaling(temps, rates, terms)
+        p = len(terms)
+        m = len(rl) if self.per_run_offset else 1
+        n_folds = 2 if self.select == "holdout" else 1
+        if n_total <= p + m:
+            raise ThermocalInputError(
+                f"poly: {n_total} samples for {p + m} coefficients; need more samples than terms"
+            )
+
+        def make_chunks() -> Iterator[Chunk]:
+            buf = np.empty((CHUNK_ROWS, p))
+            for i, r in enumerate(rl):
+                g = i if self.per_run_offset else 0
+                n = r.n_samples
+                if n_folds == 1:
+                    blocks = [(0, n, 0)]
+                else:
+                    edges = [round(n * j / HOLDOUT_BLOCKS) for j in range(HOLDOUT_BLOCKS + 1)]
+                    blocks = [(edges[j], edges[j + 1], j % 2) for j in range(HOLDOUT_BLOCKS)]
+                for a0, b0, fold in blocks:
+                    for a in range(a0, b0, CHUNK_ROWS):
+                        b = min(b0, a + CHUNK_ROWS)
+                        F = term_features(
+                            terms,
+                            scaling,
+                            temps[i][a:b],
+                            rates[i][a:b] if rates is not None else None,
+                            out=buf[: b - a],
+                        )
+                        yield F, ys[i][a:b], g, fold
+
+        red = accumulate_r(
+            make_chunks, p, m, n_folds=n_folds, solver=cast(Any, self.solver)
+        )
+        names = [t.name for t in terms] + (
+            [f"offset[{r.name or i + 1}]" for i, r in enumerate(rl)] if self.per_run_offset else ["const"]
+        )
+        required = list(range(p, p + m))
+        selection: dict[str, Any] | None = None
+        kept = list(range(p))
+        if self.select is not None:
+            sel = forward_select(
+                red, list(range(p)), required, names, cast(Any, self.select)
+            )
+            kept = sorted(c for c in sel.kept if c < p)
+            selection = {
+                "method": sel.method,
+                "kept": [names[c] for c in kept],
+                "order_added": [names[c] for c in sel.kept if c < p],
+                "path": sel.path,
+            }
+        penalised = np.zeros(p + m, dtype=bool)
+        penalised[:p] = True
+        sol = solve_r(
+            red.combined(),
+            red.n_total,
+            names,
+            penalised=penalised,
+            ridge=float(self.ridge),
+            rcond=self.rcond,
+            columns=kept + required,
+        )
+        pk = len(kept)
+        coef = sol.coef[:pk]
+        offsets = sol.coef[pk:]
+        # [constant, coef] = L @ [coef, offsets]; constant = mean of the offsets
+        L = np.zeros((pk + 1, pk + m))
+        L[0, pk:] = 1.0 / m
+        L[1:, :pk] = np.eye(pk)
+        cov = L @ sol.cov @ L.T
+        if sol.condition_number > COND_WARN:
+            warnings.warn(
+                f"poly: ill-conditioned design (condition number {sol.condition_number:.3g}); "
+                f"{sol.n_truncated} singular value(s) truncated at rcond={self.rcond}; "
+                "consider fewer terms, --select or --ridge",
+                ConditioningWarning,
+                stacklevel=2,
+            )
+        tss = 0.0
+        ybar = sum(float(np.sum(y)) for y in ys) / n_total
+        for y in ys:
+            d = y - ybar
+            tss += float(d @ d)
+        self.terms_ = [terms[c] for c in kept]
+        self.scaling_ = scaling
+        self.coef_ = np.asarray(coef, dtype=np.float64)
+        self.offsets_ = np.asarray(offsets, dtype=np.float64)
+        self.constant_ = float(np.mean(offsets))
+        self.cov_ = cov
+        self.selection_ = selection
+        stats = FitStats(
+            n_samples=n_total,
+            n_coefficients=pk + 1,
+            rms_residual=math.sqrt(sol.rss / n_total),
+            condition_number=sol.condition_number,
+            r_squared=1.0 - sol.rss / tss if tss > 0 else None,
+            dof=sol.dof,
+            extra={
+                "rank": sol.rank,
+                "n_truncated": sol.n_truncated,
+                "rcond": self.rcond,
+                "ridge": float(self.ridge),
+                "solver": red.solver,
+                "n_runs": len(rl),
+                "per_run_offsets": [float(o) for o in offsets] if self.per_run_offset else None,
+                "terms": [t.name for t in self.terms_],
+                "selected_terms": selection["kept"] if selection else None,
+            },
+        )
+        self._record_common(rl, stats, rates=rates)
+        return self
+
+    def _evaluate(self, temps_c: FloatArray, rates: FloatArray | None) -> FloatArray:
+        n = temps_c.shape[0]
+        out = np.empty(n)
+        buf = np.empty((min(n, CHUNK_ROWS), len(self.terms_)))
+        for a in range(0, n, CHUNK_ROWS):
+            b = min(n, a + CHUNK_ROWS)
+            F = term_features(
+                self.terms_,
+                self.scaling_,
+                temps_c[a:b],
+                rates[a:b] if rates is not None else None,
+                out=buf[: b - a],
+            )
+            out[a:b] = F @ self.coef_ + self.constant_
+        return out
+
+    def _rate_sensors(self) -> list[int]:
+        return sorted({t.sensor for t in self.terms_ if t.uses_rate})
+
+    def predict(self, run: RunData, *, extrapolate: bool = False) -> FloatArray:
+        """Temperature-induced signal of every sample [signal unit] (module docstring steps 1–4)."""
+        self.check_fitted()
+        self._check_temps(run)
+        rates: FloatArray | None = None
+        if self.model_uses_rate:
+            rates = self.rates(run.time_s, run.temps_c)
+        temps = self.clamp(run.temps_c, extrapolate=extrapolate)
+        if rates is not None and self.rate_range_ is not None:
+            rates = clamp_rates(
+                rates,
+                self.rate_range_,
+                self.temp_names_,
+                self._rate_sensors(),
+                extrapolate=extrapolate,
+            )
+        return self._evaluate(temps, rates)
+
+    def stream(self, sample_interval_s: float, *, extrapolate: bool = False) -> PolyStream:
+        """Sample-by-sample twin of :meth:`predict` (needs the backward rate form)."""
+        self.check_fitted()
+        if self.model_uses_rate and self.rate_method != "backward":
+            raise ThermocalInputError(
+                f"streaming needs the causal 'backward' rate form; this model uses {self.rate_method!r}"
+            )
+        return PolyStream(self, sample_interval_s, extrapolate=extrapolate)
+
+    def coefficients(self) -> list[Coefficient]:
+        """Raw-monomial coefficients ``a`` of ``T_k^P Ṫ_k^Q`` with standard errors (seed form)."""
+        self.check_fitted()
+        keys, M = raw_expansion(self.terms_, self.scaling_)
+        beta = np.r_[self.constant_, self.coef_]
+        raw = M @ beta
+        cov = M @ self.cov_ @ M.T
+        se = np.sqrt(np.clip(np.diag(cov), 0.0, None))
+        out: list[Coefficient] = []
+        for key, v, s in zip(keys, raw, se, strict=True):
+            _k, P, Q = key
+            unit = self.signal_unit
+            if P:
+                unit += "/degC" + (f"^{P}" if P > 1 else "")
+            if Q:
+                unit += "/(degC/min)" + (f"^{Q}" if Q > 1 else "")
+            out.append(
+                Coefficient(
+                    name=monomial_name(key),
+                    value=float(v),
+                    stderr=float(s) if math.isfinite(s) else None,
+                    unit=unit,
+                )
+            )
+        return out
+
+    def scaled_coefficients(self) -> list[Coefficient]:
+        """Coefficients in the scaled basis actually evaluated (constant first)."""
+        self.check_fitted()
+        se = np.sqrt(np.clip(np.diag(self.cov_), 0.0, None))
+        names = ["const"] + [t.name for t in self.terms_]
+        vals = np.r_[self.constant_, self.coef_]
+        return [
+            Coefficient(n, float(v), float(s) if math.isfinite(s) else None, self.signal_unit)
+            for n, v, s in zip(names, vals, se, strict=True)
+        ]
+
+    # -- state --
+    def _state(self) -> dict[str, Any]:
+        return {
+            "layout": STATE_LAYOUT,
+            "n_sensors": int(self.scaling_.t_center.size),
+            "base": self.scaling_.to_list(self.temp_names_ if hasattr(self, "temp_names_") else ()),
+            "terms": [t.to_dict() for t in self.terms_],
+            "coef": [float(c) for c in self.coef_],
+            "constant": float(self.constant_),
+            "offsets": [float(o) for o in self.offsets_],
+            "cov": self.cov_.tolist(),
+            "uses_rate": self.model_uses_rate,
+            "rate": {
+                "method": self.rate_method,
+                "interval_s": float(self.rate_interval_s),
+                "gap_factor": GAP_FACTOR,
+                "unit": "degC/min",
+                "clamp": True,
+            },
+            "selection": self.selection_,
+        }
+
+    def _set_state(self, state: dict[str, Any]) -> None:
+        if state.get("layout") != STATE_LAYOUT:
+            raise ThermocalInputError(
+                f"poly model state layout {state.get('layout')!r} is not {STATE_LAYOUT!r}"
+            )
+        self.scaling_ = BaseScaling.from_list(state["base"])
+        self.terms_ = [Term.from_dict(t) for t in state["terms"]]
+        self.coef_ = np.asarray(state["coef"], dtype=np.float64)
+        self.constant_ = float(state["constant"])
+        self.offsets_ = np.asarray(state.get("offsets", []), dtype=np.float64)
+        self.cov_ = np.asarray(state["cov"], dtype=np.float64)
+        self.selection_ = state.get("selection")
+        if self.coef_.size != len(self.terms_):
+            raise ThermocalInputError("poly model state: coefficient and term counts differ")
+
+    def to_dict(self) -> dict[str, Any]:
+        d = super().to_dict()
+        if not self.model_uses_rate:
+            d["rate"] = None
+        return d
+
+
+class PolyStream(ModelStream):
+    """Sample-by-sample :class:`PolyModel` (module docstring steps 1–4).
+
+    Keeps the samples of the last Δt of the current contiguous segment for the
+    backward rate; a step longer than ``GAP_FACTOR × sample_interval_s`` starts
+    a new segment (rate restarts from 0).  Warns once per stream when a sample
+    leaves the fitted range.
+    """
+
+    def __init__(self, model: PolyModel, sample_interval_s: float, *, extrapolate: bool) -> None:
+        if not sample_interval_s > 0:
+            raise ThermocalInputError(f"sample interval must be positive, got {sample_interval_s}")
+        self.model = model
+        self.extrapolate = extrapolate
+        self.gap_s = GAP_FACTOR * float(sample_interval_s)
+        self.interval_s = float(model.rate_interval_s)
+        self.uses_rate = model.model_uses_rate
+        self.t_lo = model.temp_range_[:, 0]
+        self.t_hi = model.temp_range_[:, 1]
+        rr = model.rate_range_
+        self.r_lo = rr[:, 0] if rr is not None else None
+        self.r_hi = rr[:, 1] if rr is not None else None
+        self.rate_sensors = model._rate_sensors()
+        self.reset()
+
+    def reset(self) -> None:
+        self._buf: deque[tuple[float, FloatArray]] = deque()
+        self._last_t: float | None = None
+        self._warned: set[str] = set()
+
+    def _warn(self, what: str, msg: str) -> None:
+        if what not in self._warned:
+            self._warned.add(what)
+            warnings.warn(msg, ExtrapolationWarning, stacklevel=3)
+
+    def update(self, time_s: float, temps_c: FloatArray, signal: float | None = None) -> float:
+        t = float(time_s)
+        T = np.asarray(temps_c, dtype=np.float64).reshape(1, -1)
+        rates: FloatArray | None = None
+        if self.uses_rate:
+            if self._last_t is not None and t - self._last_t > self.gap_s:
+                self._buf.clear()
+            self._last_t = t
+            self._buf.append((t, T[0].copy()))
+            while self._buf[0][0] < t - self.interval_s:
+                self._buf.popleft()
+            t_lo, T_lo = self._buf[0]
+            span = t - t_lo
+            if span > 0:
+                rates = ((T[0] - T_lo) / span * SECONDS_PER_MINUTE).reshape(1, -1)
+            else:
+                rates = np.zeros_like(T)
+        action = "extrapolating" if self.extrapolate else "clamped to the fitted range"
+        if (T < self.t_lo).any() or (T > self.t_hi).any():
+            self._warn("T", f"temperature outside the model's fitted range; {action}")
+            if not self.extrapolate:
+                T = np.clip(T, self.t_lo, self.t_hi)
+        if rates is not None and self.r_lo is not None and self.r_hi is not None:
+            js = self.rate_sensors
+            if (rates[0, js] < self.r_lo[js]).any() or (rates[0, js] > self.r_hi[js]).any():
+                self._warn("R", f"temperature rate outside the model's fitted range; {action}")
+                if not self.extrapolate:
+                    rates = rates.copy()
+                    rates[0, js] = np.clip(rates[0, js], self.r_lo[js], self.r_hi[js])
+        return float(self.model._evaluate(T, rates)[0])

@@ -1,0 +1,76 @@
+"""Log-log Allan deviation plot with confidence bars and fitted noise lines.
+
+Plotting stays at the edge: matplotlib (Agg backend) is imported inside
+:func:`plot_allan` only, never by :mod:`thermocal.allan`.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from thermocal.allan import TERM_NAMES, AllanResult, NoiseTerms
+from thermocal.io import atomic_write_path
+
+
+def plot_allan(
+    result: AllanResult,
+    noise: NoiseTerms | None,
+    path: str | Path,
+    *,
+    title: str | None = None,
+) -> Path:
+    """Write a PNG: σ(τ) with its confidence bars, the fitted model and each
+    significant fitted term (IEEE 952 slope lines).  Written atomically."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(7.0, 5.0), dpi=110)
+    try:
+        yerr = np.vstack([result.adev - result.adev_low, result.adev_high - result.adev])
+        ax.errorbar(
+            result.tau_s,
+            result.adev,
+            yerr=yerr,
+            fmt="o",
+            ms=3.5,
+            capsize=2,
+            label=f"overlapping ADEV ({result.confidence:.1%} CI)",
+        )
+        if noise is not None and result.tau_s.size:
+            tt = np.geomspace(result.tau_s[0], result.tau_s[-1], 200)
+            ax.plot(tt, noise.fit_curve(tt), "k-", lw=1.2, label="least-squares fit")
+            for name in TERM_NAMES:
+                term = noise.fit.terms()[name]
+                if term.value is None:
+                    continue
+                ax.plot(
+                    tt,
+                    noise.term_curve(name, tt),
+                    "--",
+                    lw=0.9,
+                    label=f"{term.label}: {term.value:.4g} {term.unit}",
+                )
+        ax.set_xscale("log")
+        ax.set_yscale("log")
+        ax.set_xlabel("averaging time τ [s]")
+        ax.set_ylabel(f"Allan deviation [{result.unit}]")
+        ax.grid(True, which="both", alpha=0.3)
+        ax.legend(fontsize=7)
+        if title:
+            ax.set_title(title)
+        positive = result.adev_low[result.adev_low > 0]
+        if positive.size:
+            ax.set_ylim(bottom=float(np.min(positive)) / 2.0)
+        out = Path(path)
+
+        def _write(tmp: Path) -> None:
+            fig.savefig(tmp, format="png")
+
+        atomic_write_path(out, _write)
+    finally:
+        plt.close(fig)
+    return out

@@ -1,0 +1,351 @@
+"""Turntable calibration of a gyro triad: the pipeline (SPEC §7).
+
+:func:`calibrate` reads the gyro and encoder columns of a recording, checks the
+design (16 positions, dwells, both axes moving), estimates the angle random walk
+from the dwells, runs the Kalman filter (:mod:`.kalman`, the reported estimate)
+and the batch least squares (:mod:`.estimate_ls`, the cross-check), and computes
+the Cramér–Rao bound of the design (:func:`.model.fisher_information`).
+"""
+
+from __future__ import annotations
+
+import warnings
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+import numpy.typing as npt
+
+from thermocal import units
+from thermocal.errors import MissingValueError, ThermocalInputError
+from thermocal.recording import Recording
+from thermocal.turntable import estimate_ls, kalman, model, schedule
+from thermocal.turntable.schedule import TurntableWarning
+
+FloatArray = npt.NDArray[np.float64]
+
+RESULT_FORMAT = "thermocal-turntable-result"
+RESULT_VERSION = 1
+DEFAULT_GYRO_COLUMNS = ("gyro_x", "gyro_y", "gyro_z")
+DEFAULT_PRIOR_SIGMA = (1.0, 1000.0, 3600.0)
+"""Initial σ of the filter's coefficients: bias [°/h], scale factor [ppm], misalignment [″]."""
+
+CONSTRAINTS = (
+    {
+        "combination": "rotation of the triad about the inner axis (yx - xy)/2 vs the "
+        "inner-axis encoder zero offset",
+        "status": "indistinguishable",
+        "handling": "constraint: the inner encoder zero is exact and defines the body x "
+        "azimuth; the rotation is reported in yx, xy and as inner_axis_azimuth_arcsec",
+    },
+    {
+        "combination": "outer-axis encoder zero offset / base levelling and north alignment",
+        "status": "seen only through the earth rate; not estimated",
+        "handling": "constraint: zero (SPEC §7 levelled, aligned base)",
+    },
+)
+
+
+@dataclass(frozen=True)
+class Estimate:
+    """One estimator's coefficients θ (12, units of :mod:`.model`) and covariance."""
+
+    theta: FloatArray
+    cov: FloatArray
+
+    @property
+    def sigma(self) -> FloatArray:
+        out: FloatArray = np.sqrt(np.maximum(np.diag(self.cov), 0.0))
+        return out
+
+    def to_dict(self) -> dict[str, Any]:
+        return _coeff_dict(self.theta, self.sigma, self.cov)
+
+
+def _coeff_dict(theta: FloatArray, sigma: FloatArray, cov: FloatArray | None) -> dict[str, Any]:
+    e, _ = model.error_matrix_from_coeffs(theta)
+    az, az_sigma = model.inner_axis_azimuth(theta, cov)
+    return {
+        "bias_deg_h": theta[0:3].tolist(),
+        "bias_deg_h_sigma": sigma[0:3].tolist(),
+        "scale_factor_ppm": theta[3:6].tolist(),
+        "scale_factor_ppm_sigma": sigma[3:6].tolist(),
+        "misalignment_arcsec": theta[6:12].tolist(),
+        "misalignment_arcsec_sigma": sigma[6:12].tolist(),
+        "error_matrix": e.tolist(),
+        "inner_axis_azimuth_arcsec": az,
+        "inner_axis_azimuth_arcsec_sigma": az_sigma,
+    }
+
+
+@dataclass(frozen=True)
+class TurntableResult:
+    """Result of :func:`calibrate`.
+
+    ``kalman`` is the reported estimate (SPEC §7), ``least_squares`` the cross-check,
+    ``crb`` the Cramér–Rao bound σ of each coefficient for this design and noise (12,
+    units of :mod:`.model`), ``agreement`` the largest |θ_KF − θ_LS| / σ_LS,
+    ``weak_combinations`` the poorly determined directions found in the design,
+    ``arw_deg_sqrt_h`` the angle random walk of each gyro [°/√h]."""
+
+    kalman: Estimate
+    least_squares: Estimate
+    crb: FloatArray
+    agreement: float
+    latitude_deg: float
+    arw_deg_sqrt_h: FloatArray
+    n_channels: int
+    n_states: int
+    n_positions: int
+    n_dwells: int
+    min_dwell_s: float
+    duration_s: float
+    chi2_per_dof: float
+    normalised_innovation_rms: float
+    weak_combinations: tuple[dict[str, Any], ...] = ()
+    warnings: tuple[str, ...] = field(default=())
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready dict with the INTERFACE.md keys (from the Kalman filter)."""
+        out: dict[str, Any] = {"format": RESULT_FORMAT, "version": RESULT_VERSION}
+        out.update(self.kalman.to_dict())
+        out["misalignment_names"] = list(model.MISALIGNMENT_NAMES)
+        out["misalignment_error_matrix_index"] = [
+            list(model.MISALIGNMENT_INDEX[n]) for n in model.MISALIGNMENT_NAMES
+        ]
+        out["crb"] = {
+            "bias_deg_h": self.crb[0:3].tolist(),
+            "scale_factor_ppm": self.crb[3:6].tolist(),
+            "misalignment_arcsec": self.crb[6:12].tolist(),
+        }
+        out["method"] = f"kalman ({self.n_states} states)"
+        out["least_squares"] = self.least_squares.to_dict()
+        out["agreement_max_sigma"] = self.agreement
+        out["latitude_deg"] = self.latitude_deg
+        out["arw_deg_sqrt_h"] = self.arw_deg_sqrt_h.tolist()
+        out["channels"] = list(model.CHANNEL_NAMES[: self.n_channels])
+        out["n_positions"] = self.n_positions
+        out["n_dwells"] = self.n_dwells
+        out["min_dwell_s"] = self.min_dwell_s
+        out["duration_s"] = self.duration_s
+        out["chi2_per_dof"] = self.chi2_per_dof
+        out["normalised_innovation_rms"] = self.normalised_innovation_rms
+        out["unobservable"] = [dict(c) for c in CONSTRAINTS] + [
+            dict(c) for c in self.weak_combinations
+        ]
+        out["warnings"] = list(self.warnings)
+        return out
+
+
+def _gyro_rad_s(rec: Recording, cols: Sequence[str], unit: str | None) -> FloatArray:
+    out = []
+    for c in cols:
+        v = rec.column(c)
+        u = unit or rec.units.get(c) or "deg/s"
+        out.append(units.convert(v, u, "rad/s"))
+    return np.column_stack(out)
+
+
+def _check_finite(rec: Recording, cols: Sequence[str]) -> None:
+    for c in cols:
+        bad = np.flatnonzero(~np.isfinite(rec.column(c)))
+        if bad.size:
+            raise MissingValueError(
+                f"{rec.name}: column {c!r} has {bad.size} missing/non-finite values, "
+                f"first at row {bad[0]}"
+            )
+
+
+def estimate_arw(
+    gyro_rad_s: FloatArray, dt_s: FloatArray, dwells: Sequence[schedule.Dwell]
+) -> FloatArray:
+    """Angle random walk of each gyro [rad/√s] from the scatter at rest:
+    ``N² = τ · Σ_d Σ_i (g_i − ḡ_d)² / Σ_d (n_d − 1)`` over the dwells (white rate noise
+    of the mean rate over τ has variance N²/τ; IEEE Std 952 annex C)."""
+    ss = np.zeros(3)
+    dof = 0
+    tau = []
+    for d in dwells:
+        g = gyro_rad_s[1:][d.start : d.stop]
+        if g.shape[0] < 2:
+            continue
+        ss += np.sum((g - g.mean(axis=0)) ** 2, axis=0)
+        dof += g.shape[0] - 1
+        tau.append(dt_s[d.start : d.stop])
+    if dof == 0:
+        raise ThermocalInputError("no dwell long enough to estimate the gyro noise")
+    tau_med = float(np.median(np.concatenate(tau)))
+    out: FloatArray = np.sqrt(ss / dof * tau_med)
+    return out
+
+
+def weak_combinations(
+    info: FloatArray, info_static: FloatArray, static_fraction: float, *, ratio: float = 10.0
+) -> tuple[dict[str, Any], ...]:
+    """Scale factors and misalignments seen only through the earth rate.
+
+    The earth rate gives about ``info_static / static_fraction`` over the whole run
+    (``static_fraction`` the share of time at rest); a coefficient whose total
+    information (diagonal) is less than ``ratio`` times that owes nothing to the
+    rotations.  Static data alone separate such terms only to hundreds of ppm or ″."""
+    out = []
+    earth = np.diag(info_static) / max(static_fraction, 1e-12)
+    d_all = np.diag(info)
+    for i in range(3, model.N_COEFFS):
+        gain = float(d_all[i] / earth[i]) if earth[i] > 0 else float("inf")
+        if gain < ratio:
+            out.append(
+                {
+                    "combination": model.COEFF_NAMES[i],
+                    "status": "weakly observable: seen only through the earth rate",
+                    "information_over_earth_rate_only": gain,
+                }
+            )
+    return tuple(out)
+
+
+def calibrate(
+    rec: Recording,
+    latitude_deg: float | None = None,
+    *,
+    gyro_columns: Sequence[str] = DEFAULT_GYRO_COLUMNS,
+    alpha_column: str = "alpha_deg",
+    beta_column: str = "beta_deg",
+    gyro_unit: str | None = None,
+    arw_deg_sqrt_h: float | Sequence[float] | None = None,
+    encoder_noise_arcsec: float = 0.0,
+    channels: int = 3,
+    min_positions: int = 16,
+    min_dwell_s: float = 60.0,
+    move_block_s: float = 1.0,
+    kf_interval_s: float = 1.0,
+    prior_sigma: tuple[float, float, float] = DEFAULT_PRIOR_SIGMA,
+) -> TurntableResult:
+    """Calibrate a gyro triad from a 16-position dual-axis turntable run (SPEC §7).
+
+    Parameters
+    ----------
+    rec : the recording: time [s], gyro mean rates over the interval ending at each
+        sample, encoder angles α, β at the sample times [°] (wrapped or not).
+    latitude_deg : site latitude L [°] (default: the recording's metadata).
+    gyro_columns, alpha_column, beta_column : column names.
+    gyro_unit : unit of the gyro columns (default: the recording's, else deg/s).
+    arw_deg_sqrt_h : angle random walk [°/√h], scalar or per axis; estimated from the
+        dwells when None.
+    encoder_noise_arcsec : white noise σ of the encoder readings [″].
+    channels : 3 (Δα, Δβ, Δγ; 15-state filter) or 2 (the SPEC's Δα, Δβ; 14 states).
+    min_positions, min_dwell_s : design checks (:func:`.schedule.check_design`).
+    move_block_s : least squares: rotations cut into increments of at most this [s].
+    kf_interval_s : filter measurement interval [s] (at rest and while rotating).
+    prior_sigma : filter's initial σ of bias [°/h], scale factor [ppm], misalignment [″].
+
+    Raises
+    ------
+    MissingColumnError, MissingValueError : absent or incomplete columns.
+    TurntableScheduleError : fewer positions, dwells shorter than asked, an axis that
+        never moves.
+    """
+    if channels not in (2, 3):
+        raise ThermocalInputError(f"channels must be 2 or 3, got {channels}")
+    lat = latitude_deg if latitude_deg is not None else rec.meta.latitude_deg
+    if lat is None:
+        raise ThermocalInputError(f"{rec.name}: give the latitude (--latitude DEG)")
+    if not -90.0 <= lat <= 90.0:
+        raise ThermocalInputError(f"latitude {lat} is outside [-90, 90]°")
+    cols = [*gyro_columns, alpha_column, beta_column]
+    if len(gyro_columns) != 3:
+        raise ThermocalInputError("name exactly three gyro columns (x, y, z)")
+    rec.validate(required=cols)
+    _check_finite(rec, cols)
+    t = rec.time_s
+    if t.size < 3:
+        raise ThermocalInputError(f"{rec.name}: too few samples")
+    g = _gyro_rad_s(rec, gyro_columns, gyro_unit)
+    a_deg = np.unwrap(rec.column(alpha_column), period=360.0)
+    b_deg = np.unwrap(rec.column(beta_column), period=360.0)
+    full = model.interval_model(t, g, a_deg * units.DEG_TO_RAD, b_deg * units.DEG_TO_RAD, lat)
+    schedule.warn_gaps(rec.name, t, full.valid)
+    seg = schedule.segment(t, a_deg, b_deg, full.moving, full.valid)
+    dt_med = float(np.median(full.dt_s))
+    schedule.check_design(
+        seg,
+        name=rec.name,
+        alpha_col=alpha_column,
+        beta_col=beta_column,
+        min_positions=min_positions,
+        min_dwell_s=min_dwell_s,
+        dwell_tolerance_s=max(2.0 * dt_med, 0.005 * min_dwell_s),
+    )
+    m = full.select_channels(channels)
+    if arw_deg_sqrt_h is None:
+        arw = estimate_arw(g, full.dt_s, seg.dwells)
+    else:
+        arw = np.asarray(arw_deg_sqrt_h, dtype=np.float64) * np.ones(3)
+        arw = arw * units.DEG_TO_RAD / np.sqrt(units.SECONDS_PER_HOUR)
+    arw_dh = arw * units.RAD_TO_DEG * np.sqrt(units.SECONDS_PER_HOUR)
+
+    hw = model.whitened_regressors(m, arw)
+    info = model.fisher_information(m, arw, whitened=hw)
+    crb_cov = np.linalg.pinv(info, hermitian=True)
+    crb = np.sqrt(np.maximum(np.diag(crb_cov), 0.0))
+
+    # with perfect encoders a dwell's increments are a sufficient statistic; with encoder
+    # noise each reading at rest adds information, so the dwells are cut like the filter's
+    ls_blocks = estimate_ls.make_blocks(
+        m,
+        arw,
+        max_static_block_s=kf_interval_s if encoder_noise_arcsec > 0 else None,
+        max_move_block_s=move_block_s,
+    )
+    ls = estimate_ls.solve_ls(ls_blocks, encoder_noise_arcsec=encoder_noise_arcsec)
+    kf_blocks = estimate_ls.make_blocks(
+        m, arw, max_static_block_s=kf_interval_s, max_move_block_s=kf_interval_s
+    )
+    prior = np.repeat(np.asarray(prior_sigma, dtype=np.float64), [3, 3, 6])
+    kf = kalman.run_filter(kf_blocks, prior, encoder_noise_arcsec=encoder_noise_arcsec)
+
+    msgs: list[str] = []
+    agreement = float(np.max(np.abs(kf.theta - ls.theta) / np.maximum(ls.sigma, 1e-300)))
+    if agreement > 1.0:
+        msgs.append(
+            f"Kalman filter and least squares differ by up to {agreement:.2g} σ "
+            "(prior too tight, or model mismatch)"
+        )
+    chi2 = ls.chi2 / max(ls.dof, 1)
+    if ls.dof > 0 and chi2 > 1.0 + 5.0 * np.sqrt(2.0 / ls.dof):
+        msgs.append(
+            f"least-squares residuals are {np.sqrt(chi2):.3g}× the white-noise level: "
+            "noise other than angle random walk, or an error not in the model; "
+            "the σ are optimistic"
+        )
+    info_static = model.fisher_information(m, arw, ~m.moving, whitened=hw)
+    static_fraction = float(np.sum(m.dt_s[m.valid & ~m.moving]) / np.sum(m.dt_s[m.valid]))
+    weak = weak_combinations(info, info_static, static_fraction)
+    for w in weak:
+        msgs.append(f"weakly observable combination: {w['combination']}")
+    for msg in msgs:
+        warnings.warn(f"{rec.name}: {msg}", TurntableWarning, stacklevel=2)
+    return TurntableResult(
+        kalman=estimate_from(kf.theta, kf.cov),
+        least_squares=estimate_from(ls.theta, ls.cov),
+        crb=crb,
+        agreement=agreement,
+        latitude_deg=float(lat),
+        arw_deg_sqrt_h=arw_dh,
+        n_channels=channels,
+        n_states=kf.n_states,
+        n_positions=seg.n_positions,
+        n_dwells=len(seg.dwells),
+        min_dwell_s=float(min(d.duration_s for d in seg.dwells)),
+        duration_s=rec.duration_s,
+        chi2_per_dof=chi2,
+        normalised_innovation_rms=kf.normalised_innovation_rms,
+        weak_combinations=weak,
+        warnings=tuple(msgs),
+    )
+
+
+def estimate_from(theta: FloatArray, cov: FloatArray) -> Estimate:
+    """Wrap θ and its covariance."""
+    return Estimate(theta=np.asarray(theta, dtype=np.float64), cov=np.asarray(cov))

@@ -1,0 +1,364 @@
+"""Validating a compensation model on a weakly correlated test (SPEC §5, seed 000).
+
+A model is judged on a test it was not fitted to, whose temperature history is
+not a copy of the modelling test's:
+
+1. **Correlation** of the ambient temperature histories X (modelling test) and
+   Y (validation test) on a common elapsed-time base,
+   ``r = Cov(X, Y)/(σ_X σ_Y)`` (:func:`thermocal.profiles.correlate`); the
+   validation test is *weakly correlated* when ``r < 0.4``.  A test that is not
+   gets a :class:`~thermocal.errors.CorrelationWarning`, not a refusal.
+2. **Compensation**: ``F' = F − ŷ(T, Ṫ, …)`` with the model
+   (:func:`thermocal.compensate.compensate_run`).
+3. **Hold stages**: the temperature-hold stages of the validation run are cut
+   out (:func:`thermocal.preprocess.segment_holds` on the ambient column) and,
+   before and after compensation, within each stage s:
+
+   * bias ``B0_s = mean(F)`` over the stage (SPEC §1);
+   * bias stability ``Bs_s = sqrt(Σ (F̄_j − mean F̄)²/(q − 1))`` of the q averages
+     ``F̄_j`` over complete blocks of ``round(averaging_s/τ0)`` samples from the
+     stage's first sample (:func:`thermocal.metrics.block_means`; SPEC §1);
+
+   and across the p stages:
+
+   * ``bias_stability = sqrt((1/p') Σ_s Bs_s²)`` — the **rms over the stages**
+     (our choice: the rms is the stability a user sees over a typical stage and
+     is not pulled down by short, quiet stages as a median would be; p' counts
+     the stages with ≥ 2 complete blocks);
+   * ``bias_repeatability Br = sqrt(Σ (B0_s − mean B0)²/(p − 1))`` (SPEC §1).
+
+4. **Whole run**: on the averages over ``averaging_s`` of the whole run (never
+   across a gap), after removing their mean, ``rms = sqrt(mean(F̄_j − mean F̄)²)``
+   and ``peak_to_peak = max F̄_j − min F̄_j``.
+5. ``improvement_pct[x] = 100 (x_before − x_after)/x_before`` for each figure.
+
+All figures are in the model's signal unit ([°/h] or [mg]).
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+import numpy.typing as npt
+
+from thermocal import metrics
+from thermocal.compensate import compensate_run
+from thermocal.errors import (
+    CorrelationWarning,
+    ThermocalInputError,
+    ThermocalWarning,
+    TimestampError,
+)
+from thermocal.models.base import RunData, TemperatureModel
+from thermocal.preprocess import segment_holds
+from thermocal.profiles import WEAK_CORRELATION_LIMIT, correlate
+from thermocal.recording import FloatArray, median_interval
+
+DEFAULT_AVERAGING_S = 100.0
+"""Averaging time of the stability figures [s] (SPEC §1: 10 s or 100 s averages)."""
+
+
+@dataclass(frozen=True)
+class StageFigures:
+    """Figures of one temperature-hold stage, before and after compensation [signal unit]."""
+
+    index: int
+    start_s: float
+    stop_s: float
+    mean_temp_c: float
+    n_samples: int
+    n_averages: int
+    bias_before: float
+    bias_after: float
+    bias_stability_before: float
+    bias_stability_after: float
+
+    @property
+    def duration_s(self) -> float:
+        return self.stop_s - self.start_s
+
+    def to_dict(self) -> dict[str, Any]:
+        d = {k: getattr(self, k) for k in self.__dataclass_fields__}
+        d["duration_s"] = self.duration_s
+        return d
+
+
+@dataclass(frozen=True)
+class ValidationResult:
+    """Result of :func:`validate`; :meth:`to_dict` gives the ``--json`` keys of INTERFACE.md.
+
+    ``r`` and ``weakly_correlated`` are ``None`` when no modelling history was given.
+    """
+
+    r: float | None
+    weakly_correlated: bool | None
+    r_limit: float
+    n_stages: int
+    stages: tuple[StageFigures, ...]
+    bias_stability_before: float
+    bias_stability_after: float
+    bias_repeatability_before: float
+    bias_repeatability_after: float
+    rms_before: float
+    rms_after: float
+    peak_to_peak_before: float
+    peak_to_peak_after: float
+    averaging_s: float
+    unit: str
+    n_samples: int
+    warnings: tuple[str, ...] = ()
+    extra: dict[str, Any] = field(default_factory=dict)
+
+    @property
+    def improvement_pct(self) -> dict[str, float | None]:
+        """``100 (before − after)/before`` for each figure (None when undefined)."""
+        out: dict[str, float | None] = {}
+        for key in ("bias_stability", "bias_repeatability", "rms", "peak_to_peak"):
+            b = float(getattr(self, f"{key}_before"))
+            a = float(getattr(self, f"{key}_after"))
+            out[key] = 100.0 * (b - a) / b if math.isfinite(a) and math.isfinite(b) and b else None
+        return out
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready dict (NaN → None)."""
+
+        def num(x: float | None) -> float | None:
+            return None if x is None or not math.isfinite(x) else float(x)
+
+        d: dict[str, Any] = {
+            "r": num(self.r),
+            "weakly_correlated": self.weakly_correlated,
+            "r_limit": self.r_limit,
+            "n_stages": self.n_stages,
+            "bias_stability_before": num(self.bias_stability_before),
+            "bias_stability_after": num(self.bias_stability_after),
+            "bias_repeatability_before": num(self.bias_repeatability_before),
+            "bias_repeatability_after": num(self.bias_repeatability_after),
+            "rms_before": num(self.rms_before),
+            "rms_after": num(self.rms_after),
+            "peak_to_peak_before": num(self.peak_to_peak_before),
+            "peak_to_peak_after": num(self.peak_to_peak_after),
+            "improvement_pct": {k: num(v) for k, v in self.improvement_pct.items()},
+            "averaging_s": self.averaging_s,
+            "unit": self.unit,
+            "n_samples": self.n_samples,
+            "stages": [
+                {k: (num(v) if isinstance(v, float) else v) for k, v in s.to_dict().items()}
+                for s in self.stages
+            ],
+            "warnings": list(self.warnings),
+        }
+        d.update(self.extra)
+        return d
+
+
+# --- pure figure functions -----------------------------------------------------------------
+
+
+def block_means(time_s: FloatArray, x: FloatArray, averaging_s: float, tau0_s: float) -> FloatArray:
+    """Averages of ``x`` over complete consecutive blocks of ``m = round(averaging_s/τ0)``
+    samples from the first sample, never across a gap (:func:`thermocal.metrics.block_means`)."""
+    return metrics.block_means(x, tau0_s, averaging_s, time_s=time_s)
+
+
+def stability_of_means(means: FloatArray) -> float:
+    """``sqrt(Σ (x̄_j − mean x̄)²/(m − 1))`` (SPEC §1 Bs); NaN for fewer than 2 averages."""
+    return float(np.std(means, ddof=1)) if means.size >= 2 else float("nan")
+
+
+def repeatability(biases: npt.ArrayLike) -> float:
+    """``Br = sqrt(Σ_{i=1..p} (B0_i − mean B0)²/(p − 1))`` (SPEC §1); NaN for p < 2."""
+    b = np.asarray(biases, dtype=np.float64)
+    return metrics.bias_repeatability(b) if b.size >= 2 else float("nan")
+
+
+def rms_over_stages(values: npt.ArrayLike) -> float:
+    """``sqrt((1/p') Σ v_s²)`` over the finite values (NaN when none)."""
+    v = np.asarray(values, dtype=np.float64)
+    v = v[np.isfinite(v)]
+    return float(np.sqrt(np.mean(v * v))) if v.size else float("nan")
+
+
+def run_rms_and_peak_to_peak(
+    time_s: FloatArray, x: FloatArray, averaging_s: float, tau0_s: float
+) -> tuple[float, float]:
+    """Whole-run ``rms = sqrt(mean((x̄_j − mean x̄)²))`` and ``max x̄_j − min x̄_j`` of the
+    averages over ``averaging_s`` (SPEC §1 peak-to-peak; mean removed)."""
+    m = block_means(time_s, x, averaging_s, tau0_s)
+    if m.size == 0:
+        return float("nan"), float("nan")
+    d = m - m.mean()
+    return float(np.sqrt(np.mean(d * d))), float(m.max() - m.min())
+
+
+# --- validation -----------------------------------------------------------------------------
+
+
+def validate(
+    model: TemperatureModel,
+    run_validation: RunData,
+    modeling_ambient: tuple[npt.ArrayLike, npt.ArrayLike] | None = None,
+    *,
+    validation_ambient: npt.ArrayLike | None = None,
+    averaging_s: float = DEFAULT_AVERAGING_S,
+    r_limit: float = WEAK_CORRELATION_LIMIT,
+    rate_threshold_c_per_min: float = 0.05,
+    min_stage_s: float = 600.0,
+    settle_s: float = 0.0,
+    extrapolate: bool = False,
+) -> ValidationResult:
+    """Judge ``model`` on an independent test (SPEC §5; the module docstring gives the formulas).
+
+    Parameters
+    ----------
+    model : a fitted model; figures are in ``model.signal_unit``.
+    run_validation : the validation run (signal in the model's unit).
+    modeling_ambient : ``(time_s, temp_c)`` of the modelling test's ambient temperature,
+        or ``None`` (then ``r`` is ``None`` and a :class:`CorrelationWarning` says so).
+    validation_ambient : the validation test's ambient temperature [°C], shape (n,);
+        default: the run's first temperature column.
+    averaging_s : averaging time of the stability, rms and peak-to-peak figures [s].
+    rate_threshold_c_per_min, min_stage_s, settle_s : hold detection
+        (:func:`thermocal.preprocess.segment_holds` on the ambient temperature).
+    extrapolate : evaluate the model outside its fitted range instead of clamping.
+
+    Warns
+    -----
+    CorrelationWarning : the validation test is not weakly correlated (``r ≥ r_limit``),
+        or no modelling history was given.
+    ThermocalWarning : fewer than two hold stages (repeatability undefined).
+    """
+    if run_validation.signal is None:
+        raise ThermocalInputError(f"{run_validation.name or 'validation run'}: no signal")
+    if not averaging_s > 0:
+        raise ThermocalInputError(f"averaging time must be positive, got {averaging_s}")
+    t = run_validation.time_s
+    amb = (
+        run_validation.temps_c[:, 0]
+        if validation_ambient is None
+        else np.asarray(validation_ambient, dtype=np.float64)
+    )
+    if amb.shape != t.shape:
+        raise ThermocalInputError("validation ambient temperature and time differ in length")
+    notes: list[str] = []
+
+    def note(msg: str, cat: type[Warning]) -> None:
+        notes.append(msg)
+        warnings.warn(msg, cat, stacklevel=3)
+
+    # 1. correlation of the ambient histories
+    r: float | None = None
+    weak: bool | None = None
+    if modeling_ambient is None:
+        note(
+            "no modelling-test temperature history: the correlation r was not computed (null)",
+            CorrelationWarning,
+        )
+    else:
+        try:
+            cr = correlate(modeling_ambient[0], modeling_ambient[1], t, amb, r_limit=r_limit)
+        except TimestampError:
+            raise
+        except ThermocalInputError as exc:  # e.g. a constant history: r undefined
+            note(f"the correlation r could not be computed: {exc}", CorrelationWarning)
+        else:
+            r, weak = cr.r, cr.weakly_correlated
+        if weak is False:
+            note(
+                f"the validation test is not weakly correlated with the modelling test: "
+                f"r = {r:.3f} ≥ {r_limit}",
+                CorrelationWarning,
+            )
+
+    # 2. compensation
+    comp = compensate_run(model, run_validation, extrapolate=extrapolate)
+    tau0 = median_interval(t)
+    if not (math.isfinite(tau0) and tau0 > 0):
+        raise ThermocalInputError("the validation run needs at least two increasing times")
+    before = run_validation.signal
+    after = comp.corrected
+
+    # 3. hold stages
+    segs = [
+        s
+        for s in segment_holds(
+            t,
+            amb,
+            rate_threshold_c_per_min=rate_threshold_c_per_min,
+            min_duration_s=min_stage_s,
+            settle_s=settle_s,
+        )
+        if s.kind == "hold"
+    ]
+    stages: list[StageFigures] = []
+    for i, s in enumerate(segs):
+        sl = s.slice
+        ts = t[sl]
+        mb = block_means(ts, before[sl], averaging_s, tau0)
+        ma = block_means(ts, after[sl], averaging_s, tau0)
+        stages.append(
+            StageFigures(
+                index=i,
+                start_s=s.start_s,
+                stop_s=s.stop_s,
+                mean_temp_c=s.mean_temp_c,
+                n_samples=int(ts.size),
+                n_averages=int(mb.size),
+                bias_before=metrics.bias(before[sl]),
+                bias_after=metrics.bias(after[sl]),
+                bias_stability_before=stability_of_means(mb),
+                bias_stability_after=stability_of_means(ma),
+            )
+        )
+    if len(stages) < 2:
+        note(
+            f"{len(stages)} temperature-hold stage(s) found (|Ṫ| < {rate_threshold_c_per_min} "
+            f"°C/min for ≥ {min_stage_s:g} s): bias repeatability needs at least 2",
+            ThermocalWarning,
+        )
+    short = [s.index for s in stages if s.n_averages < 2]
+    if short:
+        note(
+            f"stage(s) {', '.join(map(str, short))} hold fewer than 2 averages of "
+            f"{averaging_s:g} s: left out of the bias stability",
+            ThermocalWarning,
+        )
+
+    rms_b, ptp_b = run_rms_and_peak_to_peak(t, before, averaging_s, tau0)
+    rms_a, ptp_a = run_rms_and_peak_to_peak(t, after, averaging_s, tau0)
+    return ValidationResult(
+        r=r,
+        weakly_correlated=weak,
+        r_limit=r_limit,
+        n_stages=len(stages),
+        stages=tuple(stages),
+        bias_stability_before=rms_over_stages([s.bias_stability_before for s in stages]),
+        bias_stability_after=rms_over_stages([s.bias_stability_after for s in stages]),
+        bias_repeatability_before=repeatability([s.bias_before for s in stages]),
+        bias_repeatability_after=repeatability([s.bias_after for s in stages]),
+        rms_before=rms_b,
+        rms_after=rms_a,
+        peak_to_peak_before=ptp_b,
+        peak_to_peak_after=ptp_a,
+        averaging_s=float(averaging_s),
+        unit=model.signal_unit,
+        n_samples=run_validation.n_samples,
+        warnings=tuple(notes),
+    )
+
+
+__all__ = [
+    "DEFAULT_AVERAGING_S",
+    "StageFigures",
+    "ValidationResult",
+    "block_means",
+    "repeatability",
+    "rms_over_stages",
+    "run_rms_and_peak_to_peak",
+    "stability_of_means",
+    "validate",
+]

@@ -1,0 +1,568 @@
+"""Tests of the HTML report (thermocal.report): numbers, self-containment, figures,
+and a real headless-Chromium rendering (screenshot, console errors, images loaded).
+
+The report is built here on a small synthetic chamber test with a test-only
+linear model family (so the report is tested independently of the other model
+families); the demo test (tests/test_demo.py) renders the full workflow.
+"""
+
+from __future__ import annotations
+
+import base64
+import html
+import json
+import math
+import os
+import re
+import shutil
+import subprocess
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any, ClassVar, Self
+
+import numpy as np
+import pytest
+from numpy.testing import assert_allclose
+from scipy.signal import lfilter
+
+from thermocal.errors import ThermocalInputError
+from thermocal.io import write_json, write_recording
+from thermocal.models.base import (
+    MODEL_REGISTRY,
+    Coefficient,
+    FitStats,
+    ModelStream,
+    RunData,
+    TemperatureModel,
+    register,
+    save_model,
+)
+from thermocal.recording import FloatArray, Metadata, Recording
+from thermocal.report import (
+    ModelEntry,
+    ReportInputs,
+    build_report,
+    fmt_num,
+    improvement_pct,
+    write_report,
+)
+from thermocal.report.figures import decimate_for_plot
+
+CHROMIUM = Path("/usr/bin/chromium")
+TRUE_SLOPE = 0.05  # [°/h/°C] of the synthetic gyro on T1
+TRUE_OFFSET = 1.5  # [°/h]
+
+
+# --- a test-only model family: bias = c0 + c1 T1 ----------------------------------------
+
+
+class _LinearStream(ModelStream):
+    def __init__(self, coef: FloatArray) -> None:
+        self.coef = coef
+
+    def update(self, time_s: float, temps_c: FloatArray, signal: float | None = None) -> float:
+        return float(self.coef[0] + self.coef[1] * temps_c[0])
+
+    def reset(self) -> None:
+        pass
+
+
+class ReportTestLinear(TemperatureModel):
+    """bias = c0 + c1·T (first channel); least squares with numpy.linalg.lstsq."""
+
+    family: ClassVar[str] = "report-test-linear"
+
+    def __init__(self, *, note: str | None = None) -> None:
+        self.note = note
+
+    def fit(self, runs: Sequence[RunData]) -> Self:
+        t = np.concatenate([r.temps_c[:, 0] for r in runs])
+        y = np.concatenate([r.target() for r in runs])
+        x = np.column_stack([np.ones_like(t), t])
+        coef, *_ = np.linalg.lstsq(x, y, rcond=None)
+        res = y - x @ coef
+        s2 = float(res @ res) / (y.size - 2)
+        _q, r = np.linalg.qr(x)
+        rinv = np.linalg.solve(r, np.eye(2))
+        self.coef_ = coef
+        self.se_ = np.sqrt(s2 * np.sum(rinv**2, axis=1))
+        self._record_common(
+            runs,
+            FitStats(y.size, 2, float(np.sqrt(np.mean(res**2))), 12.5, 0.99, y.size - 2),
+        )
+        return self
+
+    def predict(self, run: RunData, *, extrapolate: bool = False) -> FloatArray:
+        temps = self.clamp(run.temps_c, extrapolate=extrapolate)
+        out: FloatArray = self.coef_[0] + self.coef_[1] * temps[:, 0]
+        return out
+
+    def stream(self, sample_interval_s: float, *, extrapolate: bool = False) -> ModelStream:
+        return _LinearStream(self.coef_)
+
+    def coefficients(self) -> list[Coefficient]:
+        return [
+            Coefficient("a0", float(self.coef_[0]), float(self.se_[0]), "deg/h"),
+            Coefficient("T1", float(self.coef_[1]), float(self.se_[1]), "deg/h/degC"),
+        ]
+
+    def _state(self) -> dict[str, Any]:
+        return {"coef": self.coef_.tolist(), "se": self.se_.tolist()}
+
+    def _set_state(self, state: dict[str, Any]) -> None:
+        self.coef_ = np.asarray(state["coef"], dtype=np.float64)
+        self.se_ = np.asarray(state["se"], dtype=np.float64)
+
+
+if ReportTestLinear.family not in MODEL_REGISTRY:
+    register(ReportTestLinear)
+
+
+# --- synthetic chamber runs -----------------------------------------------------------------
+
+
+def _run(seed: int, hours: float, period_h: float, lo: float, hi: float, name: str) -> Recording:
+    """1 Hz gyro [°/h] with bias = 1.5 + 0.05·T1 + white noise; T1…T3 lag the chamber."""
+    rng = np.random.default_rng(seed)
+    t = np.arange(0.0, hours * 3600.0, 1.0)
+    chamber = (lo + hi) / 2 + (hi - lo) / 2 * np.sign(np.sin(2 * np.pi * t / (period_h * 3600)))
+    temps = {}
+    for k, lag_s in enumerate((400.0, 900.0, 1500.0), start=1):
+        # first-order lag y_i = d·y_{i−1} + (1 − d)·u_i, exact at 1 s, starting at u_0
+        d = math.exp(-1.0 / lag_s)
+        y, _ = lfilter([1.0 - d], [1.0, -d], chamber, zi=[d * chamber[0]])
+        temps[f"T{k}"] = y
+    gyro = TRUE_OFFSET + TRUE_SLOPE * temps["T1"] + rng.normal(0.0, 0.02, t.size)
+    rec = Recording.from_arrays(
+        t,
+        {"gyro": gyro},
+        {**temps, "T_chamber": chamber},
+        meta=Metadata(sensor_id="SN-TEST-1", run_id=name),
+    )
+    return rec
+
+
+@pytest.fixture(scope="module")
+def case(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
+    d = tmp_path_factory.mktemp("report")
+    mod = _run(1, 3.0, 1.5, -10.0, 40.0, "modelling")
+    val = _run(2, 2.0, 1.0, 0.0, 30.0, "validation")
+    write_recording(mod, d / "mod.csv")
+    write_recording(val, d / "val.csv")
+    model = ReportTestLinear().fit([RunData.from_recording(mod, "gyro", ["T1", "T2"])])
+    model.signal_name = "gyro"
+    model_dict = save_model(model, d / "model.json")
+    # a validation result as `thermocal validate --json` writes it (INTERFACE.md keys)
+    r = float(np.corrcoef(mod.column("T_chamber")[: val.n_samples], val.column("T_chamber"))[0, 1])
+    validation = {
+        "r": r,
+        "weakly_correlated": r < 0.4,
+        "n_stages": 3,
+        "bias_stability_before": 0.6123456,
+        "bias_stability_after": 0.0212345,
+        "bias_repeatability_before": 0.7234567,
+        "bias_repeatability_after": 0.0134567,
+        "rms_before": 0.5345678,
+        "rms_after": 0.0456789,
+        "peak_to_peak_before": 1.5012345,
+        "peak_to_peak_after": 0.0987654,
+        "averaging_s": 100.0,
+    }
+    write_json(d / "val.json", validation)
+    inputs = ReportInputs(
+        models=(ModelEntry("linear", model_dict, validation, str(d / "model.json")),),
+        recording=val,
+        modeling=mod,
+        recording_path=str(d / "val.csv"),
+        modeling_path=str(d / "mod.csv"),
+        sensor="SN-TEST-1",
+    )
+    path = write_report(d / "report.html", inputs)
+    return {
+        "dir": d,
+        "path": path,
+        "html": path.read_text(encoding="utf-8"),
+        "model": model_dict,
+        "validation": validation,
+        "val": val,
+    }
+
+
+# --- helpers used by this file and test_demo.py -----------------------------------------------
+
+
+def tagged_numbers(text: str) -> dict[str, tuple[str, str]]:
+    """``data-key`` → (``data-value``, displayed text) of every tagged number."""
+    out = {}
+    pat = re.compile(r'<span class="num" data-key="([^"]*)" data-value="([^"]*)">([^<]*)</span>')
+    for key, value, shown in pat.findall(text):
+        out[html.unescape(key)] = (html.unescape(value), html.unescape(shown))
+    return out
+
+
+def check_number(
+    tags: dict[str, tuple[str, str]], key: str, expected: float, rel: float = 1e-15
+) -> None:
+    """The tagged value equals ``expected`` (a JSON value: exactly; an independently
+    computed reference: to ``rel``) and the shown text is its rounding."""
+    assert key in tags, f"{key} not in report"
+    value, shown = tags[key]
+    assert float(value) == pytest.approx(expected, rel=rel, abs=0.0), key
+    assert shown == fmt_num(expected, len(shown.replace("-", "").replace(".", "")) or 4) or (
+        float(shown) == pytest.approx(expected, rel=5e-3)
+    ), (key, shown, expected)
+
+
+def png_size(data: bytes) -> tuple[int, int]:
+    """Width and height of a PNG from its IHDR chunk (checks the signature)."""
+    assert data[:8] == b"\x89PNG\r\n\x1a\n"
+    assert data[12:16] == b"IHDR"
+    return int.from_bytes(data[16:20], "big"), int.from_bytes(data[20:24], "big")
+
+
+def embedded_pngs(text: str) -> dict[str, bytes]:
+    out = {}
+    for fid, b64 in re.findall(
+        r'<img class="figure" id="([^"]+)" src="data:image/png;base64,([^"]+)"', text
+    ):
+        out[fid] = base64.b64decode(b64)
+    return out
+
+
+def chromium_available() -> bool:
+    return CHROMIUM.exists()
+
+
+def skip_without_chromium() -> None:
+    """Skip only when Chromium is absent AND not in CI (in CI the test must run)."""
+    if not chromium_available() and not os.environ.get("CI"):
+        pytest.skip("/usr/bin/chromium is not installed (install Debian's chromium)")
+
+
+def run_chromium(report: Path, tmp: Path) -> dict[str, Any]:
+    """Render ``report`` headless: screenshot PNG, DOM after load, console errors."""
+    exe = str(CHROMIUM) if CHROMIUM.exists() else (shutil.which("chromium") or str(CHROMIUM))
+    common = [
+        exe,
+        "--headless",
+        "--no-sandbox",
+        "--disable-gpu",
+        "--disable-quic",
+        "--no-first-run",
+        "--disable-background-networking",
+        "--disable-component-update",
+        "--disable-sync",
+        "--disable-dev-shm-usage",
+        "--hide-scrollbars",
+        "--enable-logging=stderr",
+        "--v=0",
+    ]
+    url = report.resolve().as_uri()
+    shot = tmp / "screenshot.png"
+    env = {**os.environ, "HOME": str(tmp)}
+    p1 = subprocess.run(
+        [
+            *common,
+            f"--user-data-dir={tmp / 'profile1'}",
+            f"--screenshot={shot}",
+            "--window-size=1280,4000",
+            "--virtual-time-budget=5000",
+            url,
+        ],
+        capture_output=True,
+        text=True,
+        timeout=120,
+        env=env,
+        check=False,
+    )
+    p2 = subprocess.run(
+        [
+            *common,
+            f"--user-data-dir={tmp / 'profile2'}",
+            "--virtual-time-budget=5000",
+            "--dump-dom",
+            url,
+        ],
+        capture_output=True,
+        text=True,
+        timeout=120,
+        env=env,
+        check=False,
+    )
+    stderr = p1.stderr + p2.stderr
+    console = [
+        line
+        for line in stderr.splitlines()
+        if ("CONSOLE" in line or "console" in line)
+        and ("Uncaught" in line or "error" in line.lower())
+    ]
+    console += [line for line in stderr.splitlines() if "Uncaught" in line]
+    console += [line for line in stderr.splitlines() if "Content Security Policy" in line]
+    return {
+        "screenshot": shot,
+        "dom": p2.stdout,
+        "console_errors": console,
+        "returncodes": (p1.returncode, p2.returncode),
+        "stderr": stderr,
+    }
+
+
+def screenshot_stats(path: Path) -> tuple[int, int, float, int]:
+    """Width, height, std of the grey level [0-255] and number of distinct grey levels
+    of a PNG screenshot (a blank page has std ≈ 0 and one level)."""
+    import matplotlib.image as mpimg
+
+    png_size(path.read_bytes())  # a real PNG
+    img = np.asarray(mpimg.imread(path), dtype=np.float64)  # (h, w, 3|4) in [0, 1]
+    grey = img[:, :, :3].mean(axis=2) * 255.0
+    h, w = grey.shape
+    return w, h, float(grey.std()), int(np.unique(np.round(grey)).size)
+
+
+def check_rendered(result: dict[str, Any], n_figures_min: int) -> str:
+    """Assertions shared by the report and demo browser tests; returns the DOM."""
+    assert result["returncodes"] == (0, 0), result["stderr"][-2000:]
+    assert not result["console_errors"], result["console_errors"]
+    dom = result["dom"]
+    body = re.search(r"<body([^>]*)>", dom)
+    assert body is not None
+    attrs = dict(re.findall(r'([\w-]+)="([^"]*)"', body.group(1)))
+    assert attrs.get("data-loaded") == "1", attrs
+    total = int(attrs["data-images-total"])
+    assert total >= n_figures_min
+    assert int(attrs["data-images-ok"]) == total, attrs.get("data-images-bad")
+    for img in re.findall(r"<img[^>]*>", dom):
+        assert 'data-loaded="1"' in img
+        width = re.search(r'data-natural-width="(\d+)"', img)
+        assert width is not None and int(width.group(1)) > 100
+    w, h, std, levels = screenshot_stats(result["screenshot"])
+    assert (w, h) == (1280, 4000)
+    assert std > 10.0 and levels > 20, (std, levels)  # not a blank page
+    return str(dom)
+
+
+# --- pure helpers -------------------------------------------------------------------------------
+
+
+def test_fmt_num_and_improvement() -> None:
+    assert fmt_num(None) == "—"
+    assert fmt_num(float("nan")) == "—"
+    assert fmt_num(3) == "3"
+    assert fmt_num(0.0212345) == "0.02123"
+    assert fmt_num(1.5012345) == "1.501"
+    assert fmt_num(1.2345e-5) == "1.234e-05" or fmt_num(1.2345e-5) == "1.235e-05"
+    assert fmt_num(2.5e7, 3) == "2.50e+07"
+    assert improvement_pct(2.0, 0.5) == pytest.approx(75.0, abs=1e-12)
+    assert improvement_pct(1.0, 2.0) == pytest.approx(-100.0, abs=1e-12)
+    assert improvement_pct(0.0, 1.0) is None
+    assert improvement_pct(None, 1.0) is None
+
+
+def test_decimate_for_plot_block_means() -> None:
+    x = np.arange(10.0)
+    y = 2 * x
+    xs, ys = decimate_for_plot(x, y, max_points=4)  # m = 3: blocks 0-2, 3-5, 6-8, 9
+    assert_allclose(xs, [1.0, 4.0, 7.0, 9.0], rtol=0, atol=1e-15)
+    assert_allclose(ys, [2.0, 8.0, 14.0, 18.0], rtol=0, atol=1e-15)
+    same = decimate_for_plot(x, y, max_points=100)
+    assert_allclose(same[1], y, rtol=0, atol=0)
+
+
+# --- the built report ---------------------------------------------------------------------------
+
+
+def test_report_is_self_contained(case: dict[str, Any]) -> None:
+    text = case["html"]
+    assert text.startswith("<!DOCTYPE html>")
+    # nothing loaded from anywhere: no external src/href, CSP forbids it anyway
+    assert not re.search(r'(src|href)="(?!data:|#)', text)
+    assert "http://" not in text and "https://" not in text
+    assert "default-src 'none'" in text
+    for section in ("summary", "conditions", "profile", "validation", "bias", "allan", "drift"):
+        assert f'<section id="{section}">' in text
+
+
+def test_report_figures_are_valid_pngs(case: dict[str, Any]) -> None:
+    pngs = embedded_pngs(case["html"])
+    expected = {
+        "fig-profile",
+        "fig-fit",
+        "fig-bias_time",
+        "fig-bias_temp",
+        "fig-allan",
+        "fig-drift",
+    }
+    assert set(pngs) == expected
+    for fid, data in pngs.items():
+        w, h = png_size(data)
+        assert w >= 600 and h >= 200, fid
+        assert len(data) > 5000, fid  # has content, not an empty canvas
+    # every figure has a caption
+    assert len(re.findall(r"<figcaption>Figure \d+\. ", case["html"])) == len(expected)
+
+
+def test_report_numbers_equal_the_json(case: dict[str, Any]) -> None:
+    tags = tagged_numbers(case["html"])
+    v = case["validation"]
+    for key in (
+        "r",
+        "bias_stability_before",
+        "bias_stability_after",
+        "bias_repeatability_before",
+        "bias_repeatability_after",
+        "rms_before",
+        "rms_after",
+        "peak_to_peak_before",
+        "peak_to_peak_after",
+    ):
+        check_number(tags, f"validation.linear.{key}", v[key])
+    check_number(tags, "validation.linear.n_stages", v["n_stages"])
+    imp = 100 * (1 - v["bias_stability_after"] / v["bias_stability_before"])
+    check_number(tags, "validation.linear.bias_stability_improvement_pct", imp)
+    m = case["model"]
+    for i, c in enumerate(m["coefficients"]):
+        check_number(tags, f"model.coefficients.{i}.value", c["value"])
+        check_number(tags, f"model.coefficients.{i}.stderr", c["stderr"])
+    check_number(tags, "models.linear.rms_residual", m["fit"]["rms_residual"])
+    check_number(tags, "models.linear.condition_number", m["fit"]["condition_number"])
+    lo, hi = m["range"]["temperature_c"]["T1"]
+    check_number(tags, "model.range.temperature_c.T1.0", lo)
+    check_number(tags, "model.range.temperature_c.T1.1", hi)
+    # the fitted slope is the simulator's truth (noise 0.02 °/h over 10 800 samples)
+    assert m["coefficients"][1]["value"] == pytest.approx(TRUE_SLOPE, abs=1e-3)
+
+
+def _drift_reference(time_s: FloatArray, rate_deg_h: FloatArray) -> FloatArray:
+    """θ(t) = ∫ (ω − mean ω) dt / 3600 [°], scipy's cumulative trapezoid."""
+    from scipy.integrate import cumulative_trapezoid
+
+    out: FloatArray = cumulative_trapezoid(rate_deg_h - rate_deg_h.mean(), time_s, initial=0.0)
+    return out / 3600.0
+
+
+def test_report_drift_angle_and_flags(case: dict[str, Any]) -> None:
+    tags = tagged_numbers(case["html"])
+    val: Recording = case["val"]
+    gyro = val.column("gyro")
+    coef = [c["value"] for c in case["model"]["coefficients"]]
+    t1 = np.clip(val.column("T1"), *case["model"]["range"]["temperature_c"]["T1"])
+    after = gyro - (coef[0] + coef[1] * t1)
+    theta_before = _drift_reference(val.time_s, gyro)
+    theta_after = _drift_reference(val.time_s, after)
+    # the report's drift angle (thermocal.metrics) equals scipy's trapezoid integral
+    check_number(
+        tags, "fom.before.drift_angle_max_deg", float(np.max(np.abs(theta_before))), rel=1e-9
+    )
+    check_number(
+        tags, "fom.after.drift_angle_max_deg", float(np.max(np.abs(theta_after))), rel=1e-9
+    )
+    # compensation removes the temperature drift: the drift angle shrinks a lot
+    assert np.max(np.abs(theta_after)) < 0.1 * np.max(np.abs(theta_before))
+    # flags: r of these square-wave profiles is far from weak → correlation flag fails
+    weak = case["validation"]["weakly_correlated"]
+    assert ('data-flag="pass"' in case["html"]) and (
+        ("not weakly correlated" in case["html"]) == (not weak)
+    )
+    if not weak:
+        assert 'data-kind="correlation"' in case["html"]
+
+
+def test_report_warns_on_extrapolation_and_conditioning(case: dict[str, Any]) -> None:
+    # validation run hotter than the modelling range, ill-conditioned model fit
+    val = _run(3, 1.0, 0.5, 30.0, 60.0, "hot")
+    m = json.loads(json.dumps(case["model"]))
+    m["fit"]["condition_number"] = 3.0e9
+    v = dict(case["validation"], r=0.62, weakly_correlated=False)
+    text = build_report(ReportInputs(models=(ModelEntry("hot", m, v),), recording=val))
+    assert 'data-kind="extrapolation"' in text
+    assert 'data-kind="conditioning"' in text
+    assert 'data-kind="correlation"' in text
+    assert 'id="verdict"' in text and 'data-flag="fail"' in text
+    assert "fig-fit" not in text  # no modelling run given: no fit figure
+
+
+def test_report_bad_inputs(case: dict[str, Any]) -> None:
+    with pytest.raises(ThermocalInputError):
+        build_report(ReportInputs(models=(), recording=case["val"]))
+    entry = ModelEntry("x", case["model"], None)
+    with pytest.raises(ThermocalInputError):
+        build_report(ReportInputs(models=(entry, entry), recording=case["val"]))
+
+
+# --- real browser -------------------------------------------------------------------------------
+
+
+def test_report_renders_in_headless_chromium(case: dict[str, Any], tmp_path: Path) -> None:
+    skip_without_chromium()
+    result = run_chromium(case["path"], tmp_path)
+    dom = check_rendered(result, n_figures_min=6)
+    # the numbers in the rendered page are the JSON's
+    tags = tagged_numbers(dom)
+    check_number(tags, "validation.linear.r", case["validation"]["r"])
+    check_number(
+        tags, "validation.linear.bias_stability_after", case["validation"]["bias_stability_after"]
+    )
+
+
+# --- command line -------------------------------------------------------------------------------
+
+
+def test_report_cli_writes_the_report(case: dict[str, Any], tmp_path: Path) -> None:
+    from thermocal.cli import main
+
+    d = case["dir"]
+    out = tmp_path / "cli-report.html"
+    status = main(
+        [
+            "report",
+            "--model",
+            str(d / "model.json"),
+            "--validation",
+            str(d / "val.json"),
+            "--recording",
+            str(d / "val.csv"),
+            "--modeling",
+            str(d / "mod.csv"),
+            "--sensor",
+            "SN-CLI",
+            "-o",
+            str(out),
+        ]
+    )
+    assert status == 0
+    text = out.read_text(encoding="utf-8")
+    assert "SN-CLI" in text
+    tags = tagged_numbers(text)
+    v = case["validation"]
+    check_number(tags, "validation.model.r", v["r"])
+    check_number(tags, "validation.model.bias_repeatability_after", v["bias_repeatability_after"])
+    # the CLI's report shows the same figures-of-merit numbers as the library's
+    lib = tagged_numbers(case["html"])
+    for key in ("fom.before.bias_stability", "fom.after.bias_stability", "fom.after.bias"):
+        assert tags[key][0] == lib[key][0]
+    assert len(embedded_pngs(text)) == 6
+
+
+def test_report_cli_bad_input(
+    case: dict[str, Any], tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    from thermocal.cli import main
+
+    d = case["dir"]
+    base = ["report", "--model", str(d / "model.json"), "--recording", str(d / "val.csv")]
+    # two validation files for one model
+    status = main(
+        [*base, "--validation", str(d / "val.json"), "--validation", str(d / "val.json"),
+         "-o", str(tmp_path / "r.html")]
+    )  # fmt: skip
+    assert status == 2
+    assert "error:" in capsys.readouterr().err
+    # a model file as validation result
+    status = main([*base, "--validation", str(d / "model.json"), "-o", str(tmp_path / "r.html")])
+    assert status == 2
+    assert "not a validation result" in capsys.readouterr().err
+    # never write over an input
+    status = main([*base, "-o", str(d / "val.csv")])
+    assert status == 2
+    assert "refusing to write over" in capsys.readouterr().err
+    assert not (tmp_path / "r.html").exists()

@@ -1,0 +1,89 @@
+"""``thermocal turntable`` command line (INTERFACE.md)."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from thermocal.cli import main
+from thermocal.io import write_recording
+from thermocal.turntable import simulate_turntable16
+
+
+@pytest.fixture(scope="module")
+def run_csv(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, dict[str, list[float]]]:
+    d = tmp_path_factory.mktemp("tt")
+    rec, truth = simulate_turntable16(3, rate_hz=5.0)
+    path = d / "run.csv"
+    write_recording(rec, path)
+    return path, truth
+
+
+def test_turntable_json_and_file(
+    run_csv: tuple[Path, dict[str, list[float]]], tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    path, truth = run_csv
+    out = tmp_path / "res.json"
+    assert main(["turntable", str(path), "-o", str(out), "--latitude", "40", "--json"]) == 0
+    printed = json.loads(capsys.readouterr().out)
+    saved = json.loads(out.read_text())
+    for key in ("bias_deg_h", "scale_factor_ppm", "misalignment_arcsec"):
+        assert key in saved and key + "_sigma" in saved
+        est = np.array(saved[key])
+        sig = np.array(saved[key + "_sigma"])
+        assert np.all(np.abs(est - np.array(truth[key])) < 4 * sig)
+    assert np.array(saved["error_matrix"]).shape == (3, 3)
+    assert printed["bias_deg_h"] == saved["bias_deg_h"]
+    assert saved["agreement_max_sigma"] < 0.05
+
+
+def test_turntable_renamed_columns(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    rec, _ = simulate_turntable16(1, rate_hz=2.0)
+    rec.columns = {
+        {"gyro_x": "wx rad/s", "gyro_y": "wy rad/s", "gyro_z": "wz rad/s"}.get(k, k): (
+            np.deg2rad(v) if k.startswith("gyro") else v
+        )
+        for k, v in rec.columns.items()
+    }
+    rec.columns["outer"] = rec.columns.pop("beta_deg")
+    rec.units = {}
+    rec.signals = ()
+    path = tmp_path / "renamed.csv"
+    write_recording(rec, path)
+    out = tmp_path / "r.json"
+    code = main(
+        [
+            "turntable",
+            str(path),
+            "-o",
+            str(out),
+            "--gyro",
+            "wx rad/s,wy rad/s,wz rad/s",
+            "--gyro-unit",
+            "rad/s",
+            "--beta",
+            "outer",
+            "--latitude",
+            "40",
+            "--json",
+        ]
+    )
+    assert code == 0
+    assert json.loads(capsys.readouterr().out)["n_positions"] == 16
+
+
+def test_turntable_bad_input_exit_2(
+    run_csv: tuple[Path, dict[str, list[float]]], tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    path, _ = run_csv
+    assert main(["turntable", str(path), "-o", str(tmp_path / "x.json"), "--alpha", "nope"]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("error: ") and "'nope'" in err
+    assert main(["turntable", str(path), "-o", str(path)]) == 2
+    assert "refusing to write over the input" in capsys.readouterr().err
+    assert main(["turntable", str(path), "-o", str(tmp_path / "y.json"), "--min-dwell", "120"]) == 2
+    assert "shorter than the 120 s asked" in capsys.readouterr().err
+    assert not (tmp_path / "y.json").exists()
