@@ -11,6 +11,7 @@ Run: .venv/bin/python benchmarks/bench_allan.py [--skip-1e8]
 
 from __future__ import annotations
 
+import os
 import resource
 import subprocess
 import sys
@@ -77,7 +78,8 @@ def main() -> None:
     if "--child-1e8" in sys.argv:
         child_1e8()
         return
-    print(f"load average before: {open('/proc/loadavg').read().split()[:3]}")
+    with open("/proc/loadavg") as fh:
+        print(f"load average before: {fh.read().split()[:3]} on {os.cpu_count()} CPUs")
     bench_1e7()
     if "--skip-1e8" not in sys.argv:
         subprocess.run([sys.executable, __file__, "--child-1e8"], check=True)

@@ -10,6 +10,7 @@ memory of the process, and, separately, the time to write the result as Parquet.
 from __future__ import annotations
 
 import argparse
+import os
 import resource
 import sys
 import tempfile
@@ -44,17 +45,24 @@ def main(argv: list[str] | None = None) -> int:
     c_prog = np.append(c[keep], np.interp(end, t, c))
 
     base_rss = peak_rss_mb()
+    r0 = resource.getrusage(resource.RUSAGE_SELF)
     t0 = time.perf_counter()
     rec, _truth = run_scenario("rlg-modelling", args.seed, (t_prog, c_prog), rate_hz=args.rate_hz)[
         0
     ]
     elapsed = time.perf_counter() - t0
+    r1 = resource.getrusage(resource.RUSAGE_SELF)
+    cpu_user = r1.ru_utime - r0.ru_utime
+    cpu_sys = r1.ru_stime - r0.ru_stime
     rss = peak_rss_mb()
+    load1 = os.getloadavg()[0]
     n = rec.n_samples
     print(f"samples            {n:,d} ({args.hours:g} h at {args.rate_hz:g} Hz)")
     print(f"temperatures       {len(rec.temperatures)}")
     print(f"columns            {len(rec.columns)}")
     print(f"simulate time      {elapsed:.2f} s  (target < 10 s; ratio {elapsed / 10.0:.2f})")
+    print(f"cpu time           {cpu_user + cpu_sys:.2f} s (user {cpu_user:.2f}, sys {cpu_sys:.2f})")
+    print(f"load average (1 m) {load1:.2f} on {os.cpu_count()} CPUs")
     print(f"throughput         {n / elapsed / 1e6:.2f} M samples/s")
     print(f"peak RSS           {rss:.0f} MB (before: {base_rss:.0f} MB; target < 2048 MB)")
     if args.write:

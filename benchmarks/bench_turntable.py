@@ -31,9 +31,8 @@ def main() -> None:
     print(f"simulate: {t_sim:.2f} s")
     print(f"calibrate (best of 3): {best:.2f} s   target < 5 s: {'OK' if best < 5 else 'FAIL'}")
     print(f"max |error/σ| (Kalman): {np.max(np.abs(z)):.2f}")
-    print(
-        f"σ_KF / CRB: {np.min(res.kalman.sigma / res.crb):.4f} .. {np.max(res.kalman.sigma / res.crb):.4f}"
-    )
+    ratio = res.kalman.sigma / res.crb
+    print(f"σ_KF / CRB: {np.min(ratio):.4f} .. {np.max(ratio):.4f}")
     print(f"KF vs LS max |Δ|/σ: {res.agreement:.2e}")
     print(f"CRB bias [°/h]: {np.round(res.crb[0:3], 4)}")
     print(f"CRB scale factor [ppm]: {np.round(res.crb[3:6], 3)}")

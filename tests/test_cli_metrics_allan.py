@@ -46,7 +46,7 @@ def run_json(args: list[str], capsys: pytest.CaptureFixture[str]) -> dict[str, o
 
 
 def test_metrics_json(gyro_csv, capsys) -> None:  # type: ignore[no-untyped-def]
-    path, t, rate, temp = gyro_csv
+    path, t, rate, _temp = gyro_csv
     obj = run_json(
         [
             "metrics",

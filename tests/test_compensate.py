@@ -9,8 +9,10 @@ is registered.
 
 from __future__ import annotations
 
+import itertools
 import json
 import math
+import warnings
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Any, Self
@@ -33,6 +35,7 @@ from thermocal.compensate import (
 from thermocal.errors import (
     ExtrapolationWarning,
     MissingColumnError,
+    ThermocalInputError,
     TimestampError,
     UnitError,
 )
@@ -43,6 +46,7 @@ from thermocal.models.base import (
     ModelStream,
     RunData,
     TemperatureModel,
+    make_model,
 )
 from thermocal.preprocess import temperature_rate
 from thermocal.recording import GAP_FACTOR, FloatArray
@@ -378,3 +382,100 @@ def _families() -> list[str]:
 def test_context_rule_for_every_registered_family() -> None:
     for fam in _families():
         assert fam in CONTEXT_RULES, f"no chunk context rule for family {fam!r}"
+
+
+def _fit_family(fam: str) -> TemperatureModel:
+    from thermocal.simulate import SCENARIOS
+
+    if fam == "poly":
+        rec, _ = SCENARIOS["rlg-modelling"](1)[0]
+        m = make_model("poly").fit([RunData.from_recording(rec, "gyro", ["T1", "T2", "T3", "T4"])])
+    elif fam == "piecewise":
+        rec, _ = SCENARIOS["fog-slow"](1)[0]
+        m = make_model("piecewise").fit([RunData.from_recording(rec, "gyro", ["T1"])])
+    elif fam == "warmup":
+        res = SCENARIOS["mems-warmup"](1)
+        m = make_model("warmup").fit([RunData.from_recording(r, "gyro", ["T1"]) for r, _ in res])
+    elif fam == "bank":
+        res = SCENARIOS["accel-full-range"](1)
+        runs = [
+            RunData.from_recording(r, r.signals[0], ["T1"], known_input=tr["input"])
+            for r, tr in res
+        ]
+        m = make_model("bank").fit(runs)
+    else:  # pragma: no cover - a new family needs a fitter here
+        raise AssertionError(f"no fitter for family {fam!r}")
+    m.signal_name = "gyro"
+    return m
+
+
+@pytest.fixture(scope="module", params=_families())
+def family_model(request: pytest.FixtureRequest) -> TemperatureModel:
+    return _fit_family(str(request.param))
+
+
+def _family_data(m: TemperatureModel, n: int = 4000) -> RunData:
+    from thermocal.export_c import exercise_inputs
+
+    rng = {n: [float(a), float(b)] for n, (a, b) in zip(m.temp_names_, m.temp_range_, strict=True)}
+    d = {"temperatures": list(m.temp_names_), "range": {"temperature_c": rng}}
+    t, T, f = exercise_inputs(d, n, 1.0, seed=2, gap_at=0.3)
+    return RunData(time_s=t, temps_c=T, signal=f, temp_names=tuple(m.temp_names_), known_input=0.1)
+
+
+def test_every_family_streaming_equals_batch(family_model: TemperatureModel) -> None:
+    """StreamingCompensator (sample by sample and block by block) equals the batch
+    compensation to 1e-12, power-on and a gap included, for every registered family."""
+    m = family_model
+    run = _family_data(m)
+    assert run.signal is not None
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", ExtrapolationWarning)  # the sweep leaves the range
+        batch = compensate_run(m, run)
+        sc = StreamingCompensator(m, 1.0, known_input=run.known_input)
+        one = sc.process(run.time_s, run.temps_c, run.signal)
+        blk = StreamingCompensator(m, 1.0, known_input=run.known_input)
+        parts = [
+            blk.update_block(run.time_s[a:b], run.temps_c[a:b], run.signal[a:b]).corrected
+            for a, b in itertools.pairwise([0, 1, 7, 100, 1201, 1202, 2500, run.n_samples])
+        ]
+    scale = float(np.max(np.abs(batch.model_value))) or 1.0
+    np.testing.assert_allclose(one.corrected, batch.corrected, rtol=0, atol=1e-12 * scale)
+    np.testing.assert_allclose(one.model_value, batch.model_value, rtol=0, atol=1e-12 * scale)
+    np.testing.assert_allclose(np.concatenate(parts), batch.corrected, rtol=0, atol=1e-12 * scale)
+
+
+def test_every_family_chunked_file_equals_in_memory(
+    family_model: TemperatureModel, tmp_path: Path
+) -> None:
+    m = family_model
+    run = _family_data(m)
+    assert run.signal is not None
+    cols = {"time": run.time_s, "gyro": run.signal}
+    cols.update({n: run.temps_c[:, i] for i, n in enumerate(m.temp_names_)})
+    src = tmp_path / "in.parquet"
+    pd.DataFrame(cols).to_parquet(src)
+    with pytest.warns(ExtrapolationWarning):
+        res = compensate_file(
+            m, src, tmp_path / "out.csv", chunk_rows=333, known_input=run.known_input
+        )
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", ExtrapolationWarning)
+        batch = compensate_run(m, run)
+    assert not res.streamed
+    got = pd.read_csv(tmp_path / "out.csv")
+    scale = float(np.max(np.abs(batch.model_value))) or 1.0
+    np.testing.assert_allclose(got["gyro_model"], batch.model_value, rtol=0, atol=1e-12 * scale)
+    np.testing.assert_allclose(got["gyro_comp"], batch.corrected, rtol=0, atol=1e-12 * scale)
+
+
+def test_block_and_sample_modes_do_not_mix() -> None:
+    run = _toy_run(n=20, gap_at=None)
+    sc = StreamingCompensator(_fitted_toy(run), 1.0)
+    sc.update(0.0, [20.0, 25.0], 1.0)
+    with pytest.raises(ThermocalInputError, match="do not mix"):
+        sc.update_block([1.0, 2.0], [[20.0, 25.0], [20.0, 25.0]], [1.0, 1.0])
+    sc.reset()
+    sc.update_block([1.0, 2.0], [[20.0, 25.0], [20.0, 25.0]], [1.0, 1.0])
+    with pytest.raises(TimestampError):
+        sc.update_block([2.0, 3.0], [[20.0, 25.0], [20.0, 25.0]], [1.0, 1.0])

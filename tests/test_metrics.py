@@ -105,7 +105,7 @@ def _chamber_recording(seed: int = 0) -> tuple[Recording, np.ndarray, np.ndarray
 
 
 def test_compute_metrics_on_a_chamber_run() -> None:
-    rec, temp, rate = _chamber_recording()
+    rec, _temp, rate = _chamber_recording()
     res = metrics.compute_metrics(rec, "gyro", 10.0, 30.0, "up", ["T1"])
     omega_up = units.EARTH_RATE_DEG_H * 0.5
     assert res.earth_rate_removed == pytest.approx(omega_up)

@@ -46,7 +46,7 @@ from thermocal.report import (
     improvement_pct,
     write_report,
 )
-from thermocal.report.figures import decimate_for_plot
+from thermocal.report.figures import binned_means, decimate_for_plot
 
 CHROMIUM = Path("/usr/bin/chromium")
 TRUE_SLOPE = 0.05  # [°/h/°C] of the synthetic gyro on T1
@@ -361,11 +361,27 @@ def test_fmt_num_and_improvement() -> None:
 def test_decimate_for_plot_block_means() -> None:
     x = np.arange(10.0)
     y = 2 * x
-    xs, ys = decimate_for_plot(x, y, max_points=4)  # m = 3: blocks 0-2, 3-5, 6-8, 9
-    assert_allclose(xs, [1.0, 4.0, 7.0, 9.0], rtol=0, atol=1e-15)
-    assert_allclose(ys, [2.0, 8.0, 14.0, 18.0], rtol=0, atol=1e-15)
+    # m = 3: blocks 0-2, 3-5, 6-8; the trailing block (9) is shorter than m/2: dropped
+    xs, ys = decimate_for_plot(x, y, max_points=4)
+    assert_allclose(xs, [1.0, 4.0, 7.0], rtol=0, atol=1e-15)
+    assert_allclose(ys, [2.0, 8.0, 14.0], rtol=0, atol=1e-15)
+    xs, ys = decimate_for_plot(x, y, max_points=100, block=4)  # blocks 0-3, 4-7, 8-9
+    assert_allclose(xs, [1.5, 5.5, 8.5], rtol=0, atol=1e-15)
     same = decimate_for_plot(x, y, max_points=100)
     assert_allclose(same[1], y, rtol=0, atol=0)
+
+
+def test_binned_means() -> None:
+    rng = np.random.default_rng(0)
+    x = rng.uniform(0.0, 10.0, 20_000)
+    y = 3.0 + 0.5 * x + rng.normal(0.0, 0.1, x.size)
+    c, m, se = binned_means(x, y, n_bins=10, min_count=30)
+    assert c.size == 10
+    # bin means follow the line at the bin centres within a few standard errors
+    assert np.all(np.abs(m - (3.0 + 0.5 * c)) < 0.05)
+    # the standard error of a bin mean is ≈ sqrt(σ² + (0.5·w)²/12)/sqrt(n) with w = 1
+    expected = math.sqrt(0.1**2 + 0.25 / 12.0) / math.sqrt(x.size / 10)
+    assert_allclose(se, expected, rtol=0.1)
 
 
 # --- the built report ---------------------------------------------------------------------------

@@ -391,3 +391,12 @@ def test_program_arrays_as_profile() -> None:
     assert rec.sample_rate_hz == pytest.approx(0.5)
     assert rec.duration_s == pytest.approx(t[-1] - t[0], abs=2.0)
     assert len(truth["stages"]) == 8
+
+
+def test_flicker_at_high_rate_keeps_its_plateau() -> None:
+    b = 0.002
+    y = simulate_noise(2**22 + 37, 0.01, NoiseParams(bias_instability=b), np.random.default_rng(8))
+    plateau = 2.0 * math.log(2.0) / math.pi * b**2
+    for m in (1000, 4000):
+        k = y.size // m
+        assert avar(y, m) == pytest.approx(plateau, rel=5 * avar_rel_sigma(k) + 0.03)

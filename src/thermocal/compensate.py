@@ -164,6 +164,15 @@ class StreamingCompensator:
 
     The outputs equal :func:`compensate_run` to 1e-12 (relative) on the same data,
     start-up included, when ``sample_interval_s`` is the run's median interval.
+
+    Two ways to feed it (not to be mixed between two resets):
+
+    * :meth:`update` / :meth:`process` — one sample at a time through the family's
+      ``ModelStream`` (the firmware twin; speed set by the family's stream);
+    * :meth:`update_block` — a block of samples at once (live data often arrives in
+      packets): the block is predicted in one vectorised call together with the
+      context the model needs (:class:`ChunkPredictor`), which gives the same values
+      because ``predict`` is causal; much faster for blocks of tens of samples or more.
     """
 
     def __init__(
@@ -185,9 +194,18 @@ class StreamingCompensator:
         self.known_input = float(known_input)
         self._stream: ModelStream = model.stream(self.sample_interval_s, extrapolate=extrapolate)
         self._last_t: float | None = None
+        self._mode: str | None = None
+        self._chunks: ChunkPredictor | None = None
         self.last_model_value: float = float("nan")
         """ŷ of the last sample [model signal unit]."""
         self.n_samples = 0
+
+    def _set_mode(self, mode: str) -> None:
+        if self._mode is not None and self._mode != mode:
+            raise ThermocalInputError(
+                "StreamingCompensator: do not mix update() and update_block() between resets"
+            )
+        self._mode = mode
 
     def update(self, time_s: float, temps_c: npt.ArrayLike, signal: float) -> float:
         """Corrected output ``F − ŷ`` of one sample: time [s], temperatures (k,) [°C],
@@ -197,6 +215,8 @@ class StreamingCompensator:
             raise TimestampError(
                 f"sample {self.n_samples}: time {t!r} does not increase (previous {self._last_t!r})"
             )
+        if self._mode != "sample":
+            self._set_mode("sample")
         temps = np.asarray(temps_c, dtype=np.float64).reshape(-1)
         y = float(self._stream.update(t, temps, float(signal) - self.known_input))
         self._last_t = t
@@ -208,8 +228,47 @@ class StreamingCompensator:
         """A new power-on: forget every state."""
         self._stream.reset()
         self._last_t = None
+        self._mode = None
+        self._chunks = None
         self.last_model_value = float("nan")
         self.n_samples = 0
+
+    def update_block(
+        self, time_s: npt.ArrayLike, temps_c: npt.ArrayLike, signal: npt.ArrayLike
+    ) -> Compensation:
+        """Compensate a block of consecutive samples at once (vectorised); state carried
+        on to the next block.  Same values as :meth:`process` (see the class docstring);
+        one :class:`ExtrapolationWarning` per block with samples outside the fitted range.
+        """
+        t = np.asarray(time_s, dtype=np.float64).reshape(-1)
+        T = np.asarray(temps_c, dtype=np.float64)
+        if T.ndim == 1:
+            T = T.reshape(-1, 1)
+        f = np.asarray(signal, dtype=np.float64).reshape(-1)
+        if T.shape[0] != t.size or f.size != t.size:
+            raise ThermocalInputError("time, temperatures and signal differ in length")
+        if t.size == 0:
+            return Compensation(np.zeros(0), np.zeros(0))
+        bad = np.flatnonzero(np.diff(t) <= 0)
+        if (self._last_t is not None and not t[0] > self._last_t) or bad.size:
+            i = 0 if bad.size == 0 else int(bad[0]) + 1
+            raise TimestampError(f"sample {self.n_samples + i}: time does not increase")
+        self._set_mode("block")
+        if self._chunks is None:
+            self._chunks = ChunkPredictor(
+                self.model,
+                extrapolate=self.extrapolate,
+                known_input=self.known_input,
+                sample_interval_s=self.sample_interval_s,
+            )
+        before = self._chunks.n_outside
+        y = self._chunks.predict(t, T, f)
+        if self._chunks.n_outside > before:
+            self._chunks.warn_outside(self._chunks.n_outside - before)
+        self._last_t = float(t[-1])
+        self.last_model_value = float(y[-1])
+        self.n_samples += int(t.size)
+        return Compensation(model_value=y, corrected=f - y)
 
     def process(
         self, time_s: npt.ArrayLike, temps_c: npt.ArrayLike, signal: npt.ArrayLike
@@ -313,6 +372,7 @@ class ChunkPredictor:
         extrapolate: bool = False,
         name: str = "",
         known_input: float = 0.0,
+        sample_interval_s: float | None = None,
     ) -> None:
         self.model = model
         self.known_input = float(known_input)
@@ -328,7 +388,7 @@ class ChunkPredictor:
         self._tail_T: FloatArray = np.zeros((0, 0))
         self._tail_f: FloatArray = np.zeros(0)
         self._stream: StreamingCompensator | None = None
-        self._tau: float | None = None
+        self._tau: float | None = sample_interval_s
         self.n_outside = 0
         """Samples outside the model's fitted temperature range (for one summary warning)."""
 
@@ -415,13 +475,18 @@ class ChunkPredictor:
         """Issue one :class:`ExtrapolationWarning` for the whole file, if any sample
         was outside the fitted range."""
         if self.n_outside:
+            self.warn_outside(self.n_outside)
+
+    def warn_outside(self, n_outside: int) -> None:
+        """One :class:`ExtrapolationWarning` for ``n_outside`` samples out of range."""
+        if n_outside:
             action = "extrapolated" if self.extrapolate else "clamped to the fitted range"
             rng = ", ".join(
                 f"{n} {a:.2f}…{b:.2f} °C"
                 for n, (a, b) in zip(self.model.temp_names_, self.model.temp_range_, strict=True)
             )
             warnings.warn(
-                f"{self.name or 'data'}: {self.n_outside} samples outside the model's "
+                f"{self.name or 'data'}: {n_outside} samples outside the model's "
                 f"temperature range ({rng}); {action}",
                 ExtrapolationWarning,
                 stacklevel=2,

@@ -340,6 +340,187 @@ def _indent(text: str, n: int = 4) -> str:
     return "\n".join(pad + ln if ln.strip() else "" for ln in text.strip("\n").splitlines())
 
 
+# --- families: poly --------------------------------------------------------------------------
+
+
+def _rate_buffer_code(ctx: ExportContext) -> tuple[list[str], str, str]:
+    """State fields, init and update code of the backward-difference Ṫ (SPEC §3, seed 000):
+    a ring buffer of the raw temperatures of the last Δt of the current contiguous
+    segment; ``Ṫ = (T − T_lo)/(t − t_lo)·60`` [°C/min] with ``t_lo`` the oldest buffered
+    time ≥ t − Δt, 0 at a segment's first sample; a step > GAP_FACTOR·τ clears the buffer.
+    Fills ``rate[k]``."""
+    P, r = ctx.P, ctx.r
+    fields = [
+        f"double buf_t[{P}_RATE_BUF_LEN];",
+        f"{r} buf_T[{P}_RATE_BUF_LEN][{P}_N_TEMPS];",
+        "int buf_head; /* index of the oldest sample */",
+        "int buf_n;    /* samples in the buffer */",
+        "int have_last;",
+        "double last_t;",
+    ]
+    init = """
+s->buf_head = 0;
+s->buf_n = 0;
+s->have_last = 0;
+s->last_t = 0.0;
+"""
+    update = f"""
+/* backward temperature rate [degC/min] from the raw temperatures */
+if (s->have_last && time_s - s->last_t > {P}_GAP_FACTOR * s->sample_interval_s) {{
+    s->buf_n = 0; /* a gap: new contiguous segment */
+}}
+s->have_last = 1;
+s->last_t = time_s;
+{{
+    int slot;
+    if (s->buf_n == {P}_RATE_BUF_LEN) {{ /* full: sampling faster than sized for */
+        s->buf_head = (s->buf_head + 1) % {P}_RATE_BUF_LEN;
+        s->buf_n -= 1;
+    }}
+    slot = (s->buf_head + s->buf_n) % {P}_RATE_BUF_LEN;
+    s->buf_t[slot] = time_s;
+    for (i = 0; i < {P}_N_TEMPS; ++i) {{
+        s->buf_T[slot][i] = temps_c[i];
+    }}
+    s->buf_n += 1;
+}}
+while (s->buf_t[s->buf_head] < time_s - {P}_RATE_INTERVAL_S) {{
+    s->buf_head = (s->buf_head + 1) % {P}_RATE_BUF_LEN;
+    s->buf_n -= 1;
+}}
+{{
+    double span = time_s - s->buf_t[s->buf_head];
+    for (i = 0; i < {P}_N_TEMPS; ++i) {{
+        if (span > 0.0) {{
+            rate[i] = (temps_c[i] - s->buf_T[s->buf_head][i]) / ({r})span * {ctx.lit(60.0)};
+        }} else {{
+            rate[i] = {ctx.lit(0.0)};
+        }}
+    }}
+}}
+"""
+    return fields, init, update
+
+
+@register_generator("poly")
+def _gen_poly(ctx: ExportContext) -> FamilyCode:
+    """Polynomial model (SPEC §4a, models/poly.py docstring steps 1–4 and ``PolyStream``):
+    Ṫ from the raw temperatures, clamp T and Ṫ (rate sensors) to the fitted ranges,
+    ``u = (T − c_T)/s_T``, ``v = (Ṫ − c_R)/s_R``, ``w = (T·Ṫ − c_W)/s_W``,
+    ``y = Σ_j coef_j u^a v^b w^c + constant`` (powers by repeated multiplication)."""
+    d = ctx.model
+    st = d["state"]
+    if st.get("layout") != "thermocal-poly-1":
+        raise ModelFileError(f"poly state layout {st.get('layout')!r} is not thermocal-poly-1")
+    P, r, p = ctx.P, ctx.r, ctx.prefix
+    base = st["base"]
+    terms = st["terms"]
+    coef = np.asarray(st["coef"], dtype=np.float64)
+    uses_rate = bool(st.get("uses_rate"))
+    rate = st.get("rate") or {}
+    if uses_rate and rate.get("method", "backward") != "backward":
+        raise ModelFileError(
+            f"poly model uses the {rate.get('method')!r} rate form; only the causal "
+            "'backward' form can run sample by sample"
+        )
+    rate_sensors = sorted(
+        {int(t["sensor"]) for t in terms if t["rate_power"] or t["coupling_power"]}
+    )
+    t_sensors = sorted({int(t["sensor"]) for t in terms if t["t_power"]})
+    w_sensors = sorted({int(t["sensor"]) for t in terms if t["coupling_power"]})
+    v_sensors = sorted({int(t["sensor"]) for t in terms if t["rate_power"]})
+
+    def col(key: str) -> list[float]:
+        return [float(b[key]) for b in base]
+
+    data = [
+        ctx.clamp_arrays(),
+        "/* centres and scales of the base variables u, v, w of every sensor */",
+        ctx.array(f"{P}_T_CENTER", col("t_center")),
+        ctx.array(f"{P}_T_SCALE", col("t_scale")),
+        ctx.array(f"{P}_R_CENTER", col("rate_center")),
+        ctx.array(f"{P}_R_SCALE", col("rate_scale")),
+        ctx.array(f"{P}_W_CENTER", col("coupling_center")),
+        ctx.array(f"{P}_W_SCALE", col("coupling_scale")),
+        f"/* coefficients of the {len(terms)} terms (signal unit) and the constant */",
+        ctx.array(f"{P}_COEF", coef),
+        f"static const {r} {P}_CONSTANT = {ctx.lit(float(st['constant']))};",
+    ]
+    rr: dict[str, list[float]] = (d.get("range") or {}).get("rate_c_per_min") or {}
+    clamp_rate = uses_rate and bool(rr) and bool(rate.get("clamp", True))
+    if clamp_rate:
+        rng = np.array([rr[n] for n in d["temperatures"]], dtype=np.float64)
+        data += [
+            "/* fitted temperature-rate range [degC/min]: rates of the rate sensors are clamped */",
+            ctx.array(f"{P}_R_LO", rng[:, 0]),
+            ctx.array(f"{P}_R_HI", rng[:, 1]),
+        ]
+    defines = [f"#define {P}_N_TERMS {len(terms)}"]
+    fields: list[str] = []
+    init = ""
+    upd = [f"{r} T[{P}_N_TEMPS];", f"{r} acc = {ctx.lit(0.0)};", "int i;"]
+    if uses_rate:
+        interval = float(rate.get("interval_s", 60.0))
+        defines += [
+            f"#define {P}_RATE_INTERVAL_S {interval!r}",
+            "/* ring buffer of the rate: >= samples in RATE_INTERVAL_S + 1 */",
+            f"#ifndef {P}_RATE_BUF_LEN",
+            f"#define {P}_RATE_BUF_LEN {ctx.rate_buffer_len}",
+            "#endif",
+        ]
+        fields, init, rate_update = _rate_buffer_code(ctx)
+        upd += [f"{r} rate[{P}_N_TEMPS];", rate_update.strip("\n")]
+    upd += [
+        "(void)signal;",
+        "for (i = 0; i < " + f"{P}_N_TEMPS; ++i) {{",
+        f"    T[i] = {p}_clamp(temps_c[i], {P}_T_LO[i], {P}_T_HI[i]);",
+        "}",
+    ]
+    if clamp_rate:
+        for j in rate_sensors:
+            upd.append(f"rate[{j}] = {p}_clamp(rate[{j}], {P}_R_LO[{j}], {P}_R_HI[{j}]);")
+    for j in t_sensors:
+        upd.append(f"const {r} u{j} = (T[{j}] - {P}_T_CENTER[{j}]) / {P}_T_SCALE[{j}];")
+    for j in v_sensors:
+        upd.append(f"const {r} v{j} = (rate[{j}] - {P}_R_CENTER[{j}]) / {P}_R_SCALE[{j}];")
+    for j in w_sensors:
+        upd.append(f"const {r} w{j} = (T[{j}] * rate[{j}] - {P}_W_CENTER[{j}]) / {P}_W_SCALE[{j}];")
+
+    def power(x: str, n: int) -> str:
+        out = x
+        for _ in range(n - 1):
+            out = f"({out} * {x})"
+        return out
+
+    for i, t in enumerate(terms):
+        j = int(t["sensor"])
+        factors = [
+            power(f"{var}{j}", int(t[key]))
+            for var, key in (("u", "t_power"), ("v", "rate_power"), ("w", "coupling_power"))
+            if int(t[key])
+        ]
+        val = factors[0]
+        for fct in factors[1:]:
+            val = f"({val} * {fct})"
+        label = str(t.get("name", "")).replace("*/", "* /")
+        upd.append(f"acc += {val} * {P}_COEF[{i}]; /* {label} */")
+    upd.append(f"return acc + {P}_CONSTANT;")
+    notes = [
+        f"Polynomial model (SPEC 4a): {len(terms)} terms + constant in the centred and scaled",
+        "base variables u = (T - c_T)/s_T, v = (dT - c_R)/s_R, w = (T dT - c_W)/s_W",
+        "(dT = backward difference over the rate interval, degC/min). Inputs are clamped",
+        "to the fitted temperature (and rate) range. Call init at power-on.",
+    ]
+    return FamilyCode(
+        state_fields=fields or ["int unused; /* no state */"],
+        data="\n".join(data),
+        init=init or "s->unused = 0;",
+        update="\n".join(upd),
+        defines=defines,
+        notes=notes,
+    )
+
+
 # --- families: warmup --------------------------------------------------------------------------
 
 

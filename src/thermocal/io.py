@@ -29,6 +29,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 import pyarrow as pa
+import pyarrow.csv as pacsv
 import pyarrow.parquet as pq
 
 from thermocal import units
@@ -312,7 +313,8 @@ def write_recording(
 
     CSV files get a sidecar ``FILE.meta.json``; Parquet files carry the same JSON in
     their key-value metadata (and a sidecar only if ``sidecar=True``).
-    Time is written in [s].
+    Time is written in [s].  CSV numbers are written by Arrow's writer in their
+    shortest exact form, so a CSV round-trip reproduces every float64 bit.
     """
     p = Path(path)
     kind = file_kind(p)
@@ -329,9 +331,9 @@ def write_recording(
         if sidecar:
             write_json(sidecar_path(p), info)
     else:
-        df = pd.DataFrame(data)
-        with atomic_write(p, "w") as fh:
-            df.to_csv(fh, index=False, float_format="%.17g", lineterminator="\n")
+        table = pa.table(data)
+        opts = pacsv.WriteOptions(include_header=True, quoting_style="needed")
+        atomic_write_path(p, lambda tmp: pacsv.write_csv(table, tmp, write_options=opts))
         if sidecar is None or sidecar:
             write_json(sidecar_path(p), info)
     return p

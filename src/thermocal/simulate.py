@@ -252,6 +252,10 @@ class ThermalNetwork:
         return _plain_dict(d)
 
 
+_CHUNK = 1 << 15
+"""Samples per block of the thermal recursion (keeps the work in cache)."""
+
+
 def uniform_step(time_s: FloatArray, what: str = "time") -> float:
     """The constant sample interval [s] of a uniform time grid (relative tolerance 1e-6)."""
     if time_s.size < 2:
@@ -270,6 +274,7 @@ def simulate_nodes(
     *,
     power_on_s: float | None = 0.0,
     warmed_up: bool = False,
+    dt_s: float | None = None,
 ) -> tuple[FloatArray, FloatArray]:
     """Node temperatures [°C] and rates [°C/min] of the network for an air history.
 
@@ -278,46 +283,46 @@ def simulate_nodes(
     the powered steady state.  Exact for air linear between samples (uniform grid):
     per mode ``z_i`` (:meth:`ThermalNetwork.modes`) the air response is a first-order
     recursion and the power-step response ``w_P/λ (1 − e^{−λ(t − t_on)})``; ``T = M z``.
+    ``dt_s`` is the grid step when already checked by the caller.
     Returns ``(temperatures (n, k), rates_c_per_min (n, k))``, column-contiguous.
     """
-    h = uniform_step(time_s)
+    h = uniform_step(time_s) if dt_s is None else float(dt_s)
     lam, m, w_air, w_pow = network.modes()
+    a, b0, b1 = _foh_coefficients(lam, h)
     n, k = time_s.size, network.n_nodes
-    temps = np.zeros((k, n))
-    rates = np.zeros((k, n))
-    scratch = np.empty(n)
+    temps = np.empty((k, n))
+    rates = np.empty((k, n))
+    m_rate = m * units.SECONDS_PER_MINUTE
     u0 = float(air_c[0])
-    if warmed_up:
-        i_on = 0
-    elif power_on_s is None:
-        i_on = n
-    else:
-        i_on = int(np.searchsorted(time_s, float(power_on_s), side="left"))
-    for i in range(k):
-        li, wa, wp = float(lam[i]), float(w_air[i]), float(w_pow[i])
-        z = _first_order(air_c, li, wa, h, wa * u0 / li)
-        dz = np.multiply(air_c, wa)
-        dz -= li * z
-        if i_on < n and wp != 0.0:
-            if warmed_up:
-                z += wp / li
-            else:
-                decay = time_s[i_on:] - float(power_on_s or 0.0)
-                decay *= -li
-                np.exp(decay, out=decay)
-                z[i_on:] += wp / li
-                z[i_on:] -= (wp / li) * decay
-                decay *= wp
-                dz[i_on:] += decay
-                del decay
-        for j in range(k):
-            mj = float(m[j, i])
-            if mj != 0.0:
-                np.multiply(z, mj, out=scratch)
-                temps[j] += scratch
-                np.multiply(dz, mj * units.SECONDS_PER_MINUTE, out=scratch)
-                rates[j] += scratch
-        del z, dz
+    # z[-1] = z0 (soaked steady state) and u[-1] = u0 make the recursion exact from n = 0
+    z_last = w_air * u0 / lam
+    pow_ss = w_pow / lam
+    t_on = 0.0 if power_on_s is None else float(power_on_s)
+    powered = warmed_up or power_on_s is not None
+    zc = np.empty((k, _CHUNK))
+    dzc = np.empty((k, _CHUNK))
+    for s0 in range(0, n, _CHUNK):
+        s1 = min(n, s0 + _CHUNK)
+        c = s1 - s0
+        u = air_c[s0:s1]
+        up = air_c[s0 - 1 : s1 - 1] if s0 > 0 else np.concatenate(([u0], air_c[: s1 - 1]))
+        for i in range(k):
+            v = (w_air[i] * b1[i]) * u + (w_air[i] * b0[i]) * up
+            zc[i, :c], _ = lfilter([1.0], [1.0, -a[i]], v, zi=[a[i] * z_last[i]])
+            z_last[i] = zc[i, c - 1]
+        np.multiply(w_air[:, None], u[None, :], out=dzc[:, :c])
+        dzc[:, :c] -= lam[:, None] * zc[:, :c]
+        if warmed_up:
+            zc[:, :c] += pow_ss[:, None]
+        elif powered:
+            since = time_s[s0:s1] - t_on
+            if since[-1] >= 0:
+                on = since >= 0
+                decay = np.exp(-lam[:, None] * np.maximum(since, 0.0)[None, :])
+                zc[:, :c] += pow_ss[:, None] * (1.0 - decay) * on
+                dzc[:, :c] += w_pow[:, None] * decay * on
+        np.matmul(m, zc[:, :c], out=temps[:, s0:s1])
+        np.matmul(m_rate, dzc[:, :c], out=rates[:, s0:s1])
     return temps.T, rates.T
 
 
@@ -333,6 +338,12 @@ class ThermalResult:
     rates_c_per_min: FloatArray
     names: tuple[str, ...]
     time_constants_s: FloatArray
+    dt_s: float = float("nan")
+
+    @property
+    def sample_interval_s(self) -> float:
+        """The (uniform) sample interval [s]."""
+        return self.dt_s if math.isfinite(self.dt_s) else uniform_step(self.time_s)
 
 
 def simulate_thermal(
@@ -354,8 +365,11 @@ def simulate_thermal(
         np.asarray(program_setpoint_c, dtype=np.float64),
         chamber,
     )
-    temps, rates = simulate_nodes(t, air, network, power_on_s=power_on_s, warmed_up=warmed_up)
-    return ThermalResult(t, sp, air, temps, rates, network.names, network.time_constants_s())
+    h = uniform_step(t)
+    temps, rates = simulate_nodes(
+        t, air, network, power_on_s=power_on_s, warmed_up=warmed_up, dt_s=h
+    )
+    return ThermalResult(t, sp, air, temps, rates, network.names, network.time_constants_s(), h)
 
 
 # --- bias model ----------------------------------------------------------------------------------
@@ -561,18 +575,34 @@ def flicker_noise(n: int, dt_s: float, b: float, rng: np.random.Generator) -> Fl
     return np.asarray(x[:n], dtype=np.float64)
 
 
+FLICKER_MAX_RATE_HZ = 10.0
+"""Flicker noise is synthesised at this rate at most (held constant within each block)."""
+
+
 def simulate_noise(n: int, dt_s: float, noise: NoiseParams, rng: np.random.Generator) -> FloatArray:
-    """Sum of white (N/√τ0 per sample), flicker (:func:`flicker_noise`), rate random
-    walk (cumulative sum of N(0, K² τ0)) and rate ramp (R·t) noise, n samples at τ0 = dt_s.
+    """Sum of white (N/√τ0 per sample), flicker (:func:`flicker_noise`, at most at
+    :data:`FLICKER_MAX_RATE_HZ`), rate random walk (cumulative sum of N(0, K² τ0)) and
+    rate ramp (R·t) noise, n samples at τ0 = dt_s.
     Samples are mean rates over each interval (IEEE Std 952 Annex C)."""
-    out = np.zeros(n)
     if noise.white_density:
-        w = rng.standard_normal(n)
-        w *= noise.white_density / math.sqrt(dt_s)
-        out += w
-        del w
+        out = rng.standard_normal(n)
+        out *= noise.white_density / math.sqrt(dt_s)
+    else:
+        out = np.zeros(n)
     if noise.bias_instability:
-        out += flicker_noise(n, dt_s, noise.bias_instability, rng)
+        # flicker is synthesised at ≤ FLICKER_MAX_RATE_HZ and held over each block: it is
+        # far below the white noise at short τ, and cluster averages over whole blocks are
+        # exactly those of flicker at the lower rate
+        m = max(1, math.floor(1.0 / (dt_s * FLICKER_MAX_RATE_HZ) + 1e-9))
+        n_blocks = -(-n // m)
+        fl = flicker_noise(n_blocks, dt_s * m, noise.bias_instability, rng)
+        if m == 1:
+            out += fl
+        else:
+            whole = out[: (n // m) * m].reshape(-1, m)  # a view: updated in place
+            whole += fl[: n // m, None]
+            if n % m:
+                out[(n // m) * m :] += fl[-1]
     if noise.rate_random_walk:
         w = rng.standard_normal(n)
         w *= noise.rate_random_walk * math.sqrt(dt_s)
@@ -812,7 +842,7 @@ def simulate_sensor(
     """
     t = thermal.time_s
     n = t.size
-    dt = uniform_step(t)
+    dt = thermal.sample_interval_s
     model = bias_model or preset.bias_model
     on_idx = int(np.searchsorted(t, power_on_s))
     on_idx = min(max(on_idx, 0), n - 1)
@@ -955,7 +985,7 @@ def _truth(
             "unit": preset.unit,
             "signal": "gyro" if preset.kind == "gyro" else "accel",
             "signal_unit": out.signal_unit,
-            "sample_rate_hz": 1.0 / uniform_step(thermal.time_s),
+            "sample_rate_hz": 1.0 / thermal.sample_interval_s,
             "n_samples": int(thermal.time_s.size),
             "bias_constant": preset.bias_constant,
             "turn_on_offset": out.turn_on_offset,

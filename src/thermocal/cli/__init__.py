@@ -57,7 +57,8 @@ def main(argv: list[str] | None = None) -> int:
         return 1
     except typer.TyperException as exc:
         code = int(getattr(exc, "exit_code", 2))
-        print(f"error: {' '.join(exc.format_message().split())}", file=sys.stderr)
+        message = " ".join(exc.format_message().split()) or "missing command or argument"
+        print(f"error: {message} (see --help)", file=sys.stderr)
         return code if code else 2
     except SystemExit as exc:
         status = exc.code

@@ -18,6 +18,10 @@ from thermocal.cli.common import JsonOpt, emit, fmt, handle_errors, progress, st
 from thermocal.demo import DEMO_STEPS, QUICK, run_demo
 
 
+def _pct(value: float | None) -> str:
+    return "—" if value is None else f"{value:+.1f} %"
+
+
 @app.command("demo")
 @handle_errors
 def demo_cmd(
@@ -69,27 +73,30 @@ def demo_cmd(
     }
 
     def human() -> None:
-        table = Table(title=f"thermocal demo (seed {res.seed}) — validation on a weakly "
-                      "correlated run, bias in °/h")  # fmt: skip
-        table.add_column("model")
-        table.add_column("coeffs", justify="right")
-        table.add_column("r", justify="right")
-        table.add_column("stability before → after", justify="right")
-        table.add_column("repeatability before → after", justify="right")
-        table.add_column("improvement", justify="right")
-        for m in res.models:
-            imp = m.improvement_pct.get("bias_stability")
+        models = res.models
+        table = Table(title=f"thermocal demo (seed {res.seed}): validation run, °/h")
+        table.add_column("figure")
+        table.add_column("before", justify="right")
+        for m in models:
+            table.add_column(f"after, {m.label}" + (" *" if m is models[0] else ""),
+                             justify="right")  # fmt: skip
+        table.add_row("coefficients", "", *(str(m.n_coefficients) for m in models))
+        table.add_row("r (limit 0.4)", "", *(fmt(m.r, 3) for m in models))
+        for key, label in (
+            ("bias_stability", "bias stability"),
+            ("bias_repeatability", "bias repeatability"),
+        ):
             table.add_row(
-                m.label + (" (reported)" if m is res.models[0] else ""),
-                str(m.n_coefficients),
-                fmt(m.r, 3),
-                f"{fmt(m.bias_stability_before)} → {fmt(m.bias_stability_after)}",
-                f"{fmt(m.bias_repeatability_before)} → {fmt(m.bias_repeatability_after)}",
-                "—" if imp is None else f"{imp:.1f} %",
+                label,
+                fmt(getattr(models[0], f"{key}_before")),
+                *(
+                    f"{fmt(getattr(m, f'{key}_after'))} ({_pct(m.improvement_pct.get(key))})"
+                    for m in models
+                ),
             )
         stdout.print(table)
-        stdout.print(f"files in [bold]{res.out_dir}[/bold] ({len(res.files)} written, "
-                     f"{res.elapsed_s:.1f} s)")  # fmt: skip
+        stdout.print("* reported model; (…) improvement")
+        stdout.print(f"{len(res.files)} files in {res.out_dir} ({res.elapsed_s:.1f} s)")
         stdout.print(f"report: [bold]{res.report_path}[/bold]")
 
     emit(out, as_json, human)

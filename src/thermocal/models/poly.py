@@ -72,13 +72,15 @@ those are for reading, the scaled basis above is for evaluation.
 
 from __future__ import annotations
 
+import itertools
 import math
 import warnings
 from collections import deque
 from collections.abc import Iterator, Sequence
-from typing import Any, ClassVar, Literal, Self, cast
+from typing import Any, ClassVar, Self, cast
 
 import numpy as np
+import numpy.typing as npt
 
 from thermocal.errors import ConditioningWarning, ExtrapolationWarning, ThermocalInputError
 from thermocal.models.base import (
@@ -95,17 +97,18 @@ from thermocal.models.terms import (
     Chunk,
     Term,
     accumulate_r,
-    backward_rates,
     fit_base_scaling,
     forward_select,
     monomial_name,
     parse_terms,
     raw_expansion,
+    segment_rates,
     solve_r,
+    temperature_rates,
     term_features,
 )
-from thermocal.preprocess import RATE_METHODS, temperature_rate
-from thermocal.recording import GAP_FACTOR, FloatArray
+from thermocal.preprocess import RATE_METHODS
+from thermocal.recording import GAP_FACTOR, FloatArray, contiguous_slices
 from thermocal.units import SECONDS_PER_MINUTE
 
 DEFAULT_RCOND = 1.0e-9
@@ -113,6 +116,9 @@ DEFAULT_RCOND = 1.0e-9
 
 COND_WARN = 1.0e8
 """Condition number above which a :class:`ConditioningWarning` is raised."""
+
+SCALING_SAMPLES = 200_000
+"""Centres and scales of the base variables come from at most this many evenly spaced samples."""
 
 HOLDOUT_BLOCKS = 10
 """Hold-out selection splits each run into this many equal blocks; odd blocks are held out."""
@@ -131,7 +137,8 @@ def check_runs(runs: Sequence[RunData], family: str) -> list[RunData]:
             raise ThermocalInputError(f"{r.name or 'run'}: no signal to fit")
         if r.temps_c.shape[1] != k:
             raise ThermocalInputError(
-                f"{r.name or 'run'}: has {r.temps_c.shape[1]} temperature columns, the first run {k}"
+                f"{r.name or 'run'}: has {r.temps_c.shape[1]} temperature columns, "
+                f"the first run {k}"
             )
         if r.temp_names and rl[0].temp_names and r.temp_names != rl[0].temp_names:
             raise ThermocalInputError(
@@ -143,22 +150,21 @@ def check_runs(runs: Sequence[RunData], family: str) -> list[RunData]:
     return rl
 
 
-def clamp_rates(
-    rates: FloatArray,
+def warn_rate_range(
+    seen_lo: FloatArray,
+    seen_hi: FloatArray,
     rate_range: FloatArray,
     names: Sequence[str],
     used: Sequence[int],
     *,
     extrapolate: bool,
-) -> FloatArray:
-    """Clamp Ṫ [°C/min] of the used sensors to the fitted rate range (warns)."""
+) -> None:
+    """:class:`ExtrapolationWarning` when Ṫ of a used sensor left the fitted rate range."""
     lo, hi = rate_range[:, 0], rate_range[:, 1]
-    out = rates
-    bad = [j for j in used if (rates[:, j] < lo[j]).any() or (rates[:, j] > hi[j]).any()]
+    bad = [j for j in used if seen_lo[j] < lo[j] or seen_hi[j] > hi[j]]
     if bad:
         where = ", ".join(
-            f"d{names[j]} {rates[:, j].min():.3g}…{rates[:, j].max():.3g} °C/min "
-            f"(fitted {lo[j]:.3g}…{hi[j]:.3g})"
+            f"d{names[j]} {seen_lo[j]:.3g}…{seen_hi[j]:.3g} °C/min (fitted {lo[j]:.3g}…{hi[j]:.3g})"
             for j in bad
         )
         action = "extrapolating" if extrapolate else "clamped to the fitted range"
@@ -167,11 +173,61 @@ def clamp_rates(
             ExtrapolationWarning,
             stacklevel=3,
         )
-        if not extrapolate:
-            out = rates.copy()
-            for j in bad:
-                np.clip(out[:, j], lo[j], hi[j], out=out[:, j])
+
+
+Block = tuple[int, int, int, int, int]
+"""(segment start, segment stop, block start, block stop, fold) row indices of one block."""
+
+
+def run_blocks(time_s: FloatArray, n_folds: int = 1, chunk: int = CHUNK_ROWS) -> list[Block]:
+    """Blocks of ≤ ``chunk`` rows that never cross a gap (nor, with 2 folds, a hold-out edge).
+
+    With ``n_folds == 2`` the run is cut into :data:`HOLDOUT_BLOCKS` equal parts
+    by sample index and the odd parts form fold 1 (blocked hold-out).
+    """
+    n = int(time_s.size)
+    if n_folds == 1:
+        edges = [0, n]
+    else:
+        edges = sorted({round(n * j / HOLDOUT_BLOCKS) for j in range(HOLDOUT_BLOCKS + 1)})
+    out: list[Block] = []
+    for sl in contiguous_slices(time_s):
+        s0, s1 = int(sl.start), int(sl.stop)
+        cuts = sorted({s0, s1, *[e for e in edges if s0 < e < s1]})
+        for a0, b0 in itertools.pairwise(cuts):
+            part = int(np.searchsorted(edges, a0, side="right")) - 1
+            fold = part % 2 if n_folds == 2 else 0
+            for a in range(a0, b0, chunk):
+                out.append((s0, s1, a, min(b0, a + chunk), fold))
     return out
+
+
+def record_ranges(
+    model: TemperatureModel,
+    runs: Sequence[RunData],
+    stats: FitStats,
+    rate_bounds: tuple[FloatArray, FloatArray] | None,
+) -> None:
+    """``model._record_common`` fed with per-run minima and maxima (no full-size copies).
+
+    ``rate_bounds`` = (per-run minima, per-run maxima) of Ṫ, shape (n_runs, k).
+    """
+    summary = [
+        RunData(
+            time_s=np.array([0.0, 1.0]),
+            temps_c=np.vstack([r.temps_c.min(axis=0), r.temps_c.max(axis=0)]),
+            temp_names=r.temp_names,
+            name=r.name,
+        )
+        for r in runs
+    ]
+    rates = (
+        [np.vstack([lo, hi]) for lo, hi in zip(rate_bounds[0], rate_bounds[1], strict=True)]
+        if rate_bounds is not None
+        else None
+    )
+    model._record_common(summary, stats, rates=rates)
+    model.data_ = [{"file": r.name, "n_samples": r.n_samples} for r in runs]
 
 
 @register
@@ -267,39 +323,20 @@ class PolyModel(TemperatureModel):
         if self.solver not in ("auto", "qr", "gram"):
             raise ThermocalInputError(f"unknown solver {self.solver!r}; use auto, qr or gram")
 
-    def rates(self, time_s: FloatArray, temps_c: FloatArray) -> FloatArray:
-        """Ṫ of every temperature column [°C/min] with the model's rate form."""
-        if self.rate_method == "backward":
-            return backward_rates(time_s, temps_c, float(self.rate_interval_s))
-        cols = [
-            temperature_rate(
-                time_s,
-                temps_c[:, j],
-                float(self.rate_interval_s),
-                cast(Literal["forward", "backward", "centred"], self.rate_method),
-            )
-            for j in range(temps_c.shape[1])
-        ]
-        return np.column_stack(cols) if cols else np.zeros_like(temps_c)
-
-    @property
-    def model_uses_rate(self) -> bool:
-        """True when a fitted term uses Ṫ."""
-        return any(t.uses_rate for t in self.terms_)
-
     # -- estimator contract --
     def fit(self, runs: Sequence[RunData]) -> Self:
-        """Least-squares fit of eq. (1) on one or several runs; returns ``self``."""
+        """Least-squares fit of eq. (1) on one or several runs; returns ``self``.
+
+        Works through each run in blocks of :data:`~thermocal.models.terms.CHUNK_ROWS`
+        samples (Ṫ, features and the reduction per block), so memory stays at the
+        input arrays plus a few MB.
+        """
         self._check_params()
         rl = check_runs(runs, self.family)
         k = rl[0].temps_c.shape[1]
         terms = parse_terms(self.terms, k, self.order)
         uses_rate = any(t.uses_rate for t in terms)
-        temps = [r.temps_c for r in rl]
-        rates = [self.rates(r.time_s, r.temps_c) for r in rl] if uses_rate else None
-        ys = [r.target() for r in rl]
         n_total = sum(r.n_samples for r in rl)
-        scaling = fit_base_scaling(temps, rates, terms)
         p = len(terms)
         m = len(rl) if self.per_run_offset else 1
         n_folds = 2 if self.select == "holdout" else 1
@@ -307,42 +344,63 @@ class PolyModel(TemperatureModel):
             raise ThermocalInputError(
                 f"poly: {n_total} samples for {p + m} coefficients; need more samples than terms"
             )
+        plans = [run_blocks(r.time_s, n_folds) for r in rl]
+        # centres and scales of the base variables from ≤ SCALING_SAMPLES evenly spaced samples
+        step = max(1, math.ceil(n_total / SCALING_SAMPLES))
+        t_sub: list[FloatArray] = []
+        r_sub: list[FloatArray] = []
+        for r, plan in zip(rl, plans, strict=True):
+            idx = np.arange(0, r.n_samples, step)
+            t_sub.append(r.temps_c[idx])
+            if uses_rate:
+                r_sub.append(self._rates_at(r, plan, idx))
+        scaling = fit_base_scaling(t_sub, r_sub if uses_rate else None, terms)
+        del t_sub, r_sub
+        rate_lo = np.full((len(rl), k), np.inf)
+        rate_hi = np.full((len(rl), k), -np.inf)
+        sums = np.zeros(3)  # n, Σ(y − y0), Σ(y − y0)²
 
         def make_chunks() -> Iterator[Chunk]:
-            buf = np.empty((CHUNK_ROWS, p))
-            for i, r in enumerate(rl):
+            bufs: dict[int, FloatArray] = {}
+            sums[:] = 0.0
+            y0 = float(rl[0].target()[0])
+            for i, (r, plan) in enumerate(zip(rl, plans, strict=True)):
                 g = i if self.per_run_offset else 0
-                n = r.n_samples
-                if n_folds == 1:
-                    blocks = [(0, n, 0)]
-                else:
-                    edges = [round(n * j / HOLDOUT_BLOCKS) for j in range(HOLDOUT_BLOCKS + 1)]
-                    blocks = [(edges[j], edges[j + 1], j % 2) for j in range(HOLDOUT_BLOCKS)]
-                for a0, b0, fold in blocks:
-                    for a in range(a0, b0, CHUNK_ROWS):
-                        b = min(b0, a + CHUNK_ROWS)
-                        F = term_features(
-                            terms,
-                            scaling,
-                            temps[i][a:b],
-                            rates[i][a:b] if rates is not None else None,
-                            out=buf[: b - a],
+                sig = cast(FloatArray, r.signal)
+                for s0, s1, a, b, fold in plan:
+                    rates: FloatArray | None = None
+                    if uses_rate:
+                        rates = segment_rates(
+                            r.time_s[s0:s1],
+                            r.temps_c[s0:s1],
+                            np.arange(a - s0, b - s0),
+                            float(self.rate_interval_s),
+                            self.rate_method,
                         )
-                        yield F, ys[i][a:b], g, fold
+                        np.minimum(rate_lo[i], rates.min(axis=0), out=rate_lo[i])
+                        np.maximum(rate_hi[i], rates.max(axis=0), out=rate_hi[i])
+                    c = b - a
+                    if c not in bufs:
+                        bufs[c] = np.empty((c, p), order="F")
+                    F = term_features(terms, scaling, r.temps_c[a:b], rates, out=bufs[c])
+                    y = sig[a:b] - r.known_input
+                    d = y - y0
+                    sums[0] += c
+                    sums[1] += float(np.sum(d))
+                    sums[2] += float(d @ d)
+                    yield F, y, g, fold
 
-        red = accumulate_r(
-            make_chunks, p, m, n_folds=n_folds, solver=cast(Any, self.solver)
-        )
+        red = accumulate_r(make_chunks, p, m, n_folds=n_folds, solver=cast(Any, self.solver))
         names = [t.name for t in terms] + (
-            [f"offset[{r.name or i + 1}]" for i, r in enumerate(rl)] if self.per_run_offset else ["const"]
+            [f"offset[{r.name or i + 1}]" for i, r in enumerate(rl)]
+            if self.per_run_offset
+            else ["const"]
         )
         required = list(range(p, p + m))
         selection: dict[str, Any] | None = None
         kept = list(range(p))
         if self.select is not None:
-            sel = forward_select(
-                red, list(range(p)), required, names, cast(Any, self.select)
-            )
+            sel = forward_select(red, list(range(p)), required, names, cast(Any, self.select))
             kept = sorted(c for c in sel.kept if c < p)
             selection = {
                 "method": sel.method,
@@ -377,11 +435,8 @@ class PolyModel(TemperatureModel):
                 ConditioningWarning,
                 stacklevel=2,
             )
-        tss = 0.0
-        ybar = sum(float(np.sum(y)) for y in ys) / n_total
-        for y in ys:
-            d = y - ybar
-            tss += float(d @ d)
+        n_s, s1_, s2_ = sums
+        tss = s2_ - s1_ * s1_ / n_s
         self.terms_ = [terms[c] for c in kept]
         self.scaling_ = scaling
         self.coef_ = np.asarray(coef, dtype=np.float64)
@@ -394,7 +449,7 @@ class PolyModel(TemperatureModel):
             n_coefficients=pk + 1,
             rms_residual=math.sqrt(sol.rss / n_total),
             condition_number=sol.condition_number,
-            r_squared=1.0 - sol.rss / tss if tss > 0 else None,
+            r_squared=float(1.0 - sol.rss / tss) if tss > 0 else None,
             dof=sol.dof,
             extra={
                 "rank": sol.rank,
@@ -408,23 +463,36 @@ class PolyModel(TemperatureModel):
                 "selected_terms": selection["kept"] if selection else None,
             },
         )
-        self._record_common(rl, stats, rates=rates)
+        record_ranges(self, rl, stats, (rate_lo, rate_hi) if uses_rate else None)
         return self
 
+    def _rates_at(self, run: RunData, plan: list[Block], idx: npt.NDArray[np.intp]) -> FloatArray:
+        out = np.zeros((idx.size, run.temps_c.shape[1]))
+        for s0, s1 in sorted({(b[0], b[1]) for b in plan}):
+            sel = (idx >= s0) & (idx < s1)
+            if sel.any():
+                out[sel] = segment_rates(
+                    run.time_s[s0:s1],
+                    run.temps_c[s0:s1],
+                    idx[sel] - s0,
+                    float(self.rate_interval_s),
+                    self.rate_method,
+                )
+        return out
+
+    def rates(self, time_s: FloatArray, temps_c: FloatArray) -> FloatArray:
+        """Ṫ of every temperature column [°C/min] with the model's rate form and Δt."""
+        return temperature_rates(time_s, temps_c, float(self.rate_interval_s), self.rate_method)
+
+    @property
+    def model_uses_rate(self) -> bool:
+        """True when a fitted term uses Ṫ."""
+        return any(t.uses_rate for t in self.terms_)
+
     def _evaluate(self, temps_c: FloatArray, rates: FloatArray | None) -> FloatArray:
-        n = temps_c.shape[0]
-        out = np.empty(n)
-        buf = np.empty((min(n, CHUNK_ROWS), len(self.terms_)))
-        for a in range(0, n, CHUNK_ROWS):
-            b = min(n, a + CHUNK_ROWS)
-            F = term_features(
-                self.terms_,
-                self.scaling_,
-                temps_c[a:b],
-                rates[a:b] if rates is not None else None,
-                out=buf[: b - a],
-            )
-            out[a:b] = F @ self.coef_ + self.constant_
+        """``constant + Σ coef_j · term_j`` for a block (temperatures and rates already clamped)."""
+        F = term_features(self.terms_, self.scaling_, temps_c, rates)
+        out: FloatArray = F @ self.coef_ + self.constant_
         return out
 
     def _rate_sensors(self) -> list[int]:
@@ -434,26 +502,46 @@ class PolyModel(TemperatureModel):
         """Temperature-induced signal of every sample [signal unit] (module docstring steps 1–4)."""
         self.check_fitted()
         self._check_temps(run)
-        rates: FloatArray | None = None
-        if self.model_uses_rate:
-            rates = self.rates(run.time_s, run.temps_c)
         temps = self.clamp(run.temps_c, extrapolate=extrapolate)
-        if rates is not None and self.rate_range_ is not None:
-            rates = clamp_rates(
-                rates,
-                self.rate_range_,
-                self.temp_names_,
-                self._rate_sensors(),
-                extrapolate=extrapolate,
-            )
-        return self._evaluate(temps, rates)
+        uses_rate = self.model_uses_rate
+        js = self._rate_sensors()
+        rr = self.rate_range_
+        n = run.n_samples
+        out = np.empty(n)
+        seen_lo = np.full(run.temps_c.shape[1], np.inf)
+        seen_hi = np.full(run.temps_c.shape[1], -np.inf)
+        bufs: dict[int, FloatArray] = {}
+        for s0, s1, a, b, _f in run_blocks(run.time_s, 1):
+            rates: FloatArray | None = None
+            if uses_rate:
+                rates = segment_rates(
+                    run.time_s[s0:s1],
+                    run.temps_c[s0:s1],
+                    np.arange(a - s0, b - s0),
+                    float(self.rate_interval_s),
+                    self.rate_method,
+                )
+                np.minimum(seen_lo, rates.min(axis=0), out=seen_lo)
+                np.maximum(seen_hi, rates.max(axis=0), out=seen_hi)
+                if rr is not None and not extrapolate:
+                    for j in js:
+                        np.clip(rates[:, j], rr[j, 0], rr[j, 1], out=rates[:, j])
+            c = b - a
+            if c not in bufs:
+                bufs[c] = np.empty((c, len(self.terms_)), order="F")
+            F = term_features(self.terms_, self.scaling_, temps[a:b], rates, out=bufs[c])
+            out[a:b] = F @ self.coef_ + self.constant_
+        if uses_rate and rr is not None:
+            warn_rate_range(seen_lo, seen_hi, rr, self.temp_names_, js, extrapolate=extrapolate)
+        return out
 
     def stream(self, sample_interval_s: float, *, extrapolate: bool = False) -> PolyStream:
         """Sample-by-sample twin of :meth:`predict` (needs the backward rate form)."""
         self.check_fitted()
         if self.model_uses_rate and self.rate_method != "backward":
             raise ThermocalInputError(
-                f"streaming needs the causal 'backward' rate form; this model uses {self.rate_method!r}"
+                "streaming needs the causal 'backward' rate form; this model uses "
+                f"{self.rate_method!r}"
             )
         return PolyStream(self, sample_interval_s, extrapolate=extrapolate)
 
@@ -591,7 +679,7 @@ class PolyStream(ModelStream):
             else:
                 rates = np.zeros_like(T)
         action = "extrapolating" if self.extrapolate else "clamped to the fitted range"
-        if (T < self.t_lo).any() or (T > self.t_hi).any():
+        if np.any(np.less(T, self.t_lo)) or np.any(np.greater(T, self.t_hi)):
             self._warn("T", f"temperature outside the model's fitted range; {action}")
             if not self.extrapolate:
                 T = np.clip(T, self.t_lo, self.t_hi)

@@ -61,7 +61,7 @@ from typing import Any, Literal
 import numpy as np
 import numpy.typing as npt
 from scipy import linalg as sla
-from scipy.linalg import lapack
+from scipy.linalg import blas, lapack
 
 from thermocal.errors import DesignError, ThermocalInputError
 from thermocal.recording import GAP_FACTOR, FloatArray, contiguous_slices
@@ -93,7 +93,9 @@ class Term:
         if min(self.t_power, self.rate_power, self.coupling_power) < 0 or self.sensor < 0:
             raise ThermocalInputError(f"invalid term {self!r}")
         if self.t_power + self.rate_power + self.coupling_power == 0:
-            raise ThermocalInputError("a term must have a positive power (the constant is implicit)")
+            raise ThermocalInputError(
+                "a term must have a positive power (the constant is implicit)"
+            )
 
     @property
     def uses_rate(self) -> bool:
@@ -106,7 +108,8 @@ class Term:
 
     @property
     def name(self) -> str:
-        """Canonical text: ``T1``, ``T1^2``, ``dT1^3``, ``T1*dT1``, ``(T1*dT1)^2``, ``T1*(T1*dT1)``."""
+        """Canonical text: ``T1``, ``T1^2``, ``dT1^3``, ``T1*dT1``, ``(T1*dT1)^2``, ``T1*(T1*dT1)``.
+        """
         k = self.sensor + 1
 
         def pw(base: str, p: int) -> str:
@@ -248,7 +251,9 @@ def parse_term(text: str, n_sensors: int) -> Term | None:
     return Term(sensor, t_power=p - c, rate_power=q - c, coupling_power=c)
 
 
-def parse_terms(spec: str | Sequence[str] | None, n_sensors: int, order: int | None = None) -> list[Term]:
+def parse_terms(
+    spec: str | Sequence[str] | None, n_sensors: int, order: int | None = None
+) -> list[Term]:
     """Term list from a ``--terms`` value, or a plain polynomial from ``order``.
 
     ``spec``: ``"seed000"`` (default when both are None), a comma-separated
@@ -360,12 +365,12 @@ def fit_base_scaling(
         ]
         if rates is not None:
             rr = rates
-            checks.append(("dT", lambda t: t.rate_power > 0, lambda i, j=j: rr[i][:, j]))
+            checks.append(("dT", lambda t: t.rate_power > 0, lambda i, j=j, rr=rr: rr[i][:, j]))
             checks.append(
                 (
                     "T*dT",
                     lambda t: t.coupling_power > 0,
-                    lambda i, j=j: temps[i][:, j] * rr[i][:, j],
+                    lambda i, j=j, rr=rr: temps[i][:, j] * rr[i][:, j],
                 )
             )
         for label, needs, get in checks:
@@ -374,7 +379,7 @@ def fit_base_scaling(
                 continue
             m, s = mean_std(get)
             if not s > 1e-12 * max(1.0, abs(m)):
-                what = label.replace("T", f"T{j + 1}", 1) if label != "T*dT" else f"T{j + 1}*dT{j + 1}"
+                what = {"T": f"T{j + 1}", "dT": f"dT{j + 1}"}.get(label, f"T{j + 1}*dT{j + 1}")
                 raise DesignError(
                     f"base variable {what} is constant over the fitted data, so term(s) "
                     + ", ".join(t.name for t in users)
@@ -389,15 +394,6 @@ def fit_base_scaling(
     return BaseScaling(tc, ts, rc, rs, wc, ws)
 
 
-def _ipow(x: FloatArray, p: int, cache: dict[int, FloatArray]) -> FloatArray:
-    """x**p by repeated multiplication (same arithmetic for every block length)."""
-    if p in cache:
-        return cache[p]
-    out = x if p == 1 else _ipow(x, p - 1, cache) * x
-    cache[p] = out
-    return out
-
-
 def term_features(
     terms: Sequence[Term],
     scaling: BaseScaling,
@@ -408,70 +404,148 @@ def term_features(
     """Evaluate the terms (eq. 1) for a block of samples: returns (n, n_terms).
 
     ``temps_c`` (n, k) [°C], ``rates_c_per_min`` (n, k) [°C/min] (needed when a
-    term uses Ṫ).  ``out`` may be a preallocated (n, ≥ n_terms) array (any
-    memory order); its first columns are filled.
+    term uses Ṫ).  ``out`` may be a preallocated (n, n_terms) array (Fortran
+    order is fastest).  Powers are built by repeated multiplication
+    (``x³ = x²·x``), the same arithmetic for any block length.
     """
     n = temps_c.shape[0]
     if out is None:
-        out = np.empty((n, len(terms)), dtype=np.float64)
-    caches: dict[tuple[int, str], dict[int, FloatArray]] = {}
-    base: dict[tuple[int, str], FloatArray] = {}
+        out = np.empty((n, len(terms)), dtype=np.float64, order="F")
+    powers: dict[tuple[int, str, int], FloatArray] = {}
 
-    def var(j: int, kind: str) -> FloatArray:
-        key = (j, kind)
-        if key not in base:
+    def base(j: int, kind: str) -> FloatArray:
+        key = (j, kind, 1)
+        if key not in powers:
             T = temps_c[:, j]
             if kind == "u":
-                base[key] = (T - scaling.t_center[j]) / scaling.t_scale[j]
+                x = (T - scaling.t_center[j]) / scaling.t_scale[j]
             else:
                 if rates_c_per_min is None:
                     raise ThermocalInputError("rate terms need the temperature rate")
                 R = rates_c_per_min[:, j]
                 if kind == "v":
-                    base[key] = (R - scaling.rate_center[j]) / scaling.rate_scale[j]
+                    x = (R - scaling.rate_center[j]) / scaling.rate_scale[j]
                 else:
-                    base[key] = (T * R - scaling.coupling_center[j]) / scaling.coupling_scale[j]
-            caches[key] = {}
-        return base[key]
+                    x = (T * R - scaling.coupling_center[j]) / scaling.coupling_scale[j]
+            powers[key] = x
+        return powers[key]
+
+    def power(j: int, kind: str, p: int, dest: FloatArray | None) -> FloatArray:
+        key = (j, kind, p)
+        if key in powers:
+            if dest is not None:
+                dest[...] = powers[key]
+                return dest
+            return powers[key]
+        x = base(j, kind)
+        if p == 1:
+            if dest is not None:
+                dest[...] = x
+                return dest
+            return x
+        prev = power(j, kind, p - 1, None)
+        res = np.multiply(prev, x, out=dest) if dest is not None else prev * x
+        powers[key] = res
+        return res
 
     for col, t in enumerate(terms):
-        val: FloatArray | None = None
-        for kind, p in (("u", t.t_power), ("v", t.rate_power), ("w", t.coupling_power)):
-            if p == 0:
-                continue
-            x = var(t.sensor, kind)
-            xp = _ipow(x, p, caches[(t.sensor, kind)])
-            val = xp if val is None else val * xp
-        assert val is not None
-        out[:, col] = val
+        factors = [
+            (kind, p)
+            for kind, p in (("u", t.t_power), ("v", t.rate_power), ("w", t.coupling_power))
+            if p
+        ]
+        dest = out[:, col]
+        if len(factors) == 1:
+            power(t.sensor, factors[0][0], factors[0][1], dest)
+        else:
+            acc = power(t.sensor, factors[0][0], factors[0][1], None)
+            for kind, p in factors[1:-1]:
+                acc = acc * power(t.sensor, kind, p, None)
+            kind, p = factors[-1]
+            np.multiply(acc, power(t.sensor, kind, p, None), out=dest)
+    return out
+
+
+def segment_rates(
+    ts: FloatArray,
+    Ts: FloatArray,
+    rows: npt.NDArray[np.intp],
+    interval_s: float,
+    method: str = "backward",
+) -> FloatArray:
+    """Ṫ [°C/min] at ``rows`` of one contiguous segment (times ``ts``, temps ``Ts`` (n, k)).
+
+    The same arithmetic as :func:`thermocal.preprocess.temperature_rate`
+    (SPEC §3): partner samples ``lo``/``hi`` inside the segment (backward: the
+    first ``t_j ≥ t_i − Δt`` and i; forward: i and the first ``t_j ≥ t_i + Δt``;
+    centred: ±Δt/2), ``Ṫ = (T_hi − T_lo)/(t_hi − t_lo)·60``, 0 when the span
+    is 0.  Works on a block of rows so that long runs need no full-size temporaries.
+    """
+    n = ts.size
+    i = np.asarray(rows, dtype=np.intp)
+    if i.size == 0:
+        return np.zeros((0, Ts.shape[1]))
+    contiguous = int(i[-1]) - int(i[0]) == i.size - 1 and bool(np.all(np.diff(i) == 1))
+    ti = ts[i[0] : i[-1] + 1] if contiguous else ts[i]
+    if method == "backward":
+        lo = np.searchsorted(ts, ti - interval_s, side="left")
+        if contiguous:  # fast path: the sample itself is a slice, not a gather
+            span = ti - ts[lo]
+            out = np.zeros((i.size, Ts.shape[1]))
+            ok = span > 0
+            Ti = Ts[i[0] : i[-1] + 1]
+            if ok.all():
+                np.subtract(Ti, Ts[lo], out=out)
+                out /= span[:, None]
+                out *= SECONDS_PER_MINUTE
+            elif ok.any():
+                out[ok] = (Ti[ok] - Ts[lo[ok]]) / span[ok, None] * SECONDS_PER_MINUTE
+            return out
+        hi = i
+    elif method == "forward":
+        lo = i
+        hi = np.minimum(np.searchsorted(ts, ti + interval_s, side="left"), n - 1)
+    elif method == "centred":
+        lo = np.searchsorted(ts, ti - interval_s / 2.0, side="left")
+        hi = np.minimum(np.searchsorted(ts, ti + interval_s / 2.0, side="left"), n - 1)
+    else:
+        raise ThermocalInputError(f"unknown rate method {method!r}")
+    span = ts[hi] - ts[lo]
+    out = np.zeros((i.size, Ts.shape[1]))
+    ok = span > 0
+    if ok.all():
+        out[...] = (Ts[hi] - Ts[lo]) / span[:, None] * SECONDS_PER_MINUTE
+    elif ok.any():
+        out[ok] = (Ts[hi[ok]] - Ts[lo[ok]]) / span[ok, None] * SECONDS_PER_MINUTE
+    return out
+
+
+def temperature_rates(
+    time_s: FloatArray,
+    temps_c: FloatArray,
+    interval_s: float,
+    method: str = "backward",
+    *,
+    gap_factor: float = GAP_FACTOR,
+) -> FloatArray:
+    """Ṫ of every column [°C/min], never across a gap (:func:`segment_rates` per segment).
+
+    Equal to :func:`thermocal.preprocess.temperature_rate` applied column by column.
+    """
+    out = np.zeros_like(temps_c)
+    for sl in contiguous_slices(time_s, gap_factor):
+        a, b = int(sl.start), int(sl.stop)
+        out[a:b] = segment_rates(
+            time_s[a:b], temps_c[a:b], np.arange(b - a), interval_s, method
+        )
     return out
 
 
 def backward_rates(
-    time_s: FloatArray,
-    temps_c: FloatArray,
-    interval_s: float,
-    *,
-    gap_factor: float = GAP_FACTOR,
+    time_s: FloatArray, temps_c: FloatArray, interval_s: float, *, gap_factor: float = GAP_FACTOR
 ) -> FloatArray:
-    """Causal temperature rate of every column [°C/min], ``Ṫ(t) = (T(t) − T(t−Δt))/Δt``.
-
-    The same arithmetic as :func:`thermocal.preprocess.temperature_rate` with
-    ``method="backward"`` (partner sample: the first with ``t_j ≥ t_i − Δt``
-    inside the contiguous segment, divided by the actual time between the two
-    samples, 0 for a segment's first sample), done once for all columns.
-    """
-    out = np.zeros_like(temps_c)
-    for sl in contiguous_slices(time_s, gap_factor):
-        ts = time_s[sl]
-        Ts = temps_c[sl]
-        lo = np.searchsorted(ts, ts - interval_s, side="left")
-        span = ts - ts[lo]
-        idx = np.flatnonzero(span > 0)
-        if idx.size:
-            sub = out[sl]  # a view: writes go to out
-            sub[idx] = (Ts[idx] - Ts[lo[idx]]) / span[idx, None] * SECONDS_PER_MINUTE
-    return out
+    """Causal rate ``Ṫ(t) = (T(t) − T(t−Δt))/Δt`` [°C/min] of every column (see above)."""
+    return temperature_rates(time_s, temps_c, interval_s, "backward", gap_factor=gap_factor)
 
 
 # --- least squares in chunks ------------------------------------------------------------------
@@ -546,28 +620,32 @@ def _accumulate_qr(
 def _accumulate_gram(
     chunks: Iterable[Chunk], p: int, m: int, n_folds: int
 ) -> tuple[list[FloatArray], list[int]]:
-    """Gram matrices of [F | 1 | y] per (fold, group), assembled into [F | Z | y]."""
+    """Gram matrices of [F | 1 | y] per (fold, group), assembled into [F | Z | y].
+
+    ``FᵀF`` by BLAS ``dsyrk`` on the (Fortran-ordered) chunk, ``Fᵀ[1 y]`` by gemm.
+    """
     q1 = p + m + 1
     parts = [[np.zeros((p + 2, p + 2)) for _ in range(m)] for _ in range(n_folds)]
     counts = [0] * n_folds
-    buf: FloatArray | None = None
     for F, y, g, f in chunks:
         c = F.shape[0]
         if c == 0:
             continue
-        if buf is None or buf.shape[0] != c:
-            buf = np.empty((c, p + 2), order="F")
-        a = buf
-        a[:, :p] = F
-        a[:, p] = 1.0
-        a[:, p + 1] = y
-        parts[f][g] += a.T @ a
+        Ff = np.asfortranarray(F)
+        P = parts[f][g]
+        P[:p, :p] += blas.dsyrk(1.0, Ff, trans=1, lower=0)
+        P[:p, p] += Ff.sum(axis=0)
+        P[:p, p + 1] += Ff.T @ y
+        P[p, p] += c
+        P[p, p + 1] += float(np.sum(y))
+        P[p + 1, p + 1] += float(y @ y)
         counts[f] += c
     grams: list[FloatArray] = []
     for f in range(n_folds):
         G = np.zeros((q1, q1))
         for g in range(m):
-            P = parts[f][g]
+            P = np.triu(parts[f][g])
+            P = P + np.triu(P, 1).T
             G[:p, :p] += P[:p, :p]
             G[:p, p + g] = P[:p, p]
             G[p + g, :p] = P[p, :p]
@@ -748,7 +826,7 @@ def solve_r(
     else:
         M, rhs = Rs, z
     U, S, Vt = np.linalg.svd(M, full_matrices=False)
-    keep = S > (rcond or 0.0) * S[0]
+    keep = np.greater(S, (rcond or 0.0) * S[0])
     rank = int(keep.sum())
     Uk, Sk, Vk = U[:, keep], S[keep], Vt[keep].T
     gamma = Vk @ ((Uk.T @ rhs) / Sk)

@@ -48,13 +48,17 @@ Learned state (``_state()``, the layout the C export reads)::
       "order": N, "t0_order": M,
       "start_window_s": W,                        # start window [s]
       "sensor_name": "T1",                        # the temperature channel used
-      "t0_range_c": [lo, hi],                     # fitted start temperatures [°C]
+      "b_stderr": [[...]] or null,                # standard errors of b, same shape
+      "t0_range_c": [lo, hi],                     # fitted start temperatures [°C]; T0 is
+                                                  # clamped to it (T to the file's "range")
       "start_temps_c": [...], "start_outputs": [...],   # T0, F0 of each fitted run
       "run_coefficients": [[a_0, …, a_N], …]      # stage-1 a_j per run (two_stage)
     }
 
-Evaluation (firmware twin): ``a_j = Σ_k b_jk T0^k`` (Horner in T0),
-``ΔF = Σ_j a_j ΔT^j`` (Horner in ΔT).
+Evaluation (firmware twin), per sample: ``Tc = clamp(T, range)``; while
+``t − t_first < start_window_s``: ``sum += Tc; n += 1``; ``T0 = sum/n`` (frozen
+afterwards); ``a_j = Σ_k b_jk clamp(T0, t0_range_c)^k`` (Horner in T0);
+``ΔF = Σ_j a_j (Tc − T0)^j`` (Horner in ΔT).
 """
 
 from __future__ import annotations
@@ -269,6 +273,9 @@ class WarmupModel(TemperatureModel):
     include_a0 : keep the constant a0 (the seed does); off forces ΔF = 0 at ΔT = 0.
     sensor : index of the temperature channel used (0 = first named channel).
     method : ``"two_stage"`` (seed) or ``"joint"`` (one least-squares problem).
+    per_run_offset : ``joint`` only: a free a0 per run (nuisance parameters, so the
+        noise of each run's F0 does not bias the ΔT terms), then ``a0(T0)`` fitted to
+        those offsets as in stage 2.  (``two_stage`` always has a free a0 per run.)
     """
 
     family: ClassVar[str] = "warmup"
@@ -290,6 +297,7 @@ class WarmupModel(TemperatureModel):
         include_a0: bool = True,
         sensor: int = 0,
         method: str = "two_stage",
+        per_run_offset: bool = True,
     ) -> None:
         self.order = order
         self.t0_order = t0_order
@@ -297,13 +305,22 @@ class WarmupModel(TemperatureModel):
         self.include_a0 = include_a0
         self.sensor = sensor
         self.method = method
+        self.per_run_offset = per_run_offset
 
     @classmethod
     def from_cli_options(cls, opts: dict[str, Any]) -> Self:
         """Build from ``thermocal fit`` options (``start_window_s``, ``order``,
-        ``t0_order``, ``sensor``, ``include_a0``, ``method``); other keys and
+        ``t0_order``, ``sensor``, ``include_a0``, ``method``, ``per_run_offset``); other keys and
         ``None`` values are ignored."""
-        keys = ("order", "t0_order", "start_window_s", "include_a0", "sensor", "method")
+        keys = (
+            "order",
+            "t0_order",
+            "start_window_s",
+            "include_a0",
+            "sensor",
+            "method",
+            "per_run_offset",
+        )
         return cls(**{k: opts[k] for k in keys if opts.get(k) is not None})
 
     # -- validation --
@@ -425,17 +442,47 @@ class WarmupModel(TemperatureModel):
                 [np.full(dt.size, (t0 - mu) / sig) for dt, t0 in zip(dts, t0s, strict=True)]
             )
             w = all_dt / s_dt
-            x = np.column_stack([w**j * u**k for j in powers_j for k in range(n_k)])
+            offsets = bool(self.per_run_offset) and j0 == 0
+            slope_j = powers_j[1:] if offsets else powers_j
+            cols = [w**j * u**k for j in slope_j for k in range(n_k)]
+            labels = [self._term_name(int(j), k) for j in slope_j for k in range(n_k)]
+            if offsets:
+                # per-run a0 as nuisance parameters (turn-on F0 noise stays out of the slopes)
+                run_id = np.concatenate([np.full(dt.size, i) for i, dt in enumerate(dts)])
+                ind = [(run_id == i).astype(np.float64) for i in range(len(dts))]
+                cols = ind + cols
+                run_labels = [f"a0 of {r.name or f'run {i}'}" for i, r in enumerate(one)]
+                labels = run_labels + labels
+            x = np.column_stack(cols)
             res = lstsq_svd(x, np.concatenate(dfs))
             if res.rank < x.shape[1]:
-                terms = ", ".join(
-                    self._term_name(int(powers_j[c // n_k]), c % n_k) for c in res.null_columns
-                )
-                raise DesignError(f"warmup: singular joint design; term(s) {terms}")
+                bad = ", ".join(labels[c] for c in res.null_columns)
+                raise DesignError(f"warmup: singular joint design; term(s) {bad}")
             cond = res.condition_number
-            c_scaled = res.coef.reshape(n_j, n_k)
-            cov_c = res.sigma2 * res.cov_unit if res.dof > 0 else None
             dof = res.dof
+            if offsets:
+                n_r = len(dts)
+                cov_all = res.sigma2 * res.cov_unit if res.dof > 0 else None
+                # a0(T0) = Σ_k b_0k T0^k fitted to the per-run offsets (as in stage 2)
+                v = (t0_arr - mu) / sig
+                vmat = v[:, None] ** np.arange(n_k)[None, :]
+                res0 = lstsq_svd(vmat, res.coef[:n_r])
+                if res0.rank < n_k:
+                    raise DesignError(
+                        f"warmup: the start temperatures cannot determine T0 terms up to "
+                        f"T0^{kt}; lower --t0-order"
+                    )
+                cond = max(cond, res0.condition_number)
+                c_scaled = np.vstack([res0.coef[None, :], res.coef[n_r:].reshape(-1, n_k)])
+                if cov_all is not None and res0.dof > 0:
+                    cov_c = np.zeros((n_j * n_k, n_j * n_k))
+                    cov_c[:n_k, :n_k] = float(res0.sigma2) * res0.cov_unit
+                    cov_c[n_k:, n_k:] = cov_all[n_r:, n_r:]
+                else:
+                    cov_c = None
+            else:
+                c_scaled = res.coef.reshape(n_j, n_k)
+                cov_c = res.sigma2 * res.cov_unit if res.dof > 0 else None
             run_coefs = None
         if cond > CONDITION_WARN:
             warnings.warn(
@@ -588,7 +635,11 @@ def _evaluate(b: FloatArray, t0: FloatArray, dt: FloatArray) -> FloatArray:
 
 class WarmupStream(ModelStream):
     """Streaming twin of :meth:`WarmupModel.predict`: keeps the start-window sum of
-    T (running mean T0, frozen when the window is full)."""
+    T (running mean T0, frozen when the window is full).
+
+    ``temps_c`` holds either one value (the model's channel) or the channels of the
+    fitted runs (``sensor`` picks); the signal is not used.
+    """
 
     def __init__(self, model: WarmupModel, *, extrapolate: bool = False) -> None:
         self.model = model

@@ -203,6 +203,21 @@ class RunSignals:
     temp_names: tuple[str, ...]
     known_input: float
     warnings: tuple[str, ...]
+    model_includes_known_input: bool = False
+
+    @property
+    def model_bias(self) -> FloatArray:
+        """The model value on the bias scale (known input taken off if the model holds it)."""
+        if self.model_includes_known_input:
+            out: FloatArray = self.model - self.known_input
+            return out
+        return self.model
+
+    @property
+    def after_raw(self) -> FloatArray:
+        """Compensated output with the known input kept (what the sensor would output)."""
+        out: FloatArray = self.after + self.known_input
+        return out
 
 
 def known_input_of(rec: Recording, unit: str) -> float:
@@ -237,17 +252,24 @@ def apply_model(model_dict: dict[str, Any], rec: Recording, signal: str | None) 
         pred = np.asarray(model.predict(run), dtype=np.float64) / factor
     msgs = tuple(dict.fromkeys(" ".join(str(w.message).split()) for w in caught))
     before = x - known
+    # A model fitted on the raw output (known input not removed) carries the earth
+    # rate in its constant; tell by which level its mean is nearer (|Ω| ≫ bias changes).
+    includes = bool(
+        known != 0.0 and abs(np.mean(pred) - np.mean(x)) < abs(np.mean(pred) - np.mean(before))
+    )
+    after = x - pred if includes else before - pred
     return RunSignals(
         time_s=rec.time_s,
         signal=x,
         unit=unit,
         before=before,
         model=pred,
-        after=before - pred,
+        after=after,
         temps_c=run.temps_c,
         temp_names=temp_names,
         known_input=known,
         warnings=msgs,
+        model_includes_known_input=includes,
     )
 
 
@@ -636,6 +658,40 @@ def _model_summary(entry: ModelEntry) -> dict[str, Any]:
     }
 
 
+TRUTH_COLUMN = "truth_bias"
+"""Column of the simulator's true temperature-induced bias (thermocal.simulate)."""
+
+
+def _truth_rows(
+    inputs: ReportInputs, applied: dict[str, RunSignals], unit: str
+) -> list[dict[str, Any]]:
+    """Model error against the simulator's truth (simulated data only).
+
+    ``e = (ŷ − mean ŷ) − (E − mean E)`` with ŷ the model on the bias scale and E
+    the ``truth_bias`` column; reported: rms(e) and the share of the
+    temperature-induced bias removed, ``100 (1 − rms(e)/std(E))`` [%].
+    """
+    rec = inputs.recording
+    if TRUTH_COLUMN not in rec.columns:
+        return []
+    truth = rec.column(TRUTH_COLUMN)
+    sd = float(np.std(truth))
+    rows = []
+    for e in inputs.models:
+        sig = applied[e.label]
+        err = (sig.model_bias - np.mean(sig.model_bias)) - (truth - np.mean(truth))
+        rms = float(np.sqrt(np.mean(err**2)))
+        removed = 100.0 * (1.0 - rms / sd) if sd > 0 else None
+        rows.append(
+            {
+                "label": e.label,
+                "rms": num(rms, f"truth.{e.label}.rms_error", unit=unit_label(unit)),
+                "removed": num(removed, f"truth.{e.label}.removed_pct", 3),
+            }
+        )
+    return rows
+
+
 def _collect_warnings(inputs: ReportInputs, applied: dict[str, RunSignals]) -> list[dict[str, str]]:
     out: list[dict[str, str]] = []
     seen: set[str] = set()
@@ -734,12 +790,14 @@ def build_report(inputs: ReportInputs) -> str:
             temp_name=stage_temp,
             temp_c=stage_temp_c,
         )
-        for x in (main.signal, main.signal - main.model)
+        for x in (main.signal, main.after_raw)
     )
     allan_before = allan_of(main.time_s, main.before, tau0, unit)
     allan_after = allan_of(main.time_s, main.after, tau0, unit)
 
-    # --- figures
+    # --- figures: bias series drawn as averages over the stability averaging time
+    block = max(1, round(averaging_s / tau0))
+    avg_text = f" ({fmt_num(block * tau0)} s averages)" if block > 1 else ""
     panels = []
     if inputs.modeling is not None:
         panels.append(_temperature_panel("Modelling run", inputs.modeling, temp_names))
@@ -773,10 +831,10 @@ def build_report(inputs: ReportInputs) -> str:
         mod = apply_model(primary.model, inputs.modeling, signal)
         add_fig(
             "fit",
-            F.model_fit(mod.time_s, mod.before, mod.model, unit=unit_label(unit)),
+            F.model_fit(mod.time_s, mod.before, mod.model_bias, unit=unit_label(unit), block=block),
             "Model fit on the modelling run",
             cap(
-                f"Modelling run: measured bias and the {primary.label} model (top), "
+                f"Modelling run: measured bias{avg_text} and the {primary.label} model (top), "
                 "residual (bottom)."
             ),
         )
@@ -790,10 +848,11 @@ def build_report(inputs: ReportInputs) -> str:
             stages=stages,
             temperature=main.temps_c[:, 0],
             temperature_label=temp_names[0],
+            block=block,
         ),
         "Bias against time, before and after compensation",
         cap(
-            f"Validation run: bias before (red) and after (blue) compensation with the "
+            f"Validation run: bias{avg_text} before (red) and after (blue) compensation with the "
             f"{primary.label} model; {temp_names[0]} dotted (right axis)"
             + ("; shaded: temperature-hold stages used for stability and repeatability."
                if stages else ".")
@@ -807,9 +866,14 @@ def build_report(inputs: ReportInputs) -> str:
             main.after,
             unit=unit_label(unit),
             temperature_label=temp_names[0],
+            block=block,
         ),
         "Bias against temperature, before and after compensation",
-        cap(f"Validation run: bias against {temp_names[0]}, before and after compensation."),
+        cap(
+            f"Validation run: bias against {temp_names[0]}, before and after compensation; "
+            f"dots: {avg_text.strip(' ()') or 'samples'}, lines: means in temperature bins "
+            "with their standard errors."
+        ),
     )
     add_fig(
         "allan",
@@ -895,6 +959,8 @@ def build_report(inputs: ReportInputs) -> str:
             }
         )
 
+    truth_rows = _truth_rows(inputs, applied, unit)
+
     comparison = []
     for e in inputs.models:
         ve = e.validation or {}
@@ -958,6 +1024,12 @@ def build_report(inputs: ReportInputs) -> str:
         "validations": validations,
         "comparison": comparison,
         "fom_rows": fom_rows,
+        "truth_rows": truth_rows,
+        "truth_std": (
+            num(float(np.std(rec.column(TRUTH_COLUMN))), "truth.std", unit=unit_label(unit))
+            if truth_rows
+            else None
+        ),
         "noise_rows": noise_rows,
         "coefficients": _coefficient_rows(primary.model),
         "ranges": _range_rows(primary.model),

@@ -36,24 +36,46 @@ DPI = 110
 
 
 def decimate_for_plot(
-    x: npt.ArrayLike, *ys: npt.ArrayLike, max_points: int = MAX_PLOT_POINTS
+    x: npt.ArrayLike, *ys: npt.ArrayLike, max_points: int = MAX_PLOT_POINTS, block: int = 1
 ) -> tuple[FloatArray, ...]:
     """Block means of ``x`` and every ``y`` so that at most ``max_points`` remain.
 
-    Block length ``m = ceil(n / max_points)``; the trailing partial block is
-    averaged on its own.  With ``n ≤ max_points`` the arrays are returned unchanged.
+    Block length ``m = max(block, ceil(n / max_points))``; the trailing partial
+    block is averaged on its own.  With ``m = 1`` the arrays are returned unchanged.
     """
     arrays = [np.asarray(a, dtype=np.float64) for a in (x, *ys)]
     n = arrays[0].size
-    if n <= max_points:
+    m = max(int(block), int(np.ceil(n / max_points)), 1)
+    if m == 1:
         return tuple(arrays)
-    m = int(np.ceil(n / max_points))
     starts = np.arange(0, n, m)
     counts = np.diff(np.r_[starts, n])
+    if starts.size > 1 and counts[-1] < m / 2:  # a short trailing block is mostly noise
+        starts, counts = starts[:-1], counts[:-1]
+        arrays = [a[: starts[-1] + counts[-1]] for a in arrays]
     out = []
     for a in arrays:
         out.append(np.add.reduceat(a, starts) / counts)
     return tuple(out)
+
+
+def binned_means(
+    x: npt.ArrayLike, y: npt.ArrayLike, n_bins: int = 40, min_count: int = 30
+) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """Means of ``y`` in ``n_bins`` equal-width bins of ``x``: (bin centre, mean, standard
+    error of the mean), bins with fewer than ``min_count`` samples left out."""
+    xa = np.asarray(x, dtype=np.float64)
+    ya = np.asarray(y, dtype=np.float64)
+    edges = np.linspace(float(xa.min()), float(xa.max()), n_bins + 1)
+    idx = np.clip(np.searchsorted(edges, xa, side="right") - 1, 0, n_bins - 1)
+    cnt = np.bincount(idx, minlength=n_bins).astype(np.float64)
+    s1 = np.bincount(idx, weights=ya, minlength=n_bins)
+    s2 = np.bincount(idx, weights=ya * ya, minlength=n_bins)
+    ok = cnt >= min_count
+    mean = s1[ok] / cnt[ok]
+    var = np.maximum(s2[ok] / cnt[ok] - mean**2, 0.0) * cnt[ok] / np.maximum(cnt[ok] - 1, 1)
+    centres = 0.5 * (edges[:-1] + edges[1:])[ok]
+    return centres, mean, np.sqrt(var / cnt[ok])
 
 
 @contextmanager
@@ -127,6 +149,7 @@ def bias_vs_time(
     stages: Sequence[tuple[float, float]] = (),
     temperature: FloatArray | None = None,
     temperature_label: str = "T",
+    block: int = 1,
 ) -> bytes:
     """Bias before and after compensation against time [h]; hold stages shaded.
 
@@ -139,7 +162,7 @@ def bias_vs_time(
         ax = axes[0]
         for a, b in stages:
             ax.axvspan((a - t[0]) / 3600.0, (b - t[0]) / 3600.0, color="#e8f1e4", lw=0, zorder=0)
-        th, yb, ya = decimate_for_plot(_hours(t), before, after)
+        th, yb, ya = decimate_for_plot(_hours(t), before, after, block=block)
         ax.plot(th, yb, color=BEFORE_COLOR, lw=1.0, label="before compensation")
         ax.plot(th, ya, color=AFTER_COLOR, lw=1.0, label="after compensation")
         ax.set_xlabel("time [h]", fontsize=9)
@@ -166,17 +189,23 @@ def bias_vs_temperature(
     *,
     unit: str,
     temperature_label: str = "T",
+    block: int = 1,
 ) -> bytes:
-    """Bias before and after compensation against a temperature channel [°C]."""
+    """Bias before and after compensation against a temperature channel [°C]: averages
+    over ``block`` samples (faint dots) and means in 40 temperature bins (lines)."""
     x = np.asarray(temperature_c, dtype=np.float64)
     with _figure(1, height_in=3.6) as (fig, axes):
         ax = axes[0]
-        xs, yb, ya = decimate_for_plot(x, before, after)
-        ax.plot(xs, yb, ".", ms=2.0, color=BEFORE_COLOR, label="before compensation")
-        ax.plot(xs, ya, ".", ms=2.0, color=AFTER_COLOR, label="after compensation")
+        xs, yb, ya = decimate_for_plot(x, before, after, block=block)
+        ax.plot(xs, yb, ".", ms=2.5, color=BEFORE_COLOR, alpha=0.25)
+        ax.plot(xs, ya, ".", ms=2.5, color=AFTER_COLOR, alpha=0.25)
+        for y, col, lab in ((before, BEFORE_COLOR, "before"), (after, AFTER_COLOR, "after")):
+            c, m, se = binned_means(x, y)
+            ax.errorbar(c, m, yerr=se, fmt="o-", ms=3, lw=1.4, capsize=0, color=col,
+                        label=f"{lab} compensation (binned mean ± s.e.)")  # fmt: skip
         ax.set_xlabel(f"{temperature_label} [°C]", fontsize=9)
         ax.set_ylabel(f"bias [{unit}]", fontsize=9)
-        ax.legend(fontsize=8, loc="best", frameon=True, framealpha=0.9, markerscale=4)
+        ax.legend(fontsize=8, loc="best", frameon=True, framealpha=0.9)
         return _png(fig)
 
 
@@ -245,11 +274,12 @@ def model_fit(
     modelled: FloatArray,
     *,
     unit: str,
+    block: int = 1,
 ) -> bytes:
     """Modelling run: measured bias, model output and residual against time [h]."""
     t = np.asarray(time_s, dtype=np.float64)
     with _figure(2, height_in=2.6, sharex=True) as (fig, axes):
-        th, ym, yf = decimate_for_plot(_hours(t), measured, modelled)
+        th, ym, yf = decimate_for_plot(_hours(t), measured, modelled, block=block)
         axes[0].plot(th, ym, color=BEFORE_COLOR, lw=1.0, label="measured bias")
         axes[0].plot(th, yf, color="#111111", lw=1.0, label="model")
         axes[0].set_ylabel(f"bias [{unit}]", fontsize=9)

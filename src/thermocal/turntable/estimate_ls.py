@@ -18,7 +18,6 @@ Kay 1993, §4.5 and §8.3), with covariance ``(Aᵀ C⁻¹ A)⁻¹`` from the si
 from __future__ import annotations
 
 import itertools
-
 from dataclasses import dataclass
 
 import numpy as np
