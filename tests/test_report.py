@@ -290,14 +290,11 @@ def run_chromium(report: Path, tmp: Path) -> dict[str, Any]:
         check=False,
     )
     stderr = p1.stderr + p2.stderr
-    console = [
-        line
-        for line in stderr.splitlines()
-        if ("CONSOLE" in line or "console" in line)
-        and ("Uncaught" in line or "error" in line.lower())
-    ]
-    console += [line for line in stderr.splitlines() if "Uncaught" in line]
-    console += [line for line in stderr.splitlines() if "Content Security Policy" in line]
+    # Chromium logs every console message (log, warn, error, uncaught exceptions) as
+    # "…:CONSOLE(…)] "text", source: …"; the report writes none, so any is an error.
+    lines = stderr.splitlines()
+    console = [ln for ln in lines if ":CONSOLE" in ln or "Uncaught" in ln]
+    console += [ln for ln in lines if "Content Security Policy" in ln]
     return {
         "screenshot": shot,
         "dom": p2.stdout,
@@ -518,6 +515,19 @@ def test_report_renders_in_headless_chromium(case: dict[str, Any], tmp_path: Pat
     check_number(
         tags, "validation.linear.bias_stability_after", case["validation"]["bias_stability_after"]
     )
+
+
+def test_chromium_check_detects_console_errors(tmp_path: Path) -> None:
+    """The browser check itself: a page with a console error and an uncaught exception."""
+    skip_without_chromium()
+    bad = tmp_path / "bad.html"
+    bad.write_text(
+        "<!DOCTYPE html><html><body><p>x</p>"
+        '<script>console.error("boom"); throw new Error("xyz");</script></body></html>'
+    )
+    result = run_chromium(bad, tmp_path)
+    text = " ".join(result["console_errors"])
+    assert "boom" in text and "Uncaught Error: xyz" in text
 
 
 # --- command line -------------------------------------------------------------------------------

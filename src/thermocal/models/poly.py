@@ -381,14 +381,16 @@ class PolyModel(TemperatureModel):
                         np.maximum(rate_hi[i], rates.max(axis=0), out=rate_hi[i])
                     c = b - a
                     if c not in bufs:
-                        bufs[c] = np.empty((c, p), order="F")
-                    F = term_features(terms, scaling, r.temps_c[a:b], rates, out=bufs[c])
-                    y = sig[a:b] - r.known_input
+                        bufs[c] = np.empty((c, p + 2), order="F")
+                        bufs[c][:, p] = 1.0
+                    A = bufs[c]
+                    term_features(terms, scaling, r.temps_c[a:b], rates, out=A[:, :p])
+                    y = np.subtract(sig[a:b], r.known_input, out=A[:, p + 1])
                     d = y - y0
                     sums[0] += c
                     sums[1] += float(np.sum(d))
                     sums[2] += float(d @ d)
-                    yield F, y, g, fold
+                    yield A, g, fold
 
         red = accumulate_r(make_chunks, p, m, n_folds=n_folds, solver=cast(Any, self.solver))
         names = [t.name for t in terms] + (

@@ -550,8 +550,9 @@ def backward_rates(
 
 # --- least squares in chunks ------------------------------------------------------------------
 
-Chunk = tuple[FloatArray, FloatArray, int, int]
-"""(features (c, p), target (c,), group index, fold index) of one block of rows."""
+Chunk = tuple[FloatArray, int, int]
+"""``(A, group, fold)`` of one block of c rows: ``A`` (c, p + 2), Fortran order, holds
+``[F | 1 | y]`` (the p features, a column of ones, the target)."""
 
 
 @dataclass(frozen=True)
@@ -596,8 +597,8 @@ def _accumulate_qr(
     r_acc = [np.zeros((q1, q1), order="F") for _ in range(n_folds)]
     counts = [0] * n_folds
     buf: FloatArray | None = None
-    for F, y, g, f in chunks:
-        c = F.shape[0]
+    for A, g, f in chunks:
+        c = A.shape[0]
         if c == 0:
             continue
         rows = q1 + c
@@ -605,10 +606,10 @@ def _accumulate_qr(
             buf = np.zeros((rows, q1), order="F")
         a = buf
         a[:q1] = r_acc[f]
-        a[q1:, :p] = F
+        a[q1:, :p] = A[:, :p]
         a[q1:, p : p + m] = 0.0
         a[q1:, p + g] = 1.0
-        a[q1:, p + m] = y
+        a[q1:, p + m] = A[:, p + 1]
         qr, _tau, _work, info = lapack.dgeqrf(a, lwork=max(1, q1 * 64), overwrite_a=1)
         if info != 0:
             raise DesignError(f"QR factorisation failed (LAPACK info {info})")
@@ -620,25 +621,16 @@ def _accumulate_qr(
 def _accumulate_gram(
     chunks: Iterable[Chunk], p: int, m: int, n_folds: int
 ) -> tuple[list[FloatArray], list[int]]:
-    """Gram matrices of [F | 1 | y] per (fold, group), assembled into [F | Z | y].
-
-    ``FᵀF`` by BLAS ``dsyrk`` on the (Fortran-ordered) chunk, ``Fᵀ[1 y]`` by gemm.
-    """
+    """Gram matrices of [F | 1 | y] per (fold, group) (BLAS ``dsyrk``, upper triangle),
+    assembled into the Gram matrix of [F | Z | y]."""
     q1 = p + m + 1
     parts = [[np.zeros((p + 2, p + 2)) for _ in range(m)] for _ in range(n_folds)]
     counts = [0] * n_folds
-    for F, y, g, f in chunks:
-        c = F.shape[0]
+    for A, g, f in chunks:
+        c = A.shape[0]
         if c == 0:
             continue
-        Ff = np.asfortranarray(F)
-        P = parts[f][g]
-        P[:p, :p] += blas.dsyrk(1.0, Ff, trans=1, lower=0)
-        P[:p, p] += Ff.sum(axis=0)
-        P[:p, p + 1] += Ff.T @ y
-        P[p, p] += c
-        P[p, p + 1] += float(np.sum(y))
-        P[p + 1, p + 1] += float(y @ y)
+        parts[f][g] += blas.dsyrk(1.0, np.asfortranarray(A), trans=1, lower=0)
         counts[f] += c
     grams: list[FloatArray] = []
     for f in range(n_folds):
