@@ -108,8 +108,7 @@ class Term:
 
     @property
     def name(self) -> str:
-        """Canonical text: ``T1``, ``T1^2``, ``dT1^3``, ``T1*dT1``, ``(T1*dT1)^2``, ``T1*(T1*dT1)``.
-        """
+        """Canonical text, e.g. ``T1``, ``T1^2``, ``dT1^3``, ``T1*dT1``, ``(T1*dT1)^2``."""
         k = self.sensor + 1
 
         def pw(base: str, p: int) -> str:
@@ -345,49 +344,44 @@ def fit_base_scaling(
     wc, ws = np.zeros(k), np.ones(k)
     n = sum(t.shape[0] for t in temps)
 
-    def mean_std(get: Callable[[int], FloatArray]) -> tuple[float, float]:
-        s = 0.0
-        for i in range(len(temps)):
-            s += float(np.sum(get(i)))
-        m = s / n
+    def mean_std(values: list[FloatArray]) -> tuple[float, float]:
+        m = sum(float(np.sum(v)) for v in values) / n
         ss = 0.0
-        for i in range(len(temps)):
-            d = get(i) - m
+        for v in values:
+            d = v - m
             ss += float(np.dot(d, d))
         return m, math.sqrt(ss / n)
 
     for j in range(k):
         used = [t for t in terms if t.sensor == j]
-        if not used:
-            continue
-        checks: list[tuple[str, Callable[[Term], bool], Callable[[int], FloatArray]]] = [
-            ("T", lambda t: t.t_power > 0, lambda i, j=j: temps[i][:, j]),
-        ]
-        if rates is not None:
-            rr = rates
-            checks.append(("dT", lambda t: t.rate_power > 0, lambda i, j=j, rr=rr: rr[i][:, j]))
-            checks.append(
-                (
-                    "T*dT",
-                    lambda t: t.coupling_power > 0,
-                    lambda i, j=j, rr=rr: temps[i][:, j] * rr[i][:, j],
-                )
-            )
-        for label, needs, get in checks:
-            users = [t for t in used if needs(t)]
+        for kind in ("T", "dT", "T*dT"):
+            if kind == "T":
+                users = [t for t in used if t.t_power > 0]
+            elif kind == "dT":
+                users = [t for t in used if t.rate_power > 0]
+            else:
+                users = [t for t in used if t.coupling_power > 0]
             if not users:
                 continue
-            m, s = mean_std(get)
+            if kind == "T":
+                vals = [t[:, j] for t in temps]
+            elif rates is None:
+                raise ThermocalInputError("rate terms need the temperature rate")
+            elif kind == "dT":
+                vals = [r[:, j] for r in rates]
+            else:
+                vals = [t[:, j] * r[:, j] for t, r in zip(temps, rates, strict=True)]
+            m, s = mean_std(vals)
             if not s > 1e-12 * max(1.0, abs(m)):
-                what = {"T": f"T{j + 1}", "dT": f"dT{j + 1}"}.get(label, f"T{j + 1}*dT{j + 1}")
+                what = {"T": f"T{j + 1}", "dT": f"dT{j + 1}"}.get(kind, f"T{j + 1}*dT{j + 1}")
                 raise DesignError(
                     f"base variable {what} is constant over the fitted data, so term(s) "
                     + ", ".join(t.name for t in users)
                     + " cannot be determined; drop them or use data where it varies"
                 )
-            if label == "T":
+            if kind == "T":
                 tc[j], ts[j] = m, s
-            elif label == "dT":
+            elif kind == "dT":
                 rc[j], rs[j] = m, s
             else:
                 wc[j], ws[j] = m, s
@@ -535,9 +529,7 @@ def temperature_rates(
     out = np.zeros_like(temps_c)
     for sl in contiguous_slices(time_s, gap_factor):
         a, b = int(sl.start), int(sl.stop)
-        out[a:b] = segment_rates(
-            time_s[a:b], temps_c[a:b], np.arange(b - a), interval_s, method
-        )
+        out[a:b] = segment_rates(time_s[a:b], temps_c[a:b], np.arange(b - a), interval_s, method)
     return out
 
 
@@ -758,7 +750,7 @@ def singular_error(
         return None
     null = vt[-1]
     big = np.flatnonzero(np.abs(null) > 0.1 * np.max(np.abs(null)))
-    involved = [names[i] for i in big]
+    involved = [names[int(i)] for i in big]
     zero_cols = [names[i] for i in range(q) if not np.any(r[:, i])]
     if zero_cols:
         return DesignError(
@@ -844,7 +836,7 @@ def solve_r(
         condition_number=cond,
         rank=rank,
         n_truncated=int((~keep).sum()),
-        singular_values=sv,
+        singular_values=np.asarray(sv, dtype=np.float64),
     )
 
 
@@ -859,7 +851,7 @@ def subset_rss(r_aug: FloatArray, columns: Sequence[int]) -> tuple[float, FloatA
     z = r_aug[:, q]
     beta, _res, _rank, _sv = np.linalg.lstsq(R, z, rcond=None)
     res = z - R @ beta
-    return float(res @ res), beta
+    return float(res @ res), np.asarray(beta, dtype=np.float64)
 
 
 def holdout_rss(r_aug_hold: FloatArray, columns: Sequence[int], beta: FloatArray) -> float:

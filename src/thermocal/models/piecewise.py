@@ -1,0 +1,577 @@
+"""Piecewise-linear temperature model (SPEC §4b, seed 001, fibre-optic gyro).
+
+For a warmed-up sensor and slow temperature change (no rate terms) the
+temperature-induced signal is a piecewise-linear function of one temperature T
+[°C] (the first temperature column unless ``temperature`` names another):
+
+.. math::
+
+    y(T) = a_j + s_j T, \\qquad b_{j} \\le T < b_{j+1},                  (1)
+
+with breakpoints ``b_1 < … < b_B`` (``b_0 = −∞``, ``b_{B+1} = +∞``).  Two ways
+to get the lines:
+
+* ``method="intersect"`` (the seed's): split the data at the given (or chosen)
+  breakpoints, fit a least-squares line per segment, then move each breakpoint
+  to the intersection of the two adjacent lines,
+  ``b_j = (a_j − a_{j−1})/(s_{j−1} − s_j)`` (seed: 25 and 30 °C became 23.6 and
+  30 °C), which makes the model continuous.  An intersection that is undefined
+  (parallel lines) or falls outside the two segments' span keeps the given
+  breakpoint; the model then jumps there (reported in ``fit.discontinuities``
+  and with a warning).
+* ``method="continuous"`` (our reading): continuous piecewise-linear
+  least squares in the hinge basis ``y = c + s_0 T + Σ_j d_j max(0, T − b_j)``.
+
+Breakpoints are given (``breakpoints=[25, 30]``) or chosen from the data
+(``segments=N``): the N−1 breakpoints minimise the residual sum of squares of
+the continuous fit (coordinate search over the 1–99 % temperature quantiles,
+then Nelder–Mead refinement, on temperature-binned data).  Several runs may be
+fitted together with per-run offsets (nuisance parameters; the model's level is
+their mean).  Outside the fitted temperature range T is clamped (with an
+:class:`~thermocal.errors.ExtrapolationWarning`) unless extrapolating.
+
+Model-file ``state`` layout (``"layout": "thermocal-piecewise-1"``), for the C export::
+
+    {
+      "layout": "thermocal-piecewise-1",
+      "temperature": "T1",        # the one temperature used (= "temperatures"[0])
+      "column_index": 0,          # its position among the fitted data's columns
+      "method": "intersect" | "continuous",
+      "breakpoints": [b1, ...],   # [°C], ascending, B values
+      "intercepts": [a0, ...],    # [signal unit], B + 1 values: value of line j at T = 0
+      "slopes": [s0, ...],        # [signal unit/°C], B + 1 values
+      "offsets": [...],           # per-run offsets (nuisance), run order of "data"
+      "initial_breakpoints": [...]
+    }
+
+Evaluation of one sample: ``T`` clamped to ``range.temperature_c`` of the
+file; ``j`` = number of breakpoints ``≤ T``; ``y = intercepts[j] + slopes[j]·T``.
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+import warnings
+from collections.abc import Iterator, Sequence
+from typing import Any, ClassVar, Self
+
+import numpy as np
+import numpy.typing as npt
+from scipy import optimize
+
+from thermocal.errors import (
+    DesignError,
+    ExtrapolationWarning,
+    ThermocalInputError,
+    ThermocalWarning,
+)
+from thermocal.models.base import (
+    Coefficient,
+    FitStats,
+    ModelStream,
+    RunData,
+    TemperatureModel,
+    register,
+)
+from thermocal.models.poly import check_runs, record_ranges
+from thermocal.models.terms import CHUNK_ROWS, Chunk, accumulate_r, solve_r
+from thermocal.recording import FloatArray
+
+STATE_LAYOUT = "thermocal-piecewise-1"
+METHODS = ("intersect", "continuous")
+N_BINS = 400
+"""Temperature bins (per run) for the breakpoint search."""
+
+
+def segment_index(breakpoints: FloatArray, temp_c: FloatArray) -> npt.NDArray[np.intp]:
+    """Segment of each temperature: the number of breakpoints ``≤ T`` (eq. 1)."""
+    idx: npt.NDArray[np.intp] = np.searchsorted(breakpoints, temp_c, side="right")
+    return idx
+
+
+def evaluate_lines(
+    breakpoints: FloatArray, intercepts: FloatArray, slopes: FloatArray, temp_c: FloatArray
+) -> FloatArray:
+    """``y = a_j + s_j T`` with j from :func:`segment_index` (eq. 1)."""
+    j = np.searchsorted(breakpoints, temp_c, side="right")
+    out: FloatArray = intercepts[j] + slopes[j] * temp_c
+    return out
+
+
+def _hinge_design(x: FloatArray, bps: Sequence[float]) -> FloatArray:
+    cols = [np.ones_like(x), x] + [np.maximum(0.0, x - b) for b in bps]
+    return np.column_stack(cols)
+
+
+def choose_breakpoints(
+    temps: Sequence[FloatArray],
+    ys: Sequence[FloatArray],
+    n_segments: int,
+    *,
+    per_run_offset: bool = True,
+) -> list[float]:
+    """Breakpoints of ``n_segments`` segments chosen from the data.
+
+    Minimises the RSS of the continuous hinge fit (with per-run offsets) over
+    the ``n_segments − 1`` breakpoint positions: the data are first reduced to
+    per-run temperature bins (mean T, mean y, count as weight), then a
+    coordinate search over the 1–99 % quantiles of T is refined by Nelder–Mead.
+    """
+    if n_segments < 1:
+        raise ThermocalInputError(f"number of segments must be ≥ 1, got {n_segments}")
+    nb = n_segments - 1
+    if nb == 0:
+        return []
+    allx = np.concatenate([np.asarray(t) for t in temps])
+    lo, hi = float(allx.min()), float(allx.max())
+    if not hi > lo:
+        raise DesignError("the temperature does not vary; cannot choose breakpoints")
+    edges = np.linspace(lo, hi, N_BINS + 1)
+    bx: list[FloatArray] = []
+    by: list[FloatArray] = []
+    bw: list[FloatArray] = []
+    bg: list[FloatArray] = []
+    for r, (x, y) in enumerate(zip(temps, ys, strict=True)):
+        k = np.clip(np.searchsorted(edges, x, side="right") - 1, 0, N_BINS - 1)
+        cnt = np.bincount(k, minlength=N_BINS).astype(np.float64)
+        sx = np.bincount(k, weights=x, minlength=N_BINS)
+        sy = np.bincount(k, weights=y, minlength=N_BINS)
+        ok = cnt > 0
+        bx.append(sx[ok] / cnt[ok])
+        by.append(sy[ok] / cnt[ok])
+        bw.append(cnt[ok])
+        bg.append(np.full(int(ok.sum()), r if per_run_offset else 0, dtype=np.float64))
+    X = np.concatenate(bx)
+    Y = np.concatenate(by)
+    W = np.sqrt(np.concatenate(bw))
+    G = np.concatenate(bg).astype(np.int64)
+    groups = int(G.max()) + 1
+    Z = np.zeros((X.size, groups))
+    Z[np.arange(X.size), G] = 1.0
+    xc = (X - lo) / (hi - lo)
+
+    def rss(bps_c: Sequence[float]) -> float:
+        cols = [Z, xc[:, None]] + [np.maximum(0.0, xc - b)[:, None] for b in bps_c]
+        A = np.hstack(cols) * W[:, None]
+        beta, _res, _rank, _sv = np.linalg.lstsq(A, Y * W, rcond=None)
+        res = Y * W - A @ beta
+        return float(res @ res)
+
+    qx = np.quantile(allx, np.linspace(0.01, 0.99, 99))
+    cand = np.unique((qx - lo) / (hi - lo))
+    start = np.quantile(allx, np.linspace(0, 1, n_segments + 1)[1:-1])
+    cur = list((start - lo) / (hi - lo))
+    best = rss(cur)
+    for _sweep in range(10):
+        changed = False
+        for j in range(nb):
+            left = cur[j - 1] if j > 0 else 0.0
+            right = cur[j + 1] if j < nb - 1 else 1.0
+            for c in cand:
+                if not left < c < right:
+                    continue
+                trial = [*cur[:j], float(c), *cur[j + 1 :]]
+                v = rss(trial)
+                if v < best - 1e-12 * abs(best):
+                    best, cur, changed = v, trial, True
+        if not changed:
+            break
+
+    def penalised(v: FloatArray) -> float:
+        s = list(v)
+        if any(b <= 0.0 or b >= 1.0 for b in s) or any(
+            b2 <= b1 for b1, b2 in itertools.pairwise(s)
+        ):
+            return best * 10.0 + 1.0
+        return rss(s)
+
+    res = optimize.minimize(
+        penalised, np.array(cur), method="Nelder-Mead", options={"xatol": 1e-5, "fatol": 0.0}
+    )
+    final = list(res.x) if res.fun < best else cur
+    return [float(lo + b * (hi - lo)) for b in sorted(final)]
+
+
+@register
+class PiecewiseModel(TemperatureModel):
+    """Piecewise-linear model in one temperature (SPEC §4b); see the module docstring.
+
+    Parameters
+    ----------
+    breakpoints : breakpoints [°C] (initial ones for ``"intersect"``).
+    segments : number of segments, breakpoints chosen from the data (default 3
+        when no breakpoints are given).
+    method : ``"intersect"`` (seed: per-segment lines, breakpoints at the
+        intersections) or ``"continuous"`` (hinge-basis least squares).
+    temperature : name or 0-based index of the temperature column (default the first).
+    per_run_offset : per-run offsets as nuisance parameters.
+    """
+
+    family: ClassVar[str] = "piecewise"
+    uses_rate: ClassVar[bool] = False
+
+    breakpoints_: FloatArray
+    intercepts_: FloatArray
+    slopes_: FloatArray
+    offsets_: FloatArray
+    initial_breakpoints_: FloatArray
+    column_index_: int
+    line_cov_: FloatArray
+
+    def __init__(
+        self,
+        breakpoints: list[float] | None = None,
+        segments: int | None = None,
+        method: str = "intersect",
+        temperature: str | int | None = None,
+        per_run_offset: bool = True,
+    ) -> None:
+        self.breakpoints = breakpoints
+        self.segments = segments
+        self.method = method
+        self.temperature = temperature
+        self.per_run_offset = per_run_offset
+
+    CLI_KEYS: ClassVar[tuple[str, ...]] = (
+        "breakpoints",
+        "segments",
+        "method",
+        "temperature",
+        "per_run_offset",
+    )
+
+    @classmethod
+    def from_cli_options(cls, options: dict[str, Any]) -> PiecewiseModel:
+        """Build from the ``thermocal fit`` option dict (keys in :mod:`thermocal.cli.fit_cmd`)."""
+        params: dict[str, Any] = {}
+        for key, value in options.items():
+            if value is None:
+                continue
+            if key not in cls.CLI_KEYS:
+                raise ThermocalInputError(f"option {key!r} does not apply to model 'piecewise'")
+            params[key] = value
+        return cls(**params)
+
+    # -- helpers --
+    def _column(self, names: Sequence[str], k: int) -> int:
+        t = self.temperature
+        if t is None:
+            return 0
+        if isinstance(t, int) and not isinstance(t, bool):
+            if not 0 <= t < k:
+                raise ThermocalInputError(
+                    f"piecewise: temperature index {t} out of range 0…{k - 1}"
+                )
+            return t
+        if str(t) in names:
+            return list(names).index(str(t))
+        raise ThermocalInputError(
+            f"piecewise: temperature column {t!r} not among {', '.join(map(repr, names))}"
+        )
+
+    def _pick(self, run: RunData) -> FloatArray:
+        """The model's temperature column of a run [°C]."""
+        k = run.temps_c.shape[1]
+        name = self.temp_names_[0]
+        if k == 1:
+            return run.temps_c[:, 0]
+        if run.temp_names and name in run.temp_names:
+            return run.temps_c[:, list(run.temp_names).index(name)]
+        if self.column_index_ < k:
+            return run.temps_c[:, self.column_index_]
+        raise ThermocalInputError(
+            f"piecewise model needs temperature {name!r}; the data has {k} columns"
+        )
+
+    # -- estimator contract --
+    def fit(self, runs: Sequence[RunData]) -> Self:
+        """Fit eq. (1) on one or several runs (module docstring); returns ``self``."""
+        if self.method not in METHODS:
+            raise ThermocalInputError(
+                f"unknown piecewise method {self.method!r}; use {' or '.join(METHODS)}"
+            )
+        if self.breakpoints is not None and self.segments is not None:
+            raise ThermocalInputError("give either breakpoints or a number of segments, not both")
+        rl = check_runs(runs, self.family)
+        names = rl[0].temp_names or tuple(f"T{i + 1}" for i in range(rl[0].temps_c.shape[1]))
+        j = self._column(names, rl[0].temps_c.shape[1])
+        xs = [np.ascontiguousarray(r.temps_c[:, j]) for r in rl]
+        ys = [r.target() for r in rl]
+        lo = min(float(x.min()) for x in xs)
+        hi = max(float(x.max()) for x in xs)
+        if self.breakpoints is not None:
+            bps = sorted(float(b) for b in self.breakpoints)
+            for b in bps:
+                if not lo < b < hi:
+                    raise DesignError(
+                        f"breakpoint {b:g} °C is outside the data's temperature range "
+                        f"{lo:.2f}…{hi:.2f} °C"
+                    )
+            if len(set(bps)) != len(bps):
+                raise ThermocalInputError("breakpoints must be distinct")
+        else:
+            n_seg = 3 if self.segments is None else int(self.segments)
+            bps = choose_breakpoints(xs, ys, n_seg, per_run_offset=self.per_run_offset)
+        bp = np.asarray(bps, dtype=np.float64)
+        S = bp.size + 1
+        seg_edges = [lo, *bps, hi]
+        labels = [f"{seg_edges[s]:.4g}–{seg_edges[s + 1]:.4g} °C" for s in range(S)]
+        counts = np.zeros(S, dtype=np.int64)
+        for x in xs:
+            counts += np.bincount(segment_index(bp, x), minlength=S)
+        for s in range(S):
+            if counts[s] < 2:
+                raise DesignError(
+                    f"segment {labels[s]} has {int(counts[s])} sample(s); a line needs at least 2 "
+                    "(move or drop a breakpoint)"
+                )
+        m = len(rl) if self.per_run_offset else 1
+        centre = 0.5 * (lo + hi)
+        scale = max(0.5 * (hi - lo), 1e-12)
+        if self.method == "intersect":
+            # features: slope of each segment, then intercept steps of segments 2..S
+            p = S + (S - 1)
+            names_f = [f"slope[{lab}]" for lab in labels] + [f"level[{lab}]" for lab in labels[1:]]
+        else:
+            p = 1 + bp.size
+            names_f = ["slope"] + [f"hinge[{b:.4g}]" for b in bps]
+        names_all = names_f + (
+            [f"offset[{r.name or i + 1}]" for i, r in enumerate(rl)]
+            if self.per_run_offset
+            else ["const"]
+        )
+
+        def features(x: FloatArray, out: FloatArray) -> None:
+            u = (x - centre) / scale
+            if self.method == "intersect":
+                seg = segment_index(bp, x)
+                for s in range(S):
+                    np.multiply(u, seg == s, out=out[:, s])
+                for s in range(1, S):
+                    out[:, S + s - 1] = seg == s
+            else:
+                out[:, 0] = u
+                for i, b in enumerate(bp):
+                    np.maximum(0.0, (x - b) / scale, out=out[:, 1 + i])
+
+        def make_chunks() -> Iterator[Chunk]:
+            bufs: dict[int, FloatArray] = {}
+            for i, (x, y) in enumerate(zip(xs, ys, strict=True)):
+                g = i if self.per_run_offset else 0
+                for a in range(0, x.size, CHUNK_ROWS):
+                    b = min(x.size, a + CHUNK_ROWS)
+                    c = b - a
+                    if c not in bufs:
+                        bufs[c] = np.empty((c, p + 2), order="F")
+                        bufs[c][:, p] = 1.0
+                    A = bufs[c]
+                    features(x[a:b], A[:, :p])
+                    A[:, p + 1] = y[a:b]
+                    yield A, g, 0
+
+        red = accumulate_r(make_chunks, p, m, solver="qr")
+        sol = solve_r(red.combined(), red.n_total, names_all)
+        coef = sol.coef
+        offsets = coef[p:]
+        const = float(np.mean(offsets))
+        # lines y = a_s + k_s T as a linear map of the solution [coef, offsets]
+        q = p + m
+        A_int = np.zeros((S, q))  # intercepts a_s
+        A_slp = np.zeros((S, q))  # slopes k_s
+        A_int[:, p:] = 1.0 / m
+        if self.method == "intersect":
+            for s in range(S):
+                A_slp[s, s] = 1.0 / scale
+                A_int[s, s] = -centre / scale
+                if s > 0:
+                    A_int[s, S + s - 1] = 1.0
+        else:
+            # y = const + s0 (T − c)/σ + Σ_i d_i max(0, T − b_i)/σ
+            for s in range(S):
+                A_slp[s, 0] = 1.0 / scale
+                A_int[s, 0] = -centre / scale
+                for i in range(s):  # hinges active in segment s
+                    A_slp[s, 1 + i] = 1.0 / scale
+                    A_int[s, 1 + i] = -bp[i] / scale
+        intercepts = A_int @ coef
+        slopes = A_slp @ coef
+        Lmat = np.vstack([A_int, A_slp])
+        line_cov = Lmat @ sol.cov @ Lmat.T
+        final = bp.copy()
+        discontinuities: list[float] = []
+        if self.method == "intersect":
+            for i in range(bp.size):
+                ds = slopes[i] - slopes[i + 1]
+                x_star = (intercepts[i + 1] - intercepts[i]) / ds if ds != 0 else math.nan
+                left = final[i - 1] if i > 0 else lo
+                right = bp[i + 1] if i + 1 < bp.size else hi
+                if math.isfinite(x_star) and left < x_star < right:
+                    final[i] = x_star
+                else:
+                    discontinuities.append(float(bp[i]))
+            if discontinuities:
+                warnings.warn(
+                    "piecewise: adjacent lines do not intersect between their segments at "
+                    + ", ".join(f"{b:g} °C" for b in discontinuities)
+                    + "; the given breakpoint is kept and the model jumps there",
+                    ThermocalWarning,
+                    stacklevel=2,
+                )
+        self.column_index_ = j
+        self.breakpoints_ = final
+        self.initial_breakpoints_ = bp
+        self.intercepts_ = intercepts
+        self.slopes_ = slopes
+        self.offsets_ = offsets
+        self.line_cov_ = line_cov
+        n_total = red.n_total
+        # residual of the final model (breakpoints moved): exact, one pass
+        rss = 0.0
+        for i, (x, y) in enumerate(zip(xs, ys, strict=True)):
+            off = offsets[i] - const if self.per_run_offset else 0.0
+            res = y - evaluate_lines(final, intercepts, slopes, x) - off
+            rss += float(res @ res)
+        ybar = sum(float(np.sum(y)) for y in ys) / n_total
+        tss = sum(float(((y - ybar) ** 2).sum()) for y in ys)
+        stats = FitStats(
+            n_samples=n_total,
+            n_coefficients=2 * S if self.method == "intersect" else S + 1,
+            rms_residual=math.sqrt(rss / n_total),
+            condition_number=sol.condition_number,
+            r_squared=float(1.0 - rss / tss) if tss > 0 else None,
+            dof=sol.dof,
+            extra={
+                "method": self.method,
+                "temperature": names[j],
+                "breakpoints": [float(b) for b in final],
+                "initial_breakpoints": [float(b) for b in bp],
+                "discontinuities": discontinuities,
+                "n_runs": len(rl),
+                "per_run_offsets": [float(o) for o in offsets] if self.per_run_offset else None,
+                "rms_residual_lsq": math.sqrt(sol.rss / n_total),
+            },
+        )
+        # ranges of the used column only (record_ranges takes per-run min/max)
+        summary = [
+            RunData(
+                time_s=np.array([0.0, 1.0]),
+                temps_c=np.array([[x.min()], [x.max()]]),
+                temp_names=(names[j],),
+                name=r.name,
+            )
+            for r, x in zip(rl, xs, strict=True)
+        ]
+        record_ranges(self, summary, stats, None)
+        self.data_ = [{"file": r.name, "n_samples": r.n_samples} for r in rl]
+        return self
+
+    def predict(self, run: RunData, *, extrapolate: bool = False) -> FloatArray:
+        """Eq. (1) for every sample of ``run`` [signal unit]; T clamped to the fitted range."""
+        self.check_fitted()
+        x = self._pick(run)
+        xc = self.clamp(x[:, None], extrapolate=extrapolate)[:, 0]
+        return evaluate_lines(self.breakpoints_, self.intercepts_, self.slopes_, xc)
+
+    def stream(self, sample_interval_s: float, *, extrapolate: bool = False) -> PiecewiseStream:
+        """Sample-by-sample twin of :meth:`predict` (memoryless)."""
+        self.check_fitted()
+        return PiecewiseStream(self, extrapolate=extrapolate)
+
+    def coefficients(self) -> list[Coefficient]:
+        """Per-segment intercepts and slopes (physical units, with standard errors), breakpoints."""
+        self.check_fitted()
+        S = self.slopes_.size
+        se = np.sqrt(np.clip(np.diag(self.line_cov_), 0.0, None))
+        edges = [-math.inf, *self.breakpoints_, math.inf]
+        out: list[Coefficient] = []
+        for s in range(S):
+            lab = f"{edges[s]:.4g}…{edges[s + 1]:.4g}"
+            out.append(
+                Coefficient(
+                    f"intercept[{lab}]", float(self.intercepts_[s]), float(se[s]), self.signal_unit
+                )
+            )
+            out.append(
+                Coefficient(
+                    f"slope[{lab}]",
+                    float(self.slopes_[s]),
+                    float(se[S + s]),
+                    f"{self.signal_unit}/degC",
+                )
+            )
+        for i, b in enumerate(self.breakpoints_):
+            out.append(Coefficient(f"breakpoint[{i + 1}]", float(b), None, "degC"))
+        return out
+
+    def _state(self) -> dict[str, Any]:
+        return {
+            "layout": STATE_LAYOUT,
+            "temperature": self.temp_names_[0] if hasattr(self, "temp_names_") else None,
+            "column_index": int(self.column_index_),
+            "method": self.method,
+            "breakpoints": [float(b) for b in self.breakpoints_],
+            "intercepts": [float(a) for a in self.intercepts_],
+            "slopes": [float(s) for s in self.slopes_],
+            "offsets": [float(o) for o in self.offsets_],
+            "initial_breakpoints": [float(b) for b in self.initial_breakpoints_],
+            "line_cov": self.line_cov_.tolist(),
+        }
+
+    def _set_state(self, state: dict[str, Any]) -> None:
+        if state.get("layout") != STATE_LAYOUT:
+            raise ThermocalInputError(
+                f"piecewise model state layout {state.get('layout')!r} is not {STATE_LAYOUT!r}"
+            )
+        self.column_index_ = int(state.get("column_index", 0))
+        self.breakpoints_ = np.asarray(state["breakpoints"], dtype=np.float64)
+        self.intercepts_ = np.asarray(state["intercepts"], dtype=np.float64)
+        self.slopes_ = np.asarray(state["slopes"], dtype=np.float64)
+        self.offsets_ = np.asarray(state.get("offsets", []), dtype=np.float64)
+        self.initial_breakpoints_ = np.asarray(
+            state.get("initial_breakpoints", state["breakpoints"]), dtype=np.float64
+        )
+        S = self.slopes_.size
+        self.line_cov_ = np.asarray(
+            state.get("line_cov", np.full((2 * S, 2 * S), np.nan)), dtype=np.float64
+        )
+        if self.intercepts_.size != S or self.breakpoints_.size != S - 1:
+            raise ThermocalInputError("piecewise model state: need one more line than breakpoints")
+
+
+class PiecewiseStream(ModelStream):
+    """Sample-by-sample :class:`PiecewiseModel`: eq. (1) on the clamped temperature.
+
+    ``temps_c`` may hold only the model's temperature or every fitted column
+    (then the model's ``column_index`` is used).  Warns once per stream when a
+    sample leaves the fitted range.
+    """
+
+    def __init__(self, model: PiecewiseModel, *, extrapolate: bool) -> None:
+        self.model = model
+        self.extrapolate = extrapolate
+        self.lo = float(model.temp_range_[0, 0])
+        self.hi = float(model.temp_range_[0, 1])
+        self.reset()
+
+    def reset(self) -> None:
+        self._warned = False
+
+    def update(self, time_s: float, temps_c: FloatArray, signal: float | None = None) -> float:
+        arr = np.atleast_1d(np.asarray(temps_c, dtype=np.float64))
+        x = float(arr[0] if arr.size == 1 else arr[self.model.column_index_])
+        if x < self.lo or x > self.hi:
+            if not self._warned:
+                self._warned = True
+                action = "extrapolating" if self.extrapolate else "clamped to the fitted range"
+                warnings.warn(
+                    f"temperature {x:.2f} °C outside the model's fitted range "
+                    f"{self.lo:.2f}…{self.hi:.2f}; {action}",
+                    ExtrapolationWarning,
+                    stacklevel=2,
+                )
+            if not self.extrapolate:
+                x = min(max(x, self.lo), self.hi)
+        m = self.model
+        v = evaluate_lines(m.breakpoints_, m.intercepts_, m.slopes_, np.array([x]))
+        return float(v[0])
