@@ -482,10 +482,12 @@ def segment_rates(
     contiguous = int(i[-1]) - int(i[0]) == i.size - 1 and bool(np.all(np.diff(i) == 1))
     ti = ts[i[0] : i[-1] + 1] if contiguous else ts[i]
     if method == "backward":
-        lo = np.searchsorted(ts, ti - interval_s, side="left")
-        if contiguous:  # fast path: the sample itself is a slice, not a gather
+        if contiguous:  # fast path: search a window only; the sample itself is a slice
+            x = ti - interval_s
+            lo0 = int(np.searchsorted(ts, x[0], side="left"))
+            lo = lo0 + np.searchsorted(ts[lo0 : i[-1] + 1], x, side="left")
             span = ti - ts[lo]
-            out = np.zeros((i.size, Ts.shape[1]))
+            out = np.zeros((i.size, Ts.shape[1]), order="F")
             ok = span > 0
             Ti = Ts[i[0] : i[-1] + 1]
             if ok.all():
@@ -495,6 +497,7 @@ def segment_rates(
             elif ok.any():
                 out[ok] = (Ti[ok] - Ts[lo[ok]]) / span[ok, None] * SECONDS_PER_MINUTE
             return out
+        lo = np.searchsorted(ts, ti - interval_s, side="left")
         hi = i
     elif method == "forward":
         lo = i
@@ -505,7 +508,7 @@ def segment_rates(
     else:
         raise ThermocalInputError(f"unknown rate method {method!r}")
     span = ts[hi] - ts[lo]
-    out = np.zeros((i.size, Ts.shape[1]))
+    out = np.zeros((i.size, Ts.shape[1]), order="F")
     ok = span > 0
     if ok.all():
         out[...] = (Ts[hi] - Ts[lo]) / span[:, None] * SECONDS_PER_MINUTE
@@ -585,6 +588,8 @@ def _triangularise(a: FloatArray) -> FloatArray:
 def _accumulate_qr(
     chunks: Iterable[Chunk], p: int, m: int, n_folds: int
 ) -> tuple[list[FloatArray], list[int]]:
+    """R factors of ``[F | Z | y]`` per fold by a chunked Householder QR (TSQR-like):
+    each chunk is stacked under the running R and re-triangularised (LAPACK ``dgeqrf``)."""
     q1 = p + m + 1
     r_acc = [np.zeros((q1, q1), order="F") for _ in range(n_folds)]
     counts = [0] * n_folds
@@ -773,60 +778,97 @@ def solve_r(
     penalised: npt.NDArray[np.bool_] | None = None,
     ridge: float = 0.0,
     rcond: float | None = None,
+    noise_threshold: float | None = None,
     columns: Sequence[int] | None = None,
 ) -> LstsqSolution:
     """Least squares from the augmented R factor of ``[A | y]``, columns equilibrated.
 
-    Minimises ``‖A β − y‖² + n α ‖D_p β_p‖²`` where D scales each column of A to
-    unit RMS and only the ``penalised`` columns are shrunk (ridge α ≥ 0).  With
-    ``A = Q R`` and ``Qᵀ y = z`` this is the small problem
-    ``‖R D γ − z‖² + n α ‖γ_p‖²`` (β = D γ), solved by SVD of the stacked
-    matrix ``M = [R D; √(nα) E_p] = U S Vᵀ``: ``γ = V S⁻¹ Uᵀ [z; 0]``, singular
-    values below ``rcond · s_max`` dropped (truncated SVD).  Covariance
-    ``cov(β) = σ² D V S⁻² Vᵀ (R D)ᵀ(R D) V S⁻² Vᵀ D`` (reduces to
-    ``σ² D V S⁻² Vᵀ D`` without ridge), ``σ² = RSS/(n − rank)``.  The
-    residuals are assumed white; with coloured noise the errors are optimistic.
-    A design with ``s_min < 1e-11 s_max`` raises :class:`DesignError` naming
-    the dependent columns.  ``columns`` restricts the problem to a subset.
+    The columns are scaled to unit RMS (``A_s = A D``) and split into the free
+    ones (U: constant, per-run offsets) and the regularised ones (P: the
+    ``penalised`` terms).  A QR of ``[A_s,U  A_s,P | y]`` (from R, never from
+    the data again) gives ``R11, R12, R22, z1, z2``; the P part is solved by SVD,
+    ``R22 = U S Vᵀ``, ``c = Uᵀ z2``::
+
+        γ_P = Σ_{kept i} v_i c_i s_i/(s_i² + nα),     γ_U = R11⁻¹ (z1 − R12 γ_P)
+
+    (ridge α ≥ 0 shrinks only the P coefficients; Golub & Van Loan §6.1.4).
+    Component i is kept when ``s_i > rcond · s_max`` (truncated SVD) or, with
+    ``noise_threshold`` k, when ``|c_i| > k σ̂`` — its share of the data stands
+    out of the noise (σ̂² = RSS/(n − q) of the full fit; a discrete Picard
+    rule, Hansen, *Rank-Deficient and Discrete Ill-Posed Problems*, SIAM 1998,
+    §3.2).  ``β = D γ``; ``cov(β) = σ² D L Lᵀ D`` with L
+    the linear map from ``[z1; z2]`` to γ (triangular solves, no inverse of
+    AᵀA).  Residuals are assumed white; with coloured noise the standard
+    errors are optimistic.  A design with ``s_min < 1e-11 s_max`` raises
+    :class:`DesignError` naming the dependent columns.  ``columns`` restricts
+    the problem to a subset (in that order).
     """
     q = r_aug.shape[1] - 1
     cols = list(range(q)) if columns is None else list(columns)
-    R = r_aug[:, cols]
-    z = r_aug[:, q]
-    sub_names = [names[i] for i in cols]
-    err = singular_error(R, sub_names)
+    pen_all = np.zeros(q, dtype=bool) if penalised is None else np.asarray(penalised, dtype=bool)
+    if ridge < 0:
+        raise ThermocalInputError(f"ridge α must be ≥ 0, got {ridge}")
+    err = singular_error(r_aug[:, cols], [names[i] for i in cols])
     if err is not None:
         raise err
+    free = [c for c in cols if not pen_all[c]]
+    reg = [c for c in cols if pen_all[c]]
+    order = free + reg
+    R = r_aug[:, order]
     scale = column_scales(R) / math.sqrt(max(n, 1))  # RMS of each column
     Rs = R / scale[None, :]
     cond = scaled_condition(R)
-    pen = np.zeros(len(cols), dtype=bool) if penalised is None else penalised[cols]
-    if ridge < 0:
-        raise ThermocalInputError(f"ridge α must be ≥ 0, got {ridge}")
-    if ridge > 0 and pen.any():
-        E = np.diag(pen.astype(np.float64))[pen]
-        M = np.vstack([Rs, math.sqrt(n * ridge) * E])
-        rhs = np.r_[z, np.zeros(E.shape[0])]
+    qq = len(order)
+    nu = len(free)
+    A2 = _triangularise(np.column_stack([Rs, r_aug[:, q]]))
+    R11 = A2[:nu, :nu]
+    R12 = A2[:nu, nu:qq]
+    R22 = A2[nu:qq, nu:qq]
+    z1 = A2[:nu, qq]
+    z2 = A2[nu:qq, qq]
+    rss0 = float(A2[qq, qq] ** 2) if A2.shape[0] > qq else 0.0
+    np_ = qq - nu
+    dof_full = n - qq
+    sigma_full = math.sqrt(rss0 / dof_full) if dof_full > 0 else math.nan
+    H = np.zeros((np_, np_))
+    keep = np.zeros(np_, dtype=bool)
+    sv = np.zeros(0)
+    if np_:
+        U, S, Vt = np.linalg.svd(R22)
+        sv = S
+        c = U.T @ z2
+        keep = np.greater(S, (rcond or 0.0) * S[0])
+        if noise_threshold is not None and math.isfinite(sigma_full):
+            # a small-s_i component stays when the data along it stand out of the noise
+            strong = np.abs(c) > noise_threshold * sigma_full
+            keep |= strong & np.greater(S, SINGULAR_RCOND * S[0])
+        f = np.zeros_like(S)
+        f[keep] = S[keep] / (S[keep] ** 2 + n * ridge)
+        H = (Vt.T * f) @ U.T  # γ_P = H z2
+    gamma_p = H @ z2
+    if nu:
+        Linv_u = sla.solve_triangular(R11, np.eye(nu), lower=False)
+        gamma_u = Linv_u @ (z1 - R12 @ gamma_p)
+        Lmap = np.zeros((qq, qq))
+        Lmap[:nu, :nu] = Linv_u
+        Lmap[:nu, nu:] = -Linv_u @ R12 @ H
+        Lmap[nu:, nu:] = H
     else:
-        M, rhs = Rs, z
-    U, S, Vt = np.linalg.svd(M, full_matrices=False)
-    keep = np.greater(S, (rcond or 0.0) * S[0])
-    rank = int(keep.sum())
-    Uk, Sk, Vk = U[:, keep], S[keep], Vt[keep].T
-    gamma = Vk @ ((Uk.T @ rhs) / Sk)
-    resid = z - Rs @ gamma
-    rss = float(resid @ resid)
+        gamma_u = np.zeros(0)
+        Lmap = H
+    gamma = np.r_[gamma_u, gamma_p]
+    res2 = z2 - R22 @ gamma_p
+    rss = rss0 + float(res2 @ res2)
+    rank = nu + int(keep.sum())
     dof = n - rank
     sigma2 = rss / dof if dof > 0 else math.nan
-    H = (Vk / Sk**2) @ Vk.T  # (MᵀM)⁺
-    if ridge > 0 and pen.any():
-        RtR = Rs.T @ Rs
-        cov_g = sigma2 * (H @ RtR @ H)
-    else:
-        cov_g = sigma2 * H
-    coef = gamma / scale
-    cov = cov_g / scale[:, None] / scale[None, :]
-    sv = np.linalg.svd(Rs, compute_uv=False)
+    cov_g = sigma2 * (Lmap @ Lmap.T)
+    coef_o = gamma / scale
+    cov_o = cov_g / scale[:, None] / scale[None, :]
+    # back to the order of ``cols``
+    pos = [order.index(c) for c in cols]
+    coef = coef_o[pos]
+    cov = cov_o[np.ix_(pos, pos)]
     return LstsqSolution(
         coef=coef,
         cov=cov,
@@ -837,6 +879,7 @@ def solve_r(
         rank=rank,
         n_truncated=int((~keep).sum()),
         singular_values=np.asarray(sv, dtype=np.float64),
+        extra={"sigma_full": sigma_full},
     )
 
 

@@ -1,0 +1,375 @@
+"""``thermocal fit FILE... --model NAME --signal COL --temps COLS -o MODEL.json``.
+
+Fits a compensation model (SPEC §4) on one or several runs (several FILEs =
+several runs, each with its own turn-on offset unless ``--no-per-run-offset``)
+and writes the self-describing model file (:func:`thermocal.models.base.save_model`)
+with the data files' names and SHA-256 checksums.
+
+The family is looked up in the registry (:func:`thermocal.models.base.get_model_class`).
+The command collects the model options the user gave into one dict and calls
+``cls.from_cli_options(options)`` when the family class has it, else ``cls(**options)``
+restricted to its constructor parameters.  Only options given on the command
+line are in the dict (no ``None`` values).  Keys:
+
+==================  =======================  ==================================================
+key                 option                   meaning (families)
+==================  =======================  ==================================================
+``terms``           ``--terms``              ``seed000`` or ``"T1,T1^2,dT1,T1*dT1,..."`` (poly)
+``order``           ``--order N``            plain polynomial order (poly); order in ΔT (warmup)
+``rate_interval_s`` ``--rate-interval S``    Δt of Ṫ [s] (poly)
+``rate_method``     ``--rate-method``        backward | forward | centred (poly)
+``select``          ``--select [--select-method bic|holdout]``  term selection (poly)
+``ridge``           ``--ridge ALPHA``        ridge α on unit-RMS terms (poly)
+``rcond``           ``--rcond R``            SVD truncation threshold (poly)
+``solver``          ``--solver``             auto | qr | gram (poly)
+``noise_threshold`` ``--noise-threshold K``  keep truncated components above K σ̂ (poly)
+``breakpoints``     ``--breakpoints 25,30``  list of float [°C] (piecewise)
+``segments``        ``--segments N``         segments, breakpoints from data (piecewise)
+``method``          ``--method``             intersect | continuous (piecewise); warmup's own
+``start_window_s``  ``--start-window S``     F0/T0 averaging window [s] (warmup)
+``t0_order``        ``--t0-order M``         coefficient order in T0 (warmup)
+``deviation``       ``--deviation``          distinct-curve threshold, signal unit (bank)
+``tolerance``       ``--tolerance``          model acceptance, signal unit (bank)
+``startup_s``       ``--startup-s``          start-up smoothing window [s] (bank)
+``per_run_offset``  ``--[no-]per-run-offset``  per-run turn-on offsets (all that support it)
+==================  =======================  ==================================================
+
+``--target bias|scale_factor`` and the signal's name and unit are recorded in
+the model file.  ``--latitude DEG --axis up`` removes the earth rate seen by
+the axis (:func:`thermocal.units.earth_rate_on_axis_deg_h`) as a known input;
+``--known-input X`` gives any other known input in the canonical signal unit.
+
+JSON keys (``--json``): ``model``, ``output``, ``n_coefficients``,
+``rms_residual``, ``condition_number``, ``temperature_range`` ({name: [lo, hi]}),
+``rate_range``, ``n_samples``, ``n_runs``, ``unit``, ``target``, ``files``
+(name, sha256, n_samples), ``terms_kept`` (selection, else null), ``fit`` (all
+fit statistics), ``coefficients`` and ``warnings``.
+"""
+
+from __future__ import annotations
+
+import inspect
+import warnings
+from pathlib import Path
+from typing import Annotated, Any
+
+import typer
+from rich.table import Table
+
+from thermocal.cli.app import app
+from thermocal.cli.common import (
+    JsonOpt,
+    SignalUnitOpt,
+    TempUnitOpt,
+    emit,
+    fmt,
+    handle_errors,
+    load_recording,
+    one_line,
+    split_names,
+    stdout,
+)
+from thermocal.errors import ThermocalInputError
+from thermocal.io import check_not_input
+from thermocal.models.base import (
+    RunData,
+    TemperatureModel,
+    file_sha256,
+    get_model_class,
+    save_model,
+)
+from thermocal.units import canonical_unit, earth_rate_on_axis_deg_h, parse_axis
+
+TARGETS = ("bias", "scale_factor")
+
+
+def build_model(family: str, options: dict[str, Any]) -> TemperatureModel:
+    """Instantiate a registered family from the CLI option dict (module docstring)."""
+    cls = get_model_class(family)
+    opts = {k: v for k, v in options.items() if v is not None}
+    factory = getattr(cls, "from_cli_options", None)
+    if callable(factory):
+        model = factory(opts)
+        if not isinstance(model, TemperatureModel):
+            raise ThermocalInputError(f"model family {family!r} did not build a model")
+        return model
+    params = [p for p in inspect.signature(cls.__init__).parameters if p != "self"]
+    unknown = [k for k in opts if k not in params]
+    if unknown:
+        raise ThermocalInputError(
+            f"option(s) {', '.join(unknown)} do not apply to model {family!r}"
+        )
+    return cls(**opts)
+
+
+def _floats(text: str | None, what: str) -> list[float] | None:
+    names = split_names(text)
+    if names is None:
+        return None
+    try:
+        return [float(v) for v in names]
+    except ValueError:
+        raise ThermocalInputError(
+            f"{what}: expected comma-separated numbers, got {text!r}"
+        ) from None
+
+
+@app.command("fit")
+@handle_errors
+def fit_cmd(
+    files: Annotated[
+        list[Path],
+        typer.Argument(help="Recordings (CSV or Parquet); one run each.", show_default=False),
+    ],
+    model: Annotated[
+        str, typer.Option("--model", help="Model family: poly, piecewise, warmup, bank.")
+    ],
+    output: Annotated[Path, typer.Option("-o", "--output", help="Model file to write (JSON).")],
+    signal: Annotated[str | None, typer.Option("--signal", help="Sensor-output column.")] = None,
+    temps: Annotated[
+        str | None, typer.Option("--temps", help="Comma-separated temperature columns.")
+    ] = None,
+    time: Annotated[str | None, typer.Option("--time", help="Time column.")] = None,
+    time_unit: Annotated[str | None, typer.Option("--time-unit", help="s, ms or us.")] = None,
+    signal_unit: SignalUnitOpt = None,
+    temp_unit: TempUnitOpt = None,
+    # poly
+    terms: Annotated[
+        str | None, typer.Option("--terms", help='poly: "seed000" or "T1,T1^2,dT1,T1*dT1,...".')
+    ] = None,
+    order: Annotated[
+        int | None,
+        typer.Option("--order", help="poly: plain polynomial order; warmup: order in ΔT."),
+    ] = None,
+    rate_interval: Annotated[
+        float | None, typer.Option("--rate-interval", help="poly: Δt of Ṫ [s] (default 60).")
+    ] = None,
+    rate_method: Annotated[
+        str | None, typer.Option("--rate-method", help="poly: backward | forward | centred.")
+    ] = None,
+    select: Annotated[
+        bool, typer.Option("--select", help="poly: stepwise term selection.")
+    ] = False,
+    select_method: Annotated[
+        str, typer.Option("--select-method", help="poly: selection criterion bic | holdout.")
+    ] = "bic",
+    ridge: Annotated[float | None, typer.Option("--ridge", help="poly: ridge α.")] = None,
+    rcond: Annotated[
+        float | None, typer.Option("--rcond", help="poly: SVD truncation (default 1e-3).")
+    ] = None,
+    solver: Annotated[str | None, typer.Option("--solver", help="poly: auto | qr | gram.")] = None,
+    noise_threshold: Annotated[
+        float | None,
+        typer.Option(
+            "--noise-threshold", help="poly: keep truncated SVD components above K σ (default 10)."
+        ),
+    ] = None,
+    # piecewise
+    breakpoints: Annotated[
+        str | None, typer.Option("--breakpoints", help="piecewise: breakpoints [°C], e.g. 25,30.")
+    ] = None,
+    segments: Annotated[
+        int | None, typer.Option("--segments", help="piecewise: N segments chosen from the data.")
+    ] = None,
+    method: Annotated[
+        str | None, typer.Option("--method", help="piecewise: intersect | continuous.")
+    ] = None,
+    # warmup
+    start_window: Annotated[
+        float | None, typer.Option("--start-window", help="warmup: F0/T0 window [s].")
+    ] = None,
+    t0_order: Annotated[
+        int | None, typer.Option("--t0-order", help="warmup: coefficient order in T0.")
+    ] = None,
+    # bank
+    deviation: Annotated[
+        float | None, typer.Option("--deviation", help="bank: distinct-curve threshold.")
+    ] = None,
+    tolerance: Annotated[
+        float | None, typer.Option("--tolerance", help="bank: model acceptance tolerance.")
+    ] = None,
+    startup_s: Annotated[
+        float | None, typer.Option("--startup-s", help="bank: start-up window [s].")
+    ] = None,
+    # common
+    per_run_offset: Annotated[
+        bool | None,
+        typer.Option(
+            "--per-run-offset/--no-per-run-offset",
+            help="Estimate one turn-on offset per run (nuisance parameters).",
+        ),
+    ] = None,
+    target: Annotated[
+        str, typer.Option("--target", help="What the model describes: bias | scale_factor.")
+    ] = "bias",
+    latitude: Annotated[
+        float | None, typer.Option("--latitude", help="Latitude [deg] for earth-rate removal.")
+    ] = None,
+    axis: Annotated[
+        str | None, typer.Option("--axis", help="Sensitive axis (up, north, east, or x,y,z ENU).")
+    ] = None,
+    known_input: Annotated[
+        float | None,
+        typer.Option("--known-input", help="Known input to remove, canonical signal unit."),
+    ] = None,
+    as_json: JsonOpt = False,
+) -> None:
+    """Fit a temperature-compensation model on one or several runs and save it."""
+    if target not in TARGETS:
+        raise ThermocalInputError(f"--target must be bias or scale_factor, got {target!r}")
+    if not files:
+        raise ThermocalInputError("give at least one data file")
+    check_not_input(output, list(files))
+    if output.suffix.lower() not in (".json", ""):
+        raise ThermocalInputError(f"{output}: the model file is JSON; use a .json name")
+    options: dict[str, Any] = {
+        "terms": terms,
+        "order": order,
+        "rate_interval_s": rate_interval,
+        "rate_method": rate_method,
+        "select": select_method if select else None,
+        "ridge": ridge,
+        "rcond": rcond,
+        "solver": solver,
+        "noise_threshold": noise_threshold,
+        "breakpoints": _floats(breakpoints, "--breakpoints"),
+        "segments": segments,
+        "method": method,
+        "start_window_s": start_window,
+        "t0_order": t0_order,
+        "deviation": deviation,
+        "tolerance": tolerance,
+        "startup_s": startup_s,
+        "per_run_offset": per_run_offset,
+    }
+    if select_method not in ("bic", "holdout"):
+        raise ThermocalInputError(f"--select-method must be bic or holdout, got {select_method!r}")
+    est = build_model(model, options)
+
+    runs: list[RunData] = []
+    provenance: list[dict[str, Any]] = []
+    unit = ""
+    sig_name = signal or "signal"
+    temp_names: tuple[str, ...] | None = None
+    for path in files:
+        rec = load_recording(
+            path,
+            time=time,
+            time_unit=time_unit,
+            signal=signal,
+            temps=temps,
+            signal_unit=signal_unit,
+            temp_unit=temp_unit,
+        )
+        _values, run_unit = rec.signal(signal)
+        sig_name = signal or rec.signals[0]
+        if unit and run_unit != unit:
+            raise ThermocalInputError(f"{path}: signal unit {run_unit} differs from {unit}")
+        unit = run_unit
+        ki = 0.0
+        if latitude is not None or axis is not None:
+            if latitude is None or axis is None:
+                raise ThermocalInputError("earth-rate removal needs both --latitude and --axis")
+            if canonical_unit(unit) != "deg/h":
+                raise ThermocalInputError(
+                    f"{path}: --latitude/--axis remove the earth rate from a gyro signal; "
+                    f"this signal is in {unit}"
+                )
+            ki += earth_rate_on_axis_deg_h(latitude, parse_axis(axis))
+        if known_input is not None:
+            ki += known_input
+        run = RunData.from_recording(rec, signal, split_names(temps), known_input=ki)
+        run = RunData(
+            time_s=run.time_s,
+            temps_c=run.temps_c,
+            signal=run.signal,
+            temp_names=run.temp_names,
+            name=path.name,
+            known_input=run.known_input,
+        )
+        if temp_names is None:
+            temp_names = run.temp_names
+        elif run.temp_names != temp_names:
+            raise ThermocalInputError(
+                f"{path}: temperature columns {list(run.temp_names)} differ from the first "
+                f"file's {list(temp_names)}"
+            )
+        runs.append(run)
+        provenance.append(
+            {
+                "file": path.name,
+                "path": str(path),
+                "sha256": file_sha256(path),
+                "n_samples": run.n_samples,
+                "known_input": ki,
+            }
+        )
+
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        est.fit(runs)
+    messages = [one_line(str(w.message)) for w in caught]
+    for w in caught:  # hand them on to handle_errors, which prints them on stderr
+        warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
+
+    est.signal_name = sig_name
+    est.signal_unit = unit
+    est.target = target
+    est.data_ = provenance
+    save_model(est, output)
+
+    st = est.stats_
+    trange = {
+        n: [float(a), float(b)] for n, (a, b) in zip(est.temp_names_, est.temp_range_, strict=True)
+    }
+    rrange = (
+        {
+            n: [float(a), float(b)]
+            for n, (a, b) in zip(est.temp_names_, est.rate_range_, strict=True)
+        }
+        if est.rate_range_ is not None
+        else None
+    )
+    kept = st.extra.get("selected_terms")
+    result: dict[str, Any] = {
+        "model": est.family,
+        "output": str(output),
+        "n_coefficients": st.n_coefficients,
+        "rms_residual": st.rms_residual,
+        "condition_number": st.condition_number,
+        "temperature_range": trange,
+        "rate_range": rrange,
+        "n_samples": st.n_samples,
+        "n_runs": len(runs),
+        "unit": unit,
+        "target": target,
+        "files": [{k: p[k] for k in ("file", "sha256", "n_samples")} for p in provenance],
+        "terms_kept": kept,
+        "fit": st.to_dict(),
+        "coefficients": [c.to_dict() for c in est.coefficients()],
+        "warnings": messages,
+    }
+
+    def human() -> None:
+        tab = Table(title=f"{est.family} model → {output}")
+        tab.add_column("quantity")
+        tab.add_column("value")
+        tab.add_row("runs / samples", f"{len(runs)} / {st.n_samples}")
+        tab.add_row("coefficients", str(st.n_coefficients))
+        tab.add_row(f"rms residual [{unit}]", fmt(st.rms_residual))
+        tab.add_row("condition number", fmt(st.condition_number))
+        for n, (a, b) in trange.items():
+            tab.add_row(f"range {n} [°C]", f"{a:.2f} … {b:.2f}")
+        if kept is not None:
+            tab.add_row("terms kept", ", ".join(kept))
+        stdout.print(tab)
+        ctab = Table(title="coefficients")
+        ctab.add_column("name")
+        ctab.add_column("value")
+        ctab.add_column("std. error")
+        ctab.add_column("unit")
+        for c in est.coefficients():
+            ctab.add_row(c.name, fmt(c.value, 6), fmt(c.stderr, 3), c.unit)
+        stdout.print(ctab)
+
+    emit(result, as_json, human)

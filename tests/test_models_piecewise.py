@@ -1,0 +1,146 @@
+"""Tests of the piecewise-linear model (SPEC §4b, seed 001)."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+import pytest
+from numpy.testing import assert_allclose, assert_array_equal
+
+from thermocal.errors import DesignError, ExtrapolationWarning, ThermocalInputError
+from thermocal.models import RunData, get_model_class, load_model, save_model
+from thermocal.models.piecewise import PiecewiseModel, evaluate_lines
+from thermocal.simulate import SCENARIOS
+
+BPS = np.array([23.6, 30.0])
+INTER = np.array([1.0 - 0.05 * 23.6, 1.0 - 0.01 * 23.6, 1.064 - 0.08 * 30.0])
+SLOPES = np.array([0.05, 0.01, 0.08])
+
+
+def truth(T):
+    return evaluate_lines(BPS, INTER, SLOPES, T)
+
+
+def make_run(n=12000, noise=0.0, seed=0, gap=False, offset=0.0, name="r"):
+    rng = np.random.default_rng(seed)
+    t = np.arange(float(n))
+    if gap:
+        t[n // 2 :] += 500.0
+    T = 15 + 27 * (0.5 - 0.5 * np.cos(2 * np.pi * t / n))
+    y = truth(T) + offset + noise * rng.standard_normal(n)
+    return RunData(t, np.column_stack([T, T + 1.0]), y, ("T1", "T2"), name)
+
+
+def test_truth_is_continuous():
+    for b in BPS:
+        assert truth(np.array([b - 1e-12]))[0] == pytest.approx(truth(np.array([b]))[0], abs=1e-9)
+
+
+def test_continuous_exact_recovery_with_given_breakpoints():
+    run = make_run()
+    m = PiecewiseModel(breakpoints=[23.6, 30.0], method="continuous", per_run_offset=False)
+    m.fit([run])
+    assert_allclose(m.slopes_, SLOPES, atol=1e-10)
+    assert_allclose(m.intercepts_, INTER, atol=1e-9)
+    assert m.stats_.n_coefficients == 4
+    assert m.stats_.rms_residual < 1e-10
+
+
+def test_intersect_moves_breakpoints_and_is_continuous():
+    run = make_run(noise=0.01)
+    m = PiecewiseModel(breakpoints=[25, 30]).fit([run])
+    # the 25 °C breakpoint moves towards the true corner (seed: 25 → 23.6)
+    assert 23.0 < m.breakpoints_[0] < 25.0
+    assert m.breakpoints_[1] == pytest.approx(30.0, abs=0.3)
+    a, s = m.intercepts_, m.slopes_
+    for j, b in enumerate(m.breakpoints_):
+        assert a[j] + s[j] * b == pytest.approx(a[j + 1] + s[j + 1] * b, abs=1e-9)
+    assert m.stats_.extra["initial_breakpoints"] == [25.0, 30.0]
+
+
+@pytest.mark.parametrize("method", ["intersect", "continuous"])
+def test_breakpoints_chosen_from_data(method):
+    run = make_run(noise=0.005)
+    m = PiecewiseModel(segments=3, method=method).fit([run])
+    assert_allclose(m.breakpoints_, BPS, atol=0.2)
+    assert_allclose(m.slopes_, SLOPES, atol=2e-3)
+
+
+def test_uses_named_temperature():
+    run = make_run()
+    m = PiecewiseModel(breakpoints=[24.6, 31.0], method="continuous", temperature="T2")
+    m.fit([run])
+    assert m.temp_names_ == ("T2",)
+    # T2 = T1 + 1: same lines shifted by 1 °C
+    assert_allclose(m.slopes_, SLOPES, atol=1e-9)
+    assert_allclose(m.predict(run), truth(run.temps_c[:, 0]), atol=1e-9)
+
+
+def test_stream_equals_batch_with_gap_and_round_trip(tmp_path):
+    run = make_run(n=3000, noise=0.01, gap=True)
+    m = PiecewiseModel(segments=3).fit([run])
+    batch = m.predict(run)
+    s = m.stream(1.0)
+    vals = np.array([s.update(run.time_s[i], run.temps_c[i]) for i in range(run.n_samples)])
+    assert_allclose(vals, batch, rtol=1e-12, atol=1e-12)
+    save_model(m, tmp_path / "pw.json")
+    back = load_model(tmp_path / "pw.json")
+    assert isinstance(back, PiecewiseModel)
+    assert_array_equal(back.predict(run), batch)
+    one_col = dataclasses.replace(run, temps_c=run.temps_c[:, :1], temp_names=("T1",))
+    assert_array_equal(back.predict(one_col), batch)
+
+
+def test_out_of_range_clamps_and_warns():
+    run = make_run()
+    m = PiecewiseModel(breakpoints=[23.6, 30.0], method="continuous").fit([run])
+    hot = dataclasses.replace(run, temps_c=run.temps_c + 10.0)
+    with pytest.warns(ExtrapolationWarning):
+        got = m.predict(hot)
+    top = m.predict(dataclasses.replace(run, temps_c=np.full_like(run.temps_c, 42.0)))
+    assert_allclose(got[hot.temps_c[:, 0] > 42.0], top[0], atol=1e-12)
+    with pytest.warns(ExtrapolationWarning):
+        ext = m.predict(hot, extrapolate=True)
+    assert_allclose(ext, truth(hot.temps_c[:, 0]), atol=1e-9)
+    s = m.stream(1.0)
+    with pytest.warns(ExtrapolationWarning):
+        assert s.update(0.0, np.array([60.0, 61.0])) == pytest.approx(top[0], abs=1e-12)
+
+
+def test_per_run_offsets():
+    a = make_run(noise=0.005, seed=1, offset=0.2, name="a")
+    b = make_run(noise=0.005, seed=2, offset=-0.4, name="b")
+    m = PiecewiseModel(breakpoints=[23.6, 30.0], method="continuous").fit([a, b])
+    assert m.offsets_[0] - m.offsets_[1] == pytest.approx(0.6, abs=2e-3)
+    assert_allclose(m.slopes_, SLOPES, atol=2e-3)
+
+
+def test_bad_inputs():
+    run = make_run(n=2000)
+    with pytest.raises(DesignError, match="outside"):
+        PiecewiseModel(breakpoints=[50.0]).fit([run])
+    narrow = dataclasses.replace(
+        run, temps_c=np.column_stack([np.r_[np.full(1999, 20.0), 40.0], np.zeros(2000)])
+    )
+    with pytest.raises(DesignError, match="sample"):
+        PiecewiseModel(breakpoints=[30.0]).fit([narrow])
+    with pytest.raises(ThermocalInputError):
+        PiecewiseModel(method="spline").fit([run])
+    with pytest.raises(ThermocalInputError):
+        PiecewiseModel(breakpoints=[25.0], segments=3).fit([run])
+    with pytest.raises(ThermocalInputError):
+        PiecewiseModel(temperature="T9").fit([run])
+    assert get_model_class("piecewise") is PiecewiseModel
+
+
+@pytest.mark.parametrize("seed", [1, 2])
+def test_fog_slow_peak_to_peak_reduced_96_percent(seed):
+    """Seed 001: piecewise compensation cuts the bias peak-to-peak over 15–42 °C by ≥ 96 %."""
+    rec, tr = SCENARIOS["fog-slow"](seed)[0]
+    run = RunData.from_recording(rec, "gyro", ["T1"], known_input=tr["input"])
+    tb = rec.columns["truth_bias"]
+    for kw in ({"breakpoints": [25.0, 30.0]}, {"segments": 3, "method": "continuous"}):
+        m = PiecewiseModel(**kw).fit([run])  # type: ignore[arg-type]
+        e = tb - m.predict(run)
+        assert 1.0 - np.ptp(e) / np.ptp(tb) >= 0.96
