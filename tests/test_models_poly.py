@@ -253,26 +253,14 @@ def test_rlg_validation_noise_level():
     assert ratio <= 1.3
 
 
-def test_rlg_validation_bias_removed(monkeypatch):
-    """≥ 95 % of the temperature-induced bias removed on the validation run.
-
-    The stock ``rlg`` preset's E (≈ 0.007 °/h rms) lies below the least-squares
-    noise floor of 37 terms (white 0.12 °/h·√s → σ√(p/n) ≈ 0.0016 °/h on 57 h),
-    so the removal is checked on the same sensor with 1/10 of the noise.
-    """
-    p = simulate.PRESETS["rlg"]
-    quiet = dataclasses.replace(
-        p,
-        name="rlg-quiet",
-        noise=dataclasses.replace(
-            p.noise,
-            white_density=p.noise.white_density / 10,
-            bias_instability=p.noise.bias_instability / 10,
-        ),
-    )
-    monkeypatch.setitem(simulate.PRESETS, "rlg-quiet", quiet)
-    (mr, _), (vr, tb) = _rlg("rlg-quiet")
-    m = PolyModel().fit([mr])
+@pytest.mark.parametrize("seed", [1, 2])
+def test_rlg_validation_bias_removed(seed: int) -> None:
+    """Stock ``rlg`` preset: ≥ 95 % of the temperature-induced bias removed on the
+    weakly correlated validation run (the 37 seed-000 terms fitted on rlg-modelling)."""
+    (mr, _), (vr, tb) = _rlg("rlg", seed)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", ExtrapolationWarning)
+        m = PolyModel().fit([mr])
     ratio, removal = _judge(m, vr, tb)
     assert removal >= 0.95
     assert ratio <= 1.3
