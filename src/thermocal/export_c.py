@@ -433,19 +433,27 @@ def _gen_poly(ctx: ExportContext) -> FamilyCode:
     def col(key: str) -> list[float]:
         return [float(b[key]) for b in base]
 
-    data = [
-        ctx.clamp_arrays(),
-        "/* centres and scales of the base variables u, v, w of every sensor */",
-        ctx.array(f"{P}_T_CENTER", col("t_center")),
-        ctx.array(f"{P}_T_SCALE", col("t_scale")),
-        ctx.array(f"{P}_R_CENTER", col("rate_center")),
-        ctx.array(f"{P}_R_SCALE", col("rate_scale")),
-        ctx.array(f"{P}_W_CENTER", col("coupling_center")),
-        ctx.array(f"{P}_W_SCALE", col("coupling_scale")),
-        f"/* coefficients of the {len(terms)} terms (signal unit) and the constant */",
-        ctx.array(f"{P}_COEF", coef),
-        f"static const {r} {P}_CONSTANT = {ctx.lit(float(st['constant']))};",
+    # only the arrays the terms use: -Wall -Wextra -Werror rejects unused static consts
+    data = [ctx.clamp_arrays()]
+    used = [
+        (t_sensors, "T", "t_center", "t_scale", "u"),
+        (v_sensors, "R", "rate_center", "rate_scale", "v"),
+        (w_sensors, "W", "coupling_center", "coupling_scale", "w"),
     ]
+    for sensors, tag, c_key, s_key, var in used:
+        if sensors:
+            data += [
+                f"/* centre and scale of the base variable {var} of every sensor */",
+                ctx.array(f"{P}_{tag}_CENTER", col(c_key)),
+                ctx.array(f"{P}_{tag}_SCALE", col(s_key)),
+            ]
+    if terms:
+        data += [
+            f"/* coefficients of the {len(terms)} terms [signal unit] */",
+            ctx.array(f"{P}_COEF", coef),
+        ]
+    data.append("/* constant [signal unit] */")
+    data.append(f"static const {r} {P}_CONSTANT = {ctx.lit(float(st['constant']))};")
     rr: dict[str, list[float]] = (d.get("range") or {}).get("rate_c_per_min") or {}
     clamp_rate = uses_rate and bool(rr) and bool(rate.get("clamp", True))
     if clamp_rate:
@@ -470,6 +478,8 @@ def _gen_poly(ctx: ExportContext) -> FamilyCode:
         ]
         fields, init, rate_update = _rate_buffer_code(ctx)
         upd += [f"{r} rate[{P}_N_TEMPS];", rate_update.strip("\n")]
+    if not uses_rate:
+        upd += ["(void)s; /* memoryless without rate terms */", "(void)time_s;"]
     upd += [
         "(void)signal;",
         "for (i = 0; i < " + f"{P}_N_TEMPS; ++i) {{",
@@ -518,6 +528,90 @@ def _gen_poly(ctx: ExportContext) -> FamilyCode:
         update="\n".join(upd),
         defines=defines,
         notes=notes,
+    )
+
+
+# --- families: piecewise ---------------------------------------------------------------------
+
+
+@register_generator("piecewise")
+def _gen_piecewise(ctx: ExportContext) -> FamilyCode:
+    """Piecewise-linear model (SPEC §4b, models/piecewise.py eq. 1 and ``PiecewiseStream``):
+
+    ``T = clamp(T_in)`` to the fitted range; ``j`` = number of breakpoints ``≤ T``;
+    ``y = intercepts[j] + slopes[j]·T``.  Both methods (``intersect``, ``continuous``)
+    store their lines in this form, so one generator serves both; a discontinuous
+    ``intersect`` model (lines that do not meet) jumps at the kept breakpoint exactly
+    as in Python.  Memoryless: the state struct only holds the common fields.
+    """
+    d = ctx.model
+    st = d["state"]
+    if st.get("layout") != "thermocal-piecewise-1":
+        raise ModelFileError(
+            f"piecewise state layout {st.get('layout')!r} is not thermocal-piecewise-1"
+        )
+    P, r, p = ctx.P, ctx.r, ctx.prefix
+    bps = np.asarray(st["breakpoints"], dtype=np.float64).ravel()
+    icp = np.asarray(st["intercepts"], dtype=np.float64).ravel()
+    slp = np.asarray(st["slopes"], dtype=np.float64).ravel()
+    if icp.size != bps.size + 1 or slp.size != bps.size + 1:
+        raise ModelFileError(
+            f"piecewise state: {bps.size} breakpoints need {bps.size + 1} intercepts and "
+            f"slopes, got {icp.size} and {slp.size}"
+        )
+    if bps.size > 1 and not bool(np.all(np.diff(bps) > 0)):
+        raise ModelFileError("piecewise state: breakpoints are not strictly ascending")
+    names = [str(n) for n in d["temperatures"]]
+    used = str(st.get("temperature") or names[0])
+    if used not in names:
+        raise ModelFileError(
+            f"piecewise state: temperature {used!r} is not among the file's temperatures "
+            f"{', '.join(map(repr, names))}"
+        )
+    k = names.index(used)
+    unit = str((d.get("signal") or {}).get("unit") or "signal unit").replace("*/", "* /")
+    n_b = int(bps.size)
+    data = [
+        ctx.clamp_arrays(),
+        f"/* line j: y = A[j] + S[j] * T for BP[j-1] <= T < BP[j] ({st.get('method')} method);",
+        f"   A [{unit}], S [{unit}/degC] */",
+        ctx.array(f"{P}_A", icp),
+        ctx.array(f"{P}_S", slp),
+    ]
+    if n_b:
+        data += [
+            "/* breakpoints [degC], ascending */",
+            ctx.array(f"{P}_BP", bps),
+        ]
+    upd = [
+        f"const {r} temp = {p}_clamp(temps_c[{k}], {P}_T_LO[{k}], {P}_T_HI[{k}]);",
+        "int j = 0;",
+        "(void)s; /* memoryless */",
+        "(void)time_s;",
+        "(void)signal;",
+    ]
+    if n_b:
+        upd += [
+            "/* j = number of breakpoints <= T */",
+            f"while (j < {P}_N_BREAKPOINTS && {P}_BP[j] <= temp) {{",
+            "    ++j;",
+            "}",
+        ]
+    upd.append(f"return {P}_A[j] + {P}_S[j] * temp;")
+    return FamilyCode(
+        state_fields=["int unused; /* memoryless model: no state */"],
+        data="\n".join(data),
+        init="s->unused = 0;",
+        update="\n".join(upd),
+        defines=[
+            f"#define {P}_N_BREAKPOINTS {n_b}",
+            f"#define {P}_TEMP_INDEX {k} /* temps_c[] entry the model uses ({used}) */",
+        ],
+        notes=[
+            f"Piecewise-linear model (SPEC 4b, {st.get('method')} method) in {used} [degC]:",
+            "y = A[j] + S[j] T, j = number of breakpoints <= T; T clamped to the fitted range.",
+            "Memoryless; call init once before use.",
+        ],
     )
 
 

@@ -133,19 +133,36 @@ def _load_sidecar(path: Path) -> dict[str, Any]:
     return obj
 
 
-def _read_table(path: Path, kind: str) -> tuple[pd.DataFrame | pa.Table, dict[str, Any]]:
+class _ParquetColumns:
+    """Columns of a Parquet file read one at a time, so that peak memory stays near
+    the size of the float64 arrays handed back (not the Arrow table plus its copy)."""
+
+    def __init__(self, pf: pq.ParquetFile) -> None:
+        self._pf = pf
+        schema = pf.schema_arrow
+        self.column_names: list[str] = list(schema.names)
+        self.num_rows: int = int(pf.metadata.num_rows)
+        self.metadata: dict[bytes, bytes] = dict(schema.metadata or {})
+
+    def column(self, name: str) -> pa.ChunkedArray:
+        col: pa.ChunkedArray = self._pf.read(columns=[name], use_threads=True).column(0)
+        return col
+
+
+def _read_table(
+    path: Path, kind: str
+) -> tuple[pd.DataFrame | _ParquetColumns, dict[str, Any]]:
     if not path.exists():
         raise FileFormatError(f"{path}: no such file")
     if path.stat().st_size == 0:
         raise FileFormatError(f"{path}: the file is empty")
     if kind == "parquet":
         try:
-            table = pq.read_table(path)
+            table = _ParquetColumns(pq.ParquetFile(path))
         except (pa.ArrowInvalid, OSError) as exc:
             raise FileFormatError(f"{path}: not a readable Parquet file ({exc})") from None
         meta: dict[str, Any] = {}
-        kv = table.schema.metadata or {}
-        raw = kv.get(META_KEY.encode())
+        raw = table.metadata.get(META_KEY.encode())
         if raw:
             try:
                 meta = json.loads(raw.decode("utf-8"))
@@ -163,16 +180,27 @@ def _read_table(path: Path, kind: str) -> tuple[pd.DataFrame | pa.Table, dict[st
     return df, {}
 
 
-def _numeric_column(obj: pd.DataFrame | pa.Table, name: str, path: Path) -> FloatArray:
+def _numeric_column(obj: pd.DataFrame | _ParquetColumns, name: str, path: Path) -> FloatArray:
     """A column as float64; :class:`NonNumericError` names the first bad row."""
-    if isinstance(obj, pa.Table):
-        col = obj.column(name)
+    if isinstance(obj, _ParquetColumns):
+        try:
+            col = obj.column(name)
+        except (pa.ArrowInvalid, OSError) as exc:
+            raise FileFormatError(f"{path}: cannot read column {name!r} ({exc})") from None
         if not (pa.types.is_integer(col.type) or pa.types.is_floating(col.type)):
             if pa.types.is_boolean(col.type) or pa.types.is_decimal(col.type):
                 return np.asarray(col.to_numpy(zero_copy_only=False), dtype=np.float64)
             raise NonNumericError(f"{path}: column {name!r} is not numeric (type {col.type})")
-        if col.null_count == 0 and col.num_chunks == 1 and pa.types.is_float64(col.type):
-            return np.asarray(col.chunk(0).to_numpy(zero_copy_only=False))
+        if col.null_count == 0 and pa.types.is_float64(col.type):
+            if col.num_chunks == 1:
+                return np.asarray(col.chunk(0).to_numpy(zero_copy_only=False))
+            out = np.empty(len(col), dtype=np.float64)
+            pos = 0
+            for chunk in col.chunks:
+                n = len(chunk)
+                out[pos : pos + n] = chunk.to_numpy(zero_copy_only=True)
+                pos += n
+            return out
         arr = col.to_numpy(zero_copy_only=False)
         return np.asarray(arr, dtype=np.float64)
     series = obj[name]
@@ -228,10 +256,10 @@ def read_recording(
     side = _load_sidecar(p)
     info: dict[str, Any] = {**file_meta, **side}
 
-    names = list(obj.column_names) if isinstance(obj, pa.Table) else list(obj.columns)
+    names = list(obj.column_names) if isinstance(obj, _ParquetColumns) else list(obj.columns)
     if not names:
         raise FileFormatError(f"{p}: the file has no columns")
-    n_rows = obj.num_rows if isinstance(obj, pa.Table) else len(obj)
+    n_rows = obj.num_rows if isinstance(obj, _ParquetColumns) else len(obj)
     if n_rows == 0:
         raise FileFormatError(f"{p}: the file has a header but no data rows")
 
