@@ -59,51 +59,58 @@ def _fit_bank() -> TemperatureModel:
     return m
 
 
+def _rlg_run() -> RunData:
+    rec, _ = SCENARIOS["rlg-modelling"](1)[0]
+    return RunData.from_recording(rec, "gyro", ["T1", "T2", "T3", "T4"])
+
+
+def _fit_poly(**params: Any) -> Callable[[], TemperatureModel]:
+    def fit() -> TemperatureModel:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")  # conditioning of the 37-term seed model
+            m = make_model("poly", **params).fit([_rlg_run()])
+        m.signal_name = "gyro"
+        return m
+
+    return fit
+
+
+def _fit_piecewise(**params: Any) -> Callable[[], TemperatureModel]:
+    def fit() -> TemperatureModel:
+        rec, _ = SCENARIOS["fog-slow"](1)[0]
+        run = RunData.from_recording(rec, "gyro", ["T1"])
+        m = make_model("piecewise", **params).fit([run])
+        m.signal_name = "gyro"
+        return m
+
+    return fit
+
+
 FITTERS: dict[str, Callable[[], TemperatureModel]] = {
     "warmup": _fit_warmup,
     "bank": _fit_bank,
+    "poly": _fit_poly(),  # seed000: 37 terms with rate and coupling terms
+    # no rate or coupling terms: the C must not define the unused rate arrays/parameters
+    "poly-order2": _fit_poly(terms=None, order=2),
+    "poly-t-only": _fit_poly(terms="T1,T1^2,T3"),
+    "piecewise": _fit_piecewise(),  # intersect method, breakpoints chosen from the data
+    "piecewise-continuous": _fit_piecewise(method="continuous", breakpoints=[25.0, 30.0]),
+    "piecewise-one-line": _fit_piecewise(segments=1),
 }
-"""How each family is fitted for the export test (added as the families appear)."""
-
-
-def _register_late_families() -> None:
-    import thermocal.models  # noqa: F401
-
-    if "poly" in MODEL_REGISTRY and "poly" not in FITTERS:
-        FITTERS["poly"] = _fit_poly
-    if "piecewise" in MODEL_REGISTRY and "piecewise" not in FITTERS:
-        FITTERS["piecewise"] = _fit_piecewise
-
-
-def _fit_poly() -> TemperatureModel:
-    rec, _ = SCENARIOS["rlg-modelling"](1)[0]
-    run = RunData.from_recording(rec, "gyro", ["T1", "T2", "T3", "T4"])
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        m = make_model("poly").fit([run])
-    m.signal_name = "gyro"
-    return m
-
-
-def _fit_piecewise() -> TemperatureModel:
-    rec, _ = SCENARIOS["fog-slow"](1)[0]
-    run = RunData.from_recording(rec, "gyro", ["T1"])
-    m = make_model("piecewise").fit([run])
-    m.signal_name = "gyro"
-    return m
-
-
-_register_late_families()
+"""Export cases: name → fitter (the family is the model's)."""
 
 
 @pytest.fixture(scope="module", params=sorted(FITTERS))
 def saved_model(
     request: pytest.FixtureRequest, tmp_path_factory: pytest.TempPathFactory
 ) -> tuple[str, Path]:
-    fam = str(request.param)
-    d = tmp_path_factory.mktemp(f"model_{fam}")
+    """``(family, path)`` of a saved model; the file is ``<family>.json`` in its own folder."""
+    case = str(request.param)
+    model = FITTERS[case]()
+    fam = model.family
+    d = tmp_path_factory.mktemp(f"model_{case}")
     path = d / f"{fam}.json"
-    save_model(FITTERS[fam](), path)
+    save_model(model, path)
     return fam, path
 
 
@@ -176,6 +183,83 @@ def test_generated_code_structure(saved_model: tuple[str, Path]) -> None:
     assert "static const m_real M_T_LO" in ex.source
     assert "void m_init(m_state *s, double sample_interval_s);" in ex.header
     assert "m_real m_update(m_state *s, double time_s" in ex.header
+
+
+def _synthetic_no_rate_poly(tmp_path: Path, **params: Any) -> tuple[dict[str, Any], RunData]:
+    """A poly model without rate or coupling terms fitted on two slow synthetic temperatures:
+    y = 0.3 + 0.02 (T1 − 20) − 0.001 (T1 − 20)² + 0.01 T2 + noise [°/h]."""
+    rng = np.random.default_rng(5)
+    t = np.arange(20_000, dtype=np.float64)
+    T1 = 20.0 + 15.0 * np.sin(2 * np.pi * t / 7_000.0)
+    T2 = 25.0 + 10.0 * np.sin(2 * np.pi * t / 11_000.0 + 0.4)
+    y = 0.3 + 0.02 * (T1 - 20) - 0.001 * (T1 - 20) ** 2 + 0.01 * T2
+    run = RunData(
+        time_s=t,
+        temps_c=np.column_stack([T1, T2]),
+        signal=y + 1e-3 * rng.standard_normal(t.size),
+        temp_names=("T1", "T2"),
+    )
+    m = make_model("poly", **params).fit([run])
+    m.signal_name = "gyro"
+    save_model(m, tmp_path / "m.json")
+    return load_model_dict(tmp_path / "m.json"), run
+
+
+@pytest.mark.parametrize(
+    ("params", "n_terms"),
+    [({"terms": None, "order": 2}, 4), ({"terms": "T1,T1^2"}, 2)],
+    ids=["order2", "t1-only"],
+)
+def test_poly_without_rate_terms_compiles_strict(
+    tmp_path: Path, params: dict[str, Any], n_terms: int
+) -> None:
+    """Issue: a poly model without rate/coupling terms generated unused static arrays and
+    parameters, rejected by -Wall -Wextra -Werror.  Only what is used is generated, the
+    strict build compiles, and it equals predict to 1e-9 (values from the fit's truth)."""
+    d, run = _synthetic_no_rate_poly(tmp_path, **params)
+    assert d["state"]["uses_rate"] is False
+    assert len(d["state"]["terms"]) == n_terms
+    ex = generate_c(d, prefix="norate")
+    for unused in ("_R_CENTER", "_R_SCALE", "_W_CENTER", "_W_SCALE", "RATE_BUF", "_R_LO"):
+        assert unused not in ex.source and unused not in ex.header
+    assert "NORATE_T_CENTER" in ex.source and "NORATE_COEF" in ex.source
+    assert "(void)s;" in ex.source and "(void)time_s;" in ex.source
+    exe = compile_harness(ex, tmp_path / "c")  # cc -O2 -std=c99 -Wall -Wextra -Werror -pedantic
+    y_c = run_harness(exe, run.time_s, run.temps_c, run.signal, 1.0)
+    batch = load_model(tmp_path / "m.json").predict(run)
+    scale = float(np.max(np.abs(batch)))
+    assert float(np.max(np.abs(y_c - batch))) <= REL_TOL * scale
+    if n_terms == 4:
+        # the full order-2 model recovers the synthetic truth (noise σ = 1e-3 °/h,
+        # 2·10⁴ samples: the fitted curve's error is ~σ·sqrt(p/n) ≈ 2e-5)
+        T1, T2 = run.temps_c[:, 0], run.temps_c[:, 1]
+        ref = 0.3 + 0.02 * (T1 - 20) - 0.001 * (T1 - 20) ** 2 + 0.01 * T2
+        np.testing.assert_allclose(y_c, ref, rtol=0.0, atol=2e-4)
+
+
+def test_piecewise_export_matches_lines_and_breakpoints(tmp_path: Path) -> None:
+    """The piecewise C holds the file's lines and breakpoints and evaluates eq. (1) of
+    models/piecewise.py: y = A[j] + S[j]·clamp(T), j = #breakpoints ≤ T, checked against
+    an independent evaluation at and around every breakpoint and beyond the range."""
+    model = FITTERS["piecewise"]()
+    save_model(model, tmp_path / "pw.json")
+    d = load_model_dict(tmp_path / "pw.json")
+    st = d["state"]
+    bps = np.asarray(st["breakpoints"])
+    a = np.asarray(st["intercepts"])
+    s = np.asarray(st["slopes"])
+    lo, hi = d["range"]["temperature_c"][d["temperatures"][0]]
+    assert bps.size == 2
+    T = np.concatenate(
+        [[lo - 5.0, lo, hi, hi + 5.0], bps, np.nextafter(bps, -np.inf), np.linspace(lo, hi, 101)]
+    )
+    t = np.arange(T.size, dtype=np.float64)
+    exe = compile_harness(generate_c(d, prefix="pw"), tmp_path / "c")
+    y_c = run_harness(exe, t, T[:, None], np.zeros_like(t), 1.0)
+    Tc = np.clip(T, lo, hi)
+    j = np.array([int(np.sum(bps <= x)) for x in Tc])
+    ref = a[j] + s[j] * Tc
+    np.testing.assert_allclose(y_c, ref, rtol=0.0, atol=1e-12 * float(np.max(np.abs(ref))))
 
 
 def test_refuses_unknown_family() -> None:

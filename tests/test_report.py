@@ -16,7 +16,7 @@ import os
 import re
 import shutil
 import subprocess
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
 from pathlib import Path
 from typing import Any, ClassVar, Self
 
@@ -34,7 +34,6 @@ from thermocal.models.base import (
     ModelStream,
     RunData,
     TemperatureModel,
-    register,
     save_model,
 )
 from thermocal.recording import FloatArray, Metadata, Recording
@@ -114,8 +113,14 @@ class ReportTestLinear(TemperatureModel):
         self.se_ = np.asarray(state["se"], dtype=np.float64)
 
 
-if ReportTestLinear.family not in MODEL_REGISTRY:
-    register(ReportTestLinear)
+@pytest.fixture(scope="module", autouse=True)
+def linear_family() -> Iterator[type[ReportTestLinear]]:
+    """Register the test-only family for this module's tests and remove it afterwards, so
+    it does not leak into other test files (e.g. the every-family checks of the C export
+    and the chunked compensation) run in the same process."""
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setitem(MODEL_REGISTRY, ReportTestLinear.family, ReportTestLinear)
+        yield ReportTestLinear
 
 
 # --- synthetic chamber runs -----------------------------------------------------------------
@@ -143,13 +148,15 @@ def _run(seed: int, hours: float, period_h: float, lo: float, hi: float, name: s
 
 
 @pytest.fixture(scope="module")
-def case(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
+def case(
+    tmp_path_factory: pytest.TempPathFactory, linear_family: type[ReportTestLinear]
+) -> dict[str, Any]:
     d = tmp_path_factory.mktemp("report")
     mod = _run(1, 3.0, 1.5, -10.0, 40.0, "modelling")
     val = _run(2, 2.0, 1.0, 0.0, 30.0, "validation")
     write_recording(mod, d / "mod.csv")
     write_recording(val, d / "val.csv")
-    model = ReportTestLinear().fit([RunData.from_recording(mod, "gyro", ["T1", "T2"])])
+    model = linear_family().fit([RunData.from_recording(mod, "gyro", ["T1", "T2"])])
     model.signal_name = "gyro"
     model_dict = save_model(model, d / "model.json")
     # a validation result as `thermocal validate --json` writes it (INTERFACE.md keys)

@@ -326,7 +326,8 @@ def _first_param(model: TemperatureModel, names: tuple[str, ...], default: float
 
 CONTEXT_RULES: dict[str, Callable[[TemperatureModel], ChunkContext]] = {
     "poly": lambda m: ChunkContext(head_s=0.0, tail_s=_rate_tail_s(m)),
-    "piecewise": lambda m: ChunkContext(head_s=0.0, tail_s=_rate_tail_s(m)),
+    # eq. (1) of models/piecewise.py is memoryless: y depends on the sample's T only
+    "piecewise": lambda m: ChunkContext(head_s=0.0, tail_s=0.0),
     "warmup": lambda m: ChunkContext(
         head_s=_first_param(m, ("start_window_s", "window_s"), math.inf),
         tail_s=_rate_tail_s(m),

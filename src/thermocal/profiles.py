@@ -249,7 +249,7 @@ def rlg_modelling(
     start_c: float = 20.0,
     n_temperature_cycles: int = 2,
     cycle_rate_c_per_min: float = 1.0,
-    hold_s: float = 3600.0,
+    hold_s: float = 10800.0,
     rates_c_per_min: Sequence[float] = (2.0, 1.0, 0.5, 0.2, 0.1),
     rate_hold_s: float = 1800.0,
 ) -> Profile:
@@ -260,7 +260,9 @@ def rlg_modelling(
     ``high_c``, hold ``hold_s``, ramp to ``low_c``, hold ``hold_s``) at
     ``cycle_rate_c_per_min``.  Part 2 (label ``rate ±R``): for each rate R, ramp to
     ``high_c`` and back to ``low_c`` at R with ``rate_hold_s`` holds at the ends.
-    Finally a ramp back to ``start_c``.  The default lasts ≈ 57 h.
+    Finally a ramp back to ``start_c``.  The default lasts ≈ 65 h; its 3-h soaks at the
+    extremes take the sensor further than the 2-h holds of ``rlg-validation``, so a
+    model fitted on it covers the validation run without extrapolating.
     """
     if not low_c < high_c:
         raise ThermocalInputError(f"low_c ({low_c}) must be below high_c ({high_c})")
