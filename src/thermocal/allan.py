@@ -57,12 +57,15 @@ Frequency Stability Analysis*, NIST SP 1065 (2008); IEEE Std 1554-2005.
 from __future__ import annotations
 
 import math
+import os
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 from typing import Final, Literal
 
 import numpy as np
 import numpy.typing as npt
 from scipy import linalg, optimize, stats
+from threadpoolctl import threadpool_limits
 
 from thermocal import units
 from thermocal.errors import MissingValueError, ThermocalInputError
@@ -103,10 +106,11 @@ _SLOPE_TOLERANCE: Final = 0.25
 _LOCAL_WINDOW: Final = 4.0
 """Local slope fitted over τ*/4 … 4τ* around the tangent point."""
 
-_CHUNK: Final = 1 << 13
-"""Block length of the fused second-difference loop: blocks stay in the CPU cache, and
-at ≤ 10 000 elements OpenBLAS runs ``dot`` on one thread (its threaded ``ddot`` stalls
-badly when the cores are shared)."""
+_CHUNK: Final = 1 << 18
+"""Block length of the fused second-difference loop (three 2 MiB blocks stay in cache)."""
+
+_WORKERS: Final = max(1, min(2, os.cpu_count() or 1))
+"""Threads sharing the averaging factors of one Allan computation."""
 
 
 # --- results -------------------------------------------------------------------------
@@ -281,26 +285,40 @@ def _phase(rate: FloatArray) -> FloatArray:
     return x
 
 
-def _second_difference_sums(x: FloatArray, m: IntArray) -> FloatArray:
-    """S(m) = Σ_k (x_{k+2m} − 2 x_{k+m} + x_k)² for each m, in cache-sized blocks.
+def _second_difference_sum(x: FloatArray, x2: FloatArray, mm: int) -> float:
+    """S(m) = Σ_k (x_{k+2m} − 2 x_{k+m} + x_k)² for one m, in cache-sized blocks.
 
-    ``x_{k+2m} + x_k − (2x)_{k+m}`` uses a pre-doubled copy (doubling is exact).
+    ``x_{k+2m} + x_k − (2x)_{k+m}`` uses a pre-doubled copy ``x2`` (doubling is exact).
     """
-    n_phase = x.size
+    n_terms = x.size - 2 * mm
+    buf = np.empty(min(_CHUNK, max(n_terms, 1)), dtype=np.float64)
+    total = 0.0
+    for a in range(0, n_terms, _CHUNK):
+        b = min(a + _CHUNK, n_terms)
+        t = buf[: b - a]
+        np.add(x[a + 2 * mm : b + 2 * mm], x[a:b], out=t)
+        np.subtract(t, x2[a + mm : b + mm], out=t)
+        total += float(np.dot(t, t))
+    return total
+
+
+def _second_difference_sums(x: FloatArray, m: IntArray) -> FloatArray:
+    """S(m) for each averaging factor m (see :func:`_second_difference_sum`).
+
+    The averaging factors are shared between :data:`_WORKERS` threads (numpy releases
+    the GIL inside its loops); BLAS is held to one thread meanwhile, because a
+    multi-threaded ``dot`` inside each worker would oversubscribe the cores.
+    """
     x2 = np.multiply(x, 2.0)
-    buf = np.empty(_CHUNK, dtype=np.float64)
-    out = np.zeros(m.size, dtype=np.float64)
-    for j, mm in enumerate(m.tolist()):
-        n_terms = n_phase - 2 * mm
-        total = 0.0
-        for a in range(0, n_terms, _CHUNK):
-            b = min(a + _CHUNK, n_terms)
-            t = buf[: b - a]
-            np.add(x[a + 2 * mm : b + 2 * mm], x[a:b], out=t)
-            np.subtract(t, x2[a + mm : b + mm], out=t)
-            total += float(np.dot(t, t))
-        out[j] = total
-    return out
+    ms = [int(v) for v in m.tolist()]
+    workers = min(_WORKERS, len(ms))
+    with threadpool_limits(limits=1, user_api="blas"):
+        if workers <= 1 or x.size < 4 * _CHUNK:
+            vals = [_second_difference_sum(x, x2, mm) for mm in ms]
+        else:
+            with ThreadPoolExecutor(max_workers=workers) as pool:
+                vals = list(pool.map(lambda mm: _second_difference_sum(x, x2, mm), ms))
+    return np.asarray(vals, dtype=np.float64)
 
 
 def edf_simple(n_phase: npt.ArrayLike, m: npt.ArrayLike, alpha: npt.ArrayLike) -> FloatArray:
