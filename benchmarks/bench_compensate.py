@@ -1,11 +1,13 @@
-"""Speed of compensation with the 37-term polynomial model (issue 6).
+"""Speed of compensation with the 37-term polynomial model (issue 6), and with the
+piecewise-linear model (SPEC §4b) for comparison.
 
 * batch: ``compensate_run`` (``model.predict`` + subtraction) in memory;
 * file: ``compensate_file`` Parquet → Parquet in chunks;
 * Python streaming: ``StreamingCompensator.update`` sample by sample, and
   ``update_block`` on blocks of 100 and 1000 samples;
 * generated C (double and float): ``<p>_update`` in a loop over in-memory samples
-  (cc -O2 -std=c99), timed with ``clock()``.
+  (cc -O2 -std=c99), timed with ``clock()``;
+* piecewise (``fog-slow``, 3 segments): batch predict, per-sample streaming, C double.
 
 Targets: batch ≥ 20 M samples/s, Python streaming ≥ 100 k samples/s, C ≥ 10 M samples/s.
 
@@ -19,6 +21,7 @@ import tempfile
 import time
 import warnings
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pandas as pd
@@ -143,25 +146,57 @@ def main() -> None:
         path = Path(tmp) / "rlg_poly.json"
         save_model(model, path)
         d = load_model_dict(path)
-        tx, Tx, fx = exercise_inputs(d, 1_000_000, 1.0, gap_at=0.5)
-        fin = Path(tmp) / "x.bin"
-        with open(fin, "wb") as fh:
-            fh.write(np.int64(tx.size).tobytes())
-            fh.write(np.ascontiguousarray(np.column_stack([tx, Tx, fx])).tobytes())
         for real in ("double", "float"):
-            ex = generate_c(d, prefix="rlg_poly", real=real)
-            cdir = Path(tmp) / real
-            ex.write(cdir)
-            (cdir / "bench.c").write_text(BENCH_MAIN % {"p": ex.prefix, "P": ex.prefix.upper()})
-            exe = cdir / "bench"
-            subprocess.run(
-                [cc, "-O2", "-std=c99", "-o", str(exe), str(cdir / ex.source_name),
-                 str(cdir / "bench.c")],
-                check=True,
-            )  # fmt: skip
-            out = subprocess.run([str(exe), str(fin), "10"], capture_output=True, text=True)
-            rate_c = float(out.stdout.split()[0])
+            rate_c = c_rate(d, "rlg_poly", real, Path(tmp) / real, cc)
             print(f"generated C ({real}, cc -O2): {rate_c / 1e6:.1f} M samples/s")
+
+        # piecewise-linear model (memoryless): for comparison
+        pw_rec, _ = SCENARIOS["fog-slow"](1)[0]
+        pw_run = RunData.from_recording(pw_rec, "gyro", ["T1"])
+        pw = make_model("piecewise").fit([pw_run])
+        pw.signal_name = "gyro"
+        n_pw = 2_000_000
+        pw_t = np.arange(n_pw, dtype=np.float64)
+        pw_T = np.resize(pw_run.temps_c[:, 0], n_pw)[:, None]
+        pw_f = np.resize(pw_run.target(), n_pw)
+        pw_big = RunData(time_s=pw_t, temps_c=pw_T, signal=pw_f, temp_names=("T1",))
+        rate = best_rate(lambda: compensate_run(pw, pw_big), n_pw)
+        print(f"piecewise batch compensate_run ({n_pw} samples): {rate / 1e6:.1f} M samples/s")
+        sc_pw = StreamingCompensator(pw, 1.0)
+
+        def pw_per_sample() -> None:
+            sc_pw.reset()
+            for i in range(m_s):
+                sc_pw.update(pw_t[i], pw_T[i], pw_f[i])
+
+        rate_s = best_rate(pw_per_sample, m_s, repeat=1)
+        print(f"piecewise StreamingCompensator.update (per sample): {rate_s / 1e3:.1f} k samples/s")
+        pw_path = Path(tmp) / "fog_pw.json"
+        save_model(pw, pw_path)
+        rate_c = c_rate(load_model_dict(pw_path), "fog_pw", "double", Path(tmp) / "pw", cc)
+        print(f"piecewise generated C (double, cc -O2): {rate_c / 1e6:.1f} M samples/s")
+
+
+def c_rate(d: dict[str, Any], prefix: str, real: str, cdir: Path, cc: str) -> float:
+    """Samples/s of the generated ``<p>_update`` on 10⁶ samples of :func:`exercise_inputs`
+    (with a gap), 10 repetitions."""
+    tx, Tx, fx = exercise_inputs(d, 1_000_000, 1.0, gap_at=0.5)
+    cdir.mkdir(parents=True, exist_ok=True)
+    fin = cdir / "x.bin"
+    with open(fin, "wb") as fh:
+        fh.write(np.int64(tx.size).tobytes())
+        fh.write(np.ascontiguousarray(np.column_stack([tx, Tx, fx])).tobytes())
+    ex = generate_c(d, prefix=prefix, real=real)
+    ex.write(cdir)
+    (cdir / "bench.c").write_text(BENCH_MAIN % {"p": ex.prefix, "P": ex.prefix.upper()})
+    exe = cdir / "bench"
+    subprocess.run(
+        [cc, "-O2", "-std=c99", "-o", str(exe), str(cdir / ex.source_name),
+         str(cdir / "bench.c")],
+        check=True,
+    )  # fmt: skip
+    out = subprocess.run([str(exe), str(fin), "10"], capture_output=True, text=True, check=True)
+    return float(out.stdout.split()[0])
 
 
 if __name__ == "__main__":

@@ -185,8 +185,8 @@ def test_generated_code_structure(saved_model: tuple[str, Path]) -> None:
     assert "m_real m_update(m_state *s, double time_s" in ex.header
 
 
-def _synthetic_no_rate_poly(tmp_path: Path, **params: Any) -> tuple[dict[str, Any], RunData]:
-    """A poly model without rate or coupling terms fitted on two slow synthetic temperatures:
+def _synthetic_poly(tmp_path: Path, **params: Any) -> tuple[dict[str, Any], RunData]:
+    """A poly model (``params``) fitted on two slow synthetic temperatures:
     y = 0.3 + 0.02 (T1 − 20) − 0.001 (T1 − 20)² + 0.01 T2 + noise [°/h]."""
     rng = np.random.default_rng(5)
     t = np.arange(20_000, dtype=np.float64)
@@ -205,25 +205,37 @@ def _synthetic_no_rate_poly(tmp_path: Path, **params: Any) -> tuple[dict[str, An
     return load_model_dict(tmp_path / "m.json"), run
 
 
+NO_RATE_ARRAYS = ("_R_CENTER", "_R_SCALE", "_W_CENTER", "_W_SCALE", "RATE_BUF", "_R_LO")
+
+
 @pytest.mark.parametrize(
-    ("params", "n_terms"),
-    [({"terms": None, "order": 2}, 4), ({"terms": "T1,T1^2"}, 2)],
-    ids=["order2", "t1-only"],
+    ("params", "n_terms", "absent", "present"),
+    [
+        ({"terms": None, "order": 2}, 4, NO_RATE_ARRAYS, ("_T_CENTER", "(void)time_s;")),
+        ({"terms": "T1,T1^2"}, 2, NO_RATE_ARRAYS, ("_T_CENTER", "(void)s;")),
+        # rate terms only: no T centre/scale, no T clamp (rates come from raw temperatures)
+        ({"terms": "dT1,dT2^2"}, 2, ("_T_CENTER", "_W_CENTER", "_T_LO"), ("_R_CENTER",)),
+    ],
+    ids=["order2", "t1-only", "rate-only"],
 )
-def test_poly_without_rate_terms_compiles_strict(
-    tmp_path: Path, params: dict[str, Any], n_terms: int
+def test_poly_term_subsets_compile_strict(
+    tmp_path: Path,
+    params: dict[str, Any],
+    n_terms: int,
+    absent: tuple[str, ...],
+    present: tuple[str, ...],
 ) -> None:
     """Issue: a poly model without rate/coupling terms generated unused static arrays and
-    parameters, rejected by -Wall -Wextra -Werror.  Only what is used is generated, the
-    strict build compiles, and it equals predict to 1e-9 (values from the fit's truth)."""
-    d, run = _synthetic_no_rate_poly(tmp_path, **params)
-    assert d["state"]["uses_rate"] is False
+    parameters, rejected by -Wall -Wextra -Werror.  Only what the terms use is generated;
+    the strict build compiles (compile_harness uses CFLAGS) and equals predict to 1e-9."""
+    d, run = _synthetic_poly(tmp_path, **params)
+    assert d["state"]["uses_rate"] is ("dT1" in str(params.get("terms")))
     assert len(d["state"]["terms"]) == n_terms
-    ex = generate_c(d, prefix="norate")
-    for unused in ("_R_CENTER", "_R_SCALE", "_W_CENTER", "_W_SCALE", "RATE_BUF", "_R_LO"):
-        assert unused not in ex.source and unused not in ex.header
-    assert "NORATE_T_CENTER" in ex.source and "NORATE_COEF" in ex.source
-    assert "(void)s;" in ex.source and "(void)time_s;" in ex.source
+    ex = generate_c(d, prefix="sub")
+    for name in absent:
+        assert name not in ex.source and name not in ex.header, name
+    for name in present:
+        assert name in ex.source, name
     exe = compile_harness(ex, tmp_path / "c")  # cc -O2 -std=c99 -Wall -Wextra -Werror -pedantic
     y_c = run_harness(exe, run.time_s, run.temps_c, run.signal, 1.0)
     batch = load_model(tmp_path / "m.json").predict(run)
@@ -235,6 +247,21 @@ def test_poly_without_rate_terms_compiles_strict(
         T1, T2 = run.temps_c[:, 0], run.temps_c[:, 1]
         ref = 0.3 + 0.02 * (T1 - 20) - 0.001 * (T1 - 20) ** 2 + 0.01 * T2
         np.testing.assert_allclose(y_c, ref, rtol=0.0, atol=2e-4)
+
+
+def test_poly_constant_only_compiles_strict(tmp_path: Path) -> None:
+    """A poly model left with no term (e.g. by selection) exports as its constant."""
+    d, run = _synthetic_poly(tmp_path, terms="T1")
+    d["state"]["terms"], d["state"]["coef"] = [], []
+    for real in ("double", "float"):
+        ex = generate_c(d, prefix="const0", real=real)
+        assert "CONST0_T_LO" not in ex.source and "CONST0_COEF" not in ex.source
+        y_c = run_harness(
+            compile_harness(ex, tmp_path / real), run.time_s[:50], run.temps_c[:50],
+            run.signal[:50], 1.0,
+        )  # fmt: skip
+        c = float(d["state"]["constant"])
+        np.testing.assert_allclose(y_c, c, rtol=1e-7 if real == "float" else 0.0)
 
 
 def test_piecewise_export_matches_lines_and_breakpoints(tmp_path: Path) -> None:

@@ -3,6 +3,8 @@ power-on selection on the simulator's truth, streaming twin, files, bad input.""
 
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 import pytest
 
@@ -346,3 +348,34 @@ def test_bad_input(synthetic: BankModel) -> None:
     flat = RunData(run.time_s, np.full_like(run.temps_c, 20.0), run.signal, run.temp_names)
     with pytest.raises(DesignError, match="span only"):
         BankModel().fit([flat])
+
+
+def test_predict_equals_every_model_reference_and_stream_warns_once(synthetic: BankModel) -> None:
+    hot = power_on(1, 58.0, 21, n=300)
+    hot = RunData(
+        hot.time_s, hot.temps_c + np.linspace(0.0, 8.0, 300)[:, None], hot.signal, hot.temp_names
+    )
+    with warnings.catch_warnings(record=True) as rec:
+        warnings.simplefilter("always")
+        got = synthetic.predict(hot)
+        st = synthetic.stream(1.0)
+        live = feed(st, hot)
+    # reference: every model at every (clamped) sample, running choice then frozen
+    temp = np.minimum(hot.temps_c[:, 0], synthetic.temp_range_[0, 1])
+    f = np.column_stack(
+        [
+            pwl_evaluate(b, v, temp)
+            for b, v in zip(synthetic.breakpoints_, synthetic.values_, strict=True)
+        ]
+    )
+    m = int(np.count_nonzero(hot.time_s - hot.time_s[0] < synthetic.startup_s))
+    dev = np.abs(np.cumsum(hot.signal[:m, None] - f[:m], axis=0) / np.arange(1, m + 1)[:, None])
+    idx = np.r_[np.argmin(dev, axis=1), np.full(hot.n_samples - m, np.argmin(dev[-1]))]
+    np.testing.assert_array_equal(got, f[np.arange(hot.n_samples), idx])
+    np.testing.assert_array_equal(live, got)
+    stream_warnings = [
+        w
+        for w in rec
+        if issubclass(w.category, ExtrapolationWarning) and "samples" not in str(w.message)
+    ]
+    assert len(stream_warnings) == 1

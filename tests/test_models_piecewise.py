@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import dataclasses
+import warnings
 
 import numpy as np
 import pytest
@@ -144,3 +145,19 @@ def test_fog_slow_peak_to_peak_reduced_96_percent(seed):
         m = PiecewiseModel(**kw).fit([run])  # type: ignore[arg-type]
         e = tb - m.predict(run)
         assert 1.0 - np.ptp(e) / np.ptp(tb) >= 0.96
+
+
+def test_stream_warns_once_per_stream():
+    run = make_run()
+    m = PiecewiseModel(breakpoints=[23.6, 30.0], method="continuous").fit([run])
+    hot = dataclasses.replace(run, temps_c=run.temps_c + 10.0)
+    s = m.stream(1.0)
+    with warnings.catch_warnings(record=True) as rec:
+        warnings.simplefilter("always")
+        live = [s.update(t, row) for t, row in zip(hot.time_s, hot.temps_c, strict=True)]
+        batch = m.predict(hot)
+    assert len([w for w in rec if issubclass(w.category, ExtrapolationWarning)]) == 2
+    assert_array_equal(live, batch)
+    s.reset()
+    with pytest.warns(ExtrapolationWarning):
+        s.update(0.0, [60.0])

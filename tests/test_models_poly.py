@@ -13,8 +13,17 @@ from thermocal import simulate
 from thermocal.errors import DesignError, ExtrapolationWarning, ThermocalInputError
 from thermocal.models import RunData, get_model_class, load_model, save_model
 from thermocal.models.poly import PolyModel
-from thermocal.models.terms import Term, parse_terms, seed000_terms, temperature_rates
+from thermocal.models.terms import (
+    Term,
+    backward_partners,
+    gap_free_slices,
+    parse_terms,
+    seed000_terms,
+    temperature_rates,
+    term_features,
+)
 from thermocal.preprocess import block_average, temperature_rate
+from thermocal.recording import contiguous_slices
 
 NAMES = ("T1", "T2", "T3", "T4")
 
@@ -264,3 +273,142 @@ def test_rlg_validation_bias_removed(seed: int) -> None:
     ratio, removal = _judge(m, vr, tb)
     assert removal >= 0.95
     assert ratio <= 1.3
+
+
+# --- fast evaluation: predict (numpy blocks) and stream (Python floats) --------------------
+
+MIXED_TERMS = "T1,T1^2,T1^3,dT1,T1*dT1,(T1*dT1)^2,T1^2*dT1,T3,dT3^2,T3*dT3"
+
+
+def literal_eq1(m: PolyModel, run: RunData) -> np.ndarray:
+    """Independent reference: eq. (1) term by term (scaled features @ coef + constant),
+    Ṫ from preprocess.temperature_rate, T and Ṫ clamped to the fitted ranges."""
+    k = run.temps_c.shape[1]
+    R = np.column_stack(
+        [
+            temperature_rate(run.time_s, run.temps_c[:, j], m.rate_interval_s, m.rate_method)
+            for j in range(k)
+        ]
+    )
+    T = np.clip(run.temps_c, m.temp_range_[:, 0], m.temp_range_[:, 1])
+    R = np.clip(R, m.rate_range_[:, 0], m.rate_range_[:, 1])
+    return term_features(m.terms_, m.scaling_, T, R) @ m.coef_ + m.constant_
+
+
+def jittered_hot(run: RunData, seed: int = 4) -> RunData:
+    """Irregular sampling (±20 % jitter, a gap) and a 6 °C excursion beyond the range."""
+    rng = np.random.default_rng(seed)
+    t = np.cumsum(rng.uniform(0.8, 1.2, run.n_samples))
+    t[run.n_samples // 3 :] += 400.0
+    bump = 6.0 * np.exp(-(((np.arange(run.n_samples) - 2200) / 150.0) ** 2))
+    return dataclasses.replace(run, time_s=t, temps_c=run.temps_c + bump[:, None])
+
+
+@pytest.mark.parametrize("terms", ["seed000", MIXED_TERMS])
+def test_predict_equals_literal_eq1_and_stream_bit_for_bit(terms):
+    run, _ = make_run(n=4000, noise=0.01)
+    m = PolyModel(terms=terms).fit([run])
+    for data in (run, jittered_hot(run)):
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", ExtrapolationWarning)
+            got = m.predict(data)
+            s = m.stream(float(np.median(np.diff(data.time_s))))
+            live = np.array(
+                [s.update(t, T) for t, T in zip(data.time_s, data.temps_c, strict=True)]
+            )
+        ref = literal_eq1(m, data)
+        assert_allclose(got, ref, rtol=0, atol=1e-12 * np.abs(ref).max())
+        assert_array_equal(live, got)  # the same operations in the same order
+
+
+def test_predict_does_not_depend_on_the_block_size(monkeypatch):
+    from thermocal.models import poly
+
+    run, _ = make_run(n=5000, gap=True, noise=0.01)
+    m = PolyModel(terms=MIXED_TERMS).fit([run])
+    data = jittered_hot(run)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", ExtrapolationWarning)
+        whole = m.predict(data)
+        monkeypatch.setattr(poly, "PREDICT_BLOCK_ROWS", 97)
+        small = m.predict(data)
+    assert_array_equal(small, whole)
+
+
+@pytest.mark.parametrize("method", ["forward", "centred"])
+def test_non_causal_rate_forms_predict_but_do_not_stream(method):
+    run, _ = make_run(n=3000, gap=True, noise=0.01)
+    m = PolyModel(rate_method=method).fit([run])
+    ref = literal_eq1(m, run)
+    assert_allclose(m.predict(run), ref, rtol=0, atol=1e-12 * np.abs(ref).max())
+    with pytest.raises(ThermocalInputError, match="backward"):
+        m.stream(1.0)
+
+
+def test_predict_warning_counts_samples_like_clamp():
+    run, _ = make_run(n=3000)
+    m = PolyModel(terms="T1,T1^2,T2", per_run_offset=False).fit([run])
+    hot = dataclasses.replace(run, temps_c=run.temps_c + np.r_[0.0, 0.0, 25.0, 0.0][None, :])
+    # T3 is not used by the terms, but is outside its range: warned as TemperatureModel.clamp does
+    n_out = int(np.count_nonzero(np.any(hot.temps_c > m.temp_range_[:, 1], axis=1)))
+    assert n_out > 0
+    with pytest.warns(ExtrapolationWarning, match=rf"^{n_out} samples outside .*T3 .*clamped"):
+        got = m.predict(hot)
+    assert_array_equal(got, m.predict(run))
+
+
+def test_stream_warns_once_and_clamps():
+    run, _ = make_run(n=400)
+    m = PolyModel(terms="T1,T1^2", per_run_offset=False).fit([run])
+    hot = dataclasses.replace(run, temps_c=run.temps_c + 50.0)
+    s = m.stream(1.0)
+    with warnings.catch_warnings(record=True) as rec:
+        warnings.simplefilter("always")
+        live = [s.update(t, T) for t, T in zip(hot.time_s, hot.temps_c, strict=True)]
+    assert len([w for w in rec if issubclass(w.category, ExtrapolationWarning)]) == 1
+    top = m.predict(dataclasses.replace(run, temps_c=np.tile(m.temp_range_[:, 1], (400, 1))))
+    assert_allclose(live, top, rtol=0, atol=1e-12 * np.abs(top).max())
+    with pytest.raises(ThermocalInputError, match="channels"):
+        s.update(1e6, np.array([20.0, 21.0]))
+
+
+def test_model_without_terms_predicts_its_constant():
+    run, _ = make_run(n=500)
+    m = PolyModel(terms="T1", per_run_offset=False).fit([run])
+    m.terms_, m.coef_ = [], np.zeros(0)
+    assert_array_equal(m.predict(run), np.full(run.n_samples, m.constant_))
+    assert m.stream(1.0).update(0.0, run.temps_c[0]) == m.constant_
+
+
+def test_backward_partners_and_gap_free_slices_against_searchsorted():
+    rng = np.random.default_rng(3)
+    n = 3000
+    times = {
+        "regular": np.arange(n, dtype=float),
+        "fine": 1e5 + 0.01 * np.arange(n),
+        "jitter": np.cumsum(rng.uniform(0.5, 1.5, n)),
+        "duplicates": np.cumsum(rng.choice([0.0, 1.0, 1.0, 2.0], n)),
+    }
+    for label, t in times.items():
+        assert gap_free_slices(t) == contiguous_slices(t), label
+        for interval in (0.5, 7.3, 60.0):
+            for a, b in [(0, 100), (1, 2), (70, 1900), (2999, 3000), (100, 3000)]:
+                part = backward_partners(t, 0, a, b, interval)
+                want = np.searchsorted(t, t[a:b] - interval, side="left")
+                got = np.arange(a, b) - part if isinstance(part, int) else part
+                assert_array_equal(got, want, err_msg=f"{label} {interval} {a}:{b}")
+    gapped = times["regular"].copy()
+    gapped[1000:] += 10.0
+    assert gap_free_slices(gapped) == contiguous_slices(gapped) == [slice(0, 1000), slice(1000, n)]
+
+
+@pytest.mark.parametrize("interval", [0.5, 7.3, 60.0, 600.0])
+def test_rates_equal_preprocess_on_irregular_sampling(interval):
+    rng = np.random.default_rng(5)
+    n = 5000
+    t = np.cumsum(rng.choice([0.0, 0.9, 1.0, 1.1, 4.0], n))
+    T = np.cumsum(rng.standard_normal((n, 2)), axis=0)
+    for method in ("backward", "forward", "centred"):
+        got = temperature_rates(t, T, interval, method)
+        for j in range(2):
+            assert_array_equal(got[:, j], temperature_rate(t, T[:, j], interval, method))

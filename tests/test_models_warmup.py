@@ -3,6 +3,8 @@ reference, streaming twin, file round-trip, clamping and bad input."""
 
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 import pytest
 
@@ -327,3 +329,16 @@ def test_simulator_removes_90_percent_of_warmup_drift(held_out: str) -> None:
     ideal = WarmupModel(order=2, t0_order=2, start_window_s=0.5).fit(exact)
     left_ideal = drift - ideal.predict(run)
     assert 1.0 - np.std(left_ideal) / np.std(drift) >= 0.99
+
+
+def test_stream_warns_once_per_kind(fitted: WarmupModel) -> None:
+    run, _ = physical_run(75.0, 9)  # start temperature and temperatures above the range
+    st = fitted.stream(1.0)
+    with warnings.catch_warnings(record=True) as rec:
+        warnings.simplefilter("always")
+        live = feed(st, run, with_signal=False)
+        batch = fitted.predict(run)
+    texts = [str(w.message) for w in rec if issubclass(w.category, ExtrapolationWarning)]
+    stream_texts = [t for t in texts if "samples" not in t]
+    assert len(stream_texts) == 2  # temperature, start temperature T0: once each
+    np.testing.assert_array_equal(live, batch)

@@ -31,8 +31,11 @@ worst-case error against double is measured (:func:`measure_float_error`).
 Temperatures are always clamped to the fitted range (the Python default,
 ``extrapolate=False``).
 
-Families register a generator in :data:`GENERATORS` (STYLE rule 8); each reads
-the ``state`` layout documented in its module docstring.
+Families register a generator in :data:`GENERATORS` (STYLE rule 8): ``poly``,
+``piecewise`` (both methods), ``warmup``, ``bank``; each reads the ``state`` layout
+documented in its module docstring and emits only the constants, state and
+parameters the model uses, so the module builds with ``-Wall -Wextra -Werror``
+(e.g. a poly model without rate terms has no rate buffer or rate constants).
 """
 
 from __future__ import annotations
@@ -434,7 +437,18 @@ def _gen_poly(ctx: ExportContext) -> FamilyCode:
         return [float(b[key]) for b in base]
 
     # only the arrays the terms use: -Wall -Wextra -Werror rejects unused static consts
-    data = [ctx.clamp_arrays()]
+    needs_t = bool(t_sensors or w_sensors)  # clamped T used by u or w
+    if needs_t:
+        data = [ctx.clamp_arrays()]
+    else:  # constant or rate-only model: the temperature range is documentation only
+        rng = ctx.temp_range()
+        data = [
+            "/* fitted temperature range [degC]: "
+            + ", ".join(
+                f"{n} {lo!r}..{hi!r}" for n, (lo, hi) in zip(d["temperatures"], rng, strict=True)
+            )
+            + " (not used: no T or T*dT term) */"
+        ]
     used = [
         (t_sensors, "T", "t_center", "t_scale", "u"),
         (v_sensors, "R", "rate_center", "rate_scale", "v"),
@@ -464,9 +478,34 @@ def _gen_poly(ctx: ExportContext) -> FamilyCode:
             ctx.array(f"{P}_R_HI", rng[:, 1]),
         ]
     defines = [f"#define {P}_N_TERMS {len(terms)}"]
+    notes = [
+        f"Polynomial model (SPEC 4a): {len(terms)} terms + constant in the centred and scaled",
+        "base variables u = (T - c_T)/s_T, v = (dT - c_R)/s_R, w = (T dT - c_W)/s_W",
+        "(dT = backward difference over the rate interval, degC/min). Inputs are clamped",
+        "to the fitted temperature (and rate) range. Call init at power-on.",
+    ]
+    if not terms:
+        return FamilyCode(
+            state_fields=["int unused; /* no state */"],
+            data="\n".join(data),
+            init="s->unused = 0;",
+            update="\n".join(
+                [
+                    "(void)s; /* a constant model */",
+                    "(void)time_s;",
+                    "(void)temps_c;",
+                    "(void)signal;",
+                    f"(void){p}_clamp; /* nothing to clamp */",
+                    f"return {P}_CONSTANT;",
+                ]
+            ),
+            defines=defines,
+            notes=notes,
+        )
     fields: list[str] = []
     init = ""
-    upd = [f"{r} T[{P}_N_TEMPS];", f"{r} acc = {ctx.lit(0.0)};", "int i;"]
+    upd = [f"{r} T[{P}_N_TEMPS];"] if needs_t else []
+    upd += [f"{r} acc = {ctx.lit(0.0)};", "int i;"]
     if uses_rate:
         interval = float(rate.get("interval_s", 60.0))
         defines += [
@@ -480,12 +519,13 @@ def _gen_poly(ctx: ExportContext) -> FamilyCode:
         upd += [f"{r} rate[{P}_N_TEMPS];", rate_update.strip("\n")]
     if not uses_rate:
         upd += ["(void)s; /* memoryless without rate terms */", "(void)time_s;"]
-    upd += [
-        "(void)signal;",
-        "for (i = 0; i < " + f"{P}_N_TEMPS; ++i) {{",
-        f"    T[i] = {p}_clamp(temps_c[i], {P}_T_LO[i], {P}_T_HI[i]);",
-        "}",
-    ]
+    upd.append("(void)signal;")
+    if needs_t:
+        upd += [
+            "for (i = 0; i < " + f"{P}_N_TEMPS; ++i) {{",
+            f"    T[i] = {p}_clamp(temps_c[i], {P}_T_LO[i], {P}_T_HI[i]);",
+            "}",
+        ]
     if clamp_rate:
         for j in rate_sensors:
             upd.append(f"rate[{j}] = {p}_clamp(rate[{j}], {P}_R_LO[{j}], {P}_R_HI[{j}]);")
@@ -515,12 +555,6 @@ def _gen_poly(ctx: ExportContext) -> FamilyCode:
         label = str(t.get("name", "")).replace("*/", "* /")
         upd.append(f"acc += {val} * {P}_COEF[{i}]; /* {label} */")
     upd.append(f"return acc + {P}_CONSTANT;")
-    notes = [
-        f"Polynomial model (SPEC 4a): {len(terms)} terms + constant in the centred and scaled",
-        "base variables u = (T - c_T)/s_T, v = (dT - c_R)/s_R, w = (T dT - c_W)/s_W",
-        "(dT = backward difference over the rate interval, degC/min). Inputs are clamped",
-        "to the fitted temperature (and rate) range. Call init at power-on.",
-    ]
     return FamilyCode(
         state_fields=fields or ["int unused; /* no state */"],
         data="\n".join(data),

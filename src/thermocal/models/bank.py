@@ -70,6 +70,7 @@ during the start-up window, choose ``argmin_m |Σ/N|`` (first index on ties).
 
 from __future__ import annotations
 
+import bisect
 import math
 import warnings
 from collections.abc import Sequence
@@ -80,7 +81,12 @@ import numpy as np
 from scipy.cluster.hierarchy import fcluster, linkage
 from scipy.spatial.distance import squareform
 
-from thermocal.errors import ConditioningWarning, DesignError, ThermocalInputError
+from thermocal.errors import (
+    ConditioningWarning,
+    DesignError,
+    ExtrapolationWarning,
+    ThermocalInputError,
+)
 from thermocal.models.base import (
     Coefficient,
     FitStats,
@@ -481,6 +487,10 @@ class BankModel(TemperatureModel):
         temp = np.asarray(run.temps_c[:, col], dtype=np.float64)
         return self.clamp(temp[:, None], extrapolate=extrapolate)[:, 0]
 
+    def _startup_count(self, run: RunData) -> int:
+        """Samples in the start-up window, ``t − t_first < startup_s`` (≥ 1)."""
+        return max(1, int(np.count_nonzero(run.time_s - run.time_s[0] < self.startup_s)))
+
     def _run_selection(self, run: RunData, f: FloatArray) -> tuple[FloatArray, FloatArray, int]:
         """Running deviations (m, M) over the start-up window and per-sample choice."""
         if run.signal is None:
@@ -488,7 +498,7 @@ class BankModel(TemperatureModel):
                 f"bank: {run.name or 'run'}: selecting a model at power-on needs the "
                 "measured signal"
             )
-        m = max(1, int(np.count_nonzero(run.time_s - run.time_s[0] < self.startup_s)))
+        m = self._startup_count(run)
         y = run.target()[:m]
         dev = np.abs(np.cumsum(y[:, None] - f[:m], axis=0) / np.arange(1, m + 1)[:, None])
         choice = np.argmin(dev, axis=1)
@@ -498,7 +508,7 @@ class BankModel(TemperatureModel):
         """The model chosen for a power-on from its start-up window (SPEC §4d step 4);
         also stored in ``selection_``."""
         temp = self._prepare(run, extrapolate)
-        f = self._model_matrix(temp)
+        f = self._model_matrix(temp[: self._startup_count(run)])
         dev, _choice, m = self._run_selection(run, f)
         self.selection_ = _selection(dev[-1], m, m < run.n_samples)
         return self.selection_
@@ -507,13 +517,13 @@ class BankModel(TemperatureModel):
         """Output of the selected model at every sample [signal unit]: running
         selection during the start-up window, frozen after it."""
         temp = self._prepare(run, extrapolate)
-        f = self._model_matrix(temp)
+        f = self._model_matrix(temp[: self._startup_count(run)])  # every model, start-up only
         dev, choice, m = self._run_selection(run, f)
-        idx = np.empty(run.n_samples, dtype=np.intp)
-        idx[:m] = choice
-        idx[m:] = choice[-1]
         self.selection_ = _selection(dev[-1], m, m < run.n_samples)
-        out: FloatArray = f[np.arange(run.n_samples), idx]
+        out = np.empty(run.n_samples)
+        out[:m] = f[np.arange(m), choice]
+        c = int(choice[-1])
+        out[m:] = pwl_evaluate(self.breakpoints_[c], self.values_[c], temp[m:])
         return out
 
     def stream(
@@ -579,12 +589,15 @@ class BankModel(TemperatureModel):
 
 
 class BankStream(ModelStream):
-    """Streaming twin of :meth:`BankModel.predict`: running residual sums per model
-    during the start-up window, then the frozen choice.
+    """Streaming twin of :meth:`BankModel.predict`, in plain Python floats: running
+    residual sums per model during the start-up window, then the frozen choice (only
+    the chosen model is evaluated after it).  The same operations as ``predict``
+    (:func:`pwl_evaluate`, the cumulative sums of ``_run_selection``), so the same numbers.
 
     ``temps_c`` holds either one value (the model's channel) or the fitted run's
     channels (``sensor`` picks).  ``signal`` (raw; ``known_input`` is subtracted) is
     required during the start-up window.  ``selection`` is the current :class:`Selection`.
+    Warns once per stream when a temperature leaves the fitted range.
     """
 
     def __init__(
@@ -593,37 +606,73 @@ class BankStream(ModelStream):
         self.model = model
         self.extrapolate = extrapolate
         self.known_input = float(known_input)
+        self._col = int(model.sensor)
+        self._lo = float(model.temp_range_[0, 0])
+        self._hi = float(model.temp_range_[0, 1])
+        self._startup = float(model.startup_s)
+        self._xs = [[float(x) for x in b] for b in model.breakpoints_]
+        self._vs = [[float(v) for v in vals] for vals in model.values_]
         self.reset()
 
     def reset(self) -> None:
+        n = len(self._vs)
         self._t_first: float | None = None
-        self._sums = np.zeros(len(self.model.values_))
+        self._sums = [0.0] * n
         self._count = 0
         self._frozen = False
         self._choice = 0
-        self._dev = np.full(len(self.model.values_), np.nan)
+        self._dev = [math.nan] * n
+        self._warned = False
 
     @property
     def selection(self) -> Selection:
-        return _selection(self._dev, self._count, self._frozen)
+        return _selection(np.array(self._dev, dtype=np.float64), self._count, self._frozen)
+
+    def _value(self, m: int, temp: float) -> float:
+        """Model m at T: :func:`pwl_evaluate` on one float (same operations)."""
+        x, v = self._xs[m], self._vs[m]
+        j = min(max(bisect.bisect_right(x, temp) - 1, 0), len(x) - 2)
+        slope = (v[j + 1] - v[j]) / (x[j + 1] - x[j])
+        return v[j] + slope * (temp - x[j])
 
     def update(self, time_s: float, temps_c: FloatArray, signal: float | None = None) -> float:
-        m = self.model
-        row = np.asarray(temps_c, dtype=np.float64).reshape(1, -1)
-        col = 0 if row.shape[1] == 1 else int(m.sensor)
-        temp = m.clamp(row[:, [col]], extrapolate=self.extrapolate)[:, 0]
-        f = m._model_matrix(temp)[0]
+        if type(temps_c) is np.ndarray and temps_c.dtype == np.float64 and temps_c.ndim == 1:
+            arr = temps_c
+        else:
+            arr = np.asarray(temps_c, dtype=np.float64).reshape(-1)
+        temp = float(arr.item(0) if arr.size == 1 else arr.item(self._col))
+        if temp < self._lo or temp > self._hi:
+            if not self._warned:
+                self._warned = True
+                action = "extrapolating" if self.extrapolate else "clamped to the fitted range"
+                warnings.warn(
+                    f"temperature {temp:.2f} °C outside the model's fitted range "
+                    f"{self._lo:.2f}…{self._hi:.2f}; {action}",
+                    ExtrapolationWarning,
+                    stacklevel=2,
+                )
+            if not self.extrapolate:
+                temp = min(max(temp, self._lo), self._hi)
+        t = float(time_s)
         if self._t_first is None:
-            self._t_first = float(time_s)
-        if not self._frozen and float(time_s) - self._t_first < m.startup_s:
+            self._t_first = t
+        if not self._frozen and t - self._t_first < self._startup:
             if signal is None:
                 raise ThermocalInputError(
                     "bank: selecting a model at power-on needs the measured signal"
                 )
-            self._sums = self._sums + ((float(signal) - self.known_input) - f)
+            y = float(signal) - self.known_input
+            f = [self._value(m, temp) for m in range(len(self._vs))]
             self._count += 1
-            self._dev = np.abs(self._sums / self._count)
-            self._choice = int(np.argmin(self._dev))
-        else:
-            self._frozen = True
-        return float(f[self._choice])
+            sums = self._sums
+            best = 0
+            for m, fm in enumerate(f):
+                sums[m] = sums[m] + (y - fm)
+                dev = abs(sums[m] / self._count)
+                self._dev[m] = dev
+                if dev < self._dev[best]:
+                    best = m
+            self._choice = best
+            return f[best]
+        self._frozen = True
+        return self._value(self._choice, temp)

@@ -50,6 +50,7 @@ file; ``j`` = number of breakpoints ``≤ T``; ``y = intercepts[j] + slopes[j]·
 
 from __future__ import annotations
 
+import bisect
 import itertools
 import math
 import warnings
@@ -540,7 +541,9 @@ class PiecewiseModel(TemperatureModel):
 
 
 class PiecewiseStream(ModelStream):
-    """Sample-by-sample :class:`PiecewiseModel`: eq. (1) on the clamped temperature.
+    """Sample-by-sample :class:`PiecewiseModel`: eq. (1) on the clamped temperature, in
+    plain Python floats (``bisect`` for the segment; the same operations as
+    :func:`evaluate_lines`, so the same numbers as ``predict``).
 
     ``temps_c`` may hold only the model's temperature or every fitted column
     (then the model's ``column_index`` is used).  Warns once per stream when a
@@ -552,14 +555,21 @@ class PiecewiseStream(ModelStream):
         self.extrapolate = extrapolate
         self.lo = float(model.temp_range_[0, 0])
         self.hi = float(model.temp_range_[0, 1])
+        self._col = int(model.column_index_)
+        self._bps = [float(b) for b in model.breakpoints_]
+        self._inter = [float(a) for a in model.intercepts_]
+        self._slopes = [float(v) for v in model.slopes_]
         self.reset()
 
     def reset(self) -> None:
         self._warned = False
 
     def update(self, time_s: float, temps_c: FloatArray, signal: float | None = None) -> float:
-        arr = np.atleast_1d(np.asarray(temps_c, dtype=np.float64))
-        x = float(arr[0] if arr.size == 1 else arr[self.model.column_index_])
+        if type(temps_c) is np.ndarray and temps_c.dtype == np.float64 and temps_c.ndim == 1:
+            arr = temps_c
+        else:
+            arr = np.atleast_1d(np.asarray(temps_c, dtype=np.float64)).reshape(-1)
+        x = float(arr.item(0) if arr.size == 1 else arr.item(self._col))
         if x < self.lo or x > self.hi:
             if not self._warned:
                 self._warned = True
@@ -572,6 +582,5 @@ class PiecewiseStream(ModelStream):
                 )
             if not self.extrapolate:
                 x = min(max(x, self.lo), self.hi)
-        m = self.model
-        v = evaluate_lines(m.breakpoints_, m.intercepts_, m.slopes_, np.array([x]))
-        return float(v[0])
+        j = bisect.bisect_right(self._bps, x)
+        return self._inter[j] + self._slopes[j] * x

@@ -44,6 +44,18 @@ Evaluation, in order, for every sample (this is what :meth:`PolyModel.predict`,
    ``w_k`` built from the clamped T_k·Ṫ_k;
 4. ``y = constant + Σ_j coef[j] · u^t_power · v^rate_power · w^coupling_power``.
 
+How steps 3–4 are computed (:class:`EvalPlan`; the same operations in
+:meth:`PolyModel.predict` on numpy blocks and in :class:`PolyStream` on Python
+floats, so the two agree to the last bit): the scales are folded into the
+coefficients and the pure powers of each variable summed by Horner's rule in the
+centred variable, e.g. ``((a₃/s³·d + a₂/s²)·d + a₁/s)·d`` with ``d = T − c_T``;
+the centres of Ṫ and T·Ṫ (near 0) are folded into the coefficients and the
+constant when every ``|c| ≤ s``.  Mathematically the same model as eq. (1);
+numerically it differs from the literal sum of the scaled terms by rounding only
+(~1e-16 relative).  ``predict`` works in cache-sized blocks of
+:data:`PREDICT_BLOCK_ROWS` samples, with Ṫ's partner samples found per block by
+:func:`~thermocal.models.terms.backward_partners` (a slice on regular sampling).
+
 Model-file ``state`` layout (``"layout": "thermocal-poly-1"``), for the C export::
 
     {
@@ -80,6 +92,7 @@ import math
 import warnings
 from collections import deque
 from collections.abc import Iterator, Sequence
+from dataclasses import dataclass, field
 from typing import Any, ClassVar, Self, cast
 
 import numpy as np
@@ -100,13 +113,16 @@ from thermocal.models.terms import (
     Chunk,
     Term,
     accumulate_r,
+    backward_partners,
     fit_base_scaling,
     forward_select,
+    gap_free_slices,
     monomial_name,
     parse_terms,
     raw_expansion,
     segment_rates,
     solve_r,
+    step_range,
     temperature_rates,
     term_features,
 )
@@ -246,6 +262,433 @@ def record_ranges(
     )
     model._record_common(summary, stats, rates=rates)
     model.data_ = [{"file": r.name, "n_samples": r.n_samples} for r in runs]
+
+
+# --- evaluation: one plan for predict (numpy blocks) and the stream (Python floats) ----------
+
+PREDICT_BLOCK_ROWS = 8192
+"""Rows per block in :meth:`PolyModel.predict`: the block's temporaries (a few
+(k × rows) arrays, ~1.5 MB for four sensors) stay in the L2 cache.  (More than 4096:
+numpy's broadcast of a coefficient column is slow on smaller rows.)"""
+
+KINDS = ("u", "v", "w")
+"""Base variables of eq. (1) of :mod:`thermocal.models.terms`: T, Ṫ and T·Ṫ."""
+
+PyRow = tuple[
+    int, float, float, float, tuple[tuple[int, float, tuple[float, ...]], ...], tuple[Any, ...]
+]
+"""Stream form of one sensor: (column, c_T, c_R, c_W, ((kind, c_P, (c_{P−1}, …, c_1)), …),
+((coefficient, factor kinds), …)); kinds 0/1/2 = u/v/w."""
+
+
+@dataclass(frozen=True)
+class EvalPlan:
+    """A fitted polynomial arranged for fast evaluation (module docstring, steps 3–4).
+
+    With the centred variables ``d_u = T − c_T``, ``d_v = Ṫ − c_R``, ``d_w = T·Ṫ − c_W``
+    of each used sensor (T, Ṫ clamped) and the scale factors folded into the
+    coefficients (``coef / s^p``), the pure powers of one variable are summed by
+    Horner's rule,
+
+        p(d) = ((c_P·d + c_{P−1})·d + … + c_1)·d,
+
+    per sensor ``s_k = (p_u(d_u) + p_v(d_v)) + p_w(d_w)`` (the variables the terms use,
+    in this order), then ``s_k + c·Π factors`` for each mixed term ``u^a v^b w^c``
+    (two or more variables; factors multiplied left to right: u…, v…, w…), and
+    ``y = ((constant + s_1) + s_2) + …`` over the sensors in column order.  The same
+    operations in the same order run on numpy blocks in :meth:`PolyModel.predict` and
+    on Python floats in :class:`PolyStream`, so both give the same numbers (a
+    zero-padded Horner row only adds and multiplies exact zeros).
+
+    ``sensors``: the used columns (rows of the block arrays); ``kinds``: the variables
+    formed (``"u"``, ``"v"``, ``"w"``), stacked kind by kind in the block arrays;
+    ``horner``: (len(kinds)·len(sensors), 1) coefficient columns ``c_1 … c_P``
+    (zero-padded to the highest power; empty without pure-power terms);
+    ``centres[kind]``: (len(sensors), 1) — 0 for Ṫ and T·Ṫ when :func:`build_plan`
+    folded them into the coefficients (``centred[kind]`` False: no subtraction);
+    ``mixed``: (row, coefficient, factor kinds); ``rate_sensors``: the columns whose Ṫ
+    a term uses; ``py_rows``: the stream form.
+    """
+
+    constant: float
+    sensors: tuple[int, ...]
+    kinds: tuple[str, ...]
+    horner: list[FloatArray]
+    centres: dict[str, FloatArray]
+    centred: dict[str, bool]
+    mixed: tuple[tuple[int, float, tuple[str, ...]], ...]
+    rate_sensors: tuple[int, ...]
+    py_rows: tuple[PyRow, ...]
+
+
+def build_plan(
+    terms: Sequence[Term], scaling: BaseScaling, coef: FloatArray, constant: float
+) -> EvalPlan:
+    """Arrange fitted terms for evaluation (:class:`EvalPlan`): the coefficient of a pure
+    power ``u^p`` becomes ``coef / s_T^p`` (Horner in ``d_u``), likewise for v and w; a
+    mixed term ``u^a v^b w^c`` gets ``coef / (s_T^a s_R^b s_W^c)``.  When no mixed term
+    uses it and every sensor's ``|c| ≤ s``, the centre of Ṫ (of T·Ṫ) is folded in by the
+    binomial re-expansion ``Σ_p a_p (x − c)^p = Σ_j b_j x^j`` (the ``b_0`` join the
+    constant), which saves a pass and loses no accuracy."""
+    sensors = tuple(sorted({t.sensor for t in terms}))
+    row_of = {s: i for i, s in enumerate(sensors)}
+    centre_of = {
+        "u": scaling.t_center,
+        "v": scaling.rate_center,
+        "w": scaling.coupling_center,
+    }
+    scale_of = {"u": scaling.t_scale, "v": scaling.rate_scale, "w": scaling.coupling_scale}
+    pure: dict[tuple[str, int, int], float] = {}  # (kind, row, power) -> coefficient
+    mixed: list[tuple[int, float, tuple[str, ...]]] = []
+    for term, c in zip(terms, coef, strict=True):
+        powers = {"u": term.t_power, "v": term.rate_power, "w": term.coupling_power}
+        used = [k for k in KINDS if powers[k]]
+        j = term.sensor
+        if len(used) == 1:
+            kind = used[0]
+            p = powers[kind]
+            key = (kind, row_of[j], p)
+            pure[key] = pure.get(key, 0.0) + float(c) / float(scale_of[kind][j]) ** p
+        else:
+            div = 1.0
+            for kind in used:
+                div *= float(scale_of[kind][j]) ** powers[kind]
+            factors = tuple(k for k in KINDS for _ in range(powers[k]))
+            mixed.append((row_of[j], float(c) / div, factors))
+    kinds = tuple(
+        k for k in KINDS if any(key[0] == k for key in pure) or any(k in m[2] for m in mixed)
+    )
+    nr = len(sensors)
+    # Ṫ and T·Ṫ: re-expand about 0 when every centre is within one scale of 0 (no loss
+    # of accuracy; saves two passes):  Σ_p a_p (x − c)^p = Σ_j b_j x^j,
+    # b_j = Σ_{p ≥ max(j,1)} a_p C(p, j) (−c)^(p−j);  the b_0 go into the constant.
+    constant = float(constant)
+    centre = {k: [float(centre_of[k][s]) for s in sensors] for k in KINDS}
+    for kind in ("v", "w"):
+        if kind not in kinds or any(kind in m[2] for m in mixed):
+            continue
+        if not all(abs(centre[kind][r]) <= float(scale_of[kind][s]) for r, s in enumerate(sensors)):
+            continue
+        for r in range(nr):
+            a = {p: v for (k2, r2, p), v in pure.items() if k2 == kind and r2 == r}
+            c0 = centre[kind][r]
+            if a and c0 != 0.0:
+                top_p = max(a)
+                for j in range(top_p + 1):
+                    b = 0.0
+                    for p in range(max(j, 1), top_p + 1):
+                        b += a.get(p, 0.0) * math.comb(p, j) * (-c0) ** (p - j)
+                    if j == 0:
+                        constant += b
+                    else:
+                        pure[(kind, r, j)] = b
+            centre[kind][r] = 0.0
+    top = max((key[2] for key, v in pure.items() if v != 0.0), default=0)
+    mat = np.zeros((len(kinds) * nr, top))
+    for (kind, r, p), v in pure.items():
+        if p <= top:
+            mat[kinds.index(kind) * nr + r, p - 1] += v
+    horner = [np.ascontiguousarray(mat[:, p : p + 1]) for p in range(top)]
+    centres = {k: np.array(centre[k], dtype=np.float64).reshape(nr, 1) for k in KINDS}
+    py_rows: list[PyRow] = []
+    for r, s in enumerate(sensors):
+        polys: list[tuple[int, float, tuple[float, ...]]] = []
+        for ki, kind in enumerate(kinds):
+            col = [float(v) for v in mat[ki * nr + r]]
+            while col and col[-1] == 0.0:
+                col.pop()
+            if col:
+                polys.append((KINDS.index(kind), col[-1], tuple(reversed(col[:-1]))))
+        mix = tuple(
+            (cf, tuple(KINDS.index(f) for f in factors)) for row, cf, factors in mixed if row == r
+        )
+        py_rows.append((s, centre["u"][r], centre["v"][r], centre["w"][r], tuple(polys), mix))
+    return EvalPlan(
+        constant=constant,
+        sensors=sensors,
+        kinds=kinds,
+        horner=horner,
+        centres=centres,
+        centred={k: bool(np.any(centres[k] != 0.0)) for k in KINDS},
+        mixed=tuple(mixed),
+        rate_sensors=tuple(sorted({t.sensor for t in terms if t.uses_rate})),
+        py_rows=tuple(py_rows),
+    )
+
+
+@dataclass
+class _Seen:
+    """Ranges met while evaluating, for the warnings: per block the minima and maxima of
+    the raw T (every column) and Ṫ (rows of the used sensors), and the number of samples
+    with a temperature outside the fitted range."""
+
+    t_mins: list[FloatArray] = field(default_factory=list)
+    t_maxs: list[FloatArray] = field(default_factory=list)
+    r_mins: list[FloatArray] = field(default_factory=list)
+    r_maxs: list[FloatArray] = field(default_factory=list)
+    n_outside: int = 0
+
+    @staticmethod
+    def _reduce(parts: list[FloatArray], n: int, fn: Any, fill: float) -> FloatArray:
+        out: FloatArray = fn(np.vstack(parts), axis=0) if parts else np.full(n, fill)
+        return out
+
+    def temperature(self, k: int) -> tuple[FloatArray, FloatArray]:
+        """(minima, maxima) of every column [°C]."""
+        return (
+            self._reduce(self.t_mins, k, np.min, np.inf),
+            self._reduce(self.t_maxs, k, np.max, -np.inf),
+        )
+
+    def rate(self, nr: int) -> tuple[FloatArray, FloatArray]:
+        """(minima, maxima) of Ṫ of every used sensor [°C/min] (rows of the plan)."""
+        return (
+            self._reduce(self.r_mins, nr, np.min, np.inf),
+            self._reduce(self.r_maxs, nr, np.max, -np.inf),
+        )
+
+
+class _BlockEvaluator:
+    """Evaluates an :class:`EvalPlan` on blocks of a run (numpy, cache-sized, buffers reused)."""
+
+    def __init__(
+        self,
+        model: PolyModel,
+        plan: EvalPlan,
+        run: RunData,
+        *,
+        extrapolate: bool,
+        rates: FloatArray | None = None,
+    ) -> None:
+        self.plan = plan
+        self.rates = rates
+        self.t = run.time_s
+        self.temps = run.temps_c
+        self.k = int(run.temps_c.shape[1])
+        self.extrapolate = extrapolate
+        self.interval_s = float(model.rate_interval_s)
+        self.t_lo = np.ascontiguousarray(model.temp_range_[:, :1])
+        self.t_hi = np.ascontiguousarray(model.temp_range_[:, 1:2])
+        self.t_lo1 = self.t_lo[:, 0].copy()
+        self.t_hi1 = self.t_hi[:, 0].copy()
+        self.increasing = False
+        rows = np.array(plan.sensors, dtype=np.intp)
+        self.rows = rows
+        self.all_rows = plan.sensors == tuple(range(self.k))
+        rr = model.rate_range_
+        self.clip_rates = rr is not None and not extrapolate and bool(plan.rate_sensors)
+        self.r_lo = np.ascontiguousarray(rr[rows, :1]) if rr is not None else None
+        self.r_hi = np.ascontiguousarray(rr[rows, 1:2]) if rr is not None else None
+        self.r_lo1 = self.r_lo[:, 0].copy() if self.r_lo is not None else None
+        self.r_hi1 = self.r_hi[:, 0].copy() if self.r_hi is not None else None
+
+    def blocks(self, rows: int | None = None) -> list[tuple[int, int, int]]:
+        """(segment start, block start, block stop): blocks of ≤ ``rows`` (default
+        :data:`PREDICT_BLOCK_ROWS`) inside gap-free segments; the start of a segment
+        (Ṫ over less than Δt) is a block of its own."""
+        rows = PREDICT_BLOCK_ROWS if rows is None else int(rows)
+        out: list[tuple[int, int, int]] = []
+        t = self.t
+        steps = step_range(t)
+        self.increasing = steps[0] > 0
+        for sl in gap_free_slices(t, steps=steps):
+            s0, s1 = int(sl.start), int(sl.stop)
+            a = s0
+            if self.plan.rate_sensors and self.rates is None:
+                head = s0 + int(
+                    np.searchsorted(t[s0:s1], float(t[s0]) + self.interval_s, side="right")
+                )
+                head = min(s1, head + 1)
+                while a < head:
+                    out.append((s0, a, min(head, a + rows)))
+                    a = min(head, a + rows)
+            for b0 in range(a, s1, rows):
+                out.append((s0, b0, min(s1, b0 + rows)))
+        return out
+
+    def run_blocks(self, blocks: Sequence[tuple[int, int, int]], out: FloatArray) -> _Seen:
+        """Evaluate ``blocks`` into ``out``; returns the ranges seen."""
+        seen = _Seen()
+        if not blocks:
+            return seen
+        width = max(b - a for _s0, a, b in blocks)
+        nr = len(self.plan.sensors)
+        nd = len(self.plan.kinds) * nr
+        buf = {
+            "raw": np.empty((self.k, 2 * width)),
+            "prev": np.empty((self.k, width)),
+            "clip": np.empty((self.k, width)),
+            "rate": np.empty((nr, width)),
+            "d": np.empty((nd, width)),
+            "acc": np.empty((max(nd, nr), width)),
+            "tmp": np.empty(width),
+            "span": np.empty(width),
+        }
+        for s0, a, b in blocks:
+            self._block(s0, a, b, out[a:b], seen, buf)
+        return seen
+
+    def _block(
+        self,
+        s0: int,
+        a: int,
+        b: int,
+        o: FloatArray,
+        seen: _Seen,
+        buf: dict[str, FloatArray],
+    ) -> None:
+        plan, t, temps = self.plan, self.t, self.temps
+        c = b - a
+        width = buf["prev"].shape[1]
+        part: int | npt.NDArray[np.intp] | None = None
+        if plan.rate_sensors and self.rates is None:
+            part = backward_partners(t, s0, a, b, self.interval_s, increasing=self.increasing)
+        prev: FloatArray | None = None
+        if isinstance(part, int) and part <= width:
+            raw = buf["raw"][:, : part + c]
+            np.copyto(raw, temps[a - part : b].T)
+            cur = raw[:, part:]
+            prev = raw[:, :c]
+        else:
+            cur = buf["raw"][:, :c]
+            np.copyto(cur, temps[a:b].T)
+            if isinstance(part, int):
+                prev = buf["prev"][:, :c]
+                np.copyto(prev, temps[a - part : b - part].T)
+        # step 2: the temperature range (every column, raw values)
+        mins = cur.min(axis=1)
+        maxs = cur.max(axis=1)
+        seen.t_mins.append(mins)
+        seen.t_maxs.append(maxs)
+        tc = cur
+        if bool(np.any(mins < self.t_lo1)) or bool(np.any(maxs > self.t_hi1)):
+            outside = np.any((cur < self.t_lo) | (cur > self.t_hi), axis=0)
+            seen.n_outside += int(np.count_nonzero(outside))
+            if not self.extrapolate:
+                tc = buf["clip"][:, :c]
+                np.clip(cur, self.t_lo, self.t_hi, out=tc)
+        nr = len(plan.sensors)
+        if nr == 0:
+            o.fill(plan.constant)
+            return
+        if self.all_rows:
+            ta, cura, preva = tc, cur, prev
+        else:
+            ta, cura = tc[self.rows], cur[self.rows]
+            preva = prev[self.rows] if prev is not None else None
+        # step 1: Ṫ from the raw temperatures, (T_i − T_lo)/(t_i − t_lo)·60
+        dall = buf["d"][:, :c]
+        if "v" in plan.kinds and not plan.centred["v"]:  # d_v = Ṫ: computed in place
+            vi = plan.kinds.index("v")
+            ra = dall[vi * nr : (vi + 1) * nr]
+        else:
+            ra = buf["rate"][:, :c]
+        if plan.rate_sensors:
+            if self.rates is not None:  # forward / centred forms, computed beforehand
+                np.copyto(ra, self.rates[a:b, self.rows].T)
+            elif preva is not None:
+                assert isinstance(part, int)
+                span = np.subtract(t[a:b], t[a - part : b - part], out=buf["span"][:c])
+                np.subtract(cura, preva, out=ra)
+                np.divide(ra, span, out=ra)
+                np.multiply(ra, SECONDS_PER_MINUTE, out=ra)
+            else:
+                lo = cast(npt.NDArray[np.intp], part)
+                span = t[a:b] - t[lo]
+                ok = span > 0
+                ra.fill(0.0)
+                if ok.any():
+                    partner = temps[lo[ok]][:, self.rows].T
+                    ra[:, ok] = (cura[:, ok] - partner) / span[ok] * SECONDS_PER_MINUTE
+            rmin = ra.min(axis=1)
+            rmax = ra.max(axis=1)
+            seen.r_mins.append(rmin)
+            seen.r_maxs.append(rmax)
+            if self.clip_rates and (
+                bool(np.any(rmin < self.r_lo1)) or bool(np.any(rmax > self.r_hi1))
+            ):
+                np.clip(ra, self.r_lo, self.r_hi, out=ra)
+        # step 3: centred variables, stacked kind by kind
+        d: dict[str, FloatArray] = {}
+        for i, kind in enumerate(plan.kinds):
+            dk = dall[i * nr : (i + 1) * nr]
+            if kind == "u":
+                np.subtract(ta, plan.centres["u"], out=dk)
+            elif kind == "v":
+                if plan.centred["v"]:
+                    np.subtract(ra, plan.centres["v"], out=dk)
+            else:
+                np.multiply(ta, ra, out=dk)
+                if plan.centred["w"]:
+                    np.subtract(dk, plan.centres["w"], out=dk)
+            d[kind] = dk
+        # step 4: Horner on all variables at once, sums per sensor, then over the sensors
+        if plan.horner and not plan.mixed:
+            acc = buf["acc"][:nr, :c]
+            for i in range(len(plan.kinds)):
+                dk = dall[i * nr : (i + 1) * nr]
+                hk = [h[i * nr : (i + 1) * nr] for h in plan.horner]
+                if len(hk) == 1:
+                    np.multiply(dk, hk[0], out=dk)
+                    continue
+                np.multiply(dk, hk[-1], out=acc)
+                for cp in hk[-2:0:-1]:
+                    np.add(acc, cp, out=acc)
+                    np.multiply(acc, dk, out=acc)
+                np.add(acc, hk[0], out=acc)
+                np.multiply(acc, dk, out=dk)  # p(d) replaces d (no mixed terms need it)
+            s = dall[:nr]
+            for i in range(1, len(plan.kinds)):
+                np.add(s, dall[i * nr : (i + 1) * nr], out=s)
+        elif plan.horner:
+            acc = buf["acc"][:, :c]
+            s = acc[:nr]
+            np.multiply(dall, plan.horner[-1], out=acc)
+            for cp in plan.horner[-2::-1]:
+                np.add(acc, cp, out=acc)
+                np.multiply(acc, dall, out=acc)
+            for i in range(1, len(plan.kinds)):
+                np.add(s, acc[i * nr : (i + 1) * nr], out=s)
+        else:
+            s = buf["acc"][:nr, :c]
+            s.fill(0.0)
+        if plan.mixed:
+            tmp = buf["tmp"][:c]
+            for row, cf, factors in plan.mixed:
+                np.multiply(d[factors[0]][row], cf, out=tmp)
+                for f in factors[1:]:
+                    np.multiply(tmp, d[f][row], out=tmp)
+                np.add(s[row], tmp, out=s[row])
+        np.add(s[0], plan.constant, out=o)
+        for r in range(1, nr):
+            np.add(o, s[r], out=o)
+
+
+def warn_temperature_range(
+    seen_min: FloatArray,
+    seen_max: FloatArray,
+    temp_range: FloatArray,
+    names: Sequence[str],
+    n_outside: int,
+    *,
+    extrapolate: bool,
+) -> None:
+    """The :class:`ExtrapolationWarning` of :meth:`TemperatureModel.clamp` (same text)
+    from the ranges met: ``n`` samples outside, per column seen and fitted range."""
+    lo, hi = temp_range[:, 0], temp_range[:, 1]
+    bad = [i for i in range(lo.size) if seen_min[i] < lo[i] or seen_max[i] > hi[i]]
+    if not bad:
+        return
+    where = ", ".join(
+        f"{names[i]} {seen_min[i]:.2f}…{seen_max[i]:.2f} °C (fitted {lo[i]:.2f}…{hi[i]:.2f})"
+        for i in bad
+    )
+    action = "extrapolating" if extrapolate else "clamped to the fitted range"
+    warnings.warn(
+        f"{n_outside} samples outside the model's temperature range: {where}; {action}",
+        ExtrapolationWarning,
+        stacklevel=3,
+    )
 
 
 @register
@@ -521,51 +964,76 @@ class PolyModel(TemperatureModel):
         """True when a fitted term uses Ṫ."""
         return any(t.uses_rate for t in self.terms_)
 
-    def _evaluate(self, temps_c: FloatArray, rates: FloatArray | None) -> FloatArray:
-        """``constant + Σ coef_j · term_j`` for a block (temperatures and rates already clamped)."""
-        F = term_features(self.terms_, self.scaling_, temps_c, rates)
-        out: FloatArray = F @ self.coef_ + self.constant_
-        return out
-
     def _rate_sensors(self) -> list[int]:
         return sorted({t.sensor for t in self.terms_ if t.uses_rate})
 
+    def _plan(self) -> EvalPlan:
+        """The :class:`EvalPlan` of the fitted values (cached; rebuilt when they change)."""
+        sc = self.scaling_
+        key = (
+            tuple(self.terms_),
+            self.coef_.tobytes(),
+            float(self.constant_),
+            b"".join(
+                np.asarray(x, dtype=np.float64).tobytes()
+                for x in (
+                    sc.t_center,
+                    sc.t_scale,
+                    sc.rate_center,
+                    sc.rate_scale,
+                    sc.coupling_center,
+                    sc.coupling_scale,
+                )
+            ),
+        )
+        cached = self.__dict__.get("_plan_cache")
+        if cached is not None and cached[0] == key:
+            return cast(EvalPlan, cached[1])
+        plan = build_plan(self.terms_, sc, self.coef_, self.constant_)
+        self.__dict__["_plan_cache"] = (key, plan)
+        return plan
+
     def predict(self, run: RunData, *, extrapolate: bool = False) -> FloatArray:
-        """Temperature-induced signal of every sample [signal unit] (module docstring steps 1–4)."""
+        """Temperature-induced signal of every sample [signal unit] (module docstring steps 1–4).
+
+        Evaluated in blocks of :data:`PREDICT_BLOCK_ROWS` rows (Ṫ partners found per
+        block by :func:`~thermocal.models.terms.backward_partners`; Horner's rule per
+        sensor, :class:`EvalPlan`); the same numbers as :class:`PolyStream`.
+        """
         self.check_fitted()
         self._check_temps(run)
-        temps = self.clamp(run.temps_c, extrapolate=extrapolate)
-        uses_rate = self.model_uses_rate
-        js = self._rate_sensors()
-        rr = self.rate_range_
-        n = run.n_samples
-        out = np.empty(n)
-        seen_lo = np.full(run.temps_c.shape[1], np.inf)
-        seen_hi = np.full(run.temps_c.shape[1], -np.inf)
-        bufs: dict[int, FloatArray] = {}
-        for s0, s1, a, b, _f in run_blocks(run.time_s, 1):
-            rates: FloatArray | None = None
-            if uses_rate:
-                rates = segment_rates(
-                    run.time_s[s0:s1],
-                    run.temps_c[s0:s1],
-                    np.arange(a - s0, b - s0),
-                    float(self.rate_interval_s),
-                    self.rate_method,
-                )
-                np.minimum(seen_lo, rates.min(axis=0), out=seen_lo)
-                np.maximum(seen_hi, rates.max(axis=0), out=seen_hi)
-                if rr is not None and not extrapolate:
-                    for j in js:
-                        np.clip(rates[:, j], rr[j, 0], rr[j, 1], out=rates[:, j])
-            c = b - a
-            if c not in bufs:
-                bufs[c] = np.empty((c, len(self.terms_)), order="F")
-            Tf = np.asfortranarray(temps[a:b])
-            F = term_features(self.terms_, self.scaling_, Tf, rates, out=bufs[c])
-            out[a:b] = F @ self.coef_ + self.constant_
-        if uses_rate and rr is not None:
-            warn_rate_range(seen_lo, seen_hi, rr, self.temp_names_, js, extrapolate=extrapolate)
+        plan = self._plan()
+        k = int(run.temps_c.shape[1])
+        rates: FloatArray | None = None
+        if plan.rate_sensors and self.rate_method != "backward":
+            rates = temperature_rates(
+                run.time_s, run.temps_c, float(self.rate_interval_s), self.rate_method
+            )
+        ev = _BlockEvaluator(self, plan, run, extrapolate=extrapolate, rates=rates)
+        out = np.empty(run.n_samples)
+        seen = ev.run_blocks(ev.blocks(), out)
+        t_min, t_max = seen.temperature(k)
+        warn_temperature_range(
+            t_min,
+            t_max,
+            self.temp_range_,
+            self.temp_names_,
+            seen.n_outside,
+            extrapolate=extrapolate,
+        )
+        if plan.rate_sensors and self.rate_range_ is not None:
+            r_min = np.full(k, np.inf)
+            r_max = np.full(k, -np.inf)
+            rows = list(plan.sensors)
+            r_min[rows], r_max[rows] = seen.rate(len(rows))
+            warn_rate_range(
+                r_min,
+                r_max,
+                self.rate_range_,
+                self.temp_names_,
+                list(plan.rate_sensors),
+                extrapolate=extrapolate,
+            )
         return out
 
     def stream(self, sample_interval_s: float, *, extrapolate: bool = False) -> PolyStream:
@@ -660,67 +1128,121 @@ class PolyModel(TemperatureModel):
 
 
 class PolyStream(ModelStream):
-    """Sample-by-sample :class:`PolyModel` (module docstring steps 1–4).
+    """Sample-by-sample :class:`PolyModel` (module docstring steps 1–4), in plain Python
+    floats: the same operations as :meth:`PolyModel.predict` (:class:`EvalPlan`).
 
     Keeps the samples of the last Δt of the current contiguous segment for the
-    backward rate; a step longer than ``GAP_FACTOR × sample_interval_s`` starts
-    a new segment (rate restarts from 0).  Warns once per stream when a sample
-    leaves the fitted range.
+    backward rate (a ring buffer; the partner is the oldest sample with
+    ``t_j ≥ t − Δt``, as ``searchsorted`` in the batch); a step longer than
+    ``GAP_FACTOR × sample_interval_s`` starts a new segment (rate restarts from 0).
+    Warns once per stream (per kind: temperature, rate) when a sample leaves the
+    fitted range.
     """
 
     def __init__(self, model: PolyModel, sample_interval_s: float, *, extrapolate: bool) -> None:
         if not sample_interval_s > 0:
             raise ThermocalInputError(f"sample interval must be positive, got {sample_interval_s}")
+        plan = model._plan()
         self.model = model
         self.extrapolate = extrapolate
         self.gap_s = GAP_FACTOR * float(sample_interval_s)
         self.interval_s = float(model.rate_interval_s)
-        self.uses_rate = model.model_uses_rate
-        self.t_lo = model.temp_range_[:, 0]
-        self.t_hi = model.temp_range_[:, 1]
+        self.uses_rate = bool(plan.rate_sensors)
+        self._k = int(model.temp_range_.shape[0])
+        self._t_lo: list[float] = [float(v) for v in model.temp_range_[:, 0]]
+        self._t_hi: list[float] = [float(v) for v in model.temp_range_[:, 1]]
+        self._t_bounds = list(zip(range(self._k), self._t_lo, self._t_hi, strict=True))
         rr = model.rate_range_
-        self.r_lo = rr[:, 0] if rr is not None else None
-        self.r_hi = rr[:, 1] if rr is not None else None
-        self.rate_sensors = model._rate_sensors()
+        # (column, lo, hi) of every Ṫ the terms use; ±inf without a fitted rate range
+        self._rate_spec: list[tuple[int, float, float]] = [
+            (j, float(rr[j, 0]), float(rr[j, 1])) if rr is not None else (j, -math.inf, math.inf)
+            for j in plan.rate_sensors
+        ]
+        self._const = plan.constant
+        self._rows = plan.py_rows
         self.reset()
 
     def reset(self) -> None:
-        self._buf: deque[tuple[float, FloatArray]] = deque()
+        self._times: deque[float] = deque()
+        self._hist: deque[list[float]] = deque()
         self._last_t: float | None = None
-        self._warned: set[str] = set()
+        self._warned_t = False
+        self._warned_r = False
 
-    def _warn(self, what: str, msg: str) -> None:
-        if what not in self._warned:
-            self._warned.add(what)
-            warnings.warn(msg, ExtrapolationWarning, stacklevel=3)
+    def _warn(self, what: str) -> None:
+        action = "extrapolating" if self.extrapolate else "clamped to the fitted range"
+        warnings.warn(
+            f"{what} outside the model's fitted range; {action}", ExtrapolationWarning, stacklevel=3
+        )
 
     def update(self, time_s: float, temps_c: FloatArray, signal: float | None = None) -> float:
         t = float(time_s)
-        T = np.asarray(temps_c, dtype=np.float64).reshape(1, -1)
-        rates: FloatArray | None = None
+        if type(temps_c) is np.ndarray and temps_c.dtype == np.float64 and temps_c.ndim == 1:
+            row: list[float] = temps_c.tolist()
+        else:
+            row = np.asarray(temps_c, dtype=np.float64).reshape(-1).tolist()
+        if len(row) != self._k:
+            raise ThermocalInputError(
+                f"poly model uses {self._k} temperature channels; the sample has {len(row)}"
+            )
+        rates = row  # placeholder, replaced when the model uses Ṫ
         if self.uses_rate:
+            times, hist = self._times, self._hist
             if self._last_t is not None and t - self._last_t > self.gap_s:
-                self._buf.clear()
+                times.clear()
+                hist.clear()
             self._last_t = t
-            self._buf.append((t, T[0].copy()))
-            while self._buf[0][0] < t - self.interval_s:
-                self._buf.popleft()
-            t_lo, T_lo = self._buf[0]
-            span = t - t_lo
-            if span > 0:
-                rates = ((T[0] - T_lo) / span * SECONDS_PER_MINUTE).reshape(1, -1)
-            else:
-                rates = np.zeros_like(T)
-        action = "extrapolating" if self.extrapolate else "clamped to the fitted range"
-        if np.any(np.less(T, self.t_lo)) or np.any(np.greater(T, self.t_hi)):
-            self._warn("T", f"temperature outside the model's fitted range; {action}")
-            if not self.extrapolate:
-                T = np.clip(T, self.t_lo, self.t_hi)
-        if rates is not None and self.r_lo is not None and self.r_hi is not None:
-            js = self.rate_sensors
-            if (rates[0, js] < self.r_lo[js]).any() or (rates[0, js] > self.r_hi[js]).any():
-                self._warn("R", f"temperature rate outside the model's fitted range; {action}")
+            times.append(t)
+            hist.append(row)
+            x = t - self.interval_s
+            while times[0] < x:
+                times.popleft()
+                hist.popleft()
+            span = t - times[0]
+            rates = [0.0] * self._k
+            old = hist[0]
+            for j, lo, hi in self._rate_spec:
+                r = (row[j] - old[j]) / span * SECONDS_PER_MINUTE if span > 0 else 0.0
+                if r < lo or r > hi:
+                    if not self._warned_r:
+                        self._warned_r = True
+                        self._warn("temperature rate")
+                    if not self.extrapolate:
+                        r = lo if r < lo else hi
+                rates[j] = r
+        temps = row
+        for j, lo, hi in self._t_bounds:
+            v = row[j]
+            if v < lo or v > hi:
+                if not self._warned_t:
+                    self._warned_t = True
+                    self._warn("temperature")
                 if not self.extrapolate:
-                    rates = rates.copy()
-                    rates[0, js] = np.clip(rates[0, js], self.r_lo[js], self.r_hi[js])
-        return float(self.model._evaluate(T, rates)[0])
+                    if temps is row:
+                        temps = list(row)
+                    temps[j] = lo if v < lo else hi
+        y = self._const
+        for col, tc, rc, wc, polys, mixed in self._rows:
+            temp = temps[col]
+            s: float | None = None
+            for kind, top, rest in polys:
+                if kind == 0:
+                    d = temp - tc
+                elif kind == 1:
+                    d = rates[col] - rc
+                else:
+                    d = temp * rates[col] - wc
+                acc = d * top
+                for cp in rest:
+                    acc = (acc + cp) * d
+                s = acc if s is None else s + acc
+            if s is None:
+                s = 0.0
+            for cf, factors in mixed:
+                ds = [temp - tc, rates[col] - rc, temp * rates[col] - wc]
+                m = ds[factors[0]] * cf
+                for f in factors[1:]:
+                    m = m * ds[f]
+                s = s + m
+            y = y + s
+        return y
