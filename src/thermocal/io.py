@@ -149,9 +149,7 @@ class _ParquetColumns:
         return col
 
 
-def _read_table(
-    path: Path, kind: str
-) -> tuple[pd.DataFrame | _ParquetColumns, dict[str, Any]]:
+def _read_table(path: Path, kind: str) -> tuple[pd.DataFrame | _ParquetColumns, dict[str, Any]]:
     if not path.exists():
         raise FileFormatError(f"{path}: no such file")
     if path.stat().st_size == 0:
