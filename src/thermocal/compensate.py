@@ -59,6 +59,7 @@ from thermocal.io import (
     atomic_write_path,
     check_not_input,
     file_kind,
+    numeric_column,
     sidecar_path,
     write_json,
 )
@@ -599,30 +600,6 @@ def _iter_chunks(path: Path, kind: str, chunk_rows: int) -> Iterator[pd.DataFram
                 yield df
 
 
-def _column(chunk: pd.DataFrame | pa.RecordBatch, name: str, path: Path, row0: int) -> FloatArray:
-    if isinstance(chunk, pa.RecordBatch):
-        col = chunk.column(name)
-        if not (
-            pa.types.is_integer(col.type)
-            or pa.types.is_floating(col.type)
-            or pa.types.is_boolean(col.type)
-        ):
-            raise ThermocalInputError(f"{path}: column {name!r} is not numeric (type {col.type})")
-        return np.asarray(col.to_numpy(zero_copy_only=False), dtype=np.float64)
-    s = chunk[name]
-    if pd.api.types.is_numeric_dtype(s.dtype) and not pd.api.types.is_bool_dtype(s.dtype):
-        return s.to_numpy(dtype=np.float64, na_value=np.nan)
-    conv = pd.to_numeric(s, errors="coerce")
-    bad = conv.isna() & s.notna() & (s.astype(str).str.strip() != "")
-    if bad.any():
-        row = int(np.argmax(bad.to_numpy()))
-        raise ThermocalInputError(
-            f"{path}: non-numeric value {s.iloc[row]!r} in column {name!r} at row {row0 + row} "
-            f"(line {row0 + row + 2} of the file)"
-        )
-    return conv.to_numpy(dtype=np.float64, na_value=np.nan)
-
-
 def _check_finite(arr: FloatArray, label: str, path: Path, row0: int) -> None:
     bad = ~np.isfinite(arr)
     if bad.any():
@@ -808,7 +785,7 @@ def compensate_file(
         try:
             for chunk in _iter_chunks(src, kind_in, chunk_rows):
                 row0 = int(state["rows"])
-                t = _column(chunk, time_col, src, row0) * t_factor
+                t = numeric_column(chunk, time_col, src, row0) * t_factor
                 _check_finite(t, f"time column {time_col!r}", src, row0)
                 dt = np.diff(t)
                 last_t = state["last_t"]
@@ -820,13 +797,13 @@ def compensate_file(
                     raise TimestampError(f"{src}: time does not increase at row {r}")
                 temps = np.empty((t.size, len(temp_names)))
                 for j, c in enumerate(temp_names):
-                    v = _column(chunk, c, src, row0)
+                    v = numeric_column(chunk, c, src, row0)
                     if temp_units[c] == "counts":
                         gain, offset = md.temperature_conversion[c]
                         v = v * gain + offset
                     _check_finite(v, f"temperature column {c!r}", src, row0)
                     temps[:, j] = v
-                raw = _column(chunk, sig_name, src, row0)
+                raw = numeric_column(chunk, sig_name, src, row0)
                 _check_finite(raw, f"signal column {sig_name!r}", src, row0)
                 if factor is None:
                     tau = md.sample_interval_s or (median_interval(t) if t.size > 1 else None)

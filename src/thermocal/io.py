@@ -178,39 +178,57 @@ def _read_table(path: Path, kind: str) -> tuple[pd.DataFrame | _ParquetColumns, 
     return df, {}
 
 
-def _numeric_column(obj: pd.DataFrame | _ParquetColumns, name: str, path: Path) -> FloatArray:
-    """A column as float64; :class:`NonNumericError` names the first bad row."""
+def _arrow_to_f64(col: pa.ChunkedArray | pa.Array, name: str, path: Path) -> FloatArray:
+    """An Arrow column as float64 (copied chunk by chunk into one array)."""
+    if not (pa.types.is_integer(col.type) or pa.types.is_floating(col.type)):
+        if pa.types.is_boolean(col.type) or pa.types.is_decimal(col.type):
+            return np.asarray(col.to_numpy(zero_copy_only=False), dtype=np.float64)
+        raise NonNumericError(f"{path}: column {name!r} is not numeric (type {col.type})")
+    chunks = col.chunks if isinstance(col, pa.ChunkedArray) else [col]
+    if col.null_count == 0 and pa.types.is_float64(col.type):
+        if len(chunks) == 1:
+            return np.asarray(chunks[0].to_numpy(zero_copy_only=False))
+        out = np.empty(len(col), dtype=np.float64)
+        pos = 0
+        for chunk in chunks:
+            n = len(chunk)
+            out[pos : pos + n] = chunk.to_numpy(zero_copy_only=True)
+            pos += n
+        return out
+    return np.asarray(col.to_numpy(zero_copy_only=False), dtype=np.float64)
+
+
+def numeric_column(
+    obj: pd.DataFrame | pa.RecordBatch | _ParquetColumns,
+    name: str,
+    path: str | Path,
+    row_offset: int = 0,
+) -> FloatArray:
+    """A column of a table (or of a chunk of one) as float64.
+
+    Missing cells become NaN.  A cell that is not a number raises
+    :class:`NonNumericError` naming the column and the row (``row_offset`` is the
+    file row of the chunk's first row, for chunked readers).
+    """
+    p = Path(path)
     if isinstance(obj, _ParquetColumns):
         try:
             col = obj.column(name)
         except (pa.ArrowInvalid, OSError) as exc:
-            raise FileFormatError(f"{path}: cannot read column {name!r} ({exc})") from None
-        if not (pa.types.is_integer(col.type) or pa.types.is_floating(col.type)):
-            if pa.types.is_boolean(col.type) or pa.types.is_decimal(col.type):
-                return np.asarray(col.to_numpy(zero_copy_only=False), dtype=np.float64)
-            raise NonNumericError(f"{path}: column {name!r} is not numeric (type {col.type})")
-        if col.null_count == 0 and pa.types.is_float64(col.type):
-            if col.num_chunks == 1:
-                return np.asarray(col.chunk(0).to_numpy(zero_copy_only=False))
-            out = np.empty(len(col), dtype=np.float64)
-            pos = 0
-            for chunk in col.chunks:
-                n = len(chunk)
-                out[pos : pos + n] = chunk.to_numpy(zero_copy_only=True)
-                pos += n
-            return out
-        arr = col.to_numpy(zero_copy_only=False)
-        return np.asarray(arr, dtype=np.float64)
+            raise FileFormatError(f"{p}: cannot read column {name!r} ({exc})") from None
+        return _arrow_to_f64(col, name, p)
+    if isinstance(obj, pa.RecordBatch):
+        return _arrow_to_f64(obj.column(name), name, p)
     series = obj[name]
     if pd.api.types.is_numeric_dtype(series.dtype) and not pd.api.types.is_bool_dtype(series.dtype):
         return series.to_numpy(dtype=np.float64, na_value=np.nan)
     conv = pd.to_numeric(series, errors="coerce")
     bad = conv.isna() & series.notna() & (series.astype(str).str.strip() != "")
     if bad.any():
-        row = int(np.argmax(bad.to_numpy()))
+        row = row_offset + int(np.argmax(bad.to_numpy()))
         raise NonNumericError(
-            f"{path}: non-numeric value {series.iloc[row]!r} in column {name!r} at row {row} "
-            f"(line {row + 2} of the file)"
+            f"{p}: non-numeric value {series.iloc[row - row_offset]!r} in column {name!r} "
+            f"at row {row} (line {row + 2} of the file)"
         )
     return conv.to_numpy(dtype=np.float64, na_value=np.nan)
 
@@ -273,7 +291,7 @@ def read_recording(
         if c not in names:
             raise MissingColumnError(f"{p}: no column {c!r}; available: {available}")
 
-    t = _numeric_column(obj, time_col, p)
+    t = numeric_column(obj, time_col, p)
     if t_unit != "s":
         t = t * units.TIME_UNITS[t_unit]
 
@@ -281,11 +299,11 @@ def read_recording(
     unit_map: dict[str, str] = {}
     extra_units: dict[str, str] = dict(info.get("units") or {})
     for c in sig_names:
-        cols[c] = _numeric_column(obj, c, p)
+        cols[c] = numeric_column(obj, c, p)
         u = signal_unit or sig_info.get(c) or extra_units.get(c) or "deg/h"
         unit_map[c] = units.normalize_signal_unit(u)
     for c in tmp_names:
-        cols[c] = _numeric_column(obj, c, p)
+        cols[c] = numeric_column(obj, c, p)
         u = temp_unit or tmp_info.get(c) or "degC"
         unit_map[c] = units.normalize_temperature_unit(u)
     if keep_other:
@@ -293,7 +311,7 @@ def read_recording(
             if c == time_col or c in cols:
                 continue
             try:
-                cols[c] = _numeric_column(obj, c, p)
+                cols[c] = numeric_column(obj, c, p)
             except NonNumericError:
                 if skipped is not None:
                     skipped.append(c)
