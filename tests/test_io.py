@@ -77,6 +77,18 @@ def test_writer_is_atomic_and_leaves_no_temp(tmp_path: Path) -> None:
     assert [p.name for p in tmp_path.iterdir()] == ["a.csv"]
 
 
+def test_outputs_get_ordinary_permissions(tmp_path: Path) -> None:
+    import os
+    import stat
+
+    mask = os.umask(0o022)
+    try:
+        path = write_recording(_recording(10), tmp_path / "p.parquet")
+    finally:
+        os.umask(mask)
+    assert stat.S_IMODE(path.stat().st_mode) == 0o644
+
+
 def test_time_in_ms_and_counts_temperature(tmp_path: Path) -> None:
     path = tmp_path / "log.csv"
     pd.DataFrame({"t_ms": [0, 20, 40], "g": [1.0, 2, 3], "tc": [800, 801, 802]}).to_csv(

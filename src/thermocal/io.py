@@ -67,6 +67,14 @@ def sidecar_path(path: str | Path) -> Path:
     return p.with_name(p.name + ".meta.json")
 
 
+def _default_mode() -> int:
+    """Permissions of a newly created file under the current umask (``0o666 & ~umask``);
+    ``mkstemp`` would otherwise leave outputs readable by their owner only."""
+    mask = os.umask(0)
+    os.umask(mask)
+    return 0o666 & ~mask
+
+
 @contextlib.contextmanager
 def atomic_write(path: str | Path, mode: str = "wb") -> Iterator[Any]:
     """Open a temporary file beside ``path``; rename it over ``path`` on success.
@@ -79,6 +87,7 @@ def atomic_write(path: str | Path, mode: str = "wb") -> Iterator[Any]:
     try:
         with os.fdopen(fd, mode) as fh:
             yield fh
+        os.chmod(tmp, _default_mode())
         os.replace(tmp, target)
     except BaseException:
         with contextlib.suppress(OSError):
@@ -95,6 +104,7 @@ def atomic_write_path(path: str | Path, writer: Callable[[Path], None]) -> None:
     os.close(fd)
     try:
         writer(Path(tmp))
+        os.chmod(tmp, _default_mode())
         os.replace(tmp, target)
     except BaseException:
         with contextlib.suppress(OSError):
