@@ -277,3 +277,27 @@ def test_plot_writes_png(tmp_path: Path) -> None:
     res = allan.overlapping_adev(rng.standard_normal(4096), 1.0)
     out = plot_allan(res, allan.noise_terms(res), tmp_path / "adev.png")
     assert out.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_slope_line_is_not_read_off_the_wrong_region() -> None:
+    """A high-passed (compensated-like) white noise falls with slope ≈ −1 at long τ.
+
+    Read naively, that region gives a 'quantization' whose line lies two orders of
+    magnitude above the measured curve at τ = 1 s; the slope method must refuse it
+    (null with a reason) while the ARW is still read correctly.
+    """
+    from thermocal import preprocess
+
+    rng = np.random.default_rng(5)
+    w = rng.normal(0.0, 1.0, 2**18)  # white rate noise, 1 °/h per 1-s sample → N = 1 °/h·√s
+    y = w - preprocess.lowpass_first_order(w, 1.0, time_constant_s=3000.0)
+    res = allan.overlapping_adev(y, 1.0)
+    slopes = np.diff(np.log(res.adev)) / np.diff(np.log(res.tau_s))
+    assert slopes[-3:].max() < -0.75  # the steep fall exists
+    terms = allan.noise_terms(res)
+    q = terms.slope.quantization
+    assert q.value is None
+    assert q.reason is not None and "not this noise term" in q.reason
+    arw = terms.slope.angle_random_walk
+    assert arw.value is not None
+    assert arw.value == pytest.approx(1.0 / 60.0, rel=0.05)  # 1 °/h·√s = 1/60 °/√h

@@ -106,6 +106,10 @@ _SLOPE_TOLERANCE: Final = 0.25
 _LOCAL_WINDOW: Final = 4.0
 """Local slope fitted over τ*/4 … 4τ* around the tangent point."""
 
+_LINE_TOLERANCE: Final = math.log(1.25)
+"""A slope line may exceed the curve's upper confidence bound by at most 25 % before it
+is rejected as read off the wrong region (:func:`_read_slope`)."""
+
 _CHUNK: Final = 1 << 18
 """Block length of the fused second-difference loop (three 2 MiB blocks stay in cache)."""
 
@@ -645,6 +649,19 @@ def _read_slope(
         idx = idx[np.abs(lt[idx] - lt[k]) <= math.log(2.0) + 1e-12]
     intercept = float(np.average(g[idx], weights=edf[idx]))
     best = int(idx[np.argmax(edf[idx])])
+    # Every term's line lies below the whole curve (σ² is a sum of positive terms): a
+    # line above the curve's upper confidence bound anywhere was read off a region that
+    # belongs to something else (e.g. the steep fall of a detrended curve's last points).
+    line = intercept + s * lt
+    upper = ld + np.log(np.maximum(hi_ratio, 1.0))
+    above = np.flatnonzero(line > upper + _LINE_TOLERANCE)
+    if above.size:
+        w = int(above[np.argmax(line[above] - upper[above])])
+        return (
+            f"the slope {s:+g} region near τ = {tau[k]:.4g} s is not this noise term: its "
+            f"line would lie {math.exp(line[w] - ld[w]):.3g}× above the measured curve at "
+            f"τ = {tau[w]:.4g} s"
+        )
     if j == 2:
         val = math.exp(intercept) / BIAS_INSTABILITY_FACTOR
     else:
