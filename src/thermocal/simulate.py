@@ -1055,7 +1055,7 @@ def scenario_rlg_modelling(
     preset: str = "rlg",
 ) -> ScenarioResult:
     """Seed-000 modelling run of the ``rlg`` preset over the ``rlg-modelling`` profile
-    (≈ 57 h at 1 Hz by default); powered on at t = 0, soaked at the start temperature."""
+    (≈ 65 h at 1 Hz by default); powered on at t = 0, soaked at the start temperature."""
     p = get_preset(preset)
     program, stages = _program(profile, "rlg-modelling")
     rng = scenario_rng("rlg-modelling", seed, 1)[0]
