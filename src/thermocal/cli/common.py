@@ -161,6 +161,8 @@ def _show_warnings(caught: list[warnings.WarningMessage]) -> None:
         seen.add(msg)
         if issubclass(w.category, ThermocalWarning):
             print(f"warning: {msg}", file=sys.stderr)
+        elif issubclass(w.category, RuntimeWarning):  # numerical trouble: never hidden
+            print(f"warning: {w.category.__name__}: {msg}", file=sys.stderr)
 
 
 # --- output -------------------------------------------------------------------------------
