@@ -102,10 +102,16 @@ class CExport:
 
     def write(self, directory: str | Path) -> list[Path]:
         """Write header and source into ``directory`` (atomically); returns the paths."""
+        from thermocal.errors import ThermocalInputError
         from thermocal.io import atomic_write
 
         d = Path(directory)
-        d.mkdir(parents=True, exist_ok=True)
+        if d.exists() and not d.is_dir():
+            raise ThermocalInputError(f"{d}: exists and is not a directory (-o names a directory)")
+        try:
+            d.mkdir(parents=True, exist_ok=True)
+        except (FileExistsError, NotADirectoryError):
+            raise ThermocalInputError(f"{d}: cannot create the output directory") from None
         out = []
         for name, text in ((self.header_name, self.header), (self.source_name, self.source)):
             with atomic_write(d / name, "w") as fh:

@@ -75,14 +75,28 @@ def _default_mode() -> int:
     return 0o666 & ~mask
 
 
+def _writable_target(path: str | Path) -> Path:
+    """``path`` as a Path, its directory created; an existing directory there is an
+    input error (not an ``IsADirectoryError`` naming the temporary file)."""
+    target = Path(path)
+    if target.is_dir():
+        raise ThermocalInputError(f"{path}: is a directory, expected a file name")
+    try:
+        target.parent.mkdir(parents=True, exist_ok=True)
+    except (FileExistsError, NotADirectoryError):
+        raise ThermocalInputError(
+            f"{path}: cannot create the output, {target.parent} is not a directory"
+        ) from None
+    return target
+
+
 @contextlib.contextmanager
 def atomic_write(path: str | Path, mode: str = "wb") -> Iterator[Any]:
     """Open a temporary file beside ``path``; rename it over ``path`` on success.
 
     On any exception the temporary file is removed and ``path`` is untouched.
     """
-    target = Path(path)
-    target.parent.mkdir(parents=True, exist_ok=True)
+    target = _writable_target(path)
     fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=target.parent)
     try:
         with os.fdopen(fd, mode) as fh:
@@ -98,8 +112,7 @@ def atomic_write(path: str | Path, mode: str = "wb") -> Iterator[Any]:
 def atomic_write_path(path: str | Path, writer: Callable[[Path], None]) -> None:
     """Call ``writer(tmp_path)`` then rename ``tmp_path`` over ``path`` (for libraries
     that want a path, not a file object)."""
-    target = Path(path)
-    target.parent.mkdir(parents=True, exist_ok=True)
+    target = _writable_target(path)
     fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=target.parent)
     os.close(fd)
     try:
@@ -120,11 +133,16 @@ def write_json(path: str | Path, obj: Any) -> None:
 
 
 def check_not_input(out: str | Path, inputs: list[str | Path]) -> None:
-    """Refuse to write an output over one of the inputs (INTERFACE.md common rules)."""
+    """Refuse to write an output over one of the inputs or over an input's sidecar
+    ``FILE.meta.json`` (INTERFACE.md common rules)."""
     o = Path(out).resolve()
     for i in inputs:
         if Path(i).resolve() == o:
             raise ThermocalInputError(f"{out}: refusing to write over the input file {i}")
+        if sidecar_path(Path(i).resolve()) == o:
+            raise ThermocalInputError(
+                f"{out}: refusing to write over the metadata sidecar of the input file {i}"
+            )
 
 
 # --- reading -------------------------------------------------------------------------

@@ -480,8 +480,8 @@ def check_program(time_s: npt.ArrayLike, setpoint_c: npt.ArrayLike, what: str = 
     back = np.flatnonzero(np.diff(t) <= 0)
     if back.size:
         raise TimestampError(
-            f"{what}: time must increase strictly; row {back[0] + 1} ({t[back[0] + 1]!r}) "
-            f"follows {t[back[0]]!r}"
+            f"{what}: time must increase strictly; row {back[0] + 1} ({float(t[back[0] + 1])!r}) "
+            f"follows {float(t[back[0]])!r}"
         )
 
 
@@ -527,7 +527,7 @@ def read_program(path: str | Path) -> tuple[FloatArray, FloatArray]:
         bad = np.flatnonzero(vals.isna().to_numpy())
         if bad.size:
             raise NonNumericError(
-                f"{p}: missing or non-numeric value {df[col].iloc[bad[0]]!r} in column "
+                f"{p}: missing or non-numeric value {str(df[col].iloc[bad[0]])!r} in column "
                 f"{col!r} at row {bad[0]} (line {bad[0] + 2})"
             )
         out.append(vals.to_numpy(dtype=np.float64))

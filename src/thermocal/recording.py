@@ -409,7 +409,7 @@ def find_problems(rec: Recording, required: list[str] | None = None) -> list[Pro
             probs.append(
                 Problem(
                     "duplicate_time",
-                    f"duplicate timestamp {t[dup[0] + 1]!r} at row {dup[0] + 1} "
+                    f"duplicate timestamp {float(t[dup[0] + 1])!r} at row {dup[0] + 1} "
                     f"({dup.size} duplicates in all)",
                     column="time",
                     row=int(dup[0] + 1),
@@ -419,14 +419,14 @@ def find_problems(rec: Recording, required: list[str] | None = None) -> list[Pro
             probs.append(
                 Problem(
                     "backwards_time",
-                    f"time goes backwards at row {back[0] + 1} ({t[back[0]]!r} → "
-                    f"{t[back[0] + 1]!r}; {back.size} backward steps in all)",
+                    f"time goes backwards at row {back[0] + 1} ({float(t[back[0]])!r} → "
+                    f"{float(t[back[0] + 1])!r}; {back.size} backward steps in all)",
                     column="time",
                     row=int(back[0] + 1),
                 )
             )
     for name, arr in rec.columns.items():
-        nan = np.isnan(arr)
+        nan = ~np.isfinite(arr)
         n_nan = int(np.count_nonzero(nan))
         if n_nan:
             first = int(np.argmax(nan))
@@ -436,7 +436,7 @@ def find_problems(rec: Recording, required: list[str] | None = None) -> list[Pro
             probs.append(
                 Problem(
                     "nan",
-                    f"column {name!r} has {n_nan} NaN/empty values, first at row {first}",
+                    f"column {name!r} has {n_nan} NaN/empty/infinite values, first at row {first}",
                     severity=sev,
                     column=name,
                     row=first,

@@ -28,7 +28,7 @@ import typer
 from rich.console import Console
 from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
 
-from thermocal.errors import ThermocalInputError, ThermocalWarning
+from thermocal.errors import GapWarning, ThermocalInputError, ThermocalWarning
 from thermocal.io import read_recording
 from thermocal.recording import Metadata, Recording
 
@@ -83,12 +83,17 @@ def load_recording(
     temp_unit: str | None = None,
     meta: Metadata | None = None,
     require_signal: bool = True,
+    check: bool = True,
 ) -> Recording:
     """Read a recording with the command line's options (options win over the file).
 
     A signal named with ``--signal`` becomes the first signal; without it the
     file's sidecar roles are used.  With ``require_signal`` a recording with no
-    signal at all is an input error.
+    signal at all is an input error.  With ``check`` (INTERFACE.md common rules)
+    the time column must be finite and strictly increasing and the signal and
+    temperature columns free of NaN (:meth:`Recording.validate`, an input error
+    naming the file, column and row); gaps are allowed and reported as one
+    :class:`GapWarning`.
     """
     rec = read_recording(
         path,
@@ -105,6 +110,18 @@ def load_recording(
             f"{path}: name the signal column with --signal; available: "
             + ", ".join(repr(c) for c in rec.columns)
         )
+    if check:
+        rec.validate()
+        gaps = rec.gaps()
+        if gaps:
+            total = sum(g.length_s for g in gaps)
+            warnings.warn(
+                GapWarning(
+                    f"{path}: {len(gaps)} gaps in time ({total:.6g} s in all), first after "
+                    f"row {gaps[0].index} at {gaps[0].start_s:.6g} s"
+                ),
+                stacklevel=2,
+            )
     return rec
 
 

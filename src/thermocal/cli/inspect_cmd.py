@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import re
+import sys
 from typing import Annotated
 
 import typer
@@ -19,6 +20,7 @@ from thermocal.cli.common import (
     emit,
     fmt,
     handle_errors,
+    one_line,
     split_names,
     stdout,
 )
@@ -80,7 +82,10 @@ def inspect_cmd(
             )
         )
     emit(result.to_dict(), as_json, lambda: _print_human(result))
-    if strict and any(p.severity == "error" for p in result.problems):
+    errors = [p for p in result.problems if p.severity == "error"]
+    if strict and errors:
+        more = f" ({len(errors) - 1} more errors)" if len(errors) > 1 else ""
+        print(f"error: {file}: {one_line(errors[0].message)}{more}", file=sys.stderr)
         raise typer.Exit(2)
 
 

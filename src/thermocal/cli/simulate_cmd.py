@@ -18,6 +18,7 @@ Output naming:
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 from typing import Annotated, Any
 
@@ -104,6 +105,10 @@ def simulate_cmd(
         raise ThermocalInputError(
             f"unknown scenario {scenario!r}; known scenarios: {', '.join(SCENARIOS)}"
         )
+    if rate_hz is not None and not (math.isfinite(rate_hz) and rate_hz > 0):
+        raise ThermocalInputError(f"--rate-hz must be a positive number, got {rate_hz!r}")
+    if latitude is not None and not (math.isfinite(latitude) and abs(latitude) <= 90.0):
+        raise ThermocalInputError(f"--latitude must be within ±90°, got {latitude!r}")
     prog = None
     if profile is not None:
         prog = read_program(profile)

@@ -28,8 +28,10 @@ from thermocal.cli.common import (
     stdout,
 )
 from thermocal.compensate import unit_factor
+from thermocal.errors import ThermocalInputError
 from thermocal.io import read_recording
 from thermocal.models.base import RunData, TemperatureModel, load_model
+from thermocal.recording import find_problems
 from thermocal.validation import DEFAULT_AVERAGING_S, validate
 
 ModelArg = Annotated[
@@ -133,6 +135,9 @@ def validate_cmd(
     modeling_ambient = None
     if mod_path is not None:
         mrec = read_recording(mod_path, time=time, time_unit=time_unit, temperatures=[amb])
+        for prob in find_problems(mrec, required=[amb]):
+            if prob.severity == "error" and (prob.column in (None, "time", amb)):
+                raise ThermocalInputError(f"{mod_path}: {prob.message}")
         modeling_ambient = (mrec.time_s, mrec.temperature_c(amb))
     res = validate(
         model,

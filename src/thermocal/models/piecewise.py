@@ -84,6 +84,9 @@ METHODS = ("intersect", "continuous")
 N_BINS = 400
 """Temperature bins (per run) for the breakpoint search."""
 
+MIN_SEGMENT_SAMPLES = 2
+"""Fewest samples a segment may hold (a line needs two points)."""
+
 
 def segment_index(breakpoints: FloatArray, temp_c: FloatArray) -> npt.NDArray[np.intp]:
     """Segment of each temperature: the number of breakpoints ``≤ T`` (eq. 1)."""
@@ -151,6 +154,13 @@ def choose_breakpoints(
     Z = np.zeros((X.size, groups))
     Z[np.arange(X.size), G] = 1.0
     xc = (X - lo) / (hi - lo)
+    sorted_x = np.sort(allx)
+
+    def supported(bps_c: Sequence[float]) -> bool:
+        # every segment keeps >= MIN_SEGMENT_SAMPLES samples (segment_index convention)
+        below = np.searchsorted(sorted_x, lo + np.asarray(bps_c) * (hi - lo), side="left")
+        counts = np.diff(np.concatenate([[0], below, [sorted_x.size]]))
+        return bool(np.all(counts >= MIN_SEGMENT_SAMPLES))
 
     def rss(bps_c: Sequence[float]) -> float:
         cols = [Z, xc[:, None]] + [np.maximum(0.0, xc - b)[:, None] for b in bps_c]
@@ -163,6 +173,12 @@ def choose_breakpoints(
     cand = np.unique((qx - lo) / (hi - lo))
     start = np.quantile(allx, np.linspace(0, 1, n_segments + 1)[1:-1])
     cur = list((start - lo) / (hi - lo))
+    if not supported(cur):
+        raise DesignError(
+            f"{n_segments} segments need at least {MIN_SEGMENT_SAMPLES} samples each over "
+            f"distinct temperatures; the data ({allx.size} samples, {lo:.4g}…{hi:.4g} °C) "
+            "do not support that many (use fewer --segments)"
+        )
     best = rss(cur)
     for _sweep in range(10):
         changed = False
@@ -173,6 +189,8 @@ def choose_breakpoints(
                 if not left < c < right:
                     continue
                 trial = [*cur[:j], float(c), *cur[j + 1 :]]
+                if not supported(trial):
+                    continue
                 v = rss(trial)
                 if v < best - 1e-12 * abs(best):
                     best, cur, changed = v, trial, True
@@ -181,8 +199,10 @@ def choose_breakpoints(
 
     def penalised(v: FloatArray) -> float:
         s = list(v)
-        if any(b <= 0.0 or b >= 1.0 for b in s) or any(
-            b2 <= b1 for b1, b2 in itertools.pairwise(s)
+        if (
+            any(b <= 0.0 or b >= 1.0 for b in s)
+            or any(b2 <= b1 for b1, b2 in itertools.pairwise(s))
+            or not supported(s)
         ):
             return best * 10.0 + 1.0
         return rss(s)
