@@ -93,3 +93,69 @@ def test_usage_error_is_one_line(capsys: pytest.CaptureFixture[str]) -> None:
     code, _, err = _run(capsys, "inspect")
     assert code == 2
     assert err.strip().startswith("error: ") and len(err.strip().splitlines()) == 1
+
+
+def test_temp_conversion_option_for_raw_counts(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Raw ADC temperatures without metadata: --temp-conversion GAIN,OFFSET converts them,
+    and fit + compensate on counts give exactly what the same data in °C give."""
+    import numpy as np
+
+    df = make_tvac_log()
+    raw = tmp_path / "raw.csv"
+    df.to_csv(raw, index=False)  # no sidecar: nothing says how to convert the counts
+    common = ["--time", "time_ms", "--time-unit", "ms", "--temps", "temp_counts"]
+    code, out, _ = _run(
+        capsys, "inspect", str(raw), *common, "--temp-unit", "counts",
+        "--temp-conversion", "0.0625,-50", "--json",
+    )  # fmt: skip
+    assert code == 0
+    span = json.loads(out)["temperature_span"]["temp_counts"]
+    counts = df["temp_counts"].to_numpy()
+    assert_allclose(span, [counts.min() * 0.0625 - 50, counts.max() * 0.0625 - 50])
+
+    # the same data with the temperature already in °C
+    deg = tmp_path / "deg.csv"
+    df_c = df.assign(temp_counts=counts * 0.0625 - 50.0)
+    df_c.to_csv(deg, index=False)
+    sig = ["--signal", "gyro deg/h"]
+    for path, extra, model in [
+        (raw, ["--temp-unit", "counts", "--temp-conversion", "0.0625,-50"], "m_raw.json"),
+        (deg, [], "m_deg.json"),
+    ]:
+        code, _, err = _run(
+            capsys, "fit", str(path), "--model", "poly", "--order", "1", *common, *sig,
+            *extra, "-o", str(tmp_path / model),
+        )  # fmt: skip
+        assert code == 0, err
+    outs = {}
+    for path, extra, model in [
+        (raw, ["--temp-unit", "counts", "--temp-conversion", "0.0625,-50"], "m_raw.json"),
+        (deg, [], "m_deg.json"),
+    ]:
+        dst = tmp_path / f"comp_{model}.csv"
+        code, _, err = _run(
+            capsys, "compensate", str(tmp_path / model), str(path), "--time", "time_ms",
+            "--time-unit", "ms", *extra, "-o", str(dst),
+        )  # fmt: skip
+        assert code == 0, err
+        outs[model] = pd.read_csv(dst)["gyro deg/h_comp"].to_numpy()
+    assert_allclose(outs["m_raw.json"], outs["m_deg.json"], rtol=0, atol=1e-9)
+    # 0.01 °/h/°C recovered from the counts
+    coef = json.loads((tmp_path / "m_raw.json").read_text())["coefficients"]
+    slope = next(c["value"] for c in coef if c["name"] != "const")
+    assert slope == pytest.approx(0.01, abs=1e-3)
+    assert np.isfinite(outs["m_raw.json"]).all()
+
+
+def test_temp_conversion_option_refuses_garbage(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    path = tmp_path / "x.csv"
+    path.write_text("time,g,tc\n0,1,800\n1,2,801\n2,3,802\n")
+    code, _, err = _run(
+        capsys, "inspect", str(path), "--temps", "tc", "--temp-conversion", "0.0625"
+    )
+    assert code == 2
+    assert err.startswith("error: --temp-conversion takes 'GAIN,OFFSET'")

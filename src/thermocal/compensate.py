@@ -685,6 +685,7 @@ def compensate_file(
     extrapolate: bool = False,
     known_input: float = 0.0,
     on_progress: Callable[[int], None] | None = None,
+    temperature_conversion: tuple[float, float] | None = None,
 ) -> CompensateFileResult:
     """Compensate a CSV/Parquet file into ``out`` with constant memory.
 
@@ -698,7 +699,9 @@ def compensate_file(
 
     Chunks are predicted with their context (:class:`ChunkPredictor`), so the
     result equals an in-memory ``predict`` of the whole file.  ``known_input``
-    [model unit] is what :class:`StreamingCompensator` says.
+    [model unit] is what :class:`StreamingCompensator` says.  ``temperature_conversion``
+    ``(gain, offset)`` converts raw-count temperatures (``T = gain·counts + offset``),
+    overriding the file's metadata.
 
     Raises
     ------
@@ -749,6 +752,8 @@ def compensate_file(
         signal_unit or sig_info.get(sig_name) or extra_units.get(sig_name) or model.signal_unit
     )
     md = Metadata.from_dict(dict(info.get("metadata") or {}))
+    if temperature_conversion is not None:  # (gain, offset) for every model temperature
+        md.temperature_conversion.update(dict.fromkeys(temp_names, temperature_conversion))
     temp_units = {
         c: units.normalize_temperature_unit(temp_unit or tmp_info.get(c) or "degC")
         for c in temp_names

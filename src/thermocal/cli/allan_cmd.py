@@ -16,6 +16,7 @@ from thermocal.cli.common import (
     JsonOpt,
     SignalOpt,
     SignalUnitOpt,
+    TempConversionOpt,
     TempUnitOpt,
     TimeUnitOpt,
     emit,
@@ -88,6 +89,7 @@ def allan_cmd(
     time_unit: TimeUnitOpt = "s",
     signal_unit: SignalUnitOpt = None,
     temp_unit: TempUnitOpt = None,
+    temp_conversion: TempConversionOpt = None,
     temps: Annotated[str | None, typer.Option("--temps", hidden=True)] = None,
     as_json: JsonOpt = False,
 ) -> None:
@@ -103,6 +105,7 @@ def allan_cmd(
         temps=temps,
         signal_unit=signal_unit,
         temp_unit=temp_unit,
+        temp_conversion=temp_conversion,
     )
     if plot is not None:
         check_not_input(plot, [file])

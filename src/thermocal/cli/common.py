@@ -60,6 +60,14 @@ SignalUnitOpt = Annotated[
 TempUnitOpt = Annotated[
     str | None, typer.Option("--temp-unit", help="Temperature unit: degC or counts.")
 ]
+TempConversionOpt = Annotated[
+    str | None,
+    typer.Option(
+        "--temp-conversion",
+        help="Raw-count temperatures: 'GAIN,OFFSET' with T[°C] = GAIN·counts + OFFSET, "
+        "for every temperature column (overrides the file's metadata).",
+    ),
+]
 JsonOpt = Annotated[bool, typer.Option("--json", help="Print one JSON object on stdout.")]
 OutOpt = Annotated[Path, typer.Option("-o", "--output", help="Output file.")]
 
@@ -70,6 +78,22 @@ def split_names(text: str | None) -> list[str] | None:
         return None
     names = [t.strip() for t in text.split(",")]
     return [n for n in names if n]
+
+
+def parse_temp_conversion(text: str) -> tuple[float, float]:
+    """``"0.0625,-50"`` → ``(0.0625, -50.0)``: gain [°C/count] and offset [°C]."""
+    parts = [p.strip() for p in text.split(",")]
+    try:
+        gain, offset = (float(p) for p in parts)
+    except ValueError:
+        raise ThermocalInputError(
+            f"--temp-conversion takes 'GAIN,OFFSET' (T[°C] = GAIN·counts + OFFSET), got {text!r}"
+        ) from None
+    if not (math.isfinite(gain) and math.isfinite(offset)) or gain == 0.0:
+        raise ThermocalInputError(
+            f"--temp-conversion gain must be finite and non-zero, offset finite; got {text!r}"
+        )
+    return gain, offset
 
 
 def load_recording(
@@ -84,6 +108,7 @@ def load_recording(
     meta: Metadata | None = None,
     require_signal: bool = True,
     check: bool = True,
+    temp_conversion: str | None = None,
 ) -> Recording:
     """Read a recording with the command line's options (options win over the file).
 
@@ -93,7 +118,8 @@ def load_recording(
     the time column must be finite and strictly increasing and the signal and
     temperature columns free of NaN (:meth:`Recording.validate`, an input error
     naming the file, column and row); gaps are allowed and reported as one
-    :class:`GapWarning`.
+    :class:`GapWarning`.  ``temp_conversion`` (``"GAIN,OFFSET"``) sets the raw-count
+    conversion ``T[°C] = GAIN·counts + OFFSET`` of every temperature column.
     """
     rec = read_recording(
         path,
@@ -105,6 +131,10 @@ def load_recording(
         temp_unit=temp_unit,
         meta=meta,
     )
+    if temp_conversion is not None:
+        conv = parse_temp_conversion(temp_conversion)
+        for name in rec.temperatures:
+            rec.meta.temperature_conversion[name] = conv
     if require_signal and not rec.signals:
         raise ThermocalInputError(
             f"{path}: name the signal column with --signal; available: "

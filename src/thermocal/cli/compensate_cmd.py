@@ -19,10 +19,12 @@ from thermocal.cli.common import (
     JsonOpt,
     OutOpt,
     SignalUnitOpt,
+    TempConversionOpt,
     TempUnitOpt,
     emit,
     fmt,
     handle_errors,
+    parse_temp_conversion,
     progress,
     stdout,
 )
@@ -50,6 +52,7 @@ def compensate_cmd(
     ] = None,
     signal_unit: SignalUnitOpt = None,
     temp_unit: TempUnitOpt = None,
+    temp_conversion: TempConversionOpt = None,
     extrapolate: Annotated[
         bool,
         typer.Option(
@@ -82,6 +85,9 @@ def compensate_cmd(
             time_unit=time_unit,
             signal_unit=signal_unit,
             temp_unit=temp_unit,
+            temperature_conversion=(
+                parse_temp_conversion(temp_conversion) if temp_conversion is not None else None
+            ),
             chunk_rows=chunk_rows,
             extrapolate=extrapolate,
             known_input=known_input,

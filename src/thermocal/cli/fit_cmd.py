@@ -60,6 +60,7 @@ from thermocal.cli.app import app
 from thermocal.cli.common import (
     JsonOpt,
     SignalUnitOpt,
+    TempConversionOpt,
     TempUnitOpt,
     emit,
     fmt,
@@ -133,6 +134,7 @@ def fit_cmd(
     time_unit: Annotated[str | None, typer.Option("--time-unit", help="s, ms or us.")] = None,
     signal_unit: SignalUnitOpt = None,
     temp_unit: TempUnitOpt = None,
+    temp_conversion: TempConversionOpt = None,
     # poly
     terms: Annotated[
         str | None, typer.Option("--terms", help='poly: "seed000" or "T1,T1^2,dT1,T1*dT1,...".')
@@ -260,6 +262,7 @@ def fit_cmd(
             temps=temps,
             signal_unit=signal_unit,
             temp_unit=temp_unit,
+            temp_conversion=temp_conversion,
         )
         _values, run_unit = rec.signal(signal)
         sig_name = signal or rec.signals[0]

@@ -14,6 +14,7 @@ from thermocal.cli.common import (
     FileArg,
     JsonOpt,
     SignalUnitOpt,
+    TempConversionOpt,
     TempsOpt,
     TempUnitOpt,
     TimeUnitOpt,
@@ -21,6 +22,7 @@ from thermocal.cli.common import (
     fmt,
     handle_errors,
     one_line,
+    parse_temp_conversion,
     split_names,
     stdout,
 )
@@ -43,6 +45,7 @@ def inspect_cmd(
     temps: TempsOpt = None,
     signal_unit: SignalUnitOpt = None,
     temp_unit: TempUnitOpt = None,
+    temp_conversion: TempConversionOpt = None,
     strict: Annotated[
         bool, typer.Option("--strict", help="Exit with status 2 when an error is found.")
     ] = False,
@@ -71,6 +74,10 @@ def inspect_cmd(
             rec.units.setdefault(c, temp_unit or "degC")
             if not rec.units[c]:
                 rec.units[c] = temp_unit or "degC"
+    if temp_conversion is not None:
+        conv = parse_temp_conversion(temp_conversion)
+        for c in rec.temperatures:
+            rec.meta.temperature_conversion[c] = conv
     result = inspect_recording(rec)
     for c in skipped:
         result.problems.append(

@@ -14,6 +14,7 @@ from thermocal.cli.common import (
     JsonOpt,
     SignalOpt,
     SignalUnitOpt,
+    TempConversionOpt,
     TempsOpt,
     TempUnitOpt,
     TimeUnitOpt,
@@ -83,6 +84,7 @@ def metrics_cmd(
     time_unit: TimeUnitOpt = "s",
     signal_unit: SignalUnitOpt = None,
     temp_unit: TempUnitOpt = None,
+    temp_conversion: TempConversionOpt = None,
     as_json: JsonOpt = False,
 ) -> None:
     """Figures of merit: bias (earth rate removed with --latitude and --axis), bias
@@ -97,6 +99,7 @@ def metrics_cmd(
         temps=temps,
         signal_unit=signal_unit,
         temp_unit=temp_unit,
+        temp_conversion=temp_conversion,
     )
     res = compute_metrics(
         rec,

@@ -20,6 +20,7 @@ from thermocal.cli.common import (
     FileArg,
     JsonOpt,
     SignalUnitOpt,
+    TempConversionOpt,
     TempUnitOpt,
     emit,
     fmt,
@@ -86,6 +87,7 @@ def validate_cmd(
     ] = None,
     signal_unit: SignalUnitOpt = None,
     temp_unit: TempUnitOpt = None,
+    temp_conversion: TempConversionOpt = None,
     stage_rate: Annotated[
         float,
         typer.Option("--stage-rate", help="Hold detection: |dT/dt| below this [°C/min]."),
@@ -116,6 +118,7 @@ def validate_cmd(
         temps=",".join(read_temps),
         signal_unit=signal_unit,
         temp_unit=temp_unit,
+        temp_conversion=temp_conversion,
     )
     run = RunData.from_recording(rec, sig, temps)
     data_unit = rec.signal(sig)[1]
