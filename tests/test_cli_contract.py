@@ -261,3 +261,38 @@ def test_profile_backwards_time_message_is_plain(
     )
     _assert_input_error(code, out, err, "prog.csv", "row 2", "(10.0)")
     assert not out_path.exists()
+
+
+def test_compensate_refuses_a_sidecar_over_the_model_file(
+    model: Path, good: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``-o OUT.csv`` writes ``OUT.csv.meta.json``; if that is the model file, refuse."""
+    trap = tmp_path / "out.csv.meta.json"
+    trap.write_bytes(model.read_bytes())
+    before = trap.read_bytes()
+    code, out, err = _run(
+        capsys, "compensate", str(trap), str(good), "-o", str(tmp_path / "out.csv")
+    )
+    _assert_input_error(code, out, err, "refusing to write over the input")
+    assert trap.read_bytes() == before
+    assert not (tmp_path / "out.csv").exists()
+
+
+@pytest.mark.parametrize(
+    ("args", "needle"),
+    [
+        (["profile", "fog-slow", "-o", "{d}/prog.xlsx"], "name it *.csv"),
+        (["allan", "{good}", "--signal", "gyro", "--plot", "{d}/plot.txt"], "name it *.png"),
+    ],
+)
+def test_output_extension_matches_what_is_written(
+    good: Path,
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+    args: list[str],
+    needle: str,
+) -> None:
+    filled = [a.format(d=tmp_path, good=good) for a in args]
+    code, out, err = _run(capsys, *filled)
+    _assert_input_error(code, out, err, needle)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["good.csv"]

@@ -495,6 +495,8 @@ def write_program(path: str | Path, time_s: npt.ArrayLike, setpoint_c: npt.Array
     c = np.asarray(setpoint_c, dtype=np.float64)
     check_program(t, c, str(path))
     p = Path(path)
+    if p.suffix.lower() != ".csv":
+        raise ThermocalInputError(f"{p}: a chamber program is written as CSV; name it *.csv")
     df = pd.DataFrame({PROGRAM_TIME: t, PROGRAM_SETPOINT: c})
     with atomic_write(p, "w") as fh:
         df.to_csv(fh, index=False, float_format="%.10g", lineterminator="\n")

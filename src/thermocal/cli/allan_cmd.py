@@ -109,6 +109,10 @@ def allan_cmd(
     )
     if plot is not None:
         check_not_input(plot, [file])
+        if plot.is_dir():
+            raise ThermocalInputError(f"{plot}: is a directory, expected a file name")
+        if plot.suffix.lower() not in (".png", ".svg", ".pdf"):
+            raise ThermocalInputError(f"{plot}: --plot writes PNG, SVG or PDF; name it *.png")
     values, unit = rec.signal(signal)
     tau_spec: Any = taus
     if taus not in ("octave", "decade", "log"):

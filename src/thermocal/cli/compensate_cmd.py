@@ -29,6 +29,7 @@ from thermocal.cli.common import (
     stdout,
 )
 from thermocal.compensate import DEFAULT_CHUNK_ROWS, compensate_file
+from thermocal.io import check_not_input, file_kind, sidecar_path
 from thermocal.models.base import load_model
 
 ModelArg = Annotated[
@@ -74,6 +75,9 @@ def compensate_cmd(
     as_json: JsonOpt = False,
 ) -> None:
     """Apply MODEL to FILE; OUT gets every input column plus <signal>_model and <signal>_comp."""
+    check_not_input(output, [file, model_file])
+    if file_kind(output) == "csv":  # the CSV's sidecar must not land on an input either
+        check_not_input(sidecar_path(output), [file, model_file])
     model = load_model(model_file)
     with progress("compensating") as advance:
         res = compensate_file(
