@@ -599,3 +599,39 @@ def test_report_cli_bad_input(
     assert status == 2
     assert "refusing to write over" in capsys.readouterr().err
     assert not (tmp_path / "r.html").exists()
+
+
+@pytest.mark.parametrize("removed_in_fit", [True, False])
+def test_apply_model_uses_the_fit_provenance_for_the_earth_rate(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], removed_in_fit: bool
+) -> None:
+    """A model fitted with the earth rate removed (``--latitude/--axis``) and one fitted on
+    the raw output both give the same bias after compensation in the report."""
+    from thermocal.cli import main
+    from thermocal.models.base import load_model_dict
+    from thermocal.report.build import apply_model, known_input_of
+
+    n = 4000
+    t = np.arange(n, dtype=np.float64)
+    temp = 20.0 + 10.0 * np.sin(2 * np.pi * t / n)
+    rng = np.random.default_rng(3)
+    meta = Metadata(latitude_deg=45.0, axis="up")
+    rec0 = Recording.from_arrays(t, {"gyro": np.zeros(n)}, {"T1": temp}, meta=meta)
+    earth = known_input_of(rec0, "deg/h")
+    assert earth == pytest.approx(15.041067 * math.sin(math.radians(45.0)), rel=1e-6)
+    gyro = earth + 0.2 + 0.01 * (temp - 20.0) + 0.001 * rng.standard_normal(n)
+    rec = Recording.from_arrays(t, {"gyro": gyro}, {"T1": temp}, meta=meta)
+    path = write_recording(rec, tmp_path / "run.csv")
+    extra = ["--latitude", "45", "--axis", "up"] if removed_in_fit else []
+    out = tmp_path / "m.json"
+    code = main(
+        ["fit", str(path), "--model", "poly", "--order", "1", "--signal", "gyro", "--temps",
+         "T1", *extra, "-o", str(out)]
+    )  # fmt: skip
+    capsys.readouterr()
+    assert code == 0
+    res = apply_model(load_model_dict(out), rec, "gyro")
+    assert res.model_includes_known_input is (not removed_in_fit)
+    # after compensation only the noise is left, whichever way the model was fitted
+    assert float(np.std(res.after)) < 0.0015
+    assert abs(float(np.mean(res.after))) < 1e-3

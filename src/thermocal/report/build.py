@@ -253,10 +253,16 @@ def apply_model(model_dict: dict[str, Any], rec: Recording, signal: str | None) 
     msgs = tuple(dict.fromkeys(" ".join(str(w.message).split()) for w in caught))
     before = x - known
     # A model fitted on the raw output (known input not removed) carries the earth
-    # rate in its constant; tell by which level its mean is nearer (|Ω| ≫ bias changes).
-    includes = bool(
-        known != 0.0 and abs(np.mean(pred) - np.mean(x)) < abs(np.mean(pred) - np.mean(before))
-    )
+    # rate in its constant.  The fit's provenance says what was removed (``thermocal fit``
+    # records ``known_input`` per file); without it, tell by which level the model's mean
+    # is nearer (|Ω| ≫ bias changes).
+    fitted = [d.get("known_input") for d in model_dict.get("data", []) if isinstance(d, dict)]
+    if known == 0.0:
+        includes = False
+    elif fitted and all(isinstance(k, int | float) for k in fitted):
+        includes = all(float(k) == 0.0 for k in fitted)  # type: ignore[arg-type]
+    else:
+        includes = bool(abs(np.mean(pred) - np.mean(x)) < abs(np.mean(pred) - np.mean(before)))
     after = x - pred if includes else before - pred
     return RunSignals(
         time_s=rec.time_s,
