@@ -241,8 +241,14 @@ def chromium_available() -> bool:
 
 
 def skip_without_chromium() -> None:
-    """Skip only when Chromium is absent AND not in CI (in CI the test must run)."""
-    if not chromium_available() and not os.environ.get("CI"):
+    """Skip only when Chromium is absent AND not in CI (in CI the test must run), or
+    when ``.ci/run`` reported that installing it failed (the skip then says so)."""
+    if chromium_available():
+        return
+    failed = os.environ.get("THERMOCAL_CHROMIUM_INSTALL_FAILED")
+    if failed:
+        pytest.skip(f"chromium could not be installed by .ci/run: {failed}")
+    if not os.environ.get("CI"):
         pytest.skip("/usr/bin/chromium is not installed (install Debian's chromium)")
 
 
