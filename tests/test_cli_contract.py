@@ -283,6 +283,7 @@ def test_compensate_refuses_a_sidecar_over_the_model_file(
     [
         (["profile", "fog-slow", "-o", "{d}/prog.xlsx"], "name it *.csv"),
         (["allan", "{good}", "--signal", "gyro", "--plot", "{d}/plot.txt"], "name it *.png"),
+        (["profile", "fog-slow", "-o", "{d}/prog.csv", "--dt", "-1"], "--dt must be ≥ 0 s"),
     ],
 )
 def test_output_extension_matches_what_is_written(

@@ -12,6 +12,7 @@
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 from typing import Annotated, Any
 
@@ -69,6 +70,8 @@ def _floats(text: str | None, what: str) -> list[float] | None:
 
 
 def _write_profile(prof: Profile, output: Path, dt: float, as_json: bool, **extra: Any) -> None:
+    if not (dt >= 0 and math.isfinite(dt)):
+        raise ThermocalInputError(f"--dt must be ≥ 0 s (0: corner points only), got {dt:g}")
     t, c = prof.program(dt if dt > 0 else None)
     write_program(output, t, c)
     summary = {
