@@ -445,6 +445,21 @@ def test_every_family_streaming_equals_batch(family_model: TemperatureModel) -> 
     np.testing.assert_allclose(np.concatenate(parts), batch.corrected, rtol=0, atol=1e-12 * scale)
 
 
+def test_every_family_compensate_run_is_signal_minus_predict(
+    family_model: TemperatureModel,
+) -> None:
+    """``compensate_run`` (fused in the poly block loop) is exactly F − predict(run)."""
+    m = family_model
+    run = _family_data(m)
+    assert run.signal is not None
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", ExtrapolationWarning)
+        batch = compensate_run(m, run)
+        y = m.predict(run)
+    np.testing.assert_array_equal(batch.model_value, y)
+    np.testing.assert_array_equal(batch.corrected, run.signal - y)
+
+
 def test_every_family_chunked_file_equals_in_memory(
     family_model: TemperatureModel, tmp_path: Path
 ) -> None:
