@@ -18,6 +18,7 @@ from thermocal.cli.common import (
     SignalUnitOpt,
     TempConversionOpt,
     TempUnitOpt,
+    TimeOpt,
     TimeUnitOpt,
     emit,
     fmt,
@@ -85,7 +86,7 @@ def allan_cmd(
     confidence: Annotated[
         float, typer.Option("--confidence", help="Confidence level of the intervals.")
     ] = 0.6826894921370859,
-    time: Annotated[str | None, typer.Option("--time", help="Name of the time column.")] = None,
+    time: TimeOpt = None,
     time_unit: TimeUnitOpt = "s",
     signal_unit: SignalUnitOpt = None,
     temp_unit: TempUnitOpt = None,

@@ -31,6 +31,7 @@ from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
 from thermocal.errors import GapWarning, ThermocalInputError, ThermocalWarning
 from thermocal.io import read_recording
 from thermocal.recording import Metadata, Recording
+from thermocal.units import canonical_unit, earth_rate_on_axis_deg_h, parse_axis
 
 P = ParamSpec("P")
 R = TypeVar("R")
@@ -39,13 +40,23 @@ stdout = Console(soft_wrap=True)
 stderr = Console(stderr=True, soft_wrap=True)
 
 # --- reusable option types ----------------------------------------------------------
+# Defaults are given where a command uses an alias (``time_unit: TimeUnitOpt = "s"``);
+# each command keeps the defaults INTERFACE.md documents for it.
 
 FileArg = Annotated[Path, typer.Argument(help="Recording (CSV or Parquet).", show_default=False)]
-TimeOpt = Annotated[str, typer.Option("--time", help="Name of the time column.")]
-TimeUnitOpt = Annotated[str, typer.Option("--time-unit", help="Time unit: s, ms or us.")]
+ModelArg = Annotated[
+    Path, typer.Argument(help="Model file (JSON) written by `thermocal fit`.", show_default=False)
+]
+TimeOpt = Annotated[str | None, typer.Option("--time", help="Name of the time column.")]
+TimeUnitOpt = Annotated[str | None, typer.Option("--time-unit", help="Time unit: s, ms or us.")]
 SignalOpt = Annotated[
     str | None, typer.Option("--signal", help="Name of the sensor-output column.")
 ]
+ModelSignalOpt = Annotated[
+    str | None,
+    typer.Option("--signal", help="Signal column (default: the model's signal name)."),
+]
+"""``--signal`` of the commands that read a model file: its default is the model's signal."""
 TempsOpt = Annotated[
     str | None,
     typer.Option("--temps", help="Comma-separated temperature column names."),
@@ -68,6 +79,22 @@ TempConversionOpt = Annotated[
         "for every temperature column (overrides the file's metadata).",
     ),
 ]
+LatitudeOpt = Annotated[
+    float | None, typer.Option("--latitude", help="Test-site latitude [°] (earth rate).")
+]
+AxisOpt = Annotated[
+    str | None,
+    typer.Option(
+        "--axis", help="Sensitive axis: up, down, north, south, east, west or 'e,n,u' (ENU)."
+    ),
+]
+ExtrapolateOpt = Annotated[
+    bool,
+    typer.Option(
+        "--extrapolate",
+        help="Evaluate the model outside its fitted temperature range instead of clamping.",
+    ),
+]
 JsonOpt = Annotated[bool, typer.Option("--json", help="Print one JSON object on stdout.")]
 OutOpt = Annotated[Path, typer.Option("-o", "--output", help="Output file.")]
 
@@ -78,6 +105,20 @@ def split_names(text: str | None) -> list[str] | None:
         return None
     names = [t.strip() for t in text.split(",")]
     return [n for n in names if n]
+
+
+def split_floats(text: str | None, what: str) -> list[float] | None:
+    """``"25, 30"`` → ``[25.0, 30.0]`` (None stays None); an input error naming the option
+    ``what`` when an item is not a number."""
+    names = split_names(text)
+    if names is None:
+        return None
+    try:
+        return [float(v) for v in names]
+    except ValueError:
+        raise ThermocalInputError(
+            f"{what}: expected comma-separated numbers, got {text!r}"
+        ) from None
 
 
 def parse_temp_conversion(text: str) -> tuple[float, float]:
@@ -153,6 +194,29 @@ def load_recording(
                 stacklevel=2,
             )
     return rec
+
+
+def earth_rate_known_input(
+    latitude: float | None, axis: str | None, unit: str, where: object
+) -> float:
+    """Earth rate seen by the sensitive axis [°/h], as a known input of a gyro run.
+
+    ``Ω_axis = Ω u·(0, cos φ, sin φ)`` for the unit axis ``u`` in East-North-Up
+    (SPEC §1, :func:`thermocal.units.earth_rate_on_axis_deg_h`); 0 without
+    ``--latitude``/``--axis``.  Both options are needed together and
+    the signal (canonical unit ``unit``) must be a rate: otherwise an input error naming
+    ``where`` (the file).
+    """
+    if latitude is None and axis is None:
+        return 0.0
+    if latitude is None or axis is None:
+        raise ThermocalInputError("earth-rate removal needs both --latitude and --axis")
+    if canonical_unit(unit) != "deg/h":
+        raise ThermocalInputError(
+            f"{where}: --latitude/--axis remove the earth rate from a gyro signal; "
+            f"this signal is in {unit}"
+        )
+    return earth_rate_on_axis_deg_h(latitude, parse_axis(axis))
 
 
 # --- errors ----------------------------------------------------------------------------

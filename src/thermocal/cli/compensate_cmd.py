@@ -7,7 +7,6 @@ OUT keeps every input column and adds ``<signal>_model`` and ``<signal>_comp``
 
 from __future__ import annotations
 
-from pathlib import Path
 from typing import Annotated
 
 import typer
@@ -15,12 +14,17 @@ from rich.table import Table
 
 from thermocal.cli.app import app
 from thermocal.cli.common import (
+    ExtrapolateOpt,
     FileArg,
     JsonOpt,
+    ModelArg,
+    ModelSignalOpt,
     OutOpt,
     SignalUnitOpt,
     TempConversionOpt,
     TempUnitOpt,
+    TimeOpt,
+    TimeUnitOpt,
     emit,
     fmt,
     handle_errors,
@@ -32,10 +36,6 @@ from thermocal.compensate import DEFAULT_CHUNK_ROWS, compensate_file
 from thermocal.io import check_not_input, file_kind, sidecar_path
 from thermocal.models.base import load_model
 
-ModelArg = Annotated[
-    Path, typer.Argument(help="Model file (JSON) written by `thermocal fit`.", show_default=False)
-]
-
 
 @app.command("compensate")
 @handle_errors
@@ -43,24 +43,13 @@ def compensate_cmd(
     model_file: ModelArg,
     file: FileArg,
     output: OutOpt,
-    signal: Annotated[
-        str | None,
-        typer.Option("--signal", help="Signal column (default: the model's signal name)."),
-    ] = None,
-    time: Annotated[str | None, typer.Option("--time", help="Time column.")] = None,
-    time_unit: Annotated[
-        str | None, typer.Option("--time-unit", help="Time unit: s, ms or us.")
-    ] = None,
+    signal: ModelSignalOpt = None,
+    time: TimeOpt = None,
+    time_unit: TimeUnitOpt = None,
     signal_unit: SignalUnitOpt = None,
     temp_unit: TempUnitOpt = None,
     temp_conversion: TempConversionOpt = None,
-    extrapolate: Annotated[
-        bool,
-        typer.Option(
-            "--extrapolate",
-            help="Evaluate the model outside its fitted temperature range instead of clamping.",
-        ),
-    ] = False,
+    extrapolate: ExtrapolateOpt = False,
     known_input: Annotated[
         float,
         typer.Option(

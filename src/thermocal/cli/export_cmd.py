@@ -14,14 +14,10 @@ from typing import Annotated
 import typer
 
 from thermocal.cli.app import app
-from thermocal.cli.common import JsonOpt, emit, fmt, handle_errors, stdout
+from thermocal.cli.common import JsonOpt, ModelArg, emit, fmt, handle_errors, stdout
 from thermocal.errors import ThermocalWarning
 from thermocal.export_c import export_c, find_compiler, measure_float_error
 from thermocal.models.base import load_model_dict
-
-ModelArg = Annotated[
-    Path, typer.Argument(help="Model file (JSON) written by `thermocal fit`.", show_default=False)
-]
 
 
 @app.command("export-c")

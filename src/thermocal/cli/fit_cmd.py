@@ -58,15 +58,23 @@ from rich.table import Table
 
 from thermocal.cli.app import app
 from thermocal.cli.common import (
+    AxisOpt,
     JsonOpt,
+    LatitudeOpt,
+    SignalOpt,
     SignalUnitOpt,
     TempConversionOpt,
+    TempsOpt,
     TempUnitOpt,
+    TimeOpt,
+    TimeUnitOpt,
+    earth_rate_known_input,
     emit,
     fmt,
     handle_errors,
     load_recording,
     one_line,
+    split_floats,
     split_names,
     stdout,
 )
@@ -79,7 +87,6 @@ from thermocal.models.base import (
     get_model_class,
     save_model,
 )
-from thermocal.units import canonical_unit, earth_rate_on_axis_deg_h, parse_axis
 
 TARGETS = ("bias", "scale_factor")
 
@@ -103,18 +110,6 @@ def build_model(family: str, options: dict[str, Any]) -> TemperatureModel:
     return cls(**opts)
 
 
-def _floats(text: str | None, what: str) -> list[float] | None:
-    names = split_names(text)
-    if names is None:
-        return None
-    try:
-        return [float(v) for v in names]
-    except ValueError:
-        raise ThermocalInputError(
-            f"{what}: expected comma-separated numbers, got {text!r}"
-        ) from None
-
-
 @app.command("fit")
 @handle_errors
 def fit_cmd(
@@ -126,12 +121,10 @@ def fit_cmd(
         str, typer.Option("--model", help="Model family: poly, piecewise, warmup, bank.")
     ],
     output: Annotated[Path, typer.Option("-o", "--output", help="Model file to write (JSON).")],
-    signal: Annotated[str | None, typer.Option("--signal", help="Sensor-output column.")] = None,
-    temps: Annotated[
-        str | None, typer.Option("--temps", help="Comma-separated temperature columns.")
-    ] = None,
-    time: Annotated[str | None, typer.Option("--time", help="Time column.")] = None,
-    time_unit: Annotated[str | None, typer.Option("--time-unit", help="s, ms or us.")] = None,
+    signal: SignalOpt = None,
+    temps: TempsOpt = None,
+    time: TimeOpt = None,
+    time_unit: TimeUnitOpt = None,
     signal_unit: SignalUnitOpt = None,
     temp_unit: TempUnitOpt = None,
     temp_conversion: TempConversionOpt = None,
@@ -204,12 +197,8 @@ def fit_cmd(
     target: Annotated[
         str, typer.Option("--target", help="What the model describes: bias | scale_factor.")
     ] = "bias",
-    latitude: Annotated[
-        float | None, typer.Option("--latitude", help="Latitude [deg] for earth-rate removal.")
-    ] = None,
-    axis: Annotated[
-        str | None, typer.Option("--axis", help="Sensitive axis (up, north, east, or x,y,z ENU).")
-    ] = None,
+    latitude: LatitudeOpt = None,
+    axis: AxisOpt = None,
     known_input: Annotated[
         float | None,
         typer.Option("--known-input", help="Known input to remove, canonical signal unit."),
@@ -234,7 +223,7 @@ def fit_cmd(
         "rcond": rcond,
         "solver": solver,
         "noise_threshold": noise_threshold,
-        "breakpoints": _floats(breakpoints, "--breakpoints"),
+        "breakpoints": split_floats(breakpoints, "--breakpoints"),
         "segments": segments,
         "method": method,
         "start_window_s": start_window,
@@ -269,16 +258,7 @@ def fit_cmd(
         if unit and run_unit != unit:
             raise ThermocalInputError(f"{path}: signal unit {run_unit} differs from {unit}")
         unit = run_unit
-        ki = 0.0
-        if latitude is not None or axis is not None:
-            if latitude is None or axis is None:
-                raise ThermocalInputError("earth-rate removal needs both --latitude and --axis")
-            if canonical_unit(unit) != "deg/h":
-                raise ThermocalInputError(
-                    f"{path}: --latitude/--axis remove the earth rate from a gyro signal; "
-                    f"this signal is in {unit}"
-                )
-            ki += earth_rate_on_axis_deg_h(latitude, parse_axis(axis))
+        ki = earth_rate_known_input(latitude, axis, unit, path)
         if known_input is not None:
             ki += known_input
         run = RunData.from_recording(rec, signal, split_names(temps), known_input=ki)

@@ -17,6 +17,7 @@ from thermocal.cli.common import (
     TempConversionOpt,
     TempsOpt,
     TempUnitOpt,
+    TimeOpt,
     TimeUnitOpt,
     emit,
     fmt,
@@ -37,7 +38,7 @@ _TEMP_NAME = re.compile(r"^(t\d+|t_|temp|tmp)|temperature|°c|degc", re.IGNORECA
 @handle_errors
 def inspect_cmd(
     file: FileArg,
-    time: Annotated[str | None, typer.Option("--time", help="Time column.")] = None,
+    time: TimeOpt = None,
     time_unit: TimeUnitOpt = "s",
     signal: Annotated[
         str | None, typer.Option("--signal", help="Comma-separated signal columns.")

@@ -10,13 +10,16 @@ from rich.table import Table
 
 from thermocal.cli.app import app
 from thermocal.cli.common import (
+    AxisOpt,
     FileArg,
     JsonOpt,
+    LatitudeOpt,
     SignalOpt,
     SignalUnitOpt,
     TempConversionOpt,
     TempsOpt,
     TempUnitOpt,
+    TimeOpt,
     TimeUnitOpt,
     emit,
     fmt,
@@ -64,15 +67,8 @@ def metrics_cmd(
         typer.Option("--average", help="Averaging time S [s] of bias stability and peak-to-peak."),
     ] = None,
     temps: TempsOpt = None,
-    latitude: Annotated[
-        float | None, typer.Option("--latitude", help="Test-site latitude [°] (earth rate).")
-    ] = None,
-    axis: Annotated[
-        str | None,
-        typer.Option(
-            "--axis", help="Sensitive axis: up, down, north, south, east, west or 'e,n,u'."
-        ),
-    ] = None,
+    latitude: LatitudeOpt = None,
+    axis: AxisOpt = None,
     hold_rate: Annotated[
         float,
         typer.Option("--hold-rate", help="Hold stages: |dT/dt| below this [°C/min]."),
@@ -80,7 +76,7 @@ def metrics_cmd(
     min_hold: Annotated[
         float, typer.Option("--min-hold", help="Hold stages: at least this long [s].")
     ] = 600.0,
-    time: Annotated[str | None, typer.Option("--time", help="Name of the time column.")] = None,
+    time: TimeOpt = None,
     time_unit: TimeUnitOpt = "s",
     signal_unit: SignalUnitOpt = None,
     temp_unit: TempUnitOpt = None,

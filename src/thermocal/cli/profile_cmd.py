@@ -21,7 +21,7 @@ import pandas as pd
 import typer
 
 from thermocal.cli.app import app
-from thermocal.cli.common import JsonOpt, OutOpt, emit, handle_errors, stdout
+from thermocal.cli.common import JsonOpt, OutOpt, emit, handle_errors, split_floats, stdout
 from thermocal.errors import FileFormatError, MissingColumnError, ThermocalInputError
 from thermocal.io import check_not_input, file_kind, read_recording
 from thermocal.profiles import (
@@ -48,6 +48,16 @@ DtOpt = Annotated[
     float,
     typer.Option("--dt", help="Program step [s]; 0 writes only the corner points of the profile."),
 ]
+LowOpt = Annotated[float | None, typer.Option("--low", help="Low temperature [°C].")]
+HighOpt = Annotated[float | None, typer.Option("--high", help="High temperature [°C].")]
+StartOpt = Annotated[float | None, typer.Option("--start", help="Start/end [°C].")]
+RateOpt = Annotated[float | None, typer.Option("--rate", help="Ramp rate [°C/min].")]
+HoldSOpt = Annotated[float | None, typer.Option("--hold-s", help="Hold duration [s].")]
+SeedOpt = Annotated[int, typer.Option("--seed", help="Seed of the design search.")]
+LimitOpt = Annotated[float, typer.Option("--limit", help="Correlation limit (weak below it).")]
+NHoldsOpt = Annotated[
+    int | None, typer.Option("--n-holds", help="Number of holds of a designed profile.")
+]
 ColumnOpt = Annotated[
     str | None,
     typer.Option(
@@ -56,17 +66,6 @@ ColumnOpt = Annotated[
         "first temperature column).",
     ),
 ]
-
-
-def _floats(text: str | None, what: str) -> list[float] | None:
-    if text is None:
-        return None
-    try:
-        return [float(v) for v in text.split(",") if v.strip()]
-    except ValueError:
-        raise ThermocalInputError(
-            f"{what}: expected comma-separated numbers, got {text!r}"
-        ) from None
 
 
 def _write_profile(prof: Profile, output: Path, dt: float, as_json: bool, **extra: Any) -> None:
@@ -137,9 +136,9 @@ def load_history(path: Path, column: str | None = None) -> tuple[FloatArray, Flo
 @handle_errors
 def rlg_modelling_cmd(
     output: OutOpt,
-    low: Annotated[float | None, typer.Option("--low", help="Low temperature [°C].")] = None,
-    high: Annotated[float | None, typer.Option("--high", help="High temperature [°C].")] = None,
-    start: Annotated[float | None, typer.Option("--start", help="Start/end [°C].")] = None,
+    low: LowOpt = None,
+    high: HighOpt = None,
+    start: StartOpt = None,
     cycles: Annotated[
         int | None, typer.Option("--cycles", help="Number of full temperature cycles.")
     ] = None,
@@ -167,7 +166,7 @@ def rlg_modelling_cmd(
             "n_temperature_cycles": cycles,
             "cycle_rate_c_per_min": cycle_rate,
             "hold_s": hold_s,
-            "rates_c_per_min": _floats(rates, "--rates"),
+            "rates_c_per_min": split_floats(rates, "--rates"),
             "rate_hold_s": rate_hold_s,
         }
     )
@@ -181,9 +180,9 @@ def rlg_validation_cmd(
     holds: Annotated[
         str | None, typer.Option("--holds", help="Hold temperatures [°C], comma-separated.")
     ] = None,
-    hold_s: Annotated[float | None, typer.Option("--hold-s", help="Hold duration [s].")] = None,
-    rate: Annotated[float | None, typer.Option("--rate", help="Ramp rate [°C/min].")] = None,
-    start: Annotated[float | None, typer.Option("--start", help="Start/end [°C].")] = None,
+    hold_s: HoldSOpt = None,
+    rate: RateOpt = None,
+    start: StartOpt = None,
     against: Annotated[
         Path | None,
         typer.Option(
@@ -193,13 +192,9 @@ def rlg_validation_cmd(
         ),
     ] = None,
     column: ColumnOpt = None,
-    seed: Annotated[int, typer.Option("--seed", help="Seed of the design search.")] = 0,
-    limit: Annotated[
-        float, typer.Option("--limit", help="Correlation limit.")
-    ] = WEAK_CORRELATION_LIMIT,
-    n_holds: Annotated[
-        int | None, typer.Option("--n-holds", help="Number of holds of a designed profile.")
-    ] = None,
+    seed: SeedOpt = 0,
+    limit: LimitOpt = WEAK_CORRELATION_LIMIT,
+    n_holds: NHoldsOpt = None,
     dt: DtOpt = 60.0,
     as_json: JsonOpt = False,
 ) -> None:
@@ -212,7 +207,7 @@ def rlg_validation_cmd(
         return
     params = _clean(
         {
-            "holds_c": _floats(holds, "--holds"),
+            "holds_c": split_floats(holds, "--holds"),
             "hold_s": hold_s,
             "rate_c_per_min": rate,
             "start_c": start,
@@ -225,10 +220,10 @@ def rlg_validation_cmd(
 @handle_errors
 def fog_slow_cmd(
     output: OutOpt,
-    low: Annotated[float | None, typer.Option("--low", help="Low temperature [°C].")] = None,
-    high: Annotated[float | None, typer.Option("--high", help="High temperature [°C].")] = None,
-    rate: Annotated[float | None, typer.Option("--rate", help="Ramp rate [°C/min].")] = None,
-    hold_s: Annotated[float | None, typer.Option("--hold-s", help="Hold duration [s].")] = None,
+    low: LowOpt = None,
+    high: HighOpt = None,
+    rate: RateOpt = None,
+    hold_s: HoldSOpt = None,
     cycles: Annotated[int | None, typer.Option("--cycles", help="Number of cycles.")] = None,
     dt: DtOpt = 60.0,
     as_json: JsonOpt = False,
@@ -260,14 +255,14 @@ def mems_warmup_cmd(
         float | None, typer.Option("--record-s", help="Powered record per start (≥ 360 s).")
     ] = None,
     rate: Annotated[float | None, typer.Option("--rate", help="Transition rate [°C/min].")] = None,
-    start: Annotated[float | None, typer.Option("--start", help="Start/end [°C].")] = None,
+    start: StartOpt = None,
     dt: DtOpt = 60.0,
     as_json: JsonOpt = False,
 ) -> None:
     """Seed-003 power-on warm-ups at several start temperatures."""
     params = _clean(
         {
-            "start_temps_c": _floats(starts, "--starts"),
+            "start_temps_c": split_floats(starts, "--starts"),
             "soak_s": soak_s,
             "record_s": record_s,
             "transition_rate_c_per_min": rate,
@@ -281,10 +276,10 @@ def mems_warmup_cmd(
 @handle_errors
 def accel_full_range_cmd(
     output: OutOpt,
-    low: Annotated[float | None, typer.Option("--low", help="Low temperature [°C].")] = None,
-    high: Annotated[float | None, typer.Option("--high", help="High temperature [°C].")] = None,
+    low: LowOpt = None,
+    high: HighOpt = None,
     soak_s: Annotated[float | None, typer.Option("--soak-s", help="Soak at the ends [s].")] = None,
-    rate: Annotated[float | None, typer.Option("--rate", help="Ramp rate [°C/min].")] = None,
+    rate: RateOpt = None,
     step: Annotated[
         float | None, typer.Option("--step", help="Constant points every STEP [°C].")
     ] = None,
@@ -292,7 +287,7 @@ def accel_full_range_cmd(
         float | None, typer.Option("--point-hold-s", help="Hold at each constant point [s].")
     ] = None,
     repeats: Annotated[int | None, typer.Option("--repeats", help="Number of runs.")] = None,
-    start: Annotated[float | None, typer.Option("--start", help="Start/end [°C].")] = None,
+    start: StartOpt = None,
     dt: DtOpt = 60.0,
     as_json: JsonOpt = False,
 ) -> None:
@@ -321,9 +316,7 @@ def correlate_cmd(
     column_b: Annotated[
         str | None, typer.Option("--column-b", help="Column of B (default: --column's rule).")
     ] = None,
-    limit: Annotated[
-        float, typer.Option("--limit", help="Weak-correlation limit.")
-    ] = WEAK_CORRELATION_LIMIT,
+    limit: LimitOpt = WEAK_CORRELATION_LIMIT,
     points: Annotated[
         int, typer.Option("--points", help="Points of the common elapsed-time base.")
     ] = 10_000,
@@ -378,14 +371,12 @@ def _design(
 def design_validation_cmd(
     model: Annotated[Path, typer.Argument(help="Modelling program or recording.")],
     output: OutOpt,
-    seed: Annotated[int, typer.Option("--seed", help="Seed of the design search.")] = 0,
+    seed: SeedOpt = 0,
     column: ColumnOpt = None,
-    limit: Annotated[
-        float, typer.Option("--limit", help="Correlation limit.")
-    ] = WEAK_CORRELATION_LIMIT,
-    n_holds: Annotated[int | None, typer.Option("--n-holds", help="Number of holds.")] = None,
+    limit: LimitOpt = WEAK_CORRELATION_LIMIT,
+    n_holds: NHoldsOpt = None,
     hold_s: Annotated[float | None, typer.Option("--hold-s", help="Mean hold [s].")] = None,
-    rate: Annotated[float | None, typer.Option("--rate", help="Ramp rate [°C/min].")] = None,
+    rate: RateOpt = None,
     dt: DtOpt = 60.0,
     as_json: JsonOpt = False,
 ) -> None:

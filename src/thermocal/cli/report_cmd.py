@@ -18,8 +18,11 @@ import typer
 
 from thermocal.cli.app import app
 from thermocal.cli.common import (
+    ModelSignalOpt,
     SignalUnitOpt,
     TempUnitOpt,
+    TimeOpt,
+    TimeUnitOpt,
     handle_errors,
     load_recording,
     progress,
@@ -87,10 +90,7 @@ def report_cmd(
     modeling: Annotated[
         Path | None, typer.Option("--modeling", help="The modelling run's recording.")
     ] = None,
-    signal: Annotated[
-        str | None,
-        typer.Option("--signal", help="Signal column (default: the model's signal name)."),
-    ] = None,
+    signal: ModelSignalOpt = None,
     label: Annotated[
         list[str] | None,
         typer.Option("--label", help="Short name of each model (default: the file stem)."),
@@ -101,10 +101,8 @@ def report_cmd(
     sensor: Annotated[
         str | None, typer.Option("--sensor", help="Sensor name or serial number.")
     ] = None,
-    time: Annotated[str | None, typer.Option("--time", help="Time column.")] = None,
-    time_unit: Annotated[
-        str | None, typer.Option("--time-unit", help="Time unit: s, ms or us.")
-    ] = None,
+    time: TimeOpt = None,
+    time_unit: TimeUnitOpt = None,
     signal_unit: SignalUnitOpt = None,
     temp_unit: TempUnitOpt = None,
 ) -> None:

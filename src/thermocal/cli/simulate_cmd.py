@@ -25,7 +25,7 @@ from typing import Annotated, Any
 import typer
 
 from thermocal.cli.app import app
-from thermocal.cli.common import JsonOpt, emit, handle_errors, stdout
+from thermocal.cli.common import AxisOpt, JsonOpt, LatitudeOpt, emit, handle_errors, stdout
 from thermocal.errors import FileFormatError, ThermocalInputError
 from thermocal.io import check_not_input, file_kind, write_json, write_recording
 from thermocal.profiles import read_program
@@ -79,12 +79,8 @@ def simulate_cmd(
     rate_hz: Annotated[
         float | None, typer.Option("--rate-hz", help="Output sample rate [Hz].")
     ] = None,
-    latitude: Annotated[
-        float | None, typer.Option("--latitude", help="Latitude [°] (gyro scenarios).")
-    ] = None,
-    axis: Annotated[
-        str | None, typer.Option("--axis", help="Sensitive axis (up, north, 'e,n,u').")
-    ] = None,
+    latitude: LatitudeOpt = None,
+    axis: AxisOpt = None,
     runs: Annotated[
         int | None, typer.Option("--runs", help="Number of runs (accel-full-range).")
     ] = None,

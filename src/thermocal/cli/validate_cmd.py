@@ -17,11 +17,16 @@ from rich.table import Table
 
 from thermocal.cli.app import app
 from thermocal.cli.common import (
+    ExtrapolateOpt,
     FileArg,
     JsonOpt,
+    ModelArg,
+    ModelSignalOpt,
     SignalUnitOpt,
     TempConversionOpt,
     TempUnitOpt,
+    TimeOpt,
+    TimeUnitOpt,
     emit,
     fmt,
     handle_errors,
@@ -34,10 +39,6 @@ from thermocal.io import read_recording
 from thermocal.models.base import RunData, TemperatureModel, load_model
 from thermocal.recording import find_problems
 from thermocal.validation import DEFAULT_AVERAGING_S, validate
-
-ModelArg = Annotated[
-    Path, typer.Argument(help="Model file (JSON) written by `thermocal fit`.", show_default=False)
-]
 
 
 def _modeling_file(model: TemperatureModel, model_file: Path) -> Path | None:
@@ -77,14 +78,9 @@ def validate_cmd(
     averaging: Annotated[
         float, typer.Option("--average", "--averaging", help="Averaging time [s].")
     ] = DEFAULT_AVERAGING_S,
-    signal: Annotated[
-        str | None,
-        typer.Option("--signal", help="Signal column (default: the model's signal name)."),
-    ] = None,
-    time: Annotated[str | None, typer.Option("--time", help="Time column.")] = None,
-    time_unit: Annotated[
-        str | None, typer.Option("--time-unit", help="Time unit: s, ms or us.")
-    ] = None,
+    signal: ModelSignalOpt = None,
+    time: TimeOpt = None,
+    time_unit: TimeUnitOpt = None,
     signal_unit: SignalUnitOpt = None,
     temp_unit: TempUnitOpt = None,
     temp_conversion: TempConversionOpt = None,
@@ -98,9 +94,7 @@ def validate_cmd(
     settle: Annotated[
         float, typer.Option("--settle", help="Seconds cut from the start of each stage.")
     ] = 0.0,
-    extrapolate: Annotated[
-        bool, typer.Option("--extrapolate", help="Do not clamp to the fitted range.")
-    ] = False,
+    extrapolate: ExtrapolateOpt = False,
     as_json: JsonOpt = False,
 ) -> None:
     """Validate MODEL on FILE: correlation r, bias stability and repeatability over the
