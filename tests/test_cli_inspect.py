@@ -159,3 +159,11 @@ def test_temp_conversion_option_refuses_garbage(
     )
     assert code == 2
     assert err.startswith("error: --temp-conversion takes 'GAIN,OFFSET'")
+
+
+def test_version(capsys: pytest.CaptureFixture[str]) -> None:
+    from thermocal import __version__
+
+    code, out, _ = _run(capsys, "--version")
+    assert code == 0
+    assert out.strip() == f"thermocal {__version__}"
