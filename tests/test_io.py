@@ -234,3 +234,38 @@ def test_malformed_csv_never_crashes_or_passes_silently(
         or t.size < 2
     )
     assert has_bad == any(p.severity == "error" for p in problems)
+
+
+_arrow_col = st.one_of(
+    st.lists(st.floats(allow_nan=True, allow_infinity=True), min_size=3, max_size=3).map(
+        lambda v: pa.array(v, type=pa.float64())
+    ),
+    st.lists(st.integers(-(2**40), 2**40), min_size=3, max_size=3).map(pa.array),
+    st.lists(st.one_of(st.none(), st.floats(-1e3, 1e3)), min_size=3, max_size=3).map(
+        lambda v: pa.array(v, type=pa.float32())
+    ),
+    st.lists(st.text(max_size=3), min_size=3, max_size=3).map(pa.array),
+    st.lists(st.booleans(), min_size=3, max_size=3).map(pa.array),
+)
+
+
+@settings(
+    max_examples=40, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture]
+)
+@given(time_col=_arrow_col, gyro_col=_arrow_col, name=st.sampled_from(["time", "t"]))
+def test_malformed_parquet_never_crashes_or_passes_silently(
+    tmp_path: Path, time_col: pa.Array, gyro_col: pa.Array, name: str
+) -> None:
+    """Parquet files with any column types either read (problems reported) or raise a
+    ThermocalInputError naming the file — never another exception."""
+    path = tmp_path / "fuzz.parquet"
+    pq.write_table(pa.table({name: time_col, "gyro": gyro_col}), path)
+    try:
+        rec = read_recording(path, signals=["gyro"])
+    except ThermocalInputError as exc:
+        assert str(path) in str(exc)
+        return
+    t = rec.time_s
+    sig = rec.columns["gyro"]
+    has_bad = (not np.all(np.isfinite(t))) or np.any(np.diff(t) <= 0) or np.any(~np.isfinite(sig))
+    assert has_bad == any(p.severity == "error" for p in find_problems(rec, required=["gyro"]))
