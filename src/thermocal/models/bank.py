@@ -84,16 +84,17 @@ from scipy.spatial.distance import squareform
 from thermocal.errors import (
     ConditioningWarning,
     DesignError,
-    ExtrapolationWarning,
     ThermocalInputError,
 )
 from thermocal.models.base import (
+    ClampOnce,
     Coefficient,
     FitStats,
     ModelStream,
     RunData,
     TemperatureModel,
     register,
+    stream_channel,
 )
 from thermocal.models.warmup import CONDITION_WARN, channel_index, lstsq_svd, single_channel
 from thermocal.preprocess import segment_holds
@@ -607,8 +608,8 @@ class BankStream(ModelStream):
         self.extrapolate = extrapolate
         self.known_input = float(known_input)
         self._col = int(model.sensor)
-        self._lo = float(model.temp_range_[0, 0])
-        self._hi = float(model.temp_range_[0, 1])
+        lo, hi = (float(v) for v in model.temp_range_[0])
+        self._clamp = ClampOnce(lo, hi, extrapolate=extrapolate)
         self._startup = float(model.startup_s)
         self._xs = [[float(x) for x in b] for b in model.breakpoints_]
         self._vs = [[float(v) for v in vals] for vals in model.values_]
@@ -622,7 +623,7 @@ class BankStream(ModelStream):
         self._frozen = False
         self._choice = 0
         self._dev = [math.nan] * n
-        self._warned = False
+        self._clamp.warned = False
 
     @property
     def selection(self) -> Selection:
@@ -636,23 +637,7 @@ class BankStream(ModelStream):
         return v[j] + slope * (temp - x[j])
 
     def update(self, time_s: float, temps_c: FloatArray, signal: float | None = None) -> float:
-        if type(temps_c) is np.ndarray and temps_c.dtype == np.float64 and temps_c.ndim == 1:
-            arr = temps_c
-        else:
-            arr = np.asarray(temps_c, dtype=np.float64).reshape(-1)
-        temp = float(arr.item(0) if arr.size == 1 else arr.item(self._col))
-        if temp < self._lo or temp > self._hi:
-            if not self._warned:
-                self._warned = True
-                action = "extrapolating" if self.extrapolate else "clamped to the fitted range"
-                warnings.warn(
-                    f"temperature {temp:.2f} °C outside the model's fitted range "
-                    f"{self._lo:.2f}…{self._hi:.2f}; {action}",
-                    ExtrapolationWarning,
-                    stacklevel=2,
-                )
-            if not self.extrapolate:
-                temp = min(max(temp, self._lo), self._hi)
+        temp = self._clamp(stream_channel(temps_c, self._col))
         t = float(time_s)
         if self._t_first is None:
             self._t_first = t

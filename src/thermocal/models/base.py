@@ -206,6 +206,47 @@ class FitStats:
         return d
 
 
+# --- helpers for single-temperature streams --------------------------------------------------
+
+
+def stream_channel(temps_c: FloatArray | float, column: int) -> float:
+    """The model's temperature [°C] from one sample's ``temps_c``: the only value, or
+    the value at ``column`` when every fitted column is given."""
+    if type(temps_c) is np.ndarray and temps_c.dtype == np.float64 and temps_c.ndim == 1:
+        arr = temps_c
+    else:
+        arr = np.atleast_1d(np.asarray(temps_c, dtype=np.float64)).reshape(-1)
+    return float(arr.item(0) if arr.size == 1 else arr.item(column))
+
+
+class ClampOnce:
+    """Clamp one temperature to the fitted range ``[lo, hi]`` [°C] sample by sample, with
+    one :class:`ExtrapolationWarning` per stream (``extrapolate=True``: warn, keep T)."""
+
+    __slots__ = ("extrapolate", "hi", "lo", "warned")
+
+    def __init__(self, lo: float, hi: float, *, extrapolate: bool) -> None:
+        self.lo = float(lo)
+        self.hi = float(hi)
+        self.extrapolate = extrapolate
+        self.warned = False
+
+    def __call__(self, x: float) -> float:
+        if x < self.lo or x > self.hi:
+            if not self.warned:
+                self.warned = True
+                action = "extrapolating" if self.extrapolate else "clamped to the fitted range"
+                warnings.warn(
+                    f"temperature {x:.2f} °C outside the model's fitted range "
+                    f"{self.lo:.2f}…{self.hi:.2f}; {action}",
+                    ExtrapolationWarning,
+                    stacklevel=3,
+                )
+            if not self.extrapolate:
+                x = min(max(x, self.lo), self.hi)
+        return x
+
+
 # --- the contract ----------------------------------------------------------------------------
 
 

@@ -63,17 +63,18 @@ from scipy import optimize
 
 from thermocal.errors import (
     DesignError,
-    ExtrapolationWarning,
     ThermocalInputError,
     ThermocalWarning,
 )
 from thermocal.models.base import (
+    ClampOnce,
     Coefficient,
     FitStats,
     ModelStream,
     RunData,
     TemperatureModel,
     register,
+    stream_channel,
 )
 from thermocal.models.poly import check_runs, record_ranges
 from thermocal.models.terms import CHUNK_ROWS, Chunk, accumulate_r, solve_r
@@ -573,8 +574,8 @@ class PiecewiseStream(ModelStream):
     def __init__(self, model: PiecewiseModel, *, extrapolate: bool) -> None:
         self.model = model
         self.extrapolate = extrapolate
-        self.lo = float(model.temp_range_[0, 0])
-        self.hi = float(model.temp_range_[0, 1])
+        lo, hi = (float(v) for v in model.temp_range_[0])
+        self._clamp = ClampOnce(lo, hi, extrapolate=extrapolate)
         self._col = int(model.column_index_)
         self._bps = [float(b) for b in model.breakpoints_]
         self._inter = [float(a) for a in model.intercepts_]
@@ -582,25 +583,9 @@ class PiecewiseStream(ModelStream):
         self.reset()
 
     def reset(self) -> None:
-        self._warned = False
+        self._clamp.warned = False
 
     def update(self, time_s: float, temps_c: FloatArray, signal: float | None = None) -> float:
-        if type(temps_c) is np.ndarray and temps_c.dtype == np.float64 and temps_c.ndim == 1:
-            arr = temps_c
-        else:
-            arr = np.atleast_1d(np.asarray(temps_c, dtype=np.float64)).reshape(-1)
-        x = float(arr.item(0) if arr.size == 1 else arr.item(self._col))
-        if x < self.lo or x > self.hi:
-            if not self._warned:
-                self._warned = True
-                action = "extrapolating" if self.extrapolate else "clamped to the fitted range"
-                warnings.warn(
-                    f"temperature {x:.2f} °C outside the model's fitted range "
-                    f"{self.lo:.2f}…{self.hi:.2f}; {action}",
-                    ExtrapolationWarning,
-                    stacklevel=2,
-                )
-            if not self.extrapolate:
-                x = min(max(x, self.lo), self.hi)
+        x = self._clamp(stream_channel(temps_c, self._col))
         j = bisect.bisect_right(self._bps, x)
         return self._inter[j] + self._slopes[j] * x
