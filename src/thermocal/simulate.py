@@ -1045,6 +1045,30 @@ def _gyro_run(
 DEFAULT_LATITUDE_DEG = 45.0
 
 
+def _single_gyro_scenario(
+    name: str,
+    seed: int,
+    profile: ProfileInput,
+    rate_hz: float | None,
+    latitude_deg: float,
+    axis: str,
+    preset: str,
+    *,
+    warmed_up: bool,
+) -> ScenarioResult:
+    """One gyro run of scenario ``name`` over its profile (the built-in one by default)."""
+    p = get_preset(preset)
+    program, stages = _program(profile, name)
+    rng = scenario_rng(name, seed, 1)[0]
+    return [
+        _gyro_run(
+            name, p, seed, rng, program, stages,
+            rate_hz=rate_hz or p.rate_hz, latitude_deg=latitude_deg, axis=axis,
+            warmed_up=warmed_up,
+        )
+    ]  # fmt: skip
+
+
 def scenario_rlg_modelling(
     seed: int,
     profile: ProfileInput = None,
@@ -1056,15 +1080,9 @@ def scenario_rlg_modelling(
 ) -> ScenarioResult:
     """Seed-000 modelling run of the ``rlg`` preset over the ``rlg-modelling`` profile
     (≈ 65 h at 1 Hz by default); powered on at t = 0, soaked at the start temperature."""
-    p = get_preset(preset)
-    program, stages = _program(profile, "rlg-modelling")
-    rng = scenario_rng("rlg-modelling", seed, 1)[0]
-    return [
-        _gyro_run(
-            "rlg-modelling", p, seed, rng, program, stages,
-            rate_hz=rate_hz or p.rate_hz, latitude_deg=latitude_deg, axis=axis, warmed_up=False,
-        )
-    ]  # fmt: skip
+    return _single_gyro_scenario(
+        "rlg-modelling", seed, profile, rate_hz, latitude_deg, axis, preset, warmed_up=False
+    )
 
 
 def scenario_rlg_validation(
@@ -1078,15 +1096,9 @@ def scenario_rlg_validation(
 ) -> ScenarioResult:
     """Seed-000 validation run (holds, weakly correlated with ``rlg-modelling``), same
     sensor as :func:`scenario_rlg_modelling`, another turn-on and noise."""
-    p = get_preset(preset)
-    program, stages = _program(profile, "rlg-validation")
-    rng = scenario_rng("rlg-validation", seed, 1)[0]
-    return [
-        _gyro_run(
-            "rlg-validation", p, seed, rng, program, stages,
-            rate_hz=rate_hz or p.rate_hz, latitude_deg=latitude_deg, axis=axis, warmed_up=False,
-        )
-    ]  # fmt: skip
+    return _single_gyro_scenario(
+        "rlg-validation", seed, profile, rate_hz, latitude_deg, axis, preset, warmed_up=False
+    )
 
 
 def scenario_fog_slow(
@@ -1099,15 +1111,9 @@ def scenario_fog_slow(
     preset: str = "fog",
 ) -> ScenarioResult:
     """Seed-001 slow drift over 15–42 °C of a warmed-up ``fog`` (piecewise bias)."""
-    p = get_preset(preset)
-    program, stages = _program(profile, "fog-slow")
-    rng = scenario_rng("fog-slow", seed, 1)[0]
-    return [
-        _gyro_run(
-            "fog-slow", p, seed, rng, program, stages,
-            rate_hz=rate_hz or p.rate_hz, latitude_deg=latitude_deg, axis=axis, warmed_up=True,
-        )
-    ]  # fmt: skip
+    return _single_gyro_scenario(
+        "fog-slow", seed, profile, rate_hz, latitude_deg, axis, preset, warmed_up=True
+    )
 
 
 def _power_on_windows(profile: ProfileInput, record_s: float) -> tuple[ProgramArrays, list[Stage]]:
