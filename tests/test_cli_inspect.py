@@ -52,13 +52,46 @@ def test_inspect_human_output(capsys: pytest.CaptureFixture[str]) -> None:
 def test_inspect_reports_data_problems(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     path = tmp_path / "bad.csv"
     path.write_text("time,gyro,T1\n0,1,20\n1,,20\n1,3,20\n3,4,20\n")
-    code, out, _ = _run(capsys, "inspect", str(path), "--json")
-    assert code == 0
-    kinds = {p["kind"]: p for p in json.loads(out)["problems"]}
+    code, out, err = _run(capsys, "inspect", str(path), "--json")
+    # like a linter: every finding printed, then exit 2 because the time is unusable
+    assert code == 2
+    assert err.strip().splitlines() == [
+        f"error: {path}: duplicate timestamp 1.0 at row 2 (1 duplicates in all)"
+    ]
+    d = json.loads(out)
+    kinds = {p["kind"]: p for p in d["problems"]}
     assert kinds["duplicate_time"]["row"] == 2
     assert kinds["nan"]["column"] == "gyro"
-    code, _, _ = _run(capsys, "inspect", str(path), "--strict", "--signal", "gyro")
+    assert d["usable"] is False and d["time_ok"] is False
+    assert d["duration_s"] is None and d["n_segments"] is None
+
+
+def test_inspect_backwards_time_exits_2_with_true_summary(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    path = tmp_path / "back.csv"
+    path.write_text("time,gyro,T1\n0,1,20\n1,2,20\n0.5,1,20\n2,1,20\n")
+    code, out, err = _run(capsys, "inspect", str(path))
     assert code == 2
+    assert "time goes backwards at row 2" in out  # the findings are printed first
+    assert "0 contiguous segments" not in out and "over 0 s" not in out
+    assert "duration, sample rate, gaps and segments are not computed" in out
+    lines = err.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith(f"error: {path}: time goes backwards")
+    code, out, _ = _run(capsys, "inspect", str(path), "--json")
+    assert code == 2
+    d = json.loads(out)
+    assert d["sample_rate_hz"] is None and d["duration_s"] is None
+
+
+def test_inspect_warnings_exit_0_unless_strict(capsys: pytest.CaptureFixture[str]) -> None:
+    """Gaps and spikes are warnings: exit 0; --strict makes them fatal (exit 2)."""
+    code, _, err = _run(capsys, "inspect", str(example_path("tvac")), "--json")
+    assert code == 0, err
+    code, out, err = _run(capsys, "inspect", str(example_path("tvac")), "--strict", "--json")
+    assert code == 2
+    assert json.loads(out)["n_samples"] == 6000  # findings still printed
+    assert err.startswith("error: ") and "--strict" in err and "gaps" in err
 
 
 @pytest.mark.parametrize(

@@ -266,7 +266,11 @@ def test_compensate_file_chunked_equals_in_memory(
     assert res.n_rows == run.n_samples
     assert res.n_chunks == math.ceil(run.n_samples / 333)
     assert not res.streamed
-    df = pd.read_csv(out) if out_ext == "csv" else pq.read_table(out).to_pandas()
+    df = (
+        pd.read_csv(out, float_precision="round_trip")
+        if out_ext == "csv"
+        else pq.read_table(out).to_pandas()
+    )
     assert list(df.columns) == [
         "time",
         "gyro",

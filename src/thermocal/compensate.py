@@ -593,7 +593,13 @@ def _iter_chunks(path: Path, kind: str, chunk_rows: int) -> Iterator[pd.DataFram
         pf = pq.ParquetFile(path)
         yield from pf.iter_batches(batch_size=chunk_rows)
     else:
-        reader = pd.read_csv(path, chunksize=chunk_rows, skipinitialspace=True, low_memory=False)
+        reader = pd.read_csv(
+            path,
+            chunksize=chunk_rows,
+            skipinitialspace=True,
+            low_memory=False,
+            float_precision="round_trip",
+        )
         with reader:
             for df in reader:
                 df.columns = [str(c).strip() for c in df.columns]

@@ -55,15 +55,25 @@ class Inspection:
 
     file: str
     n_samples: int
-    duration_s: float
+    duration_s: float | None
+    """Last minus first time [s]; None when time is not finite and strictly increasing."""
     sample_rate_hz: float | None
     median_interval_s: float | None
     gaps: list[dict[str, float]]
-    n_segments: int
+    n_segments: int | None
+    """Gap-free stretches; None when time is not finite and strictly increasing."""
     columns: dict[str, ColumnSummary]
     temperature_span: dict[str, list[float] | None]
     """[min, max] [°C] per temperature column (None if raw counts with no conversion)."""
     problems: list[Problem] = field(default_factory=list)
+    time_ok: bool = True
+    """Time is finite and strictly increasing, so duration, rate, gaps and segments mean
+    something."""
+
+    @property
+    def fatal(self) -> list[Problem]:
+        """Problems that stop the other commands (severity ``error``)."""
+        return [p for p in self.problems if p.severity == "error"]
 
     def to_dict(self) -> dict[str, Any]:
         return {
@@ -78,6 +88,8 @@ class Inspection:
             "columns": {k: v.to_dict() for k, v in self.columns.items()},
             "temperature_span": self.temperature_span,
             "problems": [p.to_dict() for p in self.problems],
+            "time_ok": self.time_ok,
+            "usable": not self.fatal,
         }
 
 
@@ -179,14 +191,15 @@ def inspect_recording(rec: Recording) -> Inspection:
     return Inspection(
         file=rec.name,
         n_samples=rec.n_samples,
-        duration_s=float(t[-1] - t[0]) if t.size > 1 and time_ok else 0.0,
-        sample_rate_hz=(1.0 / med) if np.isfinite(med) and med > 0 else None,
-        median_interval_s=med if np.isfinite(med) else None,
+        duration_s=float(t[-1] - t[0]) if t.size > 1 and time_ok else None,
+        sample_rate_hz=(1.0 / med) if time_ok and np.isfinite(med) and med > 0 else None,
+        median_interval_s=med if time_ok and np.isfinite(med) else None,
         gaps=[{"start_s": g.start_s, "length_s": g.length_s, "after_row": g.index} for g in gaps],
-        n_segments=len(gaps) + 1 if time_ok else 0,
+        n_segments=(len(gaps) + 1 if t.size else 0) if time_ok else None,
         columns=columns,
         temperature_span=span,
         problems=problems,
+        time_ok=time_ok,
     )
 
 

@@ -196,7 +196,13 @@ def _read_table(path: Path, kind: str) -> tuple[pd.DataFrame | _ParquetColumns, 
                 raise FileFormatError(f"{path}: corrupt thermocal metadata") from None
         return table, meta
     try:
-        df = pd.read_csv(path, skipinitialspace=True, comment=None, low_memory=False)
+        df = pd.read_csv(
+            path,
+            skipinitialspace=True,
+            comment=None,
+            low_memory=False,
+            float_precision="round_trip",  # exact decimal → float64 on every pandas version
+        )
     except pd.errors.EmptyDataError:
         raise FileFormatError(f"{path}: the file is empty (no header)") from None
     except (pd.errors.ParserError, UnicodeDecodeError) as exc:

@@ -42,6 +42,22 @@ def _register() -> None:
 _register()
 
 
+def _usage_error_types() -> tuple[type[Exception], ...]:
+    """The exception class a usage error raises: ``typer.TyperException`` from typer 0.28 on
+    (typer no longer depends on click), ``click.ClickException`` before it."""
+    new = getattr(typer, "TyperException", None)
+    if isinstance(new, type) and issubclass(new, Exception):
+        return (new,)
+    import importlib
+
+    click = importlib.import_module("click")  # typer < 0.27 depends on click
+    old: type[Exception] = click.ClickException
+    return (old,)
+
+
+_USAGE_ERRORS = _usage_error_types()
+
+
 def main(argv: list[str] | None = None) -> int:
     """Run the command line; returns the exit status (0 ok, 2 bad input, 1 internal).
 
@@ -55,9 +71,10 @@ def main(argv: list[str] | None = None) -> int:
     except typer.Abort:
         print("error: aborted", file=sys.stderr)
         return 1
-    except typer.TyperException as exc:
+    except _USAGE_ERRORS as exc:
         code = int(getattr(exc, "exit_code", 2))
-        message = " ".join(exc.format_message().split()) or "missing command or argument"
+        text = str(getattr(exc, "format_message", exc.__str__)())
+        message = " ".join(text.split()) or "missing command or argument"
         print(f"error: {message} (see --help)", file=sys.stderr)
         return code if code else 2
     except SystemExit as exc:

@@ -48,14 +48,22 @@ def inspect_cmd(
     temp_unit: TempUnitOpt = None,
     temp_conversion: TempConversionOpt = None,
     strict: Annotated[
-        bool, typer.Option("--strict", help="Exit with status 2 when an error is found.")
+        bool,
+        typer.Option(
+            "--strict",
+            help="Exit with status 2 on warnings (gaps, spikes, skipped columns) too, "
+            "not only on errors.",
+        ),
     ] = False,
     as_json: JsonOpt = False,
 ) -> None:
     """Sample rate, duration, gaps, column ranges, NaNs and problems of a recording.
 
     Temperature columns are taken from --temps, else from the file's metadata,
-    else guessed from their names (T1, temp_..., ...).
+    else guessed from their names (T1, temp_..., ...).  Like a linter, it prints every
+    finding, then exits with status 2 when a problem would stop the other commands
+    (time not increasing, NaN in a signal or temperature, unknown unit, ...); with
+    --strict, warnings count too.
     """
     skipped: list[str] = []
     rec = read_recording(
@@ -90,20 +98,36 @@ def inspect_cmd(
             )
         )
     emit(result.to_dict(), as_json, lambda: _print_human(result))
-    errors = [p for p in result.problems if p.severity == "error"]
-    if strict and errors:
+    errors = result.fatal
+    if errors:
         more = f" ({len(errors) - 1} more errors)" if len(errors) > 1 else ""
         print(f"error: {file}: {one_line(errors[0].message)}{more}", file=sys.stderr)
+        raise typer.Exit(2)
+    warns = [p for p in result.problems if p.severity == "warning"]
+    if strict and warns:
+        more = f" ({len(warns) - 1} more warnings)" if len(warns) > 1 else ""
+        print(
+            f"error: {file}: --strict: {one_line(warns[0].message)}{more}",
+            file=sys.stderr,
+        )
         raise typer.Exit(2)
 
 
 def _print_human(r: Inspection) -> None:
     stdout.print(f"[bold]{r.file}[/bold]")
-    stdout.print(
-        f"{r.n_samples} samples over {fmt(r.duration_s, 6)} s, "
-        f"sample rate {fmt(r.sample_rate_hz, 6)} Hz, {len(r.gaps)} gaps, "
-        f"{r.n_segments} contiguous segments"
-    )
+    if r.time_ok and r.duration_s is not None:
+        stdout.print(
+            f"{r.n_samples} samples over {fmt(r.duration_s, 6)} s, "
+            f"sample rate {fmt(r.sample_rate_hz, 6)} Hz, {len(r.gaps)} gaps, "
+            f"{r.n_segments} contiguous segments"
+        )
+    elif r.time_ok:
+        stdout.print(f"{r.n_samples} samples: too few for a duration or a sample rate")
+    else:
+        stdout.print(
+            f"{r.n_samples} samples; time is not finite and strictly increasing (see the "
+            "errors below), so duration, sample rate, gaps and segments are not computed"
+        )
     table = Table("column", "role", "unit", "min", "max", "mean", "NaN", "spikes")
     for c in r.columns.values():
         table.add_row(
