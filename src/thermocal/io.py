@@ -19,8 +19,12 @@ The sidecar / Parquet metadata is a JSON object::
 from __future__ import annotations
 
 import contextlib
+import fcntl
+import glob
+import hashlib
 import json
 import os
+import secrets
 import tempfile
 from collections.abc import Callable, Iterator
 from pathlib import Path
@@ -52,6 +56,11 @@ PARQUET_SUFFIXES = (".parquet", ".pq")
 def file_kind(path: str | Path) -> str:
     """``'csv'`` or ``'parquet'`` from the extension, else :class:`FileFormatError`."""
     name = str(path).lower()
+    if name.endswith(TEMP_SUFFIX):
+        raise FileFormatError(
+            f"{path}: an unfinished output of an interrupted thermocal run, not a result; "
+            "delete it (the next run to the same output removes it)"
+        )
     if name.endswith(PARQUET_SUFFIXES):
         return "parquet"
     if name.endswith(CSV_SUFFIXES):
@@ -90,39 +99,108 @@ def _writable_target(path: str | Path) -> Path:
     return target
 
 
+TEMP_SUFFIX = ".thermocal-partial"
+"""Suffix of an output being written.  No reader accepts it (:func:`file_kind`), so an
+interrupted write can never be mistaken for a result; the next run that writes the same
+output removes the stale ones (:func:`remove_stale_temporaries`)."""
+
+WRITTEN: list[Path] = []
+"""Outputs completed by this process, in order (the CLI names them when interrupted)."""
+
+
+def _temp_path(target: Path) -> Path:
+    """``.NAME.<pid>.<random>.thermocal-partial`` beside ``target``."""
+    return target.with_name(f".{target.name}.{os.getpid()}.{secrets.token_hex(4)}{TEMP_SUFFIX}")
+
+
+def _pid_alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:  # exists, owned by someone else
+        return True
+    return True
+
+
+def remove_stale_temporaries(target: str | Path) -> list[Path]:
+    """Remove the temporaries of ``target`` left by writers that no longer run.
+
+    A temporary is ``.NAME.<pid>.<random>.thermocal-partial`` (:data:`TEMP_SUFFIX`); it is
+    stale when no process ``pid`` exists (a writer killed by SIGKILL or a power cut).
+    Temporaries of live writers are left alone.  Returns the removed paths.
+    """
+    t = Path(target)
+    removed: list[Path] = []
+    pattern = f".{glob.escape(t.name)}.*{TEMP_SUFFIX}"
+    for cand in t.parent.glob(pattern):
+        middle = cand.name[len(t.name) + 2 : -len(TEMP_SUFFIX)]
+        pid_text = middle.split(".", 1)[0]
+        if not pid_text.isdigit() or _pid_alive(int(pid_text)):
+            continue
+        with contextlib.suppress(OSError):
+            cand.unlink()
+            removed.append(cand)
+    return removed
+
+
+@contextlib.contextmanager
+def _output_lock(target: Path) -> Iterator[None]:
+    """Serialise writers of one output: an exclusive ``flock`` on a lock file kept in the
+    system's temporary directory (so the output's directory holds only the results),
+    named by a hash of the output's absolute path.  A second writer waits its turn."""
+    key = hashlib.sha256(str(target.resolve()).encode("utf-8")).hexdigest()[:32]
+    lock_dir = Path(tempfile.gettempdir()) / f"thermocal-locks-{os.getuid()}"
+    try:
+        lock_dir.mkdir(mode=0o700, exist_ok=True)
+        fd = os.open(lock_dir / f"{key}.lock", os.O_RDWR | os.O_CREAT, 0o600)
+    except OSError:  # no usable temporary directory: write unserialised
+        yield
+        return
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX)
+        yield
+    finally:
+        os.close(fd)  # closing releases the lock
+
+
+@contextlib.contextmanager
+def _temporary_for(path: str | Path) -> Iterator[tuple[Path, Path]]:
+    """(target, temporary) under the output lock, stale temporaries removed first; the
+    temporary is renamed over the target when the block ends without an exception and
+    removed otherwise."""
+    target = _writable_target(path)
+    with _output_lock(target):
+        remove_stale_temporaries(target)
+        tmp = _temp_path(target)
+        try:
+            yield target, tmp
+            os.chmod(tmp, _default_mode())
+            os.replace(tmp, target)
+        except BaseException:
+            with contextlib.suppress(OSError):
+                os.unlink(tmp)
+            raise
+    WRITTEN.append(target)
+
+
 @contextlib.contextmanager
 def atomic_write(path: str | Path, mode: str = "wb") -> Iterator[Any]:
     """Open a temporary file beside ``path``; rename it over ``path`` on success.
 
-    On any exception the temporary file is removed and ``path`` is untouched.
+    On any exception the temporary file is removed and ``path`` is untouched.  Writers
+    of the same output are serialised; temporaries carry :data:`TEMP_SUFFIX`.
     """
-    target = _writable_target(path)
-    fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=target.parent)
-    try:
-        with os.fdopen(fd, mode) as fh:
-            yield fh
-        os.chmod(tmp, _default_mode())
-        os.replace(tmp, target)
-    except BaseException:
-        with contextlib.suppress(OSError):
-            os.unlink(tmp)
-        raise
+    with _temporary_for(path) as (_target, tmp), open(tmp, mode) as fh:
+        yield fh
 
 
 def atomic_write_path(path: str | Path, writer: Callable[[Path], None]) -> None:
     """Call ``writer(tmp_path)`` then rename ``tmp_path`` over ``path`` (for libraries
     that want a path, not a file object)."""
-    target = _writable_target(path)
-    fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=target.parent)
-    os.close(fd)
-    try:
-        writer(Path(tmp))
-        os.chmod(tmp, _default_mode())
-        os.replace(tmp, target)
-    except BaseException:
-        with contextlib.suppress(OSError):
-            os.unlink(tmp)
-        raise
+    with _temporary_for(path) as (_target, tmp):
+        tmp.touch(mode=0o600)
+        writer(tmp)
 
 
 def write_json(path: str | Path, obj: Any) -> None:

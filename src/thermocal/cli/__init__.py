@@ -12,6 +12,7 @@ import sys
 import typer
 
 from thermocal.cli.app import app
+from thermocal.cli.interrupt import report_interrupted
 
 COMMAND_MODULES = (
     "inspect_cmd",
@@ -48,8 +49,6 @@ def _usage_error_types() -> tuple[type[Exception], ...]:
     new = getattr(typer, "TyperException", None)
     if isinstance(new, type) and issubclass(new, Exception):
         return (new,)
-    import importlib
-
     click = importlib.import_module("click")  # typer < 0.27 depends on click
     old: type[Exception] = click.ClickException
     return (old,)
@@ -67,10 +66,11 @@ def main(argv: list[str] | None = None) -> int:
     try:
         result = app(args=argv, prog_name="thermocal", standalone_mode=False)
     except typer.Exit as exc:
+        if isinstance(exc.__cause__, KeyboardInterrupt):  # typer >= 0.27 turns Ctrl-C into Exit
+            return report_interrupted()
         return int(exc.exit_code)
-    except typer.Abort:
-        print("error: aborted", file=sys.stderr)
-        return 1
+    except (typer.Abort, KeyboardInterrupt):  # click turns Ctrl-C into Abort
+        return report_interrupted()
     except _USAGE_ERRORS as exc:
         code = int(getattr(exc, "exit_code", 2))
         text = str(getattr(exc, "format_message", exc.__str__)())

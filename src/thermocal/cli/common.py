@@ -28,6 +28,7 @@ import typer
 from rich.console import Console
 from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
 
+from thermocal.cli.interrupt import report_interrupted
 from thermocal.errors import GapWarning, ThermocalInputError, ThermocalWarning
 from thermocal.io import read_recording
 from thermocal.recording import Metadata, Recording
@@ -244,6 +245,9 @@ def handle_errors(fn: Callable[P, R]) -> Callable[P, R]:
             except (typer.Exit, typer.Abort):
                 _show_warnings(caught)
                 raise
+            except KeyboardInterrupt:
+                _show_warnings(caught)
+                raise typer.Exit(report_interrupted()) from None
             except (ThermocalInputError, FileNotFoundError, IsADirectoryError) as exc:
                 _show_warnings(caught)
                 print(f"error: {one_line(str(exc))}", file=sys.stderr)

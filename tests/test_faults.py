@@ -1,0 +1,148 @@
+"""Faults during writes (issue 14): SIGKILL and Ctrl-C mid-write, stale temporaries, two
+writers of one output.  Each test runs the real command line in a subprocess."""
+
+from __future__ import annotations
+
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from thermocal.errors import FileFormatError
+from thermocal.io import TEMP_SUFFIX, read_recording, remove_stale_temporaries
+
+N_BIG = 400_000
+"""Rows of the file compensated while it is killed: several seconds of writing."""
+
+
+def _cli(*args: str) -> list[str]:
+    return [
+        sys.executable,
+        "-c",
+        "import sys; from thermocal.cli import main; sys.exit(main())",
+        *args,
+    ]
+
+
+@pytest.fixture(scope="module")
+def setup(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, Path]:
+    """A fitted linear model and a large CSV to compensate with it."""
+    d = tmp_path_factory.mktemp("faults")
+    rng = np.random.default_rng(7)
+    n = 2000
+    temp = np.linspace(-10.0, 50.0, n)
+    small = pd.DataFrame(
+        {
+            "time": np.arange(n, dtype=float),
+            "gyro": 0.02 * temp + rng.normal(0, 0.01, n),
+            "T1": temp,
+        }
+    )
+    small.to_csv(d / "fit.csv", index=False)
+    model = d / "model.json"
+    subprocess.run(
+        _cli("fit", str(d / "fit.csv"), "--model", "poly", "--order", "1", "--signal", "gyro",
+             "--signal-unit", "deg/h", "--temps", "T1", "--temp-unit", "degC",
+             "--time-unit", "s", "-o", str(model)),
+        check=True, capture_output=True,
+    )  # fmt: skip
+    t = np.arange(N_BIG, dtype=float) * 0.01
+    big = pd.DataFrame(
+        {"time": t, "gyro": rng.normal(0, 0.01, N_BIG), "T1": 20.0 + 10.0 * np.sin(t / 3000.0)}
+    )
+    big.to_csv(d / "big.csv", index=False)
+    return model, d / "big.csv"
+
+
+def _start_compensate(model: Path, src: Path, out: Path) -> subprocess.Popen[bytes]:
+    return subprocess.Popen(
+        _cli("compensate", str(model), str(src), "-o", str(out), "--signal-unit", "deg/h",
+             "--temp-unit", "degC", "--time-unit", "s"),
+        stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+    )  # fmt: skip
+
+
+def _wait_for_partial(out: Path, proc: subprocess.Popen[bytes], timeout_s: float = 60.0) -> Path:
+    """Wait until the writer has a temporary with data in it, then return it."""
+    end = time.monotonic() + timeout_s
+    while time.monotonic() < end:
+        parts = list(out.parent.glob(f".{out.name}.*{TEMP_SUFFIX}"))
+        if parts and parts[0].stat().st_size > 50_000:
+            return parts[0]
+        if proc.poll() is not None:
+            pytest.fail(f"the writer ended before it was killed: {proc.stderr.read()!r}")  # type: ignore[union-attr]
+        time.sleep(0.02)
+    proc.kill()
+    pytest.fail("no temporary appeared")
+
+
+def test_sigkill_mid_write_leaves_nothing_a_reader_accepts(
+    setup: tuple[Path, Path], tmp_path: Path
+) -> None:
+    model, src = setup
+    out = tmp_path / "out.csv"
+    proc = _start_compensate(model, src, out)
+    partial = _wait_for_partial(out, proc)
+    proc.send_signal(signal.SIGKILL)
+    proc.communicate()
+    assert not out.exists()
+    assert partial.exists()  # SIGKILL cannot clean up: the temporary stays...
+    with pytest.raises(FileFormatError, match="unfinished output"):
+        read_recording(partial)  # ...but no reader takes it for a result
+    # a rerun to the same output removes the stale temporary and leaves only the result
+    proc = _start_compensate(model, src, out)
+    _, err = proc.communicate(timeout=300)
+    assert proc.returncode == 0, err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["out.csv", "out.csv.meta.json"]
+    df = pd.read_csv(out, usecols=["gyro_comp"])
+    assert len(df) == N_BIG
+
+
+def test_ctrl_c_mid_write_exits_130_and_says_what_was_kept(
+    setup: tuple[Path, Path], tmp_path: Path
+) -> None:
+    model, src = setup
+    out = tmp_path / "out.parquet"
+    proc = _start_compensate(model, src, out)
+    _wait_for_partial(out, proc)
+    proc.send_signal(signal.SIGINT)
+    _, err = proc.communicate(timeout=60)
+    assert proc.returncode == 130, err
+    assert err.decode().strip().splitlines()[-1] == "interrupted: nothing written"
+    assert "Traceback" not in err.decode()
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_stale_temporaries_of_dead_writers_only_are_removed(tmp_path: Path) -> None:
+    out = tmp_path / "x.csv"
+    # a pid that no longer exists: a child that has exited and been reaped
+    child = subprocess.Popen([sys.executable, "-c", "pass"])
+    child.wait()
+    dead = tmp_path / f".x.csv.{child.pid}.abcd{TEMP_SUFFIX}"
+    live = tmp_path / f".x.csv.{os.getpid()}.ef01{TEMP_SUFFIX}"
+    other = tmp_path / f".y.csv.{child.pid}.abcd{TEMP_SUFFIX}"
+    for p in (dead, live, other):
+        p.write_text("time\n1\n")
+    removed = remove_stale_temporaries(out)
+    assert removed == [dead]
+    assert live.exists() and other.exists() and not dead.exists()
+
+
+def test_two_writers_of_one_output_are_serialised(setup: tuple[Path, Path], tmp_path: Path) -> None:
+    model, src = setup
+    small = tmp_path / "src.csv"
+    pd.read_csv(src, nrows=200_000).to_csv(small, index=False)
+    out = tmp_path / "out.csv"
+    procs = [_start_compensate(model, small, out) for _ in range(2)]
+    for p in procs:
+        _, err = p.communicate(timeout=300)
+        assert p.returncode == 0, err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["out.csv", "out.csv.meta.json", "src.csv"]
+    df = pd.read_csv(out)
+    assert len(df) == 200_000 and list(df.columns)[-2:] == ["gyro_model", "gyro_comp"]
