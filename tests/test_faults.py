@@ -146,3 +146,36 @@ def test_two_writers_of_one_output_are_serialised(setup: tuple[Path, Path], tmp_
     assert sorted(p.name for p in tmp_path.iterdir()) == ["out.csv", "out.csv.meta.json", "src.csv"]
     df = pd.read_csv(out)
     assert len(df) == 200_000 and list(df.columns)[-2:] == ["gyro_model", "gyro_comp"]
+
+
+def test_corrupt_parquet_written_by_thermocal_is_refused(tmp_path: Path) -> None:
+    """Parquet files written by thermocal carry page checksums, verified on read: bytes
+    overwritten mid-file are an error naming the file, not a silently different number."""
+    from thermocal.io import write_recording
+    from thermocal.recording import Recording
+
+    rng = np.random.default_rng(3)
+    n = 200_000
+    rec = Recording(
+        time_s=np.arange(n) * 0.01,
+        columns={"gyro": rng.normal(0.0, 1.0, n), "T1": np.full(n, 25.0)},
+        units={"gyro": "deg/h", "T1": "degC"},
+        signals=("gyro",),
+        temperatures=("T1",),
+    )
+    good = tmp_path / "good.parquet"
+    write_recording(rec, good)
+    np.testing.assert_array_equal(read_recording(good).columns["gyro"], rec.columns["gyro"])
+    bad = tmp_path / "bad.parquet"
+    data = bytearray(good.read_bytes())
+    mid = len(data) // 4  # inside the first column's data pages
+    data[mid : mid + 2800] = rng.integers(0, 256, 2800, dtype=np.uint8).tobytes()
+    bad.write_bytes(bytes(data))
+    with pytest.raises(FileFormatError, match=r"bad\.parquet.*checksum"):
+        read_recording(bad)
+    proc = subprocess.run(
+        _cli("metrics", str(bad), "--signal", "gyro", "--json"), capture_output=True, text=True
+    )
+    assert proc.returncode == 2
+    assert proc.stdout == ""
+    assert proc.stderr.startswith(f"error: {bad}") and "checksum" in proc.stderr

@@ -262,7 +262,7 @@ def _read_table(path: Path, kind: str) -> tuple[pd.DataFrame | _ParquetColumns, 
         raise FileFormatError(f"{path}: the file is empty")
     if kind == "parquet":
         try:
-            table = _ParquetColumns(pq.ParquetFile(path))
+            table = _ParquetColumns(pq.ParquetFile(path, page_checksum_verification=True))
         except (pa.ArrowInvalid, OSError) as exc:
             raise FileFormatError(f"{path}: not a readable Parquet file ({exc})") from None
         meta: dict[str, Any] = {}
@@ -483,7 +483,7 @@ def write_recording(
     if kind == "parquet":
         table = pa.table(data)
         table = table.replace_schema_metadata({META_KEY: json.dumps(info)})
-        atomic_write_path(p, lambda tmp: pq.write_table(table, tmp))
+        atomic_write_path(p, lambda tmp: pq.write_table(table, tmp, write_page_checksum=True))
         if sidecar:
             write_json(sidecar_path(p), info)
     else:
