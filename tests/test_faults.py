@@ -3,6 +3,7 @@ writers of one output.  Each test runs the real command line in a subprocess."""
 
 from __future__ import annotations
 
+import errno
 import os
 import signal
 import subprocess
@@ -179,3 +180,33 @@ def test_corrupt_parquet_written_by_thermocal_is_refused(tmp_path: Path) -> None
     assert proc.returncode == 2
     assert proc.stdout == ""
     assert proc.stderr.startswith(f"error: {bad}") and "checksum" in proc.stderr
+
+
+@pytest.mark.parametrize(
+    ("err", "text"),
+    [(errno.ENOSPC, "No space left on device"), (errno.EACCES, "Permission denied")],
+)
+def test_full_disk_or_no_permission_is_exit_2_naming_the_output(
+    tmp_path: Path,
+    monkeypatch: pytest.MonkeyPatch,
+    capsys: pytest.CaptureFixture[str],
+    err: int,
+    text: str,
+) -> None:
+    """An OS error while writing (a full disk, a read-only folder) is the user's environment,
+    not a bug: exit 2 naming the output, and no temporary left behind."""
+    import thermocal.io as tio
+    from thermocal.cli import main
+
+    def failing_replace(src: str | Path, dst: str | Path) -> None:
+        raise OSError(err, text, str(src))
+
+    monkeypatch.setattr(tio.os, "replace", failing_replace)
+    out = tmp_path / "prog.csv"
+    code = main(["profile", "fog-slow", "-o", str(out)])
+    _, stderr = capsys.readouterr()
+    assert code == 2
+    assert stderr.strip().splitlines() == [
+        f"error: {out}: cannot write the output ({text}); nothing was written"
+    ]
+    assert list(tmp_path.iterdir()) == []

@@ -19,6 +19,7 @@ The sidecar / Parquet metadata is a JSON object::
 from __future__ import annotations
 
 import contextlib
+import errno
 import fcntl
 import glob
 import hashlib
@@ -104,6 +105,11 @@ TEMP_SUFFIX = ".thermocal-partial"
 interrupted write can never be mistaken for a result; the next run that writes the same
 output removes the stale ones (:func:`remove_stale_temporaries`)."""
 
+_WRITE_ERRORS = frozenset(
+    {errno.EACCES, errno.EPERM, errno.EROFS, errno.ENOSPC, errno.EDQUOT, errno.ENOENT, errno.EFBIG}
+)
+"""Errors of the user's environment while writing an output (permissions, a full disk)."""
+
 WRITTEN: list[Path] = []
 """Outputs completed by this process, in order (the CLI names them when interrupted)."""
 
@@ -177,9 +183,14 @@ def _temporary_for(path: str | Path) -> Iterator[tuple[Path, Path]]:
             yield target, tmp
             os.chmod(tmp, _default_mode())
             os.replace(tmp, target)
-        except BaseException:
+        except BaseException as exc:
             with contextlib.suppress(OSError):
                 os.unlink(tmp)
+            if isinstance(exc, OSError) and exc.errno in _WRITE_ERRORS:
+                # name the output the user asked for, not our temporary
+                raise ThermocalInputError(
+                    f"{target}: cannot write the output ({exc.strerror}); nothing was written"
+                ) from None
             raise
     WRITTEN.append(target)
 

@@ -12,6 +12,7 @@ INTERFACE.md common rules implemented here:
 from __future__ import annotations
 
 import dataclasses
+import errno
 import functools
 import json
 import math
@@ -227,6 +228,24 @@ def one_line(text: str) -> str:
     return " ".join(str(text).split())
 
 
+USER_OS_ERRORS: frozenset[int] = frozenset(
+    {
+        errno.EACCES,
+        errno.EPERM,
+        errno.EROFS,
+        errno.ENOSPC,
+        errno.EDQUOT,
+        errno.ENAMETOOLONG,
+        errno.ENOTDIR,
+        errno.EISDIR,
+        errno.ENOENT,
+        errno.EEXIST,
+        errno.EMFILE,
+    }
+)
+"""OS errors a user causes (exit 2 with ``error:``), as opposed to bugs (exit 1)."""
+
+
 def handle_errors(fn: Callable[P, R]) -> Callable[P, R]:
     """Map exceptions to INTERFACE.md exit statuses.
 
@@ -254,6 +273,11 @@ def handle_errors(fn: Callable[P, R]) -> Callable[P, R]:
                 raise typer.Exit(2) from None
             except Exception as exc:
                 _show_warnings(caught)
+                if isinstance(exc, OSError) and exc.errno in USER_OS_ERRORS:
+                    # the user's environment, not a bug: permissions, a full disk, ...
+                    where = exc.filename if exc.filename is not None else "output"
+                    print(f"error: {where}: {exc.strerror or one_line(str(exc))}", file=sys.stderr)
+                    raise typer.Exit(2) from None
                 if os.environ.get("THERMOCAL_DEBUG"):
                     raise
                 print(
