@@ -53,6 +53,7 @@ from thermocal.errors import (
     UnitError,
 )
 from thermocal.io import (
+    CSV_FLOAT_OPTIONS,
     META_FORMAT,
     META_KEY,
     META_VERSION,
@@ -598,7 +599,7 @@ def _iter_chunks(path: Path, kind: str, chunk_rows: int) -> Iterator[pd.DataFram
             chunksize=chunk_rows,
             skipinitialspace=True,
             low_memory=False,
-            float_precision="round_trip",
+            **CSV_FLOAT_OPTIONS,
         )
         with reader:
             for df in reader:

@@ -67,3 +67,7 @@ class CorrelationWarning(ThermocalWarning):
 
 class ConditioningWarning(ThermocalWarning):
     """A least-squares design is badly conditioned."""
+
+
+class TextEncodingWarning(ThermocalWarning):
+    """A text file is not UTF-8 and was read in another encoding."""

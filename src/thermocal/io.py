@@ -27,6 +27,7 @@ import json
 import os
 import secrets
 import tempfile
+import warnings
 from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import Any
@@ -42,6 +43,7 @@ from thermocal.errors import (
     FileFormatError,
     MissingColumnError,
     NonNumericError,
+    TextEncodingWarning,
     ThermocalInputError,
 )
 from thermocal.recording import FloatArray, Metadata, Recording
@@ -49,6 +51,12 @@ from thermocal.recording import FloatArray, Metadata, Recording
 META_KEY = "thermocal"
 META_FORMAT = "thermocal-recording"
 META_VERSION = 1
+
+CSV_FLOAT_OPTIONS: dict[str, Any] = (
+    {"float_precision": "round_trip"} if int(pd.__version__.split(".")[0]) < 3 else {}
+)
+"""``pandas.read_csv`` options that parse every decimal to the nearest float64 (pandas < 3's
+default parser can be one ulp off; pandas 3 is exact by default and deprecates the option)."""
 
 CSV_SUFFIXES = (".csv", ".txt", ".csv.gz")
 PARQUET_SUFFIXES = (".parquet", ".pq")
@@ -266,6 +274,34 @@ class _ParquetColumns:
         return col
 
 
+def csv_encoding(path: str | Path, probe_bytes: int = 1 << 16) -> str:
+    """The text encoding of a CSV file: ``utf-8-sig`` (UTF-8, with or without a byte-order
+    mark) when its start decodes as UTF-8, else ``latin-1`` (Western lab PCs and
+    instrument software write it; a ``°`` in a header is the usual case, stated in a
+    warning).  UTF-16/32 (NUL bytes) are refused with the remedy.
+    """
+    p = Path(path)
+    with open(p, "rb") as fh:
+        head = fh.read(probe_bytes)
+    if head.startswith((b"\xff\xfe", b"\xfe\xff")) or b"\x00" in head:
+        raise FileFormatError(
+            f"{p}: the text is UTF-16 or UTF-32 encoded (NUL bytes); save it as UTF-8 CSV"
+        )
+    try:
+        head.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        if exc.start < len(head) - 4:  # not just a character cut at the probe's end
+            warnings.warn(
+                TextEncodingWarning(
+                    f"{p}: not UTF-8 (byte {head[exc.start]:#04x} at offset {exc.start}); "
+                    "read as Latin-1"
+                ),
+                stacklevel=3,
+            )
+            return "latin-1"
+    return "utf-8-sig"
+
+
 def _read_table(path: Path, kind: str) -> tuple[pd.DataFrame | _ParquetColumns, dict[str, Any]]:
     if not path.exists():
         raise FileFormatError(f"{path}: no such file")
@@ -284,13 +320,15 @@ def _read_table(path: Path, kind: str) -> tuple[pd.DataFrame | _ParquetColumns, 
             except (json.JSONDecodeError, UnicodeDecodeError):
                 raise FileFormatError(f"{path}: corrupt thermocal metadata") from None
         return table, meta
+    encoding = csv_encoding(path)
     try:
         df = pd.read_csv(
             path,
             skipinitialspace=True,
             comment=None,
             low_memory=False,
-            float_precision="round_trip",  # exact decimal → float64 on every pandas version
+            **CSV_FLOAT_OPTIONS,
+            encoding=encoding,
         )
     except pd.errors.EmptyDataError:
         raise FileFormatError(f"{path}: the file is empty (no header)") from None

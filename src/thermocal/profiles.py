@@ -41,7 +41,7 @@ from thermocal.errors import (
     ThermocalInputError,
     TimestampError,
 )
-from thermocal.io import atomic_write
+from thermocal.io import CSV_FLOAT_OPTIONS, atomic_write
 from thermocal.units import SECONDS_PER_MINUTE
 
 FloatArray = npt.NDArray[np.float64]
@@ -513,7 +513,7 @@ def read_program(path: str | Path) -> tuple[FloatArray, FloatArray]:
     if not p.exists():
         raise FileFormatError(f"{p}: no such file")
     try:
-        df = pd.read_csv(p, skipinitialspace=True, float_precision="round_trip")
+        df = pd.read_csv(p, skipinitialspace=True, **CSV_FLOAT_OPTIONS)
     except (pd.errors.EmptyDataError, pd.errors.ParserError, UnicodeDecodeError) as exc:
         raise FileFormatError(f"{p}: not a readable program CSV ({exc})") from None
     df.columns = [str(c).strip() for c in df.columns]
