@@ -620,6 +620,12 @@ def load_model_dict(path: str | Path) -> dict[str, Any]:
         raise ModelFileError(
             f"{p}: checksum mismatch: the model file was corrupted or edited by hand"
         )
+    from thermocal.models.schema import check_model_dict
+
+    try:
+        check_model_dict(d)
+    except ModelFileError as exc:
+        raise ModelFileError(f"{p}: {exc}") from None
     out: dict[str, Any] = d
     return out
 
