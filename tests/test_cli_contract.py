@@ -162,7 +162,8 @@ def test_piecewise_segments_chosen_with_samples_in_every_segment(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     """Clean linear data (flat RSS surface) used to yield two adjacent breakpoints
-    (27.0632, 27.0663 °C) with no sample between them, and a DesignError."""
+    (27.0632, 27.0663 °C) with no sample between them, and a DesignError.  Now the
+    data are recognised as a line: one segment is fitted and a warning says so."""
     f = tmp_path / "line.csv"
     _frame(3000).to_csv(f, index=False)
     model = tmp_path / "pw.json"
@@ -175,6 +176,10 @@ def test_piecewise_segments_chosen_with_samples_in_every_segment(
     assert d["model"] == "piecewise"
     # the data are a line 1 + 0.05 T with 0.01 noise: the fit's rms is the noise
     assert d["rms_residual"] == pytest.approx(0.01, rel=0.1)
+    assert "warning: piecewise: 3 segments asked for, 1 fitted: the data are a line" in err
+    saved = json.loads(model.read_text())
+    assert saved["state"]["breakpoints"] == []
+    assert saved["fit"]["segment_selection"]["segments_kept"] == 1
 
 
 def test_piecewise_more_segments_than_data_support(
@@ -184,12 +189,15 @@ def test_piecewise_more_segments_than_data_support(
     f = tmp_path / "short.csv"
     pd.DataFrame({"time": t, "gyro": 1.0 + 0.01 * t, "T1": 20.0 + 0.5 * t}).to_csv(f, index=False)
     model = tmp_path / "pw.json"
-    code, out, err = _run(
+    code, _out, err = _run(
         capsys, "fit", str(f), "--model", "piecewise", "--signal", "gyro", "--temps", "T1",
         "--segments", "20", "-o", str(model), "--json",
     )  # fmt: skip
-    _assert_input_error(code, out, err, "20 segments")
-    assert not model.exists()
+    # 30 samples cannot hold 20 segments of ≥ 5 samples: fewer are fitted, and said so
+    assert code == 0, err
+    assert "warning: piecewise: 20 segments asked for, 1 fitted: the data are a line" in err
+    assert "allow at most 6" in err
+    assert json.loads(model.read_text())["state"]["breakpoints"] == []
 
 
 @pytest.fixture

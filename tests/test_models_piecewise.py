@@ -9,7 +9,12 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose, assert_array_equal
 
-from thermocal.errors import DesignError, ExtrapolationWarning, ThermocalInputError
+from thermocal.errors import (
+    DesignError,
+    ExtrapolationWarning,
+    ThermocalInputError,
+    ThermocalWarning,
+)
 from thermocal.models import RunData, get_model_class, load_model, save_model
 from thermocal.models.piecewise import PiecewiseModel, evaluate_lines
 from thermocal.simulate import SCENARIOS
@@ -20,7 +25,21 @@ SLOPES = np.array([0.05, 0.01, 0.08])
 
 
 def truth(T):
-    return evaluate_lines(BPS, INTER, SLOPES, T)
+    """The seed's shape written out independently of the model code: slope 0.05 below
+    23.6 °C, 0.01 up to 30 °C, 0.08 above, value 1.0 at 23.6 °C."""
+    T = np.asarray(T, dtype=float)
+    return (
+        1.0
+        + 0.05 * np.minimum(T - 23.6, 0.0)
+        + 0.01 * np.clip(T - 23.6, 0.0, 6.4)
+        + 0.08 * np.maximum(T - 30.0, 0.0)
+    )
+
+
+def test_truth_matches_the_line_table():
+    """The hand-written lines (INTER, SLOPES) and the hinge formula agree."""
+    T = np.linspace(10.0, 45.0, 3501)
+    assert_allclose(evaluate_lines(BPS, INTER, SLOPES, T), truth(T), atol=1e-12)
 
 
 def make_run(n=12000, noise=0.0, seed=0, gap=False, offset=0.0, name="r"):
@@ -161,3 +180,98 @@ def test_stream_warns_once_per_stream():
     s.reset()
     with pytest.warns(ExtrapolationWarning):
         s.update(0.0, [60.0])
+
+
+# --- the breakpoint search: no degenerate segments, breakpoints only where warranted ----
+
+
+def _history(shape: str, n: int, rng: np.random.Generator) -> np.ndarray:
+    """Temperature histories of several shapes over about 15…42 °C."""
+    u = np.arange(n) / n
+    if shape == "ramp":
+        return 15.0 + 27.0 * u
+    if shape == "cycles":
+        return 28.5 - 13.5 * np.cos(2 * np.pi * 3 * u)
+    if shape == "holds":  # steps of 5 °C with short ramps and sensor noise
+        levels = np.repeat(np.arange(15.0, 45.0, 5.0), n // 6 + 1)[:n]
+        return np.convolve(levels, np.ones(50) / 50, mode="same") + rng.normal(0, 0.01, n)
+    if shape == "uneven":  # most samples near the cold end
+        return 15.0 + 27.0 * u**3
+    raise AssertionError(shape)
+
+
+SHAPES = ("ramp", "cycles", "holds", "uneven")
+
+
+def _segment_widths(m: PiecewiseModel) -> np.ndarray:
+    lo, hi = m.temp_range_[0]
+    return np.diff(np.concatenate([[lo], m.initial_breakpoints_, [hi]])) / (hi - lo)
+
+
+@pytest.mark.parametrize("shape", SHAPES)
+@pytest.mark.parametrize("seed", range(5))
+def test_a_straight_line_is_fitted_as_one_line_with_a_warning(shape, seed):
+    """Data that are one line (slope 0.05 /°C, noise 0.01) and 3 segments asked for: the
+    fit keeps one segment and says so; it never ends on a degenerate segment."""
+    rng = np.random.default_rng(1000 + seed)
+    n = 3000
+    T = _history(shape, n, rng)
+    y = 1.0 + 0.05 * T + 0.01 * rng.standard_normal(n)
+    run = RunData(np.arange(float(n)), T[:, None], y, ("T1",), "line")
+    with pytest.warns(
+        ThermocalWarning, match="3 segments asked for, 1 fitted: the data are a line"
+    ):
+        m = PiecewiseModel(segments=3).fit([run])
+    assert m.breakpoints_.size == 0
+    assert m.slopes_[0] == pytest.approx(0.05, abs=2e-3)
+    sel = m.stats_.extra["segment_selection"]
+    assert sel["segments_requested"] == 3 and sel["segments_kept"] == 1
+
+
+@pytest.mark.parametrize("shape", SHAPES)
+@pytest.mark.parametrize("method", ["intersect", "continuous"])
+def test_real_kinks_are_recovered(shape, method):
+    """Three segments of the seed's shape (corners at 23.6 and 30 °C) with noise
+    0.005: both corners found within 0.3 °C, slopes within 3e-3 /°C, no warning."""
+    rng = np.random.default_rng(7)
+    n = 6000
+    T = _history(shape, n, rng)
+    y = truth(T) + 0.005 * rng.standard_normal(n)
+    run = RunData(np.arange(float(n)), T[:, None], y, ("T1",), "kinks")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", ThermocalWarning)
+        m = PiecewiseModel(segments=3, method=method).fit([run])
+    assert_allclose(m.breakpoints_, BPS, atol=0.3)
+    assert_allclose(m.slopes_, SLOPES, atol=3e-3)
+    assert np.all(_segment_widths(m) >= 0.05 - 1e-12)
+
+
+def test_four_segments_recovered_and_a_fifth_refused():
+    """Corners at 20, 27 and 35 °C (slopes 0.04, −0.02, 0.03, 0.0): with 5 segments asked
+    for, the BIC keeps the true 4 and the warning says so."""
+    rng = np.random.default_rng(11)
+    n = 8000
+    T = _history("cycles", n, rng)
+    y = (
+        0.04 * np.minimum(T - 20.0, 0.0)
+        - 0.02 * np.clip(T - 20.0, 0.0, 7.0)
+        + 0.03 * np.clip(T - 27.0, 0.0, 8.0)
+        + 0.0 * np.maximum(T - 35.0, 0.0)
+        + 0.004 * rng.standard_normal(n)
+    )
+    run = RunData(np.arange(float(n)), T[:, None], y, ("T1",), "four")
+    with pytest.warns(ThermocalWarning, match="5 segments asked for, 4 fitted"):
+        m = PiecewiseModel(segments=5, method="continuous").fit([run])
+    assert_allclose(m.breakpoints_, [20.0, 27.0, 35.0], atol=0.4)
+    assert_allclose(m.slopes_, [0.04, -0.02, 0.03, 0.0], atol=3e-3)
+
+
+def test_more_segments_than_the_width_rule_allows_are_reduced():
+    """A 2 °C span cannot hold 30 segments of ≥ 5 % each: at most 20 are considered."""
+    rng = np.random.default_rng(3)
+    T = np.linspace(20.0, 22.0, 2000)
+    y = 0.1 * T + 0.001 * rng.standard_normal(T.size)
+    run = RunData(np.arange(float(T.size)), T[:, None], y, ("T1",), "narrow")
+    with pytest.warns(ThermocalWarning, match="allow at most 20"):
+        m = PiecewiseModel(segments=30).fit([run])
+    assert np.all(_segment_widths(m) >= 0.05 - 1e-12)

@@ -23,9 +23,11 @@ to get the lines:
   least squares in the hinge basis ``y = c + s_0 T + Σ_j d_j max(0, T − b_j)``.
 
 Breakpoints are given (``breakpoints=[25, 30]``) or chosen from the data
-(``segments=N``): the N−1 breakpoints minimise the residual sum of squares of
-the continuous fit (coordinate search over the 1–99 % temperature quantiles,
-then Nelder–Mead refinement, on temperature-binned data).  Several runs may be
+(``segments=N``, :func:`choose_breakpoints`): at most N−1 breakpoints minimise the
+residual sum of squares of the continuous fit on temperature-binned data, every
+segment at least 5 % of the range wide with enough samples and distinct
+temperatures, and a breakpoint is kept only when it lowers the BIC; fewer segments
+than asked are fitted with a warning.  Several runs may be
 fitted together with per-run offsets (nuisance parameters; the model's level is
 their mean).  Outside the fitted temperature range T is clamped (with an
 :class:`~thermocal.errors.ExtrapolationWarning`) unless extrapolating.
@@ -51,10 +53,10 @@ file; ``j`` = number of breakpoints ``≤ T``; ``y = intercepts[j] + slopes[j]·
 from __future__ import annotations
 
 import bisect
-import itertools
 import math
 import warnings
 from collections.abc import Iterator, Sequence
+from dataclasses import dataclass
 from typing import Any, ClassVar, Self
 
 import numpy as np
@@ -85,8 +87,46 @@ METHODS = ("intersect", "continuous")
 N_BINS = 400
 """Temperature bins (per run) for the breakpoint search."""
 
-MIN_SEGMENT_SAMPLES = 2
-"""Fewest samples a segment may hold (a line needs two points)."""
+MIN_SEGMENT_SAMPLES = 5
+"""Fewest samples a chosen segment may hold."""
+MIN_SEGMENT_WIDTH_FRACTION = 0.05
+"""A chosen segment spans at least this fraction of the data's temperature range (5 %)."""
+MIN_SEGMENT_BINS = 3
+"""A chosen segment holds at least this many distinct temperatures (occupied 1/N_BINS
+bins of the range), so that its line is determined by more than one temperature."""
+
+
+@dataclass(frozen=True)
+class BreakpointChoice:
+    """Outcome of :func:`choose_breakpoints`.
+
+    ``bic[k-1]`` is the Bayesian information criterion of the best continuous fit with
+    k segments (on the temperature-binned data; lower is better); ``supported`` the
+    largest k whose segments can all meet the minimum width, sample and distinct-
+    temperature rules; ``chosen`` the k kept.
+    """
+
+    breakpoints_c: list[float]
+    requested: int
+    supported: int
+    chosen: int
+    bic: list[float]
+
+    @property
+    def reduced(self) -> bool:
+        return self.chosen < self.requested
+
+    def to_dict(self) -> dict[str, Any]:
+        return {
+            "method": "BIC of the continuous fit on temperature-binned means",
+            "segments_requested": self.requested,
+            "segments_supported": self.supported,
+            "segments_kept": self.chosen,
+            "bic": [float(v) for v in self.bic],
+            "min_width_fraction": MIN_SEGMENT_WIDTH_FRACTION,
+            "min_samples": MIN_SEGMENT_SAMPLES,
+            "min_distinct_temperatures": MIN_SEGMENT_BINS,
+        }
 
 
 def segment_index(breakpoints: FloatArray, temp_c: FloatArray) -> npt.NDArray[np.intp]:
@@ -109,34 +149,12 @@ def _hinge_design(x: FloatArray, bps: Sequence[float]) -> FloatArray:
     return np.column_stack(cols)
 
 
-def choose_breakpoints(
-    temps: Sequence[FloatArray],
-    ys: Sequence[FloatArray],
-    n_segments: int,
-    *,
-    per_run_offset: bool = True,
-) -> list[float]:
-    """Breakpoints of ``n_segments`` segments chosen from the data.
-
-    Minimises the RSS of the continuous hinge fit (with per-run offsets) over
-    the ``n_segments − 1`` breakpoint positions: the data are first reduced to
-    per-run temperature bins (mean T, mean y, count as weight), then a
-    coordinate search over the 1–99 % quantiles of T is refined by Nelder–Mead.
-    """
-    if n_segments < 1:
-        raise ThermocalInputError(f"number of segments must be ≥ 1, got {n_segments}")
-    nb = n_segments - 1
-    if nb == 0:
-        return []
-    allx = np.concatenate([np.asarray(t) for t in temps])
-    lo, hi = float(allx.min()), float(allx.max())
-    if not hi > lo:
-        raise DesignError("the temperature does not vary; cannot choose breakpoints")
+def _bin_runs(
+    temps: Sequence[FloatArray], ys: Sequence[FloatArray], lo: float, hi: float, per_run: bool
+) -> tuple[FloatArray, FloatArray, FloatArray, npt.NDArray[np.int64], FloatArray]:
+    """Per-run temperature bins: mean T, mean y, count, run index, bin index."""
     edges = np.linspace(lo, hi, N_BINS + 1)
-    bx: list[FloatArray] = []
-    by: list[FloatArray] = []
-    bw: list[FloatArray] = []
-    bg: list[FloatArray] = []
+    bx, by, bw, bg, bk = [], [], [], [], []
     for r, (x, y) in enumerate(zip(temps, ys, strict=True)):
         k = np.clip(np.searchsorted(edges, x, side="right") - 1, 0, N_BINS - 1)
         cnt = np.bincount(k, minlength=N_BINS).astype(np.float64)
@@ -146,22 +164,71 @@ def choose_breakpoints(
         bx.append(sx[ok] / cnt[ok])
         by.append(sy[ok] / cnt[ok])
         bw.append(cnt[ok])
-        bg.append(np.full(int(ok.sum()), r if per_run_offset else 0, dtype=np.float64))
-    X = np.concatenate(bx)
-    Y = np.concatenate(by)
-    W = np.sqrt(np.concatenate(bw))
-    G = np.concatenate(bg).astype(np.int64)
+        bg.append(np.full(int(ok.sum()), r if per_run else 0, dtype=np.int64))
+        bk.append(np.flatnonzero(ok).astype(np.float64))
+    return (
+        np.concatenate(bx),
+        np.concatenate(by),
+        np.concatenate(bw),
+        np.concatenate(bg),
+        np.concatenate(bk),
+    )
+
+
+def choose_breakpoints(
+    temps: Sequence[FloatArray],
+    ys: Sequence[FloatArray],
+    n_segments: int,
+    *,
+    per_run_offset: bool = True,
+) -> BreakpointChoice:
+    """Breakpoints of at most ``n_segments`` segments chosen from the data (SPEC §4b,
+    our reading: "a continuous piecewise-linear fit with breakpoints chosen by the data").
+
+    The data are reduced to per-run temperature bins (mean T, mean y, count; N_BINS bins
+    over the range).  For each k = 1 … K the k − 1 breakpoints minimise the weighted
+    residual sum of squares RSS_k of the continuous hinge fit
+    ``y = c_r + s_0 T + Σ_j d_j max(0, T − b_j)`` (coordinate search over the 1–99 %
+    quantiles of T, then Nelder–Mead), subject to every segment spanning at least
+    :data:`MIN_SEGMENT_WIDTH_FRACTION` of the range and holding at least
+    :data:`MIN_SEGMENT_SAMPLES` samples over :data:`MIN_SEGMENT_BINS` distinct
+    temperatures, so that no segment can collapse onto a few samples.  K is
+    ``n_segments`` or the largest number of segments those rules allow.  The number kept
+    minimises the Bayesian information criterion (Schwarz 1978,
+    doi:10.1214/aos/1176344136) on the binned means,
+    ``BIC_k = n_b ln(RSS_k / n_b) + p_k ln n_b``, ``p_k = m + 1 + 2(k − 1)`` (m run
+    levels, the slope, and a slope change and a location per breakpoint): a breakpoint
+    is kept only when the data warrant it.  Binning averages the within-bin noise, so
+    coloured chamber noise inflates the criterion less than it would per sample.
+    """
+    if n_segments < 1:
+        raise ThermocalInputError(f"number of segments must be ≥ 1, got {n_segments}")
+    allx = np.concatenate([np.asarray(t) for t in temps])
+    lo, hi = float(allx.min()), float(allx.max())
+    if not hi > lo:
+        raise DesignError("the temperature does not vary; cannot choose breakpoints")
+    X, Y, cnt, G, K = _bin_runs(temps, ys, lo, hi, per_run_offset)
+    W = np.sqrt(cnt)
     groups = int(G.max()) + 1
     Z = np.zeros((X.size, groups))
     Z[np.arange(X.size), G] = 1.0
     xc = (X - lo) / (hi - lo)
     sorted_x = np.sort(allx)
+    sorted_bins = np.unique(K) / N_BINS  # left edges of occupied bins, normalised
+    n_b = X.size
 
     def supported(bps_c: Sequence[float]) -> bool:
-        # every segment keeps >= MIN_SEGMENT_SAMPLES samples (segment_index convention)
-        below = np.searchsorted(sorted_x, lo + np.asarray(bps_c) * (hi - lo), side="left")
+        b = np.asarray(bps_c, dtype=np.float64)
+        bounds = np.concatenate([[0.0], b, [1.0]])
+        if np.any(np.diff(bounds) < MIN_SEGMENT_WIDTH_FRACTION - 1e-9):
+            return False
+        below = np.searchsorted(sorted_x, lo + b * (hi - lo), side="left")
         counts = np.diff(np.concatenate([[0], below, [sorted_x.size]]))
-        return bool(np.all(counts >= MIN_SEGMENT_SAMPLES))
+        if np.any(counts < MIN_SEGMENT_SAMPLES):
+            return False
+        # distinct temperatures: occupied bins whose left edge lies in the segment
+        nb_in = np.diff(np.searchsorted(sorted_bins, bounds, side="left"))
+        return bool(np.all(nb_in >= MIN_SEGMENT_BINS))
 
     def rss(bps_c: Sequence[float]) -> float:
         cols = [Z, xc[:, None]] + [np.maximum(0.0, xc - b)[:, None] for b in bps_c]
@@ -170,49 +237,77 @@ def choose_breakpoints(
         res = Y * W - A @ beta
         return float(res @ res)
 
-    qx = np.quantile(allx, np.linspace(0.01, 0.99, 99))
-    cand = np.unique((qx - lo) / (hi - lo))
-    start = np.quantile(allx, np.linspace(0, 1, n_segments + 1)[1:-1])
-    cur = list((start - lo) / (hi - lo))
-    if not supported(cur):
-        raise DesignError(
-            f"{n_segments} segments need at least {MIN_SEGMENT_SAMPLES} samples each over "
-            f"distinct temperatures; the data ({allx.size} samples, {lo:.4g}…{hi:.4g} °C) "
-            "do not support that many (use fewer --segments)"
-        )
-    best = rss(cur)
-    for _sweep in range(10):
-        changed = False
-        for j in range(nb):
-            left = cur[j - 1] if j > 0 else 0.0
-            right = cur[j + 1] if j < nb - 1 else 1.0
-            for c in cand:
-                if not left < c < right:
-                    continue
-                trial = [*cur[:j], float(c), *cur[j + 1 :]]
-                if not supported(trial):
-                    continue
-                v = rss(trial)
-                if v < best - 1e-12 * abs(best):
-                    best, cur, changed = v, trial, True
-        if not changed:
-            break
-
-    def penalised(v: FloatArray) -> float:
-        s = list(v)
-        if (
-            any(b <= 0.0 or b >= 1.0 for b in s)
-            or any(b2 <= b1 for b1, b2 in itertools.pairwise(s))
-            or not supported(s)
+    def start(k: int) -> list[float] | None:
+        """A feasible placement of k − 1 breakpoints (quantiles, else equal widths)."""
+        if k == 1:
+            return []
+        for guess in (
+            (np.quantile(allx, np.linspace(0, 1, k + 1)[1:-1]) - lo) / (hi - lo),
+            np.linspace(0, 1, k + 1)[1:-1],
         ):
-            return best * 10.0 + 1.0
-        return rss(s)
+            cur = [float(v) for v in guess]
+            if supported(cur):
+                return cur
+        return None
 
-    res = optimize.minimize(
-        penalised, np.array(cur), method="Nelder-Mead", options={"xatol": 1e-5, "fatol": 0.0}
+    cand = np.unique((np.quantile(allx, np.linspace(0.01, 0.99, 99)) - lo) / (hi - lo))
+
+    def search(cur: list[float]) -> tuple[list[float], float]:
+        nb = len(cur)
+        best = rss(cur)
+        if nb == 0:
+            return cur, best
+        for _sweep in range(10):
+            changed = False
+            for j in range(nb):
+                left = cur[j - 1] if j > 0 else 0.0
+                right = cur[j + 1] if j < nb - 1 else 1.0
+                for c in cand:
+                    if not left < c < right:
+                        continue
+                    trial = [*cur[:j], float(c), *cur[j + 1 :]]
+                    if not supported(trial):
+                        continue
+                    v = rss(trial)
+                    if v < best - 1e-12 * abs(best):
+                        best, cur, changed = v, trial, True
+            if not changed:
+                break
+        worst = best * 10.0 + 1.0
+
+        def penalised(v: FloatArray) -> float:
+            s = sorted(float(b) for b in v)
+            return rss(s) if supported(s) else worst
+
+        res = optimize.minimize(
+            penalised, np.array(cur), method="Nelder-Mead", options={"xatol": 1e-5, "fatol": 0.0}
+        )
+        if res.fun < best:
+            cur, best = sorted(float(b) for b in res.x), float(res.fun)
+        return cur, best
+
+    fits: list[tuple[list[float], float]] = []
+    for k in range(1, n_segments + 1):
+        first = start(k)
+        if first is None:
+            break
+        fits.append(search(first))
+    # residuals below float64 resolution of the data are all the same "exact fit": floor
+    # RSS there, so that noise-free data keep the fewest segments, not rounding noise
+    floor = n_b * (1e-9 * float(np.max(np.abs(Y * W))) + np.finfo(np.float64).tiny) ** 2
+    bic = [
+        n_b * math.log(max(r, floor) / n_b) + (groups + 1 + 2 * (k - 1)) * math.log(n_b)
+        for k, (_b, r) in enumerate(fits, start=1)
+    ]
+    chosen = int(np.argmin(bic)) + 1
+    bps = fits[chosen - 1][0]
+    return BreakpointChoice(
+        breakpoints_c=[float(lo + b * (hi - lo)) for b in bps],
+        requested=n_segments,
+        supported=len(fits),
+        chosen=chosen,
+        bic=bic,
     )
-    final = list(res.x) if res.fun < best else cur
-    return [float(lo + b * (hi - lo)) for b in sorted(final)]
 
 
 @register
@@ -322,6 +417,7 @@ class PiecewiseModel(TemperatureModel):
         ys = [r.target() for r in rl]
         lo = min(float(x.min()) for x in xs)
         hi = max(float(x.max()) for x in xs)
+        choice: BreakpointChoice | None = None
         if self.breakpoints is not None:
             bps = sorted(float(b) for b in self.breakpoints)
             for b in bps:
@@ -334,7 +430,33 @@ class PiecewiseModel(TemperatureModel):
                 raise ThermocalInputError("breakpoints must be distinct")
         else:
             n_seg = 3 if self.segments is None else int(self.segments)
-            bps = choose_breakpoints(xs, ys, n_seg, per_run_offset=self.per_run_offset)
+            choice = choose_breakpoints(xs, ys, n_seg, per_run_offset=self.per_run_offset)
+            bps = choice.breakpoints_c
+            if choice.reduced:
+                reasons = []
+                if choice.supported < n_seg:
+                    reasons.append(
+                        f"segments of ≥ {MIN_SEGMENT_WIDTH_FRACTION:.0%} of the "
+                        f"{lo:.4g}…{hi:.4g} °C range with ≥ {MIN_SEGMENT_SAMPLES} samples over "
+                        f"≥ {MIN_SEGMENT_BINS} distinct temperatures allow at most "
+                        f"{choice.supported}"
+                    )
+                if choice.chosen < choice.supported:
+                    reasons.append("more breakpoints do not lower the BIC")
+                what = (
+                    "the data are a line"
+                    if choice.chosen == 1
+                    else f"the data support {choice.chosen}"
+                )
+                warnings.warn(
+                    f"piecewise: {n_seg} segments asked for, {choice.chosen} fitted: {what} ("
+                    + "; ".join(reasons)
+                    + "; BIC by number of segments: "
+                    + ", ".join(f"{k}: {v:.1f}" for k, v in enumerate(choice.bic, start=1))
+                    + ")",
+                    ThermocalWarning,
+                    stacklevel=2,
+                )
         bp = np.asarray(bps, dtype=np.float64)
         S = bp.size + 1
         seg_edges = [lo, *bps, hi]
@@ -342,10 +464,18 @@ class PiecewiseModel(TemperatureModel):
         counts = np.zeros(S, dtype=np.int64)
         for x in xs:
             counts += np.bincount(segment_index(bp, x), minlength=S)
+        spans = np.zeros(S)
+        for x in xs:
+            seg = segment_index(bp, x)
+            for s_ in range(S):
+                xs_ = x[seg == s_]
+                if xs_.size:
+                    spans[s_] = max(spans[s_], float(np.ptp(xs_)))
         for s in range(S):
-            if counts[s] < 2:
+            if counts[s] < 2 or not spans[s] > 1e-9 * max(1.0, abs(hi)):
                 raise DesignError(
-                    f"segment {labels[s]} has {int(counts[s])} sample(s); a line needs at least 2 "
+                    f"segment {labels[s]} has {int(counts[s])} sample(s) over "
+                    f"{spans[s]:.3g} °C; a line needs at least 2 distinct temperatures "
                     "(move or drop a breakpoint)"
                 )
         m = len(rl) if self.per_run_offset else 1
@@ -472,6 +602,7 @@ class PiecewiseModel(TemperatureModel):
                 "n_runs": len(rl),
                 "per_run_offsets": [float(o) for o in offsets] if self.per_run_offset else None,
                 "rms_residual_lsq": math.sqrt(sol.rss / n_total),
+                "segment_selection": None if choice is None else choice.to_dict(),
             },
         )
         # ranges of the used column only (record_ranges takes per-run min/max)
