@@ -54,8 +54,12 @@ def turntable_cmd(
         typer.Option("--arw", help="Angle random walk [°/√h] (default: from the dwells)."),
     ] = None,
     encoder_noise: Annotated[
-        float, typer.Option("--encoder-noise", help="Encoder noise σ [arcsec].")
-    ] = 0.0,
+        float | None,
+        typer.Option(
+            "--encoder-noise",
+            help="Encoder reading noise σ [arcsec] (default: estimated from the dwells).",
+        ),
+    ] = None,
     min_dwell: Annotated[
         float, typer.Option("--min-dwell", help="Shortest dwell accepted [s].")
     ] = 60.0,

@@ -9,6 +9,7 @@ the Cramér–Rao bound of the design (:func:`.model.fisher_information`).
 
 from __future__ import annotations
 
+import dataclasses
 import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass, field
@@ -105,6 +106,14 @@ class TurntableResult:
     normalised_innovation_rms: float
     weak_combinations: tuple[dict[str, Any], ...] = ()
     warnings: tuple[str, ...] = field(default=())
+    encoder_noise_arcsec: float = 0.0
+    """σ of one encoder reading used by the filter and least squares [″]."""
+    encoder_noise_source: str = "option"
+    """``"option"`` (given) or ``"dwells"`` (estimated from the readings at rest)."""
+    encoder_jitter_arcsec: float = 0.0
+    """White jitter of the readings at rest, estimated from the dwells [″]."""
+    encoder_quantum_deg: float = 0.0
+    """Reading resolution found in the data [°] (0: not quantised)."""
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready dict with the INTERFACE.md keys (from the Kalman filter)."""
@@ -127,6 +136,10 @@ class TurntableResult:
         out["channels"] = list(model.CHANNEL_NAMES[: self.n_channels])
         out["n_positions"] = self.n_positions
         out["n_dwells"] = self.n_dwells
+        out["encoder_noise_arcsec"] = self.encoder_noise_arcsec
+        out["encoder_noise_source"] = self.encoder_noise_source
+        out["encoder_jitter_arcsec"] = self.encoder_jitter_arcsec
+        out["encoder_quantum_deg"] = self.encoder_quantum_deg
         out["min_dwell_s"] = self.min_dwell_s
         out["duration_s"] = self.duration_s
         out["chi2_per_dof"] = self.chi2_per_dof
@@ -214,7 +227,7 @@ def calibrate(
     beta_column: str = "beta_deg",
     gyro_unit: str | None = None,
     arw_deg_sqrt_h: float | Sequence[float] | None = None,
-    encoder_noise_arcsec: float = 0.0,
+    encoder_noise_arcsec: float | None = None,
     channels: int = 3,
     min_positions: int = 16,
     min_dwell_s: float = 60.0,
@@ -233,7 +246,9 @@ def calibrate(
     gyro_unit : unit of the gyro columns (default: the recording's, else deg/s).
     arw_deg_sqrt_h : angle random walk [°/√h], scalar or per axis; estimated from the
         dwells when None.
-    encoder_noise_arcsec : white noise σ of the encoder readings [″].
+    encoder_noise_arcsec : white noise σ of the encoder readings [″]; estimated from the
+        readings at rest (jitter, or quantisation q/√12) when None
+        (:func:`.schedule.detect_motion`).
     channels : 3 (Δα, Δβ, Δγ; 15-state filter) or 2 (the SPEC's Δα, Δβ; 14 states).
     min_positions, min_dwell_s : design checks (:func:`.schedule.check_design`).
     move_block_s : least squares: rotations cut into increments of at most this [s].
@@ -265,6 +280,15 @@ def calibrate(
     a_deg = np.unwrap(rec.column(alpha_column), period=360.0)
     b_deg = np.unwrap(rec.column(beta_column), period=360.0)
     full = model.interval_model(t, g, a_deg * units.DEG_TO_RAD, b_deg * units.DEG_TO_RAD, lat)
+    # moves and rests from the encoder readings themselves, robust to jitter and
+    # quantisation (a per-sample rate threshold is crossed by arcseconds of jitter)
+    motion = schedule.detect_motion(t, a_deg, b_deg)
+    full = dataclasses.replace(full, moving=motion.moving)
+    if encoder_noise_arcsec is None:
+        encoder_noise_arcsec = motion.reading_sigma_arcsec
+        noise_source = "dwells"
+    else:
+        noise_source = "option"
     schedule.warn_gaps(rec.name, t, full.valid)
     seg = schedule.segment(t, a_deg, b_deg, full.moving, full.valid)
     dt_med = float(np.median(full.dt_s))
@@ -292,19 +316,37 @@ def calibrate(
 
     # with perfect encoders a dwell's increments are a sufficient statistic; with encoder
     # noise each reading at rest adds information, so the dwells are cut like the filter's
+    # A quantised encoder without jitter reads the same value all through a dwell: its
+    # reading error is one constant per dwell, not white, so a dwell is one measurement.
+    constant_at_rest = motion.quantum_deg > 0 and motion.noise_arcsec == 0
+    static_block = kf_interval_s if encoder_noise_arcsec > 0 and not constant_at_rest else None
     ls_blocks = estimate_ls.make_blocks(
         m,
         arw,
-        max_static_block_s=kf_interval_s if encoder_noise_arcsec > 0 else None,
+        max_static_block_s=static_block,
         max_move_block_s=move_block_s,
     )
     ls = estimate_ls.solve_ls(ls_blocks, encoder_noise_arcsec=encoder_noise_arcsec)
     kf_blocks = estimate_ls.make_blocks(
-        m, arw, max_static_block_s=kf_interval_s, max_move_block_s=kf_interval_s
+        m,
+        arw,
+        max_static_block_s=None if constant_at_rest else kf_interval_s,
+        max_move_block_s=kf_interval_s,
     )
     prior = np.repeat(np.asarray(prior_sigma, dtype=np.float64), [3, 3, 6])
     kf = kalman.run_filter(kf_blocks, prior, encoder_noise_arcsec=encoder_noise_arcsec)
 
+    if motion.quantum_deg > 0:
+        # The inner encoder's reading defines body x (the stated constraint); a quantised
+        # reading leaves that definition uncertain by q/√12, which moves yx and xy
+        # together in opposite directions (azimuth ψ: yx = +ψ, xy = −ψ) and is not averaged
+        # over a dwell.  Add it to both covariances.
+        v = np.zeros(model.N_COEFFS)
+        v[6 + model.MISALIGNMENT_NAMES.index("yx")] = 1.0
+        v[6 + model.MISALIGNMENT_NAMES.index("xy")] = -1.0
+        az_var = (motion.quantum_deg * units.DEG_TO_RAD * units.RAD_TO_ARCSEC) ** 2 / 12.0
+        kf = dataclasses.replace(kf, cov=kf.cov + az_var * np.outer(v, v))
+        ls = dataclasses.replace(ls, cov=ls.cov + az_var * np.outer(v, v))
     msgs: list[str] = []
     agreement = float(np.max(np.abs(kf.theta - ls.theta) / np.maximum(ls.sigma, 1e-300)))
     if agreement > 1.0:
@@ -343,6 +385,10 @@ def calibrate(
         normalised_innovation_rms=kf.normalised_innovation_rms,
         weak_combinations=weak,
         warnings=tuple(msgs),
+        encoder_noise_arcsec=float(encoder_noise_arcsec),
+        encoder_noise_source=noise_source,
+        encoder_jitter_arcsec=motion.noise_arcsec,
+        encoder_quantum_deg=motion.quantum_deg,
     )
 
 

@@ -168,6 +168,135 @@ class Segmentation:
     beta_travel_deg: float
 
 
+@dataclass(frozen=True)
+class Motion:
+    """Moves and rests found in encoder readings (:func:`detect_motion`).
+
+    ``moving`` per sample interval (n − 1,); ``noise_arcsec`` the white jitter σ of the
+    readings at rest [″] (robust, per axis, the larger); ``quantum_deg`` the reading
+    resolution [°] when the readings lie on a grid (else 0); ``tolerance_deg`` the band
+    [°] within which an angle counts as held."""
+
+    moving: npt.NDArray[np.bool_]
+    noise_arcsec: float
+    quantum_deg: float
+    tolerance_deg: float
+
+    @property
+    def reading_sigma_arcsec(self) -> float:
+        """σ of one reading [″]: the jitter, or the quantisation σ q/√12 where the jitter
+        is below it (a quantised reading at rest is constant, its error unknown)."""
+        return float(max(self.noise_arcsec, self.quantum_deg * 3600.0 / np.sqrt(12.0)))
+
+
+MOTION_WINDOW_S: Final = 0.05
+"""Half-width of the window over which an angle must stay in its band to be at rest [s]."""
+
+
+QUANTUM_CANDIDATES_DEG: Final = tuple(
+    sorted(
+        {m * 10.0**-k for k in range(0, 7) for m in (5.0, 2.0, 1.0)}
+        | {360.0 / 2.0**n for n in range(8, 29)},
+        reverse=True,
+    )
+)
+"""Reading resolutions tried [°]: decimal displays (1, 0.5, 0.2, 0.1, … 1e-6) and binary
+encoders (360/2ⁿ, n = 8 … 28)."""
+
+
+MAX_QUANTUM_DEG: Final = 0.01
+"""Coarsest reading resolution taken for an encoder grid [°] (36″)."""
+
+
+def _quantum(readings_deg: FloatArray, max_values: int = 100_000) -> float:
+    """Reading resolution [°]: the largest of :data:`QUANTUM_CANDIDATES_DEG` on whose grid
+    every reading lies (to 1e-6 of a grid step), else 0 (not quantised)."""
+    x = np.mod(np.asarray(readings_deg, dtype=np.float64), 360.0)
+    if x.size > max_values:
+        x = x[:: x.size // max_values + 1]
+    x = np.unique(x)
+    if x.size < 10:
+        return 0.0
+    for q in QUANTUM_CANDIDATES_DEG:
+        r = x / q
+        if np.all(np.abs(r - np.round(r)) < 1e-6 * np.maximum(1.0, np.abs(r)) + 1e-9):
+            # on a grid coarser than any calibration-table encoder: the angles are exact
+            # round numbers (a programmed trajectory), not readings of a coarse encoder
+            return float(q) if q <= MAX_QUANTUM_DEG else 0.0
+    return 0.0
+
+
+def detect_motion(time_s: FloatArray, alpha_deg: FloatArray, beta_deg: FloatArray) -> Motion:
+    """Classify each sample interval as moving or at rest, robustly to encoder jitter and
+    quantisation (issue 12: a per-sample rate threshold is crossed by a few arcseconds of
+    jitter at 100–200 Hz).
+
+    1. Noise: σ from the median absolute deviation of second differences of the unwrapped
+       angles, ``σ = 1.4826 · MAD(Δ²θ) / √6`` (a second difference of white noise has
+       variance 6σ²; moves are a minority of the samples and constant-rate motion has
+       zero second difference), per axis; the reading grid q from the values
+       (:func:`_quantum`).
+    2. Tolerance band ``tol = 8σ + 2q + 2″``.
+    3. A sample is at rest when both angles stay within ``tol`` over ±
+       :data:`MOTION_WINDOW_S` (at least ±1 sample): the range over the window ≤ tol.
+    4. Hysteresis: each run of such samples is extended sample by sample while both angles
+       stay within ``tol`` of the run's median, so a dwell keeps its full length.
+
+    An interval is moving unless both of its samples belong to the same rest run.
+    """
+    from scipy.ndimage import maximum_filter1d, minimum_filter1d
+
+    t = np.asarray(time_s, dtype=np.float64)
+    n = t.size
+    angles = [np.asarray(alpha_deg, dtype=np.float64), np.asarray(beta_deg, dtype=np.float64)]
+    if n < 3:
+        return Motion(np.zeros(max(n - 1, 0), dtype=bool), 0.0, 0.0, 0.0)
+    dt_med = float(np.median(np.diff(t)))
+    half = max(1, round(MOTION_WINDOW_S / dt_med)) if dt_med > 0 else 1
+    sig = []
+    for x in angles:
+        d2 = np.diff(x, 2)
+        sig.append(1.4826 * float(np.median(np.abs(d2 - np.median(d2)))) / np.sqrt(6.0))
+    sigma_deg = max(sig)
+    q = max(
+        _quantum(np.asarray(alpha_deg, dtype=np.float64)),
+        _quantum(np.asarray(beta_deg, dtype=np.float64)),
+    )
+    tol = 8.0 * sigma_deg + 2.0 * q + 2.0 / 3600.0
+    rest = np.ones(n, dtype=bool)
+    for x in angles:
+        rng_ = maximum_filter1d(x, 2 * half + 1, mode="nearest") - minimum_filter1d(
+            x, 2 * half + 1, mode="nearest"
+        )
+        rest &= rng_ <= tol
+    label = np.full(n, -1, dtype=np.int64)
+    for k, (a, b) in enumerate(runs(rest)):
+        med = [float(np.median(x[a:b])) for x in angles]
+
+        def inside(i: int, med: list[float] = med) -> bool:
+            return all(abs(x[i] - m) <= tol for x, m in zip(angles, med, strict=True))
+
+        while a > 0 and label[a - 1] < 0 and inside(a - 1):
+            a -= 1
+        while b < n and inside(b):
+            b += 1
+        label[a:b] = k
+    moving = ~((label[:-1] >= 0) & (label[:-1] == label[1:]))
+    # the jitter itself, from the rest samples about their run medians (robust)
+    dev = []
+    for x in angles:
+        resid = []
+        for k in np.unique(label[label >= 0]):
+            xs = x[label == k]
+            resid.append(xs - np.median(xs))
+        r = np.concatenate(resid) if resid else np.zeros(1)
+        dev.append(1.4826 * float(np.median(np.abs(r))))
+    noise_arcsec = float(max(dev)) * 3600.0
+    if q > 0 and noise_arcsec < q * 3600.0:
+        noise_arcsec = 0.0  # steps of one grid unit at rest are quantisation, not jitter
+    return Motion(moving, noise_arcsec, q, tol)
+
+
 def runs(mask: npt.NDArray[np.bool_]) -> list[tuple[int, int]]:
     """Maximal runs ``[start, stop)`` where ``mask`` is true."""
     m = np.concatenate([[False], np.asarray(mask, dtype=bool), [False]])
