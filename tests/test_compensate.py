@@ -177,13 +177,19 @@ def test_toy_stream_equals_predict() -> None:
     np.testing.assert_allclose(ys, y, rtol=1e-12, atol=1e-12)
 
 
-def test_batch_compensation_is_signal_minus_model() -> None:
-    run = _toy_run()
-    m = _fitted_toy(run)
+def test_batch_compensation_removes_a_known_line() -> None:
+    """A poly model fitted to an exact line y = 0.4 + 0.03 T (no noise): the model values
+    are that line and the compensated signal is what was added on top of it, both
+    written out here, not computed by the code under test."""
+    t = np.arange(500.0)
+    T = 10.0 + 0.05 * t
+    extra = np.sin(t / 7.0)  # what the temperature model must leave untouched
+    fit_run = RunData(t, T[:, None], 0.4 + 0.03 * T, ("T1",), "fit")
+    m = make_model("poly", terms="T1", per_run_offset=False).fit([fit_run])
+    run = RunData(t, T[:, None], 0.4 + 0.03 * T + extra, ("T1",), "apply")
     res = compensate_run(m, run)
-    assert run.signal is not None
-    np.testing.assert_array_equal(res.corrected, run.signal - m.predict(run))
-    np.testing.assert_array_equal(res.model_value, m.predict(run))
+    np.testing.assert_allclose(res.model_value, 0.4 + 0.03 * T, rtol=0, atol=1e-10)
+    np.testing.assert_allclose(res.corrected, extra, rtol=0, atol=1e-10)
 
 
 def test_streaming_compensator_equals_batch_with_gap_and_reset() -> None:

@@ -60,6 +60,15 @@ def test_temperature_sensitivity_both_figures() -> None:
         metrics.temperature_sensitivity([1.0, 1.0], [0.0, 1.0])
 
 
+def test_temperature_sensitivity_of_a_non_monotonic_bias() -> None:
+    """Bias up then down: |ΔB/ΔT| = |2/10| and |−1/20| → mean 0.125 °/h/°C (the signed
+    mean would be 0.075); least-squares slope by hand: T̄ = 10/3, B̄ = 2,
+    Σ(T−T̄)(B−B̄) = 10, Σ(T−T̄)² = 1400/3 → 3/140."""
+    ts = metrics.temperature_sensitivity([-10.0, 0.0, 20.0], [1.0, 3.0, 2.0])
+    assert ts.mean_abs_adjacent == pytest.approx(0.125, rel=1e-12)
+    assert ts.ls_slope == pytest.approx(3.0 / 140.0, rel=1e-12)
+
+
 def test_peak_to_peak_raw() -> None:
     assert metrics.peak_to_peak([1.0, 5.0, -2.0], 1.0, None) == pytest.approx(7.0)
 
@@ -118,8 +127,15 @@ def test_compute_metrics_on_a_chamber_run() -> None:
     # four holds; bias per hold ≈ 2 + 0.02 T; the two 10 °C holds pooled → 3 points
     assert len(res.stages) == 4
     assert [round(s.mean_temp_c) for s in res.stages] == [-10, 10, 30, 10]
-    sb = np.array([s.bias for s in res.stages])
-    assert res.bias_repeatability == pytest.approx(np.std(sb, ddof=1), rel=1e-12)
+    # each hold's bias is the truth 2 + 0.02 T with the earth rate removed (noise 0.05 °/h
+    # over ≥ 1200 s: σ of a hold mean ≤ 0.0015 °/h)
+    for s in res.stages:
+        assert s.bias == pytest.approx(2.0 + 0.02 * s.mean_temp_c, abs=0.006)
+    # repeatability of the truth's hold biases 1.8, 2.2, 2.6, 2.2: sample σ = 0.3266 °/h
+    truth_biases = np.array([1.8, 2.2, 2.6, 2.2])
+    expect = math.sqrt(np.sum((truth_biases - truth_biases.mean()) ** 2) / 3.0)
+    assert expect == pytest.approx(0.32660, abs=1e-5)
+    assert res.bias_repeatability == pytest.approx(expect, abs=0.004)
     ts = res.temperature_sensitivity
     assert ts is not None and ts.n_points == 3
     assert ts.ls_slope == pytest.approx(0.02, abs=0.001)

@@ -83,8 +83,14 @@ def test_rate_per_burst_in_tvac_log() -> None:
     starts = np.r_[0, np.flatnonzero(np.diff(t) > 1.0) + 1]
     assert starts.size == 24
     assert_allclose(rdot[starts], 0.0, atol=0)  # no partner sample: nothing across the gap
-    burst_means = [rdot[k * 250 + 50 : (k + 1) * 250].mean() for k in range(24)]
-    assert np.all(np.abs(burst_means) < 10.0)  # a rate across a 300 s gap would be ~±0.9 °C/min
+    # within a 5 s burst the 60 s backward partner is the burst's first sample (the oldest
+    # sample with time ≥ t − 60 s in the same segment): Ṫ_i = 60 (T_i − T_s)/(t_i − t_s)
+    # [°C/min], written out here; a partner across the gap would give another number
+    stops = np.r_[starts[1:], t.size]
+    for a, b in zip(starts, stops, strict=True):
+        i = np.arange(a + 1, b)
+        expect = 60.0 * (temp[i] - temp[a]) / (t[i] - t[a])
+        assert_allclose(rdot[i], expect, rtol=1e-12, atol=1e-12)
 
 
 def test_segment_holds_and_ramps() -> None:
@@ -129,3 +135,13 @@ def test_bad_arguments_raise() -> None:
         pp.temperature_rate(np.arange(3.0), np.ones(3), 60.0, "sideways")  # type: ignore[arg-type]
     with pytest.raises(ThermocalInputError, match="exactly one"):
         pp.lowpass_first_order(np.ones(3), 1.0)
+
+
+def test_one_missed_sample_is_a_gap_but_jitter_is_not() -> None:
+    """A gap is a step longer than 1.5 median intervals (recording.GAP_FACTOR): one missed
+    sample at 1 Hz (a 2 s step) is a gap; a 1.4 s step (logger jitter) is not."""
+    from thermocal.recording import find_gaps
+
+    t = np.array([0.0, 1.0, 2.0, 4.0, 5.0, 6.4, 7.4, 8.4])
+    gaps = find_gaps(t)
+    assert [(g.index, g.start_s, g.length_s) for g in gaps] == [(2, 2.0, 2.0)]

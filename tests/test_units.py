@@ -22,7 +22,9 @@ def test_rate_conversions_round_trip() -> None:
     assert_allclose(units.convert(1.0, "deg/s", "deg/h"), 3600.0)
     assert_allclose(units.convert(1.0, "rad/s", "deg/s"), 180.0 / math.pi)
     assert_allclose(units.convert(units.convert(0.123, "deg/h", "rad/s"), "rad/s", "deg/h"), 0.123)
-    assert_allclose(units.DH_TO_RS * units.RS_TO_DH, 1.0)
+    # 1 °/h = π/(180·3600) rad/s = 4.84813681109536e-6 rad/s (1 arcsec in rad)
+    assert_allclose(units.DH_TO_RS, 4.84813681109536e-6, rtol=1e-14)
+    assert_allclose(units.convert(1.0, "rad/s", "deg/h"), 206264.80624709636, rtol=1e-14)
 
 
 def test_accel_conversions() -> None:
