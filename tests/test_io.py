@@ -21,9 +21,14 @@ from thermocal.errors import (
     ThermocalInputError,
     TimestampError,
     UnitError,
+    UnitWarning,
 )
 from thermocal.io import read_recording, sidecar_path, write_recording
 from thermocal.recording import Metadata, Recording, find_problems
+
+# Files here that state no unit are about other faults; the unit defaults and their
+# warnings are tested in test_units_travel.py and in test_sidecar_options_and_cli_override.
+pytestmark = pytest.mark.filterwarnings("ignore::thermocal.errors.UnitWarning")
 
 
 def _recording(n: int = 500) -> Recording:
@@ -102,11 +107,15 @@ def test_time_in_ms_and_counts_temperature(tmp_path: Path) -> None:
         signals=["g"],
         temperatures=["tc"],
         temp_unit="counts",
+        signal_unit="deg/h",
         meta=meta,
     )
     assert_allclose(rec.time_s, [0.0, 0.02, 0.04])
     assert_allclose(rec.temperature_c("tc"), [0.0, 0.0625, 0.125])
-    rec2 = read_recording(path, time="t_ms", signals=["g"], temperatures=["tc"], temp_unit="counts")
+    rec2 = read_recording(
+        path, time="t_ms", signals=["g"], temperatures=["tc"], temp_unit="counts",
+        signal_unit="deg/h", time_unit="ms",
+    )  # fmt: skip
     with pytest.raises(UnitError, match="raw counts"):
         rec2.temperature_c("tc")
 
@@ -124,10 +133,14 @@ def test_sidecar_options_and_cli_override(tmp_path: Path) -> None:
             }
         )
     )
-    rec = read_recording(path)
+    with pytest.warns(UnitWarning, match="no unit stated for the time column 'ts'; assuming s"):
+        rec = read_recording(path)
     assert rec.units["w"] == "deg/s"
+    assert rec.unit_sources == {"<time>": "default", "w": "metadata", "T": "metadata"}
     assert rec.meta.latitude_deg == 45.0
-    rec = read_recording(path, signal_unit="deg/h")
+    # an option that contradicts the file's metadata wins, with a warning naming both
+    with pytest.warns(UnitWarning, match="--signal-unit deg/h contradicts the file's metadata"):
+        rec = read_recording(path, signal_unit="deg/h", time_unit="s")
     assert rec.units["w"] == "deg/h"
 
 

@@ -376,7 +376,11 @@ def test_cli_validate_missing_columns_and_units(
         capsys,
     )
     assert code == 2
-    assert "'deg/h'" in err and "'mg'" in err and err.count("\n") == 1
+    assert "'deg/h'" in err and "'mg'" in err
+    errors = [ln for ln in err.splitlines() if not ln.startswith("warning: ")]
+    assert len(errors) == 1 and errors[0].startswith("error: ")
+    # the option contradicts the file's metadata: said, naming both
+    assert "--signal-unit mg contradicts the file's metadata" in err
 
 
 def test_cli_compensate_end_to_end(

@@ -750,21 +750,49 @@ def compensate_file(
             raise ThermocalInputError(
                 f"{src}: already has a column {c!r}; was the file compensated already?"
             )
-    t_unit = units.normalize_time_unit(time_unit or info.get("time_unit") or "s")
+    # units resolved once (units.resolve_unit): option > file metadata > column name >
+    # the units the model was fitted on (model file "inputs") > a stated default
+    inputs: dict[str, Any] = dict(getattr(model, "inputs_", {}) or {})
+    fitted_units: dict[str, str] = dict(inputs.get("units") or {})
+    where = str(src)
+    t_unit = units.resolve_unit(
+        time_col,
+        "time",
+        option=time_unit,
+        metadata=info.get("time_unit"),
+        model=inputs.get("time_unit"),
+        where=where,
+    ).unit
     t_factor = units.TIME_UNITS[t_unit]
     sig_info: dict[str, str] = dict(info.get("signals") or {})
     extra_units: dict[str, str] = dict(info.get("units") or {})
     tmp_info: dict[str, str] = dict(info.get("temperatures") or {})
-    data_unit = units.normalize_signal_unit(
-        signal_unit or sig_info.get(sig_name) or extra_units.get(sig_name) or model.signal_unit
-    )
+    data_unit = units.resolve_unit(
+        sig_name,
+        "signal",
+        option=signal_unit,
+        metadata=sig_info.get(sig_name) or extra_units.get(sig_name),
+        model=fitted_units.get(sig_name) or model.signal_unit,
+        where=where,
+    ).unit
     md = Metadata.from_dict(dict(info.get("metadata") or {}))
     if temperature_conversion is not None:  # (gain, offset) for every model temperature
         md.temperature_conversion.update(dict.fromkeys(temp_names, temperature_conversion))
     temp_units = {
-        c: units.normalize_temperature_unit(temp_unit or tmp_info.get(c) or "degC")
+        c: units.resolve_unit(
+            c,
+            "temperature",
+            option=temp_unit,
+            metadata=tmp_info.get(c),
+            model=fitted_units.get(c),
+            where=where,
+        ).unit
         for c in temp_names
     }
+    for c, conv in dict(inputs.get("temperature_conversion") or {}).items():
+        if temp_units.get(c) == "counts" and c not in md.temperature_conversion:
+            gain, offset = (float(v) for v in list(conv)[:2])
+            md.temperature_conversion[c] = (gain, offset)
     for c, u in temp_units.items():
         if u == "counts" and c not in md.temperature_conversion:
             raise UnitError(

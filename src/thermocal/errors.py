@@ -69,5 +69,9 @@ class ConditioningWarning(ThermocalWarning):
     """A least-squares design is badly conditioned."""
 
 
+class UnitWarning(ThermocalWarning):
+    """A unit was not stated and a default was taken, or an option contradicts the file."""
+
+
 class TextEncodingWarning(ThermocalWarning):
     """A text file is not UTF-8 and was read in another encoding."""

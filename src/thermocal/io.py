@@ -406,6 +406,7 @@ def read_recording(
     meta: Metadata | None = None,
     keep_other: bool = True,
     skipped: list[str] | None = None,
+    model_units: dict[str, str] | None = None,
 ) -> Recording:
     """Read a CSV or Parquet recording.
 
@@ -419,6 +420,12 @@ def read_recording(
     meta : metadata that overrides the file's.
     keep_other : keep the other numeric columns (non-numeric ones are skipped).
     skipped : if a list is given, the names of skipped non-numeric columns are appended.
+    model_units : units recorded in a model file, by column name (``"<time>"`` for the
+        time column): used where the option, the file and the column name are silent.
+
+    Units are resolved by :func:`thermocal.units.resolve_unit` (option > file metadata >
+    column name > model file > a default stated in a warning); the source of each is in
+    ``Recording.unit_sources``.
 
     Raises
     ------
@@ -441,7 +448,8 @@ def read_recording(
         raise FileFormatError(f"{p}: the file has a header but no data rows")
 
     time_col = time or info.get("time") or "time"
-    t_unit = units.normalize_time_unit(time_unit or info.get("time_unit") or "s")
+    fallback = dict(model_units or {})
+    where = str(p)
     sig_info: dict[str, str] = dict(info.get("signals") or {})
     tmp_info: dict[str, str] = dict(info.get("temperatures") or {})
     sig_names = list(signals) if signals is not None else list(sig_info)
@@ -452,21 +460,44 @@ def read_recording(
         if c not in names:
             raise MissingColumnError(f"{p}: no column {c!r}; available: {available}")
 
+    t_res = units.resolve_unit(
+        time_col,
+        "time",
+        option=time_unit,
+        metadata=info.get("time_unit"),
+        model=fallback.get("<time>"),
+        where=where,
+    )
+    sources: dict[str, str] = {"<time>": t_res.source}
     t = numeric_column(obj, time_col, p)
-    if t_unit != "s":
-        t = t * units.TIME_UNITS[t_unit]
+    if t_res.unit != "s":
+        t = t * units.TIME_UNITS[t_res.unit]
 
     cols: dict[str, FloatArray] = {}
     unit_map: dict[str, str] = {}
     extra_units: dict[str, str] = dict(info.get("units") or {})
     for c in sig_names:
         cols[c] = numeric_column(obj, c, p)
-        u = signal_unit or sig_info.get(c) or extra_units.get(c) or "deg/h"
-        unit_map[c] = units.normalize_signal_unit(u)
+        res = units.resolve_unit(
+            c,
+            "signal",
+            option=signal_unit,
+            metadata=sig_info.get(c) or extra_units.get(c),
+            model=fallback.get(c),
+            where=where,
+        )
+        unit_map[c], sources[c] = res.unit, res.source
     for c in tmp_names:
         cols[c] = numeric_column(obj, c, p)
-        u = temp_unit or tmp_info.get(c) or "degC"
-        unit_map[c] = units.normalize_temperature_unit(u)
+        res = units.resolve_unit(
+            c,
+            "temperature",
+            option=temp_unit,
+            metadata=tmp_info.get(c),
+            model=fallback.get(c),
+            where=where,
+        )
+        unit_map[c], sources[c] = res.unit, res.source
     if keep_other:
         for c in names:
             if c == time_col or c in cols:
@@ -490,6 +521,8 @@ def read_recording(
         temperatures=tuple(tmp_names),
         meta=md,
         source=str(p),
+        time_unit=t_res.unit,
+        unit_sources=sources,
     )
 
 

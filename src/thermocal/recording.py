@@ -167,6 +167,12 @@ class Recording:
     temperatures: tuple[str, ...] = ()
     meta: Metadata = field(default_factory=Metadata)
     source: str | None = None
+    time_unit: str = "s"
+    """Unit the file's time column was written in (``time_s`` is always in seconds)."""
+    unit_sources: dict[str, str] = field(default_factory=dict)
+    """Where each column's unit came from (``option``, ``metadata``, ``column name``,
+    ``model`` or ``default``; ``"<time>"`` for the time column), for files read by
+    :func:`thermocal.io.read_recording`."""
 
     # --- construction ----------------------------------------------------------
     @classmethod
@@ -256,7 +262,9 @@ class Recording:
         """
         name = self._default(name, self.signals, "signal")
         values = self.column(name)
-        unit = self.units.get(name) or "deg/h"
+        unit = self.units.get(name)
+        if not unit:
+            raise UnitError(f"{self.name}: no unit is known for the signal column {name!r}")
         if units.normalize_signal_unit(unit) == "counts" and self.meta.scale_factor is not None:
             return units.counts_to_physical(
                 values,
@@ -271,7 +279,9 @@ class Recording:
         ``temperature_conversion`` (``T = gain·counts + offset``)."""
         name = self._default(name, self.temperatures, "temperature")
         values = self.column(name)
-        unit = self.units.get(name) or "degC"
+        unit = self.units.get(name)
+        if not unit:
+            raise UnitError(f"{self.name}: no unit is known for the temperature column {name!r}")
         if units.normalize_temperature_unit(unit) == "degC":
             return values
         conv = self.meta.temperature_conversion.get(name)

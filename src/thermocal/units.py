@@ -28,12 +28,16 @@ standard gravity from CGPM 1901 (BIPM SI Brochure).
 from __future__ import annotations
 
 import math
+import re
+import warnings
+from collections.abc import Callable
+from dataclasses import dataclass
 from typing import Final, Literal
 
 import numpy as np
 import numpy.typing as npt
 
-from thermocal.errors import UnitError
+from thermocal.errors import UnitError, UnitWarning
 
 # --- constants -----------------------------------------------------------------
 
@@ -154,6 +158,117 @@ def normalize_time_unit(unit: str) -> str:
     if u in TIME_UNITS:
         return u
     raise UnitError(f"unknown time unit {unit!r}; known units: {', '.join(TIME_UNITS)}")
+
+
+# --- the one resolver: option > file metadata > column name > model file > stated default ---
+
+UnitRole = Literal["time", "signal", "temperature"]
+UnitSource = Literal["option", "metadata", "column name", "model", "default"]
+
+DEFAULT_UNITS: Final[dict[str, str]] = {"time": "s", "signal": "deg/h", "temperature": "degC"}
+"""What a column is taken to be in when nothing states its unit — always said in a
+``warning:`` line (INTERFACE.md common rules), never assumed silently."""
+
+_UNIT_OPTION: Final[dict[str, str]] = {
+    "time": "--time-unit",
+    "signal": "--signal-unit",
+    "temperature": "--temp-unit",
+}
+_TIME_ALIASES: Final = {"sec": "s", "secs": "s", "msec": "ms", "usec": "us", "µs": "us"}
+_NAME_BRACKET = re.compile(r"[\[(]\s*([^\])]+?)\s*[\])]\s*$")
+_NAME_SEPARATORS = re.compile(r"[\s_]+")
+
+
+def _normalize_time_alias(unit: str) -> str:
+    alias: str = _TIME_ALIASES.get(unit.strip().lower()) or unit
+    return normalize_time_unit(alias)
+
+
+def _normalizer(role: UnitRole) -> Callable[[str], str]:
+    table: dict[str, Callable[[str], str]] = {
+        "time": _normalize_time_alias,
+        "signal": normalize_signal_unit,
+        "temperature": normalize_temperature_unit,
+    }
+    return table[role]
+
+
+def unit_in_column_name(name: str, role: UnitRole) -> str | None:
+    """The unit written in a column's name, or None.
+
+    Recognised: a trailing bracket (``time (ms)``, ``gx [deg/s]``, ``temp [°C]``) and a
+    last word after a space or underscore (``gyrox rad/s``, ``time_ms``,
+    ``temp_counts``), when that word is a unit of the column's role (time, signal or
+    temperature).  A name that is only a unit (``g``) or has no unit (``T1``) gives None.
+    """
+    norm = _normalizer(role)
+    text = name.strip()
+    m = _NAME_BRACKET.search(text)
+    candidates = [m.group(1)] if m and text[: m.start()].strip() else []
+    words = [w for w in _NAME_SEPARATORS.split(text) if w]
+    if len(words) >= 2:
+        candidates.append(words[-1])
+    for c in candidates:
+        try:
+            return norm(c)
+        except UnitError:
+            continue
+    return None
+
+
+@dataclass(frozen=True)
+class ResolvedUnit:
+    """A column's unit and where it came from (``option`` … ``default``)."""
+
+    unit: str
+    source: UnitSource
+
+
+def resolve_unit(
+    column: str,
+    role: UnitRole,
+    *,
+    option: str | None = None,
+    metadata: str | None = None,
+    model: str | None = None,
+    where: str = "",
+) -> ResolvedUnit:
+    """The unit of ``column``, resolved once, in INTERFACE.md's order: command-line option
+    > the file's own metadata > units in the column name > the units recorded in the model
+    file > :data:`DEFAULT_UNITS`, the last stated in a :class:`UnitWarning`.  An option
+    that contradicts the file's metadata wins, with a warning naming both.  This is the
+    only place in thermocal that chooses a unit nobody stated.
+    """
+    norm = _normalizer(role)
+    prefix = f"{where}: " if where else ""
+    meta = norm(metadata) if metadata else None
+    if option:
+        opt = norm(option)
+        if meta is not None and meta != opt:
+            warnings.warn(
+                UnitWarning(
+                    f"{prefix}{_UNIT_OPTION[role]} {opt} contradicts the file's metadata, "
+                    f"which says column {column!r} is in {meta}; using {opt}"
+                ),
+                stacklevel=2,
+            )
+        return ResolvedUnit(opt, "option")
+    if meta is not None:
+        return ResolvedUnit(meta, "metadata")
+    named = unit_in_column_name(column, role)
+    if named is not None:
+        return ResolvedUnit(named, "column name")
+    if model:
+        return ResolvedUnit(norm(model), "model")
+    default = DEFAULT_UNITS[role]
+    warnings.warn(
+        UnitWarning(
+            f"{prefix}no unit stated for the {role} column {column!r}; assuming {default} "
+            f"(give {_UNIT_OPTION[role]}, or the unit in the file's metadata or column name)"
+        ),
+        stacklevel=2,
+    )
+    return ResolvedUnit(default, "default")
 
 
 def signal_kind(unit: str) -> SignalKind:

@@ -87,7 +87,7 @@ def allan_cmd(
         float, typer.Option("--confidence", help="Confidence level of the intervals.")
     ] = 0.6826894921370859,
     time: TimeOpt = None,
-    time_unit: TimeUnitOpt = "s",
+    time_unit: TimeUnitOpt = None,
     signal_unit: SignalUnitOpt = None,
     temp_unit: TempUnitOpt = None,
     temp_conversion: TempConversionOpt = None,

@@ -152,6 +152,7 @@ def load_recording(
     require_signal: bool = True,
     check: bool = True,
     temp_conversion: str | None = None,
+    model_inputs: dict[str, Any] | None = None,
 ) -> Recording:
     """Read a recording with the command line's options (options win over the file).
 
@@ -163,7 +164,13 @@ def load_recording(
     naming the file, column and row); gaps are allowed and reported as one
     :class:`GapWarning`.  ``temp_conversion`` (``"GAIN,OFFSET"``) sets the raw-count
     conversion ``T[°C] = GAIN·counts + OFFSET`` of every temperature column.
+    ``model_inputs`` (a model file's ``inputs``: time unit, column units, temperature
+    conversions as fitted) fill in what the options and the file leave unstated.
     """
+    inputs = model_inputs or {}
+    fallback = {str(k): str(v) for k, v in dict(inputs.get("units") or {}).items()}
+    if inputs.get("time_unit"):
+        fallback["<time>"] = str(inputs["time_unit"])
     rec = read_recording(
         path,
         time=time,
@@ -173,11 +180,20 @@ def load_recording(
         signal_unit=signal_unit,
         temp_unit=temp_unit,
         meta=meta,
+        model_units=fallback,
     )
     if temp_conversion is not None:
         conv = parse_temp_conversion(temp_conversion)
         for name in rec.temperatures:
             rec.meta.temperature_conversion[name] = conv
+    for name, conv_m in dict(inputs.get("temperature_conversion") or {}).items():
+        if (
+            name in rec.temperatures
+            and rec.units.get(name) == "counts"
+            and name not in rec.meta.temperature_conversion
+        ):
+            gain, offset = (float(v) for v in list(conv_m)[:2])
+            rec.meta.temperature_conversion[name] = (gain, offset)
     if require_signal and not rec.signals:
         raise ThermocalInputError(
             f"{path}: name the signal column with --signal; available: "

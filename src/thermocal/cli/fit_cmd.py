@@ -87,8 +87,14 @@ from thermocal.models.base import (
     get_model_class,
     save_model,
 )
+from thermocal.recording import Recording
 
 TARGETS = ("bias", "scale_factor")
+
+
+def run_temp_names(rec: Recording, temps: str | None) -> list[str]:
+    """The temperature columns a fit uses: ``--temps`` or the file's."""
+    return split_names(temps) or list(rec.temperatures)
 
 
 def build_model(family: str, options: dict[str, Any]) -> TemperatureModel:
@@ -238,6 +244,7 @@ def fit_cmd(
     est = build_model(model, options)
 
     runs: list[RunData] = []
+    first_inputs: dict[str, Any] = {}
     provenance: list[dict[str, Any]] = []
     unit = ""
     sig_name = signal or "signal"
@@ -255,6 +262,15 @@ def fit_cmd(
         )
         _values, run_unit = rec.signal(signal)
         sig_name = signal or rec.signals[0]
+        if not runs:  # the model learns how its inputs were written (model file "inputs")
+            used = [sig_name, *run_temp_names(rec, temps)]
+            first_inputs = {
+                "time_unit": rec.time_unit,
+                "units": {c: rec.units[c] for c in used if rec.units.get(c)},
+                "temperature_conversion": {
+                    c: list(v) for c, v in rec.meta.temperature_conversion.items() if c in used
+                },
+            }
         if unit and run_unit != unit:
             raise ThermocalInputError(f"{path}: signal unit {run_unit} differs from {unit}")
         unit = run_unit
@@ -298,6 +314,7 @@ def fit_cmd(
     est.signal_name = sig_name
     est.signal_unit = unit
     est.target = target
+    est.inputs_ = first_inputs
     est.data_ = provenance
     save_model(est, output)
 

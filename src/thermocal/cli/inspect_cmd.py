@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import re
-import sys
 from typing import Annotated
 
 import typer
@@ -27,9 +26,11 @@ from thermocal.cli.common import (
     split_names,
     stdout,
 )
+from thermocal.errors import ThermocalInputError
 from thermocal.inspection import Inspection, inspect_recording
 from thermocal.io import read_recording
 from thermocal.recording import Problem
+from thermocal.units import resolve_unit
 
 _TEMP_NAME = re.compile(r"^(t\d+|t_|temp|tmp)|temperature|°c|degc", re.IGNORECASE)
 
@@ -39,7 +40,7 @@ _TEMP_NAME = re.compile(r"^(t\d+|t_|temp|tmp)|temperature|°c|degc", re.IGNORECA
 def inspect_cmd(
     file: FileArg,
     time: TimeOpt = None,
-    time_unit: TimeUnitOpt = "s",
+    time_unit: TimeUnitOpt = None,
     signal: Annotated[
         str | None, typer.Option("--signal", help="Comma-separated signal columns.")
     ] = None,
@@ -69,7 +70,7 @@ def inspect_cmd(
     rec = read_recording(
         file,
         time=time,
-        time_unit=time_unit if time_unit != "s" else None,
+        time_unit=time_unit,
         signals=split_names(signal),
         temperatures=split_names(temps),
         signal_unit=signal_unit,
@@ -79,10 +80,13 @@ def inspect_cmd(
     if not rec.temperatures and temps is None:
         guessed = tuple(c for c in rec.columns if _TEMP_NAME.search(c) and c not in rec.signals)
         rec.temperatures = guessed
-        for c in guessed:
-            rec.units.setdefault(c, temp_unit or "degC")
-            if not rec.units[c]:
-                rec.units[c] = temp_unit or "degC"
+        for c in guessed:  # a guessed temperature's unit goes through the one resolver
+            res = resolve_unit(
+                c, "temperature", option=temp_unit, metadata=rec.units.get(c) or None,
+                where=str(file),
+            )  # fmt: skip
+            rec.units[c] = res.unit
+            rec.unit_sources[c] = res.source
     if temp_conversion is not None:
         conv = parse_temp_conversion(temp_conversion)
         for c in rec.temperatures:
@@ -98,19 +102,16 @@ def inspect_cmd(
             )
         )
     emit(result.to_dict(), as_json, lambda: _print_human(result))
+    # raised as input errors, so that the common handler prints the warnings first and
+    # the one error: line last (exit 2)
     errors = result.fatal
     if errors:
         more = f" ({len(errors) - 1} more errors)" if len(errors) > 1 else ""
-        print(f"error: {file}: {one_line(errors[0].message)}{more}", file=sys.stderr)
-        raise typer.Exit(2)
+        raise ThermocalInputError(f"{file}: {one_line(errors[0].message)}{more}")
     warns = [p for p in result.problems if p.severity == "warning"]
     if strict and warns:
         more = f" ({len(warns) - 1} more warnings)" if len(warns) > 1 else ""
-        print(
-            f"error: {file}: --strict: {one_line(warns[0].message)}{more}",
-            file=sys.stderr,
-        )
-        raise typer.Exit(2)
+        raise ThermocalInputError(f"{file}: --strict: {one_line(warns[0].message)}{more}")
 
 
 def _print_human(r: Inspection) -> None:

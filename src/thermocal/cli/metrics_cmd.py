@@ -77,7 +77,7 @@ def metrics_cmd(
         float, typer.Option("--min-hold", help="Hold stages: at least this long [s].")
     ] = 600.0,
     time: TimeOpt = None,
-    time_unit: TimeUnitOpt = "s",
+    time_unit: TimeUnitOpt = None,
     signal_unit: SignalUnitOpt = None,
     temp_unit: TempUnitOpt = None,
     temp_conversion: TempConversionOpt = None,

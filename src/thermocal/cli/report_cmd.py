@@ -58,6 +58,7 @@ def _read_run(
     time_unit: str | None,
     signal_unit: str | None,
     temp_unit: str | None,
+    model_inputs: dict[str, Any] | None = None,
 ) -> Recording:
     return load_recording(
         path,
@@ -66,6 +67,7 @@ def _read_run(
         signal=signal,
         signal_unit=signal_unit,
         temp_unit=temp_unit,
+        model_inputs=model_inputs,
     )
 
 
@@ -135,9 +137,10 @@ def report_cmd(
         sig = signal or (entries[0].model.get("signal") or {}).get("name") or None
         if not sig:
             raise ThermocalInputError("name the signal column with --signal")
-        val_rec = _read_run(recording, sig, time, time_unit, signal_unit, temp_unit)
+        fitted = dict(entries[0].model.get("inputs") or {})  # how the first model's data were
+        val_rec = _read_run(recording, sig, time, time_unit, signal_unit, temp_unit, fitted)
         mod_rec = (
-            _read_run(modeling, sig, time, time_unit, signal_unit, temp_unit)
+            _read_run(modeling, sig, time, time_unit, signal_unit, temp_unit, fitted)
             if modeling is not None
             else None
         )

@@ -35,7 +35,7 @@ def turntable_cmd(
         float | None, typer.Option("--latitude", help="Site latitude [°] (default: metadata).")
     ] = None,
     time: TimeOpt = "time",
-    time_unit: TimeUnitOpt = "s",
+    time_unit: TimeUnitOpt = None,
     gyro: Annotated[
         str, typer.Option("--gyro", help="Gyro x,y,z column names (comma-separated).")
     ] = ",".join(DEFAULT_GYRO_COLUMNS),

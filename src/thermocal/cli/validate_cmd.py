@@ -35,7 +35,6 @@ from thermocal.cli.common import (
 )
 from thermocal.compensate import unit_factor
 from thermocal.errors import ThermocalInputError
-from thermocal.io import read_recording
 from thermocal.models.base import RunData, TemperatureModel, load_model
 from thermocal.recording import find_problems
 from thermocal.validation import DEFAULT_AVERAGING_S, validate
@@ -113,6 +112,7 @@ def validate_cmd(
         signal_unit=signal_unit,
         temp_unit=temp_unit,
         temp_conversion=temp_conversion,
+        model_inputs=model.inputs_,
     )
     run = RunData.from_recording(rec, sig, temps)
     data_unit = rec.signal(sig)[1]
@@ -131,7 +131,17 @@ def validate_cmd(
     mod_path = modeling if modeling is not None else _modeling_file(model, model_file)
     modeling_ambient = None
     if mod_path is not None:
-        mrec = read_recording(mod_path, time=time, time_unit=time_unit, temperatures=[amb])
+        mrec = load_recording(
+            mod_path,
+            time=time,
+            time_unit=time_unit,
+            temps=amb,
+            temp_unit=temp_unit,
+            temp_conversion=temp_conversion,
+            model_inputs=model.inputs_,
+            require_signal=False,
+            check=False,
+        )
         for prob in find_problems(mrec, required=[amb]):
             if prob.severity == "error" and (prob.column in (None, "time", amb)):
                 raise ThermocalInputError(f"{mod_path}: {prob.message}")

@@ -56,7 +56,7 @@ from thermocal.io import write_json
 from thermocal.recording import FloatArray, Recording
 
 MODEL_FORMAT = "thermocal-model"
-MODEL_FORMAT_VERSION = 1
+MODEL_FORMAT_VERSION = 2
 
 
 # --- input data ------------------------------------------------------------------------
@@ -294,6 +294,11 @@ class TemperatureModel(ABC):
     rate_range_: FloatArray | None
     stats_: FitStats
     data_: list[dict[str, Any]]
+    inputs_: dict[str, Any]
+    """How the fitted data were written (format version 2): ``time_unit``, ``units``
+    (column → unit as given, e.g. ``deg/s``, ``counts``) and ``temperature_conversion``
+    (column → [gain, offset]); commands that apply the model use them where the command
+    line and the data file are silent.  Empty for older files."""
 
     # metadata set by the caller (CLI) before saving; not constructor params
     signal_name: str = "signal"
@@ -455,6 +460,7 @@ class TemperatureModel(ABC):
             },
             "fit": _jsonify(self.stats_.to_dict()),
             "data": _jsonify(self.data_),
+            "inputs": _jsonify(getattr(self, "inputs_", {})),
         }
         return d
 
@@ -491,6 +497,7 @@ class TemperatureModel(ABC):
             extra={k: v for k, v in fit.items() if k not in known},
         )
         model.data_ = list(d.get("data", []))
+        model.inputs_ = dict(d.get("inputs") or {})  # format version 1 files: unknown
         sig = d.get("signal") or {}
         model.signal_name = sig.get("name", "signal")
         model.signal_unit = sig.get("unit", "deg/h")
