@@ -549,6 +549,9 @@ def _fit(
     tau = result.tau_s[ok]
     s2 = result.avar[ok]
     edf = result.edf[ok]
+    if tau.size == 0:  # a constant or too short signal: no point to fit
+        why = "no Allan deviation point above zero (a constant or too short signal)"
+        return np.zeros(5), np.full(5, np.nan), float("nan"), [why] * 5
     powers = np.arange(-2, 3, dtype=np.float64)
     design = tau[:, None] ** powers[None, :]
     model = s2.copy()

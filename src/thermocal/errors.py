@@ -69,6 +69,10 @@ class ConditioningWarning(ThermocalWarning):
     """A least-squares design is badly conditioned."""
 
 
+class PlausibilityWarning(ThermocalWarning):
+    """A value no sensor or chamber produces: a wrong unit or conversion is likely."""
+
+
 class UnitWarning(ThermocalWarning):
     """A unit was not stated and a default was taken, or an option contradicts the file."""
 

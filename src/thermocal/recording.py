@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import dataclasses
 import itertools
+import warnings
 from dataclasses import dataclass, field
 from typing import Any, Literal
 
@@ -25,6 +26,7 @@ from thermocal import units
 from thermocal.errors import (
     MissingColumnError,
     MissingValueError,
+    PlausibilityWarning,
     ThermocalInputError,
     TimestampError,
     UnitError,
@@ -335,8 +337,14 @@ class Recording:
         return dataclasses.replace(self, columns=cols, units=u)
 
     def validate(self, required: list[str] | None = None) -> None:
-        """Raise the first error of :func:`find_problems` (warnings are not raised)."""
-        for p in find_problems(self, required=required):
+        """Raise the first error of :func:`find_problems`; implausible values that are only
+        doubtful are emitted as :class:`PlausibilityWarning` (other warnings, such as
+        gaps, are reported by the caller)."""
+        problems = find_problems(self, required=required)
+        for p in problems:
+            if p.severity == "warning" and p.kind.startswith("implausible"):
+                warnings.warn(PlausibilityWarning(f"{self.name}: {p.message}"), stacklevel=2)
+        for p in problems:
             if p.severity == "error":
                 cls = {
                     "missing_column": MissingColumnError,
@@ -477,5 +485,100 @@ def find_problems(rec: Recording, required: list[str] | None = None) -> list[Pro
                     row=gaps[0].index,
                 )
             )
+    probs.extend(plausibility_problems(rec))
     order = {"error": 0, "warning": 1}
     return sorted(probs, key=lambda p: order[p.severity])
+
+
+ABSOLUTE_ZERO_C = -273.15
+"""No temperature is below this [°C]."""
+PLAUSIBLE_TEMPERATURE_C = (-100.0, 200.0)
+"""Temperatures a test chamber or a sensor reaches [°C]; outside, a unit is likely wrong."""
+PLAUSIBLE_SIGNAL = {"rate": 1e8, "accel": 1e7}
+"""Largest |value| any gyro [°/h] (≈ 28 000 °/s) or accelerometer [mg] (10 000 g) outputs."""
+
+
+def plausibility_problems(rec: Recording) -> list[Problem]:
+    """Values no sensor or chamber produces, named by column, value and row (issue 14).
+
+    Temperatures (in °C, after a counts conversion where one is given): below absolute
+    zero is an error; outside −100…+200 °C a warning (with the likely cause: kelvin,
+    raw ADC counts).  Signals, converted to their canonical unit: a magnitude beyond
+    :data:`PLAUSIBLE_SIGNAL`, or one that overflows on conversion, is an error.
+    """
+    probs: list[Problem] = []
+    for name in rec.temperatures:
+        arr = rec.columns.get(name)
+        if arr is None or not rec.units.get(name):
+            continue
+        try:
+            temp = rec.temperature_c(name)
+        except ThermocalInputError:
+            continue  # raw counts without a conversion: checked where they are used
+        finite = np.isfinite(temp)
+        if not finite.any():
+            continue
+        lo_row = int(np.argmin(np.where(finite, temp, np.inf)))
+        hi_row = int(np.argmax(np.where(finite, temp, -np.inf)))
+        lo, hi = float(temp[lo_row]), float(temp[hi_row])
+        if lo < ABSOLUTE_ZERO_C:
+            probs.append(
+                Problem(
+                    "implausible_temperature",
+                    f"temperature column {name!r} reads {lo:.6g} °C at row {lo_row}, below "
+                    "absolute zero (−273.15 °C): a wrong unit, offset or conversion",
+                    column=name,
+                    row=lo_row,
+                )
+            )
+            continue
+        a, b = PLAUSIBLE_TEMPERATURE_C
+        if lo < a or hi > b:
+            bad_row, bad = (hi_row, hi) if hi > b else (lo_row, lo)
+            vals = temp[finite]
+            if lo >= 173.0 and hi <= 473.0:
+                hint = "kelvin? give the data in °C"
+            elif np.all(vals == np.round(vals)) and hi > 1000.0:
+                hint = "raw ADC counts? give --temp-unit counts and --temp-conversion"
+            else:
+                hint = "check the unit and the conversion"
+            probs.append(
+                Problem(
+                    "implausible_temperature",
+                    f"temperature column {name!r} reads {bad:.6g} °C at row {bad_row}, "
+                    f"outside {a:g}…{b:+g} °C ({hint})",
+                    severity="warning",
+                    column=name,
+                    row=bad_row,
+                )
+            )
+    for name in rec.signals:
+        arr = rec.columns.get(name)
+        unit = rec.units.get(name)
+        if arr is None or not unit:
+            continue
+        try:
+            kind = units.signal_kind(unit)
+        except UnitError:
+            continue
+        if kind == "raw":
+            continue
+        with np.errstate(over="ignore", invalid="ignore"):
+            canon, canon_unit = units.to_canonical(arr, unit)
+        finite_in = np.isfinite(arr)
+        over = finite_in & ~np.isfinite(canon)
+        big = finite_in & np.isfinite(canon) & (np.abs(canon) > PLAUSIBLE_SIGNAL[kind])
+        if over.any() or big.any():
+            row = int(np.argmax(over | big))
+            probs.append(
+                Problem(
+                    "implausible_signal",
+                    f"signal column {name!r} reads {float(arr[row]):.6g} {unit} at row {row} "
+                    f"({float(canon[row]):.6g} {canon_unit}), beyond any sensor "
+                    f"(|value| ≤ {PLAUSIBLE_SIGNAL[kind]:g} {canon_unit}): wrong unit or "
+                    "corrupt data",
+                    column=name,
+                    row=row,
+                )
+            )
+    return probs
