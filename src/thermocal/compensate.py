@@ -60,7 +60,9 @@ from thermocal.io import (
     atomic_write_path,
     check_not_input,
     file_kind,
+    fill_fitted_conversions,
     numeric_column,
+    resolve_columns,
     sidecar_path,
     write_json,
 )
@@ -754,45 +756,30 @@ def compensate_file(
     # the units the model was fitted on (model file "inputs") > a stated default
     inputs: dict[str, Any] = dict(getattr(model, "inputs_", {}) or {})
     fitted_units: dict[str, str] = dict(inputs.get("units") or {})
-    where = str(src)
-    t_unit = units.resolve_unit(
+    fitted = {"<time>": inputs.get("time_unit"), **fitted_units}
+    fitted.setdefault(sig_name, model.signal_unit)
+    resolved = resolve_columns(
+        info,
         time_col,
-        "time",
-        option=time_unit,
-        metadata=info.get("time_unit"),
-        model=inputs.get("time_unit"),
-        where=where,
-    ).unit
+        [sig_name],
+        list(temp_names),
+        time_unit=time_unit,
+        signal_unit=signal_unit,
+        temp_unit=temp_unit,
+        model_units={k: v for k, v in fitted.items() if v},
+        where=str(src),
+    )
+    t_unit = resolved["<time>"].unit
     t_factor = units.TIME_UNITS[t_unit]
     sig_info: dict[str, str] = dict(info.get("signals") or {})
     extra_units: dict[str, str] = dict(info.get("units") or {})
     tmp_info: dict[str, str] = dict(info.get("temperatures") or {})
-    data_unit = units.resolve_unit(
-        sig_name,
-        "signal",
-        option=signal_unit,
-        metadata=sig_info.get(sig_name) or extra_units.get(sig_name),
-        model=fitted_units.get(sig_name) or model.signal_unit,
-        where=where,
-    ).unit
+    data_unit = resolved[sig_name].unit
     md = Metadata.from_dict(dict(info.get("metadata") or {}))
     if temperature_conversion is not None:  # (gain, offset) for every model temperature
         md.temperature_conversion.update(dict.fromkeys(temp_names, temperature_conversion))
-    temp_units = {
-        c: units.resolve_unit(
-            c,
-            "temperature",
-            option=temp_unit,
-            metadata=tmp_info.get(c),
-            model=fitted_units.get(c),
-            where=where,
-        ).unit
-        for c in temp_names
-    }
-    for c, conv in dict(inputs.get("temperature_conversion") or {}).items():
-        if temp_units.get(c) == "counts" and c not in md.temperature_conversion:
-            gain, offset = (float(v) for v in list(conv)[:2])
-            md.temperature_conversion[c] = (gain, offset)
+    temp_units = {c: resolved[c].unit for c in temp_names}
+    fill_fitted_conversions(inputs, temp_units, md.temperature_conversion)
     for c, u in temp_units.items():
         if u == "counts" and c not in md.temperature_conversion:
             raise UnitError(

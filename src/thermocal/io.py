@@ -394,6 +394,70 @@ def numeric_column(
     return conv.to_numpy(dtype=np.float64, na_value=np.nan)
 
 
+def resolve_columns(
+    info: dict[str, Any],
+    time_col: str,
+    signals: list[str],
+    temperatures: list[str],
+    *,
+    time_unit: str | None = None,
+    signal_unit: str | None = None,
+    temp_unit: str | None = None,
+    model_units: dict[str, str] | None = None,
+    where: str = "",
+) -> dict[str, units.ResolvedUnit]:
+    """The unit of the time column (key ``"<time>"``) and of each signal and temperature
+    column of a file whose metadata is ``info`` (sidecar / Parquet key-value), each by
+    :func:`thermocal.units.resolve_unit`: option > ``info`` > column name >
+    ``model_units`` (by column; ``"<time>"`` for time) > a default stated in a warning."""
+    fallback = model_units or {}
+    sig_info: dict[str, str] = dict(info.get("signals") or {})
+    tmp_info: dict[str, str] = dict(info.get("temperatures") or {})
+    extra_units: dict[str, str] = dict(info.get("units") or {})
+    out = {
+        "<time>": units.resolve_unit(
+            time_col,
+            "time",
+            option=time_unit,
+            metadata=info.get("time_unit"),
+            model=fallback.get("<time>"),
+            where=where,
+        )
+    }
+    for c in signals:
+        out[c] = units.resolve_unit(
+            c,
+            "signal",
+            option=signal_unit,
+            metadata=sig_info.get(c) or extra_units.get(c),
+            model=fallback.get(c),
+            where=where,
+        )
+    for c in temperatures:
+        out[c] = units.resolve_unit(
+            c,
+            "temperature",
+            option=temp_unit,
+            metadata=tmp_info.get(c),
+            model=fallback.get(c),
+            where=where,
+        )
+    return out
+
+
+def fill_fitted_conversions(
+    model_inputs: dict[str, Any] | None,
+    units_by_column: dict[str, str],
+    conversions: dict[str, tuple[float, float]],
+) -> None:
+    """Give raw-count temperature columns that no option or file converts the counts → °C
+    conversion recorded in the model file (``inputs.temperature_conversion``), in place."""
+    for name, conv in dict((model_inputs or {}).get("temperature_conversion") or {}).items():
+        if units_by_column.get(name) == "counts" and name not in conversions:
+            gain, offset = (float(v) for v in list(conv)[:2])
+            conversions[name] = (gain, offset)
+
+
 def read_recording(
     path: str | Path,
     *,
@@ -460,44 +524,25 @@ def read_recording(
         if c not in names:
             raise MissingColumnError(f"{p}: no column {c!r}; available: {available}")
 
-    t_res = units.resolve_unit(
+    resolved = resolve_columns(
+        info,
         time_col,
-        "time",
-        option=time_unit,
-        metadata=info.get("time_unit"),
-        model=fallback.get("<time>"),
+        sig_names,
+        tmp_names,
+        time_unit=time_unit,
+        signal_unit=signal_unit,
+        temp_unit=temp_unit,
+        model_units=fallback,
         where=where,
     )
-    sources: dict[str, str] = {"<time>": t_res.source}
+    sources: dict[str, str] = {c: r.source for c, r in resolved.items()}
     t = numeric_column(obj, time_col, p)
-    if t_res.unit != "s":
-        t = t * units.TIME_UNITS[t_res.unit]
+    if resolved["<time>"].unit != "s":
+        t = t * units.TIME_UNITS[resolved["<time>"].unit]
 
-    cols: dict[str, FloatArray] = {}
-    unit_map: dict[str, str] = {}
+    cols: dict[str, FloatArray] = {c: numeric_column(obj, c, p) for c in [*sig_names, *tmp_names]}
+    unit_map = {c: r.unit for c, r in resolved.items() if c != "<time>"}
     extra_units: dict[str, str] = dict(info.get("units") or {})
-    for c in sig_names:
-        cols[c] = numeric_column(obj, c, p)
-        res = units.resolve_unit(
-            c,
-            "signal",
-            option=signal_unit,
-            metadata=sig_info.get(c) or extra_units.get(c),
-            model=fallback.get(c),
-            where=where,
-        )
-        unit_map[c], sources[c] = res.unit, res.source
-    for c in tmp_names:
-        cols[c] = numeric_column(obj, c, p)
-        res = units.resolve_unit(
-            c,
-            "temperature",
-            option=temp_unit,
-            metadata=tmp_info.get(c),
-            model=fallback.get(c),
-            where=where,
-        )
-        unit_map[c], sources[c] = res.unit, res.source
     if keep_other:
         for c in names:
             if c == time_col or c in cols:
@@ -521,7 +566,7 @@ def read_recording(
         temperatures=tuple(tmp_names),
         meta=md,
         source=str(p),
-        time_unit=t_res.unit,
+        time_unit=resolved["<time>"].unit,
         unit_sources=sources,
     )
 

@@ -31,7 +31,7 @@ from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
 
 from thermocal.cli.interrupt import report_interrupted
 from thermocal.errors import GapWarning, ThermocalInputError, ThermocalWarning
-from thermocal.io import read_recording
+from thermocal.io import fill_fitted_conversions, read_recording
 from thermocal.recording import Metadata, Recording
 from thermocal.units import canonical_unit, earth_rate_on_axis_deg_h, parse_axis
 
@@ -186,14 +186,11 @@ def load_recording(
         conv = parse_temp_conversion(temp_conversion)
         for name in rec.temperatures:
             rec.meta.temperature_conversion[name] = conv
-    for name, conv_m in dict(inputs.get("temperature_conversion") or {}).items():
-        if (
-            name in rec.temperatures
-            and rec.units.get(name) == "counts"
-            and name not in rec.meta.temperature_conversion
-        ):
-            gain, offset = (float(v) for v in list(conv_m)[:2])
-            rec.meta.temperature_conversion[name] = (gain, offset)
+    fill_fitted_conversions(
+        inputs,
+        {c: rec.units.get(c, "") for c in rec.temperatures},
+        rec.meta.temperature_conversion,
+    )
     if require_signal and not rec.signals:
         raise ThermocalInputError(
             f"{path}: name the signal column with --signal; available: "
