@@ -11,6 +11,14 @@ for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
 
 import matplotlib  # noqa: E402
 import pytest  # noqa: E402
+from hypothesis import settings  # noqa: E402
+
+# On CI the property tests draw the same examples every run (a red build is then one
+# the next commit can reproduce, never a coin toss); locally they explore new examples
+# each run and keep the failures they find in .hypothesis/.
+settings.register_profile("ci", derandomize=True, database=None, print_blob=True)
+if os.environ.get("CI"):
+    settings.load_profile("ci")
 
 matplotlib.use("Agg")
 os.environ.setdefault("MPLBACKEND", "Agg")

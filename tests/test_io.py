@@ -245,6 +245,8 @@ def test_malformed_csv_never_crashes_or_passes_silently(
         or np.any(np.diff(t) <= 0)
         or np.any(np.isnan(sig))
         or t.size < 2
+        # beyond any gyro (recording.PLAUSIBLE_SIGNAL, the default unit being °/h)
+        or np.any(np.abs(sig[np.isfinite(sig)]) > 1e8)
     )
     assert has_bad == any(p.severity == "error" for p in problems)
 
@@ -283,5 +285,11 @@ def test_malformed_parquet_never_crashes_or_passes_silently(
         return
     t = rec.time_s
     sig = rec.columns["gyro"]
-    has_bad = (not np.all(np.isfinite(t))) or np.any(np.diff(t) <= 0) or np.any(~np.isfinite(sig))
+    has_bad = (
+        (not np.all(np.isfinite(t)))
+        or np.any(np.diff(t) <= 0)
+        or np.any(~np.isfinite(sig))
+        # beyond any gyro (recording.PLAUSIBLE_SIGNAL, the default unit being °/h)
+        or np.any(np.abs(sig[np.isfinite(sig)]) > 1e8)
+    )
     assert has_bad == any(p.severity == "error" for p in find_problems(rec, required=["gyro"]))

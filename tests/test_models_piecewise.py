@@ -3,7 +3,9 @@
 from __future__ import annotations
 
 import dataclasses
+import json
 import warnings
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -275,3 +277,43 @@ def test_more_segments_than_the_width_rule_allows_are_reduced():
     with pytest.warns(ThermocalWarning, match="allow at most 20"):
         m = PiecewiseModel(segments=30).fit([run])
     assert np.all(_segment_widths(m) >= 0.05 - 1e-12)
+
+
+def test_all_zero_bias_and_two_samples_fit_without_crash(tmp_path: Path) -> None:
+    """Found by the property test: an all-zero signal made the BIC floor 0 and log(0)
+    failed; two samples for two coefficients gave NaN standard errors that JSON cannot
+    hold. Now the fit is written, the standard errors are left out ("not estimable") and
+    a warning says there are no residual degrees of freedom."""
+    from typer.testing import CliRunner
+
+    from thermocal.cli import app
+
+    src = tmp_path / "two.csv"
+    src.write_text("time,gyro,T1\n0.0,0.0,0.0\n1.0,0.0,1.0\n")
+    out = tmp_path / "m.json"
+    res = CliRunner().invoke(
+        app,
+        ["fit", str(src), "--model", "piecewise", "--segments", "2", "--signal", "gyro",
+         "--temps", "T1", "-o", str(out), "--signal-unit", "deg/h", "--time-unit", "s",
+         "--temp-unit", "degC"],
+    )  # fmt: skip
+    assert res.exit_code == 0, res.output
+    assert "no residual degrees of freedom" in res.output
+    d = json.loads(out.read_text())
+    assert [c["value"] for c in d["coefficients"]] == [0.0, 0.0]
+    assert all("stderr" not in c for c in d["coefficients"])
+
+
+def test_non_finite_model_is_refused_not_written(tmp_path: Path) -> None:
+    """A model holding NaN is refused naming the field, and no file appears."""
+    from thermocal.errors import DesignError
+
+    t = np.linspace(20.0, 30.0, 50)
+    est = PiecewiseModel(breakpoints=[25.0], method="continuous").fit(
+        [RunData(np.arange(50.0), t[:, None], 0.1 * t, ("T1",), "line")]
+    )
+    est.temp_range_ = np.array([[np.nan, 30.0]])
+    out = tmp_path / "bad.json"
+    with pytest.raises(DesignError, match="non-finite"):
+        save_model(est, out)
+    assert not out.exists()

@@ -78,7 +78,7 @@ from thermocal.cli.common import (
     split_names,
     stdout,
 )
-from thermocal.errors import ThermocalInputError
+from thermocal.errors import ConditioningWarning, ThermocalInputError
 from thermocal.io import check_not_input
 from thermocal.models.base import (
     RunData,
@@ -307,6 +307,15 @@ def fit_cmd(
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         est.fit(runs)
+        dof = getattr(est.stats_, "dof", None)
+        if dof is not None and dof <= 0:
+            warnings.warn(
+                f"{est.stats_.n_samples} samples for {len(est.coefficients())} coefficients: "
+                "no residual degrees of freedom, the fit passes through the data; standard "
+                "errors and the rms residual say nothing about its accuracy — record more data",
+                ConditioningWarning,
+                stacklevel=1,
+            )
     messages = [one_line(str(w.message)) for w in caught]
     for w in caught:  # hand them on to handle_errors, which prints them on stderr
         warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)

@@ -38,6 +38,7 @@ import datetime as _dt
 import hashlib
 import inspect
 import json
+import math
 import warnings
 from abc import ABC, abstractmethod
 from collections.abc import Sequence
@@ -48,6 +49,7 @@ from typing import Any, ClassVar, Self, TypeVar
 import numpy as np
 
 from thermocal.errors import (
+    DesignError,
     ExtrapolationWarning,
     ModelFileError,
     ThermocalInputError,
@@ -170,7 +172,9 @@ class Coefficient:
 
     def to_dict(self) -> dict[str, Any]:
         d: dict[str, Any] = {"name": self.name, "value": self.value}
-        if self.stderr is not None:
+        # a standard error that cannot be estimated (no residual degrees of freedom) is
+        # left out — "not estimable" — rather than written as a non-JSON NaN
+        if self.stderr is not None and math.isfinite(self.stderr):
             d["stderr"] = self.stderr
         if self.unit:
             d["unit"] = self.unit
@@ -595,9 +599,31 @@ def check_model_header(d: Any) -> None:
             raise ModelFileError(f"model file is missing the {key!r} section")
 
 
+def _nonfinite_fields(obj: Any, path: str = "") -> list[str]:
+    """Dotted paths of the NaN/inf floats inside a JSON-like structure."""
+    if isinstance(obj, dict):
+        return [p for k, v in obj.items() for p in _nonfinite_fields(v, f"{path}.{k}")]
+    if isinstance(obj, (list, tuple)):
+        return [p for i, v in enumerate(obj) for p in _nonfinite_fields(v, f"{path}[{i}]")]
+    if isinstance(obj, float) and not math.isfinite(obj):
+        return [path.lstrip(".")]
+    return []
+
+
 def save_model(model: TemperatureModel, path: str | Path) -> dict[str, Any]:
-    """Write a fitted model as JSON (atomically), with its checksum; returns the dict."""
+    """Write a fitted model as JSON (atomically), with its checksum; returns the dict.
+
+    A model holding a non-finite number (NaN or infinity in a coefficient, range or
+    statistic) is refused with :class:`DesignError` naming the field: JSON cannot hold it
+    and firmware must never load it.
+    """
     d = model.to_dict()
+    bad = _nonfinite_fields(d)
+    if bad:
+        raise DesignError(
+            f"the fitted model holds non-finite numbers ({', '.join(bad[:5])}): the data do "
+            "not determine it (too few samples or a degenerate design); nothing written"
+        )
     d["checksum"] = checksum(d)
     write_json(path, d)
     return d

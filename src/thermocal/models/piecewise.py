@@ -294,7 +294,8 @@ def choose_breakpoints(
         fits.append(search(first))
     # residuals below float64 resolution of the data are all the same "exact fit": floor
     # RSS there, so that noise-free data keep the fewest segments, not rounding noise
-    floor = n_b * (1e-9 * float(np.max(np.abs(Y * W))) + np.finfo(np.float64).tiny) ** 2
+    # (all-zero data: the floor is the smallest positive float, never 0 — log(0) fails)
+    floor = max(n_b * (1e-9 * float(np.max(np.abs(Y * W)))) ** 2, np.finfo(np.float64).tiny)
     bic = [
         n_b * math.log(max(r, floor) / n_b) + (groups + 1 + 2 * (k - 1)) * math.log(n_b)
         for k, (_b, r) in enumerate(fits, start=1)
