@@ -19,6 +19,7 @@ The sidecar / Parquet metadata is a JSON object::
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 import errno
 import fcntl
 import glob
@@ -406,7 +407,8 @@ def read_recording(
     meta: Metadata | None = None,
     keep_other: bool = True,
     skipped: list[str] | None = None,
-    model_units: dict[str, str] | None = None,
+    temp_conversion: units.TemperatureConversion | None = None,
+    model: units.StatedUnits | None = None,
 ) -> Recording:
     """Read a CSV or Parquet recording.
 
@@ -414,17 +416,23 @@ def read_recording(
     ----------
     path : the file; its extension chooses the format.
     time : name of the time column (default: sidecar's, else ``"time"``).
-    time_unit : ``s``, ``ms`` or ``us`` (default ``s``); converted to [s].
+    time_unit : ``s``, ``ms`` or ``us``; converted to [s].
     signals, temperatures : column names with those roles (default: sidecar's).
-    signal_unit, temp_unit : units of those columns (override the sidecar).
-    meta : metadata that overrides the file's.
+    signal_unit, temp_unit : units of those columns (override the sidecar); ``signal_unit``
+        may be ``U1,…,Un``, one per signal.
+    meta : metadata that overrides the file's (its temperature conversions count as
+        options).
     keep_other : keep the other numeric columns (non-numeric ones are skipped).
     skipped : if a list is given, the names of skipped non-numeric columns are appended.
-    model_units : units recorded in a model file, by column name (``"<time>"`` for the
-        time column): used where the option, the file and the column name are silent.
+    temp_conversion : ``--temp-conversion``, the counts → °C conversion of every
+        temperature column (which it says are raw counts).
+    model : the units a model file recorded of its inputs
+        (:meth:`thermocal.units.StatedUnits.from_model_inputs`): used where the option,
+        the file and the column name are silent.
 
-    Units are resolved by :func:`thermocal.units.resolve_unit` (option > file metadata >
-    column name > model file > a default stated in a warning); the source of each is in
+    Units and temperature conversions are resolved once by
+    :func:`thermocal.units.resolve_inputs` (option > file metadata > column name > model
+    file > a default stated in a warning); the source of each is in
     ``Recording.unit_sources``.
 
     Raises
@@ -448,56 +456,49 @@ def read_recording(
         raise FileFormatError(f"{p}: the file has a header but no data rows")
 
     time_col = time or info.get("time") or "time"
-    fallback = dict(model_units or {})
     where = str(p)
     sig_info: dict[str, str] = dict(info.get("signals") or {})
     tmp_info: dict[str, str] = dict(info.get("temperatures") or {})
     sig_names = list(signals) if signals is not None else list(sig_info)
     tmp_names = list(temperatures) if temperatures is not None else list(tmp_info)
+    md = Metadata.from_dict(dict(info.get("metadata") or {}))
+    if meta is not None:
+        md = md.merged(meta)
 
     available = ", ".join(repr(c) for c in names)
     for c in [time_col, *sig_names, *tmp_names]:
         if c not in names:
             raise MissingColumnError(f"{p}: no column {c!r}; available: {available}")
 
-    t_res = units.resolve_unit(
+    stated = units.StatedUnits.from_file_info(info, where)
+    resolved = units.resolve_inputs(
         time_col,
-        "time",
-        option=time_unit,
-        metadata=info.get("time_unit"),
-        model=fallback.get("<time>"),
+        sig_names,
+        tmp_names,
+        options=units.UnitOptions(
+            time_unit=time_unit,
+            signal_unit=signal_unit,
+            temp_unit=temp_unit,
+            temp_conversion=temp_conversion,
+        ),
+        file=dataclasses.replace(
+            stated,
+            conversions={**stated.conversions, **(meta.temperature_conversion if meta else {})},
+        ),
+        model=model,
         where=where,
     )
-    sources: dict[str, str] = {"<time>": t_res.source}
     t = numeric_column(obj, time_col, p)
-    if t_res.unit != "s":
-        t = t * units.TIME_UNITS[t_res.unit]
+    if resolved.time.unit != "s":
+        t = t * units.TIME_UNITS[resolved.time.unit]
 
-    cols: dict[str, FloatArray] = {}
-    unit_map: dict[str, str] = {}
+    cols: dict[str, FloatArray] = {c: numeric_column(obj, c, p) for c in [*sig_names, *tmp_names]}
+    unit_map: dict[str, str] = resolved.units()
+    md.temperature_conversion = {  # the resolved ones; others kept for guessed columns
+        **{c: v for c, v in md.temperature_conversion.items() if c not in tmp_names},
+        **{c: r.conversion for c, r in resolved.conversions.items() if r.conversion is not None},
+    }
     extra_units: dict[str, str] = dict(info.get("units") or {})
-    for c in sig_names:
-        cols[c] = numeric_column(obj, c, p)
-        res = units.resolve_unit(
-            c,
-            "signal",
-            option=signal_unit,
-            metadata=sig_info.get(c) or extra_units.get(c),
-            model=fallback.get(c),
-            where=where,
-        )
-        unit_map[c], sources[c] = res.unit, res.source
-    for c in tmp_names:
-        cols[c] = numeric_column(obj, c, p)
-        res = units.resolve_unit(
-            c,
-            "temperature",
-            option=temp_unit,
-            metadata=tmp_info.get(c),
-            model=fallback.get(c),
-            where=where,
-        )
-        unit_map[c], sources[c] = res.unit, res.source
     if keep_other:
         for c in names:
             if c == time_col or c in cols:
@@ -510,9 +511,6 @@ def read_recording(
                 continue
             unit_map[c] = extra_units.get(c, "")
 
-    md = Metadata.from_dict(dict(info.get("metadata") or {}))
-    if meta is not None:
-        md = md.merged(meta)
     return Recording(
         time_s=t,
         columns=cols,
@@ -521,8 +519,8 @@ def read_recording(
         temperatures=tuple(tmp_names),
         meta=md,
         source=str(p),
-        time_unit=t_res.unit,
-        unit_sources=sources,
+        time_unit=resolved.time.unit,
+        unit_sources=resolved.sources(),
     )
 
 
@@ -534,7 +532,7 @@ def recording_info(rec: Recording, time: str = "time") -> dict[str, Any]:
         "time": time,
         "time_unit": "s",
         "signals": {s: rec.units.get(s, "") for s in rec.signals},
-        "temperatures": {s: rec.units.get(s, "degC") for s in rec.temperatures},
+        "temperatures": {s: rec.units.get(s, "") for s in rec.temperatures},
         "units": {
             c: u
             for c, u in rec.units.items()
