@@ -28,10 +28,11 @@ column's own unit.  A model and data of different kinds (°/h against mg) is a
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
 import warnings
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -48,9 +49,11 @@ from thermocal.errors import (
     FileFormatError,
     MissingColumnError,
     MissingValueError,
+    PlausibilityWarning,
     ThermocalInputError,
     TimestampError,
     UnitError,
+    UnitWarning,
 )
 from thermocal.io import (
     CSV_FLOAT_OPTIONS,
@@ -59,15 +62,23 @@ from thermocal.io import (
     META_VERSION,
     atomic_write_path,
     check_not_input,
+    csv_encoding,
     file_kind,
-    fill_fitted_conversions,
     numeric_column,
-    resolve_columns,
     sidecar_path,
     write_json,
 )
 from thermocal.models.base import ModelStream, RunData, TemperatureModel
-from thermocal.recording import GAP_FACTOR, FloatArray, Metadata, median_interval
+from thermocal.recording import (
+    ABSOLUTE_ZERO_C,
+    FEW_SAMPLES,
+    GAP_FACTOR,
+    PLAUSIBLE_SIGNAL,
+    FloatArray,
+    Metadata,
+    Recording,
+    median_interval,
+)
 
 DEFAULT_CHUNK_ROWS = 500_000
 """Rows per chunk of :func:`compensate_file` (≈ 100 MB of working memory for a
@@ -120,6 +131,127 @@ def unit_factor(
             f"data's unit {du!r} ({units.signal_kind(du)})"
         )
     return float(units.convert(1.0, du, mu))
+
+
+def check_signal_kind(data_unit: str, model_unit: str, where: str = "") -> None:
+    """Refuse data whose signal is of another kind than the model's (a rate against an
+    acceleration), naming both, before anything is computed or written.  Raw ``counts``
+    data pass here (their scale factor decides, :func:`unit_factor`)."""
+    du = units.normalize_signal_unit(data_unit)
+    mu = units.normalize_signal_unit(model_unit)
+    kd, km = units.signal_kind(du), units.signal_kind(mu)
+    if kd != km and kd != "raw":
+        raise UnitError(
+            f"{where + ': ' if where else ''}the model's signal unit {mu!r} ({km}) does not "
+            f"match the data's unit {du!r} ({kd}): a model applies to its own kind of "
+            "quantity only"
+        )
+
+
+def model_scale_factor(model: TemperatureModel, meta: Metadata) -> Metadata:
+    """``meta`` with the scale factor K of a raw-count signal taken from the model file's
+    ``inputs`` when the data's metadata gives none (the resolution order: file > model)."""
+    sf = (getattr(model, "inputs_", {}) or {}).get("scale_factor")
+    if meta.scale_factor is None and isinstance(sf, dict) and sf.get("value") is not None:
+        meta.scale_factor = float(sf["value"])
+        meta.scale_factor_unit = sf.get("unit") or meta.scale_factor_unit
+    return meta
+
+
+def temperature_inputs(
+    model: TemperatureModel, resolved: units.ResolvedInputs, where: str = ""
+) -> dict[str, units.TemperatureConversion | None]:
+    """How each of the model's temperature columns becomes its temperature input: a
+    counts → °C conversion, or ``None`` (the values as they are: °C for a °C model, raw
+    counts for a model fitted in counts).
+
+    Raises :class:`UnitError` for raw counts without any conversion (option, file or
+    model) under a °C model, and for °C data under a counts model."""
+    prefix = f"{where}: " if where else ""
+    out: dict[str, units.TemperatureConversion | None] = {}
+    for c, r in resolved.temperatures.items():
+        conv = resolved.conversions[c]
+        if model.temperature_unit == "counts":
+            if r.unit != "counts":
+                raise UnitError(
+                    f"{prefix}the model's temperatures are raw counts (it was fitted without a "
+                    f"conversion), but column {c!r} is in {r.unit}; give raw-count data "
+                    "(--temp-unit counts) or refit the model with --temp-conversion"
+                )
+            if conv.source == "option":
+                warnings.warn(
+                    UnitWarning(
+                        f"{prefix}the model's temperatures are raw counts; --temp-conversion "
+                        f"is not used for column {c!r}"
+                    ),
+                    stacklevel=3,
+                )
+            out[c] = None
+        elif r.unit == "counts":
+            if conv.conversion is None:
+                raise UnitError(
+                    f"{prefix}temperature column {c!r} is in raw counts and no conversion to "
+                    "°C is given (--temp-conversion GAIN,OFFSET[,int16], the file's metadata, "
+                    "or a model fitted with one)"
+                )
+            out[c] = conv.conversion
+        else:
+            out[c] = None
+    return out
+
+
+@dataclass(frozen=True)
+class ModelRun:
+    """A recording prepared for a model (:func:`prepare_run`).
+
+    ``run`` is in the model's units (signal in ``model.signal_unit``, temperatures in
+    ``model.temperature_unit``); ``data_unit`` is the data column's own unit and
+    ``factor`` takes values from it to the model's unit: ``value[model] = factor ·
+    value[data]``; :meth:`to_data_unit` brings model values (ŷ, residuals, figures) back.
+    """
+
+    run: RunData
+    data_unit: str
+    factor: float
+
+    def to_data_unit(self, values: npt.ArrayLike) -> FloatArray:
+        """Model-unit values [model unit] → the data's unit."""
+        return np.asarray(values, dtype=np.float64) / self.factor
+
+
+def prepare_run(
+    model: TemperatureModel,
+    rec: Recording,
+    signal: str | None = None,
+    temps: Sequence[str] | None = None,
+    *,
+    known_input: float = 0.0,
+) -> ModelRun:
+    """The recording's signal and temperatures as the model takes them (validate, report).
+
+    ``rec`` should be read with the model's recorded units as fallbacks
+    (``load_recording(..., model=model)``).  A signal of another kind than the model's is
+    refused (:func:`check_signal_kind`); raw-count temperatures are converted, or kept as
+    counts for a model fitted in counts (a mismatch is refused).  ``known_input`` is in
+    the data's unit.
+    """
+    sig = signal or model.signal_name
+    names = tuple(temps) if temps else tuple(model.temp_names_)
+    data_unit = rec.units.get(sig) or ""
+    check_signal_kind(data_unit, model.signal_unit, rec.name)
+    if model.temperature_unit == "counts":
+        run = RunData.from_recording(rec, sig, names, temperature_unit="counts")
+    else:
+        run = RunData.from_recording(rec, sig, names)
+    values = rec.column(sig)
+    factor = unit_factor(data_unit, model.signal_unit, meta=rec.meta, where=rec.name)
+    run = dataclasses.replace(
+        run,
+        signal=values * factor,
+        known_input=known_input * factor,
+        signal_unit=model.signal_unit,
+    )
+    return ModelRun(run, units.normalize_signal_unit(data_unit), factor)
 
 
 # --- batch -------------------------------------------------------------------------------
@@ -574,7 +706,7 @@ def _file_info(path: Path, kind: str) -> tuple[list[str], dict[str, Any], int | 
                 raise FileFormatError(f"{path}: corrupt thermocal metadata") from None
     else:
         try:
-            head = pd.read_csv(path, nrows=0, skipinitialspace=True)
+            head = pd.read_csv(path, nrows=0, skipinitialspace=True, encoding=csv_encoding(path))
         except (pd.errors.ParserError, pd.errors.EmptyDataError, UnicodeDecodeError) as exc:
             msg = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
             raise FileFormatError(f"{path}: not a readable CSV file ({msg})") from None
@@ -592,21 +724,57 @@ def _file_info(path: Path, kind: str) -> tuple[list[str], dict[str, Any], int | 
 
 
 def _iter_chunks(path: Path, kind: str, chunk_rows: int) -> Iterator[pd.DataFrame | pa.RecordBatch]:
+    """Chunks of the file; a read or parse failure mid-file is a :class:`FileFormatError`
+    naming the file (Parquet pages are checked against their checksums)."""
     if kind == "parquet":
-        pf = pq.ParquetFile(path)
-        yield from pf.iter_batches(batch_size=chunk_rows)
+        try:
+            pf = pq.ParquetFile(path, page_checksum_verification=True)
+            yield from pf.iter_batches(batch_size=chunk_rows)
+        except (pa.ArrowInvalid, OSError) as exc:
+            raise FileFormatError(f"{path}: not a readable Parquet file ({exc})") from None
     else:
         reader = pd.read_csv(
             path,
             chunksize=chunk_rows,
             skipinitialspace=True,
             low_memory=False,
+            encoding=csv_encoding(path),
             **CSV_FLOAT_OPTIONS,
         )
-        with reader:
-            for df in reader:
-                df.columns = [str(c).strip() for c in df.columns]
-                yield df
+        try:
+            with reader:
+                for df in reader:
+                    df.columns = [str(c).strip() for c in df.columns]
+                    yield df
+        except (pd.errors.ParserError, UnicodeDecodeError) as exc:
+            msg = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+            raise FileFormatError(f"{path}: not a readable CSV file ({msg})") from None
+
+
+def _check_plausible(
+    temps_c: FloatArray, names: Sequence[str], raw: FloatArray, unit: str, src: Path, row0: int
+) -> None:
+    """The chunk's values against :func:`thermocal.recording.plausibility_problems`' limits:
+    a temperature below absolute zero or a signal beyond any sensor is an input error."""
+    below = temps_c < ABSOLUTE_ZERO_C
+    if below.any():
+        r, j = (int(v) for v in np.argwhere(below)[0])
+        raise ThermocalInputError(
+            f"{src}: temperature column {names[j]!r} reads {temps_c[r, j]:.6g} °C at row "
+            f"{row0 + r}, below absolute zero (−273.15 °C): a wrong unit, offset or conversion"
+        )
+    kind = units.signal_kind(unit)
+    if kind == "raw":
+        return
+    with np.errstate(over="ignore", invalid="ignore"):
+        canon, canon_unit = units.to_canonical(raw, unit)
+    bad = ~np.isfinite(canon) | (np.abs(canon) > PLAUSIBLE_SIGNAL[kind])
+    if bad.any():
+        r = int(np.argmax(bad))
+        raise ThermocalInputError(
+            f"{src}: signal reads {raw[r]:.6g} {unit} at row {row0 + r}, beyond any sensor "
+            f"(|value| ≤ {PLAUSIBLE_SIGNAL[kind]:g} {canon_unit}): wrong unit or corrupt data"
+        )
 
 
 def _check_finite(arr: FloatArray, label: str, path: Path, row0: int) -> None:
@@ -694,29 +862,32 @@ def compensate_file(
     extrapolate: bool = False,
     known_input: float = 0.0,
     on_progress: Callable[[int], None] | None = None,
-    temperature_conversion: tuple[float, float] | None = None,
+    temperature_conversion: units.TemperatureConversion | tuple[float, float] | None = None,
 ) -> CompensateFileResult:
     """Compensate a CSV/Parquet file into ``out`` with constant memory.
 
     ``out`` keeps every input column and adds ``<signal>_model`` (ŷ) and
     ``<signal>_comp`` (``F − ŷ``), both in the data column's unit.  The signal
     column is the model's ``signal_name`` unless ``signal`` is given; the
-    temperature columns are the model's.  Units: options, then the file's sidecar
-    or Parquet metadata; a signal without a stated unit is taken to be in the
-    model's unit.  The output is written to a temporary name and renamed when
-    complete (:func:`thermocal.io.atomic_write_path`); ``out`` may not be ``path``.
+    temperature columns are the model's.  Units and temperature conversions are resolved
+    once (:func:`thermocal.units.resolve_inputs`): options, then the file's sidecar or
+    Parquet metadata, the unit in the column name, what the model file recorded of its
+    inputs (:meth:`TemperatureModel.input_units`), else a default stated in a warning.
+    The output is written to a temporary name and renamed when complete
+    (:func:`thermocal.io.atomic_write_path`); ``out`` may not be ``path``.
 
     Chunks are predicted with their context (:class:`ChunkPredictor`), so the
     result equals an in-memory ``predict`` of the whole file.  ``known_input``
     [model unit] is what :class:`StreamingCompensator` says.  ``temperature_conversion``
-    ``(gain, offset)`` converts raw-count temperatures (``T = gain·counts + offset``),
-    overriding the file's metadata.
+    ``(gain, offset[, "int16"])`` converts raw-count temperatures
+    (``T = gain·counts + offset``), overriding the file's metadata.
 
     Raises
     ------
     MissingColumnError : the signal, time or a model temperature column is absent
         (the missing and the available columns are named).
-    UnitError : the model's and the data's signal units differ in kind.
+    UnitError : the model's and the data's signal units differ in kind; temperatures in
+        raw counts without a conversion for a °C model, or in °C for a counts model.
     TimestampError, MissingValueError : time not increasing, NaN in a used column.
     """
     src = Path(path)
@@ -752,40 +923,37 @@ def compensate_file(
             raise ThermocalInputError(
                 f"{src}: already has a column {c!r}; was the file compensated already?"
             )
-    # units resolved once (units.resolve_unit): option > file metadata > column name >
-    # the units the model was fitted on (model file "inputs") > a stated default
-    inputs: dict[str, Any] = dict(getattr(model, "inputs_", {}) or {})
-    fitted_units: dict[str, str] = dict(inputs.get("units") or {})
-    fitted = {"<time>": inputs.get("time_unit"), **fitted_units}
-    fitted.setdefault(sig_name, model.signal_unit)
-    resolved = resolve_columns(
-        info,
-        time_col,
-        [sig_name],
-        list(temp_names),
-        time_unit=time_unit,
-        signal_unit=signal_unit,
-        temp_unit=temp_unit,
-        model_units={k: v for k, v in fitted.items() if v},
-        where=str(src),
-    )
-    t_unit = resolved["<time>"].unit
-    t_factor = units.TIME_UNITS[t_unit]
+    # units and temperature conversions resolved once (units.resolve_inputs): option >
+    # file metadata > column name > what the model recorded of its inputs > stated default
+    where = str(src)
     sig_info: dict[str, str] = dict(info.get("signals") or {})
     extra_units: dict[str, str] = dict(info.get("units") or {})
     tmp_info: dict[str, str] = dict(info.get("temperatures") or {})
-    data_unit = resolved[sig_name].unit
-    md = Metadata.from_dict(dict(info.get("metadata") or {}))
-    if temperature_conversion is not None:  # (gain, offset) for every model temperature
-        md.temperature_conversion.update(dict.fromkeys(temp_names, temperature_conversion))
-    temp_units = {c: resolved[c].unit for c in temp_names}
-    fill_fitted_conversions(inputs, temp_units, md.temperature_conversion)
-    for c, u in temp_units.items():
-        if u == "counts" and c not in md.temperature_conversion:
-            raise UnitError(
-                f"{src}: temperature column {c!r} is in raw counts and no conversion to °C is "
-                "given (temperature_conversion in the metadata)"
-            )
+    resolved = units.resolve_inputs(
+        time_col,
+        [sig_name],
+        temp_names,
+        options=units.UnitOptions(
+            time_unit=time_unit,
+            signal_unit=signal_unit,
+            temp_unit=temp_unit,
+            temp_conversion=(
+                units.temperature_conversion(temperature_conversion, "--temp-conversion")
+                if temperature_conversion is not None
+                else None
+            ),
+        ),
+        file=units.StatedUnits.from_file_info(info, where),
+        model=model.input_units(),
+        where=where,
+    )
+    t_unit = resolved.time.unit
+    t_factor = units.TIME_UNITS[t_unit]
+    data_unit = resolved.signals[sig_name].unit
+    check_signal_kind(data_unit, model.signal_unit, where)
+    md = model_scale_factor(model, Metadata.from_dict(dict(info.get("metadata") or {})))
+    temp_units = {c: r.unit for c, r in resolved.temperatures.items()}
+    convs = temperature_inputs(model, resolved, where)
 
     out_info = {
         "format": META_FORMAT,
@@ -797,6 +965,14 @@ def compensate_file(
     out_info["signals"] = {**sig_info, sig_name: data_unit}
     out_info["temperatures"] = {**tmp_info, **temp_units}
     out_info["units"] = {**extra_units, model_col: data_unit, comp_col: data_unit}
+    used_conv = {c: v.to_json() for c, v in convs.items() if v is not None}
+    if used_conv:  # the conversions travel with the output too
+        out_md = dict(out_info.get("metadata") or {})
+        out_md["temperature_conversion"] = {
+            **dict(out_md.get("temperature_conversion") or {}),
+            **used_conv,
+        }
+        out_info["metadata"] = out_md
 
     predictor = ChunkPredictor(
         model, extrapolate=extrapolate, name=str(src), known_input=known_input
@@ -825,13 +1001,17 @@ def compensate_file(
                 temps = np.empty((t.size, len(temp_names)))
                 for j, c in enumerate(temp_names):
                     v = numeric_column(chunk, c, src, row0)
-                    if temp_units[c] == "counts":
-                        gain, offset = md.temperature_conversion[c]
-                        v = v * gain + offset
+                    conv = convs[c]
+                    if conv is not None:  # raw counts → °C (else °C, or counts for a counts model)
+                        v = conv.to_celsius(v, f"{src}: column {c!r} (chunk from row {row0})")
                     _check_finite(v, f"temperature column {c!r}", src, row0)
                     temps[:, j] = v
                 raw = numeric_column(chunk, sig_name, src, row0)
                 _check_finite(raw, f"signal column {sig_name!r}", src, row0)
+                _check_plausible(
+                    temps if model.temperature_unit == "degC" else temps[:, :0],  # counts: no °C
+                    temp_names, raw, data_unit, src, row0,
+                )  # fmt: skip
                 if factor is None:
                     tau = md.sample_interval_s or (median_interval(t) if t.size > 1 else None)
                     factor = unit_factor(
@@ -852,6 +1032,14 @@ def compensate_file(
             w.close()
         if state["rows"] == 0:
             raise FileFormatError(f"{src}: the file has a header but no data rows")
+        if int(state["rows"]) < FEW_SAMPLES:
+            warnings.warn(
+                PlausibilityWarning(
+                    f"{src}: only {state['rows']} samples: figures from so few are not "
+                    f"meaningful (at least {FEW_SAMPLES} sample rows are expected)"
+                ),
+                stacklevel=2,
+            )
 
     atomic_write_path(dst, writer)
     if kind_out == "csv":
@@ -881,9 +1069,14 @@ __all__ = [
     "ChunkPredictor",
     "CompensateFileResult",
     "Compensation",
+    "ModelRun",
     "StreamingCompensator",
+    "check_signal_kind",
     "chunk_context",
     "compensate_file",
     "compensate_run",
+    "model_scale_factor",
+    "prepare_run",
+    "temperature_inputs",
     "unit_factor",
 ]

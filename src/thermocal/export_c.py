@@ -15,8 +15,14 @@ source file with
                               const <p>_real temps_c[<P>_N_TEMPS], <p>_real signal);
       void    <p>_set_known_input(<p>_state *s, <p>_real known_input);
 
-  ``update`` returns the model value ŷ (the temperature-induced signal, model
-  unit); ``compensate`` returns ``signal − ŷ``.  ``init`` is a power-on (it
+  ``update`` returns the model value ŷ (the temperature-induced signal);
+  ``compensate`` returns ``signal − ŷ``.  Signal, known input and results are in the
+  data's own unit (the unit the model was fitted on as given, model file ``inputs``;
+  ``--unit`` for another of the same kind, :func:`c_signal_unit`), named in every
+  function's comment and in ``<P>_SIGNAL_UNIT``; the family arithmetic runs in the
+  model's unit behind ``<P>_TO_MODEL_UNIT``.  ``temps_c`` are in the model's temperature
+  unit (``<P>_TEMPERATURE_UNIT``: °C, or raw counts for a model fitted in counts); a model
+  fitted on converted counts also gets ``<p>_temps_from_counts``.  ``init`` is a power-on (it
   forgets every state); ``sample_interval_s`` is the nominal sample interval τ:
   a time step longer than ``GAP_FACTOR`` (1.5) × τ resets the rate estimate, as
   in :class:`thermocal.compensate.StreamingCompensator`;
@@ -53,7 +59,8 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
-from thermocal.errors import ModelFileError, ThermocalInputError
+from thermocal import units
+from thermocal.errors import ModelFileError, ThermocalInputError, UnitError
 from thermocal.recording import GAP_FACTOR, FloatArray
 
 REAL_TYPES = ("double", "float")
@@ -91,6 +98,11 @@ class CExport:
     source: str
     family: str
     n_temps: int
+    unit: str = ""
+    """Unit of the functions' signal and results (:func:`c_signal_unit`)."""
+    model_unit: str = ""
+    """The model's own unit, in which the family arithmetic runs."""
+    temperature_unit: str = "degC"
 
     @property
     def header_name(self) -> str:
@@ -164,8 +176,13 @@ class ExportContext:
         rows = ",\n    ".join("{" + ", ".join(self.lit(x) for x in row) + "}" for row in m)
         return f"static const {self.r} {name}[{m.shape[0]}][{m.shape[1]}] = {{\n    {rows}\n}};"
 
+    @property
+    def tu(self) -> str:
+        """The model's temperature unit in comments: ``degC`` or ``counts``."""
+        return str(self.model.get("temperature_unit") or units.LEGACY_TEMPERATURE_UNIT)
+
     def temp_range(self) -> FloatArray:
-        """(k, 2) fitted temperature range [°C] in the model's temperature order."""
+        """(k, 2) fitted temperature range [°C or counts] in the model's temperature order."""
         tr = self.model["range"]["temperature_c"]
         return np.array([tr[n] for n in self.model["temperatures"]], dtype=np.float64)
 
@@ -173,7 +190,7 @@ class ExportContext:
         rng = self.temp_range()
         return "\n".join(
             [
-                "/* fitted temperature range [degC]: inputs are clamped to it */",
+                f"/* fitted temperature range [{self.tu}]: inputs are clamped to it */",
                 self.array(f"{self.P}_T_LO", rng[:, 0]),
                 self.array(f"{self.P}_T_HI", rng[:, 1]),
             ]
@@ -217,8 +234,21 @@ def _identity(d: dict[str, Any]) -> list[str]:
         f"created (UTC):     {d.get('created_utc')}",
         f"checksum (sha256): {d.get('checksum')}",
         f"signal:            {sig.get('name')} [{sig.get('unit')}], target {sig.get('target')}",
-        f"temperatures:      {', '.join(d.get('temperatures', []))} [degC]",
+        f"temperatures:      {', '.join(d.get('temperatures', []))} "
+        f"[{d.get('temperature_unit') or units.LEGACY_TEMPERATURE_UNIT}]",
     ]
+    inputs = d.get("inputs") or {}
+    if inputs.get("units"):
+        given = ", ".join(f"{k} [{v}]" for k, v in inputs["units"].items())
+        lines.append(f"fitted data:       {given}")
+    for name, conv in (inputs.get("temperature_conversion") or {}).items():
+        lines.append(f"conversion {name}: {units.temperature_conversion(conv).describe()}")
+    known = inputs.get("known_input")
+    if isinstance(known, dict) and known.get("value"):
+        lines.append(
+            f"known input:       {known.get('value')} {known.get('unit')} removed before the "
+            f"fit ({known.get('what')})"
+        )
     rate = d.get("rate")
     if rate:
         lines.append(f"temperature rate:  {rate.get('method')} over {rate.get('interval_s')} s")
@@ -232,18 +262,81 @@ def _comment(lines: Sequence[str]) -> str:
     return "/*\n" + "\n".join(f" * {ln}".rstrip() for ln in lines) + "\n */"
 
 
+def c_signal_unit(model: dict[str, Any], unit: str | None = None) -> tuple[str, float]:
+    """The unit the generated functions take ``signal`` and return values in, and the factor
+    ``f`` with ``value[model unit] = f · value[that unit]``.
+
+    ``unit`` (``--unit``) else the unit the model was fitted on as given (model file
+    ``inputs.units``, e.g. ``deg/s``), else the model's own unit (older files, raw-count
+    data).  A unit of another kind than the model's, or ``counts``, is a :class:`UnitError`.
+    """
+    mu = units.normalize_signal_unit(str((model.get("signal") or {}).get("unit")))
+    if unit is None:
+        given = ((model.get("inputs") or {}).get("units") or {}).get(
+            (model.get("signal") or {}).get("name")
+        )
+        ok = given and units.signal_kind(str(given)) == units.signal_kind(mu)
+        unit = str(given) if ok else mu
+    u = units.normalize_signal_unit(unit)
+    if u != mu and (units.signal_kind(u) == "raw" or units.signal_kind(mu) == "raw"):
+        raise UnitError(
+            f"export-c --unit {u}: raw counts need the scale factor, the model is in {mu}; "
+            "give a physical unit of the model's kind"
+        )
+    return u, float(units.convert(1.0, u, mu))
+
+
+def _temperature_from_counts(model: dict[str, Any], p: str, P: str) -> tuple[list[str], str]:
+    """Header declaration and source of ``<p>_temps_from_counts`` when every model
+    temperature has a counts → °C conversion recorded (the firmware reads counts)."""
+    conv_raw = (model.get("inputs") or {}).get("temperature_conversion") or {}
+    names = list(model["temperatures"])
+    if (model.get("temperature_unit") or units.LEGACY_TEMPERATURE_UNIT) != "degC" or not all(
+        n in conv_raw for n in names
+    ):
+        return [], ""
+    convs = [units.temperature_conversion(conv_raw[n]) for n in names]
+    decl = [
+        "/* Raw ADC temperature counts -> temps_c [degC] as fitted: T = gain*v + offset, v the",
+        "   count (int16: signed 16-bit stored unsigned, v >= 32768 -> v - 65536 first). */",
+        f"void {p}_temps_from_counts(const double counts[{P}_N_TEMPS], "
+        f"{p}_real temps_c[{P}_N_TEMPS]);",
+    ]
+    body = [
+        f"void {p}_temps_from_counts(const double counts[{P}_N_TEMPS], "
+        f"{p}_real temps_c[{P}_N_TEMPS])",
+        "{",
+        "    double v;",
+    ]
+    for i, (n, c) in enumerate(zip(names, convs, strict=True)):
+        enc = ", int16" if c.encoding == "int16" else ""
+        label = n.replace("*/", "* /")
+        body.append(f"    v = counts[{i}]; /* {label}: T = {c.gain!r} * v + {c.offset!r}{enc} */")
+        if c.encoding == "int16":
+            body.append(f"    if (v >= {units.INT16_SIGN_BIT!r}) {{")
+            body.append(f"        v -= {units.UINT16_MODULUS!r};")
+            body.append("    }")
+        body.append(f"    temps_c[{i}] = ({p}_real)(v * {float(c.gain)!r} + {float(c.offset)!r});")
+    body.append("}")
+    return decl, "\n".join(body)
+
+
 def generate_c(
     model: dict[str, Any],
     *,
     prefix: str = "thermocal_model",
     real: str = "double",
     sample_interval_s: float = 1.0,
+    unit: str | None = None,
 ) -> CExport:
     """Generate the C99 header and source of a model dict (see the module docstring).
 
     ``sample_interval_s`` is only used to size the Ṫ ring buffer of rate models
     (``<P>_RATE_BUF_LEN`` = ⌈Δt/τ⌉ + 8, overridable with ``-D``); the interval used at
-    run time is the argument of ``<p>_init``.
+    run time is the argument of ``<p>_init``.  ``unit`` is the signal unit of the
+    functions (:func:`c_signal_unit`: by default the unit the model was fitted on as
+    given); the family code runs in the model's unit and ``<p>_update`` converts its
+    input and output with ``<P>_TO_MODEL_UNIT``.
     """
     if real not in REAL_TYPES:
         raise ThermocalInputError(f"real type must be one of {REAL_TYPES}, got {real!r}")
@@ -265,9 +358,30 @@ def generate_c(
     k = len(model["temperatures"])
     guard = f"{P}_H"
     ident = _identity(model)
+    su, factor = c_signal_unit(model, unit)
+    mu = units.normalize_signal_unit(str(model["signal"]["unit"]))
+    tu = ctx.tu
+    convert = factor != 1.0
+    conv_decl, conv_src = _temperature_from_counts(model, p, P)
+    unit_defines = [
+        f'#define {P}_SIGNAL_UNIT "{su}" /* unit of signal, known_input and every result */',
+        f'#define {P}_TEMPERATURE_UNIT "{tu}" /* unit of temps_c[] */',
+    ]
+    if convert:
+        unit_defines.append(
+            f"#define {P}_TO_MODEL_UNIT {ctx.lit(factor)} /* [{mu}] per [{su}]: the model "
+            f"runs in {mu} */"
+        )
     header = "\n".join(
         [
-            _comment([*ident, "", *code.notes]),
+            _comment(
+                [
+                    *ident,
+                    f"C functions: signal and results in [{su}], temps_c in [{tu}]",
+                    "",
+                    *code.notes,
+                ]
+            ),
             f"#ifndef {guard}",
             f"#define {guard}",
             "",
@@ -275,34 +389,66 @@ def generate_c(
             "",
             f"#define {P}_N_TEMPS {k}",
             f"#define {P}_GAP_FACTOR {GAP_FACTOR!r}",
+            *unit_defines,
             *code.defines,
             "",
-            "/* temperature order of temps_c[]: "
+            f"/* temperature order of temps_c[] [{tu}]: "
             + ", ".join(f"{i}={n}" for i, n in enumerate(model["temperatures"]))
             + " */",
             "",
             "typedef struct {",
             "    double sample_interval_s;",
-            f"    {p}_real known_input;",
+            f"    {p}_real known_input; /* [{mu}] */",
             *[f"    {f}" for f in code.state_fields],
             f"}} {p}_state;",
             "",
             "/* Power-on: forget every state. sample_interval_s = nominal interval [s]. */",
             f"void {p}_init({p}_state *s, double sample_interval_s);",
-            "/* Known input (earth rate, gravity component) removed from the signal the model",
-            "   sees (start-up selection); default 0. */",
+            f"/* Known input [{su}] (earth rate, gravity component) removed from the signal the",
+            "   model sees (start-up selection); default 0. */",
             f"void {p}_set_known_input({p}_state *s, {p}_real known_input);",
-            "/* Model value (temperature-induced signal) of one sample. */",
+            f"/* Model value [{su}] (temperature-induced signal) of one sample: time_s [s],",
+            f"   temps_c [{tu}], signal [{su}]. */",
             f"{p}_real {p}_update({p}_state *s, double time_s, "
             f"const {p}_real temps_c[{P}_N_TEMPS], {p}_real signal);",
-            "/* Compensated output: signal - model value. */",
+            f"/* Compensated output [{su}]: signal [{su}] - model value. */",
             f"{p}_real {p}_compensate({p}_state *s, double time_s, "
             f"const {p}_real temps_c[{P}_N_TEMPS], {p}_real signal);",
+            *conv_decl,
             "",
             f"#endif /* {guard} */",
             "",
         ]
     )
+    model_fn = f"{p}_update_{c_identifier(mu)}" if convert else f"{p}_update"
+    model_fn_head = (
+        [
+            f"/* Model value [{mu}] of one sample, signal [{mu}]: the family's arithmetic. */",
+            f"static {p}_real {model_fn}({p}_state *s, double time_s, "
+            f"const {p}_real temps_c[{P}_N_TEMPS], {p}_real signal)",
+        ]
+        if convert
+        else [
+            f"/* Model value [{su}] of one sample: temps_c [{tu}], signal [{su}]. */",
+            f"{p}_real {p}_update({p}_state *s, double time_s, "
+            f"const {p}_real temps_c[{P}_N_TEMPS], {p}_real signal)",
+        ]
+    )
+    wrapper = (
+        [
+            "",
+            f"/* Model value [{su}] of one sample: temps_c [{tu}], signal [{su}]. */",
+            f"{p}_real {p}_update({p}_state *s, double time_s, "
+            f"const {p}_real temps_c[{P}_N_TEMPS], {p}_real signal)",
+            "{",
+            f"    return {model_fn}(s, time_s, temps_c, signal * {P}_TO_MODEL_UNIT) "
+            f"/ {P}_TO_MODEL_UNIT;",
+            "}",
+        ]
+        if convert
+        else []
+    )
+    ki = f"known_input * {P}_TO_MODEL_UNIT" if convert else "known_input"
     source = "\n".join(
         [
             _comment(ident[:1] + ident[1:3] + ident[5:6]),
@@ -322,26 +468,39 @@ def generate_c(
             _indent(code.init),
             "}",
             "",
+            f"/* known_input [{su}], kept in [{mu}] */",
             f"void {p}_set_known_input({p}_state *s, {p}_real known_input)",
             "{",
-            "    s->known_input = known_input;",
+            f"    s->known_input = {ki};",
             "}",
             "",
-            f"{p}_real {p}_update({p}_state *s, double time_s, "
-            f"const {p}_real temps_c[{P}_N_TEMPS], {p}_real signal)",
+            *model_fn_head,
             "{",
             _indent(code.update),
             "}",
+            *wrapper,
             "",
+            f"/* Compensated output [{su}]: signal [{su}] - model value [{su}]. */",
             f"{p}_real {p}_compensate({p}_state *s, double time_s, "
             f"const {p}_real temps_c[{P}_N_TEMPS], {p}_real signal)",
             "{",
             f"    return signal - {p}_update(s, time_s, temps_c, signal);",
             "}",
             "",
+            *([conv_src, ""] if conv_src else []),
         ]
     )
-    return CExport(prefix=p, real=real, header=header, source=source, family=fam, n_temps=k)
+    return CExport(
+        prefix=p,
+        real=real,
+        header=header,
+        source=source,
+        family=fam,
+        n_temps=k,
+        unit=su,
+        model_unit=mu,
+        temperature_unit=tu,
+    )
 
 
 def _indent(text: str, n: int = 4) -> str:
@@ -374,7 +533,7 @@ s->have_last = 0;
 s->last_t = 0.0;
 """
     update = f"""
-/* backward temperature rate [degC/min] from the raw temperatures */
+/* backward temperature rate [{ctx.tu}/min] from the raw temperatures */
 if (s->have_last && time_s - s->last_t > {P}_GAP_FACTOR * s->sample_interval_s) {{
     s->buf_n = 0; /* a gap: new contiguous segment */
 }}
@@ -449,7 +608,7 @@ def _gen_poly(ctx: ExportContext) -> FamilyCode:
     else:  # constant or rate-only model: the temperature range is documentation only
         rng = ctx.temp_range()
         data = [
-            "/* fitted temperature range [degC]: "
+            f"/* fitted temperature range [{ctx.tu}]: "
             + ", ".join(
                 f"{n} {lo!r}..{hi!r}" for n, (lo, hi) in zip(d["temperatures"], rng, strict=True)
             )
@@ -479,7 +638,8 @@ def _gen_poly(ctx: ExportContext) -> FamilyCode:
     if clamp_rate:
         rng = np.array([rr[n] for n in d["temperatures"]], dtype=np.float64)
         data += [
-            "/* fitted temperature-rate range [degC/min]: rates of the rate sensors are clamped */",
+            f"/* fitted temperature-rate range [{ctx.tu}/min]: rates of the rate sensors are "
+            "clamped */",
             ctx.array(f"{P}_R_LO", rng[:, 0]),
             ctx.array(f"{P}_R_HI", rng[:, 1]),
         ]
@@ -487,7 +647,7 @@ def _gen_poly(ctx: ExportContext) -> FamilyCode:
     notes = [
         f"Polynomial model (SPEC 4a): {len(terms)} terms + constant in the centred and scaled",
         "base variables u = (T - c_T)/s_T, v = (dT - c_R)/s_R, w = (T dT - c_W)/s_W",
-        "(dT = backward difference over the rate interval, degC/min). Inputs are clamped",
+        f"(dT = backward difference over the rate interval, {ctx.tu}/min). Inputs are clamped",
         "to the fitted temperature (and rate) range. Call init at power-on.",
     ]
     if not terms:
@@ -614,13 +774,13 @@ def _gen_piecewise(ctx: ExportContext) -> FamilyCode:
     data = [
         ctx.clamp_arrays(),
         f"/* line j: y = A[j] + S[j] * T for BP[j-1] <= T < BP[j] ({st.get('method')} method);",
-        f"   A [{unit}], S [{unit}/degC] */",
+        f"   A [{unit}], S [{unit}/{ctx.tu}] */",
         ctx.array(f"{P}_A", icp),
         ctx.array(f"{P}_S", slp),
     ]
     if n_b:
         data += [
-            "/* breakpoints [degC], ascending */",
+            f"/* breakpoints [{ctx.tu}], ascending */",
             ctx.array(f"{P}_BP", bps),
         ]
     upd = [
@@ -648,7 +808,7 @@ def _gen_piecewise(ctx: ExportContext) -> FamilyCode:
             f"#define {P}_TEMP_INDEX {k} /* temps_c[] entry the model uses ({used}) */",
         ],
         notes=[
-            f"Piecewise-linear model (SPEC 4b, {st.get('method')} method) in {used} [degC]:",
+            f"Piecewise-linear model (SPEC 4b, {st.get('method')} method) in {used} [{ctx.tu}]:",
             "y = A[j] + S[j] T, j = number of breakpoints <= T; T clamped to the fitted range.",
             "Memoryless; call init once before use.",
         ],
@@ -674,7 +834,8 @@ def _gen_warmup(ctx: ExportContext) -> FamilyCode:
     data = "\n".join(
         [
             ctx.clamp_arrays(),
-            f"/* b[j][k]: coefficient of dT^j * T0^k [{ctx.model['signal']['unit']}/degC^(j+k)] */",
+            f"/* b[j][k]: coefficient of dT^j * T0^k [{ctx.model['signal']['unit']}/"
+            f"{ctx.tu}^(j+k)] */",
             ctx.array2(f"{P}_B", b),
             f"static const {r} {P}_T0_LO = {ctx.lit(lo)}; /* fitted start temperatures */",
             f"static const {r} {P}_T0_HI = {ctx.lit(hi)};",
@@ -1009,13 +1170,16 @@ def measure_float_error(
     n: int = 100_000,
     sample_interval_s: float = 1.0,
     compiler: str | None = None,
+    unit: str | None = None,
 ) -> FloatError:
     """Compile the double and float builds and compare them on the same inputs."""
     t, T, f = exercise_inputs(model, n, sample_interval_s)
     outs = []
     with tempfile.TemporaryDirectory() as tmp:
         for real in REAL_TYPES:
-            ex = generate_c(model, prefix=prefix, real=real, sample_interval_s=sample_interval_s)
+            ex = generate_c(
+                model, prefix=prefix, real=real, sample_interval_s=sample_interval_s, unit=unit
+            )
             exe = compile_harness(ex, Path(tmp) / real, compiler)
             outs.append(run_harness(exe, t, T, f, sample_interval_s))
     d = np.abs(outs[1] - outs[0])
@@ -1030,8 +1194,10 @@ def export_c(
     prefix: str | None = None,
     real: str = "double",
     sample_interval_s: float = 1.0,
+    unit: str | None = None,
 ) -> tuple[CExport, list[Path]]:
-    """Read and verify a model file, generate its C module and write it into ``out_dir``."""
+    """Read and verify a model file, generate its C module and write it into ``out_dir``
+    (``unit``: the functions' signal unit, :func:`c_signal_unit`)."""
     from thermocal.models.base import load_model_dict
 
     d = load_model_dict(model_path)
@@ -1040,6 +1206,7 @@ def export_c(
         prefix=prefix or c_identifier(Path(model_path).stem),
         real=real,
         sample_interval_s=sample_interval_s,
+        unit=unit,
     )
     return ex, ex.write(out_dir)
 
@@ -1053,6 +1220,7 @@ __all__ = [
     "FloatError",
     "c_harness",
     "c_identifier",
+    "c_signal_unit",
     "compile_harness",
     "exercise_inputs",
     "export_c",

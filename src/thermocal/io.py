@@ -19,6 +19,7 @@ The sidecar / Parquet metadata is a JSON object::
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 import errno
 import fcntl
 import glob
@@ -394,70 +395,6 @@ def numeric_column(
     return conv.to_numpy(dtype=np.float64, na_value=np.nan)
 
 
-def resolve_columns(
-    info: dict[str, Any],
-    time_col: str,
-    signals: list[str],
-    temperatures: list[str],
-    *,
-    time_unit: str | None = None,
-    signal_unit: str | None = None,
-    temp_unit: str | None = None,
-    model_units: dict[str, str] | None = None,
-    where: str = "",
-) -> dict[str, units.ResolvedUnit]:
-    """The unit of the time column (key ``"<time>"``) and of each signal and temperature
-    column of a file whose metadata is ``info`` (sidecar / Parquet key-value), each by
-    :func:`thermocal.units.resolve_unit`: option > ``info`` > column name >
-    ``model_units`` (by column; ``"<time>"`` for time) > a default stated in a warning."""
-    fallback = model_units or {}
-    sig_info: dict[str, str] = dict(info.get("signals") or {})
-    tmp_info: dict[str, str] = dict(info.get("temperatures") or {})
-    extra_units: dict[str, str] = dict(info.get("units") or {})
-    out = {
-        "<time>": units.resolve_unit(
-            time_col,
-            "time",
-            option=time_unit,
-            metadata=info.get("time_unit"),
-            model=fallback.get("<time>"),
-            where=where,
-        )
-    }
-    for c in signals:
-        out[c] = units.resolve_unit(
-            c,
-            "signal",
-            option=signal_unit,
-            metadata=sig_info.get(c) or extra_units.get(c),
-            model=fallback.get(c),
-            where=where,
-        )
-    for c in temperatures:
-        out[c] = units.resolve_unit(
-            c,
-            "temperature",
-            option=temp_unit,
-            metadata=tmp_info.get(c),
-            model=fallback.get(c),
-            where=where,
-        )
-    return out
-
-
-def fill_fitted_conversions(
-    model_inputs: dict[str, Any] | None,
-    units_by_column: dict[str, str],
-    conversions: dict[str, tuple[float, float]],
-) -> None:
-    """Give raw-count temperature columns that no option or file converts the counts → °C
-    conversion recorded in the model file (``inputs.temperature_conversion``), in place."""
-    for name, conv in dict((model_inputs or {}).get("temperature_conversion") or {}).items():
-        if units_by_column.get(name) == "counts" and name not in conversions:
-            gain, offset = (float(v) for v in list(conv)[:2])
-            conversions[name] = (gain, offset)
-
-
 def read_recording(
     path: str | Path,
     *,
@@ -470,7 +407,8 @@ def read_recording(
     meta: Metadata | None = None,
     keep_other: bool = True,
     skipped: list[str] | None = None,
-    model_units: dict[str, str] | None = None,
+    temp_conversion: units.TemperatureConversion | None = None,
+    model: units.StatedUnits | None = None,
 ) -> Recording:
     """Read a CSV or Parquet recording.
 
@@ -478,17 +416,23 @@ def read_recording(
     ----------
     path : the file; its extension chooses the format.
     time : name of the time column (default: sidecar's, else ``"time"``).
-    time_unit : ``s``, ``ms`` or ``us`` (default ``s``); converted to [s].
+    time_unit : ``s``, ``ms`` or ``us``; converted to [s].
     signals, temperatures : column names with those roles (default: sidecar's).
-    signal_unit, temp_unit : units of those columns (override the sidecar).
-    meta : metadata that overrides the file's.
+    signal_unit, temp_unit : units of those columns (override the sidecar); ``signal_unit``
+        may be ``U1,…,Un``, one per signal.
+    meta : metadata that overrides the file's (its temperature conversions count as
+        options).
     keep_other : keep the other numeric columns (non-numeric ones are skipped).
     skipped : if a list is given, the names of skipped non-numeric columns are appended.
-    model_units : units recorded in a model file, by column name (``"<time>"`` for the
-        time column): used where the option, the file and the column name are silent.
+    temp_conversion : ``--temp-conversion``, the counts → °C conversion of every
+        temperature column (which it says are raw counts).
+    model : the units a model file recorded of its inputs
+        (:meth:`thermocal.units.StatedUnits.from_model_inputs`): used where the option,
+        the file and the column name are silent.
 
-    Units are resolved by :func:`thermocal.units.resolve_unit` (option > file metadata >
-    column name > model file > a default stated in a warning); the source of each is in
+    Units and temperature conversions are resolved once by
+    :func:`thermocal.units.resolve_inputs` (option > file metadata > column name > model
+    file > a default stated in a warning); the source of each is in
     ``Recording.unit_sources``.
 
     Raises
@@ -512,36 +456,48 @@ def read_recording(
         raise FileFormatError(f"{p}: the file has a header but no data rows")
 
     time_col = time or info.get("time") or "time"
-    fallback = dict(model_units or {})
     where = str(p)
     sig_info: dict[str, str] = dict(info.get("signals") or {})
     tmp_info: dict[str, str] = dict(info.get("temperatures") or {})
     sig_names = list(signals) if signals is not None else list(sig_info)
     tmp_names = list(temperatures) if temperatures is not None else list(tmp_info)
+    md = Metadata.from_dict(dict(info.get("metadata") or {}))
+    if meta is not None:
+        md = md.merged(meta)
 
     available = ", ".join(repr(c) for c in names)
     for c in [time_col, *sig_names, *tmp_names]:
         if c not in names:
             raise MissingColumnError(f"{p}: no column {c!r}; available: {available}")
 
-    resolved = resolve_columns(
-        info,
+    stated = units.StatedUnits.from_file_info(info, where)
+    resolved = units.resolve_inputs(
         time_col,
         sig_names,
         tmp_names,
-        time_unit=time_unit,
-        signal_unit=signal_unit,
-        temp_unit=temp_unit,
-        model_units=fallback,
+        options=units.UnitOptions(
+            time_unit=time_unit,
+            signal_unit=signal_unit,
+            temp_unit=temp_unit,
+            temp_conversion=temp_conversion,
+        ),
+        file=dataclasses.replace(
+            stated,
+            conversions={**stated.conversions, **(meta.temperature_conversion if meta else {})},
+        ),
+        model=model,
         where=where,
     )
-    sources: dict[str, str] = {c: r.source for c, r in resolved.items()}
     t = numeric_column(obj, time_col, p)
-    if resolved["<time>"].unit != "s":
-        t = t * units.TIME_UNITS[resolved["<time>"].unit]
+    if resolved.time.unit != "s":
+        t = t * units.TIME_UNITS[resolved.time.unit]
 
     cols: dict[str, FloatArray] = {c: numeric_column(obj, c, p) for c in [*sig_names, *tmp_names]}
-    unit_map = {c: r.unit for c, r in resolved.items() if c != "<time>"}
+    unit_map: dict[str, str] = resolved.units()
+    md.temperature_conversion = {  # the resolved ones; others kept for guessed columns
+        **{c: v for c, v in md.temperature_conversion.items() if c not in tmp_names},
+        **{c: r.conversion for c, r in resolved.conversions.items() if r.conversion is not None},
+    }
     extra_units: dict[str, str] = dict(info.get("units") or {})
     if keep_other:
         for c in names:
@@ -555,9 +511,6 @@ def read_recording(
                 continue
             unit_map[c] = extra_units.get(c, "")
 
-    md = Metadata.from_dict(dict(info.get("metadata") or {}))
-    if meta is not None:
-        md = md.merged(meta)
     return Recording(
         time_s=t,
         columns=cols,
@@ -566,8 +519,8 @@ def read_recording(
         temperatures=tuple(tmp_names),
         meta=md,
         source=str(p),
-        time_unit=resolved["<time>"].unit,
-        unit_sources=sources,
+        time_unit=resolved.time.unit,
+        unit_sources=resolved.sources(),
     )
 
 
@@ -579,7 +532,7 @@ def recording_info(rec: Recording, time: str = "time") -> dict[str, Any]:
         "time": time,
         "time_unit": "s",
         "signals": {s: rec.units.get(s, "") for s in rec.signals},
-        "temperatures": {s: rec.units.get(s, "degC") for s in rec.temperatures},
+        "temperatures": {s: rec.units.get(s, "") for s in rec.temperatures},
         "units": {
             c: u
             for c, u in rec.units.items()

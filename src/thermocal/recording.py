@@ -51,8 +51,10 @@ class Metadata:
     latitude_deg : test-site latitude φ [°], for earth-rate removal.
     axis : sensitive-axis direction in local ENU (``"up"``, ``"north"``, ``"e,n,u"``).
     sensor_id, run_id, notes : free text.
-    temperature_conversion : per temperature column ``(gain, offset)`` with
-        ``T[°C] = gain · counts + offset`` for raw ADC temperatures.
+    temperature_conversion : per temperature column a
+        :class:`~thermocal.units.TemperatureConversion` ``(gain, offset[, "int16"])`` with
+        ``T[°C] = gain · counts + offset`` for raw ADC temperatures (``int16``: signed
+        16-bit counts stored unsigned).
     extra : any other key-value pairs (kept through read/write round-trips).
     """
 
@@ -64,7 +66,7 @@ class Metadata:
     sensor_id: str | None = None
     run_id: str | None = None
     notes: str | None = None
-    temperature_conversion: dict[str, tuple[float, float]] = field(default_factory=dict)
+    temperature_conversion: dict[str, units.TemperatureConversion] = field(default_factory=dict)
     extra: dict[str, Any] = field(default_factory=dict)
 
     def to_dict(self) -> dict[str, Any]:
@@ -75,7 +77,7 @@ class Metadata:
             if v is None or (isinstance(v, dict) and not v):
                 continue
             if f.name == "temperature_conversion":
-                v = {k: [float(a), float(b)] for k, (a, b) in v.items()}
+                v = {k: units.temperature_conversion(c).to_json() for k, c in v.items()}
             out[f.name] = v
         return out
 
@@ -94,7 +96,8 @@ class Metadata:
                 extra[k] = v
         conv = kwargs.get("temperature_conversion") or {}
         kwargs["temperature_conversion"] = {
-            str(k): (float(v[0]), float(v[1])) for k, v in conv.items()
+            str(k): units.temperature_conversion(v, f"temperature_conversion of {k!r}")
+            for k, v in conv.items()
         }
         for k in ("sample_interval_s", "scale_factor", "latitude_deg"):
             if kwargs.get(k) is not None:
@@ -278,7 +281,8 @@ class Recording:
 
     def temperature_c(self, name: str | None = None) -> FloatArray:
         """A temperature column in [°C], converting raw counts with the metadata's
-        ``temperature_conversion`` (``T = gain·counts + offset``)."""
+        ``temperature_conversion`` (``T = gain·counts + offset``, int16 counts first made
+        signed)."""
         name = self._default(name, self.temperatures, "temperature")
         values = self.column(name)
         unit = self.units.get(name)
@@ -290,10 +294,22 @@ class Recording:
         if conv is None:
             raise UnitError(
                 f"{self.name}: temperature column {name!r} is in raw counts and no "
-                "conversion to °C is given (set temperature_conversion gain, offset)"
+                "conversion to °C is given (--temp-conversion GAIN,OFFSET[,int16], or "
+                "temperature_conversion in the file's metadata)"
             )
-        gain, offset = conv
-        return values * gain + offset
+        return units.temperature_conversion(conv).to_celsius(values, f"{self.name}: {name!r}")
+
+    def temperature_counts(self, name: str) -> FloatArray:
+        """A raw-count temperature column as stored [counts], for models fitted in counts
+        (no conversion); a column in °C is a :class:`UnitError`."""
+        unit = self.units.get(name)
+        if not unit or units.normalize_temperature_unit(unit) != "counts":
+            raise UnitError(
+                f"{self.name}: the model's temperatures are raw counts, but column {name!r} "
+                f"is in {unit or 'an unknown unit'}; give the data in counts (--temp-unit "
+                "counts) or refit the model with --temp-conversion"
+            )
+        return self.column(name)
 
     def temperatures_c(self, names: list[str] | tuple[str, ...] | None = None) -> FloatArray:
         """Temperatures as an (n_samples, n_sensors) array [°C]."""
@@ -494,6 +510,8 @@ ABSOLUTE_ZERO_C = -273.15
 """No temperature is below this [°C]."""
 PLAUSIBLE_TEMPERATURE_C = (-100.0, 200.0)
 """Temperatures a test chamber or a sensor reaches [°C]; outside, a unit is likely wrong."""
+FEW_SAMPLES = 10
+"""Fewer sample rows than this are reported (a warning; commands needing more refuse)."""
 PLAUSIBLE_SIGNAL = {"rate": 1e8, "accel": 1e7}
 """Largest |value| any gyro [°/h] (≈ 28 000 °/s) or accelerometer [mg] (10 000 g) outputs."""
 
@@ -507,10 +525,31 @@ def plausibility_problems(rec: Recording) -> list[Problem]:
     :data:`PLAUSIBLE_SIGNAL`, or one that overflows on conversion, is an error.
     """
     probs: list[Problem] = []
+    n = rec.n_samples
+    if 2 <= n < FEW_SAMPLES:
+        probs.append(
+            Problem(
+                "implausible_few_samples",
+                f"only {n} samples: figures from so few are not meaningful (at least "
+                f"{FEW_SAMPLES} sample rows are expected of a test recording)",
+                severity="warning",
+            )
+        )
     for name in rec.temperatures:
         arr = rec.columns.get(name)
         if arr is None or not rec.units.get(name):
             continue
+        fin = arr[np.isfinite(arr)]
+        if fin.size >= 2 and float(np.ptp(fin)) == 0.0:
+            probs.append(
+                Problem(
+                    "implausible_constant_temperature",
+                    f"temperature column {name!r} is constant ({float(fin[0]):.6g} "
+                    f"{rec.units[name]}): no temperature dependence can be seen in it",
+                    severity="warning",
+                    column=name,
+                )
+            )
         try:
             temp = rec.temperature_c(name)
         except ThermocalInputError:

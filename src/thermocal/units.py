@@ -19,7 +19,15 @@ m/s^2     metres per second squared   accel
 counts    raw output (pulses, LSB)    raw
 ========  ==========================  =========
 
-Temperature unit strings: ``degC`` (also ``C``, ``°C``) and ``counts`` (raw ADC).
+Temperature unit strings: ``degC`` (also ``C``, ``°C``) and ``counts`` (raw ADC), converted
+by a :class:`TemperatureConversion` ``T = gain·v + offset`` (``int16``: signed 16-bit counts
+stored unsigned).
+
+The one resolver (:func:`resolve_inputs`, per column :func:`resolve_unit` and
+:func:`resolve_temperature_conversion`) chooses every unit and conversion of a recording,
+once, in INTERFACE.md's order: command-line option > the file's own metadata > a unit in
+the column name > what the model file recorded > a default stated in a
+:class:`~thermocal.errors.UnitWarning`.  Nothing else in thermocal chooses a unit.
 
 Sources: earth rate from WGS-84 (NIMA TR8350.2, 3rd ed., 2000);
 standard gravity from CGPM 1901 (BIPM SI Brochure).
@@ -30,9 +38,9 @@ from __future__ import annotations
 import math
 import re
 import warnings
-from collections.abc import Callable
-from dataclasses import dataclass
-from typing import Final, Literal
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass, field
+from typing import Any, Final, Literal, NamedTuple
 
 import numpy as np
 import numpy.typing as npt
@@ -160,10 +168,101 @@ def normalize_time_unit(unit: str) -> str:
     raise UnitError(f"unknown time unit {unit!r}; known units: {', '.join(TIME_UNITS)}")
 
 
+# --- raw-count temperatures ------------------------------------------------------------
+
+INT16_SIGN_BIT: Final = 32768.0
+"""Unsigned 16-bit values at or above this are negative in two's complement."""
+UINT16_MODULUS: Final = 65536.0
+"""2¹⁶: an unsigned 16-bit value ``c ≥ 32768`` is the signed value ``c − 65536``."""
+
+TEMPERATURE_ENCODINGS: Final = ("plain", "int16")
+"""How raw temperature counts are stored: ``plain`` numbers, or ``int16`` (signed 16-bit
+two's complement written as unsigned 0…65535, as many loggers do)."""
+
+
+class TemperatureConversion(NamedTuple):
+    """Raw ADC counts → °C: ``T = gain · v + offset`` (gain [°C/count], offset [°C]).
+
+    ``v`` is the count as stored, except with ``encoding="int16"``: signed 16-bit two's
+    complement stored unsigned, ``v = c − 65536`` for ``c ≥ 32768`` (else ``v = c``).
+    Written in files as ``[gain, offset]`` or ``[gain, offset, "int16"]``.
+    """
+
+    gain: float
+    offset: float
+    encoding: str = "plain"
+
+    def to_celsius(self, counts: npt.ArrayLike, where: str = "") -> npt.NDArray[np.float64]:
+        """Temperatures [°C] of raw counts (an ``int16`` count outside −32768…65535 is a
+        :class:`UnitError` naming ``where``)."""
+        v = np.asarray(counts, dtype=np.float64)
+        if self.encoding == "int16":
+            bad = np.isfinite(v) & ((v < -INT16_SIGN_BIT) | (v >= UINT16_MODULUS))
+            if bad.any():
+                row = int(np.argmax(bad))
+                raise UnitError(
+                    f"{where + ': ' if where else ''}count {float(v[row]):.10g} at row {row} is "
+                    "not a 16-bit value (the conversion says int16: −32768…65535)"
+                )
+            v = np.where(v >= INT16_SIGN_BIT, v - UINT16_MODULUS, v)
+        return v * self.gain + self.offset
+
+    def to_json(self) -> list[float | str]:
+        out: list[float | str] = [float(self.gain), float(self.offset)]
+        if self.encoding != "plain":
+            out.append(self.encoding)
+        return out
+
+    def describe(self) -> str:
+        """``T[°C] = 0.0625·counts − 50`` (with the encoding when not plain)."""
+        sign = "+" if self.offset >= 0 else "−"
+        enc = " (counts signed 16-bit, stored unsigned)" if self.encoding == "int16" else ""
+        return f"T[°C] = {self.gain:.10g}·counts {sign} {abs(self.offset):.10g}{enc}"
+
+
+def temperature_conversion(
+    value: object, what: str = "temperature conversion"
+) -> TemperatureConversion:
+    """A :class:`TemperatureConversion` from ``(gain, offset[, encoding])`` (tuple, list, the
+    file form) or the text ``"GAIN,OFFSET[,int16]"``; a :class:`UnitError` naming ``what``
+    when it is neither, or the gain is zero or not finite."""
+    if isinstance(value, TemperatureConversion):
+        return value
+    parts: list[Any]
+    if isinstance(value, str):
+        parts = [p.strip() for p in value.split(",")]
+    elif isinstance(value, list | tuple):
+        parts = list(value)
+    else:
+        parts = []
+    encoding = "plain"
+    if len(parts) == 3 and isinstance(parts[2], str):
+        encoding = parts[2].strip().lower()
+        parts = parts[:2]
+    usage = (
+        f"{what} takes 'GAIN,OFFSET' or 'GAIN,OFFSET,int16' (T[°C] = GAIN·counts + OFFSET), "
+        f"got {value!r}"
+    )
+    if len(parts) != 2 or encoding not in TEMPERATURE_ENCODINGS:
+        raise UnitError(usage)
+    try:
+        gain, offset = (float(p) for p in parts)
+    except (TypeError, ValueError):
+        raise UnitError(usage) from None
+    if not (math.isfinite(gain) and math.isfinite(offset)) or gain == 0.0:
+        raise UnitError(f"{what} gain must be finite and non-zero, offset finite; got {value!r}")
+    return TemperatureConversion(gain, offset, encoding)
+
+
 # --- the one resolver: option > file metadata > column name > model file > stated default ---
 
 UnitRole = Literal["time", "signal", "temperature"]
 UnitSource = Literal["option", "metadata", "column name", "model", "default"]
+ConversionSource = Literal["option", "metadata", "model", "none"]
+
+LEGACY_TEMPERATURE_UNIT: Final = "degC"
+"""Temperature unit of a model file that names none: not a guess — every model file before
+format version 3 was fitted in °C (raw counts were always converted)."""
 
 DEFAULT_UNITS: Final[dict[str, str]] = {"time": "s", "signal": "deg/h", "temperature": "degC"}
 """What a column is taken to be in when nothing states its unit — always said in a
@@ -231,12 +330,15 @@ def resolve_unit(
     option: str | None = None,
     metadata: str | None = None,
     model: str | None = None,
+    default: str | None = None,
     where: str = "",
+    option_name: str | None = None,
 ) -> ResolvedUnit:
     """The unit of ``column``, resolved once, in INTERFACE.md's order: command-line option
     > the file's own metadata > units in the column name > the units recorded in the model
-    file > :data:`DEFAULT_UNITS`, the last stated in a :class:`UnitWarning`.  An option
-    that contradicts the file's metadata wins, with a warning naming both.  This is the
+    file > a default (``default``, else :data:`DEFAULT_UNITS`), the last stated in a
+    :class:`UnitWarning`.  An option that contradicts the file's metadata wins, with a
+    warning naming both (``option_name``: the option as the user wrote it).  This is the
     only place in thermocal that chooses a unit nobody stated.
     """
     norm = _normalizer(role)
@@ -245,10 +347,11 @@ def resolve_unit(
     if option:
         opt = norm(option)
         if meta is not None and meta != opt:
+            said = option_name or f"{_UNIT_OPTION[role]} {opt}"
             warnings.warn(
                 UnitWarning(
-                    f"{prefix}{_UNIT_OPTION[role]} {opt} contradicts the file's metadata, "
-                    f"which says column {column!r} is in {meta}; using {opt}"
+                    f"{prefix}{said} contradicts the file's metadata, which says column "
+                    f"{column!r} is in {meta}; using {opt}"
                 ),
                 stacklevel=2,
             )
@@ -260,15 +363,241 @@ def resolve_unit(
         return ResolvedUnit(named, "column name")
     if model:
         return ResolvedUnit(norm(model), "model")
-    default = DEFAULT_UNITS[role]
+    chosen = norm(default) if default else DEFAULT_UNITS[role]
+    whose = " (the model's unit)" if default else ""
     warnings.warn(
         UnitWarning(
-            f"{prefix}no unit stated for the {role} column {column!r}; assuming {default} "
+            f"{prefix}no unit stated for the {role} column {column!r}; assuming {chosen}{whose} "
             f"(give {_UNIT_OPTION[role]}, or the unit in the file's metadata or column name)"
         ),
         stacklevel=2,
     )
-    return ResolvedUnit(default, "default")
+    return ResolvedUnit(chosen, "default")
+
+
+@dataclass(frozen=True)
+class ResolvedConversion:
+    """The raw-count conversion of a temperature column and where it came from (``none``:
+    no conversion is stated anywhere)."""
+
+    conversion: TemperatureConversion | None
+    source: ConversionSource
+
+
+def resolve_temperature_conversion(
+    column: str,
+    *,
+    option: TemperatureConversion | None = None,
+    metadata: TemperatureConversion | None = None,
+    model: TemperatureConversion | None = None,
+    where: str = "",
+) -> ResolvedConversion:
+    """The counts → °C conversion of a raw-count temperature column: ``--temp-conversion``
+    > the file's metadata > the conversion recorded in the model file > none.  An option
+    that contradicts the file's metadata wins, with a :class:`UnitWarning` naming both."""
+    if option is not None:
+        if metadata is not None and tuple(metadata) != tuple(option):
+            warnings.warn(
+                UnitWarning(
+                    f"{where + ': ' if where else ''}--temp-conversion ({option.describe()}) "
+                    f"contradicts the file's metadata for column {column!r} "
+                    f"({metadata.describe()}); using the option"
+                ),
+                stacklevel=2,
+            )
+        return ResolvedConversion(option, "option")
+    if metadata is not None:
+        return ResolvedConversion(metadata, "metadata")
+    if model is not None:
+        return ResolvedConversion(model, "model")
+    return ResolvedConversion(None, "none")
+
+
+@dataclass(frozen=True)
+class UnitOptions:
+    """What the command line says about units (``None``: the option was not given).
+
+    ``signal_unit`` is one unit for every signal or ``U1,…,Un``, one per signal;
+    ``temp_conversion`` applies to every temperature column and implies raw counts.
+    """
+
+    time_unit: str | None = None
+    signal_unit: str | None = None
+    temp_unit: str | None = None
+    temp_conversion: TemperatureConversion | None = None
+
+
+@dataclass(frozen=True)
+class StatedUnits:
+    """Units a source states about columns: a data file's own metadata (sidecar or Parquet
+    key-value, :meth:`from_file_info`) or a model file's record of its inputs
+    (:meth:`from_model_inputs`).
+
+    ``signal_default`` (models only) is the model's canonical signal unit: the default,
+    stated in a warning, for data whose signal unit nothing states (older model files that
+    did not record the unit as given).
+    """
+
+    time_unit: str | None = None
+    columns: Mapping[str, str] = field(default_factory=dict)
+    conversions: Mapping[str, TemperatureConversion] = field(default_factory=dict)
+    signal_default: str | None = None
+
+    @classmethod
+    def from_file_info(cls, info: Mapping[str, Any], where: str = "") -> StatedUnits:
+        """From a recording's metadata object (``time_unit``, ``signals``, ``temperatures``,
+        ``units``, ``metadata.temperature_conversion``; see :mod:`thermocal.io`)."""
+        cols: dict[str, str] = {}
+        for key in ("units", "temperatures", "signals"):  # later keys win
+            part = info.get(key) or {}
+            if isinstance(part, Mapping):
+                cols.update({str(k): str(v) for k, v in part.items() if v})
+        md = info.get("metadata") or {}
+        raw = md.get("temperature_conversion") if isinstance(md, Mapping) else None
+        conv = {
+            str(k): temperature_conversion(v, f"{where}: temperature_conversion of {k!r}")
+            for k, v in (raw or {}).items()
+        }
+        t_unit = info.get("time_unit")
+        return cls(str(t_unit) if t_unit else None, cols, conv)
+
+    @classmethod
+    def from_model_inputs(
+        cls, inputs: Mapping[str, Any], *, signal_default: str | None = None
+    ) -> StatedUnits:
+        """From a model file's ``inputs`` (format version ≥ 2; empty for older files, whose
+        units are then unknown and fall to the stated default)."""
+        units_ = inputs.get("units") or {}
+        conv = {
+            str(k): temperature_conversion(v, f"model inputs: temperature_conversion of {k!r}")
+            for k, v in (inputs.get("temperature_conversion") or {}).items()
+        }
+        t_unit = inputs.get("time_unit")
+        return cls(
+            str(t_unit) if t_unit else None,
+            {str(k): str(v) for k, v in units_.items() if v},
+            conv,
+            signal_default,
+        )
+
+
+@dataclass(frozen=True)
+class ResolvedInputs:
+    """Every unit of a recording's used columns, each with its source, and the raw-count
+    conversion of every temperature column (:func:`resolve_inputs`)."""
+
+    time: ResolvedUnit
+    signals: Mapping[str, ResolvedUnit]
+    temperatures: Mapping[str, ResolvedUnit]
+    conversions: Mapping[str, ResolvedConversion]
+
+    def units(self) -> dict[str, str]:
+        """Column → unit of the signals and temperatures."""
+        return {c: r.unit for c, r in {**self.signals, **self.temperatures}.items()}
+
+    def sources(self) -> dict[str, str]:
+        """Column → source (``"<time>"`` for the time column), for messages and files."""
+        out: dict[str, str] = {"<time>": self.time.source}
+        out.update({c: r.source for c, r in {**self.signals, **self.temperatures}.items()})
+        return out
+
+    def unconverted_counts(self) -> list[str]:
+        """Temperature columns in raw counts with no conversion stated anywhere."""
+        return [
+            c
+            for c, r in self.temperatures.items()
+            if r.unit == "counts" and self.conversions[c].conversion is None
+        ]
+
+
+def _per_signal(option: str | None, signals: Sequence[str]) -> dict[str, str | None]:
+    if not option:
+        return dict.fromkeys(signals)
+    parts = [p.strip() for p in option.split(",")]
+    if len(parts) == 1:
+        return dict.fromkeys(signals, parts[0])
+    if len(parts) != len(signals):
+        raise UnitError(
+            f"--signal-unit gives {len(parts)} units for {len(signals)} signals "
+            f"({', '.join(map(repr, signals))}); give one unit, or one per signal"
+        )
+    return dict(zip(signals, parts, strict=True))
+
+
+def resolve_inputs(
+    time_column: str,
+    signals: Sequence[str],
+    temperatures: Sequence[str],
+    *,
+    options: UnitOptions | None = None,
+    file: StatedUnits | None = None,
+    model: StatedUnits | None = None,
+    where: str = "",
+) -> ResolvedInputs:
+    """Resolve, once, the time unit, every signal's and temperature's unit and every
+    temperature's raw-count conversion of a recording (INTERFACE.md common rules):
+    command-line option > the file's own metadata > units written in the column name >
+    the units recorded in the model file > a default stated in a :class:`UnitWarning`.
+
+    ``--temp-conversion`` says the temperatures are raw counts (with ``--temp-unit degC``
+    it is a contradiction, refused).  Pure: no file is read here.
+    """
+    opt = options or UnitOptions()
+    fil = file or StatedUnits()
+    mod = model or StatedUnits()
+    t_res = resolve_unit(
+        time_column,
+        "time",
+        option=opt.time_unit,
+        metadata=fil.time_unit,
+        model=mod.time_unit,
+        where=where,
+    )
+    sig_opts = _per_signal(opt.signal_unit, signals)
+    sig_res = {
+        c: resolve_unit(
+            c,
+            "signal",
+            option=sig_opts[c],
+            metadata=fil.columns.get(c),
+            model=mod.columns.get(c),
+            default=mod.signal_default,
+            where=where,
+        )
+        for c in signals
+    }
+    t_opt = opt.temp_unit
+    opt_name: str | None = None
+    if opt.temp_conversion is not None:
+        if t_opt and normalize_temperature_unit(t_opt) != "counts":
+            raise UnitError(
+                f"--temp-conversion converts raw counts, but --temp-unit {t_opt} says the "
+                "temperatures are °C already; give one or the other"
+            )
+        t_opt, opt_name = "counts", "--temp-conversion (raw counts)"
+    tmp_res: dict[str, ResolvedUnit] = {}
+    conv_res: dict[str, ResolvedConversion] = {}
+    for c in temperatures:
+        tmp_res[c] = resolve_unit(
+            c,
+            "temperature",
+            option=t_opt,
+            metadata=fil.columns.get(c),
+            model=mod.columns.get(c),
+            where=where,
+            option_name=opt_name,
+        )
+        if tmp_res[c].unit == "counts":
+            conv_res[c] = resolve_temperature_conversion(
+                c,
+                option=opt.temp_conversion,
+                metadata=fil.conversions.get(c),
+                model=mod.conversions.get(c),
+                where=where,
+            )
+        else:
+            conv_res[c] = ResolvedConversion(None, "none")
+    return ResolvedInputs(t_res, sig_res, tmp_res, conv_res)
 
 
 def signal_kind(unit: str) -> SignalKind:

@@ -32,11 +32,13 @@ not a copy of the modelling test's:
    and ``peak_to_peak = max F̄_j − min F̄_j``.
 5. ``improvement_pct[x] = 100 (x_before − x_after)/x_before`` for each figure.
 
-All figures are in the model's signal unit ([°/h] or [mg]).
+All figures are in the model's signal unit ([°/h] or [mg]); :meth:`ValidationResult.in_unit`
+gives them in the data's own unit (``thermocal validate`` does).
 """
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import warnings
 from dataclasses import dataclass, field
@@ -122,6 +124,29 @@ class ValidationResult:
             a = float(getattr(self, f"{key}_after"))
             out[key] = 100.0 * (b - a) / b if math.isfinite(a) and math.isfinite(b) and b else None
         return out
+
+    def in_unit(self, unit: str, factor: float) -> ValidationResult:
+        """The same result with every signal figure in ``unit``, where ``value[self.unit]
+        = factor · value[unit]`` (e.g. the data's own unit, :class:`thermocal.compensate.
+        ModelRun`); improvements, r and the stage layout are unchanged."""
+        if factor == 1.0 and unit == self.unit:
+            return self
+        keys = [
+            f"{k}_{w}"
+            for k in ("bias_stability", "bias_repeatability", "rms", "peak_to_peak")
+            for w in ("before", "after")
+        ]
+        stage_keys = ("bias_before", "bias_after", "bias_stability_before", "bias_stability_after")
+        stages = tuple(
+            dataclasses.replace(s, **{k: getattr(s, k) / factor for k in stage_keys})
+            for s in self.stages
+        )
+        return dataclasses.replace(
+            self,
+            unit=unit,
+            stages=stages,
+            **{k: getattr(self, k) / factor for k in keys},
+        )
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready dict (NaN → None)."""

@@ -22,7 +22,7 @@ import warnings
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from pathlib import Path
-from typing import Annotated, Any, ParamSpec, TypeVar
+from typing import TYPE_CHECKING, Annotated, Any, ParamSpec, TypeVar
 
 import numpy as np
 import typer
@@ -31,14 +31,27 @@ from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
 
 from thermocal.cli.interrupt import report_interrupted
 from thermocal.errors import GapWarning, ThermocalInputError, ThermocalWarning
-from thermocal.io import fill_fitted_conversions, read_recording
+from thermocal.io import read_recording
 from thermocal.recording import Metadata, Recording
-from thermocal.units import canonical_unit, earth_rate_on_axis_deg_h, parse_axis
+from thermocal.units import (
+    StatedUnits,
+    TemperatureConversion,
+    canonical_unit,
+    earth_rate_on_axis_deg_h,
+    parse_axis,
+    temperature_conversion,
+)
+
+if TYPE_CHECKING:
+    from thermocal.models.base import TemperatureModel
 
 P = ParamSpec("P")
 R = TypeVar("R")
 
-stdout = Console(soft_wrap=True)
+stdout = Console(soft_wrap=True, markup=False)
+"""Results on stdout.  No rich markup: units in brackets (``[deg/h]``) and column names such
+as ``gx [deg/s]`` must print as they are; prints that style use ``markup=True`` and
+escape what they interpolate."""
 stderr = Console(stderr=True, soft_wrap=True)
 
 # --- reusable option types ----------------------------------------------------------
@@ -77,8 +90,9 @@ TempConversionOpt = Annotated[
     str | None,
     typer.Option(
         "--temp-conversion",
-        help="Raw-count temperatures: 'GAIN,OFFSET' with T[°C] = GAIN·counts + OFFSET, "
-        "for every temperature column (overrides the file's metadata).",
+        help="Raw-count temperatures: 'GAIN,OFFSET' with T[°C] = GAIN·counts + OFFSET, or "
+        "'GAIN,OFFSET,int16' for signed 16-bit counts stored unsigned (v >= 32768 -> "
+        "v - 65536 first), for every temperature column (overrides the file's metadata).",
     ),
 ]
 LatitudeOpt = Annotated[
@@ -123,20 +137,10 @@ def split_floats(text: str | None, what: str) -> list[float] | None:
         ) from None
 
 
-def parse_temp_conversion(text: str) -> tuple[float, float]:
-    """``"0.0625,-50"`` → ``(0.0625, -50.0)``: gain [°C/count] and offset [°C]."""
-    parts = [p.strip() for p in text.split(",")]
-    try:
-        gain, offset = (float(p) for p in parts)
-    except ValueError:
-        raise ThermocalInputError(
-            f"--temp-conversion takes 'GAIN,OFFSET' (T[°C] = GAIN·counts + OFFSET), got {text!r}"
-        ) from None
-    if not (math.isfinite(gain) and math.isfinite(offset)) or gain == 0.0:
-        raise ThermocalInputError(
-            f"--temp-conversion gain must be finite and non-zero, offset finite; got {text!r}"
-        )
-    return gain, offset
+def parse_temp_conversion(text: str) -> TemperatureConversion:
+    """``"0.0625,-50"`` → gain [°C/count] 0.0625, offset [°C] −50; ``"0.0625,-50,int16"``
+    for signed 16-bit counts stored unsigned (:class:`thermocal.units.TemperatureConversion`)."""
+    return temperature_conversion(text, "--temp-conversion")
 
 
 def load_recording(
@@ -153,6 +157,7 @@ def load_recording(
     check: bool = True,
     temp_conversion: str | None = None,
     model_inputs: dict[str, Any] | None = None,
+    model: TemperatureModel | None = None,
 ) -> Recording:
     """Read a recording with the command line's options (options win over the file).
 
@@ -162,15 +167,18 @@ def load_recording(
     the time column must be finite and strictly increasing and the signal and
     temperature columns free of NaN (:meth:`Recording.validate`, an input error
     naming the file, column and row); gaps are allowed and reported as one
-    :class:`GapWarning`.  ``temp_conversion`` (``"GAIN,OFFSET"``) sets the raw-count
+    :class:`GapWarning`.  ``temp_conversion`` (``"GAIN,OFFSET[,int16]"``) sets the raw-count
     conversion ``T[°C] = GAIN·counts + OFFSET`` of every temperature column.
-    ``model_inputs`` (a model file's ``inputs``: time unit, column units, temperature
-    conversions as fitted) fill in what the options and the file leave unstated.
+    ``model`` (a fitted model; or ``model_inputs``, a model file's ``inputs``) fills in
+    what the options and the file leave unstated: the time unit, column units and
+    temperature conversions as fitted (:meth:`TemperatureModel.input_units`).  Every unit
+    is resolved once, by :func:`thermocal.units.resolve_inputs`.
     """
-    inputs = model_inputs or {}
-    fallback = {str(k): str(v) for k, v in dict(inputs.get("units") or {}).items()}
-    if inputs.get("time_unit"):
-        fallback["<time>"] = str(inputs["time_unit"])
+    stated: StatedUnits | None = None
+    if model is not None:
+        stated = model.input_units()
+    elif model_inputs is not None:
+        stated = StatedUnits.from_model_inputs(model_inputs)
     rec = read_recording(
         path,
         time=time,
@@ -180,16 +188,10 @@ def load_recording(
         signal_unit=signal_unit,
         temp_unit=temp_unit,
         meta=meta,
-        model_units=fallback,
-    )
-    if temp_conversion is not None:
-        conv = parse_temp_conversion(temp_conversion)
-        for name in rec.temperatures:
-            rec.meta.temperature_conversion[name] = conv
-    fill_fitted_conversions(
-        inputs,
-        {c: rec.units.get(c, "") for c in rec.temperatures},
-        rec.meta.temperature_conversion,
+        temp_conversion=(
+            parse_temp_conversion(temp_conversion) if temp_conversion is not None else None
+        ),
+        model=stated,
     )
     if require_signal and not rec.signals:
         raise ThermocalInputError(
@@ -232,6 +234,16 @@ def earth_rate_known_input(
             f"this signal is in {unit}"
         )
     return earth_rate_on_axis_deg_h(latitude, parse_axis(axis))
+
+
+def known_input_what(latitude: float | None, axis: str | None, other: float | None) -> str:
+    """What a fit's known input is, for the model file (``inputs.known_input.what``)."""
+    parts = []
+    if latitude is not None and axis is not None:
+        parts.append(f"earth rate at latitude {latitude:g}° on axis {axis}")
+    if other:
+        parts.append(f"--known-input {other:g}")
+    return " + ".join(parts) or "none"
 
 
 # --- errors ----------------------------------------------------------------------------

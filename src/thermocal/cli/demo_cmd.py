@@ -11,6 +11,7 @@ from pathlib import Path
 from typing import Annotated
 
 import typer
+from rich.markup import escape
 from rich.table import Table
 
 from thermocal.cli.app import app
@@ -97,6 +98,6 @@ def demo_cmd(
         stdout.print(table)
         stdout.print("* reported model; (…) improvement")
         stdout.print(f"{len(res.files)} files in {res.out_dir} ({res.elapsed_s:.1f} s)")
-        stdout.print(f"report: [bold]{res.report_path}[/bold]")
+        stdout.print(f"report: [bold]{escape(str(res.report_path))}[/bold]", markup=True)
 
     emit(out, as_json, human)

@@ -48,6 +48,7 @@ fit statistics), ``coefficients`` and ``warnings``.
 
 from __future__ import annotations
 
+import dataclasses
 import inspect
 import warnings
 from pathlib import Path
@@ -72,6 +73,7 @@ from thermocal.cli.common import (
     emit,
     fmt,
     handle_errors,
+    known_input_what,
     load_recording,
     one_line,
     split_floats,
@@ -85,6 +87,7 @@ from thermocal.models.base import (
     TemperatureModel,
     file_sha256,
     get_model_class,
+    model_inputs,
     save_model,
 )
 from thermocal.recording import Recording
@@ -262,30 +265,21 @@ def fit_cmd(
         )
         _values, run_unit = rec.signal(signal)
         sig_name = signal or rec.signals[0]
-        if not runs:  # the model learns how its inputs were written (model file "inputs")
-            used = [sig_name, *run_temp_names(rec, temps)]
-            first_inputs = {
-                "time_unit": rec.time_unit,
-                "units": {c: rec.units[c] for c in used if rec.units.get(c)},
-                "temperature_conversion": {
-                    c: list(v) for c, v in rec.meta.temperature_conversion.items() if c in used
-                },
-            }
         if unit and run_unit != unit:
             raise ThermocalInputError(f"{path}: signal unit {run_unit} differs from {unit}")
         unit = run_unit
         ki = earth_rate_known_input(latitude, axis, unit, path)
         if known_input is not None:
             ki += known_input
-        run = RunData.from_recording(rec, signal, split_names(temps), known_input=ki)
-        run = RunData(
-            time_s=run.time_s,
-            temps_c=run.temps_c,
-            signal=run.signal,
-            temp_names=run.temp_names,
-            name=path.name,
-            known_input=run.known_input,
+        if not runs:  # the model learns how its inputs were written (model file "inputs")
+            first_inputs = model_inputs(
+                rec, sig_name, run_temp_names(rec, temps), known_input=ki,
+                known_input_what=known_input_what(latitude, axis, known_input),
+            )  # fmt: skip
+        run = RunData.from_recording(
+            rec, signal, split_names(temps), known_input=ki, temperature_unit="auto"
         )
+        run = dataclasses.replace(run, name=path.name)
         if temp_names is None:
             temp_names = run.temp_names
         elif run.temp_names != temp_names:
@@ -351,6 +345,8 @@ def fit_cmd(
         "n_samples": st.n_samples,
         "n_runs": len(runs),
         "unit": unit,
+        "temperature_unit": est.temperature_unit,
+        "inputs": first_inputs,
         "target": target,
         "files": [{k: p[k] for k in ("file", "sha256", "n_samples")} for p in provenance],
         "terms_kept": kept,
@@ -368,7 +364,8 @@ def fit_cmd(
         tab.add_row(f"rms residual [{unit}]", fmt(st.rms_residual))
         tab.add_row("condition number", fmt(st.condition_number))
         for n, (a, b) in trange.items():
-            tab.add_row(f"range {n} [°C]", f"{a:.2f} … {b:.2f}")
+            tu = "°C" if est.temperature_unit == "degC" else est.temperature_unit
+            tab.add_row(f"range {n} [{tu}]", f"{a:.2f} … {b:.2f}")
         if kept is not None:
             tab.add_row("terms kept", ", ".join(kept))
         stdout.print(tab)

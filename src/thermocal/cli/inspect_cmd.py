@@ -6,6 +6,7 @@ import re
 from typing import Annotated
 
 import typer
+from rich.markup import escape
 from rich.table import Table
 
 from thermocal.cli.app import app
@@ -30,7 +31,7 @@ from thermocal.errors import ThermocalInputError
 from thermocal.inspection import Inspection, inspect_recording
 from thermocal.io import read_recording
 from thermocal.recording import Problem
-from thermocal.units import resolve_unit
+from thermocal.units import StatedUnits, UnitOptions, resolve_inputs
 
 _TEMP_NAME = re.compile(r"^(t\d+|t_|temp|tmp)|temperature|°c|degc", re.IGNORECASE)
 
@@ -67,6 +68,7 @@ def inspect_cmd(
     --strict, warnings count too.
     """
     skipped: list[str] = []
+    conv = parse_temp_conversion(temp_conversion) if temp_conversion is not None else None
     rec = read_recording(
         file,
         time=time,
@@ -75,22 +77,31 @@ def inspect_cmd(
         temperatures=split_names(temps),
         signal_unit=signal_unit,
         temp_unit=temp_unit,
+        temp_conversion=conv,
         skipped=skipped,
     )
     if not rec.temperatures and temps is None:
         guessed = tuple(c for c in rec.columns if _TEMP_NAME.search(c) and c not in rec.signals)
         rec.temperatures = guessed
-        for c in guessed:  # a guessed temperature's unit goes through the one resolver
-            res = resolve_unit(
-                c, "temperature", option=temp_unit, metadata=rec.units.get(c) or None,
-                where=str(file),
-            )  # fmt: skip
-            rec.units[c] = res.unit
-            rec.unit_sources[c] = res.source
-    if temp_conversion is not None:
-        conv = parse_temp_conversion(temp_conversion)
-        for c in rec.temperatures:
-            rec.meta.temperature_conversion[c] = conv
+        # a guessed temperature's unit and conversion go through the one resolver
+        res = resolve_inputs(
+            "<time>",
+            [],
+            guessed,
+            options=UnitOptions(temp_unit=temp_unit, temp_conversion=conv),
+            file=StatedUnits(
+                columns={c: rec.units[c] for c in guessed if rec.units.get(c)},
+                conversions={
+                    c: v for c, v in rec.meta.temperature_conversion.items() if c in guessed
+                },
+            ),
+            where=str(file),
+        )
+        rec.units.update(res.units())
+        rec.unit_sources.update({c: r.source for c, r in res.temperatures.items()})
+        for c, r in res.conversions.items():
+            if r.conversion is not None:
+                rec.meta.temperature_conversion[c] = r.conversion
     result = inspect_recording(rec)
     for c in skipped:
         result.problems.append(
@@ -115,7 +126,7 @@ def inspect_cmd(
 
 
 def _print_human(r: Inspection) -> None:
-    stdout.print(f"[bold]{r.file}[/bold]")
+    stdout.print(f"[bold]{escape(str(r.file))}[/bold]", markup=True)
     if r.time_ok and r.duration_s is not None:
         stdout.print(
             f"{r.n_samples} samples over {fmt(r.duration_s, 6)} s, "
@@ -150,7 +161,7 @@ def _print_human(r: Inspection) -> None:
             + (f" … {len(r.gaps) - 10} more" if len(r.gaps) > 10 else "")
         )
     if not r.problems:
-        stdout.print("[green]no problems found[/green]")
+        stdout.print("[green]no problems found[/green]", markup=True)
     for p in r.problems:
         colour = "red" if p.severity == "error" else "yellow"
-        stdout.print(f"[{colour}]{p.severity}[/{colour}]: {p.message}", markup=True)
+        stdout.print(f"[{colour}]{p.severity}[/{colour}]: {escape(p.message)}", markup=True)

@@ -9,6 +9,7 @@ it still exists; otherwise ``r`` is null, with a warning.
 
 from __future__ import annotations
 
+import warnings
 from pathlib import Path
 from typing import Annotated
 
@@ -33,10 +34,10 @@ from thermocal.cli.common import (
     load_recording,
     stdout,
 )
-from thermocal.compensate import unit_factor
-from thermocal.errors import ThermocalInputError
-from thermocal.models.base import RunData, TemperatureModel, load_model
-from thermocal.recording import find_problems
+from thermocal.compensate import prepare_run
+from thermocal.errors import ThermocalInputError, UnitWarning
+from thermocal.models.base import TemperatureModel, load_model
+from thermocal.recording import FloatArray, Recording, find_problems
 from thermocal.validation import DEFAULT_AVERAGING_S, validate
 
 
@@ -52,6 +53,21 @@ def _modeling_file(model: TemperatureModel, model_file: Path) -> Path | None:
             if cand.is_file():
                 return cand
     return None
+
+
+def _ambient(rec: Recording, name: str) -> FloatArray:
+    """The ambient temperature [°C] for r and the hold stages; raw counts with no
+    conversion are used as counts, with a warning (the hold threshold is then per count)."""
+    if rec.units.get(name) == "counts" and name not in rec.meta.temperature_conversion:
+        warnings.warn(
+            UnitWarning(
+                f"{rec.name}: the ambient column {name!r} is in raw counts with no conversion: "
+                "hold stages are found with --stage-rate in counts/min"
+            ),
+            stacklevel=2,
+        )
+        return rec.column(name)
+    return rec.temperature_c(name)
 
 
 @app.command("validate")
@@ -112,21 +128,12 @@ def validate_cmd(
         signal_unit=signal_unit,
         temp_unit=temp_unit,
         temp_conversion=temp_conversion,
-        model_inputs=model.inputs_,
+        model=model,
     )
-    run = RunData.from_recording(rec, sig, temps)
-    data_unit = rec.signal(sig)[1]
-    f = unit_factor(data_unit, model.signal_unit, meta=rec.meta, where=str(file))
-    if f != 1.0:
-        assert run.signal is not None
-        run = RunData(
-            time_s=run.time_s,
-            temps_c=run.temps_c,
-            signal=run.signal * f,
-            temp_names=run.temp_names,
-            name=run.name,
-        )
-    amb_val = rec.temperature_c(amb)
+    # the data in the model's units (kinds checked); figures go back to the data's unit
+    prepared = prepare_run(model, rec, sig, temps)
+    run = prepared.run
+    amb_val = _ambient(rec, amb)
 
     mod_path = modeling if modeling is not None else _modeling_file(model, model_file)
     modeling_ambient = None
@@ -138,14 +145,14 @@ def validate_cmd(
             temps=amb,
             temp_unit=temp_unit,
             temp_conversion=temp_conversion,
-            model_inputs=model.inputs_,
+            model=model,
             require_signal=False,
             check=False,
         )
         for prob in find_problems(mrec, required=[amb]):
             if prob.severity == "error" and (prob.column in (None, "time", amb)):
                 raise ThermocalInputError(f"{mod_path}: {prob.message}")
-        modeling_ambient = (mrec.time_s, mrec.temperature_c(amb))
+        modeling_ambient = (mrec.time_s, _ambient(mrec, amb))
     res = validate(
         model,
         run,
@@ -157,7 +164,10 @@ def validate_cmd(
         settle_s=settle,
         extrapolate=extrapolate,
     )
+    if prepared.data_unit != "counts":  # raw counts: figures in the physical unit K gives
+        res = res.in_unit(prepared.data_unit, prepared.factor)
     out = res.to_dict()
+    out["model_unit"] = model.signal_unit
     out["model"] = str(model_file)
     out["family"] = model.family
     out["file"] = str(file)

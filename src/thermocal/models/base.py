@@ -10,7 +10,7 @@ in :data:`MODEL_REGISTRY` with :func:`register` (STYLE rule 8).
 A model file is a self-describing, versioned JSON object (SPEC §8)::
 
     {
-      "format": "thermocal-model", "format_version": 1,
+      "format": "thermocal-model", "format_version": 3,
       "family": "poly", "thermocal_version": "0.1.0",
       "created_utc": "...",
       "signal": {"name": "gyro", "unit": "deg/h", "target": "bias"},
@@ -19,12 +19,27 @@ A model file is a self-describing, versioned JSON object (SPEC §8)::
       "params": {...constructor arguments...},
       "state": {...learned values, family specific...},
       "coefficients": [{"name": "T1", "value": ..., "stderr": ...}, ...],
-      "range": {"temperature_c": {"T1": [lo, hi], ...},
+      "range": {"temperature_c": {"T1": [lo, hi], ...}, "temperature_unit": "degC",
                 "rate_c_per_min": {"T1": [lo, hi], ...}},
       "fit": {"rms_residual": ..., "condition_number": ..., "n_samples": ..., ...},
       "data": [{"file": "run1.csv", "sha256": "..."}],
+      "inputs": {"time_unit": "ms", "units": {"gyro": "deg/s", "T1": "counts"},
+                 "unit_sources": {"<time>": "metadata", "gyro": "option", ...},
+                 "temperature_conversion": {"T1": [0.0625, -50.0, "int16"]},
+                 "temperature_unit": "degC", "known_input": {...},
+                 "temperature_rate": {...}, "scale_factor": {...}},
       "checksum": "sha256 of the canonical JSON of everything above"
     }
+
+``signal.unit`` is the canonical unit the maths use ([°/h] or [mg]); ``inputs`` (format
+version 2, completed in 3) is how the fitted data were written: the time unit, each
+column's unit as given (e.g. ``deg/s``), raw-count temperature conversions, the known
+input removed and the Ṫ definition.  ``temperature_unit`` is ``counts`` for a model fitted
+on raw-count temperatures without a conversion: its ranges (``range.temperature_c``) and
+coefficients are then in counts, and applying it needs raw-count data.  compensate,
+validate, report and export-c use ``inputs`` where the command line and the data file are
+silent (:meth:`TemperatureModel.input_units`).  Older files load; what they did not
+record is unknown and falls to the resolver's stated default.
 
 Loading checks the format tag, the version (a newer version is refused with a
 clear error), the family (must be registered) and the checksum (a corrupted or
@@ -35,6 +50,7 @@ from __future__ import annotations
 
 import copy
 import datetime as _dt
+import functools
 import hashlib
 import inspect
 import json
@@ -44,7 +60,7 @@ from abc import ABC, abstractmethod
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, ClassVar, Self, TypeVar
+from typing import Any, ClassVar, Literal, Self, TypeVar
 
 import numpy as np
 
@@ -53,12 +69,22 @@ from thermocal.errors import (
     ExtrapolationWarning,
     ModelFileError,
     ThermocalInputError,
+    UnitError,
+    UnitWarning,
 )
 from thermocal.io import write_json
 from thermocal.recording import FloatArray, Recording
+from thermocal.units import (
+    DEFAULT_UNITS,
+    LEGACY_TEMPERATURE_UNIT,
+    StatedUnits,
+    canonical_unit,
+    normalize_signal_unit,
+    normalize_temperature_unit,
+)
 
 MODEL_FORMAT = "thermocal-model"
-MODEL_FORMAT_VERSION = 2
+MODEL_FORMAT_VERSION = 3
 
 
 # --- input data ------------------------------------------------------------------------
@@ -71,13 +97,18 @@ class RunData:
     Attributes
     ----------
     time_s : sample times [s], shape (n,).
-    temps_c : temperatures [°C], shape (n, k), columns in ``temp_names`` order.
+    temps_c : temperatures [°C] (raw counts when ``temperature_unit`` is ``counts``),
+        shape (n, k), columns in ``temp_names`` order.
     signal : sensor output in its canonical unit ([°/h] or [mg]), shape (n,),
         or ``None`` when only predicting from temperatures.
     temp_names : names of the temperature columns.
     name : where the run came from (file name), for messages and provenance.
     known_input : the known input to remove before fitting (earth rate [°/h],
         gravity component [mg]); subtracted from ``signal`` by :meth:`target`.
+    signal_unit : the canonical unit of ``signal`` (``deg/h``, ``mg`` or ``counts``) when
+        known (:meth:`from_recording` sets it); a model fitted on the run records it.
+    temperature_unit : ``degC``, or ``counts`` for raw-count temperatures used without a
+        conversion (a model fitted on them is in counts).
     """
 
     time_s: FloatArray
@@ -87,6 +118,8 @@ class RunData:
     name: str = ""
     known_input: float = 0.0
     extra: dict[str, Any] = field(default_factory=dict)
+    signal_unit: str | None = None
+    temperature_unit: str = "degC"
 
     def __post_init__(self) -> None:
         n = self.time_s.shape[0]
@@ -119,9 +152,14 @@ class RunData:
         *,
         known_input: float = 0.0,
         require_signal: bool = True,
+        temperature_unit: Literal["degC", "counts", "auto"] = "degC",
     ) -> RunData:
-        """Pull the time, temperatures [°C] and signal (canonical unit) out of a recording.
+        """Pull the time, temperatures and signal (canonical unit) out of a recording.
 
+        ``temperature_unit``: ``degC`` (raw counts converted, a counts column without a
+        conversion is an error); ``counts`` (the raw counts as stored, for a model fitted
+        in counts; a °C column is an error); ``auto`` (fit): ``counts`` when every used
+        temperature is in raw counts with no conversion stated, else ``degC``.
         NaN in the used columns is an input error (never silently dropped).
         """
         names = tuple(temps) if temps else rec.temperatures
@@ -130,11 +168,18 @@ class RunData:
                 f"{rec.name}: no temperature columns named; available: "
                 + ", ".join(repr(c) for c in rec.columns)
             )
-        temps_c = rec.temperatures_c(names)
+        t_unit = temperature_unit
+        if t_unit == "auto":
+            t_unit = _auto_temperature_unit(rec, names)
+        if t_unit == "counts":
+            temps_c = np.column_stack([rec.temperature_counts(n) for n in names])
+        else:
+            temps_c = rec.temperatures_c(names)
         sig: FloatArray | None = None
+        sig_unit: str | None = None
         if require_signal or signal is not None or rec.signals:
             try:
-                sig, _unit = rec.signal(signal)
+                sig, sig_unit = rec.signal(signal)
             except ThermocalInputError:
                 if require_signal:
                     raise
@@ -155,7 +200,90 @@ class RunData:
             temp_names=names,
             name=rec.source or rec.meta.run_id or "",
             known_input=known_input,
+            signal_unit=sig_unit,
+            temperature_unit=t_unit,
         )
+
+
+def _auto_temperature_unit(rec: Recording, names: Sequence[str]) -> Literal["degC", "counts"]:
+    """``counts`` when every temperature column is in raw counts with no conversion (a
+    model in counts), ``degC`` when none is; a mix is an input error naming the columns."""
+    raw = [
+        n
+        for n in names
+        if rec.units.get(n) == "counts" and n not in rec.meta.temperature_conversion
+    ]
+    if not raw:
+        return "degC"
+    if len(raw) < len(names):
+        raise UnitError(
+            f"{rec.name}: temperature column(s) {', '.join(map(repr, raw))} are raw counts "
+            "without a conversion, the others are in °C; a model takes one temperature "
+            "unit: give --temp-conversion GAIN,OFFSET[,int16] for the counts"
+        )
+    warnings.warn(
+        UnitWarning(
+            f"{rec.name}: temperature column(s) {', '.join(map(repr, raw))} are raw counts "
+            "and no conversion to °C is given: the model is fitted in counts (its ranges and "
+            "coefficients are per count) and applies to raw-count data only"
+        ),
+        stacklevel=3,
+    )
+    return "counts"
+
+
+def _run_units(runs: Sequence[RunData]) -> tuple[str | None, str]:
+    """(canonical signal unit or None, temperature unit) shared by ``runs``; runs that
+    disagree are an input error naming both."""
+    sig = {r.signal_unit for r in runs if r.signal_unit}
+    if len(sig) > 1:
+        raise UnitError(f"the runs' signals are in different units: {', '.join(sorted(sig))}")
+    temp = {r.temperature_unit for r in runs}
+    if len(temp) > 1:
+        raise UnitError(
+            "some runs give temperatures in °C and some in raw counts without a conversion; "
+            "give --temp-conversion for the counts"
+        )
+    return (next(iter(sig)) if sig else None), (next(iter(temp)) if temp else "degC")
+
+
+def model_inputs(
+    rec: Recording,
+    signal: str,
+    temps: Sequence[str],
+    *,
+    known_input: float = 0.0,
+    known_input_what: str | None = None,
+) -> dict[str, Any]:
+    """What a model file records of how its fitted data were written (``inputs``): the
+    time unit, the signal's and temperatures' units as given (e.g. ``deg/s``, ``counts``)
+    and where each was stated, the raw-count temperature conversions, the scale factor of
+    a raw-count signal, and the known input removed (value in the canonical unit and what
+    it is).  ``rec`` is a recording read by :func:`thermocal.io.read_recording`."""
+    used = [signal, *temps]
+    out: dict[str, Any] = {
+        "time_unit": rec.time_unit,
+        "units": {c: rec.units[c] for c in used if rec.units.get(c)},
+        "unit_sources": {c: s for c, s in rec.unit_sources.items() if c in used or c == "<time>"},
+        "temperature_conversion": {
+            c: list(rec.meta.temperature_conversion[c].to_json())
+            for c in temps
+            if c in rec.meta.temperature_conversion and rec.units.get(c) == "counts"
+        },
+    }
+    sig_unit = rec.units.get(signal)
+    if sig_unit == "counts" and rec.meta.scale_factor is not None:
+        out["scale_factor"] = {
+            "value": rec.meta.scale_factor,
+            "unit": rec.meta.scale_factor_unit,
+        }
+    canon = canonical_unit(sig_unit) if sig_unit else None
+    out["known_input"] = {
+        "value": float(known_input),
+        "unit": canon,
+        "what": known_input_what or ("none" if known_input == 0.0 else "given"),
+    }
+    return out
 
 
 # --- fitted coefficients and statistics ----------------------------------------------------
@@ -299,15 +427,54 @@ class TemperatureModel(ABC):
     stats_: FitStats
     data_: list[dict[str, Any]]
     inputs_: dict[str, Any]
-    """How the fitted data were written (format version 2): ``time_unit``, ``units``
-    (column → unit as given, e.g. ``deg/s``, ``counts``) and ``temperature_conversion``
-    (column → [gain, offset]); commands that apply the model use them where the command
-    line and the data file are silent.  Empty for older files."""
+    """How the fitted data were written (format version ≥ 2, :func:`model_inputs`):
+    ``time_unit``, ``units`` (column → unit as given, e.g. ``deg/s``, ``counts``),
+    ``unit_sources``, ``temperature_conversion`` (column → [gain, offset(, "int16")]),
+    ``known_input``, ``scale_factor``; commands that apply the model use them where the
+    command line and the data file are silent (:meth:`input_units`).  Empty for older
+    files."""
 
     # metadata set by the caller (CLI) before saving; not constructor params
     signal_name: str = "signal"
-    signal_unit: str = "deg/h"
+    signal_unit: str = DEFAULT_UNITS["signal"]
+    """Canonical unit of the model's values ([°/h] or [mg]): recorded by ``fit`` from the
+    runs' ``signal_unit`` (:meth:`RunData.from_recording`); hand-built runs without a
+    unit keep RunData's documented [°/h]."""
     target: str = "bias"
+    temperature_unit: str = "degC"
+    """Unit of the model's temperature inputs: ``degC``, or ``counts`` when fitted on
+    raw-count temperatures without a conversion (recorded by ``fit`` from the runs)."""
+
+    def __init_subclass__(cls, **kwargs: Any) -> None:
+        """Every family's ``fit`` records the units of its runs (signal, temperature) —
+        the model learns its inputs without each family having to."""
+        super().__init_subclass__(**kwargs)
+        fit = cls.__dict__.get("fit")
+        if fit is None or getattr(fit, "_records_units", False):
+            return
+
+        @functools.wraps(fit)
+        def fit_recording_units(
+            self: TemperatureModel, runs: Sequence[RunData], *args: Any, **kw: Any
+        ) -> Any:
+            runs = list(runs)
+            sig_unit, temp_unit = _run_units(runs)
+            out = fit(self, runs, *args, **kw)
+            if sig_unit is not None:
+                self.signal_unit = sig_unit
+            self.temperature_unit = temp_unit
+            return out
+
+        fit_recording_units._records_units = True  # type: ignore[attr-defined]
+        setattr(cls, "fit", fit_recording_units)  # noqa: B010
+
+    def input_units(self) -> StatedUnits:
+        """The units the model file recorded of its inputs, for the resolver
+        (:func:`thermocal.units.resolve_inputs`): the time unit, each column's unit as
+        given, the temperature conversions; the model's canonical signal unit is the
+        stated default for data whose unit nothing states (older files)."""
+        inputs = dict(getattr(self, "inputs_", {}) or {})
+        return StatedUnits.from_model_inputs(inputs, signal_default=self.signal_unit)
 
     # -- estimator contract --
     @abstractmethod
@@ -406,8 +573,9 @@ class TemperatureModel(ABC):
             n = int(np.count_nonzero(below.any(axis=1) | above.any(axis=1)))
             tmin = temps_c.min(axis=0)
             tmax = temps_c.max(axis=0)
+            tu = "°C" if self.temperature_unit == "degC" else self.temperature_unit
             where = ", ".join(
-                f"{name} {tmin[i]:.2f}…{tmax[i]:.2f} °C (fitted {lo[i]:.2f}…{hi[i]:.2f})"
+                f"{name} {tmin[i]:.2f}…{tmax[i]:.2f} {tu} (fitted {lo[i]:.2f}…{hi[i]:.2f})"
                 for i, name in enumerate(self.temp_names_)
                 if below[:, i].any() or above[:, i].any()
             )
@@ -428,6 +596,7 @@ class TemperatureModel(ABC):
 
         self.check_fitted()
         params = _jsonify(self.get_params())
+        state = _jsonify(self._state())
         d: dict[str, Any] = {
             "format": MODEL_FORMAT,
             "format_version": MODEL_FORMAT_VERSION,
@@ -436,7 +605,7 @@ class TemperatureModel(ABC):
             "created_utc": _dt.datetime.now(_dt.UTC).strftime("%Y-%m-%dT%H:%M:%SZ"),
             "signal": {"name": self.signal_name, "unit": self.signal_unit, "target": self.target},
             "temperatures": list(self.temp_names_),
-            "temperature_unit": "degC",
+            "temperature_unit": self.temperature_unit,
             "rate": (
                 {
                     "method": params.get("rate_method", "backward"),
@@ -446,7 +615,7 @@ class TemperatureModel(ABC):
                 else None
             ),
             "params": params,
-            "state": _jsonify(self._state()),
+            "state": state,
             "coefficients": [c.to_dict() for c in self.coefficients()],
             "range": {
                 "temperature_c": {
@@ -464,9 +633,30 @@ class TemperatureModel(ABC):
             },
             "fit": _jsonify(self.stats_.to_dict()),
             "data": _jsonify(self.data_),
-            "inputs": _jsonify(getattr(self, "inputs_", {})),
+            "inputs": _jsonify(self._inputs_record(params, bool(state.get("uses_rate", True)))),
         }
+        d["range"]["temperature_unit"] = self.temperature_unit
         return d
+
+    def _inputs_record(self, params: dict[str, Any], rate_used: bool) -> dict[str, Any]:
+        """The model file's ``inputs``: what the caller recorded (:func:`model_inputs`) with
+        the temperature unit of the model and the Ṫ definition of rate models."""
+        out = dict(getattr(self, "inputs_", {}) or {})
+        out["temperature_unit"] = self.temperature_unit
+        if self.uses_rate and rate_used:
+            tu = self.temperature_unit
+            method = params.get("rate_method", "backward")
+            interval = params.get("rate_interval_s", 60.0)
+            out["temperature_rate"] = {
+                "method": method,
+                "interval_s": interval,
+                "unit": f"{tu}/min",
+                "definition": (
+                    f"Ṫ = ΔT/Δt × 60 [{tu}/min] of the raw temperatures over {interval} s "
+                    f"({method} difference), within a contiguous (gap-free) segment"
+                ),
+            }
+        return out
 
     @classmethod
     def from_dict(cls, d: dict[str, Any]) -> TemperatureModel:
@@ -504,8 +694,11 @@ class TemperatureModel(ABC):
         model.inputs_ = dict(d.get("inputs") or {})  # format version 1 files: unknown
         sig = d.get("signal") or {}
         model.signal_name = sig.get("name", "signal")
-        model.signal_unit = sig.get("unit", "deg/h")
+        model.signal_unit = normalize_signal_unit(str(sig["unit"]))  # required by the schema
         model.target = sig.get("target", "bias")
+        tu = d.get("temperature_unit")
+        # files before format version 3 were always fitted in °C (and say so)
+        model.temperature_unit = normalize_temperature_unit(str(tu or LEGACY_TEMPERATURE_UNIT))
         return model
 
 
