@@ -293,3 +293,30 @@ def test_malformed_parquet_never_crashes_or_passes_silently(
         or np.any(np.abs(sig[np.isfinite(sig)]) > 1e8)
     )
     assert has_bad == any(p.severity == "error" for p in find_problems(rec, required=["gyro"]))
+
+
+@pytest.mark.parametrize(
+    ("names", "expect"),
+    [
+        (["time_s", "gyro"], "time_s"),
+        (["Time (ms)", "gyro"], "Time (ms)"),
+        (["timestamp_us", "gyro"], "timestamp_us"),
+        (["t", "gyro"], "t"),
+        (["time", "time_s"], "time"),  # the plain name wins
+        (["time_s", "timestamp_ms"], "time"),  # two candidates: no guess
+        (["elapsed time", "gyro"], "elapsed time"),
+        (["temp_s", "gyro"], "time"),  # 's' as a unit, but not a time name
+    ],
+)
+def test_default_time_column(names: list[str], expect: str) -> None:
+    from thermocal.io import default_time_column
+
+    assert default_time_column(names) == expect
+    assert default_time_column(names, "gyro") == "gyro"  # the sidecar's says so
+
+
+def test_time_column_with_unit_in_its_name_is_found_and_its_unit_used(tmp_path: Path) -> None:
+    path = tmp_path / "r.csv"
+    path.write_text("time_ms,gyro\n0,1\n10,2\n20,3\n")
+    rec = read_recording(path, signals=["gyro"], signal_unit="deg/h")
+    np.testing.assert_allclose(rec.time_s, [0.0, 0.01, 0.02])

@@ -63,6 +63,7 @@ from thermocal.io import (
     atomic_write_path,
     check_not_input,
     csv_encoding,
+    default_time_column,
     file_kind,
     numeric_column,
     sidecar_path,
@@ -900,7 +901,7 @@ def compensate_file(
     model.check_fitted()
     names, info, _ = _file_info(src, kind_in)
     sig_name = signal or model.signal_name
-    time_col = time or info.get("time") or "time"
+    time_col = time or default_time_column(names, info.get("time"))
     temp_names = list(model.temp_names_)
     available = ", ".join(repr(c) for c in names)
     if time_col not in names:

@@ -29,7 +29,7 @@ import os
 import secrets
 import tempfile
 import warnings
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterator, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -395,6 +395,33 @@ def numeric_column(
     return conv.to_numpy(dtype=np.float64, na_value=np.nan)
 
 
+TIME_COLUMN_NAMES = ("time", "t", "timestamp", "elapsed", "elapsed time")
+"""Names a time column goes by, compared without case and without a unit written in the
+name (``time``, ``Time (ms)``, ``time_s``, ``timestamp_us``)."""
+
+
+def default_time_column(names: Sequence[str], stated: str | None = None) -> str:
+    """The time column when ``--time`` is not given: ``stated`` (the sidecar's), else
+    ``time`` if present, else the one column whose name, with any unit stripped
+    (:func:`thermocal.units.unit_in_column_name`), is one of :data:`TIME_COLUMN_NAMES`.
+    Several candidates, or none, give ``"time"`` (and so a missing-column error that
+    lists what is there) rather than a guess.
+    """
+    if stated:
+        return stated
+    if "time" in names:
+        return "time"
+    found = []
+    for c in names:
+        base = c.strip()
+        unit = units.unit_in_column_name(c, "time")
+        if unit is not None:
+            base = units.strip_unit_from_name(c)
+        if base.lower() in TIME_COLUMN_NAMES:
+            found.append(c)
+    return found[0] if len(found) == 1 else "time"
+
+
 def read_recording(
     path: str | Path,
     *,
@@ -455,7 +482,7 @@ def read_recording(
     if n_rows == 0:
         raise FileFormatError(f"{p}: the file has a header but no data rows")
 
-    time_col = time or info.get("time") or "time"
+    time_col = time or default_time_column(names, info.get("time"))
     where = str(p)
     sig_info: dict[str, str] = dict(info.get("signals") or {})
     tmp_info: dict[str, str] = dict(info.get("temperatures") or {})

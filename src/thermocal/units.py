@@ -315,6 +315,19 @@ def unit_in_column_name(name: str, role: UnitRole) -> str | None:
     return None
 
 
+def strip_unit_from_name(name: str) -> str:
+    """The column name without a trailing unit written in brackets or as its last word
+    (``time (ms)`` → ``time``, ``time_s`` → ``time``); unchanged when there is none."""
+    text = name.strip()
+    m = _NAME_BRACKET.search(text)
+    if m and text[: m.start()].strip():
+        return text[: m.start()].strip()
+    words = [w for w in _NAME_SEPARATORS.split(text) if w]
+    if len(words) >= 2:
+        return " ".join(words[:-1])
+    return text
+
+
 @dataclass(frozen=True)
 class ResolvedUnit:
     """A column's unit and where it came from (``option`` … ``default``)."""

@@ -85,6 +85,7 @@ from thermocal.io import check_not_input
 from thermocal.models.base import (
     RunData,
     TemperatureModel,
+    condition_wording,
     file_sha256,
     get_model_class,
     model_inputs,
@@ -310,6 +311,9 @@ def fit_cmd(
                 ConditioningWarning,
                 stacklevel=1,
             )
+        note = (getattr(est.stats_, "extra", None) or {}).get("residual_correlation", {})
+        if note and note.get("note"):
+            warnings.warn(f"{est.family}: {note['note']}", ConditioningWarning, stacklevel=1)
     messages = [one_line(str(w.message)) for w in caught]
     for w in caught:  # hand them on to handle_errors, which prints them on stderr
         warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
@@ -322,6 +326,8 @@ def fit_cmd(
     save_model(est, output)
 
     st = est.stats_
+    kappa = st.condition_number
+    corr: dict[str, Any] | None = st.extra.get("residual_correlation")
     trange = {
         n: [float(a), float(b)] for n, (a, b) in zip(est.temp_names_, est.temp_range_, strict=True)
     }
@@ -340,6 +346,7 @@ def fit_cmd(
         "n_coefficients": st.n_coefficients,
         "rms_residual": st.rms_residual,
         "condition_number": st.condition_number,
+        "condition": condition_wording(kappa),
         "temperature_range": trange,
         "rate_range": rrange,
         "n_samples": st.n_samples,
@@ -362,7 +369,13 @@ def fit_cmd(
         tab.add_row("runs / samples", f"{len(runs)} / {st.n_samples}")
         tab.add_row("coefficients", str(st.n_coefficients))
         tab.add_row(f"rms residual [{unit}]", fmt(st.rms_residual))
-        tab.add_row("condition number", fmt(st.condition_number))
+        tab.add_row("condition number", f"{fmt(st.condition_number)} ({condition_wording(kappa)})")
+        if corr:
+            tab.add_row(
+                "effective samples",
+                f"{fmt(corr['n_effective'])} (residual correlation time "
+                f"{fmt(corr['tau_samples'])} samples; std. errors × {corr['stderr_factor']:.3g})",
+            )
         for n, (a, b) in trange.items():
             tu = "°C" if est.temperature_unit == "degC" else est.temperature_unit
             tab.add_row(f"range {n} [{tu}]", f"{a:.2f} … {b:.2f}")
@@ -373,9 +386,21 @@ def fit_cmd(
         ctab.add_column("name")
         ctab.add_column("value")
         ctab.add_column("std. error")
+        ctab.add_column("|value|/s.e.")
+        weak = 0
         ctab.add_column("unit")
         for c in est.coefficients():
-            ctab.add_row(c.name, fmt(c.value, 6), fmt(c.stderr, 3), c.unit)
+            ratio = abs(c.value) / c.stderr if c.stderr else None
+            flag = "" if ratio is None or ratio >= 2.0 else " *"
+            weak += bool(flag)
+            ctab.add_row(
+                c.name, fmt(c.value, 6), fmt(c.stderr, 3), f"{fmt(ratio, 2)}{flag}", c.unit
+            )
         stdout.print(ctab)
+        if weak:
+            stdout.print(
+                f"* {weak} coefficient(s) within 2 standard errors of 0: not distinct from "
+                "zero on these data (consider --select bic or fewer terms)"
+            )
 
     emit(result, as_json, human)

@@ -338,6 +338,32 @@ class FitStats:
         return d
 
 
+CONDITION_WORDS: tuple[tuple[float, str], ...] = (
+    (1e3, "well conditioned"),
+    (1e6, "moderately conditioned"),
+    (1e10, "ill-conditioned"),
+    (math.inf, "near singular"),
+)
+"""Upper bounds of the 2-norm condition number κ of the scaled design and their words."""
+
+
+def condition_wording(kappa: float | None) -> str:
+    """Words for a condition number κ that match the number (issue 13 item 9).
+
+    κ ≤ 1e3 well conditioned; ≤ 1e6 moderately (about log₁₀κ of the data's digits are
+    lost: the coefficients' standard errors are inflated by collinear terms); ≤ 1e10
+    ill-conditioned (individual coefficients are not meaningful, only the prediction);
+    beyond, near singular. Least squares loses ≈ log₁₀ κ significant digits (Golub & Van
+    Loan, *Matrix Computations*, 4th ed., §5.3.8).
+    """
+    if kappa is None or not math.isfinite(kappa):
+        return "condition unknown"
+    words = next(w for bound, w in CONDITION_WORDS if kappa <= bound)
+    if kappa <= 1e3:
+        return words
+    return f"{words}: about {math.log10(kappa):.0f} of the data's digits lost"
+
+
 # --- helpers for single-temperature streams --------------------------------------------------
 
 

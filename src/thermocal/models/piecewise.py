@@ -78,7 +78,8 @@ from thermocal.models.base import (
     register,
     stream_channel,
 )
-from thermocal.models.poly import check_runs, record_ranges
+from thermocal.models.poly import check_runs, decide_run_offsets, record_ranges
+from thermocal.models.residuals import MAX_SAMPLES_PER_SERIES, residual_correlation
 from thermocal.models.terms import CHUNK_ROWS, Chunk, accumulate_r, solve_r
 from thermocal.recording import FloatArray
 
@@ -323,7 +324,8 @@ class PiecewiseModel(TemperatureModel):
     method : ``"intersect"`` (seed: per-segment lines, breakpoints at the
         intersections) or ``"continuous"`` (hinge-basis least squares).
     temperature : name or 0-based index of the temperature column (default the first).
-    per_run_offset : per-run offsets as nuisance parameters.
+    per_run_offset : per-run offsets as nuisance parameters; None (default) when the runs
+        overlap in temperature (:func:`thermocal.models.poly.decide_run_offsets`).
     """
 
     family: ClassVar[str] = "piecewise"
@@ -343,7 +345,7 @@ class PiecewiseModel(TemperatureModel):
         segments: int | None = None,
         method: str = "intersect",
         temperature: str | int | None = None,
-        per_run_offset: bool = True,
+        per_run_offset: bool | None = None,
     ) -> None:
         self.breakpoints = breakpoints
         self.segments = segments
@@ -416,6 +418,8 @@ class PiecewiseModel(TemperatureModel):
         j = self._column(names, rl[0].temps_c.shape[1])
         xs = [np.ascontiguousarray(r.temps_c[:, j]) for r in rl]
         ys = [r.target() for r in rl]
+        decision = decide_run_offsets(self.per_run_offset, rl, self.family, column=j)
+        use_offsets = decision.used
         lo = min(float(x.min()) for x in xs)
         hi = max(float(x.max()) for x in xs)
         choice: BreakpointChoice | None = None
@@ -431,7 +435,7 @@ class PiecewiseModel(TemperatureModel):
                 raise ThermocalInputError("breakpoints must be distinct")
         else:
             n_seg = 3 if self.segments is None else int(self.segments)
-            choice = choose_breakpoints(xs, ys, n_seg, per_run_offset=self.per_run_offset)
+            choice = choose_breakpoints(xs, ys, n_seg, per_run_offset=use_offsets)
             bps = choice.breakpoints_c
             if choice.reduced:
                 reasons = []
@@ -479,7 +483,7 @@ class PiecewiseModel(TemperatureModel):
                     f"{spans[s]:.3g} °C; a line needs at least 2 distinct temperatures "
                     "(move or drop a breakpoint)"
                 )
-        m = len(rl) if self.per_run_offset else 1
+        m = len(rl) if use_offsets else 1
         centre = 0.5 * (lo + hi)
         scale = max(0.5 * (hi - lo), 1e-12)
         if self.method == "intersect":
@@ -490,9 +494,7 @@ class PiecewiseModel(TemperatureModel):
             p = 1 + bp.size
             names_f = ["slope"] + [f"hinge[{b:.4g}]" for b in bps]
         names_all = names_f + (
-            [f"offset[{r.name or i + 1}]" for i, r in enumerate(rl)]
-            if self.per_run_offset
-            else ["const"]
+            [f"offset[{r.name or i + 1}]" for i, r in enumerate(rl)] if use_offsets else ["const"]
         )
 
         def features(x: FloatArray, out: FloatArray) -> None:
@@ -511,7 +513,7 @@ class PiecewiseModel(TemperatureModel):
         def make_chunks() -> Iterator[Chunk]:
             bufs: dict[int, FloatArray] = {}
             for i, (x, y) in enumerate(zip(xs, ys, strict=True)):
-                g = i if self.per_run_offset else 0
+                g = i if use_offsets else 0
                 for a in range(0, x.size, CHUNK_ROWS):
                     b = min(x.size, a + CHUNK_ROWS)
                     c = b - a
@@ -581,12 +583,18 @@ class PiecewiseModel(TemperatureModel):
         n_total = red.n_total
         # residual of the final model (breakpoints moved): exact, one pass
         rss = 0.0
+        residuals: list[FloatArray] = []
         for i, (x, y) in enumerate(zip(xs, ys, strict=True)):
-            off = offsets[i] - const if self.per_run_offset else 0.0
+            off = offsets[i] - const if use_offsets else 0.0
             res = y - evaluate_lines(final, intercepts, slopes, x) - off
             rss += float(res @ res)
+            residuals.append(res[:MAX_SAMPLES_PER_SERIES])
         ybar = sum(float(np.sum(y)) for y in ys) / n_total
         tss = sum(float(((y - ybar) ** 2).sum()) for y in ys)
+        # coloured residuals: the lines' covariance is scaled by τ (models.residuals)
+        corr = residual_correlation(residuals, data_rms=math.sqrt(tss / n_total))
+        del residuals
+        self.line_cov_ = corr.tau * line_cov
         stats = FitStats(
             n_samples=n_total,
             n_coefficients=2 * S if self.method == "intersect" else S + 1,
@@ -601,7 +609,9 @@ class PiecewiseModel(TemperatureModel):
                 "initial_breakpoints": [float(b) for b in bp],
                 "discontinuities": discontinuities,
                 "n_runs": len(rl),
-                "per_run_offsets": [float(o) for o in offsets] if self.per_run_offset else None,
+                "per_run_offsets": [float(o) for o in offsets] if use_offsets else None,
+                "offset_decision": decision.to_dict(),
+                "residual_correlation": corr.to_dict(),
                 "rms_residual_lsq": math.sqrt(sol.rss / n_total),
                 "segment_selection": None if choice is None else choice.to_dict(),
             },

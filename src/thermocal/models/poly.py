@@ -107,6 +107,7 @@ from thermocal.models.base import (
     TemperatureModel,
     register,
 )
+from thermocal.models.residuals import MAX_SAMPLES_PER_SERIES, residual_correlation
 from thermocal.models.terms import (
     CHUNK_ROWS,
     BaseScaling,
@@ -176,6 +177,140 @@ def check_runs(runs: Sequence[RunData], family: str) -> list[RunData]:
         if r.n_samples < 2:
             raise ThermocalInputError(f"{r.name or 'run'}: needs at least 2 samples")
     return rl
+
+
+OFFSET_OVERLAP_FRACTION = 0.5
+"""Two runs *overlap* when their central temperature ranges (2nd…98th percentile of the
+first temperature column) share at least this fraction of the narrower range."""
+
+
+@dataclass(frozen=True)
+class OffsetDecision:
+    """Whether per-run turn-on offsets are estimated, and why (issue 13, honest statistics).
+
+    A per-run offset is a free constant per run. Offsets and the temperature function are
+    only separable where runs cover common temperatures: two runs at separate temperatures
+    let the offsets absorb the whole difference between runs, and the slope then comes
+    from the within-run variation alone (a real BMI270 pair gave 449 instead of 69
+    °/h/°C). The runs form a graph (edge = overlap ≥ :data:`OFFSET_OVERLAP_FRACTION` of
+    the narrower central range); offsets are separable when the graph is connected.
+
+    ``used`` offsets estimated; ``requested`` the setting (None = automatic);
+    ``connected`` the overlap graph is connected; ``groups`` run names per connected
+    group; ``ranges_c`` central range per run [°C]; ``reason`` one line for the user.
+    """
+
+    used: bool
+    requested: bool | None
+    connected: bool
+    groups: list[list[str]]
+    ranges_c: list[tuple[float, float]]
+    reason: str
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON form (model file ``fit.extra.offset_decision``)."""
+        return {
+            "used": self.used,
+            "requested": self.requested,
+            "connected": self.connected,
+            "groups": self.groups,
+            "ranges_c": [list(r) for r in self.ranges_c],
+            "reason": self.reason,
+        }
+
+
+def run_overlap_groups(
+    ranges_c: Sequence[tuple[float, float]], fraction: float = OFFSET_OVERLAP_FRACTION
+) -> list[list[int]]:
+    """Connected groups of runs whose temperature ranges overlap.
+
+    Runs i and j are linked when ``overlap(i, j) ≥ fraction × min(width_i, width_j)`` with
+    ``overlap = min(hi) − max(lo)`` (> 0); a run of (near) zero width — a hold — is linked
+    to a run whose range contains its temperature. Groups by union–find.
+    """
+    n = len(ranges_c)
+    parent = list(range(n))
+
+    def find(i: int) -> int:
+        while parent[i] != i:
+            parent[i] = parent[parent[i]]
+            i = parent[i]
+        return i
+
+    for i in range(n):
+        for j in range(i + 1, n):
+            (lo_i, hi_i), (lo_j, hi_j) = ranges_c[i], ranges_c[j]
+            overlap = min(hi_i, hi_j) - max(lo_i, lo_j)
+            narrow = min(hi_i - lo_i, hi_j - lo_j)
+            tol = 1e-6 * max(1.0, abs(lo_i), abs(lo_j))
+            if overlap >= max(fraction * narrow, 0.0) - tol and overlap >= -tol:
+                parent[find(i)] = find(j)
+    groups: dict[int, list[int]] = {}
+    for i in range(n):
+        groups.setdefault(find(i), []).append(i)
+    return sorted(groups.values())
+
+
+def decide_run_offsets(
+    requested: bool | None, runs: Sequence[RunData], family: str, column: int = 0
+) -> OffsetDecision:
+    """Per-run offsets or one pooled constant, from the runs' temperature overlap.
+
+    ``requested`` None (automatic, the default): offsets when the runs' overlap graph is
+    connected (:func:`run_overlap_groups`), otherwise the pooled fit and a
+    :class:`ConditioningWarning` naming the separate groups. True: offsets, with that
+    warning when the graph is not connected (the slope then rests on within-run
+    variation only). False: pooled. One run: nothing to decide.
+    ``column`` the temperature column whose ranges are compared.
+    """
+    names = [r.name or f"run {i + 1}" for i, r in enumerate(runs)]
+    ranges = [
+        (
+            float(np.percentile(r.temps_c[:, column], 2)),
+            float(np.percentile(r.temps_c[:, column], 98)),
+        )
+        for r in runs
+    ]
+    if len(runs) < 2:
+        return OffsetDecision(False, requested, True, [names], ranges, "one run: one constant")
+    groups = run_overlap_groups(ranges)
+    named = [[names[i] for i in g] for g in groups]
+    connected = len(groups) == 1
+    if requested is False:
+        return OffsetDecision(False, False, connected, named, ranges, "pooled, as asked")
+    if connected:
+        return OffsetDecision(
+            True,
+            requested,
+            True,
+            named,
+            ranges,
+            "per-run offsets: the runs overlap in temperature",
+        )
+    desc = "; ".join(
+        "[" + ", ".join(f"{names[i]} {ranges[i][0]:.1f}…{ranges[i][1]:.1f} °C" for i in g) + "]"
+        for g in groups
+    )
+    why = (
+        f"{family}: the runs fall into {len(groups)} groups that do not overlap in temperature "
+        f"({desc}); per-run offsets would absorb the difference between them and the "
+        "temperature dependence would come from within-run variation only"
+    )
+    if requested is True:
+        warnings.warn(
+            why + "; per-run offsets kept as asked (--per-run-offset): distrust the slope and "
+            "its standard error, or record runs that share temperatures",
+            ConditioningWarning,
+            stacklevel=3,
+        )
+        return OffsetDecision(True, True, False, named, ranges, why)
+    warnings.warn(
+        why + "; fitting one common offset instead (pooled). Pass --per-run-offset to force "
+        "offsets, or record runs that share temperatures",
+        ConditioningWarning,
+        stacklevel=3,
+    )
+    return OffsetDecision(False, None, False, named, ranges, why + "; pooled")
 
 
 def warn_rate_range(
@@ -705,7 +840,8 @@ class PolyModel(TemperatureModel):
     select : None, ``"bic"`` or ``"holdout"`` (forward stepwise term selection).
     ridge : ridge α on the unit-RMS term columns (0 = none).
     rcond : truncation threshold of the SVD solution (relative to s_max).
-    per_run_offset : one turn-on offset per run, estimated as nuisance parameters.
+    per_run_offset : one turn-on offset per run, estimated as nuisance parameters; None
+        (default) when the runs overlap in temperature (:func:`decide_run_offsets`).
     solver : ``"auto"`` (Gram when well conditioned, else chunked QR), ``"qr"``, ``"gram"``.
     noise_threshold : a component below ``rcond`` is kept when ``|uᵢᵀz| > k σ̂`` (None: never).
     """
@@ -730,7 +866,7 @@ class PolyModel(TemperatureModel):
         select: str | None = None,
         ridge: float = 0.0,
         rcond: float | None = DEFAULT_RCOND,
-        per_run_offset: bool = True,
+        per_run_offset: bool | None = None,
         solver: str = "auto",
         noise_threshold: float | None = DEFAULT_NOISE_THRESHOLD,
     ) -> None:
@@ -803,7 +939,9 @@ class PolyModel(TemperatureModel):
         uses_rate = any(t.uses_rate for t in terms)
         n_total = sum(r.n_samples for r in rl)
         p = len(terms)
-        m = len(rl) if self.per_run_offset else 1
+        decision = decide_run_offsets(self.per_run_offset, rl, self.family)
+        use_offsets = decision.used
+        m = len(rl) if use_offsets else 1
         n_folds = 2 if self.select == "holdout" else 1
         if n_total <= p + m:
             raise ThermocalInputError(
@@ -827,12 +965,15 @@ class PolyModel(TemperatureModel):
         rate_hi = np.full((len(rl), k), -np.inf)
         sums = np.zeros(3)  # n, Σ(y − y0), Σ(y − y0)²
 
+        current_run = [0]  # the run of the chunk last yielded (residual pass)
+
         def make_chunks() -> Iterator[Chunk]:
             bufs: dict[int, FloatArray] = {}
             sums[:] = 0.0
             y0 = float(cast(FloatArray, rl[0].signal)[0]) - rl[0].known_input
             for i, (r, plan) in enumerate(zip(rl, plans, strict=True)):
-                g = i if self.per_run_offset else 0
+                current_run[0] = i
+                g = i if use_offsets else 0
                 sig = cast(FloatArray, r.signal)
                 for s0, s1, a, b, fold in plan:
                     rates: FloatArray | None = None
@@ -864,9 +1005,7 @@ class PolyModel(TemperatureModel):
 
         red = accumulate_r(make_chunks, p, m, n_folds=n_folds, solver=cast(Any, self.solver))
         names = [t.name for t in terms] + (
-            [f"offset[{r.name or i + 1}]" for i, r in enumerate(rl)]
-            if self.per_run_offset
-            else ["const"]
+            [f"offset[{r.name or i + 1}]" for i, r in enumerate(rl)] if use_offsets else ["const"]
         )
         required = list(range(p, p + m))
         selection: dict[str, Any] | None = None
@@ -895,11 +1034,25 @@ class PolyModel(TemperatureModel):
         pk = len(kept)
         coef = sol.coef[:pk]
         offsets = sol.coef[pk:]
+        # residuals, a second pass over the same chunks, for their autocorrelation time:
+        # the covariance is scaled by τ (models.residuals; chamber residuals are coloured)
+        per_run: list[list[FloatArray]] = [[] for _ in rl]
+        for A, g, _fold in make_chunks():
+            i = current_run[0]
+            if sum(x.size for x in per_run[i]) >= MAX_SAMPLES_PER_SERIES:
+                continue
+            e = A[:, p + 1] - A[:, kept] @ coef - offsets[g]
+            per_run[i].append(e)
+        corr = residual_correlation(
+            [np.concatenate(x) if x else np.zeros(0) for x in per_run],
+            data_rms=math.sqrt(max(sums[2], 0.0) / max(sums[0], 1.0)),
+        )
+        del per_run
         # [constant, coef] = L @ [coef, offsets]; constant = mean of the offsets
         L = np.zeros((pk + 1, pk + m))
         L[0, pk:] = 1.0 / m
         L[1:, :pk] = np.eye(pk)
-        cov = L @ sol.cov @ L.T
+        cov = corr.tau * (L @ sol.cov @ L.T)
         if sol.condition_number > COND_WARN:
             warnings.warn(
                 f"poly: ill-conditioned design (condition number {sol.condition_number:.3g}); "
@@ -931,7 +1084,9 @@ class PolyModel(TemperatureModel):
                 "ridge": float(self.ridge),
                 "solver": red.solver,
                 "n_runs": len(rl),
-                "per_run_offsets": [float(o) for o in offsets] if self.per_run_offset else None,
+                "per_run_offsets": [float(o) for o in offsets] if use_offsets else None,
+                "offset_decision": decision.to_dict(),
+                "residual_correlation": corr.to_dict(),
                 "terms": [t.name for t in self.terms_],
                 "selected_terms": selection["kept"] if selection else None,
             },
