@@ -365,6 +365,42 @@ def run_blocks(time_s: FloatArray, n_folds: int = 1, chunk: int = CHUNK_ROWS) ->
     return out
 
 
+SHORT_RATE_SPAN_FRACTION = 0.5
+"""Ṫ taken over less than this fraction of the rate interval Δt is a *short-span* rate."""
+
+SHORT_RATE_WARN_SHARE = 0.1
+"""Warn when more than this share of the samples have a short-span Ṫ."""
+
+
+def short_rate_share(time_s: FloatArray, interval_s: float, method: str) -> tuple[int, int]:
+    """Samples whose Ṫ spans less than half of Δt, and the contiguous segments.
+
+    Ṫ is taken inside contiguous segments (a gap > :data:`GAP_FACTOR` × the median step
+    ends one), so near a segment's start (backward), end (forward) or either (centred)
+    the difference covers less than Δt; a segment shorter than Δt — a 5 s burst logged
+    every 5 min — has *only* such samples, and its Ṫ is temperature noise divided by a
+    fraction of a second (issue 13 item 8). Returns (count, number of segments).
+    """
+    half = SHORT_RATE_SPAN_FRACTION * interval_s
+    count = 0
+    n_seg = 0
+    for sl in contiguous_slices(time_s):
+        n_seg += 1
+        ts = time_s[sl]
+        from_start = ts - ts[0]
+        to_end = ts[-1] - ts
+        if method == "backward":
+            short = from_start < half
+        elif method == "forward":
+            short = to_end < half
+        else:
+            short = (
+                np.minimum(from_start, interval_s / 2.0) + np.minimum(to_end, interval_s / 2.0)
+            ) < half
+        count += int(np.count_nonzero(short))
+    return count, n_seg
+
+
 def record_ranges(
     model: TemperatureModel,
     runs: Sequence[RunData],
@@ -948,6 +984,24 @@ class PolyModel(TemperatureModel):
                 f"poly: {n_total} samples for {p + m} coefficients; need more samples than terms"
             )
         plans = [run_blocks(r.time_s, n_folds) for r in rl]
+        if uses_rate:
+            shares = [
+                short_rate_share(r.time_s, float(self.rate_interval_s), self.rate_method)
+                for r in rl
+            ]
+            n_short = sum(c for c, _ in shares)
+            if n_short > SHORT_RATE_WARN_SHARE * n_total:
+                warnings.warn(
+                    f"poly: {n_short / n_total:.0%} of the samples have a temperature rate taken "
+                    f"over less than half the rate interval ({self.rate_interval_s:g} s): the "
+                    f"record breaks into {sum(g for _, g in shares)} contiguous segment(s) at "
+                    "its gaps (bursts or dropouts), and a rate over a fraction of a second is "
+                    "temperature noise; the rate terms and the fitted rate range rest on it. "
+                    "Fit a plain polynomial (--order N), average the record to one block per "
+                    "burst, or choose --rate-interval shorter than the segments",
+                    ConditioningWarning,
+                    stacklevel=2,
+                )
         # centres and scales of the base variables from ≤ SCALING_SAMPLES evenly spaced samples
         step = max(1, math.ceil(n_total / SCALING_SAMPLES))
         t_sub: list[FloatArray] = []
