@@ -620,4 +620,134 @@ def plausibility_problems(rec: Recording) -> list[Problem]:
                     row=row,
                 )
             )
+    probs.extend(_accelerometer_magnitude_problems(rec))
+    probs.extend(_sample_interval_problems(rec))
     return probs
+
+
+STATIC_G_MG = (800.0, 1200.0)
+"""A static accelerometer triad reads |a| ≈ 1 g; its median magnitude outside this band
+[mg] points to a wrong range setting or unit (issue 13 plausibility)."""
+SINGLE_AXIS_MAX_MG = 1500.0
+"""A static single-axis accelerometer reads within ±1 g; a median |a| beyond this [mg]."""
+
+
+def _g_hint(mag_mg: float) -> str:
+    """The likely cause of an accelerometer magnitude far from 1 g."""
+    ratios = {
+        9.80665: "m/s² given as g?",
+        1.0 / 9.80665: "g given as m/s²?",
+        1000.0: "mg given as g?",
+        0.001: "g given as mg?",
+        2.0: "a ±2 g range read as ±4 g, or a scale factor off by 2?",
+        0.5: "a ±4 g range read as ±2 g, or a scale factor off by 2?",
+    }
+    g = mag_mg / 1000.0
+    for r, hint in ratios.items():
+        if abs(g / r - 1.0) < 0.15:
+            return hint
+    return "check the range setting, scale factor and unit"
+
+
+def _accelerometer_magnitude_problems(rec: Recording) -> list[Problem]:
+    """Accelerometers whose static reading is far from 1 g: a warning naming the value.
+
+    With three or more accelerometer columns the first three are taken as a triad and
+    the median of |a| = √(ax² + ay² + az²) [mg] is compared with :data:`STATIC_G_MG`; a
+    single axis is compared with :data:`SINGLE_AXIS_MAX_MG`. The median is robust to
+    moves between static positions.
+    """
+    cols: list[tuple[str, FloatArray]] = []
+    for name in rec.signals:
+        arr, unit = rec.columns.get(name), rec.units.get(name)
+        if arr is None or not unit:
+            continue
+        try:
+            if units.signal_kind(unit) != "accel":
+                continue
+        except UnitError:
+            continue
+        with np.errstate(over="ignore", invalid="ignore"):
+            cols.append((name, units.to_canonical(arr, unit)[0]))
+    if not cols:
+        return []
+    if len(cols) >= 3:
+        names = [c[0] for c in cols[:3]]
+        with np.errstate(over="ignore", invalid="ignore"):
+            mag = np.sqrt(sum(c[1] ** 2 for c in cols[:3]))
+        mag = mag[np.isfinite(mag)]
+        if mag.size == 0:
+            return []
+        med = float(np.median(mag))
+        lo, hi = STATIC_G_MG
+        if lo <= med <= hi:
+            return []
+        return [
+            Problem(
+                "implausible_acceleration",
+                f"accelerometer triad {', '.join(names)} has a median magnitude of "
+                f"{med / 1000.0:.4g} g; at rest it reads 1 g ({_g_hint(med)})",
+                severity="warning",
+                column=names[0],
+            )
+        ]
+    out = []
+    for name, arr in cols:
+        fin = np.abs(arr[np.isfinite(arr)])
+        if fin.size and float(np.median(fin)) > SINGLE_AXIS_MAX_MG:
+            med = float(np.median(fin))
+            out.append(
+                Problem(
+                    "implausible_acceleration",
+                    f"accelerometer column {name!r} reads a median |a| of {med / 1000.0:.4g} "
+                    f"g; a static axis reads within ±1 g ({_g_hint(med)})",
+                    severity="warning",
+                    column=name,
+                )
+            )
+    return out
+
+
+SAMPLE_INTERVAL_TOLERANCE = 0.1
+"""Relative difference between the stated and the measured sample interval that is
+reported."""
+
+
+def _sample_interval_problems(rec: Recording) -> list[Problem]:
+    """A stated sample interval (metadata ``sample_interval_s``) that the time column
+    contradicts by more than 10 %: a warning with both values and the likely cause."""
+    stated = rec.meta.sample_interval_s
+    t = rec.time_s
+    if stated is None or t.size < 3 or not np.all(np.isfinite(t)):
+        return []
+    if not stated > 0:
+        return [
+            Problem(
+                "implausible_sample_interval",
+                f"metadata sample_interval_s = {stated:g} s is not positive",
+                severity="warning",
+                column="time",
+            )
+        ]
+    measured = median_interval(t)
+    if not measured > 0:
+        return []
+    ratio = measured / stated
+    if abs(ratio - 1.0) <= SAMPLE_INTERVAL_TOLERANCE:
+        return []
+    if abs(ratio / 1000.0 - 1.0) < 0.1 or abs(ratio * 1000.0 - 1.0) < 0.1:
+        hint = "the time unit is off by 1000: ms read as s or s as ms? state --time-unit"
+    elif abs(ratio / 1e6 - 1.0) < 0.1 or abs(ratio * 1e6 - 1.0) < 0.1:
+        hint = "the time unit is off by 10⁶: µs read as s? state --time-unit"
+    else:
+        hint = "decimated, averaged or mislabelled data?"
+    return [
+        Problem(
+            "implausible_sample_interval",
+            f"the time column's median interval is {measured:.6g} s "
+            f"({1.0 / measured:.6g} Hz) but the metadata state {stated:.6g} s "
+            f"({1.0 / stated:.6g} Hz) ({hint})",
+            severity="warning",
+            column="time",
+        )
+    ]
