@@ -87,3 +87,39 @@ def test_turntable_bad_input_exit_2(
     assert main(["turntable", str(path), "-o", str(tmp_path / "y.json"), "--min-dwell", "120"]) == 2
     assert "shorter than the 120 s asked" in capsys.readouterr().err
     assert not (tmp_path / "y.json").exists()
+
+
+def test_turntable_gyro_unit_from_column_name_or_a_stated_default(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """No silent unit: gyro columns written in °/h with the unit in their names give the
+    same calibration as the °/s original; with no unit anywhere, a warning states deg/s."""
+    import pandas as pd
+
+    rec, truth = simulate_turntable16(2, rate_hz=2.0)
+    df = pd.DataFrame({"time": rec.time_s, **rec.columns})
+    for k in ("gyro_x", "gyro_y", "gyro_z"):
+        df[f"{k} (deg/h)"] = df.pop(k) * 3600.0
+    df.to_csv(tmp_path / "dph.csv", index=False)
+    code = main(
+        ["turntable", str(tmp_path / "dph.csv"), "-o", str(tmp_path / "a.json"), "--gyro",
+         "gyro_x (deg/h),gyro_y (deg/h),gyro_z (deg/h)", "--time-unit", "s", "--latitude",
+         "40", "--json"]
+    )  # fmt: skip
+    out, err = capsys.readouterr()
+    assert code == 0, err
+    assert "no unit" not in err
+    got = json.loads(out)
+    sig = np.array(got["bias_deg_h_sigma"])
+    assert np.all(np.abs(np.array(got["bias_deg_h"]) - np.array(truth["bias_deg_h"])) < 4 * sig)
+
+    plain = pd.DataFrame({"time": rec.time_s, **rec.columns})
+    plain.to_csv(tmp_path / "plain.csv", index=False)
+    code = main(
+        ["turntable", str(tmp_path / "plain.csv"), "-o", str(tmp_path / "b.json"),
+         "--time-unit", "s", "--latitude", "40", "--json"]
+    )  # fmt: skip
+    out, err = capsys.readouterr()
+    assert code == 0, err
+    assert "warning:" in err and "deg/s" in err
+    assert json.loads(out)["bias_deg_h"] == pytest.approx(got["bias_deg_h"], rel=1e-6, abs=1e-9)

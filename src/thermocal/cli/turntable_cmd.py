@@ -24,6 +24,7 @@ from thermocal.errors import ThermocalInputError
 from thermocal.io import check_not_input, read_recording, write_json
 from thermocal.turntable.calibrate import DEFAULT_GYRO_COLUMNS, calibrate
 from thermocal.turntable.model import MISALIGNMENT_NAMES
+from thermocal.units import StatedUnits
 
 
 @app.command("turntable")
@@ -41,7 +42,10 @@ def turntable_cmd(
     ] = ",".join(DEFAULT_GYRO_COLUMNS),
     gyro_unit: Annotated[
         str | None,
-        typer.Option("--gyro-unit", help="Gyro unit: deg/s (default), deg/h, rad/s."),
+        typer.Option(
+            "--gyro-unit",
+            help="Gyro unit: deg/s, deg/h, rad/s (default: the file's, else deg/s with a warning).",
+        ),
     ] = None,
     alpha: Annotated[
         str, typer.Option("--alpha", help="Inner-axis encoder angle column [°].")
@@ -76,7 +80,16 @@ def turntable_cmd(
     gyro_cols = split_names(gyro) or []
     if len(gyro_cols) != 3:
         raise ThermocalInputError(f"--gyro needs three column names, got {gyro!r}")
-    rec = read_recording(file, time=time, time_unit=time_unit)
+    # the gyro columns' unit through the shared resolver: --gyro-unit > file metadata >
+    # unit in the column name > °/s (INTERFACE: gyro_z in °/s), the last stated in a warning
+    rec = read_recording(
+        file,
+        time=time,
+        time_unit=time_unit,
+        signals=gyro_cols,
+        signal_unit=gyro_unit,
+        model=StatedUnits(signal_default="deg/s"),
+    )
     result = calibrate(
         rec,
         latitude,

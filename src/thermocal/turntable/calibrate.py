@@ -19,7 +19,7 @@ import numpy as np
 import numpy.typing as npt
 
 from thermocal import units
-from thermocal.errors import MissingValueError, ThermocalInputError
+from thermocal.errors import MissingValueError, ThermocalInputError, UnitError
 from thermocal.recording import Recording
 from thermocal.turntable import estimate_ls, kalman, model, schedule
 from thermocal.turntable.schedule import TurntableWarning
@@ -152,10 +152,17 @@ class TurntableResult:
 
 
 def _gyro_rad_s(rec: Recording, cols: Sequence[str], unit: str | None) -> FloatArray:
+    """The gyro columns in rad/s; a column whose unit nothing states is refused (no
+    silent default: the command line resolves it, with a warning, before this)."""
     out = []
     for c in cols:
         v = rec.column(c)
-        u = unit or rec.units.get(c) or "deg/s"
+        u = unit or rec.units.get(c)
+        if not u:
+            raise UnitError(
+                f"{rec.name}: no unit is known for the gyro column {c!r}; give --gyro-unit "
+                "(deg/s, deg/h, rad/s) or state it in the file's metadata"
+            )
         out.append(units.convert(v, u, "rad/s"))
     return np.column_stack(out)
 
@@ -243,7 +250,7 @@ def calibrate(
         sample, encoder angles α, β at the sample times [°] (wrapped or not).
     latitude_deg : site latitude L [°] (default: the recording's metadata).
     gyro_columns, alpha_column, beta_column : column names.
-    gyro_unit : unit of the gyro columns (default: the recording's, else deg/s).
+    gyro_unit : unit of the gyro columns (default: the recording's; none known is refused).
     arw_deg_sqrt_h : angle random walk [°/√h], scalar or per axis; estimated from the
         dwells when None.
     encoder_noise_arcsec : white noise σ of the encoder readings [″]; estimated from the
