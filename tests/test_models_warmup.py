@@ -342,3 +342,44 @@ def test_stream_warns_once_per_kind(fitted: WarmupModel) -> None:
     stream_texts = [t for t in texts if "samples" not in t]
     assert len(stream_texts) == 2  # temperature, start temperature T0: once each
     np.testing.assert_array_equal(live, batch)
+
+
+def test_record_longer_than_any_fitted_power_on_is_warned(
+    fitted: WarmupModel, tmp_path, capsys
+) -> None:
+    """Issue 14: a warm-up model fitted on 480 s power-ons applied to a 6 h record says
+    so (predict, stream, and compensate through the CLI); a record within the fitted
+    span does not."""
+    import pandas as pd
+
+    from thermocal.cli import main
+
+    assert fitted.duration_range_s_ == (479.0, 479.0)
+    long_run, _ = physical_run(20.0, 9, n=6 * 3600)
+    with pytest.warns(ExtrapolationWarning, match=r"runs 21599 s after power-on.*479…479 s"):
+        fitted.predict(long_run)
+    st = fitted.stream(1.0)
+    with pytest.warns(ExtrapolationWarning, match="after power-on"):
+        feed(st, long_run)
+    short_run, _ = physical_run(20.0, 9, n=480)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", ExtrapolationWarning)
+        fitted.predict(short_run)
+        feed(fitted.stream(1.0), short_run)
+    # through the CLI, on a CSV
+    model = tmp_path / "w.json"
+    save_model(fitted, model)
+    pd.DataFrame(
+        {"time": long_run.time_s, "T1": long_run.temps_c[:, 0], "sig": long_run.signal}
+    ).to_csv(tmp_path / "long.csv", index=False)
+    code = main(
+        ["compensate", str(model), str(tmp_path / "long.csv"), "--signal", "sig",
+         "--signal-unit", "deg/h", "--time-unit", "s", "--temp-unit", "degC",
+         "-o", str(tmp_path / "out.csv")]
+    )  # fmt: skip
+    _, err = capsys.readouterr()
+    assert code == 0, err
+    assert "after power-on" in err
+    # the older files without the field still load (no check then)
+    d = load_model(model)
+    assert d.duration_range_s_ == (479.0, 479.0)

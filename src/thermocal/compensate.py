@@ -69,7 +69,7 @@ from thermocal.io import (
     sidecar_path,
     write_json,
 )
-from thermocal.models.base import ModelStream, RunData, TemperatureModel
+from thermocal.models.base import ModelStream, RunData, TemperatureModel, check_sensor_id
 from thermocal.recording import (
     ABSOLUTE_ZERO_C,
     FEW_SAMPLES,
@@ -529,6 +529,8 @@ class ChunkPredictor:
         self._tau: float | None = sample_interval_s
         self.n_outside = 0
         """Samples outside the model's fitted temperature range (for one summary warning)."""
+        self._t_first: float | None = None
+        self._t_last: float | None = None
 
     @property
     def streams(self) -> bool:
@@ -551,6 +553,9 @@ class ChunkPredictor:
             else:
                 y = self._predict_context(time_s, temps_c, signal)
         self._rows_seen += n
+        if self._t_first is None:
+            self._t_first = float(time_s[0])
+        self._t_last = float(time_s[-1])
         return y
 
     def _predict_stream(
@@ -614,6 +619,8 @@ class ChunkPredictor:
         was outside the fitted range."""
         if self.n_outside:
             self.warn_outside(self.n_outside)
+        if self._t_first is not None and self._t_last is not None:
+            self.model.check_duration(self._t_last - self._t_first)
 
     def warn_outside(self, n_outside: int) -> None:
         """One :class:`ExtrapolationWarning` for ``n_outside`` samples out of range."""
@@ -953,6 +960,7 @@ def compensate_file(
     data_unit = resolved.signals[sig_name].unit
     check_signal_kind(data_unit, model.signal_unit, where)
     md = model_scale_factor(model, Metadata.from_dict(dict(info.get("metadata") or {})))
+    check_sensor_id(getattr(model, "inputs_", None), md.sensor_id, where)
     temp_units = {c: r.unit for c, r in resolved.temperatures.items()}
     convs = temperature_inputs(model, resolved, where)
 

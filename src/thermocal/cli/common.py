@@ -193,6 +193,11 @@ def load_recording(
         ),
         model=stated,
     )
+    if model is not None or model_inputs is not None:
+        from thermocal.models.base import check_sensor_id
+
+        fitted = getattr(model, "inputs_", None) if model is not None else model_inputs
+        check_sensor_id(fitted, rec.meta.sensor_id, str(path))
     if require_signal and not rec.signals:
         raise ThermocalInputError(
             f"{path}: name the signal column with --signal; available: "

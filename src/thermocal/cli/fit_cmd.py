@@ -250,6 +250,7 @@ def fit_cmd(
     runs: list[RunData] = []
     first_inputs: dict[str, Any] = {}
     provenance: list[dict[str, Any]] = []
+    sensor_ids: list[str | None] = []
     unit = ""
     sig_name = signal or "signal"
     temp_names: tuple[str, ...] | None = None
@@ -289,6 +290,7 @@ def fit_cmd(
                 f"file's {list(temp_names)}"
             )
         runs.append(run)
+        sensor_ids.append(rec.meta.sensor_id)
         provenance.append(
             {
                 "file": path.name,
@@ -301,6 +303,18 @@ def fit_cmd(
 
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
+        known_ids = sorted({str(i) for i in sensor_ids if i})
+        if len(known_ids) > 1:
+            first_inputs.pop("sensor_id", None)
+            warnings.warn(
+                f"the runs come from different sensors ({', '.join(known_ids)}): one "
+                "compensation model for several sensors averages them; fit each sensor "
+                "on its own runs",
+                ConditioningWarning,
+                stacklevel=1,
+            )
+        elif known_ids and "sensor_id" not in first_inputs:
+            first_inputs["sensor_id"] = known_ids[0]
         est.fit(runs)
         dof = getattr(est.stats_, "dof", None)
         if dof is not None and dof <= 0:

@@ -57,7 +57,7 @@ import json
 import math
 import warnings
 from abc import ABC, abstractmethod
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, ClassVar, Literal, Self, TypeVar
@@ -277,6 +277,8 @@ def model_inputs(
             "value": rec.meta.scale_factor,
             "unit": rec.meta.scale_factor_unit,
         }
+    if rec.meta.sensor_id:
+        out["sensor_id"] = str(rec.meta.sensor_id)
     canon = canonical_unit(sig_unit) if sig_unit else None
     out["known_input"] = {
         "value": float(known_input),
@@ -284,6 +286,23 @@ def model_inputs(
         "what": known_input_what or ("none" if known_input == 0.0 else "given"),
     }
     return out
+
+
+def check_sensor_id(
+    model_inputs: Mapping[str, Any] | None, data_sensor_id: Any, where: str
+) -> None:
+    """:class:`ExtrapolationWarning` when the data's sensor id (metadata ``sensor_id``)
+    differs from the one the model was fitted on (model file ``inputs.sensor_id``):
+    a compensation model belongs to one sensor (issue 14). Silent when either is unknown."""
+    fitted = (model_inputs or {}).get("sensor_id")
+    if not fitted or not data_sensor_id or str(fitted) == str(data_sensor_id):
+        return
+    warnings.warn(
+        f"{where}: the data come from sensor {str(data_sensor_id)!r} but the model was fitted "
+        f"on sensor {str(fitted)!r}; a compensation model belongs to one sensor",
+        ExtrapolationWarning,
+        stacklevel=2,
+    )
 
 
 # --- fitted coefficients and statistics ----------------------------------------------------
@@ -554,6 +573,14 @@ class TemperatureModel(ABC):
     def check_fitted(self) -> None:
         if not self.is_fitted:
             raise ThermocalInputError(f"{self.family} model is not fitted yet")
+
+    def check_duration(self, elapsed_s: float) -> None:
+        """Warn when a record's time since its start leaves what the model was fitted on.
+
+        No limit by default; a warm-up model (fitted on power-ons of a few minutes)
+        overrides it with an :class:`ExtrapolationWarning`.
+        """
+        del elapsed_s
 
     def residuals(self, run: RunData) -> FloatArray:
         """``target − predict`` of a run (signal unit)."""

@@ -166,7 +166,7 @@ def _warmup_state(state: Any, path: str, n_temps: int) -> None:
     fields(
         {"b": matrix, "order": integer, "t0_order": integer, "sensor_name": string,
          "t0_range_c": interval},
-        optional={"b_stderr": matrix, "start_window_s": number},
+        optional={"b_stderr": matrix, "start_window_s": number, "duration_range_s": interval},
     )(state, path)  # fmt: skip
     rows, cols = len(state["b"]), len(state["b"][0]) if state["b"] else 0
     want = (state["order"] + 1, state["t0_order"] + 1)

@@ -284,6 +284,7 @@ class WarmupModel(TemperatureModel):
     b_: FloatArray
     b_stderr_: FloatArray | None
     t0_range_: tuple[float, float]
+    duration_range_s_: tuple[float, float] | None
     sensor_name_: str
     start_temps_: FloatArray
     start_outputs_: FloatArray
@@ -509,6 +510,8 @@ class WarmupModel(TemperatureModel):
         else:
             self.b_stderr_ = None
         self.t0_range_ = (float(t0_arr.min()), float(t0_arr.max()))
+        spans = [float(r.time_s[-1] - r.time_s[0]) for r in one]
+        self.duration_range_s_ = (min(spans), max(spans))
         self.sensor_name_ = one[0].temp_names[0]
         self.start_temps_ = t0_arr
         self.start_outputs_ = np.array(f0s)
@@ -559,6 +562,7 @@ class WarmupModel(TemperatureModel):
         """ΔF of every sample: ``Σ_j a_j(T0_i) (T_i − T0_i)^j`` with the causal T0_i
         (running mean over the start window, then frozen) [signal unit]."""
         temp = self.clamp(self._prepare(run)[:, None], extrapolate=extrapolate)[:, 0]
+        self.check_duration(float(run.time_s[-1] - run.time_s[0]) if run.n_samples else 0.0)
         t0 = running_start_mean(run.time_s, temp, float(self.start_window_s))
         t0c = _clamp_range(t0, *self.t0_range_, "start temperature T0", extrapolate=extrapolate)
         # T0 is constant after the start window: a_j(T0) once, the same numbers
@@ -568,6 +572,25 @@ class WarmupModel(TemperatureModel):
         if run.n_samples > m:
             out[m:] = _evaluate(self.b_, t0c[m : m + 1], temp[m:] - t0[m])
         return out
+
+    DURATION_MARGIN: ClassVar[float] = 1.1
+    """A record more than 10 % longer than the longest fitted power-on is warned."""
+
+    def check_duration(self, elapsed_s: float) -> None:
+        """:class:`ExtrapolationWarning` when a record runs longer after power-on than any
+        fitted run (issue 14: a model fitted on 900 s power-ons applied to 21 h): the
+        warm-up polynomial in ΔT says nothing about the time beyond."""
+        rng = self.duration_range_s_
+        if rng is None or not elapsed_s > self.DURATION_MARGIN * rng[1]:
+            return
+        warnings.warn(
+            f"warmup: the record runs {elapsed_s:.6g} s after power-on, but the model was "
+            f"fitted on power-ons of {rng[0]:.6g}…{rng[1]:.6g} s; beyond that the warm-up "
+            "curve is an extrapolation (fit on longer runs, or use a chamber model for "
+            "steady operation)",
+            ExtrapolationWarning,
+            stacklevel=3,
+        )
 
     def stream(self, sample_interval_s: float, *, extrapolate: bool = False) -> ModelStream:
         """Sample-by-sample twin of :meth:`predict` (T0 captured at power-on)."""
@@ -610,6 +633,9 @@ class WarmupModel(TemperatureModel):
             "start_window_s": float(self.start_window_s),
             "sensor_name": self.sensor_name_,
             "t0_range_c": list(self.t0_range_),
+            "duration_range_s": (
+                None if self.duration_range_s_ is None else list(self.duration_range_s_)
+            ),
             "start_temps_c": self.start_temps_.tolist(),
             "start_outputs": self.start_outputs_.tolist(),
             "run_coefficients": (
@@ -624,6 +650,8 @@ class WarmupModel(TemperatureModel):
         self.sensor_name_ = str(state["sensor_name"])
         lo, hi = state["t0_range_c"]
         self.t0_range_ = (float(lo), float(hi))
+        dur = state.get("duration_range_s")  # absent in files before issue 14
+        self.duration_range_s_ = None if dur is None else (float(dur[0]), float(dur[1]))
         self.start_temps_ = np.array(state.get("start_temps_c", []), dtype=np.float64)
         self.start_outputs_ = np.array(state.get("start_outputs", []), dtype=np.float64)
         rc = state.get("run_coefficients")
@@ -667,6 +695,8 @@ class WarmupStream(ModelStream):
         self._t0_lo, self._t0_hi = (float(v) for v in model.t0_range_)
         self._window = float(model.start_window_s)
         self._b = [[float(v) for v in row] for row in model.b_]
+        span = model.duration_range_s_
+        self._max_span = None if span is None else model.DURATION_MARGIN * float(span[1])
         self.reset()
 
     def reset(self) -> None:
@@ -678,6 +708,7 @@ class WarmupStream(ModelStream):
         self._a: list[float] | None = None  # a_j(T0) once T0 is frozen
         self._warned_t = False
         self._warned_t0 = False
+        self._warned_span = False
 
     @property
     def t0_c(self) -> float:
@@ -719,6 +750,13 @@ class WarmupStream(ModelStream):
         t = float(time_s)
         if self._t_first is None:
             self._t_first = t
+        if (
+            not self._warned_span
+            and self._max_span is not None
+            and t - self._t_first > self._max_span
+        ):
+            self._warned_span = True
+            self.model.check_duration(t - self._t_first)
         if not self._frozen and t - self._t_first < self._window:
             self._sum = self._sum + temp
             self._count += 1
