@@ -93,6 +93,10 @@ class Inspection:
         }
 
 
+SPIKE_BLOCK = 1 << 15
+"""Window centres per block of the Hampel test (its working memory is ≈ 2·w·8 bytes each)."""
+
+
 def count_spikes(
     time_s: FloatArray,
     x: FloatArray,
@@ -115,19 +119,29 @@ def count_spikes(
         xs = x[sl]
         if xs.size < w or not np.all(np.isfinite(xs)):
             continue
-        win = sliding_window_view(xs, w)
-        med = np.median(win, axis=1)
-        mad = np.median(np.abs(win - med[:, None]), axis=1)
+        # global MAD of the first differences, partitioned in place (one array of steps)
         d = np.diff(xs)
-        floor = 1.4826 * float(np.median(np.abs(d - np.median(d)))) / np.sqrt(2.0)
-        sigma = np.maximum(1.4826 * mad, floor)
-        centre = xs[half_window : xs.size - half_window]
-        hit = (np.abs(centre - med) > threshold * sigma) & (sigma > 0)
-        idx = np.flatnonzero(hit)
-        if idx.size:
-            n_total += int(idx.size)
-            row = int(sl.start) + half_window + int(idx[0])
-            first = row if first is None else min(first, row)
+        d -= np.median(d, overwrite_input=True)
+        np.abs(d, out=d)
+        floor = 1.4826 * float(np.median(d, overwrite_input=True)) / np.sqrt(2.0)
+        del d
+        n_centre = xs.size - 2 * half_window
+        # windows in blocks of SPIKE_BLOCK centres: w·8 bytes per centre, bounded
+        for a in range(0, n_centre, SPIKE_BLOCK):
+            b = min(n_centre, a + SPIKE_BLOCK)
+            win = sliding_window_view(xs[a : b + 2 * half_window], w)
+            med = np.median(win, axis=1)
+            dev = np.abs(win - med[:, None])
+            mad = np.median(dev, axis=1, overwrite_input=True)
+            del dev
+            sigma = np.maximum(1.4826 * mad, floor)
+            centre = xs[a + half_window : b + half_window]
+            hit = (np.abs(centre - med) > threshold * sigma) & (sigma > 0)
+            idx = np.flatnonzero(hit)
+            if idx.size:
+                n_total += int(idx.size)
+                row = int(sl.start) + half_window + a + int(idx[0])
+                first = row if first is None else min(first, row)
     return n_total, first
 
 
@@ -161,8 +175,10 @@ def inspect_recording(rec: Recording) -> Inspection:
             if name in rec.temperatures
             else "other"
         )
-        finite = arr[np.isfinite(arr)]
         nan = np.isnan(arr)
+        n_nan = int(np.count_nonzero(nan))
+        # no copy of the column when it is all finite (the common case)
+        finite = arr if n_nan == 0 and bool(np.isfinite(arr).all()) else arr[np.isfinite(arr)]
         n_spikes, first_spike = count_spikes(t, arr) if time_ok and role != "other" else (0, None)
         if n_spikes:
             problems.append(
@@ -182,8 +198,8 @@ def inspect_recording(rec: Recording) -> Inspection:
             min=float(finite.min()) if finite.size else None,
             max=float(finite.max()) if finite.size else None,
             mean=float(finite.mean()) if finite.size else None,
-            n_nan=int(nan.sum()),
-            first_nan_row=int(np.argmax(nan)) if nan.any() else None,
+            n_nan=n_nan,
+            first_nan_row=int(np.argmax(nan)) if n_nan else None,
             n_spikes=n_spikes,
         )
         if role == "temperature":

@@ -15,7 +15,9 @@ from __future__ import annotations
 
 import dataclasses
 import itertools
+import math
 import warnings
+from collections.abc import Iterator
 from dataclasses import dataclass, field
 from typing import Any, Literal
 
@@ -375,11 +377,25 @@ class Recording:
 # --- pure helpers --------------------------------------------------------------------
 
 
+DIFF_BLOCK = 1 << 18
+"""Rows per block when time steps are scanned block by block (bounded working memory)."""
+
+
+def time_steps(time_s: FloatArray, block: int = DIFF_BLOCK) -> Iterator[tuple[int, FloatArray]]:
+    """``(offset, Δt)`` blocks of the time steps ``t[i+1] − t[i]``, ``i = offset …``,
+    each at most ``block`` long: scans a long time column in constant extra memory."""
+    n = int(time_s.size) - 1
+    for a in range(0, max(n, 0), block):
+        b = min(n, a + block)
+        yield a, time_s[a + 1 : b + 1] - time_s[a:b]
+
+
 def median_interval(time_s: FloatArray) -> float:
-    """Median time step [s] (NaN for fewer than 2 samples)."""
+    """Median time step [s] (NaN for fewer than 2 samples); one array of steps as working
+    memory (the median partitions it in place)."""
     if time_s.size < 2:
         return float("nan")
-    return float(np.median(np.diff(time_s)))
+    return float(np.median(np.diff(time_s), overwrite_input=True))
 
 
 def find_gaps(time_s: FloatArray, factor: float = GAP_FACTOR) -> list[Gap]:
@@ -389,13 +405,16 @@ def find_gaps(time_s: FloatArray, factor: float = GAP_FACTOR) -> list[Gap]:
     """
     if time_s.size < 3:
         return []
-    dt = np.diff(time_s)
-    med = float(np.median(dt))
+    med = median_interval(time_s)
     if not med > 0:
         return []
-    idx = np.flatnonzero(dt > factor * med)
     t0 = float(time_s[0])
-    return [Gap(int(i), float(time_s[i] - t0), float(dt[i])) for i in idx]
+    out: list[Gap] = []
+    for a, dt in time_steps(time_s):
+        for i in np.flatnonzero(dt > factor * med):
+            j = a + int(i)
+            out.append(Gap(j, float(time_s[j] - t0), float(dt[i])))
+    return out
 
 
 def contiguous_slices(time_s: FloatArray, factor: float = GAP_FACTOR) -> list[slice]:
@@ -436,9 +455,14 @@ def find_problems(rec: Recording, required: list[str] | None = None) -> list[Pro
             )
         )
     else:
-        dt = np.diff(t)
-        dup = np.flatnonzero(dt == 0)
-        back = np.flatnonzero(dt < 0)
+        dup_parts: list[npt.NDArray[np.intp]] = []
+        back_parts: list[npt.NDArray[np.intp]] = []
+        for a, dt_block in time_steps(t):
+            dup_parts.append(a + np.flatnonzero(dt_block == 0))
+            back_parts.append(a + np.flatnonzero(dt_block < 0))
+        empty = np.zeros(0, dtype=np.intp)
+        dup = np.concatenate(dup_parts) if dup_parts else empty
+        back = np.concatenate(back_parts) if back_parts else empty
         if dup.size:
             probs.append(
                 Problem(
@@ -516,6 +540,44 @@ PLAUSIBLE_SIGNAL = {"rate": 1e8, "accel": 1e7}
 """Largest |value| any gyro [°/h] (≈ 28 000 °/s) or accelerometer [mg] (10 000 g) outputs."""
 
 
+@dataclass(frozen=True)
+class Extrema:
+    """Smallest and largest finite value of a column, their first rows, and the number
+    of finite values (:func:`finite_extrema`)."""
+
+    lo: float
+    lo_row: int
+    hi: float
+    hi_row: int
+    count: int
+
+
+def finite_extrema(arr: FloatArray, block: int = DIFF_BLOCK) -> Extrema | None:
+    """:class:`Extrema` of the finite values of ``arr`` (None when there is none),
+    scanned in blocks of ``block`` rows: a few bytes of working memory per row of a
+    block, none per row of the column."""
+    best: list[Any] = [math.inf, -1, -math.inf, -1, 0]
+    for a in range(0, arr.size, block):
+        part = arr[a : a + block]
+        fin = np.isfinite(part)
+        k = int(np.count_nonzero(fin))
+        if k == 0:
+            continue
+        best[4] += k
+        lo_part = np.where(fin, part, np.inf)
+        i = int(np.argmin(lo_part))
+        if part[i] < best[0]:
+            best[0], best[1] = float(part[i]), a + i
+        np.copyto(lo_part, part)
+        lo_part[~fin] = -np.inf
+        j = int(np.argmax(lo_part))
+        if part[j] > best[2]:
+            best[2], best[3] = float(part[j]), a + j
+    if best[4] == 0:
+        return None
+    return Extrema(best[0], best[1], best[2], best[3], best[4])
+
+
 def plausibility_problems(rec: Recording) -> list[Problem]:
     """Values no sensor or chamber produces, named by column, value and row (issue 14).
 
@@ -539,12 +601,12 @@ def plausibility_problems(rec: Recording) -> list[Problem]:
         arr = rec.columns.get(name)
         if arr is None or not rec.units.get(name):
             continue
-        fin = arr[np.isfinite(arr)]
-        if fin.size >= 2 and float(np.ptp(fin)) == 0.0:
+        ext = finite_extrema(arr)
+        if ext is not None and ext.count >= 2 and ext.hi == ext.lo:
             probs.append(
                 Problem(
                     "implausible_constant_temperature",
-                    f"temperature column {name!r} is constant ({float(fin[0]):.6g} "
+                    f"temperature column {name!r} is constant ({ext.lo:.6g} "
                     f"{rec.units[name]}): no temperature dependence can be seen in it",
                     severity="warning",
                     column=name,
@@ -554,12 +616,10 @@ def plausibility_problems(rec: Recording) -> list[Problem]:
             temp = rec.temperature_c(name)
         except ThermocalInputError:
             continue  # raw counts without a conversion: checked where they are used
-        finite = np.isfinite(temp)
-        if not finite.any():
+        ext = finite_extrema(temp)
+        if ext is None:
             continue
-        lo_row = int(np.argmin(np.where(finite, temp, np.inf)))
-        hi_row = int(np.argmax(np.where(finite, temp, -np.inf)))
-        lo, hi = float(temp[lo_row]), float(temp[hi_row])
+        lo_row, hi_row, lo, hi = ext.lo_row, ext.hi_row, ext.lo, ext.hi
         if lo < ABSOLUTE_ZERO_C:
             probs.append(
                 Problem(
@@ -574,7 +634,7 @@ def plausibility_problems(rec: Recording) -> list[Problem]:
         a, b = PLAUSIBLE_TEMPERATURE_C
         if lo < a or hi > b:
             bad_row, bad = (hi_row, hi) if hi > b else (lo_row, lo)
-            vals = temp[finite]
+            vals = temp[np.isfinite(temp)]  # only on this warning's path
             if lo >= 173.0 and hi <= 473.0:
                 hint = "kelvin? give the data in °C"
             elif np.all(vals == np.round(vals)) and hi > 1000.0:
@@ -602,18 +662,26 @@ def plausibility_problems(rec: Recording) -> list[Problem]:
             continue
         if kind == "raw":
             continue
-        with np.errstate(over="ignore", invalid="ignore"):
-            canon, canon_unit = units.to_canonical(arr, unit)
-        finite_in = np.isfinite(arr)
-        over = finite_in & ~np.isfinite(canon)
-        big = finite_in & np.isfinite(canon) & (np.abs(canon) > PLAUSIBLE_SIGNAL[kind])
-        if over.any() or big.any():
-            row = int(np.argmax(over | big))
+        found: tuple[int, float] | None = None  # (row, value in the canonical unit)
+        canon_unit = units.canonical_unit(unit)
+        for a0 in range(0, arr.size, DIFF_BLOCK):  # in blocks: bounded working memory
+            part = arr[a0 : a0 + DIFF_BLOCK]
+            with np.errstate(over="ignore", invalid="ignore"):
+                canon, _ = units.to_canonical(part, unit)
+            finite_in = np.isfinite(part)
+            beyond = finite_in & ~(np.abs(canon) <= PLAUSIBLE_SIGNAL[kind])  # inf or too big
+            if beyond.any():
+                i = int(np.argmax(beyond))
+                found = (a0 + i, float(canon[i]))
+                break
+        if found is not None:
+            row = found[0]
+            canon_row = found[1]
             probs.append(
                 Problem(
                     "implausible_signal",
                     f"signal column {name!r} reads {float(arr[row]):.6g} {unit} at row {row} "
-                    f"({float(canon[row]):.6g} {canon_unit}), beyond any sensor "
+                    f"({canon_row:.6g} {canon_unit}), beyond any sensor "
                     f"(|value| ≤ {PLAUSIBLE_SIGNAL[kind]:g} {canon_unit}): wrong unit or "
                     "corrupt data",
                     column=name,
