@@ -156,3 +156,17 @@ def test_compute_metrics_accelerometer_and_errors() -> None:
     rec2.meta.latitude_deg = None
     with pytest.raises(ThermocalInputError, match="both"):
         metrics.compute_metrics(rec2, "gyro", 10.0, None, "up")
+
+
+def test_drift_angle_total_equals_the_curves_end_across_gaps_and_blocks() -> None:
+    """The block-by-block end value is the last point of the full curve (same trapezoids,
+    nothing across a gap), whatever the block length."""
+    from thermocal.metrics import drift_angle, drift_angle_total
+
+    rng = np.random.default_rng(5)
+    t = np.cumsum(rng.uniform(0.5, 1.5, 5000))
+    t[2500:] += 100.0  # a gap
+    w = 3.0 + rng.standard_normal(t.size)
+    end = float(drift_angle(t, w, 2.5)[-1])
+    for block in (7, 1000, 1 << 18):
+        assert drift_angle_total(t, w, 2.5, block=block) == pytest.approx(end, rel=1e-12)

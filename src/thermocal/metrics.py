@@ -13,6 +13,7 @@ of a stretch is dropped.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass
 
@@ -277,6 +278,25 @@ def drift_angle(time_s: npt.ArrayLike, rate_deg_h: npt.ArrayLike, bias_deg_h: fl
     return out
 
 
+def drift_angle_total(
+    time_s: npt.ArrayLike, rate_deg_h: npt.ArrayLike, bias_deg_h: float, block: int = 1 << 18
+) -> float:
+    """The end value θ(t_end) of :func:`drift_angle` [°], summed block by block (the same
+    trapezoids, nothing integrated across a gap) without the full-length curve."""
+    t = _as_1d(time_s, "time")
+    r = _as_1d(rate_deg_h, "rate")
+    if t.shape != r.shape:
+        raise ThermocalInputError(f"time has {t.size} samples but the rate has {r.size}")
+    b0 = float(bias_deg_h)
+    total = 0.0
+    for sl in contiguous_slices(t):
+        for a in range(sl.start, sl.stop - 1, block):
+            b = min(sl.stop - 1, a + block)  # trapezoids a…b−1 join samples a…b
+            e = r[a : b + 1] - b0
+            total += float(np.sum(0.5 * (e[1:] + e[:-1]) * np.diff(t[a : b + 1])))
+    return total / units.SECONDS_PER_HOUR
+
+
 # --- recording pipeline ------------------------------------------------------------------
 
 
@@ -368,7 +388,7 @@ def compute_metrics(
     drift: float | None = None
     drift_unit: str | None = None
     if unit == "deg/h":
-        drift = float(drift_angle(t, values, float(np.mean(values)))[-1])
+        drift = drift_angle_total(t, values, float(np.mean(values)))
         drift_unit = "deg"
 
     sens: TemperatureSensitivity | None = None
@@ -380,10 +400,12 @@ def compute_metrics(
         stages = hold_stages(
             t,
             temp,
-            values - earth,
+            values,
             rate_threshold_c_per_min=rate_threshold_c_per_min,
             min_duration_s=min_hold_s,
         )
+        if earth:  # mean(ω − Ω) = mean(ω) − Ω, without a full-length copy
+            stages = tuple(dataclasses.replace(s, bias=s.bias - earth) for s in stages)
         if len(stages) >= 2:
             rep = bias_repeatability([s.bias for s in stages])
             st_temps = np.array([s.mean_temp_c for s in stages])

@@ -182,6 +182,10 @@ def lowpass_first_order(
 # --- temperature rate ------------------------------------------------------------------
 
 
+RATE_BLOCK = 1 << 16
+"""Rows per block of :func:`temperature_rate` (its working memory is per block)."""
+
+
 def temperature_rate(
     time_s: npt.ArrayLike,
     temp_c: npt.ArrayLike,
@@ -219,21 +223,26 @@ def temperature_rate(
     for sl in contiguous_slices(t, gap_factor):
         ts, Ts = t[sl], T[sl]
         n = ts.size
-        i = np.arange(n)
-        if method == "forward":
-            lo = i
-            hi = np.minimum(np.searchsorted(ts, ts + interval_s, side="left"), n - 1)
-        elif method == "backward":
-            lo = np.searchsorted(ts, ts - interval_s, side="left")
-            hi = i
-        else:
-            lo = np.searchsorted(ts, ts - interval_s / 2.0, side="left")
-            hi = np.minimum(np.searchsorted(ts, ts + interval_s / 2.0, side="left"), n - 1)
-        span = ts[hi] - ts[lo]
-        ok = span > 0
-        rate = np.zeros(n)
-        rate[ok] = (Ts[hi[ok]] - Ts[lo[ok]]) / span[ok] * SECONDS_PER_MINUTE
-        out[sl] = rate
+        seg_out = out[sl]
+        # in blocks of rows: the partner indices and spans of a block only (bounded memory)
+        for a in range(0, n, RATE_BLOCK):
+            b = min(n, a + RATE_BLOCK)
+            tb = ts[a:b]
+            i = np.arange(a, b)
+            if method == "forward":
+                lo = i
+                hi = np.minimum(np.searchsorted(ts, tb + interval_s, side="left"), n - 1)
+            elif method == "backward":
+                lo = np.searchsorted(ts, tb - interval_s, side="left")
+                hi = i
+            else:
+                lo = np.searchsorted(ts, tb - interval_s / 2.0, side="left")
+                hi = np.minimum(np.searchsorted(ts, tb + interval_s / 2.0, side="left"), n - 1)
+            span = ts[hi] - ts[lo]
+            ok = span > 0
+            rate = np.zeros(b - a)
+            rate[ok] = (Ts[hi[ok]] - Ts[lo[ok]]) / span[ok] * SECONDS_PER_MINUTE
+            seg_out[a:b] = rate
     return out
 
 
@@ -287,7 +296,14 @@ def segment_holds(
     t = _as_f64(time_s, "time_s")
     T = _as_f64(temp_c, "temp_c")
     rate = temperature_rate(t, T, rate_interval_s, "centred", gap_factor=gap_factor)
-    is_hold = np.abs(rate) < rate_threshold_c_per_min
+    is_hold = np.empty(rate.size, dtype=bool)
+    for a in range(0, rate.size, RATE_BLOCK):  # |Ṫ| without a full-size copy
+        np.less(
+            np.abs(rate[a : a + RATE_BLOCK]),
+            rate_threshold_c_per_min,
+            out=is_hold[a : a + RATE_BLOCK],
+        )
+    del rate
     segs: list[Segment] = []
     for sl in contiguous_slices(t, gap_factor):
         base = int(sl.start)
