@@ -210,3 +210,37 @@ def test_full_disk_or_no_permission_is_exit_2_naming_the_output(
         f"error: {out}: cannot write the output ({text}); nothing was written"
     ]
     assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize("suffix", [".parquet", ".csv"])
+def test_reads_that_would_not_fit_in_memory_are_refused_up_front(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str], suffix: str
+) -> None:
+    """Issue 14: a read needing more than the memory available is refused with the
+    estimate (100 000 rows × 3 columns ≈ (24 + 40) B/row ≈ 6.1 MiB against a 1 MiB limit),
+    and passes under a limit that holds it."""
+    import pandas as pd
+
+    from thermocal.cli import main
+
+    n = 100_000
+    df = pd.DataFrame({"time": np.arange(n) * 0.01, "gyro": np.zeros(n), "T1": np.full(n, 25.0)})
+    path = tmp_path / f"big{suffix}"
+    if suffix == ".csv":
+        df.to_csv(path, index=False)
+    else:
+        df.to_parquet(path)
+    monkeypatch.setenv("THERMOCAL_MEMORY_LIMIT", "1M")
+    code = main(["inspect", str(path), "--signal", "gyro", "--signal-unit", "deg/h",
+                 "--time-unit", "s"])  # fmt: skip
+    err = capsys.readouterr().err
+    assert code == 2
+    assert ("100,000 rows" in err) == (suffix == ".parquet")  # a CSV's rows are estimated
+    assert "rows of" in err and "GiB of memory" in err and "compensate" in err
+    monkeypatch.setenv("THERMOCAL_MEMORY_LIMIT", "64M")
+    code = main(["inspect", str(path), "--signal", "gyro", "--signal-unit", "deg/h",
+                 "--time-unit", "s"])  # fmt: skip
+    assert code == 0, capsys.readouterr().err
+    monkeypatch.setenv("THERMOCAL_MEMORY_LIMIT", "lots")
+    assert main(["inspect", str(path)]) == 2
+    assert "THERMOCAL_MEMORY_LIMIT" in capsys.readouterr().err

@@ -303,6 +303,71 @@ def csv_encoding(path: str | Path, probe_bytes: int = 1 << 16) -> str:
     return "utf-8-sig"
 
 
+BYTES_PER_VALUE = 8
+"""A value read is one float64."""
+WORKING_BYTES_PER_ROW = 40
+"""Working memory of the commands beyond the columns, per row (measured: 30-35 B/row at
+10⁷ rows, benchmarks/RESULTS.md), rounded up."""
+
+
+def memory_limit_bytes() -> int | None:
+    """Memory a read may use [bytes]: ``THERMOCAL_MEMORY_LIMIT`` (``2G``, ``512M``, bytes)
+    when set, else 90 % of the kernel's ``MemAvailable``; None where neither is known."""
+    env = os.environ.get("THERMOCAL_MEMORY_LIMIT", "").strip()
+    if env:
+        scale = {"K": 1 << 10, "M": 1 << 20, "G": 1 << 30, "T": 1 << 40}
+        try:
+            if env[-1].upper() in scale:
+                return int(float(env[:-1]) * scale[env[-1].upper()])
+            return int(float(env))
+        except ValueError:
+            raise ThermocalInputError(
+                f"THERMOCAL_MEMORY_LIMIT={env!r}: give bytes or a number with K, M, G or T"
+            ) from None
+    try:
+        with open("/proc/meminfo", encoding="ascii") as fh:
+            for line in fh:
+                if line.startswith("MemAvailable:"):
+                    return int(0.9 * int(line.split()[1]) * 1024)
+    except OSError:
+        return None
+    return None
+
+
+def check_memory(path: Path, n_rows: int, n_columns: int, *, estimated: bool = False) -> None:
+    """Refuse up front a read that would not fit in memory (issue 14).
+
+    Needed ≈ ``n_rows · (8 · n_columns + 40)`` bytes (the float64 columns plus the
+    commands' working memory); compared with :func:`memory_limit_bytes`. The error gives
+    both figures and the ways out (cut the file; ``compensate`` streams it).
+    """
+    limit = memory_limit_bytes()
+    need = n_rows * (BYTES_PER_VALUE * n_columns + WORKING_BYTES_PER_ROW)
+    if limit is None or need <= limit:
+        return
+    about = "about " if estimated else ""
+    raise ThermocalInputError(
+        f"{path}: reading {about}{n_rows:,} rows of {n_columns} column(s) needs about "
+        f"{need / 2**30:.3g} GiB of memory, more than the {limit / 2**30:.3g} GiB available "
+        "(THERMOCAL_MEMORY_LIMIT or the machine's free memory); cut the file by time, or "
+        "compensate it (compensate streams any length)"
+    )
+
+
+def _csv_rows_estimate(path: Path, probe_bytes: int = 1 << 16) -> tuple[int, int]:
+    """(rows, columns) of a CSV estimated from its size and its first lines."""
+    size = path.stat().st_size
+    with open(path, "rb") as fh:
+        head = fh.read(probe_bytes)
+    lines = head.splitlines()
+    if len(lines) < 2:
+        return 1, max(1, head.count(b",") + 1)
+    body = lines[1:-1] if len(lines) > 2 else lines[1:]
+    mean_len = max(1.0, sum(len(x) + 1 for x in body) / len(body))
+    cols = max(lines[0].count(b","), lines[0].count(b";"), lines[0].count(b"\t")) + 1
+    return int(size / mean_len), cols
+
+
 def _read_table(path: Path, kind: str) -> tuple[pd.DataFrame | _ParquetColumns, dict[str, Any]]:
     if not path.exists():
         raise FileFormatError(f"{path}: no such file")
@@ -322,6 +387,9 @@ def _read_table(path: Path, kind: str) -> tuple[pd.DataFrame | _ParquetColumns, 
                 raise FileFormatError(f"{path}: corrupt thermocal metadata") from None
         return table, meta
     encoding = csv_encoding(path)
+    # pandas holds every column of a CSV (and its parser about as much again)
+    rows_est, cols_est = _csv_rows_estimate(path)
+    check_memory(path, rows_est, 2 * cols_est, estimated=True)
     try:
         df = pd.read_csv(
             path,
@@ -515,6 +583,9 @@ def read_recording(
         model=model,
         where=where,
     )
+    if isinstance(obj, _ParquetColumns):  # read column by column: only what is used
+        used = len(names) if keep_other else 1 + len(sig_names) + len(tmp_names)
+        check_memory(p, n_rows, used)
     t = numeric_column(obj, time_col, p)
     if resolved.time.unit != "s":
         t = t * units.TIME_UNITS[resolved.time.unit]
