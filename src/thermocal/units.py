@@ -636,15 +636,17 @@ def canonical_unit(unit: str) -> str:
 def to_canonical(values: npt.ArrayLike, unit: str) -> tuple[npt.NDArray[np.float64], str]:
     """Convert a signal to its canonical unit ([°/h] for rates, [mg] for accelerations).
 
-    Returns the converted float64 array and the canonical unit string.
+    Returns the converted float64 array and the canonical unit string. Data already in
+    the canonical unit come back as they are (no copy, no memory per row): treat the
+    result as read-only.
     """
     u = normalize_signal_unit(unit)
     arr = np.asarray(values, dtype=np.float64)
-    if u in RATE_UNITS:
-        return arr * RATE_UNITS[u], "deg/h"
-    if u in ACCEL_UNITS:
-        return arr * ACCEL_UNITS[u], "mg"
-    return arr, "counts"
+    factor = RATE_UNITS.get(u, ACCEL_UNITS.get(u))
+    kind = "deg/h" if u in RATE_UNITS else "mg" if u in ACCEL_UNITS else "counts"
+    if factor is None or factor == 1.0:
+        return arr, kind
+    return arr * factor, kind
 
 
 def convert(values: npt.ArrayLike, from_unit: str, to_unit: str) -> npt.NDArray[np.float64]:
