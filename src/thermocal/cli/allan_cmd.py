@@ -107,6 +107,7 @@ def allan_cmd(
         signal_unit=signal_unit,
         temp_unit=temp_unit,
         temp_conversion=temp_conversion,
+        keep_other=False,  # the Allan deviation uses the time and the signal only
     )
     if plot is not None:
         check_not_input(plot, [file])

@@ -158,8 +158,12 @@ def load_recording(
     temp_conversion: str | None = None,
     model_inputs: dict[str, Any] | None = None,
     model: TemperatureModel | None = None,
+    keep_other: bool = True,
 ) -> Recording:
     """Read a recording with the command line's options (options win over the file).
+
+    ``keep_other=False`` reads only the time, signal and temperature columns (8 bytes a
+    row less for every other column, for commands that use no other).
 
     A signal named with ``--signal`` becomes the first signal; without it the
     file's sidecar roles are used.  With ``require_signal`` a recording with no
@@ -192,6 +196,7 @@ def load_recording(
             parse_temp_conversion(temp_conversion) if temp_conversion is not None else None
         ),
         model=stated,
+        keep_other=keep_other,
     )
     if model is not None or model_inputs is not None:
         from thermocal.models.base import check_sensor_id

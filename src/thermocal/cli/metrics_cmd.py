@@ -96,6 +96,7 @@ def metrics_cmd(
         signal_unit=signal_unit,
         temp_unit=temp_unit,
         temp_conversion=temp_conversion,
+        keep_other=False,  # metrics use the signal and the temperatures only
     )
     res = compute_metrics(
         rec,
