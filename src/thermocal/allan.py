@@ -60,7 +60,7 @@ import math
 import os
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
-from typing import Final, Literal
+from typing import Any, Final, Literal
 
 import numpy as np
 import numpy.typing as npt
@@ -177,6 +177,97 @@ class NoiseTerm:
     high: float | None = None
     tau_s: float | None = None
     label: str = ""
+    quality: str | None = None
+    """``"poor"`` when the noise model fits the curve badly (:class:`FitQuality`); the
+    value is kept and ``reason`` says why it is doubtful; None otherwise."""
+
+
+@dataclass(frozen=True)
+class FitQuality:
+    """How well ``σ² = Σ C_p τ^p`` describes the measured curve (issue 13 item 9).
+
+    ``reduced_chi2`` weighted residual sum of squares per degree of freedom, the weights
+    from the points' EDF (χ² with ``dof`` degrees of freedom when the model holds);
+    ``p_value`` its upper tail (neighbouring ADEV points are correlated, so this is a
+    rough guide); ``misfits`` stretches of at least :data:`MISFIT_RUN` consecutive points
+    all on one side of the fit by more than :data:`MISFIT_SIGMA` standard deviations
+    (``{"tau_from_s", "tau_to_s", "side", "mean_sigma"}``; side ``"above"`` = the fitted
+    curve lies above the points); ``quality`` ``"good"`` or ``"poor"`` (poor: a misfit
+    stretch, or a reduced χ² above :data:`POOR_CHI2`); ``reason`` one line.
+    """
+
+    reduced_chi2: float
+    dof: int
+    p_value: float
+    misfits: tuple[dict[str, Any], ...]
+    quality: str
+    reason: str | None
+
+    def to_dict(self) -> dict[str, Any]:
+        return {
+            "reduced_chi2": self.reduced_chi2,
+            "dof": self.dof,
+            "p_value": self.p_value,
+            "misfits": [dict(m) for m in self.misfits],
+            "quality": self.quality,
+            "reason": self.reason,
+        }
+
+
+POOR_CHI2 = 4.0
+"""Reduced χ² above which the noise model is reported as a poor description."""
+MISFIT_RUN = 4
+"""Consecutive points on one side of the fit that make a systematic misfit stretch..."""
+MISFIT_SIGMA = 1.5
+"""... each by more than this many of its standard deviations."""
+
+
+def fit_quality(tau_s: FloatArray, normalised_residuals: FloatArray, n_active: int) -> FitQuality:
+    """:class:`FitQuality` from the fit's residuals ``(σ²_fit − σ̂²)/sd(σ̂²)`` per point."""
+    r = np.asarray(normalised_residuals, dtype=np.float64)
+    dof = max(int(r.size) - int(n_active), 1)
+    chi2 = float(r @ r)
+    red = chi2 / dof
+    p_value = float(stats.chi2.sf(chi2, dof))
+    misfits: list[dict[str, Any]] = []
+    big = np.abs(r) > MISFIT_SIGMA
+    sign = np.sign(r)
+    k = 0
+    while k < r.size:
+        if not big[k]:
+            k += 1
+            continue
+        e = k + 1
+        while e < r.size and big[e] and sign[e] == sign[k]:
+            e += 1
+        if e - k >= MISFIT_RUN:
+            misfits.append(
+                {
+                    "tau_from_s": float(tau_s[k]),
+                    "tau_to_s": float(tau_s[e - 1]),
+                    "side": "above" if sign[k] > 0 else "below",
+                    "mean_sigma": float(np.mean(np.abs(r[k:e]))),
+                }
+            )
+        k = e
+    reasons = []
+    for m in misfits:
+        reasons.append(
+            f"the fitted curve lies {m['side']} every point from τ = {m['tau_from_s']:.4g} s "
+            f"to {m['tau_to_s']:.4g} s (by {m['mean_sigma']:.2g} standard deviations on average)"
+        )
+    if red > POOR_CHI2:
+        reasons.append(f"reduced χ² = {red:.3g} on {dof} degrees of freedom")
+    poor = bool(misfits) or red > POOR_CHI2
+    reason = (
+        "the noise model σ² = Σ C_p τ^p does not describe this curve: "
+        + "; ".join(reasons)
+        + " (another noise process — flicker of a different kind, a periodic term, a drift "
+        "or a step — or a wrong time base); the noise terms are rough"
+        if poor
+        else None
+    )
+    return FitQuality(red, dof, p_value, tuple(misfits), "poor" if poor else "good", reason)
 
 
 @dataclass(frozen=True)
@@ -206,6 +297,7 @@ class NoiseTerms:
     fit_coefficients : C_{−2..2} of ``σ² = Σ C_p τ^p`` [unit² s^p].
     fit_sigma : standard errors of ``fit_coefficients`` (NaN where C = 0).
     reduced_chi2 : weighted residual sum of squares / (points − active terms).
+    quality : how well the noise model describes the curve (:class:`FitQuality`).
     """
 
     slope: NoiseTermSet
@@ -213,6 +305,7 @@ class NoiseTerms:
     fit_coefficients: FloatArray
     fit_sigma: FloatArray
     reduced_chi2: float
+    quality: FitQuality | None = None
 
     def fit_curve(self, tau_s: npt.ArrayLike) -> FloatArray:
         """Fitted Allan deviation sqrt(Σ C_p τ^p) [unit] at ``tau_s``."""
@@ -537,13 +630,14 @@ def term_units(unit: str) -> tuple[float, tuple[tuple[float, str, str], ...]]:
 
 def _fit(
     result: AllanResult, significance: float
-) -> tuple[FloatArray, FloatArray, float, list[str | None]]:
+) -> tuple[FloatArray, FloatArray, float, list[str | None], FitQuality | None]:
     """Weighted NNLS of σ²(τ) = Σ_{p=−2..2} C_p τ^p (IEEE 952 C.2).
 
     Weights 1/sd(σ̂²) with sd(σ̂²) = σ² √(2/edf) (chi-square with edf degrees of
     freedom), iterated three times with the fitted σ² in place of the noisy σ̂²;
     standard errors from the QR factor of the weighted active design, scaled by
-    the reduced χ² when it exceeds 1.  Returns C, sd(C), reduced χ², reasons.
+    the reduced χ² when it exceeds 1.  Returns C, sd(C), reduced χ², reasons and the
+    fit's quality (:func:`fit_quality`; None without points).
     """
     ok = np.isfinite(result.adev) & (result.adev > 0) & (result.edf > 0)
     tau = result.tau_s[ok]
@@ -551,7 +645,7 @@ def _fit(
     edf = result.edf[ok]
     if tau.size == 0:  # a constant or too short signal: no point to fit
         why = "no Allan deviation point above zero (a constant or too short signal)"
-        return np.zeros(5), np.full(5, np.nan), float("nan"), [why] * 5
+        return np.zeros(5), np.full(5, np.nan), float("nan"), [why] * 5, None
     powers = np.arange(-2, 3, dtype=np.float64)
     design = tau[:, None] ** powers[None, :]
     model = s2.copy()
@@ -593,7 +687,8 @@ def _fit(
             )
         else:
             reasons.append(None)
-    return coef, sigma, red_chi2, reasons
+    quality = fit_quality(tau, resid, int(active.sum()))
+    return coef, sigma, red_chi2, reasons, quality
 
 
 def _local_slope(log_tau: FloatArray, log_dev: FloatArray, edf: FloatArray, k: int) -> float:
@@ -697,7 +792,8 @@ def noise_terms(
     """
     conf = result.confidence if confidence is None else confidence
     scale, specs = term_units(result.unit)
-    coef, sigma, red_chi2, fit_reasons = _fit(result, significance)
+    coef, sigma, red_chi2, fit_reasons, quality = _fit(result, significance)
+    poor = quality is not None and quality.quality == "poor"
     z = float(stats.norm.ppf(0.5 + conf / 2.0))
 
     fit_terms: list[NoiseTerm] = []
@@ -708,7 +804,13 @@ def noise_terms(
             val = math.sqrt(coef[j] / f) * conv
             lo = math.sqrt(max(coef[j] - z * sigma[j], 0.0) / f) * conv
             hi = math.sqrt((coef[j] + z * sigma[j]) / f) * conv
-            fit_terms.append(NoiseTerm(val, u, None, lo, hi, None, label))
+            if poor:
+                assert quality is not None
+                fit_terms.append(
+                    NoiseTerm(val, u, quality.reason, lo, hi, None, label, quality="poor")
+                )
+            else:
+                fit_terms.append(NoiseTerm(val, u, None, lo, hi, None, label))
         else:
             fit_terms.append(NoiseTerm(None, u, fit_reasons[j], label=label))
 
@@ -738,15 +840,22 @@ def noise_terms(
             else:
                 conv = scale * factor
                 val, lo, hi, tau_k = term
-                slope_terms.append(
-                    NoiseTerm(val * conv, u, None, lo * conv, hi * conv, tau_k, label)
+                note = f"read from the slope {TERM_SLOPES[j]:+g} stretch at τ = {tau_k:.4g} s" + (
+                    " (the flat minimum / 0.664)" if j == 2 else ""
                 )
+                slope_terms.append(
+                    NoiseTerm(
+                        val * conv, u, note if poor else None, lo * conv, hi * conv, tau_k,
+                        label, quality="poor" if poor else None,
+                    )
+                )  # fmt: skip
     return NoiseTerms(
         slope=NoiseTermSet("slope", *slope_terms),
         fit=NoiseTermSet("fit", *fit_terms),
         fit_coefficients=coef,
         fit_sigma=sigma,
         reduced_chi2=red_chi2,
+        quality=quality,
     )
 
 
@@ -755,12 +864,14 @@ __all__ = [
     "ONE_SIGMA_CONFIDENCE",
     "TERM_NAMES",
     "AllanResult",
+    "FitQuality",
     "NoiseTerm",
     "NoiseTermSet",
     "NoiseTerms",
     "averaging_factors",
     "confidence_interval",
     "edf_simple",
+    "fit_quality",
     "identify_alpha",
     "noise_terms",
     "overlapping_adev",

@@ -3,6 +3,7 @@ IEEE 952 noise terms by slope lines and by least squares."""
 
 from __future__ import annotations
 
+import warnings
 from pathlib import Path
 from typing import Annotated, Any
 
@@ -27,7 +28,7 @@ from thermocal.cli.common import (
     load_recording,
     stdout,
 )
-from thermocal.errors import ThermocalInputError
+from thermocal.errors import ConditioningWarning, ThermocalInputError
 from thermocal.io import check_not_input
 
 
@@ -41,6 +42,7 @@ def _terms_json(terms: dict[str, Any]) -> dict[str, Any]:
             "high": t.high,
             "tau_s": t.tau_s,
             "label": t.label,
+            "quality": t.quality,
         }
         for name, t in terms.items()
     }
@@ -68,6 +70,7 @@ def allan_json(res: AllanResult, noise: NoiseTerms) -> dict[str, Any]:
         "noise_slope_method": "slope lines (IEEE 952 C.3)",
         "fit_coefficients": noise.fit_coefficients,
         "fit_reduced_chi2": noise.reduced_chi2,
+        "fit_quality": noise.quality.to_dict() if noise.quality is not None else None,
     }
     return dict(jsonable(out))
 
@@ -133,6 +136,8 @@ def allan_cmd(
         confidence=confidence,
     )
     noise = noise_terms(res)
+    if noise.quality is not None and noise.quality.quality == "poor":
+        warnings.warn(f"{file}: {noise.quality.reason}", ConditioningWarning, stacklevel=1)
     if plot is not None:
         from thermocal.plots_allan import plot_allan
 
@@ -156,10 +161,24 @@ def allan_cmd(
         for col in ("term", "fit", "slope lines", "unit", "note"):
             t2.add_column(col)
         fit, slope = noise.fit.terms(), noise.slope.terms()
+        poor = noise.quality is not None and noise.quality.quality == "poor"
         for name in fit:
             f, s = fit[name], slope[name]
-            t2.add_row(f.label, fmt(f.value), fmt(s.value), f.unit, f.reason or s.reason or "")
+            note = "poor fit (see the warning)" if poor else (f.reason or s.reason or "")
+            mark = " ?" if poor else ""
+            t2.add_row(
+                f.label,
+                fmt(f.value) + (mark if f.value is not None else ""),
+                fmt(s.value) + (mark if s.value is not None else ""),
+                f.unit,
+                note,
+            )
         stdout.print(t2)
+        if noise.quality is not None:
+            stdout.print(
+                f"noise-model fit: reduced χ² {noise.quality.reduced_chi2:.3g} on "
+                f"{noise.quality.dof} degrees of freedom — {noise.quality.quality}"
+            )
         if plot is not None:
             stdout.print(f"plot written to {plot}")
 
