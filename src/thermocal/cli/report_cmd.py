@@ -10,6 +10,7 @@ comparison table.
 
 from __future__ import annotations
 
+import functools
 import json
 from pathlib import Path
 from typing import Annotated, Any
@@ -20,6 +21,7 @@ from thermocal.cli.app import app
 from thermocal.cli.common import (
     ModelSignalOpt,
     SignalUnitOpt,
+    TempConversionOpt,
     TempUnitOpt,
     TimeOpt,
     TimeUnitOpt,
@@ -54,20 +56,25 @@ def read_validation_json(path: Path) -> dict[str, Any]:
 def _read_run(
     path: Path,
     signal: str,
+    *,
     time: str | None,
     time_unit: str | None,
     signal_unit: str | None,
     temp_unit: str | None,
     model_inputs: dict[str, Any] | None = None,
+    temp_conversion: str | None = None,
+    temps: list[str] | None = None,
 ) -> Recording:
     return load_recording(
         path,
         time=time,
         time_unit=time_unit,
         signal=signal,
+        temps=",".join(temps) if temps else None,
         signal_unit=signal_unit,
         temp_unit=temp_unit,
         model_inputs=model_inputs,
+        temp_conversion=temp_conversion,
     )
 
 
@@ -107,8 +114,22 @@ def report_cmd(
     time_unit: TimeUnitOpt = None,
     signal_unit: SignalUnitOpt = None,
     temp_unit: TempUnitOpt = None,
+    temp_conversion: TempConversionOpt = None,
+    averaging: Annotated[
+        float | None,
+        typer.Option(
+            "--average",
+            "--averaging",
+            help="Averaging time [s] of bias stability and peak-to-peak (default: the "
+            "validation result's, else 100 s).",
+        ),
+    ] = None,
 ) -> None:
-    """Write a self-contained HTML report (figures embedded, no network needed)."""
+    """Write a self-contained HTML report (figures embedded, no network needed).
+
+    Every model given is shown (fit, range of validity, coefficients); a PASS/ATTENTION
+    verdict is stated only from a validation result given with --validation.
+    """
     validations = list(validation or [])
     labels = list(label or [])
     if validations and len(validations) != len(model):
@@ -138,12 +159,19 @@ def report_cmd(
         if not sig:
             raise ThermocalInputError("name the signal column with --signal")
         fitted = dict(entries[0].model.get("inputs") or {})  # how the first model's data were
-        val_rec = _read_run(recording, sig, time, time_unit, signal_unit, temp_unit, fitted)
-        mod_rec = (
-            _read_run(modeling, sig, time, time_unit, signal_unit, temp_unit, fitted)
-            if modeling is not None
-            else None
-        )
+        # the temperature columns every model uses, in the first model's order
+        temp_cols: list[str] = []
+        for e in entries:
+            for c in e.model.get("temperatures") or []:
+                if c not in temp_cols:
+                    temp_cols.append(str(c))
+        read = functools.partial(
+            _read_run, time=time, time_unit=time_unit, signal_unit=signal_unit,
+            temp_unit=temp_unit, model_inputs=fitted, temp_conversion=temp_conversion,
+            temps=temp_cols,
+        )  # fmt: skip
+        val_rec = read(recording, sig)
+        mod_rec = read(modeling, sig) if modeling is not None else None
         advance(1)
         inputs = ReportInputs(
             models=tuple(entries),
@@ -155,6 +183,7 @@ def report_cmd(
             title=title,
             sensor=sensor,
             generated_by="thermocal report",
+            averaging_s=averaging,
         )
         advance(1)
         path = write_report(output, inputs)

@@ -43,14 +43,15 @@ from thermocal.compensate import unit_factor
 from thermocal.errors import ThermocalInputError
 from thermocal.io import atomic_write
 from thermocal.metrics import compute_metrics, drift_angle
-from thermocal.models.base import RunData, TemperatureModel
+from thermocal.models.base import RunData, TemperatureModel, condition_wording
 from thermocal.recording import FloatArray, Metadata, Recording
 
 WEAK_CORRELATION_LIMIT = 0.4
 """Seed 000 / SPEC §5: the validation test is weakly correlated when r < 0.4."""
 
-ILL_CONDITIONED = 1.0e8
-"""Condition number (of the scaled design) above which the report warns."""
+ILL_CONDITIONED = 1.0e6
+"""Condition number (scaled design) above which the report warns: ill-conditioned in the
+words of :func:`thermocal.models.base.condition_wording`."""
 
 DEFAULT_AVERAGING_S = 100.0
 """Averaging time of the bias-stability figures when the validation JSON gives none [s]."""
@@ -94,6 +95,7 @@ class ReportInputs:
     notes : free text paragraphs under "Test conditions".
     files : other produced files (label, path) listed in the provenance table.
     generated_by : the command that made the report.
+    averaging_s : averaging time of the computed figures [s] (``--average``).
     """
 
     models: tuple[ModelEntry, ...]
@@ -108,6 +110,9 @@ class ReportInputs:
     notes: tuple[str, ...] = ()
     files: tuple[tuple[str, str], ...] = ()
     generated_by: str = "thermocal report"
+    averaging_s: float | None = None
+    """Averaging time of bias stability and peak-to-peak [s] (default: the validation
+    result's, else :data:`DEFAULT_AVERAGING_S`)."""
     extra: dict[str, Any] = field(default_factory=dict)
 
 
@@ -593,7 +598,7 @@ def _summary(
     return items
 
 
-def _coefficient_rows(model: dict[str, Any]) -> list[dict[str, Any]]:
+def _coefficient_rows(model: dict[str, Any], key: str = "model") -> list[dict[str, Any]]:
     rows = []
     for i, c in enumerate(model.get("coefficients") or []):
         val = c.get("value")
@@ -605,8 +610,8 @@ def _coefficient_rows(model: dict[str, Any]) -> list[dict[str, Any]]:
             {
                 "i": i,
                 "name": c.get("name", f"a{i}"),
-                "value": num(val, f"model.coefficients.{i}.value", digits=6),
-                "stderr": num(se, f"model.coefficients.{i}.stderr", digits=3),
+                "value": num(val, f"{key}.coefficients.{i}.value", digits=6),
+                "stderr": num(se, f"{key}.coefficients.{i}.stderr", digits=3),
                 "rel": num(rel, None, digits=3),
                 "unit": unit_label(str(c.get("unit", ""))),
             }
@@ -614,7 +619,7 @@ def _coefficient_rows(model: dict[str, Any]) -> list[dict[str, Any]]:
     return rows
 
 
-def _range_rows(model: dict[str, Any]) -> list[dict[str, Any]]:
+def _range_rows(model: dict[str, Any], key: str = "model") -> list[dict[str, Any]]:
     rng = model.get("range") or {}
     tr = rng.get("temperature_c") or {}
     rr = rng.get("rate_c_per_min") or {}
@@ -625,8 +630,8 @@ def _range_rows(model: dict[str, Any]) -> list[dict[str, Any]]:
         rows.append(
             {
                 "name": name,
-                "t_lo": num(t[0], f"model.range.temperature_c.{name}.0", digits=4),
-                "t_hi": num(t[1], f"model.range.temperature_c.{name}.1", digits=4),
+                "t_lo": num(t[0], f"{key}.range.temperature_c.{name}.0", digits=4),
+                "t_hi": num(t[1], f"{key}.range.temperature_c.{name}.1", digits=4),
                 "r_lo": num(r[0], None, digits=3),
                 "r_hi": num(r[1], None, digits=3),
             }
@@ -661,7 +666,30 @@ def _model_summary(entry: ModelEntry) -> dict[str, Any]:
         "created": m.get("created_utc"),
         "version": m.get("thermocal_version"),
         "ill_conditioned": _is_number(cond) and float(cond) > ILL_CONDITIONED,
+        "condition_words": condition_wording(float(cond) if _is_number(cond) else None),
+        "offset_note": (fit.get("offset_decision") or {}).get("reason"),
+        "effective_samples": num(
+            (fit.get("residual_correlation") or {}).get("n_effective"), None, digits=3
+        ),
     }
+
+
+def _model_details(inputs: ReportInputs) -> list[dict[str, Any]]:
+    """Section 8 for every model given: its fit, range of validity and coefficients."""
+    out = []
+    for i, e in enumerate(inputs.models):
+        key = "model" if i == 0 else f"models.{e.label}"
+        out.append(
+            {
+                "summary": _model_summary(e),
+                "ranges": _range_rows(e.model, key),
+                "coefficients": _coefficient_rows(e.model, key),
+                "has_rates": bool((e.model.get("range") or {}).get("rate_c_per_min")),
+                "suffix": "" if i == 0 else f"-{i + 1}",
+                "primary": i == 0,
+            }
+        )
+    return out
 
 
 TRUTH_COLUMN = "truth_bias"
@@ -724,14 +752,21 @@ def _collect_warnings(inputs: ReportInputs, applied: dict[str, RunSignals]) -> l
         if _is_number(cond) and float(cond) > ILL_CONDITIONED:
             add(
                 "conditioning",
-                f"{entry.label}: the scaled design is ill-conditioned (condition number "
-                f"{fmt_num(cond, 3)} > {fmt_num(ILL_CONDITIONED, 2)}); coefficients are poorly "
+                f"{entry.label}: the scaled design is {condition_wording(float(cond))} "
+                f"(condition number {fmt_num(cond, 3)}); individual coefficients are poorly "
                 "determined, prefer a term-selected or ridge model.",
             )
         sig = applied.get(entry.label)
         if sig is not None:
             for w in sig.warnings:
                 add("extrapolation", f"{entry.label} on the validation run: {w}")
+    if inputs.models and not inputs.models[0].validation:
+        add(
+            "validation",
+            "no validation result was given (thermocal validate --json, then --validation): "
+            "the report shows figures computed on the recording and states no acceptance "
+            "verdict.",
+        )
     for w in inputs.warnings:
         add("workflow", w)
     return out
@@ -777,7 +812,7 @@ def build_report(inputs: ReportInputs) -> str:
     _, unit = rec.signal(signal if signal in rec.columns else None)
     temp_names = main.temp_names
     v = primary.validation or {}
-    averaging_s = float(v.get("averaging_s") or DEFAULT_AVERAGING_S)
+    averaging_s = float(inputs.averaging_s or v.get("averaging_s") or DEFAULT_AVERAGING_S)
     tau0 = rec.sample_interval_s
 
     ambient = v.get("ambient")
@@ -1009,7 +1044,16 @@ def build_report(inputs: ReportInputs) -> str:
     warn_list = _collect_warnings(inputs, applied)
     summary = _summary(primary, fom_before, fom_after, unit)
     flags = [s["flag"] for s in summary]
-    overall = "fail" if "fail" in flags else ("pass" if "pass" in flags else "na")
+    # a verdict only from a validation result that was given, and PASS only when its
+    # correlation check is among the passed ones (issue 13 item 6)
+    if not primary.validation:
+        overall = "na"
+    elif "fail" in flags:
+        overall = "fail"
+    elif (primary.validation or {}).get("r") is not None and "pass" in flags:
+        overall = "pass"
+    else:
+        overall = "na"
 
     ctx = {
         "title": inputs.title,
@@ -1037,6 +1081,7 @@ def build_report(inputs: ReportInputs) -> str:
             else None
         ),
         "noise_rows": noise_rows,
+        "model_details": _model_details(inputs),
         "coefficients": _coefficient_rows(primary.model),
         "ranges": _range_rows(primary.model),
         "has_rates": bool((primary.model.get("range") or {}).get("rate_c_per_min")),
