@@ -152,7 +152,7 @@ def test_int16_two_complement() -> None:
 
 # --- nothing but the resolver chooses a unit ------------------------------------------------
 
-_UNIT = r"deg/h|deg/s|rad/s|degC|s|ms|us|mg|ug|g|m/s\^2|counts"
+_UNIT = r"deg/h|deg/s|rad/s|degC|s|ms|us|mg|ug|g|m/s\^2|counts(/[^'\"]+)?"
 FALLBACK = re.compile(
     rf"""(\bor\s+["']({_UNIT})["'])"""  # x or "deg/h"
     rf"""|(\.get\([^()]*,\s*["']({_UNIT})["']\))"""  # d.get(k, "deg/h")

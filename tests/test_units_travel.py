@@ -499,3 +499,25 @@ def test_printed_figures_name_their_units(
     code, out, err = _run(capsys, "validate", str(model), str(src))
     assert code == 0, err
     assert "before [deg/s]" in out and "after [deg/s]" in out
+
+
+def test_scale_factor_without_unit_is_stated(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Pulse counts with a scale factor K but no unit for K: the pulses-per-arcsec default
+    is stated in a warning; with the unit stated, nothing is said. 3 pulses per 1 s sample
+    at K = 1 pulse/arcsec is 3 arcsec/s = 3 °/h."""
+    n = 2000
+    df = pd.DataFrame({"time": np.arange(n, dtype=float), "pulses": np.full(n, 3.0)})
+    df.to_csv(tmp_path / "rlg.csv", index=False)
+    side = {"time_unit": "s", "signals": {"pulses": "counts"},
+            "metadata": {"scale_factor": 1.0}}  # fmt: skip
+    (tmp_path / "rlg.csv.meta.json").write_text(json.dumps(side))
+    code, out, err = _run(capsys, "metrics", str(tmp_path / "rlg.csv"), "--json")
+    assert code == 0, err
+    assert "counts/arcsec assumed" in err
+    assert json.loads(out)["bias"] == pytest.approx(3.0)
+    side["metadata"]["scale_factor_unit"] = "counts/arcsec"  # type: ignore[index]
+    (tmp_path / "rlg.csv.meta.json").write_text(json.dumps(side))
+    code, out, err = _run(capsys, "metrics", str(tmp_path / "rlg.csv"), "--json")
+    assert code == 0 and "assumed" not in err

@@ -123,7 +123,10 @@ def unit_factor(
             )
         tau = sample_interval_s if sample_interval_s is not None else meta.sample_interval_s
         phys_per_count, phys_unit = units.counts_to_physical(
-            1.0, meta.scale_factor, meta.scale_factor_unit or "counts/arcsec", float(tau or 1.0)
+            1.0,
+            meta.scale_factor,
+            units.scale_factor_unit_or_default(meta.scale_factor_unit, where),
+            float(tau or 1.0),
         )
         return float(phys_per_count) * unit_factor(phys_unit, mu, where=where)
     if units.signal_kind(du) != units.signal_kind(mu):

@@ -276,7 +276,7 @@ class Recording:
             return units.counts_to_physical(
                 values,
                 self.meta.scale_factor,
-                self.meta.scale_factor_unit or "counts/arcsec",
+                units.scale_factor_unit_or_default(self.meta.scale_factor_unit, self.name),
                 self.sample_interval_s,
             )
         return units.to_canonical(values, unit)

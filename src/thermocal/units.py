@@ -714,6 +714,28 @@ def parse_axis(axis: str | npt.ArrayLike) -> npt.NDArray[np.float64]:
 
 # --- raw counts ----------------------------------------------------------------------
 
+DEFAULT_SCALE_FACTOR_UNIT: Final = "counts/arcsec"
+"""Unit of a scale factor K given without one: pulses per arcsec, the seed's ring-laser
+gyro (SPEC §1), stated in a :class:`UnitWarning` wherever it is used."""
+
+
+def scale_factor_unit_or_default(unit: str | None, where: str = "") -> str:
+    """The scale factor's unit, or :data:`DEFAULT_SCALE_FACTOR_UNIT` stated in a
+    :class:`UnitWarning` (no silent default, issue 13)."""
+    if unit:
+        return unit
+    prefix = f"{where}: " if where else ""
+    warnings.warn(
+        UnitWarning(
+            f"{prefix}the scale factor K has no unit stated; {DEFAULT_SCALE_FACTOR_UNIT} "
+            "assumed (pulses per arcsec of a ring-laser gyro); state scale_factor_unit in "
+            "the metadata"
+        ),
+        stacklevel=2,
+    )
+    return DEFAULT_SCALE_FACTOR_UNIT
+
+
 SCALE_FACTOR_UNITS: Final[dict[str, tuple[bool, float, str]]] = {
     # unit of K: (integrating output?, factor to the canonical unit, canonical unit)
     "counts/deg": (True, SECONDS_PER_HOUR, "deg/h"),
