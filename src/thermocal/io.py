@@ -274,6 +274,26 @@ class _ParquetColumns:
         col: pa.ChunkedArray = self._pf.read(columns=[name], use_threads=True).column(0)
         return col
 
+    def column_f64(self, name: str) -> FloatArray | None:
+        """A numeric column as float64, read one row group at a time into the result, so
+        that the only memory beyond the result is one row group of one column (None for a
+        column that is not integer or floating point: the caller reads it whole)."""
+        field_type = self._pf.schema_arrow.field(name).type
+        if not (pa.types.is_integer(field_type) or pa.types.is_floating(field_type)):
+            return None
+        out = np.empty(self.num_rows, dtype=np.float64)
+        pos = 0
+        for i in range(self._pf.num_row_groups):
+            col = self._pf.read_row_group(i, columns=[name]).column(0)
+            for chunk in col.chunks:
+                k = len(chunk)
+                out[pos : pos + k] = chunk.to_numpy(zero_copy_only=False)  # nulls → NaN
+                pos += k
+            del col
+        if pos != self.num_rows:
+            raise pa.ArrowInvalid(f"column {name!r} has {pos} rows, the file {self.num_rows}")
+        return out
+
 
 def csv_encoding(path: str | Path, probe_bytes: int = 1 << 16) -> str:
     """The text encoding of a CSV file: ``utf-8-sig`` (UTF-8, with or without a byte-order
@@ -443,6 +463,9 @@ def numeric_column(
     p = Path(path)
     if isinstance(obj, _ParquetColumns):
         try:
+            direct = obj.column_f64(name)
+            if direct is not None:
+                return direct
             col = obj.column(name)
         except (pa.ArrowInvalid, OSError) as exc:
             raise FileFormatError(f"{p}: cannot read column {name!r} ({exc})") from None
