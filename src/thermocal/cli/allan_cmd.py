@@ -26,6 +26,7 @@ from thermocal.cli.common import (
     handle_errors,
     jsonable,
     load_recording,
+    split_names,
     stdout,
 )
 from thermocal.errors import ConditioningWarning, ThermocalInputError
@@ -75,6 +76,45 @@ def allan_json(res: AllanResult, noise: NoiseTerms) -> dict[str, Any]:
     return dict(jsonable(out))
 
 
+def _emit_channels(
+    file: Path,
+    analyses: dict[str, tuple[AllanResult, NoiseTerms]],
+    as_json: bool,
+    plot: Path | None,
+) -> None:
+    """Several channels: ``{"channels": {NAME: {…}}}`` or one noise-term table with a
+    column per channel (the ADEV points are in the JSON and the plots)."""
+
+    def human() -> None:
+        t = Table(title=f"{file} — noise terms (least-squares fit), per channel")
+        t.add_column("term")
+        for name in analyses:
+            t.add_column(name, justify="right")
+        first_noise = next(iter(analyses.values()))[1]
+        for key, term in first_noise.fit.terms().items():
+            cells = []
+            for _res, noise in analyses.values():
+                tt = noise.fit.terms()[key]
+                cells.append(f"{fmt(tt.value)} {tt.unit}" if tt.value is not None else "—")
+            t.add_row(term.label, *cells)
+        t.add_row(
+            "fit quality",
+            *[
+                f"{n.quality.quality} (χ²/ν {n.quality.reduced_chi2:.3g})" if n.quality else "—"
+                for _r, n in analyses.values()
+            ],
+        )
+        stdout.print(t)
+        if plot is not None:
+            stdout.print(f"plots written to {plot.stem}_<channel>{plot.suffix} in {plot.parent}")
+
+    emit(
+        {"channels": {name: allan_json(r, n) for name, (r, n) in analyses.items()}},
+        as_json,
+        human,
+    )
+
+
 @app.command("allan")
 @handle_errors
 def allan_cmd(
@@ -118,7 +158,6 @@ def allan_cmd(
             raise ThermocalInputError(f"{plot}: is a directory, expected a file name")
         if plot.suffix.lower() not in (".png", ".svg", ".pdf"):
             raise ThermocalInputError(f"{plot}: --plot writes PNG, SVG or PDF; name it *.png")
-    values, unit = rec.signal(signal)
     tau_spec: Any = taus
     if taus not in ("octave", "decade", "log"):
         try:
@@ -127,21 +166,32 @@ def allan_cmd(
             raise ThermocalInputError(
                 f"--taus {taus!r}: use octave, decade, log or a comma-separated list of τ [s]"
             ) from None
-    res = overlapping_adev(
-        values,
-        rec.sample_interval_s,
-        tau_spec,
-        time_s=rec.time_s,
-        unit=unit,
-        confidence=confidence,
-    )
-    noise = noise_terms(res)
-    if noise.quality is not None and noise.quality.quality == "poor":
-        warnings.warn(f"{file}: {noise.quality.reason}", ConditioningWarning, stacklevel=1)
-    if plot is not None:
-        from thermocal.plots_allan import plot_allan
+    names = split_names(signal) or [rec.signals[0]]
+    analyses: dict[str, tuple[AllanResult, NoiseTerms]] = {}
+    for name in names:  # one read of the file, every channel (INTERFACE: several channels)
+        values, unit = rec.signal(name)
+        res_c = overlapping_adev(
+            values,
+            rec.sample_interval_s,
+            tau_spec,
+            time_s=rec.time_s,
+            unit=unit,
+            confidence=confidence,
+        )
+        noise_c = noise_terms(res_c)
+        if noise_c.quality is not None and noise_c.quality.quality == "poor":
+            where = f"{file}" + (f" [{name}]" if len(names) > 1 else "")
+            warnings.warn(f"{where}: {noise_c.quality.reason}", ConditioningWarning, stacklevel=1)
+        if plot is not None:
+            from thermocal.plots_allan import plot_allan
 
-        plot_allan(res, noise, plot, title=f"{file.name} — {signal or rec.signals[0]}")
+            target = plot if len(names) == 1 else plot.with_name(f"{plot.stem}_{name}{plot.suffix}")
+            plot_allan(res_c, noise_c, target, title=f"{file.name} — {name}")
+        analyses[name] = (res_c, noise_c)
+    if len(names) > 1:
+        _emit_channels(file, analyses, as_json, plot)
+        return
+    res, noise = analyses[names[0]]
 
     def human() -> None:
         t1 = Table(title=f"{file} — overlapping Allan deviation [{res.unit}]")

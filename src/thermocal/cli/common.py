@@ -187,7 +187,7 @@ def load_recording(
         path,
         time=time,
         time_unit=time_unit,
-        signals=[signal] if signal else None,
+        signals=split_names(signal) if signal else None,  # "gx,gy,gz": several channels
         temperatures=split_names(temps),
         signal_unit=signal_unit,
         temp_unit=temp_unit,

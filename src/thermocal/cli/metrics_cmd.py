@@ -3,6 +3,7 @@ repeatability and temperature sensitivity of one signal (SPEC §1)."""
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from typing import Annotated, Any
 
 import typer
@@ -29,6 +30,7 @@ from thermocal.cli.common import (
     split_names,
     stdout,
 )
+from thermocal.errors import ThermocalInputError
 from thermocal.metrics import MetricsResult, compute_metrics
 
 
@@ -98,39 +100,87 @@ def metrics_cmd(
         temp_conversion=temp_conversion,
         keep_other=False,  # metrics use the signal and the temperatures only
     )
-    res = compute_metrics(
-        rec,
-        signal,
-        average,
-        latitude,
-        axis,
-        split_names(temps),
-        rate_threshold_c_per_min=hold_rate,
-        min_hold_s=min_hold,
-    )
+    names = split_names(signal) or [rec.signals[0]]
+    if len(names) > 1 and (latitude is not None or axis is not None):
+        raise ThermocalInputError(
+            "earth-rate removal (--latitude/--axis) takes one signal at a time: each channel's "
+            "sensitive axis points elsewhere; run metrics per gyro axis with its --axis"
+        )
+    # one read of the file, the figures of every channel (INTERFACE: several channels)
+    results = {
+        name: compute_metrics(
+            rec,
+            name,
+            average,
+            latitude,
+            axis,
+            split_names(temps),
+            rate_threshold_c_per_min=hold_rate,
+            min_hold_s=min_hold,
+        )
+        for name in names
+    }
 
     def human() -> None:
-        u = res.unit
-        table = Table(title=f"{file} — {res.signal}")
+        many = len(results) > 1
+        table = Table(title=f"{file} — {', '.join(results)}")
         table.add_column("figure")
-        table.add_column("value", justify="right")
-        table.add_column("unit")
-        table.add_row("bias", fmt(res.bias, 6), u)
-        if res.earth_rate_removed:
-            table.add_row("  earth rate removed", fmt(res.earth_rate_removed, 6), u)
-        table.add_row(f"bias stability ({res.averaging_s:g} s)", fmt(res.bias_stability), u)
-        table.add_row(f"peak-to-peak ({res.averaging_s:g} s)", fmt(res.peak_to_peak), u)
-        if res.drift_angle is not None:
-            table.add_row("drift angle (end)", fmt(res.drift_angle), res.drift_angle_unit or "")
-        if res.bias_repeatability is not None:
-            table.add_row(
-                f"bias repeatability ({len(res.stages)} stages)", fmt(res.bias_repeatability), u
-            )
-        ts = res.temperature_sensitivity
-        if ts is not None:
-            table.add_row("temp. sensitivity, mean |ΔB/ΔT|", fmt(ts.mean_abs_adjacent), ts.unit)
-            table.add_row("temp. sensitivity, LS slope", fmt(ts.ls_slope), ts.unit)
-        table.add_row("samples", str(res.n_samples), "")
+        for name in results:
+            table.add_column(name if many else "value", justify="right")
+        if not many:
+            table.add_column("unit")
+        first = next(iter(results.values()))
+        if many:  # each channel in its own unit: a row of units, no unit column
+            table.add_row("unit", *[r.unit for r in results.values()])
+
+        def row(label: str, get: Callable[[MetricsResult], float | None], digits: int = 4,
+                unit: Callable[[MetricsResult], str] = lambda r: r.unit) -> None:  # fmt: skip
+            values = [get(r) for r in results.values()]
+            if all(v is None for v in values):
+                return
+            cells = [fmt(v, digits) for v in values]
+            if many:
+                rate_unit = {unit(r) for r in results.values()} - {r.unit for r in results.values()}
+                rate_unit.discard("")
+                table.add_row(
+                    label + (f" [{', '.join(sorted(rate_unit))}]" if rate_unit else ""), *cells
+                )
+            else:
+                table.add_row(label, *cells, unit(first))
+
+        row("bias", lambda r: r.bias, 6)
+        row("  earth rate removed", lambda r: r.earth_rate_removed or None, 6)
+        row(f"bias stability ({first.averaging_s:g} s)", lambda r: r.bias_stability)
+        row(f"peak-to-peak ({first.averaging_s:g} s)", lambda r: r.peak_to_peak)
+        row("drift angle (end)", lambda r: r.drift_angle, unit=lambda r: r.drift_angle_unit or "")
+        row(
+            f"bias repeatability ({len(first.stages)} stages)",
+            lambda r: r.bias_repeatability,
+        )
+        tsu = lambda r: r.temperature_sensitivity.unit if r.temperature_sensitivity else ""  # noqa: E731
+        row(
+            "temp. sensitivity, mean |ΔB/ΔT|",
+            lambda r: (
+                r.temperature_sensitivity.mean_abs_adjacent if r.temperature_sensitivity else None
+            ),
+            unit=tsu,
+        )
+        row(
+            "temp. sensitivity, LS slope",
+            lambda r: r.temperature_sensitivity.ls_slope if r.temperature_sensitivity else None,
+            unit=tsu,
+        )
+        table.add_row(
+            "samples", *[str(r.n_samples) for r in results.values()], *([] if many else [""])
+        )
         stdout.print(table)
 
-    emit(metrics_json(res), as_json, human)
+    if len(results) == 1:
+        emit(metrics_json(first_result(results)), as_json, human)
+    else:
+        emit({"channels": {n: metrics_json(r) for n, r in results.items()}}, as_json, human)
+
+
+def first_result(results: dict[str, MetricsResult]) -> MetricsResult:
+    """The only result of a one-channel run."""
+    return next(iter(results.values()))
