@@ -97,3 +97,73 @@ def test_allan_plots_one_file_per_channel(
     assert code == 0, capsys.readouterr().err
     assert (tmp_path / "adev_gx.png").stat().st_size > 1000
     assert (tmp_path / "adev_az.png").stat().st_size > 1000
+
+
+def test_fit_several_channels_writes_a_calibration_equal_to_single_fits(
+    imu: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    from thermocal.models.base import load_model
+    from thermocal.models.calibration import load_calibration
+
+    cal_path = tmp_path / "cal.json"
+    res = _json(
+        capsys, "fit", str(imu), "--model", "poly", "--order", "2", "--signal",
+        ",".join(CHANNELS), "--signal-unit", ",".join(UNITS), *COMMON, "-o", str(cal_path),
+    )  # fmt: skip
+    assert list(res["channels"]) == list(CHANNELS)
+    cal = load_calibration(cal_path)
+    assert cal.names == list(CHANNELS)
+    assert [c.unit for c in cal.channels] == list(UNITS)
+    assert cal.channel("gx").role == {"kind": "gyro", "axis": "x"}
+    assert cal.channel("az").role == {"kind": "accel", "axis": "z"}
+    for name, unit in zip(CHANNELS, UNITS, strict=True):
+        one = tmp_path / f"{name}.json"
+        _json(
+            capsys, "fit", str(imu), "--model", "poly", "--order", "2", "--signal", name,
+            "--signal-unit", unit, *COMMON, "-o", str(one),
+        )  # fmt: skip
+        single = load_model(one)
+        multi = cal.channel(name).model
+        assert [c.value for c in multi.coefficients()] == [c.value for c in single.coefficients()]
+        assert [c.stderr for c in multi.coefficients()] == [c.stderr for c in single.coefficients()]
+    # the slopes written into the data, in the data's units: 0.1·(i+1) per °C
+    gz = {c.name: c.value for c in cal.channel("gz").model.coefficients()}
+    assert gz["T1"] == pytest.approx(0.3 * 3600, rel=1e-3)  # the model is in °/h
+
+
+def test_a_single_model_file_loads_as_a_one_channel_calibration(
+    imu: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    from thermocal.models.calibration import load_calibration
+
+    one = tmp_path / "gx.json"
+    _json(
+        capsys, "fit", str(imu), "--model", "poly", "--order", "1", "--signal", "gx",
+        "--signal-unit", "deg/s", *COMMON, "-o", str(one),
+    )  # fmt: skip
+    cal = load_calibration(one)
+    assert cal.names == ["gx"] and cal.channels[0].unit == "deg/s"
+
+
+def test_corrupt_calibration_is_refused_naming_the_channel(
+    imu: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    from thermocal.errors import ModelFileError
+    from thermocal.models.base import checksum
+    from thermocal.models.calibration import load_calibration
+
+    cal_path = tmp_path / "cal.json"
+    _json(
+        capsys, "fit", str(imu), "--model", "poly", "--order", "1", "--signal", "gx,gy",
+        "--signal-unit", "deg/s", *COMMON, "-o", str(cal_path),
+    )  # fmt: skip
+    d = json.loads(cal_path.read_text())
+    d["channels"][1]["model"]["coefficients"][0]["value"] = 1.0  # edited by hand
+    d["checksum"] = checksum(d)  # ...and the outer checksum recomputed
+    cal_path.write_text(json.dumps(d))
+    with pytest.raises(ModelFileError, match=r"channels\[1\]\.model: checksum mismatch"):
+        load_calibration(cal_path)
+    d["checksum"] = "0" * 64
+    cal_path.write_text(json.dumps(d))
+    with pytest.raises(ModelFileError, match="calibration file was corrupted"):
+        load_calibration(cal_path)

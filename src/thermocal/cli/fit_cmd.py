@@ -51,6 +51,7 @@ from __future__ import annotations
 import dataclasses
 import inspect
 import warnings
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Annotated, Any
 
@@ -91,6 +92,7 @@ from thermocal.models.base import (
     model_inputs,
     save_model,
 )
+from thermocal.models.calibration import Calibration, Channel, guess_role, save_calibration
 from thermocal.recording import Recording
 
 TARGETS = ("bias", "scale_factor")
@@ -245,8 +247,71 @@ def fit_cmd(
     }
     if select_method not in ("bic", "holdout"):
         raise ThermocalInputError(f"--select-method must be bic or holdout, got {select_method!r}")
-    est = build_model(model, options)
+    build_model(model, options)  # refuse options that do not apply before reading
+    names = split_names(signal) or []
+    # every file read once, with every channel's column (several channels: issue 15)
+    loaded = [
+        (
+            path,
+            load_recording(
+                path,
+                time=time,
+                time_unit=time_unit,
+                signal=signal,
+                temps=temps,
+                signal_unit=signal_unit,
+                temp_unit=temp_unit,
+                temp_conversion=temp_conversion,
+            ),
+        )
+        for path in files
+    ]
+    spec = _FitSpec(model, options, temps, latitude, axis, known_input, target)
+    if len(names) <= 1:
+        est, result, n_runs = _fit_channel(spec, loaded, signal)
+        save_model(est, output)
+        result["output"] = str(output)
+        emit(result, as_json, lambda: _human_single(est, result, n_runs, output))
+        return
+    fitted = [(name, *_fit_channel(spec, loaded, name)) for name in names]
+    cal = Calibration(
+        [
+            Channel(name, name, str(res["unit_as_given"]), est, guess_role(name, res["unit"]))
+            for name, est, res, _n in fitted
+        ]
+    )
+    save_calibration(cal, output)
+    out = {
+        "output": str(output),
+        "format": "thermocal-calibration",
+        "channels": {name: {**res, "output": str(output)} for name, _e, res, _n in fitted},
+    }
+    emit(out, as_json, lambda: _human_channels(fitted, output))
 
+
+@dataclass(frozen=True)
+class _FitSpec:
+    """What every channel's fit shares: the family and its options, the temperature
+    columns, the known input (earth rate or given) and the target."""
+
+    family: str
+    options: dict[str, Any]
+    temps: str | None
+    latitude: float | None
+    axis: str | None
+    known_input: float | None
+    target: str
+
+
+def _fit_channel(
+    spec: _FitSpec, loaded: list[tuple[Path, Recording]], signal: str | None
+) -> tuple[TemperatureModel, dict[str, Any], int]:
+    """Fit one channel on the loaded runs; returns the model, its ``--json`` result and
+    the number of runs. Warnings are printed (by handle_errors) and listed in the result."""
+    est = build_model(spec.family, spec.options)
+    temps, latitude, axis, known_input, target = (
+        spec.temps, spec.latitude, spec.axis, spec.known_input, spec.target,
+    )  # fmt: skip
     runs: list[RunData] = []
     first_inputs: dict[str, Any] = {}
     provenance: list[dict[str, Any]] = []
@@ -254,17 +319,7 @@ def fit_cmd(
     unit = ""
     sig_name = signal or "signal"
     temp_names: tuple[str, ...] | None = None
-    for path in files:
-        rec = load_recording(
-            path,
-            time=time,
-            time_unit=time_unit,
-            signal=signal,
-            temps=temps,
-            signal_unit=signal_unit,
-            temp_unit=temp_unit,
-            temp_conversion=temp_conversion,
-        )
+    for path, rec in loaded:
         _values, run_unit = rec.signal(signal)
         sig_name = signal or rec.signals[0]
         if unit and run_unit != unit:
@@ -337,11 +392,9 @@ def fit_cmd(
     est.target = target
     est.inputs_ = first_inputs
     est.data_ = provenance
-    save_model(est, output)
 
     st = est.stats_
     kappa = st.condition_number
-    corr: dict[str, Any] | None = st.extra.get("residual_correlation")
     trange = {
         n: [float(a), float(b)] for n, (a, b) in zip(est.temp_names_, est.temp_range_, strict=True)
     }
@@ -356,7 +409,6 @@ def fit_cmd(
     kept = st.extra.get("selected_terms")
     result: dict[str, Any] = {
         "model": est.family,
-        "output": str(output),
         "n_coefficients": st.n_coefficients,
         "rms_residual": st.rms_residual,
         "condition_number": st.condition_number,
@@ -374,47 +426,73 @@ def fit_cmd(
         "fit": st.to_dict(),
         "coefficients": [c.to_dict() for c in est.coefficients()],
         "warnings": messages,
+        "unit_as_given": (first_inputs.get("units") or {}).get(sig_name, unit),
     }
+    return est, result, len(runs)
 
-    def human() -> None:
-        tab = Table(title=f"{est.family} model → {output}")
-        tab.add_column("quantity")
-        tab.add_column("value")
-        tab.add_row("runs / samples", f"{len(runs)} / {st.n_samples}")
-        tab.add_row("coefficients", str(st.n_coefficients))
-        tab.add_row(f"rms residual [{unit}]", fmt(st.rms_residual))
-        tab.add_row("condition number", f"{fmt(st.condition_number)} ({condition_wording(kappa)})")
-        if corr:
-            tab.add_row(
-                "effective samples",
-                f"{fmt(corr['n_effective'])} (residual correlation time "
-                f"{fmt(corr['tau_samples'])} samples; std. errors × {corr['stderr_factor']:.3g})",
-            )
-        for n, (a, b) in trange.items():
-            tu = "°C" if est.temperature_unit == "degC" else est.temperature_unit
-            tab.add_row(f"range {n} [{tu}]", f"{a:.2f} … {b:.2f}")
-        if kept is not None:
-            tab.add_row("terms kept", ", ".join(kept))
-        stdout.print(tab)
-        ctab = Table(title="coefficients")
-        ctab.add_column("name")
-        ctab.add_column("value")
-        ctab.add_column("std. error")
-        ctab.add_column("|value|/s.e.")
-        weak = 0
-        ctab.add_column("unit")
-        for c in est.coefficients():
-            ratio = abs(c.value) / c.stderr if c.stderr else None
-            flag = "" if ratio is None or ratio >= 2.0 else " *"
-            weak += bool(flag)
-            ctab.add_row(
-                c.name, fmt(c.value, 6), fmt(c.stderr, 3), f"{fmt(ratio, 2)}{flag}", c.unit
-            )
-        stdout.print(ctab)
-        if weak:
-            stdout.print(
-                f"* {weak} coefficient(s) within 2 standard errors of 0: not distinct from "
-                "zero on these data (consider --select bic or fewer terms)"
-            )
 
-    emit(result, as_json, human)
+def _human_single(est: TemperatureModel, result: dict[str, Any], n_runs: int, output: Path) -> None:
+    """The fit summary and coefficient tables of one model."""
+    st = est.stats_
+    unit = result["unit"]
+    kappa = st.condition_number
+    corr: dict[str, Any] | None = st.extra.get("residual_correlation")
+    trange = result["temperature_range"]
+    kept = result["terms_kept"]
+    tab = Table(title=f"{est.family} model → {output}")
+    tab.add_column("quantity")
+    tab.add_column("value")
+    tab.add_row("runs / samples", f"{n_runs} / {st.n_samples}")
+    tab.add_row("coefficients", str(st.n_coefficients))
+    tab.add_row(f"rms residual [{unit}]", fmt(st.rms_residual))
+    tab.add_row("condition number", f"{fmt(st.condition_number)} ({condition_wording(kappa)})")
+    if corr:
+        tab.add_row(
+            "effective samples",
+            f"{fmt(corr['n_effective'])} (residual correlation time "
+            f"{fmt(corr['tau_samples'])} samples; std. errors × {corr['stderr_factor']:.3g})",
+        )
+    for n, (a, b) in trange.items():
+        tu = "°C" if est.temperature_unit == "degC" else est.temperature_unit
+        tab.add_row(f"range {n} [{tu}]", f"{a:.2f} … {b:.2f}")
+    if kept is not None:
+        tab.add_row("terms kept", ", ".join(kept))
+    stdout.print(tab)
+    ctab = Table(title="coefficients")
+    ctab.add_column("name")
+    ctab.add_column("value")
+    ctab.add_column("std. error")
+    ctab.add_column("|value|/s.e.")
+    weak = 0
+    ctab.add_column("unit")
+    for c in est.coefficients():
+        ratio = abs(c.value) / c.stderr if c.stderr else None
+        flag = "" if ratio is None or ratio >= 2.0 else " *"
+        weak += bool(flag)
+        ctab.add_row(c.name, fmt(c.value, 6), fmt(c.stderr, 3), f"{fmt(ratio, 2)}{flag}", c.unit)
+    stdout.print(ctab)
+    if weak:
+        stdout.print(
+            f"* {weak} coefficient(s) within 2 standard errors of 0: not distinct from "
+            "zero on these data (consider --select bic or fewer terms)"
+        )
+
+
+def _human_channels(
+    fitted: list[tuple[str, TemperatureModel, dict[str, Any], int]], output: Path
+) -> None:
+    """One row per channel: model, samples, residual, condition, range."""
+    tab = Table(title=f"calibration of {len(fitted)} channels → {output}")
+    for col in ("channel", "model", "coefficients", "rms residual", "condition", "range [°C]"):
+        tab.add_column(col)
+    for name, est, res, _n in fitted:
+        rng = "; ".join(f"{k} {a:.1f}…{b:.1f}" for k, (a, b) in res["temperature_range"].items())
+        tab.add_row(
+            name,
+            est.family,
+            str(res["n_coefficients"]),
+            f"{fmt(res['rms_residual'])} {res['unit']}",
+            f"{fmt(res['condition_number'])} ({res['condition']})",
+            rng,
+        )
+    stdout.print(tab)

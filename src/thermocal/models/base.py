@@ -863,6 +863,14 @@ def save_model(model: TemperatureModel, path: str | Path) -> dict[str, Any]:
     statistic) is refused with :class:`DesignError` naming the field: JSON cannot hold it
     and firmware must never load it.
     """
+    d = model_file_dict(model)
+    write_json(path, d)
+    return d
+
+
+def model_file_dict(model: TemperatureModel) -> dict[str, Any]:
+    """The model file's dict (:meth:`TemperatureModel.to_dict` with its checksum); a
+    non-finite number anywhere is refused with :class:`DesignError` naming the field."""
     d = model.to_dict()
     bad = _nonfinite_fields(d)
     if bad:
@@ -871,8 +879,31 @@ def save_model(model: TemperatureModel, path: str | Path) -> dict[str, Any]:
             "not determine it (too few samples or a degenerate design); nothing written"
         )
     d["checksum"] = checksum(d)
-    write_json(path, d)
     return d
+
+
+def verify_model_dict(d: Any, where: str) -> dict[str, Any]:
+    """Check a parsed model dict: header (format, version, sections), checksum and the
+    family's schema; errors name ``where``."""
+    try:
+        check_model_header(d)
+    except ModelFileError as exc:
+        raise ModelFileError(f"{where}: {exc}") from None
+    stored = d.get("checksum")
+    if stored is None:
+        raise ModelFileError(f"{where}: model file has no checksum")
+    if stored != checksum(d):
+        raise ModelFileError(
+            f"{where}: checksum mismatch: the model file was corrupted or edited by hand"
+        )
+    from thermocal.models.schema import check_model_dict
+
+    try:
+        check_model_dict(d)
+    except ModelFileError as exc:
+        raise ModelFileError(f"{where}: {exc}") from None
+    out: dict[str, Any] = d
+    return out
 
 
 def load_model_dict(path: str | Path) -> dict[str, Any]:
@@ -888,25 +919,7 @@ def load_model_dict(path: str | Path) -> dict[str, Any]:
         d = json.loads(text)
     except json.JSONDecodeError as exc:
         raise ModelFileError(f"{p}: corrupted model file (invalid JSON: {exc.msg})") from None
-    try:
-        check_model_header(d)
-    except ModelFileError as exc:
-        raise ModelFileError(f"{p}: {exc}") from None
-    stored = d.get("checksum")
-    if stored is None:
-        raise ModelFileError(f"{p}: model file has no checksum")
-    if not isinstance(d, dict) or stored != checksum(d):
-        raise ModelFileError(
-            f"{p}: checksum mismatch: the model file was corrupted or edited by hand"
-        )
-    from thermocal.models.schema import check_model_dict
-
-    try:
-        check_model_dict(d)
-    except ModelFileError as exc:
-        raise ModelFileError(f"{p}: {exc}") from None
-    out: dict[str, Any] = d
-    return out
+    return verify_model_dict(d, str(p))
 
 
 def load_model(path: str | Path) -> TemperatureModel:

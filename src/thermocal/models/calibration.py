@@ -1,0 +1,224 @@
+"""A calibration: several named channels, each with its own fitted model (issue 15).
+
+A real IMU has three gyros and three accelerometers; a calibration keeps one model per
+channel (any family), with the channel's signal column, its unit as given and an optional
+role, in one versioned file::
+
+    {
+      "format": "thermocal-calibration", "format_version": 1,
+      "created_utc": "...", "thermocal_version": "...",
+      "channels": [
+        {"name": "gx", "signal": "gx", "unit": "deg/s",
+         "role": {"kind": "gyro", "axis": "x"} | null,
+         "model": { …a complete model file, with its own checksum… }},
+        …
+      ],
+      "checksum": "<sha256 of the canonical JSON without this key>"
+    }
+
+Every channel's model is verified as a model file is (header, checksum, schema); the
+calibration's checksum covers the channel list. A single-model file loads as a
+calibration of one channel (:func:`load_calibration`), so every command that takes a
+calibration also takes the model files written before.
+"""
+
+from __future__ import annotations
+
+import datetime as _dt
+import json
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from thermocal.errors import ModelFileError, ThermocalInputError
+from thermocal.io import write_json
+from thermocal.models.base import (
+    MODEL_FORMAT,
+    TemperatureModel,
+    checksum,
+    model_file_dict,
+    verify_model_dict,
+)
+
+CALIBRATION_FORMAT = "thermocal-calibration"
+CALIBRATION_FORMAT_VERSION = 1
+
+ROLE_KINDS = ("gyro", "accel")
+"""Roles a channel may declare."""
+
+
+def guess_role(name: str, unit: str) -> dict[str, Any] | None:
+    """A channel's role from its unit kind and a trailing axis letter of its name
+    (``gx`` → gyro x, ``acc_z`` → accel z); None when the unit is raw counts."""
+    from thermocal import units
+    from thermocal.errors import UnitError
+
+    try:
+        kind = units.signal_kind(unit)
+    except UnitError:  # an unknown unit: no role
+        return None
+    if kind == "raw":
+        return None
+    role: dict[str, Any] = {"kind": "gyro" if kind == "rate" else "accel"}
+    last = name.strip().lower()[-1:]
+    if last in ("x", "y", "z"):
+        role["axis"] = last
+    return role
+
+
+@dataclass
+class Channel:
+    """One channel: ``name`` (unique in the calibration), the ``signal`` column it reads,
+    the ``unit`` of that column as given, an optional ``role`` and its fitted ``model``."""
+
+    name: str
+    signal: str
+    unit: str
+    model: TemperatureModel
+    role: dict[str, Any] | None = None
+
+
+@dataclass
+class Calibration:
+    """Several channels, each with its model (module docstring)."""
+
+    channels: list[Channel] = field(default_factory=list)
+
+    def __post_init__(self) -> None:
+        names = [c.name for c in self.channels]
+        if len(set(names)) != len(names):
+            raise ThermocalInputError(f"calibration: channel names must be unique, got {names}")
+
+    @property
+    def names(self) -> list[str]:
+        return [c.name for c in self.channels]
+
+    def channel(self, name: str) -> Channel:
+        for c in self.channels:
+            if c.name == name:
+                return c
+        raise ThermocalInputError(f"calibration: no channel {name!r}; it has {self.names}")
+
+    def to_dict(self) -> dict[str, Any]:
+        """The file's dict, with every model's own checksum and the calibration's."""
+        from thermocal import __version__
+
+        d: dict[str, Any] = {
+            "format": CALIBRATION_FORMAT,
+            "format_version": CALIBRATION_FORMAT_VERSION,
+            "created_utc": _dt.datetime.now(_dt.UTC).isoformat(timespec="seconds"),
+            "thermocal_version": __version__,
+            "channels": [
+                {
+                    "name": c.name,
+                    "signal": c.signal,
+                    "unit": c.unit,
+                    "role": c.role,
+                    "model": model_file_dict(c.model),
+                }
+                for c in self.channels
+            ],
+        }
+        d["checksum"] = checksum(d)
+        return d
+
+
+def save_calibration(cal: Calibration, path: str | Path) -> dict[str, Any]:
+    """Write a calibration file (atomically); returns its dict."""
+    if not cal.channels:
+        raise ThermocalInputError("calibration: no channels to write")
+    d = cal.to_dict()
+    write_json(path, d)
+    return d
+
+
+def is_calibration(d: Any) -> bool:
+    return isinstance(d, dict) and d.get("format") == CALIBRATION_FORMAT
+
+
+def calibration_from_dict(d: dict[str, Any], where: str) -> Calibration:
+    """Verify (format, version, checksums, each model's schema) and build."""
+    ver = d.get("format_version")
+    if not isinstance(ver, int):
+        raise ModelFileError(f"{where}: calibration file has no integer format_version")
+    if ver > CALIBRATION_FORMAT_VERSION:
+        raise ModelFileError(
+            f"{where}: calibration format version {ver} is newer than this thermocal supports "
+            f"({CALIBRATION_FORMAT_VERSION}); upgrade thermocal"
+        )
+    if d.get("checksum") != checksum(d):
+        raise ModelFileError(
+            f"{where}: checksum mismatch: the calibration file was corrupted or edited by hand"
+        )
+    raw = d.get("channels")
+    if not isinstance(raw, list) or not raw:
+        raise ModelFileError(f"{where}.channels: expected a non-empty list of channels")
+    channels = []
+    for i, ch in enumerate(raw):
+        at = f"{where}: channels[{i}]"
+        if not isinstance(ch, dict):
+            raise ModelFileError(f"{at}: expected an object")
+        for key in ("name", "signal", "unit", "model"):
+            if key not in ch:
+                raise ModelFileError(f"{at}: the field {key!r} is missing")
+        if not all(isinstance(ch[k], str) and ch[k] for k in ("name", "signal", "unit")):
+            raise ModelFileError(f"{at}: name, signal and unit must be non-empty strings")
+        role = ch.get("role")
+        if role is not None and (not isinstance(role, dict) or role.get("kind") not in ROLE_KINDS):
+            raise ModelFileError(f"{at}.role: expected null or {{'kind': gyro|accel, ...}}")
+        md = verify_model_dict(ch["model"], f"{at}.model")
+        try:
+            model = TemperatureModel.from_dict(md)
+        except (KeyError, TypeError, ValueError) as exc:
+            raise ModelFileError(f"{at}.model: malformed ({type(exc).__name__}: {exc})") from None
+        channels.append(Channel(ch["name"], ch["signal"], ch["unit"], model, role))
+    try:
+        return Calibration(channels)
+    except ThermocalInputError as exc:
+        raise ModelFileError(f"{where}: {exc}") from None
+
+
+def load_calibration(path: str | Path) -> Calibration:
+    """A calibration file, or a single-model file as a calibration of one channel (named
+    after the model's signal, in the unit its inputs record)."""
+    p = Path(path)
+    try:
+        d = json.loads(p.read_text(encoding="utf-8"))
+    except FileNotFoundError:
+        raise ModelFileError(f"{p}: no such model or calibration file") from None
+    except (UnicodeDecodeError, json.JSONDecodeError) as exc:
+        raise ModelFileError(f"{p}: not a JSON model or calibration file ({exc})") from None
+    if is_calibration(d):
+        return calibration_from_dict(d, str(p))
+    if isinstance(d, dict) and d.get("format") == MODEL_FORMAT:
+        from thermocal.models.base import load_model
+
+        model = load_model(p)
+        sig = model.signal_name or "signal"
+        unit = str((model.inputs_ or {}).get("units", {}).get(sig) or model.signal_unit)
+        return Calibration([Channel(sig, sig, unit, model, guess_role(sig, unit))])
+    raise ModelFileError(
+        f"{p}: neither a thermocal model nor a calibration file (missing 'format')"
+    )
+
+
+def channels_of(signals: Sequence[str], names: Sequence[str] | None = None) -> list[str]:
+    """Channel names for signal columns (the column names unless ``names`` are given)."""
+    out = list(names) if names else list(signals)
+    if len(out) != len(signals):
+        raise ThermocalInputError(f"{len(out)} channel names for {len(signals)} signals")
+    return out
+
+
+__all__ = [
+    "CALIBRATION_FORMAT",
+    "CALIBRATION_FORMAT_VERSION",
+    "Calibration",
+    "Channel",
+    "calibration_from_dict",
+    "guess_role",
+    "is_calibration",
+    "load_calibration",
+    "save_calibration",
+]
