@@ -167,3 +167,60 @@ def test_corrupt_calibration_is_refused_naming_the_channel(
     cal_path.write_text(json.dumps(d))
     with pytest.raises(ModelFileError, match="calibration file was corrupted"):
         load_calibration(cal_path)
+
+
+def test_compensate_a_calibration_in_one_pass_equals_single_channels(
+    imu: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    cal_path = tmp_path / "cal.json"
+    _json(
+        capsys, "fit", str(imu), "--model", "poly", "--order", "2", "--signal",
+        ",".join(CHANNELS), "--signal-unit", ",".join(UNITS), *COMMON, "-o", str(cal_path),
+    )  # fmt: skip
+    out = tmp_path / "all.parquet"
+    res = _json(capsys, "compensate", str(cal_path), str(imu), "-o", str(out),
+                "--chunk-rows", "3000")  # fmt: skip
+    assert list(res["channels"]) == list(CHANNELS)
+    got = pd.read_parquet(out)
+    raw = pd.read_csv(imu)
+    for name, unit in zip(CHANNELS, UNITS, strict=True):
+        # <sig>_comp = raw − model, in the data column's unit
+        np.testing.assert_allclose(
+            got[f"{name}_comp"], raw[name] - got[f"{name}_model"], rtol=0, atol=1e-12
+        )
+        assert res["channels"][name]["unit"] == unit
+        # the temperature-induced part (0.1 (i+1) per °C, quadratic model) is removed to
+        # the noise: 0.01 °/s for gyros, 0.1 mg for accelerometers
+        noise = 0.01 if name.startswith("g") else 0.1
+        assert float(got[f"{name}_comp"].std()) == pytest.approx(noise, rel=0.05)
+        # equal to a one-channel compensation with the single-channel model
+        one_model = tmp_path / f"{name}.json"
+        _json(
+            capsys, "fit", str(imu), "--model", "poly", "--order", "2", "--signal", name,
+            "--signal-unit", unit, *COMMON, "-o", str(one_model),
+        )  # fmt: skip
+        one_out = tmp_path / f"{name}.parquet"
+        _json(capsys, "compensate", str(one_model), str(imu), "-o", str(one_out),
+              "--chunk-rows", "3000")  # fmt: skip
+        single = pd.read_parquet(one_out)
+        np.testing.assert_array_equal(got[f"{name}_comp"], single[f"{name}_comp"])
+
+
+def test_compensate_a_subset_of_channels(
+    imu: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    cal_path = tmp_path / "cal.json"
+    _json(
+        capsys, "fit", str(imu), "--model", "poly", "--order", "1", "--signal", "gx,gy,az",
+        "--signal-unit", "deg/s,deg/s,mg", *COMMON, "-o", str(cal_path),
+    )  # fmt: skip
+    out = tmp_path / "sub.csv"
+    res = _json(capsys, "compensate", str(cal_path), str(imu), "-o", str(out),
+                "--signal", "gy,az")  # fmt: skip
+    assert list(res["channels"]) == ["gy", "az"]
+    cols = pd.read_csv(out).columns
+    assert "gy_comp" in cols and "az_comp" in cols and "gx_comp" not in cols
+    code = main(["compensate", str(cal_path), str(imu), "-o", str(tmp_path / "x.csv"),
+                 "--signal", "gq"])  # fmt: skip
+    assert code == 2
+    assert "no channel 'gq'" in capsys.readouterr().err

@@ -896,6 +896,7 @@ def compensate_file(
     [model unit] is what :class:`StreamingCompensator` says.  ``temperature_conversion``
     ``(gain, offset[, "int16"])`` converts raw-count temperatures
     (``T = gain·counts + offset``), overriding the file's metadata.
+    One channel of :func:`compensate_channels`.
 
     Raises
     ------
@@ -905,6 +906,66 @@ def compensate_file(
         raw counts without a conversion for a °C model, or in °C for a counts model.
     TimestampError, MissingValueError : time not increasing, NaN in a used column.
     """
+    sig = signal or model.signal_name
+    return compensate_channels(
+        [(sig, model)],
+        path,
+        out,
+        time=time,
+        time_unit=time_unit,
+        signal_unit=signal_unit,
+        temp_unit=temp_unit,
+        chunk_rows=chunk_rows,
+        extrapolate=extrapolate,
+        known_input=known_input,
+        on_progress=on_progress,
+        temperature_conversion=temperature_conversion,
+        signal_given=signal is not None,
+    )[0]
+
+
+@dataclass
+class _ChannelPlan:
+    """What one channel of :func:`compensate_channels` needs per chunk."""
+
+    model: TemperatureModel
+    signal: str
+    model_col: str
+    comp_col: str
+    data_unit: str
+    temp_names: list[str]
+    convs: dict[str, units.TemperatureConversion | None]
+    temp_units: dict[str, str]
+    md: Metadata
+    predictor: ChunkPredictor
+    factor: float | None = None
+    before: _RunningMoments = field(default_factory=lambda: _RunningMoments())
+    after: _RunningMoments = field(default_factory=lambda: _RunningMoments())
+
+
+def compensate_channels(
+    channels: Sequence[tuple[str, TemperatureModel]],
+    path: str | Path,
+    out: str | Path,
+    *,
+    time: str | None = None,
+    time_unit: str | None = None,
+    signal_unit: str | None = None,
+    temp_unit: str | None = None,
+    chunk_rows: int = DEFAULT_CHUNK_ROWS,
+    extrapolate: bool = False,
+    known_input: float = 0.0,
+    on_progress: Callable[[int], None] | None = None,
+    temperature_conversion: units.TemperatureConversion | tuple[float, float] | None = None,
+    signal_given: bool = True,
+) -> list[CompensateFileResult]:
+    """Compensate several channels ``(signal column, model)`` of one file in one chunked
+    pass with constant memory (issue 15): every chunk is read once, its time checked
+    once, each distinct temperature input converted once, and every channel adds its
+    ``<signal>_model`` and ``<signal>_comp`` in its own data column's unit (see
+    :func:`compensate_file` for the rules of one channel). ``signal_unit`` is one unit
+    for all or one per channel (``"deg/s,deg/s,deg/s,mg,mg,mg"``).
+    """
     src = Path(path)
     dst = Path(out)
     kind_in = file_kind(src)
@@ -912,136 +973,115 @@ def compensate_file(
     check_not_input(dst, [src])
     if chunk_rows < 2:
         raise ThermocalInputError(f"chunk size must be at least 2 rows, got {chunk_rows}")
-    model.check_fitted()
+    if not channels:
+        raise ThermocalInputError("no channel to compensate")
+    sig_list = [c for c, _m in channels]
+    if len(set(sig_list)) != len(sig_list):
+        raise ThermocalInputError(f"a signal column appears twice: {sig_list}")
     names, info, _ = _file_info(src, kind_in)
-    sig_name = signal or model.signal_name
     time_col = time or default_time_column(names, info.get("time"))
-    temp_names = list(model.temp_names_)
     available = ", ".join(repr(c) for c in names)
     if time_col not in names:
         raise MissingColumnError(f"{src}: no time column {time_col!r}; available: {available}")
-    if sig_name not in names:
-        raise MissingColumnError(
-            f"{src}: no signal column {sig_name!r} (the model's signal"
-            f"{'' if signal is None else ' given by --signal'}); available: {available}"
-        )
-    missing = [c for c in temp_names if c not in names]
-    if missing:
-        raise MissingColumnError(
-            f"{src}: the model's temperature column(s) {', '.join(repr(c) for c in missing)} "
-            f"are not in the file; available: {available}"
-        )
-    model_col = sig_name + MODEL_SUFFIX
-    comp_col = sig_name + COMP_SUFFIX
-    for c in (model_col, comp_col):
-        if c in names:
-            raise ThermocalInputError(
-                f"{src}: already has a column {c!r}; was the file compensated already?"
-            )
-    # units and temperature conversions resolved once (units.resolve_inputs): option >
-    # file metadata > column name > what the model recorded of its inputs > stated default
     where = str(src)
-    sig_info: dict[str, str] = dict(info.get("signals") or {})
-    extra_units: dict[str, str] = dict(info.get("units") or {})
-    tmp_info: dict[str, str] = dict(info.get("temperatures") or {})
-    resolved = units.resolve_inputs(
-        time_col,
-        [sig_name],
-        temp_names,
-        options=units.UnitOptions(
-            time_unit=time_unit,
-            signal_unit=signal_unit,
-            temp_unit=temp_unit,
-            temp_conversion=(
-                units.temperature_conversion(temperature_conversion, "--temp-conversion")
-                if temperature_conversion is not None
-                else None
+    sig_opts = units.per_signal_option(signal_unit, sig_list)
+    conv_opt = (
+        units.temperature_conversion(temperature_conversion, "--temp-conversion")
+        if temperature_conversion is not None
+        else None
+    )
+    plans: list[_ChannelPlan] = []
+    t_unit: str | None = None
+    for sig_name, model in channels:
+        model.check_fitted()
+        temp_names = list(model.temp_names_)
+        if sig_name not in names:
+            raise MissingColumnError(
+                f"{src}: no signal column {sig_name!r} (the model's signal"
+                f"{' given by --signal' if signal_given else ''}); available: {available}"
+            )
+        missing = [c for c in temp_names if c not in names]
+        if missing:
+            raise MissingColumnError(
+                f"{src}: the model's temperature column(s) "
+                f"{', '.join(repr(c) for c in missing)} are not in the file; "
+                f"available: {available}"
+            )
+        model_col = sig_name + MODEL_SUFFIX
+        comp_col = sig_name + COMP_SUFFIX
+        for c in (model_col, comp_col):
+            if c in names:
+                raise ThermocalInputError(
+                    f"{src}: already has a column {c!r}; was the file compensated already?"
+                )
+        # units and conversions resolved once per channel (units.resolve_inputs): option >
+        # file metadata > column name > what the model recorded of its inputs > default
+        resolved = units.resolve_inputs(
+            time_col,
+            [sig_name],
+            temp_names,
+            options=units.UnitOptions(
+                time_unit=time_unit,
+                signal_unit=sig_opts[sig_name],
+                temp_unit=temp_unit,
+                temp_conversion=conv_opt,
             ),
-        ),
-        file=units.StatedUnits.from_file_info(info, where),
-        model=model.input_units(),
-        where=where,
-    )
-    t_unit = resolved.time.unit
+            file=units.StatedUnits.from_file_info(info, where),
+            model=model.input_units(),
+            where=where,
+        )
+        if t_unit is None:
+            t_unit = resolved.time.unit
+        elif resolved.time.unit != t_unit:
+            raise UnitError(
+                f"{src}: the channels' models disagree on the time unit ({t_unit} and "
+                f"{resolved.time.unit}); give --time-unit"
+            )
+        data_unit = resolved.signals[sig_name].unit
+        check_signal_kind(data_unit, model.signal_unit, where)
+        md = model_scale_factor(model, Metadata.from_dict(dict(info.get("metadata") or {})))
+        check_sensor_id(getattr(model, "inputs_", None), md.sensor_id, where)
+        plans.append(
+            _ChannelPlan(
+                model=model,
+                signal=sig_name,
+                model_col=model_col,
+                comp_col=comp_col,
+                data_unit=data_unit,
+                temp_names=temp_names,
+                convs=temperature_inputs(model, resolved, where),
+                temp_units={c: r.unit for c, r in resolved.temperatures.items()},
+                md=md,
+                predictor=ChunkPredictor(
+                    model,
+                    extrapolate=extrapolate,
+                    name=str(src) if len(channels) == 1 else f"{src} [{sig_name}]",
+                    known_input=known_input,
+                ),
+            )
+        )
+    assert t_unit is not None
     t_factor = units.TIME_UNITS[t_unit]
-    data_unit = resolved.signals[sig_name].unit
-    check_signal_kind(data_unit, model.signal_unit, where)
-    md = model_scale_factor(model, Metadata.from_dict(dict(info.get("metadata") or {})))
-    check_sensor_id(getattr(model, "inputs_", None), md.sensor_id, where)
-    temp_units = {c: r.unit for c, r in resolved.temperatures.items()}
-    convs = temperature_inputs(model, resolved, where)
+    out_info = _output_info(info, time_col, t_unit, plans)
 
-    out_info = {
-        "format": META_FORMAT,
-        "version": META_VERSION,
-        **{k: v for k, v in info.items() if k not in ("format", "version")},
-    }
-    out_info["time"] = time_col
-    out_info["time_unit"] = t_unit
-    out_info["signals"] = {**sig_info, sig_name: data_unit}
-    out_info["temperatures"] = {**tmp_info, **temp_units}
-    out_info["units"] = {**extra_units, model_col: data_unit, comp_col: data_unit}
-    used_conv = {c: v.to_json() for c, v in convs.items() if v is not None}
-    if used_conv:  # the conversions travel with the output too
-        out_md = dict(out_info.get("metadata") or {})
-        out_md["temperature_conversion"] = {
-            **dict(out_md.get("temperature_conversion") or {}),
-            **used_conv,
-        }
-        out_info["metadata"] = out_md
-
-    predictor = ChunkPredictor(
-        model, extrapolate=extrapolate, name=str(src), known_input=known_input
-    )
-    factor: float | None = None
     state: dict[str, Any] = {"rows": 0, "chunks": 0, "last_t": None}
-    before = _RunningMoments()
-    after = _RunningMoments()
 
     def writer(tmp: Path) -> None:
-        nonlocal factor
         w = _Writer(tmp, kind_out, out_info)
         try:
             for chunk in _iter_chunks(src, kind_in, chunk_rows):
                 row0 = int(state["rows"])
-                t = numeric_column(chunk, time_col, src, row0) * t_factor
-                _check_finite(t, f"time column {time_col!r}", src, row0)
-                dt = np.diff(t)
-                last_t = state["last_t"]
-                if (dt <= 0).any() or (last_t is not None and t.size and t[0] <= last_t):
-                    if last_t is not None and t.size and t[0] <= last_t:
-                        r = row0
-                    else:
-                        r = row0 + int(np.argmax(dt <= 0)) + 1
-                    raise TimestampError(f"{src}: time does not increase at row {r}")
-                temps = np.empty((t.size, len(temp_names)))
-                for j, c in enumerate(temp_names):
-                    v = numeric_column(chunk, c, src, row0)
-                    conv = convs[c]
-                    if conv is not None:  # raw counts → °C (else °C, or counts for a counts model)
-                        v = conv.to_celsius(v, f"{src}: column {c!r} (chunk from row {row0})")
-                    _check_finite(v, f"temperature column {c!r}", src, row0)
-                    temps[:, j] = v
-                raw = numeric_column(chunk, sig_name, src, row0)
-                _check_finite(raw, f"signal column {sig_name!r}", src, row0)
-                _check_plausible(
-                    temps if model.temperature_unit == "degC" else temps[:, :0],  # counts: no °C
-                    temp_names, raw, data_unit, src, row0,
-                )  # fmt: skip
-                if factor is None:
-                    tau = md.sample_interval_s or (median_interval(t) if t.size > 1 else None)
-                    factor = unit_factor(
-                        data_unit, model.signal_unit, meta=md, sample_interval_s=tau, where=str(src)
-                    )
-                y_model = predictor.predict(t, temps, raw * factor)
-                y_data = y_model / factor
-                comp = raw - y_data
-                w.write(_append_columns(chunk, {model_col: y_data, comp_col: comp}))
+                t = _chunk_time(chunk, time_col, t_factor, src, row0, state["last_t"])
+                new: dict[str, FloatArray] = {}
+                temps_cache: dict[tuple[str, str], FloatArray] = {}
+                for plan in plans:
+                    y_data, comp = _compensate_chunk(plan, chunk, t, temps_cache, src, row0)
+                    new[plan.model_col] = y_data
+                    new[plan.comp_col] = comp
+                w.write(_append_columns(chunk, new))
                 state["rows"] = row0 + t.size
                 state["chunks"] = int(state["chunks"]) + 1
-                before.add(raw)
-                after.add(comp)
-                state["last_t"] = float(t[-1]) if t.size else last_t
+                state["last_t"] = float(t[-1]) if t.size else state["last_t"]
                 if on_progress is not None:
                     on_progress(int(t.size))
         finally:
@@ -1060,20 +1100,122 @@ def compensate_file(
     atomic_write_path(dst, writer)
     if kind_out == "csv":
         write_json(sidecar_path(dst), out_info)
-    predictor.finish()
+    for plan in plans:
+        plan.predictor.finish()
     n = int(state["rows"])
-    return CompensateFileResult(
-        output=str(dst),
-        n_rows=n,
-        n_chunks=int(state["chunks"]),
-        signal=sig_name,
-        model_column=model_col,
-        comp_column=comp_col,
-        unit=data_unit,
-        streamed=predictor.streams,
-        rms_before=before.rms(),
-        rms_after=after.rms(),
-    )
+    return [
+        CompensateFileResult(
+            output=str(dst),
+            n_rows=n,
+            n_chunks=int(state["chunks"]),
+            signal=plan.signal,
+            model_column=plan.model_col,
+            comp_column=plan.comp_col,
+            unit=plan.data_unit,
+            streamed=plan.predictor.streams,
+            rms_before=plan.before.rms(),
+            rms_after=plan.after.rms(),
+        )
+        for plan in plans
+    ]
+
+
+def _output_info(
+    info: dict[str, Any], time_col: str, t_unit: str, plans: Sequence[_ChannelPlan]
+) -> dict[str, Any]:
+    """The output's metadata: the input's, with the time unit, every channel's signal,
+    model and compensated columns in the data's unit, and the conversions used."""
+    out_info: dict[str, Any] = {
+        "format": META_FORMAT,
+        "version": META_VERSION,
+        **{k: v for k, v in info.items() if k not in ("format", "version")},
+    }
+    out_info["time"] = time_col
+    out_info["time_unit"] = t_unit
+    signals = dict(info.get("signals") or {})
+    temps = dict(info.get("temperatures") or {})
+    extra = dict(info.get("units") or {})
+    used_conv: dict[str, Any] = {}
+    for plan in plans:
+        signals[plan.signal] = plan.data_unit
+        temps.update(plan.temp_units)
+        extra[plan.model_col] = plan.data_unit
+        extra[plan.comp_col] = plan.data_unit
+        used_conv.update({c: v.to_json() for c, v in plan.convs.items() if v is not None})
+    out_info["signals"] = signals
+    out_info["temperatures"] = temps
+    out_info["units"] = extra
+    if used_conv:  # the conversions travel with the output too
+        out_md = dict(out_info.get("metadata") or {})
+        out_md["temperature_conversion"] = {
+            **dict(out_md.get("temperature_conversion") or {}),
+            **used_conv,
+        }
+        out_info["metadata"] = out_md
+    return out_info
+
+
+def _chunk_time(
+    chunk: pd.DataFrame | pa.RecordBatch,
+    time_col: str,
+    t_factor: float,
+    src: Path,
+    row0: int,
+    last_t: float | None,
+) -> FloatArray:
+    """The chunk's time [s], finite and increasing (also across the chunk boundary)."""
+    t = numeric_column(chunk, time_col, src, row0) * t_factor
+    _check_finite(t, f"time column {time_col!r}", src, row0)
+    dt = np.diff(t)
+    if (dt <= 0).any() or (last_t is not None and t.size and t[0] <= last_t):
+        if last_t is not None and t.size and t[0] <= last_t:
+            r = row0
+        else:
+            r = row0 + int(np.argmax(dt <= 0)) + 1
+        raise TimestampError(f"{src}: time does not increase at row {r}")
+    return t
+
+
+def _compensate_chunk(
+    plan: _ChannelPlan,
+    chunk: pd.DataFrame | pa.RecordBatch,
+    t: FloatArray,
+    temps_cache: dict[tuple[str, str], FloatArray],
+    src: Path,
+    row0: int,
+) -> tuple[FloatArray, FloatArray]:
+    """One channel of one chunk: (ŷ, F − ŷ) in the data's unit. Temperature inputs are
+    converted once per chunk and shared between channels (``temps_cache``)."""
+    temps = np.empty((t.size, len(plan.temp_names)))
+    for j, c in enumerate(plan.temp_names):
+        conv = plan.convs[c]
+        key = (c, repr(conv.to_json()) if conv is not None else "")
+        v = temps_cache.get(key)
+        if v is None:
+            v = numeric_column(chunk, c, src, row0)
+            if conv is not None:  # raw counts → °C (else °C, or counts for a counts model)
+                v = conv.to_celsius(v, f"{src}: column {c!r} (chunk from row {row0})")
+            _check_finite(v, f"temperature column {c!r}", src, row0)
+            temps_cache[key] = v
+        temps[:, j] = v
+    raw = numeric_column(chunk, plan.signal, src, row0)
+    _check_finite(raw, f"signal column {plan.signal!r}", src, row0)
+    _check_plausible(
+        temps if plan.model.temperature_unit == "degC" else temps[:, :0],  # counts: no °C
+        plan.temp_names, raw, plan.data_unit, src, row0,
+    )  # fmt: skip
+    if plan.factor is None:
+        tau = plan.md.sample_interval_s or (median_interval(t) if t.size > 1 else None)
+        plan.factor = unit_factor(
+            plan.data_unit, plan.model.signal_unit, meta=plan.md, sample_interval_s=tau,
+            where=str(src),
+        )  # fmt: skip
+    y_model = plan.predictor.predict(t, temps, raw * plan.factor)
+    y_data = y_model / plan.factor
+    comp = raw - y_data
+    plan.before.add(raw)
+    plan.after.add(comp)
+    return y_data, comp
 
 
 __all__ = [
@@ -1089,6 +1231,7 @@ __all__ = [
     "StreamingCompensator",
     "check_signal_kind",
     "chunk_context",
+    "compensate_channels",
     "compensate_file",
     "compensate_run",
     "model_scale_factor",

@@ -523,6 +523,11 @@ class ResolvedInputs:
         ]
 
 
+def per_signal_option(option: str | None, signals: Sequence[str]) -> dict[str, str | None]:
+    """``--signal-unit``: one unit for every signal, or one per signal (comma-separated)."""
+    return _per_signal(option, signals)
+
+
 def _per_signal(option: str | None, signals: Sequence[str]) -> dict[str, str | None]:
     if not option:
         return dict.fromkeys(signals)

@@ -30,11 +30,12 @@ from thermocal.cli.common import (
     handle_errors,
     parse_temp_conversion,
     progress,
+    split_names,
     stdout,
 )
-from thermocal.compensate import DEFAULT_CHUNK_ROWS, compensate_file
+from thermocal.compensate import DEFAULT_CHUNK_ROWS, compensate_channels, compensate_file
 from thermocal.io import check_not_input, file_kind, sidecar_path
-from thermocal.models.base import load_model
+from thermocal.models.calibration import load_calibration
 
 
 @app.command("compensate")
@@ -67,34 +68,75 @@ def compensate_cmd(
     check_not_input(output, [file, model_file])
     if file_kind(output) == "csv":  # the CSV's sidecar must not land on an input either
         check_not_input(sidecar_path(output), [file, model_file])
-    model = load_model(model_file)
+    cal = load_calibration(model_file)  # a model file is a calibration of one channel
+    conv = parse_temp_conversion(temp_conversion) if temp_conversion is not None else None
+    if len(cal.channels) == 1:
+        model = cal.channels[0].model
+        with progress("compensating") as advance:
+            res = compensate_file(
+                model,
+                file,
+                output,
+                signal=signal,
+                time=time,
+                time_unit=time_unit,
+                signal_unit=signal_unit,
+                temp_unit=temp_unit,
+                temperature_conversion=conv,
+                chunk_rows=chunk_rows,
+                extrapolate=extrapolate,
+                known_input=known_input,
+                on_progress=advance,
+            )
+        summary = {"model": str(model_file), "family": model.family, **res.to_dict()}
+
+        def human() -> None:
+            table = Table(title=f"{file} → {res.output}", show_header=False)
+            table.add_row("model", f"{model.family} ({model_file})")
+            table.add_row("rows", str(res.n_rows))
+            table.add_row("added columns", f"{res.model_column}, {res.comp_column} [{res.unit}]")
+            table.add_row("rms before", f"{fmt(res.rms_before)} {res.unit}")
+            table.add_row("rms after", f"{fmt(res.rms_after)} {res.unit}")
+            stdout.print(table)
+
+        emit(summary, as_json, human)
+        return
+    # a calibration: every channel (or those named by --signal) in one chunked pass
+    chosen = split_names(signal) or cal.names
+    channels = [(cal.channel(n).signal, cal.channel(n).model) for n in chosen]
     with progress("compensating") as advance:
-        res = compensate_file(
-            model,
+        results = compensate_channels(
+            channels,
             file,
             output,
-            signal=signal,
             time=time,
             time_unit=time_unit,
             signal_unit=signal_unit,
             temp_unit=temp_unit,
-            temperature_conversion=(
-                parse_temp_conversion(temp_conversion) if temp_conversion is not None else None
-            ),
+            temperature_conversion=conv,
             chunk_rows=chunk_rows,
             extrapolate=extrapolate,
             known_input=known_input,
             on_progress=advance,
         )
-    summary = {"model": str(model_file), "family": model.family, **res.to_dict()}
+    out = {
+        "model": str(model_file),
+        "output": str(output),
+        "channels": {
+            name: {"family": cal.channel(name).model.family, **r.to_dict()}
+            for name, r in zip(chosen, results, strict=True)
+        },
+    }
 
-    def human() -> None:
-        table = Table(title=f"{file} → {res.output}", show_header=False)
-        table.add_row("model", f"{model.family} ({model_file})")
-        table.add_row("rows", str(res.n_rows))
-        table.add_row("added columns", f"{res.model_column}, {res.comp_column} [{res.unit}]")
-        table.add_row("rms before", f"{fmt(res.rms_before)} {res.unit}")
-        table.add_row("rms after", f"{fmt(res.rms_after)} {res.unit}")
+    def human_many() -> None:
+        table = Table(title=f"{file} → {output} ({len(results)} channels, one pass)")
+        for col in ("channel", "model", "added columns", "rms before", "rms after", "unit"):
+            table.add_column(col)
+        for name, r in zip(chosen, results, strict=True):
+            table.add_row(
+                name, cal.channel(name).model.family, f"{r.model_column}, {r.comp_column}",
+                fmt(r.rms_before), fmt(r.rms_after), r.unit,
+            )  # fmt: skip
         stdout.print(table)
 
-    emit(summary, as_json, human)
+    emit(out, as_json, human_many)

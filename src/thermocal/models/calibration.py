@@ -198,9 +198,7 @@ def load_calibration(path: str | Path) -> Calibration:
         sig = model.signal_name or "signal"
         unit = str((model.inputs_ or {}).get("units", {}).get(sig) or model.signal_unit)
         return Calibration([Channel(sig, sig, unit, model, guess_role(sig, unit))])
-    raise ModelFileError(
-        f"{p}: neither a thermocal model nor a calibration file (missing 'format')"
-    )
+    raise ModelFileError(f"{p}: not a thermocal model or calibration file (missing 'format')")
 
 
 def channels_of(signals: Sequence[str], names: Sequence[str] | None = None) -> list[str]:
