@@ -224,3 +224,28 @@ def test_compensate_a_subset_of_channels(
                  "--signal", "gq"])  # fmt: skip
     assert code == 2
     assert "no channel 'gq'" in capsys.readouterr().err
+
+
+def test_validate_a_calibration_gives_per_channel_figures_equal_to_single_runs(
+    imu: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    cal_path = tmp_path / "cal.json"
+    _json(
+        capsys, "fit", str(imu), "--model", "poly", "--order", "2", "--signal", "gx,az",
+        "--signal-unit", "deg/s,mg", *COMMON, "-o", str(cal_path),
+    )  # fmt: skip
+    many = _json(capsys, "validate", str(cal_path), str(imu))
+    assert list(many["channels"]) == ["gx", "az"]
+    for name, unit in (("gx", "deg/s"), ("az", "mg")):
+        ch = many["channels"][name]
+        assert ch["unit"] == unit
+        assert ch["verdict"] == "NOT weakly correlated"  # validated on its own modelling run
+        one_model = tmp_path / f"{name}.json"
+        _json(
+            capsys, "fit", str(imu), "--model", "poly", "--order", "2", "--signal", name,
+            "--signal-unit", unit, *COMMON, "-o", str(one_model),
+        )  # fmt: skip
+        one = _json(capsys, "validate", str(one_model), str(imu))
+        for key in ("r", "rms_before", "rms_after", "bias_stability_before",
+                    "bias_stability_after"):  # fmt: skip
+            assert ch[key] == one[key], (name, key)

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import warnings
 from pathlib import Path
-from typing import Annotated
+from typing import Annotated, Any
 
 import typer
 from rich.table import Table
@@ -32,26 +32,32 @@ from thermocal.cli.common import (
     fmt,
     handle_errors,
     load_recording,
+    split_names,
     stdout,
 )
 from thermocal.compensate import prepare_run
 from thermocal.errors import ThermocalInputError, UnitWarning
-from thermocal.models.base import TemperatureModel, load_model
+from thermocal.models.base import TemperatureModel
+from thermocal.models.calibration import load_calibration
 from thermocal.recording import FloatArray, Recording, find_problems
 from thermocal.validation import DEFAULT_AVERAGING_S, validate
 
 
 def _modeling_file(model: TemperatureModel, model_file: Path) -> Path | None:
-    """The first data file recorded in the model file that still exists (relative paths are
-    tried from the current directory and from the model file's directory)."""
+    """The first data file recorded in the model file that still exists: its name, then
+    the path given to fit (relative ones tried from the current directory and from the
+    model file's directory)."""
     for entry in model.data_:
-        name = entry.get("file") if isinstance(entry, dict) else None
-        if not name:
+        if not isinstance(entry, dict):
             continue
-        p = Path(str(name))
-        for cand in (p, model_file.parent / p) if not p.is_absolute() else (p,):
-            if cand.is_file():
-                return cand
+        for key in ("file", "path"):  # the name, then the path given to fit
+            name = entry.get(key)
+            if not name:
+                continue
+            p = Path(str(name))
+            for cand in (p, model_file.parent / p) if not p.is_absolute() else (p,):
+                if cand.is_file():
+                    return cand
     return None
 
 
@@ -68,6 +74,40 @@ def _ambient(rec: Recording, name: str) -> FloatArray:
         )
         return rec.column(name)
     return rec.temperature_c(name)
+
+
+def _emit_channels(file: Path, per: dict[str, tuple[Any, dict[str, Any]]], as_json: bool) -> None:
+    """Several channels: ``{"channels": {NAME: {…}}}`` and one verdict per channel."""
+
+    def verdict(res: Any) -> str:
+        imp = res.improvement_pct.get("rms")
+        if res.r is not None and not res.weakly_correlated:
+            return "NOT weakly correlated"
+        if imp is None:
+            return "—"
+        return "improved" if imp > 0 else "NOT improved"
+
+    def human() -> None:
+        table = Table(title=f"validation on {file}, {len(per)} channels")
+        for col in ("channel", "r", "bias stability before → after", "rms before → after",
+                    "unit", "verdict"):  # fmt: skip
+            table.add_column(col)
+        for name, (res, _out) in per.items():
+            table.add_row(
+                name,
+                fmt(res.r, 3),
+                f"{fmt(res.bias_stability_before)} → {fmt(res.bias_stability_after)}",
+                f"{fmt(res.rms_before)} → {fmt(res.rms_after)}",
+                res.unit,
+                verdict(res),
+            )
+        stdout.print(table)
+
+    emit(
+        {"channels": {n: {**out, "verdict": verdict(res)} for n, (res, out) in per.items()}},
+        as_json,
+        human,
+    )
 
 
 @app.command("validate")
@@ -114,65 +154,76 @@ def validate_cmd(
 ) -> None:
     """Validate MODEL on FILE: correlation r, bias stability and repeatability over the
     hold stages, rms and peak-to-peak, before and after compensation."""
-    model = load_model(model_file)
-    sig = signal or model.signal_name
-    temps = list(model.temp_names_)
-    amb = ambient or temps[0]
-    read_temps = temps if amb in temps else [*temps, amb]
-    rec = load_recording(
-        file,
-        time=time,
-        time_unit=time_unit,
-        signal=sig,
-        temps=",".join(read_temps),
-        signal_unit=signal_unit,
-        temp_unit=temp_unit,
-        temp_conversion=temp_conversion,
-        model=model,
-    )
-    # the data in the model's units (kinds checked); figures go back to the data's unit
-    prepared = prepare_run(model, rec, sig, temps)
-    run = prepared.run
-    amb_val = _ambient(rec, amb)
 
-    mod_path = modeling if modeling is not None else _modeling_file(model, model_file)
-    modeling_ambient = None
-    if mod_path is not None:
-        mrec = load_recording(
-            mod_path,
+    def run_one(model: TemperatureModel, sig: str) -> tuple[Any, dict[str, Any]]:
+        """Validate one model on its signal column; (result, --json object)."""
+        temps = list(model.temp_names_)
+        amb = ambient or temps[0]
+        read_temps = temps if amb in temps else [*temps, amb]
+        rec = load_recording(
+            file,
             time=time,
             time_unit=time_unit,
-            temps=amb,
+            signal=sig,
+            temps=",".join(read_temps),
+            signal_unit=signal_unit,
             temp_unit=temp_unit,
             temp_conversion=temp_conversion,
             model=model,
-            require_signal=False,
-            check=False,
         )
-        for prob in find_problems(mrec, required=[amb]):
-            if prob.severity == "error" and (prob.column in (None, "time", amb)):
-                raise ThermocalInputError(f"{mod_path}: {prob.message}")
-        modeling_ambient = (mrec.time_s, _ambient(mrec, amb))
-    res = validate(
-        model,
-        run,
-        modeling_ambient,
-        validation_ambient=amb_val,
-        averaging_s=averaging,
-        rate_threshold_c_per_min=stage_rate,
-        min_stage_s=min_stage,
-        settle_s=settle,
-        extrapolate=extrapolate,
-    )
-    if prepared.data_unit != "counts":  # raw counts: figures in the physical unit K gives
-        res = res.in_unit(prepared.data_unit, prepared.factor)
-    out = res.to_dict()
-    out["model_unit"] = model.signal_unit
-    out["model"] = str(model_file)
-    out["family"] = model.family
-    out["file"] = str(file)
-    out["modeling_file"] = str(mod_path) if mod_path is not None else None
-    out["ambient"] = amb
+        # the data in the model's units (kinds checked); figures go back to the data's unit
+        prepared = prepare_run(model, rec, sig, temps)
+        run = prepared.run
+        amb_val = _ambient(rec, amb)
+
+        mod_path = modeling if modeling is not None else _modeling_file(model, model_file)
+        modeling_ambient = None
+        if mod_path is not None:
+            mrec = load_recording(
+                mod_path,
+                time=time,
+                time_unit=time_unit,
+                temps=amb,
+                temp_unit=temp_unit,
+                temp_conversion=temp_conversion,
+                model=model,
+                require_signal=False,
+                check=False,
+            )
+            for prob in find_problems(mrec, required=[amb]):
+                if prob.severity == "error" and (prob.column in (None, "time", amb)):
+                    raise ThermocalInputError(f"{mod_path}: {prob.message}")
+            modeling_ambient = (mrec.time_s, _ambient(mrec, amb))
+        res = validate(
+            model,
+            run,
+            modeling_ambient,
+            validation_ambient=amb_val,
+            averaging_s=averaging,
+            rate_threshold_c_per_min=stage_rate,
+            min_stage_s=min_stage,
+            settle_s=settle,
+            extrapolate=extrapolate,
+        )
+        if prepared.data_unit != "counts":  # raw counts: figures in the physical unit K gives
+            res = res.in_unit(prepared.data_unit, prepared.factor)
+        out = res.to_dict()
+        out["model_unit"] = model.signal_unit
+        out["model"] = str(model_file)
+        out["family"] = model.family
+        out["file"] = str(file)
+        out["modeling_file"] = str(mod_path) if mod_path is not None else None
+        out["ambient"] = amb
+        return res, out
+
+    cal = load_calibration(model_file)  # a model file is a calibration of one channel
+    if len(cal.channels) > 1:
+        chosen = split_names(signal) or cal.names
+        per = {n: run_one(cal.channel(n).model, cal.channel(n).signal) for n in chosen}
+        _emit_channels(file, per, as_json)
+        return
+    model = cal.channels[0].model
+    res, out = run_one(model, signal or model.signal_name)
 
     def human() -> None:
         u = res.unit

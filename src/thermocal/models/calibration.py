@@ -187,8 +187,10 @@ def load_calibration(path: str | Path) -> Calibration:
         d = json.loads(p.read_text(encoding="utf-8"))
     except FileNotFoundError:
         raise ModelFileError(f"{p}: no such model or calibration file") from None
-    except (UnicodeDecodeError, json.JSONDecodeError) as exc:
-        raise ModelFileError(f"{p}: not a JSON model or calibration file ({exc})") from None
+    except UnicodeDecodeError:
+        raise ModelFileError(f"{p}: not a text (JSON) model or calibration file") from None
+    except json.JSONDecodeError as exc:
+        raise ModelFileError(f"{p}: corrupted model file (invalid JSON: {exc.msg})") from None
     if is_calibration(d):
         return calibration_from_dict(d, str(p))
     if isinstance(d, dict) and d.get("format") == MODEL_FORMAT:
