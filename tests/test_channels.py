@@ -249,3 +249,109 @@ def test_validate_a_calibration_gives_per_channel_figures_equal_to_single_runs(
         for key in ("r", "rms_before", "rms_after", "bias_stability_before",
                     "bias_stability_after"):  # fmt: skip
             assert ch[key] == one[key], (name, key)
+
+
+C_DRIVER = r"""
+#include <stdio.h>
+#include "imu.h"
+int main(void) {
+    imu_state s;
+    double t, temps[IMU_N_TEMPS], raw[IMU_N_CHANNELS], out[IMU_N_CHANNELS];
+    int i, first = 1;
+    while (scanf("%lf", &t) == 1) {
+        for (i = 0; i < IMU_N_TEMPS; i++) if (scanf("%lf", &temps[i]) != 1) return 1;
+        for (i = 0; i < IMU_N_CHANNELS; i++) if (scanf("%lf", &raw[i]) != 1) return 1;
+        if (first) { imu_init(&s, 0.1); first = 0; }
+        imu_compensate(&s, t, temps, raw, out);
+        for (i = 0; i < IMU_N_CHANNELS; i++)
+            printf("%.17g%c", out[i], i + 1 < IMU_N_CHANNELS ? ' ' : '\n');
+    }
+    return 0;
+}
+"""
+
+
+def test_calibration_c_compiles_strict_and_matches_python(
+    imu: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """One header/source for six channels (a cubic with Ṫ terms on the gyros, a quadratic
+    on the accelerometers), compiled with -std=c99 -Wall -Wextra -Werror -pedantic,
+    equals Python's compensation to 1e-9 (relative) on 10⁴ samples with a gap and
+    temperatures beyond the fitted range (clamped)."""
+    import shutil
+    import subprocess
+
+    cc = shutil.which("cc") or shutil.which("gcc") or shutil.which("clang")
+    if cc is None:
+        pytest.skip("no C compiler on this machine")
+    from thermocal.models.base import load_model
+    from thermocal.models.calibration import Calibration, Channel, save_calibration
+
+    models = {}
+    for name, unit in zip(CHANNELS, UNITS, strict=True):
+        path = tmp_path / f"{name}.json"
+        opts = ["--terms", "T1,T1^2,dT1,T1*dT1"] if name.startswith("g") else ["--order", "2"]
+        _json(
+            capsys, "fit", str(imu), "--model", "poly", *opts, "--rate-interval", "30",
+            "--signal", name, "--signal-unit", unit, *COMMON, "-o", str(path),
+        )  # fmt: skip
+        models[name] = load_model(path)
+    cal_path = tmp_path / "imu.json"
+    save_calibration(
+        Calibration([Channel(n, n, u, models[n]) for n, u in zip(CHANNELS, UNITS, strict=True)]),
+        cal_path,
+    )
+    cdir = tmp_path / "c"
+    assert main(["export-c", str(cal_path), "-o", str(cdir), "--name", "imu"]) == 0
+    capsys.readouterr()
+    (cdir / "main.c").write_text(C_DRIVER)
+    exe = cdir / "run"
+    subprocess.run(
+        [cc, "-O2", "-std=c99", "-Wall", "-Wextra", "-Werror", "-pedantic", "-o", str(exe),
+         str(cdir / "imu.c"), str(cdir / "main.c"), "-lm"],
+        check=True,
+    )  # fmt: skip
+    # inputs: 10⁴ samples at 10 Hz, a 60 s gap, temperatures from 5 to 45 °C (fitted 15…35)
+    rng = np.random.default_rng(9)
+    n = 10_000
+    t = np.arange(n) * 0.1
+    t[n // 2 :] += 60.0
+    temp = 25.0 + 20.0 * np.sin(2 * np.pi * t / t[-1] * 1.5)
+    data = {"time": t, "T1": temp}
+    for i, name in enumerate(CHANNELS):
+        data[name] = rng.normal(0.0, 1.0, n) + (1000.0 if name == "az" else 0.0) + i
+    src = tmp_path / "in.csv"
+    pd.DataFrame(data).to_csv(src, index=False)
+    out = tmp_path / "out.parquet"
+    capsys.readouterr()
+    assert main(["compensate", str(cal_path), str(src), "-o", str(out), "--time-unit", "s"]) == 0
+    capsys.readouterr()
+    py = pd.read_parquet(out)
+    text = "\n".join(
+        " ".join(repr(float(data[c][j])) for c in ("time", "T1", *CHANNELS)) for j in range(n)
+    )
+    proc = subprocess.run([str(exe)], input=text, capture_output=True, text=True, check=True)
+    c_out = np.array([[float(v) for v in line.split()] for line in proc.stdout.splitlines()])
+    assert c_out.shape == (n, len(CHANNELS))
+    for i, name in enumerate(CHANNELS):
+        ref = py[f"{name}_comp"].to_numpy()
+        scale = max(1.0, float(np.max(np.abs(ref))))
+        np.testing.assert_allclose(c_out[:, i], ref, rtol=0, atol=1e-9 * scale, err_msg=name)
+
+
+def test_export_sizes_the_rate_buffer_for_the_fitted_sample_interval(
+    imu: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The data were at 10 Hz: a 60 s rate interval needs ⌈60/0.1⌉ + 8 = 608 slots. Before,
+    the buffer was sized for 1 s samples (68) and the firmware's Ṫ silently spanned 6.8 s."""
+    model = tmp_path / "gx.json"
+    _json(
+        capsys, "fit", str(imu), "--model", "poly", "--terms", "T1,dT1", "--signal", "gx",
+        "--signal-unit", "deg/s", *COMMON, "-o", str(model),
+    )  # fmt: skip
+    assert json.loads(model.read_text())["inputs"]["sample_interval_s"] == pytest.approx(0.1)
+    assert main(["export-c", str(model), "-o", str(tmp_path / "c"), "--name", "g"]) == 0
+    assert "#define G_RATE_BUF_LEN 608" in (tmp_path / "c" / "g.h").read_text()
+    assert main(["export-c", str(model), "-o", str(tmp_path / "d"), "--name", "g",
+                 "--sample-interval", "1"]) == 0  # fmt: skip
+    assert "#define G_RATE_BUF_LEN 68" in (tmp_path / "d" / "g.h").read_text()

@@ -9,17 +9,79 @@ compiler on 10⁵ synthetic samples over the model's range) and printed.
 
 from __future__ import annotations
 
+import json
 import warnings
 from pathlib import Path
 from typing import Annotated
 
 import typer
 
+from thermocal import units
 from thermocal.cli.app import app
 from thermocal.cli.common import JsonOpt, ModelArg, emit, fmt, handle_errors, stdout
 from thermocal.errors import ThermocalWarning, UnitWarning
-from thermocal.export_c import export_c, find_compiler, measure_float_error
-from thermocal.models.base import load_model_dict
+from thermocal.export_c import (
+    c_identifier,
+    export_c,
+    find_compiler,
+    fitted_sample_interval,
+    generate_c_calibration,
+    measure_float_error,
+)
+from thermocal.models.base import load_model_dict, model_file_dict
+from thermocal.models.calibration import is_calibration, load_calibration
+
+
+def _read_json(path: Path) -> object:
+    """The file's JSON, or None when it is not JSON (the model loader then says why)."""
+    try:
+        return json.loads(path.read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError):
+        return None
+
+
+def _export_calibration(
+    path: Path,
+    output: Path,
+    name: str | None,
+    real: str,
+    sample_interval: float | None,
+    unit: str | None,
+    as_json: bool,
+) -> None:
+    """A calibration's C: one header and one source for every channel, each channel in
+    its data's unit (``--unit`` applies one unit to every channel, or one per channel)."""
+    cal = load_calibration(path)
+    unit_of = units.per_signal_option(unit, cal.names)
+    channels = [(c.name, model_file_dict(c.model), unit_of[c.name] or c.unit) for c in cal.channels]
+    ex = generate_c_calibration(
+        channels,
+        prefix=name or c_identifier(path.stem),
+        real=real,
+        sample_interval_s=sample_interval,
+    )
+    paths = ex.write(output)
+    out = {
+        "family": "calibration",
+        "prefix": ex.prefix,
+        "real": ex.real,
+        "channels": {
+            c.name: {"unit": u, "family": c.model.family}
+            for c, u in zip(cal.channels, ex.unit.split(","), strict=True)
+        },
+        "temperature_unit": ex.temperature_unit,
+        "files": [str(p) for p in paths],
+    }
+
+    def human() -> None:
+        for p in paths:
+            stdout.print(f"wrote {p}")
+        stdout.print(
+            f"{len(cal.channels)} channels: "
+            + ", ".join(f"{n} [{v['unit']}]" for n, v in out["channels"].items())  # type: ignore[attr-defined]
+        )
+
+    emit(out, as_json, human)
 
 
 @app.command("export-c")
@@ -35,12 +97,14 @@ def export_c_cmd(
         typer.Option("--name", help="C prefix of the files and symbols (default: file stem)."),
     ] = None,
     sample_interval: Annotated[
-        float,
+        float | None,
         typer.Option(
             "--sample-interval",
-            help="Nominal sample interval [s], sizes the rate buffer of rate models.",
+            help="Nominal sample interval [s] of the firmware's samples; sizes the rate "
+            "buffer of rate models (default: the interval of the data the model was fitted "
+            "on, recorded in the model file).",
         ),
-    ] = 1.0,
+    ] = None,
     unit: Annotated[
         str | None,
         typer.Option(
@@ -53,7 +117,25 @@ def export_c_cmd(
 ) -> None:
     """Write MODEL as a C99 header and source (no dynamic allocation) into DIR."""
     real = "float" if use_float else "double"
+    raw = _read_json(model_file)
+    if is_calibration(raw):
+        _export_calibration(model_file, output, name, real, sample_interval, unit, as_json)
+        return
     d = load_model_dict(model_file)
+    if sample_interval is None:
+        sample_interval = fitted_sample_interval(d)
+        if sample_interval is None:
+            sample_interval = 1.0
+            if d.get("rate"):
+                warnings.warn(
+                    UnitWarning(
+                        f"{model_file}: the model file does not record its data's sample "
+                        "interval (an older file); the C rate buffer is sized for 1 s samples "
+                        "— give --sample-interval, or sampling faster shortens the rate "
+                        "interval in the firmware"
+                    ),
+                    stacklevel=1,
+                )
     if unit is None:
         sig = d.get("signal") or {}
         given = ((d.get("inputs") or {}).get("units") or {}).get(sig.get("name"))

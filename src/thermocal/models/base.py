@@ -279,6 +279,8 @@ def model_inputs(
         }
     if rec.meta.sensor_id:
         out["sensor_id"] = str(rec.meta.sensor_id)
+    if rec.n_samples > 1:  # sizes the Ṫ buffer of the exported C (export-c)
+        out["sample_interval_s"] = float(rec.sample_interval_s)
     canon = canonical_unit(sig_unit) if sig_unit else None
     out["known_input"] = {
         "value": float(known_input),
