@@ -1279,6 +1279,112 @@ def scenario_turntable16(seed: int, profile: ProfileInput = None, **opts: Any) -
     return out
 
 
+IMU_CHANNELS: tuple[tuple[str, str], ...] = (
+    ("gx", "deg/s"),
+    ("gy", "deg/s"),
+    ("gz", "deg/s"),
+    ("ax", "mg"),
+    ("ay", "mg"),
+    ("az", "mg"),
+)
+"""The six channels of the MEMS IMU scenario and their units."""
+IMU_BIAS_SPAN: dict[str, tuple[float, float, float, float]] = {
+    # unit: (constant, linear, quadratic, cubic) spans of b(x) = Σ c_j x^j, x = (T − 25)/40 °C
+    "deg/s": (0.2, 0.06, 0.02, 0.015),
+    "mg": (30.0, 15.0, 6.0, 4.0),
+}
+"""Realistic MEMS magnitudes over −15…+65 °C: a few 0.01 °/s and a few 10 mg (consumer and
+industrial MEMS data sheets quote 0.01-0.05 °/s/°C·40 °C and 0.1-0.5 mg/°C·40 °C)."""
+IMU_NOISE: dict[str, float] = {"deg/s": 0.005, "mg": 0.5}
+"""White noise σ per 1 s sample (°/s, mg)."""
+
+
+def scenario_mems_imu(
+    seed: int,
+    profile: ProfileInput = None,
+    *,
+    run: str = "modelling",
+    rate_hz: float = 1.0,
+    gravity_axis: str = "az",
+    preset: str = "mems-gyro",
+) -> ScenarioResult:
+    """A six-axis MEMS IMU in a chamber (issue 15): three gyros [°/s], three
+    accelerometers [mg], one die temperature ``T_die`` (the first node of the preset's
+    thermal network, so it lags the chamber air) and the air ``T_chamber``.
+
+    Each channel's temperature-induced bias is a cubic in the die temperature,
+    ``b(T) = Σ_j c_j x^j`` with ``x = (T − 25)/40`` and coefficients drawn (per seed) within
+    :data:`IMU_BIAS_SPAN`; gravity (+1000 mg) is on ``gravity_axis``; white noise
+    :data:`IMU_NOISE`. ``run`` ``"modelling"`` uses the soak-and-ramp program of
+    ``rlg-modelling``, ``"validation"`` the weakly correlated ``rlg-validation`` program
+    (the same unit: the same coefficients). Truth: ``channels`` {name: {unit, coefficients,
+    gravity_mg}} and ``truth_<name>`` columns (the temperature-induced bias alone).
+    """
+    if run not in ("modelling", "validation"):
+        raise ThermocalInputError(f"run must be modelling or validation, got {run!r}")
+    names = [n for n, _u in IMU_CHANNELS]
+    if gravity_axis not in names[3:]:
+        raise ThermocalInputError(f"gravity_axis must be one of {names[3:]}, got {gravity_axis!r}")
+    p = get_preset(preset)
+    program, stages = _program(profile, f"rlg-{run}")
+    t = _time_grid(float(program[0][-1]), rate_hz)
+    thermal = simulate_thermal(t, program[0], program[1], p.network, chamber=p.chamber)
+    die = thermal.temperatures_c[:, 0]
+    coef_rng, *noise_rngs = scenario_rng("mems-imu", seed, 1 + len(IMU_CHANNELS))
+    if run == "validation":  # a different noise draw, the same unit (same coefficients)
+        noise_rngs = scenario_rng("mems-imu-validation", seed, len(IMU_CHANNELS))
+    x = (die - 25.0) / 40.0
+    signals: dict[str, npt.ArrayLike] = {}
+    other: dict[str, npt.ArrayLike] = {"T_chamber": thermal.air_c, "setpoint_c": thermal.setpoint_c}
+    other_units = {"T_chamber": "degC", "setpoint_c": "degC"}
+    truth_channels: dict[str, Any] = {}
+    for (name, unit), rng in zip(IMU_CHANNELS, noise_rngs, strict=True):
+        span = IMU_BIAS_SPAN[unit]
+        coef = [float(coef_rng.uniform(-a, a)) for a in span]
+        bias = coef[0] + x * (coef[1] + x * (coef[2] + x * coef[3]))
+        gravity = 1000.0 if name == gravity_axis else 0.0
+        signals[name] = gravity + bias + IMU_NOISE[unit] * rng.standard_normal(t.size)
+        other[f"truth_{name}"] = bias - coef[0]
+        other_units[f"truth_{name}"] = unit
+        truth_channels[name] = {
+            "unit": unit,
+            "coefficients": coef,
+            "x": "(T_die - 25)/40",
+            "gravity_mg": gravity,
+        }
+    meta = Metadata(
+        sample_interval_s=1.0 / rate_hz,
+        sensor_id="sim-mems-imu-001",
+        run_id=f"mems-imu-seed{seed}-{run}",
+        notes="simulated by thermocal (mems-imu); truth_<channel> = temperature-induced bias "
+        "about its value at 25 °C",
+        extra={"scenario": "mems-imu", "seed": int(seed), "label": run},
+    )
+    rec = Recording.from_arrays(
+        t,
+        signals=signals,
+        temperatures={"T_die": die},
+        signal_unit=dict(IMU_CHANNELS),
+        other=other,
+        other_units=other_units,
+        meta=meta,
+    )
+    truth = _plain_dict(
+        {
+            "format": TRUTH_FORMAT,
+            "version": TRUTH_VERSION,
+            "scenario": "mems-imu",
+            "seed": int(seed),
+            "label": run,
+            "sample_rate_hz": float(rate_hz),
+            "n_samples": int(t.size),
+            "channels": truth_channels,
+            "stages": [st.to_dict() for st in stages],
+        }
+    )
+    return [(rec, truth)]
+
+
 ScenarioFn = Callable[..., ScenarioResult]
 
 SCENARIOS: dict[str, ScenarioFn] = {
@@ -1288,6 +1394,7 @@ SCENARIOS: dict[str, ScenarioFn] = {
     "mems-warmup": scenario_mems_warmup,
     "accel-full-range": scenario_accel_full_range,
     "turntable-16": scenario_turntable16,
+    "mems-imu": scenario_mems_imu,
 }
 """Registry: scenario name → ``fn(seed, profile=None, **opts) -> [(Recording, truth)]``."""
 

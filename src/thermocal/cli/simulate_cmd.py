@@ -91,6 +91,10 @@ def simulate_cmd(
     record_s: Annotated[
         float | None, typer.Option("--record-s", help="Record per power-on [s] (mems-warmup).")
     ] = None,
+    run: Annotated[
+        str | None,
+        typer.Option("--run", help="modelling or validation (mems-imu: the same unit)."),
+    ] = None,
     fmt: Annotated[
         str, typer.Option("--format", help="File format inside an output directory.")
     ] = "csv",
@@ -118,6 +122,7 @@ def simulate_cmd(
             "runs": runs,
             "orientation": orientation,
             "record_s": record_s,
+            "run": run,
         }.items()
         if v is not None
     }
