@@ -33,13 +33,28 @@ def demo_cmd(
     quick: Annotated[
         bool, typer.Option("--quick", help="Smaller data (5 s samples, fewer ramps).")
     ] = False,
+    imu: Annotated[
+        bool,
+        typer.Option(
+            "--imu",
+            help="The six-channel MEMS IMU workflow (gx..az, one die temperature) "
+            "into one calibration, one C module and one report.",
+        ),
+    ] = False,
     as_json: JsonOpt = False,
 ) -> None:
-    """Simulate, fit, validate, compensate and export a ring-laser gyro model; write a report."""
+    """Simulate, fit, validate, compensate and export a ring-laser gyro model; write a report.
+
+    With ``--imu``: the same for a six-channel MEMS IMU, into one calibration file.
+    """
     if output.exists() and not output.is_dir():
         from thermocal.errors import ThermocalInputError
 
         raise ThermocalInputError(f"{output}: exists and is not a directory")
+    if imu:
+        _imu_demo(output if output != Path("thermocal-demo") else Path("thermocal-imu-demo"),
+                  seed, quick, as_json)  # fmt: skip
+        return
     with progress("thermocal demo", total=len(DEMO_STEPS)) as advance:
         res = run_demo(output, seed=seed, config=QUICK if quick else None,
                        progress=lambda _step: advance(1))  # fmt: skip
@@ -98,6 +113,54 @@ def demo_cmd(
         stdout.print(table)
         stdout.print("* reported model; (…) improvement")
         stdout.print(f"{len(res.files)} files in {res.out_dir} ({res.elapsed_s:.1f} s)")
+        stdout.print(f"report: [bold]{escape(str(res.report_path))}[/bold]", markup=True)
+
+    emit(out, as_json, human)
+
+
+def _imu_demo(output: Path, seed: int, quick: bool, as_json: bool) -> None:
+    from thermocal.demo_imu import IMU_STEPS, run_imu_demo
+
+    with progress("thermocal demo --imu", total=len(IMU_STEPS)) as advance:
+        res = run_imu_demo(output, seed=seed, rate_hz=0.2 if quick else 1.0,
+                           progress=lambda _step: advance(1))  # fmt: skip
+    out = {
+        "report": str(res.report_path),
+        "calibration": str(res.calibration_path),
+        "out_dir": str(res.out_dir),
+        "elapsed_s": res.elapsed_s,
+        "seed": seed,
+        "channels": {
+            c.name: {
+                "unit": c.unit,
+                "n_coefficients": c.n_coefficients,
+                "rms_residual": c.rms_residual,
+                "condition_number": c.condition_number,
+                "temp_range_c": list(c.temp_range_c),
+                "r": c.r,
+                "bias_stability_before": c.bias_stability_before,
+                "bias_stability_after": c.bias_stability_after,
+                "rms_before": c.rms_before,
+                "rms_after": c.rms_after,
+                "removed_pct": c.removed_pct,
+                "warnings": c.warnings,
+            }
+            for c in res.channels
+        },
+        "files": [str(p) for p in res.files],
+    }
+
+    def human() -> None:
+        table = Table(title=f"thermocal demo --imu (seed {seed}): validation run")
+        for col in ("channel", "unit", "r", "rms before", "rms after", "bias removed"):
+            table.add_column(col, justify="left" if col in ("channel", "unit") else "right")
+        for c in res.channels:
+            table.add_row(c.name, c.unit, fmt(c.r, 3), fmt(c.rms_before), fmt(c.rms_after),
+                          f"{c.removed_pct:.1f} %")  # fmt: skip
+        stdout.print(table)
+        stdout.print("bias removed: share of the simulator's true temperature-induced bias")
+        stdout.print(f"{len(res.files)} files in {res.out_dir} ({res.elapsed_s:.1f} s)")
+        stdout.print(f"calibration: {escape(str(res.calibration_path))}")
         stdout.print(f"report: [bold]{escape(str(res.report_path))}[/bold]", markup=True)
 
     emit(out, as_json, human)

@@ -1,0 +1,247 @@
+"""``thermocal demo --imu``: the multi-channel workflow on a simulated six-axis MEMS IMU.
+
+Steps (issue 15): simulate the ``mems-imu`` scenario's modelling run and its weakly
+correlated validation run (the same unit, :func:`thermocal.simulate.scenario_mems_imu`);
+fit one cubic per channel on the die temperature into a calibration; validate every
+channel on the validation run (r against the modelling run's chamber air, figures before
+and after); compensate the validation file in one chunked pass; export one C header and
+source for the six channels; write ``report.html`` — a per-channel summary table (range,
+model, residual, validation figures before/after, share of the true temperature-induced
+bias removed) and a grid of bias against die temperature before and after, one panel per
+channel, with the channel's warnings.
+"""
+
+from __future__ import annotations
+
+import base64
+import io
+import time
+import warnings
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from thermocal.compensate import compensate_channels, prepare_run
+from thermocal.errors import ThermocalWarning
+from thermocal.export_c import generate_c_calibration
+from thermocal.io import atomic_write, write_json, write_recording
+from thermocal.models.base import RunData, model_file_dict, model_inputs
+from thermocal.models.calibration import Calibration, Channel, guess_role, save_calibration
+from thermocal.models.poly import PolyModel
+from thermocal.simulate import IMU_CHANNELS, SCENARIOS
+from thermocal.validation import validate
+
+IMU_STEPS = ("simulate", "fit", "validate", "compensate", "export-c", "report")
+"""Progress steps of :func:`run_imu_demo`."""
+
+TEMP = "T_die"
+AMBIENT = "T_chamber"
+
+
+@dataclass
+class ChannelSummary:
+    """One channel's figures: ``removed_pct`` share of the true temperature-induced bias
+    removed on the validation run (``100 (1 − rms(e)/sd(E))``, e the model's error against
+    the truth E, both centred); validation figures in the channel's data unit."""
+
+    name: str
+    unit: str
+    n_coefficients: int
+    rms_residual: float
+    condition_number: float | None
+    temp_range_c: tuple[float, float]
+    r: float | None
+    bias_stability_before: float | None
+    bias_stability_after: float | None
+    rms_before: float | None
+    rms_after: float | None
+    removed_pct: float
+    warnings: list[str] = field(default_factory=list)
+
+
+@dataclass
+class ImuDemoResult:
+    """Where everything went and the per-channel figures."""
+
+    out_dir: Path
+    report_path: Path
+    calibration_path: Path
+    channels: list[ChannelSummary]
+    files: list[Path]
+    elapsed_s: float
+
+
+def run_imu_demo(
+    out_dir: str | Path = "thermocal-imu-demo",
+    *,
+    seed: int = 1,
+    rate_hz: float = 1.0,
+    progress: Callable[[str], None] | None = None,
+) -> ImuDemoResult:
+    """Run the six-channel workflow (module docstring) into ``out_dir``."""
+    out = Path(out_dir)
+    for sub in ("data", "models", "c"):
+        (out / sub).mkdir(parents=True, exist_ok=True)
+    t0 = time.perf_counter()
+    files: list[Path] = []
+
+    def step(name: str) -> None:
+        if progress is not None:
+            progress(name)
+
+    # 1. simulate
+    ((mod, truth),) = SCENARIOS["mems-imu"](seed, rate_hz=rate_hz)
+    ((val, _),) = SCENARIOS["mems-imu"](seed, run="validation", rate_hz=rate_hz)
+    for name, rec in (("imu-modelling", mod), ("imu-validation", val)):
+        p = out / "data" / f"{name}.parquet"
+        write_recording(rec, p)
+        files.append(p)
+    truth_path = out / "data" / "imu.truth.json"
+    write_json(truth_path, truth)
+    files.append(truth_path)
+    step(IMU_STEPS[0])
+
+    # 2. fit: one cubic per channel on the die temperature
+    channels: list[Channel] = []
+    fit_warnings: dict[str, list[str]] = {}
+    for name, unit in IMU_CHANNELS:
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always", ThermocalWarning)
+            run = RunData.from_recording(mod, name, [TEMP])
+            model = PolyModel(order=3, per_run_offset=False).fit([run])
+        model.signal_name, model.signal_unit = name, run.signal_unit or unit
+        model.inputs_ = model_inputs(mod, name, [TEMP])
+        channels.append(Channel(name, name, unit, model, guess_role(name, unit)))
+        fit_warnings[name] = [str(w.message) for w in caught]
+    cal = Calibration(channels)
+    cal_path = out / "models" / "imu.json"
+    save_calibration(cal, cal_path)
+    files.append(cal_path)
+    step(IMU_STEPS[1])
+
+    # 3. validate every channel against the modelling run's chamber air
+    mod_air = (mod.time_s, mod.column(AMBIENT))
+    results = {}
+    for ch in cal.channels:
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always", ThermocalWarning)
+            mrun = prepare_run(ch.model, val, ch.signal, [TEMP])
+            res = validate(ch.model, mrun.run, mod_air, validation_ambient=val.column(AMBIENT))
+        results[ch.name] = res.in_unit(mrun.data_unit, mrun.factor)
+        fit_warnings[ch.name] += [str(w.message) for w in caught]
+    step(IMU_STEPS[2])
+
+    # 4. compensate the validation file, every channel in one pass
+    comp_path = out / "data" / "imu-validation-compensated.parquet"
+    compensate_channels(
+        [(ch.signal, ch.model) for ch in cal.channels], out / "data" / "imu-validation.parquet",
+        comp_path,
+    )  # fmt: skip
+    files.append(comp_path)
+    step(IMU_STEPS[3])
+
+    # 5. one C module for the six channels
+    ex = generate_c_calibration(
+        [(ch.name, model_file_dict(ch.model), ch.unit) for ch in cal.channels], prefix="imu"
+    )
+    files.extend(ex.write(out / "c"))
+    step(IMU_STEPS[4])
+
+    # 6. summary and report
+    summaries = []
+    for ch in cal.channels:
+        model_v = _model_in_data_unit(ch, val)
+        true_e = val.column(f"truth_{ch.name}")
+        err = (model_v - model_v.mean()) - (true_e - true_e.mean())
+        removed = 100.0 * (1.0 - float(np.sqrt(np.mean(err**2))) / float(np.std(true_e)))
+        st = ch.model.stats_
+        res = results[ch.name]
+        summaries.append(
+            ChannelSummary(
+                name=ch.name,
+                unit=ch.unit,
+                n_coefficients=st.n_coefficients,
+                rms_residual=float(st.rms_residual),
+                condition_number=st.condition_number,
+                temp_range_c=(float(ch.model.temp_range_[0, 0]), float(ch.model.temp_range_[0, 1])),
+                r=res.r,
+                bias_stability_before=res.bias_stability_before,
+                bias_stability_after=res.bias_stability_after,
+                rms_before=res.rms_before,
+                rms_after=res.rms_after,
+                removed_pct=removed,
+                warnings=fit_warnings[ch.name],
+            )
+        )
+    report = out / "report.html"
+    _write_report(report, cal, val, summaries, seed)
+    files.append(report)
+    step(IMU_STEPS[5])
+    return ImuDemoResult(out, report, cal_path, summaries, files, time.perf_counter() - t0)
+
+
+def _model_in_data_unit(ch: Channel, rec: Any) -> np.ndarray:
+    """The channel's model on ``rec`` in the data column's own unit."""
+    mrun = prepare_run(ch.model, rec, ch.signal, [TEMP])
+    return mrun.to_data_unit(ch.model.predict(mrun.run))
+
+
+def _bias_grid_png(cal: Calibration, val: Any) -> str:
+    """Bias against die temperature before and after, one panel per channel (base64 PNG)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    n = len(cal.channels)
+    cols = 3
+    rows = (n + cols - 1) // cols
+    fig, axes = plt.subplots(rows, cols, figsize=(4.2 * cols, 3.0 * rows), squeeze=False)
+    temp = val.column(TEMP)
+    step = max(1, temp.size // 4000)
+    for ax, ch in zip(axes.ravel(), cal.channels, strict=False):
+        raw = np.asarray(val.column(ch.signal), dtype=np.float64)
+        model_v = _model_in_data_unit(ch, val)
+        before = raw - np.mean(raw)
+        after = raw - model_v
+        after = after - np.mean(after)
+        ax.plot(temp[::step], before[::step], ".", ms=1.5, color="#c0392b", label="before")
+        ax.plot(temp[::step], after[::step], ".", ms=1.5, color="#2471a3", label="after")
+        ax.set_title(f"{ch.name} [{ch.unit}]", fontsize=10)
+        ax.set_xlabel(f"{TEMP} [°C]", fontsize=8)
+        ax.tick_params(labelsize=7)
+        ax.grid(alpha=0.3)
+    for ax in axes.ravel()[n:]:
+        ax.set_visible(False)
+    axes[0, 0].legend(fontsize=7, markerscale=4)
+    fig.tight_layout()
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", dpi=90)
+    plt.close(fig)
+    return base64.b64encode(buf.getvalue()).decode("ascii")
+
+
+def _write_report(
+    path: Path, cal: Calibration, val: Any, summaries: list[ChannelSummary], seed: int
+) -> None:
+    import jinja2
+
+    env = jinja2.Environment(
+        loader=jinja2.PackageLoader("thermocal.report", "templates"),
+        autoescape=jinja2.select_autoescape(["html", "j2"]),
+        undefined=jinja2.StrictUndefined,
+    )
+    html = env.get_template("calibration.html.j2").render(
+        seed=seed,
+        channels=summaries,
+        grid=_bias_grid_png(cal, val),
+        fmt=lambda v, d=4: "—" if v is None else f"{v:.{d}g}",
+    )
+    with atomic_write(path, "w") as fh:
+        fh.write(html)
+
+
+__all__ = ["IMU_STEPS", "ChannelSummary", "ImuDemoResult", "run_imu_demo"]
