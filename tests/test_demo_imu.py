@@ -15,7 +15,13 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from test_report import check_rendered, run_chromium, skip_without_chromium
+from test_report import (
+    check_number,
+    check_rendered,
+    run_chromium,
+    skip_without_chromium,
+    tagged_numbers,
+)
 from thermocal.cli import main
 from thermocal.simulate import IMU_CHANNELS
 
@@ -78,10 +84,14 @@ def test_compensated_file_is_raw_minus_model(demo: dict[str, Any]) -> None:
 
 def test_report_table_shows_the_json_numbers(demo: dict[str, Any]) -> None:
     html = (demo["dir"] / "report.html").read_text()
-    shown = dict(re.findall(r'data-channel="(\w+)".*?data-removed="([^"]+)"', html, re.S))
-    assert list(shown) == NAMES
+    assert re.findall(r'<tr data-channel="(\w+)"', html) == NAMES
+    tags = tagged_numbers(html)
+    v = json.loads((demo["dir"] / "validation.json").read_text())["channels"]
     for name in NAMES:
-        assert float(shown[name]) == demo["summary"]["channels"][name]["removed_pct"]
+        ch = demo["summary"]["channels"][name]
+        check_number(tags, f"channels.{name}.extra.0", ch["removed_pct"])
+        check_number(tags, f"channels.{name}.validation.rms_after", ch["rms_after"])
+        check_number(tags, f"channels.{name}.validation.rms_after", v[name]["rms_after"])
 
 
 def test_one_c_module_compiles(demo: dict[str, Any], tmp_path: Path) -> None:
@@ -91,7 +101,7 @@ def test_one_c_module_compiles(demo: dict[str, Any], tmp_path: Path) -> None:
     if cc is None:
         pytest.skip("no C compiler")
     d: Path = demo["dir"] / "c"
-    assert sorted(p.name for p in d.iterdir()) == ["imu.c", "imu.h"]
+    assert sorted(p.name for p in d.iterdir()) == ["imu.c", "imu.h"]  # one module
     proc = subprocess.run([cc, *CFLAGS, "-c", str(d / "imu.c"), "-I", str(d),
                            "-o", str(tmp_path / "imu.o")],
                           capture_output=True, text=True, check=False)  # fmt: skip
@@ -101,4 +111,4 @@ def test_one_c_module_compiles(demo: dict[str, Any], tmp_path: Path) -> None:
 def test_imu_report_renders_in_headless_chromium(demo: dict[str, Any], tmp_path: Path) -> None:
     skip_without_chromium()
     result = run_chromium(demo["dir"] / "report.html", tmp_path)
-    check_rendered(result, n_figures_min=1)
+    check_rendered(result, n_figures_min=2)

@@ -125,6 +125,19 @@ class ValidationResult:
             out[key] = 100.0 * (b - a) / b if math.isfinite(a) and math.isfinite(b) and b else None
         return out
 
+    @property
+    def verdict(self) -> str:
+        """One word on the model for this run: ``"NOT weakly correlated"`` when r says the
+        validation run repeats the modelling run (SPEC §5: then it proves nothing), else
+        ``"improved"``/``"NOT improved"`` by the rms of the bias before and after; ``"—"``
+        when the rms cannot be compared."""
+        if self.r is not None and not self.weakly_correlated:
+            return "NOT weakly correlated"
+        imp = self.improvement_pct.get("rms")
+        if imp is None:
+            return "—"
+        return "improved" if imp > 0 else "NOT improved"
+
     def in_unit(self, unit: str, factor: float) -> ValidationResult:
         """The same result with every signal figure in ``unit``, where ``value[self.unit]
         = factor · value[unit]`` (e.g. the data's own unit, :class:`thermocal.compensate.

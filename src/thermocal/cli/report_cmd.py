@@ -28,23 +28,28 @@ from thermocal.cli.common import (
     handle_errors,
     load_recording,
     progress,
+    split_names,
     stderr,
 )
 from thermocal.errors import FileFormatError, ThermocalInputError
 from thermocal.io import check_not_input
 from thermocal.models.base import load_model_dict
+from thermocal.models.calibration import Calibration, load_calibration
 from thermocal.recording import Recording
 from thermocal.report import ModelEntry, ReportInputs, write_report
 
 
-def read_validation_json(path: Path) -> dict[str, Any]:
-    """A validation result file (``thermocal validate --json`` output) as a dict."""
+def read_validation_json(path: Path, *, channels: bool = False) -> dict[str, Any]:
+    """A validation result file (``thermocal validate --json`` output) as a dict; with
+    ``channels`` also the several-channel form ``{"channels": {NAME: {…}}}``."""
     try:
         obj = json.loads(path.read_text(encoding="utf-8"))
     except FileNotFoundError:
         raise ThermocalInputError(f"{path}: no such validation file") from None
     except (json.JSONDecodeError, UnicodeDecodeError) as exc:
         raise FileFormatError(f"{path}: not a JSON validation result ({exc})") from None
+    if channels and isinstance(obj, dict) and isinstance(obj.get("channels"), dict):
+        return obj
     if not isinstance(obj, dict) or "bias_stability_before" not in obj:
         raise FileFormatError(
             f"{path}: not a validation result (expected the JSON object of "
@@ -143,6 +148,21 @@ def report_cmd(
     if modeling is not None:
         inputs_files.append(modeling)
     check_not_input(output, inputs_files)
+    cal = load_calibration(model[0])
+    if len(cal.channels) > 1 or len(split_names(signal) or []) > 1:
+        if len(model) > 1:
+            raise ThermocalInputError(
+                f"{model[0]} is a calibration of {len(cal.channels)} channels: give it as the "
+                "only --model (compare calibrations in separate reports)"
+            )
+        _calibration_report(
+            cal, model[0], recording, output,
+            validation=validations[0] if validations else None, modeling=modeling,
+            signal=signal, title=title, sensor=sensor, time=time, time_unit=time_unit,
+            signal_unit=signal_unit, temp_unit=temp_unit, temp_conversion=temp_conversion,
+            averaging=averaging,
+        )  # fmt: skip
+        return
 
     with progress("building report", total=3) as advance:
         entries = []
@@ -187,5 +207,74 @@ def report_cmd(
         )
         advance(1)
         path = write_report(output, inputs)
+        advance(1)
+    stderr.print(f"report written to [bold]{path}[/bold]")
+
+
+def _calibration_report(
+    cal: Calibration,
+    cal_path: Path,
+    recording: Path,
+    output: Path,
+    *,
+    validation: Path | None,
+    modeling: Path | None,
+    signal: str | None,
+    title: str,
+    sensor: str | None,
+    time: str | None,
+    time_unit: str | None,
+    signal_unit: str | None,
+    temp_unit: str | None,
+    temp_conversion: str | None,
+    averaging: float | None,
+) -> None:
+    """A calibration's report: the recording read once for every chosen channel
+    (:func:`thermocal.report.calibration.build_calibration_report`)."""
+    from thermocal.report.calibration import (
+        CalibrationReportInputs,
+        merged_inputs,
+        temperatures_of,
+        write_calibration_report,
+    )
+
+    names = split_names(signal) or cal.names
+    missing = [n for n in names if n not in cal.names]
+    if missing:
+        raise ThermocalInputError(
+            f"{cal_path}: no channel {', '.join(map(repr, missing))}; it has "
+            + ", ".join(cal.names)
+        )
+    with progress("building calibration report", total=2) as advance:
+        vdict = read_validation_json(validation, channels=True) if validation else None
+        rec = load_recording(
+            recording,
+            time=time,
+            time_unit=time_unit,
+            signal=",".join(cal.channel(n).signal for n in names),
+            temps=",".join(temperatures_of(cal, names)),
+            signal_unit=signal_unit,
+            temp_unit=temp_unit,
+            temp_conversion=temp_conversion,
+            model_inputs=merged_inputs(cal, names),
+        )
+        advance(1)
+        default_title = title == "Temperature compensation report"
+        path = write_calibration_report(
+            output,
+            CalibrationReportInputs(
+                calibration=cal,
+                recording=rec,
+                recording_path=str(recording),
+                modeling_path=str(modeling) if modeling is not None else None,
+                calibration_path=str(cal_path),
+                validation=vdict,
+                validation_path=str(validation) if validation is not None else None,
+                title="Calibration report" if default_title else title,
+                sensor=sensor,
+                averaging_s=averaging,
+                channels=names,
+            ),
+        )
         advance(1)
     stderr.print(f"report written to [bold]{path}[/bold]")

@@ -79,14 +79,6 @@ def _ambient(rec: Recording, name: str) -> FloatArray:
 def _emit_channels(file: Path, per: dict[str, tuple[Any, dict[str, Any]]], as_json: bool) -> None:
     """Several channels: ``{"channels": {NAME: {…}}}`` and one verdict per channel."""
 
-    def verdict(res: Any) -> str:
-        imp = res.improvement_pct.get("rms")
-        if res.r is not None and not res.weakly_correlated:
-            return "NOT weakly correlated"
-        if imp is None:
-            return "—"
-        return "improved" if imp > 0 else "NOT improved"
-
     def human() -> None:
         table = Table(title=f"validation on {file}, {len(per)} channels")
         for col in ("channel", "r", "bias stability before → after", "rms before → after",
@@ -99,12 +91,12 @@ def _emit_channels(file: Path, per: dict[str, tuple[Any, dict[str, Any]]], as_js
                 f"{fmt(res.bias_stability_before)} → {fmt(res.bias_stability_after)}",
                 f"{fmt(res.rms_before)} → {fmt(res.rms_after)}",
                 res.unit,
-                verdict(res),
+                res.verdict,
             )
         stdout.print(table)
 
     emit(
-        {"channels": {n: {**out, "verdict": verdict(res)} for n, (res, out) in per.items()}},
+        {"channels": {n: {**out, "verdict": res.verdict} for n, (res, out) in per.items()}},
         as_json,
         human,
     )

@@ -301,3 +301,86 @@ __all__ = [
     "model_fit",
     "temperature_profile",
 ]
+
+
+# --- several channels (a calibration) ---------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class ChannelBias:
+    """One channel's bias before and after compensation against its temperature."""
+
+    name: str
+    unit: str
+    temperature_label: str
+    temperature_c: FloatArray
+    before: FloatArray
+    after: FloatArray
+
+
+GRID_COLS = 3
+"""Panels per row of the per-channel grids."""
+
+
+@contextmanager
+def _grid(n: int, panel_height_in: float = 2.7) -> Iterator[Any]:
+    import matplotlib
+
+    matplotlib.use("Agg", force=True)
+    from matplotlib.figure import Figure
+
+    cols = min(GRID_COLS, max(n, 1))
+    rows = (n + cols - 1) // cols
+    fig = Figure(figsize=(FIG_WIDTH_IN * 1.25, panel_height_in * rows), dpi=DPI,
+                 layout="constrained")  # fmt: skip
+    axes = fig.subplots(rows, cols, squeeze=False).ravel()
+    for ax in axes[n:]:
+        ax.set_visible(False)
+    for ax in axes[:n]:
+        ax.grid(True, which="major", color="#dddddd", linewidth=0.6)
+        for side in ("top", "right"):
+            ax.spines[side].set_visible(False)
+        ax.tick_params(labelsize=7.5)
+    yield fig, axes[:n]
+
+
+def bias_vs_temperature_grid(channels: Sequence[ChannelBias]) -> bytes:
+    """One panel per channel: bias before and after compensation [its unit] against its
+    temperature [°C], both centred on their means (faint dots: block means; lines: means
+    in 30 temperature bins)."""
+    with _grid(len(channels)) as (fig, axes):
+        for ax, ch in zip(axes, channels, strict=True):
+            b = ch.before - float(np.mean(ch.before))
+            a = ch.after - float(np.mean(ch.after))
+            xs, yb, ya = decimate_for_plot(ch.temperature_c, b, a, max_points=1500)
+            ax.plot(xs, yb, ".", ms=1.8, color=BEFORE_COLOR, alpha=0.25)
+            ax.plot(xs, ya, ".", ms=1.8, color=AFTER_COLOR, alpha=0.25)
+            for y, col, lab in ((b, BEFORE_COLOR, "before"), (a, AFTER_COLOR, "after")):
+                c, m, _se = binned_means(ch.temperature_c, y, n_bins=30, min_count=5)
+                ax.plot(c, m, "-", lw=1.5, color=col, label=lab)
+            ax.set_title(f"{ch.name} [{ch.unit}]", fontsize=9)
+            ax.set_xlabel(f"{ch.temperature_label} [°C]", fontsize=8)
+        axes[0].legend(fontsize=7, frameon=False)
+        return _png(fig)
+
+
+def allan_grid(curves: Sequence[tuple[str, str, Sequence[AllanCurve]]]) -> bytes:
+    """One log-log panel per channel ``(name, unit, curves)``: Allan deviation before and
+    after compensation with its confidence intervals."""
+    colors = (BEFORE_COLOR, AFTER_COLOR)
+    with _grid(len(curves)) as (fig, axes):
+        for ax, (name, unit, cs) in zip(axes, curves, strict=True):
+            for i, c in enumerate(cs):
+                ok = np.isfinite(c.adev) & (c.adev > 0)
+                ax.plot(c.tau_s[ok], c.adev[ok], "o-", ms=2.5, lw=1.0,
+                        color=colors[i % 2], label=c.label)  # fmt: skip
+                if c.adev_low is not None and c.adev_high is not None:
+                    ok &= np.isfinite(c.adev_low) & np.isfinite(c.adev_high)
+                    ax.fill_between(c.tau_s[ok], c.adev_low[ok], c.adev_high[ok],
+                                    color=colors[i % 2], alpha=0.15, lw=0)  # fmt: skip
+            ax.set_xscale("log")
+            ax.set_yscale("log")
+            ax.set_title(f"{name} [{unit}]", fontsize=9)
+            ax.set_xlabel("τ [s]", fontsize=8)
+        axes[0].legend(fontsize=7, frameon=False)
+        return _png(fig)

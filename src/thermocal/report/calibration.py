@@ -1,0 +1,340 @@
+"""HTML report of a calibration: several channels in one document (issue 15).
+
+:func:`build_calibration_report` applies every channel's model to the validation run
+(:func:`thermocal.report.build.apply_model`, each channel in its data column's unit) and
+shows, for 1 to ~18 channels:
+
+1. a per-channel summary table — role, unit, family, coefficients, fitted temperature
+   range, fit residual, condition number; temperature sensitivity (least-squares slope
+   over the hold stages, SPEC §1) and bias stability before → after, computed here from
+   the recording with :func:`thermocal.metrics.compute_metrics`; the validation figures
+   (r, rms before → after) and one verdict per channel when ``thermocal validate --json``
+   output is given (no verdict without it);
+2. bias against temperature before and after, one panel per channel
+   (:func:`thermocal.report.figures.bias_vs_temperature_grid`);
+3. overlapping Allan deviation before and after, one panel per channel, with the IEEE 952
+   bias instability and random walk read from it (:func:`thermocal.report.build.allan_of`);
+4. per channel, in collapsible sections: coefficients with standard errors, ranges of
+   validity, the validation's stages, warnings;
+
+with a table of contents and the files' SHA-256 (provenance).  Gyro channels of a
+calibration are reported without earth-rate removal (each axis sees a different share of
+it; the report says so when the file's metadata names a latitude).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import datetime as _dt
+import warnings
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from thermocal.compensate import unit_factor
+from thermocal.errors import ThermocalInputError
+from thermocal.io import atomic_write
+from thermocal.models.base import model_file_dict
+from thermocal.models.calibration import Calibration
+from thermocal.recording import Recording
+from thermocal.report.build import (
+    DEFAULT_AVERAGING_S,
+    ILL_CONDITIONED,
+    _b64,
+    _coefficient_rows,
+    _env,
+    _range_rows,
+    allan_of,
+    apply_model,
+    figures_of_merit,
+    improvement_pct,
+    sha256_of,
+    unit_label,
+)
+
+
+@dataclass(frozen=True)
+class CalibrationReportInputs:
+    """Everything :func:`build_calibration_report` needs.
+
+    ``recording`` holds every channel's signal column and temperature inputs (the
+    validation run, or any run to show the calibration on); ``validation`` is the JSON
+    object of ``thermocal validate CAL FILE --json`` (``{"channels": {NAME: {…}}}``), or a
+    mapping channel → one validation object; ``extra`` adds named per-channel columns to
+    the summary table (``{column title: {channel: value}}``, e.g. the demo's share of the
+    simulator's true bias removed)."""
+
+    calibration: Calibration
+    recording: Recording
+    recording_path: str | None = None
+    modeling_path: str | None = None
+    calibration_path: str | None = None
+    validation: Mapping[str, Any] | None = None
+    validation_path: str | None = None
+    title: str = "IMU calibration report"
+    sensor: str | None = None
+    generated_by: str = "thermocal report"
+    averaging_s: float | None = None
+    channels: Sequence[str] | None = None
+    extra: Mapping[str, Mapping[str, float]] = field(default_factory=dict)
+    notes: tuple[str, ...] = ()
+
+
+def _validation_of(v: Mapping[str, Any] | None, name: str, single: bool) -> dict[str, Any] | None:
+    if not v:
+        return None
+    per = v.get("channels")
+    if isinstance(per, Mapping):
+        got = per.get(name)
+        return dict(got) if isinstance(got, Mapping) else None
+    if "bias_stability_before" in v and single:  # one channel's validate --json
+        return dict(v)
+    got = v.get(name)
+    return dict(got) if isinstance(got, Mapping) else None
+
+
+def _verdict(v: dict[str, Any] | None) -> tuple[str, str]:
+    """(css class, text): pass/fail from a validation object; n/a without one."""
+    if v is None:
+        return "na", "no validation"
+    text = v.get("verdict")
+    if not isinstance(text, str):  # a one-channel validate --json: the same rule
+        imp = (v.get("improvement_pct") or {}).get("rms")
+        if v.get("r") is not None and v.get("weakly_correlated") is False:
+            text = "NOT weakly correlated"
+        elif not isinstance(imp, int | float):
+            text = "—"
+        else:
+            text = "improved" if imp > 0 else "NOT improved"
+    if text == "—":
+        return "na", "no figures to compare"
+    return ("pass" if text == "improved" else "fail"), text
+
+
+def _figures_in(fom: Any, k: float) -> dict[str, float | None]:
+    """Bias stability and temperature sensitivity of a :class:`FiguresOfMerit` (canonical
+    unit) in the data's unit (``value[data] = value[canonical] / k``)."""
+
+    def div(v: float | None) -> float | None:
+        return None if v is None else float(v) / k
+
+    return {
+        "bias_stability": div(fom.bias_stability),
+        "sensitivity_slope": div(fom.sensitivity_slope),
+    }
+
+
+def _channel_section(
+    inputs: CalibrationReportInputs, name: str, averaging_s: float, tau0: float
+) -> dict[str, Any]:
+    """Everything shown for one channel (figures computed on the full data)."""
+    from thermocal.report import figures as F
+
+    ch = inputs.calibration.channel(name)
+    md = model_file_dict(ch.model)
+    rec = inputs.recording
+    if ch.signal not in rec.columns:
+        raise ThermocalInputError(
+            f"{inputs.recording_path or rec.source}: no column {ch.signal!r} for channel "
+            f"{name!r}; available: " + ", ".join(repr(c) for c in rec.columns)
+        )
+    applied = apply_model(md, rec, ch.signal)  # canonical unit ([°/h] or [mg])
+    # back to the data column's own unit: value[canonical] = k · value[data]
+    unit = rec.units.get(ch.signal) or applied.unit
+    k = unit_factor(unit, applied.unit, meta=rec.meta, where=f"channel {name}")
+    before, after = applied.before / k, applied.after / k
+    t_name = applied.temp_names[0]
+    t_c = applied.temps_c[:, 0]
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        fom = [
+            _figures_in(
+                figures_of_merit(
+                    rec.time_s,
+                    x,
+                    applied.unit,
+                    averaging_s=averaging_s,
+                    meta=rec.meta,
+                    temp_name=t_name,
+                    temp_c=t_c,
+                ),
+                k,
+            )
+            for x in (applied.before, applied.after)
+        ]
+        allan = [allan_of(rec.time_s, x, tau0, unit) for x in (before, after)]
+    msgs = list(applied.warnings) + [" ".join(str(w.message).split()) for w in caught]
+    stats = md.get("fit") or {}
+    cond = stats.get("condition_number")
+    if isinstance(cond, int | float) and cond > ILL_CONDITIONED:
+        msgs.append(f"the fit's design is ill conditioned (condition number {cond:.3g})")
+    rms_fit = stats.get("rms_residual")
+    if isinstance(rms_fit, int | float):  # model unit → data unit
+        rms_fit = float(rms_fit) / unit_factor(unit, ch.model.signal_unit, meta=rec.meta)
+    v = _validation_of(inputs.validation, name, len(inputs.calibration.channels) == 1)
+    if v is not None:
+        msgs += [str(w) for w in v.get("warnings") or []]
+        if v.get("unit") not in (None, unit):
+            msgs.append(f"the validation figures are in {v.get('unit')}, the data in {unit}")
+    vclass, vtext = _verdict(v)
+    terms = [a.terms.fit for a in allan]
+    curves = [
+        F.AllanCurve(lab, a.result.tau_s, a.result.adev, a.result.adev_low, a.result.adev_high)
+        for lab, a in zip(("before", "after"), allan, strict=True)
+    ]
+    role = ch.role or {}
+    key = f"channels.{name}"
+    return {
+        "name": name,
+        "anchor": "ch-" + "".join(c if c.isalnum() else "-" for c in name),
+        "signal": ch.signal,
+        "unit": unit,
+        "unit_label": unit_label(unit),
+        "role": " ".join(str(role[k]) for k in ("kind", "axis", "instance") if role.get(k)),
+        "family": md.get("family", ""),
+        "n_coefficients": stats.get("n_coefficients"),
+        "rms_residual": rms_fit,
+        "condition_number": cond,
+        "temperatures": list(applied.temp_names),
+        "temp_range": _range_rows(md, key),
+        "coefficients": _coefficient_rows(md, key),
+        "before": fom[0],
+        "after": fom[1],
+        "sensitivity_unit": unit_label(f"{unit}/degC"),
+        "sensitivity_improvement": improvement_pct(
+            *(
+                abs(f["sensitivity_slope"]) if f["sensitivity_slope"] is not None else None
+                for f in fom
+            )
+        ),
+        "stability_improvement": improvement_pct(
+            fom[0]["bias_stability"], fom[1]["bias_stability"]
+        ),
+        "bi_before": terms[0].bias_instability,
+        "bi_after": terms[1].bias_instability,
+        "rw_after": terms[1].angle_random_walk,
+        "validation": v,
+        "verdict_class": vclass,
+        "verdict": vtext,
+        "warnings": list(dict.fromkeys(msgs)),
+        "extra": {k: vals.get(name) for k, vals in inputs.extra.items()},
+        "_bias": F.ChannelBias(name, unit_label(unit), t_name, t_c, before, after),
+        "_allan": (name, unit_label(unit), curves),
+    }
+
+
+def build_calibration_report(inputs: CalibrationReportInputs) -> str:
+    """The calibration report as one self-contained HTML document (module docstring)."""
+    from thermocal import __version__
+    from thermocal.report import figures as F
+
+    cal = inputs.calibration
+    names = list(inputs.channels or cal.names)
+    unknown = [n for n in names if n not in cal.names]
+    if unknown:
+        raise ThermocalInputError(
+            f"no channel {', '.join(map(repr, unknown))} in the calibration; it has "
+            + ", ".join(cal.names)
+        )
+    rec = inputs.recording
+    if inputs.validation and isinstance(inputs.validation.get("channels"), Mapping):
+        first: Mapping[str, Any] = next(iter(inputs.validation["channels"].values()), {}) or {}
+        default_avg = first.get("averaging_s")
+    else:
+        default_avg = (inputs.validation or {}).get("averaging_s")
+    averaging_s = float(inputs.averaging_s or default_avg or DEFAULT_AVERAGING_S)
+    # several axes: the earth rate differs per axis, so none is removed (stated below)
+    notes = list(inputs.notes)
+    if rec.meta.latitude_deg is not None and len(names) > 1:
+        notes.append(
+            "The earth rate is not removed from gyro channels in this report (each axis "
+            "sees a different share of it); biases are the sensor's output."
+        )
+        rec = dataclasses.replace(
+            rec, meta=dataclasses.replace(rec.meta, latitude_deg=None, axis=None)
+        )
+        inputs = dataclasses.replace(inputs, recording=rec)
+    tau0 = rec.sample_interval_s
+    sections = [_channel_section(inputs, n, averaging_s, tau0) for n in names]
+    grid = F.bias_vs_temperature_grid([s.pop("_bias") for s in sections])
+    allan = F.allan_grid([s.pop("_allan") for s in sections])
+    files = [
+        (label, path, sha256_of(path))
+        for label, path in (
+            ("calibration", inputs.calibration_path),
+            ("validation run", inputs.recording_path),
+            ("modelling run", inputs.modeling_path),
+            ("validation result", inputs.validation_path),
+        )
+        if path
+    ]
+    html: str = (
+        _env()
+        .get_template("calibration.html.j2")
+        .render(
+            title=inputs.title,
+            sensor=inputs.sensor,
+            version=__version__,
+            generated_utc=_dt.datetime.now(_dt.UTC).strftime("%Y-%m-%d %H:%M UTC"),
+            generated_by=inputs.generated_by,
+            channels=sections,
+            extra_titles=list(inputs.extra),
+            has_validation=any(s["validation"] is not None for s in sections),
+            averaging_s=averaging_s,
+            n_samples=rec.time_s.size,
+            duration_h=float(rec.time_s[-1] - rec.time_s[0]) / 3600.0,
+            tau0=tau0,
+            grid=_b64(grid),
+            allan=_b64(allan),
+            files=files,
+            notes=notes,
+            any_warnings=any(s["warnings"] for s in sections),
+        )
+    )
+    return html
+
+
+def write_calibration_report(path: str | Path, inputs: CalibrationReportInputs) -> Path:
+    """Build the calibration report and write it atomically to ``path``; returns the path."""
+    html = build_calibration_report(inputs)
+    with atomic_write(path, "wb") as fh:
+        fh.write(html.encode("utf-8"))
+    return Path(path)
+
+
+def temperatures_of(cal: Calibration, names: Sequence[str] | None = None) -> list[str]:
+    """Every temperature input of the chosen channels, in first-seen order."""
+    out: list[str] = []
+    for n in names or cal.names:
+        for t in cal.channel(n).model.temp_names_:
+            if t not in out:
+                out.append(str(t))
+    return out
+
+
+def merged_inputs(cal: Calibration, names: Sequence[str] | None = None) -> dict[str, Any]:
+    """The chosen channels' recorded inputs (units, conversions, time unit) merged into one
+    model-file ``inputs`` object, to read a recording once for all of them; the first
+    channel's wins where two disagree (each channel's unit is checked again when its model
+    is applied)."""
+    out: dict[str, Any] = {}
+    units_: dict[str, Any] = {}
+    conv: dict[str, Any] = {}
+    for n in reversed(list(names or cal.names)):
+        inp = dict(getattr(cal.channel(n).model, "inputs_", {}) or {})
+        units_.update(inp.get("units") or {})
+        conv.update(inp.get("temperature_conversion") or {})
+        out.update(inp)
+    out["units"] = units_
+    out["temperature_conversion"] = conv
+    return out
+
+
+__all__ = [
+    "CalibrationReportInputs",
+    "build_calibration_report",
+    "merged_inputs",
+    "temperatures_of",
+    "write_calibration_report",
+]
