@@ -80,6 +80,9 @@ def test_compensated_file_is_raw_minus_model(demo: dict[str, Any]) -> None:
     for name in NAMES:
         np.testing.assert_allclose(comp[f"{name}_comp"], raw[name] - comp[f"{name}_model"],
                                    rtol=0, atol=1e-9)  # fmt: skip
+    # +z is up: the compensated z accelerometer keeps gravity, the others read about 0
+    assert float(comp["az_comp"].mean()) == pytest.approx(1000.0, abs=0.5)
+    assert abs(float(comp["ax_comp"].mean())) < 0.5
 
 
 def test_report_table_shows_the_json_numbers(demo: dict[str, Any]) -> None:

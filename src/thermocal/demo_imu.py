@@ -22,6 +22,7 @@ from typing import Any
 
 import numpy as np
 
+from thermocal import units
 from thermocal.compensate import compensate_channels, prepare_run
 from thermocal.errors import ThermocalWarning
 from thermocal.export_c import generate_c_calibration
@@ -37,6 +38,8 @@ IMU_STEPS = ("simulate", "fit", "validate", "compensate", "export-c", "report")
 """Progress steps of :func:`run_imu_demo`."""
 
 TEMP = "T_die"
+GRAVITY_AXIS = "+z"
+"""The simulated unit sits with +z up (the scenario's gravity on az)."""
 TRUE_REMOVED = "true bias removed [%]"
 AMBIENT = "T_chamber"
 
@@ -110,10 +113,14 @@ def run_imu_demo(
     for name, unit in IMU_CHANNELS:
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always", ThermocalWarning)
-            run = RunData.from_recording(mod, name, [TEMP])
+            # gravity on the up axis (+z) is a known input: compensation keeps it
+            g_mg = units.gravity_on_axis_mg(name[-1], GRAVITY_AXIS, units.STANDARD_GRAVITY_M_S2)
+            g_mg = g_mg if units.signal_kind(unit) == "accel" else 0.0
+            run = RunData.from_recording(mod, name, [TEMP], known_input=g_mg)
             model = PolyModel(order=3, per_run_offset=False).fit([run])
         model.signal_name, model.signal_unit = name, run.signal_unit or unit
-        model.inputs_ = model_inputs(mod, name, [TEMP])
+        what = f"gravity {g_mg:+g} mg ({GRAVITY_AXIS} up)" if g_mg else "none"
+        model.inputs_ = model_inputs(mod, name, [TEMP], known_input=g_mg, known_input_what=what)
         channels.append(Channel(name, name, unit, model, guess_role(name, unit)))
         fit_warnings[name] = [str(w.message) for w in caught]
     cal = Calibration(channels)

@@ -717,6 +717,58 @@ def parse_axis(axis: str | npt.ArrayLike) -> npt.NDArray[np.float64]:
     return vec / n
 
 
+# --- gravity --------------------------------------------------------------------------
+
+WGS84_EQUATORIAL_GRAVITY_M_S2: Final = 9.7803253359
+"""WGS-84 normal gravity at the equator γe [m/s²] (NIMA TR8350.2, 3rd ed., table 3.4)."""
+WGS84_SOMIGLIANA_K: Final = 0.00193185265241
+"""Somigliana's constant k of WGS-84 [-] (NIMA TR8350.2, eq. 4-1)."""
+WGS84_E2: Final = 0.00669437999013
+"""First eccentricity squared e² of the WGS-84 ellipsoid [-] (NIMA TR8350.2, table 3.3)."""
+
+
+def normal_gravity_m_s2(latitude_deg: float) -> float:
+    """WGS-84 normal gravity on the ellipsoid at geodetic latitude φ [m/s²].
+
+    Somigliana's closed formula (NIMA TR8350.2, eq. 4-1):
+    ``γ(φ) = γe (1 + k sin²φ) / sqrt(1 − e² sin²φ)``; 9.7803 at the equator, 9.8322 at
+    the poles.  Height above the ellipsoid is neglected (−3.1e-6 m/s² per metre).
+    """
+    if not -90.0 <= latitude_deg <= 90.0:
+        raise UnitError(f"latitude must be within ±90°, got {latitude_deg}")
+    s2 = math.sin(math.radians(latitude_deg)) ** 2
+    return (
+        WGS84_EQUATORIAL_GRAVITY_M_S2
+        * (1.0 + WGS84_SOMIGLIANA_K * s2)
+        / math.sqrt(1.0 - WGS84_E2 * s2)
+    )
+
+
+def parse_gravity_axis(text: str) -> tuple[str, float]:
+    """The body axis pointing up in a static run, ``"+z"``/``"-x"``/``"z"`` →
+    (``"z"``, +1.0): the axis letter and the sign of the specific force it reads."""
+    key = text.strip().lower().replace(" ", "")
+    sign = -1.0 if key.startswith("-") else 1.0
+    letter = key.lstrip("+-")
+    if letter not in ("x", "y", "z"):
+        raise UnitError(
+            f"--gravity-axis: expected the body axis pointing up, +x, -x, +y, -y, +z or -z; "
+            f"got {text!r}"
+        )
+    return letter, sign
+
+
+def gravity_on_axis_mg(channel_axis: str, gravity_axis: str, gravity_m_s2: float) -> float:
+    """Specific force of gravity read by a static accelerometer along ``channel_axis``
+    (``"x"``, ``"y"``, ``"z"``) when ``gravity_axis`` (``"+z"``…) points up [mg]:
+    ``±1000 · g / g0`` on the up axis, 0 on the others (g0 = 9.80665 m/s², the unit
+    of ``g`` and ``mg``)."""
+    letter, sign = parse_gravity_axis(gravity_axis)
+    if channel_axis != letter:
+        return 0.0
+    return sign * 1000.0 * gravity_m_s2 / STANDARD_GRAVITY_M_S2
+
+
 # --- raw counts ----------------------------------------------------------------------
 
 DEFAULT_SCALE_FACTOR_UNIT: Final = "counts/arcsec"

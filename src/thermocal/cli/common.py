@@ -246,11 +246,15 @@ def earth_rate_known_input(
     return earth_rate_on_axis_deg_h(latitude, parse_axis(axis))
 
 
-def known_input_what(latitude: float | None, axis: str | None, other: float | None) -> str:
+def known_input_what(
+    latitude: float | None, axis: str | None, other: float | None, gravity: str | None = None
+) -> str:
     """What a fit's known input is, for the model file (``inputs.known_input.what``)."""
     parts = []
     if latitude is not None and axis is not None:
         parts.append(f"earth rate at latitude {latitude:g}° on axis {axis}")
+    if gravity:
+        parts.append(gravity)
     if other:
         parts.append(f"--known-input {other:g}")
     return " + ".join(parts) or "none"

@@ -50,14 +50,17 @@ from __future__ import annotations
 
 import dataclasses
 import inspect
+import math
 import warnings
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Annotated, Any
 
+import numpy as np
 import typer
 from rich.table import Table
 
+from thermocal import units
 from thermocal.cli.app import app
 from thermocal.cli.common import (
     AxisOpt,
@@ -81,7 +84,7 @@ from thermocal.cli.common import (
     split_names,
     stdout,
 )
-from thermocal.errors import ConditioningWarning, ThermocalInputError
+from thermocal.errors import ConditioningWarning, ThermocalInputError, ThermocalWarning
 from thermocal.io import check_not_input
 from thermocal.models.base import (
     RunData,
@@ -93,7 +96,7 @@ from thermocal.models.base import (
     save_model,
 )
 from thermocal.models.calibration import Calibration, Channel, guess_role, save_calibration
-from thermocal.recording import Recording
+from thermocal.recording import FloatArray, Recording
 
 TARGETS = ("bias", "scale_factor")
 
@@ -215,6 +218,30 @@ def fit_cmd(
         float | None,
         typer.Option("--known-input", help="Known input to remove, canonical signal unit."),
     ] = None,
+    gravity_axis: Annotated[
+        str | None,
+        typer.Option(
+            "--gravity-axis",
+            help="Accelerometers: the body axis pointing up in the static runs (+x, -x, +y, "
+            "-y, +z, -z); the gravity it reads is a known input, so compensation keeps it.",
+        ),
+    ] = None,
+    gravity: Annotated[
+        float | None,
+        typer.Option(
+            "--gravity",
+            help="Local gravity [m/s²] for --gravity-axis (default: WGS-84 normal gravity "
+            "at --latitude, else standard gravity with a warning).",
+        ),
+    ] = None,
+    tref: Annotated[
+        float | None,
+        typer.Option(
+            "--tref",
+            help="poly: also give the coefficients about this reference temperature [°C] "
+            "(in T − TREF, the PX4/ArduPilot convention).",
+        ),
+    ] = None,
     as_json: JsonOpt = False,
 ) -> None:
     """Fit a temperature-compensation model on one or several runs and save it."""
@@ -249,6 +276,13 @@ def fit_cmd(
         raise ThermocalInputError(f"--select-method must be bic or holdout, got {select_method!r}")
     build_model(model, options)  # refuse options that do not apply before reading
     names = split_names(signal) or []
+    if len(names) > 1 and axis is not None:
+        raise ThermocalInputError(
+            "earth-rate removal (--axis) takes one signal at a time: each gyro's sensitive "
+            "axis points elsewhere; fit the gyros one by one with their --axis, or leave the "
+            "earth rate in the bias"
+        )
+    g_local = _local_gravity(gravity_axis, gravity, latitude)
     # every file read once, with every channel's column (several channels: issue 15)
     loaded = [
         (
@@ -266,7 +300,12 @@ def fit_cmd(
         )
         for path in files
     ]
-    spec = _FitSpec(model, options, temps, latitude, axis, known_input, target)
+    if tref is not None and model != "poly":
+        raise ThermocalInputError(
+            f"--tref applies to the poly family (coefficients about TREF), not {model!r}"
+        )
+    spec = _FitSpec(model, options, temps, latitude, axis, known_input, target,
+                    gravity_axis, g_local, tref)  # fmt: skip
     if len(names) <= 1:
         est, result, n_runs = _fit_channel(spec, loaded, signal)
         save_model(est, output)
@@ -301,6 +340,91 @@ class _FitSpec:
     axis: str | None
     known_input: float | None
     target: str
+    gravity_axis: str | None = None
+    gravity_m_s2: float | None = None
+    tref_c: float | None = None
+
+
+GRAVITY_TOLERANCE_MG = 100.0
+"""How far the up accelerometer's mean may be from the local gravity, and a horizontal
+one's from 0, before the orientation is doubted [mg] (0.1 g: a 6° tilt)."""
+
+
+def _local_gravity(
+    gravity_axis: str | None, gravity: float | None, latitude: float | None
+) -> float | None:
+    """The local gravity [m/s²] for ``--gravity-axis``: ``--gravity``, else WGS-84 normal
+    gravity at ``--latitude`` (:func:`thermocal.units.normal_gravity_m_s2`), else standard
+    gravity, stated in a warning."""
+    if gravity_axis is None:
+        if gravity is not None:
+            raise ThermocalInputError("--gravity applies with --gravity-axis only")
+        return None
+    units.parse_gravity_axis(gravity_axis)  # refuse a bad axis before reading
+    if gravity is not None:
+        if not 9.7 <= gravity <= 9.9:
+            raise ThermocalInputError(
+                f"--gravity {gravity:g}: local gravity on the earth's surface is 9.78-9.83 m/s²"
+            )
+        return float(gravity)
+    if latitude is not None:
+        return units.normal_gravity_m_s2(latitude)
+    warnings.warn(
+        f"--gravity-axis without --gravity or --latitude: assuming standard gravity "
+        f"{units.STANDARD_GRAVITY_M_S2} m/s² (local gravity differs by up to 0.3 %)",
+        ThermocalWarning,
+        stacklevel=2,
+    )
+    return units.STANDARD_GRAVITY_M_S2
+
+
+def _gravity_known_input(
+    spec: _FitSpec, path: Path, name: str, unit: str, values_mg: FloatArray
+) -> float:
+    """The gravity an accelerometer channel reads in the static run [mg] (0 for a gyro or
+    without ``--gravity-axis``), after checking the channel's mean against it: the up axis
+    within :data:`GRAVITY_TOLERANCE_MG` of ±g (else an input error), a horizontal axis
+    within it of 0 (else a warning: the tilt's share stays in the constant).  Without
+    ``--gravity-axis``, an accelerometer reading about ±1 g gets a warning: the model's
+    constant would hold gravity and compensation would take it out."""
+    if units.signal_kind(unit) != "accel":
+        return 0.0
+    mean = float(np.mean(values_mg))
+    if spec.gravity_axis is None or spec.gravity_m_s2 is None:
+        if abs(mean) > 500.0:
+            warnings.warn(
+                f"{path}: {name} reads {mean:.1f} mg on average: gravity is in the data; "
+                "without --gravity-axis the model's constant holds it and compensation "
+                f"takes it out ({name}_comp ≈ 0); give --gravity-axis (the axis pointing up)",
+                ThermocalWarning,
+                stacklevel=2,
+            )
+        return 0.0
+    role = guess_role(name, unit) or {}
+    letter = role.get("axis")
+    if letter is None:
+        raise ThermocalInputError(
+            f"--gravity-axis {spec.gravity_axis}: channel {name!r} names no axis (x, y or z "
+            "as its last letter); fit it with --known-input instead"
+        )
+    g_mg = units.gravity_on_axis_mg(letter, spec.gravity_axis, spec.gravity_m_s2)
+    off = mean - g_mg
+    if g_mg != 0.0 and abs(off) > GRAVITY_TOLERANCE_MG:
+        raise ThermocalInputError(
+            f"{path}: --gravity-axis {spec.gravity_axis}: {name} should read about "
+            f"{g_mg:+.1f} mg but reads {mean:.1f} mg on average; is {spec.gravity_axis} the "
+            "axis pointing up, and the unit right?"
+        )
+    if g_mg == 0.0 and abs(off) > GRAVITY_TOLERANCE_MG:
+        tilt = math.degrees(math.asin(min(1.0, abs(mean) / 1000.0)))
+        warnings.warn(
+            f"{path}: {name} is horizontal with {spec.gravity_axis} up but reads {mean:.1f} "
+            f"mg (a tilt of about {tilt:.0f}°): its share of gravity stays in the model's "
+            "constant",
+            ThermocalWarning,
+            stacklevel=2,
+        )
+    return g_mg
 
 
 def _fit_channel(
@@ -325,13 +449,21 @@ def _fit_channel(
         if unit and run_unit != unit:
             raise ThermocalInputError(f"{path}: signal unit {run_unit} differs from {unit}")
         unit = run_unit
-        ki = earth_rate_known_input(latitude, axis, unit, path)
+        # --latitude serves gravity alone when no --axis names a gyro's sensitive axis
+        earth_lat = None if (spec.gravity_axis and axis is None) else latitude
+        ki = earth_rate_known_input(earth_lat, axis, unit, path)
+        g_ki = _gravity_known_input(spec, path, sig_name, unit, _values)
+        ki += g_ki
         if known_input is not None:
             ki += known_input
         if not runs:  # the model learns how its inputs were written (model file "inputs")
+            gravity_what = (
+                f"gravity {g_ki:+.6g} mg ({spec.gravity_axis} up, g = {spec.gravity_m_s2:.7g} "
+                "m/s²)" if g_ki else None
+            )  # fmt: skip
             first_inputs = model_inputs(
                 rec, sig_name, run_temp_names(rec, temps), known_input=ki,
-                known_input_what=known_input_what(latitude, axis, known_input),
+                known_input_what=known_input_what(earth_lat, axis, known_input, gravity_what),
             )  # fmt: skip
         run = RunData.from_recording(
             rec, signal, split_names(temps), known_input=ki, temperature_unit="auto"
@@ -426,8 +558,17 @@ def _fit_channel(
         "fit": st.to_dict(),
         "coefficients": [c.to_dict() for c in est.coefficients()],
         "warnings": messages,
+        "known_input": {
+            "value": first_inputs.get("known_input", {}).get("value", ki),
+            "what": first_inputs.get("known_input", {}).get("what"),
+        },
         "unit_as_given": (first_inputs.get("units") or {}).get(sig_name, unit),
     }
+    if spec.tref_c is not None:
+        result["tref"] = {
+            "tref_c": spec.tref_c,
+            "coefficients": [c.to_dict() for c in est.coefficients_about(spec.tref_c)],  # type: ignore[attr-defined]
+        }
     return est, result, len(runs)
 
 
@@ -471,6 +612,13 @@ def _human_single(est: TemperatureModel, result: dict[str, Any], n_runs: int, ou
         weak += bool(flag)
         ctab.add_row(c.name, fmt(c.value, 6), fmt(c.stderr, 3), f"{fmt(ratio, 2)}{flag}", c.unit)
     stdout.print(ctab)
+    if "tref" in result:
+        ttab = Table(title=f"coefficients about TREF = {result['tref']['tref_c']:g} °C")
+        for col in ("name", "value", "std. error", "unit"):
+            ttab.add_column(col)
+        for c in result["tref"]["coefficients"]:
+            ttab.add_row(c["name"], fmt(c["value"], 6), fmt(c.get("stderr"), 3), c.get("unit", ""))
+        stdout.print(ttab)
     if weak:
         stdout.print(
             f"* {weak} coefficient(s) within 2 standard errors of 0: not distinct from "

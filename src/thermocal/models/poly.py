@@ -1281,6 +1281,61 @@ class PolyModel(TemperatureModel):
             )
         return out
 
+    def coefficients_about(self, tref_c: float) -> list[Coefficient]:
+        """Raw-monomial coefficients about a reference temperature: the same model written
+        in ``dT_k = T_k − TREF`` (the convention of PX4's and ArduPilot's thermal
+        calibrations, INTERFACE.md "export-params"), with standard errors.
+
+        Each monomial ``T_k^P Ṫ_k^Q = ((T_k − TREF) + TREF)^P Ṫ_k^Q`` expands binomially
+        into ``Σ_j C(P, j) TREF^(P−j) dT_k^j Ṫ_k^Q``; with ``S`` that linear map,
+        ``b = S a`` and ``cov b = S cov a Sᵀ``.  Names use ``dT1`` for ``T1 − TREF``…
+        (rates keep ``Ṫ``, written ``rate1``).  Only the constant and the
+        polynomial terms change; the model's values do not.
+        """
+        self.check_fitted()
+        if not math.isfinite(tref_c):
+            raise ThermocalInputError(f"TREF must be a finite temperature, got {tref_c}")
+        keys, M = raw_expansion(self.terms_, self.scaling_)
+        beta = np.r_[self.constant_, self.coef_]
+        raw = M @ beta
+        cov_raw = M @ self.cov_ @ M.T
+        out_keys: list[tuple[int, int, int]] = [(-1, 0, 0)]
+        index = {(-1, 0, 0): 0}
+        entries: list[tuple[int, int, float]] = []  # (row in b, column in a, weight)
+        for col, (k, P, Q) in enumerate(keys):
+            if k < 0:
+                entries.append((0, col, 1.0))
+                continue
+            for j in range(P + 1):
+                new = (k, j, Q) if (j or Q) else (-1, 0, 0)
+                if new not in index:
+                    index[new] = len(out_keys)
+                    out_keys.append(new)
+                entries.append((index[new], col, math.comb(P, j) * tref_c ** (P - j)))
+        S = np.zeros((len(out_keys), len(keys)))
+        for row, col, w in entries:
+            S[row, col] += w
+        b = S @ raw
+        se = np.sqrt(np.clip(np.diag(S @ cov_raw @ S.T), 0.0, None))
+        out: list[Coefficient] = []
+        for key, v, e in zip(out_keys, b, se, strict=True):
+            k, P, Q = key
+            unit = self.signal_unit
+            if P:
+                unit += "/degC" + (f"^{P}" if P > 1 else "")
+            if Q:
+                unit += "/(degC/min)" + (f"^{Q}" if Q > 1 else "")
+            name = "const"
+            if k >= 0:
+                parts = []
+                if P:
+                    parts.append(f"(T{k + 1}-TREF)" + (f"^{P}" if P > 1 else ""))
+                if Q:
+                    parts.append(f"rate{k + 1}" + (f"^{Q}" if Q > 1 else ""))
+                name = "*".join(parts)
+            out.append(Coefficient(name, float(v), float(e) if math.isfinite(e) else None, unit))
+        return out
+
     def scaled_coefficients(self) -> list[Coefficient]:
         """Coefficients in the scaled basis actually evaluated (constant first)."""
         self.check_fitted()
