@@ -35,7 +35,7 @@ import warnings
 from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
 import numpy.typing as npt
@@ -547,19 +547,41 @@ class ChunkPredictor:
         if self._tau is None:
             tau = median_interval(time_s) if n > 1 else float("nan")
             self._tau = tau if math.isfinite(tau) and tau > 0 else 1.0
+        return self.predict_with(time_s, temps_c, signal, [])[0]
+
+    def predict_with(
+        self,
+        time_s: FloatArray,
+        temps_c: FloatArray,
+        signal: FloatArray,
+        followers: Sequence[ChunkPredictor],
+    ) -> list[FloatArray]:
+        """ŷ of this predictor's model and of each follower's (several channels whose
+        ``poly`` models share one evaluation, :func:`thermocal.models.poly.predict_many`):
+        the context is carried once, here; the followers' counts follow."""
+        n = time_s.size
+        if n == 0:
+            return [np.zeros(0) for _ in range(1 + len(followers))]
+        if self._tau is None:
+            tau = median_interval(time_s) if n > 1 else float("nan")
+            self._tau = tau if math.isfinite(tau) and tau > 0 else 1.0
         lo, hi = self.model.temp_range_[:, 0], self.model.temp_range_[:, 1]
-        self.n_outside += int(np.count_nonzero(((temps_c < lo) | (temps_c > hi)).any(axis=1)))
+        outside = int(np.count_nonzero(((temps_c < lo) | (temps_c > hi)).any(axis=1)))
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", ExtrapolationWarning)
             if self.streams:
-                y = self._predict_stream(time_s, temps_c, signal)
+                ys = [self._predict_stream(time_s, temps_c, signal)]
             else:
-                y = self._predict_context(time_s, temps_c, signal)
-        self._rows_seen += n
-        if self._t_first is None:
-            self._t_first = float(time_s[0])
-        self._t_last = float(time_s[-1])
-        return y
+                ys = self._predict_context(
+                    time_s, temps_c, signal, [self.model, *(f.model for f in followers)]
+                )
+        for p in (self, *followers):
+            p.n_outside += outside
+            p._rows_seen += n
+            if p._t_first is None:
+                p._t_first = float(time_s[0])
+            p._t_last = float(time_s[-1])
+        return ys
 
     def _predict_stream(
         self, time_s: FloatArray, temps_c: FloatArray, signal: FloatArray
@@ -572,8 +594,12 @@ class ChunkPredictor:
         return self._stream.process(time_s, temps_c, signal).model_value
 
     def _predict_context(
-        self, time_s: FloatArray, temps_c: FloatArray, signal: FloatArray
-    ) -> FloatArray:
+        self,
+        time_s: FloatArray,
+        temps_c: FloatArray,
+        signal: FloatArray,
+        models: Sequence[TemperatureModel],
+    ) -> list[FloatArray]:
         assert self.context.head_s is not None
         assert self.context.tail_s is not None
         assert self._tau is not None
@@ -599,8 +625,15 @@ class ChunkPredictor:
             name=self.name,
             known_input=self.known_input,
         )
-        y_all = np.asarray(self.model.predict(run, extrapolate=self.extrapolate), dtype=np.float64)
-        y = y_all[m:].copy()
+        if len(models) == 1:
+            y_alls = [np.asarray(self.model.predict(run, extrapolate=self.extrapolate))]
+        else:
+            from thermocal.models.poly import PolyModel, predict_many
+
+            y_alls = predict_many(
+                [cast(PolyModel, mdl) for mdl in models], run, extrapolate=self.extrapolate
+            )
+        ys = [np.asarray(y_all[m:], dtype=np.float64).copy() for y_all in y_alls]
         # carry the context on
         if not self._head_done:
             head_s = self.context.head_s + self.MARGIN_SAMPLES * GAP_FACTOR * self._tau
@@ -615,7 +648,7 @@ class ChunkPredictor:
         self._tail_t = ct[start:].copy()
         self._tail_T = cT[start:].copy()
         self._tail_f = cf[start:].copy()
-        return y
+        return ys
 
     def finish(self) -> None:
         """Issue one :class:`ExtrapolationWarning` for the whole file, if any sample
@@ -846,7 +879,10 @@ class _Writer:
                 meta.pop(b"pandas", None)
                 meta[META_KEY.encode()] = json.dumps(self.info).encode("utf-8")
                 self._schema = table.schema.with_metadata(meta)
-                self._pq = pq.ParquetWriter(self.tmp, self._schema)
+                # dictionary encoding of float columns costs 3x the write time and rarely
+                # shrinks measured data; keep it for the others (ids, counts, text)
+                dict_cols = [f.name for f in self._schema if not pa.types.is_floating(f.type)]
+                self._pq = pq.ParquetWriter(self.tmp, self._schema, use_dictionary=dict_cols)
             assert self._schema is not None
             self._pq.write_table(table.cast(self._schema))
         else:
@@ -1065,6 +1101,7 @@ def compensate_channels(
     out_info = _output_info(info, time_col, t_unit, plans)
 
     state: dict[str, Any] = {"rows": 0, "chunks": 0, "last_t": None}
+    groups = _evaluation_groups(plans)
 
     def writer(tmp: Path) -> None:
         w = _Writer(tmp, kind_out, out_info)
@@ -1074,10 +1111,23 @@ def compensate_channels(
                 t = _chunk_time(chunk, time_col, t_factor, src, row0, state["last_t"])
                 new: dict[str, FloatArray] = {}
                 temps_cache: dict[tuple[str, str], FloatArray] = {}
-                for plan in plans:
-                    y_data, comp = _compensate_chunk(plan, chunk, t, temps_cache, src, row0)
-                    new[plan.model_col] = y_data
-                    new[plan.comp_col] = comp
+                inputs = {
+                    id(plan): _chunk_inputs(plan, chunk, t, temps_cache, src, row0)
+                    for plan in plans
+                }
+                for group in groups:  # channels sharing one evaluation: one predict call
+                    lead = group[0]
+                    temps, raw = inputs[id(lead)]
+                    ys = lead.predictor.predict_with(
+                        t, temps, raw * cast(float, lead.factor),
+                        [p.predictor for p in group[1:]],
+                    )  # fmt: skip
+                    for plan, y_model in zip(group, ys, strict=True):
+                        y_data, comp = _chunk_outputs(plan, inputs[id(plan)][1], y_model)
+                        new[plan.model_col] = y_data
+                        new[plan.comp_col] = comp
+                # the output keeps the channels in the order given
+                new = {c: new[c] for plan in plans for c in (plan.model_col, plan.comp_col)}
                 w.write(_append_columns(chunk, new))
                 state["rows"] = row0 + t.size
                 state["chunks"] = int(state["chunks"]) + 1
@@ -1176,7 +1226,7 @@ def _chunk_time(
     return t
 
 
-def _compensate_chunk(
+def _chunk_inputs(
     plan: _ChannelPlan,
     chunk: pd.DataFrame | pa.RecordBatch,
     t: FloatArray,
@@ -1184,8 +1234,9 @@ def _compensate_chunk(
     src: Path,
     row0: int,
 ) -> tuple[FloatArray, FloatArray]:
-    """One channel of one chunk: (ŷ, F − ŷ) in the data's unit. Temperature inputs are
-    converted once per chunk and shared between channels (``temps_cache``)."""
+    """One channel's inputs in one chunk: (temperatures [°C or counts], raw signal [data
+    unit]), checked. Temperature inputs are converted once per chunk and shared between
+    channels (``temps_cache``)."""
     temps = np.empty((t.size, len(plan.temp_names)))
     for j, c in enumerate(plan.temp_names):
         conv = plan.convs[c]
@@ -1210,12 +1261,43 @@ def _compensate_chunk(
             plan.data_unit, plan.model.signal_unit, meta=plan.md, sample_interval_s=tau,
             where=str(src),
         )  # fmt: skip
-    y_model = plan.predictor.predict(t, temps, raw * plan.factor)
+    return temps, raw
+
+
+def _chunk_outputs(
+    plan: _ChannelPlan, raw: FloatArray, y_model: FloatArray
+) -> tuple[FloatArray, FloatArray]:
+    """(ŷ, F − ŷ) in the data's unit from ŷ in the model's unit."""
+    assert plan.factor is not None
     y_data = y_model / plan.factor
     comp = raw - y_data
     plan.before.add(raw)
     plan.after.add(comp)
     return y_data, comp
+
+
+def _evaluation_groups(plans: Sequence[_ChannelPlan]) -> list[list[_ChannelPlan]]:
+    """Channels evaluated together: ``poly`` models with one evaluation key
+    (:func:`thermocal.models.poly.evaluation_key`: same inputs, ranges and term structure,
+    as :func:`~thermocal.models.poly.fit_shared` makes them) and the same temperature
+    conversions; every other channel alone."""
+    from thermocal.models.poly import PolyModel, evaluation_key
+
+    groups: dict[Any, list[_ChannelPlan]] = {}
+    out: list[list[_ChannelPlan]] = []
+    for plan in plans:
+        if not isinstance(plan.model, PolyModel) or plan.predictor.streams:
+            out.append([plan])
+            continue
+        convs = tuple(
+            (c, repr(v.to_json()) if v is not None else "") for c, v in sorted(plan.convs.items())
+        )
+        key = (evaluation_key(plan.model), convs)
+        if key not in groups:
+            groups[key] = []
+            out.append(groups[key])
+        groups[key].append(plan)
+    return out
 
 
 __all__ = [

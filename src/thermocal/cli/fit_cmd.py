@@ -52,9 +52,10 @@ import dataclasses
 import inspect
 import math
 import warnings
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Annotated, Any
+from typing import Annotated, Any, cast
 
 import numpy as np
 import typer
@@ -96,6 +97,7 @@ from thermocal.models.base import (
     save_model,
 )
 from thermocal.models.calibration import Calibration, Channel, guess_role, save_calibration
+from thermocal.models.poly import PolyModel, fit_shared
 from thermocal.recording import FloatArray, Recording
 
 TARGETS = ("bias", "scale_factor")
@@ -312,7 +314,7 @@ def fit_cmd(
         result["output"] = str(output)
         emit(result, as_json, lambda: _human_single(est, result, n_runs, output))
         return
-    fitted = [(name, *_fit_channel(spec, loaded, name)) for name in names]
+    fitted = _fit_channels(spec, loaded, names)
     cal = Calibration(
         [
             Channel(name, name, str(res["unit_as_given"]), est, guess_role(name, res["unit"]))
@@ -427,15 +429,69 @@ def _gravity_known_input(
     return g_mg
 
 
+@dataclass
+class _Prepared:
+    """One channel ready to fit: its model, runs and provenance, and the warnings so far."""
+
+    est: TemperatureModel
+    runs: list[RunData]
+    first_inputs: dict[str, Any]
+    provenance: list[dict[str, Any]]
+    unit: str
+    sig_name: str
+    caught: list[Any]
+
+
 def _fit_channel(
     spec: _FitSpec, loaded: list[tuple[Path, Recording]], signal: str | None
 ) -> tuple[TemperatureModel, dict[str, Any], int]:
     """Fit one channel on the loaded runs; returns the model, its ``--json`` result and
     the number of runs. Warnings are printed (by handle_errors) and listed in the result."""
+    ((_n, est, result, n_runs),) = _fit_channels(spec, loaded, [signal])
+    return est, result, n_runs
+
+
+def _fit_channels(
+    spec: _FitSpec, loaded: list[tuple[Path, Recording]], signals: Sequence[str | None]
+) -> list[tuple[str, TemperatureModel, dict[str, Any], int]]:
+    """Fit every channel on the loaded runs (each file read once, by the caller).  Channels
+    of the ``poly`` family with the same temperature inputs share one design
+    (:func:`thermocal.models.poly.fit_shared`: Ṫ, features and the design's reduction once;
+    every model equal, bit for bit, to its own fit)."""
+    preps = [_prepare_channel(spec, loaded, sig) for sig in signals]
+    if spec.family == "poly" and len(preps) > 1:
+        _share_inputs(preps)
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            fit_shared([cast(PolyModel, p.est) for p in preps], [p.runs for p in preps])
+        for p in preps:
+            p.caught.extend(caught)
+    else:
+        for p in preps:
+            with warnings.catch_warnings(record=True) as caught:
+                warnings.simplefilter("always")
+                p.est.fit(p.runs)
+            p.caught.extend(caught)
+    return [(p.sig_name, *_finish_channel(spec, p)) for p in preps]
+
+
+def _share_inputs(preps: list[_Prepared]) -> None:
+    """Give every channel's runs the first channel's time and temperature arrays when they
+    are equal (one copy in memory, and :func:`fit_shared` sees one design)."""
+    first = preps[0].runs
+    for p in preps[1:]:
+        for i, r in enumerate(p.runs):
+            f = first[i]
+            if r.temps_c is not f.temps_c and np.array_equal(r.temps_c, f.temps_c):
+                p.runs[i] = dataclasses.replace(r, temps_c=f.temps_c)
+
+
+def _prepare_channel(
+    spec: _FitSpec, loaded: list[tuple[Path, Recording]], signal: str | None
+) -> _Prepared:
+    """One channel's runs with their known inputs, its model object and provenance."""
     est = build_model(spec.family, spec.options)
-    temps, latitude, axis, known_input, target = (
-        spec.temps, spec.latitude, spec.axis, spec.known_input, spec.target,
-    )  # fmt: skip
+    temps, latitude, axis, known_input = spec.temps, spec.latitude, spec.axis, spec.known_input
     runs: list[RunData] = []
     first_inputs: dict[str, Any] = {}
     provenance: list[dict[str, Any]] = []
@@ -502,7 +558,17 @@ def _fit_channel(
             )
         elif known_ids and "sensor_id" not in first_inputs:
             first_inputs["sensor_id"] = known_ids[0]
-        est.fit(runs)
+    return _Prepared(est, runs, first_inputs, provenance, unit, sig_name, list(caught))
+
+
+def _finish_channel(
+    spec: _FitSpec, prep: _Prepared
+) -> tuple[TemperatureModel, dict[str, Any], int]:
+    """After the fit: the fit-quality warnings, the model's metadata, the ``--json`` result."""
+    est, runs, first_inputs, provenance = prep.est, prep.runs, prep.first_inputs, prep.provenance
+    unit, sig_name, target = prep.unit, prep.sig_name, spec.target
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
         dof = getattr(est.stats_, "dof", None)
         if dof is not None and dof <= 0:
             warnings.warn(
@@ -515,8 +581,9 @@ def _fit_channel(
         note = (getattr(est.stats_, "extra", None) or {}).get("residual_correlation", {})
         if note and note.get("note"):
             warnings.warn(f"{est.family}: {note['note']}", ConditioningWarning, stacklevel=1)
-    messages = [one_line(str(w.message)) for w in caught]
-    for w in caught:  # hand them on to handle_errors, which prints them on stderr
+    all_caught = [*prep.caught, *caught]
+    messages = [one_line(str(w.message)) for w in all_caught]
+    for w in all_caught:  # hand them on to handle_errors, which prints them on stderr
         warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
 
     est.signal_name = sig_name
@@ -559,7 +626,7 @@ def _fit_channel(
         "coefficients": [c.to_dict() for c in est.coefficients()],
         "warnings": messages,
         "known_input": {
-            "value": first_inputs.get("known_input", {}).get("value", ki),
+            "value": first_inputs.get("known_input", {}).get("value", 0.0),
             "what": first_inputs.get("known_input", {}).get("what"),
         },
         "unit_as_given": (first_inputs.get("units") or {}).get(sig_name, unit),

@@ -113,7 +113,7 @@ from thermocal.models.terms import (
     BaseScaling,
     Chunk,
     Term,
-    accumulate_r,
+    accumulate_targets,
     backward_partners,
     fit_base_scaling,
     forward_select,
@@ -630,8 +630,11 @@ class _BlockEvaluator:
         *,
         extrapolate: bool,
         rates: FloatArray | None = None,
+        plans: Sequence[EvalPlan] | None = None,
     ) -> None:
         self.plan = plan
+        self.plans = list(plans) if plans else [plan]
+        """The plans evaluated: one, or several of one structure (:func:`predict_many`)."""
         self.rates = rates
         self.t = run.time_s
         self.temps = run.temps_c
@@ -677,8 +680,11 @@ class _BlockEvaluator:
                 out.append((s0, b0, min(s1, b0 + rows)))
         return out
 
-    def run_blocks(self, blocks: Sequence[tuple[int, int, int]], out: FloatArray) -> _Seen:
-        """Evaluate ``blocks`` into ``out``; returns the ranges seen."""
+    def run_blocks(
+        self, blocks: Sequence[tuple[int, int, int]], out: FloatArray | Sequence[FloatArray]
+    ) -> _Seen:
+        """Evaluate ``blocks`` into ``out`` (one array per plan); returns the ranges seen."""
+        outs = [out] if isinstance(out, np.ndarray) else list(out)
         seen = _Seen()
         if not blocks:
             return seen
@@ -695,8 +701,10 @@ class _BlockEvaluator:
             "tmp": np.empty(width),
             "span": np.empty(width),
         }
+        if len(self.plans) > 1:
+            buf["dwork"] = np.empty((nd, width))
         for s0, a, b in blocks:
-            self._block(s0, a, b, out[a:b], seen, buf)
+            self._block(s0, a, b, [o[a:b] for o in outs], seen, buf)
         return seen
 
     def _block(
@@ -704,7 +712,7 @@ class _BlockEvaluator:
         s0: int,
         a: int,
         b: int,
-        o: FloatArray,
+        outs: list[FloatArray],
         seen: _Seen,
         buf: dict[str, FloatArray],
     ) -> None:
@@ -740,7 +748,8 @@ class _BlockEvaluator:
                 np.clip(cur, self.t_lo, self.t_hi, out=tc)
         nr = len(plan.sensors)
         if nr == 0:
-            o.fill(plan.constant)
+            for o, pl in zip(outs, self.plans, strict=True):
+                o.fill(pl.constant)
             return
         if self.all_rows:
             ta, cura, preva = tc, cur, prev
@@ -793,7 +802,29 @@ class _BlockEvaluator:
                 if plan.centred["w"]:
                     np.subtract(dk, plan.centres["w"], out=dk)
             d[kind] = dk
-        # step 4: Horner on all variables at once, sums per sensor, then over the sensors
+        # step 4, per plan: on the centred variables themselves (one plan), or on a copy
+        # of them for each plan (several plans of one structure: the same operations)
+        if len(self.plans) == 1:
+            self._horner(plan, dall, d, nr, c, buf, outs[0])
+            return
+        work = buf["dwork"][:, :c]
+        for o, pl in zip(outs, self.plans, strict=True):
+            np.copyto(work, dall)
+            dw = {kind: work[i * nr : (i + 1) * nr] for i, kind in enumerate(plan.kinds)}
+            self._horner(pl, work, dw, nr, c, buf, o)
+
+    @staticmethod
+    def _horner(
+        plan: EvalPlan,
+        dall: FloatArray,
+        d: dict[str, FloatArray],
+        nr: int,
+        c: int,
+        buf: dict[str, FloatArray],
+        o: FloatArray,
+    ) -> None:
+        """Step 4 of one plan: Horner on all variables at once (``dall`` is overwritten),
+        sums per sensor, then over the sensors, into ``o``."""
         if plan.horner and not plan.mixed:
             acc = buf["acc"][:nr, :c]
             for i in range(len(plan.kinds)):
@@ -966,189 +997,16 @@ class PolyModel(TemperatureModel):
 
         Works through each run in blocks of :data:`~thermocal.models.terms.CHUNK_ROWS`
         samples (Ṫ, features and the reduction per block), so memory stays at the
-        input arrays plus a few MB.
+        input arrays plus a few MB.  :func:`fit_shared` fits several channels at once.
         """
-        self._check_params()
-        rl = check_runs(runs, self.family)
-        k = rl[0].temps_c.shape[1]
-        terms = parse_terms(self.terms, k, self.order)
-        uses_rate = any(t.uses_rate for t in terms)
-        n_total = sum(r.n_samples for r in rl)
-        p = len(terms)
-        decision = decide_run_offsets(self.per_run_offset, rl, self.family)
-        use_offsets = decision.used
-        m = len(rl) if use_offsets else 1
-        n_folds = 2 if self.select == "holdout" else 1
-        if n_total <= p + m:
-            raise ThermocalInputError(
-                f"poly: {n_total} samples for {p + m} coefficients; need more samples than terms"
-            )
-        plans = [run_blocks(r.time_s, n_folds) for r in rl]
-        if uses_rate:
-            shares = [
-                short_rate_share(r.time_s, float(self.rate_interval_s), self.rate_method)
-                for r in rl
-            ]
-            n_short = sum(c for c, _ in shares)
-            if n_short > SHORT_RATE_WARN_SHARE * n_total:
-                warnings.warn(
-                    f"poly: {n_short / n_total:.0%} of the samples have a temperature rate taken "
-                    f"over less than half the rate interval ({self.rate_interval_s:g} s): the "
-                    f"record breaks into {sum(g for _, g in shares)} contiguous segment(s) at "
-                    "its gaps (bursts or dropouts), and a rate over a fraction of a second is "
-                    "temperature noise; the rate terms and the fitted rate range rest on it. "
-                    "Fit a plain polynomial (--order N), average the record to one block per "
-                    "burst, or choose --rate-interval shorter than the segments",
-                    ConditioningWarning,
-                    stacklevel=2,
-                )
-        # centres and scales of the base variables from ≤ SCALING_SAMPLES evenly spaced samples
-        step = max(1, math.ceil(n_total / SCALING_SAMPLES))
-        t_sub: list[FloatArray] = []
-        r_sub: list[FloatArray] = []
-        for r, plan in zip(rl, plans, strict=True):
-            idx = np.arange(0, r.n_samples, step)
-            t_sub.append(r.temps_c[idx])
-            if uses_rate:
-                r_sub.append(self._rates_at(r, plan, idx))
-        scaling = fit_base_scaling(t_sub, r_sub if uses_rate else None, terms)
-        del t_sub, r_sub
-        temp_lo = np.full((len(rl), k), np.inf)
-        temp_hi = np.full((len(rl), k), -np.inf)
-        rate_lo = np.full((len(rl), k), np.inf)
-        rate_hi = np.full((len(rl), k), -np.inf)
-        sums = np.zeros(3)  # n, Σ(y − y0), Σ(y − y0)²
-
-        current_run = [0]  # the run of the chunk last yielded (residual pass)
-
-        def make_chunks() -> Iterator[Chunk]:
-            bufs: dict[int, FloatArray] = {}
-            sums[:] = 0.0
-            y0 = float(cast(FloatArray, rl[0].signal)[0]) - rl[0].known_input
-            for i, (r, plan) in enumerate(zip(rl, plans, strict=True)):
-                current_run[0] = i
-                g = i if use_offsets else 0
-                sig = cast(FloatArray, r.signal)
-                for s0, s1, a, b, fold in plan:
-                    rates: FloatArray | None = None
-                    if uses_rate:
-                        rates = segment_rates(
-                            r.time_s[s0:s1],
-                            r.temps_c[s0:s1],
-                            np.arange(a - s0, b - s0),
-                            float(self.rate_interval_s),
-                            self.rate_method,
-                        )
-                        np.minimum(rate_lo[i], rates.min(axis=0), out=rate_lo[i])
-                        np.maximum(rate_hi[i], rates.max(axis=0), out=rate_hi[i])
-                    c = b - a
-                    if c not in bufs:
-                        bufs[c] = np.empty((c, p + 2), order="F")
-                        bufs[c][:, p] = 1.0
-                    A = bufs[c]
-                    Tf = np.asfortranarray(r.temps_c[a:b])  # contiguous columns
-                    np.minimum(temp_lo[i], Tf.min(axis=0), out=temp_lo[i])
-                    np.maximum(temp_hi[i], Tf.max(axis=0), out=temp_hi[i])
-                    term_features(terms, scaling, Tf, rates, out=A[:, :p])
-                    y = np.subtract(sig[a:b], r.known_input, out=A[:, p + 1])
-                    d = y - y0
-                    sums[0] += c
-                    sums[1] += float(np.sum(d))
-                    sums[2] += float(d @ d)
-                    yield A, g, fold
-
-        red = accumulate_r(make_chunks, p, m, n_folds=n_folds, solver=cast(Any, self.solver))
-        names = [t.name for t in terms] + (
-            [f"offset[{r.name or i + 1}]" for i, r in enumerate(rl)] if use_offsets else ["const"]
-        )
-        required = list(range(p, p + m))
-        selection: dict[str, Any] | None = None
-        kept = list(range(p))
-        if self.select is not None:
-            sel = forward_select(red, list(range(p)), required, names, cast(Any, self.select))
-            kept = sorted(c for c in sel.kept if c < p)
-            selection = {
-                "method": sel.method,
-                "kept": [names[c] for c in kept],
-                "order_added": [names[c] for c in sel.kept if c < p],
-                "path": sel.path,
-            }
-        penalised = np.zeros(p + m, dtype=bool)
-        penalised[:p] = True
-        sol = solve_r(
-            red.combined(),
-            red.n_total,
-            names,
-            penalised=penalised,
-            ridge=float(self.ridge),
-            rcond=self.rcond,
-            noise_threshold=self.noise_threshold,
-            columns=kept + required,
-        )
-        pk = len(kept)
-        coef = sol.coef[:pk]
-        offsets = sol.coef[pk:]
-        # residuals, a second pass over the same chunks, for their autocorrelation time:
-        # the covariance is scaled by τ (models.residuals; chamber residuals are coloured)
-        per_run: list[list[FloatArray]] = [[] for _ in rl]
-        for A, g, _fold in make_chunks():
-            i = current_run[0]
-            if sum(x.size for x in per_run[i]) >= MAX_SAMPLES_PER_SERIES:
-                continue
-            e = A[:, p + 1] - A[:, kept] @ coef - offsets[g]
-            per_run[i].append(e)
-        corr = residual_correlation(
-            [np.concatenate(x) if x else np.zeros(0) for x in per_run],
-            data_rms=math.sqrt(max(sums[2], 0.0) / max(sums[0], 1.0)),
-        )
-        del per_run
-        # [constant, coef] = L @ [coef, offsets]; constant = mean of the offsets
-        L = np.zeros((pk + 1, pk + m))
-        L[0, pk:] = 1.0 / m
-        L[1:, :pk] = np.eye(pk)
-        cov = corr.tau * (L @ sol.cov @ L.T)
-        if sol.condition_number > COND_WARN:
-            warnings.warn(
-                f"poly: ill-conditioned design (condition number {sol.condition_number:.3g}); "
-                f"{sol.n_truncated} singular value(s) truncated at rcond={self.rcond}; "
-                "consider fewer terms, --select or --ridge",
-                ConditioningWarning,
-                stacklevel=2,
-            )
-        n_s, s1_, s2_ = sums
-        tss = s2_ - s1_ * s1_ / n_s
-        self.terms_ = [terms[c] for c in kept]
-        self.scaling_ = scaling
-        self.coef_ = np.asarray(coef, dtype=np.float64)
-        self.offsets_ = np.asarray(offsets, dtype=np.float64)
-        self.constant_ = float(np.mean(offsets))
-        self.cov_ = cov
-        self.selection_ = selection
-        stats = FitStats(
-            n_samples=n_total,
-            n_coefficients=pk + 1,
-            rms_residual=math.sqrt(sol.rss / n_total),
-            condition_number=sol.condition_number,
-            r_squared=float(1.0 - sol.rss / tss) if tss > 0 else None,
-            dof=sol.dof,
-            extra={
-                "rank": sol.rank,
-                "n_truncated": sol.n_truncated,
-                "rcond": self.rcond,
-                "ridge": float(self.ridge),
-                "solver": red.solver,
-                "n_runs": len(rl),
-                "per_run_offsets": [float(o) for o in offsets] if use_offsets else None,
-                "offset_decision": decision.to_dict(),
-                "residual_correlation": corr.to_dict(),
-                "terms": [t.name for t in self.terms_],
-                "selected_terms": selection["kept"] if selection else None,
-            },
-        )
-        record_ranges(
-            self, rl, stats, (rate_lo, rate_hi) if uses_rate else None, (temp_lo, temp_hi)
-        )
+        fit_shared([self], [runs])
         return self
+
+    def _params_key(self) -> tuple[Any, ...]:
+        t = self.terms if not isinstance(self.terms, list) else tuple(self.terms)
+        return (t, self.order, float(self.rate_interval_s), self.rate_method, self.select,
+                float(self.ridge), self.rcond, self.per_run_offset, self.solver,
+                self.noise_threshold)  # fmt: skip
 
     def _rates_at(self, run: RunData, plan: list[Block], idx: npt.NDArray[np.intp]) -> FloatArray:
         out = np.zeros((idx.size, run.temps_c.shape[1]))
@@ -1389,6 +1247,298 @@ class PolyModel(TemperatureModel):
         if not self.model_uses_rate:
             d["rate"] = None
         return d
+
+
+def evaluation_key(model: PolyModel) -> tuple[Any, ...]:
+    """What decides how a fitted model's inputs are turned into its centred variables
+    (steps 1–3 of the module docstring) and the shape of step 4: models with equal keys
+    (channels fitted together by :func:`fit_shared`, unless term selection differs) can
+    be evaluated together by :func:`predict_many`."""
+    model.check_fitted()
+    plan = model._plan()
+    rr = model.rate_range_
+    return (
+        tuple(model.temp_names_),
+        float(model.rate_interval_s),
+        model.rate_method,
+        np.asarray(model.temp_range_).tobytes(),
+        None if rr is None else np.asarray(rr).tobytes(),
+        plan.sensors,
+        plan.kinds,
+        plan.rate_sensors,
+        tuple(sorted(plan.centred.items())),
+        tuple((k, np.asarray(v).tobytes()) for k, v in sorted(plan.centres.items())),
+        tuple((row, factors) for row, _c, factors in plan.mixed),
+        len(plan.horner),
+    )
+
+
+def predict_many(
+    models: Sequence[PolyModel], run: RunData, *, extrapolate: bool = False
+) -> list[FloatArray]:
+    """:meth:`PolyModel.predict` of several models on one run: the clamped temperatures,
+    Ṫ and centred variables once, then each model's polynomial (step 4) on a copy of
+    them — the same operations as each model alone, so each result equals its own
+    :meth:`~PolyModel.predict` bit for bit.  Models whose :func:`evaluation_key` differs
+    are evaluated one by one.  Range warnings are issued once (the ranges are shared)."""
+    if not models:
+        return []
+    head = models[0]
+    key = evaluation_key(head)
+    if len(models) == 1 or any(evaluation_key(m) != key for m in models[1:]):
+        return [m.predict(run, extrapolate=extrapolate) for m in models]
+    head._check_temps(run)
+    plan = head._plan()
+    rates: FloatArray | None = None
+    if plan.rate_sensors and head.rate_method != "backward":
+        rates = temperature_rates(
+            run.time_s, run.temps_c, float(head.rate_interval_s), head.rate_method
+        )
+    ev = _BlockEvaluator(
+        head, plan, run, extrapolate=extrapolate, rates=rates, plans=[m._plan() for m in models]
+    )
+    outs = [np.empty(run.n_samples) for _ in models]
+    seen = ev.run_blocks(ev.blocks(), outs)
+    k = int(run.temps_c.shape[1])
+    t_min, t_max = seen.temperature(k)
+    warn_temperature_range(
+        t_min, t_max, head.temp_range_, head.temp_names_, seen.n_outside, extrapolate=extrapolate
+    )
+    if plan.rate_sensors and head.rate_range_ is not None:
+        r_min = np.full(k, np.inf)
+        r_max = np.full(k, -np.inf)
+        rows = list(plan.sensors)
+        r_min[rows], r_max[rows] = seen.rate(len(rows))
+        warn_rate_range(
+            r_min, r_max, head.rate_range_, head.temp_names_, list(plan.rate_sensors),
+            extrapolate=extrapolate,
+        )  # fmt: skip
+    return outs
+
+
+def _same_inputs(a: RunData, b: RunData) -> bool:
+    """The two runs have the same times and temperatures (the same arrays, or equal)."""
+
+    def same(x: FloatArray, y: FloatArray) -> bool:
+        return x is y or (x.shape == y.shape and bool(np.array_equal(x, y)))
+
+    return same(a.time_s, b.time_s) and same(a.temps_c, b.temps_c)
+
+
+def fit_shared(models: Sequence[PolyModel], runs_by_model: Sequence[Sequence[RunData]]) -> None:
+    """Fit several channels that share one design (issue 15): the same parameters and the
+    same runs' times and temperatures, each with its own signal and known input.
+
+    The work that depends on the temperatures alone — Ṫ, the base-variable scaling, the
+    features, the reduction of the design, the offset decision, the ranges — is done once;
+    the design's Gram matrix is accumulated once; only the targets' products are per channel
+    (:func:`~thermocal.models.terms.accumulate_targets`), so each channel's reduction is
+    computed by the operations a single channel gets, bit for bit.  Term
+    selection, the solution, the residuals' autocorrelation and the covariance are per
+    channel, so every model equals the one :meth:`PolyModel.fit` gives on its own runs.
+    """
+    if not models or len(models) != len(runs_by_model):
+        raise ThermocalInputError("fit_shared: one list of runs per model")
+    head = models[0]
+    for mdl in models:
+        mdl._check_params()
+        if mdl._params_key() != head._params_key():
+            raise ThermocalInputError("fit_shared: the models' parameters differ")
+    rls = [check_runs(r, head.family) for r in runs_by_model]
+    rl = rls[0]
+    for other in rls[1:]:
+        if len(other) != len(rl) or not all(
+            _same_inputs(a, b) for a, b in zip(rl, other, strict=True)
+        ):
+            raise ThermocalInputError(
+                "fit_shared: the channels' runs differ in time or temperatures; fit them apart"
+            )
+    nt = len(models)
+    k = rl[0].temps_c.shape[1]
+    terms = parse_terms(head.terms, k, head.order)
+    uses_rate = any(t.uses_rate for t in terms)
+    n_total = sum(r.n_samples for r in rl)
+    p = len(terms)
+    decision = decide_run_offsets(head.per_run_offset, rl, head.family)
+    use_offsets = decision.used
+    m = len(rl) if use_offsets else 1
+    n_folds = 2 if head.select == "holdout" else 1
+    if n_total <= p + m:
+        raise ThermocalInputError(
+            f"poly: {n_total} samples for {p + m} coefficients; need more samples than terms"
+        )
+    plans = [run_blocks(r.time_s, n_folds) for r in rl]
+    if uses_rate:
+        shares = [
+            short_rate_share(r.time_s, float(head.rate_interval_s), head.rate_method) for r in rl
+        ]
+        n_short = sum(c for c, _ in shares)
+        if n_short > SHORT_RATE_WARN_SHARE * n_total:
+            warnings.warn(
+                f"poly: {n_short / n_total:.0%} of the samples have a temperature rate taken "
+                f"over less than half the rate interval ({head.rate_interval_s:g} s): the "
+                f"record breaks into {sum(g for _, g in shares)} contiguous segment(s) at "
+                "its gaps (bursts or dropouts), and a rate over a fraction of a second is "
+                "temperature noise; the rate terms and the fitted rate range rest on it. "
+                "Fit a plain polynomial (--order N), average the record to one block per "
+                "burst, or choose --rate-interval shorter than the segments",
+                ConditioningWarning,
+                stacklevel=3,
+            )
+    # centres and scales of the base variables from ≤ SCALING_SAMPLES evenly spaced samples
+    step = max(1, math.ceil(n_total / SCALING_SAMPLES))
+    t_sub: list[FloatArray] = []
+    r_sub: list[FloatArray] = []
+    for r, plan in zip(rl, plans, strict=True):
+        idx = np.arange(0, r.n_samples, step)
+        t_sub.append(r.temps_c[idx])
+        if uses_rate:
+            r_sub.append(head._rates_at(r, plan, idx))
+    scaling = fit_base_scaling(t_sub, r_sub if uses_rate else None, terms)
+    del t_sub, r_sub
+    temp_lo = np.full((len(rl), k), np.inf)
+    temp_hi = np.full((len(rl), k), -np.inf)
+    rate_lo = np.full((len(rl), k), np.inf)
+    rate_hi = np.full((len(rl), k), -np.inf)
+    sums = np.zeros((nt, 3))  # per target: n, Σ(y − y0), Σ(y − y0)²
+    y0 = np.array([float(cast(FloatArray, rs[0].signal)[0]) - rs[0].known_input for rs in rls])
+    current_run = [0]  # the run of the chunk last yielded (residual pass)
+
+    def make_chunks() -> Iterator[Chunk]:
+        bufs: dict[int, FloatArray] = {}
+        sums[:] = 0.0
+        for i, (r, plan) in enumerate(zip(rl, plans, strict=True)):
+            current_run[0] = i
+            g = i if use_offsets else 0
+            sigs = [cast(FloatArray, rs[i].signal) for rs in rls]
+            known = [rs[i].known_input for rs in rls]
+            for s0, s1, a, b, fold in plan:
+                rates: FloatArray | None = None
+                if uses_rate:
+                    rates = segment_rates(
+                        r.time_s[s0:s1],
+                        r.temps_c[s0:s1],
+                        np.arange(a - s0, b - s0),
+                        float(head.rate_interval_s),
+                        head.rate_method,
+                    )
+                    np.minimum(rate_lo[i], rates.min(axis=0), out=rate_lo[i])
+                    np.maximum(rate_hi[i], rates.max(axis=0), out=rate_hi[i])
+                c = b - a
+                if c not in bufs:
+                    bufs[c] = np.empty((c, p + 1 + nt), order="F")
+                    bufs[c][:, p] = 1.0
+                A = bufs[c]
+                Tf = np.asfortranarray(r.temps_c[a:b])  # contiguous columns
+                np.minimum(temp_lo[i], Tf.min(axis=0), out=temp_lo[i])
+                np.maximum(temp_hi[i], Tf.max(axis=0), out=temp_hi[i])
+                term_features(terms, scaling, Tf, rates, out=A[:, :p])
+                for j in range(nt):
+                    y = np.subtract(sigs[j][a:b], known[j], out=A[:, p + 1 + j])
+                    d = y - y0[j]
+                    sums[j, 0] += c
+                    sums[j, 1] += float(np.sum(d))
+                    sums[j, 2] += float(d @ d)
+                yield A, g, fold
+
+    reds = accumulate_targets(make_chunks, p, m, nt, n_folds=n_folds, solver=cast(Any, head.solver))
+    names = [t.name for t in terms] + (
+        [f"offset[{r.name or i + 1}]" for i, r in enumerate(rl)] if use_offsets else ["const"]
+    )
+    required = list(range(p, p + m))
+    penalised = np.zeros(p + m, dtype=bool)
+    penalised[:p] = True
+    solved = []
+    for j, mdl in enumerate(models):
+        red = reds[j]
+        selection: dict[str, Any] | None = None
+        kept = list(range(p))
+        if mdl.select is not None:
+            sel = forward_select(red, list(range(p)), required, names, cast(Any, mdl.select))
+            kept = sorted(c for c in sel.kept if c < p)
+            selection = {
+                "method": sel.method,
+                "kept": [names[c] for c in kept],
+                "order_added": [names[c] for c in sel.kept if c < p],
+                "path": sel.path,
+            }
+        sol = solve_r(
+            red.combined(),
+            red.n_total,
+            names,
+            penalised=penalised,
+            ridge=float(mdl.ridge),
+            rcond=mdl.rcond,
+            noise_threshold=mdl.noise_threshold,
+            columns=kept + required,
+        )
+        solved.append((kept, selection, sol))
+    # residuals, a second pass over the same chunks, for their autocorrelation time:
+    # the covariance is scaled by τ (models.residuals; chamber residuals are coloured)
+    per_run: list[list[list[FloatArray]]] = [[[] for _ in rl] for _ in models]
+    for A, g, _fold in make_chunks():
+        i = current_run[0]
+        for j, (kept, _sel, sol) in enumerate(solved):
+            if sum(x.size for x in per_run[j][i]) >= MAX_SAMPLES_PER_SERIES:
+                continue
+            pk = len(kept)
+            e = A[:, p + 1 + j] - A[:, kept] @ sol.coef[:pk] - sol.coef[pk:][g]
+            per_run[j][i].append(e)
+    for j, (mdl, (kept, selection, sol)) in enumerate(zip(models, solved, strict=True)):
+        pk = len(kept)
+        coef = sol.coef[:pk]
+        offsets = sol.coef[pk:]
+        n_s, s1_, s2_ = sums[j]
+        corr = residual_correlation(
+            [np.concatenate(x) if x else np.zeros(0) for x in per_run[j]],
+            data_rms=math.sqrt(max(s2_, 0.0) / max(n_s, 1.0)),
+        )
+        per_run[j] = []
+        # [constant, coef] = L @ [coef, offsets]; constant = mean of the offsets
+        L = np.zeros((pk + 1, pk + m))
+        L[0, pk:] = 1.0 / m
+        L[1:, :pk] = np.eye(pk)
+        cov = corr.tau * (L @ sol.cov @ L.T)
+        if sol.condition_number > COND_WARN:
+            warnings.warn(
+                f"poly: ill-conditioned design (condition number {sol.condition_number:.3g}); "
+                f"{sol.n_truncated} singular value(s) truncated at rcond={mdl.rcond}; "
+                "consider fewer terms, --select or --ridge",
+                ConditioningWarning,
+                stacklevel=3,
+            )
+        tss = s2_ - s1_ * s1_ / n_s
+        mdl.terms_ = [terms[c] for c in kept]
+        mdl.scaling_ = scaling
+        mdl.coef_ = np.asarray(coef, dtype=np.float64)
+        mdl.offsets_ = np.asarray(offsets, dtype=np.float64)
+        mdl.constant_ = float(np.mean(offsets))
+        mdl.cov_ = cov
+        mdl.selection_ = selection
+        stats = FitStats(
+            n_samples=n_total,
+            n_coefficients=pk + 1,
+            rms_residual=math.sqrt(sol.rss / n_total),
+            condition_number=sol.condition_number,
+            r_squared=float(1.0 - sol.rss / tss) if tss > 0 else None,
+            dof=sol.dof,
+            extra={
+                "rank": sol.rank,
+                "n_truncated": sol.n_truncated,
+                "rcond": mdl.rcond,
+                "ridge": float(mdl.ridge),
+                "solver": reds[j].solver,
+                "n_runs": len(rl),
+                "per_run_offsets": [float(o) for o in offsets] if use_offsets else None,
+                "offset_decision": decision.to_dict(),
+                "residual_correlation": corr.to_dict(),
+                "terms": [t.name for t in mdl.terms_],
+                "selected_terms": selection["kept"] if selection else None,
+            },
+        )
+        record_ranges(
+            mdl, rls[j], stats, (rate_lo, rate_hi) if uses_rate else None, (temp_lo, temp_hi)
+        )
 
 
 class PolyStream(ModelStream):

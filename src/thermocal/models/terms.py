@@ -625,16 +625,17 @@ def backward_rates(
 # --- least squares in chunks ------------------------------------------------------------------
 
 Chunk = tuple[FloatArray, int, int]
-"""``(A, group, fold)`` of one block of c rows: ``A`` (c, p + 2), Fortran order, holds
-``[F | 1 | y]`` (the p features, a column of ones, the target)."""
+"""``(A, group, fold)`` of one block of c rows: ``A`` (c, p + 1 + t), Fortran order, holds
+``[F | 1 | Y]`` (the p features, a column of ones, the t ≥ 1 targets: several channels
+sharing one design, issue 15)."""
 
 
 @dataclass(frozen=True)
 class Reduced:
     """A design reduced to triangular form, per fold.
 
-    ``r_aug[f]`` is the (q+1)×(q+1) upper-triangular factor of ``[F | Z | y]``
-    for fold f (q = p features + m groups); ``n[f]`` its row count;
+    ``r_aug[f]`` is the (q+t)×(q+t) upper-triangular factor of ``[F | Z | Y]``
+    for fold f (q = p features + m groups, t targets, usually 1); ``n[f]`` its row count;
     ``solver`` ``"qr"`` or ``"gram"``.
     """
 
@@ -665,12 +666,13 @@ def _triangularise(a: FloatArray) -> FloatArray:
 
 
 def _accumulate_qr(
-    chunks: Iterable[Chunk], p: int, m: int, n_folds: int
-) -> tuple[list[FloatArray], list[int]]:
-    """R factors of ``[F | Z | y]`` per fold by a chunked Householder QR (TSQR-like):
-    each chunk is stacked under the running R and re-triangularised (LAPACK ``dgeqrf``)."""
+    chunks: Iterable[Chunk], p: int, m: int, n_folds: int, n_targets: int = 1
+) -> tuple[list[list[FloatArray]], list[int]]:
+    """R factors of ``[F | Z | y_j]`` per target and fold by a chunked Householder QR
+    (TSQR-like): each chunk is stacked under the running R and re-triangularised (LAPACK
+    ``dgeqrf``); one update per target, so each equals a one-target run."""
     q1 = p + m + 1
-    r_acc = [np.zeros((q1, q1), order="F") for _ in range(n_folds)]
+    r_acc = [[np.zeros((q1, q1), order="F") for _ in range(n_folds)] for _ in range(n_targets)]
     counts = [0] * n_folds
     buf: FloatArray | None = None
     for A, g, f in chunks:
@@ -680,50 +682,63 @@ def _accumulate_qr(
         rows = q1 + c
         if buf is None or buf.shape[0] != rows:
             buf = np.zeros((rows, q1), order="F")
-        a = buf
-        a[:q1] = r_acc[f]
-        a[q1:, :p] = A[:, :p]
-        a[q1:, p : p + m] = 0.0
-        a[q1:, p + g] = 1.0
-        a[q1:, p + m] = A[:, p + 1]
-        qr, _tau, _work, info = lapack.dgeqrf(a, lwork=max(1, q1 * 64), overwrite_a=1)
-        if info != 0:
-            raise DesignError(f"QR factorisation failed (LAPACK info {info})")
-        r_acc[f] = np.asfortranarray(np.triu(qr[:q1]))
+        for j in range(n_targets):
+            a = buf
+            a[:q1] = r_acc[j][f]
+            a[q1:, :p] = A[:, :p]
+            a[q1:, p : p + m] = 0.0
+            a[q1:, p + g] = 1.0
+            a[q1:, p + m] = A[:, p + 1 + j]
+            qr, _tau, _work, info = lapack.dgeqrf(a, lwork=max(1, q1 * 64), overwrite_a=1)
+            if info != 0:
+                raise DesignError(f"QR factorisation failed (LAPACK info {info})")
+            r_acc[j][f] = np.asfortranarray(np.triu(qr[:q1]))
         counts[f] += c
-    return [np.ascontiguousarray(r) for r in r_acc], counts
+    return [[np.ascontiguousarray(r) for r in rj] for rj in r_acc], counts
 
 
 def _accumulate_gram(
-    chunks: Iterable[Chunk], p: int, m: int, n_folds: int
-) -> tuple[list[FloatArray], list[int]]:
-    """Gram matrices of [F | 1 | y] per (fold, group) (BLAS ``dsyrk``, upper triangle),
-    assembled into the Gram matrix of [F | Z | y]."""
+    chunks: Iterable[Chunk], p: int, m: int, n_folds: int, n_targets: int = 1
+) -> tuple[list[list[FloatArray]], list[int]]:
+    """Gram matrices of ``[F | Z | y_j]`` per fold and target: ``[F | 1]ᵀ[F | 1]`` per
+    (fold, group) once (BLAS ``dsyrk``, upper triangle), ``[F | 1]ᵀ y_j`` and ``y_jᵀ y_j``
+    per target; returns ``grams[f][j]``."""
+    t = n_targets
     q1 = p + m + 1
-    parts = [[np.zeros((p + 2, p + 2)) for _ in range(m)] for _ in range(n_folds)]
+    xx = [[np.zeros((p + 1, p + 1)) for _ in range(m)] for _ in range(n_folds)]
+    xy = [[np.zeros((p + 1, t)) for _ in range(m)] for _ in range(n_folds)]
+    yy = [[np.zeros(t) for _ in range(m)] for _ in range(n_folds)]
     counts = [0] * n_folds
     for A, g, f in chunks:
         c = A.shape[0]
         if c == 0:
             continue
-        parts[f][g] += blas.dsyrk(1.0, np.asfortranarray(A), trans=1, lower=0)
+        X = np.asfortranarray(A[:, : p + 1])
+        xx[f][g] += blas.dsyrk(1.0, X, trans=1, lower=0)
+        for j in range(t):
+            y = A[:, p + 1 + j]
+            xy[f][g][:, j] += X.T @ y
+            yy[f][g][j] += float(y @ y)
         counts[f] += c
-    grams: list[FloatArray] = []
+    grams: list[list[FloatArray]] = []
     for f in range(n_folds):
-        G = np.zeros((q1, q1))
-        for g in range(m):
-            P = np.triu(parts[f][g])
-            P = P + np.triu(P, 1).T
-            G[:p, :p] += P[:p, :p]
-            G[:p, p + g] = P[:p, p]
-            G[p + g, :p] = P[p, :p]
-            G[p + g, p + g] = P[p, p]
-            G[:p, q1 - 1] += P[:p, p + 1]
-            G[q1 - 1, :p] += P[p + 1, :p]
-            G[p + g, q1 - 1] = P[p, p + 1]
-            G[q1 - 1, p + g] = P[p + 1, p]
-            G[q1 - 1, q1 - 1] += P[p + 1, p + 1]
-        grams.append(G)
+        per_target = []
+        for j in range(t):
+            G = np.zeros((q1, q1))
+            for g in range(m):
+                P = np.triu(xx[f][g])
+                P = P + np.triu(P, 1).T
+                G[:p, :p] += P[:p, :p]
+                G[:p, p + g] = P[:p, p]
+                G[p + g, :p] = P[p, :p]
+                G[p + g, p + g] = P[p, p]
+                G[:p, q1 - 1] += xy[f][g][:p, j]
+                G[q1 - 1, :p] += xy[f][g][:p, j]
+                G[p + g, q1 - 1] = xy[f][g][p, j]
+                G[q1 - 1, p + g] = xy[f][g][p, j]
+                G[q1 - 1, q1 - 1] += yy[f][g][j]
+            per_target.append(G)
+        grams.append(per_target)
     return grams, counts
 
 
@@ -756,25 +771,48 @@ def accumulate_r(
     kept when every fold's Cholesky succeeds and the column-equilibrated design
     has κ ≤ :data:`GRAM_MAX_COND`, else the chunked Householder QR.
     """
+    return accumulate_targets(make_chunks, p, m, 1, n_folds=n_folds, solver=solver)[0]
+
+
+def accumulate_targets(
+    make_chunks: Callable[[], Iterator[Chunk]],
+    p: int,
+    m: int,
+    n_targets: int,
+    *,
+    n_folds: int = 1,
+    solver: Literal["auto", "qr", "gram"] = "auto",
+) -> list[Reduced]:
+    """:func:`accumulate_r` for ``n_targets`` targets sharing one design (several channels,
+    issue 15): one :class:`Reduced` per target, each computed by the very operations a
+    single target gets, so each equals its own one-target reduction bit for bit.
+
+    Shared: the features of every chunk (built once by ``make_chunks``), the Gram matrix
+    of ``[F | 1]`` (BLAS ``dsyrk``) and the Gram/QR decision; per target: ``[F | 1]ᵀ y`` and
+    ``yᵀy`` (Gram path) or the Householder update (QR path, used for ill-conditioned
+    designs).
+    """
     if solver not in ("auto", "qr", "gram"):
         raise ThermocalInputError(f"unknown solver {solver!r}; use auto, qr or gram")
     if solver in ("auto", "gram"):
-        grams, counts = _accumulate_gram(make_chunks(), p, m, n_folds)
-        rs = [_chol_r(G) for G in grams]
-        ok = all(r is not None for r in rs)
-        if ok:
-            rr = [r for r in rs if r is not None]
-            red = Reduced(rr, counts, "gram")
-            cond = scaled_condition(red.combined()[: p + m, : p + m])
+        grams, counts = _accumulate_gram(make_chunks(), p, m, n_folds, n_targets)
+        reds: list[Reduced] = []
+        for j in range(n_targets):
+            rs = [_chol_r(G[j]) for G in grams]
+            if not all(r is not None for r in rs):
+                break
+            reds.append(Reduced([r for r in rs if r is not None], counts, "gram"))
+        if len(reds) == n_targets:
+            cond = scaled_condition(reds[0].combined()[: p + m, : p + m])
             if solver == "gram" or cond <= GRAM_MAX_COND:
-                return red
+                return reds
         elif solver == "gram":
             raise DesignError(
                 "the Gram matrix is not positive definite (singular design); use solver='qr' "
                 "to find the terms at fault"
             )
-    r_list, counts = _accumulate_qr(make_chunks(), p, m, n_folds)
-    return Reduced(r_list, counts, "qr")
+    r_lists, counts = _accumulate_qr(make_chunks(), p, m, n_folds, n_targets)
+    return [Reduced(r_list, counts, "qr") for r_list in r_lists]
 
 
 def column_scales(r: FloatArray) -> FloatArray:
