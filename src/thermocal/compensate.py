@@ -32,7 +32,8 @@ import dataclasses
 import json
 import math
 import warnings
-from collections.abc import Callable, Iterator, Sequence
+from collections.abc import Callable, Iterator, Mapping, Sequence
+from concurrent.futures import Future, ThreadPoolExecutor
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, cast
@@ -425,6 +426,111 @@ class StreamingCompensator:
             c[i] = self.update(float(t[i]), T[i], float(f[i]))
             y[i] = self.last_model_value
         return Compensation(model_value=y, corrected=c)
+
+
+class CalibrationStream:
+    """Compensate every channel of a calibration sample by sample (live data, issue 15).
+
+    One :class:`StreamingCompensator` per channel (each keeps its own rate buffer and
+    power-on state), fed from one sample of the whole IMU: the time [s], the
+    temperatures of :attr:`temperature_names` (the union of every channel's inputs, in
+    first-seen order, °C) and the raw outputs of :attr:`names`, each in its channel's
+    data unit (:attr:`units`, the unit the calibration recorded; converted to the model's
+    unit and back, ``value[model] = factor · value[data]``).  Returns the corrected
+    outputs ``F − ŷ`` in the same units.  Equal to :func:`compensate_channels` on the
+    same samples (tested to 1e-9 relative).
+
+    ``channels``: a :class:`~thermocal.models.calibration.Calibration` or ``(name,
+    model, data unit)`` triples.
+    """
+
+    def __init__(
+        self,
+        channels: Any,
+        sample_interval_s: float,
+        *,
+        extrapolate: bool = False,
+    ) -> None:
+        from thermocal.models.calibration import Calibration
+
+        triples = (
+            [(c.name, c.model, c.unit) for c in channels.channels]
+            if isinstance(channels, Calibration)
+            else [(str(n), m, str(u)) for n, m, u in channels]
+        )
+        if not triples:
+            raise ThermocalInputError("CalibrationStream: no channel")
+        self.names = tuple(n for n, _m, _u in triples)
+        self.units = tuple(u for _n, _m, u in triples)
+        temps: list[str] = []
+        for _n, m, _u in triples:
+            temps.extend(str(t) for t in m.temp_names_ if str(t) not in temps)
+        self.temperature_names = tuple(temps)
+        self._cols = [
+            np.array([temps.index(str(t)) for t in m.temp_names_], dtype=np.intp)
+            for _n, m, _u in triples
+        ]
+        self._factors = np.array(
+            [unit_factor(u, m.signal_unit, where=f"channel {n}") for n, m, u in triples]
+        )
+        self._comps = [
+            StreamingCompensator(m, sample_interval_s, extrapolate=extrapolate)
+            for _n, m, _u in triples
+        ]
+
+    def _temps(self, temps_c: Any) -> FloatArray:
+        if isinstance(temps_c, Mapping):
+            missing = [t for t in self.temperature_names if t not in temps_c]
+            if missing:
+                raise ThermocalInputError(f"no value for temperature input(s) {missing}")
+            return np.array([float(temps_c[t]) for t in self.temperature_names])
+        arr = np.asarray(temps_c, dtype=np.float64)
+        if arr.shape[-1] != len(self.temperature_names):
+            raise ThermocalInputError(
+                f"expected {len(self.temperature_names)} temperatures "
+                f"({', '.join(self.temperature_names)}), got {arr.shape[-1]}"
+            )
+        return arr
+
+    def _raw(self, raw: npt.ArrayLike) -> FloatArray:
+        arr = np.asarray(raw, dtype=np.float64)
+        if arr.shape[-1] != len(self.names):
+            raise ThermocalInputError(
+                f"expected {len(self.names)} raw values ({', '.join(self.names)}), "
+                f"got {arr.shape[-1]}"
+            )
+        return arr
+
+    def update(self, time_s: float, temps_c: Any, raw: npt.ArrayLike) -> FloatArray:
+        """Corrected outputs (N,) of one sample [each channel's data unit]; ``temps_c``:
+        (k,) in :attr:`temperature_names` order, or a mapping name → °C."""
+        T = self._temps(temps_c)
+        f = self._raw(raw)
+        out = np.empty(len(self.names))
+        for i, comp in enumerate(self._comps):
+            k = self._factors[i]
+            out[i] = comp.update(time_s, T[self._cols[i]], float(f[i]) * k) / k
+        return out
+
+    def update_block(
+        self, time_s: npt.ArrayLike, temps_c: npt.ArrayLike, raw: npt.ArrayLike
+    ) -> tuple[FloatArray, FloatArray]:
+        """A block of samples: ``temps_c`` (n, k), ``raw`` (n, N) → (model values,
+        corrected outputs), both (n, N) in each channel's data unit."""
+        t = np.asarray(time_s, dtype=np.float64).reshape(-1)
+        T = self._temps(np.asarray(temps_c, dtype=np.float64).reshape(t.size, -1))
+        f = self._raw(np.asarray(raw, dtype=np.float64).reshape(t.size, -1))
+        model = np.empty((t.size, len(self.names)))
+        for i, comp in enumerate(self._comps):
+            k = self._factors[i]
+            res = comp.update_block(t, T[:, self._cols[i]], f[:, i] * k)
+            model[:, i] = res.model_value / k
+        return model, f - model
+
+    def reset(self) -> None:
+        """A new power-on of the IMU: every channel forgets its state."""
+        for comp in self._comps:
+            comp.reset()
 
 
 # --- chunk context rules ---------------------------------------------------------------------
@@ -1105,6 +1211,10 @@ def compensate_channels(
 
     def writer(tmp: Path) -> None:
         w = _Writer(tmp, kind_out, out_info)
+        # the previous chunk is written on a second thread while this one is computed
+        # (pyarrow and numpy release the GIL); one chunk in flight, errors re-raised here
+        pool = ThreadPoolExecutor(max_workers=1, thread_name_prefix="thermocal-write")
+        pending: Future[None] | None = None
         try:
             for chunk in _iter_chunks(src, kind_in, chunk_rows):
                 row0 = int(state["rows"])
@@ -1128,13 +1238,19 @@ def compensate_channels(
                         new[plan.comp_col] = comp
                 # the output keeps the channels in the order given
                 new = {c: new[c] for plan in plans for c in (plan.model_col, plan.comp_col)}
-                w.write(_append_columns(chunk, new))
+                table = _append_columns(chunk, new)
+                if pending is not None:
+                    pending.result()
+                pending = pool.submit(w.write, table)
                 state["rows"] = row0 + t.size
                 state["chunks"] = int(state["chunks"]) + 1
                 state["last_t"] = float(t[-1]) if t.size else state["last_t"]
                 if on_progress is not None:
                     on_progress(int(t.size))
+            if pending is not None:
+                pending.result()
         finally:
+            pool.shutdown(wait=True)
             w.close()
         if state["rows"] == 0:
             raise FileFormatError(f"{src}: the file has a header but no data rows")
@@ -1305,6 +1421,7 @@ __all__ = [
     "CONTEXT_RULES",
     "DEFAULT_CHUNK_ROWS",
     "MODEL_SUFFIX",
+    "CalibrationStream",
     "ChunkContext",
     "ChunkPredictor",
     "CompensateFileResult",
