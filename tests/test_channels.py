@@ -276,7 +276,7 @@ def test_calibration_c_compiles_strict_and_matches_python(
 ) -> None:
     """One header/source for six channels (a cubic with Ṫ terms on the gyros, a quadratic
     on the accelerometers), compiled with -std=c99 -Wall -Wextra -Werror -pedantic,
-    equals Python's compensation to 1e-9 (relative) on 10⁴ samples with a gap and
+    equals Python's compensation to 1e-9 (relative) on 10⁵ samples with a gap and
     temperatures beyond the fitted range (clamped)."""
     import shutil
     import subprocess
@@ -311,9 +311,9 @@ def test_calibration_c_compiles_strict_and_matches_python(
          str(cdir / "imu.c"), str(cdir / "main.c"), "-lm"],
         check=True,
     )  # fmt: skip
-    # inputs: 10⁴ samples at 10 Hz, a 60 s gap, temperatures from 5 to 45 °C (fitted 15…35)
+    # inputs: 10⁵ samples at 10 Hz, a 60 s gap, temperatures from 5 to 45 °C (fitted 15…35)
     rng = np.random.default_rng(9)
-    n = 10_000
+    n = 100_000
     t = np.arange(n) * 0.1
     t[n // 2 :] += 60.0
     temp = 25.0 + 20.0 * np.sin(2 * np.pi * t / t[-1] * 1.5)
