@@ -231,12 +231,8 @@ def _calibration_report(
 ) -> None:
     """A calibration's report: the recording read once for every chosen channel
     (:func:`thermocal.report.calibration.build_calibration_report`)."""
-    from thermocal.report.calibration import (
-        CalibrationReportInputs,
-        merged_inputs,
-        temperatures_of,
-        write_calibration_report,
-    )
+    from thermocal.models.calibration import merged_inputs, temperatures_of
+    from thermocal.report.calibration import CalibrationReportInputs, write_calibration_report
 
     names = split_names(signal) or cal.names
     missing = [n for n in names if n not in cal.names]

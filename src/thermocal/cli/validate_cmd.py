@@ -147,22 +147,28 @@ def validate_cmd(
     """Validate MODEL on FILE: correlation r, bias stability and repeatability over the
     hold stages, rms and peak-to-peak, before and after compensation."""
 
-    def run_one(model: TemperatureModel, sig: str) -> tuple[Any, dict[str, Any]]:
-        """Validate one model on its signal column; (result, --json object)."""
+    modeling_cache: dict[Path, Recording] = {}
+
+    def run_one(
+        model: TemperatureModel, sig: str, rec: Recording | None = None
+    ) -> tuple[Any, dict[str, Any]]:
+        """Validate one model on its signal column; (result, --json object).  ``rec``: the
+        file already read (several channels: once for all of them)."""
         temps = list(model.temp_names_)
         amb = ambient or temps[0]
         read_temps = temps if amb in temps else [*temps, amb]
-        rec = load_recording(
-            file,
-            time=time,
-            time_unit=time_unit,
-            signal=sig,
-            temps=",".join(read_temps),
-            signal_unit=signal_unit,
-            temp_unit=temp_unit,
-            temp_conversion=temp_conversion,
-            model=model,
-        )
+        if rec is None:
+            rec = load_recording(
+                file,
+                time=time,
+                time_unit=time_unit,
+                signal=sig,
+                temps=",".join(read_temps),
+                signal_unit=signal_unit,
+                temp_unit=temp_unit,
+                temp_conversion=temp_conversion,
+                model=model,
+            )
         # the data in the model's units (kinds checked); figures go back to the data's unit
         prepared = prepare_run(model, rec, sig, temps)
         run = prepared.run
@@ -171,20 +177,23 @@ def validate_cmd(
         mod_path = modeling if modeling is not None else _modeling_file(model, model_file)
         modeling_ambient = None
         if mod_path is not None:
-            mrec = load_recording(
-                mod_path,
-                time=time,
-                time_unit=time_unit,
-                temps=amb,
-                temp_unit=temp_unit,
-                temp_conversion=temp_conversion,
-                model=model,
-                require_signal=False,
-                check=False,
-            )
-            for prob in find_problems(mrec, required=[amb]):
-                if prob.severity == "error" and (prob.column in (None, "time", amb)):
-                    raise ThermocalInputError(f"{mod_path}: {prob.message}")
+            mrec = modeling_cache.get(mod_path)
+            if mrec is None or amb not in mrec.columns:
+                mrec = load_recording(
+                    mod_path,
+                    time=time,
+                    time_unit=time_unit,
+                    temps=amb,
+                    temp_unit=temp_unit,
+                    temp_conversion=temp_conversion,
+                    model=model,
+                    require_signal=False,
+                    check=False,
+                )
+                for prob in find_problems(mrec, required=[amb]):
+                    if prob.severity == "error" and (prob.column in (None, "time", amb)):
+                        raise ThermocalInputError(f"{mod_path}: {prob.message}")
+                modeling_cache[mod_path] = mrec
             modeling_ambient = (mrec.time_s, _ambient(mrec, amb))
         res = validate(
             model,
@@ -210,8 +219,31 @@ def validate_cmd(
 
     cal = load_calibration(model_file)  # a model file is a calibration of one channel
     if len(cal.channels) > 1:
+        from thermocal.models.calibration import merged_inputs, temperatures_of
+
         chosen = split_names(signal) or cal.names
-        per = {n: run_one(cal.channel(n).model, cal.channel(n).signal) for n in chosen}
+        missing = [n for n in chosen if n not in cal.names]
+        if missing:
+            raise ThermocalInputError(
+                f"{model_file}: no channel {', '.join(map(repr, missing))}; it has "
+                + ", ".join(cal.names)
+            )
+        read_temps = temperatures_of(cal, chosen)
+        if ambient and ambient not in read_temps:
+            read_temps.append(ambient)
+        # the file read once, every chosen channel's column (issue 15)
+        rec_all = load_recording(
+            file,
+            time=time,
+            time_unit=time_unit,
+            signal=",".join(cal.channel(n).signal for n in chosen),
+            temps=",".join(read_temps),
+            signal_unit=signal_unit,
+            temp_unit=temp_unit,
+            temp_conversion=temp_conversion,
+            model_inputs=merged_inputs(cal, chosen),
+        )
+        per = {n: run_one(cal.channel(n).model, cal.channel(n).signal, rec_all) for n in chosen}
         _emit_channels(file, per, as_json)
         return
     model = cal.channels[0].model

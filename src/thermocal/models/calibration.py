@@ -179,6 +179,34 @@ def calibration_from_dict(d: dict[str, Any], where: str) -> Calibration:
         raise ModelFileError(f"{where}: {exc}") from None
 
 
+def temperatures_of(cal: Calibration, names: Sequence[str] | None = None) -> list[str]:
+    """Every temperature input of the chosen channels, in first-seen order."""
+    out: list[str] = []
+    for n in names or cal.names:
+        for t in cal.channel(n).model.temp_names_:
+            if t not in out:
+                out.append(str(t))
+    return out
+
+
+def merged_inputs(cal: Calibration, names: Sequence[str] | None = None) -> dict[str, Any]:
+    """The chosen channels' recorded inputs (units, conversions, time unit) merged into one
+    model-file ``inputs`` object, to read a recording once for all of them; the first
+    channel's wins where two disagree (each channel's unit is checked again when its model
+    is applied)."""
+    out: dict[str, Any] = {}
+    units_: dict[str, Any] = {}
+    conv: dict[str, Any] = {}
+    for n in reversed(list(names or cal.names)):
+        inp = dict(getattr(cal.channel(n).model, "inputs_", {}) or {})
+        units_.update(inp.get("units") or {})
+        conv.update(inp.get("temperature_conversion") or {})
+        out.update(inp)
+    out["units"] = units_
+    out["temperature_conversion"] = conv
+    return out
+
+
 def load_calibration(path: str | Path) -> Calibration:
     """A calibration file, or a single-model file as a calibration of one channel (named
     after the model's signal, in the unit its inputs record)."""
@@ -220,5 +248,7 @@ __all__ = [
     "guess_role",
     "is_calibration",
     "load_calibration",
+    "merged_inputs",
     "save_calibration",
+    "temperatures_of",
 ]
