@@ -28,7 +28,8 @@ import pandas as pd
 
 from thermocal.compensate import StreamingCompensator, compensate_file, compensate_run
 from thermocal.export_c import exercise_inputs, find_compiler, generate_c
-from thermocal.models.base import RunData, load_model_dict, make_model, save_model
+from thermocal.models.base import RunData, make_model
+from thermocal.models.files import load_model_dict, save_model
 from thermocal.simulate import SCENARIOS
 
 TEMPS = ["T1", "T2", "T3", "T4"]

@@ -16,7 +16,7 @@ from thermocal.cli import main
 from thermocal.compensate import CalibrationStream
 from thermocal.errors import ThermocalInputError
 from thermocal.io import write_recording
-from thermocal.models.calibration import load_calibration
+from thermocal.models.files import load_calibration
 from thermocal.simulate import IMU_CHANNELS, SCENARIOS
 
 NAMES = [n for n, _u in IMU_CHANNELS]

@@ -28,15 +28,8 @@ from thermocal.export_c import (
     generate_c,
     run_harness,
 )
-from thermocal.models.base import (
-    MODEL_REGISTRY,
-    RunData,
-    TemperatureModel,
-    load_model,
-    load_model_dict,
-    make_model,
-    save_model,
-)
+from thermocal.models.base import MODEL_REGISTRY, RunData, TemperatureModel, make_model
+from thermocal.models.files import load_model, load_model_dict, save_model
 from thermocal.simulate import SCENARIOS
 
 N_SAMPLES = 100_000

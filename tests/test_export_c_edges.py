@@ -12,7 +12,8 @@ import pytest
 
 from thermocal.compensate import StreamingCompensator
 from thermocal.export_c import compile_harness, find_compiler, generate_c, run_harness
-from thermocal.models.base import RunData, load_model, load_model_dict, make_model, save_model
+from thermocal.models.base import RunData, make_model
+from thermocal.models.files import load_model, load_model_dict, save_model
 
 pytestmark = pytest.mark.skipif(find_compiler() is None, reason="no C compiler")
 

@@ -34,8 +34,8 @@ from thermocal.models.base import (
     ModelStream,
     RunData,
     TemperatureModel,
-    save_model,
 )
+from thermocal.models.files import save_model
 from thermocal.recording import FloatArray, Metadata, Recording
 from thermocal.report import (
     ModelEntry,
@@ -614,7 +614,7 @@ def test_apply_model_uses_the_fit_provenance_for_the_earth_rate(
     """A model fitted with the earth rate removed (``--latitude/--axis``) and one fitted on
     the raw output both give the same bias after compensation in the report."""
     from thermocal.cli import main
-    from thermocal.models.base import load_model_dict
+    from thermocal.models.files import load_model_dict
     from thermocal.report.build import apply_model, known_input_of
 
     n = 4000

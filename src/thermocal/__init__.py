@@ -18,7 +18,23 @@ from __future__ import annotations
 
 __version__ = "0.1.0"
 
-from thermocal.io import read_recording, write_recording
+from typing import TYPE_CHECKING, Any
+
 from thermocal.recording import Metadata, Recording
+
+if TYPE_CHECKING:
+    from thermocal.io import read_recording, write_recording
+
+
+def __getattr__(name: str) -> Any:
+    """``read_recording`` and ``write_recording`` are imported on first use, so that the
+    maths modules (``import thermocal.metrics`` …) do not load the file layer (pandas,
+    pyarrow) with the package."""
+    if name in ("read_recording", "write_recording"):
+        from thermocal import io
+
+        return getattr(io, name)
+    raise AttributeError(f"module 'thermocal' has no attribute {name!r}")
+
 
 __all__ = ["Metadata", "Recording", "__version__", "read_recording", "write_recording"]

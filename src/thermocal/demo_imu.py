@@ -28,7 +28,8 @@ from thermocal.errors import ThermocalWarning
 from thermocal.export_c import generate_c_calibration
 from thermocal.io import write_json, write_recording
 from thermocal.models.base import RunData, model_file_dict, model_inputs
-from thermocal.models.calibration import Calibration, Channel, guess_role, save_calibration
+from thermocal.models.calibration import Calibration, Channel, guess_role
+from thermocal.models.files import save_calibration
 from thermocal.models.poly import PolyModel
 from thermocal.report.calibration import CalibrationReportInputs, write_calibration_report
 from thermocal.simulate import IMU_CHANNELS, SCENARIOS

@@ -1,7 +1,7 @@
 """Plain C99 code computing a model's correction sample by sample (SPEC §8).
 
 "Coefficients solidified in the IMU software": :func:`generate_c` turns a model
-file's dict (:func:`thermocal.models.base.load_model_dict`) into a header and a
+file's dict (:func:`thermocal.models.files.load_model_dict`) into a header and a
 source file with
 
 * no dynamic allocation, no library beyond ``<math.h>``-free C99 (``<stddef.h>``);
@@ -1346,7 +1346,7 @@ def export_c(
 ) -> tuple[CExport, list[Path]]:
     """Read and verify a model file, generate its C module and write it into ``out_dir``
     (``unit``: the functions' signal unit, :func:`c_signal_unit`)."""
-    from thermocal.models.base import load_model_dict
+    from thermocal.models.files import load_model_dict
 
     d = load_model_dict(model_path)
     ex = generate_c(

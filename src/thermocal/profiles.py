@@ -31,7 +31,6 @@ from typing import Any
 
 import numpy as np
 import numpy.typing as npt
-import pandas as pd
 
 from thermocal.errors import (
     DesignError,
@@ -41,7 +40,6 @@ from thermocal.errors import (
     ThermocalInputError,
     TimestampError,
 )
-from thermocal.io import CSV_FLOAT_OPTIONS, atomic_write
 from thermocal.units import SECONDS_PER_MINUTE
 
 FloatArray = npt.NDArray[np.float64]
@@ -491,6 +489,10 @@ PROGRAM_SETPOINT = "setpoint_c"
 
 def write_program(path: str | Path, time_s: npt.ArrayLike, setpoint_c: npt.ArrayLike) -> Path:
     """Write a chamber program CSV with columns ``time_s, setpoint_c`` (atomic)."""
+    import pandas as pd
+
+    from thermocal.io import atomic_write  # the file edge, imported on use
+
     t = np.asarray(time_s, dtype=np.float64)
     c = np.asarray(setpoint_c, dtype=np.float64)
     check_program(t, c, str(path))
@@ -509,6 +511,10 @@ def read_program(path: str | Path) -> tuple[FloatArray, FloatArray]:
     Raises :class:`FileFormatError`, :class:`MissingColumnError`,
     :class:`NonNumericError` or :class:`TimestampError` naming the file.
     """
+    import pandas as pd
+
+    from thermocal.io import CSV_FLOAT_OPTIONS  # the file edge, imported on use
+
     p = Path(path)
     if not p.exists():
         raise FileFormatError(f"{p}: no such file")

@@ -48,7 +48,7 @@ import numpy as np
 import numpy.typing as npt
 
 from thermocal import metrics
-from thermocal.compensate import compensate_run
+from thermocal.compensation import compensate_run
 from thermocal.errors import (
     CorrelationWarning,
     ThermocalInputError,

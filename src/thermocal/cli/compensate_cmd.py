@@ -35,7 +35,7 @@ from thermocal.cli.common import (
 )
 from thermocal.compensate import DEFAULT_CHUNK_ROWS, compensate_channels, compensate_file
 from thermocal.io import check_not_input, file_kind, sidecar_path
-from thermocal.models.calibration import load_calibration
+from thermocal.models.files import load_calibration
 
 
 @app.command("compensate")

@@ -28,8 +28,9 @@ from thermocal.export_c import (
     generate_c_calibration,
     measure_float_error,
 )
-from thermocal.models.base import load_model_dict, model_file_dict
-from thermocal.models.calibration import is_calibration, load_calibration
+from thermocal.models.base import model_file_dict
+from thermocal.models.calibration import is_calibration
+from thermocal.models.files import load_calibration, load_model_dict
 
 
 def _read_json(path: Path) -> object:

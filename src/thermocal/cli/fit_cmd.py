@@ -2,7 +2,7 @@
 
 Fits a compensation model (SPEC §4) on one or several runs (several FILEs =
 several runs, each with its own turn-on offset unless ``--no-per-run-offset``)
-and writes the self-describing model file (:func:`thermocal.models.base.save_model`)
+and writes the self-describing model file (:func:`thermocal.models.files.save_model`)
 with the data files' names and SHA-256 checksums.
 
 The family is looked up in the registry (:func:`thermocal.models.base.get_model_class`).
@@ -91,12 +91,11 @@ from thermocal.models.base import (
     RunData,
     TemperatureModel,
     condition_wording,
-    file_sha256,
     get_model_class,
     model_inputs,
-    save_model,
 )
-from thermocal.models.calibration import Calibration, Channel, guess_role, save_calibration
+from thermocal.models.calibration import Calibration, Channel, guess_role
+from thermocal.models.files import file_sha256, save_calibration, save_model
 from thermocal.models.poly import PolyModel, fit_shared
 from thermocal.recording import FloatArray, Recording
 

@@ -33,8 +33,8 @@ from thermocal.cli.common import (
 )
 from thermocal.errors import FileFormatError, ThermocalInputError
 from thermocal.io import check_not_input
-from thermocal.models.base import load_model_dict
-from thermocal.models.calibration import Calibration, load_calibration
+from thermocal.models.calibration import Calibration
+from thermocal.models.files import load_calibration, load_model_dict
 from thermocal.recording import Recording
 from thermocal.report import ModelEntry, ReportInputs, write_report
 

@@ -38,7 +38,7 @@ from thermocal.cli.common import (
 from thermocal.compensate import prepare_run
 from thermocal.errors import ThermocalInputError, UnitWarning
 from thermocal.models.base import TemperatureModel
-from thermocal.models.calibration import load_calibration
+from thermocal.models.files import load_calibration
 from thermocal.recording import FloatArray, Recording, find_problems
 from thermocal.validation import DEFAULT_AVERAGING_S, validate
 

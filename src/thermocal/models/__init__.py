@@ -8,6 +8,7 @@ Importing this package registers every family in
 from __future__ import annotations
 
 import importlib
+from typing import TYPE_CHECKING, Any
 
 from thermocal.models.base import (
     MODEL_REGISTRY,
@@ -17,12 +18,25 @@ from thermocal.models.base import (
     RunData,
     TemperatureModel,
     get_model_class,
-    load_model,
-    load_model_dict,
     make_model,
     register,
-    save_model,
 )
+
+if TYPE_CHECKING:
+    from thermocal.models.files import load_model, load_model_dict, save_model
+
+FILE_FUNCTIONS = ("load_model", "load_model_dict", "save_model")
+"""Read and write model files: :mod:`thermocal.models.files`, imported on first use (the
+maths of the models does not load the file layer)."""
+
+
+def __getattr__(name: str) -> Any:
+    if name in FILE_FUNCTIONS:
+        from thermocal.models import files
+
+        return getattr(files, name)
+    raise AttributeError(f"module 'thermocal.models' has no attribute {name!r}")
+
 
 FAMILY_MODULES = ("poly", "piecewise", "warmup", "bank")
 

@@ -59,7 +59,6 @@ import warnings
 from abc import ABC, abstractmethod
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
-from pathlib import Path
 from typing import Any, ClassVar, Literal, Self, TypeVar
 
 import numpy as np
@@ -72,7 +71,6 @@ from thermocal.errors import (
     UnitError,
     UnitWarning,
 )
-from thermocal.io import write_json
 from thermocal.recording import FloatArray, Recording
 from thermocal.units import (
     DEFAULT_UNITS,
@@ -821,15 +819,6 @@ def checksum(d: dict[str, Any]) -> str:
     return hashlib.sha256(_canonical(d)).hexdigest()
 
 
-def file_sha256(path: str | Path, chunk: int = 1 << 20) -> str:
-    """SHA-256 of a data file (provenance in model files)."""
-    h = hashlib.sha256()
-    with open(path, "rb") as fh:
-        while block := fh.read(chunk):
-            h.update(block)
-    return h.hexdigest()
-
-
 def check_model_header(d: Any) -> None:
     """Refuse foreign, newer or unknown model dicts with a clear :class:`ModelFileError`."""
     if not isinstance(d, dict) or d.get("format") != MODEL_FORMAT:
@@ -856,18 +845,6 @@ def _nonfinite_fields(obj: Any, path: str = "") -> list[str]:
     if isinstance(obj, float) and not math.isfinite(obj):
         return [path.lstrip(".")]
     return []
-
-
-def save_model(model: TemperatureModel, path: str | Path) -> dict[str, Any]:
-    """Write a fitted model as JSON (atomically), with its checksum; returns the dict.
-
-    A model holding a non-finite number (NaN or infinity in a coefficient, range or
-    statistic) is refused with :class:`DesignError` naming the field: JSON cannot hold it
-    and firmware must never load it.
-    """
-    d = model_file_dict(model)
-    write_json(path, d)
-    return d
 
 
 def model_file_dict(model: TemperatureModel) -> dict[str, Any]:
@@ -906,35 +883,6 @@ def verify_model_dict(d: Any, where: str) -> dict[str, Any]:
         raise ModelFileError(f"{where}: {exc}") from None
     out: dict[str, Any] = d
     return out
-
-
-def load_model_dict(path: str | Path) -> dict[str, Any]:
-    """Read and verify a model file (format, version, checksum) without building it."""
-    p = Path(path)
-    try:
-        text = p.read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise ModelFileError(f"{p}: no such model file") from None
-    except UnicodeDecodeError:
-        raise ModelFileError(f"{p}: not a text (JSON) model file") from None
-    try:
-        d = json.loads(text)
-    except json.JSONDecodeError as exc:
-        raise ModelFileError(f"{p}: corrupted model file (invalid JSON: {exc.msg})") from None
-    return verify_model_dict(d, str(p))
-
-
-def load_model(path: str | Path) -> TemperatureModel:
-    """Load and verify a model file; returns the fitted model."""
-    d = load_model_dict(path)
-    try:
-        return TemperatureModel.from_dict(d)
-    except ModelFileError as exc:
-        raise ModelFileError(f"{path}: {exc}") from None
-    except (KeyError, TypeError, ValueError) as exc:
-        raise ModelFileError(
-            f"{path}: malformed model file ({type(exc).__name__}: {exc})"
-        ) from None
 
 
 def make_model(family: str, **params: Any) -> TemperatureModel:

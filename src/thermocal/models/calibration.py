@@ -25,16 +25,12 @@ calibration also takes the model files written before.
 from __future__ import annotations
 
 import datetime as _dt
-import json
 from collections.abc import Sequence
 from dataclasses import dataclass, field
-from pathlib import Path
 from typing import Any
 
 from thermocal.errors import ModelFileError, ThermocalInputError
-from thermocal.io import write_json
 from thermocal.models.base import (
-    MODEL_FORMAT,
     TemperatureModel,
     checksum,
     model_file_dict,
@@ -124,15 +120,6 @@ class Calibration:
         return d
 
 
-def save_calibration(cal: Calibration, path: str | Path) -> dict[str, Any]:
-    """Write a calibration file (atomically); returns its dict."""
-    if not cal.channels:
-        raise ThermocalInputError("calibration: no channels to write")
-    d = cal.to_dict()
-    write_json(path, d)
-    return d
-
-
 def is_calibration(d: Any) -> bool:
     return isinstance(d, dict) and d.get("format") == CALIBRATION_FORMAT
 
@@ -207,30 +194,6 @@ def merged_inputs(cal: Calibration, names: Sequence[str] | None = None) -> dict[
     return out
 
 
-def load_calibration(path: str | Path) -> Calibration:
-    """A calibration file, or a single-model file as a calibration of one channel (named
-    after the model's signal, in the unit its inputs record)."""
-    p = Path(path)
-    try:
-        d = json.loads(p.read_text(encoding="utf-8"))
-    except FileNotFoundError:
-        raise ModelFileError(f"{p}: no such model or calibration file") from None
-    except UnicodeDecodeError:
-        raise ModelFileError(f"{p}: not a text (JSON) model or calibration file") from None
-    except json.JSONDecodeError as exc:
-        raise ModelFileError(f"{p}: corrupted model file (invalid JSON: {exc.msg})") from None
-    if is_calibration(d):
-        return calibration_from_dict(d, str(p))
-    if isinstance(d, dict) and d.get("format") == MODEL_FORMAT:
-        from thermocal.models.base import load_model
-
-        model = load_model(p)
-        sig = model.signal_name or "signal"
-        unit = str((model.inputs_ or {}).get("units", {}).get(sig) or model.signal_unit)
-        return Calibration([Channel(sig, sig, unit, model, guess_role(sig, unit))])
-    raise ModelFileError(f"{p}: not a thermocal model or calibration file (missing 'format')")
-
-
 def channels_of(signals: Sequence[str], names: Sequence[str] | None = None) -> list[str]:
     """Channel names for signal columns (the column names unless ``names`` are given)."""
     out = list(names) if names else list(signals)
@@ -247,8 +210,6 @@ __all__ = [
     "calibration_from_dict",
     "guess_role",
     "is_calibration",
-    "load_calibration",
     "merged_inputs",
-    "save_calibration",
     "temperatures_of",
 ]

@@ -39,7 +39,7 @@ from markupsafe import Markup, escape
 
 from thermocal import units
 from thermocal.allan import AllanResult, NoiseTerms, noise_terms, overlapping_adev
-from thermocal.compensate import unit_factor
+from thermocal.compensation import unit_factor
 from thermocal.errors import ThermocalInputError
 from thermocal.io import atomic_write
 from thermocal.metrics import compute_metrics, drift_angle

@@ -32,7 +32,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from thermocal.compensate import unit_factor
+from thermocal.compensation import unit_factor
 from thermocal.errors import ThermocalInputError
 from thermocal.io import atomic_write
 from thermocal.models.base import model_file_dict

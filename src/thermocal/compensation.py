@@ -1,0 +1,733 @@
+"""Compensation with a fitted model, in memory and live (SPEC §4, §8): the maths of
+:mod:`thermocal.compensate` without files (issue 15: the maths imports no I/O).
+
+A model gives the temperature-induced part of the signal, ``ŷ = model(T, Ṫ, …)``; the
+compensated output is ``F' = F − ŷ`` (SPEC §4c: "output F' = F − ΔF").
+
+* :func:`compensate_run` — in memory, ``model.predict(run)`` on a whole run.
+* :class:`ChunkPredictor` — a long run chunk by chunk with the *context* the model needs
+  (the samples since power-on that fix its start-up state and the last Δt seconds that
+  feed the Ṫ buffer, declared by each family: :meth:`TemperatureModel.chunk_context`);
+  because ``predict`` is causal the values of a chunk's own rows equal those of a
+  whole-run ``predict``.  Families without a finite context are streamed sample by sample.
+* :class:`StreamingCompensator` — live data, one sample at a time, through the family's
+  :class:`~thermocal.models.base.ModelStream`; :class:`CalibrationStream` — every channel
+  of a calibration at once.
+
+Units: the model predicts in its signal unit (``model.signal_unit``); data in another unit
+of the same kind are converted with :mod:`thermocal.units` (:func:`unit_factor`).  A model
+and data of different kinds (°/h against mg) is a :class:`~thermocal.errors.UnitError`
+naming both.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import warnings
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass
+from typing import Any, cast
+
+import numpy as np
+import numpy.typing as npt
+
+from thermocal import units
+from thermocal.errors import (
+    ExtrapolationWarning,
+    ThermocalInputError,
+    TimestampError,
+    UnitError,
+    UnitWarning,
+)
+from thermocal.models.base import ModelStream, RunData, TemperatureModel
+from thermocal.recording import GAP_FACTOR, FloatArray, Metadata, Recording, median_interval
+
+# --- unit handling ------------------------------------------------------------------------
+
+
+def unit_factor(
+    data_unit: str,
+    model_unit: str,
+    *,
+    meta: Metadata | None = None,
+    sample_interval_s: float | None = None,
+    where: str = "",
+) -> float:
+    """Factor ``f`` with ``value[model unit] = f · value[data unit]`` (all units are linear).
+
+    Raw ``counts`` data are turned into a physical unit with the metadata's scale
+    factor K (SPEC §1: ``ω = N/(τK)`` or ``N/K``, :func:`thermocal.units.counts_to_physical`).
+
+    Raises
+    ------
+    UnitError : the two units measure different kinds of quantity (the message names
+        both), or counts cannot be converted because no scale factor is given.
+    """
+    du = units.normalize_signal_unit(data_unit)
+    mu = units.normalize_signal_unit(model_unit)
+    prefix = f"{where}: " if where else ""
+    if du == mu:
+        return 1.0
+    if du == "counts":
+        if meta is None or meta.scale_factor is None:
+            raise UnitError(
+                f"{prefix}the data signal is in raw counts but the model is in {mu!r} and "
+                "no scale factor K is given to convert them"
+            )
+        tau = sample_interval_s if sample_interval_s is not None else meta.sample_interval_s
+        phys_per_count, phys_unit = units.counts_to_physical(
+            1.0,
+            meta.scale_factor,
+            units.scale_factor_unit_or_default(meta.scale_factor_unit, where),
+            float(tau or 1.0),
+        )
+        return float(phys_per_count) * unit_factor(phys_unit, mu, where=where)
+    if units.signal_kind(du) != units.signal_kind(mu):
+        raise UnitError(
+            f"{prefix}the model's signal unit {mu!r} ({units.signal_kind(mu)}) does not match the "
+            f"data's unit {du!r} ({units.signal_kind(du)})"
+        )
+    return float(units.convert(1.0, du, mu))
+
+
+def check_signal_kind(data_unit: str, model_unit: str, where: str = "") -> None:
+    """Refuse data whose signal is of another kind than the model's (a rate against an
+    acceleration), naming both, before anything is computed or written.  Raw ``counts``
+    data pass here (their scale factor decides, :func:`unit_factor`)."""
+    du = units.normalize_signal_unit(data_unit)
+    mu = units.normalize_signal_unit(model_unit)
+    kd, km = units.signal_kind(du), units.signal_kind(mu)
+    if kd != km and kd != "raw":
+        raise UnitError(
+            f"{where + ': ' if where else ''}the model's signal unit {mu!r} ({km}) does not "
+            f"match the data's unit {du!r} ({kd}): a model applies to its own kind of "
+            "quantity only"
+        )
+
+
+def model_scale_factor(model: TemperatureModel, meta: Metadata) -> Metadata:
+    """``meta`` with the scale factor K of a raw-count signal taken from the model file's
+    ``inputs`` when the data's metadata gives none (the resolution order: file > model)."""
+    sf = (getattr(model, "inputs_", {}) or {}).get("scale_factor")
+    if meta.scale_factor is None and isinstance(sf, dict) and sf.get("value") is not None:
+        meta.scale_factor = float(sf["value"])
+        meta.scale_factor_unit = sf.get("unit") or meta.scale_factor_unit
+    return meta
+
+
+def temperature_inputs(
+    model: TemperatureModel, resolved: units.ResolvedInputs, where: str = ""
+) -> dict[str, units.TemperatureConversion | None]:
+    """How each of the model's temperature columns becomes its temperature input: a
+    counts → °C conversion, or ``None`` (the values as they are: °C for a °C model, raw
+    counts for a model fitted in counts).
+
+    Raises :class:`UnitError` for raw counts without any conversion (option, file or
+    model) under a °C model, and for °C data under a counts model."""
+    prefix = f"{where}: " if where else ""
+    out: dict[str, units.TemperatureConversion | None] = {}
+    for c, r in resolved.temperatures.items():
+        conv = resolved.conversions[c]
+        if model.temperature_unit == "counts":
+            if r.unit != "counts":
+                raise UnitError(
+                    f"{prefix}the model's temperatures are raw counts (it was fitted without a "
+                    f"conversion), but column {c!r} is in {r.unit}; give raw-count data "
+                    "(--temp-unit counts) or refit the model with --temp-conversion"
+                )
+            if conv.source == "option":
+                warnings.warn(
+                    UnitWarning(
+                        f"{prefix}the model's temperatures are raw counts; --temp-conversion "
+                        f"is not used for column {c!r}"
+                    ),
+                    stacklevel=3,
+                )
+            out[c] = None
+        elif r.unit == "counts":
+            if conv.conversion is None:
+                raise UnitError(
+                    f"{prefix}temperature column {c!r} is in raw counts and no conversion to "
+                    "°C is given (--temp-conversion GAIN,OFFSET[,int16], the file's metadata, "
+                    "or a model fitted with one)"
+                )
+            out[c] = conv.conversion
+        else:
+            out[c] = None
+    return out
+
+
+@dataclass(frozen=True)
+class ModelRun:
+    """A recording prepared for a model (:func:`prepare_run`).
+
+    ``run`` is in the model's units (signal in ``model.signal_unit``, temperatures in
+    ``model.temperature_unit``); ``data_unit`` is the data column's own unit and
+    ``factor`` takes values from it to the model's unit: ``value[model] = factor ·
+    value[data]``; :meth:`to_data_unit` brings model values (ŷ, residuals, figures) back.
+    """
+
+    run: RunData
+    data_unit: str
+    factor: float
+
+    def to_data_unit(self, values: npt.ArrayLike) -> FloatArray:
+        """Model-unit values [model unit] → the data's unit."""
+        return np.asarray(values, dtype=np.float64) / self.factor
+
+
+def prepare_run(
+    model: TemperatureModel,
+    rec: Recording,
+    signal: str | None = None,
+    temps: Sequence[str] | None = None,
+    *,
+    known_input: float = 0.0,
+) -> ModelRun:
+    """The recording's signal and temperatures as the model takes them (validate, report).
+
+    ``rec`` should be read with the model's recorded units as fallbacks
+    (``load_recording(..., model=model)``).  A signal of another kind than the model's is
+    refused (:func:`check_signal_kind`); raw-count temperatures are converted, or kept as
+    counts for a model fitted in counts (a mismatch is refused).  ``known_input`` is in
+    the data's unit.
+    """
+    sig = signal or model.signal_name
+    names = tuple(temps) if temps else tuple(model.temp_names_)
+    data_unit = rec.units.get(sig) or ""
+    check_signal_kind(data_unit, model.signal_unit, rec.name)
+    if model.temperature_unit == "counts":
+        run = RunData.from_recording(rec, sig, names, temperature_unit="counts")
+    else:
+        run = RunData.from_recording(rec, sig, names)
+    values = rec.column(sig)
+    factor = unit_factor(data_unit, model.signal_unit, meta=rec.meta, where=rec.name)
+    run = dataclasses.replace(
+        run,
+        signal=values * factor,
+        known_input=known_input * factor,
+        signal_unit=model.signal_unit,
+    )
+    return ModelRun(run, units.normalize_signal_unit(data_unit), factor)
+
+
+# --- batch -------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class Compensation:
+    """Result of :func:`compensate_run`.
+
+    ``model_value`` ŷ and ``corrected`` ``F' = F − ŷ`` [model signal unit], shape (n,).
+    """
+
+    model_value: FloatArray
+    corrected: FloatArray
+
+
+def compensate_run(
+    model: TemperatureModel, run: RunData, *, extrapolate: bool = False
+) -> Compensation:
+    """Apply a model to a whole run in memory: ``F' = F − ŷ(T, Ṫ, …)`` (SPEC §4).
+
+    ``run.signal`` must be in the model's unit.  ``known_input`` is not removed:
+    the compensated output still contains the true input (earth rate, gravity).
+    """
+    if run.signal is None:
+        raise ThermocalInputError(f"{run.name or 'run'}: no signal to compensate")
+    y = np.asarray(model.predict(run, extrapolate=extrapolate), dtype=np.float64)
+    return Compensation(model_value=y, corrected=run.signal - y)
+
+
+# --- streaming -----------------------------------------------------------------------------
+
+
+class StreamingCompensator:
+    """Compensate live data sample by sample: ``F'_i = F_i − ŷ_i``.
+
+    Wraps ``model.stream(sample_interval_s)`` (the family's
+    :class:`~thermocal.models.base.ModelStream`): the rate buffer of length Δt,
+    T0/F0 captured at power-on and any start-up selection live there; a step
+    longer than ``GAP_FACTOR`` × ``sample_interval_s`` resets the rate estimate.
+    Time must increase strictly (a :class:`~thermocal.errors.TimestampError`
+    otherwise).  Signals and results are in the model's signal unit.  ``known_input``
+    (earth rate [°/h], gravity component [mg]) is removed from the signal the model
+    sees (as :meth:`RunData.target` does; it matters to the bank's start-up
+    selection) but not from the corrected output.
+
+    The outputs equal :func:`compensate_run` to 1e-12 (relative) on the same data,
+    start-up included, when ``sample_interval_s`` is the run's median interval.
+
+    Two ways to feed it (not to be mixed between two resets):
+
+    * :meth:`update` / :meth:`process` — one sample at a time through the family's
+      ``ModelStream`` (the firmware twin; speed set by the family's stream);
+    * :meth:`update_block` — a block of samples at once (live data often arrives in
+      packets): the block is predicted in one vectorised call together with the
+      context the model needs (:class:`ChunkPredictor`), which gives the same values
+      because ``predict`` is causal; much faster for blocks of tens of samples or more.
+    """
+
+    def __init__(
+        self,
+        model: TemperatureModel,
+        sample_interval_s: float,
+        *,
+        extrapolate: bool = False,
+        known_input: float = 0.0,
+    ) -> None:
+        if not (math.isfinite(sample_interval_s) and sample_interval_s > 0):
+            raise ThermocalInputError(
+                f"sample interval must be positive and finite, got {sample_interval_s!r}"
+            )
+        model.check_fitted()
+        self.model = model
+        self.sample_interval_s = float(sample_interval_s)
+        self.extrapolate = extrapolate
+        self.known_input = float(known_input)
+        self._stream: ModelStream = model.stream(self.sample_interval_s, extrapolate=extrapolate)
+        self._last_t: float | None = None
+        self._mode: str | None = None
+        self._chunks: ChunkPredictor | None = None
+        self.last_model_value: float = float("nan")
+        """ŷ of the last sample [model signal unit]."""
+        self.n_samples = 0
+
+    def _set_mode(self, mode: str) -> None:
+        if self._mode is not None and self._mode != mode:
+            raise ThermocalInputError(
+                "StreamingCompensator: do not mix update() and update_block() between resets"
+            )
+        self._mode = mode
+
+    def update(self, time_s: float, temps_c: npt.ArrayLike, signal: float) -> float:
+        """Corrected output ``F − ŷ`` of one sample: time [s], temperatures (k,) [°C],
+        raw signal F [model unit]."""
+        t = float(time_s)
+        if self._last_t is not None and not t > self._last_t:
+            raise TimestampError(
+                f"sample {self.n_samples}: time {t!r} does not increase (previous {self._last_t!r})"
+            )
+        if self._mode != "sample":
+            self._set_mode("sample")
+        temps = np.asarray(temps_c, dtype=np.float64).reshape(-1)
+        y = float(self._stream.update(t, temps, float(signal) - self.known_input))
+        self._last_t = t
+        self.last_model_value = y
+        self.n_samples += 1
+        return float(signal) - y
+
+    def reset(self) -> None:
+        """A new power-on: forget every state."""
+        self._stream.reset()
+        self._last_t = None
+        self._mode = None
+        self._chunks = None
+        self.last_model_value = float("nan")
+        self.n_samples = 0
+
+    def update_block(
+        self, time_s: npt.ArrayLike, temps_c: npt.ArrayLike, signal: npt.ArrayLike
+    ) -> Compensation:
+        """Compensate a block of consecutive samples at once (vectorised); state carried
+        on to the next block.  Same values as :meth:`process` (see the class docstring);
+        one :class:`ExtrapolationWarning` per block with samples outside the fitted range.
+        """
+        t = np.asarray(time_s, dtype=np.float64).reshape(-1)
+        T = np.asarray(temps_c, dtype=np.float64)
+        if T.ndim == 1:
+            T = T.reshape(-1, 1)
+        f = np.asarray(signal, dtype=np.float64).reshape(-1)
+        if T.shape[0] != t.size or f.size != t.size:
+            raise ThermocalInputError("time, temperatures and signal differ in length")
+        if t.size == 0:
+            return Compensation(np.zeros(0), np.zeros(0))
+        bad = np.flatnonzero(np.diff(t) <= 0)
+        if (self._last_t is not None and not t[0] > self._last_t) or bad.size:
+            i = 0 if bad.size == 0 else int(bad[0]) + 1
+            raise TimestampError(f"sample {self.n_samples + i}: time does not increase")
+        self._set_mode("block")
+        if self._chunks is None:
+            self._chunks = ChunkPredictor(
+                self.model,
+                extrapolate=self.extrapolate,
+                known_input=self.known_input,
+                sample_interval_s=self.sample_interval_s,
+            )
+        before = self._chunks.n_outside
+        y = self._chunks.predict(t, T, f)
+        if self._chunks.n_outside > before:
+            self._chunks.warn_outside(self._chunks.n_outside - before)
+        self._last_t = float(t[-1])
+        self.last_model_value = float(y[-1])
+        self.n_samples += int(t.size)
+        return Compensation(model_value=y, corrected=f - y)
+
+    def process(
+        self, time_s: npt.ArrayLike, temps_c: npt.ArrayLike, signal: npt.ArrayLike
+    ) -> Compensation:
+        """Feed arrays sample by sample (state carried on from earlier calls)."""
+        t = np.asarray(time_s, dtype=np.float64)
+        T = np.asarray(temps_c, dtype=np.float64)
+        if T.ndim == 1:
+            T = T.reshape(-1, 1)
+        f = np.asarray(signal, dtype=np.float64)
+        y = np.empty_like(t)
+        c = np.empty_like(t)
+        for i in range(t.size):
+            c[i] = self.update(float(t[i]), T[i], float(f[i]))
+            y[i] = self.last_model_value
+        return Compensation(model_value=y, corrected=c)
+
+
+class CalibrationStream:
+    """Compensate every channel of a calibration sample by sample (live data, issue 15).
+
+    One :class:`StreamingCompensator` per channel (each keeps its own rate buffer and
+    power-on state), fed from one sample of the whole IMU: the time [s], the
+    temperatures of :attr:`temperature_names` (the union of every channel's inputs, in
+    first-seen order, °C) and the raw outputs of :attr:`names`, each in its channel's
+    data unit (:attr:`units`, the unit the calibration recorded; converted to the model's
+    unit and back, ``value[model] = factor · value[data]``).  Returns the corrected
+    outputs ``F − ŷ`` in the same units.  Equal to :func:`compensate_channels` on the
+    same samples (tested to 1e-9 relative).
+
+    ``channels``: a :class:`~thermocal.models.calibration.Calibration` or ``(name,
+    model, data unit)`` triples.
+    """
+
+    def __init__(
+        self,
+        channels: Any,
+        sample_interval_s: float,
+        *,
+        extrapolate: bool = False,
+    ) -> None:
+        from thermocal.models.calibration import Calibration
+
+        triples = (
+            [(c.name, c.model, c.unit) for c in channels.channels]
+            if isinstance(channels, Calibration)
+            else [(str(n), m, str(u)) for n, m, u in channels]
+        )
+        if not triples:
+            raise ThermocalInputError("CalibrationStream: no channel")
+        self.names = tuple(n for n, _m, _u in triples)
+        self.units = tuple(u for _n, _m, u in triples)
+        temps: list[str] = []
+        for _n, m, _u in triples:
+            temps.extend(str(t) for t in m.temp_names_ if str(t) not in temps)
+        self.temperature_names = tuple(temps)
+        self._cols = [
+            np.array([temps.index(str(t)) for t in m.temp_names_], dtype=np.intp)
+            for _n, m, _u in triples
+        ]
+        self._factors = np.array(
+            [unit_factor(u, m.signal_unit, where=f"channel {n}") for n, m, u in triples]
+        )
+        self._comps = [
+            StreamingCompensator(m, sample_interval_s, extrapolate=extrapolate)
+            for _n, m, _u in triples
+        ]
+
+    def _temps(self, temps_c: Any) -> FloatArray:
+        if isinstance(temps_c, Mapping):
+            missing = [t for t in self.temperature_names if t not in temps_c]
+            if missing:
+                raise ThermocalInputError(f"no value for temperature input(s) {missing}")
+            return np.array([float(temps_c[t]) for t in self.temperature_names])
+        arr = np.asarray(temps_c, dtype=np.float64)
+        if arr.shape[-1] != len(self.temperature_names):
+            raise ThermocalInputError(
+                f"expected {len(self.temperature_names)} temperatures "
+                f"({', '.join(self.temperature_names)}), got {arr.shape[-1]}"
+            )
+        return arr
+
+    def _raw(self, raw: npt.ArrayLike) -> FloatArray:
+        arr = np.asarray(raw, dtype=np.float64)
+        if arr.shape[-1] != len(self.names):
+            raise ThermocalInputError(
+                f"expected {len(self.names)} raw values ({', '.join(self.names)}), "
+                f"got {arr.shape[-1]}"
+            )
+        return arr
+
+    def update(self, time_s: float, temps_c: Any, raw: npt.ArrayLike) -> FloatArray:
+        """Corrected outputs (N,) of one sample [each channel's data unit]; ``temps_c``:
+        (k,) in :attr:`temperature_names` order, or a mapping name → °C."""
+        T = self._temps(temps_c)
+        f = self._raw(raw)
+        out = np.empty(len(self.names))
+        for i, comp in enumerate(self._comps):
+            k = self._factors[i]
+            out[i] = comp.update(time_s, T[self._cols[i]], float(f[i]) * k) / k
+        return out
+
+    def update_block(
+        self, time_s: npt.ArrayLike, temps_c: npt.ArrayLike, raw: npt.ArrayLike
+    ) -> tuple[FloatArray, FloatArray]:
+        """A block of samples: ``temps_c`` (n, k), ``raw`` (n, N) → (model values,
+        corrected outputs), both (n, N) in each channel's data unit."""
+        t = np.asarray(time_s, dtype=np.float64).reshape(-1)
+        T = self._temps(np.asarray(temps_c, dtype=np.float64).reshape(t.size, -1))
+        f = self._raw(np.asarray(raw, dtype=np.float64).reshape(t.size, -1))
+        model = np.empty((t.size, len(self.names)))
+        for i, comp in enumerate(self._comps):
+            k = self._factors[i]
+            res = comp.update_block(t, T[:, self._cols[i]], f[:, i] * k)
+            model[:, i] = res.model_value / k
+        return model, f - model
+
+    def reset(self) -> None:
+        """A new power-on of the IMU: every channel forgets its state."""
+        for comp in self._comps:
+            comp.reset()
+
+
+# --- chunk context rules ---------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class ChunkContext:
+    """What a chunk must be predicted together with to reproduce a whole-run predict.
+
+    ``head_s`` — seconds from the first sample whose samples fix the start-up state
+    (the warm-up window of T0/F0, the bank's selection window); ``tail_s`` — seconds of
+    history before the chunk (the Ṫ interval Δt).  ``None`` for either means the
+    family needs all history (then the file is streamed sample by sample).
+    """
+
+    head_s: float | None
+    tail_s: float | None
+
+
+def _params(model: TemperatureModel) -> dict[str, Any]:
+    return model.get_params()
+
+
+def _rate_tail_s(model: TemperatureModel) -> float:
+    if not model.uses_rate:
+        return 0.0
+    p = _params(model)
+    return float(p.get("rate_interval_s", 60.0) or 60.0)
+
+
+def _first_param(model: TemperatureModel, names: tuple[str, ...], default: float) -> float:
+    p = _params(model)
+    for n in names:
+        v = p.get(n)
+        if v is not None:
+            return float(v)
+    return default
+
+
+CONTEXT_RULES: dict[str, Callable[[TemperatureModel], ChunkContext]] = {
+    "poly": lambda m: ChunkContext(head_s=0.0, tail_s=_rate_tail_s(m)),
+    # eq. (1) of models/piecewise.py is memoryless: y depends on the sample's T only
+    "piecewise": lambda m: ChunkContext(head_s=0.0, tail_s=0.0),
+    "warmup": lambda m: ChunkContext(
+        head_s=_first_param(m, ("start_window_s", "window_s"), math.inf),
+        tail_s=_rate_tail_s(m),
+    ),
+    "bank": lambda m: ChunkContext(
+        head_s=_first_param(m, ("startup_s", "start_window_s"), math.inf),
+        tail_s=_rate_tail_s(m),
+    ),
+}
+"""Chunk context of each family (STYLE rule 8: a registry keyed by family name).
+
+A family missing here is compensated by streaming (exact, slower)."""
+
+
+def chunk_context(model: TemperatureModel) -> ChunkContext:
+    """The :class:`ChunkContext` of a model's family (``None`` fields: stream instead)."""
+    rule = CONTEXT_RULES.get(model.family)
+    if rule is None:
+        return ChunkContext(head_s=None, tail_s=None)
+    ctx = rule(model)
+    if ctx.head_s is not None and not math.isfinite(ctx.head_s):
+        return ChunkContext(head_s=None, tail_s=ctx.tail_s)
+    return ctx
+
+
+class ChunkPredictor:
+    """Predict a long run chunk by chunk with the context carried across chunks.
+
+    For chunk ``c`` the model sees ``head ∪ tail ∪ c``: ``head`` = the samples in the
+    first ``head_s`` seconds of the run, ``tail`` = the samples of the previous
+    chunks within ``tail_s`` (plus a margin of a few sample intervals) before the
+    chunk.  When head and tail meet they are one contiguous stretch; otherwise
+    the jump in time between them is a gap, which the model treats like any gap.
+    Families without a finite context are streamed sample by sample.
+    """
+
+    MARGIN_SAMPLES = 4
+
+    def __init__(
+        self,
+        model: TemperatureModel,
+        *,
+        extrapolate: bool = False,
+        name: str = "",
+        known_input: float = 0.0,
+        sample_interval_s: float | None = None,
+    ) -> None:
+        self.model = model
+        self.known_input = float(known_input)
+        self.extrapolate = extrapolate
+        self.name = name
+        self.context = chunk_context(model)
+        self._rows_seen = 0
+        self._head_t: FloatArray = np.zeros(0)
+        self._head_T: FloatArray = np.zeros((0, 0))
+        self._head_f: FloatArray = np.zeros(0)
+        self._head_done = False
+        self._tail_t: FloatArray = np.zeros(0)
+        self._tail_T: FloatArray = np.zeros((0, 0))
+        self._tail_f: FloatArray = np.zeros(0)
+        self._stream: StreamingCompensator | None = None
+        self._tau: float | None = sample_interval_s
+        self.n_outside = 0
+        """Samples outside the model's fitted temperature range (for one summary warning)."""
+        self._t_first: float | None = None
+        self._t_last: float | None = None
+
+    @property
+    def streams(self) -> bool:
+        return self.context.head_s is None or self.context.tail_s is None
+
+    def predict(self, time_s: FloatArray, temps_c: FloatArray, signal: FloatArray) -> FloatArray:
+        """ŷ for the next chunk of rows (in order) [model unit]."""
+        n = time_s.size
+        if n == 0:
+            return np.zeros(0)
+        if self._tau is None:
+            tau = median_interval(time_s) if n > 1 else float("nan")
+            self._tau = tau if math.isfinite(tau) and tau > 0 else 1.0
+        return self.predict_with(time_s, temps_c, signal, [])[0]
+
+    def predict_with(
+        self,
+        time_s: FloatArray,
+        temps_c: FloatArray,
+        signal: FloatArray,
+        followers: Sequence[ChunkPredictor],
+    ) -> list[FloatArray]:
+        """ŷ of this predictor's model and of each follower's (several channels whose
+        ``poly`` models share one evaluation, :func:`thermocal.models.poly.predict_many`):
+        the context is carried once, here; the followers' counts follow."""
+        n = time_s.size
+        if n == 0:
+            return [np.zeros(0) for _ in range(1 + len(followers))]
+        if self._tau is None:
+            tau = median_interval(time_s) if n > 1 else float("nan")
+            self._tau = tau if math.isfinite(tau) and tau > 0 else 1.0
+        lo, hi = self.model.temp_range_[:, 0], self.model.temp_range_[:, 1]
+        outside = int(np.count_nonzero(((temps_c < lo) | (temps_c > hi)).any(axis=1)))
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", ExtrapolationWarning)
+            if self.streams:
+                ys = [self._predict_stream(time_s, temps_c, signal)]
+            else:
+                ys = self._predict_context(
+                    time_s, temps_c, signal, [self.model, *(f.model for f in followers)]
+                )
+        for p in (self, *followers):
+            p.n_outside += outside
+            p._rows_seen += n
+            if p._t_first is None:
+                p._t_first = float(time_s[0])
+            p._t_last = float(time_s[-1])
+        return ys
+
+    def _predict_stream(
+        self, time_s: FloatArray, temps_c: FloatArray, signal: FloatArray
+    ) -> FloatArray:
+        if self._stream is None:
+            assert self._tau is not None
+            self._stream = StreamingCompensator(
+                self.model, self._tau, extrapolate=self.extrapolate, known_input=self.known_input
+            )
+        return self._stream.process(time_s, temps_c, signal).model_value
+
+    def _predict_context(
+        self,
+        time_s: FloatArray,
+        temps_c: FloatArray,
+        signal: FloatArray,
+        models: Sequence[TemperatureModel],
+    ) -> list[FloatArray]:
+        assert self.context.head_s is not None
+        assert self.context.tail_s is not None
+        assert self._tau is not None
+        k = temps_c.shape[1]
+        if self._head_T.shape[1] != k:
+            self._head_T = np.zeros((0, k))
+            self._tail_T = np.zeros((0, k))
+        # context rows: head (only those not also in the tail) then tail
+        t0 = self._head_t[0] if self._head_t.size else time_s[0]
+        if self._tail_t.size and self._head_t.size:
+            keep_head = self._head_t < self._tail_t[0]
+        else:
+            keep_head = np.ones(self._head_t.size, dtype=bool)
+        ct = np.concatenate([self._head_t[keep_head], self._tail_t, time_s])
+        cT = np.concatenate([self._head_T[keep_head], self._tail_T, temps_c])
+        cf = np.concatenate([self._head_f[keep_head], self._tail_f, signal])
+        m = ct.size - time_s.size
+        run = RunData(
+            time_s=ct,
+            temps_c=cT,
+            signal=cf,
+            temp_names=tuple(self.model.temp_names_),
+            name=self.name,
+            known_input=self.known_input,
+        )
+        if len(models) == 1:
+            y_alls = [np.asarray(self.model.predict(run, extrapolate=self.extrapolate))]
+        else:
+            from thermocal.models.poly import PolyModel, predict_many
+
+            y_alls = predict_many(
+                [cast(PolyModel, mdl) for mdl in models], run, extrapolate=self.extrapolate
+            )
+        ys = [np.asarray(y_all[m:], dtype=np.float64).copy() for y_all in y_alls]
+        # carry the context on
+        if not self._head_done:
+            head_s = self.context.head_s + self.MARGIN_SAMPLES * GAP_FACTOR * self._tau
+            in_head = time_s - t0 <= head_s
+            self._head_t = np.concatenate([self._head_t, time_s[in_head]])
+            self._head_T = np.concatenate([self._head_T, temps_c[in_head]])
+            self._head_f = np.concatenate([self._head_f, signal[in_head]])
+            self._head_done = not bool(in_head.all())
+        span = self.context.tail_s + self.MARGIN_SAMPLES * GAP_FACTOR * self._tau
+        start = int(np.searchsorted(ct, ct[-1] - span, side="left"))
+        start = max(0, min(start, ct.size - self.MARGIN_SAMPLES))
+        self._tail_t = ct[start:].copy()
+        self._tail_T = cT[start:].copy()
+        self._tail_f = cf[start:].copy()
+        return ys
+
+    def finish(self) -> None:
+        """Issue one :class:`ExtrapolationWarning` for the whole file, if any sample
+        was outside the fitted range."""
+        if self.n_outside:
+            self.warn_outside(self.n_outside)
+        if self._t_first is not None and self._t_last is not None:
+            self.model.check_duration(self._t_last - self._t_first)
+
+    def warn_outside(self, n_outside: int) -> None:
+        """One :class:`ExtrapolationWarning` for ``n_outside`` samples out of range."""
+        if n_outside:
+            action = "extrapolated" if self.extrapolate else "clamped to the fitted range"
+            rng = ", ".join(
+                f"{n} {a:.2f}…{b:.2f} °C"
+                for n, (a, b) in zip(self.model.temp_names_, self.model.temp_range_, strict=True)
+            )
+            warnings.warn(
+                f"{self.name or 'data'}: {n_outside} samples outside the model's "
+                f"temperature range ({rng}); {action}",
+                ExtrapolationWarning,
+                stacklevel=2,
+            )

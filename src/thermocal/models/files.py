@@ -1,0 +1,122 @@
+"""Model and calibration files: the file edge of :mod:`thermocal.models` (issue 15).
+
+The maths modules (:mod:`thermocal.models.base`, the families, :mod:`thermocal.models.
+calibration`) build and check plain dicts (:func:`~thermocal.models.base.model_file_dict`,
+:func:`~thermocal.models.base.verify_model_dict`, :meth:`Calibration.to_dict`,
+:func:`~thermocal.models.calibration.calibration_from_dict`) and import no I/O; reading and
+writing the files (atomically, :func:`thermocal.io.write_json`) happens here.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+from pathlib import Path
+from typing import Any
+
+from thermocal.errors import ModelFileError, ThermocalInputError
+from thermocal.io import write_json
+from thermocal.models.base import (
+    MODEL_FORMAT,
+    TemperatureModel,
+    model_file_dict,
+    verify_model_dict,
+)
+from thermocal.models.calibration import (
+    Calibration,
+    Channel,
+    calibration_from_dict,
+    guess_role,
+    is_calibration,
+)
+
+
+def file_sha256(path: str | Path, chunk: int = 1 << 20) -> str:
+    """SHA-256 of a data file (provenance in model files)."""
+    h = hashlib.sha256()
+    with open(path, "rb") as fh:
+        while block := fh.read(chunk):
+            h.update(block)
+    return h.hexdigest()
+
+
+def save_model(model: TemperatureModel, path: str | Path) -> dict[str, Any]:
+    """Write a fitted model as JSON (atomically), with its checksum; returns the dict.
+
+    A model holding a non-finite number (NaN or infinity in a coefficient, range or
+    statistic) is refused with :class:`DesignError` naming the field: JSON cannot hold it
+    and firmware must never load it.
+    """
+    d = model_file_dict(model)
+    write_json(path, d)
+    return d
+
+
+def load_model_dict(path: str | Path) -> dict[str, Any]:
+    """Read and verify a model file (format, version, checksum) without building it."""
+    p = Path(path)
+    try:
+        text = p.read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise ModelFileError(f"{p}: no such model file") from None
+    except UnicodeDecodeError:
+        raise ModelFileError(f"{p}: not a text (JSON) model file") from None
+    try:
+        d = json.loads(text)
+    except json.JSONDecodeError as exc:
+        raise ModelFileError(f"{p}: corrupted model file (invalid JSON: {exc.msg})") from None
+    return verify_model_dict(d, str(p))
+
+
+def load_model(path: str | Path) -> TemperatureModel:
+    """Load and verify a model file; returns the fitted model."""
+    d = load_model_dict(path)
+    try:
+        return TemperatureModel.from_dict(d)
+    except ModelFileError as exc:
+        raise ModelFileError(f"{path}: {exc}") from None
+    except (KeyError, TypeError, ValueError) as exc:
+        raise ModelFileError(
+            f"{path}: malformed model file ({type(exc).__name__}: {exc})"
+        ) from None
+
+
+def save_calibration(cal: Calibration, path: str | Path) -> dict[str, Any]:
+    """Write a calibration file (atomically); returns its dict."""
+    if not cal.channels:
+        raise ThermocalInputError("calibration: no channels to write")
+    d = cal.to_dict()
+    write_json(path, d)
+    return d
+
+
+def load_calibration(path: str | Path) -> Calibration:
+    """A calibration file, or a single-model file as a calibration of one channel (named
+    after the model's signal, in the unit its inputs record)."""
+    p = Path(path)
+    try:
+        d = json.loads(p.read_text(encoding="utf-8"))
+    except FileNotFoundError:
+        raise ModelFileError(f"{p}: no such model or calibration file") from None
+    except UnicodeDecodeError:
+        raise ModelFileError(f"{p}: not a text (JSON) model or calibration file") from None
+    except json.JSONDecodeError as exc:
+        raise ModelFileError(f"{p}: corrupted model file (invalid JSON: {exc.msg})") from None
+    if is_calibration(d):
+        return calibration_from_dict(d, str(p))
+    if isinstance(d, dict) and d.get("format") == MODEL_FORMAT:
+        model = load_model(p)
+        sig = model.signal_name or "signal"
+        unit = str((model.inputs_ or {}).get("units", {}).get(sig) or model.signal_unit)
+        return Calibration([Channel(sig, sig, unit, model, guess_role(sig, unit))])
+    raise ModelFileError(f"{p}: not a thermocal model or calibration file (missing 'format')")
+
+
+__all__ = [
+    "file_sha256",
+    "load_calibration",
+    "load_model",
+    "load_model_dict",
+    "save_calibration",
+    "save_model",
+]
