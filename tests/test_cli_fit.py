@@ -129,17 +129,20 @@ def test_never_writes_over_input(tmp_path, capsys):
 
 
 def test_dispatch_through_registry(monkeypatch):
-    """Families without ``from_cli_options`` get their constructor arguments."""
+    """A family registered without its own option table gets its constructor arguments;
+    every family refuses an option it does not take (one parser for all)."""
 
     class Plain(PiecewiseModel):
         family = "plain-test"
+        CLI_KEYS = None
 
-    monkeypatch.delattr(PiecewiseModel, "from_cli_options")
     monkeypatch.setitem(MODEL_REGISTRY, "plain-test", Plain)
     m = build_model("plain-test", {"segments": 2, "method": None})
     assert isinstance(m, Plain) and m.segments == 2
     with pytest.raises(ThermocalInputError, match="ridge"):
         build_model("plain-test", {"ridge": 1.0})
-    for fam in ("warmup", "bank"):
-        if fam in MODEL_REGISTRY:
-            assert build_model(fam, {}).family == fam
+    for fam, foreign in (("poly", "segments"), ("piecewise", "ridge"), ("warmup", "tolerance"),
+                         ("bank", "rate_interval_s")):  # fmt: skip
+        assert build_model(fam, {}).family == fam
+        with pytest.raises(ThermocalInputError, match=f"{foreign} does not apply to model '{fam}'"):
+            build_model(fam, {foreign: 1.0})

@@ -24,7 +24,6 @@ import pytest
 
 from thermocal import units
 from thermocal.compensate import (
-    CONTEXT_RULES,
     ChunkContext,
     ChunkPredictor,
     StreamingCompensator,
@@ -230,8 +229,8 @@ def test_chunk_predictor_equals_whole_predict(
     run = _toy_run()
     m = _fitted_toy(run)
     if use_rule:
-        monkeypatch.setitem(
-            CONTEXT_RULES, "toy-test", lambda mm: ChunkContext(mm.window_s, mm.rate_interval_s)
+        monkeypatch.setattr(
+            type(m), "chunk_context", lambda mm: ChunkContext(mm.window_s, mm.rate_interval_s)
         )
     cp = ChunkPredictor(m)
     assert cp.streams is not use_rule
@@ -267,8 +266,8 @@ def test_compensate_file_chunked_equals_in_memory(
 ) -> None:
     run = _toy_run()
     m = _fitted_toy(run)
-    monkeypatch.setitem(
-        CONTEXT_RULES, "toy-test", lambda mm: ChunkContext(mm.window_s, mm.rate_interval_s)
+    monkeypatch.setattr(
+        type(m), "chunk_context", lambda mm: ChunkContext(mm.window_s, mm.rate_interval_s)
     )
     src = tmp_path / "in.csv"
     _write_csv(src, run)
@@ -394,9 +393,11 @@ def _families() -> list[str]:
     return sorted(MODEL_REGISTRY)
 
 
-def test_context_rule_for_every_registered_family() -> None:
+def test_every_registered_family_declares_its_chunk_context() -> None:
+    """No family falls back to the (exact but slow) sample-by-sample default unnoticed."""
     for fam in _families():
-        assert fam in CONTEXT_RULES, f"no chunk context rule for family {fam!r}"
+        cls = MODEL_REGISTRY[fam]
+        assert cls.chunk_context is not TemperatureModel.chunk_context, fam
 
 
 def _fit_family(fam: str) -> TemperatureModel:

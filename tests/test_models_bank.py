@@ -296,11 +296,13 @@ def test_registry_and_cli_options() -> None:
             "deviation": 0.5,
             "tolerance": None,
             "startup_s": 10,
-            "per_run_offset": True,
-            "extrapolate": False,
+            "per_run_offset": None,  # not given
         }
     )
     assert (m.deviation, m.tolerance, m.startup_s) == (0.5, 0.2, 10)
+    # the bank has no per-run offsets: the option is refused, not dropped silently
+    with pytest.raises(ThermocalInputError, match="per_run_offset does not apply"):
+        BankModel.from_cli_options({"per_run_offset": True})
 
 
 # --- range and bad input ------------------------------------------------------------------------

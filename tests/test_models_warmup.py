@@ -232,10 +232,13 @@ def test_registry_and_cli_options() -> None:
             "order": 3,
             "t0_order": None,
             "per_run_offset": True,
-            "target": "bias",
+            "segments": None,  # not given: no matter that warmup does not take it
         }
     )
     assert (m.start_window_s, m.order, m.t0_order) == (5.0, 3, 2)
+    # an option warmup does not take is refused (no longer dropped silently)
+    with pytest.raises(ThermocalInputError, match="segments does not apply to model 'warmup'"):
+        WarmupModel.from_cli_options({"segments": 3})
 
 
 # --- range and bad input -----------------------------------------------------------------------

@@ -11,7 +11,8 @@ Three ways to apply a model, all giving the same numbers:
   in chunks with constant memory.  Every chunk is predicted together with the
   *context* the model needs (the samples since power-on that fix its start-up
   state and the last Δt seconds that feed the Ṫ buffer, see
-  :data:`CONTEXT_RULES`); because ``predict`` is causal (models/base.py
+  :meth:`~thermocal.models.base.TemperatureModel.chunk_context`); because ``predict``
+  is causal (models/base.py
   contract) the values of the chunk's own rows equal those of a whole-file
   ``predict``.  Families without a context rule are streamed sample by sample
   (:class:`StreamingCompensator`), which is exact but slower.
@@ -45,9 +46,7 @@ import pyarrow.parquet as pq
 
 from thermocal import units
 from thermocal.compensation import (  # the maths, re-exported
-    CONTEXT_RULES,
     CalibrationStream,
-    ChunkContext,
     ChunkPredictor,
     Compensation,
     ModelRun,
@@ -83,7 +82,7 @@ from thermocal.io import (
     sidecar_path,
     write_json,
 )
-from thermocal.models.base import TemperatureModel, check_sensor_id
+from thermocal.models.base import ChunkContext, TemperatureModel, check_sensor_id
 from thermocal.recording import (
     ABSOLUTE_ZERO_C,
     FEW_SAMPLES,
@@ -739,7 +738,6 @@ def _evaluation_groups(plans: Sequence[_ChannelPlan]) -> list[list[_ChannelPlan]
 
 __all__ = [
     "COMP_SUFFIX",
-    "CONTEXT_RULES",
     "DEFAULT_CHUNK_ROWS",
     "MODEL_SUFFIX",
     "CalibrationStream",

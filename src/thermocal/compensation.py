@@ -7,7 +7,8 @@ compensated output is ``F' = F − ŷ`` (SPEC §4c: "output F' = F − ΔF").
 * :func:`compensate_run` — in memory, ``model.predict(run)`` on a whole run.
 * :class:`ChunkPredictor` — a long run chunk by chunk with the *context* the model needs
   (the samples since power-on that fix its start-up state and the last Δt seconds that
-  feed the Ṫ buffer, declared by each family: :meth:`TemperatureModel.chunk_context`);
+  feed the Ṫ buffer, declared by each family:
+  :meth:`~thermocal.models.base.TemperatureModel.chunk_context`);
   because ``predict`` is causal the values of a chunk's own rows equal those of a
   whole-run ``predict``.  Families without a finite context are streamed sample by sample.
 * :class:`StreamingCompensator` — live data, one sample at a time, through the family's
@@ -25,7 +26,7 @@ from __future__ import annotations
 import dataclasses
 import math
 import warnings
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any, cast
 
@@ -40,7 +41,7 @@ from thermocal.errors import (
     UnitError,
     UnitWarning,
 )
-from thermocal.models.base import ModelStream, RunData, TemperatureModel
+from thermocal.models.base import ChunkContext, ModelStream, RunData, TemperatureModel
 from thermocal.recording import GAP_FACTOR, FloatArray, Metadata, Recording, median_interval
 
 # --- unit handling ------------------------------------------------------------------------
@@ -489,64 +490,10 @@ class CalibrationStream:
 # --- chunk context rules ---------------------------------------------------------------------
 
 
-@dataclass(frozen=True)
-class ChunkContext:
-    """What a chunk must be predicted together with to reproduce a whole-run predict.
-
-    ``head_s`` — seconds from the first sample whose samples fix the start-up state
-    (the warm-up window of T0/F0, the bank's selection window); ``tail_s`` — seconds of
-    history before the chunk (the Ṫ interval Δt).  ``None`` for either means the
-    family needs all history (then the file is streamed sample by sample).
-    """
-
-    head_s: float | None
-    tail_s: float | None
-
-
-def _params(model: TemperatureModel) -> dict[str, Any]:
-    return model.get_params()
-
-
-def _rate_tail_s(model: TemperatureModel) -> float:
-    if not model.uses_rate:
-        return 0.0
-    p = _params(model)
-    return float(p.get("rate_interval_s", 60.0) or 60.0)
-
-
-def _first_param(model: TemperatureModel, names: tuple[str, ...], default: float) -> float:
-    p = _params(model)
-    for n in names:
-        v = p.get(n)
-        if v is not None:
-            return float(v)
-    return default
-
-
-CONTEXT_RULES: dict[str, Callable[[TemperatureModel], ChunkContext]] = {
-    "poly": lambda m: ChunkContext(head_s=0.0, tail_s=_rate_tail_s(m)),
-    # eq. (1) of models/piecewise.py is memoryless: y depends on the sample's T only
-    "piecewise": lambda m: ChunkContext(head_s=0.0, tail_s=0.0),
-    "warmup": lambda m: ChunkContext(
-        head_s=_first_param(m, ("start_window_s", "window_s"), math.inf),
-        tail_s=_rate_tail_s(m),
-    ),
-    "bank": lambda m: ChunkContext(
-        head_s=_first_param(m, ("startup_s", "start_window_s"), math.inf),
-        tail_s=_rate_tail_s(m),
-    ),
-}
-"""Chunk context of each family (STYLE rule 8: a registry keyed by family name).
-
-A family missing here is compensated by streaming (exact, slower)."""
-
-
 def chunk_context(model: TemperatureModel) -> ChunkContext:
-    """The :class:`ChunkContext` of a model's family (``None`` fields: stream instead)."""
-    rule = CONTEXT_RULES.get(model.family)
-    if rule is None:
-        return ChunkContext(head_s=None, tail_s=None)
-    ctx = rule(model)
+    """The :class:`ChunkContext` the model's family declares
+    (:meth:`TemperatureModel.chunk_context`; ``None`` fields: stream instead)."""
+    ctx = model.chunk_context()
     if ctx.head_s is not None and not math.isfinite(ctx.head_s):
         return ChunkContext(head_s=None, tail_s=ctx.tail_s)
     return ctx
@@ -731,3 +678,20 @@ class ChunkPredictor:
                 ExtrapolationWarning,
                 stacklevel=2,
             )
+
+
+__all__ = [
+    "CalibrationStream",
+    "ChunkContext",
+    "ChunkPredictor",
+    "Compensation",
+    "ModelRun",
+    "StreamingCompensator",
+    "check_signal_kind",
+    "chunk_context",
+    "compensate_run",
+    "model_scale_factor",
+    "prepare_run",
+    "temperature_inputs",
+    "unit_factor",
+]

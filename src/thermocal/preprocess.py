@@ -182,6 +182,169 @@ def lowpass_first_order(
 # --- temperature rate ------------------------------------------------------------------
 
 
+RATE_BLOCK_ROWS = 32768
+"""Rows per block when computing Ṫ of a whole run (:func:`temperature_rates`)."""
+
+
+def step_range(time_s: FloatArray) -> tuple[float, float]:
+    """Smallest and largest time step ``min/max(t_{i+1} − t_i)`` [s] (NaN-free input;
+    ``(inf, -inf)`` for fewer than 2 samples), reduced in cache-sized blocks."""
+    n = int(time_s.size)
+    lo, hi = math.inf, -math.inf
+    if n < 2:
+        return lo, hi
+    step = RATE_BLOCK_ROWS * 8
+    buf = np.empty(min(step, n - 1))
+    for a in range(0, n - 1, step):
+        b = min(n - 1, a + step)
+        d = np.subtract(time_s[a + 1 : b + 1], time_s[a:b], out=buf[: b - a])
+        lo = min(lo, float(d.min()))
+        hi = max(hi, float(d.max()))
+    return lo, hi
+
+
+def gap_free_slices(
+    time_s: FloatArray,
+    gap_factor: float = GAP_FACTOR,
+    steps: tuple[float, float] | None = None,
+) -> list[slice]:
+    """Contiguous index ranges between gaps: the same slices as
+    :func:`thermocal.recording.contiguous_slices` (a step longer than ``gap_factor`` ×
+    the median step is a gap), with an exact shortcut for gap-free data.
+
+    When every step is positive and ``max(dt) ≤ gap_factor · min(dt)``, no step can
+    exceed ``gap_factor`` × the median (``median ≥ min``), so the whole run is one
+    slice without computing the median; otherwise the general function is used.
+    ``steps``: :func:`step_range` of ``time_s`` when already known.
+    """
+    n = int(time_s.size)
+    if n < 3:
+        return [slice(0, n)] if n else []
+    lo, hi = step_range(time_s) if steps is None else steps
+    if lo > 0 and hi <= gap_factor * lo:
+        return [slice(0, n)]
+    return contiguous_slices(time_s, gap_factor)
+
+
+def backward_partners(
+    time_s: FloatArray, s0: int, a: int, b: int, interval_s: float, *, increasing: bool = False
+) -> int | npt.NDArray[np.intp]:
+    """Partner samples of the causal rate for rows ``a … b−1`` of the segment starting at ``s0``.
+
+    ``lo_i`` = the first row ``j ≥ s0`` with ``t_j ≥ t_i − Δt``
+    (``searchsorted(..., side="left")``, as :func:`thermocal.preprocess.temperature_rate`).
+    Returns an ``int`` L when ``lo_i = i − L`` for every row, with ``t_{lo_i} < t_i``
+    (checked exactly: ``t_{i−L} ≥ t_i − Δt > t_{i−L−1}``, ``i − L − 1 ≥ s0``) — the
+    usual case of regular sampling, where the partner values are a slice; else the
+    array of absolute indices ``lo_i``.  ``increasing=True`` tells that the times are
+    known to increase strictly (then ``t_{i−L} < t_i`` needs no check).
+    """
+    x0 = float(time_s[a]) - interval_s
+    lo_a = s0 + int(np.searchsorted(time_s[s0 : a + 1], x0, side="left"))
+    shift = a - lo_a
+    x = time_s[a:b] - interval_s
+    if lo_a > s0 and shift >= 1:
+        prev = time_s[a - shift - 1 : b - shift]
+        if (
+            bool(np.all(prev[1:] >= x))
+            and bool(np.all(prev[:-1] < x))
+            and (increasing or bool(np.all(time_s[a:b] > prev[1:])))
+        ):
+            return shift
+    lo: npt.NDArray[np.intp] = lo_a + np.searchsorted(time_s[lo_a:b], x, side="left")
+    return lo
+
+
+def segment_rates(
+    ts: FloatArray,
+    Ts: FloatArray,
+    rows: npt.NDArray[np.intp],
+    interval_s: float,
+    method: str = "backward",
+) -> FloatArray:
+    """Ṫ [°C/min] at ``rows`` of one contiguous segment (times ``ts``, temps ``Ts`` (n, k)).
+
+    The same arithmetic as :func:`thermocal.preprocess.temperature_rate`
+    (SPEC §3): partner samples ``lo``/``hi`` inside the segment (backward: the
+    first ``t_j ≥ t_i − Δt`` and i; forward: i and the first ``t_j ≥ t_i + Δt``;
+    centred: ±Δt/2), ``Ṫ = (T_hi − T_lo)/(t_hi − t_lo)·60``, 0 when the span
+    is 0.  Works on a block of rows so that long runs need no full-size temporaries;
+    a backward block of consecutive rows uses :func:`backward_partners` (slices
+    instead of gathers on regular sampling).  Returns (len(rows), k), Fortran order.
+    """
+    n = ts.size
+    i = np.asarray(rows, dtype=np.intp)
+    if i.size == 0:
+        return np.zeros((0, Ts.shape[1]), order="F")
+    contiguous = int(i[-1]) - int(i[0]) == i.size - 1 and bool(np.all(np.diff(i) == 1))
+    ti = ts[i[0] : i[-1] + 1] if contiguous else ts[i]
+    if method == "backward" and contiguous:
+        a, b = int(i[0]), int(i[-1]) + 1
+        out = np.empty((b - a, Ts.shape[1]), order="F")
+        part = backward_partners(ts, 0, a, b, interval_s)
+        if isinstance(part, int):
+            span = ts[a:b] - ts[a - part : b - part]
+            np.subtract(Ts[a:b], Ts[a - part : b - part], out=out)
+            out /= span[:, None]
+            out *= SECONDS_PER_MINUTE
+            return out
+        lo = part
+        hi = i
+    elif method == "backward":
+        lo = np.searchsorted(ts, ti - interval_s, side="left")
+        hi = i
+    elif method == "forward":
+        lo = i
+        hi = np.minimum(np.searchsorted(ts, ti + interval_s, side="left"), n - 1)
+    elif method == "centred":
+        lo = np.searchsorted(ts, ti - interval_s / 2.0, side="left")
+        hi = np.minimum(np.searchsorted(ts, ti + interval_s / 2.0, side="left"), n - 1)
+    else:
+        raise ThermocalInputError(f"unknown rate method {method!r}")
+    span = ts[hi] - ts[lo]
+    out = np.zeros((i.size, Ts.shape[1]), order="F")
+    ok = span > 0
+    if ok.all():
+        out[...] = (Ts[hi] - Ts[lo]) / span[:, None] * SECONDS_PER_MINUTE
+    elif ok.any():
+        out[ok] = (Ts[hi[ok]] - Ts[lo[ok]]) / span[ok, None] * SECONDS_PER_MINUTE
+    return out
+
+
+def temperature_rates(
+    time_s: FloatArray,
+    temps_c: FloatArray,
+    interval_s: float,
+    method: str = "backward",
+    *,
+    gap_factor: float = GAP_FACTOR,
+) -> FloatArray:
+    """Ṫ of every column [°C/min], never across a gap (:func:`segment_rates` per segment,
+    in blocks of :data:`RATE_BLOCK_ROWS` rows).
+
+    Equal, bit for bit, to :func:`thermocal.preprocess.temperature_rate` applied column
+    by column.  ``temps_c`` may be 1-D (one column; a 1-D result).
+    """
+    T = np.asarray(temps_c, dtype=np.float64)
+    one_d = T.ndim == 1
+    T2 = T.reshape(-1, 1) if one_d else T
+    out = np.zeros(T2.shape)
+    for sl in gap_free_slices(time_s, gap_factor):
+        s0, s1 = int(sl.start), int(sl.stop)
+        ts, Ts = time_s[s0:s1], T2[s0:s1]
+        for a in range(0, s1 - s0, RATE_BLOCK_ROWS):
+            b = min(s1 - s0, a + RATE_BLOCK_ROWS)
+            out[s0 + a : s0 + b] = segment_rates(ts, Ts, np.arange(a, b), interval_s, method)
+    return out[:, 0] if one_d else out
+
+
+def backward_rates(
+    time_s: FloatArray, temps_c: FloatArray, interval_s: float, *, gap_factor: float = GAP_FACTOR
+) -> FloatArray:
+    """Causal rate ``Ṫ(t) = (T(t) − T(t−Δt))/Δt`` [°C/min] of every column (see above)."""
+    return temperature_rates(time_s, temps_c, interval_s, "backward", gap_factor=gap_factor)
+
+
 RATE_BLOCK = 1 << 16
 """Rows per block of :func:`temperature_rate` (its working memory is per block)."""
 
@@ -219,30 +382,9 @@ def temperature_rate(
         raise ThermocalInputError(f"unknown rate method {method!r}; use one of {RATE_METHODS}")
     if not interval_s > 0:
         raise ThermocalInputError(f"rate interval must be positive, got {interval_s}")
-    out = np.zeros_like(T)
-    for sl in contiguous_slices(t, gap_factor):
-        ts, Ts = t[sl], T[sl]
-        n = ts.size
-        seg_out = out[sl]
-        # in blocks of rows: the partner indices and spans of a block only (bounded memory)
-        for a in range(0, n, RATE_BLOCK):
-            b = min(n, a + RATE_BLOCK)
-            tb = ts[a:b]
-            i = np.arange(a, b)
-            if method == "forward":
-                lo = i
-                hi = np.minimum(np.searchsorted(ts, tb + interval_s, side="left"), n - 1)
-            elif method == "backward":
-                lo = np.searchsorted(ts, tb - interval_s, side="left")
-                hi = i
-            else:
-                lo = np.searchsorted(ts, tb - interval_s / 2.0, side="left")
-                hi = np.minimum(np.searchsorted(ts, tb + interval_s / 2.0, side="left"), n - 1)
-            span = ts[hi] - ts[lo]
-            ok = span > 0
-            rate = np.zeros(b - a)
-            rate[ok] = (Ts[hi[ok]] - Ts[lo[ok]]) / span[ok] * SECONDS_PER_MINUTE
-            seg_out[a:b] = rate
+    # one implementation of Ṫ for the whole package (issue 15): the block form the models
+    # use, on one column
+    out: FloatArray = temperature_rates(t, T, interval_s, method, gap_factor=gap_factor)
     return out
 
 

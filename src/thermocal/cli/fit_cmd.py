@@ -7,7 +7,7 @@ with the data files' names and SHA-256 checksums.
 
 The family is looked up in the registry (:func:`thermocal.models.base.get_model_class`).
 The command collects the model options the user gave into one dict and calls
-``cls.from_cli_options(options)`` when the family class has it, else ``cls(**options)``
+``cls.from_cli_options(options)``, the one option parser of every family
 restricted to its constructor parameters.  Only options given on the command
 line are in the dict (no ``None`` values).  Keys:
 
@@ -49,7 +49,6 @@ fit statistics), ``coefficients`` and ``warnings``.
 from __future__ import annotations
 
 import dataclasses
-import inspect
 import math
 import warnings
 from collections.abc import Sequence
@@ -108,22 +107,10 @@ def run_temp_names(rec: Recording, temps: str | None) -> list[str]:
 
 
 def build_model(family: str, options: dict[str, Any]) -> TemperatureModel:
-    """Instantiate a registered family from the CLI option dict (module docstring)."""
-    cls = get_model_class(family)
-    opts = {k: v for k, v in options.items() if v is not None}
-    factory = getattr(cls, "from_cli_options", None)
-    if callable(factory):
-        model = factory(opts)
-        if not isinstance(model, TemperatureModel):
-            raise ThermocalInputError(f"model family {family!r} did not build a model")
-        return model
-    params = [p for p in inspect.signature(cls.__init__).parameters if p != "self"]
-    unknown = [k for k in opts if k not in params]
-    if unknown:
-        raise ThermocalInputError(
-            f"option(s) {', '.join(unknown)} do not apply to model {family!r}"
-        )
-    return cls(**opts)
+    """Instantiate a registered family from the CLI option dict by its one option parser
+    (:meth:`TemperatureModel.from_cli_options`: an option the family does not take is
+    refused, for every family)."""
+    return get_model_class(family).from_cli_options(options)
 
 
 @app.command("fit")

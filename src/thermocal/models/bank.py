@@ -73,7 +73,7 @@ from __future__ import annotations
 import bisect
 import math
 import warnings
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any, ClassVar, Self
 
@@ -87,6 +87,7 @@ from thermocal.errors import (
     ThermocalInputError,
 )
 from thermocal.models.base import (
+    ChunkContext,
     ClampOnce,
     Coefficient,
     FitStats,
@@ -263,22 +264,18 @@ class BankModel(TemperatureModel):
         self.hold_min_s = hold_min_s
         self.error_metric = error_metric
 
-    @classmethod
-    def from_cli_options(cls, opts: dict[str, Any]) -> Self:
-        """Build from ``thermocal fit`` options (``deviation``, ``tolerance``,
-        ``startup_s``, ``sensor``, ``knot_spacing_c``, ``grid_step_c``, ``hold_min_s``,
-        ``error_metric``); other keys and ``None`` values are ignored."""
-        keys = (
-            "deviation",
-            "tolerance",
-            "startup_s",
-            "sensor",
-            "knot_spacing_c",
-            "grid_step_c",
-            "hold_min_s",
-            "error_metric",
+    CLI_KEYS: ClassVar[Mapping[str, str] | None] = {
+        k: k
+        for k in (
+            "deviation", "tolerance", "startup_s", "sensor", "knot_spacing_c", "grid_step_c",
+            "hold_min_s", "error_metric",
         )
-        return cls(**{k: opts[k] for k in keys if opts.get(k) is not None})
+    }  # fmt: skip
+
+    def chunk_context(self) -> ChunkContext:
+        """The model is chosen from the first ``startup_s`` seconds after power-on."""
+        w = float(self.startup_s)
+        return ChunkContext(head_s=w if math.isfinite(w) else None, tail_s=0.0)
 
     def _check_params(self) -> None:
         for name in ("deviation", "tolerance", "startup_s", "knot_spacing_c", "grid_step_c"):

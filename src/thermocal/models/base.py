@@ -450,6 +450,21 @@ class ModelStream(ABC):
         """Forget everything (a new power-on)."""
 
 
+@dataclass(frozen=True)
+class ChunkContext:
+    """What a chunk of a long run must be predicted together with to reproduce a
+    whole-run predict (declared by each family, :meth:`TemperatureModel.chunk_context`).
+
+    ``head_s`` — seconds from the first sample whose samples fix the start-up state
+    (the warm-up window of T0/F0, the bank's selection window); ``tail_s`` — seconds of
+    history before the chunk (the Ṫ interval Δt).  ``None`` for either means the
+    family needs all history (then a file is streamed sample by sample).
+    """
+
+    head_s: float | None
+    tail_s: float | None
+
+
 class TemperatureModel(ABC):
     """Base class of every compensation model family.
 
@@ -550,6 +565,33 @@ class TemperatureModel(ABC):
     def _param_names(cls) -> list[str]:
         sig = inspect.signature(cls.__init__)
         return [p for p in sig.parameters if p != "self"]
+
+    CLI_KEYS: ClassVar[Mapping[str, str] | None] = None
+    """``thermocal fit`` option key → constructor parameter; None: the constructor's own
+    parameter names.  The one option parser, :meth:`from_cli_options`, refuses the rest."""
+
+    @classmethod
+    def from_cli_options(cls, options: Mapping[str, Any]) -> Self:
+        """Build from the ``thermocal fit`` option dict: ``None`` values are options not
+        given; a given option the family does not take is an input error naming it and
+        the options the family does take (the same rule for every family)."""
+        keys = (
+            dict(cls.CLI_KEYS) if cls.CLI_KEYS is not None else {p: p for p in cls._param_names()}
+        )
+        given = {k: v for k, v in options.items() if v is not None}
+        unknown = [k for k in given if k not in keys]
+        if unknown:
+            verb = "does" if len(unknown) == 1 else "do"
+            raise ThermocalInputError(
+                f"option{'s' if len(unknown) > 1 else ''} {', '.join(unknown)} {verb} not apply "
+                f"to model {cls.family!r} (it takes: {', '.join(keys)})"
+            )
+        return cls(**{keys[k]: v for k, v in given.items()})
+
+    def chunk_context(self) -> ChunkContext:
+        """The context a chunk needs (:class:`ChunkContext`); the default — all history —
+        makes file compensation stream the family sample by sample (exact, slower)."""
+        return ChunkContext(head_s=None, tail_s=None)
 
     def get_params(self) -> dict[str, Any]:
         """Constructor arguments (estimator contract)."""

@@ -55,7 +55,7 @@ from __future__ import annotations
 import bisect
 import math
 import warnings
-from collections.abc import Iterator, Sequence
+from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any, ClassVar, Self
 
@@ -69,6 +69,7 @@ from thermocal.errors import (
     ThermocalWarning,
 )
 from thermocal.models.base import (
+    ChunkContext,
     ClampOnce,
     Coefficient,
     FitStats,
@@ -353,25 +354,13 @@ class PiecewiseModel(TemperatureModel):
         self.temperature = temperature
         self.per_run_offset = per_run_offset
 
-    CLI_KEYS: ClassVar[tuple[str, ...]] = (
-        "breakpoints",
-        "segments",
-        "method",
-        "temperature",
-        "per_run_offset",
-    )
+    CLI_KEYS: ClassVar[Mapping[str, str] | None] = {
+        k: k for k in ("breakpoints", "segments", "method", "temperature", "per_run_offset")
+    }
 
-    @classmethod
-    def from_cli_options(cls, options: dict[str, Any]) -> PiecewiseModel:
-        """Build from the ``thermocal fit`` option dict (keys in :mod:`thermocal.cli.fit_cmd`)."""
-        params: dict[str, Any] = {}
-        for key, value in options.items():
-            if value is None:
-                continue
-            if key not in cls.CLI_KEYS:
-                raise ThermocalInputError(f"option {key!r} does not apply to model 'piecewise'")
-            params[key] = value
-        return cls(**params)
+    def chunk_context(self) -> ChunkContext:
+        """Eq. (1) is memoryless: a sample's value depends on its own temperature only."""
+        return ChunkContext(head_s=0.0, tail_s=0.0)
 
     # -- helpers --
     def _column(self, names: Sequence[str], k: int) -> int:

@@ -91,7 +91,7 @@ import itertools
 import math
 import warnings
 from collections import deque
-from collections.abc import Iterator, Sequence
+from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any, ClassVar, Self, cast
 
@@ -100,6 +100,7 @@ import numpy.typing as npt
 
 from thermocal.errors import ConditioningWarning, ExtrapolationWarning, ThermocalInputError
 from thermocal.models.base import (
+    ChunkContext,
     Coefficient,
     FitStats,
     ModelStream,
@@ -949,7 +950,7 @@ class PolyModel(TemperatureModel):
         self.noise_threshold = noise_threshold
 
     # -- construction from the command line --
-    CLI_KEYS: ClassVar[dict[str, str]] = {
+    CLI_KEYS: ClassVar[Mapping[str, str] | None] = {
         "terms": "terms",
         "order": "order",
         "rate_interval_s": "rate_interval_s",
@@ -962,17 +963,9 @@ class PolyModel(TemperatureModel):
         "noise_threshold": "noise_threshold",
     }
 
-    @classmethod
-    def from_cli_options(cls, options: dict[str, Any]) -> PolyModel:
-        """Build from the ``thermocal fit`` option dict (keys in :mod:`thermocal.cli.fit_cmd`)."""
-        params: dict[str, Any] = {}
-        for key, value in options.items():
-            if value is None:
-                continue
-            if key not in cls.CLI_KEYS:
-                raise ThermocalInputError(f"option {key!r} does not apply to model 'poly'")
-            params[cls.CLI_KEYS[key]] = value
-        return cls(**params)
+    def chunk_context(self) -> ChunkContext:
+        """Eq. (1) needs the last Δt seconds (the Ṫ interval) and nothing of the start."""
+        return ChunkContext(head_s=0.0, tail_s=float(self.rate_interval_s))
 
     # -- helpers --
     def _check_params(self) -> None:

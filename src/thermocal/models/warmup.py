@@ -66,7 +66,7 @@ from __future__ import annotations
 import dataclasses
 import math
 import warnings
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from typing import Any, ClassVar, Self
 
 import numpy as np
@@ -80,6 +80,7 @@ from thermocal.errors import (
     ThermocalInputError,
 )
 from thermocal.models.base import (
+    ChunkContext,
     Coefficient,
     FitStats,
     ModelStream,
@@ -308,21 +309,18 @@ class WarmupModel(TemperatureModel):
         self.method = method
         self.per_run_offset = per_run_offset
 
-    @classmethod
-    def from_cli_options(cls, opts: dict[str, Any]) -> Self:
-        """Build from ``thermocal fit`` options (``start_window_s``, ``order``,
-        ``t0_order``, ``sensor``, ``include_a0``, ``method``, ``per_run_offset``); other keys and
-        ``None`` values are ignored."""
-        keys = (
-            "order",
-            "t0_order",
-            "start_window_s",
-            "include_a0",
-            "sensor",
-            "method",
+    CLI_KEYS: ClassVar[Mapping[str, str] | None] = {
+        k: k
+        for k in (
+            "order", "t0_order", "start_window_s", "include_a0", "sensor", "method",
             "per_run_offset",
         )
-        return cls(**{k: opts[k] for k in keys if opts.get(k) is not None})
+    }  # fmt: skip
+
+    def chunk_context(self) -> ChunkContext:
+        """T0 and F0 come from the first ``start_window_s`` seconds of the run; no Ṫ."""
+        w = float(self.start_window_s)
+        return ChunkContext(head_s=w if math.isfinite(w) else None, tail_s=0.0)
 
     # -- validation --
     def _check_params(self) -> None:
