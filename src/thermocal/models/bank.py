@@ -233,6 +233,7 @@ class BankModel(TemperatureModel):
     """
 
     family: ClassVar[str] = "bank"
+    C_GENERATOR: ClassVar[str | None] = "thermocal.export_c.bank"
     uses_rate: ClassVar[bool] = False
 
     breakpoints_: list[FloatArray]

@@ -566,6 +566,10 @@ class TemperatureModel(ABC):
         sig = inspect.signature(cls.__init__)
         return [p for p in sig.parameters if p != "self"]
 
+    C_GENERATOR: ClassVar[str | None] = None
+    """The module of :mod:`thermocal.export_c` whose ``generate(ctx)`` writes this family's
+    C code (imported only by ``export-c``); None: no C export."""
+
     CLI_KEYS: ClassVar[Mapping[str, str] | None] = None
     """``thermocal fit`` option key → constructor parameter; None: the constructor's own
     parameter names.  The one option parser, :meth:`from_cli_options`, refuses the rest."""

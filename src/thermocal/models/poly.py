@@ -915,6 +915,7 @@ class PolyModel(TemperatureModel):
     """
 
     family: ClassVar[str] = "poly"
+    C_GENERATOR: ClassVar[str | None] = "thermocal.export_c.poly"
     uses_rate: ClassVar[bool] = True
 
     terms_: list[Term]

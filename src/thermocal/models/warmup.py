@@ -280,6 +280,7 @@ class WarmupModel(TemperatureModel):
     """
 
     family: ClassVar[str] = "warmup"
+    C_GENERATOR: ClassVar[str | None] = "thermocal.export_c.warmup"
     uses_rate: ClassVar[bool] = False
 
     b_: FloatArray

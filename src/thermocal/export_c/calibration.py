@@ -1,0 +1,188 @@
+"""One C module for a whole calibration, and the file-level entry point
+(:mod:`thermocal.export_c`)."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
+
+from thermocal.errors import ThermocalInputError
+from thermocal.export_c.core import (
+    CExport,
+    _comment,
+    c_identifier,
+    generate_c,
+)
+
+
+def generate_c_calibration(
+    channels: Sequence[tuple[str, dict[str, Any], str | None]],
+    *,
+    prefix: str = "thermocal_cal",
+    real: str = "double",
+    sample_interval_s: float | None = None,
+) -> CExport:
+    """One C99 header and source for a whole calibration (issue 15).
+
+    ``channels``: ``(name, model dict, unit)`` per channel (unit None: the channel's data
+    unit as fitted, :func:`c_signal_unit`). Each channel is the same code as its own
+    :func:`generate_c` module under the prefix ``<prefix>_<name>``; on top, one state
+    struct holding every channel's, one ``<prefix>_init`` and one
+    ``<prefix>_compensate(s, time_s, temps_c[<P>_N_TEMPS], raw[<P>_N_CHANNELS],
+    out[<P>_N_CHANNELS])`` taking the union of the channels' temperature inputs (in the
+    order of ``<P>_TEMPERATURE_NAMES``) and the N raw values, each in its channel's unit,
+    and writing the N compensated values. No allocation; the per-channel functions stay
+    callable (``<prefix>_<name>_compensate``). ``sample_interval_s`` sizes the Ṫ buffers
+    (None: each channel's fitted interval, :func:`fitted_sample_interval`).
+    """
+    if not channels:
+        raise ThermocalInputError("a calibration with no channel has no C")
+    p = c_identifier(prefix)
+    P = p.upper()
+    mods: list[tuple[str, CExport, list[str]]] = []
+    temps: list[str] = []
+    for _name, md, _unit in channels:
+        for t in md["temperatures"]:
+            if t not in temps:
+                temps.append(str(t))
+    tus = set()
+    for name, md, unit in channels:
+        ex = generate_c(
+            md,
+            prefix=f"{p}_{c_identifier(name)}",
+            real=real,
+            sample_interval_s=(
+                sample_interval_s
+                if sample_interval_s is not None
+                else fitted_sample_interval(md) or 1.0
+            ),
+            unit=unit,
+        )
+        mods.append((name, ex, [str(t) for t in md["temperatures"]]))
+        tus.add(ex.temperature_unit)
+    if len(tus) > 1:
+        raise ThermocalInputError(
+            "the channels' models take temperatures in different units "
+            f"({', '.join(sorted(tus))}); one calibration's C takes one kind"
+        )
+    n, k = len(mods), len(temps)
+    chan_list = ", ".join(f"{i}={name} [{ex.unit}]" for i, (name, ex, _t) in enumerate(mods))
+    temp_list = ", ".join(f"{i}={t}" for i, t in enumerate(temps))
+    tu = next(iter(tus))
+    parts_h = [ex.header for _n, ex, _t in mods]
+    header = "\n".join(
+        [
+            _comment(
+                [
+                    f"thermocal calibration of {n} channels: {chan_list}",
+                    f"temps_c[] order: {temp_list} [{tu}]",
+                    "Each channel's own functions are below; the calibration's functions at the "
+                    "end take every channel at once.",
+                ]
+            ),
+            f"#ifndef {P}_CAL_H",
+            f"#define {P}_CAL_H",
+            "",
+            *parts_h,
+            f"typedef {real} {p}_real;",
+            f"#define {P}_N_CHANNELS {n}",
+            f"#define {P}_N_TEMPS {k}",
+            f"/* channels: {chan_list} */",
+            f"/* temperatures: {temp_list} */",
+            "",
+            "typedef struct {",
+            *[f"    {ex.prefix}_state {c_identifier(name)};" for name, ex, _t in mods],
+            f"}} {p}_state;",
+            "",
+            "/* Power-on: forget every channel's state; sample_interval_s: nominal [s]. */",
+            f"void {p}_init({p}_state *s, double sample_interval_s);",
+            f"/* One sample of every channel: time_s [s], temps_c [{tu}] in the order above,",
+            "   raw[i] in channel i's unit; out[i] = raw[i] - model value, same unit. */",
+            f"void {p}_compensate({p}_state *s, double time_s, const {p}_real "
+            f"temps_c[{P}_N_TEMPS], const {p}_real raw[{P}_N_CHANNELS], "
+            f"{p}_real out[{P}_N_CHANNELS]);",
+            "",
+            f"#endif /* {P}_CAL_H */",
+            "",
+        ]
+    )
+    bodies = []
+    for _name, ex, _t in mods:
+        lines = [ln for ln in ex.source.split("\n") if ln != f'#include "{ex.prefix}.h"']
+        bodies.append("\n".join(lines))
+    calls = []
+    for i, (name, ex, ts) in enumerate(mods):
+        ident = c_identifier(name)
+        idx = ", ".join(f"temps_c[{temps.index(t)}]" for t in ts)
+        calls += [
+            "    {",
+            f"        const {p}_real t_{ident}[{len(ts)}] = {{{idx}}};",
+            f"        out[{i}] = {ex.prefix}_compensate(&s->{ident}, time_s, t_{ident}, raw[{i}]);",
+            "    }",
+        ]
+    source = "\n".join(
+        [
+            _comment([f"thermocal calibration of {n} channels: {chan_list}"]),
+            f'#include "{p}.h"',
+            "",
+            *bodies,
+            f"void {p}_init({p}_state *s, double sample_interval_s)",
+            "{",
+            *[
+                f"    {ex.prefix}_init(&s->{c_identifier(name)}, sample_interval_s);"
+                for name, ex, _t in mods
+            ],
+            "}",
+            "",
+            f"void {p}_compensate({p}_state *s, double time_s, const {p}_real "
+            f"temps_c[{P}_N_TEMPS], const {p}_real raw[{P}_N_CHANNELS], "
+            f"{p}_real out[{P}_N_CHANNELS])",
+            "{",
+            *calls,
+            "}",
+            "",
+        ]
+    )
+    return CExport(
+        prefix=p,
+        real=real,
+        header=header,
+        source=source,
+        family="calibration",
+        n_temps=k,
+        unit=",".join(ex.unit for _n, ex, _t in mods),
+        model_unit=",".join(ex.model_unit for _n, ex, _t in mods),
+        temperature_unit=tu,
+    )
+
+
+def fitted_sample_interval(model: dict[str, Any]) -> float | None:
+    """The sample interval [s] of the data a model was fitted on (model file
+    ``inputs.sample_interval_s``), or None for files that do not record it."""
+    v = (model.get("inputs") or {}).get("sample_interval_s")
+    return float(v) if isinstance(v, int | float) and v > 0 else None
+
+
+def export_c(
+    model_path: str | Path,
+    out_dir: str | Path,
+    *,
+    prefix: str | None = None,
+    real: str = "double",
+    sample_interval_s: float = 1.0,
+    unit: str | None = None,
+) -> tuple[CExport, list[Path]]:
+    """Read and verify a model file, generate its C module and write it into ``out_dir``
+    (``unit``: the functions' signal unit, :func:`c_signal_unit`)."""
+    from thermocal.models.files import load_model_dict
+
+    d = load_model_dict(model_path)
+    ex = generate_c(
+        d,
+        prefix=prefix or c_identifier(Path(model_path).stem),
+        real=real,
+        sample_interval_s=sample_interval_s,
+        unit=unit,
+    )
+    return ex, ex.write(out_dir)

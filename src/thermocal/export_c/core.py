@@ -1,0 +1,523 @@
+"""The generated module's skeleton and the helpers every family's generator uses
+(:mod:`thermocal.export_c`)."""
+
+from __future__ import annotations
+
+import math
+import re
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import numpy.typing as npt
+
+from thermocal import units
+from thermocal.errors import ModelFileError, ThermocalInputError, UnitError
+from thermocal.recording import GAP_FACTOR, FloatArray
+
+REAL_TYPES = ("double", "float")
+
+
+# --- the generated module -------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class FamilyCode:
+    """What a family generator contributes to the common skeleton.
+
+    ``state_fields`` — C declarations inside the state struct (one per line);
+    ``data`` — ``static const`` definitions and static helper functions (source file);
+    ``init`` — statements of ``<p>_init`` (``s`` and ``sample_interval_s`` in scope);
+    ``update`` — statements of ``<p>_update`` ending in ``return``;
+    ``defines`` — extra ``#define`` lines of the header; ``notes`` — comment lines.
+    """
+
+    state_fields: list[str]
+    data: str
+    init: str
+    update: str
+    defines: list[str] = field(default_factory=list)
+    notes: list[str] = field(default_factory=list)
+
+
+@dataclass(frozen=True)
+class CExport:
+    """A generated C module: ``header`` (``<prefix>.h``) and ``source`` (``<prefix>.c``)."""
+
+    prefix: str
+    real: str
+    header: str
+    source: str
+    family: str
+    n_temps: int
+    unit: str = ""
+    """Unit of the functions' signal and results (:func:`c_signal_unit`)."""
+    model_unit: str = ""
+    """The model's own unit, in which the family arithmetic runs."""
+    temperature_unit: str = "degC"
+
+    @property
+    def header_name(self) -> str:
+        return f"{self.prefix}.h"
+
+    @property
+    def source_name(self) -> str:
+        return f"{self.prefix}.c"
+
+    def write(self, directory: str | Path) -> list[Path]:
+        """Write header and source into ``directory`` (atomically); returns the paths."""
+        from thermocal.errors import ThermocalInputError
+        from thermocal.io import atomic_write
+
+        d = Path(directory)
+        if d.exists() and not d.is_dir():
+            raise ThermocalInputError(f"{d}: exists and is not a directory (-o names a directory)")
+        try:
+            d.mkdir(parents=True, exist_ok=True)
+        except (FileExistsError, NotADirectoryError):
+            raise ThermocalInputError(f"{d}: cannot create the output directory") from None
+        out = []
+        for name, text in ((self.header_name, self.header), (self.source_name, self.source)):
+            with atomic_write(d / name, "w") as fh:
+                fh.write(text)
+            out.append(d / name)
+        return out
+
+
+@dataclass(frozen=True)
+class ExportContext:
+    """What a family generator gets: the model dict, the C prefix and helpers."""
+
+    model: dict[str, Any]
+    prefix: str
+    real: str
+    rate_buffer_len: int
+
+    @property
+    def P(self) -> str:
+        """The C macro prefix (upper case)."""
+        return self.prefix.upper()
+
+    @property
+    def r(self) -> str:
+        """The C real type name."""
+        return f"{self.prefix}_real"
+
+    def lit(self, x: float) -> str:
+        """A C literal of the real type (17 significant digits, ``f`` suffix for float)."""
+        if not math.isfinite(x):
+            raise ModelFileError(f"non-finite coefficient {x!r} cannot be exported")
+        s = repr(float(x))
+        if "e" not in s and "." not in s and "inf" not in s:
+            s += ".0"
+        return s + ("f" if self.real == "float" else "")
+
+    def array(self, name: str, values: Sequence[float] | npt.ArrayLike) -> str:
+        """``static const <real> NAME[n] = {…};`` (1-D)."""
+        v = np.asarray(values, dtype=np.float64).ravel()
+        body = ",\n    ".join(
+            ", ".join(self.lit(x) for x in v[i : i + 4]) for i in range(0, v.size, 4)
+        )
+        return (
+            f"static const {self.r} {name}[{max(v.size, 1)}] = {{\n    {body or self.lit(0.0)}\n}};"
+        )
+
+    def array2(self, name: str, values: npt.ArrayLike) -> str:
+        """``static const <real> NAME[a][b] = {{…}, …};``."""
+        m = np.asarray(values, dtype=np.float64)
+        rows = ",\n    ".join("{" + ", ".join(self.lit(x) for x in row) + "}" for row in m)
+        return f"static const {self.r} {name}[{m.shape[0]}][{m.shape[1]}] = {{\n    {rows}\n}};"
+
+    @property
+    def tu(self) -> str:
+        """The model's temperature unit in comments: ``degC`` or ``counts``."""
+        return str(self.model.get("temperature_unit") or units.LEGACY_TEMPERATURE_UNIT)
+
+    def temp_range(self) -> FloatArray:
+        """(k, 2) fitted temperature range [°C or counts] in the model's temperature order."""
+        tr = self.model["range"]["temperature_c"]
+        return np.array([tr[n] for n in self.model["temperatures"]], dtype=np.float64)
+
+    def clamp_arrays(self) -> str:
+        rng = self.temp_range()
+        return "\n".join(
+            [
+                f"/* fitted temperature range [{self.tu}]: inputs are clamped to it */",
+                self.array(f"{self.P}_T_LO", rng[:, 0]),
+                self.array(f"{self.P}_T_HI", rng[:, 1]),
+            ]
+        )
+
+
+Generator = Callable[[ExportContext], FamilyCode]
+
+
+def family_generator(family: str) -> Generator:
+    """The C generator a model family declares on its class (``C_GENERATOR``: the module
+    of :mod:`thermocal.export_c` whose ``generate(ctx)`` writes its code), so a family's
+    options, chunk context and C code are declared in one place."""
+    import importlib
+
+    from thermocal.models import MODEL_REGISTRY
+
+    cls = MODEL_REGISTRY.get(family)
+    module = getattr(cls, "C_GENERATOR", None) if cls is not None else None
+    if not module:
+        have = sorted(f for f, c in MODEL_REGISTRY.items() if getattr(c, "C_GENERATOR", None))
+        raise ModelFileError(
+            f"no C generator for model family {family!r}; available: {', '.join(have)}"
+        )
+    gen: Generator = importlib.import_module(module).generate
+    return gen
+
+
+# --- common skeleton ----------------------------------------------------------------------
+
+
+def c_identifier(text: str) -> str:
+    """A valid C identifier from a file stem (``rlg poly-v2`` → ``rlg_poly_v2``)."""
+    s = re.sub(r"[^0-9A-Za-z_]", "_", text).strip("_").lower() or "model"
+    if s[0].isdigit():
+        s = "m_" + s
+    return s
+
+
+def _identity(d: dict[str, Any]) -> list[str]:
+    sig = d.get("signal") or {}
+    lines = [
+        "Generated by thermocal export-c from a thermocal model file. Do not edit.",
+        f"family:            {d.get('family')}",
+        f"format:            {d.get('format')} version {d.get('format_version')}",
+        f"thermocal version: {d.get('thermocal_version')}",
+        f"created (UTC):     {d.get('created_utc')}",
+        f"checksum (sha256): {d.get('checksum')}",
+        f"signal:            {sig.get('name')} [{sig.get('unit')}], target {sig.get('target')}",
+        f"temperatures:      {', '.join(d.get('temperatures', []))} "
+        f"[{d.get('temperature_unit') or units.LEGACY_TEMPERATURE_UNIT}]",
+    ]
+    inputs = d.get("inputs") or {}
+    if inputs.get("units"):
+        given = ", ".join(f"{k} [{v}]" for k, v in inputs["units"].items())
+        lines.append(f"fitted data:       {given}")
+    for name, conv in (inputs.get("temperature_conversion") or {}).items():
+        lines.append(f"conversion {name}: {units.temperature_conversion(conv).describe()}")
+    known = inputs.get("known_input")
+    if isinstance(known, dict) and known.get("value"):
+        lines.append(
+            f"known input:       {known.get('value')} {known.get('unit')} removed before the "
+            f"fit ({known.get('what')})"
+        )
+    rate = d.get("rate")
+    if rate:
+        lines.append(f"temperature rate:  {rate.get('method')} over {rate.get('interval_s')} s")
+    for entry in d.get("data") or []:
+        if isinstance(entry, dict) and entry.get("file"):
+            lines.append(f"fitted on:         {entry.get('file')}")
+    return [ln.replace("*/", "* /") for ln in lines]
+
+
+def _comment(lines: Sequence[str]) -> str:
+    return "/*\n" + "\n".join(f" * {ln}".rstrip() for ln in lines) + "\n */"
+
+
+def c_signal_unit(model: dict[str, Any], unit: str | None = None) -> tuple[str, float]:
+    """The unit the generated functions take ``signal`` and return values in, and the factor
+    ``f`` with ``value[model unit] = f · value[that unit]``.
+
+    ``unit`` (``--unit``) else the unit the model was fitted on as given (model file
+    ``inputs.units``, e.g. ``deg/s``), else the model's own unit (older files, raw-count
+    data).  A unit of another kind than the model's, or ``counts``, is a :class:`UnitError`.
+    """
+    mu = units.normalize_signal_unit(str((model.get("signal") or {}).get("unit")))
+    if unit is None:
+        given = ((model.get("inputs") or {}).get("units") or {}).get(
+            (model.get("signal") or {}).get("name")
+        )
+        ok = given and units.signal_kind(str(given)) == units.signal_kind(mu)
+        unit = str(given) if ok else mu
+    u = units.normalize_signal_unit(unit)
+    if u != mu and (units.signal_kind(u) == "raw" or units.signal_kind(mu) == "raw"):
+        raise UnitError(
+            f"export-c --unit {u}: raw counts need the scale factor, the model is in {mu}; "
+            "give a physical unit of the model's kind"
+        )
+    return u, float(units.convert(1.0, u, mu))
+
+
+def _temperature_from_counts(model: dict[str, Any], p: str, P: str) -> tuple[list[str], str]:
+    """Header declaration and source of ``<p>_temps_from_counts`` when every model
+    temperature has a counts → °C conversion recorded (the firmware reads counts)."""
+    conv_raw = (model.get("inputs") or {}).get("temperature_conversion") or {}
+    names = list(model["temperatures"])
+    if (model.get("temperature_unit") or units.LEGACY_TEMPERATURE_UNIT) != "degC" or not all(
+        n in conv_raw for n in names
+    ):
+        return [], ""
+    convs = [units.temperature_conversion(conv_raw[n]) for n in names]
+    decl = [
+        "/* Raw ADC temperature counts -> temps_c [degC] as fitted: T = gain*v + offset, v the",
+        "   count (int16: signed 16-bit stored unsigned, v >= 32768 -> v - 65536 first). */",
+        f"void {p}_temps_from_counts(const double counts[{P}_N_TEMPS], "
+        f"{p}_real temps_c[{P}_N_TEMPS]);",
+    ]
+    body = [
+        f"void {p}_temps_from_counts(const double counts[{P}_N_TEMPS], "
+        f"{p}_real temps_c[{P}_N_TEMPS])",
+        "{",
+        "    double v;",
+    ]
+    for i, (n, c) in enumerate(zip(names, convs, strict=True)):
+        enc = ", int16" if c.encoding == "int16" else ""
+        label = n.replace("*/", "* /")
+        body.append(f"    v = counts[{i}]; /* {label}: T = {c.gain!r} * v + {c.offset!r}{enc} */")
+        if c.encoding == "int16":
+            body.append(f"    if (v >= {units.INT16_SIGN_BIT!r}) {{")
+            body.append(f"        v -= {units.UINT16_MODULUS!r};")
+            body.append("    }")
+        body.append(f"    temps_c[{i}] = ({p}_real)(v * {float(c.gain)!r} + {float(c.offset)!r});")
+    body.append("}")
+    return decl, "\n".join(body)
+
+
+def generate_c(
+    model: dict[str, Any],
+    *,
+    prefix: str = "thermocal_model",
+    real: str = "double",
+    sample_interval_s: float = 1.0,
+    unit: str | None = None,
+) -> CExport:
+    """Generate the C99 header and source of a model dict (see the module docstring).
+
+    ``sample_interval_s`` is only used to size the Ṫ ring buffer of rate models
+    (``<P>_RATE_BUF_LEN`` = ⌈Δt/τ⌉ + 8, overridable with ``-D``); the interval used at
+    run time is the argument of ``<p>_init``.  ``unit`` is the signal unit of the
+    functions (:func:`c_signal_unit`: by default the unit the model was fitted on as
+    given); the family code runs in the model's unit and ``<p>_update`` converts its
+    input and output with ``<P>_TO_MODEL_UNIT``.
+    """
+    if real not in REAL_TYPES:
+        raise ThermocalInputError(f"real type must be one of {REAL_TYPES}, got {real!r}")
+    fam = str(model.get("family"))
+    gen = family_generator(fam)
+    if not sample_interval_s > 0:
+        raise ThermocalInputError(f"sample interval must be positive, got {sample_interval_s}")
+    p = c_identifier(prefix)
+    rate = model.get("rate") or {}
+    interval = float(rate.get("interval_s") or 0.0)
+    buf = math.ceil(interval / sample_interval_s) + 8 if interval > 0 else 2
+    ctx = ExportContext(model=model, prefix=p, real=real, rate_buffer_len=buf)
+    code = gen(ctx)
+    P = ctx.P
+    k = len(model["temperatures"])
+    guard = f"{P}_H"
+    ident = _identity(model)
+    su, factor = c_signal_unit(model, unit)
+    mu = units.normalize_signal_unit(str(model["signal"]["unit"]))
+    tu = ctx.tu
+    convert = factor != 1.0
+    conv_decl, conv_src = _temperature_from_counts(model, p, P)
+    unit_defines = [
+        f'#define {P}_SIGNAL_UNIT "{su}" /* unit of signal, known_input and every result */',
+        f'#define {P}_TEMPERATURE_UNIT "{tu}" /* unit of temps_c[] */',
+    ]
+    if convert:
+        unit_defines.append(
+            f"#define {P}_TO_MODEL_UNIT {ctx.lit(factor)} /* [{mu}] per [{su}]: the model "
+            f"runs in {mu} */"
+        )
+    header = "\n".join(
+        [
+            _comment(
+                [
+                    *ident,
+                    f"C functions: signal and results in [{su}], temps_c in [{tu}]",
+                    "",
+                    *code.notes,
+                ]
+            ),
+            f"#ifndef {guard}",
+            f"#define {guard}",
+            "",
+            f"typedef {real} {p}_real;",
+            "",
+            f"#define {P}_N_TEMPS {k}",
+            f"#define {P}_GAP_FACTOR {GAP_FACTOR!r}",
+            *unit_defines,
+            *code.defines,
+            "",
+            f"/* temperature order of temps_c[] [{tu}]: "
+            + ", ".join(f"{i}={n}" for i, n in enumerate(model["temperatures"]))
+            + " */",
+            "",
+            "typedef struct {",
+            "    double sample_interval_s;",
+            f"    {p}_real known_input; /* [{mu}] */",
+            *[f"    {f}" for f in code.state_fields],
+            f"}} {p}_state;",
+            "",
+            "/* Power-on: forget every state. sample_interval_s = nominal interval [s]. */",
+            f"void {p}_init({p}_state *s, double sample_interval_s);",
+            f"/* Known input [{su}] (earth rate, gravity component) removed from the signal the",
+            "   model sees (start-up selection); default 0. */",
+            f"void {p}_set_known_input({p}_state *s, {p}_real known_input);",
+            f"/* Model value [{su}] (temperature-induced signal) of one sample: time_s [s],",
+            f"   temps_c [{tu}], signal [{su}]. */",
+            f"{p}_real {p}_update({p}_state *s, double time_s, "
+            f"const {p}_real temps_c[{P}_N_TEMPS], {p}_real signal);",
+            f"/* Compensated output [{su}]: signal [{su}] - model value. */",
+            f"{p}_real {p}_compensate({p}_state *s, double time_s, "
+            f"const {p}_real temps_c[{P}_N_TEMPS], {p}_real signal);",
+            *conv_decl,
+            "",
+            f"#endif /* {guard} */",
+            "",
+        ]
+    )
+    model_fn = f"{p}_update_{c_identifier(mu)}" if convert else f"{p}_update"
+    model_fn_head = (
+        [
+            f"/* Model value [{mu}] of one sample, signal [{mu}]: the family's arithmetic. */",
+            f"static {p}_real {model_fn}({p}_state *s, double time_s, "
+            f"const {p}_real temps_c[{P}_N_TEMPS], {p}_real signal)",
+        ]
+        if convert
+        else [
+            f"/* Model value [{su}] of one sample: temps_c [{tu}], signal [{su}]. */",
+            f"{p}_real {p}_update({p}_state *s, double time_s, "
+            f"const {p}_real temps_c[{P}_N_TEMPS], {p}_real signal)",
+        ]
+    )
+    wrapper = (
+        [
+            "",
+            f"/* Model value [{su}] of one sample: temps_c [{tu}], signal [{su}]. */",
+            f"{p}_real {p}_update({p}_state *s, double time_s, "
+            f"const {p}_real temps_c[{P}_N_TEMPS], {p}_real signal)",
+            "{",
+            f"    return {model_fn}(s, time_s, temps_c, signal * {P}_TO_MODEL_UNIT) "
+            f"/ {P}_TO_MODEL_UNIT;",
+            "}",
+        ]
+        if convert
+        else []
+    )
+    ki = f"known_input * {P}_TO_MODEL_UNIT" if convert else "known_input"
+    source = "\n".join(
+        [
+            _comment(ident[:1] + ident[1:3] + ident[5:6]),
+            f'#include "{p}.h"',
+            "",
+            f"static {p}_real {p}_clamp({p}_real x, {p}_real lo, {p}_real hi)",
+            "{",
+            "    return x < lo ? lo : (x > hi ? hi : x);",
+            "}",
+            "",
+            code.data,
+            "",
+            f"void {p}_init({p}_state *s, double sample_interval_s)",
+            "{",
+            "    s->sample_interval_s = sample_interval_s;",
+            f"    s->known_input = {ctx.lit(0.0)};",
+            _indent(code.init),
+            "}",
+            "",
+            f"/* known_input [{su}], kept in [{mu}] */",
+            f"void {p}_set_known_input({p}_state *s, {p}_real known_input)",
+            "{",
+            f"    s->known_input = {ki};",
+            "}",
+            "",
+            *model_fn_head,
+            "{",
+            _indent(code.update),
+            "}",
+            *wrapper,
+            "",
+            f"/* Compensated output [{su}]: signal [{su}] - model value [{su}]. */",
+            f"{p}_real {p}_compensate({p}_state *s, double time_s, "
+            f"const {p}_real temps_c[{P}_N_TEMPS], {p}_real signal)",
+            "{",
+            f"    return signal - {p}_update(s, time_s, temps_c, signal);",
+            "}",
+            "",
+            *([conv_src, ""] if conv_src else []),
+        ]
+    )
+    return CExport(
+        prefix=p,
+        real=real,
+        header=header,
+        source=source,
+        family=fam,
+        n_temps=k,
+        unit=su,
+        model_unit=mu,
+        temperature_unit=tu,
+    )
+
+
+def _indent(text: str, n: int = 4) -> str:
+    pad = " " * n
+    return "\n".join(pad + ln if ln.strip() else "" for ln in text.strip("\n").splitlines())
+
+
+def _rate_buffer_code(ctx: ExportContext) -> tuple[list[str], str, str]:
+    """State fields, init and update code of the backward-difference Ṫ (SPEC §3, seed 000):
+    a ring buffer of the raw temperatures of the last Δt of the current contiguous
+    segment; ``Ṫ = (T − T_lo)/(t − t_lo)·60`` [°C/min] with ``t_lo`` the oldest buffered
+    time ≥ t − Δt, 0 at a segment's first sample; a step > GAP_FACTOR·τ clears the buffer.
+    Fills ``rate[k]``."""
+    P, r = ctx.P, ctx.r
+    fields = [
+        f"double buf_t[{P}_RATE_BUF_LEN];",
+        f"{r} buf_T[{P}_RATE_BUF_LEN][{P}_N_TEMPS];",
+        "int buf_head; /* index of the oldest sample */",
+        "int buf_n;    /* samples in the buffer */",
+        "int have_last;",
+        "double last_t;",
+    ]
+    init = """
+s->buf_head = 0;
+s->buf_n = 0;
+s->have_last = 0;
+s->last_t = 0.0;
+"""
+    update = f"""
+/* backward temperature rate [{ctx.tu}/min] from the raw temperatures */
+if (s->have_last && time_s - s->last_t > {P}_GAP_FACTOR * s->sample_interval_s) {{
+    s->buf_n = 0; /* a gap: new contiguous segment */
+}}
+s->have_last = 1;
+s->last_t = time_s;
+{{
+    int slot;
+    if (s->buf_n == {P}_RATE_BUF_LEN) {{ /* full: sampling faster than sized for */
+        s->buf_head = (s->buf_head + 1) % {P}_RATE_BUF_LEN;
+        s->buf_n -= 1;
+    }}
+    slot = (s->buf_head + s->buf_n) % {P}_RATE_BUF_LEN;
+    s->buf_t[slot] = time_s;
+    for (i = 0; i < {P}_N_TEMPS; ++i) {{
+        s->buf_T[slot][i] = temps_c[i];
+    }}
+    s->buf_n += 1;
+}}
+while (s->buf_t[s->buf_head] < time_s - {P}_RATE_INTERVAL_S) {{
+    s->buf_head = (s->buf_head + 1) % {P}_RATE_BUF_LEN;
+    s->buf_n -= 1;
+}}
+{{
+    double span = time_s - s->buf_t[s->buf_head];
+    for (i = 0; i < {P}_N_TEMPS; ++i) {{
+        if (span > 0.0) {{
+            rate[i] = (temps_c[i] - s->buf_T[s->buf_head][i]) / ({r})span * {ctx.lit(60.0)};
+        }} else {{
+            rate[i] = {ctx.lit(0.0)};
+        }}
+    }}
+}}
+"""
+    return fields, init, update

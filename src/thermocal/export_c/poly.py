@@ -1,0 +1,173 @@
+"""C code of the ``poly`` family (:mod:`thermocal.export_c`): the polynomial of SPEC §4a
+with its Ṫ buffer, as models/poly.py streams it."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from thermocal.errors import ModelFileError
+from thermocal.export_c.core import (
+    ExportContext,
+    FamilyCode,
+    _rate_buffer_code,
+)
+
+
+def generate(ctx: ExportContext) -> FamilyCode:
+    """Polynomial model (SPEC §4a, models/poly.py docstring steps 1–4 and ``PolyStream``):
+    Ṫ from the raw temperatures, clamp T and Ṫ (rate sensors) to the fitted ranges,
+    ``u = (T − c_T)/s_T``, ``v = (Ṫ − c_R)/s_R``, ``w = (T·Ṫ − c_W)/s_W``,
+    ``y = Σ_j coef_j u^a v^b w^c + constant`` (powers by repeated multiplication)."""
+    d = ctx.model
+    st = d["state"]
+    if st.get("layout") != "thermocal-poly-1":
+        raise ModelFileError(f"poly state layout {st.get('layout')!r} is not thermocal-poly-1")
+    P, r, p = ctx.P, ctx.r, ctx.prefix
+    base = st["base"]
+    terms = st["terms"]
+    coef = np.asarray(st["coef"], dtype=np.float64)
+    uses_rate = bool(st.get("uses_rate"))
+    rate = st.get("rate") or {}
+    if uses_rate and rate.get("method", "backward") != "backward":
+        raise ModelFileError(
+            f"poly model uses the {rate.get('method')!r} rate form; only the causal "
+            "'backward' form can run sample by sample"
+        )
+    rate_sensors = sorted(
+        {int(t["sensor"]) for t in terms if t["rate_power"] or t["coupling_power"]}
+    )
+    t_sensors = sorted({int(t["sensor"]) for t in terms if t["t_power"]})
+    w_sensors = sorted({int(t["sensor"]) for t in terms if t["coupling_power"]})
+    v_sensors = sorted({int(t["sensor"]) for t in terms if t["rate_power"]})
+
+    def col(key: str) -> list[float]:
+        return [float(b[key]) for b in base]
+
+    # only the arrays the terms use: -Wall -Wextra -Werror rejects unused static consts
+    needs_t = bool(t_sensors or w_sensors)  # clamped T used by u or w
+    if needs_t:
+        data = [ctx.clamp_arrays()]
+    else:  # constant or rate-only model: the temperature range is documentation only
+        rng = ctx.temp_range()
+        data = [
+            f"/* fitted temperature range [{ctx.tu}]: "
+            + ", ".join(
+                f"{n} {lo!r}..{hi!r}" for n, (lo, hi) in zip(d["temperatures"], rng, strict=True)
+            )
+            + " (not used: no T or T*dT term) */"
+        ]
+    used = [
+        (t_sensors, "T", "t_center", "t_scale", "u"),
+        (v_sensors, "R", "rate_center", "rate_scale", "v"),
+        (w_sensors, "W", "coupling_center", "coupling_scale", "w"),
+    ]
+    for sensors, tag, c_key, s_key, var in used:
+        if sensors:
+            data += [
+                f"/* centre and scale of the base variable {var} of every sensor */",
+                ctx.array(f"{P}_{tag}_CENTER", col(c_key)),
+                ctx.array(f"{P}_{tag}_SCALE", col(s_key)),
+            ]
+    if terms:
+        data += [
+            f"/* coefficients of the {len(terms)} terms [signal unit] */",
+            ctx.array(f"{P}_COEF", coef),
+        ]
+    data.append("/* constant [signal unit] */")
+    data.append(f"static const {r} {P}_CONSTANT = {ctx.lit(float(st['constant']))};")
+    rr: dict[str, list[float]] = (d.get("range") or {}).get("rate_c_per_min") or {}
+    clamp_rate = uses_rate and bool(rr) and bool(rate.get("clamp", True))
+    if clamp_rate:
+        rng = np.array([rr[n] for n in d["temperatures"]], dtype=np.float64)
+        data += [
+            f"/* fitted temperature-rate range [{ctx.tu}/min]: rates of the rate sensors are "
+            "clamped */",
+            ctx.array(f"{P}_R_LO", rng[:, 0]),
+            ctx.array(f"{P}_R_HI", rng[:, 1]),
+        ]
+    defines = [f"#define {P}_N_TERMS {len(terms)}"]
+    notes = [
+        f"Polynomial model (SPEC 4a): {len(terms)} terms + constant in the centred and scaled",
+        "base variables u = (T - c_T)/s_T, v = (dT - c_R)/s_R, w = (T dT - c_W)/s_W",
+        f"(dT = backward difference over the rate interval, {ctx.tu}/min). Inputs are clamped",
+        "to the fitted temperature (and rate) range. Call init at power-on.",
+    ]
+    if not terms:
+        return FamilyCode(
+            state_fields=["int unused; /* no state */"],
+            data="\n".join(data),
+            init="s->unused = 0;",
+            update="\n".join(
+                [
+                    "(void)s; /* a constant model */",
+                    "(void)time_s;",
+                    "(void)temps_c;",
+                    "(void)signal;",
+                    f"(void){p}_clamp; /* nothing to clamp */",
+                    f"return {P}_CONSTANT;",
+                ]
+            ),
+            defines=defines,
+            notes=notes,
+        )
+    fields: list[str] = []
+    init = ""
+    upd = [f"{r} T[{P}_N_TEMPS];"] if needs_t else []
+    upd += [f"{r} acc = {ctx.lit(0.0)};", "int i;"]
+    if uses_rate:
+        interval = float(rate.get("interval_s", 60.0))
+        defines += [
+            f"#define {P}_RATE_INTERVAL_S {interval!r}",
+            "/* ring buffer of the rate: >= samples in RATE_INTERVAL_S + 1 */",
+            f"#ifndef {P}_RATE_BUF_LEN",
+            f"#define {P}_RATE_BUF_LEN {ctx.rate_buffer_len}",
+            "#endif",
+        ]
+        fields, init, rate_update = _rate_buffer_code(ctx)
+        upd += [f"{r} rate[{P}_N_TEMPS];", rate_update.strip("\n")]
+    if not uses_rate:
+        upd += ["(void)s; /* memoryless without rate terms */", "(void)time_s;"]
+    upd.append("(void)signal;")
+    if needs_t:
+        upd += [
+            "for (i = 0; i < " + f"{P}_N_TEMPS; ++i) {{",
+            f"    T[i] = {p}_clamp(temps_c[i], {P}_T_LO[i], {P}_T_HI[i]);",
+            "}",
+        ]
+    if clamp_rate:
+        for j in rate_sensors:
+            upd.append(f"rate[{j}] = {p}_clamp(rate[{j}], {P}_R_LO[{j}], {P}_R_HI[{j}]);")
+    for j in t_sensors:
+        upd.append(f"const {r} u{j} = (T[{j}] - {P}_T_CENTER[{j}]) / {P}_T_SCALE[{j}];")
+    for j in v_sensors:
+        upd.append(f"const {r} v{j} = (rate[{j}] - {P}_R_CENTER[{j}]) / {P}_R_SCALE[{j}];")
+    for j in w_sensors:
+        upd.append(f"const {r} w{j} = (T[{j}] * rate[{j}] - {P}_W_CENTER[{j}]) / {P}_W_SCALE[{j}];")
+
+    def power(x: str, n: int) -> str:
+        out = x
+        for _ in range(n - 1):
+            out = f"({out} * {x})"
+        return out
+
+    for i, t in enumerate(terms):
+        j = int(t["sensor"])
+        factors = [
+            power(f"{var}{j}", int(t[key]))
+            for var, key in (("u", "t_power"), ("v", "rate_power"), ("w", "coupling_power"))
+            if int(t[key])
+        ]
+        val = factors[0]
+        for fct in factors[1:]:
+            val = f"({val} * {fct})"
+        label = str(t.get("name", "")).replace("*/", "* /")
+        upd.append(f"acc += {val} * {P}_COEF[{i}]; /* {label} */")
+    upd.append(f"return acc + {P}_CONSTANT;")
+    return FamilyCode(
+        state_fields=fields or ["int unused; /* no state */"],
+        data="\n".join(data),
+        init=init or "s->unused = 0;",
+        update="\n".join(upd),
+        defines=defines,
+        notes=notes,
+    )
