@@ -30,6 +30,7 @@ column's own unit.  A model and data of different kinds (°/h against mg) is a
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
 import warnings
@@ -400,6 +401,7 @@ class _ChannelPlan:
     temp_units: dict[str, str]
     md: Metadata
     predictor: ChunkPredictor
+    time_unit: str = "s"
     factor: float | None = None
     before: _RunningMoments = field(default_factory=lambda: _RunningMoments())
     after: _RunningMoments = field(default_factory=lambda: _RunningMoments())
@@ -445,84 +447,27 @@ def compensate_channels(
     available = ", ".join(repr(c) for c in names)
     if time_col not in names:
         raise MissingColumnError(f"{src}: no time column {time_col!r}; available: {available}")
-    where = str(src)
     sig_opts = units.per_signal_option(signal_unit, sig_list)
     conv_opt = (
         units.temperature_conversion(temperature_conversion, "--temp-conversion")
         if temperature_conversion is not None
         else None
     )
-    plans: list[_ChannelPlan] = []
-    t_unit: str | None = None
-    for sig_name, model in channels:
-        model.check_fitted()
-        temp_names = list(model.temp_names_)
-        if sig_name not in names:
-            raise MissingColumnError(
-                f"{src}: no signal column {sig_name!r} (the model's signal"
-                f"{' given by --signal' if signal_given else ''}); available: {available}"
-            )
-        missing = [c for c in temp_names if c not in names]
-        if missing:
-            raise MissingColumnError(
-                f"{src}: the model's temperature column(s) "
-                f"{', '.join(repr(c) for c in missing)} are not in the file; "
-                f"available: {available}"
-            )
-        model_col = sig_name + MODEL_SUFFIX
-        comp_col = sig_name + COMP_SUFFIX
-        for c in (model_col, comp_col):
-            if c in names:
-                raise ThermocalInputError(
-                    f"{src}: already has a column {c!r}; was the file compensated already?"
-                )
-        # units and conversions resolved once per channel (units.resolve_inputs): option >
-        # file metadata > column name > what the model recorded of its inputs > default
-        resolved = units.resolve_inputs(
-            time_col,
-            [sig_name],
-            temp_names,
-            options=units.UnitOptions(
-                time_unit=time_unit,
-                signal_unit=sig_opts[sig_name],
-                temp_unit=temp_unit,
-                temp_conversion=conv_opt,
-            ),
-            file=units.StatedUnits.from_file_info(info, where),
-            model=model.input_units(),
-            where=where,
+    ctx = _FileContext(src, names, info, time_col, available, signal_given)
+    opts = units.UnitOptions(time_unit=time_unit, temp_unit=temp_unit, temp_conversion=conv_opt)
+    plans = [
+        _channel_plan(ctx, sig_name, model, sig_opts[sig_name], opts,
+                      extrapolate=extrapolate, known_input=known_input,
+                      name=str(src) if len(channels) == 1 else f"{src} [{sig_name}]")
+        for sig_name, model in channels
+    ]  # fmt: skip
+    t_units = {plan.time_unit for plan in plans}
+    if len(t_units) > 1:
+        raise UnitError(
+            f"{src}: the channels' models disagree on the time unit "
+            f"({' and '.join(sorted(t_units))}); give --time-unit"
         )
-        if t_unit is None:
-            t_unit = resolved.time.unit
-        elif resolved.time.unit != t_unit:
-            raise UnitError(
-                f"{src}: the channels' models disagree on the time unit ({t_unit} and "
-                f"{resolved.time.unit}); give --time-unit"
-            )
-        data_unit = resolved.signals[sig_name].unit
-        check_signal_kind(data_unit, model.signal_unit, where)
-        md = model_scale_factor(model, Metadata.from_dict(dict(info.get("metadata") or {})))
-        check_sensor_id(getattr(model, "inputs_", None), md.sensor_id, where)
-        plans.append(
-            _ChannelPlan(
-                model=model,
-                signal=sig_name,
-                model_col=model_col,
-                comp_col=comp_col,
-                data_unit=data_unit,
-                temp_names=temp_names,
-                convs=temperature_inputs(model, resolved, where),
-                temp_units={c: r.unit for c, r in resolved.temperatures.items()},
-                md=md,
-                predictor=ChunkPredictor(
-                    model,
-                    extrapolate=extrapolate,
-                    name=str(src) if len(channels) == 1 else f"{src} [{sig_name}]",
-                    known_input=known_input,
-                ),
-            )
-        )
-    assert t_unit is not None
+    t_unit = plans[0].time_unit
     t_factor = units.TIME_UNITS[t_unit]
     out_info = _output_info(info, time_col, t_unit, plans)
 
@@ -539,26 +484,7 @@ def compensate_channels(
             for chunk in _iter_chunks(src, kind_in, chunk_rows):
                 row0 = int(state["rows"])
                 t = _chunk_time(chunk, time_col, t_factor, src, row0, state["last_t"])
-                new: dict[str, FloatArray] = {}
-                temps_cache: dict[tuple[str, str], FloatArray] = {}
-                inputs = {
-                    id(plan): _chunk_inputs(plan, chunk, t, temps_cache, src, row0)
-                    for plan in plans
-                }
-                for group in groups:  # channels sharing one evaluation: one predict call
-                    lead = group[0]
-                    temps, raw = inputs[id(lead)]
-                    ys = lead.predictor.predict_with(
-                        t, temps, raw * cast(float, lead.factor),
-                        [p.predictor for p in group[1:]],
-                    )  # fmt: skip
-                    for plan, y_model in zip(group, ys, strict=True):
-                        y_data, comp = _chunk_outputs(plan, inputs[id(plan)][1], y_model)
-                        new[plan.model_col] = y_data
-                        new[plan.comp_col] = comp
-                # the output keeps the channels in the order given
-                new = {c: new[c] for plan in plans for c in (plan.model_col, plan.comp_col)}
-                table = _append_columns(chunk, new)
+                table = _compensate_one_chunk(chunk, t, plans, groups, src, row0)
                 if pending is not None:
                     pending.result()
                 pending = pool.submit(w.write, table)
@@ -604,6 +530,112 @@ def compensate_channels(
         )
         for plan in plans
     ]
+
+
+@dataclass(frozen=True)
+class _FileContext:
+    """What every channel's plan checks against: the input file, its columns and metadata."""
+
+    src: Path
+    names: list[str]
+    info: dict[str, Any]
+    time_col: str
+    available: str
+    signal_given: bool
+
+
+def _channel_plan(
+    ctx: _FileContext,
+    sig_name: str,
+    model: TemperatureModel,
+    signal_unit: str | None,
+    opts: units.UnitOptions,
+    *,
+    extrapolate: bool,
+    known_input: float,
+    name: str,
+) -> _ChannelPlan:
+    """One channel checked against the file (its columns exist, its outputs do not yet)
+    with its units and conversions resolved once (:func:`thermocal.units.resolve_inputs`:
+    option > file metadata > column name > what the model recorded > default)."""
+    src, names, where = ctx.src, ctx.names, str(ctx.src)
+    model.check_fitted()
+    temp_names = list(model.temp_names_)
+    if sig_name not in names:
+        raise MissingColumnError(
+            f"{src}: no signal column {sig_name!r} (the model's signal"
+            f"{' given by --signal' if ctx.signal_given else ''}); available: {ctx.available}"
+        )
+    missing = [c for c in temp_names if c not in names]
+    if missing:
+        raise MissingColumnError(
+            f"{src}: the model's temperature column(s) "
+            f"{', '.join(repr(c) for c in missing)} are not in the file; "
+            f"available: {ctx.available}"
+        )
+    model_col = sig_name + MODEL_SUFFIX
+    comp_col = sig_name + COMP_SUFFIX
+    for c in (model_col, comp_col):
+        if c in names:
+            raise ThermocalInputError(
+                f"{src}: already has a column {c!r}; was the file compensated already?"
+            )
+    resolved = units.resolve_inputs(
+        ctx.time_col,
+        [sig_name],
+        temp_names,
+        options=dataclasses.replace(opts, signal_unit=signal_unit),
+        file=units.StatedUnits.from_file_info(ctx.info, where),
+        model=model.input_units(),
+        where=where,
+    )
+    data_unit = resolved.signals[sig_name].unit
+    check_signal_kind(data_unit, model.signal_unit, where)
+    md = model_scale_factor(model, Metadata.from_dict(dict(ctx.info.get("metadata") or {})))
+    check_sensor_id(getattr(model, "inputs_", None), md.sensor_id, where)
+    return _ChannelPlan(
+        model=model,
+        signal=sig_name,
+        model_col=model_col,
+        comp_col=comp_col,
+        data_unit=data_unit,
+        temp_names=temp_names,
+        convs=temperature_inputs(model, resolved, where),
+        temp_units={c: r.unit for c, r in resolved.temperatures.items()},
+        md=md,
+        predictor=ChunkPredictor(
+            model, extrapolate=extrapolate, name=name, known_input=known_input
+        ),
+        time_unit=resolved.time.unit,
+    )
+
+
+def _compensate_one_chunk(
+    chunk: pd.DataFrame | pa.RecordBatch,
+    t: FloatArray,
+    plans: Sequence[_ChannelPlan],
+    groups: Sequence[Sequence[_ChannelPlan]],
+    src: Path,
+    row0: int,
+) -> Any:
+    """One chunk of every channel: inputs read and checked once, one prediction per group
+    of channels sharing an evaluation, ``<sig>_model``/``<sig>_comp`` appended in the
+    order the channels were given."""
+    new: dict[str, FloatArray] = {}
+    temps_cache: dict[tuple[str, str], FloatArray] = {}
+    inputs = {id(plan): _chunk_inputs(plan, chunk, t, temps_cache, src, row0) for plan in plans}
+    for group in groups:  # channels sharing one evaluation: one predict call
+        lead = group[0]
+        temps, raw = inputs[id(lead)]
+        ys = lead.predictor.predict_with(
+            t, temps, raw * cast(float, lead.factor), [p.predictor for p in group[1:]]
+        )
+        for plan, y_model in zip(group, ys, strict=True):
+            y_data, comp = _chunk_outputs(plan, inputs[id(plan)][1], y_model)
+            new[plan.model_col] = y_data
+            new[plan.comp_col] = comp
+    ordered = {c: new[c] for plan in plans for c in (plan.model_col, plan.comp_col)}
+    return _append_columns(chunk, ordered)
 
 
 def _output_info(
