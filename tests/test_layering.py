@@ -26,6 +26,10 @@ MATHS = [
     "thermocal.models.bank",
     "thermocal.models.calibration",
     "thermocal.models.terms",
+    "thermocal.models.fitting",
+    "thermocal.models.poly_fit",
+    "thermocal.models.poly_eval",
+    "thermocal.export_c",
 ]
 FILE_LAYER = ["pandas", "pyarrow", "thermocal.io", "thermocal.compensate", "thermocal.models.files"]
 

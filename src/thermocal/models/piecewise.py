@@ -79,7 +79,7 @@ from thermocal.models.base import (
     register,
     stream_channel,
 )
-from thermocal.models.poly import check_runs, decide_run_offsets, record_ranges
+from thermocal.models.fitting import check_runs, decide_run_offsets, record_ranges
 from thermocal.models.residuals import MAX_SAMPLES_PER_SERIES, residual_correlation
 from thermocal.models.terms import CHUNK_ROWS, Chunk, accumulate_r, solve_r
 from thermocal.recording import FloatArray
