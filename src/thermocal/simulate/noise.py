@@ -1,0 +1,102 @@
+"""Sensor noise by IEEE Std 952-1997 Annex C: white, flicker, random walks and ramps.
+
+Part of :mod:`thermocal.simulate`."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+import numpy.typing as npt
+import scipy.fft
+
+FloatArray = npt.NDArray[np.float64]
+ProgramArrays = tuple[FloatArray, FloatArray]
+Truth = dict[str, Any]
+
+
+# --- noise (IEEE Std 952-1997 Annex C) -----------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class NoiseParams:
+    """Noise terms of a sensor output, in its unit ``u`` (°/h or mg).
+
+    white_density : N [u·√s] = [u/√Hz], two-sided PSD N² (angle / velocity random walk;
+        a gyro ARW of N' [°/√h] is N = 60·N' [°/h·√s]); Allan ``σ²(τ) = N²/τ``.
+    bias_instability : B [u], flicker PSD ``B²/(2πf)``; Allan plateau ``0.664 B``.
+    rate_random_walk : K [u/√s]; Allan ``σ²(τ) = K² τ/3``.
+    rate_ramp : R [u/s]; Allan ``σ²(τ) = R² τ²/2``.
+    resolution : output LSB [u] (0: none); pulse outputs are quantized by K instead.
+    """
+
+    white_density: float = 0.0
+    bias_instability: float = 0.0
+    rate_random_walk: float = 0.0
+    rate_ramp: float = 0.0
+    resolution: float = 0.0
+
+
+def flicker_noise(n: int, dt_s: float, b: float, rng: np.random.Generator) -> FloatArray:
+    """Flicker (1/f) noise with two-sided PSD ``S(f) = B²/(2πf)`` (IEEE 952 bias instability).
+
+    Spectral synthesis: ``X_k = sqrt(N f_s S(f_k)/2)·(a + ib)``, a, b ~ N(0, 1),
+    ``x = irfft(X)`` (so ``E|X_k|² = N f_s S(f_k)``); the DC bin is zero.
+    """
+    if b == 0.0 or n == 0:
+        return np.zeros(n)
+    nfft = int(scipy.fft.next_fast_len(n, real=True))
+    f = np.fft.rfftfreq(nfft, dt_s)
+    amp = np.zeros(f.size)
+    np.sqrt(nfft / dt_s * b**2 / (4 * math.pi) / f[1:], out=amp[1:])
+    del f
+    spec = np.empty(amp.size, dtype=np.complex128)
+    spec.real = rng.standard_normal(amp.size)
+    spec.imag = rng.standard_normal(amp.size)
+    spec *= amp
+    if nfft % 2 == 0:  # the Nyquist bin of a real signal is real (same variance)
+        spec[-1] = math.sqrt(2.0) * spec[-1].real
+    del amp
+    x = scipy.fft.irfft(spec, nfft, workers=-1, overwrite_x=True)
+    return np.asarray(x[:n], dtype=np.float64)
+
+
+FLICKER_MAX_RATE_HZ = 10.0
+"""Flicker noise is synthesised at this rate at most (held constant within each block)."""
+
+
+def simulate_noise(n: int, dt_s: float, noise: NoiseParams, rng: np.random.Generator) -> FloatArray:
+    """Sum of white (N/√τ0 per sample), flicker (:func:`flicker_noise`, at most at
+    :data:`FLICKER_MAX_RATE_HZ`), rate random walk (cumulative sum of N(0, K² τ0)) and
+    rate ramp (R·t) noise, n samples at τ0 = dt_s.
+    Samples are mean rates over each interval (IEEE Std 952 Annex C)."""
+    if noise.white_density:
+        out = rng.standard_normal(n)
+        out *= noise.white_density / math.sqrt(dt_s)
+    else:
+        out = np.zeros(n)
+    if noise.bias_instability:
+        # flicker is synthesised at ≤ FLICKER_MAX_RATE_HZ and held over each block: it is
+        # far below the white noise at short τ, and cluster averages over whole blocks are
+        # exactly those of flicker at the lower rate
+        m = max(1, math.floor(1.0 / (dt_s * FLICKER_MAX_RATE_HZ) + 1e-9))
+        n_blocks = -(-n // m)
+        fl = flicker_noise(n_blocks, dt_s * m, noise.bias_instability, rng)
+        if m == 1:
+            out += fl
+        else:
+            whole = out[: (n // m) * m].reshape(-1, m)  # a view: updated in place
+            whole += fl[: n // m, None]
+            if n % m:
+                out[(n // m) * m :] += fl[-1]
+    if noise.rate_random_walk:
+        w = rng.standard_normal(n)
+        w *= noise.rate_random_walk * math.sqrt(dt_s)
+        np.cumsum(w, out=w)
+        out += w
+        del w
+    if noise.rate_ramp:
+        out += noise.rate_ramp * dt_s * np.arange(n)
+    return out
