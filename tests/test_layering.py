@@ -27,6 +27,7 @@ MATHS = [
     "thermocal.models.calibration",
     "thermocal.models.terms",
     "thermocal.models.fitting",
+    "thermocal.models.lstsq",
     "thermocal.models.poly_fit",
     "thermocal.models.poly_eval",
     "thermocal.export_c",

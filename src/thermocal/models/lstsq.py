@@ -1,0 +1,507 @@
+"""Least squares in chunks (SPEC §4a numerics): designs reduced to triangular factors by
+Gram/Cholesky or Householder QR, solved by the SVD of the column-equilibrated factor with
+condition numbers and standard errors, and forward term selection (BIC or hold-out).
+
+Used by the polynomial and piecewise families (:mod:`thermocal.models.poly_fit`,
+:mod:`thermocal.models.piecewise`); re-exported by :mod:`thermocal.models.terms`."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Iterable, Iterator, Sequence
+from dataclasses import dataclass, field
+from typing import Any, Literal
+
+import numpy as np
+import numpy.typing as npt
+from scipy import linalg as sla
+from scipy.linalg import blas, lapack
+
+from thermocal.errors import DesignError, ThermocalInputError
+from thermocal.preprocess import (  # Ṫ has one implementation, in preprocess (issue 15)
+    RATE_BLOCK_ROWS as RATE_BLOCK_ROWS,
+)
+from thermocal.preprocess import (
+    backward_partners as backward_partners,
+)
+from thermocal.preprocess import (
+    backward_rates as backward_rates,
+)
+from thermocal.preprocess import (
+    gap_free_slices as gap_free_slices,
+)
+from thermocal.preprocess import (
+    segment_rates as segment_rates,
+)
+from thermocal.preprocess import (
+    step_range as step_range,
+)
+from thermocal.preprocess import (
+    temperature_rates as temperature_rates,
+)
+from thermocal.recording import FloatArray
+
+GRAM_MAX_COND = 1.0e5
+"""Largest condition number (column-equilibrated design) for which the Gram path is kept."""
+
+SINGULAR_RCOND = 1.0e-11
+"""``s_min/s_max`` below this: the design is singular → :class:`DesignError`."""
+
+
+# --- least squares in chunks ------------------------------------------------------------------
+
+Chunk = tuple[FloatArray, int, int]
+"""``(A, group, fold)`` of one block of c rows: ``A`` (c, p + 1 + t), Fortran order, holds
+``[F | 1 | Y]`` (the p features, a column of ones, the t ≥ 1 targets: several channels
+sharing one design, issue 15)."""
+
+
+@dataclass(frozen=True)
+class Reduced:
+    """A design reduced to triangular form, per fold.
+
+    ``r_aug[f]`` is the (q+t)×(q+t) upper-triangular factor of ``[F | Z | Y]``
+    for fold f (q = p features + m groups, t targets, usually 1); ``n[f]`` its row count;
+    ``solver`` ``"qr"`` or ``"gram"``.
+    """
+
+    r_aug: list[FloatArray]
+    n: list[int]
+    solver: str
+
+    def combined(self) -> FloatArray:
+        """R factor of all folds together."""
+        if len(self.r_aug) == 1:
+            return self.r_aug[0]
+        return _triangularise(np.vstack(self.r_aug))
+
+    @property
+    def n_total(self) -> int:
+        return int(sum(self.n))
+
+
+def _triangularise(a: FloatArray) -> FloatArray:
+    q = a.shape[1]
+    if a.shape[0] == 0:
+        return np.zeros((q, q))
+    r = sla.qr(a, mode="r", check_finite=False)[0]
+    out = np.zeros((q, q))
+    m = min(r.shape[0], q)
+    out[:m] = np.triu(r[:m])
+    return out
+
+
+def _accumulate_qr(
+    chunks: Iterable[Chunk], p: int, m: int, n_folds: int, n_targets: int = 1
+) -> tuple[list[list[FloatArray]], list[int]]:
+    """R factors of ``[F | Z | y_j]`` per target and fold by a chunked Householder QR
+    (TSQR-like): each chunk is stacked under the running R and re-triangularised (LAPACK
+    ``dgeqrf``); one update per target, so each equals a one-target run."""
+    q1 = p + m + 1
+    r_acc = [[np.zeros((q1, q1), order="F") for _ in range(n_folds)] for _ in range(n_targets)]
+    counts = [0] * n_folds
+    buf: FloatArray | None = None
+    for A, g, f in chunks:
+        c = A.shape[0]
+        if c == 0:
+            continue
+        rows = q1 + c
+        if buf is None or buf.shape[0] != rows:
+            buf = np.zeros((rows, q1), order="F")
+        for j in range(n_targets):
+            a = buf
+            a[:q1] = r_acc[j][f]
+            a[q1:, :p] = A[:, :p]
+            a[q1:, p : p + m] = 0.0
+            a[q1:, p + g] = 1.0
+            a[q1:, p + m] = A[:, p + 1 + j]
+            qr, _tau, _work, info = lapack.dgeqrf(a, lwork=max(1, q1 * 64), overwrite_a=1)
+            if info != 0:
+                raise DesignError(f"QR factorisation failed (LAPACK info {info})")
+            r_acc[j][f] = np.asfortranarray(np.triu(qr[:q1]))
+        counts[f] += c
+    return [[np.ascontiguousarray(r) for r in rj] for rj in r_acc], counts
+
+
+def _accumulate_gram(
+    chunks: Iterable[Chunk], p: int, m: int, n_folds: int, n_targets: int = 1
+) -> tuple[list[list[FloatArray]], list[int]]:
+    """Gram matrices of ``[F | Z | y_j]`` per fold and target: ``[F | 1]ᵀ[F | 1]`` per
+    (fold, group) once (BLAS ``dsyrk``, upper triangle), ``[F | 1]ᵀ y_j`` and ``y_jᵀ y_j``
+    per target; returns ``grams[f][j]``."""
+    t = n_targets
+    q1 = p + m + 1
+    xx = [[np.zeros((p + 1, p + 1)) for _ in range(m)] for _ in range(n_folds)]
+    xy = [[np.zeros((p + 1, t)) for _ in range(m)] for _ in range(n_folds)]
+    yy = [[np.zeros(t) for _ in range(m)] for _ in range(n_folds)]
+    counts = [0] * n_folds
+    for A, g, f in chunks:
+        c = A.shape[0]
+        if c == 0:
+            continue
+        X = np.asfortranarray(A[:, : p + 1])
+        xx[f][g] += blas.dsyrk(1.0, X, trans=1, lower=0)
+        for j in range(t):
+            y = A[:, p + 1 + j]
+            xy[f][g][:, j] += X.T @ y
+            yy[f][g][j] += float(y @ y)
+        counts[f] += c
+    grams: list[list[FloatArray]] = []
+    for f in range(n_folds):
+        per_target = []
+        for j in range(t):
+            G = np.zeros((q1, q1))
+            for g in range(m):
+                P = np.triu(xx[f][g])
+                P = P + np.triu(P, 1).T
+                G[:p, :p] += P[:p, :p]
+                G[:p, p + g] = P[:p, p]
+                G[p + g, :p] = P[p, :p]
+                G[p + g, p + g] = P[p, p]
+                G[:p, q1 - 1] += xy[f][g][:p, j]
+                G[q1 - 1, :p] += xy[f][g][:p, j]
+                G[p + g, q1 - 1] = xy[f][g][p, j]
+                G[q1 - 1, p + g] = xy[f][g][p, j]
+                G[q1 - 1, q1 - 1] += yy[f][g][j]
+            per_target.append(G)
+        grams.append(per_target)
+    return grams, counts
+
+
+def _chol_r(G: FloatArray) -> FloatArray | None:
+    """Upper Cholesky factor of an augmented Gram matrix, equilibrated; None if not PD."""
+    d = np.sqrt(np.diag(G))
+    if not np.all(d > 0):
+        return None
+    Gs = G / d[:, None] / d[None, :]
+    try:
+        Rs = sla.cholesky(Gs, lower=False, check_finite=False)
+    except np.linalg.LinAlgError:
+        return None
+    R: FloatArray = Rs * d[None, :]
+    return R
+
+
+def accumulate_r(
+    make_chunks: Callable[[], Iterator[Chunk]],
+    p: int,
+    m: int,
+    *,
+    n_folds: int = 1,
+    solver: Literal["auto", "qr", "gram"] = "auto",
+) -> Reduced:
+    """Reduce the design ``[F | Z | y]`` to triangular factors, per fold, in chunks.
+
+    ``make_chunks()`` yields :data:`Chunk` tuples (it is called a second time
+    when the Gram path is abandoned for the QR path).  ``"auto"``: Gram path,
+    kept when every fold's Cholesky succeeds and the column-equilibrated design
+    has κ ≤ :data:`GRAM_MAX_COND`, else the chunked Householder QR.
+    """
+    return accumulate_targets(make_chunks, p, m, 1, n_folds=n_folds, solver=solver)[0]
+
+
+def accumulate_targets(
+    make_chunks: Callable[[], Iterator[Chunk]],
+    p: int,
+    m: int,
+    n_targets: int,
+    *,
+    n_folds: int = 1,
+    solver: Literal["auto", "qr", "gram"] = "auto",
+) -> list[Reduced]:
+    """:func:`accumulate_r` for ``n_targets`` targets sharing one design (several channels,
+    issue 15): one :class:`Reduced` per target, each computed by the very operations a
+    single target gets, so each equals its own one-target reduction bit for bit.
+
+    Shared: the features of every chunk (built once by ``make_chunks``), the Gram matrix
+    of ``[F | 1]`` (BLAS ``dsyrk``) and the Gram/QR decision; per target: ``[F | 1]ᵀ y`` and
+    ``yᵀy`` (Gram path) or the Householder update (QR path, used for ill-conditioned
+    designs).
+    """
+    if solver not in ("auto", "qr", "gram"):
+        raise ThermocalInputError(f"unknown solver {solver!r}; use auto, qr or gram")
+    if solver in ("auto", "gram"):
+        grams, counts = _accumulate_gram(make_chunks(), p, m, n_folds, n_targets)
+        reds: list[Reduced] = []
+        for j in range(n_targets):
+            rs = [_chol_r(G[j]) for G in grams]
+            if not all(r is not None for r in rs):
+                break
+            reds.append(Reduced([r for r in rs if r is not None], counts, "gram"))
+        if len(reds) == n_targets:
+            cond = scaled_condition(reds[0].combined()[: p + m, : p + m])
+            if solver == "gram" or cond <= GRAM_MAX_COND:
+                return reds
+        elif solver == "gram":
+            raise DesignError(
+                "the Gram matrix is not positive definite (singular design); use solver='qr' "
+                "to find the terms at fault"
+            )
+    r_lists, counts = _accumulate_qr(make_chunks(), p, m, n_folds, n_targets)
+    return [Reduced(r_list, counts, "qr") for r_list in r_lists]
+
+
+def column_scales(r: FloatArray) -> FloatArray:
+    """Column 2-norms of the design from its R factor (‖A e_j‖ = ‖R e_j‖)."""
+    s = np.sqrt(np.sum(r * r, axis=0))
+    out: FloatArray = np.where(s > 0, s, 1.0)
+    return out
+
+
+def scaled_condition(r: FloatArray) -> float:
+    """2-norm condition number of the column-equilibrated design (from its R factor)."""
+    rs = r / column_scales(r)[None, :]
+    sv = np.linalg.svd(rs, compute_uv=False)
+    if sv.size == 0 or sv[-1] <= 0:
+        return math.inf
+    return float(sv[0] / sv[-1])
+
+
+@dataclass(frozen=True)
+class LstsqSolution:
+    """Solution of a column-scaled least-squares problem from its R factor.
+
+    ``coef`` (q,) and ``cov`` (q, q) in the original column units; ``rss`` the
+    residual sum of squares (ridge and truncation included); ``dof`` = n − rank;
+    ``condition_number`` of the equilibrated design; ``rank`` singular values
+    kept; ``singular_values`` of the equilibrated R (descending).
+    """
+
+    coef: FloatArray
+    cov: FloatArray
+    rss: float
+    n: int
+    dof: int
+    condition_number: float
+    rank: int
+    n_truncated: int
+    singular_values: FloatArray
+    extra: dict[str, Any] = field(default_factory=dict)
+
+    @property
+    def sigma2(self) -> float:
+        return self.rss / self.dof if self.dof > 0 else math.nan
+
+
+def singular_error(
+    r: FloatArray, names: Sequence[str], *, rcond: float = SINGULAR_RCOND
+) -> DesignError | None:
+    """A :class:`DesignError` naming the columns of a (near-)singular design, or None."""
+    q = r.shape[1]
+    if q == 0:
+        return None
+    rs = r / column_scales(r)[None, :]
+    _u, sv, vt = np.linalg.svd(rs)
+    if sv.size < q:
+        sv = np.r_[sv, np.zeros(q - sv.size)]
+    if sv[-1] > rcond * sv[0]:
+        return None
+    null = vt[-1]
+    big = np.flatnonzero(np.abs(null) > 0.1 * np.max(np.abs(null)))
+    involved = [names[int(i)] for i in big]
+    zero_cols = [names[i] for i in range(q) if not np.any(r[:, i])]
+    if zero_cols:
+        return DesignError(
+            "singular design: column(s) " + ", ".join(zero_cols) + " are zero over the fitted data"
+        )
+    return DesignError(
+        "singular design (condition number "
+        + (f"{sv[0] / sv[-1]:.3g}" if sv[-1] > 0 else "∞")
+        + "): these terms are linearly dependent in the data: "
+        + ", ".join(involved)
+        + "; drop one of them or add data that separates them"
+    )
+
+
+def solve_r(
+    r_aug: FloatArray,
+    n: int,
+    names: Sequence[str],
+    *,
+    penalised: npt.NDArray[np.bool_] | None = None,
+    ridge: float = 0.0,
+    rcond: float | None = None,
+    noise_threshold: float | None = None,
+    columns: Sequence[int] | None = None,
+) -> LstsqSolution:
+    """Least squares from the augmented R factor of ``[A | y]``, columns equilibrated.
+
+    The columns are scaled to unit RMS (``A_s = A D``) and split into the free
+    ones (U: constant, per-run offsets) and the regularised ones (P: the
+    ``penalised`` terms).  A QR of ``[A_s,U  A_s,P | y]`` (from R, never from
+    the data again) gives ``R11, R12, R22, z1, z2``; the P part is solved by SVD,
+    ``R22 = U S Vᵀ``, ``c = Uᵀ z2``::
+
+        γ_P = Σ_{kept i} v_i c_i s_i/(s_i² + nα),     γ_U = R11⁻¹ (z1 − R12 γ_P)
+
+    (ridge α ≥ 0 shrinks only the P coefficients; Golub & Van Loan §6.1.4).
+    Component i is kept when ``s_i > rcond · s_max`` (truncated SVD) or, with
+    ``noise_threshold`` k, when ``|c_i| > k σ̂`` — its share of the data stands
+    out of the noise (σ̂² = RSS/(n − q) of the full fit; a discrete Picard
+    rule, Hansen, *Rank-Deficient and Discrete Ill-Posed Problems*, SIAM 1998,
+    §3.2).  ``β = D γ``; ``cov(β) = σ² D L Lᵀ D`` with L
+    the linear map from ``[z1; z2]`` to γ (triangular solves, no inverse of
+    AᵀA).  Residuals are assumed white; with coloured noise the standard
+    errors are optimistic.  A design with ``s_min < 1e-11 s_max`` raises
+    :class:`DesignError` naming the dependent columns.  ``columns`` restricts
+    the problem to a subset (in that order).
+    """
+    q = r_aug.shape[1] - 1
+    cols = list(range(q)) if columns is None else list(columns)
+    pen_all = np.zeros(q, dtype=bool) if penalised is None else np.asarray(penalised, dtype=bool)
+    if ridge < 0:
+        raise ThermocalInputError(f"ridge α must be ≥ 0, got {ridge}")
+    err = singular_error(r_aug[:, cols], [names[i] for i in cols])
+    if err is not None:
+        raise err
+    free = [c for c in cols if not pen_all[c]]
+    reg = [c for c in cols if pen_all[c]]
+    order = free + reg
+    R = r_aug[:, order]
+    scale = column_scales(R) / math.sqrt(max(n, 1))  # RMS of each column
+    Rs = R / scale[None, :]
+    cond = scaled_condition(R)
+    qq = len(order)
+    nu = len(free)
+    A2 = _triangularise(np.column_stack([Rs, r_aug[:, q]]))
+    R11 = A2[:nu, :nu]
+    R12 = A2[:nu, nu:qq]
+    R22 = A2[nu:qq, nu:qq]
+    z1 = A2[:nu, qq]
+    z2 = A2[nu:qq, qq]
+    rss0 = float(A2[qq, qq] ** 2) if A2.shape[0] > qq else 0.0
+    np_ = qq - nu
+    dof_full = n - qq
+    sigma_full = math.sqrt(rss0 / dof_full) if dof_full > 0 else math.nan
+    H = np.zeros((np_, np_))
+    keep = np.zeros(np_, dtype=bool)
+    sv = np.zeros(0)
+    if np_:
+        U, S, Vt = np.linalg.svd(R22)
+        sv = S
+        c = U.T @ z2
+        keep = np.greater(S, (rcond or 0.0) * S[0])
+        if noise_threshold is not None and math.isfinite(sigma_full):
+            # a small-s_i component stays when the data along it stand out of the noise
+            strong = np.abs(c) > noise_threshold * sigma_full
+            keep |= strong & np.greater(S, SINGULAR_RCOND * S[0])
+        f = np.zeros_like(S)
+        f[keep] = S[keep] / (S[keep] ** 2 + n * ridge)
+        H = (Vt.T * f) @ U.T  # γ_P = H z2
+    gamma_p = H @ z2
+    if nu:
+        Linv_u = sla.solve_triangular(R11, np.eye(nu), lower=False)
+        gamma_u = Linv_u @ (z1 - R12 @ gamma_p)
+        Lmap = np.zeros((qq, qq))
+        Lmap[:nu, :nu] = Linv_u
+        Lmap[:nu, nu:] = -Linv_u @ R12 @ H
+        Lmap[nu:, nu:] = H
+    else:
+        gamma_u = np.zeros(0)
+        Lmap = H
+    gamma = np.r_[gamma_u, gamma_p]
+    res2 = z2 - R22 @ gamma_p
+    rss = rss0 + float(res2 @ res2)
+    rank = nu + int(keep.sum())
+    dof = n - rank
+    sigma2 = rss / dof if dof > 0 else math.nan
+    cov_g = sigma2 * (Lmap @ Lmap.T)
+    coef_o = gamma / scale
+    cov_o = cov_g / scale[:, None] / scale[None, :]
+    # back to the order of ``cols``
+    pos = [order.index(c) for c in cols]
+    coef = coef_o[pos]
+    cov = cov_o[np.ix_(pos, pos)]
+    return LstsqSolution(
+        coef=coef,
+        cov=cov,
+        rss=rss,
+        n=n,
+        dof=dof,
+        condition_number=cond,
+        rank=rank,
+        n_truncated=int((~keep).sum()),
+        singular_values=np.asarray(sv, dtype=np.float64),
+        extra={"sigma_full": sigma_full},
+    )
+
+
+def subset_rss(r_aug: FloatArray, columns: Sequence[int]) -> tuple[float, FloatArray]:
+    """RSS and coefficients of the least-squares fit on a column subset, from R_aug.
+
+    ``‖y − A_S β‖² = ‖r_y − R_S β‖²`` where ``r_y`` is the last column of
+    ``R_aug`` (Q orthogonal); solved by lstsq on the small matrix.
+    """
+    q = r_aug.shape[1] - 1
+    R = r_aug[:, list(columns)]
+    z = r_aug[:, q]
+    beta, _res, _rank, _sv = np.linalg.lstsq(R, z, rcond=None)
+    res = z - R @ beta
+    return float(res @ res), np.asarray(beta, dtype=np.float64)
+
+
+def holdout_rss(r_aug_hold: FloatArray, columns: Sequence[int], beta: FloatArray) -> float:
+    """``‖y_h − A_h,S β‖²`` of a held-out fold from its R factor."""
+    q = r_aug_hold.shape[1] - 1
+    res = r_aug_hold[:, q] - r_aug_hold[:, list(columns)] @ beta
+    return float(res @ res)
+
+
+@dataclass(frozen=True)
+class Selection:
+    """Result of forward stepwise selection: kept columns in the order added, and the path."""
+
+    kept: list[int]
+    path: list[dict[str, Any]]
+    method: str
+
+
+def forward_select(
+    red: Reduced,
+    candidates: Sequence[int],
+    required: Sequence[int],
+    names: Sequence[str],
+    method: Literal["bic", "holdout"] = "bic",
+) -> Selection:
+    """Forward stepwise term selection (SPEC §4a: by information criterion or validation error).
+
+    Starting from the ``required`` columns (constant / per-run offsets), add at
+    each step the candidate that lowers the score most; stop when none lowers
+    it.  ``"bic"``: ``n ln(RSS/n) + k ln n`` on all data (Schwarz 1978,
+    doi:10.1214/aos/1176344136); ``"holdout"``: RSS on fold 1 of a fit on fold 0
+    (blocked hold-out; ``red`` must have two folds).
+    """
+    kept: list[int] = list(required)
+    remaining = [c for c in candidates if c not in kept]
+    path: list[dict[str, Any]] = []
+    if method == "bic":
+        R = red.combined()
+        n = red.n_total
+
+        def score(cols: list[int]) -> float:
+            rss, _ = subset_rss(R, cols)
+            return n * math.log(max(rss, 1e-300) / n) + len(cols) * math.log(n)
+
+    elif method == "holdout":
+        if len(red.r_aug) != 2:
+            raise ThermocalInputError("hold-out selection needs two folds")
+        Rt, Rh = red.r_aug
+
+        def score(cols: list[int]) -> float:
+            _rss, beta = subset_rss(Rt, cols)
+            return holdout_rss(Rh, cols, beta)
+
+    else:
+        raise ThermocalInputError(f"unknown selection method {method!r}; use bic or holdout")
+    current = score(kept)
+    path.append({"added": None, "score": current})
+    while remaining:
+        trials = [(score([*kept, c]), c) for c in remaining]
+        best, c = min(trials)
+        if not best < current:
+            break
+        kept.append(c)
+        remaining.remove(c)
+        current = best
+        path.append({"added": names[c], "score": best})
+    return Selection(kept=kept, path=path, method=method)
