@@ -31,6 +31,7 @@ MATHS = [
     "thermocal.models.poly_fit",
     "thermocal.models.poly_eval",
     "thermocal.export_c",
+    "thermocal.report.analysis",
 ]
 FILE_LAYER = ["pandas", "pyarrow", "thermocal.io", "thermocal.compensate", "thermocal.models.files"]
 

@@ -8,15 +8,29 @@ writes it atomically.  Figures come from :mod:`thermocal.report.figures`
 
 from __future__ import annotations
 
-from thermocal.report.build import (
-    ModelEntry,
-    ReportInputs,
-    build_report,
-    figures_of_merit,
-    fmt_num,
-    improvement_pct,
-    write_report,
-)
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    from thermocal.report.build import (
+        ModelEntry,
+        ReportInputs,
+        build_report,
+        figures_of_merit,
+        fmt_num,
+        improvement_pct,
+        write_report,
+    )
+
+
+def __getattr__(name: str) -> Any:
+    """The report's names are imported from :mod:`thermocal.report.build` on first use, so
+    ``thermocal.report.analysis`` (pure numbers) loads without the file layer."""
+    if name in __all__:
+        from thermocal.report import build
+
+        return getattr(build, name)
+    raise AttributeError(f"module 'thermocal.report' has no attribute {name!r}")
+
 
 __all__ = [
     "ModelEntry",

@@ -24,11 +24,9 @@ Public API: :class:`ModelEntry`, :class:`ReportInputs`, :func:`build_report`
 from __future__ import annotations
 
 import base64
-import dataclasses
 import datetime as _dt
 import hashlib
 import math
-import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -37,14 +35,34 @@ from typing import Any, TypeGuard
 import numpy as np
 from markupsafe import Markup, escape
 
-from thermocal import units
-from thermocal.allan import AllanResult, NoiseTerms, noise_terms, overlapping_adev
-from thermocal.compensation import unit_factor
 from thermocal.errors import ThermocalInputError
 from thermocal.io import atomic_write
-from thermocal.metrics import compute_metrics, drift_angle
-from thermocal.models.base import RunData, TemperatureModel, condition_wording
-from thermocal.recording import FloatArray, Metadata, Recording
+from thermocal.models.base import condition_wording
+from thermocal.recording import Recording
+from thermocal.report.analysis import (
+    NOISE_TERMS as NOISE_TERMS,
+)
+from thermocal.report.analysis import (
+    AllanAnalysis as AllanAnalysis,
+)
+from thermocal.report.analysis import (
+    FiguresOfMerit as FiguresOfMerit,
+)
+from thermocal.report.analysis import (
+    RunSignals as RunSignals,
+)
+from thermocal.report.analysis import (  # the numbers, re-exported
+    allan_of as allan_of,
+)
+from thermocal.report.analysis import (
+    apply_model as apply_model,
+)
+from thermocal.report.analysis import (
+    figures_of_merit as figures_of_merit,
+)
+from thermocal.report.analysis import (
+    known_input_of as known_input_of,
+)
 
 WEAK_CORRELATION_LIMIT = 0.4
 """Seed 000 / SPEC §5: the validation test is weakly correlated when r < 0.4."""
@@ -189,189 +207,6 @@ def unit_label(unit: str) -> str:
         .replace("sqrt(Hz)", "√Hz")
         .replace("ug", "µg")
     )
-
-
-# --- analysis of the runs --------------------------------------------------------------------
-
-
-@dataclass(frozen=True)
-class RunSignals:
-    """The bias of a run before and after compensation by one model [signal unit]."""
-
-    time_s: FloatArray
-    signal: FloatArray
-    unit: str
-    before: FloatArray
-    model: FloatArray
-    after: FloatArray
-    temps_c: FloatArray
-    temp_names: tuple[str, ...]
-    known_input: float
-    warnings: tuple[str, ...]
-    model_includes_known_input: bool = False
-
-    @property
-    def model_bias(self) -> FloatArray:
-        """The model value on the bias scale (known input taken off if the model holds it)."""
-        if self.model_includes_known_input:
-            out: FloatArray = self.model - self.known_input
-            return out
-        return self.model
-
-    @property
-    def after_raw(self) -> FloatArray:
-        """Compensated output with the known input kept (what the sensor would output)."""
-        out: FloatArray = self.after + self.known_input
-        return out
-
-
-def known_input_of(rec: Recording, unit: str) -> float:
-    """Earth rate seen by the sensitive axis [°/h] when the metadata gives latitude and
-    axis (SPEC §1: B0 = mean − Ω_axis), else 0 (accelerometers: 0)."""
-    if unit != "deg/h" or rec.meta.latitude_deg is None or rec.meta.axis is None:
-        return 0.0
-    return float(
-        units.earth_rate_on_axis_deg_h(rec.meta.latitude_deg, units.parse_axis(rec.meta.axis))
-    )
-
-
-def apply_model(model_dict: dict[str, Any], rec: Recording, signal: str | None) -> RunSignals:
-    """Apply a model (file content) to a recording: bias before, model value, bias after.
-
-    ``after = before − model(T, Ṫ)``; the model is evaluated on the fitted range
-    (clamped, as in compensation); :class:`~thermocal.errors.ExtrapolationWarning`
-    messages are collected, not raised.
-    """
-    model = TemperatureModel.from_dict(model_dict)
-    sig_name = signal or (model_dict.get("signal") or {}).get("name")
-    if sig_name not in rec.columns:
-        sig_name = None if not rec.signals else rec.signals[0]
-    temp_names = tuple(model_dict["temperatures"])
-    x, unit = rec.signal(sig_name)
-    factor = unit_factor(unit, model.signal_unit, meta=rec.meta, where=rec.name)
-    known = known_input_of(rec, unit)
-    run = RunData.from_recording(rec, sig_name, temp_names, known_input=known)
-    run = dataclasses.replace(run, signal=x * factor, known_input=known * factor)
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always")
-        pred = np.asarray(model.predict(run), dtype=np.float64) / factor
-    msgs = tuple(dict.fromkeys(" ".join(str(w.message).split()) for w in caught))
-    before = x - known
-    # A model fitted on the raw output (known input not removed) carries the earth
-    # rate in its constant.  The fit's provenance says what was removed (``thermocal fit``
-    # records ``known_input`` per file); without it, tell by which level the model's mean
-    # is nearer (|Ω| ≫ bias changes).
-    fitted = [d.get("known_input") for d in model_dict.get("data", []) if isinstance(d, dict)]
-    if known == 0.0:
-        includes = False
-    elif fitted and all(isinstance(k, int | float) for k in fitted):
-        includes = all(float(k) == 0.0 for k in fitted)  # type: ignore[arg-type]
-    else:
-        includes = bool(abs(np.mean(pred) - np.mean(x)) < abs(np.mean(pred) - np.mean(before)))
-    after = x - pred if includes else before - pred
-    return RunSignals(
-        time_s=rec.time_s,
-        signal=x,
-        unit=unit,
-        before=before,
-        model=pred,
-        after=after,
-        temps_c=run.temps_c,
-        temp_names=temp_names,
-        known_input=known,
-        warnings=msgs,
-        model_includes_known_input=includes,
-    )
-
-
-@dataclass(frozen=True)
-class FiguresOfMerit:
-    """SPEC §1 figures of a whole run [signal unit], from
-    :func:`thermocal.metrics.compute_metrics` (the numbers of ``thermocal metrics``):
-    bias B0 (earth rate removed when latitude and axis are known), bias stability
-    and peak-to-peak over ``averaging_s`` averages, temperature sensitivity over
-    the hold stages (least-squares slope and mean |ΔB/ΔT|) [unit/°C], and the
-    largest and final drift angle [°] (gyros)."""
-
-    bias: float
-    bias_stability: float
-    averaging_s: float
-    peak_to_peak: float
-    sensitivity_slope: float | None
-    sensitivity_mean_abs: float | None
-    drift_angle: FloatArray | None
-    drift_angle_end_deg: float | None
-    drift_angle_max_deg: float | None
-
-
-def figures_of_merit(
-    time_s: FloatArray,
-    x: FloatArray,
-    unit: str,
-    *,
-    averaging_s: float,
-    meta: Metadata,
-    temp_name: str,
-    temp_c: FloatArray,
-) -> FiguresOfMerit:
-    """Figures of merit of a rate ``x`` [canonical unit, known input included] (SPEC §1).
-
-    Runs :func:`thermocal.metrics.compute_metrics` on a recording of ``x`` with
-    ``temp_c`` as the hold-stage temperature; the drift angle
-    ``θ(t) = ∫ (ω − B0) dt`` with B0 the run's mean rate is
-    :func:`thermocal.metrics.drift_angle` (held across gaps).
-    """
-    rec = Recording.from_arrays(
-        time_s,
-        {"signal": x},
-        {temp_name: temp_c},
-        signal_unit=unit,
-        meta=dataclasses.replace(meta, scale_factor=None, scale_factor_unit=None),
-    )
-    m = compute_metrics(rec, "signal", averaging_s, temps=[temp_name])
-    sens = m.temperature_sensitivity
-    ang: FloatArray | None = None
-    end = mx = None
-    if unit == "deg/h":
-        ang = drift_angle(time_s, x, float(np.mean(x)))
-        end = float(ang[-1])
-        mx = float(np.max(np.abs(ang)))
-    return FiguresOfMerit(
-        bias=m.bias,
-        bias_stability=m.bias_stability,
-        averaging_s=m.averaging_s,
-        peak_to_peak=m.peak_to_peak,
-        sensitivity_slope=sens.ls_slope if sens is not None else None,
-        sensitivity_mean_abs=sens.mean_abs_adjacent if sens is not None else None,
-        drift_angle=ang,
-        drift_angle_end_deg=end,
-        drift_angle_max_deg=mx,
-    )
-
-
-NOISE_TERMS = (
-    ("quantization", "Quantization noise Q"),
-    ("angle_random_walk", "Angle random walk N"),
-    ("bias_instability", "Bias instability B"),
-    ("rate_random_walk", "Rate random walk K"),
-    ("rate_ramp", "Rate ramp R"),
-)
-
-
-@dataclass(frozen=True)
-class AllanAnalysis:
-    """Allan deviation of one series and its noise terms (both IEEE 952 methods)."""
-
-    result: AllanResult
-    terms: NoiseTerms
-
-
-def allan_of(time_s: FloatArray, x: FloatArray, tau0_s: float, unit: str) -> AllanAnalysis:
-    """Overlapping Allan deviation (octave τ, ±1σ confidence intervals, split at gaps) and
-    the IEEE Std 952 noise terms, by :func:`thermocal.allan.overlapping_adev` and
-    :func:`thermocal.allan.noise_terms` (NIST SP 1065 eq. 11; SPEC §1)."""
-    res = overlapping_adev(x, tau0_s, "octave", time_s=time_s, unit=unit)
-    return AllanAnalysis(result=res, terms=noise_terms(res))
 
 
 # --- provenance ------------------------------------------------------------------------------
@@ -788,17 +623,28 @@ def _env() -> Any:
     return env
 
 
-def build_report(inputs: ReportInputs) -> str:
-    """The report as one self-contained HTML document (str).
+@dataclass(frozen=True)
+class _Analysis:
+    """The numbers behind the report: each model applied to the validation run, and the
+    primary model's figures of merit and Allan deviation before and after (SPEC §1)."""
 
-    Steps: apply each model to the validation run (bias before, model, after);
-    SPEC §1 figures of merit and Allan deviation before and after for the
-    primary model; figures (PNG, base64); tables from the model and validation
-    JSON; warnings; render ``templates/report.html.j2``.
-    """
-    from thermocal import __version__
-    from thermocal.report import figures as F
+    primary: ModelEntry
+    signal: str | None
+    unit: str
+    applied: dict[str, RunSignals]
+    main: RunSignals
+    temp_names: tuple[str, ...]
+    averaging_s: float
+    tau0: float
+    stage_temp: str
+    fom_before: FiguresOfMerit
+    fom_after: FiguresOfMerit
+    allan_before: AllanAnalysis
+    allan_after: AllanAnalysis
 
+
+def _analyse(inputs: ReportInputs) -> _Analysis:
+    """Apply every model to the validation run; the primary's figures before and after."""
     if not inputs.models:
         raise ThermocalInputError("report: at least one model is needed")
     primary = inputs.models[0]
@@ -814,7 +660,6 @@ def build_report(inputs: ReportInputs) -> str:
     v = primary.validation or {}
     averaging_s = float(inputs.averaging_s or v.get("averaging_s") or DEFAULT_AVERAGING_S)
     tau0 = rec.sample_interval_s
-
     ambient = v.get("ambient")
     stage_temp = ambient if isinstance(ambient, str) and ambient in rec.columns else temp_names[0]
     stage_temp_c = (
@@ -833,10 +678,23 @@ def build_report(inputs: ReportInputs) -> str:
         )
         for x in (main.signal, main.after_raw)
     )
-    allan_before = allan_of(main.time_s, main.before, tau0, unit)
-    allan_after = allan_of(main.time_s, main.after, tau0, unit)
+    return _Analysis(
+        primary, signal, unit, applied, main, temp_names, averaging_s, tau0, stage_temp,
+        fom_before, fom_after,
+        allan_of(main.time_s, main.before, tau0, unit),
+        allan_of(main.time_s, main.after, tau0, unit),
+    )  # fmt: skip
 
-    # --- figures: bias series drawn as averages over the stability averaging time
+
+def _report_figures(inputs: ReportInputs, an: _Analysis) -> dict[str, dict[str, str]]:
+    """Every figure (PNG, base64) with its title and numbered caption."""
+    from thermocal.report import figures as F
+
+    primary, main, unit, temp_names = an.primary, an.main, an.unit, an.temp_names
+    rec, signal, averaging_s, tau0 = inputs.recording, an.signal, an.averaging_s, an.tau0
+    fom_before, fom_after = an.fom_before, an.fom_after
+    allan_before, allan_after = an.allan_before, an.allan_after
+    # bias series drawn as averages over the stability averaging time
     block = max(1, round(averaging_s / tau0))
     avg_text = f" ({fmt_num(block * tau0)} s averages)" if block > 1 else ""
     panels = []
@@ -951,7 +809,12 @@ def build_report(inputs: ReportInputs) -> str:
             ),
         )
 
-    # --- tables
+    return figs
+
+
+def _noise_rows(an: _Analysis) -> list[dict[str, Any]]:
+    """IEEE 952 noise terms before and after, by both methods."""
+    allan_before, allan_after = an.allan_before, an.allan_after
     noise_rows = []
     for key, label in NOISE_TERMS:
         cells = []
@@ -967,6 +830,13 @@ def build_report(inputs: ReportInputs) -> str:
                     }
                 )
         noise_rows.append({"label": label, "unit": unit_label(term_unit), "cells": cells})
+    return noise_rows
+
+
+def _fom_rows(an: _Analysis) -> list[dict[str, Any]]:
+    """SPEC §1 figures of merit before and after, with the improvement."""
+    unit, averaging_s, stage_temp = an.unit, an.averaging_s, an.stage_temp
+    fom_before, fom_after = an.fom_before, an.fom_after
     fom_rows = []
     for name, label, u, digits in (
         ("bias", "Bias B0", unit_label(unit), 5),
@@ -1000,8 +870,11 @@ def build_report(inputs: ReportInputs) -> str:
             }
         )
 
-    truth_rows = _truth_rows(inputs, applied, unit)
+    return fom_rows
 
+
+def _comparison_rows(inputs: ReportInputs) -> list[dict[str, Any]]:
+    """One row per model: its summary and its validation figures."""
     comparison = []
     for e in inputs.models:
         ve = e.validation or {}
@@ -1023,7 +896,13 @@ def build_report(inputs: ReportInputs) -> str:
             }
         )
 
-    validations = [
+    return comparison
+
+
+def _validation_tables(inputs: ReportInputs, unit: str) -> list[dict[str, Any]]:
+    """The validation figures and stages of every model given with a validation result."""
+    primary = inputs.models[0]
+    return [
         {
             "label": e.label,
             "rows": _validation_rows(e, unit_label(unit)),
@@ -1037,24 +916,41 @@ def build_report(inputs: ReportInputs) -> str:
         if e.validation
     ]
 
+
+def _overall(primary: ModelEntry, summary: list[dict[str, Any]]) -> str:
+    """The verdict: only from a validation result that was given, and PASS only when its
+    correlation check is among the passed ones (issue 13 item 6)."""
+    flags = [s["flag"] for s in summary]
+    if not primary.validation:
+        return "na"
+    if "fail" in flags:
+        return "fail"
+    if (primary.validation or {}).get("r") is not None and "pass" in flags:
+        return "pass"
+    return "na"
+
+
+def build_report(inputs: ReportInputs) -> str:
+    """The report as one self-contained HTML document (str).
+
+    Steps: apply each model to the validation run and compute the primary model's SPEC §1
+    figures of merit and Allan deviation before and after (:func:`_analyse`); figures
+    (:func:`_report_figures`); tables from the figures and the model and validation JSON
+    (:func:`_noise_rows`, :func:`_fom_rows`, :func:`_comparison_rows`,
+    :func:`_validation_tables`); warnings; the verdict (:func:`_overall`); render
+    ``templates/report.html.j2``.
+    """
+    from thermocal import __version__
+
+    an = _analyse(inputs)
+    primary, rec, unit, signal = an.primary, inputs.recording, an.unit, an.signal
+    figs = _report_figures(inputs, an)
+    truth_rows = _truth_rows(inputs, an.applied, unit)
     runs = []
     if inputs.modeling is not None:
         runs.append(_run_info("modelling", inputs.modeling, inputs.modeling_path, signal))
     runs.append(_run_info("validation", rec, inputs.recording_path, signal))
-    warn_list = _collect_warnings(inputs, applied)
-    summary = _summary(primary, fom_before, fom_after, unit)
-    flags = [s["flag"] for s in summary]
-    # a verdict only from a validation result that was given, and PASS only when its
-    # correlation check is among the passed ones (issue 13 item 6)
-    if not primary.validation:
-        overall = "na"
-    elif "fail" in flags:
-        overall = "fail"
-    elif (primary.validation or {}).get("r") is not None and "pass" in flags:
-        overall = "pass"
-    else:
-        overall = "na"
-
+    summary = _summary(primary, an.fom_before, an.fom_after, unit)
     ctx = {
         "title": inputs.title,
         "sensor": inputs.sensor or rec.meta.sensor_id or "",
@@ -1065,31 +961,31 @@ def build_report(inputs: ReportInputs) -> str:
         "signal": signal,
         "primary": _model_summary(primary),
         "summary": summary,
-        "overall": overall,
-        "warnings": warn_list,
+        "overall": _overall(primary, summary),
+        "warnings": _collect_warnings(inputs, an.applied),
         "runs": runs,
         "notes": list(inputs.notes),
         "files": [{"label": a, "path": b} for a, b in inputs.files],
         "figs": figs,
-        "validations": validations,
-        "comparison": comparison,
-        "fom_rows": fom_rows,
+        "validations": _validation_tables(inputs, unit),
+        "comparison": _comparison_rows(inputs),
+        "fom_rows": _fom_rows(an),
         "truth_rows": truth_rows,
         "truth_std": (
             num(float(np.std(rec.column(TRUTH_COLUMN))), "truth.std", unit=unit_label(unit))
             if truth_rows
             else None
         ),
-        "noise_rows": noise_rows,
+        "noise_rows": _noise_rows(an),
         "model_details": _model_details(inputs),
         "coefficients": _coefficient_rows(primary.model),
         "ranges": _range_rows(primary.model),
         "has_rates": bool((primary.model.get("range") or {}).get("rate_c_per_min")),
-        "known_input": main.known_input,
-        "averaging_s": averaging_s,
+        "known_input": an.main.known_input,
+        "averaging_s": an.averaging_s,
         "limit_r": WEAK_CORRELATION_LIMIT,
         "n_figures": len(figs),
-        "temp_names": ", ".join(temp_names),
+        "temp_names": ", ".join(an.temp_names),
     }
     html: str = _env().get_template("report.html.j2").render(**ctx)
     return html

@@ -38,6 +38,7 @@ from thermocal.io import atomic_write
 from thermocal.models.base import model_file_dict
 from thermocal.models.calibration import Calibration
 from thermocal.recording import Recording
+from thermocal.report.analysis import allan_of, apply_model, figures_of_merit
 from thermocal.report.build import (
     DEFAULT_AVERAGING_S,
     ILL_CONDITIONED,
@@ -45,9 +46,6 @@ from thermocal.report.build import (
     _coefficient_rows,
     _env,
     _range_rows,
-    allan_of,
-    apply_model,
-    figures_of_merit,
     improvement_pct,
     sha256_of,
     unit_label,
