@@ -258,6 +258,19 @@ def _poly_shift_matrix(mu: float, sigma: float, n: int) -> FloatArray:
 # --- the model ------------------------------------------------------------------------------
 
 
+@dataclasses.dataclass(frozen=True)
+class _ScaledFit:
+    """The warm-up fit in scaled variables: c (n_j × n_k), its covariance (None without
+    residual degrees of freedom), the degrees of freedom, the worst condition number and
+    the per-run stage-1 coefficients (two-stage only)."""
+
+    c_scaled: FloatArray
+    cov_c: FloatArray | None
+    dof: int
+    cond: float
+    run_coefs: FloatArray | None
+
+
 @register
 class WarmupModel(TemperatureModel):
     """Two-stage warm-up model ``ΔF = Σ_j a_j(T0) ΔT^j``, ``a_j(T0) = Σ_k b_jk T0^k``
@@ -352,7 +365,11 @@ class WarmupModel(TemperatureModel):
         """Fit the b matrix to several power-on runs (SPEC §4c).
 
         Stage 1 (per run, post-window samples): ``ΔF = Σ_j a_j ΔT^j`` by least
-        squares.  Stage 2: ``a_j = Σ_k b_jk T0^k`` over the runs by least squares.
+        squares.  Stage 2: ``a_j = Σ_k b_jk T0^k`` over the runs by least squares
+        (``method="joint"``: both at once).  Steps: the runs' start values and
+        post-window changes (:meth:`_start_values`), the distinct start temperatures,
+        the scaled fit (:meth:`_fit_two_stage` or :meth:`_fit_joint`), the physical b
+        with standard errors and the statistics (:meth:`_set_fitted`).
         """
         self._check_params()
         if not runs:
@@ -364,11 +381,37 @@ class WarmupModel(TemperatureModel):
             raise ThermocalInputError(
                 f"warmup: the runs name the temperature channel differently: {sorted(names)}"
             )
-        order, kt = int(self.order), int(self.t0_order)
-        j0 = self._j0
-        n_j = order + 1 - j0
-        n_k = kt + 1
+        t0s, f0s, dts, dfs = self._start_values(one)
+        t0_arr = np.array(t0s)
+        n_distinct = self._distinct_start_temperatures(t0_arr)
+        all_dt = np.concatenate(dts)
+        s_dt = float(np.max(np.abs(all_dt)))
+        if not s_dt > 0:
+            raise DesignError(
+                "warmup: the temperature does not change after the start window (ΔT ≡ 0); "
+                "the ΔT terms cannot be determined"
+            )
+        mu = float(np.mean(t0_arr))
+        sig = float(np.max(np.abs(t0_arr - mu))) or 1.0
+        scaled = (
+            self._fit_two_stage(one, dts, dfs, t0_arr, s_dt, mu, sig)
+            if self.method == "two_stage"
+            else self._fit_joint(one, dts, dfs, t0s, t0_arr, all_dt, s_dt, mu, sig)
+        )
+        if scaled.cond > CONDITION_WARN:
+            warnings.warn(
+                f"warmup: badly conditioned design (condition number {scaled.cond:.3g})",
+                ConditioningWarning,
+                stacklevel=2,
+            )
+        self._set_fitted(one, scaled, t0s, f0s, dts, dfs, s_dt, mu, sig, n_distinct)
+        return self
 
+    def _start_values(
+        self, one: list[RunData]
+    ) -> tuple[list[float], list[float], list[FloatArray], list[FloatArray]]:
+        """Per run: T0 and F0 (means over the start window) and the post-window ΔT, ΔF."""
+        n_j = int(self.order) + 1 - self._j0
         t0s, f0s, dts, dfs = [], [], [], []
         for r in one:
             temp = r.temps_c[:, 0]
@@ -380,129 +423,170 @@ class WarmupModel(TemperatureModel):
                 raise DesignError(
                     f"warmup: {r.name or 'run'} has {r.n_samples - m} samples after the "
                     f"{self.start_window_s:g} s start window; at least {n_j} are needed "
-                    f"(order {order})"
+                    f"(order {self.order})"
                 )
             t0s.append(t0)
             f0s.append(f0)
             dts.append(temp[m:] - t0)
             dfs.append(y[m:] - f0)
-        t0_arr = np.array(t0s)
+        return t0s, f0s, dts, dfs
 
-        # distinct start temperatures (greedy grouping of the sorted T0s)
+    def _distinct_start_temperatures(self, t0_arr: FloatArray) -> int:
+        """How many start temperatures ≥ DISTINCT_T0_C apart (greedy on the sorted T0s);
+        refuses fewer than the T0 order needs."""
+        kt = int(self.t0_order)
         srt = np.sort(t0_arr)
         n_distinct = 1 + int(np.count_nonzero(np.diff(srt) >= DISTINCT_T0_C))
-        if n_distinct < n_k:
+        if n_distinct < kt + 1:
             raise DesignError(
-                f"warmup: t0_order={kt} needs runs at ≥ {n_k} distinct start temperatures "
+                f"warmup: t0_order={kt} needs runs at ≥ {kt + 1} distinct start temperatures "
                 f"(≥ {DISTINCT_T0_C:g} °C apart); got {n_distinct} "
                 f"({', '.join(f'{v:.2f}' for v in srt)} °C); add runs or lower --t0-order"
             )
+        return n_distinct
 
-        all_dt = np.concatenate(dts)
-        s_dt = float(np.max(np.abs(all_dt)))
-        if not s_dt > 0:
-            raise DesignError(
-                "warmup: the temperature does not change after the start window (ΔT ≡ 0); "
-                "the ΔT terms cannot be determined"
-            )
-        mu = float(np.mean(t0_arr))
-        sig = float(np.max(np.abs(t0_arr - mu))) or 1.0
+    def _fit_two_stage(
+        self,
+        one: list[RunData],
+        dts: list[FloatArray],
+        dfs: list[FloatArray],
+        t0_arr: FloatArray,
+        s_dt: float,
+        mu: float,
+        sig: float,
+    ) -> _ScaledFit:
+        """Stage 1 per run, stage 2 across runs, in the scaled variables."""
+        order, kt, j0 = int(self.order), int(self.t0_order), self._j0
+        n_j, n_k = order + 1 - j0, kt + 1
         powers_j = np.arange(j0, order + 1)
+        a_runs = np.empty((len(one), n_j))
+        cond = 0.0
+        for i, (dt, df) in enumerate(zip(dts, dfs, strict=True)):
+            x = (dt / s_dt)[:, None] ** powers_j[None, :]
+            res = lstsq_svd(x, df)
+            if res.rank < n_j:
+                terms = ", ".join(f"ΔT^{powers_j[c]}" for c in res.null_columns)
+                raise DesignError(
+                    f"warmup: {one[i].name or f'run {i}'}: term(s) {terms} cannot be "
+                    f"determined (ΔT takes too few distinct values after the start window)"
+                )
+            cond = max(cond, res.condition_number)
+            a_runs[i] = res.coef
+        v = (t0_arr - mu) / sig
+        vmat = v[:, None] ** np.arange(n_k)[None, :]
+        res2 = lstsq_svd(vmat, a_runs)
+        if res2.rank < n_k:
+            raise DesignError(
+                f"warmup: the start temperatures cannot determine T0 terms up to "
+                f"T0^{kt}; lower --t0-order"
+            )
+        cond = max(cond, res2.condition_number)
+        c_scaled = res2.coef.T  # (n_j, n_k)
+        # cov(vec c) block-diagonal over j (per-coefficient residual variance)
+        cov_c: FloatArray | None = (
+            np.asarray(np.kron(np.diag(res2.sigma2), res2.cov_unit), dtype=np.float64)
+            if res2.dof > 0
+            else None
+        )
+        dof = res2.dof
+        run_coefs: FloatArray | None = a_runs
+        return _ScaledFit(c_scaled, cov_c, int(dof), float(cond), run_coefs)
 
-        if self.method == "two_stage":
-            a_runs = np.empty((len(one), n_j))
-            cond = 0.0
-            for i, (dt, df) in enumerate(zip(dts, dfs, strict=True)):
-                x = (dt / s_dt)[:, None] ** powers_j[None, :]
-                res = lstsq_svd(x, df)
-                if res.rank < n_j:
-                    terms = ", ".join(f"ΔT^{powers_j[c]}" for c in res.null_columns)
-                    raise DesignError(
-                        f"warmup: {one[i].name or f'run {i}'}: term(s) {terms} cannot be "
-                        f"determined (ΔT takes too few distinct values after the start window)"
-                    )
-                cond = max(cond, res.condition_number)
-                a_runs[i] = res.coef
+    def _fit_joint(
+        self,
+        one: list[RunData],
+        dts: list[FloatArray],
+        dfs: list[FloatArray],
+        t0s: list[float],
+        t0_arr: FloatArray,
+        all_dt: FloatArray,
+        s_dt: float,
+        mu: float,
+        sig: float,
+    ) -> _ScaledFit:
+        """Both stages in one least-squares problem (per-run a0 as nuisance parameters
+        when asked)."""
+        order, kt, j0 = int(self.order), int(self.t0_order), self._j0
+        n_j, n_k = order + 1 - j0, kt + 1
+        powers_j = np.arange(j0, order + 1)
+        u = np.concatenate(
+            [np.full(dt.size, (t0 - mu) / sig) for dt, t0 in zip(dts, t0s, strict=True)]
+        )
+        w = all_dt / s_dt
+        offsets = bool(self.per_run_offset) and j0 == 0
+        slope_j = powers_j[1:] if offsets else powers_j
+        cols = [w**j * u**k for j in slope_j for k in range(n_k)]
+        labels = [self._term_name(int(j), k) for j in slope_j for k in range(n_k)]
+        if offsets:
+            # per-run a0 as nuisance parameters (turn-on F0 noise stays out of the slopes)
+            run_id = np.concatenate([np.full(dt.size, i) for i, dt in enumerate(dts)])
+            ind = [(run_id == i).astype(np.float64) for i in range(len(dts))]
+            cols = ind + cols
+            run_labels = [f"a0 of {r.name or f'run {i}'}" for i, r in enumerate(one)]
+            labels = run_labels + labels
+        x = np.column_stack(cols)
+        res = lstsq_svd(x, np.concatenate(dfs))
+        if res.rank < x.shape[1]:
+            bad = ", ".join(labels[c] for c in res.null_columns)
+            raise DesignError(f"warmup: singular joint design; term(s) {bad}")
+        cond = res.condition_number
+        dof = res.dof
+        if offsets:
+            n_r = len(dts)
+            cov_all = res.sigma2 * res.cov_unit if res.dof > 0 else None
+            # a0(T0) = Σ_k b_0k T0^k fitted to the per-run offsets (as in stage 2)
             v = (t0_arr - mu) / sig
             vmat = v[:, None] ** np.arange(n_k)[None, :]
-            res2 = lstsq_svd(vmat, a_runs)
-            if res2.rank < n_k:
+            res0 = lstsq_svd(vmat, res.coef[:n_r])
+            if res0.rank < n_k:
                 raise DesignError(
                     f"warmup: the start temperatures cannot determine T0 terms up to "
                     f"T0^{kt}; lower --t0-order"
                 )
-            cond = max(cond, res2.condition_number)
-            c_scaled = res2.coef.T  # (n_j, n_k)
-            # cov(vec c) block-diagonal over j (per-coefficient residual variance)
-            cov_c = np.kron(np.diag(res2.sigma2), res2.cov_unit) if res2.dof > 0 else None
-            dof = res2.dof
-            run_coefs: FloatArray | None = a_runs
-        else:
-            u = np.concatenate(
-                [np.full(dt.size, (t0 - mu) / sig) for dt, t0 in zip(dts, t0s, strict=True)]
-            )
-            w = all_dt / s_dt
-            offsets = bool(self.per_run_offset) and j0 == 0
-            slope_j = powers_j[1:] if offsets else powers_j
-            cols = [w**j * u**k for j in slope_j for k in range(n_k)]
-            labels = [self._term_name(int(j), k) for j in slope_j for k in range(n_k)]
-            if offsets:
-                # per-run a0 as nuisance parameters (turn-on F0 noise stays out of the slopes)
-                run_id = np.concatenate([np.full(dt.size, i) for i, dt in enumerate(dts)])
-                ind = [(run_id == i).astype(np.float64) for i in range(len(dts))]
-                cols = ind + cols
-                run_labels = [f"a0 of {r.name or f'run {i}'}" for i, r in enumerate(one)]
-                labels = run_labels + labels
-            x = np.column_stack(cols)
-            res = lstsq_svd(x, np.concatenate(dfs))
-            if res.rank < x.shape[1]:
-                bad = ", ".join(labels[c] for c in res.null_columns)
-                raise DesignError(f"warmup: singular joint design; term(s) {bad}")
-            cond = res.condition_number
-            dof = res.dof
-            if offsets:
-                n_r = len(dts)
-                cov_all = res.sigma2 * res.cov_unit if res.dof > 0 else None
-                # a0(T0) = Σ_k b_0k T0^k fitted to the per-run offsets (as in stage 2)
-                v = (t0_arr - mu) / sig
-                vmat = v[:, None] ** np.arange(n_k)[None, :]
-                res0 = lstsq_svd(vmat, res.coef[:n_r])
-                if res0.rank < n_k:
-                    raise DesignError(
-                        f"warmup: the start temperatures cannot determine T0 terms up to "
-                        f"T0^{kt}; lower --t0-order"
-                    )
-                cond = max(cond, res0.condition_number)
-                c_scaled = np.vstack([res0.coef[None, :], res.coef[n_r:].reshape(-1, n_k)])
-                if cov_all is not None and res0.dof > 0:
-                    cov_c = np.zeros((n_j * n_k, n_j * n_k))
-                    cov_c[:n_k, :n_k] = float(res0.sigma2) * res0.cov_unit
-                    cov_c[n_k:, n_k:] = cov_all[n_r:, n_r:]
-                else:
-                    cov_c = None
+            cond = max(cond, res0.condition_number)
+            c_scaled = np.vstack([res0.coef[None, :], res.coef[n_r:].reshape(-1, n_k)])
+            if cov_all is not None and res0.dof > 0:
+                cov_c = np.zeros((n_j * n_k, n_j * n_k))
+                cov_c[:n_k, :n_k] = float(res0.sigma2) * res0.cov_unit
+                cov_c[n_k:, n_k:] = cov_all[n_r:, n_r:]
             else:
-                c_scaled = res.coef.reshape(n_j, n_k)
-                cov_c = res.sigma2 * res.cov_unit if res.dof > 0 else None
-            run_coefs = None
-        if cond > CONDITION_WARN:
-            warnings.warn(
-                f"warmup: badly conditioned design (condition number {cond:.3g})",
-                ConditioningWarning,
-                stacklevel=2,
-            )
+                cov_c = None
+        else:
+            c_scaled = res.coef.reshape(n_j, n_k)
+            cov_c = res.sigma2 * res.cov_unit if res.dof > 0 else None
+        run_coefs = None
+        return _ScaledFit(c_scaled, cov_c, int(dof), float(cond), run_coefs)
 
-        # physical b: a_j = (1/s^j) Σ_k c_jk ((T0 − μ)/σ)^k
+    def _set_fitted(
+        self,
+        one: list[RunData],
+        scaled: _ScaledFit,
+        t0s: list[float],
+        f0s: list[float],
+        dts: list[FloatArray],
+        dfs: list[FloatArray],
+        s_dt: float,
+        mu: float,
+        sig: float,
+        n_distinct: int,
+    ) -> None:
+        """The physical b (``a_j = (1/s^j) Σ_k c_jk ((T0 − μ)/σ)^k``) with standard errors,
+        the ranges and the residual statistics on the post-window samples."""
+        order, kt, j0 = int(self.order), int(self.t0_order), self._j0
+        n_j, n_k = order + 1 - j0, kt + 1
+        powers_j = np.arange(j0, order + 1)
+        t0_arr = np.array(t0s)
         mshift = _poly_shift_matrix(mu, sig, n_k)
         transform = np.zeros((n_j * n_k, n_j * n_k))
         for jj, j in enumerate(powers_j):
             sl = slice(jj * n_k, (jj + 1) * n_k)
             transform[sl, sl] = mshift / s_dt ** float(j)
-        b_vec = transform @ c_scaled.reshape(-1)
+        b_vec = transform @ scaled.c_scaled.reshape(-1)
         b = np.zeros((order + 1, n_k))
         b[j0:] = b_vec.reshape(n_j, n_k)
         self.b_ = b
-        if cov_c is not None:
-            cov_b = transform @ cov_c @ transform.T
+        if scaled.cov_c is not None:
+            cov_b = transform @ scaled.cov_c @ transform.T
             se = np.zeros((order + 1, n_k))
             se[j0:] = np.sqrt(np.maximum(np.diag(cov_b), 0.0)).reshape(n_j, n_k)
             self.b_stderr_ = se
@@ -516,13 +600,11 @@ class WarmupModel(TemperatureModel):
         self.start_outputs_ = np.array(f0s)
         self.run_coefficients_ = (
             None
-            if run_coefs is None
+            if scaled.run_coefs is None
             else np.column_stack(
-                [np.zeros((len(one), j0)), run_coefs / s_dt ** powers_j.astype(float)]
+                [np.zeros((len(one), j0)), scaled.run_coefs / s_dt ** powers_j.astype(float)]
             )
         )
-
-        # residuals of the full model on the post-window samples
         resid = np.concatenate(
             [
                 df - _evaluate(b, np.full(dt.size, t0), dt)
@@ -538,9 +620,9 @@ class WarmupModel(TemperatureModel):
                 n_samples=int(all_df.size),
                 n_coefficients=n_j * n_k,
                 rms_residual=float(np.sqrt(np.mean(resid**2))),
-                condition_number=float(cond),
+                condition_number=float(scaled.cond),
                 r_squared=1.0 - rss / sst if sst > 0 else None,
-                dof=int(dof),
+                dof=int(scaled.dof),
                 extra={
                     "method": self.method,
                     "n_runs": len(one),
@@ -549,7 +631,6 @@ class WarmupModel(TemperatureModel):
                 },
             ),
         )
-        return self
 
     # -- use --
     def _prepare(self, run: RunData) -> FloatArray:
