@@ -79,9 +79,14 @@ from thermocal.models.base import (
     register,
     stream_channel,
 )
-from thermocal.models.fitting import check_runs, decide_run_offsets, record_ranges
+from thermocal.models.fitting import (
+    OffsetDecision,
+    check_runs,
+    decide_run_offsets,
+    record_ranges,
+)
 from thermocal.models.residuals import MAX_SAMPLES_PER_SERIES, residual_correlation
-from thermocal.models.terms import CHUNK_ROWS, Chunk, accumulate_r, solve_r
+from thermocal.models.terms import CHUNK_ROWS, Chunk, LstsqSolution, accumulate_r, solve_r
 from thermocal.recording import FloatArray
 
 STATE_LAYOUT = "thermocal-piecewise-1"
@@ -313,6 +318,22 @@ def choose_breakpoints(
     )
 
 
+@dataclass(frozen=True)
+class _Lines:
+    """The least-squares lines of the segments: intercepts a_s and slopes k_s [signal unit,
+    per °C], their covariance (2S × 2S), the per-run offsets and their mean, the solution
+    and the sample count."""
+
+    intercepts: FloatArray
+    slopes: FloatArray
+    line_cov: FloatArray
+    offsets: FloatArray
+    const: float
+    sol: LstsqSolution
+    n_total: int
+    m: int
+
+
 @register
 class PiecewiseModel(TemperatureModel):
     """Piecewise-linear model in one temperature (SPEC §4b); see the module docstring.
@@ -396,7 +417,14 @@ class PiecewiseModel(TemperatureModel):
 
     # -- estimator contract --
     def fit(self, runs: Sequence[RunData]) -> Self:
-        """Fit eq. (1) on one or several runs (module docstring); returns ``self``."""
+        """Fit eq. (1) on one or several runs (module docstring); returns ``self``.
+
+        Steps: the initial breakpoints, given or chosen by BIC (:meth:`_initial_breakpoints`);
+        every segment checked to hold a line (:meth:`_check_segments`); the lines by
+        chunked least squares (:meth:`_solve_lines`); the breakpoints moved to where
+        adjacent lines meet (intersect method, :meth:`_intersections`); residuals,
+        their correlation and the statistics (:meth:`_set_fitted`).
+        """
         if self.method not in METHODS:
             raise ThermocalInputError(
                 f"unknown piecewise method {self.method!r}; use {' or '.join(METHODS)}"
@@ -409,9 +437,22 @@ class PiecewiseModel(TemperatureModel):
         xs = [np.ascontiguousarray(r.temps_c[:, j]) for r in rl]
         ys = [r.target() for r in rl]
         decision = decide_run_offsets(self.per_run_offset, rl, self.family, column=j)
-        use_offsets = decision.used
         lo = min(float(x.min()) for x in xs)
         hi = max(float(x.max()) for x in xs)
+        bps, choice = self._initial_breakpoints(xs, ys, decision.used, lo, hi)
+        bp = np.asarray(bps, dtype=np.float64)
+        self._check_segments(bp, xs, lo, hi)
+        lines = self._solve_lines(xs, ys, bp, rl, decision.used, lo, hi)
+        final, discontinuities = self._intersections(bp, lines, lo, hi)
+        self._set_fitted(rl, names, j, xs, ys, bp, final, discontinuities, lines, decision,
+                         choice)  # fmt: skip
+        return self
+
+    def _initial_breakpoints(
+        self, xs: list[FloatArray], ys: list[FloatArray], use_offsets: bool, lo: float, hi: float
+    ) -> tuple[list[float], BreakpointChoice | None]:
+        """The breakpoints given (checked inside the data's range), or the number of
+        segments the data support, chosen by BIC (a warning when fewer than asked)."""
         choice: BreakpointChoice | None = None
         if self.breakpoints is not None:
             bps = sorted(float(b) for b in self.breakpoints)
@@ -452,9 +493,13 @@ class PiecewiseModel(TemperatureModel):
                     ThermocalWarning,
                     stacklevel=2,
                 )
-        bp = np.asarray(bps, dtype=np.float64)
+        return list(bps), choice
+
+    @staticmethod
+    def _check_segments(bp: FloatArray, xs: list[FloatArray], lo: float, hi: float) -> None:
+        """Every segment holds at least two distinct temperatures (a line is determined)."""
         S = bp.size + 1
-        seg_edges = [lo, *bps, hi]
+        seg_edges = [lo, *bp.tolist(), hi]
         labels = [f"{seg_edges[s]:.4g}–{seg_edges[s + 1]:.4g} °C" for s in range(S)]
         counts = np.zeros(S, dtype=np.int64)
         for x in xs:
@@ -473,6 +518,23 @@ class PiecewiseModel(TemperatureModel):
                     f"{spans[s]:.3g} °C; a line needs at least 2 distinct temperatures "
                     "(move or drop a breakpoint)"
                 )
+
+    def _solve_lines(
+        self,
+        xs: list[FloatArray],
+        ys: list[FloatArray],
+        bp: FloatArray,
+        rl: list[RunData],
+        use_offsets: bool,
+        lo: float,
+        hi: float,
+    ) -> _Lines:
+        """The segments' lines ``y = a_s + k_s T`` by chunked least squares (Householder QR),
+        with their covariance."""
+        S = bp.size + 1
+        bps = bp.tolist()
+        seg_edges = [lo, *bps, hi]
+        labels = [f"{seg_edges[s]:.4g}–{seg_edges[s + 1]:.4g} °C" for s in range(S)]
         m = len(rl) if use_offsets else 1
         centre = 0.5 * (lo + hi)
         scale = max(0.5 * (hi - lo), 1e-12)
@@ -543,6 +605,14 @@ class PiecewiseModel(TemperatureModel):
         slopes = A_slp @ coef
         Lmat = np.vstack([A_int, A_slp])
         line_cov = Lmat @ sol.cov @ Lmat.T
+        return _Lines(intercepts, slopes, line_cov, offsets, const, sol, red.n_total, m)
+
+    def _intersections(
+        self, bp: FloatArray, lines: _Lines, lo: float, hi: float
+    ) -> tuple[FloatArray, list[float]]:
+        """Intersect method: each breakpoint moved to where the adjacent lines meet, when
+        that lies between its neighbours; the others kept (the model jumps there)."""
+        intercepts, slopes = lines.intercepts, lines.slopes
         final = bp.copy()
         discontinuities: list[float] = []
         if self.method == "intersect":
@@ -563,6 +633,28 @@ class PiecewiseModel(TemperatureModel):
                     ThermocalWarning,
                     stacklevel=2,
                 )
+        return final, discontinuities
+
+    def _set_fitted(
+        self,
+        rl: list[RunData],
+        names: Sequence[str],
+        j: int,
+        xs: list[FloatArray],
+        ys: list[FloatArray],
+        bp: FloatArray,
+        final: FloatArray,
+        discontinuities: list[float],
+        lines: _Lines,
+        decision: OffsetDecision,
+        choice: BreakpointChoice | None,
+    ) -> None:
+        """The fitted values; the residuals of the final model (breakpoints moved), their
+        correlation time scaling the lines' covariance, the statistics and ranges."""
+        intercepts, slopes, line_cov, offsets = (
+            lines.intercepts, lines.slopes, lines.line_cov, lines.offsets,
+        )  # fmt: skip
+        const, sol, use_offsets, S = lines.const, lines.sol, decision.used, bp.size + 1
         self.column_index_ = j
         self.breakpoints_ = final
         self.initial_breakpoints_ = bp
@@ -570,7 +662,7 @@ class PiecewiseModel(TemperatureModel):
         self.slopes_ = slopes
         self.offsets_ = offsets
         self.line_cov_ = line_cov
-        n_total = red.n_total
+        n_total = lines.n_total
         # residual of the final model (breakpoints moved): exact, one pass
         rss = 0.0
         residuals: list[FloatArray] = []
@@ -618,7 +710,6 @@ class PiecewiseModel(TemperatureModel):
         ]
         record_ranges(self, summary, stats, None)
         self.data_ = [{"file": r.name, "n_samples": r.n_samples} for r in rl]
-        return self
 
     def predict(self, run: RunData, *, extrapolate: bool = False) -> FloatArray:
         """Eq. (1) for every sample of ``run`` [signal unit]; T clamped to the fitted range."""
