@@ -240,38 +240,10 @@ def run_demo(
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", ThermocalWarning)
 
-        # 1. profiles
-        prof_m = rlg_modelling(
-            low_c=cfg.low_c,
-            high_c=cfg.high_c,
-            n_temperature_cycles=cfg.n_temperature_cycles,
-            hold_s=cfg.hold_s,
-            rates_c_per_min=cfg.rates_c_per_min,
-            rate_hold_s=cfg.rate_hold_s,
-        )
-        prog_m = prof_m.program(60.0)
-        prof_v = design_validation_profile(
-            *prog_m, seed=seed, n_holds=cfg.n_holds, hold_s=cfg.validation_hold_s
-        )
-        for name, prof in (("rlg-modelling", prof_m), ("rlg-validation", prof_v)):
-            p = out / "profiles" / f"{name}.csv"
-            write_program(p, *prof.program(60.0))
-            written.append(p)
+        prof_m, prof_v = _demo_profiles(out, cfg, seed, written)  # 1. profiles
         done(DEMO_STEPS[0])
-
-        # 2. simulation
-        ((mod, truth_m),) = run_scenario("rlg-modelling", seed, prof_m, rate_hz=cfg.rate_hz)
-        ((val, truth_v),) = run_scenario("rlg-validation", seed, prof_v, rate_hz=cfg.rate_hz)
-        mod_path = out / "data" / "rlg-modelling.parquet"
-        val_path = out / "data" / "rlg-validation.parquet"
-        for rec, truth, path in ((mod, truth_m, mod_path), (val, truth_v, val_path)):
-            write_recording(rec, path)
-            tp = path.with_suffix(".truth.json")
-            write_json(tp, truth)
-            written += [path, tp]
-        mod = dataclasses.replace(mod, source=str(mod_path))
-        val = dataclasses.replace(val, source=str(val_path))
-        done(DEMO_STEPS[1])
+        mod, val, mod_path, val_path = _demo_runs(out, cfg, seed, prof_m, prof_v, written)
+        done(DEMO_STEPS[1])  # 2. simulation
 
         # 3-4. fits
         # the earth rate on the sensitive axis is a known input, not a temperature effect
@@ -344,20 +316,7 @@ def run_demo(
             ModelEntry(lab, model_dicts[lab], val_dicts[lab], str(model_paths[lab]))
             for lab in order
         )
-        notes = (
-            f"Simulated data (thermocal.simulate, preset rlg, seed {seed}): a navigation-grade "
-            "ring-laser gyro with four temperature sensors (T1 block, T2 discharge, T3 mount, "
-            f"T4 case), sampled at {cfg.rate_hz:g} Hz, sensitive axis up at latitude "
-            f"{mod.meta.latitude_deg:g}°. Modelling run: shortened seed-000 profile "
-            f"({cfg.low_c:g}…{cfg.high_c:g} °C cycle, ramps at ±"
-            + ", ±".join(f"{r:g}" for r in cfg.rates_c_per_min)
-            + " °C/min). Validation run: hold profile designed by thermocal to be weakly "
-            "correlated with the modelling run (SPEC §5).",
-            f"Models: 'seed37' is the seed's 37-term polynomial (SPEC §4a); 'selected' the same "
-            f"family with term selection (BIC). The model with the smaller rms of the "
-            f"compensated validation run ('{primary}') is reported in detail and was used for "
-            "the compensated file.",
-        )
+        notes = _demo_notes(cfg, seed, mod, primary)
         files = [("C export", str(p.relative_to(out))) for lab in order for p in c_files[lab]]
         files += [("validation result", str(val_paths[lab].relative_to(out))) for lab in order]
         files.append(("compensated validation run", str(comp_path.relative_to(out))))
@@ -382,29 +341,11 @@ def run_demo(
         done(DEMO_STEPS[7])
     msgs = tuple(dict.fromkeys(" ".join(str(w.message).split()) for w in caught))
 
-    summaries = []
-    for lab in order:
-        vd = val_dicts[lab]
-        fit = model_dicts[lab].get("fit") or {}
-        summaries.append(
-            ModelSummary(
-                label=lab,
-                model_path=model_paths[lab],
-                validation_path=val_paths[lab],
-                c_files=c_files[lab],
-                n_coefficients=len(model_dicts[lab].get("coefficients") or []),
-                condition_number=_num(fit.get("condition_number")),
-                rms_residual=float(fit.get("rms_residual") or float("nan")),
-                r=_num(vd.get("r")),
-                weakly_correlated=vd.get("weakly_correlated"),
-                n_stages=int(vd.get("n_stages") or 0),
-                bias_stability_before=_num(vd.get("bias_stability_before")),
-                bias_stability_after=_num(vd.get("bias_stability_after")),
-                bias_repeatability_before=_num(vd.get("bias_repeatability_before")),
-                bias_repeatability_after=_num(vd.get("bias_repeatability_after")),
-                improvement_pct=dict(vd.get("improvement_pct") or {}),
-            )
-        )
+    summaries = [
+        _summary_of(lab, model_paths[lab], val_paths[lab], c_files[lab], model_dicts[lab],
+                    val_dicts[lab])
+        for lab in order
+    ]  # fmt: skip
     return DemoResult(
         out_dir=out,
         report_path=report_path,
@@ -416,6 +357,93 @@ def run_demo(
         elapsed_s=time.perf_counter() - t_start,
         seed=seed,
         warnings=msgs,
+    )
+
+
+def _demo_profiles(out: Path, cfg: DemoConfig, seed: int, written: list[Path]) -> tuple[Any, Any]:
+    """The modelling profile (a shortened seed-000 cycle) and a validation profile designed
+    to be weakly correlated with it (SPEC §5), written as chamber programs."""
+    prof_m = rlg_modelling(
+        low_c=cfg.low_c,
+        high_c=cfg.high_c,
+        n_temperature_cycles=cfg.n_temperature_cycles,
+        hold_s=cfg.hold_s,
+        rates_c_per_min=cfg.rates_c_per_min,
+        rate_hold_s=cfg.rate_hold_s,
+    )
+    prog_m = prof_m.program(60.0)
+    prof_v = design_validation_profile(
+        *prog_m, seed=seed, n_holds=cfg.n_holds, hold_s=cfg.validation_hold_s
+    )
+    for name, prof in (("rlg-modelling", prof_m), ("rlg-validation", prof_v)):
+        p = out / "profiles" / f"{name}.csv"
+        write_program(p, *prof.program(60.0))
+        written.append(p)
+    return prof_m, prof_v
+
+
+def _demo_runs(
+    out: Path, cfg: DemoConfig, seed: int, prof_m: Any, prof_v: Any, written: list[Path]
+) -> tuple[Any, Any, Path, Path]:
+    """The simulated modelling and validation runs, written with their truth."""
+    ((mod, truth_m),) = run_scenario("rlg-modelling", seed, prof_m, rate_hz=cfg.rate_hz)
+    ((val, truth_v),) = run_scenario("rlg-validation", seed, prof_v, rate_hz=cfg.rate_hz)
+    mod_path = out / "data" / "rlg-modelling.parquet"
+    val_path = out / "data" / "rlg-validation.parquet"
+    for rec, truth, path in ((mod, truth_m, mod_path), (val, truth_v, val_path)):
+        write_recording(rec, path)
+        tp = path.with_suffix(".truth.json")
+        write_json(tp, truth)
+        written += [path, tp]
+    mod = dataclasses.replace(mod, source=str(mod_path))
+    val = dataclasses.replace(val, source=str(val_path))
+    return mod, val, mod_path, val_path
+
+
+def _demo_notes(cfg: DemoConfig, seed: int, mod: Any, primary: str) -> tuple[str, ...]:
+    """The report's notes on the simulated data and the models."""
+    return (
+        f"Simulated data (thermocal.simulate, preset rlg, seed {seed}): a navigation-grade "
+        "ring-laser gyro with four temperature sensors (T1 block, T2 discharge, T3 mount, "
+        f"T4 case), sampled at {cfg.rate_hz:g} Hz, sensitive axis up at latitude "
+        f"{mod.meta.latitude_deg:g}°. Modelling run: shortened seed-000 profile "
+        f"({cfg.low_c:g}…{cfg.high_c:g} °C cycle, ramps at ±"
+        + ", ±".join(f"{r:g}" for r in cfg.rates_c_per_min)
+        + " °C/min). Validation run: hold profile designed by thermocal to be weakly "
+        "correlated with the modelling run (SPEC §5).",
+        f"Models: 'seed37' is the seed's 37-term polynomial (SPEC §4a); 'selected' the same "
+        f"family with term selection (BIC). The model with the smaller rms of the "
+        f"compensated validation run ('{primary}') is reported in detail and was used for "
+        "the compensated file.",
+    )
+
+
+def _summary_of(
+    lab: str,
+    model_path: Path,
+    val_path: Path,
+    c_files: tuple[Path, ...],
+    md: dict[str, Any],
+    vd: dict[str, Any],
+) -> ModelSummary:
+    """One model's figures for :class:`DemoResult` (from its model and validation files)."""
+    fit = md.get("fit") or {}
+    return ModelSummary(
+        label=lab,
+        model_path=model_path,
+        validation_path=val_path,
+        c_files=c_files,
+        n_coefficients=len(md.get("coefficients") or []),
+        condition_number=_num(fit.get("condition_number")),
+        rms_residual=float(fit.get("rms_residual") or float("nan")),
+        r=_num(vd.get("r")),
+        weakly_correlated=vd.get("weakly_correlated"),
+        n_stages=int(vd.get("n_stages") or 0),
+        bias_stability_before=_num(vd.get("bias_stability_before")),
+        bias_stability_after=_num(vd.get("bias_stability_after")),
+        bias_repeatability_before=_num(vd.get("bias_repeatability_before")),
+        bias_repeatability_after=_num(vd.get("bias_repeatability_after")),
+        improvement_pct=dict(vd.get("improvement_pct") or {}),
     )
 
 
