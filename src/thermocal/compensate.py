@@ -65,6 +65,7 @@ from thermocal.errors import (
     MissingColumnError,
     MissingValueError,
     PlausibilityWarning,
+    TextLayoutWarning,
     ThermocalInputError,
     TimestampError,
     UnitError,
@@ -76,6 +77,7 @@ from thermocal.io import (
     META_VERSION,
     atomic_write_path,
     check_not_input,
+    csv_chunk_options,
     csv_encoding,
     default_time_column,
     file_kind,
@@ -176,8 +178,10 @@ def _file_info(path: Path, kind: str) -> tuple[list[str], dict[str, Any], int | 
             except (json.JSONDecodeError, UnicodeDecodeError):
                 raise FileFormatError(f"{path}: corrupt thermocal metadata") from None
     else:
+        enc = csv_encoding(path)
+        opts = csv_chunk_options(path, enc)
         try:
-            head = pd.read_csv(path, nrows=0, skipinitialspace=True, encoding=csv_encoding(path))
+            head = pd.read_csv(path, nrows=0, skipinitialspace=True, encoding=enc, **opts)
         except (pd.errors.ParserError, pd.errors.EmptyDataError, UnicodeDecodeError) as exc:
             msg = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
             raise FileFormatError(f"{path}: not a readable CSV file ({msg})") from None
@@ -208,13 +212,18 @@ def _iter_chunks(path: Path, kind: str, chunk_rows: int) -> Iterator[pd.DataFram
         except (pa.ArrowInvalid, OSError) as exc:
             raise FileFormatError(f"{path}: not a readable Parquet file ({exc})") from None
     else:
+        enc = csv_encoding(path)
+        with warnings.catch_warnings():  # _file_info stated the layout already
+            warnings.simplefilter("ignore", TextLayoutWarning)
+            opts = csv_chunk_options(path, enc)
         reader = pd.read_csv(
             path,
             chunksize=chunk_rows,
             skipinitialspace=True,
             low_memory=False,
-            encoding=csv_encoding(path),
+            encoding=enc,
             **CSV_FLOAT_OPTIONS,
+            **opts,
         )
         try:
             with reader:

@@ -77,5 +77,9 @@ class UnitWarning(ThermocalWarning):
     """A unit was not stated and a default was taken, or an option contradicts the file."""
 
 
+class TextLayoutWarning(ThermocalWarning):
+    """A text log's banner lines or mangled lines were skipped (they are named)."""
+
+
 class TextEncodingWarning(ThermocalWarning):
     """A text file is not UTF-8 and was read in another encoding."""

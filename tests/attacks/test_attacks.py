@@ -97,6 +97,7 @@ DATA_COMMANDS: dict[str, list[str]] = {
 """Commands that read a recording (the model, where needed, is the good one)."""
 
 E2 = frozenset({2})
+E0 = frozenset({0})
 E0_OR_2 = frozenset({0, 2})
 
 
@@ -117,7 +118,8 @@ def _broken_csv() -> list[tuple[str, bytes, frozenset[int], str]]:
         ("missing-temp-column", good.replace("T1", "Tx").encode(), E2, "T1"),
         ("missing-time-column", good.replace("time", "tyme").encode(), E2, "time"),
         ("only-whitespace", b"   \n\n  \n", E2, ""),
-        ("semicolons-unannounced", good.replace(",", ";").encode(), E2, ""),
+        # issue 16: other delimiters are read, and said (INTERFACE: detected or given)
+        ("semicolons-unannounced", good.replace(",", ";").encode(), E0, "';'-separated"),
     ]
 
 
