@@ -603,6 +603,8 @@ def _read_text(
     first_data = lay.skip + (1 if lay.header else 0)  # 0-based line of the first data row
     bad: list[tuple[int, str]] = []
     rows: list[list[float]] = []
+    ordinal: list[int] = []  # each kept row's place among the data lines (dropped ones too)
+    n_data = 0
     n = len(names)
     with open(path, encoding=encoding, errors="strict", newline="") as fh:
         for lineno, line in enumerate(fh, start=1):
@@ -612,12 +614,14 @@ def _read_text(
             if not text.strip() or text.lstrip().startswith("#"):
                 continue
             fields = _split(text, lay.delimiter)
+            n_data += 1
             try:
                 if len(fields) != n:
                     raise ValueError(f"{len(fields)} fields, {n} expected")
                 rows.append(
                     [float(f.replace(",", ".") if lay.decimal == "," else f) for f in fields]
                 )
+                ordinal.append(n_data - 1)
             except ValueError as exc:
                 if o.on_bad_lines == "error":
                     raise FileFormatError(
@@ -628,6 +632,8 @@ def _read_text(
     if not rows:
         raise FileFormatError(f"{path}: the file has a header but no data rows")
     df = pd.DataFrame(np.asarray(rows, dtype=np.float64), columns=names)
+    # --rate: time = data-line number / rate, so a dropped line leaves a gap, not a shift
+    df.attrs["row_index"] = np.asarray(ordinal, dtype=np.float64)
     report: dict[str, Any] = {
         "text_layout": {
             "banner_lines": len(lay.banner),
@@ -813,8 +819,9 @@ def _rate_time(
     time_unit: str | None,
     text: TextOptions,
 ) -> tuple[Any, list[str], str, str]:
-    """``--rate``: a file without a time column gets ``time = row / rate`` [s]; a file
-    that has one is refused (say which to believe)."""
+    """``--rate``: a file without a time column gets ``time = row / rate`` [s], the row
+    counted among the log's data lines (a mangled line dropped leaves a gap); a file that
+    has a time column is refused (say which to believe)."""
     assert text.rate_hz is not None
     named = time or info.get("time")
     if named and named in names:
@@ -824,13 +831,19 @@ def _rate_time(
         )
     col = named or "time"
     if col in names:
-        raise ThermocalInputError(f"{p}: --rate: the file already has a column {col!r}")
+        raise ThermocalInputError(
+            f"{p}: --rate {text.rate_hz:g} Hz given but the file has a time column {col!r}; "
+            "drop --rate"
+        )
     if isinstance(obj, _ParquetColumns):
         raise ThermocalInputError(f"{p}: --rate is for text logs; a Parquet file has its time")
     if time_unit not in (None, "s"):
         raise ThermocalInputError("--rate gives the time in seconds; drop --time-unit")
+    rows = obj.attrs.get("row_index")
+    if rows is None or len(rows) != len(obj):
+        rows = np.arange(len(obj), dtype=np.float64)
     obj = obj.copy()
-    obj.insert(0, col, np.arange(len(obj), dtype=np.float64) / float(text.rate_hz))
+    obj.insert(0, col, np.asarray(rows, dtype=np.float64) / float(text.rate_hz))
     return obj, [col, *names], col, "s"
 
 

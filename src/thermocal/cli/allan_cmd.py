@@ -13,8 +13,13 @@ from rich.table import Table
 from thermocal.allan import AllanResult, NoiseTerms, noise_terms, overlapping_adev
 from thermocal.cli.app import app
 from thermocal.cli.common import (
+    DecimalOpt,
+    DelimiterOpt,
     FileArg,
     JsonOpt,
+    NamesOpt,
+    OnBadLinesOpt,
+    RateOpt,
     SignalOpt,
     SignalUnitOpt,
     TempConversionOpt,
@@ -28,6 +33,7 @@ from thermocal.cli.common import (
     load_recording,
     split_names,
     stdout,
+    text_options,
 )
 from thermocal.errors import ConditioningWarning, ThermocalInputError
 from thermocal.io import check_not_input
@@ -135,6 +141,11 @@ def allan_cmd(
     temp_unit: TempUnitOpt = None,
     temp_conversion: TempConversionOpt = None,
     temps: Annotated[str | None, typer.Option("--temps", hidden=True)] = None,
+    t_names: NamesOpt = None,
+    t_rate: RateOpt = None,
+    t_bad: OnBadLinesOpt = "error",
+    t_delim: DelimiterOpt = None,
+    t_dec: DecimalOpt = None,
     as_json: JsonOpt = False,
 ) -> None:
     """Overlapping Allan deviation with chi-square confidence intervals and the noise
@@ -143,6 +154,7 @@ def allan_cmd(
     differenced across: each contiguous stretch is processed alone and pooled."""
     rec = load_recording(
         file,
+        text=text_options(t_names, t_rate, t_bad, t_delim, t_dec),
         time=time,
         time_unit=time_unit,
         signal=signal,

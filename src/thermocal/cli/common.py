@@ -31,7 +31,7 @@ from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
 
 from thermocal.cli.interrupt import report_interrupted
 from thermocal.errors import GapWarning, ThermocalInputError, ThermocalWarning
-from thermocal.io import read_recording
+from thermocal.io import TextOptions, read_recording
 from thermocal.recording import Metadata, Recording
 from thermocal.units import (
     StatedUnits,
@@ -63,6 +63,50 @@ ModelArg = Annotated[
     Path, typer.Argument(help="Model file (JSON) written by `thermocal fit`.", show_default=False)
 ]
 TimeOpt = Annotated[str | None, typer.Option("--time", help="Name of the time column.")]
+NamesOpt = Annotated[
+    str | None,
+    typer.Option("--names", help="Text logs without a header row: the column names, a,b,c."),
+]
+RateOpt = Annotated[
+    float | None,
+    typer.Option("--rate", help="Text logs without a time column: sample rate [Hz]."),
+]
+OnBadLinesOpt = Annotated[
+    str,
+    typer.Option(
+        "--on-bad-lines",
+        help="Mangled lines in a text log: error (name the first) or skip (drop, count).",
+    ),
+]
+DelimiterOpt = Annotated[
+    str | None,
+    typer.Option("--delimiter", help="Text logs: the field delimiter (default: detected)."),
+]
+DecimalOpt = Annotated[
+    str | None,
+    typer.Option("--decimal", help="Text logs: the decimal mark, . or , (default: detected)."),
+]
+
+
+def text_options(
+    names: str | None,
+    rate: float | None,
+    on_bad_lines: str,
+    delimiter: str | None,
+    decimal: str | None,
+) -> TextOptions | None:
+    """The text-log options of the command line (None when none is given)."""
+    if names is None and rate is None and on_bad_lines == "error" and not delimiter and not decimal:
+        return None
+    return TextOptions(
+        names=tuple(split_names(names) or []) if names is not None else None,
+        rate_hz=rate,
+        on_bad_lines=on_bad_lines,
+        delimiter=delimiter,
+        decimal=decimal,
+    )
+
+
 TimeUnitOpt = Annotated[str | None, typer.Option("--time-unit", help="Time unit: s, ms or us.")]
 SignalOpt = Annotated[
     str | None, typer.Option("--signal", help="Name of the sensor-output column.")
@@ -159,6 +203,7 @@ def load_recording(
     model_inputs: dict[str, Any] | None = None,
     model: TemperatureModel | None = None,
     keep_other: bool = True,
+    text: TextOptions | None = None,
 ) -> Recording:
     """Read a recording with the command line's options (options win over the file).
 
@@ -197,6 +242,7 @@ def load_recording(
         ),
         model=stated,
         keep_other=keep_other,
+        text=text,
     )
     if model is not None or model_inputs is not None:
         from thermocal.models.base import check_sensor_id

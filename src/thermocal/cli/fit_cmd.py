@@ -64,8 +64,13 @@ from thermocal import units
 from thermocal.cli.app import app
 from thermocal.cli.common import (
     AxisOpt,
+    DecimalOpt,
+    DelimiterOpt,
     JsonOpt,
     LatitudeOpt,
+    NamesOpt,
+    OnBadLinesOpt,
+    RateOpt,
     SignalOpt,
     SignalUnitOpt,
     TempConversionOpt,
@@ -83,6 +88,7 @@ from thermocal.cli.common import (
     split_floats,
     split_names,
     stdout,
+    text_options,
 )
 from thermocal.errors import ConditioningWarning, ThermocalInputError, ThermocalWarning
 from thermocal.io import check_not_input
@@ -230,6 +236,11 @@ def fit_cmd(
             "(in T − TREF, the PX4/ArduPilot convention).",
         ),
     ] = None,
+    t_names: NamesOpt = None,
+    t_rate: RateOpt = None,
+    t_bad: OnBadLinesOpt = "error",
+    t_delim: DelimiterOpt = None,
+    t_dec: DecimalOpt = None,
     as_json: JsonOpt = False,
 ) -> None:
     """Fit a temperature-compensation model on one or several runs and save it."""
@@ -284,6 +295,7 @@ def fit_cmd(
                 signal_unit=signal_unit,
                 temp_unit=temp_unit,
                 temp_conversion=temp_conversion,
+                text=text_options(t_names, t_rate, t_bad, t_delim, t_dec),
             ),
         )
         for path in files

@@ -11,8 +11,13 @@ from rich.table import Table
 
 from thermocal.cli.app import app
 from thermocal.cli.common import (
+    DecimalOpt,
+    DelimiterOpt,
     FileArg,
     JsonOpt,
+    NamesOpt,
+    OnBadLinesOpt,
+    RateOpt,
     SignalUnitOpt,
     TempConversionOpt,
     TempsOpt,
@@ -26,6 +31,7 @@ from thermocal.cli.common import (
     parse_temp_conversion,
     split_names,
     stdout,
+    text_options,
 )
 from thermocal.errors import ThermocalInputError
 from thermocal.inspection import Inspection, inspect_recording
@@ -57,6 +63,11 @@ def inspect_cmd(
             "not only on errors.",
         ),
     ] = False,
+    t_names: NamesOpt = None,
+    t_rate: RateOpt = None,
+    t_bad: OnBadLinesOpt = "error",
+    t_delim: DelimiterOpt = None,
+    t_dec: DecimalOpt = None,
     as_json: JsonOpt = False,
 ) -> None:
     """Sample rate, duration, gaps, column ranges, NaNs and problems of a recording.
@@ -71,6 +82,7 @@ def inspect_cmd(
     conv = parse_temp_conversion(temp_conversion) if temp_conversion is not None else None
     rec = read_recording(
         file,
+        text=text_options(t_names, t_rate, t_bad, t_delim, t_dec),
         time=time,
         time_unit=time_unit,
         signals=split_names(signal),

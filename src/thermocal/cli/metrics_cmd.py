@@ -12,9 +12,14 @@ from rich.table import Table
 from thermocal.cli.app import app
 from thermocal.cli.common import (
     AxisOpt,
+    DecimalOpt,
+    DelimiterOpt,
     FileArg,
     JsonOpt,
     LatitudeOpt,
+    NamesOpt,
+    OnBadLinesOpt,
+    RateOpt,
     SignalOpt,
     SignalUnitOpt,
     TempConversionOpt,
@@ -29,6 +34,7 @@ from thermocal.cli.common import (
     load_recording,
     split_names,
     stdout,
+    text_options,
 )
 from thermocal.errors import ThermocalInputError
 from thermocal.metrics import MetricsResult, compute_metrics
@@ -83,6 +89,11 @@ def metrics_cmd(
     signal_unit: SignalUnitOpt = None,
     temp_unit: TempUnitOpt = None,
     temp_conversion: TempConversionOpt = None,
+    t_names: NamesOpt = None,
+    t_rate: RateOpt = None,
+    t_bad: OnBadLinesOpt = "error",
+    t_delim: DelimiterOpt = None,
+    t_dec: DecimalOpt = None,
     as_json: JsonOpt = False,
 ) -> None:
     """Figures of merit: bias (earth rate removed with --latitude and --axis), bias
@@ -91,6 +102,7 @@ def metrics_cmd(
     temperature sensitivity."""
     rec = load_recording(
         file,
+        text=text_options(t_names, t_rate, t_bad, t_delim, t_dec),
         time=time,
         time_unit=time_unit,
         signal=signal,

@@ -18,11 +18,16 @@ from rich.table import Table
 
 from thermocal.cli.app import app
 from thermocal.cli.common import (
+    DecimalOpt,
+    DelimiterOpt,
     ExtrapolateOpt,
     FileArg,
     JsonOpt,
     ModelArg,
     ModelSignalOpt,
+    NamesOpt,
+    OnBadLinesOpt,
+    RateOpt,
     SignalUnitOpt,
     TempConversionOpt,
     TempUnitOpt,
@@ -34,6 +39,7 @@ from thermocal.cli.common import (
     load_recording,
     split_names,
     stdout,
+    text_options,
 )
 from thermocal.compensate import prepare_run
 from thermocal.errors import ThermocalInputError, UnitWarning
@@ -142,6 +148,11 @@ def validate_cmd(
         float, typer.Option("--settle", help="Seconds cut from the start of each stage.")
     ] = 0.0,
     extrapolate: ExtrapolateOpt = False,
+    t_names: NamesOpt = None,
+    t_rate: RateOpt = None,
+    t_bad: OnBadLinesOpt = "error",
+    t_delim: DelimiterOpt = None,
+    t_dec: DecimalOpt = None,
     as_json: JsonOpt = False,
 ) -> None:
     """Validate MODEL on FILE: correlation r, bias stability and repeatability over the
@@ -168,6 +179,7 @@ def validate_cmd(
                 temp_unit=temp_unit,
                 temp_conversion=temp_conversion,
                 model=model,
+                text=text_options(t_names, t_rate, t_bad, t_delim, t_dec),
             )
         # the data in the model's units (kinds checked); figures go back to the data's unit
         prepared = prepare_run(model, rec, sig, temps)
@@ -242,6 +254,7 @@ def validate_cmd(
             temp_unit=temp_unit,
             temp_conversion=temp_conversion,
             model_inputs=merged_inputs(cal, chosen),
+            text=text_options(t_names, t_rate, t_bad, t_delim, t_dec),
         )
         per = {n: run_one(cal.channel(n).model, cal.channel(n).signal, rec_all) for n in chosen}
         _emit_channels(file, per, as_json)
