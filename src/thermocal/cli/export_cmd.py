@@ -198,3 +198,78 @@ def export_c_cmd(
             )
 
     emit(out, as_json, human)
+
+
+@app.command("export-params")
+@handle_errors
+def export_params_cmd(
+    calibration: Annotated[
+        Path, typer.Argument(help="Calibration or model file (JSON).", show_default=False)
+    ],
+    fmt: Annotated[str, typer.Option("--format", help="Firmware: px4 or ardupilot.")],
+    output: Annotated[Path, typer.Option("-o", "--output", help="Parameter file to write.")],
+    gyro: Annotated[
+        str | None,
+        typer.Option("--gyro", help="Gyro channels x,y,z (default: the channels' roles)."),
+    ] = None,
+    accel: Annotated[
+        str | None,
+        typer.Option("--accel", help="Accelerometer channels x,y,z (default: the roles)."),
+    ] = None,
+    instance: Annotated[
+        int, typer.Option("--instance", help="Sensor instance, 0-based (PX4 TC_G0, INS_TCAL1).")
+    ] = 0,
+    tref: Annotated[
+        float | None,
+        typer.Option("--tref", help="PX4 reference temperature [°C] (default: mid-range)."),
+    ] = None,
+    device_id: Annotated[
+        int | None,
+        typer.Option("--device-id", help="PX4 device id (default: the recorded sensor id)."),
+    ] = None,
+    as_json: JsonOpt = False,
+) -> None:
+    """Write firmware thermal-calibration parameters: PX4 TC_* (QGroundControl file) or
+    ArduPilot INS_TCAL* (.parm), from a calibration of cubic polynomials in one
+    temperature (see ``thermocal.export_params``)."""
+    from thermocal.cli.common import split_names
+    from thermocal.export_params import export_params
+    from thermocal.io import atomic_write, check_not_input
+
+    check_not_input(output, [calibration])
+    cal = load_calibration(calibration)
+    ids = {"gyro": device_id, "accel": device_id} if device_id is not None else None
+    ps = export_params(
+        cal, fmt, gyro=split_names(gyro), accel=split_names(accel), instance=instance,
+        device_id=ids, tref_c=tref,
+    )  # fmt: skip
+    with atomic_write(output, "w") as fh:
+        fh.write(ps.text())
+    out = {
+        "output": str(output),
+        "format": fmt,
+        "params": ps.params,
+        "axes": [
+            {"channel": a.channel, "kind": a.kind, "axis": a.axis, "tref_c": a.tref_c,
+             "coefficients": list(a.coef), "tmin_c": a.tmin_c, "tmax_c": a.tmax_c,
+             "relative": a.relative}
+            for a in ps.axes
+        ],
+        "notes": ps.notes,
+    }  # fmt: skip
+
+    def human() -> None:
+        stdout.print(f"wrote {output}: {len(ps.params)} {fmt} parameters")
+        for a in ps.axes:
+            unit = "rad/s" if a.kind == "gyro" else "m/s^2"
+            stdout.print(
+                f"  {a.kind} {a.axis} <- {a.channel}: offset at TREF {fmt_c(a.coef[0])} {unit}"
+            )
+        for n in ps.notes:
+            stdout.print(n)
+
+    emit(out, as_json, human)
+
+
+def fmt_c(v: float) -> str:
+    return f"{v:.4g}"

@@ -513,7 +513,7 @@ def _prepare_channel(
         if not runs:  # the model learns how its inputs were written (model file "inputs")
             gravity_what = (
                 f"gravity {g_ki:+.6g} mg ({spec.gravity_axis} up, g = {spec.gravity_m_s2:.7g} "
-                "m/s²)" if g_ki else None
+                "m/s²)" if spec.gravity_axis and units.signal_kind(unit) == "accel" else None
             )  # fmt: skip
             first_inputs = model_inputs(
                 rec, sig_name, run_temp_names(rec, temps), known_input=ki,

@@ -1,0 +1,337 @@
+"""Firmware thermal-calibration parameters from a calibration (issue 16; INTERFACE.md
+"Firmware parameter formats").
+
+* **PX4** (``TemperatureCompensation``): per sensor instance ``n`` and axis ``i``,
+  ``offset_i = X0_i + X1_i·dT + X2_i·dT² + X3_i·dT³`` with
+  ``dT = clamp(T, TMIN, TMAX) − TREF``; the firmware subtracts the offset.  Gyros in
+  [rad/s], accelerometers in [m/s²].  Parameters ``TC_G<n>_*`` / ``TC_A<n>_*``: ``ID``
+  (device id), ``TMIN``, ``TMAX``, ``TREF``, ``X<p>_<i>``; written as a QGroundControl
+  parameter file (tab-separated ``vehicle component name value type``, type 9 = float,
+  6 = int32).
+* **ArduPilot** (``AP_InertialSensor_tempcal``): the firmware subtracts
+  ``poly(clamp(T) − 35) − poly(T_cal − 35)`` with ``poly(t) = (c1 + (c2 + c3·t)·t)·t·1e-6``
+  (no constant term: the correction is relative to the calibration temperature T_cal),
+  in [rad/s] and [m/s²].  Parameters ``INS_TCAL<n+1>_ENABLE``, ``_TMIN``, ``_TMAX``,
+  ``_ACC{1,2,3}_{X,Y,Z}``, ``_GYR{1,2,3}_{X,Y,Z}`` (``c_k``); written as ``NAME VALUE``
+  lines (a ``.parm`` file).
+
+A channel's polynomial is re-expanded about the format's reference temperature
+(:meth:`thermocal.models.poly.PolyModel.coefficients_about`, exact) and converted from
+the model's unit (°/h or mg) to the firmware's.  A calibration the format cannot express —
+another family, Ṫ or several temperature inputs, a power above 3, raw-count temperatures
+without a conversion — is refused with what to fit instead.
+
+Accelerometers: gravity is in their data.  A channel fitted with ``--gravity-axis`` has
+gravity as a known input, so its offset is the bias alone (absolute, PX4 ``X0``).
+Without it, the model's constant holds gravity: the PX4 offset is then taken relative to
+the model's value at the middle of its fitted range (PX4's own script fits accelerometers
+relative to the run's median), and a warning says so.
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from thermocal import units
+from thermocal.errors import ThermocalInputError, ThermocalWarning
+from thermocal.models.base import TemperatureModel
+from thermocal.models.calibration import Calibration
+
+FORMATS = ("px4", "ardupilot")
+ARDUPILOT_TREF_C = 35.0
+"""ArduPilot's fixed reference of the temperature polynomial [°C]
+(AP_InertialSensor_tempcal: ``TEMP_REFERENCE``)."""
+ARDUPILOT_SCALE = 1.0e-6
+"""ArduPilot stores ``c_k`` scaled: the firmware multiplies the polynomial by 1e-6."""
+ARDUPILOT_MIN_SPAN_C = 10.0
+"""ArduPilot's learning needs a sweep of at least 10 °C (tempcal_IMU.py's minimum)."""
+AXES = ("x", "y", "z")
+RAD_PER_S_PER_DEG_PER_H = math.pi / 180.0 / 3600.0
+M_S2_PER_MG = units.STANDARD_GRAVITY_M_S2 / 1000.0
+
+
+@dataclass(frozen=True)
+class AxisPoly:
+    """One axis: polynomial coefficients ``b_k`` of ``(T − tref)^k``, k = 0…3, in the
+    firmware's unit ([rad/s] or [m/s²]), the fitted range and the channel it came from."""
+
+    channel: str
+    kind: str  # "gyro" or "accel"
+    axis: str
+    tref_c: float
+    coef: tuple[float, float, float, float]
+    tmin_c: float
+    tmax_c: float
+    relative: bool = False
+
+    def offset(self, temp_c: Any) -> Any:
+        """The firmware's offset at ``temp_c`` (clamped to the range) [firmware unit]."""
+        t = np.clip(np.asarray(temp_c, dtype=np.float64), self.tmin_c, self.tmax_c) - self.tref_c
+        b0, b1, b2, b3 = self.coef
+        return b0 + t * (b1 + t * (b2 + t * b3))
+
+
+@dataclass
+class ParamSet:
+    """The parameters of one export: ``params`` name → value, ``types`` name → MAVLink
+    parameter type (9 float, 6 int32), what the firmware does at the range ends, and the
+    warnings raised."""
+
+    format: str
+    params: dict[str, float] = field(default_factory=dict)
+    types: dict[str, int] = field(default_factory=dict)
+    axes: list[AxisPoly] = field(default_factory=list)
+    notes: list[str] = field(default_factory=list)
+
+    def text(self) -> str:
+        """The file: QGroundControl parameters (PX4) or ``NAME VALUE`` lines (ArduPilot)."""
+        if self.format == "px4":
+            head = [
+                "# Onboard parameters for Vehicle 1",
+                "#",
+                "# thermocal export-params --format px4 (thermal compensation, TC_*)",
+                "#",
+                "# Vehicle-Id Component-Id Name Value Type",
+            ]
+            rows = [
+                f"1\t1\t{n}\t{_num(v, self.types.get(n, 9))}\t{self.types.get(n, 9)}"
+                for n, v in self.params.items()
+            ]
+            return "\n".join(head + rows) + "\n"
+        head = ["# thermocal export-params --format ardupilot (INS_TCAL*)"]
+        rows = [f"{n} {_num(v, self.types.get(n, 9))}" for n, v in self.params.items()]
+        return "\n".join(head + rows) + "\n"
+
+
+def _num(v: float, typ: int) -> str:
+    return str(int(v)) if typ == 6 else repr(float(v))
+
+
+def _model_unit_factor(kind: str, model_unit: str) -> float:
+    """Firmware unit per model unit: [rad/s per °/h] for gyros, [m/s² per mg] for accels."""
+    if kind == "gyro":
+        return float(units.convert(1.0, model_unit, "deg/h")) * RAD_PER_S_PER_DEG_PER_H
+    return float(units.convert(1.0, model_unit, "mg")) * M_S2_PER_MG
+
+
+def _check_expressible(name: str, model: TemperatureModel) -> None:
+    """Refuse a channel the firmware formats cannot express, saying what to fit instead."""
+    fix = "fit it with --model poly --order 3 on one temperature column"
+    if model.family != "poly":
+        raise ThermocalInputError(
+            f"channel {name!r}: a {model.family} model cannot be written as firmware "
+            f"parameters (a cubic in T − TREF); {fix}"
+        )
+    temps = list(model.temp_names_)
+    if len(temps) != 1:
+        raise ThermocalInputError(
+            f"channel {name!r}: the model uses {len(temps)} temperature inputs "
+            f"({', '.join(temps)}); the firmware takes one; {fix}"
+        )
+    if model.temperature_unit != "degC":
+        raise ThermocalInputError(
+            f"channel {name!r}: the model is in raw temperature counts; the firmware takes °C: "
+            "refit with --temp-conversion GAIN,OFFSET"
+        )
+    for c in model.coefficients_about(0.0):  # type: ignore[attr-defined]
+        if c.name == "const":
+            continue
+        if "rate" in c.name:
+            raise ThermocalInputError(
+                f"channel {name!r}: the model has a temperature-rate term ({c.name}); the "
+                f"firmware has none; {fix}"
+            )
+        power = int(c.name.split("^")[1]) if "^" in c.name else 1
+        if power > 3:
+            raise ThermocalInputError(
+                f"channel {name!r}: the model has a T^{power} term; the firmware takes a cubic; "
+                f"{fix}"
+            )
+
+
+def axis_poly(name: str, model: TemperatureModel, kind: str, axis: str, tref_c: float) -> AxisPoly:
+    """One channel as the firmware's cubic about ``tref_c`` in its unit (exact re-expansion)."""
+    _check_expressible(name, model)
+    coefs = {c.name: c.value for c in model.coefficients_about(tref_c)}  # type: ignore[attr-defined]
+    b = [coefs.get("const", 0.0)] + [
+        coefs.get("(T1-TREF)" if k == 1 else f"(T1-TREF)^{k}", 0.0) for k in (1, 2, 3)
+    ]
+    f = _model_unit_factor(kind, model.signal_unit)
+    lo, hi = (float(v) for v in model.temp_range_[0])
+    relative = False
+    if kind == "accel" and "gravity" not in str(
+        ((getattr(model, "inputs_", {}) or {}).get("known_input") or {}).get("what", "")
+    ):
+        # gravity is in the constant: offset relative to the model at mid-range
+        mid = 0.5 * (lo + hi) - tref_c
+        b[0] = -(b[1] * mid + b[2] * mid**2 + b[3] * mid**3)
+        relative = True
+    return AxisPoly(name, kind, axis, tref_c, (b[0] * f, b[1] * f, b[2] * f, b[3] * f),
+                    lo, hi, relative)  # fmt: skip
+
+
+def map_axes(
+    cal: Calibration, gyro: Sequence[str] | None, accel: Sequence[str] | None
+) -> dict[str, dict[str, str]]:
+    """``{"gyro": {"x": channel, …}, "accel": {…}}`` from ``--gyro``/``--accel`` (channels
+    in x, y, z order) or the channels' roles; each triad complete or absent."""
+    out: dict[str, dict[str, str]] = {}
+    for kind, given in (("gyro", gyro), ("accel", accel)):
+        if given:
+            if len(given) != 3:
+                raise ThermocalInputError(f"--{kind} takes three channels, x,y,z; got {given}")
+            missing = [c for c in given if c not in cal.names]
+            if missing:
+                raise ThermocalInputError(
+                    f"--{kind}: no channel {', '.join(map(repr, missing))} in the calibration "
+                    f"({', '.join(cal.names)})"
+                )
+            out[kind] = dict(zip(AXES, given, strict=True))
+            continue
+        found = {
+            str((ch.role or {}).get("axis")): ch.name
+            for ch in cal.channels
+            if (ch.role or {}).get("kind") == kind and (ch.role or {}).get("axis") in AXES
+        }
+        if found and set(found) != set(AXES):
+            raise ThermocalInputError(
+                f"the calibration has {kind} axes {sorted(found)} only; the firmware takes a "
+                f"triad: give --{kind} X,Y,Z"
+            )
+        if found:
+            out[kind] = {a: found[a] for a in AXES}
+    if not out:
+        raise ThermocalInputError(
+            "no gyro or accelerometer triad found in the calibration's roles; give "
+            "--gyro X,Y,Z and/or --accel X,Y,Z"
+        )
+    return out
+
+
+def export_params(
+    cal: Calibration,
+    fmt: str,
+    *,
+    gyro: Sequence[str] | None = None,
+    accel: Sequence[str] | None = None,
+    instance: int = 0,
+    device_id: Mapping[str, int] | None = None,
+    tref_c: float | None = None,
+) -> ParamSet:
+    """The parameters of ``fmt`` for the calibration's gyro and accelerometer triads
+    (module docstring).  ``tref_c`` (PX4): the reference temperature, default the middle
+    of the fitted range; ``device_id``: ``{"gyro": id, "accel": id}`` (default the
+    calibration's recorded sensor id when numeric, else 0 with a warning)."""
+    if fmt not in FORMATS:
+        raise ThermocalInputError(f"--format must be one of {', '.join(FORMATS)}, got {fmt!r}")
+    if instance < 0:
+        raise ThermocalInputError(f"--instance must be ≥ 0, got {instance}")
+    triads = map_axes(cal, gyro, accel)
+    out = ParamSet(fmt)
+    for kind, chans in triads.items():
+        models = {a: cal.channel(c).model for a, c in chans.items()}
+        lo = max(float(m.temp_range_[0, 0]) for m in models.values())
+        hi = min(float(m.temp_range_[0, 1]) for m in models.values())
+        if not hi > lo:
+            raise ThermocalInputError(f"the {kind} channels' fitted ranges do not overlap")
+        if fmt == "px4":
+            tref = 0.5 * (lo + hi) if tref_c is None else float(tref_c)
+        else:
+            tref = ARDUPILOT_TREF_C
+            if hi - lo < ARDUPILOT_MIN_SPAN_C:
+                warnings.warn(
+                    f"{kind}: the fitted range {lo:.1f}…{hi:.1f} °C spans less than "
+                    f"{ARDUPILOT_MIN_SPAN_C:g} °C; ArduPilot's calibration needs at least that",
+                    ThermocalWarning,
+                    stacklevel=2,
+                )
+        polys = [axis_poly(chans[a], models[a], kind, a, tref) for a in AXES]
+        out.axes += polys
+        if any(p.relative for p in polys):
+            warnings.warn(
+                f"{kind}: fitted without --gravity-axis, so gravity is in the model's constant: "
+                "the offsets are relative to the model's value at mid-range (as PX4's own "
+                "script does); refit with --gravity-axis for absolute offsets",
+                ThermocalWarning,
+                stacklevel=2,
+            )
+        out.notes.append(
+            f"{kind}: the firmware clamps the temperature to {lo:.2f}…{hi:.2f} °C (the fitted "
+            "range): below and above, the correction of the range end is applied"
+        )
+        if fmt == "px4":
+            _px4_params(out, kind, polys, instance, lo, hi, tref, _device_id(cal, kind, device_id))
+        else:
+            _ardupilot_params(out, kind, polys, instance, lo, hi)
+    return out
+
+
+def _device_id(cal: Calibration, kind: str, given: Mapping[str, int] | None) -> int:
+    if given and kind in given:
+        return int(given[kind])
+    for ch in cal.channels:
+        sid = (getattr(ch.model, "inputs_", {}) or {}).get("sensor_id")
+        if sid is not None and str(sid).isdigit():
+            return int(sid)
+    warnings.warn(
+        f"{kind}: no numeric device id recorded; TC_*_ID written as 0, which PX4 matches to no "
+        "sensor: give --device-id",
+        ThermocalWarning,
+        stacklevel=3,
+    )
+    return 0
+
+
+def _px4_params(
+    out: ParamSet,
+    kind: str,
+    polys: list[AxisPoly],
+    n: int,
+    lo: float,
+    hi: float,
+    tref: float,
+    device_id: int,
+) -> None:
+    p = f"TC_{'G' if kind == 'gyro' else 'A'}{n}_"
+    out.params[f"TC_{'G' if kind == 'gyro' else 'A'}_ENABLE"] = 1
+    out.types[f"TC_{'G' if kind == 'gyro' else 'A'}_ENABLE"] = 6
+    out.params[p + "ID"] = device_id
+    out.types[p + "ID"] = 6
+    out.params[p + "TMIN"] = lo
+    out.params[p + "TMAX"] = hi
+    out.params[p + "TREF"] = tref
+    for i, poly in enumerate(polys):
+        for k in range(4):
+            out.params[f"{p}X{k}_{i}"] = poly.coef[k]
+
+
+def _ardupilot_params(
+    out: ParamSet, kind: str, polys: list[AxisPoly], n: int, lo: float, hi: float
+) -> None:
+    p = f"INS_TCAL{n + 1}_"
+    out.params[p + "ENABLE"] = 1
+    out.types[p + "ENABLE"] = 6
+    # one range for the instance: where every channel was fitted
+    out.params[p + "TMIN"] = max(out.params.get(p + "TMIN", lo), lo)
+    out.params[p + "TMAX"] = min(out.params.get(p + "TMAX", hi), hi)
+    tag = "GYR" if kind == "gyro" else "ACC"
+    for poly in polys:
+        for k in (1, 2, 3):
+            out.params[f"{p}{tag}{k}_{poly.axis.upper()}"] = poly.coef[k] / ARDUPILOT_SCALE
+
+
+__all__ = [
+    "ARDUPILOT_TREF_C",
+    "FORMATS",
+    "AxisPoly",
+    "ParamSet",
+    "axis_poly",
+    "export_params",
+    "map_axes",
+]
