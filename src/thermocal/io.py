@@ -64,6 +64,7 @@ default parser can be one ulp off; pandas 3 is exact by default and deprecates t
 
 CSV_SUFFIXES = (".csv", ".txt", ".csv.gz", ".log", ".tsv", ".dat")
 PARQUET_SUFFIXES = (".parquet", ".pq")
+ULOG_SUFFIXES = (".ulg",)
 
 
 def file_kind(path: str | Path) -> str:
@@ -76,11 +77,13 @@ def file_kind(path: str | Path) -> str:
         )
     if name.endswith(PARQUET_SUFFIXES):
         return "parquet"
+    if name.endswith(ULOG_SUFFIXES):
+        return "ulog"
     if name.endswith(CSV_SUFFIXES):
         return "csv"
     raise FileFormatError(
         f"{path}: not a CSV or Parquet file (expected extension .csv, or .txt, .log, .tsv, "
-        ".dat for a text log, or .parquet)"
+        ".dat for a text log, .parquet, or .ulg for a PX4 log)"
     )
 
 
@@ -671,13 +674,79 @@ def _read_text(
     return df, report
 
 
+# --- PX4 ULog ------------------------------------------------------------------------------
+
+PX4_UNITS: dict[str, dict[str, str]] = {
+    "sensor_gyro": {"x": "rad/s", "y": "rad/s", "z": "rad/s", "temperature": "degC"},
+    "sensor_accel": {"x": "m/s^2", "y": "m/s^2", "z": "m/s^2", "temperature": "degC"},
+    "sensor_baro": {"temperature": "degC"},
+    "vehicle_imu_status": {},
+}
+"""Units of PX4's sensor topics (uORB msg definitions: SensorGyro.msg [rad/s], SensorAccel.msg
+[m/s²], temperature [°C]); the time is ``timestamp`` [µs]."""
+
+DEFAULT_ULOG_TOPIC = "sensor_gyro.0"
+
+
+def parse_topic(topic: str | None) -> tuple[str, int]:
+    """``NAME[.N]`` → (name, instance); default :data:`DEFAULT_ULOG_TOPIC`."""
+    text = (topic or DEFAULT_ULOG_TOPIC).strip()
+    name, _, inst = text.partition(".")
+    if not name or (inst and not inst.isdigit()):
+        raise ThermocalInputError(
+            f"--topic must be NAME or NAME.N (e.g. sensor_gyro.0), got {text!r}"
+        )
+    return name, int(inst or 0)
+
+
+def _read_ulog(path: Path, topic: str | None) -> tuple[pd.DataFrame, dict[str, Any]]:
+    """One topic instance of a PX4 ULog as a table: its fields as columns, ``timestamp``
+    [µs] the time, PX4's units for the known topics, the median ``device_id`` as the
+    sensor id.  Needs ``pyulog`` (``pip install 'thermocal[logs]'``)."""
+    try:
+        from pyulog import ULog
+    except ImportError:
+        raise ThermocalInputError(
+            f"{path}: reading PX4 ULog files needs pyulog: pip install 'thermocal[logs]' "
+            "(or pip install pyulog)"
+        ) from None
+    name, inst = parse_topic(topic)
+    try:
+        ulog = ULog(str(path), message_name_filter_list=[name])
+    except Exception as exc:  # pyulog raises several kinds on a bad file
+        raise FileFormatError(f"{path}: not a readable ULog file ({exc})") from None
+    found = [d for d in ulog.data_list if d.name == name and d.multi_id == inst]
+    if not found:
+        have = sorted(f"{d.name}.{d.multi_id}" for d in ULog(str(path)).data_list)
+        raise MissingColumnError(
+            f"{path}: no topic {name}.{inst} in the log; it has: {', '.join(have) or 'none'}"
+        )
+    data = found[0].data
+    cols = {k: np.asarray(v, dtype=np.float64) for k, v in data.items()}
+    df = pd.DataFrame(cols)
+    units_ = {k: u for k, u in PX4_UNITS.get(name, {}).items() if k in df.columns}
+    info: dict[str, Any] = {"time": "timestamp", "time_unit": "us", "units": units_}
+    if "device_id" in df.columns:
+        ids = df["device_id"].to_numpy()
+        info["metadata"] = {"sensor_id": str(int(np.median(ids)))}
+        if np.unique(ids).size > 1:
+            warnings.warn(
+                TextLayoutWarning(f"{path}: {name}.{inst} changes device_id during the log"),
+                stacklevel=3,
+            )
+    info["ulog_topic"] = f"{name}.{inst}"
+    return df, info
+
+
 def _read_table(
-    path: Path, kind: str, text: TextOptions | None = None
+    path: Path, kind: str, text: TextOptions | None = None, topic: str | None = None
 ) -> tuple[pd.DataFrame | _ParquetColumns, dict[str, Any]]:
     if not path.exists():
         raise FileFormatError(f"{path}: no such file")
     if path.stat().st_size == 0:
         raise FileFormatError(f"{path}: the file is empty")
+    if kind == "ulog":
+        return _read_ulog(path, topic)
     if kind == "parquet":
         try:
             table = _ParquetColumns(pq.ParquetFile(path, page_checksum_verification=True))
@@ -862,6 +931,7 @@ def read_recording(
     temp_conversion: units.TemperatureConversion | None = None,
     model: units.StatedUnits | None = None,
     text: TextOptions | None = None,
+    topic: str | None = None,
 ) -> Recording:
     """Read a CSV, text log or Parquet recording.
 
@@ -885,6 +955,7 @@ def read_recording(
     text : how to read a text log (:class:`TextOptions`: ``--names``, ``--rate``,
         ``--on-bad-lines``, ``--delimiter``, ``--decimal``); banners, other delimiters and
         decimal commas are detected without it.
+    topic : a PX4 ULog's topic instance, ``NAME[.N]`` (default ``sensor_gyro.0``).
 
     Units and temperature conversions are resolved once by
     :func:`thermocal.units.resolve_inputs` (option > file metadata > column name > model
@@ -900,7 +971,9 @@ def read_recording(
     """
     p = Path(path)
     kind = file_kind(p)
-    obj, file_meta = _read_table(p, kind, text)
+    if topic is not None and kind != "ulog":
+        raise ThermocalInputError(f"{p}: --topic is for flight-controller logs (.ulg)")
+    obj, file_meta = _read_table(p, kind, text, topic)
     side = _load_sidecar(p)
     info: dict[str, Any] = {**file_meta, **side}
 

@@ -24,6 +24,7 @@ COMMAND_MODULES = (
     "compensate_cmd",
     "validate_cmd",
     "export_cmd",
+    "tempcal_cmd",
     "turntable_cmd",
     "report_cmd",
     "demo_cmd",

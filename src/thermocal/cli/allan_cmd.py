@@ -26,6 +26,7 @@ from thermocal.cli.common import (
     TempUnitOpt,
     TimeOpt,
     TimeUnitOpt,
+    TopicOpt,
     emit,
     fmt,
     handle_errors,
@@ -142,6 +143,7 @@ def allan_cmd(
     temp_conversion: TempConversionOpt = None,
     temps: Annotated[str | None, typer.Option("--temps", hidden=True)] = None,
     t_names: NamesOpt = None,
+    topic: TopicOpt = None,
     t_rate: RateOpt = None,
     t_bad: OnBadLinesOpt = "error",
     t_delim: DelimiterOpt = None,
@@ -155,6 +157,7 @@ def allan_cmd(
     rec = load_recording(
         file,
         text=text_options(t_names, t_rate, t_bad, t_delim, t_dec),
+        topic=topic,
         time=time,
         time_unit=time_unit,
         signal=signal,

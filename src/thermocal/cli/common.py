@@ -63,6 +63,12 @@ ModelArg = Annotated[
     Path, typer.Argument(help="Model file (JSON) written by `thermocal fit`.", show_default=False)
 ]
 TimeOpt = Annotated[str | None, typer.Option("--time", help="Name of the time column.")]
+TopicOpt = Annotated[
+    str | None,
+    typer.Option(
+        "--topic", help="PX4 ULog (.ulg): the topic instance, NAME[.N] (default sensor_gyro.0)."
+    ),
+]
 NamesOpt = Annotated[
     str | None,
     typer.Option("--names", help="Text logs without a header row: the column names, a,b,c."),
@@ -204,6 +210,7 @@ def load_recording(
     model: TemperatureModel | None = None,
     keep_other: bool = True,
     text: TextOptions | None = None,
+    topic: str | None = None,
 ) -> Recording:
     """Read a recording with the command line's options (options win over the file).
 
@@ -243,6 +250,7 @@ def load_recording(
         model=stated,
         keep_other=keep_other,
         text=text,
+        topic=topic,
     )
     if model is not None or model_inputs is not None:
         from thermocal.models.base import check_sensor_id

@@ -78,6 +78,7 @@ from thermocal.cli.common import (
     TempUnitOpt,
     TimeOpt,
     TimeUnitOpt,
+    TopicOpt,
     earth_rate_known_input,
     emit,
     fmt,
@@ -237,6 +238,7 @@ def fit_cmd(
         ),
     ] = None,
     t_names: NamesOpt = None,
+    topic: TopicOpt = None,
     t_rate: RateOpt = None,
     t_bad: OnBadLinesOpt = "error",
     t_delim: DelimiterOpt = None,
@@ -296,6 +298,7 @@ def fit_cmd(
                 temp_unit=temp_unit,
                 temp_conversion=temp_conversion,
                 text=text_options(t_names, t_rate, t_bad, t_delim, t_dec),
+                topic=topic,
             ),
         )
         for path in files

@@ -24,6 +24,7 @@ from thermocal.cli.common import (
     TempUnitOpt,
     TimeOpt,
     TimeUnitOpt,
+    TopicOpt,
     emit,
     fmt,
     handle_errors,
@@ -64,6 +65,7 @@ def inspect_cmd(
         ),
     ] = False,
     t_names: NamesOpt = None,
+    topic: TopicOpt = None,
     t_rate: RateOpt = None,
     t_bad: OnBadLinesOpt = "error",
     t_delim: DelimiterOpt = None,
@@ -83,6 +85,7 @@ def inspect_cmd(
     rec = read_recording(
         file,
         text=text_options(t_names, t_rate, t_bad, t_delim, t_dec),
+        topic=topic,
         time=time,
         time_unit=time_unit,
         signals=split_names(signal),

@@ -27,6 +27,7 @@ from thermocal.cli.common import (
     TempUnitOpt,
     TimeOpt,
     TimeUnitOpt,
+    TopicOpt,
     emit,
     fmt,
     handle_errors,
@@ -90,6 +91,7 @@ def metrics_cmd(
     temp_unit: TempUnitOpt = None,
     temp_conversion: TempConversionOpt = None,
     t_names: NamesOpt = None,
+    topic: TopicOpt = None,
     t_rate: RateOpt = None,
     t_bad: OnBadLinesOpt = "error",
     t_delim: DelimiterOpt = None,
@@ -103,6 +105,7 @@ def metrics_cmd(
     rec = load_recording(
         file,
         text=text_options(t_names, t_rate, t_bad, t_delim, t_dec),
+        topic=topic,
         time=time,
         time_unit=time_unit,
         signal=signal,

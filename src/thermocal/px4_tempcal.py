@@ -1,0 +1,187 @@
+"""PX4's whole thermal calibration from one ULog (issue 16): ``thermocal px4-tempcal``.
+
+PX4's ``Tools/process_sensor_caldata.py`` fits, for every ``sensor_gyro`` and
+``sensor_accel`` instance, a cubic per axis in ``T − TREF`` (TREF mid-range; accelerometers
+relative to their median because gravity is in the data) and writes ``TC_*`` parameters.
+thermocal does the same with three differences (each stated in the summary):
+
+* **equal weight across the temperature range**: the samples are first reduced to the
+  median of each temperature bin (:data:`BIN_WIDTH_C`), so a slow end of the sweep does not
+  outweigh a fast middle — PX4 bins the temperature for the same reason;
+* **robust to spikes**: the bin statistic is the median, not the mean;
+* **judged on data it was not fitted to**: a cubic fitted on the even bins is evaluated on
+  the odd ones (hold-out rms per axis, in the report and the JSON), before the final fit on
+  every bin.
+
+The fitted cubics form a calibration (one channel per axis, roles gyro/accel x/y/z, in the
+log's units rad/s and m/s²); :func:`thermocal.export_params.export_params` writes the
+parameter file.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import warnings
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from thermocal.errors import ThermocalInputError, ThermocalWarning
+from thermocal.models.base import RunData, model_inputs
+from thermocal.models.calibration import Calibration, Channel
+from thermocal.models.poly import PolyModel
+from thermocal.recording import FloatArray, Recording
+
+BIN_WIDTH_C = 0.5
+"""Width of the temperature bins whose medians are fitted [°C]."""
+MIN_BINS = 8
+"""Fewest occupied bins a cubic is fitted to (and judged on)."""
+MIN_SWEEP_C = 10.0
+"""A sweep narrower than this gets a warning (ArduPilot's learning requires 10 °C)."""
+AXES = ("x", "y", "z")
+TOPICS = ("sensor_gyro", "sensor_accel")
+
+
+def temperature_bins(
+    temp_c: FloatArray, values: FloatArray, width_c: float = BIN_WIDTH_C
+) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """(bin centres, median temperature, median of each column of ``values``) of the
+    occupied temperature bins of ``width_c`` [°C]."""
+    lo = math.floor(float(np.min(temp_c)) / width_c) * width_c
+    idx = np.floor((temp_c - lo) / width_c).astype(np.int64)
+    order = np.argsort(idx, kind="stable")
+    idx_s = idx[order]
+    starts = np.flatnonzero(np.r_[True, np.diff(idx_s) != 0])
+    stops = np.r_[starts[1:], idx_s.size]
+    centres = lo + (idx_s[starts] + 0.5) * width_c
+    t_med = np.array([np.median(temp_c[order[a:b]]) for a, b in zip(starts, stops, strict=True)])
+    v_med = np.array(
+        [np.median(values[order[a:b]], axis=0) for a, b in zip(starts, stops, strict=True)]
+    )
+    f64 = np.float64
+    return centres.astype(f64), t_med.astype(f64), v_med.astype(f64)
+
+
+@dataclass
+class SensorFit:
+    """One sensor instance: its topic, device id, sweep, per-axis hold-out rms [its unit]."""
+
+    topic: str
+    kind: str
+    instance: int
+    device_id: int
+    unit: str
+    sweep_c: tuple[float, float]
+    n_samples: int
+    n_bins: int
+    holdout_rms: dict[str, float] = field(default_factory=dict)
+    channels: list[Channel] = field(default_factory=list)
+
+
+def _cubic(t: FloatArray, y: FloatArray, unit: str, name: str, rec: Recording) -> PolyModel:
+    """A cubic in T fitted to bin medians (the bins are the samples; their index the time)."""
+    run = RunData(
+        time_s=np.arange(t.size, dtype=np.float64),
+        temps_c=t.reshape(-1, 1),
+        signal=y,
+        temp_names=("temperature",),
+        name=name,
+        signal_unit=unit,
+    )
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # bin medians: few samples, correlated by design
+        return PolyModel(order=3, per_run_offset=False).fit([run])
+
+
+def fit_sensor(rec: Recording, topic: str, kind: str, instance: int) -> SensorFit:
+    """Bin, judge (even bins → odd bins) and fit one sensor instance's three axes."""
+    temp = rec.temperature_c("temperature")
+    lo, hi = float(np.min(temp)), float(np.max(temp))
+    if hi - lo < MIN_SWEEP_C:
+        warnings.warn(
+            f"{topic}: the temperature sweeps only {hi - lo:.1f} °C ({lo:.1f}…{hi:.1f}); a "
+            f"calibration needs ≥ {MIN_SWEEP_C:g} °C (ArduPilot refuses less)",
+            ThermocalWarning,
+            stacklevel=2,
+        )
+    vals = np.column_stack([rec.signal(a)[0] for a in AXES])  # canonical unit (°/h or mg)
+    unit = rec.signal(AXES[0])[1]
+    _c, t_med, v_med = temperature_bins(temp, vals)
+    if t_med.size < MIN_BINS:
+        raise ThermocalInputError(
+            f"{topic}: the temperature covers {t_med.size} bins of {BIN_WIDTH_C:g} °C; a cubic "
+            f"needs at least {MIN_BINS}: record a wider sweep"
+        )
+    sid = rec.meta.sensor_id
+    fit = SensorFit(
+        topic, kind, instance, int(sid) if sid and str(sid).isdigit() else 0, unit,
+        (lo, hi), int(temp.size), int(t_med.size),
+    )  # fmt: skip
+    even, odd = np.arange(0, t_med.size, 2), np.arange(1, t_med.size, 2)
+    short = "g" if kind == "gyro" else "a"
+    for j, axis in enumerate(AXES):
+        name = f"{short}{instance}_{axis}"
+        held = _cubic(t_med[even], v_med[even, j], unit, name, rec)
+        run_odd = RunData(
+            np.arange(odd.size, dtype=np.float64), t_med[odd].reshape(-1, 1), None,
+            ("temperature",),
+        )  # fmt: skip
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            pred = held.predict(run_odd)
+        fit.holdout_rms[axis] = float(np.sqrt(np.mean((v_med[odd, j] - pred) ** 2)))
+        model = _cubic(t_med, v_med[:, j], unit, name, rec)
+        model.signal_name, model.signal_unit = axis, unit
+        model.inputs_ = {
+            **model_inputs(rec, axis, ["temperature"]),
+            "sensor_id": str(fit.device_id),
+        }
+        role = {"kind": kind, "axis": axis, "instance": instance}
+        fit.channels.append(Channel(name, axis, rec.units.get(axis, unit), model, role))
+    return fit
+
+
+def log_topics(path: Path) -> list[tuple[str, int]]:
+    """The ``sensor_gyro``/``sensor_accel`` instances of a ULog that carry a temperature."""
+    try:
+        from pyulog import ULog
+    except ImportError:
+        raise ThermocalInputError(
+            f"{path}: reading PX4 ULog files needs pyulog: pip install 'thermocal[logs]'"
+        ) from None
+    ulog = ULog(str(path), message_name_filter_list=list(TOPICS))
+    out = []
+    for d in ulog.data_list:
+        t = d.data.get("temperature")
+        if t is not None and np.isfinite(t).any() and not np.all(t == 0):
+            out.append((d.name, int(d.multi_id)))
+    return sorted(out)
+
+
+def calibration_of(fits: list[SensorFit]) -> Calibration:
+    return Calibration([ch for f in fits for ch in f.channels])
+
+
+def summary(fits: list[SensorFit]) -> dict[str, Any]:
+    """The JSON summary: per sensor the sweep, bins and hold-out rms per axis."""
+    return {
+        f"{f.topic}.{f.instance}": {
+            **{k: v for k, v in dataclasses.asdict(f).items() if k != "channels"},
+            "holdout_rms_unit": f.unit,
+        }
+        for f in fits
+    }
+
+
+__all__ = [
+    "BIN_WIDTH_C",
+    "SensorFit",
+    "calibration_of",
+    "fit_sensor",
+    "log_topics",
+    "summary",
+    "temperature_bins",
+]

@@ -1,0 +1,114 @@
+"""PX4 logs in, PX4 parameters out (issue 16).
+
+A ULog with a −10…50 °C sweep (gyro and accelerometer, cubic biases, noise, spikes) is
+written by :mod:`ulog_writer`; ``thermocal px4-tempcal`` fits it; PX4's own correction —
+``offset = X0 + X1·dT + X2·dT² + X3·dT³``, ``dT = clamp(T, TMIN, TMAX) − TREF``, from
+TemperatureCompensation.cpp, written out here — applied to the truth removes ≥ 95 % of
+every axis's temperature-induced bias."""
+
+from __future__ import annotations
+
+import contextlib
+import io
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from thermocal.cli import main
+from ulog_writer import SENSOR_FIELDS, ulog_bytes
+
+G0 = 9.80665
+
+
+@pytest.fixture(scope="module")
+def sweep(tmp_path_factory: pytest.TempPathFactory) -> dict:
+    d = tmp_path_factory.mktemp("ulog")
+    rng = np.random.default_rng(4)
+    n = 20000
+    t = np.arange(n) * 0.03
+    T = -10.0 + 60.0 * (0.5 - 0.5 * np.cos(np.pi * t / t[-1]))
+    x = (T - 20.0) / 30.0
+    gyro = np.column_stack(
+        [0.002 + 0.004 * x - 0.001 * x**2 + 0.0005 * x**3, -0.001 + 0.002 * x, 0.003 * x**2]
+    )  # fmt: skip  [rad/s]
+    accel = np.column_stack(
+        [0.05 + 0.08 * x + 0.02 * x**3, -0.03 * x, -G0 + 0.1 * x - 0.03 * x**2]
+    )  # fmt: skip  [m/s²]
+    g = gyro + rng.normal(0.0, 0.001, (n, 3))
+    a = accel + rng.normal(0.0, 0.02, (n, 3))
+    g[rng.integers(0, n, 40)] += 0.5  # spikes
+    ts = (1e6 + t * 1e6).astype(np.int64)
+    rows_g = [
+        (int(s), 2293768, *map(float, v), float(tt)) for s, v, tt in zip(ts, g, T, strict=True)
+    ]
+    rows_a = [
+        (int(s), 2293776, *map(float, v), float(tt)) for s, v, tt in zip(ts, a, T, strict=True)
+    ]
+    log = d / "sweep.ulg"
+    log.write_bytes(ulog_bytes([("sensor_gyro", 0, SENSOR_FIELDS, rows_g),
+                                ("sensor_accel", 0, SENSOR_FIELDS, rows_a)]))  # fmt: skip
+    buf = io.StringIO()
+    with contextlib.redirect_stdout(buf):
+        code = main(["px4-tempcal", str(log), "-o", str(d / "out"), "--json"])
+    assert code == 0, buf.getvalue()
+    return {"dir": d / "out", "T": T.astype(np.float32).astype(np.float64), "gyro": gyro,
+            "accel": accel, "summary": json.loads(buf.getvalue())}  # fmt: skip
+
+
+def _params(path: Path) -> dict[str, float]:
+    out = {}
+    for line in path.read_text().splitlines():
+        if not line.startswith("#"):
+            _v, _c, name, value, _t = line.split("\t")
+            out[name] = float(value)
+    return out
+
+
+def _removed(correction: np.ndarray, truth: np.ndarray) -> float:
+    err = (correction - correction.mean()) - (truth - truth.mean())
+    return 100.0 * (1.0 - math.sqrt(float(np.mean(err**2))) / float(np.std(truth)))
+
+
+def test_px4_correction_removes_95_percent_of_every_axis(sweep: dict) -> None:
+    p = _params(sweep["dir"] / "px4.params")
+    assert p["TC_G0_ID"] == 2293768 and p["TC_A0_ID"] == 2293776
+    T = sweep["T"]
+    for kind, truth in (("G", sweep["gyro"]), ("A", sweep["accel"])):
+        dT = np.clip(T, p[f"TC_{kind}0_TMIN"], p[f"TC_{kind}0_TMAX"]) - p[f"TC_{kind}0_TREF"]
+        for i in range(3):
+            x = [p[f"TC_{kind}0_X{k}_{i}"] for k in range(4)]
+            offset = x[0] + x[1] * dT + x[2] * dT**2 + x[3] * dT**3
+            removed = _removed(offset, truth[:, i])
+            assert removed >= 95.0, (kind, i, removed)
+    # gyros: absolute offsets — at TREF the offset is the true bias there (spikes ignored)
+    for i in range(3):
+        tref = p["TC_G0_TREF"]
+        true = np.interp(tref, np.sort(T), sweep["gyro"][np.argsort(T), i])
+        assert p[f"TC_G0_X0_{i}"] == pytest.approx(true, abs=3e-4)
+
+
+def test_outputs_and_holdout_figures(sweep: dict) -> None:
+    d = sweep["dir"]
+    assert (d / "calibration.json").is_file()
+    assert (d / "report_sensor_gyro_0.html").is_file()
+    s = sweep["summary"]["sensors"]
+    gyro = s["sensor_gyro.0"]
+    assert gyro["device_id"] == 2293768 and gyro["n_samples"] == 20000
+    assert gyro["sweep_c"][0] == pytest.approx(-10.0, abs=0.01)
+    # the held-out bins are fitted to their noise: 0.001 rad/s per sample, ~80 samples a bin
+    # (medians: ×1.25) → about 0.001·1.25/√80 rad/s = 29 °/h; far above it would mean the
+    # spikes or the uneven sampling leaked into the fit
+    for axis in "xyz":
+        assert gyro["holdout_rms"][axis] < 2.0 * 0.001 * 1.25 / math.sqrt(80) * 180 / math.pi * 3600
+
+
+def test_a_log_without_sensors_is_refused(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    log = tmp_path / "empty.ulg"
+    log.write_bytes(ulog_bytes([("vehicle_status", 0, [("uint64_t", "timestamp")], [(1,), (2,)])]))
+    assert main(["px4-tempcal", str(log), "-o", str(tmp_path / "o")]) == 2
+    assert "no sensor_gyro or sensor_accel topic" in capsys.readouterr().err
