@@ -112,3 +112,31 @@ def test_a_log_without_sensors_is_refused(
     log.write_bytes(ulog_bytes([("vehicle_status", 0, [("uint64_t", "timestamp")], [(1,), (2,)])]))
     assert main(["px4-tempcal", str(log), "-o", str(tmp_path / "o")]) == 2
     assert "no sensor_gyro or sensor_accel topic" in capsys.readouterr().err
+
+
+SAMPLE = Path(__file__).parent / "data" / "pyulog_sample_log_small.ulg"
+"""A real PX4 log (pyulog's own sample; source and licence in tests/data/README.md)."""
+
+
+@pytest.mark.parametrize("topic", ["sensor_gyro.0", "sensor_gyro.2", "sensor_accel.1"])
+def test_a_real_px4_log_reads(topic: str, capsys: pytest.CaptureFixture[str]) -> None:
+    buf = io.StringIO()
+    with contextlib.redirect_stdout(buf):
+        code = main(["inspect", str(SAMPLE), "--topic", topic, "--signal", "x,y,z",
+                     "--temps", "temperature", "--json"])  # fmt: skip
+    assert code == 0, capsys.readouterr().err
+    d = json.loads(buf.getvalue())
+    cols = d["columns"]
+    unit = "rad/s" if topic.startswith("sensor_gyro") else "m/s^2"
+    assert cols["x"]["unit"] == unit and cols["temperature"]["unit"] == "degC"
+    if topic.startswith("sensor_accel"):  # sitting on the ground: |a| ≈ g
+        mag = math.sqrt(sum(cols[a]["mean"] ** 2 for a in "xyz"))
+        assert mag == pytest.approx(G0, rel=0.02)
+
+
+def test_a_flight_log_is_no_temperature_sweep(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    assert main(["px4-tempcal", str(SAMPLE), "-o", str(tmp_path / "o")]) == 2
+    err = capsys.readouterr().err
+    assert "the temperature sweeps only" in err and "record a wider sweep" in err

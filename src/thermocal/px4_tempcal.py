@@ -100,9 +100,10 @@ def fit_sensor(rec: Recording, topic: str, kind: str, instance: int) -> SensorFi
     """Bin, judge (even bins → odd bins) and fit one sensor instance's three axes."""
     temp = rec.temperature_c("temperature")
     lo, hi = float(np.min(temp)), float(np.max(temp))
+    where = f"{topic}.{instance}"
     if hi - lo < MIN_SWEEP_C:
         warnings.warn(
-            f"{topic}: the temperature sweeps only {hi - lo:.1f} °C ({lo:.1f}…{hi:.1f}); a "
+            f"{where}: the temperature sweeps only {hi - lo:.1f} °C ({lo:.1f}…{hi:.1f}); a "
             f"calibration needs ≥ {MIN_SWEEP_C:g} °C (ArduPilot refuses less)",
             ThermocalWarning,
             stacklevel=2,
@@ -112,7 +113,7 @@ def fit_sensor(rec: Recording, topic: str, kind: str, instance: int) -> SensorFi
     _c, t_med, v_med = temperature_bins(temp, vals)
     if t_med.size < MIN_BINS:
         raise ThermocalInputError(
-            f"{topic}: the temperature covers {t_med.size} bins of {BIN_WIDTH_C:g} °C; a cubic "
+            f"{where}: the temperature covers {t_med.size} bins of {BIN_WIDTH_C:g} °C; a cubic "
             f"needs at least {MIN_BINS}: record a wider sweep"
         )
     sid = rec.meta.sensor_id
