@@ -65,6 +65,7 @@ default parser can be one ulp off; pandas 3 is exact by default and deprecates t
 CSV_SUFFIXES = (".csv", ".txt", ".csv.gz", ".log", ".tsv", ".dat")
 PARQUET_SUFFIXES = (".parquet", ".pq")
 ULOG_SUFFIXES = (".ulg",)
+DATAFLASH_SUFFIXES = (".bin",)
 
 
 def file_kind(path: str | Path) -> str:
@@ -79,11 +80,13 @@ def file_kind(path: str | Path) -> str:
         return "parquet"
     if name.endswith(ULOG_SUFFIXES):
         return "ulog"
+    if name.endswith(DATAFLASH_SUFFIXES):
+        return "dataflash"
     if name.endswith(CSV_SUFFIXES):
         return "csv"
     raise FileFormatError(
         f"{path}: not a CSV or Parquet file (expected extension .csv, or .txt, .log, .tsv, "
-        ".dat for a text log, .parquet, or .ulg for a PX4 log)"
+        ".dat for a text log, .parquet, .ulg for a PX4 log or .bin for an ArduPilot log)"
     )
 
 
@@ -688,9 +691,9 @@ PX4_UNITS: dict[str, dict[str, str]] = {
 DEFAULT_ULOG_TOPIC = "sensor_gyro.0"
 
 
-def parse_topic(topic: str | None) -> tuple[str, int]:
+def parse_topic(topic: str | None, default: str = DEFAULT_ULOG_TOPIC) -> tuple[str, int]:
     """``NAME[.N]`` → (name, instance); default :data:`DEFAULT_ULOG_TOPIC`."""
-    text = (topic or DEFAULT_ULOG_TOPIC).strip()
+    text = (topic or default).strip()
     name, _, inst = text.partition(".")
     if not name or (inst and not inst.isdigit()):
         raise ThermocalInputError(
@@ -738,6 +741,68 @@ def _read_ulog(path: Path, topic: str | None) -> tuple[pd.DataFrame, dict[str, A
     return df, info
 
 
+# --- ArduPilot DataFlash --------------------------------------------------------------------
+
+ARDUPILOT_UNITS: dict[str, dict[str, str]] = {
+    "IMU": {
+        "GyrX": "rad/s", "GyrY": "rad/s", "GyrZ": "rad/s",
+        "AccX": "m/s^2", "AccY": "m/s^2", "AccZ": "m/s^2", "T": "degC",
+    },
+}  # fmt: skip
+"""Units of ArduPilot's IMU log message (LogStructure.h: gyro [rad/s], accel [m/s²],
+temperature [°C]); the time is ``TimeUS`` [µs]."""
+
+DEFAULT_DATAFLASH_TOPIC = "IMU.0"
+
+
+def _read_dataflash(path: Path, topic: str | None) -> tuple[pd.DataFrame, dict[str, Any]]:
+    """One message type and instance (field ``I``) of an ArduPilot DataFlash log as a
+    table: the message's fields as columns, ``TimeUS`` [µs] the time, ArduPilot's units for
+    known messages.  Needs ``pymavlink`` (``pip install 'thermocal[logs]'``)."""
+    try:
+        from pymavlink import DFReader
+    except ImportError:
+        raise ThermocalInputError(
+            f"{path}: reading ArduPilot DataFlash logs needs pymavlink: pip install "
+            "'thermocal[logs]' (or pip install pymavlink)"
+        ) from None
+    name, inst = parse_topic(topic, DEFAULT_DATAFLASH_TOPIC)
+    try:
+        log = DFReader.DFReader_binary(str(path), zero_time_base=False)
+    except Exception as exc:  # pymavlink raises several kinds on a bad file
+        raise FileFormatError(f"{path}: not a readable DataFlash log ({exc})") from None
+    rows: list[dict[str, Any]] = []
+    names_seen: set[str] = set()
+    try:
+        while True:
+            m = log.recv_msg()
+            if m is None:
+                break
+            mtype = m.get_type()
+            names_seen.add(mtype)
+            if mtype != name:
+                continue
+            d = m.to_dict()
+            if int(d.get("I", 0)) != inst:
+                continue
+            rows.append({k: v for k, v in d.items() if isinstance(v, int | float)})
+    finally:  # pymavlink keeps the file and its memory map open
+        for attr in ("data_map", "filehandle"):
+            h = getattr(log, attr, None)
+            if h is not None:
+                h.close()
+    if not rows:
+        raise MissingColumnError(
+            f"{path}: no {name} messages of instance {inst} in the log; it has: "
+            + ", ".join(sorted(names_seen - {"FMT", "FMTU", "UNIT", "MULT"}))
+        )
+    df = pd.DataFrame(rows).astype(np.float64)
+    units_ = {k: u for k, u in ARDUPILOT_UNITS.get(name, {}).items() if k in df.columns}
+    info: dict[str, Any] = {"time": "TimeUS", "time_unit": "us", "units": units_}
+    info["dataflash_message"] = f"{name}.{inst}"
+    return df, info
+
+
 def _read_table(
     path: Path, kind: str, text: TextOptions | None = None, topic: str | None = None
 ) -> tuple[pd.DataFrame | _ParquetColumns, dict[str, Any]]:
@@ -747,6 +812,8 @@ def _read_table(
         raise FileFormatError(f"{path}: the file is empty")
     if kind == "ulog":
         return _read_ulog(path, topic)
+    if kind == "dataflash":
+        return _read_dataflash(path, topic)
     if kind == "parquet":
         try:
             table = _ParquetColumns(pq.ParquetFile(path, page_checksum_verification=True))
@@ -971,8 +1038,8 @@ def read_recording(
     """
     p = Path(path)
     kind = file_kind(p)
-    if topic is not None and kind != "ulog":
-        raise ThermocalInputError(f"{p}: --topic is for flight-controller logs (.ulg)")
+    if topic is not None and kind not in ("ulog", "dataflash"):
+        raise ThermocalInputError(f"{p}: --topic is for flight-controller logs (.ulg, .bin)")
     obj, file_meta = _read_table(p, kind, text, topic)
     side = _load_sidecar(p)
     info: dict[str, Any] = {**file_meta, **side}

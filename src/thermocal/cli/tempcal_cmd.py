@@ -120,3 +120,96 @@ def px4_tempcal_cmd(
         stdout.print(f"parameters: [bold]{params_path}[/bold]", markup=True)
 
     emit(out, as_json, human)
+
+
+@app.command("ardupilot-tempcal")
+@handle_errors
+def ardupilot_tempcal_cmd(
+    log: Annotated[Path, typer.Argument(help="ArduPilot log (.bin).", show_default=False)],
+    output: Annotated[Path, typer.Option("-o", "--output", help="Directory to write.")],
+    as_json: JsonOpt = False,
+) -> None:
+    """ArduPilot's thermal calibration from one DataFlash log: every IMU instance's gyro
+    and accelerometer fitted as in px4-tempcal, written as INS_TCAL* (.parm), a calibration
+    and reports (the polynomial about 35 °C without constant, as the firmware takes it)."""
+
+    from thermocal.errors import MissingColumnError
+    from thermocal.export_params import ParamSet, export_params
+    from thermocal.io import atomic_write
+    from thermocal.models.calibration import Calibration
+    from thermocal.models.files import save_calibration
+    from thermocal.px4_tempcal import calibration_of, fit_sensor, summary
+    from thermocal.recording import Recording
+    from thermocal.report.calibration import CalibrationReportInputs, write_calibration_report
+
+    if output.exists() and not output.is_dir():
+        raise ThermocalInputError(f"{output}: exists and is not a directory")
+    fits, reports = [], []
+    params = ParamSet("ardupilot")
+    for inst in range(3):  # ArduPilot logs up to three IMUs
+        try:
+            rec = load_recording(log, topic=f"IMU.{inst}", signal="GyrX", temps="T")
+        except MissingColumnError:
+            if inst == 0:
+                raise
+            break
+        output.mkdir(parents=True, exist_ok=True)
+        per_kind = []
+        for kind, prefix, unit in (("gyro", "Gyr", "rad/s"), ("accel", "Acc", "m/s^2")):
+            sub_rec = Recording.from_arrays(
+                rec.time_s, {a: rec.column(f"{prefix}{a.upper()}") for a in "xyz"},
+                {"temperature": rec.column("T")}, signal_unit=unit,
+            )  # fmt: skip
+            sub_rec.source = str(log)
+            fit = fit_sensor(sub_rec, f"IMU.{prefix}", kind, inst)
+            fits.append(fit)
+            per_kind.append((fit, sub_rec))
+        sub = Calibration([ch for f, _r in per_kind for ch in f.channels])
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            ps = export_params(sub, "ardupilot", instance=inst)
+        params.params.update(ps.params)
+        params.types.update(ps.types)
+        params.axes += ps.axes
+        params.notes += [f"IMU.{inst}: {n}" for n in ps.notes]
+        for fit, sub_rec in per_kind:
+            rp = output / f"report_IMU_{inst}_{fit.kind}.html"
+            write_calibration_report(
+                rp,
+                CalibrationReportInputs(
+                    calibration=Calibration(fit.channels), recording=sub_rec,
+                    recording_path=str(log), title=f"ArduPilot thermal calibration — IMU {inst} "
+                    f"{fit.kind}", generated_by="thermocal ardupilot-tempcal",
+                ),
+            )  # fmt: skip
+            reports.append(rp)
+    cal_path = output / "calibration.json"
+    save_calibration(calibration_of(fits), cal_path)
+    parm = output / "ardupilot.parm"
+    with atomic_write(parm, "w") as fh:
+        fh.write(params.text())
+    out = {
+        "log": str(log),
+        "params": str(parm),
+        "calibration": str(cal_path),
+        "reports": [str(p) for p in reports],
+        "sensors": summary(fits),
+        "notes": params.notes,
+    }
+
+    def human() -> None:
+        table = Table(title=f"ArduPilot thermal calibration of {log}")
+        for col in ("IMU", "sensor", "sweep [°C]", "bins", "hold-out rms x/y/z"):
+            table.add_column(col)
+        for f in fits:
+            table.add_row(
+                str(f.instance), f.kind, f"{f.sweep_c[0]:.1f}…{f.sweep_c[1]:.1f}",
+                str(f.n_bins),
+                " / ".join(fmt(float(v), 3) for v in f.holdout_rms.values()) + f" {f.unit}",
+            )  # fmt: skip
+        stdout.print(table)
+        for n in params.notes:
+            stdout.print(n)
+        stdout.print(f"parameters: [bold]{parm}[/bold]", markup=True)
+
+    emit(out, as_json, human)
