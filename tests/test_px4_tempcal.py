@@ -140,3 +140,25 @@ def test_a_flight_log_is_no_temperature_sweep(
     assert main(["px4-tempcal", str(SAMPLE), "-o", str(tmp_path / "o")]) == 2
     err = capsys.readouterr().err
     assert "the temperature sweeps only" in err and "record a wider sweep" in err
+
+
+def test_a_sensor_that_moved_is_warned(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """Halfway through the sweep the board is tilted by 10°: gravity moves from z into x."""
+    n = 6000
+    t = np.arange(n) * 0.05
+    T = -10.0 + 60.0 * t / t[-1]
+    tilt = np.where(np.arange(n) < n // 2, 0.0, math.radians(10.0))
+    a = np.column_stack([G0 * np.sin(tilt), np.zeros(n), -G0 * np.cos(tilt)])
+    rows = [
+        (int(1e6 + ti * 1e6), 7, *map(float, v), float(tt))
+        for ti, v, tt in zip(t, a, T, strict=True)
+    ]
+    still = [
+        (int(1e6 + ti * 1e6), 7, 0.0, 0.0, -G0, float(tt)) for ti, tt in zip(t, T, strict=True)
+    ]
+    for name, data, moved in (("moved", rows, True), ("still", still, False)):
+        log = tmp_path / f"{name}.ulg"
+        log.write_bytes(ulog_bytes([("sensor_accel", 0, SENSOR_FIELDS, data)]))
+        assert main(["px4-tempcal", str(log), "-o", str(tmp_path / name)]) == 0
+        err = capsys.readouterr().err
+        assert ("the sensor moved during the log (the gravity direction changed by" in err) is moved

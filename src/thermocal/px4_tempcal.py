@@ -39,6 +39,12 @@ BIN_WIDTH_C = 0.5
 """Width of the temperature bins whose medians are fitted [°C]."""
 MIN_BINS = 8
 """Fewest occupied bins a cubic is fitted to (and judged on)."""
+MOVED_DEG = 2.0
+"""The gravity direction (accelerometers) or a mean rotation (gyros, in degrees per block)
+changing by more than this during the log means the sensor moved [°]."""
+MOVED_RATE_DEG_S = 0.5
+"""A gyro block mean above this rate means the sensor was turned [°/s]."""
+N_BLOCKS = 10
 MIN_SWEEP_C = 10.0
 """A sweep narrower than this gets a warning (ArduPilot's learning requires 10 °C)."""
 AXES = ("x", "y", "z")
@@ -96,6 +102,22 @@ def _cubic(t: FloatArray, y: FloatArray, unit: str, name: str, rec: Recording) -
         return PolyModel(order=3, per_run_offset=False).fit([run])
 
 
+def movement(kind: str, vals_canonical: FloatArray) -> float | None:
+    """How much the sensor moved: accelerometers — the largest angle between a block's mean
+    specific force and the whole log's [°]; gyros — the largest block-mean rate [°/s].
+    ``vals_canonical`` (n, 3) in mg or °/h."""
+    blocks = np.array_split(vals_canonical, N_BLOCKS)
+    means = np.array([b.mean(axis=0) for b in blocks if b.size])
+    if kind == "accel":
+        ref = vals_canonical.mean(axis=0)
+        nref = float(np.linalg.norm(ref))
+        if nref < 500.0:  # no gravity to measure the orientation by (< 0.5 g)
+            return None
+        cos = means @ ref / (np.linalg.norm(means, axis=1) * nref)
+        return float(np.degrees(np.arccos(np.clip(cos, -1.0, 1.0))).max())
+    return float(np.linalg.norm(means, axis=1).max() / 3600.0)
+
+
 def fit_sensor(rec: Recording, topic: str, kind: str, instance: int) -> SensorFit:
     """Bin, judge (even bins → odd bins) and fit one sensor instance's three axes."""
     temp = rec.temperature_c("temperature")
@@ -110,6 +132,19 @@ def fit_sensor(rec: Recording, topic: str, kind: str, instance: int) -> SensorFi
         )
     vals = np.column_stack([rec.signal(a)[0] for a in AXES])  # canonical unit (°/h or mg)
     unit = rec.signal(AXES[0])[1]
+    moved = movement(kind, vals)
+    if moved is not None and moved > (MOVED_DEG if kind == "accel" else MOVED_RATE_DEG_S):
+        what = (
+            f"the gravity direction changed by {moved:.1f}°"
+            if kind == "accel"
+            else f"it turned at up to {moved:.2f} °/s"
+        )
+        warnings.warn(
+            f"{where}: the sensor moved during the log ({what}): a thermal calibration needs "
+            "it still; the fit mixes the motion into the temperature effect",
+            ThermocalWarning,
+            stacklevel=2,
+        )
     _c, t_med, v_med = temperature_bins(temp, vals)
     if t_med.size < MIN_BINS:
         raise ThermocalInputError(

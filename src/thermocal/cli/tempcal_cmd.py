@@ -81,6 +81,7 @@ def px4_tempcal_cmd(
                     "temperature bins (equal weight across the range, robust to spikes); "
                     "'hold-out rms' is the rms of a cubic fitted to the even bins on the odd "
                     "ones, in the canonical unit (°/h or mg).",
+                    *(f"Firmware: {n}" for n in ps.notes),
                 ),
             ),
         )  # fmt: skip
@@ -180,6 +181,7 @@ def ardupilot_tempcal_cmd(
                     calibration=Calibration(fit.channels), recording=sub_rec,
                     recording_path=str(log), title=f"ArduPilot thermal calibration — IMU {inst} "
                     f"{fit.kind}", generated_by="thermocal ardupilot-tempcal",
+                    notes=tuple(f"Firmware: {n}" for n in ps.notes),
                 ),
             )  # fmt: skip
             reports.append(rp)

@@ -360,7 +360,8 @@ def bias_vs_temperature_grid(channels: Sequence[ChannelBias]) -> bytes:
                 ax.plot(c, m, "-", lw=1.5, color=col, label=lab)
             ax.set_title(f"{ch.name} [{ch.unit}]", fontsize=9)
             ax.set_xlabel(f"{ch.temperature_label} [°C]", fontsize=8)
-        axes[0].legend(fontsize=7, frameon=False)
+        if axes[0].get_legend_handles_labels()[0]:
+            axes[0].legend(fontsize=7, frameon=False)
         return _png(fig)
 
 
@@ -370,6 +371,11 @@ def allan_grid(curves: Sequence[tuple[str, str, Sequence[AllanCurve]]]) -> bytes
     colors = (BEFORE_COLOR, AFTER_COLOR)
     with _grid(len(curves)) as (fig, axes):
         for ax, (name, unit, cs) in zip(axes, curves, strict=True):
+            if not any(bool(np.any(np.isfinite(c.adev) & (c.adev > 0))) for c in cs):
+                ax.set_title(f"{name} [{unit}]", fontsize=9)
+                ax.text(0.5, 0.5, "no variation", ha="center", va="center",
+                        transform=ax.transAxes)  # fmt: skip
+                continue
             for i, c in enumerate(cs):
                 ok = np.isfinite(c.adev) & (c.adev > 0)
                 ax.plot(c.tau_s[ok], c.adev[ok], "o-", ms=2.5, lw=1.0,
@@ -382,5 +388,6 @@ def allan_grid(curves: Sequence[tuple[str, str, Sequence[AllanCurve]]]) -> bytes
             ax.set_yscale("log")
             ax.set_title(f"{name} [{unit}]", fontsize=9)
             ax.set_xlabel("τ [s]", fontsize=8)
-        axes[0].legend(fontsize=7, frameon=False)
+        if axes[0].get_legend_handles_labels()[0]:
+            axes[0].legend(fontsize=7, frameon=False)
         return _png(fig)
