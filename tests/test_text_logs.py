@@ -160,3 +160,28 @@ def test_names_and_rate_are_checked(tmp_path: Path, capsys: pytest.CaptureFixtur
     csv.write_text("time,g\n0,1\n1,2\n2,3\n")
     assert main(["inspect", str(csv), "--rate", "10"]) == 2
     assert "has a time column" in capsys.readouterr().err
+
+
+def test_fit_and_compensate_a_serial_log(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    import pandas as pd
+
+    path = tmp_path / "bmi.log"
+    data = _samples(7)
+    _write_log(path, data, mangle=True)
+    opts = [*TEXT, "--on-bad-lines", "skip"]
+    model = tmp_path / "m.json"
+    assert main(["fit", str(path), "--signal", "gx", "--temps", "T", "--model", "poly",
+                 "--order", "1", *opts, "-o", str(model)]) == 0  # fmt: skip
+    out = tmp_path / "comp.csv"
+    assert main(["compensate", str(model), str(path), *opts[:4], "--on-bad-lines", "skip",
+                 "-o", str(out)]) == 0  # fmt: skip
+    capsys.readouterr()
+    d = pd.read_csv(out)
+    assert len(d) == N - 3
+    keep = np.setdiff1d(np.arange(N), [500, 900, 1200])
+    np.testing.assert_allclose(d["time"], keep / RATE_HZ, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(d["gx_comp"], d["gx"] - d["gx_model"], rtol=0, atol=1e-9)
+    # the 0.8 (deg/h)/°C slope written into the data is what the model removed
+    assert float(np.std(d["gx_comp"])) == pytest.approx(5.0, rel=0.1)

@@ -75,6 +75,7 @@ from thermocal.io import (
     META_FORMAT,
     META_KEY,
     META_VERSION,
+    TextOptions,
     atomic_write_path,
     check_not_input,
     csv_chunk_options,
@@ -82,6 +83,7 @@ from thermocal.io import (
     default_time_column,
     file_kind,
     numeric_column,
+    read_text_table,
     sidecar_path,
     write_json,
 )
@@ -156,8 +158,16 @@ class _RunningMoments:
         return math.sqrt(self.m2 / self.n) if self.n else float("nan")
 
 
-def _file_info(path: Path, kind: str) -> tuple[list[str], dict[str, Any], int | None]:
-    """Column names, thermocal metadata (sidecar over Parquet key-value) and row count."""
+def _file_info(
+    path: Path,
+    kind: str,
+    table: pd.DataFrame | None = None,
+    table_info: dict[str, Any] | None = None,
+) -> tuple[list[str], dict[str, Any], int | None]:
+    """Column names, thermocal metadata (sidecar over Parquet key-value) and row count
+    (``table``: a text log already read whole, with its metadata)."""
+    if table is not None:
+        return [str(c) for c in table.columns], dict(table_info or {}), len(table)
     if not path.exists():
         raise FileFormatError(f"{path}: no such file")
     if path.stat().st_size == 0:
@@ -198,9 +208,16 @@ def _file_info(path: Path, kind: str) -> tuple[list[str], dict[str, Any], int | 
     return names, meta, n_rows
 
 
-def _iter_chunks(path: Path, kind: str, chunk_rows: int) -> Iterator[pd.DataFrame | pa.RecordBatch]:
+def _iter_chunks(
+    path: Path, kind: str, chunk_rows: int, table: pd.DataFrame | None = None
+) -> Iterator[pd.DataFrame | pa.RecordBatch]:
     """Chunks of the file; a read or parse failure mid-file is a :class:`FileFormatError`
-    naming the file (Parquet pages are checked against their checksums)."""
+    naming the file (Parquet pages are checked against their checksums).  ``table``: a
+    text log read whole (text options), sliced."""
+    if table is not None:
+        for a in range(0, len(table), chunk_rows):
+            yield table.iloc[a : a + chunk_rows].reset_index(drop=True)
+        return
     if kind == "parquet":
         try:
             # a buffered stream without pre-buffering: with the defaults the reader's
@@ -350,6 +367,7 @@ def compensate_file(
     known_input: float = 0.0,
     on_progress: Callable[[int], None] | None = None,
     temperature_conversion: units.TemperatureConversion | tuple[float, float] | None = None,
+    text: TextOptions | None = None,
 ) -> CompensateFileResult:
     """Compensate a CSV/Parquet file into ``out`` with constant memory.
 
@@ -393,6 +411,7 @@ def compensate_file(
         on_progress=on_progress,
         temperature_conversion=temperature_conversion,
         signal_given=signal is not None,
+        text=text,
     )[0]
 
 
@@ -431,6 +450,7 @@ def compensate_channels(
     on_progress: Callable[[int], None] | None = None,
     temperature_conversion: units.TemperatureConversion | tuple[float, float] | None = None,
     signal_given: bool = True,
+    text: TextOptions | None = None,
 ) -> list[CompensateFileResult]:
     """Compensate several channels ``(signal column, model)`` of one file in one chunked
     pass with constant memory (issue 15): every chunk is read once, its time checked
@@ -451,7 +471,8 @@ def compensate_channels(
     sig_list = [c for c, _m in channels]
     if len(set(sig_list)) != len(sig_list):
         raise ThermocalInputError(f"a signal column appears twice: {sig_list}")
-    names, info, _ = _file_info(src, kind_in)
+    text_table, text_info = read_text_table(src, text, time) if text is not None else (None, None)
+    names, info, _ = _file_info(src, kind_in, text_table, text_info)
     time_col = time or default_time_column(names, info.get("time"))
     available = ", ".join(repr(c) for c in names)
     if time_col not in names:
@@ -490,7 +511,7 @@ def compensate_channels(
         pool = ThreadPoolExecutor(max_workers=1, thread_name_prefix="thermocal-write")
         pending: Future[None] | None = None
         try:
-            for chunk in _iter_chunks(src, kind_in, chunk_rows):
+            for chunk in _iter_chunks(src, kind_in, chunk_rows, text_table):
                 row0 = int(state["rows"])
                 t = _chunk_time(chunk, time_col, t_factor, src, row0, state["last_t"])
                 table = _compensate_one_chunk(chunk, t, plans, groups, src, row0)

@@ -946,6 +946,28 @@ def default_time_column(names: Sequence[str], stated: str | None = None) -> str:
     return found[0] if len(found) == 1 else "time"
 
 
+def read_text_table(
+    path: str | Path, text: TextOptions, time: str | None = None
+) -> tuple[pd.DataFrame, dict[str, Any]]:
+    """A text log read whole with ``text`` (names, rate, bad lines, delimiter, decimal):
+    the table (a ``time`` column added for ``--rate``) and its sidecar metadata — for
+    commands that then go through it in chunks (compensate).  Text logs are small; the
+    memory check still applies."""
+    p = Path(path)
+    if file_kind(p) != "csv":
+        raise ThermocalInputError(
+            f"{p}: --names, --rate, --on-bad-lines, --delimiter and --decimal are for text logs"
+        )
+    obj, file_meta = _read_table(p, "csv", text)
+    info: dict[str, Any] = {**file_meta, **_load_sidecar(p)}
+    assert isinstance(obj, pd.DataFrame)
+    names = list(obj.columns)
+    if text.rate_hz is not None:
+        obj, names, t_col, t_unit = _rate_time(p, obj, names, info, time, None, text)
+        info["time"], info["time_unit"] = t_col, t_unit
+    return obj, info
+
+
 def _rate_time(
     p: Path,
     obj: Any,

@@ -14,12 +14,17 @@ from rich.table import Table
 
 from thermocal.cli.app import app
 from thermocal.cli.common import (
+    DecimalOpt,
+    DelimiterOpt,
     ExtrapolateOpt,
     FileArg,
     JsonOpt,
     ModelArg,
     ModelSignalOpt,
+    NamesOpt,
+    OnBadLinesOpt,
     OutOpt,
+    RateOpt,
     SignalUnitOpt,
     TempConversionOpt,
     TempUnitOpt,
@@ -32,6 +37,7 @@ from thermocal.cli.common import (
     progress,
     split_names,
     stdout,
+    text_options,
 )
 from thermocal.compensate import DEFAULT_CHUNK_ROWS, compensate_channels, compensate_file
 from thermocal.io import check_not_input, file_kind, sidecar_path
@@ -62,6 +68,11 @@ def compensate_cmd(
     chunk_rows: Annotated[
         int, typer.Option("--chunk-rows", help="Rows read and written at a time.")
     ] = DEFAULT_CHUNK_ROWS,
+    t_names: NamesOpt = None,
+    t_rate: RateOpt = None,
+    t_bad: OnBadLinesOpt = "error",
+    t_delim: DelimiterOpt = None,
+    t_dec: DecimalOpt = None,
     as_json: JsonOpt = False,
 ) -> None:
     """Apply MODEL to FILE; OUT gets every input column plus <signal>_model and <signal>_comp."""
@@ -87,6 +98,7 @@ def compensate_cmd(
                 extrapolate=extrapolate,
                 known_input=known_input,
                 on_progress=advance,
+                text=text_options(t_names, t_rate, t_bad, t_delim, t_dec),
             )
         summary = {"model": str(model_file), "family": model.family, **res.to_dict()}
 
@@ -118,6 +130,7 @@ def compensate_cmd(
             extrapolate=extrapolate,
             known_input=known_input,
             on_progress=advance,
+            text=text_options(t_names, t_rate, t_bad, t_delim, t_dec),
         )
     out = {
         "model": str(model_file),
