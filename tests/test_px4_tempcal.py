@@ -162,3 +162,22 @@ def test_a_sensor_that_moved_is_warned(tmp_path: Path, capsys: pytest.CaptureFix
         assert main(["px4-tempcal", str(log), "-o", str(tmp_path / name)]) == 0
         err = capsys.readouterr().err
         assert ("the sensor moved during the log (the gravity direction changed by" in err) is moved
+
+
+def test_compensate_a_px4_log(
+    sweep: dict, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    log = sweep["dir"].parent / "sweep.ulg"
+    model = tmp_path / "g.json"
+    sel = ["--topic", "sensor_gyro.0", "--signal", "x", "--temps", "temperature"]
+    assert main(["fit", str(log), *sel, "--model", "poly", "--order", "3", "-o", str(model)]) == 0
+    out = tmp_path / "g.parquet"
+    assert (
+        main(["compensate", str(model), str(log), "--topic", "sensor_gyro.0", "-o", str(out)]) == 0
+    )
+    capsys.readouterr()
+    import pandas as pd
+
+    d = pd.read_parquet(out)
+    assert len(d) == 20000 and {"x_model", "x_comp", "device_id"} <= set(d.columns)
+    np.testing.assert_allclose(d["x_comp"], d["x"] - d["x_model"], rtol=0, atol=1e-12)

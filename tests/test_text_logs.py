@@ -185,3 +185,20 @@ def test_fit_and_compensate_a_serial_log(
     np.testing.assert_allclose(d["gx_comp"], d["gx"] - d["gx_model"], rtol=0, atol=1e-9)
     # the 0.8 (deg/h)/°C slope written into the data is what the model removed
     assert float(np.std(d["gx_comp"])) == pytest.approx(5.0, rel=0.1)
+
+
+def test_report_and_compensate_read_logs_too(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The text options and --topic reach report and compensate (INTERFACE: all commands)."""
+    path = tmp_path / "bmi.log"
+    _write_log(path, _samples(9), mangle=False)
+    model = tmp_path / "m.json"
+    assert main(["fit", str(path), "--signal", "gx", "--temps", "T", "--model", "poly",
+                 "--order", "1", *TEXT, "-o", str(model)]) == 0  # fmt: skip
+    html = tmp_path / "r.html"
+    text = ["--names", "gx,gy,gz,T", "--rate", "100"]
+    assert main(["report", "--model", str(model), "--recording", str(path), *text,
+                 "--average", "1", "-o", str(html)]) == 0  # fmt: skip
+    assert html.stat().st_size > 10_000
+    capsys.readouterr()

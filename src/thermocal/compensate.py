@@ -83,6 +83,7 @@ from thermocal.io import (
     default_time_column,
     file_kind,
     numeric_column,
+    read_log_table,
     read_text_table,
     sidecar_path,
     write_json,
@@ -368,6 +369,7 @@ def compensate_file(
     on_progress: Callable[[int], None] | None = None,
     temperature_conversion: units.TemperatureConversion | tuple[float, float] | None = None,
     text: TextOptions | None = None,
+    topic: str | None = None,
 ) -> CompensateFileResult:
     """Compensate a CSV/Parquet file into ``out`` with constant memory.
 
@@ -412,6 +414,7 @@ def compensate_file(
         temperature_conversion=temperature_conversion,
         signal_given=signal is not None,
         text=text,
+        topic=topic,
     )[0]
 
 
@@ -451,6 +454,7 @@ def compensate_channels(
     temperature_conversion: units.TemperatureConversion | tuple[float, float] | None = None,
     signal_given: bool = True,
     text: TextOptions | None = None,
+    topic: str | None = None,
 ) -> list[CompensateFileResult]:
     """Compensate several channels ``(signal column, model)`` of one file in one chunked
     pass with constant memory (issue 15): every chunk is read once, its time checked
@@ -471,7 +475,12 @@ def compensate_channels(
     sig_list = [c for c, _m in channels]
     if len(set(sig_list)) != len(sig_list):
         raise ThermocalInputError(f"a signal column appears twice: {sig_list}")
-    text_table, text_info = read_text_table(src, text, time) if text is not None else (None, None)
+    text_table: pd.DataFrame | None = None
+    text_info: dict[str, Any] | None = None
+    if kind_in in ("ulog", "dataflash"):  # flight-controller logs: read whole, then chunked
+        text_table, text_info = read_log_table(src, topic)
+    elif text is not None:
+        text_table, text_info = read_text_table(src, text, time)
     names, info, _ = _file_info(src, kind_in, text_table, text_info)
     time_col = time or default_time_column(names, info.get("time"))
     available = ", ".join(repr(c) for c in names)

@@ -946,6 +946,18 @@ def default_time_column(names: Sequence[str], stated: str | None = None) -> str:
     return found[0] if len(found) == 1 else "time"
 
 
+def read_log_table(path: str | Path, topic: str | None) -> tuple[pd.DataFrame, dict[str, Any]]:
+    """One topic instance of a flight-controller log (.ulg, .bin) as a table and its
+    metadata (for commands that go through it in chunks: compensate)."""
+    p = Path(path)
+    kind = file_kind(p)
+    if kind not in ("ulog", "dataflash"):
+        raise ThermocalInputError(f"{p}: --topic is for flight-controller logs (.ulg, .bin)")
+    obj, info = _read_table(p, kind, None, topic)
+    assert isinstance(obj, pd.DataFrame)
+    return obj, info
+
+
 def read_text_table(
     path: str | Path, text: TextOptions, time: str | None = None
 ) -> tuple[pd.DataFrame, dict[str, Any]]:

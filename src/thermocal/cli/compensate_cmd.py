@@ -30,6 +30,7 @@ from thermocal.cli.common import (
     TempUnitOpt,
     TimeOpt,
     TimeUnitOpt,
+    TopicOpt,
     emit,
     fmt,
     handle_errors,
@@ -68,6 +69,7 @@ def compensate_cmd(
     chunk_rows: Annotated[
         int, typer.Option("--chunk-rows", help="Rows read and written at a time.")
     ] = DEFAULT_CHUNK_ROWS,
+    topic: TopicOpt = None,
     t_names: NamesOpt = None,
     t_rate: RateOpt = None,
     t_bad: OnBadLinesOpt = "error",
@@ -99,6 +101,7 @@ def compensate_cmd(
                 known_input=known_input,
                 on_progress=advance,
                 text=text_options(t_names, t_rate, t_bad, t_delim, t_dec),
+                topic=topic,
             )
         summary = {"model": str(model_file), "family": model.family, **res.to_dict()}
 
@@ -131,6 +134,7 @@ def compensate_cmd(
             known_input=known_input,
             on_progress=advance,
             text=text_options(t_names, t_rate, t_bad, t_delim, t_dec),
+            topic=topic,
         )
     out = {
         "model": str(model_file),

@@ -19,17 +19,24 @@ import typer
 
 from thermocal.cli.app import app
 from thermocal.cli.common import (
+    DecimalOpt,
+    DelimiterOpt,
     ModelSignalOpt,
+    NamesOpt,
+    OnBadLinesOpt,
+    RateOpt,
     SignalUnitOpt,
     TempConversionOpt,
     TempUnitOpt,
     TimeOpt,
     TimeUnitOpt,
+    TopicOpt,
     handle_errors,
     load_recording,
     progress,
     split_names,
     stderr,
+    text_options,
 )
 from thermocal.errors import FileFormatError, ThermocalInputError
 from thermocal.io import check_not_input
@@ -69,6 +76,8 @@ def _read_run(
     model_inputs: dict[str, Any] | None = None,
     temp_conversion: str | None = None,
     temps: list[str] | None = None,
+    text: Any = None,
+    topic: str | None = None,
 ) -> Recording:
     return load_recording(
         path,
@@ -80,6 +89,8 @@ def _read_run(
         temp_unit=temp_unit,
         model_inputs=model_inputs,
         temp_conversion=temp_conversion,
+        text=text,
+        topic=topic,
     )
 
 
@@ -129,6 +140,12 @@ def report_cmd(
             "validation result's, else 100 s).",
         ),
     ] = None,
+    topic: TopicOpt = None,
+    t_names: NamesOpt = None,
+    t_rate: RateOpt = None,
+    t_bad: OnBadLinesOpt = "error",
+    t_delim: DelimiterOpt = None,
+    t_dec: DecimalOpt = None,
 ) -> None:
     """Write a self-contained HTML report (figures embedded, no network needed).
 
@@ -190,7 +207,8 @@ def report_cmd(
             temp_unit=temp_unit, model_inputs=fitted, temp_conversion=temp_conversion,
             temps=temp_cols,
         )  # fmt: skip
-        val_rec = read(recording, sig)
+        text = text_options(t_names, t_rate, t_bad, t_delim, t_dec)
+        val_rec = read(recording, sig, text=text, topic=topic)
         mod_rec = read(modeling, sig) if modeling is not None else None
         advance(1)
         inputs = ReportInputs(
