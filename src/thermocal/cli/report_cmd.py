@@ -177,7 +177,8 @@ def report_cmd(
             validation=validations[0] if validations else None, modeling=modeling,
             signal=signal, title=title, sensor=sensor, time=time, time_unit=time_unit,
             signal_unit=signal_unit, temp_unit=temp_unit, temp_conversion=temp_conversion,
-            averaging=averaging,
+            averaging=averaging, text=text_options(t_names, t_rate, t_bad, t_delim, t_dec),
+            topic=topic,
         )  # fmt: skip
         return
 
@@ -246,6 +247,8 @@ def _calibration_report(
     temp_unit: str | None,
     temp_conversion: str | None,
     averaging: float | None,
+    text: Any = None,
+    topic: str | None = None,
 ) -> None:
     """A calibration's report: the recording read once for every chosen channel
     (:func:`thermocal.report.calibration.build_calibration_report`)."""
@@ -271,6 +274,8 @@ def _calibration_report(
             temp_unit=temp_unit,
             temp_conversion=temp_conversion,
             model_inputs=merged_inputs(cal, names),
+            text=text,
+            topic=topic,
         )
         advance(1)
         default_title = title == "Temperature compensation report"
