@@ -10,6 +10,7 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, cast
 
 import numpy as np
+from threadpoolctl import threadpool_limits
 
 from thermocal.errors import ConditioningWarning, ThermocalInputError
 from thermocal.models.base import (
@@ -81,16 +82,19 @@ def fit_shared(models: Sequence[PolyModel], runs_by_model: Sequence[Sequence[Run
     covariance and statistics (:func:`_finish_channel`).
     """
     head, rls = _shared_runs(models, runs_by_model)
-    design = _shared_design(head, rls[0])
-    dp = _DesignPass(design, rls)
-    reds = accumulate_targets(
-        dp.chunks, design.p, design.m, len(models), n_folds=design.n_folds,
-        solver=cast(Any, head.solver),
-    )  # fmt: skip
-    solved = [_solve_channel(mdl, red, design) for mdl, red in zip(models, reds, strict=True)]
-    residuals = dp.residuals(solved)
-    for j, mdl in enumerate(models):
-        _finish_channel(mdl, design, dp, j, solved[j], residuals[j], reds[j].solver, rls[j])
+    # BLAS on one thread: the blocks are small (≤ 32 768 × ~40), where threads oversubscribe
+    # and triple the wall time on a loaded machine (issue 17); the same numbers either way
+    with threadpool_limits(limits=1, user_api="blas"):
+        design = _shared_design(head, rls[0])
+        dp = _DesignPass(design, rls)
+        reds = accumulate_targets(
+            dp.chunks, design.p, design.m, len(models), n_folds=design.n_folds,
+            solver=cast(Any, head.solver),
+        )  # fmt: skip
+        solved = [_solve_channel(m, red, design) for m, red in zip(models, reds, strict=True)]
+        residuals = dp.residuals(solved)
+        for j, mdl in enumerate(models):
+            _finish_channel(mdl, design, dp, j, solved[j], residuals[j], reds[j].solver, rls[j])
 
 
 def _shared_runs(
