@@ -20,10 +20,9 @@ __version__ = "0.1.0"
 
 from typing import TYPE_CHECKING, Any
 
-from thermocal.recording import Metadata, Recording
-
 if TYPE_CHECKING:
     from thermocal.io import read_recording, write_recording
+    from thermocal.recording import Metadata, Recording
 
 
 def __getattr__(name: str) -> Any:
@@ -34,6 +33,10 @@ def __getattr__(name: str) -> Any:
         from thermocal import io
 
         return getattr(io, name)
+    if name in ("Metadata", "Recording"):  # numpy: imported on first use too
+        from thermocal import recording
+
+        return getattr(recording, name)
     raise AttributeError(f"module 'thermocal' has no attribute {name!r}")
 
 

@@ -1,17 +1,21 @@
 """thermocal's command line (INTERFACE.md).
 
 Each command lives in its own module under :mod:`thermocal.cli` and registers on
-:data:`thermocal.cli.app.app`; :func:`main` is the console entry point.
+:data:`thermocal.cli.application.app`; :func:`main` is the console entry point.  A run imports only
+the module of the command it runs (:data:`COMMANDS`), so ``thermocal --version`` and
+``import thermocal.cli`` load neither pandas, pyarrow, scipy nor matplotlib (issue 17);
+``--help`` and an unknown command load them all (the list needs every command's help).
 """
 
 from __future__ import annotations
 
 import importlib
 import sys
+from typing import Any
 
 import typer
 
-from thermocal.cli.app import app
+from thermocal.cli.application import app as _app
 from thermocal.cli.interrupt import report_interrupted
 
 COMMAND_MODULES = (
@@ -31,17 +35,57 @@ COMMAND_MODULES = (
 )
 """Command modules, registered in this order (a missing module is skipped)."""
 
+COMMANDS: dict[str, str] = {
+    "inspect": "inspect_cmd",
+    "metrics": "metrics_cmd",
+    "allan": "allan_cmd",
+    "profile": "profile_cmd",
+    "simulate": "simulate_cmd",
+    "fit": "fit_cmd",
+    "compensate": "compensate_cmd",
+    "validate": "validate_cmd",
+    "export-c": "export_cmd",
+    "export-params": "export_cmd",
+    "px4-tempcal": "tempcal_cmd",
+    "ardupilot-tempcal": "tempcal_cmd",
+    "turntable": "turntable_cmd",
+    "report": "report_cmd",
+    "demo": "demo_cmd",
+}
+"""The module of every command (a test checks it against what the modules register)."""
 
-def _register() -> None:
+_REGISTERED: set[str] = set()
+
+
+def _register(modules: tuple[str, ...] = COMMAND_MODULES) -> None:
+    """Import command modules (they register on the app), each once, in list order."""
     for mod in COMMAND_MODULES:
+        if mod not in modules or mod in _REGISTERED:
+            continue
         try:
             importlib.import_module(f"thermocal.cli.{mod}")
         except ModuleNotFoundError as exc:
             if exc.name != f"thermocal.cli.{mod}":
                 raise
+        _REGISTERED.add(mod)
 
 
-_register()
+def _modules_for(args: list[str]) -> tuple[str, ...]:
+    """The command modules a run needs: the named command's; none for ``--version``
+    alone; all for help, no command or an unknown one."""
+    first = next((a for a in args if not a.startswith("-")), None)
+    if first is None:
+        return () if "--version" in args and "--help" not in args else COMMAND_MODULES
+    mod = COMMANDS.get(first)
+    return (mod,) if mod is not None else COMMAND_MODULES
+
+
+def __getattr__(name: str) -> Any:
+    """``thermocal.cli.app``: the application with every command registered."""
+    if name == "app":
+        _register()
+        return _app
+    raise AttributeError(f"module 'thermocal.cli' has no attribute {name!r}")
 
 
 def _usage_error_types() -> tuple[type[Exception], ...]:
@@ -64,8 +108,10 @@ def main(argv: list[str] | None = None) -> int:
     Usage errors (unknown option, missing argument) print one ``error: ...`` line
     on stderr and return 2, as INTERFACE.md asks.
     """
+    args = list(sys.argv[1:] if argv is None else argv)
+    _register(_modules_for(args))
     try:
-        result = app(args=argv, prog_name="thermocal", standalone_mode=False)
+        result = _app(args=args, prog_name="thermocal", standalone_mode=False)
     except typer.Exit as exc:
         if isinstance(exc.__cause__, KeyboardInterrupt):  # typer >= 0.27 turns Ctrl-C into Exit
             return report_interrupted()

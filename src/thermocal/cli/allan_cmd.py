@@ -11,7 +11,7 @@ import typer
 from rich.table import Table
 
 from thermocal.allan import AllanResult, NoiseTerms, noise_terms, overlapping_adev
-from thermocal.cli.app import app
+from thermocal.cli.application import app
 from thermocal.cli.common import (
     DecimalOpt,
     DelimiterOpt,

@@ -12,7 +12,7 @@ from typing import Annotated
 import typer
 from rich.table import Table
 
-from thermocal.cli.app import app
+from thermocal.cli.application import app
 from thermocal.cli.common import (
     DecimalOpt,
     DelimiterOpt,

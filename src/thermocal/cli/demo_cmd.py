@@ -14,7 +14,7 @@ import typer
 from rich.markup import escape
 from rich.table import Table
 
-from thermocal.cli.app import app
+from thermocal.cli.application import app
 from thermocal.cli.common import JsonOpt, emit, fmt, handle_errors, progress, stdout
 from thermocal.demo import DEMO_STEPS, QUICK, run_demo
 

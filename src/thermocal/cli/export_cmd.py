@@ -17,7 +17,7 @@ from typing import Annotated
 import typer
 
 from thermocal import units
-from thermocal.cli.app import app
+from thermocal.cli.application import app
 from thermocal.cli.common import JsonOpt, ModelArg, emit, fmt, handle_errors, stdout
 from thermocal.errors import ThermocalWarning, UnitWarning
 from thermocal.export_c import (

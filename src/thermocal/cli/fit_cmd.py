@@ -61,7 +61,7 @@ import typer
 from rich.table import Table
 
 from thermocal import units
-from thermocal.cli.app import app
+from thermocal.cli.application import app
 from thermocal.cli.common import (
     AxisOpt,
     DecimalOpt,

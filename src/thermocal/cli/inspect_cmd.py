@@ -9,7 +9,7 @@ import typer
 from rich.markup import escape
 from rich.table import Table
 
-from thermocal.cli.app import app
+from thermocal.cli.application import app
 from thermocal.cli.common import (
     DecimalOpt,
     DelimiterOpt,

@@ -9,7 +9,7 @@ from typing import Annotated, Any
 import typer
 from rich.table import Table
 
-from thermocal.cli.app import app
+from thermocal.cli.application import app
 from thermocal.cli.common import (
     AxisOpt,
     DecimalOpt,

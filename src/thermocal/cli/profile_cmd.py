@@ -20,7 +20,7 @@ import numpy as np
 import pandas as pd
 import typer
 
-from thermocal.cli.app import app
+from thermocal.cli.application import app
 from thermocal.cli.common import JsonOpt, OutOpt, emit, handle_errors, split_floats, stdout
 from thermocal.errors import FileFormatError, MissingColumnError, ThermocalInputError
 from thermocal.io import check_not_input, file_kind, read_recording

@@ -17,7 +17,7 @@ from typing import Annotated, Any
 
 import typer
 
-from thermocal.cli.app import app
+from thermocal.cli.application import app
 from thermocal.cli.common import (
     DecimalOpt,
     DelimiterOpt,

@@ -24,7 +24,7 @@ from typing import Annotated, Any
 
 import typer
 
-from thermocal.cli.app import app
+from thermocal.cli.application import app
 from thermocal.cli.common import AxisOpt, JsonOpt, LatitudeOpt, emit, handle_errors, stdout
 from thermocal.errors import FileFormatError, ThermocalInputError
 from thermocal.io import check_not_input, file_kind, write_json, write_recording

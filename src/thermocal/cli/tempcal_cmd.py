@@ -15,7 +15,7 @@ from typing import Annotated
 import typer
 from rich.table import Table
 
-from thermocal.cli.app import app
+from thermocal.cli.application import app
 from thermocal.cli.common import JsonOpt, emit, fmt, handle_errors, load_recording, stdout
 from thermocal.errors import ThermocalInputError
 
