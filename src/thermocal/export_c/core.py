@@ -495,10 +495,11 @@ s->last_t = time_s;
 {{
     int slot;
     if (s->buf_n == {P}_RATE_BUF_LEN) {{ /* full: sampling faster than sized for */
-        s->buf_head = (s->buf_head + 1) % {P}_RATE_BUF_LEN;
+        if (++s->buf_head == {P}_RATE_BUF_LEN) s->buf_head = 0;
         s->buf_n -= 1;
     }}
-    slot = (s->buf_head + s->buf_n) % {P}_RATE_BUF_LEN;
+    slot = s->buf_head + s->buf_n; /* no % in the hot path: one wrap at most */
+    if (slot >= {P}_RATE_BUF_LEN) slot -= {P}_RATE_BUF_LEN;
     s->buf_t[slot] = time_s;
     for (i = 0; i < {P}_N_TEMPS; ++i) {{
         s->buf_T[slot][i] = temps_c[i];
@@ -506,14 +507,15 @@ s->last_t = time_s;
     s->buf_n += 1;
 }}
 while (s->buf_t[s->buf_head] < time_s - {P}_RATE_INTERVAL_S) {{
-    s->buf_head = (s->buf_head + 1) % {P}_RATE_BUF_LEN;
+    if (++s->buf_head == {P}_RATE_BUF_LEN) s->buf_head = 0;
     s->buf_n -= 1;
 }}
 {{
     double span = time_s - s->buf_t[s->buf_head];
+    const {r} inv_span = span > 0.0 ? ({r})({ctx.lit(60.0)} / span) : {ctx.lit(0.0)};
     for (i = 0; i < {P}_N_TEMPS; ++i) {{
         if (span > 0.0) {{
-            rate[i] = (temps_c[i] - s->buf_T[s->buf_head][i]) / ({r})span * {ctx.lit(60.0)};
+            rate[i] = (temps_c[i] - s->buf_T[s->buf_head][i]) * inv_span;
         }} else {{
             rate[i] = {ctx.lit(0.0)};
         }}

@@ -64,9 +64,10 @@ def generate(ctx: ExportContext) -> FamilyCode:
     for sensors, tag, c_key, s_key, var in used:
         if sensors:
             data += [
-                f"/* centre and scale of the base variable {var} of every sensor */",
+                f"/* centre and reciprocal scale (1/s, no division per sample) of the base "
+                f"variable {var} of every sensor */",
                 ctx.array(f"{P}_{tag}_CENTER", col(c_key)),
-                ctx.array(f"{P}_{tag}_SCALE", col(s_key)),
+                ctx.array(f"{P}_{tag}_INV_SCALE", 1.0 / np.asarray(col(s_key), dtype=np.float64)),
             ]
     if terms:
         data += [
@@ -138,11 +139,13 @@ def generate(ctx: ExportContext) -> FamilyCode:
         for j in rate_sensors:
             upd.append(f"rate[{j}] = {p}_clamp(rate[{j}], {P}_R_LO[{j}], {P}_R_HI[{j}]);")
     for j in t_sensors:
-        upd.append(f"const {r} u{j} = (T[{j}] - {P}_T_CENTER[{j}]) / {P}_T_SCALE[{j}];")
+        upd.append(f"const {r} u{j} = (T[{j}] - {P}_T_CENTER[{j}]) * {P}_T_INV_SCALE[{j}];")
     for j in v_sensors:
-        upd.append(f"const {r} v{j} = (rate[{j}] - {P}_R_CENTER[{j}]) / {P}_R_SCALE[{j}];")
+        upd.append(f"const {r} v{j} = (rate[{j}] - {P}_R_CENTER[{j}]) * {P}_R_INV_SCALE[{j}];")
     for j in w_sensors:
-        upd.append(f"const {r} w{j} = (T[{j}] * rate[{j}] - {P}_W_CENTER[{j}]) / {P}_W_SCALE[{j}];")
+        upd.append(
+            f"const {r} w{j} = (T[{j}] * rate[{j}] - {P}_W_CENTER[{j}]) * {P}_W_INV_SCALE[{j}];"
+        )
 
     def power(x: str, n: int) -> str:
         out = x
