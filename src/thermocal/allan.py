@@ -64,12 +64,17 @@ from typing import Any, Final, Literal
 
 import numpy as np
 import numpy.typing as npt
-from scipy import linalg, optimize, stats
 from threadpoolctl import threadpool_limits
 
 from thermocal import units
+from thermocal._lazy import LazyModule
 from thermocal.errors import MissingValueError, ThermocalInputError
 from thermocal.recording import contiguous_slices
+
+# scipy is imported when first needed (a command that reads the help does not pay for it)
+linalg = LazyModule("scipy.linalg")
+optimize = LazyModule("scipy.optimize")
+stats = LazyModule("scipy.stats")
 
 FloatArray = npt.NDArray[np.float64]
 IntArray = npt.NDArray[np.int64]

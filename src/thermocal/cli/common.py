@@ -31,7 +31,6 @@ from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
 
 from thermocal.cli.interrupt import report_interrupted
 from thermocal.errors import GapWarning, ThermocalInputError, ThermocalWarning
-from thermocal.io import TextOptions, read_recording
 from thermocal.recording import Metadata, Recording
 from thermocal.units import (
     StatedUnits,
@@ -43,6 +42,7 @@ from thermocal.units import (
 )
 
 if TYPE_CHECKING:
+    from thermocal.io import TextOptions
     from thermocal.models.base import TemperatureModel
 
 P = ParamSpec("P")
@@ -102,6 +102,8 @@ def text_options(
     decimal: str | None,
 ) -> TextOptions | None:
     """The text-log options of the command line (None when none is given)."""
+    from thermocal.io import TextOptions
+
     if names is None and rate is None and on_bad_lines == "error" and not delimiter and not decimal:
         return None
     return TextOptions(
@@ -235,6 +237,8 @@ def load_recording(
         stated = model.input_units()
     elif model_inputs is not None:
         stated = StatedUnits.from_model_inputs(model_inputs)
+    from thermocal.io import read_recording  # the file layer, when a command reads
+
     rec = read_recording(
         path,
         time=time,
