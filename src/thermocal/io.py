@@ -535,14 +535,24 @@ def _banner(lines: Sequence[str]) -> tuple[str, ...]:
     return tuple(x for x in lines if x.strip())
 
 
+def _head_lines(path: Path, encoding: str, errors: str) -> list[str]:
+    """The first :data:`SNIFF_LINES` lines of a text file, line ends removed."""
+    with open(path, encoding=encoding, errors=errors, newline="") as fh:
+        return [fh.readline().rstrip("\r\n") for _ in range(SNIFF_LINES)]
+
+
+def _delimiter_name(delimiter: str) -> str:
+    """How a warning names a delimiter: ``tab``, ``blank`` or the quoted character."""
+    return {"\t": "tab", " ": "blank"}.get(delimiter, repr(delimiter))
+
+
 def csv_chunk_options(path: Path, encoding: str) -> dict[str, Any]:
     """``pandas.read_csv`` options for reading a text file in chunks (compensate): the
     detected delimiter, decimal mark and banner lines to skip, stated in a warning when
     not a plain comma CSV; a file without a header row is refused (name the columns)."""
     if path.name.lower().endswith(".gz"):
         return {}
-    with open(path, encoding=encoding, errors="replace", newline="") as fh:
-        head = [fh.readline().rstrip("\r\n") for _ in range(SNIFF_LINES)]
+    head = _head_lines(path, encoding, "replace")
     try:
         lay = sniff_text(head)
     except FileFormatError:
@@ -555,10 +565,10 @@ def csv_chunk_options(path: Path, encoding: str) -> dict[str, Any]:
             "columns: add a header line, or read it with --names in another command and "
             "write it out"
         )
-    shown = {"\t": "tab", " ": "blank"}.get(lay.delimiter, repr(lay.delimiter))
     warnings.warn(
         TextLayoutWarning(
-            f"{path}: read as {shown}-separated text with decimal mark {lay.decimal!r}"
+            f"{path}: read as {_delimiter_name(lay.delimiter)}-separated text with decimal "
+            f"mark {lay.decimal!r}"
             + (f", {len(lay.banner)} banner line(s) skipped" if lay.banner else "")
         ),
         stacklevel=3,
@@ -578,9 +588,7 @@ def _read_text(
     lines (another number of fields, a non-number) refused naming the first or, with
     ``on_bad_lines="skip"``, dropped and counted.  Warnings say what was skipped."""
     o = opts or TextOptions()
-    with open(path, encoding=encoding, errors="strict", newline="") as fh:
-        head = [fh.readline().rstrip("\r\n") for _ in range(SNIFF_LINES)]
-    head = [x for x in head]
+    head = _head_lines(path, encoding, "strict")
     try:
         lay = sniff_text(head, o)
     except FileFormatError as exc:
@@ -650,11 +658,10 @@ def _read_text(
         }
     }
     if lay.delimiter != "," or lay.decimal != ".":
-        shown_delim = {"\t": "tab", " ": "blank"}.get(lay.delimiter, repr(lay.delimiter))
         warnings.warn(
             TextLayoutWarning(
-                f"{path}: read as {shown_delim}-separated text with decimal mark "
-                f"{lay.decimal!r} (give --delimiter/--decimal if that is wrong)"
+                f"{path}: read as {_delimiter_name(lay.delimiter)}-separated text with decimal "
+                f"mark {lay.decimal!r} (give --delimiter/--decimal if that is wrong)"
             ),
             stacklevel=3,
         )
@@ -832,8 +839,7 @@ def _read_table(
     rows_est, cols_est = _csv_rows_estimate(path)
     check_memory(path, rows_est, 2 * cols_est, estimated=True)
     if not path.name.lower().endswith(".gz"):
-        with open(path, encoding=encoding, errors="replace", newline="") as fh:
-            head = [fh.readline().rstrip("\r\n") for _ in range(SNIFF_LINES)]
+        head = _head_lines(path, encoding, "replace")
         try:
             lay = sniff_text(head, text)
         except FileFormatError:
