@@ -89,6 +89,14 @@ class ParamSet:
     axes: list[AxisPoly] = field(default_factory=list)
     notes: list[str] = field(default_factory=list)
 
+    def merge(self, other: ParamSet, label: str) -> None:
+        """Add another instance's parameters (one file for every sensor of a log); its notes
+        are prefixed with ``label``."""
+        self.params.update(other.params)
+        self.types.update(other.types)
+        self.axes += other.axes
+        self.notes += [f"{label}: {n}" for n in other.notes]
+
     def text(self) -> str:
         """The file: QGroundControl parameters (PX4) or ``NAME VALUE`` lines (ArduPilot)."""
         if self.format == "px4":

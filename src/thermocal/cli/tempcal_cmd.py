@@ -62,10 +62,7 @@ def px4_tempcal_cmd(
             ps = export_params(
                 sub, "px4", instance=inst, device_id={kind: fit.device_id}, tref_c=tref
             )
-        params.params.update(ps.params)
-        params.types.update(ps.types)
-        params.axes += ps.axes
-        params.notes += [f"{name}.{inst}: {n}" for n in ps.notes]
+        params.merge(ps, f"{name}.{inst}")
         rp = output / f"report_{name}_{inst}.html"
         write_calibration_report(
             rp,
@@ -169,10 +166,7 @@ def ardupilot_tempcal_cmd(
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             ps = export_params(sub, "ardupilot", instance=inst)
-        params.params.update(ps.params)
-        params.types.update(ps.types)
-        params.axes += ps.axes
-        params.notes += [f"IMU.{inst}: {n}" for n in ps.notes]
+        params.merge(ps, f"IMU.{inst}")
         for fit, sub_rec in per_kind:
             rp = output / f"report_IMU_{inst}_{fit.kind}.html"
             write_calibration_report(
