@@ -141,10 +141,10 @@ from thermocal.models.poly_eval import (
 from thermocal.models.poly_eval import (
     EvalPlan as EvalPlan,
 )
-from thermocal.models.poly_eval import _BlockEvaluator
 from thermocal.models.poly_eval import (
     build_plan as build_plan,
 )
+from thermocal.models.poly_eval import evaluate
 from thermocal.models.poly_eval import (
     evaluation_key as evaluation_key,
 )
@@ -350,41 +350,7 @@ class PolyModel(TemperatureModel):
         block by :func:`~thermocal.models.terms.backward_partners`; Horner's rule per
         sensor, :class:`EvalPlan`); the same numbers as :class:`PolyStream`.
         """
-        self.check_fitted()
-        self._check_temps(run)
-        plan = self._plan()
-        k = int(run.temps_c.shape[1])
-        rates: FloatArray | None = None
-        if plan.rate_sensors and self.rate_method != "backward":
-            rates = temperature_rates(
-                run.time_s, run.temps_c, float(self.rate_interval_s), self.rate_method
-            )
-        ev = _BlockEvaluator(self, plan, run, extrapolate=extrapolate, rates=rates)
-        out = np.empty(run.n_samples)
-        seen = ev.run_blocks(ev.blocks(), out)
-        t_min, t_max = seen.temperature(k)
-        warn_temperature_range(
-            t_min,
-            t_max,
-            self.temp_range_,
-            self.temp_names_,
-            seen.n_outside,
-            extrapolate=extrapolate,
-        )
-        if plan.rate_sensors and self.rate_range_ is not None:
-            r_min = np.full(k, np.inf)
-            r_max = np.full(k, -np.inf)
-            rows = list(plan.sensors)
-            r_min[rows], r_max[rows] = seen.rate(len(rows))
-            warn_rate_range(
-                r_min,
-                r_max,
-                self.rate_range_,
-                self.temp_names_,
-                list(plan.rate_sensors),
-                extrapolate=extrapolate,
-            )
-        return out
+        return evaluate([self], run, extrapolate=extrapolate)[0]
 
     def stream(self, sample_interval_s: float, *, extrapolate: bool = False) -> PolyStream:
         """Sample-by-sample twin of :meth:`predict` (needs the backward rate form)."""
@@ -407,11 +373,7 @@ class PolyModel(TemperatureModel):
         out: list[Coefficient] = []
         for key, v, s in zip(keys, raw, se, strict=True):
             _k, P, Q = key
-            unit = self.signal_unit
-            if P:
-                unit += "/degC" + (f"^{P}" if P > 1 else "")
-            if Q:
-                unit += "/(degC/min)" + (f"^{Q}" if Q > 1 else "")
+            unit = _monomial_unit(self.signal_unit, P, Q)
             out.append(
                 Coefficient(
                     name=monomial_name(key),
@@ -461,11 +423,7 @@ class PolyModel(TemperatureModel):
         out: list[Coefficient] = []
         for key, v, e in zip(out_keys, b, se, strict=True):
             k, P, Q = key
-            unit = self.signal_unit
-            if P:
-                unit += "/degC" + (f"^{P}" if P > 1 else "")
-            if Q:
-                unit += "/(degC/min)" + (f"^{Q}" if Q > 1 else "")
+            unit = _monomial_unit(self.signal_unit, P, Q)
             name = "const"
             if k >= 0:
                 parts = []
@@ -530,6 +488,16 @@ class PolyModel(TemperatureModel):
         if not self.model_uses_rate:
             d["rate"] = None
         return d
+
+
+def _monomial_unit(signal_unit: str, P: int, Q: int) -> str:
+    """Unit of the coefficient of ``T^P Ṫ^Q``: ``signal/degC^P/(degC/min)^Q``."""
+    unit = signal_unit
+    if P:
+        unit += "/degC" + (f"^{P}" if P > 1 else "")
+    if Q:
+        unit += "/(degC/min)" + (f"^{Q}" if Q > 1 else "")
+    return unit
 
 
 class PolyStream(ModelStream):

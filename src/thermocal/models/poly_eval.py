@@ -528,6 +528,17 @@ def predict_many(
     key = evaluation_key(head)
     if len(models) == 1 or any(evaluation_key(m) != key for m in models[1:]):
         return [m.predict(run, extrapolate=extrapolate) for m in models]
+    return evaluate(models, run, extrapolate=extrapolate)
+
+
+def evaluate(
+    models: Sequence[PolyModel], run: RunData, *, extrapolate: bool = False
+) -> list[FloatArray]:
+    """Steps 1–4 for models of one :func:`evaluation_key` (one model: :meth:`PolyModel.
+    predict`): the inputs, Ṫ and centred variables once, each model's polynomial, and the
+    range warnings once (the ranges are shared)."""
+    head = models[0]
+    head.check_fitted()
     head._check_temps(run)
     plan = head._plan()
     rates: FloatArray | None = None
