@@ -38,7 +38,7 @@ from thermocal.errors import (
     TimestampError,
     UnitError,
 )
-from thermocal.io import CSV_FLOAT_OPTIONS
+from thermocal.io import csv_float_options
 from thermocal.models.base import (
     MODEL_REGISTRY,
     Coefficient,
@@ -277,7 +277,7 @@ def test_compensate_file_chunked_equals_in_memory(
     assert res.n_chunks == math.ceil(run.n_samples / 333)
     assert not res.streamed
     df = (
-        pd.read_csv(out, **CSV_FLOAT_OPTIONS)
+        pd.read_csv(out, **csv_float_options())
         if out_ext == "csv"
         else pq.read_table(out).to_pandas()
     )

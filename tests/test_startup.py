@@ -1,6 +1,8 @@
 """Start-up (issue 17, first item): ``thermocal --version`` and ``import thermocal.cli`` load
-neither pandas, pyarrow, scipy nor matplotlib; a run imports only its command's module.
-Checked in fresh interpreters; the wall-time figures belong to the benchmarks."""
+neither pandas, pyarrow, scipy nor matplotlib; a run imports only its command's module;
+``--help`` (every command registered, every option's help resolved) loads not even numpy:
+each command imports what it uses when it runs.  Checked in fresh interpreters; the wall-time
+figures belong to the benchmarks."""
 
 from __future__ import annotations
 
@@ -50,3 +52,37 @@ def test_the_command_map_is_what_the_modules_register() -> None:
     names = {c.name: c.callback.__module__.rsplit(".", 1)[1] for c in app.registered_commands}
     names.update({g.name: "profile_cmd" for g in app.registered_groups})
     assert names == cli.COMMANDS
+
+
+HELP_FREE = (*HEAVY, "numpy", "rich.console", "jinja2")
+PROFILE_COMMANDS = ("rlg-modelling", "correlate", "design-validation")
+
+
+def test_help_resolves_every_command_without_the_maths() -> None:
+    """``thermocal --help`` and each command's ``--help`` run on typer alone: the maths,
+    numpy and rich's console are imported when a command runs, not when it is listed."""
+    commands = sorted({*__import__("thermocal.cli").cli.COMMANDS} - {"profile"})
+    code = (
+        "import sys, contextlib, io; from thermocal.cli import main\n"
+        "buf = io.StringIO()\n"
+        "with contextlib.redirect_stdout(buf):\n"
+        "    codes = [main(['--help'])]\n"
+        f"    codes += [main([c, '--help']) for c in {commands!r}]\n"
+        f"    codes += [main(['profile', c, '--help']) for c in {PROFILE_COMMANDS!r}]\n"
+        "assert 'compensate' in buf.getvalue() and '500000' in buf.getvalue(), buf.getvalue()\n"
+        f"print(sum(codes), *[m for m in {HELP_FREE!r} if m in sys.modules])"
+    )
+    assert _loaded(code) == ["0"]
+
+
+def test_the_help_names_are_the_libraries_names() -> None:
+    """The values the help shows (thermocal.defaults) are the ones the maths uses."""
+    from thermocal import compensate, defaults, profiles, validation
+    from thermocal.simulate import SCENARIOS
+    from thermocal.turntable.calibrate import DEFAULT_GYRO_COLUMNS
+
+    assert tuple(SCENARIOS) == defaults.SCENARIO_NAMES
+    assert compensate.DEFAULT_CHUNK_ROWS is defaults.DEFAULT_CHUNK_ROWS
+    assert validation.DEFAULT_AVERAGING_S is defaults.DEFAULT_AVERAGING_S
+    assert profiles.WEAK_CORRELATION_LIMIT is defaults.WEAK_CORRELATION_LIMIT
+    assert DEFAULT_GYRO_COLUMNS is defaults.DEFAULT_GYRO_COLUMNS

@@ -17,8 +17,7 @@ class LazyModule:
         self._module: ModuleType | None = None
 
     def __getattr__(self, attr: str) -> Any:
-        if attr.startswith("__"):
-            raise AttributeError(attr)
+        # every attribute, dunders too (``pd.__version__``): a probe costs only the import
         if self._module is None:
             self._module = importlib.import_module(self._name)
         return getattr(self._module, attr)

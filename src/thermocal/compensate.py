@@ -38,14 +38,12 @@ from collections.abc import Callable, Iterator, Sequence
 from concurrent.futures import Future, ThreadPoolExecutor
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, cast
+from typing import TYPE_CHECKING, Any, cast
 
 import numpy as np
-import pandas as pd
-import pyarrow as pa
-import pyarrow.parquet as pq
 
 from thermocal import units
+from thermocal._lazy import LazyModule
 from thermocal.compensation import (  # the maths, re-exported
     CalibrationStream,
     ChunkPredictor,
@@ -60,6 +58,7 @@ from thermocal.compensation import (  # the maths, re-exported
     temperature_inputs,
     unit_factor,
 )
+from thermocal.defaults import DEFAULT_CHUNK_ROWS as DEFAULT_CHUNK_ROWS
 from thermocal.errors import (
     FileFormatError,
     MissingColumnError,
@@ -71,7 +70,6 @@ from thermocal.errors import (
     UnitError,
 )
 from thermocal.io import (
-    CSV_FLOAT_OPTIONS,
     META_FORMAT,
     META_KEY,
     META_VERSION,
@@ -80,6 +78,7 @@ from thermocal.io import (
     check_not_input,
     csv_chunk_options,
     csv_encoding,
+    csv_float_options,
     default_time_column,
     file_kind,
     numeric_column,
@@ -98,9 +97,15 @@ from thermocal.recording import (
     median_interval,
 )
 
-DEFAULT_CHUNK_ROWS = 500_000
-"""Rows per chunk of :func:`compensate_file` (≈ 100 MB of working memory for a
-37-term polynomial)."""
+if TYPE_CHECKING:
+    import pandas as pd
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+else:
+    pd = LazyModule("pandas")
+    pa = LazyModule("pyarrow")
+    pq = LazyModule("pyarrow.parquet")
+
 
 MODEL_SUFFIX = "_model"
 COMP_SUFFIX = "_comp"
@@ -240,7 +245,7 @@ def _iter_chunks(
             skipinitialspace=True,
             low_memory=False,
             encoding=enc,
-            **CSV_FLOAT_OPTIONS,
+            **csv_float_options(),
             **opts,
         )
         try:

@@ -14,9 +14,16 @@ from __future__ import annotations
 
 from importlib import resources
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
-import pandas as pd
+
+from thermocal._lazy import LazyModule
+
+if TYPE_CHECKING:
+    import pandas as pd
+else:
+    pd = LazyModule("pandas")
 
 EXAMPLES = {"tvac": "tvac_bursts.csv"}
 TVAC_COUNTS_GAIN_C = 0.0625

@@ -22,6 +22,7 @@ import contextlib
 import dataclasses
 import errno
 import fcntl
+import functools
 import glob
 import hashlib
 import json
@@ -33,15 +34,12 @@ import warnings
 from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
-import pandas as pd
-import pyarrow as pa
-import pyarrow.csv as pacsv
-import pyarrow.parquet as pq
 
 from thermocal import units
+from thermocal._lazy import LazyModule
 from thermocal.errors import (
     FileFormatError,
     MissingColumnError,
@@ -52,15 +50,30 @@ from thermocal.errors import (
 )
 from thermocal.recording import FloatArray, Metadata, Recording
 
+if TYPE_CHECKING:
+    import pandas as pd
+    import pyarrow as pa
+    import pyarrow.csv as pacsv
+    import pyarrow.parquet as pq
+else:
+    pd = LazyModule("pandas")
+    pa = LazyModule("pyarrow")
+    pacsv = LazyModule("pyarrow.csv")
+    pq = LazyModule("pyarrow.parquet")
+
 META_KEY = "thermocal"
 META_FORMAT = "thermocal-recording"
 META_VERSION = 1
 
-CSV_FLOAT_OPTIONS: dict[str, Any] = (
-    {"float_precision": "round_trip"} if int(pd.__version__.split(".")[0]) < 3 else {}
-)
-"""``pandas.read_csv`` options that parse every decimal to the nearest float64 (pandas < 3's
-default parser can be one ulp off; pandas 3 is exact by default and deprecates the option)."""
+
+@functools.cache
+def csv_float_options() -> dict[str, Any]:
+    """``pandas.read_csv`` options that parse every decimal to the nearest float64 (pandas < 3's
+    default parser can be one ulp off; pandas 3 is exact by default and deprecates the option).
+    A function so that importing this module does not import pandas (issue 17)."""
+    major = int(pd.__version__.split(".")[0])
+    return {"float_precision": "round_trip"} if major < 3 else {}
+
 
 CSV_SUFFIXES = (".csv", ".txt", ".csv.gz", ".log", ".tsv", ".dat")
 PARQUET_SUFFIXES = (".parquet", ".pq")
@@ -855,7 +868,7 @@ def _read_table(
             skipinitialspace=True,
             comment=None,
             low_memory=False,
-            **CSV_FLOAT_OPTIONS,
+            **csv_float_options(),
             encoding=encoding,
         )
     except pd.errors.EmptyDataError:

@@ -22,15 +22,20 @@ import itertools
 import math
 import warnings
 from dataclasses import dataclass
-from typing import Literal
+from typing import TYPE_CHECKING, Literal
 
 import numpy as np
 import numpy.typing as npt
-from scipy import signal as sps
 
+from thermocal._lazy import LazyModule
 from thermocal.errors import GapWarning, ThermocalInputError
 from thermocal.recording import GAP_FACTOR, FloatArray, contiguous_slices
 from thermocal.units import SECONDS_PER_MINUTE
+
+if TYPE_CHECKING:
+    from scipy import signal as sps
+else:
+    sps = LazyModule("scipy.signal")
 
 RateMethod = Literal["forward", "backward", "centred"]
 RATE_METHODS: tuple[str, ...] = ("forward", "backward", "centred")

@@ -32,6 +32,9 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
+from thermocal.defaults import PROGRAM_SETPOINT as PROGRAM_SETPOINT
+from thermocal.defaults import PROGRAM_TIME as PROGRAM_TIME
+from thermocal.defaults import WEAK_CORRELATION_LIMIT as WEAK_CORRELATION_LIMIT
 from thermocal.errors import (
     DesignError,
     FileFormatError,
@@ -44,8 +47,6 @@ from thermocal.units import SECONDS_PER_MINUTE
 
 FloatArray = npt.NDArray[np.float64]
 
-WEAK_CORRELATION_LIMIT = 0.4
-"""Seed 000: a validation test is weakly correlated with the modelling test when r < 0.4."""
 
 DEFAULT_CORRELATION_POINTS = 10_000
 """Number of points of the common elapsed-time base used by :func:`correlate`."""
@@ -483,10 +484,6 @@ def check_program(time_s: npt.ArrayLike, setpoint_c: npt.ArrayLike, what: str = 
         )
 
 
-PROGRAM_TIME = "time_s"
-PROGRAM_SETPOINT = "setpoint_c"
-
-
 def write_program(path: str | Path, time_s: npt.ArrayLike, setpoint_c: npt.ArrayLike) -> Path:
     """Write a chamber program CSV with columns ``time_s, setpoint_c`` (atomic)."""
     import pandas as pd
@@ -513,13 +510,13 @@ def read_program(path: str | Path) -> tuple[FloatArray, FloatArray]:
     """
     import pandas as pd
 
-    from thermocal.io import CSV_FLOAT_OPTIONS  # the file edge, imported on use
+    from thermocal.io import csv_float_options  # the file edge, imported on use
 
     p = Path(path)
     if not p.exists():
         raise FileFormatError(f"{p}: no such file")
     try:
-        df = pd.read_csv(p, skipinitialspace=True, **CSV_FLOAT_OPTIONS)
+        df = pd.read_csv(p, skipinitialspace=True, **csv_float_options())
     except (pd.errors.EmptyDataError, pd.errors.ParserError, UnicodeDecodeError) as exc:
         raise FileFormatError(f"{p}: not a readable program CSV ({exc})") from None
     df.columns = [str(c).strip() for c in df.columns]

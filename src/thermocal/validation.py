@@ -49,6 +49,8 @@ import numpy.typing as npt
 
 from thermocal import metrics
 from thermocal.compensation import compensate_run
+from thermocal.defaults import DEFAULT_AVERAGING_S as DEFAULT_AVERAGING_S
+from thermocal.defaults import WEAK_CORRELATION_LIMIT
 from thermocal.errors import (
     CorrelationWarning,
     ThermocalInputError,
@@ -57,11 +59,8 @@ from thermocal.errors import (
 )
 from thermocal.models.base import RunData, TemperatureModel
 from thermocal.preprocess import segment_holds
-from thermocal.profiles import WEAK_CORRELATION_LIMIT, correlate
+from thermocal.profiles import correlate
 from thermocal.recording import FloatArray, median_interval
-
-DEFAULT_AVERAGING_S = 100.0
-"""Averaging time of the stability figures [s] (SPEC §1: 10 s or 100 s averages)."""
 
 
 @dataclass(frozen=True)

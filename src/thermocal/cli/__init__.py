@@ -3,8 +3,11 @@
 Each command lives in its own module under :mod:`thermocal.cli` and registers on
 :data:`thermocal.cli.application.app`; :func:`main` is the console entry point.  A run imports only
 the module of the command it runs (:data:`COMMANDS`), so ``thermocal --version`` and
-``import thermocal.cli`` load neither pandas, pyarrow, scipy nor matplotlib (issue 17);
-``--help`` and an unknown command load them all (the list needs every command's help).
+``import thermocal.cli`` load neither pandas, pyarrow, scipy nor matplotlib (issue 17).
+``--help`` and an unknown command register every command module; those import only typer,
+the option declarations (:mod:`thermocal.cli.common`) and :mod:`thermocal.defaults` at their
+top, and the maths through :class:`thermocal._lazy.LazyModule` when a command runs, so the
+list of commands loads not even numpy.
 """
 
 from __future__ import annotations

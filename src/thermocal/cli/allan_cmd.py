@@ -5,12 +5,11 @@ from __future__ import annotations
 
 import warnings
 from pathlib import Path
-from typing import Annotated, Any
+from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
-from rich.table import Table
 
-from thermocal.allan import AllanResult, NoiseTerms, noise_terms, overlapping_adev
+from thermocal._lazy import LazyModule
 from thermocal.cli.application import app
 from thermocal.cli.common import (
     DecimalOpt,
@@ -37,7 +36,16 @@ from thermocal.cli.common import (
     text_options,
 )
 from thermocal.errors import ConditioningWarning, ThermocalInputError
-from thermocal.io import check_not_input
+
+if TYPE_CHECKING:
+    import rich.table as _rich_table
+
+    import thermocal.allan as _allan
+    import thermocal.io as _io
+else:
+    _rich_table = LazyModule("rich.table")
+    _allan = LazyModule("thermocal.allan")
+    _io = LazyModule("thermocal.io")
 
 
 def _terms_json(terms: dict[str, Any]) -> dict[str, Any]:
@@ -56,7 +64,7 @@ def _terms_json(terms: dict[str, Any]) -> dict[str, Any]:
     }
 
 
-def allan_json(res: AllanResult, noise: NoiseTerms) -> dict[str, Any]:
+def allan_json(res: _allan.AllanResult, noise: _allan.NoiseTerms) -> dict[str, Any]:
     """The ``--json`` object of ``thermocal allan``: ``noise`` holds the fit-method
     terms, ``noise_slope`` the slope-line terms (each value or null with a reason)."""
     out: dict[str, Any] = {
@@ -85,7 +93,7 @@ def allan_json(res: AllanResult, noise: NoiseTerms) -> dict[str, Any]:
 
 def _emit_channels(
     file: Path,
-    analyses: dict[str, tuple[AllanResult, NoiseTerms]],
+    analyses: dict[str, tuple[_allan.AllanResult, _allan.NoiseTerms]],
     as_json: bool,
     plot: Path | None,
 ) -> None:
@@ -93,7 +101,7 @@ def _emit_channels(
     column per channel (the ADEV points are in the JSON and the plots)."""
 
     def human() -> None:
-        t = Table(title=f"{file} — noise terms (least-squares fit), per channel")
+        t = _rich_table.Table(title=f"{file} — noise terms (least-squares fit), per channel")
         t.add_column("term")
         for name in analyses:
             t.add_column(name, justify="right")
@@ -168,7 +176,7 @@ def allan_cmd(
         keep_other=False,  # the Allan deviation uses the time and the signal only
     )
     if plot is not None:
-        check_not_input(plot, [file])
+        _io.check_not_input(plot, [file])
         if plot.is_dir():
             raise ThermocalInputError(f"{plot}: is a directory, expected a file name")
         if plot.suffix.lower() not in (".png", ".svg", ".pdf"):
@@ -182,10 +190,10 @@ def allan_cmd(
                 f"--taus {taus!r}: use octave, decade, log or a comma-separated list of τ [s]"
             ) from None
     names = split_names(signal) or [rec.signals[0]]
-    analyses: dict[str, tuple[AllanResult, NoiseTerms]] = {}
+    analyses: dict[str, tuple[_allan.AllanResult, _allan.NoiseTerms]] = {}
     for name in names:  # one read of the file, every channel (INTERFACE: several channels)
         values, unit = rec.signal(name)
-        res_c = overlapping_adev(
+        res_c = _allan.overlapping_adev(
             values,
             rec.sample_interval_s,
             tau_spec,
@@ -193,7 +201,7 @@ def allan_cmd(
             unit=unit,
             confidence=confidence,
         )
-        noise_c = noise_terms(res_c)
+        noise_c = _allan.noise_terms(res_c)
         if noise_c.quality is not None and noise_c.quality.quality == "poor":
             where = f"{file}" + (f" [{name}]" if len(names) > 1 else "")
             warnings.warn(f"{where}: {noise_c.quality.reason}", ConditioningWarning, stacklevel=1)
@@ -209,7 +217,7 @@ def allan_cmd(
     res, noise = analyses[names[0]]
 
     def human() -> None:
-        t1 = Table(title=f"{file} — overlapping Allan deviation [{res.unit}]")
+        t1 = _rich_table.Table(title=f"{file} — overlapping Allan deviation [{res.unit}]")
         for col in ("τ [s]", "ADEV", "low", "high", "terms", "edf"):
             t1.add_column(col, justify="right")
         for i in range(res.tau_s.size):
@@ -222,7 +230,7 @@ def allan_cmd(
                 fmt(float(res.edf[i]), 3),
             )
         stdout.print(t1)
-        t2 = Table(title="noise terms")
+        t2 = _rich_table.Table(title="noise terms")
         for col in ("term", "fit", "slope lines", "unit", "note"):
             t2.add_column(col)
         fit, slope = noise.fit.terms(), noise.slope.terms()

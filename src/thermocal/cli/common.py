@@ -24,35 +24,55 @@ from contextlib import contextmanager
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated, Any, ParamSpec, TypeVar
 
-import numpy as np
 import typer
-from rich.console import Console
-from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
 
+from thermocal._lazy import LazyModule
 from thermocal.cli.interrupt import report_interrupted
 from thermocal.errors import GapWarning, ThermocalInputError, ThermocalWarning
-from thermocal.recording import Metadata, Recording
-from thermocal.units import (
-    StatedUnits,
-    TemperatureConversion,
-    canonical_unit,
-    earth_rate_on_axis_deg_h,
-    parse_axis,
-    temperature_conversion,
-)
 
 if TYPE_CHECKING:
+    import numpy as np
+    from rich.console import Console
+
+    from thermocal import units
     from thermocal.io import TextOptions
     from thermocal.models.base import TemperatureModel
+    from thermocal.recording import Metadata, Recording
+else:
+    # this module is imported to register commands (``--help``): nothing heavy at import
+    np = LazyModule("numpy")
+    units = LazyModule("thermocal.units")
 
 P = ParamSpec("P")
 R = TypeVar("R")
 
-stdout = Console(soft_wrap=True, markup=False)
+
+class _LazyConsole:
+    """A :class:`rich.console.Console` built on first use (``rich.console`` costs start-up)."""
+
+    def __init__(self, **options: Any) -> None:
+        self._options = options
+        self._console: Console | None = None
+
+    def real(self) -> Console:
+        """The console itself (built now if not yet)."""
+        if self._console is None:
+            from rich.console import Console
+
+            self._console = Console(**self._options)
+        return self._console
+
+    def __getattr__(self, attr: str) -> Any:
+        if attr.startswith("__"):
+            raise AttributeError(attr)
+        return getattr(self.real(), attr)
+
+
+stdout: Console = _LazyConsole(soft_wrap=True, markup=False)  # type: ignore[assignment]
 """Results on stdout.  No rich markup: units in brackets (``[deg/h]``) and column names such
 as ``gx [deg/s]`` must print as they are; prints that style use ``markup=True`` and
 escape what they interpolate."""
-stderr = Console(stderr=True, soft_wrap=True)
+stderr: Console = _LazyConsole(stderr=True, soft_wrap=True)  # type: ignore[assignment]
 
 # --- reusable option types ----------------------------------------------------------
 # Defaults are given where a command uses an alias (``time_unit: TimeUnitOpt = "s"``);
@@ -189,10 +209,10 @@ def split_floats(text: str | None, what: str) -> list[float] | None:
         ) from None
 
 
-def parse_temp_conversion(text: str) -> TemperatureConversion:
+def parse_temp_conversion(text: str) -> units.TemperatureConversion:
     """``"0.0625,-50"`` → gain [°C/count] 0.0625, offset [°C] −50; ``"0.0625,-50,int16"``
     for signed 16-bit counts stored unsigned (:class:`thermocal.units.TemperatureConversion`)."""
-    return temperature_conversion(text, "--temp-conversion")
+    return units.temperature_conversion(text, "--temp-conversion")
 
 
 def load_recording(
@@ -232,11 +252,11 @@ def load_recording(
     temperature conversions as fitted (:meth:`TemperatureModel.input_units`).  Every unit
     is resolved once, by :func:`thermocal.units.resolve_inputs`.
     """
-    stated: StatedUnits | None = None
+    stated: units.StatedUnits | None = None
     if model is not None:
         stated = model.input_units()
     elif model_inputs is not None:
-        stated = StatedUnits.from_model_inputs(model_inputs)
+        stated = units.StatedUnits.from_model_inputs(model_inputs)
     from thermocal.io import read_recording  # the file layer, when a command reads
 
     rec = read_recording(
@@ -296,12 +316,12 @@ def earth_rate_known_input(
         return 0.0
     if latitude is None or axis is None:
         raise ThermocalInputError("earth-rate removal needs both --latitude and --axis")
-    if canonical_unit(unit) != "deg/h":
+    if units.canonical_unit(unit) != "deg/h":
         raise ThermocalInputError(
             f"{where}: --latitude/--axis remove the earth rate from a gyro signal; "
             f"this signal is in {unit}"
         )
-    return earth_rate_on_axis_deg_h(latitude, parse_axis(axis))
+    return units.earth_rate_on_axis_deg_h(latitude, units.parse_axis(axis))
 
 
 def known_input_what(
@@ -451,12 +471,14 @@ def progress(description: str, total: float | None = None) -> Iterator[Callable[
     if not sys.stderr.isatty():
         yield lambda _amount: None
         return
+    from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
+
     with Progress(
         TextColumn("[bold]{task.description}"),
         BarColumn(),
         TextColumn("{task.percentage:>3.0f}%"),
         TimeElapsedColumn(),
-        console=stderr,
+        console=stderr.real() if isinstance(stderr, _LazyConsole) else stderr,
         transient=True,
     ) as bar:
         task = bar.add_task(description, total=total)

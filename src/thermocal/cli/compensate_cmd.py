@@ -7,11 +7,12 @@ OUT keeps every input column and adds ``<signal>_model`` and ``<signal>_comp``
 
 from __future__ import annotations
 
-from typing import Annotated
+from typing import TYPE_CHECKING, Annotated
 
 import typer
-from rich.table import Table
 
+from thermocal import defaults
+from thermocal._lazy import LazyModule
 from thermocal.cli.application import app
 from thermocal.cli.common import (
     DecimalOpt,
@@ -40,9 +41,18 @@ from thermocal.cli.common import (
     stdout,
     text_options,
 )
-from thermocal.compensate import DEFAULT_CHUNK_ROWS, compensate_channels, compensate_file
-from thermocal.io import check_not_input, file_kind, sidecar_path
-from thermocal.models.files import load_calibration
+
+if TYPE_CHECKING:
+    import rich.table as _rich_table
+
+    import thermocal.compensate as _compensate
+    import thermocal.io as _io
+    import thermocal.models.files as _files
+else:
+    _rich_table = LazyModule("rich.table")
+    _compensate = LazyModule("thermocal.compensate")
+    _io = LazyModule("thermocal.io")
+    _files = LazyModule("thermocal.models.files")
 
 
 @app.command("compensate")
@@ -68,7 +78,7 @@ def compensate_cmd(
     ] = 0.0,
     chunk_rows: Annotated[
         int, typer.Option("--chunk-rows", help="Rows read and written at a time.")
-    ] = DEFAULT_CHUNK_ROWS,
+    ] = defaults.DEFAULT_CHUNK_ROWS,
     topic: TopicOpt = None,
     t_names: NamesOpt = None,
     t_rate: RateOpt = None,
@@ -78,15 +88,15 @@ def compensate_cmd(
     as_json: JsonOpt = False,
 ) -> None:
     """Apply MODEL to FILE; OUT gets every input column plus <signal>_model and <signal>_comp."""
-    check_not_input(output, [file, model_file])
-    if file_kind(output) == "csv":  # the CSV's sidecar must not land on an input either
-        check_not_input(sidecar_path(output), [file, model_file])
-    cal = load_calibration(model_file)  # a model file is a calibration of one channel
+    _io.check_not_input(output, [file, model_file])
+    if _io.file_kind(output) == "csv":  # the CSV's sidecar must not land on an input either
+        _io.check_not_input(_io.sidecar_path(output), [file, model_file])
+    cal = _files.load_calibration(model_file)  # a model file is a calibration of one channel
     conv = parse_temp_conversion(temp_conversion) if temp_conversion is not None else None
     if len(cal.channels) == 1:
         model = cal.channels[0].model
         with progress("compensating") as advance:
-            res = compensate_file(
+            res = _compensate.compensate_file(
                 model,
                 file,
                 output,
@@ -106,7 +116,7 @@ def compensate_cmd(
         summary = {"model": str(model_file), "family": model.family, **res.to_dict()}
 
         def human() -> None:
-            table = Table(title=f"{file} → {res.output}", show_header=False)
+            table = _rich_table.Table(title=f"{file} → {res.output}", show_header=False)
             table.add_row("model", f"{model.family} ({model_file})")
             table.add_row("rows", str(res.n_rows))
             table.add_row("added columns", f"{res.model_column}, {res.comp_column} [{res.unit}]")
@@ -120,7 +130,7 @@ def compensate_cmd(
     chosen = split_names(signal) or cal.names
     channels = [(cal.channel(n).signal, cal.channel(n).model) for n in chosen]
     with progress("compensating") as advance:
-        results = compensate_channels(
+        results = _compensate.compensate_channels(
             channels,
             file,
             output,
@@ -146,7 +156,7 @@ def compensate_cmd(
     }
 
     def human_many() -> None:
-        table = Table(title=f"{file} → {output} ({len(results)} channels, one pass)")
+        table = _rich_table.Table(title=f"{file} → {output} ({len(results)} channels, one pass)")
         for col in ("channel", "model", "added columns", "rms before", "rms after", "unit"):
             table.add_column(col)
         for name, r in zip(chosen, results, strict=True):

@@ -8,15 +8,23 @@ progress bar on a terminal, then prints a short summary table and the report's p
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Annotated
+from typing import TYPE_CHECKING, Annotated
 
 import typer
-from rich.markup import escape
-from rich.table import Table
 
+from thermocal._lazy import LazyModule
 from thermocal.cli.application import app
 from thermocal.cli.common import JsonOpt, emit, fmt, handle_errors, progress, stdout
-from thermocal.demo import DEMO_STEPS, QUICK, run_demo
+
+if TYPE_CHECKING:
+    import rich.markup as _markup
+    import rich.table as _rich_table
+
+    import thermocal.demo as _demo
+else:
+    _markup = LazyModule("rich.markup")
+    _rich_table = LazyModule("rich.table")
+    _demo = LazyModule("thermocal.demo")
 
 
 def _pct(value: float | None) -> str:
@@ -55,8 +63,8 @@ def demo_cmd(
         _imu_demo(output if output != Path("thermocal-demo") else Path("thermocal-imu-demo"),
                   seed, quick, as_json)  # fmt: skip
         return
-    with progress("thermocal demo", total=len(DEMO_STEPS)) as advance:
-        res = run_demo(output, seed=seed, config=QUICK if quick else None,
+    with progress("thermocal demo", total=len(_demo.DEMO_STEPS)) as advance:
+        res = _demo.run_demo(output, seed=seed, config=_demo.QUICK if quick else None,
                        progress=lambda _step: advance(1))  # fmt: skip
 
     out = {
@@ -90,7 +98,7 @@ def demo_cmd(
 
     def human() -> None:
         models = res.models
-        table = Table(title=f"thermocal demo (seed {res.seed}): validation run, °/h")
+        table = _rich_table.Table(title=f"thermocal demo (seed {res.seed}): validation run, °/h")
         table.add_column("figure")
         table.add_column("before", justify="right")
         for m in models:
@@ -113,7 +121,7 @@ def demo_cmd(
         stdout.print(table)
         stdout.print("* reported model; (…) improvement")
         stdout.print(f"{len(res.files)} files in {res.out_dir} ({res.elapsed_s:.1f} s)")
-        stdout.print(f"report: [bold]{escape(str(res.report_path))}[/bold]", markup=True)
+        stdout.print(f"report: [bold]{_markup.escape(str(res.report_path))}[/bold]", markup=True)
 
     emit(out, as_json, human)
 
@@ -151,7 +159,7 @@ def _imu_demo(output: Path, seed: int, quick: bool, as_json: bool) -> None:
     }
 
     def human() -> None:
-        table = Table(title=f"thermocal demo --imu (seed {seed}): validation run")
+        table = _rich_table.Table(title=f"thermocal demo --imu (seed {seed}): validation run")
         for col in ("channel", "unit", "r", "rms before", "rms after", "bias removed"):
             table.add_column(col, justify="left" if col in ("channel", "unit") else "right")
         for c in res.channels:
@@ -160,7 +168,7 @@ def _imu_demo(output: Path, seed: int, quick: bool, as_json: bool) -> None:
         stdout.print(table)
         stdout.print("bias removed: share of the simulator's true temperature-induced bias")
         stdout.print(f"{len(res.files)} files in {res.out_dir} ({res.elapsed_s:.1f} s)")
-        stdout.print(f"calibration: {escape(str(res.calibration_path))}")
-        stdout.print(f"report: [bold]{escape(str(res.report_path))}[/bold]", markup=True)
+        stdout.print(f"calibration: {_markup.escape(str(res.calibration_path))}")
+        stdout.print(f"report: [bold]{_markup.escape(str(res.report_path))}[/bold]", markup=True)
 
     emit(out, as_json, human)

@@ -12,25 +12,27 @@ from __future__ import annotations
 import json
 import warnings
 from pathlib import Path
-from typing import Annotated
+from typing import TYPE_CHECKING, Annotated
 
 import typer
 
-from thermocal import units
+from thermocal._lazy import LazyModule
 from thermocal.cli.application import app
 from thermocal.cli.common import JsonOpt, ModelArg, emit, fmt, handle_errors, stdout
 from thermocal.errors import ThermocalWarning, UnitWarning
-from thermocal.export_c import (
-    c_identifier,
-    export_c,
-    find_compiler,
-    fitted_sample_interval,
-    generate_c_calibration,
-    measure_float_error,
-)
-from thermocal.models.base import model_file_dict
-from thermocal.models.calibration import is_calibration
-from thermocal.models.files import load_calibration, load_model_dict
+
+if TYPE_CHECKING:
+    import thermocal.export_c as _export_c
+    import thermocal.models.base as _base
+    import thermocal.models.calibration as _calibration
+    import thermocal.models.files as _files
+    from thermocal import units
+else:
+    units = LazyModule("thermocal.units")
+    _export_c = LazyModule("thermocal.export_c")
+    _base = LazyModule("thermocal.models.base")
+    _calibration = LazyModule("thermocal.models.calibration")
+    _files = LazyModule("thermocal.models.files")
 
 
 def _read_json(path: Path) -> object:
@@ -52,12 +54,14 @@ def _export_calibration(
 ) -> None:
     """A calibration's C: one header and one source for every channel, each channel in
     its data's unit (``--unit`` applies one unit to every channel, or one per channel)."""
-    cal = load_calibration(path)
+    cal = _files.load_calibration(path)
     unit_of = units.per_signal_option(unit, cal.names)
-    channels = [(c.name, model_file_dict(c.model), unit_of[c.name] or c.unit) for c in cal.channels]
-    ex = generate_c_calibration(
+    channels = [
+        (c.name, _base.model_file_dict(c.model), unit_of[c.name] or c.unit) for c in cal.channels
+    ]
+    ex = _export_c.generate_c_calibration(
         channels,
-        prefix=name or c_identifier(path.stem),
+        prefix=name or _export_c.c_identifier(path.stem),
         real=real,
         sample_interval_s=sample_interval,
     )
@@ -119,12 +123,12 @@ def export_c_cmd(
     """Write MODEL as a C99 header and source (no dynamic allocation) into DIR."""
     real = "float" if use_float else "double"
     raw = _read_json(model_file)
-    if is_calibration(raw):
+    if _calibration.is_calibration(raw):
         _export_calibration(model_file, output, name, real, sample_interval, unit, as_json)
         return
-    d = load_model_dict(model_file)
+    d = _files.load_model_dict(model_file)
     if sample_interval is None:
-        sample_interval = fitted_sample_interval(d)
+        sample_interval = _export_c.fitted_sample_interval(d)
         if sample_interval is None:
             sample_interval = 1.0
             if d.get("rate"):
@@ -158,7 +162,7 @@ def export_c_cmd(
                 ),
                 stacklevel=1,
             )
-    ex, paths = export_c(
+    ex, paths = _export_c.export_c(
         model_file, output, prefix=name, real=real, sample_interval_s=sample_interval, unit=unit
     )
     out: dict[str, object] = {
@@ -173,14 +177,14 @@ def export_c_cmd(
         "float_max_rel_error": None,
     }
     if use_float:
-        if find_compiler() is None:
+        if _export_c.find_compiler() is None:
             warnings.warn(
                 "no C compiler found: the float build's error was not measured",
                 ThermocalWarning,
                 stacklevel=1,
             )
         else:
-            err = measure_float_error(
+            err = _export_c.measure_float_error(
                 d, prefix=ex.prefix, sample_interval_s=sample_interval, unit=unit
             )
             out["float_max_abs_error"] = err.max_abs
@@ -237,7 +241,7 @@ def export_params_cmd(
     from thermocal.io import atomic_write, check_not_input
 
     check_not_input(output, [calibration])
-    cal = load_calibration(calibration)
+    cal = _files.load_calibration(calibration)
     ids = {"gyro": device_id, "accel": device_id} if device_id is not None else None
     ps = export_params(
         cal, fmt, gyro=split_names(gyro), accel=split_names(accel), instance=instance,

@@ -54,13 +54,11 @@ import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Annotated, Any, cast
+from typing import TYPE_CHECKING, Annotated, Any, cast
 
-import numpy as np
 import typer
-from rich.table import Table
 
-from thermocal import units
+from thermocal._lazy import LazyModule
 from thermocal.cli.application import app
 from thermocal.cli.common import (
     AxisOpt,
@@ -92,32 +90,42 @@ from thermocal.cli.common import (
     text_options,
 )
 from thermocal.errors import ConditioningWarning, ThermocalInputError, ThermocalWarning
-from thermocal.io import check_not_input
-from thermocal.models.base import (
-    RunData,
-    TemperatureModel,
-    condition_wording,
-    get_model_class,
-    model_inputs,
-)
-from thermocal.models.calibration import Calibration, Channel, guess_role
-from thermocal.models.files import file_sha256, save_calibration, save_model
-from thermocal.models.poly import PolyModel, fit_shared
-from thermocal.recording import FloatArray, Recording
+
+if TYPE_CHECKING:
+    import numpy as np
+    import rich.table as _rich_table
+
+    import thermocal.io as _io
+    import thermocal.models.base as _base
+    import thermocal.models.calibration as _calibration
+    import thermocal.models.files as _files
+    import thermocal.models.poly as _poly
+    import thermocal.recording as _recording
+    from thermocal import units
+else:
+    np = LazyModule("numpy")
+    _rich_table = LazyModule("rich.table")
+    units = LazyModule("thermocal.units")
+    _io = LazyModule("thermocal.io")
+    _base = LazyModule("thermocal.models.base")
+    _calibration = LazyModule("thermocal.models.calibration")
+    _files = LazyModule("thermocal.models.files")
+    _poly = LazyModule("thermocal.models.poly")
+    _recording = LazyModule("thermocal.recording")
 
 TARGETS = ("bias", "scale_factor")
 
 
-def run_temp_names(rec: Recording, temps: str | None) -> list[str]:
+def run_temp_names(rec: _recording.Recording, temps: str | None) -> list[str]:
     """The temperature columns a fit uses: ``--temps`` or the file's."""
     return split_names(temps) or list(rec.temperatures)
 
 
-def build_model(family: str, options: dict[str, Any]) -> TemperatureModel:
+def build_model(family: str, options: dict[str, Any]) -> _base.TemperatureModel:
     """Instantiate a registered family from the CLI option dict by its one option parser
     (:meth:`TemperatureModel.from_cli_options`: an option the family does not take is
     refused, for every family)."""
-    return get_model_class(family).from_cli_options(options)
+    return _base.get_model_class(family).from_cli_options(options)
 
 
 @app.command("fit")
@@ -250,7 +258,7 @@ def fit_cmd(
         raise ThermocalInputError(f"--target must be bias or scale_factor, got {target!r}")
     if not files:
         raise ThermocalInputError("give at least one data file")
-    check_not_input(output, list(files))
+    _io.check_not_input(output, list(files))
     if output.suffix.lower() not in (".json", ""):
         raise ThermocalInputError(f"{output}: the model file is JSON; use a .json name")
     options: dict[str, Any] = {
@@ -311,18 +319,24 @@ def fit_cmd(
                     gravity_axis, g_local, tref)  # fmt: skip
     if len(names) <= 1:
         est, result, n_runs = _fit_channel(spec, loaded, signal)
-        save_model(est, output)
+        _files.save_model(est, output)
         result["output"] = str(output)
         emit(result, as_json, lambda: _human_single(est, result, n_runs, output))
         return
     fitted = _fit_channels(spec, loaded, names)
-    cal = Calibration(
+    cal = _calibration.Calibration(
         [
-            Channel(name, name, str(res["unit_as_given"]), est, guess_role(name, res["unit"]))
+            _calibration.Channel(
+                name,
+                name,
+                str(res["unit_as_given"]),
+                est,
+                _calibration.guess_role(name, res["unit"]),
+            )
             for name, est, res, _n in fitted
         ]
     )
-    save_calibration(cal, output)
+    _files.save_calibration(cal, output)
     out = {
         "output": str(output),
         "format": "thermocal-calibration",
@@ -382,7 +396,7 @@ def _local_gravity(
 
 
 def _gravity_known_input(
-    spec: _FitSpec, path: Path, name: str, unit: str, values_mg: FloatArray
+    spec: _FitSpec, path: Path, name: str, unit: str, values_mg: _recording.FloatArray
 ) -> float:
     """The gravity an accelerometer channel reads in the static run [mg] (0 for a gyro or
     without ``--gravity-axis``), after checking the channel's mean against it: the up axis
@@ -403,7 +417,7 @@ def _gravity_known_input(
                 stacklevel=2,
             )
         return 0.0
-    role = guess_role(name, unit) or {}
+    role = _calibration.guess_role(name, unit) or {}
     letter = role.get("axis")
     if letter is None:
         raise ThermocalInputError(
@@ -434,8 +448,8 @@ def _gravity_known_input(
 class _Prepared:
     """One channel ready to fit: its model, runs and provenance, and the warnings so far."""
 
-    est: TemperatureModel
-    runs: list[RunData]
+    est: _base.TemperatureModel
+    runs: list[_base.RunData]
     first_inputs: dict[str, Any]
     provenance: list[dict[str, Any]]
     unit: str
@@ -444,8 +458,8 @@ class _Prepared:
 
 
 def _fit_channel(
-    spec: _FitSpec, loaded: list[tuple[Path, Recording]], signal: str | None
-) -> tuple[TemperatureModel, dict[str, Any], int]:
+    spec: _FitSpec, loaded: list[tuple[Path, _recording.Recording]], signal: str | None
+) -> tuple[_base.TemperatureModel, dict[str, Any], int]:
     """Fit one channel on the loaded runs; returns the model, its ``--json`` result and
     the number of runs. Warnings are printed (by handle_errors) and listed in the result."""
     ((_n, est, result, n_runs),) = _fit_channels(spec, loaded, [signal])
@@ -453,8 +467,8 @@ def _fit_channel(
 
 
 def _fit_channels(
-    spec: _FitSpec, loaded: list[tuple[Path, Recording]], signals: Sequence[str | None]
-) -> list[tuple[str, TemperatureModel, dict[str, Any], int]]:
+    spec: _FitSpec, loaded: list[tuple[Path, _recording.Recording]], signals: Sequence[str | None]
+) -> list[tuple[str, _base.TemperatureModel, dict[str, Any], int]]:
     """Fit every channel on the loaded runs (each file read once, by the caller).  Channels
     of the ``poly`` family with the same temperature inputs share one design
     (:func:`thermocal.models.poly.fit_shared`: Ṫ, features and the design's reduction once;
@@ -464,7 +478,7 @@ def _fit_channels(
         _share_inputs(preps)
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")
-            fit_shared([cast(PolyModel, p.est) for p in preps], [p.runs for p in preps])
+            _poly.fit_shared([cast(_poly.PolyModel, p.est) for p in preps], [p.runs for p in preps])
         for p in preps:
             p.caught.extend(caught)
     else:
@@ -488,12 +502,12 @@ def _share_inputs(preps: list[_Prepared]) -> None:
 
 
 def _prepare_channel(
-    spec: _FitSpec, loaded: list[tuple[Path, Recording]], signal: str | None
+    spec: _FitSpec, loaded: list[tuple[Path, _recording.Recording]], signal: str | None
 ) -> _Prepared:
     """One channel's runs with their known inputs, its model object and provenance."""
     est = build_model(spec.family, spec.options)
     temps, latitude, axis, known_input = spec.temps, spec.latitude, spec.axis, spec.known_input
-    runs: list[RunData] = []
+    runs: list[_base.RunData] = []
     first_inputs: dict[str, Any] = {}
     provenance: list[dict[str, Any]] = []
     sensor_ids: list[str | None] = []
@@ -518,11 +532,11 @@ def _prepare_channel(
                 f"gravity {g_ki:+.6g} mg ({spec.gravity_axis} up, g = {spec.gravity_m_s2:.7g} "
                 "m/s²)" if spec.gravity_axis and units.signal_kind(unit) == "accel" else None
             )  # fmt: skip
-            first_inputs = model_inputs(
+            first_inputs = _base.model_inputs(
                 rec, sig_name, run_temp_names(rec, temps), known_input=ki,
                 known_input_what=known_input_what(earth_lat, axis, known_input, gravity_what),
             )  # fmt: skip
-        run = RunData.from_recording(
+        run = _base.RunData.from_recording(
             rec, signal, split_names(temps), known_input=ki, temperature_unit="auto"
         )
         run = dataclasses.replace(run, name=path.name)
@@ -539,7 +553,7 @@ def _prepare_channel(
             {
                 "file": path.name,
                 "path": str(path),
-                "sha256": file_sha256(path),
+                "sha256": _files.file_sha256(path),
                 "n_samples": run.n_samples,
                 "known_input": ki,
             }
@@ -564,7 +578,7 @@ def _prepare_channel(
 
 def _finish_channel(
     spec: _FitSpec, prep: _Prepared
-) -> tuple[TemperatureModel, dict[str, Any], int]:
+) -> tuple[_base.TemperatureModel, dict[str, Any], int]:
     """After the fit: the fit-quality warnings, the model's metadata, the ``--json`` result."""
     est, runs, first_inputs, provenance = prep.est, prep.runs, prep.first_inputs, prep.provenance
     unit, sig_name, target = prep.unit, prep.sig_name, spec.target
@@ -612,7 +626,7 @@ def _finish_channel(
         "n_coefficients": st.n_coefficients,
         "rms_residual": st.rms_residual,
         "condition_number": st.condition_number,
-        "condition": condition_wording(kappa),
+        "condition": _base.condition_wording(kappa),
         "temperature_range": trange,
         "rate_range": rrange,
         "n_samples": st.n_samples,
@@ -640,7 +654,9 @@ def _finish_channel(
     return est, result, len(runs)
 
 
-def _human_single(est: TemperatureModel, result: dict[str, Any], n_runs: int, output: Path) -> None:
+def _human_single(
+    est: _base.TemperatureModel, result: dict[str, Any], n_runs: int, output: Path
+) -> None:
     """The fit summary and coefficient tables of one model."""
     st = est.stats_
     unit = result["unit"]
@@ -648,13 +664,14 @@ def _human_single(est: TemperatureModel, result: dict[str, Any], n_runs: int, ou
     corr: dict[str, Any] | None = st.extra.get("residual_correlation")
     trange = result["temperature_range"]
     kept = result["terms_kept"]
-    tab = Table(title=f"{est.family} model → {output}")
+    tab = _rich_table.Table(title=f"{est.family} model → {output}")
     tab.add_column("quantity")
     tab.add_column("value")
     tab.add_row("runs / samples", f"{n_runs} / {st.n_samples}")
     tab.add_row("coefficients", str(st.n_coefficients))
     tab.add_row(f"rms residual [{unit}]", fmt(st.rms_residual))
-    tab.add_row("condition number", f"{fmt(st.condition_number)} ({condition_wording(kappa)})")
+    wording = _base.condition_wording(kappa)
+    tab.add_row("condition number", f"{fmt(st.condition_number)} ({wording})")
     if corr:
         tab.add_row(
             "effective samples",
@@ -667,7 +684,7 @@ def _human_single(est: TemperatureModel, result: dict[str, Any], n_runs: int, ou
     if kept is not None:
         tab.add_row("terms kept", ", ".join(kept))
     stdout.print(tab)
-    ctab = Table(title="coefficients")
+    ctab = _rich_table.Table(title="coefficients")
     ctab.add_column("name")
     ctab.add_column("value")
     ctab.add_column("std. error")
@@ -681,7 +698,7 @@ def _human_single(est: TemperatureModel, result: dict[str, Any], n_runs: int, ou
         ctab.add_row(c.name, fmt(c.value, 6), fmt(c.stderr, 3), f"{fmt(ratio, 2)}{flag}", c.unit)
     stdout.print(ctab)
     if "tref" in result:
-        ttab = Table(title=f"coefficients about TREF = {result['tref']['tref_c']:g} °C")
+        ttab = _rich_table.Table(title=f"coefficients about TREF = {result['tref']['tref_c']:g} °C")
         for col in ("name", "value", "std. error", "unit"):
             ttab.add_column(col)
         for c in result["tref"]["coefficients"]:
@@ -695,10 +712,10 @@ def _human_single(est: TemperatureModel, result: dict[str, Any], n_runs: int, ou
 
 
 def _human_channels(
-    fitted: list[tuple[str, TemperatureModel, dict[str, Any], int]], output: Path
+    fitted: list[tuple[str, _base.TemperatureModel, dict[str, Any], int]], output: Path
 ) -> None:
     """One row per channel: model, samples, residual, condition, range."""
-    tab = Table(title=f"calibration of {len(fitted)} channels → {output}")
+    tab = _rich_table.Table(title=f"calibration of {len(fitted)} channels → {output}")
     for col in ("channel", "model", "coefficients", "rms residual", "condition", "range [°C]"):
         tab.add_column(col)
     for name, est, res, _n in fitted:

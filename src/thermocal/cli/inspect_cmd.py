@@ -3,12 +3,11 @@
 from __future__ import annotations
 
 import re
-from typing import Annotated
+from typing import TYPE_CHECKING, Annotated
 
 import typer
-from rich.markup import escape
-from rich.table import Table
 
+from thermocal._lazy import LazyModule
 from thermocal.cli.application import app
 from thermocal.cli.common import (
     DecimalOpt,
@@ -35,10 +34,22 @@ from thermocal.cli.common import (
     text_options,
 )
 from thermocal.errors import ThermocalInputError
-from thermocal.inspection import Inspection, inspect_recording
-from thermocal.io import read_recording
-from thermocal.recording import Problem
-from thermocal.units import StatedUnits, UnitOptions, resolve_inputs
+
+if TYPE_CHECKING:
+    import rich.markup as _markup
+    import rich.table as _rich_table
+
+    import thermocal.inspection as _inspection
+    import thermocal.io as _io
+    import thermocal.recording as _recording
+    from thermocal import units
+else:
+    _markup = LazyModule("rich.markup")
+    _rich_table = LazyModule("rich.table")
+    _inspection = LazyModule("thermocal.inspection")
+    _io = LazyModule("thermocal.io")
+    _recording = LazyModule("thermocal.recording")
+    units = LazyModule("thermocal.units")
 
 _TEMP_NAME = re.compile(r"^(t\d+|t_|temp|tmp)|temperature|°c|degc", re.IGNORECASE)
 
@@ -82,7 +93,7 @@ def inspect_cmd(
     """
     skipped: list[str] = []
     conv = parse_temp_conversion(temp_conversion) if temp_conversion is not None else None
-    rec = read_recording(
+    rec = _io.read_recording(
         file,
         text=text_options(t_names, t_rate, t_bad, t_delim, t_dec),
         topic=topic,
@@ -99,12 +110,12 @@ def inspect_cmd(
         guessed = tuple(c for c in rec.columns if _TEMP_NAME.search(c) and c not in rec.signals)
         rec.temperatures = guessed
         # a guessed temperature's unit and conversion go through the one resolver
-        res = resolve_inputs(
+        res = units.resolve_inputs(
             "<time>",
             [],
             guessed,
-            options=UnitOptions(temp_unit=temp_unit, temp_conversion=conv),
-            file=StatedUnits(
+            options=units.UnitOptions(temp_unit=temp_unit, temp_conversion=conv),
+            file=units.StatedUnits(
                 columns={c: rec.units[c] for c in guessed if rec.units.get(c)},
                 conversions={
                     c: v for c, v in rec.meta.temperature_conversion.items() if c in guessed
@@ -117,10 +128,10 @@ def inspect_cmd(
         for c, r in res.conversions.items():
             if r.conversion is not None:
                 rec.meta.temperature_conversion[c] = r.conversion
-    result = inspect_recording(rec)
+    result = _inspection.inspect_recording(rec)
     for c in skipped:
         result.problems.append(
-            Problem(
+            _recording.Problem(
                 "non_numeric",
                 f"column {c!r} holds non-numeric values and was skipped",
                 severity="warning",
@@ -140,8 +151,8 @@ def inspect_cmd(
         raise ThermocalInputError(f"{file}: --strict: {one_line(warns[0].message)}{more}")
 
 
-def _print_human(r: Inspection) -> None:
-    stdout.print(f"[bold]{escape(str(r.file))}[/bold]", markup=True)
+def _print_human(r: _inspection.Inspection) -> None:
+    stdout.print(f"[bold]{_markup.escape(str(r.file))}[/bold]", markup=True)
     if r.time_ok and r.duration_s is not None:
         stdout.print(
             f"{r.n_samples} samples over {fmt(r.duration_s, 6)} s, "
@@ -155,7 +166,7 @@ def _print_human(r: Inspection) -> None:
             f"{r.n_samples} samples; time is not finite and strictly increasing (see the "
             "errors below), so duration, sample rate, gaps and segments are not computed"
         )
-    table = Table("column", "role", "unit", "min", "max", "mean", "NaN", "spikes")
+    table = _rich_table.Table("column", "role", "unit", "min", "max", "mean", "NaN", "spikes")
     for c in r.columns.values():
         table.add_row(
             c.name,
@@ -179,4 +190,4 @@ def _print_human(r: Inspection) -> None:
         stdout.print("[green]no problems found[/green]", markup=True)
     for p in r.problems:
         colour = "red" if p.severity == "error" else "yellow"
-        stdout.print(f"[{colour}]{p.severity}[/{colour}]: {escape(p.message)}", markup=True)
+        stdout.print(f"[{colour}]{p.severity}[/{colour}]: {_markup.escape(p.message)}", markup=True)

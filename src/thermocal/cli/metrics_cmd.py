@@ -4,11 +4,11 @@ repeatability and temperature sensitivity of one signal (SPEC §1)."""
 from __future__ import annotations
 
 from collections.abc import Callable
-from typing import Annotated, Any
+from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
-from rich.table import Table
 
+from thermocal._lazy import LazyModule
 from thermocal.cli.application import app
 from thermocal.cli.common import (
     AxisOpt,
@@ -38,10 +38,18 @@ from thermocal.cli.common import (
     text_options,
 )
 from thermocal.errors import ThermocalInputError
-from thermocal.metrics import MetricsResult, compute_metrics
+
+if TYPE_CHECKING:
+    import rich.table as _rich_table
+
+    import thermocal.metrics as _metrics
+    from thermocal.metrics import MetricsResult
+else:
+    _rich_table = LazyModule("rich.table")
+    _metrics = LazyModule("thermocal.metrics")
 
 
-def metrics_json(res: MetricsResult) -> dict[str, Any]:
+def metrics_json(res: _metrics.MetricsResult) -> dict[str, Any]:
     """The ``--json`` object of ``thermocal metrics`` (INTERFACE.md keys first)."""
     d: dict[str, Any] = jsonable(res)
     ts = res.temperature_sensitivity
@@ -123,7 +131,7 @@ def metrics_cmd(
         )
     # one read of the file, the figures of every channel (INTERFACE: several channels)
     results = {
-        name: compute_metrics(
+        name: _metrics.compute_metrics(
             rec,
             name,
             average,
@@ -138,7 +146,7 @@ def metrics_cmd(
 
     def human() -> None:
         many = len(results) > 1
-        table = Table(title=f"{file} — {', '.join(results)}")
+        table = _rich_table.Table(title=f"{file} — {', '.join(results)}")
         table.add_column("figure")
         for name in results:
             table.add_column(name if many else "value", justify="right")
@@ -196,6 +204,6 @@ def metrics_cmd(
         emit({"channels": {n: metrics_json(r) for n, r in results.items()}}, as_json, human)
 
 
-def first_result(results: dict[str, MetricsResult]) -> MetricsResult:
+def first_result(results: dict[str, _metrics.MetricsResult]) -> _metrics.MetricsResult:
     """The only result of a one-channel run."""
     return next(iter(results.values()))

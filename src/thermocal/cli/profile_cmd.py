@@ -14,28 +14,32 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
-from typing import Annotated, Any
+from typing import TYPE_CHECKING, Annotated, Any
 
-import numpy as np
-import pandas as pd
 import typer
 
+from thermocal import defaults
+from thermocal._lazy import LazyModule
 from thermocal.cli.application import app
 from thermocal.cli.common import JsonOpt, OutOpt, emit, handle_errors, split_floats, stdout
 from thermocal.errors import FileFormatError, MissingColumnError, ThermocalInputError
-from thermocal.io import check_not_input, file_kind, read_recording
-from thermocal.profiles import (
-    PROGRAM_SETPOINT,
-    PROGRAM_TIME,
-    WEAK_CORRELATION_LIMIT,
-    Profile,
-    builtin_profile,
-    correlate,
-    design_validation_profile,
-    read_program,
-    write_program,
-)
-from thermocal.recording import FloatArray
+
+if TYPE_CHECKING:
+    import numpy as np
+
+    import thermocal.io as _io
+    import thermocal.profiles as _profiles
+    import thermocal.recording as _recording
+else:
+    np = LazyModule("numpy")
+    _io = LazyModule("thermocal.io")
+    _profiles = LazyModule("thermocal.profiles")
+    _recording = LazyModule("thermocal.recording")
+
+if TYPE_CHECKING:
+    import pandas as pd
+else:
+    pd = LazyModule("pandas")
 
 profile_app = typer.Typer(
     help="Chamber test profiles (time_s, setpoint_c programs), their correlation, and the "
@@ -68,11 +72,13 @@ ColumnOpt = Annotated[
 ]
 
 
-def _write_profile(prof: Profile, output: Path, dt: float, as_json: bool, **extra: Any) -> None:
+def _write_profile(
+    prof: _profiles.Profile, output: Path, dt: float, as_json: bool, **extra: Any
+) -> None:
     if not (dt >= 0 and math.isfinite(dt)):
         raise ThermocalInputError(f"--dt must be ≥ 0 s (0: corner points only), got {dt:g}")
     t, c = prof.program(dt if dt > 0 else None)
-    write_program(output, t, c)
+    _profiles.write_program(output, t, c)
     summary = {
         "profile": prof.name,
         "file": str(output),
@@ -98,30 +104,32 @@ def _clean(params: dict[str, Any]) -> dict[str, Any]:
     return {k: v for k, v in params.items() if v is not None}
 
 
-def load_history(path: Path, column: str | None = None) -> tuple[FloatArray, FloatArray, str]:
+def load_history(
+    path: Path, column: str | None = None
+) -> tuple[_recording.FloatArray, _recording.FloatArray, str]:
     """A temperature history ``(time_s, temperature_c, column)`` from a chamber program CSV
     (``time_s, setpoint_c``; its set-point unless ``column`` is another of its columns) or a
     recording (``column``, default its first temperature column, else ``setpoint_c``)."""
     if not path.exists():
         raise FileFormatError(f"{path}: no such file")
     time_col: str | None = None
-    if file_kind(path) == "csv":
+    if _io.file_kind(path) == "csv":
         try:
             header = [str(c).strip() for c in pd.read_csv(path, nrows=0).columns]
         except (pd.errors.EmptyDataError, pd.errors.ParserError, UnicodeDecodeError) as exc:
             raise FileFormatError(f"{path}: not a readable CSV file ({exc})") from None
-        is_program = PROGRAM_TIME in header and PROGRAM_SETPOINT in header
+        is_program = defaults.PROGRAM_TIME in header and defaults.PROGRAM_SETPOINT in header
         if is_program and (column is None or column not in header):
-            t, c = read_program(path)
-            return t, c, PROGRAM_SETPOINT
-        if PROGRAM_TIME in header and "time" not in header:
-            time_col = PROGRAM_TIME
-    rec = read_recording(path, time=time_col)
+            t, c = _profiles.read_program(path)
+            return t, c, defaults.PROGRAM_SETPOINT
+        if defaults.PROGRAM_TIME in header and "time" not in header:
+            time_col = defaults.PROGRAM_TIME
+    rec = _io.read_recording(path, time=time_col)
     if column is None:
         if rec.temperatures:
             column = rec.temperatures[0]
-        elif PROGRAM_SETPOINT in rec.columns:
-            column = PROGRAM_SETPOINT
+        elif defaults.PROGRAM_SETPOINT in rec.columns:
+            column = defaults.PROGRAM_SETPOINT
         else:
             raise MissingColumnError(
                 f"{path}: no temperature column known; name one with --column (available: "
@@ -170,7 +178,7 @@ def rlg_modelling_cmd(
             "rate_hold_s": rate_hold_s,
         }
     )
-    _write_profile(builtin_profile("rlg-modelling", **params), output, dt, as_json)
+    _write_profile(_profiles.builtin_profile("rlg-modelling", **params), output, dt, as_json)
 
 
 @profile_app.command("rlg-validation")
@@ -193,7 +201,7 @@ def rlg_validation_cmd(
     ] = None,
     column: ColumnOpt = None,
     seed: SeedOpt = 0,
-    limit: LimitOpt = WEAK_CORRELATION_LIMIT,
+    limit: LimitOpt = defaults.WEAK_CORRELATION_LIMIT,
     n_holds: NHoldsOpt = None,
     dt: DtOpt = 60.0,
     as_json: JsonOpt = False,
@@ -202,7 +210,7 @@ def rlg_validation_cmd(
     if against is not None:
         if holds is not None:
             raise ThermocalInputError("give either --holds or --against, not both")
-        check_not_input(output, [against])
+        _io.check_not_input(output, [against])
         _design(against, output, column, seed, limit, n_holds, hold_s, rate, dt, as_json)
         return
     params = _clean(
@@ -213,7 +221,7 @@ def rlg_validation_cmd(
             "start_c": start,
         }
     )
-    _write_profile(builtin_profile("rlg-validation", **params), output, dt, as_json)
+    _write_profile(_profiles.builtin_profile("rlg-validation", **params), output, dt, as_json)
 
 
 @profile_app.command("fog-slow")
@@ -238,7 +246,7 @@ def fog_slow_cmd(
             "n_cycles": cycles,
         }
     )
-    _write_profile(builtin_profile("fog-slow", **params), output, dt, as_json)
+    _write_profile(_profiles.builtin_profile("fog-slow", **params), output, dt, as_json)
 
 
 @profile_app.command("mems-warmup")
@@ -269,7 +277,7 @@ def mems_warmup_cmd(
             "start_c": start,
         }
     )
-    _write_profile(builtin_profile("mems-warmup", **params), output, dt, as_json)
+    _write_profile(_profiles.builtin_profile("mems-warmup", **params), output, dt, as_json)
 
 
 @profile_app.command("accel-full-range")
@@ -304,7 +312,7 @@ def accel_full_range_cmd(
             "start_c": start,
         }
     )
-    _write_profile(builtin_profile("accel-full-range", **params), output, dt, as_json)
+    _write_profile(_profiles.builtin_profile("accel-full-range", **params), output, dt, as_json)
 
 
 @profile_app.command("correlate")
@@ -316,7 +324,7 @@ def correlate_cmd(
     column_b: Annotated[
         str | None, typer.Option("--column-b", help="Column of B (default: --column's rule).")
     ] = None,
-    limit: LimitOpt = WEAK_CORRELATION_LIMIT,
+    limit: LimitOpt = defaults.WEAK_CORRELATION_LIMIT,
     points: Annotated[
         int, typer.Option("--points", help="Points of the common elapsed-time base.")
     ] = 10_000,
@@ -325,7 +333,7 @@ def correlate_cmd(
     """r = Cov(X, Y)/(σX σY) of two temperature histories on a common elapsed-time base."""
     ta, xa, ca = load_history(file_a, column)
     tb, xb, cb = load_history(file_b, column_b if column_b is not None else column)
-    res = correlate(ta, xa, tb, xb, r_limit=limit, n_points=points)
+    res = _profiles.correlate(ta, xa, tb, xb, r_limit=limit, n_points=points)
     out = {
         "r": res.r,
         "weakly_correlated": res.weakly_correlated,
@@ -360,9 +368,9 @@ def _design(
 ) -> None:
     tm, cm, _ = load_history(model, column)
     kwargs: dict[str, Any] = _clean({"n_holds": n_holds, "hold_s": hold_s, "rate_c_per_min": rate})
-    prof = design_validation_profile(tm, cm, seed, limit, **kwargs)
+    prof = _profiles.design_validation_profile(tm, cm, seed, limit, **kwargs)
     tv, cv = prof.knots()
-    res = correlate(tm, cm, tv, cv, r_limit=limit)
+    res = _profiles.correlate(tm, cm, tv, cv, r_limit=limit)
     _write_profile(prof, output, dt, as_json, r=res.r, weakly_correlated=res.weakly_correlated)
 
 
@@ -373,7 +381,7 @@ def design_validation_cmd(
     output: OutOpt,
     seed: SeedOpt = 0,
     column: ColumnOpt = None,
-    limit: LimitOpt = WEAK_CORRELATION_LIMIT,
+    limit: LimitOpt = defaults.WEAK_CORRELATION_LIMIT,
     n_holds: NHoldsOpt = None,
     hold_s: Annotated[float | None, typer.Option("--hold-s", help="Mean hold [s].")] = None,
     rate: RateOpt = None,
@@ -381,5 +389,5 @@ def design_validation_cmd(
     as_json: JsonOpt = False,
 ) -> None:
     """A hold profile over the modelling range, weakly correlated with it (seeded)."""
-    check_not_input(output, [model])
+    _io.check_not_input(output, [model])
     _design(model, output, column, seed, limit, n_holds, hold_s, rate, dt, as_json)

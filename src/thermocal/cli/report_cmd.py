@@ -13,10 +13,11 @@ from __future__ import annotations
 import functools
 import json
 from pathlib import Path
-from typing import Annotated, Any
+from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
 
+from thermocal._lazy import LazyModule
 from thermocal.cli.application import app
 from thermocal.cli.common import (
     DecimalOpt,
@@ -39,11 +40,19 @@ from thermocal.cli.common import (
     text_options,
 )
 from thermocal.errors import FileFormatError, ThermocalInputError
-from thermocal.io import check_not_input
-from thermocal.models.calibration import Calibration
-from thermocal.models.files import load_calibration, load_model_dict
-from thermocal.recording import Recording
-from thermocal.report import ModelEntry, ReportInputs, write_report
+
+if TYPE_CHECKING:
+    import thermocal.io as _io
+    import thermocal.models.calibration as _calibration
+    import thermocal.models.files as _files
+    import thermocal.recording as _recording
+    import thermocal.report as _report
+else:
+    _io = LazyModule("thermocal.io")
+    _calibration = LazyModule("thermocal.models.calibration")
+    _files = LazyModule("thermocal.models.files")
+    _recording = LazyModule("thermocal.recording")
+    _report = LazyModule("thermocal.report")
 
 
 def read_validation_json(path: Path, *, channels: bool = False) -> dict[str, Any]:
@@ -78,7 +87,7 @@ def _read_run(
     temps: list[str] | None = None,
     text: Any = None,
     topic: str | None = None,
-) -> Recording:
+) -> _recording.Recording:
     return load_recording(
         path,
         time=time,
@@ -164,8 +173,8 @@ def report_cmd(
     inputs_files: list[str | Path] = [*model, *validations, recording]
     if modeling is not None:
         inputs_files.append(modeling)
-    check_not_input(output, inputs_files)
-    cal = load_calibration(model[0])
+    _io.check_not_input(output, inputs_files)
+    cal = _files.load_calibration(model[0])
     if len(cal.channels) > 1 or len(split_names(signal) or []) > 1:
         if len(model) > 1:
             raise ThermocalInputError(
@@ -185,10 +194,10 @@ def report_cmd(
     with progress("building report", total=3) as advance:
         entries = []
         for i, mpath in enumerate(model):
-            mdict = load_model_dict(mpath)
+            mdict = _files.load_model_dict(mpath)
             vdict = read_validation_json(validations[i]) if validations else None
             lab = labels[i] if labels else mpath.stem
-            entries.append(ModelEntry(lab, mdict, vdict, str(mpath)))
+            entries.append(_report.ModelEntry(lab, mdict, vdict, str(mpath)))
         if len({e.label for e in entries}) != len(entries):
             raise ThermocalInputError(
                 "two models have the same label (file stem); name them with --label"
@@ -212,7 +221,7 @@ def report_cmd(
         val_rec = read(recording, sig, text=text, topic=topic)
         mod_rec = read(modeling, sig) if modeling is not None else None
         advance(1)
-        inputs = ReportInputs(
+        inputs = _report.ReportInputs(
             models=tuple(entries),
             recording=val_rec,
             modeling=mod_rec,
@@ -225,13 +234,13 @@ def report_cmd(
             averaging_s=averaging,
         )
         advance(1)
-        path = write_report(output, inputs)
+        path = _report.write_report(output, inputs)
         advance(1)
     stderr.print(f"report written to [bold]{path}[/bold]")
 
 
 def _calibration_report(
-    cal: Calibration,
+    cal: _calibration.Calibration,
     cal_path: Path,
     recording: Path,
     output: Path,

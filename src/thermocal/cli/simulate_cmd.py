@@ -20,22 +20,30 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
-from typing import Annotated, Any
+from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
 
+from thermocal import defaults
+from thermocal._lazy import LazyModule
 from thermocal.cli.application import app
 from thermocal.cli.common import AxisOpt, JsonOpt, LatitudeOpt, emit, handle_errors, stdout
 from thermocal.errors import FileFormatError, ThermocalInputError
-from thermocal.io import check_not_input, file_kind, write_json, write_recording
-from thermocal.profiles import read_program
-from thermocal.simulate import SCENARIOS, TRUTH_FORMAT, TRUTH_VERSION, run_scenario
+
+if TYPE_CHECKING:
+    import thermocal.io as _io
+    import thermocal.profiles as _profiles
+    import thermocal.simulate as _simulate
+else:
+    _io = LazyModule("thermocal.io")
+    _profiles = LazyModule("thermocal.profiles")
+    _simulate = LazyModule("thermocal.simulate")
 
 
 def output_paths(output: Path, scenario: str, labels: list[str], fmt: str) -> list[Path]:
     """File names for the results of a scenario (see the module docstring)."""
     try:
-        file_kind(output)
+        _io.file_kind(output)
         is_file = True
     except FileFormatError:
         is_file = False
@@ -60,7 +68,10 @@ def output_paths(output: Path, scenario: str, labels: list[str], fmt: str) -> li
 @handle_errors
 def simulate_cmd(
     scenario: Annotated[
-        str, typer.Argument(help="Scenario: " + ", ".join(SCENARIOS) + ".", show_default=False)
+        str,
+        typer.Argument(
+            help="Scenario: " + ", ".join(defaults.SCENARIO_NAMES) + ".", show_default=False
+        ),
     ],
     output: Annotated[
         Path,
@@ -101,9 +112,9 @@ def simulate_cmd(
     as_json: JsonOpt = False,
 ) -> None:
     """A simulated recording (or several) with known truth."""
-    if scenario not in SCENARIOS:
+    if scenario not in defaults.SCENARIO_NAMES:
         raise ThermocalInputError(
-            f"unknown scenario {scenario!r}; known scenarios: {', '.join(SCENARIOS)}"
+            f"unknown scenario {scenario!r}; known scenarios: {', '.join(defaults.SCENARIO_NAMES)}"
         )
     if rate_hz is not None and not (math.isfinite(rate_hz) and rate_hz > 0):
         raise ThermocalInputError(f"--rate-hz must be a positive number, got {rate_hz!r}")
@@ -111,8 +122,8 @@ def simulate_cmd(
         raise ThermocalInputError(f"--latitude must be within ±90°, got {latitude!r}")
     prog = None
     if profile is not None:
-        prog = read_program(profile)
-        check_not_input(output, [profile])
+        prog = _profiles.read_program(profile)
+        _io.check_not_input(output, [profile])
     opts: dict[str, Any] = {
         k: v
         for k, v in {
@@ -126,25 +137,25 @@ def simulate_cmd(
         }.items()
         if v is not None
     }
-    results = run_scenario(scenario, seed, prog, **opts)
+    results = _simulate.run_scenario(scenario, seed, prog, **opts)
     labels = [str(t.get("label", "")) for _, t in results]
     if len(set(labels)) != len(labels):
         labels = [f"{i + 1}" for i in range(len(results))]
     paths = output_paths(output, scenario, labels, fmt)
     inputs: list[str | Path] = [profile] if profile is not None else []
     for p in paths:
-        check_not_input(p, inputs)
+        _io.check_not_input(p, inputs)
     if truth is not None:
-        check_not_input(truth, [*inputs, *paths])
+        _io.check_not_input(truth, [*inputs, *paths])
     for (rec, _), p in zip(results, paths, strict=True):
-        write_recording(rec, p)
+        _io.write_recording(rec, p)
     files = [{"file": str(p), **tr} for (_, tr), p in zip(results, paths, strict=True)]
     if truth is not None:
-        write_json(
+        _io.write_json(
             truth,
             {
-                "format": TRUTH_FORMAT,
-                "version": TRUTH_VERSION,
+                "format": _simulate.TRUTH_FORMAT,
+                "version": _simulate.TRUTH_VERSION,
                 "scenario": scenario,
                 "seed": seed,
                 "profile": str(profile) if profile is not None else None,

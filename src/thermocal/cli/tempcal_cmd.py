@@ -10,14 +10,19 @@ from __future__ import annotations
 
 import warnings
 from pathlib import Path
-from typing import Annotated
+from typing import TYPE_CHECKING, Annotated
 
 import typer
-from rich.table import Table
 
+from thermocal._lazy import LazyModule
 from thermocal.cli.application import app
 from thermocal.cli.common import JsonOpt, emit, fmt, handle_errors, load_recording, stdout
 from thermocal.errors import ThermocalInputError
+
+if TYPE_CHECKING:
+    import rich.table as _rich_table
+else:
+    _rich_table = LazyModule("rich.table")
 
 
 @app.command("px4-tempcal")
@@ -103,7 +108,7 @@ def px4_tempcal_cmd(
     }
 
     def human() -> None:
-        table = Table(title=f"PX4 thermal calibration of {log}")
+        table = _rich_table.Table(title=f"PX4 thermal calibration of {log}")
         for col in ("sensor", "device id", "sweep [°C]", "bins", "hold-out rms x/y/z"):
             table.add_column(col)
         for f in fits:
@@ -194,7 +199,7 @@ def ardupilot_tempcal_cmd(
     }
 
     def human() -> None:
-        table = Table(title=f"ArduPilot thermal calibration of {log}")
+        table = _rich_table.Table(title=f"ArduPilot thermal calibration of {log}")
         for col in ("IMU", "sensor", "sweep [°C]", "bins", "hold-out rms x/y/z"):
             table.add_column(col)
         for f in fits:

@@ -2,11 +2,12 @@
 
 from __future__ import annotations
 
-from typing import Annotated
+from typing import TYPE_CHECKING, Annotated
 
 import typer
-from rich.table import Table
 
+from thermocal import defaults
+from thermocal._lazy import LazyModule
 from thermocal.cli.application import app
 from thermocal.cli.common import (
     FileArg,
@@ -21,10 +22,20 @@ from thermocal.cli.common import (
     stdout,
 )
 from thermocal.errors import ThermocalInputError
-from thermocal.io import check_not_input, read_recording, write_json
-from thermocal.turntable.calibrate import DEFAULT_GYRO_COLUMNS, calibrate
-from thermocal.turntable.model import MISALIGNMENT_NAMES
-from thermocal.units import StatedUnits
+
+if TYPE_CHECKING:
+    import rich.table as _rich_table
+
+    import thermocal.io as _io
+    import thermocal.turntable.calibrate as _calibrate
+    import thermocal.turntable.model as _model
+    from thermocal import units
+else:
+    _rich_table = LazyModule("rich.table")
+    _io = LazyModule("thermocal.io")
+    _calibrate = LazyModule("thermocal.turntable.calibrate")
+    _model = LazyModule("thermocal.turntable.model")
+    units = LazyModule("thermocal.units")
 
 
 @app.command("turntable")
@@ -39,7 +50,7 @@ def turntable_cmd(
     time_unit: TimeUnitOpt = None,
     gyro: Annotated[
         str, typer.Option("--gyro", help="Gyro x,y,z column names (comma-separated).")
-    ] = ",".join(DEFAULT_GYRO_COLUMNS),
+    ] = ",".join(defaults.DEFAULT_GYRO_COLUMNS),
     gyro_unit: Annotated[
         str | None,
         typer.Option(
@@ -76,21 +87,21 @@ def turntable_cmd(
     as_json: JsonOpt = False,
 ) -> None:
     """Gyro-triad bias, scale factor and misalignment from a 16-position turntable run."""
-    check_not_input(output, [file])
+    _io.check_not_input(output, [file])
     gyro_cols = split_names(gyro) or []
     if len(gyro_cols) != 3:
         raise ThermocalInputError(f"--gyro needs three column names, got {gyro!r}")
     # the gyro columns' unit through the shared resolver: --gyro-unit > file metadata >
     # unit in the column name > °/s (INTERFACE: gyro_z in °/s), the last stated in a warning
-    rec = read_recording(
+    rec = _io.read_recording(
         file,
         time=time,
         time_unit=time_unit,
         signals=gyro_cols,
         signal_unit=gyro_unit,
-        model=StatedUnits(signal_default="deg/s"),
+        model=units.StatedUnits(signal_default="deg/s"),
     )
-    result = calibrate(
+    result = _calibrate.calibrate(
         rec,
         latitude,
         gyro_columns=gyro_cols,
@@ -104,17 +115,17 @@ def turntable_cmd(
     )
     out = result.to_dict()
     out["input"] = str(file)
-    write_json(output, out)
+    _io.write_json(output, out)
 
     def human() -> None:
-        table = Table(title=f"turntable calibration of {file} ({out['method']})")
+        table = _rich_table.Table(title=f"turntable calibration of {file} ({out['method']})")
         for col in ("coefficient", "value", "σ", "CRB σ", "least squares", "unit"):
             table.add_column(col)
         ls = out["least_squares"]
         groups = (
             ("bias", "bias_deg_h", "°/h", ("x", "y", "z")),
             ("scale factor", "scale_factor_ppm", "ppm", ("x", "y", "z")),
-            ("misalignment", "misalignment_arcsec", "″", MISALIGNMENT_NAMES),
+            ("misalignment", "misalignment_arcsec", "″", _model.MISALIGNMENT_NAMES),
         )
         for label, key, unit, names in groups:
             for i, n in enumerate(names):

@@ -11,11 +11,12 @@ from __future__ import annotations
 
 import warnings
 from pathlib import Path
-from typing import Annotated, Any
+from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
-from rich.table import Table
 
+from thermocal import defaults
+from thermocal._lazy import LazyModule
 from thermocal.cli.application import app
 from thermocal.cli.common import (
     DecimalOpt,
@@ -41,15 +42,26 @@ from thermocal.cli.common import (
     stdout,
     text_options,
 )
-from thermocal.compensate import prepare_run
 from thermocal.errors import ThermocalInputError, UnitWarning
-from thermocal.models.base import TemperatureModel
-from thermocal.models.files import load_calibration
-from thermocal.recording import FloatArray, Recording, find_problems
-from thermocal.validation import DEFAULT_AVERAGING_S, validate
+
+if TYPE_CHECKING:
+    import rich.table as _rich_table
+
+    import thermocal.compensate as _compensate
+    import thermocal.models.base as _base
+    import thermocal.models.files as _files
+    import thermocal.recording as _recording
+    import thermocal.validation as _validation
+else:
+    _rich_table = LazyModule("rich.table")
+    _compensate = LazyModule("thermocal.compensate")
+    _base = LazyModule("thermocal.models.base")
+    _files = LazyModule("thermocal.models.files")
+    _recording = LazyModule("thermocal.recording")
+    _validation = LazyModule("thermocal.validation")
 
 
-def _modeling_file(model: TemperatureModel, model_file: Path) -> Path | None:
+def _modeling_file(model: _base.TemperatureModel, model_file: Path) -> Path | None:
     """The first data file recorded in the model file that still exists: its name, then
     the path given to fit (relative ones tried from the current directory and from the
     model file's directory)."""
@@ -67,7 +79,7 @@ def _modeling_file(model: TemperatureModel, model_file: Path) -> Path | None:
     return None
 
 
-def _ambient(rec: Recording, name: str) -> FloatArray:
+def _ambient(rec: _recording.Recording, name: str) -> _recording.FloatArray:
     """The ambient temperature [°C] for r and the hold stages; raw counts with no
     conversion are used as counts, with a warning (the hold threshold is then per count)."""
     if rec.units.get(name) == "counts" and name not in rec.meta.temperature_conversion:
@@ -86,7 +98,7 @@ def _emit_channels(file: Path, per: dict[str, tuple[Any, dict[str, Any]]], as_js
     """Several channels: ``{"channels": {NAME: {…}}}`` and one verdict per channel."""
 
     def human() -> None:
-        table = Table(title=f"validation on {file}, {len(per)} channels")
+        table = _rich_table.Table(title=f"validation on {file}, {len(per)} channels")
         for col in ("channel", "r", "bias stability before → after", "rms before → after",
                     "unit", "verdict"):  # fmt: skip
             table.add_column(col)
@@ -130,7 +142,7 @@ def validate_cmd(
     ] = None,
     averaging: Annotated[
         float, typer.Option("--average", "--averaging", help="Averaging time [s].")
-    ] = DEFAULT_AVERAGING_S,
+    ] = defaults.DEFAULT_AVERAGING_S,
     signal: ModelSignalOpt = None,
     time: TimeOpt = None,
     time_unit: TimeUnitOpt = None,
@@ -158,10 +170,10 @@ def validate_cmd(
     """Validate MODEL on FILE: correlation r, bias stability and repeatability over the
     hold stages, rms and peak-to-peak, before and after compensation."""
 
-    modeling_cache: dict[Path, Recording] = {}
+    modeling_cache: dict[Path, _recording.Recording] = {}
 
     def run_one(
-        model: TemperatureModel, sig: str, rec: Recording | None = None
+        model: _base.TemperatureModel, sig: str, rec: _recording.Recording | None = None
     ) -> tuple[Any, dict[str, Any]]:
         """Validate one model on its signal column; (result, --json object).  ``rec``: the
         file already read (several channels: once for all of them)."""
@@ -182,7 +194,7 @@ def validate_cmd(
                 text=text_options(t_names, t_rate, t_bad, t_delim, t_dec),
             )
         # the data in the model's units (kinds checked); figures go back to the data's unit
-        prepared = prepare_run(model, rec, sig, temps)
+        prepared = _compensate.prepare_run(model, rec, sig, temps)
         run = prepared.run
         amb_val = _ambient(rec, amb)
 
@@ -202,12 +214,12 @@ def validate_cmd(
                     require_signal=False,
                     check=False,
                 )
-                for prob in find_problems(mrec, required=[amb]):
+                for prob in _recording.find_problems(mrec, required=[amb]):
                     if prob.severity == "error" and (prob.column in (None, "time", amb)):
                         raise ThermocalInputError(f"{mod_path}: {prob.message}")
                 modeling_cache[mod_path] = mrec
             modeling_ambient = (mrec.time_s, _ambient(mrec, amb))
-        res = validate(
+        res = _validation.validate(
             model,
             run,
             modeling_ambient,
@@ -229,7 +241,7 @@ def validate_cmd(
         out["ambient"] = amb
         return res, out
 
-    cal = load_calibration(model_file)  # a model file is a calibration of one channel
+    cal = _files.load_calibration(model_file)  # a model file is a calibration of one channel
     if len(cal.channels) > 1:
         from thermocal.models.calibration import merged_inputs, temperatures_of
 
@@ -270,7 +282,7 @@ def validate_cmd(
             weak = "weakly correlated" if res.weakly_correlated else "NOT weakly correlated"
             head = f"r = {fmt(res.r, 3)} ({weak})"
 
-        table = Table(title=f"validation of {model.family} model on {file}: {head}")
+        table = _rich_table.Table(title=f"validation of {model.family} model on {file}: {head}")
         table.add_column("figure")
         table.add_column(f"before [{u}]", justify="right")
         table.add_column(f"after [{u}]", justify="right")

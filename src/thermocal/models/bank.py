@@ -75,12 +75,11 @@ import math
 import warnings
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
-from typing import Any, ClassVar, Self
+from typing import TYPE_CHECKING, Any, ClassVar, Self
 
 import numpy as np
-from scipy.cluster.hierarchy import fcluster, linkage
-from scipy.spatial.distance import squareform
 
+from thermocal._lazy import LazyModule
 from thermocal.errors import (
     ConditioningWarning,
     DesignError,
@@ -100,6 +99,13 @@ from thermocal.models.base import (
 from thermocal.models.warmup import CONDITION_WARN, channel_index, lstsq_svd, single_channel
 from thermocal.preprocess import segment_holds
 from thermocal.recording import FloatArray
+
+if TYPE_CHECKING:
+    from scipy.cluster import hierarchy as _hierarchy
+    from scipy.spatial import distance as _distance
+else:
+    _hierarchy = LazyModule("scipy.cluster.hierarchy")
+    _distance = LazyModule("scipy.spatial.distance")
 
 ERROR_METRICS = ("max", "rms")
 
@@ -169,8 +175,8 @@ def cluster_runs(distance: FloatArray, threshold: float) -> list[list[int]]:
     if n == 1:
         return [[0]]
     finite = np.where(np.isfinite(distance), distance, 1e300)
-    z = linkage(squareform(finite, checks=False), method="complete")
-    labels = fcluster(z, t=threshold, criterion="distance")
+    z = _hierarchy.linkage(_distance.squareform(finite, checks=False), method="complete")
+    labels = _hierarchy.fcluster(z, t=threshold, criterion="distance")
     groups: dict[int, list[int]] = {}
     for i, lab in enumerate(labels):
         groups.setdefault(int(lab), []).append(i)

@@ -10,13 +10,12 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Iterable, Iterator, Sequence
 from dataclasses import dataclass, field
-from typing import Any, Literal
+from typing import TYPE_CHECKING, Any, Literal
 
 import numpy as np
 import numpy.typing as npt
-from scipy import linalg as sla
-from scipy.linalg import blas, lapack
 
+from thermocal._lazy import LazyModule
 from thermocal.errors import DesignError, ThermocalInputError
 from thermocal.preprocess import (  # Ṫ has one implementation, in preprocess (issue 15)
     RATE_BLOCK_ROWS as RATE_BLOCK_ROWS,
@@ -40,6 +39,14 @@ from thermocal.preprocess import (
     temperature_rates as temperature_rates,
 )
 from thermocal.recording import FloatArray
+
+if TYPE_CHECKING:
+    from scipy import linalg as sla
+    from scipy.linalg import blas, lapack
+else:
+    sla = LazyModule("scipy.linalg")
+    blas = LazyModule("scipy.linalg.blas")
+    lapack = LazyModule("scipy.linalg.lapack")
 
 GRAM_MAX_COND = 1.0e5
 """Largest condition number (column-equilibrated design) for which the Gram path is kept."""

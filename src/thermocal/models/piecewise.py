@@ -57,12 +57,12 @@ import math
 import warnings
 from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass
-from typing import Any, ClassVar, Self
+from typing import TYPE_CHECKING, Any, ClassVar, Self
 
 import numpy as np
 import numpy.typing as npt
-from scipy import optimize
 
+from thermocal._lazy import LazyModule
 from thermocal.errors import (
     DesignError,
     ThermocalInputError,
@@ -88,6 +88,11 @@ from thermocal.models.fitting import (
 from thermocal.models.residuals import MAX_SAMPLES_PER_SERIES, residual_correlation
 from thermocal.models.terms import CHUNK_ROWS, Chunk, LstsqSolution, accumulate_r, solve_r
 from thermocal.recording import FloatArray
+
+if TYPE_CHECKING:
+    from scipy import optimize
+else:
+    optimize = LazyModule("scipy.optimize")
 
 STATE_LAYOUT = "thermocal-piecewise-1"
 METHODS = ("intersect", "continuous")

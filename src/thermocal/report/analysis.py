@@ -19,15 +19,9 @@ from thermocal.metrics import compute_metrics, drift_angle
 from thermocal.models.base import RunData, TemperatureModel
 from thermocal.recording import FloatArray, Metadata, Recording
 
-WEAK_CORRELATION_LIMIT = 0.4
-"""Seed 000 / SPEC §5: the validation test is weakly correlated when r < 0.4."""
-
 ILL_CONDITIONED = 1.0e6
 """Condition number (scaled design) above which the report warns: ill-conditioned in the
 words of :func:`thermocal.models.base.condition_wording`."""
-
-DEFAULT_AVERAGING_S = 100.0
-"""Averaging time of the bias-stability figures when the validation JSON gives none [s]."""
 
 
 # --- analysis of the runs --------------------------------------------------------------------

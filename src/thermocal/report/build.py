@@ -35,6 +35,7 @@ from typing import Any, TypeGuard
 import numpy as np
 from markupsafe import Markup, escape
 
+from thermocal.defaults import DEFAULT_AVERAGING_S, WEAK_CORRELATION_LIMIT
 from thermocal.errors import ThermocalInputError
 from thermocal.io import atomic_write
 from thermocal.models.base import condition_wording
@@ -64,15 +65,9 @@ from thermocal.report.analysis import (
     known_input_of as known_input_of,
 )
 
-WEAK_CORRELATION_LIMIT = 0.4
-"""Seed 000 / SPEC §5: the validation test is weakly correlated when r < 0.4."""
-
 ILL_CONDITIONED = 1.0e6
 """Condition number (scaled design) above which the report warns: ill-conditioned in the
 words of :func:`thermocal.models.base.condition_wording`."""
-
-DEFAULT_AVERAGING_S = 100.0
-"""Averaging time of the bias-stability figures when the validation JSON gives none [s]."""
 
 
 # --- inputs ------------------------------------------------------------------------------

@@ -33,6 +33,7 @@ from pathlib import Path
 from typing import Any
 
 from thermocal.compensation import unit_factor
+from thermocal.defaults import DEFAULT_AVERAGING_S
 from thermocal.errors import ThermocalInputError
 from thermocal.io import atomic_write
 from thermocal.models.base import model_file_dict
@@ -40,7 +41,6 @@ from thermocal.models.calibration import Calibration
 from thermocal.recording import Recording
 from thermocal.report.analysis import allan_of, apply_model, figures_of_merit
 from thermocal.report.build import (
-    DEFAULT_AVERAGING_S,
     ILL_CONDITIONED,
     _b64,
     _coefficient_rows,

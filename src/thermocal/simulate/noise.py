@@ -6,11 +6,17 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import numpy.typing as npt
-import scipy.fft
+
+from thermocal._lazy import LazyModule
+
+if TYPE_CHECKING:
+    import scipy.fft as sfft
+else:
+    sfft = LazyModule("scipy.fft")
 
 FloatArray = npt.NDArray[np.float64]
 ProgramArrays = tuple[FloatArray, FloatArray]
@@ -47,7 +53,7 @@ def flicker_noise(n: int, dt_s: float, b: float, rng: np.random.Generator) -> Fl
     """
     if b == 0.0 or n == 0:
         return np.zeros(n)
-    nfft = int(scipy.fft.next_fast_len(n, real=True))
+    nfft = int(sfft.next_fast_len(n, real=True))
     f = np.fft.rfftfreq(nfft, dt_s)
     amp = np.zeros(f.size)
     np.sqrt(nfft / dt_s * b**2 / (4 * math.pi) / f[1:], out=amp[1:])
@@ -59,7 +65,7 @@ def flicker_noise(n: int, dt_s: float, b: float, rng: np.random.Generator) -> Fl
     if nfft % 2 == 0:  # the Nyquist bin of a real signal is real (same variance)
         spec[-1] = math.sqrt(2.0) * spec[-1].real
     del amp
-    x = scipy.fft.irfft(spec, nfft, workers=-1, overwrite_x=True)
+    x = sfft.irfft(spec, nfft, workers=-1, overwrite_x=True)
     return np.asarray(x[:n], dtype=np.float64)
 
 

@@ -7,17 +7,22 @@ from __future__ import annotations
 import dataclasses
 import math
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import numpy.typing as npt
-from scipy.signal import lfilter
 
 from thermocal import units
+from thermocal._lazy import LazyModule
 from thermocal.errors import ThermocalInputError
 from thermocal.profiles import (
     check_program,
 )
+
+if TYPE_CHECKING:
+    from scipy import signal as _signal
+else:
+    _signal = LazyModule("scipy.signal")
 
 FloatArray = npt.NDArray[np.float64]
 ProgramArrays = tuple[FloatArray, FloatArray]
@@ -86,7 +91,7 @@ def _first_order(u: FloatArray, lam: float, gain: float, h: float, z0: float) ->
     if u.size > 1:
         v = np.multiply(u[1:], gain * float(b1[0]))
         v += (gain * float(b0[0])) * u[:-1]
-        out[1:], _ = lfilter([1.0], [1.0, -float(a[0])], v, zi=[float(a[0]) * z0])
+        out[1:], _ = _signal.lfilter([1.0], [1.0, -float(a[0])], v, zi=[float(a[0]) * z0])
     return out
 
 
@@ -276,7 +281,7 @@ def simulate_nodes(
         up = air_c[s0 - 1 : s1 - 1] if s0 > 0 else np.concatenate(([u0], air_c[: s1 - 1]))
         for i in range(k):
             v = (w_air[i] * b1[i]) * u + (w_air[i] * b0[i]) * up
-            zc[i, :c], _ = lfilter([1.0], [1.0, -a[i]], v, zi=[a[i] * z_last[i]])
+            zc[i, :c], _ = _signal.lfilter([1.0], [1.0, -a[i]], v, zi=[a[i] * z_last[i]])
             z_last[i] = zc[i, c - 1]
         np.multiply(w_air[:, None], u[None, :], out=dzc[:, :c])
         dzc[:, :c] -= lam[:, None] * zc[:, :c]

@@ -19,6 +19,7 @@ import numpy as np
 import numpy.typing as npt
 
 from thermocal import units
+from thermocal.defaults import DEFAULT_GYRO_COLUMNS as DEFAULT_GYRO_COLUMNS
 from thermocal.errors import MissingValueError, ThermocalInputError, UnitError
 from thermocal.recording import Recording
 from thermocal.turntable import estimate_ls, kalman, model, schedule
@@ -28,7 +29,6 @@ FloatArray = npt.NDArray[np.float64]
 
 RESULT_FORMAT = "thermocal-turntable-result"
 RESULT_VERSION = 1
-DEFAULT_GYRO_COLUMNS = ("gyro_x", "gyro_y", "gyro_z")
 DEFAULT_PRIOR_SIGMA = (1.0, 1000.0, 3600.0)
 """Initial σ of the filter's coefficients: bias [°/h], scale factor [ppm], misalignment [″]."""
 

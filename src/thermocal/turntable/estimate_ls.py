@@ -19,14 +19,20 @@ from __future__ import annotations
 
 import itertools
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 import numpy.typing as npt
-import scipy.linalg
 
+from thermocal._lazy import LazyModule
 from thermocal.errors import DesignError
 from thermocal.turntable.model import N_COEFFS, IntervalModel
 from thermocal.turntable.schedule import runs
+
+if TYPE_CHECKING:
+    from scipy import linalg as sla
+else:
+    sla = LazyModule("scipy.linalg")
 
 FloatArray = npt.NDArray[np.float64]
 IntArray = npt.NDArray[np.intp]
@@ -153,7 +159,7 @@ def block_covariance(blocks: Blocks, encoder_noise_arcsec: float = 0.0) -> Float
     ``C = blockdiag(cov W_j) + σ_e² (D Dᵀ ⊗ diag(1, 1[, 0]))``: a block's start point
     is the previous block's end point unless the block restarts the integration."""
     k, nc = blocks.n, blocks.n_channels
-    c = scipy.linalg.block_diag(*blocks.cov)
+    c = sla.block_diag(*blocks.cov)
     if encoder_noise_arcsec > 0:
         d = np.zeros((k, k + int(np.count_nonzero(blocks.restart))))
         point = -1
@@ -179,9 +185,9 @@ def solve_ls(
     normalised before the SVD; singular values below ``rcond`` × the largest are
     dropped (their directions get an infinite variance)."""
     if encoder_noise_arcsec > 0:
-        low = scipy.linalg.cholesky(block_covariance(blocks, encoder_noise_arcsec), lower=True)
-        a = scipy.linalg.solve_triangular(low, blocks.h.reshape(-1, N_COEFFS), lower=True)
-        y = scipy.linalg.solve_triangular(low, blocks.y.reshape(-1), lower=True)
+        low = sla.cholesky(block_covariance(blocks, encoder_noise_arcsec), lower=True)
+        a = sla.solve_triangular(low, blocks.h.reshape(-1, N_COEFFS), lower=True)
+        y = sla.solve_triangular(low, blocks.y.reshape(-1), lower=True)
     else:  # blocks independent: whiten each block's channels by its own Cholesky factor
         low_b = np.linalg.cholesky(blocks.cov)
         a = np.linalg.solve(low_b, blocks.h).reshape(-1, N_COEFFS)

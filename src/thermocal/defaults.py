@@ -1,0 +1,38 @@
+"""Defaults and names the command line shows in its help, kept free of numpy.
+
+``thermocal --help`` registers every command without importing the maths (issue 17): the
+values a command's help or defaults show live here, and the modules that use them import them
+from here (one definition each)."""
+
+from __future__ import annotations
+
+from typing import Final
+
+DEFAULT_CHUNK_ROWS: Final = 500_000
+"""Rows per chunk of :func:`thermocal.compensate.compensate_file` (≈ 100 MB of working memory
+for a 37-term polynomial)."""
+
+WEAK_CORRELATION_LIMIT: Final = 0.4
+"""Seed 000 / SPEC §5: a validation test is weakly correlated with the modelling test when
+r < 0.4."""
+
+DEFAULT_AVERAGING_S: Final = 100.0
+"""Averaging time of the stability figures [s] (SPEC §1: 10 s or 100 s averages)."""
+
+DEFAULT_GYRO_COLUMNS: Final = ("gyro_x", "gyro_y", "gyro_z")
+"""Gyro columns of a turntable recording (``thermocal turntable --gyro``)."""
+
+SCENARIO_NAMES: Final = (
+    "rlg-modelling",
+    "rlg-validation",
+    "fog-slow",
+    "mems-warmup",
+    "accel-full-range",
+    "turntable-16",
+    "mems-imu",
+)
+"""The simulator's scenarios (:data:`thermocal.simulate.SCENARIOS`, a test checks they agree)."""
+
+PROGRAM_TIME: Final = "time_s"
+PROGRAM_SETPOINT: Final = "setpoint_c"
+"""Columns of a chamber program CSV (:func:`thermocal.profiles.read_program`)."""
