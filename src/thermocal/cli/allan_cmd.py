@@ -1,8 +1,6 @@
 """``thermocal allan FILE``: overlapping Allan deviation, confidence intervals and
 IEEE 952 noise terms by slope lines and by least squares."""
 
-from __future__ import annotations
-
 import warnings
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated, Any
@@ -64,7 +62,7 @@ def _terms_json(terms: dict[str, Any]) -> dict[str, Any]:
     }
 
 
-def allan_json(res: _allan.AllanResult, noise: _allan.NoiseTerms) -> dict[str, Any]:
+def allan_json(res: "_allan.AllanResult", noise: "_allan.NoiseTerms") -> dict[str, Any]:
     """The ``--json`` object of ``thermocal allan``: ``noise`` holds the fit-method
     terms, ``noise_slope`` the slope-line terms (each value or null with a reason)."""
     out: dict[str, Any] = {
@@ -93,7 +91,7 @@ def allan_json(res: _allan.AllanResult, noise: _allan.NoiseTerms) -> dict[str, A
 
 def _emit_channels(
     file: Path,
-    analyses: dict[str, tuple[_allan.AllanResult, _allan.NoiseTerms]],
+    analyses: "dict[str, tuple[_allan.AllanResult, _allan.NoiseTerms]]",
     as_json: bool,
     plot: Path | None,
 ) -> None:

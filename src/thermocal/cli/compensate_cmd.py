@@ -5,8 +5,6 @@ OUT keeps every input column and adds ``<signal>_model`` and ``<signal>_comp``
 (:func:`thermocal.compensate.compensate_file`).
 """
 
-from __future__ import annotations
-
 from typing import TYPE_CHECKING, Annotated
 
 import typer

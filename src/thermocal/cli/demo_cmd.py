@@ -5,8 +5,6 @@ term-selected fits → validation → compensation → C export → HTML report)
 progress bar on a terminal, then prints a short summary table and the report's path.
 """
 
-from __future__ import annotations
-
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated
 

@@ -7,8 +7,6 @@ build against the double build is measured (both compiled with the system C
 compiler on 10⁵ synthetic samples over the model's range) and printed.
 """
 
-from __future__ import annotations
-
 import json
 import warnings
 from pathlib import Path

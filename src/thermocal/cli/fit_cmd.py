@@ -46,8 +46,6 @@ JSON keys (``--json``): ``model``, ``output``, ``n_coefficients``,
 fit statistics), ``coefficients`` and ``warnings``.
 """
 
-from __future__ import annotations
-
 import dataclasses
 import math
 import warnings
@@ -116,12 +114,12 @@ else:
 TARGETS = ("bias", "scale_factor")
 
 
-def run_temp_names(rec: _recording.Recording, temps: str | None) -> list[str]:
+def run_temp_names(rec: "_recording.Recording", temps: str | None) -> list[str]:
     """The temperature columns a fit uses: ``--temps`` or the file's."""
     return split_names(temps) or list(rec.temperatures)
 
 
-def build_model(family: str, options: dict[str, Any]) -> _base.TemperatureModel:
+def build_model(family: str, options: dict[str, Any]) -> "_base.TemperatureModel":
     """Instantiate a registered family from the CLI option dict by its one option parser
     (:meth:`TemperatureModel.from_cli_options`: an option the family does not take is
     refused, for every family)."""
@@ -396,7 +394,7 @@ def _local_gravity(
 
 
 def _gravity_known_input(
-    spec: _FitSpec, path: Path, name: str, unit: str, values_mg: _recording.FloatArray
+    spec: _FitSpec, path: Path, name: str, unit: str, values_mg: "_recording.FloatArray"
 ) -> float:
     """The gravity an accelerometer channel reads in the static run [mg] (0 for a gyro or
     without ``--gravity-axis``), after checking the channel's mean against it: the up axis
@@ -448,8 +446,8 @@ def _gravity_known_input(
 class _Prepared:
     """One channel ready to fit: its model, runs and provenance, and the warnings so far."""
 
-    est: _base.TemperatureModel
-    runs: list[_base.RunData]
+    est: "_base.TemperatureModel"
+    runs: "list[_base.RunData]"
     first_inputs: dict[str, Any]
     provenance: list[dict[str, Any]]
     unit: str
@@ -458,8 +456,8 @@ class _Prepared:
 
 
 def _fit_channel(
-    spec: _FitSpec, loaded: list[tuple[Path, _recording.Recording]], signal: str | None
-) -> tuple[_base.TemperatureModel, dict[str, Any], int]:
+    spec: _FitSpec, loaded: "list[tuple[Path, _recording.Recording]]", signal: str | None
+) -> "tuple[_base.TemperatureModel, dict[str, Any], int]":
     """Fit one channel on the loaded runs; returns the model, its ``--json`` result and
     the number of runs. Warnings are printed (by handle_errors) and listed in the result."""
     ((_n, est, result, n_runs),) = _fit_channels(spec, loaded, [signal])
@@ -467,8 +465,8 @@ def _fit_channel(
 
 
 def _fit_channels(
-    spec: _FitSpec, loaded: list[tuple[Path, _recording.Recording]], signals: Sequence[str | None]
-) -> list[tuple[str, _base.TemperatureModel, dict[str, Any], int]]:
+    spec: _FitSpec, loaded: "list[tuple[Path, _recording.Recording]]", signals: Sequence[str | None]
+) -> "list[tuple[str, _base.TemperatureModel, dict[str, Any], int]]":
     """Fit every channel on the loaded runs (each file read once, by the caller).  Channels
     of the ``poly`` family with the same temperature inputs share one design
     (:func:`thermocal.models.poly.fit_shared`: Ṫ, features and the design's reduction once;
@@ -502,7 +500,7 @@ def _share_inputs(preps: list[_Prepared]) -> None:
 
 
 def _prepare_channel(
-    spec: _FitSpec, loaded: list[tuple[Path, _recording.Recording]], signal: str | None
+    spec: _FitSpec, loaded: "list[tuple[Path, _recording.Recording]]", signal: str | None
 ) -> _Prepared:
     """One channel's runs with their known inputs, its model object and provenance."""
     est = build_model(spec.family, spec.options)
@@ -578,7 +576,7 @@ def _prepare_channel(
 
 def _finish_channel(
     spec: _FitSpec, prep: _Prepared
-) -> tuple[_base.TemperatureModel, dict[str, Any], int]:
+) -> "tuple[_base.TemperatureModel, dict[str, Any], int]":
     """After the fit: the fit-quality warnings, the model's metadata, the ``--json`` result."""
     est, runs, first_inputs, provenance = prep.est, prep.runs, prep.first_inputs, prep.provenance
     unit, sig_name, target = prep.unit, prep.sig_name, spec.target
@@ -655,7 +653,7 @@ def _finish_channel(
 
 
 def _human_single(
-    est: _base.TemperatureModel, result: dict[str, Any], n_runs: int, output: Path
+    est: "_base.TemperatureModel", result: dict[str, Any], n_runs: int, output: Path
 ) -> None:
     """The fit summary and coefficient tables of one model."""
     st = est.stats_
@@ -712,7 +710,7 @@ def _human_single(
 
 
 def _human_channels(
-    fitted: list[tuple[str, _base.TemperatureModel, dict[str, Any], int]], output: Path
+    fitted: "list[tuple[str, _base.TemperatureModel, dict[str, Any], int]]", output: Path
 ) -> None:
     """One row per channel: model, samples, residual, condition, range."""
     tab = _rich_table.Table(title=f"calibration of {len(fitted)} channels → {output}")

@@ -1,7 +1,5 @@
 """``thermocal inspect FILE``: what is in a recording and what is wrong with it."""
 
-from __future__ import annotations
-
 import re
 from typing import TYPE_CHECKING, Annotated
 
@@ -151,7 +149,7 @@ def inspect_cmd(
         raise ThermocalInputError(f"{file}: --strict: {one_line(warns[0].message)}{more}")
 
 
-def _print_human(r: _inspection.Inspection) -> None:
+def _print_human(r: "_inspection.Inspection") -> None:
     stdout.print(f"[bold]{_markup.escape(str(r.file))}[/bold]", markup=True)
     if r.time_ok and r.duration_s is not None:
         stdout.print(

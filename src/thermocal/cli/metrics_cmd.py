@@ -1,8 +1,6 @@
 """``thermocal metrics FILE``: bias, bias stability, peak-to-peak, drift angle,
 repeatability and temperature sensitivity of one signal (SPEC §1)."""
 
-from __future__ import annotations
-
 from collections.abc import Callable
 from typing import TYPE_CHECKING, Annotated, Any
 
@@ -49,7 +47,7 @@ else:
     _metrics = LazyModule("thermocal.metrics")
 
 
-def metrics_json(res: _metrics.MetricsResult) -> dict[str, Any]:
+def metrics_json(res: "_metrics.MetricsResult") -> dict[str, Any]:
     """The ``--json`` object of ``thermocal metrics`` (INTERFACE.md keys first)."""
     d: dict[str, Any] = jsonable(res)
     ts = res.temperature_sensitivity
@@ -156,8 +154,8 @@ def metrics_cmd(
         if many:  # each channel in its own unit: a row of units, no unit column
             table.add_row("unit", *[r.unit for r in results.values()])
 
-        def row(label: str, get: Callable[[MetricsResult], float | None], digits: int = 4,
-                unit: Callable[[MetricsResult], str] = lambda r: r.unit) -> None:  # fmt: skip
+        def row(label: str, get: "Callable[[MetricsResult], float | None]", digits: int = 4,
+                unit: "Callable[[MetricsResult], str]" = lambda r: r.unit) -> None:  # fmt: skip
             values = [get(r) for r in results.values()]
             if all(v is None for v in values):
                 return
@@ -204,6 +202,6 @@ def metrics_cmd(
         emit({"channels": {n: metrics_json(r) for n, r in results.items()}}, as_json, human)
 
 
-def first_result(results: dict[str, _metrics.MetricsResult]) -> _metrics.MetricsResult:
+def first_result(results: "dict[str, _metrics.MetricsResult]") -> "_metrics.MetricsResult":
     """The only result of a one-channel run."""
     return next(iter(results.values()))

@@ -10,8 +10,6 @@
   over the modelling range with |r| below the limit.
 """
 
-from __future__ import annotations
-
 import math
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated, Any
@@ -73,7 +71,7 @@ ColumnOpt = Annotated[
 
 
 def _write_profile(
-    prof: _profiles.Profile, output: Path, dt: float, as_json: bool, **extra: Any
+    prof: "_profiles.Profile", output: Path, dt: float, as_json: bool, **extra: Any
 ) -> None:
     if not (dt >= 0 and math.isfinite(dt)):
         raise ThermocalInputError(f"--dt must be ≥ 0 s (0: corner points only), got {dt:g}")
@@ -106,7 +104,7 @@ def _clean(params: dict[str, Any]) -> dict[str, Any]:
 
 def load_history(
     path: Path, column: str | None = None
-) -> tuple[_recording.FloatArray, _recording.FloatArray, str]:
+) -> "tuple[_recording.FloatArray, _recording.FloatArray, str]":
     """A temperature history ``(time_s, temperature_c, column)`` from a chamber program CSV
     (``time_s, setpoint_c``; its set-point unless ``column`` is another of its columns) or a
     recording (``column``, default its first temperature column, else ``setpoint_c``)."""

@@ -8,8 +8,6 @@ recording.  The first model is reported in detail; the others appear in the
 comparison table.
 """
 
-from __future__ import annotations
-
 import functools
 import json
 from pathlib import Path
@@ -87,7 +85,7 @@ def _read_run(
     temps: list[str] | None = None,
     text: Any = None,
     topic: str | None = None,
-) -> _recording.Recording:
+) -> "_recording.Recording":
     return load_recording(
         path,
         time=time,
@@ -240,7 +238,7 @@ def report_cmd(
 
 
 def _calibration_report(
-    cal: _calibration.Calibration,
+    cal: "_calibration.Calibration",
     cal_path: Path,
     recording: Path,
     output: Path,

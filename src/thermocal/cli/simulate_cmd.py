@@ -16,8 +16,6 @@ Output naming:
   ``files`` (``file`` is the path written).
 """
 
-from __future__ import annotations
-
 import math
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated, Any

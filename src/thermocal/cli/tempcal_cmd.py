@@ -6,8 +6,6 @@ held-out bins and fitted as a cubic per axis (:mod:`thermocal.px4_tempcal`); wri
 sensor, ``DIR/report_<topic>_<n>.html``.
 """
 
-from __future__ import annotations
-
 import warnings
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated

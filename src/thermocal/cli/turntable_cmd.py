@@ -1,7 +1,5 @@
 """``thermocal turntable FILE -o RESULT.json``: gyro-triad calibration (SPEC §7)."""
 
-from __future__ import annotations
-
 from typing import TYPE_CHECKING, Annotated
 
 import typer

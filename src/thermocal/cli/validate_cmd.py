@@ -7,8 +7,6 @@ column).  Without ``--modeling`` the model file's recorded data file is used if
 it still exists; otherwise ``r`` is null, with a warning.
 """
 
-from __future__ import annotations
-
 import warnings
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated, Any
@@ -61,7 +59,7 @@ else:
     _validation = LazyModule("thermocal.validation")
 
 
-def _modeling_file(model: _base.TemperatureModel, model_file: Path) -> Path | None:
+def _modeling_file(model: "_base.TemperatureModel", model_file: Path) -> Path | None:
     """The first data file recorded in the model file that still exists: its name, then
     the path given to fit (relative ones tried from the current directory and from the
     model file's directory)."""
@@ -79,7 +77,7 @@ def _modeling_file(model: _base.TemperatureModel, model_file: Path) -> Path | No
     return None
 
 
-def _ambient(rec: _recording.Recording, name: str) -> _recording.FloatArray:
+def _ambient(rec: "_recording.Recording", name: str) -> "_recording.FloatArray":
     """The ambient temperature [°C] for r and the hold stages; raw counts with no
     conversion are used as counts, with a warning (the hold threshold is then per count)."""
     if rec.units.get(name) == "counts" and name not in rec.meta.temperature_conversion:
@@ -173,7 +171,7 @@ def validate_cmd(
     modeling_cache: dict[Path, _recording.Recording] = {}
 
     def run_one(
-        model: _base.TemperatureModel, sig: str, rec: _recording.Recording | None = None
+        model: "_base.TemperatureModel", sig: str, rec: "_recording.Recording | None" = None
     ) -> tuple[Any, dict[str, Any]]:
         """Validate one model on its signal column; (result, --json object).  ``rec``: the
         file already read (several channels: once for all of them)."""
