@@ -301,3 +301,28 @@ def test_slope_line_is_not_read_off_the_wrong_region() -> None:
     arw = terms.slope.angle_random_walk
     assert arw.value is not None
     assert arw.value == pytest.approx(1.0 / 60.0, rel=0.05)  # 1 °/h·√s = 1/60 °/√h
+
+
+def test_nnls_small_is_scipys_nnls() -> None:
+    """The noise-term fit's exact NNLS (support enumeration) against scipy.optimize.nnls
+    (Lawson–Hanson active set) on random 23×5 problems, half with a sparse positive truth."""
+    from scipy.optimize import nnls
+
+    rng = np.random.default_rng(1)
+    for i in range(300):
+        a = rng.standard_normal((23, 5)) * rng.uniform(0.01, 100.0, 5)
+        if i % 2:
+            x = np.abs(rng.standard_normal(5)) * (rng.random(5) > 0.5)
+            b = a @ x + 0.01 * rng.standard_normal(23)
+        else:
+            b = rng.standard_normal(23)
+        ref, _ = nnls(a, b)
+        assert_allclose(allan.nnls_small(a, b), ref, rtol=1e-9, atol=1e-12 * np.abs(ref).max())
+
+
+def test_fit_p_value_is_the_chi_square_survival_function() -> None:
+    from scipy.stats import chi2
+
+    r = np.linspace(-2.0, 3.0, 9)
+    q = allan.fit_quality(np.arange(1.0, 10.0), r, 3)
+    assert q.p_value == pytest.approx(chi2.sf(float(r @ r), 6), rel=1e-12)

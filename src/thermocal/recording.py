@@ -180,6 +180,9 @@ class Recording:
     """Where each column's unit came from (``option``, ``metadata``, ``column name``,
     ``model`` or ``default``; ``"<time>"`` for the time column), for files read by
     :func:`thermocal.io.read_recording`."""
+    _scan: tuple[FloatArray, TimeScan] | None = field(
+        default=None, init=False, repr=False, compare=False
+    )
 
     # --- construction ----------------------------------------------------------
     @classmethod
@@ -237,10 +240,11 @@ class Recording:
 
     @property
     def sample_interval_s(self) -> float:
-        """Nominal sample interval τ [s]: metadata if given, else the median time step."""
+        """Nominal sample interval τ [s]: metadata if given, else the median time step (the
+        mean step on a regular grid, :func:`scan_time`)."""
         if self.meta.sample_interval_s is not None:
             return float(self.meta.sample_interval_s)
-        return median_interval(self.time_s)
+        return self.time_scan().interval_s
 
     @property
     def sample_rate_hz(self) -> float:
@@ -330,13 +334,22 @@ class Recording:
             )
         return pool[0]
 
+    def time_scan(self) -> TimeScan:
+        """The time checks (:func:`scan_time`), computed once per time array: validation,
+        gaps, segments and the sample interval share one pass.  A new ``time_s`` object
+        (``dataclasses.replace``, :meth:`select`) is scanned anew; writing into the time
+        array in place is not detected."""
+        if self._scan is None or self._scan[0] is not self.time_s:
+            self._scan = (self.time_s, scan_time(self.time_s))
+        return self._scan[1]
+
     def gaps(self, factor: float = GAP_FACTOR) -> list[Gap]:
         """Gaps in time (see :func:`find_gaps`)."""
-        return find_gaps(self.time_s, factor=factor)
+        return find_gaps(self.time_s, factor=factor, scan=self.time_scan())
 
     def segments(self, factor: float = GAP_FACTOR) -> list[slice]:
         """Contiguous (gap-free) index ranges."""
-        return contiguous_slices(self.time_s, factor=factor)
+        return contiguous_slices(self.time_s, factor=factor, scan=self.time_scan())
 
     def select(self, index: slice | npt.NDArray[np.bool_] | npt.NDArray[np.intp]) -> Recording:
         """A recording of the selected rows (metadata and roles kept)."""
@@ -390,23 +403,84 @@ def time_steps(time_s: FloatArray, block: int = DIFF_BLOCK) -> Iterator[tuple[in
         yield a, time_s[a + 1 : b + 1] - time_s[a:b]
 
 
+REGULAR_GRID_ULPS = 64
+"""Steps that differ by at most this many units in the last place of the largest time stamp
+differ only by the rounding of the stamps: the grid is regular (:func:`scan_time`)."""
+
+
+@dataclass(frozen=True)
+class TimeScan:
+    """What one pass over the time steps ``Δt_i = t[i+1] − t[i]`` finds (:func:`scan_time`).
+
+    ``interval_s`` is the nominal sample interval [s]: on a regular grid (every step within
+    :data:`REGULAR_GRID_ULPS` units in the last place of the largest stamp of each other)
+    the mean step ``(t[n−1] − t[0]) / (n − 1)``, which the median then equals to that
+    rounding; otherwise the median step (one O(n) partition).  NaN for fewer than 2 samples
+    or a non-finite time.  ``duplicate_rows``/``backward_rows`` are the ``i`` with
+    ``Δt_i = 0`` / ``Δt_i < 0``.
+    """
+
+    n: int
+    finite: bool
+    min_step_s: float
+    max_step_s: float
+    interval_s: float
+    regular: bool
+    duplicate_rows: npt.NDArray[np.intp]
+    backward_rows: npt.NDArray[np.intp]
+
+
+def scan_time(time_s: FloatArray) -> TimeScan:
+    """Scan a time column once, block by block (:func:`time_steps`, bounded memory): finite
+    or not, smallest and largest step, duplicates, backward steps and the interval
+    (:class:`TimeScan`).  The exact median is computed only when the grid is not regular
+    (issue 17: the checks of a 10⁸-row file took six differences and four medians)."""
+    n = int(time_s.size)
+    empty = np.zeros(0, dtype=np.intp)
+    nan = float("nan")
+    if n < 2 or not bool(np.isfinite(time_s).all()):
+        finite = n == 0 or bool(np.isfinite(time_s).all())
+        return TimeScan(n, finite, nan, nan, nan, False, empty, empty)
+    lo, hi = math.inf, -math.inf
+    dup_parts: list[npt.NDArray[np.intp]] = []
+    back_parts: list[npt.NDArray[np.intp]] = []
+    for a, dt in time_steps(time_s):
+        lo = min(lo, float(dt.min()))
+        hi = max(hi, float(dt.max()))
+        if lo <= 0.0:
+            dup_parts.append(a + np.flatnonzero(dt == 0))
+            back_parts.append(a + np.flatnonzero(dt < 0))
+    dup = np.concatenate(dup_parts) if dup_parts else empty
+    back = np.concatenate(back_parts) if back_parts else empty
+    stamp_ulp = float(np.spacing(max(abs(float(time_s[0])), abs(float(time_s[-1])))))
+    regular = lo > 0 and hi - lo <= REGULAR_GRID_ULPS * stamp_ulp
+    if regular:
+        interval = float(time_s[-1] - time_s[0]) / (n - 1)
+    else:
+        interval = float(np.median(np.diff(time_s), overwrite_input=True))
+    return TimeScan(n, True, lo, hi, interval, regular, dup, back)
+
+
 def median_interval(time_s: FloatArray) -> float:
-    """Median time step [s] (NaN for fewer than 2 samples); one array of steps as working
-    memory (the median partitions it in place)."""
-    if time_s.size < 2:
-        return float("nan")
-    return float(np.median(np.diff(time_s), overwrite_input=True))
+    """Nominal time step [s]: the median step, or the mean step on a regular grid where the
+    two agree to the rounding of the stamps (:func:`scan_time`); NaN for fewer than 2
+    samples."""
+    return scan_time(time_s).interval_s
 
 
-def find_gaps(time_s: FloatArray, factor: float = GAP_FACTOR) -> list[Gap]:
-    """Gaps: steps longer than ``factor`` × the median step.
+def find_gaps(
+    time_s: FloatArray, factor: float = GAP_FACTOR, scan: TimeScan | None = None
+) -> list[Gap]:
+    """Gaps: steps longer than ``factor`` × the nominal step (:func:`scan_time`; ``scan``
+    if the caller has it already).
 
     Returns one :class:`Gap` per gap, ``start_s`` measured from the first sample.
     """
     if time_s.size < 3:
         return []
-    med = median_interval(time_s)
-    if not med > 0:
+    sc = scan if scan is not None else scan_time(time_s)
+    med = sc.interval_s
+    if not med > 0 or not sc.max_step_s > factor * med:  # no step long enough: no pass
         return []
     t0 = float(time_s[0])
     out: list[Gap] = []
@@ -417,9 +491,12 @@ def find_gaps(time_s: FloatArray, factor: float = GAP_FACTOR) -> list[Gap]:
     return out
 
 
-def contiguous_slices(time_s: FloatArray, factor: float = GAP_FACTOR) -> list[slice]:
+def contiguous_slices(
+    time_s: FloatArray, factor: float = GAP_FACTOR, scan: TimeScan | None = None
+) -> list[slice]:
     """Index ranges between gaps (one slice for a gap-free recording)."""
-    bounds = [0] + [g.index + 1 for g in find_gaps(time_s, factor)] + [int(time_s.size)]
+    gaps = find_gaps(time_s, factor, scan)
+    bounds = [0] + [g.index + 1 for g in gaps] + [int(time_s.size)]
     return [slice(a, b) for a, b in itertools.pairwise(bounds) if b > a]
 
 
@@ -444,7 +521,8 @@ def find_problems(rec: Recording, required: list[str] | None = None) -> list[Pro
     if t.size == 0:
         probs.append(Problem("empty", "the recording has no samples"))
         return probs
-    bad_t = np.flatnonzero(~np.isfinite(t))
+    scan = rec.time_scan()
+    bad_t = np.flatnonzero(~np.isfinite(t)) if not scan.finite else np.zeros(0, dtype=np.intp)
     if bad_t.size:
         probs.append(
             Problem(
@@ -455,14 +533,7 @@ def find_problems(rec: Recording, required: list[str] | None = None) -> list[Pro
             )
         )
     else:
-        dup_parts: list[npt.NDArray[np.intp]] = []
-        back_parts: list[npt.NDArray[np.intp]] = []
-        for a, dt_block in time_steps(t):
-            dup_parts.append(a + np.flatnonzero(dt_block == 0))
-            back_parts.append(a + np.flatnonzero(dt_block < 0))
-        empty = np.zeros(0, dtype=np.intp)
-        dup = np.concatenate(dup_parts) if dup_parts else empty
-        back = np.concatenate(back_parts) if back_parts else empty
+        dup, back = scan.duplicate_rows, scan.backward_rows
         if dup.size:
             probs.append(
                 Problem(
@@ -510,14 +581,14 @@ def find_problems(rec: Recording, required: list[str] | None = None) -> list[Pro
     if t.size < 2:
         probs.append(Problem("too_short", "the recording has fewer than 2 samples"))
     if not any(p.kind in ("nonfinite_time", "duplicate_time", "backwards_time") for p in probs):
-        gaps = find_gaps(t)
+        gaps = rec.gaps()
         if gaps:
             total = sum(g.length_s for g in gaps)
             probs.append(
                 Problem(
                     "gaps",
                     f"{len(gaps)} gaps in time (longer than {GAP_FACTOR}× the median "
-                    f"interval {median_interval(t):.6g} s), {total:.6g} s in all; "
+                    f"interval {scan.interval_s:.6g} s), {total:.6g} s in all; "
                     "first after row "
                     f"{gaps[0].index} at {gaps[0].start_s:.6g} s",
                     severity="warning",

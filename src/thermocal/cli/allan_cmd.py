@@ -196,6 +196,7 @@ def allan_cmd(
             rec.sample_interval_s,
             tau_spec,
             time_s=rec.time_s,
+            segments=rec.segments(),  # one scan of the time column for every channel
             unit=unit,
             confidence=confidence,
         )
