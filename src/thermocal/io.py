@@ -292,6 +292,41 @@ class _ParquetColumns:
         self.column_names: list[str] = list(schema.names)
         self.num_rows: int = int(pf.metadata.num_rows)
         self.metadata: dict[bytes, bytes] = dict(schema.metadata or {})
+        self._read: dict[str, FloatArray] = {}
+
+    def read_f64(self, names: Sequence[str]) -> None:
+        """Read the integer and floating-point columns among ``names`` together, one row
+        group at a time (pyarrow decodes the columns of a row group on several threads);
+        :meth:`column_f64` then hands each one over.  Peak memory: the results plus one
+        row group of these columns."""
+        schema = self._pf.schema_arrow
+        todo = [
+            n
+            for n in dict.fromkeys(names)
+            if n in self.column_names
+            and n not in self._read
+            and (
+                pa.types.is_integer(schema.field(n).type)
+                or pa.types.is_floating(schema.field(n).type)
+            )
+        ]
+        if len(todo) < 2:
+            return
+        out = {n: np.empty(self.num_rows, dtype=np.float64) for n in todo}
+        pos = 0
+        for i in range(self._pf.num_row_groups):
+            group = self._pf.read_row_group(i, columns=todo, use_threads=True)
+            k = 0
+            for n in todo:
+                k = 0
+                for chunk in group.column(n).chunks:
+                    out[n][pos + k : pos + k + len(chunk)] = arrow_chunk_f64(chunk)
+                    k += len(chunk)
+            pos += k
+            del group
+        if pos != self.num_rows:
+            raise pa.ArrowInvalid(f"columns {todo} have {pos} rows, the file {self.num_rows}")
+        self._read.update(out)
 
     def column(self, name: str) -> pa.ChunkedArray:
         col: pa.ChunkedArray = self._pf.read(columns=[name], use_threads=True).column(0)
@@ -301,6 +336,8 @@ class _ParquetColumns:
         """A numeric column as float64, read one row group at a time into the result, so
         that the only memory beyond the result is one row group of one column (None for a
         column that is not integer or floating point: the caller reads it whole)."""
+        if name in self._read:  # read with others by :meth:`read_f64`
+            return self._read.pop(name)
         field_type = self._pf.schema_arrow.field(name).type
         if not (pa.types.is_integer(field_type) or pa.types.is_floating(field_type)):
             return None
@@ -1160,6 +1197,7 @@ def read_recording(
     if isinstance(obj, _ParquetColumns):  # read column by column: only what is used
         used = len(names) if keep_other else 1 + len(sig_names) + len(tmp_names)
         check_memory(p, n_rows, used)
+        obj.read_f64([time_col, *sig_names, *tmp_names])
     t = numeric_column(obj, time_col, p)
     if resolved.time.unit != "s":
         t = t * units.TIME_UNITS[resolved.time.unit]

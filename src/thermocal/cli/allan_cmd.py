@@ -7,7 +7,7 @@ from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
 
-from thermocal._lazy import LazyModule
+from thermocal._lazy import LazyModule, prefetch
 from thermocal.cli.application import app
 from thermocal.cli.common import (
     DecimalOpt,
@@ -160,6 +160,7 @@ def allan_cmd(
     terms (quantization, angle random walk, bias instability, rate random walk, rate
     ramp) by least squares and by IEEE 952 slope lines.  Gaps are never
     differenced across: each contiguous stretch is processed alone and pooled."""
+    prefetch("scipy.special", "scipy.linalg", "rich.table")  # imported while the file is read
     rec = load_recording(
         file,
         text=text_options(t_names, t_rate, t_bad, t_delim, t_dec),

@@ -1,0 +1,240 @@
+"""Benchmark: whole commands against what a user would run instead (issue 17).
+
+Each figure is printed next to its anchor, measured in the same run, as a ratio:
+
+* start-up: ``thermocal --version``, ``thermocal --help`` and ``thermocal fit --help``
+  against ``python -c "import typer, rich"`` (the floor), and against a one-command typer
+  application's own ``--help`` (typer ≥ 0.28 imports pydantic to coerce a command's options:
+  a cost every typer command line pays); medians of 15 runs;
+* Allan end to end: ``thermocal allan FILE --signal ...`` (read + compute, octave τ, the
+  table printed) against a three-line allantools script (pyarrow read of the two columns,
+  ``1/median(diff(t))``, ``allantools.oadev(..., taus="octave")``) at 10⁷ and 10⁸ rows of
+  a five-column Parquet file (time, rate, two temperatures, one unused column), read once
+  beforehand so that both find it in the page cache; interleaved runs, best of 5 at 10⁷
+  and of 2 at 10⁸;
+* compensation of a 10⁸-row Parquet file (time, a gyro, a temperature; a linear model):
+  ``thermocal compensate`` against a plain pyarrow read + write of the same columns plus
+  one output column (``iter_batches`` → ``ParquetWriter``), wall time and peak resident
+  memory of each process.
+
+Run: ``.venv/bin/python benchmarks/bench_end_to_end.py [--skip-1e8]``.  Files go to
+``benchmarks/_data/`` (git-ignored; about 4 + 2.4 GB at 10⁸ rows, written once).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+DATA = Path(__file__).resolve().parent / "_data"
+PY = sys.executable
+THERMOCAL = [PY, "-c", "import sys; from thermocal.cli import main; sys.exit(main())"]
+
+WRAPPER = r"""
+import resource, subprocess, sys, time
+t0 = time.perf_counter()
+proc = subprocess.run(sys.argv[1:], stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+dt = time.perf_counter() - t0
+peak_kb = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss
+print(f"{proc.returncode} {peak_kb} {dt:.4f}")
+if proc.returncode:
+    print(proc.stderr[-2000:], file=sys.stderr)
+"""
+
+ALLANTOOLS_SCRIPT = r"""
+import sys, numpy as np, pyarrow.parquet as pq, allantools
+tab = pq.read_table(sys.argv[1], columns=["time [s]", "rate [deg/h]"])
+t, y = tab.column(0).to_numpy(), tab.column(1).to_numpy()
+taus, adev, err, n = allantools.oadev(y, rate=1.0 / np.median(np.diff(t)), data_type="freq",
+                                      taus="octave")
+print(len(taus), adev[0])
+"""
+
+PYARROW_SCRIPT = r"""
+import sys, numpy as np, pyarrow as pa, pyarrow.parquet as pq
+src, out = sys.argv[1], sys.argv[2]
+pf = pq.ParquetFile(src, pre_buffer=False)
+writer = None
+for batch in pf.iter_batches(batch_size=500_000, columns=["time", "gyro", "T1"]):
+    gyro = batch.column(1).to_numpy()
+    temp = batch.column(2).to_numpy()
+    comp = gyro - (0.5 + 0.02 * (temp - 25.0))
+    table = pa.Table.from_batches([batch]).append_column("gyro_comp", pa.array(comp))
+    if writer is None:
+        writer = pq.ParquetWriter(out, table.schema, use_dictionary=False)
+    writer.write_table(table)
+writer.close()
+"""
+
+SPEED_FLOOR_SCRIPT = r"""
+import typer
+from typing import Annotated
+app = typer.Typer(rich_markup_mode=None)
+@app.command()
+def one(x: Annotated[float, typer.Option("--x", help="A number.")] = 1.0) -> None:
+    '''One command with one option.'''
+@app.command()
+def two() -> None:
+    '''A second command, so that the first is a subcommand.'''
+import sys
+app(sys.argv[1:], prog_name="one")
+"""
+
+
+def run(cmd: list[str]) -> tuple[float, float]:
+    """(wall seconds, peak resident MB) of one process."""
+    out = subprocess.run([PY, "-c", WRAPPER, *cmd], capture_output=True, text=True, check=False)
+    code, peak_kb, seconds = out.stdout.split()
+    if int(code) != 0:
+        raise SystemExit(f"{cmd[3:]} failed: {out.stderr}")
+    return float(seconds), int(peak_kb) / 1024.0
+
+
+def median_time(cmd: list[str], n: int = 15) -> float:
+    times = []
+    for _ in range(n):
+        t0 = time.perf_counter()
+        subprocess.run(cmd, capture_output=True, check=True)
+        times.append(time.perf_counter() - t0)
+    return statistics.median(times)
+
+
+def startup() -> dict[str, float]:
+    floor = median_time([PY, "-c", "import typer, rich"])
+    with tempfile.TemporaryDirectory() as tmp:
+        mini = Path(tmp) / "mini.py"
+        mini.write_text(SPEED_FLOOR_SCRIPT)
+        typer_help = median_time([PY, str(mini), "one", "--help"])
+    figures = {
+        "--version": median_time([*THERMOCAL, "--version"]),
+        "--help": median_time([*THERMOCAL, "--help"]),
+        "fit --help": median_time([*THERMOCAL, "fit", "--help"]),
+    }
+    print(f"start-up (medians of 15): floor `import typer, rich` {floor:.3f} s; a one-option")
+    print(f"  typer command's own --help {typer_help:.3f} s ({typer_help / floor:.2f}x the floor)")
+    for name, t in figures.items():
+        own = f", {t / typer_help:.2f}x typer's own" if name == "fit --help" else ""
+        print(f"  thermocal {name:<11s} {t:.3f} s = {t / floor:.2f}x the floor{own}")
+    ok = figures["--version"] <= 2 * floor and figures["--help"] <= 2 * floor
+    print(f"  target (--version and --help within 2x the floor): {'met' if ok else 'NOT met'}")
+    return {"floor": floor, "typer_help": typer_help, **figures}
+
+
+def allan_file(rows: int) -> Path:
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    path = DATA / f"e2e_allan_{rows}.parquet"
+    if path.exists():
+        return path
+    DATA.mkdir(exist_ok=True)
+    rng = np.random.default_rng(0)
+    t = np.arange(rows) * 0.01
+    y = rng.standard_normal(rows) + np.cumsum(rng.standard_normal(rows)) * 1e-4 + 10.0
+    ramp = 1e-6 * np.arange(rows)
+    table = pa.table({"time [s]": t, "rate [deg/h]": y, "T1 [degC]": 25.0 + ramp,
+                      "T2 [degC]": 24.0 + ramp, "aux": rng.standard_normal(rows)})  # fmt: skip
+    del t, y, ramp
+    pq.write_table(table, path, compression="none")
+    return path
+
+
+def warm(path: Path) -> None:
+    """Read a file once so that both sides find it in the page cache (the first reader
+    of a cold 4 GB file pays the disk, whichever it is)."""
+    with open(path, "rb") as fh:
+        while fh.read(1 << 24):
+            pass
+
+
+def allan(rows: int, repeat: int) -> float:
+    path = allan_file(rows)
+    warm(path)
+    ours: list[tuple[float, float]] = []
+    theirs: list[tuple[float, float]] = []
+    with tempfile.TemporaryDirectory() as tmp:
+        script = Path(tmp) / "allantools_script.py"
+        script.write_text(ALLANTOOLS_SCRIPT)
+        for _ in range(repeat):  # interleaved: a slow spell of the machine hits both
+            ours.append(run([*THERMOCAL, "allan", str(path), "--signal", "rate [deg/h]"]))
+            theirs.append(run([PY, str(script), str(path)]))
+    t_ours, mb_ours = min(ours)
+    t_theirs, mb_theirs = min(theirs)
+    ratio = t_theirs / t_ours
+    med = statistics.median(b[0] for b in theirs) / statistics.median(a[0] for a in ours)
+    print(f"allan end to end, {rows:.0e} rows (best of {repeat}, interleaved):")
+    print(f"  thermocal allan   {t_ours:7.2f} s  {mb_ours:7.0f} MB")
+    print(f"  allantools script {t_theirs:7.2f} s  {mb_theirs:7.0f} MB")
+    print(f"  speed-up {ratio:.2f}x (of the medians {med:.2f}x); target >= 3x: "
+          f"{'met' if ratio >= 3 else 'NOT met'}")  # fmt: skip
+    return ratio
+
+
+def compensate(rows: int) -> tuple[float, float]:
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    DATA.mkdir(exist_ok=True)
+    path = DATA / f"e2e_comp_{rows}.parquet"
+    if not path.exists():
+        meta = {"format": "thermocal-recording", "version": 1, "time": "time",
+                "time_unit": "s", "signals": {"gyro": "deg/h"},
+                "temperatures": {"T1": "degC"}}  # fmt: skip
+        fields = [(name, pa.float64()) for name in ("time", "gyro", "T1")]
+        schema = pa.schema(fields).with_metadata({"thermocal": json.dumps(meta)})
+        rng = np.random.default_rng(1)
+        with pq.ParquetWriter(path, schema) as writer:  # written in slices: bounded memory
+            step = 5_000_000
+            for a in range(0, rows, step):
+                t = np.arange(a, min(rows, a + step)) * 0.01
+                temp = 25.0 + 15.0 * np.sin(2 * np.pi * t / (rows * 0.01))
+                gyro = 0.5 + 0.02 * (temp - 25.0) + rng.normal(0.0, 0.05, t.size)
+                writer.write_table(pa.table({"time": t, "gyro": gyro, "T1": temp}, schema=schema))
+    model = DATA / "e2e_comp_model.json"
+    small = DATA / "e2e_comp_fit.parquet"
+    if not model.exists():
+        pq.write_table(pq.ParquetFile(path).read_row_group(0).slice(0, 200_000), small)
+        subprocess.run([*THERMOCAL, "fit", str(small), "--model", "poly", "--order", "1",
+                        "--signal", "gyro", "--temps", "T1", "-o", str(model)],
+                       check=True, capture_output=True)  # fmt: skip
+    out = DATA / "e2e_comp_out.parquet"
+    with tempfile.TemporaryDirectory() as tmp:
+        script = Path(tmp) / "pyarrow_script.py"
+        script.write_text(PYARROW_SCRIPT)
+        t_pa, mb_pa = run([PY, str(script), str(path), str(out)])
+        out.unlink(missing_ok=True)
+        t_tc, mb_tc = run([*THERMOCAL, "compensate", str(model), str(path), "-o", str(out)])
+        out.unlink(missing_ok=True)
+    ratio = t_tc / t_pa
+    print(f"compensate, {rows:.0e} rows (one run each):")
+    print(f"  thermocal compensate  {t_tc:7.1f} s  {mb_tc:7.0f} MB")
+    print(f"  pyarrow read + write  {t_pa:7.1f} s  {mb_pa:7.0f} MB")
+    ok = ratio <= 1.5 and mb_tc <= 600
+    print(f"  time ratio {ratio:.2f}x (target <= 1.5x), peak {mb_tc:.0f} MB (target <= 600 MB): "
+          f"{'met' if ok else 'NOT met'}")  # fmt: skip
+    return ratio, mb_tc
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--skip-1e8", action="store_true", help="only the start-up and 10⁷ figures")
+    args = ap.parse_args()
+    print(f"load average {os.getloadavg()[0]:.2f}, {os.cpu_count()} cores")
+    startup()
+    allan(10**7, repeat=5)
+    if not args.skip_1e8:
+        allan(10**8, repeat=2)
+        compensate(10**8)
+
+
+if __name__ == "__main__":
+    main()
