@@ -314,19 +314,21 @@ class _ParquetColumns:
             return
         out = {n: np.empty(self.num_rows, dtype=np.float64) for n in todo}
         pos = 0
-        for i in range(self._pf.num_row_groups):
-            group = self._pf.read_row_group(i, columns=todo, use_threads=True)
-            k = 0
-            for n in todo:
+        try:
+            for i in range(self._pf.num_row_groups):
+                group = self._pf.read_row_group(i, columns=todo, use_threads=True)
                 k = 0
-                for chunk in group.column(n).chunks:
-                    out[n][pos + k : pos + k + len(chunk)] = arrow_chunk_f64(chunk)
-                    k += len(chunk)
-            pos += k
-            del group
-        if pos != self.num_rows:
-            raise pa.ArrowInvalid(f"columns {todo} have {pos} rows, the file {self.num_rows}")
-        self._read.update(out)
+                for n in todo:
+                    k = 0
+                    for chunk in group.column(n).chunks:
+                        out[n][pos + k : pos + k + len(chunk)] = arrow_chunk_f64(chunk)
+                        k += len(chunk)
+                pos += k
+                del group
+        except (pa.ArrowInvalid, OSError):
+            return  # a damaged file: column by column, the error names the column
+        if pos == self.num_rows:
+            self._read.update(out)
 
     def column(self, name: str) -> pa.ChunkedArray:
         col: pa.ChunkedArray = self._pf.read(columns=[name], use_threads=True).column(0)
