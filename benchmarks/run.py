@@ -48,7 +48,8 @@ BENCHMARKS: dict[str, tuple[list[str], list[str]]] = {
 }
 """Every benchmark script (``bench_<name>.py``) and the RESULTS.md section it feeds."""
 
-TARGET = re.compile(r"target|NOT met|\bmet\b", re.IGNORECASE)
+TARGET = re.compile(r"target|NOT met|\bmet\b|\bFAIL\b|\bPASS\b", re.IGNORECASE)
+MISSED = re.compile(r"NOT met|\bFAIL\b")
 
 
 def run_one(name: str, args: list[str], log: object) -> tuple[int, float, list[str]]:
@@ -99,7 +100,7 @@ def main() -> int:
         print(f"{name:<20s} {seconds:7.1f} s  {state}")
         for t in targets:
             print(f"    {t}")
-        missed = any("NOT met" in t for t in targets)
+        missed = any(MISSED.search(t) for t in targets)
         bad += int(status != 0 or missed)
     return 1 if bad else 0
 

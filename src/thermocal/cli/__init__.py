@@ -36,6 +36,7 @@ COMMAND_MODULES = (
     "tempcal_cmd",
     "turntable_cmd",
     "report_cmd",
+    "fleet_cmd",
     "demo_cmd",
 )
 """Command modules, registered in this order (a missing module is skipped)."""
@@ -55,6 +56,7 @@ COMMANDS: dict[str, str] = {
     "ardupilot-tempcal": "tempcal_cmd",
     "turntable": "turntable_cmd",
     "report": "report_cmd",
+    "fleet": "fleet_cmd",
     "demo": "demo_cmd",
 }
 """The module of every command (a test checks it against what the modules register)."""

@@ -1,0 +1,105 @@
+"""``thermocal fleet CONFIG.toml -o DIR [--workers N] [--scheduler ADDRESS] [--force]``:
+one calibration per unit of a production batch (:mod:`thermocal.fleet`; INTERFACE.md
+"Fleet configuration").
+
+Exit status 0 when every unit was calibrated, 4 when some failed (each recorded with its
+error; the others went on), 2 for a bad configuration.
+"""
+
+import os
+import sys
+from pathlib import Path
+from typing import TYPE_CHECKING, Annotated
+
+import typer
+
+from thermocal._lazy import LazyModule
+from thermocal.cli.application import app
+from thermocal.cli.common import JsonOpt, emit, handle_errors, progress, stdout
+from thermocal.errors import ThermocalInputError
+
+if TYPE_CHECKING:
+    from thermocal import fleet as _fleet
+else:
+    _fleet = LazyModule("thermocal.fleet")
+
+
+@app.command("fleet")
+@handle_errors
+def fleet_cmd(
+    config: Annotated[Path, typer.Argument(help="Fleet configuration (TOML).", show_default=False)],
+    output: Annotated[Path, typer.Option("-o", "--output", help="Output directory.")],
+    workers: Annotated[
+        int | None,
+        typer.Option(
+            "--workers",
+            help="Local worker processes (default: the number of CPUs; 1 runs in this process).",
+        ),
+    ] = None,
+    scheduler: Annotated[
+        str | None,
+        typer.Option(
+            "--scheduler",
+            help="Dask distributed scheduler, tcp://HOST:PORT (needs thermocal[fleet]).",
+        ),
+    ] = None,
+    force: Annotated[
+        bool, typer.Option("--force", help="Redo units already calibrated in DIR.")
+    ] = False,
+    as_json: JsonOpt = False,
+) -> None:
+    """Calibrate every unit of a production batch: the [fit] options once, one [[unit]] per
+    device (modelling files, optional validation file), pass/fail [limits]; per unit
+    DIR/units/<id>/, then DIR/summary.csv, DIR/summary.parquet and DIR/fleet.html.  A rerun
+    resumes where a stopped batch left off."""
+    cfg = _fleet.load_config(config)
+    if workers is not None and workers < 1:
+        raise ThermocalInputError(f"--workers must be at least 1, got {workers}")
+    if scheduler is not None and workers is not None:
+        raise ThermocalInputError("give --workers or --scheduler, not both")
+    if output.exists() and not output.is_dir():
+        raise ThermocalInputError(f"{output}: exists and is not a directory")
+    n_workers = workers if workers is not None else max(1, min(os.cpu_count() or 1, len(cfg.units)))
+    with progress("units", total=len(cfg.units)) as advance:
+
+        def on_unit(outcome: "_fleet.UnitOutcome") -> None:
+            advance(1)
+            if outcome.status != "ok" and not as_json:
+                print(f"warning: unit {outcome.id}: {outcome.error}", file=sys.stderr)
+
+        res = _fleet.run_fleet(
+            cfg, output, workers=n_workers, scheduler=scheduler, force=force, on_unit=on_unit
+        )
+    rows = res.rows
+    n_ok = sum(1 for r in rows if r["status"] == "ok")
+    n_failed = sum(1 for r in rows if r["status"] == "failed")
+    n_pass = sum(1 for r in rows if r["status"] == "ok" and r.get("pass") is True)
+    out = {
+        "output": str(output),
+        "units": len(rows),
+        "ok": n_ok,
+        "failed": n_failed,
+        "pending": len(rows) - n_ok - n_failed,
+        "passed": n_pass,
+        "ran": list(res.ran),
+        "skipped": list(res.skipped),
+        "failed_units": {r["id"]: r["error"] for r in rows if r["status"] == "failed"},
+        "summary_csv": str(res.summary_csv),
+        "summary_parquet": str(res.summary_parquet),
+        "report": str(res.html),
+        "interrupted": res.interrupted,
+    }
+
+    def human() -> None:
+        stdout.print(
+            f"{len(rows)} units: {n_ok} calibrated ({len(res.ran)} now, {len(res.skipped)} "
+            f"done before), {n_failed} failed, {n_pass} passed"
+        )
+        stdout.print(f"summary: {res.summary_csv}, {res.summary_parquet}")
+        stdout.print(f"report: {res.html}")
+
+    emit(out, as_json, human)
+    if res.interrupted:
+        print(f"error: {res.interrupted}", file=sys.stderr)
+    if n_failed or res.interrupted or out["pending"]:
+        raise typer.Exit(_fleet.EXIT_SOME_FAILED)

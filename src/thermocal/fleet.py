@@ -1,0 +1,785 @@
+"""Production batches: one calibration per unit of a fleet (issue 18; INTERFACE.md "Fleet
+configuration").
+
+A TOML configuration names the ``thermocal fit`` options once (``[fit]``, by their long names
+without dashes), optional ``thermocal validate`` options (``[validate]``), optional pass/fail
+limits (``[limits]``) and one ``[[unit]]`` per device: ``id``, ``modeling`` (its files) and
+optionally ``validation`` (a file); paths are relative to the configuration.
+
+Each unit is one task, :func:`run_unit`: ``thermocal fit`` and, with a validation run,
+``thermocal validate --modeling`` run in the worker's process through the command line's own
+entry point (so a unit gets exactly what the two commands give, options, units and warnings
+included, without a process start-up per unit), in a private temporary directory; the task
+returns the files' bytes and the figures.  The driver (:func:`run_fleet`) writes them under
+``DIR/units/<id>/`` through a temporary directory renamed into place, ``unit.json`` last, so
+a unit directory either is complete or does not exist.  A rerun skips the units whose
+``unit.json`` says ``ok`` (failed ones are tried again); ``force`` redoes them all.
+
+Where the tasks run: in this process (one worker), in local worker processes (BLAS held to one
+thread each: the fits already are), or on a Dask distributed cluster (``scheduler``) — the
+same function on the same inputs, so the same numbers bit for bit.
+
+After the batch: ``DIR/summary.csv`` and ``DIR/summary.parquet`` (one row per unit: ``id``,
+``status``, ``error``, ``pass``, ``fail_reasons``, and per channel ``<channel>.<figure>``)
+and ``DIR/fleet.html`` (:mod:`thermocal.report.fleet`).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import io
+import json
+import math
+import os
+import re
+import secrets
+import shutil
+import tempfile
+import threading
+import time
+import tomllib
+from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from thermocal.errors import ThermocalInputError
+
+UNIT_FILE = "unit.json"
+"""Written last in a unit's directory: its presence with ``status: ok`` marks the unit done."""
+UNIT_FORMAT = "thermocal-fleet-unit"
+UNIT_VERSION = 1
+CALIBRATION_FILE = "calibration.json"
+VALIDATION_FILE = "validation.json"
+
+FIT_FIGURES = ("rms_residual", "condition_number", "n_coefficients", "n_samples")
+"""Per-channel figures of a fit (``thermocal fit --json``), in the summary."""
+VALIDATION_FIGURES = (
+    "r",
+    "rms_before",
+    "rms_after",
+    "peak_to_peak_before",
+    "peak_to_peak_after",
+    "bias_stability_before",
+    "bias_stability_after",
+    "bias_repeatability_before",
+    "bias_repeatability_after",
+)
+"""Per-channel figures of a validation (``thermocal validate --json``), in the summary."""
+FIGURES = FIT_FIGURES + VALIDATION_FIGURES
+
+_ID = re.compile(r"^[A-Za-z0-9][A-Za-z0-9._-]{0,127}$")
+
+EXIT_SOME_FAILED = 4
+"""Exit status of ``thermocal fleet`` when some unit failed (INTERFACE.md)."""
+
+
+# --- configuration ------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class UnitSpec:
+    """One device of the batch: its id, modelling files and optional validation file
+    (absolute paths)."""
+
+    id: str
+    modeling: tuple[str, ...]
+    validation: str | None = None
+
+
+@dataclass(frozen=True)
+class Limit:
+    """A pass/fail threshold on a figure: ``figure ≤ value`` (``max``) or ``≥`` (``min``),
+    for every channel or for the one named (the figure in that channel's data unit)."""
+
+    figure: str
+    bound: str
+    value: float
+    channel: str | None = None
+
+    def check(self, value: float | None) -> bool:
+        if value is None or not math.isfinite(value):
+            return False
+        return value <= self.value if self.bound == "max" else value >= self.value
+
+    @property
+    def label(self) -> str:
+        where = f"{self.channel}." if self.channel else ""
+        return f"{where}{self.figure} {'≤' if self.bound == 'max' else '≥'} {self.value:g}"
+
+
+@dataclass(frozen=True)
+class FleetConfig:
+    """A parsed fleet configuration (:func:`load_config`)."""
+
+    path: Path
+    fit_args: tuple[str, ...]
+    validate_args: tuple[str, ...]
+    limits: tuple[Limit, ...]
+    units: tuple[UnitSpec, ...]
+    fit_options: dict[str, Any] = field(default_factory=dict)
+
+
+def _click_command(command: str) -> Any:
+    """The command line's own parser of ``thermocal <command>``."""
+    import typer
+
+    from thermocal.cli import COMMANDS, _register
+    from thermocal.cli.application import app
+
+    _register((COMMANDS[command],))
+    return typer.main.get_command(app).commands[command]  # type: ignore[attr-defined]
+
+
+_PLACEHOLDERS = {"fit": ["FILE", "-o", "CAL.json"], "validate": ["CAL.json", "FILE"]}
+
+
+def check_args(command: str, args: Sequence[str], where: str) -> None:
+    """Parse ``thermocal <command> ARGS`` with the command's own parser (placeholders for
+    its files), so that a value of the wrong type is a configuration error now rather than
+    the same failure in every unit."""
+    from thermocal.cli import _USAGE_ERRORS
+
+    cmd = _click_command(command)
+    try:
+        cmd.make_context(command, [*_PLACEHOLDERS[command], *args])
+    except _USAGE_ERRORS as exc:
+        text = str(getattr(exc, "format_message", exc.__str__)())
+        raise ThermocalInputError(f"{where}: {' '.join(text.split())}") from None
+
+
+def _command_options(command: str) -> dict[str, bool]:
+    """The long options of a ``thermocal`` command: name → is a flag."""
+    params = _click_command(command).params
+    out: dict[str, bool] = {}
+    for p in params:
+        for opt in getattr(p, "opts", []):
+            if opt.startswith("--"):
+                out[opt[2:]] = bool(getattr(p, "is_flag", False))
+    return out
+
+
+def options_to_args(table: Mapping[str, Any], command: str, where: str) -> list[str]:
+    """``{"model": "poly", "order": 2, "signal": ["gx", "gy"], "select": true}`` →
+    ``["--model", "poly", "--order", "2", "--signal", "gx,gy", "--select"]`` for
+    ``thermocal <command>``; an unknown option or a value of the wrong shape is a
+    configuration error naming it (``where``: the table)."""
+    known = _command_options(command)
+    refused = {"output", "json", "help", "modeling"}
+    args: list[str] = []
+    for key, value in table.items():
+        name = str(key).replace("_", "-")
+        if name not in known or name in refused:
+            usable = ", ".join(sorted(k for k in known if k not in refused))
+            raise ThermocalInputError(
+                f"{where}: {key!r} is not an option of thermocal {command}; it takes {usable}"
+            )
+        if known[name]:
+            if not isinstance(value, bool):
+                raise ThermocalInputError(f"{where}: {key} is a flag: write true or false")
+            if value:
+                args.append(f"--{name}")
+            continue
+        if isinstance(value, list):
+            if not value or not all(isinstance(v, str | int | float) for v in value):
+                raise ThermocalInputError(f"{where}: {key}: expected a list of names or numbers")
+            text = ",".join(str(v) for v in value)
+        elif isinstance(value, str | int | float) and not isinstance(value, bool):
+            text = str(value)
+        else:
+            raise ThermocalInputError(f"{where}: {key}: expected a string, number or list")
+        args += [f"--{name}", text]
+    check_args(command, args, where)
+    return args
+
+
+def _limits(table: Mapping[str, Any], where: str, channel: str | None = None) -> list[Limit]:
+    out: list[Limit] = []
+    for key, value in table.items():
+        if isinstance(value, Mapping) and channel is None:  # [limits.<channel>]
+            out += _limits(value, f"{where}.{key}", channel=str(key))
+            continue
+        m = re.fullmatch(r"(.+)_(max|min)", str(key))
+        if m is None or m.group(1) not in FIGURES:
+            raise ThermocalInputError(
+                f"{where}: {key!r} is not a limit; write <figure>_max or <figure>_min with a "
+                f"figure among {', '.join(FIGURES)}"
+            )
+        if isinstance(value, bool) or not isinstance(value, int | float):
+            raise ThermocalInputError(f"{where}: {key}: expected a number")
+        out.append(Limit(m.group(1), m.group(2), float(value), channel))
+    return out
+
+
+def load_config(path: str | Path) -> FleetConfig:
+    """Read and check a fleet configuration (module docstring).  Every error is a
+    :class:`ThermocalInputError` naming the file and the entry (``thermocal fleet`` exits 2);
+    a missing data file is not one: that unit fails and the others go on."""
+    p = Path(path)
+    try:
+        doc = tomllib.loads(p.read_text(encoding="utf-8"))
+    except FileNotFoundError:
+        raise ThermocalInputError(f"{p}: no such configuration file") from None
+    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
+        raise ThermocalInputError(f"{p}: not a valid TOML file ({exc})") from None
+    unknown = sorted(set(doc) - {"fit", "validate", "limits", "unit"})
+    if unknown:
+        raise ThermocalInputError(
+            f"{p}: unknown table(s) {', '.join(unknown)}; use fit, validate, limits, unit"
+        )
+    fit = doc.get("fit", {})
+    if not isinstance(fit, dict) or not fit:
+        raise ThermocalInputError(f"{p}: a [fit] table with the options of thermocal fit is needed")
+    fit_args = options_to_args(fit, "fit", f"{p} [fit]")
+    val_table = doc.get("validate", {})
+    if not isinstance(val_table, dict):
+        raise ThermocalInputError(f"{p}: [validate] must be a table")
+    validate_args = options_to_args(val_table, "validate", f"{p} [validate]")
+    lim_table = doc.get("limits", {})
+    if not isinstance(lim_table, dict):
+        raise ThermocalInputError(f"{p}: [limits] must be a table")
+    limits = _limits(lim_table, f"{p} [limits]")
+    raw_units = doc.get("unit", [])
+    if not isinstance(raw_units, list) or not raw_units:
+        raise ThermocalInputError(f"{p}: no [[unit]] entries")
+    base = p.resolve().parent
+    units: list[UnitSpec] = []
+    seen: set[str] = set()
+    for i, u in enumerate(raw_units, start=1):
+        where = f"{p} [[unit]] #{i}"
+        if not isinstance(u, dict):
+            raise ThermocalInputError(f"{where}: must be a table")
+        extra = sorted(set(u) - {"id", "modeling", "validation"})
+        if extra:
+            raise ThermocalInputError(
+                f"{where}: unknown key(s) {', '.join(extra)}; use id, modeling, validation"
+            )
+        uid = u.get("id")
+        if not isinstance(uid, str) or not _ID.match(uid):
+            raise ThermocalInputError(
+                f"{where}: id must be letters, digits, '.', '_' or '-' (it names a directory), "
+                f"got {uid!r}"
+            )
+        if uid in seen:
+            raise ThermocalInputError(f"{where}: id {uid!r} is used twice")
+        seen.add(uid)
+        mod = u.get("modeling")
+        if isinstance(mod, str):
+            mod = [mod]
+        if not isinstance(mod, list) or not mod or not all(isinstance(m, str) for m in mod):
+            raise ThermocalInputError(
+                f"{where} ({uid}): modeling must be a file or a list of files"
+            )
+        val = u.get("validation")
+        if val is not None and not isinstance(val, str):
+            raise ThermocalInputError(f"{where} ({uid}): validation must be one file")
+        units.append(
+            UnitSpec(
+                uid,
+                tuple(str(base / m) for m in mod),
+                str(base / val) if val is not None else None,
+            )
+        )
+    return FleetConfig(p, tuple(fit_args), tuple(validate_args), tuple(limits), tuple(units), fit)
+
+
+# --- one unit -----------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class UnitTask:
+    """What a worker needs for one unit (plain data: it travels to Dask workers)."""
+
+    unit: UnitSpec
+    fit_args: tuple[str, ...]
+    validate_args: tuple[str, ...]
+
+
+@dataclass
+class UnitOutcome:
+    """What a worker hands back for one unit: status, error, warnings, the command outputs
+    (``fit`` and ``validation``, as ``--json`` prints them), the files' bytes, seconds."""
+
+    id: str
+    status: str
+    error: str | None = None
+    warnings: list[str] = field(default_factory=list)
+    fit: dict[str, Any] | None = None
+    validation: dict[str, Any] | None = None
+    files: dict[str, bytes] = field(default_factory=dict)
+    seconds: float = 0.0
+    worker: str = ""
+
+
+_CLI_LOCK = threading.Lock()
+"""A unit redirects the process's stdout and stderr while its commands run: units of one
+process (a Dask worker with several threads) take turns."""
+
+
+def _run_cli(args: Sequence[str]) -> tuple[int, str, str]:
+    """``thermocal ARGS`` in this process: (exit status, stdout, stderr)."""
+    from thermocal.cli import main
+
+    out, err = io.StringIO(), io.StringIO()
+    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+        code = main(list(args))
+    return code, out.getvalue(), err.getvalue()
+
+
+def _messages(stderr: str, prefix: str) -> list[str]:
+    return [line[len(prefix) :].strip() for line in stderr.splitlines() if line.startswith(prefix)]
+
+
+def _failure(stderr: str, code: int, what: str) -> str:
+    errors = _messages(stderr, "error:")
+    if errors:
+        return errors[-1]
+    tail = stderr.strip().splitlines()[-1:] or [f"exit status {code}"]
+    return f"{what} failed: {tail[0]}"
+
+
+def run_unit(task: UnitTask) -> UnitOutcome:
+    """Calibrate one unit (module docstring): ``thermocal fit`` on its modelling files, then
+    ``thermocal validate --modeling`` on its validation file if it has one.  Never raises for
+    the unit's own faults (a missing or corrupt file, a singular design): they make a failed
+    outcome whose error names the file, as the command printed it."""
+    from threadpoolctl import threadpool_limits
+
+    t0 = time.perf_counter()
+    u = task.unit
+    outcome = UnitOutcome(u.id, "failed", worker=f"{os.uname().nodename}:{os.getpid()}")
+    with _CLI_LOCK, threadpool_limits(limits=1), tempfile.TemporaryDirectory() as tmp:
+        cal = Path(tmp) / CALIBRATION_FILE
+        code, out, err = _run_cli(["fit", *u.modeling, *task.fit_args, "-o", str(cal), "--json"])
+        outcome.warnings += _messages(err, "warning:")
+        if code != 0:
+            outcome.error = _failure(err, code, "fit")
+            outcome.seconds = time.perf_counter() - t0
+            return outcome
+        outcome.fit = json.loads(out)
+        outcome.files[CALIBRATION_FILE] = cal.read_bytes()
+        if u.validation is not None:
+            args = ["validate", str(cal), u.validation, "--modeling", u.modeling[0]]
+            code, out, err = _run_cli([*args, *task.validate_args, "--json"])
+            outcome.warnings += _messages(err, "warning:")
+            if code != 0:
+                outcome.error = _failure(err, code, "validate")
+                outcome.seconds = time.perf_counter() - t0
+                return outcome
+            outcome.validation = json.loads(out)
+            outcome.files[VALIDATION_FILE] = out.encode("utf-8")
+    outcome.status = "ok"
+    outcome.seconds = time.perf_counter() - t0
+    return outcome
+
+
+def _per_channel(obj: Mapping[str, Any] | None, default: str) -> dict[str, Mapping[str, Any]]:
+    """``{"channels": {name: {...}}}`` or one channel's flat dict → ``{name: {...}}``."""
+    if not obj:
+        return {}
+    chans = obj.get("channels")
+    if isinstance(chans, Mapping):
+        return {str(k): v for k, v in chans.items() if isinstance(v, Mapping)}
+    return {default: obj}
+
+
+def unit_figures(outcome: UnitOutcome, signal: str) -> dict[str, dict[str, Any]]:
+    """Per channel: unit, the fit and validation figures, and the fitted coefficients
+    (``{term: value}``, in the channel's model unit)."""
+    fits = _per_channel(outcome.fit, signal)
+    vals = _per_channel(outcome.validation, signal)
+    out: dict[str, dict[str, Any]] = {}
+    for name, f in fits.items():
+        row: dict[str, Any] = {"unit": f.get("unit_as_given") or f.get("unit")}
+        for k in FIT_FIGURES:
+            row[k] = f.get(k)
+        v = vals.get(name, {})
+        for k in VALIDATION_FIGURES:
+            row[k] = v.get(k)
+        coefs = {}
+        for c in f.get("coefficients") or []:
+            if isinstance(c, Mapping) and "name" in c and "value" in c:
+                coefs[str(c["name"])] = c["value"]
+        row["coefficients"] = coefs
+        out[name] = row
+    return out
+
+
+def judge(figures: Mapping[str, Mapping[str, Any]], limits: Sequence[Limit]) -> list[str]:
+    """The limits a unit fails (empty: it passes)."""
+    failed: list[str] = []
+    for lim in limits:
+        names = [lim.channel] if lim.channel else list(figures)
+        for ch in names:
+            fig = figures.get(ch or "")
+            if fig is None:
+                failed.append(f"{lim.label}: no channel {ch!r}")
+                continue
+            value = fig.get(lim.figure)
+            if value is None:
+                why = "no validation run" if lim.figure in VALIDATION_FIGURES else "not computed"
+                failed.append(f"{ch}.{lim.figure} {why} ({lim.label})")
+            elif not lim.check(float(value)):
+                failed.append(f"{ch}.{lim.figure} = {float(value):.6g} fails {lim.label}")
+    return failed
+
+
+# --- the batch ----------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class FleetResult:
+    """What :func:`run_fleet` did: units run now, skipped (done before), failed, and the
+    summary rows of every unit of the configuration."""
+
+    ran: tuple[str, ...]
+    skipped: tuple[str, ...]
+    failed: tuple[str, ...]
+    rows: tuple[dict[str, Any], ...]
+    summary_csv: Path
+    summary_parquet: Path
+    html: Path
+    interrupted: str | None = None
+
+
+def unit_dir(out_dir: Path, uid: str) -> Path:
+    return out_dir / "units" / uid
+
+
+def read_unit(out_dir: Path, uid: str) -> dict[str, Any] | None:
+    """A unit's ``unit.json`` (None when absent or unreadable: not done)."""
+    f = unit_dir(out_dir, uid) / UNIT_FILE
+    try:
+        obj = json.loads(f.read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return None
+    return obj if isinstance(obj, dict) and obj.get("format") == UNIT_FORMAT else None
+
+
+def _clean_stale(units_dir: Path) -> None:
+    """Temporary unit directories of an interrupted run (``.<id>.tmp-*``, ``.<id>.old-*``)."""
+    if units_dir.is_dir():
+        for d in units_dir.glob(".*.tmp-*"):
+            shutil.rmtree(d, ignore_errors=True)
+        for d in units_dir.glob(".*.old-*"):
+            shutil.rmtree(d, ignore_errors=True)
+
+
+def write_unit(out_dir: Path, outcome: UnitOutcome, record: dict[str, Any]) -> Path:
+    """Write a unit's files into a temporary directory, ``unit.json`` last, and rename it
+    into place (an older directory of the unit is moved aside first and removed after):
+    ``units/<id>/`` is complete or absent, whenever the run stops."""
+    units_dir = out_dir / "units"
+    units_dir.mkdir(parents=True, exist_ok=True)
+    tag = secrets.token_hex(4)
+    tmp = units_dir / f".{outcome.id}.tmp-{tag}"
+    tmp.mkdir()
+    for name, data in outcome.files.items():
+        (tmp / name).write_bytes(data)
+    text = json.dumps(record, indent=2, ensure_ascii=False, allow_nan=False)
+    (tmp / UNIT_FILE).write_text(text + "\n", encoding="utf-8")
+    final = unit_dir(out_dir, outcome.id)
+    old = None
+    if final.exists():
+        old = units_dir / f".{outcome.id}.old-{tag}"
+        os.replace(final, old)
+    os.replace(tmp, final)
+    if old is not None:
+        shutil.rmtree(old, ignore_errors=True)
+    return final
+
+
+def _finite(obj: Any) -> Any:
+    """NaN/inf → None for JSON."""
+    if isinstance(obj, float):
+        return obj if math.isfinite(obj) else None
+    if isinstance(obj, dict):
+        return {k: _finite(v) for k, v in obj.items()}
+    if isinstance(obj, list | tuple):
+        return [_finite(v) for v in obj]
+    return obj
+
+
+def unit_record(outcome: UnitOutcome, config: FleetConfig, signal: str) -> dict[str, Any]:
+    """The content of ``unit.json``: status, error, warnings, figures per channel,
+    pass/fail against the limits, inputs and timing."""
+    figures = unit_figures(outcome, signal) if outcome.status == "ok" else {}
+    reasons = judge(figures, config.limits) if outcome.status == "ok" else []
+    passed: bool | None = None
+    if outcome.status == "ok":
+        passed = not reasons
+    record: dict[str, Any] = _finite(
+        {
+            "format": UNIT_FORMAT,
+            "version": UNIT_VERSION,
+            "id": outcome.id,
+            "status": outcome.status,
+            "error": outcome.error,
+            "pass": passed if config.limits else (True if outcome.status == "ok" else None),
+            "fail_reasons": reasons,
+            "warnings": outcome.warnings,
+            "channels": figures,
+            "files": sorted(outcome.files),
+            "seconds": outcome.seconds,
+            "worker": outcome.worker,
+            "finished_utc": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()),
+        }
+    )
+    return record
+
+
+def summary_rows(config: FleetConfig, out_dir: Path) -> list[dict[str, Any]]:
+    """One row per unit of the configuration, from the units' ``unit.json`` (a unit with
+    none: ``status`` ``pending``)."""
+    rows: list[dict[str, Any]] = []
+    for u in config.units:
+        rec = read_unit(out_dir, u.id)
+        row: dict[str, Any] = {"id": u.id}
+        if rec is None:
+            row.update(status="pending", error="not run yet", **{"pass": None})
+            row["fail_reasons"] = ""
+            rows.append(row)
+            continue
+        row.update(
+            status=rec.get("status"),
+            error=rec.get("error"),
+            **{"pass": rec.get("pass")},
+        )
+        row["fail_reasons"] = "; ".join(rec.get("fail_reasons") or [])
+        row["seconds"] = rec.get("seconds")
+        row["n_warnings"] = len(rec.get("warnings") or [])
+        for ch, fig in (rec.get("channels") or {}).items():
+            row[f"{ch}.unit"] = fig.get("unit")
+            for k in FIGURES:
+                row[f"{ch}.{k}"] = fig.get(k)
+        rows.append(row)
+    return rows
+
+
+def write_summary(rows: Sequence[Mapping[str, Any]], out_dir: Path) -> tuple[Path, Path]:
+    """``summary.csv`` and ``summary.parquet`` (atomic writes), columns in first-seen order."""
+    import pandas as pd
+
+    from thermocal.io import atomic_write, atomic_write_path
+
+    columns: list[str] = []
+    for r in rows:
+        columns += [c for c in r if c not in columns]
+    df = pd.DataFrame([{c: r.get(c) for c in columns} for r in rows], columns=columns)
+    for c in columns:  # numbers stay numbers (a column of None is left as objects)
+        if c.split(".")[-1] in FIGURES or c == "seconds":
+            df[c] = pd.to_numeric(df[c], errors="coerce")
+    df["pass"] = df["pass"].astype("boolean")
+    csv_path, pq_path = out_dir / "summary.csv", out_dir / "summary.parquet"
+    with atomic_write(csv_path, "w") as fh:
+        df.to_csv(fh, index=False)
+    atomic_write_path(pq_path, lambda tmp: df.to_parquet(tmp, index=False))
+    return csv_path, pq_path
+
+
+Executor = Callable[[list[UnitTask]], Iterator[UnitOutcome]]
+
+
+def local_executor(workers: int) -> Executor:
+    """Units in this process (one worker) or in ``workers`` local processes, results as
+    they finish."""
+
+    def run(tasks: list[UnitTask]) -> Iterator[UnitOutcome]:
+        if workers <= 1:
+            for t in tasks:
+                yield run_unit(t)
+            return
+        import multiprocessing
+        from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
+
+        ctx = multiprocessing.get_context("spawn")  # no fork of a threaded parent
+        with ProcessPoolExecutor(max_workers=workers, mp_context=ctx) as pool:
+            pending = {pool.submit(run_unit, t) for t in tasks}
+            try:
+                while pending:
+                    done, pending = wait(pending, return_when=FIRST_COMPLETED)
+                    for fut in done:
+                        yield fut.result()
+            finally:
+                for fut in pending:
+                    fut.cancel()
+
+    return run
+
+
+def dask_executor(address: str) -> Executor:
+    """Units on a Dask distributed cluster (``tcp://HOST:PORT``), results as they finish.
+    Workers must read the unit's files at the same paths (a shared file system); the
+    results travel back to this process, which writes them."""
+    import importlib
+
+    try:
+        distributed: Any = importlib.import_module("distributed")  # untyped: held as Any
+    except ImportError:
+        raise ThermocalInputError(
+            "--scheduler needs Dask distributed: pip install 'thermocal[fleet]'"
+        ) from None
+
+    def run(tasks: list[UnitTask]) -> Iterator[UnitOutcome]:
+        try:
+            client = distributed.Client(address, timeout=30)
+        except (OSError, TimeoutError) as exc:
+            raise ThermocalInputError(f"--scheduler {address}: cannot connect ({exc})") from None
+        try:
+            keys = [f"thermocal-unit-{t.unit.id}-{secrets.token_hex(4)}" for t in tasks]
+            futures = client.map(run_unit, tasks, pure=False, key=keys)
+            for fut in distributed.as_completed(futures):
+                yield fut.result()
+        finally:
+            client.close()
+
+    return run
+
+
+def run_fleet(
+    config: FleetConfig,
+    out_dir: str | Path,
+    *,
+    workers: int = 1,
+    scheduler: str | None = None,
+    force: bool = False,
+    on_unit: Callable[[UnitOutcome], None] | None = None,
+    executor: Executor | None = None,
+) -> FleetResult:
+    """Calibrate every unit not yet done (all with ``force``), write each as it finishes,
+    then the summary and ``fleet.html`` (module docstring).  ``on_unit`` is called after
+    each unit is written (progress).  A unit's fault never stops the others; an interrupted
+    batch (Ctrl-C, a worker that died) keeps every unit written so far, writes the summary
+    and re-raises (``KeyboardInterrupt``) or reports it in ``interrupted``."""
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    _clean_stale(out / "units")
+    todo: list[UnitTask] = []
+    skipped: list[str] = []
+    for u in config.units:
+        rec = read_unit(out, u.id)
+        if rec is not None and rec.get("status") == "ok" and not force:
+            skipped.append(u.id)
+            continue
+        todo.append(UnitTask(u, config.fit_args, config.validate_args))
+    signal = str(config.fit_options.get("signal", "signal"))
+    if isinstance(config.fit_options.get("signal"), list):
+        signal = ",".join(map(str, config.fit_options["signal"]))
+    run = executor or (dask_executor(scheduler) if scheduler else local_executor(workers))
+    ran: list[str] = []
+    failed: list[str] = []
+    interrupted: str | None = None
+    try:
+        for outcome in run(todo):
+            write_unit(out, outcome, unit_record(outcome, config, signal))
+            ran.append(outcome.id)
+            if outcome.status != "ok":
+                failed.append(outcome.id)
+            if on_unit is not None:
+                on_unit(outcome)
+    except KeyboardInterrupt:
+        _finish(config, out)
+        raise
+    except Exception as exc:  # a worker process died, the cluster went away
+        from concurrent.futures.process import BrokenProcessPool
+
+        if not isinstance(exc, BrokenProcessPool) and "distributed" not in type(exc).__module__:
+            raise
+        left = [t.unit.id for t in todo if t.unit.id not in ran]
+        interrupted = (
+            f"the batch stopped: {type(exc).__name__}: {exc}; {len(left)} unit(s) not done "
+            f"({', '.join(left[:10])}{', …' if len(left) > 10 else ''}): rerun to resume"
+        )
+    rows, csv_path, pq_path, html = _finish(config, out)
+    return FleetResult(
+        tuple(ran), tuple(skipped), tuple(failed), tuple(rows), csv_path, pq_path, html, interrupted
+    )
+
+
+def _finish(config: FleetConfig, out: Path) -> tuple[list[dict[str, Any]], Path, Path, Path]:
+    from thermocal.report.fleet import write_fleet_report
+
+    rows = summary_rows(config, out)
+    csv_path, pq_path = write_summary(rows, out)
+    records = {u.id: read_unit(out, u.id) for u in config.units}
+    html = write_fleet_report(out / "fleet.html", config, records)
+    return rows, csv_path, pq_path, html
+
+
+def robust_z(values: Iterable[float]) -> list[float]:
+    """Modified z-scores ``0.6745 (x − median) / MAD`` (Iglewicz & Hoaglin, 1993; |z| > 3.5
+    marks an outlier); NaN where the MAD is zero or the value missing."""
+    import numpy as np
+
+    x = np.asarray(list(values), dtype=np.float64)
+    ok = np.isfinite(x)
+    if ok.sum() < 3:
+        return [math.nan] * x.size
+    med = float(np.median(x[ok]))
+    mad = float(np.median(np.abs(x[ok] - med)))
+    if not mad > 0:
+        return [math.nan] * x.size
+    return [float(0.6745 * (v - med) / mad) if math.isfinite(v) else math.nan for v in x]
+
+
+OUTLIER_Z = 3.5
+"""|modified z| above this names a unit as an outlier (Iglewicz & Hoaglin)."""
+
+
+def outliers(records: Mapping[str, Mapping[str, Any] | None]) -> list[dict[str, Any]]:
+    """Units whose figure or coefficient is a robust outlier among the ok units, per
+    channel: ``{"id", "channel", "what", "value", "z"}``, largest |z| first."""
+    ok = {k: v for k, v in records.items() if v and v.get("status") == "ok"}
+    found: list[dict[str, Any]] = []
+    channels = sorted({ch for v in ok.values() for ch in (v.get("channels") or {})})
+    for ch in channels:
+        ids = [k for k, v in ok.items() if ch in (v.get("channels") or {})]
+        figs = [ok[k]["channels"][ch] for k in ids]
+        names = [f for f in ("rms_residual", "rms_after", "bias_stability_after")]
+        terms = sorted({t for f in figs for t in (f.get("coefficients") or {})})
+        series: dict[str, list[float]] = {}
+        for n in names:
+            series[n] = [_num(f.get(n)) for f in figs]
+        for t in terms:
+            series[f"coefficient {t}"] = [_num((f.get("coefficients") or {}).get(t)) for f in figs]
+        for what, vals in series.items():
+            for uid, v, z in zip(ids, vals, robust_z(vals), strict=True):
+                if math.isfinite(z) and abs(z) > OUTLIER_Z:
+                    found.append({"id": uid, "channel": ch, "what": what, "value": v, "z": z})
+    return sorted(found, key=lambda d: -abs(d["z"]))
+
+
+def _num(v: Any) -> float:
+    try:
+        return float(v) if v is not None else math.nan
+    except (TypeError, ValueError):
+        return math.nan
+
+
+def progress_line(outcome: UnitOutcome) -> str:
+    what = "ok" if outcome.status == "ok" else f"FAILED: {outcome.error}"
+    return f"{outcome.id}: {what} ({outcome.seconds:.1f} s)"
+
+
+__all__ = [
+    "EXIT_SOME_FAILED",
+    "FleetConfig",
+    "FleetResult",
+    "Limit",
+    "UnitOutcome",
+    "UnitSpec",
+    "UnitTask",
+    "dask_executor",
+    "judge",
+    "load_config",
+    "local_executor",
+    "outliers",
+    "read_unit",
+    "robust_z",
+    "run_fleet",
+    "run_unit",
+    "summary_rows",
+    "unit_figures",
+    "write_summary",
+    "write_unit",
+]
