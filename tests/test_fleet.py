@@ -229,3 +229,18 @@ def test_robust_z_against_a_hand_computation() -> None:
     # median 3, |x − 3| = 2, 1, 0, 1, 97 → MAD 1; z = 0.6745 (x − 3)
     assert fleet.robust_z(x) == pytest.approx([0.6745 * (v - 3.0) for v in x])
     assert all(math.isnan(z) for z in fleet.robust_z([2.0, 2.0, 2.0, 5.0]))  # MAD 0
+
+
+def test_the_readme_configuration_is_valid(tmp_path: Path) -> None:
+    readme = (Path(__file__).resolve().parents[1] / "README.md").read_text(encoding="utf-8")
+    block = readme.split("```toml\n", 1)[1].split("```", 1)[0]
+    cfg_path = tmp_path / "batch.toml"
+    cfg_path.write_text(block, encoding="utf-8")
+    cfg = fleet.load_config(cfg_path)
+    assert [u.id for u in cfg.units] == ["SN0001", "SN0002"]
+    assert cfg.fit_args[:4] == ("--model", "poly", "--order", "3")
+    assert {lim.label for lim in cfg.limits} == {
+        "rms_after ≤ 0.5",
+        "condition_number ≤ 1e+06",
+        "gz.bias_stability_after ≤ 0.05",
+    }
