@@ -326,3 +326,19 @@ def test_fit_p_value_is_the_chi_square_survival_function() -> None:
     r = np.linspace(-2.0, 3.0, 9)
     q = allan.fit_quality(np.arange(1.0, 10.0), r, 3)
     assert q.p_value == pytest.approx(chi2.sf(float(r @ r), 6), rel=1e-12)
+
+
+def test_nnls_small_with_fewer_points_than_terms() -> None:
+    """Three points, five terms: the support has at most three independent columns (what
+    scipy's active set keeps), never a minimum-norm solution over all five."""
+    from scipy.optimize import nnls
+
+    # the minimum-norm solution over all five columns is positive here
+    a = np.array([[2.1, 1.2, 0.6, 0.5, 2.5], [2.8, 2.0, 2.3, 1.9, 2.8], [2.5, 0.5, 2.6, 0.6, 2.3]])
+    b = np.array([6.4, 11.1, 7.7])
+    assert np.all(np.linalg.lstsq(a, b, rcond=None)[0] > 0)
+    x = allan.nnls_small(a, b)
+    assert np.count_nonzero(x) <= 3
+    assert np.linalg.norm(a @ x - b) == pytest.approx(
+        np.linalg.norm(a @ nnls(a, b)[0] - b), abs=1e-12
+    )

@@ -654,9 +654,9 @@ def nnls_small(a: FloatArray, b: FloatArray) -> FloatArray:
     best_rss = float(b @ b)
     for mask in range(1, 1 << k):
         cols = [j for j in range(k) if mask >> j & 1]
-        sol, *_ = np.linalg.lstsq(a[:, cols], b, rcond=None)
-        if np.any(sol <= 0.0):
-            continue
+        sol, _res, rank, _sv = np.linalg.lstsq(a[:, cols], b, rcond=None)
+        if rank < len(cols) or np.any(sol <= 0.0):  # supports of independent columns only,
+            continue  # as the active set keeps them (fewer points than terms)
         r = a[:, cols] @ sol - b
         rss = float(r @ r)
         if rss < best_rss:

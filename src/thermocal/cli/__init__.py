@@ -108,6 +108,19 @@ def _usage_error_types() -> tuple[type[Exception], ...]:
 
 _USAGE_ERRORS = _usage_error_types()
 
+_CLICK: dict[frozenset[str], Any] = {}
+
+
+def _click_command() -> Any:
+    """The application as typer builds it for click, once per set of registered command
+    modules: typer rebuilds every command's parameters from their annotations on each call
+    of the application (≈ 6 ms a command), which a process running many commands in a row
+    (``thermocal fleet``'s units) would pay every time."""
+    key = frozenset(_REGISTERED)
+    if key not in _CLICK:
+        _CLICK[key] = typer.main.get_command(_app)
+    return _CLICK[key]
+
 
 def main(argv: list[str] | None = None) -> int:
     """Run the command line; returns the exit status (0 ok, 2 bad input, 1 internal).
@@ -118,7 +131,7 @@ def main(argv: list[str] | None = None) -> int:
     args = list(sys.argv[1:] if argv is None else argv)
     _register(_modules_for(args))
     try:
-        result = _app(args=args, prog_name="thermocal", standalone_mode=False)
+        result = _click_command().main(args=args, prog_name="thermocal", standalone_mode=False)
     except typer.Exit as exc:
         if isinstance(exc.__cause__, KeyboardInterrupt):  # typer >= 0.27 turns Ctrl-C into Exit
             return report_interrupted()
