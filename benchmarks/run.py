@@ -45,6 +45,7 @@ BENCHMARKS: dict[str, tuple[list[str], list[str]]] = {
     "turntable": ([], []),
     "models_warmup_bank": ([], []),
     "demo": (["--repeat", "3"], ["--repeat", "1"]),
+    "fleet": ([], ["--skip-big"]),
 }
 """Every benchmark script (``bench_<name>.py``) and the RESULTS.md section it feeds."""
 
