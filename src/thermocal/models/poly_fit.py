@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import math
 import warnings
-from collections.abc import Iterator, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, cast
 
@@ -216,16 +216,23 @@ class _DesignPass:
         )
         self.current_run = 0
 
-    def chunks(self) -> Iterator[Chunk]:
+    def chunks(self, wanted: Callable[[int], bool] | None = None) -> Iterator[Chunk]:
+        """The blocks of every run.  Without ``wanted`` (the reducing pass) the ranges and
+        sums are gathered on the way; with it (a later pass) they are left as they are and
+        the rest of run ``i`` is skipped as soon as ``wanted(i)`` is false."""
         d, nt, p = self.d, len(self.rls), self.d.p
         bufs: dict[int, FloatArray] = {}
-        self.sums[:] = 0.0
+        gather = wanted is None
+        if gather:
+            self.sums[:] = 0.0
         for i, (r, plan) in enumerate(zip(d.runs, d.plans, strict=True)):
             self.current_run = i
             g = i if d.decision.used else 0
             sigs = [cast(FloatArray, rs[i].signal) for rs in self.rls]
             known = [rs[i].known_input for rs in self.rls]
             for s0, s1, a, b, fold in plan:
+                if wanted is not None and not wanted(i):
+                    break
                 rates: FloatArray | None = None
                 if d.uses_rate:
                     rates = segment_rates(
@@ -235,31 +242,40 @@ class _DesignPass:
                         float(d.head.rate_interval_s),
                         d.head.rate_method,
                     )
-                    np.minimum(self.rate_lo[i], rates.min(axis=0), out=self.rate_lo[i])
-                    np.maximum(self.rate_hi[i], rates.max(axis=0), out=self.rate_hi[i])
+                    if gather:
+                        np.minimum(self.rate_lo[i], rates.min(axis=0), out=self.rate_lo[i])
+                        np.maximum(self.rate_hi[i], rates.max(axis=0), out=self.rate_hi[i])
                 c = b - a
                 if c not in bufs:
                     bufs[c] = np.empty((c, p + 1 + nt), order="F")
                     bufs[c][:, p] = 1.0
                 A = bufs[c]
                 Tf = np.asfortranarray(r.temps_c[a:b])  # contiguous columns
-                np.minimum(self.temp_lo[i], Tf.min(axis=0), out=self.temp_lo[i])
-                np.maximum(self.temp_hi[i], Tf.max(axis=0), out=self.temp_hi[i])
+                if gather:
+                    np.minimum(self.temp_lo[i], Tf.min(axis=0), out=self.temp_lo[i])
+                    np.maximum(self.temp_hi[i], Tf.max(axis=0), out=self.temp_hi[i])
                 term_features(d.terms, d.scaling, Tf, rates, out=A[:, :p])
                 for j in range(nt):
                     y = np.subtract(sigs[j][a:b], known[j], out=A[:, p + 1 + j])
-                    dev = y - self.y0[j]
-                    self.sums[j, 0] += c
-                    self.sums[j, 1] += float(np.sum(dev))
-                    self.sums[j, 2] += float(dev @ dev)
+                    if gather:
+                        dev = y - self.y0[j]
+                        self.sums[j, 0] += c
+                        self.sums[j, 1] += float(np.sum(dev))
+                        self.sums[j, 2] += float(dev @ dev)
                 yield A, g, fold
 
     def residuals(self, solved: Sequence[_Solved]) -> list[list[FloatArray]]:
         """Each channel's residuals per run (at most MAX_SAMPLES_PER_SERIES a run), a
-        second pass over the same blocks."""
+        second pass over the same blocks that leaves a run once every channel has its
+        residuals of it (the features of the rest would be computed for nothing: 10⁷
+        samples a run need 2²¹)."""
         p = self.d.p
         per_run: list[list[list[FloatArray]]] = [[[] for _ in self.d.runs] for _ in solved]
-        for A, g, _fold in self.chunks():
+
+        def wanted(i: int) -> bool:
+            return any(sum(x.size for x in runs[i]) < MAX_SAMPLES_PER_SERIES for runs in per_run)
+
+        for A, g, _fold in self.chunks(wanted):
             i = self.current_run
             for j, (kept, _sel, sol) in enumerate(solved):
                 if sum(x.size for x in per_run[j][i]) >= MAX_SAMPLES_PER_SERIES:
