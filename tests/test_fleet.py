@@ -244,3 +244,57 @@ def test_the_readme_configuration_is_valid(tmp_path: Path) -> None:
         "condition_number ≤ 1e+06",
         "gz.bias_stability_after ≤ 0.05",
     }
+
+
+def test_a_killed_worker_process_then_a_rerun(tmp_path: Path) -> None:
+    """A real worker process killed mid-batch (SIGKILL) once the first unit is written: the
+    driver names the units not done and exits 4, no half-written unit is left, and a rerun
+    finishes them (the units written before are skipped)."""
+    import os
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    psutil = pytest.importorskip("psutil")
+    rng = np.random.default_rng(9)
+    n = 600_000  # each unit takes a fraction of a second: the kill lands mid-batch
+    t = np.arange(n, dtype=np.float64) * 0.1
+    temp = np.linspace(-10.0, 60.0, n)
+    lines = ['[fit]\nmodel = "poly"\norder = 1\nsignal = "gyro [deg/h]"\ntemps = "T1 [degC]"\n']
+    for i in range(8):
+        gyro = 1.0 + 0.02 * (temp - 25.0) + rng.normal(0.0, 0.01, n)
+        frame = pd.DataFrame({"time [s]": t, "gyro [deg/h]": gyro, "T1 [degC]": temp})
+        frame.to_parquet(tmp_path / f"k{i}.parquet", index=False)
+        lines.append(f'[[unit]]\nid = "k{i}"\nmodeling = ["k{i}.parquet"]\n')
+    cfg = tmp_path / "kill.toml"
+    cfg.write_text("\n".join(lines), encoding="utf-8")
+    out = tmp_path / "out"
+    cmd = [sys.executable, "-c", "import sys; from thermocal.cli import main; sys.exit(main())",
+           "fleet", str(cfg), "-o", str(out), "--workers", "2", "--json"]  # fmt: skip
+    proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        deadline = time.monotonic() + 120
+        while time.monotonic() < deadline and proc.poll() is None:
+            units = out / "units"
+            if units.exists() and any(p.name.startswith("k") for p in units.iterdir()):
+                break
+            time.sleep(0.02)
+        children = psutil.Process(proc.pid).children(recursive=True)
+        workers = [c for c in children if "spawn_main" in " ".join(c.cmdline())]
+        assert workers, "no worker processes"
+        os.kill(workers[0].pid, signal.SIGKILL)  # one worker of the pool dies
+        stdout, stderr = proc.communicate(timeout=120)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+    assert proc.returncode == fleet.EXIT_SOME_FAILED, stderr + stdout
+    assert "rerun to resume" in stderr
+    summary = json.loads(stdout)
+    assert summary["pending"] >= 1 and summary["failed"] == 0
+    assert not list((out / "units").glob(".*"))  # no half-written unit
+    done_before = {p.name for p in (out / "units").iterdir()}
+    res = fleet.run_fleet(fleet.load_config(cfg), out)
+    assert set(res.skipped) == done_before
+    assert set(res.ran) == {f"k{i}" for i in range(8)} - done_before
+    assert all(r["status"] == "ok" for r in res.rows)
