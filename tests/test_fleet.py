@@ -298,3 +298,18 @@ def test_a_killed_worker_process_then_a_rerun(tmp_path: Path) -> None:
     assert set(res.skipped) == done_before
     assert set(res.ran) == {f"k{i}" for i in range(8)} - done_before
     assert all(r["status"] == "ok" for r in res.rows)
+
+
+def test_scheduler_without_dask_says_how_to_install(
+    batch: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    import sys
+
+    monkeypatch.setitem(sys.modules, "distributed", None)  # as if not installed
+    code = main(
+        ["fleet", str(batch), "-o", str(tmp_path / "out"), "--scheduler", "tcp://127.0.0.1:1"]
+    )
+    err = capsys.readouterr().err
+    assert code == 2
+    assert err.count("\n") == 1 and "pip install 'thermocal[fleet]'" in err
+    assert not (tmp_path / "out").exists()  # refused before anything is written

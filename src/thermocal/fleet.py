@@ -651,6 +651,7 @@ def run_fleet(
     each unit is written (progress).  A unit's fault never stops the others; an interrupted
     batch (Ctrl-C, a worker that died) keeps every unit written so far, writes the summary
     and re-raises (``KeyboardInterrupt``) or reports it in ``interrupted``."""
+    run = executor or (dask_executor(scheduler) if scheduler else local_executor(workers))
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     _clean_stale(out / "units")
@@ -665,7 +666,6 @@ def run_fleet(
     signal = str(config.fit_options.get("signal", "signal"))
     if isinstance(config.fit_options.get("signal"), list):
         signal = ",".join(map(str, config.fit_options["signal"]))
-    run = executor or (dask_executor(scheduler) if scheduler else local_executor(workers))
     ran: list[str] = []
     failed: list[str] = []
     interrupted: str | None = None
