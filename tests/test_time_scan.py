@@ -73,3 +73,14 @@ def test_a_recording_scans_its_time_once(monkeypatch: pytest.MonkeyPatch) -> Non
     assert calls == [10_000]
     part = rec.select(slice(0, 5000))  # a new time array: scanned anew
     assert part.gaps() == [] and calls == [10_000, 5000]
+
+
+def test_extreme_stamps_raise_no_warning() -> None:
+    """Stamps at the edge of float64 (a corrupt file): no overflow in the regularity test
+    (found by the malformed-Parquet property test)."""
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        sc = scan_time(np.array([0.0, 0.0, 1.7976931348623157e308]))
+    assert sc.duplicate_rows.tolist() == [0] and not sc.regular

@@ -452,7 +452,7 @@ def scan_time(time_s: FloatArray) -> TimeScan:
             back_parts.append(a + np.flatnonzero(dt < 0))
     dup = np.concatenate(dup_parts) if dup_parts else empty
     back = np.concatenate(back_parts) if back_parts else empty
-    stamp_ulp = float(np.spacing(max(abs(float(time_s[0])), abs(float(time_s[-1])))))
+    stamp_ulp = math.ulp(max(abs(float(time_s[0])), abs(float(time_s[-1]))))  # no overflow
     regular = lo > 0 and hi - lo <= REGULAR_GRID_ULPS * stamp_ulp
     if regular:
         interval = float(time_s[-1] - time_s[0]) / (n - 1)
