@@ -22,6 +22,7 @@ from thermocal import units
 from thermocal.defaults import DEFAULT_GYRO_COLUMNS as DEFAULT_GYRO_COLUMNS
 from thermocal.errors import MissingValueError, ThermocalInputError, UnitError
 from thermocal.recording import Recording
+from thermocal.turntable import accel as accel_mod
 from thermocal.turntable import estimate_ls, kalman, model, schedule
 from thermocal.turntable.schedule import TurntableWarning
 
@@ -114,6 +115,14 @@ class TurntableResult:
     """White jitter of the readings at rest, estimated from the dwells [″]."""
     encoder_quantum_deg: float = 0.0
     """Reading resolution found in the data [°] (0: not quantised)."""
+    accel: accel_mod.AccelEstimate | None = None
+    """The accelerometer triad (``accel_columns`` given), from the dwells' gravity."""
+    gravity_m_s2: float | None = None
+    """Local gravity used for the accelerometers [m/s²]."""
+    temperature_c: float | None = None
+    """Mean of the run's temperature column [°C] (``temperature_column`` given)."""
+    temperature_span_c: float | None = None
+    """Its range over the run (max − min) [°C]: a soak that drifts during the run."""
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready dict with the INTERFACE.md keys (from the Kalman filter)."""
@@ -148,6 +157,12 @@ class TurntableResult:
             dict(c) for c in self.weak_combinations
         ]
         out["warnings"] = list(self.warnings)
+        if self.accel is not None:  # keys added only when asked: single-run JSON unchanged
+            out["accel"] = self.accel.to_dict()
+            out["gravity_m_s2"] = self.gravity_m_s2
+        if self.temperature_c is not None:
+            out["temperature_c"] = self.temperature_c
+            out["temperature_span_c"] = self.temperature_span_c
         return out
 
 
@@ -241,6 +256,10 @@ def calibrate(
     move_block_s: float = 1.0,
     kf_interval_s: float = 1.0,
     prior_sigma: tuple[float, float, float] = DEFAULT_PRIOR_SIGMA,
+    accel_columns: Sequence[str] | None = None,
+    accel_unit: str | None = None,
+    gravity_m_s2: float | None = None,
+    temperature_column: str | None = None,
 ) -> TurntableResult:
     """Calibrate a gyro triad from a 16-position dual-axis turntable run (SPEC §7).
 
@@ -261,6 +280,12 @@ def calibrate(
     move_block_s : least squares: rotations cut into increments of at most this [s].
     kf_interval_s : filter measurement interval [s] (at rest and while rotating).
     prior_sigma : filter's initial σ of bias [°/h], scale factor [ppm], misalignment [″].
+    accel_columns : the accelerometer triad's columns (x, y, z), estimated from the mean
+        specific force of each dwell (:mod:`.accel`); ``accel_unit`` their unit (default:
+        the recording's; none known is refused); ``gravity_m_s2`` the local gravity
+        (default: WGS-84 normal gravity at the latitude).
+    temperature_column : a temperature column [°C] whose mean and span over the run are
+        reported (the run's soak temperature).
 
     Raises
     ------
@@ -278,6 +303,12 @@ def calibrate(
     cols = [*gyro_columns, alpha_column, beta_column]
     if len(gyro_columns) != 3:
         raise ThermocalInputError("name exactly three gyro columns (x, y, z)")
+    if accel_columns is not None:
+        if len(accel_columns) != 3:
+            raise ThermocalInputError("name exactly three accelerometer columns (x, y, z)")
+        cols += list(accel_columns)
+    if temperature_column is not None:
+        cols.append(temperature_column)
     rec.validate(required=cols)
     _check_finite(rec, cols)
     t = rec.time_s
@@ -373,6 +404,23 @@ def calibrate(
     weak = weak_combinations(info, info_static, static_fraction)
     for w in weak:
         msgs.append(f"weakly observable combination: {w['combination']}")
+    acc_est: accel_mod.AccelEstimate | None = None
+    g_local: float | None = None
+    if accel_columns is not None:
+        g_local = (
+            float(gravity_m_s2) if gravity_m_s2 is not None else units.normal_gravity_m_s2(lat)
+        )
+        acc_est = _accel_triad(rec, accel_columns, accel_unit, a_deg, b_deg, seg.dwells, g_local)
+        if acc_est.residual_rms_mg > 1.0:
+            msgs.append(
+                f"accelerometer dwell means depart from the triad model by "
+                f"{acc_est.residual_rms_mg:.3g} mg rms: check the unit, the axes or the gravity"
+            )
+    t_mean = t_span = None
+    if temperature_column is not None:
+        temp = rec.temperature_c(temperature_column)
+        t_mean = float(np.mean(temp))
+        t_span = float(np.max(temp) - np.min(temp))
     for msg in msgs:
         warnings.warn(f"{rec.name}: {msg}", TurntableWarning, stacklevel=2)
     return TurntableResult(
@@ -396,7 +444,38 @@ def calibrate(
         encoder_noise_source=noise_source,
         encoder_jitter_arcsec=motion.noise_arcsec,
         encoder_quantum_deg=motion.quantum_deg,
+        accel=acc_est,
+        gravity_m_s2=g_local,
+        temperature_c=t_mean,
+        temperature_span_c=t_span,
     )
+
+
+def _accel_triad(
+    rec: Recording,
+    columns: Sequence[str],
+    unit: str | None,
+    alpha_deg: FloatArray,
+    beta_deg: FloatArray,
+    dwells: Sequence[schedule.Dwell],
+    g_m_s2: float,
+) -> accel_mod.AccelEstimate:
+    """The accelerometer triad from the dwells: mean specific force [m/s²] and mean encoder
+    angles of each dwell (:func:`.accel.estimate_accel_triad`)."""
+    out = []
+    for c in columns:
+        u = unit or rec.units.get(c)
+        if not u:
+            raise UnitError(
+                f"{rec.name}: no unit is known for the accelerometer column {c!r}; give "
+                "--accel-unit (m/s^2, mg, g) or state it in the file's metadata"
+            )
+        out.append(units.convert(rec.column(c), u, "m/s^2"))
+    f = np.column_stack(out)
+    f_mean, n = accel_mod.dwell_means(f, dwells)
+    ang, _ = accel_mod.dwell_means(np.column_stack([alpha_deg, beta_deg]), dwells)
+    f_true = accel_mod.gravity_in_body(ang[:, 0], ang[:, 1], g_m_s2)
+    return accel_mod.estimate_accel_triad(f_mean, f_true, n)
 
 
 def estimate_from(theta: FloatArray, cov: FloatArray) -> Estimate:

@@ -1,0 +1,292 @@
+"""A triad's error model over temperature from turntable runs at several soaks (issue 19).
+
+Each run gives θ (12: bias, scale factors, misalignments) with standard errors at its
+soak temperature T_r.  Each parameter becomes a polynomial in ``T − TREF``:
+
+    θ_k(T) = Σ_{p=0}^{P} c_kp (T − TREF)^p
+
+fitted by weighted least squares (weights 1/σ_rk², through an SVD of the design scaled to
+[−1, 1]); the standard errors are scaled by the reduced χ² when it exceeds 1 (the soaks
+scatter more than their own σ say).  The order P is ``order`` if given, else chosen per
+parameter from 0…min(3, R − 2) by the leave-one-temperature-out (LOTO) error: each run is
+predicted from the others' fit, and the order with the smallest LOTO rms (in units of the
+runs' σ) wins, a higher order having to lower it by 5 %.  Each parameter's LOTO rms is
+reported so the user sees whether the soaks support the order.  Outside the calibrated range the polynomials are
+evaluated at the nearest end (clamped), as the firmware does.
+
+Applied to data (:func:`correct`): ``x_c = (I + E(T))⁻¹ (x − b(T))`` per sample, at each
+sample's temperature.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+import numpy.typing as npt
+
+from thermocal.errors import DesignError, ModelFileError, ThermocalInputError
+from thermocal.turntable import model
+
+FloatArray = npt.NDArray[np.float64]
+
+MAX_ORDER = 3
+PARAMETER_NAMES = (
+    "bias_x",
+    "bias_y",
+    "bias_z",
+    "scale_factor_x",
+    "scale_factor_y",
+    "scale_factor_z",
+    *(f"misalignment_{m}" for m in model.MISALIGNMENT_NAMES),
+)
+"""θ's twelve names, in order."""
+UNITS = {
+    "gyro": ("deg/h",) * 3 + ("ppm",) * 3 + ("arcsec",) * 6,
+    "accel": ("mg",) * 3 + ("ppm",) * 3 + ("arcsec",) * 6,
+}
+TRIAD_FORMAT = "thermocal-triad-thermal"
+TRIAD_VERSION = 1
+
+
+@dataclass(frozen=True)
+class ParameterFit:
+    """One parameter's polynomial in ``T − TREF`` (``coef`` ascending powers, its
+    covariance), the LOTO rms [parameter unit] and the reduced χ² of the fit."""
+
+    name: str
+    unit: str
+    coef: FloatArray
+    cov: FloatArray
+    loto_rms: float
+    reduced_chi2: float
+
+    @property
+    def sigma(self) -> FloatArray:
+        out: FloatArray = np.sqrt(np.maximum(np.diag(self.cov), 0.0))
+        return out
+
+
+def _design(dt: FloatArray, order: int, scale: float) -> FloatArray:
+    out: FloatArray = (dt[:, None] / scale) ** np.arange(order + 1)[None, :]
+    return out
+
+
+def _wls(
+    dt: FloatArray, v: FloatArray, w: FloatArray, order: int, scale: float
+) -> tuple[FloatArray, FloatArray, float]:
+    """Weighted LS of one parameter: (coef in physical powers, covariance, reduced χ²)."""
+    a = _design(dt, order, scale) * np.sqrt(w)[:, None]
+    y = v * np.sqrt(w)
+    u, s, vt = np.linalg.svd(a, full_matrices=False)
+    if not s[-1] > 1e-12 * s[0]:
+        raise DesignError(f"the soak temperatures cannot support order {order}")
+    vs = vt.T / s
+    x = vs @ (u.T @ y)
+    r = a @ x - y
+    dof = len(v) - (order + 1)
+    chi2 = float(r @ r) / dof if dof > 0 else float("nan")
+    cov = (vs @ vs.T) * (max(chi2, 1.0) if dof > 0 else 1.0)
+    unscale = scale ** -np.arange(order + 1)
+    coef: FloatArray = x * unscale
+    return coef, cov * np.outer(unscale, unscale), chi2
+
+
+def _choose_order(
+    dt: FloatArray, v: FloatArray, sigma: FloatArray, w: FloatArray, scale: float
+) -> int:
+    """The order 0…min(3, R − 2) with the smallest LOTO error in units of the runs' own σ;
+    a higher order must lower it by 5 % to be taken."""
+    best, chosen = math.inf, 0
+    for p in range(0, min(MAX_ORDER, len(v) - 2) + 1):
+        pred = _loto(dt, v, w, p, scale)
+        ok = np.isfinite(pred)
+        if not ok.any():
+            continue
+        score = float(np.sqrt(np.mean(((pred - v) / sigma)[ok] ** 2)))
+        if score < best * 0.95:
+            best, chosen = score, p
+    return chosen
+
+
+def _loto(dt: FloatArray, v: FloatArray, w: FloatArray, order: int, scale: float) -> FloatArray:
+    """Each run predicted from the others (NaN when the others cannot support ``order``)."""
+    out = np.full(len(v), np.nan)
+    for i in range(len(v)):
+        keep = np.arange(len(v)) != i
+        if keep.sum() < order + 1:
+            continue
+        try:
+            coef, _, _ = _wls(dt[keep], v[keep], w[keep], order, scale)
+        except DesignError:
+            continue
+        out[i] = float(np.polynomial.polynomial.polyval(dt[i], coef))
+    return out
+
+
+@dataclass(frozen=True)
+class TriadThermal:
+    """A triad's twelve parameters as polynomials in temperature (module docstring)."""
+
+    kind: str
+    tref_c: float
+    order: int
+    t_lo_c: float
+    t_hi_c: float
+    fits: tuple[ParameterFit, ...]
+    soak_temperatures_c: tuple[float, ...]
+
+    def theta_at(self, temp_c: npt.ArrayLike) -> FloatArray:
+        """θ (n, 12) at temperatures clamped to the calibrated range."""
+        t = np.clip(np.asarray(temp_c, dtype=np.float64), self.t_lo_c, self.t_hi_c)
+        dt = t - self.tref_c
+        out: FloatArray = np.stack(
+            [np.polynomial.polynomial.polyval(dt, f.coef) for f in self.fits], axis=-1
+        )
+        return out
+
+    def to_dict(self) -> dict[str, Any]:
+        return {
+            "format": TRIAD_FORMAT,
+            "version": TRIAD_VERSION,
+            "kind": self.kind,
+            "tref_c": self.tref_c,
+            "order": self.order,
+            "temperature_range_c": [self.t_lo_c, self.t_hi_c],
+            "soak_temperatures_c": list(self.soak_temperatures_c),
+            "parameters": [
+                {
+                    "name": f.name,
+                    "unit": f.unit,
+                    "coefficients": f.coef.tolist(),
+                    "coefficients_sigma": f.sigma.tolist(),
+                    "covariance": f.cov.tolist(),
+                    "loto_rms": f.loto_rms,
+                    "reduced_chi2": f.reduced_chi2 if math.isfinite(f.reduced_chi2) else None,
+                }
+                for f in self.fits
+            ],
+        }
+
+    @classmethod
+    def from_dict(cls, d: dict[str, Any], where: str = "triad") -> TriadThermal:
+        try:
+            if d.get("format") != TRIAD_FORMAT:
+                raise ModelFileError(f"{where}: not a {TRIAD_FORMAT} entry")
+            fits = tuple(
+                ParameterFit(
+                    str(p["name"]),
+                    str(p["unit"]),
+                    np.asarray(p["coefficients"], dtype=np.float64),
+                    np.asarray(p["covariance"], dtype=np.float64),
+                    float(p["loto_rms"]),
+                    float("nan") if p.get("reduced_chi2") is None else float(p["reduced_chi2"]),
+                )
+                for p in d["parameters"]
+            )
+            lo, hi = (float(v) for v in d["temperature_range_c"])
+            out = cls(
+                str(d["kind"]),
+                float(d["tref_c"]),
+                int(d["order"]),
+                lo,
+                hi,
+                fits,
+                tuple(float(v) for v in d.get("soak_temperatures_c", [])),
+            )
+        except (KeyError, TypeError, ValueError) as exc:
+            raise ModelFileError(f"{where}: malformed triad model ({exc})") from None
+        if len(out.fits) != 12 or out.kind not in UNITS:
+            raise ModelFileError(f"{where}: a triad has twelve parameters, gyro or accel")
+        return out
+
+
+def fit_triad(
+    kind: str,
+    temps_c: Sequence[float],
+    thetas: npt.ArrayLike,
+    sigmas: npt.ArrayLike,
+    *,
+    tref_c: float | None = None,
+    order: int | None = None,
+) -> TriadThermal:
+    """Fit the twelve parameters of a triad over the soaks (module docstring).
+
+    ``thetas``/``sigmas`` (R, 12) per run in the units of :data:`UNITS`; ``tref_c``
+    defaults to the middle of the soak range; ``order`` to the LOTO choice."""
+    if kind not in UNITS:
+        raise ThermocalInputError(f"triad kind must be gyro or accel, got {kind!r}")
+    t = np.asarray(temps_c, dtype=np.float64)
+    th = np.asarray(thetas, dtype=np.float64)
+    sg = np.asarray(sigmas, dtype=np.float64)
+    r = t.size
+    if th.shape != (r, 12) or sg.shape != (r, 12):
+        raise ThermocalInputError("thetas and sigmas must be (runs, 12)")
+    if r < 2:
+        raise DesignError("a temperature model needs runs at two soak temperatures at least")
+    span = float(t.max() - t.min())
+    if not span > 0.5:
+        raise DesignError(
+            f"the runs' temperatures span {span:.3g} °C: soak them at different temperatures"
+        )
+    tref = float(0.5 * (t.min() + t.max())) if tref_c is None else float(tref_c)
+    dt = t - tref
+    scale = max(float(np.max(np.abs(dt))), 1.0)
+    max_order = min(MAX_ORDER, r - 1)
+    if order is not None and not 0 <= order <= max_order:
+        raise DesignError(
+            f"order {order} needs at least {order + 1} soak temperatures; the runs give {r}"
+        )
+    fits = []
+    for k in range(12):
+        w = 1.0 / np.maximum(sg[:, k], 1e-12 * max(float(np.max(sg[:, k])), 1e-300)) ** 2
+        p_k = order if order is not None else _choose_order(dt, th[:, k], sg[:, k], w, scale)
+        coef, cov, chi2 = _wls(dt, th[:, k], w, p_k, scale)
+        pred = _loto(dt, th[:, k], w, p_k, scale) if r > p_k + 1 else np.full(r, np.nan)
+        ok = np.isfinite(pred)
+        loto = float(np.sqrt(np.mean((pred - th[:, k])[ok] ** 2))) if ok.any() else float("nan")
+        fits.append(ParameterFit(PARAMETER_NAMES[k], UNITS[kind][k], coef, cov, loto, chi2))
+    chosen = max(len(f.coef) - 1 for f in fits)
+    return TriadThermal(
+        kind, tref, chosen, float(t.min()), float(t.max()), tuple(fits), tuple(float(v) for v in t)
+    )
+
+
+def error_terms(triad: TriadThermal, temp_c: npt.ArrayLike) -> tuple[FloatArray, FloatArray]:
+    """``(b(T) (n, 3) in the bias unit, E(T) (n, 3, 3))`` at each temperature."""
+    th = triad.theta_at(temp_c)
+    th2 = np.atleast_2d(th)
+    e = np.zeros((th2.shape[0], 3, 3))
+    for i in range(3):
+        e[:, i, i] = th2[:, 3 + i] * 1e-6
+    arcsec = math.pi / (180.0 * 3600.0)
+    for k, name in enumerate(model.MISALIGNMENT_NAMES):
+        r, c = model.MISALIGNMENT_INDEX[name]
+        e[:, r, c] = th2[:, 6 + k] * arcsec
+    b: FloatArray = th2[:, 0:3]
+    return b, e
+
+
+def correct(
+    triad: TriadThermal, x: npt.ArrayLike, temp_c: npt.ArrayLike, bias_to_data: float
+) -> FloatArray:
+    """``x_c = (I + E(T))⁻¹ (x − b(T))`` per sample; ``x`` (n, 3) in the data's unit,
+    ``bias_to_data`` the factor from the triad's bias unit (°/h or mg) to it."""
+    xs = np.asarray(x, dtype=np.float64)
+    b, e = error_terms(triad, temp_c)
+    m = e + np.eye(3)[None, :, :]
+    out = np.linalg.solve(m, (xs - b * bias_to_data)[..., None])[..., 0]
+    return np.asarray(out, dtype=np.float64)
+
+
+__all__ = [
+    "PARAMETER_NAMES",
+    "ParameterFit",
+    "TriadThermal",
+    "correct",
+    "error_terms",
+    "fit_triad",
+]
