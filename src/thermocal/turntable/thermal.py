@@ -11,8 +11,8 @@ scatter more than their own σ say).  The order P is ``order`` if given, else ch
 parameter from 0…min(3, R − 2) by the leave-one-temperature-out (LOTO) error: each run is
 predicted from the others' fit, and the order with the smallest LOTO rms (in units of the
 runs' σ) wins, a higher order having to lower it by 5 %.  Each parameter's LOTO rms is
-reported so the user sees whether the soaks support the order.  Outside the calibrated range the polynomials are
-evaluated at the nearest end (clamped), as the firmware does.
+reported so the user sees whether the soaks support the order.  Outside the calibrated
+range the polynomials are evaluated at the nearest end (clamped), as the firmware does.
 
 Applied to data (:func:`correct`): ``x_c = (I + E(T))⁻¹ (x − b(T))`` per sample, at each
 sample's temperature.
