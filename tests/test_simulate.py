@@ -374,6 +374,7 @@ def test_scenario_registry_and_bad_input() -> None:
         "mems-warmup",
         "accel-full-range",
         "turntable-16",
+        "turntable-thermal",
         "mems-imu",
     }
     with pytest.raises(ThermocalInputError, match="unknown scenario"):

@@ -60,6 +60,7 @@ from thermocal.compensation import (  # the maths, re-exported
 )
 from thermocal.defaults import DEFAULT_CHUNK_ROWS as DEFAULT_CHUNK_ROWS
 from thermocal.errors import (
+    ExtrapolationWarning,
     FileFormatError,
     MissingColumnError,
     MissingValueError,
@@ -83,9 +84,11 @@ from thermocal.io import (
     file_kind,
     numeric_column,
     read_log_table,
+    read_recording,
     read_text_table,
     sidecar_path,
     write_json,
+    write_recording,
 )
 from thermocal.models.base import ChunkContext, TemperatureModel, check_sensor_id
 from thermocal.recording import (
@@ -833,3 +836,84 @@ __all__ = [
     "temperature_inputs",
     "unit_factor",
 ]
+
+
+@dataclass(frozen=True)
+class TriadCompensation:
+    """What :func:`compensate_triads` did for one triad: its columns, the added ones, the
+    data unit and the share of samples outside the calibrated temperature range."""
+
+    triad: str
+    columns: tuple[str, ...]
+    comp_columns: tuple[str, ...]
+    unit: str
+    outside_range_fraction: float
+
+    def to_dict(self) -> dict[str, Any]:
+        return dataclasses.asdict(self)
+
+
+def compensate_triads(
+    triads: Sequence[Any],
+    path: str | Path,
+    out: str | Path,
+    *,
+    time: str | None = None,
+    time_unit: str | None = None,
+) -> list[TriadCompensation]:
+    """Apply triad calibrations (issue 19) to a recording: for each triad and each of its
+    axes a column ``<col>_comp = [(I + E(T))⁻¹ (x − b(T))]_axis`` in the column's own unit,
+    ``T`` the triad's temperature column at each sample (clamped to the calibrated range,
+    with a warning when samples leave it; :func:`thermocal.turntable.thermal.correct`).
+    The recording is read whole and the output written atomically with every input column.
+    """
+    from thermocal.turntable import thermal
+
+    src, dst = Path(path), Path(out)
+    check_not_input(dst, [src])
+    rec = read_recording(src, time=time, time_unit=time_unit)
+    new_cols: dict[str, FloatArray] = {}
+    new_units: dict[str, str] = {}
+    results = []
+    for tri in triads:
+        missing = [c for c in (*tri.columns, tri.temperature) if c not in rec.columns]
+        if missing:
+            raise MissingColumnError(
+                f"{src}: the {tri.name} triad reads {', '.join(map(repr, missing))}, absent; "
+                "available: " + ", ".join(repr(c) for c in rec.columns)
+            )
+        data_units = {rec.units.get(c) or tri.unit for c in tri.columns}
+        if len(data_units) != 1:
+            raise ThermocalInputError(f"{src}: the {tri.name} triad's columns differ in unit")
+        data_unit = data_units.pop()
+        if units.canonical_unit(data_unit) != units.canonical_unit(tri.unit):
+            raise UnitError(
+                f"{src}: the {tri.name} triad was calibrated on {tri.unit} data; these columns "
+                f"are in {data_unit}"
+            )
+        bias_unit = "deg/h" if tri.model.kind == "gyro" else "mg"
+        to_data = float(units.convert(np.array([1.0]), bias_unit, data_unit)[0])
+        x = np.column_stack([rec.column(c) for c in tri.columns])
+        temp = rec.temperature_c(tri.temperature)
+        outside = float(np.mean((temp < tri.model.t_lo_c) | (temp > tri.model.t_hi_c)))
+        if outside > 0:
+            warnings.warn(
+                ExtrapolationWarning(
+                    f"{src}: {100 * outside:.3g} % of the samples are outside the {tri.name} "
+                    f"triad's calibrated range {tri.model.t_lo_c:g}…{tri.model.t_hi_c:g} °C: "
+                    "its parameters are held at the nearest end there"
+                ),
+                stacklevel=2,
+            )
+        xc = thermal.correct(tri.model, x, temp, to_data)
+        comp = []
+        for k, c in enumerate(tri.columns):
+            name = f"{c}_comp"
+            new_cols[name] = np.ascontiguousarray(xc[:, k])
+            new_units[name] = data_unit
+            comp.append(name)
+        results.append(
+            TriadCompensation(tri.name, tuple(tri.columns), tuple(comp), data_unit, outside)
+        )
+    write_recording(rec.with_columns(new_cols, new_units), dst)
+    return results

@@ -29,6 +29,7 @@ SCENARIO_NAMES: Final = (
     "mems-warmup",
     "accel-full-range",
     "turntable-16",
+    "turntable-thermal",
     "mems-imu",
 )
 """The simulator's scenarios (:data:`thermocal.simulate.SCENARIOS`, a test checks they agree)."""

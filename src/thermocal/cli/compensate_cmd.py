@@ -39,6 +39,7 @@ from thermocal.cli.common import (
     stdout,
     text_options,
 )
+from thermocal.errors import ThermocalInputError
 
 if TYPE_CHECKING:
     import rich.table as _rich_table
@@ -91,6 +92,25 @@ def compensate_cmd(
         _io.check_not_input(_io.sidecar_path(output), [file, model_file])
     cal = _files.load_calibration(model_file)  # a model file is a calibration of one channel
     conv = parse_temp_conversion(temp_conversion) if temp_conversion is not None else None
+    if cal.triads:
+        if cal.channels:
+            raise ThermocalInputError(
+                f"{model_file}: a calibration with both triads and single channels is not "
+                "applied yet; split it"
+            )
+        done = _compensate.compensate_triads(
+            cal.triads, file, output, time=time, time_unit=time_unit
+        )
+        summary_t = {"model": str(model_file), "output": str(output),
+                     "triads": [d.to_dict() for d in done]}  # fmt: skip
+
+        def human_t() -> None:
+            for d in done:
+                stdout.print(f"{d.triad}: {', '.join(d.comp_columns)} [{d.unit}]")
+            stdout.print(f"written: {output}")
+
+        emit(summary_t, as_json, human_t)
+        return
     if len(cal.channels) == 1:
         model = cal.channels[0].model
         with progress("compensating") as advance:

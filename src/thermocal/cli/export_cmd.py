@@ -53,6 +53,7 @@ def _export_calibration(
     """A calibration's C: one header and one source for every channel, each channel in
     its data's unit (``--unit`` applies one unit to every channel, or one per channel)."""
     cal = _files.load_calibration(path)
+    cal.require_channels("export-c")
     unit_of = units.per_signal_option(unit, cal.names)
     channels = [
         (c.name, _base.model_file_dict(c.model), unit_of[c.name] or c.unit) for c in cal.channels
@@ -240,6 +241,7 @@ def export_params_cmd(
 
     check_not_input(output, [calibration])
     cal = _files.load_calibration(calibration)
+    cal.require_channels("export-params")
     ids = {"gyro": device_id, "accel": device_id} if device_id is not None else None
     ps = export_params(
         cal, fmt, gyro=split_names(gyro), accel=split_names(accel), instance=instance,

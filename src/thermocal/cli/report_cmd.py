@@ -173,6 +173,7 @@ def report_cmd(
         inputs_files.append(modeling)
     _io.check_not_input(output, inputs_files)
     cal = _files.load_calibration(model[0])
+    cal.require_channels("report")
     if len(cal.channels) > 1 or len(split_names(signal) or []) > 1:
         if len(model) > 1:
             raise ThermocalInputError(

@@ -1,5 +1,9 @@
-"""``thermocal turntable FILE -o RESULT.json``: gyro-triad calibration (SPEC §7)."""
+"""``thermocal turntable FILE -o RESULT.json``: gyro-triad calibration (SPEC §7);
+``thermocal turntable FILE... --temps COL [--accel X,Y,Z] -o CAL.json``: both triads'
+error models over temperature from runs at several soaks (issue 19), written as a
+calibration that ``compensate`` applies."""
 
+from pathlib import Path
 from typing import TYPE_CHECKING, Annotated
 
 import typer
@@ -8,7 +12,6 @@ from thermocal import defaults
 from thermocal._lazy import LazyModule
 from thermocal.cli.application import app
 from thermocal.cli.common import (
-    FileArg,
     JsonOpt,
     OutOpt,
     TimeOpt,
@@ -25,10 +28,16 @@ if TYPE_CHECKING:
     import rich.table as _rich_table
 
     import thermocal.io as _io
+    import thermocal.models.calibration as _calibration
+    import thermocal.models.files as _files
     import thermocal.turntable.calibrate as _calibrate
     import thermocal.turntable.model as _model
+    import thermocal.turntable.thermal as _thermal
     from thermocal import units
 else:
+    _calibration = LazyModule("thermocal.models.calibration")
+    _files = LazyModule("thermocal.models.files")
+    _thermal = LazyModule("thermocal.turntable.thermal")
     _rich_table = LazyModule("rich.table")
     _io = LazyModule("thermocal.io")
     _calibrate = LazyModule("thermocal.turntable.calibrate")
@@ -39,7 +48,13 @@ else:
 @app.command("turntable")
 @handle_errors
 def turntable_cmd(
-    file: FileArg,
+    files: Annotated[
+        list[Path],
+        typer.Argument(
+            help="Turntable recording(s) (CSV or Parquet); several: one per soak temperature.",
+            show_default=False,
+        ),
+    ],
     output: OutOpt,
     latitude: Annotated[
         float | None, typer.Option("--latitude", help="Site latitude [°] (default: metadata).")
@@ -82,13 +97,63 @@ def turntable_cmd(
             "--channels", help="3: Δα, Δβ, Δγ (15 states); 2: the SPEC's Δα, Δβ (14 states)."
         ),
     ] = 3,
+    temps: Annotated[
+        str | None,
+        typer.Option(
+            "--temps",
+            help="Temperature column [°C]: with several runs, every parameter becomes a "
+            "polynomial in temperature and the output a calibration.",
+        ),
+    ] = None,
+    accel: Annotated[
+        str | None,
+        typer.Option("--accel", help="Accelerometer x,y,z column names (also calibrated)."),
+    ] = None,
+    accel_unit: Annotated[
+        str | None,
+        typer.Option("--accel-unit", help="Accelerometer unit: m/s^2, mg, g (default: file's)."),
+    ] = None,
+    gravity: Annotated[
+        float | None,
+        typer.Option(
+            "--gravity", help="Local gravity [m/s²] (default: WGS-84 normal gravity at latitude)."
+        ),
+    ] = None,
+    order: Annotated[
+        int | None,
+        typer.Option(
+            "--order", help="Polynomial order in temperature (default: chosen per parameter)."
+        ),
+    ] = None,
+    tref: Annotated[
+        float | None,
+        typer.Option("--tref", help="Reference temperature [°C] (default: mid soak range)."),
+    ] = None,
     as_json: JsonOpt = False,
 ) -> None:
-    """Gyro-triad bias, scale factor and misalignment from a 16-position turntable run."""
-    _io.check_not_input(output, [file])
+    """Gyro-triad bias, scale factor and misalignment from a 16-position turntable run; with
+    several runs at soak temperatures (--temps), both triads' error models over temperature."""
+    _io.check_not_input(output, list(files))
     gyro_cols = split_names(gyro) or []
     if len(gyro_cols) != 3:
         raise ThermocalInputError(f"--gyro needs three column names, got {gyro!r}")
+    accel_cols = split_names(accel) if accel else None
+    if accel_cols is not None and len(accel_cols) != 3:
+        raise ThermocalInputError(f"--accel needs three column names, got {accel!r}")
+    if len(files) > 1 or (temps is not None and (order is not None or tref is not None)):
+        if temps is None:
+            raise ThermocalInputError(
+                "several runs: name their temperature column with --temps (one run per soak)"
+            )
+        _thermal_calibration(
+            files, output, temps, gyro_cols, accel_cols, latitude, time, time_unit, gyro_unit,
+            accel_unit, gravity, alpha, beta, arw, encoder_noise, min_dwell, channels, order,
+            tref, as_json,
+        )  # fmt: skip
+        return
+    if order is not None or tref is not None:
+        raise ThermocalInputError("--order and --tref need several runs and --temps")
+    file = files[0]
     # the gyro columns' unit through the shared resolver: --gyro-unit > file metadata >
     # unit in the column name > °/s (INTERFACE: gyro_z in °/s), the last stated in a warning
     rec = _io.read_recording(
@@ -110,6 +175,10 @@ def turntable_cmd(
         encoder_noise_arcsec=encoder_noise,
         min_dwell_s=min_dwell,
         channels=channels,
+        accel_columns=accel_cols,
+        accel_unit=accel_unit,
+        gravity_m_s2=gravity,
+        temperature_column=temps,
     )
     out = result.to_dict()
     out["input"] = str(file)
@@ -143,6 +212,144 @@ def turntable_cmd(
         )
 
     emit(out, as_json, human)
+
+
+def _thermal_calibration(
+    files: list[Path],
+    output: Path,
+    temps: str,
+    gyro_cols: list[str],
+    accel_cols: list[str] | None,
+    latitude: float | None,
+    time: str | None,
+    time_unit: str | None,
+    gyro_unit: str | None,
+    accel_unit: str | None,
+    gravity: float | None,
+    alpha: str,
+    beta: str,
+    arw: float | None,
+    encoder_noise: float | None,
+    min_dwell: float,
+    channels: int,
+    order: int | None,
+    tref: float | None,
+    as_json: bool,
+) -> None:
+    """Each run calibrated alone, then every parameter of each triad as a polynomial in
+    temperature (:mod:`thermocal.turntable.thermal`); writes a calibration of triads."""
+    if output.suffix.lower() != ".json":
+        raise ThermocalInputError(f"{output}: the calibration is JSON; use a .json name")
+    runs = []
+    gyro_units: set[str] = set()
+    accel_units: set[str] = set()
+    for f in files:
+        rec = _io.read_recording(
+            f,
+            time=time,
+            time_unit=time_unit,
+            signals=gyro_cols,
+            signal_unit=gyro_unit,
+            temperatures=[temps],
+            model=units.StatedUnits(signal_default="deg/s"),
+        )
+        res = _calibrate.calibrate(
+            rec,
+            latitude,
+            gyro_columns=gyro_cols,
+            alpha_column=alpha,
+            beta_column=beta,
+            gyro_unit=gyro_unit,
+            arw_deg_sqrt_h=arw,
+            encoder_noise_arcsec=encoder_noise,
+            min_dwell_s=min_dwell,
+            channels=channels,
+            accel_columns=accel_cols,
+            accel_unit=accel_unit,
+            gravity_m_s2=gravity,
+            temperature_column=temps,
+        )
+        gyro_units |= {rec.units[c] for c in gyro_cols}  # resolved by read_recording
+        if accel_cols is not None:
+            accel_units |= {accel_unit} if accel_unit else {rec.units[c] for c in accel_cols}
+        runs.append((f, res))
+    for what, found in (("gyro", gyro_units), ("accelerometer", accel_units)):
+        if len(found) > 1:
+            raise ThermocalInputError(f"the runs' {what} columns differ in unit: {sorted(found)}")
+    temps_c = [float(r.temperature_c) for _f, r in runs]  # type: ignore[arg-type]
+    gyro_model = _thermal.fit_triad(
+        "gyro",
+        temps_c,
+        [r.kalman.theta for _f, r in runs],
+        [r.kalman.sigma for _f, r in runs],
+        tref_c=tref,
+        order=order,
+    )
+    triads = [
+        _calibration.Triad("gyro", (gyro_cols[0], gyro_cols[1], gyro_cols[2]),
+                           gyro_units.pop(), temps, gyro_model)
+    ]  # fmt: skip
+    accel_model = None
+    if accel_cols is not None:
+        accel_model = _thermal.fit_triad(
+            "accel",
+            temps_c,
+            [r.accel.theta for _f, r in runs if r.accel is not None],
+            [r.accel.sigma for _f, r in runs if r.accel is not None],
+            tref_c=gyro_model.tref_c,
+            order=order,
+        )
+        triads.append(
+            _calibration.Triad("accel", (accel_cols[0], accel_cols[1], accel_cols[2]),
+                               accel_units.pop(), temps, accel_model)
+        )  # fmt: skip
+    cal = _calibration.Calibration([], triads)
+    _files.save_calibration(cal, output)
+    out = {
+        "output": str(output),
+        "format": "thermocal-calibration",
+        "runs": [{"input": str(f), **r.to_dict()} for f, r in runs],
+        "gyro": _triad_summary(gyro_model),
+    }
+    if accel_model is not None:
+        out["accel"] = _triad_summary(accel_model)
+
+    def human() -> None:
+        for name, tri in (("gyro", gyro_model), ("accel", accel_model)):
+            if tri is None:
+                continue
+            table = _rich_table.Table(
+                title=f"{name} triad over temperature (TREF {tri.tref_c:g} °C, soaks "
+                f"{', '.join(f'{t:g}' for t in tri.soak_temperatures_c)} °C)"
+            )
+            for col in ("parameter", "unit", "order", "at TREF", "σ", "LOTO rms"):
+                table.add_column(col)
+            for fit in tri.fits:
+                table.add_row(fit.name, fit.unit, str(len(fit.coef) - 1), fmt(fit.coef[0], 5),
+                              fmt(fit.sigma[0], 3), fmt(fit.loto_rms, 3))  # fmt: skip
+            stdout.print(table)
+        stdout.print(f"calibration written: {output} (compensate applies it per sample)")
+
+    emit(out, as_json, human)
+
+
+def _triad_summary(tri: "_thermal.TriadThermal") -> dict[str, object]:
+    """The JSON of one triad's temperature model (INTERFACE.md: tref_c, order, coefficients
+    with _sigma, loto_rms)."""
+    return {
+        "tref_c": tri.tref_c,
+        "order": tri.order,
+        "temperature_range_c": [tri.t_lo_c, tri.t_hi_c],
+        "parameters": {
+            f.name: {
+                "unit": f.unit,
+                "coefficients": f.coef.tolist(),
+                "coefficients_sigma": f.sigma.tolist(),
+                "loto_rms": f.loto_rms,
+            }
+            for f in tri.fits
+        },
+    }
 
 
 __all__ = ["turntable_cmd"]

@@ -240,6 +240,7 @@ def validate_cmd(
         return res, out
 
     cal = _files.load_calibration(model_file)  # a model file is a calibration of one channel
+    cal.require_channels("validate")
     if len(cal.channels) > 1:
         from thermocal.models.calibration import merged_inputs, temperatures_of
 

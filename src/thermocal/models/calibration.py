@@ -76,15 +76,40 @@ class Channel:
 
 
 @dataclass
+class Triad:
+    """A sensor triad whose error model couples its three axes (issue 19): ``name``
+    (``gyro``/``accel``), the three ``columns`` (x, y, z) it reads, their ``unit`` as given,
+    the ``temperature`` column whose value indexes the model, and the ``model`` itself
+    (:class:`thermocal.turntable.thermal.TriadThermal`: bias, scale factors and
+    misalignments as polynomials in temperature).  Applied as
+    ``x_c = (I + E(T))⁻¹ (x − b(T))`` per sample (``<col>_comp``)."""
+
+    name: str
+    columns: tuple[str, str, str]
+    unit: str
+    temperature: str
+    model: Any  # TriadThermal (imported lazily: the turntable package needs scipy)
+
+
+@dataclass
 class Calibration:
-    """Several channels, each with its model (module docstring)."""
+    """Several channels, each with its model, and triads (module docstring)."""
 
     channels: list[Channel] = field(default_factory=list)
+    triads: list[Triad] = field(default_factory=list)
 
     def __post_init__(self) -> None:
-        names = [c.name for c in self.channels]
+        names = [c.name for c in self.channels] + [t.name for t in self.triads]
         if len(set(names)) != len(names):
             raise ThermocalInputError(f"calibration: channel names must be unique, got {names}")
+
+    def require_channels(self, what: str) -> None:
+        """Refuse a calibration of triads only for a command that handles channels only."""
+        if not self.channels:
+            raise ThermocalInputError(
+                f"this calibration holds triads ({', '.join(t.name for t in self.triads)}) and no "
+                f"single-channel model: {what} does not handle triads yet (compensate does)"
+            )
 
     @property
     def names(self) -> list[str]:
@@ -116,6 +141,17 @@ class Calibration:
                 for c in self.channels
             ],
         }
+        if self.triads:  # the key only when there are triads: older files are unchanged
+            d["triads"] = [
+                {
+                    "name": t.name,
+                    "columns": list(t.columns),
+                    "unit": t.unit,
+                    "temperature": t.temperature,
+                    "model": t.model.to_dict(),
+                }
+                for t in self.triads
+            ]
         d["checksum"] = checksum(d)
         return d
 
@@ -139,7 +175,10 @@ def calibration_from_dict(d: dict[str, Any], where: str) -> Calibration:
             f"{where}: checksum mismatch: the calibration file was corrupted or edited by hand"
         )
     raw = d.get("channels")
-    if not isinstance(raw, list) or not raw:
+    raw_triads = d.get("triads", [])
+    if not isinstance(raw_triads, list):
+        raise ModelFileError(f"{where}.triads: expected a list")
+    if not isinstance(raw, list) or not (raw or raw_triads):
         raise ModelFileError(f"{where}.channels: expected a non-empty list of channels")
     channels = []
     for i, ch in enumerate(raw):
@@ -160,10 +199,26 @@ def calibration_from_dict(d: dict[str, Any], where: str) -> Calibration:
         except (KeyError, TypeError, ValueError) as exc:
             raise ModelFileError(f"{at}.model: malformed ({type(exc).__name__}: {exc})") from None
         channels.append(Channel(ch["name"], ch["signal"], ch["unit"], model, role))
+    triads = [_triad_from_dict(t, f"{where}: triads[{i}]") for i, t in enumerate(raw_triads)]
     try:
-        return Calibration(channels)
+        return Calibration(channels, triads)
     except ThermocalInputError as exc:
         raise ModelFileError(f"{where}: {exc}") from None
+
+
+def _triad_from_dict(t: Any, at: str) -> Triad:
+    from thermocal.turntable.thermal import TriadThermal
+
+    if not isinstance(t, dict):
+        raise ModelFileError(f"{at}: expected an object")
+    cols = t.get("columns")
+    if not (isinstance(cols, list) and len(cols) == 3 and all(isinstance(c, str) for c in cols)):
+        raise ModelFileError(f"{at}.columns: expected three column names")
+    for key in ("name", "unit", "temperature"):
+        if not isinstance(t.get(key), str) or not t[key]:
+            raise ModelFileError(f"{at}: {key} must be a non-empty string")
+    model = TriadThermal.from_dict(t.get("model") or {}, f"{at}.model")
+    return Triad(t["name"], (cols[0], cols[1], cols[2]), t["unit"], t["temperature"], model)
 
 
 def temperatures_of(cal: Calibration, names: Sequence[str] | None = None) -> list[str]:

@@ -83,7 +83,7 @@ def load_model(path: str | Path) -> TemperatureModel:
 
 def save_calibration(cal: Calibration, path: str | Path) -> dict[str, Any]:
     """Write a calibration file (atomically); returns its dict."""
-    if not cal.channels:
+    if not cal.channels and not cal.triads:
         raise ThermocalInputError("calibration: no channels to write")
     d = cal.to_dict()
     write_json(path, d)

@@ -443,6 +443,23 @@ def scenario_turntable16(seed: int, profile: ProfileInput = None, **opts: Any) -
     return out
 
 
+def scenario_turntable_thermal(
+    seed: int, profile: ProfileInput = None, **opts: Any
+) -> ScenarioResult:
+    """16-position runs of a gyro and an accelerometer triad at several soak temperatures
+    and a held-out run at an unseen one, every parameter a known polynomial in temperature
+    (:func:`thermocal.turntable.simulate.simulate_turntable_thermal`, issue 19)."""
+    if profile is not None:
+        raise ThermocalInputError("the turntable-thermal scenario takes no chamber profile")
+    from thermocal.turntable.simulate import simulate_turntable_thermal
+
+    try:
+        runs = simulate_turntable_thermal(seed=seed, **opts)
+    except TypeError as exc:
+        raise ThermocalInputError(f"turntable-thermal: {exc}") from None
+    return [(rec, _plain(truth)) for rec, truth in runs]
+
+
 IMU_CHANNELS: tuple[tuple[str, str], ...] = (
     ("gx", "deg/s"),
     ("gy", "deg/s"),
@@ -558,6 +575,7 @@ SCENARIOS: dict[str, ScenarioFn] = {
     "mems-warmup": scenario_mems_warmup,
     "accel-full-range": scenario_accel_full_range,
     "turntable-16": scenario_turntable16,
+    "turntable-thermal": scenario_turntable_thermal,
     "mems-imu": scenario_mems_imu,
 }
 """Registry: scenario name → ``fn(seed, profile=None, **opts) -> [(Recording, truth)]``."""

@@ -180,3 +180,176 @@ def simulate_turntable16(
         "inner_axis_azimuth_arcsec = (yx - xy)/2",
     }
     return rec, truth_dict
+
+
+# --- several soaks: the error model over temperature (issue 19) -------------------------
+
+THERMAL_TREF_C = 20.0
+"""Reference temperature of the thermal truth's polynomials [°C]."""
+
+GYRO_THERMAL_TRUTH: dict[str, tuple[tuple[float, ...], ...]] = {
+    # coefficients of (T − TREF)^0..3 per element of θ: cubic biases [°/h], quadratic
+    # scale factors [ppm], linear misalignments [″] (a tactical-grade triad)
+    "bias": (
+        (0.05, 2.0e-3, -3.0e-5, 4.0e-7),
+        (-0.03, -1.5e-3, 2.0e-5, -3.0e-7),
+        (0.02, 1.0e-3, 1.0e-5, 2.0e-7),
+    ),
+    "scale_factor": ((60.0, 1.2, 0.015), (-40.0, -0.8, 0.010), (25.0, 1.5, -0.012)),
+    "misalignment": (
+        (30.0, 0.25),
+        (-25.0, 0.15),
+        (-10.0, -0.2),
+        (15.0, 0.1),
+        (40.0, -0.3),
+        (-35.0, 0.2),
+    ),
+}
+ACCEL_THERMAL_TRUTH: dict[str, tuple[tuple[float, ...], ...]] = {
+    # biases [mg], scale factors [ppm], misalignments [″]
+    "bias": (
+        (1.2, 0.02, -3.0e-4, 2.0e-6),
+        (-0.8, -0.015, 2.0e-4, -1.0e-6),
+        (0.5, 0.01, 1.0e-4, 1.5e-6),
+    ),
+    "scale_factor": ((150.0, 2.5, 0.02), (-120.0, -2.0, 0.015), (90.0, 3.0, -0.02)),
+    "misalignment": (
+        (20.0, 0.3),
+        (-15.0, 0.2),
+        (10.0, -0.25),
+        (25.0, 0.15),
+        (-30.0, 0.1),
+        (12.0, -0.2),
+    ),
+}
+
+
+def thermal_theta(spec: dict[str, tuple[tuple[float, ...], ...]], temp_c: Any) -> FloatArray:
+    """θ (…, 12) of a thermal truth at temperatures [°C] (polynomials in T − TREF)."""
+    d = np.asarray(temp_c, dtype=np.float64) - THERMAL_TREF_C
+    cols = [
+        np.polynomial.polynomial.polyval(d, np.asarray(c))
+        for key in ("bias", "scale_factor", "misalignment")
+        for c in spec[key]
+    ]
+    out: FloatArray = np.stack(cols, axis=-1)
+    return out
+
+
+def simulate_turntable_thermal(
+    seed: int = 0,
+    *,
+    soaks_c: tuple[float, ...] = (-40.0, -20.0, 0.0, 20.0, 40.0, 60.0),
+    held_out_c: float = 10.0,
+    drift_c: float = 1.5,
+    rate_hz: float = 20.0,
+    dwell_s: float = 60.0,
+    move_rate_deg_s: float = 10.0,
+    latitude_deg: float = 40.0,
+    arw_deg_sqrt_h: float = 0.01,
+    accel_noise_mg: float = 0.05,
+    encoder_noise_arcsec: float = 0.0,
+) -> list[tuple[Recording, dict[str, Any]]]:
+    """16-position runs at several soak temperatures plus a held-out run at an unseen one,
+    a gyro and an accelerometer triad whose every parameter follows
+    :data:`GYRO_THERMAL_TRUTH` / :data:`ACCEL_THERMAL_TRUTH` and is applied at each sample's
+    temperature; the soak drifts by ``drift_c`` during each run (a chamber that has not
+    quite settled).  Columns: ``time`` [s], ``gyro_x/y/z`` [°/s], ``accel_x/y/z`` [m/s²],
+    ``alpha_deg``/``beta_deg`` [°], ``T_imu`` [°C].  The truth of each run holds the
+    polynomials, the run's mean temperature and θ at it."""
+    sched = build_schedule(dwell_s=dwell_s, move_rate_deg_s=move_rate_deg_s)
+    tau = 1.0 / rate_hz
+    n = int(np.floor(sched.duration_s * rate_hz)) + 1
+    t = np.arange(n) * tau
+    a_deg, b_deg = sched.angles_at(t)
+    a = a_deg * units.DEG_TO_RAD
+    b = b_deg * units.DEG_TO_RAD
+    a_prev = np.concatenate([[a[0]], a[:-1]])
+    b_prev = np.concatenate([[b[0]], b[:-1]])
+    a_mid, b_mid = 0.5 * (a + a_prev), 0.5 * (b + b_prev)
+    omega_true = kinematics.omega_ib_b(
+        a_mid, b_mid, (a - a_prev) / tau, (b - b_prev) / tau, latitude_deg
+    )
+    g = units.normal_gravity_m_s2(latitude_deg)
+    c_nb = kinematics.mat_nb(a, b)
+    f_true = np.einsum("nji,j->ni", c_nb, np.array([0.0, 0.0, g]))
+    runs = [(f"T{c:+g}", c) for c in soaks_c] + [(f"heldout_T{held_out_c:+g}", held_out_c)]
+    ss = np.random.SeedSequence([int(seed), 19])
+    out: list[tuple[Recording, dict[str, Any]]] = []
+    for (label, soak), child in zip(runs, ss.spawn(len(runs)), strict=True):
+        rng = np.random.default_rng(child)
+        temp = soak + drift_c * (t / t[-1] - 0.5)
+        tg = thermal_theta(GYRO_THERMAL_TRUTH, temp)
+        ta = thermal_theta(ACCEL_THERMAL_TRUTH, temp)
+        e_g = _error_matrices(tg)
+        e_a = _error_matrices(ta)
+        arw = arw_deg_sqrt_h * units.DEG_TO_RAD / np.sqrt(units.SECONDS_PER_HOUR)
+        gyro = (
+            omega_true
+            + np.einsum("nij,nj->ni", e_g, omega_true)
+            + tg[:, 0:3] * units.DH_TO_RS
+            + rng.standard_normal((n, 3)) * (arw / np.sqrt(tau))
+        )
+        acc = (
+            f_true
+            + np.einsum("nij,nj->ni", e_a, f_true)
+            + ta[:, 0:3] * 9.80665e-3
+            + rng.standard_normal((n, 3)) * accel_noise_mg * 9.80665e-3
+        )
+        enc = encoder_noise_arcsec / 3600.0
+        rec = Recording.from_arrays(
+            t,
+            signals={c: gyro[:, k] * units.RAD_TO_DEG for k, c in enumerate(GYRO_COLUMNS)},
+            temperatures={"T_imu": temp},
+            signal_unit="deg/s",
+            other={
+                **{f"accel_{ax}": acc[:, k] for k, ax in enumerate("xyz")},
+                ALPHA_COLUMN: np.mod(a_deg + rng.standard_normal(n) * enc, 360.0),
+                BETA_COLUMN: np.mod(b_deg + rng.standard_normal(n) * enc, 360.0),
+            },
+            other_units={
+                **{f"accel_{ax}": "m/s^2" for ax in "xyz"},
+                ALPHA_COLUMN: "deg",
+                BETA_COLUMN: "deg",
+            },
+            meta=Metadata(
+                sample_interval_s=tau,
+                latitude_deg=latitude_deg,
+                run_id=f"turntable-thermal seed {seed} {label}",
+                notes="simulated 16-position run at a soak temperature (turntable-thermal)",
+                extra={"scenario": "turntable-thermal"},
+            ),
+        )
+        mean_t = float(np.mean(temp))
+        truth: dict[str, Any] = {
+            "scenario": "turntable-thermal",
+            "label": label,
+            "soak_c": soak,
+            "held_out": label.startswith("heldout"),
+            "temperature_c": mean_t,
+            "drift_c": drift_c,
+            "tref_c": THERMAL_TREF_C,
+            "gyro_polynomials": {k: [list(c) for c in v] for k, v in GYRO_THERMAL_TRUTH.items()},
+            "accel_polynomials": {k: [list(c) for c in v] for k, v in ACCEL_THERMAL_TRUTH.items()},
+            "gyro_theta_at_mean": thermal_theta(GYRO_THERMAL_TRUTH, mean_t).tolist(),
+            "accel_theta_at_mean": thermal_theta(ACCEL_THERMAL_TRUTH, mean_t).tolist(),
+            "gravity_m_s2": g,
+            "latitude_deg": latitude_deg,
+            "seed": seed,
+            "rate_hz": rate_hz,
+            "arw_deg_sqrt_h": arw_deg_sqrt_h,
+            "accel_noise_mg": accel_noise_mg,
+        }
+        out.append((rec, truth))
+    return out
+
+
+def _error_matrices(theta: FloatArray) -> FloatArray:
+    """E (n, 3, 3) from θ (n, 12): ppm on the diagonal, arcseconds off it."""
+    e = np.zeros((theta.shape[0], 3, 3))
+    for i in range(3):
+        e[:, i, i] = theta[:, 3 + i] * 1e-6
+    for k, name in enumerate(model.MISALIGNMENT_NAMES):
+        r, c = model.MISALIGNMENT_INDEX[name]
+        e[:, r, c] = theta[:, 6 + k] * units.ARCSEC_TO_RAD
+    return e
