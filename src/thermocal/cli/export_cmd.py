@@ -53,6 +53,27 @@ def _export_calibration(
     """A calibration's C: one header and one source for every channel, each channel in
     its data's unit (``--unit`` applies one unit to every channel, or one per channel)."""
     cal = _files.load_calibration(path)
+    if cal.triads and not cal.channels:  # a turntable calibration over temperature
+        from thermocal.export_c.triad import generate_c_triads
+
+        ex = generate_c_triads(
+            cal.triads, prefix=name or _export_c.c_identifier(path.stem), real=real
+        )
+        paths = ex.write(output)
+        out_t = {
+            "family": "triads",
+            "prefix": ex.prefix,
+            "real": ex.real,
+            "triads": {t.name: {"unit": t.unit, "columns": list(t.columns)} for t in cal.triads},
+            "files": [str(p) for p in paths],
+        }
+
+        def human_t() -> None:
+            for p in paths:
+                stdout.print(f"wrote {p}")
+
+        emit(out_t, as_json, human_t)
+        return
     cal.require_channels("export-c")
     unit_of = units.per_signal_option(unit, cal.names)
     channels = [

@@ -1,0 +1,126 @@
+"""Plain C99 for a calibration of triads (issue 19): per triad one function
+
+    void <p>_<triad>_correct(double temp_c, const <real> x[3], <real> out[3]);
+
+computing ``out = (I + E(T))⁻¹ (x − b(T))`` in the data's unit: ``T`` clamped to the
+calibrated range, every parameter a polynomial in ``T − TREF`` (Horner), ``E`` with
+``E_ii = θ_ppm·10⁻⁶`` and ``E_ij = θ_″·π/648000``, the 3×3 solve by the adjugate over the
+determinant (no allocation, no library call; ``I + E`` is within 10⁻³ of the identity, so
+the determinant is near 1).  Matches :func:`thermocal.turntable.thermal.correct`.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from typing import Any
+
+from thermocal import __version__
+from thermocal.export_c.core import CExport, c_identifier
+from thermocal.turntable import model as tt_model
+
+_ARCSEC_RAD = math.pi / 648000.0
+
+
+def _lit(x: float) -> str:
+    return repr(float(x))
+
+
+def _triad_code(p: str, tri: Any, bias_to_data: float, real: str) -> tuple[str, str]:
+    """(declaration, definition) of one triad's correction function."""
+    m = tri.model
+    name = f"{p}_{c_identifier(tri.name)}"
+    bias_unit = "deg/h" if m.kind == "gyro" else "mg"
+    P = name.upper()
+    order = max(len(f.coef) for f in m.fits)
+    rows = []
+    for f in m.fits:
+        c = [float(v) for v in f.coef] + [0.0] * (order - len(f.coef))
+        rows.append("    {" + ", ".join(_lit(v) for v in c) + "}, /* " + f.name + f" [{f.unit}] */")
+    lines = [
+        f"/* {tri.name} triad: parameters as polynomials in (T - TREF), ascending powers */",
+        f"static const double {P}_COEF[12][{order}] = {{",
+        *rows,
+        "};",
+        f"static const double {P}_TREF = {_lit(m.tref_c)};",
+        f"static const double {P}_T_LO = {_lit(m.t_lo_c)};",
+        f"static const double {P}_T_HI = {_lit(m.t_hi_c)};",
+        f"/* bias unit ({bias_unit}) to the data's unit ({tri.unit}) */",
+        f"static const double {P}_BIAS_TO_DATA = {_lit(bias_to_data)};",
+        "",
+        f"void {name}_correct(double temp_c, const {real} x[3], {real} out[3])",
+        "{",
+        f"    double t = temp_c < {P}_T_LO ? {P}_T_LO : (temp_c > {P}_T_HI ? {P}_T_HI : temp_c);",
+        f"    double dt = t - {P}_TREF;",
+        "    double th[12], m[3][3], r[3], det;",
+        "    int k, j;",
+        "    for (k = 0; k < 12; ++k) {",
+        f"        double acc = {P}_COEF[k][{order - 1}];",
+        f"        for (j = {order - 2}; j >= 0; --j) acc = acc * dt + {P}_COEF[k][j];",
+        "        th[k] = acc;",
+        "    }",
+        "    m[0][0] = 1.0 + th[3] * 1e-6;",
+        "    m[1][1] = 1.0 + th[4] * 1e-6;",
+        "    m[2][2] = 1.0 + th[5] * 1e-6;",
+    ]
+    for k, mis in enumerate(tt_model.MISALIGNMENT_NAMES):
+        i, j = tt_model.MISALIGNMENT_INDEX[mis]
+        lines.append(f"    m[{i}][{j}] = th[{6 + k}] * {_lit(_ARCSEC_RAD)}; /* {mis} */")
+    lines += [
+        f"    r[0] = (double)x[0] - th[0] * {P}_BIAS_TO_DATA;",
+        f"    r[1] = (double)x[1] - th[1] * {P}_BIAS_TO_DATA;",
+        f"    r[2] = (double)x[2] - th[2] * {P}_BIAS_TO_DATA;",
+        "    det = m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1])",
+        "        - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])",
+        "        + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);",
+        f"    out[0] = ({real})(((m[1][1] * m[2][2] - m[1][2] * m[2][1]) * r[0]",
+        "        - (m[0][1] * m[2][2] - m[0][2] * m[2][1]) * r[1]",
+        "        + (m[0][1] * m[1][2] - m[0][2] * m[1][1]) * r[2]) / det);",
+        f"    out[1] = ({real})((-(m[1][0] * m[2][2] - m[1][2] * m[2][0]) * r[0]",
+        "        + (m[0][0] * m[2][2] - m[0][2] * m[2][0]) * r[1]",
+        "        - (m[0][0] * m[1][2] - m[0][2] * m[1][0]) * r[2]) / det);",
+        f"    out[2] = ({real})(((m[1][0] * m[2][1] - m[1][1] * m[2][0]) * r[0]",
+        "        - (m[0][0] * m[2][1] - m[0][1] * m[2][0]) * r[1]",
+        "        + (m[0][0] * m[1][1] - m[0][1] * m[1][0]) * r[2]) / det);",
+        "}",
+    ]
+    decl = (
+        f"/* {tri.name}: out = (I + E(T))^-1 (x - b(T)) in {tri.unit}; columns "
+        f"{', '.join(tri.columns)}; T [degC] of {tri.temperature}, clamped to "
+        f"[{m.t_lo_c:g}, {m.t_hi_c:g}] */\n"
+        f"void {name}_correct(double temp_c, const {real} x[3], {real} out[3]);"
+    )
+    return decl, "\n".join(lines)
+
+
+def generate_c_triads(triads: Sequence[Any], *, prefix: str, real: str = "double") -> CExport:
+    """The C module of a calibration's triads (module docstring)."""
+    from thermocal import units
+
+    if real not in ("double", "float"):
+        raise ValueError("real must be double or float")
+    p = c_identifier(prefix)
+    decls, defs = [], []
+    for tri in triads:
+        bias_unit = "deg/h" if tri.model.kind == "gyro" else "mg"
+        factor = float(units.convert([1.0], bias_unit, tri.unit)[0])
+        d, f = _triad_code(p, tri, factor, real)
+        decls.append(d)
+        defs.append(f)
+    guard = f"{p.upper()}_H"
+    banner = (
+        f"/*\n * Generated by thermocal {__version__} export-c from a calibration of triads. "
+        "Do not edit.\n */\n"
+    )
+    header = (
+        banner
+        + f"#ifndef {guard}\n#define {guard}\n\n"
+        + "\n\n".join(decls)
+        + f"\n\n#endif /* {guard} */\n"
+    )
+    source = banner + f'#include "{p}.h"\n\n' + "\n\n".join(defs) + "\n"
+    units_of = ",".join(t.unit for t in triads)
+    return CExport(p, real, header, source, "triads", 1, unit=units_of, model_unit=units_of)
+
+
+__all__ = ["generate_c_triads"]
