@@ -169,3 +169,27 @@ def test_bias_only_and_single_temperature_do_much_worse(workflow: dict) -> None:
     )
     assert bias_only_mg > 10 * ours, msg
     assert single_mg > 10 * ours, msg
+
+
+def test_a_soak_that_missed_a_position(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """The 0 °C run holds 15 of the 16 positions: it is used, the warning says so, and the
+    held-out run is still compensated to the accelerometer target."""
+    runs = simulate_turntable_thermal(seed=6, drop_position=("T+0", 5))
+    files = []
+    for rec, truth in runs:
+        f = tmp_path / f"{truth['label']}.parquet"
+        write_recording(rec, f)
+        files.append((f, truth))
+    soaks = [str(f) for f, tr in files if not tr["held_out"]]
+    held = next(f for f, tr in files if tr["held_out"])
+    cal = tmp_path / "cal.json"
+    code = main(["turntable", *soaks, "--temps", "T_imu", "--accel", ",".join(A_COLS),
+                 "-o", str(cal)])  # fmt: skip
+    assert code == 0
+    err = capsys.readouterr().err
+    assert "T+0" in err and "15 positions held" in err
+    comp = tmp_path / "comp.parquet"
+    assert main(["compensate", str(cal), str(held), "-o", str(comp)]) == 0
+    _rec, _omega, f_true, dwells, _tau = _truth_frame(held)
+    ours = pd.read_parquet(comp)[[f"{c}_comp" for c in A_COLS]].to_numpy()
+    assert _dwell_rms(ours, f_true, dwells) / MG < 0.02

@@ -214,6 +214,11 @@ def turntable_cmd(
     emit(out, as_json, human)
 
 
+MIN_POSITIONS_OF_A_SOAK = 12
+"""A soak run missing a few of the sixteen positions is still used (with a warning): twelve
+distinct attitudes still separate the twelve parameters of each triad."""
+
+
 def _thermal_calibration(
     files: list[Path],
     output: Path,
@@ -268,6 +273,7 @@ def _thermal_calibration(
             accel_unit=accel_unit,
             gravity_m_s2=gravity,
             temperature_column=temps,
+            min_positions=MIN_POSITIONS_OF_A_SOAK,
         )
         gyro_units |= {rec.units[c] for c in gyro_cols}  # resolved by read_recording
         if accel_cols is not None:

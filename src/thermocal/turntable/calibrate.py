@@ -404,6 +404,11 @@ def calibrate(
     weak = weak_combinations(info, info_static, static_fraction)
     for w in weak:
         msgs.append(f"weakly observable combination: {w['combination']}")
+    if seg.n_positions < len(schedule.POSITIONS_16):
+        msgs.append(
+            f"{seg.n_positions} positions held, not the {len(schedule.POSITIONS_16)} of SPEC §7: "
+            "estimated with what is there (the σ say how well)"
+        )
     acc_est: accel_mod.AccelEstimate | None = None
     g_local: float | None = None
     if accel_columns is not None:

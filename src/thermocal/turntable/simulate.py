@@ -249,6 +249,7 @@ def simulate_turntable_thermal(
     arw_deg_sqrt_h: float = 0.01,
     accel_noise_mg: float = 0.05,
     encoder_noise_arcsec: float = 0.0,
+    drop_position: tuple[str, int] | None = None,
 ) -> list[tuple[Recording, dict[str, Any]]]:
     """16-position runs at several soak temperatures plus a held-out run at an unseen one,
     a gyro and an accelerometer triad whose every parameter follows
@@ -256,28 +257,39 @@ def simulate_turntable_thermal(
     temperature; the soak drifts by ``drift_c`` during each run (a chamber that has not
     quite settled).  Columns: ``time`` [s], ``gyro_x/y/z`` [°/s], ``accel_x/y/z`` [m/s²],
     ``alpha_deg``/``beta_deg`` [°], ``T_imu`` [°C].  The truth of each run holds the
-    polynomials, the run's mean temperature and θ at it."""
-    sched = build_schedule(dwell_s=dwell_s, move_rate_deg_s=move_rate_deg_s)
+    polynomials, the run's mean temperature and θ at it.  ``drop_position`` (label, index)
+    leaves one position out of that run (a run that missed a position)."""
+
+    def kinematic(positions: tuple[tuple[float, float], ...]) -> tuple[Any, ...]:
+        sched = build_schedule(
+            dwell_s=dwell_s, move_rate_deg_s=move_rate_deg_s, positions_deg=positions
+        )
+        n = int(np.floor(sched.duration_s * rate_hz)) + 1
+        t = np.arange(n) * tau
+        a_deg, b_deg = sched.angles_at(t)
+        a = a_deg * units.DEG_TO_RAD
+        b = b_deg * units.DEG_TO_RAD
+        a_prev = np.concatenate([[a[0]], a[:-1]])
+        b_prev = np.concatenate([[b[0]], b[:-1]])
+        a_mid, b_mid = 0.5 * (a + a_prev), 0.5 * (b + b_prev)
+        omega = kinematics.omega_ib_b(
+            a_mid, b_mid, (a - a_prev) / tau, (b - b_prev) / tau, latitude_deg
+        )
+        f = np.einsum("nji,j->ni", kinematics.mat_nb(a, b), np.array([0.0, 0.0, g]))
+        return n, t, a_deg, b_deg, omega, f
+
     tau = 1.0 / rate_hz
-    n = int(np.floor(sched.duration_s * rate_hz)) + 1
-    t = np.arange(n) * tau
-    a_deg, b_deg = sched.angles_at(t)
-    a = a_deg * units.DEG_TO_RAD
-    b = b_deg * units.DEG_TO_RAD
-    a_prev = np.concatenate([[a[0]], a[:-1]])
-    b_prev = np.concatenate([[b[0]], b[:-1]])
-    a_mid, b_mid = 0.5 * (a + a_prev), 0.5 * (b + b_prev)
-    omega_true = kinematics.omega_ib_b(
-        a_mid, b_mid, (a - a_prev) / tau, (b - b_prev) / tau, latitude_deg
-    )
     g = units.normal_gravity_m_s2(latitude_deg)
-    c_nb = kinematics.mat_nb(a, b)
-    f_true = np.einsum("nji,j->ni", c_nb, np.array([0.0, 0.0, g]))
+    full = kinematic(POSITIONS_16)
     runs = [(f"T{c:+g}", c) for c in soaks_c] + [(f"heldout_T{held_out_c:+g}", held_out_c)]
     ss = np.random.SeedSequence([int(seed), 19])
     out: list[tuple[Recording, dict[str, Any]]] = []
     for (label, soak), child in zip(runs, ss.spawn(len(runs)), strict=True):
         rng = np.random.default_rng(child)
+        n, t, a_deg, b_deg, omega_true, f_true = full
+        if drop_position is not None and drop_position[0] == label:
+            kept = tuple(pos for i, pos in enumerate(POSITIONS_16) if i != drop_position[1])
+            n, t, a_deg, b_deg, omega_true, f_true = kinematic(kept)
         temp = soak + drift_c * (t / t[-1] - 0.5)
         tg = thermal_theta(GYRO_THERMAL_TRUTH, temp)
         ta = thermal_theta(ACCEL_THERMAL_TRUTH, temp)
