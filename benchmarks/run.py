@@ -46,6 +46,7 @@ BENCHMARKS: dict[str, tuple[list[str], list[str]]] = {
     "models_warmup_bank": ([], []),
     "demo": (["--repeat", "3"], ["--repeat", "1"]),
     "fleet": ([], ["--skip-big"]),
+    "turntable_thermal": ([], []),
 }
 """Every benchmark script (``bench_<name>.py``) and the RESULTS.md section it feeds."""
 
