@@ -193,3 +193,24 @@ def test_a_soak_that_missed_a_position(tmp_path: Path, capsys: pytest.CaptureFix
     _rec, _omega, f_true, dwells, _tau = _truth_frame(held)
     ours = pd.read_parquet(comp)[[f"{c}_comp" for c in A_COLS]].to_numpy()
     assert _dwell_rms(ours, f_true, dwells) / MG < 0.02
+
+
+def test_validate_judges_the_held_out_run(
+    workflow: dict, capsys: pytest.CaptureFixture[str]
+) -> None:
+    code = main(["validate", str(workflow["cal"]), str(workflow["held"]), "--json"])
+    assert code == 0
+    out = json.loads(capsys.readouterr().out)
+    acc, gyro = out["triads"]["accel"], out["triads"]["gyro"]
+    assert acc["unit"] == "mg" and max(acc["dwell_rms_after"]) < 0.02
+    assert min(acc["dwell_rms_before"]) > 20 * max(acc["dwell_rms_after"])
+    assert max(gyro["move_angle_rms_after_arcsec"]) < min(gyro["move_angle_rms_before_arcsec"]) / 5
+    # the same figures the test computes itself on the compensated file
+    _rec, _omega, f_true, dwells, _tau = _truth_frame(workflow["held"])  # type: ignore[arg-type]
+    comp = pd.read_parquet(workflow["comp"])
+    mine = [
+        _dwell_rms(comp[[f"{c}_comp" for c in A_COLS]].to_numpy()[:, [k]], f_true[:, [k]], dwells)
+        / MG
+        for k in range(3)
+    ]
+    np.testing.assert_allclose(acc["dwell_rms_after"], mine, rtol=1e-6)

@@ -47,6 +47,7 @@ if TYPE_CHECKING:
 
     import thermocal.compensate as _compensate
     import thermocal.models.base as _base
+    import thermocal.models.calibration as _calibration
     import thermocal.models.files as _files
     import thermocal.recording as _recording
     import thermocal.validation as _validation
@@ -54,6 +55,7 @@ else:
     _rich_table = LazyModule("rich.table")
     _compensate = LazyModule("thermocal.compensate")
     _base = LazyModule("thermocal.models.base")
+    _calibration = LazyModule("thermocal.models.calibration")
     _files = LazyModule("thermocal.models.files")
     _recording = LazyModule("thermocal.recording")
     _validation = LazyModule("thermocal.validation")
@@ -163,10 +165,24 @@ def validate_cmd(
     t_bad: OnBadLinesOpt = "error",
     t_delim: DelimiterOpt = None,
     t_dec: DecimalOpt = None,
+    latitude: Annotated[
+        float | None,
+        typer.Option(
+            "--latitude",
+            help="Site latitude [°] of a turntable run (a calibration of triads; default: "
+            "the file's metadata).",
+        ),
+    ] = None,
     as_json: JsonOpt = False,
 ) -> None:
     """Validate MODEL on FILE: correlation r, bias stability and repeatability over the
-    hold stages, rms and peak-to-peak, before and after compensation."""
+    hold stages, rms and peak-to-peak, before and after compensation; a calibration of
+    triads (thermocal turntable over temperature) on a turntable run: dwell-mean and
+    move-angle errors before and after."""
+    pre = _files.load_calibration(model_file)
+    if pre.triads and not pre.channels:
+        _validate_triads(pre, model_file, file, time, time_unit, latitude, as_json)
+        return
 
     modeling_cache: dict[Path, _recording.Recording] = {}
 
@@ -300,6 +316,54 @@ def validate_cmd(
                 fmt(getattr(res, f"{key}_after")),
                 "—" if pct is None else f"{pct:.1f} %",
             )
+        stdout.print(table)
+
+    emit(out, as_json, human)
+
+
+def _validate_triads(
+    cal: "_calibration.Calibration",
+    model_file: Path,
+    file: Path,
+    time: str | None,
+    time_unit: str | None,
+    latitude: float | None,
+    as_json: bool,
+) -> None:
+    """A calibration of triads judged on a turntable run (issue 19)."""
+    from thermocal.io import read_recording
+    from thermocal.turntable.calibrate import validate_triads
+
+    rec = read_recording(file, time=time, time_unit=time_unit)
+    results = validate_triads(cal.triads, rec, latitude)
+    for r in results:
+        if r.outside_range_fraction > 0:
+            warnings.warn(
+                UnitWarning(
+                    f"{file}: {100 * r.outside_range_fraction:.3g} % of the samples are outside "
+                    f"the {r.triad} triad's calibrated temperature range"
+                ),
+                stacklevel=1,
+            )
+    out = {
+        "model": str(model_file),
+        "file": str(file),
+        "family": "triads",
+        "triads": {r.triad: r.to_dict() for r in results},
+    }
+
+    def human() -> None:
+        table = _rich_table.Table(title=f"{model_file} on {file}")
+        for col in ("triad", "figure", "x before → after", "y before → after", "z before → after"):
+            table.add_column(col)
+        for r in results:
+            rows = [("dwell-mean error rms", r.unit, r.dwell_rms_before, r.dwell_rms_after)]
+            before_m, after_m = r.move_angle_rms_before_arcsec, r.move_angle_rms_after_arcsec
+            if before_m is not None and after_m is not None:
+                rows.append(("move-angle error rms", "arcsec", before_m, after_m))
+            for label, unit, before, after in rows:
+                cells = [f"{fmt(b)} → {fmt(a)}" for b, a in zip(before, after, strict=True)]
+                table.add_row(r.triad, f"{label} [{unit}]", *cells)
         stdout.print(table)
 
     emit(out, as_json, human)

@@ -486,3 +486,79 @@ def _accel_triad(
 def estimate_from(theta: FloatArray, cov: FloatArray) -> Estimate:
     """Wrap θ and its covariance."""
     return Estimate(theta=np.asarray(theta, dtype=np.float64), cov=np.asarray(cov))
+
+
+def validate_triads(
+    triads: Sequence[Any],
+    rec: Recording,
+    latitude_deg: float | None = None,
+    *,
+    gravity_m_s2: float | None = None,
+    alpha_column: str = "alpha_deg",
+    beta_column: str = "beta_deg",
+) -> list[Any]:
+    """Judge a calibration of triads (issue 19) on an independent 16-position run: the
+    reference of every sample from the encoder angles (true body rate ``ω_ib^b``, eq. (2),
+    over each interval; specific force ``C_nᵇ (0, 0, g)`` at rest), the dwells and moves
+    from the encoders (:func:`.schedule.detect_motion`), and per triad the dwell-mean and
+    move-angle errors before and after compensation
+    (:func:`thermocal.turntable.thermal.validate_triad`)."""
+    from thermocal.turntable import kinematics, thermal
+
+    lat = latitude_deg if latitude_deg is not None else rec.meta.latitude_deg
+    if lat is None:
+        raise ThermocalInputError(f"{rec.name}: give the latitude (--latitude DEG)")
+    cols = [alpha_column, beta_column]
+    for tri in triads:
+        cols += [*tri.columns, tri.temperature]
+    rec.validate(required=cols)
+    _check_finite(rec, cols)
+    t = rec.time_s
+    a_deg = np.unwrap(rec.column(alpha_column), period=360.0)
+    b_deg = np.unwrap(rec.column(beta_column), period=360.0)
+    motion = schedule.detect_motion(t, a_deg, b_deg)
+    valid = np.ones(t.size - 1, dtype=bool)
+    seg = schedule.segment(t, a_deg, b_deg, motion.moving, valid)
+    if len(seg.dwells) < 2:
+        raise ThermocalInputError(f"{rec.name}: fewer than two dwells: not a turntable run")
+    a, b = a_deg * units.DEG_TO_RAD, b_deg * units.DEG_TO_RAD
+    dt = np.diff(t, prepend=t[0] - float(np.median(np.diff(t))))
+    a_prev, b_prev = np.concatenate([[a[0]], a[:-1]]), np.concatenate([[b[0]], b[:-1]])
+    with np.errstate(divide="ignore", invalid="ignore"):
+        omega = kinematics.omega_ib_b(
+            0.5 * (a + a_prev), 0.5 * (b + b_prev), (a - a_prev) / dt, (b - b_prev) / dt, lat
+        )
+    g = float(gravity_m_s2) if gravity_m_s2 is not None else units.normal_gravity_m_s2(lat)
+    f_true = np.einsum("nji,j->ni", kinematics.mat_nb(a, b), np.array([0.0, 0.0, g]))
+    dt_med = float(np.median(np.diff(t)))
+    out = []
+    for tri in triads:
+        unit = tri.unit
+        x = np.column_stack([rec.column(c) for c in tri.columns])
+        temp = rec.temperature_c(tri.temperature)
+        if tri.model.kind == "gyro":
+            ref = units.convert(omega, "rad/s", unit)
+            factor = float(units.convert(np.array([1.0]), unit, "deg/h")[0])
+            bias_to_data = float(units.convert(np.array([1.0]), "deg/h", unit)[0])
+            fig_unit = "deg/h"
+        else:
+            ref = units.convert(f_true, "m/s^2", unit)
+            factor = float(units.convert(np.array([1.0]), unit, "mg")[0])
+            bias_to_data = float(units.convert(np.array([1.0]), "mg", unit)[0])
+            fig_unit = "mg"
+        out.append(
+            thermal.validate_triad(
+                tri.model,
+                unit,
+                x,
+                temp,
+                np.asarray(ref),
+                list(seg.dwells),
+                bias_to_data,
+                dt_med,
+                name=tri.name,
+                figure_unit_factor=factor,
+                figure_unit=fig_unit,
+            )
+        )
+    return out

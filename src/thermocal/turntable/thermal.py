@@ -20,6 +20,7 @@ sample's temperature.
 
 from __future__ import annotations
 
+import itertools
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -315,8 +316,85 @@ __all__ = [
     "PARAMETER_NAMES",
     "ParameterFit",
     "TriadThermal",
+    "TriadValidation",
     "correct",
     "error_terms",
     "fit_triad",
     "solve3",
+    "validate_triad",
 ]
+
+
+@dataclass(frozen=True)
+class TriadValidation:
+    """How a triad calibration does on an independent turntable run (:func:`validate_triad`):
+    per axis, before (raw) and after (compensated), the rms over the dwells of the dwell-mean
+    error against the reference the encoders give (earth rate or gravity in body axes) and,
+    for gyros, the rms over the moves of the angle error accumulated during each move."""
+
+    triad: str
+    unit: str
+    dwell_rms_before: tuple[float, float, float]
+    dwell_rms_after: tuple[float, float, float]
+    move_angle_rms_before_arcsec: tuple[float, float, float] | None
+    move_angle_rms_after_arcsec: tuple[float, float, float] | None
+    n_dwells: int
+    temperature_c: tuple[float, float]
+    outside_range_fraction: float
+
+    def to_dict(self) -> dict[str, Any]:
+        from dataclasses import asdict
+
+        return asdict(self)
+
+
+def validate_triad(
+    triad: TriadThermal,
+    kind_unit: str,
+    x: FloatArray,
+    temp_c: FloatArray,
+    reference: FloatArray,
+    dwells: Sequence[Any],
+    bias_to_data: float,
+    dt_s: float,
+    *,
+    name: str,
+    figure_unit_factor: float,
+    figure_unit: str,
+) -> TriadValidation:
+    """Compare raw and compensated samples ``x`` (n, 3, data unit) with ``reference`` (n, 3,
+    same unit; the true body rate or specific force from the encoder angles) over the
+    ``dwells`` (interval indexing of :mod:`.schedule`) and, for a gyro triad, over the moves
+    between them (angle = Σ rate·Δt).  Figures in ``figure_unit`` (data unit ×
+    ``figure_unit_factor``: °/h or mg)."""
+    xc = correct(triad, x, temp_c, bias_to_data)
+
+    def dwell_rms(v: FloatArray) -> tuple[float, float, float]:
+        errs = np.array(
+            [v[1:][d.start : d.stop].mean(axis=0) - reference[1:][d.start : d.stop].mean(axis=0)
+             for d in dwells]
+        )  # fmt: skip
+        r = np.sqrt(np.mean(errs**2, axis=0)) * figure_unit_factor
+        return (float(r[0]), float(r[1]), float(r[2]))
+
+    def move_rms(v: FloatArray) -> tuple[float, float, float]:
+        errs = []
+        for d0, d1 in itertools.pairwise(dwells):
+            sl = slice(d0.stop, d1.start)
+            errs.append(((v[1:][sl] - reference[1:][sl]) * dt_s).sum(axis=0))
+        r = np.sqrt(np.mean(np.square(errs), axis=0)) * figure_unit_factor
+        return (float(r[0]), float(r[1]), float(r[2]))
+
+    moves = triad.kind == "gyro" and len(dwells) > 1
+    outside = float(np.mean((temp_c < triad.t_lo_c) | (temp_c > triad.t_hi_c)))
+    return TriadValidation(
+        name,
+        figure_unit,
+        dwell_rms(x),
+        dwell_rms(xc),
+        move_rms(x) if moves else None,
+        move_rms(xc) if moves else None,
+        len(dwells),
+        (float(np.min(temp_c)), float(np.max(temp_c))),
+        outside,
+    )
