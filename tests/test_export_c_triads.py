@@ -99,7 +99,8 @@ def test_commands_that_do_not_handle_triads_say_so(
     assert main(["validate", str(path), str(rec), "--latitude", "45"]) == 2
     assert "alpha_deg" in capsys.readouterr().err
     assert main(["report", "--model", str(path), "--recording", str(rec), "-o",
-                 str(tmp_path / "r.html")]) == 2  # fmt: skip
-    assert "does not handle triads yet" in capsys.readouterr().err
+                 str(tmp_path / "r.html"), "--latitude", "45"]) == 2  # fmt: skip
+    assert "alpha_deg" in capsys.readouterr().err
+    assert not (tmp_path / "r.html").exists()
     assert main(["export-params", str(path), "--format", "px4", "-o", str(tmp_path / "p")]) == 2
     assert "does not handle triads yet" in capsys.readouterr().err

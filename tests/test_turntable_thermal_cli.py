@@ -214,3 +214,15 @@ def test_validate_judges_the_held_out_run(
         for k in range(3)
     ]
     np.testing.assert_allclose(acc["dwell_rms_after"], mine, rtol=1e-6)
+
+
+def test_the_report_shows_every_parameter_and_the_held_out_run(workflow: dict) -> None:
+    out = Path(workflow["dir"]) / "report.html"  # type: ignore[arg-type]
+    code = main(["report", "--model", str(workflow["cal"]), "--recording", str(workflow["held"]),
+                 "-o", str(out)])  # fmt: skip
+    assert code == 0
+    html = out.read_text(encoding="utf-8")
+    assert html.count('class="figure"') == 2  # one figure per triad
+    for name in ("bias_x", "scale_factor_z", "misalignment_yz", "move-angle error rms"):
+        assert name in html
+    assert 'id="triad-gyro"' in html and 'id="triad-accel"' in html

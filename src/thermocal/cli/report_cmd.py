@@ -153,6 +153,14 @@ def report_cmd(
     t_bad: OnBadLinesOpt = "error",
     t_delim: DelimiterOpt = None,
     t_dec: DecimalOpt = None,
+    latitude: Annotated[
+        float | None,
+        typer.Option(
+            "--latitude",
+            help="Site latitude [°] of a turntable run (a calibration of triads; default: "
+            "the file's metadata).",
+        ),
+    ] = None,
 ) -> None:
     """Write a self-contained HTML report (figures embedded, no network needed).
 
@@ -173,6 +181,15 @@ def report_cmd(
         inputs_files.append(modeling)
     _io.check_not_input(output, inputs_files)
     cal = _files.load_calibration(model[0])
+    if cal.triads and not cal.channels:  # a turntable calibration over temperature
+        from thermocal.report.triads import write_triad_report
+        from thermocal.turntable.calibrate import validate_triads
+
+        rec = _io.read_recording(recording, time=time, time_unit=time_unit)
+        results = validate_triads(cal.triads, rec, latitude)
+        path = write_triad_report(output, cal, model[0], results, recording)
+        stderr.print(f"report: {path}")
+        return
     cal.require_channels("report")
     if len(cal.channels) > 1 or len(split_names(signal) or []) > 1:
         if len(model) > 1:

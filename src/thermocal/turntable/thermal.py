@@ -139,6 +139,20 @@ class TriadThermal:
     t_hi_c: float
     fits: tuple[ParameterFit, ...]
     soak_temperatures_c: tuple[float, ...]
+    runs: tuple[tuple[float, tuple[float, ...], tuple[float, ...]], ...] = ()
+    """Each run's (temperature [°C], θ, σ) the polynomials were fitted to (for reports)."""
+
+    def sigma_at(self, temp_c: npt.ArrayLike) -> FloatArray:
+        """Standard error (…, 12) of each fitted parameter at temperatures (clamped):
+        ``σ(T)² = vᵀ C v``, ``v = (1, ΔT, ΔT², …)``."""
+        t = np.clip(np.asarray(temp_c, dtype=np.float64), self.t_lo_c, self.t_hi_c)
+        dt = t - self.tref_c
+        cols = []
+        for f in self.fits:
+            v = dt[..., None] ** np.arange(len(f.coef))
+            cols.append(np.sqrt(np.maximum(np.einsum("...i,ij,...j->...", v, f.cov, v), 0.0)))
+        out: FloatArray = np.stack(cols, axis=-1)
+        return out
 
     def theta_at(self, temp_c: npt.ArrayLike) -> FloatArray:
         """θ (n, 12) at temperatures clamped to the calibrated range."""
@@ -158,6 +172,10 @@ class TriadThermal:
             "order": self.order,
             "temperature_range_c": [self.t_lo_c, self.t_hi_c],
             "soak_temperatures_c": list(self.soak_temperatures_c),
+            "runs": [
+                {"temperature_c": t, "theta": list(th), "sigma": list(sg)}
+                for t, th, sg in self.runs
+            ],
             "parameters": [
                 {
                     "name": f.name,
@@ -197,6 +215,14 @@ class TriadThermal:
                 hi,
                 fits,
                 tuple(float(v) for v in d.get("soak_temperatures_c", [])),
+                tuple(
+                    (
+                        float(r["temperature_c"]),
+                        tuple(float(v) for v in r["theta"]),
+                        tuple(float(v) for v in r["sigma"]),
+                    )
+                    for r in d.get("runs", [])
+                ),
             )
         except (KeyError, TypeError, ValueError) as exc:
             raise ModelFileError(f"{where}: malformed triad model ({exc})") from None
@@ -251,8 +277,19 @@ def fit_triad(
         loto = float(np.sqrt(np.mean((pred - th[:, k])[ok] ** 2))) if ok.any() else float("nan")
         fits.append(ParameterFit(PARAMETER_NAMES[k], UNITS[kind][k], coef, cov, loto, chi2))
     chosen = max(len(f.coef) - 1 for f in fits)
+    runs = tuple(
+        (float(t[i]), tuple(float(v) for v in th[i]), tuple(float(v) for v in sg[i]))
+        for i in range(r)
+    )
     return TriadThermal(
-        kind, tref, chosen, float(t.min()), float(t.max()), tuple(fits), tuple(float(v) for v in t)
+        kind,
+        tref,
+        chosen,
+        float(t.min()),
+        float(t.max()),
+        tuple(fits),
+        tuple(float(v) for v in t),
+        runs,
     )
 
 
