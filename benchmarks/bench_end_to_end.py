@@ -35,20 +35,11 @@ from pathlib import Path
 
 import numpy as np
 
+from _harness import THERMOCAL, measure
+
 DATA = Path(__file__).resolve().parent / "_data"
 PY = sys.executable
-THERMOCAL = [PY, "-c", "import sys; from thermocal.cli import main; sys.exit(main())"]
 
-WRAPPER = r"""
-import resource, subprocess, sys, time
-t0 = time.perf_counter()
-proc = subprocess.run(sys.argv[1:], stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
-dt = time.perf_counter() - t0
-peak_kb = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss
-print(f"{proc.returncode} {peak_kb} {dt:.4f}")
-if proc.returncode:
-    print(proc.stderr[-2000:], file=sys.stderr)
-"""
 
 ALLANTOOLS_SCRIPT = r"""
 import sys, numpy as np, pyarrow.parquet as pq, allantools
@@ -92,11 +83,7 @@ app(sys.argv[1:], prog_name="one")
 
 def run(cmd: list[str]) -> tuple[float, float]:
     """(wall seconds, peak resident MB) of one process."""
-    out = subprocess.run([PY, "-c", WRAPPER, *cmd], capture_output=True, text=True, check=False)
-    code, peak_kb, seconds = out.stdout.split()
-    if int(code) != 0:
-        raise SystemExit(f"{cmd[3:]} failed: {out.stderr}")
-    return float(seconds), int(peak_kb) / 1024.0
+    return measure(cmd)
 
 
 def median_time(cmd: list[str], n: int = 15) -> float:

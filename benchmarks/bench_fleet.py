@@ -25,19 +25,9 @@ from pathlib import Path
 
 import numpy as np
 
-DATA = Path(__file__).resolve().parent / "_data"
-THERMOCAL = [sys.executable, "-c", "import sys; from thermocal.cli import main; sys.exit(main())"]
+from _harness import THERMOCAL, measure
 
-WRAPPER = r"""
-import resource, subprocess, sys, time
-t0 = time.perf_counter()
-proc = subprocess.run(sys.argv[1:], stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
-dt = time.perf_counter() - t0
-peak_kb = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss
-print(f"{proc.returncode} {peak_kb} {dt:.4f}")
-if proc.returncode:
-    print(proc.stderr[-2000:], file=sys.stderr)
-"""
+DATA = Path(__file__).resolve().parent / "_data"
 
 
 def write_batch(units: int, rows: int) -> Path:
@@ -98,11 +88,7 @@ def fleet(cfg: Path, out: Path, workers: int | None) -> tuple[float, float]:
     cmd = [*THERMOCAL, "fleet", str(cfg), "-o", str(out)]
     if workers is not None:
         cmd += ["--workers", str(workers)]
-    res = subprocess.run([sys.executable, "-c", WRAPPER, *cmd], capture_output=True, text=True)
-    code, peak_kb, seconds = res.stdout.split()
-    if int(code) != 0:
-        raise SystemExit(f"fleet failed ({code}): {res.stderr}")
-    return float(seconds), int(peak_kb) / 1024.0
+    return measure(cmd)
 
 
 def main() -> int:

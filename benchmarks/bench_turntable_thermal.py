@@ -12,29 +12,15 @@ Run: ``.venv/bin/python benchmarks/bench_turntable_thermal.py``.  Files go to
 from __future__ import annotations
 
 import os
-import subprocess
-import sys
 from pathlib import Path
 
+from _harness import THERMOCAL, measure
+
 DATA = Path(__file__).resolve().parent / "_data" / "tt_thermal"
-THERMOCAL = [sys.executable, "-c", "import sys; from thermocal.cli import main; sys.exit(main())"]
-WRAPPER = r"""
-import resource, subprocess, sys, time
-t0 = time.perf_counter()
-proc = subprocess.run(sys.argv[1:], stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
-dt = time.perf_counter() - t0
-print(f"{proc.returncode} {resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss} {dt:.4f}")
-if proc.returncode:
-    print(proc.stderr[-2000:], file=sys.stderr)
-"""
 
 
 def run(cmd: list[str]) -> tuple[float, float]:
-    res = subprocess.run([sys.executable, "-c", WRAPPER, *cmd], capture_output=True, text=True)
-    code, kb, sec = res.stdout.split()
-    if int(code):
-        raise SystemExit(res.stderr)
-    return float(sec), int(kb) / 1024.0
+    return measure(cmd)
 
 
 def main() -> int:

@@ -184,6 +184,14 @@ ExtrapolateOpt = Annotated[
     ),
 ]
 JsonOpt = Annotated[bool, typer.Option("--json", help="Print one JSON object on stdout.")]
+TurntableLatitudeOpt = Annotated[
+    float | None,
+    typer.Option(
+        "--latitude",
+        help="Site latitude [°] of a turntable run (a calibration of triads; default: "
+        "the file's metadata).",
+    ),
+]
 OutOpt = Annotated[Path, typer.Option("-o", "--output", help="Output file.")]
 
 

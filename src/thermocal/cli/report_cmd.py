@@ -30,6 +30,7 @@ from thermocal.cli.common import (
     TimeOpt,
     TimeUnitOpt,
     TopicOpt,
+    TurntableLatitudeOpt,
     handle_errors,
     load_recording,
     progress,
@@ -153,14 +154,7 @@ def report_cmd(
     t_bad: OnBadLinesOpt = "error",
     t_delim: DelimiterOpt = None,
     t_dec: DecimalOpt = None,
-    latitude: Annotated[
-        float | None,
-        typer.Option(
-            "--latitude",
-            help="Site latitude [°] of a turntable run (a calibration of triads; default: "
-            "the file's metadata).",
-        ),
-    ] = None,
+    latitude: TurntableLatitudeOpt = None,
 ) -> None:
     """Write a self-contained HTML report (figures embedded, no network needed).
 

@@ -3,6 +3,7 @@
 error models over temperature from runs at several soaks (issue 19), written as a
 calibration that ``compensate`` applies."""
 
+from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated
 
@@ -30,6 +31,7 @@ if TYPE_CHECKING:
     import thermocal.io as _io
     import thermocal.models.calibration as _calibration
     import thermocal.models.files as _files
+    import thermocal.recording as _recording
     import thermocal.turntable.calibrate as _calibrate
     import thermocal.turntable.model as _model
     import thermocal.turntable.thermal as _thermal
@@ -140,46 +142,21 @@ def turntable_cmd(
     accel_cols = split_names(accel) if accel else None
     if accel_cols is not None and len(accel_cols) != 3:
         raise ThermocalInputError(f"--accel needs three column names, got {accel!r}")
+    opts = _RunOptions(
+        gyro_cols, accel_cols, temps, latitude, time, time_unit, gyro_unit, accel_unit, gravity,
+        alpha, beta, arw, encoder_noise, min_dwell, channels,
+    )  # fmt: skip
     if len(files) > 1 or (temps is not None and (order is not None or tref is not None)):
         if temps is None:
             raise ThermocalInputError(
                 "several runs: name their temperature column with --temps (one run per soak)"
             )
-        _thermal_calibration(
-            files, output, temps, gyro_cols, accel_cols, latitude, time, time_unit, gyro_unit,
-            accel_unit, gravity, alpha, beta, arw, encoder_noise, min_dwell, channels, order,
-            tref, as_json,
-        )  # fmt: skip
+        _thermal_calibration(files, output, opts, order, tref, as_json)
         return
     if order is not None or tref is not None:
         raise ThermocalInputError("--order and --tref need several runs and --temps")
     file = files[0]
-    # the gyro columns' unit through the shared resolver: --gyro-unit > file metadata >
-    # unit in the column name > °/s (INTERFACE: gyro_z in °/s), the last stated in a warning
-    rec = _io.read_recording(
-        file,
-        time=time,
-        time_unit=time_unit,
-        signals=gyro_cols,
-        signal_unit=gyro_unit,
-        model=units.StatedUnits(signal_default="deg/s"),
-    )
-    result = _calibrate.calibrate(
-        rec,
-        latitude,
-        gyro_columns=gyro_cols,
-        alpha_column=alpha,
-        beta_column=beta,
-        gyro_unit=gyro_unit,
-        arw_deg_sqrt_h=arw,
-        encoder_noise_arcsec=encoder_noise,
-        min_dwell_s=min_dwell,
-        channels=channels,
-        accel_columns=accel_cols,
-        accel_unit=accel_unit,
-        gravity_m_s2=gravity,
-        temperature_column=temps,
-    )
+    _rec, result = _calibrate_file(file, opts, min_positions=16)
     out = result.to_dict()
     out["input"] = str(file)
     _io.write_json(output, out)
@@ -214,6 +191,62 @@ def turntable_cmd(
     emit(out, as_json, human)
 
 
+@dataclass(frozen=True)
+class _RunOptions:
+    """What every run of the command is read and calibrated with."""
+
+    gyro: list[str]
+    accel: list[str] | None
+    temps: str | None
+    latitude: float | None
+    time: str | None
+    time_unit: str | None
+    gyro_unit: str | None
+    accel_unit: str | None
+    gravity: float | None
+    alpha: str
+    beta: str
+    arw: float | None
+    encoder_noise: float | None
+    min_dwell: float
+    channels: int
+
+
+def _calibrate_file(
+    path: Path, o: _RunOptions, *, min_positions: int
+) -> tuple["_recording.Recording", "_calibrate.TurntableResult"]:
+    """Read one run and calibrate it.  The gyro columns' unit goes through the shared
+    resolver: --gyro-unit > file metadata > unit in the column name > °/s (INTERFACE: gyro_z
+    in °/s), the last stated in a warning."""
+    rec = _io.read_recording(
+        path,
+        time=o.time,
+        time_unit=o.time_unit,
+        signals=o.gyro,
+        signal_unit=o.gyro_unit,
+        temperatures=[o.temps] if o.temps else None,
+        model=units.StatedUnits(signal_default="deg/s"),
+    )
+    res = _calibrate.calibrate(
+        rec,
+        o.latitude,
+        gyro_columns=o.gyro,
+        alpha_column=o.alpha,
+        beta_column=o.beta,
+        gyro_unit=o.gyro_unit,
+        arw_deg_sqrt_h=o.arw,
+        encoder_noise_arcsec=o.encoder_noise,
+        min_dwell_s=o.min_dwell,
+        channels=o.channels,
+        accel_columns=o.accel,
+        accel_unit=o.accel_unit,
+        gravity_m_s2=o.gravity,
+        temperature_column=o.temps,
+        min_positions=min_positions,
+    )
+    return rec, res
+
+
 MIN_POSITIONS_OF_A_SOAK = 12
 """A soak run missing a few of the sixteen positions is still used (with a warning): twelve
 distinct attitudes still separate the twelve parameters of each triad."""
@@ -222,21 +255,7 @@ distinct attitudes still separate the twelve parameters of each triad."""
 def _thermal_calibration(
     files: list[Path],
     output: Path,
-    temps: str,
-    gyro_cols: list[str],
-    accel_cols: list[str] | None,
-    latitude: float | None,
-    time: str | None,
-    time_unit: str | None,
-    gyro_unit: str | None,
-    accel_unit: str | None,
-    gravity: float | None,
-    alpha: str,
-    beta: str,
-    arw: float | None,
-    encoder_noise: float | None,
-    min_dwell: float,
-    channels: int,
+    opts: "_RunOptions",
     order: int | None,
     tref: float | None,
     as_json: bool,
@@ -248,36 +267,14 @@ def _thermal_calibration(
     runs = []
     gyro_units: set[str] = set()
     accel_units: set[str] = set()
+    gyro_cols, accel_cols, temps = opts.gyro, opts.accel, str(opts.temps)
     for f in files:
-        rec = _io.read_recording(
-            f,
-            time=time,
-            time_unit=time_unit,
-            signals=gyro_cols,
-            signal_unit=gyro_unit,
-            temperatures=[temps],
-            model=units.StatedUnits(signal_default="deg/s"),
-        )
-        res = _calibrate.calibrate(
-            rec,
-            latitude,
-            gyro_columns=gyro_cols,
-            alpha_column=alpha,
-            beta_column=beta,
-            gyro_unit=gyro_unit,
-            arw_deg_sqrt_h=arw,
-            encoder_noise_arcsec=encoder_noise,
-            min_dwell_s=min_dwell,
-            channels=channels,
-            accel_columns=accel_cols,
-            accel_unit=accel_unit,
-            gravity_m_s2=gravity,
-            temperature_column=temps,
-            min_positions=MIN_POSITIONS_OF_A_SOAK,
-        )
+        rec, res = _calibrate_file(f, opts, min_positions=MIN_POSITIONS_OF_A_SOAK)
         gyro_units |= {rec.units[c] for c in gyro_cols}  # resolved by read_recording
         if accel_cols is not None:
-            accel_units |= {accel_unit} if accel_unit else {rec.units[c] for c in accel_cols}
+            accel_units |= (
+                {opts.accel_unit} if opts.accel_unit else {rec.units[c] for c in accel_cols}
+            )
         runs.append((f, res))
     for what, found in (("gyro", gyro_units), ("accelerometer", accel_units)):
         if len(found) > 1:

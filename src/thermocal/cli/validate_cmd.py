@@ -32,6 +32,7 @@ from thermocal.cli.common import (
     TempUnitOpt,
     TimeOpt,
     TimeUnitOpt,
+    TurntableLatitudeOpt,
     emit,
     fmt,
     handle_errors,
@@ -165,14 +166,7 @@ def validate_cmd(
     t_bad: OnBadLinesOpt = "error",
     t_delim: DelimiterOpt = None,
     t_dec: DecimalOpt = None,
-    latitude: Annotated[
-        float | None,
-        typer.Option(
-            "--latitude",
-            help="Site latitude [°] of a turntable run (a calibration of triads; default: "
-            "the file's metadata).",
-        ),
-    ] = None,
+    latitude: TurntableLatitudeOpt = None,
     as_json: JsonOpt = False,
 ) -> None:
     """Validate MODEL on FILE: correlation r, bias stability and repeatability over the
@@ -357,13 +351,9 @@ def _validate_triads(
         for col in ("triad", "figure", "x before → after", "y before → after", "z before → after"):
             table.add_column(col)
         for r in results:
-            rows = [("dwell-mean error rms", r.unit, r.dwell_rms_before, r.dwell_rms_after)]
-            before_m, after_m = r.move_angle_rms_before_arcsec, r.move_angle_rms_after_arcsec
-            if before_m is not None and after_m is not None:
-                rows.append(("move-angle error rms", "arcsec", before_m, after_m))
-            for label, unit, before, after in rows:
+            for label, before, after in r.rows():
                 cells = [f"{fmt(b)} → {fmt(a)}" for b, a in zip(before, after, strict=True)]
-                table.add_row(r.triad, f"{label} [{unit}]", *cells)
+                table.add_row(r.triad, label, *cells)
         stdout.print(table)
 
     emit(out, as_json, human)

@@ -92,15 +92,11 @@ def build_triad_report(
         )
     val = []
     for r in validation or []:
-        rows = [("dwell-mean error rms", r.unit, r.dwell_rms_before, r.dwell_rms_after)]
-        if r.move_angle_rms_before_arcsec is not None and r.move_angle_rms_after_arcsec:
-            rows.append(("move-angle error rms", "arcsec", r.move_angle_rms_before_arcsec,
-                         r.move_angle_rms_after_arcsec))  # fmt: skip
-        for label, unit, before, after in rows:
+        for label, before, after in r.rows():
             val.append(
                 {
                     "triad": r.triad,
-                    "label": f"{label} [{unit}]",
+                    "label": label,
                     "cells": [f"{b:.4g} → {a:.4g}" for b, a in zip(before, after, strict=True)],
                 }
             )

@@ -384,6 +384,16 @@ class TriadValidation:
 
         return asdict(self)
 
+    def rows(self) -> list[tuple[str, tuple[float, ...], tuple[float, ...]]]:
+        """``(label [unit], before (x, y, z), after (x, y, z))`` for a table."""
+        out: list[tuple[str, tuple[float, ...], tuple[float, ...]]] = [
+            (f"dwell-mean error rms [{self.unit}]", self.dwell_rms_before, self.dwell_rms_after)
+        ]
+        before, after = self.move_angle_rms_before_arcsec, self.move_angle_rms_after_arcsec
+        if before is not None and after is not None:
+            out.append(("move-angle error rms [arcsec]", before, after))
+        return out
+
 
 def validate_triad(
     triad: TriadThermal,
