@@ -87,6 +87,27 @@ class TurntableTruth:
         }
 
 
+def _sampled_motion(
+    sched: Any, rate_hz: float, latitude_deg: float
+) -> tuple[int, FloatArray, FloatArray, FloatArray, FloatArray]:
+    """Samples of a schedule at ``rate_hz``: (n, time [s], α [°], β [°], the mean true body
+    rate over each interval ending at sample i [rad/s], row 0 at rest)."""
+    tau = 1.0 / rate_hz
+    n = int(np.floor(sched.duration_s * rate_hz)) + 1
+    t = np.arange(n, dtype=np.float64) * tau
+    a_deg, b_deg = sched.angles_at(t)
+    a = a_deg * units.DEG_TO_RAD
+    b = b_deg * units.DEG_TO_RAD
+    a_prev = np.concatenate([[a[0]], a[:-1]])
+    b_prev = np.concatenate([[b[0]], b[:-1]])
+    a_mid = 0.5 * (a + a_prev)
+    b_mid = 0.5 * (b + b_prev)
+    omega = kinematics.omega_ib_b(
+        a_mid, b_mid, (a - a_prev) / tau, (b - b_prev) / tau, latitude_deg
+    )
+    return n, t, a_deg, b_deg, omega
+
+
 def simulate_turntable16(
     seed: int = 0,
     *,
@@ -123,19 +144,7 @@ def simulate_turntable16(
         positions_deg=positions_deg,
     )
     tau = 1.0 / rate_hz
-    n = int(np.floor(sched.duration_s * rate_hz)) + 1
-    t = np.arange(n) * tau
-    a_deg, b_deg = sched.angles_at(t)
-    a = a_deg * units.DEG_TO_RAD
-    b = b_deg * units.DEG_TO_RAD
-    # mean true body rate over each interval ending at sample i (row 0: at rest)
-    a_prev = np.concatenate([[a[0]], a[:-1]])
-    b_prev = np.concatenate([[b[0]], b[:-1]])
-    a_mid = 0.5 * (a + a_prev)
-    b_mid = 0.5 * (b + b_prev)
-    omega_true = kinematics.omega_ib_b(
-        a_mid, b_mid, (a - a_prev) / tau, (b - b_prev) / tau, latitude_deg
-    )
+    n, t, a_deg, b_deg, omega_true = _sampled_motion(sched, rate_hz, latitude_deg)
     e_mat = tr.error_matrix
     bias = np.asarray(tr.bias_deg_h) * units.DH_TO_RS
     arw_rad_sqrt_s = arw_deg_sqrt_h * units.DEG_TO_RAD / np.sqrt(units.SECONDS_PER_HOUR)
@@ -264,17 +273,8 @@ def simulate_turntable_thermal(
         sched = build_schedule(
             dwell_s=dwell_s, move_rate_deg_s=move_rate_deg_s, positions_deg=positions
         )
-        n = int(np.floor(sched.duration_s * rate_hz)) + 1
-        t = np.arange(n) * tau
-        a_deg, b_deg = sched.angles_at(t)
-        a = a_deg * units.DEG_TO_RAD
-        b = b_deg * units.DEG_TO_RAD
-        a_prev = np.concatenate([[a[0]], a[:-1]])
-        b_prev = np.concatenate([[b[0]], b[:-1]])
-        a_mid, b_mid = 0.5 * (a + a_prev), 0.5 * (b + b_prev)
-        omega = kinematics.omega_ib_b(
-            a_mid, b_mid, (a - a_prev) / tau, (b - b_prev) / tau, latitude_deg
-        )
+        n, t, a_deg, b_deg, omega = _sampled_motion(sched, rate_hz, latitude_deg)
+        a, b = a_deg * units.DEG_TO_RAD, b_deg * units.DEG_TO_RAD
         f = np.einsum("nji,j->ni", kinematics.mat_nb(a, b), np.array([0.0, 0.0, g]))
         return n, t, a_deg, b_deg, omega, f
 
