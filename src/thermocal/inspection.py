@@ -109,8 +109,9 @@ def count_spikes(
     A sample is a spike when ``|x_i − med_i| > threshold · 1.4826 · MAD_i`` where
     ``med_i`` and ``MAD_i`` are the median and median absolute deviation of the
     window ``i ± half_window`` (Hampel 1974; Pearson 2002).  Windows whose MAD is
-    zero use the segment's global MAD of first differences.  Returns the count and
-    the first spike's row.
+    zero use the segment's global MAD of first differences (a floor of σ, so only the
+    samples farther than ``threshold`` floors from their window's median need their
+    window's MAD).  Returns the count and the first spike's row.
     """
     n_total = 0
     first: int | None = None
@@ -125,23 +126,28 @@ def count_spikes(
         np.abs(d, out=d)
         floor = 1.4826 * float(np.median(d, overwrite_input=True)) / np.sqrt(2.0)
         del d
-        n_centre = xs.size - 2 * half_window
-        # windows in blocks of SPIKE_BLOCK centres: w·8 bytes per centre, bounded
-        for a in range(0, n_centre, SPIKE_BLOCK):
-            b = min(n_centre, a + SPIKE_BLOCK)
-            win = sliding_window_view(xs[a : b + 2 * half_window], w)
-            med = np.median(win, axis=1)
-            dev = np.abs(win - med[:, None])
-            mad = np.median(dev, axis=1, overwrite_input=True)
-            del dev
+        # the window medians of every centre (scipy.ndimage's running selection, exact for
+        # an odd window: 20× the speed of np.median over sliding windows), then the MAD only
+        # where a spike is possible: sigma ≥ floor, so |x − med| ≤ threshold·floor is no spike
+        from scipy import ndimage
+
+        med_all = ndimage.median_filter(xs, size=w, mode="nearest")
+        med = med_all[half_window : xs.size - half_window]
+        centre = xs[half_window : xs.size - half_window]
+        dev_c = np.abs(centre - med)
+        cand = np.flatnonzero(dev_c > threshold * floor) if floor > 0 else np.flatnonzero(dev_c > 0)
+        hits: list[int] = []
+        for a in range(0, cand.size, SPIKE_BLOCK):  # bounded working memory
+            idx = cand[a : a + SPIKE_BLOCK]
+            win = sliding_window_view(xs, w)[idx]
+            mad = np.median(np.abs(win - med[idx, None]), axis=1)
             sigma = np.maximum(1.4826 * mad, floor)
-            centre = xs[a + half_window : b + half_window]
-            hit = (np.abs(centre - med) > threshold * sigma) & (sigma > 0)
-            idx = np.flatnonzero(hit)
-            if idx.size:
-                n_total += int(idx.size)
-                row = int(sl.start) + half_window + a + int(idx[0])
-                first = row if first is None else min(first, row)
+            hit = (dev_c[idx] > threshold * sigma) & (sigma > 0)
+            hits.extend(int(i) for i in idx[hit][:1])
+            n_total += int(np.count_nonzero(hit))
+        if hits:
+            row = int(sl.start) + half_window + min(hits)
+            first = row if first is None else min(first, row)
     return n_total, first
 
 
