@@ -313,3 +313,56 @@ def test_scheduler_without_dask_says_how_to_install(
     assert code == 2
     assert err.count("\n") == 1 and "pip install 'thermocal[fleet]'" in err
     assert not (tmp_path / "out").exists()  # refused before anything is written
+
+
+def test_ctrl_c_stops_the_batch_and_a_rerun_resumes(tmp_path: Path) -> None:
+    """SIGINT to ``thermocal fleet`` with two worker processes, once a unit is written: exit
+    130, the units written are complete, none is recorded as failed by the interruption,
+    the workers are gone, and a rerun finishes the rest."""
+    import os
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    psutil = pytest.importorskip("psutil")
+    rng = np.random.default_rng(4)
+    n = 600_000
+    t = np.arange(n, dtype=np.float64) * 0.1
+    temp = np.linspace(-10.0, 60.0, n)
+    lines = ['[fit]\nmodel = "poly"\norder = 1\nsignal = "gyro [deg/h]"\ntemps = "T1 [degC]"\n']
+    for i in range(8):
+        gyro = 1.0 + 0.02 * (temp - 25.0) + rng.normal(0.0, 0.01, n)
+        pd.DataFrame({"time [s]": t, "gyro [deg/h]": gyro, "T1 [degC]": temp}).to_parquet(
+            tmp_path / f"c{i}.parquet", index=False
+        )
+        lines.append(f'[[unit]]\nid = "c{i}"\nmodeling = ["c{i}.parquet"]\n')
+    cfg = tmp_path / "c.toml"
+    cfg.write_text("\n".join(lines), encoding="utf-8")
+    out = tmp_path / "out"
+    cmd = [sys.executable, "-c", "import sys; from thermocal.cli import main; sys.exit(main())",
+           "fleet", str(cfg), "-o", str(out), "--workers", "2"]  # fmt: skip
+    proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        deadline = time.monotonic() + 120
+        while time.monotonic() < deadline and proc.poll() is None:
+            units = out / "units"
+            if units.exists() and any(p.name.startswith("c") for p in units.iterdir()):
+                break
+            time.sleep(0.02)
+        children = psutil.Process(proc.pid).children(recursive=True)
+        os.kill(proc.pid, signal.SIGINT)
+        _stdout, stderr = proc.communicate(timeout=120)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+    assert proc.returncode == 130, stderr
+    _gone, alive = psutil.wait_procs(children, timeout=10)
+    assert alive == []  # the workers did not outlive the batch
+    written = {p.name for p in (out / "units").iterdir() if not p.name.startswith(".")}
+    for uid in written:
+        assert fleet.read_unit(out, uid)["status"] == "ok"  # type: ignore[index]
+    assert len(written) < 8
+    res = fleet.run_fleet(fleet.load_config(cfg), out)
+    assert set(res.skipped) == written and len(res.ran) == 8 - len(written)
+    assert all(r["status"] == "ok" for r in res.rows)
