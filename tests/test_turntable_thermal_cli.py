@@ -26,6 +26,7 @@ from thermocal.turntable import kinematics
 from thermocal.turntable.calibrate import calibrate
 from thermocal.turntable.schedule import detect_motion, segment
 from thermocal.turntable.simulate import (
+    ACCEL_THERMAL_TRUTH,
     GYRO_THERMAL_TRUTH,
     simulate_turntable_thermal,
     thermal_theta,
@@ -254,3 +255,55 @@ def test_encoder_jitter_in_every_run(tmp_path: Path) -> None:
     f_true = np.einsum("nji,j->ni", kinematics.mat_nb(a, b), np.array([0.0, 0.0, g]))
     ours = pd.read_parquet(comp)[[f"{c}_comp" for c in A_COLS]].to_numpy()
     assert _dwell_rms(ours, f_true, dwells) / MG < 0.02
+
+
+def test_a_logger_csv_chain_without_repeating_options(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Runs written the way a lab logger writes them: CSV with a banner line, time in ms,
+    units only in the column names (gyro in °/h, accelerometers in mg), other column names,
+    a gap in the held-out run.  turntable names the columns once; compensate, validate and
+    report then need only the calibration (encoders, latitude, units travel with it)."""
+    mg = 9.80665e-3
+    names = {}
+    for rec, truth in simulate_turntable_thermal(seed=3):
+        df = pd.DataFrame(
+            {
+                "t [ms]": rec.time_s * 1000.0,
+                **{f"g{a} [deg/h]": rec.column(f"gyro_{a}") * 3600.0 for a in "xyz"},
+                **{f"a{a} [mg]": rec.column(f"accel_{a}") / mg for a in "xyz"},
+                "enc_in [deg]": rec.column("alpha_deg"),
+                "enc_out [deg]": rec.column("beta_deg"),
+                "T_imu [degC]": rec.column("T_imu"),
+            }
+        )
+        if truth["held_out"]:
+            df = df.drop(index=range(3000, 3040))  # a gap
+        f = tmp_path / f"{truth['label']}.csv"
+        with open(f, "w", encoding="utf-8") as fh:
+            fh.write("# IMU logger v2.3, unit 0042\n")
+            df.to_csv(fh, index=False, float_format="%.12g")
+        names[truth["label"]] = f
+    soaks = [str(f) for lab, f in names.items() if not lab.startswith("heldout")]
+    cal = tmp_path / "cal.json"
+    code = main(["turntable", *soaks, "--time", "t [ms]",
+                 "--gyro", "gx [deg/h],gy [deg/h],gz [deg/h]",
+                 "--accel", "ax [mg],ay [mg],az [mg]", "--alpha", "enc_in [deg]",
+                 "--beta", "enc_out [deg]", "--temps", "T_imu [degC]", "--latitude", "40",
+                 "-o", str(cal), "--json"])  # fmt: skip
+    assert code == 0, capsys.readouterr().err
+    out = json.loads(capsys.readouterr().out)
+    # the −40 °C run's accelerometer biases against the simulator's truth there [mg]
+    true_acc = thermal_theta(ACCEL_THERMAL_TRUTH, out["runs"][0]["temperature_c"])
+    np.testing.assert_allclose(out["runs"][0]["accel"]["bias_mg"], true_acc[0:3], atol=0.03)
+    held = str(names["heldout_T+10"])
+    comp = tmp_path / "comp.csv"
+    assert main(["compensate", str(cal), held, "-o", str(comp)]) == 0
+    capsys.readouterr()
+    assert main(["validate", str(cal), held, "--json"]) == 0
+    val = json.loads(capsys.readouterr().out)["triads"]
+    assert val["accel"]["unit"] == "mg" and max(val["accel"]["dwell_rms_after"]) < 0.02
+    assert max(val["gyro"]["move_angle_rms_after_arcsec"]) < 5.0
+    # the compensated columns in the data's units: az at +1 g where the raw read ≈ 1 g + bias
+    df = pd.read_csv(comp)
+    assert df["az [mg]_comp"].abs().max() == pytest.approx(1000.0 * 9.80169 / 9.80665, rel=1e-3)

@@ -97,6 +97,7 @@ from thermocal.recording import (
     PLAUSIBLE_SIGNAL,
     FloatArray,
     Metadata,
+    Recording,
     median_interval,
 )
 
@@ -853,6 +854,20 @@ class TriadCompensation:
         return dataclasses.asdict(self)
 
 
+def read_for_triads(
+    path: str | Path,
+    triads: Sequence[Any],
+    *,
+    time: str | None = None,
+    time_unit: str | None = None,
+) -> Recording:
+    """A recording read for triad calibrations: their temperature columns as temperatures,
+    so that their units go through the resolver (option > metadata > column name); the
+    triads' own columns keep the unit their metadata or name states."""
+    temps = list(dict.fromkeys(t.temperature for t in triads))
+    return read_recording(path, time=time, time_unit=time_unit, temperatures=temps)
+
+
 def compensate_triads(
     triads: Sequence[Any],
     path: str | Path,
@@ -871,7 +886,7 @@ def compensate_triads(
 
     src, dst = Path(path), Path(out)
     check_not_input(dst, [src])
-    rec = read_recording(src, time=time, time_unit=time_unit)
+    rec = read_for_triads(src, triads, time=time, time_unit=time_unit)
     new_cols: dict[str, FloatArray] = {}
     new_units: dict[str, str] = {}
     results = []

@@ -1221,7 +1221,7 @@ def read_recording(
                 if skipped is not None:
                     skipped.append(c)
                 continue
-            unit_map[c] = extra_units.get(c, "")
+            unit_map[c] = units.other_column_unit(c, extra_units.get(c))
 
     return Recording(
         time_s=t,

@@ -315,6 +315,16 @@ def unit_in_column_name(name: str, role: UnitRole) -> str | None:
     return None
 
 
+def other_column_unit(column: str, metadata: str | None) -> str:
+    """The unit of a column outside the signal and temperature roles (an accelerometer triad
+    read beside the gyros, an auxiliary channel): the file's metadata, else a signal unit
+    written in the column's name (rate, acceleration, raw), else ``""`` — the resolver's
+    order without its last step: nothing is assumed for such a column."""
+    if metadata:
+        return metadata
+    return unit_in_column_name(column, "signal") or ""
+
+
 def strip_unit_from_name(name: str) -> str:
     """The column name without a trailing unit written in brackets or as its last word
     (``time (ms)`` → ``time``, ``time_s`` → ``time``); unchanged when there is none."""

@@ -176,10 +176,11 @@ def report_cmd(
     _io.check_not_input(output, inputs_files)
     cal = _files.load_calibration(model[0])
     if cal.triads and not cal.channels:  # a turntable calibration over temperature
+        from thermocal.compensate import read_for_triads
         from thermocal.report.triads import write_triad_report
         from thermocal.turntable.calibrate import validate_triads
 
-        rec = _io.read_recording(recording, time=time, time_unit=time_unit)
+        rec = read_for_triads(recording, cal.triads, time=time, time_unit=time_unit)
         results = validate_triads(cal.triads, rec, latitude)
         path = write_triad_report(output, cal, model[0], results, recording)
         stderr.print(f"report: {path}")

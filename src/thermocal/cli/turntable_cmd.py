@@ -280,6 +280,8 @@ def _thermal_calibration(
         if len(found) > 1:
             raise ThermocalInputError(f"the runs' {what} columns differ in unit: {sorted(found)}")
     temps_c = [float(r.temperature_c) for _f, r in runs]  # type: ignore[arg-type]
+    rig = (opts.alpha, opts.beta)
+    latitude = runs[0][1].latitude_deg  # as used (the option or the files' metadata)
     gyro_model = _thermal.fit_triad(
         "gyro",
         temps_c,
@@ -290,7 +292,7 @@ def _thermal_calibration(
     )
     triads = [
         _calibration.Triad("gyro", (gyro_cols[0], gyro_cols[1], gyro_cols[2]),
-                           gyro_units.pop(), temps, gyro_model)
+                           gyro_units.pop(), temps, gyro_model, rig, latitude)
     ]  # fmt: skip
     accel_model = None
     if accel_cols is not None:
@@ -304,7 +306,7 @@ def _thermal_calibration(
         )
         triads.append(
             _calibration.Triad("accel", (accel_cols[0], accel_cols[1], accel_cols[2]),
-                               accel_units.pop(), temps, accel_model)
+                               accel_units.pop(), temps, accel_model, rig, latitude)
         )  # fmt: skip
     cal = _calibration.Calibration([], triads)
     _files.save_calibration(cal, output)

@@ -325,10 +325,10 @@ def _validate_triads(
     as_json: bool,
 ) -> None:
     """A calibration of triads judged on a turntable run (issue 19)."""
-    from thermocal.io import read_recording
+    from thermocal.compensate import read_for_triads
     from thermocal.turntable.calibrate import validate_triads
 
-    rec = read_recording(file, time=time, time_unit=time_unit)
+    rec = read_for_triads(file, cal.triads, time=time, time_unit=time_unit)
     results = validate_triads(cal.triads, rec, latitude)
     for r in results:
         if r.outside_range_fraction > 0:

@@ -82,13 +82,17 @@ class Triad:
     the ``temperature`` column whose value indexes the model, and the ``model`` itself
     (:class:`thermocal.turntable.thermal.TriadThermal`: bias, scale factors and
     misalignments as polynomials in temperature).  Applied as
-    ``x_c = (I + E(T))⁻¹ (x − b(T))`` per sample (``<col>_comp``)."""
+    ``x_c = (I + E(T))⁻¹ (x − b(T))`` per sample (``<col>_comp``).  ``encoders`` (α, β
+    columns) and ``latitude_deg`` are those of the calibration runs: a later command on a run
+    of the same rig (validate, report) needs none of them repeated."""
 
     name: str
     columns: tuple[str, str, str]
     unit: str
     temperature: str
     model: Any  # TriadThermal (imported lazily: the turntable package needs scipy)
+    encoders: tuple[str, str] = ("alpha_deg", "beta_deg")
+    latitude_deg: float | None = None
 
 
 @dataclass
@@ -148,6 +152,8 @@ class Calibration:
                     "columns": list(t.columns),
                     "unit": t.unit,
                     "temperature": t.temperature,
+                    "encoders": list(t.encoders),
+                    "latitude_deg": t.latitude_deg,
                     "model": t.model.to_dict(),
                 }
                 for t in self.triads
@@ -218,7 +224,21 @@ def _triad_from_dict(t: Any, at: str) -> Triad:
         if not isinstance(t.get(key), str) or not t[key]:
             raise ModelFileError(f"{at}: {key} must be a non-empty string")
     model = TriadThermal.from_dict(t.get("model") or {}, f"{at}.model")
-    return Triad(t["name"], (cols[0], cols[1], cols[2]), t["unit"], t["temperature"], model)
+    enc = t.get("encoders", ["alpha_deg", "beta_deg"])
+    lat = t.get("latitude_deg")
+    if not (isinstance(enc, list) and len(enc) == 2 and all(isinstance(c, str) for c in enc)):
+        raise ModelFileError(f"{at}.encoders: expected the two encoder column names")
+    if lat is not None and not isinstance(lat, int | float):
+        raise ModelFileError(f"{at}.latitude_deg: expected a number or null")
+    return Triad(
+        t["name"],
+        (cols[0], cols[1], cols[2]),
+        t["unit"],
+        t["temperature"],
+        model,
+        (enc[0], enc[1]),
+        None if lat is None else float(lat),
+    )
 
 
 def temperatures_of(cal: Calibration, names: Sequence[str] | None = None) -> list[str]:

@@ -494,18 +494,25 @@ def validate_triads(
     latitude_deg: float | None = None,
     *,
     gravity_m_s2: float | None = None,
-    alpha_column: str = "alpha_deg",
-    beta_column: str = "beta_deg",
+    alpha_column: str | None = None,
+    beta_column: str | None = None,
 ) -> list[Any]:
     """Judge a calibration of triads (issue 19) on an independent 16-position run: the
     reference of every sample from the encoder angles (true body rate ``ω_ib^b``, eq. (2),
     over each interval; specific force ``C_nᵇ (0, 0, g)`` at rest), the dwells and moves
     from the encoders (:func:`.schedule.detect_motion`), and per triad the dwell-mean and
     move-angle errors before and after compensation
-    (:func:`thermocal.turntable.thermal.validate_triad`)."""
+    (:func:`thermocal.turntable.thermal.validate_triad`).  The encoder columns and the
+    latitude default to the calibration runs' (recorded with the triads), the latitude after
+    the recording's own metadata."""
     from thermocal.turntable import kinematics, thermal
 
-    lat = latitude_deg if latitude_deg is not None else rec.meta.latitude_deg
+    alpha_column = alpha_column or triads[0].encoders[0]
+    beta_column = beta_column or triads[0].encoders[1]
+    lat = next(
+        (v for v in (latitude_deg, rec.meta.latitude_deg, triads[0].latitude_deg) if v is not None),
+        None,
+    )
     if lat is None:
         raise ThermocalInputError(f"{rec.name}: give the latitude (--latitude DEG)")
     cols = [alpha_column, beta_column]
