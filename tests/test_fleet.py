@@ -246,40 +246,55 @@ def test_the_readme_configuration_is_valid(tmp_path: Path) -> None:
     }
 
 
-def test_a_killed_worker_process_then_a_rerun(tmp_path: Path) -> None:
-    """A real worker process killed mid-batch (SIGKILL) once the first unit is written: the
-    driver names the units not done and exits 4, no half-written unit is left, and a rerun
-    finishes them (the units written before are skipped)."""
-    import os
-    import signal
-    import subprocess
-    import sys
-    import time
-
-    psutil = pytest.importorskip("psutil")
-    rng = np.random.default_rng(9)
-    n = 600_000  # each unit takes a fraction of a second: the kill lands mid-batch
+def _slow_batch(folder: Path, prefix: str, seed: int) -> Path:
+    """Eight units of 6·10⁵ rows (each a fraction of a second): a batch long enough for a
+    signal or a kill to land in the middle of it.  Returns the configuration."""
+    rng = np.random.default_rng(seed)
+    n = 600_000
     t = np.arange(n, dtype=np.float64) * 0.1
     temp = np.linspace(-10.0, 60.0, n)
     lines = ['[fit]\nmodel = "poly"\norder = 1\nsignal = "gyro [deg/h]"\ntemps = "T1 [degC]"\n']
     for i in range(8):
         gyro = 1.0 + 0.02 * (temp - 25.0) + rng.normal(0.0, 0.01, n)
         frame = pd.DataFrame({"time [s]": t, "gyro [deg/h]": gyro, "T1 [degC]": temp})
-        frame.to_parquet(tmp_path / f"k{i}.parquet", index=False)
-        lines.append(f'[[unit]]\nid = "k{i}"\nmodeling = ["k{i}.parquet"]\n')
-    cfg = tmp_path / "kill.toml"
+        frame.to_parquet(folder / f"{prefix}{i}.parquet", index=False)
+        lines.append(f'[[unit]]\nid = "{prefix}{i}"\nmodeling = ["{prefix}{i}.parquet"]\n')
+    cfg = folder / f"{prefix}.toml"
     cfg.write_text("\n".join(lines), encoding="utf-8")
-    out = tmp_path / "out"
+    return cfg
+
+
+def _start_fleet_and_wait(cfg: Path, out: Path, *extra: str) -> Any:
+    """``thermocal fleet CFG -o OUT --workers 2`` in a child process, returned once its first
+    unit is written (or it has ended)."""
+    import subprocess
+    import sys
+    import time
+
     cmd = [sys.executable, "-c", "import sys; from thermocal.cli import main; sys.exit(main())",
-           "fleet", str(cfg), "-o", str(out), "--workers", "2", "--json"]  # fmt: skip
+           "fleet", str(cfg), "-o", str(out), "--workers", "2", *extra]  # fmt: skip
     proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    deadline = time.monotonic() + 120
+    units = out / "units"
+    while time.monotonic() < deadline and proc.poll() is None:
+        if units.exists() and any(not p.name.startswith(".") for p in units.iterdir()):
+            break
+        time.sleep(0.02)
+    return proc
+
+
+def test_a_killed_worker_process_then_a_rerun(tmp_path: Path) -> None:
+    """A real worker process killed mid-batch (SIGKILL) once the first unit is written: the
+    driver names the units not done and exits 4, no half-written unit is left, and a rerun
+    finishes them (the units written before are skipped)."""
+    import os
+    import signal
+
+    psutil = pytest.importorskip("psutil")
+    cfg = _slow_batch(tmp_path, "k", seed=9)
+    out = tmp_path / "out"
+    proc = _start_fleet_and_wait(cfg, out, "--json")
     try:
-        deadline = time.monotonic() + 120
-        while time.monotonic() < deadline and proc.poll() is None:
-            units = out / "units"
-            if units.exists() and any(p.name.startswith("k") for p in units.iterdir()):
-                break
-            time.sleep(0.02)
         children = psutil.Process(proc.pid).children(recursive=True)
         workers = [c for c in children if "spawn_main" in " ".join(c.cmdline())]
         assert workers, "no worker processes"
@@ -321,35 +336,12 @@ def test_ctrl_c_stops_the_batch_and_a_rerun_resumes(tmp_path: Path) -> None:
     the workers are gone, and a rerun finishes the rest."""
     import os
     import signal
-    import subprocess
-    import sys
-    import time
 
     psutil = pytest.importorskip("psutil")
-    rng = np.random.default_rng(4)
-    n = 600_000
-    t = np.arange(n, dtype=np.float64) * 0.1
-    temp = np.linspace(-10.0, 60.0, n)
-    lines = ['[fit]\nmodel = "poly"\norder = 1\nsignal = "gyro [deg/h]"\ntemps = "T1 [degC]"\n']
-    for i in range(8):
-        gyro = 1.0 + 0.02 * (temp - 25.0) + rng.normal(0.0, 0.01, n)
-        pd.DataFrame({"time [s]": t, "gyro [deg/h]": gyro, "T1 [degC]": temp}).to_parquet(
-            tmp_path / f"c{i}.parquet", index=False
-        )
-        lines.append(f'[[unit]]\nid = "c{i}"\nmodeling = ["c{i}.parquet"]\n')
-    cfg = tmp_path / "c.toml"
-    cfg.write_text("\n".join(lines), encoding="utf-8")
+    cfg = _slow_batch(tmp_path, "c", seed=4)
     out = tmp_path / "out"
-    cmd = [sys.executable, "-c", "import sys; from thermocal.cli import main; sys.exit(main())",
-           "fleet", str(cfg), "-o", str(out), "--workers", "2"]  # fmt: skip
-    proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    proc = _start_fleet_and_wait(cfg, out)
     try:
-        deadline = time.monotonic() + 120
-        while time.monotonic() < deadline and proc.poll() is None:
-            units = out / "units"
-            if units.exists() and any(p.name.startswith("c") for p in units.iterdir()):
-                break
-            time.sleep(0.02)
         children = psutil.Process(proc.pid).children(recursive=True)
         os.kill(proc.pid, signal.SIGINT)
         _stdout, stderr = proc.communicate(timeout=120)

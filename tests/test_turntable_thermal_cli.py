@@ -38,17 +38,25 @@ MG = 9.80665e-3
 ARCSEC = np.pi / 180 / 3600
 
 
+def _write_runs(runs: list, folder: Path) -> tuple[list[str], Path]:
+    """The simulated runs as Parquet files: (the soaks' paths, the held-out run's path)."""
+    soaks, held = [], None
+    for rec, truth in runs:
+        f = folder / f"{truth['label']}.parquet"
+        write_recording(rec, f)
+        if truth["held_out"]:
+            held = f
+        else:
+            soaks.append(str(f))
+    assert held is not None
+    return soaks, held
+
+
 @pytest.fixture(scope="module")
 def workflow(tmp_path_factory: pytest.TempPathFactory) -> dict[str, object]:
     d = tmp_path_factory.mktemp("thermal")
     runs = simulate_turntable_thermal(seed=5)
-    files = []
-    for rec, truth in runs:
-        f = d / f"{truth['label']}.parquet"
-        write_recording(rec, f)
-        files.append((f, truth))
-    soaks = [str(f) for f, tr in files if not tr["held_out"]]
-    held = next(f for f, tr in files if tr["held_out"])
+    soaks, held = _write_runs(runs, d)
     cal = d / "cal.json"
     code = main(["turntable", *soaks, "--temps", "T_imu", "--accel", ",".join(A_COLS),
                  "-o", str(cal), "--json"])  # fmt: skip
@@ -176,13 +184,7 @@ def test_a_soak_that_missed_a_position(tmp_path: Path, capsys: pytest.CaptureFix
     """The 0 °C run holds 15 of the 16 positions: it is used, the warning says so, and the
     held-out run is still compensated to the accelerometer target."""
     runs = simulate_turntable_thermal(seed=6, drop_position=("T+0", 5))
-    files = []
-    for rec, truth in runs:
-        f = tmp_path / f"{truth['label']}.parquet"
-        write_recording(rec, f)
-        files.append((f, truth))
-    soaks = [str(f) for f, tr in files if not tr["held_out"]]
-    held = next(f for f, tr in files if tr["held_out"])
+    soaks, held = _write_runs(runs, tmp_path)
     cal = tmp_path / "cal.json"
     code = main(["turntable", *soaks, "--temps", "T_imu", "--accel", ",".join(A_COLS),
                  "-o", str(cal)])  # fmt: skip
@@ -233,13 +235,7 @@ def test_encoder_jitter_in_every_run(tmp_path: Path) -> None:
     """Encoders read with 3″ of white jitter in every run (soaks and held-out): the
     calibration still compensates the held-out accelerometers to the target."""
     runs = simulate_turntable_thermal(seed=8, encoder_noise_arcsec=3.0)
-    files = []
-    for rec, truth in runs:
-        f = tmp_path / f"{truth['label']}.parquet"
-        write_recording(rec, f)
-        files.append((f, truth))
-    soaks = [str(f) for f, tr in files if not tr["held_out"]]
-    held = next(f for f, tr in files if tr["held_out"])
+    soaks, held = _write_runs(runs, tmp_path)
     cal = tmp_path / "cal.json"
     assert main(["turntable", *soaks, "--temps", "T_imu", "--accel", ",".join(A_COLS),
                  "-o", str(cal)]) == 0  # fmt: skip
