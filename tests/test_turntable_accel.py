@@ -12,6 +12,7 @@ import pytest
 
 from thermocal.errors import DesignError
 from thermocal.turntable import accel
+from thermocal.turntable.model import error_matrices
 from thermocal.turntable.schedule import POSITIONS_16
 
 G = 9.80619  # WGS-84 normal gravity near 45°, m/s²
@@ -22,7 +23,7 @@ TRUTH = np.array([1.5, -2.0, 0.8, 120.0, -300.0, 80.0, 30.0, -25.0, -10.0, 15.0,
 def _dwells(noise_mg: float, seed: int, n: int = 6000) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     pos = np.array(POSITIONS_16, dtype=np.float64)
     f_true = accel.gravity_in_body(pos[:, 0], pos[:, 1], G)
-    e = accel.error_matrix_of(TRUTH)
+    e = error_matrices(TRUTH)
     b = TRUTH[0:3] * accel.MG_M_S2
     rng = np.random.default_rng(seed)
     f_meas = f_true @ (np.eye(3) + e).T + b

@@ -771,11 +771,6 @@ def _num(v: Any) -> float:
         return math.nan
 
 
-def progress_line(outcome: UnitOutcome) -> str:
-    what = "ok" if outcome.status == "ok" else f"FAILED: {outcome.error}"
-    return f"{outcome.id}: {what} ({outcome.seconds:.1f} s)"
-
-
 __all__ = [
     "EXIT_SOME_FAILED",
     "FleetConfig",

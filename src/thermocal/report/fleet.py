@@ -40,7 +40,7 @@ def _fmt(v: Any, digits: int = 4) -> str:
 def _figure_distributions(channel: str, ok: Mapping[str, Mapping[str, Any]]) -> bytes:
     """Histograms of a channel's rms residual and (if validated) rms after compensation,
     and a strip plot of every coefficient's robust z-score across the units."""
-    from thermocal.fleet import robust_z
+    from thermocal.fleet import OUTLIER_Z, robust_z
     from thermocal.report.figures import _figure, _png
 
     figs = [r["channels"][channel] for r in ok.values()]
@@ -66,14 +66,16 @@ def _figure_distributions(channel: str, ok: Mapping[str, Mapping[str, Any]]) -> 
                                    for f in figs]), dtype=float)  # fmt: skip
             z = z[np.isfinite(z)]
             jitter = (np.arange(z.size) % 7 - 3) * 0.05
-            out = np.abs(z) > 3.5
+            out = np.abs(z) > OUTLIER_Z
             ax.scatter(z[~out], j + jitter[~out], s=8, color="#555555")
             ax.scatter(z[out], j + jitter[out], s=14, color="#c0392b")
         ax.set_yticks(range(len(terms)))
         ax.set_yticklabels(terms, fontsize=7)
-        ax.axvline(-3.5, color="#c0392b", linewidth=0.8, linestyle="--")
-        ax.axvline(3.5, color="#c0392b", linewidth=0.8, linestyle="--")
-        ax.set_xlabel("coefficient, robust z-score across units (|z| > 3.5: outlier)", fontsize=9)
+        ax.axvline(-OUTLIER_Z, color="#c0392b", linewidth=0.8, linestyle="--")
+        ax.axvline(OUTLIER_Z, color="#c0392b", linewidth=0.8, linestyle="--")
+        ax.set_xlabel(
+            f"coefficient, robust z-score across units (|z| > {OUTLIER_Z:g}: outlier)", fontsize=9
+        )
         fig.set_size_inches(9.0, 2.8 + max(2.0, 0.18 * len(terms)))
         return _png(fig)
 

@@ -28,6 +28,7 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
+from thermocal import units
 from thermocal.errors import DesignError, ThermocalInputError
 from thermocal.turntable import kinematics, model
 
@@ -35,11 +36,6 @@ FloatArray = npt.NDArray[np.float64]
 
 MG_M_S2 = 9.80665e-3
 """One milli-g [m/s²] (standard gravity / 1000)."""
-PPM = 1e-6
-ARCSEC_RAD = math.pi / (180.0 * 3600.0)
-
-ACCEL_COEFF_UNITS = ("mg",) * 3 + ("ppm",) * 3 + ("arcsec",) * 6
-"""Units of the accelerometer θ."""
 
 
 @dataclass(frozen=True)
@@ -62,7 +58,7 @@ class AccelEstimate:
     @property
     def error_matrix(self) -> FloatArray:
         """E_a (dimensionless)."""
-        return error_matrix_of(self.theta)
+        return model.error_matrices(self.theta)
 
     @property
     def bias_m_s2(self) -> FloatArray:
@@ -84,19 +80,6 @@ class AccelEstimate:
             "n_dwells": self.n_dwells,
             "condition_number": self.condition_number,
         }
-
-
-def error_matrix_of(theta: npt.ArrayLike) -> FloatArray:
-    """E_a from θ: ``E_ii = θ_{3+i}·10⁻⁶``, ``E_ij = θ_m`` [″] in radians for the
-    misalignment m of (i, j) (:data:`.model.MISALIGNMENT_INDEX`)."""
-    th = np.asarray(theta, dtype=np.float64)
-    e = np.zeros((3, 3))
-    for i in range(3):
-        e[i, i] = th[3 + i] * PPM
-    for k, name in enumerate(model.MISALIGNMENT_NAMES):
-        r, c = model.MISALIGNMENT_INDEX[name]
-        e[r, c] = th[6 + k] * ARCSEC_RAD
-    return e
 
 
 def gravity_in_body(alpha_deg: npt.ArrayLike, beta_deg: npt.ArrayLike, g_m_s2: float) -> FloatArray:
@@ -178,32 +161,20 @@ def _theta_index(i: int, j: int) -> int:
 
 def _unit_factor(i: int, j: int) -> float:
     """θ units per unit of E_ij: ppm on the diagonal, arcsec off it."""
-    return 1.0 / PPM if i == j else 1.0 / ARCSEC_RAD
+    return 1.0 / units.PPM if i == j else units.RAD_TO_ARCSEC
 
 
-def dwell_means(
-    values: FloatArray, dwells: Sequence[Any], settle_s: float = 0.0, dt_s: float = 0.0
-) -> tuple[FloatArray, FloatArray]:
+def dwell_means(values: FloatArray, dwells: Sequence[Any]) -> tuple[FloatArray, FloatArray]:
     """Mean of ``values`` (n, k) over each dwell's samples (interval ``[start, stop)`` are
-    the samples ``start+1 … stop``), skipping the first ``settle_s`` of each; returns the
-    means (m, k) and the sample counts (m,)."""
-    means = []
-    counts = []
-    skip = round(settle_s / dt_s) if dt_s > 0 else 0
-    for d in dwells:
-        rows = values[1:][d.start + skip : d.stop]
-        if rows.shape[0] == 0:
-            rows = values[1:][d.start : d.stop]
-        means.append(rows.mean(axis=0))
-        counts.append(rows.shape[0])
-    return np.asarray(means, dtype=np.float64), np.asarray(counts, dtype=np.float64)
+    the samples ``start+1 … stop``); returns the means (m, k) and the sample counts (m,)."""
+    rows = [values[1:][d.start : d.stop] for d in dwells]
+    means = np.asarray([r.mean(axis=0) for r in rows], dtype=np.float64)
+    return means, np.asarray([r.shape[0] for r in rows], dtype=np.float64)
 
 
 __all__ = [
-    "ACCEL_COEFF_UNITS",
     "AccelEstimate",
     "dwell_means",
-    "error_matrix_of",
     "estimate_accel_triad",
     "gravity_in_body",
 ]

@@ -118,13 +118,24 @@ def coeffs_from_error_matrix(error_matrix: npt.ArrayLike, bias_deg_h: npt.ArrayL
     return np.concatenate([b, np.diag(e) / units.PPM, np.array(mis)])
 
 
+def error_matrices(theta: npt.ArrayLike) -> FloatArray:
+    """E (…, 3, 3) from θ (…, 12), stacked or not: ``E_ii = θ_{3+i}`` [ppm] · 10⁻⁶ and the
+    misalignments θ_6… [″] in radians at :data:`MISALIGNMENT_INDEX` (the biases θ_0…2 are
+    not part of E; any bias unit, gyro or accelerometer)."""
+    th = np.asarray(theta, dtype=np.float64)
+    e = np.zeros((*th.shape[:-1], 3, 3))
+    for i in range(3):
+        e[..., i, i] = th[..., 3 + i] * units.PPM
+    for k, n in enumerate(MISALIGNMENT_NAMES):
+        r, c = MISALIGNMENT_INDEX[n]
+        e[..., r, c] = th[..., 6 + k] * units.ARCSEC_TO_RAD
+    return e
+
+
 def error_matrix_from_coeffs(theta: npt.ArrayLike) -> tuple[FloatArray, FloatArray]:
     """(E, b [°/h]) from θ (inverse of :func:`coeffs_from_error_matrix`)."""
     th = np.asarray(theta, dtype=np.float64).reshape(N_COEFFS)
-    e = np.diag(th[3:6] * units.PPM)
-    for k, n in enumerate(MISALIGNMENT_NAMES):
-        e[MISALIGNMENT_INDEX[n]] = th[6 + k] * units.ARCSEC_TO_RAD
-    return e, th[0:3].copy()
+    return error_matrices(th), th[0:3].copy()
 
 
 def inner_axis_azimuth(

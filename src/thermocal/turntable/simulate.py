@@ -293,8 +293,8 @@ def simulate_turntable_thermal(
         temp = soak + drift_c * (t / t[-1] - 0.5)
         tg = thermal_theta(GYRO_THERMAL_TRUTH, temp)
         ta = thermal_theta(ACCEL_THERMAL_TRUTH, temp)
-        e_g = _error_matrices(tg)
-        e_a = _error_matrices(ta)
+        e_g = model.error_matrices(tg)
+        e_a = model.error_matrices(ta)
         arw = arw_deg_sqrt_h * units.DEG_TO_RAD / np.sqrt(units.SECONDS_PER_HOUR)
         gyro = (
             omega_true
@@ -354,14 +354,3 @@ def simulate_turntable_thermal(
         }
         out.append((rec, truth))
     return out
-
-
-def _error_matrices(theta: FloatArray) -> FloatArray:
-    """E (n, 3, 3) from θ (n, 12): ppm on the diagonal, arcseconds off it."""
-    e = np.zeros((theta.shape[0], 3, 3))
-    for i in range(3):
-        e[:, i, i] = theta[:, 3 + i] * 1e-6
-    for k, name in enumerate(model.MISALIGNMENT_NAMES):
-        r, c = model.MISALIGNMENT_INDEX[name]
-        e[:, r, c] = theta[:, 6 + k] * units.ARCSEC_TO_RAD
-    return e

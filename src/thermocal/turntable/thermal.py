@@ -295,17 +295,9 @@ def fit_triad(
 
 def error_terms(triad: TriadThermal, temp_c: npt.ArrayLike) -> tuple[FloatArray, FloatArray]:
     """``(b(T) (n, 3) in the bias unit, E(T) (n, 3, 3))`` at each temperature."""
-    th = triad.theta_at(temp_c)
-    th2 = np.atleast_2d(th)
-    e = np.zeros((th2.shape[0], 3, 3))
-    for i in range(3):
-        e[:, i, i] = th2[:, 3 + i] * 1e-6
-    arcsec = math.pi / (180.0 * 3600.0)
-    for k, name in enumerate(model.MISALIGNMENT_NAMES):
-        r, c = model.MISALIGNMENT_INDEX[name]
-        e[:, r, c] = th2[:, 6 + k] * arcsec
-    b: FloatArray = th2[:, 0:3]
-    return b, e
+    th = np.atleast_2d(triad.theta_at(temp_c))
+    b: FloatArray = th[:, 0:3]
+    return b, model.error_matrices(th)
 
 
 CORRECT_BLOCK = 1 << 18
