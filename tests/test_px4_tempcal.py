@@ -139,11 +139,14 @@ def test_a_flight_log_is_no_temperature_sweep(
 ) -> None:
     assert main(["px4-tempcal", str(SAMPLE), "-o", str(tmp_path / "o")]) == 2
     err = capsys.readouterr().err
-    assert "the temperature sweeps only" in err and "record a wider sweep" in err
+    assert "the data cannot support this fit" in err and "record a wider sweep" in err
+    assert "6 samples for 4 coefficients" in err
 
 
-def test_a_sensor_that_moved_is_warned(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    """Halfway through the sweep the board is tilted by 10°: gravity moves from z into x."""
+def test_a_sensor_that_moved_is_refused(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """Halfway through the sweep the board is tilted by 10°: gravity moves from z into x.
+    The accelerometer calibration would fit the step: refused, naming the time and the
+    angle; with --allow-motion written with a warning; the still board passes quietly."""
     n = 6000
     t = np.arange(n) * 0.05
     T = -10.0 + 60.0 * t / t[-1]
@@ -159,9 +162,19 @@ def test_a_sensor_that_moved_is_warned(tmp_path: Path, capsys: pytest.CaptureFix
     for name, data, moved in (("moved", rows, True), ("still", still, False)):
         log = tmp_path / f"{name}.ulg"
         log.write_bytes(ulog_bytes([("sensor_accel", 0, SENSOR_FIELDS, data)]))
-        assert main(["px4-tempcal", str(log), "-o", str(tmp_path / name)]) == 0
+        code = main(["px4-tempcal", str(log), "-o", str(tmp_path / name)])
         err = capsys.readouterr().err
-        assert ("the sensor moved during the log (the gravity direction changed by" in err) is moved
+        assert code == (2 if moved else 0), err
+        assert ("the gravity direction changed" in err) is moved
+        if moved:
+            assert "at 151.0 s" in err  # the log's time: it starts at 1 s
+            assert "(10.0°)" in err and "--allow-motion" in err
+            assert not (tmp_path / name / "px4.params").exists()
+            code = main(["px4-tempcal", str(log), "-o", str(tmp_path / name), "--allow-motion"])
+            err = capsys.readouterr().err
+            assert code == 0 and "the gravity direction changed" in err and "warning:" in err
+        else:
+            assert "warning" not in err
 
 
 def test_compensate_a_px4_log(

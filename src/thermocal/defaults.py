@@ -37,3 +37,14 @@ SCENARIO_NAMES: Final = (
 PROGRAM_TIME: Final = "time_s"
 PROGRAM_SETPOINT: Final = "setpoint_c"
 """Columns of a chamber program CSV (:func:`thermocal.profiles.read_program`)."""
+
+
+ALLOW_NARROW: Final = "--allow-narrow"
+"""The override of the adequacy tests of the sweep (span, samples, Ṫ range)."""
+ALLOW_MOTION: Final = "--allow-motion"
+"""The override of the adequacy test of stillness."""
+
+
+def overrides_of(allow_narrow: bool, allow_motion: bool) -> tuple[str, ...]:
+    """The adequacy overrides a command was given (:mod:`thermocal.adequacy`)."""
+    return tuple(o for o, on in ((ALLOW_NARROW, allow_narrow), (ALLOW_MOTION, allow_motion)) if on)

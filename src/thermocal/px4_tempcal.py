@@ -29,7 +29,8 @@ from typing import Any
 
 import numpy as np
 
-from thermocal.errors import ThermocalInputError, ThermocalWarning
+from thermocal import adequacy, units
+from thermocal.errors import ThermocalInputError
 from thermocal.models.base import RunData, model_inputs
 from thermocal.models.calibration import Calibration, Channel
 from thermocal.models.poly import PolyModel
@@ -39,14 +40,8 @@ BIN_WIDTH_C = 0.5
 """Width of the temperature bins whose medians are fitted [°C]."""
 MIN_BINS = 8
 """Fewest occupied bins a cubic is fitted to (and judged on)."""
-MOVED_DEG = 2.0
-"""The gravity direction (accelerometers) or a mean rotation (gyros, in degrees per block)
-changing by more than this during the log means the sensor moved [°]."""
-MOVED_RATE_DEG_S = 0.5
-"""A gyro block mean above this rate means the sensor was turned [°/s]."""
-N_BLOCKS = 10
-MIN_SWEEP_C = 10.0
-"""A sweep narrower than this gets a warning (ArduPilot's learning requires 10 °C)."""
+MIN_SWEEP_C = adequacy.ARDUPILOT_MIN_SPAN_C
+"""ArduPilot's learning requires a 10 °C sweep (the firmware minimum of the adequacy check)."""
 AXES = ("x", "y", "z")
 TOPICS = ("sensor_gyro", "sensor_accel")
 
@@ -85,6 +80,7 @@ class SensorFit:
     n_bins: int
     holdout_rms: dict[str, float] = field(default_factory=dict)
     channels: list[Channel] = field(default_factory=list)
+    adequacy: dict[str, Any] = field(default_factory=dict)
 
 
 def _cubic(t: FloatArray, y: FloatArray, unit: str, name: str, rec: Recording) -> PolyModel:
@@ -102,49 +98,48 @@ def _cubic(t: FloatArray, y: FloatArray, unit: str, name: str, rec: Recording) -
         return PolyModel(order=3, per_run_offset=False).fit([run])
 
 
-def movement(kind: str, vals_canonical: FloatArray) -> float | None:
-    """How much the sensor moved: accelerometers — the largest angle between a block's mean
-    specific force and the whole log's [°]; gyros — the largest block-mean rate [°/s].
-    ``vals_canonical`` (n, 3) in mg or °/h."""
-    blocks = np.array_split(vals_canonical, N_BLOCKS)
-    means = np.array([b.mean(axis=0) for b in blocks if b.size])
-    if kind == "accel":
-        ref = vals_canonical.mean(axis=0)
-        nref = float(np.linalg.norm(ref))
-        if nref < 500.0:  # no gravity to measure the orientation by (< 0.5 g)
-            return None
-        cos = means @ ref / (np.linalg.norm(means, axis=1) * nref)
-        return float(np.degrees(np.arccos(np.clip(cos, -1.0, 1.0))).max())
-    return float(np.linalg.norm(means, axis=1).max() / 3600.0)
-
-
-def fit_sensor(rec: Recording, topic: str, kind: str, instance: int) -> SensorFit:
-    """Bin, judge (even bins → odd bins) and fit one sensor instance's three axes."""
+def fit_sensor(
+    rec: Recording,
+    topic: str,
+    kind: str,
+    instance: int,
+    *,
+    overrides: tuple[str, ...] = (),
+    firmware: str = "px4",
+) -> SensorFit:
+    """Judge the log (:func:`thermocal.adequacy.judge`: a cubic's sweep, the sensor still,
+    the firmware's minimum sweep), then bin, judge (even bins → odd bins) and fit one
+    sensor instance's three axes."""
     temp = rec.temperature_c("temperature")
     lo, hi = float(np.min(temp)), float(np.max(temp))
     where = f"{topic}.{instance}"
-    if hi - lo < MIN_SWEEP_C:
-        warnings.warn(
-            f"{where}: the temperature sweeps only {hi - lo:.1f} °C ({lo:.1f}…{hi:.1f}); a "
-            f"calibration needs ≥ {MIN_SWEEP_C:g} °C (ArduPilot refuses less)",
-            ThermocalWarning,
-            stacklevel=2,
-        )
     vals = np.column_stack([rec.signal(a)[0] for a in AXES])  # canonical unit (°/h or mg)
     unit = rec.signal(AXES[0])[1]
-    moved = movement(kind, vals)
-    if moved is not None and moved > (MOVED_DEG if kind == "accel" else MOVED_RATE_DEG_S):
-        what = (
-            f"the gravity direction changed by {moved:.1f}°"
-            if kind == "accel"
-            else f"it turned at up to {moved:.2f} °/s"
+    given = rec.units.get(AXES[0], unit)
+    try:
+        factor = float(units.convert(1.0, unit, given))
+    except ThermocalInputError:
+        factor, given = 1.0, unit
+    judged = adequacy.judge(
+        adequacy.Needs({"temperature": 3}, 4),
+        [rec.time_s],
+        [temp.reshape(-1, 1)],
+        ["temperature"],
+        signals=[vals],
+        kind=kind,
+        name=where,
+        unit_factor=factor,
+        unit=given,
+        overrides=overrides,
+    )
+    if firmware == "ardupilot":
+        judged = judged.merged(
+            adequacy.Adequacy(
+                (adequacy.firmware_test(hi - lo, "ArduPilot", adequacy.ARDUPILOT_MIN_SPAN_C),),
+                overrides,
+            )
         )
-        warnings.warn(
-            f"{where}: the sensor moved during the log ({what}): a thermal calibration needs "
-            "it still; the fit mixes the motion into the temperature effect",
-            ThermocalWarning,
-            stacklevel=2,
-        )
+    record = judged.enforce().to_dict()
     _c, t_med, v_med = temperature_bins(temp, vals)
     if t_med.size < MIN_BINS:
         raise ThermocalInputError(
@@ -154,7 +149,7 @@ def fit_sensor(rec: Recording, topic: str, kind: str, instance: int) -> SensorFi
     sid = rec.meta.sensor_id
     fit = SensorFit(
         topic, kind, instance, int(sid) if sid and str(sid).isdigit() else 0, unit,
-        (lo, hi), int(temp.size), int(t_med.size),
+        (lo, hi), int(temp.size), int(t_med.size), adequacy=record,
     )  # fmt: skip
     even, odd = np.arange(0, t_med.size, 2), np.arange(1, t_med.size, 2)
     short = "g" if kind == "gyro" else "a"
@@ -171,6 +166,7 @@ def fit_sensor(rec: Recording, topic: str, kind: str, instance: int) -> SensorFi
         fit.holdout_rms[axis] = float(np.sqrt(np.mean((v_med[odd, j] - pred) ** 2)))
         model = _cubic(t_med, v_med[:, j], unit, name, rec)
         model.signal_name, model.signal_unit = axis, unit
+        model.adequacy_ = record
         model.inputs_ = {
             **model_inputs(rec, axis, ["temperature"]),
             "sensor_id": str(fit.device_id),

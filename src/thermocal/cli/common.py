@@ -184,6 +184,21 @@ ExtrapolateOpt = Annotated[
     ),
 ]
 JsonOpt = Annotated[bool, typer.Option("--json", help="Print one JSON object on stdout.")]
+AllowNarrowOpt = Annotated[
+    bool,
+    typer.Option(
+        "--allow-narrow",
+        help="Calibrate even where the sweep is too narrow for the model (span, samples, Ṫ "
+        "range), with a warning recorded in the calibration.",
+    ),
+]
+AllowMotionOpt = Annotated[
+    bool,
+    typer.Option(
+        "--allow-motion",
+        help="Calibrate even where the sensor moved during the record, with a warning.",
+    ),
+]
 TurntableLatitudeOpt = Annotated[
     float | None,
     typer.Option(

@@ -17,7 +17,7 @@ import typer
 from thermocal._lazy import LazyModule
 from thermocal.cli.application import app
 from thermocal.cli.common import JsonOpt, ModelArg, emit, fmt, handle_errors, stdout
-from thermocal.errors import ThermocalWarning, UnitWarning
+from thermocal.errors import ThermocalInputError, ThermocalWarning, UnitWarning
 
 if TYPE_CHECKING:
     import thermocal.export_c as _export_c
@@ -41,6 +41,27 @@ def _read_json(path: Path) -> object:
         return None
 
 
+def _check_adequacy(cal: "_calibration.Calibration", path: Path, firmware: str | None) -> None:
+    """Firmware output only from data that supported the fit
+    (:func:`thermocal.adequacy.check_for_firmware`); ArduPilot's own minimum sweep too."""
+    from thermocal.adequacy import ARDUPILOT_MIN_SPAN_C, check_for_firmware
+
+    for ch in cal.channels:
+        where = f"{path}: channel {ch.name}" if len(cal.channels) > 1 else str(path)
+        record = ch.model.adequacy_
+        check_for_firmware(record, where)
+        if firmware != "ardupilot":
+            continue
+        rng = ch.model.temp_range_
+        span = float(rng[0, 1] - rng[0, 0]) if rng.size else 0.0
+        allowed = "--allow-narrow" in ((record or {}).get("overrides") or [])
+        if span < ARDUPILOT_MIN_SPAN_C and not allowed:
+            raise ThermocalInputError(
+                f"{where}: the calibration covers {span:.3g} °C; ArduPilot's temperature "
+                f"calibration needs ≥ {ARDUPILOT_MIN_SPAN_C:g} °C (refit on a wider sweep)"
+            )
+
+
 def _export_calibration(
     path: Path,
     output: Path,
@@ -53,6 +74,7 @@ def _export_calibration(
     """A calibration's C: one header and one source for every channel, each channel in
     its data's unit (``--unit`` applies one unit to every channel, or one per channel)."""
     cal = _files.load_calibration(path)
+    _check_adequacy(cal, path, None)
     if cal.triads and not cal.channels:  # a turntable calibration over temperature
         from thermocal.export_c.triad import generate_c_triads
 
@@ -147,6 +169,9 @@ def export_c_cmd(
         _export_calibration(model_file, output, name, real, sample_interval, unit, as_json)
         return
     d = _files.load_model_dict(model_file)
+    from thermocal.adequacy import check_for_firmware
+
+    check_for_firmware(d.get("adequacy"), str(model_file))
     if sample_interval is None:
         sample_interval = _export_c.fitted_sample_interval(d)
         if sample_interval is None:
@@ -263,6 +288,7 @@ def export_params_cmd(
     check_not_input(output, [calibration])
     cal = _files.load_calibration(calibration)
     cal.require_channels("export-params")
+    _check_adequacy(cal, calibration, fmt)
     ids = {"gyro": device_id, "accel": device_id} if device_id is not None else None
     ps = export_params(
         cal, fmt, gyro=split_names(gyro), accel=split_names(accel), instance=instance,

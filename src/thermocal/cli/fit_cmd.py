@@ -56,9 +56,12 @@ from typing import TYPE_CHECKING, Annotated, Any, cast
 
 import typer
 
+from thermocal import errors as _errors
 from thermocal._lazy import LazyModule
 from thermocal.cli.application import app
 from thermocal.cli.common import (
+    AllowMotionOpt,
+    AllowNarrowOpt,
     AxisOpt,
     DecimalOpt,
     DelimiterOpt,
@@ -87,12 +90,14 @@ from thermocal.cli.common import (
     stdout,
     text_options,
 )
+from thermocal.defaults import overrides_of
 from thermocal.errors import ConditioningWarning, ThermocalInputError, ThermocalWarning
 
 if TYPE_CHECKING:
     import numpy as np
     import rich.table as _rich_table
 
+    import thermocal.adequacy as _adequacy
     import thermocal.io as _io
     import thermocal.models.base as _base
     import thermocal.models.calibration as _calibration
@@ -104,6 +109,7 @@ else:
     np = LazyModule("numpy")
     _rich_table = LazyModule("rich.table")
     units = LazyModule("thermocal.units")
+    _adequacy = LazyModule("thermocal.adequacy")
     _io = LazyModule("thermocal.io")
     _base = LazyModule("thermocal.models.base")
     _calibration = LazyModule("thermocal.models.calibration")
@@ -243,6 +249,8 @@ def fit_cmd(
             "(in T − TREF, the PX4/ArduPilot convention).",
         ),
     ] = None,
+    allow_narrow: AllowNarrowOpt = False,
+    allow_motion: AllowMotionOpt = False,
     t_names: NamesOpt = None,
     topic: TopicOpt = None,
     t_rate: RateOpt = None,
@@ -314,7 +322,8 @@ def fit_cmd(
             f"--tref applies to the poly family (coefficients about TREF), not {model!r}"
         )
     spec = _FitSpec(model, options, temps, latitude, axis, known_input, target,
-                    gravity_axis, g_local, tref)  # fmt: skip
+                    gravity_axis, g_local, tref,
+                    overrides_of(allow_narrow, allow_motion))  # fmt: skip
     if len(names) <= 1:
         est, result, n_runs = _fit_channel(spec, loaded, signal)
         _files.save_model(est, output)
@@ -358,6 +367,7 @@ class _FitSpec:
     gravity_axis: str | None = None
     gravity_m_s2: float | None = None
     tref_c: float | None = None
+    overrides: tuple[str, ...] = ()
 
 
 GRAVITY_TOLERANCE_MG = 100.0
@@ -559,6 +569,7 @@ def _prepare_channel(
 
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
+        est.adequacy_ = _judge_channel(spec, est, runs, sig_name, first_inputs, unit)
         known_ids = sorted({str(i) for i in sensor_ids if i})
         if len(known_ids) > 1:
             first_inputs.pop("sensor_id", None)
@@ -572,6 +583,41 @@ def _prepare_channel(
         elif known_ids and "sensor_id" not in first_inputs:
             first_inputs["sensor_id"] = known_ids[0]
     return _Prepared(est, runs, first_inputs, provenance, unit, sig_name, list(caught))
+
+
+def _judge_channel(
+    spec: _FitSpec,
+    est: "_base.TemperatureModel",
+    runs: "list[_base.RunData]",
+    sig_name: str,
+    first_inputs: dict[str, Any],
+    unit: str,
+) -> dict[str, Any]:
+    """Judge the data before the fit (:func:`thermocal.adequacy.judge`): refuse what they
+    cannot support (exit 2), warn where overridden; the record goes into the model file."""
+    names = list(runs[0].temp_names)
+    needs = est.data_needs(names, len(runs))
+    kind = {"rate": "gyro", "accel": "accel"}.get(units.signal_kind(unit))
+    given = str((first_inputs.get("units") or {}).get(sig_name, unit))
+    try:
+        factor = float(units.convert(1.0, unit, given))
+    except _errors.UnitError:  # counts with a scale factor: figures in the canonical unit
+        factor, given = 1.0, unit
+    judged = _adequacy.judge(
+        needs,
+        [r.time_s for r in runs],
+        [r.temps_c for r in runs],
+        names,
+        signals=[r.target() for r in runs],
+        kind=kind,
+        name=sig_name,
+        temperature_unit="°C" if runs[0].temperature_unit == "degC" else "counts",
+        unit_factor=factor,
+        unit=given,
+        overrides=spec.overrides,
+        rate_interval_s=float(spec.options.get("rate_interval_s") or 60.0),
+    )
+    return judged.enforce().to_dict()
 
 
 def _finish_channel(
@@ -643,6 +689,7 @@ def _finish_channel(
             "what": first_inputs.get("known_input", {}).get("what"),
         },
         "unit_as_given": (first_inputs.get("units") or {}).get(sig_name, unit),
+        "adequacy": est.adequacy_,
     }
     if spec.tref_c is not None:
         result["tref"] = {

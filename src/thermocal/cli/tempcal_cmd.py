@@ -14,7 +14,17 @@ import typer
 
 from thermocal._lazy import LazyModule
 from thermocal.cli.application import app
-from thermocal.cli.common import JsonOpt, emit, fmt, handle_errors, load_recording, stdout
+from thermocal.cli.common import (
+    AllowMotionOpt,
+    AllowNarrowOpt,
+    JsonOpt,
+    emit,
+    fmt,
+    handle_errors,
+    load_recording,
+    stdout,
+)
+from thermocal.defaults import overrides_of
 from thermocal.errors import ThermocalInputError
 
 if TYPE_CHECKING:
@@ -32,6 +42,8 @@ def px4_tempcal_cmd(
         float | None,
         typer.Option("--tref", help="Reference temperature [°C] (default: mid-range)."),
     ] = None,
+    allow_narrow: AllowNarrowOpt = False,
+    allow_motion: AllowMotionOpt = False,
     as_json: JsonOpt = False,
 ) -> None:
     """Fit every gyro and accelerometer instance of a PX4 log as PX4 would (a cubic per axis
@@ -57,7 +69,7 @@ def px4_tempcal_cmd(
     for name, inst in topics:
         kind = "gyro" if name == "sensor_gyro" else "accel"
         rec = load_recording(log, topic=f"{name}.{inst}", signal="x,y,z", temps="temperature")
-        fit = fit_sensor(rec, name, kind, inst)
+        fit = fit_sensor(rec, name, kind, inst, overrides=overrides_of(allow_narrow, allow_motion))
         fits.append(fit)
         sub = Calibration(fit.channels)
         with warnings.catch_warnings():  # accelerometers: relative offsets, as PX4's script
@@ -128,6 +140,8 @@ def px4_tempcal_cmd(
 def ardupilot_tempcal_cmd(
     log: Annotated[Path, typer.Argument(help="ArduPilot log (.bin).", show_default=False)],
     output: Annotated[Path, typer.Option("-o", "--output", help="Directory to write.")],
+    allow_narrow: AllowNarrowOpt = False,
+    allow_motion: AllowMotionOpt = False,
     as_json: JsonOpt = False,
 ) -> None:
     """ArduPilot's thermal calibration from one DataFlash log: every IMU instance's gyro
@@ -162,7 +176,10 @@ def ardupilot_tempcal_cmd(
                 {"temperature": rec.column("T")}, signal_unit=unit,
             )  # fmt: skip
             sub_rec.source = str(log)
-            fit = fit_sensor(sub_rec, f"IMU.{prefix}", kind, inst)
+            fit = fit_sensor(
+                sub_rec, f"IMU.{prefix}", kind, inst,
+                overrides=overrides_of(allow_narrow, allow_motion), firmware="ardupilot",
+            )  # fmt: skip
             fits.append(fit)
             per_kind.append((fit, sub_rec))
         sub = Calibration([ch for f, _r in per_kind for ch in f.channels])

@@ -80,6 +80,7 @@ from typing import TYPE_CHECKING, Any, ClassVar, Self
 import numpy as np
 
 from thermocal._lazy import LazyModule
+from thermocal.adequacy import Needs
 from thermocal.errors import (
     ConditioningWarning,
     DesignError,
@@ -270,6 +271,11 @@ class BankModel(TemperatureModel):
         self.grid_step_c = grid_step_c
         self.hold_min_s = hold_min_s
         self.error_metric = error_metric
+
+    def data_needs(self, temp_names: Sequence[str], n_runs: int) -> Needs:
+        """Each curve of the bank is judged as a line in its column."""
+        j = self.sensor if 0 <= self.sensor < len(temp_names) else 0
+        return Needs({temp_names[j]: 1} if temp_names else {}, 2)
 
     CLI_KEYS: ClassVar[Mapping[str, str] | None] = {
         k: k

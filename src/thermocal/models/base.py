@@ -63,6 +63,7 @@ from typing import Any, ClassVar, Literal, Self, TypeVar
 
 import numpy as np
 
+from thermocal.adequacy import Needs
 from thermocal.errors import (
     DesignError,
     ExtrapolationWarning,
@@ -486,6 +487,9 @@ class TemperatureModel(ABC):
     rate_range_: FloatArray | None
     stats_: FitStats
     data_: list[dict[str, Any]]
+    adequacy_: dict[str, Any] | None = None
+    """The adequacy record of the data it was fitted on (:mod:`thermocal.adequacy`), or
+    None (files written before the check, or fitted through the library)."""
     inputs_: dict[str, Any]
     """How the fitted data were written (format version ≥ 2, :func:`model_inputs`):
     ``time_unit``, ``units`` (column → unit as given, e.g. ``deg/s``, ``counts``),
@@ -535,6 +539,13 @@ class TemperatureModel(ABC):
         stated default for data whose unit nothing states (older files)."""
         inputs = dict(getattr(self, "inputs_", {}) or {})
         return StatedUnits.from_model_inputs(inputs, signal_default=self.signal_unit)
+
+    # -- what the data must offer (thermocal.adequacy) --
+    def data_needs(self, temp_names: Sequence[str], n_runs: int) -> Needs:
+        """What this model asks of the data before it is fitted (its polynomial order in
+        each temperature column, coefficient count, Ṫ columns), for
+        :func:`thermocal.adequacy.judge`.  Default: a line in the first column."""
+        return Needs({temp_names[0]: 1} if temp_names else {}, 2)
 
     # -- estimator contract --
     @abstractmethod
@@ -734,6 +745,8 @@ class TemperatureModel(ABC):
             "data": _jsonify(self.data_),
             "inputs": _jsonify(self._inputs_record(params, bool(state.get("uses_rate", True)))),
         }
+        if self.adequacy_ is not None:
+            d["adequacy"] = _jsonify(self.adequacy_)
         d["range"]["temperature_unit"] = self.temperature_unit
         return d
 
@@ -791,6 +804,8 @@ class TemperatureModel(ABC):
         )
         model.data_ = list(d.get("data", []))
         model.inputs_ = dict(d.get("inputs") or {})  # format version 1 files: unknown
+        adequacy = d.get("adequacy")
+        model.adequacy_ = dict(adequacy) if isinstance(adequacy, dict) else None
         sig = d.get("signal") or {}
         model.signal_name = sig.get("name", "signal")
         model.signal_unit = normalize_signal_unit(str(sig["unit"]))  # required by the schema

@@ -63,6 +63,7 @@ import numpy as np
 import numpy.typing as npt
 
 from thermocal._lazy import LazyModule
+from thermocal.adequacy import Needs
 from thermocal.errors import (
     DesignError,
     ThermocalInputError,
@@ -390,6 +391,15 @@ class PiecewiseModel(TemperatureModel):
         return ChunkContext(head_s=0.0, tail_s=0.0)
 
     # -- helpers --
+    def data_needs(self, temp_names: Sequence[str], n_runs: int) -> Needs:
+        """Judged as a line in the model's column (each segment's own data are checked by
+        the fit); S + 1 coefficients for S given segments, plus per-run offsets."""
+        j = self._column(temp_names, len(temp_names)) if temp_names else 0
+        # breakpoints chosen from the data (segments=N) are fewer where the data are short
+        s = len(self.breakpoints) + 1 if self.breakpoints else 1
+        offsets = n_runs - 1 if (self.per_run_offset is not False and n_runs > 1) else 0
+        return Needs({temp_names[j]: 1} if temp_names else {}, s + 1 + offsets)
+
     def _column(self, names: Sequence[str], k: int) -> int:
         t = self.temperature
         if t is None:

@@ -101,6 +101,7 @@ from typing import Any, ClassVar, Self, cast
 import numpy as np
 import numpy.typing as npt
 
+from thermocal.adequacy import Needs
 from thermocal.errors import ExtrapolationWarning, ThermocalInputError
 from thermocal.models.base import (
     ChunkContext,
@@ -160,6 +161,7 @@ from thermocal.models.terms import (
     BaseScaling,
     Term,
     monomial_name,
+    parse_terms,
     raw_expansion,
     segment_rates,
     temperature_rates,
@@ -308,6 +310,18 @@ class PolyModel(TemperatureModel):
     def rates(self, time_s: FloatArray, temps_c: FloatArray) -> FloatArray:
         """Ṫ of every temperature column [°C/min] with the model's rate form and Δt."""
         return temperature_rates(time_s, temps_c, float(self.rate_interval_s), self.rate_method)
+
+    def data_needs(self, temp_names: Sequence[str], n_runs: int) -> Needs:
+        """Order in T per column (T and T·Ṫ powers), the terms plus the constant and the
+        per-run offsets, and the columns with Ṫ terms."""
+        terms = parse_terms(self.terms, len(temp_names), self.order)
+        order = {n: 0 for n in temp_names}
+        for t in terms:
+            n = temp_names[t.sensor]
+            order[n] = max(order[n], t.t_power + t.coupling_power)
+        rate = tuple(temp_names[s] for s in sorted({t.sensor for t in terms if t.uses_rate}))
+        offsets = n_runs - 1 if (self.per_run_offset is not False and n_runs > 1) else 0
+        return Needs(order, len(terms) + 1 + offsets, rate)
 
     @property
     def model_uses_rate(self) -> bool:

@@ -73,6 +73,7 @@ import numpy as np
 import numpy.typing as npt
 from numpy.polynomial import polynomial as npoly
 
+from thermocal.adequacy import Needs
 from thermocal.errors import (
     ConditioningWarning,
     DesignError,
@@ -322,6 +323,14 @@ class WarmupModel(TemperatureModel):
         self.sensor = sensor
         self.method = method
         self.per_run_offset = per_run_offset
+
+    def data_needs(self, temp_names: Sequence[str], n_runs: int) -> Needs:
+        """Judged in its column as a line (the ΔT polynomial of each run rests on the
+        warm-up itself, the T0 dependence on the runs' start temperatures), with
+        (order + 1)(t0_order + 1) coefficients."""
+        j = self.sensor if 0 <= self.sensor < len(temp_names) else 0
+        n = (self.order + 1) * (self.t0_order + 1)
+        return Needs({temp_names[j]: 1} if temp_names else {}, n)
 
     CLI_KEYS: ClassVar[Mapping[str, str] | None] = {
         k: k

@@ -1,0 +1,728 @@
+"""Can these data support this answer?  One adequacy check for every calibration command.
+
+A temperature calibration is only as good as the sweep it was fitted on.  Before a fit,
+:func:`judge` measures what the recording offers against what the model needs and returns
+an :class:`Adequacy` record: each test's figure, threshold and verdict.  ``fit``,
+``px4-tempcal``, ``ardupilot-tempcal``, ``turntable`` (over temperature) and ``fleet``
+(through ``fit``) call it; the record is stored in the model file (key ``adequacy``) and
+printed with ``--json``; ``export-params`` and ``export-c`` refuse a calibration whose
+record failed without an override (:func:`check_for_firmware`).
+
+The tests (figures over every run of a channel together):
+
+``samples_per_coefficient``
+    n / p, the samples per fitted coefficient.  n ≤ p cannot be fitted (refused, no
+    override); n / p < :data:`MIN_SAMPLES_PER_COEFFICIENT` is refused unless
+    ``--allow-narrow``.
+``temperature_span``
+    The span of each temperature column between its 0.1 and 99.9 percentiles [°C] (a
+    few spikes do not make a range) against :data:`MIN_SPAN_PER_ORDER_C` × the model's
+    polynomial order in T: a cubic over 0.3 °C extrapolates its own noise (the constant
+    of such a fit was 5e8 °/h).  ``--allow-narrow`` overrides.
+``distinct_temperatures``
+    Occupied temperature bins (``max(span / 20, 0.1 °C)`` wide, at least
+    :data:`MIN_SAMPLES_PER_BIN` samples each) against order + 1: fewer cannot determine
+    the polynomial (refused, no override); exactly order + 1 (e.g. a two-point soak for a
+    line) determines it but cannot check its shape (a warning).
+``range_ends``
+    The share of samples in the lowest and the highest tenth of the span [%] (the smaller
+    of the two): a range whose ends are held by a handful of samples is warned about.
+``rate_range``
+    Models with Ṫ terms: the span of Ṫ [°C/min] (1–99 percentiles, Ṫ over
+    :data:`RATE_INTERVAL_S`) against :data:`MIN_RATE_SPAN_C_PER_MIN`; a sweep at one rate
+    cannot separate Ṫ terms from the constant.  ``--allow-narrow`` overrides.
+``stillness``
+    Motion told from thermal drift (:func:`stillness`): one-second block means against a
+    running median over :data:`STILL_WINDOW_S` (slow thermal drift follows the median,
+    a bump or a turn does not), judged against the sensor's own noise (the scatter within
+    the blocks) and an absolute floor (:data:`MOTION_FLOOR_DEG_S`, :data:`MOTION_FLOOR_MG`).
+    Moving more than :data:`MAX_MOVING_SHARE` of the time (a flight log) is refused unless
+    ``--allow-motion``; shorter episodes are named with their times in a warning.
+``firmware_minimum``
+    The firmware's own minimum sweep (ArduPilot's learning requires
+    :data:`ARDUPILOT_MIN_SPAN_C` °C).
+
+Sources: SPEC §3–§4 (the chamber program must cover the operating range with soaks and
+ramps; the temperature-rate terms need ramps of both signs), IEEE Std 952-2020 Annex C
+(thermal tests at stabilised and ramped temperatures), ArduPilot's ``TCal`` learning
+(``AP_InertialSensor_tempcal.cpp``: a 10 °C minimum span), PX4's
+``process_sensor_caldata.py`` (binned cubic per axis).
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+from collections.abc import Iterable, Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+import numpy.typing as npt
+
+from thermocal.defaults import ALLOW_MOTION, ALLOW_NARROW, overrides_of
+from thermocal.errors import ThermocalInputError, ThermocalWarning
+
+FloatArray = npt.NDArray[np.float64]
+
+
+MIN_SAMPLES_PER_COEFFICIENT = 10.0
+"""Fewest samples per fitted coefficient accepted without ``--allow-narrow``."""
+MIN_SPAN_PER_ORDER_C = 5.0
+"""Temperature span needed per polynomial order [°C]: a line 5 °C, a cubic 15 °C."""
+N_SPAN_BINS = 20
+MIN_BIN_WIDTH_C = 0.1
+MIN_SAMPLES_PER_BIN = 3
+END_FRACTION = 0.1
+MIN_END_SHARE_PCT = 0.5
+"""Fewest samples in each end tenth of the span [% of the samples] before a warning."""
+RATE_INTERVAL_S = 60.0
+MIN_RATE_SPAN_C_PER_MIN = 0.1
+"""Narrowest Ṫ span that supports Ṫ terms [°C/min]."""
+STILL_BLOCK_S = 1.0
+STILL_WINDOW_S = 60.0
+STILL_K_SIGMA = 8.0
+MOTION_FLOOR_DEG_S = 0.3
+"""Smallest departure of a gyro's 1-s mean from its running median taken as motion [°/s]."""
+MOTION_FLOOR_MG = 20.0
+"""Smallest departure of an accelerometer's 1-s mean from its running median taken as
+motion [mg] (about 1.1° of tilt)."""
+ROTATING_DEG_S = 20.0
+"""A gyro whose median rate exceeds this is turning, not drifting [°/s]."""
+MAX_MOVING_SHARE = 0.02
+"""Moving more than this share of the time is refused without ``--allow-motion``."""
+ARDUPILOT_MIN_SPAN_C = 10.0
+"""ArduPilot's temperature-calibration learning needs at least this sweep [°C]."""
+DEG_H_PER_DEG_S = 3600.0
+
+
+@dataclass(frozen=True)
+class AdequacyTest:
+    """One test: its figure and threshold (in ``unit``), verdict ``pass`` | ``warn`` |
+    ``fail`` | ``n/a``, the option that overrides a failure (None: it cannot be
+    overridden) and a one-line message."""
+
+    name: str
+    figure: float | None
+    threshold: float | None
+    unit: str
+    verdict: str
+    override: str | None
+    message: str
+
+    def to_dict(self) -> dict[str, Any]:
+        def num(v: float | None) -> float | None:
+            return None if v is None or not math.isfinite(v) else float(v)
+
+        return {
+            "name": self.name,
+            "figure": num(self.figure),
+            "threshold": num(self.threshold),
+            "unit": self.unit,
+            "verdict": self.verdict,
+            "override": self.override,
+            "message": self.message,
+        }
+
+
+@dataclass(frozen=True)
+class Adequacy:
+    """The record of every test and the overrides the user gave."""
+
+    tests: tuple[AdequacyTest, ...]
+    overrides: tuple[str, ...] = ()
+    subject: str = ""
+
+    @property
+    def failed(self) -> tuple[AdequacyTest, ...]:
+        return tuple(t for t in self.tests if t.verdict == "fail")
+
+    @property
+    def refused(self) -> tuple[AdequacyTest, ...]:
+        """Failed tests that no given override allows."""
+        return tuple(
+            t for t in self.failed if t.override is None or t.override not in self.overrides
+        )
+
+    @property
+    def verdict(self) -> str:
+        if self.refused:
+            return "fail"
+        return "overridden" if self.failed else "pass"
+
+    def to_dict(self) -> dict[str, Any]:
+        return {
+            "verdict": self.verdict,
+            "overrides": list(self.overrides),
+            "tests": [t.to_dict() for t in self.tests],
+        }
+
+    def merged(self, other: Adequacy) -> Adequacy:
+        return Adequacy((*self.tests, *other.tests), self.overrides, self.subject)
+
+    def enforce(self) -> Adequacy:
+        """Refuse (:class:`ThermocalInputError`, exit 2) what is not supported and not
+        overridden, naming every missing thing; warn for overridden failures and for
+        ``warn`` verdicts.  Returns ``self``."""
+        refused = self.refused
+        if refused:
+            hints = sorted({t.override for t in refused if t.override})
+            hint = (
+                f" (to fit anyway, knowingly: {' '.join(hints)})"
+                if hints and all(t.override for t in refused)
+                else ""
+            )
+            raise ThermocalInputError(
+                "the data cannot support this fit: "
+                + "; ".join(t.message for t in refused)
+                + hint
+            )
+        for t in self.failed:
+            warnings.warn(
+                f"{t.message} — fitted anyway ({t.override}): do not trust this "
+                "calibration beyond what the data cover",
+                ThermocalWarning,
+                stacklevel=2,
+            )
+        for t in self.tests:
+            if t.verdict == "warn":
+                warnings.warn(t.message, ThermocalWarning, stacklevel=2)
+        return self
+
+
+def from_dict(d: Any) -> dict[str, Any] | None:
+    """A stored record, checked for shape (None when absent or malformed)."""
+    if not isinstance(d, dict) or not isinstance(d.get("tests"), list):
+        return None
+    return d
+
+
+# --- the tests ---------------------------------------------------------------------------
+
+
+def _span(temps: FloatArray) -> tuple[float, float]:
+    t = temps[np.isfinite(temps)]
+    if t.size == 0:
+        return math.nan, math.nan
+    if t.size < 1000:
+        return float(t.min()), float(t.max())
+    lo, hi = np.percentile(t, [0.1, 99.9])
+    return float(lo), float(hi)
+
+
+def samples_test(n_samples: int, n_coefficients: int, name: str = "") -> AdequacyTest:
+    """n / p against :data:`MIN_SAMPLES_PER_COEFFICIENT` (n ≤ p: refused outright)."""
+    ratio = n_samples / max(n_coefficients, 1)
+    if n_samples <= n_coefficients:
+        return AdequacyTest(
+            "samples_per_coefficient",
+            ratio,
+            MIN_SAMPLES_PER_COEFFICIENT,
+            "samples",
+            "fail",
+            None,
+            f"{name + ': ' if name else ''}{n_samples} samples for {n_coefficients} "
+            "coefficients: the fit would pass through the data; record more",
+        )
+    ok = ratio >= MIN_SAMPLES_PER_COEFFICIENT
+    return AdequacyTest(
+        "samples_per_coefficient",
+        ratio,
+        MIN_SAMPLES_PER_COEFFICIENT,
+        "samples",
+        "pass" if ok else "fail",
+        ALLOW_NARROW,
+        f"{name + ': ' if name else ''}{n_samples} samples for {n_coefficients} "
+        f"coefficients ({ratio:.3g} each; "
+        f"{MIN_SAMPLES_PER_COEFFICIENT:g} needed)",
+    )
+
+
+def temperature_tests(
+    temps: FloatArray, name: str, order: int, *, unit: str = "°C"
+) -> list[AdequacyTest]:
+    """Span, distinct temperatures and coverage of the ends of one temperature column
+    (all runs together) for a polynomial of ``order`` in it."""
+    if unit != "°C":
+        return [
+            AdequacyTest(
+                "temperature_span",
+                None,
+                None,
+                unit,
+                "n/a",
+                None,
+                f"{name}: temperatures in raw {unit} without a conversion: span not judged",
+            )
+        ]
+    t = temps[np.isfinite(temps)]
+    lo, hi = _span(t)
+    span = hi - lo if t.size else 0.0
+    need = MIN_SPAN_PER_ORDER_C * max(order, 1)
+    out = [
+        AdequacyTest(
+            "temperature_span",
+            span,
+            need,
+            "°C",
+            "pass" if span >= need else "fail",
+            ALLOW_NARROW,
+            (
+                f"{name} is constant at {lo:.2f} °C"
+                if span == 0
+                else f"{name} spans {span:.3g} °C ({lo:.2f}…{hi:.2f} °C)"
+            )
+            + f"; a model of order {order} in temperature needs ≥ {need:g} °C: record a "
+            "wider sweep",
+        )
+    ]
+    width = max(span / N_SPAN_BINS, MIN_BIN_WIDTH_C)
+    per_bin = max(1, min(MIN_SAMPLES_PER_BIN, t.size // (3 * N_SPAN_BINS)))
+    if t.size and span > 0:
+        idx = np.clip(np.floor((t - lo) / width).astype(np.int64), 0, None)
+        counts = np.bincount(idx[(t >= lo) & (t <= hi)])
+        distinct = int(np.count_nonzero(counts >= per_bin))
+    else:
+        distinct = 1 if t.size else 0
+    if distinct < order + 1:
+        verdict, override = "fail", None
+        msg = (
+            f"{name} holds {distinct} distinct temperature(s) (bins of {width:.2g} °C with "
+            f"≥ {per_bin} samples); a polynomial of order {order} needs "
+            f"≥ {order + 1}: add soak temperatures or fit a lower order"
+        )
+    elif distinct == order + 1:
+        verdict, override = "warn", None
+        msg = (
+            f"{name} holds {distinct} distinct temperatures for a polynomial of order "
+            f"{order}: the fit passes through them and cannot show whether the shape is "
+            "right; add a temperature"
+        )
+    else:
+        verdict, override, msg = "pass", None, f"{name}: {distinct} distinct temperatures"
+    out.append(
+        AdequacyTest(
+            "distinct_temperatures",
+            float(distinct),
+            float(order + 1),
+            "bins",
+            verdict,
+            override,
+            msg,
+        )
+    )
+    if t.size and span > 0:
+        low = float(np.count_nonzero(t <= lo + END_FRACTION * span)) / t.size * 100.0
+        high = float(np.count_nonzero(t >= hi - END_FRACTION * span)) / t.size * 100.0
+        share = min(low, high)
+        end = "lowest" if low <= high else "highest"
+        out.append(
+            AdequacyTest(
+                "range_ends",
+                share,
+                MIN_END_SHARE_PCT,
+                "%",
+                "pass" if share >= MIN_END_SHARE_PCT else "warn",
+                None,
+                f"{name}: the {end} tenth of the range holds {share:.2g} % of the samples: "
+                "the model's end there rests on few samples (soak longer at the ends)",
+            )
+        )
+    return out
+
+
+def temperature_rate_c_per_min(
+    time_s: FloatArray, temps: FloatArray, interval_s: float = RATE_INTERVAL_S
+) -> FloatArray:
+    """Ṫ = (T(t) − T(t − Δ)) / Δ × 60 [°C/min] with Δ = ``interval_s`` (samples closer than
+    Δ to the start are left out)."""
+    if time_s.size < 2:
+        return np.empty(0)
+    keep = time_s >= time_s[0] + interval_s
+    if not keep.any():
+        return np.empty(0)
+    back = np.interp(time_s[keep] - interval_s, time_s, temps)
+    return (temps[keep] - back) / interval_s * 60.0  # type: ignore[no-any-return]
+
+
+def rate_test(rates_c_per_min: FloatArray, name: str) -> AdequacyTest:
+    """The Ṫ span (1–99 percentiles) against :data:`MIN_RATE_SPAN_C_PER_MIN`."""
+    r = rates_c_per_min[np.isfinite(rates_c_per_min)]
+    if r.size == 0:
+        span, lo, hi = 0.0, math.nan, math.nan
+    else:
+        lo, hi = (float(v) for v in np.percentile(r, [1.0, 99.0]))
+        span = hi - lo
+    ok = span >= MIN_RATE_SPAN_C_PER_MIN
+    return AdequacyTest(
+        "rate_range",
+        span,
+        MIN_RATE_SPAN_C_PER_MIN,
+        "°C/min",
+        "pass" if ok else "fail",
+        ALLOW_NARROW,
+        f"{name}: Ṫ spans {span:.3g} °C/min ({lo:.3g}…{hi:.3g}); the model's Ṫ terms need "
+        f"≥ {MIN_RATE_SPAN_C_PER_MIN:g} °C/min (ramps up and down) or a model without them",
+    )
+
+
+def firmware_test(span_c: float, firmware: str, minimum_c: float) -> AdequacyTest:
+    ok = span_c >= minimum_c
+    return AdequacyTest(
+        "firmware_minimum",
+        span_c,
+        minimum_c,
+        "°C",
+        "pass" if ok else "fail",
+        ALLOW_NARROW,
+        f"the sweep spans {span_c:.3g} °C; {firmware}'s temperature calibration needs "
+        f"≥ {minimum_c:g} °C",
+    )
+
+
+@dataclass(frozen=True)
+class Motion:
+    """What :func:`stillness` found: the share of moving time, the largest departure [the
+    given unit], the threshold used, the bumps (start, end [s], peak) and the steps (time
+    [s], size [the given unit], the angle between the levels before and after [°] or None
+    without a level to measure it by), and the median level (its norm)."""
+
+    share: float
+    peak: float
+    threshold: float
+    episodes: list[tuple[float, float, float]] = field(default_factory=list)
+    rotating: float | None = None
+    steps: list[tuple[float, float, float | None]] = field(default_factory=list)
+
+
+MAX_PER_BLOCK = 64
+"""Samples a block's median is taken over (longer blocks are decimated evenly)."""
+
+
+def _block_stats(
+    time_s: FloatArray, values: FloatArray, block_s: float
+) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
+    """Per occupied block: start time [s], samples, median (n_blocks, m), and the sensor's
+    own noise σ_w per column (1.4826 × the median absolute deviation from the block
+    medians, all blocks together).  Medians, so that isolated spikes are not motion; long
+    blocks are decimated to about :data:`MAX_PER_BLOCK` samples (a median needs no more)."""
+    idx = np.floor((time_s - time_s[0]) / block_s).astype(np.int64)
+    per_block = time_s.size / max(1, int(idx[-1] - idx[0]) + 1)
+    step = max(1, int(per_block // MAX_PER_BLOCK))
+    if step > 1:
+        idx, values = idx[::step], values[::step]
+    uniq, starts, counts = np.unique(idx, return_index=True, return_counts=True)
+    m = values.shape[1]
+    med = np.empty((uniq.size, m))
+    sigma = np.empty(m)
+    lo_i = starts + (counts - 1) // 2
+    hi_i = starts + counts // 2
+    inv = np.repeat(np.arange(uniq.size), counts)
+    for j in range(m):
+        sv = values[np.lexsort((values[:, j], idx)), j]  # idx is sorted: blocks stay in place
+        med[:, j] = 0.5 * (sv[lo_i] + sv[hi_i])
+        sigma[j] = 1.4826 * float(np.median(np.abs(values[:, j] - med[inv, j])))
+    return time_s[0] + uniq * block_s, counts.astype(np.float64), med, sigma
+
+
+def _window_medians(t_block: FloatArray, x: FloatArray, window_s: float) -> FloatArray:
+    """Per block, the medians of the block values in [t − w/2, t + w/2] (centre), in
+    [t − w/2, t) (before) and in (t, t + w/2] (after): shape (3, n_blocks, m).  Time-based,
+    so gaps and bursts are handled; a sliding median filter when the blocks are regular."""
+    n = t_block.size
+    steps = np.diff(t_block)
+    if n > 2 and np.allclose(steps, steps[0]):
+        from scipy.ndimage import median_filter
+
+        h = max(1, round(window_s / 2 / steps[0])) | 1
+        c = np.column_stack(
+            [median_filter(x[:, j], size=2 * h + 1, mode="nearest") for j in range(x.shape[1])]
+        )
+        side = np.column_stack(
+            [median_filter(x[:, j], size=h, mode="nearest") for j in range(x.shape[1])]
+        )
+        # h odd: the side window centred at b - 1 - h // 2 ends at b - 1 (before the block),
+        # centred at b + 1 + h // 2 it starts at b + 1 (after it)
+        before_i = np.clip(np.arange(n) - 1 - h // 2, 0, n - 1)
+        after_i = np.clip(np.arange(n) + 1 + h // 2, 0, n - 1)
+        before, after = side[before_i], side[after_i]
+        before[0], after[-1] = x[0], x[-1]
+        return np.stack([c, before, after])
+    half = window_s / 2
+    lo = np.searchsorted(t_block, t_block - half, side="left")
+    hi = np.searchsorted(t_block, t_block + half, side="right")
+    me = np.arange(n)
+    c = np.array([np.median(x[a:b], axis=0) for a, b in zip(lo, hi, strict=True)])
+    before = np.array(
+        [np.median(x[a:b], axis=0) if b > a else x[b] for a, b in zip(lo, me, strict=True)]
+    )
+    after = np.array(
+        [np.median(x[a:b], axis=0) if b > a else x[a - 1] for a, b in zip(me + 1, hi, strict=True)]
+    )
+    return np.stack([c, before, after])
+
+
+def _runs_of(mask: npt.NDArray[np.bool_]) -> list[tuple[int, int]]:
+    edges = np.flatnonzero(np.diff(np.r_[0, mask.astype(np.int8), 0]))
+    return [(int(a), int(b)) for a, b in zip(edges[::2], edges[1::2], strict=True)]
+
+
+def stillness(
+    time_s: npt.ArrayLike, values: npt.ArrayLike, floor: float, *, k_sigma: float = STILL_K_SIGMA
+) -> Motion:
+    """Tell motion from thermal drift.
+
+    Blocks of ``max(1 s, 10 samples)``; each block's median ``m_b`` (a vector for a triad;
+    a median, so that isolated spikes are not motion).  Slow thermal drift changes little
+    within :data:`STILL_WINDOW_S`; motion does not:
+
+    * a **bump** (a turn and back, a knock): ``|m_b − M_b|`` with ``M_b`` the median of the
+      block medians within ±w/2;
+    * a **step** (the board re-oriented, a bias jump): ``2 |M_b − (B_b + A_b)/2|`` with
+      ``B_b``/``A_b`` the medians over w/2 before and after the block — a step moves the
+      centre median to one side, a ramp keeps it half-way — counted once per step (the
+      middle of its plateau), with its size ``|A_b − B_b|`` and the angle between the
+      levels before and after.
+
+    Either beyond ``max(floor, 1.25 k σ_w / √n_b)`` is motion, with σ_w the sensor's own
+    noise (robust scatter about the block medians, combined over the axes) and n_b the
+    samples per block (the median of n white samples scatters 1.25 σ/√n).  ``values`` (n,)
+    or (n, m) in the unit of ``floor``."""
+    t = np.asarray(time_s, dtype=np.float64)
+    v = np.asarray(values, dtype=np.float64)
+    if v.ndim == 1:
+        v = v[:, None]
+    ok = np.isfinite(t) & np.all(np.isfinite(v), axis=1)
+    t, v = t[ok], v[ok]
+    if t.size < 20:
+        return Motion(0.0, 0.0, floor)
+    dt = float(np.median(np.diff(t)))
+    block_s = max(STILL_BLOCK_S, 10.0 * dt)
+    tb, cnt, meds, sigma = _block_stats(t, v, block_s)
+    centre, before, after = _window_medians(tb, meds, max(STILL_WINDOW_S, 30.0 * block_s))
+    dev = np.sqrt(np.sum((meds - centre) ** 2, axis=1))
+    # a step moves the centre median to one side; a ramp (or any smooth drift) keeps it
+    # half-way between the medians before and after
+    jump = 2.0 * np.sqrt(np.sum((centre - 0.5 * (before + after)) ** 2, axis=1))
+    sigma_w = float(np.sqrt(np.sum(sigma**2)))
+    n_b = float(np.median(cnt))
+    threshold = max(floor, k_sigma * 1.25 * sigma_w / math.sqrt(max(n_b, 1.0)))
+    moving = dev > threshold
+    episodes = [
+        (float(tb[a]), float(tb[b - 1] + block_s), float(dev[a:b].max()))
+        for a, b in _runs_of(moving)
+    ]
+    steps: list[tuple[float, float, float | None]] = []
+    for a, b in _runs_of(jump > threshold):
+        top = np.flatnonzero(jump[a:b] >= 0.95 * jump[a:b].max())
+        i = a + int(top[top.size // 2])  # the middle of the plateau: where the level changed
+        moving[i] = True
+        u, w = before[i], after[i]
+        nu, nw = float(np.linalg.norm(u)), float(np.linalg.norm(w))
+        angle = (
+            math.degrees(math.acos(max(-1.0, min(1.0, float(u @ w) / (nu * nw)))))
+            if min(nu, nw) > 10.0 * threshold and v.shape[1] > 1
+            else None
+        )
+        steps.append((float(tb[i]), float(np.linalg.norm(w - u)), angle))
+    share = float(np.sum(cnt[moving]) / np.sum(cnt))
+    level = float(np.linalg.norm(np.median(meds, axis=0)))
+    peak = float(max(dev.max(), jump.max()))
+    return Motion(share, peak, threshold, episodes, level, steps)
+
+
+def stillness_test(
+    time_s: npt.ArrayLike,
+    values: npt.ArrayLike,
+    kind: str,
+    name: str,
+    *,
+    unit_factor: float = 1.0,
+    unit: str | None = None,
+) -> AdequacyTest:
+    """:func:`stillness` of a gyro (``values`` [°/h]) or accelerometer ([mg]) channel or
+    triad, as a test; ``unit_factor``/``unit`` express the figures in the data's unit
+    (figure × unit_factor).  Refused (``--allow-motion``): moving more than
+    :data:`MAX_MOVING_SHARE` of the time, a gyro turning at more than
+    :data:`ROTATING_DEG_S`, an accelerometer whose level stepped (the board was
+    re-oriented: gravity moved between the axes).  Warned: shorter bumps, a gyro's step."""
+    if kind not in ("gyro", "accel"):
+        return AdequacyTest(
+            "stillness", None, None, "", "n/a", None,
+            f"{name}: not a gyro or accelerometer unit: stillness not judged",
+        )  # fmt: skip
+    canonical = "deg/h" if kind == "gyro" else "mg"
+    floor = MOTION_FLOOR_DEG_S * DEG_H_PER_DEG_S if kind == "gyro" else MOTION_FLOOR_MG
+    mot = stillness(time_s, values, floor)
+    shown = unit or canonical
+
+    def f(x: float) -> str:
+        return f"{x * unit_factor:.3g} {shown}"
+
+    eps = ", ".join(f"{a:.1f}–{b:.1f} s (up to {f(p)})" for a, b, p in mot.episodes[:4])
+    more = f" and {len(mot.episodes) - 4} more" if len(mot.episodes) > 4 else ""
+    steps = ", ".join(
+        f"at {ts:.1f} s by {f(size)}" + (f" ({ang:.1f}°)" if ang is not None else "")
+        for ts, size, ang in mot.steps[:4]
+    )
+    rot = mot.rotating if kind == "gyro" else None
+    pct = mot.share * 100.0
+    fig, thr = pct, MAX_MOVING_SHARE * 100.0
+    if rot is not None and rot > ROTATING_DEG_S * DEG_H_PER_DEG_S:
+        return AdequacyTest(
+            "stillness", rot * unit_factor, ROTATING_DEG_S * DEG_H_PER_DEG_S * unit_factor,
+            shown, "fail", ALLOW_MOTION,
+            f"{name} turns at {f(rot)} (median): a thermal calibration needs the sensor still",
+        )  # fmt: skip
+    if mot.share > MAX_MOVING_SHARE:
+        verdict = "fail"
+        msg = (
+            f"{name}: the sensor moved during {pct:.3g} % of the record (departures from its "
+            f"slow drift up to {f(mot.peak)}, threshold {f(mot.threshold)}): "
+            f"{eps}{more}; a thermal calibration needs it still"
+        )
+    elif kind == "accel" and mot.steps:
+        verdict = "fail"
+        msg = (
+            f"{name}: the gravity direction changed (the board was moved) {steps}: the "
+            "levels before and after differ by more than any thermal drift; record the sweep "
+            "without touching the board"
+        )
+    elif mot.episodes or mot.steps:
+        verdict = "warn"
+        what = [f"moved at {eps}{more}"] if mot.episodes else []
+        what += [f"stepped {steps} (a bias jump or a re-orientation)"] if mot.steps else []
+        msg = f"{name}: the sensor {' and '.join(what)} ({pct:.2g} % of the record)"
+    else:
+        verdict = "pass"
+        msg = (
+            f"{name}: still (largest departure from the slow drift {f(mot.peak)}, "
+            f"threshold {f(mot.threshold)})"
+        )
+    return AdequacyTest("stillness", fig, thr, "% moving", verdict, ALLOW_MOTION, msg)
+
+
+# --- what a model needs ----------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class Needs:
+    """What a model asks of the data: its polynomial order in T per temperature column
+    (0: the column is not used in T), the number of coefficients and whether Ṫ terms
+    are fitted (per column)."""
+
+    order: dict[str, int]
+    n_coefficients: int
+    rate: tuple[str, ...] = ()
+
+
+def judge(
+    needs: Needs,
+    runs_time_s: Sequence[FloatArray],
+    runs_temps: Sequence[FloatArray],
+    temp_names: Sequence[str],
+    *,
+    signals: Sequence[FloatArray] | None = None,
+    kind: str | None = None,
+    name: str = "",
+    temperature_unit: str = "°C",
+    unit_factor: float = 1.0,
+    unit: str | None = None,
+    overrides: Iterable[str] = (),
+    rate_interval_s: float = RATE_INTERVAL_S,
+) -> Adequacy:
+    """Every test for one channel fitted on ``runs`` (times [s], temperatures (n, k) in
+    ``temp_names`` order, signals in the canonical unit of ``kind``)."""
+    n = int(sum(t.size for t in runs_time_s))
+    tests = [samples_test(n, needs.n_coefficients, name)]
+    for j, tn in enumerate(temp_names):
+        order = needs.order.get(tn, 0)
+        if order <= 0 and tn not in needs.rate:
+            continue
+        col = np.concatenate([np.asarray(T, dtype=np.float64)[:, j] for T in runs_temps])
+        if order > 0:
+            tests.extend(temperature_tests(col, tn, order, unit=temperature_unit))
+        if tn in needs.rate:
+            rates = np.concatenate(
+                [
+                    temperature_rate_c_per_min(
+                        np.asarray(ts, dtype=np.float64),
+                        np.asarray(T, dtype=np.float64)[:, j],
+                        rate_interval_s,
+                    )
+                    for ts, T in zip(runs_time_s, runs_temps, strict=True)
+                ]
+            )
+            tests.append(rate_test(rates, tn))
+    if signals is not None and kind is not None:
+        per_run = [
+            stillness_test(
+                ts,
+                s,
+                kind,
+                f"{name} (run {i + 1})" if len(signals) > 1 else name,
+                unit_factor=unit_factor,
+                unit=unit,
+            )
+            for i, (ts, s) in enumerate(zip(runs_time_s, signals, strict=True))
+        ]
+        tests.append(_worst_stillness(per_run))
+    return Adequacy(tuple(tests), tuple(overrides), name)
+
+
+def _worst_stillness(tests: list[AdequacyTest]) -> AdequacyTest:
+    rank = {"fail": 3, "warn": 2, "pass": 1, "n/a": 0}
+    return max(tests, key=lambda t: (rank[t.verdict], t.figure or 0.0))
+
+
+def check_for_firmware(record: Any, where: str) -> None:
+    """Refuse (exit 2) firmware output from a model whose adequacy failed without an
+    override at fit time, naming the failed test; warn when it was overridden; say nothing
+    for a model that passed.  A model file without a record (written before the check
+    existed) gets a warning."""
+    rec = from_dict(record)
+    if rec is None:
+        warnings.warn(
+            f"{where}: the calibration carries no adequacy record (written before thermocal "
+            "judged its data): refit it to have the sweep checked",
+            ThermocalWarning,
+            stacklevel=2,
+        )
+        return
+    failed = [t for t in rec["tests"] if isinstance(t, dict) and t.get("verdict") == "fail"]
+    overrides = set(rec.get("overrides") or [])
+    refused = [t for t in failed if t.get("override") not in overrides or not t.get("override")]
+    if refused:
+        raise ThermocalInputError(
+            f"{where}: its data failed the adequacy check ("
+            + "; ".join(f"{t.get('name')}: {t.get('message')}" for t in refused)
+            + "): no firmware parameters from it"
+        )
+    if failed:
+        warnings.warn(
+            f"{where}: fitted with {', '.join(sorted(overrides))} although "
+            + "; ".join(f"{t.get('name')} failed" for t in failed)
+            + ": these firmware parameters rest on data that do not support them",
+            ThermocalWarning,
+            stacklevel=2,
+        )
+
+
+__all__ = [
+    "ALLOW_MOTION",
+    "ALLOW_NARROW",
+    "Adequacy",
+    "AdequacyTest",
+    "Motion",
+    "Needs",
+    "check_for_firmware",
+    "firmware_test",
+    "judge",
+    "overrides_of",
+    "rate_test",
+    "samples_test",
+    "stillness",
+    "stillness_test",
+    "temperature_rate_c_per_min",
+    "temperature_tests",
+]
