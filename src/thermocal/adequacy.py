@@ -173,9 +173,7 @@ class Adequacy:
                 else ""
             )
             raise ThermocalInputError(
-                "the data cannot support this fit: "
-                + "; ".join(t.message for t in refused)
-                + hint
+                "the data cannot support this fit: " + "; ".join(t.message for t in refused) + hint
             )
         for t in self.failed:
             warnings.warn(
