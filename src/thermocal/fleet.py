@@ -708,11 +708,38 @@ def config_inputs(config: FleetConfig) -> list[str]:
     return out
 
 
+def _link_chain(path: Path) -> list[Path]:
+    """``path`` (absolute, not resolved) and every path its symbolic links lead through
+    (``out/fleet.html`` → ``/proc/self/fd/1`` → ``/dev/pts/0``…), the resolved one last."""
+    chain = [Path(os.path.abspath(path))]
+    p = chain[0]
+    for _ in range(40):
+        # the link of the first component that is one (a folder or the file itself)
+        hop = None
+        for i in range(1, len(p.parts) + 1):
+            head = Path(*p.parts[:i])
+            if head.is_symlink():
+                try:
+                    target = os.readlink(head)
+                except OSError:
+                    break
+                hop = Path(os.path.normpath(head.parent / target)).joinpath(*p.parts[i:])
+                break
+        if hop is None or hop in chain:
+            break
+        chain.append(hop)
+        p = hop
+    chain.append(path.resolve())
+    return chain
+
+
 def _special(path: Path) -> str | None:
-    """Why ``path`` (resolved) is no place for an output, or None."""
-    for root in SPECIAL_ROOTS:
-        if path == root or path.is_relative_to(root):
-            return f"it is under {root}, not a storage file system"
+    """Why ``path`` is no place for an output (it or a link it leads through lies under
+    :data:`SPECIAL_ROOTS`, or it is a FIFO, a device or a socket), or None."""
+    for p in _link_chain(path):
+        for root in SPECIAL_ROOTS:
+            if p == root or p.is_relative_to(root):
+                return f"it is under {root}, not a storage file system"
     try:
         mode = os.stat(path).st_mode
     except OSError:
@@ -752,7 +779,7 @@ def check_outputs(config: FleetConfig, out_dir: str | Path) -> None:
 
     def is_input(target: Path, kind: str) -> None:
         r = target.resolve()
-        why = _special(r)
+        why = _special(target)
         if why is not None:
             refuse(target, why)
         for i in inputs:
