@@ -5,6 +5,7 @@ in mg), a still sensor in a chamber swept over 70 °C (modelling) or cycled 5–
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -46,7 +47,9 @@ def write_run(path: Path, seed: int, *, noise_scale: float = 1.0, validation: bo
     return Run(path, pd.read_csv(path))  # the values as the file holds them
 
 
-def config_text(units: dict[str, tuple[str, str | None]], limits: str = "", extra: str = "") -> str:
+def config_text(
+    units: Mapping[str, tuple[str, str | None]], limits: str = "", extra: str = ""
+) -> str:
     """A fleet configuration: poly order 1 on every channel of :data:`CHANNELS`,
     ``units``: id → (modelling file, validation file or None), relative to the config."""
     signal = ", ".join(f'"{c}"' for c in CHANNELS)

@@ -77,7 +77,7 @@ def test_changed_data_options_and_version_redo_exactly_the_units_concerned(
     T, x = frame[TEMP].to_numpy(), frame[GX].to_numpy()
     assert _slope(out, "U2") == pytest.approx(np.polyfit(T, x, 1)[0], rel=1e-7)
     summary = pd.read_csv(out / "summary.csv", keep_default_na=False).set_index("id")
-    assert "U2_mod.csv changed" in summary.loc["U2", "redone"]
+    assert "U2_mod.csv changed" in str(summary.loc["U2", "redone"])
     assert summary.loc["U1", "redone"] == "" and summary.loc["U3", "redone"] == ""
     html = (out / "fleet.html").read_text(encoding="utf-8")
     assert "U2_mod.csv changed" in html.split('id="redone"')[1].split("</table>")[0]
@@ -186,6 +186,7 @@ def test_an_interrupted_rerun_leaves_stale_units_pending(
     assert rows.loc["U1", "status"] == "ok"
     for uid in ("U2", "U3"):
         assert rows.loc[uid, "status"] == "pending"
-        assert "to be redone" in rows.loc[uid, "error"] and "[fit]" in rows.loc[uid, "error"]
+        error = str(rows.loc[uid, "error"])
+        assert "to be redone" in error and "[fit]" in error
     res = fleet.run_fleet(cfg, out)
     assert sorted(res.ran) == ["U2", "U3"] and res.skipped == ("U1",)

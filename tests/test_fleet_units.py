@@ -110,14 +110,14 @@ def test_every_figure_in_the_channels_own_unit(
             assert csv.loc[uid, f"{col}.unit"] == unit
             # the slope written (truth), within the noise of 3000 samples over 70 °C
             _bias, slope, sigma = CHANNELS[col]
-            se = 3 * sigma / (np.std(np.linspace(-10, 60, 3000)) * math.sqrt(3000))
+            se = 3 * sigma / (float(np.std(np.linspace(-10, 60, 3000))) * math.sqrt(3000))
             assert fig["coefficients"]["T1"] == pytest.approx(slope, abs=5 * se)
             # the report shows the same numbers (4 significant digits, 6 for coefficients)
             assert f"{e['rms_residual']:.4g}" in html
             assert f"{e['T1']:.6g}" in html
     assert csv.loc["U1", "pass"] and not csv.loc["U2", "pass"]
     assert list(pq["pass"]) == [True, False]
-    reasons = csv.loc["U2", "fail_reasons"]
+    reasons = str(csv.loc["U2", "fail_reasons"])
     assert "gx [deg/s].rms_residual" in reasons and "deg/s fails" in reasons
     assert "gy [rad/s].rms_after" in reasons and "rad/s fails" in reasons
     assert "az [mg].rms_residual" in reasons
