@@ -12,8 +12,25 @@ entry point (so a unit gets exactly what the two commands give, options, units a
 included, without a process start-up per unit), in a private temporary directory; the task
 returns the files' bytes and the figures.  The driver (:func:`run_fleet`) writes them under
 ``DIR/units/<id>/`` through a temporary directory renamed into place, ``unit.json`` last, so
-a unit directory either is complete or does not exist.  A rerun skips the units whose
-``unit.json`` says ``ok`` (failed ones are tried again); ``force`` redoes them all.
+a unit directory either is complete or does not exist.
+
+Figures are in each channel's data unit (the unit of its column as given: °/s, rad/s, mg,
+g, m/s²…; :func:`channel_figures`), not the model's internal canonical unit (°/h, mg):
+``unit.json``, the summary, the report and the limits all use it.  Raw counts converted
+by a scale factor stay in the physical unit the factor gives (as ``thermocal validate``).
+
+A rerun skips a unit only when its ``unit.json`` says ``ok`` and it is still right
+(:func:`stale_reasons`): the same input contents (SHA-256 of the modelling and validation
+files and their ``.meta.json`` sidecars), the same options as they apply to it (``[fit]``,
+``[validate]`` if it has a validation run, ``[limits]``), the same thermocal version, and a
+folder that verifies (every file's recorded SHA-256, ``calibration.json`` through the model
+loader's checksum check).  Otherwise it is redone and the reason is reported (``redone``);
+``force`` redoes them all.
+
+Inputs are sacred (:func:`check_outputs`): before anything is written, the run is refused
+when a path it would write, replace or delete is, or contains, one of its inputs (the
+configuration, the data files and their sidecars; compared by resolved path and by inode),
+or is a special file (FIFO, device, ``/proc``, ``/dev``, ``/sys``).
 
 Where the tasks run: in this process (one worker), in local worker processes (BLAS held to one
 thread each: the fits already are), or on a Dask distributed cluster (``scheduler``) — the
@@ -27,6 +44,7 @@ and ``DIR/fleet.html`` (:mod:`thermocal.report.fleet`).
 from __future__ import annotations
 
 import contextlib
+import hashlib
 import io
 import json
 import math
@@ -34,6 +52,7 @@ import os
 import re
 import secrets
 import shutil
+import stat
 import tempfile
 import threading
 import time
@@ -48,7 +67,9 @@ from thermocal.errors import ThermocalInputError
 UNIT_FILE = "unit.json"
 """Written last in a unit's directory: its presence with ``status: ok`` marks the unit done."""
 UNIT_FORMAT = "thermocal-fleet-unit"
-UNIT_VERSION = 1
+UNIT_VERSION = 2
+"""2: ``inputs`` (SHA-256 per file), ``options``, ``thermocal_version``, ``files`` with their
+SHA-256, figures in the data's unit."""
 CALIBRATION_FILE = "calibration.json"
 VALIDATION_FILE = "validation.json"
 
@@ -67,6 +88,8 @@ VALIDATION_FIGURES = (
 )
 """Per-channel figures of a validation (``thermocal validate --json``), in the summary."""
 FIGURES = FIT_FIGURES + VALIDATION_FIGURES
+_UNITLESS = frozenset({"r", "condition_number", "n_coefficients", "n_samples"})
+"""Figures without a unit (every other figure is in the channel's data unit)."""
 
 _ID = re.compile(r"^[A-Za-z0-9][A-Za-z0-9._-]{0,127}$")
 
@@ -309,6 +332,8 @@ class UnitOutcome:
     files: dict[str, bytes] = field(default_factory=dict)
     seconds: float = 0.0
     worker: str = ""
+    figures: dict[str, dict[str, Any]] = field(default_factory=dict)
+    """Per channel, in the channel's data unit (:func:`channel_figures`)."""
 
 
 _CLI_LOCK = threading.Lock()
@@ -368,41 +393,121 @@ def run_unit(task: UnitTask) -> UnitOutcome:
                 return outcome
             outcome.validation = json.loads(out)
             outcome.files[VALIDATION_FILE] = out.encode("utf-8")
+        try:
+            outcome.figures = channel_figures(cal, outcome.validation)
+        except ThermocalInputError as exc:  # the calibration just written does not load
+            outcome.error = one_line_error(exc)
+            outcome.seconds = time.perf_counter() - t0
+            return outcome
     outcome.status = "ok"
     outcome.seconds = time.perf_counter() - t0
     return outcome
 
 
-def _per_channel(obj: Mapping[str, Any] | None, default: str) -> dict[str, Mapping[str, Any]]:
-    """``{"channels": {name: {...}}}`` or one channel's flat dict → ``{name: {...}}``."""
+def _per_channel(
+    obj: Mapping[str, Any] | None, names: Sequence[str]
+) -> dict[str, Mapping[str, Any]]:
+    """``{"channels": {name: {...}}}`` or one channel's flat dict (the only channel of
+    ``names``) → ``{name: {...}}``."""
     if not obj:
         return {}
     chans = obj.get("channels")
     if isinstance(chans, Mapping):
         return {str(k): v for k, v in chans.items() if isinstance(v, Mapping)}
-    return {default: obj}
+    return {names[0]: obj} if len(names) == 1 else {}
 
 
-def unit_figures(outcome: UnitOutcome, signal: str) -> dict[str, dict[str, Any]]:
-    """Per channel: unit, the fit and validation figures, and the fitted coefficients
-    (``{term: value}``, in the channel's model unit)."""
-    fits = _per_channel(outcome.fit, signal)
-    vals = _per_channel(outcome.validation, signal)
+def one_line_error(exc: BaseException) -> str:
+    return " ".join(str(exc).split())
+
+
+def shown_unit(model_unit: str, data_unit: str) -> tuple[str, float]:
+    """The unit a channel's figures are shown in and the factor taking a value in the
+    model's unit to it: ``(data_unit, f)`` with ``x[data_unit] = f · x[model_unit]``
+    (:func:`thermocal.units.convert`, e.g. 1/3600 from °/h to °/s) when both are physical
+    units of one kind; otherwise (raw counts, made physical by a scale factor) the model's
+    own unit and 1."""
+    from thermocal import units
+    from thermocal.errors import UnitError
+
+    try:
+        mu, du = units.normalize_signal_unit(model_unit), units.normalize_signal_unit(data_unit)
+        kind = units.signal_kind(mu)
+        if kind != "raw" and units.signal_kind(du) == kind:
+            return du, float(units.convert(1.0, mu, du))
+    except UnitError:
+        pass
+    return model_unit, 1.0
+
+
+def _convert_unit_label(unit: str, model_unit: str, shown: str) -> str | None:
+    """``deg/h/degC^2`` → ``deg/s/degC^2``: the unit of a coefficient proportional to the
+    signal (its unit starts with the model's signal unit) in the shown unit; None when the
+    coefficient is not in the signal's unit (a breakpoint in °C, a time constant)."""
+    if unit == model_unit or unit.startswith(model_unit + "/"):
+        return shown + unit[len(model_unit) :]
+    return None
+
+
+def channel_figures(
+    calibration: str | Path, validation: Mapping[str, Any] | None = None
+) -> dict[str, dict[str, Any]]:
+    """Per channel of a calibration (or model) file: ``unit`` (the channel's data unit,
+    :func:`shown_unit`), ``unit_as_given``, ``model_unit``, the fit figures
+    (:data:`FIT_FIGURES`), the validation figures (:data:`VALIDATION_FIGURES`, from
+    ``thermocal validate --json``) and ``coefficients`` ``{term: value}`` with
+    ``coefficient_units``, every signal figure in ``unit``.
+
+    The fit's figures are read from the file through the model loader (checksum verified),
+    in the model's unit, and multiplied by the factor of :func:`shown_unit`; validation
+    figures come in the unit that ``validate`` names and are converted the same way."""
+    from thermocal.models.files import load_calibration
+
+    cal = load_calibration(calibration)
+    vals = _per_channel(validation, cal.names)
     out: dict[str, dict[str, Any]] = {}
-    for name, f in fits.items():
-        row: dict[str, Any] = {"unit": f.get("unit_as_given") or f.get("unit")}
-        for k in FIT_FIGURES:
-            row[k] = f.get(k)
-        v = vals.get(name, {})
+    for ch in cal.channels:
+        model = ch.model
+        model_unit = str(model.signal_unit)
+        unit, factor = shown_unit(model_unit, ch.unit)
+        st = model.stats_
+        row: dict[str, Any] = {
+            "unit": unit,
+            "unit_as_given": ch.unit,
+            "model_unit": model_unit,
+            "rms_residual": float(st.rms_residual) * factor,
+            "condition_number": st.condition_number,
+            "n_coefficients": st.n_coefficients,
+            "n_samples": st.n_samples,
+        }
+        v = vals.get(ch.name, {})
+        v_unit = str(v.get("unit") or unit)
+        v_factor = 1.0 if v_unit == unit else shown_unit(v_unit, unit)[1]
+        if v_unit != unit and shown_unit(v_unit, unit)[0] != unit:
+            v = {}  # figures in a unit that cannot be shown in the channel's: left out
         for k in VALIDATION_FIGURES:
-            row[k] = v.get(k)
-        coefs = {}
-        for c in f.get("coefficients") or []:
-            if isinstance(c, Mapping) and "name" in c and "value" in c:
-                coefs[str(c["name"])] = c["value"]
+            x = v.get(k)
+            if x is not None and k != "r":
+                x = float(x) * v_factor
+            row[k] = x
+        coefs: dict[str, float] = {}
+        coef_units: dict[str, str] = {}
+        for c in model.coefficients():
+            label = _convert_unit_label(c.unit, model_unit, unit)
+            coefs[c.name] = float(c.value) * (factor if label is not None else 1.0)
+            coef_units[c.name] = label if label is not None else c.unit
         row["coefficients"] = coefs
-        out[name] = row
+        row["coefficient_units"] = coef_units
+        adequacy = getattr(model, "adequacy_", None)
+        if isinstance(adequacy, Mapping):
+            row["adequacy"] = adequacy.get("verdict")
+        out[ch.name] = row
     return out
+
+
+def unit_figures(outcome: UnitOutcome) -> dict[str, dict[str, Any]]:
+    """Per channel figures of an outcome, in each channel's data unit (:func:`channel_figures`)."""
+    return outcome.figures
 
 
 def judge(figures: Mapping[str, Mapping[str, Any]], limits: Sequence[Limit]) -> list[str]:
@@ -420,7 +525,8 @@ def judge(figures: Mapping[str, Mapping[str, Any]], limits: Sequence[Limit]) -> 
                 why = "no validation run" if lim.figure in VALIDATION_FIGURES else "not computed"
                 failed.append(f"{ch}.{lim.figure} {why} ({lim.label})")
             elif not lim.check(float(value)):
-                failed.append(f"{ch}.{lim.figure} = {float(value):.6g} fails {lim.label}")
+                unit = "" if lim.figure in _UNITLESS else f" {fig.get('unit') or ''}".rstrip()
+                failed.append(f"{ch}.{lim.figure} = {float(value):.6g}{unit} fails {lim.label}")
     return failed
 
 
@@ -429,8 +535,9 @@ def judge(figures: Mapping[str, Mapping[str, Any]], limits: Sequence[Limit]) -> 
 
 @dataclass(frozen=True)
 class FleetResult:
-    """What :func:`run_fleet` did: units run now, skipped (done before), failed, and the
-    summary rows of every unit of the configuration."""
+    """What :func:`run_fleet` did: units run now, skipped (done before and still right),
+    failed, the units redone with why (``{id: reason}``), and the summary rows of every
+    unit of the configuration."""
 
     ran: tuple[str, ...]
     skipped: tuple[str, ...]
@@ -440,6 +547,7 @@ class FleetResult:
     summary_parquet: Path
     html: Path
     interrupted: str | None = None
+    redone: Mapping[str, str] = field(default_factory=dict)
 
 
 def unit_dir(out_dir: Path, uid: str) -> Path:
@@ -456,19 +564,297 @@ def read_unit(out_dir: Path, uid: str) -> dict[str, Any] | None:
     return obj if isinstance(obj, dict) and obj.get("format") == UNIT_FORMAT else None
 
 
+# --- what a unit depends on, and whether its folder is still right --------------------------
+
+
+def file_sha256(path: str | Path) -> str | None:
+    """SHA-256 of a file's content; None when it cannot be read (missing: the unit fails
+    and is retried)."""
+    h = hashlib.sha256()
+    try:
+        with open(path, "rb") as fh:
+            while block := fh.read(1 << 20):
+                h.update(block)
+    except OSError:
+        return None
+    return h.hexdigest()
+
+
+def unit_input_paths(u: UnitSpec) -> list[str]:
+    """The files a unit reads: its modelling files, its validation file, and the
+    ``FILE.meta.json`` sidecar of each where one exists (it sets units and conversions)."""
+    from thermocal.io import sidecar_path
+
+    out: list[str] = []
+    for f in (*u.modeling, *([u.validation] if u.validation else [])):
+        out.append(f)
+        side = sidecar_path(f)
+        if side.exists():
+            out.append(str(side))
+    return out
+
+
+def unit_inputs(u: UnitSpec) -> dict[str, str | None]:
+    """``{path: sha256}`` of :func:`unit_input_paths` (recorded in ``unit.json``)."""
+    return {f: file_sha256(f) for f in unit_input_paths(u)}
+
+
+def unit_options(config: FleetConfig, u: UnitSpec) -> dict[str, Any]:
+    """The options as they apply to a unit: ``fit`` (``[fit]`` as arguments), ``validate``
+    (``[validate]``, only for a unit with a validation run) and ``limits``
+    (``[channel, figure, bound, value]``; every limit applies to every unit: a channel
+    limit on a unit without the channel fails it)."""
+    return {
+        "fit": list(config.fit_args),
+        "validate": list(config.validate_args) if u.validation is not None else [],
+        "limits": [[lim.channel, lim.figure, lim.bound, lim.value] for lim in config.limits],
+    }
+
+
+def _version() -> str:
+    from thermocal import __version__
+
+    return str(__version__)
+
+
+def verify_unit_folder(folder: Path, rec: Mapping[str, Any]) -> list[str]:
+    """What is wrong with a unit's folder (empty: it verifies): every file ``unit.json``
+    lists is present with its recorded SHA-256, and ``calibration.json`` loads through the
+    model loader (format, version, checksum)."""
+    from thermocal.models.files import load_calibration
+
+    problems: list[str] = []
+    files = rec.get("files")
+    if not isinstance(files, Mapping) or CALIBRATION_FILE not in files:
+        return ["unit.json does not list its files"]
+    for name, digest in files.items():
+        if not isinstance(name, str) or "/" in name or name.startswith("."):
+            problems.append(f"unit.json lists a file {name!r} outside its folder")
+            continue
+        got = file_sha256(folder / name)
+        if got is None:
+            problems.append(f"{name} is missing")
+        elif got != digest:
+            problems.append(f"{name} changed since it was written")
+    try:
+        load_calibration(folder / CALIBRATION_FILE)
+    except ThermocalInputError as exc:
+        problems.append(f"{CALIBRATION_FILE} does not verify ({one_line_error(exc)})")
+    return problems
+
+
+def stale_reasons(
+    out_dir: Path, config: FleetConfig, u: UnitSpec, inputs: Mapping[str, str | None]
+) -> list[str] | None:
+    """Why a unit must be (re)done: None for a unit never run (no folder), ``[]`` for one
+    done and still right, else the reasons (module docstring)."""
+    folder = unit_dir(out_dir, u.id)
+    rec = read_unit(out_dir, u.id)
+    if rec is None:
+        if folder.exists() or folder.is_symlink():
+            return ["its folder has no readable unit.json"]
+        return None
+    if rec.get("status") != "ok":
+        return [f"it failed before ({rec.get('error') or 'no error recorded'})"]
+    if rec.get("version") != UNIT_VERSION:
+        return [f"its unit.json is of an older fleet format (version {rec.get('version')})"]
+    reasons: list[str] = []
+    if rec.get("thermocal_version") != _version():
+        reasons.append(f"thermocal version changed ({rec.get('thermocal_version')} → {_version()})")
+    before = rec.get("inputs") or {}
+    for f, digest in inputs.items():
+        if f not in before:
+            reasons.append(f"input {f} is new to it")
+        elif before[f] != digest:
+            reasons.append(f"input {f} changed" if digest else f"input {f} cannot be read")
+    for f in before:
+        if f not in inputs:
+            reasons.append(f"input {f} is no longer one of its inputs")
+    old_opts = rec.get("options") or {}
+    new_opts = unit_options(config, u)
+    for key, label in (("fit", "[fit]"), ("validate", "[validate]"), ("limits", "[limits]")):
+        if old_opts.get(key) != new_opts[key]:
+            reasons.append(f"its {label} options changed")
+    reasons += verify_unit_folder(folder, rec)
+    return reasons
+
+
+# --- inputs are sacred --------------------------------------------------------------------
+
+SPECIAL_ROOTS = (Path("/proc"), Path("/dev"), Path("/sys"))
+"""File systems that are not storage: never an output."""
+
+
+@dataclass(frozen=True)
+class _Input:
+    given: str
+    resolved: Path
+    inode: tuple[int, int] | None
+
+
+def _inode(path: Path, follow: bool = True) -> tuple[int, int] | None:
+    try:
+        st = os.stat(path, follow_symlinks=follow)
+    except OSError:
+        return None
+    return (st.st_dev, st.st_ino)
+
+
+def config_inputs(config: FleetConfig) -> list[str]:
+    """Every file the batch reads: the configuration and each unit's inputs."""
+    out = [str(config.path)]
+    for u in config.units:
+        out += unit_input_paths(u)
+    return out
+
+
+def _link_chain(path: Path) -> list[Path]:
+    """``path`` (absolute, not resolved) and every path its symbolic links lead through
+    (``out/fleet.html`` → ``/proc/self/fd/1`` → ``/dev/pts/0``…), the resolved one last."""
+    chain = [Path(os.path.abspath(path))]
+    p = chain[0]
+    for _ in range(40):
+        # the link of the first component that is one (a folder or the file itself)
+        hop = None
+        for i in range(1, len(p.parts) + 1):
+            head = Path(*p.parts[:i])
+            if head.is_symlink():
+                try:
+                    target = os.readlink(head)
+                except OSError:
+                    break
+                hop = Path(os.path.normpath(head.parent / target)).joinpath(*p.parts[i:])
+                break
+        if hop is None or hop in chain:
+            break
+        chain.append(hop)
+        p = hop
+    chain.append(path.resolve())
+    return chain
+
+
+def _special(path: Path) -> str | None:
+    """Why ``path`` is no place for an output (it or a link it leads through lies under
+    :data:`SPECIAL_ROOTS`, or it is a FIFO, a device or a socket), or None."""
+    for p in _link_chain(path):
+        for root in SPECIAL_ROOTS:
+            if p == root or p.is_relative_to(root):
+                return f"it is under {root}, not a storage file system"
+    try:
+        mode = os.stat(path).st_mode
+    except OSError:
+        return None
+    for test, what in (
+        (stat.S_ISFIFO, "a FIFO"),
+        (stat.S_ISCHR, "a character device"),
+        (stat.S_ISBLK, "a block device"),
+        (stat.S_ISSOCK, "a socket"),
+    ):
+        if test(mode):
+            return f"it is {what}"
+    return None
+
+
+def check_outputs(config: FleetConfig, out_dir: str | Path) -> None:
+    """Refuse the run (:class:`ThermocalInputError`, exit 2, before anything is written)
+    when a path the fleet writes, replaces or deletes is, or contains, one of its inputs
+    (:func:`config_inputs`; compared by resolved path and by inode, so a symlink or a hard
+    link to an input counts), or is a special file (FIFO, device, socket, under ``/proc``,
+    ``/dev``, ``/sys``).
+
+    The paths: ``DIR`` itself, ``DIR/summary.csv``, ``DIR/summary.parquet``,
+    ``DIR/fleet.html`` (and their stale temporaries), ``DIR/units`` and, for every unit,
+    ``DIR/units/<id>`` (replaced when the unit is redone) and the temporary folders of
+    interrupted runs (deleted)."""
+    from thermocal.io import TEMP_SUFFIX
+
+    out = Path(out_dir)
+    inputs = [_Input(f, Path(f).resolve(), _inode(Path(f))) for f in config_inputs(config)]
+    by_inode: dict[tuple[int, int] | None, _Input] = {
+        i.inode: i for i in inputs if i.inode is not None
+    }
+
+    def refuse(target: Path, why: str) -> None:
+        raise ThermocalInputError(f"{target}: refusing to write the fleet output there: {why}")
+
+    def is_input(target: Path, kind: str) -> None:
+        r = target.resolve()
+        why = _special(target)
+        if why is not None:
+            refuse(target, why)
+        for i in inputs:
+            if i.resolved == r:
+                refuse(target, f"it is the input {i.given}")
+        hit = by_inode.get(_inode(target)) if target.exists() else None
+        if hit is not None:
+            refuse(target, f"it is the input {hit.given} (the same file)")
+        if kind == "file" and target.exists() and not target.is_file():
+            refuse(target, "it exists and is not a regular file")
+        if kind == "dir" and target.exists() and not target.is_dir():
+            refuse(target, "it exists and is not a directory")
+
+    def holds_input(folder: Path) -> None:
+        """``folder`` is replaced or deleted: no input may be in it."""
+        is_input(folder, "dir")
+        r = folder.resolve()
+        for i in inputs:
+            if i.resolved.is_relative_to(r):
+                refuse(folder, f"it contains the input {i.given}, and fleet replaces it")
+        if not folder.is_dir():
+            return
+        for root, dirs, files in os.walk(r):
+            for name in (*files, *dirs):
+                hit = by_inode.get(_inode(Path(root) / name, follow=False))
+                if hit is not None:
+                    refuse(folder, f"it holds {Path(root) / name}, which is the input {hit.given}")
+
+    is_input(out, "dir")
+    for name in ("summary.csv", "summary.parquet", "fleet.html"):
+        target = out / name
+        is_input(target, "file")
+        if out.is_dir():
+            for tmp in out.glob(f".{glob_escape(name)}.*{TEMP_SUFFIX}"):
+                is_input(tmp, "file")
+    units = out / "units"
+    is_input(units, "dir")
+    for u in config.units:
+        holds_input(unit_dir(out, u.id))
+    for d in _stale_folders(units):
+        holds_input(d)
+
+
+def glob_escape(name: str) -> str:
+    import glob
+
+    return glob.escape(name)
+
+
+_STALE = re.compile(r"^\.(?P<id>[A-Za-z0-9][A-Za-z0-9._-]*)\.(tmp|old)-[0-9a-f]{8}$")
+"""A unit folder being written (``.<id>.tmp-<hex>``) or set aside (``.<id>.old-<hex>``)."""
+
+
+def _stale_folders(units_dir: Path) -> list[Path]:
+    """Temporary unit folders of an interrupted run (:data:`_STALE`)."""
+    if not units_dir.is_dir():
+        return []
+    return sorted(p for p in units_dir.iterdir() if _STALE.match(p.name))
+
+
 def _clean_stale(units_dir: Path) -> None:
-    """Temporary unit directories of an interrupted run (``.<id>.tmp-*``, ``.<id>.old-*``)."""
-    if units_dir.is_dir():
-        for d in units_dir.glob(".*.tmp-*"):
-            shutil.rmtree(d, ignore_errors=True)
-        for d in units_dir.glob(".*.old-*"):
+    """Remove the temporary unit folders of an interrupted run (checked by
+    :func:`check_outputs` to hold no input)."""
+    for d in _stale_folders(units_dir):
+        if d.is_symlink() or not d.is_dir():
+            d.unlink(missing_ok=True)
+        else:
             shutil.rmtree(d, ignore_errors=True)
 
 
 def write_unit(out_dir: Path, outcome: UnitOutcome, record: dict[str, Any]) -> Path:
-    """Write a unit's files into a temporary directory, ``unit.json`` last, and rename it
-    into place (an older directory of the unit is moved aside first and removed after):
-    ``units/<id>/`` is complete or absent, whenever the run stops."""
+    """Write a unit's files into a temporary directory, ``unit.json`` last (with each
+    file's SHA-256), and rename it into place (an older directory of the unit is moved
+    aside first and removed after): ``units/<id>/`` is complete or absent, whenever the run
+    stops."""
     units_dir = out_dir / "units"
     units_dir.mkdir(parents=True, exist_ok=True)
     tag = secrets.token_hex(4)
@@ -476,16 +862,23 @@ def write_unit(out_dir: Path, outcome: UnitOutcome, record: dict[str, Any]) -> P
     tmp.mkdir()
     for name, data in outcome.files.items():
         (tmp / name).write_bytes(data)
+    record = {
+        **record,
+        "files": {n: hashlib.sha256(d).hexdigest() for n, d in sorted(outcome.files.items())},
+    }
     text = json.dumps(record, indent=2, ensure_ascii=False, allow_nan=False)
     (tmp / UNIT_FILE).write_text(text + "\n", encoding="utf-8")
     final = unit_dir(out_dir, outcome.id)
     old = None
-    if final.exists():
+    if final.exists() or final.is_symlink():
         old = units_dir / f".{outcome.id}.old-{tag}"
         os.replace(final, old)
     os.replace(tmp, final)
     if old is not None:
-        shutil.rmtree(old, ignore_errors=True)
+        if old.is_symlink() or not old.is_dir():
+            old.unlink(missing_ok=True)
+        else:
+            shutil.rmtree(old, ignore_errors=True)
     return final
 
 
@@ -500,14 +893,25 @@ def _finite(obj: Any) -> Any:
     return obj
 
 
-def unit_record(outcome: UnitOutcome, config: FleetConfig, signal: str) -> dict[str, Any]:
-    """The content of ``unit.json``: status, error, warnings, figures per channel,
-    pass/fail against the limits, inputs and timing."""
-    figures = unit_figures(outcome, signal) if outcome.status == "ok" else {}
+def unit_record(
+    outcome: UnitOutcome,
+    config: FleetConfig,
+    *,
+    inputs: Mapping[str, str | None] | None = None,
+    redone_because: str | None = None,
+) -> dict[str, Any]:
+    """The content of ``unit.json``: status, error, warnings, figures per channel (in each
+    channel's data unit), pass/fail against the limits, what the unit was made from
+    (``inputs`` with their SHA-256, ``options``, ``thermocal_version``), why it was redone,
+    and timing.  :func:`write_unit` adds ``files`` (name → SHA-256)."""
+    spec = next((u for u in config.units if u.id == outcome.id), None)
+    figures = unit_figures(outcome) if outcome.status == "ok" else {}
     reasons = judge(figures, config.limits) if outcome.status == "ok" else []
     passed: bool | None = None
     if outcome.status == "ok":
         passed = not reasons
+    if inputs is None and spec is not None:
+        inputs = unit_inputs(spec)
     record: dict[str, Any] = _finite(
         {
             "format": UNIT_FORMAT,
@@ -519,7 +923,10 @@ def unit_record(outcome: UnitOutcome, config: FleetConfig, signal: str) -> dict[
             "fail_reasons": reasons,
             "warnings": outcome.warnings,
             "channels": figures,
-            "files": sorted(outcome.files),
+            "inputs": dict(inputs or {}),
+            "options": unit_options(config, spec) if spec is not None else {},
+            "thermocal_version": _version(),
+            "redone_because": redone_because,
             "seconds": outcome.seconds,
             "worker": outcome.worker,
             "finished_utc": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()),
@@ -528,16 +935,26 @@ def unit_record(outcome: UnitOutcome, config: FleetConfig, signal: str) -> dict[
     return record
 
 
-def summary_rows(config: FleetConfig, out_dir: Path) -> list[dict[str, Any]]:
+def summary_rows(
+    config: FleetConfig,
+    out_dir: Path,
+    redone: Mapping[str, str] | None = None,
+    stale: Mapping[str, str] | None = None,
+) -> list[dict[str, Any]]:
     """One row per unit of the configuration, from the units' ``unit.json`` (a unit with
-    none: ``status`` ``pending``)."""
+    none, or found stale and not redone (``stale``: an interrupted run): ``status``
+    ``pending``); ``redone``: the reason a unit was redone in this run."""
     rows: list[dict[str, Any]] = []
+    redone = redone or {}
+    stale = stale or {}
     for u in config.units:
         rec = read_unit(out_dir, u.id)
         row: dict[str, Any] = {"id": u.id}
-        if rec is None:
-            row.update(status="pending", error="not run yet", **{"pass": None})
+        if rec is None or u.id in stale:
+            why = "not run yet" if rec is None else f"to be redone: {stale[u.id]}"
+            row.update(status="pending", error=why, **{"pass": None})
             row["fail_reasons"] = ""
+            row["redone"] = ""
             rows.append(row)
             continue
         row.update(
@@ -546,6 +963,7 @@ def summary_rows(config: FleetConfig, out_dir: Path) -> list[dict[str, Any]]:
             **{"pass": rec.get("pass")},
         )
         row["fail_reasons"] = "; ".join(rec.get("fail_reasons") or [])
+        row["redone"] = redone.get(u.id, "")
         row["seconds"] = rec.get("seconds")
         row["n_warnings"] = len(rec.get("warnings") or [])
         for ch, fig in (rec.get("channels") or {}).items():
@@ -661,39 +1079,47 @@ def run_fleet(
     on_unit: Callable[[UnitOutcome], None] | None = None,
     executor: Executor | None = None,
 ) -> FleetResult:
-    """Calibrate every unit not yet done (all with ``force``), write each as it finishes,
-    then the summary and ``fleet.html`` (module docstring).  ``on_unit`` is called after
-    each unit is written (progress).  A unit's fault never stops the others; an interrupted
-    batch (Ctrl-C, a worker that died) keeps every unit written so far, writes the summary
-    and re-raises (``KeyboardInterrupt``) or reports it in ``interrupted``."""
-    run = executor or (dask_executor(scheduler) if scheduler else local_executor(workers))
+    """Calibrate every unit not yet done or no longer right (all with ``force``), write
+    each as it finishes, then the summary and ``fleet.html`` (module docstring).  Refused
+    before anything is written when an output path is, or holds, an input
+    (:func:`check_outputs`).  ``on_unit`` is called after each unit is written (progress).
+    A unit's fault never stops the others; an interrupted batch (Ctrl-C, a worker that
+    died) keeps every unit written so far, writes the summary and re-raises
+    (``KeyboardInterrupt``) or reports it in ``interrupted``."""
     out = Path(out_dir)
+    check_outputs(config, out)
+    run = executor or (dask_executor(scheduler) if scheduler else local_executor(workers))
     out.mkdir(parents=True, exist_ok=True)
     _clean_stale(out / "units")
     todo: list[UnitTask] = []
     skipped: list[str] = []
+    redo: dict[str, str] = {}
+    inputs: dict[str, dict[str, str | None]] = {}
     for u in config.units:
-        rec = read_unit(out, u.id)
-        if rec is not None and rec.get("status") == "ok" and not force:
+        inputs[u.id] = unit_inputs(u)
+        reasons = stale_reasons(out, config, u, inputs[u.id])
+        if reasons is not None and not reasons and not force:
             skipped.append(u.id)
             continue
+        if reasons is not None:
+            redo[u.id] = "; ".join(reasons) if reasons else "--force"
         todo.append(UnitTask(u, config.fit_args, config.validate_args))
-    signal = str(config.fit_options.get("signal", "signal"))
-    if isinstance(config.fit_options.get("signal"), list):
-        signal = ",".join(map(str, config.fit_options["signal"]))
     ran: list[str] = []
     failed: list[str] = []
     interrupted: str | None = None
     try:
         for outcome in run(todo):
-            write_unit(out, outcome, unit_record(outcome, config, signal))
+            record = unit_record(
+                outcome, config, inputs=inputs[outcome.id], redone_because=redo.get(outcome.id)
+            )
+            write_unit(out, outcome, record)
             ran.append(outcome.id)
             if outcome.status != "ok":
                 failed.append(outcome.id)
             if on_unit is not None:
                 on_unit(outcome)
     except KeyboardInterrupt:
-        _finish(config, out)
+        _finish(config, out, redo, ran)
         raise
     except Exception as exc:  # a worker process died, the cluster went away
         from concurrent.futures.process import BrokenProcessPool
@@ -705,19 +1131,34 @@ def run_fleet(
             f"the batch stopped: {type(exc).__name__}: {exc}; {len(left)} unit(s) not done "
             f"({', '.join(left[:10])}{', …' if len(left) > 10 else ''}): rerun to resume"
         )
-    rows, csv_path, pq_path, html = _finish(config, out)
+    rows, csv_path, pq_path, html = _finish(config, out, redo, ran)
     return FleetResult(
-        tuple(ran), tuple(skipped), tuple(failed), tuple(rows), csv_path, pq_path, html, interrupted
+        tuple(ran),
+        tuple(skipped),
+        tuple(failed),
+        tuple(rows),
+        csv_path,
+        pq_path,
+        html,
+        interrupted,
+        {k: v for k, v in redo.items() if k in ran},
     )
 
 
-def _finish(config: FleetConfig, out: Path) -> tuple[list[dict[str, Any]], Path, Path, Path]:
+def _finish(
+    config: FleetConfig, out: Path, redo: Mapping[str, str], ran: Sequence[str]
+) -> tuple[list[dict[str, Any]], Path, Path, Path]:
+    """The summary and the report; units found stale and not redone (an interrupted run)
+    are pending, never shown with their old figures."""
     from thermocal.report.fleet import write_fleet_report
 
-    rows = summary_rows(config, out)
+    done = set(ran)
+    redone = {k: v for k, v in redo.items() if k in done}
+    stale = {k: v for k, v in redo.items() if k not in done}
+    rows = summary_rows(config, out, redone, stale)
     csv_path, pq_path = write_summary(rows, out)
-    records = {u.id: read_unit(out, u.id) for u in config.units}
-    html = write_fleet_report(out / "fleet.html", config, records)
+    records = {u.id: (None if u.id in stale else read_unit(out, u.id)) for u in config.units}
+    html = write_fleet_report(out / "fleet.html", config, records, redone=redone)
     return rows, csv_path, pq_path, html
 
 
@@ -741,26 +1182,78 @@ OUTLIER_Z = 3.5
 """|modified z| above this names a unit as an outlier (Iglewicz & Hoaglin)."""
 
 
+def common_unit(figs: Sequence[Mapping[str, Any]]) -> tuple[str, list[float]]:
+    """The unit most of a channel's units are shown in, and per record the factor taking
+    its signal figures there (NaN where it cannot be converted: left out of comparisons
+    across units).  A batch whose files give one channel in different units is compared in
+    one unit."""
+    from collections import Counter
+
+    names = [str(f.get("unit") or "") for f in figs]
+    if not names:
+        return "", []
+    unit = Counter(names).most_common(1)[0][0]
+    factors = []
+    for n in names:
+        if n == unit:
+            factors.append(1.0)
+            continue
+        shown, f = shown_unit(n, unit)
+        factors.append(f if shown == unit else math.nan)
+    return unit, factors
+
+
+def channel_series(figs: Sequence[Mapping[str, Any]]) -> tuple[str, dict[str, list[float]]]:
+    """A channel's figures and coefficients across units, each in one unit
+    (:func:`common_unit`): ``(unit, {what: values})``, ``what`` a figure name or
+    ``coefficient <term>``."""
+    unit, factors = common_unit(figs)
+    series: dict[str, list[float]] = {}
+    for n in ("rms_residual", "rms_after", "bias_stability_after"):
+        series[n] = [_num(f.get(n)) * k for f, k in zip(figs, factors, strict=True)]
+    terms = sorted({t for f in figs for t in (f.get("coefficients") or {})})
+    for t in terms:
+        vals = []
+        for f, k in zip(figs, factors, strict=True):
+            cu = str((f.get("coefficient_units") or {}).get(t, ""))
+            scaled = _convert_unit_label(cu, str(f.get("unit") or ""), unit) is not None
+            vals.append(_num((f.get("coefficients") or {}).get(t)) * (k if scaled else 1.0))
+        series[f"coefficient {t}"] = vals
+    return unit, series
+
+
+def coefficient_unit(figs: Sequence[Mapping[str, Any]], term: str, unit: str) -> str:
+    """The unit of a coefficient across units, in the channel's common ``unit``."""
+    for f in figs:
+        cu = (f.get("coefficient_units") or {}).get(term)
+        if cu:
+            label = _convert_unit_label(str(cu), str(f.get("unit") or ""), unit)
+            return label if label is not None else str(cu)
+    return ""
+
+
 def outliers(records: Mapping[str, Mapping[str, Any] | None]) -> list[dict[str, Any]]:
     """Units whose figure or coefficient is a robust outlier among the ok units, per
-    channel: ``{"id", "channel", "what", "value", "z"}``, largest |z| first."""
+    channel: ``{"id", "channel", "what", "value", "unit", "z"}`` (the value in the
+    channel's common data unit, :func:`channel_series`), largest |z| first."""
     ok = {k: v for k, v in records.items() if v and v.get("status") == "ok"}
     found: list[dict[str, Any]] = []
     channels = sorted({ch for v in ok.values() for ch in (v.get("channels") or {})})
     for ch in channels:
         ids = [k for k, v in ok.items() if ch in (v.get("channels") or {})]
         figs = [ok[k]["channels"][ch] for k in ids]
-        names = [f for f in ("rms_residual", "rms_after", "bias_stability_after")]
-        terms = sorted({t for f in figs for t in (f.get("coefficients") or {})})
-        series: dict[str, list[float]] = {}
-        for n in names:
-            series[n] = [_num(f.get(n)) for f in figs]
-        for t in terms:
-            series[f"coefficient {t}"] = [_num((f.get("coefficients") or {}).get(t)) for f in figs]
+        unit, series = channel_series(figs)
         for what, vals in series.items():
+            if what.startswith("coefficient "):
+                what_unit = coefficient_unit(figs, what[len("coefficient ") :], unit)
+            else:
+                what_unit = unit
             for uid, v, z in zip(ids, vals, robust_z(vals), strict=True):
                 if math.isfinite(z) and abs(z) > OUTLIER_Z:
-                    found.append({"id": uid, "channel": ch, "what": what, "value": v, "z": z})
+                    found.append(
+                        {"id": uid, "channel": ch, "what": what, "value": v, "unit": what_unit,
+                         "z": z}
+                    )  # fmt: skip
     return sorted(found, key=lambda d: -abs(d["z"]))
 
 
@@ -779,6 +1272,8 @@ __all__ = [
     "UnitOutcome",
     "UnitSpec",
     "UnitTask",
+    "channel_figures",
+    "check_outputs",
     "dask_executor",
     "judge",
     "load_config",
@@ -788,6 +1283,8 @@ __all__ = [
     "robust_z",
     "run_fleet",
     "run_unit",
+    "shown_unit",
+    "stale_reasons",
     "summary_rows",
     "unit_figures",
     "write_summary",

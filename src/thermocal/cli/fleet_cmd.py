@@ -51,7 +51,10 @@ def fleet_cmd(
     """Calibrate every unit of a production batch: the [fit] options once, one [[unit]] per
     device (modelling files, optional validation file), pass/fail [limits]; per unit
     DIR/units/<id>/, then DIR/summary.csv, DIR/summary.parquet and DIR/fleet.html.  A rerun
-    resumes where a stopped batch left off."""
+    resumes where a stopped batch left off, redoing the units whose inputs, options or
+    thermocal version changed or whose folder does not verify (JSON ``redone``: id → why).
+    Every figure is in its channel's data unit.  Refused (exit 2, nothing written) when an
+    output path is, or holds, one of the inputs, or is a special file."""
     cfg = _fleet.load_config(config)
     if workers is not None and workers < 1:
         raise ThermocalInputError(f"--workers must be at least 1, got {workers}")
@@ -83,6 +86,7 @@ def fleet_cmd(
         "passed": n_pass,
         "ran": list(res.ran),
         "skipped": list(res.skipped),
+        "redone": dict(res.redone),
         "failed_units": {r["id"]: r["error"] for r in rows if r["status"] == "failed"},
         "summary_csv": str(res.summary_csv),
         "summary_parquet": str(res.summary_parquet),
@@ -95,6 +99,8 @@ def fleet_cmd(
             f"{len(rows)} units: {n_ok} calibrated ({len(res.ran)} now, {len(res.skipped)} "
             f"done before), {n_failed} failed, {n_pass} passed"
         )
+        for uid, why in res.redone.items():
+            stdout.print(f"redone {uid}: {why}", markup=False, highlight=False)
         stdout.print(f"summary: {res.summary_csv}, {res.summary_parquet}")
         stdout.print(f"report: {res.html}")
 

@@ -39,20 +39,22 @@ def _fmt(v: Any, digits: int = 4) -> str:
 
 def _figure_distributions(channel: str, ok: Mapping[str, Mapping[str, Any]]) -> bytes:
     """Histograms of a channel's rms residual and (if validated) rms after compensation,
-    and a strip plot of every coefficient's robust z-score across the units."""
-    from thermocal.fleet import OUTLIER_Z, robust_z
+    in the channel's data unit (:func:`thermocal.fleet.channel_series`), and a strip plot
+    of every coefficient's robust z-score across the units."""
+    from thermocal.fleet import OUTLIER_Z, channel_series, robust_z
     from thermocal.report.figures import _figure, _png
 
     figs = [r["channels"][channel] for r in ok.values()]
-    unit = figs[0].get("unit") or ""
-    terms = sorted({t for f in figs for t in (f.get("coefficients") or {})})
+    unit, series = channel_series(figs)
+    terms = [k[len("coefficient ") :] for k in series if k.startswith("coefficient ")]
     with _figure(nrows=2, height_in=2.6) as (fig, axes):
         ax = axes[0]
         for key, label, colour in (
             ("rms_residual", "fit rms residual", "#1f6fb2"),
             ("rms_after", "validation rms after", "#c0392b"),
         ):
-            vals = np.array([f.get(key) for f in figs if f.get(key) is not None], dtype=float)
+            vals = np.array(series[key], dtype=float)
+            vals = vals[np.isfinite(vals)]
             if vals.size:
                 ax.hist(vals, bins=max(5, min(30, vals.size // 2)), alpha=0.6, color=colour,
                         label=f"{label} (n={vals.size})")  # fmt: skip
@@ -62,8 +64,7 @@ def _figure_distributions(channel: str, ok: Mapping[str, Mapping[str, Any]]) -> 
             ax.legend(fontsize=8)
         ax = axes[1]
         for j, t in enumerate(terms):
-            z = np.array(robust_z([float((f.get("coefficients") or {}).get(t, math.nan))
-                                   for f in figs]), dtype=float)  # fmt: skip
+            z = np.array(robust_z(series[f"coefficient {t}"]), dtype=float)
             z = z[np.isfinite(z)]
             jitter = (np.arange(z.size) % 7 - 3) * 0.05
             out = np.abs(z) > OUTLIER_Z
@@ -80,8 +81,14 @@ def _figure_distributions(channel: str, ok: Mapping[str, Mapping[str, Any]]) -> 
         return _png(fig)
 
 
-def build_fleet_report(config: FleetConfig, records: Mapping[str, Mapping[str, Any] | None]) -> str:
-    """The batch report as one HTML document (module docstring)."""
+def build_fleet_report(
+    config: FleetConfig,
+    records: Mapping[str, Mapping[str, Any] | None],
+    redone: Mapping[str, str] | None = None,
+) -> str:
+    """The batch report as one HTML document (module docstring); every figure in its
+    channel's data unit, as ``unit.json`` holds it; ``redone``: the units redone in this
+    run and why."""
     from thermocal import __version__
     from thermocal.fleet import outliers
     from thermocal.report.build import _env
@@ -97,9 +104,23 @@ def build_fleet_report(config: FleetConfig, records: Mapping[str, Mapping[str, A
                 "error": (rec or {}).get("error") or ("not run yet" if rec is None else ""),
                 "reasons": "; ".join((rec or {}).get("fail_reasons") or []),
                 "channels": {
-                    ch: {k: _fmt(v) for k, v in f.items() if k != "coefficients"}
+                    ch: {
+                        k: _fmt(v)
+                        for k, v in f.items()
+                        if k not in ("coefficients", "coefficient_units")
+                    }
                     for ch, f in ((rec or {}).get("channels") or {}).items()
                 },
+                "coefficients": [
+                    {
+                        "channel": ch,
+                        "name": name,
+                        "value": _fmt(value, 6),
+                        "unit": (f.get("coefficient_units") or {}).get(name, ""),
+                    }
+                    for ch, f in ((rec or {}).get("channels") or {}).items()
+                    for name, value in (f.get("coefficients") or {}).items()
+                ],
                 "n_warnings": len((rec or {}).get("warnings") or []),
             }
         )
@@ -136,6 +157,7 @@ def build_fleet_report(config: FleetConfig, records: Mapping[str, Mapping[str, A
                 for o in outliers(records)[:50]
             ],
             failed=[u for u in units if u["status"] == "failed"],
+            redone=sorted((redone or {}).items()),
             out_of_limits=[u for u in units if u["status"] == "ok" and u["pass"] is False],
             fit_options=config.fit_options,
         )
@@ -144,10 +166,13 @@ def build_fleet_report(config: FleetConfig, records: Mapping[str, Mapping[str, A
 
 
 def write_fleet_report(
-    path: str | Path, config: FleetConfig, records: Mapping[str, Mapping[str, Any] | None]
+    path: str | Path,
+    config: FleetConfig,
+    records: Mapping[str, Mapping[str, Any] | None],
+    redone: Mapping[str, str] | None = None,
 ) -> Path:
     """Build the batch report and write it atomically; returns the path."""
-    html = build_fleet_report(config, records)
+    html = build_fleet_report(config, records, redone)
     with atomic_write(path, "wb") as fh:
         fh.write(html.encode("utf-8"))
     return Path(path)
