@@ -140,9 +140,7 @@ def test_px4_accelerometer_parameters_of_a_tilted_board(soaks: tuple, tmp_path: 
         assert "relative" in err or "CAL_ACC" in _o
 
 
-def test_ardupilot_accelerometer_parameters_of_a_tilted_board(
-    soaks: tuple, tmp_path: Path
-) -> None:
+def test_ardupilot_accelerometer_parameters_of_a_tilted_board(soaks: tuple, tmp_path: Path) -> None:
     _d, cal, _res = soaks
     out = tmp_path / "imu.parm"
     code, stdout, err = _run("export-params", str(cal), "--format", "ardupilot", "-o", str(out))
