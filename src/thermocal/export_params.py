@@ -230,9 +230,10 @@ def map_axes(
                 ch = cal.channel(c)
                 role = ch.role or guess_role(c, ch.model.signal_unit) or {}
                 if role.get("kind") not in (None, kind):
+                    art = {"gyro": "a gyro", "accel": "an accel"}
                     raise ThermocalInputError(
-                        f"--{kind} {','.join(given)}: channel {c!r} is a {role['kind']} "
-                        f"({ch.model.signal_unit}), not a {kind}"
+                        f"--{kind} {','.join(given)}: channel {c!r} is {art[role['kind']]} "
+                        f"({ch.model.signal_unit}), not {art[kind]}"
                     )
             out[kind] = dict(zip(AXES, given, strict=True))
             continue
