@@ -196,7 +196,7 @@ def axis_poly(name: str, model: TemperatureModel, kind: str, axis: str, tref_c: 
     if kind == "accel":
         # no absolute offset is known (module docstring): relative to the model at mid-range
         mid = 0.5 * (lo + hi) - tref_c
-        b[0] = -(b[1] * mid + b[2] * mid**2 + b[3] * mid**3)
+        b[0] = 0.0 - (b[1] * mid + b[2] * mid**2 + b[3] * mid**3)  # no -0.0 at mid
         relative = True
     return AxisPoly(name, kind, axis, tref_c, (b[0] * f, b[1] * f, b[2] * f, b[3] * f),
                     lo, hi, relative)  # fmt: skip
