@@ -21,11 +21,21 @@ the model's unit (°/h or mg) to the firmware's.  A calibration the format canno
 another family, Ṫ or several temperature inputs, a power above 3, raw-count temperatures
 without a conversion — is refused with what to fit instead.
 
-Accelerometers: gravity is in their data.  A channel fitted with ``--gravity-axis`` has
-gravity as a known input, so its offset is the bias alone (absolute, PX4 ``X0``).
-Without it, the model's constant holds gravity: the PX4 offset is then taken relative to
-the model's value at the middle of its fitted range (PX4's own script fits accelerometers
-relative to the run's median), and a warning says so.
+Accelerometers: gravity is in their data, and from one placement a horizontal bias
+cannot be told from the bench's tilt (:mod:`thermocal.gravity`: a triad fitted with
+``--gravity-axis`` removes gravity along its measured direction, so its model's constant
+holds the horizontal biases only relative to the placement's mean; a lone channel's
+direction is not known at all; without ``--gravity-axis`` the constant holds gravity).
+So no absolute accelerometer offset is ever written: the PX4 offset is relative to the
+model's value at the middle of the fitted range (PX4's own script fits accelerometers
+relative to the run's median; the absolute offset is the accelerometer calibration's,
+``CAL_ACC*``), and ArduPilot's polynomial is relative to the calibration temperature by
+its definition.  The notes say so; a model fitted without ``--gravity-axis`` is also
+warned.
+
+Refused (issue 26): a channel given twice or to both triads, a channel of the other kind,
+an instance the firmware does not have (:data:`MAX_INSTANCES`), and any parameter that is
+not a finite float32 (or, for the int32 ``ID``, outside int32).
 """
 
 from __future__ import annotations
@@ -52,6 +62,16 @@ ARDUPILOT_SCALE = 1.0e-6
 ARDUPILOT_MIN_SPAN_C = 10.0
 """ArduPilot's learning needs a sweep of at least 10 °C (tempcal_IMU.py's minimum)."""
 AXES = ("x", "y", "z")
+MAX_INSTANCES = {"px4": 4, "ardupilot": 3}
+"""Sensor instances each firmware has thermal-calibration parameters for.  PX4:
+``GYRO_COUNT_MAX = ACCEL_COUNT_MAX = 4`` with ``static_assert``s that the ``TC_G0…TC_G3`` /
+``TC_A0…TC_A3`` parameters match (PX4-Autopilot
+``src/modules/temperature_compensation/TemperatureCompensation.h``).  ArduPilot:
+``INS_TCAL1_…INS_TCAL3_`` (``AP_SUBGROUPINFO(tcal_old_param[0..2], "_TCAL1_"…"_TCAL3_")``
+in ``libraries/AP_InertialSensor/AP_InertialSensor.cpp``, the first three IMUs)."""
+FLOAT32_MAX = float(np.finfo(np.float32).max)
+"""Largest finite float32 (≈ 3.4028235e38): the firmware stores parameters as 32-bit floats."""
+INT32_RANGE = (-(2**31), 2**31 - 1)
 RAD_PER_S_PER_DEG_PER_H = math.pi / 180.0 / 3600.0
 M_S2_PER_MG = units.STANDARD_GRAVITY_M_S2 / 1000.0
 
@@ -173,12 +193,10 @@ def axis_poly(name: str, model: TemperatureModel, kind: str, axis: str, tref_c: 
     f = _model_unit_factor(kind, model.signal_unit)
     lo, hi = (float(v) for v in model.temp_range_[0])
     relative = False
-    if kind == "accel" and "gravity" not in str(
-        ((getattr(model, "inputs_", {}) or {}).get("known_input") or {}).get("what", "")
-    ):
-        # gravity is in the constant: offset relative to the model at mid-range
+    if kind == "accel":
+        # no absolute offset is known (module docstring): relative to the model at mid-range
         mid = 0.5 * (lo + hi) - tref_c
-        b[0] = -(b[1] * mid + b[2] * mid**2 + b[3] * mid**3)
+        b[0] = 0.0 - (b[1] * mid + b[2] * mid**2 + b[3] * mid**3)  # no -0.0 at mid
         relative = True
     return AxisPoly(name, kind, axis, tref_c, (b[0] * f, b[1] * f, b[2] * f, b[3] * f),
                     lo, hi, relative)  # fmt: skip
@@ -189,17 +207,34 @@ def map_axes(
 ) -> dict[str, dict[str, str]]:
     """``{"gyro": {"x": channel, …}, "accel": {…}}`` from ``--gyro``/``--accel`` (channels
     in x, y, z order) or the channels' roles; each triad complete or absent."""
+    from thermocal.models.calibration import guess_role
+
     out: dict[str, dict[str, str]] = {}
     for kind, given in (("gyro", gyro), ("accel", accel)):
         if given:
             if len(given) != 3:
                 raise ThermocalInputError(f"--{kind} takes three channels, x,y,z; got {given}")
+            twice = sorted({c for c in given if list(given).count(c) > 1})
+            if twice:
+                raise ThermocalInputError(
+                    f"--{kind} {','.join(given)}: channel {', '.join(map(repr, twice))} given "
+                    "for more than one axis; each axis takes its own channel"
+                )
             missing = [c for c in given if c not in cal.names]
             if missing:
                 raise ThermocalInputError(
                     f"--{kind}: no channel {', '.join(map(repr, missing))} in the calibration "
                     f"({', '.join(cal.names)})"
                 )
+            for c in given:
+                ch = cal.channel(c)
+                role = ch.role or guess_role(c, ch.model.signal_unit) or {}
+                if role.get("kind") not in (None, kind):
+                    art = {"gyro": "a gyro", "accel": "an accel"}
+                    raise ThermocalInputError(
+                        f"--{kind} {','.join(given)}: channel {c!r} is {art[role['kind']]} "
+                        f"({ch.model.signal_unit}), not {art[kind]}"
+                    )
             out[kind] = dict(zip(AXES, given, strict=True))
             continue
         found = {
@@ -219,7 +254,40 @@ def map_axes(
             "no gyro or accelerometer triad found in the calibration's roles; give "
             "--gyro X,Y,Z and/or --accel X,Y,Z"
         )
+    if "gyro" in out and "accel" in out:
+        both = sorted(set(out["gyro"].values()) & set(out["accel"].values()))
+        if both:
+            raise ThermocalInputError(
+                f"--gyro and --accel both take channel {', '.join(map(repr, both))}; a "
+                "channel is one sensor's axis"
+            )
     return out
+
+
+def _show(v: float) -> str:
+    """A value for an error line (an integer of thousands of digits is not printed)."""
+    if isinstance(v, int) and abs(v) >= 10**18:
+        return f"an integer of {v.bit_length()} bits"
+    return repr(v)
+
+
+def check_values(ps: ParamSet) -> None:
+    """Refuse any parameter the firmware cannot store: a float (type 9) that is NaN,
+    infinite or beyond ±:data:`FLOAT32_MAX` (it would be written as ``nan``/``inf`` or
+    become infinite in float32), an int32 (type 6) outside :data:`INT32_RANGE`."""
+    for name, v in ps.params.items():
+        if ps.types.get(name, 9) == 6:
+            whole = isinstance(v, int) or (math.isfinite(v) and float(v).is_integer())
+            if not (whole and INT32_RANGE[0] <= int(v) <= INT32_RANGE[1]):
+                raise ThermocalInputError(
+                    f"{name} = {_show(v)}: not an int32 ({INT32_RANGE[0]}…{INT32_RANGE[1]}), which "
+                    "the firmware stores"
+                )
+        elif not (math.isfinite(v) and abs(v) <= FLOAT32_MAX):
+            raise ThermocalInputError(
+                f"{name} = {_show(v)}: not a finite float32 (|x| ≤ {FLOAT32_MAX:.8g}), which the "
+                "firmware stores; check the calibration's coefficients, range and --tref"
+            )
 
 
 def export_params(
@@ -238,8 +306,14 @@ def export_params(
     calibration's recorded sensor id when numeric, else 0 with a warning)."""
     if fmt not in FORMATS:
         raise ThermocalInputError(f"--format must be one of {', '.join(FORMATS)}, got {fmt!r}")
-    if instance < 0:
-        raise ThermocalInputError(f"--instance must be ≥ 0, got {instance}")
+    n_max = MAX_INSTANCES[fmt]
+    if not 0 <= instance < n_max:
+        have = "TC_G0…TC_G3 and TC_A0…TC_A3" if fmt == "px4" else "INS_TCAL1…INS_TCAL3"
+        raise ThermocalInputError(
+            f"--instance {instance}: {fmt} has {have}, instances 0…{n_max - 1}"
+        )
+    if tref_c is not None and not math.isfinite(tref_c):
+        raise ThermocalInputError(f"--tref {tref_c}: not a finite temperature")
     triads = map_axes(cal, gyro, accel)
     out = ParamSet(fmt)
     for kind, chans in triads.items():
@@ -261,14 +335,8 @@ def export_params(
                 )
         polys = [axis_poly(chans[a], models[a], kind, a, tref) for a in AXES]
         out.axes += polys
-        if any(p.relative for p in polys):
-            warnings.warn(
-                f"{kind}: fitted without --gravity-axis, so gravity is in the model's constant: "
-                "the offsets are relative to the model's value at mid-range (as PX4's own "
-                "script does); refit with --gravity-axis for absolute offsets",
-                ThermocalWarning,
-                stacklevel=2,
-            )
+        if kind == "accel":
+            _accel_notes(out, fmt, [models[a] for a in AXES], lo, hi)
         out.notes.append(
             f"{kind}: the firmware clamps the temperature to {lo:.2f}…{hi:.2f} °C (the fitted "
             "range): below and above, the correction of the range end is applied"
@@ -277,7 +345,43 @@ def export_params(
             _px4_params(out, kind, polys, instance, lo, hi, tref, _device_id(cal, kind, device_id))
         else:
             _ardupilot_params(out, kind, polys, instance, lo, hi)
+    check_values(out)
     return out
+
+
+def _accel_notes(
+    out: ParamSet, fmt: str, models: Sequence[TemperatureModel], lo: float, hi: float
+) -> None:
+    """Say which convention the accelerometer offsets follow and why no absolute one is
+    written (module docstring); warn when gravity is in the models' constants."""
+    gravity = [((getattr(m, "inputs_", {}) or {}).get("known_input") or {}) for m in models]
+    if not all("gravity" in str(k.get("what", "")) for k in gravity):
+        warnings.warn(
+            "accel: fitted without --gravity-axis, so gravity is in the model's constant "
+            "(compensate would take it out); the firmware offsets below are relative, as "
+            "PX4's own script writes them",
+            ThermocalWarning,
+            stacklevel=3,
+        )
+        why = "gravity is in the models' constants"
+    elif all((k.get("gravity") or {}).get("direction_measured") for k in gravity):
+        why = (
+            "gravity was removed along the triad's measured direction, and on one placement "
+            "a horizontal bias cannot be told from the bench's tilt"
+        )
+    else:
+        why = "the gravity direction was not measured (channels fitted without their triad)"
+    if fmt == "px4":
+        out.notes.append(
+            f"accel: offsets relative to the model's value at mid-range "
+            f"({0.5 * (lo + hi):.2f} °C), as PX4's own script writes them ({why}); the "
+            "absolute offset is the accelerometer calibration's (CAL_ACC*)"
+        )
+    else:
+        out.notes.append(
+            f"accel: ArduPilot's correction is relative to the calibration temperature by "
+            f"its definition; no absolute offset is written ({why})"
+        )
 
 
 def _device_id(cal: Calibration, kind: str, given: Mapping[str, int] | None) -> int:
@@ -285,8 +389,14 @@ def _device_id(cal: Calibration, kind: str, given: Mapping[str, int] | None) -> 
         return int(given[kind])
     for ch in cal.channels:
         sid = (getattr(ch.model, "inputs_", {}) or {}).get("sensor_id")
-        if sid is not None and str(sid).isdigit():
-            return int(sid)
+        text = str(sid) if sid is not None else ""
+        if text.isascii() and text.isdigit():
+            if len(text) > 10:  # beyond any int32; check_values would refuse it
+                raise ThermocalInputError(
+                    f"{kind}: the recorded sensor id ({len(text)} digits) is not a device id "
+                    "the firmware can store (int32): give --device-id"
+                )
+            return int(text)
     warnings.warn(
         f"{kind}: no numeric device id recorded; TC_*_ID written as 0, which PX4 matches to no "
         "sensor: give --device-id",
@@ -337,9 +447,11 @@ def _ardupilot_params(
 __all__ = [
     "ARDUPILOT_TREF_C",
     "FORMATS",
+    "MAX_INSTANCES",
     "AxisPoly",
     "ParamSet",
     "axis_poly",
+    "check_values",
     "export_params",
     "map_axes",
 ]

@@ -266,7 +266,12 @@ def export_params_cmd(
         typer.Option("--accel", help="Accelerometer channels x,y,z (default: the roles)."),
     ] = None,
     instance: Annotated[
-        int, typer.Option("--instance", help="Sensor instance, 0-based (PX4 TC_G0, INS_TCAL1).")
+        int,
+        typer.Option(
+            "--instance",
+            help="Sensor instance, 0-based: PX4 0-3 (TC_G0…TC_G3), ArduPilot 0-2 "
+            "(INS_TCAL1…INS_TCAL3).",
+        ),
     ] = 0,
     tref: Annotated[
         float | None,

@@ -47,7 +47,6 @@ fit statistics), ``coefficients`` and ``warnings``.
 """
 
 import dataclasses
-import math
 import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -91,13 +90,14 @@ from thermocal.cli.common import (
     text_options,
 )
 from thermocal.defaults import overrides_of
-from thermocal.errors import ConditioningWarning, ThermocalInputError, ThermocalWarning
+from thermocal.errors import ConditioningWarning, ThermocalInputError
 
 if TYPE_CHECKING:
     import numpy as np
     import rich.table as _rich_table
 
     import thermocal.adequacy as _adequacy
+    import thermocal.gravity as _gravity
     import thermocal.io as _io
     import thermocal.models.base as _base
     import thermocal.models.calibration as _calibration
@@ -115,6 +115,7 @@ else:
     _calibration = LazyModule("thermocal.models.calibration")
     _files = LazyModule("thermocal.models.files")
     _poly = LazyModule("thermocal.models.poly")
+    _gravity = LazyModule("thermocal.gravity")
     _recording = LazyModule("thermocal.recording")
 
 TARGETS = ("bias", "scale_factor")
@@ -323,6 +324,7 @@ def fit_cmd(
         )
     spec = _FitSpec(model, options, temps, latitude, axis, known_input, target,
                     gravity_axis, g_local, tref,
+                    _gravity.triad_gravity(loaded, names, gravity_axis, g_local),
                     overrides_of(allow_narrow, allow_motion))  # fmt: skip
     if len(names) <= 1:
         est, result, n_runs = _fit_channel(spec, loaded, signal)
@@ -367,89 +369,28 @@ class _FitSpec:
     gravity_axis: str | None = None
     gravity_m_s2: float | None = None
     tref_c: float | None = None
+    gravity_triad: "_gravity.TriadGravity | None" = None
     overrides: tuple[str, ...] = ()
-
-
-GRAVITY_TOLERANCE_MG = 100.0
-"""How far the up accelerometer's mean may be from the local gravity, and a horizontal
-one's from 0, before the orientation is doubted [mg] (0.1 g: a 6° tilt)."""
 
 
 def _local_gravity(
     gravity_axis: str | None, gravity: float | None, latitude: float | None
 ) -> float | None:
-    """The local gravity [m/s²] for ``--gravity-axis``: ``--gravity``, else WGS-84 normal
-    gravity at ``--latitude`` (:func:`thermocal.units.normal_gravity_m_s2`), else standard
-    gravity, stated in a warning."""
-    if gravity_axis is None:
-        if gravity is not None:
-            raise ThermocalInputError("--gravity applies with --gravity-axis only")
-        return None
-    units.parse_gravity_axis(gravity_axis)  # refuse a bad axis before reading
-    if gravity is not None:
-        if not 9.7 <= gravity <= 9.9:
-            raise ThermocalInputError(
-                f"--gravity {gravity:g}: local gravity on the earth's surface is 9.78-9.83 m/s²"
-            )
-        return float(gravity)
-    if latitude is not None:
-        return units.normal_gravity_m_s2(latitude)
-    warnings.warn(
-        f"--gravity-axis without --gravity or --latitude: assuming standard gravity "
-        f"{units.STANDARD_GRAVITY_M_S2} m/s² (local gravity differs by up to 0.3 %)",
-        ThermocalWarning,
-        stacklevel=2,
-    )
-    return units.STANDARD_GRAVITY_M_S2
+    """The local gravity [m/s²] for ``--gravity-axis``
+    (:func:`thermocal.gravity.local_gravity_m_s2`)."""
+    return _gravity.local_gravity_m_s2(gravity_axis, gravity, latitude)
 
 
 def _gravity_known_input(
-    spec: _FitSpec, path: Path, name: str, unit: str, values_mg: "_recording.FloatArray"
-) -> float:
-    """The gravity an accelerometer channel reads in the static run [mg] (0 for a gyro or
-    without ``--gravity-axis``), after checking the channel's mean against it: the up axis
-    within :data:`GRAVITY_TOLERANCE_MG` of ±g (else an input error), a horizontal axis
-    within it of 0 (else a warning: the tilt's share stays in the constant).  Without
-    ``--gravity-axis``, an accelerometer reading about ±1 g gets a warning: the model's
-    constant would hold gravity and compensation would take it out."""
-    if units.signal_kind(unit) != "accel":
-        return 0.0
-    mean = float(np.mean(values_mg))
-    if spec.gravity_axis is None or spec.gravity_m_s2 is None:
-        if abs(mean) > 500.0:
-            warnings.warn(
-                f"{path}: {name} reads {mean:.1f} mg on average: gravity is in the data; "
-                "without --gravity-axis the model's constant holds it and compensation "
-                f"takes it out ({name}_comp ≈ 0); give --gravity-axis (the axis pointing up)",
-                ThermocalWarning,
-                stacklevel=2,
-            )
-        return 0.0
-    role = _calibration.guess_role(name, unit) or {}
-    letter = role.get("axis")
-    if letter is None:
-        raise ThermocalInputError(
-            f"--gravity-axis {spec.gravity_axis}: channel {name!r} names no axis (x, y or z "
-            "as its last letter); fit it with --known-input instead"
-        )
-    g_mg = units.gravity_on_axis_mg(letter, spec.gravity_axis, spec.gravity_m_s2)
-    off = mean - g_mg
-    if g_mg != 0.0 and abs(off) > GRAVITY_TOLERANCE_MG:
-        raise ThermocalInputError(
-            f"{path}: --gravity-axis {spec.gravity_axis}: {name} should read about "
-            f"{g_mg:+.1f} mg but reads {mean:.1f} mg on average; is {spec.gravity_axis} the "
-            "axis pointing up, and the unit right?"
-        )
-    if g_mg == 0.0 and abs(off) > GRAVITY_TOLERANCE_MG:
-        tilt = math.degrees(math.asin(min(1.0, abs(mean) / 1000.0)))
-        warnings.warn(
-            f"{path}: {name} is horizontal with {spec.gravity_axis} up but reads {mean:.1f} "
-            f"mg (a tilt of about {tilt:.0f}°): its share of gravity stays in the model's "
-            "constant",
-            ThermocalWarning,
-            stacklevel=2,
-        )
-    return g_mg
+    spec: _FitSpec, run: int, path: Path, name: str, unit: str, values_mg: "_recording.FloatArray"
+) -> "_gravity.GravityInput":
+    """The gravity an accelerometer channel reads in run ``run`` [mg], with the words and
+    record of the model's known input: along the triad's measured direction when the
+    triad is fitted together, else along the nominal up axis with a warning that the
+    direction is unknown (:func:`thermocal.gravity.channel_gravity`)."""
+    return _gravity.channel_gravity(
+        spec.gravity_triad, run, path, name, unit, values_mg, spec.gravity_axis, spec.gravity_m_s2
+    )
 
 
 @dataclass
@@ -531,19 +472,17 @@ def _prepare_channel(
         # --latitude serves gravity alone when no --axis names a gyro's sensitive axis
         earth_lat = None if (spec.gravity_axis and axis is None) else latitude
         ki = earth_rate_known_input(earth_lat, axis, unit, path)
-        g_ki = _gravity_known_input(spec, path, sig_name, unit, _values)
-        ki += g_ki
+        g_in = _gravity_known_input(spec, len(runs), path, sig_name, unit, _values)
+        ki += g_in.value_mg
         if known_input is not None:
             ki += known_input
         if not runs:  # the model learns how its inputs were written (model file "inputs")
-            gravity_what = (
-                f"gravity {g_ki:+.6g} mg ({spec.gravity_axis} up, g = {spec.gravity_m_s2:.7g} "
-                "m/s²)" if spec.gravity_axis and units.signal_kind(unit) == "accel" else None
-            )  # fmt: skip
             first_inputs = _base.model_inputs(
                 rec, sig_name, run_temp_names(rec, temps), known_input=ki,
-                known_input_what=known_input_what(earth_lat, axis, known_input, gravity_what),
+                known_input_what=known_input_what(earth_lat, axis, known_input, g_in.what),
             )  # fmt: skip
+            if g_in.record is not None:  # export-params reads whether it was measured
+                first_inputs["known_input"]["gravity"] = g_in.record
         run = _base.RunData.from_recording(
             rec, signal, split_names(temps), known_input=ki, temperature_unit="auto"
         )
