@@ -36,6 +36,10 @@ MAX_IDENTIFIER_LEN = 63
 an internal identifier (§5.2.4.1).  Longer names keep their first characters and end in a
 hash of the whole original, so two long names that differ only at the end stay distinct."""
 
+MAX_PREFIX_LEN = 2 * MAX_IDENTIFIER_LEN + 1
+"""Longest prefix of a generated module: a calibration's ``<prefix>_<channel>``, two
+identifiers of the gate joined by ``_`` (a longer ``--name`` is shortened as above)."""
+
 _HASH_LEN = 8
 
 
@@ -81,7 +85,11 @@ def _short_hash(text: str) -> str:
 
 
 def c_identifier(
-    name: str, used: MutableMapping[str, str] | None = None, *, what: str = "name"
+    name: str,
+    used: MutableMapping[str, str] | None = None,
+    *,
+    what: str = "name",
+    max_len: int = MAX_IDENTIFIER_LEN,
 ) -> str:
     """A safe C identifier from any string (``rlg poly-v2`` → ``rlg_poly_v2``).
 
@@ -90,8 +98,8 @@ def c_identifier(
     an ASCII letter or digit → ``_``; lower case; runs of ``_`` → one, none at either end;
     nothing left → ``id_<hash>``; a leading digit → ``m_`` before it; a C/C++ keyword or a
     reserved standard name (:data:`RESERVED`) → ``c_`` before
-    it; longer than :data:`MAX_IDENTIFIER_LEN` → the first characters, ``_`` and 8 hex
-    digits of the original's SHA-256.  A safe identifier maps to itself.
+    it; longer than ``max_len`` (:data:`MAX_IDENTIFIER_LEN`) → the first characters, ``_``
+    and 8 hex digits of the original's SHA-256.  A safe identifier maps to itself.
 
     ``used`` maps the identifiers given out so far to their originals (updated): a second
     original mapping to an identifier already taken is a :class:`ThermocalInputError`
@@ -113,8 +121,8 @@ def c_identifier(
         s = _DIGIT_PREFIX + s
     if s in RESERVED:
         s = _RESERVED_PREFIX + s
-    if len(s) > MAX_IDENTIFIER_LEN:
-        s = s[: MAX_IDENTIFIER_LEN - _HASH_LEN - 1].rstrip("_") + "_" + _short_hash(str(name))
+    if len(s) > max_len:
+        s = s[: max_len - _HASH_LEN - 1].rstrip("_") + "_" + _short_hash(str(name))
     if used is not None:
         other = used.get(s)
         if other is not None and other != name:
@@ -264,6 +272,7 @@ __all__ = [
     "CPP_KEYWORDS",
     "C_KEYWORDS",
     "MAX_IDENTIFIER_LEN",
+    "MAX_PREFIX_LEN",
     "RESERVED",
     "c_code_only",
     "c_comment",

@@ -55,7 +55,6 @@ from thermocal.export_c.core import (
     CExport,
     ExportContext,
     FamilyCode,
-    c_identifier,
     c_signal_unit,
     family_generator,
     generate_c,
@@ -70,6 +69,7 @@ from thermocal.export_c.harness import (
     measure_float_error,
     run_harness,
 )
+from thermocal.identifiers import c_identifier
 
 __all__ = [
     "CFLAGS",

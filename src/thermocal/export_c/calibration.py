@@ -204,7 +204,7 @@ def export_c(
     d = load_model_dict(model_path)
     ex = generate_c(
         d,
-        prefix=prefix or c_identifier(Path(model_path).stem),
+        prefix=c_identifier(prefix or Path(model_path).stem),
         real=real,
         sample_interval_s=sample_interval_s,
         unit=unit,

@@ -14,7 +14,13 @@ import numpy.typing as npt
 
 from thermocal import units
 from thermocal.errors import ModelFileError, ThermocalInputError, UnitError
-from thermocal.identifiers import c_comment, c_identifier, c_string, check_generated_c
+from thermocal.identifiers import (
+    MAX_PREFIX_LEN,
+    c_comment,
+    c_identifier,
+    c_string,
+    check_generated_c,
+)
 from thermocal.recording import GAP_FACTOR, FloatArray
 
 REAL_TYPES = ("double", "float")
@@ -61,7 +67,7 @@ class CExport:
     def __post_init__(self) -> None:
         # the backstop of the identifier gate (thermocal.identifiers): a module that a name
         # from a file or option could have steered is refused, never written
-        if c_identifier(self.prefix) != self.prefix:
+        if c_identifier(self.prefix, max_len=MAX_PREFIX_LEN) != self.prefix:
             raise ThermocalInputError(f"C prefix {self.prefix!r} is not a safe identifier")
         check_generated_c(self.header, f"generated C ({self.header_name})")
         check_generated_c(self.source, f"generated C ({self.source_name})")
@@ -311,7 +317,7 @@ def generate_c(
     gen = family_generator(fam)
     if not sample_interval_s > 0:
         raise ThermocalInputError(f"sample interval must be positive, got {sample_interval_s}")
-    p = c_identifier(prefix)
+    p = c_identifier(prefix, max_len=MAX_PREFIX_LEN)
     rate = model.get("rate") or {}
     interval = float(rate.get("interval_s") or 0.0)
     buf = math.ceil(interval / sample_interval_s) + 8 if interval > 0 else 2

@@ -32,7 +32,7 @@ def _triad_code(p: str, tri: Any, bias_to_data: float, real: str, ident: str) ->
     """(declaration, definition) of one triad's correction function (``ident``: the triad's
     name through :func:`thermocal.identifiers.c_identifier`)."""
     m = tri.model
-    name = c_identifier(f"{p}_{ident}")
+    name = f"{p}_{ident}"  # two identifiers of the gate joined by '_': an identifier
     label = c_comment(tri.name)
     bias_unit = "deg/h" if m.kind == "gyro" else "mg"
     P = name.upper()
@@ -118,7 +118,7 @@ def generate_c_triads(triads: Sequence[Any], *, prefix: str, real: str = "double
         factor = float(units.convert([1.0], bias_unit, tri.unit)[0])
         ident = c_identifier(tri.name, used, what="triad")
         d, f = _triad_code(p, tri, factor, real, ident)
-        for n in c_names(d + "\n" + f, c_identifier(f"{p}_{ident}")):
+        for n in c_names(d + "\n" + f, f"{p}_{ident}"):
             if seen.setdefault(n, f"triad {tri.name!r}") != f"triad {tri.name!r}":
                 raise ThermocalInputError(
                     f"triad {tri.name!r} and {seen[n]} both give the C name {n}; rename one"
