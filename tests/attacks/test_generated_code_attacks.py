@@ -178,11 +178,11 @@ def test_hostile_channel_and_temperature_names_give_inert_c_equal_to_python(
     code, out, err = _run(capsys, "export-c", str(cal), "-o", str(cdir), "--name", PREFIX, "--json")
     assert code == 0, err
     prefix = json.loads(out)["prefix"]
+    _assert_inert(cdir, prefix)
     assert prefix == "imu_error_injected"  # "imu */⏎#error INJECTED⏎" as an identifier
     header = (cdir / f"{prefix}.h").read_text()
     # the channel "int": its functions under imu_error_injected_c_int_, a member c_int
     assert "imu_error_injected_c_int_state c_int;" in header
-    _assert_inert(cdir, prefix)
     # the compiled C equals thermocal compensate on the same samples
     comp = tmp_path / "comp.parquet"
     code, _, err = _run(capsys, "compensate", str(cal), str(data), "-o", str(comp))
@@ -315,8 +315,8 @@ def _triad_check(
     code, out, err = _run(capsys, "export-c", str(cal), "-o", str(cdir), "--name", PREFIX, "--json")
     assert code == 0, err
     prefix = json.loads(out)["prefix"]
-    assert prefix == "imu_error_injected"
     _assert_inert(cdir, prefix)
+    assert prefix == "imu_error_injected"
     held = pd.read_parquet(runs["held"])  # type: ignore[arg-type]
     rows = held[[TRIAD_COLUMNS["T_imu"], *G_COLS, *A_COLS]].to_numpy()
     driver = TRIAD_DRIVER.replace("@GYRO@", functions[0]).replace("@ACCEL@", functions[1])
