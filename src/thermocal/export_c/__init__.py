@@ -29,6 +29,14 @@ source file with
 * a comment block with the model file's identity (family, format version,
   thermocal version, checksum, signal, temperatures, data files).
 
+Names come from files and options (columns, channels, temperatures, triads, ``--name``, string
+fields of a model file) and may hold anything: every one reaches the C through the one gate,
+:mod:`thermocal.identifiers` (identifiers by :func:`~thermocal.identifiers.c_identifier`,
+names that meet after mapping refused; comment text by
+:func:`~thermocal.identifiers.c_comment`; string literals by
+:func:`~thermocal.identifiers.c_string`), and every module is checked by
+:func:`~thermocal.identifiers.check_generated_c` before it is written (issue 26).
+
 The arithmetic follows the family's ``ModelStream`` operation by operation, so
 the double build agrees with the Python streaming compensator to rounding
 (tests: 1e-9 relative on 10⁵ samples with cc -O2 -std=c99).  Time is ``double``
@@ -55,7 +63,6 @@ from thermocal.export_c.core import (
     CExport,
     ExportContext,
     FamilyCode,
-    c_identifier,
     c_signal_unit,
     family_generator,
     generate_c,
@@ -70,6 +77,7 @@ from thermocal.export_c.harness import (
     measure_float_error,
     run_harness,
 )
+from thermocal.identifiers import c_identifier
 
 __all__ = [
     "CFLAGS",

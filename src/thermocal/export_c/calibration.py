@@ -11,9 +11,26 @@ from thermocal.errors import ThermocalInputError
 from thermocal.export_c.core import (
     CExport,
     _comment,
-    c_identifier,
     generate_c,
 )
+from thermocal.identifiers import c_comment, c_identifier, c_names
+
+
+def check_distinct_names(
+    modules: Sequence[tuple[str, CExport]], top: Sequence[str], what: str
+) -> None:
+    """Refuse (:class:`ThermocalInputError`) modules of one file that declare the same C
+    name: each ``(original name, module)`` declares the identifiers under its own prefix
+    (:func:`thermocal.identifiers.c_names`), the file itself ``top``.  Distinct identifiers
+    can still meet once suffixed (channels ``a`` and ``a_t0``: ``A_T0_ORDER``)."""
+    seen = {n: f"the {what}s' common code" for n in top}
+    for name, ex in modules:
+        for n in sorted(c_names(ex.header + "\n" + ex.source, ex.prefix)):
+            if n in seen and seen[n] != f"{what} {name!r}":
+                raise ThermocalInputError(
+                    f"{what} {name!r} and {seen[n]} both give the C name {n}; rename one of them"
+                )
+            seen[n] = f"{what} {name!r}"
 
 
 def generate_c_calibration(
@@ -40,6 +57,8 @@ def generate_c_calibration(
         raise ThermocalInputError("a calibration with no channel has no C")
     p = c_identifier(prefix)
     P = p.upper()
+    used: dict[str, str] = {}
+    ident = {name: c_identifier(name, used, what="channel") for name, _md, _u in channels}
     mods: list[tuple[str, CExport, list[str]]] = []
     temps: list[str] = []
     for _name, md, _unit in channels:
@@ -50,7 +69,7 @@ def generate_c_calibration(
     for name, md, unit in channels:
         ex = generate_c(
             md,
-            prefix=f"{p}_{c_identifier(name)}",
+            prefix=f"{p}_{ident[name]}",
             real=real,
             sample_interval_s=(
                 sample_interval_s
@@ -66,9 +85,14 @@ def generate_c_calibration(
             "the channels' models take temperatures in different units "
             f"({', '.join(sorted(tus))}); one calibration's C takes one kind"
         )
+    top = [f"{p}_{s}" for s in ("init", "compensate", "state", "real")]
+    top += [f"{P}_{s}" for s in ("N_CHANNELS", "N_TEMPS", "CAL_H")]
+    check_distinct_names([(name, ex) for name, ex, _t in mods], top, "channel")
     n, k = len(mods), len(temps)
-    chan_list = ", ".join(f"{i}={name} [{ex.unit}]" for i, (name, ex, _t) in enumerate(mods))
-    temp_list = ", ".join(f"{i}={t}" for i, t in enumerate(temps))
+    chan_list = c_comment(
+        ", ".join(f"{i}={name} [{ex.unit}]" for i, (name, ex, _t) in enumerate(mods))
+    )
+    temp_list = c_comment(", ".join(f"{i}={t}" for i, t in enumerate(temps)))
     tu = next(iter(tus))
     parts_h = [ex.header for _n, ex, _t in mods]
     header = "\n".join(
@@ -92,7 +116,7 @@ def generate_c_calibration(
             f"/* temperatures: {temp_list} */",
             "",
             "typedef struct {",
-            *[f"    {ex.prefix}_state {c_identifier(name)};" for name, ex, _t in mods],
+            *[f"    {ex.prefix}_state {ident[name]};" for name, ex, _t in mods],
             f"}} {p}_state;",
             "",
             "/* Power-on: forget every channel's state; sample_interval_s: nominal [s]. */",
@@ -113,12 +137,12 @@ def generate_c_calibration(
         bodies.append("\n".join(lines))
     calls = []
     for i, (name, ex, ts) in enumerate(mods):
-        ident = c_identifier(name)
+        cid = ident[name]
         idx = ", ".join(f"temps_c[{temps.index(t)}]" for t in ts)
         calls += [
             "    {",
-            f"        const {p}_real t_{ident}[{len(ts)}] = {{{idx}}};",
-            f"        out[{i}] = {ex.prefix}_compensate(&s->{ident}, time_s, t_{ident}, raw[{i}]);",
+            f"        const {p}_real t_{cid}[{len(ts)}] = {{{idx}}};",
+            f"        out[{i}] = {ex.prefix}_compensate(&s->{cid}, time_s, t_{cid}, raw[{i}]);",
             "    }",
         ]
     source = "\n".join(
@@ -130,7 +154,7 @@ def generate_c_calibration(
             f"void {p}_init({p}_state *s, double sample_interval_s)",
             "{",
             *[
-                f"    {ex.prefix}_init(&s->{c_identifier(name)}, sample_interval_s);"
+                f"    {ex.prefix}_init(&s->{ident[name]}, sample_interval_s);"
                 for name, ex, _t in mods
             ],
             "}",
@@ -180,7 +204,7 @@ def export_c(
     d = load_model_dict(model_path)
     ex = generate_c(
         d,
-        prefix=prefix or c_identifier(Path(model_path).stem),
+        prefix=c_identifier(prefix or Path(model_path).stem),
         real=real,
         sample_interval_s=sample_interval_s,
         unit=unit,

@@ -4,7 +4,6 @@
 from __future__ import annotations
 
 import math
-import re
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -15,6 +14,13 @@ import numpy.typing as npt
 
 from thermocal import units
 from thermocal.errors import ModelFileError, ThermocalInputError, UnitError
+from thermocal.identifiers import (
+    MAX_PREFIX_LEN,
+    c_comment,
+    c_identifier,
+    c_string,
+    check_generated_c,
+)
 from thermocal.recording import GAP_FACTOR, FloatArray
 
 REAL_TYPES = ("double", "float")
@@ -57,6 +63,14 @@ class CExport:
     model_unit: str = ""
     """The model's own unit, in which the family arithmetic runs."""
     temperature_unit: str = "degC"
+
+    def __post_init__(self) -> None:
+        # the backstop of the identifier gate (thermocal.identifiers): a module that a name
+        # from a file or option could have steered is refused, never written
+        if c_identifier(self.prefix, max_len=MAX_PREFIX_LEN) != self.prefix:
+            raise ThermocalInputError(f"C prefix {self.prefix!r} is not a safe identifier")
+        check_generated_c(self.header, f"generated C ({self.header_name})")
+        check_generated_c(self.source, f"generated C ({self.source_name})")
 
     @property
     def header_name(self) -> str:
@@ -132,8 +146,9 @@ class ExportContext:
 
     @property
     def tu(self) -> str:
-        """The model's temperature unit in comments: ``degC`` or ``counts``."""
-        return str(self.model.get("temperature_unit") or units.LEGACY_TEMPERATURE_UNIT)
+        """The model's temperature unit: ``degC`` or ``counts`` (anything else in the model
+        file is a :class:`UnitError`)."""
+        return _temperature_unit(self.model)
 
     def temp_range(self) -> FloatArray:
         """(k, 2) fitted temperature range [°C or counts] in the model's temperature order."""
@@ -176,12 +191,11 @@ def family_generator(family: str) -> Generator:
 # --- common skeleton ----------------------------------------------------------------------
 
 
-def c_identifier(text: str) -> str:
-    """A valid C identifier from a file stem (``rlg poly-v2`` → ``rlg_poly_v2``)."""
-    s = re.sub(r"[^0-9A-Za-z_]", "_", text).strip("_").lower() or "model"
-    if s[0].isdigit():
-        s = "m_" + s
-    return s
+def _temperature_unit(d: dict[str, Any]) -> str:
+    """The model file's temperature unit, ``degC`` or ``counts`` (else :class:`UnitError`)."""
+    return units.normalize_temperature_unit(
+        str(d.get("temperature_unit") or units.LEGACY_TEMPERATURE_UNIT)
+    )
 
 
 def _identity(d: dict[str, Any]) -> list[str]:
@@ -194,7 +208,7 @@ def _identity(d: dict[str, Any]) -> list[str]:
         f"created (UTC):     {d.get('created_utc')}",
         f"checksum (sha256): {d.get('checksum')}",
         f"signal:            {sig.get('name')} [{sig.get('unit')}], target {sig.get('target')}",
-        f"temperatures:      {', '.join(d.get('temperatures', []))} "
+        f"temperatures:      {', '.join(map(str, d.get('temperatures', [])))} "
         f"[{d.get('temperature_unit') or units.LEGACY_TEMPERATURE_UNIT}]",
     ]
     inputs = d.get("inputs") or {}
@@ -215,11 +229,12 @@ def _identity(d: dict[str, Any]) -> list[str]:
     for entry in d.get("data") or []:
         if isinstance(entry, dict) and entry.get("file"):
             lines.append(f"fitted on:         {entry.get('file')}")
-    return [ln.replace("*/", "* /") for ln in lines]
+    return [c_comment(ln) for ln in lines]
 
 
 def _comment(lines: Sequence[str]) -> str:
-    return "/*\n" + "\n".join(f" * {ln}".rstrip() for ln in lines) + "\n */"
+    """A comment block, every line through :func:`c_comment` (one line each)."""
+    return "/*\n" + "\n".join(f" * {c_comment(ln)}".rstrip() for ln in lines) + "\n */"
 
 
 def c_signal_unit(model: dict[str, Any], unit: str | None = None) -> tuple[str, float]:
@@ -251,9 +266,7 @@ def _temperature_from_counts(model: dict[str, Any], p: str, P: str) -> tuple[lis
     temperature has a counts → °C conversion recorded (the firmware reads counts)."""
     conv_raw = (model.get("inputs") or {}).get("temperature_conversion") or {}
     names = list(model["temperatures"])
-    if (model.get("temperature_unit") or units.LEGACY_TEMPERATURE_UNIT) != "degC" or not all(
-        n in conv_raw for n in names
-    ):
+    if _temperature_unit(model) != "degC" or not all(n in conv_raw for n in names):
         return [], ""
     convs = [units.temperature_conversion(conv_raw[n]) for n in names]
     decl = [
@@ -270,7 +283,7 @@ def _temperature_from_counts(model: dict[str, Any], p: str, P: str) -> tuple[lis
     ]
     for i, (n, c) in enumerate(zip(names, convs, strict=True)):
         enc = ", int16" if c.encoding == "int16" else ""
-        label = n.replace("*/", "* /")
+        label = c_comment(n)
         body.append(f"    v = counts[{i}]; /* {label}: T = {c.gain!r} * v + {c.offset!r}{enc} */")
         if c.encoding == "int16":
             body.append(f"    if (v >= {units.INT16_SIGN_BIT!r}) {{")
@@ -304,7 +317,7 @@ def generate_c(
     gen = family_generator(fam)
     if not sample_interval_s > 0:
         raise ThermocalInputError(f"sample interval must be positive, got {sample_interval_s}")
-    p = c_identifier(prefix)
+    p = c_identifier(prefix, max_len=MAX_PREFIX_LEN)
     rate = model.get("rate") or {}
     interval = float(rate.get("interval_s") or 0.0)
     buf = math.ceil(interval / sample_interval_s) + 8 if interval > 0 else 2
@@ -320,8 +333,9 @@ def generate_c(
     convert = factor != 1.0
     conv_decl, conv_src = _temperature_from_counts(model, p, P)
     unit_defines = [
-        f'#define {P}_SIGNAL_UNIT "{su}" /* unit of signal, known_input and every result */',
-        f'#define {P}_TEMPERATURE_UNIT "{tu}" /* unit of temps_c[] */',
+        f"#define {P}_SIGNAL_UNIT {c_string(su)} /* unit of signal, known_input and every "
+        "result */",
+        f"#define {P}_TEMPERATURE_UNIT {c_string(tu)} /* unit of temps_c[] */",
     ]
     if convert:
         unit_defines.append(
@@ -349,7 +363,7 @@ def generate_c(
             *code.defines,
             "",
             f"/* temperature order of temps_c[] [{tu}]: "
-            + ", ".join(f"{i}={n}" for i, n in enumerate(model["temperatures"]))
+            + ", ".join(f"{i}={c_comment(n)}" for i, n in enumerate(model["temperatures"]))
             + " */",
             "",
             "typedef struct {",

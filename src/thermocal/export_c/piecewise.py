@@ -10,6 +10,7 @@ from thermocal.export_c.core import (
     ExportContext,
     FamilyCode,
 )
+from thermocal.identifiers import c_comment
 
 
 def generate(ctx: ExportContext) -> FamilyCode:
@@ -46,11 +47,12 @@ def generate(ctx: ExportContext) -> FamilyCode:
             f"{', '.join(map(repr, names))}"
         )
     k = names.index(used)
-    unit = str((d.get("signal") or {}).get("unit") or "signal unit").replace("*/", "* /")
+    unit = c_comment((d.get("signal") or {}).get("unit") or "signal unit")
+    method = c_comment(st.get("method"))
     n_b = int(bps.size)
     data = [
         ctx.clamp_arrays(),
-        f"/* line j: y = A[j] + S[j] * T for BP[j-1] <= T < BP[j] ({st.get('method')} method);",
+        f"/* line j: y = A[j] + S[j] * T for BP[j-1] <= T < BP[j] ({method} method);",
         f"   A [{unit}], S [{unit}/{ctx.tu}] */",
         ctx.array(f"{P}_A", icp),
         ctx.array(f"{P}_S", slp),
@@ -82,10 +84,10 @@ def generate(ctx: ExportContext) -> FamilyCode:
         update="\n".join(upd),
         defines=[
             f"#define {P}_N_BREAKPOINTS {n_b}",
-            f"#define {P}_TEMP_INDEX {k} /* temps_c[] entry the model uses ({used}) */",
+            f"#define {P}_TEMP_INDEX {k} /* temps_c[] entry the model uses ({c_comment(used)}) */",
         ],
         notes=[
-            f"Piecewise-linear model (SPEC 4b, {st.get('method')} method) in {used} [{ctx.tu}]:",
+            f"Piecewise-linear model (SPEC 4b, {method} method) in {used} [{ctx.tu}]:",
             "y = A[j] + S[j] T, j = number of breakpoints <= T; T clamped to the fitted range.",
             "Memoryless; call init once before use.",
         ],

@@ -11,6 +11,7 @@ from thermocal.export_c.core import (
     FamilyCode,
     _rate_buffer_code,
 )
+from thermocal.identifiers import c_comment
 
 N_ACCUMULATORS = 4
 """Partial sums of the terms in the generated C (term i goes to sum i mod 4; the sums are
@@ -175,7 +176,7 @@ def generate(ctx: ExportContext) -> FamilyCode:
         val = factors[0]
         for fct in factors[1:]:
             val = f"({val} * {fct})"
-        label = str(t.get("name", "")).replace("*/", "* /")
+        label = c_comment(t.get("name", ""))
         upd.append(f"acc{i % n_acc} += {val} * {P}_COEF[{i}]; /* {label} */")
     total = [f"acc{k}" for k in range(n_acc)]
     while len(total) > 1:  # a balanced sum of the partial sums

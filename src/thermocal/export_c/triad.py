@@ -16,7 +16,9 @@ from collections.abc import Sequence
 from typing import Any
 
 from thermocal import __version__
-from thermocal.export_c.core import CExport, c_identifier
+from thermocal.errors import ThermocalInputError
+from thermocal.export_c.core import CExport
+from thermocal.identifiers import c_comment, c_identifier, c_names
 from thermocal.turntable import model as tt_model
 
 _ARCSEC_RAD = math.pi / 648000.0
@@ -26,26 +28,34 @@ def _lit(x: float) -> str:
     return repr(float(x))
 
 
-def _triad_code(p: str, tri: Any, bias_to_data: float, real: str) -> tuple[str, str]:
-    """(declaration, definition) of one triad's correction function."""
+def _triad_code(p: str, tri: Any, bias_to_data: float, real: str, ident: str) -> tuple[str, str]:
+    """(declaration, definition) of one triad's correction function (``ident``: the triad's
+    name through :func:`thermocal.identifiers.c_identifier`)."""
     m = tri.model
-    name = f"{p}_{c_identifier(tri.name)}"
+    name = f"{p}_{ident}"  # two identifiers of the gate joined by '_': an identifier
+    label = c_comment(tri.name)
     bias_unit = "deg/h" if m.kind == "gyro" else "mg"
     P = name.upper()
     order = max(len(f.coef) for f in m.fits)
     rows = []
     for f in m.fits:
         c = [float(v) for v in f.coef] + [0.0] * (order - len(f.coef))
-        rows.append("    {" + ", ".join(_lit(v) for v in c) + "}, /* " + f.name + f" [{f.unit}] */")
+        rows.append(
+            "    {"
+            + ", ".join(_lit(v) for v in c)
+            + "}, /* "
+            + c_comment(f"{f.name} [{f.unit}]")
+            + " */"
+        )
     lines = [
-        f"/* {tri.name} triad: parameters as polynomials in (T - TREF), ascending powers */",
+        f"/* {label} triad: parameters as polynomials in (T - TREF), ascending powers */",
         f"static const double {P}_COEF[12][{order}] = {{",
         *rows,
         "};",
         f"static const double {P}_TREF = {_lit(m.tref_c)};",
         f"static const double {P}_T_LO = {_lit(m.t_lo_c)};",
         f"static const double {P}_T_HI = {_lit(m.t_hi_c)};",
-        f"/* bias unit ({bias_unit}) to the data's unit ({tri.unit}) */",
+        f"/* bias unit ({bias_unit}) to the data's unit ({c_comment(tri.unit)}) */",
         f"static const double {P}_BIAS_TO_DATA = {_lit(bias_to_data)};",
         "",
         f"void {name}_correct(double temp_c, const {real} x[3], {real} out[3])",
@@ -84,12 +94,12 @@ def _triad_code(p: str, tri: Any, bias_to_data: float, real: str) -> tuple[str, 
         "        + (m[0][0] * m[1][1] - m[0][1] * m[1][0]) * r[2]) / det);",
         "}",
     ]
-    decl = (
-        f"/* {tri.name}: out = (I + E(T))^-1 (x - b(T)) in {tri.unit}; columns "
-        f"{', '.join(tri.columns)}; T [degC] of {tri.temperature}, clamped to "
-        f"[{m.t_lo_c:g}, {m.t_hi_c:g}] */\n"
-        f"void {name}_correct(double temp_c, const {real} x[3], {real} out[3]);"
+    about = c_comment(
+        f"{tri.name}: out = (I + E(T))^-1 (x - b(T)) in {tri.unit}; columns "
+        f"{', '.join(map(str, tri.columns))}; T [degC] of {tri.temperature}, clamped to "
+        f"[{m.t_lo_c:g}, {m.t_hi_c:g}]"
     )
+    decl = f"/* {about} */\nvoid {name}_correct(double temp_c, const {real} x[3], {real} out[3]);"
     return decl, "\n".join(lines)
 
 
@@ -100,11 +110,19 @@ def generate_c_triads(triads: Sequence[Any], *, prefix: str, real: str = "double
     if real not in ("double", "float"):
         raise ValueError("real must be double or float")
     p = c_identifier(prefix)
+    used: dict[str, str] = {}
     decls, defs = [], []
+    seen = {f"{p.upper()}_H": "the guard of the file"}
     for tri in triads:
         bias_unit = "deg/h" if tri.model.kind == "gyro" else "mg"
         factor = float(units.convert([1.0], bias_unit, tri.unit)[0])
-        d, f = _triad_code(p, tri, factor, real)
+        ident = c_identifier(tri.name, used, what="triad")
+        d, f = _triad_code(p, tri, factor, real, ident)
+        for n in c_names(d + "\n" + f, f"{p}_{ident}"):
+            if seen.setdefault(n, f"triad {tri.name!r}") != f"triad {tri.name!r}":
+                raise ThermocalInputError(
+                    f"triad {tri.name!r} and {seen[n]} both give the C name {n}; rename one"
+                )
         decls.append(d)
         defs.append(f)
     guard = f"{p.upper()}_H"

@@ -9,6 +9,7 @@ from thermocal.export_c.core import (
     ExportContext,
     FamilyCode,
 )
+from thermocal.identifiers import c_comment
 
 
 def generate(ctx: ExportContext) -> FamilyCode:
@@ -26,7 +27,7 @@ def generate(ctx: ExportContext) -> FamilyCode:
     data = "\n".join(
         [
             ctx.clamp_arrays(),
-            f"/* b[j][k]: coefficient of dT^j * T0^k [{ctx.model['signal']['unit']}/"
+            f"/* b[j][k]: coefficient of dT^j * T0^k [{c_comment(ctx.model['signal']['unit'])}/"
             f"{ctx.tu}^(j+k)] */",
             ctx.array2(f"{P}_B", b),
             f"static const {r} {P}_T0_LO = {ctx.lit(lo)}; /* fitted start temperatures */",
