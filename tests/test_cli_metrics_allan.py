@@ -116,8 +116,8 @@ def test_allan_json_and_plot(gyro_csv, capsys, tmp_path) -> None:  # type: ignor
     )
     for key in ("tau_s", "adev", "adev_low", "adev_high", "unit", "noise"):
         assert key in obj
-    assert obj["unit"] == "deg/h"
-    taus, devs, _e, ns = allantools.oadev(rate, rate=2.0, data_type="freq", taus="octave")
+    assert obj["unit"] == "deg/s"  # the data's own unit
+    taus, devs, _e, ns = allantools.oadev(rate / 3600.0, rate=2.0, data_type="freq", taus="octave")
     np.testing.assert_allclose(obj["tau_s"], taus, rtol=1e-12)
     np.testing.assert_allclose(obj["adev"], devs, rtol=1e-9)
     assert obj["n_terms"] == ns.astype(int).tolist()
@@ -127,7 +127,8 @@ def test_allan_json_and_plot(gyro_csv, capsys, tmp_path) -> None:  # type: ignor
     assert isinstance(noise, dict) and isinstance(slope, dict)
     assert set(noise) == INTERFACE_NOISE_KEYS == set(slope)
     arw = noise["angle_random_walk"]
-    # white rate noise 0.2 °/h at 2 Hz: N = 0.2·√0.5 °/h·√s = 0.2·√0.5/60 °/√h
+    # white rate noise 0.2 °/h at 2 Hz: N = 0.2·√0.5 °/h·√s = 0.2·√0.5/60 °/√h (an angle
+    # figure: the data's angle unit, degrees)
     assert arw["unit"] == "deg/sqrt(h)"
     assert arw["value"] == pytest.approx(0.2 * math.sqrt(0.5) / 60.0, rel=0.05)
     for term in (noise["bias_instability"], slope["bias_instability"]):
