@@ -36,7 +36,8 @@ import numpy as np
 from markupsafe import Markup, escape
 
 from thermocal.defaults import DEFAULT_AVERAGING_S, WEAK_CORRELATION_LIMIT
-from thermocal.errors import ThermocalInputError
+from thermocal import units
+from thermocal.errors import ThermocalInputError, UnitError
 from thermocal.io import atomic_write
 from thermocal.models.base import condition_wording
 from thermocal.recording import Recording
@@ -62,8 +63,12 @@ from thermocal.report.analysis import (
     figures_of_merit as figures_of_merit,
 )
 from thermocal.report.analysis import (
+    in_data_unit as in_data_unit,
+)
+from thermocal.report.analysis import (
     known_input_of as known_input_of,
 )
+from thermocal.metrics import data_unit_of
 
 ILL_CONDITIONED = 1.0e6
 """Condition number (scaled design) above which the report warns: ill-conditioned in the
@@ -127,6 +132,13 @@ class ReportInputs:
     """Averaging time of bias stability and peak-to-peak [s] (default: the validation
     result's, else :data:`DEFAULT_AVERAGING_S`)."""
     extra: dict[str, Any] = field(default_factory=dict)
+    drift_reference_s: tuple[float, float] | None = None
+    """Drift angle before compensation: b0 is the mean over this window [s since the first
+    sample] (default the first 10 % of the run)."""
+    drift_bias: float | None = None
+    """Drift angle before compensation: this b0 [the data's unit] instead of a window."""
+    warnings_caught: tuple[str, ...] = ()
+    """``warning:`` lines thermocal printed while reading the runs (shown in the report)."""
 
 
 # --- number formatting -------------------------------------------------------------------
@@ -428,11 +440,34 @@ def _summary(
     return items
 
 
-def _coefficient_rows(model: dict[str, Any], key: str = "model") -> list[dict[str, Any]]:
+def model_factor(model: dict[str, Any], unit: str | None) -> tuple[str, float]:
+    """(the model's signal unit, k) with ``value[model unit] = k · value[unit]``; k = 1 when
+    ``unit`` is not given, equal, or of another kind (counts)."""
+    mu = str((model.get("signal") or {}).get("unit") or "")
+    if not unit or not mu or unit == mu:
+        return mu, 1.0
+    try:
+        return mu, float(units.convert(1.0, unit, mu))
+    except (UnitError, ThermocalInputError):
+        return mu, 1.0
+
+
+def _coefficient_rows(
+    model: dict[str, Any], key: str = "model", unit: str | None = None
+) -> list[dict[str, Any]]:
+    """The coefficients with their standard errors; with ``unit`` (the data's) every
+    coefficient whose unit starts with the model's signal unit is converted to it
+    (``deg/h/degC`` → ``deg/s/degC`` for °/s data: value / k)."""
+    mu, k = model_factor(model, unit)
     rows = []
     for i, c in enumerate(model.get("coefficients") or []):
         val = c.get("value")
         se = c.get("stderr")
+        cunit = str(c.get("unit", ""))
+        if k != 1.0 and unit and cunit.startswith(mu):
+            val = float(val) / k if _is_number(val) else val
+            se = float(se) / k if _is_number(se) else se
+            cunit = unit + cunit[len(mu) :]
         rel = None
         if _is_number(val) and _is_number(se) and float(val) != 0.0:
             rel = 100.0 * abs(float(se) / float(val))
@@ -443,7 +478,7 @@ def _coefficient_rows(model: dict[str, Any], key: str = "model") -> list[dict[st
                 "value": num(val, f"{key}.coefficients.{i}.value", digits=6),
                 "stderr": num(se, f"{key}.coefficients.{i}.stderr", digits=3),
                 "rel": num(rel, None, digits=3),
-                "unit": unit_label(str(c.get("unit", ""))),
+                "unit": unit_label(cunit),
             }
         )
     return rows
@@ -469,9 +504,14 @@ def _range_rows(model: dict[str, Any], key: str = "model") -> list[dict[str, Any
     return rows
 
 
-def _model_summary(entry: ModelEntry) -> dict[str, Any]:
+def _model_summary(entry: ModelEntry, unit: str | None = None) -> dict[str, Any]:
+    """One model's summary; with ``unit`` (the data's) its fit residual is converted to it."""
     m = entry.model
     fit = m.get("fit") or {}
+    _mu, k_fit = model_factor(m, unit)
+    rms_fit = fit.get("rms_residual")
+    if _is_number(rms_fit):
+        rms_fit = float(rms_fit) / k_fit
     params = m.get("params") or {}
     rate = m.get("rate") or {}
     cond = fit.get("condition_number")
@@ -479,7 +519,7 @@ def _model_summary(entry: ModelEntry) -> dict[str, Any]:
         "label": entry.label,
         "family": m.get("family"),
         "n_coefficients": num(len(m.get("coefficients") or []), f"models.{entry.label}.n_coef"),
-        "rms_residual": num(fit.get("rms_residual"), f"models.{entry.label}.rms_residual"),
+        "rms_residual": num(rms_fit, f"models.{entry.label}.rms_residual"),
         "condition_number": num(cond, f"models.{entry.label}.condition_number", digits=3),
         "r_squared": num(fit.get("r_squared"), None, digits=5),
         "n_samples": num(fit.get("n_samples"), None),
@@ -504,16 +544,16 @@ def _model_summary(entry: ModelEntry) -> dict[str, Any]:
     }
 
 
-def _model_details(inputs: ReportInputs) -> list[dict[str, Any]]:
+def _model_details(inputs: ReportInputs, unit: str | None = None) -> list[dict[str, Any]]:
     """Section 8 for every model given: its fit, range of validity and coefficients."""
     out = []
     for i, e in enumerate(inputs.models):
         key = "model" if i == 0 else f"models.{e.label}"
         out.append(
             {
-                "summary": _model_summary(e),
+                "summary": _model_summary(e, unit),
                 "ranges": _range_rows(e.model, key),
-                "coefficients": _coefficient_rows(e.model, key),
+                "coefficients": _coefficient_rows(e.model, key, unit),
                 "has_rates": bool((e.model.get("range") or {}).get("rate_c_per_min")),
                 "suffix": "" if i == 0 else f"-{i + 1}",
                 "primary": i == 0,
@@ -636,6 +676,8 @@ class _Analysis:
     fom_after: FiguresOfMerit
     allan_before: AllanAnalysis
     allan_after: AllanAnalysis
+    k: float = 1.0
+    """``value[canonical] = k · value[unit]``: the model's unit over the data's."""
 
 
 def _analyse(inputs: ReportInputs) -> _Analysis:
@@ -648,9 +690,14 @@ def _analyse(inputs: ReportInputs) -> _Analysis:
         raise ThermocalInputError(f"report: model labels must be unique, got {labels}")
     rec = inputs.recording
     signal = inputs.signal or (primary.model.get("signal") or {}).get("name")
-    applied = {e.label: apply_model(e.model, rec, signal) for e in inputs.models}
+    sig_col = signal if signal in rec.columns else (rec.signals[0] if rec.signals else None)
+    _, canon = rec.signal(sig_col)
+    # every figure in the data's own unit (the column's unit as given, issue 25)
+    unit, k = data_unit_of(rec, sig_col or "", canon)
+    applied = {
+        e.label: in_data_unit(apply_model(e.model, rec, signal), unit, k) for e in inputs.models
+    }
     main = applied[primary.label]
-    _, unit = rec.signal(signal if signal in rec.columns else None)
     temp_names = main.temp_names
     v = primary.validation or {}
     averaging_s = float(inputs.averaging_s or v.get("averaging_s") or DEFAULT_AVERAGING_S)
@@ -661,6 +708,8 @@ def _analyse(inputs: ReportInputs) -> _Analysis:
         rec.temperature_c(stage_temp) if stage_temp not in temp_names
         else main.temps_c[:, temp_names.index(stage_temp)]
     )  # fmt: skip
+    # drift angle: before about a stated reference constant (the mean over a window at the
+    # start), after with nothing removed but the known input (the model removes the bias)
     fom_before, fom_after = (
         figures_of_merit(
             main.time_s,
@@ -670,14 +719,17 @@ def _analyse(inputs: ReportInputs) -> _Analysis:
             meta=rec.meta,
             temp_name=stage_temp,
             temp_c=stage_temp_c,
+            drift_bias=drift_bias,
+            drift_reference_s=None if drift_bias is not None else inputs.drift_reference_s,
         )
-        for x in (main.signal, main.after_raw)
+        for x, drift_bias in ((main.signal, inputs.drift_bias), (main.after_raw, 0.0))
     )
     return _Analysis(
         primary, signal, unit, applied, main, temp_names, averaging_s, tau0, stage_temp,
         fom_before, fom_after,
         allan_of(main.time_s, main.before, tau0, unit),
         allan_of(main.time_s, main.after, tau0, unit),
+        k,
     )  # fmt: skip
 
 
@@ -722,7 +774,7 @@ def _report_figures(inputs: ReportInputs, an: _Analysis) -> dict[str, dict[str, 
         ),
     )
     if inputs.modeling is not None:
-        mod = apply_model(primary.model, inputs.modeling, signal)
+        mod = in_data_unit(apply_model(primary.model, inputs.modeling, signal), unit, an.k)
         add_fig(
             "fit",
             F.model_fit(mod.time_s, mod.before, mod.model_bias, unit=unit_label(unit), block=block),
@@ -796,15 +848,37 @@ def _report_figures(inputs: ReportInputs, an: _Analysis) -> dict[str, dict[str, 
     if fom_before.drift_angle is not None and fom_after.drift_angle is not None:
         add_fig(
             "drift",
-            F.drift_angle(main.time_s, fom_before.drift_angle, fom_after.drift_angle),
+            F.drift_angle(
+                main.time_s,
+                fom_before.drift_angle,
+                fom_after.drift_angle,
+                unit=unit_label(fom_before.drift_angle_unit or ""),
+            ),
             "Drift angle before and after compensation",
             cap(
-                "Drift angle: integral of the rate with its mean (the bias B0) removed, "
-                "before and after compensation."
+                "Angle error over time, θ(t) = ∫ (ω − Ω − b0) dt: before compensation (red) "
+                f"with {drift_reference_words(fom_before.drift_reference)}; after (blue) the "
+                "compensated rate integrated with no bias removed (the model removes it)."
             ),
         )
 
     return figs
+
+
+def drift_reference_words(ref: Any) -> str:
+    """How the constant b0 of the drift angle was chosen, in words (a
+    :class:`~thermocal.metrics.DriftReference` or None)."""
+    if ref is None:
+        return "no bias removed"
+    b0 = f"{fmt_num(ref.bias, 5)} {unit_label(ref.unit)}"
+    if ref.kind == "window":
+        return (
+            f"b0 = {b0}, the mean of the uncompensated rate over {fmt_num(ref.start_s)}…"
+            f"{fmt_num(ref.end_s)} s from the start of the run (a reference window)"
+        )
+    if ref.kind == "bias":
+        return f"the given b0 = {b0}"
+    return f"b0 = {b0}"
 
 
 def _noise_rows(an: _Analysis) -> list[dict[str, Any]]:
@@ -843,7 +917,8 @@ def _fom_rows(an: _Analysis) -> list[dict[str, Any]]:
          f"{unit_label(unit)}/°C", 4),
         ("sensitivity_mean_abs", "Temperature sensitivity, mean |ΔB/ΔT| of adjacent stages",
          f"{unit_label(unit)}/°C", 4),
-        ("drift_angle_max_deg", "Largest |drift angle|", "°", 4),
+        ("drift_angle_max", "Largest |drift angle|",
+         unit_label(fom_before.drift_angle_unit or ""), 4),
     ):  # fmt: skip
         b = getattr(fom_before, name)
         a = getattr(fom_after, name)
@@ -865,15 +940,26 @@ def _fom_rows(an: _Analysis) -> list[dict[str, Any]]:
             }
         )
 
+    tb, ta = fom_before.drift_angle_max_time_s, fom_after.drift_angle_max_time_s
+    if tb is not None and ta is not None:
+        fom_rows.append(
+            {
+                "label": "Largest |drift angle| reached at",
+                "unit": "h",
+                "before": num(tb / 3600.0, "fom.before.drift_angle_max_time_h", 4),
+                "after": num(ta / 3600.0, "fom.after.drift_angle_max_time_h", 4),
+                "improvement": num(None),
+            }
+        )
     return fom_rows
 
 
-def _comparison_rows(inputs: ReportInputs) -> list[dict[str, Any]]:
+def _comparison_rows(inputs: ReportInputs, unit: str | None = None) -> list[dict[str, Any]]:
     """One row per model: its summary and its validation figures."""
     comparison = []
     for e in inputs.models:
         ve = e.validation or {}
-        ms = _model_summary(e)
+        ms = _model_summary(e, unit)
         comparison.append(
             {
                 **ms,
@@ -954,7 +1040,7 @@ def build_report(inputs: ReportInputs) -> str:
         "version": __version__,
         "unit": unit_label(unit),
         "signal": signal,
-        "primary": _model_summary(primary),
+        "primary": _model_summary(primary, unit),
         "summary": summary,
         "overall": _overall(primary, summary),
         "warnings": _collect_warnings(inputs, an.applied),
@@ -963,7 +1049,7 @@ def build_report(inputs: ReportInputs) -> str:
         "files": [{"label": a, "path": b} for a, b in inputs.files],
         "figs": figs,
         "validations": _validation_tables(inputs, unit),
-        "comparison": _comparison_rows(inputs),
+        "comparison": _comparison_rows(inputs, unit),
         "fom_rows": _fom_rows(an),
         "truth_rows": truth_rows,
         "truth_std": (
@@ -972,8 +1058,8 @@ def build_report(inputs: ReportInputs) -> str:
             else None
         ),
         "noise_rows": _noise_rows(an),
-        "model_details": _model_details(inputs),
-        "coefficients": _coefficient_rows(primary.model),
+        "model_details": _model_details(inputs, unit),
+        "coefficients": _coefficient_rows(primary.model, "model", unit),
         "ranges": _range_rows(primary.model),
         "has_rates": bool((primary.model.get("range") or {}).get("rate_c_per_min")),
         "known_input": an.main.known_input,

@@ -196,7 +196,7 @@ def _channel_section(
         "condition_number": cond,
         "temperatures": list(applied.temp_names),
         "temp_range": _range_rows(md, key),
-        "coefficients": _coefficient_rows(md, key),
+        "coefficients": _coefficient_rows(md, key, unit),
         "before": fom[0],
         "after": fom[1],
         "sensitivity_unit": unit_label(f"{unit}/degC"),

@@ -253,8 +253,11 @@ def drift_angle(
     time_s: FloatArray,
     before_deg: FloatArray,
     after_deg: FloatArray,
+    *,
+    unit: str = "°",
 ) -> bytes:
-    """Drift angle [°] (integral of the bias-corrected rate) before and after compensation."""
+    """Drift angle [``unit``] (integral of the rate less a stated constant bias) before and
+    after compensation, against time [h]."""
     t = np.asarray(time_s, dtype=np.float64)
     with _figure(1, height_in=3.4) as (fig, axes):
         ax = axes[0]
@@ -263,7 +266,7 @@ def drift_angle(
         ax.plot(th, ya, color=AFTER_COLOR, lw=1.2, label="after compensation")
         ax.axhline(0.0, color="#999999", lw=0.6)
         ax.set_xlabel("time [h]", fontsize=9)
-        ax.set_ylabel("drift angle [°]", fontsize=9)
+        ax.set_ylabel(f"drift angle [{unit}]", fontsize=9)
         ax.legend(fontsize=8, loc="upper left", frameon=False)
         return _png(fig)
 
