@@ -27,6 +27,8 @@ import base64
 import datetime as _dt
 import hashlib
 import math
+import re
+import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -37,7 +39,7 @@ from markupsafe import Markup, escape
 
 from thermocal import units
 from thermocal.defaults import DEFAULT_AVERAGING_S, WEAK_CORRELATION_LIMIT
-from thermocal.errors import ThermocalInputError, UnitError
+from thermocal.errors import ThermocalInputError, ThermocalWarning, UnitError
 from thermocal.io import atomic_write
 from thermocal.metrics import data_unit_of
 from thermocal.models.base import condition_wording
@@ -231,8 +233,54 @@ def sha256_of(path: str | Path) -> str | None:
     return h.hexdigest()
 
 
-def _run_info(role: str, rec: Recording, path: str | None, signal: str | None) -> dict[str, Any]:
+GAP_SHARE_WARN = 0.10
+"""Share of a run's time span in gaps above which the report warns."""
+
+
+def gap_share(rec: Recording) -> tuple[int, float, float]:
+    """(number of gaps, their total length [s], their share of the time span)."""
+    gaps = rec.gaps()
+    total = float(sum(g.length_s for g in gaps))
+    span = rec.duration_s
+    return len(gaps), total, (total / span if span > 0 else 0.0)
+
+
+def conversions_of(rec: Recording, signal: str | None, shown_unit: str) -> list[str]:
+    """Every conversion applied to a run, in words: the time column's unit, the signal's
+    unit as given (and where it came from) and the unit the report shows, a scale factor K
+    of raw counts, each raw-count temperature's ``T = gain·counts + offset``."""
+    src = rec.unit_sources
+    out = [
+        f"time: column in {rec.time_unit}"
+        + (f" ({src['<time>']})" if src.get("<time>") else "")
+        + ("" if rec.time_unit == "s" else ", converted to s")
+    ]
+    if signal:
+        given = rec.units.get(signal, "") or "?"
+        line = f"signal {signal}: {given}" + (f" ({src[signal]})" if src.get(signal) else "")
+        if given == "counts" and rec.meta.scale_factor is not None:
+            line += (
+                f", converted with the scale factor K = {rec.meta.scale_factor:.10g} "
+                f"{rec.meta.scale_factor_unit or ''}".rstrip()
+            )
+        line += f"; figures shown in {unit_label(shown_unit)}"
+        out.append(line)
+    for name in rec.temperatures:
+        u = rec.units.get(name, "")
+        conv = rec.meta.temperature_conversion.get(name)
+        where = f" ({src[name]})" if src.get(name) else ""
+        if conv is not None and u == "counts":
+            out.append(f"temperature {name}: raw counts{where}, {conv.describe()}")
+        else:
+            out.append(f"temperature {name}: {unit_label(u or 'degC')}{where}")
+    return out
+
+
+def _run_info(
+    role: str, rec: Recording, path: str | None, signal: str | None, shown_unit: str = ""
+) -> dict[str, Any]:
     sig = signal if signal in rec.columns else (rec.signals[0] if rec.signals else None)
+    n_gaps, gap_s, share = gap_share(rec)
     temps = [c for c in rec.temperatures if c in rec.columns]
     t_lo = t_hi = None
     if temps:
@@ -245,7 +293,10 @@ def _run_info(role: str, rec: Recording, path: str | None, signal: str | None) -
         "n_samples": rec.n_samples,
         "duration_h": rec.duration_s / 3600.0,
         "interval_s": rec.sample_interval_s,
-        "n_gaps": len(rec.gaps()),
+        "n_gaps": n_gaps,
+        "gap_s": gap_s,
+        "gap_share_pct": 100.0 * share,
+        "conversions": conversions_of(rec, sig, shown_unit or rec.units.get(sig or "", "")),
         "signal": sig,
         "signal_unit": unit_label(rec.units.get(sig, "")) if sig else "",
         "temperatures": ", ".join(temps),
@@ -596,14 +647,113 @@ def _truth_rows(
     return rows
 
 
-def _collect_warnings(inputs: ReportInputs, applied: dict[str, RunSignals]) -> list[dict[str, str]]:
+def _core(text: str, labels: Sequence[str]) -> str:
+    """A warning's text without the prefixes the report and the commands put before it
+    (``warning:``, ``label:``, ``label on the … run:``, ``FILE:``), normalised, so that one
+    finding said by several sources is shown once."""
+    t = " ".join(text.split())
+    alts = "|".join(re.escape(lab) for lab in sorted(labels, key=len, reverse=True))
+    pattern = re.compile(
+        r"^(?:warning: |(?:" + (alts or "(?!)") + r")(?: on the [a-z]+ run)?: "
+        r"|[^:\s]+\.(?:csv|parquet|ulg|bin|txt|log|json)(?: \[[^\]]*\])?: )",
+        re.IGNORECASE,
+    )
+    while True:
+        new = pattern.sub("", t, count=1)
+        if new == t:
+            break
+        t = new
+    return t.rstrip(". ").lower()
+
+
+def _adequacy_of(entry: ModelEntry) -> dict[str, Any] | None:
+    """The model file's ``adequacy`` record (see the adequacy check) as table rows, or None
+    for files without one."""
+    return adequacy_rows(entry.model.get("adequacy"), f"adequacy.{entry.label}", entry.label)
+
+
+def adequacy_rows(ad: Any, key: str, label: str) -> dict[str, Any] | None:
+    """``{"label", "verdict", "overrides", "tests": [{name, figure, threshold, unit,
+    verdict, override, message}]}`` from an ``adequacy`` record; None when there is none."""
+    if not isinstance(ad, dict):
+        return None
+    tests = []
+    for i, t in enumerate(ad.get("tests") or []):
+        if not isinstance(t, dict):
+            continue
+        u = str(t.get("unit") or "")
+        tests.append(
+            {
+                "name": str(t.get("name", f"test {i + 1}")),
+                "figure": num(t.get("figure") if _is_number(t.get("figure")) else None,
+                              f"{key}.{t.get('name', i)}.figure", 4, unit_label(u)),
+                "threshold": num(t.get("threshold") if _is_number(t.get("threshold")) else None,
+                                 f"{key}.{t.get('name', i)}.threshold", 4, unit_label(u)),
+                "verdict": str(t.get("verdict") or "n/a"),
+                "override": t.get("override") or "",
+                "message": str(t.get("message") or ""),
+            }
+        )  # fmt: skip
+    verdict = str(ad.get("verdict") or "n/a")
+    return {
+        "label": label,
+        "verdict": verdict,
+        "overrides": [str(o) for o in ad.get("overrides") or []],
+        "tests": tests,
+        "css": {"pass": "pass", "fail": "fail", "overridden": "warn"}.get(verdict, "na"),
+    }
+
+
+def _collect_warnings(
+    inputs: ReportInputs,
+    applied: dict[str, RunSignals],
+    an: _Analysis | None = None,
+    runs: Sequence[dict[str, Any]] = (),
+    run_warnings: Sequence[str] = (),
+) -> list[dict[str, str]]:
+    """Every warning once (:func:`_core` compares them): the validation results', the
+    models' (conditioning, adequacy), extrapolation, what thermocal printed while reading
+    and analysing the runs, gaps, and a recording that is the modelling data itself."""
     out: list[dict[str, str]] = []
     seen: set[str] = set()
+    labels = [e.label for e in inputs.models]
 
     def add(kind: str, text: str) -> None:
-        if text not in seen:
-            seen.add(text)
+        key = _core(text, labels)
+        if key not in seen and not any(key in k or k in key for k in seen if len(k) > 20):
+            seen.add(key)
             out.append({"kind": kind, "text": text})
+
+    if an is not None and an.role == "modelling":
+        add(
+            "data",
+            "the recording is the data the model was fitted on (the modelling run): the "
+            "figures below show how well the model fits, not how it performs on an "
+            "independent run.",
+        )
+    for run in runs:
+        if run.get("gap_share_pct", 0.0) > 100.0 * GAP_SHARE_WARN:
+            add(
+                "data",
+                f"{run['file']} ({run['role']} run): {run['n_gaps']} gap(s) cover "
+                f"{fmt_num(run['gap_share_pct'], 3)} % of its {fmt_num(run['duration_h'], 3)} h; "
+                "the figures use only the samples recorded.",
+            )
+    for w in inputs.warnings_caught:
+        add("input", w)
+    for w in run_warnings:
+        add("analysis", w)
+    for entry in inputs.models:
+        ad = _adequacy_of(entry)
+        if ad is not None and ad["verdict"] in ("fail", "overridden"):
+            failed = ", ".join(t["name"] for t in ad["tests"] if t["verdict"] == "fail")
+            add(
+                "adequacy",
+                f"{entry.label}: the data it was fitted on "
+                + ("failed" if ad["verdict"] == "fail" else "failed (overridden at fit time by "
+                   + (", ".join(ad["overrides"]) or "an override") + ")")
+                + f" the adequacy test(s) {failed or '—'}; see the adequacy table.",
+            )  # fmt: skip
 
     for entry in inputs.models:
         v = entry.validation or {}
@@ -629,7 +779,8 @@ def _collect_warnings(inputs: ReportInputs, applied: dict[str, RunSignals]) -> l
         sig = applied.get(entry.label)
         if sig is not None:
             for w in sig.warnings:
-                add("extrapolation", f"{entry.label} on the validation run: {w}")
+                where = an.run_name if an is not None else "validation run"
+                add("extrapolation", f"{entry.label} on the {where}: {w}")
     if inputs.models and not inputs.models[0].validation:
         add(
             "validation",
@@ -678,6 +829,33 @@ class _Analysis:
     allan_after: AllanAnalysis
     k: float = 1.0
     """``value[canonical] = k · value[unit]``: the model's unit over the data's."""
+    role: str = "validation"
+    """The recording's role: ``modelling`` (a model was fitted on it), ``validation`` (a
+    validation result was given) or ``test`` (:func:`recording_role`)."""
+    recording_sha256: str | None = None
+
+    @property
+    def run_name(self) -> str:
+        """The recording named by its role, e.g. ``"modelling run"``."""
+        return f"{self.role} run"
+
+
+def recording_role(inputs: ReportInputs, sha256: str | None) -> str:
+    """What the recording is to the models: ``"modelling"`` when one of them was fitted on
+    it (its SHA-256, else its file name, among the model files' ``data``), else
+    ``"validation"`` when a validation result was given, else ``"test"``."""
+    name = Path(inputs.recording_path).name if inputs.recording_path else None
+    for e in inputs.models:
+        for d in e.model.get("data") or []:
+            if not isinstance(d, dict):
+                continue
+            if sha256 is not None and d.get("sha256") == sha256:
+                return "modelling"
+            if sha256 is None and name is not None and d.get("file") == name:
+                return "modelling"
+    if any(e.validation for e in inputs.models):
+        return "validation"
+    return "test"
 
 
 def _analyse(inputs: ReportInputs) -> _Analysis:
@@ -690,6 +868,8 @@ def _analyse(inputs: ReportInputs) -> _Analysis:
         raise ThermocalInputError(f"report: model labels must be unique, got {labels}")
     rec = inputs.recording
     signal = inputs.signal or (primary.model.get("signal") or {}).get("name")
+    rec_sha = sha256_of(inputs.recording_path) if inputs.recording_path else None
+    role = recording_role(inputs, rec_sha)
     sig_col = signal if signal in rec.columns else (rec.signals[0] if rec.signals else None)
     _, canon = rec.signal(sig_col)
     # every figure in the data's own unit (the column's unit as given, issue 25)
@@ -729,7 +909,7 @@ def _analyse(inputs: ReportInputs) -> _Analysis:
         fom_before, fom_after,
         allan_of(main.time_s, main.before, tau0, unit),
         allan_of(main.time_s, main.after, tau0, unit),
-        k,
+        k, role, rec_sha,
     )  # fmt: skip
 
 
@@ -747,7 +927,7 @@ def _report_figures(inputs: ReportInputs, an: _Analysis) -> dict[str, dict[str, 
     panels = []
     if inputs.modeling is not None:
         panels.append(_temperature_panel("Modelling run", inputs.modeling, temp_names))
-    panels.append(_temperature_panel("Validation run", rec, temp_names))
+    panels.append(_temperature_panel(an.run_name.capitalize(), rec, temp_names))
     stages = _stages_from(primary.validation)
     figs: dict[str, dict[str, str]] = {}
 
@@ -770,7 +950,7 @@ def _report_figures(inputs: ReportInputs, an: _Analysis) -> dict[str, dict[str, 
             + ", ".join(temp_names)
             + ") and the chamber air temperature (dashed) against time, for "
             + ("the modelling run (top) and " if inputs.modeling is not None else "")
-            + "the validation run."
+            + f"the {an.run_name}."
         ),
     )
     if inputs.modeling is not None:
@@ -798,7 +978,8 @@ def _report_figures(inputs: ReportInputs, an: _Analysis) -> dict[str, dict[str, 
         ),
         "Bias against time, before and after compensation",
         cap(
-            f"Validation run: bias{avg_text} before (red) and after (blue) compensation with the "
+            f"{an.run_name.capitalize()}: bias{avg_text} before (red) and after (blue) "
+            "compensation with the "
             f"{primary.label} model; {temp_names[0]} dotted (right axis)"
             + ("; shaded: temperature-hold stages used for stability and repeatability."
                if stages else ".")
@@ -816,7 +997,8 @@ def _report_figures(inputs: ReportInputs, an: _Analysis) -> dict[str, dict[str, 
         ),
         "Bias against temperature, before and after compensation",
         cap(
-            f"Validation run: bias against {temp_names[0]}, before and after compensation; "
+            f"{an.run_name.capitalize()}: bias against {temp_names[0]}, before and after "
+            "compensation; "
             f"dots: {avg_text.strip(' ()') or 'samples'}, lines: means in temperature bins "
             "with their standard errors."
         ),
@@ -841,7 +1023,7 @@ def _report_figures(inputs: ReportInputs, an: _Analysis) -> dict[str, dict[str, 
         ),
         "Allan deviation before and after compensation",
         cap(
-            "Overlapping Allan deviation of the validation run before and after "
+            f"Overlapping Allan deviation of the {an.run_name} before and after "
             "compensation; bars: confidence intervals."
         ),
     )
@@ -1023,15 +1205,24 @@ def build_report(inputs: ReportInputs) -> str:
     """
     from thermocal import __version__
 
-    an = _analyse(inputs)
+    # every warning thermocal gives while the numbers and figures are made is shown in the
+    # report too (and still reaches the caller: re-issued below)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        an = _analyse(inputs)
+        figs = _report_figures(inputs, an)
+    for w in caught:
+        warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
     primary, rec, unit, signal = an.primary, inputs.recording, an.unit, an.signal
-    figs = _report_figures(inputs, an)
     truth_rows = _truth_rows(inputs, an.applied, unit)
     runs = []
     if inputs.modeling is not None:
-        runs.append(_run_info("modelling", inputs.modeling, inputs.modeling_path, signal))
-    runs.append(_run_info("validation", rec, inputs.recording_path, signal))
+        runs.append(_run_info("modelling", inputs.modeling, inputs.modeling_path, signal, unit))
+    runs.append(_run_info(an.role, rec, inputs.recording_path, signal, unit))
     summary = _summary(primary, an.fom_before, an.fom_after, unit)
+    run_warnings = [
+        " ".join(str(w.message).split()) for w in caught if issubclass(w.category, ThermocalWarning)
+    ]
     ctx = {
         "title": inputs.title,
         "sensor": inputs.sensor or rec.meta.sensor_id or "",
@@ -1043,7 +1234,10 @@ def build_report(inputs: ReportInputs) -> str:
         "primary": _model_summary(primary, unit),
         "summary": summary,
         "overall": _overall(primary, summary),
-        "warnings": _collect_warnings(inputs, an.applied),
+        "warnings": _collect_warnings(inputs, an.applied, an, runs, run_warnings),
+        "run_name": an.run_name,
+        "role": an.role,
+        "adequacy": [a for a in (_adequacy_of(e) for e in inputs.models) if a is not None],
         "runs": runs,
         "notes": list(inputs.notes),
         "files": [{"label": a, "path": b} for a, b in inputs.files],
