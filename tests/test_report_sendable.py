@@ -189,3 +189,17 @@ def test_one_finding_from_several_sources_is_shown_once(work: Path) -> None:
     html = build_report(inputs)
     hits = [w for w in _warnings(html) if "2350 samples outside" in w]
     assert len(hits) == 1, hits
+
+
+def test_an_empty_figure_says_why(monkeypatch: pytest.MonkeyPatch) -> None:
+    from thermocal.report import figures as F
+
+    drawn: list[Any] = []
+    monkeypatch.setattr(F, "_png", lambda fig: drawn.append(fig) or b"png")
+    t = np.arange(100.0)
+    F.bias_vs_temperature(np.full(100, 25.0), t, t, unit="°/s", temperature_label="T1")
+    F.allan_deviation([F.AllanCurve("after compensation", np.array([1.0]), np.array([0.0]))],
+                      unit="°/s")  # fmt: skip
+    texts = [" ".join(tx.get_text() for tx in fig.axes[0].texts) for fig in drawn]
+    assert "T1 does not vary (constant at 25 °C)" in texts[0]
+    assert "no Allan deviation to draw for after compensation" in texts[1]
