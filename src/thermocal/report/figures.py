@@ -327,12 +327,12 @@ __all__ = [
     "AllanCurve",
     "TemperaturePanel",
     "allan_deviation",
-    "say_why_empty",
     "bias_vs_temperature",
     "bias_vs_time",
     "decimate_for_plot",
     "drift_angle",
     "model_fit",
+    "say_why_empty",
     "temperature_profile",
 ]
 
