@@ -272,7 +272,8 @@ def conversions_of(rec: Recording, signal: str | None, shown_unit: str) -> list[
         if conv is not None and u == "counts":
             out.append(f"temperature {name}: raw counts{where}, {conv.describe()}")
         else:
-            out.append(f"temperature {name}: {unit_label(u or 'degC')}{where}")
+            shown = unit_label(u) if u else "unit not stated"
+            out.append(f"temperature {name}: {shown}{where}")
     return out
 
 
