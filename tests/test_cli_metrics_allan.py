@@ -78,17 +78,19 @@ def test_metrics_json(gyro_csv, capsys) -> None:  # type: ignore[no-untyped-def]
         "temperature_sensitivity",
     ):
         assert key in obj
-    omega = units.EARTH_RATE_DEG_H * math.sin(math.radians(52.0))
-    assert obj["unit"] == "deg/h" and obj["averaging_s"] == 10.0
+    # every figure in the data's own unit (°/s), named in "unit" (INTERFACE common rules)
+    omega = units.EARTH_RATE_DEG_H * math.sin(math.radians(52.0)) / 3600.0  # [°/s]
+    rate_dps = rate / 3600.0
+    assert obj["unit"] == "deg/s" and obj["averaging_s"] == 10.0
     assert obj["earth_rate_removed"] == pytest.approx(omega, rel=1e-12)
-    assert obj["bias"] == pytest.approx(rate.mean() - omega, rel=1e-9)
-    blocks = rate.reshape(-1, 20).mean(axis=1)
+    assert obj["bias"] == pytest.approx(rate_dps.mean() - omega, rel=1e-9)
+    blocks = rate_dps.reshape(-1, 20).mean(axis=1)
     assert obj["bias_stability"] == pytest.approx(np.std(blocks, ddof=1), rel=1e-9)
     assert obj["peak_to_peak"] == pytest.approx(np.ptp(blocks), rel=1e-9)
     ts = obj["temperature_sensitivity"]
-    assert isinstance(ts, dict)
+    assert isinstance(ts, dict) and ts["unit"] == "deg/s/degC"
     # two holds (20 and 40 °C): (B40 − B20)/20 with B = 5 + 0.01 T → 0.01 °/h/°C
-    assert ts["ls_slope"] == pytest.approx(0.01, abs=0.002)
+    assert ts["ls_slope"] == pytest.approx(0.01 / 3600.0, abs=0.002 / 3600.0)
     assert ts["mean_abs_adjacent"] == pytest.approx(ts["ls_slope"], rel=1e-9)
     assert obj["n_stages"] == 2 and obj["n_samples"] == t.size
 
@@ -114,8 +116,8 @@ def test_allan_json_and_plot(gyro_csv, capsys, tmp_path) -> None:  # type: ignor
     )
     for key in ("tau_s", "adev", "adev_low", "adev_high", "unit", "noise"):
         assert key in obj
-    assert obj["unit"] == "deg/h"
-    taus, devs, _e, ns = allantools.oadev(rate, rate=2.0, data_type="freq", taus="octave")
+    assert obj["unit"] == "deg/s"  # the data's own unit
+    taus, devs, _e, ns = allantools.oadev(rate / 3600.0, rate=2.0, data_type="freq", taus="octave")
     np.testing.assert_allclose(obj["tau_s"], taus, rtol=1e-12)
     np.testing.assert_allclose(obj["adev"], devs, rtol=1e-9)
     assert obj["n_terms"] == ns.astype(int).tolist()
@@ -125,7 +127,8 @@ def test_allan_json_and_plot(gyro_csv, capsys, tmp_path) -> None:  # type: ignor
     assert isinstance(noise, dict) and isinstance(slope, dict)
     assert set(noise) == INTERFACE_NOISE_KEYS == set(slope)
     arw = noise["angle_random_walk"]
-    # white rate noise 0.2 °/h at 2 Hz: N = 0.2·√0.5 °/h·√s = 0.2·√0.5/60 °/√h
+    # white rate noise 0.2 °/h at 2 Hz: N = 0.2·√0.5 °/h·√s = 0.2·√0.5/60 °/√h (an angle
+    # figure: the data's angle unit, degrees)
     assert arw["unit"] == "deg/sqrt(h)"
     assert arw["value"] == pytest.approx(0.2 * math.sqrt(0.5) / 60.0, rel=0.05)
     for term in (noise["bias_instability"], slope["bias_instability"]):

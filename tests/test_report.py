@@ -458,11 +458,11 @@ def test_report_numbers_equal_the_json(case: dict[str, Any]) -> None:
     assert m["coefficients"][1]["value"] == pytest.approx(TRUE_SLOPE, abs=1e-3)
 
 
-def _drift_reference(time_s: FloatArray, rate_deg_h: FloatArray) -> FloatArray:
-    """θ(t) = ∫ (ω − mean ω) dt / 3600 [°], scipy's cumulative trapezoid."""
+def _drift_reference(time_s: FloatArray, rate_deg_h: FloatArray, b0: float) -> FloatArray:
+    """θ(t) = ∫ (ω − b0) dt / 3600 [°], scipy's cumulative trapezoid."""
     from scipy.integrate import cumulative_trapezoid
 
-    out: FloatArray = cumulative_trapezoid(rate_deg_h - rate_deg_h.mean(), time_s, initial=0.0)
+    out: FloatArray = cumulative_trapezoid(rate_deg_h - b0, time_s, initial=0.0)
     return out / 3600.0
 
 
@@ -473,15 +473,17 @@ def test_report_drift_angle_and_flags(case: dict[str, Any]) -> None:
     coef = [c["value"] for c in case["model"]["coefficients"]]
     t1 = np.clip(val.column("T1"), *case["model"]["range"]["temperature_c"]["T1"])
     after = gyro - (coef[0] + coef[1] * t1)
-    theta_before = _drift_reference(val.time_s, gyro)
-    theta_after = _drift_reference(val.time_s, after)
+    # before: b0 = the mean over the first 10 % of the run (a stated reference, not the
+    # run's own mean); after: the compensated rate with nothing removed (issue 25 item 6)
+    rel = val.time_s - val.time_s[0]
+    b0 = float(np.mean(gyro[rel <= 0.1 * rel[-1]]))
+    theta_before = _drift_reference(val.time_s, gyro, b0)
+    theta_after = _drift_reference(val.time_s, after, 0.0)
     # the report's drift angle (thermocal.metrics) equals scipy's trapezoid integral
-    check_number(
-        tags, "fom.before.drift_angle_max_deg", float(np.max(np.abs(theta_before))), rel=1e-9
-    )
-    check_number(
-        tags, "fom.after.drift_angle_max_deg", float(np.max(np.abs(theta_after))), rel=1e-9
-    )
+    check_number(tags, "fom.before.drift_angle_max", float(np.max(np.abs(theta_before))), rel=1e-9)
+    check_number(tags, "fom.after.drift_angle_max", float(np.max(np.abs(theta_after))), rel=1e-9)
+    k_b = int(np.argmax(np.abs(theta_before)))
+    check_number(tags, "fom.before.drift_angle_max_time_h", float(rel[k_b]) / 3600.0, rel=1e-9)
     # compensation removes the temperature drift: the drift angle shrinks a lot
     assert np.max(np.abs(theta_after)) < 0.1 * np.max(np.abs(theta_before))
     # flags: r of these square-wave profiles is far from weak → correlation flag fails

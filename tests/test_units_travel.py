@@ -136,15 +136,15 @@ def test_units_in_column_names(tmp_path: Path, capsys: pytest.CaptureFixture[str
     assert d["duration_s"] == pytest.approx(10.0, rel=1e-9)
     assert d["columns"]["gyrox rad/s"]["unit"] == "rad/s"
     assert "no unit stated" not in err
-    # 1e-4 rad/s = 20.6265 °/h: metrics reports the bias in °/h (canonical) naming it
+    # metrics reports the bias of 1e-4 rad/s in rad/s, the column's unit, naming it
     code, out, err = _run(
         capsys, "metrics", str(f), "--time", "time (ms)", "--signal", "gyrox rad/s",
         "--average", "1", "--json",
     )  # fmt: skip
     assert code == 0, err
     m = json.loads(out)
-    assert m["unit"] == "deg/h"
-    assert m["bias"] == pytest.approx(1e-4 * 180.0 / np.pi * 3600.0, rel=1e-9)
+    assert m["unit"] == "rad/s"  # the data's own unit (issue 25)
+    assert m["bias"] == pytest.approx(1e-4, rel=1e-9)
 
 
 def test_nothing_stated_gives_a_warning_naming_the_default(

@@ -46,9 +46,10 @@ rate_random_walk K   °/h/√h              µg/√h (accel. random walk)   U/�
 rate_ramp R          °/h/h               µg/h                         U/s
 ===================  ==================  ===========================  =========================
 
-(``(°/h)·s`` is exactly one arcsec; ``(°/h)·√s = (°/√h)/60``.)  Rates in
-``deg/s`` or ``rad/s`` and accelerations in ``g``, ``ug``, ``m/s^2`` are first
-scaled to [°/h] / [mg].
+(``(°/h)·s`` is exactly one arcsec; ``(°/h)·√s = (°/√h)/60``.)  Rates in ``deg/s``
+or ``rad/s`` keep the data's own unit (:data:`ANGLE_RATE_TERMS`): Q in arcsec or µrad,
+N in °/√h or rad/√h, B in °/s or rad/s, K in (°/s)/√h or (rad/s)/√h, R in (°/s)/h or
+(rad/s)/h.  Accelerations in ``g``, ``ug``, ``m/s^2`` are first scaled to [mg].
 
 References: IEEE Std 952-1997 (R2008) Annex C; W. J. Riley, *Handbook of
 Frequency Stability Analysis*, NIST SP 1065 (2008); IEEE Std 1554-2005.
@@ -600,6 +601,29 @@ def overlapping_adev(
 # --- noise terms -----------------------------------------------------------------------
 
 
+_SQRT_H_PER_SQRT_S: Final = math.sqrt(units.SECONDS_PER_HOUR)  # √h = 60 √s
+
+ANGLE_RATE_TERMS: Final[dict[str, tuple[tuple[float, str, str], ...]]] = {
+    "deg/s": (
+        (units.SECONDS_PER_HOUR, "arcsec", "quantization"),  # (°/s)·s = ° = 3600″
+        (_SQRT_H_PER_SQRT_S, "deg/sqrt(h)", "angle random walk"),  # °/√s = 60 °/√h
+        (1.0, "deg/s", "bias instability"),
+        (_SQRT_H_PER_SQRT_S, "deg/s/sqrt(h)", "rate random walk"),
+        (units.SECONDS_PER_HOUR, "deg/s/h", "rate ramp"),
+    ),
+    "rad/s": (
+        (1e6, "urad", "quantization"),  # (rad/s)·s = rad = 10⁶ µrad
+        (_SQRT_H_PER_SQRT_S, "rad/sqrt(h)", "angle random walk"),
+        (1.0, "rad/s", "bias instability"),
+        (_SQRT_H_PER_SQRT_S, "rad/s/sqrt(h)", "rate random walk"),
+        (units.SECONDS_PER_HOUR, "rad/s/h", "rate ramp"),
+    ),
+}
+"""Noise-term units of rates in [°/s] and [rad/s]: each figure in the data's own unit
+(rate terms in the data's rate unit, angle terms in its angle unit) on IEEE 952's time
+bases (√h, h); (factor, unit, label) per term as :func:`term_units` gives them."""
+
+
 def term_units(unit: str) -> tuple[float, tuple[tuple[float, str, str], ...]]:
     """Scale to the base unit and, per term, (factor, unit string, label).
 
@@ -610,6 +634,8 @@ def term_units(unit: str) -> tuple[float, tuple[tuple[float, str, str], ...]]:
         u = units.normalize_signal_unit(unit)
     except ThermocalInputError:
         u = unit
+    if u in ANGLE_RATE_TERMS:
+        return 1.0, ANGLE_RATE_TERMS[u]
     if u in units.RATE_UNITS:
         return units.RATE_UNITS[u], (
             (1.0, "arcsec", "quantization"),

@@ -1,9 +1,11 @@
 """Gyro and accelerometer figures of merit (SPEC §1; IEEE Std 952/647 style).
 
-Rates are in [°/h] (gyros) or [mg] (accelerometers), times in [s], temperatures
-in [°C].  Every function here is a pure function on arrays;
-:func:`compute_metrics` runs them on a :class:`~thermocal.recording.Recording`
-for the command line and the reports.
+The pure functions take rates in any one unit (their results are in the same unit;
+the drift angle's time base is stated by ``time_unit_s``), times in [s], temperatures
+in [°C].  :func:`compute_metrics` runs them on a :class:`~thermocal.recording.Recording`
+for the command line and the reports and gives every figure in the data's own unit
+(the signal column's unit as given: °/s data give °/s, rad/s data rad/s, g data g;
+raw counts converted by a scale factor K give the canonical [°/h] or [mg]).
 
 Averages over a stated time ("bias stability at 100 s") are non-overlapping
 block means of ``m = round(averaging_s / τ0)`` consecutive samples, formed
@@ -63,13 +65,65 @@ class Stage:
 
 
 @dataclass(frozen=True)
-class MetricsResult:
-    """Figures of merit of one signal (JSON keys of ``thermocal metrics``).
+class DriftReference:
+    """The constant bias b0 removed before the drift angle is integrated (SPEC §1).
 
-    ``bias`` has the earth-rate component ``earth_rate_removed`` [°/h] taken off;
+    Attributes
+    ----------
+    kind : ``"window"`` — b0 is the mean of ω − Ω_axis over the reference window
+        [``start_s``, ``end_s``] (seconds since the first sample); ``"bias"`` — b0 was
+        given (``--drift-bias``); ``"model"`` — a compensation model removed the bias
+        (b0 = 0 on the compensated output).
+    start_s, end_s : the window [s since the first sample] (None unless ``"window"``).
+    bias : b0 [``unit``], earth rate already removed (comparable with ``bias``).
+    unit : the rate unit of ``bias``.
+    n_samples : samples in the window (None unless ``"window"``).
+    """
+
+    kind: str
+    start_s: float | None
+    end_s: float | None
+    bias: float
+    unit: str
+    n_samples: int | None = None
+
+
+@dataclass(frozen=True)
+class DriftExtreme:
+    """The drift angle's end value and its largest magnitude (SPEC §1, seed 001).
+
+    ``end`` θ(t_end), ``max_abs`` max_t |θ(t)|, reached at ``max_time_s`` [s since the
+    first sample]; all angles in [``unit``]."""
+
+    end: float
+    max_abs: float
+    max_time_s: float
+    unit: str
+
+
+DEFAULT_DRIFT_REFERENCE_FRACTION = 0.1
+"""Default drift-angle reference window: the first 10 % of the run's duration."""
+
+RATE_ANGLE_UNITS: dict[str, tuple[str, float]] = {
+    "deg/h": ("deg", units.SECONDS_PER_HOUR),
+    "deg/s": ("deg", 1.0),
+    "rad/s": ("rad", 1.0),
+}
+"""Rate unit → (the angle unit of its integral, seconds per the rate's time unit)."""
+
+
+@dataclass(frozen=True)
+class MetricsResult:
+    """Figures of merit of one signal (JSON keys of ``thermocal metrics``), every rate
+    figure in ``unit`` — the data's own unit (module docstring).
+
+    ``bias`` has the earth-rate component ``earth_rate_removed`` [unit] taken off;
     ``bias_stability`` and ``peak_to_peak`` are over ``averaging_s`` averages;
-    ``drift_angle`` is the final value of the integral of the bias-corrected
-    rate [°] (trapezoid rule, gaps not integrated; gyros only).
+    ``drift_angle`` is the final value and ``drift_angle_max`` the largest magnitude
+    (reached at ``drift_angle_max_time_s`` [s since the first sample]) of
+    ``θ(t) = ∫ (ω − Ω_axis − b0) dt`` [``drift_angle_unit``: deg, or rad for rad/s data],
+    b0 the constant stated by ``drift_reference`` (trapezoid rule, gaps not integrated;
+    gyros only).
     """
 
     bias: float
@@ -88,6 +142,9 @@ class MetricsResult:
     n_averages: int
     duration_s: float
     signal: str
+    drift_angle_max: float | None = None
+    drift_angle_max_time_s: float | None = None
+    drift_reference: DriftReference | None = None
 
 
 # --- helpers ---------------------------------------------------------------------------
@@ -259,18 +316,26 @@ def peak_to_peak(
     return float(np.max(means) - np.min(means))
 
 
-def drift_angle(time_s: npt.ArrayLike, rate_deg_h: npt.ArrayLike, bias_deg_h: float) -> FloatArray:
-    """Drift angle ``θ(t) = ∫ (ω − B0) dt`` [°] (SPEC §1, seed 001).
+def drift_angle(
+    time_s: npt.ArrayLike,
+    rate: npt.ArrayLike,
+    bias: float,
+    *,
+    time_unit_s: float = units.SECONDS_PER_HOUR,
+) -> FloatArray:
+    """Drift angle ``θ(t) = ∫ (ω − b0) dt`` [angle unit of ω] (SPEC §1, seed 001).
 
     Cumulative trapezoid rule: ``θ_k = θ_{k−1} + ½(e_k + e_{k−1})(t_k − t_{k−1})
-    / 3600`` with ``e = ω − B0`` [°/h] and t [s]; θ_0 = 0.  Across a gap (see
-    :func:`thermocal.recording.find_gaps`) nothing is integrated (θ is held).
+    / time_unit_s`` with ``e = ω − b0`` and t [s]; θ_0 = 0.  ``time_unit_s`` is the
+    number of seconds in the rate's time unit (3600 for [°/h] → θ in [°]; 1 for [°/s] or
+    [rad/s]).  Across a gap (see :func:`thermocal.recording.find_gaps`) nothing is
+    integrated (θ is held).
     """
     t = _as_1d(time_s, "time")
-    e = _as_1d(rate_deg_h, "rate") - float(bias_deg_h)
+    e = _as_1d(rate, "rate") - float(bias)
     if t.shape != e.shape:
         raise ThermocalInputError(f"time has {t.size} samples but the rate has {e.size}")
-    inc = 0.5 * (e[1:] + e[:-1]) * np.diff(t) / units.SECONDS_PER_HOUR
+    inc = 0.5 * (e[1:] + e[:-1]) * np.diff(t) / float(time_unit_s)
     for sl in contiguous_slices(t)[:-1]:
         inc[sl.stop - 1] = 0.0
     out = np.zeros(t.size)
@@ -278,23 +343,85 @@ def drift_angle(time_s: npt.ArrayLike, rate_deg_h: npt.ArrayLike, bias_deg_h: fl
     return out
 
 
-def drift_angle_total(
-    time_s: npt.ArrayLike, rate_deg_h: npt.ArrayLike, bias_deg_h: float, block: int = 1 << 18
-) -> float:
-    """The end value θ(t_end) of :func:`drift_angle` [°], summed block by block (the same
-    trapezoids, nothing integrated across a gap) without the full-length curve."""
+def drift_angle_extreme(
+    time_s: npt.ArrayLike,
+    rate: npt.ArrayLike,
+    bias: float,
+    *,
+    time_unit_s: float = units.SECONDS_PER_HOUR,
+    unit: str = "deg",
+    block: int = 1 << 18,
+) -> DriftExtreme:
+    """End value and largest magnitude of :func:`drift_angle` (the same trapezoids,
+    nothing integrated across a gap), block by block without the full-length curve.
+
+    ``max_abs = max_k |θ_k|`` at ``max_time_s = t_k − t_0`` (the first such sample)."""
     t = _as_1d(time_s, "time")
-    r = _as_1d(rate_deg_h, "rate")
+    r = _as_1d(rate, "rate")
     if t.shape != r.shape:
         raise ThermocalInputError(f"time has {t.size} samples but the rate has {r.size}")
-    b0 = float(bias_deg_h)
-    total = 0.0
+    b0 = float(bias)
+    theta = 0.0
+    best, best_i = 0.0, 0
     for sl in contiguous_slices(t):
         for a in range(sl.start, sl.stop - 1, block):
             b = min(sl.stop - 1, a + block)  # trapezoids a…b−1 join samples a…b
             e = r[a : b + 1] - b0
-            total += float(np.sum(0.5 * (e[1:] + e[:-1]) * np.diff(t[a : b + 1])))
-    return total / units.SECONDS_PER_HOUR
+            cum = theta + np.cumsum(0.5 * (e[1:] + e[:-1]) * np.diff(t[a : b + 1])) / float(
+                time_unit_s
+            )
+            k = int(np.argmax(np.abs(cum)))
+            if abs(float(cum[k])) > best:
+                best, best_i = abs(float(cum[k])), a + 1 + k
+            theta = float(cum[-1])
+    return DriftExtreme(end=theta, max_abs=best, max_time_s=float(t[best_i] - t[0]), unit=unit)
+
+
+def drift_angle_total(
+    time_s: npt.ArrayLike, rate_deg_h: npt.ArrayLike, bias_deg_h: float, block: int = 1 << 18
+) -> float:
+    """The end value θ(t_end) of :func:`drift_angle` [°] for a rate in [°/h], summed block
+    by block (the same trapezoids, nothing integrated across a gap) without the curve."""
+    return drift_angle_extreme(time_s, rate_deg_h, bias_deg_h, block=block).end
+
+
+def reference_bias(
+    time_s: npt.ArrayLike,
+    rate: npt.ArrayLike,
+    *,
+    window_s: tuple[float, float] | None = None,
+    earth_rate: float = 0.0,
+    unit: str = "deg/h",
+) -> DriftReference:
+    """The drift angle's constant b0: the mean of ``ω − Ω_axis`` over a reference window.
+
+    ``window_s`` = (start, end) [s since the first sample]; default the first
+    :data:`DEFAULT_DRIFT_REFERENCE_FRACTION` of the run's duration.  ``earth_rate`` Ω_axis
+    and ``rate`` in ``unit``.  A window holding no sample is a
+    :class:`~thermocal.errors.ThermocalInputError`.
+    """
+    t = _as_1d(time_s, "time")
+    r = _as_1d(rate, "rate")
+    rel = t - t[0]
+    duration = float(rel[-1])
+    if window_s is None:
+        start, end = 0.0, DEFAULT_DRIFT_REFERENCE_FRACTION * duration
+    else:
+        start, end = float(window_s[0]), float(window_s[1])
+        if not (math.isfinite(start) and math.isfinite(end) and end > start >= 0.0):
+            raise ThermocalInputError(
+                f"--drift-reference {start:g},{end:g}: give START,END in seconds since the "
+                "first sample, with 0 ≤ START < END"
+            )
+    sel = (rel >= start) & (rel <= end)
+    n = int(np.count_nonzero(sel))
+    if n == 0:
+        raise ThermocalInputError(
+            f"drift reference window {start:g}…{end:g} s holds no sample (the run lasts "
+            f"{duration:g} s from its first sample); choose another --drift-reference"
+        )
+    b0 = float(np.mean(r[sel])) - float(earth_rate)
+    return DriftReference("window", start, end, b0, unit, n)
 
 
 # --- recording pipeline ------------------------------------------------------------------
@@ -331,6 +458,21 @@ def hold_stages(
     )
 
 
+def data_unit_of(rec: Recording, name: str, canonical: str) -> tuple[str, float]:
+    """The unit a signal's figures are shown in and the factor ``k`` with
+    ``value[canonical] = k · value[shown]``.
+
+    The column's own unit as given (``deg/s`` stays ``deg/s``); raw counts are shown in
+    the unit :meth:`Recording.signal` gave them (``canonical``: [°/h] or [mg] when a scale
+    factor K converted them, else ``counts``), so k = 1.
+    """
+    given = rec.units.get(name)
+    u = units.normalize_signal_unit(given) if given else canonical
+    if u == "counts" or u == canonical:
+        return canonical, 1.0
+    return u, float(units.convert(1.0, u, canonical))
+
+
 def compute_metrics(
     rec: Recording,
     signal: str | None = None,
@@ -341,13 +483,15 @@ def compute_metrics(
     *,
     rate_threshold_c_per_min: float = 0.05,
     min_hold_s: float = 600.0,
+    drift_reference_s: tuple[float, float] | None = None,
+    drift_bias: float | None = None,
 ) -> MetricsResult:
-    """All figures of merit of one signal of a recording (SPEC §1).
+    """All figures of merit of one signal of a recording (SPEC §1), in the data's own unit
+    (:func:`data_unit_of`).
 
     Parameters
     ----------
-    rec : the recording; the signal is read in [°/h] or [mg]
-        (:meth:`Recording.signal`).
+    rec : the recording.
     signal : column name (default: the first signal).
     averaging_s : averaging time of bias stability and peak-to-peak [s]
         (default: the sample interval, i.e. no averaging).
@@ -356,10 +500,21 @@ def compute_metrics(
     temps : temperature columns; the first one defines hold stages
         (|Ṫ| < ``rate_threshold_c_per_min`` for at least ``min_hold_s``) for
         bias repeatability and temperature sensitivity over the stages.
+    drift_reference_s : the drift angle's reference window (start, end) [s since the
+        first sample]; b0 is the mean of ω − Ω_axis over it (:func:`reference_bias`;
+        default the first 10 % of the run).
+    drift_bias : b0 given instead [data unit, earth rate already removed].
+
+    The drift angle ``θ(t) = ∫ (ω − Ω_axis − b0) dt`` (gyros only) is never taken about
+    the same run's mean (that makes θ(t_end) ≈ 0 by construction): b0 is the stated
+    constant of ``drift_reference``.
     """
-    values, unit = rec.signal(signal)
     name = signal or (rec.signals[0] if rec.signals else "")
-    values = _as_1d(values, f"column {name!r}")
+    canon_values, canon = rec.signal(signal)
+    shown, k = data_unit_of(rec, name, canon)
+    canon_values = _as_1d(canon_values, f"column {name!r}")
+    values = canon_values if k == 1.0 else canon_values / k  # [shown unit]
+    unit = shown
     t = rec.time_s
     tau0 = rec.sample_interval_s
     avg = float(averaging_s) if averaging_s is not None else tau0
@@ -369,13 +524,13 @@ def compute_metrics(
     if lat is not None or axis is not None:
         if lat is None or ax is None:
             raise ThermocalInputError("earth-rate removal needs both --latitude and --axis")
-        if unit != "deg/h":
+        if canon != "deg/h":
             raise ThermocalInputError(
                 f"earth-rate removal applies to gyro rates, but {name!r} is in {unit}"
             )
         if not -90.0 <= lat <= 90.0:
             raise ThermocalInputError(f"latitude must be within ±90°, got {lat}")
-        earth = units.earth_rate_on_axis_deg_h(lat, units.parse_axis(ax))
+        earth = units.earth_rate_on_axis_deg_h(lat, units.parse_axis(ax)) / k  # [unit]
     b0 = bias(values, earth_rate_deg_h=earth)
     means = block_means(values, tau0, avg, time_s=t)
     if means.size < 2:
@@ -387,9 +542,27 @@ def compute_metrics(
     p2p = float(np.max(means) - np.min(means))
     drift: float | None = None
     drift_unit: str | None = None
-    if unit == "deg/h":
-        drift = drift_angle_total(t, values, float(np.mean(values)))
-        drift_unit = "deg"
+    drift_max: float | None = None
+    drift_max_t: float | None = None
+    ref: DriftReference | None = None
+    if unit in RATE_ANGLE_UNITS:
+        angle_unit, per = RATE_ANGLE_UNITS[unit]
+        if drift_bias is not None:
+            if drift_reference_s is not None:
+                raise ThermocalInputError("give either --drift-reference or --drift-bias, not both")
+            if not math.isfinite(drift_bias):
+                raise ThermocalInputError(f"--drift-bias must be a number, got {drift_bias!r}")
+            ref = DriftReference("bias", None, None, float(drift_bias), unit)
+        else:
+            ref = reference_bias(t, values, window_s=drift_reference_s, earth_rate=earth, unit=unit)
+        ext = drift_angle_extreme(t, values, ref.bias + earth, time_unit_s=per, unit=angle_unit)
+        drift, drift_unit = ext.end, angle_unit
+        drift_max, drift_max_t = ext.max_abs, ext.max_time_s
+    elif drift_bias is not None or drift_reference_s is not None:
+        raise ThermocalInputError(
+            f"the drift angle applies to gyro rates, but {name!r} is in {unit}: "
+            "--drift-reference/--drift-bias do not apply"
+        )
 
     sens: TemperatureSensitivity | None = None
     rep: float | None = None
@@ -428,6 +601,9 @@ def compute_metrics(
         stages=stages,
         drift_angle=drift,
         drift_angle_unit=drift_unit,
+        drift_angle_max=drift_max,
+        drift_angle_max_time_s=drift_max_t,
+        drift_reference=ref,
         earth_rate_removed=earth,
         n_samples=int(values.size),
         n_segments=len(contiguous_slices(t)),
@@ -438,6 +614,8 @@ def compute_metrics(
 
 
 __all__ = [
+    "DriftExtreme",
+    "DriftReference",
     "MetricsResult",
     "Stage",
     "TemperatureSensitivity",
@@ -447,8 +625,11 @@ __all__ = [
     "bias_stability",
     "block_means",
     "compute_metrics",
+    "data_unit_of",
     "drift_angle",
+    "drift_angle_extreme",
     "hold_stages",
     "peak_to_peak",
+    "reference_bias",
     "temperature_sensitivity",
 ]

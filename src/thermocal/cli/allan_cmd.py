@@ -40,10 +40,12 @@ if TYPE_CHECKING:
 
     import thermocal.allan as _allan
     import thermocal.io as _io
+    import thermocal.metrics as _metrics
 else:
     _rich_table = LazyModule("rich.table")
     _allan = LazyModule("thermocal.allan")
     _io = LazyModule("thermocal.io")
+    _metrics = LazyModule("thermocal.metrics")
 
 
 def _terms_json(terms: dict[str, Any]) -> dict[str, Any]:
@@ -191,7 +193,10 @@ def allan_cmd(
     names = split_names(signal) or [rec.signals[0]]
     analyses: dict[str, tuple[_allan.AllanResult, _allan.NoiseTerms]] = {}
     for name in names:  # one read of the file, every channel (INTERFACE: several channels)
-        values, unit = rec.signal(name)
+        canonical, canon_unit = rec.signal(name)
+        # every figure in the data's own unit (°/s data: ADEV in °/s; INTERFACE common rules)
+        unit, k = _metrics.data_unit_of(rec, name, canon_unit)
+        values = canonical if k == 1.0 else canonical / k
         res_c = _allan.overlapping_adev(
             values,
             rec.sample_interval_s,

@@ -48,7 +48,8 @@ else:
 
 
 def metrics_json(res: "_metrics.MetricsResult") -> dict[str, Any]:
-    """The ``--json`` object of ``thermocal metrics`` (INTERFACE.md keys first)."""
+    """The ``--json`` object of ``thermocal metrics`` (INTERFACE.md keys first); every rate
+    figure in ``unit`` (the data's own unit), angles in ``drift_angle_unit``."""
     d: dict[str, Any] = jsonable(res)
     ts = res.temperature_sensitivity
     return {
@@ -59,8 +60,11 @@ def metrics_json(res: "_metrics.MetricsResult") -> dict[str, Any]:
         "unit": res.unit,
         "temperature_sensitivity": None if ts is None else d["temperature_sensitivity"],
         "bias_repeatability": res.bias_repeatability,
+        "drift_angle_max": res.drift_angle_max,
+        "drift_angle_max_time_s": res.drift_angle_max_time_s,
         "drift_angle": res.drift_angle,
         "drift_angle_unit": res.drift_angle_unit,
+        "drift_reference": d["drift_reference"],
         "earth_rate_removed": res.earth_rate_removed,
         "n_stages": len(res.stages),
         "stages": d["stages"],
@@ -91,6 +95,22 @@ def metrics_cmd(
     min_hold: Annotated[
         float, typer.Option("--min-hold", help="Hold stages: at least this long [s].")
     ] = 600.0,
+    drift_reference: Annotated[
+        str | None,
+        typer.Option(
+            "--drift-reference",
+            help="Drift angle: remove the mean rate over START,END [s since the first "
+            "sample] (default: the first 10 % of the run).",
+        ),
+    ] = None,
+    drift_bias: Annotated[
+        float | None,
+        typer.Option(
+            "--drift-bias",
+            help="Drift angle: remove this bias [the data's unit, earth rate already "
+            "removed] instead of a reference window.",
+        ),
+    ] = None,
     time: TimeOpt = None,
     time_unit: TimeUnitOpt = None,
     signal_unit: SignalUnitOpt = None,
@@ -121,6 +141,7 @@ def metrics_cmd(
         temp_conversion=temp_conversion,
         keep_other=False,  # metrics use the signal and the temperatures only
     )
+    window = _parse_window(drift_reference)
     names = split_names(signal) or [rec.signals[0]]
     if len(names) > 1 and (latitude is not None or axis is not None):
         raise ThermocalInputError(
@@ -138,6 +159,8 @@ def metrics_cmd(
             split_names(temps),
             rate_threshold_c_per_min=hold_rate,
             min_hold_s=min_hold,
+            drift_reference_s=window,
+            drift_bias=drift_bias,
         )
         for name in names
     }
@@ -173,7 +196,12 @@ def metrics_cmd(
         row("  earth rate removed", lambda r: r.earth_rate_removed or None, 6)
         row(f"bias stability ({first.averaging_s:g} s)", lambda r: r.bias_stability)
         row(f"peak-to-peak ({first.averaging_s:g} s)", lambda r: r.peak_to_peak)
-        row("drift angle (end)", lambda r: r.drift_angle, unit=lambda r: r.drift_angle_unit or "")
+        angle_unit = lambda r: r.drift_angle_unit or ""  # noqa: E731
+        row("drift angle, largest |θ|", lambda r: r.drift_angle_max, unit=angle_unit)
+        row("  reached at [s]", lambda r: r.drift_angle_max_time_s, unit=lambda r: "")
+        row("drift angle (end)", lambda r: r.drift_angle, unit=angle_unit)
+        row("  bias b0 removed", lambda r: r.drift_reference.bias if r.drift_reference else None,
+            6)  # fmt: skip
         row(
             f"bias repeatability ({len(first.stages)} stages)",
             lambda r: r.bias_repeatability,
@@ -195,11 +223,41 @@ def metrics_cmd(
             "samples", *[str(r.n_samples) for r in results.values()], *([] if many else [""])
         )
         stdout.print(table)
+        ref = first.drift_reference
+        if ref is not None:
+            stdout.print(f"drift angle: {_reference_words(ref)}")
 
     if len(results) == 1:
         emit(metrics_json(first_result(results)), as_json, human)
     else:
         emit({"channels": {n: metrics_json(r) for n, r in results.items()}}, as_json, human)
+
+
+def _parse_window(text: str | None) -> tuple[float, float] | None:
+    """``--drift-reference START,END`` [s] as a pair (None when not given)."""
+    if text is None:
+        return None
+    parts = [p.strip() for p in text.split(",")]
+    try:
+        if len(parts) != 2:
+            raise ValueError
+        return float(parts[0]), float(parts[1])
+    except ValueError:
+        raise ThermocalInputError(
+            f"--drift-reference {text!r}: give START,END in seconds since the first sample, "
+            "e.g. 0,600"
+        ) from None
+
+
+def _reference_words(ref: "_metrics.DriftReference") -> str:
+    """How b0 was chosen, in words."""
+    if ref.kind == "window":
+        return (
+            f"θ(t) = ∫ (ω − Ω − b0) dt with b0 = {fmt(ref.bias, 6)} {ref.unit}, the mean "
+            f"over {ref.start_s:g}…{ref.end_s:g} s from the first sample "
+            "(--drift-reference; default the first 10 % of the run)"
+        )
+    return f"θ(t) = ∫ (ω − Ω − b0) dt with the given b0 = {fmt(ref.bias, 6)} {ref.unit}"
 
 
 def first_result(results: "dict[str, _metrics.MetricsResult]") -> "_metrics.MetricsResult":

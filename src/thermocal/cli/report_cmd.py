@@ -10,6 +10,7 @@ comparison table.
 
 import functools
 import json
+import warnings
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated, Any
 
@@ -38,7 +39,7 @@ from thermocal.cli.common import (
     stderr,
     text_options,
 )
-from thermocal.errors import FileFormatError, ThermocalInputError
+from thermocal.errors import FileFormatError, ThermocalInputError, ThermocalWarning
 
 if TYPE_CHECKING:
     import thermocal.io as _io
@@ -229,8 +230,18 @@ def report_cmd(
             temps=temp_cols,
         )  # fmt: skip
         text = text_options(t_names, t_rate, t_bad, t_delim, t_dec)
-        val_rec = read(recording, sig, text=text, topic=topic)
-        mod_rec = read(modeling, sig) if modeling is not None else None
+        # what thermocal warns while reading the runs goes into the report too (issue 25)
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            val_rec = read(recording, sig, text=text, topic=topic)
+            mod_rec = read(modeling, sig) if modeling is not None else None
+        for w in caught:
+            warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
+        read_warnings = tuple(
+            " ".join(str(w.message).split())
+            for w in caught
+            if issubclass(w.category, ThermocalWarning)
+        )
         advance(1)
         inputs = _report.ReportInputs(
             models=tuple(entries),
@@ -243,6 +254,7 @@ def report_cmd(
             sensor=sensor,
             generated_by="thermocal report",
             averaging_s=averaging,
+            warnings_caught=read_warnings,
         )
         advance(1)
         path = _report.write_report(output, inputs)

@@ -15,7 +15,7 @@ import numpy as np
 from thermocal import units
 from thermocal.allan import AllanResult, NoiseTerms, noise_terms, overlapping_adev
 from thermocal.compensation import unit_factor
-from thermocal.metrics import compute_metrics, drift_angle
+from thermocal.metrics import RATE_ANGLE_UNITS, DriftReference, compute_metrics, drift_angle
 from thermocal.models.base import RunData, TemperatureModel
 from thermocal.recording import FloatArray, Metadata, Recording
 
@@ -56,6 +56,22 @@ class RunSignals:
         """Compensated output with the known input kept (what the sensor would output)."""
         out: FloatArray = self.after + self.known_input
         return out
+
+
+def in_data_unit(sig: RunSignals, unit: str, k: float) -> RunSignals:
+    """``sig`` (canonical unit) in the data's own ``unit``: every series and the known input
+    divided by ``k`` (``value[canonical] = k · value[data]``)."""
+    if k == 1.0 and unit == sig.unit:
+        return sig
+    return dataclasses.replace(
+        sig,
+        unit=unit,
+        signal=sig.signal / k,
+        before=sig.before / k,
+        model=sig.model / k,
+        after=sig.after / k,
+        known_input=sig.known_input / k,
+    )
 
 
 def known_input_of(rec: Recording, unit: str) -> float:
@@ -123,8 +139,10 @@ class FiguresOfMerit:
     :func:`thermocal.metrics.compute_metrics` (the numbers of ``thermocal metrics``):
     bias B0 (earth rate removed when latitude and axis are known), bias stability
     and peak-to-peak over ``averaging_s`` averages, temperature sensitivity over
-    the hold stages (least-squares slope and mean |ΔB/ΔT|) [unit/°C], and the
-    largest and final drift angle [°] (gyros)."""
+    the hold stages (least-squares slope and mean |ΔB/ΔT|) [unit/°C], and the drift
+    angle θ(t) = ∫ (ω − Ω − b0) dt [``drift_angle_unit``] (gyros), b0 the constant of
+    ``drift_reference``: its curve, end value, largest magnitude and when it is reached
+    [s since the first sample]."""
 
     bias: float
     bias_stability: float
@@ -133,8 +151,27 @@ class FiguresOfMerit:
     sensitivity_slope: float | None
     sensitivity_mean_abs: float | None
     drift_angle: FloatArray | None
-    drift_angle_end_deg: float | None
-    drift_angle_max_deg: float | None
+    drift_angle_end: float | None = None
+    drift_angle_max: float | None = None
+    drift_angle_max_time_s: float | None = None
+    drift_angle_unit: str | None = None
+    drift_reference: DriftReference | None = None
+
+    @property
+    def drift_angle_max_deg(self) -> float | None:
+        """The largest |drift angle| in degrees [°] (converted from rad for rad/s data)."""
+        return _in_degrees(self.drift_angle_max, self.drift_angle_unit)
+
+    @property
+    def drift_angle_end_deg(self) -> float | None:
+        """The drift angle at the end of the run [°]."""
+        return _in_degrees(self.drift_angle_end, self.drift_angle_unit)
+
+
+def _in_degrees(value: float | None, unit: str | None) -> float | None:
+    if value is None:
+        return None
+    return value * units.RAD_TO_DEG if unit == "rad" else value
 
 
 def figures_of_merit(
@@ -146,13 +183,18 @@ def figures_of_merit(
     meta: Metadata,
     temp_name: str,
     temp_c: FloatArray,
+    drift_bias: float | None = None,
+    drift_reference_s: tuple[float, float] | None = None,
 ) -> FiguresOfMerit:
-    """Figures of merit of a rate ``x`` [canonical unit, known input included] (SPEC §1).
+    """Figures of merit of a rate ``x`` [``unit``, known input included] (SPEC §1).
 
     Runs :func:`thermocal.metrics.compute_metrics` on a recording of ``x`` with
-    ``temp_c`` as the hold-stage temperature; the drift angle
-    ``θ(t) = ∫ (ω − B0) dt`` with B0 the run's mean rate is
-    :func:`thermocal.metrics.drift_angle` (held across gaps).
+    ``temp_c`` as the hold-stage temperature.  The drift angle
+    ``θ(t) = ∫ (ω − Ω_axis − b0) dt`` (:func:`thermocal.metrics.drift_angle`, held across
+    gaps) removes a stated constant b0, never the run's own mean: ``drift_bias`` when
+    given (0 on a compensated output: the model is what removes the bias), else the mean
+    over ``drift_reference_s`` (default the first 10 % of the run,
+    :func:`thermocal.metrics.reference_bias`).
     """
     rec = Recording.from_arrays(
         time_s,
@@ -161,14 +203,19 @@ def figures_of_merit(
         signal_unit=unit,
         meta=dataclasses.replace(meta, scale_factor=None, scale_factor_unit=None),
     )
-    m = compute_metrics(rec, "signal", averaging_s, temps=[temp_name])
+    m = compute_metrics(
+        rec,
+        "signal",
+        averaging_s,
+        temps=[temp_name],
+        drift_bias=drift_bias,
+        drift_reference_s=drift_reference_s,
+    )
     sens = m.temperature_sensitivity
     ang: FloatArray | None = None
-    end = mx = None
-    if unit == "deg/h":
-        ang = drift_angle(time_s, x, float(np.mean(x)))
-        end = float(ang[-1])
-        mx = float(np.max(np.abs(ang)))
+    if m.drift_reference is not None and m.unit in RATE_ANGLE_UNITS:
+        per = RATE_ANGLE_UNITS[m.unit][1]
+        ang = drift_angle(time_s, x, m.drift_reference.bias + m.earth_rate_removed, time_unit_s=per)
     return FiguresOfMerit(
         bias=m.bias,
         bias_stability=m.bias_stability,
@@ -177,8 +224,11 @@ def figures_of_merit(
         sensitivity_slope=sens.ls_slope if sens is not None else None,
         sensitivity_mean_abs=sens.mean_abs_adjacent if sens is not None else None,
         drift_angle=ang,
-        drift_angle_end_deg=end,
-        drift_angle_max_deg=mx,
+        drift_angle_end=m.drift_angle,
+        drift_angle_max=m.drift_angle_max,
+        drift_angle_max_time_s=m.drift_angle_max_time_s,
+        drift_angle_unit=m.drift_angle_unit,
+        drift_reference=m.drift_reference,
     )
 
 

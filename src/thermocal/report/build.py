@@ -27,6 +27,8 @@ import base64
 import datetime as _dt
 import hashlib
 import math
+import re
+import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -35,9 +37,11 @@ from typing import Any, TypeGuard
 import numpy as np
 from markupsafe import Markup, escape
 
+from thermocal import units
 from thermocal.defaults import DEFAULT_AVERAGING_S, WEAK_CORRELATION_LIMIT
-from thermocal.errors import ThermocalInputError
+from thermocal.errors import ThermocalInputError, ThermocalWarning, UnitError
 from thermocal.io import atomic_write
+from thermocal.metrics import data_unit_of
 from thermocal.models.base import condition_wording
 from thermocal.recording import Recording
 from thermocal.report.analysis import (
@@ -60,6 +64,9 @@ from thermocal.report.analysis import (
 )
 from thermocal.report.analysis import (
     figures_of_merit as figures_of_merit,
+)
+from thermocal.report.analysis import (
+    in_data_unit as in_data_unit,
 )
 from thermocal.report.analysis import (
     known_input_of as known_input_of,
@@ -127,6 +134,13 @@ class ReportInputs:
     """Averaging time of bias stability and peak-to-peak [s] (default: the validation
     result's, else :data:`DEFAULT_AVERAGING_S`)."""
     extra: dict[str, Any] = field(default_factory=dict)
+    drift_reference_s: tuple[float, float] | None = None
+    """Drift angle before compensation: b0 is the mean over this window [s since the first
+    sample] (default the first 10 % of the run)."""
+    drift_bias: float | None = None
+    """Drift angle before compensation: this b0 [the data's unit] instead of a window."""
+    warnings_caught: tuple[str, ...] = ()
+    """``warning:`` lines thermocal printed while reading the runs (shown in the report)."""
 
 
 # --- number formatting -------------------------------------------------------------------
@@ -219,8 +233,55 @@ def sha256_of(path: str | Path) -> str | None:
     return h.hexdigest()
 
 
-def _run_info(role: str, rec: Recording, path: str | None, signal: str | None) -> dict[str, Any]:
+GAP_SHARE_WARN = 0.10
+"""Share of a run's time span in gaps above which the report warns."""
+
+
+def gap_share(rec: Recording) -> tuple[int, float, float]:
+    """(number of gaps, their total length [s], their share of the time span)."""
+    gaps = rec.gaps()
+    total = float(sum(g.length_s for g in gaps))
+    span = rec.duration_s
+    return len(gaps), total, (total / span if span > 0 else 0.0)
+
+
+def conversions_of(rec: Recording, signal: str | None, shown_unit: str) -> list[str]:
+    """Every conversion applied to a run, in words: the time column's unit, the signal's
+    unit as given (and where it came from) and the unit the report shows, a scale factor K
+    of raw counts, each raw-count temperature's ``T = gain·counts + offset``."""
+    src = rec.unit_sources
+    out = [
+        f"time: column in {rec.time_unit}"
+        + (f" ({src['<time>']})" if src.get("<time>") else "")
+        + ("" if rec.time_unit == "s" else ", converted to s")
+    ]
+    if signal:
+        given = rec.units.get(signal, "") or "?"
+        line = f"signal {signal}: {given}" + (f" ({src[signal]})" if src.get(signal) else "")
+        if given == "counts" and rec.meta.scale_factor is not None:
+            line += (
+                f", converted with the scale factor K = {rec.meta.scale_factor:.10g} "
+                f"{rec.meta.scale_factor_unit or ''}".rstrip()
+            )
+        line += f"; figures shown in {unit_label(shown_unit)}"
+        out.append(line)
+    for name in rec.temperatures:
+        u = rec.units.get(name, "")
+        conv = rec.meta.temperature_conversion.get(name)
+        where = f" ({src[name]})" if src.get(name) else ""
+        if conv is not None and u == "counts":
+            out.append(f"temperature {name}: raw counts{where}, {conv.describe()}")
+        else:
+            shown = unit_label(u) if u else "unit not stated"
+            out.append(f"temperature {name}: {shown}{where}")
+    return out
+
+
+def _run_info(
+    role: str, rec: Recording, path: str | None, signal: str | None, shown_unit: str = ""
+) -> dict[str, Any]:
     sig = signal if signal in rec.columns else (rec.signals[0] if rec.signals else None)
+    n_gaps, gap_s, share = gap_share(rec)
     temps = [c for c in rec.temperatures if c in rec.columns]
     t_lo = t_hi = None
     if temps:
@@ -233,7 +294,10 @@ def _run_info(role: str, rec: Recording, path: str | None, signal: str | None) -
         "n_samples": rec.n_samples,
         "duration_h": rec.duration_s / 3600.0,
         "interval_s": rec.sample_interval_s,
-        "n_gaps": len(rec.gaps()),
+        "n_gaps": n_gaps,
+        "gap_s": gap_s,
+        "gap_share_pct": 100.0 * share,
+        "conversions": conversions_of(rec, sig, shown_unit or rec.units.get(sig or "", "")),
         "signal": sig,
         "signal_unit": unit_label(rec.units.get(sig, "")) if sig else "",
         "temperatures": ", ".join(temps),
@@ -428,11 +492,34 @@ def _summary(
     return items
 
 
-def _coefficient_rows(model: dict[str, Any], key: str = "model") -> list[dict[str, Any]]:
+def model_factor(model: dict[str, Any], unit: str | None) -> tuple[str, float]:
+    """(the model's signal unit, k) with ``value[model unit] = k · value[unit]``; k = 1 when
+    ``unit`` is not given, equal, or of another kind (counts)."""
+    mu = str((model.get("signal") or {}).get("unit") or "")
+    if not unit or not mu or unit == mu:
+        return mu, 1.0
+    try:
+        return mu, float(units.convert(1.0, unit, mu))
+    except (UnitError, ThermocalInputError):
+        return mu, 1.0
+
+
+def _coefficient_rows(
+    model: dict[str, Any], key: str = "model", unit: str | None = None
+) -> list[dict[str, Any]]:
+    """The coefficients with their standard errors; with ``unit`` (the data's) every
+    coefficient whose unit starts with the model's signal unit is converted to it
+    (``deg/h/degC`` → ``deg/s/degC`` for °/s data: value / k)."""
+    mu, k = model_factor(model, unit)
     rows = []
     for i, c in enumerate(model.get("coefficients") or []):
         val = c.get("value")
         se = c.get("stderr")
+        cunit = str(c.get("unit", ""))
+        if k != 1.0 and unit and cunit.startswith(mu):
+            val = float(val) / k if _is_number(val) else val
+            se = float(se) / k if _is_number(se) else se
+            cunit = unit + cunit[len(mu) :]
         rel = None
         if _is_number(val) and _is_number(se) and float(val) != 0.0:
             rel = 100.0 * abs(float(se) / float(val))
@@ -443,7 +530,7 @@ def _coefficient_rows(model: dict[str, Any], key: str = "model") -> list[dict[st
                 "value": num(val, f"{key}.coefficients.{i}.value", digits=6),
                 "stderr": num(se, f"{key}.coefficients.{i}.stderr", digits=3),
                 "rel": num(rel, None, digits=3),
-                "unit": unit_label(str(c.get("unit", ""))),
+                "unit": unit_label(cunit),
             }
         )
     return rows
@@ -469,9 +556,14 @@ def _range_rows(model: dict[str, Any], key: str = "model") -> list[dict[str, Any
     return rows
 
 
-def _model_summary(entry: ModelEntry) -> dict[str, Any]:
+def _model_summary(entry: ModelEntry, unit: str | None = None) -> dict[str, Any]:
+    """One model's summary; with ``unit`` (the data's) its fit residual is converted to it."""
     m = entry.model
     fit = m.get("fit") or {}
+    _mu, k_fit = model_factor(m, unit)
+    rms_fit = fit.get("rms_residual")
+    if _is_number(rms_fit):
+        rms_fit = float(rms_fit) / k_fit
     params = m.get("params") or {}
     rate = m.get("rate") or {}
     cond = fit.get("condition_number")
@@ -479,7 +571,7 @@ def _model_summary(entry: ModelEntry) -> dict[str, Any]:
         "label": entry.label,
         "family": m.get("family"),
         "n_coefficients": num(len(m.get("coefficients") or []), f"models.{entry.label}.n_coef"),
-        "rms_residual": num(fit.get("rms_residual"), f"models.{entry.label}.rms_residual"),
+        "rms_residual": num(rms_fit, f"models.{entry.label}.rms_residual"),
         "condition_number": num(cond, f"models.{entry.label}.condition_number", digits=3),
         "r_squared": num(fit.get("r_squared"), None, digits=5),
         "n_samples": num(fit.get("n_samples"), None),
@@ -504,16 +596,16 @@ def _model_summary(entry: ModelEntry) -> dict[str, Any]:
     }
 
 
-def _model_details(inputs: ReportInputs) -> list[dict[str, Any]]:
+def _model_details(inputs: ReportInputs, unit: str | None = None) -> list[dict[str, Any]]:
     """Section 8 for every model given: its fit, range of validity and coefficients."""
     out = []
     for i, e in enumerate(inputs.models):
         key = "model" if i == 0 else f"models.{e.label}"
         out.append(
             {
-                "summary": _model_summary(e),
+                "summary": _model_summary(e, unit),
                 "ranges": _range_rows(e.model, key),
-                "coefficients": _coefficient_rows(e.model, key),
+                "coefficients": _coefficient_rows(e.model, key, unit),
                 "has_rates": bool((e.model.get("range") or {}).get("rate_c_per_min")),
                 "suffix": "" if i == 0 else f"-{i + 1}",
                 "primary": i == 0,
@@ -556,14 +648,113 @@ def _truth_rows(
     return rows
 
 
-def _collect_warnings(inputs: ReportInputs, applied: dict[str, RunSignals]) -> list[dict[str, str]]:
+def _core(text: str, labels: Sequence[str]) -> str:
+    """A warning's text without the prefixes the report and the commands put before it
+    (``warning:``, ``label:``, ``label on the … run:``, ``FILE:``), normalised, so that one
+    finding said by several sources is shown once."""
+    t = " ".join(text.split())
+    alts = "|".join(re.escape(lab) for lab in sorted(labels, key=len, reverse=True))
+    pattern = re.compile(
+        r"^(?:warning: |(?:" + (alts or "(?!)") + r")(?: on the [a-z]+ run)?: "
+        r"|[^:\s]+\.(?:csv|parquet|ulg|bin|txt|log|json)(?: \[[^\]]*\])?: )",
+        re.IGNORECASE,
+    )
+    while True:
+        new = pattern.sub("", t, count=1)
+        if new == t:
+            break
+        t = new
+    return t.rstrip(". ").lower()
+
+
+def _adequacy_of(entry: ModelEntry) -> dict[str, Any] | None:
+    """The model file's ``adequacy`` record (see the adequacy check) as table rows, or None
+    for files without one."""
+    return adequacy_rows(entry.model.get("adequacy"), f"adequacy.{entry.label}", entry.label)
+
+
+def adequacy_rows(ad: Any, key: str, label: str) -> dict[str, Any] | None:
+    """``{"label", "verdict", "overrides", "tests": [{name, figure, threshold, unit,
+    verdict, override, message}]}`` from an ``adequacy`` record; None when there is none."""
+    if not isinstance(ad, dict):
+        return None
+    tests = []
+    for i, t in enumerate(ad.get("tests") or []):
+        if not isinstance(t, dict):
+            continue
+        u = str(t.get("unit") or "")
+        tests.append(
+            {
+                "name": str(t.get("name", f"test {i + 1}")),
+                "figure": num(t.get("figure") if _is_number(t.get("figure")) else None,
+                              f"{key}.{t.get('name', i)}.figure", 4, unit_label(u)),
+                "threshold": num(t.get("threshold") if _is_number(t.get("threshold")) else None,
+                                 f"{key}.{t.get('name', i)}.threshold", 4, unit_label(u)),
+                "verdict": str(t.get("verdict") or "n/a"),
+                "override": t.get("override") or "",
+                "message": str(t.get("message") or ""),
+            }
+        )  # fmt: skip
+    verdict = str(ad.get("verdict") or "n/a")
+    return {
+        "label": label,
+        "verdict": verdict,
+        "overrides": [str(o) for o in ad.get("overrides") or []],
+        "tests": tests,
+        "css": {"pass": "pass", "fail": "fail", "overridden": "warn"}.get(verdict, "na"),
+    }
+
+
+def _collect_warnings(
+    inputs: ReportInputs,
+    applied: dict[str, RunSignals],
+    an: _Analysis | None = None,
+    runs: Sequence[dict[str, Any]] = (),
+    run_warnings: Sequence[str] = (),
+) -> list[dict[str, str]]:
+    """Every warning once (:func:`_core` compares them): the validation results', the
+    models' (conditioning, adequacy), extrapolation, what thermocal printed while reading
+    and analysing the runs, gaps, and a recording that is the modelling data itself."""
     out: list[dict[str, str]] = []
     seen: set[str] = set()
+    labels = [e.label for e in inputs.models]
 
     def add(kind: str, text: str) -> None:
-        if text not in seen:
-            seen.add(text)
+        key = _core(text, labels)
+        if key not in seen and not any(key in k or k in key for k in seen if len(k) > 20):
+            seen.add(key)
             out.append({"kind": kind, "text": text})
+
+    if an is not None and an.role == "modelling":
+        add(
+            "data",
+            "the recording is the data the model was fitted on (the modelling run): the "
+            "figures below show how well the model fits, not how it performs on an "
+            "independent run.",
+        )
+    for run in runs:
+        if run.get("gap_share_pct", 0.0) > 100.0 * GAP_SHARE_WARN:
+            add(
+                "data",
+                f"{run['file']} ({run['role']} run): {run['n_gaps']} gap(s) cover "
+                f"{fmt_num(run['gap_share_pct'], 3)} % of its {fmt_num(run['duration_h'], 3)} h; "
+                "the figures use only the samples recorded.",
+            )
+    for w in inputs.warnings_caught:
+        add("input", w)
+    for w in run_warnings:
+        add("analysis", w)
+    for entry in inputs.models:
+        ad = _adequacy_of(entry)
+        if ad is not None and ad["verdict"] in ("fail", "overridden"):
+            failed = ", ".join(t["name"] for t in ad["tests"] if t["verdict"] == "fail")
+            add(
+                "adequacy",
+                f"{entry.label}: the data it was fitted on "
+                + ("failed" if ad["verdict"] == "fail" else "failed (overridden at fit time by "
+                   + (", ".join(ad["overrides"]) or "an override") + ")")
+                + f" the adequacy test(s) {failed or '—'}; see the adequacy table.",
+            )  # fmt: skip
 
     for entry in inputs.models:
         v = entry.validation or {}
@@ -589,7 +780,8 @@ def _collect_warnings(inputs: ReportInputs, applied: dict[str, RunSignals]) -> l
         sig = applied.get(entry.label)
         if sig is not None:
             for w in sig.warnings:
-                add("extrapolation", f"{entry.label} on the validation run: {w}")
+                where = an.run_name if an is not None else "validation run"
+                add("extrapolation", f"{entry.label} on the {where}: {w}")
     if inputs.models and not inputs.models[0].validation:
         add(
             "validation",
@@ -636,6 +828,35 @@ class _Analysis:
     fom_after: FiguresOfMerit
     allan_before: AllanAnalysis
     allan_after: AllanAnalysis
+    k: float = 1.0
+    """``value[canonical] = k · value[unit]``: the model's unit over the data's."""
+    role: str = "validation"
+    """The recording's role: ``modelling`` (a model was fitted on it), ``validation`` (a
+    validation result was given) or ``test`` (:func:`recording_role`)."""
+    recording_sha256: str | None = None
+
+    @property
+    def run_name(self) -> str:
+        """The recording named by its role, e.g. ``"modelling run"``."""
+        return f"{self.role} run"
+
+
+def recording_role(inputs: ReportInputs, sha256: str | None) -> str:
+    """What the recording is to the models: ``"modelling"`` when one of them was fitted on
+    it (its SHA-256, else its file name, among the model files' ``data``), else
+    ``"validation"`` when a validation result was given, else ``"test"``."""
+    name = Path(inputs.recording_path).name if inputs.recording_path else None
+    for e in inputs.models:
+        for d in e.model.get("data") or []:
+            if not isinstance(d, dict):
+                continue
+            if sha256 is not None and d.get("sha256") == sha256:
+                return "modelling"
+            if sha256 is None and name is not None and d.get("file") == name:
+                return "modelling"
+    if any(e.validation for e in inputs.models):
+        return "validation"
+    return "test"
 
 
 def _analyse(inputs: ReportInputs) -> _Analysis:
@@ -648,9 +869,16 @@ def _analyse(inputs: ReportInputs) -> _Analysis:
         raise ThermocalInputError(f"report: model labels must be unique, got {labels}")
     rec = inputs.recording
     signal = inputs.signal or (primary.model.get("signal") or {}).get("name")
-    applied = {e.label: apply_model(e.model, rec, signal) for e in inputs.models}
+    rec_sha = sha256_of(inputs.recording_path) if inputs.recording_path else None
+    role = recording_role(inputs, rec_sha)
+    sig_col = signal if signal in rec.columns else (rec.signals[0] if rec.signals else None)
+    _, canon = rec.signal(sig_col)
+    # every figure in the data's own unit (the column's unit as given, issue 25)
+    unit, k = data_unit_of(rec, sig_col or "", canon)
+    applied = {
+        e.label: in_data_unit(apply_model(e.model, rec, signal), unit, k) for e in inputs.models
+    }
     main = applied[primary.label]
-    _, unit = rec.signal(signal if signal in rec.columns else None)
     temp_names = main.temp_names
     v = primary.validation or {}
     averaging_s = float(inputs.averaging_s or v.get("averaging_s") or DEFAULT_AVERAGING_S)
@@ -661,6 +889,8 @@ def _analyse(inputs: ReportInputs) -> _Analysis:
         rec.temperature_c(stage_temp) if stage_temp not in temp_names
         else main.temps_c[:, temp_names.index(stage_temp)]
     )  # fmt: skip
+    # drift angle: before about a stated reference constant (the mean over a window at the
+    # start), after with nothing removed but the known input (the model removes the bias)
     fom_before, fom_after = (
         figures_of_merit(
             main.time_s,
@@ -670,14 +900,17 @@ def _analyse(inputs: ReportInputs) -> _Analysis:
             meta=rec.meta,
             temp_name=stage_temp,
             temp_c=stage_temp_c,
+            drift_bias=drift_bias,
+            drift_reference_s=None if drift_bias is not None else inputs.drift_reference_s,
         )
-        for x in (main.signal, main.after_raw)
+        for x, drift_bias in ((main.signal, inputs.drift_bias), (main.after_raw, 0.0))
     )
     return _Analysis(
         primary, signal, unit, applied, main, temp_names, averaging_s, tau0, stage_temp,
         fom_before, fom_after,
         allan_of(main.time_s, main.before, tau0, unit),
         allan_of(main.time_s, main.after, tau0, unit),
+        k, role, rec_sha,
     )  # fmt: skip
 
 
@@ -695,7 +928,7 @@ def _report_figures(inputs: ReportInputs, an: _Analysis) -> dict[str, dict[str, 
     panels = []
     if inputs.modeling is not None:
         panels.append(_temperature_panel("Modelling run", inputs.modeling, temp_names))
-    panels.append(_temperature_panel("Validation run", rec, temp_names))
+    panels.append(_temperature_panel(an.run_name.capitalize(), rec, temp_names))
     stages = _stages_from(primary.validation)
     figs: dict[str, dict[str, str]] = {}
 
@@ -718,11 +951,11 @@ def _report_figures(inputs: ReportInputs, an: _Analysis) -> dict[str, dict[str, 
             + ", ".join(temp_names)
             + ") and the chamber air temperature (dashed) against time, for "
             + ("the modelling run (top) and " if inputs.modeling is not None else "")
-            + "the validation run."
+            + f"the {an.run_name}."
         ),
     )
     if inputs.modeling is not None:
-        mod = apply_model(primary.model, inputs.modeling, signal)
+        mod = in_data_unit(apply_model(primary.model, inputs.modeling, signal), unit, an.k)
         add_fig(
             "fit",
             F.model_fit(mod.time_s, mod.before, mod.model_bias, unit=unit_label(unit), block=block),
@@ -746,7 +979,8 @@ def _report_figures(inputs: ReportInputs, an: _Analysis) -> dict[str, dict[str, 
         ),
         "Bias against time, before and after compensation",
         cap(
-            f"Validation run: bias{avg_text} before (red) and after (blue) compensation with the "
+            f"{an.run_name.capitalize()}: bias{avg_text} before (red) and after (blue) "
+            "compensation with the "
             f"{primary.label} model; {temp_names[0]} dotted (right axis)"
             + ("; shaded: temperature-hold stages used for stability and repeatability."
                if stages else ".")
@@ -764,7 +998,8 @@ def _report_figures(inputs: ReportInputs, an: _Analysis) -> dict[str, dict[str, 
         ),
         "Bias against temperature, before and after compensation",
         cap(
-            f"Validation run: bias against {temp_names[0]}, before and after compensation; "
+            f"{an.run_name.capitalize()}: bias against {temp_names[0]}, before and after "
+            "compensation; "
             f"dots: {avg_text.strip(' ()') or 'samples'}, lines: means in temperature bins "
             "with their standard errors."
         ),
@@ -789,22 +1024,44 @@ def _report_figures(inputs: ReportInputs, an: _Analysis) -> dict[str, dict[str, 
         ),
         "Allan deviation before and after compensation",
         cap(
-            "Overlapping Allan deviation of the validation run before and after "
+            f"Overlapping Allan deviation of the {an.run_name} before and after "
             "compensation; bars: confidence intervals."
         ),
     )
     if fom_before.drift_angle is not None and fom_after.drift_angle is not None:
         add_fig(
             "drift",
-            F.drift_angle(main.time_s, fom_before.drift_angle, fom_after.drift_angle),
+            F.drift_angle(
+                main.time_s,
+                fom_before.drift_angle,
+                fom_after.drift_angle,
+                unit=unit_label(fom_before.drift_angle_unit or ""),
+            ),
             "Drift angle before and after compensation",
             cap(
-                "Drift angle: integral of the rate with its mean (the bias B0) removed, "
-                "before and after compensation."
+                "Angle error over time, θ(t) = ∫ (ω − Ω − b0) dt: before compensation (red) "
+                f"with {drift_reference_words(fom_before.drift_reference)}; after (blue) the "
+                "compensated rate integrated with no bias removed (the model removes it)."
             ),
         )
 
     return figs
+
+
+def drift_reference_words(ref: Any) -> str:
+    """How the constant b0 of the drift angle was chosen, in words (a
+    :class:`~thermocal.metrics.DriftReference` or None)."""
+    if ref is None:
+        return "no bias removed"
+    b0 = f"{fmt_num(ref.bias, 5)} {unit_label(ref.unit)}"
+    if ref.kind == "window":
+        return (
+            f"b0 = {b0}, the mean of the uncompensated rate over {fmt_num(ref.start_s)}…"
+            f"{fmt_num(ref.end_s)} s from the start of the run (a reference window)"
+        )
+    if ref.kind == "bias":
+        return f"the given b0 = {b0}"
+    return f"b0 = {b0}"
 
 
 def _noise_rows(an: _Analysis) -> list[dict[str, Any]]:
@@ -843,7 +1100,8 @@ def _fom_rows(an: _Analysis) -> list[dict[str, Any]]:
          f"{unit_label(unit)}/°C", 4),
         ("sensitivity_mean_abs", "Temperature sensitivity, mean |ΔB/ΔT| of adjacent stages",
          f"{unit_label(unit)}/°C", 4),
-        ("drift_angle_max_deg", "Largest |drift angle|", "°", 4),
+        ("drift_angle_max", "Largest |drift angle|",
+         unit_label(fom_before.drift_angle_unit or ""), 4),
     ):  # fmt: skip
         b = getattr(fom_before, name)
         a = getattr(fom_after, name)
@@ -865,15 +1123,26 @@ def _fom_rows(an: _Analysis) -> list[dict[str, Any]]:
             }
         )
 
+    tb, ta = fom_before.drift_angle_max_time_s, fom_after.drift_angle_max_time_s
+    if tb is not None and ta is not None:
+        fom_rows.append(
+            {
+                "label": "Largest |drift angle| reached at",
+                "unit": "h",
+                "before": num(tb / 3600.0, "fom.before.drift_angle_max_time_h", 4),
+                "after": num(ta / 3600.0, "fom.after.drift_angle_max_time_h", 4),
+                "improvement": num(None),
+            }
+        )
     return fom_rows
 
 
-def _comparison_rows(inputs: ReportInputs) -> list[dict[str, Any]]:
+def _comparison_rows(inputs: ReportInputs, unit: str | None = None) -> list[dict[str, Any]]:
     """One row per model: its summary and its validation figures."""
     comparison = []
     for e in inputs.models:
         ve = e.validation or {}
-        ms = _model_summary(e)
+        ms = _model_summary(e, unit)
         comparison.append(
             {
                 **ms,
@@ -937,15 +1206,24 @@ def build_report(inputs: ReportInputs) -> str:
     """
     from thermocal import __version__
 
-    an = _analyse(inputs)
+    # every warning thermocal gives while the numbers and figures are made is shown in the
+    # report too (and still reaches the caller: re-issued below)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        an = _analyse(inputs)
+        figs = _report_figures(inputs, an)
+    for w in caught:
+        warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
     primary, rec, unit, signal = an.primary, inputs.recording, an.unit, an.signal
-    figs = _report_figures(inputs, an)
     truth_rows = _truth_rows(inputs, an.applied, unit)
     runs = []
     if inputs.modeling is not None:
-        runs.append(_run_info("modelling", inputs.modeling, inputs.modeling_path, signal))
-    runs.append(_run_info("validation", rec, inputs.recording_path, signal))
+        runs.append(_run_info("modelling", inputs.modeling, inputs.modeling_path, signal, unit))
+    runs.append(_run_info(an.role, rec, inputs.recording_path, signal, unit))
     summary = _summary(primary, an.fom_before, an.fom_after, unit)
+    run_warnings = [
+        " ".join(str(w.message).split()) for w in caught if issubclass(w.category, ThermocalWarning)
+    ]
     ctx = {
         "title": inputs.title,
         "sensor": inputs.sensor or rec.meta.sensor_id or "",
@@ -954,16 +1232,19 @@ def build_report(inputs: ReportInputs) -> str:
         "version": __version__,
         "unit": unit_label(unit),
         "signal": signal,
-        "primary": _model_summary(primary),
+        "primary": _model_summary(primary, unit),
         "summary": summary,
         "overall": _overall(primary, summary),
-        "warnings": _collect_warnings(inputs, an.applied),
+        "warnings": _collect_warnings(inputs, an.applied, an, runs, run_warnings),
+        "run_name": an.run_name,
+        "role": an.role,
+        "adequacy": [a for a in (_adequacy_of(e) for e in inputs.models) if a is not None],
         "runs": runs,
         "notes": list(inputs.notes),
         "files": [{"label": a, "path": b} for a, b in inputs.files],
         "figs": figs,
         "validations": _validation_tables(inputs, unit),
-        "comparison": _comparison_rows(inputs),
+        "comparison": _comparison_rows(inputs, unit),
         "fom_rows": _fom_rows(an),
         "truth_rows": truth_rows,
         "truth_std": (
@@ -972,8 +1253,8 @@ def build_report(inputs: ReportInputs) -> str:
             else None
         ),
         "noise_rows": _noise_rows(an),
-        "model_details": _model_details(inputs),
-        "coefficients": _coefficient_rows(primary.model),
+        "model_details": _model_details(inputs, unit),
+        "coefficients": _coefficient_rows(primary.model, "model", unit),
         "ranges": _range_rows(primary.model),
         "has_rates": bool((primary.model.get("range") or {}).get("rate_c_per_min")),
         "known_input": an.main.known_input,

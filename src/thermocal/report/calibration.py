@@ -46,6 +46,7 @@ from thermocal.report.build import (
     _coefficient_rows,
     _env,
     _range_rows,
+    adequacy_rows,
     improvement_pct,
     sha256_of,
     unit_label,
@@ -175,6 +176,13 @@ def _channel_section(
         msgs += [str(w) for w in v.get("warnings") or []]
         if v.get("unit") not in (None, unit):
             msgs.append(f"the validation figures are in {v.get('unit')}, the data in {unit}")
+    adequacy = adequacy_rows(md.get("adequacy"), f"channels.{name}.adequacy", name)
+    if adequacy is not None and adequacy["verdict"] in ("fail", "overridden"):
+        failed = ", ".join(t["name"] for t in adequacy["tests"] if t["verdict"] == "fail")
+        msgs.append(
+            f"the data this channel was fitted on failed the adequacy test(s) {failed or '—'}"
+            + (" (overridden at fit time)" if adequacy["verdict"] == "overridden" else "")
+        )
     vclass, vtext = _verdict(v)
     terms = [a.terms.fit for a in allan]
     curves = [
@@ -196,7 +204,7 @@ def _channel_section(
         "condition_number": cond,
         "temperatures": list(applied.temp_names),
         "temp_range": _range_rows(md, key),
-        "coefficients": _coefficient_rows(md, key),
+        "coefficients": _coefficient_rows(md, key, unit),
         "before": fom[0],
         "after": fom[1],
         "sensitivity_unit": unit_label(f"{unit}/degC"),
@@ -213,6 +221,7 @@ def _channel_section(
         "bi_after": terms[1].bias_instability,
         "rw_after": terms[1].angle_random_walk,
         "validation": v,
+        "adequacy": adequacy,
         "verdict_class": vclass,
         "verdict": vtext,
         "warnings": list(dict.fromkeys(msgs)),
@@ -261,7 +270,10 @@ def build_calibration_report(inputs: CalibrationReportInputs) -> str:
         (label, path, sha256_of(path))
         for label, path in (
             ("calibration", inputs.calibration_path),
-            ("validation run", inputs.recording_path),
+            (
+                "validation run" if inputs.validation else "recording (test run)",
+                inputs.recording_path,
+            ),
             ("modelling run", inputs.modeling_path),
             ("validation result", inputs.validation_path),
         )

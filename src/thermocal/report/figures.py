@@ -196,6 +196,15 @@ def bias_vs_temperature(
     x = np.asarray(temperature_c, dtype=np.float64)
     with _figure(1, height_in=3.6) as (fig, axes):
         ax = axes[0]
+        fin = x[np.isfinite(x)]
+        if fin.size == 0 or float(np.ptp(fin)) == 0.0:
+            say_why_empty(
+                ax,
+                f"no bias-against-temperature curve: {temperature_label} does not vary"
+                + (f" (constant at {float(fin[0]):.4g} °C)" if fin.size else " (no value)"),
+            )
+            ax.set_xlabel(f"{temperature_label} [°C]", fontsize=9)
+            return _png(fig)
         xs, yb, ya = decimate_for_plot(x, before, after, block=block)
         ax.plot(xs, yb, ".", ms=2.5, color=BEFORE_COLOR, alpha=0.25)
         ax.plot(xs, ya, ".", ms=2.5, color=AFTER_COLOR, alpha=0.25)
@@ -220,11 +229,31 @@ class AllanCurve:
     adev_high: FloatArray | None = None
 
 
+def say_why_empty(ax: Any, reason: str) -> None:
+    """Write in an empty panel why it is empty (a blank figure never goes out unexplained)."""
+    ax.text(0.5, 0.5, reason, ha="center", va="center", wrap=True, fontsize=9,
+            color="#5b6773", transform=ax.transAxes)  # fmt: skip
+
+
 def allan_deviation(curves: Sequence[AllanCurve], *, unit: str) -> bytes:
-    """Log-log Allan deviation σ(τ) with confidence intervals as error bars."""
+    """Log-log Allan deviation σ(τ) with confidence intervals as error bars; a curve with no
+    positive point is named in the panel with the reason."""
     colors = (BEFORE_COLOR, AFTER_COLOR, "#27ae60", "#8e44ad")
     with _figure(1, height_in=4.0) as (fig, axes):
         ax = axes[0]
+        empty = [
+            c.label
+            for c in curves
+            if not np.any(
+                np.isfinite(np.asarray(c.adev, dtype=np.float64)) & (np.asarray(c.adev) > 0)
+            )
+        ]
+        if empty:
+            say_why_empty(
+                ax,
+                "no Allan deviation to draw for " + ", ".join(empty) + ": the record is "
+                "shorter than two clusters of the smallest τ, or the output does not vary",
+            )
         for i, c in enumerate(curves):
             col = colors[i % len(colors)]
             tau = np.asarray(c.tau_s, dtype=np.float64)
@@ -241,8 +270,9 @@ def allan_deviation(curves: Sequence[AllanCurve], *, unit: str) -> bytes:
                 )  # fmt: skip
             else:
                 ax.plot(tau[ok], ad[ok], "o-", ms=3, lw=1.1, color=col, label=c.label)
-        ax.set_xscale("log")
-        ax.set_yscale("log")
+        if len(empty) < len(curves):
+            ax.set_xscale("log")
+            ax.set_yscale("log")
         ax.set_xlabel("averaging time τ [s]", fontsize=9)
         ax.set_ylabel(f"Allan deviation σ(τ) [{unit}]", fontsize=9)
         ax.legend(fontsize=8, frameon=False)
@@ -253,8 +283,11 @@ def drift_angle(
     time_s: FloatArray,
     before_deg: FloatArray,
     after_deg: FloatArray,
+    *,
+    unit: str = "°",
 ) -> bytes:
-    """Drift angle [°] (integral of the bias-corrected rate) before and after compensation."""
+    """Drift angle [``unit``] (integral of the rate less a stated constant bias) before and
+    after compensation, against time [h]."""
     t = np.asarray(time_s, dtype=np.float64)
     with _figure(1, height_in=3.4) as (fig, axes):
         ax = axes[0]
@@ -263,7 +296,7 @@ def drift_angle(
         ax.plot(th, ya, color=AFTER_COLOR, lw=1.2, label="after compensation")
         ax.axhline(0.0, color="#999999", lw=0.6)
         ax.set_xlabel("time [h]", fontsize=9)
-        ax.set_ylabel("drift angle [°]", fontsize=9)
+        ax.set_ylabel(f"drift angle [{unit}]", fontsize=9)
         ax.legend(fontsize=8, loc="upper left", frameon=False)
         return _png(fig)
 
@@ -299,6 +332,7 @@ __all__ = [
     "decimate_for_plot",
     "drift_angle",
     "model_fit",
+    "say_why_empty",
     "temperature_profile",
 ]
 
