@@ -1002,7 +1002,7 @@ class RangeExcess:
     def describe(self) -> str:
         """One phrase: share, how far, and the columns that left their range."""
         what = {"temperature": "temperature", "temperature_rate": "Ṫ",
-                "time_since_power_on": "time since power-on"}[self.quantity]  # fmt: skip
+                "time_since_power_on": "time after power-on"}[self.quantity]  # fmt: skip
         cols = ", ".join(
             f"{c} met {self.seen[c][0]:.4g}…{self.seen[c][1]:.4g} {self.unit}, calibrated "
             f"{self.fitted[c][0]:.4g}…{self.fitted[c][1]:.4g}"
