@@ -353,7 +353,7 @@ def zero_reference(
             f"the known input the model was fitted with ({rec.get('what') or 'given'}), "
             "assumed the same on this run"
         )
-    return 0.0, "0: no known input given, in the file's metadata or in the model file"
+    return 0.0, "no known input given, in the file's metadata or in the model file: zero is 0"
 
 
 # --- streaming -----------------------------------------------------------------------------

@@ -1005,7 +1005,7 @@ class RangeExcess:
                 "time_since_power_on": "time after power-on"}[self.quantity]  # fmt: skip
         cols = ", ".join(
             f"{c} met {self.seen[c][0]:.4g}…{self.seen[c][1]:.4g} {self.unit}, calibrated "
-            f"{self.fitted[c][0]:.4g}…{self.fitted[c][1]:.4g}"
+            f"{self.fitted[c][0]:.4g}…{self.fitted[c][1]:.4g} {self.unit}"
             for c in self.fitted
             if self.beyond[c] > 0
         )
