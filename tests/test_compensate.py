@@ -476,6 +476,10 @@ def test_every_family_compensate_run_is_signal_minus_predict(
     np.testing.assert_array_equal(batch.corrected, run.signal - y)
 
 
+# the models were fitted on other data: the absolute error gets worse (issue 25), said aside
+@pytest.mark.filterwarnings(
+    "ignore:.*makes the absolute error worse:thermocal.errors.ThermocalWarning"
+)
 def test_every_family_chunked_file_equals_in_memory(
     family_model: TemperatureModel, tmp_path: Path
 ) -> None:

@@ -125,7 +125,10 @@ def _independent(
 def test_figures_equal_independent_computation() -> None:
     run, noise, model = _synthetic_run()
     t_mod, T_mod = _profile((30.0, 0.0, 10.0, 50.0))  # another history, r ≈ 0
-    res = validate(model, run, (t_mod, T_mod), averaging_s=100.0)
+    # the toy has no constant term: its output keeps the 3 °/h bias, which the raw output
+    # partly hid (its thermal part is mostly negative): worse about zero (issue 25)
+    with pytest.warns(ThermocalWarning, match=r"syn: the compensation makes the absolute error"):
+        res = validate(model, run, (t_mod, T_mod), averaging_s=100.0)
     # one stage per hold, bounded by the programmed corners (± the 60 s rate window)
     assert res.n_stages == len(LEVELS)
     for i, s in enumerate(res.stages):
@@ -156,6 +159,15 @@ def test_figures_equal_independent_computation() -> None:
     _base, x, y = common_base(t_mod, T_mod, run.time_s, run.temps_c[:, 0])
     assert res.r == pytest.approx(float(np.corrcoef(x, y)[0, 1]), abs=1e-12)
     assert res.weakly_correlated is (res.r is not None and res.r < 0.4)
+    # what the user sees, per sample about zero (no known input): computed here
+    for when, x in (("before", run.signal), ("after", run.signal - model.predict(run))):
+        d_abs = res.to_dict()
+        assert d_abs[f"mean_{when}"] == pytest.approx(float(np.mean(x)), rel=1e-12)
+        assert d_abs[f"rms_about_zero_{when}"] == pytest.approx(
+            float(np.sqrt(np.mean(x * x))), rel=1e-12
+        )
+        assert d_abs[f"max_abs_{when}"] == pytest.approx(float(np.max(np.abs(x))), rel=1e-12)
+    assert res.absolute_error_worse and res.verdict == "NOT improved (absolute error worse)"
     d = res.to_dict()
     for key in (
         "r", "weakly_correlated", "n_stages", "bias_stability_before", "bias_stability_after",
@@ -167,6 +179,10 @@ def test_figures_equal_independent_computation() -> None:
     json.dumps(d, allow_nan=False)
 
 
+# the toy keeps its 3 °/h bias after compensation (see above)
+@pytest.mark.filterwarnings(
+    "ignore:.*makes the absolute error worse:thermocal.errors.ThermocalWarning"
+)
 def test_strongly_correlated_test_warns_but_is_not_refused() -> None:
     run, _noise, model = _synthetic_run()
     with pytest.warns(
@@ -179,6 +195,10 @@ def test_strongly_correlated_test_warns_but_is_not_refused() -> None:
     assert any("not weakly correlated" in w for w in res.warnings)
 
 
+# the toy keeps its 3 °/h bias after compensation (see above)
+@pytest.mark.filterwarnings(
+    "ignore:.*makes the absolute error worse:thermocal.errors.ThermocalWarning"
+)
 def test_no_modelling_history_gives_null_r() -> None:
     run, _noise, model = _synthetic_run()
     with pytest.warns(CorrelationWarning, match="r was not computed"):

@@ -45,11 +45,14 @@ import numpy as np
 from thermocal import units
 from thermocal._lazy import LazyModule
 from thermocal.compensation import (  # the maths, re-exported
+    AbsoluteFigures,
     CalibrationStream,
     ChunkPredictor,
     Compensation,
     ModelRun,
     StreamingCompensator,
+    absolute_error_worse,
+    absolute_worse_message,
     check_signal_kind,
     chunk_context,
     compensate_run,
@@ -57,6 +60,7 @@ from thermocal.compensation import (  # the maths, re-exported
     prepare_run,
     temperature_inputs,
     unit_factor,
+    zero_reference,
 )
 from thermocal.defaults import DEFAULT_CHUNK_ROWS as DEFAULT_CHUNK_ROWS
 from thermocal.errors import (
@@ -67,6 +71,7 @@ from thermocal.errors import (
     PlausibilityWarning,
     TextLayoutWarning,
     ThermocalInputError,
+    ThermocalWarning,
     TimestampError,
     UnitError,
 )
@@ -90,7 +95,12 @@ from thermocal.io import (
     write_json,
     write_recording,
 )
-from thermocal.models.base import ChunkContext, TemperatureModel, check_sensor_id
+from thermocal.models.base import (
+    ChunkContext,
+    TemperatureModel,
+    check_sensor_id,
+    outside_range_dict,
+)
 from thermocal.recording import (
     ABSOLUTE_ZERO_C,
     FEW_SAMPLES,
@@ -135,6 +145,27 @@ class CompensateFileResult:
     rms_after: float
     """Rms of the compensated signal about its mean [data unit]."""
     extra: dict[str, Any] = field(default_factory=dict)
+    mean_before: float = float("nan")
+    """What the sensor's user sees (:class:`~thermocal.compensation.AbsoluteFigures`),
+    per sample about :attr:`zero_reference`: ``mean(F − K)`` of the signal [data unit]."""
+    mean_after: float = float("nan")
+    """``mean(F' − K)`` of the compensated signal [data unit]."""
+    rms_about_zero_before: float = float("nan")
+    """``sqrt(mean((F − K)²))`` [data unit]."""
+    rms_about_zero_after: float = float("nan")
+    """``sqrt(mean((F' − K)²))`` [data unit]."""
+    max_abs_before: float = float("nan")
+    """``max |F − K|`` [data unit]."""
+    max_abs_after: float = float("nan")
+    """``max |F' − K|`` [data unit]."""
+    zero_reference: dict[str, Any] = field(default_factory=dict)
+    """``{value [data unit], unit, what}``: the level an ideal sensor would output."""
+    absolute_error_worse: bool = False
+    """The compensation raised the rms about zero or the max |error| by more than 1 %."""
+    outside_range: dict[str, Any] = field(default_factory=dict)
+    """How far the file leaves the model's calibrated ranges, per input
+    (:func:`~thermocal.models.base.outside_range_dict`)."""
+    outside_calibrated_range: bool = False
 
     def to_dict(self) -> dict[str, Any]:
         d = {k: getattr(self, k) for k in self.__dataclass_fields__ if k != "extra"}
@@ -150,11 +181,15 @@ class _RunningMoments:
         self.n = 0
         self.mean = 0.0
         self.m2 = 0.0
+        self.lo = math.inf
+        self.hi = -math.inf
 
     def add(self, x: FloatArray) -> None:
         nb = int(x.size)
         if nb == 0:
             return
+        self.lo = min(self.lo, float(np.min(x)))
+        self.hi = max(self.hi, float(np.max(x)))
         mb = float(np.mean(x))
         m2b = float(np.sum((x - mb) ** 2))
         n = self.n + nb
@@ -166,6 +201,17 @@ class _RunningMoments:
     def rms(self) -> float:
         """Root mean square about the mean, ``sqrt(Σ(x − x̄)²/n)``."""
         return math.sqrt(self.m2 / self.n) if self.n else float("nan")
+
+    def about(self, reference: float) -> AbsoluteFigures:
+        """Mean, rms and largest magnitude about ``reference`` (same unit):
+        ``sqrt(Σ(x − K)²/n) = sqrt(m2/n + (x̄ − K)²)``, ``max |x − K| = max(x_max − K,
+        K − x_min)``."""
+        if not self.n:
+            return AbsoluteFigures(float("nan"), float("nan"), float("nan"))
+        d = self.mean - reference
+        return AbsoluteFigures(
+            d, math.sqrt(self.m2 / self.n + d * d), max(self.hi - reference, reference - self.lo)
+        )
 
 
 def _file_info(
@@ -443,6 +489,8 @@ class _ChannelPlan:
     predictor: ChunkPredictor
     time_unit: str = "s"
     factor: float | None = None
+    zero: tuple[float, str] = (0.0, "0")
+    """The level an ideal sensor would output [model unit] and what it is."""
     before: _RunningMoments = field(default_factory=lambda: _RunningMoments())
     after: _RunningMoments = field(default_factory=lambda: _RunningMoments())
 
@@ -563,21 +611,48 @@ def compensate_channels(
     for plan in plans:
         plan.predictor.finish()
     n = int(state["rows"])
-    return [
-        CompensateFileResult(
-            output=str(dst),
-            n_rows=n,
-            n_chunks=int(state["chunks"]),
-            signal=plan.signal,
-            model_column=plan.model_col,
-            comp_column=plan.comp_col,
-            unit=plan.data_unit,
-            streamed=plan.predictor.streams,
-            rms_before=plan.before.rms(),
-            rms_after=plan.after.rms(),
+    return [_file_result(plan, str(dst), n, int(state["chunks"])) for plan in plans]
+
+
+def _file_result(
+    plan: _ChannelPlan, output: str, n_rows: int, n_chunks: int
+) -> CompensateFileResult:
+    """One channel's summary: the figures about the mean and about zero (in the data's
+    unit), with a warning when the compensation makes the absolute error worse."""
+    k = plan.factor or 1.0
+    ref = plan.zero[0] / k  # the reference in the data's unit
+    b, a = plan.before.about(ref), plan.after.about(ref)
+    worse = absolute_error_worse(b, a)
+    if worse:
+        warnings.warn(
+            ThermocalWarning(
+                absolute_worse_message(plan.predictor.name, plan.data_unit, b, a, worse)
+            ),
+            stacklevel=3,
         )
-        for plan in plans
-    ]
+    excess = plan.predictor.outside_range
+    return CompensateFileResult(
+        output=output,
+        n_rows=n_rows,
+        n_chunks=n_chunks,
+        signal=plan.signal,
+        model_column=plan.model_col,
+        comp_column=plan.comp_col,
+        unit=plan.data_unit,
+        streamed=plan.predictor.streams,
+        rms_before=plan.before.rms(),
+        rms_after=plan.after.rms(),
+        mean_before=b.mean,
+        mean_after=a.mean,
+        rms_about_zero_before=b.rms_about_zero,
+        rms_about_zero_after=a.rms_about_zero,
+        max_abs_before=b.max_abs,
+        max_abs_after=a.max_abs,
+        zero_reference={"value": ref, "unit": plan.data_unit, "what": plan.zero[1]},
+        absolute_error_worse=bool(worse),
+        outside_range=outside_range_dict(excess),
+        outside_calibrated_range=any(e.n_outside for e in excess),
+    )
 
 
 @dataclass(frozen=True)
@@ -655,6 +730,7 @@ def _channel_plan(
             model, extrapolate=extrapolate, name=name, known_input=known_input
         ),
         time_unit=resolved.time.unit,
+        zero=zero_reference(model, md, known_input),
     )
 
 
@@ -836,6 +912,7 @@ __all__ = [
     "prepare_run",
     "temperature_inputs",
     "unit_factor",
+    "zero_reference",
 ]
 
 

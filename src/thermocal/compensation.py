@@ -41,7 +41,15 @@ from thermocal.errors import (
     UnitError,
     UnitWarning,
 )
-from thermocal.models.base import ChunkContext, ModelStream, RunData, TemperatureModel
+from thermocal.models.base import (
+    ChunkContext,
+    ModelStream,
+    RangeExcess,
+    RangeTally,
+    RunData,
+    TemperatureModel,
+    outside_range_message,
+)
 from thermocal.recording import GAP_FACTOR, FloatArray, Metadata, Recording, median_interval
 
 # --- unit handling ------------------------------------------------------------------------
@@ -241,6 +249,113 @@ def compensate_run(
     return Compensation(model_value=y, corrected=run.signal - y)
 
 
+# --- what the sensor's user sees ----------------------------------------------------------
+
+ABSOLUTE_WORSE_TOLERANCE = 0.01
+"""A compensated output is *absolutely worse* when its rms about zero or its largest
+|error| exceeds the raw output's by more than this fraction (1 %: beyond the change a
+model that removes nothing of the noise makes by itself)."""
+
+
+@dataclass(frozen=True)
+class AbsoluteFigures:
+    """The output as the sensor's user sees it, per sample, against the level an ideal
+    sensor would give (the reference K: 0, or the known input — earth rate, gravity):
+    ``mean = mean(x − K)``, ``rms_about_zero = sqrt(mean((x − K)²)) = sqrt(σ² + mean²)``
+    (σ the rms about the mean) and ``max_abs = max |x − K|`` [unit of x].  Unlike the
+    figures about the mean, these see a constant offset the model adds or leaves."""
+
+    mean: float
+    rms_about_zero: float
+    max_abs: float
+
+
+def absolute_figures(x: npt.ArrayLike, reference: float = 0.0) -> AbsoluteFigures:
+    """:class:`AbsoluteFigures` of the samples ``x`` about ``reference`` (same unit)."""
+    e = np.asarray(x, dtype=np.float64) - float(reference)
+    if e.size == 0:
+        return AbsoluteFigures(float("nan"), float("nan"), float("nan"))
+    return AbsoluteFigures(
+        float(np.mean(e)), float(np.sqrt(np.mean(e * e))), float(np.max(np.abs(e)))
+    )
+
+
+def absolute_error_worse(
+    before: AbsoluteFigures, after: AbsoluteFigures, tolerance: float = ABSOLUTE_WORSE_TOLERANCE
+) -> list[str]:
+    """The absolute figures the compensation made worse: ``"rms about zero"`` when
+    ``after > (1 + tolerance) · before``; ``"max |error|"`` likewise, counted only when the
+    rms about zero did not improve as well (a larger single extreme while the rms about
+    zero falls is a noise sample, not a worse output); empty when none."""
+    out = []
+    b, a = before.rms_about_zero, after.rms_about_zero
+    finite = math.isfinite(a) and math.isfinite(b)
+    if finite and a > (1.0 + tolerance) * b:
+        out.append("rms about zero")
+    bm, am = before.max_abs, after.max_abs
+    if (
+        finite
+        and a >= b
+        and math.isfinite(am)
+        and math.isfinite(bm)
+        and am > (1.0 + tolerance) * bm
+    ):
+        out.append("max |error|")
+    return out
+
+
+def absolute_worse_message(
+    where: str, unit: str, before: AbsoluteFigures, after: AbsoluteFigures, worse: Sequence[str]
+) -> str:
+    """The ``warning:`` text for a compensation that makes the absolute error worse."""
+    pct = (
+        100.0 * (after.rms_about_zero - before.rms_about_zero) / before.rms_about_zero
+        if before.rms_about_zero > 0
+        else float("nan")
+    )
+    return (
+        f"{where}: the compensation makes the absolute error worse ({', '.join(worse)}): "
+        f"mean {before.mean:.4g} → {after.mean:.4g} {unit}, rms about zero "
+        f"{before.rms_about_zero:.4g} → {after.rms_about_zero:.4g} {unit} ({pct:+.3g} %), "
+        f"max |error| {before.max_abs:.4g} → {after.max_abs:.4g} {unit}; the model does not "
+        "describe this sensor at these conditions (another power-on, temperature or sensor?)"
+    )
+
+
+def zero_reference(
+    model: TemperatureModel, meta: Metadata | None, known_input: float = 0.0
+) -> tuple[float, str]:
+    """The level an ideal sensor would output on this run [model unit] and what it is: the
+    "zero" of the absolute figures (:class:`AbsoluteFigures`).
+
+    In order: ``known_input`` when given (non-zero); for a gyro, the earth rate on the
+    sensitive axis when the data's metadata give latitude and axis (SPEC §1,
+    :func:`thermocal.units.earth_rate_on_axis_deg_h`); the known input the model file
+    recorded of its fit (``inputs.known_input``, assumed the same on this run); else 0.
+    """
+    if known_input:
+        return float(known_input), "the known input given (--known-input)"
+    mu = units.normalize_signal_unit(model.signal_unit)
+    if (
+        meta is not None
+        and meta.latitude_deg is not None
+        and meta.axis is not None
+        and units.signal_kind(mu) == units.signal_kind("deg/h")
+    ):
+        w = units.earth_rate_on_axis_deg_h(meta.latitude_deg, units.parse_axis(meta.axis))
+        return float(units.convert(w, "deg/h", mu)), (
+            f"the earth rate on axis {meta.axis} at latitude {meta.latitude_deg:g}° (file metadata)"
+        )
+    rec = ((getattr(model, "inputs_", {}) or {}).get("known_input")) or {}
+    val = rec.get("value") if isinstance(rec, dict) else None
+    if isinstance(val, int | float) and val and rec.get("unit") in (None, mu):
+        return float(val), (
+            f"the known input the model was fitted with ({rec.get('what') or 'given'}), "
+            "assumed the same on this run"
+        )
+    return 0.0, "no known input given, in the file's metadata or in the model file: zero is 0"
+
+
 # --- streaming -----------------------------------------------------------------------------
 
 
@@ -291,6 +406,7 @@ class StreamingCompensator:
         self._last_t: float | None = None
         self._mode: str | None = None
         self._chunks: ChunkPredictor | None = None
+        self._warned = False
         self.last_model_value: float = float("nan")
         """ŷ of the last sample [model signal unit]."""
         self.n_samples = 0
@@ -325,15 +441,25 @@ class StreamingCompensator:
         self._last_t = None
         self._mode = None
         self._chunks = None
+        self._warned = False
         self.last_model_value = float("nan")
         self.n_samples = 0
+
+    @property
+    def outside_range(self) -> tuple[RangeExcess, ...]:
+        """How far the blocks fed since the last reset (:meth:`update_block`) leave the
+        model's calibrated ranges: share of samples and distance per input (empty before
+        any block; :meth:`update` relies on the family stream's own one warning)."""
+        return self._chunks.outside_range if self._chunks is not None else ()
 
     def update_block(
         self, time_s: npt.ArrayLike, temps_c: npt.ArrayLike, signal: npt.ArrayLike
     ) -> Compensation:
         """Compensate a block of consecutive samples at once (vectorised); state carried
         on to the next block.  Same values as :meth:`process` (see the class docstring);
-        one :class:`ExtrapolationWarning` per block with samples outside the fitted range.
+        one :class:`ExtrapolationWarning` per stream, at the first block with samples outside
+        a calibrated range (temperature, Ṫ, time since power-on; :attr:`outside_range`
+        gives the share and distance over every block fed since).
         """
         t = np.asarray(time_s, dtype=np.float64).reshape(-1)
         T = np.asarray(temps_c, dtype=np.float64)
@@ -356,10 +482,10 @@ class StreamingCompensator:
                 known_input=self.known_input,
                 sample_interval_s=self.sample_interval_s,
             )
-        before = self._chunks.n_outside
         y = self._chunks.predict(t, T, f)
-        if self._chunks.n_outside > before:
-            self._chunks.warn_outside(self._chunks.n_outside - before)
+        if not self._warned and any(e.n_outside for e in self._chunks.outside_range):
+            self._warned = True  # once per stream: outside_range gives the figures later
+            self._chunks.warn_outside()
         self._last_t = float(t[-1])
         self.last_model_value = float(y[-1])
         self.n_samples += int(t.size)
@@ -537,9 +663,9 @@ class ChunkPredictor:
         self._stream: StreamingCompensator | None = None
         self._tau: float | None = sample_interval_s
         self.n_outside = 0
-        """Samples outside the model's fitted temperature range (for one summary warning)."""
-        self._t_first: float | None = None
-        self._t_last: float | None = None
+        """Samples outside the model's fitted temperature range."""
+        self.tally = RangeTally(model)
+        """How far the rows seen leave the calibrated ranges (one summary warning)."""
 
     @property
     def streams(self) -> bool:
@@ -581,12 +707,11 @@ class ChunkPredictor:
                 ys = self._predict_context(
                     time_s, temps_c, signal, [self.model, *(f.model for f in followers)]
                 )
+        self.tally.add(time_s, temps_c)
         for p in (self, *followers):
             p.n_outside += outside
             p._rows_seen += n
-            if p._t_first is None:
-                p._t_first = float(time_s[0])
-            p._t_last = float(time_s[-1])
+            p.tally = self.tally  # one evaluation key: the same ranges, counted once
         return ys
 
     def _predict_stream(
@@ -657,36 +782,37 @@ class ChunkPredictor:
         return ys
 
     def finish(self) -> None:
-        """Issue one :class:`ExtrapolationWarning` for the whole file, if any sample
-        was outside the fitted range."""
-        if self.n_outside:
-            self.warn_outside(self.n_outside)
-        if self._t_first is not None and self._t_last is not None:
-            self.model.check_duration(self._t_last - self._t_first)
+        """Issue one :class:`ExtrapolationWarning` for the whole file when samples left the
+        calibrated ranges (temperature, Ṫ, time since power-on), saying for what share of
+        the samples and how far (:func:`~thermocal.models.base.outside_range_message`)."""
+        self.warn_outside()
 
-    def warn_outside(self, n_outside: int) -> None:
-        """One :class:`ExtrapolationWarning` for ``n_outside`` samples out of range."""
-        if n_outside:
-            action = "extrapolated" if self.extrapolate else "clamped to the fitted range"
-            rng = ", ".join(
-                f"{n} {a:.2f}…{b:.2f} °C"
-                for n, (a, b) in zip(self.model.temp_names_, self.model.temp_range_, strict=True)
-            )
-            warnings.warn(
-                f"{self.name or 'data'}: {n_outside} samples outside the model's "
-                f"temperature range ({rng}); {action}",
-                ExtrapolationWarning,
-                stacklevel=2,
-            )
+    @property
+    def outside_range(self) -> tuple[RangeExcess, ...]:
+        """How far the rows predicted so far leave the calibrated ranges."""
+        return self.tally.result()
+
+    def warn_outside(self) -> None:
+        """One :class:`ExtrapolationWarning` for the rows so far, if any left a range."""
+        msg = outside_range_message(
+            self.tally.result(), self.name or "data", extrapolate=self.extrapolate
+        )
+        if msg:
+            warnings.warn(msg, ExtrapolationWarning, stacklevel=3)
 
 
 __all__ = [
+    "ABSOLUTE_WORSE_TOLERANCE",
+    "AbsoluteFigures",
     "CalibrationStream",
     "ChunkContext",
     "ChunkPredictor",
     "Compensation",
     "ModelRun",
     "StreamingCompensator",
+    "absolute_error_worse",
+    "absolute_figures",
+    "absolute_worse_message",
     "check_signal_kind",
     "chunk_context",
     "compensate_run",
@@ -694,4 +820,5 @@ __all__ = [
     "prepare_run",
     "temperature_inputs",
     "unit_factor",
+    "zero_reference",
 ]

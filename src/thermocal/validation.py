@@ -31,6 +31,17 @@ not a copy of the modelling test's:
    across a gap), after removing their mean, ``rms = sqrt(mean(F̄_j − mean F̄)²)``
    and ``peak_to_peak = max F̄_j − min F̄_j``.
 5. ``improvement_pct[x] = 100 (x_before − x_after)/x_before`` for each figure.
+6. **What the user sees** (issue 25): per sample, about the level an ideal sensor would
+   give (``K``, :func:`thermocal.compensation.zero_reference`: the known input — earth rate,
+   gravity — or 0), ``mean = mean(F − K)``, ``rms_about_zero = sqrt(mean((F − K)²))`` and
+   ``max_abs = max |F − K|``, before and after (:class:`~thermocal.compensation.
+   AbsoluteFigures`).  A compensation that raises the rms about zero or the largest |error|
+   by more than 1 % is *absolutely worse*: a warning, ``absolute_error_worse`` and the
+   verdict ``NOT improved (absolute error worse)`` — the figures about the mean cannot see a
+   constant offset the model adds (a model fitted at 13 °C applied at 47 °C).
+7. **Applicability**: the share of samples outside the model's calibrated temperature
+   range (and Ṫ range, and time since power-on for warm-up models) and how far
+   (:class:`~thermocal.models.base.RangeExcess`), one warning for the run.
 
 All figures are in the model's signal unit ([°/h] or [mg]); :meth:`ValidationResult.in_unit`
 gives them in the data's own unit (``thermocal validate`` does).
@@ -48,16 +59,31 @@ import numpy as np
 import numpy.typing as npt
 
 from thermocal import metrics
-from thermocal.compensation import compensate_run
+from thermocal.compensation import (
+    AbsoluteFigures,
+    absolute_error_worse,
+    absolute_figures,
+    absolute_worse_message,
+    compensate_run,
+)
 from thermocal.defaults import DEFAULT_AVERAGING_S as DEFAULT_AVERAGING_S
 from thermocal.defaults import WEAK_CORRELATION_LIMIT
 from thermocal.errors import (
     CorrelationWarning,
+    ExtrapolationWarning,
     ThermocalInputError,
     ThermocalWarning,
     TimestampError,
 )
-from thermocal.models.base import RunData, TemperatureModel
+from thermocal.models.base import (
+    RANGE_WARNING_PATTERNS,
+    RangeExcess,
+    RunData,
+    TemperatureModel,
+    outside_range,
+    outside_range_dict,
+    outside_range_message,
+)
 from thermocal.preprocess import segment_holds
 from thermocal.profiles import correlate
 from thermocal.recording import FloatArray, median_interval
@@ -113,6 +139,28 @@ class ValidationResult:
     n_samples: int
     warnings: tuple[str, ...] = ()
     extra: dict[str, Any] = field(default_factory=dict)
+    absolute_before: AbsoluteFigures | None = None
+    """Per-sample figures of the raw output about :attr:`zero_reference` [unit]."""
+    absolute_after: AbsoluteFigures | None = None
+    """The same of the compensated output [unit]."""
+    zero_reference: float = 0.0
+    """The level an ideal sensor would output, "zero" of the absolute figures [unit]."""
+    zero_reference_what: str = "0"
+    absolute_worse: tuple[str, ...] = ()
+    """The absolute figures the compensation made worse (beyond 1 %)."""
+    outside_range: tuple[RangeExcess, ...] = ()
+    """How far the run leaves the model's calibrated ranges, per input."""
+
+    @property
+    def absolute_error_worse(self) -> bool:
+        """True when the compensation makes the absolute error worse (rms about zero or
+        max |error| after > before by more than 1 %)."""
+        return bool(self.absolute_worse)
+
+    @property
+    def outside_calibrated_range(self) -> bool:
+        """True when any sample left a calibrated range (temperature, Ṫ, power-on time)."""
+        return any(e.n_outside for e in self.outside_range)
 
     @property
     def improvement_pct(self) -> dict[str, float | None]:
@@ -128,14 +176,32 @@ class ValidationResult:
     def verdict(self) -> str:
         """One word on the model for this run: ``"NOT weakly correlated"`` when r says the
         validation run repeats the modelling run (SPEC §5: then it proves nothing), else
-        ``"improved"``/``"NOT improved"`` by the rms of the bias before and after; ``"—"``
-        when the rms cannot be compared."""
+        ``"NOT improved (absolute error worse)"`` when the compensation makes the error
+        about zero worse (:attr:`absolute_error_worse`), else ``"improved"``/``"NOT
+        improved"`` by the rms of the bias before and after; ``"—"`` when the rms cannot be
+        compared.  A run outside the calibrated range is flagged beside the verdict
+        (:attr:`outside_calibrated_range`, :attr:`verdict_line`), not in this word."""
         if self.r is not None and not self.weakly_correlated:
             return "NOT weakly correlated"
+        if self.absolute_error_worse:
+            return "NOT improved (absolute error worse)"
         imp = self.improvement_pct.get("rms")
         if imp is None:
             return "—"
         return "improved" if imp > 0 else "NOT improved"
+
+    @property
+    def verdict_line(self) -> str:
+        """The verdict with what qualifies it: the run outside the calibrated range."""
+        bad = [e for e in self.outside_range if e.n_outside]
+        if not bad:
+            return self.verdict
+        what = ", ".join(
+            f"{e.quantity.replace('_', ' ')} {100.0 * e.share:.3g} % of samples, up to "
+            f"{e.max_beyond:.3g} {e.unit} beyond"
+            for e in bad
+        )
+        return f"{self.verdict}; outside the calibrated range ({what})"
 
     def in_unit(self, unit: str, factor: float) -> ValidationResult:
         """The same result with every signal figure in ``unit``, where ``value[self.unit]
@@ -153,10 +219,19 @@ class ValidationResult:
             dataclasses.replace(s, **{k: getattr(s, k) / factor for k in stage_keys})
             for s in self.stages
         )
+
+        def absolute(a: AbsoluteFigures | None) -> AbsoluteFigures | None:
+            if a is None:
+                return None
+            return AbsoluteFigures(a.mean / factor, a.rms_about_zero / factor, a.max_abs / factor)
+
         return dataclasses.replace(
             self,
             unit=unit,
             stages=stages,
+            absolute_before=absolute(self.absolute_before),
+            absolute_after=absolute(self.absolute_after),
+            zero_reference=self.zero_reference / factor,
             **{k: getattr(self, k) / factor for k in keys},
         )
 
@@ -180,6 +255,24 @@ class ValidationResult:
             "peak_to_peak_before": num(self.peak_to_peak_before),
             "peak_to_peak_after": num(self.peak_to_peak_after),
             "improvement_pct": {k: num(v) for k, v in self.improvement_pct.items()},
+        }
+        # what the sensor's user sees: per sample, about the reference "zero" (unit)
+        for when, a in (("before", self.absolute_before), ("after", self.absolute_after)):
+            d[f"mean_{when}"] = num(a.mean) if a else None
+            d[f"rms_about_zero_{when}"] = num(a.rms_about_zero) if a else None
+            d[f"max_abs_{when}"] = num(a.max_abs) if a else None
+        d["zero_reference"] = {
+            "value": num(self.zero_reference),
+            "unit": self.unit,
+            "what": self.zero_reference_what,
+        }
+        d["absolute_error_worse"] = self.absolute_error_worse
+        d["absolute_error_worse_figures"] = list(self.absolute_worse)
+        d["outside_calibrated_range"] = self.outside_calibrated_range
+        d["outside_range"] = outside_range_dict(self.outside_range)
+        d["verdict"] = self.verdict
+        d["verdict_line"] = self.verdict_line
+        d |= {
             "averaging_s": self.averaging_s,
             "unit": self.unit,
             "n_samples": self.n_samples,
@@ -247,6 +340,8 @@ def validate(
     min_stage_s: float = 600.0,
     settle_s: float = 0.0,
     extrapolate: bool = False,
+    zero_reference: tuple[float, str] = (0.0, "0"),
+    display_unit: tuple[str, float] | None = None,
 ) -> ValidationResult:
     """Judge ``model`` on an independent test (SPEC §5; the module docstring gives the formulas).
 
@@ -262,12 +357,20 @@ def validate(
     rate_threshold_c_per_min, min_stage_s, settle_s : hold detection
         (:func:`thermocal.preprocess.segment_holds` on the ambient temperature).
     extrapolate : evaluate the model outside its fitted range instead of clamping.
+    zero_reference : ``(K, what)``, the level an ideal sensor would output on this run
+        [model unit] (:func:`thermocal.compensation.zero_reference`): the "zero" of the
+        absolute figures.
+    display_unit : ``(unit, factor)`` with ``value[model unit] = factor · value[unit]``:
+        the unit the warning texts state figures in (the data's own); default the model's.
 
     Warns
     -----
     CorrelationWarning : the validation test is not weakly correlated (``r ≥ r_limit``),
         or no modelling history was given.
-    ThermocalWarning : fewer than two hold stages (repeatability undefined).
+    ThermocalWarning : fewer than two hold stages (repeatability undefined); the
+        compensation makes the absolute error worse.
+    ExtrapolationWarning : samples outside the model's calibrated ranges (one warning:
+        share and distance per input; replaces the model's own range warnings).
     """
     if run_validation.signal is None:
         raise ThermocalInputError(f"{run_validation.name or 'validation run'}: no signal")
@@ -311,8 +414,16 @@ def validate(
                 CorrelationWarning,
             )
 
-    # 2. compensation
-    comp = compensate_run(model, run_validation, extrapolate=extrapolate)
+    # 2. compensation; the model's per-call range warnings give way to one with figures
+    with warnings.catch_warnings():
+        for pattern in RANGE_WARNING_PATTERNS:
+            warnings.filterwarnings("ignore", pattern, ExtrapolationWarning)
+        comp = compensate_run(model, run_validation, extrapolate=extrapolate)
+    where = run_validation.name or "validation run"
+    excess = outside_range(model, t, run_validation.temps_c)
+    msg = outside_range_message(excess, where, extrapolate=extrapolate)
+    if msg:
+        note(msg, ExtrapolationWarning)
     tau0 = median_interval(t)
     if not (math.isfinite(tau0) and tau0 > 0):
         raise ThermocalInputError("the validation run needs at least two increasing times")
@@ -367,6 +478,15 @@ def validate(
 
     rms_b, ptp_b = run_rms_and_peak_to_peak(t, before, averaging_s, tau0)
     rms_a, ptp_a = run_rms_and_peak_to_peak(t, after, averaging_s, tau0)
+    ref, ref_what = zero_reference
+    abs_b = absolute_figures(before, ref)
+    abs_a = absolute_figures(after, ref)
+    worse = absolute_error_worse(abs_b, abs_a)
+    if worse:
+        du, k = display_unit or (model.signal_unit, 1.0)
+        shown = [AbsoluteFigures(a.mean / k, a.rms_about_zero / k, a.max_abs / k)
+                 for a in (abs_b, abs_a)]  # fmt: skip
+        note(absolute_worse_message(where, du, shown[0], shown[1], worse), ThermocalWarning)
     return ValidationResult(
         r=r,
         weakly_correlated=weak,
@@ -385,6 +505,12 @@ def validate(
         unit=model.signal_unit,
         n_samples=run_validation.n_samples,
         warnings=tuple(notes),
+        absolute_before=abs_b,
+        absolute_after=abs_a,
+        zero_reference=float(ref),
+        zero_reference_what=ref_what,
+        absolute_worse=tuple(worse),
+        outside_range=excess,
     )
 
 

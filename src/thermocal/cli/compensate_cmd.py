@@ -138,8 +138,19 @@ def compensate_cmd(
             table.add_row("model", f"{model.family} ({model_file})")
             table.add_row("rows", str(res.n_rows))
             table.add_row("added columns", f"{res.model_column}, {res.comp_column} [{res.unit}]")
-            table.add_row("rms before", f"{fmt(res.rms_before)} {res.unit}")
-            table.add_row("rms after", f"{fmt(res.rms_after)} {res.unit}")
+            table.add_row("rms before (about the mean)", f"{fmt(res.rms_before)} {res.unit}")
+            table.add_row("rms after (about the mean)", f"{fmt(res.rms_after)} {res.unit}")
+            for key, label in (
+                ("mean", "mean"),
+                ("rms_about_zero", "rms about zero"),
+                ("max_abs", "max |error|"),
+            ):
+                b, a = getattr(res, f"{key}_before"), getattr(res, f"{key}_after")
+                table.add_row(f"{label} before → after", f"{fmt(b)} → {fmt(a)} {res.unit}")
+            z = res.zero_reference
+            table.add_row("zero", f"{fmt(z.get('value'))} {res.unit}: {z.get('what')}")
+            if res.absolute_error_worse:
+                table.add_row("verdict", "the absolute error is WORSE after compensation")
             stdout.print(table)
 
         emit(summary, as_json, human)
@@ -175,12 +186,17 @@ def compensate_cmd(
 
     def human_many() -> None:
         table = _rich_table.Table(title=f"{file} → {output} ({len(results)} channels, one pass)")
-        for col in ("channel", "model", "added columns", "rms before", "rms after", "unit"):
+        for col in ("channel", "model", "added columns", "rms before", "rms after",
+                    "mean before → after", "rms about zero before → after", "unit"):  # fmt: skip
             table.add_column(col)
         for name, r in zip(chosen, results, strict=True):
             table.add_row(
                 name, cal.channel(name).model.family, f"{r.model_column}, {r.comp_column}",
-                fmt(r.rms_before), fmt(r.rms_after), r.unit,
+                fmt(r.rms_before), fmt(r.rms_after),
+                f"{fmt(r.mean_before)} → {fmt(r.mean_after)}",
+                f"{fmt(r.rms_about_zero_before)} → {fmt(r.rms_about_zero_after)}"
+                + (" (WORSE)" if r.absolute_error_worse else ""),
+                r.unit,
             )  # fmt: skip
         stdout.print(table)
 

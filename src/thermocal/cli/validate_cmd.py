@@ -101,16 +101,19 @@ def _emit_channels(file: Path, per: dict[str, tuple[Any, dict[str, Any]]], as_js
     def human() -> None:
         table = _rich_table.Table(title=f"validation on {file}, {len(per)} channels")
         for col in ("channel", "r", "bias stability before → after", "rms before → after",
-                    "unit", "verdict"):  # fmt: skip
+                    "mean before → after", "rms about zero before → after", "unit",
+                    "verdict"):  # fmt: skip
             table.add_column(col)
-        for name, (res, _out) in per.items():
+        for name, (res, out) in per.items():
             table.add_row(
                 name,
                 fmt(res.r, 3),
                 f"{fmt(res.bias_stability_before)} → {fmt(res.bias_stability_after)}",
                 f"{fmt(res.rms_before)} → {fmt(res.rms_after)}",
+                f"{fmt(out['mean_before'])} → {fmt(out['mean_after'])}",
+                f"{fmt(out['rms_about_zero_before'])} → {fmt(out['rms_about_zero_after'])}",
                 res.unit,
-                res.verdict,
+                res.verdict_line,
             )
         stdout.print(table)
 
@@ -204,6 +207,7 @@ def validate_cmd(
         # the data in the model's units (kinds checked); figures go back to the data's unit
         prepared = _compensate.prepare_run(model, rec, sig, temps)
         run = prepared.run
+        counts = prepared.data_unit == "counts"  # raw counts: figures in K's physical unit
         amb_val = _ambient(rec, amb)
 
         mod_path = modeling if modeling is not None else _modeling_file(model, model_file)
@@ -237,8 +241,10 @@ def validate_cmd(
             min_stage_s=min_stage,
             settle_s=settle,
             extrapolate=extrapolate,
+            zero_reference=_compensate.zero_reference(model, rec.meta),
+            display_unit=None if counts else (prepared.data_unit, prepared.factor),
         )
-        if prepared.data_unit != "counts":  # raw counts: figures in the physical unit K gives
+        if not counts:
             res = res.in_unit(prepared.data_unit, prepared.factor)
         out = res.to_dict()
         out["model_unit"] = model.signal_unit
@@ -310,7 +316,22 @@ def validate_cmd(
                 fmt(getattr(res, f"{key}_after")),
                 "—" if pct is None else f"{pct:.1f} %",
             )
+        for key, label in (
+            ("mean", "mean (about zero)"),
+            ("rms_about_zero", "rms about zero"),
+            ("max_abs", "max |error|"),
+        ):
+            b, a = out[f"{key}_before"], out[f"{key}_after"]
+            pct = 100.0 * (abs(b) - abs(a)) / abs(b) if b and a is not None else None
+            table.add_row(
+                label, fmt(b), fmt(a), "—" if pct is None else f"{pct:.1f} %"
+            )  # fmt: skip
         stdout.print(table)
+        stdout.print(
+            f"zero = {fmt(res.zero_reference)} {u}: {res.zero_reference_what}; the figures "
+            "about the mean ignore a constant offset, those about zero do not"
+        )
+        stdout.print(f"verdict: {res.verdict_line}")
 
     emit(out, as_json, human)
 

@@ -473,6 +473,21 @@ def _summary(
                 "flag_text": "improved" if ok else "not improved",
             }
         )
+    b, a = v.get("rms_about_zero_before"), v.get("rms_about_zero_after")
+    if b is not None and a is not None:  # what the user sees (issue 25): worse fails
+        worse = bool(v.get("absolute_error_worse"))
+        imp = improvement_pct(float(b), float(a))
+        items.append(
+            {
+                "label": "Error about zero (rms per sample)",
+                "before": num(b, f"{key}.rms_about_zero_before", unit=unit_label(unit)),
+                "after": num(a, f"{key}.rms_about_zero_after", unit=unit_label(unit)),
+                "value": num(imp, f"{key}.rms_about_zero_improvement_pct", digits=3, unit="%"),
+                "note": "improvement",
+                "flag": _flag(not worse),
+                "flag_text": "absolute error worse" if worse else "not worse",
+            }
+        )
     if fom_before.drift_angle_max_deg is not None and fom_after.drift_angle_max_deg is not None:
         imp = improvement_pct(fom_before.drift_angle_max_deg, fom_after.drift_angle_max_deg)
         ok = None if imp is None else imp > 0
