@@ -490,6 +490,16 @@ def _split(line: str, delim: str) -> list[str]:
     return line.split() if delim == " " else [f.strip() for f in line.split(delim)]
 
 
+def parse_number(field: str) -> float:
+    """A text field as a float, as a CSV reader takes it: ASCII digits, sign, ``.``,
+    exponent, or ``nan``/``inf``.  Python's :func:`float` also accepts digit-group
+    underscores (``0_5`` → 5.0) and non-ASCII digits (``١٢``); those are malformed numbers
+    here (``ValueError``), so a mangled line is a bad line, not a silent value."""
+    if "_" in field or not field.isascii():
+        raise ValueError(f"malformed number {field.strip()[:40]!r}")
+    return float(field)
+
+
 def _is_number(field: str, decimal: str, *, empty: bool = False) -> bool:
     """A number written with ``decimal`` (an empty field counts when ``empty``: a missing
     value, NaN downstream, not a sign of a banner)."""
@@ -497,10 +507,38 @@ def _is_number(field: str, decimal: str, *, empty: bool = False) -> bool:
     if empty and not f:
         return True
     try:
-        float(f)
+        parse_number(f)
     except ValueError:
         return False
     return True
+
+
+def short_name(name: str, limit: int = 60) -> str:
+    """``repr`` of a column name for a message, cut to ``limit`` characters (a header of
+    megabytes must not become a message of megabytes)."""
+    return repr(name) if len(name) <= limit else repr(name[:limit]) + f"… ({len(name):,} chars)"
+
+
+def names_list(names: Sequence[str], limit: int = 20) -> str:
+    """Column names for a message: the first ``limit``, each cut (:func:`short_name`)."""
+    shown = ", ".join(short_name(c) for c in names[:limit])
+    return shown + (f", … ({len(names) - limit:,} more)" if len(names) > limit else "")
+
+
+def check_unique_names(path: str | Path, names: Sequence[str]) -> None:
+    """Refuse a header that names a column twice (compared after stripping blanks): which
+    of the two a command would read is a guess (:class:`FileFormatError` naming it)."""
+    seen: dict[str, int] = {}
+    for k, raw in enumerate(names):
+        name = str(raw).strip()
+        if not name:
+            continue  # unnamed columns are told apart by position
+        if name in seen:
+            raise FileFormatError(
+                f"{path}: the column name {short_name(name)} appears twice (columns "
+                f"{seen[name] + 1} and {k + 1}); rename one"
+            )
+        seen[name] = k
 
 
 @dataclass(frozen=True)
@@ -648,6 +686,7 @@ def _read_text(
     names: list[str] | None = None
     if lay.header:
         names = [c.strip() for c in _split(head[lay.skip], lay.delimiter)]
+        check_unique_names(path, names)
         if o.names is not None:
             raise ThermocalInputError(
                 f"{path}: the file has a header row ({', '.join(names)}); --names is for "
@@ -685,7 +724,7 @@ def _read_text(
                 if len(fields) != n:
                     raise ValueError(f"{len(fields)} fields, {n} expected")
                 rows.append(
-                    [float(f.replace(",", ".") if lay.decimal == "," else f) for f in fields]
+                    [parse_number(f.replace(",", ".") if lay.decimal == "," else f) for f in fields]
                 )
                 ordinal.append(n_data - 1)
             except ValueError as exc:
@@ -878,6 +917,7 @@ def _read_table(
             table = _ParquetColumns(pq.ParquetFile(path, page_checksum_verification=True))
         except (pa.ArrowInvalid, OSError) as exc:
             raise FileFormatError(f"{path}: not a readable Parquet file ({exc})") from None
+        check_unique_names(path, table.column_names)
         meta: dict[str, Any] = {}
         raw = table.metadata.get(META_KEY.encode())
         if raw:
@@ -901,6 +941,7 @@ def _read_table(
         )
         if (lay is not None and not lay.plain) or needs_text:
             return _read_text(path, encoding, text)
+    check_unique_names(path, _csv_header_names(path, encoding))  # before pandas renames
     try:
         df = pd.read_csv(
             path,
@@ -916,7 +957,32 @@ def _read_table(
         msg = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
         raise FileFormatError(f"{path}: not a readable CSV file ({msg})") from None
     df.columns = [str(c).strip() for c in df.columns]
+    check_unique_names(path, list(df.columns))  # ``a`` and ``a `` are one name stripped
     return df, {}
+
+
+def _csv_header_names(path: Path, encoding: str) -> list[str]:
+    """The names of a comma CSV's header line as written (pandas renames a repeated name
+    ``a.1``, so repeats are looked for here).  One pass over the line: linear in its
+    length.  Empty for a header the ``csv`` module cannot split (the reader then says)."""
+    opener: Callable[..., Any] = open
+    if path.name.lower().endswith(".gz"):
+        import gzip
+
+        opener = gzip.open
+    try:
+        with opener(path, "rt", encoding=encoding, errors="replace", newline="") as fh:
+            line = fh.readline().lstrip("\ufeff")
+    except (OSError, EOFError):
+        return []
+    if '"' not in line:
+        return [f.strip() for f in line.rstrip("\r\n").split(",")]
+    import csv
+
+    try:
+        return [f.strip() for f in next(csv.reader([line], skipinitialspace=True), [])]
+    except csv.Error:  # a quoted field beyond the csv module's size limit
+        return []
 
 
 def arrow_chunk_f64(chunk: pa.Array) -> FloatArray:
@@ -1173,10 +1239,12 @@ def read_recording(
     if meta is not None:
         md = md.merged(meta)
 
-    available = ", ".join(repr(c) for c in names)
+    present = set(names)
     for c in [time_col, *sig_names, *tmp_names]:
-        if c not in names:
-            raise MissingColumnError(f"{p}: no column {c!r}; available: {available}")
+        if c not in present:
+            raise MissingColumnError(
+                f"{p}: no column {short_name(c)}; available: {names_list(names)}"
+            )
 
     stated = units.StatedUnits.from_file_info(info, where)
     resolved = units.resolve_inputs(
