@@ -439,3 +439,17 @@ def test_a_complete_set_joins_an_existing_dir(
         "report_sensor_gyro_0.html",
     ]  # fmt: skip
     assert (out_dir / "notes.txt").read_text() == "mine\n"
+    assert not [w for w in _warnings(err) if "damaged" in w or "left out" in w], err
+
+
+def test_whole_logs_give_no_damage_warning(
+    tmp_path: Path, capfd: pytest.CaptureFixture[str]
+) -> None:
+    """No false alarm: the real PX4 sample log and a whole DataFlash log read without one."""
+    argv = ["inspect", str(SAMPLE_LOG), "--topic", "vehicle_angular_velocity.0"]
+    code, _out, err = _run(argv, [SAMPLE_LOG], capfd)
+    assert code == 0 and "damaged" not in err, err
+    log = tmp_path / "whole.bin"
+    log.write_bytes(_good_bin(2))
+    code, _out, err = _run(["inspect", str(log), "--topic", "IMU.1"], [log], capfd)
+    assert code == 0 and "damaged" not in err, err
