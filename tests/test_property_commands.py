@@ -1,6 +1,8 @@
 """Every command on arbitrary small recordings ends in exit 0 or 2, never 1, never a
 traceback (issue 14).  Hypothesis draws recordings of 0–50 rows with NaN, inf, huge and
-tiny values, repeated and backwards times and constant columns."""
+tiny values, repeated and backwards times and constant columns.
+Issue 26: the log readers (inspect --topic, px4-tempcal, ardupilot-tempcal) on a small valid
+ULog or DataFlash log with random bytes flipped, a run zeroed or randomised, or cut."""
 
 from __future__ import annotations
 
@@ -110,3 +112,85 @@ def test_every_command_exits_0_or_2(
     assert "Traceback" not in err
     if code == 2:
         assert err.strip().splitlines()[-1].startswith("error: "), err
+
+
+# --- flight-controller logs (issue 26): random damage to a small valid log ------------------
+
+
+def _small_logs() -> dict[str, bytes]:
+    """A valid ULog (sensor_gyro.0, 200 samples at 10 Hz, 10 → 50 °C) and DataFlash log (the
+    same as IMU.0), written by the test writers."""
+    from dataflash_writer import imu_log
+    from ulog_writer import SENSOR_FIELDS, ulog_bytes
+
+    n = 200
+    ts = (1e6 + np.arange(n) * 1e5).astype(np.int64)
+    temp = np.linspace(10.0, 50.0, n)
+    ulog_rows = [
+        (int(s), 7, 0.001 * float(x), 0.0, 0.0, float(x)) for s, x in zip(ts, temp, strict=True)
+    ]
+    bin_rows = [
+        (int(s), 0, 0.001 * float(x), 0.0, 0.0, 0.0, 0.0, -9.8, 0, 0, float(x))
+        for s, x in zip(ts, temp, strict=True)
+    ]
+    return {
+        ".ulg": ulog_bytes([("sensor_gyro", 0, SENSOR_FIELDS, ulog_rows)]),
+        ".bin": imu_log(bin_rows),
+    }
+
+
+SMALL_LOGS = _small_logs()
+
+
+@st.composite
+def damaged(draw: st.DrawFn, raw: bytes) -> bytes:
+    """``raw`` with random damage: bytes flipped, a run zeroed or randomised, or cut."""
+    out = bytearray(raw)
+    kind = draw(st.sampled_from(["flip", "zero-run", "random-run", "truncate", "mixed"]))
+    if kind in ("flip", "mixed"):
+        for _ in range(draw(st.integers(1, 20))):
+            out[draw(st.integers(0, len(out) - 1))] = draw(st.integers(0, 255))
+    if kind in ("zero-run", "random-run", "mixed"):
+        a = draw(st.integers(0, len(out) - 1))
+        b = min(len(out), a + draw(st.integers(1, 4000)))
+        fill = (
+            bytes(b - a) if kind == "zero-run" else draw(st.binary(min_size=b - a, max_size=b - a))
+        )
+        out[a:b] = fill
+    if kind in ("truncate", "mixed"):
+        out = out[: draw(st.integers(0, len(out)))]
+    return bytes(out)
+
+
+LOG_COMMANDS: dict[str, tuple[str, list[str]]] = {
+    "inspect-ulg": (".ulg", ["inspect", "{f}", "--topic", "sensor_gyro.0"]),
+    "inspect-bin": (".bin", ["inspect", "{f}", "--topic", "IMU.0"]),
+    "px4-tempcal": (".ulg", ["px4-tempcal", "{f}", "-o", "{o}"]),
+    "ardupilot-tempcal": (".bin", ["ardupilot-tempcal", "{f}", "-o", "{o}"]),
+}
+
+
+@pytest.mark.parametrize("command", sorted(LOG_COMMANDS))
+@settings(
+    max_examples=20,
+    deadline=None,
+    suppress_health_check=[HealthCheck.function_scoped_fixture, HealthCheck.too_slow],
+)
+@given(data=st.data())
+def test_damaged_logs_exit_0_or_2(
+    command: str, data: st.DataObject, tmp_path: Path, capfd: pytest.CaptureFixture[str]
+) -> None:
+    ext, argv = LOG_COMMANDS[command]
+    f = tmp_path / f"log{ext}"
+    f.write_bytes(data.draw(damaged(SMALL_LOGS[ext])))
+    args = [a.format(f=f, o=tmp_path / "out") for a in argv]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        code = main(args)
+    _, err = capfd.readouterr()
+    assert code in (0, 2), err[-2000:]
+    assert "Traceback" not in err
+    lines = [ln for ln in err.splitlines() if ln.strip()]
+    assert all(ln.startswith(("warning: ", "error: ")) for ln in lines), err[:2000]
+    if code == 2:
+        assert lines[-1].startswith("error: "), err

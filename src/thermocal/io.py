@@ -25,10 +25,14 @@ import fcntl
 import functools
 import glob
 import hashlib
+import io
 import json
 import math
 import os
+import re
 import secrets
+import shutil
+import sys
 import tempfile
 import warnings
 from collections.abc import Callable, Iterator, Sequence
@@ -47,6 +51,7 @@ from thermocal.errors import (
     TextEncodingWarning,
     TextLayoutWarning,
     ThermocalInputError,
+    ThermocalWarning,
 )
 from thermocal.recording import FloatArray, Metadata, Recording
 
@@ -244,6 +249,72 @@ def atomic_write_path(path: str | Path, writer: Callable[[Path], None]) -> None:
     with _temporary_for(path) as (_target, tmp):
         tmp.touch(mode=0o600)
         writer(tmp)
+
+
+_STAGED: list[Path] = []
+"""Staging directories of this process not yet moved into place (:func:`discard_staging`)."""
+
+
+def _remove_stale_staging(target: Path) -> None:
+    """Remove the staging directories of ``target`` left by runs that no longer exist."""
+    for cand in target.parent.glob(f".{glob.escape(target.name)}.*{TEMP_SUFFIX}"):
+        middle = cand.name[len(target.name) + 2 : -len(TEMP_SUFFIX)]
+        pid_text = middle.split(".", 1)[0]
+        dead = pid_text.isdigit() and not _pid_alive(int(pid_text))
+        if dead and cand.is_dir() and not cand.is_symlink():
+            shutil.rmtree(cand, ignore_errors=True)
+
+
+def staging_directory(target: str | Path) -> Path:
+    """A new empty directory beside ``target``, ``.NAME.<pid>.<random>.thermocal-partial``,
+    in which a command builds a set of outputs (calibration, parameters, reports) that must
+    appear whole or not at all; :func:`commit_directory` moves it into place,
+    :func:`discard_staging` removes it on failure, and the next
+    run to the same target removes those of runs that died."""
+    t = Path(target)
+    if t.exists() and not t.is_dir():
+        raise ThermocalInputError(f"{target}: exists and is not a directory")
+    try:
+        t.parent.mkdir(parents=True, exist_ok=True)
+    except (FileExistsError, NotADirectoryError):
+        raise ThermocalInputError(
+            f"{target}: cannot create the output, {t.parent} is not a directory"
+        ) from None
+    _remove_stale_staging(t)
+    stage = _temp_path(t)
+    stage.mkdir()
+    _STAGED.append(stage)
+    return stage
+
+
+def commit_directory(stage: Path, target: str | Path) -> None:
+    """Move a complete output set from ``stage`` into ``target``: one rename when ``target``
+    does not exist or is an empty directory (atomic); otherwise each file replaces its
+    namesake in ``target`` (``os.replace``, atomic per file; other files of ``target`` are
+    left alone), then ``stage`` is removed."""
+    t = Path(target)
+    with _output_lock(t):
+        empty = t.is_dir() and not t.is_symlink() and not any(t.iterdir())
+        if (not t.exists() and not t.is_symlink()) or empty:
+            os.replace(stage, t)
+        else:
+            t.mkdir(parents=True, exist_ok=True)
+            for f in sorted(stage.iterdir()):
+                os.replace(f, t / f.name)
+            stage.rmdir()
+    with contextlib.suppress(ValueError):
+        _STAGED.remove(stage)
+    for k, w in enumerate(WRITTEN):  # name the outputs where they now are
+        if w.parent == stage:
+            WRITTEN[k] = t / w.name
+
+
+def discard_staging() -> None:
+    """Remove every staging directory of this process not moved into place."""
+    while _STAGED:
+        stage = _STAGED.pop()
+        shutil.rmtree(stage, ignore_errors=True)
+        WRITTEN[:] = [w for w in WRITTEN if w.parent != stage]
 
 
 def write_json(path: str | Path, obj: Any) -> None:
@@ -490,6 +561,16 @@ def _split(line: str, delim: str) -> list[str]:
     return line.split() if delim == " " else [f.strip() for f in line.split(delim)]
 
 
+def parse_number(field: str) -> float:
+    """A text field as a float, as a CSV reader takes it: ASCII digits, sign, ``.``,
+    exponent, or ``nan``/``inf``.  Python's :func:`float` also accepts digit-group
+    underscores (``0_5`` → 5.0) and non-ASCII digits (``١٢``); those are malformed numbers
+    here (``ValueError``), so a mangled line is a bad line, not a silent value."""
+    if "_" in field or not field.isascii():
+        raise ValueError(f"malformed number {field.strip()[:40]!r}")
+    return float(field)
+
+
 def _is_number(field: str, decimal: str, *, empty: bool = False) -> bool:
     """A number written with ``decimal`` (an empty field counts when ``empty``: a missing
     value, NaN downstream, not a sign of a banner)."""
@@ -497,10 +578,38 @@ def _is_number(field: str, decimal: str, *, empty: bool = False) -> bool:
     if empty and not f:
         return True
     try:
-        float(f)
+        parse_number(f)
     except ValueError:
         return False
     return True
+
+
+def short_name(name: str, limit: int = 60) -> str:
+    """``repr`` of a column name for a message, cut to ``limit`` characters (a header of
+    megabytes must not become a message of megabytes)."""
+    return repr(name) if len(name) <= limit else repr(name[:limit]) + f"… ({len(name):,} chars)"
+
+
+def names_list(names: Sequence[str], limit: int = 20) -> str:
+    """Column names for a message: the first ``limit``, each cut (:func:`short_name`)."""
+    shown = ", ".join(short_name(c) for c in names[:limit])
+    return shown + (f", … ({len(names) - limit:,} more)" if len(names) > limit else "")
+
+
+def check_unique_names(path: str | Path, names: Sequence[str]) -> None:
+    """Refuse a header that names a column twice (compared after stripping blanks): which
+    of the two a command would read is a guess (:class:`FileFormatError` naming it)."""
+    seen: dict[str, int] = {}
+    for k, raw in enumerate(names):
+        name = str(raw).strip()
+        if not name:
+            continue  # unnamed columns are told apart by position
+        if name in seen:
+            raise FileFormatError(
+                f"{path}: the column name {short_name(name)} appears twice (columns "
+                f"{seen[name] + 1} and {k + 1}); rename one"
+            )
+        seen[name] = k
 
 
 @dataclass(frozen=True)
@@ -648,6 +757,7 @@ def _read_text(
     names: list[str] | None = None
     if lay.header:
         names = [c.strip() for c in _split(head[lay.skip], lay.delimiter)]
+        check_unique_names(path, names)
         if o.names is not None:
             raise ThermocalInputError(
                 f"{path}: the file has a header row ({', '.join(names)}); --names is for "
@@ -685,7 +795,7 @@ def _read_text(
                 if len(fields) != n:
                     raise ValueError(f"{len(fields)} fields, {n} expected")
                 rows.append(
-                    [float(f.replace(",", ".") if lay.decimal == "," else f) for f in fields]
+                    [parse_number(f.replace(",", ".") if lay.decimal == "," else f) for f in fields]
                 )
                 ordinal.append(n_data - 1)
             except ValueError as exc:
@@ -761,10 +871,131 @@ def parse_topic(topic: str | None, default: str = DEFAULT_ULOG_TOPIC) -> tuple[s
     return name, int(inst or 0)
 
 
-def _read_ulog(path: Path, topic: str | None) -> tuple[pd.DataFrame, dict[str, Any]]:
-    """One topic instance of a PX4 ULog as a table: its fields as columns, ``timestamp``
-    [µs] the time, PX4's units for the known topics, the median ``device_id`` as the
-    sensor id.  Needs ``pyulog`` (``pip install 'thermocal[logs]'``)."""
+class LogDamageWarning(ThermocalWarning):
+    """A flight-controller log is cut or damaged: what was lost is said."""
+
+
+class _LibraryNoise:
+    """A text sink counting the lines a log library prints, by kind (numbers and hex
+    replaced by ``#``), so that 143 652 ``bad header`` lines become one sentence."""
+
+    MAX_KINDS = 50
+
+    def __init__(self) -> None:
+        self.lines = 0
+        self.kinds: dict[str, int] = {}
+        self._part = ""
+
+    def write(self, text: str) -> int:
+        self._part += text
+        if "\n" in self._part:
+            *done, self._part = self._part.split("\n")
+            for line in done:
+                self._count(line)
+        return len(text)
+
+    def flush(self) -> None:
+        pass
+
+    def _count(self, line: str) -> None:
+        line = line.strip()
+        if not line:
+            return
+        self.lines += 1
+        kind = re.sub(r"0x[0-9a-fA-F]+|\d+", "#", line[:200])[:80]
+        if kind not in self.kinds and len(self.kinds) >= self.MAX_KINDS:
+            kind = "other messages"
+        self.kinds[kind] = self.kinds.get(kind, 0) + 1
+
+    def close(self) -> None:
+        if self._part:
+            self._count(self._part)
+            self._part = ""
+
+    def summary(self, library: str) -> str:
+        """``pymavlink printed 143 652 line(s): 143 650 × 'bad header # at #', …`` or ``""``."""
+        if not self.lines:
+            return ""
+        top = sorted(self.kinds.items(), key=lambda kv: -kv[1])[:3]
+        shown = ", ".join(f"{n:,} × {k!r}" for k, n in top)
+        more = ", …" if len(self.kinds) > 3 else ""
+        return f"{library} printed {self.lines:,} line(s), not shown: {shown}{more}"
+
+
+@contextlib.contextmanager
+def _library_output_captured() -> Iterator[_LibraryNoise]:
+    """Capture what a log library prints while reading: Python's ``sys.stdout``/``stderr``
+    and the file descriptors 1 and 2 underneath (compiled parts print there), counted in a
+    :class:`_LibraryNoise` instead of flooding the terminal."""
+    noise = _LibraryNoise()
+    saved: list[tuple[int, int]] = []
+    spool = tempfile.TemporaryFile()  # noqa: SIM115 (closed in the finally below)
+    for stream in (sys.stdout, sys.stderr, sys.__stdout__, sys.__stderr__):
+        with contextlib.suppress(Exception):
+            if stream is not None:
+                stream.flush()
+    for fd in (1, 2):
+        try:
+            saved.append((fd, os.dup(fd)))
+            os.dup2(spool.fileno(), fd)
+        except OSError:
+            continue
+    try:
+        with contextlib.redirect_stdout(noise), contextlib.redirect_stderr(noise):
+            yield noise
+    finally:
+        for fd, copy in saved:
+            os.dup2(copy, fd)
+            os.close(copy)
+        spool.seek(0)
+        for raw in spool:
+            noise.write(raw.decode("utf-8", "replace"))
+        spool.close()
+        noise.close()
+
+
+class _TrackedReader(io.BufferedReader):
+    """A log file as a library reads it, noting where the library stopped (the position at
+    ``close``) and whether its last read came back short (the file ends inside a message;
+    a clean end is a read of nothing)."""
+
+    def __init__(self, path: Path) -> None:
+        super().__init__(io.FileIO(path, "rb"))
+        self.stopped_at: int | None = None
+        self.short_read = False
+
+    def read(self, size: int | None = -1) -> bytes:
+        data = super().read(size)
+        self.short_read = size is not None and size > 0 and 0 < len(data) < size
+        return data
+
+    def close(self) -> None:
+        if self.stopped_at is None and not self.closed:
+            self.stopped_at = self.tell()
+        super().close()
+
+
+@dataclass(frozen=True)
+class _ULogRead:
+    """A parsed ULog and what its reading lost: ``notes`` (sentences for one warning)."""
+
+    ulog: Any
+    damaged: bool
+    skipped: bool
+    """pyulog skipped damaged messages inside the file (``file_corruption``)."""
+    notes: tuple[str, ...]
+
+
+def _parse_ulog(path: Path, names: list[str] | None) -> _ULogRead:
+    """Parse a ULog with pyulog (only the topics ``names``, all when None), its printed
+    noise captured, and measure what was lost:
+
+    * pyulog stops at a damaged message header (a zeroed length, say) without saying so:
+      the bytes after the position it stopped at, as a share of the file;
+    * a file cut inside its last message (a short read);
+    * pyulog's own ``file_corruption`` flag (damaged messages skipped: the topics' missing
+      samples are estimated from their sample interval, :func:`_topic_loss`).
+    """
     try:
         from pyulog import ULog
     except ImportError:
@@ -772,19 +1003,120 @@ def _read_ulog(path: Path, topic: str | None) -> tuple[pd.DataFrame, dict[str, A
             f"{path}: reading PX4 ULog files needs pyulog: pip install 'thermocal[logs]' "
             "(or pip install pyulog)"
         ) from None
-    name, inst = parse_topic(topic)
+    if not path.exists():
+        raise FileFormatError(f"{path}: no such file")
+    size = path.stat().st_size
+    if size == 0:
+        raise FileFormatError(f"{path}: the file is empty")
+    fh = _TrackedReader(path)
     try:
-        ulog = ULog(str(path), message_name_filter_list=[name])
+        with _library_output_captured() as noise:
+            ulog = ULog(fh, message_name_filter_list=names)
     except Exception as exc:  # pyulog raises several kinds on a bad file
-        raise FileFormatError(f"{path}: not a readable ULog file ({exc})") from None
-    found = [d for d in ulog.data_list if d.name == name and d.multi_id == inst]
+        msg = " ".join(str(exc).split())[:200] or type(exc).__name__
+        raise FileFormatError(f"{path}: not a readable ULog file ({msg})") from None
+    finally:
+        fh.close()
+    notes: list[str] = []
+    stop = fh.stopped_at if fh.stopped_at is not None else size
+    if stop < size:
+        notes.append(
+            f"pyulog stopped at byte {stop:,} of {size:,} (a damaged message header): the "
+            f"last {100.0 * (size - stop) / size:.1f} % of the file is not read"
+        )
+    cut = fh.short_read and stop == size
+    if cut:
+        notes.append("the file ends inside a message (cut): its last message is lost")
+    if ulog.file_corruption:
+        notes.append("pyulog found damaged messages and skipped them")
+    said = noise.summary("pyulog")
+    if said:
+        notes.append(said)
+    skipped = bool(ulog.file_corruption)
+    return _ULogRead(ulog, stop < size or cut or skipped, skipped, tuple(notes))
+
+
+def _warn_damage(path: Path, notes: Sequence[str]) -> None:
+    if notes:
+        warnings.warn(
+            LogDamageWarning(f"{path}: the log is damaged: " + "; ".join(notes)), stacklevel=3
+        )
+
+
+def _topic_loss(time_us: FloatArray) -> tuple[int, int]:
+    """(missing, expected) samples of a topic in a damaged log, judged by its median sample
+    interval: expected = span / median interval + 1."""
+    n = int(time_us.size)
+    if n < 3:
+        return 0, n
+    dt = np.diff(time_us)
+    med = float(np.median(dt))
+    if not (math.isfinite(med) and med > 0):
+        return 0, n
+    span = float(time_us[-1] - time_us[0])
+    expected = round(span / med) + 1
+    return max(0, expected - n), max(expected, n)
+
+
+def ulog_sensor_instances(path: str | Path, topics: Sequence[str]) -> list[tuple[str, int]]:
+    """The instances of ``topics`` in a ULog that carry a temperature, sorted; every instance
+    left out (no ``temperature`` field, or one that is all 0 or NaN: no sensor behind it) is
+    named in a warning, and damage to the log is said (:func:`_parse_ulog`)."""
+    p = Path(path)
+    read = _parse_ulog(p, list(topics))
+    _warn_damage(p, read.notes)
+    out: list[tuple[str, int]] = []
+    left: list[str] = []
+    for d in read.ulog.data_list:
+        t = d.data.get("temperature")
+        where = f"{d.name}.{int(d.multi_id)}"
+        if t is None:
+            left.append(f"{where} (no temperature field)")
+        elif not np.isfinite(t).any():
+            left.append(f"{where} (temperature all NaN)")
+        elif np.all(t == 0):
+            left.append(f"{where} (temperature all 0)")
+        else:
+            out.append((d.name, int(d.multi_id)))
+    if left:
+        warnings.warn(
+            LogDamageWarning(
+                f"{p}: {len(left)} sensor instance(s) left out, without a usable temperature: "
+                + ", ".join(left)
+            ),
+            stacklevel=2,
+        )
+    return sorted(out)
+
+
+def _read_ulog(path: Path, topic: str | None) -> tuple[pd.DataFrame, dict[str, Any]]:
+    """One topic instance of a PX4 ULog as a table: its fields as columns, ``timestamp``
+    [µs] the time, PX4's units for the known topics, the median ``device_id`` as the
+    sensor id.  Damage to the log is said in a warning with what was lost
+    (:func:`_parse_ulog`).  Needs ``pyulog`` (``pip install 'thermocal[logs]'``)."""
+    name, inst = parse_topic(topic)
+    read = _parse_ulog(path, [name])
+    found = [d for d in read.ulog.data_list if d.name == name and d.multi_id == inst]
     if not found:
-        have = sorted(f"{d.name}.{d.multi_id}" for d in ULog(str(path)).data_list)
+        _warn_damage(path, read.notes)
+        every = _parse_ulog(path, None).ulog.data_list if not read.damaged else []
+        have = sorted(f"{d.name}.{d.multi_id}" for d in every or read.ulog.data_list)
         raise MissingColumnError(
-            f"{path}: no topic {name}.{inst} in the log; it has: {', '.join(have) or 'none'}"
+            f"{path}: no topic {name}.{inst} in the log"
+            + (" (it may be in the damaged part)" if read.damaged else "")
+            + f"; it has: {', '.join(have) or 'none'}"
         )
     data = found[0].data
     cols = {k: np.asarray(v, dtype=np.float64) for k, v in data.items()}
+    notes = list(read.notes)
+    if read.skipped and "timestamp" in cols:  # messages skipped inside the read part
+        missing, expected = _topic_loss(cols["timestamp"])
+        if missing:
+            notes.append(
+                f"{name}.{inst} misses about {missing:,} of {expected:,} samples "
+                f"({100.0 * missing / expected:.1f} %) judged by its sample interval"
+            )
+    _warn_damage(path, notes)
     df = pd.DataFrame(cols)
     units_ = {k: u for k, u in PX4_UNITS.get(name, {}).items() if k in df.columns}
     info: dict[str, Any] = {"time": "timestamp", "time_unit": "us", "units": units_}
@@ -814,10 +1146,19 @@ temperature [°C]); the time is ``TimeUS`` [µs]."""
 DEFAULT_DATAFLASH_TOPIC = "IMU.0"
 
 
+DATAFLASH_PADDING = 528
+"""Bytes at the end of a DataFlash log that may be padding rather than messages (block
+logging fills its last page; pymavlink ignores up to this many, DFReader.py)."""
+
+
 def _read_dataflash(path: Path, topic: str | None) -> tuple[pd.DataFrame, dict[str, Any]]:
     """One message type and instance (field ``I``) of an ArduPilot DataFlash log as a
     table: the message's fields as columns, ``TimeUS`` [µs] the time, ArduPilot's units for
-    known messages.  Needs ``pymavlink`` (``pip install 'thermocal[logs]'``)."""
+    known messages.  Older logs name their second and third IMU ``IMU2``/``IMU3`` (no ``I``
+    field): ``IMU.1`` reads ``IMU2``.  pymavlink's printed complaints are captured; bytes
+    of the file that are not whole messages (file size − Σ message lengths, trailing
+    padding of one fill byte excepted) are lost and said in a warning with their share.
+    Needs ``pymavlink`` (``pip install 'thermocal[logs]'``)."""
     try:
         from pymavlink import DFReader
     except ImportError:
@@ -826,40 +1167,94 @@ def _read_dataflash(path: Path, topic: str | None) -> tuple[pd.DataFrame, dict[s
             "'thermocal[logs]' (or pip install pymavlink)"
         ) from None
     name, inst = parse_topic(topic, DEFAULT_DATAFLASH_TOPIC)
-    try:
-        log = DFReader.DFReader_binary(str(path), zero_time_base=False)
-    except Exception as exc:  # pymavlink raises several kinds on a bad file
-        raise FileFormatError(f"{path}: not a readable DataFlash log ({exc})") from None
+    legacy = f"{name}{inst + 1}" if inst > 0 else None  # IMU2 = IMU.1 in older logs
     rows: list[dict[str, Any]] = []
+    legacy_rows: list[dict[str, Any]] = []
     names_seen: set[str] = set()
-    try:
-        while True:
-            m = log.recv_msg()
-            if m is None:
-                break
-            mtype = m.get_type()
-            names_seen.add(mtype)
-            if mtype != name:
-                continue
-            d = m.to_dict()
-            if int(d.get("I", 0)) != inst:
-                continue
-            rows.append({k: v for k, v in d.items() if isinstance(v, int | float)})
-    finally:  # pymavlink keeps the file and its memory map open
-        for attr in ("data_map", "filehandle"):
-            h = getattr(log, attr, None)
-            if h is not None:
-                h.close()
+    accounted = 0  # bytes in whole messages
+    last_end = 0
+    size = path.stat().st_size
+    with _library_output_captured() as noise:
+        try:
+            log = DFReader.DFReader_binary(str(path), zero_time_base=False)
+        except Exception as exc:  # pymavlink raises several kinds on a bad file
+            msg = " ".join(str(exc).split())[:200] or type(exc).__name__
+            raise FileFormatError(f"{path}: not a readable DataFlash log ({msg})") from None
+        try:
+            while True:
+                try:
+                    m = log.recv_msg()
+                except Exception as exc:
+                    msg = " ".join(str(exc).split())[:200] or type(exc).__name__
+                    raise FileFormatError(
+                        f"{path}: a damaged DataFlash log pymavlink cannot read past byte "
+                        f"{getattr(log, 'offset', 0):,} ({msg})"
+                    ) from None
+                if m is None:
+                    break
+                accounted += int(m.fmt.len)  # header included (LogStructure.h)
+                last_end = int(getattr(log, "offset", 0))
+                mtype = m.get_type()
+                names_seen.add(mtype)
+                if mtype == name:
+                    d = m.to_dict()
+                    if int(d.get("I", 0)) == inst:
+                        rows.append({k: v for k, v in d.items() if isinstance(v, int | float)})
+                elif mtype == legacy:
+                    d = m.to_dict()
+                    if "I" not in d:
+                        legacy_rows.append(
+                            {k: v for k, v in d.items() if isinstance(v, int | float)}
+                        )
+        finally:  # pymavlink keeps the file and its memory map open
+            for attr in ("data_map", "filehandle"):
+                h = getattr(log, attr, None)
+                if h is not None:
+                    h.close()
+    notes = _dataflash_loss(path, size, accounted, last_end)
+    said = noise.summary("pymavlink")
+    if said and notes:
+        notes.append(said)
+    _warn_damage(path, notes)
+    if not rows and legacy_rows:
+        rows = legacy_rows
     if not rows:
         raise MissingColumnError(
-            f"{path}: no {name} messages of instance {inst} in the log; it has: "
-            + ", ".join(sorted(names_seen - {"FMT", "FMTU", "UNIT", "MULT"}))
+            f"{path}: no {name} messages of instance {inst} in the log"
+            + (" (they may be in its damaged part)" if notes else "")
+            + "; it has: "
+            + (", ".join(sorted(names_seen - {"FMT", "FMTU", "UNIT", "MULT"})) or "none")
         )
     df = pd.DataFrame(rows).astype(np.float64)
     units_ = {k: u for k, u in ARDUPILOT_UNITS.get(name, {}).items() if k in df.columns}
     info: dict[str, Any] = {"time": "TimeUS", "time_unit": "us", "units": units_}
     info["dataflash_message"] = f"{name}.{inst}"
     return df, info
+
+
+def _dataflash_loss(path: Path, size: int, accounted: int, last_end: int) -> list[str]:
+    """Sentences on the bytes of a DataFlash log that were not whole messages: skipped as
+    damaged inside the log, or left at its end (a cut last message; a tail shorter than
+    :data:`DATAFLASH_PADDING` of one repeated fill byte is padding, not loss)."""
+    lost_inside = max(0, last_end - accounted)
+    tail = max(0, size - last_end)
+    notes = []
+    if lost_inside:
+        notes.append(
+            f"{lost_inside:,} bytes ({100.0 * lost_inside / size:.1f} % of the file) are not "
+            "whole messages and were skipped, with the messages in them"
+        )
+    if tail:
+        with open(path, "rb") as fh:
+            fh.seek(last_end)
+            rest = fh.read(DATAFLASH_PADDING + 1)
+        padding = len(rest) < DATAFLASH_PADDING and len(set(rest)) == 1
+        if not padding:
+            notes.append(
+                f"its last {tail:,} bytes ({100.0 * tail / size:.1f} % of the file) are not a "
+                "whole message (the file is cut or damaged at its end)"
+            )
+    return notes
 
 
 def _read_table(
@@ -878,6 +1273,7 @@ def _read_table(
             table = _ParquetColumns(pq.ParquetFile(path, page_checksum_verification=True))
         except (pa.ArrowInvalid, OSError) as exc:
             raise FileFormatError(f"{path}: not a readable Parquet file ({exc})") from None
+        check_unique_names(path, table.column_names)
         meta: dict[str, Any] = {}
         raw = table.metadata.get(META_KEY.encode())
         if raw:
@@ -901,6 +1297,7 @@ def _read_table(
         )
         if (lay is not None and not lay.plain) or needs_text:
             return _read_text(path, encoding, text)
+    check_unique_names(path, _csv_header_names(path, encoding))  # before pandas renames
     try:
         df = pd.read_csv(
             path,
@@ -916,7 +1313,32 @@ def _read_table(
         msg = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
         raise FileFormatError(f"{path}: not a readable CSV file ({msg})") from None
     df.columns = [str(c).strip() for c in df.columns]
+    check_unique_names(path, list(df.columns))  # ``a`` and ``a `` are one name stripped
     return df, {}
+
+
+def _csv_header_names(path: Path, encoding: str) -> list[str]:
+    """The names of a comma CSV's header line as written (pandas renames a repeated name
+    ``a.1``, so repeats are looked for here).  One pass over the line: linear in its
+    length.  Empty for a header the ``csv`` module cannot split (the reader then says)."""
+    opener: Callable[..., Any] = open
+    if path.name.lower().endswith(".gz"):
+        import gzip
+
+        opener = gzip.open
+    try:
+        with opener(path, "rt", encoding=encoding, errors="replace", newline="") as fh:
+            line = fh.readline().lstrip("\ufeff")
+    except (OSError, EOFError):
+        return []
+    if '"' not in line:
+        return [f.strip() for f in line.rstrip("\r\n").split(",")]
+    import csv
+
+    try:
+        return [f.strip() for f in next(csv.reader([line], skipinitialspace=True), [])]
+    except csv.Error:  # a quoted field beyond the csv module's size limit
+        return []
 
 
 def arrow_chunk_f64(chunk: pa.Array) -> FloatArray:
@@ -1173,10 +1595,12 @@ def read_recording(
     if meta is not None:
         md = md.merged(meta)
 
-    available = ", ".join(repr(c) for c in names)
+    present = set(names)
     for c in [time_col, *sig_names, *tmp_names]:
-        if c not in names:
-            raise MissingColumnError(f"{p}: no column {c!r}; available: {available}")
+        if c not in present:
+            raise MissingColumnError(
+                f"{p}: no column {short_name(c)}; available: {names_list(names)}"
+            )
 
     stated = units.StatedUnits.from_file_info(info, where)
     resolved = units.resolve_inputs(

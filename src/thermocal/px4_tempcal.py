@@ -177,20 +177,12 @@ def fit_sensor(
 
 
 def log_topics(path: Path) -> list[tuple[str, int]]:
-    """The ``sensor_gyro``/``sensor_accel`` instances of a ULog that carry a temperature."""
-    try:
-        from pyulog import ULog
-    except ImportError:
-        raise ThermocalInputError(
-            f"{path}: reading PX4 ULog files needs pyulog: pip install 'thermocal[logs]'"
-        ) from None
-    ulog = ULog(str(path), message_name_filter_list=list(TOPICS))
-    out = []
-    for d in ulog.data_list:
-        t = d.data.get("temperature")
-        if t is not None and np.isfinite(t).any() and not np.all(t == 0):
-            out.append((d.name, int(d.multi_id)))
-    return sorted(out)
+    """The ``sensor_gyro``/``sensor_accel`` instances of a ULog that carry a temperature
+    (:func:`thermocal.io.ulog_sensor_instances`: an unreadable log is refused, damage and
+    every instance left out are said in warnings)."""
+    from thermocal.io import ulog_sensor_instances
+
+    return ulog_sensor_instances(path, TOPICS)
 
 
 def calibration_of(fits: list[SensorFit]) -> Calibration:

@@ -6,9 +6,11 @@ held-out bins and fitted as a cubic per axis (:mod:`thermocal.px4_tempcal`); wri
 sensor, ``DIR/report_<topic>_<n>.html``.
 """
 
+import functools
 import warnings
+from collections.abc import Callable
 from pathlib import Path
-from typing import TYPE_CHECKING, Annotated
+from typing import TYPE_CHECKING, Annotated, ParamSpec, TypeVar
 
 import typer
 
@@ -32,9 +34,31 @@ if TYPE_CHECKING:
 else:
     _rich_table = LazyModule("rich.table")
 
+P = ParamSpec("P")
+R = TypeVar("R")
+
+
+def staged_outputs(fn: Callable[P, R]) -> Callable[P, R]:
+    """The output set is built in a staging directory beside DIR and moved into place when
+    complete (:func:`thermocal.io.commit_directory`); on any failure — a later sensor's
+    error, Ctrl-C — this removes the staging directory, so that no part of the set is left."""
+
+    @functools.wraps(fn)
+    def wrapper(*args: P.args, **kwargs: P.kwargs) -> R:
+        try:
+            return fn(*args, **kwargs)
+        except BaseException:
+            from thermocal.io import discard_staging
+
+            discard_staging()
+            raise
+
+    return wrapper
+
 
 @app.command("px4-tempcal")
 @handle_errors
+@staged_outputs
 def px4_tempcal_cmd(
     log: Annotated[Path, typer.Argument(help="PX4 log (.ulg).", show_default=False)],
     output: Annotated[Path, typer.Option("-o", "--output", help="Directory to write.")],
@@ -50,7 +74,7 @@ def px4_tempcal_cmd(
     about TREF), robust to spikes, with equal weight across the temperature range and
     judged on held-out data; write the TC_* parameters, the calibration and reports."""
     from thermocal.export_params import ParamSet, export_params
-    from thermocal.io import atomic_write
+    from thermocal.io import atomic_write, commit_directory, staging_directory
     from thermocal.models.calibration import Calibration
     from thermocal.models.files import save_calibration
     from thermocal.px4_tempcal import calibration_of, fit_sensor, log_topics, summary
@@ -63,7 +87,7 @@ def px4_tempcal_cmd(
         raise ThermocalInputError(
             f"{log}: no sensor_gyro or sensor_accel topic with a temperature in the log"
         )
-    output.mkdir(parents=True, exist_ok=True)
+    stage = staging_directory(output)  # the set is moved into place whole, or removed
     fits, reports = [], []
     params = ParamSet("px4")
     for name, inst in topics:
@@ -80,7 +104,7 @@ def px4_tempcal_cmd(
         params.merge(ps, f"{name}.{inst}")
         rp = output / f"report_{name}_{inst}.html"
         write_calibration_report(
-            rp,
+            stage / rp.name,
             CalibrationReportInputs(
                 calibration=sub, recording=rec, recording_path=str(log),
                 title=f"PX4 thermal calibration — {name}.{inst}",
@@ -99,10 +123,11 @@ def px4_tempcal_cmd(
         )  # fmt: skip
         reports.append(rp)
     cal_path = output / "calibration.json"
-    save_calibration(calibration_of(fits), cal_path)
+    save_calibration(calibration_of(fits), stage / cal_path.name)
     params_path = output / "px4.params"
-    with atomic_write(params_path, "w") as fh:
+    with atomic_write(stage / params_path.name, "w") as fh:
         fh.write(params.text())
+    commit_directory(stage, output)
     if any(f.kind == "accel" for f in fits):
         params.notes.append(
             "accelerometers: offsets relative to mid-range (gravity is in the data), as PX4's "
@@ -137,6 +162,7 @@ def px4_tempcal_cmd(
 
 @app.command("ardupilot-tempcal")
 @handle_errors
+@staged_outputs
 def ardupilot_tempcal_cmd(
     log: Annotated[Path, typer.Argument(help="ArduPilot log (.bin).", show_default=False)],
     output: Annotated[Path, typer.Option("-o", "--output", help="Directory to write.")],
@@ -150,7 +176,7 @@ def ardupilot_tempcal_cmd(
 
     from thermocal.errors import MissingColumnError
     from thermocal.export_params import ParamSet, export_params
-    from thermocal.io import atomic_write
+    from thermocal.io import atomic_write, commit_directory, staging_directory
     from thermocal.models.calibration import Calibration
     from thermocal.models.files import save_calibration
     from thermocal.px4_tempcal import calibration_of, fit_sensor, summary
@@ -159,6 +185,7 @@ def ardupilot_tempcal_cmd(
 
     if output.exists() and not output.is_dir():
         raise ThermocalInputError(f"{output}: exists and is not a directory")
+    stage = staging_directory(output)  # the set is moved into place whole, or removed
     fits, reports = [], []
     params = ParamSet("ardupilot")
     for inst in range(3):  # ArduPilot logs up to three IMUs
@@ -168,7 +195,6 @@ def ardupilot_tempcal_cmd(
             if inst == 0:
                 raise
             break
-        output.mkdir(parents=True, exist_ok=True)
         per_kind = []
         for kind, prefix, unit in (("gyro", "Gyr", "rad/s"), ("accel", "Acc", "m/s^2")):
             sub_rec = Recording.from_arrays(
@@ -190,7 +216,7 @@ def ardupilot_tempcal_cmd(
         for fit, sub_rec in per_kind:
             rp = output / f"report_IMU_{inst}_{fit.kind}.html"
             write_calibration_report(
-                rp,
+                stage / rp.name,
                 CalibrationReportInputs(
                     calibration=Calibration(fit.channels), recording=sub_rec,
                     recording_path=str(log), title=f"ArduPilot thermal calibration — IMU {inst} "
@@ -200,10 +226,11 @@ def ardupilot_tempcal_cmd(
             )  # fmt: skip
             reports.append(rp)
     cal_path = output / "calibration.json"
-    save_calibration(calibration_of(fits), cal_path)
+    save_calibration(calibration_of(fits), stage / cal_path.name)
     parm = output / "ardupilot.parm"
-    with atomic_write(parm, "w") as fh:
+    with atomic_write(stage / parm.name, "w") as fh:
         fh.write(params.text())
+    commit_directory(stage, output)
     out = {
         "log": str(log),
         "params": str(parm),
