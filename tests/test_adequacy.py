@@ -385,3 +385,58 @@ def test_a_re_oriented_accelerometer_is_a_step() -> None:
     assert test.verdict == "fail" and "at 300.0 s" in test.message and "(10.0°)" in test.message
     mot = stillness(t, a, 20.0)
     assert mot.steps[0][1] == pytest.approx(2000.0 * math.sin(math.radians(5.0)), rel=0.01)
+
+
+# --- turntable over temperature: the soaks ---------------------------------------------------
+
+
+def test_turntable_soaks_too_close_are_refused_or_marked(tmp_path: Path) -> None:
+    """Two soak runs moved to 20 and 22 °C: a line in temperature needs 5 °C — refused;
+    with --allow-narrow written, marked 'overridden' in the calibration, and export-c
+    warns; a record edited to a plain failure makes export-c refuse."""
+    from thermocal.io import write_recording
+    from thermocal.turntable.simulate import simulate_turntable_thermal
+
+    runs = [r for r in simulate_turntable_thermal(seed=11) if not r[1]["held_out"]][:2]
+    paths = []
+    for (rec, truth), base in zip(runs, (20.0, 22.0), strict=True):
+        t = rec.columns["T_imu"]
+        rec.columns["T_imu"] = base + (t - t.mean()) * 0.01  # drifting 0.015 °C in the run
+        p = tmp_path / f"{truth['label']}.parquet"
+        write_recording(rec, p)
+        paths.append(str(p))
+    cal = tmp_path / "cal.json"
+    code, text = _cli("turntable", *paths, "--temps", "T_imu", "-o", str(cal))
+    assert code == 2 and "the soak temperatures spans 2" in text and "≥ 5 °C" in text, text
+    assert not cal.exists()
+    code, text = _cli("turntable", *paths, "--temps", "T_imu", "-o", str(cal), "--allow-narrow")
+    assert code == 0, text
+    tri = json.loads(cal.read_text())["triads"][0]
+    assert tri["adequacy"]["verdict"] == "overridden"
+    code, text = _cli("export-c", str(cal), "-o", str(tmp_path / "c"))
+    assert code == 0 and "rest on data that do not support them" in text
+    d = json.loads(cal.read_text())
+    for t in d["triads"]:
+        t["adequacy"]["overrides"] = []
+    d.pop("checksum")
+    d["checksum"] = checksum(d)
+    bad = tmp_path / "bad.json"
+    bad.write_text(json.dumps(d))
+    code, text = _cli("export-c", str(bad), "-o", str(tmp_path / "c2"))
+    assert code == 2 and "temperature_span" in text, text
+
+
+def test_fit_prints_in_the_data_unit(tmp_path: Path) -> None:
+    """The residual of a °/s gyro is printed and given in °/s (it was °/h, ×3600)."""
+    t, temp, gx = _still_sweep(4, minutes=20.0)
+    data = _write(tmp_path / "g.csv", t, {"gx [deg/s]": gx, "T1 [degC]": temp})
+    code, text = _cli(
+        "fit", str(data), "--model", "poly", "--order", "2", "--signal", "gx [deg/s]",
+        "--temps", "T1 [degC]", "-o", str(tmp_path / "m.json"), "--json",
+    )  # fmt: skip
+    assert code == 0, text
+    d = json.loads(text[text.index("{") :])
+    # the residual of a quadratic fit to a quadratic bias is the white noise, 0.05 °/s
+    assert d["unit"] == "deg/s" and d["model_unit"] == "deg/h"
+    assert d["rms_residual"] == pytest.approx(0.05, rel=0.02)
+    assert d["rms_residual_model_unit"] == pytest.approx(d["rms_residual"] * 3600.0, rel=1e-12)

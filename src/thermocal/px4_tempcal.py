@@ -120,11 +120,12 @@ def fit_sensor(
         factor = float(units.convert(1.0, unit, given))
     except ThermocalInputError:
         factor, given = 1.0, unit
+    tname = f"{where} temperature"
     judged = adequacy.judge(
-        adequacy.Needs({"temperature": 3}, 4),
+        adequacy.Needs({tname: 3}, 4),
         [rec.time_s],
         [temp.reshape(-1, 1)],
-        ["temperature"],
+        [tname],
         signals=[vals],
         kind=kind,
         name=where,

@@ -46,6 +46,9 @@ def _check_adequacy(cal: "_calibration.Calibration", path: Path, firmware: str |
     (:func:`thermocal.adequacy.check_for_firmware`); ArduPilot's own minimum sweep too."""
     from thermocal.adequacy import ARDUPILOT_MIN_SPAN_C, check_for_firmware
 
+    for tri in cal.triads:
+        if tri.adequacy is not None:  # turntable calibrations since the check existed
+            check_for_firmware(tri.adequacy, f"{path}: triad {tri.name}")
     for ch in cal.channels:
         where = f"{path}: channel {ch.name}" if len(cal.channels) > 1 else str(path)
         record = ch.model.adequacy_

@@ -40,7 +40,8 @@ the axis (:func:`thermocal.units.earth_rate_on_axis_deg_h`) as a known input;
 ``--known-input X`` gives any other known input in the canonical signal unit.
 
 JSON keys (``--json``): ``model``, ``output``, ``n_coefficients``,
-``rms_residual``, ``condition_number``, ``temperature_range`` ({name: [lo, hi]}),
+``rms_residual`` (in the data's own unit, ``unit``; ``rms_residual_model_unit`` in the
+model's canonical ``model_unit``), ``condition_number``, ``temperature_range`` ({name: [lo, hi]}),
 ``rate_range``, ``n_samples``, ``n_runs``, ``unit``, ``target``, ``files``
 (name, sha256, n_samples), ``terms_kept`` (selection, else null), ``fit`` (all
 fit statistics), ``coefficients`` and ``warnings``.
@@ -340,7 +341,7 @@ def fit_cmd(
                 name,
                 str(res["unit_as_given"]),
                 est,
-                _calibration.guess_role(name, res["unit"]),
+                _calibration.guess_role(name, res["model_unit"]),
             )
             for name, est, res, _n in fitted
         ]
@@ -524,6 +525,17 @@ def _prepare_channel(
     return _Prepared(est, runs, first_inputs, provenance, unit, sig_name, list(caught))
 
 
+def _data_unit(first_inputs: dict[str, Any], sig_name: str, unit: str) -> tuple[str, float]:
+    """The data's own unit of a channel (as given in the file, option or column name) and
+    the factor from the model's canonical unit to it (raw counts scaled to a physical unit
+    stay in the canonical unit)."""
+    given = str((first_inputs.get("units") or {}).get(sig_name, unit))
+    try:
+        return given, float(units.convert(1.0, unit, given))
+    except _errors.UnitError:
+        return unit, 1.0
+
+
 def _judge_channel(
     spec: _FitSpec,
     est: "_base.TemperatureModel",
@@ -537,11 +549,7 @@ def _judge_channel(
     names = list(runs[0].temp_names)
     needs = est.data_needs(names, len(runs))
     kind = {"rate": "gyro", "accel": "accel"}.get(units.signal_kind(unit))
-    given = str((first_inputs.get("units") or {}).get(sig_name, unit))
-    try:
-        factor = float(units.convert(1.0, unit, given))
-    except _errors.UnitError:  # counts with a scale factor: figures in the canonical unit
-        factor, given = 1.0, unit
+    given, factor = _data_unit(first_inputs, sig_name, unit)
     judged = _adequacy.judge(
         needs,
         [r.time_s for r in runs],
@@ -604,17 +612,20 @@ def _finish_channel(
         else None
     )
     kept = st.extra.get("selected_terms")
+    given, to_given = _data_unit(first_inputs, sig_name, unit)
     result: dict[str, Any] = {
         "model": est.family,
         "n_coefficients": st.n_coefficients,
-        "rms_residual": st.rms_residual,
+        "rms_residual": st.rms_residual * to_given,  # in the data's own unit (``unit``)
+        "rms_residual_model_unit": st.rms_residual,
         "condition_number": st.condition_number,
         "condition": _base.condition_wording(kappa),
         "temperature_range": trange,
         "rate_range": rrange,
         "n_samples": st.n_samples,
         "n_runs": len(runs),
-        "unit": unit,
+        "unit": given,
+        "model_unit": unit,
         "temperature_unit": est.temperature_unit,
         "inputs": first_inputs,
         "target": target,
@@ -653,7 +664,7 @@ def _human_single(
     tab.add_column("value")
     tab.add_row("runs / samples", f"{n_runs} / {st.n_samples}")
     tab.add_row("coefficients", str(st.n_coefficients))
-    tab.add_row(f"rms residual [{unit}]", fmt(st.rms_residual))
+    tab.add_row(f"rms residual [{unit}]", fmt(result["rms_residual"]))
     wording = _base.condition_wording(kappa)
     tab.add_row("condition number", f"{fmt(st.condition_number)} ({wording})")
     if corr:
@@ -691,7 +702,7 @@ def _human_single(
     if weak:
         stdout.print(
             f"* {weak} coefficient(s) within 2 standard errors of 0: not distinct from "
-            "zero on these data (consider --select bic or fewer terms)"
+            "zero on these data (consider --select or fewer terms)"
         )
 
 

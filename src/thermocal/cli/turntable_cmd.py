@@ -13,6 +13,7 @@ from thermocal import defaults
 from thermocal._lazy import LazyModule
 from thermocal.cli.application import app
 from thermocal.cli.common import (
+    AllowNarrowOpt,
     JsonOpt,
     OutOpt,
     TimeOpt,
@@ -23,6 +24,7 @@ from thermocal.cli.common import (
     split_names,
     stdout,
 )
+from thermocal.defaults import overrides_of
 from thermocal.errors import ThermocalInputError
 
 if TYPE_CHECKING:
@@ -131,6 +133,7 @@ def turntable_cmd(
         float | None,
         typer.Option("--tref", help="Reference temperature [°C] (default: mid soak range)."),
     ] = None,
+    allow_narrow: AllowNarrowOpt = False,
     as_json: JsonOpt = False,
 ) -> None:
     """Gyro-triad bias, scale factor and misalignment from a 16-position turntable run; with
@@ -151,7 +154,7 @@ def turntable_cmd(
             raise ThermocalInputError(
                 "several runs: name their temperature column with --temps (one run per soak)"
             )
-        _thermal_calibration(files, output, opts, order, tref, as_json)
+        _thermal_calibration(files, output, opts, order, tref, as_json, allow_narrow)
         return
     if order is not None or tref is not None:
         raise ThermocalInputError("--order and --tref need several runs and --temps")
@@ -259,9 +262,12 @@ def _thermal_calibration(
     order: int | None,
     tref: float | None,
     as_json: bool,
+    allow_narrow: bool = False,
 ) -> None:
     """Each run calibrated alone, then every parameter of each triad as a polynomial in
-    temperature (:mod:`thermocal.turntable.thermal`); writes a calibration of triads."""
+    temperature (:mod:`thermocal.turntable.thermal`); writes a calibration of triads.  The
+    soak temperatures are judged first (:mod:`thermocal.adequacy`: span and distinct soaks
+    for the order asked, a line when the order is chosen per parameter)."""
     if output.suffix.lower() != ".json":
         raise ThermocalInputError(f"{output}: the calibration is JSON; use a .json name")
     runs = []
@@ -280,6 +286,16 @@ def _thermal_calibration(
         if len(found) > 1:
             raise ThermocalInputError(f"the runs' {what} columns differ in unit: {sorted(found)}")
     temps_c = [float(r.temperature_c) for _f, r in runs]  # type: ignore[arg-type]
+    import numpy as np
+
+    from thermocal import adequacy
+
+    soaks = np.asarray(temps_c, dtype=np.float64)
+    judged = adequacy.Adequacy(
+        tuple(adequacy.temperature_tests(soaks, "the soak temperatures", order or 1)),
+        overrides_of(allow_narrow, False),
+    )
+    record = judged.enforce().to_dict()
     rig = (opts.alpha, opts.beta)
     latitude = runs[0][1].latitude_deg  # as used (the option or the files' metadata)
     gyro_model = _thermal.fit_triad(
@@ -292,7 +308,7 @@ def _thermal_calibration(
     )
     triads = [
         _calibration.Triad("gyro", (gyro_cols[0], gyro_cols[1], gyro_cols[2]),
-                           gyro_units.pop(), temps, gyro_model, rig, latitude)
+                           gyro_units.pop(), temps, gyro_model, rig, latitude, record)
     ]  # fmt: skip
     accel_model = None
     if accel_cols is not None:
@@ -306,7 +322,7 @@ def _thermal_calibration(
         )
         triads.append(
             _calibration.Triad("accel", (accel_cols[0], accel_cols[1], accel_cols[2]),
-                               accel_units.pop(), temps, accel_model, rig, latitude)
+                               accel_units.pop(), temps, accel_model, rig, latitude, record)
         )  # fmt: skip
     cal = _calibration.Calibration([], triads)
     _files.save_calibration(cal, output)
@@ -315,6 +331,7 @@ def _thermal_calibration(
         "format": "thermocal-calibration",
         "runs": [{"input": str(f), **r.to_dict()} for f, r in runs],
         "gyro": _triad_summary(gyro_model),
+        "adequacy": record,
     }
     if accel_model is not None:
         out["accel"] = _triad_summary(accel_model)

@@ -93,6 +93,8 @@ class Triad:
     model: Any  # TriadThermal (imported lazily: the turntable package needs scipy)
     encoders: tuple[str, str] = ("alpha_deg", "beta_deg")
     latitude_deg: float | None = None
+    adequacy: dict[str, Any] | None = None
+    """The adequacy record of the soaks it was fitted on (:mod:`thermocal.adequacy`)."""
 
 
 @dataclass
@@ -155,6 +157,7 @@ class Calibration:
                     "encoders": list(t.encoders),
                     "latitude_deg": t.latitude_deg,
                     "model": t.model.to_dict(),
+                    **({"adequacy": t.adequacy} if t.adequacy is not None else {}),
                 }
                 for t in self.triads
             ]
@@ -238,6 +241,7 @@ def _triad_from_dict(t: Any, at: str) -> Triad:
         model,
         (enc[0], enc[1]),
         None if lat is None else float(lat),
+        t["adequacy"] if isinstance(t.get("adequacy"), dict) else None,
     )
 
 
