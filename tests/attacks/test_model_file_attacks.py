@@ -28,6 +28,8 @@ from typing import Any
 
 import numpy as np
 import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 
 from thermocal.cli import main
 
@@ -60,7 +62,9 @@ def _ramp_csv(path: Path) -> None:
         for k in (1, -1, 2)
     ]
     for i in range(t.size):
-        lines.append(",".join([f"{t[i]:.0f}", *(repr(float(c[i])) for c in cols), repr(float(temp[i]))]))
+        lines.append(
+            ",".join([f"{t[i]:.0f}", *(repr(float(c[i])) for c in cols), repr(float(temp[i]))])
+        )
     path.write_text("\n".join(lines) + "\n")
 
 
@@ -87,7 +91,8 @@ def originals(tmp_path_factory: pytest.TempPathFactory) -> dict[str, tuple[bytes
     assert _run(["fit", *map(str, warm), "--model", "warmup", "--signal", "gyro", "--temps",
                  "T1", "-o", str(f)]) == 0  # fmt: skip
     out["warmup"] = (f.read_bytes(), warm[0])
-    assert _run(["simulate", "accel-full-range", "-o", str(d / "acc"), "--runs", "3"]) == 0
+    assert _run(["simulate", "accel-full-range", "-o", str(d / "acc"), "--runs", "3",
+                 "--rate-hz", "0.1"]) == 0  # fmt: skip
     acc = sorted((d / "acc").glob("*.csv"))
     f = d / "bank.json"
     assert _run(["fit", *map(str, acc), "--model", "bank", "--signal", "accel", "--temps",
@@ -318,7 +323,9 @@ def _triad_mutations() -> list[Mutation]:
         Mutation("coefficients-empty", _edit(lambda d: _set(d, ARRAY_AT["triads"], [])), coef),
         Mutation(
             "coefficients-2d",
-            _edit(lambda d: _set(d, ARRAY_AT["triads"], [[v] for v in _get(d, ARRAY_AT["triads"])])),
+            _edit(
+                lambda d: _set(d, ARRAY_AT["triads"], [[v] for v in _get(d, ARRAY_AT["triads"])])
+            ),
             coef,
         ),
         Mutation(
@@ -338,7 +345,9 @@ def _triad_mutations() -> list[Mutation]:
             "triads[0].model.tref_c",
         ),
         Mutation(
-            "tref-null", _edit(on(lambda m: m.__setitem__("tref_c", None))), "triads[0].model.tref_c"
+            "tref-null",
+            _edit(on(lambda m: m.__setitem__("tref_c", None))),
+            "triads[0].model.tref_c",
         ),
         Mutation("tref-missing", _edit(on(lambda m: m.pop("tref_c"))), "tref_c"),
         Mutation(
@@ -492,3 +501,73 @@ def test_the_singular_triad_would_blow_up_the_output(
     sx = 1e-6 * (c0 + c1 * (t_zero + 0.01 - m["tref_c"]))
     assert abs(0.0004 / (1.0 + sx)) > 1.0
     assert math.isfinite(sx)
+
+
+# --- property: any one edit of a real file, re-signed ---------------------------------------
+
+HOSTILE: list[Any] = [None, "", "NaN", "1e309", True, 0, -1, 0.5, 1e308, -1e308, 2**53, [],
+                      {}, [[1.0]], [1.0] * 13, {"a": 1}, "DELETE"]  # fmt: skip
+"""Replacement values (``"DELETE"``: the key or item is removed)."""
+
+
+def _paths(obj: Any, path: Path_ = ()) -> list[Path_]:
+    """Every key path inside a parsed JSON value (containers and leaves)."""
+    out: list[Path_] = [path] if path else []
+    if isinstance(obj, dict):
+        for k, v in obj.items():
+            if k != "checksum":
+                out += _paths(v, (*path, k))
+    elif isinstance(obj, list):
+        for i, v in enumerate(obj[:4]):  # the first items: long arrays repeat their kind
+            out += _paths(v, (*path, i))
+    return out
+
+
+@pytest.fixture(scope="module")
+def all_paths(originals: dict[str, tuple[bytes, Path]]) -> dict[str, list[Path_]]:
+    return {kind: _paths(json.loads(raw)) for kind, (raw, _) in originals.items()}
+
+
+@pytest.mark.parametrize("command", sorted(COMMANDS))
+@settings(
+    max_examples=30,
+    deadline=None,
+    suppress_health_check=[HealthCheck.function_scoped_fixture, HealthCheck.too_slow],
+)
+@given(data=st.data())
+def test_any_edit_ends_in_exit_0_or_2(
+    command: str,
+    data: st.DataObject,
+    originals: dict[str, tuple[bytes, Path]],
+    all_paths: dict[str, list[Path_]],
+    tmp_path_factory: pytest.TempPathFactory,
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    """One value anywhere in a real model or calibration file replaced by a hostile one (or
+    removed), the file re-signed: every command ends in exit 0 or 2, never 1 or a
+    traceback, and exit 2 says why in one ``error:`` line."""
+    kind = data.draw(st.sampled_from(KINDS), label="kind")
+    raw, rec = originals[kind]
+    d = json.loads(raw)
+    path = data.draw(st.sampled_from(all_paths[kind]), label="path")
+    value = data.draw(st.sampled_from(HOSTILE), label="value")
+    parent = _get(d, path[:-1])
+    if value == "DELETE":
+        del parent[path[-1]]
+    else:
+        parent[path[-1]] = copy.deepcopy(value)
+    if isinstance(d, dict):
+        _resign(d)
+    tmp = tmp_path_factory.mktemp("edit")
+    model = tmp / "model.json"
+    model.write_text(json.dumps(d))
+    (tmp / "out").mkdir()
+    argv = [a.format(m=model, d=rec, o=tmp / "out") for a in COMMANDS[command]]
+    before = _digest(rec)
+    code = _run(argv)
+    _, err = capsys.readouterr()
+    assert "Traceback" not in err, err
+    assert code in (0, 2), f"{_dotted(path)} = {value!r}: exit {code}; {err[-1500:]}"
+    if code == 2:
+        assert err.strip().splitlines()[-1].startswith("error: "), err
+    assert _digest(rec) == before

@@ -43,7 +43,12 @@ record is unknown and falls to the resolver's stated default.
 
 Loading checks the format tag, the version (a newer version is refused with a
 clear error), the family (must be registered) and the checksum (a corrupted or
-hand-edited file is refused).
+hand-edited file is refused).  The checksum guards against accidents (truncation, a
+hand edit, a bit flip), not against tampering: anyone can recompute it.  So the content
+is checked too, before anything uses it: the reader's bounds (:mod:`thermocal.models.
+filecheck`: 64 MiB, nesting depth 32, finite numbers only, integers within ±2⁵³) and each
+section's types and shapes (:mod:`thermocal.models.schema`; triads:
+:func:`thermocal.turntable.thermal.check_triad_dict`), every error naming the key path.
 """
 
 from __future__ import annotations

@@ -21,7 +21,6 @@ from thermocal.models.base import (
     model_file_dict,
     verify_model_dict,
 )
-from thermocal.models.filecheck import read_json
 from thermocal.models.calibration import (
     Calibration,
     Channel,
@@ -29,6 +28,7 @@ from thermocal.models.calibration import (
     guess_role,
     is_calibration,
 )
+from thermocal.models.filecheck import read_json
 
 
 def file_sha256(path: str | Path, chunk: int = 1 << 20) -> str:

@@ -277,8 +277,7 @@ def check_params(params: dict[str, Any], family_class: type, path: str) -> None:
         p = sig.parameters.get(key)
         if p is None or key == "self":
             raise ModelFileError(
-                f"{at}: the {getattr(family_class, 'family', '?')} family takes no such "
-                "parameter"
+                f"{at}: the {getattr(family_class, 'family', '?')} family takes no such parameter"
             )
         checks = _annotation_checks(p.annotation)
         if checks is None:

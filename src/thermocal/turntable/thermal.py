@@ -329,7 +329,7 @@ def check_triad_dict(d: Any, where: str) -> None:
             raise _fail(f"{at}.name", repr(PARAMETER_NAMES[k]), p.get("name"))
         if not isinstance(p.get("unit"), str):
             raise _fail(f"{at}.unit", "a string", p.get("unit"))
-        coef = p.get("coefficients")
+        coef: list[float] = p.get("coefficients")  # type: ignore[assignment]
         _numbers(coef, f"{at}.coefficients", min_len=1)
         if len(coef) > MAX_ORDER + 1:
             raise _fail(f"{at}.coefficients", f"at most {MAX_ORDER + 1} coefficients", coef)
