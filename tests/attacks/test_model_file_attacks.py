@@ -281,6 +281,14 @@ def _model_mutations(kind: str) -> list[Mutation]:
         ),
     ]
     if kind in ("poly", "calibration"):
+        term = (*at, "state", "terms", 0)
+        out.append(
+            Mutation(
+                "power-2-to-the-53",  # ran for ever in export-c before the bound
+                _edit(lambda d: _set(d, (*term, "t_power"), 2**53)),
+                _dotted((*term, "t_power")),
+            )
+        )
         out.append(
             Mutation(
                 "center-far-from-range",

@@ -120,6 +120,11 @@ def _same_length(state: dict[str, Any], path: str, key: str, n: int, what: str) 
 
 # --- families ----------------------------------------------------------------------------
 
+MAX_TERM_POWER = 32
+"""Highest power of a poly term's base variable accepted in a file (a polynomial of
+higher order in one temperature is no calibration; a power of 2⁵³ would make export-c
+and compensate run for ever)."""
+
 BASE_KEYS = (
     "t_center", "t_scale", "rate_center", "rate_scale", "coupling_center", "coupling_scale"
 )  # fmt: skip
@@ -148,6 +153,11 @@ def _poly_state(state: Any, path: str, n_temps: int) -> None:
             if base[key] == 0:
                 raise ModelFileError(f"{path}.base[{i}].{key}: must not be 0")
     for i, term in enumerate(state["terms"]):
+        for key in ("t_power", "rate_power", "coupling_power"):
+            if not 0 <= term[key] <= MAX_TERM_POWER:
+                raise ModelFileError(
+                    f"{path}.terms[{i}].{key}: {term[key]} is not a power 0…{MAX_TERM_POWER}"
+                )
         if not 0 <= term["sensor"] < len(state["base"]):
             raise ModelFileError(
                 f"{path}.terms[{i}].sensor: {term['sensor']} is not one of the "
@@ -423,4 +433,11 @@ def check_model_dict(d: dict[str, Any], root: str = "") -> None:
             near_range(center, lo, hi, _at(root, f"state.base[{k}].t_center"), "the centre")
 
 
-__all__ = ["STATE_SCHEMAS", "check_model_dict", "check_params", "near_range", "range_margin"]
+__all__ = [
+    "MAX_TERM_POWER",
+    "STATE_SCHEMAS",
+    "check_model_dict",
+    "check_params",
+    "near_range",
+    "range_margin",
+]
