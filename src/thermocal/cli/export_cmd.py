@@ -7,7 +7,6 @@ build against the double build is measured (both compiled with the system C
 compiler on 10⁵ synthetic samples over the model's range) and printed.
 """
 
-import json
 import warnings
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated
@@ -34,10 +33,14 @@ else:
 
 
 def _read_json(path: Path) -> object:
-    """The file's JSON, or None when it is not JSON (the model loader then says why)."""
+    """The file's JSON, or None when it is not JSON within the model files' bounds (the
+    model loader then says why)."""
+    from thermocal.errors import ModelFileError
+    from thermocal.models.filecheck import read_json
+
     try:
-        return json.loads(path.read_text(encoding="utf-8"))
-    except (OSError, UnicodeDecodeError, json.JSONDecodeError):
+        return read_json(path)
+    except ModelFileError:
         return None
 
 

@@ -43,7 +43,12 @@ record is unknown and falls to the resolver's stated default.
 
 Loading checks the format tag, the version (a newer version is refused with a
 clear error), the family (must be registered) and the checksum (a corrupted or
-hand-edited file is refused).
+hand-edited file is refused).  The checksum guards against accidents (truncation, a
+hand edit, a bit flip), not against tampering: anyone can recompute it.  So the content
+is checked too, before anything uses it: the reader's bounds (:mod:`thermocal.models.
+filecheck`: 64 MiB, nesting depth 32, finite numbers only, integers within ±2⁵³) and each
+section's types and shapes (:mod:`thermocal.models.schema`; triads:
+:func:`thermocal.turntable.thermal.check_triad_dict`), every error naming the key path.
 """
 
 from __future__ import annotations
@@ -922,24 +927,30 @@ def model_file_dict(model: TemperatureModel) -> dict[str, Any]:
     return d
 
 
-def verify_model_dict(d: Any, where: str) -> dict[str, Any]:
+def verify_model_dict(d: Any, where: str, root: str = "") -> dict[str, Any]:
     """Check a parsed model dict: header (format, version, sections), checksum and the
-    family's schema; errors name ``where``."""
+    family's schema (:func:`thermocal.models.schema.check_model_dict`); errors name
+    ``where`` (the file) and the key path, prefixed by ``root`` (``channels[0].model`` in a
+    calibration).
+
+    The checksum guards against accidents (truncation, a hand edit, a bit flip), not
+    against tampering: anyone can recompute it, so the content is checked as well."""
+    at = f"{where}: {root}" if root else where
     try:
         check_model_header(d)
     except ModelFileError as exc:
-        raise ModelFileError(f"{where}: {exc}") from None
+        raise ModelFileError(f"{at}: {exc}") from None
     stored = d.get("checksum")
     if stored is None:
-        raise ModelFileError(f"{where}: model file has no checksum")
+        raise ModelFileError(f"{at}: model file has no checksum")
     if stored != checksum(d):
         raise ModelFileError(
-            f"{where}: checksum mismatch: the model file was corrupted or edited by hand"
+            f"{at}: checksum mismatch: the model file was corrupted or edited by hand"
         )
     from thermocal.models.schema import check_model_dict
 
     try:
-        check_model_dict(d)
+        check_model_dict(d, root)
     except ModelFileError as exc:
         raise ModelFileError(f"{where}: {exc}") from None
     out: dict[str, Any] = d

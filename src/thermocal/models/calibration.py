@@ -202,7 +202,7 @@ def calibration_from_dict(d: dict[str, Any], where: str) -> Calibration:
         role = ch.get("role")
         if role is not None and (not isinstance(role, dict) or role.get("kind") not in ROLE_KINDS):
             raise ModelFileError(f"{at}.role: expected null or {{'kind': gyro|accel, ...}}")
-        md = verify_model_dict(ch["model"], f"{at}.model")
+        md = verify_model_dict(ch["model"], where, f"channels[{i}].model")
         try:
             model = TemperatureModel.from_dict(md)
         except (KeyError, TypeError, ValueError) as exc:
@@ -226,13 +226,17 @@ def _triad_from_dict(t: Any, at: str) -> Triad:
     for key in ("name", "unit", "temperature"):
         if not isinstance(t.get(key), str) or not t[key]:
             raise ModelFileError(f"{at}: {key} must be a non-empty string")
-    model = TriadThermal.from_dict(t.get("model") or {}, f"{at}.model")
+    if "model" not in t:
+        raise ModelFileError(f"{at}: the field 'model' is missing")
+    model = TriadThermal.from_dict(t["model"], f"{at}.model")
     enc = t.get("encoders", ["alpha_deg", "beta_deg"])
     lat = t.get("latitude_deg")
     if not (isinstance(enc, list) and len(enc) == 2 and all(isinstance(c, str) for c in enc)):
         raise ModelFileError(f"{at}.encoders: expected the two encoder column names")
-    if lat is not None and not isinstance(lat, int | float):
-        raise ModelFileError(f"{at}.latitude_deg: expected a number or null")
+    if lat is not None and (
+        isinstance(lat, bool) or not isinstance(lat, int | float) or not -90 <= lat <= 90
+    ):
+        raise ModelFileError(f"{at}.latitude_deg: expected a latitude [°] or null, got {lat!r}")
     return Triad(
         t["name"],
         (cols[0], cols[1], cols[2]),

@@ -10,7 +10,6 @@ writing the files (atomically, :func:`thermocal.io.write_json`) happens here.
 from __future__ import annotations
 
 import hashlib
-import json
 from pathlib import Path
 from typing import Any
 
@@ -29,6 +28,7 @@ from thermocal.models.calibration import (
     guess_role,
     is_calibration,
 )
+from thermocal.models.filecheck import read_json
 
 
 def file_sha256(path: str | Path, chunk: int = 1 << 20) -> str:
@@ -55,22 +55,18 @@ def save_model(model: TemperatureModel, path: str | Path) -> dict[str, Any]:
 def load_model_dict(path: str | Path) -> dict[str, Any]:
     """Read and verify a model file (format, version, checksum) without building it."""
     p = Path(path)
-    try:
-        text = p.read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise ModelFileError(f"{p}: no such model file") from None
-    except UnicodeDecodeError:
-        raise ModelFileError(f"{p}: not a text (JSON) model file") from None
-    try:
-        d = json.loads(text)
-    except json.JSONDecodeError as exc:
-        raise ModelFileError(f"{p}: corrupted model file (invalid JSON: {exc.msg})") from None
+    d = read_json(p, "model file")
     return verify_model_dict(d, str(p))
 
 
 def load_model(path: str | Path) -> TemperatureModel:
     """Load and verify a model file; returns the fitted model."""
-    d = load_model_dict(path)
+    return model_from_dict(load_model_dict(path), path)
+
+
+def model_from_dict(d: dict[str, Any], path: str | Path) -> TemperatureModel:
+    """The fitted model of a verified model dict (:func:`verify_model_dict`); errors name
+    ``path``."""
     try:
         return TemperatureModel.from_dict(d)
     except ModelFileError as exc:
@@ -94,18 +90,11 @@ def load_calibration(path: str | Path) -> Calibration:
     """A calibration file, or a single-model file as a calibration of one channel (named
     after the model's signal, in the unit its inputs record)."""
     p = Path(path)
-    try:
-        d = json.loads(p.read_text(encoding="utf-8"))
-    except FileNotFoundError:
-        raise ModelFileError(f"{p}: no such model or calibration file") from None
-    except UnicodeDecodeError:
-        raise ModelFileError(f"{p}: not a text (JSON) model or calibration file") from None
-    except json.JSONDecodeError as exc:
-        raise ModelFileError(f"{p}: corrupted model file (invalid JSON: {exc.msg})") from None
+    d = read_json(p, "model or calibration file")
     if is_calibration(d):
         return calibration_from_dict(d, str(p))
     if isinstance(d, dict) and d.get("format") == MODEL_FORMAT:
-        model = load_model(p)
+        model = model_from_dict(verify_model_dict(d, str(p)), p)
         sig = model.signal_name or "signal"
         unit = str((model.inputs_ or {}).get("units", {}).get(sig) or model.signal_unit)
         return Calibration([Channel(sig, sig, unit, model, guess_role(sig, unit))])

@@ -23,7 +23,13 @@ from thermocal.errors import ModelFileError
 Check = Callable[[Any, str], None]
 
 
+def _at(path: str, key: str) -> str:
+    """The key path of ``key`` inside ``path`` (``state`` + ``coef`` → ``state.coef``)."""
+    return f"{path}.{key}" if path else key
+
+
 def _fail(path: str, what: str, got: Any) -> ModelFileError:
+    path = path or "(top level)"
     text = repr(got)
     if len(text) > 60:
         text = text[:57] + "..."
@@ -84,11 +90,11 @@ def fields(spec: dict[str, Check], *, optional: dict[str, Check] | None = None) 
             raise _fail(path, "an object", value)
         for key, sub in spec.items():
             if key not in value:
-                raise ModelFileError(f"{path}: the field {key!r} is missing")
-            sub(value[key], f"{path}.{key}")
+                raise ModelFileError(f"{path or '(top level)'}: the field {key!r} is missing")
+            sub(value[key], _at(path, key))
         for key, sub in (optional or {}).items():
             if key in value and value[key] is not None:
-                sub(value[key], f"{path}.{key}")
+                sub(value[key], _at(path, key))
 
     return check
 
@@ -114,14 +120,23 @@ def _same_length(state: dict[str, Any], path: str, key: str, n: int, what: str) 
 
 # --- families ----------------------------------------------------------------------------
 
+MAX_TERM_POWER = 32
+"""Highest power of a poly term's base variable accepted in a file (a polynomial of
+higher order in one temperature is no calibration; a power of 2⁵³ would make export-c
+and compensate run for ever)."""
+
+BASE_KEYS = (
+    "t_center", "t_scale", "rate_center", "rate_scale", "coupling_center", "coupling_scale"
+)  # fmt: skip
+"""The poly family's centre and scale of each base variable (:class:`~thermocal.models.
+terms.BaseScaling`), centres at even positions."""
+
 
 def _poly_state(state: Any, path: str, n_temps: int) -> None:
     fields(
         {
             "layout": string,
-            "base": list_of(
-                fields({"t_center": number, "t_scale": number}), min_len=1
-            ),
+            "base": list_of(fields({k: number for k in BASE_KEYS}), min_len=1),
             "terms": list_of(
                 fields({"sensor": integer, "t_power": integer, "rate_power": integer,
                         "coupling_power": integer})
@@ -134,9 +149,15 @@ def _poly_state(state: Any, path: str, n_temps: int) -> None:
     )(state, path)  # fmt: skip
     _same_length(state, path, "coef", len(state["terms"]), "one per term")
     for i, base in enumerate(state["base"]):
-        if base["t_scale"] == 0:
-            raise ModelFileError(f"{path}.base[{i}].t_scale: must not be 0")
+        for key in BASE_KEYS[1::2]:
+            if base[key] == 0:
+                raise ModelFileError(f"{path}.base[{i}].{key}: must not be 0")
     for i, term in enumerate(state["terms"]):
+        for key in ("t_power", "rate_power", "coupling_power"):
+            if not 0 <= term[key] <= MAX_TERM_POWER:
+                raise ModelFileError(
+                    f"{path}.terms[{i}].{key}: {term[key]} is not a power 0…{MAX_TERM_POWER}"
+                )
         if not 0 <= term["sensor"] < len(state["base"]):
             raise ModelFileError(
                 f"{path}.terms[{i}].sensor: {term['sensor']} is not one of the "
@@ -207,43 +228,216 @@ STATE_SCHEMAS: dict[str, Callable[[Any, str, int], None]] = {
 """The ``state`` schema of each family, by family name (as in the model registry)."""
 
 
-def check_model_dict(d: dict[str, Any]) -> None:
-    """Validate a model file's content; raise :class:`ModelFileError` naming the field.
+def near_range(value: float, lo: float, hi: float, path: str, what: str) -> None:
+    """A reference temperature (TREF, a polynomial's centre) inside the calibrated range
+    ``[lo, hi]`` or within :func:`range_margin` of it: polynomials in ``T − TREF`` are exact
+    for any TREF in theory, but one far outside the range is a corrupted file, not a fit."""
+    margin = range_margin(lo, hi)
+    if not lo - margin <= value <= hi + margin:
+        raise ModelFileError(
+            f"{path}: {what} {value:g} is far outside the calibrated range [{lo:g}, {hi:g}] "
+            f"(more than {margin:g} beyond it)"
+        )
 
-    Checks the common sections (signal, temperatures, range, params, fit) and the family's
-    ``state`` (:data:`STATE_SCHEMAS`).  Units are checked against thermocal's glossary.
+
+def range_margin(lo: float, hi: float) -> float:
+    """How far beyond a calibrated range ``[lo, hi]`` a reference temperature may lie: the
+    range's span, at least 50 (°C, or counts for a model fitted in counts)."""
+    return max(hi - lo, 50.0)
+
+
+def _annotation_checks(annotation: Any) -> list[Check] | None:
+    """The checks one of which a constructor argument's value must pass, from its type
+    annotation (``"int | None"``...); None when the annotation is not understood (then
+    anything JSON holds is left to the family)."""
+    simple: dict[str, Check] = {
+        "int": integer,
+        "float": number,
+        "bool": boolean,
+        "str": string,
+        "list[float]": list_of(number),
+        "list[str]": list_of(string),
+        "list[int]": list_of(integer),
+    }
+    out: list[Check] = []
+    for part in str(annotation).replace(" ", "").split("|"):
+        if part == "None":
+            out.append(_null)
+        elif part in simple:
+            out.append(simple[part])
+        else:
+            return None
+    return out or None
+
+
+def _null(value: Any, path: str) -> None:
+    if value is not None:
+        raise _fail(path, "null", value)
+
+
+def check_params(params: dict[str, Any], family_class: type, path: str) -> None:
+    """Each constructor argument in ``params`` of the type its annotation states (an
+    integer where the family takes ``int``, a finite number for ``float``...); an argument
+    the family does not take is refused by name."""
+    import inspect
+
+    sig = inspect.signature(family_class.__init__)  # type: ignore[misc]
+    for key, value in params.items():
+        at = _at(path, key)
+        p = sig.parameters.get(key)
+        if p is None or key == "self":
+            raise ModelFileError(
+                f"{at}: the {getattr(family_class, 'family', '?')} family takes no such parameter"
+            )
+        checks = _annotation_checks(p.annotation)
+        if checks is None:
+            continue
+        for check in checks:
+            try:
+                check(value, at)
+                break
+            except ModelFileError:
+                continue
+        else:
+            raise _fail(at, f"{p.annotation} (the family's parameter type)", value)
+
+
+def _string_map(value: Any, path: str) -> None:
+    """An object of string values (or nulls)."""
+    _map_of(string, value, path)
+
+
+def _conversion(value: Any, path: str) -> None:
+    """``[gain, offset]`` or ``[gain, offset, "int16"]``."""
+    if not isinstance(value, list) or len(value) not in (2, 3):
+        raise _fail(path, '[gain, offset] or [gain, offset, "int16"]', value)
+    number(value[0], f"{path}[0]")
+    number(value[1], f"{path}[1]")
+    if len(value) == 3:
+        string(value[2], f"{path}[2]")
+
+
+def _positive(value: Any, path: str) -> None:
+    number(value, path)
+    if not value > 0:
+        raise _fail(path, "a positive number", value)
+
+
+INPUTS = fields(
+    {},
+    optional={
+        "time_unit": string,
+        "units": _string_map,
+        "unit_sources": _string_map,
+        "temperature_conversion": lambda v, p: _map_of(_conversion, v, p),
+        "temperature_unit": string,
+        "sample_interval_s": _positive,
+        "known_input": fields({}, optional={"value": number, "unit": string, "what": string}),
+        "temperature_rate": fields({}, optional={"interval_s": _positive, "method": string}),
+        "scale_factor": fields({}),
+        "sensor_id": lambda v, p: None if isinstance(v, str | int) else _fail_now(v, p),
+    },
+)
+"""The ``inputs`` section (base.py docstring): what compensate, validate, report and
+export-c read of it, each of its type."""
+
+FIT = fields(
+    {},
+    optional={
+        "n_samples": integer,
+        "n_coefficients": integer,
+        "rms_residual": number,
+        "condition_number": number,
+        "r_squared": number,
+        "dof": number,
+    },
+)
+"""The ``fit`` statistics the model object and the reports read (nulls allowed)."""
+
+
+def _map_of(item: Check, value: Any, path: str) -> None:
+    """An object whose non-null values pass ``item``."""
+    fields({})(value, path)
+    for k, v in value.items():
+        if v is not None:
+            item(v, _at(path, k))
+
+
+def _fail_now(value: Any, path: str) -> None:
+    raise _fail(path, "a string or an integer", value)
+
+
+def check_model_dict(d: dict[str, Any], root: str = "") -> None:
+    """Validate a model file's content; raise :class:`ModelFileError` naming the key path
+    (``state.coef[2]``; ``root`` prefixes it, e.g. ``channels[0].model`` in a calibration).
+
+    Checks the common sections (signal, temperatures, range, params against the family's
+    constructor types, fit, inputs), the family's ``state`` (:data:`STATE_SCHEMAS`), and
+    that a poly model's centres lie in or near the fitted range (:func:`near_range`).
+    Units are checked against thermocal's glossary.
     """
     from thermocal import units
+    from thermocal.models.base import get_model_class
 
     fields(
         {
             "family": string,
-            "signal": fields({"name": string, "unit": string}),
+            "signal": fields({"name": string, "unit": string}, optional={"target": string}),
             "temperatures": list_of(string, min_len=1),
             "params": fields({}),
             "state": fields({}),
             "range": fields({"temperature_c": fields({})}),
-            "fit": fields({}),
-        }
-    )(d, "model")
+            "fit": FIT,
+        },
+        optional={
+            "inputs": INPUTS,
+            "rate": fields({}, optional={"method": string, "interval_s": _positive}),
+            "data": list_of(fields({})),
+            "temperature_unit": string,
+        },
+    )(d, root)
     try:
         units.normalize_signal_unit(d["signal"]["unit"])
     except Exception as exc:
-        raise ModelFileError(f"model.signal.unit: {exc}") from None
+        raise ModelFileError(f"{_at(root, 'signal.unit')}: {exc}") from None
+    target = d["signal"].get("target")
+    if target is not None and target not in ("bias", "scale_factor"):
+        raise _fail(_at(root, "signal.target"), "bias or scale_factor", target)
     temps: list[str] = d["temperatures"]
     if len(set(temps)) != len(temps):
-        raise ModelFileError(f"model.temperatures: names repeat: {temps}")
+        raise ModelFileError(f"{_at(root, 'temperatures')}: names repeat: {temps}")
     ranges = d["range"]["temperature_c"]
     for name in temps:
         if name not in ranges:
-            raise ModelFileError(f"model.range.temperature_c: no range for {name!r}")
-        interval(ranges[name], f"model.range.temperature_c.{name}")
+            raise ModelFileError(f"{_at(root, 'range.temperature_c')}: no range for {name!r}")
+        interval(ranges[name], _at(root, f"range.temperature_c.{name}"))
     rates = d["range"].get("rate_c_per_min")
     if rates is not None:
-        fields({name: interval for name in temps})(rates, "model.range.rate_c_per_min")
+        fields({name: interval for name in temps})(rates, _at(root, "range.rate_c_per_min"))
+    klass = get_model_class(d["family"])  # an unknown family is refused, naming it
+    check_params(d["params"], klass, _at(root, "params"))
+    sensor = d["params"].get("sensor")
+    if d["family"] in ("warmup", "bank") and sensor is not None and not 0 <= sensor < len(temps):
+        raise ModelFileError(
+            f"{_at(root, 'params.sensor')}: {sensor} is not one of the {len(temps)} "
+            "temperature inputs"
+        )
     schema = STATE_SCHEMAS.get(d["family"])
-    if schema is not None:  # an unknown family is refused by the registry, naming it
-        schema(d["state"], "model.state", len(temps))
+    if schema is not None:
+        schema(d["state"], _at(root, "state"), len(temps))
+    if d["family"] == "poly":
+        used = {t["sensor"] for t in d["state"]["terms"] if t["t_power"] or t["coupling_power"]}
+        for k in sorted(used):
+            lo, hi = ranges[temps[k]]
+            center = d["state"]["base"][k]["t_center"]
+            near_range(center, lo, hi, _at(root, f"state.base[{k}].t_center"), "the centre")
 
 
-__all__ = ["STATE_SCHEMAS", "check_model_dict"]
+__all__ = [
+    "MAX_TERM_POWER",
+    "STATE_SCHEMAS",
+    "check_model_dict",
+    "check_params",
+    "near_range",
+    "range_margin",
+]

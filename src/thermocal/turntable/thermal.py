@@ -191,44 +191,198 @@ class TriadThermal:
         }
 
     @classmethod
-    def from_dict(cls, d: dict[str, Any], where: str = "triad") -> TriadThermal:
-        try:
-            if d.get("format") != TRIAD_FORMAT:
-                raise ModelFileError(f"{where}: not a {TRIAD_FORMAT} entry")
-            fits = tuple(
-                ParameterFit(
-                    str(p["name"]),
-                    str(p["unit"]),
-                    np.asarray(p["coefficients"], dtype=np.float64),
-                    np.asarray(p["covariance"], dtype=np.float64),
-                    float(p["loto_rms"]),
-                    float("nan") if p.get("reduced_chi2") is None else float(p["reduced_chi2"]),
+    def from_dict(cls, d: Any, where: str = "triad") -> TriadThermal:
+        """The file form (:meth:`to_dict`) back, checked before use (:func:`check_triad_dict`:
+        types, shapes, finite numbers, TREF, a well-conditioned ``I + E(T)``); ``where``
+        prefixes the key path in errors (``FILE: triads[0].model``)."""
+        check_triad_dict(d, where)
+        fits = tuple(
+            ParameterFit(
+                p["name"],
+                p["unit"],
+                np.asarray(p["coefficients"], dtype=np.float64),
+                np.asarray(p["covariance"], dtype=np.float64),
+                _float_or_nan(p.get("loto_rms")),
+                _float_or_nan(p.get("reduced_chi2")),
+            )
+            for p in d["parameters"]
+        )
+        lo, hi = (float(v) for v in d["temperature_range_c"])
+        out = cls(
+            d["kind"],
+            float(d["tref_c"]),
+            int(d["order"]),
+            lo,
+            hi,
+            fits,
+            tuple(float(v) for v in d.get("soak_temperatures_c") or []),
+            tuple(
+                (
+                    float(r["temperature_c"]),
+                    tuple(float(v) for v in r["theta"]),
+                    tuple(float(v) for v in r["sigma"]),
                 )
-                for p in d["parameters"]
-            )
-            lo, hi = (float(v) for v in d["temperature_range_c"])
-            out = cls(
-                str(d["kind"]),
-                float(d["tref_c"]),
-                int(d["order"]),
-                lo,
-                hi,
-                fits,
-                tuple(float(v) for v in d.get("soak_temperatures_c", [])),
-                tuple(
-                    (
-                        float(r["temperature_c"]),
-                        tuple(float(v) for v in r["theta"]),
-                        tuple(float(v) for v in r["sigma"]),
-                    )
-                    for r in d.get("runs", [])
-                ),
-            )
-        except (KeyError, TypeError, ValueError) as exc:
-            raise ModelFileError(f"{where}: malformed triad model ({exc})") from None
-        if len(out.fits) != 12 or out.kind not in UNITS:
-            raise ModelFileError(f"{where}: a triad has twelve parameters, gyro or accel")
+                for r in d.get("runs") or []
+            ),
+        )
+        check_conditioning(out, where)
         return out
+
+
+MAX_CONDITION = 10.0
+"""Largest condition number of ``I + E(T)`` accepted over a triad's calibrated range.  A
+sensor triad's scale-factor errors and misalignments are small (``I + E`` within a few
+per cent of the identity, condition number ≈ 1); 10 means one axis reads ten times another
+after compensation: a corrupted file, not a calibration.  The compensation's error
+amplification is bounded by this number."""
+CONDITION_GRID = 1001
+"""Temperatures of the calibrated range at which ``I + E(T)`` is checked."""
+
+
+def _float_or_nan(v: Any) -> float:
+    return float("nan") if v is None else float(v)
+
+
+def _fail(path: str, what: str, got: Any) -> ModelFileError:
+    text = repr(got)
+    if len(text) > 60:
+        text = text[:57] + "..."
+    return ModelFileError(f"{path}: expected {what}, got {text}")
+
+
+def _is_number(v: Any) -> bool:
+    return isinstance(v, int | float) and not isinstance(v, bool) and math.isfinite(v)
+
+
+def _numbers(v: Any, path: str, n: int | None = None, *, min_len: int = 0) -> None:
+    """A list of finite numbers (``n`` of them, or at least ``min_len``)."""
+    want = f"a list of {n} finite numbers" if n is not None else "a list of finite numbers"
+    if not isinstance(v, list) or (n is not None and len(v) != n) or len(v) < min_len:
+        raise _fail(path, want, v)
+    for i, x in enumerate(v):
+        if not _is_number(x):
+            raise _fail(f"{path}[{i}]", "a finite number", x)
+
+
+def check_triad_dict(d: Any, where: str) -> None:
+    """Check a triad model's file form before anything uses it; :class:`ModelFileError`
+    naming the key path (``where`` + ``.parameters[0].coefficients``) otherwise.
+
+    Checked: the format tag and version, ``kind`` (gyro/accel), ``order`` (0…3), a finite
+    ``tref_c`` inside or near (:func:`thermocal.models.schema.near_range`) a finite
+    ``temperature_range_c`` ``[lo, hi]`` with lo < hi, the twelve parameters in θ's order
+    (:data:`PARAMETER_NAMES`), each with 1…4 finite coefficients (ascending powers of
+    ``T − TREF``) and a square finite covariance of that size, and the recorded runs
+    (temperature, twelve θ and twelve σ each)."""
+    from thermocal.models.schema import near_range
+
+    if not isinstance(d, dict):
+        raise _fail(where, "an object (a triad model)", d)
+    if d.get("format") != TRIAD_FORMAT:
+        raise _fail(f"{where}.format", repr(TRIAD_FORMAT), d.get("format"))
+    ver = d.get("version", TRIAD_VERSION)
+    if isinstance(ver, bool) or not isinstance(ver, int):
+        raise _fail(f"{where}.version", "an integer", ver)
+    if ver > TRIAD_VERSION:
+        raise ModelFileError(
+            f"{where}.version: triad model version {ver} is newer than this thermocal "
+            f"supports ({TRIAD_VERSION}); upgrade thermocal"
+        )
+    for key in ("kind", "tref_c", "order", "temperature_range_c", "parameters"):
+        if key not in d:
+            raise ModelFileError(f"{where}: the field {key!r} is missing")
+    if d["kind"] not in UNITS:
+        raise _fail(f"{where}.kind", "gyro or accel", d["kind"])
+    order = d["order"]
+    if isinstance(order, bool) or not isinstance(order, int) or not 0 <= order <= MAX_ORDER:
+        raise _fail(f"{where}.order", f"an integer 0…{MAX_ORDER}", order)
+    _numbers(d["temperature_range_c"], f"{where}.temperature_range_c", 2)
+    lo, hi = d["temperature_range_c"]
+    if not lo < hi:
+        raise _fail(f"{where}.temperature_range_c", "[low, high] with low < high", [lo, hi])
+    if not _is_number(d["tref_c"]):
+        raise _fail(f"{where}.tref_c", "a finite number (TREF [°C])", d["tref_c"])
+    near_range(d["tref_c"], lo, hi, f"{where}.tref_c", "TREF")
+    soaks = d.get("soak_temperatures_c")
+    if soaks is not None:
+        _numbers(soaks, f"{where}.soak_temperatures_c")
+    runs = d.get("runs")
+    if runs is not None:
+        if not isinstance(runs, list):
+            raise _fail(f"{where}.runs", "a list", runs)
+        for i, r in enumerate(runs):
+            at = f"{where}.runs[{i}]"
+            if not isinstance(r, dict):
+                raise _fail(at, "an object", r)
+            if not _is_number(r.get("temperature_c")):
+                raise _fail(f"{at}.temperature_c", "a finite number", r.get("temperature_c"))
+            _numbers(r.get("theta"), f"{at}.theta", 12)
+            _numbers(r.get("sigma"), f"{at}.sigma", 12)
+    params = d["parameters"]
+    if not isinstance(params, list) or len(params) != 12:
+        raise _fail(f"{where}.parameters", "a list of the twelve parameters", params)
+    for k, p in enumerate(params):
+        at = f"{where}.parameters[{k}]"
+        if not isinstance(p, dict):
+            raise _fail(at, "an object", p)
+        if p.get("name") != PARAMETER_NAMES[k]:
+            raise _fail(f"{at}.name", repr(PARAMETER_NAMES[k]), p.get("name"))
+        if not isinstance(p.get("unit"), str):
+            raise _fail(f"{at}.unit", "a string", p.get("unit"))
+        coef: list[float] = p.get("coefficients")  # type: ignore[assignment]
+        _numbers(coef, f"{at}.coefficients", min_len=1)
+        if len(coef) > MAX_ORDER + 1:
+            raise _fail(f"{at}.coefficients", f"at most {MAX_ORDER + 1} coefficients", coef)
+        cov = p.get("covariance")
+        n = len(coef)
+        if not isinstance(cov, list) or len(cov) != n:
+            raise _fail(f"{at}.covariance", f"a {n}×{n} matrix", cov)
+        for i, row in enumerate(cov):
+            _numbers(row, f"{at}.covariance[{i}]", n)
+        for key in ("loto_rms", "reduced_chi2"):
+            v = p.get(key)
+            if v is not None and not _is_number(v):
+                raise _fail(f"{at}.{key}", "a finite number or null", v)
+
+
+def check_conditioning(triad: TriadThermal, where: str) -> None:
+    """Refuse a triad whose ``I + E(T)`` is singular or ill-conditioned somewhere in its
+    calibrated range (compensation divides by it: ``x_c = (I + E)⁻¹ (x − b)``): checked at
+    :data:`CONDITION_GRID` temperatures spanning the range (the polynomials are clamped to
+    it, so no other temperature is ever used) and the soaks; the condition number
+    (2-norm, ratio of extreme singular values) must be at most :data:`MAX_CONDITION` and
+    the determinant keep one sign (a sign change is a singular point between two grid
+    temperatures)."""
+    grid = np.linspace(triad.t_lo_c, triad.t_hi_c, CONDITION_GRID)
+    _, e = error_terms(triad, grid)
+    m = e + np.eye(3)[None, :, :]
+    with np.errstate(all="ignore"):
+        sv = np.linalg.svd(m, compute_uv=False) if np.isfinite(m).all() else None
+        det = np.linalg.det(m) if sv is not None else None
+    at = f"{where}.parameters"
+    if sv is None or det is None:
+        k = int(np.argmax(~np.isfinite(m).all(axis=(1, 2))))
+        raise ModelFileError(
+            f"{at}: I + E(T) is not finite at T = {grid[k]:.4g} °C: the scale factors or "
+            "misalignments overflow"
+        )
+    with np.errstate(divide="ignore", invalid="ignore"):
+        cond = np.where(sv[:, -1] > 0, sv[:, 0] / sv[:, -1], np.inf)
+    worst = int(np.argmax(cond))
+    if not cond[worst] <= MAX_CONDITION:
+        raise ModelFileError(
+            f"{at}: I + E(T) is singular or ill-conditioned at T = {grid[worst]:.4g} °C "
+            f"(condition number {cond[worst]:.3g} > {MAX_CONDITION:g}): the scale factors and "
+            "misalignments do not describe a sensor triad"
+        )
+    flips = np.flatnonzero(np.sign(det[1:]) != np.sign(det[:-1]))
+    if flips.size:
+        k = int(flips[0])
+        raise ModelFileError(
+            f"{at}: I + E(T) is singular between T = {grid[k]:.4g} and {grid[k + 1]:.4g} °C "
+            "(its determinant changes sign): the scale factors and misalignments do not "
+            "describe a sensor triad"
+        )
 
 
 def fit_triad(
@@ -342,10 +496,13 @@ def correct(
 
 
 __all__ = [
+    "MAX_CONDITION",
     "PARAMETER_NAMES",
     "ParameterFit",
     "TriadThermal",
     "TriadValidation",
+    "check_conditioning",
+    "check_triad_dict",
     "correct",
     "error_terms",
     "fit_triad",
