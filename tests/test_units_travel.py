@@ -492,7 +492,8 @@ def test_printed_figures_name_their_units(
         "--temps", "T1", "--temp-unit", "degC", "--time-unit", "s", "-o", str(model),
     )  # fmt: skip
     assert code == 0, err
-    assert "rms residual [deg/h]" in out and "range T1 [°C]" in out
+    # the data's own unit (issue 25): the column is in deg/s
+    assert "rms residual [deg/s]" in out and "range T1 [°C]" in out
     code, out, err = _run(capsys, "compensate", str(model), str(src), "-o", str(tmp_path / "c.csv"))
     assert code == 0, err
     assert "gx [deg/s]_model, gx [deg/s]_comp [deg/s]" in out
