@@ -133,7 +133,7 @@ def test_a_dask_cluster_gives_the_same_numbers(batch: Path, tmp_path: Path) -> N
     one, dask_out = tmp_path / "one", tmp_path / "dask"
     main(["fleet", str(batch), "-o", str(one), "--workers", "1"])
     with distributed.LocalCluster(
-        n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None
+        n_workers=2, threads_per_worker=1, processes=True, dashboard_address=":0"
     ) as cluster:
         code = main(
             ["fleet", str(batch), "-o", str(dask_out), "--scheduler", cluster.scheduler_address]
@@ -174,9 +174,13 @@ def test_an_interrupted_batch_resumes(batch: Path, tmp_path: Path) -> None:
     res = fleet.run_fleet(cfg, out)
     assert not half.exists()
     assert set(res.skipped) == {"u01", "u02", "u03"}
-    assert set(res.ran) == {"u04", "u05", "u06", "bad", "gone"}  # failed units are retried
+    assert set(res.ran) == {"u04", "u05", "u06", "bad", "gone"}  # the units not yet run
     rows = {r["id"]: r for r in res.rows}
     assert all(rows[u]["status"] == "ok" for u in SLOPES)
+    assert rows["bad"]["status"] == rows["gone"]["status"] == "failed"
+    # a plain rerun retries exactly the failed units (they ran and failed above)
+    res = fleet.run_fleet(cfg, out)
+    assert set(res.ran) == {"bad", "gone"} and set(res.skipped) == set(SLOPES)
     res = fleet.run_fleet(cfg, out, force=True)
     assert res.skipped == () and len(res.ran) == 8
 

@@ -123,7 +123,18 @@ def test_compute_metrics_on_a_chamber_run() -> None:
     assert res.bias_stability == pytest.approx(np.std(blocks, ddof=1), rel=1e-12)
     assert res.peak_to_peak == pytest.approx(blocks.max() - blocks.min(), rel=1e-12)
     assert res.averaging_s == 10.0 and res.unit == "deg/h"
-    assert res.drift_angle is not None and res.drift_angle_unit == "deg"
+    # the drift angle about the stated reference (issue 25/27: it was only checked to exist):
+    # b0 = mean of ω − Ω over the first 10 % of the run, θ(t) = ∫ (ω − Ω − b0) dt by the
+    # trapezoid rule in degrees (°/h × s / 3600), computed here with numpy alone
+    rel = rec.time_s - rec.time_s[0]
+    b0 = float(np.mean((rate - omega_up)[rel <= 0.1 * rel[-1]]))
+    e = rate - omega_up - b0
+    theta = np.concatenate([[0.0], np.cumsum(0.5 * (e[1:] + e[:-1]) * np.diff(rec.time_s))]) / 3600
+    assert res.drift_angle_unit == "deg"
+    assert res.drift_angle == pytest.approx(theta[-1], rel=1e-9)
+    assert res.drift_angle_max == pytest.approx(np.abs(theta).max(), rel=1e-9)
+    # the bias rises 0.8 °/h from the −10 °C hold to the 30 °C hold: the angle is not ≈ 0
+    assert abs(res.drift_angle) > 0.5
     # four holds; bias per hold ≈ 2 + 0.02 T; the two 10 °C holds pooled → 3 points
     assert len(res.stages) == 4
     assert [round(s.mean_temp_c) for s in res.stages] == [-10, 10, 30, 10]
