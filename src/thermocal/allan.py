@@ -893,14 +893,44 @@ def noise_terms(
         local = np.array([_local_slope(lt, ld, edf, k) for k in range(tau.size)])
         for j, (factor, u, label) in enumerate(specs):
             term = _read_slope(j, tau, lt, ld, edf, local, lo_ratio, hi_ratio)
-            if isinstance(term, str):
+            conv = scale * factor
+            k_min = int(np.argmin(dev))
+            # a minimum inside the data: the curve rises after it beyond both intervals (a
+            # later point's lower bound above the minimum's upper bound), not a noisy tail
+            turns_up = 0 < k_min < tau.size - 1 and bool(
+                np.any(dev[k_min + 1 :] * lo_ratio[k_min + 1 :] > dev[k_min] * hi_ratio[k_min])
+            )
+            if j == 2 and (isinstance(term, str) or fit_reasons[j] is not None) and turns_up:
+                # IEEE 952 C.3: bias instability is the curve's minimum / 0.664, read wherever
+                # the curve turns up again inside the data, whatever the least-squares fit says
+                why = term if isinstance(term, str) else fit_reasons[j]
+                val = float(dev[k_min]) / BIAS_INSTABILITY_FACTOR
+                note = (
+                    f"read at the curve's minimum τ = {tau[k_min]:.4g} s (minimum / 0.664, "
+                    f"IEEE 952 C.3); rough: {why}"
+                )
+                slope_terms.append(
+                    NoiseTerm(
+                        val * conv, u, note, val * float(lo_ratio[k_min]) * conv,
+                        val * float(hi_ratio[k_min]) * conv, float(tau[k_min]), label,
+                        quality="poor" if poor else "rough",
+                    )
+                )  # fmt: skip
+            elif isinstance(term, str):
                 slope_terms.append(NoiseTerm(None, u, term, label=label))
             elif fit_reasons[j] is not None:
+                # the slope line stands (IEEE 952 C.3), marked rough: the fit does not find it
+                val, lo, hi, tau_k = term
                 reason = (
-                    f"a slope {TERM_SLOPES[j]:+g} stretch near τ = {term[3]:.4g} s is not "
-                    f"supported by the least-squares fit ({fit_reasons[j]})"
+                    f"read from the slope {TERM_SLOPES[j]:+g} stretch at τ = {tau_k:.4g} s; "
+                    f"rough: the least-squares fit does not support it ({fit_reasons[j]})"
                 )
-                slope_terms.append(NoiseTerm(None, u, reason, tau_s=term[3], label=label))
+                slope_terms.append(
+                    NoiseTerm(
+                        val * conv, u, reason, lo * conv, hi * conv, tau_k, label,
+                        quality="poor" if poor else "rough",
+                    )
+                )  # fmt: skip
             else:
                 conv = scale * factor
                 val, lo, hi, tau_k = term

@@ -1,6 +1,7 @@
 """``thermocal allan FILE``: overlapping Allan deviation, confidence intervals and
 IEEE 952 noise terms by slope lines and by least squares."""
 
+import math
 import warnings
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated, Any
@@ -41,11 +42,68 @@ if TYPE_CHECKING:
     import thermocal.allan as _allan
     import thermocal.io as _io
     import thermocal.metrics as _metrics
+    import thermocal.stability.family as _family
 else:
     _rich_table = LazyModule("rich.table")
     _allan = LazyModule("thermocal.allan")
     _io = LazyModule("thermocal.io")
     _metrics = LazyModule("thermocal.metrics")
+    _family = LazyModule("thermocal.stability.family")
+
+
+def _column_unit(name: str) -> str:
+    """A phase column's unit from its name (``phase [s]``, ``angle (deg)``), else ``""``:
+    phase units are not signal (rate) units, so the recording's unit resolver cannot give it."""
+    import re
+
+    hit = re.search(r"[\[(]([^\])]+)[\])]\s*$", name)
+    return hit.group(1).strip() if hit else ""
+
+
+def family_json(res: "_family.StabilityResult") -> dict[str, Any]:
+    """The ``--json`` object of ``allan --deviation``: ``tau_s`` and per deviation NAME the
+    keys NAME, NAME_low, NAME_high, NAME_edf, NAME_alpha, NAME_n, NAME_tau_s, NAME_unit;
+    ``alpha`` the noise identified per ``tau_s`` (first Allan-family deviation)."""
+    out: dict[str, Any] = {
+        "tau_s": res.tau_s,
+        "data_type": res.data_type,
+        "confidence": res.confidence,
+        "tau0_s": res.tau0_s,
+        "n_segments": res.n_segments,
+        "deviations": list(res.curves),
+    }
+    alpha_src = next(
+        (c for c in res.curves.values() if c.name not in ("theo1", "hdev", "ohdev", "htotdev")),
+        next(iter(res.curves.values())),
+    )
+    out["alpha"] = alpha_src.alpha if alpha_src.name != "theo1" else None
+    for name, c in res.curves.items():
+        out[name] = c.dev
+        out[f"{name}_low"] = c.low
+        out[f"{name}_high"] = c.high
+        out[f"{name}_edf"] = c.edf
+        out[f"{name}_alpha"] = c.alpha
+        out[f"{name}_alpha_method"] = list(c.alpha_method)
+        out[f"{name}_n"] = c.n_terms
+        out[f"{name}_tau_s"] = c.tau_s
+        out[f"{name}_unit"] = c.unit
+    return dict(jsonable(out))
+
+
+def _family_human(file: Path, res: "_family.StabilityResult") -> None:
+    for name, c in res.curves.items():
+        t = _rich_table.Table(title=f"{file} — {name} [{c.unit}] ({res.data_type} data)")
+        for col in ("τ [s]", name, "low", "high", "edf", "α", "terms"):
+            t.add_column(col, justify="right")
+        for i in range(c.tau_s.size):
+            if not math.isfinite(float(c.dev[i])):
+                continue
+            t.add_row(
+                fmt(float(c.tau_s[i])), fmt(float(c.dev[i]), 5), fmt(float(c.low[i]), 5),
+                fmt(float(c.high[i]), 5), fmt(float(c.edf[i]), 4), str(int(c.alpha[i])),
+                str(int(c.n_terms[i])),
+            )  # fmt: skip
+        stdout.print(t)
 
 
 def _terms_json(terms: dict[str, Any]) -> dict[str, Any]:
@@ -156,6 +214,22 @@ def allan_cmd(
     t_bad: OnBadLinesOpt = "error",
     t_delim: DelimiterOpt = None,
     t_dec: DecimalOpt = None,
+    deviation: Annotated[
+        str | None,
+        typer.Option(
+            "--deviation",
+            help="Deviations (NIST SP 1065), comma-separated: oadev (default), adev, mdev, "
+            "tdev, hdev, ohdev, totdev, mtotdev, ttotdev, htotdev, theo1, mtie, tierms.",
+        ),
+    ] = None,
+    data_type: Annotated[
+        str,
+        typer.Option(
+            "--data-type",
+            help="rate (default: the column is a rate) or phase (an integrated quantity: "
+            "angle, velocity, seconds of a clock).",
+        ),
+    ] = "rate",
     as_json: JsonOpt = False,
 ) -> None:
     """Overlapping Allan deviation with chi-square confidence intervals and the noise
@@ -183,7 +257,7 @@ def allan_cmd(
         if plot.suffix.lower() not in (".png", ".svg", ".pdf"):
             raise ThermocalInputError(f"{plot}: --plot writes PNG, SVG or PDF; name it *.png")
     tau_spec: Any = taus
-    if taus not in ("octave", "decade", "log"):
+    if taus not in ("octave", "decade", "log", "all"):
         try:
             tau_spec = [float(v) for v in taus.split(",") if v.strip()]
         except ValueError:
@@ -191,6 +265,34 @@ def allan_cmd(
                 f"--taus {taus!r}: use octave, decade, log or a comma-separated list of τ [s]"
             ) from None
     names = split_names(signal) or [rec.signals[0]]
+    if data_type not in ("rate", "phase"):
+        raise ThermocalInputError(f"--data-type {data_type!r}: use rate or phase")
+    if deviation is not None or data_type == "phase":
+        devs = _family.parse_deviations(deviation or "oadev")
+        fam_spec: Any = "all" if taus == "all" else tau_spec
+        results = {}
+        for name in names:
+            if data_type == "phase":  # the column as given, in its own unit
+                values, unit = rec.column(name), _column_unit(name)
+            else:
+                canonical, canon_unit = rec.signal(name)
+                unit, k = _metrics.data_unit_of(rec, name, canon_unit)
+                values = canonical if k == 1.0 else canonical / k
+            results[name] = _family.stability(
+                values, rec.sample_interval_s, devs, fam_spec, data_type=data_type,
+                segments=rec.segments(), unit=unit, confidence=confidence,
+            )  # fmt: skip
+        if len(names) == 1:
+            one = results[names[0]]
+            emit(family_json(one), as_json, lambda: _family_human(file, one))
+        else:
+
+            def human_all() -> None:
+                for r in results.values():
+                    _family_human(file, r)
+
+            emit({"channels": {n: family_json(r) for n, r in results.items()}}, as_json, human_all)
+        return
     analyses: dict[str, tuple[_allan.AllanResult, _allan.NoiseTerms]] = {}
     for name in names:  # one read of the file, every channel (INTERFACE: several channels)
         canonical, canon_unit = rec.signal(name)

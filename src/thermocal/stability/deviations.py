@@ -1,0 +1,253 @@
+"""The NIST SP 1065 family of frequency-stability deviations, gap-aware.
+
+Every deviation is computed from phase points ``x_k`` [unit·s for rate data; the column's
+unit for phase data] of one gap-free stretch; rate samples ``y_i`` (each the mean over τ0)
+become ``x_k = τ0 Σ_{i<k} y_i``.  With τ = m τ0 and N phase points (SP 1065 equation numbers):
+
+* ``adev``   (eq. 7)  σ² = Σ (x_{k+2m} − 2x_{k+m} + x_k)² / (2τ²(M)), k = 0, m, 2m, …
+* ``oadev``  (eq. 11) the same over every k, N − 2m terms
+* ``mdev``   (eq. 14) Mod σ² = Σ_j (Σ_{i=j}^{j+m−1} x_{i+2m} − 2x_{i+m} + x_i)² / (2m²τ²(N−3m+1))
+* ``tdev``   (eq. 15) σ_x² = τ²/3 · Mod σ²
+* ``hdev``   (eq. 17) Hσ² = Σ (x_{k+3m} − 3x_{k+2m} + 3x_{k+m} − x_k)² / (6τ² M), k = 0, m, …
+* ``ohdev``  (eq. 18) the same over every k, N − 3m terms
+* ``totdev`` (eq. 25) over the series extended by odd reflection at both ends, N − 2 terms
+* ``mtotdev`` (eq. 27) each 3m-point subsequence: linear trend removed by its half means,
+  extended by even reflection to 9m points, 6m modified second differences; N − 3m + 1 of them
+* ``ttotdev`` (eq. 28) τ²/3 · Mtot σ²
+* ``htotdev`` (eq. 29) as mtotdev on the rate (third differences of phase); m = 1 is ohdev
+  (as Stable32)
+* ``theo1``  (eq. 30) m even, τ = 0.75 m τ0:
+  Σ_i Σ_{δ=0}^{m/2−1} ((x_i − x_{i−δ+m/2}) + (x_{i+m} − x_{i+δ+m/2}))²/(m/2 − δ)
+  divided by 0.75 (m τ0)² (N − m)
+* ``mtie``   (eq. 31) max over windows of m + 1 phase points of (max − min)
+* ``tierms`` (eq. 33) √(mean (x_{k+m} − x_k)²)
+
+No bias correction is applied (totdev, mtotdev, htotdev, theo1 as defined; Stable32's "no
+bias" outputs).  Segments separated by gaps are never differenced across: each stretch gives
+sums of squares and term counts per τ, pooled as Σ S / Σ count (MTIE: the largest).
+"""
+
+from __future__ import annotations
+
+from typing import Final
+
+import numpy as np
+import numpy.typing as npt
+
+from thermocal._lazy import LazyModule
+
+ndimage = LazyModule("scipy.ndimage")
+
+FloatArray = npt.NDArray[np.float64]
+IntArray = npt.NDArray[np.int64]
+
+DEVIATIONS: Final = (
+    "oadev",
+    "adev",
+    "mdev",
+    "tdev",
+    "hdev",
+    "ohdev",
+    "totdev",
+    "mtotdev",
+    "ttotdev",
+    "htotdev",
+    "theo1",
+    "mtie",
+    "tierms",
+)
+"""Names accepted by ``--deviation``, as in NIST SP 1065 / allantools / Stable32."""
+
+TIME_DEVIATIONS: Final = frozenset({"tdev", "ttotdev", "mtie", "tierms"})
+"""Deviations in phase units (unit·s for rate data) rather than in rate units."""
+
+_BLOCK: Final = 1 << 22
+"""Elements per block of the O(N·m) kernels (mtotdev, htotdev, theo1)."""
+
+
+def max_factor(name: str, n_phase: int) -> int:
+    """Largest averaging factor m with at least one term for N phase points."""
+    if name in ("adev", "oadev", "tierms", "mtie"):
+        return (n_phase - 1) // 2 if name in ("adev", "oadev") else n_phase - 1
+    if name in ("mdev", "tdev", "mtotdev", "ttotdev"):
+        return (n_phase + 1) // 3 if name in ("mdev", "tdev") else n_phase // 3
+    if name in ("hdev", "ohdev"):
+        return (n_phase - 1) // 3
+    if name == "htotdev":
+        return (n_phase - 1) // 3
+    if name == "totdev":
+        return n_phase - 2
+    if name == "theo1":
+        return n_phase - 1
+    raise ValueError(name)
+
+
+def _second(x: FloatArray, m: int, stride: int) -> FloatArray:
+    xs = x[::stride] if stride > 1 else x
+    k = m // stride
+    return np.asarray(xs[2 * k :] - 2.0 * xs[k:-k] + xs[: -2 * k], dtype=np.float64)
+
+
+def _third(x: FloatArray, m: int, stride: int) -> FloatArray:
+    xs = x[::stride] if stride > 1 else x
+    k = m // stride
+    n = xs.size - 3 * k
+    return np.asarray(
+        xs[3 * k : 3 * k + n] - 3.0 * xs[2 * k : 2 * k + n] + 3.0 * xs[k : k + n] - xs[:n],
+        dtype=np.float64,
+    )
+
+
+def _tot_kernel(z: FloatArray, m: int) -> tuple[float, int]:
+    """Σ_n (1/6m) Σ_{j<6m} ((S1 − 2S2 + S3)/m)² over the N − 3m + 1 subsequences of 3m
+    points of ``z``, each with its half-mean linear trend removed and extended by even
+    reflection to 9m points (S1, S2, S3 the sums of consecutive m-point blocks from j)."""
+    n_sub = z.size - 3 * m + 1
+    if n_sub < 1:
+        return 0.0, 0
+    w = np.lib.stride_tricks.sliding_window_view(z, 3 * m)
+    h1, h2 = (3 * m) // 2, (3 * m + 1) // 2
+    idx = np.arange(3 * m, dtype=np.float64)
+    rows = max(1, _BLOCK // (9 * m))
+    total = 0.0
+    for a in range(0, n_sub, rows):
+        blk = w[a : a + rows]
+        slope = (blk[:, h2:].mean(axis=1) - blk[:, :h1].mean(axis=1)) / h2
+        x0 = blk - slope[:, None] * idx[None, :]
+        x0 = x0 - x0.mean(axis=1, keepdims=True)
+        flip = x0[:, ::-1]
+        xs = np.concatenate([flip, x0, flip], axis=1)
+        cs = np.zeros((xs.shape[0], xs.shape[1] + 1))
+        np.cumsum(xs, axis=1, out=cs[:, 1:])
+        s = cs[:, m:] - cs[:, :-m]  # block sums starting at j, j = 0 … 8m
+        v = (s[:, : 6 * m] - 2.0 * s[:, m : 7 * m] + s[:, 2 * m : 8 * m]) / m
+        total += float(np.einsum("ij,ij->", v, v)) / (6.0 * m)
+    return total, n_sub
+
+
+def _theo1_sum(x: FloatArray, m: int) -> float:
+    """Σ_{i<N−m} Σ_{δ<m/2} ((x_i − x_{i−δ+m/2}) + (x_{i+m} − x_{i+δ+m/2}))² / (m/2 − δ)."""
+    n = x.size - m
+    h = m // 2
+    total = 0.0
+    base = x[:n] + x[m : m + n]
+    for dl in range(h):
+        v = base - x[h - dl : h - dl + n] - x[h + dl : h + dl + n]
+        total += float(v @ v) / (h - dl)
+    return total
+
+
+def segment_sums(
+    name: str, x: FloatArray, tau0_s: float, m: IntArray
+) -> tuple[FloatArray, FloatArray]:
+    """(numerator, terms) per m for one gap-free stretch of phase ``x``: the variance is
+    numerator / terms (for mtie the numerator is the MTIE itself and terms its window count).
+    ``m`` must respect :func:`max_factor`; a factor without a term gives (0, 0)."""
+    num = np.zeros(m.size)
+    cnt = np.zeros(m.size)
+    n = x.size
+    if name == "totdev":
+        ext = np.concatenate([2.0 * x[0] - x[n - 2 : 0 : -1], x, 2.0 * x[-1] - x[-2:0:-1]])
+        mid = n - 2
+    for i, mm in enumerate(int(v) for v in m.tolist()):
+        tau = mm * tau0_s
+        if mm < 1 or mm > max_factor(name, n):
+            continue
+        if name in ("adev", "oadev"):
+            v = _second(x, mm, mm if name == "adev" else 1)
+            num[i], cnt[i] = float(v @ v) / (2.0 * tau * tau), v.size
+        elif name in ("mdev", "tdev"):
+            cs = np.concatenate([[0.0], np.cumsum(x)])
+            s = cs[mm:] - cs[:-mm]
+            k = n - 3 * mm + 1
+            v = s[2 * mm : 2 * mm + k] - 2.0 * s[mm : mm + k] + s[:k]
+            val = float(v @ v) / (2.0 * mm * mm * tau * tau)
+            num[i], cnt[i] = (val * tau * tau / 3.0 if name == "tdev" else val), k
+        elif name in ("hdev", "ohdev") or (name == "htotdev" and mm == 1):
+            v = _third(x, mm, mm if name == "hdev" else 1)
+            num[i], cnt[i] = float(v @ v) / (6.0 * tau * tau), v.size
+        elif name == "totdev":
+            c = mid + 1
+            v = ext[c - mm : c - mm + mid] - 2.0 * ext[c : c + mid] + ext[c + mm : c + mm + mid]
+            num[i], cnt[i] = float(v @ v) / (2.0 * tau * tau), mid
+        elif name in ("mtotdev", "ttotdev"):
+            s, k = _tot_kernel(x, mm)
+            val = s / (2.0 * tau * tau)
+            num[i], cnt[i] = (val * tau * tau / 3.0 if name == "ttotdev" else val), k
+        elif name == "htotdev":
+            s, k = _tot_kernel(np.diff(x) / tau0_s, mm)
+            num[i], cnt[i] = s / 6.0, k
+        elif name == "theo1":
+            if mm % 2:
+                continue
+            num[i], cnt[i] = _theo1_sum(x, mm) / (0.75 * tau * tau), n - mm
+        elif name == "tierms":
+            v = x[mm:] - x[:-mm]
+            num[i], cnt[i] = float(v @ v), n - mm
+        elif name == "mtie":
+            w = mm + 1
+            # window [k, k + m]: the filters centre their window; shift it to start at k
+            hi = ndimage.maximum_filter1d(x, w, origin=-(w // 2))
+            lo = ndimage.minimum_filter1d(x, w, origin=-(w // 2))
+            k = n - mm
+            num[i], cnt[i] = float(np.max(hi[:k] - lo[:k])), k
+        else:
+            raise ValueError(f"unknown deviation {name!r}")
+    return num, cnt
+
+
+def pool(
+    name: str, parts: list[tuple[FloatArray, FloatArray]], size: int
+) -> tuple[FloatArray, FloatArray]:
+    """Deviation and term count per m from the stretches' (numerator, terms)."""
+    num = np.zeros(size)
+    cnt = np.zeros(size)
+    for a, b in parts:
+        if name == "mtie":
+            num = np.maximum(num, np.where(b > 0, a, 0.0))
+        else:
+            num += a
+        cnt += b
+    with np.errstate(invalid="ignore", divide="ignore"):
+        if name == "mtie":
+            dev = np.where(cnt > 0, num, np.nan)
+        else:
+            dev = np.where(cnt > 0, np.sqrt(num / np.where(cnt > 0, cnt, 1.0)), np.nan)
+    return np.asarray(dev, dtype=np.float64), cnt
+
+
+def theo1_tau(m: npt.ArrayLike, tau0_s: float) -> FloatArray:
+    """Theo1's averaging time τ = 0.75 m τ0 [s]."""
+    return np.asarray(0.75 * np.asarray(m, dtype=np.float64) * tau0_s)
+
+
+def as_phase(values: FloatArray, tau0_s: float, data_type: str) -> FloatArray:
+    """Phase points of one stretch: rate y → x_k = τ0 Σ_{i<k} y_i (N = n + 1); phase as given."""
+    if data_type == "phase":
+        return np.asarray(values, dtype=np.float64)
+    x = np.empty(values.size + 1)
+    x[0] = 0.0
+    np.cumsum(values, out=x[1:])
+    x *= tau0_s
+    return x
+
+
+def centred(x: FloatArray) -> FloatArray:
+    """x minus the straight line through its end points: every variance here cancels a linear
+    phase (a constant rate) exactly; removing it keeps the sums free of rounding growth."""
+    if x.size < 2:
+        return x
+    k = np.arange(x.size, dtype=np.float64)
+    return np.asarray(x - x[0] - (x[-1] - x[0]) * k / (x.size - 1), dtype=np.float64)
+
+
+__all__ = [
+    "DEVIATIONS",
+    "TIME_DEVIATIONS",
+    "as_phase",
+    "centred",
+    "max_factor",
+    "pool",
+    "segment_sums",
+    "theo1_tau",
+]

@@ -1,0 +1,333 @@
+"""Equivalent degrees of freedom (EDF) and power-law noise identification.
+
+Symbols: α the exponent of the frequency (rate) power spectral density ``S_y(f) ∝ f^α``
+(+2 white PM / quantization, +1 flicker PM, 0 white FM / angle random walk, −1 flicker FM /
+bias instability, −2 random-walk FM / rate random walk, −3, −4); N phase points; m the
+averaging factor (τ = m τ0).
+
+* :func:`greenhall_edf`: C. A. Greenhall and W. J. Riley, "Uncertainty of stability
+  variances based on finite differences", Proc. 35th PTTI Meeting (2003), eqs. (7)–(13) and
+  Tables 1–3 (the algorithm Stable32 uses); written here from the paper's equations.
+* :func:`edf_totdev`, :func:`edf_mtotdev`, :func:`edf_htotdev`: NIST SP 1065 (2008) §5.2.11,
+  §5.2.12, §5.2.14 (``b·(N/m) − c``; Htot ``(N/m)/(b0 + b1·m/N)``).
+* :func:`identify_noise`: lag-1 autocorrelation (W. J. Riley and C. A. Greenhall, "Power law
+  noise identification using the lag 1 autocorrelation", Proc. 18th EFTF, 2004), with the
+  B1 ratio (Barnes 1969; D. A. Howe et al., 2000) when fewer than 30 averaged points remain.
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+from dataclasses import dataclass
+from typing import Final
+
+import numpy as np
+import numpy.typing as npt
+
+FloatArray = npt.NDArray[np.float64]
+
+J_MAX: Final = 100
+"""Greenhall's summation limit beyond which the large-sample approximations are used."""
+
+MIN_ACF_POINTS: Final = 30
+"""Averaged points the lag-1 autocorrelation method needs (Riley & Greenhall 2004)."""
+
+MIN_B1_GROUPS: Final = 8
+"""m-averages the B1 ratio needs; with fewer, no noise type is identified at that τ and
+the caller carries the α of the next shorter τ (the choice that reproduces Stable32's α column
+on its PHASE.DAT: its last octave point, 7 averages, keeps the white FM of the one before)."""
+
+# Table 1 (modified variances, F = 1) and Table 2 (unmodified, F = m) of Greenhall & Riley
+# 2003: (a0, a1) of 1/edf ≈ (a0 − a1/r)/r, indexed [α][d] with d = 1, 2, 3.
+_TABLE1: Final[dict[int, tuple[tuple[float, float] | None, ...]]] = {
+    2: ((2.0 / 3.0, 1.0 / 3.0), (7.0 / 9.0, 0.5), (22.0 / 25.0, 2.0 / 3.0)),
+    1: ((0.840, 0.345), (0.997, 0.616), (1.141, 0.843)),
+    0: ((1.079, 0.368), (1.033, 0.607), (1.184, 0.848)),
+    -1: (None, (1.048, 0.534), (1.180, 0.816)),
+    -2: (None, (1.302, 0.535), (1.175, 0.777)),
+    -3: (None, None, (1.194, 0.703)),
+    -4: (None, None, (1.489, 0.702)),
+}
+_TABLE2: Final[dict[int, tuple[tuple[float, float] | None, ...]]] = {
+    2: ((1.5, 0.5), (35.0 / 18.0, 1.0), (231.0 / 100.0, 1.5)),
+    1: ((78.6, 25.2), (790.0, 410.0), (9950.0, 6520.0)),
+    0: ((2.0 / 3.0, 1.0 / 6.0), (2.0 / 3.0, 1.0 / 3.0), (7.0 / 9.0, 0.5)),
+    -1: (None, (0.852, 0.375), (0.997, 0.617)),
+    -2: (None, (1.079, 0.368), (1.033, 0.607)),
+    -3: (None, None, (1.053, 0.553)),
+    -4: (None, None, (1.302, 0.535)),
+}
+_TABLE3: Final = ((6.0, 4.0), (15.23, 12.0), (47.8, 40.0))
+"""(b0, b1) of the α = +1 normalisation (b0 + b1 ln m)² (Table 3)."""
+
+
+def _sw(t: FloatArray, alpha: int) -> FloatArray:
+    """Greenhall eq. (7): the generalised autocovariance kernel of phase noise of type α."""
+    a = np.abs(t)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        lg = np.where(a > 0, np.log(np.where(a > 0, a, 1.0)), 0.0)
+    if alpha == 2:
+        return -a
+    if alpha == 1:
+        return t**2 * lg
+    if alpha == 0:
+        return a**3
+    if alpha == -1:
+        return -(t**4) * lg
+    if alpha == -2:
+        return -(a**5)
+    if alpha == -3:
+        return t**6 * lg
+    if alpha == -4:
+        return a**7
+    raise ValueError(f"noise exponent α must be an integer in −4…2, got {alpha}")
+
+
+def _sx(t: FloatArray, f: float, alpha: int) -> FloatArray:
+    """Eq. (8): the filter of length 1/F applied (F = ∞: the limit sw(t, α + 2))."""
+    if math.isinf(f):
+        return _sw(t, alpha + 2)
+    return f * f * (2.0 * _sw(t, alpha) - _sw(t - 1.0 / f, alpha) - _sw(t + 1.0 / f, alpha))
+
+
+_BINOMIAL: Final = {1: (2, -1), 2: (6, -4, 1), 3: (20, -15, 6, -1)}
+
+
+def _sz(t: FloatArray, f: float, alpha: int, d: int) -> FloatArray:
+    """Eq. (9): the d-th difference (d = 1, 2, 3) of ``_sx``."""
+    c = _BINOMIAL[d]
+    out = c[0] * _sx(t, f, alpha)
+    for k in range(1, d + 1):
+        out = out + c[k] * (_sx(t - k, f, alpha) + _sx(t + k, f, alpha))
+    return np.asarray(out, dtype=np.float64)
+
+
+def _basic_sum(j: int, m_terms: float, s: float, f: float, alpha: int, d: int) -> float:
+    """Eq. (10): sz²(0) + 2 Σ_{i=1}^{J−1} (1 − i/M) sz²(i/S) + (1 − J/M) sz²(J/S)."""
+    first = float(_sz(np.zeros(1), f, alpha, d)[0]) ** 2
+    last = (1.0 - j / m_terms) * float(_sz(np.array([j / s]), f, alpha, d)[0]) ** 2
+    i = np.arange(1, int(j), dtype=np.float64)
+    mid = float(np.sum(2.0 * (1.0 - i / m_terms) * _sz(i / s, f, alpha, d) ** 2))
+    return first + mid + last
+
+
+def greenhall_edf(
+    alpha: int, d: int, m: int, n_phase: int, *, overlapping: bool, modified: bool
+) -> float:
+    """EDF of a finite-difference variance (Greenhall & Riley 2003, eqs. 11–13, Tables 1–3).
+
+    ``d`` = 2 for the Allan family (ADEV, OADEV, MDEV, TDEV), 3 for Hadamard (HDEV, OHDEV);
+    ``overlapping``: stride S = m (else 1); ``modified``: filter factor F = 1 (else m).
+    Needs α + 2d > 1.  L = m/F + m d phase points per term, M = 1 + ⌊S(N − L)/m⌋ terms,
+    J = min(M, (d+1)S), r = M/S.  Returns NaN when N < L (no term).
+    """
+    f = 1.0 if modified else float(m)
+    s = float(m) if overlapping else 1.0
+    if alpha + 2 * d <= 1:
+        raise ValueError(f"Greenhall EDF needs α + 2d > 1 (α = {alpha}, d = {d})")
+    big_l = m / f + m * d
+    if n_phase < big_l:
+        return float("nan")
+    big_m = 1.0 + math.floor(s * (n_phase - big_l) / m)
+    j = min(big_m, (d + 1) * s)
+    r = big_m / s
+    if modified:  # case 1: modified variances, every α
+        if j <= J_MAX:
+            inv = _basic_sum(int(j), big_m, s, 1.0, alpha, d) / (
+                float(_sz(np.zeros(1), 1.0, alpha, d)[0]) ** 2 * big_m
+            )
+        elif r > d + 1:
+            a0, a1 = _coeffs(_TABLE1, alpha, d)
+            inv = (a0 - a1 / r) / r
+        else:
+            mp = J_MAX / r
+            inv = _basic_sum(J_MAX, J_MAX, mp, 1.0, alpha, d) / (
+                float(_sz(np.zeros(1), 1.0, alpha, d)[0]) ** 2 * J_MAX
+            )
+        return 1.0 / inv
+    if alpha <= 0:  # case 2: unmodified, α ≤ 0
+        if j <= J_MAX:
+            fp = float(m) if m * (d + 1) <= J_MAX else math.inf
+            inv = _basic_sum(int(j), big_m, s, fp, alpha, d) / (
+                float(_sz(np.zeros(1), fp, alpha, d)[0]) ** 2 * big_m
+            )
+        elif r > d + 1:
+            a0, a1 = _coeffs(_TABLE2, alpha, d)
+            inv = (a0 - a1 / r) / r
+        else:
+            mp = J_MAX / r
+            inv = _basic_sum(J_MAX, J_MAX, mp, math.inf, alpha, d) / (
+                float(_sz(np.zeros(1), math.inf, alpha, d)[0]) ** 2 * J_MAX
+            )
+        return 1.0 / inv
+    if alpha == 1:  # case 3: unmodified, flicker PM
+        if j <= J_MAX:
+            inv = _basic_sum(int(j), big_m, s, float(m), 1, d) / (
+                float(_sz(np.zeros(1), float(m), 1, d)[0]) ** 2 * big_m
+            )
+        else:
+            b0, b1 = _TABLE3[d - 1]
+            norm = (b0 + b1 * math.log(m)) ** 2
+            if r > d + 1:
+                a0, a1 = _coeffs(_TABLE2, 1, d)
+                inv = (a0 - a1 / r) / (norm * r)
+            else:
+                mp = J_MAX / r
+                inv = _basic_sum(J_MAX, J_MAX, mp, mp, 1, d) / (norm * J_MAX)
+        return 1.0 / inv
+    # case 4: unmodified, white PM
+    if math.ceil(r) <= d:  # the exact sum (the paper's small-K case)
+        inv = _basic_sum(int(j), big_m, s, float(m), 2, d) / (
+            float(_sz(np.zeros(1), float(m), 2, d)[0]) ** 2 * big_m
+        )
+        return 1.0 / inv
+    a0 = math.comb(4 * d, 2 * d) / math.comb(2 * d, d) ** 2
+    a1 = d / 2.0
+    return 1.0 / ((a0 - a1 / r) / big_m)
+
+
+def _coeffs(
+    table: dict[int, tuple[tuple[float, float] | None, ...]], alpha: int, d: int
+) -> tuple[float, float]:
+    row = table[alpha][d - 1]
+    if row is None:
+        raise ValueError(f"no Greenhall table entry for α = {alpha}, d = {d}")
+    return row
+
+
+# --- total-deviation family (SP 1065 Tables 7, 8 and §5.2.14) --------------------------------
+
+_TOT: Final = {0: (1.50, 0.0), -1: (1.17, 0.22), -2: (0.93, 0.36)}
+_MTOT: Final = {
+    2: (1.90, 2.10),
+    1: (1.20, 1.40),
+    0: (1.10, 1.20),
+    -1: (0.85, 0.50),
+    -2: (0.75, 0.31),
+}
+_HTOT: Final = {0: (0.559, 1.004), -1: (0.868, 1.140), -2: (0.938, 1.696)}
+
+
+def edf_totdev(n_phase: int, m: int, alpha: int) -> float:
+    """Total variance EDF, SP 1065 Table 7: ``b·(N/m) − c`` for α = 0, −1, −2; phase
+    noise (α > 0) takes the overlapping Allan EDF (Greenhall)."""
+    if alpha in _TOT:
+        b, c = _TOT[alpha]
+        return b * n_phase / m - c
+    return greenhall_edf(max(alpha, -2), 2, m, n_phase, overlapping=True, modified=False)
+
+
+def edf_mtotdev(n_phase: int, m: int, alpha: int) -> float:
+    """Modified total (and time total) variance EDF, SP 1065 Table 8: ``b·(N/m) − c``."""
+    b, c = _MTOT[max(min(alpha, 2), -2)]
+    return b * n_phase / m - c
+
+
+def edf_htotdev(n_phase: int, m: int, alpha: int) -> float:
+    """Hadamard total variance EDF, SP 1065 §5.2.14: ``(N/m)/(b0 + b1·m/N)`` for α = 0, −1,
+    −2 (other α take the overlapping Hadamard EDF of Greenhall)."""
+    if alpha in _HTOT:
+        b0, b1 = _HTOT[alpha]
+        return (n_phase / m) / (b0 + b1 * m / n_phase)
+    return greenhall_edf(max(alpha, -4), 3, m, n_phase, overlapping=True, modified=False)
+
+
+# --- noise identification ----------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class NoiseId:
+    """The identified power-law noise at one averaging factor.
+
+    ``alpha`` the integer exponent; ``alpha_float`` the unrounded lag-1 estimate (NaN for
+    B1); ``method`` ``"lag1"`` or ``"b1"`` (or ``"none"`` when neither could run: α = 0
+    assumed); ``d`` differences taken (lag-1 method).
+    """
+
+    alpha: int
+    alpha_float: float
+    method: str
+    d: int
+
+
+def lag1_autocorrelation(z: FloatArray) -> float:
+    """r1 = Σ (z_n − z̄)(z_{n+1} − z̄) / Σ (z_n − z̄)²  (Riley & Greenhall 2004, eq. 2)."""
+    c = z - z.mean()
+    den = float(c @ c)
+    return float(c[:-1] @ c[1:]) / den if den > 0 else 0.0
+
+
+def _detrend(z: FloatArray, deg: int) -> FloatArray:
+    t = np.arange(z.size, dtype=np.float64)
+    t = (t - t.mean()) / max(float(t.std()), 1.0)
+    coef = np.polynomial.polynomial.polyfit(t, z, deg)
+    return np.asarray(z - np.polynomial.polynomial.polyval(t, coef), dtype=np.float64)
+
+
+def _b1_theory(n: int, mu: int) -> float:
+    """Expected B1 (standard over Allan variance) for N averages and τ-exponent μ of the
+    Allan variance (Howe, Beard, Greenhall, Riley 2000, Table 3)."""
+    if mu == 2:
+        return n * (n + 1.0) / 6.0
+    if mu == 1:
+        return n / 2.0
+    if mu == 0:
+        return n * math.log(n) / (2.0 * (n - 1.0) * math.log(2.0))
+    if mu == -1:
+        return 1.0
+    if mu == -2:
+        return (n * n - 1.0) / (1.5 * n * (n - 1.0))
+    return float(n * (1.0 - float(n) ** mu) / (2.0 * (n - 1.0) * (1.0 - 2.0**mu)))
+
+
+_MU_TO_ALPHA: Final = {-2: 2, -1: 0, 0: -1, 1: -2, 2: -3, 3: -4}
+
+
+def identify_noise(x: FloatArray, m: int, *, dmax: int, phase_input: bool) -> NoiseId:
+    """Power-law noise α at averaging factor m (Riley & Greenhall 2004; B1 otherwise).
+
+    ``x``: phase points of one gap-free stretch.  Lag-1 method: the phase decimated by m
+    (quadratic trend removed) when the data were given as phase, else the rate averaged
+    over blocks of m (linear trend removed); difference until ρ = r1/(1 + r1) < 0.25 or d =
+    dmax (``dmax`` counted on phase: 2 for the Allan family, 3 for Hadamard; one less on
+    rate); α = −round(2ρ) − 2d (+2 for phase).  With fewer than 30 averaged points: the B1
+    ratio of the standard variance of the m-averages to their Allan variance, against the
+    theoretical B1 of each noise (boundaries at geometric means); B1 cannot tell white from
+    flicker PM and reports white PM (α = +2).
+    """
+    if phase_input:
+        z = x[:: max(m, 1)]
+        deg, add, dm = 2, 2, dmax
+    else:
+        y = np.diff(x)
+        nb = y.size // m
+        z = y[: nb * m].reshape(nb, m).mean(axis=1) if nb else y[:0]
+        deg, add, dm = 1, 0, dmax - 1
+    if z.size >= MIN_ACF_POINTS:
+        z = _detrend(z, deg)
+        d = 0
+        while True:
+            r1 = lag1_autocorrelation(z)
+            rho = r1 / (1.0 + r1) if r1 > -1.0 else 0.0
+            if rho < 0.25 or d >= dm:
+                a = -round(2.0 * rho) - 2 * d + add
+                return NoiseId(int(a), -2.0 * (rho + d) + add, "lag1", d)
+            z = np.diff(z)
+            d += 1
+    y = np.diff(x)
+    nb = y.size // m
+    if nb < MIN_B1_GROUPS:
+        return NoiseId(0, float("nan"), "none", 0)
+    ym = y[: nb * m].reshape(nb, m).mean(axis=1)
+    avar = float(np.mean(np.diff(ym) ** 2)) / 2.0
+    if avar <= 0:
+        return NoiseId(0, float("nan"), "none", 0)
+    b1 = float(np.var(ym, ddof=1)) / avar
+    mus = [-2, -1, 0, 1, 2, 3][: 4 + max(dmax - 2, 0) * 2]
+    chosen = mus[-1]
+    for lo, hi in itertools.pairwise(mus):
+        if b1 < math.sqrt(_b1_theory(nb, lo) * _b1_theory(nb, hi)):
+            chosen = lo
+            break
+    return NoiseId(_MU_TO_ALPHA[chosen], float("nan"), "b1", 0)

@@ -1,0 +1,274 @@
+"""Several deviations of one record at once, with Greenhall intervals per τ.
+
+:func:`stability` is the library entry of ``thermocal allan --deviation``: it splits the
+record at gaps, computes each requested deviation of :mod:`.deviations` per stretch, pools
+them, identifies the power-law noise per τ (:func:`.edf.identify_noise`) and gives each
+point its equivalent degrees of freedom and chi-square interval (NIST SP 1065 eq. 45):
+
+=========================  =========================================================
+deviation                  EDF
+=========================  =========================================================
+adev / oadev               Greenhall d = 2, S = 1 / m, F = m
+mdev, tdev                 Greenhall d = 2, S = m, F = 1
+hdev / ohdev               Greenhall d = 3, S = 1 / m, F = m
+totdev                     SP 1065 Table 7 (α = 0, −1, −2), else as oadev
+mtotdev, ttotdev           SP 1065 Table 8
+htotdev                    SP 1065 §5.2.14 (α = 0, −1, −2), else as ohdev; m = 1 as ohdev
+theo1, mtie, tierms        none (NaN: no interval is reported)
+=========================  =========================================================
+
+The EDFs of gap-separated stretches add (independent estimates).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+import numpy.typing as npt
+
+from thermocal.errors import MissingValueError, ThermocalInputError
+from thermocal.stability import deviations as dv
+from thermocal.stability import edf as ed
+
+FloatArray = npt.NDArray[np.float64]
+IntArray = npt.NDArray[np.int64]
+
+HADAMARD = frozenset({"hdev", "ohdev", "htotdev"})
+
+
+@dataclass(frozen=True, eq=False)
+class DeviationCurve:
+    """One deviation against τ.
+
+    ``tau_s`` [s] (theo1: 0.75 m τ0), ``m`` averaging factors, ``dev`` [``unit``],
+    ``low``/``high`` its interval (NaN where none), ``edf``, ``n_terms``, ``alpha`` the noise
+    exponent used for the EDF, ``alpha_method`` ``lag1``/``b1``/``none`` per τ.
+    """
+
+    name: str
+    tau_s: FloatArray
+    m: IntArray
+    dev: FloatArray
+    low: FloatArray
+    high: FloatArray
+    edf: FloatArray
+    n_terms: FloatArray
+    alpha: IntArray
+    alpha_method: tuple[str, ...]
+    unit: str
+
+
+@dataclass(frozen=True, eq=False)
+class StabilityResult:
+    """Deviations of one record: ``curves`` by name, the common ``tau_s``/``m`` (theo1 has its
+    own), ``tau0_s``, ``data_type``, ``confidence``, ``n_segments``, ``n_points``."""
+
+    curves: dict[str, DeviationCurve]
+    tau_s: FloatArray
+    m: IntArray
+    tau0_s: float
+    data_type: str
+    confidence: float
+    n_segments: int
+    n_points: int
+    unit: str
+    notes: tuple[str, ...] = field(default=())
+
+
+def parse_deviations(spec: str) -> list[str]:
+    """``"oadev,mdev"`` → names, checked against :data:`.deviations.DEVIATIONS`."""
+    names = [s.strip().lower() for s in spec.split(",") if s.strip()]
+    bad = [n for n in names if n not in dv.DEVIATIONS]
+    if bad or not names:
+        raise ThermocalInputError(
+            f"--deviation {spec!r}: unknown {', '.join(bad) or 'empty list'}; use "
+            + ", ".join(dv.DEVIATIONS)
+        )
+    return list(dict.fromkeys(names))
+
+
+def factors(
+    taus: str | npt.ArrayLike, tau0_s: float, m_max: int, *, theo1: bool = False
+) -> IntArray:
+    """Averaging factors for a τ set (``octave``: 1, 2, 4 …; ``decade``: 1, 2, 4, 10, 20,
+    40 …; ``log``: ≈10 per decade; ``all``: every m; or τ [s]); theo1: even m with
+    τ = 0.75 m τ0."""
+    if m_max < 1:
+        return np.zeros(0, dtype=np.int64)
+    m: npt.NDArray[np.float64] | IntArray
+    if isinstance(taus, str):
+        if taus == "octave":
+            m = 2 ** np.arange(int(math.log2(m_max)) + 1)
+        elif taus == "decade":
+            dec = 10 ** np.arange(int(math.log10(m_max)) + 1)
+            m = (dec[:, None] * np.array([1, 2, 4])[None, :]).ravel()
+        elif taus == "log":
+            m = np.round(10.0 ** (np.arange(int(10 * math.log10(m_max)) + 1) / 10.0))
+        elif taus == "all":
+            m = np.arange(1, m_max + 1)
+        else:
+            raise ThermocalInputError(
+                f"unknown tau set {taus!r}; use octave, decade, log, all or τ [s]"
+            )
+        if theo1:
+            m = 2 * m
+    else:
+        tau = np.asarray(taus, dtype=np.float64).ravel()
+        if tau.size == 0 or not np.all(np.isfinite(tau)) or np.any(tau <= 0):
+            raise ThermocalInputError("averaging times τ must be positive and finite")
+        m = 2 * np.round(tau / (1.5 * tau0_s)) if theo1 else np.round(tau / tau0_s)
+    mi = np.unique(np.asarray(m).astype(np.int64))
+    return mi[(mi >= 1) & (mi <= m_max)]
+
+
+def _edf(name: str, alpha: int, m: int, n_phase: int) -> float:
+    try:
+        if name == "adev":
+            return ed.greenhall_edf(alpha, 2, m, n_phase, overlapping=False, modified=False)
+        if name == "oadev":
+            return ed.greenhall_edf(alpha, 2, m, n_phase, overlapping=True, modified=False)
+        if name in ("mdev", "tdev"):
+            return ed.greenhall_edf(alpha, 2, m, n_phase, overlapping=True, modified=True)
+        if name == "hdev":
+            return ed.greenhall_edf(alpha, 3, m, n_phase, overlapping=False, modified=False)
+        if name == "ohdev" or (name == "htotdev" and m == 1):
+            return ed.greenhall_edf(alpha, 3, m, n_phase, overlapping=True, modified=False)
+        if name == "totdev":
+            return ed.edf_totdev(n_phase, m, alpha)
+        if name in ("mtotdev", "ttotdev"):
+            return ed.edf_mtotdev(n_phase, m, alpha)
+        if name == "htotdev":
+            return ed.edf_htotdev(n_phase, m, alpha)
+    except ValueError:
+        return float("nan")
+    return float("nan")
+
+
+def stability(
+    values: npt.ArrayLike,
+    tau0_s: float,
+    names: list[str],
+    taus: str | npt.ArrayLike = "octave",
+    *,
+    data_type: str = "rate",
+    segments: list[slice] | None = None,
+    unit: str = "",
+    confidence: float = 0.6826894921370859,
+    alpha: int | None = None,
+) -> StabilityResult:
+    """Deviations ``names`` of rate or phase data [unit] sampled every ``tau0_s`` [s].
+
+    ``segments``: the gap-free index ranges (default: one); ``alpha``: force the noise
+    exponent of the EDF instead of identifying it.  Rate data give deviations in ``unit``
+    and time deviations (tdev, ttotdev, mtie, tierms) in ``unit*s``; phase data give
+    deviations in ``unit/s`` and time deviations in ``unit``.
+    """
+    from thermocal.allan import confidence_interval
+
+    if data_type not in ("rate", "phase"):
+        raise ThermocalInputError(f"--data-type {data_type!r}: use rate or phase")
+    y = np.asarray(values, dtype=np.float64).ravel()
+    if not (math.isfinite(tau0_s) and tau0_s > 0):
+        raise ThermocalInputError(f"sample interval τ0 must be positive, got {tau0_s!r}")
+    bad = np.flatnonzero(~np.isfinite(y))
+    if bad.size:
+        raise MissingValueError(
+            f"data have {bad.size} NaN/infinite samples (first at row {bad[0]}); "
+            "remove them or split the record"
+        )
+    slices = segments if segments is not None else [slice(0, y.size)]
+    # rate data: the phase of the fluctuation about each stretch's mean rate (as allantools'
+    # frequency2phase; a constant rate would make TIE/MTIE the bias times τ)
+    phases = [
+        dv.as_phase(
+            y[sl] - (y[sl].mean() if data_type == "rate" and sl.stop > sl.start else 0.0),
+            tau0_s,
+            data_type,
+        )
+        for sl in slices
+    ]
+    phases = [x for x in phases if x.size >= 3]
+    if not phases:
+        raise ThermocalInputError("stability analysis needs at least 3 contiguous points")
+    longest = max(phases, key=lambda x: x.size)
+    n_long = longest.size
+    m_common = factors(
+        taus,
+        tau0_s,
+        max(dv.max_factor(n, n_long) for n in names if n != "theo1")
+        if any(n != "theo1" for n in names)
+        else 1,
+    )
+    curves: dict[str, DeviationCurve] = {}
+    id_cache: dict[tuple[int, int], ed.NoiseId] = {}
+    centred = [dv.centred(x) for x in phases]
+    for name in names:
+        m = (
+            factors(taus, tau0_s, dv.max_factor(name, n_long), theo1=True)
+            if name == "theo1"
+            else m_common
+        )
+        parts = [
+            dv.segment_sums(name, xr if name in ("mtie", "tierms") else xc, tau0_s, m)
+            for xr, xc in zip(phases, centred, strict=True)
+        ]
+        dev, cnt = dv.pool(name, parts, m.size)
+        dmax = 3 if name in HADAMARD else 2
+        alphas = np.zeros(m.size, dtype=np.int64)
+        methods: list[str] = []
+        for i, mm in enumerate(m.tolist()):
+            if alpha is not None:
+                alphas[i] = alpha
+                methods.append("given")
+                continue
+            key = (int(mm), dmax)
+            if key not in id_cache:
+                id_cache[key] = ed.identify_noise(
+                    longest, int(mm), dmax=dmax, phase_input=data_type == "phase"
+                )
+            nid = id_cache[key]
+            if nid.method == "none" and i > 0:  # too few averages: the shorter τ's noise
+                alphas[i] = alphas[i - 1]
+                methods.append("previous")
+                continue
+            alphas[i] = max(min(nid.alpha, 2), -2 if dmax == 2 else -4)
+            methods.append(nid.method)
+        edf = np.zeros(m.size)
+        for x in phases:
+            for i, mm in enumerate(m.tolist()):
+                if mm <= dv.max_factor(name, x.size):
+                    e = _edf(name, int(alphas[i]), int(mm), x.size)
+                    edf[i] += e if math.isfinite(e) and e > 0 else 0.0
+        edf[edf <= 0] = np.nan
+        ok = np.isfinite(edf) & np.isfinite(dev)
+        lo = np.full(m.size, np.nan)
+        hi = np.full(m.size, np.nan)
+        if ok.any():
+            lo_ok, hi_ok = confidence_interval(dev[ok], edf[ok], confidence)
+            lo[ok], hi[ok] = lo_ok, hi_ok
+        tau = dv.theo1_tau(m, tau0_s) if name == "theo1" else m * float(tau0_s)
+        curves[name] = DeviationCurve(
+            name, np.asarray(tau, dtype=np.float64), m, dev, lo, hi, edf, cnt, alphas,
+            tuple(methods), _unit(name, unit, data_type),
+        )  # fmt: skip
+    return StabilityResult(
+        curves=curves,
+        tau_s=np.asarray(m_common * float(tau0_s), dtype=np.float64),
+        m=m_common,
+        tau0_s=float(tau0_s),
+        data_type=data_type,
+        confidence=float(confidence),
+        n_segments=len(phases),
+        n_points=int(sum(x.size for x in phases)),
+        unit=unit,
+    )
+
+
+def _unit(name: str, unit: str, data_type: str) -> str:
+    if not unit:
+        return ""
+    if data_type == "rate":
+        return f"{unit}*s" if name in dv.TIME_DEVIATIONS else unit
+    return unit if name in dv.TIME_DEVIATIONS else f"{unit}/s"
