@@ -348,14 +348,14 @@ def test_a_flight_like_log_is_refused_unless_allowed(tmp_path: Path) -> None:
 
 
 def test_stillness_threshold_follows_the_noise() -> None:
-    """A noisy sensor (σ = 3 °/s white at 100 Hz): the 1-s medians scatter 1.25·3/√64 (the
-    block median is taken over ≤ 64 samples), so the threshold is 8× that, not the 0.3 °/s
-    floor, and the noise alone is still."""
+    """A noisy sensor (σ = 3 °/s white at 100 Hz): the 1-s medians (over every 2nd sample:
+    ≤ 64 a block) scatter 1.25·3/√50, so the threshold is 8× that, not the 0.3 °/s floor,
+    and the noise alone is still."""
     rng = np.random.default_rng(9)
     t = np.arange(0.0, 600.0, 0.01)
     g = rng.normal(0.0, 3.0, t.size) * 3600.0
     mot = stillness(t, g, 0.3 * 3600.0)
-    per_block = 100 // (100 // 64)  # decimated to every 1st sample: 100 per block
+    per_block = 100 // math.ceil(100 / 64)  # 100 a block, decimated to every 2nd: 50
     expected = 8.0 * 1.25 * 3.0 * 3600.0 / math.sqrt(per_block)
     assert mot.threshold == pytest.approx(expected, rel=0.05)
     assert mot.share == 0.0 and not mot.steps

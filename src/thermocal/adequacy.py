@@ -395,6 +395,8 @@ class Motion:
 
 MAX_PER_BLOCK = 64
 """Samples a block's median is taken over (longer blocks are decimated evenly)."""
+SIGMA_SAMPLES = 200_000
+"""Samples the sensor's own noise is estimated from (an even subsample of long records)."""
 
 
 def _block_stats(
@@ -403,24 +405,34 @@ def _block_stats(
     """Per occupied block: start time [s], samples, median (n_blocks, m), and the sensor's
     own noise σ_w per column (1.4826 × the median absolute deviation from the block
     medians, all blocks together).  Medians, so that isolated spikes are not motion; long
-    blocks are decimated to about :data:`MAX_PER_BLOCK` samples (a median needs no more)."""
-    idx = np.floor((time_s - time_s[0]) / block_s).astype(np.int64)
-    per_block = time_s.size / max(1, int(idx[-1] - idx[0]) + 1)
-    step = max(1, int(per_block // MAX_PER_BLOCK))
-    if step > 1:
-        idx, values = idx[::step], values[::step]
-    uniq, starts, counts = np.unique(idx, return_index=True, return_counts=True)
-    m = values.shape[1]
-    med = np.empty((uniq.size, m))
+    blocks are decimated evenly to about :data:`MAX_PER_BLOCK` samples first (a median
+    needs no more), so the cost is linear in the record and small (time increases, so the
+    blocks are runs of consecutive samples: no sort of the record)."""
+    n = time_s.size
+    span_blocks = int((time_s[-1] - time_s[0]) / block_s) + 1
+    step = max(1, math.ceil(n / span_blocks / MAX_PER_BLOCK))
+    t_d = time_s[::step]
+    v = values[::step]
+    idx = ((t_d - time_s[0]) / block_s).astype(np.int64)
+    starts = np.r_[0, np.flatnonzero(np.diff(idx)) + 1]
+    counts = np.diff(np.r_[starts, idx.size])
+    m = v.shape[1]
+    med = np.empty((starts.size, m))
     sigma = np.empty(m)
-    lo_i = starts + (counts - 1) // 2
-    hi_i = starts + counts // 2
-    inv = np.repeat(np.arange(uniq.size), counts)
+    inv = np.repeat(np.arange(starts.size), counts)
+    equal = bool(np.all(counts == counts[0]))
     for j in range(m):
-        sv = values[np.lexsort((values[:, j], idx)), j]  # idx is sorted: blocks stay in place
-        med[:, j] = 0.5 * (sv[lo_i] + sv[hi_i])
-        sigma[j] = 1.4826 * float(np.median(np.abs(values[:, j] - med[inv, j])))
-    return time_s[0] + uniq * block_s, counts.astype(np.float64), med, sigma
+        if equal:  # the common case: a regular record
+            med[:, j] = np.median(v[:, j].reshape(starts.size, int(counts[0])), axis=1)
+        else:
+            sv = v[np.lexsort((v[:, j], idx)), j]  # idx is sorted: blocks stay in place
+            lo_i = starts + (counts - 1) // 2
+            hi_i = starts + counts // 2
+            med[:, j] = 0.5 * (sv[lo_i] + sv[hi_i])
+        every = max(1, idx.size // SIGMA_SAMPLES)  # the noise from an even subsample
+        dev = v[::every, j] - med[inv[::every], j]
+        sigma[j] = 1.4826 * float(np.median(np.abs(dev)))
+    return time_s[0] + idx[starts] * block_s, counts.astype(np.float64), med, sigma
 
 
 def _window_medians(t_block: FloatArray, x: FloatArray, window_s: float) -> FloatArray:
@@ -491,10 +503,11 @@ def stillness(
     if v.ndim == 1:
         v = v[:, None]
     ok = np.isfinite(t) & np.all(np.isfinite(v), axis=1)
-    t, v = t[ok], v[ok]
+    if not ok.all():
+        t, v = t[ok], v[ok]
     if t.size < 20:
         return Motion(0.0, 0.0, floor)
-    dt = float(np.median(np.diff(t)))
+    dt = float(np.median(np.diff(t[:100_001])))  # the sample interval, from the start
     block_s = max(STILL_BLOCK_S, 10.0 * dt)
     tb, cnt, meds, sigma = _block_stats(t, v, block_s)
     centre, before, after = _window_medians(tb, meds, max(STILL_WINDOW_S, 30.0 * block_s))
