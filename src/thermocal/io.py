@@ -1411,8 +1411,8 @@ def numeric_column(
     if bad.any():
         row = row_offset + int(np.argmax(bad.to_numpy()))
         raise NonNumericError(
-            f"{p}: non-numeric value {series.iloc[row - row_offset]!r} in column {name!r} "
-            f"at row {row} (line {row + 2} of the file)"
+            f"{p}: non-numeric value {short_name(str(series.iloc[row - row_offset]))} in column "
+            f"{short_name(name)} at row {row} (line {row + 2} of the file)"
         )
     return conv.to_numpy(dtype=np.float64, na_value=np.nan)
 

@@ -532,7 +532,7 @@ def read_program(path: str | Path) -> tuple[FloatArray, FloatArray]:
         bad = np.flatnonzero(vals.isna().to_numpy())
         if bad.size:
             raise NonNumericError(
-                f"{p}: missing or non-numeric value {str(df[col].iloc[bad[0]])!r} in column "
+                f"{p}: missing or non-numeric value {str(df[col].iloc[bad[0]])[:60]!r} in column "
                 f"{col!r} at row {bad[0]} (line {bad[0] + 2})"
             )
         out.append(vals.to_numpy(dtype=np.float64))
