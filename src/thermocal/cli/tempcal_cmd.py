@@ -174,9 +174,17 @@ def ardupilot_tempcal_cmd(
     and accelerometer fitted as in px4-tempcal, written as INS_TCAL* (.parm), a calibration
     and reports (the polynomial about 35 °C without constant, as the firmware takes it)."""
 
+    import numpy as np
+
     from thermocal.errors import MissingColumnError
     from thermocal.export_params import ParamSet, export_params
-    from thermocal.io import atomic_write, commit_directory, staging_directory
+    from thermocal.io import (
+        atomic_write,
+        commit_directory,
+        dataflash_table,
+        read_dataflash_log,
+        staging_directory,
+    )
     from thermocal.models.calibration import Calibration
     from thermocal.models.files import save_calibration
     from thermocal.px4_tempcal import calibration_of, fit_sensor, summary
@@ -188,20 +196,31 @@ def ardupilot_tempcal_cmd(
     stage = staging_directory(output)  # the set is moved into place whole, or removed
     fits, reports = [], []
     params = ParamSet("ardupilot")
+    dlog = read_dataflash_log(log, ["IMU", "IMU2", "IMU3"])  # the log is read once
     for inst in range(3):  # ArduPilot logs up to three IMUs
         try:
-            rec = load_recording(log, topic=f"IMU.{inst}", signal="GyrX", temps="T")
+            df, _info = dataflash_table(dlog, log, "IMU", inst)
         except MissingColumnError:
             if inst == 0:
                 raise
             break
+        tcol = next((c for c in ("T", "Temp") if c in df.columns), None)
+        if tcol is None:  # LogStructure.h: ``T`` (``Temp`` in Copter 3.4–3.6)
+            raise ThermocalInputError(
+                f"{log}: IMU.{inst} has no temperature field (T or Temp); it has: "
+                + ", ".join(map(str, df.columns))
+            )
+        time_s = df["TimeUS"].to_numpy() * 1e-6
+        temp_c = df[tcol].to_numpy()
         per_kind = []
         for kind, prefix, unit in (("gyro", "Gyr", "rad/s"), ("accel", "Acc", "m/s^2")):
+            xyz = np.column_stack([df[f"{prefix}{a.upper()}"].to_numpy() for a in "xyz"])
             sub_rec = Recording.from_arrays(
-                rec.time_s, {a: rec.column(f"{prefix}{a.upper()}") for a in "xyz"},
-                {"temperature": rec.column("T")}, signal_unit=unit,
+                time_s, {a: xyz[:, j] for j, a in enumerate("xyz")},
+                {"temperature": temp_c}, signal_unit=unit,
             )  # fmt: skip
             sub_rec.source = str(log)
+            sub_rec.validate()
             fit = fit_sensor(
                 sub_rec, f"IMU.{prefix}", kind, inst,
                 overrides=overrides_of(allow_narrow, allow_motion), firmware="ardupilot",
