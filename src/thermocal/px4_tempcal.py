@@ -30,7 +30,7 @@ from typing import Any
 import numpy as np
 
 from thermocal import adequacy, units
-from thermocal.errors import ThermocalInputError
+from thermocal.errors import ThermocalInputError, ThermocalWarning
 from thermocal.models.base import RunData, model_inputs
 from thermocal.models.calibration import Calibration, Channel
 from thermocal.models.poly import PolyModel
@@ -210,3 +210,102 @@ __all__ = [
     "summary",
     "temperature_bins",
 ]
+
+
+# --- gates (issue 28, item 5): doubtful, named in a warning --------------------------------
+
+STALL_S = 600.0
+"""A sweep that does not rise by :data:`STALL_RISE_C` for this long has stopped rising
+(ArduPilot's learning ends then: AP_InertialSensor_tempcal.cpp ``CAL_TIMEOUT_MS`` = 600 s)."""
+STALL_RISE_C = 0.5
+"""The rise ArduPilot's learning waits for before it takes the next sample [°C]."""
+END_MARGIN_C = 2.0
+"""A reference temperature closer than this to an end of the calibrated range [°C]."""
+
+
+class GateWarning(ThermocalWarning):
+    """A calibration log that is usable but doubtful: said, named, not refused."""
+
+
+def sweep_stall(time_s: FloatArray, temp_c: FloatArray) -> tuple[float, float, float]:
+    """(longest time without a :data:`STALL_RISE_C` rise of the running maximum [s], the
+    temperature it stalled at [°C], the time it began [s from the log's start]).  A rise:
+    the running maximum enters the next 0.5 °C step above the first temperature; the
+    stretch after the last rise counts too (a sweep that ends on a plateau)."""
+    t = np.asarray(time_s, dtype=np.float64)
+    temp = np.asarray(temp_c, dtype=np.float64)
+    if t.size < 2:
+        return 0.0, float(temp[0]) if temp.size else math.nan, 0.0
+    level = np.floor((np.maximum.accumulate(temp) - temp[0]) / STALL_RISE_C)
+    rises = [0, *(int(i) + 1 for i in np.flatnonzero(np.diff(level) > 0))]
+    marks = np.array([*(t[r] for r in rises), t[-1]])
+    gaps = np.diff(marks)
+    k = int(np.argmax(gaps))
+    return float(gaps[k]), float(temp[rises[k]]), float(marks[k] - t[0])
+
+
+def stall_warning(where: str, time_s: FloatArray, temp_c: FloatArray) -> str | None:
+    """The sentence of a sweep that stops rising for more than :data:`STALL_S`, or None."""
+    gap, at_c, start = sweep_stall(time_s, temp_c)
+    if gap <= STALL_S:
+        return None
+    return (
+        f"{where}: the temperature sweep stops rising: {gap:.0f} s from {start:.0f} s on "
+        f"without a {STALL_RISE_C:g} °C rise (at {at_c:.1f} °C); ArduPilot's own learning "
+        f"ends after {STALL_S:.0f} s without one — check the heating"
+    )
+
+
+def step_warnings(
+    fits: list[SensorFit], series: dict[str, tuple[FloatArray, FloatArray]]
+) -> list[str]:
+    """A step-like bias on one instance of a multi-IMU board:
+    :func:`thermocal.adequacy.stillness` of every instance of a kind (``series``: name →
+    (time [s], values in the canonical unit)); a step on one instance not seen on another
+    within the stillness window is a bias jump of that sensor, not the board moving (which
+    every instance would see)."""
+    out: list[str] = []
+    by_kind: dict[str, list[SensorFit]] = {}
+    for f in fits:
+        by_kind.setdefault(f.kind, []).append(f)
+    for kind, group in by_kind.items():
+        if len(group) < 2:
+            continue
+        floor = (
+            adequacy.MOTION_FLOOR_DEG_S * adequacy.DEG_H_PER_DEG_S
+            if kind == "gyro"
+            else adequacy.MOTION_FLOOR_MG
+        )
+        steps = {}
+        for f in group:
+            key = f"{f.topic}.{f.instance}"
+            if key in series:
+                t, v = series[key]
+                steps[key] = adequacy.stillness(t, v, floor).steps
+        for key, mine in steps.items():
+            others = [s for k, ss in steps.items() if k != key for s in ss]
+            alone = [
+                s for s in mine
+                if not any(abs(s[0] - o[0]) <= adequacy.STILL_WINDOW_S for o in others)
+            ]  # fmt: skip
+            if alone:
+                t0 = float(series[key][0][0])
+                shown = ", ".join(f"{s[0] - t0:.0f} s" for s in alone[:5])
+                out.append(
+                    f"{key}: a step-like bias at {shown} that the other {kind} instance(s) do "
+                    "not show — a bias jump of this sensor (not the board moving); its "
+                    "calibration is doubtful"
+                )
+    return out
+
+
+def end_warning(where: str, what: str, ref_c: float, lo: float, hi: float) -> str | None:
+    """``what`` (a reference temperature) within :data:`END_MARGIN_C` of, or outside, the
+    calibrated range [lo, hi] °C: the firmware clamps there, the cubic is least known."""
+    if lo + END_MARGIN_C <= ref_c <= hi - END_MARGIN_C:
+        return None
+    return (
+        f"{where}: {what} {ref_c:.1f} °C is too close to the calibration's end "
+        f"({lo:.1f}…{hi:.1f} °C; within {END_MARGIN_C:g} °C or outside): the cubic is least "
+        "determined there and the firmware clamps beyond it"
+    )

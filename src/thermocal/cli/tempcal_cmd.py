@@ -10,7 +10,7 @@ import functools
 import warnings
 from collections.abc import Callable
 from pathlib import Path
-from typing import TYPE_CHECKING, Annotated, ParamSpec, TypeVar
+from typing import TYPE_CHECKING, Annotated, Any, ParamSpec, TypeVar
 
 import typer
 
@@ -73,11 +73,22 @@ def px4_tempcal_cmd(
     """Fit every gyro and accelerometer instance of a PX4 log as PX4 would (a cubic per axis
     about TREF), robust to spikes, with equal weight across the temperature range and
     judged on held-out data; write the TC_* parameters, the calibration and reports."""
+    import numpy as np
+
     from thermocal.export_params import ParamSet, export_params
     from thermocal.io import atomic_write, commit_directory, staging_directory
     from thermocal.models.calibration import Calibration
     from thermocal.models.files import save_calibration
-    from thermocal.px4_tempcal import calibration_of, fit_sensor, log_topics, summary
+    from thermocal.px4_tempcal import (
+        GateWarning,
+        calibration_of,
+        end_warning,
+        fit_sensor,
+        log_topics,
+        stall_warning,
+        step_warnings,
+        summary,
+    )
     from thermocal.report.calibration import CalibrationReportInputs, write_calibration_report
 
     if output.exists() and not output.is_dir():
@@ -89,12 +100,20 @@ def px4_tempcal_cmd(
         )
     stage = staging_directory(output)  # the set is moved into place whole, or removed
     fits, reports = [], []
+    gates: list[str | None] = []
+    series: dict[str, tuple[Any, Any]] = {}
     params = ParamSet("px4")
     for name, inst in topics:
         kind = "gyro" if name == "sensor_gyro" else "accel"
         rec = load_recording(log, topic=f"{name}.{inst}", signal="x,y,z", temps="temperature")
         fit = fit_sensor(rec, name, kind, inst, overrides=overrides_of(allow_narrow, allow_motion))
         fits.append(fit)
+        where = f"{name}.{inst}"
+        temp_c = rec.temperature_c("temperature")
+        series[where] = (rec.time_s, np.column_stack([rec.signal(a)[0] for a in "xyz"]))
+        gates.append(stall_warning(where, rec.time_s, temp_c))
+        if tref is not None:
+            gates.append(end_warning(where, "TREF", tref, *fit.sweep_c))
         sub = Calibration(fit.channels)
         with warnings.catch_warnings():  # accelerometers: relative offsets, as PX4's script
             warnings.simplefilter("ignore")
@@ -122,6 +141,10 @@ def px4_tempcal_cmd(
             ),
         )  # fmt: skip
         reports.append(rp)
+    gates.extend(step_warnings(fits, series))
+    for msg in gates:
+        if msg:
+            warnings.warn(GateWarning(msg), stacklevel=1)
     cal_path = output / "calibration.json"
     save_calibration(calibration_of(fits), stage / cal_path.name)
     params_path = output / "px4.params"
@@ -187,7 +210,14 @@ def ardupilot_tempcal_cmd(
     )
     from thermocal.models.calibration import Calibration
     from thermocal.models.files import save_calibration
-    from thermocal.px4_tempcal import calibration_of, fit_sensor, summary
+    from thermocal.px4_tempcal import (
+        GateWarning,
+        calibration_of,
+        fit_sensor,
+        stall_warning,
+        step_warnings,
+        summary,
+    )
     from thermocal.recording import Recording
     from thermocal.report.calibration import CalibrationReportInputs, write_calibration_report
 
@@ -195,6 +225,8 @@ def ardupilot_tempcal_cmd(
         raise ThermocalInputError(f"{output}: exists and is not a directory")
     stage = staging_directory(output)  # the set is moved into place whole, or removed
     fits, reports = [], []
+    gates: list[str | None] = []
+    series: dict[str, tuple[Any, Any]] = {}
     params = ParamSet("ardupilot")
     dlog = read_dataflash_log(log, ["IMU", "IMU2", "IMU3"])  # the log is read once
     for inst in range(3):  # ArduPilot logs up to three IMUs
@@ -212,6 +244,16 @@ def ardupilot_tempcal_cmd(
             )
         time_s = df["TimeUS"].to_numpy() * 1e-6
         temp_c = df[tcol].to_numpy()
+        if not np.isfinite(temp_c).any() or np.all(temp_c[np.isfinite(temp_c)] == 0):
+            warnings.warn(
+                GateWarning(
+                    f"{log}: IMU.{inst} left out: its temperature is all 0 or NaN (a sensor "
+                    "without a thermometer cannot be calibrated over temperature)"
+                ),
+                stacklevel=1,
+            )
+            continue
+        gates.append(stall_warning(f"IMU.{inst}", time_s, temp_c))
         per_kind = []
         for kind, prefix, unit in (("gyro", "Gyr", "rad/s"), ("accel", "Acc", "m/s^2")):
             xyz = np.column_stack([df[f"{prefix}{a.upper()}"].to_numpy() for a in "xyz"])
@@ -227,6 +269,9 @@ def ardupilot_tempcal_cmd(
             )  # fmt: skip
             fits.append(fit)
             per_kind.append((fit, sub_rec))
+            series[f"{fit.topic}.{inst}"] = (time_s, np.column_stack(
+                [sub_rec.signal(a)[0] for a in "xyz"]
+            ))  # fmt: skip
         sub = Calibration([ch for f, _r in per_kind for ch in f.channels])
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
@@ -244,6 +289,12 @@ def ardupilot_tempcal_cmd(
                 ),
             )  # fmt: skip
             reports.append(rp)
+    if not fits:
+        raise ThermocalInputError(f"{log}: no IMU with a usable temperature in the log")
+    gates.extend(step_warnings(fits, series))
+    for msg in gates:
+        if msg:
+            warnings.warn(GateWarning(msg), stacklevel=1)
     cal_path = output / "calibration.json"
     save_calibration(calibration_of(fits), stage / cal_path.name)
     parm = output / "ardupilot.parm"
