@@ -178,12 +178,13 @@ def fit_sensor(
 
 
 def log_topics(path: Path) -> list[tuple[str, int]]:
-    """The ``sensor_gyro``/``sensor_accel`` instances of a ULog that carry a temperature
+    """The ``sensor_gyro``/``sensor_accel``/``sensor_baro``/``sensor_mag`` instances of a ULog
+    that carry a temperature
     (:func:`thermocal.io.ulog_sensor_instances`: an unreadable log is refused, damage and
     every instance left out are said in warnings)."""
     from thermocal.io import ulog_sensor_instances
 
-    return ulog_sensor_instances(path, TOPICS)
+    return ulog_sensor_instances(path, (*TOPICS, *OFFSET_TOPICS))
 
 
 def calibration_of(fits: list[SensorFit]) -> Calibration:
@@ -309,3 +310,100 @@ def end_warning(where: str, what: str, ref_c: float, lo: float, hi: float) -> st
         f"({lo:.1f}…{hi:.1f} °C; within {END_MARGIN_C:g} °C or outside): the cubic is least "
         "determined there and the firmware clamps beyond it"
     )
+
+
+# --- barometers and magnetometers (issue 28, item 3) -------------------------------------
+
+OFFSET_TOPICS = {"sensor_baro": ("baro", ("pressure",), "Pa"), "sensor_mag": ("mag", AXES, "gauss")}
+"""PX4 topics calibrated as offsets in the firmware's unit (uORB ``SensorBaro.msg`` pressure
+[Pa], ``SensorMag.msg`` x, y, z [gauss]) with the polynomial order of their parameters
+(:data:`thermocal.export_params.PX4_OFFSET_SENSORS`: 5 for TC_B, 3 for TC_M)."""
+
+
+@dataclass(frozen=True)
+class OffsetFit:
+    """A barometer or magnetometer instance: the polynomial about ``tref_c`` per axis
+    (``coefficients[axis][k]`` of ``(T − TREF)^k`` [unit], relative to the median of the
+    log — the weather's pressure and the Earth's field are in the data, as PX4's own script
+    fits them), judged like the IMU on held-out temperature bins (``holdout_rms`` [unit])."""
+
+    topic: str
+    kind: str
+    instance: int
+    device_id: int
+    unit: str
+    sweep_c: tuple[float, float]
+    tref_c: float
+    n_samples: int
+    n_bins: int
+    order: int
+    coefficients: tuple[tuple[float, ...], ...]
+    holdout_rms: dict[str, float]
+    adequacy: dict[str, Any]
+
+
+def fit_offset_sensor(
+    time_s: FloatArray,
+    temp_c: FloatArray,
+    values: FloatArray,
+    topic: str,
+    instance: int,
+    device_id: int,
+    *,
+    tref_c: float | None = None,
+    overrides: tuple[str, ...] = (),
+) -> OffsetFit:
+    """Judge (:func:`thermocal.adequacy.judge`: sweep, bins, ends), bin (medians of
+    :data:`BIN_WIDTH_C` bins, equal weight across the range, robust to spikes), judge on
+    held-out bins (a polynomial fitted to the even bins, its rms on the odd ones) and fit a
+    polynomial of PX4's order in ``T − TREF`` (TREF mid-range unless given) to every bin.
+    ``values`` (n, axes) in the topic's unit (:data:`OFFSET_TOPICS`)."""
+    from thermocal.export_params import PX4_OFFSET_SENSORS
+
+    kind, fields, unit = OFFSET_TOPICS[topic]
+    order = PX4_OFFSET_SENSORS[kind][1]
+    where = f"{topic}.{instance}"
+    vals = np.asarray(values, dtype=np.float64).reshape(len(temp_c), -1)
+    temp = np.asarray(temp_c, dtype=np.float64)
+    lo, hi = float(np.min(temp)), float(np.max(temp))
+    tname = f"{where} temperature"
+    record = (
+        adequacy.judge(
+            adequacy.Needs({tname: order}, order + 1), [np.asarray(time_s, dtype=np.float64)],
+            [temp.reshape(-1, 1)], [tname], kind=kind, name=where, overrides=overrides,
+        )
+        .enforce()
+        .to_dict()
+    )  # fmt: skip
+    rel = vals - np.median(vals, axis=0)
+    _c, t_med, v_med = temperature_bins(temp, rel)
+    need = max(MIN_BINS, 2 * (order + 1))
+    if t_med.size < need:
+        raise ThermocalInputError(
+            f"{where}: the temperature covers {t_med.size} bins of {BIN_WIDTH_C:g} °C; a "
+            f"polynomial of order {order} needs at least {need}: record a wider sweep"
+        )
+    tref = 0.5 * (lo + hi) if tref_c is None else float(tref_c)
+    x = t_med - tref
+    even, odd = np.arange(0, x.size, 2), np.arange(1, x.size, 2)
+    coefs, rms = [], {}
+    names = fields if len(fields) > 1 else ("pressure",)
+    for j, name in enumerate(names):
+        held = np.polynomial.polynomial.polyfit(x[even], v_med[even, j], order)
+        pred = np.polynomial.polynomial.polyval(x[odd], held)
+        rms[name] = float(np.sqrt(np.mean((v_med[odd, j] - pred) ** 2)))
+        coefs.append(
+            tuple(float(c) for c in np.polynomial.polynomial.polyfit(x, v_med[:, j], order))
+        )
+    return OffsetFit(
+        topic, kind, instance, device_id, unit, (lo, hi), tref, int(temp.size), int(t_med.size),
+        order, tuple(coefs), rms, record,
+    )  # fmt: skip
+
+
+def offset_summary(fits: list[OffsetFit]) -> dict[str, Any]:
+    """The JSON summary of the barometers and magnetometers (as :func:`summary`)."""
+    return {
+        f"{f.topic}.{f.instance}": {**dataclasses.asdict(f), "holdout_rms_unit": f.unit}
+        for f in fits
+    }

@@ -75,16 +75,19 @@ def px4_tempcal_cmd(
     judged on held-out data; write the TC_* parameters, the calibration and reports."""
     import numpy as np
 
-    from thermocal.export_params import ParamSet, export_params
-    from thermocal.io import atomic_write, commit_directory, staging_directory
+    from thermocal.export_params import ParamSet, export_params, px4_offset_params
+    from thermocal.io import atomic_write, commit_directory, read_log_table, staging_directory
     from thermocal.models.calibration import Calibration
     from thermocal.models.files import save_calibration
     from thermocal.px4_tempcal import (
+        OFFSET_TOPICS,
         GateWarning,
         calibration_of,
         end_warning,
+        fit_offset_sensor,
         fit_sensor,
         log_topics,
+        offset_summary,
         stall_warning,
         step_warnings,
         summary,
@@ -102,8 +105,26 @@ def px4_tempcal_cmd(
     fits, reports = [], []
     gates: list[str | None] = []
     series: dict[str, tuple[Any, Any]] = {}
+    offset_fits = []
     params = ParamSet("px4")
     for name, inst in topics:
+        if name in OFFSET_TOPICS:  # barometers and magnetometers: TC_B / TC_M
+            df, _info = read_log_table(log, f"{name}.{inst}")
+            fields = OFFSET_TOPICS[name][1]
+            ids = df["device_id"].to_numpy() if "device_id" in df.columns else np.zeros(1)
+            ofit = fit_offset_sensor(
+                df["timestamp"].to_numpy() * 1e-6, df["temperature"].to_numpy(),
+                np.column_stack([df[f].to_numpy() for f in fields]), name, inst,
+                int(np.median(ids)), tref_c=tref,
+                overrides=overrides_of(allow_narrow, allow_motion),
+            )  # fmt: skip
+            offset_fits.append(ofit)
+            params.merge(
+                px4_offset_params(ofit.kind, inst, ofit.device_id, *ofit.sweep_c, ofit.tref_c,
+                                  ofit.coefficients),
+                f"{name}.{inst}",
+            )  # fmt: skip
+            continue
         kind = "gyro" if name == "sensor_gyro" else "accel"
         rec = load_recording(log, topic=f"{name}.{inst}", signal="x,y,z", temps="temperature")
         fit = fit_sensor(rec, name, kind, inst, overrides=overrides_of(allow_narrow, allow_motion))
@@ -145,6 +166,10 @@ def px4_tempcal_cmd(
     for msg in gates:
         if msg:
             warnings.warn(GateWarning(msg), stacklevel=1)
+    if not fits:
+        raise ThermocalInputError(
+            f"{log}: no sensor_gyro or sensor_accel topic with a temperature in the log"
+        )
     cal_path = output / "calibration.json"
     save_calibration(calibration_of(fits), stage / cal_path.name)
     params_path = output / "px4.params"
@@ -161,7 +186,7 @@ def px4_tempcal_cmd(
         "params": str(params_path),
         "calibration": str(cal_path),
         "reports": [str(p) for p in reports],
-        "sensors": summary(fits),
+        "sensors": {**summary(fits), **offset_summary(offset_fits)},
         "notes": params.notes,
     }
 
@@ -174,6 +199,12 @@ def px4_tempcal_cmd(
                 f"{f.topic}.{f.instance}", str(f.device_id),
                 f"{f.sweep_c[0]:.1f}…{f.sweep_c[1]:.1f}", str(f.n_bins),
                 " / ".join(fmt(v, 3) for v in f.holdout_rms.values()) + f" {f.unit}",
+            )  # fmt: skip
+        for o in offset_fits:
+            table.add_row(
+                f"{o.topic}.{o.instance}", str(o.device_id),
+                f"{o.sweep_c[0]:.1f}…{o.sweep_c[1]:.1f}", str(o.n_bins),
+                " / ".join(fmt(v, 3) for v in o.holdout_rms.values()) + f" {o.unit}",
             )  # fmt: skip
         stdout.print(table)
         for n in params.notes:
