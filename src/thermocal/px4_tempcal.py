@@ -407,3 +407,118 @@ def offset_summary(fits: list[OffsetFit]) -> dict[str, Any]:
         f"{f.topic}.{f.instance}": {**dataclasses.asdict(f), "holdout_rms_unit": f.unit}
         for f in fits
     }
+
+
+# --- ArduPilot log hygiene (issue 28, item 4) ---------------------------------------------
+
+AP_ROTATIONS: dict[int, str] = {
+    0: "NONE", 1: "YAW_45", 2: "YAW_90", 3: "YAW_135", 4: "YAW_180", 5: "YAW_225",
+    6: "YAW_270", 7: "YAW_315", 8: "ROLL_180", 9: "ROLL_180_YAW_45", 10: "ROLL_180_YAW_90",
+    11: "ROLL_180_YAW_135", 12: "PITCH_180", 13: "ROLL_180_YAW_225", 14: "ROLL_180_YAW_270",
+    15: "ROLL_180_YAW_315", 16: "ROLL_90", 17: "ROLL_90_YAW_45", 18: "ROLL_90_YAW_90",
+    19: "ROLL_90_YAW_135", 20: "ROLL_270", 21: "ROLL_270_YAW_45", 22: "ROLL_270_YAW_90",
+    23: "ROLL_270_YAW_135", 24: "PITCH_90", 25: "PITCH_270", 26: "PITCH_180_YAW_90",
+    27: "PITCH_180_YAW_270", 28: "ROLL_90_PITCH_90", 29: "ROLL_180_PITCH_90",
+    30: "ROLL_270_PITCH_90", 31: "ROLL_90_PITCH_180", 32: "ROLL_270_PITCH_180",
+    33: "ROLL_90_PITCH_270", 34: "ROLL_180_PITCH_270", 35: "ROLL_270_PITCH_270",
+    36: "ROLL_90_PITCH_180_YAW_90", 37: "ROLL_90_YAW_270", 39: "PITCH_315",
+    40: "ROLL_90_PITCH_315", 41: "PITCH_7", 42: "ROLL_45", 43: "ROLL_315",
+}  # fmt: skip
+"""ArduPilot's ``enum Rotation`` (``libraries/AP_Math/rotations.h``), the board orientations
+``AHRS_ORIENTATION`` takes, by value; 38 (``ROLL_90_PITCH_68_YAW_293``) and 100 (custom) are
+not implemented and refused by name."""
+AP_REFUSED_ROTATIONS = {38: "ROLL_90_PITCH_68_YAW_293", 100: "CUSTOM"}
+
+
+def ardupilot_rotation(code: int) -> FloatArray:
+    """The matrix ``R`` of ArduPilot rotation ``code``: ``Vector3::rotate`` gives ``R·v``
+    with ``R = Rz(yaw)·Ry(pitch)·Rx(roll)`` for ``ROTATION_ROLL_r_PITCH_p_YAW_y`` (checked
+    against rotations.cpp: YAW_90 is (x, y) → (−y, x), ROLL_90 is (y, z) → (−z, y), PITCH_90
+    is (x, z) → (z, −x))."""
+    if code not in AP_ROTATIONS:
+        name = AP_REFUSED_ROTATIONS.get(code, "unknown")
+        raise ThermocalInputError(
+            f"AHRS_ORIENTATION {code} ({name}) is not implemented: the data cannot be rotated "
+            "back to the sensor frame; calibrate from a log recorded with AHRS_ORIENTATION 0"
+        )
+    angles = {"ROLL": 0.0, "PITCH": 0.0, "YAW": 0.0}
+    parts = AP_ROTATIONS[code].split("_")
+    for axis, deg in zip(parts[::2], parts[1::2], strict=True):
+        angles[axis] = math.radians(float(deg))
+    cr, sr = math.cos(angles["ROLL"]), math.sin(angles["ROLL"])
+    cp, sp = math.cos(angles["PITCH"]), math.sin(angles["PITCH"])
+    cy, sy = math.cos(angles["YAW"]), math.sin(angles["YAW"])
+    rx = np.array([[1, 0, 0], [0, cr, -sr], [0, sr, cr]])
+    ry = np.array([[cp, 0, sp], [0, 1, 0], [-sp, 0, cp]])
+    rz = np.array([[cy, -sy, 0], [sy, cy, 0], [0, 0, 1]])
+    r: FloatArray = np.round(rz @ ry @ rx, 12).astype(np.float64)
+    return r
+
+
+AP_TREF_C = 35.0
+"""ArduPilot's ``TEMP_REFERENCE`` (AP_InertialSensor_tempcal.cpp)."""
+
+
+@dataclass(frozen=True)
+class ActiveTcal:
+    """An IMU's ``INS_TCAL<n>_*`` found in the log's parameters: ``coefficients[kind]`` the
+    3×3 ``c_k`` (row k = 1…3, columns x, y, z, as stored: ×1e-6 in use), the range and the
+    calibration temperatures ``INS_ACC<n>_CALTEMP``/``INS_GYR<n>_CALTEMP`` [°C]."""
+
+    instance: int
+    tmin_c: float
+    tmax_c: float
+    coefficients: dict[str, list[list[float]]]
+    caltemp_c: dict[str, float]
+
+    def correction(self, kind: str, temp_c: FloatArray) -> FloatArray:
+        """What the firmware subtracted (AP_InertialSensor_tempcal.cpp ``correct_sensor``):
+        ``poly(clamp(T) − 35) − poly(clamp(T_cal) − 35)``, ``poly(t) = (c1 + (c2 + c3·t)·t)·t
+        ·1e-6``, (n, 3) [rad/s or m/s²]."""
+        c = np.asarray(self.coefficients[kind], dtype=np.float64)
+
+        def poly(t: FloatArray) -> FloatArray:
+            t = t[:, None]
+            out: FloatArray = (c[0] + (c[1] + c[2] * t) * t) * t * 1e-6
+            return out
+
+        t = np.clip(np.asarray(temp_c, dtype=np.float64), self.tmin_c, self.tmax_c)
+        tcal = float(np.clip(self.caltemp_c[kind], self.tmin_c, self.tmax_c))
+        return poly(t - AP_TREF_C) - poly(np.array([tcal - AP_TREF_C]))
+
+
+def ardupilot_active(params: dict[str, float], instance: int) -> ActiveTcal | None:
+    """The active temperature calibration of IMU ``instance`` in a log's ``PARM`` values
+    (``INS_TCAL<n>_ENABLE`` = 1, n = instance + 1), or None."""
+    n = instance + 1
+    if int(params.get(f"INS_TCAL{n}_ENABLE", 0)) != 1:
+        return None
+    coef = {
+        kind: [[params.get(f"INS_TCAL{n}_{tag}{k}_{a}", 0.0) for a in "XYZ"] for k in (1, 2, 3)]
+        for kind, tag in (("accel", "ACC"), ("gyro", "GYR"))
+    }
+    tmin = params.get(f"INS_TCAL{n}_TMIN", 0.0)
+    tmax = params.get(f"INS_TCAL{n}_TMAX", 70.0)
+    cal = {
+        kind: params.get(f"INS_{tag}{n}_CALTEMP", math.nan)
+        for kind, tag in (("accel", "ACC"), ("gyro", "GYR"))
+    }
+    cal = {k: (v if math.isfinite(v) and v > -100.0 else AP_TREF_C) for k, v in cal.items()}
+    return ActiveTcal(instance, tmin, tmax, coef, cal)
+
+
+def ardupilot_raw(
+    params: dict[str, float], instance: int, kind: str, temp_c: FloatArray, xyz: FloatArray
+) -> tuple[FloatArray, ActiveTcal | None, int]:
+    """Logged IMU data back to the raw sensor frame as ArduPilot's firmware produced them:
+    the logged vector is ``R·(v − correction)`` (the temperature correction in the sensor
+    frame, then the board's rotation ``AHRS_ORIENTATION``), so ``v = Rᵀ·logged +
+    correction``.  Returns (v, the active calibration or None, the orientation code)."""
+    code = int(params.get("AHRS_ORIENTATION", 0))
+    out = np.asarray(xyz, dtype=np.float64)
+    if code:
+        out = out @ ardupilot_rotation(code)  # row vectors: (Rᵀ·v)ᵀ = vᵀ·R
+    active = ardupilot_active(params, instance)
+    if active is not None:
+        out = out + active.correction(kind, temp_c)
+    return out, active, code

@@ -242,8 +242,11 @@ def ardupilot_tempcal_cmd(
     from thermocal.models.calibration import Calibration
     from thermocal.models.files import save_calibration
     from thermocal.px4_tempcal import (
+        AP_ROTATIONS,
         GateWarning,
+        ardupilot_raw,
         calibration_of,
+        end_warning,
         fit_sensor,
         stall_warning,
         step_warnings,
@@ -258,6 +261,8 @@ def ardupilot_tempcal_cmd(
     fits, reports = [], []
     gates: list[str | None] = []
     series: dict[str, tuple[Any, Any]] = {}
+    hygiene: dict[str, dict[str, Any]] = {}
+    orientation = 0
     params = ParamSet("ardupilot")
     dlog = read_dataflash_log(log, ["IMU", "IMU2", "IMU3"])  # the log is read once
     for inst in range(3):  # ArduPilot logs up to three IMUs
@@ -288,6 +293,10 @@ def ardupilot_tempcal_cmd(
         per_kind = []
         for kind, prefix, unit in (("gyro", "Gyr", "rad/s"), ("accel", "Acc", "m/s^2")):
             xyz = np.column_stack([df[f"{prefix}{a.upper()}"].to_numpy() for a in "xyz"])
+            xyz, active, orientation = ardupilot_raw(dlog.params, inst, kind, temp_c, xyz)
+            hyg = hygiene.setdefault(f"IMU.{inst}", {"active_tcal_removed": active is not None})
+            if active is not None:
+                hyg.update(tmin_c=active.tmin_c, tmax_c=active.tmax_c, caltemp_c=active.caltemp_c)
             sub_rec = Recording.from_arrays(
                 time_s, {a: xyz[:, j] for j, a in enumerate("xyz")},
                 {"temperature": temp_c}, signal_unit=unit,
@@ -308,6 +317,20 @@ def ardupilot_tempcal_cmd(
             warnings.simplefilter("ignore")
             ps = export_params(sub, "ardupilot", instance=inst)
         params.merge(ps, f"IMU.{inst}")
+        hyg = hygiene[f"IMU.{inst}"]
+        old_coef = {n: dlog.params[n] for n in ps.params if n in dlog.params}
+        hyg["coefficients"] = {
+            n: {"old": old_coef.get(n), "new": float(v)}
+            for n, v in ps.params.items() if "_ACC" in n or "_GYR" in n
+        }  # fmt: skip
+        for kind in ("accel", "gyro"):
+            ref = hyg.get("caltemp_c", {}).get(kind)
+            if ref is not None:
+                lo_c, hi_c = (
+                    ps.params[f"INS_TCAL{inst + 1}_TMIN"],
+                    ps.params[f"INS_TCAL{inst + 1}_TMAX"],
+                )
+                gates.append(end_warning(f"IMU.{inst}", f"{kind} CALTEMP", ref, lo_c, hi_c))
         for fit, sub_rec in per_kind:
             rp = output / f"report_IMU_{inst}_{fit.kind}.html"
             write_calibration_report(
@@ -339,9 +362,34 @@ def ardupilot_tempcal_cmd(
         "reports": [str(p) for p in reports],
         "sensors": summary(fits),
         "notes": params.notes,
+        "log_hygiene": {
+            "AHRS_ORIENTATION": orientation,
+            "rotated_back_to_sensor_frame": orientation != 0,
+            "imus": hygiene,
+        },
     }
+    found = [k for k, h in hygiene.items() if h["active_tcal_removed"]]
+    if found:
+        params.notes.append(
+            "active INS_TCAL coefficients found in the log and removed from the data before "
+            "fitting (the firmware had subtracted them): " + ", ".join(found)
+        )
+    if orientation:
+        params.notes.append(
+            f"AHRS_ORIENTATION {orientation} ({AP_ROTATIONS[orientation]}): the data were "
+            "rotated back to the sensor frame before fitting"
+        )
 
     def human() -> None:
+        if found:
+            old_new = _rich_table.Table(title="INS_TCAL coefficients: in the log → new")
+            for col in ("parameter", "old", "new"):
+                old_new.add_column(col)
+            for h in hygiene.values():
+                for n, v in h.get("coefficients", {}).items():
+                    if v["old"] is not None:
+                        old_new.add_row(n, fmt(v["old"], 6), fmt(v["new"], 6))
+            stdout.print(old_new)
         table = _rich_table.Table(title=f"ArduPilot thermal calibration of {log}")
         for col in ("IMU", "sensor", "sweep [°C]", "bins", "hold-out rms x/y/z"):
             table.add_column(col)
