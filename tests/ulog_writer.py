@@ -15,6 +15,13 @@ SENSOR_FIELDS = [
 ]  # fmt: skip
 
 
+def _code(type_name: str) -> str:
+    """``float`` → ``f``; an array ``float[3]`` → ``3f`` (its elements given one by one in a
+    row, as the format stores them)."""
+    base, _, count = type_name.partition("[")
+    return (count.rstrip("]") if count else "") + TYPE_CODES[base]
+
+
 def ulog_bytes(
     topics: Sequence[tuple[str, int, Sequence[tuple[str, str]], Sequence[Sequence[float]]]],
 ) -> bytes:
@@ -34,7 +41,7 @@ def ulog_bytes(
     for msg_id, (name, inst, _fields, _rows) in enumerate(topics):
         msg("A", struct.pack("<BH", inst, msg_id) + name.encode())
     for msg_id, (_name, _inst, fields, rows) in enumerate(topics):
-        code = "<" + "".join(TYPE_CODES[t] for t, _n in fields)
+        code = "<" + "".join(_code(t) for t, _n in fields)
         for row in rows:
             msg("D", struct.pack("<H", msg_id) + struct.pack(code, *row))
     return bytes(out)

@@ -455,3 +455,56 @@ __all__ = [
     "export_params",
     "map_axes",
 ]
+
+
+PX4_OFFSET_SENSORS = {"baro": ("B", 5, 1), "mag": ("M", 3, 3)}
+"""PX4's other thermally compensated sensors: parameter letter, polynomial order, axes.
+PX4-Autopilot parameter reference (``src/modules/temperature_compensation``):
+``TC_B<n>_ID``, ``_TMIN``, ``_TMAX``, ``_TREF``, ``_X0``…``_X5`` ("Barometer offset
+temperature ^k polynomial coefficient", in Pa as ``sensor_baro.pressure``) for n = 0…3 and
+``TC_B_ENABLE``; ``TC_M<n>_ID``, ``_TMIN``, ``_TMAX``, ``_TREF``, ``_X<k>_<axis>``, k = 0…3
+("Magnetometer offset temperature ^k polynomial coefficient", in gauss as ``sensor_mag``)
+for n = 0…3 and ``TC_M_ENABLE`` (PX4 v1.15 and later).  The firmware subtracts
+``Σ X_k·dT^k`` with ``dT = clamp(T, TMIN, TMAX) − TREF`` from the measurement."""
+PX4_OFFSET_INSTANCES = 4
+
+
+def px4_offset_params(
+    kind: str,
+    instance: int,
+    device_id: int,
+    tmin_c: float,
+    tmax_c: float,
+    tref_c: float,
+    coefficients: Sequence[Sequence[float]],
+) -> ParamSet:
+    """PX4 ``TC_B<n>_*`` (``kind`` "baro", ``coefficients`` [[X0…X5]]) or ``TC_M<n>_*``
+    ("mag", [[X0…X3] per axis x, y, z]): polynomial in ``T − TREF`` [firmware unit: Pa,
+    gauss], (:data:`PX4_OFFSET_SENSORS`); refused for an instance PX4 has no parameters
+    for, or a value that is not a finite float32."""
+    if kind not in PX4_OFFSET_SENSORS:
+        raise ThermocalInputError(f"no PX4 thermal parameters for a {kind!r} sensor")
+    letter, order, n_axes = PX4_OFFSET_SENSORS[kind]
+    if not 0 <= instance < PX4_OFFSET_INSTANCES:
+        raise ThermocalInputError(
+            f"PX4 has TC_{letter}0…TC_{letter}{PX4_OFFSET_INSTANCES - 1}; {kind} instance "
+            f"{instance} has none"
+        )
+    if len(coefficients) != n_axes or any(len(c) != order + 1 for c in coefficients):
+        raise ThermocalInputError(
+            f"TC_{letter}: {n_axes} axis/axes of {order + 1} coefficients expected"
+        )
+    out = ParamSet("px4")
+    p = f"TC_{letter}{instance}_"
+    out.params[f"TC_{letter}_ENABLE"] = 1
+    out.types[f"TC_{letter}_ENABLE"] = 6
+    out.params[p + "ID"] = device_id
+    out.types[p + "ID"] = 6
+    out.params[p + "TMIN"] = tmin_c
+    out.params[p + "TMAX"] = tmax_c
+    out.params[p + "TREF"] = tref_c
+    for i, axis_coef in enumerate(coefficients):
+        for k, c in enumerate(axis_coef):
+            out.params[f"{p}X{k}" if n_axes == 1 else f"{p}X{k}_{i}"] = float(c)
+    check_values(out)
+    return out

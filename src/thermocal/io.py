@@ -52,6 +52,7 @@ from thermocal.errors import (
     TextLayoutWarning,
     ThermocalInputError,
     ThermocalWarning,
+    UnitWarning,
 )
 from thermocal.recording import FloatArray, Metadata, Recording
 
@@ -848,14 +849,35 @@ def _read_text(
 
 # --- PX4 ULog ------------------------------------------------------------------------------
 
+_XYZ = ("x", "y", "z")
 PX4_UNITS: dict[str, dict[str, str]] = {
-    "sensor_gyro": {"x": "rad/s", "y": "rad/s", "z": "rad/s", "temperature": "degC"},
-    "sensor_accel": {"x": "m/s^2", "y": "m/s^2", "z": "m/s^2", "temperature": "degC"},
-    "sensor_baro": {"temperature": "degC"},
-    "vehicle_imu_status": {},
-}
-"""Units of PX4's sensor topics (uORB msg definitions: SensorGyro.msg [rad/s], SensorAccel.msg
-[m/s²], temperature [°C]); the time is ``timestamp`` [µs]."""
+    "sensor_gyro": {**dict.fromkeys(_XYZ, "rad/s"), "temperature": "degC"},
+    "sensor_accel": {**dict.fromkeys(_XYZ, "m/s^2"), "temperature": "degC"},
+    "sensor_baro": {"pressure": "Pa", "temperature": "degC"},
+    "sensor_mag": {**dict.fromkeys(_XYZ, "gauss"), "temperature": "degC"},
+    "sensor_combined": {
+        **{f"gyro_rad[{i}]": "rad/s" for i in range(3)},
+        **{f"accelerometer_m_s2[{i}]": "m/s^2" for i in range(3)},
+        "gyro_integral_dt": "us", "accelerometer_integral_dt": "us",
+    },
+    "vehicle_imu": {
+        **{f"delta_angle[{i}]": "rad" for i in range(3)},
+        **{f"delta_velocity[{i}]": "m/s" for i in range(3)},
+        "delta_angle_dt": "us", "delta_velocity_dt": "us",
+        **{f"gyro_rad_s[{i}]": "rad/s" for i in range(3)},
+        **{f"accel_m_s2[{i}]": "m/s^2" for i in range(3)},
+    },
+    "vehicle_imu_status": {"temperature_accel": "degC", "temperature_gyro": "degC"},
+}  # fmt: skip
+"""Units of PX4's sensor topics, from the uORB message definitions (PX4-Autopilot
+``msg/SensorGyro.msg`` [rad/s], ``SensorAccel.msg`` [m/s²], ``SensorBaro.msg`` pressure [Pa],
+``SensorMag.msg`` [gauss], ``SensorCombined.msg`` ``gyro_rad`` [rad/s] and
+``accelerometer_m_s2`` [m/s²], ``VehicleImu.msg`` ``delta_angle`` [rad] and ``delta_velocity``
+[m/s] over ``delta_angle_dt``/``delta_velocity_dt`` [µs]; temperatures [°C]).  pyulog names an
+array's elements ``name[i]``.  ``vehicle_imu`` is also given as rates:
+``gyro_rad_s[i] = delta_angle[i] / delta_angle_dt`` [rad/s] and
+``accel_m_s2[i] = delta_velocity[i] / delta_velocity_dt`` [m/s²] (columns added by the
+reader).  The time is ``timestamp`` [µs]."""
 
 DEFAULT_ULOG_TOPIC = "sensor_gyro.0"
 
@@ -1117,9 +1139,20 @@ def _read_ulog(path: Path, topic: str | None) -> tuple[pd.DataFrame, dict[str, A
                 f"({100.0 * missing / expected:.1f} %) judged by its sample interval"
             )
     _warn_damage(path, notes)
+    if name == "vehicle_imu":  # integrals over their intervals → rates (PX4_UNITS)
+        for i in range(3):
+            for d_col, dt_col, out in (
+                (f"delta_angle[{i}]", "delta_angle_dt", f"gyro_rad_s[{i}]"),
+                (f"delta_velocity[{i}]", "delta_velocity_dt", f"accel_m_s2[{i}]"),
+            ):
+                if d_col in cols and dt_col in cols:
+                    dt_s = cols[dt_col] * 1e-6
+                    with np.errstate(divide="ignore", invalid="ignore"):
+                        cols[out] = np.where(dt_s > 0, cols[d_col] / dt_s, np.nan)
     df = pd.DataFrame(cols)
     units_ = {k: u for k, u in PX4_UNITS.get(name, {}).items() if k in df.columns}
     info: dict[str, Any] = {"time": "timestamp", "time_unit": "us", "units": units_}
+    info["fc_log"] = True
     if "device_id" in df.columns:
         ids = df["device_id"].to_numpy()
         info["metadata"] = {"sensor_id": str(int(np.median(ids)))}
@@ -1134,14 +1167,36 @@ def _read_ulog(path: Path, topic: str | None) -> tuple[pd.DataFrame, dict[str, A
 
 # --- ArduPilot DataFlash --------------------------------------------------------------------
 
-ARDUPILOT_UNITS: dict[str, dict[str, str]] = {
-    "IMU": {
-        "GyrX": "rad/s", "GyrY": "rad/s", "GyrZ": "rad/s",
-        "AccX": "m/s^2", "AccY": "m/s^2", "AccZ": "m/s^2", "T": "degC",
-    },
+_IMU_UNITS = {
+    **dict.fromkeys(("GyrX", "GyrY", "GyrZ"), "rad/s"),
+    **dict.fromkeys(("AccX", "AccY", "AccZ"), "m/s^2"),
+    "T": "degC", "Temp": "degC", "GHz": "Hz", "AHz": "Hz",
 }  # fmt: skip
-"""Units of ArduPilot's IMU log message (LogStructure.h: gyro [rad/s], accel [m/s²],
-temperature [°C]); the time is ``TimeUS`` [µs]."""
+ARDUPILOT_UNITS: dict[str, dict[str, str]] = {
+    "IMU": _IMU_UNITS, "IMU2": _IMU_UNITS, "IMU3": _IMU_UNITS,
+    "GYR": dict.fromkeys(("GyrX", "GyrY", "GyrZ"), "rad/s"),
+    "ACC": dict.fromkeys(("AccX", "AccY", "AccZ"), "m/s^2"),
+    "BARO": {
+        "Alt": "m", "AltAMSL": "m", "Press": "Pa", "CPress": "Pa", "Temp": "degC",
+        "CRt": "m/s", "Offset": "m", "GndTemp": "degC",
+    },
+    "MAG": dict.fromkeys(
+        ("MagX", "MagY", "MagZ", "OfsX", "OfsY", "OfsZ", "MOX", "MOY", "MOZ"), "mGauss"
+    ),
+    "TCLR": {"Temp": "degC"},
+}  # fmt: skip
+"""Units of ArduPilot's log messages, fixed by the firmware's message definitions whether or
+not a log carries unit (FMTU/UNIT/MULT) messages — ArduPilot ``libraries/AP_InertialSensor/
+LogStructure.h``: ``IMU`` "TimeUS,I,GyrX,GyrY,GyrZ,AccX,AccY,AccZ,EG,EA,T,GH,AH,GHz,AHz" with
+units "s#EEEooo--O--zz" (E rad/s, o m/s², O degC, z Hz), multipliers 1; ``GYR``/``ACC`` the
+same; older firmware (Copter 3.4–3.6) logs ``IMU``, ``IMU2``, ``IMU3`` without ``I`` and names
+the temperature ``Temp`` (same units); ``libraries/AP_Logger/LogStructure.h``: ``BARO``
+"TimeUS,I,Alt,AltAMSL,Press,Temp,…" units "s#mmPO…" (P Pa, O degC; ``Temp`` stored ×100 as
+int16 'c', scaled by pymavlink), ``MAG`` "TimeUS,I,MagX,…" units "s#GGG…" with multiplier C
+(10⁻³): milligauss; ``AP_InertialSensor_tempcal.cpp`` ``TCLR``
+"TimeUS,I,SType,Temp,X,Y,Z,NSamp" (no units declared: Temp the learning's temperature [°C];
+X,Y,Z the mean accelerometer [m/s², relative to the first] for SType 0, gyro [rad/s] for
+SType 1 — set per read by :func:`_read_dataflash`).  The time is ``TimeUS`` [µs]."""
 
 DEFAULT_DATAFLASH_TOPIC = "IMU.0"
 
@@ -1151,14 +1206,24 @@ DATAFLASH_PADDING = 528
 logging fills its last page; pymavlink ignores up to this many, DFReader.py)."""
 
 
-def _read_dataflash(path: Path, topic: str | None) -> tuple[pd.DataFrame, dict[str, Any]]:
-    """One message type and instance (field ``I``) of an ArduPilot DataFlash log as a
-    table: the message's fields as columns, ``TimeUS`` [µs] the time, ArduPilot's units for
-    known messages.  Older logs name their second and third IMU ``IMU2``/``IMU3`` (no ``I``
-    field): ``IMU.1`` reads ``IMU2``.  pymavlink's printed complaints are captured; bytes
-    of the file that are not whole messages (file size − Σ message lengths, trailing
-    padding of one fill byte excepted) are lost and said in a warning with their share.
-    Needs ``pymavlink`` (``pip install 'thermocal[logs]'``)."""
+@dataclass(frozen=True)
+class DataflashLog:
+    """What one pass over a DataFlash log kept: the rows of the wanted message types (numeric
+    fields), every message type seen, the parameters (``PARM``: the last value of each name)
+    and the sentences on what was lost (:func:`_dataflash_loss`)."""
+
+    rows: dict[str, list[dict[str, float]]]
+    names_seen: frozenset[str]
+    params: dict[str, float]
+    notes: tuple[str, ...]
+
+
+def read_dataflash_log(path: str | Path, messages: Sequence[str]) -> DataflashLog:
+    """Read an ArduPilot DataFlash log once, keeping the messages named in ``messages`` and
+    every ``PARM``.  pymavlink's printed complaints are captured; bytes of the file that are
+    not whole messages (file size − Σ message lengths, trailing padding of one fill byte
+    excepted) are lost and said in a warning with their share.  Needs ``pymavlink``
+    (``pip install 'thermocal[logs]'``)."""
     try:
         from pymavlink import DFReader
     except ImportError:
@@ -1166,10 +1231,10 @@ def _read_dataflash(path: Path, topic: str | None) -> tuple[pd.DataFrame, dict[s
             f"{path}: reading ArduPilot DataFlash logs needs pymavlink: pip install "
             "'thermocal[logs]' (or pip install pymavlink)"
         ) from None
-    name, inst = parse_topic(topic, DEFAULT_DATAFLASH_TOPIC)
-    legacy = f"{name}{inst + 1}" if inst > 0 else None  # IMU2 = IMU.1 in older logs
-    rows: list[dict[str, Any]] = []
-    legacy_rows: list[dict[str, Any]] = []
+    path = Path(path)
+    keep = set(messages)
+    rows: dict[str, list[dict[str, float]]] = {m: [] for m in keep}
+    params: dict[str, float] = {}
     names_seen: set[str] = set()
     accounted = 0  # bytes in whole messages
     last_end = 0
@@ -1196,16 +1261,14 @@ def _read_dataflash(path: Path, topic: str | None) -> tuple[pd.DataFrame, dict[s
                 last_end = int(getattr(log, "offset", 0))
                 mtype = m.get_type()
                 names_seen.add(mtype)
-                if mtype == name:
+                if mtype in keep:
                     d = m.to_dict()
-                    if int(d.get("I", 0)) == inst:
-                        rows.append({k: v for k, v in d.items() if isinstance(v, int | float)})
-                elif mtype == legacy:
-                    d = m.to_dict()
-                    if "I" not in d:
-                        legacy_rows.append(
-                            {k: v for k, v in d.items() if isinstance(v, int | float)}
-                        )
+                    rows[mtype].append(
+                        {k: float(v) for k, v in d.items() if isinstance(v, int | float)}
+                    )
+                elif mtype == "PARM":
+                    with contextlib.suppress(AttributeError, TypeError, ValueError):
+                        params[str(m.Name)] = float(m.Value)
         finally:  # pymavlink keeps the file and its memory map open
             for attr in ("data_map", "filehandle"):
                 h = getattr(log, attr, None)
@@ -1216,20 +1279,55 @@ def _read_dataflash(path: Path, topic: str | None) -> tuple[pd.DataFrame, dict[s
     if said and notes:
         notes.append(said)
     _warn_damage(path, notes)
-    if not rows and legacy_rows:
-        rows = legacy_rows
+    return DataflashLog(rows, frozenset(names_seen), params, tuple(notes))
+
+
+def dataflash_table(
+    log: DataflashLog, path: Path, name: str, inst: int
+) -> tuple[pd.DataFrame, dict[str, Any]]:
+    """Instance ``inst`` of message ``name`` from a :func:`read_dataflash_log` pass, as a
+    table with the firmware's units (:data:`ARDUPILOT_UNITS`).  Both layouts: the instance
+    field ``I`` (newer firmware) or, for ``IMU.1``/``IMU.2``, the older messages
+    ``IMU2``/``IMU3`` without it; ``T`` or ``Temp`` the temperature."""
+    legacy = f"{name}{inst + 1}" if inst > 0 else None  # IMU2 = IMU.1 in older logs
+    rows = [r for r in log.rows.get(name, []) if int(r.get("I", 0)) == inst]
+    source = name
+    if not rows and legacy:
+        rows = [r for r in log.rows.get(legacy, []) if "I" not in r]
+        source = legacy
     if not rows:
         raise MissingColumnError(
             f"{path}: no {name} messages of instance {inst} in the log"
-            + (" (they may be in its damaged part)" if notes else "")
+            + (" (they may be in its damaged part)" if log.notes else "")
             + "; it has: "
-            + (", ".join(sorted(names_seen - {"FMT", "FMTU", "UNIT", "MULT"})) or "none")
+            + (", ".join(sorted(log.names_seen - {"FMT", "FMTU", "UNIT", "MULT"})) or "none")
         )
     df = pd.DataFrame(rows).astype(np.float64)
-    units_ = {k: u for k, u in ARDUPILOT_UNITS.get(name, {}).items() if k in df.columns}
+    known = dict(ARDUPILOT_UNITS.get(source, {}))
+    if source == "TCLR" and "SType" in df.columns:  # X, Y, Z: accel (0) or gyro (1) means
+        kinds = set(df["SType"].astype(int).tolist())
+        if len(kinds) == 1:
+            u = {0: "m/s^2", 1: "rad/s"}.get(kinds.pop())
+            if u:
+                known.update(dict.fromkeys(("X", "Y", "Z"), u))
+    units_ = {k: u for k, u in known.items() if k in df.columns}
     info: dict[str, Any] = {"time": "TimeUS", "time_unit": "us", "units": units_}
     info["dataflash_message"] = f"{name}.{inst}"
+    info["dataflash_source"] = source
+    info["fc_log"] = True
     return df, info
+
+
+def _read_dataflash(path: Path, topic: str | None) -> tuple[pd.DataFrame, dict[str, Any]]:
+    """One message type and instance (field ``I``) of an ArduPilot DataFlash log as a
+    table: the message's fields as columns, ``TimeUS`` [µs] the time, the firmware's units
+    (:data:`ARDUPILOT_UNITS`, whether or not the log carries unit messages).  Older logs
+    name their second and third IMU ``IMU2``/``IMU3`` (no ``I`` field): ``IMU.1`` reads
+    ``IMU2`` (:func:`dataflash_table`).  The log is read once (:func:`read_dataflash_log`)."""
+    name, inst = parse_topic(topic, DEFAULT_DATAFLASH_TOPIC)
+    wanted = [name] + ([f"{name}{inst + 1}"] if inst > 0 else [])
+    log = read_dataflash_log(path, wanted)
+    return dataflash_table(log, path, name, inst)
 
 
 def _dataflash_loss(path: Path, size: int, accounted: int, last_end: int) -> list[str]:
@@ -1515,6 +1613,37 @@ def _rate_time(
     return obj, [col, *names], col, "s"
 
 
+def _fc_log_unknown_units(
+    p: Path,
+    info: dict[str, Any],
+    sig_names: Sequence[str],
+    option: str | None,
+    model: units.StatedUnits | None,
+) -> None:
+    """A flight-controller log's field whose unit neither the firmware's message definition
+    known here (:data:`PX4_UNITS`, :data:`ARDUPILOT_UNITS`), nor ``--signal-unit``, the column
+    name or the model states is read as raw values (``counts``, not converted) with a
+    :class:`~thermocal.errors.UnitWarning` — never guessed as °/h (issue 28)."""
+    if option:
+        return
+    known: dict[str, str] = info.setdefault("units", {})
+    topic = info.get("ulog_topic") or info.get("dataflash_message") or "?"
+    for c in sig_names:
+        if c in known or units.unit_in_column_name(c, "signal") is not None:
+            continue
+        if model is not None and model.columns.get(c):
+            continue
+        known[c] = "counts"
+        warnings.warn(
+            UnitWarning(
+                f"{p}: the unit of field {c!r} of {topic} is not known from the firmware's "
+                "message definition: read as raw values (counts), not converted; give "
+                "--signal-unit"
+            ),
+            stacklevel=3,
+        )
+
+
 def read_recording(
     path: str | Path,
     *,
@@ -1602,6 +1731,8 @@ def read_recording(
                 f"{p}: no column {short_name(c)}; available: {names_list(names)}"
             )
 
+    if info.get("fc_log"):
+        _fc_log_unknown_units(p, info, sig_names, signal_unit, model)
     stated = units.StatedUnits.from_file_info(info, where)
     resolved = units.resolve_inputs(
         time_col,

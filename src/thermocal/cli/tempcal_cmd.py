@@ -10,7 +10,7 @@ import functools
 import warnings
 from collections.abc import Callable
 from pathlib import Path
-from typing import TYPE_CHECKING, Annotated, ParamSpec, TypeVar
+from typing import TYPE_CHECKING, Annotated, Any, ParamSpec, TypeVar
 
 import typer
 
@@ -73,11 +73,25 @@ def px4_tempcal_cmd(
     """Fit every gyro and accelerometer instance of a PX4 log as PX4 would (a cubic per axis
     about TREF), robust to spikes, with equal weight across the temperature range and
     judged on held-out data; write the TC_* parameters, the calibration and reports."""
-    from thermocal.export_params import ParamSet, export_params
-    from thermocal.io import atomic_write, commit_directory, staging_directory
+    import numpy as np
+
+    from thermocal.export_params import ParamSet, export_params, px4_offset_params
+    from thermocal.io import atomic_write, commit_directory, read_log_table, staging_directory
     from thermocal.models.calibration import Calibration
     from thermocal.models.files import save_calibration
-    from thermocal.px4_tempcal import calibration_of, fit_sensor, log_topics, summary
+    from thermocal.px4_tempcal import (
+        OFFSET_TOPICS,
+        GateWarning,
+        calibration_of,
+        end_warning,
+        fit_offset_sensor,
+        fit_sensor,
+        log_topics,
+        offset_summary,
+        stall_warning,
+        step_warnings,
+        summary,
+    )
     from thermocal.report.calibration import CalibrationReportInputs, write_calibration_report
 
     if output.exists() and not output.is_dir():
@@ -89,12 +103,38 @@ def px4_tempcal_cmd(
         )
     stage = staging_directory(output)  # the set is moved into place whole, or removed
     fits, reports = [], []
+    gates: list[str | None] = []
+    series: dict[str, tuple[Any, Any]] = {}
+    offset_fits = []
     params = ParamSet("px4")
     for name, inst in topics:
+        if name in OFFSET_TOPICS:  # barometers and magnetometers: TC_B / TC_M
+            df, _info = read_log_table(log, f"{name}.{inst}")
+            fields = OFFSET_TOPICS[name][1]
+            ids = df["device_id"].to_numpy() if "device_id" in df.columns else np.zeros(1)
+            ofit = fit_offset_sensor(
+                df["timestamp"].to_numpy() * 1e-6, df["temperature"].to_numpy(),
+                np.column_stack([df[f].to_numpy() for f in fields]), name, inst,
+                int(np.median(ids)), tref_c=tref,
+                overrides=overrides_of(allow_narrow, allow_motion),
+            )  # fmt: skip
+            offset_fits.append(ofit)
+            params.merge(
+                px4_offset_params(ofit.kind, inst, ofit.device_id, *ofit.sweep_c, ofit.tref_c,
+                                  ofit.coefficients),
+                f"{name}.{inst}",
+            )  # fmt: skip
+            continue
         kind = "gyro" if name == "sensor_gyro" else "accel"
         rec = load_recording(log, topic=f"{name}.{inst}", signal="x,y,z", temps="temperature")
         fit = fit_sensor(rec, name, kind, inst, overrides=overrides_of(allow_narrow, allow_motion))
         fits.append(fit)
+        where = f"{name}.{inst}"
+        temp_c = rec.temperature_c("temperature")
+        series[where] = (rec.time_s, np.column_stack([rec.signal(a)[0] for a in "xyz"]))
+        gates.append(stall_warning(where, rec.time_s, temp_c))
+        if tref is not None:
+            gates.append(end_warning(where, "TREF", tref, *fit.sweep_c))
         sub = Calibration(fit.channels)
         with warnings.catch_warnings():  # accelerometers: relative offsets, as PX4's script
             warnings.simplefilter("ignore")
@@ -122,6 +162,14 @@ def px4_tempcal_cmd(
             ),
         )  # fmt: skip
         reports.append(rp)
+    gates.extend(step_warnings(fits, series))
+    for msg in gates:
+        if msg:
+            warnings.warn(GateWarning(msg), stacklevel=1)
+    if not fits:
+        raise ThermocalInputError(
+            f"{log}: no sensor_gyro or sensor_accel topic with a temperature in the log"
+        )
     cal_path = output / "calibration.json"
     save_calibration(calibration_of(fits), stage / cal_path.name)
     params_path = output / "px4.params"
@@ -138,7 +186,7 @@ def px4_tempcal_cmd(
         "params": str(params_path),
         "calibration": str(cal_path),
         "reports": [str(p) for p in reports],
-        "sensors": summary(fits),
+        "sensors": {**summary(fits), **offset_summary(offset_fits)},
         "notes": params.notes,
     }
 
@@ -151,6 +199,12 @@ def px4_tempcal_cmd(
                 f"{f.topic}.{f.instance}", str(f.device_id),
                 f"{f.sweep_c[0]:.1f}…{f.sweep_c[1]:.1f}", str(f.n_bins),
                 " / ".join(fmt(v, 3) for v in f.holdout_rms.values()) + f" {f.unit}",
+            )  # fmt: skip
+        for o in offset_fits:
+            table.add_row(
+                f"{o.topic}.{o.instance}", str(o.device_id),
+                f"{o.sweep_c[0]:.1f}…{o.sweep_c[1]:.1f}", str(o.n_bins),
+                " / ".join(fmt(v, 3) for v in o.holdout_rms.values()) + f" {o.unit}",
             )  # fmt: skip
         stdout.print(table)
         for n in params.notes:
@@ -174,12 +228,30 @@ def ardupilot_tempcal_cmd(
     and accelerometer fitted as in px4-tempcal, written as INS_TCAL* (.parm), a calibration
     and reports (the polynomial about 35 °C without constant, as the firmware takes it)."""
 
+    import numpy as np
+
     from thermocal.errors import MissingColumnError
     from thermocal.export_params import ParamSet, export_params
-    from thermocal.io import atomic_write, commit_directory, staging_directory
+    from thermocal.io import (
+        atomic_write,
+        commit_directory,
+        dataflash_table,
+        read_dataflash_log,
+        staging_directory,
+    )
     from thermocal.models.calibration import Calibration
     from thermocal.models.files import save_calibration
-    from thermocal.px4_tempcal import calibration_of, fit_sensor, summary
+    from thermocal.px4_tempcal import (
+        AP_ROTATIONS,
+        GateWarning,
+        ardupilot_raw,
+        calibration_of,
+        end_warning,
+        fit_sensor,
+        stall_warning,
+        step_warnings,
+        summary,
+    )
     from thermocal.recording import Recording
     from thermocal.report.calibration import CalibrationReportInputs, write_calibration_report
 
@@ -187,32 +259,78 @@ def ardupilot_tempcal_cmd(
         raise ThermocalInputError(f"{output}: exists and is not a directory")
     stage = staging_directory(output)  # the set is moved into place whole, or removed
     fits, reports = [], []
+    gates: list[str | None] = []
+    series: dict[str, tuple[Any, Any]] = {}
+    hygiene: dict[str, dict[str, Any]] = {}
+    orientation = 0
     params = ParamSet("ardupilot")
+    dlog = read_dataflash_log(log, ["IMU", "IMU2", "IMU3"])  # the log is read once
     for inst in range(3):  # ArduPilot logs up to three IMUs
         try:
-            rec = load_recording(log, topic=f"IMU.{inst}", signal="GyrX", temps="T")
+            df, _info = dataflash_table(dlog, log, "IMU", inst)
         except MissingColumnError:
             if inst == 0:
                 raise
             break
+        tcol = next((c for c in ("T", "Temp") if c in df.columns), None)
+        if tcol is None:  # LogStructure.h: ``T`` (``Temp`` in Copter 3.4–3.6)
+            raise ThermocalInputError(
+                f"{log}: IMU.{inst} has no temperature field (T or Temp); it has: "
+                + ", ".join(map(str, df.columns))
+            )
+        time_s = df["TimeUS"].to_numpy() * 1e-6
+        temp_c = df[tcol].to_numpy()
+        if not np.isfinite(temp_c).any() or np.all(temp_c[np.isfinite(temp_c)] == 0):
+            warnings.warn(
+                GateWarning(
+                    f"{log}: IMU.{inst} left out: its temperature is all 0 or NaN (a sensor "
+                    "without a thermometer cannot be calibrated over temperature)"
+                ),
+                stacklevel=1,
+            )
+            continue
+        gates.append(stall_warning(f"IMU.{inst}", time_s, temp_c))
         per_kind = []
         for kind, prefix, unit in (("gyro", "Gyr", "rad/s"), ("accel", "Acc", "m/s^2")):
+            xyz = np.column_stack([df[f"{prefix}{a.upper()}"].to_numpy() for a in "xyz"])
+            xyz, active, orientation = ardupilot_raw(dlog.params, inst, kind, temp_c, xyz)
+            hyg = hygiene.setdefault(f"IMU.{inst}", {"active_tcal_removed": active is not None})
+            if active is not None:
+                hyg.update(tmin_c=active.tmin_c, tmax_c=active.tmax_c, caltemp_c=active.caltemp_c)
             sub_rec = Recording.from_arrays(
-                rec.time_s, {a: rec.column(f"{prefix}{a.upper()}") for a in "xyz"},
-                {"temperature": rec.column("T")}, signal_unit=unit,
+                time_s, {a: xyz[:, j] for j, a in enumerate("xyz")},
+                {"temperature": temp_c}, signal_unit=unit,
             )  # fmt: skip
             sub_rec.source = str(log)
+            sub_rec.validate()
             fit = fit_sensor(
                 sub_rec, f"IMU.{prefix}", kind, inst,
                 overrides=overrides_of(allow_narrow, allow_motion), firmware="ardupilot",
             )  # fmt: skip
             fits.append(fit)
             per_kind.append((fit, sub_rec))
+            series[f"{fit.topic}.{inst}"] = (time_s, np.column_stack(
+                [sub_rec.signal(a)[0] for a in "xyz"]
+            ))  # fmt: skip
         sub = Calibration([ch for f, _r in per_kind for ch in f.channels])
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             ps = export_params(sub, "ardupilot", instance=inst)
         params.merge(ps, f"IMU.{inst}")
+        hyg = hygiene[f"IMU.{inst}"]
+        old_coef = {n: dlog.params[n] for n in ps.params if n in dlog.params}
+        hyg["coefficients"] = {
+            n: {"old": old_coef.get(n), "new": float(v)}
+            for n, v in ps.params.items() if "_ACC" in n or "_GYR" in n
+        }  # fmt: skip
+        for kind in ("accel", "gyro"):
+            ref = hyg.get("caltemp_c", {}).get(kind)
+            if ref is not None:
+                lo_c, hi_c = (
+                    ps.params[f"INS_TCAL{inst + 1}_TMIN"],
+                    ps.params[f"INS_TCAL{inst + 1}_TMAX"],
+                )
+                gates.append(end_warning(f"IMU.{inst}", f"{kind} CALTEMP", ref, lo_c, hi_c))
         for fit, sub_rec in per_kind:
             rp = output / f"report_IMU_{inst}_{fit.kind}.html"
             write_calibration_report(
@@ -225,6 +343,12 @@ def ardupilot_tempcal_cmd(
                 ),
             )  # fmt: skip
             reports.append(rp)
+    if not fits:
+        raise ThermocalInputError(f"{log}: no IMU with a usable temperature in the log")
+    gates.extend(step_warnings(fits, series))
+    for msg in gates:
+        if msg:
+            warnings.warn(GateWarning(msg), stacklevel=1)
     cal_path = output / "calibration.json"
     save_calibration(calibration_of(fits), stage / cal_path.name)
     parm = output / "ardupilot.parm"
@@ -238,9 +362,34 @@ def ardupilot_tempcal_cmd(
         "reports": [str(p) for p in reports],
         "sensors": summary(fits),
         "notes": params.notes,
+        "log_hygiene": {
+            "AHRS_ORIENTATION": orientation,
+            "rotated_back_to_sensor_frame": orientation != 0,
+            "imus": hygiene,
+        },
     }
+    found = [k for k, h in hygiene.items() if h["active_tcal_removed"]]
+    if found:
+        params.notes.append(
+            "active INS_TCAL coefficients found in the log and removed from the data before "
+            "fitting (the firmware had subtracted them): " + ", ".join(found)
+        )
+    if orientation:
+        params.notes.append(
+            f"AHRS_ORIENTATION {orientation} ({AP_ROTATIONS[orientation]}): the data were "
+            "rotated back to the sensor frame before fitting"
+        )
 
     def human() -> None:
+        if found:
+            old_new = _rich_table.Table(title="INS_TCAL coefficients: in the log → new")
+            for col in ("parameter", "old", "new"):
+                old_new.add_column(col)
+            for h in hygiene.values():
+                for n, v in h.get("coefficients", {}).items():
+                    if v["old"] is not None:
+                        old_new.add_row(n, fmt(v["old"], 6), fmt(v["new"], 6))
+            stdout.print(old_new)
         table = _rich_table.Table(title=f"ArduPilot thermal calibration of {log}")
         for col in ("IMU", "sensor", "sweep [°C]", "bins", "hold-out rms x/y/z"):
             table.add_column(col)
