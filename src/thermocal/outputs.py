@@ -161,23 +161,24 @@ def check_outputs(
     def refuse(target: Path, why: str) -> None:
         raise ThermocalInputError(f"{target}: refusing to write {what} there: {why}")
 
-    def not_input(target: Path) -> None:
+    def not_input(target: Path, folder: bool = False) -> None:
         why = special_reason(target)
         if why is not None:
             refuse(target, why)
         r = target.resolve()
-        for i in ins:
-            if i.resolved == r:
-                raise ThermocalInputError(f"{target}: refusing to write over {i.label}")
-        hit = by_inode.get(_inode(target)) if target.exists() else None
+        hit = next((i for i in ins if i.resolved == r), None)
+        link = ""
+        if hit is None and target.exists():
+            hit = by_inode.get(_inode(target))
+            link = " (the same file: a hard link)"
+        if hit is not None and folder:
+            refuse(target, f"it is {hit.label}{link}, not a directory")
         if hit is not None:
-            raise ThermocalInputError(
-                f"{target}: refusing to write over {hit.label} (the same file: a hard link)"
-            )
+            raise ThermocalInputError(f"{target}: refusing to write over {hit.label}{link}")
 
-    def holds_no_input(folder: Path) -> None:
+    def holds_no_input(folder: Path, is_dir: bool = True) -> None:
         """``folder`` is replaced or deleted: no input may be in it."""
-        not_input(folder)
+        not_input(folder, folder=is_dir)
         r = folder.resolve()
         for i in ins:
             if i.resolved.is_relative_to(r):
@@ -192,10 +193,10 @@ def check_outputs(
 
     def no_stale_input(target: Path) -> None:
         for tmp in _temporaries(target):
-            holds_no_input(tmp)
+            holds_no_input(tmp, is_dir=False)
 
     for d in (Path(x) for x in dirs):
-        not_input(d)
+        not_input(d, folder=True)
         if d.exists() and not d.is_dir():
             raise ThermocalInputError(f"{d}: exists and is not a directory")
         no_stale_input(d)
