@@ -18,6 +18,7 @@ replace ``/dev/stdout`` or ``/dev/null`` of the machine the tests run on (as roo
 
 from __future__ import annotations
 
+import builtins
 import contextlib
 import hashlib
 import io
@@ -341,14 +342,21 @@ def _special(path: Any) -> bool:
 
 @pytest.fixture
 def machine_guard(monkeypatch: pytest.MonkeyPatch) -> None:
-    """Replacing or deleting anything under /dev, /proc or /sys raises (module docstring)."""
-    for mod, name in ((os, "replace"), (os, "rename"), (os, "unlink"), (shutil, "rmtree")):
+    """Creating a folder, opening a file for writing, replacing or deleting anything under
+    /dev, /proc or /sys raises (module docstring)."""
+    for mod, name in (
+        (os, "replace"), (os, "rename"), (os, "unlink"), (shutil, "rmtree"), (os, "mkdir"),
+        (builtins, "open"),
+    ):  # fmt: skip
         real = getattr(mod, name)
 
         def guarded(*args: Any, _real: Any = real, _name: str = name, **kw: Any) -> Any:
             paths = [a for a in args[:2] if isinstance(a, str | os.PathLike)]
             if _name == "unlink":  # a writer's own temporary may go
                 paths = [a for a in paths if TEMP_SUFFIX not in os.fspath(a)]
+            if _name == "open":  # reading /proc, /sys is fine
+                mode = str(args[1] if len(args) > 1 else kw.get("mode", "r"))
+                paths = paths[:1] if set(mode) & set("wax+") else []
             if any(_special(a) for a in paths):
                 raise RuntimeError(f"test guard: {_name}{args[:2]} touches a special file")
             return _real(*args, **kw)
