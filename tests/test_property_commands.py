@@ -2,7 +2,9 @@
 traceback (issue 14).  Hypothesis draws recordings of 0–50 rows with NaN, inf, huge and
 tiny values, repeated and backwards times and constant columns.
 Issue 26: the log readers (inspect --topic, px4-tempcal, ardupilot-tempcal) on a small valid
-ULog or DataFlash log with random bytes flipped, a run zeroed or randomised, or cut."""
+ULog or DataFlash log with random bytes flipped, a run zeroed or randomised, or cut; ``fleet``
+on random small configurations (bad keys, wrong types, missing files, odd ids: exit 0, 2 or 4,
+inputs unchanged) and ``export-params`` on random calibrations and options (exit 0 or 2)."""
 
 from __future__ import annotations
 
@@ -194,3 +196,212 @@ def test_damaged_logs_exit_0_or_2(
     assert all(ln.startswith(("warning: ", "error: ")) for ln in lines), err[:2000]
     if code == 2:
         assert lines[-1].startswith("error: "), err
+
+
+# --- fleet (issue 26 item 9): random small configurations -----------------------------------
+
+FLEET_DATA = "time [s],gx [deg/s],T1 [degC]\n" + "".join(
+    f"{i},{0.5 + 0.002 * (t - 25.0) + 0.001 * np.sin(i)!r},{t!r}\n"
+    for i, t in enumerate(np.linspace(-10.0, 60.0, 300).tolist())
+)
+"""A still gyro swept −10 → 60 °C (300 s at 1 Hz): enough for ``poly --order 1``."""
+
+_TOML_VALUES = st.one_of(
+    st.sampled_from(['"poly"', '"gx [deg/s]"', '"T1 [degC]"', "1", "0", "-3", "2.5", "true",
+                     '""', "[]", '["gx [deg/s]"]', "{}", '"nan"', "1e309", '"../x"']),
+)  # fmt: skip
+_FIT_KEYS = ["model", "order", "signal", "temps", "signal_unit", "time", "no_such_option",
+             "ridge", "select", "rate_interval"]  # fmt: skip
+_IDS = ["U1", "U2", "u-3", "U1", "U2", "u-3", "", "../up", "a/b", ".hidden", "x" * 300, "Ü"]
+_FILES = ["run.csv"] * 4 + ["missing.csv", "../run.csv", "", "run.parquet", "cfg.toml"]
+
+
+def _toml_str(s: str) -> str:
+    return '"' + s.replace("\\", "\\\\").replace('"', '\\"') + '"'
+
+
+@st.composite
+def fleet_configs(draw: st.DrawFn) -> str:
+    """A TOML batch: a usable [fit] with random keys replaced, added or dropped (values of
+    any type), 0–3 units with odd ids, missing or repeated files, and a stray table."""
+    fit = {"model": '"poly"', "order": "1", "signal": '"gx [deg/s]"', "temps": '"T1 [degC]"'}
+    for _ in range(draw(st.sampled_from([0, 0, 0, 1, 2]))):  # a usable [fit] half the time
+        key = draw(st.sampled_from(_FIT_KEYS))
+        if draw(st.booleans()):
+            fit[key] = draw(_TOML_VALUES)
+        else:
+            fit.pop(key, None)
+    lines = ["[fit]"] + [f"{_toml_str(k)} = {v}" for k, v in fit.items()]
+    if draw(st.integers(0, 3)) == 0:
+        key = draw(st.sampled_from(["rms_residual_max", "rms_residual_max", "x", "rms_min"]))
+        lines += ["[limits]", f"{key} = {draw(st.sampled_from(['1.0', '1e-9', '-1', 'true']))}"]
+    if draw(st.integers(0, 3)) == 0:
+        averaging = draw(st.sampled_from(["10", "10", "-1", '"x"']))
+        lines += ["[validate]", f"averaging = {averaging}"]
+    for _ in range(draw(st.sampled_from([0, 1, 1, 2, 3]))):
+        lines.append("[[unit]]")
+        if draw(st.integers(0, 5)):
+            lines.append(f"id = {_toml_str(draw(st.sampled_from(_IDS)))}")
+        kind = draw(st.sampled_from(["list", "list", "list", "string", "number", "none"]))
+        files = [draw(st.sampled_from(_FILES)) for _ in range(draw(st.sampled_from([1, 1, 2, 0])))]
+        if kind == "list":
+            lines.append(f"modeling = [{', '.join(_toml_str(f) for f in files)}]")
+        elif kind == "string":
+            lines.append(f"modeling = {_toml_str(files[0] if files else 'run.csv')}")
+        elif kind == "number":
+            lines.append("modeling = 3")
+        if draw(st.integers(0, 3)) == 0:
+            lines.append(f"validation = {_toml_str(draw(st.sampled_from(_FILES)))}")
+        if draw(st.integers(0, 4)) == 0:
+            lines.append(f"{_toml_str(draw(st.sampled_from(['colour', 'id'])))} = 1")
+    return "\n".join(lines) + "\n"
+
+
+@settings(
+    max_examples=20,
+    deadline=None,
+    suppress_health_check=[HealthCheck.function_scoped_fixture, HealthCheck.too_slow],
+)
+@given(text=fleet_configs())
+def test_fleet_exits_0_2_or_4(
+    text: str, tmp_path_factory: pytest.TempPathFactory, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``thermocal fleet`` on a random configuration: exit 0 (all calibrated), 4 (some units
+    failed, each recorded) or 2 (refused, one ``error:`` line), never 1; no input changes."""
+    import hashlib
+
+    d = tmp_path_factory.mktemp("fleet-prop")
+    (d / "run.csv").write_text(FLEET_DATA)
+    cfg = d / "cfg.toml"
+    cfg.write_text(text, encoding="utf-8")
+    inputs = [d / "run.csv", cfg]
+    before = [hashlib.sha256(p.read_bytes()).hexdigest() for p in inputs]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        code = main(["fleet", str(cfg), "-o", str(d / "out"), "--workers", "1"])
+    _, err = capsys.readouterr()
+    assert code in (0, 2, 4), err[-2000:]
+    assert "Traceback" not in err
+    if code == 2:
+        assert err.strip().splitlines()[-1].startswith("error: "), err
+    assert [hashlib.sha256(p.read_bytes()).hexdigest() for p in inputs] == before
+
+
+# --- export-params (issue 26 item 9): random calibrations and options -----------------------
+
+
+@pytest.fixture(scope="module")
+def params_calibration(tmp_path_factory: pytest.TempPathFactory) -> bytes:
+    """Gyros gx, gy, gz [deg/s] and accelerometers ax, ay, az [mg] (+z up), cubic in T1,
+    10 → 40 °C over 400 s."""
+    d = tmp_path_factory.mktemp("params-prop")
+    rng = np.random.default_rng(9)
+    n = 400
+    t = np.arange(n, dtype=float)
+    temp = 10.0 + 30.0 * t / (n - 1)
+    cols = {"time": t, "T1": temp}
+    for k, c in enumerate(("gx", "gy", "gz")):
+        cols[c] = 0.1 * k + 0.01 * (temp - 25.0) + rng.normal(0.0, 0.001, n)
+    for c, g in zip(("ax", "ay", "az"), (0.0, 0.0, 1000.0), strict=True):
+        cols[c] = g + 0.3 * (temp - 25.0) + rng.normal(0.0, 0.5, n)
+    lines = [",".join(cols)] + [
+        ",".join(repr(float(v)) for v in row) for row in zip(*cols.values(), strict=True)
+    ]
+    (d / "d.csv").write_text("\n".join(lines) + "\n")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        code = main(["fit", str(d / "d.csv"), "--model", "poly", "--order", "3", "--signal",
+                     "gx,gy,gz,ax,ay,az", "--signal-unit", "deg/s,deg/s,deg/s,mg,mg,mg",
+                     "--time-unit", "s", "--temps", "T1", "--temp-unit", "degC",
+                     "--gravity-axis", "+z", "--gravity", "9.80665",
+                     "-o", str(d / "cal.json")])  # fmt: skip
+    assert code == 0
+    return (d / "cal.json").read_bytes()
+
+
+_CHANNEL_NAMES = ["gx", "gy", "gz", "ax", "ay", "az", "nope", "", "gx "]
+
+
+@st.composite
+def params_options(draw: st.DrawFn) -> list[str]:
+    """Format, axes maps (repeated, missing, unknown, wrong length), instance, TREF and
+    device id, each drawn or left out."""
+    fmts = ["px4", "ardupilot"] * 4 + ["PX4", "qgc", ""]
+    args = ["--format", draw(st.sampled_from(fmts))]
+    for opt, good in (("--gyro", "gx,gy,gz"), ("--accel", "ax,ay,az")):
+        how = draw(st.sampled_from(["good", "good", "random", "none"]))
+        if how == "good":
+            args += [opt, good]
+        elif how == "random":
+            names = draw(st.lists(st.sampled_from(_CHANNEL_NAMES), min_size=0, max_size=4))
+            args += [opt, ",".join(names)]
+    if draw(st.booleans()):
+        args += ["--instance", str(draw(st.sampled_from([0, 1, 2, 3, 4, -1, 99, 2**40])))]
+    if draw(st.booleans()):
+        args += ["--tref", draw(st.sampled_from(["25", "-300", "nan", "inf", "1e39", "40"]))]
+    if draw(st.booleans()):
+        args += ["--device-id", str(draw(st.sampled_from([0, 1, -1, 2**31, 2**64])))]
+    return args
+
+
+@st.composite
+def edited_calibrations(draw: st.DrawFn, raw: bytes) -> bytes:
+    """The calibration as fitted, or with one coefficient or the range edited (checksums
+    recomputed, as anyone can), or its channels cut."""
+    import json
+
+    from thermocal.models.base import checksum
+
+    cal = json.loads(raw)
+    kind = draw(st.sampled_from(["as-fitted", "as-fitted", "coef", "drop-channels", "roles"]))
+    chans = cal["channels"]
+    if kind == "coef":
+        ch = chans[draw(st.integers(0, len(chans) - 1))]
+        coef = ch["model"]["state"]["coef"]
+        coef[draw(st.integers(0, len(coef) - 1))] = draw(
+            st.sampled_from([0.0, 1e30, -1e30, 3.4e38, 1e-300, 1e6])
+        )
+    elif kind == "drop-channels":
+        keep = draw(st.integers(0, len(chans)))
+        cal["channels"] = chans[:keep]
+    elif kind == "roles":
+        for ch in chans:
+            ch.pop("role", None)
+    for ch in cal["channels"]:
+        ch["model"].pop("checksum", None)
+        ch["model"]["checksum"] = checksum(ch["model"])
+    cal.pop("checksum", None)
+    cal["checksum"] = checksum(cal)
+    return json.dumps(cal).encode()
+
+
+@settings(
+    max_examples=30,
+    deadline=None,
+    suppress_health_check=[HealthCheck.function_scoped_fixture, HealthCheck.too_slow],
+)
+@given(data=st.data())
+def test_export_params_exits_0_or_2(
+    data: st.DataObject,
+    params_calibration: bytes,
+    tmp_path_factory: pytest.TempPathFactory,
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    """``thermocal export-params`` on a random calibration with random options: exit 0 or 2
+    (one ``error:`` line, no output file), never 1; the calibration is unchanged."""
+    d = tmp_path_factory.mktemp("params-prop-run")
+    cal = d / "cal.json"
+    raw = data.draw(edited_calibrations(params_calibration))
+    cal.write_bytes(raw)
+    out = d / "out.params"
+    args = ["export-params", str(cal), "-o", str(out), *data.draw(params_options())]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        code = main(args)
+    _, err = capsys.readouterr()
+    assert code in (0, 2), err[-2000:]
+    assert "Traceback" not in err
+    if code == 2:
+        assert err.strip().splitlines()[-1].startswith("error: "), err
+        assert not out.exists()
+    assert cal.read_bytes() == raw

@@ -52,7 +52,6 @@ import os
 import re
 import secrets
 import shutil
-import stat
 import tempfile
 import threading
 import time
@@ -681,24 +680,6 @@ def stale_reasons(
 
 # --- inputs are sacred --------------------------------------------------------------------
 
-SPECIAL_ROOTS = (Path("/proc"), Path("/dev"), Path("/sys"))
-"""File systems that are not storage: never an output."""
-
-
-@dataclass(frozen=True)
-class _Input:
-    given: str
-    resolved: Path
-    inode: tuple[int, int] | None
-
-
-def _inode(path: Path, follow: bool = True) -> tuple[int, int] | None:
-    try:
-        st = os.stat(path, follow_symlinks=follow)
-    except OSError:
-        return None
-    return (st.st_dev, st.st_ino)
-
 
 def config_inputs(config: FleetConfig) -> list[str]:
     """Every file the batch reads: the configuration and each unit's inputs."""
@@ -706,53 +687,6 @@ def config_inputs(config: FleetConfig) -> list[str]:
     for u in config.units:
         out += unit_input_paths(u)
     return out
-
-
-def _link_chain(path: Path) -> list[Path]:
-    """``path`` (absolute, not resolved) and every path its symbolic links lead through
-    (``out/fleet.html`` → ``/proc/self/fd/1`` → ``/dev/pts/0``…), the resolved one last."""
-    chain = [Path(os.path.abspath(path))]
-    p = chain[0]
-    for _ in range(40):
-        # the link of the first component that is one (a folder or the file itself)
-        hop = None
-        for i in range(1, len(p.parts) + 1):
-            head = Path(*p.parts[:i])
-            if head.is_symlink():
-                try:
-                    target = os.readlink(head)
-                except OSError:
-                    break
-                hop = Path(os.path.normpath(head.parent / target)).joinpath(*p.parts[i:])
-                break
-        if hop is None or hop in chain:
-            break
-        chain.append(hop)
-        p = hop
-    chain.append(path.resolve())
-    return chain
-
-
-def _special(path: Path) -> str | None:
-    """Why ``path`` is no place for an output (it or a link it leads through lies under
-    :data:`SPECIAL_ROOTS`, or it is a FIFO, a device or a socket), or None."""
-    for p in _link_chain(path):
-        for root in SPECIAL_ROOTS:
-            if p == root or p.is_relative_to(root):
-                return f"it is under {root}, not a storage file system"
-    try:
-        mode = os.stat(path).st_mode
-    except OSError:
-        return None
-    for test, what in (
-        (stat.S_ISFIFO, "a FIFO"),
-        (stat.S_ISCHR, "a character device"),
-        (stat.S_ISBLK, "a block device"),
-        (stat.S_ISSOCK, "a socket"),
-    ):
-        if test(mode):
-            return f"it is {what}"
-    return None
 
 
 def check_outputs(config: FleetConfig, out_dir: str | Path) -> None:
@@ -765,68 +699,19 @@ def check_outputs(config: FleetConfig, out_dir: str | Path) -> None:
     The paths: ``DIR`` itself, ``DIR/summary.csv``, ``DIR/summary.parquet``,
     ``DIR/fleet.html`` (and their stale temporaries), ``DIR/units`` and, for every unit,
     ``DIR/units/<id>`` (replaced when the unit is redone) and the temporary folders of
-    interrupted runs (deleted)."""
-    from thermocal.io import TEMP_SUFFIX
+    interrupted runs (deleted).  The rules are those of every command, one gate:
+    :func:`thermocal.outputs.check_outputs`."""
+    from thermocal.outputs import check_outputs as gate
 
     out = Path(out_dir)
-    inputs = [_Input(f, Path(f).resolve(), _inode(Path(f))) for f in config_inputs(config)]
-    by_inode: dict[tuple[int, int] | None, _Input] = {
-        i.inode: i for i in inputs if i.inode is not None
-    }
-
-    def refuse(target: Path, why: str) -> None:
-        raise ThermocalInputError(f"{target}: refusing to write the fleet output there: {why}")
-
-    def is_input(target: Path, kind: str) -> None:
-        r = target.resolve()
-        why = _special(target)
-        if why is not None:
-            refuse(target, why)
-        for i in inputs:
-            if i.resolved == r:
-                refuse(target, f"it is the input {i.given}")
-        hit = by_inode.get(_inode(target)) if target.exists() else None
-        if hit is not None:
-            refuse(target, f"it is the input {hit.given} (the same file)")
-        if kind == "file" and target.exists() and not target.is_file():
-            refuse(target, "it exists and is not a regular file")
-        if kind == "dir" and target.exists() and not target.is_dir():
-            refuse(target, "it exists and is not a directory")
-
-    def holds_input(folder: Path) -> None:
-        """``folder`` is replaced or deleted: no input may be in it."""
-        is_input(folder, "dir")
-        r = folder.resolve()
-        for i in inputs:
-            if i.resolved.is_relative_to(r):
-                refuse(folder, f"it contains the input {i.given}, and fleet replaces it")
-        if not folder.is_dir():
-            return
-        for root, dirs, files in os.walk(r):
-            for name in (*files, *dirs):
-                hit = by_inode.get(_inode(Path(root) / name, follow=False))
-                if hit is not None:
-                    refuse(folder, f"it holds {Path(root) / name}, which is the input {hit.given}")
-
-    is_input(out, "dir")
-    for name in ("summary.csv", "summary.parquet", "fleet.html"):
-        target = out / name
-        is_input(target, "file")
-        if out.is_dir():
-            for tmp in out.glob(f".{glob_escape(name)}.*{TEMP_SUFFIX}"):
-                is_input(tmp, "file")
     units = out / "units"
-    is_input(units, "dir")
-    for u in config.units:
-        holds_input(unit_dir(out, u.id))
-    for d in _stale_folders(units):
-        holds_input(d)
-
-
-def glob_escape(name: str) -> str:
-    import glob
-
-    return glob.escape(name)
+    gate(
+        [out / name for name in ("summary.csv", "summary.parquet", "fleet.html")],
+        config_inputs(config),
+        dirs=[out, units],
+        replaced=[*(unit_dir(out, u.id) for u in config.units), *_stale_folders(units)],
+        what="the fleet output",
+    )
 
 
 _STALE = re.compile(r"^\.(?P<id>[A-Za-z0-9][A-Za-z0-9._-]*)\.(tmp|old)-[0-9a-f]{8}$")

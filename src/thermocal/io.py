@@ -54,6 +54,7 @@ from thermocal.errors import (
     ThermocalWarning,
     UnitWarning,
 )
+from thermocal.outputs import check_outputs, refuse_special
 from thermocal.recording import FloatArray, Metadata, Recording
 
 if TYPE_CHECKING:
@@ -127,6 +128,7 @@ def _writable_target(path: str | Path) -> Path:
     """``path`` as a Path, its directory created; an existing directory there is an
     input error (not an ``IsADirectoryError`` naming the temporary file)."""
     target = Path(path)
+    refuse_special(target)  # a FIFO, a device, /proc…: never replaced by a regular file
     if target.is_dir():
         raise ThermocalInputError(f"{path}: is a directory, expected a file name")
     try:
@@ -273,6 +275,7 @@ def staging_directory(target: str | Path) -> Path:
     :func:`discard_staging` removes it on failure, and the next
     run to the same target removes those of runs that died."""
     t = Path(target)
+    refuse_special(t)
     if t.exists() and not t.is_dir():
         raise ThermocalInputError(f"{target}: exists and is not a directory")
     try:
@@ -326,16 +329,10 @@ def write_json(path: str | Path, obj: Any) -> None:
 
 
 def check_not_input(out: str | Path, inputs: list[str | Path]) -> None:
-    """Refuse to write an output over one of the inputs or over an input's sidecar
-    ``FILE.meta.json`` (INTERFACE.md common rules)."""
-    o = Path(out).resolve()
-    for i in inputs:
-        if Path(i).resolve() == o:
-            raise ThermocalInputError(f"{out}: refusing to write over the input file {i}")
-        if sidecar_path(Path(i).resolve()) == o:
-            raise ThermocalInputError(
-                f"{out}: refusing to write over the metadata sidecar of the input file {i}"
-            )
+    """Refuse to write ``out`` over one of the inputs or an input's sidecar
+    ``FILE.meta.json``, or onto a special file (the one gate,
+    :func:`thermocal.outputs.check_outputs`; INTERFACE.md common rules)."""
+    check_outputs([out], inputs)
 
 
 # --- reading -------------------------------------------------------------------------

@@ -13,6 +13,7 @@ import typer
 from thermocal._lazy import LazyModule
 from thermocal.cli.application import app
 from thermocal.cli.common import JsonOpt, emit, fmt, handle_errors, progress, stdout
+from thermocal.outputs import check_outputs
 
 if TYPE_CHECKING:
     import rich.markup as _markup
@@ -53,13 +54,15 @@ def demo_cmd(
 
     With ``--imu``: the same for a six-channel MEMS IMU, into one calibration file.
     """
+    if imu and output == Path("thermocal-demo"):
+        output = Path("thermocal-imu-demo")
+    check_outputs([], [], dirs=[output])  # no FIFO, device, /proc… (the demo reads no file)
     if output.exists() and not output.is_dir():
         from thermocal.errors import ThermocalInputError
 
         raise ThermocalInputError(f"{output}: exists and is not a directory")
     if imu:
-        _imu_demo(output if output != Path("thermocal-demo") else Path("thermocal-imu-demo"),
-                  seed, quick, as_json)  # fmt: skip
+        _imu_demo(output, seed, quick, as_json)
         return
     with progress("thermocal demo", total=len(_demo.DEMO_STEPS)) as advance:
         res = _demo.run_demo(output, seed=seed, config=_demo.QUICK if quick else None,

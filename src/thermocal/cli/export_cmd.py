@@ -17,6 +17,7 @@ from thermocal._lazy import LazyModule
 from thermocal.cli.application import app
 from thermocal.cli.common import JsonOpt, ModelArg, emit, fmt, handle_errors, stdout
 from thermocal.errors import ThermocalInputError, ThermocalWarning, UnitWarning
+from thermocal.outputs import check_outputs
 
 if TYPE_CHECKING:
     import thermocal.export_c as _export_c
@@ -87,7 +88,7 @@ def _export_calibration(
         ex = generate_c_triads(
             cal.triads, prefix=name or _export_c.c_identifier(path.stem), real=real
         )
-        paths = ex.write(output)
+        paths = ex.write(output, inputs=[path])
         out_t = {
             "family": "triads",
             "prefix": ex.prefix,
@@ -113,7 +114,7 @@ def _export_calibration(
         real=real,
         sample_interval_s=sample_interval,
     )
-    paths = ex.write(output)
+    paths = ex.write(output, inputs=[path])
     out = {
         "family": "calibration",
         "prefix": ex.prefix,
@@ -170,6 +171,7 @@ def export_c_cmd(
 ) -> None:
     """Write MODEL as a C99 header and source (no dynamic allocation) into DIR."""
     real = "float" if use_float else "double"
+    check_outputs([], [model_file], dirs=[output])  # the files themselves: when named
     raw = _read_json(model_file)
     if _calibration.is_calibration(raw):
         _export_calibration(model_file, output, name, real, sample_interval, unit, as_json)

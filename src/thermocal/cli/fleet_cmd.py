@@ -60,6 +60,7 @@ def fleet_cmd(
         raise ThermocalInputError(f"--workers must be at least 1, got {workers}")
     if scheduler is not None and workers is not None:
         raise ThermocalInputError("give --workers or --scheduler, not both")
+    _fleet.check_outputs(cfg, output)  # inputs are sacred: before anything is written
     if output.exists() and not output.is_dir():
         raise ThermocalInputError(f"{output}: exists and is not a directory")
     n_workers = workers if workers is not None else max(1, min(os.cpu_count() or 1, len(cfg.units)))

@@ -21,6 +21,7 @@ from thermocal._lazy import LazyModule
 from thermocal.cli.application import app
 from thermocal.cli.common import JsonOpt, OutOpt, emit, handle_errors, split_floats, stdout
 from thermocal.errors import FileFormatError, MissingColumnError, ThermocalInputError
+from thermocal.outputs import check_outputs
 
 if TYPE_CHECKING:
     import numpy as np
@@ -73,6 +74,7 @@ ColumnOpt = Annotated[
 def _write_profile(
     prof: "_profiles.Profile", output: Path, dt: float, as_json: bool, **extra: Any
 ) -> None:
+    check_outputs([output], [])  # no FIFO, device, /proc… (inputs: checked by the caller)
     if not (dt >= 0 and math.isfinite(dt)):
         raise ThermocalInputError(f"--dt must be ≥ 0 s (0: corner points only), got {dt:g}")
     t, c = prof.program(dt if dt > 0 else None)

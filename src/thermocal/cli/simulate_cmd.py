@@ -27,6 +27,7 @@ from thermocal._lazy import LazyModule
 from thermocal.cli.application import app
 from thermocal.cli.common import AxisOpt, JsonOpt, LatitudeOpt, emit, handle_errors, stdout
 from thermocal.errors import FileFormatError, ThermocalInputError
+from thermocal.outputs import check_outputs
 
 if TYPE_CHECKING:
     import thermocal.io as _io
@@ -60,6 +61,18 @@ def output_paths(output: Path, scenario: str, labels: list[str], fmt: str) -> li
     if output.exists() and not output.is_dir():
         raise ThermocalInputError(f"{output}: exists and is not a directory")
     return [output / (f"{scenario}_{lab}{ext}" if lab else f"{scenario}{ext}") for lab in labels]
+
+
+def _early_gate(output: Path, truth: Path | None, inputs: list[str | Path]) -> None:
+    """Refuse outputs over the inputs or on special files before simulating
+    (:func:`thermocal.outputs.check_outputs`; the files named after the results are
+    checked again once known)."""
+    try:
+        _io.file_kind(output)
+        files, dirs = [output], []
+    except FileFormatError:
+        files, dirs = [], [output]
+    check_outputs([*files, *([truth] if truth is not None else [])], inputs, dirs=dirs)
 
 
 @app.command("simulate")
@@ -119,9 +132,10 @@ def simulate_cmd(
     if latitude is not None and not (math.isfinite(latitude) and abs(latitude) <= 90.0):
         raise ThermocalInputError(f"--latitude must be within ±90°, got {latitude!r}")
     prog = None
+    inputs: list[str | Path] = [profile] if profile is not None else []
+    _early_gate(output, truth, inputs)
     if profile is not None:
         prog = _profiles.read_program(profile)
-        _io.check_not_input(output, [profile])
     opts: dict[str, Any] = {
         k: v
         for k, v in {
@@ -140,9 +154,8 @@ def simulate_cmd(
     if len(set(labels)) != len(labels):
         labels = [f"{i + 1}" for i in range(len(results))]
     paths = output_paths(output, scenario, labels, fmt)
-    inputs: list[str | Path] = [profile] if profile is not None else []
-    for p in paths:
-        _io.check_not_input(p, inputs)
+    sidecars = [_io.sidecar_path(p) for p in paths if _io.file_kind(p) == "csv"]
+    check_outputs([*paths, *sidecars], inputs, dirs=[p.parent for p in paths])
     if truth is not None:
         _io.check_not_input(truth, [*inputs, *paths])
     for (rec, _), p in zip(results, paths, strict=True):

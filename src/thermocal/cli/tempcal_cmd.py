@@ -28,6 +28,7 @@ from thermocal.cli.common import (
 )
 from thermocal.defaults import overrides_of
 from thermocal.errors import ThermocalInputError
+from thermocal.outputs import check_outputs
 
 if TYPE_CHECKING:
     import rich.table as _rich_table
@@ -94,6 +95,8 @@ def px4_tempcal_cmd(
     )
     from thermocal.report.calibration import CalibrationReportInputs, write_calibration_report
 
+    # DIR may hold the log; the files of the set (replaced by name) may not be it
+    check_outputs([output / "calibration.json", output / "px4.params"], [log], dirs=[output])
     if output.exists() and not output.is_dir():
         raise ThermocalInputError(f"{output}: exists and is not a directory")
     topics = log_topics(log)
@@ -101,6 +104,7 @@ def px4_tempcal_cmd(
         raise ThermocalInputError(
             f"{log}: no sensor_gyro or sensor_accel topic with a temperature in the log"
         )
+    check_outputs([output / f"report_{n}_{i}.html" for n, i in topics], [log], dirs=[output])
     stage = staging_directory(output)  # the set is moved into place whole, or removed
     fits, reports = [], []
     gates: list[str | None] = []
@@ -255,6 +259,10 @@ def ardupilot_tempcal_cmd(
     from thermocal.recording import Recording
     from thermocal.report.calibration import CalibrationReportInputs, write_calibration_report
 
+    # DIR may hold the log; the files of the set (replaced by name) may not be it
+    names = ["calibration.json", "ardupilot.parm"]
+    names += [f"report_IMU_{i}_{k}.html" for i in range(3) for k in ("gyro", "accel")]
+    check_outputs([output / n for n in names], [log], dirs=[output])
     if output.exists() and not output.is_dir():
         raise ThermocalInputError(f"{output}: exists and is not a directory")
     stage = staging_directory(output)  # the set is moved into place whole, or removed

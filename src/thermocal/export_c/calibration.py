@@ -209,4 +209,4 @@ def export_c(
         sample_interval_s=sample_interval_s,
         unit=unit,
     )
-    return ex, ex.write(out_dir)
+    return ex, ex.write(out_dir, inputs=[model_path])

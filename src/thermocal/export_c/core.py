@@ -80,12 +80,16 @@ class CExport:
     def source_name(self) -> str:
         return f"{self.prefix}.c"
 
-    def write(self, directory: str | Path) -> list[Path]:
-        """Write header and source into ``directory`` (atomically); returns the paths."""
+    def write(self, directory: str | Path, inputs: Sequence[str | Path] = ()) -> list[Path]:
+        """Write header and source into ``directory`` (atomically); returns the paths.
+        Neither may be one of ``inputs`` (the model file: ``export-c model.c -o .``) nor a
+        special file (:func:`thermocal.outputs.check_outputs`)."""
         from thermocal.errors import ThermocalInputError
         from thermocal.io import atomic_write
+        from thermocal.outputs import check_outputs
 
         d = Path(directory)
+        check_outputs([d / self.header_name, d / self.source_name], inputs, dirs=[d])
         if d.exists() and not d.is_dir():
             raise ThermocalInputError(f"{d}: exists and is not a directory (-o names a directory)")
         try:

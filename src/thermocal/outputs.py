@@ -1,0 +1,215 @@
+"""Where a command may write: the one gate every output passes before anything is written
+(issue 26 item 1; INTERFACE.md common rules, "nothing is ever written over an input file").
+
+:func:`check_outputs` refuses (:class:`~thermocal.errors.ThermocalInputError`, exit 2, one
+``error:`` line naming the output and the input) when
+
+* a file the command writes or replaces **is** one of its inputs or an input's metadata
+  sidecar ``FILE.meta.json``: compared by resolved path (so a symbolic link to an input, or
+  a path through a linked folder, counts) and by inode (so a hard link counts);
+* a folder the command replaces or deletes (``replaced``) is, or **contains**, an input (by
+  resolved path, and by the inode of every entry under it, links not followed).  A folder
+  the command only writes into (``dirs``: ``export-c``, the tempcal commands, ``demo``) may
+  hold inputs: the files it would write there are checked one by one;
+* a temporary of an output (``.NAME.<pid>.<random>.thermocal-partial`` beside it, see
+  :data:`thermocal.io.TEMP_SUFFIX`), which a later run removes, is or holds an input;
+* the output is a **special file** (:func:`special_reason`): a FIFO, a character or block
+  device, a socket, anything under ``/proc``, ``/dev`` or ``/sys``, or a symbolic link whose
+  chain passes through them (a link to ``/proc/self/fd/1``, ``/dev/stdout`` itself).  The
+  writers rename a finished temporary over the output, which would replace the special file
+  by a regular one (as root even ``/dev/stdout`` or ``/dev/null``) instead of writing into
+  it.  ``/dev/null`` is refused like every other device: the simplest rule, and one that
+  cannot go wrong as root; to discard results, write them into a temporary folder.
+
+Files the command writes that do not exist yet and hold no input pass.  The check runs
+before the first byte is written; :func:`thermocal.io.atomic_write` and
+:func:`thermocal.io.staging_directory` repeat the special-file part for every file they
+open, as a backstop.
+"""
+
+from __future__ import annotations
+
+import glob
+import os
+import stat
+from collections.abc import Iterable
+from dataclasses import dataclass
+from pathlib import Path
+
+from thermocal.errors import ThermocalInputError
+
+SPECIAL_ROOTS = (Path("/proc"), Path("/dev"), Path("/sys"))
+"""File systems that are not storage: never an output."""
+
+
+@dataclass(frozen=True)
+class _Input:
+    label: str
+    """How the error names it: ``the input file X`` or ``the metadata sidecar of …``."""
+    resolved: Path
+    inode: tuple[int, int] | None
+
+
+def _inode(path: Path, follow: bool = True) -> tuple[int, int] | None:
+    """(device, inode) of ``path``, or None when it does not exist."""
+    try:
+        st = os.stat(path, follow_symlinks=follow)
+    except OSError:
+        return None
+    return (st.st_dev, st.st_ino)
+
+
+def _link_chain(path: Path) -> list[Path]:
+    """``path`` (absolute, not resolved) and every path its symbolic links lead through
+    (``out/fleet.html`` → ``/proc/self/fd/1`` → ``/dev/pts/0``…), the resolved one last."""
+    chain = [Path(os.path.abspath(path))]
+    p = chain[0]
+    for _ in range(40):
+        # the link of the first component that is one (a folder or the file itself)
+        hop = None
+        for i in range(1, len(p.parts) + 1):
+            head = Path(*p.parts[:i])
+            if head.is_symlink():
+                try:
+                    target = os.readlink(head)
+                except OSError:
+                    break
+                hop = Path(os.path.normpath(head.parent / target)).joinpath(*p.parts[i:])
+                break
+        if hop is None or hop in chain:
+            break
+        chain.append(hop)
+        p = hop
+    chain.append(path.resolve())
+    return chain
+
+
+def special_reason(path: str | Path) -> str | None:
+    """Why ``path`` is no place for an output (it, or a link it leads through, lies under
+    :data:`SPECIAL_ROOTS`, or it is a FIFO, a device or a socket), or None.  Only
+    ``stat`` and ``readlink`` are used: a FIFO is never opened."""
+    p = Path(path)
+    for hop in _link_chain(p):
+        for root in SPECIAL_ROOTS:
+            if hop == root or hop.is_relative_to(root):
+                return f"it is under {root}, not a storage file system"
+    try:
+        mode = os.stat(p).st_mode
+    except OSError:
+        return None
+    for test, what in (
+        (stat.S_ISFIFO, "a FIFO"),
+        (stat.S_ISCHR, "a character device"),
+        (stat.S_ISBLK, "a block device"),
+        (stat.S_ISSOCK, "a socket"),
+    ):
+        if test(mode):
+            return f"it is {what}"
+    return None
+
+
+def refuse_special(path: str | Path, what: str = "the output") -> None:
+    """Raise when ``path`` is a special file (:func:`special_reason`)."""
+    why = special_reason(path)
+    if why is not None:
+        raise ThermocalInputError(f"{path}: refusing to write {what} there: {why}")
+
+
+def _inputs(inputs: Iterable[str | Path]) -> list[_Input]:
+    from thermocal.io import sidecar_path
+
+    out = []
+    for given in inputs:
+        p = Path(given)
+        out.append(_Input(f"the input file {given}", p.resolve(), _inode(p)))
+        side = sidecar_path(p)
+        out.append(
+            _Input(f"the metadata sidecar of the input file {given}", side.resolve(), _inode(side))
+        )
+    return out
+
+
+def _temporaries(target: Path) -> list[Path]:
+    """The temporaries of ``target`` (files or staging folders) a later run removes."""
+    from thermocal.io import TEMP_SUFFIX
+
+    parent = target.parent
+    if not parent.is_dir():
+        return []
+    return sorted(parent.glob(f".{glob.escape(target.name)}.*{TEMP_SUFFIX}"))
+
+
+def check_outputs(
+    outputs: Iterable[str | Path],
+    inputs: Iterable[str | Path],
+    *,
+    dirs: Iterable[str | Path] = (),
+    replaced: Iterable[str | Path] = (),
+    what: str = "the output",
+) -> None:
+    """Refuse a run, before anything is written, whose outputs would write, replace or
+    delete one of its ``inputs`` or land on a special file (module docstring).
+
+    ``outputs``: files the command writes (replacing any file of that name); ``dirs``:
+    folders it creates or writes files into; ``replaced``: folders it replaces or deletes
+    (they may hold no input).  ``what`` names the outputs in the message."""
+    ins = _inputs(inputs)
+    by_inode: dict[tuple[int, int] | None, _Input] = {
+        i.inode: i for i in ins if i.inode is not None
+    }
+
+    def refuse(target: Path, why: str) -> None:
+        raise ThermocalInputError(f"{target}: refusing to write {what} there: {why}")
+
+    def not_input(target: Path, folder: bool = False) -> None:
+        why = special_reason(target)
+        if why is not None:
+            refuse(target, why)
+        r = target.resolve()
+        hit = next((i for i in ins if i.resolved == r), None)
+        link = ""
+        if hit is None and target.exists():
+            hit = by_inode.get(_inode(target))
+            link = " (the same file: a hard link)"
+        if hit is not None and folder:
+            refuse(target, f"it is {hit.label}{link}, not a directory")
+        if hit is not None:
+            raise ThermocalInputError(f"{target}: refusing to write over {hit.label}{link}")
+
+    def holds_no_input(folder: Path, is_dir: bool = True) -> None:
+        """``folder`` is replaced or deleted: no input may be in it."""
+        not_input(folder, folder=is_dir)
+        r = folder.resolve()
+        for i in ins:
+            if i.resolved.is_relative_to(r):
+                refuse(folder, f"it contains {i.label}, which would be deleted")
+        if not folder.is_dir():
+            return
+        for root, subdirs, files in os.walk(r):
+            for name in (*files, *subdirs):
+                hit = by_inode.get(_inode(Path(root) / name, follow=False))
+                if hit is not None:
+                    refuse(folder, f"it holds {Path(root) / name}, which is {hit.label}")
+
+    def no_stale_input(target: Path) -> None:
+        for tmp in _temporaries(target):
+            holds_no_input(tmp, is_dir=False)
+
+    for d in (Path(x) for x in dirs):
+        not_input(d, folder=True)
+        if d.exists() and not d.is_dir():
+            raise ThermocalInputError(f"{d}: exists and is not a directory")
+        no_stale_input(d)
+    for d in (Path(x) for x in replaced):
+        holds_no_input(d)
+        if d.exists() and not d.is_dir():
+            raise ThermocalInputError(f"{d}: exists and is not a directory")
+        no_stale_input(d)
+    for f in (Path(x) for x in outputs):
+        not_input(f)
+        if f.is_dir():
+            raise ThermocalInputError(f"{f}: is a directory, expected a file name")
+        no_stale_input(f)
+
+
+__all__ = ["SPECIAL_ROOTS", "check_outputs", "refuse_special", "special_reason"]
