@@ -54,12 +54,21 @@ class RichDisplay:
         self.console = Console(stderr=True)
         self.live = Live(console=self.console, refresh_per_second=REFRESH_HZ, transient=False)
         self.live.start()
+        self._last = -1.0e9
+        self._open = True
 
     def update(self, state: StationState) -> None:
-        self.live.update(render(state))
+        import time
+
+        now = time.monotonic()  # the loop turns at 50 Hz; the display needs 4
+        if now - self._last >= 1.0 / REFRESH_HZ:
+            self._last = now
+            self.live.update(render(state))
 
     def log(self, message: str) -> None:
         self.console.print(message, markup=False, highlight=False)
 
     def close(self) -> None:
-        self.live.stop()
+        if self._open:
+            self._open = False
+            self.live.stop()
