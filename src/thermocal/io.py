@@ -1641,6 +1641,22 @@ def _fc_log_unknown_units(
         )
 
 
+def _station_path(p: Path) -> bool:
+    """``DIR`` (or ``DIR/SENSOR``) written by ``thermocal station run``."""
+    return (p.is_dir() or not p.exists()) and (
+        (p / "station.json").is_file() or (p.parent / "station.json").is_file()
+    )
+
+
+def _read_station(p: Path) -> tuple[pd.DataFrame, dict[str, Any]]:
+    """The closed Parquet parts of a station recording as one table
+    (:func:`thermocal.station.recorder.read_station`)."""
+    from thermocal.station.recorder import read_station
+
+    table, meta = read_station(p)
+    return table.to_pandas(), meta
+
+
 def read_recording(
     path: str | Path,
     *,
@@ -1658,11 +1674,12 @@ def read_recording(
     text: TextOptions | None = None,
     topic: str | None = None,
 ) -> Recording:
-    """Read a CSV, text log or Parquet recording.
+    """Read a CSV, text log or Parquet recording, or a station's recording folder.
 
     Parameters
     ----------
-    path : the file; its extension chooses the format.
+    path : the file; its extension chooses the format.  A folder written by ``thermocal
+        station run`` is read as one recording (``DIR``, or ``DIR/SENSOR`` of several).
     time : name of the time column (default: sidecar's, else ``"time"``).
     time_unit : ``s``, ``ms`` or ``us``; converted to [s].
     signals, temperatures : column names with those roles (default: sidecar's).
@@ -1695,10 +1712,11 @@ def read_recording(
     UnitError : an unknown unit string.
     """
     p = Path(path)
-    kind = file_kind(p)
+    station = _station_path(p)  # a station's recording folder, DIR or DIR/SENSOR
+    kind = "station" if station else file_kind(p)
     if topic is not None and kind not in ("ulog", "dataflash"):
         raise ThermocalInputError(f"{p}: --topic is for flight-controller logs (.ulg, .bin)")
-    obj, file_meta = _read_table(p, kind, text, topic)
+    obj, file_meta = _read_station(p) if station else _read_table(p, kind, text, topic)
     side = _load_sidecar(p)
     info: dict[str, Any] = {**file_meta, **side}
 

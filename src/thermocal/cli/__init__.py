@@ -38,6 +38,7 @@ COMMAND_MODULES = (
     "report_cmd",
     "fleet_cmd",
     "demo_cmd",
+    "station_cmd",
 )
 """Command modules, registered in this order (a missing module is skipped)."""
 
@@ -58,6 +59,7 @@ COMMANDS: dict[str, str] = {
     "report": "report_cmd",
     "fleet": "fleet_cmd",
     "demo": "demo_cmd",
+    "station": "station_cmd",
 }
 """The module of every command (a test checks it against what the modules register)."""
 

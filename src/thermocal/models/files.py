@@ -33,10 +33,14 @@ from thermocal.models.filecheck import read_json
 
 def file_sha256(path: str | Path, chunk: int = 1 << 20) -> str:
     """SHA-256 of a data file (provenance in model files)."""
+    from thermocal.station.recorder import is_station_path, station_files
+
     h = hashlib.sha256()
-    with open(path, "rb") as fh:
-        while block := fh.read(chunk):
-            h.update(block)
+    # a station's recording folder (DIR or DIR/SENSOR): its closed parts, in order
+    for f in station_files(Path(path)) if is_station_path(Path(path)) else [Path(path)]:
+        with open(f, "rb") as fh:
+            while block := fh.read(chunk):
+                h.update(block)
     return h.hexdigest()
 
 

@@ -1,0 +1,187 @@
+"""``thermocal station check|run``: the test station (INTERFACE.md, "Test station").
+
+Thin: parse, call :func:`thermocal.station.check.check_station` or
+:func:`thermocal.station.run.run_station`, print.  pymodbus and pyserial are imported when a
+command runs (``pip install 'thermocal[station]'``).
+"""
+
+import signal
+import sys
+from pathlib import Path
+from typing import TYPE_CHECKING, Annotated, Any
+
+import typer
+
+from thermocal._lazy import LazyModule
+from thermocal.cli.application import app
+from thermocal.cli.common import JsonOpt, emit, handle_errors, stdout
+from thermocal.cli.interrupt import EXIT_INTERRUPTED
+
+if TYPE_CHECKING:
+    import thermocal.profiles as _profiles
+    import thermocal.station.check as _check
+    import thermocal.station.config as _config
+    import thermocal.station.display as _display
+    import thermocal.station.run as _run
+else:
+    _profiles = LazyModule("thermocal.profiles")
+    _check = LazyModule("thermocal.station.check")
+    _config = LazyModule("thermocal.station.config")
+    _display = LazyModule("thermocal.station.display")
+    _run = LazyModule("thermocal.station.run")
+
+station_app = typer.Typer(
+    help="The test station: drive the chamber over Modbus and record serial sensors into a "
+    "crash-safe folder that every command reads as one recording.",
+    no_args_is_help=True,
+)
+app.add_typer(station_app, name="station")
+
+StationArg = Annotated[
+    Path, typer.Argument(help="STATION.toml: [chamber] and [[sensor]] tables.", show_default=False)
+]
+
+
+def _nan_none(v: float) -> float | None:
+    return None if v != v else v
+
+
+@station_app.command("check")
+@handle_errors
+def check_cmd(
+    station: StationArg,
+    listen: Annotated[
+        float, typer.Option("--listen", help="Seconds to listen to each sensor [s].")
+    ] = 3.0,
+    as_json: JsonOpt = False,
+) -> None:
+    """Connect to the chamber and every sensor; print the chamber's temperature and
+    set-point and each sensor's rate and first parsed line.  Exit 2 naming what did not
+    answer."""
+    cfg = _config.load_station(station)
+    res = _check.check_station(cfg, listen)
+    out: dict[str, Any] = {
+        "chamber": {
+            "driver": res.chamber,
+            "ok": res.chamber_ok,
+            "temperature_c": _nan_none(res.temperature_c),
+            "setpoint_c": _nan_none(res.setpoint_c),
+            "error": res.chamber_error or None,
+        },
+        "sensors": [
+            {
+                "id": s.id,
+                "device": s.device,
+                "ok": s.ok,
+                "rate_hz": _nan_none(s.rate_hz),
+                "lines": s.lines,
+                "bad_lines": s.bad_lines,
+                "first_line": s.first_line or None,
+                "error": s.error or None,
+            }
+            for s in res.sensors
+        ],
+    }
+
+    def human() -> None:
+        c = out["chamber"]
+        stdout.print(
+            f"chamber {res.chamber}: "
+            + (
+                f"temperature {c['temperature_c']} °C, set-point {c['setpoint_c']} °C"
+                if res.chamber_ok
+                else f"NO ANSWER: {res.chamber_error}"
+            )
+        )
+        for s in res.sensors:
+            rate = "—" if s.rate_hz != s.rate_hz else f"{s.rate_hz:.1f} Hz"
+            stdout.print(
+                f"sensor {s.id} ({s.device}): "
+                + (
+                    f"{rate}, {s.lines} lines ({s.bad_lines} bad), first: {s.first_line}"
+                    if s.ok
+                    else f"NO ANSWER: {s.error}"
+                )
+            )
+
+    emit(out, as_json, human)
+    if res.failed:
+        print("error: did not answer: " + "; ".join(res.failed), file=sys.stderr)
+        raise typer.Exit(2)
+
+
+def _sigterm(_signum: int, _frame: Any) -> None:
+    raise KeyboardInterrupt
+
+
+@station_app.command("run")
+@handle_errors
+def run_cmd(
+    station: StationArg,
+    profile: Annotated[
+        Path,
+        typer.Option(
+            "--profile", help="Chamber program CSV (time_s, setpoint_c).", show_default=False
+        ),
+    ],
+    output: Annotated[
+        Path, typer.Option("-o", "--output", help="Recording folder.", show_default=False)
+    ],
+    resume: Annotated[
+        bool, typer.Option("--resume", help="Continue the program where DIR's recording ends.")
+    ] = False,
+    time_scale: Annotated[
+        float, typer.Option("--time-scale", help="Run the program K times faster (rehearsals).")
+    ] = 1.0,
+    as_json: JsonOpt = False,
+) -> None:
+    """Run the chamber program and record every sensor and the chamber into DIR.
+
+    Ctrl-C, an error or the end of the program writes the safe set-point and closes every
+    file; continue an interrupted run with --resume.
+    """
+    cfg = _config.load_station(station)
+    prog_t, prog_c = _profiles.read_program(profile)
+    live = sys.stderr.isatty() and not as_json
+    disp = _display.RichDisplay() if live else _run.LogDisplay()
+    if hasattr(signal, "SIGTERM"):
+        signal.signal(signal.SIGTERM, _sigterm)
+    try:
+        res = _run.run_station(
+            cfg, (list(prog_t), list(prog_c)), output, profile_source=str(profile),
+            resume=resume, time_scale=time_scale, display=disp,
+        )  # fmt: skip
+    except KeyboardInterrupt:
+        if live:
+            disp.close()  # type: ignore[union-attr]
+        print(
+            f"interrupted: safe set-point written as logged above; the closed parts in {output} "
+            "are kept (the part open at the interruption was closed too); continue with "
+            "--resume",
+            file=sys.stderr,
+        )
+        raise typer.Exit(EXIT_INTERRUPTED) from None
+    finally:
+        if live:
+            disp.close()  # type: ignore[union-attr]
+    out = {
+        "out_dir": str(res.out_dir),
+        "ended": res.ended,
+        "program_start_s": res.program_start_s,
+        "program_end_s": res.program_end_s,
+        "parts": res.parts,
+        "samples": res.samples,
+        "bad_lines": res.bad_lines,
+        "setpoints_written": len(res.setpoints),
+        "safe_setpoint_c": res.safe_setpoint_c,
+    }
+
+    def human() -> None:
+        stdout.print(
+            f"recorded {sum(res.samples.values()):,} samples into {res.out_dir} "
+            f"({len(res.parts)} parts), program {res.program_start_s:.0f}–"
+            f"{res.program_end_s:.0f} s, ended: {res.ended}; bad lines: "
+            + ", ".join(f"{k} {v}" for k, v in res.bad_lines.items())
+        )
+
+    emit(out, as_json, human)

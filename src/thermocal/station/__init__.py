@@ -1,0 +1,18 @@
+"""The test station (INTERFACE.md, "Test station"; issue 31): drive a climatic chamber over
+Modbus, record serial sensors with host time stamps, and keep the recording crash-safe.
+
+Modules
+-------
+config    ``STATION.toml`` → frozen dataclasses (every key checked, errors name the key).
+chamber   chamber drivers: ``modbus-tcp``, ``modbus-rtu`` (pymodbus) and ``none`` (by hand).
+sensors   serial line readers (pyserial): host time stamps, bad lines counted and kept aside.
+recorder  Parquet parts closed every ``part_s`` seconds, ``station.json``; reading ``DIR``
+          back as one recording.
+run       the program loop: set-points, polling, stale sensors, the safe set-point on stop.
+sim       a simulated chamber (a pymodbus server with first-order dynamics) and simulated
+          serial sensors on pseudo-terminals, for tests, rehearsals and the demo.
+
+Units: temperatures [°C], times [s]; host time is the wall clock (``time.time()``) of the
+station PC, stored relative to the recording's start time (``station.json``).
+pymodbus and pyserial are an optional extra: ``pip install 'thermocal[station]'``.
+"""

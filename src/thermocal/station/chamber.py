@@ -1,0 +1,195 @@
+"""Chamber drivers: write the set-point and read the chamber's temperature.
+
+``modbus-tcp`` and ``modbus-rtu`` talk to the controller with pymodbus's synchronous
+clients through a generic register map (:class:`RegisterMap`: one holding register for the
+set-point, one holding or input register for the temperature, a scale in °C per count and
+16-bit signed or unsigned counts).  ``none`` is a chamber run by hand: each new set-point is
+shown to the operator and the chamber's temperature is unknown (NaN).
+
+No presets: the register maps of commercial controllers (Watlow F4, ESPEC, Vötsch/Weiss)
+depend on the controller's firmware and configured decimal places; a map copied from memory
+would write set-points to the wrong register.  Give the map from your controller's manual
+in ``STATION.toml``.
+"""
+
+from __future__ import annotations
+
+import inspect
+import math
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Any, Protocol
+
+from thermocal.errors import ThermocalError, ThermocalInputError
+from thermocal.station.config import ChamberConfig, require
+
+
+class ChamberError(ThermocalError):
+    """The chamber did not answer, or answered with a Modbus exception."""
+
+
+@dataclass(frozen=True)
+class RegisterMap:
+    """How a temperature is held in one 16-bit register.
+
+    ``counts = round(T / scale)``; signed registers hold −32768…32767 as two's complement
+    (``u = counts mod 2¹⁶``), unsigned ones 0…65535.  ``scale`` [°C per count].
+    """
+
+    setpoint_register: int
+    temperature_register: int
+    register_kind: str = "holding"
+    scale: float = 0.1
+    signed: bool = True
+
+    def encode(self, temperature_c: float) -> int:
+        """°C → the unsigned 16-bit word written to the register."""
+        counts = round(temperature_c / self.scale)
+        lo, hi = (-32768, 32767) if self.signed else (0, 65535)
+        if not (math.isfinite(temperature_c) and lo <= counts <= hi):
+            kind = "signed" if self.signed else "unsigned"
+            raise ThermocalInputError(
+                f"set-point {temperature_c:g} °C does not fit a {kind} 16-bit register at "
+                f"scale {self.scale:g} °C/count ({lo * self.scale:g}…{hi * self.scale:g} °C)"
+            )
+        return counts & 0xFFFF
+
+    def decode(self, word: int) -> float:
+        """The unsigned 16-bit word read from a register → °C."""
+        w = int(word) & 0xFFFF
+        if self.signed and w >= 0x8000:
+            w -= 0x10000
+        return w * self.scale
+
+
+class Chamber(Protocol):
+    """What the station needs of a chamber.  Temperatures [°C]."""
+
+    name: str
+
+    def connect(self) -> None: ...
+
+    def write_setpoint(self, setpoint_c: float) -> None: ...
+
+    def read_temperature(self) -> float: ...
+
+    def read_setpoint(self) -> float: ...
+
+    def close(self) -> None: ...
+
+
+class ManualChamber:
+    """``driver = "none"``: the operator sets the chamber by hand; every new set-point is
+    handed to ``show`` (the live display or a log line)."""
+
+    name = "none (by hand)"
+
+    def __init__(self, show: Callable[[str], None] | None = None) -> None:
+        self._show = show or (lambda _msg: None)
+        self._setpoint = math.nan
+
+    def connect(self) -> None:
+        return None
+
+    def write_setpoint(self, setpoint_c: float) -> None:
+        self._setpoint = setpoint_c
+        self._show(f"set the chamber to {setpoint_c:.2f} °C")
+
+    def read_temperature(self) -> float:
+        return math.nan
+
+    def read_setpoint(self) -> float:
+        return self._setpoint
+
+    def close(self) -> None:
+        return None
+
+
+def _unit_keyword(method: Callable[..., Any]) -> str:
+    """pymodbus ≥ 3.10 names the slave id ``device_id``; older releases ``slave``."""
+    params = inspect.signature(method).parameters
+    return "device_id" if "device_id" in params else "slave"
+
+
+class ModbusChamber:
+    """A controller on Modbus TCP or RTU (pymodbus).  Every request either returns or raises
+    :class:`ChamberError` within ``io_timeout_s`` (no retries: the station's own loop retries
+    at its poll interval and stops after ``timeout_s``)."""
+
+    def __init__(self, cfg: ChamberConfig) -> None:
+        self.cfg = cfg
+        self.map = RegisterMap(
+            cfg.setpoint_register, cfg.temperature_register, cfg.register_kind, cfg.scale,
+            cfg.signed,
+        )  # fmt: skip
+        if cfg.driver == "modbus-tcp":
+            self.name = f"modbus-tcp {cfg.host}:{cfg.port} unit {cfg.unit}"
+        else:
+            self.name = f"modbus-rtu {cfg.device} {cfg.baud} Bd unit {cfg.unit}"
+        self._client: Any = None
+
+    def connect(self) -> None:
+        client_mod = require("pymodbus.client")
+        if self.cfg.driver == "modbus-tcp":
+            self._client = client_mod.ModbusTcpClient(
+                self.cfg.host, port=self.cfg.port, timeout=self.cfg.io_timeout_s, retries=0
+            )
+        else:
+            require("serial")
+            self._client = client_mod.ModbusSerialClient(
+                self.cfg.device, baudrate=self.cfg.baud, timeout=self.cfg.io_timeout_s,
+                retries=0,
+            )  # fmt: skip
+        self._kw = _unit_keyword(self._client.read_holding_registers)
+        if not self._client.connect():
+            raise ChamberError(f"chamber {self.name}: cannot connect")
+
+    def _call(self, what: str, fn: Callable[..., Any], *args: Any) -> Any:
+        if self._client is None:
+            self.connect()
+        exc_mod = require("pymodbus.exceptions")
+        try:
+            rr = fn(*args, **{self._kw: self.cfg.unit})
+        except (exc_mod.ModbusException, OSError) as exc:
+            raise ChamberError(f"chamber {self.name}: {what}: {exc}") from None
+        if rr is None or rr.isError():
+            raise ChamberError(f"chamber {self.name}: {what}: Modbus error {rr}")
+        return rr
+
+    def write_setpoint(self, setpoint_c: float) -> None:
+        word = self.map.encode(setpoint_c)
+        self._call(
+            f"write set-point to register {self.map.setpoint_register}",
+            self._client_method("write_register"),
+            self.map.setpoint_register,
+            word,
+        )
+
+    def _client_method(self, name: str) -> Callable[..., Any]:
+        if self._client is None:
+            self.connect()
+        fn: Callable[..., Any] = getattr(self._client, name)
+        return fn
+
+    def _read(self, register: int, kind: str) -> float:
+        method = "read_input_registers" if kind == "input" else "read_holding_registers"
+        rr = self._call(f"read {kind} register {register}", self._client_method(method), register)
+        return self.map.decode(rr.registers[0])
+
+    def read_temperature(self) -> float:
+        return self._read(self.map.temperature_register, self.map.register_kind)
+
+    def read_setpoint(self) -> float:
+        return self._read(self.map.setpoint_register, "holding")
+
+    def close(self) -> None:
+        if self._client is not None:
+            self._client.close()
+            self._client = None
+
+
+def make_chamber(cfg: ChamberConfig, show: Callable[[str], None] | None = None) -> Chamber:
+    """The driver named by ``cfg.driver`` (not yet connected)."""
+    if cfg.driver == "none":
+        return ManualChamber(show)
+    return ModbusChamber(cfg)

@@ -1,0 +1,88 @@
+"""``thermocal station check``: does every part of the station answer?"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass
+
+from thermocal.errors import ThermocalInputError
+from thermocal.station.chamber import ChamberError, make_chamber
+from thermocal.station.config import StationConfig
+from thermocal.station.sensors import SerialSensor
+
+
+@dataclass(frozen=True)
+class SensorCheck:
+    """A sensor's answer: lines and bad lines seen in ``listen_s``, rate [Hz], the first
+    parsed line, or the error."""
+
+    id: str
+    device: str
+    ok: bool
+    rate_hz: float
+    lines: int
+    bad_lines: int
+    first_line: str
+    error: str
+
+
+@dataclass(frozen=True)
+class StationCheck:
+    """The chamber's temperature and set-point [°C] (NaN for ``none``) and each sensor."""
+
+    chamber: str
+    chamber_ok: bool
+    chamber_error: str
+    temperature_c: float
+    setpoint_c: float
+    sensors: tuple[SensorCheck, ...]
+
+    @property
+    def failed(self) -> list[str]:
+        """What did not answer."""
+        out = [] if self.chamber_ok else [f"chamber ({self.chamber_error})"]
+        out += [f"sensor {s.id} ({s.error})" for s in self.sensors if not s.ok]
+        return out
+
+
+def check_station(cfg: StationConfig, listen_s: float = 3.0) -> StationCheck:
+    """Connect to the chamber (read its temperature and set-point) and listen to every
+    sensor for up to ``listen_s`` seconds [s] (less once each has sent 20 good lines)."""
+    if not listen_s > 0:
+        raise ThermocalInputError(f"--listen must be > 0 s, got {listen_s}")
+    chamber = make_chamber(cfg.chamber)
+    temp = sp = math.nan
+    err = ""
+    try:
+        chamber.connect()
+        temp = chamber.read_temperature()
+        sp = chamber.read_setpoint()
+    except ChamberError as exc:
+        err = str(exc)
+    finally:
+        chamber.close()
+    sensors = [SerialSensor(s) for s in cfg.sensors]
+    opened: list[SerialSensor] = []
+    errors: dict[str, str] = {}
+    for s in sensors:
+        try:
+            s.start()
+            opened.append(s)
+        except ThermocalInputError as exc:
+            errors[s.cfg.id] = str(exc)
+    t_end = time.time() + listen_s
+    while time.time() < t_end and not all(s.stats.good >= 20 for s in opened):
+        time.sleep(0.05)
+    for s in opened:
+        s.close()
+    out = []
+    for s in sensors:
+        st = s.stats
+        e = errors.get(s.cfg.id) or st.error
+        if not e and st.good == 0:
+            e = (f"no parsed line in {listen_s:g} s ({st.bad} bad)" if st.bad
+                 else f"silent for {listen_s:g} s")  # fmt: skip
+        out.append(SensorCheck(s.cfg.id, s.cfg.device, not e, st.rate_hz(), st.lines, st.bad,
+                               st.first_line, e))  # fmt: skip
+    return StationCheck(chamber.name, not err, err, temp, sp, tuple(out))

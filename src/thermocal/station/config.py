@@ -1,0 +1,327 @@
+"""``STATION.toml``: the chamber and the sensors of a test station (INTERFACE.md, "Test
+station").  Every key is checked here; an error names the file and the key.
+
+Example::
+
+    part_s = 60                      # Parquet parts closed every 60 s [s]
+
+    [chamber]
+    driver = "modbus-tcp"            # or "modbus-rtu" (device, baud) or "none"
+    host = "192.168.0.20"
+    port = 502
+    unit = 1                         # Modbus slave id
+    setpoint_register = 300          # holding register written with the set-point
+    temperature_register = 100       # register read for the chamber's temperature
+    register_kind = "input"          # "holding" | "input" (of the temperature)
+    scale = 0.1                      # [°C per count]
+    signed = true                    # 16-bit two's complement
+    poll_s = 1                       # [s]
+    safe_setpoint_c = 25             # written on stop, error or Ctrl-C [°C]
+
+    [[sensor]]
+    id = "imu1"
+    device = "/dev/ttyUSB0"
+    baud = 115200
+    names = ["gx", "gy", "gz", "temp"]
+    units = ["deg/s", "deg/s", "deg/s", "degC"]
+    delimiter = ","
+    rate_hz = 100                    # the lines carry no time: time = line / rate
+
+Keys beyond the contract (all optional): ``[chamber]`` ``timeout_s`` (a chamber that does
+not answer for this long stops the run safely, default 30 s), ``io_timeout_s`` (one
+request, default 1 s), ``tolerance_c`` and ``drift_s`` (a chamber further than
+``tolerance_c`` from its set-point for ``drift_s`` of program time is reported; defaults
+5 °C, 1800 s); ``[[sensor]]`` ``decimal`` (``.`` or ``,``) and ``stale_s`` (a sensor
+silent this long is reported, default ``max(2 s, 20 / rate_hz)``).
+"""
+
+from __future__ import annotations
+
+import math
+import re
+import tomllib
+from dataclasses import asdict, dataclass
+from pathlib import Path
+from typing import Any
+
+from thermocal import units
+from thermocal.errors import ThermocalInputError
+
+DRIVERS = ("modbus-tcp", "modbus-rtu", "none")
+"""Chamber drivers: Modbus TCP, Modbus RTU over a serial line, or a chamber run by hand."""
+
+CHAMBER_STREAM = "chamber"
+"""The stream name of the chamber's own polled temperature (reserved: no sensor id)."""
+
+_ID = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_]*$")
+TIME_NAMES = ("time",)
+"""A sensor field with this name is the line's own time (its unit one of s, ms, us)."""
+
+
+@dataclass(frozen=True)
+class ChamberConfig:
+    """The ``[chamber]`` table.  Temperatures [°C], times [s]."""
+
+    driver: str = "none"
+    host: str = "127.0.0.1"
+    port: int = 502
+    device: str = ""
+    baud: int = 9600
+    unit: int = 1
+    setpoint_register: int = 0
+    temperature_register: int = 0
+    register_kind: str = "holding"
+    scale: float = 0.1
+    signed: bool = True
+    poll_s: float = 1.0
+    safe_setpoint_c: float = 25.0
+    timeout_s: float = 30.0
+    io_timeout_s: float = 1.0
+    tolerance_c: float = 5.0
+    drift_s: float = 1800.0
+
+
+@dataclass(frozen=True)
+class SensorConfig:
+    """One ``[[sensor]]``: a serial port sending one sample per text line."""
+
+    id: str
+    device: str
+    baud: int = 115200
+    names: tuple[str, ...] = ()
+    units: tuple[str, ...] = ()
+    delimiter: str | None = None
+    decimal: str = "."
+    rate_hz: float | None = None
+    stale_s: float | None = None
+
+    @property
+    def silence_s(self) -> float:
+        """Seconds without a line after which the sensor is reported stopped [s]."""
+        if self.stale_s is not None:
+            return self.stale_s
+        return max(2.0, 20.0 / self.rate_hz) if self.rate_hz else 2.0
+
+    @property
+    def time_name(self) -> str | None:
+        """The field holding the line's own time, if any."""
+        return next((n for n in self.names if n in TIME_NAMES), None)
+
+
+@dataclass(frozen=True)
+class StationConfig:
+    """A whole ``STATION.toml``."""
+
+    chamber: ChamberConfig
+    sensors: tuple[SensorConfig, ...]
+    part_s: float = 60.0
+    source: str = ""
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready (``station.json``'s ``config``)."""
+        out = asdict(self)
+        out["sensors"] = [asdict(s) for s in self.sensors]
+        return out
+
+
+def _err(where: str, msg: str) -> ThermocalInputError:
+    return ThermocalInputError(f"{where}: {msg}")
+
+
+def _take(
+    table: dict[str, Any], key: str, kind: type | tuple[type, ...], where: str, default: Any
+) -> Any:
+    if key not in table:
+        return default
+    v = table[key]
+    if kind is float and isinstance(v, int) and not isinstance(v, bool):
+        v = float(v)
+    if not isinstance(v, kind) or (kind is int and isinstance(v, bool)):
+        name = kind.__name__ if isinstance(kind, type) else "/".join(k.__name__ for k in kind)
+        raise _err(where, f"{key} must be {name}, got {v!r}")
+    if isinstance(v, float) and not math.isfinite(v):
+        raise _err(where, f"{key} must be finite, got {v!r}")
+    return v
+
+
+def _positive(v: float, key: str, where: str) -> float:
+    if not v > 0:
+        raise _err(where, f"{key} must be > 0, got {v!r}")
+    return v
+
+
+def _chamber(t: dict[str, Any], where: str) -> ChamberConfig:
+    w = f"{where} [chamber]"
+    known = set(ChamberConfig.__dataclass_fields__)
+    unknown = sorted(set(t) - known)
+    if unknown:
+        raise _err(w, f"unknown key {unknown[0]!r}; known: {', '.join(sorted(known))}")
+    d = ChamberConfig()
+    driver = _take(t, "driver", str, w, d.driver)
+    if driver not in DRIVERS:
+        raise _err(w, f"driver must be one of {', '.join(DRIVERS)}, got {driver!r}")
+    kind = _take(t, "register_kind", str, w, d.register_kind)
+    if kind not in ("holding", "input"):
+        raise _err(w, f"register_kind must be holding or input, got {kind!r}")
+    c = ChamberConfig(
+        driver=driver,
+        host=_take(t, "host", str, w, d.host),
+        port=_take(t, "port", int, w, d.port),
+        device=_take(t, "device", str, w, d.device),
+        baud=_take(t, "baud", int, w, d.baud),
+        unit=_take(t, "unit", int, w, d.unit),
+        setpoint_register=_take(t, "setpoint_register", int, w, d.setpoint_register),
+        temperature_register=_take(t, "temperature_register", int, w, d.temperature_register),
+        register_kind=kind,
+        scale=_positive(_take(t, "scale", float, w, d.scale), "scale", w),
+        signed=_take(t, "signed", bool, w, d.signed),
+        poll_s=_positive(_take(t, "poll_s", float, w, d.poll_s), "poll_s", w),
+        safe_setpoint_c=_take(t, "safe_setpoint_c", float, w, d.safe_setpoint_c),
+        timeout_s=_positive(_take(t, "timeout_s", float, w, d.timeout_s), "timeout_s", w),
+        io_timeout_s=_positive(
+            _take(t, "io_timeout_s", float, w, d.io_timeout_s), "io_timeout_s", w
+        ),
+        tolerance_c=_positive(_take(t, "tolerance_c", float, w, d.tolerance_c), "tolerance_c", w),
+        drift_s=_positive(_take(t, "drift_s", float, w, d.drift_s), "drift_s", w),
+    )
+    if driver != "none":
+        for key in ("setpoint_register", "temperature_register"):
+            if key not in t:
+                raise _err(w, f"driver {driver} needs {key}")
+        for key in ("setpoint_register", "temperature_register"):
+            if not 0 <= getattr(c, key) <= 0xFFFF:
+                raise _err(w, f"{key} must be a register address 0..65535")
+        if not 0 <= c.unit <= 247:
+            raise _err(w, f"unit (slave id) must be 0..247, got {c.unit}")
+    if driver == "modbus-rtu" and not c.device:
+        raise _err(w, "driver modbus-rtu needs device (a serial port) and baud")
+    return c
+
+
+def _unit_ok(u: str) -> bool:
+    for norm in (
+        units.normalize_signal_unit,
+        units.normalize_temperature_unit,
+        units.normalize_time_unit,
+    ):
+        try:
+            norm(u)
+        except ThermocalInputError:
+            continue
+        return True
+    return False
+
+
+def _sensor(t: dict[str, Any], where: str, i: int) -> SensorConfig:
+    w = f"{where} [[sensor]] #{i + 1}"
+    known = set(SensorConfig.__dataclass_fields__)
+    unknown = sorted(set(t) - known)
+    if unknown:
+        raise _err(w, f"unknown key {unknown[0]!r}; known: {', '.join(sorted(known))}")
+    sid = _take(t, "id", str, w, "")
+    if not _ID.match(sid) or sid == CHAMBER_STREAM:
+        raise _err(w, f"id must be letters, digits and _ (and not {CHAMBER_STREAM!r}), got {sid!r}")
+    w = f"{where} sensor {sid!r}"
+    device = _take(t, "device", str, w, "")
+    if not device:
+        raise _err(w, "device (a serial port) is missing")
+    names = tuple(_take(t, "names", list, w, []))
+    units_ = tuple(_take(t, "units", list, w, []))
+    if not names or not all(isinstance(n, str) and n for n in names):
+        raise _err(w, "names must be a non-empty list of column names")
+    if len(set(names)) != len(names):
+        raise _err(w, f"names repeats a name: {list(names)}")
+    if len(units_) != len(names):
+        raise _err(w, f"units must give one unit per name ({len(names)}), got {len(units_)}")
+    for n, u in zip(names, units_, strict=True):
+        if not isinstance(u, str) or not _unit_ok(u):
+            raise _err(w, f"unknown unit {u!r} of {n!r}")
+    reserved = {"host_time", "program_s", "setpoint_c", "chamber_c"}
+    clash = sorted(reserved & set(names))
+    if clash:
+        raise _err(w, f"name {clash[0]!r} is the station's own column; rename it")
+    rate = _take(t, "rate_hz", float, w, None)
+    if rate is not None:
+        _positive(rate, "rate_hz", w)
+    delim = _take(t, "delimiter", str, w, None)
+    if delim is not None and len(delim) != 1:
+        raise _err(w, f"delimiter must be one character, got {delim!r}")
+    decimal = _take(t, "decimal", str, w, ".")
+    if decimal not in (".", ","):
+        raise _err(w, f"decimal must be . or , got {decimal!r}")
+    if decimal == delim:
+        raise _err(w, "decimal and delimiter are the same character")
+    s = SensorConfig(
+        id=sid,
+        device=device,
+        baud=_take(t, "baud", int, w, 115200),
+        names=names,
+        units=units_,
+        delimiter=delim,
+        decimal=decimal,
+        rate_hz=rate,
+        stale_s=_take(t, "stale_s", float, w, None),
+    )
+    if s.time_name is not None:
+        tu = units_[names.index(s.time_name)]
+        try:
+            units.normalize_time_unit(tu)
+        except ThermocalInputError:
+            raise _err(
+                w, f"{s.time_name!r} is the line's time; its unit must be s, ms or us"
+            ) from None
+        if rate is not None:
+            raise _err(w, f"rate_hz given but the lines carry a time ({s.time_name!r}); drop one")
+    return s
+
+
+def parse_station(text: str, where: str = "STATION.toml") -> StationConfig:
+    """Parse and check the text of a ``STATION.toml``."""
+    try:
+        doc = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise _err(where, f"not valid TOML ({exc})") from None
+    known = {"part_s", "chamber", "sensor"}
+    unknown = sorted(set(doc) - known)
+    if unknown:
+        raise _err(where, f"unknown key {unknown[0]!r}; known: chamber, sensor, part_s")
+    ch = doc.get("chamber")
+    if not isinstance(ch, dict):
+        raise _err(where, 'no [chamber] table (driver = "none" for a chamber run by hand)')
+    raw_sensors = doc.get("sensor", [])
+    if not isinstance(raw_sensors, list) or not raw_sensors:
+        raise _err(where, "no [[sensor]]: a station records at least one serial sensor")
+    sensors = tuple(_sensor(s, where, i) for i, s in enumerate(raw_sensors))
+    ids = [s.id for s in sensors]
+    dup = sorted({i for i in ids if ids.count(i) > 1})
+    if dup:
+        raise _err(where, f"sensor id {dup[0]!r} used twice")
+    part_s = _positive(_take(doc, "part_s", float, where, 60.0), "part_s", where)
+    return StationConfig(_chamber(ch, where), sensors, part_s, where)
+
+
+def load_station(path: str | Path) -> StationConfig:
+    """Read and check ``STATION.toml`` (:func:`parse_station`)."""
+    p = Path(path)
+    if not p.is_file():
+        raise ThermocalInputError(f"{p}: no such file")
+    try:
+        text = p.read_text(encoding="utf-8")
+    except UnicodeDecodeError:
+        raise ThermocalInputError(f"{p}: not UTF-8 text") from None
+    return parse_station(text, str(p))
+
+
+def require(module: str) -> Any:
+    """Import an optional library of the station, or a one-line input error saying what to
+    install (exit 2 on the command line)."""
+    import importlib
+
+    try:
+        return importlib.import_module(module)
+    except ImportError:
+        lib = {"pymodbus": "pymodbus", "serial": "pyserial"}.get(module.split(".")[0], module)
+        raise ThermocalInputError(
+            f"the test station needs {lib}, which is not installed: "
+            "pip install 'thermocal[station]'"
+        ) from None

@@ -1,0 +1,387 @@
+"""The crash-safe recording folder of a station run.
+
+Layout of ``DIR``::
+
+    station.json              config, profile, start time, runs, parts, events
+    imu1-0000.parquet         closed parts of sensor ``imu1`` (every ``part_s`` seconds)
+    chamber-0000.parquet      the chamber's polled temperature and set-point
+    imu1.bad.txt              bad lines of ``imu1``: host time, line index, reason, text
+    .imu1-0007.parquet.tmp    a part being written: no reader accepts the name
+
+Rows wait in memory until their part is closed; the part is written under the temporary
+name, flushed to disk (``fsync``) and renamed.  A SIGKILL therefore loses at most the rows
+of the open part; every closed part is complete.  ``station.json`` is rewritten the same
+way (temporary, ``fsync``, rename) after each part and event.  A part's Parquet key-value
+metadata holds the thermocal metadata object (:func:`thermocal.io.recording_info`'s
+layout: time column, units of every column, the sensor id and the station's metadata), so
+each part is a complete recording on its own and :func:`read_station` concatenates them.
+
+Columns of a sensor part: ``time`` [s since the recording's start; from the line's own
+time field, else ``line index / rate_hz`` anchored at the run's first line, else the host
+time], ``host_time`` [s since the start], the sensor's named fields in their units,
+``chamber_c`` (the chamber's last polled temperature [°C], NaN when unknown), ``setpoint_c``
+(the set-point last written [°C]) and ``program_s`` (the program's time [s]).
+"""
+
+from __future__ import annotations
+
+import datetime as _dt
+import json
+import os
+import re
+import time
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+from thermocal import units
+from thermocal.errors import FileFormatError, ThermocalInputError
+from thermocal.station.config import CHAMBER_STREAM, StationConfig
+
+if TYPE_CHECKING:
+    import pyarrow as pa
+
+STATION_JSON = "station.json"
+STATION_FORMAT = "thermocal-station"
+STATION_VERSION = 1
+PART_RE = re.compile(r"^(?P<stream>[A-Za-z0-9][A-Za-z0-9_]*)-(?P<index>\d{4,})\.parquet$")
+STATION_COLUMNS = {
+    "time": "s",
+    "host_time": "s",
+    "chamber_c": "degC",
+    "setpoint_c": "degC",
+    "program_s": "s",
+}
+"""The station's own columns and their units."""
+
+
+def _fsync_write(path: Path, data: bytes) -> None:
+    tmp = path.with_name("." + path.name + ".tmp")
+    with open(tmp, "wb") as fh:
+        fh.write(data)
+        fh.flush()
+        os.fsync(fh.fileno())
+    os.replace(tmp, path)
+
+
+def part_name(stream: str, index: int) -> str:
+    return f"{stream}-{index:04d}.parquet"
+
+
+def closed_parts(out_dir: Path, stream: str | None = None) -> list[tuple[str, int, Path]]:
+    """Closed parts in ``out_dir`` as ``(stream, index, path)``, in stream and index order."""
+    out = []
+    for p in out_dir.iterdir():
+        m = PART_RE.match(p.name)
+        if m and (stream is None or m["stream"] == stream):
+            out.append((m["stream"], int(m["index"]), p))
+    return sorted(out, key=lambda x: (x[0], x[1]))
+
+
+def _column_units(names: tuple[str, ...], units_: tuple[str, ...]) -> dict[str, str]:
+    return dict(zip(names, units_, strict=True))
+
+
+def _is_temperature(unit: str) -> bool:
+    try:
+        return units.normalize_temperature_unit(unit) == "degC"
+    except ThermocalInputError:
+        return False
+
+
+@dataclass
+class _Stream:
+    """One stream's rows waiting for their part."""
+
+    name: str
+    columns: list[str]
+    units: dict[str, str]
+    next_index: int = 0
+    rows: int = 0
+
+    def __post_init__(self) -> None:
+        self.data: dict[str, list[float]] = {c: [] for c in self.columns}
+
+
+class Recorder:
+    """Writes the parts and ``station.json`` of one recording folder.
+
+    ``start_unix`` is the recording's start (host wall clock [s]); a resumed recording keeps
+    the first run's.  Not thread-safe: the station's loop calls it.
+    """
+
+    def __init__(
+        self,
+        out_dir: Path,
+        cfg: StationConfig,
+        program: tuple[list[float], list[float]],
+        *,
+        profile_source: str,
+        time_scale: float,
+        resume: bool,
+    ) -> None:
+        self.dir = out_dir
+        self.cfg = cfg
+        self.resume = resume
+        self.time_scale = time_scale
+        self.streams: dict[str, _Stream] = {}
+        self.removed_tmp: list[str] = []
+        if resume:
+            self.doc = self._load_for_resume(program)
+        else:
+            if out_dir.exists() and (not out_dir.is_dir() or any(out_dir.iterdir())):
+                raise ThermocalInputError(
+                    f"{out_dir}: exists and is not empty; continue it with --resume or name "
+                    "another -o"
+                )
+            out_dir.mkdir(parents=True, exist_ok=True)
+            now = time.time()
+            self.doc = {
+                "format": STATION_FORMAT,
+                "version": STATION_VERSION,
+                "config": cfg.to_dict(),
+                "profile": {
+                    "source": profile_source,
+                    "time_s": list(program[0]),
+                    "setpoint_c": list(program[1]),
+                },
+                "start_unix": now,
+                "start_utc": _dt.datetime.fromtimestamp(now, _dt.UTC).isoformat(),
+                "time_scale": time_scale,
+                "runs": [],
+                "parts": [],
+                "events": [],
+            }
+        self.start_unix = float(self.doc["start_unix"])
+        self._declare_streams()
+        self.part_started = time.time()
+        self.doc["runs"].append(
+            {"start_unix": time.time(), "time_scale": time_scale, "resumed": resume}
+        )
+        self.save()
+
+    # --- setup ------------------------------------------------------------------------
+    def _load_for_resume(self, program: tuple[list[float], list[float]]) -> dict[str, Any]:
+        doc = read_station_json(self.dir)
+        rec = doc.get("profile") or {}
+        if [float(x) for x in rec.get("time_s", [])] != [float(x) for x in program[0]] or [
+            float(x) for x in rec.get("setpoint_c", [])
+        ] != [float(x) for x in program[1]]:
+            raise ThermocalInputError(
+                f"{self.dir}: --resume with another program than the recording's "
+                f"({rec.get('source', '?')}); give the same --profile"
+            )
+        for p in self.dir.glob(".*.parquet.tmp"):  # the part open at the crash
+            self.removed_tmp.append(p.name)
+            p.unlink()
+        doc["parts"] = [  # what is on disk, whatever the last station.json said
+            {"stream": s, "file": p.name} for s, _i, p in closed_parts(self.dir)
+        ]
+        return doc
+
+    def _declare_streams(self) -> None:
+        existing = closed_parts(self.dir)
+        nxt: dict[str, int] = {}
+        for s, i, _p in existing:
+            nxt[s] = max(nxt.get(s, 0), i + 1)
+        for sc in self.cfg.sensors:
+            own = [n for n in sc.names if n != sc.time_name]
+            cols = ["time", "host_time", *own, "chamber_c", "setpoint_c", "program_s"]
+            u = {**STATION_COLUMNS, **{n: x for n, x in _column_units(sc.names, sc.units).items()
+                                       if n != sc.time_name}}  # fmt: skip
+            self.streams[sc.id] = _Stream(sc.id, cols, u, nxt.get(sc.id, 0))
+        cols = ["time", "program_s", "setpoint_c", "chamber_c"]
+        self.streams[CHAMBER_STREAM] = _Stream(
+            CHAMBER_STREAM, cols, {c: STATION_COLUMNS[c] for c in cols},
+            nxt.get(CHAMBER_STREAM, 0),
+        )  # fmt: skip
+
+    # --- rows, parts, events ---------------------------------------------------------------
+    def rel(self, unix: float) -> float:
+        """Host wall-clock time → seconds since the recording's start."""
+        return unix - self.start_unix
+
+    def add(self, stream: str, row: dict[str, float]) -> None:
+        st = self.streams[stream]
+        for c in st.columns:
+            st.data[c].append(float(row.get(c, float("nan"))))
+        st.rows += 1
+
+    def _meta(self, st: _Stream) -> dict[str, Any]:
+        from thermocal.io import META_FORMAT, META_VERSION
+
+        temps = {c: u for c, u in st.units.items() if c != "time" and _is_temperature(u)}
+        sigs = {}
+        if st.name != CHAMBER_STREAM:
+            sc = next(s for s in self.cfg.sensors if s.id == st.name)
+            sigs = {
+                n: u for n, u in zip(sc.names, sc.units, strict=True)
+                if n != sc.time_name and not _is_temperature(u)
+            }  # fmt: skip
+            temps = {n: u for n, u in zip(sc.names, sc.units, strict=True) if _is_temperature(u)}
+        others = {c: u for c, u in st.units.items() if c not in sigs and c not in temps}
+        others.pop("time", None)
+        station = {
+            "start_unix": self.start_unix,
+            "start_utc": self.doc["start_utc"],
+            "time_scale": self.time_scale,
+            "stream": st.name,
+            "chamber": self.doc["config"]["chamber"]["driver"],
+            "profile": self.doc["profile"]["source"],
+        }
+        return {
+            "format": META_FORMAT,
+            "version": META_VERSION,
+            "time": "time",
+            "time_unit": "s",
+            "signals": sigs,
+            "temperatures": temps,
+            "units": others,
+            "metadata": {"sensor_id": st.name, "extra": {"station": station}},
+        }
+
+    def close_parts(self) -> list[str]:
+        """Close the open part of every stream that has rows; returns the files written."""
+        import pyarrow as pa
+        import pyarrow.parquet as pq
+
+        from thermocal.io import META_KEY
+
+        written = []
+        for st in self.streams.values():
+            if st.rows == 0:
+                continue
+            table = pa.table({c: pa.array(st.data[c], pa.float64()) for c in st.columns})
+            table = table.replace_schema_metadata({META_KEY: json.dumps(self._meta(st))})
+            name = part_name(st.name, st.next_index)
+            final = self.dir / name
+            tmp = self.dir / ("." + name + ".tmp")
+            pq.write_table(table, tmp, write_page_checksum=True)
+            with open(tmp, "rb") as fh:
+                os.fsync(fh.fileno())
+            os.replace(tmp, final)
+            self.doc["parts"].append(
+                {
+                    "stream": st.name,
+                    "file": name,
+                    "rows": st.rows,
+                    "time_first": st.data["time"][0],
+                    "time_last": st.data["time"][-1],
+                    "program_s_last": st.data["program_s"][-1],
+                }
+            )
+            written.append(name)
+            st.next_index += 1
+            st.rows = 0
+            st.data = {c: [] for c in st.columns}
+        self.part_started = time.time()
+        if written:
+            self.save()
+        return written
+
+    def maybe_rotate(self, now_unix: float) -> list[str]:
+        if now_unix - self.part_started >= self.cfg.part_s:
+            return self.close_parts()
+        return []
+
+    def event(self, kind: str, message: str, **fields: Any) -> None:
+        now = time.time()
+        self.doc["events"].append(
+            {"time": self.rel(now), "kind": kind, "message": message, **fields}
+        )
+        self.save()
+
+    def bad_lines(self, sensor: str, rows: list[tuple[float, int, str, str]]) -> None:
+        """Append bad lines to ``DIR/<sensor>.bad.txt`` (flushed at once)."""
+        if not rows:
+            return
+        with open(self.dir / f"{sensor}.bad.txt", "a", encoding="utf-8") as fh:
+            for t, idx, reason, text in rows:
+                fh.write(f"{self.rel(t):.6f}\t{idx}\t{reason}\t{text}\n")
+            fh.flush()
+            os.fsync(fh.fileno())
+
+    def save(self) -> None:
+        _fsync_write(self.dir / STATION_JSON, json.dumps(self.doc, indent=1).encode())
+
+
+def read_station_json(out_dir: Path) -> dict[str, Any]:
+    p = out_dir / STATION_JSON
+    if not p.is_file():
+        raise FileFormatError(f"{out_dir}: not a station recording (no {STATION_JSON})")
+    try:
+        doc = json.loads(p.read_text(encoding="utf-8"))
+    except (json.JSONDecodeError, UnicodeDecodeError) as exc:
+        raise FileFormatError(f"{p}: not valid JSON ({exc})") from None
+    if not isinstance(doc, dict) or doc.get("format") != STATION_FORMAT:
+        raise FileFormatError(f"{p}: not a thermocal station file")
+    if int(doc.get("version", 0)) > STATION_VERSION:
+        raise FileFormatError(f"{p}: written by a newer thermocal (version {doc['version']})")
+    return doc
+
+
+def is_station_path(path: Path) -> bool:
+    """``DIR`` or ``DIR/SENSOR`` of a station recording."""
+    if path.is_dir():
+        return (path / STATION_JSON).is_file()
+    return not path.exists() and (path.parent / STATION_JSON).is_file()
+
+
+def sensor_ids(doc: dict[str, Any]) -> list[str]:
+    return [str(s["id"]) for s in (doc.get("config") or {}).get("sensors", [])]
+
+
+def _stream_of(path: Path) -> tuple[Path, str]:
+    """``(DIR, stream)`` of ``DIR`` (its only sensor) or ``DIR/SENSOR``."""
+    if path.is_dir():
+        doc = read_station_json(path)
+        ids = sensor_ids(doc)
+        if len(ids) != 1:
+            raise FileFormatError(
+                f"{path}: a station recording of {len(ids)} sensors ({', '.join(ids)}); "
+                f"name one as {path}/ID (or {path}/{CHAMBER_STREAM})"
+            )
+        return path, ids[0]
+    doc = read_station_json(path.parent)
+    ids = sensor_ids(doc)
+    if path.name not in (*ids, CHAMBER_STREAM):
+        raise FileFormatError(
+            f"{path}: no sensor {path.name!r} in this station recording; sensors: "
+            f"{', '.join([*ids, CHAMBER_STREAM])}"
+        )
+    return path.parent, path.name
+
+
+def station_files(path: Path) -> list[Path]:
+    """The closed parts of ``DIR`` or ``DIR/SENSOR``, in order (the recording's content)."""
+    out_dir, stream = _stream_of(path)
+    parts = closed_parts(out_dir, stream)
+    if not parts:
+        raise FileFormatError(f"{out_dir}: no closed part of {stream!r} yet")
+    return [p for _s, _i, p in parts]
+
+
+def read_station(path: Path) -> tuple[pa.Table, dict[str, Any]]:
+    """A station recording as one table: ``DIR`` (its only sensor) or ``DIR/SENSOR`` (one
+    of several, or ``DIR/chamber``).  The closed parts are concatenated in order; the
+    metadata object is the last part's.  Raises :class:`FileFormatError` naming what is
+    missing."""
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    from thermocal.io import META_KEY
+
+    files = station_files(path)
+    tables = []
+    for p in files:
+        try:
+            tables.append(pq.read_table(p))
+        except (pa.ArrowInvalid, OSError) as exc:
+            raise FileFormatError(f"{p}: not a readable Parquet part ({exc})") from None
+    raw = (tables[-1].schema.metadata or {}).get(META_KEY.encode())
+    meta: dict[str, Any] = json.loads(raw.decode()) if raw else {}
+    table = pa.concat_tables([t.replace_schema_metadata(None) for t in tables])
+    return table, meta
+
+
+__all__ = ["Recorder", "closed_parts", "is_station_path", "read_station", "read_station_json"]

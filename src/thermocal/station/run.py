@@ -1,0 +1,377 @@
+"""The station's program loop: set-points, chamber polling, sensor lines into the recorder,
+stale sensors, a silent or drifting chamber, and the safe set-point on every way out.
+
+Program time ``p`` [s] runs ``time_scale`` times faster than the host clock:
+``p = p0 + K·(t − t_run)``, ``p0`` = 0 for a new run and, for ``--resume``, the largest
+``program_s`` the recording holds (the program continues where the recording ends).  The
+set-point is the program interpolated linearly at ``p`` (``numpy.interp``: steps where the
+program has them, ramps where it ramps), rounded to the register's resolution, and written
+whenever that rounded value changes.
+"""
+
+from __future__ import annotations
+
+import math
+import sys
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Protocol
+
+from thermocal.errors import ThermocalInputError
+from thermocal.station.chamber import Chamber, ChamberError, make_chamber
+from thermocal.station.config import CHAMBER_STREAM, StationConfig
+from thermocal.station.recorder import Recorder, closed_parts
+from thermocal.station.sensors import SerialSensor
+
+LOOP_S = 0.02
+"""Longest sleep of the loop [s]: sensor lines are drained and stop requests seen at least
+this often."""
+
+
+class StationStopped(ThermocalInputError):
+    """The run stopped safely because the chamber stopped answering (exit 2)."""
+
+
+@dataclass
+class SensorView:
+    """One sensor's line of the live display."""
+
+    id: str
+    rate_hz: float
+    last: tuple[float, ...]
+    names: tuple[str, ...]
+    bad: int
+    samples: int
+    stopped: bool
+
+
+@dataclass
+class StationState:
+    """What the live display shows, refreshed by the loop."""
+
+    step: int = 0
+    n_steps: int = 0
+    program_s: float = 0.0
+    end_s: float = 0.0
+    setpoint_c: float = math.nan
+    chamber_c: float = math.nan
+    time_scale: float = 1.0
+    sensors: list[SensorView] = field(default_factory=list)
+    samples: int = 0
+    parts: int = 0
+    chamber_ok: bool = True
+
+    @property
+    def time_left_s(self) -> float:
+        """Host seconds left [s]."""
+        return max(0.0, (self.end_s - self.program_s) / self.time_scale)
+
+
+class Display(Protocol):
+    def update(self, state: StationState) -> None: ...
+
+    def log(self, message: str) -> None: ...
+
+
+class LogDisplay:
+    """Not a terminal: a line per program step and per event on stderr, nothing else."""
+
+    def update(self, state: StationState) -> None:
+        return None
+
+    def log(self, message: str) -> None:
+        print(message, file=sys.stderr, flush=True)
+
+
+@dataclass(frozen=True)
+class RunResult:
+    """What a run did: folder, program span covered [s], parts written, samples per stream,
+    bad lines per sensor, how it ended (``"end"``, ``"interrupted"``, ``"chamber"``), the
+    set-points written as ``(program_s, °C)`` and the safe set-point written (or None)."""
+
+    out_dir: Path
+    program_start_s: float
+    program_end_s: float
+    parts: list[str]
+    samples: dict[str, int]
+    bad_lines: dict[str, int]
+    ended: str
+    setpoints: list[tuple[float, float]]
+    safe_setpoint_c: float | None
+    events: list[dict[str, Any]]
+
+
+def _last_program_s(out_dir: Path) -> float:
+    """The largest ``program_s`` in the closed parts (0 when there are none) [s]."""
+    import pyarrow.compute as pc
+    import pyarrow.parquet as pq
+
+    last = 0.0
+    for _s, _i, p in closed_parts(out_dir):
+        col = pq.read_table(p, columns=["program_s"])["program_s"]
+        m = pc.max(col).as_py()
+        if m is not None and math.isfinite(m):
+            last = max(last, float(m))
+    return last
+
+
+def run_station(
+    cfg: StationConfig,
+    program: tuple[list[float], list[float]],
+    out_dir: Path,
+    *,
+    profile_source: str = "",
+    resume: bool = False,
+    time_scale: float = 1.0,
+    display: Display | None = None,
+    chamber: Chamber | None = None,
+    should_stop: Callable[[], bool] | None = None,
+) -> RunResult:
+    """Run the program on the station and record everything into ``out_dir``.
+
+    Raises :class:`StationStopped` (after the safe set-point and every file are written)
+    when the chamber has not answered for ``chamber.timeout_s``; a ``KeyboardInterrupt`` is
+    re-raised after the same safe stop.  ``should_stop`` (tests, a GUI) ends the run early
+    as an interrupt does, without the exception.
+    """
+    import numpy as np
+
+    if not (math.isfinite(time_scale) and time_scale > 0):
+        raise ThermocalInputError(f"--time-scale must be > 0, got {time_scale}")
+    disp = display or LogDisplay()
+    t_prog = np.asarray(program[0], dtype=np.float64)
+    c_prog = np.asarray(program[1], dtype=np.float64)
+    end_s = float(t_prog[-1])
+    ch_cfg = cfg.chamber
+    chamber = chamber or make_chamber(ch_cfg, disp.log)
+    for c in (*c_prog, ch_cfg.safe_setpoint_c):  # every set-point must fit the register
+        _quantize(float(c), ch_cfg.scale, ch_cfg.signed, ch_cfg.driver)
+
+    p0 = _last_program_s(out_dir) if resume and out_dir.is_dir() else 0.0
+    if resume and p0 >= end_s:
+        raise ThermocalInputError(
+            f"{out_dir}: the recording already reaches the program's end ({end_s:g} s)"
+        )
+    rec = Recorder(
+        out_dir, cfg, (list(map(float, t_prog)), list(map(float, c_prog))),
+        profile_source=profile_source, time_scale=time_scale, resume=resume,
+    )  # fmt: skip
+    if rec.removed_tmp:
+        rec.event("resume", "removed the part open at the interruption: " + ", ".join(
+            rec.removed_tmp))  # fmt: skip
+    if resume:
+        rec.event("resume", f"program continues at {p0:.1f} s", program_s=p0)
+        disp.log(f"resuming at program time {p0:.1f} s of {end_s:.1f} s")
+
+    sensors = [SerialSensor(s) for s in cfg.sensors]
+    state = StationState(n_steps=len(t_prog) - 1, end_s=end_s, time_scale=time_scale)
+    setpoints: list[tuple[float, float]] = []
+    samples = {s.id: 0 for s in cfg.sensors} | {CHAMBER_STREAM: 0}
+    bad = {s.id: 0 for s in cfg.sensors}
+    parts: list[str] = []
+    stopped = {s.id: False for s in cfg.sensors}
+    anchors: dict[str, float] = {}
+    last_time: dict[str, float] = {}
+    ended = "end"
+    safe: float | None = None
+    sp = math.nan
+    chamber_c = math.nan
+    fail_since: float | None = None
+    drift_since: float | None = None
+    drift_reported = False
+    step = -1
+    t_run = time.time()
+    p = p0
+    try:
+        try:
+            chamber.connect()
+            chamber_c = chamber.read_temperature()
+        except ChamberError as exc:
+            raise ThermocalInputError(f"{exc} (check [chamber] in {cfg.source})") from None
+        for s in sensors:
+            s.open()
+        for s in sensors:
+            s.start()
+        rec.event("start", f"chamber {chamber.name}, sensors " + ", ".join(
+            s.cfg.id for s in sensors), program_s=p0, time_scale=time_scale)  # fmt: skip
+        t_run = time.time()
+        next_poll = t_run
+        while True:
+            now = time.time()
+            p = p0 + (now - t_run) * time_scale
+            if p >= end_s or (should_stop is not None and should_stop()):
+                if p < end_s:
+                    ended = "interrupted"
+                p = min(p, end_s)
+                break
+            k = int(np.searchsorted(t_prog, p, side="right")) - 1
+            if k != step:
+                step = k
+                nxt = float(c_prog[min(k + 1, len(c_prog) - 1)])
+                msg = (f"step {k + 1}/{state.n_steps}: {float(c_prog[k]):.2f} → {nxt:.2f} °C "
+                       f"from program time {float(t_prog[k]):.0f} s")  # fmt: skip
+                disp.log(msg)
+                rec.event("step", msg, program_s=p, step=k + 1)
+            target = _quantize(float(np.interp(p, t_prog, c_prog)), ch_cfg.scale, ch_cfg.signed,
+                               ch_cfg.driver)  # fmt: skip
+            try:
+                if target != sp:
+                    chamber.write_setpoint(target)
+                    sp = target
+                    setpoints.append((p, target))
+                    rec.event("setpoint", f"{target:.3f} °C", program_s=p, setpoint_c=target)
+                if now >= next_poll:
+                    next_poll = max(next_poll + ch_cfg.poll_s, now)
+                    chamber_c = chamber.read_temperature()
+                    rec.add(CHAMBER_STREAM, {"time": rec.rel(now), "program_s": p,
+                                             "setpoint_c": sp, "chamber_c": chamber_c})  # fmt: skip
+                    samples[CHAMBER_STREAM] += 1
+                if fail_since is not None:
+                    rec.event("chamber", "the chamber answers again")
+                    disp.log("chamber answers again")
+                    fail_since = None
+            except ChamberError as exc:
+                if fail_since is None:
+                    fail_since = now
+                    rec.event("chamber", f"no answer: {exc}")
+                    disp.log(f"warning: {exc}")
+                elif now - fail_since >= ch_cfg.timeout_s:
+                    ended = "chamber"
+                    raise StationStopped(
+                        f"{exc}; no answer for {now - fail_since:.0f} s (timeout_s "
+                        f"{ch_cfg.timeout_s:g}): run stopped at program time {p:.1f} s; "
+                        f"continue with --resume"
+                    ) from None
+                next_poll = now + min(ch_cfg.poll_s, 0.5)
+            state.chamber_ok = fail_since is None
+            # drift: chamber away from its set-point for drift_s of program time
+            if math.isfinite(chamber_c) and abs(chamber_c - sp) > ch_cfg.tolerance_c:
+                drift_since = p if drift_since is None else drift_since
+                if not drift_reported and p - drift_since >= ch_cfg.drift_s:
+                    away = abs(chamber_c - sp)
+                    msg = (f"warning: chamber {chamber_c:.2f} °C is {away:.2f} °C from its "
+                           f"set-point {sp:.2f} °C for {p - drift_since:.0f} s")  # fmt: skip
+                    rec.event("drift", msg, program_s=p)
+                    disp.log(msg)
+                    drift_reported = True
+            else:
+                drift_since, drift_reported = None, False
+            # sensors
+            views = []
+            for s in sensors:
+                sid = s.cfg.id
+                got, bads = s.drain()
+                if bads:
+                    bad[sid] += len(bads)
+                    rec.bad_lines(sid, [(b.host_unix, b.index, b.reason, b.text) for b in bads])
+                for smp in got:
+                    row = _sensor_row(s, smp.host_unix, smp.index, smp.values, rec, anchors,
+                                      last_time)  # fmt: skip
+                    row.update(chamber_c=chamber_c, setpoint_c=sp,
+                               program_s=p0 + (smp.host_unix - t_run) * time_scale)  # fmt: skip
+                    rec.add(sid, row)
+                samples[sid] += len(got)
+                silent = (now - (s.stats.last_unix if s.stats.good else t_run)
+                          > s.cfg.silence_s) or bool(s.stats.error)  # fmt: skip
+                if silent and not stopped[sid]:
+                    why = s.stats.error or f"no line for {s.cfg.silence_s:g} s"
+                    msg = f"warning: sensor {sid} ({s.cfg.device}) stopped: {why}"
+                    rec.event("sensor", msg, sensor=sid, program_s=p)
+                    disp.log(msg)
+                elif not silent and stopped[sid]:
+                    rec.event("sensor", f"sensor {sid} sends again", sensor=sid, program_s=p)
+                    disp.log(f"sensor {sid} sends again")
+                stopped[sid] = silent
+                views.append(SensorView(sid, s.stats.rate_hz(), s.stats.last_values,
+                                        s.cfg.names, bad[sid], samples[sid], silent))  # fmt: skip
+            parts += rec.maybe_rotate(now)
+            state.step, state.program_s, state.setpoint_c = step + 1, p, sp
+            state.chamber_c, state.sensors = chamber_c, views
+            state.samples, state.parts = sum(samples.values()), len(parts)
+            disp.update(state)
+            time.sleep(LOOP_S)
+    except KeyboardInterrupt:
+        ended = "interrupted"
+        raise
+    finally:
+        safe = _safe_stop(chamber, ch_cfg.safe_setpoint_c, rec, disp)
+        for s in sensors:
+            s.close()
+        # the last lines that arrived before the ports closed
+        for s in sensors:
+            got, bads = s.drain()
+            bad[s.cfg.id] += len(bads)
+            rec.bad_lines(s.cfg.id, [(b.host_unix, b.index, b.reason, b.text) for b in bads])
+            for smp in got:
+                row = _sensor_row(s, smp.host_unix, smp.index, smp.values, rec, anchors, last_time)
+                row.update(chamber_c=chamber_c, setpoint_c=sp,
+                           program_s=p0 + (smp.host_unix - t_run) * time_scale)  # fmt: skip
+                rec.add(s.cfg.id, row)
+                samples[s.cfg.id] += 1
+        parts += rec.close_parts()
+        rec.event("stop", f"ended: {ended}", program_s=p, ended=ended,
+                  safe_setpoint_c=safe)  # fmt: skip
+        chamber.close()
+    return RunResult(out_dir, p0, p, parts, samples, bad, ended, setpoints, safe,
+                     list(rec.doc["events"]))  # fmt: skip
+
+
+def _quantize(c: float, scale: float, signed: bool, driver: str) -> float:
+    """The set-point as the register holds it [°C] (unchanged for ``none``)."""
+    if driver == "none":
+        return c
+    from thermocal.station.chamber import RegisterMap
+
+    m = RegisterMap(0, 0, "holding", scale, signed)
+    return m.decode(m.encode(c))
+
+
+def _sensor_row(
+    s: SerialSensor,
+    host_unix: float,
+    index: int,
+    values: tuple[float, ...],
+    rec: Recorder,
+    anchors: dict[str, float],
+    last_time: dict[str, float],
+) -> dict[str, float]:
+    """One line's row: the time rule of :mod:`thermocal.station.recorder`."""
+    from thermocal import units
+
+    cfg = s.cfg
+    row = dict(zip(cfg.names, values, strict=True))
+    host = rec.rel(host_unix)
+    if cfg.time_name is not None:
+        tu = units.normalize_time_unit(cfg.units[cfg.names.index(cfg.time_name)])
+        t = row.pop(cfg.time_name) * units.TIME_UNITS[tu]
+    elif cfg.rate_hz is not None:
+        anchor = anchors.setdefault(cfg.id, host - index / cfg.rate_hz)
+        t = anchor + index / cfg.rate_hz
+    else:  # host time; lines of one read share it: 1 µs apart keeps time increasing
+        t = max(host, last_time.get(cfg.id, -math.inf) + 1e-6)
+        last_time[cfg.id] = t
+    row["time"] = t
+    row["host_time"] = host
+    return row
+
+
+def _safe_stop(chamber: Chamber, safe_c: float, rec: Recorder, disp: Display) -> float | None:
+    """Write the safe set-point (twice tried); record and say whether it was written."""
+    for _attempt in range(2):
+        try:
+            chamber.write_setpoint(safe_c)
+        except ChamberError as exc:
+            err = str(exc)
+            continue
+        except Exception as exc:  # never let the safe stop hide the original error
+            err = f"{type(exc).__name__}: {exc}"
+            continue
+        rec.event("safe", f"safe set-point {safe_c:g} °C written", setpoint_c=safe_c)
+        disp.log(f"safe set-point {safe_c:g} °C written")
+        return safe_c
+    msg = f"warning: could not write the safe set-point {safe_c:g} °C: {err}; SET IT BY HAND"
+    rec.event("safe", msg)
+    disp.log(msg)
+    return None
