@@ -23,6 +23,7 @@ import dataclasses
 import errno
 import fcntl
 import functools
+import gc
 import glob
 import hashlib
 import io
@@ -1237,11 +1238,18 @@ def read_dataflash_log(path: str | Path, messages: Sequence[str]) -> DataflashLo
     last_end = 0
     size = path.stat().st_size
     with _library_output_captured() as noise:
+        failure = None
         try:
             log = DFReader.DFReader_binary(str(path), zero_time_base=False)
         except Exception as exc:  # pymavlink raises several kinds on a bad file
-            msg = " ".join(str(exc).split())[:200] or type(exc).__name__
-            raise FileFormatError(f"{path}: not a readable DataFlash log ({msg})") from None
+            failure = " ".join(str(exc).split())[:200] or type(exc).__name__
+        if failure is not None:
+            # pymavlink leaves the file of a log it could not open to the garbage collector:
+            # close it now, quietly, rather than warn later in someone else's code
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore", ResourceWarning)
+                gc.collect()
+            raise FileFormatError(f"{path}: not a readable DataFlash log ({failure})")
         try:
             while True:
                 try:
