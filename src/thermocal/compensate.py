@@ -324,7 +324,7 @@ def _check_plausible(
     if kind == "raw":
         return
     with np.errstate(over="ignore", invalid="ignore"):
-        canon, canon_unit = units.to_canonical(raw, unit)
+        canon, canon_unit = units.to_canonical(raw, unit, finite=False)
     bad = ~np.isfinite(canon) | (np.abs(canon) > PLAUSIBLE_SIGNAL[kind])
     if bad.any():
         r = int(np.argmax(bad))

@@ -17,7 +17,7 @@ import dataclasses
 import itertools
 import math
 import warnings
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
 from typing import Any, Literal
 
@@ -282,8 +282,9 @@ class Recording:
                 self.meta.scale_factor,
                 units.scale_factor_unit_or_default(self.meta.scale_factor_unit, self.name),
                 self.sample_interval_s,
+                f"{self.name}: signal column {name!r}",
             )
-        return units.to_canonical(values, unit)
+        return units.to_canonical(values, unit, f"{self.name}: signal column {name!r}")
 
     def temperature_c(self, name: str | None = None) -> FloatArray:
         """A temperature column in [°C], converting raw counts with the metadata's
@@ -609,6 +610,30 @@ FEW_SAMPLES = 10
 """Fewer sample rows than this are reported (a warning; commands needing more refuse)."""
 PLAUSIBLE_SIGNAL = {"rate": 1e8, "accel": 1e7}
 """Largest |value| any gyro [°/h] (≈ 28 000 °/s) or accelerometer [mg] (10 000 g) outputs."""
+PLAUSIBLE_COUNTS = 2.0**64
+"""Largest |value| of a raw count column without a scale factor: no ADC or pulse counter
+has more than 64 bits (and float64 is exact for integers only up to 2⁵³)."""
+
+
+def _physical_of_counts(
+    rec: Recording,
+) -> Callable[[FloatArray], tuple[FloatArray, str]] | None:
+    """The conversion counts → [°/h] or [mg] of ``rec``'s scale factor, for a block of
+    rows and without the overflow refusal (the caller reports the row itself); None when
+    the recording states no scale factor."""
+    k = rec.meta.scale_factor
+    if k is None:
+        return None
+    k_unit = units.scale_factor_unit_or_default(rec.meta.scale_factor_unit, rec.name)
+    try:
+        tau = rec.sample_interval_s if units.SCALE_FACTOR_UNITS[k_unit][0] else 1.0
+    except (KeyError, ThermocalInputError):
+        return None  # an unknown unit or no interval: refused where the signal is used
+
+    def conv(part: FloatArray) -> tuple[FloatArray, str]:
+        return units.counts_to_physical(part, k, k_unit, tau, finite=False)
+
+    return conv
 
 
 @dataclass(frozen=True)
@@ -731,16 +756,26 @@ def plausibility_problems(rec: Recording) -> list[Problem]:
             kind = units.signal_kind(unit)
         except UnitError:
             continue
-        if kind == "raw":
-            continue
         found: tuple[int, float] | None = None  # (row, value in the canonical unit)
-        canon_unit = units.canonical_unit(unit)
+        to_physical = _physical_of_counts(rec) if kind == "raw" else None
+        if kind == "raw" and to_physical is None:
+            canon_unit, limit = unit, PLAUSIBLE_COUNTS  # counts stay counts
+        elif kind == "raw":
+            canon_unit = to_physical(arr[:1])[1]
+            limit = PLAUSIBLE_SIGNAL["rate" if canon_unit == "deg/h" else "accel"]
+        else:
+            canon_unit, limit = units.canonical_unit(unit), PLAUSIBLE_SIGNAL[kind]
         for a0 in range(0, arr.size, DIFF_BLOCK):  # in blocks: bounded working memory
             part = arr[a0 : a0 + DIFF_BLOCK]
             with np.errstate(over="ignore", invalid="ignore"):
-                canon, _ = units.to_canonical(part, unit)
+                if kind != "raw":
+                    canon, _ = units.to_canonical(part, unit, finite=False)
+                elif to_physical is None:
+                    canon = part
+                else:
+                    canon = to_physical(part)[0]
             finite_in = np.isfinite(part)
-            beyond = finite_in & ~(np.abs(canon) <= PLAUSIBLE_SIGNAL[kind])  # inf or too big
+            beyond = finite_in & ~(np.abs(canon) <= limit)  # inf or too big
             if beyond.any():
                 i = int(np.argmax(beyond))
                 found = (a0 + i, float(canon[i]))
@@ -753,7 +788,7 @@ def plausibility_problems(rec: Recording) -> list[Problem]:
                     "implausible_signal",
                     f"signal column {name!r} reads {float(arr[row]):.6g} {unit} at row {row} "
                     f"({canon_row:.6g} {canon_unit}), beyond any sensor "
-                    f"(|value| ≤ {PLAUSIBLE_SIGNAL[kind]:g} {canon_unit}): wrong unit or "
+                    f"(|value| ≤ {limit:g} {canon_unit}): wrong unit, scale factor or "
                     "corrupt data",
                     column=name,
                     row=row,
@@ -807,7 +842,7 @@ def _accelerometer_magnitude_problems(rec: Recording) -> list[Problem]:
         except UnitError:
             continue
         with np.errstate(over="ignore", invalid="ignore"):
-            cols.append((name, units.to_canonical(arr, unit)[0]))
+            cols.append((name, units.to_canonical(arr, unit, finite=False)[0]))
     if not cols:
         return []
     if len(cols) >= 3:
