@@ -104,6 +104,7 @@ from thermocal.models.base import (
 from thermocal.recording import (
     ABSOLUTE_ZERO_C,
     FEW_SAMPLES,
+    PLAUSIBLE_COUNTS,
     PLAUSIBLE_SIGNAL,
     FloatArray,
     Metadata,
@@ -309,10 +310,19 @@ def _iter_chunks(
 
 
 def _check_plausible(
-    temps_c: FloatArray, names: Sequence[str], raw: FloatArray, unit: str, src: Path, row0: int
+    temps_c: FloatArray,
+    names: Sequence[str],
+    raw: FloatArray,
+    unit: str,
+    src: Path,
+    row0: int,
+    signal: str = "",
+    counts_scale: tuple[float, str, float] | None = None,
 ) -> None:
     """The chunk's values against :func:`thermocal.recording.plausibility_problems`' limits:
-    a temperature below absolute zero or a signal beyond any sensor is an input error."""
+    a temperature below absolute zero or a signal beyond any sensor is an input error.
+    Raw counts are checked after their scale factor ``counts_scale`` (K, unit of K, τ [s])
+    when one is given, else against :data:`~thermocal.recording.PLAUSIBLE_COUNTS`."""
     below = temps_c < ABSOLUTE_ZERO_C
     if below.any():
         r, j = (int(v) for v in np.argwhere(below)[0])
@@ -321,16 +331,23 @@ def _check_plausible(
             f"{row0 + r}, below absolute zero (−273.15 °C): a wrong unit, offset or conversion"
         )
     kind = units.signal_kind(unit)
-    if kind == "raw":
-        return
     with np.errstate(over="ignore", invalid="ignore"):
-        canon, canon_unit = units.to_canonical(raw, unit, finite=False)
-    bad = ~np.isfinite(canon) | (np.abs(canon) > PLAUSIBLE_SIGNAL[kind])
+        if kind != "raw":
+            canon, canon_unit = units.to_canonical(raw, unit, finite=False)
+            limit = PLAUSIBLE_SIGNAL[kind]
+        elif counts_scale is None:
+            canon, canon_unit, limit = raw, unit, PLAUSIBLE_COUNTS
+        else:
+            canon, canon_unit = units.counts_to_physical(raw, *counts_scale, finite=False)
+            limit = PLAUSIBLE_SIGNAL["rate" if canon_unit == "deg/h" else "accel"]
+    bad = ~np.isfinite(canon) | (np.abs(canon) > limit)
     if bad.any():
         r = int(np.argmax(bad))
+        col = f"column {signal!r} " if signal else ""
         raise ThermocalInputError(
-            f"{src}: signal reads {raw[r]:.6g} {unit} at row {row0 + r}, beyond any sensor "
-            f"(|value| ≤ {PLAUSIBLE_SIGNAL[kind]:g} {canon_unit}): wrong unit or corrupt data"
+            f"{src}: signal {col}reads {raw[r]:.6g} {unit} at row {row0 + r} "
+            f"({float(canon[r]):.6g} {canon_unit}), beyond any sensor "
+            f"(|value| ≤ {limit:g} {canon_unit}): wrong unit, scale factor or corrupt data"
         )
 
 
@@ -843,9 +860,14 @@ def _chunk_inputs(
         temps[:, j] = v
     raw = numeric_column(chunk, plan.signal, src, row0)
     _check_finite(raw, f"signal column {plan.signal!r}", src, row0)
+    counts_scale = None
+    if units.signal_kind(plan.data_unit) == "raw" and plan.md.scale_factor is not None:
+        tau = plan.md.sample_interval_s or (median_interval(t) if t.size > 1 else 1.0)
+        k_unit = units.scale_factor_unit_or_default(plan.md.scale_factor_unit, str(src))
+        counts_scale = (plan.md.scale_factor, k_unit, float(tau))
     _check_plausible(
         temps if plan.model.temperature_unit == "degC" else temps[:, :0],  # counts: no °C
-        plan.temp_names, raw, plan.data_unit, src, row0,
+        plan.temp_names, raw, plan.data_unit, src, row0, plan.signal, counts_scale,
     )  # fmt: skip
     if plan.factor is None:
         tau = plan.md.sample_interval_s or (median_interval(t) if t.size > 1 else None)

@@ -710,6 +710,8 @@ def plausibility_problems(rec: Recording) -> list[Problem]:
             )
         try:
             temp = rec.temperature_c(name)
+        except units.ConversionOverflowError:
+            raise  # a finite count beyond float64 once converted: no °C to check
         except ThermocalInputError:
             continue  # raw counts without a conversion: checked where they are used
         ext = finite_extrema(temp)

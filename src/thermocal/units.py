@@ -641,6 +641,10 @@ def signal_kind(unit: str) -> SignalKind:
     return "raw"
 
 
+class ConversionOverflowError(UnitError):
+    """A finite value became non-finite (±inf, NaN) on a unit conversion (exit 2)."""
+
+
 OVERFLOW_SCAN_BLOCK: Final = 1 << 16
 """Rows per block of :func:`refuse_overflow`'s search for the first overflowing value
 (a few bytes of working memory per row of a block, none per row of the column)."""
@@ -679,7 +683,7 @@ def refuse_overflow(
         bad = ~np.isfinite(o) & np.isfinite(v)
         if bad.any():
             i = a + int(np.argmax(bad))
-            raise UnitError(
+            raise ConversionOverflowError(
                 f"{where + ': ' if where else ''}{float(vin[i]):.6g} at row "
                 f"{first_row + i // per_row} becomes {float(flat[i])} on conversion "
                 f"({what}), beyond any float64: a wrong unit or scale factor, or corrupt data"
