@@ -62,6 +62,7 @@ import numpy.typing as npt
 
 from thermocal.defaults import ALLOW_MOTION, ALLOW_NARROW, overrides_of
 from thermocal.errors import ThermocalInputError, ThermocalWarning
+from thermocal.recording import all_finite, is_increasing, median_in_blocks
 
 FloatArray = npt.NDArray[np.float64]
 
@@ -198,13 +199,16 @@ def from_dict(d: Any) -> dict[str, Any] | None:
 # --- the tests ---------------------------------------------------------------------------
 
 
-def _span(temps: FloatArray) -> tuple[float, float]:
-    t = temps[np.isfinite(temps)]
+def _span(temps: FloatArray, *, finite_scratch: bool = False) -> tuple[float, float]:
+    """The 0.1 and 99.9 percentiles of the finite temperatures (min and max under 1000).
+    ``finite_scratch``: ``temps`` is already finite and may be reordered in place (no
+    copy: the percentiles partition it)."""
+    t = temps if finite_scratch else temps[np.isfinite(temps)]
     if t.size == 0:
         return math.nan, math.nan
     if t.size < 1000:
         return float(t.min()), float(t.max())
-    lo, hi = np.percentile(t, [0.1, 99.9])
+    lo, hi = np.percentile(t, [0.1, 99.9], overwrite_input=True)
     return float(lo), float(hi)
 
 
@@ -253,8 +257,8 @@ def temperature_tests(
                 f"{name}: temperatures in raw {unit} without a conversion: span not judged",
             )
         ]
-    t = temps[np.isfinite(temps)]
-    lo, hi = _span(t)
+    t = temps[np.isfinite(temps)]  # a copy, reordered by the percentiles (order is not used)
+    lo, hi = _span(t, finite_scratch=True)
     span = hi - lo if t.size else 0.0
     need = MIN_SPAN_PER_ORDER_C * max(order, 1)
     out = [
@@ -277,8 +281,16 @@ def temperature_tests(
     width = max(span / N_SPAN_BINS, MIN_BIN_WIDTH_C)
     per_bin = max(1, min(MIN_SAMPLES_PER_BIN, t.size // (3 * N_SPAN_BINS)))
     if t.size and span > 0:
-        idx = np.clip(np.floor((t - lo) / width).astype(np.int64), 0, None)
-        counts = np.bincount(idx[(t >= lo) & (t <= hi)])
+        counts = np.zeros(0, dtype=np.intp)
+        for a in range(0, t.size, 1 << 18):  # in blocks: the bin counts add up
+            tb = t[a : a + (1 << 18)]
+            idx = np.clip(np.floor((tb - lo) / width).astype(np.int64), 0, None)
+            c = np.bincount(idx[(tb >= lo) & (tb <= hi)])
+            if c.size > counts.size:
+                c[: counts.size] += counts
+                counts = c
+            else:
+                counts[: c.size] += c
         distinct = int(np.count_nonzero(counts >= per_bin))
     else:
         distinct = 1 if t.size else 0
@@ -397,7 +409,77 @@ MAX_PER_BLOCK = 64
 """Samples a block's median is taken over (longer blocks are decimated evenly)."""
 
 
+STATS_CHUNK = 1 << 18
+"""Rows per chunk of :func:`_block_stats` (its working memory is per chunk)."""
+
+
 def _block_stats(
+    time_s: FloatArray, values: FloatArray, block_s: float
+) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
+    """:func:`_block_stats_whole`, the same numbers, chunk by chunk for increasing times:
+    the blocks' boundaries found in one pass, each chunk of whole blocks sorted alone (the
+    stable sort by (block, value) keeps blocks in place, so it is the whole-array sort's
+    result), σ_w's median selected block by block (:func:`median_in_blocks`).  No array
+    as long as the run beyond the data (issue 26: the whole-array form held ≈ 60 bytes a
+    sample)."""
+    n = time_s.size
+    if n < 2 * STATS_CHUNK or not is_increasing(time_s):
+        return _block_stats_whole(time_s, values, block_s)
+    t0 = time_s[0]
+
+    def idx_of(a: int, b: int) -> npt.NDArray[np.int64]:
+        return np.floor((time_s[a:b] - t0) / block_s).astype(np.int64)
+
+    last = int(idx_of(n - 1, n)[0])
+    step = max(1, int((n / max(1, last + 1)) // MAX_PER_BLOCK))
+    vals = values[::step] if step > 1 else values
+    n_dec = vals.shape[0]
+    chunk = max(1, STATS_CHUNK // step)
+
+    def dec_idx(a: int, b: int) -> npt.NDArray[np.int64]:  # decimated rows a … b − 1
+        return idx_of(a * step, (b - 1) * step + 1)[::step]
+
+    uniq_parts: list[npt.NDArray[np.int64]] = []
+    start_parts: list[npt.NDArray[np.intp]] = []
+    prev: int | None = None
+    for a in range(0, n_dec, chunk):
+        ix = dec_idx(a, min(n_dec, a + chunk))
+        heads = np.flatnonzero(ix[1:] != ix[:-1]) + 1
+        if prev is None or int(ix[0]) != prev:
+            heads = np.r_[0, heads]
+        uniq_parts.append(ix[heads])
+        start_parts.append(heads + a)
+        prev = int(ix[-1])
+    uniq = np.concatenate(uniq_parts)
+    starts = np.concatenate(start_parts).astype(np.intp)
+    counts = np.diff(np.r_[starts, n_dec])
+    m = vals.shape[1]
+    med = np.empty((uniq.size, m))
+    sigma = np.empty(m)
+    lo_i = starts + (counts - 1) // 2
+    hi_i = starts + counts // 2
+    b0 = 0
+    while b0 < uniq.size:  # chunks of whole blocks
+        r0 = int(starts[b0])
+        b1 = max(b0 + 1, int(np.searchsorted(starts, r0 + chunk, side="left")))
+        r1 = int(starts[b1]) if b1 < uniq.size else n_dec
+        ix = dec_idx(r0, r1)
+        for j in range(m):
+            vj = vals[r0:r1, j]
+            sv = vj[np.lexsort((vj, ix))]
+            med[b0:b1, j] = 0.5 * (sv[lo_i[b0:b1] - r0] + sv[hi_i[b0:b1] - r0])
+        b0 = b1
+    for j in range(m):
+
+        def dev(a: int, b: int, j: int = j) -> FloatArray:
+            inv = np.searchsorted(starts, np.arange(a, b), side="right") - 1
+            return np.abs(vals[a:b, j] - med[inv, j])
+
+        sigma[j] = 1.4826 * median_in_blocks(dev, n_dec)
+    return t0 + uniq * block_s, counts.astype(np.float64), med, sigma
+
+
+def _block_stats_whole(
     time_s: FloatArray, values: FloatArray, block_s: float
 ) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
     """Per occupied block: start time [s], samples, median (n_blocks, m), and the sensor's
@@ -490,11 +572,12 @@ def stillness(
     v = np.asarray(values, dtype=np.float64)
     if v.ndim == 1:
         v = v[:, None]
-    ok = np.isfinite(t) & np.all(np.isfinite(v), axis=1)
-    t, v = t[ok], v[ok]
+    if not (all_finite(t) and all_finite(v)):  # a copy only when something is dropped
+        ok = np.isfinite(t) & np.all(np.isfinite(v), axis=1)
+        t, v = t[ok], v[ok]
     if t.size < 20:
         return Motion(0.0, 0.0, floor)
-    dt = float(np.median(np.diff(t)))
+    dt = median_in_blocks(lambda a, b: np.diff(t[a : b + 1]), t.size - 1)
     block_s = max(STILL_BLOCK_S, 10.0 * dt)
     tb, cnt, meds, sigma = _block_stats(t, v, block_s)
     centre, before, after = _window_medians(tb, meds, max(STILL_WINDOW_S, 30.0 * block_s))
@@ -637,7 +720,8 @@ def judge(
         order = needs.order.get(tn, 0)
         if order <= 0 and tn not in needs.rate:
             continue
-        col = np.concatenate([np.asarray(T, dtype=np.float64)[:, j] for T in runs_temps])
+        parts = [np.asarray(T, dtype=np.float64)[:, j] for T in runs_temps]
+        col = parts[0] if len(parts) == 1 else np.concatenate(parts)  # no copy of one run
         if order > 0:
             tests.extend(temperature_tests(col, tn, order, unit=temperature_unit))
         if tn in needs.rate:

@@ -8,7 +8,6 @@ range and NaN count, temperature span, spikes (Hampel test) and the problems of
 
 from __future__ import annotations
 
-from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -25,6 +24,7 @@ from thermocal.recording import (
     find_gaps,
     find_problems,
     finite_extrema,
+    median_in_blocks,
     median_interval,
 )
 
@@ -101,57 +101,6 @@ of one chunk at a time, ≈ 2 MB each, instead of two arrays as long as the colu
 
 SPIKE_BLOCK = 1 << 15
 """Window centres per block of the Hampel test (its working memory is ≈ 2·w·8 bytes each)."""
-
-
-MEDIAN_BLOCK = 1 << 18
-"""Values per block of :func:`median_in_blocks`."""
-
-
-def median_in_blocks(
-    values: Callable[[int, int], FloatArray], n: int, block: int = MEDIAN_BLOCK
-) -> float:
-    """``np.median`` of ``n`` values that ``values(a, b)`` computes block by block (rows
-    a … b − 1), exactly (the same bits), with memory of a few blocks instead of the
-    whole array.
-
-    Selection by bracketing (Floyd & Rivest 1975, "Expected time bounds for selection"):
-    a strided sample of ≈ 65 536 values gives bounds ``lo ≤ hi`` around its median; one
-    pass counts the values below ``lo`` and keeps those within ``[lo, hi]``; when the
-    middle order statistic(s) ``(n − 1)//2`` and ``n//2`` fall among the kept ones they
-    are selected there (``np.partition``), their mean is the median as ``np.median``
-    forms it.  Otherwise the bracket is widened (three tries), and at last the whole
-    array is built.  NaN-free values are assumed (the caller checks).
-    """
-    if n <= 4 * block:
-        return float(np.median(values(0, n), overwrite_input=True))
-    k_lo, k_hi = (n - 1) // 2, n // 2
-    step = max(1, n // 65536)
-    sample = np.sort(
-        np.concatenate(
-            [  # copies: a strided view would keep its whole block alive
-                values(a, min(n, a + block))[(-a) % step :: step].copy() for a in range(0, n, block)
-            ]
-        )
-    )
-    m = sample.size
-    widen = 0.01
-    for _ in range(3):
-        lo = sample[max(0, int(m * (0.5 - widen)))]
-        hi = sample[min(m - 1, int(m * (0.5 + widen)))]
-        below = 0
-        kept: list[FloatArray] = []
-        for a in range(0, n, block):
-            v = values(a, min(n, a + block))
-            below += int(np.count_nonzero(v < lo))
-            kept.append(v[(v >= lo) & (v <= hi)])
-        mid = np.concatenate(kept)
-        if below <= k_lo and k_hi < below + mid.size:
-            i, j = k_lo - below, k_hi - below
-            part = np.partition(mid, [i, j])
-            return float(np.mean(part[[i, j]])) if i != j else float(part[i])
-        widen *= 4.0
-    whole = np.concatenate([values(a, min(n, a + block)) for a in range(0, n, block)])
-    return float(np.median(whole, overwrite_input=True))
 
 
 def count_spikes(

@@ -25,7 +25,7 @@ import numpy.typing as npt
 
 from thermocal import units
 from thermocal.errors import MissingValueError, ThermocalInputError
-from thermocal.recording import Recording, contiguous_slices
+from thermocal.recording import Recording, contiguous_slices, is_increasing
 
 FloatArray = npt.NDArray[np.float64]
 
@@ -414,7 +414,7 @@ def reference_bias(
                 f"--drift-reference {start:g},{end:g}: give START,END in seconds since the "
                 "first sample, with 0 ≤ START < END"
             )
-    if _increasing(t):  # the window is one stretch: found by bisection, no copy
+    if is_increasing(t):  # the window is one stretch: found by bisection, no copy
         # t_i − t_0 is non-decreasing in i (rounding is monotone): the rows with
         # start ≤ t_i − t_0 ≤ end are i0 … i1 − 1
         i0 = bisect.bisect_left(range(t.size), True, key=lambda i: bool(t[i] - t0 >= start))
@@ -433,15 +433,6 @@ def reference_bias(
         )
     b0 = float(np.mean(selected)) - float(earth_rate)
     return DriftReference("window", start, end, b0, unit, n)
-
-
-def _increasing(t: FloatArray, block: int = 1 << 16) -> bool:
-    """``t`` strictly increasing, checked in blocks (a few bytes a row of one block)."""
-    for a in range(0, max(t.size - 1, 0), block):
-        d = np.diff(t[a : a + block + 1])
-        if not bool(np.all(d > 0)):
-            return False
-    return True
 
 
 # --- recording pipeline ------------------------------------------------------------------

@@ -323,6 +323,8 @@ class Recording:
         names = tuple(names) if names is not None else self.temperatures
         if not names:
             raise MissingColumnError(f"{self.name}: no temperature columns named")
+        if len(names) == 1:  # one column: a view of it (no copy; the (n, 1) array is read)
+            return self.temperature_c(names[0]).reshape(-1, 1)
         return np.column_stack([self.temperature_c(n) for n in names])
 
     def _default(self, name: str | None, pool: tuple[str, ...], what: str) -> str:
@@ -646,6 +648,76 @@ class Extrema:
     hi: float
     hi_row: int
     count: int
+
+
+MEDIAN_BLOCK = 1 << 18
+"""Values per block of :func:`median_in_blocks`."""
+
+
+def median_in_blocks(
+    values: Callable[[int, int], FloatArray], n: int, block: int = MEDIAN_BLOCK
+) -> float:
+    """``np.median`` of ``n`` values that ``values(a, b)`` computes block by block (rows
+    a … b − 1), exactly (the same bits), with memory of a few blocks instead of the
+    whole array.
+
+    Selection by bracketing (Floyd & Rivest 1975, "Expected time bounds for selection"):
+    a strided sample of ≈ 65 536 values gives bounds ``lo ≤ hi`` around its median; one
+    pass counts the values below ``lo`` and keeps those within ``[lo, hi]``; when the
+    middle order statistic(s) ``(n − 1)//2`` and ``n//2`` fall among the kept ones they
+    are selected there (``np.partition``), their mean is the median as ``np.median``
+    forms it.  Otherwise the bracket is widened (three tries), and at last the whole
+    array is built.  NaN-free values are assumed (the caller checks).
+    """
+    if n <= 4 * block:
+        return float(np.median(values(0, n), overwrite_input=True))
+    k_lo, k_hi = (n - 1) // 2, n // 2
+    step = max(1, n // 65536)
+    sample = np.sort(
+        np.concatenate(
+            [  # copies: a strided view would keep its whole block alive
+                values(a, min(n, a + block))[(-a) % step :: step].copy() for a in range(0, n, block)
+            ]
+        )
+    )
+    m = sample.size
+    widen = 0.01
+    for _ in range(3):
+        lo = sample[max(0, int(m * (0.5 - widen)))]
+        hi = sample[min(m - 1, int(m * (0.5 + widen)))]
+        below = 0
+        kept: list[FloatArray] = []
+        for a in range(0, n, block):
+            v = values(a, min(n, a + block))
+            below += int(np.count_nonzero(v < lo))
+            kept.append(v[(v >= lo) & (v <= hi)])
+        mid = np.concatenate(kept)
+        if below <= k_lo and k_hi < below + mid.size:
+            i, j = k_lo - below, k_hi - below
+            part = np.partition(mid, [i, j])
+            return float(np.mean(part[[i, j]])) if i != j else float(part[i])
+        widen *= 4.0
+    whole = np.concatenate([values(a, min(n, a + block)) for a in range(0, n, block)])
+    return float(np.median(whole, overwrite_input=True))
+
+
+def all_finite(arr: npt.NDArray[np.float64]) -> bool:
+    """Every element finite, without a mask as long as the array on the usual path: the
+    sum is finite exactly when every element is (or it overflowed: then the mask)."""
+    if arr.size == 0:
+        return True
+    with np.errstate(over="ignore", invalid="ignore"):
+        if math.isfinite(float(np.sum(arr))):
+            return True
+    return bool(np.isfinite(arr).all())
+
+
+def is_increasing(t: FloatArray, block: int = DIFF_BLOCK) -> bool:
+    """``t`` strictly increasing, checked in blocks (a few bytes a row of one block)."""
+    for a in range(0, max(t.size - 1, 0), block):
+        if not bool(np.all(np.diff(t[a : a + block + 1]) > 0)):
+            return False
+    return True
 
 
 def finite_extrema(arr: FloatArray, block: int = DIFF_BLOCK) -> Extrema | None:
