@@ -428,7 +428,8 @@ def _block_stats(
     t0 = time_s[0]
 
     def idx_of(a: int, b: int) -> npt.NDArray[np.int64]:
-        return np.floor((time_s[a:b] - t0) / block_s).astype(np.int64)
+        out: npt.NDArray[np.int64] = np.floor((time_s[a:b] - t0) / block_s).astype(np.int64)
+        return out
 
     last = int(idx_of(n - 1, n)[0])
     step = max(1, int((n / max(1, last + 1)) // MAX_PER_BLOCK))
@@ -473,7 +474,8 @@ def _block_stats(
 
         def dev(a: int, b: int, j: int = j) -> FloatArray:
             inv = np.searchsorted(starts, np.arange(a, b), side="right") - 1
-            return np.abs(vals[a:b, j] - med[inv, j])
+            out: FloatArray = np.abs(vals[a:b, j] - med[inv, j])
+            return out
 
         sigma[j] = 1.4826 * median_in_blocks(dev, n_dec)
     return t0 + uniq * block_s, counts.astype(np.float64), med, sigma

@@ -861,9 +861,9 @@ def _chunk_inputs(
     _check_finite(raw, f"signal column {plan.signal!r}", src, row0)
     counts_scale = None
     if units.signal_kind(plan.data_unit) == "raw" and plan.md.scale_factor is not None:
-        tau = plan.md.sample_interval_s or (median_interval(t) if t.size > 1 else 1.0)
+        tau_k = plan.md.sample_interval_s or (median_interval(t) if t.size > 1 else 1.0)
         k_unit = units.scale_factor_unit_or_default(plan.md.scale_factor_unit, str(src))
-        counts_scale = (plan.md.scale_factor, k_unit, float(tau))
+        counts_scale = (plan.md.scale_factor, k_unit, float(tau_k))
     _check_plausible(
         temps if plan.model.temperature_unit == "degC" else temps[:, :0],  # counts: no °C
         plan.temp_names, raw, plan.data_unit, src, row0, plan.signal, counts_scale,

@@ -832,11 +832,11 @@ def plausibility_problems(rec: Recording) -> list[Problem]:
             continue
         found: tuple[int, float] | None = None  # (row, value in the canonical unit)
         to_physical = _physical_of_counts(rec) if kind == "raw" else None
-        if kind == "raw" and to_physical is None:
-            canon_unit, limit = unit, PLAUSIBLE_COUNTS  # counts stay counts
-        elif kind == "raw":
+        if to_physical is not None:
             canon_unit = to_physical(arr[:1])[1]
             limit = PLAUSIBLE_SIGNAL["rate" if canon_unit == "deg/h" else "accel"]
+        elif kind == "raw":
+            canon_unit, limit = unit, PLAUSIBLE_COUNTS  # counts stay counts
         else:
             canon_unit, limit = units.canonical_unit(unit), PLAUSIBLE_SIGNAL[kind]
         for a0 in range(0, arr.size, DIFF_BLOCK):  # in blocks: bounded working memory
