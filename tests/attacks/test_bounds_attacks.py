@@ -30,7 +30,7 @@ import pyarrow.parquet as pq
 import pytest
 
 import thermocal.cli.fit_cmd as fit_cmd
-import thermocal.cli.turntable_cmd as turntable_cmd
+import thermocal.io as io_mod
 from thermocal.cli import main
 
 N = 600
@@ -109,7 +109,7 @@ def no_reading(monkeypatch: pytest.MonkeyPatch) -> None:
         raise AssertionError("a data file was read before the option was checked")
 
     monkeypatch.setattr(fit_cmd, "load_recording", refuse)
-    monkeypatch.setattr(turntable_cmd._io, "read_recording", refuse, raising=False)
+    monkeypatch.setattr(io_mod, "read_recording", refuse)
 
 
 @pytest.mark.parametrize("case", sorted(FIT_CEILINGS))
