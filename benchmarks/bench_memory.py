@@ -1,115 +1,156 @@
-"""Benchmark: peak memory of whole commands against the length of the file (issue 14).
+"""Benchmark: peak memory of whole commands against the length of the file (issues 14, 26).
 
-For each size (rows) a Parquet recording is written once (time [s], a gyro [°/h] and one
-temperature [°C], units in the file's metadata), a linear model is fitted on a 10⁵-row
-slice, then ``compensate``, ``allan``, ``metrics`` and ``inspect`` run as separate
-``thermocal`` processes; each one's peak resident memory is read with
-``resource.getrusage(RUSAGE_CHILDREN)`` (the largest child so far, so each command runs
-in its own ``python -c`` wrapper).  Printed: MB and bytes per row, and the figure the
-issue asks for (≈ 8 bytes per column used + 16 bytes a row of working space + a fixed
-base for allan, metrics and inspect; constant for compensate).
+For each size (rows) a Parquet recording is written once — time [s], one gyro [°/h] and
+``--temps`` temperatures T1…Tk [°C], all float64, units in the file's metadata — and
+``inspect``, ``metrics``, ``allan``, ``fit`` (plain polynomial, ``--order 2``) and
+``compensate`` run on it, each as its own ``thermocal`` process
+(:func:`benchmarks._harness.measure`: the peak resident memory of that one child).
 
-Run: ``.venv/bin/python benchmarks/bench_memory.py [--rows 1000000 10000000 20000000]``.
-Files go to ``benchmarks/_data/`` (git-ignored).
+The figure (issue 26, item 8)::
+
+    bytes per row = (peak RSS on the N-row file − peak RSS of the same command on a
+                     10 000-row file) / N
+
+The baseline (the interpreter, numpy, pyarrow, scipy … and whatever the command holds
+that does not grow with the file) is measured the same way, so what is left is what the
+command holds per row of the file.  It is printed as bytes per row and, divided by the
+number of columns the command uses (time, signal and temperatures; allan: time and
+signal), as bytes per value.  Target: **≤ 40 bytes per row of the columns used** when
+those are up to three float64 columns (24 B of data: the columns themselves plus 16 B a
+row of working space); with more columns, 8 B per further column: ``max(40, 16 + 8 ×
+columns)`` B/row.  ``compensate`` streams its file: its target is a constant, ≤ 200 MB
+above its baseline whatever the length (printed as B/row at that length).
+
+Run: ``.venv/bin/python benchmarks/bench_memory.py [--rows 10000000 20000000] [--temps 1 4]``.
+Files go to ``benchmarks/_data/`` (git-ignored); a file of 2·10⁷ rows and four
+temperatures is 0.9 GB.
 """
 
 from __future__ import annotations
 
 import argparse
 import json
-import subprocess
-import sys
-import time
 from pathlib import Path
 
 import numpy as np
 
+from _harness import THERMOCAL, measure
+
 DATA = Path(__file__).resolve().parent / "_data"
-
-WRAPPER = r"""
-import resource, subprocess, sys, time
-t0 = time.perf_counter()
-proc = subprocess.run(sys.argv[1:], capture_output=True, text=True)
-dt = time.perf_counter() - t0
-peak_kb = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss
-print(f"{proc.returncode} {peak_kb} {dt:.3f}")
-if proc.returncode:
-    print(proc.stderr[-2000:], file=sys.stderr)
-"""
+TINY = 10_000
+"""Rows of the baseline file."""
+WORKING_B_PER_ROW = 16
+"""Bytes a row of working space the target allows above the columns used."""
 
 
-def _write(rows: int) -> Path:
+def write_file(rows: int, n_temps: int) -> Path:
+    """The recording (written once, in slices: bounded memory)."""
     import pyarrow as pa
     import pyarrow.parquet as pq
 
-    path = DATA / f"mem_{rows}.parquet"
+    path = DATA / f"mem_{rows}_{n_temps}t.parquet"
     if path.exists():
         return path
     DATA.mkdir(exist_ok=True)
     rng = np.random.default_rng(1)
-    t = np.arange(rows, dtype=np.float64) * 0.01
-    temp = 25.0 + 15.0 * np.sin(2 * np.pi * t / max(t[-1], 1.0))
-    gyro = 0.5 + 0.02 * (temp - 25.0) + rng.normal(0.0, 0.05, rows)
+    temps = [f"T{k + 1}" for k in range(n_temps)]
     meta = {
         "format": "thermocal-recording",
         "version": 1,
         "time": "time",
         "time_unit": "s",
         "signals": {"gyro": "deg/h"},
-        "temperatures": {"T1": "degC"},
+        "temperatures": dict.fromkeys(temps, "degC"),
     }
-    table = pa.table({"time": t, "gyro": gyro, "T1": temp}).replace_schema_metadata(
+    schema = pa.schema([(c, pa.float64()) for c in ("time", "gyro", *temps)]).with_metadata(
         {"thermocal": json.dumps(meta)}
     )
-    pq.write_table(table, path)
+    span = max((rows - 1) * 0.01, 1.0)
+    tmp = path.with_suffix(".tmp")
+    with pq.ParquetWriter(tmp, schema) as w:
+        for a in range(0, rows, 1 << 20):
+            t = np.arange(a, min(rows, a + (1 << 20)), dtype=np.float64) * 0.01
+            base = 25.0 + 15.0 * np.sin(2 * np.pi * t / span)
+            cols = {"time": t}
+            # each sensor its own lag: no temperature a linear combination of the others
+            ts = [base + 0.4 * k * np.sin(2 * np.pi * (k + 1) * t / span) for k in range(n_temps)]
+            cols["gyro"] = 0.5 + 0.02 * (ts[0] - 25.0) + rng.normal(0.0, 0.05, t.size)
+            cols.update(zip(temps, ts, strict=True))
+            w.write_table(pa.table(cols, schema=schema))
+    tmp.rename(path)
     return path
 
 
-def _run(args: list[str]) -> tuple[int, float, float]:
-    thermocal = [
-        sys.executable,
-        "-c",
-        "import sys; from thermocal.cli import main; sys.exit(main())",
-    ]
-    out = subprocess.run(
-        [sys.executable, "-c", WRAPPER, *thermocal, *args],
-        capture_output=True,
-        text=True,
-        check=False,
-    )
-    code, peak_kb, seconds = out.stdout.split()
-    if int(code) != 0:
-        raise SystemExit(f"{args[0]} failed: {out.stderr}")
-    return int(code), int(peak_kb) * 1024 / 1e6, float(seconds)
+def commands(src: Path, n_temps: int, out: Path) -> dict[str, tuple[list[str], int]]:
+    """name → (thermocal arguments, number of columns used)."""
+    temps = ",".join(f"T{k + 1}" for k in range(n_temps))
+    model = DATA / f"mem_model_{n_temps}t.json"
+    return {
+        "inspect": (["inspect", str(src), "--json"], 2 + n_temps),
+        "metrics": (["metrics", str(src), "--signal", "gyro", "--temps", temps,
+                     "--average", "10", "--json"], 2 + n_temps),
+        "allan": (["allan", str(src), "--signal", "gyro", "--json"], 2),
+        "fit": (["fit", str(src), "--model", "poly", "--order", "2", "--signal", "gyro",
+                 "--temps", temps, "--allow-narrow", "-o", str(out.with_suffix(".json")),
+                 "--json"], 2 + n_temps),
+        "compensate": (["compensate", str(model), str(src), "-o", str(out)], 0),
+    }  # fmt: skip
+
+
+COMPENSATE_MB = 200.0
+"""``compensate`` streams its file: at most this much above its baseline, whatever the
+length (its chunks and the writer's buffers)."""
+
+
+def target(name: str, n_cols: int, rows: int) -> float:
+    """Bytes a row allowed above the baseline: 40 B a row of the columns used, and 8 B
+    more for every column beyond three (``max(40, 16 + 8 × columns)``); for
+    ``compensate`` the constant :data:`COMPENSATE_MB` spread over the rows."""
+    if name == "compensate":
+        return COMPENSATE_MB * 1024 * 1024 / rows
+    return max(40.0, WORKING_B_PER_ROW + 8.0 * n_cols)
 
 
 def main() -> None:
-    ap = argparse.ArgumentParser()
-    ap.add_argument("--rows", type=int, nargs="+", default=[1_000_000, 10_000_000])
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--rows", type=int, nargs="+", default=[10_000_000, 20_000_000])
+    ap.add_argument("--temps", type=int, nargs="+", default=[1, 4], help="temperature columns")
+    ap.add_argument("--only", nargs="*", help="commands to run (default all)")
     args = ap.parse_args()
-    print("rows        command     peak MB   bytes/row   seconds")
-    for rows in args.rows:
-        src = _write(rows)
-        small = DATA / "mem_fit.parquet"
-        if not small.exists():
-            _write(100_000).rename(small)
-        model = DATA / "mem_model.json"
+    print(f"{'rows':>10s} {'T':>2s} {'command':<11s} {'peak MB':>8s} {'base MB':>8s} "
+          f"{'B/row':>7s} {'cols':>4s} {'B/value':>7s} {'s':>6s}  target")  # fmt: skip
+    for n_temps in args.temps:
+        tiny = write_file(TINY, n_temps)
+        model = DATA / f"mem_model_{n_temps}t.json"
         if not model.exists():
-            _run(["fit", str(small), "--model", "poly", "--order", "1", "--signal", "gyro",
-                  "--temps", "T1", "-o", str(model)])  # fmt: skip
-        out = DATA / f"mem_out_{rows}.parquet"
-        commands = {
-            "compensate": ["compensate", str(model), str(src), "-o", str(out)],
-            "allan": ["allan", str(src), "--signal", "gyro", "--json"],
-            "metrics": ["metrics", str(src), "--signal", "gyro", "--temps", "T1",
-                        "--average", "10", "--json"],
-            "inspect": ["inspect", str(src), "--json"],
-        }  # fmt: skip
-        for name, cmd in commands.items():
-            _code, mb, seconds = _run(cmd)
-            print(f"{rows:<11d} {name:<11s} {mb:8.0f}   {mb * 1e6 / rows:9.0f}   {seconds:7.1f}")
-        out.unlink(missing_ok=True)
-        time.sleep(0.5)
+            fit_src = write_file(100_000, n_temps)
+            temps = ",".join(f"T{k + 1}" for k in range(n_temps))
+            measure([*THERMOCAL, "fit", str(fit_src), "--model", "poly", "--order", "1",
+                     "--signal", "gyro", "--temps", temps, "--allow-narrow",
+                     "-o", str(model)])  # fmt: skip
+        out_tiny = DATA / "mem_out_tiny.parquet"
+        base = {}
+        for name, (cmd, _cols) in commands(tiny, n_temps, out_tiny).items():
+            if args.only and name not in args.only:
+                continue
+            base[name] = measure([*THERMOCAL, *cmd])[1]
+            out_tiny.unlink(missing_ok=True)
+        for rows in args.rows:
+            src = write_file(rows, n_temps)
+            out = DATA / f"mem_out_{rows}.parquet"
+            for name, (cmd, n_cols) in commands(src, n_temps, out).items():
+                if name not in base:
+                    continue
+                seconds, mb = measure([*THERMOCAL, *cmd])
+                out.unlink(missing_ok=True)
+                out.with_suffix(".json").unlink(missing_ok=True)
+                per_row = (mb - base[name]) * 1024 * 1024 / rows
+                per_value = per_row / n_cols if n_cols else float("nan")
+                goal = target(name, n_cols, rows)
+                verdict = "met" if per_row <= goal else "NOT met"
+                print(f"{rows:>10d} {n_temps:>2d} {name:<11s} {mb:8.0f} {base[name]:8.0f} "
+                      f"{per_row:7.1f} {n_cols:>4d} {per_value:7.1f} {seconds:6.1f}  "
+                      f"target ≤ {goal:.0f} B/row: {verdict}", flush=True)  # fmt: skip
 
 
 if __name__ == "__main__":

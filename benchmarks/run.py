@@ -40,7 +40,10 @@ BENCHMARKS: dict[str, tuple[list[str], list[str]]] = {
     "channels": ([], ["--skip-file"]),
     "compensate": ([], []),
     "end_to_end": ([], ["--skip-1e8"]),
-    "memory": (["--rows", "1000000", "10000000", "100000000"], ["--rows", "1000000", "10000000"]),
+    "memory": (
+        ["--rows", "10000000", "20000000", "--temps", "1", "4"],
+        ["--rows", "10000000", "--temps", "1"],
+    ),
     "simulate": ([], ["--hours", "2.8"]),
     "turntable": ([], []),
     "models_warmup_bank": ([], []),

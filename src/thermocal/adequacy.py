@@ -62,6 +62,7 @@ import numpy.typing as npt
 
 from thermocal.defaults import ALLOW_MOTION, ALLOW_NARROW, overrides_of
 from thermocal.errors import ThermocalInputError, ThermocalWarning
+from thermocal.recording import all_finite
 
 FloatArray = npt.NDArray[np.float64]
 
@@ -198,13 +199,16 @@ def from_dict(d: Any) -> dict[str, Any] | None:
 # --- the tests ---------------------------------------------------------------------------
 
 
-def _span(temps: FloatArray) -> tuple[float, float]:
-    t = temps[np.isfinite(temps)]
+def _span(temps: FloatArray, *, finite_scratch: bool = False) -> tuple[float, float]:
+    """The 0.1 and 99.9 percentiles of the finite temperatures (min and max under 1000).
+    ``finite_scratch``: ``temps`` is already finite and may be reordered in place (no
+    copy: the percentiles partition it)."""
+    t = temps if finite_scratch else temps[np.isfinite(temps)]
     if t.size == 0:
         return math.nan, math.nan
     if t.size < 1000:
         return float(t.min()), float(t.max())
-    lo, hi = np.percentile(t, [0.1, 99.9])
+    lo, hi = np.percentile(t, [0.1, 99.9], overwrite_input=True)
     return float(lo), float(hi)
 
 
@@ -253,8 +257,8 @@ def temperature_tests(
                 f"{name}: temperatures in raw {unit} without a conversion: span not judged",
             )
         ]
-    t = temps[np.isfinite(temps)]
-    lo, hi = _span(t)
+    t = temps[np.isfinite(temps)]  # a copy, reordered by the percentiles (order is not used)
+    lo, hi = _span(t, finite_scratch=True)
     span = hi - lo if t.size else 0.0
     need = MIN_SPAN_PER_ORDER_C * max(order, 1)
     out = [
@@ -277,8 +281,16 @@ def temperature_tests(
     width = max(span / N_SPAN_BINS, MIN_BIN_WIDTH_C)
     per_bin = max(1, min(MIN_SAMPLES_PER_BIN, t.size // (3 * N_SPAN_BINS)))
     if t.size and span > 0:
-        idx = np.clip(np.floor((t - lo) / width).astype(np.int64), 0, None)
-        counts = np.bincount(idx[(t >= lo) & (t <= hi)])
+        counts = np.zeros(0, dtype=np.intp)
+        for a in range(0, t.size, 1 << 18):  # in blocks: the bin counts add up
+            tb = t[a : a + (1 << 18)]
+            idx = np.clip(np.floor((tb - lo) / width).astype(np.int64), 0, None)
+            c = np.bincount(idx[(tb >= lo) & (tb <= hi)])
+            if c.size > counts.size:
+                c[: counts.size] += counts
+                counts = c
+            else:
+                counts[: c.size] += c
         distinct = int(np.count_nonzero(counts >= per_bin))
     else:
         distinct = 1 if t.size else 0
@@ -419,7 +431,8 @@ def _block_stats(
     m = v.shape[1]
     med = np.empty((starts.size, m))
     sigma = np.empty(m)
-    inv = np.repeat(np.arange(starts.size), counts)
+    every = max(1, idx.size // SIGMA_SAMPLES)  # the noise from an even subsample
+    inv = np.searchsorted(starts, np.arange(0, idx.size, every), side="right") - 1
     equal = bool(np.all(counts == counts[0]))
     for j in range(m):
         if equal:  # the common case: a regular record
@@ -429,8 +442,7 @@ def _block_stats(
             lo_i = starts + (counts - 1) // 2
             hi_i = starts + counts // 2
             med[:, j] = 0.5 * (sv[lo_i] + sv[hi_i])
-        every = max(1, idx.size // SIGMA_SAMPLES)  # the noise from an even subsample
-        dev = v[::every, j] - med[inv[::every], j]
+        dev = v[::every, j] - med[inv, j]
         sigma[j] = 1.4826 * float(np.median(np.abs(dev)))
     return time_s[0] + idx[starts] * block_s, counts.astype(np.float64), med, sigma
 
@@ -502,8 +514,8 @@ def stillness(
     v = np.asarray(values, dtype=np.float64)
     if v.ndim == 1:
         v = v[:, None]
-    ok = np.isfinite(t) & np.all(np.isfinite(v), axis=1)
-    if not ok.all():
+    if not (all_finite(t) and all_finite(v)):  # a copy only when something is dropped
+        ok = np.isfinite(t) & np.all(np.isfinite(v), axis=1)
         t, v = t[ok], v[ok]
     if t.size < 20:
         return Motion(0.0, 0.0, floor)
@@ -650,7 +662,8 @@ def judge(
         order = needs.order.get(tn, 0)
         if order <= 0 and tn not in needs.rate:
             continue
-        col = np.concatenate([np.asarray(T, dtype=np.float64)[:, j] for T in runs_temps])
+        parts = [np.asarray(T, dtype=np.float64)[:, j] for T in runs_temps]
+        col = parts[0] if len(parts) == 1 else np.concatenate(parts)  # no copy of one run
         if order > 0:
             tests.extend(temperature_tests(col, tn, order, unit=temperature_unit))
         if tn in needs.rate:

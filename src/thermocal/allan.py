@@ -61,7 +61,7 @@ import math
 import os
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
-from typing import Any, Final, Literal
+from typing import Any, Final, Literal, cast
 
 import numpy as np
 import numpy.typing as npt
@@ -379,48 +379,61 @@ def averaging_factors(taus: TauSpec, tau0_s: float, n_samples: int) -> IntArray:
 # --- the estimator -------------------------------------------------------------------
 
 
-def _phase(rate: FloatArray) -> FloatArray:
-    """x_k = Σ_{i<k} (y_i − ȳ), in units of rate·τ0 (x_0 = 0)."""
-    x = np.empty(rate.size + 1, dtype=np.float64)
-    x[0] = 0.0
-    np.subtract(rate, rate.mean(), out=x[1:])
-    np.cumsum(x[1:], out=x[1:])
+def _phase(rate: FloatArray, overwrite: bool = False) -> FloatArray:
+    """x_k = Σ_{i<k} (y_i − ȳ), in units of rate·τ0, *without* its leading x_0 = 0: the
+    array returned holds x_1 … x_n (one per rate sample; :func:`_second_difference_sum`
+    supplies x_0).  With ``overwrite`` (and a writeable ``rate``) it is computed in
+    ``rate``'s own buffer: no memory per sample."""
+    mean = rate.mean()
+    x = rate if overwrite and rate.flags.writeable else np.empty_like(rate)
+    np.subtract(rate, mean, out=x)
+    np.cumsum(x, out=x)
     return x
 
 
-def _second_difference_sum(x: FloatArray, x2: FloatArray, mm: int) -> float:
-    """S(m) = Σ_k (x_{k+2m} − 2 x_{k+m} + x_k)² for one m, in cache-sized blocks.
+def _second_difference_sum(x1: FloatArray, mm: int) -> float:
+    """S(m) = Σ_k (x_{k+2m} − 2 x_{k+m} + x_k)² for one m, in cache-sized blocks, with
+    ``x1`` = x_1 … x_n (x_0 = 0 is not stored, :func:`_phase`).
 
-    ``x_{k+2m} + x_k − (2x)_{k+m}`` uses a pre-doubled copy ``x2`` (doubling is exact).
+    Each block computes ``x_{k+2m} + x_k − 2·x_{k+m}`` into one block buffer (doubling is
+    exact: the same bits as a pre-doubled copy of the phase, without its 8 bytes a sample).
     """
-    n_terms = x.size - 2 * mm
-    buf = np.empty(min(_CHUNK, max(n_terms, 1)), dtype=np.float64)
+    n_terms = x1.size + 1 - 2 * mm
+    size = min(_CHUNK, max(n_terms, 1))
+    buf = np.empty(size, dtype=np.float64)
+    buf2 = np.empty(size, dtype=np.float64)
     total = 0.0
     for a in range(0, n_terms, _CHUNK):
         b = min(a + _CHUNK, n_terms)
-        t = buf[: b - a]
-        np.add(x[a + 2 * mm : b + 2 * mm], x[a:b], out=t)
-        np.subtract(t, x2[a + mm : b + mm], out=t)
+        t, t2 = buf[: b - a], buf2[: b - a]
+        lo = max(a, 1)  # rows k ≥ 1 read x_k = x1[k − 1]; k = 0 reads x_0 = 0
+        r = slice(lo - a, b - a)
+        np.add(x1[lo + 2 * mm - 1 : b + 2 * mm - 1], x1[lo - 1 : b - 1], out=t[r])
+        np.multiply(x1[lo + mm - 1 : b + mm - 1], 2.0, out=t2[r])
+        if a == 0:  # k = 0: x_{2m} + x_0 − 2 x_m, x_0 = 0
+            t[0] = x1[2 * mm - 1] + 0.0
+            t2[0] = x1[mm - 1] * 2.0
+        np.subtract(t, t2, out=t)
         total += float(np.dot(t, t))
     return total
 
 
-def _second_difference_sums(x: FloatArray, m: IntArray) -> FloatArray:
-    """S(m) for each averaging factor m (see :func:`_second_difference_sum`).
+def _second_difference_sums(x1: FloatArray, m: IntArray) -> FloatArray:
+    """S(m) for each averaging factor m (see :func:`_second_difference_sum`; ``x1`` the
+    phase without x_0).
 
     The averaging factors are shared between :data:`_WORKERS` threads (numpy releases
     the GIL inside its loops); BLAS is held to one thread meanwhile, because a
     multi-threaded ``dot`` inside each worker would oversubscribe the cores.
     """
-    x2 = np.multiply(x, 2.0)
     ms = [int(v) for v in m.tolist()]
     workers = min(_WORKERS, len(ms))
     with threadpool_limits(limits=1, user_api="blas"):
-        if workers <= 1 or x.size < 4 * _CHUNK:
-            vals = [_second_difference_sum(x, x2, mm) for mm in ms]
+        if workers <= 1 or x1.size < 4 * _CHUNK:
+            vals = [_second_difference_sum(x1, mm) for mm in ms]
         else:
             with ThreadPoolExecutor(max_workers=workers) as pool:
-                vals = list(pool.map(lambda mm: _second_difference_sum(x, x2, mm), ms))
+                vals = list(pool.map(lambda mm: _second_difference_sum(x1, mm), ms))
     return np.asarray(vals, dtype=np.float64)
 
 
@@ -505,6 +518,7 @@ def overlapping_adev(
     unit: str = "deg/h",
     confidence: float = ONE_SIGMA_CONFIDENCE,
     alpha: int | None = None,
+    overwrite: bool = False,
 ) -> AllanResult:
     """Overlapping Allan deviation of rate data (NIST SP 1065 eq. 11, IEEE 952 C.1).
 
@@ -525,16 +539,23 @@ def overlapping_adev(
     confidence : confidence level of ``adev_low``/``adev_high`` (default ±1σ).
     alpha : force the noise exponent of the EDF (default: identified per τ by
         :func:`identify_alpha`).
+    overwrite : the phase may be accumulated in ``rate``'s own buffer (a writeable
+        float64 array the caller no longer needs: its values are destroyed), so that the
+        computation holds no array per sample beyond the data (issue 26).
 
     Raises
     ------
     MissingValueError : NaN or infinite rate samples.
     ThermocalInputError : too few samples, bad τ0 or τ list, mismatched time.
     """
-    y = np.asarray(rate, dtype=np.float64).ravel()
+    own = isinstance(rate, np.ndarray) and rate.dtype == np.float64 and rate.ndim == 1
+    y = cast(FloatArray, rate) if own else np.asarray(rate, dtype=np.float64).ravel()
+    overwrite = overwrite and own  # only the caller's own float64 buffer
     if not (math.isfinite(tau0_s) and tau0_s > 0):
         raise ThermocalInputError(f"sample interval τ0 must be positive, got {tau0_s!r}")
-    bad = np.flatnonzero(~np.isfinite(y))
+    with np.errstate(over="ignore", invalid="ignore"):
+        all_finite = math.isfinite(float(np.add.reduce(y))) if y.size else True
+    bad = np.zeros(0, dtype=np.intp) if all_finite else np.flatnonzero(~np.isfinite(y))
     if bad.size:
         raise MissingValueError(
             f"rate has {bad.size} NaN/infinite samples (first at row {bad[0]}); "
@@ -561,8 +582,9 @@ def overlapping_adev(
         ok = (n_phase - 2 * m) >= 2
         if not np.any(ok):
             continue
-        x = _phase(seg)
-        sums[ok] += _second_difference_sums(x, m[ok])
+        x1 = _phase(seg, overwrite)
+        sums[ok] += _second_difference_sums(x1, m[ok])
+        del x1
         n_terms[ok] += n_phase - 2 * m[ok]
         used += seg.size
         segs += 1

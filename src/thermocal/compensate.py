@@ -93,7 +93,6 @@ from thermocal.io import (
     read_text_table,
     sidecar_path,
     write_json,
-    write_recording,
 )
 from thermocal.models.base import (
     ChunkContext,
@@ -104,6 +103,7 @@ from thermocal.models.base import (
 from thermocal.recording import (
     ABSOLUTE_ZERO_C,
     FEW_SAMPLES,
+    PLAUSIBLE_COUNTS,
     PLAUSIBLE_SIGNAL,
     FloatArray,
     Metadata,
@@ -309,10 +309,19 @@ def _iter_chunks(
 
 
 def _check_plausible(
-    temps_c: FloatArray, names: Sequence[str], raw: FloatArray, unit: str, src: Path, row0: int
+    temps_c: FloatArray,
+    names: Sequence[str],
+    raw: FloatArray,
+    unit: str,
+    src: Path,
+    row0: int,
+    signal: str = "",
+    counts_scale: tuple[float, str, float] | None = None,
 ) -> None:
     """The chunk's values against :func:`thermocal.recording.plausibility_problems`' limits:
-    a temperature below absolute zero or a signal beyond any sensor is an input error."""
+    a temperature below absolute zero or a signal beyond any sensor is an input error.
+    Raw counts are checked after their scale factor ``counts_scale`` (K, unit of K, τ [s])
+    when one is given, else against :data:`~thermocal.recording.PLAUSIBLE_COUNTS`."""
     below = temps_c < ABSOLUTE_ZERO_C
     if below.any():
         r, j = (int(v) for v in np.argwhere(below)[0])
@@ -321,16 +330,23 @@ def _check_plausible(
             f"{row0 + r}, below absolute zero (−273.15 °C): a wrong unit, offset or conversion"
         )
     kind = units.signal_kind(unit)
-    if kind == "raw":
-        return
     with np.errstate(over="ignore", invalid="ignore"):
-        canon, canon_unit = units.to_canonical(raw, unit)
-    bad = ~np.isfinite(canon) | (np.abs(canon) > PLAUSIBLE_SIGNAL[kind])
+        if kind != "raw":
+            canon, canon_unit = units.to_canonical(raw, unit, finite=False)
+            limit = PLAUSIBLE_SIGNAL[kind]
+        elif counts_scale is None:
+            canon, canon_unit, limit = raw, unit, PLAUSIBLE_COUNTS
+        else:
+            canon, canon_unit = units.counts_to_physical(raw, *counts_scale, finite=False)
+            limit = PLAUSIBLE_SIGNAL["rate" if canon_unit == "deg/h" else "accel"]
+    bad = ~np.isfinite(canon) | (np.abs(canon) > limit)
     if bad.any():
         r = int(np.argmax(bad))
+        col = f"column {signal!r} " if signal else ""
         raise ThermocalInputError(
-            f"{src}: signal reads {raw[r]:.6g} {unit} at row {row0 + r}, beyond any sensor "
-            f"(|value| ≤ {PLAUSIBLE_SIGNAL[kind]:g} {canon_unit}): wrong unit or corrupt data"
+            f"{src}: signal {col}reads {raw[r]:.6g} {unit} at row {row0 + r} "
+            f"({float(canon[r]):.6g} {canon_unit}), beyond any sensor "
+            f"(|value| ≤ {limit:g} {canon_unit}): wrong unit, scale factor or corrupt data"
         )
 
 
@@ -843,9 +859,14 @@ def _chunk_inputs(
         temps[:, j] = v
     raw = numeric_column(chunk, plan.signal, src, row0)
     _check_finite(raw, f"signal column {plan.signal!r}", src, row0)
+    counts_scale = None
+    if units.signal_kind(plan.data_unit) == "raw" and plan.md.scale_factor is not None:
+        tau_k = plan.md.sample_interval_s or (median_interval(t) if t.size > 1 else 1.0)
+        k_unit = units.scale_factor_unit_or_default(plan.md.scale_factor_unit, str(src))
+        counts_scale = (plan.md.scale_factor, k_unit, float(tau_k))
     _check_plausible(
         temps if plan.model.temperature_unit == "degC" else temps[:, :0],  # counts: no °C
-        plan.temp_names, raw, plan.data_unit, src, row0,
+        plan.temp_names, raw, plan.data_unit, src, row0, plan.signal, counts_scale,
     )  # fmt: skip
     if plan.factor is None:
         tau = plan.md.sample_interval_s or (median_interval(t) if t.size > 1 else None)
@@ -952,60 +973,210 @@ def compensate_triads(
     *,
     time: str | None = None,
     time_unit: str | None = None,
+    chunk_rows: int = DEFAULT_CHUNK_ROWS,
 ) -> list[TriadCompensation]:
     """Apply triad calibrations (issue 19) to a recording: for each triad and each of its
     axes a column ``<col>_comp = [(I + E(T))⁻¹ (x − b(T))]_axis`` in the column's own unit,
     ``T`` the triad's temperature column at each sample (clamped to the calibrated range,
     with a warning when samples leave it; :func:`thermocal.turntable.thermal.correct`).
-    The recording is read whole and the output written atomically with every input column.
+
+    In chunks of ``chunk_rows`` rows with constant memory, like :func:`compensate_channels`
+    (issue 26): the correction is per sample, so each chunk's values equal those of a
+    whole-file pass; every input column is kept as it is and the output is written chunk
+    by chunk to a temporary name, renamed when complete.  Units: option > the file's
+    metadata > a unit in the column name > the unit the triad was calibrated on
+    (:func:`thermocal.units.resolve_inputs`).
     """
     from thermocal.turntable import thermal
 
     src, dst = Path(path), Path(out)
+    kind_in, kind_out = file_kind(src), file_kind(dst)
     check_not_input(dst, [src])
-    rec = read_for_triads(src, triads, time=time, time_unit=time_unit)
-    new_cols: dict[str, FloatArray] = {}
-    new_units: dict[str, str] = {}
+    if chunk_rows < 2:
+        raise ThermocalInputError(f"chunk size must be at least 2 rows, got {chunk_rows}")
+    text_table: pd.DataFrame | None = None
+    text_info: dict[str, Any] | None = None
+    if kind_in in ("ulog", "dataflash"):  # flight-controller logs: read whole, then chunked
+        text_table, text_info = read_log_table(src, None)
+    names, info, _ = _file_info(src, kind_in, text_table, text_info)
+    time_col = time or default_time_column(names, info.get("time"))
+    available = ", ".join(repr(c) for c in names)
+    if time_col not in names:
+        raise MissingColumnError(f"{src}: no time column {time_col!r}; available: {available}")
+    plans = [_triad_plan(tri, names, available, src) for tri in triads]
+    signals = [c for p in plans for c in p.columns]
+    temp_names = list(dict.fromkeys(p.temperature for p in plans))
+    resolved = units.resolve_inputs(
+        time_col,
+        list(dict.fromkeys(signals)),
+        temp_names,
+        options=units.UnitOptions(time_unit=time_unit),
+        file=units.StatedUnits.from_file_info(info, str(src)),
+        model=units.StatedUnits(None, {c: p.tri.unit for p in plans for c in p.columns}),
+        where=str(src),
+    )
+    unconverted = resolved.unconverted_counts()
+    if unconverted:
+        raise UnitError(
+            f"{src}: temperature column(s) {', '.join(map(repr, unconverted))} in raw counts "
+            "with no conversion to °C stated (metadata temperature_conversion)"
+        )
+    for p in plans:
+        p.resolve(resolved, src)
+    t_factor = units.TIME_UNITS[resolved.time.unit]
+    out_info = _triad_output_info(info, time_col, resolved, plans)
+    state: dict[str, Any] = {"rows": 0, "last_t": None}
+
+    def writer(tmp: Path) -> None:
+        w = _Writer(tmp, kind_out, out_info)
+        try:
+            for chunk in _iter_chunks(src, kind_in, chunk_rows, text_table):
+                row0 = int(state["rows"])
+                t = _chunk_time(chunk, time_col, t_factor, src, row0, state["last_t"])
+                temps: dict[str, FloatArray] = {}
+                for c in temp_names:
+                    v = numeric_column(chunk, c, src, row0)
+                    conv = resolved.conversions[c].conversion
+                    if conv is not None:
+                        v = conv.to_celsius(v, f"{src}: column {c!r} (chunk from row {row0})")
+                    _check_finite(v, f"temperature column {c!r}", src, row0)
+                    _check_plausible(v[:, None], [c], v[:0], "deg/h", src, row0)
+                    temps[c] = v
+                new: dict[str, FloatArray] = {}
+                for p in plans:
+                    new.update(p.correct(chunk, temps[p.temperature], src, row0, thermal))
+                w.write(_append_columns(chunk, new))
+                state["rows"] = row0 + t.size
+                state["last_t"] = float(t[-1]) if t.size else state["last_t"]
+        finally:
+            w.close()
+        if state["rows"] == 0:
+            raise FileFormatError(f"{src}: the file has a header but no data rows")
+
+    atomic_write_path(dst, writer)
+    if kind_out == "csv":
+        write_json(sidecar_path(dst), out_info)
     results = []
-    for tri in triads:
-        missing = [c for c in (*tri.columns, tri.temperature) if c not in rec.columns]
-        if missing:
-            raise MissingColumnError(
-                f"{src}: the {tri.name} triad reads {', '.join(map(repr, missing))}, absent; "
-                "available: " + ", ".join(repr(c) for c in rec.columns)
-            )
-        data_units = {rec.units.get(c) or tri.unit for c in tri.columns}
-        if len(data_units) != 1:
-            raise ThermocalInputError(f"{src}: the {tri.name} triad's columns differ in unit")
-        data_unit = data_units.pop()
-        if units.canonical_unit(data_unit) != units.canonical_unit(tri.unit):
-            raise UnitError(
-                f"{src}: the {tri.name} triad was calibrated on {tri.unit} data; these columns "
-                f"are in {data_unit}"
-            )
-        bias_unit = "deg/h" if tri.model.kind == "gyro" else "mg"
-        to_data = float(units.convert(np.array([1.0]), bias_unit, data_unit)[0])
-        x = np.column_stack([rec.column(c) for c in tri.columns])
-        temp = rec.temperature_c(tri.temperature)
-        outside = float(np.mean((temp < tri.model.t_lo_c) | (temp > tri.model.t_hi_c)))
+    for p in plans:
+        outside = p.n_outside / max(int(state["rows"]), 1)
         if outside > 0:
             warnings.warn(
                 ExtrapolationWarning(
-                    f"{src}: {100 * outside:.3g} % of the samples are outside the {tri.name} "
-                    f"triad's calibrated range {tri.model.t_lo_c:g}…{tri.model.t_hi_c:g} °C: "
-                    "its parameters are held at the nearest end there"
+                    f"{src}: {100 * outside:.3g} % of the samples are outside the {p.tri.name} "
+                    f"triad's calibrated range {p.tri.model.t_lo_c:g}…{p.tri.model.t_hi_c:g} "
+                    "°C: its parameters are held at the nearest end there"
                 ),
                 stacklevel=2,
             )
-        xc = thermal.correct(tri.model, x, temp, to_data)
-        comp = []
-        for k, c in enumerate(tri.columns):
-            name = f"{c}_comp"
-            new_cols[name] = np.ascontiguousarray(xc[:, k])
-            new_units[name] = data_unit
-            comp.append(name)
         results.append(
-            TriadCompensation(tri.name, tuple(tri.columns), tuple(comp), data_unit, outside)
+            TriadCompensation(
+                p.tri.name, tuple(p.columns), tuple(p.comp_columns), p.data_unit, outside
+            )
         )
-    write_recording(rec.with_columns(new_cols, new_units), dst)
     return results
+
+
+@dataclass
+class _TriadPlan:
+    """One triad of :func:`compensate_triads`: its columns checked against the file, its
+    data unit (once resolved) and the count of samples outside its calibrated range."""
+
+    tri: Any
+    columns: list[str]
+    temperature: str
+    comp_columns: list[str]
+    data_unit: str = ""
+    to_data: float = 1.0
+    n_outside: int = 0
+
+    def resolve(self, resolved: units.ResolvedInputs, src: Path) -> None:
+        """The data unit of the triad's columns (one for all three) and the factor from
+        its bias unit (°/h or mg) to it."""
+        tri = self.tri
+        data_units = {resolved.signals[c].unit for c in self.columns}
+        if len(data_units) != 1:
+            raise ThermocalInputError(f"{src}: the {tri.name} triad's columns differ in unit")
+        self.data_unit = data_units.pop()
+        if units.canonical_unit(self.data_unit) != units.canonical_unit(tri.unit):
+            raise UnitError(
+                f"{src}: the {tri.name} triad was calibrated on {tri.unit} data; these columns "
+                f"are in {self.data_unit}"
+            )
+        bias_unit = "deg/h" if tri.model.kind == "gyro" else "mg"
+        self.to_data = float(units.convert(np.array([1.0]), bias_unit, self.data_unit)[0])
+
+    def correct(
+        self,
+        chunk: pd.DataFrame | pa.RecordBatch,
+        temp: FloatArray,
+        src: Path,
+        row0: int,
+        thermal: Any,
+    ) -> dict[str, FloatArray]:
+        """The chunk's compensated columns (:func:`thermocal.turntable.thermal.correct`)."""
+        x = np.empty((temp.size, 3))
+        for k, c in enumerate(self.columns):
+            v = numeric_column(chunk, c, src, row0)
+            _check_finite(v, f"signal column {c!r}", src, row0)
+            _check_plausible(temp[:0, None], [], v, self.data_unit, src, row0, c)
+            x[:, k] = v
+        m = self.tri.model
+        self.n_outside += int(np.count_nonzero((temp < m.t_lo_c) | (temp > m.t_hi_c)))
+        xc = thermal.correct(m, x, temp, self.to_data)
+        return {name: np.ascontiguousarray(xc[:, k]) for k, name in enumerate(self.comp_columns)}
+
+
+def _triad_plan(tri: Any, names: Sequence[str], available: str, src: Path) -> _TriadPlan:
+    """A triad's columns checked against the file: present, and their ``_comp`` columns
+    not yet there."""
+    missing = [c for c in (*tri.columns, tri.temperature) if c not in names]
+    if missing:
+        raise MissingColumnError(
+            f"{src}: the {tri.name} triad reads {', '.join(map(repr, missing))}, absent; "
+            f"available: {available}"
+        )
+    comp = [f"{c}{COMP_SUFFIX}" for c in tri.columns]
+    for c in comp:
+        if c in names:
+            raise ThermocalInputError(
+                f"{src}: already has a column {c!r}; was the file compensated already?"
+            )
+    return _TriadPlan(tri, list(tri.columns), tri.temperature, comp)
+
+
+def _triad_output_info(
+    info: dict[str, Any], time_col: str, resolved: units.ResolvedInputs, plans: Sequence[_TriadPlan]
+) -> dict[str, Any]:
+    """The output's metadata: the input's, with the time unit, the triads' columns and
+    temperatures in their resolved units and the compensated columns in the data's unit."""
+    out_info: dict[str, Any] = {
+        "format": META_FORMAT,
+        "version": META_VERSION,
+        **{k: v for k, v in info.items() if k not in ("format", "version")},
+    }
+    out_info["time"] = time_col
+    out_info["time_unit"] = resolved.time.unit
+    signals = dict(info.get("signals") or {})
+    extra = dict(info.get("units") or {})
+    for p in plans:
+        for c, comp in zip(p.columns, p.comp_columns, strict=True):
+            (signals if c in signals else extra)[c] = p.data_unit
+            extra[comp] = p.data_unit
+    temps = dict(info.get("temperatures") or {})
+    temps.update({c: r.unit for c, r in resolved.temperatures.items()})
+    out_info["signals"] = signals
+    out_info["temperatures"] = temps
+    out_info["units"] = extra
+    used_conv = {
+        c: r.conversion.to_json()
+        for c, r in resolved.conversions.items()
+        if r.conversion is not None
+    }
+    if used_conv:
+        out_md = dict(out_info.get("metadata") or {})
+        out_md["temperature_conversion"] = {
+            **dict(out_md.get("temperature_conversion") or {}),
+            **used_conv,
+        }
+        out_info["metadata"] = out_md
+    return out_info

@@ -23,6 +23,8 @@ from thermocal.recording import (
     contiguous_slices,
     find_gaps,
     find_problems,
+    finite_extrema,
+    median_in_blocks,
     median_interval,
 )
 
@@ -93,6 +95,10 @@ class Inspection:
         }
 
 
+SPIKE_CHUNK = 1 << 18
+"""Window centres per chunk of the Hampel test's running median (issue 26: the medians
+of one chunk at a time, ≈ 2 MB each, instead of two arrays as long as the column)."""
+
 SPIKE_BLOCK = 1 << 15
 """Window centres per block of the Hampel test (its working memory is ≈ 2·w·8 bytes each)."""
 
@@ -120,31 +126,49 @@ def count_spikes(
         xs = x[sl]
         if xs.size < w or not np.all(np.isfinite(xs)):
             continue
-        # global MAD of the first differences, partitioned in place (one array of steps)
-        d = np.diff(xs)
-        d -= np.median(d, overwrite_input=True)
-        np.abs(d, out=d)
-        floor = 1.4826 * float(np.median(d, overwrite_input=True)) / np.sqrt(2.0)
-        del d
+
+        # global MAD of the first differences, their medians selected block by block
+        # (exactly np.median's, without an array of steps as long as the column)
+        def steps(a: int, b: int, xs: FloatArray = xs) -> FloatArray:
+            return np.diff(xs[a : b + 1])
+
+        med_d = median_in_blocks(steps, xs.size - 1)
+
+        def abs_dev(a: int, b: int, med_d: float = med_d) -> FloatArray:
+            d = steps(a, b)
+            d -= med_d
+            return np.abs(d, out=d)
+
+        floor = 1.4826 * median_in_blocks(abs_dev, xs.size - 1) / np.sqrt(2.0)
         # the window medians of every centre (scipy.ndimage's running selection, exact for
         # an odd window: 20× the speed of np.median over sliding windows), then the MAD only
         # where a spike is possible: sigma ≥ floor, so |x − med| ≤ threshold·floor is no spike
         from scipy import ndimage
 
-        med_all = ndimage.median_filter(xs, size=w, mode="nearest")
-        med = med_all[half_window : xs.size - half_window]
-        centre = xs[half_window : xs.size - half_window]
-        dev_c = np.abs(centre - med)
-        cand = np.flatnonzero(dev_c > threshold * floor) if floor > 0 else np.flatnonzero(dev_c > 0)
         hits: list[int] = []
-        for a in range(0, cand.size, SPIKE_BLOCK):  # bounded working memory
-            idx = cand[a : a + SPIKE_BLOCK]
-            win = sliding_window_view(xs, w)[idx]
-            mad = np.median(np.abs(win - med[idx, None]), axis=1)
-            sigma = np.maximum(1.4826 * mad, floor)
-            hit = (dev_c[idx] > threshold * sigma) & (sigma > 0)
-            hits.extend(int(i) for i in idx[hit][:1])
-            n_total += int(np.count_nonzero(hit))
+        n_centres = xs.size - 2 * half_window
+        windows = sliding_window_view(xs, w)
+        for c0 in range(0, n_centres, SPIKE_CHUNK):  # chunks of centres: bounded memory
+            c1 = min(n_centres, c0 + SPIKE_CHUNK)
+            # centre c (row c + half_window) has window xs[c : c + w]; the chunk's windows
+            # lie in xs[c0 : c1 + 2·half_window], whose filter is exact away from its ends
+            sub = xs[c0 : c1 + 2 * half_window]
+            med = ndimage.median_filter(sub, size=w, mode="nearest")[half_window:-half_window]
+            dev_c = np.abs(xs[c0 + half_window : c1 + half_window] - med)
+            cand = (
+                np.flatnonzero(dev_c > threshold * floor)
+                if floor > 0
+                else np.flatnonzero(dev_c > 0)
+            )
+            for a in range(0, cand.size, SPIKE_BLOCK):
+                idx = cand[a : a + SPIKE_BLOCK]
+                win = windows[c0 + idx]
+                mad = np.median(np.abs(win - med[idx, None]), axis=1)
+                sigma = np.maximum(1.4826 * mad, floor)
+                hit = (dev_c[idx] > threshold * sigma) & (sigma > 0)
+                hits.extend(int(c0 + i) for i in idx[hit][:1])
+                n_total += int(np.count_nonzero(hit))
+            del med, dev_c
         if hits:
             row = int(sl.start) + half_window + min(hits)
             first = row if first is None else min(first, row)
@@ -158,8 +182,8 @@ def _temperature_span_c(rec: Recording, name: str) -> list[float] | None:
         temp = rec.temperature_c(name)
     except ThermocalInputError:
         return None
-    finite = temp[np.isfinite(temp)]
-    return [float(finite.min()), float(finite.max())] if finite.size else None
+    ext = finite_extrema(temp)  # in blocks: no copy of the column
+    return [ext.lo, ext.hi] if ext is not None else None
 
 
 def inspect_recording(rec: Recording) -> Inspection:

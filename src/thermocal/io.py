@@ -386,15 +386,15 @@ class _ParquetColumns:
         pos = 0
         try:
             for i in range(self._pf.num_row_groups):
-                group = self._pf.read_row_group(i, columns=todo, use_threads=True)
                 k = 0
-                for n in todo:
+                for n in todo:  # one column chunk at a time: the decoding buffers of one
+                    group = self._pf.read_row_group(i, columns=[n], use_threads=False)
                     k = 0
-                    for chunk in group.column(n).chunks:
+                    for chunk in group.column(0).chunks:
                         out[n][pos + k : pos + k + len(chunk)] = arrow_chunk_f64(chunk)
                         k += len(chunk)
+                    del group
                 pos += k
-                del group
         except (pa.ArrowInvalid, OSError):
             return  # a damaged file: column by column, the error names the column
         if pos == self.num_rows:

@@ -15,6 +15,7 @@ of a stretch is dropped.
 
 from __future__ import annotations
 
+import bisect
 import dataclasses
 import math
 from dataclasses import dataclass
@@ -24,7 +25,7 @@ import numpy.typing as npt
 
 from thermocal import units
 from thermocal.errors import MissingValueError, ThermocalInputError
-from thermocal.recording import Recording, contiguous_slices
+from thermocal.recording import Recording, contiguous_slices, is_increasing
 
 FloatArray = npt.NDArray[np.float64]
 
@@ -402,8 +403,8 @@ def reference_bias(
     """
     t = _as_1d(time_s, "time")
     r = _as_1d(rate, "rate")
-    rel = t - t[0]
-    duration = float(rel[-1])
+    t0 = t[0]
+    duration = float(t[-1] - t0)
     if window_s is None:
         start, end = 0.0, DEFAULT_DRIFT_REFERENCE_FRACTION * duration
     else:
@@ -413,14 +414,24 @@ def reference_bias(
                 f"--drift-reference {start:g},{end:g}: give START,END in seconds since the "
                 "first sample, with 0 ≤ START < END"
             )
-    sel = (rel >= start) & (rel <= end)
-    n = int(np.count_nonzero(sel))
+    if is_increasing(t):  # the window is one stretch: found by bisection, no copy
+        # t_i − t_0 is non-decreasing in i (rounding is monotone): the rows with
+        # start ≤ t_i − t_0 ≤ end are i0 … i1 − 1
+        i0 = bisect.bisect_left(range(t.size), True, key=lambda i: bool(t[i] - t0 >= start))
+        i1 = bisect.bisect_left(range(t.size), True, key=lambda i: bool(t[i] - t0 > end))
+        n = max(i1 - i0, 0)
+        selected = r[i0:i1]
+    else:
+        rel = t - t0
+        sel = (rel >= start) & (rel <= end)
+        n = int(np.count_nonzero(sel))
+        selected = r[sel]
     if n == 0:
         raise ThermocalInputError(
             f"drift reference window {start:g}…{end:g} s holds no sample (the run lasts "
             f"{duration:g} s from its first sample); choose another --drift-reference"
         )
-    b0 = float(np.mean(r[sel])) - float(earth_rate)
+    b0 = float(np.mean(selected)) - float(earth_rate)
     return DriftReference("window", start, end, b0, unit, n)
 
 

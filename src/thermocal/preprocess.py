@@ -442,15 +442,21 @@ def segment_holds(
     """
     t = _as_f64(time_s, "time_s")
     T = _as_f64(temp_c, "temp_c")
-    rate = temperature_rate(t, T, rate_interval_s, "centred", gap_factor=gap_factor)
-    is_hold = np.empty(rate.size, dtype=bool)
-    for a in range(0, rate.size, RATE_BLOCK):  # |Ṫ| without a full-size copy
-        np.less(
-            np.abs(rate[a : a + RATE_BLOCK]),
-            rate_threshold_c_per_min,
-            out=is_hold[a : a + RATE_BLOCK],
-        )
-    del rate
+    if t.size != T.size:
+        raise ThermocalInputError("time_s and temp_c have different lengths")
+    if not rate_interval_s > 0:
+        raise ThermocalInputError(f"rate interval must be positive, got {rate_interval_s}")
+    # |Ṫ| < threshold block by block (the centred Ṫ of temperature_rate, bit for bit):
+    # one byte a sample, no full-length Ṫ (issue 26)
+    is_hold = np.full(t.size, rate_threshold_c_per_min > 0.0)  # rows of no segment: Ṫ = 0
+    T2 = T.reshape(-1, 1)
+    for sl in gap_free_slices(t, gap_factor):
+        s0, s1 = int(sl.start), int(sl.stop)
+        ts, Ts = t[s0:s1], T2[s0:s1]
+        for a in range(0, s1 - s0, RATE_BLOCK_ROWS):
+            b = min(s1 - s0, a + RATE_BLOCK_ROWS)
+            r = segment_rates(ts, Ts, np.arange(a, b), rate_interval_s, "centred")[:, 0]
+            np.less(np.abs(r), rate_threshold_c_per_min, out=is_hold[s0 + a : s0 + b])
     segs: list[Segment] = []
     for sl in contiguous_slices(t, gap_factor):
         base = int(sl.start)

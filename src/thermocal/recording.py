@@ -17,7 +17,7 @@ import dataclasses
 import itertools
 import math
 import warnings
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
 from typing import Any, Literal
 
@@ -282,8 +282,9 @@ class Recording:
                 self.meta.scale_factor,
                 units.scale_factor_unit_or_default(self.meta.scale_factor_unit, self.name),
                 self.sample_interval_s,
+                f"{self.name}: signal column {name!r}",
             )
-        return units.to_canonical(values, unit)
+        return units.to_canonical(values, unit, f"{self.name}: signal column {name!r}")
 
     def temperature_c(self, name: str | None = None) -> FloatArray:
         """A temperature column in [°C], converting raw counts with the metadata's
@@ -322,6 +323,8 @@ class Recording:
         names = tuple(names) if names is not None else self.temperatures
         if not names:
             raise MissingColumnError(f"{self.name}: no temperature columns named")
+        if len(names) == 1:  # one column: a view of it (no copy; the (n, 1) array is read)
+            return self.temperature_c(names[0]).reshape(-1, 1)
         return np.column_stack([self.temperature_c(n) for n in names])
 
     def _default(self, name: str | None, pool: tuple[str, ...], what: str) -> str:
@@ -609,6 +612,30 @@ FEW_SAMPLES = 10
 """Fewer sample rows than this are reported (a warning; commands needing more refuse)."""
 PLAUSIBLE_SIGNAL = {"rate": 1e8, "accel": 1e7}
 """Largest |value| any gyro [°/h] (≈ 28 000 °/s) or accelerometer [mg] (10 000 g) outputs."""
+PLAUSIBLE_COUNTS = 2.0**64
+"""Largest |value| of a raw count column without a scale factor: no ADC or pulse counter
+has more than 64 bits (and float64 is exact for integers only up to 2⁵³)."""
+
+
+def _physical_of_counts(
+    rec: Recording,
+) -> Callable[[FloatArray], tuple[FloatArray, str]] | None:
+    """The conversion counts → [°/h] or [mg] of ``rec``'s scale factor, for a block of
+    rows and without the overflow refusal (the caller reports the row itself); None when
+    the recording states no scale factor."""
+    k = rec.meta.scale_factor
+    if k is None:
+        return None
+    k_unit = units.scale_factor_unit_or_default(rec.meta.scale_factor_unit, rec.name)
+    try:
+        tau = rec.sample_interval_s if units.SCALE_FACTOR_UNITS[k_unit][0] else 1.0
+    except (KeyError, ThermocalInputError):
+        return None  # an unknown unit or no interval: refused where the signal is used
+
+    def conv(part: FloatArray) -> tuple[FloatArray, str]:
+        return units.counts_to_physical(part, k, k_unit, tau, finite=False)
+
+    return conv
 
 
 @dataclass(frozen=True)
@@ -621,6 +648,76 @@ class Extrema:
     hi: float
     hi_row: int
     count: int
+
+
+MEDIAN_BLOCK = 1 << 18
+"""Values per block of :func:`median_in_blocks`."""
+
+
+def median_in_blocks(
+    values: Callable[[int, int], FloatArray], n: int, block: int = MEDIAN_BLOCK
+) -> float:
+    """``np.median`` of ``n`` values that ``values(a, b)`` computes block by block (rows
+    a … b − 1), exactly (the same bits), with memory of a few blocks instead of the
+    whole array.
+
+    Selection by bracketing (Floyd & Rivest 1975, "Expected time bounds for selection"):
+    a strided sample of ≈ 65 536 values gives bounds ``lo ≤ hi`` around its median; one
+    pass counts the values below ``lo`` and keeps those within ``[lo, hi]``; when the
+    middle order statistic(s) ``(n − 1)//2`` and ``n//2`` fall among the kept ones they
+    are selected there (``np.partition``), their mean is the median as ``np.median``
+    forms it.  Otherwise the bracket is widened (three tries), and at last the whole
+    array is built.  NaN-free values are assumed (the caller checks).
+    """
+    if n <= 4 * block:
+        return float(np.median(values(0, n), overwrite_input=True))
+    k_lo, k_hi = (n - 1) // 2, n // 2
+    step = max(1, n // 65536)
+    sample = np.sort(
+        np.concatenate(
+            [  # copies: a strided view would keep its whole block alive
+                values(a, min(n, a + block))[(-a) % step :: step].copy() for a in range(0, n, block)
+            ]
+        )
+    )
+    m = sample.size
+    widen = 0.01
+    for _ in range(3):
+        lo = sample[max(0, int(m * (0.5 - widen)))]
+        hi = sample[min(m - 1, int(m * (0.5 + widen)))]
+        below = 0
+        kept: list[FloatArray] = []
+        for a in range(0, n, block):
+            v = values(a, min(n, a + block))
+            below += int(np.count_nonzero(v < lo))
+            kept.append(v[(v >= lo) & (v <= hi)])
+        mid = np.concatenate(kept)
+        if below <= k_lo and k_hi < below + mid.size:
+            i, j = k_lo - below, k_hi - below
+            part = np.partition(mid, [i, j])
+            return float(np.mean(part[[i, j]])) if i != j else float(part[i])
+        widen *= 4.0
+    whole = np.concatenate([values(a, min(n, a + block)) for a in range(0, n, block)])
+    return float(np.median(whole, overwrite_input=True))
+
+
+def all_finite(arr: npt.NDArray[np.float64]) -> bool:
+    """Every element finite, without a mask as long as the array on the usual path: the
+    sum is finite exactly when every element is (or it overflowed: then the mask)."""
+    if arr.size == 0:
+        return True
+    with np.errstate(over="ignore", invalid="ignore"):
+        if math.isfinite(float(np.sum(arr))):
+            return True
+    return bool(np.isfinite(arr).all())
+
+
+def is_increasing(t: FloatArray, block: int = DIFF_BLOCK) -> bool:
+    """``t`` strictly increasing, checked in blocks (a few bytes a row of one block)."""
+    for a in range(0, max(t.size - 1, 0), block):
+        if not bool(np.all(np.diff(t[a : a + block + 1]) > 0)):
+            return False
+    return True
 
 
 def finite_extrema(arr: FloatArray, block: int = DIFF_BLOCK) -> Extrema | None:
@@ -685,6 +782,8 @@ def plausibility_problems(rec: Recording) -> list[Problem]:
             )
         try:
             temp = rec.temperature_c(name)
+        except units.ConversionOverflowError:
+            raise  # a finite count beyond float64 once converted: no °C to check
         except ThermocalInputError:
             continue  # raw counts without a conversion: checked where they are used
         ext = finite_extrema(temp)
@@ -731,16 +830,26 @@ def plausibility_problems(rec: Recording) -> list[Problem]:
             kind = units.signal_kind(unit)
         except UnitError:
             continue
-        if kind == "raw":
-            continue
         found: tuple[int, float] | None = None  # (row, value in the canonical unit)
-        canon_unit = units.canonical_unit(unit)
+        to_physical = _physical_of_counts(rec) if kind == "raw" else None
+        if to_physical is not None:
+            canon_unit = to_physical(arr[:1])[1]
+            limit = PLAUSIBLE_SIGNAL["rate" if canon_unit == "deg/h" else "accel"]
+        elif kind == "raw":
+            canon_unit, limit = unit, PLAUSIBLE_COUNTS  # counts stay counts
+        else:
+            canon_unit, limit = units.canonical_unit(unit), PLAUSIBLE_SIGNAL[kind]
         for a0 in range(0, arr.size, DIFF_BLOCK):  # in blocks: bounded working memory
             part = arr[a0 : a0 + DIFF_BLOCK]
             with np.errstate(over="ignore", invalid="ignore"):
-                canon, _ = units.to_canonical(part, unit)
+                if kind != "raw":
+                    canon, _ = units.to_canonical(part, unit, finite=False)
+                elif to_physical is None:
+                    canon = part
+                else:
+                    canon = to_physical(part)[0]
             finite_in = np.isfinite(part)
-            beyond = finite_in & ~(np.abs(canon) <= PLAUSIBLE_SIGNAL[kind])  # inf or too big
+            beyond = finite_in & ~(np.abs(canon) <= limit)  # inf or too big
             if beyond.any():
                 i = int(np.argmax(beyond))
                 found = (a0 + i, float(canon[i]))
@@ -753,7 +862,7 @@ def plausibility_problems(rec: Recording) -> list[Problem]:
                     "implausible_signal",
                     f"signal column {name!r} reads {float(arr[row]):.6g} {unit} at row {row} "
                     f"({canon_row:.6g} {canon_unit}), beyond any sensor "
-                    f"(|value| ≤ {PLAUSIBLE_SIGNAL[kind]:g} {canon_unit}): wrong unit or "
+                    f"(|value| ≤ {limit:g} {canon_unit}): wrong unit, scale factor or "
                     "corrupt data",
                     column=name,
                     row=row,
@@ -807,7 +916,7 @@ def _accelerometer_magnitude_problems(rec: Recording) -> list[Problem]:
         except UnitError:
             continue
         with np.errstate(over="ignore", invalid="ignore"):
-            cols.append((name, units.to_canonical(arr, unit)[0]))
+            cols.append((name, units.to_canonical(arr, unit, finite=False)[0]))
     if not cols:
         return []
     if len(cols) >= 3:

@@ -205,7 +205,10 @@ class TemperatureConversion(NamedTuple):
                     "not a 16-bit value (the conversion says int16: −32768…65535)"
                 )
             v = np.where(v >= INT16_SIGN_BIT, v - UINT16_MODULUS, v)
-        return v * self.gain + self.offset
+        with np.errstate(over="ignore", invalid="ignore"):
+            out = v * self.gain + self.offset
+        refuse_overflow(out, v, f"counts → °C, {self.describe()}", where)
+        return out
 
     def to_json(self) -> list[float | str]:
         out: list[float | str] = [float(self.gain), float(self.offset)]
@@ -638,6 +641,55 @@ def signal_kind(unit: str) -> SignalKind:
     return "raw"
 
 
+class ConversionOverflowError(UnitError):
+    """A finite value became non-finite (±inf, NaN) on a unit conversion (exit 2)."""
+
+
+OVERFLOW_SCAN_BLOCK: Final = 1 << 16
+"""Rows per block of :func:`refuse_overflow`'s search for the first overflowing value
+(a few bytes of working memory per row of a block, none per row of the column)."""
+
+
+def refuse_overflow(
+    out: npt.NDArray[np.float64],
+    values: npt.NDArray[np.float64],
+    what: str,
+    where: str = "",
+    first_row: int = 0,
+) -> None:
+    """Refuse (:class:`UnitError`, exit 2) a conversion that made a finite value
+    non-finite (a float64 overflow: |x| > 1.8e308), naming ``where`` (the column), the
+    first such row (``first_row`` + index, rows of a 2-D array by its first axis) and the
+    value before and after.
+
+    Cheap on the usual path: the sum of ``out`` is finite exactly when every element is
+    (an infinite or NaN term makes it non-finite; a finite overflow of the sum sends it to
+    the block scan, which then finds nothing); no copy is made.  Only when it is not are
+    ``out`` and ``values`` scanned, in blocks of :data:`OVERFLOW_SCAN_BLOCK`, for a
+    non-finite output whose input was finite (a NaN or infinity already in the data is
+    not the conversion's doing and is left to the callers' gap handling)."""
+    flat = out.reshape(-1)
+    if flat.size == 0:
+        return
+    with np.errstate(over="ignore", invalid="ignore"):
+        total = float(np.add.reduce(flat))
+    if math.isfinite(total):
+        return
+    vin = np.broadcast_to(values, out.shape).reshape(-1)
+    per_row = flat.size // out.shape[0] if out.ndim > 1 and out.shape[0] else 1
+    for a in range(0, flat.size, OVERFLOW_SCAN_BLOCK):
+        o = flat[a : a + OVERFLOW_SCAN_BLOCK]
+        v = vin[a : a + OVERFLOW_SCAN_BLOCK]
+        bad = ~np.isfinite(o) & np.isfinite(v)
+        if bad.any():
+            i = a + int(np.argmax(bad))
+            raise ConversionOverflowError(
+                f"{where + ': ' if where else ''}{float(vin[i]):.6g} at row "
+                f"{first_row + i // per_row} becomes {float(flat[i])} on conversion "
+                f"({what}), beyond any float64: a wrong unit or scale factor, or corrupt data"
+            )
+
+
 def canonical_unit(unit: str) -> str:
     """The unit figures of merit are reported in: [°/h] for rates, [mg] for accelerations.
 
@@ -648,12 +700,21 @@ def canonical_unit(unit: str) -> str:
     return {"rate": "deg/h", "accel": "mg", "raw": "counts"}[kind]
 
 
-def to_canonical(values: npt.ArrayLike, unit: str) -> tuple[npt.NDArray[np.float64], str]:
+def to_canonical(
+    values: npt.ArrayLike,
+    unit: str,
+    where: str = "",
+    first_row: int = 0,
+    *,
+    finite: bool = True,
+) -> tuple[npt.NDArray[np.float64], str]:
     """Convert a signal to its canonical unit ([°/h] for rates, [mg] for accelerations).
 
     Returns the converted float64 array and the canonical unit string. Data already in
     the canonical unit come back as they are (no copy, no memory per row): treat the
-    result as read-only.
+    result as read-only.  A finite value that overflows on conversion is a
+    :class:`UnitError` naming ``where`` and its row (:func:`refuse_overflow`) unless
+    ``finite=False`` (callers that report such values themselves).
     """
     u = normalize_signal_unit(unit)
     arr = np.asarray(values, dtype=np.float64)
@@ -661,21 +722,33 @@ def to_canonical(values: npt.ArrayLike, unit: str) -> tuple[npt.NDArray[np.float
     kind = "deg/h" if u in RATE_UNITS else "mg" if u in ACCEL_UNITS else "counts"
     if factor is None or factor == 1.0:
         return arr, kind
-    return arr * factor, kind
+    with np.errstate(over="ignore"):
+        out = arr * factor
+    if finite:
+        refuse_overflow(out, arr, f"{unit} → {kind}", where, first_row)
+    return out, kind
 
 
-def convert(values: npt.ArrayLike, from_unit: str, to_unit: str) -> npt.NDArray[np.float64]:
-    """Convert between two signal units of the same kind (rate↔rate, accel↔accel)."""
+def convert(
+    values: npt.ArrayLike, from_unit: str, to_unit: str, where: str = ""
+) -> npt.NDArray[np.float64]:
+    """Convert between two signal units of the same kind (rate↔rate, accel↔accel); a finite
+    value that overflows is a :class:`UnitError` naming ``where`` (:func:`refuse_overflow`)."""
     f = normalize_signal_unit(from_unit)
     t = normalize_signal_unit(to_unit)
     arr = np.asarray(values, dtype=np.float64)
     if f == t:
         return arr.copy()
     if f in RATE_UNITS and t in RATE_UNITS:
-        return arr * (RATE_UNITS[f] / RATE_UNITS[t])
-    if f in ACCEL_UNITS and t in ACCEL_UNITS:
-        return arr * (ACCEL_UNITS[f] / ACCEL_UNITS[t])
-    raise UnitError(f"cannot convert {from_unit!r} to {to_unit!r}: different kinds of quantity")
+        factor = RATE_UNITS[f] / RATE_UNITS[t]
+    elif f in ACCEL_UNITS and t in ACCEL_UNITS:
+        factor = ACCEL_UNITS[f] / ACCEL_UNITS[t]
+    else:
+        raise UnitError(f"cannot convert {from_unit!r} to {to_unit!r}: different kinds of quantity")
+    with np.errstate(over="ignore"):
+        out = arr * factor
+    refuse_overflow(out, arr, f"{from_unit} → {to_unit}", where)
+    return out
 
 
 def earth_rate_on_axis_deg_h(latitude_deg: float, axis_enu: npt.ArrayLike) -> float:
@@ -822,12 +895,21 @@ gives [arcsec/s] = [°/h].  Non-integrating outputs (MEMS LSB): ``value = N / K`
 
 
 def counts_to_physical(
-    counts: npt.ArrayLike, scale_factor: float, scale_factor_unit: str, interval_s: float
+    counts: npt.ArrayLike,
+    scale_factor: float,
+    scale_factor_unit: str,
+    interval_s: float,
+    where: str = "",
+    first_row: int = 0,
+    *,
+    finite: bool = True,
 ) -> tuple[npt.NDArray[np.float64], str]:
     """Convert raw counts to the canonical unit ([°/h] or [mg]) with scale factor K.
 
     SPEC §1: ``ω = N / (τ K)`` for pulse (integrating) outputs, ``N / K`` otherwise.
-    Returns the converted array and the canonical unit string.
+    Returns the converted array and the canonical unit string.  A finite count that
+    overflows on conversion (1e300 counts with a small K) is a :class:`UnitError` naming
+    ``where`` and its row (:func:`refuse_overflow`) unless ``finite=False``.
     """
     if scale_factor_unit not in SCALE_FACTOR_UNITS:
         raise UnitError(
@@ -841,5 +923,20 @@ def counts_to_physical(
     if integrating:
         if not interval_s > 0:
             raise UnitError("an integrating (pulse) output needs a positive sample interval τ")
-        return arr * (factor / (interval_s * scale_factor)), unit
-    return arr * (factor / scale_factor), unit
+        with np.errstate(over="ignore"):
+            gain = factor / (interval_s * scale_factor)
+    else:
+        with np.errstate(over="ignore"):
+            gain = factor / scale_factor
+    if not math.isfinite(gain):
+        raise UnitError(
+            f"{where + ': ' if where else ''}scale factor K = {scale_factor:g} "
+            f"{scale_factor_unit} makes one count an infinite {unit}"
+        )
+    with np.errstate(over="ignore"):
+        out = arr * gain
+    if finite:
+        refuse_overflow(
+            out, arr, f"counts → {unit}, K = {scale_factor:g} {scale_factor_unit}", where, first_row
+        )
+    return out, unit

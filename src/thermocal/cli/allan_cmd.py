@@ -244,7 +244,7 @@ def allan_cmd(
         time=time,
         time_unit=time_unit,
         signal=signal,
-        temps=temps,
+        temps=temps if temps is not None else "",  # no temperature column is read
         signal_unit=signal_unit,
         temp_unit=temp_unit,
         temp_conversion=temp_conversion,
@@ -307,6 +307,9 @@ def allan_cmd(
             segments=rec.segments(),  # one scan of the time column for every channel
             unit=unit,
             confidence=confidence,
+            # the phase is accumulated in the column's own buffer (no memory per sample):
+            # the column is not used again unless the channel is named twice
+            overwrite=names.count(name) == 1,
         )
         noise_c = _allan.noise_terms(res_c)
         if noise_c.quality is not None and noise_c.quality.quality == "poor":

@@ -99,7 +99,7 @@ def compensate_cmd(
                 "applied yet; split it"
             )
         done = _compensate.compensate_triads(
-            cal.triads, file, output, time=time, time_unit=time_unit
+            cal.triads, file, output, time=time, time_unit=time_unit, chunk_rows=chunk_rows
         )
         summary_t = {"model": str(model_file), "output": str(output),
                      "triads": [d.to_dict() for d in done]}  # fmt: skip

@@ -48,6 +48,7 @@ fit statistics), ``coefficients`` and ``warnings``.
 """
 
 import dataclasses
+import re
 import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -125,6 +126,60 @@ TARGETS = ("bias", "scale_factor")
 def run_temp_names(rec: "_recording.Recording", temps: str | None) -> list[str]:
     """The temperature columns a fit uses: ``--temps`` or the file's."""
     return split_names(temps) or list(rec.temperatures)
+
+
+MAX_ORDER = 10
+"""Hard ceiling of ``--order`` (poly: powers of each temperature; warmup: order in ΔT) and
+``--t0-order`` (warmup).  A temperature polynomial of order 10 over a −40…85 °C range
+already has a condition number near 1e9 on scaled variables (each further power loses about
+one digit of the fit's 16); calibration practice (IEEE Std 952/1293, the PX4 and ArduPilot
+thermal calibrations: order 3) stays well below.  The data limit (more coefficients than
+samples or distinct temperatures) is checked once the data are read (``thermocal.adequacy``);
+this ceiling is checked before anything is read or allocated, so that an order of 10²⁰ —
+which typer parses as a Python int — never becomes a list of 10²⁰ terms."""
+
+MAX_TERMS = 200
+"""Hard ceiling of the number of terms in ``--terms`` (poly).  The seed set ``seed000`` has
+9 terms per temperature sensor (37 with four sensors and the constant); 200 terms is five times
+that, and a design matrix of 200 float64 columns costs 1.6 kB per sample (16 GB at 10⁷
+samples), beyond any machine the fit is meant for."""
+
+MAX_SEGMENTS = 100
+"""Hard ceiling of ``--segments`` (piecewise): each segment adds two coefficients and
+needs its own temperature span; 100 segments over a −40…85 °C range is 1.25 °C each, below
+which a segment fits the noise of one soak rather than a temperature effect."""
+
+
+def check_ceilings(
+    order: int | None, t0_order: int | None, segments: int | None, terms: str | None
+) -> None:
+    """Refuse (:class:`ThermocalInputError`, exit 2) an order or term count beyond the hard
+    ceilings :data:`MAX_ORDER`, :data:`MAX_TERMS`, :data:`MAX_SEGMENTS`, before any data is
+    read.  The value is checked, not only its type: typer parses any integer literal."""
+    for option, value, lo, hi in (
+        ("--order", order, 1, MAX_ORDER),
+        ("--t0-order", t0_order, 0, MAX_ORDER),
+        ("--segments", segments, 1, MAX_SEGMENTS),
+    ):
+        if value is not None and not lo <= value <= hi:
+            shown = (
+                str(value)
+                if len(str(value)) <= 24
+                else f"{str(value)[:20]}… ({len(str(value))} digits)"
+            )
+            raise ThermocalInputError(f"{option} must be between {lo} and {hi}, got {shown}")
+    if terms is not None:
+        n = terms.count(",") + 1
+        if n > MAX_TERMS:
+            raise ThermocalInputError(f"--terms lists {n} terms; at most {MAX_TERMS} are accepted")
+        for power in _POWER.findall(terms):
+            if len(power) > 3 or int(power) > MAX_ORDER:
+                raise ThermocalInputError(
+                    f"--terms: power {power[:20]} is above the ceiling {MAX_ORDER}"
+                )
+
+
+_POWER = re.compile(r"\^\s*(\d+)")
 
 
 def build_model(family: str, options: dict[str, Any]) -> "_base.TemperatureModel":
@@ -264,6 +319,7 @@ def fit_cmd(
     """Fit a temperature-compensation model on one or several runs and save it."""
     if target not in TARGETS:
         raise ThermocalInputError(f"--target must be bias or scale_factor, got {target!r}")
+    check_ceilings(order, t0_order, segments, terms)
     if not files:
         raise ThermocalInputError("give at least one data file")
     _io.check_not_input(output, list(files))

@@ -138,6 +138,8 @@ def turntable_cmd(
 ) -> None:
     """Gyro-triad bias, scale factor and misalignment from a 16-position turntable run; with
     several runs at soak temperatures (--temps), both triads' error models over temperature."""
+    if order is not None:
+        check_order(order)
     _io.check_not_input(output, list(files))
     gyro_cols = split_names(gyro) or []
     if len(gyro_cols) != 3:
@@ -253,6 +255,22 @@ def _calibrate_file(
 MIN_POSITIONS_OF_A_SOAK = 12
 """A soak run missing a few of the sixteen positions is still used (with a warning): twelve
 distinct attitudes still separate the twelve parameters of each triad."""
+
+
+def check_order(order: int) -> None:
+    """Refuse (exit 2) a ``--order`` outside 0 … :data:`thermocal.turntable.thermal.MAX_ORDER`
+    (3: a cubic in temperature per parameter, the most a few soaks can support; the number of
+    soaks limits it further once the runs are read) before any file is read: typer parses an
+    order of 10²⁰ as a Python int."""
+    from thermocal.turntable.thermal import MAX_ORDER
+
+    if not 0 <= order <= MAX_ORDER:
+        shown = (
+            str(order)
+            if len(str(order)) <= 24
+            else f"{str(order)[:20]}… ({len(str(order))} digits)"
+        )
+        raise ThermocalInputError(f"--order must be between 0 and {MAX_ORDER}, got {shown}")
 
 
 def _thermal_calibration(
