@@ -941,7 +941,7 @@ def read_for_triads(
     """A recording read for triad calibrations: their temperature columns as temperatures,
     so that their units go through the resolver (option > metadata > column name); the
     triads' own columns keep the unit their metadata or name states."""
-    temps = list(dict.fromkeys(t.temperature for t in triads))
+    temps = list(dict.fromkeys(t.temperature for t in triads if t.temperature))
     return read_recording(path, time=time, time_unit=time_unit, temperatures=temps)
 
 
@@ -968,7 +968,7 @@ def compensate_triads(
     new_units: dict[str, str] = {}
     results = []
     for tri in triads:
-        missing = [c for c in (*tri.columns, tri.temperature) if c not in rec.columns]
+        missing = [c for c in (*tri.columns, tri.temperature) if c and c not in rec.columns]
         if missing:
             raise MissingColumnError(
                 f"{src}: the {tri.name} triad reads {', '.join(map(repr, missing))}, absent; "
@@ -986,7 +986,8 @@ def compensate_triads(
         bias_unit = "deg/h" if tri.model.kind == "gyro" else "mg"
         to_data = float(units.convert(np.array([1.0]), bias_unit, data_unit)[0])
         x = np.column_stack([rec.column(c) for c in tri.columns])
-        temp = rec.temperature_c(tri.temperature)
+        temp = (rec.temperature_c(tri.temperature) if tri.temperature  # "": one temperature
+                else np.full(rec.n_samples, tri.model.tref_c))  # fmt: skip
         outside = float(np.mean((temp < tri.model.t_lo_c) | (temp > tri.model.t_hi_c)))
         if outside > 0:
             warnings.warn(

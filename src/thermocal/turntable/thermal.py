@@ -141,6 +141,10 @@ class TriadThermal:
     soak_temperatures_c: tuple[float, ...]
     runs: tuple[tuple[float, tuple[float, ...], tuple[float, ...]], ...] = ()
     """Each run's (temperature [°C], θ, σ) the polynomials were fitted to (for reports)."""
+    method: str = "turntable"
+    """How the runs were calibrated: ``turntable`` or ``multipos`` (issue 30)."""
+    gravity_m_s2: float | None = None
+    """Local gravity the runs were calibrated with (multipos), for a later validation."""
 
     def sigma_at(self, temp_c: npt.ArrayLike) -> FloatArray:
         """Standard error (…, 12) of each fitted parameter at temperatures (clamped):
@@ -183,11 +187,13 @@ class TriadThermal:
                     "coefficients": f.coef.tolist(),
                     "coefficients_sigma": f.sigma.tolist(),
                     "covariance": f.cov.tolist(),
-                    "loto_rms": f.loto_rms,
+                    "loto_rms": f.loto_rms if math.isfinite(f.loto_rms) else None,
                     "reduced_chi2": f.reduced_chi2 if math.isfinite(f.reduced_chi2) else None,
                 }
                 for f in self.fits
             ],
+            **({} if self.method == "turntable" else {"method": self.method}),
+            **({} if self.gravity_m_s2 is None else {"gravity_m_s2": self.gravity_m_s2}),
         }
 
     @classmethod
@@ -201,7 +207,7 @@ class TriadThermal:
                     str(p["unit"]),
                     np.asarray(p["coefficients"], dtype=np.float64),
                     np.asarray(p["covariance"], dtype=np.float64),
-                    float(p["loto_rms"]),
+                    float("nan") if p["loto_rms"] is None else float(p["loto_rms"]),
                     float("nan") if p.get("reduced_chi2") is None else float(p["reduced_chi2"]),
                 )
                 for p in d["parameters"]
@@ -223,6 +229,8 @@ class TriadThermal:
                     )
                     for r in d.get("runs", [])
                 ),
+                str(d.get("method", "turntable")),
+                None if d.get("gravity_m_s2") is None else float(d["gravity_m_s2"]),
             )
         except (KeyError, TypeError, ValueError) as exc:
             raise ModelFileError(f"{where}: malformed triad model ({exc})") from None
@@ -239,11 +247,16 @@ def fit_triad(
     *,
     tref_c: float | None = None,
     order: int | None = None,
+    method: str = "turntable",
+    gravity_m_s2: float | None = None,
 ) -> TriadThermal:
     """Fit the twelve parameters of a triad over the soaks (module docstring).
 
     ``thetas``/``sigmas`` (R, 12) per run in the units of :data:`UNITS`; ``tref_c``
-    defaults to the middle of the soak range; ``order`` to the LOTO choice."""
+    defaults to the middle of the soak range; ``order`` to the LOTO choice.  A parameter
+    whose σ is zero in every run is one held by a constraint (the multi-position
+    accelerometer's upper misalignments, issue 30): fitted unweighted.  ``method`` and
+    ``gravity_m_s2`` are recorded with the model."""
     if kind not in UNITS:
         raise ThermocalInputError(f"triad kind must be gyro or accel, got {kind!r}")
     t = np.asarray(temps_c, dtype=np.float64)
@@ -269,7 +282,10 @@ def fit_triad(
         )
     fits = []
     for k in range(12):
-        w = 1.0 / np.maximum(sg[:, k], 1e-12 * max(float(np.max(sg[:, k])), 1e-300)) ** 2
+        if not np.any(sg[:, k] > 0):
+            w = np.ones(r)  # a constrained parameter (σ = 0 everywhere): unweighted
+        else:
+            w = 1.0 / np.maximum(sg[:, k], 1e-12 * float(np.max(sg[:, k]))) ** 2
         p_k = order if order is not None else _choose_order(dt, th[:, k], sg[:, k], w, scale)
         coef, cov, chi2 = _wls(dt, th[:, k], w, p_k, scale)
         pred = _loto(dt, th[:, k], w, p_k, scale) if r > p_k + 1 else np.full(r, np.nan)
@@ -290,7 +306,43 @@ def fit_triad(
         tuple(fits),
         tuple(float(v) for v in t),
         runs,
+        method,
+        gravity_m_s2,
     )
+
+
+def constant_triad(
+    kind: str,
+    temp_c: float,
+    theta: npt.ArrayLike,
+    cov: npt.ArrayLike,
+    *,
+    t_range_c: tuple[float, float] | None = None,
+    method: str = "turntable",
+    gravity_m_s2: float | None = None,
+) -> TriadThermal:
+    """A triad calibrated at one temperature: every parameter a constant (order 0), the
+    calibrated range ``t_range_c`` (the temperatures the run saw; default that temperature
+    alone; the model is applied unchanged at any temperature, with the usual warning
+    outside it).  ``theta``
+    (12) and its covariance in the units of :data:`UNITS`."""
+    if kind not in UNITS:
+        raise ThermocalInputError(f"triad kind must be gyro or accel, got {kind!r}")
+    th = np.asarray(theta, dtype=np.float64).reshape(12)
+    c = np.asarray(cov, dtype=np.float64).reshape(12, 12)
+    fits = tuple(
+        ParameterFit(PARAMETER_NAMES[k], UNITS[kind][k], th[k : k + 1].copy(),
+                     c[k : k + 1, k : k + 1].copy(), float("nan"), float("nan"))
+        for k in range(12)
+    )  # fmt: skip
+    sg = np.sqrt(np.maximum(np.diag(c), 0.0))
+    t = float(temp_c)
+    lo, hi = (t, t) if t_range_c is None else (float(t_range_c[0]), float(t_range_c[1]))
+    return TriadThermal(
+        kind, t, 0, lo, hi, fits, (t,),
+        ((t, tuple(float(v) for v in th), tuple(float(v) for v in sg)),),
+        method, gravity_m_s2,
+    )  # fmt: skip
 
 
 def error_terms(triad: TriadThermal, temp_c: npt.ArrayLike) -> tuple[FloatArray, FloatArray]:
@@ -347,6 +399,7 @@ __all__ = [
     "TriadThermal",
     "TriadValidation",
     "correct",
+    "constant_triad",
     "error_terms",
     "fit_triad",
     "solve3",
