@@ -160,4 +160,74 @@ def _rodrigues(phi: FloatArray) -> FloatArray:
     return out
 
 
-__all__ = ["Truth", "random_truth", "simulate_session"]
+
+
+ACCEL_COLUMNS = ("accel_x", "accel_y", "accel_z")
+GYRO_COLUMNS = ("gyro_x", "gyro_y", "gyro_z")
+TEMPERATURE_COLUMN = "T_imu"
+
+
+def simulate_runs(
+    seed_rngs: list[np.random.Generator],
+    *,
+    runs: int = 1,
+    rate_hz: float = 100.0,
+    latitude_deg: float = 45.0,
+    n_poses: int = 16,
+    temperatures_c: tuple[float, ...] | None = None,
+) -> list[tuple[Any, dict[str, Any]]]:
+    """``runs`` sessions of one IMU at temperatures spread over −10…+50 °C (one: 25 °C),
+    each a :class:`~thermocal.recording.Recording` (accelerometer in m/s², gyro in °/s,
+    ``T_imu`` [°C] drifting ±0.2 °C) with its truth: θ at the run's mean temperature,
+    θ₀ and θ₁ of :func:`random_truth`, the still windows, g and the latitude."""
+    from thermocal.recording import Metadata, Recording
+
+    if runs < 1:
+        raise ValueError("runs must be at least 1")
+    truth0, slope = random_truth(seed_rngs[0])
+    temps = temperatures_c or (
+        (TREF_TRUTH_C,) if runs == 1 else tuple(np.linspace(-10.0, 50.0, runs).tolist())
+    )
+    out = []
+    for i, tc in enumerate(temps):
+        rng = np.random.default_rng(seed_rngs[1].integers(2**63) + i)
+        ta = truth0.accel + slope.accel * (tc - TREF_TRUTH_C)
+        tg = truth0.gyro + slope.gyro * (tc - TREF_TRUTH_C)
+        s = simulate_session(rng, ta, tg, n_poses=n_poses, rate_hz=rate_hz,
+                             latitude_deg=latitude_deg)  # fmt: skip
+        n = s["time_s"].size
+        temp = tc + 0.2 * np.sin(np.linspace(0, np.pi, n))
+        acc = s["accel_mg"] * MG_M_S2
+        sig = {c: acc[:, k] for k, c in enumerate(ACCEL_COLUMNS)}
+        sig |= {c: s["gyro_deg_s"][:, k] for k, c in enumerate(GYRO_COLUMNS)}
+        unit = {c: "m/s^2" for c in ACCEL_COLUMNS} | {c: "deg/s" for c in GYRO_COLUMNS}
+        rec = Recording.from_arrays(
+            s["time_s"], sig, {TEMPERATURE_COLUMN: temp}, signal_unit=unit,
+            meta=Metadata(latitude_deg=latitude_deg, sample_interval_s=1.0 / rate_hz),
+        )  # fmt: skip
+        label = f"T{tc:+.0f}"
+        out.append(
+            (
+                rec,
+                {
+                    "label": label,
+                    "temperature_c": float(np.mean(temp)),
+                    "accel_theta": ta.tolist(),
+                    "gyro_theta": tg.tolist(),
+                    "theta_units": {"accel": "mg, ppm, arcsec", "gyro": "deg/h, ppm, arcsec"},
+                    "accel_theta0": truth0.accel.tolist(),
+                    "accel_theta1_per_c": slope.accel.tolist(),
+                    "gyro_theta0": truth0.gyro.tolist(),
+                    "gyro_theta1_per_c": slope.gyro.tolist(),
+                    "tref_c": TREF_TRUTH_C,
+                    "poses": [list(p) for p in s["poses"]],
+                    "gravity_m_s2": s["g_m_s2"],
+                    "latitude_deg": latitude_deg,
+                    "misalignment_names": list(model.MISALIGNMENT_NAMES),
+                },
+            )
+        )
+    return out
+
+
+__all__ = ["Truth", "random_truth", "simulate_runs", "simulate_session"]
