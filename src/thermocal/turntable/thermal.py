@@ -282,11 +282,11 @@ def fit_triad(
         )
     fits = []
     for k in range(12):
-        if not np.any(sg[:, k] > 0):
-            w = np.ones(r)  # a constrained parameter (σ = 0 everywhere): unweighted
-        else:
-            w = 1.0 / np.maximum(sg[:, k], 1e-12 * float(np.max(sg[:, k]))) ** 2
-        p_k = order if order is not None else _choose_order(dt, th[:, k], sg[:, k], w, scale)
+        sg_k = sg[:, k]
+        if not np.any(sg_k > 0):  # a constrained parameter (σ = 0 everywhere): unweighted
+            sg_k = np.ones(r)
+        w = 1.0 / np.maximum(sg_k, 1e-12 * float(np.max(sg_k))) ** 2
+        p_k = order if order is not None else _choose_order(dt, th[:, k], sg_k, w, scale)
         coef, cov, chi2 = _wls(dt, th[:, k], w, p_k, scale)
         pred = _loto(dt, th[:, k], w, p_k, scale) if r > p_k + 1 else np.full(r, np.nan)
         ok = np.isfinite(pred)
