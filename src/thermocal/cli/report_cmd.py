@@ -181,8 +181,13 @@ def report_cmd(
         from thermocal.report.triads import write_triad_report
         from thermocal.turntable.calibrate import validate_triads
 
+        from thermocal.multipos import validate as _mp_validate
+
         rec = read_for_triads(recording, cal.triads, time=time, time_unit=time_unit)
-        results = validate_triads(cal.triads, rec, latitude)
+        if _mp_validate.is_multipos(cal.triads):  # held-out poses (issue 30)
+            results: list[Any] = _mp_validate.validate_triads(cal.triads, rec, latitude)
+        else:
+            results = validate_triads(cal.triads, rec, latitude)
         path = write_triad_report(output, cal, model[0], results, recording)
         stderr.print(f"report: {path}")
         return

@@ -349,8 +349,13 @@ def _validate_triads(
     from thermocal.compensate import read_for_triads
     from thermocal.turntable.calibrate import validate_triads
 
+    from thermocal.multipos import validate as _mp_validate
+
     rec = read_for_triads(file, cal.triads, time=time, time_unit=time_unit)
-    results = validate_triads(cal.triads, rec, latitude)
+    if _mp_validate.is_multipos(cal.triads):  # held-out poses (issue 30)
+        results: list[Any] = _mp_validate.validate_triads(cal.triads, rec, latitude)
+    else:
+        results = validate_triads(cal.triads, rec, latitude)
     for r in results:
         if r.outside_range_fraction > 0:
             warnings.warn(

@@ -225,6 +225,7 @@ class MultiposValidation:
     per_axis_after: tuple[float, float, float]
     n: int
     what: str
+    outside_range_fraction: float = 0.0
 
     def to_dict(self) -> dict[str, Any]:
         from dataclasses import asdict

@@ -175,11 +175,15 @@ def simulate_runs(
     latitude_deg: float = 45.0,
     n_poses: int = 16,
     temperatures_c: tuple[float, ...] | None = None,
+    held_out: bool = True,
 ) -> list[tuple[Any, dict[str, Any]]]:
     """``runs`` sessions of one IMU at temperatures spread over −10…+50 °C (one: 25 °C),
     each a :class:`~thermocal.recording.Recording` (accelerometer in m/s², gyro in °/s,
     ``T_imu`` [°C] drifting ±0.2 °C) with its truth: θ at the run's mean temperature,
-    θ₀ and θ₁ of :func:`random_truth`, the still windows, g and the latitude."""
+    θ₀ and θ₁ of :func:`random_truth`, the still windows, g and the latitude.  With
+    ``held_out`` one more session of the same IMU (other poses, other noise), labelled
+    ``held-out``, at the first temperature (several runs: midway between the first two),
+    for validation."""
     from thermocal.recording import Metadata, Recording
 
     if runs < 1:
@@ -188,6 +192,9 @@ def simulate_runs(
     temps = temperatures_c or (
         (TREF_TRUTH_C,) if runs == 1 else tuple(np.linspace(-10.0, 50.0, runs).tolist())
     )
+    held = temps[0] if len(temps) == 1 else 0.5 * (temps[0] + temps[1])
+    if held_out:
+        temps = (*temps, held)
     out = []
     for i, tc in enumerate(temps):
         rng = np.random.default_rng(seed_rngs[1].integers(2**63) + i)
@@ -205,12 +212,14 @@ def simulate_runs(
             s["time_s"], sig, {TEMPERATURE_COLUMN: temp}, signal_unit=unit,
             meta=Metadata(latitude_deg=latitude_deg, sample_interval_s=1.0 / rate_hz),
         )  # fmt: skip
-        label = f"T{tc:+.0f}"
+        is_held = held_out and i == len(temps) - 1
+        label = "held-out" if is_held else f"T{tc:+.0f}"
         out.append(
             (
                 rec,
                 {
                     "label": label,
+                    "held_out": is_held,
                     "temperature_c": float(np.mean(temp)),
                     "accel_theta": ta.tolist(),
                     "gyro_theta": tg.tolist(),
