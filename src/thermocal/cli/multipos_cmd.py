@@ -139,9 +139,7 @@ def multipos_cmd(
     tref: Annotated[
         float | None, typer.Option("--tref", help="Reference temperature [°C].")
     ] = None,
-    static_s: Annotated[
-        float, typer.Option("--static-s", help="Shortest still pose [s].")
-    ] = 1.0,
+    static_s: Annotated[float, typer.Option("--static-s", help="Shortest still pose [s].")] = 1.0,
     time: TimeOpt = None,
     time_unit: TimeUnitOpt = None,
     as_json: JsonOpt = False,
@@ -155,8 +153,7 @@ def multipos_cmd(
     gyr_cols = _three(gyro, "--gyro")
     if len(files) > 1 and temps is None:
         raise ThermocalInputError(
-            "several files: name their temperature column with --temps (one file per "
-            "temperature)"
+            "several files: name their temperature column with --temps (one file per temperature)"
         )
     if (order is not None or tref is not None) and len(files) < 2:
         raise ThermocalInputError("--order and --tref need several files and --temps")
@@ -242,8 +239,9 @@ def multipos_cmd(
             )  # fmt: skip
         models[kind] = m
         triads.append(
-            _calibration.Triad(kind, (cols[0], cols[1], cols[2]), unit, temps or "", m,
-                               latitude_deg=lat_used)  # fmt: skip
+            _calibration.Triad(
+                kind, (cols[0], cols[1], cols[2]), unit, temps or "", m, latitude_deg=lat_used
+            )
         )
     cal = _calibration.Calibration([], triads)
     _files.save_calibration(cal, output)

@@ -347,9 +347,8 @@ def _validate_triads(
 ) -> None:
     """A calibration of triads judged on a turntable run (issue 19)."""
     from thermocal.compensate import read_for_triads
-    from thermocal.turntable.calibrate import validate_triads
-
     from thermocal.multipos import validate as _mp_validate
+    from thermocal.turntable.calibrate import validate_triads
 
     rec = read_for_triads(file, cal.triads, time=time, time_unit=time_unit)
     if _mp_validate.is_multipos(cal.triads):  # held-out poses (issue 30)

@@ -73,8 +73,8 @@ class AccelFit:
     def correct(self, f_mg: npt.ArrayLike) -> FloatArray:
         """``(I + E)⁻¹ (f − b)`` [mg] of specific forces (…, 3) [mg]."""
         f = np.asarray(f_mg, dtype=np.float64)
-        out: FloatArray = np.linalg.solve(np.eye(3) + self.error_matrix, (f - self.theta[0:3]).T).T
-        return out
+        out = np.linalg.solve(np.eye(3) + self.error_matrix, (f - self.theta[0:3]).T).T
+        return np.asarray(out, dtype=np.float64)
 
 
 def _unpack(p: FloatArray) -> tuple[FloatArray, FloatArray]:
@@ -135,7 +135,7 @@ def fit_gravity_magnitude(f_mg: npt.ArrayLike, sigma_mg: npt.ArrayLike, g_mg: fl
     sol = least_squares(resid, np.zeros(9), method="trf", x_scale="jac", xtol=1e-12,
                         ftol=1e-12, gtol=1e-12)  # fmt: skip
     jac = np.asarray(sol.jac)
-    u_, s_, vt = np.linalg.svd(jac, full_matrices=False)
+    _u, s_, vt = np.linalg.svd(jac, full_matrices=False)
     if not s_[-1] > 1e-10 * s_[0]:
         raise DesignError(
             "the poses cannot separate the accelerometer's bias, scale factors and "

@@ -16,6 +16,7 @@ rate).
 
 from __future__ import annotations
 
+import itertools
 import math
 import warnings
 from collections.abc import Sequence
@@ -25,7 +26,6 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
-from thermocal import units
 from thermocal.errors import DesignError, ThermocalInputError, ThermocalWarning
 from thermocal.multipos import accel as _accel
 from thermocal.multipos import gyro as _gyro
@@ -264,7 +264,7 @@ def rotation_errors(
     ``u_{k+1} × (A_{k+1}ᵀ A_k⁻ᵀ u_k)`` [rad] (its norm is the rotation-angle error),
     ``f`` the specific force that gives the up directions."""
     out = []
-    for p0, p1 in zip(sections, sections[1:], strict=False):
+    for p0, p1 in itertools.pairwise(sections):
         sl = slice(p0.start, p1.end)
         d = attitude_along(rate_rad_s[sl], dt_s[sl])
         a0 = d[: p0.end - p0.start].mean(axis=0)

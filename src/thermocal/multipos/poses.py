@@ -17,6 +17,7 @@ axis (the Ferraris method); any other name is a static pose.
 
 from __future__ import annotations
 
+import itertools
 from dataclasses import dataclass
 from typing import Any, Final
 
@@ -110,7 +111,7 @@ def detect_poses(
     starts, ends = edges[0::2], edges[1::2]
     h = w // 2
     min_n = max(2, round(static_s / dt))
-    out = []
+    out: list[Section] = []
     for s0, e0 in zip(starts, ends, strict=True):
         s, e = int(s0) + h, int(e0) - h
         if e - s < min_n:
@@ -139,7 +140,7 @@ def parse_poses(d: Any, n_samples: int, where: str = "--poses") -> list[Section]
             )
         out.append(Section(str(name), s, e))
     out.sort(key=lambda sec: sec.start)
-    for a, b in zip(out, out[1:], strict=False):
+    for a, b in itertools.pairwise(out):
         if b.start < a.end:
             raise ThermocalInputError(f"{where}: sections {a.name!r} and {b.name!r} overlap")
     return out

@@ -160,8 +160,6 @@ def _rodrigues(phi: FloatArray) -> FloatArray:
     return out
 
 
-
-
 ACCEL_COLUMNS = ("accel_x", "accel_y", "accel_z")
 GYRO_COLUMNS = ("gyro_x", "gyro_y", "gyro_z")
 TEMPERATURE_COLUMN = "T_imu"

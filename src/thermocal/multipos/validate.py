@@ -92,10 +92,16 @@ def validate_triads(
     eb, ea, pb, pa = gravity_errors(xa, xa_c, sections, g)
     out = [
         MultiposValidation(
-            acc.name, a_unit, float(np.sqrt(np.mean(eb**2))), float(np.sqrt(np.mean(ea**2))),
-            _rms3(pb), _rms3(pa), len(sections), "gravity-magnitude error",
+            acc.name,
+            a_unit,
+            float(np.sqrt(np.mean(eb**2))),
+            float(np.sqrt(np.mean(ea**2))),
+            _rms3(pb),
+            _rms3(pa),
+            len(sections),
+            "gravity-magnitude error",
             outside(acc, ta),
-        )  # fmt: skip
+        )
     ]
     if gyr is not None and xg is not None and xg_c is not None:
         dt = np.diff(t)
@@ -105,10 +111,16 @@ def validate_triads(
         nb, na = np.linalg.norm(vb, axis=1), np.linalg.norm(va, axis=1)
         out.append(
             MultiposValidation(
-                gyr.name, "deg", float(math.sqrt(np.mean(nb**2))),
-                float(math.sqrt(np.mean(na**2))), _rms3(vb), _rms3(va), len(nb),
-                "rotation-angle error", outside(gyr, temp_of(gyr)),
-            )  # fmt: skip
+                gyr.name,
+                "deg",
+                float(math.sqrt(np.mean(nb**2))),
+                float(math.sqrt(np.mean(na**2))),
+                _rms3(vb),
+                _rms3(va),
+                len(nb),
+                "rotation-angle error",
+                outside(gyr, temp_of(gyr)),
+            )
         )
     return out
 
