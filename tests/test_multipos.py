@@ -16,11 +16,12 @@ hand-placed sessions with known truth.
 
 from __future__ import annotations
 
+import contextlib
 import json
 import math
 import subprocess
-import warnings
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pandas as pd
@@ -30,7 +31,7 @@ from scipy.optimize import least_squares
 from thermocal.cli import main
 from thermocal.export_c.harness import find_compiler
 from thermocal.models.files import load_calibration
-from thermocal.multipos.calibrate import calibrate_session
+from thermocal.multipos.calibrate import SessionResult, calibrate_session
 from thermocal.multipos.simulate import random_truth, simulate_session
 from thermocal.turntable import thermal
 
@@ -51,19 +52,19 @@ def _e(theta: np.ndarray) -> np.ndarray:
     return e
 
 
-def _session(seed: int, n_poses: int = 14) -> tuple[dict, np.ndarray, np.ndarray]:
+def _session(seed: int, n_poses: int = 14) -> tuple[dict[str, Any], np.ndarray, np.ndarray]:
     rng = np.random.default_rng(seed)
     t0, _t1 = random_truth(rng)
     return simulate_session(rng, t0.accel, t0.gyro, n_poses=n_poses), t0.accel, t0.gyro
 
 
-def _calibrate(s: dict) -> object:
+def _calibrate(s: dict[str, Any]) -> SessionResult:
     return calibrate_session(s["time_s"], s["accel_mg"], s["gyro_deg_s"] * DEG,
                              g_mg=s["g_m_s2"] / MG, latitude_deg=45.0)  # fmt: skip
 
 
 @pytest.fixture(scope="module")
-def many_seeds() -> list[tuple[dict, np.ndarray, np.ndarray, object]]:
+def many_seeds() -> list[tuple[dict[str, Any], np.ndarray, np.ndarray, SessionResult]]:
     out = []
     for seed in range(24):
         s, ta, tg = _session(seed)
@@ -71,7 +72,7 @@ def many_seeds() -> list[tuple[dict, np.ndarray, np.ndarray, object]]:
     return out
 
 
-def test_every_parameter_within_3_sigma_z_rms_near_one(many_seeds: list) -> None:
+def test_every_parameter_within_3_sigma_z_rms_near_one(many_seeds: list[Any]) -> None:
     za, zg = [], []
     for s, ta, tg, res in many_seeds:
         assert len(res.poses) == len(s["poses"])  # every hand-placed pose found
@@ -92,7 +93,7 @@ def test_every_parameter_within_3_sigma_z_rms_near_one(many_seeds: list) -> None
         assert 0.75 < float(np.sqrt(np.mean(z**2))) < 1.25, (name, np.sqrt(np.mean(z**2)))
 
 
-def test_gravity_residual_at_the_noise_floor(many_seeds: list) -> None:
+def test_gravity_residual_at_the_noise_floor(many_seeds: list[Any]) -> None:
     """rms after ≈ the pose means' own noise × √((m − 9)/m) (nine parameters fitted)."""
     ratios = []
     for _s, _ta, _tg, res in many_seeds:
@@ -115,7 +116,7 @@ def test_agrees_with_an_independent_least_squares() -> None:
 
     def resid(p: np.ndarray) -> np.ndarray:  # L lower triangular, b
         low = np.array([[p[3], 0, 0], [p[4], p[5], 0], [p[6], p[7], p[8]]])
-        return (np.linalg.norm((f - p[0:3]) @ low.T, axis=1) - g) / sig
+        return np.asarray((np.linalg.norm((f - p[0:3]) @ low.T, axis=1) - g) / sig)
 
     p0 = np.array([0, 0, 0, 1, 0, 1, 0, 0, 1], dtype=float)
     sol = least_squares(resid, p0, xtol=1e-15, ftol=1e-15, gtol=1e-15)
@@ -125,7 +126,7 @@ def test_agrees_with_an_independent_least_squares() -> None:
     np.testing.assert_allclose(res.accel.error_matrix, e_ind, atol=2e-7)
 
 
-def _write_csv(path: Path, s: dict, *, gyro: bool = True) -> None:
+def _write_csv(path: Path, s: dict[str, Any], *, gyro: bool = True) -> None:
     cols = {"time": s["time_s"]}
     for k, a in enumerate("xyz"):
         cols[f"accel_{a} [m/s^2]"] = s["accel_mg"][:, k] * MG
@@ -187,25 +188,27 @@ int main(void)
 
 
 @pytest.fixture(scope="module")
-def chain(tmp_path_factory: pytest.TempPathFactory) -> dict:
+def chain(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
     d = tmp_path_factory.mktemp("mp")
     truth = d / "truth.json"
     assert main(["simulate", "multipos", "-o", str(d), "--seed", "11", "--truth",
                  str(truth)]) == 0  # fmt: skip
+    tr = json.loads(truth.read_text())
+    run = next(f for f in tr["files"] if f["label"] == "T+25")
     cal = d / "cal.json"
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-    return {"dir": d, "truth": json.loads(truth.read_text()), "cal": cal}
+    out = d / "out.json"
+    with out.open("w") as fh, contextlib.redirect_stdout(fh):
+        code = main(["multipos", run["file"], "--accel", A_COLS, "--gyro", G_COLS, "--temps",
+                     "T_imu", "-o", str(cal), "--json"])  # fmt: skip
+    assert code == 0
+    return {"dir": d, "truth": tr, "cal": cal, "out": json.loads(out.read_text())}
 
 
-def test_cli_chain(chain: dict, capsys: pytest.CaptureFixture[str]) -> None:
+def test_cli_chain(chain: dict[str, Any], capsys: pytest.CaptureFixture[str]) -> None:
     d, tr, cal = chain["dir"], chain["truth"], chain["cal"]
     files = {f["label"]: f for f in tr["files"]}
     run, held = files["T+25"], files["held-out"]
-    capsys.readouterr()
-    assert main(["multipos", run["file"], "--accel", A_COLS, "--gyro", G_COLS, "--temps",
-                 "T_imu", "-o", str(cal), "--json"]) == 0  # fmt: skip
-    out = json.loads(capsys.readouterr().out)
+    out = chain["out"]
     for key in ("accel", "gyro", "n_poses", "gravity_residual_rms_before",
                 "gravity_residual_rms_after", "poses"):  # fmt: skip
         assert key in out
@@ -243,10 +246,8 @@ def test_cli_chain(chain: dict, capsys: pytest.CaptureFixture[str]) -> None:
 
 
 @pytest.mark.skipif(find_compiler() is None, reason="no C compiler on this machine")
-def test_export_c_matches_python(chain: dict, tmp_path: Path) -> None:
+def test_export_c_matches_python(chain: dict[str, Any], tmp_path: Path) -> None:
     cal_path = chain["cal"]
-    if not cal_path.exists():
-        pytest.skip("test_cli_chain writes the calibration")
     assert main(["export-c", str(cal_path), "-o", str(tmp_path), "--name", "mp"]) == 0
     (tmp_path / "main.c").write_text(MAIN)
     exe = tmp_path / "mp"
