@@ -50,6 +50,7 @@ BENCHMARKS: dict[str, tuple[list[str], list[str]]] = {
     "demo": (["--repeat", "3"], ["--repeat", "1"]),
     "fleet": ([], ["--skip-big"]),
     "turntable_thermal": ([], []),
+    "multipos": ([], []),
 }
 """Every benchmark script (``bench_<name>.py``) and the RESULTS.md section it feeds."""
 

@@ -376,6 +376,7 @@ def test_scenario_registry_and_bad_input() -> None:
         "turntable-16",
         "turntable-thermal",
         "mems-imu",
+        "multipos",
     }
     with pytest.raises(ThermocalInputError, match="unknown scenario"):
         run_scenario("nope", 0)

@@ -962,7 +962,7 @@ def read_for_triads(
     """A recording read for triad calibrations: their temperature columns as temperatures,
     so that their units go through the resolver (option > metadata > column name); the
     triads' own columns keep the unit their metadata or name states."""
-    temps = list(dict.fromkeys(t.temperature for t in triads))
+    temps = list(dict.fromkeys(t.temperature for t in triads if t.temperature))
     return read_recording(path, time=time, time_unit=time_unit, temperatures=temps)
 
 
@@ -1005,7 +1005,7 @@ def compensate_triads(
         raise MissingColumnError(f"{src}: no time column {time_col!r}; available: {available}")
     plans = [_triad_plan(tri, names, available, src) for tri in triads]
     signals = [c for p in plans for c in p.columns]
-    temp_names = list(dict.fromkeys(p.temperature for p in plans))
+    temp_names = list(dict.fromkeys(p.temperature for p in plans if p.temperature))
     resolved = units.resolve_inputs(
         time_col,
         list(dict.fromkeys(signals)),
@@ -1044,7 +1044,9 @@ def compensate_triads(
                     temps[c] = v
                 new: dict[str, FloatArray] = {}
                 for p in plans:
-                    new.update(p.correct(chunk, temps[p.temperature], src, row0, thermal))
+                    temp = (temps[p.temperature] if p.temperature  # "": one temperature
+                            else np.full(t.size, p.tri.model.tref_c))  # fmt: skip
+                    new.update(p.correct(chunk, temp, src, row0, thermal))
                 w.write(_append_columns(chunk, new))
                 state["rows"] = row0 + t.size
                 state["last_t"] = float(t[-1]) if t.size else state["last_t"]
@@ -1129,7 +1131,8 @@ class _TriadPlan:
 def _triad_plan(tri: Any, names: Sequence[str], available: str, src: Path) -> _TriadPlan:
     """A triad's columns checked against the file: present, and their ``_comp`` columns
     not yet there."""
-    missing = [c for c in (*tri.columns, tri.temperature) if c not in names]
+    # a triad calibrated at one temperature names none ("": applied at its TREF)
+    missing = [c for c in (*tri.columns, tri.temperature) if c and c not in names]
     if missing:
         raise MissingColumnError(
             f"{src}: the {tri.name} triad reads {', '.join(map(repr, missing))}, absent; "

@@ -31,6 +31,7 @@ SCENARIO_NAMES: Final = (
     "turntable-16",
     "turntable-thermal",
     "mems-imu",
+    "multipos",
 )
 """The simulator's scenarios (:data:`thermocal.simulate.SCENARIOS`, a test checks they agree)."""
 

@@ -178,11 +178,15 @@ def report_cmd(
     cal = _files.load_calibration(model[0])
     if cal.triads and not cal.channels:  # a turntable calibration over temperature
         from thermocal.compensate import read_for_triads
+        from thermocal.multipos import validate as _mp_validate
         from thermocal.report.triads import write_triad_report
         from thermocal.turntable.calibrate import validate_triads
 
         rec = read_for_triads(recording, cal.triads, time=time, time_unit=time_unit)
-        results = validate_triads(cal.triads, rec, latitude)
+        if _mp_validate.is_multipos(cal.triads):  # held-out poses (issue 30)
+            results: list[Any] = _mp_validate.validate_triads(cal.triads, rec, latitude)
+        else:
+            results = validate_triads(cal.triads, rec, latitude)
         path = write_triad_report(output, cal, model[0], results, recording)
         stderr.print(f"report: {path}")
         return

@@ -347,10 +347,14 @@ def _validate_triads(
 ) -> None:
     """A calibration of triads judged on a turntable run (issue 19)."""
     from thermocal.compensate import read_for_triads
+    from thermocal.multipos import validate as _mp_validate
     from thermocal.turntable.calibrate import validate_triads
 
     rec = read_for_triads(file, cal.triads, time=time, time_unit=time_unit)
-    results = validate_triads(cal.triads, rec, latitude)
+    if _mp_validate.is_multipos(cal.triads):  # held-out poses (issue 30)
+        results: list[Any] = _mp_validate.validate_triads(cal.triads, rec, latitude)
+    else:
+        results = validate_triads(cal.triads, rec, latitude)
     for r in results:
         if r.outside_range_fraction > 0:
             warnings.warn(

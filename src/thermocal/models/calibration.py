@@ -79,7 +79,8 @@ class Channel:
 class Triad:
     """A sensor triad whose error model couples its three axes (issue 19): ``name``
     (``gyro``/``accel``), the three ``columns`` (x, y, z) it reads, their ``unit`` as given,
-    the ``temperature`` column whose value indexes the model, and the ``model`` itself
+    the ``temperature`` column whose value indexes the model (``""`` for a model calibrated
+    at one temperature and read without one, issue 30), and the ``model`` itself
     (:class:`thermocal.turntable.thermal.TriadThermal`: bias, scale factors and
     misalignments as polynomials in temperature).  Applied as
     ``x_c = (I + E(T))⁻¹ (x − b(T))`` per sample (``<col>_comp``).  ``encoders`` (α, β
@@ -224,11 +225,13 @@ def _triad_from_dict(t: Any, at: str) -> Triad:
     if not (isinstance(cols, list) and len(cols) == 3 and all(isinstance(c, str) for c in cols)):
         raise ModelFileError(f"{at}.columns: expected three column names")
     for key in ("name", "unit", "temperature"):
-        if not isinstance(t.get(key), str) or not t[key]:
+        if not isinstance(t.get(key), str) or not (t[key] or key == "temperature"):
             raise ModelFileError(f"{at}: {key} must be a non-empty string")
     if "model" not in t:
         raise ModelFileError(f"{at}: the field 'model' is missing")
     model = TriadThermal.from_dict(t["model"], f"{at}.model")
+    if not t["temperature"] and model.order != 0:
+        raise ModelFileError(f"{at}: a triad over temperature must name its temperature column")
     enc = t.get("encoders", ["alpha_deg", "beta_deg"])
     lat = t.get("latitude_deg")
     if not (isinstance(enc, list) and len(enc) == 2 and all(isinstance(c, str) for c in enc)):

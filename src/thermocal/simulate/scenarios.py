@@ -460,6 +460,22 @@ def scenario_turntable_thermal(
     return [(rec, _plain(truth)) for rec, truth in runs]
 
 
+def scenario_multipos(seed: int, profile: ProfileInput = None, **opts: Any) -> ScenarioResult:
+    """Hand-placed multi-position sessions of an IMU with known bias, scale factors and
+    misalignments and their temperature trends (issue 30;
+    :func:`thermocal.multipos.simulate.simulate_runs`; ``runs`` sessions at temperatures
+    over −10…+50 °C, one at 25 °C by default)."""
+    if profile is not None:
+        raise ThermocalInputError("the multipos scenario takes no chamber profile")
+    from thermocal.multipos.simulate import simulate_runs
+
+    try:
+        runs = simulate_runs(scenario_rng("multipos", seed, 2), **opts)
+    except (TypeError, ValueError) as exc:
+        raise ThermocalInputError(f"multipos: {exc}") from None
+    return [(rec, _plain({"scenario": "multipos", "seed": int(seed), **t})) for rec, t in runs]
+
+
 IMU_CHANNELS: tuple[tuple[str, str], ...] = (
     ("gx", "deg/s"),
     ("gy", "deg/s"),
@@ -577,6 +593,7 @@ SCENARIOS: dict[str, ScenarioFn] = {
     "turntable-16": scenario_turntable16,
     "turntable-thermal": scenario_turntable_thermal,
     "mems-imu": scenario_mems_imu,
+    "multipos": scenario_multipos,
 }
 """Registry: scenario name → ``fn(seed, profile=None, **opts) -> [(Recording, truth)]``."""
 

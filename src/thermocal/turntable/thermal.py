@@ -141,6 +141,10 @@ class TriadThermal:
     soak_temperatures_c: tuple[float, ...]
     runs: tuple[tuple[float, tuple[float, ...], tuple[float, ...]], ...] = ()
     """Each run's (temperature [°C], θ, σ) the polynomials were fitted to (for reports)."""
+    method: str = "turntable"
+    """How the runs were calibrated: ``turntable`` or ``multipos`` (issue 30)."""
+    gravity_m_s2: float | None = None
+    """Local gravity the runs were calibrated with (multipos), for a later validation."""
 
     def sigma_at(self, temp_c: npt.ArrayLike) -> FloatArray:
         """Standard error (…, 12) of each fitted parameter at temperatures (clamped):
@@ -183,11 +187,13 @@ class TriadThermal:
                     "coefficients": f.coef.tolist(),
                     "coefficients_sigma": f.sigma.tolist(),
                     "covariance": f.cov.tolist(),
-                    "loto_rms": f.loto_rms,
+                    "loto_rms": f.loto_rms if math.isfinite(f.loto_rms) else None,
                     "reduced_chi2": f.reduced_chi2 if math.isfinite(f.reduced_chi2) else None,
                 }
                 for f in self.fits
             ],
+            **({} if self.method == "turntable" else {"method": self.method}),
+            **({} if self.gravity_m_s2 is None else {"gravity_m_s2": self.gravity_m_s2}),
         }
 
     @classmethod
@@ -224,6 +230,8 @@ class TriadThermal:
                 )
                 for r in d.get("runs") or []
             ),
+            str(d.get("method") or "turntable"),
+            None if d.get("gravity_m_s2") is None else float(d["gravity_m_s2"]),
         )
         check_conditioning(out, where)
         return out
@@ -298,7 +306,7 @@ def check_triad_dict(d: Any, where: str) -> None:
         raise _fail(f"{where}.order", f"an integer 0…{MAX_ORDER}", order)
     _numbers(d["temperature_range_c"], f"{where}.temperature_range_c", 2)
     lo, hi = d["temperature_range_c"]
-    if not lo < hi:
+    if not (lo < hi or (lo == hi and d["order"] == 0)):  # one temperature: a constant
         raise _fail(f"{where}.temperature_range_c", "[low, high] with low < high", [lo, hi])
     if not _is_number(d["tref_c"]):
         raise _fail(f"{where}.tref_c", "a finite number (TREF [°C])", d["tref_c"])
@@ -393,11 +401,16 @@ def fit_triad(
     *,
     tref_c: float | None = None,
     order: int | None = None,
+    method: str = "turntable",
+    gravity_m_s2: float | None = None,
 ) -> TriadThermal:
     """Fit the twelve parameters of a triad over the soaks (module docstring).
 
     ``thetas``/``sigmas`` (R, 12) per run in the units of :data:`UNITS`; ``tref_c``
-    defaults to the middle of the soak range; ``order`` to the LOTO choice."""
+    defaults to the middle of the soak range; ``order`` to the LOTO choice.  A parameter
+    whose σ is zero in every run is one held by a constraint (the multi-position
+    accelerometer's upper misalignments, issue 30): fitted unweighted.  ``method`` and
+    ``gravity_m_s2`` are recorded with the model."""
     if kind not in UNITS:
         raise ThermocalInputError(f"triad kind must be gyro or accel, got {kind!r}")
     t = np.asarray(temps_c, dtype=np.float64)
@@ -423,8 +436,11 @@ def fit_triad(
         )
     fits = []
     for k in range(12):
-        w = 1.0 / np.maximum(sg[:, k], 1e-12 * max(float(np.max(sg[:, k])), 1e-300)) ** 2
-        p_k = order if order is not None else _choose_order(dt, th[:, k], sg[:, k], w, scale)
+        sg_k = sg[:, k]
+        if not np.any(sg_k > 0):  # a constrained parameter (σ = 0 everywhere): unweighted
+            sg_k = np.ones(r)
+        w = 1.0 / np.maximum(sg_k, 1e-12 * float(np.max(sg_k))) ** 2
+        p_k = order if order is not None else _choose_order(dt, th[:, k], sg_k, w, scale)
         coef, cov, chi2 = _wls(dt, th[:, k], w, p_k, scale)
         pred = _loto(dt, th[:, k], w, p_k, scale) if r > p_k + 1 else np.full(r, np.nan)
         ok = np.isfinite(pred)
@@ -444,7 +460,43 @@ def fit_triad(
         tuple(fits),
         tuple(float(v) for v in t),
         runs,
+        method,
+        gravity_m_s2,
     )
+
+
+def constant_triad(
+    kind: str,
+    temp_c: float,
+    theta: npt.ArrayLike,
+    cov: npt.ArrayLike,
+    *,
+    t_range_c: tuple[float, float] | None = None,
+    method: str = "turntable",
+    gravity_m_s2: float | None = None,
+) -> TriadThermal:
+    """A triad calibrated at one temperature: every parameter a constant (order 0), the
+    calibrated range ``t_range_c`` (the temperatures the run saw; default that temperature
+    alone; the model is applied unchanged at any temperature, with the usual warning
+    outside it).  ``theta``
+    (12) and its covariance in the units of :data:`UNITS`."""
+    if kind not in UNITS:
+        raise ThermocalInputError(f"triad kind must be gyro or accel, got {kind!r}")
+    th = np.asarray(theta, dtype=np.float64).reshape(12)
+    c = np.asarray(cov, dtype=np.float64).reshape(12, 12)
+    fits = tuple(
+        ParameterFit(PARAMETER_NAMES[k], UNITS[kind][k], th[k : k + 1].copy(),
+                     c[k : k + 1, k : k + 1].copy(), float("nan"), float("nan"))
+        for k in range(12)
+    )  # fmt: skip
+    sg = np.sqrt(np.maximum(np.diag(c), 0.0))
+    t = float(temp_c)
+    lo, hi = (t, t) if t_range_c is None else (float(t_range_c[0]), float(t_range_c[1]))
+    return TriadThermal(
+        kind, t, 0, lo, hi, fits, (t,),
+        ((t, tuple(float(v) for v in th), tuple(float(v) for v in sg)),),
+        method, gravity_m_s2,
+    )  # fmt: skip
 
 
 def error_terms(triad: TriadThermal, temp_c: npt.ArrayLike) -> tuple[FloatArray, FloatArray]:
@@ -503,6 +555,7 @@ __all__ = [
     "TriadValidation",
     "check_conditioning",
     "check_triad_dict",
+    "constant_triad",
     "correct",
     "error_terms",
     "fit_triad",

@@ -1,0 +1,228 @@
+"""Accelerometer triad from the gravity magnitude over unknown poses, or in closed form from
+the six faces.
+
+**Gravity magnitude** (Tedaldi et al., ICRA 2014, eq. 9–10).  At rest the specific force
+has the magnitude of local gravity ``g`` whatever the pose, so with the pose means
+``f_k`` (k = 1…m) the nine parameters ``p = (b, s, m)`` — bias ``b`` [mg], scale-factor
+errors ``s`` and the three misalignments ``xy = E[1,0]``, ``xz = E[2,0]``, ``yz = E[2,1]``
+of a lower-triangular ``E`` (the accelerometer frame, package docstring) — minimise::
+
+    Σ_k  r_k² ,   r_k = ( | (I + E)⁻¹ (f_k − b) | − g ) / σ_k
+
+(scipy.optimize.least_squares, trust-region reflective, from ``p = 0``).  ``σ_k`` is the
+noise of the pose mean along gravity: the white-noise variance of the pose's samples
+(from first differences, ``var(Δx)/2``, which a slow tremor hardly touches) over its
+sample count.  Covariance ``(JᵀJ)⁻¹`` at the solution (J of the weighted residuals), scaled
+by the reduced χ² when that exceeds its 3-σ range ``1 + 3·√(2/(m − 9))`` (the poses scatter
+more than their noise says: tremor, coloured noise, a model that does not fit).
+
+**Six faces** (closed form): with gravity along ±each body axis,
+``f_{j±} = ±g (I + E) e_j + b``, so ``b = Σ_faces f / 6`` and the column ``j`` of ``I + E``
+is ``(f_{j+} − f_{j−}) / 2g``: all nine elements of E, relative to the faces of the box;
+variances from the pose means' noise.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any, Final
+
+import numpy as np
+import numpy.typing as npt
+
+from thermocal import units
+from thermocal.errors import DesignError
+from thermocal.turntable import model
+
+FloatArray = npt.NDArray[np.float64]
+
+FREE_MISALIGNMENTS: Final = ("xy", "xz", "yz")
+"""The accelerometer misalignments the gravity magnitude determines (E lower triangular)."""
+MIN_POSES: Final = 9
+"""Nine parameters from the gravity magnitude: at least nine distinct poses."""
+DISTINCT_DEG: Final = 10.0
+"""Two poses whose gravity directions are closer than this are the same pose."""
+
+
+@dataclass(frozen=True)
+class AccelFit:
+    """θ (12: bias [mg], scale factors [ppm], misalignments [″]), its covariance (12×12;
+    zero rows for the constrained misalignments), the gravity-magnitude residual rms of the
+    poses before and after [mg], the reduced χ², the method and the number of poses."""
+
+    theta: FloatArray
+    cov: FloatArray
+    residual_rms_before_mg: float
+    residual_rms_after_mg: float
+    reduced_chi2: float
+    method: str
+    n_poses: int
+    residuals_mg: tuple[float, ...]
+    """Each pose's gravity-magnitude error after calibration [mg]."""
+
+    @property
+    def sigma(self) -> FloatArray:
+        out: FloatArray = np.sqrt(np.maximum(np.diag(self.cov), 0.0))
+        return out
+
+    @property
+    def error_matrix(self) -> FloatArray:
+        return model.error_matrices(self.theta)
+
+    def correct(self, f_mg: npt.ArrayLike) -> FloatArray:
+        """``(I + E)⁻¹ (f − b)`` [mg] of specific forces (…, 3) [mg]."""
+        f = np.asarray(f_mg, dtype=np.float64)
+        out = np.linalg.solve(np.eye(3) + self.error_matrix, (f - self.theta[0:3]).T).T
+        return np.asarray(out, dtype=np.float64)
+
+
+def _unpack(p: FloatArray) -> tuple[FloatArray, FloatArray]:
+    """(b [mg], E) from the nine free parameters (E entries in 10⁻³)."""
+    e = np.zeros((3, 3))
+    e[0, 0], e[1, 1], e[2, 2] = p[3] * 1e-3, p[4] * 1e-3, p[5] * 1e-3
+    e[1, 0], e[2, 0], e[2, 1] = p[6] * 1e-3, p[7] * 1e-3, p[8] * 1e-3
+    return p[0:3], e
+
+
+FREE_INDEX: Final = (0, 1, 2, 3, 4, 5, 8, 10, 11)
+"""Indices in θ of the nine free parameters (bias, scale factors, xy, xz, yz)."""
+_FREE_FACTOR = np.array([1.0, 1.0, 1.0] + [1e-3 / units.PPM] * 3 + [1e-3 * units.RAD_TO_ARCSEC] * 3)
+"""θ units per unit of the free parameters (mg; 10⁻³ → ppm; 10⁻³ rad → ″)."""
+
+
+def check_poses(f_mg: FloatArray) -> None:
+    """Refuse poses that cannot determine the nine parameters: fewer than nine distinct
+    gravity directions, or directions all near one plane (a scale factor or a bias along
+    the plane's normal is then unseen)."""
+    u = f_mg / np.linalg.norm(f_mg, axis=1)[:, None]
+    distinct: list[FloatArray] = []
+    for v in u:
+        if all(float(v @ d) < math.cos(math.radians(DISTINCT_DEG)) for d in distinct):
+            distinct.append(v)
+    if len(distinct) < MIN_POSES:
+        raise DesignError(
+            f"{len(distinct)} distinct poses (gravity directions more than {DISTINCT_DEG:g}° "
+            f"apart) of {len(u)}: the accelerometer's bias, scale factors and misalignments "
+            f"need at least {MIN_POSES}; place the board in more orientations"
+        )
+    w, v = np.linalg.eigh(np.asarray(distinct).T @ np.asarray(distinct) / len(distinct))
+    if w[0] < 0.02:
+        n = v[:, 0]
+        raise DesignError(
+            "the poses' gravity directions all lie near one plane (normal "
+            f"{n[0]:+.2f}, {n[1]:+.2f}, {n[2]:+.2f} in body axes): tilt the board out of it "
+            "so that gravity also has a component along that normal"
+        )
+
+
+def fit_gravity_magnitude(f_mg: npt.ArrayLike, sigma_mg: npt.ArrayLike, g_mg: float) -> AccelFit:
+    """The nine parameters from the pose means ``f_mg`` (m, 3) [mg] with their noise along
+    gravity ``sigma_mg`` (m,) [mg] and local gravity ``g_mg`` [mg] (module docstring)."""
+    from scipy.optimize import least_squares
+
+    f = np.asarray(f_mg, dtype=np.float64)
+    sg = np.asarray(sigma_mg, dtype=np.float64)
+    m = f.shape[0]
+    check_poses(f)
+
+    def resid(p: FloatArray) -> FloatArray:
+        b, e = _unpack(p)
+        c = np.linalg.solve(np.eye(3) + e, (f - b).T).T
+        out: FloatArray = (np.linalg.norm(c, axis=1) - g_mg) / sg
+        return out
+
+    sol = least_squares(resid, np.zeros(9), method="trf", x_scale="jac", xtol=1e-12,
+                        ftol=1e-12, gtol=1e-12)  # fmt: skip
+    jac = np.asarray(sol.jac)
+    _u, s_, vt = np.linalg.svd(jac, full_matrices=False)
+    if not s_[-1] > 1e-10 * s_[0]:
+        raise DesignError(
+            "the poses cannot separate the accelerometer's bias, scale factors and "
+            "misalignments (singular design): add poses in other orientations"
+        )
+    cov_p = (vt.T / s_**2) @ vt
+    r = np.asarray(sol.fun)
+    dof = m - 9
+    chi2 = float(r @ r) / dof if dof > 0 else float("nan")
+    if dof > 0 and chi2 > 1.0 + 3.0 * math.sqrt(2.0 / dof):
+        cov_p = cov_p * chi2
+    theta = np.zeros(12)
+    cov = np.zeros((12, 12))
+    idx = np.array(FREE_INDEX)
+    theta[idx] = sol.x * _FREE_FACTOR
+    cov[np.ix_(idx, idx)] = cov_p * np.outer(_FREE_FACTOR, _FREE_FACTOR)
+    before = np.linalg.norm(f, axis=1) - g_mg
+    after = r * sg
+    return AccelFit(
+        theta,
+        cov,
+        float(np.sqrt(np.mean(before**2))),
+        float(np.sqrt(np.mean(after**2))),
+        chi2,
+        "gravity-magnitude",
+        m,
+        tuple(float(v) for v in after),
+    )
+
+
+def fit_six_faces(
+    faces_mg: dict[str, FloatArray], sigma_mg: dict[str, float], g_mg: float
+) -> AccelFit:
+    """Closed form from the six named faces (module docstring): ``faces_mg`` maps
+    ``x_p``…``z_a`` to the pose mean [mg], ``sigma_mg`` to its per-axis noise [mg]."""
+    from thermocal.multipos.poses import FACES
+
+    missing = [n for n in FACES if n not in faces_mg]
+    if missing:
+        raise DesignError(f"the six-face calibration needs every face; missing {missing}")
+    f = {k: np.asarray(v, dtype=np.float64) for k, v in faces_mg.items()}
+    b = sum((f[n] for n in FACES), np.zeros(3)) / 6.0
+    var_b = sum(sigma_mg[n] ** 2 for n in FACES) / 36.0
+    ie = np.zeros((3, 3))
+    var_e = np.zeros(3)
+    for j, ax in enumerate("xyz"):
+        ie[:, j] = (f[f"{ax}_p"] - f[f"{ax}_a"]) / (2.0 * g_mg)
+        var_e[j] = (sigma_mg[f"{ax}_p"] ** 2 + sigma_mg[f"{ax}_a"] ** 2) / (2.0 * g_mg) ** 2
+    e = ie - np.eye(3)
+    theta = model.coeffs_from_error_matrix(e, b)
+    sig = np.zeros(12)
+    sig[0:3] = math.sqrt(var_b)
+    sig[3:6] = np.sqrt(var_e) / units.PPM
+    for k, n in enumerate(model.MISALIGNMENT_NAMES):
+        sig[6 + k] = math.sqrt(var_e[model.MISALIGNMENT_INDEX[n][1]]) * units.RAD_TO_ARCSEC
+    fs = np.asarray([f[n] for n in FACES])
+    before = np.linalg.norm(fs, axis=1) - g_mg
+    after = np.linalg.norm(np.linalg.solve(ie, (fs - b).T).T, axis=1) - g_mg
+    return AccelFit(
+        theta,
+        np.diag(sig**2),
+        float(np.sqrt(np.mean(before**2))),
+        float(np.sqrt(np.mean(after**2))),
+        float("nan"),
+        "six-face",
+        6,
+        tuple(float(v) for v in after),
+    )
+
+
+def to_dict(fit: AccelFit) -> dict[str, Any]:
+    s = fit.sigma
+    return {
+        "method": fit.method,
+        "bias_mg": fit.theta[0:3].tolist(),
+        "scale_factor_ppm": fit.theta[3:6].tolist(),
+        "misalignment_arcsec": fit.theta[6:12].tolist(),
+        "bias_mg_sigma": s[0:3].tolist(),
+        "scale_factor_ppm_sigma": s[3:6].tolist(),
+        "misalignment_arcsec_sigma": s[6:12].tolist(),
+    }
+
+
+__all__ = [
+    "FREE_INDEX",
+    "AccelFit",
+    "check_poses",
+    "fit_gravity_magnitude",
+    "fit_six_faces",
+]

@@ -1,0 +1,288 @@
+"""One multi-position session end to end (pure maths on arrays), and the validation of a
+calibration on a held-out session.
+
+:func:`calibrate_session`: the static poses (:mod:`.poses`), each pose's mean specific
+force and its noise, the accelerometer triad (:mod:`.accel`: gravity magnitude over ≥ 9
+poses, or the closed form when only the six faces are given), the calibrated up
+direction of each pose, the gyro bias from the statics and its scale factors and
+misalignments from the motions between poses and the 360° turns (:mod:`.gyro`).
+
+:func:`validate_session`: on another session, the poses found the same way and, before
+(raw) and after compensation with a calibration of triads, the gravity-magnitude error
+of each pose mean and the rotation-angle error of each motion (the angle between the
+pose's up direction and the one carried over from the previous pose by the integrated
+rate).
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+import warnings
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+import numpy.typing as npt
+
+from thermocal.errors import DesignError, ThermocalInputError, ThermocalWarning
+from thermocal.multipos import accel as _accel
+from thermocal.multipos import gyro as _gyro
+from thermocal.multipos.geometry import attitude_along
+from thermocal.multipos.poses import FACES, Section, detect_poses
+from thermocal.turntable import model
+
+FloatArray = npt.NDArray[np.float64]
+
+
+@dataclass(frozen=True)
+class PoseStats:
+    """A static pose: its samples, mean specific force [mg], per-sample white noise σ of
+    each axis [mg] (``var(Δx)/2``), mean rate [rad/s] and rate noise σ [rad/s] (gyro)."""
+
+    section: Section
+    f_mean_mg: FloatArray
+    f_sigma_mg: FloatArray
+    w_mean_rad_s: FloatArray | None
+    w_sigma_rad_s: FloatArray | None
+
+    @property
+    def mean_sigma_mg(self) -> float:
+        """Noise of the pose mean along gravity [mg] (isotropic noise assumed)."""
+        return float(math.sqrt(float(np.mean(self.f_sigma_mg**2)) / self.section.n))
+
+
+def _white_sigma(x: FloatArray) -> FloatArray:
+    d = np.diff(x, axis=0)
+    out: FloatArray = np.sqrt(np.mean(d * d, axis=0) / 2.0) if d.shape[0] else np.zeros(3)
+    return out
+
+
+def pose_stats(
+    accel_mg: FloatArray, gyro_rad_s: FloatArray | None, sections: Sequence[Section]
+) -> list[PoseStats]:
+    out = []
+    for s in sections:
+        f = accel_mg[s.start : s.end]
+        w = None if gyro_rad_s is None else gyro_rad_s[s.start : s.end]
+        out.append(
+            PoseStats(
+                s,
+                f.mean(axis=0),
+                _white_sigma(f),
+                None if w is None else w.mean(axis=0),
+                None if w is None else _white_sigma(w),
+            )
+        )
+    return out
+
+
+@dataclass(frozen=True)
+class SessionResult:
+    """What :func:`calibrate_session` found."""
+
+    accel: _accel.AccelFit
+    gyro: _gyro.GyroFit | None
+    poses: tuple[PoseStats, ...]
+    turns: tuple[Section, ...]
+    g_mg: float
+    temperature_c: float | None
+    not_still: tuple[str, ...] = field(default=())
+
+    def poses_dict(self) -> list[dict[str, Any]]:
+        return [
+            {
+                "name": p.section.name,
+                "start": p.section.start,
+                "end": p.section.end,
+                "mean_specific_force_mg": p.f_mean_mg.tolist(),
+                "gravity_residual_mg": r,
+                "still_ratio": p.section.still_ratio,
+            }
+            for p, r in zip(self.poses, self.accel.residuals_mg, strict=False)
+        ]
+
+
+def _up_function(theta: FloatArray, idx: Sequence[int], f_mg: FloatArray) -> Any:
+    """``p ↦`` unit up directions of the poses for the accelerometer parameters ``p`` at
+    ``idx`` of θ (the others held)."""
+    base = theta.copy()
+    ids = np.asarray(idx)
+
+    def up_of(p: FloatArray) -> FloatArray:
+        th = base.copy()
+        th[ids] = p
+        e = model.error_matrices(th)
+        c = np.linalg.solve(np.eye(3) + e, (f_mg - th[0:3]).T).T
+        out: FloatArray = c / np.linalg.norm(c, axis=1)[:, None]
+        return out
+
+    return up_of
+
+
+def calibrate_session(
+    time_s: npt.ArrayLike,
+    accel_mg: npt.ArrayLike,
+    gyro_rad_s: npt.ArrayLike | None,
+    *,
+    g_mg: float,
+    latitude_deg: float | None = None,
+    sections: Sequence[Section] | None = None,
+    static_s: float = 1.0,
+    temperature_c: npt.ArrayLike | None = None,
+    where: str = "session",
+) -> SessionResult:
+    """Calibrate the accelerometer (and gyro) triad of one session (module docstring).
+    ``accel_mg`` (n, 3) [mg], ``gyro_rad_s`` (n, 3) [rad/s] or None, ``g_mg`` local
+    gravity [mg]; ``sections`` from a POSES file, else found from the data."""
+    t = np.asarray(time_s, dtype=np.float64)
+    a = np.asarray(accel_mg, dtype=np.float64)
+    w = None if gyro_rad_s is None else np.asarray(gyro_rad_s, dtype=np.float64)
+    if sections is None:
+        sections = detect_poses(t, a, w, static_s=static_s)
+    statics = [s for s in sections if not s.is_turn]
+    turns = [s for s in sections if s.is_turn]
+    not_still = tuple(s.name for s in statics if s.still_ratio > 2.0)
+    if not_still:
+        warnings.warn(
+            ThermocalWarning(
+                f"{where}: {len(not_still)} poses are not still (window variance more than "
+                f"twice the quietest): {', '.join(not_still[:8])}"
+                f"{' …' if len(not_still) > 8 else ''}; their means carry the motion"
+            ),
+            stacklevel=2,
+        )
+    stats = pose_stats(a, w, statics)
+    if len(stats) < 6:
+        raise DesignError(
+            f"{where}: {len(stats)} static poses found (still for at least {static_s:g} s): "
+            f"the accelerometer triad needs at least {_accel.MIN_POSES} distinct poses "
+            "(6 with the six faces named in --poses)"
+        )
+    f = np.asarray([p.f_mean_mg for p in stats])
+    sig = np.asarray([p.mean_sigma_mg for p in stats])
+    names = [p.section.name for p in stats]
+    if all(n in names for n in FACES) and len(stats) < _accel.MIN_POSES:
+        faces = {n: f[names.index(n)] for n in FACES}
+        face_sig = {n: float(sig[names.index(n)]) for n in FACES}
+        acc = _accel.fit_six_faces(faces, face_sig, g_mg)
+        idx: Sequence[int] = tuple(range(12))
+        # residuals of the six faces only: map back in pose order
+        order = [FACES.index(n) if n in FACES else -1 for n in names]
+        acc = _accel.AccelFit(
+            acc.theta, acc.cov, acc.residual_rms_before_mg, acc.residual_rms_after_mg,
+            acc.reduced_chi2, acc.method, len(stats),
+            tuple(acc.residuals_mg[o] if o >= 0 else float("nan") for o in order),
+        )  # fmt: skip
+    else:
+        acc = _accel.fit_gravity_magnitude(f, sig, g_mg)
+        idx = _accel.FREE_INDEX
+    temp = None
+    if temperature_c is not None:
+        tc = np.asarray(temperature_c, dtype=np.float64)
+        temp = float(np.nanmean(np.concatenate([tc[s.start : s.end] for s in statics])))
+    gfit = None
+    if w is not None:
+        up_of = _up_function(acc.theta, idx, f)
+        free = acc.theta[np.asarray(idx)]
+        free_cov = acc.cov[np.ix_(np.asarray(idx), np.asarray(idx))]
+        up = up_of(free)
+        n = np.asarray([p.section.n for p in stats], dtype=np.float64)
+        wm = np.asarray([p.w_mean_rad_s for p in stats])
+        ws = np.sqrt(np.average(np.asarray([p.w_sigma_rad_s for p in stats]) ** 2, axis=0,
+                                weights=n))  # fmt: skip
+        bias, bias_cov = _gyro.static_bias(wm, n, ws, up, latitude_deg)
+        dt = np.diff(t)
+        dt = np.concatenate([dt, dt[-1:]])
+        turn_pairs = []
+        for tr in turns:
+            before = [i for i, p in enumerate(stats) if p.section.end <= tr.start]
+            if not before:
+                raise ThermocalInputError(
+                    f"{where}: the turn {tr.name!r} has no still pose before it (its axis is "
+                    "the up direction of that pose)"
+                )
+            turn_pairs.append((tr, before[-1]))
+        gfit = _gyro.fit_rotations(
+            w, dt, [p.section for p in stats], up_of, free, free_cov, bias, bias_cov,
+            np.asarray(sig) / g_mg, float(np.sqrt(np.mean(ws**2))), turn_pairs,
+        )  # fmt: skip
+    return SessionResult(acc, gfit, tuple(stats), tuple(turns), g_mg, temp, not_still)
+
+
+@dataclass(frozen=True)
+class MultiposValidation:
+    """Held-out session figures before (raw) and after compensation: per triad, the rms
+    over poses of the gravity-magnitude error [accelerometer unit] or over motions of the
+    rotation-angle error [°] (and its per-axis rms, for the report's table)."""
+
+    triad: str
+    unit: str
+    rms_before: float
+    rms_after: float
+    per_axis_before: tuple[float, float, float]
+    per_axis_after: tuple[float, float, float]
+    n: int
+    what: str
+    outside_range_fraction: float = 0.0
+
+    def to_dict(self) -> dict[str, Any]:
+        from dataclasses import asdict
+
+        return asdict(self)
+
+    def rows(self) -> list[tuple[str, tuple[float, ...], tuple[float, ...]]]:
+        return [
+            (f"{self.what} rms [{self.unit}] (total {self.rms_before:.4g} → "
+             f"{self.rms_after:.4g})", self.per_axis_before, self.per_axis_after)
+        ]  # fmt: skip
+
+
+def _rms3(v: FloatArray) -> tuple[float, float, float]:
+    r = np.sqrt(np.mean(v**2, axis=0))
+    return (float(r[0]), float(r[1]), float(r[2]))
+
+
+def gravity_errors(
+    f_before: FloatArray, f_after: FloatArray, sections: Sequence[Section], g: float
+) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
+    """Per pose: |mean f| − g before and after, and the per-axis error of the mean against
+    g along the after-direction (for the table), all in the unit of ``f``."""
+    mb = np.asarray([f_before[s.start : s.end].mean(axis=0) for s in sections])
+    ma = np.asarray([f_after[s.start : s.end].mean(axis=0) for s in sections])
+    ua = ma / np.linalg.norm(ma, axis=1)[:, None]
+    eb = np.linalg.norm(mb, axis=1) - g
+    ea = np.linalg.norm(ma, axis=1) - g
+    return eb, ea, mb - g * ua, ma - g * ua
+
+
+def rotation_errors(
+    rate_rad_s: FloatArray, dt_s: FloatArray, f: FloatArray, sections: Sequence[Section]
+) -> FloatArray:
+    """Per motion between consecutive poses, the direction error vector
+    ``u_{k+1} × (A_{k+1}ᵀ A_k⁻ᵀ u_k)`` [rad] (its norm is the rotation-angle error),
+    ``f`` the specific force that gives the up directions."""
+    out = []
+    for p0, p1 in itertools.pairwise(sections):
+        sl = slice(p0.start, p1.end)
+        d = attitude_along(rate_rad_s[sl], dt_s[sl])
+        a0 = d[: p0.end - p0.start].mean(axis=0)
+        a1 = d[p1.start - p0.start :].mean(axis=0)
+        u0 = f[p0.start : p0.end].mean(axis=0)
+        u1 = f[p1.start : p1.end].mean(axis=0)
+        u0, u1 = u0 / np.linalg.norm(u0), u1 / np.linalg.norm(u1)
+        p = a1.T @ np.linalg.solve(a0.T, u0)
+        out.append(np.cross(u1, p))
+    return np.asarray(out).reshape(-1, 3)
+
+
+__all__ = [
+    "MultiposValidation",
+    "PoseStats",
+    "SessionResult",
+    "calibrate_session",
+    "gravity_errors",
+    "pose_stats",
+    "rotation_errors",
+]

@@ -1,0 +1,286 @@
+"""Gyro triad from the rotations between static poses (and from known 360° turns).
+
+**Bias**: the sample-weighted mean of the static poses' rates, minus, with the latitude
+L, the vertical earth rate ``Ω sin L · u_k`` along each pose's (calibrated) up direction
+``u_k``.  The horizontal earth rate's direction in the board is not known (the heading of
+a hand-placed pose is not measured): it is left in the bias and counted in its σ, as
+independent unknown headings, ``Σ_k w_k² (Ω cos L)² (1 − u_ki²)/2`` per axis (without L,
+``Σ_k w_k² Ω²/3``), with the white noise ``σ_i²/N``.
+
+**Scale factors and misalignments** (the nine elements of ``E_g``; the idea of Tedaldi et
+al., ICRA 2014, §III-C, with every element of E free).  Gravity is fixed in the local
+frame, so between the mean attitudes of consecutive poses k and k+1 the calibrated
+gravity directions satisfy ``u_{k+1} = A_{k+1}ᵀ A_k⁻ᵀ u_k``, where
+``A = mean_{window} D(t)`` and ``D(t) = Π exp([ω_c τ×])`` is the attitude integrated from
+the start of pose k with the calibrated rate ``ω_c = (I + E_g)⁻¹ (ω − b_g)``
+(:func:`.geometry.attitude_along`; averaging D over each pose matches the pose's mean
+specific force even when the board trembles).  The residual
+``r = u_{k+1} − A_{k+1}ᵀ A_k⁻ᵀ u_k`` of every motion is minimised over ``E_g`` by
+Gauss–Newton: a perturbation ``δE`` turns the total rotation R by
+``ε = −Rᵀ Σ_t D(t) δE ω_c(t) τ``, so ``∂r/∂E_ij = [p×] Rᵀ Σ_t D(t) e_i ω_cj(t) τ`` with
+``p = A_{k+1}ᵀ A_k⁻ᵀ u_k``; the attitude is integrated again at each iteration.
+
+Each motion's residual has, per component, the variance
+``σ_u,k² + σ_u,k+1² + σ_ω² τ T_eff + (Ω T_span)²/3`` (accelerometer direction noise of
+the two pose means, angle random walk over ``T_eff = T_motion + (T_k + T_{k+1})/3``, the
+earth rate not integrated out over the span); the covariance ``(JᵀJ)⁻¹`` of the whitened
+problem (scaled by a significant reduced χ², as :mod:`.accel`) is widened by the
+propagated uncertainties of the gyro bias and of the accelerometer calibration that
+defines ``u`` (``K G C Gᵀ Kᵀ``, ``K = (JᵀJ)⁻¹Jᵀ``).  Rotations all about one axis leave
+``E_g``'s other columns unseen: refused.
+
+**360° turns** (Ferraris et al., Sensors and Actuators A 46, 1995,
+doi:10.1016/0924-4247(94)00969-1): a full turn about the vertical adds
+``Σ ω_c τ − 2π s u = 0`` (``u`` the up direction of the pose before it, ``s = ±1`` the
+sense), three linear rows of the same least squares.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+import numpy.typing as npt
+
+from thermocal import units
+from thermocal.errors import DesignError
+from thermocal.multipos.geometry import attitude_along, skew
+from thermocal.multipos.poses import Section
+from thermocal.turntable import model
+
+FloatArray = npt.NDArray[np.float64]
+
+
+@dataclass(frozen=True)
+class GyroFit:
+    """θ (12: bias [°/h], scale factors [ppm], misalignments [″]) and its covariance, the
+    rms of the motions' gravity-direction residuals before (raw rate, bias removed) and
+    after calibration [rad], the reduced χ² and the number of motions and turns used."""
+
+    theta: FloatArray
+    cov: FloatArray
+    direction_rms_before_rad: float
+    direction_rms_after_rad: float
+    reduced_chi2: float
+    n_motions: int
+    n_turns: int
+
+    @property
+    def sigma(self) -> FloatArray:
+        out: FloatArray = np.sqrt(np.maximum(np.diag(self.cov), 0.0))
+        return out
+
+
+def static_bias(
+    rate_means_rad_s: FloatArray,
+    n_samples: FloatArray,
+    rate_sigma_rad_s: FloatArray,
+    up: FloatArray,
+    latitude_deg: float | None,
+) -> tuple[FloatArray, FloatArray]:
+    """Gyro bias [rad/s] and its covariance from the static poses (module docstring):
+    ``rate_means`` (m, 3), ``n_samples`` (m,), per-sample white noise σ (3,), ``up`` (m, 3)
+    unit up directions in body axes."""
+    w = n_samples / n_samples.sum()
+    om = units.EARTH_RATE_RAD_S
+    b = (w[:, None] * rate_means_rad_s).sum(axis=0)
+    if latitude_deg is not None:
+        sl, cl = math.sin(math.radians(latitude_deg)), math.cos(math.radians(latitude_deg))
+        b = b - om * sl * (w[:, None] * up).sum(axis=0)
+        var_e = (w[:, None] ** 2 * (om * cl) ** 2 * (1.0 - up**2) / 2.0).sum(axis=0)
+    else:
+        var_e = np.full(3, float((w**2).sum()) * om**2 / 3.0)
+    var = rate_sigma_rad_s**2 / n_samples.sum() + var_e
+    return b, np.diag(var)
+
+
+@dataclass(frozen=True)
+class _Motion:
+    start: int
+    k_end: int  # samples of pose k: [start, k_end)
+    k1_start: int  # samples of pose k+1: [k1_start, stop)
+    stop: int
+    var: float  # residual variance per component [rad²]
+    pose_k: int
+    pose_k1: int
+
+
+def _direction(u0: FloatArray, a0: FloatArray, a1: FloatArray) -> FloatArray:
+    out: FloatArray = a1.T @ np.linalg.solve(a0.T, u0)
+    return out
+
+
+def fit_rotations(
+    rate_rad_s: FloatArray,
+    dt_s: FloatArray,
+    poses: Sequence[Section],
+    up_of: Callable[[FloatArray], FloatArray],
+    accel_free: FloatArray,
+    accel_free_cov: FloatArray,
+    bias_rad_s: FloatArray,
+    bias_cov: FloatArray,
+    dir_sigma_rad: FloatArray,
+    rate_sigma_rad_s: float,
+    turns: Sequence[tuple[Section, int]] = (),
+    *,
+    max_iter: int = 8,
+) -> GyroFit:
+    """``E_g`` from the motions between consecutive ``poses`` (module docstring).
+
+    ``up_of(p)`` gives the poses' calibrated unit up directions (m, 3) for accelerometer
+    parameters ``p`` (``accel_free`` at the solution, covariance ``accel_free_cov``);
+    ``dir_sigma_rad`` (m,) the noise of each pose's direction; ``turns`` the 360° turns with
+    the index of the pose before each."""
+    om = units.EARTH_RATE_RAD_S
+    dt_med = float(np.median(dt_s))
+    up = up_of(accel_free)
+    motions: list[_Motion] = []
+    for k in range(len(poses) - 1):
+        p0, p1 = poses[k], poses[k + 1]
+        if np.any(dt_s[p0.start : p1.end - 1] > 1.5 * dt_med):
+            continue  # a gap in time: the rotation across it is unknown
+        t_k, t_k1 = p0.n * dt_med, p1.n * dt_med
+        t_m = (p1.start - p0.end) * dt_med
+        t_eff = t_m + (t_k + t_k1) / 3.0
+        t_span = t_m + (t_k + t_k1) / 2.0
+        var = (dir_sigma_rad[k] ** 2 + dir_sigma_rad[k + 1] ** 2
+               + rate_sigma_rad_s**2 * dt_med * t_eff + (om * t_span) ** 2 / 3.0)  # fmt: skip
+        motions.append(_Motion(p0.start, p0.end, p1.start, p1.end, var, k, k + 1))
+    n_rows = 3 * len(motions) + 3 * len(turns)
+    if n_rows < 9 + 3:
+        raise DesignError(
+            f"{len(motions)} motions between static poses: the gyro's scale factors and "
+            "misalignments need rotations about at least two different axes (and a still "
+            "pose before and after each)"
+        )
+    e = np.zeros((3, 3))
+
+    def evaluate(e: FloatArray, b: FloatArray, u: FloatArray, jac: bool):  # type: ignore[no-untyped-def]
+        ie_inv = np.linalg.inv(np.eye(3) + e)
+        r = np.empty(n_rows)
+        j = np.zeros((n_rows, 9))
+        jb = np.zeros((n_rows, 3))
+        atts: list[tuple[FloatArray, FloatArray]] = []
+        turn_info: list[tuple[FloatArray, float, float]] = []
+        for m_i, mo in enumerate(motions):
+            sl = slice(mo.start, mo.stop)
+            wc = (rate_rad_s[sl] - b) @ ie_inv.T
+            d = attitude_along(wc, dt_s[sl])
+            a0 = d[: mo.k_end - mo.start].mean(axis=0)
+            a1 = d[mo.k1_start - mo.start :].mean(axis=0)
+            atts.append((a0, a1))
+            p = _direction(u[mo.pose_k], a0, a1)
+            s = 1.0 / math.sqrt(mo.var)
+            r[3 * m_i : 3 * m_i + 3] = (u[mo.pose_k1] - p) * s
+            if jac:
+                rot = a1 @ np.linalg.inv(a0)
+                tau = dt_s[sl][:, None]
+                sij = np.einsum("tai,tj->aij", d, wc * tau).reshape(3, 9)
+                px = skew(p) @ rot.T
+                j[3 * m_i : 3 * m_i + 3] = px @ sij * s
+                jb[3 * m_i : 3 * m_i + 3] = px @ d.sum(axis=0) * dt_med * s
+        for t_i, (sec, k) in enumerate(turns):
+            sl = slice(sec.start, sec.end)
+            wc = (rate_rad_s[sl] - b) @ ie_inv.T
+            tau = dt_s[sl][:, None]
+            tot = (wc * tau).sum(axis=0)
+            sense = 1.0 if float(tot @ u[k]) >= 0 else -1.0
+            t_turn = sec.n * dt_med
+            var = (rate_sigma_rad_s**2 * dt_med * t_turn + (2 * math.pi * dir_sigma_rad[k]) ** 2
+                   + (om * t_turn) ** 2 / 3.0)  # fmt: skip
+            s = 1.0 / math.sqrt(var)
+            row = slice(3 * len(motions) + 3 * t_i, 3 * len(motions) + 3 * t_i + 3)
+            r[row] = (tot - 2.0 * math.pi * sense * u[k]) * s
+            turn_info.append((tot, sense, s))
+            if jac:
+                # ∂/∂E_ij of Σ (I+E)⁻¹ ω' τ ≈ −e_i Σ ω_cj τ ; ∂/∂b ≈ −T I
+                colsum = (wc * tau).sum(axis=0)
+                for i in range(3):
+                    j[row.start + i, 3 * i : 3 * i + 3] = -colsum * s
+                jb[row] = -np.eye(3) * t_turn * s
+        return r, j, jb, (atts, turn_info)
+
+    r0, _j, _jb, _a = evaluate(e, bias_rad_s, up, jac=False)
+    scale = 1e-3
+    for _ in range(max_iter):
+        r, j, jb, _atts = evaluate(e, bias_rad_s, up, jac=True)
+        step, *_ = np.linalg.lstsq(j * scale, -r, rcond=None)
+        e = e + (step * scale).reshape(3, 3)
+        if float(np.max(np.abs(step * scale))) < 1e-10:
+            break
+    r, j, jb, atts = evaluate(e, bias_rad_s, up, jac=True)
+    _u, s_, vt = np.linalg.svd(j * scale, full_matrices=False)
+    if not s_[-1] > 1e-6 * s_[0]:
+        raise DesignError(
+            "the rotations between poses are all about one axis (or too small): the gyro's "
+            "scale factors and misalignments of the other axes are unseen; turn the board "
+            "about at least two different axes between poses"
+        )
+    cov_p = (vt.T / s_**2) @ vt * scale**2  # covariance of E's nine elements
+    dof = (2 * len(motions) + 3 * len(turns)) - 9
+    chi2 = float(r @ r) / dof if dof > 0 else float("nan")
+    if dof > 0 and chi2 > 1.0 + 3.0 * math.sqrt(2.0 / dof):
+        cov_p = cov_p * chi2
+    gain = cov_p @ j.T  # K = (JᵀJ)⁻¹ Jᵀ (whitened)
+    cov_p = cov_p + gain @ jb @ bias_cov @ jb.T @ gain.T
+    # the accelerometer's uncertainty through u (numerical derivative of the residuals)
+    ga = np.zeros((n_rows, accel_free.size))
+    for q in range(accel_free.size):
+        h = max(1e-6, 1e-3 * math.sqrt(max(float(accel_free_cov[q, q]), 0.0)))
+        pq = accel_free.copy()
+        pq[q] += h
+        r_q = _residuals_fixed_att(motions, turns, atts, up_of(pq), r)
+        ga[:, q] = (r_q - r) / h
+    cov_p = cov_p + gain @ ga @ accel_free_cov @ ga.T @ gain.T
+    theta = np.zeros(12)
+    theta[0:3] = bias_rad_s * units.RS_TO_DH
+    theta[3:12] = model.coeffs_from_error_matrix(e, np.zeros(3))[3:12]
+    # Jacobian of θ[3:12] w.r.t. the row-major elements of E
+    t_mat = np.zeros((9, 9))
+    for i in range(3):
+        t_mat[i, 4 * i] = 1.0 / units.PPM
+    for k, name in enumerate(model.MISALIGNMENT_NAMES):
+        rr, cc = model.MISALIGNMENT_INDEX[name]
+        t_mat[3 + k, 3 * rr + cc] = units.RAD_TO_ARCSEC
+    cov = np.zeros((12, 12))
+    cov[0:3, 0:3] = bias_cov * units.RS_TO_DH**2
+    cov[3:12, 3:12] = t_mat @ cov_p @ t_mat.T
+    sw = np.array([math.sqrt(mo.var) for mo in motions])
+    n_m = 3 * len(motions)
+    before = r0[:n_m].reshape(-1, 3) * sw[:, None]
+    after = r[:n_m].reshape(-1, 3) * sw[:, None]
+    return GyroFit(
+        theta,
+        cov,
+        float(np.sqrt(np.mean(np.sum(before**2, axis=1)))) if n_m else float("nan"),
+        float(np.sqrt(np.mean(np.sum(after**2, axis=1)))) if n_m else float("nan"),
+        chi2,
+        len(motions),
+        len(turns),
+    )
+
+
+def _residuals_fixed_att(
+    motions: Sequence[_Motion],
+    turns: Sequence[tuple[Section, int]],
+    held: tuple[list[tuple[FloatArray, FloatArray]], list[tuple[FloatArray, float, float]]],
+    u: FloatArray,
+    r_ref: FloatArray,
+) -> FloatArray:
+    """The whitened residuals for other up directions ``u``, the attitudes (and the turns'
+    integrated rates) held."""
+    atts, turn_info = held
+    out = r_ref.copy()
+    for m_i, mo in enumerate(motions):
+        a0, a1 = atts[m_i]
+        s = 1.0 / math.sqrt(mo.var)
+        out[3 * m_i : 3 * m_i + 3] = (u[mo.pose_k1] - _direction(u[mo.pose_k], a0, a1)) * s
+    for t_i, ((_sec, k), (tot, sense, s)) in enumerate(zip(turns, turn_info, strict=True)):
+        row = slice(3 * len(motions) + 3 * t_i, 3 * len(motions) + 3 * t_i + 3)
+        out[row] = (tot - 2.0 * math.pi * sense * u[k]) * s
+    return out
+
+
+__all__ = ["GyroFit", "fit_rotations", "static_bias"]

@@ -1,0 +1,240 @@
+"""Hand-placed multi-position sessions with known truth (issue 30).
+
+Poses: ``n_poses`` orientations drawn uniformly on SO(3) (a board put down by hand in
+random orientations), each held ``dwell_s`` (± 30 %) with a small tremor (a rotation of
+``tremor_deg`` amplitude at a few hertz about a random axis); between them a hand
+rotation about the fixed body axis of the relative rotation, with the smooth profile
+``(1 − cos πt/T)/2`` over ``move_s`` (± 30 %), and a linear acceleration bump of the hand.
+The attitude is integrated from the body rate exactly as the estimator integrates
+(``C_{i+1} = C_i exp([ω_i τ×])``, :func:`.geometry.attitude_along`); the gyro reads the
+body rate plus the earth rate at ``latitude_deg`` (ENU local frame), the accelerometer the
+specific force ``C_nᵇ (0, 0, g) + a_hand``, both through the error model of the package
+docstring with white noise.  Several temperatures: each parameter is
+``θ(T) = θ₀ + θ₁ (T − 25 °C)``.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+import numpy.typing as npt
+
+from thermocal import units
+from thermocal.multipos.geometry import attitude_along, matrix_to_rotvec
+from thermocal.turntable import model
+
+FloatArray = npt.NDArray[np.float64]
+
+MG_M_S2 = 9.80665e-3
+TREF_TRUTH_C = 25.0
+
+
+@dataclass(frozen=True)
+class Truth:
+    """True θ of both triads at a temperature (units of :mod:`thermocal.turntable.thermal`)."""
+
+    accel: FloatArray
+    gyro: FloatArray
+
+
+def random_truth(rng: np.random.Generator) -> tuple[Truth, Truth]:
+    """θ₀ and the slope θ₁ [per °C] of a consumer MEMS IMU.  Accelerometer misalignments
+    lower triangular (the accelerometer frame is the body frame)."""
+    a0 = np.zeros(12)
+    a0[0:3] = rng.uniform(-40, 40, 3)  # mg
+    a0[3:6] = rng.uniform(-8000, 8000, 3)  # ppm
+    a0[[8, 10, 11]] = rng.uniform(-2000, 2000, 3)  # xy, xz, yz [″]
+    g0 = np.zeros(12)
+    g0[0:3] = rng.uniform(-2000, 2000, 3)  # °/h
+    g0[3:6] = rng.uniform(-8000, 8000, 3)
+    g0[6:12] = rng.uniform(-3000, 3000, 6)
+    a1 = np.zeros(12)
+    a1[0:3] = rng.uniform(-0.5, 0.5, 3)  # mg/°C
+    a1[3:6] = rng.uniform(-50, 50, 3)  # ppm/°C
+    g1 = np.zeros(12)
+    g1[0:3] = rng.uniform(-30, 30, 3)  # °/h/°C
+    g1[3:6] = rng.uniform(-50, 50, 3)
+    return Truth(a0, g0), Truth(a1, g1)
+
+
+def _random_rotation(rng: np.random.Generator) -> FloatArray:
+    q = rng.normal(size=4)
+    q /= np.linalg.norm(q)
+    w, x, y, z = q
+    return np.array([
+        [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+        [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+        [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
+    ])  # fmt: skip
+
+
+def simulate_session(
+    rng: np.random.Generator,
+    accel_theta: FloatArray,
+    gyro_theta: FloatArray,
+    *,
+    n_poses: int = 16,
+    rate_hz: float = 100.0,
+    dwell_s: float = 5.0,
+    move_s: float = 2.0,
+    accel_noise_mg: float = 2.0,
+    gyro_noise_deg_s: float = 0.03,
+    tremor_deg: float = 0.003,
+    latitude_deg: float = 45.0,
+    max_angle_deg: float = 170.0,
+) -> dict[str, Any]:
+    """One session (module docstring): ``time_s``, ``accel_mg`` (n, 3), ``gyro_deg_s``
+    (n, 3), the true ``attitude`` (n, 3, 3, body → local), ``poses`` (start, end) of the
+    still windows and ``g_m_s2``."""
+    dt = 1.0 / rate_hz
+    cs = [_random_rotation(rng)]
+    while len(cs) < n_poses:
+        c = _random_rotation(rng)
+        ang = np.linalg.norm(matrix_to_rotvec(cs[-1].T @ c))
+        if ang < math.radians(max_angle_deg) and ang > math.radians(30.0):
+            cs.append(c)
+    rates = []
+    poses = []
+    n0 = 0
+    for k in range(n_poses):
+        n_d = round(dwell_s * rng.uniform(0.7, 1.3) * rate_hz)
+        tt = np.arange(n_d + 1) * dt
+        axis = rng.normal(size=3)
+        axis /= np.linalg.norm(axis)
+        ang = math.radians(tremor_deg) * np.sin(2 * math.pi * rng.uniform(1.5, 4.0) * tt
+                                                + rng.uniform(0, 2 * math.pi))  # fmt: skip
+        ang -= ang[0]
+        rates.append(np.diff(ang)[:, None] / dt * axis[None, :])
+        poses.append((n0, n0 + n_d))
+        n0 += n_d
+        if k + 1 < n_poses:
+            # the tremor leaves the attitude at exp(ang[-1] axis): rotate from there
+            c_now = cs[k] @ _rodrigues(axis * ang[-1])
+            phi = matrix_to_rotvec(c_now.T @ cs[k + 1])
+            n_m = round(move_s * rng.uniform(0.7, 1.3) * rate_hz)
+            s = (1 - np.cos(np.pi * np.arange(n_m + 1) / n_m)) / 2
+            rates.append(np.diff(s)[:, None] / dt * phi[None, :])
+            n0 += n_m
+    w_nb = np.vstack(rates)
+    n = w_nb.shape[0]
+    d = attitude_along(np.vstack([w_nb, np.zeros((1, 3))]), np.full(n + 1, dt))
+    att = cs[0][None] @ d  # body → local (ENU), n + 1 samples
+    g = units.normal_gravity_m_s2(latitude_deg)
+    f_true = np.einsum("nji,j->ni", att, np.array([0.0, 0.0, g])) / MG_M_S2  # mg
+    # the hand's acceleration during the moves (local frame), ≤ 0.05 g
+    moving = np.ones(n + 1, dtype=bool)
+    for s0, e0 in poses:
+        moving[s0 : e0 + 1] = False
+    bump = np.zeros((n + 1, 3))
+    bump[moving] = (
+        rng.normal(0, 30.0, size=(1, 3))
+        * np.sin(np.linspace(0, 40 * np.pi, n + 1)[moving])[:, None]
+    )
+    f_true += np.einsum("nji,nj->ni", att, bump)
+    lat = math.radians(latitude_deg)
+    om_n = units.EARTH_RATE_RAD_S * np.array([0.0, math.cos(lat), math.sin(lat)])
+    w_true = np.vstack([w_nb, np.zeros((1, 3))]) + np.einsum("nji,j->ni", att, om_n)
+    e_a = model.error_matrices(accel_theta)
+    e_g = model.error_matrices(gyro_theta)
+    accel = f_true @ (np.eye(3) + e_a).T + accel_theta[0:3]
+    accel += rng.normal(0, accel_noise_mg, size=accel.shape)
+    gyro = w_true @ (np.eye(3) + e_g).T + gyro_theta[0:3] * units.DH_TO_RS
+    gyro = gyro * units.RAD_TO_DEG + rng.normal(0, gyro_noise_deg_s, size=gyro.shape)
+    return {
+        "time_s": np.arange(n + 1) * dt,
+        "accel_mg": accel,
+        "gyro_deg_s": gyro,
+        "attitude": att,
+        "poses": poses,
+        "g_m_s2": g,
+    }
+
+
+def _rodrigues(phi: FloatArray) -> FloatArray:
+    from thermocal.multipos.geometry import rotvec_to_matrix
+
+    out: FloatArray = rotvec_to_matrix(phi)
+    return out
+
+
+ACCEL_COLUMNS = ("accel_x", "accel_y", "accel_z")
+GYRO_COLUMNS = ("gyro_x", "gyro_y", "gyro_z")
+TEMPERATURE_COLUMN = "T_imu"
+
+
+def simulate_runs(
+    seed_rngs: list[np.random.Generator],
+    *,
+    runs: int = 1,
+    rate_hz: float = 100.0,
+    latitude_deg: float = 45.0,
+    n_poses: int = 16,
+    temperatures_c: tuple[float, ...] | None = None,
+    held_out: bool = True,
+) -> list[tuple[Any, dict[str, Any]]]:
+    """``runs`` sessions of one IMU at temperatures spread over −10…+50 °C (one: 25 °C),
+    each a :class:`~thermocal.recording.Recording` (accelerometer in m/s², gyro in °/s,
+    ``T_imu`` [°C] drifting ±0.2 °C) with its truth: θ at the run's mean temperature,
+    θ₀ and θ₁ of :func:`random_truth`, the still windows, g and the latitude.  With
+    ``held_out`` one more session of the same IMU (other poses, other noise), labelled
+    ``held-out``, at the first temperature (several runs: midway between the first two),
+    for validation."""
+    from thermocal.recording import Metadata, Recording
+
+    if runs < 1:
+        raise ValueError("runs must be at least 1")
+    truth0, slope = random_truth(seed_rngs[0])
+    temps = temperatures_c or (
+        (TREF_TRUTH_C,) if runs == 1 else tuple(np.linspace(-10.0, 50.0, runs).tolist())
+    )
+    held = temps[0] if len(temps) == 1 else 0.5 * (temps[0] + temps[1])
+    if held_out:
+        temps = (*temps, held)
+    out = []
+    for i, tc in enumerate(temps):
+        rng = np.random.default_rng(seed_rngs[1].integers(2**63) + i)
+        ta = truth0.accel + slope.accel * (tc - TREF_TRUTH_C)
+        tg = truth0.gyro + slope.gyro * (tc - TREF_TRUTH_C)
+        s = simulate_session(rng, ta, tg, n_poses=n_poses, rate_hz=rate_hz,
+                             latitude_deg=latitude_deg)  # fmt: skip
+        n = s["time_s"].size
+        temp = tc + 0.2 * np.sin(np.linspace(0, np.pi, n))
+        acc = s["accel_mg"] * MG_M_S2
+        sig = {c: acc[:, k] for k, c in enumerate(ACCEL_COLUMNS)}
+        sig |= {c: s["gyro_deg_s"][:, k] for k, c in enumerate(GYRO_COLUMNS)}
+        unit = {c: "m/s^2" for c in ACCEL_COLUMNS} | {c: "deg/s" for c in GYRO_COLUMNS}
+        rec = Recording.from_arrays(
+            s["time_s"], sig, {TEMPERATURE_COLUMN: temp}, signal_unit=unit,
+            meta=Metadata(latitude_deg=latitude_deg, sample_interval_s=1.0 / rate_hz),
+        )  # fmt: skip
+        is_held = held_out and i == len(temps) - 1
+        label = "held-out" if is_held else f"T{tc:+.0f}"
+        out.append(
+            (
+                rec,
+                {
+                    "label": label,
+                    "held_out": is_held,
+                    "temperature_c": float(np.mean(temp)),
+                    "accel_theta": ta.tolist(),
+                    "gyro_theta": tg.tolist(),
+                    "theta_units": {"accel": "mg, ppm, arcsec", "gyro": "deg/h, ppm, arcsec"},
+                    "accel_theta0": truth0.accel.tolist(),
+                    "accel_theta1_per_c": slope.accel.tolist(),
+                    "gyro_theta0": truth0.gyro.tolist(),
+                    "gyro_theta1_per_c": slope.gyro.tolist(),
+                    "tref_c": TREF_TRUTH_C,
+                    "poses": [list(p) for p in s["poses"]],
+                    "gravity_m_s2": s["g_m_s2"],
+                    "latitude_deg": latitude_deg,
+                    "misalignment_names": list(model.MISALIGNMENT_NAMES),
+                },
+            )
+        )
+    return out
+
+
+__all__ = ["Truth", "random_truth", "simulate_runs", "simulate_session"]

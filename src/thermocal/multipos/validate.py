@@ -1,0 +1,138 @@
+"""A calibration of triads judged on a held-out multi-position session (issue 30).
+
+The poses are found in the held-out session as in calibration (:func:`.poses.detect_poses`
+on the raw data).  Accelerometer: per pose, ``|mean f| − g`` before (raw) and after
+compensation ``(I + E(T))⁻¹ (f − b(T))`` — rms over the poses in the accelerometer's
+unit; per axis, the pose mean against ``g`` along its compensated direction.  Gyro (with
+the accelerometer triad, which gives the up directions): per motion between consecutive
+poses, the rotation-angle error ``|u_{k+1} × A_{k+1}ᵀ A_k⁻ᵀ u_k|`` [°] (:func:`.calibrate.
+rotation_errors`) with raw data before and compensated data after.  ``g`` is the one the
+calibration recorded (else normal gravity at the latitude).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+
+from thermocal import units
+from thermocal.errors import ThermocalInputError
+from thermocal.multipos.calibrate import (
+    MultiposValidation,
+    gravity_errors,
+    rotation_errors,
+)
+from thermocal.multipos.poses import detect_poses
+
+
+def _columns(rec: Any, tri: Any) -> tuple[Any, str]:
+    x = np.column_stack([rec.column(c) for c in tri.columns])
+    found = {rec.units.get(c) or tri.unit for c in tri.columns}
+    unit = found.pop() if len(found) == 1 else tri.unit
+    return x, unit
+
+
+def validate_triads(
+    triads: Sequence[Any],
+    rec: Any,
+    latitude_deg: float | None = None,
+    *,
+    static_s: float = 1.0,
+) -> list[MultiposValidation]:
+    """Held-out figures of each triad (module docstring)."""
+    from thermocal.turntable import thermal
+
+    by = {t.model.kind: t for t in triads}
+    acc = by.get("accel")
+    if acc is None:
+        raise ThermocalInputError(
+            f"{rec.name}: a multi-position calibration is validated through its "
+            "accelerometer triad (it gives the poses' up directions); this one has none"
+        )
+    rec.validate(required=[c for t in triads for c in (*t.columns, t.temperature) if c])
+    lat = next((v for v in (latitude_deg, rec.meta.latitude_deg, acc.latitude_deg)
+                if v is not None), None)  # fmt: skip
+    g_m_s2 = acc.model.gravity_m_s2
+    if g_m_s2 is None:
+        if lat is None:
+            raise ThermocalInputError(f"{rec.name}: give the latitude (--latitude DEG)")
+        g_m_s2 = units.normal_gravity_m_s2(float(lat))
+    t = rec.time_s
+
+    def temp_of(tri: Any) -> Any:
+        if tri.temperature:
+            return rec.temperature_c(tri.temperature)
+        return np.full(rec.n_samples, tri.model.tref_c)
+
+    def outside(tri: Any, temp: Any) -> float:
+        return float(np.mean((temp < tri.model.t_lo_c) | (temp > tri.model.t_hi_c)))
+
+    xa, a_unit = _columns(rec, acc)
+    ta = temp_of(acc)
+    a_to = float(units.convert(np.array([1.0]), "mg", a_unit)[0])
+    xa_c = thermal.correct(acc.model, xa, ta, a_to)
+    gyr = by.get("gyro")
+    xg = xg_c = None
+    if gyr is not None:
+        xg, g_unit = _columns(rec, gyr)
+        tg = temp_of(gyr)
+        g_to = float(units.convert(np.array([1.0]), "deg/h", g_unit)[0])
+        xg_c = thermal.correct(gyr.model, xg, tg, g_to)
+        xg = units.convert(xg, g_unit, "rad/s")
+        xg_c = units.convert(xg_c, g_unit, "rad/s")
+    sections = detect_poses(t, xa, xg, static_s=static_s)
+    if len(sections) < 2:
+        raise ThermocalInputError(
+            f"{rec.name}: {len(sections)} still poses found: not a multi-position session"
+        )
+    g = float(units.convert(np.array([g_m_s2]), "m/s^2", a_unit)[0])
+    eb, ea, pb, pa = gravity_errors(xa, xa_c, sections, g)
+    out = [
+        MultiposValidation(
+            acc.name,
+            a_unit,
+            float(np.sqrt(np.mean(eb**2))),
+            float(np.sqrt(np.mean(ea**2))),
+            _rms3(pb),
+            _rms3(pa),
+            len(sections),
+            "gravity-magnitude error",
+            outside(acc, ta),
+        )
+    ]
+    if gyr is not None and xg is not None and xg_c is not None:
+        dt = np.diff(t)
+        dt = np.concatenate([dt, dt[-1:]])
+        vb = rotation_errors(xg, dt, xa, sections) * units.RAD_TO_DEG
+        va = rotation_errors(xg_c, dt, xa_c, sections) * units.RAD_TO_DEG
+        nb, na = np.linalg.norm(vb, axis=1), np.linalg.norm(va, axis=1)
+        out.append(
+            MultiposValidation(
+                gyr.name,
+                "deg",
+                float(math.sqrt(np.mean(nb**2))),
+                float(math.sqrt(np.mean(na**2))),
+                _rms3(vb),
+                _rms3(va),
+                len(nb),
+                "rotation-angle error",
+                outside(gyr, temp_of(gyr)),
+            )
+        )
+    return out
+
+
+def _rms3(v: Any) -> tuple[float, float, float]:
+    r = np.sqrt(np.mean(np.asarray(v) ** 2, axis=0))
+    return (float(r[0]), float(r[1]), float(r[2]))
+
+
+def is_multipos(triads: Sequence[Any]) -> bool:
+    """A calibration of triads made by ``thermocal multipos``."""
+    return any(getattr(t.model, "method", "turntable") == "multipos" for t in triads)
+
+
+__all__ = ["is_multipos", "validate_triads"]
