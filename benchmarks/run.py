@@ -47,6 +47,7 @@ BENCHMARKS: dict[str, tuple[list[str], list[str]]] = {
     "demo": (["--repeat", "3"], ["--repeat", "1"]),
     "fleet": ([], ["--skip-big"]),
     "turntable_thermal": ([], []),
+    "stability": ([], ["--repeat", "1"]),
 }
 """Every benchmark script (``bench_<name>.py``) and the RESULTS.md section it feeds."""
 
