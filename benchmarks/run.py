@@ -51,6 +51,7 @@ BENCHMARKS: dict[str, tuple[list[str], list[str]]] = {
     "fleet": ([], ["--skip-big"]),
     "turntable_thermal": ([], []),
     "multipos": ([], []),
+    "stability": ([], ["--repeat", "1"]),
 }
 """Every benchmark script (``bench_<name>.py``) and the RESULTS.md section it feeds."""
 

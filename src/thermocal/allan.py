@@ -620,6 +620,130 @@ def overlapping_adev(
     )
 
 
+# --- dynamic Allan deviation ---------------------------------------------------------
+
+
+STATIONARITY_FALSE_ALARM: Final = 0.01
+"""Family-wise false-alarm probability of :func:`dynamic_adev`'s stationarity test."""
+
+
+@dataclass(frozen=True, eq=False)
+class DynamicAllan:
+    """Overlapping ADEV in sliding windows (dynamic Allan deviation).
+
+    ``t_s`` the windows' centres [s from the first sample]; ``adev`` (windows × τ) [unit],
+    NaN where a window is too short for that τ; ``adev_low``/``adev_high`` its interval at
+    the whole record's confidence; ``changes`` every (window, τ) where the window's
+    deviation and the whole record's differ beyond both their intervals at the test's
+    confidence ``test_confidence`` (``{"t_s", "tau_s", "adev", "whole_adev"}``);
+    ``stationary`` no such change.
+    """
+
+    window_s: float
+    step_s: float
+    t_s: FloatArray
+    tau_s: FloatArray
+    adev: FloatArray
+    adev_low: FloatArray
+    adev_high: FloatArray
+    unit: str
+    test_confidence: float
+    changes: tuple[dict[str, float], ...]
+
+    @property
+    def stationary(self) -> bool:
+        return not self.changes
+
+
+def dynamic_adev(
+    rate: npt.ArrayLike,
+    tau0_s: float,
+    window_s: float,
+    whole: AllanResult,
+    *,
+    time_s: npt.ArrayLike | None = None,
+    step_s: float | None = None,
+) -> DynamicAllan:
+    """Dynamic Allan deviation: :func:`overlapping_adev` in windows of ``window_s`` [s]
+    stepped by ``step_s`` (default half a window), at the τ of ``whole`` (the whole
+    record's result) that fit a window (L. Galleani & P. Tavella, "The dynamic Allan
+    variance", IEEE Trans. UFFC 56(3), 2009).
+
+    Stationarity: a window's ADEV and the whole record's differ when their chi-square
+    intervals (NIST SP 1065 eq. 45, each with its own EDF) are disjoint.  With many
+    windows × τ compared, each interval is taken at ``1 − 0.01 / comparisons``
+    (Bonferroni), so a stationary record is flagged with probability ≤ 1 %.
+    """
+    y = np.asarray(rate, dtype=np.float64).ravel()
+    if not (math.isfinite(window_s) and window_s > 0):
+        raise ThermocalInputError(f"--dynamic {window_s!r}: give a window length > 0 [s]")
+    n_win = round(window_s / tau0_s)
+    if n_win < 8:
+        raise ThermocalInputError(
+            f"--dynamic {window_s:g} s holds {n_win} samples at τ0 = {tau0_s:g} s; give at "
+            "least 8 samples' worth"
+        )
+    if n_win > y.size // 2:
+        raise ThermocalInputError(
+            f"--dynamic {window_s:g} s: the record ({y.size * tau0_s:g} s) holds fewer than "
+            "two windows; give a shorter window"
+        )
+    step = max(1, round((step_s if step_s is not None else window_s / 2.0) / tau0_s))
+    t = None if time_s is None else np.asarray(time_s, dtype=np.float64).ravel()
+    m_all = whole.m[whole.m <= max_averaging_factor(n_win)]
+    if m_all.size == 0:
+        raise ThermocalInputError(f"--dynamic {window_s:g} s: no τ of the record fits a window")
+    starts = list(range(0, y.size - n_win + 1, step))
+    results: list[AllanResult | None] = []
+    centres = []
+    for a in starts:
+        sl = slice(a, a + n_win)
+        centres.append(
+            (a + n_win / 2.0) * tau0_s if t is None else float(np.mean(t[sl][[0, -1]]) - t[0])
+        )
+        try:
+            results.append(
+                overlapping_adev(
+                    y[sl], tau0_s, m_all * tau0_s, time_s=None if t is None else t[sl],
+                    unit=whole.unit, confidence=whole.confidence,
+                )
+            )  # fmt: skip
+        except ThermocalInputError:  # a window cut to pieces by gaps
+            results.append(None)
+    shape = (len(starts), m_all.size)
+    dev, lo, hi, edf = (np.full(shape, np.nan) for _ in range(4))
+    for i, r in enumerate(results):
+        if r is None:
+            continue
+        j = np.searchsorted(m_all, r.m)
+        dev[i, j], lo[i, j], hi[i, j], edf[i, j] = r.adev, r.adev_low, r.adev_high, r.edf
+    cols = np.searchsorted(whole.m, m_all)
+    w_dev, w_edf = whole.adev[cols], whole.edf[cols]
+    ok = np.isfinite(dev) & (dev > 0) & (edf > 0) & (w_dev > 0)[None, :]
+    n_cmp = int(ok.sum())
+    test_conf = 1.0 - STATIONARITY_FALSE_ALARM / max(n_cmp, 1)
+    changes: list[dict[str, float]] = []
+    if n_cmp:
+        ii, jj = np.nonzero(ok)
+        d_lo, d_hi = confidence_interval(dev[ii, jj], edf[ii, jj], test_conf)
+        w_lo, w_hi = confidence_interval(w_dev[jj], w_edf[jj], test_conf)
+        apart = (d_lo > w_hi) | (d_hi < w_lo)
+        for k in np.flatnonzero(apart):
+            changes.append(
+                {
+                    "t_s": float(centres[ii[k]]),
+                    "tau_s": float(m_all[jj[k]] * tau0_s),
+                    "adev": float(dev[ii[k], jj[k]]),
+                    "whole_adev": float(w_dev[jj[k]]),
+                }
+            )
+    return DynamicAllan(
+        window_s=n_win * tau0_s, step_s=step * tau0_s, t_s=np.asarray(centres, dtype=np.float64),
+        tau_s=np.asarray(m_all * tau0_s, dtype=np.float64), adev=dev, adev_low=lo,
+        adev_high=hi, unit=whole.unit, test_confidence=test_conf, changes=tuple(changes),
+    )  # fmt: skip
+
+
 # --- noise terms -----------------------------------------------------------------------
 
 
@@ -980,12 +1104,14 @@ __all__ = [
     "ONE_SIGMA_CONFIDENCE",
     "TERM_NAMES",
     "AllanResult",
+    "DynamicAllan",
     "FitQuality",
     "NoiseTerm",
     "NoiseTermSet",
     "NoiseTerms",
     "averaging_factors",
     "confidence_interval",
+    "dynamic_adev",
     "edf_simple",
     "fit_quality",
     "identify_alpha",

@@ -24,10 +24,16 @@ import numpy as np
 import numpy.typing as npt
 
 from thermocal import units
+from thermocal._lazy import LazyModule
 from thermocal.errors import MissingValueError, ThermocalInputError
 from thermocal.recording import Recording, contiguous_slices, is_increasing
 
 FloatArray = npt.NDArray[np.float64]
+
+special = LazyModule("scipy.special")  # chi-square quantiles, when an interval is asked for
+
+ONE_SIGMA: float = math.erf(1.0 / math.sqrt(2.0))
+"""0.6827, the confidence of a ±1σ interval."""
 
 
 # --- results -------------------------------------------------------------------------
@@ -264,6 +270,68 @@ def bias_repeatability(biases: npt.ArrayLike) -> float:
     if b.size < 2:
         raise ThermocalInputError(f"bias repeatability needs at least two biases, got {b.size}")
     return float(np.std(b, ddof=1))
+
+
+@dataclass(frozen=True)
+class RunRepeatability:
+    """Turn-on to turn-on repeatability over separate power-ons (SPEC §1), in ``unit``.
+
+    ``runs`` each run's figures (its bias and in-run bias stability); ``bias_repeatability``
+    the sample standard deviation of the run biases, ``low``/``high`` its chi-square
+    interval at ``confidence`` (:func:`std_interval`); ``bias_mean`` the mean run bias.
+    """
+
+    runs: tuple[MetricsResult, ...]
+    files: tuple[str, ...]
+    bias_mean: float
+    bias_repeatability: float
+    bias_repeatability_low: float
+    bias_repeatability_high: float
+    confidence: float
+    unit: str
+
+
+def std_interval(s: float, n: int, confidence: float = ONE_SIGMA) -> tuple[float, float]:
+    """Chi-square interval of a standard deviation ``s`` of ``n`` normal samples.
+
+    ``ν = n − 1``: ``σ ∈ [s √(ν / χ²_{(1+c)/2}(ν)), s √(ν / χ²_{(1−c)/2}(ν))]`` (e.g. NIST/
+    SEMATECH e-Handbook of Statistical Methods §7.2.3; NIST SP 1065 eq. 45 for deviations).
+    """
+    if n < 2:
+        raise ThermocalInputError(f"a standard deviation needs at least two values, got {n}")
+    if not 0.0 < confidence < 1.0:
+        raise ThermocalInputError(f"confidence must be in (0, 1), got {confidence!r}")
+    nu = float(n - 1)
+    p = (1.0 - confidence) / 2.0
+    chi_upper = float(special.chdtri(nu, p))  # upper quantile (inverse survival function)
+    chi_lower = float(special.chdtri(nu, 1.0 - p))
+    return s * math.sqrt(nu / chi_upper), s * math.sqrt(nu / chi_lower)
+
+
+def run_repeatability(
+    runs: list[MetricsResult], files: list[str], confidence: float = ONE_SIGMA
+) -> RunRepeatability:
+    """Turn-on to turn-on bias repeatability of several runs of one signal (separate
+    power-ons): ``Br = sqrt(Σ (B_i − B̄)² / (p − 1))`` over the p run biases (SPEC §1,
+    :func:`bias_repeatability`) with its chi-square interval (:func:`std_interval`).
+    Every run must be in one unit."""
+    if len(runs) < 2:
+        raise ThermocalInputError(f"turn-on repeatability needs at least two runs, got {len(runs)}")
+    unit = runs[0].unit
+    for r, f in zip(runs, files, strict=True):
+        if r.unit != unit:
+            raise ThermocalInputError(
+                f"{f}: {r.signal} is in {r.unit}, the first run in {unit}; give the runs in "
+                "one unit (--signal-unit)"
+            )
+    biases = [r.bias for r in runs]
+    br = bias_repeatability(biases)
+    lo, hi = std_interval(br, len(runs), confidence)
+    return RunRepeatability(
+        runs=tuple(runs), files=tuple(files), bias_mean=float(np.mean(biases)),
+        bias_repeatability=br, bias_repeatability_low=lo, bias_repeatability_high=hi,
+        confidence=confidence, unit=unit,
+    )  # fmt: skip
 
 
 def temperature_sensitivity(
@@ -628,6 +696,7 @@ __all__ = [
     "DriftExtreme",
     "DriftReference",
     "MetricsResult",
+    "RunRepeatability",
     "Stage",
     "TemperatureSensitivity",
     "bias",
@@ -642,5 +711,7 @@ __all__ = [
     "hold_stages",
     "peak_to_peak",
     "reference_bias",
+    "run_repeatability",
+    "std_interval",
     "temperature_sensitivity",
 ]

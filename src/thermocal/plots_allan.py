@@ -10,7 +10,7 @@ from pathlib import Path
 
 import numpy as np
 
-from thermocal.allan import TERM_NAMES, AllanResult, NoiseTerms
+from thermocal.allan import TERM_NAMES, AllanResult, DynamicAllan, NoiseTerms
 from thermocal.io import atomic_write_path
 
 
@@ -74,3 +74,52 @@ def plot_allan(
     finally:
         plt.close(fig)
     return out
+
+
+def plot_dynamic(dyn: DynamicAllan, path: str | Path, *, title: str | None = None) -> Path:
+    """Write a heat map of the dynamic Allan deviation: window centre [s] across, τ [s]
+    up (log), log10 ADEV [unit] as colour; windows where the curve departs from the whole
+    record's are outlined.  Written atomically."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(7.0, 5.0), dpi=110)
+    try:
+        with np.errstate(divide="ignore", invalid="ignore"):
+            z = np.log10(np.where(dyn.adev > 0, dyn.adev, np.nan)).T
+        t_edges = _edges(dyn.t_s, log=False)
+        tau_edges = _edges(dyn.tau_s, log=True)
+        mesh = ax.pcolormesh(t_edges, tau_edges, np.ma.masked_invalid(z), shading="flat")
+        fig.colorbar(mesh, ax=ax, label=f"log10 ADEV [{dyn.unit}]")
+        if dyn.changes:
+            ax.plot(
+                [c["t_s"] for c in dyn.changes], [c["tau_s"] for c in dyn.changes], "rx",
+                ms=4, label="differs from the whole record",
+            )  # fmt: skip
+            ax.legend(fontsize=7)
+        ax.set_yscale("log")
+        ax.set_xlabel(f"window centre [s] (windows of {dyn.window_s:g} s)")
+        ax.set_ylabel("averaging time τ [s]")
+        ax.set_title(title or "dynamic Allan deviation")
+        out = Path(path)
+
+        def _write(tmp: Path) -> None:
+            fig.savefig(tmp, format="png")
+
+        atomic_write_path(out, _write)
+    finally:
+        plt.close(fig)
+    return out
+
+
+def _edges(centres: np.ndarray, *, log: bool) -> np.ndarray:
+    """Cell edges around sorted centres (geometric midpoints on a log axis)."""
+    c = np.log(centres) if log else np.asarray(centres, dtype=np.float64)
+    if c.size == 1:
+        e = np.array([c[0] - 0.5, c[0] + 0.5])
+    else:
+        mid = (c[1:] + c[:-1]) / 2.0
+        e = np.concatenate([[2 * c[0] - mid[0]], mid, [2 * c[-1] - mid[-1]]])
+    return np.exp(e) if log else e

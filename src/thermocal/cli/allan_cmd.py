@@ -122,9 +122,33 @@ def _terms_json(terms: dict[str, Any]) -> dict[str, Any]:
     }
 
 
-def allan_json(res: "_allan.AllanResult", noise: "_allan.NoiseTerms") -> dict[str, Any]:
+def dynamic_json(dyn: "_allan.DynamicAllan") -> dict[str, Any]:
+    """``dynamic``: ``window_s``, ``step_s``, ``t_s`` (window centres), ``tau_s``, ``adev``
+    (windows × τ, null where a window is too short), ``adev_low``/``adev_high``,
+    ``stationary``, ``changes`` and the test's ``test_confidence``."""
+    return {
+        "window_s": dyn.window_s,
+        "step_s": dyn.step_s,
+        "t_s": dyn.t_s,
+        "tau_s": dyn.tau_s,
+        "adev": dyn.adev,
+        "adev_low": dyn.adev_low,
+        "adev_high": dyn.adev_high,
+        "unit": dyn.unit,
+        "stationary": dyn.stationary,
+        "changes": list(dyn.changes),
+        "test_confidence": dyn.test_confidence,
+    }
+
+
+def allan_json(
+    res: "_allan.AllanResult",
+    noise: "_allan.NoiseTerms",
+    dyn: "_allan.DynamicAllan | None" = None,
+) -> dict[str, Any]:
     """The ``--json`` object of ``thermocal allan``: ``noise`` holds the fit-method
-    terms, ``noise_slope`` the slope-line terms (each value or null with a reason)."""
+    terms, ``noise_slope`` the slope-line terms (each value or null with a reason);
+    ``dynamic`` with ``--dynamic``."""
     out: dict[str, Any] = {
         "tau_s": res.tau_s,
         "adev": res.adev,
@@ -146,6 +170,8 @@ def allan_json(res: "_allan.AllanResult", noise: "_allan.NoiseTerms") -> dict[st
         "fit_reduced_chi2": noise.reduced_chi2,
         "fit_quality": noise.quality.to_dict() if noise.quality is not None else None,
     }
+    if dyn is not None:
+        out["dynamic"] = dynamic_json(dyn)
     return dict(jsonable(out))
 
 
@@ -154,6 +180,7 @@ def _emit_channels(
     analyses: "dict[str, tuple[_allan.AllanResult, _allan.NoiseTerms]]",
     as_json: bool,
     plot: Path | None,
+    dynamics: "dict[str, _allan.DynamicAllan]",
 ) -> None:
     """Several channels: ``{"channels": {NAME: {…}}}`` or one noise-term table with a
     column per channel (the ADEV points are in the JSON and the plots)."""
@@ -182,7 +209,11 @@ def _emit_channels(
             stdout.print(f"plots written to {plot.stem}_<channel>{plot.suffix} in {plot.parent}")
 
     emit(
-        {"channels": {name: allan_json(r, n) for name, (r, n) in analyses.items()}},
+        {
+            "channels": {
+                name: allan_json(r, n, dynamics.get(name)) for name, (r, n) in analyses.items()
+            }
+        },
         as_json,
         human,
     )
@@ -230,6 +261,15 @@ def allan_cmd(
             "angle, velocity, seconds of a clock).",
         ),
     ] = "rate",
+    dynamic: Annotated[
+        float | None,
+        typer.Option(
+            "--dynamic",
+            help="Dynamic ADEV: the overlapping ADEV in sliding windows of this many seconds "
+            "(half-window steps), a heat map beside --plot, a warning when the record is not "
+            "stationary.",
+        ),
+    ] = None,
     as_json: JsonOpt = False,
 ) -> None:
     """Overlapping Allan deviation with chi-square confidence intervals and the noise
@@ -267,6 +307,11 @@ def allan_cmd(
     names = split_names(signal) or [rec.signals[0]]
     if data_type not in ("rate", "phase"):
         raise ThermocalInputError(f"--data-type {data_type!r}: use rate or phase")
+    if dynamic is not None and (deviation is not None or data_type == "phase"):
+        raise ThermocalInputError(
+            "--dynamic computes the overlapping ADEV of rate data; run it without --deviation "
+            "and --data-type phase"
+        )
     if deviation is not None or data_type == "phase":
         devs = _family.parse_deviations(deviation or "oadev")
         fam_spec: Any = "all" if taus == "all" else tau_spec
@@ -294,6 +339,7 @@ def allan_cmd(
             emit({"channels": {n: family_json(r) for n, r in results.items()}}, as_json, human_all)
         return
     analyses: dict[str, tuple[_allan.AllanResult, _allan.NoiseTerms]] = {}
+    dynamics: dict[str, _allan.DynamicAllan] = {}
     for name in names:  # one read of the file, every channel (INTERFACE: several channels)
         canonical, canon_unit = rec.signal(name)
         # every figure in the data's own unit (°/s data: ADEV in °/s; INTERFACE common rules)
@@ -312,17 +358,39 @@ def allan_cmd(
             overwrite=names.count(name) == 1,
         )
         noise_c = _allan.noise_terms(res_c)
+        where = f"{file}" + (f" [{name}]" if len(names) > 1 else "")
         if noise_c.quality is not None and noise_c.quality.quality == "poor":
-            where = f"{file}" + (f" [{name}]" if len(names) > 1 else "")
             warnings.warn(f"{where}: {noise_c.quality.reason}", ConditioningWarning, stacklevel=1)
+        if dynamic is not None:
+            dyn = _allan.dynamic_adev(
+                values, rec.sample_interval_s, dynamic, res_c, time_s=rec.time_s
+            )
+            dynamics[name] = dyn
+            if not dyn.stationary:
+                worst = max(dyn.changes, key=lambda c: abs(math.log(c["adev"] / c["whole_adev"])))
+                warnings.warn(
+                    f"{where}: the record is not stationary: in {len(dyn.changes)} (window, τ) "
+                    f"cells the {dyn.window_s:g} s windows' ADEV differs from the whole "
+                    f"record's beyond both intervals (e.g. {worst['adev']:.4g} against "
+                    f"{worst['whole_adev']:.4g} {res_c.unit} at τ = {worst['tau_s']:.4g} s in "
+                    f"the window centred at {worst['t_s']:.4g} s); the noise terms of the "
+                    "whole record average over changing noise",
+                    ConditioningWarning,
+                    stacklevel=1,
+                )
         if plot is not None:
-            from thermocal.plots_allan import plot_allan
+            from thermocal.plots_allan import plot_allan, plot_dynamic
 
             target = plot if len(names) == 1 else plot.with_name(f"{plot.stem}_{name}{plot.suffix}")
             plot_allan(res_c, noise_c, target, title=f"{file.name} — {name}")
+            if name in dynamics:
+                plot_dynamic(
+                    dynamics[name], target.with_name(f"{target.stem}_dynamic{target.suffix}"),
+                    title=f"{file.name} — {name}: dynamic ADEV",
+                )  # fmt: skip
         analyses[name] = (res_c, noise_c)
     if len(names) > 1:
-        _emit_channels(file, analyses, as_json, plot)
+        _emit_channels(file, analyses, as_json, plot, dynamics)
         return
     res, noise = analyses[names[0]]
 
@@ -362,7 +430,13 @@ def allan_cmd(
                 f"noise-model fit: reduced χ² {noise.quality.reduced_chi2:.3g} on "
                 f"{noise.quality.dof} degrees of freedom — {noise.quality.quality}"
             )
+        dyn = dynamics.get(names[0])
+        if dyn is not None:
+            stdout.print(
+                f"dynamic ADEV: {dyn.t_s.size} windows of {dyn.window_s:g} s, "
+                + ("stationary" if dyn.stationary else f"{len(dyn.changes)} changes (warning)")
+            )
         if plot is not None:
             stdout.print(f"plot written to {plot}")
 
-    emit(allan_json(res, noise), as_json, human)
+    emit(allan_json(res, noise, dynamics.get(names[0])), as_json, human)

@@ -2,6 +2,7 @@
 repeatability and temperature sensitivity of one signal (SPEC §1)."""
 
 from collections.abc import Callable
+from pathlib import Path
 from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
@@ -12,7 +13,6 @@ from thermocal.cli.common import (
     AxisOpt,
     DecimalOpt,
     DelimiterOpt,
-    FileArg,
     JsonOpt,
     LatitudeOpt,
     NamesOpt,
@@ -79,7 +79,14 @@ def metrics_json(res: "_metrics.MetricsResult") -> dict[str, Any]:
 @app.command("metrics")
 @handle_errors
 def metrics_cmd(
-    file: FileArg,
+    files: Annotated[
+        list[Path],
+        typer.Argument(
+            help="Recording(s) (CSV or Parquet); several files are separate power-ons of one "
+            "sensor: each run's figures and the turn-on to turn-on bias repeatability.",
+            show_default=False,
+        ),
+    ],
     signal: SignalOpt = None,
     average: Annotated[
         float | None,
@@ -127,7 +134,13 @@ def metrics_cmd(
     """Figures of merit: bias (earth rate removed with --latitude and --axis), bias
     stability at the averaging time, peak-to-peak, drift angle, and over the
     temperature-hold stages of the first --temps column: bias repeatability and
-    temperature sensitivity."""
+    temperature sensitivity.  Several files (separate power-ons): each run's bias and in-run
+    bias stability, and the turn-on to turn-on repeatability (sample standard deviation of
+    the run biases with its 68.3 % chi-square interval)."""
+    if len(files) > 1:
+        _several_runs(files, locals())
+        return
+    file = files[0]
     rec = load_recording(
         file,
         text=text_options(t_names, t_rate, t_bad, t_delim, t_dec),
@@ -263,3 +276,104 @@ def _reference_words(ref: "_metrics.DriftReference") -> str:
 def first_result(results: "dict[str, _metrics.MetricsResult]") -> "_metrics.MetricsResult":
     """The only result of a one-channel run."""
     return next(iter(results.values()))
+
+
+def _several_runs(files: list[Path], opts: dict[str, Any]) -> None:
+    """``metrics FILE FILE...``: every file one power-on; per channel ``runs`` (each run's
+    figures, as one file's JSON plus ``file``), ``bias`` the mean run bias,
+    ``bias_stability`` the largest in-run bias stability, ``bias_repeatability`` (turn-on
+    to turn-on: sample standard deviation of the run biases) with
+    ``bias_repeatability_low``/``_high`` (68.3 % chi-square interval), all in ``unit``."""
+    window = _parse_window(opts["drift_reference"])
+    per_file: list[dict[str, MetricsResult]] = []
+    names: list[str] | None = None
+    for file in files:
+        rec = load_recording(
+            file,
+            text=text_options(
+                opts["t_names"], opts["t_rate"], opts["t_bad"], opts["t_delim"], opts["t_dec"]
+            ),
+            topic=opts["topic"],
+            time=opts["time"],
+            time_unit=opts["time_unit"],
+            signal=opts["signal"],
+            temps=opts["temps"],
+            signal_unit=opts["signal_unit"],
+            temp_unit=opts["temp_unit"],
+            temp_conversion=opts["temp_conversion"],
+            keep_other=False,
+        )
+        these = split_names(opts["signal"]) or [rec.signals[0]]
+        if names is None:
+            names = these
+        elif these != names:
+            raise ThermocalInputError(
+                f"{file}: signals {these} differ from the first run's {names}"
+            )
+        if len(these) > 1 and (opts["latitude"] is not None or opts["axis"] is not None):
+            raise ThermocalInputError(
+                "earth-rate removal (--latitude/--axis) takes one signal at a time"
+            )
+        per_file.append(
+            {
+                n: _metrics.compute_metrics(
+                    rec,
+                    n,
+                    opts["average"],
+                    opts["latitude"],
+                    opts["axis"],
+                    split_names(opts["temps"]),
+                    rate_threshold_c_per_min=opts["hold_rate"],
+                    min_hold_s=opts["min_hold"],
+                    drift_reference_s=window,
+                    drift_bias=opts["drift_bias"],
+                )
+                for n in these
+            }
+        )
+    assert names is not None
+    labels = [str(f) for f in files]
+    reps = {n: _metrics.run_repeatability([r[n] for r in per_file], labels) for n in names}
+
+    def one(rep: "_metrics.RunRepeatability") -> dict[str, Any]:
+        return dict(
+            jsonable(
+                {
+                    "runs": [
+                        {"file": f, **metrics_json(r)}
+                        for f, r in zip(rep.files, rep.runs, strict=True)
+                    ],
+                    "n_runs": len(rep.runs),
+                    "bias": rep.bias_mean,
+                    "bias_stability": max(r.bias_stability for r in rep.runs),
+                    "averaging_s": rep.runs[0].averaging_s,
+                    "bias_repeatability": rep.bias_repeatability,
+                    "bias_repeatability_low": rep.bias_repeatability_low,
+                    "bias_repeatability_high": rep.bias_repeatability_high,
+                    "bias_repeatability_kind": "turn-on to turn-on (sample standard deviation "
+                    "of the run biases)",
+                    "confidence": rep.confidence,
+                    "unit": rep.unit,
+                }
+            )
+        )
+
+    def human() -> None:
+        for name, rep in reps.items():
+            t = _rich_table.Table(title=f"{name} — {len(rep.runs)} power-ons [{rep.unit}]")
+            for col in ("run", "bias", f"bias stability ({rep.runs[0].averaging_s:g} s)"):
+                t.add_column(col, justify="right")
+            for f, r in zip(rep.files, rep.runs, strict=True):
+                t.add_row(f, fmt(r.bias, 6), fmt(r.bias_stability))
+            stdout.print(t)
+            stdout.print(
+                f"turn-on to turn-on bias repeatability: {fmt(rep.bias_repeatability)} "
+                f"{rep.unit} (68.3 % interval {fmt(rep.bias_repeatability_low)} … "
+                f"{fmt(rep.bias_repeatability_high)}); mean bias {fmt(rep.bias_mean, 6)} "
+                f"{rep.unit}"
+            )
+
+    if len(names) == 1:
+        emit(one(reps[names[0]]), bool(opts["as_json"]), human)
+    else:
+        emit({"channels": {n: one(r) for n, r in reps.items()}}, bool(opts["as_json"]), human)

@@ -1,0 +1,173 @@
+"""``thermocal noise FILE``: the IMU noise model for estimators (Kalibr's ``imu.yaml`` or
+JSON), from the Allan analysis of every axis (:mod:`thermocal.stability.noise_model`)."""
+
+import json
+from pathlib import Path
+from typing import TYPE_CHECKING, Annotated
+
+import typer
+
+from thermocal._lazy import LazyModule, prefetch
+from thermocal.cli.application import app
+from thermocal.cli.common import (
+    DecimalOpt,
+    DelimiterOpt,
+    FileArg,
+    NamesOpt,
+    OnBadLinesOpt,
+    RateOpt,
+    TimeOpt,
+    TimeUnitOpt,
+    TopicOpt,
+    fmt,
+    handle_errors,
+    jsonable,
+    load_recording,
+    split_names,
+    stdout,
+    text_options,
+)
+from thermocal.errors import ThermocalInputError
+
+if TYPE_CHECKING:
+    import rich.table as _rich_table
+
+    import thermocal.io as _io
+    import thermocal.metrics as _metrics
+    import thermocal.stability.noise_model as _nm
+else:
+    _rich_table = LazyModule("rich.table")
+    _io = LazyModule("thermocal.io")
+    _metrics = LazyModule("thermocal.metrics")
+    _nm = LazyModule("thermocal.stability.noise_model")
+
+
+def _triad(text: str | None, option: str) -> list[str]:
+    names = (split_names(text) or []) if text else []
+    if text is not None and len(names) != 3:
+        raise ThermocalInputError(f"{option} {text!r}: give three columns X,Y,Z")
+    return names
+
+
+@app.command("noise")
+@handle_errors
+def noise_cmd(
+    file: FileArg,
+    gyro: Annotated[str, typer.Option("--gyro", help="Gyro columns X,Y,Z.")],
+    output: Annotated[Path, typer.Option("-o", "--output", help="Output file.")],
+    accel: Annotated[
+        str | None, typer.Option("--accel", help="Accelerometer columns X,Y,Z.")
+    ] = None,
+    gyro_unit: Annotated[
+        str | None,
+        typer.Option("--gyro-unit", help="Unit of the gyro columns: deg/h, deg/s, rad/s."),
+    ] = None,
+    accel_unit: Annotated[
+        str | None,
+        typer.Option("--accel-unit", help="Unit of the accelerometer columns: mg, ug, g, m/s^2."),
+    ] = None,
+    out_format: Annotated[
+        str, typer.Option("--format", help="kalibr (imu.yaml) or json (every term of every axis).")
+    ] = "kalibr",
+    inflate: Annotated[
+        float,
+        typer.Option(
+            "--inflate", help="Multiply every Kalibr noise value by this (≥ 1; stated in the file)."
+        ),
+    ] = 1.0,
+    rostopic: Annotated[
+        str, typer.Option("--rostopic", help="Kalibr's rostopic of this IMU.")
+    ] = "/imu0",
+    confidence: Annotated[
+        float, typer.Option("--confidence", help="Confidence level of the intervals.")
+    ] = 0.6826894921370859,
+    time: TimeOpt = None,
+    time_unit: TimeUnitOpt = None,
+    t_names: NamesOpt = None,
+    topic: TopicOpt = None,
+    t_rate: RateOpt = None,
+    t_bad: OnBadLinesOpt = "error",
+    t_delim: DelimiterOpt = None,
+    t_dec: DecimalOpt = None,
+) -> None:
+    """IMU noise model for estimators: per axis the white-noise density (the −½ line of
+    the Allan deviation at τ = 1 s) and the random walk (+½ line at τ = 3 s, or the
+    least-squares fit), in continuous time; Kalibr's imu.yaml takes per sensor the largest
+    axis."""
+    prefetch("scipy.special", "scipy.linalg", "rich.table")
+    if out_format not in ("kalibr", "json"):
+        raise ThermocalInputError(f"--format {out_format!r}: use kalibr or json")
+    g_names = _triad(gyro, "--gyro")
+    a_names = _triad(accel, "--accel")
+    if out_format == "kalibr" and not a_names:
+        raise ThermocalInputError(
+            "--format kalibr: Kalibr's imu.yaml needs the accelerometer too; give --accel X,Y,Z "
+            "(or --format json for the gyro alone)"
+        )
+    _io.check_not_input(output, [file])
+    if output.is_dir():
+        raise ThermocalInputError(f"{output}: is a directory, expected a file name")
+    n_g, n_a = len(g_names), len(a_names)
+    unit_list = None
+    if gyro_unit is not None or accel_unit is not None:
+        if (gyro_unit is None) or (n_a and accel_unit is None):
+            raise ThermocalInputError(
+                "give both --gyro-unit and --accel-unit, or neither (units from the column "
+                "names or the file's metadata)"
+            )
+        unit_list = ",".join([gyro_unit] * n_g + [accel_unit or ""] * n_a)
+    rec = load_recording(
+        file,
+        text=text_options(t_names, t_rate, t_bad, t_delim, t_dec),
+        topic=topic,
+        time=time,
+        time_unit=time_unit,
+        signal=",".join(g_names + a_names),
+        signal_unit=unit_list,
+        keep_other=False,
+    )
+    axes = []
+    for name in g_names + a_names:
+        canonical, canon_unit = rec.signal(name)
+        unit, k = _metrics.data_unit_of(rec, name, canon_unit)
+        values = canonical if k == 1.0 else canonical / k
+        axes.append(
+            _nm.axis_noise(
+                values, rec.sample_interval_s, name=name,
+                sensor="gyro" if name in g_names else "accel", unit=unit,
+                segments=rec.segments(), time_s=rec.time_s, confidence=confidence,
+            )
+        )  # fmt: skip
+    model = _nm.noise_model(
+        axes, 1.0 / rec.sample_interval_s, inflate=inflate, rostopic=rostopic,
+        confidence=confidence,
+    )  # fmt: skip
+    for ax in axes:
+        for t in (ax.density, ax.walk):
+            if t.method == "bound":
+                import warnings
+
+                from thermocal.errors import ConditioningWarning
+
+                warnings.warn(
+                    f"{file} [{ax.name}]: {t.term.replace('_', ' ')}: {t.reason}",
+                    ConditioningWarning,
+                    stacklevel=1,
+                )
+    if out_format == "kalibr":
+        text = _nm.kalibr_yaml(model, file.name)
+    else:
+        text = json.dumps(jsonable(_nm.model_json(model, file.name)), allow_nan=False, indent=1)
+    with _io.atomic_write(output, "w") as fh:
+        fh.write(text + ("" if text.endswith("\n") else "\n"))
+
+    table = _rich_table.Table(title=f"{file} — IMU noise model (continuous time)")
+    for col in ("axis", "noise density", "random walk", "unit (density; walk)", "from"):
+        table.add_column(col)
+    for ax in axes:
+        table.add_row(
+            ax.name, fmt(ax.density.value), fmt(ax.walk.value),
+            f"{ax.density.unit}; {ax.walk.unit}", f"{ax.density.method}; {ax.walk.method}",
+        )  # fmt: skip
+    stdout.print(table)
+    stdout.print(f"{out_format} noise model written to {output} (per sensor the largest axis)")

@@ -1,0 +1,432 @@
+"""The noise model of an IMU for estimators (Kalibr's ``imu.yaml``), from Allan analysis.
+
+Pure maths and text: no file I/O.  The noise terms are those of
+:func:`thermocal.allan.noise_terms` (IEEE 952 slope lines, least-squares fit); this module
+only chooses, converts and states them.
+
+Continuous-time model of one axis (Kalibr's IMU noise model, J. Rehder et al., *Extending
+kalibr*, ICRA 2016; the Kalibr wiki "IMU Noise Model")::
+
+    ω̃(t) = ω(t) + b(t) + n(t),   E[n(t) n(t')] = σ_n² δ(t − t'),   ḃ(t) = σ_b w(t)
+
+* ``σ_n`` noise density [rad/s/√Hz] (gyro) or [m/s²/√Hz] (accelerometer) is the white-noise
+  coefficient N of the Allan variance ``σ²(τ) = N²/τ``: the −½ slope line read at τ = 1 s
+  (IEEE 952-1997 C.3; N in (rad/s)·√s = rad/s/√Hz).
+* ``σ_b`` random walk [rad/s²/√Hz] or [m/s³/√Hz] is the rate random walk coefficient K of
+  ``σ²(τ) = K² τ / 3``: the +½ slope line read at τ = 3 s (K in (rad/s)/√s = rad/s²/√Hz).
+
+The density is taken from the slope line where the curve has that slope, else from the
+weighted least-squares fit (IEEE 952 C.2); the random walk from the fit when the noise model
+fits the curve well (the +½ stretch of a real record still holds white noise at its short
+end, which biases the line up), else from the slope line; else (only the random walk,
+which a short record may not reach) as the upper bound the curve allows,
+``K ≤ min_τ σ_high(τ) √(3/τ)`` (every term lies below the curve), flagged ``poor``.
+Kalibr wants one number per sensor: the largest over the axes.
+
+Discrete time at sample interval Δt (Kalibr wiki): white noise ``σ_d = σ_c / √Δt``;
+random walk ``σ_d = σ_c · √Δt``.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import dataclass
+from typing import Any, Final, Literal
+
+import numpy as np
+import numpy.typing as npt
+
+from thermocal import units
+from thermocal.allan import (
+    AllanResult,
+    NoiseTerm,
+    NoiseTerms,
+    noise_terms,
+    overlapping_adev,
+    term_units,
+)
+from thermocal.errors import ThermocalInputError
+
+Sensor = Literal["gyro", "accel"]
+
+SI_UNIT: Final[dict[str, str]] = {"gyro": "rad/s", "accel": "m/s^2"}
+"""The SI unit each sensor's data are converted to for Kalibr."""
+
+KALIBR_KEYS: Final = (
+    "accelerometer_noise_density",
+    "accelerometer_random_walk",
+    "gyroscope_noise_density",
+    "gyroscope_random_walk",
+    "update_rate",
+    "rostopic",
+)
+"""The keys of Kalibr's ``imu.yaml``."""
+
+_DENSITY_UNIT: Final = {"gyro": "rad/s/sqrt(Hz)", "accel": "m/s^2/sqrt(Hz)"}
+_WALK_UNIT: Final = {"gyro": "rad/s^2/sqrt(Hz)", "accel": "m/s^3/sqrt(Hz)"}
+_TERM_OF: Final = {"density": "angle_random_walk", "walk": "rate_random_walk"}
+_TERM_WORDS: Final = {
+    ("gyro", "density"): "angle random walk N (white rate noise)",
+    ("gyro", "walk"): "rate random walk K",
+    ("accel", "density"): "velocity random walk N (white acceleration noise)",
+    ("accel", "walk"): "acceleration random walk K",
+}
+_READ_AT: Final = {"density": 1.0, "walk": 3.0}
+_SLOPE: Final = {"density": "−½", "walk": "+½"}
+
+
+@dataclass(frozen=True)
+class ContinuousTerm:
+    """One continuous-time coefficient of one axis in SI units.
+
+    ``value``/``low``/``high`` [``unit``]; ``method`` ``slope`` (the IEEE 952 slope line),
+    ``fit`` (weighted least squares) or ``bound`` (upper bound from the curve: the record
+    does not show the term); ``tau_s`` where the slope line touches the curve (slope), the
+    τ of the bounding point (bound), None (fit); ``read_at_tau_s`` where the line is read
+    (1 s for white noise, 3 s for random walk); ``quality`` ``good|rough|poor``.
+    """
+
+    value: float
+    low: float | None
+    high: float | None
+    unit: str
+    term: str
+    method: str
+    tau_s: float | None
+    read_at_tau_s: float
+    quality: str
+    reason: str | None
+
+
+@dataclass(frozen=True, eq=False)
+class AxisNoise:
+    """The Allan analysis of one axis and its two Kalibr coefficients.
+
+    ``unit`` the data's own unit (of ``allan`` and ``terms``); ``density`` the white-noise
+    density, ``walk`` the random-walk strength, both in SI (:data:`SI_UNIT` per √Hz).
+    """
+
+    name: str
+    sensor: Sensor
+    unit: str
+    allan: AllanResult
+    terms: NoiseTerms
+    density: ContinuousTerm
+    walk: ContinuousTerm
+
+
+@dataclass(frozen=True, eq=False)
+class NoiseModel:
+    """The IMU noise model: every axis, and per sensor the largest axis (Kalibr).
+
+    ``update_rate_hz`` 1/τ0; ``inflate`` the factor every Kalibr value is multiplied by
+    (1: none); ``chosen`` maps a Kalibr key to the axis it came from.
+    """
+
+    axes: tuple[AxisNoise, ...]
+    update_rate_hz: float
+    inflate: float
+    rostopic: str
+    confidence: float
+    chosen: dict[str, AxisNoise]
+
+    def kalibr(self) -> dict[str, float | str]:
+        """Kalibr's ``imu.yaml`` values (continuous time, inflated), by key."""
+        out: dict[str, float | str] = {}
+        for key, ax in self.chosen.items():
+            out[key] = _term_for(key, ax).value * self.inflate
+        out["update_rate"] = self.update_rate_hz
+        out["rostopic"] = self.rostopic
+        return {k: out[k] for k in KALIBR_KEYS if k in out}
+
+
+def _term_for(key: str, ax: AxisNoise) -> ContinuousTerm:
+    return ax.density if key.endswith("noise_density") else ax.walk
+
+
+def _native(term: NoiseTerm, j: int, unit: str) -> tuple[float | None, float | None, float | None]:
+    """A reported term back in the data unit's own coefficient (unit·s^k, τ in s)."""
+    scale, specs = term_units(unit)
+    conv = scale * specs[j][0]
+
+    def back(v: float | None) -> float | None:
+        return None if v is None else v / conv
+
+    return back(term.value), back(term.low), back(term.high)
+
+
+def _choose(
+    kind: str, sensor: Sensor, unit: str, res: AllanResult, terms: NoiseTerms
+) -> ContinuousTerm:
+    """The slope-line term, else the fitted one, else (random walk) the curve's bound."""
+    name = _TERM_OF[kind]
+    j = ("quantization", "angle_random_walk", "bias_instability", "rate_random_walk").index(name)
+    si = float(units.convert(1.0, unit, SI_UNIT[sensor]))
+    out_unit = _DENSITY_UNIT[sensor] if kind == "density" else _WALK_UNIT[sensor]
+    order = [("slope", terms.slope.terms()[name]), ("fit", terms.fit.terms()[name])]
+    if kind == "walk" and terms.quality is not None and terms.quality.quality == "good":
+        # the +½ stretch of a real record still holds some white noise at its short end,
+        # which biases the line up (+4 % on simulated records); a good fit separates them
+        order.reverse()
+    for method, term in order:
+        if term.value is None:
+            continue
+        v, lo, hi = _native(term, j, unit)
+        assert v is not None
+        return ContinuousTerm(
+            value=v * si,
+            low=None if lo is None else lo * si,
+            high=None if hi is None else hi * si,
+            unit=out_unit,
+            term=name,
+            method=method,
+            tau_s=term.tau_s,
+            read_at_tau_s=_READ_AT[kind],
+            quality=term.quality or "good",
+            reason=term.reason,
+        )
+    # not in the data: the largest coefficient the curve allows (every term lies below it)
+    ok = np.isfinite(res.adev_high) & (res.adev > 0)
+    if not ok.any():
+        raise ThermocalInputError(
+            f"no Allan deviation point above zero: no {name.replace('_', ' ')} can be read"
+        )
+    tau, high = res.tau_s[ok], res.adev_high[ok]
+    power = 0.5 if kind == "density" else -0.5  # N ≤ σ√τ, K ≤ σ√(3/τ)
+    cand = high * tau**power * (1.0 if kind == "density" else math.sqrt(3.0))
+    k = int(np.argmin(cand))
+    why = (terms.slope.terms()[name].reason or "") + "; " + (terms.fit.terms()[name].reason or "")
+    return ContinuousTerm(
+        value=float(cand[k]) * si,
+        low=0.0,
+        high=float(cand[k]) * si,
+        unit=out_unit,
+        term=name,
+        method="bound",
+        tau_s=float(tau[k]),
+        read_at_tau_s=_READ_AT[kind],
+        quality="poor",
+        reason=(
+            f"the record does not show this term ({why.strip('; ')}); the value is the "
+            f"largest the curve allows, the {_SLOPE[kind]} line through the upper bound at "
+            f"τ = {tau[k]:.4g} s: a longer record would give the term itself"
+        ),
+    )
+
+
+def axis_noise(
+    values: npt.ArrayLike,
+    tau0_s: float,
+    *,
+    name: str,
+    sensor: Sensor,
+    unit: str,
+    segments: list[slice] | None = None,
+    time_s: npt.ArrayLike | None = None,
+    confidence: float = 0.6826894921370859,
+    taus: Any = "octave",
+) -> AxisNoise:
+    """Allan analysis (:func:`thermocal.allan.overlapping_adev`, :func:`noise_terms`) of one
+    axis in the data's unit ``unit`` and its continuous-time density and random walk in SI.
+    """
+    u = units.normalize_signal_unit(unit)
+    kind_units = units.RATE_UNITS if sensor == "gyro" else units.ACCEL_UNITS
+    if u not in kind_units:
+        raise ThermocalInputError(
+            f"{name}: a {'gyro' if sensor == 'gyro' else 'accelerometer'} column in {unit!r}; "
+            f"the noise model needs one of {', '.join(kind_units)} "
+            f"(--{'gyro' if sensor == 'gyro' else 'accel'}-unit)"
+        )
+    res = overlapping_adev(
+        values, tau0_s, taus, time_s=time_s, segments=segments, unit=u, confidence=confidence
+    )
+    terms = noise_terms(res)
+    return AxisNoise(
+        name=name,
+        sensor=sensor,
+        unit=u,
+        allan=res,
+        terms=terms,
+        density=_choose("density", sensor, u, res, terms),
+        walk=_choose("walk", sensor, u, res, terms),
+    )
+
+
+def noise_model(
+    axes: list[AxisNoise],
+    update_rate_hz: float,
+    *,
+    inflate: float = 1.0,
+    rostopic: str = "/imu0",
+    confidence: float = 0.6826894921370859,
+) -> NoiseModel:
+    """Per sensor the largest density and the largest random walk over its axes."""
+    if not (math.isfinite(inflate) and inflate >= 1.0):
+        raise ThermocalInputError(f"--inflate {inflate!r}: give a factor ≥ 1 (1: none)")
+    chosen: dict[str, AxisNoise] = {}
+    for sensor, prefix in (("gyro", "gyroscope"), ("accel", "accelerometer")):
+        mine = [a for a in axes if a.sensor == sensor]
+        if not mine:
+            continue
+        chosen[f"{prefix}_noise_density"] = max(mine, key=lambda a: a.density.value)
+        chosen[f"{prefix}_random_walk"] = max(mine, key=lambda a: a.walk.value)
+    return NoiseModel(tuple(axes), update_rate_hz, inflate, rostopic, confidence, chosen)
+
+
+def _yaml_float(x: float) -> str:
+    """A float YAML 1.1 (PyYAML) reads as a float: a mantissa with a dot, signed exponent."""
+    return f"{x:.6e}"
+
+
+def kalibr_yaml(model: NoiseModel, source: str) -> str:
+    """Kalibr's ``imu.yaml`` text with a comment block per key (term, τ, method, discrete
+    conversion, the axes compared)."""
+    dt = 1.0 / model.update_rate_hz
+    lines = [
+        f"# IMU noise model for Kalibr, written by thermocal noise from {source}",
+        "# Continuous-time values (Kalibr's convention). Allan analysis: overlapping Allan",
+        "# deviation (NIST SP 1065), noise terms by IEEE 952-1997 C.3 slope lines, else the",
+        "# weighted least-squares fit (C.2). Kalibr takes one number per sensor: each value",
+        "# below is the LARGEST over that sensor's axes.",
+    ]
+    if model.inflate != 1.0:
+        lines.append(
+            f"# Every noise value below is INFLATED ×{model.inflate:g} (--inflate) over the "
+            "measured one, for unmodelled effects (vibration, temperature)."
+        )
+    lines.append("")
+    values = model.kalibr()
+    for key in KALIBR_KEYS:
+        if key not in values:
+            continue
+        if key in model.chosen:
+            ax = model.chosen[key]
+            t = _term_for(key, ax)
+            white = key.endswith("noise_density")
+            words = _TERM_WORDS[(ax.sensor, "density" if white else "walk")]
+            if t.method == "slope":
+                how = (
+                    f"the {_SLOPE['density' if white else 'walk']} slope line of the ADEV "
+                    f"(touching the curve at τ = {t.tau_s:.4g} s) read at τ = "
+                    f"{t.read_at_tau_s:g} s"
+                )
+            elif t.method == "fit":
+                fin = ax.allan.tau_s[np.isfinite(ax.allan.adev) & (ax.allan.adev > 0)]
+                how = (
+                    "the weighted least-squares fit of the Allan variance over τ = "
+                    f"{fin[0]:.4g} … {fin[-1]:.4g} s (its "
+                    f"{_SLOPE['density' if white else 'walk']} line at τ = {t.read_at_tau_s:g} s)"
+                )
+            else:
+                how = f"an UPPER BOUND: {t.reason}"
+            others = ", ".join(
+                f"{a.name} {_yaml_float(_term_for(key, a).value)}"
+                for a in model.axes
+                if a.sensor == ax.sensor
+            )
+            lines.append(f"# {key} [{t.unit}]: {words} of axis {ax.name}, from {how}.")
+            lines.append(f"#   quality {t.quality}; axes: {others}.")
+            if t.low is not None and t.high is not None:
+                lines.append(
+                    f"#   {model.confidence * 100:.1f} % interval of {ax.name}: "
+                    f"{_yaml_float(t.low)} … {_yaml_float(t.high)} (not inflated)."
+                )
+            v = float(values[key])
+            if white:
+                lines.append(
+                    f"#   discrete time at Δt = {dt:.6g} s: σ_d = σ_c / √Δt = "
+                    f"{_yaml_float(v / math.sqrt(dt))}"
+                )
+            else:
+                lines.append(
+                    f"#   discrete time at Δt = {dt:.6g} s: σ_d = σ_c · √Δt = "
+                    f"{_yaml_float(v * math.sqrt(dt))}"
+                )
+            lines.append(f"{key}: {_yaml_float(v)}")
+        elif key == "update_rate":
+            lines.append("# update_rate [Hz]: 1 / the recording's sample interval.")
+            lines.append(f"{key}: {float(model.update_rate_hz)!r}")
+        else:
+            lines.append("# rostopic: the ROS topic of this IMU in your bag (--rostopic).")
+            lines.append(f"{key}: {json.dumps(model.rostopic)}")
+        lines.append("")
+    return "\n".join(lines)
+
+
+def _term_json(t: NoiseTerm, method: str) -> dict[str, Any]:
+    return {
+        "value": t.value,
+        "unit": t.unit,
+        "low": t.low,
+        "high": t.high,
+        "tau_s": t.tau_s,
+        "method": method,
+        "quality": None if t.value is None else (t.quality or "good"),
+        "reason": t.reason,
+        "label": t.label,
+    }
+
+
+def _best(slope: NoiseTerm, fit: NoiseTerm) -> dict[str, Any]:
+    """The slope reading where it exists, else the fitted term."""
+    return _term_json(slope, "slope") if slope.value is not None else _term_json(fit, "fit")
+
+
+def _continuous_json(t: ContinuousTerm) -> dict[str, Any]:
+    return {
+        "value": t.value,
+        "low": t.low,
+        "high": t.high,
+        "unit": t.unit,
+        "term": t.term,
+        "method": t.method,
+        "tau_s": t.tau_s,
+        "read_at_tau_s": t.read_at_tau_s,
+        "quality": t.quality,
+        "reason": t.reason,
+    }
+
+
+def model_json(model: NoiseModel, source: str) -> dict[str, Any]:
+    """The JSON noise model: ``kalibr`` (the values and the axis each came from), and per
+    axis ``terms`` (every IEEE 952 term in the data's unit: the slope reading where it
+    exists, else the fit; ``value``, ``unit``, ``low``, ``high``, ``tau_s``, ``method``,
+    ``quality``, ``reason``), ``terms_fit`` (all fitted terms), ``noise_density`` and
+    ``random_walk`` (continuous time, SI)."""
+    axes: dict[str, Any] = {}
+    for ax in model.axes:
+        slope, fit = ax.terms.slope.terms(), ax.terms.fit.terms()
+        axes[ax.name] = {
+            "sensor": ax.sensor,
+            "unit": ax.unit,
+            "terms": {k: _best(slope[k], fit[k]) for k in slope},
+            "terms_fit": {k: _term_json(fit[k], "fit") for k in fit},
+            "fit_quality": ax.terms.quality.to_dict() if ax.terms.quality else None,
+            "noise_density": _continuous_json(ax.density),
+            "random_walk": _continuous_json(ax.walk),
+        }
+    return {
+        "source": source,
+        "kalibr": model.kalibr(),
+        "kalibr_axis": {k: a.name for k, a in model.chosen.items()},
+        "kalibr_rule": "per sensor the largest value over its axes",
+        "inflate": model.inflate,
+        "update_rate_hz": model.update_rate_hz,
+        "confidence": model.confidence,
+        "discrete_time": "white noise σ_d = σ_c / √Δt; random walk σ_d = σ_c · √Δt",
+        "axes": axes,
+    }
+
+
+__all__ = [
+    "KALIBR_KEYS",
+    "SI_UNIT",
+    "AxisNoise",
+    "ContinuousTerm",
+    "NoiseModel",
+    "axis_noise",
+    "kalibr_yaml",
+    "model_json",
+    "noise_model",
+]
