@@ -1308,6 +1308,11 @@ def dataflash_table(
             + (", ".join(sorted(log.names_seen - {"FMT", "FMTU", "UNIT", "MULT"})) or "none")
         )
     df = pd.DataFrame(rows).astype(np.float64)
+    if "TimeUS" not in df.columns:  # a damaged FMT message renames the fields
+        raise FileFormatError(
+            f"{path}: the {source} messages have no TimeUS field (their format definition is "
+            "damaged); fields: " + names_list([str(c) for c in df.columns])
+        )
     known = dict(ARDUPILOT_UNITS.get(source, {}))
     if source == "TCLR" and "SType" in df.columns:  # X, Y, Z: accel (0) or gyro (1) means
         kinds = set(df["SType"].astype(int).tolist())

@@ -611,7 +611,7 @@ def _judge_channel(
         [r.time_s for r in runs],
         [r.temps_c for r in runs],
         names,
-        signals=[r.target() for r in runs],
+        signals=[r.signal for r in runs if r.signal is not None],  # no copy: a shift is no motion
         kind=kind,
         name=sig_name,
         temperature_unit="°C" if runs[0].temperature_unit == "degC" else "counts",

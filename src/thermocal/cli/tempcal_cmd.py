@@ -115,6 +115,7 @@ def px4_tempcal_cmd(
         if name in OFFSET_TOPICS:  # barometers and magnetometers: TC_B / TC_M
             df, _info = read_log_table(log, f"{name}.{inst}")
             fields = OFFSET_TOPICS[name][1]
+            _require_fields(df, ["timestamp", "temperature", *fields], log, f"{name}.{inst}")
             ids = df["device_id"].to_numpy() if "device_id" in df.columns else np.zeros(1)
             ofit = fit_offset_sensor(
                 df["timestamp"].to_numpy() * 1e-6, df["temperature"].to_numpy(),
@@ -286,6 +287,7 @@ def ardupilot_tempcal_cmd(
                 f"{log}: IMU.{inst} has no temperature field (T or Temp); it has: "
                 + ", ".join(map(str, df.columns))
             )
+        _require_fields(df, [f"{p}{a}" for p in ("Gyr", "Acc") for a in "XYZ"], log, f"IMU.{inst}")
         time_s = df["TimeUS"].to_numpy() * 1e-6
         temp_c = df[tcol].to_numpy()
         if not np.isfinite(temp_c).any() or np.all(temp_c[np.isfinite(temp_c)] == 0):
@@ -413,3 +415,14 @@ def ardupilot_tempcal_cmd(
         stdout.print(f"parameters: [bold]{parm}[/bold]", markup=True)
 
     emit(out, as_json, human)
+
+
+def _require_fields(df: Any, names: list[str], log: Path, where: str) -> None:
+    """Refuse (exit 2) a topic or message missing fields the calibration reads (a damaged
+    format definition renames them), naming them."""
+    missing = [n for n in names if n not in df.columns]
+    if missing:
+        raise ThermocalInputError(
+            f"{log}: {where} lacks the field(s) {', '.join(missing)} (a damaged format "
+            "definition?); it has: " + ", ".join(map(str, list(df.columns)[:20]))
+        )
