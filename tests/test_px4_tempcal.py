@@ -194,3 +194,31 @@ def test_compensate_a_px4_log(
     d = pd.read_parquet(out)
     assert len(d) == 20000 and {"x_model", "x_comp", "device_id"} <= set(d.columns)
     np.testing.assert_allclose(d["x_comp"], d["x"] - d["x_model"], rtol=0, atol=1e-12)
+
+
+def test_the_holdout_is_held_out(sweep: dict) -> None:
+    """The hold-out rms is a cubic fitted to the even 0.5 °C bins judged on the odd ones,
+    recomputed here with numpy alone (np.polyfit) from the log's samples: fitting on every
+    bin (the odd ones included) would give a smaller, in-sample figure."""
+    from thermocal.io import read_recording
+
+    log = sweep["dir"].parent / "sweep.ulg"
+    rec = read_recording(log, topic="sensor_gyro.0")
+    temp = rec.column("temperature")
+    lo = math.floor(float(temp.min()) / 0.5) * 0.5
+    idx = np.floor((temp - lo) / 0.5).astype(int)
+    bins = np.unique(idx)
+    t_med = np.array([np.median(temp[idx == b]) for b in bins])
+    to_deg_h = 180.0 / math.pi * 3600.0
+    got = sweep["summary"]["sensors"]["sensor_gyro.0"]["holdout_rms"]
+    assert sweep["summary"]["sensors"]["sensor_gyro.0"]["holdout_rms_unit"] == "deg/h"
+    for axis in "xyz":
+        v = rec.column(axis) * to_deg_h
+        v_med = np.array([np.median(v[idx == b]) for b in bins])
+        even, odd = slice(0, None, 2), slice(1, None, 2)
+        held = np.polyval(np.polyfit(t_med[even], v_med[even], 3), t_med[odd])
+        want = float(np.sqrt(np.mean((v_med[odd] - held) ** 2)))
+        insample = np.polyval(np.polyfit(t_med, v_med, 3), t_med[odd])
+        leak = float(np.sqrt(np.mean((v_med[odd] - insample) ** 2)))
+        assert want != pytest.approx(leak, rel=1e-3)  # the two are told apart here
+        assert got[axis] == pytest.approx(want, rel=1e-6), axis
