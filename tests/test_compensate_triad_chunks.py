@@ -111,7 +111,10 @@ def test_chunked_triad_compensation_equals_the_whole_file(
     assert len(calls) == 2 * math.ceil(n / chunk) and max(calls) == chunk
     got = _columns(out)
     for c, v in given.items():  # every input column kept as it was
-        np.testing.assert_array_equal(got[c], v, err_msg=c)
+        if suffix == ".parquet":
+            np.testing.assert_array_equal(got[c], v, err_msg=c)
+        else:  # CSV text: pandas < 2.2 writes some values with fewer digits (floor check)
+            np.testing.assert_allclose(got[c], v, rtol=1e-12, atol=0.0, err_msg=c)
     for c, v in expected.items():
         np.testing.assert_allclose(got[c], v, rtol=1e-12, atol=0.0, err_msg=c)
         if suffix == ".parquet":

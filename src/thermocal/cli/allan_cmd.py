@@ -354,8 +354,10 @@ def allan_cmd(
             unit=unit,
             confidence=confidence,
             # the phase is accumulated in the column's own buffer (no memory per sample):
-            # the column is not used again unless the channel is named twice
-            overwrite=names.count(name) == 1,
+            # the column is not used again unless the channel is named twice or the
+            # dynamic ADEV reads the rate after it (it did, on the floor's numpy/pyarrow,
+            # where the buffer is writeable: windows of phase, found by the floor check)
+            overwrite=names.count(name) == 1 and dynamic is None,
         )
         noise_c = _allan.noise_terms(res_c)
         where = f"{file}" + (f" [{name}]" if len(names) > 1 else "")
