@@ -63,8 +63,11 @@ def setup(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, Path]:
 
 def _start_compensate(model: Path, src: Path, out: Path) -> subprocess.Popen[bytes]:
     return subprocess.Popen(
+        # small chunks: the temporary grows chunk by chunk, so the test sees it part-written
+        # whatever the speed of the machine and the Parquet writer's buffering (the floor's
+        # pyarrow wrote the first 50 kB at the end of a 500 000-row chunk: a flaky test)
         _cli("compensate", str(model), str(src), "-o", str(out), "--signal-unit", "deg/h",
-             "--temp-unit", "degC", "--time-unit", "s"),
+             "--temp-unit", "degC", "--time-unit", "s", "--chunk-rows", "20000"),
         stdout=subprocess.PIPE, stderr=subprocess.PIPE,
     )  # fmt: skip
 
@@ -77,7 +80,8 @@ def _wait_for_partial(out: Path, proc: subprocess.Popen[bytes], timeout_s: float
         if parts and parts[0].stat().st_size > 50_000:
             return parts[0]
         if proc.poll() is not None:
-            pytest.fail(f"the writer ended before it was killed: {proc.stderr.read()!r}")  # type: ignore[union-attr]
+            _, err = proc.communicate()  # closes the pipes (no ResourceWarning later)
+            pytest.fail(f"the writer ended before it was killed: {err!r}")
         time.sleep(0.02)
     proc.kill()
     pytest.fail("no temporary appeared")
