@@ -97,6 +97,36 @@ def _autocovariance(x: FloatArray) -> FloatArray:
     return np.asarray(acov, dtype=np.float64)
 
 
+DIRECT_LAGS = 64
+"""Lags summed directly before the FFT of the whole series is needed (Sokal's window is
+usually a few lags: white or weakly correlated residuals)."""
+
+
+def _lagged_sums(pieces: Sequence[FloatArray], lags: int) -> FloatArray:
+    """Σ_t x_t x_{t+k} for k = 0 … ``lags`` of each centred piece, pooled (lags never
+    cross from one piece into the next): the FFT's numbers, by direct sums."""
+    acc = np.zeros(lags + 1)
+    for p in pieces:
+        if p.size < 2:
+            continue
+        x = p - p.mean()
+        for k in range(min(lags, x.size - 1) + 1):
+            acc[k] += float(np.dot(x[: x.size - k], x[k:]))
+    return acc
+
+
+def _window_within(acc: FloatArray, longest: int, c: float) -> bool:
+    """Whether Sokal's window M ≥ c τ(M) is reached within the lags of ``acc`` (then the
+    longer lags do not change the result)."""
+    if acc[0] <= 0.0:
+        return True
+    rho = acc / acc[0]
+    top = min(acc.size - 1, max(1, longest // 4))
+    cums = 1.0 + 2.0 * np.cumsum(rho[1 : top + 1])
+    ms = np.arange(1, top + 1)
+    return bool(np.any(ms >= c * cums))
+
+
 def residual_correlation(
     series: Sequence[FloatArray], *, data_rms: float | None = None, c: float = SOKAL_C
 ) -> ResidualCorrelation:
@@ -118,21 +148,24 @@ def residual_correlation(
     longest = max((p.size for p in pieces), default=0)
     if longest < 3:
         return ResidualCorrelation(1.0, n_total, float(n_total), 0, 0.0, False)
-    acc = np.zeros(longest)
-    used = 0
-    for p in pieces:
-        if p.size < 2:
-            continue
-        acov = _autocovariance(p - p.mean()) * p.size  # Σ lagged products
-        acc[: p.size] += acov
-        used += p.size
+    used = int(sum(p.size for p in pieces if p.size >= 2))
+    # the window is usually a few lags: their sums directly (no FFT of 2^22 points, no
+    # 100 MB of transforms); the whole autocovariance only when the window is longer
+    acc = _lagged_sums(pieces, min(DIRECT_LAGS, longest - 1))
+    if not _window_within(acc, longest, c):
+        acc = np.zeros(longest)
+        for p in pieces:
+            if p.size < 2:
+                continue
+            acov = _autocovariance(p - p.mean()) * p.size  # Σ lagged products
+            acc[: p.size] += acov
     exact = data_rms is not None and math.sqrt(acc[0] / max(used, 1)) <= 1e-9 * data_rms
     if acc[0] <= 0.0 or exact:
         return ResidualCorrelation(1.0, n_total, float(n_total), 0, 0.0, True)
     rho = acc / acc[0]
     # windows up to a quarter of the longest run: beyond, the estimated autocorrelation
     # of a slow component (a step, a drift) decays and turns negative by construction
-    top = max(1, longest // 4)
+    top = min(acc.size - 1, max(1, longest // 4))  # the lags summed (all, or the direct ones)
     cums = 1.0 + 2.0 * np.cumsum(rho[1 : top + 1])  # τ(M) for M = 1, 2, …, top
     ms = np.arange(1, top + 1)
     ok = np.flatnonzero(ms >= c * cums)
