@@ -30,9 +30,12 @@ column's own unit.  A model and data of different kinds (°/h against mg) is a
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import json
 import math
+import signal
+import threading
 import warnings
 from collections.abc import Callable, Iterator, Sequence
 from concurrent.futures import Future, ThreadPoolExecutor
@@ -126,6 +129,38 @@ COMP_SUFFIX = "_comp"
 
 
 # --- files ---------------------------------------------------------------------------------
+
+
+@dataclass
+class _CtrlC:
+    seen: bool = False
+
+
+@contextlib.contextmanager
+def _ctrl_c_noted() -> Iterator[_CtrlC]:
+    """Note a Ctrl-C (SIGINT) while pandas' C parser reads a CSV file: it turns the
+    KeyboardInterrupt raised inside its ``read`` into a ParserError ("Calling read(nbytes)
+    on source failed"), which would read as a damaged file.  The handler notes it and
+    raises KeyboardInterrupt as Python's default does; installed only where a handler can
+    be (the main thread) and where SIGINT is not ignored (fleet workers)."""
+    note = _CtrlC()
+    if threading.current_thread() is not threading.main_thread():
+        yield note
+        return
+    before = signal.getsignal(signal.SIGINT)
+    if before is not signal.default_int_handler:
+        yield note
+        return
+
+    def handler(signum: int, frame: Any) -> None:
+        note.seen = True
+        signal.default_int_handler(signum, frame)
+
+    signal.signal(signal.SIGINT, handler)
+    try:
+        yield note
+    finally:
+        signal.signal(signal.SIGINT, before)
 
 
 @dataclass(frozen=True)
@@ -299,11 +334,13 @@ def _iter_chunks(
             **opts,
         )
         try:
-            with reader:
+            with reader, _ctrl_c_noted() as ctrl_c:
                 for df in reader:
                     df.columns = [str(c).strip() for c in df.columns]
                     yield df
         except (pd.errors.ParserError, UnicodeDecodeError) as exc:
+            if ctrl_c.seen:  # Ctrl-C inside pandas' read: the C parser reports a read failure
+                raise KeyboardInterrupt from None
             msg = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
             raise FileFormatError(f"{path}: not a readable CSV file ({msg})") from None
 

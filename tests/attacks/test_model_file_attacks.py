@@ -585,3 +585,30 @@ def test_any_edit_ends_in_exit_0_or_2(
     if code == 2:
         assert err.strip().splitlines()[-1].startswith("error: "), err
     assert _digest(rec) == before
+
+
+@pytest.mark.parametrize("content", ["[" * 100_000 + "]" * 100_000, '{"r": ' + "9" * 5000 + "}"])
+def test_a_hostile_validation_file_is_exit_2(tmp_path: Path, content: str) -> None:
+    """``report --validation`` reads another JSON file than the model: deep nesting or a
+    5000-digit integer there ended in exit 1 (RecursionError, ValueError)."""
+    from typer.testing import CliRunner
+
+    from thermocal.cli import app
+
+    bad = tmp_path / "validation.json"
+    bad.write_text(content)
+    rec = tmp_path / "rec.csv"
+    rec.write_text("time,gyro,T1\n" + "".join(f"{i},{0.01 * i},{20 + i}\n" for i in range(50)))
+    model = tmp_path / "m.json"
+    res = CliRunner().invoke(
+        app, ["fit", str(rec), "--model", "poly", "--order", "1", "--signal", "gyro",
+              "--temps", "T1", "-o", str(model), "--allow-narrow"],
+    )  # fmt: skip
+    assert res.exit_code == 0, res.output
+    res = CliRunner().invoke(
+        app, ["report", "--model", str(model), "--validation", str(bad), "--recording",
+              str(rec), "-o", str(tmp_path / "r.html")],
+    )  # fmt: skip
+    assert res.exit_code == 2, res.output
+    assert "validation.json" in res.output and "Traceback" not in res.output
+    assert not (tmp_path / "r.html").exists()

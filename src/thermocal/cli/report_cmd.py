@@ -62,8 +62,10 @@ def read_validation_json(path: Path, *, channels: bool = False) -> dict[str, Any
         obj = json.loads(path.read_text(encoding="utf-8"))
     except FileNotFoundError:
         raise ThermocalInputError(f"{path}: no such validation file") from None
-    except (json.JSONDecodeError, UnicodeDecodeError) as exc:
+    except (ValueError, UnicodeDecodeError) as exc:  # JSONDecodeError, a 5000-digit integer
         raise FileFormatError(f"{path}: not a JSON validation result ({exc})") from None
+    except RecursionError:
+        raise FileFormatError(f"{path}: not a validation result (nested too deeply)") from None
     if channels and isinstance(obj, dict) and isinstance(obj.get("channels"), dict):
         return obj
     if not isinstance(obj, dict) or "bias_stability_before" not in obj:
