@@ -64,7 +64,7 @@ def library_loop(cfg: Path, out: Path) -> float:
 import time, tomllib
 from pathlib import Path
 from threadpoolctl import threadpool_limits
-from thermocal.io import read_recording
+from thermocal.readers.dispatch import read_recording
 from thermocal.models.base import RunData, make_model
 from thermocal.models.files import save_model
 cfg = Path({str(cfg)!r}); out = Path({str(out)!r}); out.mkdir(parents=True, exist_ok=True)

@@ -22,7 +22,7 @@ import numpy as np
 CHILD = r"""
 import json, resource, sys, time
 import numpy as np
-import thermocal.io as tio
+import thermocal.readers as tio
 base = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
 t0 = time.perf_counter()
 rec = tio.read_recording(sys.argv[1])
@@ -42,8 +42,8 @@ def main() -> None:
     out_dir = Path(__file__).parent / "_data"
     path = out_dir / f"read_{args.rows}.parquet"
     if not path.exists():
-        from thermocal.io import write_recording
         from thermocal.recording import Recording
+        from thermocal.writers import write_recording
 
         rng = np.random.default_rng(0)
         n = args.rows

@@ -19,9 +19,9 @@ from pathlib import Path
 
 import numpy as np
 
-from thermocal.io import write_recording
 from thermocal.profiles import builtin_profile
 from thermocal.simulate import run_scenario
+from thermocal.writers import write_recording
 
 
 def peak_rss_mb() -> float:

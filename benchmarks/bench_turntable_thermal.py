@@ -27,8 +27,8 @@ def main() -> int:
     import pyarrow as pa
     import pyarrow.parquet as pq
 
-    from thermocal.io import write_recording
     from thermocal.turntable.simulate import simulate_turntable_thermal
+    from thermocal.writers import write_recording
 
     print(f"load average {os.getloadavg()[0]:.2f}, {os.cpu_count()} cores")
     DATA.mkdir(parents=True, exist_ok=True)

@@ -394,8 +394,8 @@ def test_turntable_soaks_too_close_are_refused_or_marked(tmp_path: Path) -> None
     """Two soak runs moved to 20 and 22 °C: a line in temperature needs 5 °C — refused;
     with --allow-narrow written, marked 'overridden' in the calibration, and export-c
     warns; a record edited to a plain failure makes export-c refuse."""
-    from thermocal.io import write_recording
     from thermocal.turntable.simulate import simulate_turntable_thermal
+    from thermocal.writers import write_recording
 
     runs = [r for r in simulate_turntable_thermal(seed=11) if not r[1]["held_out"]][:2]
     paths = []

@@ -19,7 +19,7 @@ import pytest
 
 from dataflash_writer import imu_log
 from thermocal.cli import main
-from thermocal.io import read_recording
+from thermocal.readers.dispatch import read_recording
 
 G0 = 9.80665
 

@@ -15,9 +15,9 @@ import pytest
 from thermocal.cli import main
 from thermocal.compensate import CalibrationStream
 from thermocal.errors import ThermocalInputError
-from thermocal.io import write_recording
 from thermocal.models.files import load_calibration
 from thermocal.simulate import IMU_CHANNELS, SCENARIOS
+from thermocal.writers import write_recording
 
 NAMES = [n for n, _u in IMU_CHANNELS]
 

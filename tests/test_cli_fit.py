@@ -12,12 +12,12 @@ import pytest
 from thermocal.cli import main
 from thermocal.cli.fit_cmd import build_model
 from thermocal.errors import ThermocalInputError
-from thermocal.io import write_recording
 from thermocal.models import load_model
 from thermocal.models.base import MODEL_REGISTRY
 from thermocal.models.piecewise import PiecewiseModel
 from thermocal.models.poly import PolyModel
 from thermocal.recording import Recording
+from thermocal.writers import write_recording
 
 
 def _write_run(path: Path, seed: int, offset: float = 0.0, n: int = 4000) -> Path:

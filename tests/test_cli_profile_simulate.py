@@ -10,8 +10,8 @@ import pytest
 from numpy.testing import assert_allclose
 
 from thermocal.cli import main
-from thermocal.io import read_recording
 from thermocal.profiles import builtin_profile, correlate, read_program, write_program
+from thermocal.readers.dispatch import read_recording
 
 
 def run(capsys: pytest.CaptureFixture[str], *args: str) -> tuple[int, str, str]:

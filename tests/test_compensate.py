@@ -38,7 +38,6 @@ from thermocal.errors import (
     TimestampError,
     UnitError,
 )
-from thermocal.io import csv_float_options
 from thermocal.models.base import (
     MODEL_REGISTRY,
     Coefficient,
@@ -49,6 +48,7 @@ from thermocal.models.base import (
     make_model,
 )
 from thermocal.preprocess import temperature_rate
+from thermocal.readers.common import csv_float_options
 from thermocal.recording import GAP_FACTOR, FloatArray
 
 # --- a toy model with a rate buffer and a start-up state ------------------------------------

@@ -20,12 +20,13 @@ import pyarrow.parquet as pq
 import pytest
 
 import thermocal.compensate as compensate_mod
-import thermocal.io as io_mod
+import thermocal.readers.dispatch as io_mod
 from thermocal.cli import main
-from thermocal.io import read_recording, write_recording
 from thermocal.models.files import load_calibration
+from thermocal.readers.dispatch import read_recording
 from thermocal.turntable import thermal
 from thermocal.turntable.simulate import simulate_turntable_thermal
+from thermocal.writers import write_recording
 
 G_COLS = ["gyro_x", "gyro_y", "gyro_z"]
 A_COLS = ["accel_x", "accel_y", "accel_z"]

@@ -21,8 +21,8 @@ from test_report import (
 )
 from thermocal.cli import main
 from thermocal.demo import DEMO_STEPS, QUICK, run_demo
-from thermocal.io import read_recording
 from thermocal.models import RunData, load_model, load_model_dict
+from thermocal.readers.dispatch import read_recording
 
 DEMO_BUDGET_S = 60.0
 """The issue's limit for ``thermocal demo`` on the 2-core machine [s]."""

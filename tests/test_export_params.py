@@ -17,8 +17,8 @@ import numpy as np
 import pytest
 
 from thermocal.cli import main
-from thermocal.io import write_recording
 from thermocal.simulate import SCENARIOS
+from thermocal.writers import write_recording
 
 G0 = 9.80665
 GYROS, ACCELS = ("gx", "gy", "gz"), ("ax", "ay", "az")

@@ -16,7 +16,9 @@ import pandas as pd
 import pytest
 
 from thermocal.errors import FileFormatError
-from thermocal.io import TEMP_SUFFIX, read_recording, remove_stale_temporaries
+from thermocal.outputs import TEMP_SUFFIX
+from thermocal.readers.dispatch import read_recording
+from thermocal.writers import remove_stale_temporaries
 
 N_BIG = 400_000
 """Rows of the file compensated while it is killed: several seconds of writing."""
@@ -156,8 +158,8 @@ def test_two_writers_of_one_output_are_serialised(setup: tuple[Path, Path], tmp_
 def test_corrupt_parquet_written_by_thermocal_is_refused(tmp_path: Path) -> None:
     """Parquet files written by thermocal carry page checksums, verified on read: bytes
     overwritten mid-file are an error naming the file, not a silently different number."""
-    from thermocal.io import write_recording
     from thermocal.recording import Recording
+    from thermocal.writers import write_recording
 
     rng = np.random.default_rng(3)
     n = 200_000
@@ -199,7 +201,7 @@ def test_full_disk_or_no_permission_is_exit_2_naming_the_output(
 ) -> None:
     """An OS error while writing (a full disk, a read-only folder) is the user's environment,
     not a bug: exit 2 naming the output, and no temporary left behind."""
-    import thermocal.io as tio
+    import thermocal.writers as tio
     from thermocal.cli import main
 
     def failing_replace(src: str | Path, dst: str | Path) -> None:

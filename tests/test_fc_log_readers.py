@@ -29,7 +29,7 @@ from dataflash_writer import (
 )
 from thermocal.cli import main
 from thermocal.errors import UnitWarning
-from thermocal.io import read_recording
+from thermocal.readers.dispatch import read_recording
 from ulog_writer import ulog_bytes
 
 G0 = 9.80665

@@ -18,8 +18,8 @@ import pytest
 from thermocal import units
 from thermocal.cli import main
 from thermocal.errors import UnitError
-from thermocal.io import write_recording
 from thermocal.simulate import SCENARIOS
+from thermocal.writers import write_recording
 
 
 def test_normal_gravity_matches_the_wgs84_table() -> None:

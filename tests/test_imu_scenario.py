@@ -15,8 +15,8 @@ import pandas as pd
 import pytest
 
 from thermocal.cli import main
-from thermocal.io import write_recording
 from thermocal.simulate import IMU_CHANNELS, SCENARIOS
+from thermocal.writers import write_recording
 
 
 @pytest.fixture(scope="module")

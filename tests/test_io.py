@@ -24,8 +24,10 @@ from thermocal.errors import (
     UnitError,
     UnitWarning,
 )
-from thermocal.io import read_recording, sidecar_path, write_recording
+from thermocal.outputs import sidecar_path
+from thermocal.readers.dispatch import read_recording
 from thermocal.recording import Metadata, Recording, find_problems
+from thermocal.writers import write_recording
 
 # Files here that state no unit are about other faults; the unit defaults and their
 # warnings are tested in test_units_travel.py and in test_sidecar_options_and_cli_override.
@@ -310,7 +312,7 @@ def test_malformed_parquet_never_crashes_or_passes_silently(
     ],
 )
 def test_default_time_column(names: list[str], expect: str) -> None:
-    from thermocal.io import default_time_column
+    from thermocal.readers.common import default_time_column
 
     assert default_time_column(names) == expect
     assert default_time_column(names, "gyro") == "gyro"  # the sidecar's says so

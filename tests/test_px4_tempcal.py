@@ -200,7 +200,7 @@ def test_the_holdout_is_held_out(sweep: dict) -> None:
     """The hold-out rms is a cubic fitted to the even 0.5 °C bins judged on the odd ones,
     recomputed here with numpy alone (np.polyfit) from the log's samples: fitting on every
     bin (the odd ones included) would give a smaller, in-sample figure."""
-    from thermocal.io import read_recording
+    from thermocal.readers.dispatch import read_recording
 
     log = sweep["dir"].parent / "sweep.ulg"
     rec = read_recording(log, topic="sensor_gyro.0")

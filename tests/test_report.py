@@ -26,7 +26,6 @@ from numpy.testing import assert_allclose
 from scipy.signal import lfilter
 
 from thermocal.errors import ThermocalInputError
-from thermocal.io import write_json, write_recording
 from thermocal.models.base import (
     MODEL_REGISTRY,
     Coefficient,
@@ -46,6 +45,7 @@ from thermocal.report import (
     write_report,
 )
 from thermocal.report.figures import binned_means, decimate_for_plot
+from thermocal.writers import write_json, write_recording
 
 CHROMIUM = Path("/usr/bin/chromium")
 TRUE_SLOPE = 0.05  # [°/h/°C] of the synthetic gyro on T1

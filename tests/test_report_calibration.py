@@ -22,8 +22,8 @@ from test_report import (
     tagged_numbers,
 )
 from thermocal.cli import main
-from thermocal.io import write_recording
 from thermocal.simulate import SCENARIOS
+from thermocal.writers import write_recording
 
 NAMES = ["gx", "gy", "gz", "ax", "ay", "az"]
 RAD_PER_DEG = np.pi / 180.0

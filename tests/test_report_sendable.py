@@ -169,7 +169,7 @@ def test_the_adequacy_record_is_shown(work: Path, verdict: str, css: str) -> Non
 
 
 def test_one_finding_from_several_sources_is_shown_once(work: Path) -> None:
-    from thermocal.io import read_recording
+    from thermocal.readers.dispatch import read_recording
     from thermocal.report import ModelEntry, ReportInputs, build_report
 
     msg = "2350 samples outside the model's temperature range: T1 20.00…50.00 °C"

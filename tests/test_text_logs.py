@@ -16,7 +16,8 @@ import pytest
 
 from thermocal.cli import main
 from thermocal.errors import TextLayoutWarning
-from thermocal.io import TextOptions, read_recording, sniff_text
+from thermocal.readers.dispatch import read_recording
+from thermocal.readers.text import TextOptions, sniff_text
 
 BANNER = [
     "=~=~=~=~=~=~=~=~=~=~=~= PuTTY log 2026.11.20 10:15:03 =~=~=~=~=~=~=~=~=~=~=~=",

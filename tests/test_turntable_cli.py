@@ -9,8 +9,8 @@ import numpy as np
 import pytest
 
 from thermocal.cli import main
-from thermocal.io import write_recording
 from thermocal.turntable import simulate_turntable16
+from thermocal.writers import write_recording
 
 
 @pytest.fixture(scope="module")

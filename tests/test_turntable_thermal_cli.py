@@ -21,7 +21,7 @@ import pandas as pd
 import pytest
 
 from thermocal.cli import main
-from thermocal.io import read_recording, write_recording
+from thermocal.readers.dispatch import read_recording
 from thermocal.turntable import kinematics
 from thermocal.turntable.calibrate import calibrate
 from thermocal.turntable.schedule import detect_motion, segment
@@ -31,6 +31,7 @@ from thermocal.turntable.simulate import (
     simulate_turntable_thermal,
     thermal_theta,
 )
+from thermocal.writers import write_recording
 
 G_COLS = ["gyro_x", "gyro_y", "gyro_z"]
 A_COLS = ["accel_x", "accel_y", "accel_z"]

@@ -455,7 +455,8 @@ def test_a_sidecar_alone_gives_the_time_unit(
 def test_int16_conversion_in_a_sidecar_and_round_trip(tmp_path: Path) -> None:
     """The sidecar's ``temperature_conversion`` may say ``int16`` too; it survives a
     write/read round trip of the recording."""
-    from thermocal.io import read_recording, write_recording
+    from thermocal.readers.dispatch import read_recording
+    from thermocal.writers import write_recording
 
     src = tmp_path / "s.csv"
     raw = np.array([65280.0, 65535.0, 0.0, 256.0])  # −256, −1, 0, 256 as signed counts

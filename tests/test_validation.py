@@ -19,7 +19,6 @@ import pytest
 
 from thermocal.cli import main
 from thermocal.errors import CorrelationWarning, ExtrapolationWarning, ThermocalWarning
-from thermocal.io import write_recording
 from thermocal.models.base import (
     MODEL_REGISTRY,
     Coefficient,
@@ -34,6 +33,7 @@ from thermocal.profiles import common_base
 from thermocal.recording import FloatArray, Recording
 from thermocal.simulate import SCENARIOS
 from thermocal.validation import validate
+from thermocal.writers import write_recording
 
 # --- a toy model: exact quadratic bias in T1 -----------------------------------------------
 

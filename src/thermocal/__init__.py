@@ -21,18 +21,23 @@ __version__ = "0.1.0"
 from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
-    from thermocal.io import read_recording, write_recording
+    from thermocal.readers.dispatch import read_recording
     from thermocal.recording import Metadata, Recording
+    from thermocal.writers import write_recording
 
 
 def __getattr__(name: str) -> Any:
     """``read_recording`` and ``write_recording`` are imported on first use, so that the
     maths modules (``import thermocal.metrics`` …) do not load the file layer (pandas,
     pyarrow) with the package."""
-    if name in ("read_recording", "write_recording"):
-        from thermocal import io
+    if name == "read_recording":
+        from thermocal.readers import dispatch
 
-        return getattr(io, name)
+        return dispatch.read_recording
+    if name == "write_recording":
+        from thermocal import writers
+
+        return writers.write_recording
     if name in ("Metadata", "Recording"):  # numpy: imported on first use too
         from thermocal import recording
 

@@ -78,34 +78,23 @@ from thermocal.errors import (
     TimestampError,
     UnitError,
 )
-from thermocal.io import (
-    META_FORMAT,
-    META_KEY,
-    META_VERSION,
-    TextOptions,
-    atomic_write_path,
-    check_not_input,
-    csv_chunk_options,
-    csv_encoding,
-    csv_float_options,
-    default_time_column,
-    file_kind,
-    numeric_column,
-    read_log_table,
-    read_recording,
-    read_text_table,
-    sidecar_path,
-    write_json,
-)
 from thermocal.models.base import (
     ChunkContext,
     TemperatureModel,
     check_sensor_id,
     outside_range_dict,
 )
+from thermocal.outputs import sidecar_path
+from thermocal.readers.common import csv_encoding, csv_float_options, default_time_column, file_kind
+from thermocal.readers.dispatch import read_log_table, read_recording, read_text_table
+from thermocal.readers.table import numeric_column
+from thermocal.readers.text import TextOptions, csv_chunk_options
 from thermocal.recording import (
     ABSOLUTE_ZERO_C,
     FEW_SAMPLES,
+    META_FORMAT,
+    META_KEY,
+    META_VERSION,
     PLAUSIBLE_COUNTS,
     PLAUSIBLE_SIGNAL,
     FloatArray,
@@ -113,6 +102,7 @@ from thermocal.recording import (
     Recording,
     median_interval,
 )
+from thermocal.writers import atomic_write_path, check_not_input, write_json
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -489,7 +479,7 @@ def compensate_file(
     Parquet metadata, the unit in the column name, what the model file recorded of its
     inputs (:meth:`TemperatureModel.input_units`), else a default stated in a warning.
     The output is written to a temporary name and renamed when complete
-    (:func:`thermocal.io.atomic_write_path`); ``out`` may not be ``path``.
+    (:func:`thermocal.writers.atomic_write_path`); ``out`` may not be ``path``.
 
     Chunks are predicted with their context (:class:`ChunkPredictor`), so the
     result equals an in-memory ``predict`` of the whole file.  ``known_input``

@@ -26,7 +26,6 @@ from thermocal import units
 from thermocal.compensate import compensate_channels, prepare_run
 from thermocal.errors import ThermocalWarning
 from thermocal.export_c import generate_c_calibration
-from thermocal.io import write_json, write_recording
 from thermocal.models.base import RunData, model_file_dict, model_inputs
 from thermocal.models.calibration import Calibration, Channel, guess_role
 from thermocal.models.files import save_calibration
@@ -34,6 +33,7 @@ from thermocal.models.poly import PolyModel
 from thermocal.report.calibration import CalibrationReportInputs, write_calibration_report
 from thermocal.simulate import IMU_CHANNELS, SCENARIOS
 from thermocal.validation import validate
+from thermocal.writers import write_json, write_recording
 
 IMU_STEPS = ("simulate", "fit", "validate", "compensate", "export-c", "report")
 """Progress steps of :func:`run_imu_demo`."""

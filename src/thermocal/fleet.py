@@ -582,7 +582,7 @@ def file_sha256(path: str | Path) -> str | None:
 def unit_input_paths(u: UnitSpec) -> list[str]:
     """The files a unit reads: its modelling files, its validation file, and the
     ``FILE.meta.json`` sidecar of each where one exists (it sets units and conversions)."""
-    from thermocal.io import sidecar_path
+    from thermocal.outputs import sidecar_path
 
     out: list[str] = []
     for f in (*u.modeling, *([u.validation] if u.validation else [])):
@@ -863,7 +863,7 @@ def write_summary(rows: Sequence[Mapping[str, Any]], out_dir: Path) -> tuple[Pat
     """``summary.csv`` and ``summary.parquet`` (atomic writes), columns in first-seen order."""
     import pandas as pd
 
-    from thermocal.io import atomic_write, atomic_write_path
+    from thermocal.writers import atomic_write, atomic_write_path
 
     columns: list[str] = []
     for r in rows:

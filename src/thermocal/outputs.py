@@ -12,7 +12,7 @@
   the command only writes into (``dirs``: ``export-c``, the tempcal commands, ``demo``) may
   hold inputs: the files it would write there are checked one by one;
 * a temporary of an output (``.NAME.<pid>.<random>.thermocal-partial`` beside it, see
-  :data:`thermocal.io.TEMP_SUFFIX`), which a later run removes, is or holds an input;
+  :data:`thermocal.outputs.TEMP_SUFFIX`), which a later run removes, is or holds an input;
 * the output is a **special file** (:func:`special_reason`): a FIFO, a character or block
   device, a socket, anything under ``/proc``, ``/dev`` or ``/sys``, or a symbolic link whose
   chain passes through them (a link to ``/proc/self/fd/1``, ``/dev/stdout`` itself).  The
@@ -22,8 +22,8 @@
   cannot go wrong as root; to discard results, write them into a temporary folder.
 
 Files the command writes that do not exist yet and hold no input pass.  The check runs
-before the first byte is written; :func:`thermocal.io.atomic_write` and
-:func:`thermocal.io.staging_directory` repeat the special-file part for every file they
+before the first byte is written; :func:`thermocal.writers.atomic_write` and
+:func:`thermocal.writers.staging_directory` repeat the special-file part for every file they
 open, as a backstop.
 """
 
@@ -116,7 +116,7 @@ def refuse_special(path: str | Path, what: str = "the output") -> None:
 
 
 def _inputs(inputs: Iterable[str | Path]) -> list[_Input]:
-    from thermocal.io import sidecar_path
+    from thermocal.outputs import sidecar_path
 
     out = []
     for given in inputs:
@@ -131,7 +131,7 @@ def _inputs(inputs: Iterable[str | Path]) -> list[_Input]:
 
 def _temporaries(target: Path) -> list[Path]:
     """The temporaries of ``target`` (files or staging folders) a later run removes."""
-    from thermocal.io import TEMP_SUFFIX
+    from thermocal.outputs import TEMP_SUFFIX
 
     parent = target.parent
     if not parent.is_dir():
@@ -213,3 +213,15 @@ def check_outputs(
 
 
 __all__ = ["SPECIAL_ROOTS", "check_outputs", "refuse_special", "special_reason"]
+
+
+def sidecar_path(path: str | Path) -> Path:
+    """``FILE.meta.json`` beside ``FILE``."""
+    p = Path(path)
+    return p.with_name(p.name + ".meta.json")
+
+
+TEMP_SUFFIX = ".thermocal-partial"
+"""Suffix of an output being written.  No reader accepts it (:func:`file_kind`), so an
+interrupted write can never be mistaken for a result; the next run that writes the same
+output removes the stale ones (:func:`remove_stale_temporaries`)."""

@@ -11,7 +11,7 @@ from pathlib import Path
 import numpy as np
 
 from thermocal.allan import TERM_NAMES, AllanResult, DynamicAllan, NoiseTerms
-from thermocal.io import atomic_write_path
+from thermocal.writers import atomic_write_path
 
 
 def plot_allan(

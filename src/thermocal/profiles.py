@@ -488,7 +488,7 @@ def write_program(path: str | Path, time_s: npt.ArrayLike, setpoint_c: npt.Array
     """Write a chamber program CSV with columns ``time_s, setpoint_c`` (atomic)."""
     import pandas as pd
 
-    from thermocal.io import atomic_write  # the file edge, imported on use
+    from thermocal.writers import atomic_write
 
     t = np.asarray(time_s, dtype=np.float64)
     c = np.asarray(setpoint_c, dtype=np.float64)
@@ -510,7 +510,7 @@ def read_program(path: str | Path) -> tuple[FloatArray, FloatArray]:
     """
     import pandas as pd
 
-    from thermocal.io import csv_float_options  # the file edge, imported on use
+    from thermocal.readers.common import csv_float_options
 
     p = Path(path)
     if not p.exists():

@@ -180,9 +180,9 @@ def fit_sensor(
 def log_topics(path: Path) -> list[tuple[str, int]]:
     """The ``sensor_gyro``/``sensor_accel``/``sensor_baro``/``sensor_mag`` instances of a ULog
     that carry a temperature
-    (:func:`thermocal.io.ulog_sensor_instances`: an unreadable log is refused, damage and
+    (:func:`thermocal.readers.ulog.ulog_sensor_instances`: an unreadable log is refused, damage and
     every instance left out are said in warnings)."""
-    from thermocal.io import ulog_sensor_instances
+    from thermocal.readers.ulog import ulog_sensor_instances
 
     return ulog_sensor_instances(path, (*TOPICS, *OFFSET_TOPICS))
 

@@ -34,6 +34,12 @@ from thermocal.errors import (
     UnitError,
 )
 
+META_KEY = "thermocal"
+META_FORMAT = "thermocal-recording"
+META_VERSION = 1
+"""Key, format and version of the metadata a recording file carries (Parquet key-value
+metadata or sidecar JSON)."""
+
 FloatArray = npt.NDArray[np.float64]
 
 GAP_FACTOR = 1.5
@@ -179,7 +185,7 @@ class Recording:
     unit_sources: dict[str, str] = field(default_factory=dict)
     """Where each column's unit came from (``option``, ``metadata``, ``column name``,
     ``model`` or ``default``; ``"<time>"`` for the time column), for files read by
-    :func:`thermocal.io.read_recording`."""
+    :func:`thermocal.readers.dispatch.read_recording`."""
     _scan: tuple[FloatArray, TimeScan] | None = field(
         default=None, init=False, repr=False, compare=False
     )

@@ -472,7 +472,7 @@ class StatedUnits:
     @classmethod
     def from_file_info(cls, info: Mapping[str, Any], where: str = "") -> StatedUnits:
         """From a recording's metadata object (``time_unit``, ``signals``, ``temperatures``,
-        ``units``, ``metadata.temperature_conversion``; see :mod:`thermocal.io`)."""
+        ``units``, ``metadata.temperature_conversion``; see :mod:`thermocal.readers`)."""
         cols: dict[str, str] = {}
         for key in ("units", "temperatures", "signals"):  # later keys win
             part = info.get(key) or {}

@@ -30,7 +30,7 @@ import pyarrow.parquet as pq
 import pytest
 
 from thermocal.cli import main
-from thermocal.io import TEMP_SUFFIX
+from thermocal.outputs import TEMP_SUFFIX
 
 N = 600
 """Rows of the good recording: 600 s at 1 Hz, a temperature ramp 10 → 40 °C."""

@@ -30,7 +30,7 @@ import pyarrow.parquet as pq
 import pytest
 
 import thermocal.cli.fit_cmd as fit_cmd
-import thermocal.io as io_mod
+import thermocal.readers.dispatch as io_mod
 from thermocal.cli import main
 
 N = 600

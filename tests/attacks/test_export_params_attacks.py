@@ -25,8 +25,8 @@ import numpy as np
 import pytest
 
 from thermocal.cli import main
-from thermocal.io import TEMP_SUFFIX
 from thermocal.models.base import checksum
+from thermocal.outputs import TEMP_SUFFIX
 
 GYROS, ACCELS = ("gx", "gy", "gz"), ("ax", "ay", "az")
 

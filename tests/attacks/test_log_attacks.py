@@ -37,7 +37,7 @@ import pytest
 
 from dataflash_writer import FMT_TYPE, IMU_FMT, IMU_LABELS, data_message, fmt_message, imu_log
 from thermocal.cli import main
-from thermocal.io import TEMP_SUFFIX
+from thermocal.outputs import TEMP_SUFFIX
 from ulog_writer import SENSOR_FIELDS, ulog_bytes
 
 SAMPLE_LOG = Path(__file__).parent.parent / "data" / "pyulog_sample_log_small.ulg"

@@ -35,7 +35,7 @@ import numpy as np
 import pytest
 
 from thermocal.cli import main
-from thermocal.io import TEMP_SUFFIX
+from thermocal.outputs import TEMP_SUFFIX
 
 GYROS, ACCELS = ("gx", "gy", "gz"), ("ax", "ay", "az")
 SPECIAL = ("/dev", "/proc", "/sys")
@@ -73,8 +73,8 @@ def assets(tmp_path_factory: pytest.TempPathFactory) -> Path:
     a 16-position turntable run, a PX4 ULog, an ArduPilot DataFlash log, a fleet batch."""
     from dataflash_writer import imu_log
     from fleet_data import config_text, write_run
-    from thermocal.io import write_recording
     from thermocal.turntable import simulate_turntable16
+    from thermocal.writers import write_recording
     from ulog_writer import SENSOR_FIELDS, ulog_bytes
 
     d = tmp_path_factory.mktemp("output-attacks")

@@ -32,7 +32,7 @@ import pyarrow.parquet as pq
 import pytest
 
 from thermocal.cli import main
-from thermocal.io import TEMP_SUFFIX
+from thermocal.outputs import TEMP_SUFFIX
 
 N = 600
 UNITS = ["--signal-unit", "deg/h", "--time-unit", "s", "--temp-unit", "degC"]

@@ -40,13 +40,13 @@ if TYPE_CHECKING:
     import rich.table as _rich_table
 
     import thermocal.allan as _allan
-    import thermocal.io as _io
     import thermocal.metrics as _metrics
     import thermocal.stability.family as _family
+    import thermocal.writers as _writers
 else:
     _rich_table = LazyModule("rich.table")
     _allan = LazyModule("thermocal.allan")
-    _io = LazyModule("thermocal.io")
+    _writers = LazyModule("thermocal.writers")
     _metrics = LazyModule("thermocal.metrics")
     _family = LazyModule("thermocal.stability.family")
 
@@ -291,7 +291,7 @@ def allan_cmd(
         keep_other=False,  # the Allan deviation uses the time and the signal only
     )
     if plot is not None:
-        _io.check_not_input(plot, [file])
+        _writers.check_not_input(plot, [file])
         if plot.is_dir():
             raise ThermocalInputError(f"{plot}: is a directory, expected a file name")
         if plot.suffix.lower() not in (".png", ".svg", ".pdf"):

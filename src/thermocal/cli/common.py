@@ -35,8 +35,8 @@ if TYPE_CHECKING:
     from rich.console import Console
 
     from thermocal import units
-    from thermocal.io import TextOptions
     from thermocal.models.base import TemperatureModel
+    from thermocal.readers.text import TextOptions
     from thermocal.recording import Metadata, Recording
 else:
     # this module is imported to register commands (``--help``): nothing heavy at import
@@ -122,7 +122,7 @@ def text_options(
     decimal: str | None,
 ) -> TextOptions | None:
     """The text-log options of the command line (None when none is given)."""
-    from thermocal.io import TextOptions
+    from thermocal.readers.text import TextOptions
 
     if names is None and rate is None and on_bad_lines == "error" and not delimiter and not decimal:
         return None
@@ -280,7 +280,7 @@ def load_recording(
         stated = model.input_units()
     elif model_inputs is not None:
         stated = units.StatedUnits.from_model_inputs(model_inputs)
-    from thermocal.io import read_recording  # the file layer, when a command reads
+    from thermocal.readers.dispatch import read_recording
 
     rec = read_recording(
         path,

@@ -45,12 +45,16 @@ if TYPE_CHECKING:
     import rich.table as _rich_table
 
     import thermocal.compensate as _compensate
-    import thermocal.io as _io
     import thermocal.models.files as _files
+    import thermocal.outputs as _outputs
+    import thermocal.readers as _readers
+    import thermocal.writers as _writers
 else:
     _rich_table = LazyModule("rich.table")
     _compensate = LazyModule("thermocal.compensate")
-    _io = LazyModule("thermocal.io")
+    _outputs = LazyModule("thermocal.outputs")
+    _readers = LazyModule("thermocal.readers")
+    _writers = LazyModule("thermocal.writers")
     _files = LazyModule("thermocal.models.files")
 
 
@@ -87,9 +91,9 @@ def compensate_cmd(
     as_json: JsonOpt = False,
 ) -> None:
     """Apply MODEL to FILE; OUT gets every input column plus <signal>_model and <signal>_comp."""
-    _io.check_not_input(output, [file, model_file])
-    if _io.file_kind(output) == "csv":  # the CSV's sidecar must not land on an input either
-        _io.check_not_input(_io.sidecar_path(output), [file, model_file])
+    _writers.check_not_input(output, [file, model_file])
+    if _readers.file_kind(output) == "csv":  # the CSV's sidecar must not land on an input either
+        _writers.check_not_input(_outputs.sidecar_path(output), [file, model_file])
     cal = _files.load_calibration(model_file)  # a model file is a calibration of one channel
     conv = parse_temp_conversion(temp_conversion) if temp_conversion is not None else None
     if cal.triads:

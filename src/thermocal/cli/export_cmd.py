@@ -296,7 +296,7 @@ def export_params_cmd(
     temperature (see ``thermocal.export_params``)."""
     from thermocal.cli.common import split_names
     from thermocal.export_params import export_params
-    from thermocal.io import atomic_write, check_not_input
+    from thermocal.writers import atomic_write, check_not_input
 
     check_not_input(output, [calibration])
     cal = _files.load_calibration(calibration)

@@ -100,19 +100,19 @@ if TYPE_CHECKING:
 
     import thermocal.adequacy as _adequacy
     import thermocal.gravity as _gravity
-    import thermocal.io as _io
     import thermocal.models.base as _base
     import thermocal.models.calibration as _calibration
     import thermocal.models.files as _files
     import thermocal.models.poly as _poly
     import thermocal.recording as _recording
+    import thermocal.writers as _writers
     from thermocal import units
 else:
     np = LazyModule("numpy")
     _rich_table = LazyModule("rich.table")
     units = LazyModule("thermocal.units")
     _adequacy = LazyModule("thermocal.adequacy")
-    _io = LazyModule("thermocal.io")
+    _writers = LazyModule("thermocal.writers")
     _base = LazyModule("thermocal.models.base")
     _calibration = LazyModule("thermocal.models.calibration")
     _files = LazyModule("thermocal.models.files")
@@ -322,7 +322,7 @@ def fit_cmd(
     check_ceilings(order, t0_order, segments, terms)
     if not files:
         raise ThermocalInputError("give at least one data file")
-    _io.check_not_input(output, list(files))
+    _writers.check_not_input(output, list(files))
     if output.suffix.lower() not in (".json", ""):
         raise ThermocalInputError(f"{output}: the model file is JSON; use a .json name")
     options: dict[str, Any] = {

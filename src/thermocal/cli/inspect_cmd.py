@@ -38,14 +38,14 @@ if TYPE_CHECKING:
     import rich.table as _rich_table
 
     import thermocal.inspection as _inspection
-    import thermocal.io as _io
+    import thermocal.readers as _readers
     import thermocal.recording as _recording
     from thermocal import units
 else:
     _markup = LazyModule("rich.markup")
     _rich_table = LazyModule("rich.table")
     _inspection = LazyModule("thermocal.inspection")
-    _io = LazyModule("thermocal.io")
+    _readers = LazyModule("thermocal.readers")
     _recording = LazyModule("thermocal.recording")
     units = LazyModule("thermocal.units")
 
@@ -91,7 +91,7 @@ def inspect_cmd(
     """
     skipped: list[str] = []
     conv = parse_temp_conversion(temp_conversion) if temp_conversion is not None else None
-    rec = _io.read_recording(
+    rec = _readers.read_recording(
         file,
         text=text_options(t_names, t_rate, t_bad, t_delim, t_dec),
         topic=topic,

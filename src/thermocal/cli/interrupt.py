@@ -11,10 +11,10 @@ EXIT_INTERRUPTED = 130
 def report_interrupted() -> int:
     """Print what was kept and return :data:`EXIT_INTERRUPTED`.
 
-    Complete outputs were renamed into place (:data:`thermocal.io.WRITTEN`); the one being
+    Complete outputs were renamed into place (:data:`thermocal.writers.WRITTEN`); the one being
     written was still a temporary and has been removed by its writer.
     """
-    tio = sys.modules.get("thermocal.io")  # not loaded: nothing can have been written
+    tio = sys.modules.get("thermocal.writers")  # not loaded: nothing can have been written
     done = [str(p) for p in getattr(tio, "WRITTEN", [])]
     if done:
         print(

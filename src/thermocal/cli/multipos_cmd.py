@@ -31,17 +31,19 @@ if TYPE_CHECKING:
     import numpy as np
     import rich.table as _rich_table
 
-    import thermocal.io as _io
     import thermocal.models.calibration as _calibration
     import thermocal.models.files as _files
     import thermocal.multipos.calibrate as _mp
     import thermocal.multipos.poses as _poses
+    import thermocal.readers as _readers
     import thermocal.turntable.thermal as _thermal
+    import thermocal.writers as _writers
     from thermocal import units
 else:
     np = LazyModule("numpy")
     _rich_table = LazyModule("rich.table")
-    _io = LazyModule("thermocal.io")
+    _readers = LazyModule("thermocal.readers")
+    _writers = LazyModule("thermocal.writers")
     _calibration = LazyModule("thermocal.models.calibration")
     _files = LazyModule("thermocal.models.files")
     _mp = LazyModule("thermocal.multipos.calibrate")
@@ -146,7 +148,7 @@ def multipos_cmd(
 ) -> None:
     """Accelerometer (and gyro) triad bias, scale factors and misalignments from hand-placed
     poses, without a turntable (Tedaldi et al. 2014; Ferraris et al. 1995)."""
-    _io.check_not_input(output, [*files, *([poses] if poses else [])])
+    _writers.check_not_input(output, [*files, *([poses] if poses else [])])
     if output.suffix.lower() != ".json":
         raise ThermocalInputError(f"{output}: the calibration is JSON; use a .json name")
     acc_cols = _three(accel, "--accel") or []
@@ -176,7 +178,7 @@ def multipos_cmd(
     g_used = gravity
     for f in files:
         given = [accel_unit] * 3 + ([gyro_unit] * 3 if gyr_cols else [])
-        rec = _io.read_recording(
+        rec = _readers.read_recording(
             f, time=time, time_unit=time_unit, signals=[*acc_cols, *(gyr_cols or [])],
             signal_unit=",".join(given) if all(given) else None,  # type: ignore[arg-type]
             temperatures=[temps] if temps else None,

@@ -32,12 +32,12 @@ from thermocal.errors import ThermocalInputError
 if TYPE_CHECKING:
     import rich.table as _rich_table
 
-    import thermocal.io as _io
     import thermocal.metrics as _metrics
     import thermocal.stability.noise_model as _nm
+    import thermocal.writers as _writers
 else:
     _rich_table = LazyModule("rich.table")
-    _io = LazyModule("thermocal.io")
+    _writers = LazyModule("thermocal.writers")
     _metrics = LazyModule("thermocal.metrics")
     _nm = LazyModule("thermocal.stability.noise_model")
 
@@ -104,7 +104,7 @@ def noise_cmd(
             "--format kalibr: Kalibr's imu.yaml needs the accelerometer too; give --accel X,Y,Z "
             "(or --format json for the gyro alone)"
         )
-    _io.check_not_input(output, [file])
+    _writers.check_not_input(output, [file])
     if output.is_dir():
         raise ThermocalInputError(f"{output}: is a directory, expected a file name")
     n_g, n_a = len(g_names), len(a_names)
@@ -158,7 +158,7 @@ def noise_cmd(
         text = _nm.kalibr_yaml(model, file.name)
     else:
         text = json.dumps(jsonable(_nm.model_json(model, file.name)), allow_nan=False, indent=1)
-    with _io.atomic_write(output, "w") as fh:
+    with _writers.atomic_write(output, "w") as fh:
         fh.write(text + ("" if text.endswith("\n") else "\n"))
 
     table = _rich_table.Table(title=f"{file} — IMU noise model (continuous time)")

@@ -26,12 +26,14 @@ from thermocal.outputs import check_outputs
 if TYPE_CHECKING:
     import numpy as np
 
-    import thermocal.io as _io
     import thermocal.profiles as _profiles
+    import thermocal.readers as _readers
     import thermocal.recording as _recording
+    import thermocal.writers as _writers
 else:
     np = LazyModule("numpy")
-    _io = LazyModule("thermocal.io")
+    _readers = LazyModule("thermocal.readers")
+    _writers = LazyModule("thermocal.writers")
     _profiles = LazyModule("thermocal.profiles")
     _recording = LazyModule("thermocal.recording")
 
@@ -113,7 +115,7 @@ def load_history(
     if not path.exists():
         raise FileFormatError(f"{path}: no such file")
     time_col: str | None = None
-    if _io.file_kind(path) == "csv":
+    if _readers.file_kind(path) == "csv":
         try:
             header = [str(c).strip() for c in pd.read_csv(path, nrows=0).columns]
         except (pd.errors.EmptyDataError, pd.errors.ParserError, UnicodeDecodeError) as exc:
@@ -124,7 +126,7 @@ def load_history(
             return t, c, defaults.PROGRAM_SETPOINT
         if defaults.PROGRAM_TIME in header and "time" not in header:
             time_col = defaults.PROGRAM_TIME
-    rec = _io.read_recording(path, time=time_col)
+    rec = _readers.read_recording(path, time=time_col)
     if column is None:
         if rec.temperatures:
             column = rec.temperatures[0]
@@ -210,7 +212,7 @@ def rlg_validation_cmd(
     if against is not None:
         if holds is not None:
             raise ThermocalInputError("give either --holds or --against, not both")
-        _io.check_not_input(output, [against])
+        _writers.check_not_input(output, [against])
         _design(against, output, column, seed, limit, n_holds, hold_s, rate, dt, as_json)
         return
     params = _clean(
@@ -389,5 +391,5 @@ def design_validation_cmd(
     as_json: JsonOpt = False,
 ) -> None:
     """A hold profile over the modelling range, weakly correlated with it (seeded)."""
-    _io.check_not_input(output, [model])
+    _writers.check_not_input(output, [model])
     _design(model, output, column, seed, limit, n_holds, hold_s, rate, dt, as_json)

@@ -42,13 +42,13 @@ from thermocal.cli.common import (
 from thermocal.errors import FileFormatError, ThermocalInputError, ThermocalWarning
 
 if TYPE_CHECKING:
-    import thermocal.io as _io
     import thermocal.models.calibration as _calibration
     import thermocal.models.files as _files
     import thermocal.recording as _recording
     import thermocal.report as _report
+    import thermocal.writers as _writers
 else:
-    _io = LazyModule("thermocal.io")
+    _writers = LazyModule("thermocal.writers")
     _calibration = LazyModule("thermocal.models.calibration")
     _files = LazyModule("thermocal.models.files")
     _recording = LazyModule("thermocal.recording")
@@ -176,7 +176,7 @@ def report_cmd(
     inputs_files: list[str | Path] = [*model, *validations, recording]
     if modeling is not None:
         inputs_files.append(modeling)
-    _io.check_not_input(output, inputs_files)
+    _writers.check_not_input(output, inputs_files)
     cal = _files.load_calibration(model[0])
     if cal.triads and not cal.channels:  # a turntable calibration over temperature
         from thermocal.compensate import read_for_triads

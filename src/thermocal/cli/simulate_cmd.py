@@ -30,11 +30,15 @@ from thermocal.errors import FileFormatError, ThermocalInputError
 from thermocal.outputs import check_outputs
 
 if TYPE_CHECKING:
-    import thermocal.io as _io
+    import thermocal.outputs as _outputs
     import thermocal.profiles as _profiles
+    import thermocal.readers as _readers
     import thermocal.simulate as _simulate
+    import thermocal.writers as _writers
 else:
-    _io = LazyModule("thermocal.io")
+    _outputs = LazyModule("thermocal.outputs")
+    _readers = LazyModule("thermocal.readers")
+    _writers = LazyModule("thermocal.writers")
     _profiles = LazyModule("thermocal.profiles")
     _simulate = LazyModule("thermocal.simulate")
 
@@ -42,7 +46,7 @@ else:
 def output_paths(output: Path, scenario: str, labels: list[str], fmt: str) -> list[Path]:
     """File names for the results of a scenario (see the module docstring)."""
     try:
-        _io.file_kind(output)
+        _readers.file_kind(output)
         is_file = True
     except FileFormatError:
         is_file = False
@@ -68,7 +72,7 @@ def _early_gate(output: Path, truth: Path | None, inputs: list[str | Path]) -> N
     (:func:`thermocal.outputs.check_outputs`; the files named after the results are
     checked again once known)."""
     try:
-        _io.file_kind(output)
+        _readers.file_kind(output)
         files, dirs = [output], []
     except FileFormatError:
         files, dirs = [], [output]
@@ -154,15 +158,15 @@ def simulate_cmd(
     if len(set(labels)) != len(labels):
         labels = [f"{i + 1}" for i in range(len(results))]
     paths = output_paths(output, scenario, labels, fmt)
-    sidecars = [_io.sidecar_path(p) for p in paths if _io.file_kind(p) == "csv"]
+    sidecars = [_outputs.sidecar_path(p) for p in paths if _readers.file_kind(p) == "csv"]
     check_outputs([*paths, *sidecars], inputs, dirs=[p.parent for p in paths])
     if truth is not None:
-        _io.check_not_input(truth, [*inputs, *paths])
+        _writers.check_not_input(truth, [*inputs, *paths])
     for (rec, _), p in zip(results, paths, strict=True):
-        _io.write_recording(rec, p)
+        _writers.write_recording(rec, p)
     files = [{"file": str(p), **tr} for (_, tr), p in zip(results, paths, strict=True)]
     if truth is not None:
-        _io.write_json(
+        _writers.write_json(
             truth,
             {
                 "format": _simulate.TRUTH_FORMAT,

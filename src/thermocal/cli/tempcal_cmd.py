@@ -41,7 +41,7 @@ R = TypeVar("R")
 
 def staged_outputs(fn: Callable[P, R]) -> Callable[P, R]:
     """The output set is built in a staging directory beside DIR and moved into place when
-    complete (:func:`thermocal.io.commit_directory`); on any failure — a later sensor's
+    complete (:func:`thermocal.writers.commit_directory`); on any failure — a later sensor's
     error, Ctrl-C — this removes the staging directory, so that no part of the set is left."""
 
     @functools.wraps(fn)
@@ -49,7 +49,7 @@ def staged_outputs(fn: Callable[P, R]) -> Callable[P, R]:
         try:
             return fn(*args, **kwargs)
         except BaseException:
-            from thermocal.io import discard_staging
+            from thermocal.writers import discard_staging
 
             discard_staging()
             raise
@@ -77,7 +77,6 @@ def px4_tempcal_cmd(
     import numpy as np
 
     from thermocal.export_params import ParamSet, export_params, px4_offset_params
-    from thermocal.io import atomic_write, commit_directory, read_log_table, staging_directory
     from thermocal.models.calibration import Calibration
     from thermocal.models.files import save_calibration
     from thermocal.px4_tempcal import (
@@ -93,7 +92,9 @@ def px4_tempcal_cmd(
         step_warnings,
         summary,
     )
+    from thermocal.readers.dispatch import read_log_table
     from thermocal.report.calibration import CalibrationReportInputs, write_calibration_report
+    from thermocal.writers import atomic_write, commit_directory, staging_directory
 
     # DIR may hold the log; the files of the set (replaced by name) may not be it
     check_outputs([output / "calibration.json", output / "px4.params"], [log], dirs=[output])
@@ -237,13 +238,6 @@ def ardupilot_tempcal_cmd(
 
     from thermocal.errors import MissingColumnError
     from thermocal.export_params import ParamSet, export_params
-    from thermocal.io import (
-        atomic_write,
-        commit_directory,
-        dataflash_table,
-        read_dataflash_log,
-        staging_directory,
-    )
     from thermocal.models.calibration import Calibration
     from thermocal.models.files import save_calibration
     from thermocal.px4_tempcal import (
@@ -257,8 +251,10 @@ def ardupilot_tempcal_cmd(
         step_warnings,
         summary,
     )
+    from thermocal.readers.dataflash import dataflash_table, read_dataflash_log
     from thermocal.recording import Recording
     from thermocal.report.calibration import CalibrationReportInputs, write_calibration_report
+    from thermocal.writers import atomic_write, commit_directory, staging_directory
 
     # DIR may hold the log; the files of the set (replaced by name) may not be it
     names = ["calibration.json", "ardupilot.parm"]

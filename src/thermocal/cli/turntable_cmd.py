@@ -30,20 +30,22 @@ from thermocal.errors import ThermocalInputError
 if TYPE_CHECKING:
     import rich.table as _rich_table
 
-    import thermocal.io as _io
     import thermocal.models.calibration as _calibration
     import thermocal.models.files as _files
+    import thermocal.readers as _readers
     import thermocal.recording as _recording
     import thermocal.turntable.calibrate as _calibrate
     import thermocal.turntable.model as _model
     import thermocal.turntable.thermal as _thermal
+    import thermocal.writers as _writers
     from thermocal import units
 else:
     _calibration = LazyModule("thermocal.models.calibration")
     _files = LazyModule("thermocal.models.files")
     _thermal = LazyModule("thermocal.turntable.thermal")
     _rich_table = LazyModule("rich.table")
-    _io = LazyModule("thermocal.io")
+    _readers = LazyModule("thermocal.readers")
+    _writers = LazyModule("thermocal.writers")
     _calibrate = LazyModule("thermocal.turntable.calibrate")
     _model = LazyModule("thermocal.turntable.model")
     units = LazyModule("thermocal.units")
@@ -140,7 +142,7 @@ def turntable_cmd(
     several runs at soak temperatures (--temps), both triads' error models over temperature."""
     if order is not None:
         check_order(order)
-    _io.check_not_input(output, list(files))
+    _writers.check_not_input(output, list(files))
     gyro_cols = split_names(gyro) or []
     if len(gyro_cols) != 3:
         raise ThermocalInputError(f"--gyro needs three column names, got {gyro!r}")
@@ -164,7 +166,7 @@ def turntable_cmd(
     _rec, result = _calibrate_file(file, opts, min_positions=16)
     out = result.to_dict()
     out["input"] = str(file)
-    _io.write_json(output, out)
+    _writers.write_json(output, out)
 
     def human() -> None:
         table = _rich_table.Table(title=f"turntable calibration of {file} ({out['method']})")
@@ -223,7 +225,7 @@ def _calibrate_file(
     """Read one run and calibrate it.  The gyro columns' unit goes through the shared
     resolver: --gyro-unit > file metadata > unit in the column name > °/s (INTERFACE: gyro_z
     in °/s), the last stated in a warning."""
-    rec = _io.read_recording(
+    rec = _readers.read_recording(
         path,
         time=o.time,
         time_unit=o.time_unit,

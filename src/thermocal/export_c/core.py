@@ -85,8 +85,8 @@ class CExport:
         Neither may be one of ``inputs`` (the model file: ``export-c model.c -o .``) nor a
         special file (:func:`thermocal.outputs.check_outputs`)."""
         from thermocal.errors import ThermocalInputError
-        from thermocal.io import atomic_write
         from thermocal.outputs import check_outputs
+        from thermocal.writers import atomic_write
 
         d = Path(directory)
         check_outputs([d / self.header_name, d / self.source_name], inputs, dirs=[d])

@@ -263,7 +263,7 @@ def model_inputs(
     time unit, the signal's and temperatures' units as given (e.g. ``deg/s``, ``counts``)
     and where each was stated, the raw-count temperature conversions, the scale factor of
     a raw-count signal, and the known input removed (value in the canonical unit and what
-    it is).  ``rec`` is a recording read by :func:`thermocal.io.read_recording`."""
+    it is).  ``rec`` is a recording read by :func:`thermocal.readers.dispatch.read_recording`."""
     used = [signal, *temps]
     out: dict[str, Any] = {
         "time_unit": rec.time_unit,

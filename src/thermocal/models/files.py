@@ -4,7 +4,7 @@ The maths modules (:mod:`thermocal.models.base`, the families, :mod:`thermocal.m
 calibration`) build and check plain dicts (:func:`~thermocal.models.base.model_file_dict`,
 :func:`~thermocal.models.base.verify_model_dict`, :meth:`Calibration.to_dict`,
 :func:`~thermocal.models.calibration.calibration_from_dict`) and import no I/O; reading and
-writing the files (atomically, :func:`thermocal.io.write_json`) happens here.
+writing the files (atomically, :func:`thermocal.writers.write_json`) happens here.
 """
 
 from __future__ import annotations
@@ -14,7 +14,6 @@ from pathlib import Path
 from typing import Any
 
 from thermocal.errors import ModelFileError, ThermocalInputError
-from thermocal.io import write_json
 from thermocal.models.base import (
     MODEL_FORMAT,
     TemperatureModel,
@@ -29,6 +28,7 @@ from thermocal.models.calibration import (
     is_calibration,
 )
 from thermocal.models.filecheck import read_json
+from thermocal.writers import write_json
 
 
 def file_sha256(path: str | Path, chunk: int = 1 << 20) -> str:

@@ -40,7 +40,6 @@ from markupsafe import Markup, escape
 from thermocal import units
 from thermocal.defaults import DEFAULT_AVERAGING_S, WEAK_CORRELATION_LIMIT
 from thermocal.errors import ThermocalInputError, ThermocalWarning, UnitError
-from thermocal.io import atomic_write
 from thermocal.metrics import data_unit_of
 from thermocal.models.base import condition_wording
 from thermocal.recording import Recording
@@ -71,6 +70,7 @@ from thermocal.report.analysis import (
 from thermocal.report.analysis import (
     known_input_of as known_input_of,
 )
+from thermocal.writers import atomic_write
 
 ILL_CONDITIONED = 1.0e6
 """Condition number (scaled design) above which the report warns: ill-conditioned in the

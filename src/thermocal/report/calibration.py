@@ -35,7 +35,6 @@ from typing import Any
 from thermocal.compensation import unit_factor
 from thermocal.defaults import DEFAULT_AVERAGING_S
 from thermocal.errors import ThermocalInputError
-from thermocal.io import atomic_write
 from thermocal.models.base import model_file_dict
 from thermocal.models.calibration import Calibration
 from thermocal.recording import Recording
@@ -51,6 +50,7 @@ from thermocal.report.build import (
     sha256_of,
     unit_label,
 )
+from thermocal.writers import atomic_write
 
 
 @dataclass(frozen=True)

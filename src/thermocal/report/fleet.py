@@ -19,7 +19,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from thermocal.io import atomic_write
+from thermocal.writers import atomic_write
 
 if TYPE_CHECKING:
     from thermocal.fleet import FleetConfig

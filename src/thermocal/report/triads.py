@@ -14,7 +14,7 @@ from typing import Any
 
 import numpy as np
 
-from thermocal.io import atomic_write
+from thermocal.writers import atomic_write
 
 
 def _b64(png: bytes) -> str:

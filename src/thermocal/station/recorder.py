@@ -12,7 +12,7 @@ Rows wait in memory until their part is closed; the part is written under the te
 name, flushed to disk (``fsync``) and renamed.  A SIGKILL therefore loses at most the rows
 of the open part; every closed part is complete.  ``station.json`` is rewritten the same
 way (temporary, ``fsync``, rename) after each part and event.  A part's Parquet key-value
-metadata holds the thermocal metadata object (:func:`thermocal.io.recording_info`'s
+metadata holds the thermocal metadata object (:func:`thermocal.readers.dispatch.recording_info`'s
 layout: time column, units of every column, the sensor id and the station's metadata), so
 each part is a complete recording on its own and :func:`read_station` concatenates them.
 
@@ -208,7 +208,7 @@ class Recorder:
         st.rows += 1
 
     def _meta(self, st: _Stream) -> dict[str, Any]:
-        from thermocal.io import META_FORMAT, META_VERSION
+        from thermocal.recording import META_FORMAT, META_VERSION
 
         temps = {c: u for c, u in st.units.items() if c != "time" and _is_temperature(u)}
         sigs = {}
@@ -245,7 +245,7 @@ class Recorder:
         import pyarrow as pa
         import pyarrow.parquet as pq
 
-        from thermocal.io import META_KEY
+        from thermocal.recording import META_KEY
 
         written = []
         for st in self.streams.values():
@@ -369,7 +369,7 @@ def read_station(path: Path) -> tuple[pa.Table, dict[str, Any]]:
     import pyarrow as pa
     import pyarrow.parquet as pq
 
-    from thermocal.io import META_KEY
+    from thermocal.recording import META_KEY
 
     files = station_files(path)
     tables = []

@@ -2,9 +2,9 @@
 
 Every line gets the host's wall-clock time [s] (``time.time()``) when its bytes are read;
 lines read in one chunk share it.  A line is parsed with the text-log rules of
-:mod:`thermocal.io` (INTERFACE.md common rules): the fields split at the stated delimiter
+:mod:`thermocal.readers` (INTERFACE.md common rules): the fields split at the stated delimiter
 (or the first of ``,`` ``;`` tab blanks that gives one field per name), numbers as a CSV
-reader takes them (:func:`thermocal.io.parse_number`: no digit-group underscores, no
+reader takes them (:func:`thermocal.readers.text.parse_number`: no digit-group underscores, no
 non-ASCII digits), a decimal comma when the TOML says so.  A line that does not give one
 number per name — a banner, a mangled or cut line — is a *bad line*: counted, kept aside
 with its host time and reason, never merged into the data.  Empty lines are ignored.
@@ -45,7 +45,7 @@ class LineParser:
     decimal: str = "."
 
     def _numbers(self, fields: list[str]) -> tuple[float, ...]:
-        from thermocal.io import parse_number
+        from thermocal.readers.text import parse_number
 
         out = []
         for f in fields:

@@ -1,0 +1,350 @@
+"""What every reader shares: formats by suffix, encodings, memory checks, numeric columns,
+the time column's names, and the capture of log libraries' noise."""
+
+from __future__ import annotations
+
+import contextlib
+import functools
+import io
+import math
+import os
+import re
+import sys
+import tempfile
+import warnings
+from collections.abc import Iterator, Sequence
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from thermocal import units
+from thermocal._lazy import LazyModule
+from thermocal.errors import (
+    FileFormatError,
+    TextEncodingWarning,
+    ThermocalInputError,
+    ThermocalWarning,
+)
+from thermocal.outputs import TEMP_SUFFIX
+from thermocal.recording import FloatArray
+
+if TYPE_CHECKING:
+    import pandas as pd
+    import pyarrow as pa
+    import pyarrow.csv as pacsv
+    import pyarrow.parquet as pq
+else:
+    pd = LazyModule("pandas")
+    pa = LazyModule("pyarrow")
+    pacsv = LazyModule("pyarrow.csv")
+    pq = LazyModule("pyarrow.parquet")
+
+
+@functools.cache
+def csv_float_options() -> dict[str, Any]:
+    """``pandas.read_csv`` options that parse every decimal to the nearest float64 (pandas < 3's
+    default parser can be one ulp off; pandas 3 is exact by default and deprecates the option).
+    A function so that importing this module does not import pandas (issue 17)."""
+    major = int(pd.__version__.split(".")[0])
+    return {"float_precision": "round_trip"} if major < 3 else {}
+
+
+CSV_SUFFIXES = (".csv", ".txt", ".csv.gz", ".log", ".tsv", ".dat")
+PARQUET_SUFFIXES = (".parquet", ".pq")
+ULOG_SUFFIXES = (".ulg",)
+DATAFLASH_SUFFIXES = (".bin",)
+
+
+def file_kind(path: str | Path) -> str:
+    """``'csv'`` or ``'parquet'`` from the extension, else :class:`FileFormatError`."""
+    name = str(path).lower()
+    if name.endswith(TEMP_SUFFIX):
+        raise FileFormatError(
+            f"{path}: an unfinished output of an interrupted thermocal run, not a result; "
+            "delete it (the next run to the same output removes it)"
+        )
+    if name.endswith(PARQUET_SUFFIXES):
+        return "parquet"
+    if name.endswith(ULOG_SUFFIXES):
+        return "ulog"
+    if name.endswith(DATAFLASH_SUFFIXES):
+        return "dataflash"
+    if name.endswith(CSV_SUFFIXES):
+        return "csv"
+    raise FileFormatError(
+        f"{path}: not a CSV or Parquet file (expected extension .csv, or .txt, .log, .tsv, "
+        ".dat for a text log, .parquet, .ulg for a PX4 log or .bin for an ArduPilot log)"
+    )
+
+
+def csv_encoding(path: str | Path, probe_bytes: int = 1 << 16) -> str:
+    """The text encoding of a CSV file: ``utf-8-sig`` (UTF-8, with or without a byte-order
+    mark) when its start decodes as UTF-8, else ``latin-1`` (Western lab PCs and
+    instrument software write it; a ``°`` in a header is the usual case, stated in a
+    warning).  UTF-16/32 (NUL bytes) are refused with the remedy.
+    """
+    p = Path(path)
+    with open(p, "rb") as fh:
+        head = fh.read(probe_bytes)
+    if head.startswith((b"\xff\xfe", b"\xfe\xff")) or b"\x00" in head:
+        raise FileFormatError(
+            f"{p}: the text is UTF-16 or UTF-32 encoded (NUL bytes); save it as UTF-8 CSV"
+        )
+    try:
+        head.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        if exc.start < len(head) - 4:  # not just a character cut at the probe's end
+            warnings.warn(
+                TextEncodingWarning(
+                    f"{p}: not UTF-8 (byte {head[exc.start]:#04x} at offset {exc.start}); "
+                    "read as Latin-1"
+                ),
+                stacklevel=3,
+            )
+            return "latin-1"
+    return "utf-8-sig"
+
+
+BYTES_PER_VALUE = 8
+"""A value read is one float64."""
+WORKING_BYTES_PER_ROW = 40
+"""Working memory of the commands beyond the columns, per row (measured: 30-35 B/row at
+10⁷ rows, benchmarks/RESULTS.md), rounded up."""
+
+
+def memory_limit_bytes() -> int | None:
+    """Memory a read may use [bytes]: ``THERMOCAL_MEMORY_LIMIT`` (``2G``, ``512M``, bytes)
+    when set, else 90 % of the kernel's ``MemAvailable``; None where neither is known."""
+    env = os.environ.get("THERMOCAL_MEMORY_LIMIT", "").strip()
+    if env:
+        scale = {"K": 1 << 10, "M": 1 << 20, "G": 1 << 30, "T": 1 << 40}
+        try:
+            if env[-1].upper() in scale:
+                return int(float(env[:-1]) * scale[env[-1].upper()])
+            return int(float(env))
+        except ValueError:
+            raise ThermocalInputError(
+                f"THERMOCAL_MEMORY_LIMIT={env!r}: give bytes or a number with K, M, G or T"
+            ) from None
+    try:
+        with open("/proc/meminfo", encoding="ascii") as fh:
+            for line in fh:
+                if line.startswith("MemAvailable:"):
+                    return int(0.9 * int(line.split()[1]) * 1024)
+    except OSError:
+        return None
+    return None
+
+
+def check_memory(path: Path, n_rows: int, n_columns: int, *, estimated: bool = False) -> None:
+    """Refuse up front a read that would not fit in memory (issue 14).
+
+    Needed ≈ ``n_rows · (8 · n_columns + 40)`` bytes (the float64 columns plus the
+    commands' working memory); compared with :func:`memory_limit_bytes`. The error gives
+    both figures and the ways out (cut the file; ``compensate`` streams it).
+    """
+    limit = memory_limit_bytes()
+    need = n_rows * (BYTES_PER_VALUE * n_columns + WORKING_BYTES_PER_ROW)
+    if limit is None or need <= limit:
+        return
+    about = "about " if estimated else ""
+    raise ThermocalInputError(
+        f"{path}: reading {about}{n_rows:,} rows of {n_columns} column(s) needs about "
+        f"{need / 2**30:.3g} GiB of memory, more than the {limit / 2**30:.3g} GiB available "
+        "(THERMOCAL_MEMORY_LIMIT or the machine's free memory); cut the file by time, or "
+        "compensate it (compensate streams any length)"
+    )
+
+
+def csv_rows_estimate(path: Path, probe_bytes: int = 1 << 16) -> tuple[int, int]:
+    """(rows, columns) of a CSV estimated from its size and its first lines."""
+    size = path.stat().st_size
+    with open(path, "rb") as fh:
+        head = fh.read(probe_bytes)
+    lines = head.splitlines()
+    if len(lines) < 2:
+        return 1, max(1, head.count(b",") + 1)
+    body = lines[1:-1] if len(lines) > 2 else lines[1:]
+    mean_len = max(1.0, sum(len(x) + 1 for x in body) / len(body))
+    cols = max(lines[0].count(b","), lines[0].count(b";"), lines[0].count(b"\t")) + 1
+    return int(size / mean_len), cols
+
+
+def short_name(name: str, limit: int = 60) -> str:
+    """``repr`` of a column name for a message, cut to ``limit`` characters (a header of
+    megabytes must not become a message of megabytes)."""
+    return repr(name) if len(name) <= limit else repr(name[:limit]) + f"… ({len(name):,} chars)"
+
+
+def names_list(names: Sequence[str], limit: int = 20) -> str:
+    """Column names for a message: the first ``limit``, each cut (:func:`short_name`)."""
+    shown = ", ".join(short_name(c) for c in names[:limit])
+    return shown + (f", … ({len(names) - limit:,} more)" if len(names) > limit else "")
+
+
+def check_unique_names(path: str | Path, names: Sequence[str]) -> None:
+    """Refuse a header that names a column twice (compared after stripping blanks): which
+    of the two a command would read is a guess (:class:`FileFormatError` naming it)."""
+    seen: dict[str, int] = {}
+    for k, raw in enumerate(names):
+        name = str(raw).strip()
+        if not name:
+            continue  # unnamed columns are told apart by position
+        if name in seen:
+            raise FileFormatError(
+                f"{path}: the column name {short_name(name)} appears twice (columns "
+                f"{seen[name] + 1} and {k + 1}); rename one"
+            )
+        seen[name] = k
+
+
+class LogDamageWarning(ThermocalWarning):
+    """A flight-controller log is cut or damaged: what was lost is said."""
+
+
+class LibraryNoise:
+    """A text sink counting the lines a log library prints, by kind (numbers and hex
+    replaced by ``#``), so that 143 652 ``bad header`` lines become one sentence."""
+
+    MAX_KINDS = 50
+
+    def __init__(self) -> None:
+        self.lines = 0
+        self.kinds: dict[str, int] = {}
+        self._part = ""
+
+    def write(self, text: str) -> int:
+        self._part += text
+        if "\n" in self._part:
+            *done, self._part = self._part.split("\n")
+            for line in done:
+                self._count(line)
+        return len(text)
+
+    def flush(self) -> None:
+        pass
+
+    def _count(self, line: str) -> None:
+        line = line.strip()
+        if not line:
+            return
+        self.lines += 1
+        kind = re.sub(r"0x[0-9a-fA-F]+|\d+", "#", line[:200])[:80]
+        if kind not in self.kinds and len(self.kinds) >= self.MAX_KINDS:
+            kind = "other messages"
+        self.kinds[kind] = self.kinds.get(kind, 0) + 1
+
+    def close(self) -> None:
+        if self._part:
+            self._count(self._part)
+            self._part = ""
+
+    def summary(self, library: str) -> str:
+        """``pymavlink printed 143 652 line(s): 143 650 × 'bad header # at #', …`` or ``""``."""
+        if not self.lines:
+            return ""
+        top = sorted(self.kinds.items(), key=lambda kv: -kv[1])[:3]
+        shown = ", ".join(f"{n:,} × {k!r}" for k, n in top)
+        more = ", …" if len(self.kinds) > 3 else ""
+        return f"{library} printed {self.lines:,} line(s), not shown: {shown}{more}"
+
+
+@contextlib.contextmanager
+def library_output_captured() -> Iterator[LibraryNoise]:
+    """Capture what a log library prints while reading: Python's ``sys.stdout``/``stderr``
+    and the file descriptors 1 and 2 underneath (compiled parts print there), counted in a
+    :class:`LibraryNoise` instead of flooding the terminal."""
+    noise = LibraryNoise()
+    saved: list[tuple[int, int]] = []
+    spool = tempfile.TemporaryFile()  # noqa: SIM115 (closed in the finally below)
+    for stream in (sys.stdout, sys.stderr, sys.__stdout__, sys.__stderr__):
+        with contextlib.suppress(Exception):
+            if stream is not None:
+                stream.flush()
+    for fd in (1, 2):
+        try:
+            saved.append((fd, os.dup(fd)))
+            os.dup2(spool.fileno(), fd)
+        except OSError:
+            continue
+    try:
+        with contextlib.redirect_stdout(noise), contextlib.redirect_stderr(noise):
+            yield noise
+    finally:
+        for fd, copy in saved:
+            os.dup2(copy, fd)
+            os.close(copy)
+        spool.seek(0)
+        for raw in spool:
+            noise.write(raw.decode("utf-8", "replace"))
+        spool.close()
+        noise.close()
+
+
+class TrackedReader(io.BufferedReader):
+    """A log file as a library reads it, noting where the library stopped (the position at
+    ``close``) and whether its last read came back short (the file ends inside a message;
+    a clean end is a read of nothing)."""
+
+    def __init__(self, path: Path) -> None:
+        super().__init__(io.FileIO(path, "rb"))
+        self.stopped_at: int | None = None
+        self.short_read = False
+
+    def read(self, size: int | None = -1) -> bytes:
+        data = super().read(size)
+        self.short_read = size is not None and size > 0 and 0 < len(data) < size
+        return data
+
+    def close(self) -> None:
+        if self.stopped_at is None and not self.closed:
+            self.stopped_at = self.tell()
+        super().close()
+
+
+def warn_damage(path: Path, notes: Sequence[str]) -> None:
+    if notes:
+        warnings.warn(
+            LogDamageWarning(f"{path}: the log is damaged: " + "; ".join(notes)), stacklevel=3
+        )
+
+
+def arrow_chunk_f64(chunk: pa.Array) -> FloatArray:
+    """A numeric Arrow array as float64, nulls as NaN, without pandas: ``to_numpy`` with
+    copies allowed goes through pyarrow's pandas shim and imports pandas (0.3 s)."""
+    if not pa.types.is_float64(chunk.type):
+        chunk = chunk.cast(pa.float64())
+    if chunk.null_count:
+        chunk = chunk.fill_null(math.nan)
+    data = chunk.buffers()[1]  # the values; ``to_numpy`` itself imports pandas
+    if data is None:  # an empty array
+        return np.empty(0, dtype=np.float64)
+    return np.frombuffer(data, dtype=np.float64, count=len(chunk), offset=8 * chunk.offset)
+
+
+TIME_COLUMN_NAMES = ("time", "t", "timestamp", "elapsed", "elapsed time")
+"""Names a time column goes by, compared without case and without a unit written in the
+name (``time``, ``Time (ms)``, ``time_s``, ``timestamp_us``)."""
+
+
+def default_time_column(names: Sequence[str], stated: str | None = None) -> str:
+    """The time column when ``--time`` is not given: ``stated`` (the sidecar's), else
+    ``time`` if present, else the one column whose name, with any unit stripped
+    (:func:`thermocal.units.unit_in_column_name`), is one of :data:`TIME_COLUMN_NAMES`.
+    Several candidates, or none, give ``"time"`` (and so a missing-column error that
+    lists what is there) rather than a guess.
+    """
+    if stated:
+        return stated
+    if "time" in names:
+        return "time"
+    found = []
+    for c in names:
+        base = c.strip()
+        unit = units.unit_in_column_name(c, "time")
+        if unit is not None:
+            base = units.strip_unit_from_name(c)
+        if base.lower() in TIME_COLUMN_NAMES:
+            found.append(c)
+    return found[0] if len(found) == 1 else "time"

@@ -1,0 +1,341 @@
+"""One entry for every file a command takes: :func:`read_recording` dispatches by format
+(CSV/Parquet, text log, ULog, DataFlash, station folder) and returns a :class:`Recording`."""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import warnings
+from collections.abc import Sequence
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+from thermocal import units
+from thermocal._lazy import LazyModule
+from thermocal.errors import (
+    FileFormatError,
+    MissingColumnError,
+    NonNumericError,
+    ThermocalInputError,
+    UnitWarning,
+)
+from thermocal.readers.common import (
+    check_memory,
+    check_unique_names,
+    csv_encoding,
+    csv_float_options,
+    csv_rows_estimate,
+    default_time_column,
+    file_kind,
+    names_list,
+    short_name,
+)
+from thermocal.readers.dataflash import read_dataflash
+from thermocal.readers.station import is_station_path, read_station_table
+from thermocal.readers.table import ParquetColumns, csv_header_names, load_sidecar, numeric_column
+from thermocal.readers.text import TextOptions, head_lines, rate_time, read_text, sniff_text
+from thermocal.readers.ulog import read_ulog
+from thermocal.recording import META_FORMAT, META_KEY, META_VERSION, FloatArray, Metadata, Recording
+
+if TYPE_CHECKING:
+    import pandas as pd
+    import pyarrow as pa
+    import pyarrow.csv as pacsv
+    import pyarrow.parquet as pq
+else:
+    pd = LazyModule("pandas")
+    pa = LazyModule("pyarrow")
+    pacsv = LazyModule("pyarrow.csv")
+    pq = LazyModule("pyarrow.parquet")
+
+
+def read_table(
+    path: Path, kind: str, text: TextOptions | None = None, topic: str | None = None
+) -> tuple[pd.DataFrame | ParquetColumns, dict[str, Any]]:
+    if not path.exists():
+        raise FileFormatError(f"{path}: no such file")
+    if path.stat().st_size == 0:
+        raise FileFormatError(f"{path}: the file is empty")
+    if kind == "ulog":
+        return read_ulog(path, topic)
+    if kind == "dataflash":
+        return read_dataflash(path, topic)
+    if kind == "parquet":
+        try:
+            table = ParquetColumns(pq.ParquetFile(path, page_checksum_verification=True))
+        except (pa.ArrowInvalid, OSError) as exc:
+            raise FileFormatError(f"{path}: not a readable Parquet file ({exc})") from None
+        check_unique_names(path, table.column_names)
+        meta: dict[str, Any] = {}
+        raw = table.metadata.get(META_KEY.encode())
+        if raw:
+            try:
+                meta = json.loads(raw.decode("utf-8"))
+            except (json.JSONDecodeError, UnicodeDecodeError):
+                raise FileFormatError(f"{path}: corrupt thermocal metadata") from None
+        return table, meta
+    encoding = csv_encoding(path)
+    # pandas holds every column of a CSV (and its parser about as much again)
+    rows_est, cols_est = csv_rows_estimate(path)
+    check_memory(path, rows_est, 2 * cols_est, estimated=True)
+    if not path.name.lower().endswith(".gz"):
+        head = head_lines(path, encoding, "replace")
+        try:
+            lay = sniff_text(head, text)
+        except FileFormatError:
+            lay = None  # not numeric text: the CSV reader says what is wrong
+        needs_text = text is not None and (
+            text.names is not None or text.on_bad_lines == "skip" or text.delimiter or text.decimal
+        )
+        if (lay is not None and not lay.plain) or needs_text:
+            return read_text(path, encoding, text)
+    check_unique_names(path, csv_header_names(path, encoding))  # before pandas renames
+    try:
+        df = pd.read_csv(
+            path,
+            skipinitialspace=True,
+            comment=None,
+            low_memory=False,
+            **csv_float_options(),
+            encoding=encoding,
+        )
+    except pd.errors.EmptyDataError:
+        raise FileFormatError(f"{path}: the file is empty (no header)") from None
+    except (pd.errors.ParserError, UnicodeDecodeError) as exc:
+        msg = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+        raise FileFormatError(f"{path}: not a readable CSV file ({msg})") from None
+    df.columns = [str(c).strip() for c in df.columns]
+    check_unique_names(path, list(df.columns))  # ``a`` and ``a `` are one name stripped
+    return df, {}
+
+
+def read_log_table(path: str | Path, topic: str | None) -> tuple[pd.DataFrame, dict[str, Any]]:
+    """One topic instance of a flight-controller log (.ulg, .bin) as a table and its
+    metadata (for commands that go through it in chunks: compensate)."""
+    p = Path(path)
+    kind = file_kind(p)
+    if kind not in ("ulog", "dataflash"):
+        raise ThermocalInputError(f"{p}: --topic is for flight-controller logs (.ulg, .bin)")
+    obj, info = read_table(p, kind, None, topic)
+    assert isinstance(obj, pd.DataFrame)
+    return obj, info
+
+
+def read_text_table(
+    path: str | Path, text: TextOptions, time: str | None = None
+) -> tuple[pd.DataFrame, dict[str, Any]]:
+    """A text log read whole with ``text`` (names, rate, bad lines, delimiter, decimal):
+    the table (a ``time`` column added for ``--rate``) and its sidecar metadata — for
+    commands that then go through it in chunks (compensate).  Text logs are small; the
+    memory check still applies."""
+    p = Path(path)
+    if file_kind(p) != "csv":
+        raise ThermocalInputError(
+            f"{p}: --names, --rate, --on-bad-lines, --delimiter and --decimal are for text logs"
+        )
+    obj, file_meta = read_table(p, "csv", text)
+    info: dict[str, Any] = {**file_meta, **load_sidecar(p)}
+    assert isinstance(obj, pd.DataFrame)
+    names = list(obj.columns)
+    if text.rate_hz is not None:
+        obj, names, t_col, t_unit = rate_time(p, obj, names, info, time, None, text)
+        info["time"], info["time_unit"] = t_col, t_unit
+    return obj, info
+
+
+def _fc_log_unknown_units(
+    p: Path,
+    info: dict[str, Any],
+    sig_names: Sequence[str],
+    option: str | None,
+    model: units.StatedUnits | None,
+) -> None:
+    """A flight-controller log's field whose unit neither the firmware's message definition
+    known here (:data:`PX4_UNITS`, :data:`ARDUPILOT_UNITS`), nor ``--signal-unit``, the column
+    name or the model states is read as raw values (``counts``, not converted) with a
+    :class:`~thermocal.errors.UnitWarning` — never guessed as °/h (issue 28)."""
+    if option:
+        return
+    known: dict[str, str] = info.setdefault("units", {})
+    topic = info.get("ulog_topic") or info.get("dataflash_message") or "?"
+    for c in sig_names:
+        if c in known or units.unit_in_column_name(c, "signal") is not None:
+            continue
+        if model is not None and model.columns.get(c):
+            continue
+        known[c] = "counts"
+        warnings.warn(
+            UnitWarning(
+                f"{p}: the unit of field {c!r} of {topic} is not known from the firmware's "
+                "message definition: read as raw values (counts), not converted; give "
+                "--signal-unit"
+            ),
+            stacklevel=3,
+        )
+
+
+def read_recording(
+    path: str | Path,
+    *,
+    time: str | None = None,
+    time_unit: str | None = None,
+    signals: list[str] | None = None,
+    temperatures: list[str] | None = None,
+    signal_unit: str | None = None,
+    temp_unit: str | None = None,
+    meta: Metadata | None = None,
+    keep_other: bool = True,
+    skipped: list[str] | None = None,
+    temp_conversion: units.TemperatureConversion | None = None,
+    model: units.StatedUnits | None = None,
+    text: TextOptions | None = None,
+    topic: str | None = None,
+) -> Recording:
+    """Read a CSV, text log or Parquet recording, or a station's recording folder.
+
+    Parameters
+    ----------
+    path : the file; its extension chooses the format.  A folder written by ``thermocal
+        station run`` is read as one recording (``DIR``, or ``DIR/SENSOR`` of several).
+    time : name of the time column (default: sidecar's, else ``"time"``).
+    time_unit : ``s``, ``ms`` or ``us``; converted to [s].
+    signals, temperatures : column names with those roles (default: sidecar's).
+    signal_unit, temp_unit : units of those columns (override the sidecar); ``signal_unit``
+        may be ``U1,…,Un``, one per signal.
+    meta : metadata that overrides the file's (its temperature conversions count as
+        options).
+    keep_other : keep the other numeric columns (non-numeric ones are skipped).
+    skipped : if a list is given, the names of skipped non-numeric columns are appended.
+    temp_conversion : ``--temp-conversion``, the counts → °C conversion of every
+        temperature column (which it says are raw counts).
+    model : the units a model file recorded of its inputs
+        (:meth:`thermocal.units.StatedUnits.from_model_inputs`): used where the option,
+        the file and the column name are silent.
+    text : how to read a text log (:class:`TextOptions`: ``--names``, ``--rate``,
+        ``--on-bad-lines``, ``--delimiter``, ``--decimal``); banners, other delimiters and
+        decimal commas are detected without it.
+    topic : a PX4 ULog's topic instance, ``NAME[.N]`` (default ``sensor_gyro.0``).
+
+    Units and temperature conversions are resolved once by
+    :func:`thermocal.units.resolve_inputs` (option > file metadata > column name > model
+    file > a default stated in a warning); the source of each is in
+    ``Recording.unit_sources``.
+
+    Raises
+    ------
+    FileFormatError : not CSV/Parquet, unreadable or empty.
+    MissingColumnError : a named column is absent (the available ones are listed).
+    NonNumericError : a non-numeric cell in a named column (row and column named).
+    UnitError : an unknown unit string.
+    """
+    p = Path(path)
+    station = is_station_path(p)  # a station's recording folder, DIR or DIR/SENSOR
+    kind = "station" if station else file_kind(p)
+    if topic is not None and kind not in ("ulog", "dataflash"):
+        raise ThermocalInputError(f"{p}: --topic is for flight-controller logs (.ulg, .bin)")
+    obj, file_meta = read_station_table(p) if station else read_table(p, kind, text, topic)
+    side = load_sidecar(p)
+    info: dict[str, Any] = {**file_meta, **side}
+
+    names = list(obj.column_names) if isinstance(obj, ParquetColumns) else list(obj.columns)
+    if text is not None and text.rate_hz is not None:
+        obj, names, time, time_unit = rate_time(p, obj, names, info, time, time_unit, text)
+    if not names:
+        raise FileFormatError(f"{p}: the file has no columns")
+    n_rows = obj.num_rows if isinstance(obj, ParquetColumns) else len(obj)
+    if n_rows == 0:
+        raise FileFormatError(f"{p}: the file has a header but no data rows")
+
+    time_col = time or default_time_column(names, info.get("time"))
+    where = str(p)
+    sig_info: dict[str, str] = dict(info.get("signals") or {})
+    tmp_info: dict[str, str] = dict(info.get("temperatures") or {})
+    sig_names = list(signals) if signals is not None else list(sig_info)
+    tmp_names = list(temperatures) if temperatures is not None else list(tmp_info)
+    md = Metadata.from_dict(dict(info.get("metadata") or {}))
+    if meta is not None:
+        md = md.merged(meta)
+
+    present = set(names)
+    for c in [time_col, *sig_names, *tmp_names]:
+        if c not in present:
+            raise MissingColumnError(
+                f"{p}: no column {short_name(c)}; available: {names_list(names)}"
+            )
+
+    if info.get("fc_log"):
+        _fc_log_unknown_units(p, info, sig_names, signal_unit, model)
+    stated = units.StatedUnits.from_file_info(info, where)
+    resolved = units.resolve_inputs(
+        time_col,
+        sig_names,
+        tmp_names,
+        options=units.UnitOptions(
+            time_unit=time_unit,
+            signal_unit=signal_unit,
+            temp_unit=temp_unit,
+            temp_conversion=temp_conversion,
+        ),
+        file=dataclasses.replace(
+            stated,
+            conversions={**stated.conversions, **(meta.temperature_conversion if meta else {})},
+        ),
+        model=model,
+        where=where,
+    )
+    if isinstance(obj, ParquetColumns):  # read column by column: only what is used
+        used = len(names) if keep_other else 1 + len(sig_names) + len(tmp_names)
+        check_memory(p, n_rows, used)
+        obj.read_f64([time_col, *sig_names, *tmp_names])
+    t = numeric_column(obj, time_col, p)
+    if resolved.time.unit != "s":
+        t = t * units.TIME_UNITS[resolved.time.unit]
+
+    cols: dict[str, FloatArray] = {c: numeric_column(obj, c, p) for c in [*sig_names, *tmp_names]}
+    unit_map: dict[str, str] = resolved.units()
+    md.temperature_conversion = {  # the resolved ones; others kept for guessed columns
+        **{c: v for c, v in md.temperature_conversion.items() if c not in tmp_names},
+        **{c: r.conversion for c, r in resolved.conversions.items() if r.conversion is not None},
+    }
+    extra_units: dict[str, str] = dict(info.get("units") or {})
+    if keep_other:
+        for c in names:
+            if c == time_col or c in cols:
+                continue
+            try:
+                cols[c] = numeric_column(obj, c, p)
+            except NonNumericError:
+                if skipped is not None:
+                    skipped.append(c)
+                continue
+            unit_map[c] = units.other_column_unit(c, extra_units.get(c))
+
+    return Recording(
+        time_s=t,
+        columns=cols,
+        units=unit_map,
+        signals=tuple(sig_names),
+        temperatures=tuple(tmp_names),
+        meta=md,
+        source=str(p),
+        time_unit=resolved.time.unit,
+        unit_sources=resolved.sources(),
+    )
+
+
+def recording_info(rec: Recording, time: str = "time") -> dict[str, Any]:
+    """The metadata object written beside (or into) a recording file."""
+    return {
+        "format": META_FORMAT,
+        "version": META_VERSION,
+        "time": time,
+        "time_unit": "s",
+        "signals": {s: rec.units.get(s, "") for s in rec.signals},
+        "temperatures": {s: rec.units.get(s, "") for s in rec.temperatures},
+        "units": {
+            c: u
+            for c, u in rec.units.items()
+            if u and c not in rec.signals and c not in rec.temperatures
+        },
+        "metadata": rec.meta.to_dict(),
+    }

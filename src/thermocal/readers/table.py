@@ -1,0 +1,208 @@
+"""CSV and Parquet tables with units in a sidecar, in Parquet metadata or in column names."""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Callable, Sequence
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from thermocal._lazy import LazyModule
+from thermocal.errors import (
+    FileFormatError,
+    NonNumericError,
+)
+from thermocal.outputs import sidecar_path
+from thermocal.readers.common import arrow_chunk_f64, short_name
+from thermocal.recording import FloatArray
+
+if TYPE_CHECKING:
+    import pandas as pd
+    import pyarrow as pa
+    import pyarrow.csv as pacsv
+    import pyarrow.parquet as pq
+else:
+    pd = LazyModule("pandas")
+    pa = LazyModule("pyarrow")
+    pacsv = LazyModule("pyarrow.csv")
+    pq = LazyModule("pyarrow.parquet")
+
+
+# --- reading -------------------------------------------------------------------------
+
+
+def load_sidecar(path: Path) -> dict[str, Any]:
+    side = sidecar_path(path)
+    if not side.exists():
+        return {}
+    try:
+        obj = json.loads(side.read_text(encoding="utf-8"))
+    except (json.JSONDecodeError, UnicodeDecodeError) as exc:
+        raise FileFormatError(f"{side}: not valid JSON ({exc})") from None
+    if not isinstance(obj, dict):
+        raise FileFormatError(f"{side}: expected a JSON object")
+    return obj
+
+
+class ParquetColumns:
+    """Columns of a Parquet file read one at a time, so that peak memory stays near
+    the size of the float64 arrays handed back (not the Arrow table plus its copy)."""
+
+    def __init__(self, pf: pq.ParquetFile) -> None:
+        self._pf = pf
+        schema = pf.schema_arrow
+        self.column_names: list[str] = list(schema.names)
+        self.num_rows: int = int(pf.metadata.num_rows)
+        self.metadata: dict[bytes, bytes] = dict(schema.metadata or {})
+        self._read: dict[str, FloatArray] = {}
+
+    def read_f64(self, names: Sequence[str]) -> None:
+        """Read the integer and floating-point columns among ``names`` together, one row
+        group at a time (pyarrow decodes the columns of a row group on several threads);
+        :meth:`column_f64` then hands each one over.  Peak memory: the results plus one
+        row group of these columns."""
+        schema = self._pf.schema_arrow
+        todo = [
+            n
+            for n in dict.fromkeys(names)
+            if n in self.column_names
+            and n not in self._read
+            and (
+                pa.types.is_integer(schema.field(n).type)
+                or pa.types.is_floating(schema.field(n).type)
+            )
+        ]
+        if len(todo) < 2:
+            return
+        out = {n: np.empty(self.num_rows, dtype=np.float64) for n in todo}
+        pos = 0
+        try:
+            for i in range(self._pf.num_row_groups):
+                k = 0
+                for n in todo:  # one column chunk at a time: the decoding buffers of one
+                    group = self._pf.read_row_group(i, columns=[n], use_threads=False)
+                    k = 0
+                    for chunk in group.column(0).chunks:
+                        out[n][pos + k : pos + k + len(chunk)] = arrow_chunk_f64(chunk)
+                        k += len(chunk)
+                    del group
+                pos += k
+        except (pa.ArrowInvalid, OSError):
+            return  # a damaged file: column by column, the error names the column
+        if pos == self.num_rows:
+            self._read.update(out)
+
+    def column(self, name: str) -> pa.ChunkedArray:
+        col: pa.ChunkedArray = self._pf.read(columns=[name], use_threads=True).column(0)
+        return col
+
+    def column_f64(self, name: str) -> FloatArray | None:
+        """A numeric column as float64, read one row group at a time into the result, so
+        that the only memory beyond the result is one row group of one column (None for a
+        column that is not integer or floating point: the caller reads it whole)."""
+        if name in self._read:  # read with others by :meth:`read_f64`
+            return self._read.pop(name)
+        field_type = self._pf.schema_arrow.field(name).type
+        if not (pa.types.is_integer(field_type) or pa.types.is_floating(field_type)):
+            return None
+        out = np.empty(self.num_rows, dtype=np.float64)
+        pos = 0
+        for i in range(self._pf.num_row_groups):
+            col = self._pf.read_row_group(i, columns=[name]).column(0)
+            for chunk in col.chunks:
+                k = len(chunk)
+                out[pos : pos + k] = arrow_chunk_f64(chunk)  # nulls → NaN
+                pos += k
+            del col
+        if pos != self.num_rows:
+            raise pa.ArrowInvalid(f"column {name!r} has {pos} rows, the file {self.num_rows}")
+        return out
+
+
+def csv_header_names(path: Path, encoding: str) -> list[str]:
+    """The names of a comma CSV's header line as written (pandas renames a repeated name
+    ``a.1``, so repeats are looked for here).  One pass over the line: linear in its
+    length.  Empty for a header the ``csv`` module cannot split (the reader then says)."""
+    opener: Callable[..., Any] = open
+    if path.name.lower().endswith(".gz"):
+        import gzip
+
+        opener = gzip.open
+    try:
+        with opener(path, "rt", encoding=encoding, errors="replace", newline="") as fh:
+            line = fh.readline().lstrip("\ufeff")
+    except (OSError, EOFError):
+        return []
+    if '"' not in line:
+        return [f.strip() for f in line.rstrip("\r\n").split(",")]
+    import csv
+
+    try:
+        return [f.strip() for f in next(csv.reader([line], skipinitialspace=True), [])]
+    except csv.Error:  # a quoted field beyond the csv module's size limit
+        return []
+
+
+def arrow_to_f64(col: pa.ChunkedArray | pa.Array, name: str, path: Path) -> FloatArray:
+    """An Arrow column as float64 (copied chunk by chunk into one array)."""
+    if not (pa.types.is_integer(col.type) or pa.types.is_floating(col.type)):
+        if pa.types.is_boolean(col.type) or pa.types.is_decimal(col.type):
+            return np.asarray(col.to_numpy(zero_copy_only=False), dtype=np.float64)
+        raise NonNumericError(f"{path}: column {name!r} is not numeric (type {col.type})")
+    chunks = col.chunks if isinstance(col, pa.ChunkedArray) else [col]
+    if col.null_count == 0 and pa.types.is_float64(col.type):
+        if len(chunks) == 1:
+            return arrow_chunk_f64(chunks[0])
+        out = np.empty(len(col), dtype=np.float64)
+        pos = 0
+        for chunk in chunks:
+            n = len(chunk)
+            out[pos : pos + n] = chunk.to_numpy(zero_copy_only=True)
+            pos += n
+        return out
+    out = np.empty(len(col), dtype=np.float64)
+    pos = 0
+    for chunk in chunks:
+        out[pos : pos + len(chunk)] = arrow_chunk_f64(chunk)
+        pos += len(chunk)
+    return out
+
+
+def numeric_column(
+    obj: pd.DataFrame | pa.RecordBatch | ParquetColumns,
+    name: str,
+    path: str | Path,
+    row_offset: int = 0,
+) -> FloatArray:
+    """A column of a table (or of a chunk of one) as float64.
+
+    Missing cells become NaN.  A cell that is not a number raises
+    :class:`NonNumericError` naming the column and the row (``row_offset`` is the
+    file row of the chunk's first row, for chunked readers).
+    """
+    p = Path(path)
+    if isinstance(obj, ParquetColumns):
+        try:
+            direct = obj.column_f64(name)
+            if direct is not None:
+                return direct
+            col = obj.column(name)
+        except (pa.ArrowInvalid, OSError) as exc:
+            raise FileFormatError(f"{p}: cannot read column {name!r} ({exc})") from None
+        return arrow_to_f64(col, name, p)
+    if isinstance(obj, pa.RecordBatch):
+        return arrow_to_f64(obj.column(name), name, p)
+    series = obj[name]
+    if pd.api.types.is_numeric_dtype(series.dtype) and not pd.api.types.is_bool_dtype(series.dtype):
+        return series.to_numpy(dtype=np.float64, na_value=np.nan)
+    conv = pd.to_numeric(series, errors="coerce")
+    bad = conv.isna() & series.notna() & (series.astype(str).str.strip() != "")
+    if bad.any():
+        row = row_offset + int(np.argmax(bad.to_numpy()))
+        raise NonNumericError(
+            f"{p}: non-numeric value {short_name(str(series.iloc[row - row_offset]))} in column "
+            f"{short_name(name)} at row {row} (line {row + 2} of the file)"
+        )
+    return conv.to_numpy(dtype=np.float64, na_value=np.nan)

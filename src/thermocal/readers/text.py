@@ -1,0 +1,367 @@
+"""Text and serial-terminal logs: layout sniffed (delimiter, decimal mark, banner, header),
+mangled lines counted and kept aside, a time column built from a stated rate."""
+
+from __future__ import annotations
+
+import math
+import warnings
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from thermocal._lazy import LazyModule
+from thermocal.errors import (
+    FileFormatError,
+    TextLayoutWarning,
+    ThermocalInputError,
+)
+from thermocal.readers.common import check_unique_names
+from thermocal.readers.table import ParquetColumns
+
+if TYPE_CHECKING:
+    import pandas as pd
+    import pyarrow as pa
+    import pyarrow.csv as pacsv
+    import pyarrow.parquet as pq
+else:
+    pd = LazyModule("pandas")
+    pa = LazyModule("pyarrow")
+    pacsv = LazyModule("pyarrow.csv")
+    pq = LazyModule("pyarrow.parquet")
+
+
+# --- text logs (serial terminals, spreadsheets of other locales) ----------------------------
+
+
+@dataclass(frozen=True)
+class TextOptions:
+    """How to read a text log (INTERFACE.md common rules): ``names`` for a file without a
+    header row; ``rate_hz`` for a file without a time column (time = row / rate);
+    ``on_bad_lines`` ``"error"`` (default: the first mangled line is named) or ``"skip"``
+    (mangled lines dropped, how many reported); ``delimiter`` and ``decimal`` (detected when
+    None: ``,`` ``;`` tab or blanks; ``.`` or ``,``)."""
+
+    names: tuple[str, ...] | None = None
+    rate_hz: float | None = None
+    on_bad_lines: str = "error"
+    delimiter: str | None = None
+    decimal: str | None = None
+
+    def __post_init__(self) -> None:
+        if self.on_bad_lines not in ("error", "skip"):
+            raise ThermocalInputError(
+                f"--on-bad-lines must be error or skip, got {self.on_bad_lines!r}"
+            )
+        if self.rate_hz is not None and not (math.isfinite(self.rate_hz) and self.rate_hz > 0):
+            raise ThermocalInputError(f"--rate must be a positive rate [Hz], got {self.rate_hz}")
+        if self.decimal not in (None, ".", ","):
+            raise ThermocalInputError(f"--decimal must be . or , — got {self.decimal!r}")
+        if self.names is not None and len(set(self.names)) != len(self.names):
+            raise ThermocalInputError(f"--names repeats a name: {list(self.names)}")
+
+
+SNIFF_LINES = 400
+"""Lines read to find a text log's layout (banner, delimiter, decimal mark, header)."""
+
+_DELIMS = (",", ";", "\t", " ")
+
+
+def _split(line: str, delim: str) -> list[str]:
+    return line.split() if delim == " " else [f.strip() for f in line.split(delim)]
+
+
+def parse_number(field: str) -> float:
+    """A text field as a float, as a CSV reader takes it: ASCII digits, sign, ``.``,
+    exponent, or ``nan``/``inf``.  Python's :func:`float` also accepts digit-group
+    underscores (``0_5`` → 5.0) and non-ASCII digits (``١٢``); those are malformed numbers
+    here (``ValueError``), so a mangled line is a bad line, not a silent value."""
+    if "_" in field or not field.isascii():
+        raise ValueError(f"malformed number {field.strip()[:40]!r}")
+    return float(field)
+
+
+def _is_number(field: str, decimal: str, *, empty: bool = False) -> bool:
+    """A number written with ``decimal`` (an empty field counts when ``empty``: a missing
+    value, NaN downstream, not a sign of a banner)."""
+    f = field.strip().replace(decimal, ".") if decimal == "," else field.strip()
+    if empty and not f:
+        return True
+    try:
+        parse_number(f)
+    except ValueError:
+        return False
+    return True
+
+
+@dataclass(frozen=True)
+class TextLayout:
+    """A text log's layout found by :func:`sniff_text`: ``skip`` lines before the header
+    (or first data row), the banner lines skipped, the delimiter, the decimal mark, whether
+    the first kept line is a header, the number of fields."""
+
+    skip: int
+    banner: tuple[str, ...]
+    delimiter: str
+    decimal: str
+    header: bool
+    n_fields: int
+
+    @property
+    def plain(self) -> bool:
+        """An ordinary comma CSV with a header and nothing to skip (the fast path)."""
+        return self.skip == 0 and self.delimiter == "," and self.decimal == "." and self.header
+
+
+def sniff_text(lines: Sequence[str], opts: TextOptions | None = None) -> TextLayout:
+    """The layout of a text log from its first lines.
+
+    For each candidate delimiter (``, ; tab blanks``, or the one given) the modal number of
+    fields m (≥ 2) of the non-empty, non-``#`` lines; the delimiter whose modal count
+    covers most lines wins (ties: in that order).  The data start at the first line with m
+    fields that is numeric (empty fields allowed: missing values), or that names the
+    columns (no field a number) and is followed by a line of m fields (the header); the
+    lines before
+    are a banner (a terminal's, a logger's) and are skipped.  Lines further down that do
+    not fit are mangled lines, for ``--on-bad-lines``.  The decimal mark is ``,`` when the
+    delimiter is not a comma and the data parse with ``,`` but not with ``.``.
+    """
+    o = opts or TextOptions()
+    delims = [o.delimiter] if o.delimiter else list(_DELIMS)
+    delims = ["\t" if d == "\\t" else d for d in delims]
+    body = [x for x in lines if x.strip() and not x.lstrip().startswith("#")]
+    best: tuple[int, int, str] | None = None  # (-covered, order, delimiter)
+    for order, d in enumerate(delims):
+        counts = [len(_split(x, d)) for x in body]
+        good = [c for c in counts if c >= 2]
+        if not good:
+            continue
+        m = max(set(good), key=good.count)
+        key = (-good.count(m), order, d)
+        if best is None or key < best:
+            best = key
+    if best is None:
+        raise FileFormatError(
+            "no lines with two or more fields were found (is it a data log? give "
+            "--delimiter and --decimal if it uses others than , ; tab blanks)"
+        )
+    d = best[2]
+    m = max(
+        set(c for c in (len(_split(x, d)) for x in body) if c >= 2),
+        key=[len(_split(x, d)) for x in body].count,
+    )
+    decimals = [o.decimal] if o.decimal else ([".", ","] if d != "," else ["."])
+
+    def numeric(line: str, dec: str) -> bool:
+        f = _split(line, d)
+        return len(f) == m and all(_is_number(x, dec, empty=True) for x in f)
+
+    # the decimal mark under which most lines of m fields are numbers (ties: ".")
+    dec = max(decimals, key=lambda c: (sum(numeric(x, c) for x in body), c == "."))
+    for k, line in enumerate(lines):
+        if not line.strip() or line.lstrip().startswith("#") or len(_split(line, d)) != m:
+            continue
+        if numeric(line, dec):
+            return TextLayout(k, _banner(lines[:k]), d, dec, False, m)
+        names = _split(line, d)
+        nxt = next((x for x in lines[k + 1 :] if x.strip()), None)
+        is_names = all(f and not _is_number(f, dec) for f in names)
+        if is_names and nxt is not None and len(_split(nxt, d)) == m:
+            return TextLayout(k, _banner(lines[:k]), d, dec, True, m)
+    raise FileFormatError(
+        f"no line of {m} numeric fields separated by {d!r} was found (give --delimiter and "
+        "--decimal if the log uses others)"
+    )
+
+
+def _banner(lines: Sequence[str]) -> tuple[str, ...]:
+    return tuple(x for x in lines if x.strip())
+
+
+def head_lines(path: Path, encoding: str, errors: str) -> list[str]:
+    """The first :data:`SNIFF_LINES` lines of a text file, line ends removed."""
+    with open(path, encoding=encoding, errors=errors, newline="") as fh:
+        return [fh.readline().rstrip("\r\n") for _ in range(SNIFF_LINES)]
+
+
+def delimiter_name(delimiter: str) -> str:
+    """How a warning names a delimiter: ``tab``, ``blank`` or the quoted character."""
+    return {"\t": "tab", " ": "blank"}.get(delimiter, repr(delimiter))
+
+
+def csv_chunk_options(path: Path, encoding: str) -> dict[str, Any]:
+    """``pandas.read_csv`` options for reading a text file in chunks (compensate): the
+    detected delimiter, decimal mark and banner lines to skip, stated in a warning when
+    not a plain comma CSV; a file without a header row is refused (name the columns)."""
+    if path.name.lower().endswith(".gz"):
+        return {}
+    head = head_lines(path, encoding, "replace")
+    try:
+        lay = sniff_text(head)
+    except FileFormatError:
+        return {}  # the CSV reader says what is wrong
+    if lay.plain:
+        return {}
+    if not lay.header:
+        raise ThermocalInputError(
+            f"{path}: no header row (line {lay.skip + 1} is data); compensate needs named "
+            "columns: add a header line, or read it with --names in another command and "
+            "write it out"
+        )
+    warnings.warn(
+        TextLayoutWarning(
+            f"{path}: read as {delimiter_name(lay.delimiter)}-separated text with decimal "
+            f"mark {lay.decimal!r}"
+            + (f", {len(lay.banner)} banner line(s) skipped" if lay.banner else "")
+        ),
+        stacklevel=3,
+    )
+    return {
+        "sep": r"\s+" if lay.delimiter == " " else lay.delimiter,
+        "decimal": lay.decimal,
+        "skiprows": lay.skip,
+    }
+
+
+def read_text(
+    path: Path, encoding: str, opts: TextOptions | None
+) -> tuple[pd.DataFrame, dict[str, Any]]:
+    """A text log as a DataFrame of floats: banner skipped, delimiter and decimal mark
+    detected (or given), header taken from ``--names`` when the file has none, mangled
+    lines (another number of fields, a non-number) refused naming the first or, with
+    ``on_bad_lines="skip"``, dropped and counted.  Warnings say what was skipped."""
+    o = opts or TextOptions()
+    head = head_lines(path, encoding, "strict")
+    try:
+        lay = sniff_text(head, o)
+    except FileFormatError as exc:
+        raise FileFormatError(f"{path}: {exc}") from None
+    names: list[str] | None = None
+    if lay.header:
+        names = [c.strip() for c in _split(head[lay.skip], lay.delimiter)]
+        check_unique_names(path, names)
+        if o.names is not None:
+            raise ThermocalInputError(
+                f"{path}: the file has a header row ({', '.join(names)}); --names is for "
+                "files without one"
+            )
+    elif o.names is None:
+        raise ThermocalInputError(
+            f"{path}: no header row (line {lay.skip + 1} is data: "
+            f"{head[lay.skip].strip()[:60]!r}); name its {lay.n_fields} columns with "
+            "--names a,b,c"
+        )
+    else:
+        names = list(o.names)
+        if len(names) != lay.n_fields:
+            raise ThermocalInputError(
+                f"{path}: --names gives {len(names)} names for {lay.n_fields} columns "
+                f"(line {lay.skip + 1}: {head[lay.skip].strip()[:60]!r})"
+            )
+    first_data = lay.skip + (1 if lay.header else 0)  # 0-based line of the first data row
+    bad: list[tuple[int, str]] = []
+    rows: list[list[float]] = []
+    ordinal: list[int] = []  # each kept row's place among the data lines (dropped ones too)
+    n_data = 0
+    n = len(names)
+    with open(path, encoding=encoding, errors="strict", newline="") as fh:
+        for lineno, line in enumerate(fh, start=1):
+            if lineno <= first_data:
+                continue
+            text = line.rstrip("\r\n")
+            if not text.strip() or text.lstrip().startswith("#"):
+                continue
+            fields = _split(text, lay.delimiter)
+            n_data += 1
+            try:
+                if len(fields) != n:
+                    raise ValueError(f"{len(fields)} fields, {n} expected")
+                rows.append(
+                    [parse_number(f.replace(",", ".") if lay.decimal == "," else f) for f in fields]
+                )
+                ordinal.append(n_data - 1)
+            except ValueError as exc:
+                if o.on_bad_lines == "error":
+                    raise FileFormatError(
+                        f"{path}: line {lineno} is not a data row ({exc}): {text.strip()[:80]!r}; "
+                        "fix it or pass --on-bad-lines skip to drop such lines"
+                    ) from None
+                bad.append((lineno, text))
+    if not rows:
+        raise FileFormatError(f"{path}: the file has a header but no data rows")
+    df = pd.DataFrame(np.asarray(rows, dtype=np.float64), columns=names)
+    # --rate: time = data-line number / rate, so a dropped line leaves a gap, not a shift
+    df.attrs["row_index"] = np.asarray(ordinal, dtype=np.float64)
+    report: dict[str, Any] = {
+        "text_layout": {
+            "banner_lines": len(lay.banner),
+            "delimiter": "\t" if lay.delimiter == "\t" else lay.delimiter,
+            "decimal": lay.decimal,
+            "header": lay.header,
+            "bad_lines": [ln for ln, _t in bad],
+        }
+    }
+    if lay.delimiter != "," or lay.decimal != ".":
+        warnings.warn(
+            TextLayoutWarning(
+                f"{path}: read as {delimiter_name(lay.delimiter)}-separated text with decimal "
+                f"mark {lay.decimal!r} (give --delimiter/--decimal if that is wrong)"
+            ),
+            stacklevel=3,
+        )
+    if lay.banner:
+        warnings.warn(
+            TextLayoutWarning(
+                f"{path}: {len(lay.banner)} banner line(s) before the data skipped (first: "
+                f"{lay.banner[0].strip()[:60]!r})"
+            ),
+            stacklevel=3,
+        )
+    if bad:
+        shown = ", ".join(str(ln) for ln, _t in bad[:5]) + (" …" if len(bad) > 5 else "")
+        warnings.warn(
+            TextLayoutWarning(
+                f"{path}: {len(bad)} mangled line(s) dropped (--on-bad-lines skip): line(s) {shown}"
+            ),
+            stacklevel=3,
+        )
+    return df, report
+
+
+def rate_time(
+    p: Path,
+    obj: Any,
+    names: list[str],
+    info: dict[str, Any],
+    time: str | None,
+    time_unit: str | None,
+    text: TextOptions,
+) -> tuple[Any, list[str], str, str]:
+    """``--rate``: a file without a time column gets ``time = row / rate`` [s], the row
+    counted among the log's data lines (a mangled line dropped leaves a gap); a file that
+    has a time column is refused (say which to believe)."""
+    assert text.rate_hz is not None
+    named = time or info.get("time")
+    if named and named in names:
+        raise ThermocalInputError(
+            f"{p}: --rate {text.rate_hz:g} Hz given but the file has a time column "
+            f"{named!r}; drop --rate (or name another column with --time)"
+        )
+    col = named or "time"
+    if col in names:
+        raise ThermocalInputError(
+            f"{p}: --rate {text.rate_hz:g} Hz given but the file has a time column {col!r}; "
+            "drop --rate"
+        )
+    if isinstance(obj, ParquetColumns):
+        raise ThermocalInputError(f"{p}: --rate is for text logs; a Parquet file has its time")
+    if time_unit not in (None, "s"):
+        raise ThermocalInputError("--rate gives the time in seconds; drop --time-unit")
+    rows = obj.attrs.get("row_index")
+    if rows is None or len(rows) != len(obj):
+        rows = np.arange(len(obj), dtype=np.float64)
+    obj = obj.copy()
+    obj.insert(0, col, np.asarray(rows, dtype=np.float64) / float(text.rate_hz))
+    return obj, [col, *names], col, "s"

@@ -1,0 +1,245 @@
+"""PX4 ULog files (pyulog), read by topic and instance in the units of PX4's messages."""
+
+from __future__ import annotations
+
+import math
+import warnings
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from thermocal._lazy import LazyModule
+from thermocal.errors import (
+    FileFormatError,
+    MissingColumnError,
+    TextLayoutWarning,
+    ThermocalInputError,
+)
+from thermocal.readers.common import (
+    LogDamageWarning,
+    TrackedReader,
+    library_output_captured,
+    warn_damage,
+)
+from thermocal.recording import FloatArray
+
+if TYPE_CHECKING:
+    import pandas as pd
+    import pyarrow as pa
+    import pyarrow.csv as pacsv
+    import pyarrow.parquet as pq
+else:
+    pd = LazyModule("pandas")
+    pa = LazyModule("pyarrow")
+    pacsv = LazyModule("pyarrow.csv")
+    pq = LazyModule("pyarrow.parquet")
+
+
+# --- PX4 ULog ------------------------------------------------------------------------------
+
+_XYZ = ("x", "y", "z")
+PX4_UNITS: dict[str, dict[str, str]] = {
+    "sensor_gyro": {**dict.fromkeys(_XYZ, "rad/s"), "temperature": "degC"},
+    "sensor_accel": {**dict.fromkeys(_XYZ, "m/s^2"), "temperature": "degC"},
+    "sensor_baro": {"pressure": "Pa", "temperature": "degC"},
+    "sensor_mag": {**dict.fromkeys(_XYZ, "gauss"), "temperature": "degC"},
+    "sensor_combined": {
+        **{f"gyro_rad[{i}]": "rad/s" for i in range(3)},
+        **{f"accelerometer_m_s2[{i}]": "m/s^2" for i in range(3)},
+        "gyro_integral_dt": "us", "accelerometer_integral_dt": "us",
+    },
+    "vehicle_imu": {
+        **{f"delta_angle[{i}]": "rad" for i in range(3)},
+        **{f"delta_velocity[{i}]": "m/s" for i in range(3)},
+        "delta_angle_dt": "us", "delta_velocity_dt": "us",
+        **{f"gyro_rad_s[{i}]": "rad/s" for i in range(3)},
+        **{f"accel_m_s2[{i}]": "m/s^2" for i in range(3)},
+    },
+    "vehicle_imu_status": {"temperature_accel": "degC", "temperature_gyro": "degC"},
+}  # fmt: skip
+"""Units of PX4's sensor topics, from the uORB message definitions (PX4-Autopilot
+``msg/SensorGyro.msg`` [rad/s], ``SensorAccel.msg`` [m/s²], ``SensorBaro.msg`` pressure [Pa],
+``SensorMag.msg`` [gauss], ``SensorCombined.msg`` ``gyro_rad`` [rad/s] and
+``accelerometer_m_s2`` [m/s²], ``VehicleImu.msg`` ``delta_angle`` [rad] and ``delta_velocity``
+[m/s] over ``delta_angle_dt``/``delta_velocity_dt`` [µs]; temperatures [°C]).  pyulog names an
+array's elements ``name[i]``.  ``vehicle_imu`` is also given as rates:
+``gyro_rad_s[i] = delta_angle[i] / delta_angle_dt`` [rad/s] and
+``accel_m_s2[i] = delta_velocity[i] / delta_velocity_dt`` [m/s²] (columns added by the
+reader).  The time is ``timestamp`` [µs]."""
+
+DEFAULT_ULOG_TOPIC = "sensor_gyro.0"
+
+
+def parse_topic(topic: str | None, default: str = DEFAULT_ULOG_TOPIC) -> tuple[str, int]:
+    """``NAME[.N]`` → (name, instance); default :data:`DEFAULT_ULOG_TOPIC`."""
+    text = (topic or default).strip()
+    name, _, inst = text.partition(".")
+    if not name or (inst and not inst.isdigit()):
+        raise ThermocalInputError(
+            f"--topic must be NAME or NAME.N (e.g. sensor_gyro.0), got {text!r}"
+        )
+    return name, int(inst or 0)
+
+
+@dataclass(frozen=True)
+class _ULogRead:
+    """A parsed ULog and what its reading lost: ``notes`` (sentences for one warning)."""
+
+    ulog: Any
+    damaged: bool
+    skipped: bool
+    """pyulog skipped damaged messages inside the file (``file_corruption``)."""
+    notes: tuple[str, ...]
+
+
+def _parse_ulog(path: Path, names: list[str] | None) -> _ULogRead:
+    """Parse a ULog with pyulog (only the topics ``names``, all when None), its printed
+    noise captured, and measure what was lost:
+
+    * pyulog stops at a damaged message header (a zeroed length, say) without saying so:
+      the bytes after the position it stopped at, as a share of the file;
+    * a file cut inside its last message (a short read);
+    * pyulog's own ``file_corruption`` flag (damaged messages skipped: the topics' missing
+      samples are estimated from their sample interval, :func:`_topic_loss`).
+    """
+    try:
+        from pyulog import ULog
+    except ImportError:
+        raise ThermocalInputError(
+            f"{path}: reading PX4 ULog files needs pyulog: pip install 'thermocal[logs]' "
+            "(or pip install pyulog)"
+        ) from None
+    if not path.exists():
+        raise FileFormatError(f"{path}: no such file")
+    size = path.stat().st_size
+    if size == 0:
+        raise FileFormatError(f"{path}: the file is empty")
+    fh = TrackedReader(path)
+    try:
+        with library_output_captured() as noise:
+            ulog = ULog(fh, message_name_filter_list=names)
+    except Exception as exc:  # pyulog raises several kinds on a bad file
+        msg = " ".join(str(exc).split())[:200] or type(exc).__name__
+        raise FileFormatError(f"{path}: not a readable ULog file ({msg})") from None
+    finally:
+        fh.close()
+    notes: list[str] = []
+    stop = fh.stopped_at if fh.stopped_at is not None else size
+    if stop < size:
+        notes.append(
+            f"pyulog stopped at byte {stop:,} of {size:,} (a damaged message header): the "
+            f"last {100.0 * (size - stop) / size:.1f} % of the file is not read"
+        )
+    cut = fh.short_read and stop == size
+    if cut:
+        notes.append("the file ends inside a message (cut): its last message is lost")
+    if ulog.file_corruption:
+        notes.append("pyulog found damaged messages and skipped them")
+    said = noise.summary("pyulog")
+    if said:
+        notes.append(said)
+    skipped = bool(ulog.file_corruption)
+    return _ULogRead(ulog, stop < size or cut or skipped, skipped, tuple(notes))
+
+
+def _topic_loss(time_us: FloatArray) -> tuple[int, int]:
+    """(missing, expected) samples of a topic in a damaged log, judged by its median sample
+    interval: expected = span / median interval + 1."""
+    n = int(time_us.size)
+    if n < 3:
+        return 0, n
+    dt = np.diff(time_us)
+    med = float(np.median(dt))
+    if not (math.isfinite(med) and med > 0):
+        return 0, n
+    span = float(time_us[-1] - time_us[0])
+    expected = round(span / med) + 1
+    return max(0, expected - n), max(expected, n)
+
+
+def ulog_sensor_instances(path: str | Path, topics: Sequence[str]) -> list[tuple[str, int]]:
+    """The instances of ``topics`` in a ULog that carry a temperature, sorted; every instance
+    left out (no ``temperature`` field, or one that is all 0 or NaN: no sensor behind it) is
+    named in a warning, and damage to the log is said (:func:`_parse_ulog`)."""
+    p = Path(path)
+    read = _parse_ulog(p, list(topics))
+    warn_damage(p, read.notes)
+    out: list[tuple[str, int]] = []
+    left: list[str] = []
+    for d in read.ulog.data_list:
+        t = d.data.get("temperature")
+        where = f"{d.name}.{int(d.multi_id)}"
+        if t is None:
+            left.append(f"{where} (no temperature field)")
+        elif not np.isfinite(t).any():
+            left.append(f"{where} (temperature all NaN)")
+        elif np.all(t == 0):
+            left.append(f"{where} (temperature all 0)")
+        else:
+            out.append((d.name, int(d.multi_id)))
+    if left:
+        warnings.warn(
+            LogDamageWarning(
+                f"{p}: {len(left)} sensor instance(s) left out, without a usable temperature: "
+                + ", ".join(left)
+            ),
+            stacklevel=2,
+        )
+    return sorted(out)
+
+
+def read_ulog(path: Path, topic: str | None) -> tuple[pd.DataFrame, dict[str, Any]]:
+    """One topic instance of a PX4 ULog as a table: its fields as columns, ``timestamp``
+    [µs] the time, PX4's units for the known topics, the median ``device_id`` as the
+    sensor id.  Damage to the log is said in a warning with what was lost
+    (:func:`_parse_ulog`).  Needs ``pyulog`` (``pip install 'thermocal[logs]'``)."""
+    name, inst = parse_topic(topic)
+    read = _parse_ulog(path, [name])
+    found = [d for d in read.ulog.data_list if d.name == name and d.multi_id == inst]
+    if not found:
+        warn_damage(path, read.notes)
+        every = _parse_ulog(path, None).ulog.data_list if not read.damaged else []
+        have = sorted(f"{d.name}.{d.multi_id}" for d in every or read.ulog.data_list)
+        raise MissingColumnError(
+            f"{path}: no topic {name}.{inst} in the log"
+            + (" (it may be in the damaged part)" if read.damaged else "")
+            + f"; it has: {', '.join(have) or 'none'}"
+        )
+    data = found[0].data
+    cols = {k: np.asarray(v, dtype=np.float64) for k, v in data.items()}
+    notes = list(read.notes)
+    if read.skipped and "timestamp" in cols:  # messages skipped inside the read part
+        missing, expected = _topic_loss(cols["timestamp"])
+        if missing:
+            notes.append(
+                f"{name}.{inst} misses about {missing:,} of {expected:,} samples "
+                f"({100.0 * missing / expected:.1f} %) judged by its sample interval"
+            )
+    warn_damage(path, notes)
+    if name == "vehicle_imu":  # integrals over their intervals → rates (PX4_UNITS)
+        for i in range(3):
+            for d_col, dt_col, out in (
+                (f"delta_angle[{i}]", "delta_angle_dt", f"gyro_rad_s[{i}]"),
+                (f"delta_velocity[{i}]", "delta_velocity_dt", f"accel_m_s2[{i}]"),
+            ):
+                if d_col in cols and dt_col in cols:
+                    dt_s = cols[dt_col] * 1e-6
+                    with np.errstate(divide="ignore", invalid="ignore"):
+                        cols[out] = np.where(dt_s > 0, cols[d_col] / dt_s, np.nan)
+    df = pd.DataFrame(cols)
+    units_ = {k: u for k, u in PX4_UNITS.get(name, {}).items() if k in df.columns}
+    info: dict[str, Any] = {"time": "timestamp", "time_unit": "us", "units": units_}
+    info["fc_log"] = True
+    if "device_id" in df.columns:
+        ids = df["device_id"].to_numpy()
+        info["metadata"] = {"sensor_id": str(int(np.median(ids)))}
+        if np.unique(ids).size > 1:
+            warnings.warn(
+                TextLayoutWarning(f"{path}: {name}.{inst} changes device_id during the log"),
+                stacklevel=3,
+            )
+    info["ulog_topic"] = f"{name}.{inst}"
+    return df, info
