@@ -1,6 +1,6 @@
 """Benchmark: overlapping Allan deviation, thermocal vs allantools.
 
-* 10⁷ white+random-walk rate samples, octave taus: thermocal.allan.overlapping_adev
+* 10⁷ white+random-walk rate samples, octave taus: thermocal.stability.allan.overlapping_adev
   against allantools.oadev in the same run (best of 3 each), ratio printed and
   results compared (relative 1e-9).
 * 10⁸ samples in a child process: wall time and peak resident memory (must stay
@@ -40,7 +40,7 @@ def best_of(fn, repeats: int = 3) -> tuple[float, object]:  # type: ignore[no-un
 def bench_1e7() -> bool:
     import allantools
 
-    from thermocal.allan import overlapping_adev
+    from thermocal.stability.allan import overlapping_adev
 
     n = 10**7
     y = make_rate(n)
@@ -61,7 +61,7 @@ def bench_1e7() -> bool:
 
 
 def child_1e8() -> None:
-    from thermocal.allan import overlapping_adev
+    from thermocal.stability.allan import overlapping_adev
 
     y = make_rate(10**8, seed=1)
     t0 = time.perf_counter()

@@ -33,7 +33,7 @@ import pandas as pd
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from bench_fit import make_data
-from thermocal.compensate import compensate_channels
+from thermocal.compensate.files import compensate_channels
 from thermocal.models.base import RunData
 from thermocal.models.poly import PolyModel, fit_shared
 

@@ -26,8 +26,8 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from thermocal.compensate import StreamingCompensator, compensate_file, compensate_run
-from thermocal.export_c import exercise_inputs, find_compiler, generate_c
+from thermocal.compensate.files import StreamingCompensator, compensate_file, compensate_run
+from thermocal.export.c import exercise_inputs, find_compiler, generate_c
 from thermocal.models.base import RunData, make_model
 from thermocal.models.files import load_model_dict, save_model
 from thermocal.simulate import SCENARIOS

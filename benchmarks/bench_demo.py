@@ -1,6 +1,6 @@
 """Time ``thermocal demo`` (issue 7: must stay under 60 s on the 2-core machine).
 
-Prints the duration of each step of :func:`thermocal.demo.run_demo` (default,
+Prints the duration of each step of :func:`thermocal.demo.chamber.run_demo` (default,
 full-size data: 1 Hz, ~17.5 h modelling + ~11 h validation run), the total, and
 the wall-clock time of the ``thermocal demo`` command (process start-up and
 imports included), best of ``--repeat`` runs.
@@ -17,7 +17,7 @@ import tempfile
 import time
 from pathlib import Path
 
-from thermocal.demo import run_demo
+from thermocal.demo.chamber import run_demo
 
 
 def main() -> None:

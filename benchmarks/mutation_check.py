@@ -41,7 +41,7 @@ MUTANTS: tuple[Mutant, ...] = (
     # --- the eight that survived the audit (issue 12 §5) -------------------------------
     Mutant(
         "allan-rrw-read-at-1s",
-        "src/thermocal/allan.py",
+        "src/thermocal/stability/allan.py",
         'READ_TAU_S: Final = (math.sqrt(3.0), 1.0, float("nan"), 3.0, math.sqrt(2.0))',
         'READ_TAU_S: Final = (math.sqrt(3.0), 1.0, float("nan"), 1.0, math.sqrt(2.0))',
         ("tests/test_allan.py", "tests/test_allan_references.py"),
@@ -49,7 +49,7 @@ MUTANTS: tuple[Mutant, ...] = (
     ),
     Mutant(
         "allan-edf-overwritten",
-        "src/thermocal/allan.py",
+        "src/thermocal/stability/allan.py",
         "edf[idx] += edf_simple(n_phase, m[idx], alphas[idx])",
         "edf[idx] = edf_simple(n_phase, m[idx], alphas[idx])",
         ("tests/test_allan.py", "tests/test_allan_references.py"),
@@ -89,7 +89,7 @@ MUTANTS: tuple[Mutant, ...] = (
     ),
     Mutant(
         "c-piecewise-strict-breakpoint",
-        "src/thermocal/export_c.py",
+        "src/thermocal/export/c.py",
         'f"while (j < {P}_N_BREAKPOINTS && {P}_BP[j] <= temp) {{",',
         'f"while (j < {P}_N_BREAKPOINTS && {P}_BP[j] < temp) {{",',
         ("tests/test_export_c.py", "tests/test_export_c_edges.py"),
@@ -97,7 +97,7 @@ MUTANTS: tuple[Mutant, ...] = (
     ),
     Mutant(
         "c-rate-gap-without-factor",
-        "src/thermocal/export_c.py",
+        "src/thermocal/export/c.py",
         "time_s - s->last_t > {P}_GAP_FACTOR * s->sample_interval_s",
         "time_s - s->last_t > s->sample_interval_s",
         ("tests/test_export_c.py", "tests/test_export_c_edges.py"),
@@ -130,7 +130,7 @@ MUTANTS: tuple[Mutant, ...] = (
     ),
     Mutant(
         "allan-variance-missing-2",
-        "src/thermocal/allan.py",
+        "src/thermocal/stability/allan.py",
         "avar = sums / (2.0 * m.astype(np.float64) ** 2 * n_terms)",
         "avar = sums / (m.astype(np.float64) ** 2 * n_terms)",
         ("tests/test_allan.py",),
@@ -154,7 +154,7 @@ MUTANTS: tuple[Mutant, ...] = (
     ),
     Mutant(
         "compensate-unit-factor-inverted",
-        "src/thermocal/compensate.py",
+        "src/thermocal/compensate/files.py",
         "y_data = y_model / factor",
         "y_data = y_model * factor",
         ("tests/test_compensate.py",),

@@ -1,4 +1,4 @@
-"""Overlapping Allan deviation and noise terms (thermocal.allan).
+"""Overlapping Allan deviation and noise terms (thermocal.stability.allan).
 
 References: NIST SP 1065 (Riley, Handbook of Frequency Stability Analysis,
 2008) §12 1000-point "ran" data set and the NBS14 10-point set with their
@@ -19,8 +19,8 @@ import pytest
 from allantools import ci as at_ci
 from numpy.testing import assert_allclose
 
-from thermocal import allan
 from thermocal.errors import MissingValueError, ThermocalInputError
+from thermocal.stability import allan
 
 # --- reference data -----------------------------------------------------------------------
 
@@ -266,12 +266,12 @@ def test_bad_input() -> None:
 
 
 def test_allan_maths_does_not_import_matplotlib() -> None:
-    code = "import sys, thermocal.allan; sys.exit('matplotlib' in sys.modules)"
+    code = "import sys, thermocal.stability.allan; sys.exit('matplotlib' in sys.modules)"
     assert subprocess.run([sys.executable, "-c", code], check=False).returncode == 0
 
 
 def test_plot_writes_png(tmp_path: Path) -> None:
-    from thermocal.plots_allan import plot_allan
+    from thermocal.report.allan_plots import plot_allan
 
     rng = np.random.default_rng(1)
     res = allan.overlapping_adev(rng.standard_normal(4096), 1.0)

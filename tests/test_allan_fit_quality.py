@@ -15,8 +15,8 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from thermocal.allan import fit_quality, noise_terms, overlapping_adev
 from thermocal.cli import main
+from thermocal.stability.allan import fit_quality, noise_terms, overlapping_adev
 
 
 def _white_rw(seed: int, n: int = 200_000) -> np.ndarray:

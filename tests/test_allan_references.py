@@ -8,7 +8,7 @@ import math
 import numpy as np
 import pytest
 
-from thermocal import allan
+from thermocal.stability import allan
 
 
 def _exact_curve(n_arw: float, k_rrw: float) -> allan.AllanResult:

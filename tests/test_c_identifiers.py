@@ -16,7 +16,7 @@ from pathlib import Path
 import pytest
 
 from thermocal.errors import ThermocalInputError
-from thermocal.export_c.harness import find_compiler
+from thermocal.export.c.harness import find_compiler
 from thermocal.identifiers import (
     MAX_IDENTIFIER_LEN,
     c_comment,

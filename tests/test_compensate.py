@@ -23,7 +23,7 @@ import pyarrow.parquet as pq
 import pytest
 
 from thermocal import units
-from thermocal.compensate import (
+from thermocal.compensate.files import (
     ChunkContext,
     ChunkPredictor,
     StreamingCompensator,
@@ -431,7 +431,7 @@ def family_model(request: pytest.FixtureRequest) -> TemperatureModel:
 
 
 def _family_data(m: TemperatureModel, n: int = 4000) -> RunData:
-    from thermocal.export_c import exercise_inputs
+    from thermocal.export.c import exercise_inputs
 
     rng = {n: [float(a), float(b)] for n, (a, b) in zip(m.temp_names_, m.temp_range_, strict=True)}
     d = {"temperatures": list(m.temp_names_), "range": {"temperature_c": rng}}

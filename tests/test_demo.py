@@ -20,7 +20,7 @@ from test_report import (
     tagged_numbers,
 )
 from thermocal.cli import main
-from thermocal.demo import DEMO_STEPS, QUICK, run_demo
+from thermocal.demo.chamber import DEMO_STEPS, QUICK, run_demo
 from thermocal.models import RunData, load_model, load_model_dict
 from thermocal.readers.dispatch import read_recording
 
@@ -135,7 +135,7 @@ def test_demo_report_shows_the_json_numbers(demo: dict[str, Any]) -> None:
 
 
 def test_demo_c_files_compile(demo: dict[str, Any], tmp_path: Path) -> None:
-    from thermocal.export_c import CFLAGS, find_compiler
+    from thermocal.export.c import CFLAGS, find_compiler
 
     cc = find_compiler()
     if cc is None:

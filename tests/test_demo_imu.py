@@ -98,7 +98,7 @@ def test_report_table_shows_the_json_numbers(demo: dict[str, Any]) -> None:
 
 
 def test_one_c_module_compiles(demo: dict[str, Any], tmp_path: Path) -> None:
-    from thermocal.export_c import CFLAGS, find_compiler
+    from thermocal.export.c import CFLAGS, find_compiler
 
     cc = find_compiler()
     if cc is None:

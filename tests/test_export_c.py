@@ -18,9 +18,9 @@ import numpy as np
 import pytest
 
 from thermocal.cli import main
-from thermocal.compensate import StreamingCompensator
+from thermocal.compensate.files import StreamingCompensator
 from thermocal.errors import ModelFileError
-from thermocal.export_c import (
+from thermocal.export.c import (
     c_harness,
     compile_harness,
     exercise_inputs,
@@ -111,7 +111,7 @@ def test_every_registered_family_has_a_generator() -> None:
     import thermocal.models  # noqa: F401
 
     for fam, cls in MODEL_REGISTRY.items():  # declared on the class, and it resolves
-        assert f"thermocal.export_c.{fam}" == cls.C_GENERATOR, fam
+        assert f"thermocal.export.c.{fam}" == cls.C_GENERATOR, fam
         assert callable(family_generator(fam))
     with pytest.raises(ModelFileError, match="no C generator for model family 'nope'"):
         family_generator("nope")

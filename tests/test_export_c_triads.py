@@ -12,8 +12,8 @@ import pytest
 
 from thermocal import units
 from thermocal.cli import main
-from thermocal.export_c.harness import find_compiler
-from thermocal.export_c.triad import generate_c_triads
+from thermocal.export.c.harness import find_compiler
+from thermocal.export.c.triad import generate_c_triads
 from thermocal.models.calibration import Calibration, Triad
 from thermocal.models.files import save_calibration
 from thermocal.turntable import thermal

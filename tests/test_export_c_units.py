@@ -17,7 +17,7 @@ import pytest
 
 from thermocal import units
 from thermocal.cli import main
-from thermocal.export_c import compile_harness, generate_c, run_harness
+from thermocal.export.c import compile_harness, generate_c, run_harness
 from thermocal.models.base import checksum
 from thermocal.models.files import load_model_dict
 

@@ -19,8 +19,8 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from thermocal import fleet
 from thermocal.cli import main
+from thermocal.fleet import batch as fleet
 
 SLOPES = {"u01": 0.020, "u02": 0.021, "u03": 0.019, "u04": 0.0205, "u05": 0.0195, "u06": 0.2}
 """Temperature sensitivity [°/h per °C] of each unit; u06 is the outlier."""

@@ -15,8 +15,8 @@ import pandas as pd
 import pytest
 
 from fleet_data import TEMP, config_text, write_run
-from thermocal import fleet
 from thermocal.cli import main
+from thermocal.fleet import batch as fleet
 
 GX = "gx [deg/s]"
 

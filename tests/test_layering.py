@@ -1,5 +1,5 @@
 """The maths imports no I/O (issue 15, STYLE.md): importing a maths module loads neither
-the file layer (:mod:`thermocal.io`, :mod:`thermocal.compensate`, model files) nor pandas
+the file layer (:mod:`thermocal.io`, :mod:`thermocal.compensate.files`, model files) nor pandas
 or pyarrow.  Checked in a fresh interpreter, so nothing imported by other tests hides it."""
 
 from __future__ import annotations
@@ -14,10 +14,10 @@ MATHS = [
     "thermocal.recording",
     "thermocal.preprocess",
     "thermocal.metrics",
-    "thermocal.allan",
+    "thermocal.stability.allan",
     "thermocal.profiles",
     "thermocal.validation",
-    "thermocal.compensation",
+    "thermocal.compensate.kernels",
     "thermocal.models",
     "thermocal.models.base",
     "thermocal.models.poly",
@@ -30,10 +30,16 @@ MATHS = [
     "thermocal.models.lstsq",
     "thermocal.models.poly_fit",
     "thermocal.models.poly_eval",
-    "thermocal.export_c",
+    "thermocal.export.c",
     "thermocal.report.analysis",
 ]
-FILE_LAYER = ["pandas", "pyarrow", "thermocal.io", "thermocal.compensate", "thermocal.models.files"]
+FILE_LAYER = [
+    "pandas",
+    "pyarrow",
+    "thermocal.io",
+    "thermocal.compensate.files",
+    "thermocal.models.files",
+]
 
 
 @pytest.mark.parametrize("module", MATHS)

@@ -29,7 +29,7 @@ import pytest
 from scipy.optimize import least_squares
 
 from thermocal.cli import main
-from thermocal.export_c.harness import find_compiler
+from thermocal.export.c.harness import find_compiler
 from thermocal.models.files import load_calibration
 from thermocal.multipos.calibrate import SessionResult, calibrate_session
 from thermocal.multipos.simulate import random_truth, simulate_session

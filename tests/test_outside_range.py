@@ -14,7 +14,7 @@ import pandas as pd
 import pytest
 
 from thermocal.cli import main
-from thermocal.compensation import StreamingCompensator
+from thermocal.compensate.kernels import StreamingCompensator
 from thermocal.errors import ExtrapolationWarning
 from thermocal.models.files import load_model
 

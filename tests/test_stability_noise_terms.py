@@ -10,7 +10,7 @@ import math
 import numpy as np
 import pytest
 
-from thermocal import allan
+from thermocal.stability import allan
 
 FS = 100.0
 N_ARW_DEG_SQRT_H = 1.0  # angle random walk [°/√h]

@@ -15,7 +15,7 @@ tangential part of the mean bias, ``b̄ − u (u·b̄)``, is taken as tilt, so t
 constant holds the bias *along* gravity (``|f̄| − g``, known because ``g`` is) but the
 horizontal biases only relative to the placement's mean.  The temperature dependence
 (the slopes) is unaffected: the known input is constant within a placement.  This is why
-:mod:`thermocal.export_params` writes accelerometer offsets relative to mid-range (PX4's
+:mod:`thermocal.export.params` writes accelerometer offsets relative to mid-range (PX4's
 convention; ArduPilot's polynomial has no constant) and leaves the absolute offset to the
 firmware's accelerometer calibration.
 

@@ -9,7 +9,7 @@ not a copy of the modelling test's:
    validation test is *weakly correlated* when ``r < 0.4``.  A test that is not
    gets a :class:`~thermocal.errors.CorrelationWarning`, not a refusal.
 2. **Compensation**: ``F' = F − ŷ(T, Ṫ, …)`` with the model
-   (:func:`thermocal.compensate.compensate_run`).
+   (:func:`thermocal.compensate.files.compensate_run`).
 3. **Hold stages**: the temperature-hold stages of the validation run are cut
    out (:func:`thermocal.preprocess.segment_holds` on the ambient column) and,
    before and after compensation, within each stage s:
@@ -32,9 +32,9 @@ not a copy of the modelling test's:
    and ``peak_to_peak = max F̄_j − min F̄_j``.
 5. ``improvement_pct[x] = 100 (x_before − x_after)/x_before`` for each figure.
 6. **What the user sees** (issue 25): per sample, about the level an ideal sensor would
-   give (``K``, :func:`thermocal.compensation.zero_reference`: the known input — earth rate,
+   give (``K``, :func:`thermocal.compensate.kernels.zero_reference`: the known input — earth rate,
    gravity — or 0), ``mean = mean(F − K)``, ``rms_about_zero = sqrt(mean((F − K)²))`` and
-   ``max_abs = max |F − K|``, before and after (:class:`~thermocal.compensation.
+   ``max_abs = max |F − K|``, before and after (:class:`~thermocal.compensate.kernels.
    AbsoluteFigures`).  A compensation that raises the rms about zero or the largest |error|
    by more than 1 % is *absolutely worse*: a warning, ``absolute_error_worse`` and the
    verdict ``NOT improved (absolute error worse)`` — the figures about the mean cannot see a
@@ -59,7 +59,7 @@ import numpy as np
 import numpy.typing as npt
 
 from thermocal import metrics
-from thermocal.compensation import (
+from thermocal.compensate.kernels import (
     AbsoluteFigures,
     absolute_error_worse,
     absolute_figures,
@@ -205,7 +205,7 @@ class ValidationResult:
 
     def in_unit(self, unit: str, factor: float) -> ValidationResult:
         """The same result with every signal figure in ``unit``, where ``value[self.unit]
-        = factor · value[unit]`` (e.g. the data's own unit, :class:`thermocal.compensate.
+        = factor · value[unit]`` (e.g. the data's own unit, :class:`thermocal.compensate.files.
         ModelRun`); improvements, r and the stage layout are unchanged."""
         if factor == 1.0 and unit == self.unit:
             return self
@@ -358,7 +358,7 @@ def validate(
         (:func:`thermocal.preprocess.segment_holds` on the ambient temperature).
     extrapolate : evaluate the model outside its fitted range instead of clamping.
     zero_reference : ``(K, what)``, the level an ideal sensor would output on this run
-        [model unit] (:func:`thermocal.compensation.zero_reference`): the "zero" of the
+        [model unit] (:func:`thermocal.compensate.kernels.zero_reference`): the "zero" of the
         absolute figures.
     display_unit : ``(unit, factor)`` with ``value[model unit] = factor · value[unit]``:
         the unit the warning texts state figures in (the data's own); default the model's.

@@ -32,7 +32,7 @@ import pyarrow.parquet as pq
 import pytest
 
 from thermocal.cli import main
-from thermocal.export_c.harness import find_compiler
+from thermocal.export.c.harness import find_compiler
 
 pytestmark = pytest.mark.skipif(find_compiler() is None, reason="no C compiler on this machine")
 

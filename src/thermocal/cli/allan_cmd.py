@@ -39,13 +39,13 @@ from thermocal.errors import ConditioningWarning, ThermocalInputError
 if TYPE_CHECKING:
     import rich.table as _rich_table
 
-    import thermocal.allan as _allan
     import thermocal.metrics as _metrics
+    import thermocal.stability.allan as _allan
     import thermocal.stability.family as _family
     import thermocal.writers as _writers
 else:
     _rich_table = LazyModule("rich.table")
-    _allan = LazyModule("thermocal.allan")
+    _allan = LazyModule("thermocal.stability.allan")
     _writers = LazyModule("thermocal.writers")
     _metrics = LazyModule("thermocal.metrics")
     _family = LazyModule("thermocal.stability.family")
@@ -381,7 +381,7 @@ def allan_cmd(
                     stacklevel=1,
                 )
         if plot is not None:
-            from thermocal.plots_allan import plot_allan, plot_dynamic
+            from thermocal.report.allan_plots import plot_allan, plot_dynamic
 
             target = plot if len(names) == 1 else plot.with_name(f"{plot.stem}_{name}{plot.suffix}")
             plot_allan(res_c, noise_c, target, title=f"{file.name} — {name}")

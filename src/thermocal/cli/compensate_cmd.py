@@ -2,7 +2,7 @@
 
 OUT keeps every input column and adds ``<signal>_model`` and ``<signal>_comp``
 (INTERFACE.md).  Files of any size are processed in chunks with constant memory
-(:func:`thermocal.compensate.compensate_file`).
+(:func:`thermocal.compensate.files.compensate_file`).
 """
 
 from typing import TYPE_CHECKING, Annotated
@@ -44,14 +44,14 @@ from thermocal.errors import ThermocalInputError
 if TYPE_CHECKING:
     import rich.table as _rich_table
 
-    import thermocal.compensate as _compensate
+    import thermocal.compensate.files as _compensate
     import thermocal.models.files as _files
     import thermocal.outputs as _outputs
     import thermocal.readers as _readers
     import thermocal.writers as _writers
 else:
     _rich_table = LazyModule("rich.table")
-    _compensate = LazyModule("thermocal.compensate")
+    _compensate = LazyModule("thermocal.compensate.files")
     _outputs = LazyModule("thermocal.outputs")
     _readers = LazyModule("thermocal.readers")
     _writers = LazyModule("thermocal.writers")

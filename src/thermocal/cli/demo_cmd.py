@@ -1,6 +1,6 @@
 """``thermocal demo [-o DIR]``: the whole chamber workflow on built-in simulated data.
 
-Runs :func:`thermocal.demo.run_demo` (profiles → simulation → 37-term and
+Runs :func:`thermocal.demo.chamber.run_demo` (profiles → simulation → 37-term and
 term-selected fits → validation → compensation → C export → HTML report) with a
 progress bar on a terminal, then prints a short summary table and the report's path.
 """
@@ -19,11 +19,11 @@ if TYPE_CHECKING:
     import rich.markup as _markup
     import rich.table as _rich_table
 
-    import thermocal.demo as _demo
+    import thermocal.demo.chamber as _demo
 else:
     _markup = LazyModule("rich.markup")
     _rich_table = LazyModule("rich.table")
-    _demo = LazyModule("thermocal.demo")
+    _demo = LazyModule("thermocal.demo.chamber")
 
 
 def _pct(value: float | None) -> str:
@@ -128,7 +128,7 @@ def demo_cmd(
 
 
 def _imu_demo(output: Path, seed: int, quick: bool, as_json: bool) -> None:
-    from thermocal.demo_imu import IMU_STEPS, run_imu_demo
+    from thermocal.demo.imu import IMU_STEPS, run_imu_demo
 
     with progress("thermocal demo --imu", total=len(IMU_STEPS)) as advance:
         res = run_imu_demo(output, seed=seed, rate_hz=0.2 if quick else 1.0,

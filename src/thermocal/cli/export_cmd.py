@@ -1,6 +1,6 @@
 """``thermocal export-c MODEL.json -o DIR [--float] [--unit U]``: plain C99 header and source.
 
-See :mod:`thermocal.export_c`.  The C works in the unit the model was fitted on as the data
+See :mod:`thermocal.export.c`.  The C works in the unit the model was fitted on as the data
 gave it (the model file's ``inputs``), or in ``--unit``; older model files that did not
 record it give the model's unit, with a warning.  With ``--float`` the worst-case error of the float
 build against the double build is measured (both compiled with the system C
@@ -20,14 +20,14 @@ from thermocal.errors import ThermocalInputError, ThermocalWarning, UnitWarning
 from thermocal.outputs import check_outputs
 
 if TYPE_CHECKING:
-    import thermocal.export_c as _export_c
+    import thermocal.export.c as _export_c
     import thermocal.models.base as _base
     import thermocal.models.calibration as _calibration
     import thermocal.models.files as _files
     from thermocal import units
 else:
     units = LazyModule("thermocal.units")
-    _export_c = LazyModule("thermocal.export_c")
+    _export_c = LazyModule("thermocal.export.c")
     _base = LazyModule("thermocal.models.base")
     _calibration = LazyModule("thermocal.models.calibration")
     _files = LazyModule("thermocal.models.files")
@@ -83,7 +83,7 @@ def _export_calibration(
     cal = _files.load_calibration(path)
     _check_adequacy(cal, path, None)
     if cal.triads and not cal.channels:  # a turntable calibration over temperature
-        from thermocal.export_c.triad import generate_c_triads
+        from thermocal.export.c.triad import generate_c_triads
 
         ex = generate_c_triads(
             cal.triads, prefix=name or _export_c.c_identifier(path.stem), real=real
@@ -293,9 +293,9 @@ def export_params_cmd(
 ) -> None:
     """Write firmware thermal-calibration parameters: PX4 TC_* (QGroundControl file) or
     ArduPilot INS_TCAL* (.parm), from a calibration of cubic polynomials in one
-    temperature (see ``thermocal.export_params``)."""
+    temperature (see ``thermocal.export.params``)."""
     from thermocal.cli.common import split_names
-    from thermocal.export_params import export_params
+    from thermocal.export.params import export_params
     from thermocal.writers import atomic_write, check_not_input
 
     check_not_input(output, [calibration])

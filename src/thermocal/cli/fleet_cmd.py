@@ -1,5 +1,5 @@
 """``thermocal fleet CONFIG.toml -o DIR [--workers N] [--scheduler ADDRESS] [--force]``:
-one calibration per unit of a production batch (:mod:`thermocal.fleet`; INTERFACE.md
+one calibration per unit of a production batch (:mod:`thermocal.fleet.batch`; INTERFACE.md
 "Fleet configuration").
 
 Exit status 0 when every unit was calibrated, 4 when some failed (each recorded with its
@@ -19,9 +19,9 @@ from thermocal.cli.common import JsonOpt, emit, handle_errors, progress, stdout
 from thermocal.errors import ThermocalInputError
 
 if TYPE_CHECKING:
-    from thermocal import fleet as _fleet
+    from thermocal.fleet import batch as _fleet
 else:
-    _fleet = LazyModule("thermocal.fleet")
+    _fleet = LazyModule("thermocal.fleet.batch")
 
 
 @app.command("fleet")

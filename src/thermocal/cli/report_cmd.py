@@ -179,7 +179,7 @@ def report_cmd(
     _writers.check_not_input(output, inputs_files)
     cal = _files.load_calibration(model[0])
     if cal.triads and not cal.channels:  # a turntable calibration over temperature
-        from thermocal.compensate import read_for_triads
+        from thermocal.compensate.files import read_for_triads
         from thermocal.multipos import validate as _mp_validate
         from thermocal.report.triads import write_triad_report
         from thermocal.turntable.calibrate import validate_triads

@@ -1,7 +1,7 @@
 """``thermocal px4-tempcal LOG.ulg -o DIR``: PX4's thermal calibration from one log.
 
 Every ``sensor_gyro``/``sensor_accel`` instance with a temperature is binned, judged on
-held-out bins and fitted as a cubic per axis (:mod:`thermocal.px4_tempcal`); writes
+held-out bins and fitted as a cubic per axis (:mod:`thermocal.tempcal.px4`); writes
 ``DIR/calibration.json``, ``DIR/px4.params`` (QGroundControl, TC_*) and one report per
 sensor, ``DIR/report_<topic>_<n>.html``.
 """
@@ -76,10 +76,12 @@ def px4_tempcal_cmd(
     judged on held-out data; write the TC_* parameters, the calibration and reports."""
     import numpy as np
 
-    from thermocal.export_params import ParamSet, export_params, px4_offset_params
+    from thermocal.export.params import ParamSet, export_params, px4_offset_params
     from thermocal.models.calibration import Calibration
     from thermocal.models.files import save_calibration
-    from thermocal.px4_tempcal import (
+    from thermocal.readers.dispatch import read_log_table
+    from thermocal.report.calibration import CalibrationReportInputs, write_calibration_report
+    from thermocal.tempcal.px4 import (
         OFFSET_TOPICS,
         GateWarning,
         calibration_of,
@@ -92,8 +94,6 @@ def px4_tempcal_cmd(
         step_warnings,
         summary,
     )
-    from thermocal.readers.dispatch import read_log_table
-    from thermocal.report.calibration import CalibrationReportInputs, write_calibration_report
     from thermocal.writers import atomic_write, commit_directory, staging_directory
 
     # DIR may hold the log; the files of the set (replaced by name) may not be it
@@ -237,10 +237,13 @@ def ardupilot_tempcal_cmd(
     import numpy as np
 
     from thermocal.errors import MissingColumnError
-    from thermocal.export_params import ParamSet, export_params
+    from thermocal.export.params import ParamSet, export_params
     from thermocal.models.calibration import Calibration
     from thermocal.models.files import save_calibration
-    from thermocal.px4_tempcal import (
+    from thermocal.readers.dataflash import dataflash_table, read_dataflash_log
+    from thermocal.recording import Recording
+    from thermocal.report.calibration import CalibrationReportInputs, write_calibration_report
+    from thermocal.tempcal.px4 import (
         AP_ROTATIONS,
         GateWarning,
         ardupilot_raw,
@@ -251,9 +254,6 @@ def ardupilot_tempcal_cmd(
         step_warnings,
         summary,
     )
-    from thermocal.readers.dataflash import dataflash_table, read_dataflash_log
-    from thermocal.recording import Recording
-    from thermocal.report.calibration import CalibrationReportInputs, write_calibration_report
     from thermocal.writers import atomic_write, commit_directory, staging_directory
 
     # DIR may hold the log; the files of the set (replaced by name) may not be it

@@ -46,7 +46,7 @@ from thermocal.errors import ThermocalInputError, UnitWarning
 if TYPE_CHECKING:
     import rich.table as _rich_table
 
-    import thermocal.compensate as _compensate
+    import thermocal.compensate.files as _compensate
     import thermocal.models.base as _base
     import thermocal.models.calibration as _calibration
     import thermocal.models.files as _files
@@ -54,7 +54,7 @@ if TYPE_CHECKING:
     import thermocal.validation as _validation
 else:
     _rich_table = LazyModule("rich.table")
-    _compensate = LazyModule("thermocal.compensate")
+    _compensate = LazyModule("thermocal.compensate.files")
     _base = LazyModule("thermocal.models.base")
     _calibration = LazyModule("thermocal.models.calibration")
     _files = LazyModule("thermocal.models.files")
@@ -346,7 +346,7 @@ def _validate_triads(
     as_json: bool,
 ) -> None:
     """A calibration of triads judged on a turntable run (issue 19)."""
-    from thermocal.compensate import read_for_triads
+    from thermocal.compensate.files import read_for_triads
     from thermocal.multipos import validate as _mp_validate
     from thermocal.turntable.calibrate import validate_triads
 

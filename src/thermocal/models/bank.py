@@ -240,7 +240,7 @@ class BankModel(TemperatureModel):
     """
 
     family: ClassVar[str] = "bank"
-    C_GENERATOR: ClassVar[str | None] = "thermocal.export_c.bank"
+    C_GENERATOR: ClassVar[str | None] = "thermocal.export.c.bank"
     uses_rate: ClassVar[bool] = False
 
     breakpoints_: list[FloatArray]

@@ -583,7 +583,7 @@ class TemperatureModel(ABC):
         return [p for p in sig.parameters if p != "self"]
 
     C_GENERATOR: ClassVar[str | None] = None
-    """The module of :mod:`thermocal.export_c` whose ``generate(ctx)`` writes this family's
+    """The module of :mod:`thermocal.export.c` whose ``generate(ctx)`` writes this family's
     C code (imported only by ``export-c``); None: no C export."""
 
     CLI_KEYS: ClassVar[Mapping[str, str] | None] = None

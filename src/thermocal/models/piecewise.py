@@ -357,7 +357,7 @@ class PiecewiseModel(TemperatureModel):
     """
 
     family: ClassVar[str] = "piecewise"
-    C_GENERATOR: ClassVar[str | None] = "thermocal.export_c.piecewise"
+    C_GENERATOR: ClassVar[str | None] = "thermocal.export.c.piecewise"
     uses_rate: ClassVar[bool] = False
 
     breakpoints_: FloatArray

@@ -206,7 +206,7 @@ class PolyModel(TemperatureModel):
     """
 
     family: ClassVar[str] = "poly"
-    C_GENERATOR: ClassVar[str | None] = "thermocal.export_c.poly"
+    C_GENERATOR: ClassVar[str | None] = "thermocal.export.c.poly"
     uses_rate: ClassVar[bool] = True
 
     terms_: list[Term]

@@ -294,7 +294,7 @@ class WarmupModel(TemperatureModel):
     """
 
     family: ClassVar[str] = "warmup"
-    C_GENERATOR: ClassVar[str | None] = "thermocal.export_c.warmup"
+    C_GENERATOR: ClassVar[str | None] = "thermocal.export.c.warmup"
     uses_rate: ClassVar[bool] = False
 
     b_: FloatArray

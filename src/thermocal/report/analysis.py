@@ -13,11 +13,11 @@ from typing import Any
 import numpy as np
 
 from thermocal import units
-from thermocal.allan import AllanResult, NoiseTerms, noise_terms, overlapping_adev
-from thermocal.compensation import unit_factor
+from thermocal.compensate.kernels import unit_factor
 from thermocal.metrics import RATE_ANGLE_UNITS, DriftReference, compute_metrics, drift_angle
 from thermocal.models.base import RunData, TemperatureModel
 from thermocal.recording import FloatArray, Metadata, Recording
+from thermocal.stability.allan import AllanResult, NoiseTerms, noise_terms, overlapping_adev
 
 ILL_CONDITIONED = 1.0e6
 """Condition number (scaled design) above which the report warns: ill-conditioned in the
@@ -251,7 +251,7 @@ class AllanAnalysis:
 
 def allan_of(time_s: FloatArray, x: FloatArray, tau0_s: float, unit: str) -> AllanAnalysis:
     """Overlapping Allan deviation (octave τ, ±1σ confidence intervals, split at gaps) and
-    the IEEE Std 952 noise terms, by :func:`thermocal.allan.overlapping_adev` and
-    :func:`thermocal.allan.noise_terms` (NIST SP 1065 eq. 11; SPEC §1)."""
+    the IEEE Std 952 noise terms, by :func:`thermocal.stability.allan.overlapping_adev` and
+    :func:`thermocal.stability.allan.noise_terms` (NIST SP 1065 eq. 11; SPEC §1)."""
     res = overlapping_adev(x, tau0_s, "octave", time_s=time_s, unit=unit)
     return AllanAnalysis(result=res, terms=noise_terms(res))

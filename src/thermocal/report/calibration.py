@@ -32,7 +32,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from thermocal.compensation import unit_factor
+from thermocal.compensate.kernels import unit_factor
 from thermocal.defaults import DEFAULT_AVERAGING_S
 from thermocal.errors import ThermocalInputError
 from thermocal.models.base import model_file_dict

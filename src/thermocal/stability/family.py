@@ -165,7 +165,7 @@ def stability(
     and time deviations (tdev, ttotdev, mtie, tierms) in ``unit*s``; phase data give
     deviations in ``unit/s`` and time deviations in ``unit``.
     """
-    from thermocal.allan import confidence_interval
+    from thermocal.stability.allan import confidence_interval
 
     if data_type not in ("rate", "phase"):
         raise ThermocalInputError(f"--data-type {data_type!r}: use rate or phase")

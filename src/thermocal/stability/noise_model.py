@@ -1,7 +1,7 @@
 """The noise model of an IMU for estimators (Kalibr's ``imu.yaml``), from Allan analysis.
 
 Pure maths and text: no file I/O.  The noise terms are those of
-:func:`thermocal.allan.noise_terms` (IEEE 952 slope lines, least-squares fit); this module
+:func:`thermocal.stability.allan.noise_terms` (IEEE 952 slope lines, least-squares fit); this module
 only chooses, converts and states them.
 
 Continuous-time model of one axis (Kalibr's IMU noise model, J. Rehder et al., *Extending
@@ -38,7 +38,8 @@ import numpy as np
 import numpy.typing as npt
 
 from thermocal import units
-from thermocal.allan import (
+from thermocal.errors import ThermocalInputError
+from thermocal.stability.allan import (
     AllanResult,
     NoiseTerm,
     NoiseTerms,
@@ -46,7 +47,6 @@ from thermocal.allan import (
     overlapping_adev,
     term_units,
 )
-from thermocal.errors import ThermocalInputError
 
 Sensor = Literal["gyro", "accel"]
 
@@ -227,8 +227,8 @@ def axis_noise(
     confidence: float = 0.6826894921370859,
     taus: Any = "octave",
 ) -> AxisNoise:
-    """Allan analysis (:func:`thermocal.allan.overlapping_adev`, :func:`noise_terms`) of one
-    axis in the data's unit ``unit`` and its continuous-time density and random walk in SI.
+    """Allan analysis (:func:`thermocal.stability.allan.overlapping_adev`, :func:`noise_terms`)
+    of one axis in the data's unit ``unit`` and its continuous-time density and random walk in SI.
     """
     u = units.normalize_signal_unit(unit)
     kind_units = units.RATE_UNITS if sensor == "gyro" else units.ACCEL_UNITS

@@ -25,7 +25,7 @@ source file with
   fitted on converted counts also gets ``<p>_temps_from_counts``.  ``init`` is a power-on (it
   forgets every state); ``sample_interval_s`` is the nominal sample interval τ:
   a time step longer than ``GAP_FACTOR`` (1.5) × τ resets the rate estimate, as
-  in :class:`thermocal.compensate.StreamingCompensator`;
+  in :class:`thermocal.compensate.files.StreamingCompensator`;
 * a comment block with the model file's identity (family, format version,
   thermocal version, checksum, signal, temperatures, data files).
 
@@ -57,8 +57,8 @@ parameters the model uses, so the module builds with ``-Wall -Wextra -Werror``
 
 from __future__ import annotations
 
-from thermocal.export_c.calibration import export_c, fitted_sample_interval, generate_c_calibration
-from thermocal.export_c.core import (
+from thermocal.export.c.calibration import export_c, fitted_sample_interval, generate_c_calibration
+from thermocal.export.c.core import (
     REAL_TYPES,
     CExport,
     ExportContext,
@@ -67,7 +67,7 @@ from thermocal.export_c.core import (
     family_generator,
     generate_c,
 )
-from thermocal.export_c.harness import (
+from thermocal.export.c.harness import (
     CFLAGS,
     FloatError,
     c_harness,

@@ -1,4 +1,4 @@
-"""C code of the ``piecewise`` family (:mod:`thermocal.export_c`): piecewise-linear
+"""C code of the ``piecewise`` family (:mod:`thermocal.export.c`): piecewise-linear
 segments (SPEC §4b)."""
 
 from __future__ import annotations
@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 
 from thermocal.errors import ModelFileError
-from thermocal.export_c.core import (
+from thermocal.export.c.core import (
     ExportContext,
     FamilyCode,
 )

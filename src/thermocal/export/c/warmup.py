@@ -1,11 +1,11 @@
-"""C code of the ``warmup`` family (:mod:`thermocal.export_c`): warm-up models indexed
+"""C code of the ``warmup`` family (:mod:`thermocal.export.c`): warm-up models indexed
 by the start temperature (SPEC §4c)."""
 
 from __future__ import annotations
 
 import numpy as np
 
-from thermocal.export_c.core import (
+from thermocal.export.c.core import (
     ExportContext,
     FamilyCode,
 )

@@ -1,5 +1,5 @@
 """One C module for a whole calibration, and the file-level entry point
-(:mod:`thermocal.export_c`)."""
+(:mod:`thermocal.export.c`)."""
 
 from __future__ import annotations
 
@@ -8,7 +8,7 @@ from pathlib import Path
 from typing import Any
 
 from thermocal.errors import ThermocalInputError
-from thermocal.export_c.core import (
+from thermocal.export.c.core import (
     CExport,
     _comment,
     generate_c,

@@ -3,7 +3,7 @@
 Yield (calibrated, passed, failed), the distribution of each channel's residual figures and
 fitted coefficients across the units (each coefficient as a robust z-score, so that terms of
 different sizes share one axis), the robust outliers named (modified z-score above
-:data:`thermocal.fleet.OUTLIER_Z`, Iglewicz & Hoaglin 1993), the failed units with their
+:data:`thermocal.fleet.batch.OUTLIER_Z`, Iglewicz & Hoaglin 1993), the failed units with their
 errors and the units outside the limits.  One self-contained file (figures as data URIs);
 matplotlib and jinja2 are imported here only.
 """
@@ -22,7 +22,7 @@ import numpy as np
 from thermocal.writers import atomic_write
 
 if TYPE_CHECKING:
-    from thermocal.fleet import FleetConfig
+    from thermocal.fleet.batch import FleetConfig
 
 
 def _b64(png: bytes) -> str:
@@ -39,9 +39,9 @@ def _fmt(v: Any, digits: int = 4) -> str:
 
 def _figure_distributions(channel: str, ok: Mapping[str, Mapping[str, Any]]) -> bytes:
     """Histograms of a channel's rms residual and (if validated) rms after compensation,
-    in the channel's data unit (:func:`thermocal.fleet.channel_series`), and a strip plot
+    in the channel's data unit (:func:`thermocal.fleet.batch.channel_series`), and a strip plot
     of every coefficient's robust z-score across the units."""
-    from thermocal.fleet import OUTLIER_Z, channel_series, robust_z
+    from thermocal.fleet.batch import OUTLIER_Z, channel_series, robust_z
     from thermocal.report.figures import _figure, _png
 
     figs = [r["channels"][channel] for r in ok.values()]
@@ -90,7 +90,7 @@ def build_fleet_report(
     channel's data unit, as ``unit.json`` holds it; ``redone``: the units redone in this
     run and why."""
     from thermocal import __version__
-    from thermocal.fleet import outliers
+    from thermocal.fleet.batch import outliers
     from thermocal.report.build import _env
 
     units = []

@@ -1,11 +1,11 @@
-"""C code of the ``bank`` family (:mod:`thermocal.export_c`): the bank of models
+"""C code of the ``bank`` family (:mod:`thermocal.export.c`): the bank of models
 chosen at power-on (SPEC §4d)."""
 
 from __future__ import annotations
 
 import numpy as np
 
-from thermocal.export_c.core import (
+from thermocal.export.c.core import (
     ExportContext,
     FamilyCode,
 )

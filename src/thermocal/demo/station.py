@@ -1,6 +1,6 @@
 """The whole station chain on one machine, no hardware (issue 31, item 6)::
 
-    python -m thermocal.station.demo -o station-demo [--time-scale 200]
+    python -m thermocal.demo.station -o station-demo [--time-scale 200]
 
 A simulated chamber (pymodbus's Modbus TCP server on 127.0.0.1, first-order dynamics,
 :mod:`thermocal.station.sim`) and a simulated serial gyro (a pseudo-terminal streaming
@@ -96,7 +96,7 @@ def run_demo(out: Path, time_scale: float = 200.0) -> dict[str, object]:
 
 
 def cli(argv: list[str] | None = None) -> int:
-    ap = argparse.ArgumentParser(prog="python -m thermocal.station.demo", description=__doc__)
+    ap = argparse.ArgumentParser(prog="python -m thermocal.demo.station", description=__doc__)
     ap.add_argument("-o", "--output", type=Path, default=Path("station-demo"))
     ap.add_argument("--time-scale", type=float, default=200.0)
     a = ap.parse_args(argv)

@@ -1,7 +1,7 @@
 """Log-log Allan deviation plot with confidence bars and fitted noise lines.
 
 Plotting stays at the edge: matplotlib (Agg backend) is imported inside
-:func:`plot_allan` only, never by :mod:`thermocal.allan`.
+:func:`plot_allan` only, never by :mod:`thermocal.stability.allan`.
 """
 
 from __future__ import annotations
@@ -10,7 +10,7 @@ from pathlib import Path
 
 import numpy as np
 
-from thermocal.allan import TERM_NAMES, AllanResult, DynamicAllan, NoiseTerms
+from thermocal.stability.allan import TERM_NAMES, AllanResult, DynamicAllan, NoiseTerms
 from thermocal.writers import atomic_write_path
 
 

@@ -17,7 +17,7 @@ from typing import Any
 
 from thermocal import __version__
 from thermocal.errors import ThermocalInputError
-from thermocal.export_c.core import CExport
+from thermocal.export.c.core import CExport
 from thermocal.identifiers import c_comment, c_identifier, c_names
 from thermocal.turntable import model as tt_model
 

@@ -14,7 +14,7 @@ thermocal does the same with three differences (each stated in the summary):
   every bin.
 
 The fitted cubics form a calibration (one channel per axis, roles gyro/accel x/y/z, in the
-log's units rad/s and m/s²); :func:`thermocal.export_params.export_params` writes the
+log's units rad/s and m/s²); :func:`thermocal.export.params.export_params` writes the
 parameter file.
 """
 
@@ -317,7 +317,7 @@ def end_warning(where: str, what: str, ref_c: float, lo: float, hi: float) -> st
 OFFSET_TOPICS = {"sensor_baro": ("baro", ("pressure",), "Pa"), "sensor_mag": ("mag", AXES, "gauss")}
 """PX4 topics calibrated as offsets in the firmware's unit (uORB ``SensorBaro.msg`` pressure
 [Pa], ``SensorMag.msg`` x, y, z [gauss]) with the polynomial order of their parameters
-(:data:`thermocal.export_params.PX4_OFFSET_SENSORS`: 5 for TC_B, 3 for TC_M)."""
+(:data:`thermocal.export.params.PX4_OFFSET_SENSORS`: 5 for TC_B, 3 for TC_M)."""
 
 
 @dataclass(frozen=True)
@@ -358,7 +358,7 @@ def fit_offset_sensor(
     held-out bins (a polynomial fitted to the even bins, its rms on the odd ones) and fit a
     polynomial of PX4's order in ``T − TREF`` (TREF mid-range unless given) to every bin.
     ``values`` (n, axes) in the topic's unit (:data:`OFFSET_TOPICS`)."""
-    from thermocal.export_params import PX4_OFFSET_SENSORS
+    from thermocal.export.params import PX4_OFFSET_SENSORS
 
     kind, fields, unit = OFFSET_TOPICS[topic]
     order = PX4_OFFSET_SENSORS[kind][1]

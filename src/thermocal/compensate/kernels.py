@@ -1,5 +1,5 @@
 """Compensation with a fitted model, in memory and live (SPEC §4, §8): the maths of
-:mod:`thermocal.compensate` without files (issue 15: the maths imports no I/O).
+:mod:`thermocal.compensate.files` without files (issue 15: the maths imports no I/O).
 
 A model gives the temperature-induced part of the signal, ``ŷ = model(T, Ṫ, …)``; the
 compensated output is ``F' = F − ŷ`` (SPEC §4c: "output F' = F − ΔF").

@@ -38,7 +38,7 @@ same function on the same inputs, so the same numbers bit for bit.
 
 After the batch: ``DIR/summary.csv`` and ``DIR/summary.parquet`` (one row per unit: ``id``,
 ``status``, ``error``, ``pass``, ``fail_reasons``, and per channel ``<channel>.<figure>``)
-and ``DIR/fleet.html`` (:mod:`thermocal.report.fleet`).
+and ``DIR/fleet.html`` (:mod:`thermocal.fleet.report`).
 """
 
 from __future__ import annotations
@@ -1035,7 +1035,7 @@ def _finish(
 ) -> tuple[list[dict[str, Any]], Path, Path, Path]:
     """The summary and the report; units found stale and not redone (an interrupted run)
     are pending, never shown with their old figures."""
-    from thermocal.report.fleet import write_fleet_report
+    from thermocal.fleet.report import write_fleet_report
 
     done = set(ran)
     redone = {k: v for k, v in redo.items() if k in done}

@@ -18,8 +18,8 @@ temperature sensors (seed 000):
    r of the chamber temperatures, hold-stage bias stability and repeatability
    before and after), saved as the JSON of ``thermocal validate --json``.
 5. **Compensation** of the validation file with the reported model
-   (:func:`thermocal.compensate.compensate_file`).
-6. **C export** of both models (:func:`thermocal.export_c.export_c`).
+   (:func:`thermocal.compensate.files.compensate_file`).
+6. **C export** of both models (:func:`thermocal.export.c.export_c`).
 7. **Report** — ``report.html`` (:func:`thermocal.report.write_report`) with the
    figures of merit and Allan deviation before and after compensation.
 
@@ -40,9 +40,9 @@ from typing import Any
 import numpy as np
 
 from thermocal import units
-from thermocal.compensate import compensate_file
+from thermocal.compensate.files import compensate_file
 from thermocal.errors import ModelFileError, ThermocalWarning
-from thermocal.export_c import export_c
+from thermocal.export.c import export_c
 from thermocal.models.base import RunData, TemperatureModel, make_model
 from thermocal.models.files import save_model
 from thermocal.profiles import design_validation_profile, rlg_modelling, write_program

@@ -1,4 +1,4 @@
-"""Compile and run generated C against Python (tests, float error; :mod:`thermocal.export_c`)."""
+"""Compile and run generated C against Python (tests, float error; :mod:`thermocal.export.c`)."""
 
 from __future__ import annotations
 
@@ -13,7 +13,7 @@ import numpy as np
 import numpy.typing as npt
 
 from thermocal.errors import ThermocalInputError
-from thermocal.export_c.core import REAL_TYPES, CExport, generate_c
+from thermocal.export.c.core import REAL_TYPES, CExport, generate_c
 from thermocal.recording import FloatArray
 
 # --- compile and run (tests, float error) -----------------------------------------------------

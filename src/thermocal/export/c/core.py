@@ -1,5 +1,5 @@
 """The generated module's skeleton and the helpers every family's generator uses
-(:mod:`thermocal.export_c`)."""
+(:mod:`thermocal.export.c`)."""
 
 from __future__ import annotations
 
@@ -175,7 +175,7 @@ Generator = Callable[[ExportContext], FamilyCode]
 
 def family_generator(family: str) -> Generator:
     """The C generator a model family declares on its class (``C_GENERATOR``: the module
-    of :mod:`thermocal.export_c` whose ``generate(ctx)`` writes its code), so a family's
+    of :mod:`thermocal.export.c` whose ``generate(ctx)`` writes its code), so a family's
     options, chunk context and C code are declared in one place."""
     import importlib
 

@@ -23,9 +23,9 @@ from typing import Any
 import numpy as np
 
 from thermocal import units
-from thermocal.compensate import compensate_channels, prepare_run
+from thermocal.compensate.files import compensate_channels, prepare_run
 from thermocal.errors import ThermocalWarning
-from thermocal.export_c import generate_c_calibration
+from thermocal.export.c import generate_c_calibration
 from thermocal.models.base import RunData, model_file_dict, model_inputs
 from thermocal.models.calibration import Calibration, Channel, guess_role
 from thermocal.models.files import save_calibration

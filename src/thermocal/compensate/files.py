@@ -1,5 +1,5 @@
 """Compensation of files with a fitted model (SPEC §4, §8); the maths (in memory, in
-chunks, live) is :mod:`thermocal.compensation`, re-exported here.
+chunks, live) is :mod:`thermocal.compensate.kernels`, re-exported here.
 
 A model gives the temperature-induced part of the signal, ``ŷ = model(T, Ṫ, …)``;
 the compensated output is ``F' = F − ŷ`` (SPEC §4c: "output F' = F − ΔF").
@@ -47,7 +47,7 @@ import numpy as np
 
 from thermocal import units
 from thermocal._lazy import LazyModule
-from thermocal.compensation import (  # the maths, re-exported
+from thermocal.compensate.kernels import (  # the maths, re-exported
     AbsoluteFigures,
     CalibrationStream,
     ChunkPredictor,
@@ -171,7 +171,7 @@ class CompensateFileResult:
     """Rms of the compensated signal about its mean [data unit]."""
     extra: dict[str, Any] = field(default_factory=dict)
     mean_before: float = float("nan")
-    """What the sensor's user sees (:class:`~thermocal.compensation.AbsoluteFigures`),
+    """What the sensor's user sees (:class:`~thermocal.compensate.kernels.AbsoluteFigures`),
     per sample about :attr:`zero_reference`: ``mean(F − K)`` of the signal [data unit]."""
     mean_after: float = float("nan")
     """``mean(F' − K)`` of the compensated signal [data unit]."""

@@ -1,4 +1,4 @@
-"""C code of the ``poly`` family (:mod:`thermocal.export_c`): the polynomial of SPEC §4a
+"""C code of the ``poly`` family (:mod:`thermocal.export.c`): the polynomial of SPEC §4a
 with its Ṫ buffer, as models/poly.py streams it."""
 
 from __future__ import annotations
@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 
 from thermocal.errors import ModelFileError
-from thermocal.export_c.core import (
+from thermocal.export.c.core import (
     ExportContext,
     FamilyCode,
     _rate_buffer_code,
