@@ -29,15 +29,15 @@ LAYERS: dict[str, int] = {
     # 2 maths: pure functions on arrays
     "preprocess": 2, "metrics": 2, "profiles": 2, "inspection": 2, "adequacy": 2, "gravity": 2,
     "stability": 2, "models": 2, "compensate.kernels": 2, "simulate": 2, "turntable": 2,
-    "multipos": 2, "datasets": 2,
+    "multipos": 2, "datasets": 2, "compensate": 2,
     # 3 files: reading, writing, model files, the drivers that stream files
-    "readers": 3, "writers": 3, "models.files": 3, "models.schema": 3, "models.filecheck": 3,
-    "models.calibration": 3, "compensate.files": 3, "validation": 3, "export": 3, "tempcal": 3,
+    "readers": 3, "writers": 3, "models.files": 3, "models.filecheck": 3, "compensate.files": 3,
+    "validation": 3, "export": 3, "tempcal": 3,
     "station": 3, "fitting": 3,
     # 4 presentation and batch drivers
     "report": 4, "fleet": 4, "demo": 4,
     # 5 the command line
-    "cli": 5, "__main__": 5,
+    "cli": 5, "__main__": 5, "thermocal": 5,
 }  # fmt: skip
 
 
@@ -71,11 +71,17 @@ def imports_of(path: Path, modules: set[str]) -> set[str]:
             if isinstance(child, ast.Import):
                 found.update(a.name for a in child.names)
             elif isinstance(child, ast.ImportFrom) and child.module and child.level == 0:
-                found.add(child.module)
-                found.update(f"{child.module}.{a.name}" for a in child.names)
-            elif isinstance(child, ast.Call) and ast.unparse(child.func).endswith("LazyModule"):
-                if child.args and isinstance(child.args[0], ast.Constant):
-                    found.add(str(child.args[0].value))
+                subs = {f"{child.module}.{a.name}" for a in child.names}
+                found.update(subs & modules)  # ``from pkg import submodule``
+                if not subs <= modules:  # names defined in the module (or package) itself
+                    found.add(child.module)
+            elif (
+                isinstance(child, ast.Call)
+                and ast.unparse(child.func).endswith("LazyModule")
+                and child.args
+                and isinstance(child.args[0], ast.Constant)
+            ):
+                found.add(str(child.args[0].value))
             visit(child)
 
     visit(tree)
@@ -177,8 +183,10 @@ def main(argv: list[str] | None = None) -> int:
                 print(f"  {r} -> {', '.join(sorted(arrows.get(r, ()))) or '(nothing)'}")
         print(f"{len(g)} modules, {sum(len(v) for v in arrows.values())} arrows")
         for a, b in sorted(up):
-            print(f"UPWARD: {a} (layer {LAYERS.get(room(a))}) imports {b} (layer "
-                  f"{LAYERS.get(room(b))})")
+            print(
+                f"UPWARD: {a} (layer {LAYERS.get(room(a))}) imports {b} (layer "
+                f"{LAYERS.get(room(b))})"
+            )
         for c in circles:
             print("CIRCLE: " + " <-> ".join(c))
         unplaced = sorted({room(m) for m in g if room(m) not in LAYERS})
