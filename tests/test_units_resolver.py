@@ -200,3 +200,19 @@ def test_the_fallback_detector_finds_them(tmp_path: Path) -> None:
         '    e = rec.units.get(c) or "deg/s"\n'
     )
     assert len(_fallbacks(pkg)) == 4
+
+
+def test_shown_unit_is_the_datas_own_unit_with_exact_factors() -> None:
+    """Figures of a model in °/h shown for °/s data: 1 °/h = 1/3600 °/s (written out here);
+    mg model, m/s^2 data: 1 mg = 9.80665e-3 m/s² (standard gravity, CGPM 1901); raw counts or
+    another kind keep the model's unit."""
+    from thermocal.units import ShownUnit, shown_unit
+
+    s = shown_unit("deg/h", "deg/s")
+    assert s.unit == "deg/s"
+    assert s.to_shown == pytest.approx(1 / 3600, rel=1e-15)
+    assert s.to_model == pytest.approx(3600.0, rel=1e-15)
+    a = shown_unit("mg", "m/s^2")
+    assert a.unit == "m/s^2" and a.to_shown == pytest.approx(9.80665e-3, rel=1e-12)
+    for other in ("counts", "mg", None, "furlongs"):
+        assert shown_unit("deg/h", other) == ShownUnit("deg/h", 1.0, 1.0)

@@ -940,3 +940,41 @@ def counts_to_physical(
             out, arr, f"counts → {unit}, K = {scale_factor:g} {scale_factor_unit}", where, first_row
         )
     return out, unit
+
+
+@dataclass(frozen=True)
+class ShownUnit:
+    """The unit a channel's figures are shown to the user in, and the factors between it
+    and the unit the model works in: ``x[unit] = to_shown · x[model_unit]`` and
+    ``x[model_unit] = to_model · x[unit]`` (both from :func:`convert`, so each is exact
+    for its own direction)."""
+
+    unit: str
+    to_shown: float
+    to_model: float
+
+
+def shown_unit(model_unit: str, data_unit: str | None) -> ShownUnit:
+    """The data's own unit for figures computed in ``model_unit`` (INTERFACE.md: every
+    figure in the data's own unit).
+
+    ``data_unit`` (the column's unit as given: option, file metadata or column name) is
+    kept as written when it is a physical unit of the model unit's kind (°/s data of a
+    model in °/h: factor 1/3600).  Raw counts made physical by a scale factor, an unknown
+    or missing unit, or another kind keep the model's unit, with factors 1.
+    """
+    same = ShownUnit(model_unit, 1.0, 1.0)
+    if not data_unit:
+        return same
+    try:
+        mu, du = normalize_signal_unit(model_unit), normalize_signal_unit(data_unit)
+        kind = signal_kind(mu)
+        if kind == "raw" or signal_kind(du) != kind:
+            return same
+        return ShownUnit(
+            data_unit,
+            float(convert(1.0, model_unit, data_unit)),
+            float(convert(1.0, data_unit, model_unit)),
+        )
+    except UnitError:
+        return same
