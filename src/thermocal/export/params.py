@@ -72,8 +72,6 @@ in ``libraries/AP_InertialSensor/AP_InertialSensor.cpp``, the first three IMUs).
 FLOAT32_MAX = float(np.finfo(np.float32).max)
 """Largest finite float32 (≈ 3.4028235e38): the firmware stores parameters as 32-bit floats."""
 INT32_RANGE = (-(2**31), 2**31 - 1)
-RAD_PER_S_PER_DEG_PER_H = math.pi / 180.0 / 3600.0
-M_S2_PER_MG = units.STANDARD_GRAVITY_M_S2 / 1000.0
 
 
 @dataclass(frozen=True)
@@ -144,8 +142,8 @@ def _num(v: float, typ: int) -> str:
 def _model_unit_factor(kind: str, model_unit: str) -> float:
     """Firmware unit per model unit: [rad/s per °/h] for gyros, [m/s² per mg] for accels."""
     if kind == "gyro":
-        return float(units.convert(1.0, model_unit, "deg/h")) * RAD_PER_S_PER_DEG_PER_H
-    return float(units.convert(1.0, model_unit, "mg")) * M_S2_PER_MG
+        return float(units.convert(1.0, model_unit, "deg/h")) * units.DH_TO_RS
+    return float(units.convert(1.0, model_unit, "mg")) * units.MG_TO_MS2
 
 
 def _check_expressible(name: str, model: TemperatureModel) -> None:
