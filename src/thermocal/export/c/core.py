@@ -81,12 +81,14 @@ class CExport:
         return f"{self.prefix}.c"
 
     def write(self, directory: str | Path, inputs: Sequence[str | Path] = ()) -> list[Path]:
-        """Write header and source into ``directory`` (atomically); returns the paths.
+        """Write header and source into ``directory`` as a pair; returns the paths.
         Neither may be one of ``inputs`` (the model file: ``export-c model.c -o .``) nor a
-        special file (:func:`thermocal.outputs.check_outputs`)."""
+        special file (:func:`thermocal.outputs.check_outputs`).  Both are written whole
+        to temporaries beside their targets before either is renamed into place
+        (:func:`write_together`): a failure writing either leaves neither new file, and
+        an older pair as it was."""
         from thermocal.errors import ThermocalInputError
         from thermocal.outputs import check_outputs
-        from thermocal.writers import atomic_write
 
         d = Path(directory)
         check_outputs([d / self.header_name, d / self.source_name], inputs, dirs=[d])
@@ -96,12 +98,33 @@ class CExport:
             d.mkdir(parents=True, exist_ok=True)
         except (FileExistsError, NotADirectoryError):
             raise ThermocalInputError(f"{d}: cannot create the output directory") from None
-        out = []
-        for name, text in ((self.header_name, self.header), (self.source_name, self.source)):
-            with atomic_write(d / name, "w") as fh:
-                fh.write(text)
-            out.append(d / name)
-        return out
+        files = [(d / self.header_name, self.header), (d / self.source_name, self.source)]
+        write_together(files)
+        return [p for p, _text in files]
+
+
+def _write_text(path: Path, text: str) -> None:
+    """``text`` into ``path`` (the temporary of one file of :func:`write_together`)."""
+    with open(path, "w") as fh:
+        fh.write(text)
+
+
+def write_together(files: Sequence[tuple[Path, str]]) -> None:
+    """Write text files that only make sense together (a C header and its source): each
+    into its own temporary beside its target (:func:`thermocal.writers.atomic_write_path`),
+    nested, so that every temporary is complete before the first rename; an exception
+    while writing any of them removes every temporary and renames none."""
+    from thermocal.writers import atomic_write_path
+
+    if not files:
+        return
+    (path, text), rest = files[0], files[1:]
+
+    def writer(tmp: Path) -> None:
+        _write_text(tmp, text)
+        write_together(rest)  # the others complete (and renamed) before this one is
+
+    atomic_write_path(path, writer)
 
 
 @dataclass(frozen=True)
