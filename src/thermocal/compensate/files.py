@@ -1009,6 +1009,7 @@ __all__ = [
     "COMP_SUFFIX",
     "DEFAULT_CHUNK_ROWS",
     "MODEL_SUFFIX",
+    "CalibrationCompensation",
     "CalibrationStream",
     "ChunkContext",
     "ChunkPredictor",
@@ -1018,6 +1019,7 @@ __all__ = [
     "StreamingCompensator",
     "check_signal_kind",
     "chunk_context",
+    "compensate_calibration_file",
     "compensate_channels",
     "compensate_file",
     "compensate_run",
@@ -1295,3 +1297,114 @@ def _triad_output_info(
         }
         out_info["metadata"] = out_md
     return out_info
+
+
+@dataclass(frozen=True)
+class CalibrationCompensation:
+    """What :func:`compensate_calibration_file` did: the calibration file applied, the
+    output written and, by the calibration's content, either ``triads`` (a turntable
+    calibration), ``single`` (one channel: its family and result) or ``channels`` (each
+    chosen channel's name, family and result, one pass)."""
+
+    model_file: str
+    output: str
+    kind: str
+    """``"triads"``, ``"single"`` or ``"channels"``."""
+    triads: tuple[TriadCompensation, ...] = ()
+    channels: tuple[tuple[str, str, CompensateFileResult], ...] = ()
+    """``(channel name, model family, result)``; one entry for ``single``."""
+
+    def to_dict(self) -> dict[str, Any]:
+        """The ``thermocal compensate --json`` object (INTERFACE.md)."""
+        if self.kind == "triads":
+            return {"model": self.model_file, "output": self.output,
+                    "triads": [d.to_dict() for d in self.triads]}  # fmt: skip
+        if self.kind == "single":
+            _name, family, res = self.channels[0]
+            return {"model": self.model_file, "family": family, **res.to_dict()}
+        return {
+            "model": self.model_file,
+            "output": self.output,
+            "channels": {
+                name: {"family": family, **r.to_dict()} for name, family, r in self.channels
+            },
+        }
+
+
+def _split_names(text: str | None) -> list[str]:
+    """``"gx, gy,gz"`` → ``["gx", "gy", "gz"]`` (None or empty: none)."""
+    return [t.strip() for t in (text or "").split(",") if t.strip()]
+
+
+def compensate_calibration_file(
+    model_file: str | Path,
+    path: str | Path,
+    out: str | Path,
+    *,
+    signal: str | None = None,
+    time: str | None = None,
+    time_unit: str | None = None,
+    signal_unit: str | None = None,
+    temp_unit: str | None = None,
+    temp_conversion: str | None = None,
+    chunk_rows: int = DEFAULT_CHUNK_ROWS,
+    extrapolate: bool = False,
+    known_input: float = 0.0,
+    on_progress: Callable[[int], None] | None = None,
+    text: TextOptions | None = None,
+    topic: str | None = None,
+) -> CalibrationCompensation:
+    """``thermocal compensate``: apply a model or calibration file to a recording.
+
+    ``out`` may be neither input (nor, for a CSV, may its sidecar).  A calibration of
+    triads is applied by :func:`compensate_triads`; one channel (a model file) by
+    :func:`compensate_file` (``signal``: its column, default the model's); several
+    channels (those named in ``signal``, ``"gx,gy"``, default all) in one pass by
+    :func:`compensate_channels`.  ``temp_conversion`` is ``"GAIN,OFFSET[,int16]"``
+    (:func:`thermocal.units.temperature_conversion`).  A calibration with both triads and
+    channels is refused (:class:`ThermocalInputError`).
+    """
+    from thermocal.models.files import load_calibration
+
+    check_not_input(out, [path, model_file])
+    if file_kind(Path(out)) == "csv":  # the CSV's sidecar must not land on an input either
+        check_not_input(sidecar_path(out), [path, model_file])
+    cal = load_calibration(model_file)  # a model file is a calibration of one channel
+    conv = (
+        units.temperature_conversion(temp_conversion, "--temp-conversion")
+        if temp_conversion is not None
+        else None
+    )
+    if cal.triads:
+        if cal.channels:
+            raise ThermocalInputError(
+                f"{model_file}: a calibration with both triads and single channels is not "
+                "applied yet; split it"
+            )
+        done = compensate_triads(
+            cal.triads, path, out, time=time, time_unit=time_unit, chunk_rows=chunk_rows
+        )
+        return CalibrationCompensation(str(model_file), str(out), "triads", tuple(done))
+    common: dict[str, Any] = dict(
+        time=time, time_unit=time_unit, signal_unit=signal_unit, temp_unit=temp_unit,
+        temperature_conversion=conv, chunk_rows=chunk_rows, extrapolate=extrapolate,
+        known_input=known_input, on_progress=on_progress, text=text, topic=topic,
+    )  # fmt: skip
+    if len(cal.channels) == 1:
+        ch = cal.channels[0]
+        res = compensate_file(ch.model, path, out, signal=signal, **common)
+        return CalibrationCompensation(
+            str(model_file), str(out), "single", channels=((ch.name, ch.model.family, res),)
+        )
+    chosen = _split_names(signal) or cal.names
+    models = [(cal.channel(n).signal, cal.channel(n).model) for n in chosen]
+    results = compensate_channels(models, path, out, **common)
+    return CalibrationCompensation(
+        str(model_file),
+        str(out),
+        "channels",
+        channels=tuple(
+            (name, cal.channel(name).model.family, r)
+            for name, r in zip(chosen, results, strict=True)
+        ),
+    )
