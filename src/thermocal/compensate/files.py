@@ -568,31 +568,21 @@ def compensate_channels(
     kind_in = file_kind(src)
     kind_out = file_kind(dst)
     check_not_input(dst, [src])
-    if chunk_rows < 2:
-        raise ThermocalInputError(f"chunk size must be at least 2 rows, got {chunk_rows}")
+    _check_chunk_rows(chunk_rows)
     if not channels:
         raise ThermocalInputError("no channel to compensate")
     sig_list = [c for c, _m in channels]
     if len(set(sig_list)) != len(sig_list):
         raise ThermocalInputError(f"a signal column appears twice: {sig_list}")
-    text_table: pd.DataFrame | None = None
-    text_info: dict[str, Any] | None = None
-    if kind_in in ("ulog", "dataflash"):  # flight-controller logs: read whole, then chunked
-        text_table, text_info = read_log_table(src, topic)
-    elif text is not None:
-        text_table, text_info = read_text_table(src, text, time)
-    names, info, _ = _file_info(src, kind_in, text_table, text_info)
-    time_col = time or default_time_column(names, info.get("time"))
-    available = ", ".join(repr(c) for c in names)
-    if time_col not in names:
-        raise MissingColumnError(f"{src}: no time column {time_col!r}; available: {available}")
+    source = _open_source(src, kind_in, time, text, topic)
     sig_opts = units.per_signal_option(signal_unit, sig_list)
     conv_opt = (
         units.temperature_conversion(temperature_conversion, "--temp-conversion")
         if temperature_conversion is not None
         else None
     )
-    ctx = _FileContext(src, names, info, time_col, available, signal_given)
+    ctx = _FileContext(src, source.names, source.info, source.time_col, source.available,
+                       signal_given)  # fmt: skip
     opts = units.UnitOptions(time_unit=time_unit, temp_unit=temp_unit, temp_conversion=conv_opt)
     plans = [
         _channel_plan(ctx, sig_name, model, sig_opts[sig_name], opts,
@@ -607,54 +597,129 @@ def compensate_channels(
             f"({' and '.join(sorted(t_units))}); give --time-unit"
         )
     t_unit = plans[0].time_unit
-    t_factor = units.TIME_UNITS[t_unit]
-    out_info = _output_info(info, time_col, t_unit, plans)
+    out_info = _output_info(source.info, source.time_col, t_unit, plans)
+    state = _PassState()
+    run = _ChannelPass(source, plans, _evaluation_groups(plans), units.TIME_UNITS[t_unit],
+                       chunk_rows, on_progress, state)  # fmt: skip
+    atomic_write_path(dst, lambda tmp: run.write(tmp, kind_out, out_info))
+    if kind_out == "csv":
+        write_json(sidecar_path(dst), out_info)
+    for plan in plans:
+        plan.predictor.finish()
+    return [_file_result(plan, str(dst), state.rows, state.chunks) for plan in plans]
 
-    state: dict[str, Any] = {"rows": 0, "chunks": 0, "last_t": None}
-    groups = _evaluation_groups(plans)
 
-    def writer(tmp: Path) -> None:
+def _check_chunk_rows(chunk_rows: int) -> None:
+    """A chunk holds at least 2 rows (an input error otherwise)."""
+    if chunk_rows < 2:
+        raise ThermocalInputError(f"chunk size must be at least 2 rows, got {chunk_rows}")
+
+
+@dataclass(frozen=True)
+class _Source:
+    """The input of a chunked pass: its path and kind, its columns and metadata, the table
+    of a log read whole (ULog, DataFlash, a text log with options; None: read in chunks)
+    and the time column, checked present."""
+
+    src: Path
+    kind: str
+    names: list[str]
+    info: dict[str, Any]
+    table: pd.DataFrame | None
+    time_col: str
+    available: str
+
+    def chunks(self, chunk_rows: int) -> Iterator[pd.DataFrame | pa.RecordBatch]:
+        """The file's rows, ``chunk_rows`` at a time."""
+        return _iter_chunks(self.src, self.kind, chunk_rows, self.table)
+
+
+def _open_source(
+    src: Path, kind_in: str, time: str | None, text: TextOptions | None, topic: str | None
+) -> _Source:
+    """The input's columns and metadata (flight-controller logs and text logs with options
+    read whole first) and its time column (``time``, else the metadata's or the default);
+    :class:`MissingColumnError` naming the available columns when it is absent."""
+    text_table: pd.DataFrame | None = None
+    text_info: dict[str, Any] | None = None
+    if kind_in in ("ulog", "dataflash"):  # flight-controller logs: read whole, then chunked
+        text_table, text_info = read_log_table(src, topic)
+    elif text is not None:
+        text_table, text_info = read_text_table(src, text, time)
+    names, info, _ = _file_info(src, kind_in, text_table, text_info)
+    time_col = time or default_time_column(names, info.get("time"))
+    available = ", ".join(repr(c) for c in names)
+    if time_col not in names:
+        raise MissingColumnError(f"{src}: no time column {time_col!r}; available: {available}")
+    return _Source(src, kind_in, names, info, text_table, time_col, available)
+
+
+@dataclass
+class _PassState:
+    """Progress of a chunked pass: rows and chunks done, the last time [s] seen."""
+
+    rows: int = 0
+    chunks: int = 0
+    last_t: float | None = None
+
+    def advance(self, t: FloatArray) -> None:
+        """One chunk of times ``t`` [s] done."""
+        self.rows += int(t.size)
+        self.chunks += 1
+        self.last_t = float(t[-1]) if t.size else self.last_t
+
+    def check_rows(self, src: Path) -> None:
+        """A file with a header and no row is a format error."""
+        if self.rows == 0:
+            raise FileFormatError(f"{src}: the file has a header but no data rows")
+
+
+@dataclass(frozen=True)
+class _ChannelPass:
+    """The chunked pass of :func:`compensate_channels` over one source."""
+
+    source: _Source
+    plans: list[_ChannelPlan]
+    groups: list[list[_ChannelPlan]]
+    t_factor: float
+    chunk_rows: int
+    on_progress: Callable[[int], None] | None
+    state: _PassState
+
+    def write(self, tmp: Path, kind_out: str, out_info: dict[str, Any]) -> None:
+        """Every chunk compensated and written to ``tmp``; the previous chunk is written on
+        a second thread while this one is computed (pyarrow and numpy release the GIL);
+        one chunk in flight, errors re-raised here."""
+        src, state = self.source.src, self.state
         w = _Writer(tmp, kind_out, out_info)
-        # the previous chunk is written on a second thread while this one is computed
-        # (pyarrow and numpy release the GIL); one chunk in flight, errors re-raised here
         pool = ThreadPoolExecutor(max_workers=1, thread_name_prefix="thermocal-write")
         pending: Future[None] | None = None
         try:
-            for chunk in _iter_chunks(src, kind_in, chunk_rows, text_table):
-                row0 = int(state["rows"])
-                t = _chunk_time(chunk, time_col, t_factor, src, row0, state["last_t"])
-                table = _compensate_one_chunk(chunk, t, plans, groups, src, row0)
+            for chunk in self.source.chunks(self.chunk_rows):
+                row0 = state.rows
+                t = _chunk_time(chunk, self.source.time_col, self.t_factor, src, row0,
+                                state.last_t)  # fmt: skip
+                table = _compensate_one_chunk(chunk, t, self.plans, self.groups, src, row0)
                 if pending is not None:
                     pending.result()
                 pending = pool.submit(w.write, table)
-                state["rows"] = row0 + t.size
-                state["chunks"] = int(state["chunks"]) + 1
-                state["last_t"] = float(t[-1]) if t.size else state["last_t"]
-                if on_progress is not None:
-                    on_progress(int(t.size))
+                state.advance(t)
+                if self.on_progress is not None:
+                    self.on_progress(int(t.size))
             if pending is not None:
                 pending.result()
         finally:
             pool.shutdown(wait=True)
             w.close()
-        if state["rows"] == 0:
-            raise FileFormatError(f"{src}: the file has a header but no data rows")
-        if int(state["rows"]) < FEW_SAMPLES:
+        state.check_rows(src)
+        if state.rows < FEW_SAMPLES:
             warnings.warn(
                 PlausibilityWarning(
-                    f"{src}: only {state['rows']} samples: figures from so few are not "
+                    f"{src}: only {state.rows} samples: figures from so few are not "
                     f"meaningful (at least {FEW_SAMPLES} sample rows are expected)"
                 ),
                 stacklevel=2,
             )
-
-    atomic_write_path(dst, writer)
-    if kind_out == "csv":
-        write_json(sidecar_path(dst), out_info)
-    for plan in plans:
-        plan.predictor.finish()
-    n = int(state["rows"])
-    return [_file_result(plan, str(dst), n, int(state["chunks"])) for plan in plans]
 
 
 def _file_result(
@@ -944,6 +1009,7 @@ __all__ = [
     "COMP_SUFFIX",
     "DEFAULT_CHUNK_ROWS",
     "MODEL_SUFFIX",
+    "CalibrationCompensation",
     "CalibrationStream",
     "ChunkContext",
     "ChunkPredictor",
@@ -953,6 +1019,7 @@ __all__ = [
     "StreamingCompensator",
     "check_signal_kind",
     "chunk_context",
+    "compensate_calibration_file",
     "compensate_channels",
     "compensate_file",
     "compensate_run",
@@ -1014,80 +1081,24 @@ def compensate_triads(
     metadata > a unit in the column name > the unit the triad was calibrated on
     (:func:`thermocal.units.resolve_inputs`).
     """
-    from thermocal.turntable import thermal
-
     src, dst = Path(path), Path(out)
     kind_in, kind_out = file_kind(src), file_kind(dst)
     check_not_input(dst, [src])
-    if chunk_rows < 2:
-        raise ThermocalInputError(f"chunk size must be at least 2 rows, got {chunk_rows}")
-    text_table: pd.DataFrame | None = None
-    text_info: dict[str, Any] | None = None
-    if kind_in in ("ulog", "dataflash"):  # flight-controller logs: read whole, then chunked
-        text_table, text_info = read_log_table(src, None)
-    names, info, _ = _file_info(src, kind_in, text_table, text_info)
-    time_col = time or default_time_column(names, info.get("time"))
-    available = ", ".join(repr(c) for c in names)
-    if time_col not in names:
-        raise MissingColumnError(f"{src}: no time column {time_col!r}; available: {available}")
-    plans = [_triad_plan(tri, names, available, src) for tri in triads]
-    signals = [c for p in plans for c in p.columns]
-    temp_names = list(dict.fromkeys(p.temperature for p in plans if p.temperature))
-    resolved = units.resolve_inputs(
-        time_col,
-        list(dict.fromkeys(signals)),
-        temp_names,
-        options=units.UnitOptions(time_unit=time_unit),
-        file=units.StatedUnits.from_file_info(info, str(src)),
-        model=units.StatedUnits(None, {c: p.tri.unit for p in plans for c in p.columns}),
-        where=str(src),
-    )
-    unconverted = resolved.unconverted_counts()
-    if unconverted:
-        raise UnitError(
-            f"{src}: temperature column(s) {', '.join(map(repr, unconverted))} in raw counts "
-            "with no conversion to °C stated (metadata temperature_conversion)"
-        )
-    for p in plans:
-        p.resolve(resolved, src)
-    t_factor = units.TIME_UNITS[resolved.time.unit]
-    out_info = _triad_output_info(info, time_col, resolved, plans)
-    state: dict[str, Any] = {"rows": 0, "last_t": None}
-
-    def writer(tmp: Path) -> None:
-        w = _Writer(tmp, kind_out, out_info)
-        try:
-            for chunk in _iter_chunks(src, kind_in, chunk_rows, text_table):
-                row0 = int(state["rows"])
-                t = _chunk_time(chunk, time_col, t_factor, src, row0, state["last_t"])
-                temps: dict[str, FloatArray] = {}
-                for c in temp_names:
-                    v = numeric_column(chunk, c, src, row0)
-                    conv = resolved.conversions[c].conversion
-                    if conv is not None:
-                        v = conv.to_celsius(v, f"{src}: column {c!r} (chunk from row {row0})")
-                    _check_finite(v, f"temperature column {c!r}", src, row0)
-                    _check_plausible(v[:, None], [c], v[:0], "deg/h", src, row0)
-                    temps[c] = v
-                new: dict[str, FloatArray] = {}
-                for p in plans:
-                    temp = (temps[p.temperature] if p.temperature  # "": one temperature
-                            else np.full(t.size, p.tri.model.tref_c))  # fmt: skip
-                    new.update(p.correct(chunk, temp, src, row0, thermal))
-                w.write(_append_columns(chunk, new))
-                state["rows"] = row0 + t.size
-                state["last_t"] = float(t[-1]) if t.size else state["last_t"]
-        finally:
-            w.close()
-        if state["rows"] == 0:
-            raise FileFormatError(f"{src}: the file has a header but no data rows")
-
-    atomic_write_path(dst, writer)
+    _check_chunk_rows(chunk_rows)
+    source = _open_source(src, kind_in, time, None, None)
+    plans = [_triad_plan(tri, source.names, source.available, src) for tri in triads]
+    resolved = _resolve_triads(source, plans, time_unit)
+    out_info = _triad_output_info(source.info, source.time_col, resolved, plans)
+    state = _PassState()
+    atomic_write_path(
+        dst, lambda tmp: _write_triads(tmp, source, kind_out, out_info, plans, resolved,
+                                       chunk_rows, state)
+    )  # fmt: skip
     if kind_out == "csv":
         write_json(sidecar_path(dst), out_info)
     results = []
     for p in plans:
-        outside = p.n_outside / max(int(state["rows"]), 1)
+        outside = p.n_outside / max(state.rows, 1)
         if outside > 0:
             warnings.warn(
                 ExtrapolationWarning(
@@ -1103,6 +1114,82 @@ def compensate_triads(
             )
         )
     return results
+
+
+def _resolve_triads(
+    source: _Source, plans: Sequence[_TriadPlan], time_unit: str | None
+) -> units.ResolvedInputs:
+    """The units of the triads' columns and temperatures resolved once (option > metadata >
+    column name > the unit each triad was calibrated on); raw-count temperatures without a
+    conversion refused; each plan's data unit set."""
+    src = source.src
+    signals = [c for p in plans for c in p.columns]
+    resolved = units.resolve_inputs(
+        source.time_col,
+        list(dict.fromkeys(signals)),
+        _triad_temperatures(plans),
+        options=units.UnitOptions(time_unit=time_unit),
+        file=units.StatedUnits.from_file_info(source.info, str(src)),
+        model=units.StatedUnits(None, {c: p.tri.unit for p in plans for c in p.columns}),
+        where=str(src),
+    )
+    unconverted = resolved.unconverted_counts()
+    if unconverted:
+        raise UnitError(
+            f"{src}: temperature column(s) {', '.join(map(repr, unconverted))} in raw counts "
+            "with no conversion to °C stated (metadata temperature_conversion)"
+        )
+    for p in plans:
+        p.resolve(resolved, src)
+    return resolved
+
+
+def _triad_temperatures(plans: Sequence[_TriadPlan]) -> list[str]:
+    """The triads' temperature columns, each once, in the triads' order."""
+    return list(dict.fromkeys(p.temperature for p in plans if p.temperature))
+
+
+def _write_triads(
+    tmp: Path,
+    source: _Source,
+    kind_out: str,
+    out_info: dict[str, Any],
+    plans: Sequence[_TriadPlan],
+    resolved: units.ResolvedInputs,
+    chunk_rows: int,
+    state: _PassState,
+) -> None:
+    """The chunked pass of :func:`compensate_triads`: every chunk's temperatures converted
+    and checked once, each triad's compensated columns appended, the chunk written."""
+    from thermocal.turntable import thermal
+
+    src = source.src
+    t_factor = units.TIME_UNITS[resolved.time.unit]
+    temp_names = _triad_temperatures(plans)
+    w = _Writer(tmp, kind_out, out_info)
+    try:
+        for chunk in source.chunks(chunk_rows):
+            row0 = state.rows
+            t = _chunk_time(chunk, source.time_col, t_factor, src, row0, state.last_t)
+            temps: dict[str, FloatArray] = {}
+            for c in temp_names:
+                v = numeric_column(chunk, c, src, row0)
+                conv = resolved.conversions[c].conversion
+                if conv is not None:
+                    v = conv.to_celsius(v, f"{src}: column {c!r} (chunk from row {row0})")
+                _check_finite(v, f"temperature column {c!r}", src, row0)
+                _check_plausible(v[:, None], [c], v[:0], "deg/h", src, row0)
+                temps[c] = v
+            new: dict[str, FloatArray] = {}
+            for p in plans:
+                temp = (temps[p.temperature] if p.temperature  # "": one temperature
+                        else np.full(t.size, p.tri.model.tref_c))  # fmt: skip
+                new.update(p.correct(chunk, temp, src, row0, thermal))
+            w.write(_append_columns(chunk, new))
+            state.advance(t)
+    finally:
+        w.close()
+    state.check_rows(src)
 
 
 @dataclass
@@ -1210,3 +1297,114 @@ def _triad_output_info(
         }
         out_info["metadata"] = out_md
     return out_info
+
+
+@dataclass(frozen=True)
+class CalibrationCompensation:
+    """What :func:`compensate_calibration_file` did: the calibration file applied, the
+    output written and, by the calibration's content, either ``triads`` (a turntable
+    calibration), ``single`` (one channel: its family and result) or ``channels`` (each
+    chosen channel's name, family and result, one pass)."""
+
+    model_file: str
+    output: str
+    kind: str
+    """``"triads"``, ``"single"`` or ``"channels"``."""
+    triads: tuple[TriadCompensation, ...] = ()
+    channels: tuple[tuple[str, str, CompensateFileResult], ...] = ()
+    """``(channel name, model family, result)``; one entry for ``single``."""
+
+    def to_dict(self) -> dict[str, Any]:
+        """The ``thermocal compensate --json`` object (INTERFACE.md)."""
+        if self.kind == "triads":
+            return {"model": self.model_file, "output": self.output,
+                    "triads": [d.to_dict() for d in self.triads]}  # fmt: skip
+        if self.kind == "single":
+            _name, family, res = self.channels[0]
+            return {"model": self.model_file, "family": family, **res.to_dict()}
+        return {
+            "model": self.model_file,
+            "output": self.output,
+            "channels": {
+                name: {"family": family, **r.to_dict()} for name, family, r in self.channels
+            },
+        }
+
+
+def _split_names(text: str | None) -> list[str]:
+    """``"gx, gy,gz"`` → ``["gx", "gy", "gz"]`` (None or empty: none)."""
+    return [t.strip() for t in (text or "").split(",") if t.strip()]
+
+
+def compensate_calibration_file(
+    model_file: str | Path,
+    path: str | Path,
+    out: str | Path,
+    *,
+    signal: str | None = None,
+    time: str | None = None,
+    time_unit: str | None = None,
+    signal_unit: str | None = None,
+    temp_unit: str | None = None,
+    temp_conversion: str | None = None,
+    chunk_rows: int = DEFAULT_CHUNK_ROWS,
+    extrapolate: bool = False,
+    known_input: float = 0.0,
+    on_progress: Callable[[int], None] | None = None,
+    text: TextOptions | None = None,
+    topic: str | None = None,
+) -> CalibrationCompensation:
+    """``thermocal compensate``: apply a model or calibration file to a recording.
+
+    ``out`` may be neither input (nor, for a CSV, may its sidecar).  A calibration of
+    triads is applied by :func:`compensate_triads`; one channel (a model file) by
+    :func:`compensate_file` (``signal``: its column, default the model's); several
+    channels (those named in ``signal``, ``"gx,gy"``, default all) in one pass by
+    :func:`compensate_channels`.  ``temp_conversion`` is ``"GAIN,OFFSET[,int16]"``
+    (:func:`thermocal.units.temperature_conversion`).  A calibration with both triads and
+    channels is refused (:class:`ThermocalInputError`).
+    """
+    from thermocal.models.files import load_calibration
+
+    check_not_input(out, [path, model_file])
+    if file_kind(Path(out)) == "csv":  # the CSV's sidecar must not land on an input either
+        check_not_input(sidecar_path(out), [path, model_file])
+    cal = load_calibration(model_file)  # a model file is a calibration of one channel
+    conv = (
+        units.temperature_conversion(temp_conversion, "--temp-conversion")
+        if temp_conversion is not None
+        else None
+    )
+    if cal.triads:
+        if cal.channels:
+            raise ThermocalInputError(
+                f"{model_file}: a calibration with both triads and single channels is not "
+                "applied yet; split it"
+            )
+        done = compensate_triads(
+            cal.triads, path, out, time=time, time_unit=time_unit, chunk_rows=chunk_rows
+        )
+        return CalibrationCompensation(str(model_file), str(out), "triads", tuple(done))
+    common: dict[str, Any] = dict(
+        time=time, time_unit=time_unit, signal_unit=signal_unit, temp_unit=temp_unit,
+        temperature_conversion=conv, chunk_rows=chunk_rows, extrapolate=extrapolate,
+        known_input=known_input, on_progress=on_progress, text=text, topic=topic,
+    )  # fmt: skip
+    if len(cal.channels) == 1:
+        ch = cal.channels[0]
+        res = compensate_file(ch.model, path, out, signal=signal, **common)
+        return CalibrationCompensation(
+            str(model_file), str(out), "single", channels=((ch.name, ch.model.family, res),)
+        )
+    chosen = _split_names(signal) or cal.names
+    models = [(cal.channel(n).signal, cal.channel(n).model) for n in chosen]
+    results = compensate_channels(models, path, out, **common)
+    return CalibrationCompensation(
+        str(model_file),
+        str(out),
+        "channels",
+        channels=tuple(
+            (name, cal.channel(name).model.family, r)
+            for name, r in zip(chosen, results, strict=True)
+        ),
+    )

@@ -44,6 +44,7 @@ import math
 import warnings
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -72,8 +73,6 @@ in ``libraries/AP_InertialSensor/AP_InertialSensor.cpp``, the first three IMUs).
 FLOAT32_MAX = float(np.finfo(np.float32).max)
 """Largest finite float32 (≈ 3.4028235e38): the firmware stores parameters as 32-bit floats."""
 INT32_RANGE = (-(2**31), 2**31 - 1)
-RAD_PER_S_PER_DEG_PER_H = math.pi / 180.0 / 3600.0
-M_S2_PER_MG = units.STANDARD_GRAVITY_M_S2 / 1000.0
 
 
 @dataclass(frozen=True)
@@ -144,8 +143,8 @@ def _num(v: float, typ: int) -> str:
 def _model_unit_factor(kind: str, model_unit: str) -> float:
     """Firmware unit per model unit: [rad/s per °/h] for gyros, [m/s² per mg] for accels."""
     if kind == "gyro":
-        return float(units.convert(1.0, model_unit, "deg/h")) * RAD_PER_S_PER_DEG_PER_H
-    return float(units.convert(1.0, model_unit, "mg")) * M_S2_PER_MG
+        return float(units.convert(1.0, model_unit, "deg/h")) * units.DH_TO_RS
+    return float(units.convert(1.0, model_unit, "mg")) * units.MG_TO_MS2
 
 
 def _check_expressible(name: str, model: TemperatureModel) -> None:
@@ -508,3 +507,61 @@ def px4_offset_params(
             out.params[f"{p}X{k}" if n_axes == 1 else f"{p}X{k}_{i}"] = float(c)
     check_values(out)
     return out
+
+
+@dataclass(frozen=True)
+class ParamsFileResult:
+    """What :func:`export_params_file` wrote: the parameter file, its firmware and the
+    parameters (:class:`ParamSet`)."""
+
+    output: str
+    format: str
+    params: ParamSet
+
+    def to_dict(self) -> dict[str, Any]:
+        """The ``thermocal export-params --json`` object (INTERFACE.md)."""
+        return {
+            "output": self.output,
+            "format": self.format,
+            "params": self.params.params,
+            "axes": [
+                {"channel": a.channel, "kind": a.kind, "axis": a.axis, "tref_c": a.tref_c,
+                 "coefficients": list(a.coef), "tmin_c": a.tmin_c, "tmax_c": a.tmax_c,
+                 "relative": a.relative}
+                for a in self.params.axes
+            ],
+            "notes": self.params.notes,
+        }  # fmt: skip
+
+
+def export_params_file(
+    calibration: str | Path,
+    fmt: str,
+    output: str | Path,
+    *,
+    gyro: Sequence[str] | None = None,
+    accel: Sequence[str] | None = None,
+    instance: int = 0,
+    tref_c: float | None = None,
+    device_id: int | None = None,
+) -> ParamsFileResult:
+    """``thermocal export-params``: a calibration (or model) file's firmware parameters
+    (:func:`export_params`) written atomically to ``output`` (never one of the inputs),
+    once the data behind it are known to support the fit
+    (:func:`thermocal.export.checks.check_firmware_adequacy`, ArduPilot's minimum sweep
+    too).  ``device_id``: the PX4 device id of both the gyro and the accelerometer."""
+    from thermocal.export.checks import check_firmware_adequacy
+    from thermocal.models.files import load_calibration
+    from thermocal.writers import atomic_write, check_not_input
+
+    check_not_input(output, [calibration])
+    cal = load_calibration(calibration)
+    cal.require_channels("export-params")
+    check_firmware_adequacy(cal, calibration, fmt)
+    ids = {"gyro": device_id, "accel": device_id} if device_id is not None else None
+    ps = export_params(
+        cal, fmt, gyro=gyro, accel=accel, instance=instance, device_id=ids, tref_c=tref_c
+    )
+    with atomic_write(output, "w") as fh:
+        fh.write(ps.text())
+    return ParamsFileResult(str(output), fmt, ps)

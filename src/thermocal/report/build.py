@@ -929,58 +929,84 @@ def _analyse(inputs: ReportInputs) -> _Analysis:
     )  # fmt: skip
 
 
+@dataclass
+class _FigureSet:
+    """Figures (PNG, base64) keyed by name, numbered in the order they are added."""
+
+    figs: dict[str, dict[str, str]] = field(default_factory=dict)
+    n: int = 0
+
+    def add(self, key: str, png: bytes, title: str, caption: str) -> None:
+        """Add figure ``key`` with its title and caption ``Figure N. <caption>``."""
+        self.n += 1
+        self.figs[key] = {
+            "src": _b64(png),
+            "title": title,
+            "caption": f"Figure {self.n}. {caption}",
+            "id": f"fig-{key}",
+        }
+
+
 def _report_figures(inputs: ReportInputs, an: _Analysis) -> dict[str, dict[str, str]]:
     """Every figure (PNG, base64) with its title and numbered caption."""
+    # bias series drawn as averages over the stability averaging time
+    block = max(1, round(an.averaging_s / an.tau0))
+    avg_text = f" ({fmt_num(block * an.tau0)} s averages)" if block > 1 else ""
+    fs = _FigureSet()
+    _profile_figure(fs, inputs, an)
+    if inputs.modeling is not None:
+        _fit_figure(fs, inputs.modeling, an, block, avg_text)
+    _bias_figures(fs, an, block, avg_text)
+    _allan_figure(fs, an)
+    _drift_figure(fs, an)
+    return fs.figs
+
+
+def _profile_figure(fs: _FigureSet, inputs: ReportInputs, an: _Analysis) -> None:
+    """The temperature channels of the modelling run (when given) and of the run judged."""
     from thermocal.report import figures as F
 
-    primary, main, unit, temp_names = an.primary, an.main, an.unit, an.temp_names
-    rec, signal, averaging_s, tau0 = inputs.recording, an.signal, an.averaging_s, an.tau0
-    fom_before, fom_after = an.fom_before, an.fom_after
-    allan_before, allan_after = an.allan_before, an.allan_after
-    # bias series drawn as averages over the stability averaging time
-    block = max(1, round(averaging_s / tau0))
-    avg_text = f" ({fmt_num(block * tau0)} s averages)" if block > 1 else ""
+    temp_names = an.temp_names
     panels = []
     if inputs.modeling is not None:
         panels.append(_temperature_panel("Modelling run", inputs.modeling, temp_names))
-    panels.append(_temperature_panel(an.run_name.capitalize(), rec, temp_names))
-    stages = _stages_from(primary.validation)
-    figs: dict[str, dict[str, str]] = {}
-
-    def add_fig(key: str, png: bytes, title: str, caption: str) -> None:
-        figs[key] = {"src": _b64(png), "title": title, "caption": caption, "id": f"fig-{key}"}
-
-    n_fig = 0
-
-    def cap(text: str) -> str:
-        nonlocal n_fig
-        n_fig += 1
-        return f"Figure {n_fig}. {text}"
-
-    add_fig(
+    panels.append(_temperature_panel(an.run_name.capitalize(), inputs.recording, temp_names))
+    fs.add(
         "profile",
         F.temperature_profile(panels),
         "Chamber profile and temperature channels",
-        cap(
-            "Temperature channels of the sensor (the model uses "
-            + ", ".join(temp_names)
-            + ") and the chamber air temperature (dashed) against time, for "
-            + ("the modelling run (top) and " if inputs.modeling is not None else "")
-            + f"the {an.run_name}."
-        ),
+        "Temperature channels of the sensor (the model uses "
+        + ", ".join(temp_names)
+        + ") and the chamber air temperature (dashed) against time, for "
+        + ("the modelling run (top) and " if inputs.modeling is not None else "")
+        + f"the {an.run_name}.",
     )
-    if inputs.modeling is not None:
-        mod = in_data_unit(apply_model(primary.model, inputs.modeling, signal), unit, an.k)
-        add_fig(
-            "fit",
-            F.model_fit(mod.time_s, mod.before, mod.model_bias, unit=unit_label(unit), block=block),
-            "Model fit on the modelling run",
-            cap(
-                f"Modelling run: measured bias{avg_text} and the {primary.label} model (top), "
-                "residual (bottom)."
-            ),
-        )
-    add_fig(
+
+
+def _fit_figure(
+    fs: _FigureSet, modeling: Recording, an: _Analysis, block: int, avg_text: str
+) -> None:
+    """The primary model against the modelling run's bias, and the residual."""
+    from thermocal.report import figures as F
+
+    primary, unit = an.primary, an.unit
+    mod = in_data_unit(apply_model(primary.model, modeling, an.signal), unit, an.k)
+    fs.add(
+        "fit",
+        F.model_fit(mod.time_s, mod.before, mod.model_bias, unit=unit_label(unit), block=block),
+        "Model fit on the modelling run",
+        f"Modelling run: measured bias{avg_text} and the {primary.label} model (top), "
+        "residual (bottom).",
+    )
+
+
+def _bias_figures(fs: _FigureSet, an: _Analysis, block: int, avg_text: str) -> None:
+    """The bias against time and against temperature, before and after compensation."""
+    from thermocal.report import figures as F
+
+    primary, main, unit, temp_names = an.primary, an.main, an.unit, an.temp_names
+    stages = _stages_from(primary.validation)
+    fs.add(
         "bias_time",
         F.bias_vs_time(
             main.time_s,
@@ -993,15 +1019,13 @@ def _report_figures(inputs: ReportInputs, an: _Analysis) -> dict[str, dict[str, 
             block=block,
         ),
         "Bias against time, before and after compensation",
-        cap(
-            f"{an.run_name.capitalize()}: bias{avg_text} before (red) and after (blue) "
-            "compensation with the "
-            f"{primary.label} model; {temp_names[0]} dotted (right axis)"
-            + ("; shaded: temperature-hold stages used for stability and repeatability."
-               if stages else ".")
-        ),
+        f"{an.run_name.capitalize()}: bias{avg_text} before (red) and after (blue) "
+        "compensation with the "
+        f"{primary.label} model; {temp_names[0]} dotted (right axis)"
+        + ("; shaded: temperature-hold stages used for stability and repeatability."
+           if stages else "."),
     )  # fmt: skip
-    add_fig(
+    fs.add(
         "bias_temp",
         F.bias_vs_temperature(
             main.temps_c[:, 0],
@@ -1012,14 +1036,18 @@ def _report_figures(inputs: ReportInputs, an: _Analysis) -> dict[str, dict[str, 
             block=block,
         ),
         "Bias against temperature, before and after compensation",
-        cap(
-            f"{an.run_name.capitalize()}: bias against {temp_names[0]}, before and after "
-            "compensation; "
-            f"dots: {avg_text.strip(' ()') or 'samples'}, lines: means in temperature bins "
-            "with their standard errors."
-        ),
+        f"{an.run_name.capitalize()}: bias against {temp_names[0]}, before and after "
+        "compensation; "
+        f"dots: {avg_text.strip(' ()') or 'samples'}, lines: means in temperature bins "
+        "with their standard errors.",
     )
-    add_fig(
+
+
+def _allan_figure(fs: _FigureSet, an: _Analysis) -> None:
+    """The overlapping Allan deviation before and after compensation."""
+    from thermocal.report import figures as F
+
+    fs.add(
         "allan",
         F.allan_deviation(
             [
@@ -1031,36 +1059,38 @@ def _report_figures(inputs: ReportInputs, an: _Analysis) -> dict[str, dict[str, 
                     al.result.adev_high,
                 )
                 for lab, al in (
-                    ("before compensation", allan_before),
-                    ("after compensation", allan_after),
+                    ("before compensation", an.allan_before),
+                    ("after compensation", an.allan_after),
                 )
             ],
-            unit=unit_label(unit),
+            unit=unit_label(an.unit),
         ),
         "Allan deviation before and after compensation",
-        cap(
-            f"Overlapping Allan deviation of the {an.run_name} before and after "
-            "compensation; bars: confidence intervals."
-        ),
+        f"Overlapping Allan deviation of the {an.run_name} before and after "
+        "compensation; bars: confidence intervals.",
     )
-    if fom_before.drift_angle is not None and fom_after.drift_angle is not None:
-        add_fig(
-            "drift",
-            F.drift_angle(
-                main.time_s,
-                fom_before.drift_angle,
-                fom_after.drift_angle,
-                unit=unit_label(fom_before.drift_angle_unit or ""),
-            ),
-            "Drift angle before and after compensation",
-            cap(
-                "Angle error over time, θ(t) = ∫ (ω − Ω − b0) dt: before compensation (red) "
-                f"with {drift_reference_words(fom_before.drift_reference)}; after (blue) the "
-                "compensated rate integrated with no bias removed (the model removes it)."
-            ),
-        )
 
-    return figs
+
+def _drift_figure(fs: _FigureSet, an: _Analysis) -> None:
+    """The drift angle before and after compensation (gyros: when both are known)."""
+    from thermocal.report import figures as F
+
+    fom_before, fom_after = an.fom_before, an.fom_after
+    if fom_before.drift_angle is None or fom_after.drift_angle is None:
+        return
+    fs.add(
+        "drift",
+        F.drift_angle(
+            an.main.time_s,
+            fom_before.drift_angle,
+            fom_after.drift_angle,
+            unit=unit_label(fom_before.drift_angle_unit or ""),
+        ),
+        "Drift angle before and after compensation",
+        "Angle error over time, θ(t) = ∫ (ω − Ω − b0) dt: before compensation (red) "
+        f"with {drift_reference_words(fom_before.drift_reference)}; after (blue) the "
+        "compensated rate integrated with no bias removed (the model removes it).",
+    )
 
 
 def drift_reference_words(ref: Any) -> str:

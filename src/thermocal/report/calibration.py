@@ -124,6 +124,54 @@ def _figures_in(fom: Any, k: float) -> dict[str, float | None]:
     }
 
 
+def _channel_merits(
+    rec: Any, applied: Any, k: float, unit: str, averaging_s: float, tau0: float
+) -> tuple[list[dict[str, float | None]], list[Any], list[str]]:
+    """One channel's figures of merit (in the data's unit) and Allan deviations before and
+    after compensation, and the warnings raised while computing them (one line each)."""
+    before, after = applied.before / k, applied.after / k
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        fom = [
+            _figures_in(
+                figures_of_merit(
+                    rec.time_s,
+                    x,
+                    applied.unit,
+                    averaging_s=averaging_s,
+                    meta=rec.meta,
+                    temp_name=applied.temp_names[0],
+                    temp_c=applied.temps_c[:, 0],
+                ),
+                k,
+            )
+            for x in (applied.before, applied.after)
+        ]
+        allan = [allan_of(rec.time_s, x, tau0, unit) for x in (before, after)]
+    return fom, allan, [" ".join(str(w.message).split()) for w in caught]
+
+
+def _channel_notes(
+    cond: Any, v: dict[str, Any] | None, unit: str, adequacy: dict[str, Any] | None
+) -> list[str]:
+    """A channel's warnings from its files: an ill-conditioned fit, the validation
+    result's warnings and unit, a failed (or overridden) adequacy test."""
+    msgs: list[str] = []
+    if isinstance(cond, int | float) and cond > ILL_CONDITIONED:
+        msgs.append(f"the fit's design is ill conditioned (condition number {cond:.3g})")
+    if v is not None:
+        msgs += [str(w) for w in v.get("warnings") or []]
+        if v.get("unit") not in (None, unit):
+            msgs.append(f"the validation figures are in {v.get('unit')}, the data in {unit}")
+    if adequacy is not None and adequacy["verdict"] in ("fail", "overridden"):
+        failed = ", ".join(t["name"] for t in adequacy["tests"] if t["verdict"] == "fail")
+        msgs.append(
+            f"the data this channel was fitted on failed the adequacy test(s) {failed or '—'}"
+            + (" (overridden at fit time)" if adequacy["verdict"] == "overridden" else "")
+        )
+    return msgs
+
+
 def _channel_section(
     inputs: CalibrationReportInputs, name: str, averaging_s: float, tau0: float
 ) -> dict[str, Any]:
@@ -145,44 +193,15 @@ def _channel_section(
     before, after = applied.before / k, applied.after / k
     t_name = applied.temp_names[0]
     t_c = applied.temps_c[:, 0]
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always")
-        fom = [
-            _figures_in(
-                figures_of_merit(
-                    rec.time_s,
-                    x,
-                    applied.unit,
-                    averaging_s=averaging_s,
-                    meta=rec.meta,
-                    temp_name=t_name,
-                    temp_c=t_c,
-                ),
-                k,
-            )
-            for x in (applied.before, applied.after)
-        ]
-        allan = [allan_of(rec.time_s, x, tau0, unit) for x in (before, after)]
-    msgs = list(applied.warnings) + [" ".join(str(w.message).split()) for w in caught]
+    fom, allan, caught = _channel_merits(rec, applied, k, unit, averaging_s, tau0)
     stats = md.get("fit") or {}
     cond = stats.get("condition_number")
-    if isinstance(cond, int | float) and cond > ILL_CONDITIONED:
-        msgs.append(f"the fit's design is ill conditioned (condition number {cond:.3g})")
     rms_fit = stats.get("rms_residual")
     if isinstance(rms_fit, int | float):  # model unit → data unit
         rms_fit = float(rms_fit) / unit_factor(unit, ch.model.signal_unit, meta=rec.meta)
     v = _validation_of(inputs.validation, name, len(inputs.calibration.channels) == 1)
-    if v is not None:
-        msgs += [str(w) for w in v.get("warnings") or []]
-        if v.get("unit") not in (None, unit):
-            msgs.append(f"the validation figures are in {v.get('unit')}, the data in {unit}")
     adequacy = adequacy_rows(md.get("adequacy"), f"channels.{name}.adequacy", name)
-    if adequacy is not None and adequacy["verdict"] in ("fail", "overridden"):
-        failed = ", ".join(t["name"] for t in adequacy["tests"] if t["verdict"] == "fail")
-        msgs.append(
-            f"the data this channel was fitted on failed the adequacy test(s) {failed or '—'}"
-            + (" (overridden at fit time)" if adequacy["verdict"] == "overridden" else "")
-        )
+    msgs = [*applied.warnings, *caught, *_channel_notes(cond, v, unit, adequacy)]
     vclass, vtext = _verdict(v)
     terms = [a.terms.fit for a in allan]
     curves = [

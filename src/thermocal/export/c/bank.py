@@ -16,13 +16,39 @@ def generate(ctx: ExportContext) -> FamilyCode:
     evaluated at the clamped T; during ``t − t_first < startup_s`` the residual sums
     ``Σ (y − f_m)`` pick ``argmin_m |Σ_m/N|``; then the choice is frozen."""
     st = ctx.model["state"]
+    P, r = ctx.P, ctx.r
+    m = len(st["models"])
+    return FamilyCode(
+        state_fields=[
+            "int started;",
+            "double t_first;",
+            f"{r} sums[{P}_N_MODELS];",
+            "long count;",
+            "int frozen;",
+            "int choice; /* index of the selected model */",
+        ],
+        data=_data(ctx),
+        init=_init(ctx),
+        update=_update(ctx),
+        defines=[f"#define {P}_N_MODELS {m}"],
+        notes=[
+            "Model bank (SPEC 4d): one piecewise-linear model per characteristic curve,",
+            f"selected during the first {float(st['startup_s']):g} s after power-on by the",
+            "smallest |mean(signal - known_input - model)|; pass the raw signal to update.",
+        ],
+    )
+
+
+def _data(ctx: ExportContext) -> str:
+    """The models' breakpoints and values in two arrays with offsets, and ``<p>_pwl``."""
+    st = ctx.model["state"]
     models = st["models"]
     P, r, p = ctx.P, ctx.r, ctx.prefix
     m = len(models)
     bps = [np.asarray(mm["breakpoints_c"], dtype=np.float64) for mm in models]
     vals = [np.asarray(mm["values"], dtype=np.float64) for mm in models]
     offsets = np.cumsum([0] + [b.size for b in bps])
-    data = "\n".join(
+    return "\n".join(
         [
             ctx.clamp_arrays(),
             f"/* {m} piecewise-linear models; model i uses entries OFF[i] .. OFF[i+1]-1 */",
@@ -52,7 +78,12 @@ def generate(ctx: ExportContext) -> FamilyCode:
             "}",
         ]
     )
-    init = f"""
+
+
+def _init(ctx: ExportContext) -> str:
+    """Power-on: no model chosen, the residual sums cleared."""
+    P = ctx.P
+    return f"""
 int i;
 s->started = 0;
 s->t_first = 0.0;
@@ -63,7 +94,12 @@ for (i = 0; i < {P}_N_MODELS; ++i) {{
     s->sums[i] = {ctx.lit(0.0)};
 }}
 """
-    update = f"""
+
+
+def _update(ctx: ExportContext) -> str:
+    """Every model at the clamped T; the start-up selection, then the frozen choice."""
+    P, r, p = ctx.P, ctx.r, ctx.prefix
+    return f"""
 {r} temp = {p}_clamp(temps_c[0], {P}_T_LO[0], {P}_T_HI[0]);
 {r} f[{P}_N_MODELS];
 int i;
@@ -93,22 +129,3 @@ if (!s->frozen && time_s - s->t_first < {P}_STARTUP_S) {{
 }}
 return f[s->choice];
 """
-    return FamilyCode(
-        state_fields=[
-            "int started;",
-            "double t_first;",
-            f"{r} sums[{P}_N_MODELS];",
-            "long count;",
-            "int frozen;",
-            "int choice; /* index of the selected model */",
-        ],
-        data=data,
-        init=init,
-        update=update,
-        defines=[f"#define {P}_N_MODELS {m}"],
-        notes=[
-            "Model bank (SPEC 4d): one piecewise-linear model per characteristic curve,",
-            f"selected during the first {float(st['startup_s']):g} s after power-on by the",
-            "smallest |mean(signal - known_input - model)|; pass the raw signal to update.",
-        ],
-    )

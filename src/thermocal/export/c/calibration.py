@@ -4,6 +4,7 @@
 from __future__ import annotations
 
 from collections.abc import Sequence
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -59,6 +60,33 @@ def generate_c_calibration(
     P = p.upper()
     used: dict[str, str] = {}
     ident = {name: c_identifier(name, used, what="channel") for name, _md, _u in channels}
+    mods, temps, tu = _channel_modules(channels, p, ident, real, sample_interval_s)
+    top = [f"{p}_{s}" for s in ("init", "compensate", "state", "real")]
+    top += [f"{P}_{s}" for s in ("N_CHANNELS", "N_TEMPS", "CAL_H")]
+    check_distinct_names([(name, ex) for name, ex, _t in mods], top, "channel")
+    cm = _CalModules(p=p, real=real, ident=ident, mods=mods, temps=temps, tu=tu)
+    return CExport(
+        prefix=p,
+        real=real,
+        header=_cal_header(cm),
+        source=_cal_source(cm),
+        family="calibration",
+        n_temps=len(temps),
+        unit=",".join(ex.unit for _n, ex, _t in mods),
+        model_unit=",".join(ex.model_unit for _n, ex, _t in mods),
+        temperature_unit=tu,
+    )
+
+
+def _channel_modules(
+    channels: Sequence[tuple[str, dict[str, Any], str | None]],
+    p: str,
+    ident: dict[str, str],
+    real: str,
+    sample_interval_s: float | None,
+) -> tuple[list[tuple[str, CExport, list[str]]], list[str], str]:
+    """Every channel's own module ``(name, module, its temperatures)``, the union of the
+    temperatures in first-seen order and their one unit (different units refused)."""
     mods: list[tuple[str, CExport, list[str]]] = []
     temps: list[str] = []
     for _name, md, _unit in channels:
@@ -85,21 +113,44 @@ def generate_c_calibration(
             "the channels' models take temperatures in different units "
             f"({', '.join(sorted(tus))}); one calibration's C takes one kind"
         )
-    top = [f"{p}_{s}" for s in ("init", "compensate", "state", "real")]
-    top += [f"{P}_{s}" for s in ("N_CHANNELS", "N_TEMPS", "CAL_H")]
-    check_distinct_names([(name, ex) for name, ex, _t in mods], top, "channel")
-    n, k = len(mods), len(temps)
-    chan_list = c_comment(
-        ", ".join(f"{i}={name} [{ex.unit}]" for i, (name, ex, _t) in enumerate(mods))
-    )
-    temp_list = c_comment(", ".join(f"{i}={t}" for i, t in enumerate(temps)))
-    tu = next(iter(tus))
-    parts_h = [ex.header for _n, ex, _t in mods]
-    header = "\n".join(
+    return mods, temps, next(iter(tus))
+
+
+@dataclass(frozen=True)
+class _CalModules:
+    """The channels' modules of one calibration and what its common code needs."""
+
+    p: str
+    real: str
+    ident: dict[str, str]
+    mods: list[tuple[str, CExport, list[str]]]
+    temps: list[str]
+    tu: str
+
+    @property
+    def P(self) -> str:
+        return self.p.upper()
+
+    @property
+    def chan_list(self) -> str:
+        return c_comment(
+            ", ".join(f"{i}={name} [{ex.unit}]" for i, (name, ex, _t) in enumerate(self.mods))
+        )
+
+    @property
+    def temp_list(self) -> str:
+        return c_comment(", ".join(f"{i}={t}" for i, t in enumerate(self.temps)))
+
+
+def _cal_header(cm: _CalModules) -> str:
+    """The calibration's header: every channel's header, then the common declarations."""
+    p, P, tu, real = cm.p, cm.P, cm.tu, cm.real
+    chan_list, temp_list = cm.chan_list, cm.temp_list
+    return "\n".join(
         [
             _comment(
                 [
-                    f"thermocal calibration of {n} channels: {chan_list}",
+                    f"thermocal calibration of {len(cm.mods)} channels: {chan_list}",
                     f"temps_c[] order: {temp_list} [{tu}]",
                     "Each channel's own functions are below; the calibration's functions at the "
                     "end take every channel at once.",
@@ -108,15 +159,15 @@ def generate_c_calibration(
             f"#ifndef {P}_CAL_H",
             f"#define {P}_CAL_H",
             "",
-            *parts_h,
+            *[ex.header for _n, ex, _t in cm.mods],
             f"typedef {real} {p}_real;",
-            f"#define {P}_N_CHANNELS {n}",
-            f"#define {P}_N_TEMPS {k}",
+            f"#define {P}_N_CHANNELS {len(cm.mods)}",
+            f"#define {P}_N_TEMPS {len(cm.temps)}",
             f"/* channels: {chan_list} */",
             f"/* temperatures: {temp_list} */",
             "",
             "typedef struct {",
-            *[f"    {ex.prefix}_state {ident[name]};" for name, ex, _t in mods],
+            *[f"    {ex.prefix}_state {cm.ident[name]};" for name, ex, _t in cm.mods],
             f"}} {p}_state;",
             "",
             "/* Power-on: forget every channel's state; sample_interval_s: nominal [s]. */",
@@ -131,31 +182,37 @@ def generate_c_calibration(
             "",
         ]
     )
+
+
+def _cal_source(cm: _CalModules) -> str:
+    """The calibration's source: every channel's source (without its own include), then
+    ``<p>_init`` and ``<p>_compensate`` calling each channel's."""
+    p, P = cm.p, cm.P
     bodies = []
-    for _name, ex, _t in mods:
+    for _name, ex, _t in cm.mods:
         lines = [ln for ln in ex.source.split("\n") if ln != f'#include "{ex.prefix}.h"']
         bodies.append("\n".join(lines))
     calls = []
-    for i, (name, ex, ts) in enumerate(mods):
-        cid = ident[name]
-        idx = ", ".join(f"temps_c[{temps.index(t)}]" for t in ts)
+    for i, (name, ex, ts) in enumerate(cm.mods):
+        cid = cm.ident[name]
+        idx = ", ".join(f"temps_c[{cm.temps.index(t)}]" for t in ts)
         calls += [
             "    {",
             f"        const {p}_real t_{cid}[{len(ts)}] = {{{idx}}};",
             f"        out[{i}] = {ex.prefix}_compensate(&s->{cid}, time_s, t_{cid}, raw[{i}]);",
             "    }",
         ]
-    source = "\n".join(
+    return "\n".join(
         [
-            _comment([f"thermocal calibration of {n} channels: {chan_list}"]),
+            _comment([f"thermocal calibration of {len(cm.mods)} channels: {cm.chan_list}"]),
             f'#include "{p}.h"',
             "",
             *bodies,
             f"void {p}_init({p}_state *s, double sample_interval_s)",
             "{",
             *[
-                f"    {ex.prefix}_init(&s->{ident[name]}, sample_interval_s);"
-                for name, ex, _t in mods
+                f"    {ex.prefix}_init(&s->{cm.ident[name]}, sample_interval_s);"
+                for name, ex, _t in cm.mods
             ],
             "}",
             "",
@@ -167,17 +224,6 @@ def generate_c_calibration(
             "}",
             "",
         ]
-    )
-    return CExport(
-        prefix=p,
-        real=real,
-        header=header,
-        source=source,
-        family="calibration",
-        n_temps=k,
-        unit=",".join(ex.unit for _n, ex, _t in mods),
-        model_unit=",".join(ex.model_unit for _n, ex, _t in mods),
-        temperature_unit=tu,
     )
 
 

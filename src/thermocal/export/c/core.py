@@ -81,12 +81,14 @@ class CExport:
         return f"{self.prefix}.c"
 
     def write(self, directory: str | Path, inputs: Sequence[str | Path] = ()) -> list[Path]:
-        """Write header and source into ``directory`` (atomically); returns the paths.
+        """Write header and source into ``directory`` as a pair; returns the paths.
         Neither may be one of ``inputs`` (the model file: ``export-c model.c -o .``) nor a
-        special file (:func:`thermocal.outputs.check_outputs`)."""
+        special file (:func:`thermocal.outputs.check_outputs`).  Both are written whole
+        to temporaries beside their targets before either is renamed into place
+        (:func:`write_together`): a failure writing either leaves neither new file, and
+        an older pair as it was."""
         from thermocal.errors import ThermocalInputError
         from thermocal.outputs import check_outputs
-        from thermocal.writers import atomic_write
 
         d = Path(directory)
         check_outputs([d / self.header_name, d / self.source_name], inputs, dirs=[d])
@@ -96,12 +98,33 @@ class CExport:
             d.mkdir(parents=True, exist_ok=True)
         except (FileExistsError, NotADirectoryError):
             raise ThermocalInputError(f"{d}: cannot create the output directory") from None
-        out = []
-        for name, text in ((self.header_name, self.header), (self.source_name, self.source)):
-            with atomic_write(d / name, "w") as fh:
-                fh.write(text)
-            out.append(d / name)
-        return out
+        files = [(d / self.header_name, self.header), (d / self.source_name, self.source)]
+        write_together(files)
+        return [p for p, _text in files]
+
+
+def _write_text(path: Path, text: str) -> None:
+    """``text`` into ``path`` (the temporary of one file of :func:`write_together`)."""
+    with open(path, "w") as fh:
+        fh.write(text)
+
+
+def write_together(files: Sequence[tuple[Path, str]]) -> None:
+    """Write text files that only make sense together (a C header and its source): each
+    into its own temporary beside its target (:func:`thermocal.writers.atomic_write_path`),
+    nested, so that every temporary is complete before the first rename; an exception
+    while writing any of them removes every temporary and renames none."""
+    from thermocal.writers import atomic_write_path
+
+    if not files:
+        return
+    (path, text), rest = files[0], files[1:]
+
+    def writer(tmp: Path) -> None:
+        _write_text(tmp, text)
+        write_together(rest)  # the others complete (and renamed) before this one is
+
+    atomic_write_path(path, writer)
 
 
 @dataclass(frozen=True)
@@ -327,30 +350,72 @@ def generate_c(
     buf = math.ceil(interval / sample_interval_s) + 8 if interval > 0 else 2
     ctx = ExportContext(model=model, prefix=p, real=real, rate_buffer_len=buf)
     code = gen(ctx)
-    P = ctx.P
-    k = len(model["temperatures"])
-    guard = f"{P}_H"
-    ident = _identity(model)
     su, factor = c_signal_unit(model, unit)
-    mu = units.normalize_signal_unit(str(model["signal"]["unit"]))
-    tu = ctx.tu
-    convert = factor != 1.0
-    conv_decl, conv_src = _temperature_from_counts(model, p, P)
+    conv_decl, conv_src = _temperature_from_counts(model, p, ctx.P)
+    sk = _Skeleton(
+        ctx=ctx,
+        code=code,
+        ident=_identity(model),
+        su=su,
+        mu=units.normalize_signal_unit(str(model["signal"]["unit"])),
+        factor=factor,
+        conv_decl=conv_decl,
+        conv_src=conv_src,
+    )
+    return CExport(
+        prefix=p,
+        real=real,
+        header=_header(sk),
+        source=_source(sk),
+        family=fam,
+        n_temps=len(model["temperatures"]),
+        unit=su,
+        model_unit=sk.mu,
+        temperature_unit=ctx.tu,
+    )
+
+
+@dataclass(frozen=True)
+class _Skeleton:
+    """What the header and the source of one model's module share (:func:`generate_c`):
+    the family's code, the identity comment, the functions' signal unit ``su``, the model's
+    unit ``mu`` and ``factor`` [mu per su], the counts-to-temperature helper."""
+
+    ctx: ExportContext
+    code: FamilyCode
+    ident: list[str]
+    su: str
+    mu: str
+    factor: float
+    conv_decl: list[str]
+    conv_src: str
+
+    @property
+    def convert(self) -> bool:
+        """Whether the functions' unit differs from the model's (``<P>_TO_MODEL_UNIT``)."""
+        return self.factor != 1.0
+
+
+def _header(sk: _Skeleton) -> str:
+    """The header ``<p>.h`` of :func:`generate_c`."""
+    ctx, code, su, mu = sk.ctx, sk.code, sk.su, sk.mu
+    p, P, tu, real = ctx.prefix, ctx.P, ctx.tu, ctx.real
+    guard = f"{P}_H"
     unit_defines = [
         f"#define {P}_SIGNAL_UNIT {c_string(su)} /* unit of signal, known_input and every "
         "result */",
         f"#define {P}_TEMPERATURE_UNIT {c_string(tu)} /* unit of temps_c[] */",
     ]
-    if convert:
+    if sk.convert:
         unit_defines.append(
-            f"#define {P}_TO_MODEL_UNIT {ctx.lit(factor)} /* [{mu}] per [{su}]: the model "
+            f"#define {P}_TO_MODEL_UNIT {ctx.lit(sk.factor)} /* [{mu}] per [{su}]: the model "
             f"runs in {mu} */"
         )
-    header = "\n".join(
+    return "\n".join(
         [
             _comment(
                 [
-                    *ident,
+                    *sk.ident,
                     f"C functions: signal and results in [{su}], temps_c in [{tu}]",
                     "",
                     *code.notes,
@@ -361,13 +426,13 @@ def generate_c(
             "",
             f"typedef {real} {p}_real;",
             "",
-            f"#define {P}_N_TEMPS {k}",
+            f"#define {P}_N_TEMPS {len(ctx.model['temperatures'])}",
             f"#define {P}_GAP_FACTOR {GAP_FACTOR!r}",
             *unit_defines,
             *code.defines,
             "",
             f"/* temperature order of temps_c[] [{tu}]: "
-            + ", ".join(f"{i}={c_comment(n)}" for i, n in enumerate(model["temperatures"]))
+            + ", ".join(f"{i}={c_comment(n)}" for i, n in enumerate(ctx.model["temperatures"]))
             + " */",
             "",
             "typedef struct {",
@@ -388,42 +453,53 @@ def generate_c(
             f"/* Compensated output [{su}]: signal [{su}] - model value. */",
             f"{p}_real {p}_compensate({p}_state *s, double time_s, "
             f"const {p}_real temps_c[{P}_N_TEMPS], {p}_real signal);",
-            *conv_decl,
+            *sk.conv_decl,
             "",
             f"#endif /* {guard} */",
             "",
         ]
     )
-    model_fn = f"{p}_update_{c_identifier(mu)}" if convert else f"{p}_update"
-    model_fn_head = (
-        [
-            f"/* Model value [{mu}] of one sample, signal [{mu}]: the family's arithmetic. */",
-            f"static {p}_real {model_fn}({p}_state *s, double time_s, "
-            f"const {p}_real temps_c[{P}_N_TEMPS], {p}_real signal)",
-        ]
-        if convert
-        else [
+
+
+def _update_functions(sk: _Skeleton) -> tuple[str, list[str], list[str]]:
+    """``(name, head, wrapper)`` of the family's update function: ``<p>_update`` itself, or a
+    static ``<p>_update_<mu>`` in the model's unit behind a ``<p>_update`` converting with
+    ``<P>_TO_MODEL_UNIT``."""
+    ctx, su, mu = sk.ctx, sk.su, sk.mu
+    p, P, tu = ctx.prefix, ctx.P, ctx.tu
+    if not sk.convert:
+        head = [
             f"/* Model value [{su}] of one sample: temps_c [{tu}], signal [{su}]. */",
             f"{p}_real {p}_update({p}_state *s, double time_s, "
             f"const {p}_real temps_c[{P}_N_TEMPS], {p}_real signal)",
         ]
-    )
-    wrapper = (
-        [
-            "",
-            f"/* Model value [{su}] of one sample: temps_c [{tu}], signal [{su}]. */",
-            f"{p}_real {p}_update({p}_state *s, double time_s, "
-            f"const {p}_real temps_c[{P}_N_TEMPS], {p}_real signal)",
-            "{",
-            f"    return {model_fn}(s, time_s, temps_c, signal * {P}_TO_MODEL_UNIT) "
-            f"/ {P}_TO_MODEL_UNIT;",
-            "}",
-        ]
-        if convert
-        else []
-    )
-    ki = f"known_input * {P}_TO_MODEL_UNIT" if convert else "known_input"
-    source = "\n".join(
+        return f"{p}_update", head, []
+    model_fn = f"{p}_update_{c_identifier(mu)}"
+    head = [
+        f"/* Model value [{mu}] of one sample, signal [{mu}]: the family's arithmetic. */",
+        f"static {p}_real {model_fn}({p}_state *s, double time_s, "
+        f"const {p}_real temps_c[{P}_N_TEMPS], {p}_real signal)",
+    ]
+    wrapper = [
+        "",
+        f"/* Model value [{su}] of one sample: temps_c [{tu}], signal [{su}]. */",
+        f"{p}_real {p}_update({p}_state *s, double time_s, "
+        f"const {p}_real temps_c[{P}_N_TEMPS], {p}_real signal)",
+        "{",
+        f"    return {model_fn}(s, time_s, temps_c, signal * {P}_TO_MODEL_UNIT) "
+        f"/ {P}_TO_MODEL_UNIT;",
+        "}",
+    ]
+    return model_fn, head, wrapper
+
+
+def _source(sk: _Skeleton) -> str:
+    """The source ``<p>.c`` of :func:`generate_c`."""
+    ctx, code, su, mu, ident = sk.ctx, sk.code, sk.su, sk.mu, sk.ident
+    p, P = ctx.prefix, ctx.P
+    _model_fn, model_fn_head, wrapper = _update_functions(sk)
+    ki = f"known_input * {P}_TO_MODEL_UNIT" if sk.convert else "known_input"
+    return "\n".join(
         [
             _comment(ident[:1] + ident[1:3] + ident[5:6]),
             f'#include "{p}.h"',
@@ -461,19 +537,8 @@ def generate_c(
             f"    return signal - {p}_update(s, time_s, temps_c, signal);",
             "}",
             "",
-            *([conv_src, ""] if conv_src else []),
+            *([sk.conv_src, ""] if sk.conv_src else []),
         ]
-    )
-    return CExport(
-        prefix=p,
-        real=real,
-        header=header,
-        source=source,
-        family=fam,
-        n_temps=k,
-        unit=su,
-        model_unit=mu,
-        temperature_unit=tu,
     )
 
 

@@ -11,17 +11,14 @@ the determinant is near 1).  Matches :func:`thermocal.turntable.thermal.correct`
 
 from __future__ import annotations
 
-import math
 from collections.abc import Sequence
 from typing import Any
 
-from thermocal import __version__
+from thermocal import __version__, units
 from thermocal.errors import ThermocalInputError
 from thermocal.export.c.core import CExport
 from thermocal.identifiers import c_comment, c_identifier, c_names
 from thermocal.turntable import model as tt_model
-
-_ARCSEC_RAD = math.pi / 648000.0
 
 
 def _lit(x: float) -> str:
@@ -75,7 +72,7 @@ def _triad_code(p: str, tri: Any, bias_to_data: float, real: str, ident: str) ->
     ]
     for k, mis in enumerate(tt_model.MISALIGNMENT_NAMES):
         i, j = tt_model.MISALIGNMENT_INDEX[mis]
-        lines.append(f"    m[{i}][{j}] = th[{6 + k}] * {_lit(_ARCSEC_RAD)}; /* {mis} */")
+        lines.append(f"    m[{i}][{j}] = th[{6 + k}] * {_lit(units.ARCSEC_TO_RAD)}; /* {mis} */")
     lines += [
         f"    r[0] = (double)x[0] - th[0] * {P}_BIAS_TO_DATA;",
         f"    r[1] = (double)x[1] - th[1] * {P}_BIAS_TO_DATA;",
@@ -105,8 +102,6 @@ def _triad_code(p: str, tri: Any, bias_to_data: float, real: str, ident: str) ->
 
 def generate_c_triads(triads: Sequence[Any], *, prefix: str, real: str = "double") -> CExport:
     """The C module of a calibration's triads (module docstring)."""
-    from thermocal import units
-
     if real not in ("double", "float"):
         raise ValueError("real must be double or float")
     p = c_identifier(prefix)

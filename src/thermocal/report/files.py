@@ -1,0 +1,359 @@
+"""``thermocal report``: the HTML report of a model, calibration or turntable calibration
+from the files the other commands write (:mod:`thermocal.report`).
+
+:func:`make_report` reads the model files, the validation results and the recordings
+(every recording through :func:`thermocal.readers.read_recording` with the same text-log
+options and ``--topic``), chooses the report (models compared, one calibration of
+channels, or a calibration of triads judged on the recording) and writes it atomically.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import json
+import warnings
+from collections.abc import Callable, Iterator, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+from thermocal import units
+from thermocal.errors import FileFormatError, GapWarning, ThermocalInputError, ThermocalWarning
+
+if TYPE_CHECKING:
+    from contextlib import AbstractContextManager
+
+    from thermocal.models.calibration import Calibration
+    from thermocal.readers.text import TextOptions
+    from thermocal.recording import Recording
+
+    Progress = Callable[[str, float | None], AbstractContextManager[Callable[[float], None]]]
+    """``progress(description, total)`` → a context yielding ``advance(amount)``."""
+
+DEFAULT_TITLE = "Temperature compensation report"
+
+
+@contextlib.contextmanager
+def _no_progress(
+    _description: str, _total: float | None = None
+) -> Iterator[Callable[[float], None]]:
+    yield lambda _amount: None
+
+
+def read_validation_json(path: Path, *, channels: bool = False) -> dict[str, Any]:
+    """A validation result file (``thermocal validate --json`` output) as a dict; with
+    ``channels`` also the several-channel form ``{"channels": {NAME: {…}}}``."""
+    try:
+        obj = json.loads(path.read_text(encoding="utf-8"))
+    except FileNotFoundError:
+        raise ThermocalInputError(f"{path}: no such validation file") from None
+    except (ValueError, UnicodeDecodeError) as exc:  # JSONDecodeError, a 5000-digit integer
+        raise FileFormatError(f"{path}: not a JSON validation result ({exc})") from None
+    except RecursionError:
+        raise FileFormatError(f"{path}: not a validation result (nested too deeply)") from None
+    if channels and isinstance(obj, dict) and isinstance(obj.get("channels"), dict):
+        return obj
+    if not isinstance(obj, dict) or "bias_stability_before" not in obj:
+        raise FileFormatError(
+            f"{path}: not a validation result (expected the JSON object of "
+            "`thermocal validate --json`, with bias_stability_before, ...)"
+        )
+    return obj
+
+
+@dataclass(frozen=True)
+class ReadOptions:
+    """How the report's recordings are read: the command line's column, unit and text-log
+    options (:func:`thermocal.readers.read_recording`), the same for every recording."""
+
+    time: str | None = None
+    time_unit: str | None = None
+    signal_unit: str | None = None
+    temp_unit: str | None = None
+    temp_conversion: str | None = None
+    """``"GAIN,OFFSET[,int16]"`` (:func:`thermocal.units.temperature_conversion`)."""
+    text: TextOptions | None = None
+    topic: str | None = None
+
+
+def _names(text: str | None) -> list[str] | None:
+    """``"a, b"`` → ``["a", "b"]``; None stays None."""
+    return None if text is None else [t.strip() for t in text.split(",") if t.strip()]
+
+
+def read_run(
+    path: Path, signals: str, temps: Sequence[str], model_inputs: dict[str, Any], opts: ReadOptions
+) -> Recording:
+    """A recording read as the command line reads one for a fitted model: ``signals`` (one
+    name or ``"a,b"``) and the temperature columns ``temps``, units resolved once with the
+    model file's ``inputs`` filling in what the options and the file leave unstated
+    (:func:`thermocal.units.resolve_inputs`); the sensor id compared with the model's; a
+    signal required; time finite and increasing, no NaN (:meth:`Recording.validate`),
+    gaps reported in one :class:`GapWarning`."""
+    from thermocal.models.base import check_sensor_id
+    from thermocal.readers.dispatch import read_recording
+
+    conv = opts.temp_conversion
+    rec = read_recording(
+        path,
+        time=opts.time,
+        time_unit=opts.time_unit,
+        signals=_names(signals) if signals else None,
+        temperatures=_names(",".join(temps)) if temps else None,
+        signal_unit=opts.signal_unit,
+        temp_unit=opts.temp_unit,
+        temp_conversion=(
+            units.temperature_conversion(conv, "--temp-conversion") if conv is not None else None
+        ),
+        model=units.StatedUnits.from_model_inputs(model_inputs),
+        text=opts.text,
+        topic=opts.topic,
+    )
+    check_sensor_id(model_inputs, rec.meta.sensor_id, str(path))
+    if not rec.signals:
+        raise ThermocalInputError(
+            f"{path}: name the signal column with --signal; available: "
+            + ", ".join(repr(c) for c in rec.columns)
+        )
+    rec.validate()
+    gaps = rec.gaps()
+    if gaps:
+        total = sum(g.length_s for g in gaps)
+        warnings.warn(
+            GapWarning(
+                f"{path}: {len(gaps)} gaps in time ({total:.6g} s in all), first after "
+                f"row {gaps[0].index} at {gaps[0].start_s:.6g} s"
+            ),
+            stacklevel=2,
+        )
+    return rec
+
+
+@dataclass(frozen=True)
+class ReportResult:
+    """What :func:`make_report` wrote: the HTML file and the kind of report, ``"models"``,
+    ``"calibration"`` or ``"triads"``."""
+
+    path: Path
+    kind: str
+
+
+def make_report(
+    models: Sequence[Path],
+    recording: Path,
+    output: Path,
+    *,
+    validations: Sequence[Path] = (),
+    modeling: Path | None = None,
+    signal: str | None = None,
+    labels: Sequence[str] = (),
+    title: str = DEFAULT_TITLE,
+    sensor: str | None = None,
+    averaging_s: float | None = None,
+    latitude_deg: float | None = None,
+    read: ReadOptions | None = None,
+    progress: Progress | None = None,
+) -> ReportResult:
+    """``thermocal report``: a self-contained HTML report written atomically to ``output``.
+
+    A calibration of triads (the first model file) is judged on ``recording``
+    (held-out poses of a multi-position calibration, else the turntable's validation;
+    ``latitude_deg`` [°] default the file's metadata) and reported
+    (:func:`thermocal.report.triads.write_triad_report`); a calibration of several
+    channels (or several named in ``signal``) gets the calibration report
+    (:func:`thermocal.report.calibration.write_calibration_report`); model files are
+    reported and compared (:func:`thermocal.report.write_report`; one ``validations``
+    file and one label per model, in the same order).  ``progress`` draws the steps.
+    Input errors (:class:`ThermocalInputError`): counts that do not match, the output
+    being an input, a calibration of channels given with other models.
+    """
+    from thermocal.models.files import load_calibration
+    from thermocal.writers import check_not_input
+
+    opts = read or ReadOptions()
+    bar = progress or _no_progress
+    if validations and len(validations) != len(models):
+        raise ThermocalInputError(
+            f"{len(validations)} --validation files for {len(models)} --model files; "
+            "give one validation per model, in the same order"
+        )
+    if labels and len(labels) != len(models):
+        raise ThermocalInputError(f"{len(labels)} --label values for {len(models)} --model files")
+    inputs_files: list[str | Path] = [*models, *validations, recording]
+    if modeling is not None:
+        inputs_files.append(modeling)
+    check_not_input(output, inputs_files)
+    cal = load_calibration(models[0])
+    if cal.triads and not cal.channels:  # a turntable calibration over temperature
+        return _triad_report(cal, models[0], recording, output, opts, latitude_deg)
+    cal.require_channels("report")
+    if len(cal.channels) > 1 or len(_names(signal) or []) > 1:
+        if len(models) > 1:
+            raise ThermocalInputError(
+                f"{models[0]} is a calibration of {len(cal.channels)} channels: give it as the "
+                "only --model (compare calibrations in separate reports)"
+            )
+        return _calibration_report(
+            cal, models[0], recording, output, opts, bar,
+            validation=validations[0] if validations else None, modeling=modeling,
+            signal=signal, title=title, sensor=sensor, averaging_s=averaging_s,
+        )  # fmt: skip
+    return _models_report(
+        models, recording, output, opts, bar, validations=validations, modeling=modeling,
+        signal=signal, labels=labels, title=title, sensor=sensor, averaging_s=averaging_s,
+    )  # fmt: skip
+
+
+def _triad_report(
+    cal: Calibration,
+    cal_path: Path,
+    recording: Path,
+    output: Path,
+    opts: ReadOptions,
+    latitude_deg: float | None,
+) -> ReportResult:
+    """A calibration of triads judged on ``recording`` and reported."""
+    from thermocal.compensate.files import read_for_triads
+    from thermocal.multipos import validate as _mp_validate
+    from thermocal.report.triads import write_triad_report
+    from thermocal.turntable.calibrate import validate_triads
+
+    rec = read_for_triads(recording, cal.triads, time=opts.time, time_unit=opts.time_unit)
+    if _mp_validate.is_multipos(cal.triads):  # held-out poses (issue 30)
+        results: list[Any] = _mp_validate.validate_triads(cal.triads, rec, latitude_deg)
+    else:
+        results = validate_triads(cal.triads, rec, latitude_deg)
+    path = write_triad_report(output, cal, cal_path, results, recording)
+    return ReportResult(Path(path), "triads")
+
+
+def _models_report(
+    models: Sequence[Path],
+    recording: Path,
+    output: Path,
+    opts: ReadOptions,
+    bar: Progress,
+    *,
+    validations: Sequence[Path],
+    modeling: Path | None,
+    signal: str | None,
+    labels: Sequence[str],
+    title: str,
+    sensor: str | None,
+    averaging_s: float | None,
+) -> ReportResult:
+    """Model files reported and compared: both runs read with the same options (what they
+    warn shown in the report too, issue 25)."""
+    from thermocal.models.files import load_model_dict
+    from thermocal.report.build import ModelEntry, ReportInputs, write_report
+
+    with bar("building report", 3) as advance:
+        entries = []
+        for i, mpath in enumerate(models):
+            mdict = load_model_dict(mpath)
+            vdict = read_validation_json(validations[i]) if validations else None
+            lab = labels[i] if labels else mpath.stem
+            entries.append(ModelEntry(lab, mdict, vdict, str(mpath)))
+        if len({e.label for e in entries}) != len(entries):
+            raise ThermocalInputError(
+                "two models have the same label (file stem); name them with --label"
+            )
+        sig = signal or (entries[0].model.get("signal") or {}).get("name") or None
+        if not sig:
+            raise ThermocalInputError("name the signal column with --signal")
+        fitted = dict(entries[0].model.get("inputs") or {})  # how the first model's data were
+        # the temperature columns every model uses, in the first model's order
+        temp_cols: list[str] = []
+        for e in entries:
+            for c in e.model.get("temperatures") or []:
+                if c not in temp_cols:
+                    temp_cols.append(str(c))
+        # what thermocal warns while reading the runs goes into the report too (issue 25)
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            val_rec = read_run(recording, sig, temp_cols, fitted, opts)
+            mod_rec = (
+                read_run(modeling, sig, temp_cols, fitted, opts) if modeling is not None else None
+            )
+        for w in caught:
+            warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
+        read_warnings = tuple(
+            " ".join(str(w.message).split())
+            for w in caught
+            if issubclass(w.category, ThermocalWarning)
+        )
+        advance(1)
+        inputs = ReportInputs(
+            models=tuple(entries),
+            recording=val_rec,
+            modeling=mod_rec,
+            signal=sig,
+            recording_path=str(recording),
+            modeling_path=str(modeling) if modeling is not None else None,
+            title=title,
+            sensor=sensor,
+            generated_by="thermocal report",
+            averaging_s=averaging_s,
+            warnings_caught=read_warnings,
+        )
+        advance(1)
+        path = write_report(output, inputs)
+        advance(1)
+    return ReportResult(Path(path), "models")
+
+
+def _calibration_report(
+    cal: Calibration,
+    cal_path: Path,
+    recording: Path,
+    output: Path,
+    opts: ReadOptions,
+    bar: Progress,
+    *,
+    validation: Path | None,
+    modeling: Path | None,
+    signal: str | None,
+    title: str,
+    sensor: str | None,
+    averaging_s: float | None,
+) -> ReportResult:
+    """A calibration's report: the recording read once for every chosen channel
+    (:func:`thermocal.report.calibration.build_calibration_report`)."""
+    from thermocal.models.calibration import merged_inputs, temperatures_of
+    from thermocal.report.calibration import CalibrationReportInputs, write_calibration_report
+
+    names = _names(signal) or cal.names
+    missing = [n for n in names if n not in cal.names]
+    if missing:
+        raise ThermocalInputError(
+            f"{cal_path}: no channel {', '.join(map(repr, missing))}; it has "
+            + ", ".join(cal.names)
+        )
+    with bar("building calibration report", 2) as advance:
+        vdict = read_validation_json(validation, channels=True) if validation else None
+        rec = read_run(
+            recording,
+            ",".join(cal.channel(n).signal for n in names),
+            temperatures_of(cal, names),
+            merged_inputs(cal, names),
+            opts,
+        )
+        advance(1)
+        path = write_calibration_report(
+            output,
+            CalibrationReportInputs(
+                calibration=cal,
+                recording=rec,
+                recording_path=str(recording),
+                modeling_path=str(modeling) if modeling is not None else None,
+                calibration_path=str(cal_path),
+                validation=vdict,
+                validation_path=str(validation) if validation is not None else None,
+                title="Calibration report" if title == DEFAULT_TITLE else title,
+                sensor=sensor,
+                averaging_s=averaging_s,
+                channels=names,
+            ),
+        )
+        advance(1)
+    return ReportResult(Path(path), "calibration")
