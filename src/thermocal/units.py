@@ -62,7 +62,11 @@ SECONDS_PER_MINUTE: Final = 60.0
 
 DEG_TO_RAD: Final = math.pi / 180.0
 RAD_TO_DEG: Final = 180.0 / math.pi
-ARCSEC_TO_RAD: Final = DEG_TO_RAD / 3600.0
+ARCSEC_PER_DEG: Final = 3600.0
+"""Seconds of arc in one degree [″/°]."""
+DEG_TO_ARCSEC: Final = ARCSEC_PER_DEG
+ARCSEC_TO_DEG: Final = 1.0 / ARCSEC_PER_DEG
+ARCSEC_TO_RAD: Final = DEG_TO_RAD / ARCSEC_PER_DEG
 RAD_TO_ARCSEC: Final = 1.0 / ARCSEC_TO_RAD
 PPM: Final = 1e-6
 """One part per million (dimensionless)."""
