@@ -175,9 +175,9 @@ def normalize_angle_unit(unit: str) -> str:
 
 def angle_to_deg(values: npt.ArrayLike, unit: str) -> npt.NDArray[np.float64]:
     """An angle in ``unit`` (:data:`ANGLE_UNITS`) in [°]: ``θ[°] = θ[unit] · factor``."""
-    out: npt.NDArray[np.float64] = np.asarray(values, dtype=np.float64) * ANGLE_UNITS[
-        normalize_angle_unit(unit)
-    ]
+    out: npt.NDArray[np.float64] = (
+        np.asarray(values, dtype=np.float64) * ANGLE_UNITS[normalize_angle_unit(unit)]
+    )
     return out
 
 
