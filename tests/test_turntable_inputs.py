@@ -146,3 +146,18 @@ def test_profile_correlate_reads_serial_logs_and_ulog_topics(
                     "--topic", "sensor_baro.0", "--column", "temperature", "--points",
                     str(t.size)], capsys)  # fmt: skip
     assert got["r"] == pytest.approx(want, abs=1e-5)
+
+
+def test_angle_units_of_the_glossary() -> None:
+    from thermocal import units
+    from thermocal.errors import UnitError
+
+    assert [units.normalize_angle_unit(u) for u in ("deg", "°", "Degrees", "rad", "radian")] == [
+        "deg", "deg", "deg", "rad", "rad"
+    ]  # fmt: skip
+    np.testing.assert_allclose(units.angle_to_deg([np.pi, -np.pi / 2], "rad"), [180.0, -90.0])
+    assert units.unit_in_column_name("enc_in [rad]", "angle") == "rad"
+    assert units.unit_in_column_name("alpha_deg", "angle") == "deg"
+    assert units.DEG_TO_ARCSEC == 3600.0 and units.ARCSEC_TO_DEG * 3600.0 == 1.0
+    with pytest.raises(UnitError, match="unknown angle unit"):
+        units.normalize_angle_unit("deg/s")
