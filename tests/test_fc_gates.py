@@ -15,7 +15,7 @@ import pytest
 
 from dataflash_writer import NEW_IMU_FMT, NEW_IMU_LABELS, dataflash_log
 from thermocal.cli import main
-from thermocal.tempcal.px4 import sweep_stall
+from thermocal.tempcal.pipeline import sweep_stall
 from ulog_writer import SENSOR_FIELDS, ulog_bytes
 
 

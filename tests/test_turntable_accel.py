@@ -10,6 +10,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from thermocal import units
 from thermocal.errors import DesignError
 from thermocal.turntable import accel
 from thermocal.turntable.model import error_matrices
@@ -24,10 +25,10 @@ def _dwells(noise_mg: float, seed: int, n: int = 6000) -> tuple[np.ndarray, np.n
     pos = np.array(POSITIONS_16, dtype=np.float64)
     f_true = accel.gravity_in_body(pos[:, 0], pos[:, 1], G)
     e = error_matrices(TRUTH)
-    b = TRUTH[0:3] * accel.MG_M_S2
+    b = TRUTH[0:3] * units.MG_TO_MS2
     rng = np.random.default_rng(seed)
     f_meas = f_true @ (np.eye(3) + e).T + b
-    f_meas += rng.normal(0.0, noise_mg * accel.MG_M_S2, f_meas.shape)
+    f_meas += rng.normal(0.0, noise_mg * units.MG_TO_MS2, f_meas.shape)
     return f_meas, f_true, np.full(len(pos), float(n))
 
 
@@ -44,7 +45,7 @@ def _joint_lstsq(f_meas: np.ndarray, f_true: np.ndarray) -> np.ndarray:
     x = np.linalg.lstsq(np.array(rows), np.array(rhs), rcond=None)[0]
     e = x[:9].reshape(3, 3)
     theta = np.zeros(12)
-    theta[0:3] = x[9:] / accel.MG_M_S2
+    theta[0:3] = x[9:] / units.MG_TO_MS2
     theta[3:6] = np.diag(e) * 1e6
     names = {"yx": (0, 1), "zx": (0, 2), "xy": (1, 0), "zy": (1, 2), "xz": (2, 0), "yz": (2, 1)}
     for k, nm in enumerate(("yx", "zx", "xy", "zy", "xz", "yz")):

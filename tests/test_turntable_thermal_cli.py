@@ -22,7 +22,6 @@ import pytest
 
 from thermocal.cli import main
 from thermocal.readers.dispatch import read_recording
-from thermocal.turntable import kinematics
 from thermocal.turntable.calibrate import calibrate
 from thermocal.turntable.schedule import detect_motion, segment
 from thermocal.turntable.simulate import (
@@ -37,6 +36,54 @@ G_COLS = ["gyro_x", "gyro_y", "gyro_z"]
 A_COLS = ["accel_x", "accel_y", "accel_z"]
 MG = 9.80665e-3
 ARCSEC = np.pi / 180 / 3600
+EARTH_RATE_RAD_S = 7.292115e-5  # WGS-84 Ω
+
+
+# --- the reference, from first principles (not the package's kinematics) ---------------------
+# Base frame ENU; body axes at α = β = 0: x East, y Down, z North (SPEC §7).  The inner axis
+# turns the body about its own z by α, the outer axis turns the inner gimbal about base East
+# by β, so body → base is C_b^n = R_E(β) · C_0 · R_z(α), with right-handed rotations.
+
+
+def _rot_x(t: np.ndarray) -> np.ndarray:
+    c, s = np.cos(t), np.sin(t)
+    out = np.zeros((t.size, 3, 3))
+    out[:, 0, 0] = 1.0
+    out[:, 1, 1], out[:, 1, 2], out[:, 2, 1], out[:, 2, 2] = c, -s, s, c
+    return out
+
+
+def _rot_z(t: np.ndarray) -> np.ndarray:
+    c, s = np.cos(t), np.sin(t)
+    out = np.zeros((t.size, 3, 3))
+    out[:, 0, 0], out[:, 0, 1], out[:, 1, 0], out[:, 1, 1] = c, -s, s, c
+    out[:, 2, 2] = 1.0
+    return out
+
+
+C_0 = np.column_stack([[1.0, 0.0, 0.0], [0.0, 0.0, -1.0], [0.0, 1.0, 0.0]])
+"""Columns: body x, y, z in ENU at α = β = 0 (East, Down, North)."""
+
+
+def _c_nb(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Base → body, C_n^b = (R_E(β) C_0 R_z(α))ᵀ, per sample."""
+    return np.transpose(_rot_x(b) @ C_0 @ _rot_z(a), (0, 2, 1))
+
+
+def _reference(a: np.ndarray, b: np.ndarray, lat_deg: float, g: float, tau: float) -> tuple:
+    """(ω_ib^b [rad/s] over each interval, specific force at rest f^b [m/s²]): the earth rate
+    Ω (0, cos L, sin L) in ENU and the outer rate β̇ about East seen in the body, plus the
+    inner rate α̇ about body z (at the interval's mid angles); gravity's reaction (0, 0, g)
+    up in ENU seen in the body."""
+    a_prev, b_prev = np.concatenate([[a[0]], a[:-1]]), np.concatenate([[b[0]], b[:-1]])
+    lat = np.deg2rad(lat_deg)
+    w_ie = EARTH_RATE_RAD_S * np.array([0.0, np.cos(lat), np.sin(lat)])
+    c_mid = _c_nb(0.5 * (a + a_prev), 0.5 * (b + b_prev))
+    a_dot, b_dot = (a - a_prev) / tau, (b - b_prev) / tau
+    in_base = w_ie[None, :] + b_dot[:, None] * np.array([1.0, 0.0, 0.0])
+    omega = np.einsum("nij,nj->ni", c_mid, in_base) + a_dot[:, None] * np.array([0.0, 0.0, 1.0])
+    f_true = np.einsum("nij,j->ni", _c_nb(a, b), np.array([0.0, 0.0, g]))
+    return omega, f_true
 
 
 def _write_runs(runs: list, folder: Path) -> tuple[list[str], Path]:
@@ -77,14 +124,11 @@ def _truth_frame(held: Path) -> tuple[pd.DataFrame, np.ndarray, np.ndarray, list
     a = np.deg2rad(np.unwrap(rec.column("alpha_deg"), period=360.0))
     b = np.deg2rad(np.unwrap(rec.column("beta_deg"), period=360.0))
     tau = float(np.median(np.diff(t)))
-    a_prev, b_prev = np.concatenate([[a[0]], a[:-1]]), np.concatenate([[b[0]], b[:-1]])
     lat = float(rec.meta.latitude_deg or 40.0)
-    omega = kinematics.omega_ib_b(0.5 * (a + a_prev), 0.5 * (b + b_prev), (a - a_prev) / tau,
-                                  (b - b_prev) / tau, lat)  # fmt: skip
     from thermocal import units
 
     g = units.normal_gravity_m_s2(lat)
-    f_true = np.einsum("nji,j->ni", kinematics.mat_nb(a, b), np.array([0.0, 0.0, g]))
+    omega, f_true = _reference(a, b, lat, g, tau)
     a_deg, b_deg = np.rad2deg(a), np.rad2deg(b)
     motion = detect_motion(t, a_deg, b_deg)
     seg = segment(t, a_deg, b_deg, motion.moving, np.ones(t.size - 1, dtype=bool))
@@ -249,7 +293,7 @@ def test_encoder_jitter_in_every_run(tmp_path: Path) -> None:
     from thermocal import units
 
     g = units.normal_gravity_m_s2(40.0)
-    f_true = np.einsum("nji,j->ni", kinematics.mat_nb(a, b), np.array([0.0, 0.0, g]))
+    _omega, f_true = _reference(a, b, 40.0, g, _t)
     ours = pd.read_parquet(comp)[[f"{c}_comp" for c in A_COLS]].to_numpy()
     assert _dwell_rms(ours, f_true, dwells) / MG < 0.02
 

@@ -62,7 +62,11 @@ SECONDS_PER_MINUTE: Final = 60.0
 
 DEG_TO_RAD: Final = math.pi / 180.0
 RAD_TO_DEG: Final = 180.0 / math.pi
-ARCSEC_TO_RAD: Final = DEG_TO_RAD / 3600.0
+ARCSEC_PER_DEG: Final = 3600.0
+"""Seconds of arc in one degree [″/°]."""
+DEG_TO_ARCSEC: Final = ARCSEC_PER_DEG
+ARCSEC_TO_DEG: Final = 1.0 / ARCSEC_PER_DEG
+ARCSEC_TO_RAD: Final = DEG_TO_RAD / ARCSEC_PER_DEG
 RAD_TO_ARCSEC: Final = 1.0 / ARCSEC_TO_RAD
 PPM: Final = 1e-6
 """One part per million (dimensionless)."""
@@ -138,6 +142,16 @@ _SIGNAL_ALIASES: Final = {
 TIME_UNITS: Final[dict[str, float]] = {"s": 1.0, "ms": 1e-3, "us": 1e-6}
 """Factor taking a time in the key's unit to [s]."""
 
+ANGLE_UNITS: Final[dict[str, float]] = {"deg": 1.0, "rad": RAD_TO_DEG}
+"""Factor taking an angle (a turntable's encoder reading) in the key's unit to [°]."""
+_ANGLE_ALIASES: Final = {
+    "°": "deg",
+    "degree": "deg",
+    "degrees": "deg",
+    "radian": "rad",
+    "radians": "rad",
+}
+
 
 def normalize_signal_unit(unit: str) -> str:
     """Return the canonical spelling of a signal unit, or raise :class:`UnitError`."""
@@ -148,6 +162,23 @@ def normalize_signal_unit(unit: str) -> str:
     if alias is not None:
         return alias
     raise UnitError(f"unknown signal unit {unit!r}; known units: {', '.join(SIGNAL_UNITS)}")
+
+
+def normalize_angle_unit(unit: str) -> str:
+    """Return ``'deg'`` or ``'rad'`` (an encoder angle's unit), or raise :class:`UnitError`."""
+    u = unit.strip().lower()
+    alias = u if u in ANGLE_UNITS else _ANGLE_ALIASES.get(u)
+    if alias is None:
+        raise UnitError(f"unknown angle unit {unit!r}; known units: {', '.join(ANGLE_UNITS)}")
+    return alias
+
+
+def angle_to_deg(values: npt.ArrayLike, unit: str) -> npt.NDArray[np.float64]:
+    """An angle in ``unit`` (:data:`ANGLE_UNITS`) in [°]: ``θ[°] = θ[unit] · factor``."""
+    out: npt.NDArray[np.float64] = (
+        np.asarray(values, dtype=np.float64) * ANGLE_UNITS[normalize_angle_unit(unit)]
+    )
+    return out
 
 
 def normalize_temperature_unit(unit: str) -> str:
@@ -259,7 +290,7 @@ def temperature_conversion(
 
 # --- the one resolver: option > file metadata > column name > model file > stated default ---
 
-UnitRole = Literal["time", "signal", "temperature"]
+UnitRole = Literal["time", "signal", "temperature", "angle"]
 UnitSource = Literal["option", "metadata", "column name", "model", "default"]
 ConversionSource = Literal["option", "metadata", "model", "none"]
 
@@ -267,7 +298,12 @@ LEGACY_TEMPERATURE_UNIT: Final = "degC"
 """Temperature unit of a model file that names none: not a guess — every model file before
 format version 3 was fitted in °C (raw counts were always converted)."""
 
-DEFAULT_UNITS: Final[dict[str, str]] = {"time": "s", "signal": "deg/h", "temperature": "degC"}
+DEFAULT_UNITS: Final[dict[str, str]] = {
+    "time": "s",
+    "signal": "deg/h",
+    "temperature": "degC",
+    "angle": "deg",
+}
 """What a column is taken to be in when nothing states its unit — always said in a
 ``warning:`` line (INTERFACE.md common rules), never assumed silently."""
 
@@ -275,6 +311,7 @@ _UNIT_OPTION: Final[dict[str, str]] = {
     "time": "--time-unit",
     "signal": "--signal-unit",
     "temperature": "--temp-unit",
+    "angle": "--encoder-unit",
 }
 _TIME_ALIASES: Final = {"sec": "s", "secs": "s", "msec": "ms", "usec": "us", "µs": "us"}
 _NAME_BRACKET = re.compile(r"[\[(]\s*([^\])]+?)\s*[\])]\s*$")
@@ -291,6 +328,7 @@ def _normalizer(role: UnitRole) -> Callable[[str], str]:
         "time": _normalize_time_alias,
         "signal": normalize_signal_unit,
         "temperature": normalize_temperature_unit,
+        "angle": normalize_angle_unit,
     }
     return table[role]
 

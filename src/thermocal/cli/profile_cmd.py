@@ -19,7 +19,21 @@ import typer
 from thermocal import defaults
 from thermocal._lazy import LazyModule
 from thermocal.cli.application import app
-from thermocal.cli.common import JsonOpt, OutOpt, emit, handle_errors, split_floats, stdout
+from thermocal.cli.common import (
+    DecimalOpt,
+    DelimiterOpt,
+    JsonOpt,
+    NamesOpt,
+    OnBadLinesOpt,
+    OutOpt,
+    TopicOpt,
+    emit,
+    handle_errors,
+    split_floats,
+    stdout,
+    text_options,
+)
+from thermocal.cli.common import RateOpt as TextRateOpt
 from thermocal.errors import FileFormatError, MissingColumnError, ThermocalInputError
 from thermocal.outputs import check_outputs
 
@@ -39,6 +53,8 @@ else:
 
 if TYPE_CHECKING:
     import pandas as pd
+
+    from thermocal.readers.text import TextOptions
 else:
     pd = LazyModule("pandas")
 
@@ -107,11 +123,17 @@ def _clean(params: dict[str, Any]) -> dict[str, Any]:
 
 
 def load_history(
-    path: Path, column: str | None = None
+    path: Path,
+    column: str | None = None,
+    *,
+    text: "TextOptions | None" = None,
+    topic: str | None = None,
 ) -> "tuple[_recording.FloatArray, _recording.FloatArray, str]":
     """A temperature history ``(time_s, temperature_c, column)`` from a chamber program CSV
     (``time_s, setpoint_c``; its set-point unless ``column`` is another of its columns) or a
-    recording (``column``, default its first temperature column, else ``setpoint_c``)."""
+    recording (``column``, default its first temperature column, else ``setpoint_c``), read
+    by :func:`thermocal.readers.read_recording` with the text-log options ``text`` and the
+    log topic ``topic`` as every command reads a recording."""
     if not path.exists():
         raise FileFormatError(f"{path}: no such file")
     time_col: str | None = None
@@ -126,7 +148,7 @@ def load_history(
             return t, c, defaults.PROGRAM_SETPOINT
         if defaults.PROGRAM_TIME in header and "time" not in header:
             time_col = defaults.PROGRAM_TIME
-    rec = _readers.read_recording(path, time=time_col)
+    rec = _readers.read_recording(path, time=time_col, text=text, topic=topic)
     if column is None:
         if rec.temperatures:
             column = rec.temperatures[0]
@@ -330,11 +352,20 @@ def correlate_cmd(
     points: Annotated[
         int, typer.Option("--points", help="Points of the common elapsed-time base.")
     ] = 10_000,
+    t_names: NamesOpt = None,
+    topic: TopicOpt = None,
+    t_rate: TextRateOpt = None,
+    t_bad: OnBadLinesOpt = "error",
+    t_delim: DelimiterOpt = None,
+    t_dec: DecimalOpt = None,
     as_json: JsonOpt = False,
 ) -> None:
     """r = Cov(X, Y)/(σX σY) of two temperature histories on a common elapsed-time base."""
-    ta, xa, ca = load_history(file_a, column)
-    tb, xb, cb = load_history(file_b, column_b if column_b is not None else column)
+    text = text_options(t_names, t_rate, t_bad, t_delim, t_dec)
+    ta, xa, ca = load_history(file_a, column, text=text, topic=topic)
+    tb, xb, cb = load_history(
+        file_b, column_b if column_b is not None else column, text=text, topic=topic
+    )
     res = _profiles.correlate(ta, xa, tb, xb, r_limit=limit, n_points=points)
     out = {
         "r": res.r,

@@ -3,7 +3,9 @@
 Modules: :mod:`.kinematics` (frames, eq. (1)–(3)), :mod:`.schedule` (16 positions,
 design checks), :mod:`.model` (error model, measurement model, Cramér–Rao bound),
 :mod:`.simulate` (``turntable-16`` scenario), :mod:`.estimate_ls` (batch least
-squares), :mod:`.kalman` (14/15-state filter), :mod:`.calibrate` (the pipeline).
+squares), :mod:`.kalman` (14/15-state filter), :mod:`.calibrate` (the pipeline),
+:mod:`.thermal` (every parameter over temperature), :mod:`.files` (the command at the file
+layer's edge: runs read, calibrated, written; imported by nothing in the maths).
 """
 
 from __future__ import annotations

@@ -34,9 +34,6 @@ from thermocal.turntable import kinematics, model
 
 FloatArray = npt.NDArray[np.float64]
 
-MG_M_S2 = 9.80665e-3
-"""One milli-g [m/s²] (standard gravity / 1000)."""
-
 
 @dataclass(frozen=True)
 class AccelEstimate:
@@ -62,7 +59,7 @@ class AccelEstimate:
 
     @property
     def bias_m_s2(self) -> FloatArray:
-        out: FloatArray = self.theta[0:3] * MG_M_S2
+        out: FloatArray = self.theta[0:3] * units.MG_TO_MS2
         return out
 
     def to_dict(self) -> dict[str, Any]:
@@ -136,7 +133,7 @@ def estimate_accel_triad(
         ss += float(r @ r)
         cov_x = var * (v_inv_s @ v_inv_s.T)
         # x = (E_i0 g, E_i1 g, E_i2 g, b_i) in m/s²: back to E and b
-        scale = np.array([1.0 / g, 1.0 / g, 1.0 / g, 1.0 / MG_M_S2])
+        scale = np.array([1.0 / g, 1.0 / g, 1.0 / g, 1.0 / units.MG_TO_MS2])
         xs = x * scale
         cs = cov_x * np.outer(scale, scale)
         idx = [_theta_index(i, j) for j in range(3)] + [i]
@@ -145,7 +142,7 @@ def estimate_accel_triad(
             theta[ip] = xs[p] * up
             for q, (iq, uq) in enumerate(zip(idx, units_of, strict=True)):
                 cov[ip, iq] = cs[p, q] * up * uq
-    rms_mg = math.sqrt(ss / max(float(w.sum()), 1.0)) / MG_M_S2
+    rms_mg = math.sqrt(ss / max(float(w.sum()), 1.0)) / units.MG_TO_MS2
     return AccelEstimate(theta, cov, rms_mg, m, cond)
 
 

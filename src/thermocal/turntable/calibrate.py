@@ -248,6 +248,7 @@ def calibrate(
     alpha_column: str = "alpha_deg",
     beta_column: str = "beta_deg",
     gyro_unit: str | None = None,
+    encoder_unit: str | None = None,
     arw_deg_sqrt_h: float | Sequence[float] | None = None,
     encoder_noise_arcsec: float | None = None,
     channels: int = 3,
@@ -266,9 +267,12 @@ def calibrate(
     Parameters
     ----------
     rec : the recording: time [s], gyro mean rates over the interval ending at each
-        sample, encoder angles α, β at the sample times [°] (wrapped or not).
+        sample, encoder angles α, β at the sample times [° or rad] (wrapped or not).
     latitude_deg : site latitude L [°] (default: the recording's metadata).
     gyro_columns, alpha_column, beta_column : column names.
+    encoder_unit : unit of the encoder columns, ``deg`` or ``rad`` (default: the recording's
+        metadata, else the unit in the column name, else ° with a warning:
+        :func:`thermocal.units.resolve_unit`, role ``angle``).
     gyro_unit : unit of the gyro columns (default: the recording's; none known is refused).
     arw_deg_sqrt_h : angle random walk [°/√h], scalar or per axis; estimated from the
         dwells when None.
@@ -290,9 +294,134 @@ def calibrate(
     Raises
     ------
     MissingColumnError, MissingValueError : absent or incomplete columns.
-    TurntableScheduleError : fewer positions, dwells shorter than asked, an axis that
-        never moves.
+    TurntableScheduleError : fewer positions, dwells shorter than asked, an axis not moving.
     """
+    lat = _check_inputs(
+        rec, latitude_deg, channels, gyro_columns, alpha_column, beta_column, accel_columns,
+        temperature_column,
+    )  # fmt: skip
+    g = _gyro_rad_s(rec, gyro_columns, gyro_unit)
+    a_deg = np.unwrap(encoder_deg(rec, alpha_column, encoder_unit), period=360.0)
+    b_deg = np.unwrap(encoder_deg(rec, beta_column, encoder_unit), period=360.0)
+    full, motion, seg = _segment(
+        rec, g, a_deg, b_deg, lat, alpha_column, beta_column, min_positions, min_dwell_s
+    )
+    noise_source = "dwells" if encoder_noise_arcsec is None else "option"
+    if encoder_noise_arcsec is None:
+        encoder_noise_arcsec = motion.reading_sigma_arcsec
+    m = full.select_channels(channels)
+    arw = _arw_rad_sqrt_s(arw_deg_sqrt_h, g, full.dt_s, seg.dwells)
+    est = _estimate(
+        m, arw, motion, float(encoder_noise_arcsec), kf_interval_s, move_block_s, prior_sigma
+    )
+    msgs = list(_diagnostics(est, seg.n_positions))
+    acc_est, g_local = None, None
+    if accel_columns is not None:
+        g_local = (
+            float(gravity_m_s2) if gravity_m_s2 is not None else units.normal_gravity_m_s2(lat)
+        )
+        acc_est = _accel_triad(rec, accel_columns, accel_unit, a_deg, b_deg, seg.dwells, g_local)
+        msgs.extend(_accel_diagnostics(acc_est))
+    t_mean, t_span = _soak_temperature(rec, temperature_column)
+    for msg in msgs:
+        warnings.warn(f"{rec.name}: {msg}", TurntableWarning, stacklevel=2)
+    return TurntableResult(
+        kalman=estimate_from(est.kf.theta, est.kf.cov),
+        least_squares=estimate_from(est.ls.theta, est.ls.cov), crb=est.crb,
+        agreement=est.agreement, latitude_deg=float(lat),
+        arw_deg_sqrt_h=arw * units.RAD_TO_DEG * np.sqrt(units.SECONDS_PER_HOUR),
+        n_channels=channels, n_states=est.kf.n_states, n_positions=seg.n_positions,
+        n_dwells=len(seg.dwells), min_dwell_s=float(min(d.duration_s for d in seg.dwells)),
+        duration_s=rec.duration_s, chi2_per_dof=est.chi2_per_dof,
+        normalised_innovation_rms=est.kf.normalised_innovation_rms,
+        weak_combinations=est.weak, warnings=tuple(msgs),
+        encoder_noise_arcsec=float(encoder_noise_arcsec), encoder_noise_source=noise_source,
+        encoder_jitter_arcsec=motion.noise_arcsec, encoder_quantum_deg=motion.quantum_deg,
+        accel=acc_est, gravity_m_s2=g_local, temperature_c=t_mean, temperature_span_c=t_span,
+    )  # fmt: skip
+
+
+def _segment(
+    rec: Recording,
+    g: FloatArray,
+    a_deg: FloatArray,
+    b_deg: FloatArray,
+    lat: float,
+    alpha_column: str,
+    beta_column: str,
+    min_positions: int,
+    min_dwell_s: float,
+) -> tuple[model.IntervalModel, schedule.Motion, schedule.Segmentation]:
+    """The run's interval model (:func:`.model.interval_model`), its moves and rests from the
+    encoder readings themselves (:func:`.schedule.detect_motion`: robust to jitter and
+    quantisation, which a per-sample rate threshold is not), the dwells, positions and the
+    design checks (:func:`.schedule.check_design`)."""
+    t = rec.time_s
+    full = model.interval_model(t, g, a_deg * units.DEG_TO_RAD, b_deg * units.DEG_TO_RAD, lat)
+    motion = schedule.detect_motion(t, a_deg, b_deg)
+    full = dataclasses.replace(full, moving=motion.moving)
+    schedule.warn_gaps(rec.name, t, full.valid)
+    seg = schedule.segment(t, a_deg, b_deg, full.moving, full.valid)
+    dt_med = float(np.median(full.dt_s))
+    schedule.check_design(
+        seg,
+        name=rec.name,
+        alpha_col=alpha_column,
+        beta_col=beta_column,
+        min_positions=min_positions,
+        min_dwell_s=min_dwell_s,
+        dwell_tolerance_s=max(2.0 * dt_med, 0.005 * min_dwell_s),
+    )
+    return full, motion, seg
+
+
+def _arw_rad_sqrt_s(
+    arw_deg_sqrt_h: float | Sequence[float] | None,
+    g: FloatArray,
+    dt_s: FloatArray,
+    dwells: Sequence[schedule.Dwell],
+) -> FloatArray:
+    """The angle random walk per gyro [rad/√s]: given [°/√h] (``N[rad/√s] = N[°/√h] ·
+    (π/180) / √3600``), else estimated from the dwells (:func:`estimate_arw`)."""
+    if arw_deg_sqrt_h is None:
+        return estimate_arw(g, dt_s, dwells)
+    arw = np.asarray(arw_deg_sqrt_h, dtype=np.float64) * np.ones(3)
+    out: FloatArray = arw * units.DEG_TO_RAD / np.sqrt(units.SECONDS_PER_HOUR)
+    return out
+
+
+def _accel_diagnostics(acc: accel_mod.AccelEstimate) -> tuple[str, ...]:
+    """The doubt about the accelerometer triad: dwell means more than 1 mg rms off the
+    model."""
+    if acc.residual_rms_mg > 1.0:
+        return (
+            f"accelerometer dwell means depart from the triad model by "
+            f"{acc.residual_rms_mg:.3g} mg rms: check the unit, the axes or the gravity",
+        )
+    return ()
+
+
+def _soak_temperature(rec: Recording, column: str | None) -> tuple[float | None, float | None]:
+    """(mean, max − min) of the run's temperature column [°C]; (None, None) without one."""
+    if column is None:
+        return None, None
+    temp = rec.temperature_c(column)
+    return float(np.mean(temp)), float(np.max(temp) - np.min(temp))
+
+
+def _check_inputs(
+    rec: Recording,
+    latitude_deg: float | None,
+    channels: int,
+    gyro_columns: Sequence[str],
+    alpha_column: str,
+    beta_column: str,
+    accel_columns: Sequence[str] | None,
+    temperature_column: str | None,
+) -> float:
+    """The latitude [°] (the argument, else the recording's metadata) after refusing what
+    cannot be calibrated: channels not 2 or 3, no or an impossible latitude, not three gyro
+    (or accelerometer) columns, absent or incomplete columns, fewer than three samples."""
     if channels not in (2, 3):
         raise ThermocalInputError(f"channels must be 2 or 3, got {channels}")
     lat = latitude_deg if latitude_deg is not None else rec.meta.latitude_deg
@@ -311,42 +440,47 @@ def calibrate(
         cols.append(temperature_column)
     rec.validate(required=cols)
     _check_finite(rec, cols)
-    t = rec.time_s
-    if t.size < 3:
+    if rec.time_s.size < 3:
         raise ThermocalInputError(f"{rec.name}: too few samples")
-    g = _gyro_rad_s(rec, gyro_columns, gyro_unit)
-    a_deg = np.unwrap(rec.column(alpha_column), period=360.0)
-    b_deg = np.unwrap(rec.column(beta_column), period=360.0)
-    full = model.interval_model(t, g, a_deg * units.DEG_TO_RAD, b_deg * units.DEG_TO_RAD, lat)
-    # moves and rests from the encoder readings themselves, robust to jitter and
-    # quantisation (a per-sample rate threshold is crossed by arcseconds of jitter)
-    motion = schedule.detect_motion(t, a_deg, b_deg)
-    full = dataclasses.replace(full, moving=motion.moving)
-    if encoder_noise_arcsec is None:
-        encoder_noise_arcsec = motion.reading_sigma_arcsec
-        noise_source = "dwells"
-    else:
-        noise_source = "option"
-    schedule.warn_gaps(rec.name, t, full.valid)
-    seg = schedule.segment(t, a_deg, b_deg, full.moving, full.valid)
-    dt_med = float(np.median(full.dt_s))
-    schedule.check_design(
-        seg,
-        name=rec.name,
-        alpha_col=alpha_column,
-        beta_col=beta_column,
-        min_positions=min_positions,
-        min_dwell_s=min_dwell_s,
-        dwell_tolerance_s=max(2.0 * dt_med, 0.005 * min_dwell_s),
-    )
-    m = full.select_channels(channels)
-    if arw_deg_sqrt_h is None:
-        arw = estimate_arw(g, full.dt_s, seg.dwells)
-    else:
-        arw = np.asarray(arw_deg_sqrt_h, dtype=np.float64) * np.ones(3)
-        arw = arw * units.DEG_TO_RAD / np.sqrt(units.SECONDS_PER_HOUR)
-    arw_dh = arw * units.RAD_TO_DEG * np.sqrt(units.SECONDS_PER_HOUR)
+    return float(lat)
 
+
+def encoder_deg(rec: Recording, column: str, unit: str | None = None) -> FloatArray:
+    """An encoder angle column in [°]: its unit resolved like every column's
+    (:func:`thermocal.units.resolve_unit`, role ``angle``: ``unit`` (``--encoder-unit``) >
+    the file's metadata > the unit in the column's name > ° with a warning), then
+    ``θ[°] = θ[unit] · ANGLE_UNITS[unit]``."""
+    resolved = units.resolve_unit(
+        column, "angle", option=unit, metadata=rec.units.get(column) or None, where=rec.name
+    )
+    return units.angle_to_deg(rec.column(column), resolved.unit)
+
+
+@dataclass(frozen=True)
+class _Estimates:
+    """The two estimators of one run and what judges them."""
+
+    kf: Any
+    ls: Any
+    crb: FloatArray
+    agreement: float
+    chi2_per_dof: float
+    dof: int
+    weak: tuple[dict[str, Any], ...]
+
+
+def _estimate(
+    m: model.IntervalModel,
+    arw: FloatArray,
+    motion: schedule.Motion,
+    encoder_noise_arcsec: float,
+    kf_interval_s: float,
+    move_block_s: float,
+    prior_sigma: tuple[float, float, float],
+) -> _Estimates:
+    """The Cramér–Rao bound of the design, the least squares (cross-check) and the Kalman
+    filter (reported), the quantised inner encoder's azimuth uncertainty added to both, and
+    the weakly observable combinations."""
     hw = model.whitened_regressors(m, arw)
     info = model.fisher_information(m, arw, whitened=hw)
     crb_cov = np.linalg.pinv(info, hermitian=True)
@@ -385,75 +519,39 @@ def calibrate(
         az_var = (motion.quantum_deg * units.DEG_TO_RAD * units.RAD_TO_ARCSEC) ** 2 / 12.0
         kf = dataclasses.replace(kf, cov=kf.cov + az_var * np.outer(v, v))
         ls = dataclasses.replace(ls, cov=ls.cov + az_var * np.outer(v, v))
-    msgs: list[str] = []
     agreement = float(np.max(np.abs(kf.theta - ls.theta) / np.maximum(ls.sigma, 1e-300)))
-    if agreement > 1.0:
+    info_static = model.fisher_information(m, arw, ~m.moving, whitened=hw)
+    static_fraction = float(np.sum(m.dt_s[m.valid & ~m.moving]) / np.sum(m.dt_s[m.valid]))
+    weak = weak_combinations(info, info_static, static_fraction)
+    chi2 = ls.chi2 / max(ls.dof, 1)
+    return _Estimates(kf, ls, crb, agreement, chi2, int(ls.dof), weak)
+
+
+def _diagnostics(est: _Estimates, n_positions: int) -> tuple[str, ...]:
+    """The doubts about one run's estimate, each one sentence: the filter and least squares
+    apart by more than 1 σ, residuals above the white-noise level (χ²/dof beyond
+    1 + 5·√(2/dof)), weakly observable combinations, fewer than the sixteen positions."""
+    msgs: list[str] = []
+    if est.agreement > 1.0:
         msgs.append(
-            f"Kalman filter and least squares differ by up to {agreement:.2g} σ "
+            f"Kalman filter and least squares differ by up to {est.agreement:.2g} σ "
             "(prior too tight, or model mismatch)"
         )
-    chi2 = ls.chi2 / max(ls.dof, 1)
-    if ls.dof > 0 and chi2 > 1.0 + 5.0 * np.sqrt(2.0 / ls.dof):
+    chi2 = est.chi2_per_dof
+    if est.dof > 0 and chi2 > 1.0 + 5.0 * np.sqrt(2.0 / est.dof):
         msgs.append(
             f"least-squares residuals are {np.sqrt(chi2):.3g}× the white-noise level: "
             "noise other than angle random walk, or an error not in the model; "
             "the σ are optimistic"
         )
-    info_static = model.fisher_information(m, arw, ~m.moving, whitened=hw)
-    static_fraction = float(np.sum(m.dt_s[m.valid & ~m.moving]) / np.sum(m.dt_s[m.valid]))
-    weak = weak_combinations(info, info_static, static_fraction)
-    for w in weak:
+    for w in est.weak:
         msgs.append(f"weakly observable combination: {w['combination']}")
-    if seg.n_positions < len(schedule.POSITIONS_16):
+    if n_positions < len(schedule.POSITIONS_16):
         msgs.append(
-            f"{seg.n_positions} positions held, not the {len(schedule.POSITIONS_16)} of SPEC §7: "
+            f"{n_positions} positions held, not the {len(schedule.POSITIONS_16)} of SPEC §7: "
             "estimated with what is there (the σ say how well)"
         )
-    acc_est: accel_mod.AccelEstimate | None = None
-    g_local: float | None = None
-    if accel_columns is not None:
-        g_local = (
-            float(gravity_m_s2) if gravity_m_s2 is not None else units.normal_gravity_m_s2(lat)
-        )
-        acc_est = _accel_triad(rec, accel_columns, accel_unit, a_deg, b_deg, seg.dwells, g_local)
-        if acc_est.residual_rms_mg > 1.0:
-            msgs.append(
-                f"accelerometer dwell means depart from the triad model by "
-                f"{acc_est.residual_rms_mg:.3g} mg rms: check the unit, the axes or the gravity"
-            )
-    t_mean = t_span = None
-    if temperature_column is not None:
-        temp = rec.temperature_c(temperature_column)
-        t_mean = float(np.mean(temp))
-        t_span = float(np.max(temp) - np.min(temp))
-    for msg in msgs:
-        warnings.warn(f"{rec.name}: {msg}", TurntableWarning, stacklevel=2)
-    return TurntableResult(
-        kalman=estimate_from(kf.theta, kf.cov),
-        least_squares=estimate_from(ls.theta, ls.cov),
-        crb=crb,
-        agreement=agreement,
-        latitude_deg=float(lat),
-        arw_deg_sqrt_h=arw_dh,
-        n_channels=channels,
-        n_states=kf.n_states,
-        n_positions=seg.n_positions,
-        n_dwells=len(seg.dwells),
-        min_dwell_s=float(min(d.duration_s for d in seg.dwells)),
-        duration_s=rec.duration_s,
-        chi2_per_dof=chi2,
-        normalised_innovation_rms=kf.normalised_innovation_rms,
-        weak_combinations=weak,
-        warnings=tuple(msgs),
-        encoder_noise_arcsec=float(encoder_noise_arcsec),
-        encoder_noise_source=noise_source,
-        encoder_jitter_arcsec=motion.noise_arcsec,
-        encoder_quantum_deg=motion.quantum_deg,
-        accel=acc_est,
-        gravity_m_s2=g_local,
-        temperature_c=t_mean,
-        temperature_span_c=t_span,
-    )
+    return tuple(msgs)
 
 
 def _accel_triad(
@@ -521,8 +619,8 @@ def validate_triads(
     rec.validate(required=cols)
     _check_finite(rec, cols)
     t = rec.time_s
-    a_deg = np.unwrap(rec.column(alpha_column), period=360.0)
-    b_deg = np.unwrap(rec.column(beta_column), period=360.0)
+    a_deg = np.unwrap(encoder_deg(rec, alpha_column), period=360.0)
+    b_deg = np.unwrap(encoder_deg(rec, beta_column), period=360.0)
     motion = schedule.detect_motion(t, a_deg, b_deg)
     valid = np.ones(t.size - 1, dtype=bool)
     seg = schedule.segment(t, a_deg, b_deg, motion.moving, valid)

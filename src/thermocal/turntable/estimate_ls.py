@@ -217,11 +217,3 @@ def solve_ls(
         singular_values=s,
         rank=rank,
     )
-
-
-def information_matrix(blocks: Blocks) -> FloatArray:
-    """Block-level Fisher information ``Σ_j h_jᵀ (cov W_j)⁻¹ h_j`` (perfect encoders)."""
-    low = np.linalg.cholesky(blocks.cov)
-    hw = np.linalg.solve(low, blocks.h).reshape(-1, N_COEFFS)
-    out: FloatArray = hw.T @ hw
-    return out

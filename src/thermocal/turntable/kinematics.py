@@ -43,12 +43,6 @@ MAT_C0: Final = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, -1.0, 0.0]])
 """C_0: body → base at α = β = 0 (body x = East, y = Down, z = North)."""
 
 
-def earth_rate_n(latitude_deg: float) -> FloatArray:
-    """Earth rate in ENU [rad/s]: ``ω_ie^n = Ω (0, cos L, sin L)`` (SPEC §7)."""
-    lat = np.deg2rad(latitude_deg)
-    return units.EARTH_RATE_RAD_S * np.array([0.0, np.cos(lat), np.sin(lat)])
-
-
 def mat_nb(alpha_rad: npt.ArrayLike, beta_rad: npt.ArrayLike) -> FloatArray:
     """Body-to-base matrices ``C_b^n = R_E(β) C_0 R_z(α)``, eq. (1); shape (..., 3, 3).
 
@@ -108,11 +102,6 @@ def outer_axis_b(alpha_rad: npt.ArrayLike) -> FloatArray:
     a = np.asarray(alpha_rad, dtype=np.float64)
     out: FloatArray = np.stack([np.cos(a), -np.sin(a), np.zeros_like(a)], axis=-1)
     return out
-
-
-def inner_axis_b(shape: tuple[int, ...] = ()) -> FloatArray:
-    """Inner axis in body axes ``e_z = (0, 0, 1)``, broadcast to ``shape + (3,)``."""
-    return np.broadcast_to(np.array([0.0, 0.0, 1.0]), (*shape, 3)).copy()
 
 
 def omega_ib_b(

@@ -92,8 +92,6 @@ COEFF_NAMES: Final = (
 )
 """Names of θ, in order."""
 
-COEFF_UNITS: Final = ("deg/h",) * 3 + ("ppm",) * 3 + ("arcsec",) * 6
-
 MISALIGNMENT_NAMES: Final = ("yx", "zx", "xy", "zy", "xz", "yz")
 MISALIGNMENT_INDEX: Final[dict[str, tuple[int, int]]] = {
     "yx": (0, 1),

@@ -20,6 +20,7 @@ from typing import Final
 import numpy as np
 import numpy.typing as npt
 
+from thermocal import units
 from thermocal.errors import DesignError, GapWarning, ThermocalWarning
 
 FloatArray = npt.NDArray[np.float64]
@@ -186,7 +187,7 @@ class Motion:
     def reading_sigma_arcsec(self) -> float:
         """σ of one reading [″]: the jitter, or the quantisation σ q/√12 where the jitter
         is below it (a quantised reading at rest is constant, its error unknown)."""
-        return float(max(self.noise_arcsec, self.quantum_deg * 3600.0 / np.sqrt(12.0)))
+        return float(max(self.noise_arcsec, self.quantum_deg * units.DEG_TO_ARCSEC / np.sqrt(12.0)))
 
 
 MOTION_WINDOW_S: Final = 0.05
@@ -262,7 +263,7 @@ def detect_motion(time_s: FloatArray, alpha_deg: FloatArray, beta_deg: FloatArra
         _quantum(np.asarray(alpha_deg, dtype=np.float64)),
         _quantum(np.asarray(beta_deg, dtype=np.float64)),
     )
-    tol = 8.0 * sigma_deg + 2.0 * q + 2.0 / 3600.0
+    tol = 8.0 * sigma_deg + 2.0 * q + 2.0 * units.ARCSEC_TO_DEG
     rest = np.ones(n, dtype=bool)
     for x in angles:
         rng_ = maximum_filter1d(x, 2 * half + 1, mode="nearest") - minimum_filter1d(
@@ -291,8 +292,8 @@ def detect_motion(time_s: FloatArray, alpha_deg: FloatArray, beta_deg: FloatArra
             resid.append(xs - np.median(xs))
         r = np.concatenate(resid) if resid else np.zeros(1)
         dev.append(1.4826 * float(np.median(np.abs(r))))
-    noise_arcsec = float(max(dev)) * 3600.0
-    if q > 0 and noise_arcsec < q * 3600.0:
+    noise_arcsec = float(max(dev)) * units.DEG_TO_ARCSEC
+    if q > 0 and noise_arcsec < q * units.DEG_TO_ARCSEC:
         noise_arcsec = 0.0  # steps of one grid unit at rest are quantisation, not jitter
     return Motion(moving, noise_arcsec, q, tol)
 

@@ -150,7 +150,7 @@ def simulate_turntable16(
     arw_rad_sqrt_s = arw_deg_sqrt_h * units.DEG_TO_RAD / np.sqrt(units.SECONDS_PER_HOUR)
     noise = rng.standard_normal((n, 3)) * (arw_rad_sqrt_s / np.sqrt(tau))
     omega_meas = omega_true @ (np.eye(3) + e_mat).T + bias + noise
-    enc_sigma_deg = encoder_noise_arcsec / 3600.0
+    enc_sigma_deg = encoder_noise_arcsec * units.ARCSEC_TO_DEG
     a_enc = a_deg + rng.standard_normal(n) * enc_sigma_deg
     b_enc = b_deg + rng.standard_normal(n) * enc_sigma_deg
     gyro_deg_s = omega_meas * units.RAD_TO_DEG
@@ -245,6 +245,41 @@ def thermal_theta(spec: dict[str, tuple[tuple[float, ...], ...]], temp_c: Any) -
     return out
 
 
+def _thermal_truth(
+    label: str,
+    soak: float,
+    mean_t: float,
+    drift_c: float,
+    g: float,
+    latitude_deg: float,
+    seed: int,
+    rate_hz: float,
+    arw_deg_sqrt_h: float,
+    accel_noise_mg: float,
+) -> dict[str, Any]:
+    """The truth of one run of :func:`simulate_turntable_thermal`: the polynomials, the run's
+    mean temperature ``mean_t`` [°C] and θ at it, and the simulation's settings."""
+    return {
+        "scenario": "turntable-thermal",
+        "label": label,
+        "soak_c": soak,
+        "held_out": label.startswith("heldout"),
+        "temperature_c": mean_t,
+        "drift_c": drift_c,
+        "tref_c": THERMAL_TREF_C,
+        "gyro_polynomials": {k: [list(c) for c in v] for k, v in GYRO_THERMAL_TRUTH.items()},
+        "accel_polynomials": {k: [list(c) for c in v] for k, v in ACCEL_THERMAL_TRUTH.items()},
+        "gyro_theta_at_mean": thermal_theta(GYRO_THERMAL_TRUTH, mean_t).tolist(),
+        "accel_theta_at_mean": thermal_theta(ACCEL_THERMAL_TRUTH, mean_t).tolist(),
+        "gravity_m_s2": g,
+        "latitude_deg": latitude_deg,
+        "seed": seed,
+        "rate_hz": rate_hz,
+        "arw_deg_sqrt_h": arw_deg_sqrt_h,
+        "accel_noise_mg": accel_noise_mg,
+    }
+
+
 def simulate_turntable_thermal(
     seed: int = 0,
     *,
@@ -305,10 +340,10 @@ def simulate_turntable_thermal(
         acc = (
             f_true
             + np.einsum("nij,nj->ni", e_a, f_true)
-            + ta[:, 0:3] * 9.80665e-3
-            + rng.standard_normal((n, 3)) * accel_noise_mg * 9.80665e-3
+            + ta[:, 0:3] * units.MG_TO_MS2
+            + rng.standard_normal((n, 3)) * accel_noise_mg * units.MG_TO_MS2
         )
-        enc = encoder_noise_arcsec / 3600.0
+        enc = encoder_noise_arcsec * units.ARCSEC_TO_DEG
         rec = Recording.from_arrays(
             t,
             signals={c: gyro[:, k] * units.RAD_TO_DEG for k, c in enumerate(GYRO_COLUMNS)},
@@ -332,25 +367,9 @@ def simulate_turntable_thermal(
                 extra={"scenario": "turntable-thermal"},
             ),
         )
-        mean_t = float(np.mean(temp))
-        truth: dict[str, Any] = {
-            "scenario": "turntable-thermal",
-            "label": label,
-            "soak_c": soak,
-            "held_out": label.startswith("heldout"),
-            "temperature_c": mean_t,
-            "drift_c": drift_c,
-            "tref_c": THERMAL_TREF_C,
-            "gyro_polynomials": {k: [list(c) for c in v] for k, v in GYRO_THERMAL_TRUTH.items()},
-            "accel_polynomials": {k: [list(c) for c in v] for k, v in ACCEL_THERMAL_TRUTH.items()},
-            "gyro_theta_at_mean": thermal_theta(GYRO_THERMAL_TRUTH, mean_t).tolist(),
-            "accel_theta_at_mean": thermal_theta(ACCEL_THERMAL_TRUTH, mean_t).tolist(),
-            "gravity_m_s2": g,
-            "latitude_deg": latitude_deg,
-            "seed": seed,
-            "rate_hz": rate_hz,
-            "arw_deg_sqrt_h": arw_deg_sqrt_h,
-            "accel_noise_mg": accel_noise_mg,
-        }
+        truth = _thermal_truth(
+            label, soak, float(np.mean(temp)), drift_c, g, latitude_deg, seed, rate_hz,
+            arw_deg_sqrt_h, accel_noise_mg,
+        )  # fmt: skip
         out.append((rec, truth))
     return out

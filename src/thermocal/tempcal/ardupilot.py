@@ -1,0 +1,376 @@
+"""ArduPilot's thermal calibration from one DataFlash log: ``thermocal ardupilot-tempcal``.
+
+The ArduPilot dialect of the one pipeline (:mod:`thermocal.tempcal.pipeline`): the ``IMU``
+messages (up to three instances; temperature ``T``, ``Temp`` in Copter 3.4–3.6), the
+``INS_TCAL<n>_*`` parameters (a polynomial about :data:`AP_TREF_C` = 35 °C without constant,
+as the firmware takes it), and the log's hygiene: the board rotation ``AHRS_ORIENTATION`` and
+an active ``INS_TCAL`` the firmware had subtracted are undone before fitting
+(:func:`ardupilot_raw`).
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from thermocal.errors import ThermocalInputError
+from thermocal.models.calibration import Calibration
+from thermocal.outputs import check_outputs
+from thermocal.recording import FloatArray, Recording
+from thermocal.tempcal.pipeline import (
+    AXES,
+    GateWarning,
+    OutputSet,
+    Reporter,
+    ReportRequest,
+    SensorFit,
+    calibration_of,
+    check_output_dir,
+    end_warning,
+    fit_sensor,
+    require_fields,
+    staged_set,
+    stall_warning,
+    step_warnings,
+    summary,
+    warn_gates,
+)
+
+PARAMS_NAME = "ardupilot.parm"
+"""The parameter file of the set (Mission Planner's ``.parm``, ``INS_TCAL*``)."""
+MAX_IMUS = 3
+"""ArduPilot logs up to three IMUs (``IMU``, instances 0…2)."""
+KINDS = (("gyro", "Gyr", "rad/s"), ("accel", "Acc", "m/s^2"))
+"""(kind, field prefix of the ``IMU`` message, its unit) per sensor of an IMU."""
+
+
+# --- ArduPilot log hygiene (issue 28, item 4) ---------------------------------------------
+
+AP_ROTATIONS: dict[int, str] = {
+    0: "NONE", 1: "YAW_45", 2: "YAW_90", 3: "YAW_135", 4: "YAW_180", 5: "YAW_225",
+    6: "YAW_270", 7: "YAW_315", 8: "ROLL_180", 9: "ROLL_180_YAW_45", 10: "ROLL_180_YAW_90",
+    11: "ROLL_180_YAW_135", 12: "PITCH_180", 13: "ROLL_180_YAW_225", 14: "ROLL_180_YAW_270",
+    15: "ROLL_180_YAW_315", 16: "ROLL_90", 17: "ROLL_90_YAW_45", 18: "ROLL_90_YAW_90",
+    19: "ROLL_90_YAW_135", 20: "ROLL_270", 21: "ROLL_270_YAW_45", 22: "ROLL_270_YAW_90",
+    23: "ROLL_270_YAW_135", 24: "PITCH_90", 25: "PITCH_270", 26: "PITCH_180_YAW_90",
+    27: "PITCH_180_YAW_270", 28: "ROLL_90_PITCH_90", 29: "ROLL_180_PITCH_90",
+    30: "ROLL_270_PITCH_90", 31: "ROLL_90_PITCH_180", 32: "ROLL_270_PITCH_180",
+    33: "ROLL_90_PITCH_270", 34: "ROLL_180_PITCH_270", 35: "ROLL_270_PITCH_270",
+    36: "ROLL_90_PITCH_180_YAW_90", 37: "ROLL_90_YAW_270", 39: "PITCH_315",
+    40: "ROLL_90_PITCH_315", 41: "PITCH_7", 42: "ROLL_45", 43: "ROLL_315",
+}  # fmt: skip
+"""ArduPilot's ``enum Rotation`` (``libraries/AP_Math/rotations.h``), the board orientations
+``AHRS_ORIENTATION`` takes, by value; 38 (``ROLL_90_PITCH_68_YAW_293``) and 100 (custom) are
+not implemented and refused by name."""
+AP_REFUSED_ROTATIONS = {38: "ROLL_90_PITCH_68_YAW_293", 100: "CUSTOM"}
+
+
+def ardupilot_rotation(code: int) -> FloatArray:
+    """The matrix ``R`` of ArduPilot rotation ``code``: ``Vector3::rotate`` gives ``R·v``
+    with ``R = Rz(yaw)·Ry(pitch)·Rx(roll)`` for ``ROTATION_ROLL_r_PITCH_p_YAW_y`` (checked
+    against rotations.cpp: YAW_90 is (x, y) → (−y, x), ROLL_90 is (y, z) → (−z, y), PITCH_90
+    is (x, z) → (z, −x))."""
+    if code not in AP_ROTATIONS:
+        name = AP_REFUSED_ROTATIONS.get(code, "unknown")
+        raise ThermocalInputError(
+            f"AHRS_ORIENTATION {code} ({name}) is not implemented: the data cannot be rotated "
+            "back to the sensor frame; calibrate from a log recorded with AHRS_ORIENTATION 0"
+        )
+    angles = {"ROLL": 0.0, "PITCH": 0.0, "YAW": 0.0}
+    parts = AP_ROTATIONS[code].split("_")
+    for axis, deg in zip(parts[::2], parts[1::2], strict=True):
+        angles[axis] = math.radians(float(deg))
+    cr, sr = math.cos(angles["ROLL"]), math.sin(angles["ROLL"])
+    cp, sp = math.cos(angles["PITCH"]), math.sin(angles["PITCH"])
+    cy, sy = math.cos(angles["YAW"]), math.sin(angles["YAW"])
+    rx = np.array([[1, 0, 0], [0, cr, -sr], [0, sr, cr]])
+    ry = np.array([[cp, 0, sp], [0, 1, 0], [-sp, 0, cp]])
+    rz = np.array([[cy, -sy, 0], [sy, cy, 0], [0, 0, 1]])
+    r: FloatArray = np.round(rz @ ry @ rx, 12).astype(np.float64)
+    return r
+
+
+AP_TREF_C = 35.0
+"""ArduPilot's ``TEMP_REFERENCE`` (AP_InertialSensor_tempcal.cpp)."""
+
+
+@dataclass(frozen=True)
+class ActiveTcal:
+    """An IMU's ``INS_TCAL<n>_*`` found in the log's parameters: ``coefficients[kind]`` the
+    3×3 ``c_k`` (row k = 1…3, columns x, y, z, as stored: ×1e-6 in use), the range and the
+    calibration temperatures ``INS_ACC<n>_CALTEMP``/``INS_GYR<n>_CALTEMP`` [°C]."""
+
+    instance: int
+    tmin_c: float
+    tmax_c: float
+    coefficients: dict[str, list[list[float]]]
+    caltemp_c: dict[str, float]
+
+    def correction(self, kind: str, temp_c: FloatArray) -> FloatArray:
+        """What the firmware subtracted (AP_InertialSensor_tempcal.cpp ``correct_sensor``):
+        ``poly(clamp(T) − 35) − poly(clamp(T_cal) − 35)``, ``poly(t) = (c1 + (c2 + c3·t)·t)·t
+        ·1e-6``, (n, 3) [rad/s or m/s²]."""
+        c = np.asarray(self.coefficients[kind], dtype=np.float64)
+
+        def poly(t: FloatArray) -> FloatArray:
+            t = t[:, None]
+            out: FloatArray = (c[0] + (c[1] + c[2] * t) * t) * t * 1e-6
+            return out
+
+        t = np.clip(np.asarray(temp_c, dtype=np.float64), self.tmin_c, self.tmax_c)
+        tcal = float(np.clip(self.caltemp_c[kind], self.tmin_c, self.tmax_c))
+        return poly(t - AP_TREF_C) - poly(np.array([tcal - AP_TREF_C]))
+
+
+def ardupilot_active(params: dict[str, float], instance: int) -> ActiveTcal | None:
+    """The active temperature calibration of IMU ``instance`` in a log's ``PARM`` values
+    (``INS_TCAL<n>_ENABLE`` = 1, n = instance + 1), or None."""
+    n = instance + 1
+    if int(params.get(f"INS_TCAL{n}_ENABLE", 0)) != 1:
+        return None
+    coef = {
+        kind: [[params.get(f"INS_TCAL{n}_{tag}{k}_{a}", 0.0) for a in "XYZ"] for k in (1, 2, 3)]
+        for kind, tag in (("accel", "ACC"), ("gyro", "GYR"))
+    }
+    tmin = params.get(f"INS_TCAL{n}_TMIN", 0.0)
+    tmax = params.get(f"INS_TCAL{n}_TMAX", 70.0)
+    cal = {
+        kind: params.get(f"INS_{tag}{n}_CALTEMP", math.nan)
+        for kind, tag in (("accel", "ACC"), ("gyro", "GYR"))
+    }
+    cal = {k: (v if math.isfinite(v) and v > -100.0 else AP_TREF_C) for k, v in cal.items()}
+    return ActiveTcal(instance, tmin, tmax, coef, cal)
+
+
+def ardupilot_raw(
+    params: dict[str, float], instance: int, kind: str, temp_c: FloatArray, xyz: FloatArray
+) -> tuple[FloatArray, ActiveTcal | None, int]:
+    """Logged IMU data back to the raw sensor frame as ArduPilot's firmware produced them:
+    the logged vector is ``R·(v − correction)`` (the temperature correction in the sensor
+    frame, then the board's rotation ``AHRS_ORIENTATION``), so ``v = Rᵀ·logged +
+    correction``.  Returns (v, the active calibration or None, the orientation code)."""
+    code = int(params.get("AHRS_ORIENTATION", 0))
+    out = np.asarray(xyz, dtype=np.float64)
+    if code:
+        out = out @ ardupilot_rotation(code)  # row vectors: (Rᵀ·v)ᵀ = vᵀ·R
+    active = ardupilot_active(params, instance)
+    if active is not None:
+        out = out + active.correction(kind, temp_c)
+    return out, active, code
+
+
+# --- the whole command -----------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class ArdupilotTempcalResult:
+    """What :func:`ardupilot_tempcal` wrote and found: the files of the set, every IMU
+    sensor's fit, the parameter file's notes and the log's hygiene (``AHRS_ORIENTATION``,
+    per IMU the active ``INS_TCAL`` removed and its coefficients old → new)."""
+
+    log: Path
+    params_path: Path
+    calibration_path: Path
+    reports: tuple[Path, ...]
+    fits: tuple[SensorFit, ...]
+    notes: tuple[str, ...]
+    orientation: int
+    hygiene: dict[str, dict[str, Any]]
+
+    @property
+    def active_found(self) -> list[str]:
+        """The IMUs whose active ``INS_TCAL`` was removed from the data."""
+        return [k for k, h in self.hygiene.items() if h["active_tcal_removed"]]
+
+    def to_dict(self) -> dict[str, Any]:
+        """The JSON of ``ardupilot-tempcal --json`` (INTERFACE.md)."""
+        return {
+            "log": str(self.log),
+            "params": str(self.params_path),
+            "calibration": str(self.calibration_path),
+            "reports": [str(p) for p in self.reports],
+            "sensors": summary(self.fits),
+            "notes": list(self.notes),
+            "log_hygiene": {
+                "AHRS_ORIENTATION": self.orientation,
+                "rotated_back_to_sensor_frame": self.orientation != 0,
+                "imus": self.hygiene,
+            },
+        }
+
+
+@dataclass
+class _Run:
+    """The state of one :func:`ardupilot_tempcal` run across its IMUs."""
+
+    log: Path
+    dlog: Any
+    overrides: tuple[str, ...]
+    params: Any
+    out_set: OutputSet
+    fits: list[SensorFit]
+    gates: list[str | None]
+    series: dict[str, tuple[FloatArray, FloatArray]]
+    hygiene: dict[str, dict[str, Any]]
+    orientation: int = 0
+
+
+def ardupilot_tempcal(
+    log: Path, output: Path, *, overrides: tuple[str, ...] = (), reporter: Reporter | None = None
+) -> ArdupilotTempcalResult:
+    """ArduPilot's thermal calibration of every IMU of a DataFlash log, written to the
+    directory ``output`` as one set: ``calibration.json``, ``ardupilot.parm``
+    (``INS_TCAL<n>_*``) and ``report_IMU_<n>_<kind>.html`` per sensor (written by
+    ``reporter``; none: not written).  Each IMU's gyro and accelerometer go through the
+    pipeline (:func:`.pipeline.fit_sensor` with ArduPilot's minimum sweep) after the log's
+    hygiene (:func:`ardupilot_raw`); an IMU whose temperature is all 0 or NaN is left out
+    with a warning.  ``overrides`` the adequacy checks let through."""
+    from thermocal.errors import MissingColumnError
+    from thermocal.export.params import ParamSet
+    from thermocal.readers.dataflash import dataflash_table, read_dataflash_log
+
+    # DIR may hold the log; the files of the set (replaced by name) may not be it
+    names = ["calibration.json", PARAMS_NAME]
+    names += [f"report_IMU_{i}_{k}.html" for i in range(MAX_IMUS) for k in ("gyro", "accel")]
+    check_outputs([output / n for n in names], [log], dirs=[output])
+    check_output_dir(output)
+    with staged_set(output, reporter) as out_set:  # moved into place whole, or removed
+        dlog = read_dataflash_log(log, ["IMU", "IMU2", "IMU3"])  # the log is read once
+        run = _Run(log, dlog, overrides, ParamSet("ardupilot"), out_set, [], [], {}, {})
+        for inst in range(MAX_IMUS):
+            try:
+                df, _info = dataflash_table(dlog, log, "IMU", inst)
+            except MissingColumnError:
+                if inst == 0:
+                    raise
+                break
+            _imu(run, df, inst)
+        if not run.fits:
+            raise ThermocalInputError(f"{log}: no IMU with a usable temperature in the log")
+        run.gates.extend(step_warnings(run.fits, run.series))
+        warn_gates(run.gates)
+        out_set.commit(calibration_of(run.fits), PARAMS_NAME, run.params.text())
+    notes = list(run.params.notes)
+    found = [k for k, h in run.hygiene.items() if h["active_tcal_removed"]]
+    if found:
+        notes.append(
+            "active INS_TCAL coefficients found in the log and removed from the data before "
+            "fitting (the firmware had subtracted them): " + ", ".join(found)
+        )
+    if run.orientation:
+        notes.append(
+            f"AHRS_ORIENTATION {run.orientation} ({AP_ROTATIONS[run.orientation]}): the data "
+            "were rotated back to the sensor frame before fitting"
+        )
+    return ArdupilotTempcalResult(
+        log, output / PARAMS_NAME, output / "calibration.json", tuple(out_set.reports),
+        tuple(run.fits), tuple(notes), run.orientation, run.hygiene,
+    )  # fmt: skip
+
+
+def _imu_temperature(run: _Run, df: Any, inst: int) -> FloatArray | None:
+    """The temperature of IMU ``inst`` [°C] (field ``T``, ``Temp`` in Copter 3.4–3.6;
+    refused when neither is there); None, with a warning, when it is all 0 or NaN."""
+    tcol = next((c for c in ("T", "Temp") if c in df.columns), None)
+    if tcol is None:  # LogStructure.h: ``T`` (``Temp`` in Copter 3.4–3.6)
+        raise ThermocalInputError(
+            f"{run.log}: IMU.{inst} has no temperature field (T or Temp); it has: "
+            + ", ".join(map(str, df.columns))
+        )
+    require_fields(df, [f"{p}{a}" for p in ("Gyr", "Acc") for a in "XYZ"], run.log, f"IMU.{inst}")
+    temp_c: FloatArray = df[tcol].to_numpy()
+    if not np.isfinite(temp_c).any() or np.all(temp_c[np.isfinite(temp_c)] == 0):
+        warnings.warn(
+            GateWarning(
+                f"{run.log}: IMU.{inst} left out: its temperature is all 0 or NaN (a sensor "
+                "without a thermometer cannot be calibrated over temperature)"
+            ),
+            stacklevel=3,
+        )
+        return None
+    return temp_c
+
+
+def _imu(run: _Run, df: Any, inst: int) -> None:
+    """One IMU: its gyro and accelerometer back to the sensor frame (:func:`ardupilot_raw`)
+    and through the pipeline, its ``INS_TCAL<n>`` parameters, hygiene, gates and reports."""
+    from thermocal.export.params import export_params
+
+    temp_c = _imu_temperature(run, df, inst)
+    if temp_c is None:
+        return
+    time_s = df["TimeUS"].to_numpy() * 1e-6
+    run.gates.append(stall_warning(f"IMU.{inst}", time_s, temp_c))
+    per_kind: list[tuple[SensorFit, Recording]] = []
+    for kind, prefix, unit in KINDS:
+        xyz = np.column_stack([df[f"{prefix}{a.upper()}"].to_numpy() for a in AXES])
+        xyz, active, run.orientation = ardupilot_raw(run.dlog.params, inst, kind, temp_c, xyz)
+        hyg = run.hygiene.setdefault(f"IMU.{inst}", {"active_tcal_removed": active is not None})
+        if active is not None:
+            hyg.update(tmin_c=active.tmin_c, tmax_c=active.tmax_c, caltemp_c=active.caltemp_c)
+        sub_rec = Recording.from_arrays(
+            time_s, {a: xyz[:, j] for j, a in enumerate(AXES)},
+            {"temperature": temp_c}, signal_unit=unit,
+        )  # fmt: skip
+        sub_rec.source = str(run.log)
+        sub_rec.validate()
+        fit = fit_sensor(
+            sub_rec, f"IMU.{prefix}", kind, inst, overrides=run.overrides, firmware="ardupilot"
+        )
+        run.fits.append(fit)
+        per_kind.append((fit, sub_rec))
+        run.series[f"{fit.topic}.{inst}"] = (
+            time_s, np.column_stack([sub_rec.signal(a)[0] for a in AXES])
+        )  # fmt: skip
+    sub = Calibration([ch for f, _r in per_kind for ch in f.channels])
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        ps = export_params(sub, "ardupilot", instance=inst)
+    run.params.merge(ps, f"IMU.{inst}")
+    _hygiene_and_gates(run, inst, ps)
+    for fit, sub_rec in per_kind:
+        run.out_set.report(
+            f"report_IMU_{inst}_{fit.kind}.html",
+            ReportRequest(
+                calibration=Calibration(fit.channels), recording=sub_rec,
+                recording_path=str(run.log), title=f"ArduPilot thermal calibration — IMU {inst} "
+                f"{fit.kind}", generated_by="thermocal ardupilot-tempcal",
+                notes=tuple(f"Firmware: {n}" for n in ps.notes),
+            ),
+        )  # fmt: skip
+
+
+def _hygiene_and_gates(run: _Run, inst: int, ps: Any) -> None:
+    """IMU ``inst``'s coefficients in the log (old) beside the new ones, and the gate of a
+    ``CALTEMP`` too close to the calibrated range's ends."""
+    hyg = run.hygiene[f"IMU.{inst}"]
+    old_coef = {n: run.dlog.params[n] for n in ps.params if n in run.dlog.params}
+    hyg["coefficients"] = {
+        n: {"old": old_coef.get(n), "new": float(v)}
+        for n, v in ps.params.items() if "_ACC" in n or "_GYR" in n
+    }  # fmt: skip
+    for kind in ("accel", "gyro"):
+        ref = hyg.get("caltemp_c", {}).get(kind)
+        if ref is not None:
+            lo_c, hi_c = (
+                ps.params[f"INS_TCAL{inst + 1}_TMIN"],
+                ps.params[f"INS_TCAL{inst + 1}_TMAX"],
+            )
+            run.gates.append(end_warning(f"IMU.{inst}", f"{kind} CALTEMP", ref, lo_c, hi_c))
+
+
+__all__ = [
+    "AP_ROTATIONS",
+    "AP_TREF_C",
+    "ActiveTcal",
+    "ArdupilotTempcalResult",
+    "ardupilot_active",
+    "ardupilot_raw",
+    "ardupilot_rotation",
+    "ardupilot_tempcal",
+]

@@ -1,0 +1,287 @@
+"""The turntable at the file layer's edge: ``thermocal turntable FILE...`` as one library call.
+
+One run (:func:`turntable_calibration` with one file): the gyro triad's bias, scale factor
+and misalignment (SPEC §7, :func:`thermocal.turntable.calibrate.calibrate`), written as the
+result JSON.  Several runs at soak temperatures (issue 19): each run calibrated alone, then
+every parameter of each triad as a polynomial in temperature
+(:func:`thermocal.turntable.thermal.fit_triad`), judged first
+(:mod:`thermocal.adequacy`) and written as a calibration of triads that ``compensate``
+applies.  Every run is read by :func:`thermocal.readers.read_recording` with the same
+options as every other command (text logs, ULog/DataFlash topics).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from thermocal import adequacy, units
+from thermocal.errors import ThermocalInputError
+from thermocal.readers.text import TextOptions
+from thermocal.recording import Recording
+from thermocal.turntable import thermal as _thermal
+from thermocal.turntable.calibrate import TurntableResult, calibrate
+
+MIN_POSITIONS_OF_A_SOAK = 12
+"""A soak run missing a few of the sixteen positions is still used (with a warning): twelve
+distinct attitudes still separate the twelve parameters of each triad."""
+
+
+@dataclass(frozen=True)
+class TurntableOptions:
+    """What every run of the command is read and calibrated with: the columns (gyro x, y, z;
+    accelerometer x, y, z or None; the temperature or None; encoders α, β), their units
+    (None: the file's, by :func:`thermocal.units.resolve_unit`), the latitude [°], gravity
+    [m/s²], angle random walk [°/√h], encoder noise [″], shortest dwell [s], channels (2 or
+    3), and how the file is read (time column and unit, text-log options, log topic)."""
+
+    gyro: tuple[str, str, str]
+    accel: tuple[str, str, str] | None = None
+    temps: str | None = None
+    latitude: float | None = None
+    time: str | None = "time"
+    time_unit: str | None = None
+    gyro_unit: str | None = None
+    accel_unit: str | None = None
+    gravity: float | None = None
+    alpha: str = "alpha_deg"
+    beta: str = "beta_deg"
+    encoder_unit: str | None = None
+    arw: float | None = None
+    encoder_noise: float | None = None
+    min_dwell: float = 60.0
+    channels: int = 3
+    text: TextOptions | None = None
+    topic: str | None = None
+
+
+def check_order(order: int) -> None:
+    """Refuse (exit 2) a ``--order`` outside 0 … :data:`thermocal.turntable.thermal.MAX_ORDER`
+    (3: a cubic in temperature per parameter, the most a few soaks can support; the number of
+    soaks limits it further once the runs are read) before any file is read: typer parses an
+    order of 10²⁰ as a Python int."""
+    if not 0 <= order <= _thermal.MAX_ORDER:
+        shown = (
+            str(order)
+            if len(str(order)) <= 24
+            else f"{str(order)[:20]}… ({len(str(order))} digits)"
+        )
+        raise ThermocalInputError(
+            f"--order must be between 0 and {_thermal.MAX_ORDER}, got {shown}"
+        )
+
+
+def read_run(path: Path, o: TurntableOptions) -> Recording:
+    """Read one run (:func:`thermocal.readers.read_recording`).  The gyro columns' unit goes
+    through the shared resolver: --gyro-unit > file metadata > unit in the column name > °/s
+    (INTERFACE: gyro_z in °/s), the last stated in a warning."""
+    from thermocal.readers.dispatch import read_recording
+
+    return read_recording(
+        path,
+        time=o.time,
+        time_unit=o.time_unit,
+        signals=list(o.gyro),
+        signal_unit=o.gyro_unit,
+        temperatures=[o.temps] if o.temps else None,
+        model=units.StatedUnits(signal_default="deg/s"),
+        text=o.text,
+        topic=o.topic,
+    )
+
+
+def calibrate_run(
+    path: Path, o: TurntableOptions, *, min_positions: int
+) -> tuple[Recording, TurntableResult]:
+    """Read one run and calibrate it (:func:`thermocal.turntable.calibrate.calibrate`)."""
+    rec = read_run(path, o)
+    res = calibrate(
+        rec,
+        o.latitude,
+        gyro_columns=o.gyro,
+        alpha_column=o.alpha,
+        beta_column=o.beta,
+        gyro_unit=o.gyro_unit,
+        encoder_unit=o.encoder_unit,
+        arw_deg_sqrt_h=o.arw,
+        encoder_noise_arcsec=o.encoder_noise,
+        min_dwell_s=o.min_dwell,
+        channels=o.channels,
+        accel_columns=o.accel,
+        accel_unit=o.accel_unit,
+        gravity_m_s2=o.gravity,
+        temperature_column=o.temps,
+        min_positions=min_positions,
+    )
+    return rec, res
+
+
+@dataclass(frozen=True)
+class SingleRunResult:
+    """One run's calibration (:class:`~thermocal.turntable.calibrate.TurntableResult`), the
+    file it came from and the result JSON written."""
+
+    input: Path
+    output: Path
+    result: TurntableResult
+
+    def to_dict(self) -> dict[str, Any]:
+        """The result JSON (INTERFACE.md), with ``input``."""
+        out: dict[str, Any] = self.result.to_dict()
+        out["input"] = str(self.input)
+        return out
+
+
+def triad_summary(tri: _thermal.TriadThermal) -> dict[str, object]:
+    """The JSON of one triad's temperature model (INTERFACE.md: tref_c, order, coefficients
+    with _sigma, loto_rms)."""
+    return {
+        "tref_c": tri.tref_c,
+        "order": tri.order,
+        "temperature_range_c": [tri.t_lo_c, tri.t_hi_c],
+        "parameters": {
+            f.name: {
+                "unit": f.unit,
+                "coefficients": f.coef.tolist(),
+                "coefficients_sigma": f.sigma.tolist(),
+                "loto_rms": f.loto_rms,
+            }
+            for f in tri.fits
+        },
+    }
+
+
+@dataclass(frozen=True)
+class ThermalRunsResult:
+    """Several soak runs' calibration: each run's result, the triads' temperature models
+    (``accel`` None without accelerometer columns), the adequacy record of the soaks and the
+    calibration file written."""
+
+    output: Path
+    runs: tuple[tuple[Path, TurntableResult], ...]
+    gyro: _thermal.TriadThermal
+    accel: _thermal.TriadThermal | None
+    adequacy: dict[str, Any]
+
+    def to_dict(self) -> dict[str, Any]:
+        """The JSON of ``turntable --temps`` with several runs (INTERFACE.md)."""
+        out: dict[str, Any] = {
+            "output": str(self.output),
+            "format": "thermocal-calibration",
+            "runs": [{"input": str(f), **r.to_dict()} for f, r in self.runs],
+            "gyro": triad_summary(self.gyro),
+            "adequacy": self.adequacy,
+        }
+        if self.accel is not None:
+            out["accel"] = triad_summary(self.accel)
+        return out
+
+
+def turntable_calibration(
+    files: Sequence[Path],
+    output: Path,
+    opts: TurntableOptions,
+    *,
+    order: int | None = None,
+    tref_c: float | None = None,
+    overrides: tuple[str, ...] = (),
+) -> SingleRunResult | ThermalRunsResult:
+    """``thermocal turntable``: one run → :class:`SingleRunResult` (the result JSON written
+    to ``output``); several runs, or one with ``opts.temps`` and ``order``/``tref_c`` →
+    :class:`ThermalRunsResult` (the calibration written to ``output``, :func:`thermal_runs`).
+    Refuses (exit 2) an output that is an input, an order outside 0…3, several runs without
+    a temperature column, and ``order``/``tref_c`` for one run."""
+    from thermocal.writers import check_not_input, write_json
+
+    if order is not None:
+        check_order(order)
+    check_not_input(output, list(files))
+    if len(files) > 1 or (opts.temps is not None and (order is not None or tref_c is not None)):
+        if opts.temps is None:
+            raise ThermocalInputError(
+                "several runs: name their temperature column with --temps (one run per soak)"
+            )
+        return thermal_runs(files, output, opts, order, tref_c, overrides)
+    if order is not None or tref_c is not None:
+        raise ThermocalInputError("--order and --tref need several runs and --temps")
+    _rec, result = calibrate_run(files[0], opts, min_positions=16)
+    single = SingleRunResult(files[0], output, result)
+    write_json(output, single.to_dict())
+    return single
+
+
+def thermal_runs(
+    files: Sequence[Path],
+    output: Path,
+    opts: TurntableOptions,
+    order: int | None,
+    tref_c: float | None,
+    overrides: tuple[str, ...] = (),
+) -> ThermalRunsResult:
+    """Each run calibrated alone (at least :data:`MIN_POSITIONS_OF_A_SOAK` positions), then
+    every parameter of each triad as a polynomial in temperature about ``tref_c`` [°C]
+    (:func:`thermocal.turntable.thermal.fit_triad`); writes a calibration of triads.  The
+    soak temperatures are judged first (:func:`thermocal.adequacy.temperature_tests`: span
+    and distinct soaks for the order asked, 1 when the order is chosen per parameter)."""
+    from thermocal.models.calibration import Calibration, Triad
+    from thermocal.models.files import save_calibration
+
+    if output.suffix.lower() != ".json":
+        raise ThermocalInputError(f"{output}: the calibration is JSON; use a .json name")
+    runs, gyro_unit, accel_unit = _soak_runs(files, opts)
+    temps_c = [float(r.temperature_c) for _f, r in runs]  # type: ignore[arg-type]
+    judged = adequacy.Adequacy(
+        tuple(
+            adequacy.temperature_tests(
+                np.asarray(temps_c, dtype=np.float64), "the soak temperatures", order or 1
+            )
+        ),
+        overrides,
+    )
+    record = judged.enforce().to_dict()
+    rig, temps = (opts.alpha, opts.beta), str(opts.temps)
+    latitude = runs[0][1].latitude_deg  # as used (the option or the files' metadata)
+    gyro_model = _thermal.fit_triad(
+        "gyro", temps_c, [r.kalman.theta for _f, r in runs], [r.kalman.sigma for _f, r in runs],
+        tref_c=tref_c, order=order,
+    )  # fmt: skip
+    triads = [Triad("gyro", opts.gyro, gyro_unit, temps, gyro_model, rig, latitude, record)]
+    accel_model = None
+    if opts.accel is not None:
+        accel_model = _thermal.fit_triad(
+            "accel", temps_c,
+            [r.accel.theta for _f, r in runs if r.accel is not None],
+            [r.accel.sigma for _f, r in runs if r.accel is not None],
+            tref_c=gyro_model.tref_c, order=order,
+        )  # fmt: skip
+        triads.append(
+            Triad("accel", opts.accel, str(accel_unit), temps, accel_model, rig, latitude, record)
+        )
+    save_calibration(Calibration([], triads), output)
+    return ThermalRunsResult(output, tuple(runs), gyro_model, accel_model, record)
+
+
+def _soak_runs(
+    files: Sequence[Path], opts: TurntableOptions
+) -> tuple[list[tuple[Path, TurntableResult]], str, str | None]:
+    """Every soak run calibrated alone; (runs, the gyro unit, the accelerometer unit or
+    None), refusing runs whose columns differ in unit."""
+    runs = []
+    gyro_units: set[str] = set()
+    accel_units: set[str] = set()
+    for f in files:
+        rec, res = calibrate_run(f, opts, min_positions=MIN_POSITIONS_OF_A_SOAK)
+        gyro_units |= {rec.units[c] for c in opts.gyro}  # resolved by read_recording
+        if opts.accel is not None:
+            accel_units |= (
+                {opts.accel_unit} if opts.accel_unit else {rec.units[c] for c in opts.accel}
+            )
+        runs.append((f, res))
+    for what, found in (("gyro", gyro_units), ("accelerometer", accel_units)):
+        if len(found) > 1:
+            raise ThermocalInputError(f"the runs' {what} columns differ in unit: {sorted(found)}")
+    return runs, gyro_units.pop(), (accel_units.pop() if accel_units else None)
