@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from thermocal.cli import main
-from thermocal.cli.fit_cmd import build_model
+from thermocal.pipeline.fit import build_model
 from thermocal.errors import ThermocalInputError
 from thermocal.models import load_model
 from thermocal.models.base import MODEL_REGISTRY
