@@ -6,6 +6,7 @@ warnings and writes the same JSON without running the command line."""
 from __future__ import annotations
 
 import dataclasses
+import errno
 import json
 import math
 import warnings
@@ -14,7 +15,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from thermocal._lazy import LazyModule
-from thermocal.errors import ThermocalWarning
+from thermocal.errors import ThermocalInputError, ThermocalWarning
 
 if TYPE_CHECKING:
     import numpy as np
@@ -70,4 +71,41 @@ def warning_lines(caught: Iterable[warnings.WarningMessage]) -> list[str]:
     return out
 
 
-__all__ = ["json_text", "jsonable", "one_line", "warning_lines"]
+USER_OS_ERRORS: frozenset[int] = frozenset(
+    {
+        errno.EACCES,
+        errno.EPERM,
+        errno.EROFS,
+        errno.ENOSPC,
+        errno.EDQUOT,
+        errno.ENAMETOOLONG,
+        errno.ENOTDIR,
+        errno.EISDIR,
+        errno.ENOENT,
+        errno.EEXIST,
+        errno.EMFILE,
+    }
+)
+"""OS errors a user causes (exit 2 with ``error:``), as opposed to bugs (exit 1)."""
+
+
+def error_text(exc: Exception) -> tuple[str, bool]:
+    """The text of the ``error:`` line the command line prints for ``exc`` and whether it is
+    the user's (exit 2: bad input, a missing file, permissions, a full disk) rather than
+    thermocal's own failure (exit 1, ``internal: TYPE: message``)."""
+    if isinstance(exc, ThermocalInputError | FileNotFoundError | IsADirectoryError):
+        return one_line(exc), True
+    if isinstance(exc, OSError) and exc.errno in USER_OS_ERRORS:
+        where = exc.filename if exc.filename is not None else "output"
+        return f"{where}: {exc.strerror or one_line(exc)}", True
+    return f"internal: {type(exc).__name__}: {one_line(exc)}", False
+
+
+__all__ = [
+    "USER_OS_ERRORS",
+    "error_text",
+    "json_text",
+    "jsonable",
+    "one_line",
+    "warning_lines",
+]
