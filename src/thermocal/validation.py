@@ -52,6 +52,7 @@ from __future__ import annotations
 import dataclasses
 import math
 import warnings
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -328,6 +329,163 @@ def run_rms_and_peak_to_peak(
 # --- validation -----------------------------------------------------------------------------
 
 
+def _correlation(
+    modeling_ambient: tuple[npt.ArrayLike, npt.ArrayLike] | None,
+    t: FloatArray,
+    amb: FloatArray,
+    r_limit: float,
+    note: Callable[[str, type[Warning]], None],
+) -> tuple[float | None, bool | None]:
+    """Step 1: ``(r, weakly_correlated)`` of the ambient histories (None, None without a
+    modelling history or when r is undefined), the warnings given to ``note``."""
+    r: float | None = None
+    weak: bool | None = None
+    if modeling_ambient is None:
+        note(
+            "no modelling-test temperature history: the correlation r was not computed (null)",
+            CorrelationWarning,
+        )
+        return r, weak
+    try:
+        cr = correlate(modeling_ambient[0], modeling_ambient[1], t, amb, r_limit=r_limit)
+    except TimestampError:
+        raise
+    except ThermocalInputError as exc:  # e.g. a constant history: r undefined
+        note(f"the correlation r could not be computed: {exc}", CorrelationWarning)
+    else:
+        r, weak = cr.r, cr.weakly_correlated
+    if weak is False:
+        note(
+            f"the validation test is not weakly correlated with the modelling test: "
+            f"r = {r:.3f} ≥ {r_limit}",
+            CorrelationWarning,
+        )
+    return r, weak
+
+
+def _stages(
+    t: FloatArray,
+    amb: FloatArray,
+    before: FloatArray,
+    after: FloatArray,
+    averaging_s: float,
+    tau0: float,
+    holds: tuple[float, float, float],
+) -> list[StageFigures]:
+    """Step 3: the figures of each hold stage of ``amb`` (``holds``: rate threshold
+    [°C/min], shortest stage [s], settling cut [s]; :func:`segment_holds`)."""
+    rate, min_s, settle = holds
+    segs = segment_holds(
+        t, amb, rate_threshold_c_per_min=rate, min_duration_s=min_s, settle_s=settle
+    )
+    stages: list[StageFigures] = []
+    for i, s in enumerate(g for g in segs if g.kind == "hold"):
+        sl = s.slice
+        ts = t[sl]
+        mb = block_means(ts, before[sl], averaging_s, tau0)
+        ma = block_means(ts, after[sl], averaging_s, tau0)
+        stages.append(
+            StageFigures(
+                index=i,
+                start_s=s.start_s,
+                stop_s=s.stop_s,
+                mean_temp_c=s.mean_temp_c,
+                n_samples=int(ts.size),
+                n_averages=int(mb.size),
+                bias_before=metrics.bias(before[sl]),
+                bias_after=metrics.bias(after[sl]),
+                bias_stability_before=stability_of_means(mb),
+                bias_stability_after=stability_of_means(ma),
+            )
+        )
+    return stages
+
+
+def _stage_notes(
+    stages: list[StageFigures],
+    averaging_s: float,
+    rate_threshold_c_per_min: float,
+    min_stage_s: float,
+    note: Callable[[str, type[Warning]], None],
+) -> None:
+    """The warnings on the hold stages: fewer than two, or stages too short to average."""
+    if len(stages) < 2:
+        note(
+            f"{len(stages)} temperature-hold stage(s) found (|Ṫ| < {rate_threshold_c_per_min} "
+            f"°C/min for ≥ {min_stage_s:g} s): bias repeatability needs at least 2",
+            ThermocalWarning,
+        )
+    short = [s.index for s in stages if s.n_averages < 2]
+    if short:
+        note(
+            f"stage(s) {', '.join(map(str, short))} hold fewer than 2 averages of "
+            f"{averaging_s:g} s: left out of the bias stability",
+            ThermocalWarning,
+        )
+
+
+def _absolute(
+    before: FloatArray,
+    after: FloatArray,
+    ref: float,
+    where: str,
+    display_unit: tuple[str, float],
+    note: Callable[[str, type[Warning]], None],
+) -> tuple[AbsoluteFigures, AbsoluteFigures, list[str]]:
+    """Step 6: the per-sample figures about ``ref`` before and after, and those made worse
+    (a warning in ``display_unit``, ``(unit, factor)``)."""
+    abs_b = absolute_figures(before, ref)
+    abs_a = absolute_figures(after, ref)
+    worse = absolute_error_worse(abs_b, abs_a)
+    if worse:
+        du, k = display_unit
+        shown = [AbsoluteFigures(a.mean / k, a.rms_about_zero / k, a.max_abs / k)
+                 for a in (abs_b, abs_a)]  # fmt: skip
+        note(absolute_worse_message(where, du, shown[0], shown[1], worse), ThermocalWarning)
+    return abs_b, abs_a, list(worse)
+
+
+def _compensated(
+    model: TemperatureModel,
+    run: RunData,
+    extrapolate: bool,
+    where: str,
+    note: Callable[[str, type[Warning]], None],
+) -> tuple[FloatArray, tuple[RangeExcess, ...]]:
+    """Step 2: the compensated signal and how far the run leaves the calibrated ranges
+    (step 7: one warning with the figures, in place of the model's own range warnings)."""
+    with warnings.catch_warnings():
+        for pattern in RANGE_WARNING_PATTERNS:
+            warnings.filterwarnings("ignore", pattern, ExtrapolationWarning)
+        comp = compensate_run(model, run, extrapolate=extrapolate)
+    excess = outside_range(model, run.time_s, run.temps_c)
+    msg = outside_range_message(excess, where, extrapolate=extrapolate)
+    if msg:
+        note(msg, ExtrapolationWarning)
+    return comp.corrected, excess
+
+
+def _inputs(
+    run: RunData, validation_ambient: npt.ArrayLike | None, averaging_s: float
+) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """The run's time [s], ambient temperature [°C] (default its first temperature
+    column) and signal, checked: a signal, a positive averaging time, one ambient value
+    per sample."""
+    if run.signal is None:
+        raise ThermocalInputError(f"{run.name or 'validation run'}: no signal")
+    if not averaging_s > 0:
+        raise ThermocalInputError(f"averaging time must be positive, got {averaging_s}")
+    t = run.time_s
+    amb = (
+        run.temps_c[:, 0]
+        if validation_ambient is None
+        else np.asarray(validation_ambient, dtype=np.float64)
+    )
+    if amb.shape != t.shape:
+        raise ThermocalInputError("validation ambient temperature and time differ in length")
+    return t, amb, run.signal
+
+
 def validate(
     model: TemperatureModel,
     run_validation: RunData,
@@ -372,18 +530,7 @@ def validate(
     ExtrapolationWarning : samples outside the model's calibrated ranges (one warning:
         share and distance per input; replaces the model's own range warnings).
     """
-    if run_validation.signal is None:
-        raise ThermocalInputError(f"{run_validation.name or 'validation run'}: no signal")
-    if not averaging_s > 0:
-        raise ThermocalInputError(f"averaging time must be positive, got {averaging_s}")
-    t = run_validation.time_s
-    amb = (
-        run_validation.temps_c[:, 0]
-        if validation_ambient is None
-        else np.asarray(validation_ambient, dtype=np.float64)
-    )
-    if amb.shape != t.shape:
-        raise ThermocalInputError("validation ambient temperature and time differ in length")
+    t, amb, before = _inputs(run_validation, validation_ambient, averaging_s)
     notes: list[str] = []
 
     def note(msg: str, cat: type[Warning]) -> None:
@@ -391,102 +538,27 @@ def validate(
         warnings.warn(msg, cat, stacklevel=3)
 
     # 1. correlation of the ambient histories
-    r: float | None = None
-    weak: bool | None = None
-    if modeling_ambient is None:
-        note(
-            "no modelling-test temperature history: the correlation r was not computed (null)",
-            CorrelationWarning,
-        )
-    else:
-        try:
-            cr = correlate(modeling_ambient[0], modeling_ambient[1], t, amb, r_limit=r_limit)
-        except TimestampError:
-            raise
-        except ThermocalInputError as exc:  # e.g. a constant history: r undefined
-            note(f"the correlation r could not be computed: {exc}", CorrelationWarning)
-        else:
-            r, weak = cr.r, cr.weakly_correlated
-        if weak is False:
-            note(
-                f"the validation test is not weakly correlated with the modelling test: "
-                f"r = {r:.3f} ≥ {r_limit}",
-                CorrelationWarning,
-            )
+    r, weak = _correlation(modeling_ambient, t, amb, r_limit, note)
 
     # 2. compensation; the model's per-call range warnings give way to one with figures
-    with warnings.catch_warnings():
-        for pattern in RANGE_WARNING_PATTERNS:
-            warnings.filterwarnings("ignore", pattern, ExtrapolationWarning)
-        comp = compensate_run(model, run_validation, extrapolate=extrapolate)
     where = run_validation.name or "validation run"
-    excess = outside_range(model, t, run_validation.temps_c)
-    msg = outside_range_message(excess, where, extrapolate=extrapolate)
-    if msg:
-        note(msg, ExtrapolationWarning)
+    after, excess = _compensated(model, run_validation, extrapolate, where, note)
     tau0 = median_interval(t)
     if not (math.isfinite(tau0) and tau0 > 0):
         raise ThermocalInputError("the validation run needs at least two increasing times")
-    before = run_validation.signal
-    after = comp.corrected
 
     # 3. hold stages
-    segs = [
-        s
-        for s in segment_holds(
-            t,
-            amb,
-            rate_threshold_c_per_min=rate_threshold_c_per_min,
-            min_duration_s=min_stage_s,
-            settle_s=settle_s,
-        )
-        if s.kind == "hold"
-    ]
-    stages: list[StageFigures] = []
-    for i, s in enumerate(segs):
-        sl = s.slice
-        ts = t[sl]
-        mb = block_means(ts, before[sl], averaging_s, tau0)
-        ma = block_means(ts, after[sl], averaging_s, tau0)
-        stages.append(
-            StageFigures(
-                index=i,
-                start_s=s.start_s,
-                stop_s=s.stop_s,
-                mean_temp_c=s.mean_temp_c,
-                n_samples=int(ts.size),
-                n_averages=int(mb.size),
-                bias_before=metrics.bias(before[sl]),
-                bias_after=metrics.bias(after[sl]),
-                bias_stability_before=stability_of_means(mb),
-                bias_stability_after=stability_of_means(ma),
-            )
-        )
-    if len(stages) < 2:
-        note(
-            f"{len(stages)} temperature-hold stage(s) found (|Ṫ| < {rate_threshold_c_per_min} "
-            f"°C/min for ≥ {min_stage_s:g} s): bias repeatability needs at least 2",
-            ThermocalWarning,
-        )
-    short = [s.index for s in stages if s.n_averages < 2]
-    if short:
-        note(
-            f"stage(s) {', '.join(map(str, short))} hold fewer than 2 averages of "
-            f"{averaging_s:g} s: left out of the bias stability",
-            ThermocalWarning,
-        )
+    stages = _stages(
+        t, amb, before, after, averaging_s, tau0, (rate_threshold_c_per_min, min_stage_s, settle_s)
+    )
+    _stage_notes(stages, averaging_s, rate_threshold_c_per_min, min_stage_s, note)
 
     rms_b, ptp_b = run_rms_and_peak_to_peak(t, before, averaging_s, tau0)
     rms_a, ptp_a = run_rms_and_peak_to_peak(t, after, averaging_s, tau0)
     ref, ref_what = zero_reference
-    abs_b = absolute_figures(before, ref)
-    abs_a = absolute_figures(after, ref)
-    worse = absolute_error_worse(abs_b, abs_a)
-    if worse:
-        du, k = display_unit or (model.signal_unit, 1.0)
-        shown = [AbsoluteFigures(a.mean / k, a.rms_about_zero / k, a.max_abs / k)
-                 for a in (abs_b, abs_a)]  # fmt: skip
-        note(absolute_worse_message(where, du, shown[0], shown[1], worse), ThermocalWarning)
+    abs_b, abs_a, worse = _absolute(
+        before, after, ref, where, display_unit or (model.signal_unit, 1.0), note
+    )
     return ValidationResult(
         r=r,
         weakly_correlated=weak,

@@ -29,7 +29,7 @@ import pyarrow as pa
 import pyarrow.parquet as pq
 import pytest
 
-import thermocal.cli.fit_cmd as fit_cmd
+import thermocal.pipeline.fit as fit_cmd
 import thermocal.readers.dispatch as io_mod
 from thermocal.cli import main
 

@@ -11,7 +11,6 @@ INTERFACE.md common rules implemented here:
 
 from __future__ import annotations
 
-import dataclasses
 import errno
 import functools
 import json
@@ -28,16 +27,20 @@ import typer
 
 from thermocal._lazy import LazyModule
 from thermocal.cli.interrupt import report_interrupted
-from thermocal.errors import GapWarning, ThermocalInputError, ThermocalWarning
+from thermocal.errors import ThermocalInputError, ThermocalWarning
+from thermocal.pipeline.messages import jsonable as jsonable
+from thermocal.pipeline.messages import one_line as one_line
+from thermocal.pipeline.messages import warning_lines
+from thermocal.pipeline.reading import load_recording as load_recording
+from thermocal.pipeline.reading import split_floats as split_floats
+from thermocal.pipeline.reading import split_names as split_names
+from thermocal.pipeline.reading import text_options as text_options
 
 if TYPE_CHECKING:
     import numpy as np
     from rich.console import Console
 
     from thermocal import units
-    from thermocal.models.base import TemperatureModel
-    from thermocal.readers.text import TextOptions
-    from thermocal.recording import Metadata, Recording
 else:
     # this module is imported to register commands (``--help``): nothing heavy at import
     np = LazyModule("numpy")
@@ -112,27 +115,6 @@ DecimalOpt = Annotated[
     str | None,
     typer.Option("--decimal", help="Text logs: the decimal mark, . or , (default: detected)."),
 ]
-
-
-def text_options(
-    names: str | None,
-    rate: float | None,
-    on_bad_lines: str,
-    delimiter: str | None,
-    decimal: str | None,
-) -> TextOptions | None:
-    """The text-log options of the command line (None when none is given)."""
-    from thermocal.readers.text import TextOptions
-
-    if names is None and rate is None and on_bad_lines == "error" and not delimiter and not decimal:
-        return None
-    return TextOptions(
-        names=tuple(split_names(names) or []) if names is not None else None,
-        rate_hz=rate,
-        on_bad_lines=on_bad_lines,
-        delimiter=delimiter,
-        decimal=decimal,
-    )
 
 
 TimeUnitOpt = Annotated[str | None, typer.Option("--time-unit", help="Time unit: s, ms or us.")]
@@ -210,162 +192,13 @@ TurntableLatitudeOpt = Annotated[
 OutOpt = Annotated[Path, typer.Option("-o", "--output", help="Output file.")]
 
 
-def split_names(text: str | None) -> list[str] | None:
-    """``"T1, T2,T 3"`` → ``["T1", "T2", "T 3"]`` (None stays None)."""
-    if text is None:
-        return None
-    names = [t.strip() for t in text.split(",")]
-    return [n for n in names if n]
-
-
-def split_floats(text: str | None, what: str) -> list[float] | None:
-    """``"25, 30"`` → ``[25.0, 30.0]`` (None stays None); an input error naming the option
-    ``what`` when an item is not a number."""
-    names = split_names(text)
-    if names is None:
-        return None
-    try:
-        return [float(v) for v in names]
-    except ValueError:
-        raise ThermocalInputError(
-            f"{what}: expected comma-separated numbers, got {text!r}"
-        ) from None
-
-
 def parse_temp_conversion(text: str) -> units.TemperatureConversion:
     """``"0.0625,-50"`` → gain [°C/count] 0.0625, offset [°C] −50; ``"0.0625,-50,int16"``
     for signed 16-bit counts stored unsigned (:class:`thermocal.units.TemperatureConversion`)."""
     return units.temperature_conversion(text, "--temp-conversion")
 
 
-def load_recording(
-    path: Path,
-    *,
-    time: str | None = None,
-    time_unit: str | None = None,
-    signal: str | None = None,
-    temps: str | None = None,
-    signal_unit: str | None = None,
-    temp_unit: str | None = None,
-    meta: Metadata | None = None,
-    require_signal: bool = True,
-    check: bool = True,
-    temp_conversion: str | None = None,
-    model_inputs: dict[str, Any] | None = None,
-    model: TemperatureModel | None = None,
-    keep_other: bool = True,
-    text: TextOptions | None = None,
-    topic: str | None = None,
-) -> Recording:
-    """Read a recording with the command line's options (options win over the file).
-
-    ``keep_other=False`` reads only the time, signal and temperature columns (8 bytes a
-    row less for every other column, for commands that use no other).
-
-    A signal named with ``--signal`` becomes the first signal; without it the
-    file's sidecar roles are used.  With ``require_signal`` a recording with no
-    signal at all is an input error.  With ``check`` (INTERFACE.md common rules)
-    the time column must be finite and strictly increasing and the signal and
-    temperature columns free of NaN (:meth:`Recording.validate`, an input error
-    naming the file, column and row); gaps are allowed and reported as one
-    :class:`GapWarning`.  ``temp_conversion`` (``"GAIN,OFFSET[,int16]"``) sets the raw-count
-    conversion ``T[°C] = GAIN·counts + OFFSET`` of every temperature column.
-    ``model`` (a fitted model; or ``model_inputs``, a model file's ``inputs``) fills in
-    what the options and the file leave unstated: the time unit, column units and
-    temperature conversions as fitted (:meth:`TemperatureModel.input_units`).  Every unit
-    is resolved once, by :func:`thermocal.units.resolve_inputs`.
-    """
-    stated: units.StatedUnits | None = None
-    if model is not None:
-        stated = model.input_units()
-    elif model_inputs is not None:
-        stated = units.StatedUnits.from_model_inputs(model_inputs)
-    from thermocal.readers.dispatch import read_recording
-
-    rec = read_recording(
-        path,
-        time=time,
-        time_unit=time_unit,
-        signals=split_names(signal) if signal else None,  # "gx,gy,gz": several channels
-        temperatures=split_names(temps),
-        signal_unit=signal_unit,
-        temp_unit=temp_unit,
-        meta=meta,
-        temp_conversion=(
-            parse_temp_conversion(temp_conversion) if temp_conversion is not None else None
-        ),
-        model=stated,
-        keep_other=keep_other,
-        text=text,
-        topic=topic,
-    )
-    if model is not None or model_inputs is not None:
-        from thermocal.models.base import check_sensor_id
-
-        fitted = getattr(model, "inputs_", None) if model is not None else model_inputs
-        check_sensor_id(fitted, rec.meta.sensor_id, str(path))
-    if require_signal and not rec.signals:
-        raise ThermocalInputError(
-            f"{path}: name the signal column with --signal; available: "
-            + ", ".join(repr(c) for c in rec.columns)
-        )
-    if check:
-        rec.validate()
-        gaps = rec.gaps()
-        if gaps:
-            total = sum(g.length_s for g in gaps)
-            warnings.warn(
-                GapWarning(
-                    f"{path}: {len(gaps)} gaps in time ({total:.6g} s in all), first after "
-                    f"row {gaps[0].index} at {gaps[0].start_s:.6g} s"
-                ),
-                stacklevel=2,
-            )
-    return rec
-
-
-def earth_rate_known_input(
-    latitude: float | None, axis: str | None, unit: str, where: object
-) -> float:
-    """Earth rate seen by the sensitive axis [°/h], as a known input of a gyro run.
-
-    ``Ω_axis = Ω u·(0, cos φ, sin φ)`` for the unit axis ``u`` in East-North-Up
-    (SPEC §1, :func:`thermocal.units.earth_rate_on_axis_deg_h`); 0 without
-    ``--latitude``/``--axis``.  Both options are needed together and
-    the signal (canonical unit ``unit``) must be a rate: otherwise an input error naming
-    ``where`` (the file).
-    """
-    if latitude is None and axis is None:
-        return 0.0
-    if latitude is None or axis is None:
-        raise ThermocalInputError("earth-rate removal needs both --latitude and --axis")
-    if units.canonical_unit(unit) != "deg/h":
-        raise ThermocalInputError(
-            f"{where}: --latitude/--axis remove the earth rate from a gyro signal; "
-            f"this signal is in {unit}"
-        )
-    return units.earth_rate_on_axis_deg_h(latitude, units.parse_axis(axis))
-
-
-def known_input_what(
-    latitude: float | None, axis: str | None, other: float | None, gravity: str | None = None
-) -> str:
-    """What a fit's known input is, for the model file (``inputs.known_input.what``)."""
-    parts = []
-    if latitude is not None and axis is not None:
-        parts.append(f"earth rate at latitude {latitude:g}° on axis {axis}")
-    if gravity:
-        parts.append(gravity)
-    if other:
-        parts.append(f"--known-input {other:g}")
-    return " + ".join(parts) or "none"
-
-
 # --- errors ----------------------------------------------------------------------------
-
-
-def one_line(text: str) -> str:
-    return " ".join(str(text).split())
 
 
 USER_OS_ERRORS: frozenset[int] = frozenset(
@@ -432,39 +265,12 @@ def handle_errors(fn: Callable[P, R]) -> Callable[P, R]:
 
 
 def _show_warnings(caught: list[warnings.WarningMessage]) -> None:
-    seen: set[str] = set()
-    for w in caught:
-        msg = one_line(str(w.message))
-        if msg in seen:
-            continue
-        seen.add(msg)
-        if issubclass(w.category, ThermocalWarning):
-            print(f"warning: {msg}", file=sys.stderr)
-        elif issubclass(w.category, RuntimeWarning):  # numerical trouble: never hidden
-            print(f"warning: {w.category.__name__}: {msg}", file=sys.stderr)
+    """One ``warning: ...`` line on stderr per message (:func:`warning_lines`)."""
+    for line in warning_lines(caught):
+        print(f"warning: {line}", file=sys.stderr)
 
 
 # --- output -------------------------------------------------------------------------------
-
-
-def jsonable(obj: Any) -> Any:
-    """Convert results to plain JSON types: dataclasses → dicts, numpy → Python,
-    NaN/inf → ``None``."""
-    if dataclasses.is_dataclass(obj) and not isinstance(obj, type):
-        return {f.name: jsonable(getattr(obj, f.name)) for f in dataclasses.fields(obj)}
-    if isinstance(obj, dict):
-        return {str(k): jsonable(v) for k, v in obj.items()}
-    if isinstance(obj, list | tuple):
-        return [jsonable(v) for v in obj]
-    if isinstance(obj, np.ndarray):
-        return jsonable(obj.tolist())
-    if isinstance(obj, np.generic):
-        return jsonable(obj.item())
-    if isinstance(obj, float):
-        return obj if math.isfinite(obj) else None
-    if isinstance(obj, Path):
-        return str(obj)
-    return obj
 
 
 def emit(obj: Any, as_json: bool, human: Callable[[], None] | None = None) -> None:

@@ -43,9 +43,8 @@ and ``DIR/fleet.html`` (:mod:`thermocal.fleet.report`).
 
 from __future__ import annotations
 
-import contextlib
+import dataclasses
 import hashlib
-import io
 import json
 import math
 import os
@@ -55,13 +54,31 @@ import shutil
 import tempfile
 import threading
 import time
-import tomllib
-from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
+import warnings
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any, TypeVar, cast
 
-from thermocal.errors import ThermocalInputError
+from thermocal.errors import ThermocalInputError, ThermocalWarning
+from thermocal.fleet.config import FleetConfig, Limit, UnitSpec, load_config
+from thermocal.fleet.report import write_fleet_report
+from thermocal.fleet.stats import (
+    FIGURES,
+    FIT_FIGURES,
+    OUTLIER_Z,
+    UNITLESS,
+    VALIDATION_FIGURES,
+    convert_unit_label,
+    outliers,
+    robust_z,
+    shown_unit,
+)
+from thermocal.pipeline.messages import error_text, json_text, jsonable, warning_lines
+from thermocal.pipeline.options import FitOptions, ValidateOptions
+
+if TYPE_CHECKING:
+    from multiprocessing.context import BaseContext
 
 UNIT_FILE = "unit.json"
 """Written last in a unit's directory: its presence with ``status: ok`` marks the unit done."""
@@ -72,237 +89,11 @@ SHA-256, figures in the data's unit."""
 CALIBRATION_FILE = "calibration.json"
 VALIDATION_FILE = "validation.json"
 
-FIT_FIGURES = ("rms_residual", "condition_number", "n_coefficients", "n_samples")
-"""Per-channel figures of a fit (``thermocal fit --json``), in the summary."""
-VALIDATION_FIGURES = (
-    "r",
-    "rms_before",
-    "rms_after",
-    "peak_to_peak_before",
-    "peak_to_peak_after",
-    "bias_stability_before",
-    "bias_stability_after",
-    "bias_repeatability_before",
-    "bias_repeatability_after",
-)
-"""Per-channel figures of a validation (``thermocal validate --json``), in the summary."""
-FIGURES = FIT_FIGURES + VALIDATION_FIGURES
-_UNITLESS = frozenset({"r", "condition_number", "n_coefficients", "n_samples"})
-"""Figures without a unit (every other figure is in the channel's data unit)."""
-
-_ID = re.compile(r"^[A-Za-z0-9][A-Za-z0-9._-]{0,127}$")
-
 EXIT_SOME_FAILED = 4
 """Exit status of ``thermocal fleet`` when some unit failed (INTERFACE.md)."""
 
 
 # --- configuration ------------------------------------------------------------------------
-
-
-@dataclass(frozen=True)
-class UnitSpec:
-    """One device of the batch: its id, modelling files and optional validation file
-    (absolute paths)."""
-
-    id: str
-    modeling: tuple[str, ...]
-    validation: str | None = None
-
-
-@dataclass(frozen=True)
-class Limit:
-    """A pass/fail threshold on a figure: ``figure ≤ value`` (``max``) or ``≥`` (``min``),
-    for every channel or for the one named (the figure in that channel's data unit)."""
-
-    figure: str
-    bound: str
-    value: float
-    channel: str | None = None
-
-    def check(self, value: float | None) -> bool:
-        if value is None or not math.isfinite(value):
-            return False
-        return value <= self.value if self.bound == "max" else value >= self.value
-
-    @property
-    def label(self) -> str:
-        where = f"{self.channel}." if self.channel else ""
-        return f"{where}{self.figure} {'≤' if self.bound == 'max' else '≥'} {self.value:g}"
-
-
-@dataclass(frozen=True)
-class FleetConfig:
-    """A parsed fleet configuration (:func:`load_config`)."""
-
-    path: Path
-    fit_args: tuple[str, ...]
-    validate_args: tuple[str, ...]
-    limits: tuple[Limit, ...]
-    units: tuple[UnitSpec, ...]
-    fit_options: dict[str, Any] = field(default_factory=dict)
-
-
-def _click_command(command: str) -> Any:
-    """The command line's own parser of ``thermocal <command>``."""
-    import typer
-
-    from thermocal.cli import COMMANDS, _register
-    from thermocal.cli.application import app
-
-    _register((COMMANDS[command],))
-    return typer.main.get_command(app).commands[command]  # type: ignore[attr-defined]
-
-
-_PLACEHOLDERS = {"fit": ["FILE", "-o", "CAL.json"], "validate": ["CAL.json", "FILE"]}
-
-
-def check_args(command: str, args: Sequence[str], where: str) -> None:
-    """Parse ``thermocal <command> ARGS`` with the command's own parser (placeholders for
-    its files), so that a value of the wrong type is a configuration error now rather than
-    the same failure in every unit."""
-    from thermocal.cli import _USAGE_ERRORS
-
-    cmd = _click_command(command)
-    try:
-        cmd.make_context(command, [*_PLACEHOLDERS[command], *args])
-    except _USAGE_ERRORS as exc:
-        text = str(getattr(exc, "format_message", exc.__str__)())
-        raise ThermocalInputError(f"{where}: {' '.join(text.split())}") from None
-
-
-def _command_options(command: str) -> dict[str, bool]:
-    """The long options of a ``thermocal`` command: name → is a flag."""
-    params = _click_command(command).params
-    out: dict[str, bool] = {}
-    for p in params:
-        for opt in getattr(p, "opts", []):
-            if opt.startswith("--"):
-                out[opt[2:]] = bool(getattr(p, "is_flag", False))
-    return out
-
-
-def options_to_args(table: Mapping[str, Any], command: str, where: str) -> list[str]:
-    """``{"model": "poly", "order": 2, "signal": ["gx", "gy"], "select": true}`` →
-    ``["--model", "poly", "--order", "2", "--signal", "gx,gy", "--select"]`` for
-    ``thermocal <command>``; an unknown option or a value of the wrong shape is a
-    configuration error naming it (``where``: the table)."""
-    known = _command_options(command)
-    refused = {"output", "json", "help", "modeling"}
-    args: list[str] = []
-    for key, value in table.items():
-        name = str(key).replace("_", "-")
-        if name not in known or name in refused:
-            usable = ", ".join(sorted(k for k in known if k not in refused))
-            raise ThermocalInputError(
-                f"{where}: {key!r} is not an option of thermocal {command}; it takes {usable}"
-            )
-        if known[name]:
-            if not isinstance(value, bool):
-                raise ThermocalInputError(f"{where}: {key} is a flag: write true or false")
-            if value:
-                args.append(f"--{name}")
-            continue
-        if isinstance(value, list):
-            if not value or not all(isinstance(v, str | int | float) for v in value):
-                raise ThermocalInputError(f"{where}: {key}: expected a list of names or numbers")
-            text = ",".join(str(v) for v in value)
-        elif isinstance(value, str | int | float) and not isinstance(value, bool):
-            text = str(value)
-        else:
-            raise ThermocalInputError(f"{where}: {key}: expected a string, number or list")
-        args += [f"--{name}", text]
-    check_args(command, args, where)
-    return args
-
-
-def _limits(table: Mapping[str, Any], where: str, channel: str | None = None) -> list[Limit]:
-    out: list[Limit] = []
-    for key, value in table.items():
-        if isinstance(value, Mapping) and channel is None:  # [limits.<channel>]
-            out += _limits(value, f"{where}.{key}", channel=str(key))
-            continue
-        m = re.fullmatch(r"(.+)_(max|min)", str(key))
-        if m is None or m.group(1) not in FIGURES:
-            raise ThermocalInputError(
-                f"{where}: {key!r} is not a limit; write <figure>_max or <figure>_min with a "
-                f"figure among {', '.join(FIGURES)}"
-            )
-        if isinstance(value, bool) or not isinstance(value, int | float):
-            raise ThermocalInputError(f"{where}: {key}: expected a number")
-        out.append(Limit(m.group(1), m.group(2), float(value), channel))
-    return out
-
-
-def load_config(path: str | Path) -> FleetConfig:
-    """Read and check a fleet configuration (module docstring).  Every error is a
-    :class:`ThermocalInputError` naming the file and the entry (``thermocal fleet`` exits 2);
-    a missing data file is not one: that unit fails and the others go on."""
-    p = Path(path)
-    try:
-        doc = tomllib.loads(p.read_text(encoding="utf-8"))
-    except FileNotFoundError:
-        raise ThermocalInputError(f"{p}: no such configuration file") from None
-    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
-        raise ThermocalInputError(f"{p}: not a valid TOML file ({exc})") from None
-    unknown = sorted(set(doc) - {"fit", "validate", "limits", "unit"})
-    if unknown:
-        raise ThermocalInputError(
-            f"{p}: unknown table(s) {', '.join(unknown)}; use fit, validate, limits, unit"
-        )
-    fit = doc.get("fit", {})
-    if not isinstance(fit, dict) or not fit:
-        raise ThermocalInputError(f"{p}: a [fit] table with the options of thermocal fit is needed")
-    fit_args = options_to_args(fit, "fit", f"{p} [fit]")
-    val_table = doc.get("validate", {})
-    if not isinstance(val_table, dict):
-        raise ThermocalInputError(f"{p}: [validate] must be a table")
-    validate_args = options_to_args(val_table, "validate", f"{p} [validate]")
-    lim_table = doc.get("limits", {})
-    if not isinstance(lim_table, dict):
-        raise ThermocalInputError(f"{p}: [limits] must be a table")
-    limits = _limits(lim_table, f"{p} [limits]")
-    raw_units = doc.get("unit", [])
-    if not isinstance(raw_units, list) or not raw_units:
-        raise ThermocalInputError(f"{p}: no [[unit]] entries")
-    base = p.resolve().parent
-    units: list[UnitSpec] = []
-    seen: set[str] = set()
-    for i, u in enumerate(raw_units, start=1):
-        where = f"{p} [[unit]] #{i}"
-        if not isinstance(u, dict):
-            raise ThermocalInputError(f"{where}: must be a table")
-        extra = sorted(set(u) - {"id", "modeling", "validation"})
-        if extra:
-            raise ThermocalInputError(
-                f"{where}: unknown key(s) {', '.join(extra)}; use id, modeling, validation"
-            )
-        uid = u.get("id")
-        if not isinstance(uid, str) or not _ID.match(uid):
-            raise ThermocalInputError(
-                f"{where}: id must be letters, digits, '.', '_' or '-' (it names a directory), "
-                f"got {uid!r}"
-            )
-        if uid in seen:
-            raise ThermocalInputError(f"{where}: id {uid!r} is used twice")
-        seen.add(uid)
-        mod = u.get("modeling")
-        if isinstance(mod, str):
-            mod = [mod]
-        if not isinstance(mod, list) or not mod or not all(isinstance(m, str) for m in mod):
-            raise ThermocalInputError(
-                f"{where} ({uid}): modeling must be a file or a list of files"
-            )
-        val = u.get("validation")
-        if val is not None and not isinstance(val, str):
-            raise ThermocalInputError(f"{where} ({uid}): validation must be one file")
-        units.append(
-            UnitSpec(
-                uid,
-                tuple(str(base / m) for m in mod),
-                str(base / val) if val is not None else None,
-            )
-        )
-    return FleetConfig(p, tuple(fit_args), tuple(validate_args), tuple(limits), tuple(units), fit)
 
 
 # --- one unit -----------------------------------------------------------------------------
@@ -313,14 +104,14 @@ class UnitTask:
     """What a worker needs for one unit (plain data: it travels to Dask workers)."""
 
     unit: UnitSpec
-    fit_args: tuple[str, ...]
-    validate_args: tuple[str, ...]
+    fit: FitOptions
+    validate: ValidateOptions
 
 
 @dataclass
 class UnitOutcome:
-    """What a worker hands back for one unit: status, error, warnings, the command outputs
-    (``fit`` and ``validation``, as ``--json`` prints them), the files' bytes, seconds."""
+    """What a worker hands back for one unit: status, error, warnings, the results (``fit``
+    and ``validation``, as ``--json`` prints them), the files' bytes, seconds."""
 
     id: str
     status: str
@@ -335,70 +126,67 @@ class UnitOutcome:
     """Per channel, in the channel's data unit (:func:`channel_figures`)."""
 
 
-_CLI_LOCK = threading.Lock()
-"""A unit redirects the process's stdout and stderr while its commands run: units of one
-process (a Dask worker with several threads) take turns."""
+_CAPTURE_LOCK = threading.Lock()
+"""A unit records the warnings of its fit and validation (:func:`warnings.catch_warnings`
+changes the whole process's warning state): units of one process (a Dask worker with several
+threads) take turns."""
+
+T = TypeVar("T")
 
 
-def _run_cli(args: Sequence[str]) -> tuple[int, str, str]:
-    """``thermocal ARGS`` in this process: (exit status, stdout, stderr)."""
-    from thermocal.cli import main
-
-    out, err = io.StringIO(), io.StringIO()
-    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
-        code = main(list(args))
-    return code, out.getvalue(), err.getvalue()
-
-
-def _messages(stderr: str, prefix: str) -> list[str]:
-    return [line[len(prefix) :].strip() for line in stderr.splitlines() if line.startswith(prefix)]
-
-
-def _failure(stderr: str, code: int, what: str) -> str:
-    errors = _messages(stderr, "error:")
-    if errors:
-        return errors[-1]
-    tail = stderr.strip().splitlines()[-1:] or [f"exit status {code}"]
-    return f"{what} failed: {tail[0]}"
+def _step(outcome: UnitOutcome, work: Callable[[], T]) -> T | None:
+    """``work()`` with its warnings recorded in ``outcome.warnings`` (as the command prints
+    them, :func:`thermocal.pipeline.messages.warning_lines`); a failure recorded in
+    ``outcome.error`` (the command's ``error:`` text, :func:`~thermocal.pipeline.messages.
+    error_text`) and None returned.  Ctrl-C is not the unit's fault: it propagates."""
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", ThermocalWarning)
+        try:
+            return work()
+        except Exception as exc:
+            text, users = error_text(exc)
+            if not users and os.environ.get("THERMOCAL_DEBUG"):
+                raise
+            outcome.error = text
+            return None
+        finally:
+            outcome.warnings += warning_lines(caught)
 
 
 def run_unit(task: UnitTask) -> UnitOutcome:
-    """Calibrate one unit (module docstring): ``thermocal fit`` on its modelling files, then
-    ``thermocal validate --modeling`` on its validation file if it has one.  Never raises for
-    the unit's own faults (a missing or corrupt file, a singular design): they make a failed
-    outcome whose error names the file, as the command printed it."""
+    """Calibrate one unit (module docstring): :func:`thermocal.pipeline.fit.fit_files` on its
+    modelling files, then :func:`thermocal.pipeline.validate.validate_files` on its
+    validation file (``modeling``: its first modelling file) if it has one.  Never raises
+    for the unit's own faults (a missing or corrupt file, a singular design): they make a
+    failed outcome whose error names the file, as the command would print it."""
     from threadpoolctl import threadpool_limits
+
+    from thermocal.pipeline.fit import fit_files
+    from thermocal.pipeline.validate import validate_files
 
     t0 = time.perf_counter()
     u = task.unit
     outcome = UnitOutcome(u.id, "failed", worker=f"{os.uname().nodename}:{os.getpid()}")
-    with _CLI_LOCK, threadpool_limits(limits=1), tempfile.TemporaryDirectory() as tmp:
+    with _CAPTURE_LOCK, threadpool_limits(limits=1), tempfile.TemporaryDirectory() as tmp:
         cal = Path(tmp) / CALIBRATION_FILE
-        code, out, err = _run_cli(["fit", *u.modeling, *task.fit_args, "-o", str(cal), "--json"])
-        outcome.warnings += _messages(err, "warning:")
-        if code != 0:
-            outcome.error = _failure(err, code, "fit")
-            outcome.seconds = time.perf_counter() - t0
-            return outcome
-        outcome.fit = json.loads(out)
-        outcome.files[CALIBRATION_FILE] = cal.read_bytes()
-        if u.validation is not None:
-            args = ["validate", str(cal), u.validation, "--modeling", u.modeling[0]]
-            code, out, err = _run_cli([*args, *task.validate_args, "--json"])
-            outcome.warnings += _messages(err, "warning:")
-            if code != 0:
-                outcome.error = _failure(err, code, "validate")
-                outcome.seconds = time.perf_counter() - t0
-                return outcome
-            outcome.validation = json.loads(out)
-            outcome.files[VALIDATION_FILE] = out.encode("utf-8")
-        try:
-            outcome.figures = channel_figures(cal, outcome.validation)
-        except ThermocalInputError as exc:  # the calibration just written does not load
-            outcome.error = one_line_error(exc)
-            outcome.seconds = time.perf_counter() - t0
-            return outcome
-    outcome.status = "ok"
+        fitted = _step(outcome, lambda: fit_files([Path(m) for m in u.modeling], task.fit, cal))
+        if fitted is not None:
+            outcome.fit = jsonable(fitted.to_dict())
+            outcome.files[CALIBRATION_FILE] = cal.read_bytes()
+        if fitted is not None and u.validation is not None:
+            opts = dataclasses.replace(task.validate, modeling=Path(u.modeling[0]))
+            val = Path(u.validation)
+            report = _step(outcome, lambda: validate_files(cal, val, opts))
+            if report is not None:
+                text = json_text(report.to_dict())
+                outcome.validation = json.loads(text)
+                outcome.files[VALIDATION_FILE] = text.encode("utf-8")
+        if outcome.error is None:
+            try:
+                outcome.figures = channel_figures(cal, outcome.validation)
+                outcome.status = "ok"
+            except ThermocalInputError as exc:  # the calibration just written does not load
+                outcome.error = one_line_error(exc)
     outcome.seconds = time.perf_counter() - t0
     return outcome
 
@@ -418,34 +206,6 @@ def _per_channel(
 
 def one_line_error(exc: BaseException) -> str:
     return " ".join(str(exc).split())
-
-
-def shown_unit(model_unit: str, data_unit: str) -> tuple[str, float]:
-    """The unit a channel's figures are shown in and the factor taking a value in the
-    model's unit to it: ``(data_unit, f)`` with ``x[data_unit] = f · x[model_unit]``
-    (:func:`thermocal.units.convert`, e.g. 1/3600 from °/h to °/s) when both are physical
-    units of one kind; otherwise (raw counts, made physical by a scale factor) the model's
-    own unit and 1."""
-    from thermocal import units
-    from thermocal.errors import UnitError
-
-    try:
-        mu, du = units.normalize_signal_unit(model_unit), units.normalize_signal_unit(data_unit)
-        kind = units.signal_kind(mu)
-        if kind != "raw" and units.signal_kind(du) == kind:
-            return du, float(units.convert(1.0, mu, du))
-    except UnitError:
-        pass
-    return model_unit, 1.0
-
-
-def _convert_unit_label(unit: str, model_unit: str, shown: str) -> str | None:
-    """``deg/h/degC^2`` → ``deg/s/degC^2``: the unit of a coefficient proportional to the
-    signal (its unit starts with the model's signal unit) in the shown unit; None when the
-    coefficient is not in the signal's unit (a breakpoint in °C, a time constant)."""
-    if unit == model_unit or unit.startswith(model_unit + "/"):
-        return shown + unit[len(model_unit) :]
-    return None
 
 
 def channel_figures(
@@ -492,7 +252,7 @@ def channel_figures(
         coefs: dict[str, float] = {}
         coef_units: dict[str, str] = {}
         for c in model.coefficients():
-            label = _convert_unit_label(c.unit, model_unit, unit)
+            label = convert_unit_label(c.unit, model_unit, unit)
             coefs[c.name] = float(c.value) * (factor if label is not None else 1.0)
             coef_units[c.name] = label if label is not None else c.unit
         row["coefficients"] = coefs
@@ -524,7 +284,7 @@ def judge(figures: Mapping[str, Mapping[str, Any]], limits: Sequence[Limit]) -> 
                 why = "no validation run" if lim.figure in VALIDATION_FIGURES else "not computed"
                 failed.append(f"{ch}.{lim.figure} {why} ({lim.label})")
             elif not lim.check(float(value)):
-                unit = "" if lim.figure in _UNITLESS else f" {fig.get('unit') or ''}".rstrip()
+                unit = "" if lim.figure in UNITLESS else f" {fig.get('unit') or ''}".rstrip()
                 failed.append(f"{ch}.{lim.figure} = {float(value):.6g}{unit} fails {lim.label}")
     return failed
 
@@ -883,6 +643,41 @@ def write_summary(rows: Sequence[Mapping[str, Any]], out_dir: Path) -> tuple[Pat
 Executor = Callable[[list[UnitTask]], Iterator[UnitOutcome]]
 
 
+def _fit_options(config: FleetConfig) -> FitOptions:
+    """The ``[fit]`` options every unit runs (a configuration from :func:`load_config` has
+    them)."""
+    if config.fit is None:
+        raise ThermocalInputError(f"{config.path}: no [fit] options")
+    return config.fit
+
+
+class _OwnedSpawnContext:
+    """A ``spawn`` multiprocessing context that keeps the worker processes it starts, so that
+    the driver can end them itself (:meth:`terminate`) without reaching into the pool: the
+    ``mp_context`` of :class:`concurrent.futures.ProcessPoolExecutor` is a public parameter,
+    and the pool starts its workers through the context's ``Process``."""
+
+    def __init__(self) -> None:
+        import multiprocessing
+
+        self._ctx = multiprocessing.get_context("spawn")  # no fork of a threaded parent
+        self.processes: list[Any] = []
+
+    def Process(self, *args: Any, **kwargs: Any) -> Any:
+        proc = self._ctx.Process(*args, **kwargs)
+        self.processes.append(proc)
+        return proc
+
+    def __getattr__(self, name: str) -> Any:
+        return getattr(self._ctx, name)
+
+    def terminate(self) -> None:
+        """End every worker still running (SIGTERM)."""
+        for proc in self.processes:
+            if proc.is_alive():
+                proc.terminate()
+
+
 def local_executor(workers: int) -> Executor:
     """Units in this process (one worker) or in ``workers`` local processes, results as
     they finish."""
@@ -892,12 +687,13 @@ def local_executor(workers: int) -> Executor:
             for t in tasks:
                 yield run_unit(t)
             return
-        import multiprocessing
         from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 
-        ctx = multiprocessing.get_context("spawn")  # no fork of a threaded parent
+        ctx = _OwnedSpawnContext()
         pool = ProcessPoolExecutor(
-            max_workers=workers, mp_context=ctx, initializer=_ignore_interrupts
+            max_workers=workers,
+            mp_context=cast("BaseContext", ctx),  # a spawn context by delegation
+            initializer=_ignore_interrupts,
         )
         pending = {pool.submit(run_unit, t) for t in tasks}
         try:
@@ -908,10 +704,8 @@ def local_executor(workers: int) -> Executor:
         except BaseException:
             # Ctrl-C (or a failure): the units running are abandoned, not waited for; they
             # were never written, so a rerun does them
-            procs = list((getattr(pool, "_processes", None) or {}).values())
             pool.shutdown(wait=False, cancel_futures=True)
-            for proc in procs:
-                proc.terminate()
+            ctx.terminate()
             raise
         pool.shutdown(wait=True)
 
@@ -988,7 +782,7 @@ def run_fleet(
             continue
         if reasons is not None:
             redo[u.id] = "; ".join(reasons) if reasons else "--force"
-        todo.append(UnitTask(u, config.fit_args, config.validate_args))
+        todo.append(UnitTask(u, _fit_options(config), config.validate))
     ran: list[str] = []
     failed: list[str] = []
     interrupted: str | None = None
@@ -1035,8 +829,6 @@ def _finish(
 ) -> tuple[list[dict[str, Any]], Path, Path, Path]:
     """The summary and the report; units found stale and not redone (an interrupted run)
     are pending, never shown with their old figures."""
-    from thermocal.fleet.report import write_fleet_report
-
     done = set(ran)
     redone = {k: v for k, v in redo.items() if k in done}
     stale = {k: v for k, v in redo.items() if k not in done}
@@ -1047,110 +839,12 @@ def _finish(
     return rows, csv_path, pq_path, html
 
 
-def robust_z(values: Iterable[float]) -> list[float]:
-    """Modified z-scores ``0.6745 (x − median) / MAD`` (Iglewicz & Hoaglin, 1993; |z| > 3.5
-    marks an outlier); NaN where the MAD is zero or the value missing."""
-    import numpy as np
-
-    x = np.asarray(list(values), dtype=np.float64)
-    ok = np.isfinite(x)
-    if ok.sum() < 3:
-        return [math.nan] * x.size
-    med = float(np.median(x[ok]))
-    mad = float(np.median(np.abs(x[ok] - med)))
-    if not mad > 0:
-        return [math.nan] * x.size
-    return [float(0.6745 * (v - med) / mad) if math.isfinite(v) else math.nan for v in x]
-
-
-OUTLIER_Z = 3.5
-"""|modified z| above this names a unit as an outlier (Iglewicz & Hoaglin)."""
-
-
-def common_unit(figs: Sequence[Mapping[str, Any]]) -> tuple[str, list[float]]:
-    """The unit most of a channel's units are shown in, and per record the factor taking
-    its signal figures there (NaN where it cannot be converted: left out of comparisons
-    across units).  A batch whose files give one channel in different units is compared in
-    one unit."""
-    from collections import Counter
-
-    names = [str(f.get("unit") or "") for f in figs]
-    if not names:
-        return "", []
-    unit = Counter(names).most_common(1)[0][0]
-    factors = []
-    for n in names:
-        if n == unit:
-            factors.append(1.0)
-            continue
-        shown, f = shown_unit(n, unit)
-        factors.append(f if shown == unit else math.nan)
-    return unit, factors
-
-
-def channel_series(figs: Sequence[Mapping[str, Any]]) -> tuple[str, dict[str, list[float]]]:
-    """A channel's figures and coefficients across units, each in one unit
-    (:func:`common_unit`): ``(unit, {what: values})``, ``what`` a figure name or
-    ``coefficient <term>``."""
-    unit, factors = common_unit(figs)
-    series: dict[str, list[float]] = {}
-    for n in ("rms_residual", "rms_after", "bias_stability_after"):
-        series[n] = [_num(f.get(n)) * k for f, k in zip(figs, factors, strict=True)]
-    terms = sorted({t for f in figs for t in (f.get("coefficients") or {})})
-    for t in terms:
-        vals = []
-        for f, k in zip(figs, factors, strict=True):
-            cu = str((f.get("coefficient_units") or {}).get(t, ""))
-            scaled = _convert_unit_label(cu, str(f.get("unit") or ""), unit) is not None
-            vals.append(_num((f.get("coefficients") or {}).get(t)) * (k if scaled else 1.0))
-        series[f"coefficient {t}"] = vals
-    return unit, series
-
-
-def coefficient_unit(figs: Sequence[Mapping[str, Any]], term: str, unit: str) -> str:
-    """The unit of a coefficient across units, in the channel's common ``unit``."""
-    for f in figs:
-        cu = (f.get("coefficient_units") or {}).get(term)
-        if cu:
-            label = _convert_unit_label(str(cu), str(f.get("unit") or ""), unit)
-            return label if label is not None else str(cu)
-    return ""
-
-
-def outliers(records: Mapping[str, Mapping[str, Any] | None]) -> list[dict[str, Any]]:
-    """Units whose figure or coefficient is a robust outlier among the ok units, per
-    channel: ``{"id", "channel", "what", "value", "unit", "z"}`` (the value in the
-    channel's common data unit, :func:`channel_series`), largest |z| first."""
-    ok = {k: v for k, v in records.items() if v and v.get("status") == "ok"}
-    found: list[dict[str, Any]] = []
-    channels = sorted({ch for v in ok.values() for ch in (v.get("channels") or {})})
-    for ch in channels:
-        ids = [k for k, v in ok.items() if ch in (v.get("channels") or {})]
-        figs = [ok[k]["channels"][ch] for k in ids]
-        unit, series = channel_series(figs)
-        for what, vals in series.items():
-            if what.startswith("coefficient "):
-                what_unit = coefficient_unit(figs, what[len("coefficient ") :], unit)
-            else:
-                what_unit = unit
-            for uid, v, z in zip(ids, vals, robust_z(vals), strict=True):
-                if math.isfinite(z) and abs(z) > OUTLIER_Z:
-                    found.append(
-                        {"id": uid, "channel": ch, "what": what, "value": v, "unit": what_unit,
-                         "z": z}
-                    )  # fmt: skip
-    return sorted(found, key=lambda d: -abs(d["z"]))
-
-
-def _num(v: Any) -> float:
-    try:
-        return float(v) if v is not None else math.nan
-    except (TypeError, ValueError):
-        return math.nan
-
-
 __all__ = [
     "EXIT_SOME_FAILED",
+    "FIGURES",
+    "FIT_FIGURES",
+    "OUTLIER_Z",
+    "VALIDATION_FIGURES",
     "FleetConfig",
     "FleetResult",
     "Limit",

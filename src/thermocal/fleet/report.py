@@ -3,7 +3,7 @@
 Yield (calibrated, passed, failed), the distribution of each channel's residual figures and
 fitted coefficients across the units (each coefficient as a robust z-score, so that terms of
 different sizes share one axis), the robust outliers named (modified z-score above
-:data:`thermocal.fleet.batch.OUTLIER_Z`, Iglewicz & Hoaglin 1993), the failed units with their
+:data:`thermocal.fleet.stats.OUTLIER_Z`, Iglewicz & Hoaglin 1993), the failed units with their
 errors and the units outside the limits.  One self-contained file (figures as data URIs);
 matplotlib and jinja2 are imported here only.
 """
@@ -19,10 +19,14 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from thermocal.fleet.stats import HISTOGRAM_FIGURES, OUTLIER_Z, channel_series, outliers, robust_z
 from thermocal.writers import atomic_write
 
 if TYPE_CHECKING:
-    from thermocal.fleet.batch import FleetConfig
+    from thermocal.fleet.config import FleetConfig
+
+_COLOURS = ("#1f6fb2", "#c0392b", "#2e8b57", "#8e44ad")
+"""Colours of the histograms, in the order of :data:`thermocal.fleet.stats.HISTOGRAM_FIGURES`."""
 
 
 def _b64(png: bytes) -> str:
@@ -39,9 +43,8 @@ def _fmt(v: Any, digits: int = 4) -> str:
 
 def _figure_distributions(channel: str, ok: Mapping[str, Mapping[str, Any]]) -> bytes:
     """Histograms of a channel's rms residual and (if validated) rms after compensation,
-    in the channel's data unit (:func:`thermocal.fleet.batch.channel_series`), and a strip plot
+    in the channel's data unit (:func:`thermocal.fleet.stats.channel_series`), and a strip plot
     of every coefficient's robust z-score across the units."""
-    from thermocal.fleet.batch import OUTLIER_Z, channel_series, robust_z
     from thermocal.report.figures import _figure, _png
 
     figs = [r["channels"][channel] for r in ok.values()]
@@ -49,10 +52,7 @@ def _figure_distributions(channel: str, ok: Mapping[str, Mapping[str, Any]]) -> 
     terms = [k[len("coefficient ") :] for k in series if k.startswith("coefficient ")]
     with _figure(nrows=2, height_in=2.6) as (fig, axes):
         ax = axes[0]
-        for key, label, colour in (
-            ("rms_residual", "fit rms residual", "#1f6fb2"),
-            ("rms_after", "validation rms after", "#c0392b"),
-        ):
+        for (key, label), colour in zip(HISTOGRAM_FIGURES.items(), _COLOURS, strict=False):
             vals = np.array(series[key], dtype=float)
             vals = vals[np.isfinite(vals)]
             if vals.size:
@@ -90,7 +90,6 @@ def build_fleet_report(
     channel's data unit, as ``unit.json`` holds it; ``redone``: the units redone in this
     run and why."""
     from thermocal import __version__
-    from thermocal.fleet.batch import outliers
     from thermocal.report.build import _env
 
     units = []

@@ -1,0 +1,188 @@
+"""The fleet's figures and their statistics across units (issue 18): the figure names a unit
+records, the unit a channel's figures are shown in, robust z-scores and outliers.  Shared by
+the batch driver (:mod:`thermocal.fleet.batch`) and its report (:mod:`thermocal.fleet.report`)."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterable, Mapping, Sequence
+from typing import Any
+
+FIT_FIGURES = ("rms_residual", "condition_number", "n_coefficients", "n_samples")
+"""Per-channel figures of a fit (``thermocal fit --json``), in the summary."""
+
+
+VALIDATION_FIGURES = (
+    "r",
+    "rms_before",
+    "rms_after",
+    "peak_to_peak_before",
+    "peak_to_peak_after",
+    "bias_stability_before",
+    "bias_stability_after",
+    "bias_repeatability_before",
+    "bias_repeatability_after",
+)
+"""Per-channel figures of a validation (``thermocal validate --json``), in the summary."""
+
+
+FIGURES = FIT_FIGURES + VALIDATION_FIGURES
+
+
+UNITLESS = frozenset({"r", "condition_number", "n_coefficients", "n_samples"})
+"""Figures without a unit (every other figure is in the channel's data unit)."""
+
+
+def shown_unit(model_unit: str, data_unit: str) -> tuple[str, float]:
+    """The unit a channel's figures are shown in and the factor taking a value in the
+    model's unit to it: ``(data_unit, f)`` with ``x[data_unit] = f · x[model_unit]``
+    (:func:`thermocal.units.convert`, e.g. 1/3600 from °/h to °/s) when both are physical
+    units of one kind; otherwise (raw counts, made physical by a scale factor) the model's
+    own unit and 1."""
+    from thermocal import units
+    from thermocal.errors import UnitError
+
+    try:
+        mu, du = units.normalize_signal_unit(model_unit), units.normalize_signal_unit(data_unit)
+        kind = units.signal_kind(mu)
+        if kind != "raw" and units.signal_kind(du) == kind:
+            return du, float(units.convert(1.0, mu, du))
+    except UnitError:
+        pass
+    return model_unit, 1.0
+
+
+def convert_unit_label(unit: str, model_unit: str, shown: str) -> str | None:
+    """``deg/h/degC^2`` → ``deg/s/degC^2``: the unit of a coefficient proportional to the
+    signal (its unit starts with the model's signal unit) in the shown unit; None when the
+    coefficient is not in the signal's unit (a breakpoint in °C, a time constant)."""
+    if unit == model_unit or unit.startswith(model_unit + "/"):
+        return shown + unit[len(model_unit) :]
+    return None
+
+
+def robust_z(values: Iterable[float]) -> list[float]:
+    """Modified z-scores ``0.6745 (x − median) / MAD`` (Iglewicz & Hoaglin, 1993; |z| > 3.5
+    marks an outlier); NaN where the MAD is zero or the value missing."""
+    import numpy as np
+
+    x = np.asarray(list(values), dtype=np.float64)
+    ok = np.isfinite(x)
+    if ok.sum() < 3:
+        return [math.nan] * x.size
+    med = float(np.median(x[ok]))
+    mad = float(np.median(np.abs(x[ok] - med)))
+    if not mad > 0:
+        return [math.nan] * x.size
+    return [float(0.6745 * (v - med) / mad) if math.isfinite(v) else math.nan for v in x]
+
+
+OUTLIER_Z = 3.5
+"""|modified z| above this names a unit as an outlier (Iglewicz & Hoaglin)."""
+
+
+def common_unit(figs: Sequence[Mapping[str, Any]]) -> tuple[str, list[float]]:
+    """The unit most of a channel's units are shown in, and per record the factor taking
+    its signal figures there (NaN where it cannot be converted: left out of comparisons
+    across units).  A batch whose files give one channel in different units is compared in
+    one unit."""
+    from collections import Counter
+
+    names = [str(f.get("unit") or "") for f in figs]
+    if not names:
+        return "", []
+    unit = Counter(names).most_common(1)[0][0]
+    factors = []
+    for n in names:
+        if n == unit:
+            factors.append(1.0)
+            continue
+        shown, f = shown_unit(n, unit)
+        factors.append(f if shown == unit else math.nan)
+    return unit, factors
+
+
+SERIES_FIGURES = ("rms_residual", "rms_after", "bias_stability_after")
+"""The figures of a channel compared across the units (:func:`channel_series`: the outliers
+and the report)."""
+HISTOGRAM_FIGURES = {"rms_residual": "fit rms residual", "rms_after": "validation rms after"}
+"""The figures whose distribution across the units the report draws, with their labels."""
+
+
+def channel_series(figs: Sequence[Mapping[str, Any]]) -> tuple[str, dict[str, list[float]]]:
+    """A channel's figures and coefficients across units, each in one unit
+    (:func:`common_unit`): ``(unit, {what: values})``, ``what`` a figure name or
+    ``coefficient <term>``."""
+    unit, factors = common_unit(figs)
+    series: dict[str, list[float]] = {}
+    for n in SERIES_FIGURES:
+        series[n] = [_num(f.get(n)) * k for f, k in zip(figs, factors, strict=True)]
+    terms = sorted({t for f in figs for t in (f.get("coefficients") or {})})
+    for t in terms:
+        vals = []
+        for f, k in zip(figs, factors, strict=True):
+            cu = str((f.get("coefficient_units") or {}).get(t, ""))
+            scaled = convert_unit_label(cu, str(f.get("unit") or ""), unit) is not None
+            vals.append(_num((f.get("coefficients") or {}).get(t)) * (k if scaled else 1.0))
+        series[f"coefficient {t}"] = vals
+    return unit, series
+
+
+def coefficient_unit(figs: Sequence[Mapping[str, Any]], term: str, unit: str) -> str:
+    """The unit of a coefficient across units, in the channel's common ``unit``."""
+    for f in figs:
+        cu = (f.get("coefficient_units") or {}).get(term)
+        if cu:
+            label = convert_unit_label(str(cu), str(f.get("unit") or ""), unit)
+            return label if label is not None else str(cu)
+    return ""
+
+
+def outliers(records: Mapping[str, Mapping[str, Any] | None]) -> list[dict[str, Any]]:
+    """Units whose figure or coefficient is a robust outlier among the ok units, per
+    channel: ``{"id", "channel", "what", "value", "unit", "z"}`` (the value in the
+    channel's common data unit, :func:`channel_series`), largest |z| first."""
+    ok = {k: v for k, v in records.items() if v and v.get("status") == "ok"}
+    found: list[dict[str, Any]] = []
+    channels = sorted({ch for v in ok.values() for ch in (v.get("channels") or {})})
+    for ch in channels:
+        ids = [k for k, v in ok.items() if ch in (v.get("channels") or {})]
+        figs = [ok[k]["channels"][ch] for k in ids]
+        unit, series = channel_series(figs)
+        for what, vals in series.items():
+            if what.startswith("coefficient "):
+                what_unit = coefficient_unit(figs, what[len("coefficient ") :], unit)
+            else:
+                what_unit = unit
+            for uid, v, z in zip(ids, vals, robust_z(vals), strict=True):
+                if math.isfinite(z) and abs(z) > OUTLIER_Z:
+                    found.append(
+                        {"id": uid, "channel": ch, "what": what, "value": v, "unit": what_unit,
+                         "z": z}
+                    )  # fmt: skip
+    return sorted(found, key=lambda d: -abs(d["z"]))
+
+
+def _num(v: Any) -> float:
+    try:
+        return float(v) if v is not None else math.nan
+    except (TypeError, ValueError):
+        return math.nan
+
+
+__all__ = [
+    "FIGURES",
+    "FIT_FIGURES",
+    "HISTOGRAM_FIGURES",
+    "OUTLIER_Z",
+    "SERIES_FIGURES",
+    "UNITLESS",
+    "VALIDATION_FIGURES",
+    "channel_series",
+    "coefficient_unit",
+    "common_unit",
+    "convert_unit_label",
+    "outliers",
+    "robust_z",
+    "shown_unit",
+]

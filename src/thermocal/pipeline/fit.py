@@ -1,0 +1,625 @@
+"""Fitting a compensation model on recordings: :func:`fit_files` (``thermocal fit``; SPEC §4).
+
+Fits one model (one channel) or a calibration of several channels on one or several runs
+(several files = several runs, each with its own turn-on offset unless
+``per_run_offset=False``) and writes the self-describing model file
+(:func:`thermocal.models.files.save_model`; several channels:
+:func:`thermocal.models.files.save_calibration`) with the data files' names and SHA-256
+checksums.  The family is looked up in the registry (:func:`thermocal.models.base.get_model_class`)
+and built from the options by its one option parser (:meth:`TemperatureModel.from_cli_options`,
+:func:`model_options` gives the keys).  Every file is read once, through
+:func:`thermocal.pipeline.reading.load_recording` with the text-log options and ``topic``.
+
+The data are judged before the fit (:func:`thermocal.adequacy.judge`: refused when they cannot
+support the model, unless overridden); the earth rate seen by a gyro's axis (``latitude``,
+``axis``), the gravity an accelerometer reads (``gravity_axis``) and ``known_input`` are
+removed as known inputs.  Warnings are issued (:mod:`warnings`) and listed in each channel's
+figures (``warnings``).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import re
+import warnings
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING, Any, cast
+
+import numpy as np
+
+from thermocal import errors as _errors
+from thermocal import units
+from thermocal.defaults import overrides_of
+from thermocal.errors import ConditioningWarning, ThermocalInputError
+from thermocal.pipeline.messages import one_line
+from thermocal.pipeline.options import FitOptions
+from thermocal.pipeline.reading import load_recording, split_floats, split_names, text_options
+
+if TYPE_CHECKING:
+    import thermocal.adequacy as _adequacy
+    import thermocal.gravity as _gravity
+    import thermocal.models.base as _base
+    import thermocal.models.calibration as _calibration
+    import thermocal.models.files as _files
+    import thermocal.models.poly as _poly
+    import thermocal.recording as _recording
+    import thermocal.writers as _writers
+else:
+    from thermocal._lazy import LazyModule
+
+    _adequacy = LazyModule("thermocal.adequacy")
+    _writers = LazyModule("thermocal.writers")
+    _base = LazyModule("thermocal.models.base")
+    _calibration = LazyModule("thermocal.models.calibration")
+    _files = LazyModule("thermocal.models.files")
+    _poly = LazyModule("thermocal.models.poly")
+    _gravity = LazyModule("thermocal.gravity")
+    _recording = LazyModule("thermocal.recording")
+
+TARGETS = ("bias", "scale_factor")
+
+
+def run_temp_names(rec: _recording.Recording, temps: str | None) -> list[str]:
+    """The temperature columns a fit uses: ``--temps`` or the file's."""
+    return split_names(temps) or list(rec.temperatures)
+
+
+MAX_ORDER = 10
+"""Hard ceiling of ``--order`` (poly: powers of each temperature; warmup: order in ΔT) and
+``--t0-order`` (warmup).  A temperature polynomial of order 10 over a −40…85 °C range
+already has a condition number near 1e9 on scaled variables (each further power loses about
+one digit of the fit's 16); calibration practice (IEEE Std 952/1293, the PX4 and ArduPilot
+thermal calibrations: order 3) stays well below.  The data limit (more coefficients than
+samples or distinct temperatures) is checked once the data are read (``thermocal.adequacy``);
+this ceiling is checked before anything is read or allocated, so that an order of 10²⁰ —
+which typer parses as a Python int — never becomes a list of 10²⁰ terms."""
+
+MAX_TERMS = 200
+"""Hard ceiling of the number of terms in ``--terms`` (poly).  The seed set ``seed000`` has
+9 terms per temperature sensor (37 with four sensors and the constant); 200 terms is five times
+that, and a design matrix of 200 float64 columns costs 1.6 kB per sample (16 GB at 10⁷
+samples), beyond any machine the fit is meant for."""
+
+MAX_SEGMENTS = 100
+"""Hard ceiling of ``--segments`` (piecewise): each segment adds two coefficients and
+needs its own temperature span; 100 segments over a −40…85 °C range is 1.25 °C each, below
+which a segment fits the noise of one soak rather than a temperature effect."""
+
+
+def check_ceilings(
+    order: int | None, t0_order: int | None, segments: int | None, terms: str | None
+) -> None:
+    """Refuse (:class:`ThermocalInputError`, exit 2) an order or term count beyond the hard
+    ceilings :data:`MAX_ORDER`, :data:`MAX_TERMS`, :data:`MAX_SEGMENTS`, before any data is
+    read.  The value is checked, not only its type: typer parses any integer literal."""
+    for option, value, lo, hi in (
+        ("--order", order, 1, MAX_ORDER),
+        ("--t0-order", t0_order, 0, MAX_ORDER),
+        ("--segments", segments, 1, MAX_SEGMENTS),
+    ):
+        if value is not None and not lo <= value <= hi:
+            shown = (
+                str(value)
+                if len(str(value)) <= 24
+                else f"{str(value)[:20]}… ({len(str(value))} digits)"
+            )
+            raise ThermocalInputError(f"{option} must be between {lo} and {hi}, got {shown}")
+    if terms is not None:
+        n = terms.count(",") + 1
+        if n > MAX_TERMS:
+            raise ThermocalInputError(f"--terms lists {n} terms; at most {MAX_TERMS} are accepted")
+        for power in _POWER.findall(terms):
+            if len(power) > 3 or int(power) > MAX_ORDER:
+                raise ThermocalInputError(
+                    f"--terms: power {power[:20]} is above the ceiling {MAX_ORDER}"
+                )
+
+
+_POWER = re.compile(r"\^\s*(\d+)")
+
+
+def build_model(family: str, options: dict[str, Any]) -> _base.TemperatureModel:
+    """Instantiate a registered family from the CLI option dict by its one option parser
+    (:meth:`TemperatureModel.from_cli_options`: an option the family does not take is
+    refused, for every family)."""
+    return _base.get_model_class(family).from_cli_options(options)
+
+
+def earth_rate_known_input(
+    latitude: float | None, axis: str | None, unit: str, where: object
+) -> float:
+    """Earth rate seen by the sensitive axis [°/h], as a known input of a gyro run.
+
+    ``Ω_axis = Ω u·(0, cos φ, sin φ)`` for the unit axis ``u`` in East-North-Up
+    (SPEC §1, :func:`thermocal.units.earth_rate_on_axis_deg_h`); 0 without
+    ``--latitude``/``--axis``.  Both options are needed together and
+    the signal (canonical unit ``unit``) must be a rate: otherwise an input error naming
+    ``where`` (the file).
+    """
+    if latitude is None and axis is None:
+        return 0.0
+    if latitude is None or axis is None:
+        raise ThermocalInputError("earth-rate removal needs both --latitude and --axis")
+    if units.canonical_unit(unit) != "deg/h":
+        raise ThermocalInputError(
+            f"{where}: --latitude/--axis remove the earth rate from a gyro signal; "
+            f"this signal is in {unit}"
+        )
+    return units.earth_rate_on_axis_deg_h(latitude, units.parse_axis(axis))
+
+
+def known_input_what(
+    latitude: float | None, axis: str | None, other: float | None, gravity: str | None = None
+) -> str:
+    """What a fit's known input is, for the model file (``inputs.known_input.what``)."""
+    parts = []
+    if latitude is not None and axis is not None:
+        parts.append(f"earth rate at latitude {latitude:g}° on axis {axis}")
+    if gravity:
+        parts.append(gravity)
+    if other:
+        parts.append(f"--known-input {other:g}")
+    return " + ".join(parts) or "none"
+
+
+@dataclass(frozen=True)
+class _FitSpec:
+    """What every channel's fit shares: the family and its options, the temperature
+    columns, the known input (earth rate or given) and the target."""
+
+    family: str
+    options: dict[str, Any]
+    temps: str | None
+    latitude: float | None
+    axis: str | None
+    known_input: float | None
+    target: str
+    gravity_axis: str | None = None
+    gravity_m_s2: float | None = None
+    tref_c: float | None = None
+    gravity_triad: _gravity.TriadGravity | None = None
+    overrides: tuple[str, ...] = ()
+
+
+def _local_gravity(
+    gravity_axis: str | None, gravity: float | None, latitude: float | None
+) -> float | None:
+    """The local gravity [m/s²] for ``--gravity-axis``
+    (:func:`thermocal.gravity.local_gravity_m_s2`)."""
+    return _gravity.local_gravity_m_s2(gravity_axis, gravity, latitude)
+
+
+def _gravity_known_input(
+    spec: _FitSpec, run: int, path: Path, name: str, unit: str, values_mg: _recording.FloatArray
+) -> _gravity.GravityInput:
+    """The gravity an accelerometer channel reads in run ``run`` [mg], with the words and
+    record of the model's known input: along the triad's measured direction when the
+    triad is fitted together, else along the nominal up axis with a warning that the
+    direction is unknown (:func:`thermocal.gravity.channel_gravity`)."""
+    return _gravity.channel_gravity(
+        spec.gravity_triad, run, path, name, unit, values_mg, spec.gravity_axis, spec.gravity_m_s2
+    )
+
+
+@dataclass
+class _Prepared:
+    """One channel ready to fit: its model, runs and provenance, and the warnings so far."""
+
+    est: _base.TemperatureModel
+    runs: list[_base.RunData]
+    first_inputs: dict[str, Any]
+    provenance: list[dict[str, Any]]
+    unit: str
+    sig_name: str
+    caught: list[Any]
+
+
+def _fit_channel(
+    spec: _FitSpec, loaded: list[tuple[Path, _recording.Recording]], signal: str | None
+) -> tuple[_base.TemperatureModel, dict[str, Any], int]:
+    """Fit one channel on the loaded runs; returns the model, its ``--json`` result and
+    the number of runs. Warnings are printed (by handle_errors) and listed in the result."""
+    ((_n, est, result, n_runs),) = _fit_channels(spec, loaded, [signal])
+    return est, result, n_runs
+
+
+def _fit_channels(
+    spec: _FitSpec, loaded: list[tuple[Path, _recording.Recording]], signals: Sequence[str | None]
+) -> list[tuple[str, _base.TemperatureModel, dict[str, Any], int]]:
+    """Fit every channel on the loaded runs (each file read once, by the caller).  Channels
+    of the ``poly`` family with the same temperature inputs share one design
+    (:func:`thermocal.models.poly.fit_shared`: Ṫ, features and the design's reduction once;
+    every model equal, bit for bit, to its own fit)."""
+    preps = [_prepare_channel(spec, loaded, sig) for sig in signals]
+    if spec.family == "poly" and len(preps) > 1:
+        _share_inputs(preps)
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            _poly.fit_shared([cast(_poly.PolyModel, p.est) for p in preps], [p.runs for p in preps])
+        for p in preps:
+            p.caught.extend(caught)
+    else:
+        for p in preps:
+            with warnings.catch_warnings(record=True) as caught:
+                warnings.simplefilter("always")
+                p.est.fit(p.runs)
+            p.caught.extend(caught)
+    return [(p.sig_name, *_finish_channel(spec, p)) for p in preps]
+
+
+def _share_inputs(preps: list[_Prepared]) -> None:
+    """Give every channel's runs the first channel's time and temperature arrays when they
+    are equal (one copy in memory, and :func:`fit_shared` sees one design)."""
+    first = preps[0].runs
+    for p in preps[1:]:
+        for i, r in enumerate(p.runs):
+            f = first[i]
+            if r.temps_c is not f.temps_c and np.array_equal(r.temps_c, f.temps_c):
+                p.runs[i] = dataclasses.replace(r, temps_c=f.temps_c)
+
+
+def _prepare_channel(
+    spec: _FitSpec, loaded: list[tuple[Path, _recording.Recording]], signal: str | None
+) -> _Prepared:
+    """One channel's runs with their known inputs, its model object and provenance."""
+    est = build_model(spec.family, spec.options)
+    temps, latitude, axis, known_input = spec.temps, spec.latitude, spec.axis, spec.known_input
+    runs: list[_base.RunData] = []
+    first_inputs: dict[str, Any] = {}
+    provenance: list[dict[str, Any]] = []
+    sensor_ids: list[str | None] = []
+    unit = ""
+    sig_name = signal or "signal"
+    temp_names: tuple[str, ...] | None = None
+    for path, rec in loaded:
+        _values, run_unit = rec.signal(signal)
+        sig_name = signal or rec.signals[0]
+        if unit and run_unit != unit:
+            raise ThermocalInputError(f"{path}: signal unit {run_unit} differs from {unit}")
+        unit = run_unit
+        # --latitude serves gravity alone when no --axis names a gyro's sensitive axis
+        earth_lat = None if (spec.gravity_axis and axis is None) else latitude
+        ki = earth_rate_known_input(earth_lat, axis, unit, path)
+        g_in = _gravity_known_input(spec, len(runs), path, sig_name, unit, _values)
+        ki += g_in.value_mg
+        if known_input is not None:
+            ki += known_input
+        if not runs:  # the model learns how its inputs were written (model file "inputs")
+            first_inputs = _base.model_inputs(
+                rec, sig_name, run_temp_names(rec, temps), known_input=ki,
+                known_input_what=known_input_what(earth_lat, axis, known_input, g_in.what),
+            )  # fmt: skip
+            if g_in.record is not None:  # export-params reads whether it was measured
+                first_inputs["known_input"]["gravity"] = g_in.record
+        run = _base.RunData.from_recording(
+            rec, signal, split_names(temps), known_input=ki, temperature_unit="auto"
+        )
+        run = dataclasses.replace(run, name=path.name)
+        if temp_names is None:
+            temp_names = run.temp_names
+        elif run.temp_names != temp_names:
+            raise ThermocalInputError(
+                f"{path}: temperature columns {list(run.temp_names)} differ from the first "
+                f"file's {list(temp_names)}"
+            )
+        runs.append(run)
+        sensor_ids.append(rec.meta.sensor_id)
+        provenance.append(
+            {
+                "file": path.name,
+                "path": str(path),
+                "sha256": _files.file_sha256(path),
+                "n_samples": run.n_samples,
+                "known_input": ki,
+            }
+        )
+
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        est.adequacy_ = _judge_channel(spec, est, runs, sig_name, first_inputs, unit)
+        known_ids = sorted({str(i) for i in sensor_ids if i})
+        if len(known_ids) > 1:
+            first_inputs.pop("sensor_id", None)
+            warnings.warn(
+                f"the runs come from different sensors ({', '.join(known_ids)}): one "
+                "compensation model for several sensors averages them; fit each sensor "
+                "on its own runs",
+                ConditioningWarning,
+                stacklevel=1,
+            )
+        elif known_ids and "sensor_id" not in first_inputs:
+            first_inputs["sensor_id"] = known_ids[0]
+    return _Prepared(est, runs, first_inputs, provenance, unit, sig_name, list(caught))
+
+
+def _data_unit(first_inputs: dict[str, Any], sig_name: str, unit: str) -> tuple[str, float]:
+    """The data's own unit of a channel (as given in the file, option or column name) and
+    the factor from the model's canonical unit to it (raw counts scaled to a physical unit
+    stay in the canonical unit)."""
+    given = str((first_inputs.get("units") or {}).get(sig_name, unit))
+    try:
+        return given, float(units.convert(1.0, unit, given))
+    except _errors.UnitError:
+        return unit, 1.0
+
+
+def _judge_channel(
+    spec: _FitSpec,
+    est: _base.TemperatureModel,
+    runs: list[_base.RunData],
+    sig_name: str,
+    first_inputs: dict[str, Any],
+    unit: str,
+) -> dict[str, Any]:
+    """Judge the data before the fit (:func:`thermocal.adequacy.judge`): refuse what they
+    cannot support (exit 2), warn where overridden; the record goes into the model file."""
+    names = list(runs[0].temp_names)
+    needs = est.data_needs(names, len(runs))
+    kind = {"rate": "gyro", "accel": "accel"}.get(units.signal_kind(unit))
+    given, factor = _data_unit(first_inputs, sig_name, unit)
+    judged = _adequacy.judge(
+        needs,
+        [r.time_s for r in runs],
+        [r.temps_c for r in runs],
+        names,
+        signals=[r.signal for r in runs if r.signal is not None],  # no copy: a shift is no motion
+        kind=kind,
+        name=sig_name,
+        temperature_unit="°C" if runs[0].temperature_unit == "degC" else "counts",
+        unit_factor=factor,
+        unit=given,
+        overrides=spec.overrides,
+        rate_interval_s=float(spec.options.get("rate_interval_s") or 60.0),
+    )
+    return judged.enforce().to_dict()
+
+
+def _finish_channel(
+    spec: _FitSpec, prep: _Prepared
+) -> tuple[_base.TemperatureModel, dict[str, Any], int]:
+    """After the fit: the fit-quality warnings, the model's metadata, the ``--json`` result."""
+    est, runs, first_inputs, provenance = prep.est, prep.runs, prep.first_inputs, prep.provenance
+    unit, sig_name, target = prep.unit, prep.sig_name, spec.target
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        dof = getattr(est.stats_, "dof", None)
+        if dof is not None and dof <= 0:
+            warnings.warn(
+                f"{est.stats_.n_samples} samples for {len(est.coefficients())} coefficients: "
+                "no residual degrees of freedom, the fit passes through the data; standard "
+                "errors and the rms residual say nothing about its accuracy — record more data",
+                ConditioningWarning,
+                stacklevel=1,
+            )
+        note = (getattr(est.stats_, "extra", None) or {}).get("residual_correlation", {})
+        if note and note.get("note"):
+            warnings.warn(f"{est.family}: {note['note']}", ConditioningWarning, stacklevel=1)
+    all_caught = [*prep.caught, *caught]
+    messages = [one_line(str(w.message)) for w in all_caught]
+    for w in all_caught:  # hand them on to handle_errors, which prints them on stderr
+        warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
+
+    est.signal_name = sig_name
+    est.signal_unit = unit
+    est.target = target
+    est.inputs_ = first_inputs
+    est.data_ = provenance
+
+    st = est.stats_
+    kappa = st.condition_number
+    trange = {
+        n: [float(a), float(b)] for n, (a, b) in zip(est.temp_names_, est.temp_range_, strict=True)
+    }
+    rrange = (
+        {
+            n: [float(a), float(b)]
+            for n, (a, b) in zip(est.temp_names_, est.rate_range_, strict=True)
+        }
+        if est.rate_range_ is not None
+        else None
+    )
+    kept = st.extra.get("selected_terms")
+    given, to_given = _data_unit(first_inputs, sig_name, unit)
+    result: dict[str, Any] = {
+        "model": est.family,
+        "n_coefficients": st.n_coefficients,
+        "rms_residual": st.rms_residual * to_given,  # in the data's own unit (``unit``)
+        "rms_residual_model_unit": st.rms_residual,
+        "condition_number": st.condition_number,
+        "condition": _base.condition_wording(kappa),
+        "temperature_range": trange,
+        "rate_range": rrange,
+        "n_samples": st.n_samples,
+        "n_runs": len(runs),
+        "unit": given,
+        "model_unit": unit,
+        "temperature_unit": est.temperature_unit,
+        "inputs": first_inputs,
+        "target": target,
+        "files": [{k: p[k] for k in ("file", "sha256", "n_samples")} for p in provenance],
+        "terms_kept": kept,
+        "fit": st.to_dict(),
+        "coefficients": [c.to_dict() for c in est.coefficients()],
+        "warnings": messages,
+        "known_input": {
+            "value": first_inputs.get("known_input", {}).get("value", 0.0),
+            "what": first_inputs.get("known_input", {}).get("what"),
+        },
+        "unit_as_given": (first_inputs.get("units") or {}).get(sig_name, unit),
+        "adequacy": est.adequacy_,
+    }
+    if spec.tref_c is not None:
+        result["tref"] = {
+            "tref_c": spec.tref_c,
+            "coefficients": [c.to_dict() for c in est.coefficients_about(spec.tref_c)],  # type: ignore[attr-defined]
+        }
+    return est, result, len(runs)
+
+
+# --- the one entry ----------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class FittedChannel:
+    """One channel fitted by :func:`fit_files`: its model, its ``--json`` figures (INTERFACE.md
+    ``fit`` keys; ``rms_residual`` in the data's own unit) and the number of runs."""
+
+    name: str
+    model: _base.TemperatureModel
+    figures: dict[str, Any]
+    n_runs: int
+
+
+@dataclass(frozen=True)
+class FitResult:
+    """What :func:`fit_files` fitted and wrote: the file ``output``, a model file for one
+    channel or a calibration file (``calibration``) for several, and each channel."""
+
+    output: Path
+    channels: tuple[FittedChannel, ...]
+    calibration: bool
+
+    @property
+    def warnings(self) -> list[str]:
+        """Every channel's warnings (one line each)."""
+        return [w for ch in self.channels for w in ch.figures["warnings"]]
+
+    def to_dict(self) -> dict[str, Any]:
+        """``thermocal fit --json``: one channel's figures with ``output``, or ``{"output",
+        "format": "thermocal-calibration", "channels": {name: figures}}``."""
+        if not self.calibration:
+            return self.channels[0].figures
+        return {
+            "output": str(self.output),
+            "format": "thermocal-calibration",
+            "channels": {
+                ch.name: {**ch.figures, "output": str(self.output)} for ch in self.channels
+            },
+        }
+
+
+def model_options(o: FitOptions) -> dict[str, Any]:
+    """The family options of ``o`` as :meth:`TemperatureModel.from_cli_options` takes them
+    (keys: ``terms``, ``order``, ``rate_interval_s``, ``rate_method``, ``select`` (the
+    criterion, or None), ``ridge``, ``rcond``, ``solver``, ``noise_threshold``,
+    ``breakpoints`` [°C], ``segments``, ``method``, ``start_window_s``, ``t0_order``,
+    ``deviation``, ``tolerance``, ``startup_s``, ``per_run_offset``)."""
+    return {
+        "terms": o.terms,
+        "order": o.order,
+        "rate_interval_s": o.rate_interval,
+        "rate_method": o.rate_method,
+        "select": o.select_method if o.select else None,
+        "ridge": o.ridge,
+        "rcond": o.rcond,
+        "solver": o.solver,
+        "noise_threshold": o.noise_threshold,
+        "breakpoints": split_floats(o.breakpoints, "--breakpoints"),
+        "segments": o.segments,
+        "method": o.method,
+        "start_window_s": o.start_window,
+        "t0_order": o.t0_order,
+        "deviation": o.deviation,
+        "tolerance": o.tolerance,
+        "startup_s": o.startup_s,
+        "per_run_offset": o.per_run_offset,
+    }
+
+
+def _check_options(paths: Sequence[Path], o: FitOptions, output: Path) -> dict[str, Any]:
+    """Everything refused before a file is read: target, ceilings, output name, family
+    options; returns the family options (:func:`model_options`)."""
+    if o.target not in TARGETS:
+        raise ThermocalInputError(f"--target must be bias or scale_factor, got {o.target!r}")
+    check_ceilings(o.order, o.t0_order, o.segments, o.terms)
+    if not paths:
+        raise ThermocalInputError("give at least one data file")
+    _writers.check_not_input(output, list(paths))
+    if output.suffix.lower() not in (".json", ""):
+        raise ThermocalInputError(f"{output}: the model file is JSON; use a .json name")
+    options = model_options(o)
+    if o.select_method not in ("bic", "holdout"):
+        raise ThermocalInputError(
+            f"--select-method must be bic or holdout, got {o.select_method!r}"
+        )
+    build_model(o.model, options)  # refuse options that do not apply before reading
+    if len(split_names(o.signal) or []) > 1 and o.axis is not None:
+        raise ThermocalInputError(
+            "earth-rate removal (--axis) takes one signal at a time: each gyro's sensitive "
+            "axis points elsewhere; fit the gyros one by one with their --axis, or leave the "
+            "earth rate in the bias"
+        )
+    return options
+
+
+def fit_files(paths: Sequence[Path], options: FitOptions, output: Path) -> FitResult:
+    """Fit ``options.model`` on the recordings ``paths`` (one run each) and save it to
+    ``output`` (module docstring).  Options are checked before any file is read
+    (:class:`ThermocalInputError`); each file is read once with every channel's column."""
+    o = options
+    family_options = _check_options(paths, o, output)
+    names = split_names(o.signal) or []
+    g_local = _local_gravity(o.gravity_axis, o.gravity, o.latitude)
+    text = text_options(o.names, o.rate, o.on_bad_lines, o.delimiter, o.decimal)
+    loaded = [
+        (
+            path,
+            load_recording(
+                path,
+                time=o.time,
+                time_unit=o.time_unit,
+                signal=o.signal,
+                temps=o.temps,
+                signal_unit=o.signal_unit,
+                temp_unit=o.temp_unit,
+                temp_conversion=o.temp_conversion,
+                text=text,
+                topic=o.topic,
+            ),
+        )
+        for path in paths
+    ]
+    if o.tref is not None and o.model != "poly":
+        raise ThermocalInputError(
+            f"--tref applies to the poly family (coefficients about TREF), not {o.model!r}"
+        )
+    spec = _FitSpec(o.model, family_options, o.temps, o.latitude, o.axis, o.known_input,
+                    o.target, o.gravity_axis, g_local, o.tref,
+                    _gravity.triad_gravity(loaded, names, o.gravity_axis, g_local),
+                    overrides_of(o.allow_narrow, o.allow_motion))  # fmt: skip
+    if len(names) <= 1:
+        est, result, n_runs = _fit_channel(spec, loaded, o.signal)
+        _files.save_model(est, output)
+        result["output"] = str(output)
+        return FitResult(output, (FittedChannel(est.signal_name, est, result, n_runs),), False)
+    fitted = _fit_channels(spec, loaded, names)
+    cal = _calibration.Calibration(
+        [
+            _calibration.Channel(
+                name,
+                name,
+                str(res["unit_as_given"]),
+                est,
+                _calibration.guess_role(name, res["model_unit"]),
+            )
+            for name, est, res, _n in fitted
+        ]
+    )
+    _files.save_calibration(cal, output)
+    channels = tuple(FittedChannel(name, est, res, n) for name, est, res, n in fitted)
+    return FitResult(output, channels, True)
+
+
+__all__ = [
+    "MAX_ORDER",
+    "MAX_SEGMENTS",
+    "MAX_TERMS",
+    "FitResult",
+    "FittedChannel",
+    "build_model",
+    "check_ceilings",
+    "fit_files",
+    "model_options",
+]

@@ -1,0 +1,111 @@
+"""Values and messages as the command line shows them: plain JSON types (:func:`jsonable`),
+one-line texts (:func:`one_line`) and the ``warning:`` lines of caught warnings
+(:func:`warning_lines`).  Used by the command line and by the fleet, which records the same
+warnings and writes the same JSON without running the command line."""
+
+from __future__ import annotations
+
+import dataclasses
+import errno
+import json
+import math
+import warnings
+from collections.abc import Iterable
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+from thermocal._lazy import LazyModule
+from thermocal.errors import ThermocalInputError, ThermocalWarning
+
+if TYPE_CHECKING:
+    import numpy as np
+else:
+    np = LazyModule("numpy")
+
+
+def one_line(text: object) -> str:
+    """``text`` with every run of white space (newlines included) made one space."""
+    return " ".join(str(text).split())
+
+
+def jsonable(obj: Any) -> Any:
+    """Convert results to plain JSON types: dataclasses → dicts, numpy → Python,
+    NaN/inf → ``None``, paths → strings."""
+    if dataclasses.is_dataclass(obj) and not isinstance(obj, type):
+        return {f.name: jsonable(getattr(obj, f.name)) for f in dataclasses.fields(obj)}
+    if isinstance(obj, dict):
+        return {str(k): jsonable(v) for k, v in obj.items()}
+    if isinstance(obj, list | tuple):
+        return [jsonable(v) for v in obj]
+    if isinstance(obj, np.ndarray):
+        return jsonable(obj.tolist())
+    if isinstance(obj, np.generic):
+        return jsonable(obj.item())
+    if isinstance(obj, float):
+        return obj if math.isfinite(obj) else None
+    if isinstance(obj, Path):
+        return str(obj)
+    return obj
+
+
+def json_text(obj: Any) -> str:
+    """The one line ``--json`` prints: :func:`jsonable` of ``obj``, newline-terminated."""
+    return json.dumps(jsonable(obj), allow_nan=False) + "\n"
+
+
+def warning_lines(caught: Iterable[warnings.WarningMessage]) -> list[str]:
+    """The text of each ``warning:`` line the command line prints for ``caught``, each
+    message once: thermocal warnings as they are, numerical ``RuntimeWarning``\\ s with their
+    class name in front; other warnings are not shown."""
+    seen: set[str] = set()
+    out: list[str] = []
+    for w in caught:
+        msg = one_line(w.message)
+        if msg in seen:
+            continue
+        seen.add(msg)
+        if issubclass(w.category, ThermocalWarning):
+            out.append(msg)
+        elif issubclass(w.category, RuntimeWarning):  # numerical trouble: never hidden
+            out.append(f"{w.category.__name__}: {msg}")
+    return out
+
+
+USER_OS_ERRORS: frozenset[int] = frozenset(
+    {
+        errno.EACCES,
+        errno.EPERM,
+        errno.EROFS,
+        errno.ENOSPC,
+        errno.EDQUOT,
+        errno.ENAMETOOLONG,
+        errno.ENOTDIR,
+        errno.EISDIR,
+        errno.ENOENT,
+        errno.EEXIST,
+        errno.EMFILE,
+    }
+)
+"""OS errors a user causes (exit 2 with ``error:``), as opposed to bugs (exit 1)."""
+
+
+def error_text(exc: Exception) -> tuple[str, bool]:
+    """The text of the ``error:`` line the command line prints for ``exc`` and whether it is
+    the user's (exit 2: bad input, a missing file, permissions, a full disk) rather than
+    thermocal's own failure (exit 1, ``internal: TYPE: message``)."""
+    if isinstance(exc, ThermocalInputError | FileNotFoundError | IsADirectoryError):
+        return one_line(exc), True
+    if isinstance(exc, OSError) and exc.errno in USER_OS_ERRORS:
+        where = exc.filename if exc.filename is not None else "output"
+        return f"{where}: {exc.strerror or one_line(exc)}", True
+    return f"internal: {type(exc).__name__}: {one_line(exc)}", False
+
+
+__all__ = [
+    "USER_OS_ERRORS",
+    "error_text",
+    "json_text",
+    "jsonable",
+    "one_line",
+    "warning_lines",
+]

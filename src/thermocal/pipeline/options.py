@@ -1,0 +1,211 @@
+"""The options of ``thermocal fit`` and ``thermocal validate`` as frozen dataclasses.
+
+One field per long option of the command, named as the option without its dashes
+(``--rate-interval`` → ``rate_interval``), with the command's default: the command line
+builds them from its parameters, a fleet configuration from its ``[fit]``/``[validate]``
+tables (:func:`options_from_table`), and a test checks that the fields and the command's
+options are the same set.  What the command takes besides (its files, ``-o``, ``--json``)
+is not an option here.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import typing
+from collections.abc import Mapping
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, TypeVar
+
+from thermocal.defaults import DEFAULT_AVERAGING_S
+from thermocal.errors import ThermocalInputError
+
+
+@dataclass(frozen=True)
+class FitOptions:
+    """``thermocal fit`` (INTERFACE.md; :func:`thermocal.pipeline.fit.fit_files`)."""
+
+    model: str
+    signal: str | None = None
+    temps: str | None = None
+    time: str | None = None
+    time_unit: str | None = None
+    signal_unit: str | None = None
+    temp_unit: str | None = None
+    temp_conversion: str | None = None
+    # poly
+    terms: str | None = None
+    order: int | None = None
+    rate_interval: float | None = None
+    rate_method: str | None = None
+    select: bool = False
+    select_method: str = "bic"
+    ridge: float | None = None
+    rcond: float | None = None
+    solver: str | None = None
+    noise_threshold: float | None = None
+    # piecewise
+    breakpoints: str | None = None
+    segments: int | None = None
+    method: str | None = None
+    # warmup
+    start_window: float | None = None
+    t0_order: int | None = None
+    # bank
+    deviation: float | None = None
+    tolerance: float | None = None
+    startup_s: float | None = None
+    # every family
+    per_run_offset: bool | None = None
+    target: str = "bias"
+    latitude: float | None = None
+    axis: str | None = None
+    known_input: float | None = None
+    gravity_axis: str | None = None
+    gravity: float | None = None
+    tref: float | None = None
+    allow_narrow: bool = False
+    allow_motion: bool = False
+    # how the files are read (text logs, ULog)
+    names: str | None = None
+    topic: str | None = None
+    rate: float | None = None
+    on_bad_lines: str = "error"
+    delimiter: str | None = None
+    decimal: str | None = None
+
+
+@dataclass(frozen=True)
+class ValidateOptions:
+    """``thermocal validate`` (INTERFACE.md; :func:`thermocal.pipeline.validate.validate_files`).
+    The text-log options (``names``, ``rate``, ``on_bad_lines``, ``delimiter``, ``decimal``)
+    apply to the validated file and to the ``modeling`` file alike."""
+
+    modeling: Path | None = None
+    ambient: str | None = None
+    averaging: float = DEFAULT_AVERAGING_S
+    signal: str | None = None
+    time: str | None = None
+    time_unit: str | None = None
+    signal_unit: str | None = None
+    temp_unit: str | None = None
+    temp_conversion: str | None = None
+    stage_rate: float = 0.05
+    min_stage: float = 600.0
+    settle: float = 0.0
+    extrapolate: bool = False
+    names: str | None = None
+    rate: float | None = None
+    on_bad_lines: str = "error"
+    delimiter: str | None = None
+    decimal: str | None = None
+    latitude: float | None = None
+
+
+ALIASES: dict[str, dict[str, str]] = {"validate": {"average": "averaging"}}
+"""Second names of an option (``--average`` is ``--averaging``), per command."""
+
+NOT_IN_TABLES = frozenset({"modeling"})
+"""Options a fleet sets itself (the unit's own modelling file)."""
+
+OPTIONS: dict[str, type[Any]] = {"fit": FitOptions, "validate": ValidateOptions}
+"""The options dataclass of each command."""
+
+O = TypeVar("O", FitOptions, ValidateOptions)
+
+
+def option_kinds(cls: type[Any]) -> dict[str, str]:
+    """``{option name: "flag" | "int" | "float" | "str" | "path"}`` of an options dataclass
+    (option names with dashes)."""
+    hints = typing.get_type_hints(cls)
+    out: dict[str, str] = {}
+    for f in dataclasses.fields(cls):
+        args = set(typing.get_args(hints[f.name])) - {type(None)} or {hints[f.name]}
+        kind = next(iter(args))
+        name = f.name.replace("_", "-")
+        out[name] = {bool: "flag", int: "int", float: "float", Path: "path"}.get(kind, "str")
+    return out
+
+
+def options_of(cls: type[O], values: Mapping[str, Any]) -> O:
+    """The options dataclass from a mapping holding at least its fields (a command's
+    parameters, named as the fields)."""
+    return cls(**{f.name: values[f.name] for f in dataclasses.fields(cls) if f.name in values})
+
+
+def _table_text(key: str, value: Any, where: str) -> str:
+    """A table value as the command line would take it: a list as ``a,b``, a number as
+    written."""
+    if isinstance(value, list):
+        if not value or not all(isinstance(v, str | int | float) for v in value):
+            raise ThermocalInputError(f"{where}: {key}: expected a list of names or numbers")
+        return ",".join(str(v) for v in value)
+    if isinstance(value, str | int | float) and not isinstance(value, bool):
+        return str(value)
+    raise ThermocalInputError(f"{where}: {key}: expected a string, number or list")
+
+
+def _parse(kind: str, name: str, text: str, where: str) -> Any:
+    """``text`` as the option's type, refused as the command line refuses it."""
+    try:
+        if kind == "int":
+            return int(text)
+        if kind == "float":
+            return float(text)
+    except ValueError:
+        what = "integer" if kind == "int" else "float"
+        raise ThermocalInputError(
+            f"{where}: Invalid value for '--{name}': {text!r} is not a valid {what}."
+        ) from None
+    return Path(text) if kind == "path" else text
+
+
+def options_from_table(command: str, table: Mapping[str, Any], where: str) -> tuple[Any, list[str]]:
+    """A fleet configuration's table of ``command`` options (``{"model": "poly", "order": 2,
+    "signal": ["gx", "gy"], "select": true}``) → the options dataclass and the same options
+    as command-line arguments (``["--model", "poly", "--order", "2", "--signal", "gx,gy",
+    "--select"]``, recorded with each unit).  An unknown option, a value of the wrong shape
+    or type, or a missing required option is a :class:`ThermocalInputError` naming it
+    (``where``: the file and table).  A flag set to false is left at its default."""
+    cls = OPTIONS[command]
+    kinds = option_kinds(cls)
+    aliases = ALIASES.get(command, {})
+    known = {n: n for n in kinds if n.replace("-", "_") not in NOT_IN_TABLES}
+    known |= {a: t for a, t in aliases.items()}
+    args: list[str] = []
+    values: dict[str, Any] = {}
+    for key, value in table.items():
+        name = str(key).replace("_", "-")
+        if name not in known:
+            raise ThermocalInputError(
+                f"{where}: {key!r} is not an option of thermocal {command}; it takes "
+                + ", ".join(sorted(known))
+            )
+        field = known[name].replace("-", "_")
+        kind = kinds[known[name]]
+        if kind == "flag":
+            if not isinstance(value, bool):
+                raise ThermocalInputError(f"{where}: {key} is a flag: write true or false")
+            if value:
+                args.append(f"--{name}")
+                values[field] = True
+            continue
+        text = _table_text(str(key), value, where)
+        args += [f"--{name}", text]
+        values[field] = _parse(kind, name, text, where)
+    required = [f.name for f in dataclasses.fields(cls) if f.default is dataclasses.MISSING]
+    for f in required:
+        if f not in values:
+            raise ThermocalInputError(f"{where}: Missing option '--{f.replace('_', '-')}'.")
+    return cls(**values), args
+
+
+__all__ = [
+    "ALIASES",
+    "OPTIONS",
+    "FitOptions",
+    "ValidateOptions",
+    "option_kinds",
+    "options_from_table",
+    "options_of",
+]

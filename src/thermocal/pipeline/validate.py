@@ -1,0 +1,301 @@
+"""Judging a model or calibration on an independent recording: :func:`validate_files`
+(``thermocal validate``; SPEC §5, :func:`thermocal.validation.validate`).
+
+``r`` compares the ``ambient`` column of the modelling and validation runs (default: the
+model's first temperature column).  The modelling run is ``options.modeling``, else the model
+file's recorded data file if it still exists (:func:`modeling_file`); otherwise ``r`` is null,
+with a warning.  Both files are read through :func:`thermocal.pipeline.reading.load_recording`
+with the same options (time, units, temperature conversion and the text-log options: a
+headerless serial log as the modelling run needs ``names`` as much as the validated one).
+A calibration of triads (``thermocal turntable``, ``thermocal multipos``) is judged on a
+turntable or multi-position run instead (dwell-mean and move-angle errors, held-out poses).
+"""
+
+from __future__ import annotations
+
+import warnings
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+from thermocal.errors import ThermocalInputError, UnitWarning
+from thermocal.pipeline.options import ValidateOptions
+from thermocal.pipeline.reading import load_recording, split_names, text_options
+
+if TYPE_CHECKING:
+    from thermocal.models.base import TemperatureModel
+    from thermocal.models.calibration import Calibration
+    from thermocal.readers.text import TextOptions
+    from thermocal.recording import FloatArray, Recording
+    from thermocal.validation import ValidationResult
+
+
+@dataclass(frozen=True)
+class ChannelValidation:
+    """One channel judged: its model, the :class:`~thermocal.validation.ValidationResult`
+    (in the data's own unit) and its ``--json`` object (``figures``)."""
+
+    name: str
+    model: TemperatureModel
+    result: ValidationResult
+    figures: dict[str, Any]
+
+
+@dataclass(frozen=True)
+class ValidationReport:
+    """What :func:`validate_files` found: per channel (``several``: a calibration of several
+    channels), or per triad (``triads``: a calibration of triads on a turntable run)."""
+
+    model_file: Path
+    file: Path
+    channels: tuple[ChannelValidation, ...] = ()
+    several: bool = False
+    triads: tuple[Any, ...] = ()
+
+    def to_dict(self) -> dict[str, Any]:
+        """``thermocal validate --json``: one channel's figures; ``{"channels": {name:
+        figures}}`` for several; ``{"model", "file", "family": "triads", "triads"}``."""
+        if self.triads:
+            return {
+                "model": str(self.model_file),
+                "file": str(self.file),
+                "family": "triads",
+                "triads": {r.triad: r.to_dict() for r in self.triads},
+            }
+        if self.several:
+            return {
+                "channels": {
+                    c.name: {**c.figures, "verdict": c.result.verdict} for c in self.channels
+                }
+            }
+        return self.channels[0].figures
+
+
+def modeling_file(model: TemperatureModel, model_file: Path) -> Path | None:
+    """The first data file recorded in the model file that still exists: its name, then
+    the path given to fit (relative ones tried from the current directory and from the
+    model file's directory)."""
+    for entry in model.data_:
+        if not isinstance(entry, dict):
+            continue
+        for key in ("file", "path"):  # the name, then the path given to fit
+            name = entry.get(key)
+            if not name:
+                continue
+            p = Path(str(name))
+            for cand in (p, model_file.parent / p) if not p.is_absolute() else (p,):
+                if cand.is_file():
+                    return cand
+    return None
+
+
+def ambient_c(rec: Recording, name: str) -> FloatArray:
+    """The ambient temperature [°C] for r and the hold stages; raw counts with no
+    conversion are used as counts, with a warning (the hold threshold is then per count)."""
+    if rec.units.get(name) == "counts" and name not in rec.meta.temperature_conversion:
+        warnings.warn(
+            UnitWarning(
+                f"{rec.name}: the ambient column {name!r} is in raw counts with no conversion: "
+                "hold stages are found with --stage-rate in counts/min"
+            ),
+            stacklevel=2,
+        )
+        return rec.column(name)
+    return rec.temperature_c(name)
+
+
+@dataclass
+class _Context:
+    """What every channel's validation shares: the files, options, and the modelling runs
+    read so far (one read per file and ambient column)."""
+
+    model_file: Path
+    file: Path
+    o: ValidateOptions
+    text: TextOptions | None
+    modeling: dict[Path, Recording]
+
+
+def _modeling_ambient(
+    ctx: _Context, model: TemperatureModel, amb: str
+) -> tuple[Path | None, tuple[FloatArray, FloatArray] | None]:
+    """The modelling run's file and ``(time_s, ambient)``, read with the validated file's
+    options (None when there is no modelling run)."""
+    from thermocal import recording
+
+    o = ctx.o
+    mod_path = o.modeling if o.modeling is not None else modeling_file(model, ctx.model_file)
+    if mod_path is None:
+        return None, None
+    mrec = ctx.modeling.get(mod_path)
+    if mrec is None or amb not in mrec.columns:
+        mrec = load_recording(
+            mod_path,
+            time=o.time,
+            time_unit=o.time_unit,
+            temps=amb,
+            temp_unit=o.temp_unit,
+            temp_conversion=o.temp_conversion,
+            model=model,
+            require_signal=False,
+            check=False,
+            text=ctx.text,
+        )
+        for prob in recording.find_problems(mrec, required=[amb]):
+            if prob.severity == "error" and (prob.column in (None, "time", amb)):
+                raise ThermocalInputError(f"{mod_path}: {prob.message}")
+        ctx.modeling[mod_path] = mrec
+    return mod_path, (mrec.time_s, ambient_c(mrec, amb))
+
+
+def _validate_channel(
+    ctx: _Context, model: TemperatureModel, sig: str, rec: Recording | None = None
+) -> tuple[ValidationResult, dict[str, Any]]:
+    """Validate one model on its signal column; (result, --json object).  ``rec``: the
+    file already read (several channels: once for all of them)."""
+    from thermocal import validation
+    from thermocal.compensate import files as compensate
+
+    o = ctx.o
+    temps = list(model.temp_names_)
+    amb = o.ambient or temps[0]
+    read_temps = temps if amb in temps else [*temps, amb]
+    if rec is None:
+        rec = load_recording(
+            ctx.file,
+            time=o.time,
+            time_unit=o.time_unit,
+            signal=sig,
+            temps=",".join(read_temps),
+            signal_unit=o.signal_unit,
+            temp_unit=o.temp_unit,
+            temp_conversion=o.temp_conversion,
+            model=model,
+            text=ctx.text,
+        )
+    # the data in the model's units (kinds checked); figures go back to the data's unit
+    prepared = compensate.prepare_run(model, rec, sig, temps)
+    counts = prepared.data_unit == "counts"  # raw counts: figures in K's physical unit
+    amb_val = ambient_c(rec, amb)
+    mod_path, modeling_ambient = _modeling_ambient(ctx, model, amb)
+    res = validation.validate(
+        model,
+        prepared.run,
+        modeling_ambient,
+        validation_ambient=amb_val,
+        averaging_s=o.averaging,
+        rate_threshold_c_per_min=o.stage_rate,
+        min_stage_s=o.min_stage,
+        settle_s=o.settle,
+        extrapolate=o.extrapolate,
+        zero_reference=compensate.zero_reference(model, rec.meta),
+        display_unit=None if counts else (prepared.data_unit, prepared.factor),
+    )
+    if not counts:
+        res = res.in_unit(prepared.data_unit, prepared.factor)
+    out = res.to_dict()
+    out["model_unit"] = model.signal_unit
+    out["model"] = str(ctx.model_file)
+    out["family"] = model.family
+    out["file"] = str(ctx.file)
+    out["modeling_file"] = str(mod_path) if mod_path is not None else None
+    out["ambient"] = amb
+    return res, out
+
+
+def _validate_channels(ctx: _Context, cal: Calibration) -> ValidationReport:
+    """A calibration of several channels: the file read once with every chosen channel's
+    column (issue 15), each channel judged on it."""
+    from thermocal.models.calibration import merged_inputs, temperatures_of
+
+    o = ctx.o
+    chosen = split_names(o.signal) or cal.names
+    missing = [n for n in chosen if n not in cal.names]
+    if missing:
+        raise ThermocalInputError(
+            f"{ctx.model_file}: no channel {', '.join(map(repr, missing))}; it has "
+            + ", ".join(cal.names)
+        )
+    read_temps = temperatures_of(cal, chosen)
+    if o.ambient and o.ambient not in read_temps:
+        read_temps.append(o.ambient)
+    rec_all = load_recording(
+        ctx.file,
+        time=o.time,
+        time_unit=o.time_unit,
+        signal=",".join(cal.channel(n).signal for n in chosen),
+        temps=",".join(read_temps),
+        signal_unit=o.signal_unit,
+        temp_unit=o.temp_unit,
+        temp_conversion=o.temp_conversion,
+        model_inputs=merged_inputs(cal, chosen),
+        text=ctx.text,
+    )
+    per = []
+    for n in chosen:
+        ch = cal.channel(n)
+        res, out = _validate_channel(ctx, ch.model, ch.signal, rec_all)
+        per.append(ChannelValidation(n, ch.model, res, out))
+    return ValidationReport(ctx.model_file, ctx.file, tuple(per), several=True)
+
+
+def _validate_triads(
+    cal: Calibration, model_file: Path, file: Path, o: ValidateOptions
+) -> ValidationReport:
+    """A calibration of triads judged on a turntable run (issue 19), or on held-out poses
+    of a multi-position calibration (issue 30); a warning per triad for the share of samples
+    outside its calibrated temperature range."""
+    from thermocal.compensate.files import read_for_triads
+    from thermocal.multipos import validate as _mp_validate
+    from thermocal.turntable.calibrate import validate_triads
+
+    rec = read_for_triads(file, cal.triads, time=o.time, time_unit=o.time_unit)
+    if _mp_validate.is_multipos(cal.triads):  # held-out poses (issue 30)
+        results: list[Any] = _mp_validate.validate_triads(cal.triads, rec, o.latitude)
+    else:
+        results = validate_triads(cal.triads, rec, o.latitude)
+    for r in results:
+        if r.outside_range_fraction > 0:
+            warnings.warn(
+                UnitWarning(
+                    f"{file}: {100 * r.outside_range_fraction:.3g} % of the samples are outside "
+                    f"the {r.triad} triad's calibrated temperature range"
+                ),
+                stacklevel=1,
+            )
+    return ValidationReport(model_file, file, triads=tuple(results))
+
+
+def validate_files(
+    calibration: Path, file: Path, options: ValidateOptions | None = None
+) -> ValidationReport:
+    """Judge the model or calibration file ``calibration`` on the recording ``file`` (module
+    docstring): correlation r, bias stability and repeatability over the hold stages, rms and
+    peak-to-peak, before and after compensation, in the data's own unit
+    (:func:`thermocal.validation.validate`); triads: dwell-mean and move-angle errors."""
+    from thermocal.models.files import load_calibration
+
+    o = options if options is not None else ValidateOptions()
+    pre = load_calibration(calibration)
+    if pre.triads and not pre.channels:
+        return _validate_triads(pre, calibration, file, o)
+    text = text_options(o.names, o.rate, o.on_bad_lines, o.delimiter, o.decimal)
+    ctx = _Context(calibration, file, o, text, {})
+    cal = load_calibration(calibration)  # a model file is a calibration of one channel
+    cal.require_channels("validate")
+    if len(cal.channels) > 1:
+        return _validate_channels(ctx, cal)
+    model = cal.channels[0].model
+    res, out = _validate_channel(ctx, model, o.signal or model.signal_name)
+    return ValidationReport(
+        calibration, file, (ChannelValidation(model.signal_name, model, res, out),)
+    )
+
+
+__all__ = [
+    "ChannelValidation",
+    "ValidationReport",
+    "ambient_c",
+    "modeling_file",
+    "validate_files",
+]
