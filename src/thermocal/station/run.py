@@ -20,9 +20,10 @@ from pathlib import Path
 from typing import Any, Protocol
 
 from thermocal.errors import ThermocalInputError
+from thermocal.readers.station import closed_parts
 from thermocal.station.chamber import Chamber, ChamberError, make_chamber
 from thermocal.station.config import CHAMBER_STREAM, StationConfig
-from thermocal.station.recorder import Recorder, closed_parts
+from thermocal.station.recorder import Recorder
 from thermocal.station.sensors import SerialSensor
 
 LOOP_S = 0.02
