@@ -36,6 +36,7 @@ from typing import Any
 from thermocal import units
 from thermocal.errors import ThermocalInputError
 from thermocal.readers.station import (
+    CHAMBER_STREAM,
     STATION_FORMAT,
     STATION_JSON,
     STATION_VERSION,
@@ -45,7 +46,7 @@ from thermocal.readers.station import (
     read_station_json,
     station_files,
 )
-from thermocal.station.config import CHAMBER_STREAM, StationConfig
+from thermocal.station.config import StationConfig
 
 STATION_COLUMNS = {
     "time": "s",

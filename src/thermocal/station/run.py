@@ -20,9 +20,9 @@ from pathlib import Path
 from typing import Any, Protocol
 
 from thermocal.errors import ThermocalInputError
-from thermocal.readers.station import closed_parts
+from thermocal.readers.station import CHAMBER_STREAM, closed_parts
 from thermocal.station.chamber import Chamber, ChamberError, make_chamber
-from thermocal.station.config import CHAMBER_STREAM, StationConfig
+from thermocal.station.config import StationConfig
 from thermocal.station.recorder import Recorder
 from thermocal.station.sensors import SerialSensor
 
