@@ -14,7 +14,8 @@ of the open part; every closed part is complete.  ``station.json`` is rewritten 
 way (temporary, ``fsync``, rename) after each part and event.  A part's Parquet key-value
 metadata holds the thermocal metadata object (:func:`thermocal.readers.dispatch.recording_info`'s
 layout: time column, units of every column, the sensor id and the station's metadata), so
-each part is a complete recording on its own and :func:`thermocal.readers.station.read_station` concatenates them.
+each part is a complete recording on its own and
+:func:`thermocal.readers.station.read_station` concatenates them.
 
 Columns of a sensor part: ``time`` [s since the recording's start; from the line's own
 time field, else ``line index / rate_hz`` anchored at the run's first line, else the host
