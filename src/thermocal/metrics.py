@@ -552,6 +552,103 @@ def data_unit_of(rec: Recording, name: str, canonical: str) -> tuple[str, float]
     return u, float(units.convert(1.0, u, canonical))
 
 
+def _earth_rate(
+    rec: Recording,
+    name: str,
+    canon: str,
+    unit: str,
+    k: float,
+    latitude_deg: float | None,
+    axis: str | None,
+) -> float:
+    """The earth rate on the sensitive axis [data unit] to remove: 0 unless a latitude or
+    an axis is given (options, else the recording's metadata); both are then needed, and
+    the signal must be a gyro rate (:func:`thermocal.units.earth_rate_on_axis_deg_h` / k)."""
+    lat = latitude_deg if latitude_deg is not None else rec.meta.latitude_deg
+    ax = axis if axis is not None else rec.meta.axis
+    if lat is None and axis is None:
+        return 0.0
+    if lat is None or ax is None:
+        raise ThermocalInputError("earth-rate removal needs both --latitude and --axis")
+    if canon != "deg/h":
+        raise ThermocalInputError(
+            f"earth-rate removal applies to gyro rates, but {name!r} is in {unit}"
+        )
+    if not -90.0 <= lat <= 90.0:
+        raise ThermocalInputError(f"latitude must be within ±90°, got {lat}")
+    return units.earth_rate_on_axis_deg_h(lat, units.parse_axis(ax)) / k  # [unit]
+
+
+def _drift(
+    t: FloatArray,
+    values: FloatArray,
+    name: str,
+    unit: str,
+    earth: float,
+    drift_reference_s: tuple[float, float] | None,
+    drift_bias: float | None,
+) -> tuple[DriftReference, DriftExtreme] | None:
+    """The drift angle's reference bias b0 and ``θ(t) = ∫ (ω − Ω_axis − b0) dt`` at the
+    end and at its largest (gyro rates only; None otherwise, where the drift options are
+    an error)."""
+    if unit not in RATE_ANGLE_UNITS:
+        if drift_bias is not None or drift_reference_s is not None:
+            raise ThermocalInputError(
+                f"the drift angle applies to gyro rates, but {name!r} is in {unit}: "
+                "--drift-reference/--drift-bias do not apply"
+            )
+        return None
+    angle_unit, per = RATE_ANGLE_UNITS[unit]
+    if drift_bias is not None:
+        if drift_reference_s is not None:
+            raise ThermocalInputError("give either --drift-reference or --drift-bias, not both")
+        if not math.isfinite(drift_bias):
+            raise ThermocalInputError(f"--drift-bias must be a number, got {drift_bias!r}")
+        ref = DriftReference("bias", None, None, float(drift_bias), unit)
+    else:
+        ref = reference_bias(t, values, window_s=drift_reference_s, earth_rate=earth, unit=unit)
+    ext = drift_angle_extreme(t, values, ref.bias + earth, time_unit_s=per, unit=angle_unit)
+    return ref, ext
+
+
+def _stage_figures(
+    t: FloatArray,
+    temp: FloatArray | None,
+    values: FloatArray,
+    unit: str,
+    earth: float,
+    rate_threshold_c_per_min: float,
+    min_hold_s: float,
+) -> tuple[tuple[Stage, ...], float | None, TemperatureSensitivity | None]:
+    """The hold stages of the temperature ``temp`` [°C] (none without one), the bias
+    repeatability over them (two or more) and the temperature sensitivity over the
+    stages pooled by set-point (within 0.5 °C; two or more set-points)."""
+    if temp is None:
+        return (), None, None
+    stages = hold_stages(
+        t,
+        temp,
+        values,
+        rate_threshold_c_per_min=rate_threshold_c_per_min,
+        min_duration_s=min_hold_s,
+    )
+    if earth:  # mean(ω − Ω) = mean(ω) − Ω, without a full-length copy
+        stages = tuple(dataclasses.replace(s, bias=s.bias - earth) for s in stages)
+    if len(stages) < 2:
+        return stages, None, None
+    rep = bias_repeatability([s.bias for s in stages])
+    st_temps = np.array([s.mean_temp_c for s in stages])
+    st_bias = np.array([s.bias for s in stages])
+    # hold stages at the same set-point (within 0.5 °C) are pooled
+    key = np.round(st_temps * 2.0) / 2.0
+    uniq = np.unique(key)
+    if uniq.size < 2:
+        return stages, rep, None
+    pt = np.array([st_temps[key == k].mean() for k in uniq])
+    pb = np.array([st_bias[key == k].mean() for k in uniq])
+    return stages, rep, temperature_sensitivity(pt, pb, unit=unit)
+
+
 def compute_metrics(
     rec: Recording,
     signal: str | None = None,
@@ -597,19 +694,7 @@ def compute_metrics(
     t = rec.time_s
     tau0 = rec.sample_interval_s
     avg = float(averaging_s) if averaging_s is not None else tau0
-    lat = latitude_deg if latitude_deg is not None else rec.meta.latitude_deg
-    ax = axis if axis is not None else rec.meta.axis
-    earth = 0.0
-    if lat is not None or axis is not None:
-        if lat is None or ax is None:
-            raise ThermocalInputError("earth-rate removal needs both --latitude and --axis")
-        if canon != "deg/h":
-            raise ThermocalInputError(
-                f"earth-rate removal applies to gyro rates, but {name!r} is in {unit}"
-            )
-        if not -90.0 <= lat <= 90.0:
-            raise ThermocalInputError(f"latitude must be within ±90°, got {lat}")
-        earth = units.earth_rate_on_axis_deg_h(lat, units.parse_axis(ax)) / k  # [unit]
+    earth = _earth_rate(rec, name, canon, unit, k, latitude_deg, axis)
     b0 = bias(values, earth_rate_deg_h=earth)
     means = block_means(values, tau0, avg, time_s=t)
     if means.size < 2:
@@ -619,56 +704,18 @@ def compute_metrics(
         )
     stab = float(np.std(means, ddof=1))
     p2p = float(np.max(means) - np.min(means))
-    drift: float | None = None
-    drift_unit: str | None = None
-    drift_max: float | None = None
-    drift_max_t: float | None = None
-    ref: DriftReference | None = None
-    if unit in RATE_ANGLE_UNITS:
-        angle_unit, per = RATE_ANGLE_UNITS[unit]
-        if drift_bias is not None:
-            if drift_reference_s is not None:
-                raise ThermocalInputError("give either --drift-reference or --drift-bias, not both")
-            if not math.isfinite(drift_bias):
-                raise ThermocalInputError(f"--drift-bias must be a number, got {drift_bias!r}")
-            ref = DriftReference("bias", None, None, float(drift_bias), unit)
-        else:
-            ref = reference_bias(t, values, window_s=drift_reference_s, earth_rate=earth, unit=unit)
-        ext = drift_angle_extreme(t, values, ref.bias + earth, time_unit_s=per, unit=angle_unit)
-        drift, drift_unit = ext.end, angle_unit
-        drift_max, drift_max_t = ext.max_abs, ext.max_time_s
-    elif drift_bias is not None or drift_reference_s is not None:
-        raise ThermocalInputError(
-            f"the drift angle applies to gyro rates, but {name!r} is in {unit}: "
-            "--drift-reference/--drift-bias do not apply"
-        )
-
-    sens: TemperatureSensitivity | None = None
-    rep: float | None = None
-    stages: tuple[Stage, ...] = ()
+    drift = _drift(t, values, name, unit, earth, drift_reference_s, drift_bias)
+    ref, ext = drift if drift is not None else (None, None)
     temp_names = list(temps) if temps else list(rec.temperatures)
-    if temp_names:
-        temp = rec.temperature_c(temp_names[0])
-        stages = hold_stages(
-            t,
-            temp,
-            values,
-            rate_threshold_c_per_min=rate_threshold_c_per_min,
-            min_duration_s=min_hold_s,
-        )
-        if earth:  # mean(ω − Ω) = mean(ω) − Ω, without a full-length copy
-            stages = tuple(dataclasses.replace(s, bias=s.bias - earth) for s in stages)
-        if len(stages) >= 2:
-            rep = bias_repeatability([s.bias for s in stages])
-            st_temps = np.array([s.mean_temp_c for s in stages])
-            st_bias = np.array([s.bias for s in stages])
-            # hold stages at the same set-point (within 0.5 °C) are pooled
-            key = np.round(st_temps * 2.0) / 2.0
-            uniq = np.unique(key)
-            if uniq.size >= 2:
-                pt = np.array([st_temps[key == k].mean() for k in uniq])
-                pb = np.array([st_bias[key == k].mean() for k in uniq])
-                sens = temperature_sensitivity(pt, pb, unit=unit)
+    stages, rep, sens = _stage_figures(
+        t,
+        rec.temperature_c(temp_names[0]) if temp_names else None,
+        values,
+        unit,
+        earth,
+        rate_threshold_c_per_min,
+        min_hold_s,
+    )
     return MetricsResult(
         bias=b0,
         bias_stability=stab,
@@ -678,10 +725,10 @@ def compute_metrics(
         temperature_sensitivity=sens,
         bias_repeatability=rep,
         stages=stages,
-        drift_angle=drift,
-        drift_angle_unit=drift_unit,
-        drift_angle_max=drift_max,
-        drift_angle_max_time_s=drift_max_t,
+        drift_angle=ext.end if ext is not None else None,
+        drift_angle_unit=RATE_ANGLE_UNITS[unit][0] if ext is not None else None,
+        drift_angle_max=ext.max_abs if ext is not None else None,
+        drift_angle_max_time_s=ext.max_time_s if ext is not None else None,
         drift_reference=ref,
         earth_rate_removed=earth,
         n_samples=int(values.size),
