@@ -18,7 +18,9 @@ from __future__ import annotations
 import bisect
 import dataclasses
 import math
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from typing import TypeVar
 
 import numpy as np
 import numpy.typing as npt
@@ -28,6 +30,8 @@ from thermocal._lazy import LazyModule
 from thermocal.errors import MissingValueError, ThermocalInputError
 from thermocal.recording import Recording, contiguous_slices, is_increasing
 
+_Run = TypeVar("_Run")
+"""A run as the caller names it (a path): ``read`` turns it into a recording."""
 FloatArray = npt.NDArray[np.float64]
 
 special = LazyModule("scipy.special")  # chi-square quantiles, when an interval is asked for
@@ -739,10 +743,104 @@ def compute_metrics(
     )
 
 
+@dataclass(frozen=True)
+class MetricsOptions:
+    """The options of :func:`compute_metrics` shared by every channel and run (``metrics``'
+    command line): averaging time [s], earth-rate removal (latitude [°], axis), temperature
+    columns, hold-stage detection (|Ṫ| [°C/min], shortest hold [s]) and the drift angle's
+    reference window [s] or bias [data unit]."""
+
+    averaging_s: float | None = None
+    latitude_deg: float | None = None
+    axis: str | None = None
+    temps: tuple[str, ...] | None = None
+    rate_threshold_c_per_min: float = 0.05
+    min_hold_s: float = 600.0
+    drift_reference_s: tuple[float, float] | None = None
+    drift_bias: float | None = None
+
+    @property
+    def removes_earth_rate(self) -> bool:
+        """A latitude or an axis is given (earth-rate removal, one signal at a time)."""
+        return self.latitude_deg is not None or self.axis is not None
+
+    def of(self, rec: Recording, name: str) -> MetricsResult:
+        """:func:`compute_metrics` of the signal ``name`` of ``rec`` with these options."""
+        return compute_metrics(
+            rec,
+            name,
+            self.averaging_s,
+            self.latitude_deg,
+            self.axis,
+            list(self.temps) if self.temps else None,
+            rate_threshold_c_per_min=self.rate_threshold_c_per_min,
+            min_hold_s=self.min_hold_s,
+            drift_reference_s=self.drift_reference_s,
+            drift_bias=self.drift_bias,
+        )
+
+
+def channel_metrics(
+    rec: Recording, names: list[str], options: MetricsOptions
+) -> dict[str, MetricsResult]:
+    """The figures of every channel ``names`` of one recording (one read of the file,
+    INTERFACE: several channels).  Earth-rate removal takes one channel: each channel's
+    sensitive axis points elsewhere."""
+    if len(names) > 1 and options.removes_earth_rate:
+        raise ThermocalInputError(
+            "earth-rate removal (--latitude/--axis) takes one signal at a time: each channel's "
+            "sensitive axis points elsewhere; run metrics per gyro axis with its --axis"
+        )
+    return {name: options.of(rec, name) for name in names}
+
+
+@dataclass(frozen=True, eq=False)
+class PowerOnMetrics:
+    """The result of :func:`power_on_metrics`: the channels, each run's figures per channel
+    (in the order of the runs) and the turn-on to turn-on repeatability per channel."""
+
+    names: tuple[str, ...]
+    runs: tuple[dict[str, MetricsResult], ...]
+    repeatability: dict[str, RunRepeatability]
+
+
+def power_on_metrics(
+    runs: Sequence[_Run],
+    read: Callable[[_Run], Recording],
+    signals: list[str] | None,
+    options: MetricsOptions,
+) -> PowerOnMetrics:
+    """Several power-ons of one sensor: ``read(run)`` gives each run's recording (read in
+    turn, so the first bad file stops the analysis), the figures of the channels
+    ``signals`` (default each file's first signal; every run the same channels), and per
+    channel :func:`run_repeatability` over the runs, labelled ``str(run)``."""
+    per_run: list[dict[str, MetricsResult]] = []
+    names: list[str] | None = None
+    for run in runs:
+        rec = read(run)
+        these = signals or [rec.signals[0]]
+        if names is None:
+            names = these
+        elif these != names:
+            raise ThermocalInputError(f"{run}: signals {these} differ from the first run's {names}")
+        if len(these) > 1 and options.removes_earth_rate:
+            raise ThermocalInputError(
+                "earth-rate removal (--latitude/--axis) takes one signal at a time"
+            )
+        per_run.append({n: options.of(rec, n) for n in these})
+    if names is None:
+        raise ThermocalInputError("no run to analyse")
+    labels = [str(r) for r in runs]
+    reps = {n: run_repeatability([r[n] for r in per_run], labels) for n in names}
+    return PowerOnMetrics(tuple(names), tuple(per_run), reps)
+
+
 __all__ = [
     "DriftExtreme",
     "DriftReference",
+    "MetricsOptions",
     "MetricsResult",
+    "PowerOnMetrics",
     "RunRepeatability",
     "Stage",
     "TemperatureSensitivity",
@@ -751,12 +849,14 @@ __all__ = [
     "bias_repeatability",
     "bias_stability",
     "block_means",
+    "channel_metrics",
     "compute_metrics",
     "data_unit_of",
     "drift_angle",
     "drift_angle_extreme",
     "hold_stages",
     "peak_to_peak",
+    "power_on_metrics",
     "reference_bias",
     "run_repeatability",
     "std_interval",
