@@ -23,7 +23,7 @@ from thermocal import units
 from thermocal.errors import ThermocalInputError
 from thermocal.models.calibration import Calibration, Triad
 from thermocal.models.files import save_calibration
-from thermocal.multipos.calibrate import SessionResult, calibrate_session
+from thermocal.multipos.calibrate import METHOD, SessionResult, calibrate_session
 from thermocal.multipos.poses import parse_poses
 from thermocal.readers import read_recording
 from thermocal.recording import Recording
@@ -207,7 +207,7 @@ def _fit_triads(
                 [ft.theta for ft in fits], [ft.sigma for ft in fits],  # type: ignore[union-attr]
                 tref_c=opts.tref_c if kind == "accel" or "accel" not in models
                 else models["accel"].tref_c,
-                order=opts.order, method="multipos", gravity_m_s2=grav.g_m_s2,
+                order=opts.order, method=METHOD, gravity_m_s2=grav.g_m_s2,
             )  # fmt: skip
         else:
             r = runs[0].result
@@ -215,7 +215,7 @@ def _fit_triads(
             assert ft is not None
             m = thermal.constant_triad(
                 kind, r.temperature_c if r.temperature_c is not None else NO_TEMPERATURE_TREF_C,
-                ft.theta, ft.cov, t_range_c=runs[0].t_range_c, method="multipos",
+                ft.theta, ft.cov, t_range_c=runs[0].t_range_c, method=METHOD,
                 gravity_m_s2=grav.g_m_s2,
             )  # fmt: skip
         models[kind] = m
