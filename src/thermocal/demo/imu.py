@@ -49,7 +49,7 @@ TRUE_REMOVED = "true bias removed [%]"
 AMBIENT = "T_chamber"
 
 
-@dataclass
+@dataclass(frozen=True)
 class ChannelSummary:
     """One channel's figures: ``removed_pct`` share of the true temperature-induced bias
     removed on the validation run (``100 (1 − rms(e)/sd(E))``, e the model's error against
@@ -70,7 +70,7 @@ class ChannelSummary:
     warnings: list[str] = field(default_factory=list)
 
 
-@dataclass
+@dataclass(frozen=True)
 class ImuDemoResult:
     """Where everything went and the per-channel figures."""
 
