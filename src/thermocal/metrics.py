@@ -18,7 +18,9 @@ from __future__ import annotations
 import bisect
 import dataclasses
 import math
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from typing import TypeVar
 
 import numpy as np
 import numpy.typing as npt
@@ -28,6 +30,8 @@ from thermocal._lazy import LazyModule
 from thermocal.errors import MissingValueError, ThermocalInputError
 from thermocal.recording import Recording, contiguous_slices, is_increasing
 
+_Run = TypeVar("_Run")
+"""A run as the caller names it (a path): ``read`` turns it into a recording."""
 FloatArray = npt.NDArray[np.float64]
 
 special = LazyModule("scipy.special")  # chi-square quantiles, when an interval is asked for
@@ -552,6 +556,103 @@ def data_unit_of(rec: Recording, name: str, canonical: str) -> tuple[str, float]
     return u, float(units.convert(1.0, u, canonical))
 
 
+def _earth_rate(
+    rec: Recording,
+    name: str,
+    canon: str,
+    unit: str,
+    k: float,
+    latitude_deg: float | None,
+    axis: str | None,
+) -> float:
+    """The earth rate on the sensitive axis [data unit] to remove: 0 unless a latitude or
+    an axis is given (options, else the recording's metadata); both are then needed, and
+    the signal must be a gyro rate (:func:`thermocal.units.earth_rate_on_axis_deg_h` / k)."""
+    lat = latitude_deg if latitude_deg is not None else rec.meta.latitude_deg
+    ax = axis if axis is not None else rec.meta.axis
+    if lat is None and axis is None:
+        return 0.0
+    if lat is None or ax is None:
+        raise ThermocalInputError("earth-rate removal needs both --latitude and --axis")
+    if canon != "deg/h":
+        raise ThermocalInputError(
+            f"earth-rate removal applies to gyro rates, but {name!r} is in {unit}"
+        )
+    if not -90.0 <= lat <= 90.0:
+        raise ThermocalInputError(f"latitude must be within ±90°, got {lat}")
+    return units.earth_rate_on_axis_deg_h(lat, units.parse_axis(ax)) / k  # [unit]
+
+
+def _drift(
+    t: FloatArray,
+    values: FloatArray,
+    name: str,
+    unit: str,
+    earth: float,
+    drift_reference_s: tuple[float, float] | None,
+    drift_bias: float | None,
+) -> tuple[DriftReference, DriftExtreme] | None:
+    """The drift angle's reference bias b0 and ``θ(t) = ∫ (ω − Ω_axis − b0) dt`` at the
+    end and at its largest (gyro rates only; None otherwise, where the drift options are
+    an error)."""
+    if unit not in RATE_ANGLE_UNITS:
+        if drift_bias is not None or drift_reference_s is not None:
+            raise ThermocalInputError(
+                f"the drift angle applies to gyro rates, but {name!r} is in {unit}: "
+                "--drift-reference/--drift-bias do not apply"
+            )
+        return None
+    angle_unit, per = RATE_ANGLE_UNITS[unit]
+    if drift_bias is not None:
+        if drift_reference_s is not None:
+            raise ThermocalInputError("give either --drift-reference or --drift-bias, not both")
+        if not math.isfinite(drift_bias):
+            raise ThermocalInputError(f"--drift-bias must be a number, got {drift_bias!r}")
+        ref = DriftReference("bias", None, None, float(drift_bias), unit)
+    else:
+        ref = reference_bias(t, values, window_s=drift_reference_s, earth_rate=earth, unit=unit)
+    ext = drift_angle_extreme(t, values, ref.bias + earth, time_unit_s=per, unit=angle_unit)
+    return ref, ext
+
+
+def _stage_figures(
+    t: FloatArray,
+    temp: FloatArray | None,
+    values: FloatArray,
+    unit: str,
+    earth: float,
+    rate_threshold_c_per_min: float,
+    min_hold_s: float,
+) -> tuple[tuple[Stage, ...], float | None, TemperatureSensitivity | None]:
+    """The hold stages of the temperature ``temp`` [°C] (none without one), the bias
+    repeatability over them (two or more) and the temperature sensitivity over the
+    stages pooled by set-point (within 0.5 °C; two or more set-points)."""
+    if temp is None:
+        return (), None, None
+    stages = hold_stages(
+        t,
+        temp,
+        values,
+        rate_threshold_c_per_min=rate_threshold_c_per_min,
+        min_duration_s=min_hold_s,
+    )
+    if earth:  # mean(ω − Ω) = mean(ω) − Ω, without a full-length copy
+        stages = tuple(dataclasses.replace(s, bias=s.bias - earth) for s in stages)
+    if len(stages) < 2:
+        return stages, None, None
+    rep = bias_repeatability([s.bias for s in stages])
+    st_temps = np.array([s.mean_temp_c for s in stages])
+    st_bias = np.array([s.bias for s in stages])
+    # hold stages at the same set-point (within 0.5 °C) are pooled
+    key = np.round(st_temps * 2.0) / 2.0
+    uniq = np.unique(key)
+    if uniq.size < 2:
+        return stages, rep, None
+    pt = np.array([st_temps[key == k].mean() for k in uniq])
+    pb = np.array([st_bias[key == k].mean() for k in uniq])
+    return stages, rep, temperature_sensitivity(pt, pb, unit=unit)
+
+
 def compute_metrics(
     rec: Recording,
     signal: str | None = None,
@@ -597,19 +698,7 @@ def compute_metrics(
     t = rec.time_s
     tau0 = rec.sample_interval_s
     avg = float(averaging_s) if averaging_s is not None else tau0
-    lat = latitude_deg if latitude_deg is not None else rec.meta.latitude_deg
-    ax = axis if axis is not None else rec.meta.axis
-    earth = 0.0
-    if lat is not None or axis is not None:
-        if lat is None or ax is None:
-            raise ThermocalInputError("earth-rate removal needs both --latitude and --axis")
-        if canon != "deg/h":
-            raise ThermocalInputError(
-                f"earth-rate removal applies to gyro rates, but {name!r} is in {unit}"
-            )
-        if not -90.0 <= lat <= 90.0:
-            raise ThermocalInputError(f"latitude must be within ±90°, got {lat}")
-        earth = units.earth_rate_on_axis_deg_h(lat, units.parse_axis(ax)) / k  # [unit]
+    earth = _earth_rate(rec, name, canon, unit, k, latitude_deg, axis)
     b0 = bias(values, earth_rate_deg_h=earth)
     means = block_means(values, tau0, avg, time_s=t)
     if means.size < 2:
@@ -619,56 +708,18 @@ def compute_metrics(
         )
     stab = float(np.std(means, ddof=1))
     p2p = float(np.max(means) - np.min(means))
-    drift: float | None = None
-    drift_unit: str | None = None
-    drift_max: float | None = None
-    drift_max_t: float | None = None
-    ref: DriftReference | None = None
-    if unit in RATE_ANGLE_UNITS:
-        angle_unit, per = RATE_ANGLE_UNITS[unit]
-        if drift_bias is not None:
-            if drift_reference_s is not None:
-                raise ThermocalInputError("give either --drift-reference or --drift-bias, not both")
-            if not math.isfinite(drift_bias):
-                raise ThermocalInputError(f"--drift-bias must be a number, got {drift_bias!r}")
-            ref = DriftReference("bias", None, None, float(drift_bias), unit)
-        else:
-            ref = reference_bias(t, values, window_s=drift_reference_s, earth_rate=earth, unit=unit)
-        ext = drift_angle_extreme(t, values, ref.bias + earth, time_unit_s=per, unit=angle_unit)
-        drift, drift_unit = ext.end, angle_unit
-        drift_max, drift_max_t = ext.max_abs, ext.max_time_s
-    elif drift_bias is not None or drift_reference_s is not None:
-        raise ThermocalInputError(
-            f"the drift angle applies to gyro rates, but {name!r} is in {unit}: "
-            "--drift-reference/--drift-bias do not apply"
-        )
-
-    sens: TemperatureSensitivity | None = None
-    rep: float | None = None
-    stages: tuple[Stage, ...] = ()
+    drift = _drift(t, values, name, unit, earth, drift_reference_s, drift_bias)
+    ref, ext = drift if drift is not None else (None, None)
     temp_names = list(temps) if temps else list(rec.temperatures)
-    if temp_names:
-        temp = rec.temperature_c(temp_names[0])
-        stages = hold_stages(
-            t,
-            temp,
-            values,
-            rate_threshold_c_per_min=rate_threshold_c_per_min,
-            min_duration_s=min_hold_s,
-        )
-        if earth:  # mean(ω − Ω) = mean(ω) − Ω, without a full-length copy
-            stages = tuple(dataclasses.replace(s, bias=s.bias - earth) for s in stages)
-        if len(stages) >= 2:
-            rep = bias_repeatability([s.bias for s in stages])
-            st_temps = np.array([s.mean_temp_c for s in stages])
-            st_bias = np.array([s.bias for s in stages])
-            # hold stages at the same set-point (within 0.5 °C) are pooled
-            key = np.round(st_temps * 2.0) / 2.0
-            uniq = np.unique(key)
-            if uniq.size >= 2:
-                pt = np.array([st_temps[key == k].mean() for k in uniq])
-                pb = np.array([st_bias[key == k].mean() for k in uniq])
-                sens = temperature_sensitivity(pt, pb, unit=unit)
+    stages, rep, sens = _stage_figures(
+        t,
+        rec.temperature_c(temp_names[0]) if temp_names else None,
+        values,
+        unit,
+        earth,
+        rate_threshold_c_per_min,
+        min_hold_s,
+    )
     return MetricsResult(
         bias=b0,
         bias_stability=stab,
@@ -678,10 +729,10 @@ def compute_metrics(
         temperature_sensitivity=sens,
         bias_repeatability=rep,
         stages=stages,
-        drift_angle=drift,
-        drift_angle_unit=drift_unit,
-        drift_angle_max=drift_max,
-        drift_angle_max_time_s=drift_max_t,
+        drift_angle=ext.end if ext is not None else None,
+        drift_angle_unit=RATE_ANGLE_UNITS[unit][0] if ext is not None else None,
+        drift_angle_max=ext.max_abs if ext is not None else None,
+        drift_angle_max_time_s=ext.max_time_s if ext is not None else None,
         drift_reference=ref,
         earth_rate_removed=earth,
         n_samples=int(values.size),
@@ -692,10 +743,104 @@ def compute_metrics(
     )
 
 
+@dataclass(frozen=True)
+class MetricsOptions:
+    """The options of :func:`compute_metrics` shared by every channel and run (``metrics``'
+    command line): averaging time [s], earth-rate removal (latitude [°], axis), temperature
+    columns, hold-stage detection (|Ṫ| [°C/min], shortest hold [s]) and the drift angle's
+    reference window [s] or bias [data unit]."""
+
+    averaging_s: float | None = None
+    latitude_deg: float | None = None
+    axis: str | None = None
+    temps: tuple[str, ...] | None = None
+    rate_threshold_c_per_min: float = 0.05
+    min_hold_s: float = 600.0
+    drift_reference_s: tuple[float, float] | None = None
+    drift_bias: float | None = None
+
+    @property
+    def removes_earth_rate(self) -> bool:
+        """A latitude or an axis is given (earth-rate removal, one signal at a time)."""
+        return self.latitude_deg is not None or self.axis is not None
+
+    def of(self, rec: Recording, name: str) -> MetricsResult:
+        """:func:`compute_metrics` of the signal ``name`` of ``rec`` with these options."""
+        return compute_metrics(
+            rec,
+            name,
+            self.averaging_s,
+            self.latitude_deg,
+            self.axis,
+            list(self.temps) if self.temps else None,
+            rate_threshold_c_per_min=self.rate_threshold_c_per_min,
+            min_hold_s=self.min_hold_s,
+            drift_reference_s=self.drift_reference_s,
+            drift_bias=self.drift_bias,
+        )
+
+
+def channel_metrics(
+    rec: Recording, names: list[str], options: MetricsOptions
+) -> dict[str, MetricsResult]:
+    """The figures of every channel ``names`` of one recording (one read of the file,
+    INTERFACE: several channels).  Earth-rate removal takes one channel: each channel's
+    sensitive axis points elsewhere."""
+    if len(names) > 1 and options.removes_earth_rate:
+        raise ThermocalInputError(
+            "earth-rate removal (--latitude/--axis) takes one signal at a time: each channel's "
+            "sensitive axis points elsewhere; run metrics per gyro axis with its --axis"
+        )
+    return {name: options.of(rec, name) for name in names}
+
+
+@dataclass(frozen=True, eq=False)
+class PowerOnMetrics:
+    """The result of :func:`power_on_metrics`: the channels, each run's figures per channel
+    (in the order of the runs) and the turn-on to turn-on repeatability per channel."""
+
+    names: tuple[str, ...]
+    runs: tuple[dict[str, MetricsResult], ...]
+    repeatability: dict[str, RunRepeatability]
+
+
+def power_on_metrics(
+    runs: Sequence[_Run],
+    read: Callable[[_Run], Recording],
+    signals: list[str] | None,
+    options: MetricsOptions,
+) -> PowerOnMetrics:
+    """Several power-ons of one sensor: ``read(run)`` gives each run's recording (read in
+    turn, so the first bad file stops the analysis), the figures of the channels
+    ``signals`` (default each file's first signal; every run the same channels), and per
+    channel :func:`run_repeatability` over the runs, labelled ``str(run)``."""
+    per_run: list[dict[str, MetricsResult]] = []
+    names: list[str] | None = None
+    for run in runs:
+        rec = read(run)
+        these = signals or [rec.signals[0]]
+        if names is None:
+            names = these
+        elif these != names:
+            raise ThermocalInputError(f"{run}: signals {these} differ from the first run's {names}")
+        if len(these) > 1 and options.removes_earth_rate:
+            raise ThermocalInputError(
+                "earth-rate removal (--latitude/--axis) takes one signal at a time"
+            )
+        per_run.append({n: options.of(rec, n) for n in these})
+    if names is None:
+        raise ThermocalInputError("no run to analyse")
+    labels = [str(r) for r in runs]
+    reps = {n: run_repeatability([r[n] for r in per_run], labels) for n in names}
+    return PowerOnMetrics(tuple(names), tuple(per_run), reps)
+
+
 __all__ = [
     "DriftExtreme",
     "DriftReference",
+    "MetricsOptions",
     "MetricsResult",
+    "PowerOnMetrics",
     "RunRepeatability",
     "Stage",
     "TemperatureSensitivity",
@@ -704,12 +849,14 @@ __all__ = [
     "bias_repeatability",
     "bias_stability",
     "block_means",
+    "channel_metrics",
     "compute_metrics",
     "data_unit_of",
     "drift_angle",
     "drift_angle_extreme",
     "hold_stages",
     "peak_to_peak",
+    "power_on_metrics",
     "reference_bias",
     "run_repeatability",
     "std_interval",

@@ -2,7 +2,6 @@
 IEEE 952 noise terms by slope lines and by least squares."""
 
 import math
-import warnings
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated, Any
 
@@ -34,30 +33,19 @@ from thermocal.cli.common import (
     stdout,
     text_options,
 )
-from thermocal.errors import ConditioningWarning, ThermocalInputError
+from thermocal.errors import ThermocalInputError
 
 if TYPE_CHECKING:
     import rich.table as _rich_table
 
-    import thermocal.metrics as _metrics
     import thermocal.stability.allan as _allan
+    import thermocal.stability.analysis as _analysis
     import thermocal.stability.family as _family
     import thermocal.writers as _writers
 else:
     _rich_table = LazyModule("rich.table")
-    _allan = LazyModule("thermocal.stability.allan")
     _writers = LazyModule("thermocal.writers")
-    _metrics = LazyModule("thermocal.metrics")
-    _family = LazyModule("thermocal.stability.family")
-
-
-def _column_unit(name: str) -> str:
-    """A phase column's unit from its name (``phase [s]``, ``angle (deg)``), else ``""``:
-    phase units are not signal (rate) units, so the recording's unit resolver cannot give it."""
-    import re
-
-    hit = re.search(r"[\[(]([^\])]+)[\])]\s*$", name)
-    return hit.group(1).strip() if hit else ""
+    _analysis = LazyModule("thermocal.stability.analysis")
 
 
 def family_json(res: "_family.StabilityResult") -> dict[str, Any]:
@@ -219,57 +207,91 @@ def _emit_channels(
     )
 
 
+TausOpt = Annotated[
+    str, typer.Option("--taus", help="Tau set: octave, decade, log, or a list '1,10,100' [s].")
+]
+PlotOpt = Annotated[Path | None, typer.Option("--plot", help="Write a log-log PNG plot here.")]
+ConfidenceOpt = Annotated[
+    float, typer.Option("--confidence", help="Confidence level of the intervals.")
+]
+HiddenTempsOpt = Annotated[str | None, typer.Option("--temps", hidden=True)]
+DeviationOpt = Annotated[
+    str | None,
+    typer.Option(
+        "--deviation",
+        help="Deviations (NIST SP 1065), comma-separated: oadev (default), adev, mdev, "
+        "tdev, hdev, ohdev, totdev, mtotdev, ttotdev, htotdev, theo1, mtie, tierms.",
+    ),
+]
+DataTypeOpt = Annotated[
+    str,
+    typer.Option(
+        "--data-type",
+        help="rate (default: the column is a rate) or phase (an integrated quantity: "
+        "angle, velocity, seconds of a clock).",
+    ),
+]
+DynamicOpt = Annotated[
+    float | None,
+    typer.Option(
+        "--dynamic",
+        help="Dynamic ADEV: the overlapping ADEV in sliding windows of this many seconds "
+        "(half-window steps), a heat map beside --plot, a warning when the record is not "
+        "stationary.",
+    ),
+]
+
+
+def _check_plot(plot: Path | None, file: Path) -> None:
+    """``--plot``: a PNG, SVG or PDF file name that is not the input."""
+    if plot is None:
+        return
+    _writers.check_not_input(plot, [file])
+    if plot.is_dir():
+        raise ThermocalInputError(f"{plot}: is a directory, expected a file name")
+    if plot.suffix.lower() not in (".png", ".svg", ".pdf"):
+        raise ThermocalInputError(f"{plot}: --plot writes PNG, SVG or PDF; name it *.png")
+
+
+def _write_plots(file: Path, plot: Path, res: "_analysis.AllanAnalysis") -> None:
+    """The ADEV plot of every channel (``PLOT_CHANNEL.png`` with several) and, with
+    ``--dynamic``, its heat map beside it (``…_dynamic.png``)."""
+    from thermocal.report.allan_plots import plot_allan, plot_dynamic
+
+    many = len(res.names) > 1
+    for name, ch in res.channels.items():
+        target = plot.with_name(f"{plot.stem}_{name}{plot.suffix}") if many else plot
+        plot_allan(ch.adev, ch.noise, target, title=f"{file.name} — {name}")
+        if ch.dynamic is not None:
+            plot_dynamic(
+                ch.dynamic, target.with_name(f"{target.stem}_dynamic{target.suffix}"),
+                title=f"{file.name} — {name}: dynamic ADEV",
+            )  # fmt: skip
+
+
 @app.command("allan")
 @handle_errors
 def allan_cmd(
     file: FileArg,
     signal: SignalOpt = None,
-    taus: Annotated[
-        str, typer.Option("--taus", help="Tau set: octave, decade, log, or a list '1,10,100' [s].")
-    ] = "octave",
-    plot: Annotated[
-        Path | None, typer.Option("--plot", help="Write a log-log PNG plot here.")
-    ] = None,
-    confidence: Annotated[
-        float, typer.Option("--confidence", help="Confidence level of the intervals.")
-    ] = 0.6826894921370859,
+    taus: TausOpt = "octave",
+    plot: PlotOpt = None,
+    confidence: ConfidenceOpt = 0.6826894921370859,
     time: TimeOpt = None,
     time_unit: TimeUnitOpt = None,
     signal_unit: SignalUnitOpt = None,
     temp_unit: TempUnitOpt = None,
     temp_conversion: TempConversionOpt = None,
-    temps: Annotated[str | None, typer.Option("--temps", hidden=True)] = None,
+    temps: HiddenTempsOpt = None,
     t_names: NamesOpt = None,
     topic: TopicOpt = None,
     t_rate: RateOpt = None,
     t_bad: OnBadLinesOpt = "error",
     t_delim: DelimiterOpt = None,
     t_dec: DecimalOpt = None,
-    deviation: Annotated[
-        str | None,
-        typer.Option(
-            "--deviation",
-            help="Deviations (NIST SP 1065), comma-separated: oadev (default), adev, mdev, "
-            "tdev, hdev, ohdev, totdev, mtotdev, ttotdev, htotdev, theo1, mtie, tierms.",
-        ),
-    ] = None,
-    data_type: Annotated[
-        str,
-        typer.Option(
-            "--data-type",
-            help="rate (default: the column is a rate) or phase (an integrated quantity: "
-            "angle, velocity, seconds of a clock).",
-        ),
-    ] = "rate",
-    dynamic: Annotated[
-        float | None,
-        typer.Option(
-            "--dynamic",
-            help="Dynamic ADEV: the overlapping ADEV in sliding windows of this many seconds "
-            "(half-window steps), a heat map beside --plot, a warning when the record is not "
-            "stationary.",
-        ),
-    ] = None,
+    deviation: DeviationOpt = None,
+    data_type: DataTypeOpt = "rate",
+    dynamic: DynamicOpt = None,
     as_json: JsonOpt = False,
 ) -> None:
     """Overlapping Allan deviation with chi-square confidence intervals and the noise
@@ -290,111 +312,46 @@ def allan_cmd(
         temp_conversion=temp_conversion,
         keep_other=False,  # the Allan deviation uses the time and the signal only
     )
+    _check_plot(plot, file)
+    tau_spec = _analysis.parse_taus(taus)
+    res = _analysis.allan_analysis(
+        rec, split_names(signal) or [rec.signals[0]], taus=tau_spec, confidence=confidence,
+        deviations=deviation, data_type=data_type, dynamic_s=dynamic, where=str(file),
+    )  # fmt: skip
+    if res.is_family:
+        _emit_family(file, res, as_json)
+        return
     if plot is not None:
-        _writers.check_not_input(plot, [file])
-        if plot.is_dir():
-            raise ThermocalInputError(f"{plot}: is a directory, expected a file name")
-        if plot.suffix.lower() not in (".png", ".svg", ".pdf"):
-            raise ThermocalInputError(f"{plot}: --plot writes PNG, SVG or PDF; name it *.png")
-    tau_spec: Any = taus
-    if taus not in ("octave", "decade", "log", "all"):
-        try:
-            tau_spec = [float(v) for v in taus.split(",") if v.strip()]
-        except ValueError:
-            raise ThermocalInputError(
-                f"--taus {taus!r}: use octave, decade, log or a comma-separated list of τ [s]"
-            ) from None
-    names = split_names(signal) or [rec.signals[0]]
-    if data_type not in ("rate", "phase"):
-        raise ThermocalInputError(f"--data-type {data_type!r}: use rate or phase")
-    if dynamic is not None and (deviation is not None or data_type == "phase"):
-        raise ThermocalInputError(
-            "--dynamic computes the overlapping ADEV of rate data; run it without --deviation "
-            "and --data-type phase"
-        )
-    if deviation is not None or data_type == "phase":
-        devs = _family.parse_deviations(deviation or "oadev")
-        fam_spec: Any = "all" if taus == "all" else tau_spec
-        results = {}
-        for name in names:
-            if data_type == "phase":  # the column as given, in its own unit
-                values, unit = rec.column(name), _column_unit(name)
-            else:
-                canonical, canon_unit = rec.signal(name)
-                unit, k = _metrics.data_unit_of(rec, name, canon_unit)
-                values = canonical if k == 1.0 else canonical / k
-            results[name] = _family.stability(
-                values, rec.sample_interval_s, devs, fam_spec, data_type=data_type,
-                segments=rec.segments(), unit=unit, confidence=confidence,
-            )  # fmt: skip
-        if len(names) == 1:
-            one = results[names[0]]
-            emit(family_json(one), as_json, lambda: _family_human(file, one))
-        else:
+        _write_plots(file, plot, res)
+    _emit_allan(file, res, as_json, plot)
 
-            def human_all() -> None:
-                for r in results.values():
-                    _family_human(file, r)
 
-            emit({"channels": {n: family_json(r) for n, r in results.items()}}, as_json, human_all)
+def _emit_family(file: Path, res: "_analysis.AllanAnalysis", as_json: bool) -> None:
+    """``--deviation`` or phase data: one channel's object, or ``{"channels": …}``."""
+    if len(res.names) == 1:
+        one = res.family[res.names[0]]
+        emit(family_json(one), as_json, lambda: _family_human(file, one))
         return
-    analyses: dict[str, tuple[_allan.AllanResult, _allan.NoiseTerms]] = {}
-    dynamics: dict[str, _allan.DynamicAllan] = {}
-    for name in names:  # one read of the file, every channel (INTERFACE: several channels)
-        canonical, canon_unit = rec.signal(name)
-        # every figure in the data's own unit (°/s data: ADEV in °/s; INTERFACE common rules)
-        unit, k = _metrics.data_unit_of(rec, name, canon_unit)
-        values = canonical if k == 1.0 else canonical / k
-        res_c = _allan.overlapping_adev(
-            values,
-            rec.sample_interval_s,
-            tau_spec,
-            time_s=rec.time_s,
-            segments=rec.segments(),  # one scan of the time column for every channel
-            unit=unit,
-            confidence=confidence,
-            # the phase is accumulated in the column's own buffer (no memory per sample):
-            # the column is not used again unless the channel is named twice or the
-            # dynamic ADEV reads the rate after it (it did, on the floor's numpy/pyarrow,
-            # where the buffer is writeable: windows of phase, found by the floor check)
-            overwrite=names.count(name) == 1 and dynamic is None,
-        )
-        noise_c = _allan.noise_terms(res_c)
-        where = f"{file}" + (f" [{name}]" if len(names) > 1 else "")
-        if noise_c.quality is not None and noise_c.quality.quality == "poor":
-            warnings.warn(f"{where}: {noise_c.quality.reason}", ConditioningWarning, stacklevel=1)
-        if dynamic is not None:
-            dyn = _allan.dynamic_adev(
-                values, rec.sample_interval_s, dynamic, res_c, time_s=rec.time_s
-            )
-            dynamics[name] = dyn
-            if not dyn.stationary:
-                worst = max(dyn.changes, key=lambda c: abs(math.log(c["adev"] / c["whole_adev"])))
-                warnings.warn(
-                    f"{where}: the record is not stationary: in {len(dyn.changes)} (window, τ) "
-                    f"cells the {dyn.window_s:g} s windows' ADEV differs from the whole "
-                    f"record's beyond both intervals (e.g. {worst['adev']:.4g} against "
-                    f"{worst['whole_adev']:.4g} {res_c.unit} at τ = {worst['tau_s']:.4g} s in "
-                    f"the window centred at {worst['t_s']:.4g} s); the noise terms of the "
-                    "whole record average over changing noise",
-                    ConditioningWarning,
-                    stacklevel=1,
-                )
-        if plot is not None:
-            from thermocal.report.allan_plots import plot_allan, plot_dynamic
 
-            target = plot if len(names) == 1 else plot.with_name(f"{plot.stem}_{name}{plot.suffix}")
-            plot_allan(res_c, noise_c, target, title=f"{file.name} — {name}")
-            if name in dynamics:
-                plot_dynamic(
-                    dynamics[name], target.with_name(f"{target.stem}_dynamic{target.suffix}"),
-                    title=f"{file.name} — {name}: dynamic ADEV",
-                )  # fmt: skip
-        analyses[name] = (res_c, noise_c)
+    def human_all() -> None:
+        for r in res.family.values():
+            _family_human(file, r)
+
+    emit({"channels": {n: family_json(r) for n, r in res.family.items()}}, as_json, human_all)
+
+
+def _emit_allan(
+    file: Path, analysis: "_analysis.AllanAnalysis", as_json: bool, plot: Path | None
+) -> None:
+    """The ADEV table and the noise terms of one channel (several: :func:`_emit_channels`)."""
+    names = analysis.names
+    dynamics = {n: c.dynamic for n, c in analysis.channels.items() if c.dynamic is not None}
     if len(names) > 1:
-        _emit_channels(file, analyses, as_json, plot, dynamics)
+        pairs = {n: (c.adev, c.noise) for n, c in analysis.channels.items()}
+        _emit_channels(file, pairs, as_json, plot, dynamics)
         return
-    res, noise = analyses[names[0]]
+    ch = analysis.channels[names[0]]
+    res, noise = ch.adev, ch.noise
 
     def human() -> None:
         t1 = _rich_table.Table(title=f"{file} — overlapping Allan deviation [{res.unit}]")
@@ -432,7 +389,7 @@ def allan_cmd(
                 f"noise-model fit: reduced χ² {noise.quality.reduced_chi2:.3g} on "
                 f"{noise.quality.dof} degrees of freedom — {noise.quality.quality}"
             )
-        dyn = dynamics.get(names[0])
+        dyn = ch.dynamic
         if dyn is not None:
             stdout.print(
                 f"dynamic ADEV: {dyn.t_s.size} windows of {dyn.window_s:g} s, "
@@ -441,4 +398,4 @@ def allan_cmd(
         if plot is not None:
             stdout.print(f"plot written to {plot}")
 
-    emit(allan_json(res, noise, dynamics.get(names[0])), as_json, human)
+    emit(allan_json(res, noise, ch.dynamic), as_json, human)

@@ -42,6 +42,7 @@ if TYPE_CHECKING:
 
     import thermocal.metrics as _metrics
     from thermocal.metrics import MetricsResult
+    from thermocal.recording import Recording
 else:
     _rich_table = LazyModule("rich.table")
     _metrics = LazyModule("thermocal.metrics")
@@ -76,48 +77,55 @@ def metrics_json(res: "_metrics.MetricsResult") -> dict[str, Any]:
     }
 
 
+MetricsFilesArg = Annotated[
+    list[Path],
+    typer.Argument(
+        help="Recording(s) (CSV or Parquet); several files are separate power-ons of one "
+        "sensor: each run's figures and the turn-on to turn-on bias repeatability.",
+        show_default=False,
+    ),
+]
+AverageOpt = Annotated[
+    float | None,
+    typer.Option("--average", help="Averaging time S [s] of bias stability and peak-to-peak."),
+]
+HoldRateOpt = Annotated[
+    float, typer.Option("--hold-rate", help="Hold stages: |dT/dt| below this [°C/min].")
+]
+MinHoldOpt = Annotated[
+    float, typer.Option("--min-hold", help="Hold stages: at least this long [s].")
+]
+DriftReferenceOpt = Annotated[
+    str | None,
+    typer.Option(
+        "--drift-reference",
+        help="Drift angle: remove the mean rate over START,END [s since the first "
+        "sample] (default: the first 10 % of the run).",
+    ),
+]
+DriftBiasOpt = Annotated[
+    float | None,
+    typer.Option(
+        "--drift-bias",
+        help="Drift angle: remove this bias [the data's unit, earth rate already "
+        "removed] instead of a reference window.",
+    ),
+]
+
+
 @app.command("metrics")
 @handle_errors
 def metrics_cmd(
-    files: Annotated[
-        list[Path],
-        typer.Argument(
-            help="Recording(s) (CSV or Parquet); several files are separate power-ons of one "
-            "sensor: each run's figures and the turn-on to turn-on bias repeatability.",
-            show_default=False,
-        ),
-    ],
+    files: MetricsFilesArg,
     signal: SignalOpt = None,
-    average: Annotated[
-        float | None,
-        typer.Option("--average", help="Averaging time S [s] of bias stability and peak-to-peak."),
-    ] = None,
+    average: AverageOpt = None,
     temps: TempsOpt = None,
     latitude: LatitudeOpt = None,
     axis: AxisOpt = None,
-    hold_rate: Annotated[
-        float,
-        typer.Option("--hold-rate", help="Hold stages: |dT/dt| below this [°C/min]."),
-    ] = 0.05,
-    min_hold: Annotated[
-        float, typer.Option("--min-hold", help="Hold stages: at least this long [s].")
-    ] = 600.0,
-    drift_reference: Annotated[
-        str | None,
-        typer.Option(
-            "--drift-reference",
-            help="Drift angle: remove the mean rate over START,END [s since the first "
-            "sample] (default: the first 10 % of the run).",
-        ),
-    ] = None,
-    drift_bias: Annotated[
-        float | None,
-        typer.Option(
-            "--drift-bias",
-            help="Drift angle: remove this bias [the data's unit, earth rate already "
-            "removed] instead of a reference window.",
-        ),
-    ] = None,
+    hold_rate: HoldRateOpt = 0.05,
+    min_hold: MinHoldOpt = 600.0,
+    drift_reference: DriftReferenceOpt = None,
+    drift_bias: DriftBiasOpt = None,
     time: TimeOpt = None,
     time_unit: TimeUnitOpt = None,
     signal_unit: SignalUnitOpt = None,
@@ -137,46 +145,43 @@ def metrics_cmd(
     temperature sensitivity.  Several files (separate power-ons): each run's bias and in-run
     bias stability, and the turn-on to turn-on repeatability (sample standard deviation of
     the run biases with its 68.3 % chi-square interval)."""
+
+    def read(file: Path) -> "Recording":
+        return load_recording(
+            file,
+            text=text_options(t_names, t_rate, t_bad, t_delim, t_dec),
+            topic=topic,
+            time=time,
+            time_unit=time_unit,
+            signal=signal,
+            temps=temps,
+            signal_unit=signal_unit,
+            temp_unit=temp_unit,
+            temp_conversion=temp_conversion,
+            keep_other=False,  # metrics use the signal and the temperatures only
+        )
+
+    def options() -> "_metrics.MetricsOptions":
+        t_names_ = split_names(temps)
+        return _metrics.MetricsOptions(
+            average, latitude, axis, tuple(t_names_) if t_names_ else None, hold_rate,
+            min_hold, _parse_window(drift_reference), drift_bias,
+        )  # fmt: skip
+
     if len(files) > 1:
-        _several_runs(files, locals())
+        opts = options()  # the window is checked before any file is read
+        res = _metrics.power_on_metrics(files, read, split_names(signal), opts)
+        _emit_runs(res, as_json)
         return
     file = files[0]
-    rec = load_recording(
-        file,
-        text=text_options(t_names, t_rate, t_bad, t_delim, t_dec),
-        topic=topic,
-        time=time,
-        time_unit=time_unit,
-        signal=signal,
-        temps=temps,
-        signal_unit=signal_unit,
-        temp_unit=temp_unit,
-        temp_conversion=temp_conversion,
-        keep_other=False,  # metrics use the signal and the temperatures only
-    )
-    window = _parse_window(drift_reference)
-    names = split_names(signal) or [rec.signals[0]]
-    if len(names) > 1 and (latitude is not None or axis is not None):
-        raise ThermocalInputError(
-            "earth-rate removal (--latitude/--axis) takes one signal at a time: each channel's "
-            "sensitive axis points elsewhere; run metrics per gyro axis with its --axis"
-        )
-    # one read of the file, the figures of every channel (INTERFACE: several channels)
-    results = {
-        name: _metrics.compute_metrics(
-            rec,
-            name,
-            average,
-            latitude,
-            axis,
-            split_names(temps),
-            rate_threshold_c_per_min=hold_rate,
-            min_hold_s=min_hold,
-            drift_reference_s=window,
-            drift_bias=drift_bias,
-        )
-        for name in names
-    }
+    rec = read(file)
+    opts = options()
+    results = _metrics.channel_metrics(rec, split_names(signal) or [rec.signals[0]], opts)
+    _emit_metrics(file, results, as_json)
+
+
+def _emit_metrics(file: Path, results: "dict[str, MetricsResult]", as_json: bool) -> None:
+    """One file: the table of every channel's figures, or their JSON."""
 
     def human() -> None:
         many = len(results) > 1
@@ -278,62 +283,13 @@ def first_result(results: "dict[str, _metrics.MetricsResult]") -> "_metrics.Metr
     return next(iter(results.values()))
 
 
-def _several_runs(files: list[Path], opts: dict[str, Any]) -> None:
+def _emit_runs(res: "_metrics.PowerOnMetrics", as_json: bool) -> None:
     """``metrics FILE FILE...``: every file one power-on; per channel ``runs`` (each run's
     figures, as one file's JSON plus ``file``), ``bias`` the mean run bias,
     ``bias_stability`` the largest in-run bias stability, ``bias_repeatability`` (turn-on
     to turn-on: sample standard deviation of the run biases) with
     ``bias_repeatability_low``/``_high`` (68.3 % chi-square interval), all in ``unit``."""
-    window = _parse_window(opts["drift_reference"])
-    per_file: list[dict[str, MetricsResult]] = []
-    names: list[str] | None = None
-    for file in files:
-        rec = load_recording(
-            file,
-            text=text_options(
-                opts["t_names"], opts["t_rate"], opts["t_bad"], opts["t_delim"], opts["t_dec"]
-            ),
-            topic=opts["topic"],
-            time=opts["time"],
-            time_unit=opts["time_unit"],
-            signal=opts["signal"],
-            temps=opts["temps"],
-            signal_unit=opts["signal_unit"],
-            temp_unit=opts["temp_unit"],
-            temp_conversion=opts["temp_conversion"],
-            keep_other=False,
-        )
-        these = split_names(opts["signal"]) or [rec.signals[0]]
-        if names is None:
-            names = these
-        elif these != names:
-            raise ThermocalInputError(
-                f"{file}: signals {these} differ from the first run's {names}"
-            )
-        if len(these) > 1 and (opts["latitude"] is not None or opts["axis"] is not None):
-            raise ThermocalInputError(
-                "earth-rate removal (--latitude/--axis) takes one signal at a time"
-            )
-        per_file.append(
-            {
-                n: _metrics.compute_metrics(
-                    rec,
-                    n,
-                    opts["average"],
-                    opts["latitude"],
-                    opts["axis"],
-                    split_names(opts["temps"]),
-                    rate_threshold_c_per_min=opts["hold_rate"],
-                    min_hold_s=opts["min_hold"],
-                    drift_reference_s=window,
-                    drift_bias=opts["drift_bias"],
-                )
-                for n in these
-            }
-        )
-    assert names is not None
-    labels = [str(f) for f in files]
-    reps = {n: _metrics.run_repeatability([r[n] for r in per_file], labels) for n in names}
+    names, reps = list(res.names), res.repeatability
 
     def one(rep: "_metrics.RunRepeatability") -> dict[str, Any]:
         return dict(
@@ -374,6 +330,6 @@ def _several_runs(files: list[Path], opts: dict[str, Any]) -> None:
             )
 
     if len(names) == 1:
-        emit(one(reps[names[0]]), bool(opts["as_json"]), human)
+        emit(one(reps[names[0]]), as_json, human)
     else:
-        emit({"channels": {n: one(r) for n, r in reps.items()}}, bool(opts["as_json"]), human)
+        emit({"channels": {n: one(r) for n, r in reps.items()}}, as_json, human)

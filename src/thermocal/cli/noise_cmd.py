@@ -32,13 +32,13 @@ from thermocal.errors import ThermocalInputError
 if TYPE_CHECKING:
     import rich.table as _rich_table
 
-    import thermocal.metrics as _metrics
+    import thermocal.stability.analysis as _analysis
     import thermocal.stability.noise_model as _nm
     import thermocal.writers as _writers
 else:
     _rich_table = LazyModule("rich.table")
     _writers = LazyModule("thermocal.writers")
-    _metrics = LazyModule("thermocal.metrics")
+    _analysis = LazyModule("thermocal.stability.analysis")
     _nm = LazyModule("thermocal.stability.noise_model")
 
 
@@ -49,38 +49,58 @@ def _triad(text: str | None, option: str) -> list[str]:
     return names
 
 
+GyroColsOpt = Annotated[str, typer.Option("--gyro", help="Gyro columns X,Y,Z.")]
+NoiseOutOpt = Annotated[Path, typer.Option("-o", "--output", help="Output file.")]
+AccelColsOpt = Annotated[str | None, typer.Option("--accel", help="Accelerometer columns X,Y,Z.")]
+GyroUnitOpt = Annotated[
+    str | None,
+    typer.Option("--gyro-unit", help="Unit of the gyro columns: deg/h, deg/s, rad/s."),
+]
+AccelUnitOpt = Annotated[
+    str | None,
+    typer.Option("--accel-unit", help="Unit of the accelerometer columns: mg, ug, g, m/s^2."),
+]
+FormatOpt = Annotated[
+    str, typer.Option("--format", help="kalibr (imu.yaml) or json (every term of every axis).")
+]
+InflateOpt = Annotated[
+    float,
+    typer.Option(
+        "--inflate", help="Multiply every Kalibr noise value by this (≥ 1; stated in the file)."
+    ),
+]
+RostopicOpt = Annotated[str, typer.Option("--rostopic", help="Kalibr's rostopic of this IMU.")]
+ConfidenceOpt = Annotated[
+    float, typer.Option("--confidence", help="Confidence level of the intervals.")
+]
+
+
+def _unit_list(gyro_unit: str | None, accel_unit: str | None, n_g: int, n_a: int) -> str | None:
+    """``--gyro-unit``/``--accel-unit`` as the recording's per-column unit list (None: the
+    file's own units); both or neither."""
+    if gyro_unit is None and accel_unit is None:
+        return None
+    if (gyro_unit is None) or (n_a and accel_unit is None):
+        raise ThermocalInputError(
+            "give both --gyro-unit and --accel-unit, or neither (units from the column "
+            "names or the file's metadata)"
+        )
+    return ",".join([gyro_unit] * n_g + [accel_unit or ""] * n_a)
+
+
 @app.command("noise")
 @handle_errors
 def noise_cmd(
     file: FileArg,
-    gyro: Annotated[str, typer.Option("--gyro", help="Gyro columns X,Y,Z.")],
-    output: Annotated[Path, typer.Option("-o", "--output", help="Output file.")],
-    accel: Annotated[
-        str | None, typer.Option("--accel", help="Accelerometer columns X,Y,Z.")
-    ] = None,
-    gyro_unit: Annotated[
-        str | None,
-        typer.Option("--gyro-unit", help="Unit of the gyro columns: deg/h, deg/s, rad/s."),
-    ] = None,
-    accel_unit: Annotated[
-        str | None,
-        typer.Option("--accel-unit", help="Unit of the accelerometer columns: mg, ug, g, m/s^2."),
-    ] = None,
-    out_format: Annotated[
-        str, typer.Option("--format", help="kalibr (imu.yaml) or json (every term of every axis).")
-    ] = "kalibr",
-    inflate: Annotated[
-        float,
-        typer.Option(
-            "--inflate", help="Multiply every Kalibr noise value by this (≥ 1; stated in the file)."
-        ),
-    ] = 1.0,
-    rostopic: Annotated[
-        str, typer.Option("--rostopic", help="Kalibr's rostopic of this IMU.")
-    ] = "/imu0",
-    confidence: Annotated[
-        float, typer.Option("--confidence", help="Confidence level of the intervals.")
-    ] = 0.6826894921370859,
+    gyro: GyroColsOpt,
+    output: NoiseOutOpt,
+    accel: AccelColsOpt = None,
+    gyro_unit: GyroUnitOpt = None,
+    accel_unit: AccelUnitOpt = None,
+    out_format: FormatOpt = "kalibr",
+    inflate: InflateOpt = 1.0,
+    rostopic: RostopicOpt = "/imu0",
+    confidence: ConfidenceOpt = 0.6826894921370859,
     time: TimeOpt = None,
     time_unit: TimeUnitOpt = None,
     t_names: NamesOpt = None,
@@ -107,15 +127,6 @@ def noise_cmd(
     _writers.check_not_input(output, [file])
     if output.is_dir():
         raise ThermocalInputError(f"{output}: is a directory, expected a file name")
-    n_g, n_a = len(g_names), len(a_names)
-    unit_list = None
-    if gyro_unit is not None or accel_unit is not None:
-        if (gyro_unit is None) or (n_a and accel_unit is None):
-            raise ThermocalInputError(
-                "give both --gyro-unit and --accel-unit, or neither (units from the column "
-                "names or the file's metadata)"
-            )
-        unit_list = ",".join([gyro_unit] * n_g + [accel_unit or ""] * n_a)
     rec = load_recording(
         file,
         text=text_options(t_names, t_rate, t_bad, t_delim, t_dec),
@@ -123,48 +134,24 @@ def noise_cmd(
         time=time,
         time_unit=time_unit,
         signal=",".join(g_names + a_names),
-        signal_unit=unit_list,
+        signal_unit=_unit_list(gyro_unit, accel_unit, len(g_names), len(a_names)),
         keep_other=False,
     )
-    axes = []
-    for name in g_names + a_names:
-        canonical, canon_unit = rec.signal(name)
-        unit, k = _metrics.data_unit_of(rec, name, canon_unit)
-        values = canonical if k == 1.0 else canonical / k
-        axes.append(
-            _nm.axis_noise(
-                values, rec.sample_interval_s, name=name,
-                sensor="gyro" if name in g_names else "accel", unit=unit,
-                segments=rec.segments(), time_s=rec.time_s, confidence=confidence,
-            )
-        )  # fmt: skip
-    model = _nm.noise_model(
-        axes, 1.0 / rec.sample_interval_s, inflate=inflate, rostopic=rostopic,
-        confidence=confidence,
+    res = _analysis.imu_noise(
+        rec, g_names, a_names, inflate=inflate, rostopic=rostopic, confidence=confidence,
+        where=str(file),
     )  # fmt: skip
-    for ax in axes:
-        for t in (ax.density, ax.walk):
-            if t.method == "bound":
-                import warnings
-
-                from thermocal.errors import ConditioningWarning
-
-                warnings.warn(
-                    f"{file} [{ax.name}]: {t.term.replace('_', ' ')}: {t.reason}",
-                    ConditioningWarning,
-                    stacklevel=1,
-                )
     if out_format == "kalibr":
-        text = _nm.kalibr_yaml(model, file.name)
+        text = _nm.kalibr_yaml(res.model, file.name)
     else:
-        text = json.dumps(jsonable(_nm.model_json(model, file.name)), allow_nan=False, indent=1)
+        text = json.dumps(jsonable(_nm.model_json(res.model, file.name)), allow_nan=False, indent=1)
     with _writers.atomic_write(output, "w") as fh:
         fh.write(text + ("" if text.endswith("\n") else "\n"))
 
     table = _rich_table.Table(title=f"{file} — IMU noise model (continuous time)")
     for col in ("axis", "noise density", "random walk", "unit (density; walk)", "from"):
         table.add_column(col)
-    for ax in axes:
+    for ax in res.axes:
         table.add_row(
             ax.name, fmt(ax.density.value), fmt(ax.walk.value),
             f"{ax.density.unit}; {ax.walk.unit}", f"{ax.density.method}; {ax.walk.method}",

@@ -16,9 +16,8 @@ Output naming:
   ``files`` (``file`` is the path written).
 """
 
-import math
 from pathlib import Path
-from typing import TYPE_CHECKING, Annotated, Any
+from typing import TYPE_CHECKING, Annotated
 
 import typer
 
@@ -79,51 +78,58 @@ def _early_gate(output: Path, truth: Path | None, inputs: list[str | Path]) -> N
     check_outputs([*files, *([truth] if truth is not None else [])], inputs, dirs=dirs)
 
 
+ScenarioArg = Annotated[
+    str,
+    typer.Argument(
+        help="Scenario: " + ", ".join(defaults.SCENARIO_NAMES) + ".", show_default=False
+    ),
+]
+SimOutOpt = Annotated[
+    Path,
+    typer.Option(
+        "-o", "--output", help="Output file (one result), directory or file stem (several)."
+    ),
+]
+SeedOpt = Annotated[int, typer.Option("--seed", help="Random seed (same seed, same file).")]
+ProfileOpt = Annotated[
+    Path | None,
+    typer.Option("--profile", help="Chamber program CSV (time_s, setpoint_c) to run instead."),
+]
+TruthOpt = Annotated[
+    Path | None, typer.Option("--truth", help="Write every true parameter to this JSON.")
+]
+RateHzOpt = Annotated[float | None, typer.Option("--rate-hz", help="Output sample rate [Hz].")]
+RunsOpt = Annotated[int | None, typer.Option("--runs", help="Number of runs (accel-full-range).")]
+OrientationOpt = Annotated[
+    str | None,
+    typer.Option("--orientation", help="horizontal, up or down (accel-full-range)."),
+]
+RecordOpt = Annotated[
+    float | None, typer.Option("--record-s", help="Record per power-on [s] (mems-warmup).")
+]
+RunOpt = Annotated[
+    str | None,
+    typer.Option("--run", help="modelling or validation (mems-imu: the same unit)."),
+]
+FormatOpt = Annotated[str, typer.Option("--format", help="File format inside an output directory.")]
+
+
 @app.command("simulate")
 @handle_errors
 def simulate_cmd(
-    scenario: Annotated[
-        str,
-        typer.Argument(
-            help="Scenario: " + ", ".join(defaults.SCENARIO_NAMES) + ".", show_default=False
-        ),
-    ],
-    output: Annotated[
-        Path,
-        typer.Option(
-            "-o", "--output", help="Output file (one result), directory or file stem (several)."
-        ),
-    ],
-    seed: Annotated[int, typer.Option("--seed", help="Random seed (same seed, same file).")] = 0,
-    profile: Annotated[
-        Path | None,
-        typer.Option("--profile", help="Chamber program CSV (time_s, setpoint_c) to run instead."),
-    ] = None,
-    truth: Annotated[
-        Path | None, typer.Option("--truth", help="Write every true parameter to this JSON.")
-    ] = None,
-    rate_hz: Annotated[
-        float | None, typer.Option("--rate-hz", help="Output sample rate [Hz].")
-    ] = None,
+    scenario: ScenarioArg,
+    output: SimOutOpt,
+    seed: SeedOpt = 0,
+    profile: ProfileOpt = None,
+    truth: TruthOpt = None,
+    rate_hz: RateHzOpt = None,
     latitude: LatitudeOpt = None,
     axis: AxisOpt = None,
-    runs: Annotated[
-        int | None, typer.Option("--runs", help="Number of runs (accel-full-range).")
-    ] = None,
-    orientation: Annotated[
-        str | None,
-        typer.Option("--orientation", help="horizontal, up or down (accel-full-range)."),
-    ] = None,
-    record_s: Annotated[
-        float | None, typer.Option("--record-s", help="Record per power-on [s] (mems-warmup).")
-    ] = None,
-    run: Annotated[
-        str | None,
-        typer.Option("--run", help="modelling or validation (mems-imu: the same unit)."),
-    ] = None,
-    fmt: Annotated[
-        str, typer.Option("--format", help="File format inside an output directory.")
-    ] = "csv",
+    runs: RunsOpt = None,
+    orientation: OrientationOpt = None,
+    record_s: RecordOpt = None,
+    run: RunOpt = None,
+    fmt: FormatOpt = "csv",
     as_json: JsonOpt = False,
 ) -> None:
     """A simulated recording (or several) with known truth."""
@@ -131,62 +137,31 @@ def simulate_cmd(
         raise ThermocalInputError(
             f"unknown scenario {scenario!r}; known scenarios: {', '.join(defaults.SCENARIO_NAMES)}"
         )
-    if rate_hz is not None and not (math.isfinite(rate_hz) and rate_hz > 0):
-        raise ThermocalInputError(f"--rate-hz must be a positive number, got {rate_hz!r}")
-    if latitude is not None and not (math.isfinite(latitude) and abs(latitude) <= 90.0):
-        raise ThermocalInputError(f"--latitude must be within ±90°, got {latitude!r}")
-    prog = None
+    opts = _simulate.SimulateOptions(rate_hz, latitude, axis, runs, orientation, record_s, run)
     inputs: list[str | Path] = [profile] if profile is not None else []
     _early_gate(output, truth, inputs)
-    if profile is not None:
-        prog = _profiles.read_program(profile)
-    opts: dict[str, Any] = {
-        k: v
-        for k, v in {
-            "rate_hz": rate_hz,
-            "latitude_deg": latitude,
-            "axis": axis,
-            "runs": runs,
-            "orientation": orientation,
-            "record_s": record_s,
-            "run": run,
-        }.items()
-        if v is not None
-    }
-    results = _simulate.run_scenario(scenario, seed, prog, **opts)
-    labels = [str(t.get("label", "")) for _, t in results]
-    if len(set(labels)) != len(labels):
-        labels = [f"{i + 1}" for i in range(len(results))]
-    paths = output_paths(output, scenario, labels, fmt)
+    prog = _profiles.read_program(profile) if profile is not None else None
+    sim = _simulate.simulate_scenario(scenario, seed, prog, opts)
+    paths = output_paths(output, scenario, list(sim.labels), fmt)
     sidecars = [_outputs.sidecar_path(p) for p in paths if _readers.file_kind(p) == "csv"]
     check_outputs([*paths, *sidecars], inputs, dirs=[p.parent for p in paths])
     if truth is not None:
         _writers.check_not_input(truth, [*inputs, *paths])
-    for (rec, _), p in zip(results, paths, strict=True):
+    for (rec, _), p in zip(sim.results, paths, strict=True):
         _writers.write_recording(rec, p)
-    files = [{"file": str(p), **tr} for (_, tr), p in zip(results, paths, strict=True)]
     if truth is not None:
-        _writers.write_json(
-            truth,
-            {
-                "format": _simulate.TRUTH_FORMAT,
-                "version": _simulate.TRUTH_VERSION,
-                "scenario": scenario,
-                "seed": seed,
-                "profile": str(profile) if profile is not None else None,
-                "files": files,
-            },
-        )
+        profile_name = str(profile) if profile is not None else None
+        _writers.write_json(truth, sim.truth_document([str(p) for p in paths], profile_name))
     summary = {
         "scenario": scenario,
         "seed": seed,
         "files": [str(p) for p in paths],
-        "n_samples": [rec.n_samples for rec, _ in results],
+        "n_samples": [rec.n_samples for rec, _ in sim.results],
         "truth": str(truth) if truth is not None else None,
     }
 
     def human() -> None:
-        for (rec, _), p in zip(results, paths, strict=True):
+        for (rec, _), p in zip(sim.results, paths, strict=True):
             stdout.print(
                 f"{p}: {rec.n_samples} samples, {rec.duration_s / 3600:.2f} h at "
                 f"{rec.sample_rate_hz:g} Hz"

@@ -205,6 +205,139 @@ def _num(v: Any) -> float | None:
     return None if v is None else float(v)
 
 
+def _fit_models(
+    out: Path,
+    cfg: DemoConfig,
+    mod: Recording,
+    caught: list[warnings.WarningMessage],
+    written: list[Path],
+    done: Callable[[str], None],
+) -> tuple[dict[str, TemperatureModel], dict[str, Path], dict[str, dict[str, Any]], list[str]]:
+    """Steps 3-4: the seed-37 and the selected polynomial fits of the modelling run, saved
+    under ``models/``; the warnings each fit raised (from ``caught``), labelled."""
+    # the earth rate on the sensitive axis is a known input, not a temperature effect
+    earth = _earth_rate(mod)
+    run_m = RunData.from_recording(mod, SIGNAL, list(TEMPS), known_input=earth)
+    fitted: dict[str, TemperatureModel] = {}
+    model_paths: dict[str, Path] = {}
+    model_dicts: dict[str, dict[str, Any]] = {}
+    fit_warnings: list[str] = []
+    for label, select, step in (
+        ("seed37", False, DEMO_STEPS[2]),
+        ("selected", True, DEMO_STEPS[3]),
+    ):
+        n0 = len(caught)
+        model = _fit_poly(run_m, cfg, select=select)
+        fit_warnings += [f"{label} fit: {' '.join(str(w.message).split())}" for w in caught[n0:]]
+        path = out / "models" / f"{label}.json"
+        model_dicts[label] = save_model(model, path)
+        fitted[label] = model
+        model_paths[label] = path
+        written.append(path)
+        done(step)
+    return fitted, model_paths, model_dicts, fit_warnings
+
+
+def _validate_models(
+    out: Path,
+    cfg: DemoConfig,
+    fitted: dict[str, TemperatureModel],
+    model_paths: dict[str, Path],
+    mod: Recording,
+    mod_path: Path,
+    val: Recording,
+    val_path: Path,
+    written: list[Path],
+) -> tuple[dict[str, dict[str, Any]], dict[str, Path], list[str]]:
+    """Step 5: each model judged on the validation run (``validation/LABEL.json``), and
+    the labels best first: the smaller rms of the whole compensated validation run
+    (within-stage stability of a navigation-grade RLG is noise-limited)."""
+    val_dicts: dict[str, dict[str, Any]] = {}
+    val_paths: dict[str, Path] = {}
+    for label, model in fitted.items():
+        vd = _validation_dict(model, model_paths[label], val, val_path, mod, mod_path, cfg)
+        vp = out / "validation" / f"{label}.json"
+        write_json(vp, vd)
+        val_dicts[label] = vd
+        val_paths[label] = vp
+        written.append(vp)
+    order = sorted(
+        fitted,
+        key=lambda lab: (float(val_dicts[lab].get("rms_after") or np.inf), lab != "selected"),
+    )
+    return val_dicts, val_paths, order
+
+
+def _export_models(
+    out: Path,
+    cfg: DemoConfig,
+    model_paths: dict[str, Path],
+    fit_warnings: list[str],
+    written: list[Path],
+) -> dict[str, tuple[Path, ...]]:
+    """Step 7: each model as C under ``c/`` (a family without a C generator: a warning)."""
+    c_files: dict[str, tuple[Path, ...]] = {}
+    for label in model_paths:
+        try:
+            _ex, paths = export_c(
+                model_paths[label],
+                out / "c",
+                prefix=f"thermocal_{label}",
+                sample_interval_s=1.0 / cfg.rate_hz,
+            )
+        except ModelFileError as exc:  # a family without a C generator
+            fit_warnings.append(f"{label}: C export not available ({exc})")
+            paths = []
+        c_files[label] = tuple(paths)
+        written += paths
+    return c_files
+
+
+def _write_demo_report(
+    out: Path,
+    cfg: DemoConfig,
+    seed: int,
+    order: list[str],
+    primary: str,
+    model_dicts: dict[str, dict[str, Any]],
+    val_dicts: dict[str, dict[str, Any]],
+    model_paths: dict[str, Path],
+    val_paths: dict[str, Path],
+    c_files: dict[str, tuple[Path, ...]],
+    comp_path: Path,
+    mod: Recording,
+    mod_path: Path,
+    val: Recording,
+    val_path: Path,
+    fit_warnings: list[str],
+) -> Path:
+    """Step 8: ``report.html`` of the models, best first."""
+    entries = tuple(
+        ModelEntry(lab, model_dicts[lab], val_dicts[lab], str(model_paths[lab])) for lab in order
+    )
+    notes = _demo_notes(cfg, seed, mod, primary)
+    files = [("C export", str(p.relative_to(out))) for lab in order for p in c_files[lab]]
+    files += [("validation result", str(val_paths[lab].relative_to(out))) for lab in order]
+    files.append(("compensated validation run", str(comp_path.relative_to(out))))
+    return write_report(
+        out / "report.html",
+        ReportInputs(
+            models=entries,
+            recording=val,
+            modeling=mod,
+            signal=SIGNAL,
+            recording_path=str(val_path),
+            modeling_path=str(mod_path),
+            title="Temperature compensation of a ring-laser gyro (thermocal demo)",
+            sensor=mod.meta.sensor_id,
+            notes=notes,
+            warnings=tuple(dict.fromkeys(fit_warnings)),
+            files=tuple(files),
+            generated_by="thermocal demo",
+        ),
+    )
+
+
 def run_demo(
     out_dir: str | Path = "thermocal-demo",
     *,
@@ -246,44 +379,13 @@ def run_demo(
         done(DEMO_STEPS[1])  # 2. simulation
 
         # 3-4. fits
-        # the earth rate on the sensitive axis is a known input, not a temperature effect
-        earth = _earth_rate(mod)
-        run_m = RunData.from_recording(mod, SIGNAL, list(TEMPS), known_input=earth)
-        fitted: dict[str, TemperatureModel] = {}
-        model_paths: dict[str, Path] = {}
-        model_dicts: dict[str, dict[str, Any]] = {}
-        fit_warnings: list[str] = []
-        for label, select, step in (
-            ("seed37", False, DEMO_STEPS[2]),
-            ("selected", True, DEMO_STEPS[3]),
-        ):
-            n0 = len(caught)
-            model = _fit_poly(run_m, cfg, select=select)
-            fit_warnings += [
-                f"{label} fit: {' '.join(str(w.message).split())}" for w in caught[n0:]
-            ]
-            path = out / "models" / f"{label}.json"
-            model_dicts[label] = save_model(model, path)
-            fitted[label] = model
-            model_paths[label] = path
-            written.append(path)
-            done(step)
+        fitted, model_paths, model_dicts, fit_warnings = _fit_models(
+            out, cfg, mod, caught, written, done
+        )
 
         # 5. validation
-        val_dicts: dict[str, dict[str, Any]] = {}
-        val_paths: dict[str, Path] = {}
-        for label, model in fitted.items():
-            vd = _validation_dict(model, model_paths[label], val, val_path, mod, mod_path, cfg)
-            vp = out / "validation" / f"{label}.json"
-            write_json(vp, vd)
-            val_dicts[label] = vd
-            val_paths[label] = vp
-            written.append(vp)
-        # the reported model: the smaller rms of the whole compensated validation run
-        # (within-stage stability of a navigation-grade RLG is noise-limited)
-        order = sorted(
-            fitted,
-            key=lambda lab: (float(val_dicts[lab].get("rms_after") or np.inf), lab != "selected"),
+        val_dicts, val_paths, order = _validate_models(
+            out, cfg, fitted, model_paths, mod, mod_path, val, val_path, written
         )
         primary = order[0]
         done(DEMO_STEPS[4])
@@ -295,48 +397,14 @@ def run_demo(
         done(DEMO_STEPS[5])
 
         # 7. C export
-        c_files: dict[str, tuple[Path, ...]] = {}
-        for label in fitted:
-            try:
-                _ex, paths = export_c(
-                    model_paths[label],
-                    out / "c",
-                    prefix=f"thermocal_{label}",
-                    sample_interval_s=1.0 / cfg.rate_hz,
-                )
-            except ModelFileError as exc:  # a family without a C generator
-                fit_warnings.append(f"{label}: C export not available ({exc})")
-                paths = []
-            c_files[label] = tuple(paths)
-            written += paths
+        c_files = _export_models(out, cfg, model_paths, fit_warnings, written)
         done(DEMO_STEPS[6])
 
         # 8. report
-        entries = tuple(
-            ModelEntry(lab, model_dicts[lab], val_dicts[lab], str(model_paths[lab]))
-            for lab in order
-        )
-        notes = _demo_notes(cfg, seed, mod, primary)
-        files = [("C export", str(p.relative_to(out))) for lab in order for p in c_files[lab]]
-        files += [("validation result", str(val_paths[lab].relative_to(out))) for lab in order]
-        files.append(("compensated validation run", str(comp_path.relative_to(out))))
-        report_path = write_report(
-            out / "report.html",
-            ReportInputs(
-                models=entries,
-                recording=val,
-                modeling=mod,
-                signal=SIGNAL,
-                recording_path=str(val_path),
-                modeling_path=str(mod_path),
-                title="Temperature compensation of a ring-laser gyro (thermocal demo)",
-                sensor=mod.meta.sensor_id,
-                notes=notes,
-                warnings=tuple(dict.fromkeys(fit_warnings)),
-                files=tuple(files),
-                generated_by="thermocal demo",
-            ),
-        )
+        report_path = _write_demo_report(
+            out, cfg, seed, order, primary, model_dicts, val_dicts, model_paths, val_paths,
+            c_files, comp_path, mod, mod_path, val, val_path, fit_warnings,
+        )  # fmt: skip
         written.append(report_path)
         done(DEMO_STEPS[7])
     msgs = tuple(dict.fromkeys(" ".join(str(w.message).split()) for w in caught))

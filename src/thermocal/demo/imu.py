@@ -18,7 +18,7 @@ import warnings
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -35,6 +35,10 @@ from thermocal.simulate import IMU_CHANNELS, SCENARIOS
 from thermocal.validation import validate
 from thermocal.writers import write_json, write_recording
 
+if TYPE_CHECKING:
+    from thermocal.recording import Recording
+    from thermocal.validation import ValidationResult
+
 IMU_STEPS = ("simulate", "fit", "validate", "compensate", "export-c", "report")
 """Progress steps of :func:`run_imu_demo`."""
 
@@ -45,7 +49,7 @@ TRUE_REMOVED = "true bias removed [%]"
 AMBIENT = "T_chamber"
 
 
-@dataclass
+@dataclass(frozen=True)
 class ChannelSummary:
     """One channel's figures: ``removed_pct`` share of the true temperature-induced bias
     removed on the validation run (``100 (1 − rms(e)/sd(E))``, e the model's error against
@@ -66,7 +70,7 @@ class ChannelSummary:
     warnings: list[str] = field(default_factory=list)
 
 
-@dataclass
+@dataclass(frozen=True)
 class ImuDemoResult:
     """Where everything went and the per-channel figures."""
 
@@ -76,6 +80,71 @@ class ImuDemoResult:
     channels: list[ChannelSummary]
     files: list[Path]
     elapsed_s: float
+
+
+def _fit_channels(mod: Recording) -> tuple[Calibration, dict[str, list[str]]]:
+    """Step 2: one cubic per channel in the die temperature, gravity on the up axis a
+    known input of the accelerometers; the warnings of each channel's fit."""
+    channels: list[Channel] = []
+    fit_warnings: dict[str, list[str]] = {}
+    for name, unit in IMU_CHANNELS:
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always", ThermocalWarning)
+            # gravity on the up axis (+z) is a known input: compensation keeps it
+            g_mg = units.gravity_on_axis_mg(name[-1], GRAVITY_AXIS, units.STANDARD_GRAVITY_M_S2)
+            g_mg = g_mg if units.signal_kind(unit) == "accel" else 0.0
+            run = RunData.from_recording(mod, name, [TEMP], known_input=g_mg)
+            model = PolyModel(order=3, per_run_offset=False).fit([run])
+        model.signal_name, model.signal_unit = name, run.signal_unit or unit
+        what = f"gravity {g_mg:+g} mg ({GRAVITY_AXIS} up)" if g_mg else "none"
+        model.inputs_ = model_inputs(mod, name, [TEMP], known_input=g_mg, known_input_what=what)
+        channels.append(Channel(name, name, unit, model, guess_role(name, unit)))
+        fit_warnings[name] = [str(w.message) for w in caught]
+    return Calibration(channels), fit_warnings
+
+
+def _validate_channels(
+    cal: Calibration, mod: Recording, val: Recording, fit_warnings: dict[str, list[str]]
+) -> dict[str, ValidationResult]:
+    """Step 3: every channel judged on the validation run against the modelling run's
+    chamber air, in the data's own unit; its warnings added to ``fit_warnings``."""
+    mod_air = (mod.time_s, mod.column(AMBIENT))
+    results = {}
+    for ch in cal.channels:
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always", ThermocalWarning)
+            mrun = prepare_run(ch.model, val, ch.signal, [TEMP])
+            res = validate(ch.model, mrun.run, mod_air, validation_ambient=val.column(AMBIENT))
+        results[ch.name] = res.in_unit(mrun.data_unit, mrun.factor)
+        fit_warnings[ch.name] += [str(w.message) for w in caught]
+    return results
+
+
+def _summary(
+    ch: Channel, val: Recording, res: ValidationResult, warns: list[str]
+) -> ChannelSummary:
+    """A channel's line of the summary; ``removed_pct = 100·(1 − rms(e)/sd(E))``, e the
+    model's error against the simulator's temperature-induced bias E, both centred."""
+    model_v = _model_in_data_unit(ch, val)
+    true_e = val.column(f"truth_{ch.name}")
+    err = (model_v - model_v.mean()) - (true_e - true_e.mean())
+    removed = 100.0 * (1.0 - float(np.sqrt(np.mean(err**2))) / float(np.std(true_e)))
+    st = ch.model.stats_
+    return ChannelSummary(
+        name=ch.name,
+        unit=ch.unit,
+        n_coefficients=st.n_coefficients,
+        rms_residual=float(st.rms_residual),
+        condition_number=st.condition_number,
+        temp_range_c=(float(ch.model.temp_range_[0, 0]), float(ch.model.temp_range_[0, 1])),
+        r=res.r,
+        bias_stability_before=res.bias_stability_before,
+        bias_stability_after=res.bias_stability_after,
+        rms_before=res.rms_before,
+        rms_after=res.rms_after,
+        removed_pct=removed,
+        warnings=warns,
+    )
 
 
 def run_imu_demo(
@@ -109,37 +178,14 @@ def run_imu_demo(
     step(IMU_STEPS[0])
 
     # 2. fit: one cubic per channel on the die temperature
-    channels: list[Channel] = []
-    fit_warnings: dict[str, list[str]] = {}
-    for name, unit in IMU_CHANNELS:
-        with warnings.catch_warnings(record=True) as caught:
-            warnings.simplefilter("always", ThermocalWarning)
-            # gravity on the up axis (+z) is a known input: compensation keeps it
-            g_mg = units.gravity_on_axis_mg(name[-1], GRAVITY_AXIS, units.STANDARD_GRAVITY_M_S2)
-            g_mg = g_mg if units.signal_kind(unit) == "accel" else 0.0
-            run = RunData.from_recording(mod, name, [TEMP], known_input=g_mg)
-            model = PolyModel(order=3, per_run_offset=False).fit([run])
-        model.signal_name, model.signal_unit = name, run.signal_unit or unit
-        what = f"gravity {g_mg:+g} mg ({GRAVITY_AXIS} up)" if g_mg else "none"
-        model.inputs_ = model_inputs(mod, name, [TEMP], known_input=g_mg, known_input_what=what)
-        channels.append(Channel(name, name, unit, model, guess_role(name, unit)))
-        fit_warnings[name] = [str(w.message) for w in caught]
-    cal = Calibration(channels)
+    cal, fit_warnings = _fit_channels(mod)
     cal_path = out / "models" / "imu.json"
     save_calibration(cal, cal_path)
     files.append(cal_path)
     step(IMU_STEPS[1])
 
     # 3. validate every channel against the modelling run's chamber air
-    mod_air = (mod.time_s, mod.column(AMBIENT))
-    results = {}
-    for ch in cal.channels:
-        with warnings.catch_warnings(record=True) as caught:
-            warnings.simplefilter("always", ThermocalWarning)
-            mrun = prepare_run(ch.model, val, ch.signal, [TEMP])
-            res = validate(ch.model, mrun.run, mod_air, validation_ambient=val.column(AMBIENT))
-        results[ch.name] = res.in_unit(mrun.data_unit, mrun.factor)
-        fit_warnings[ch.name] += [str(w.message) for w in caught]
+    results = _validate_channels(cal, mod, val, fit_warnings)
     step(IMU_STEPS[2])
 
     # 4. compensate the validation file, every channel in one pass
@@ -159,31 +205,7 @@ def run_imu_demo(
     step(IMU_STEPS[4])
 
     # 6. summary and report
-    summaries = []
-    for ch in cal.channels:
-        model_v = _model_in_data_unit(ch, val)
-        true_e = val.column(f"truth_{ch.name}")
-        err = (model_v - model_v.mean()) - (true_e - true_e.mean())
-        removed = 100.0 * (1.0 - float(np.sqrt(np.mean(err**2))) / float(np.std(true_e)))
-        st = ch.model.stats_
-        res = results[ch.name]
-        summaries.append(
-            ChannelSummary(
-                name=ch.name,
-                unit=ch.unit,
-                n_coefficients=st.n_coefficients,
-                rms_residual=float(st.rms_residual),
-                condition_number=st.condition_number,
-                temp_range_c=(float(ch.model.temp_range_[0, 0]), float(ch.model.temp_range_[0, 1])),
-                r=res.r,
-                bias_stability_before=res.bias_stability_before,
-                bias_stability_after=res.bias_stability_after,
-                rms_before=res.rms_before,
-                rms_after=res.rms_after,
-                removed_pct=removed,
-                warnings=fit_warnings[ch.name],
-            )
-        )
+    summaries = [_summary(ch, val, results[ch.name], fit_warnings[ch.name]) for ch in cal.channels]
     report = out / "report.html"
     validation = {
         "channels": {n: {**r.to_dict(), "verdict": r.verdict} for n, r in results.items()}

@@ -33,7 +33,7 @@ from thermocal.writers import write_json
 
 def file_sha256(path: str | Path, chunk: int = 1 << 20) -> str:
     """SHA-256 of a data file (provenance in model files)."""
-    from thermocal.station.recorder import is_station_path, station_files
+    from thermocal.readers.station import is_station_path, station_files
 
     h = hashlib.sha256()
     # a station's recording folder (DIR or DIR/SENSOR): its closed parts, in order

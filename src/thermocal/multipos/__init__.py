@@ -22,6 +22,7 @@ to the faces of the box (all six misalignments).
 Modules: :mod:`.poses` (static poses, the POSES file), :mod:`.accel` (accelerometer from
 the gravity magnitude, six-face closed form), :mod:`.gyro` (gyro from the rotations
 between poses and from 360° turns), :mod:`.calibrate` (one session end to end, its
-validation), :mod:`.simulate` (sessions with known truth).  Pure maths on numpy arrays;
-no I/O.
+validation), :mod:`.simulate` (sessions with known truth): pure maths on numpy arrays, no
+I/O.  :mod:`.files` is the file edge ``thermocal multipos`` calls: it reads the sessions,
+fits in temperature and saves the calibration.
 """

@@ -35,6 +35,10 @@ from thermocal.turntable import model
 
 FloatArray = npt.NDArray[np.float64]
 
+METHOD = "multipos"
+"""The ``method`` tag of a triad model made by ``thermocal multipos`` (the turntable's are
+``"turntable"``): :func:`thermocal.multipos.validate.is_multipos` reads it back."""
+
 
 @dataclass(frozen=True)
 class PoseStats:
@@ -278,6 +282,7 @@ def rotation_errors(
 
 
 __all__ = [
+    "METHOD",
     "MultiposValidation",
     "PoseStats",
     "SessionResult",

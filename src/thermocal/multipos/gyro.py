@@ -112,30 +112,22 @@ def _direction(u0: FloatArray, a0: FloatArray, a1: FloatArray) -> FloatArray:
     return out
 
 
-def fit_rotations(
-    rate_rad_s: FloatArray,
+_Held = tuple[list[tuple[FloatArray, FloatArray]], list[tuple[FloatArray, float, float]]]
+"""The attitudes at each motion's ends and each turn's (integrated rate, sense, weight)."""
+
+
+def _motions(
     dt_s: FloatArray,
     poses: Sequence[Section],
-    up_of: Callable[[FloatArray], FloatArray],
-    accel_free: FloatArray,
-    accel_free_cov: FloatArray,
-    bias_rad_s: FloatArray,
-    bias_cov: FloatArray,
+    dt_med: float,
     dir_sigma_rad: FloatArray,
     rate_sigma_rad_s: float,
-    turns: Sequence[tuple[Section, int]] = (),
-    *,
-    max_iter: int = 8,
-) -> GyroFit:
-    """``E_g`` from the motions between consecutive ``poses`` (module docstring).
-
-    ``up_of(p)`` gives the poses' calibrated unit up directions (m, 3) for accelerometer
-    parameters ``p`` (``accel_free`` at the solution, covariance ``accel_free_cov``);
-    ``dir_sigma_rad`` (m,) the noise of each pose's direction; ``turns`` the 360° turns with
-    the index of the pose before each."""
+) -> list[_Motion]:
+    """The motions between consecutive poses not split by a gap in time, each with the
+    variance of its residual per component [rad²]: the two poses' direction noise, the
+    rate noise integrated over ``T_m + (T_k + T_k+1)/3`` and the earth rate's unmodelled
+    turn over ``T_m + (T_k + T_k+1)/2`` (uniform, ``(Ω T)²/3``)."""
     om = units.EARTH_RATE_RAD_S
-    dt_med = float(np.median(dt_s))
-    up = up_of(accel_free)
     motions: list[_Motion] = []
     for k in range(len(poses) - 1):
         p0, p1 = poses[k], poses[k + 1]
@@ -148,16 +140,34 @@ def fit_rotations(
         var = (dir_sigma_rad[k] ** 2 + dir_sigma_rad[k + 1] ** 2
                + rate_sigma_rad_s**2 * dt_med * t_eff + (om * t_span) ** 2 / 3.0)  # fmt: skip
         motions.append(_Motion(p0.start, p0.end, p1.start, p1.end, var, k, k + 1))
-    n_rows = 3 * len(motions) + 3 * len(turns)
-    if n_rows < 9 + 3:
-        raise DesignError(
-            f"{len(motions)} motions between static poses: the gyro's scale factors and "
-            "misalignments need rotations about at least two different axes (and a still "
-            "pose before and after each)"
-        )
-    e = np.zeros((3, 3))
+    return motions
 
-    def evaluate(e: FloatArray, b: FloatArray, u: FloatArray, jac: bool):  # type: ignore[no-untyped-def]
+
+@dataclass(frozen=True, eq=False)
+class _Rotations:
+    """The whitened residuals of the rotation fit (module docstring) and their Jacobians."""
+
+    rate_rad_s: FloatArray
+    dt_s: FloatArray
+    dt_med: float
+    motions: list[_Motion]
+    turns: Sequence[tuple[Section, int]]
+    dir_sigma_rad: FloatArray
+    rate_sigma_rad_s: float
+
+    @property
+    def n_rows(self) -> int:
+        return 3 * len(self.motions) + 3 * len(self.turns)
+
+    def evaluate(
+        self, e: FloatArray, b: FloatArray, u: FloatArray, jac: bool
+    ) -> tuple[FloatArray, FloatArray, FloatArray, _Held]:
+        """Residuals r, ∂r/∂E (row-major), ∂r/∂b and the attitudes held, for the error
+        matrix ``e``, the bias ``b`` [rad/s] and the poses' up directions ``u``."""
+        om = units.EARTH_RATE_RAD_S
+        rate_rad_s, dt_s, dt_med = self.rate_rad_s, self.dt_s, self.dt_med
+        motions, turns = self.motions, self.turns
+        n_rows = self.n_rows
         ie_inv = np.linalg.inv(np.eye(3) + e)
         r = np.empty(n_rows)
         j = np.zeros((n_rows, 9))
@@ -188,7 +198,8 @@ def fit_rotations(
             tot = (wc * tau).sum(axis=0)
             sense = 1.0 if float(tot @ u[k]) >= 0 else -1.0
             t_turn = sec.n * dt_med
-            var = (rate_sigma_rad_s**2 * dt_med * t_turn + (2 * math.pi * dir_sigma_rad[k]) ** 2
+            var = (self.rate_sigma_rad_s**2 * dt_med * t_turn
+                   + (2 * math.pi * self.dir_sigma_rad[k]) ** 2
                    + (om * t_turn) ** 2 / 3.0)  # fmt: skip
             s = 1.0 / math.sqrt(var)
             row = slice(3 * len(motions) + 3 * t_i, 3 * len(motions) + 3 * t_i + 3)
@@ -202,42 +213,72 @@ def fit_rotations(
                 jb[row] = -np.eye(3) * t_turn * s
         return r, j, jb, (atts, turn_info)
 
-    r0, _j, _jb, _a = evaluate(e, bias_rad_s, up, jac=False)
-    scale = 1e-3
+
+_SCALE = 1e-3
+"""Column scale of the Gauss-Newton steps in E (its elements are ~1e-3)."""
+
+
+def _solve_error_matrix(
+    rot: _Rotations, bias_rad_s: FloatArray, up: FloatArray, max_iter: int
+) -> FloatArray:
+    """Gauss-Newton on E from E = 0 until the largest step is below 1e-10."""
+    e = np.zeros((3, 3))
     for _ in range(max_iter):
-        r, j, jb, _atts = evaluate(e, bias_rad_s, up, jac=True)
-        step, *_ = np.linalg.lstsq(j * scale, -r, rcond=None)
-        e = e + (step * scale).reshape(3, 3)
-        if float(np.max(np.abs(step * scale))) < 1e-10:
+        r, j, _jb, _atts = rot.evaluate(e, bias_rad_s, up, jac=True)
+        step, *_ = np.linalg.lstsq(j * _SCALE, -r, rcond=None)
+        e = e + (step * _SCALE).reshape(3, 3)
+        if float(np.max(np.abs(step * _SCALE))) < 1e-10:
             break
-    r, j, jb, atts = evaluate(e, bias_rad_s, up, jac=True)
-    _u, s_, vt = np.linalg.svd(j * scale, full_matrices=False)
+    return e
+
+
+def _error_matrix_cov(
+    rot: _Rotations,
+    r: FloatArray,
+    j: FloatArray,
+    jb: FloatArray,
+    held: _Held,
+    up_of: Callable[[FloatArray], FloatArray],
+    accel_free: FloatArray,
+    accel_free_cov: FloatArray,
+    bias_cov: FloatArray,
+) -> tuple[FloatArray, float]:
+    """Covariance of E's nine elements (row-major) and the reduced χ²: ``(JᵀJ)⁻¹`` of the
+    whitened fit (scaled by χ²/ν when above 1 + 3√(2/ν)), plus the bias's and the
+    accelerometer's covariances carried through ``K = (JᵀJ)⁻¹Jᵀ``."""
+    _u, s_, vt = np.linalg.svd(j * _SCALE, full_matrices=False)
     if not s_[-1] > 1e-6 * s_[0]:
         raise DesignError(
             "the rotations between poses are all about one axis (or too small): the gyro's "
             "scale factors and misalignments of the other axes are unseen; turn the board "
             "about at least two different axes between poses"
         )
-    cov_p = (vt.T / s_**2) @ vt * scale**2  # covariance of E's nine elements
-    dof = (2 * len(motions) + 3 * len(turns)) - 9
+    cov_p = (vt.T / s_**2) @ vt * _SCALE**2  # covariance of E's nine elements
+    dof = (2 * len(rot.motions) + 3 * len(rot.turns)) - 9
     chi2 = float(r @ r) / dof if dof > 0 else float("nan")
     if dof > 0 and chi2 > 1.0 + 3.0 * math.sqrt(2.0 / dof):
         cov_p = cov_p * chi2
     gain = cov_p @ j.T  # K = (JᵀJ)⁻¹ Jᵀ (whitened)
     cov_p = cov_p + gain @ jb @ bias_cov @ jb.T @ gain.T
     # the accelerometer's uncertainty through u (numerical derivative of the residuals)
-    ga = np.zeros((n_rows, accel_free.size))
+    ga = np.zeros((rot.n_rows, accel_free.size))
     for q in range(accel_free.size):
         h = max(1e-6, 1e-3 * math.sqrt(max(float(accel_free_cov[q, q]), 0.0)))
         pq = accel_free.copy()
         pq[q] += h
-        r_q = _residuals_fixed_att(motions, turns, atts, up_of(pq), r)
+        r_q = _residuals_fixed_att(rot.motions, rot.turns, held, up_of(pq), r)
         ga[:, q] = (r_q - r) / h
-    cov_p = cov_p + gain @ ga @ accel_free_cov @ ga.T @ gain.T
+    return cov_p + gain @ ga @ accel_free_cov @ ga.T @ gain.T, chi2
+
+
+def _coefficients(
+    e: FloatArray, bias_rad_s: FloatArray, bias_cov: FloatArray, cov_p: FloatArray
+) -> tuple[FloatArray, FloatArray]:
+    """θ (bias [°/h], scale factors [ppm], misalignments [″]) of E and the bias, and its
+    covariance through the Jacobian of θ[3:12] w.r.t. E's row-major elements."""
     theta = np.zeros(12)
     theta[0:3] = bias_rad_s * units.RS_TO_DH
     theta[3:12] = model.coeffs_from_error_matrix(e, np.zeros(3))[3:12]
-    # Jacobian of θ[3:12] w.r.t. the row-major elements of E
     t_mat = np.zeros((9, 9))
     for i in range(3):
         t_mat[i, 4 * i] = 1.0 / units.PPM
@@ -247,6 +288,47 @@ def fit_rotations(
     cov = np.zeros((12, 12))
     cov[0:3, 0:3] = bias_cov * units.RS_TO_DH**2
     cov[3:12, 3:12] = t_mat @ cov_p @ t_mat.T
+    return theta, cov
+
+
+def fit_rotations(
+    rate_rad_s: FloatArray,
+    dt_s: FloatArray,
+    poses: Sequence[Section],
+    up_of: Callable[[FloatArray], FloatArray],
+    accel_free: FloatArray,
+    accel_free_cov: FloatArray,
+    bias_rad_s: FloatArray,
+    bias_cov: FloatArray,
+    dir_sigma_rad: FloatArray,
+    rate_sigma_rad_s: float,
+    turns: Sequence[tuple[Section, int]] = (),
+    *,
+    max_iter: int = 8,
+) -> GyroFit:
+    """``E_g`` from the motions between consecutive ``poses`` (module docstring).
+
+    ``up_of(p)`` gives the poses' calibrated unit up directions (m, 3) for accelerometer
+    parameters ``p`` (``accel_free`` at the solution, covariance ``accel_free_cov``);
+    ``dir_sigma_rad`` (m,) the noise of each pose's direction; ``turns`` the 360° turns with
+    the index of the pose before each."""
+    dt_med = float(np.median(dt_s))
+    up = up_of(accel_free)
+    motions = _motions(dt_s, poses, dt_med, dir_sigma_rad, rate_sigma_rad_s)
+    rot = _Rotations(rate_rad_s, dt_s, dt_med, motions, turns, dir_sigma_rad, rate_sigma_rad_s)
+    if rot.n_rows < 9 + 3:
+        raise DesignError(
+            f"{len(motions)} motions between static poses: the gyro's scale factors and "
+            "misalignments need rotations about at least two different axes (and a still "
+            "pose before and after each)"
+        )
+    r0, _j, _jb, _a = rot.evaluate(np.zeros((3, 3)), bias_rad_s, up, jac=False)
+    e = _solve_error_matrix(rot, bias_rad_s, up, max_iter)
+    r, j, jb, held = rot.evaluate(e, bias_rad_s, up, jac=True)
+    cov_p, chi2 = _error_matrix_cov(
+        rot, r, j, jb, held, up_of, accel_free, accel_free_cov, bias_cov
+    )
+    theta, cov = _coefficients(e, bias_rad_s, bias_cov, cov_p)
     sw = np.array([math.sqrt(mo.var) for mo in motions])
     n_m = 3 * len(motions)
     before = r0[:n_m].reshape(-1, 3) * sw[:, None]
@@ -265,7 +347,7 @@ def fit_rotations(
 def _residuals_fixed_att(
     motions: Sequence[_Motion],
     turns: Sequence[tuple[Section, int]],
-    held: tuple[list[tuple[FloatArray, FloatArray]], list[tuple[FloatArray, float, float]]],
+    held: _Held,
     u: FloatArray,
     r_ref: FloatArray,
 ) -> FloatArray:

@@ -21,6 +21,7 @@ import numpy as np
 from thermocal import units
 from thermocal.errors import ThermocalInputError
 from thermocal.multipos.calibrate import (
+    METHOD,
     MultiposValidation,
     gravity_errors,
     rotation_errors,
@@ -132,7 +133,7 @@ def _rms3(v: Any) -> tuple[float, float, float]:
 
 def is_multipos(triads: Sequence[Any]) -> bool:
     """A calibration of triads made by ``thermocal multipos``."""
-    return any(getattr(t.model, "method", "turntable") == "multipos" for t in triads)
+    return any(getattr(t.model, "method", "turntable") == METHOD for t in triads)
 
 
 __all__ = ["is_multipos", "validate_triads"]

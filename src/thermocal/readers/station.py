@@ -1,35 +1,136 @@
-"""A recording folder written by ``thermocal station run``, read as one recording."""
+"""A recording folder written by ``thermocal station run``, read as one recording.
+
+The folder's layout (``station.json``, closed parts ``SENSOR-NNNN.parquet``, the temporary
+name of a part being written) is described in :mod:`thermocal.station.recorder`, the writer,
+which imports its names from here: the reader needs nothing of the station's drivers.
+"""
 
 from __future__ import annotations
 
+import json
+import re
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from thermocal._lazy import LazyModule
+from thermocal.errors import FileFormatError
 
 if TYPE_CHECKING:
     import pandas as pd
     import pyarrow as pa
-    import pyarrow.csv as pacsv
+
+STATION_JSON = "station.json"
+STATION_FORMAT = "thermocal-station"
+STATION_VERSION = 1
+PART_RE = re.compile(r"^(?P<stream>[A-Za-z0-9][A-Za-z0-9_]*)-(?P<index>\d{4,})\.parquet$")
+CHAMBER_STREAM = "chamber"
+"""The stream of the chamber's polled temperature and set-point (not a sensor id)."""
+
+
+def closed_parts(out_dir: Path, stream: str | None = None) -> list[tuple[str, int, Path]]:
+    """Closed parts in ``out_dir`` as ``(stream, index, path)``, in stream and index order."""
+    out = []
+    for p in out_dir.iterdir():
+        m = PART_RE.match(p.name)
+        if m and (stream is None or m["stream"] == stream):
+            out.append((m["stream"], int(m["index"]), p))
+    return sorted(out, key=lambda x: (x[0], x[1]))
+
+
+def read_station_json(out_dir: Path) -> dict[str, Any]:
+    p = out_dir / STATION_JSON
+    if not p.is_file():
+        raise FileFormatError(f"{out_dir}: not a station recording (no {STATION_JSON})")
+    try:
+        doc = json.loads(p.read_text(encoding="utf-8"))
+    except (json.JSONDecodeError, UnicodeDecodeError) as exc:
+        raise FileFormatError(f"{p}: not valid JSON ({exc})") from None
+    if not isinstance(doc, dict) or doc.get("format") != STATION_FORMAT:
+        raise FileFormatError(f"{p}: not a thermocal station file")
+    if int(doc.get("version", 0)) > STATION_VERSION:
+        raise FileFormatError(f"{p}: written by a newer thermocal (version {doc['version']})")
+    return doc
+
+
+def is_station_path(path: Path) -> bool:
+    """``DIR`` or ``DIR/SENSOR`` of a station recording."""
+    if path.is_dir():
+        return (path / STATION_JSON).is_file()
+    return not path.exists() and (path.parent / STATION_JSON).is_file()
+
+
+def sensor_ids(doc: dict[str, Any]) -> list[str]:
+    return [str(s["id"]) for s in (doc.get("config") or {}).get("sensors", [])]
+
+
+def _stream_of(path: Path) -> tuple[Path, str]:
+    """``(DIR, stream)`` of ``DIR`` (its only sensor) or ``DIR/SENSOR``."""
+    if path.is_dir():
+        doc = read_station_json(path)
+        ids = sensor_ids(doc)
+        if len(ids) != 1:
+            raise FileFormatError(
+                f"{path}: a station recording of {len(ids)} sensors ({', '.join(ids)}); "
+                f"name one as {path}/ID (or {path}/{CHAMBER_STREAM})"
+            )
+        return path, ids[0]
+    doc = read_station_json(path.parent)
+    ids = sensor_ids(doc)
+    if path.name not in (*ids, CHAMBER_STREAM):
+        raise FileFormatError(
+            f"{path}: no sensor {path.name!r} in this station recording; sensors: "
+            f"{', '.join([*ids, CHAMBER_STREAM])}"
+        )
+    return path.parent, path.name
+
+
+def station_files(path: Path) -> list[Path]:
+    """The closed parts of ``DIR`` or ``DIR/SENSOR``, in order (the recording's content)."""
+    out_dir, stream = _stream_of(path)
+    parts = closed_parts(out_dir, stream)
+    if not parts:
+        raise FileFormatError(f"{out_dir}: no closed part of {stream!r} yet")
+    return [p for _s, _i, p in parts]
+
+
+def read_station(path: Path) -> tuple[pa.Table, dict[str, Any]]:
+    """A station recording as one table: ``DIR`` (its only sensor) or ``DIR/SENSOR`` (one
+    of several, or ``DIR/chamber``).  The closed parts are concatenated in order; the
+    metadata object is the last part's.  Raises :class:`FileFormatError` naming what is
+    missing."""
+    import pyarrow as pa
     import pyarrow.parquet as pq
-else:
-    pd = LazyModule("pandas")
-    pa = LazyModule("pyarrow")
-    pacsv = LazyModule("pyarrow.csv")
-    pq = LazyModule("pyarrow.parquet")
 
+    from thermocal.recording import META_KEY
 
-def is_station_path(p: Path) -> bool:
-    """``DIR`` (or ``DIR/SENSOR``) written by ``thermocal station run``."""
-    return (p.is_dir() or not p.exists()) and (
-        (p / "station.json").is_file() or (p.parent / "station.json").is_file()
-    )
+    files = station_files(path)
+    tables = []
+    for p in files:
+        try:
+            tables.append(pq.read_table(p))
+        except (pa.ArrowInvalid, OSError) as exc:
+            raise FileFormatError(f"{p}: not a readable Parquet part ({exc})") from None
+    raw = (tables[-1].schema.metadata or {}).get(META_KEY.encode())
+    meta: dict[str, Any] = json.loads(raw.decode()) if raw else {}
+    table = pa.concat_tables([t.replace_schema_metadata(None) for t in tables])
+    return table, meta
 
 
 def read_station_table(p: Path) -> tuple[pd.DataFrame, dict[str, Any]]:
-    """The closed Parquet parts of a station recording as one table
-    (:func:`thermocal.station.recorder.read_station`)."""
-    from thermocal.station.recorder import read_station
-
+    """The closed Parquet parts of a station recording as one table (:func:`read_station`)."""
     table, meta = read_station(p)
     return table.to_pandas(), meta
+
+
+__all__ = [
+    "CHAMBER_STREAM",
+    "STATION_FORMAT",
+    "STATION_JSON",
+    "STATION_VERSION",
+    "closed_parts",
+    "is_station_path",
+    "read_station",
+    "read_station_json",
+    "read_station_table",
+    "sensor_ids",
+    "station_files",
+]

@@ -98,6 +98,12 @@ from thermocal.simulate.scenarios import (
     ScenarioFn as ScenarioFn,
 )
 from thermocal.simulate.scenarios import (
+    SimulateOptions as SimulateOptions,
+)
+from thermocal.simulate.scenarios import (
+    Simulation as Simulation,
+)
+from thermocal.simulate.scenarios import (
     run_scenario as run_scenario,
 )
 from thermocal.simulate.scenarios import (
@@ -123,6 +129,9 @@ from thermocal.simulate.scenarios import (
 )
 from thermocal.simulate.scenarios import (
     scenario_turntable16 as scenario_turntable16,
+)
+from thermocal.simulate.scenarios import (
+    simulate_scenario as simulate_scenario,
 )
 from thermocal.simulate.sensors import (
     ACCEL as ACCEL,

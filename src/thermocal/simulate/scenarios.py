@@ -9,6 +9,7 @@ import dataclasses
 import math
 import zlib
 from collections.abc import Callable, Sequence
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -614,3 +615,64 @@ def run_scenario(
         if "unexpected keyword" in str(exc):
             raise ThermocalInputError(f"scenario {name!r}: {exc}") from None
         raise
+
+
+@dataclass(frozen=True)
+class SimulateOptions:
+    """The options ``thermocal simulate`` passes to a scenario (None: the scenario's
+    default): sample rate [Hz], latitude [°] and sensitive axis, number of runs,
+    orientation, record per power-on [s] and run (modelling or validation)."""
+
+    rate_hz: float | None = None
+    latitude_deg: float | None = None
+    axis: str | None = None
+    runs: int | None = None
+    orientation: str | None = None
+    record_s: float | None = None
+    run: str | None = None
+
+    def __post_init__(self) -> None:
+        rate, lat = self.rate_hz, self.latitude_deg
+        if rate is not None and not (math.isfinite(rate) and rate > 0):
+            raise ThermocalInputError(f"--rate-hz must be a positive number, got {rate!r}")
+        if lat is not None and not (math.isfinite(lat) and abs(lat) <= 90.0):
+            raise ThermocalInputError(f"--latitude must be within ±90°, got {lat!r}")
+
+    def given(self) -> dict[str, Any]:
+        """The options given, as the scenario's keyword arguments."""
+        return {k: v for k, v in dataclasses.asdict(self).items() if v is not None}
+
+
+@dataclass(frozen=True, eq=False)
+class Simulation:
+    """The result of :func:`simulate_scenario`: each recording with its truth, and a label per
+    recording (the truth's ``label``, else 1, 2, … when the labels do not tell them
+    apart)."""
+
+    scenario: str
+    seed: int
+    results: ScenarioResult
+    labels: tuple[str, ...]
+
+    def truth_document(self, files: Sequence[str], profile: str | None) -> dict[str, Any]:
+        """The ``--truth`` JSON: format, version, scenario, seed, profile and per recording
+        its truth with ``file`` the path it was written to."""
+        return {
+            "format": TRUTH_FORMAT,
+            "version": TRUTH_VERSION,
+            "scenario": self.scenario,
+            "seed": self.seed,
+            "profile": profile,
+            "files": [{"file": f, **tr} for (_, tr), f in zip(self.results, files, strict=True)],
+        }
+
+
+def simulate_scenario(
+    scenario: str, seed: int, profile: ProfileInput, options: SimulateOptions
+) -> Simulation:
+    """Run the scenario (:func:`run_scenario`) with ``options`` and label its recordings."""
+    results = run_scenario(scenario, seed, profile, **options.given())
+    labels = [str(t.get("label", "")) for _, t in results]
+    if len(set(labels)) != len(labels):
+        labels = [f"{i + 1}" for i in range(len(results))]
+    return Simulation(scenario, seed, results, tuple(labels))

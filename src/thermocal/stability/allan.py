@@ -508,6 +508,64 @@ def confidence_interval(
     return dev * np.sqrt(nu / chi_hi), dev * np.sqrt(nu / chi_lo)
 
 
+def _checked_rate(rate: npt.ArrayLike, tau0_s: float, overwrite: bool) -> tuple[FloatArray, bool]:
+    """The rate as a 1-D float64 array (the caller's own buffer when it is one, then
+    ``overwrite`` may stand) after checking τ0 and that every sample is finite."""
+    own = isinstance(rate, np.ndarray) and rate.dtype == np.float64 and rate.ndim == 1
+    y = cast(FloatArray, rate) if own else np.asarray(rate, dtype=np.float64).ravel()
+    if not (math.isfinite(tau0_s) and tau0_s > 0):
+        raise ThermocalInputError(f"sample interval τ0 must be positive, got {tau0_s!r}")
+    with np.errstate(over="ignore", invalid="ignore"):
+        all_finite = math.isfinite(float(np.add.reduce(y))) if y.size else True
+    bad = np.zeros(0, dtype=np.intp) if all_finite else np.flatnonzero(~np.isfinite(y))
+    if bad.size:
+        raise MissingValueError(
+            f"rate has {bad.size} NaN/infinite samples (first at row {bad[0]}); "
+            "remove them or split the record"
+        )
+    return y, overwrite and own  # only the caller's own float64 buffer
+
+
+def _gap_free_slices(
+    y: FloatArray, time_s: npt.ArrayLike | None, segments: list[slice] | None
+) -> list[slice]:
+    """The gap-free index ranges of the record (the whole record without a time column)."""
+    if time_s is None:
+        return [slice(0, y.size)]
+    t = np.asarray(time_s, dtype=np.float64).ravel()
+    if t.shape != y.shape:
+        raise ThermocalInputError(f"time has {t.size} samples but rate has {y.size}")
+    return segments if segments is not None else contiguous_slices(t)
+
+
+def _pooled_sums(
+    y: FloatArray, slices: list[slice], m: IntArray, overwrite: bool
+) -> tuple[FloatArray, IntArray, int, int, list[tuple[int, IntArray]]]:
+    """Per averaging factor m, the second-difference sums of squares S and term counts L
+    pooled over the segments (``Σ_s S_s``, ``Σ_s L_s`` with ``L_s = N_s + 1 − 2m``), the
+    samples and segments used, and per used segment its phase count and the indices of
+    the factors it serves (for the EDF)."""
+    sums = np.zeros(m.size)
+    n_terms = np.zeros(m.size, dtype=np.int64)
+    used = 0
+    segs = 0
+    seg_terms: list[tuple[int, IntArray]] = []
+    for sl in slices:
+        seg = y[sl]
+        n_phase = seg.size + 1
+        ok = (n_phase - 2 * m) >= 2
+        if not np.any(ok):
+            continue
+        x1 = _phase(seg, overwrite)
+        sums[ok] += _second_difference_sums(x1, m[ok])
+        del x1
+        n_terms[ok] += n_phase - 2 * m[ok]
+        used += seg.size
+        segs += 1
+        seg_terms.append((n_phase, np.flatnonzero(ok)))
+    return sums, n_terms, used, segs, seg_terms
+
+
 def overlapping_adev(
     rate: npt.ArrayLike,
     tau0_s: float,
@@ -548,47 +606,11 @@ def overlapping_adev(
     MissingValueError : NaN or infinite rate samples.
     ThermocalInputError : too few samples, bad τ0 or τ list, mismatched time.
     """
-    own = isinstance(rate, np.ndarray) and rate.dtype == np.float64 and rate.ndim == 1
-    y = cast(FloatArray, rate) if own else np.asarray(rate, dtype=np.float64).ravel()
-    overwrite = overwrite and own  # only the caller's own float64 buffer
-    if not (math.isfinite(tau0_s) and tau0_s > 0):
-        raise ThermocalInputError(f"sample interval τ0 must be positive, got {tau0_s!r}")
-    with np.errstate(over="ignore", invalid="ignore"):
-        all_finite = math.isfinite(float(np.add.reduce(y))) if y.size else True
-    bad = np.zeros(0, dtype=np.intp) if all_finite else np.flatnonzero(~np.isfinite(y))
-    if bad.size:
-        raise MissingValueError(
-            f"rate has {bad.size} NaN/infinite samples (first at row {bad[0]}); "
-            "remove them or split the record"
-        )
-    if time_s is None:
-        slices = [slice(0, y.size)]
-    else:
-        t = np.asarray(time_s, dtype=np.float64).ravel()
-        if t.shape != y.shape:
-            raise ThermocalInputError(f"time has {t.size} samples but rate has {y.size}")
-        slices = segments if segments is not None else contiguous_slices(t)
+    y, overwrite = _checked_rate(rate, tau0_s, overwrite)
+    slices = _gap_free_slices(y, time_s, segments)
     longest = max(sl.stop - sl.start for sl in slices)
     m = averaging_factors(taus, tau0_s, longest)
-
-    sums = np.zeros(m.size)
-    n_terms = np.zeros(m.size, dtype=np.int64)
-    used = 0
-    segs = 0
-    seg_terms: list[tuple[int, IntArray]] = []
-    for sl in slices:
-        seg = y[sl]
-        n_phase = seg.size + 1
-        ok = (n_phase - 2 * m) >= 2
-        if not np.any(ok):
-            continue
-        x1 = _phase(seg, overwrite)
-        sums[ok] += _second_difference_sums(x1, m[ok])
-        del x1
-        n_terms[ok] += n_phase - 2 * m[ok]
-        used += seg.size
-        segs += 1
-        seg_terms.append((n_phase, np.flatnonzero(ok)))
+    sums, n_terms, used, segs, seg_terms = _pooled_sums(y, slices, m, overwrite)
 
     avar = sums / (2.0 * m.astype(np.float64) ** 2 * n_terms)
     adev = np.sqrt(avar)
@@ -977,6 +999,116 @@ def _read_slope(
     return val, val * float(lo_ratio[best]), val * float(hi_ratio[best]), float(tau[k])
 
 
+def _fit_terms(
+    specs: tuple[tuple[float, str, str], ...],
+    scale: float,
+    coef: FloatArray,
+    sigma: FloatArray,
+    fit_reasons: list[str | None],
+    quality: FitQuality | None,
+    z: float,
+) -> list[NoiseTerm]:
+    """The least-squares terms of :func:`noise_terms`: ``√(C_p / f_p)`` in the term's unit,
+    the interval ``√((C_p ± z·sd) / f_p)``; ``None`` with the fit's reason where it rejects
+    the term; every value marked poor when the fit's quality is."""
+    poor = quality is not None and quality.quality == "poor"
+    fit_terms: list[NoiseTerm] = []
+    for j, (factor, u, label) in enumerate(specs):
+        f = _FIT_FACTORS[j] * 1.0
+        conv = scale * factor
+        if fit_reasons[j] is None:
+            val = math.sqrt(coef[j] / f) * conv
+            lo = math.sqrt(max(coef[j] - z * sigma[j], 0.0) / f) * conv
+            hi = math.sqrt((coef[j] + z * sigma[j]) / f) * conv
+            if poor:
+                assert quality is not None
+                fit_terms.append(
+                    NoiseTerm(val, u, quality.reason, lo, hi, None, label, quality="poor")
+                )
+            else:
+                fit_terms.append(NoiseTerm(val, u, None, lo, hi, None, label))
+        else:
+            fit_terms.append(NoiseTerm(None, u, fit_reasons[j], label=label))
+
+    return fit_terms
+
+
+def _slope_terms(
+    result: AllanResult,
+    specs: tuple[tuple[float, str, str], ...],
+    scale: float,
+    fit_reasons: list[str | None],
+    poor: bool,
+) -> list[NoiseTerm]:
+    """The slope-line terms of :func:`noise_terms` (IEEE 952 C.3, read by
+    :func:`_read_slope`; bias instability at the curve's minimum when the curve turns up)."""
+    ok = np.isfinite(result.adev) & (result.adev > 0) & (result.edf > 0)
+    tau = result.tau_s[ok]
+    dev = result.adev[ok]
+    lo_ratio = result.adev_low[ok] / dev
+    hi_ratio = result.adev_high[ok] / dev
+    edf = result.edf[ok]
+    slope_terms: list[NoiseTerm] = []
+    if tau.size < 3:
+        reason = "fewer than three Allan deviation points: no slope can be read"
+        return [NoiseTerm(None, u, reason, label=lb) for _f, u, lb in specs]
+    lt, ld = np.log(tau), np.log(dev)
+    local = np.array([_local_slope(lt, ld, edf, k) for k in range(tau.size)])
+    for j, (factor, u, label) in enumerate(specs):
+        term = _read_slope(j, tau, lt, ld, edf, local, lo_ratio, hi_ratio)
+        conv = scale * factor
+        k_min = int(np.argmin(dev))
+        # a minimum inside the data: the curve rises after it beyond both intervals (a
+        # later point's lower bound above the minimum's upper bound), not a noisy tail
+        turns_up = 0 < k_min < tau.size - 1 and bool(
+            np.any(dev[k_min + 1 :] * lo_ratio[k_min + 1 :] > dev[k_min] * hi_ratio[k_min])
+        )
+        if j == 2 and (isinstance(term, str) or fit_reasons[j] is not None) and turns_up:
+            # IEEE 952 C.3: bias instability is the curve's minimum / 0.664, read wherever
+            # the curve turns up again inside the data, whatever the least-squares fit says
+            why = term if isinstance(term, str) else fit_reasons[j]
+            val = float(dev[k_min]) / BIAS_INSTABILITY_FACTOR
+            note = (
+                f"read at the curve's minimum τ = {tau[k_min]:.4g} s (minimum / 0.664, "
+                f"IEEE 952 C.3); rough: {why}"
+            )
+            slope_terms.append(
+                NoiseTerm(
+                    val * conv, u, note, val * float(lo_ratio[k_min]) * conv,
+                    val * float(hi_ratio[k_min]) * conv, float(tau[k_min]), label,
+                    quality="poor" if poor else "rough",
+                )
+            )  # fmt: skip
+        elif isinstance(term, str):
+            slope_terms.append(NoiseTerm(None, u, term, label=label))
+        elif fit_reasons[j] is not None:
+            # the slope line stands (IEEE 952 C.3), marked rough: the fit does not find it
+            val, lo, hi, tau_k = term
+            reason = (
+                f"read from the slope {TERM_SLOPES[j]:+g} stretch at τ = {tau_k:.4g} s; "
+                f"rough: the least-squares fit does not support it ({fit_reasons[j]})"
+            )
+            slope_terms.append(
+                NoiseTerm(
+                    val * conv, u, reason, lo * conv, hi * conv, tau_k, label,
+                    quality="poor" if poor else "rough",
+                )
+            )  # fmt: skip
+        else:
+            conv = scale * factor
+            val, lo, hi, tau_k = term
+            note = f"read from the slope {TERM_SLOPES[j]:+g} stretch at τ = {tau_k:.4g} s" + (
+                " (the flat minimum / 0.664)" if j == 2 else ""
+            )
+            slope_terms.append(
+                NoiseTerm(
+                    val * conv, u, note if poor else None, lo * conv, hi * conv, tau_k,
+                    label, quality="poor" if poor else None,
+                )
+            )  # fmt: skip
+    return slope_terms
+
+
 def noise_terms(
     result: AllanResult, *, significance: float = 3.0, confidence: float | None = None
 ) -> NoiseTerms:
@@ -1006,89 +1138,8 @@ def noise_terms(
     poor = quality is not None and quality.quality == "poor"
     z = float(special.ndtri(0.5 + conf / 2.0))  # normal quantile
 
-    fit_terms: list[NoiseTerm] = []
-    for j, (factor, u, label) in enumerate(specs):
-        f = _FIT_FACTORS[j] * 1.0
-        conv = scale * factor
-        if fit_reasons[j] is None:
-            val = math.sqrt(coef[j] / f) * conv
-            lo = math.sqrt(max(coef[j] - z * sigma[j], 0.0) / f) * conv
-            hi = math.sqrt((coef[j] + z * sigma[j]) / f) * conv
-            if poor:
-                assert quality is not None
-                fit_terms.append(
-                    NoiseTerm(val, u, quality.reason, lo, hi, None, label, quality="poor")
-                )
-            else:
-                fit_terms.append(NoiseTerm(val, u, None, lo, hi, None, label))
-        else:
-            fit_terms.append(NoiseTerm(None, u, fit_reasons[j], label=label))
-
-    ok = np.isfinite(result.adev) & (result.adev > 0) & (result.edf > 0)
-    tau = result.tau_s[ok]
-    dev = result.adev[ok]
-    lo_ratio = result.adev_low[ok] / dev
-    hi_ratio = result.adev_high[ok] / dev
-    edf = result.edf[ok]
-    slope_terms: list[NoiseTerm] = []
-    if tau.size < 3:
-        reason = "fewer than three Allan deviation points: no slope can be read"
-        slope_terms = [NoiseTerm(None, u, reason, label=lb) for _f, u, lb in specs]
-    else:
-        lt, ld = np.log(tau), np.log(dev)
-        local = np.array([_local_slope(lt, ld, edf, k) for k in range(tau.size)])
-        for j, (factor, u, label) in enumerate(specs):
-            term = _read_slope(j, tau, lt, ld, edf, local, lo_ratio, hi_ratio)
-            conv = scale * factor
-            k_min = int(np.argmin(dev))
-            # a minimum inside the data: the curve rises after it beyond both intervals (a
-            # later point's lower bound above the minimum's upper bound), not a noisy tail
-            turns_up = 0 < k_min < tau.size - 1 and bool(
-                np.any(dev[k_min + 1 :] * lo_ratio[k_min + 1 :] > dev[k_min] * hi_ratio[k_min])
-            )
-            if j == 2 and (isinstance(term, str) or fit_reasons[j] is not None) and turns_up:
-                # IEEE 952 C.3: bias instability is the curve's minimum / 0.664, read wherever
-                # the curve turns up again inside the data, whatever the least-squares fit says
-                why = term if isinstance(term, str) else fit_reasons[j]
-                val = float(dev[k_min]) / BIAS_INSTABILITY_FACTOR
-                note = (
-                    f"read at the curve's minimum τ = {tau[k_min]:.4g} s (minimum / 0.664, "
-                    f"IEEE 952 C.3); rough: {why}"
-                )
-                slope_terms.append(
-                    NoiseTerm(
-                        val * conv, u, note, val * float(lo_ratio[k_min]) * conv,
-                        val * float(hi_ratio[k_min]) * conv, float(tau[k_min]), label,
-                        quality="poor" if poor else "rough",
-                    )
-                )  # fmt: skip
-            elif isinstance(term, str):
-                slope_terms.append(NoiseTerm(None, u, term, label=label))
-            elif fit_reasons[j] is not None:
-                # the slope line stands (IEEE 952 C.3), marked rough: the fit does not find it
-                val, lo, hi, tau_k = term
-                reason = (
-                    f"read from the slope {TERM_SLOPES[j]:+g} stretch at τ = {tau_k:.4g} s; "
-                    f"rough: the least-squares fit does not support it ({fit_reasons[j]})"
-                )
-                slope_terms.append(
-                    NoiseTerm(
-                        val * conv, u, reason, lo * conv, hi * conv, tau_k, label,
-                        quality="poor" if poor else "rough",
-                    )
-                )  # fmt: skip
-            else:
-                conv = scale * factor
-                val, lo, hi, tau_k = term
-                note = f"read from the slope {TERM_SLOPES[j]:+g} stretch at τ = {tau_k:.4g} s" + (
-                    " (the flat minimum / 0.664)" if j == 2 else ""
-                )
-                slope_terms.append(
-                    NoiseTerm(
-                        val * conv, u, note if poor else None, lo * conv, hi * conv, tau_k,
-                        label, quality="poor" if poor else None,
-                    )
-                )  # fmt: skip
+    fit_terms = _fit_terms(specs, scale, coef, sigma, fit_reasons, quality, z)
+    slope_terms = _slope_terms(result, specs, scale, fit_reasons, poor)
     return NoiseTerms(
         slope=NoiseTermSet("slope", *slope_terms),
         fit=NoiseTermSet("fit", *fit_terms),

@@ -146,6 +146,84 @@ def _edf(name: str, alpha: int, m: int, n_phase: int) -> float:
     return float("nan")
 
 
+def _segment_phases(
+    values: npt.ArrayLike, tau0_s: float, data_type: str, segments: list[slice] | None
+) -> list[FloatArray]:
+    """The phase of each gap-free stretch of at least 3 points.  Rate data: the phase of
+    the fluctuation about each stretch's mean rate (as allantools' frequency2phase; a
+    constant rate would make TIE/MTIE the bias times τ)."""
+    y = np.asarray(values, dtype=np.float64).ravel()
+    if not (math.isfinite(tau0_s) and tau0_s > 0):
+        raise ThermocalInputError(f"sample interval τ0 must be positive, got {tau0_s!r}")
+    bad = np.flatnonzero(~np.isfinite(y))
+    if bad.size:
+        raise MissingValueError(
+            f"data have {bad.size} NaN/infinite samples (first at row {bad[0]}); "
+            "remove them or split the record"
+        )
+    slices = segments if segments is not None else [slice(0, y.size)]
+    phases = [
+        dv.as_phase(
+            y[sl] - (y[sl].mean() if data_type == "rate" and sl.stop > sl.start else 0.0),
+            tau0_s,
+            data_type,
+        )
+        for sl in slices
+    ]
+    phases = [x for x in phases if x.size >= 3]
+    if not phases:
+        raise ThermocalInputError("stability analysis needs at least 3 contiguous points")
+    return phases
+
+
+def _noise_exponents(
+    name: str,
+    m: IntArray,
+    longest: FloatArray,
+    data_type: str,
+    alpha: int | None,
+    id_cache: dict[tuple[int, int], ed.NoiseId],
+) -> tuple[IntArray, tuple[str, ...]]:
+    """Per averaging factor, the noise exponent α for the EDF and how it was found: given,
+    identified on the longest stretch (:func:`thermocal.stability.edf.identify_noise`,
+    d = 3 for the Hadamard family, else 2; clipped to −2…2, −4…2 for Hadamard), or the
+    shorter τ's where too few averages identify nothing."""
+    dmax = 3 if name in HADAMARD else 2
+    alphas = np.zeros(m.size, dtype=np.int64)
+    methods: list[str] = []
+    for i, mm in enumerate(m.tolist()):
+        if alpha is not None:
+            alphas[i] = alpha
+            methods.append("given")
+            continue
+        key = (int(mm), dmax)
+        if key not in id_cache:
+            id_cache[key] = ed.identify_noise(
+                longest, int(mm), dmax=dmax, phase_input=data_type == "phase"
+            )
+        nid = id_cache[key]
+        if nid.method == "none" and i > 0:  # too few averages: the shorter τ's noise
+            alphas[i] = alphas[i - 1]
+            methods.append("previous")
+            continue
+        alphas[i] = max(min(nid.alpha, 2), -2 if dmax == 2 else -4)
+        methods.append(nid.method)
+    return alphas, tuple(methods)
+
+
+def _pooled_edf(name: str, m: IntArray, alphas: IntArray, phases: list[FloatArray]) -> FloatArray:
+    """The equivalent degrees of freedom summed over the stretches long enough for each
+    factor (NaN where none contributes)."""
+    edf = np.zeros(m.size)
+    for x in phases:
+        for i, mm in enumerate(m.tolist()):
+            if mm <= dv.max_factor(name, x.size):
+                e = _edf(name, int(alphas[i]), int(mm), x.size)
+                edf[i] += e if math.isfinite(e) and e > 0 else 0.0
+    edf[edf <= 0] = np.nan
+    return edf
+
+
 def stability(
     values: npt.ArrayLike,
     tau0_s: float,
@@ -169,29 +247,7 @@ def stability(
 
     if data_type not in ("rate", "phase"):
         raise ThermocalInputError(f"--data-type {data_type!r}: use rate or phase")
-    y = np.asarray(values, dtype=np.float64).ravel()
-    if not (math.isfinite(tau0_s) and tau0_s > 0):
-        raise ThermocalInputError(f"sample interval τ0 must be positive, got {tau0_s!r}")
-    bad = np.flatnonzero(~np.isfinite(y))
-    if bad.size:
-        raise MissingValueError(
-            f"data have {bad.size} NaN/infinite samples (first at row {bad[0]}); "
-            "remove them or split the record"
-        )
-    slices = segments if segments is not None else [slice(0, y.size)]
-    # rate data: the phase of the fluctuation about each stretch's mean rate (as allantools'
-    # frequency2phase; a constant rate would make TIE/MTIE the bias times τ)
-    phases = [
-        dv.as_phase(
-            y[sl] - (y[sl].mean() if data_type == "rate" and sl.stop > sl.start else 0.0),
-            tau0_s,
-            data_type,
-        )
-        for sl in slices
-    ]
-    phases = [x for x in phases if x.size >= 3]
-    if not phases:
-        raise ThermocalInputError("stability analysis needs at least 3 contiguous points")
+    phases = _segment_phases(values, tau0_s, data_type, segments)
     longest = max(phases, key=lambda x: x.size)
     n_long = longest.size
     m_common = factors(
@@ -215,33 +271,8 @@ def stability(
             for xr, xc in zip(phases, centred, strict=True)
         ]
         dev, cnt = dv.pool(name, parts, m.size)
-        dmax = 3 if name in HADAMARD else 2
-        alphas = np.zeros(m.size, dtype=np.int64)
-        methods: list[str] = []
-        for i, mm in enumerate(m.tolist()):
-            if alpha is not None:
-                alphas[i] = alpha
-                methods.append("given")
-                continue
-            key = (int(mm), dmax)
-            if key not in id_cache:
-                id_cache[key] = ed.identify_noise(
-                    longest, int(mm), dmax=dmax, phase_input=data_type == "phase"
-                )
-            nid = id_cache[key]
-            if nid.method == "none" and i > 0:  # too few averages: the shorter τ's noise
-                alphas[i] = alphas[i - 1]
-                methods.append("previous")
-                continue
-            alphas[i] = max(min(nid.alpha, 2), -2 if dmax == 2 else -4)
-            methods.append(nid.method)
-        edf = np.zeros(m.size)
-        for x in phases:
-            for i, mm in enumerate(m.tolist()):
-                if mm <= dv.max_factor(name, x.size):
-                    e = _edf(name, int(alphas[i]), int(mm), x.size)
-                    edf[i] += e if math.isfinite(e) and e > 0 else 0.0
-        edf[edf <= 0] = np.nan
+        alphas, methods = _noise_exponents(name, m, longest, data_type, alpha, id_cache)
+        edf = _pooled_edf(name, m, alphas, phases)
         ok = np.isfinite(edf) & np.isfinite(dev)
         lo = np.full(m.size, np.nan)
         hi = np.full(m.size, np.nan)
@@ -251,7 +282,7 @@ def stability(
         tau = dv.theo1_tau(m, tau0_s) if name == "theo1" else m * float(tau0_s)
         curves[name] = DeviationCurve(
             name, np.asarray(tau, dtype=np.float64), m, dev, lo, hi, edf, cnt, alphas,
-            tuple(methods), _unit(name, unit, data_type),
+            methods, _unit(name, unit, data_type),
         )  # fmt: skip
     return StabilityResult(
         curves=curves,

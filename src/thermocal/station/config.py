@@ -46,12 +46,10 @@ from typing import Any
 
 from thermocal import units
 from thermocal.errors import ThermocalInputError
+from thermocal.readers.station import CHAMBER_STREAM  # the reader owns the stream name
 
 DRIVERS = ("modbus-tcp", "modbus-rtu", "none")
 """Chamber drivers: Modbus TCP, Modbus RTU over a serial line, or a chamber run by hand."""
-
-CHAMBER_STREAM = "chamber"
-"""The stream name of the chamber's own polled temperature (reserved: no sensor id)."""
 
 _ID = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_]*$")
 TIME_NAMES = ("time",)

@@ -14,7 +14,8 @@ of the open part; every closed part is complete.  ``station.json`` is rewritten 
 way (temporary, ``fsync``, rename) after each part and event.  A part's Parquet key-value
 metadata holds the thermocal metadata object (:func:`thermocal.readers.dispatch.recording_info`'s
 layout: time column, units of every column, the sensor id and the station's metadata), so
-each part is a complete recording on its own and :func:`read_station` concatenates them.
+each part is a complete recording on its own and
+:func:`thermocal.readers.station.read_station` concatenates them.
 
 Columns of a sensor part: ``time`` [s since the recording's start; from the line's own
 time field, else ``line index / rate_hz`` anchored at the run's first line, else the host
@@ -28,23 +29,26 @@ from __future__ import annotations
 import datetime as _dt
 import json
 import os
-import re
 import time
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 from thermocal import units
-from thermocal.errors import FileFormatError, ThermocalInputError
-from thermocal.station.config import CHAMBER_STREAM, StationConfig
+from thermocal.errors import ThermocalInputError
+from thermocal.readers.station import (
+    CHAMBER_STREAM,
+    STATION_FORMAT,
+    STATION_JSON,
+    STATION_VERSION,
+    closed_parts,
+    is_station_path,
+    read_station,
+    read_station_json,
+    station_files,
+)
+from thermocal.station.config import StationConfig
 
-if TYPE_CHECKING:
-    import pyarrow as pa
-
-STATION_JSON = "station.json"
-STATION_FORMAT = "thermocal-station"
-STATION_VERSION = 1
-PART_RE = re.compile(r"^(?P<stream>[A-Za-z0-9][A-Za-z0-9_]*)-(?P<index>\d{4,})\.parquet$")
 STATION_COLUMNS = {
     "time": "s",
     "host_time": "s",
@@ -66,16 +70,6 @@ def _fsync_write(path: Path, data: bytes) -> None:
 
 def part_name(stream: str, index: int) -> str:
     return f"{stream}-{index:04d}.parquet"
-
-
-def closed_parts(out_dir: Path, stream: str | None = None) -> list[tuple[str, int, Path]]:
-    """Closed parts in ``out_dir`` as ``(stream, index, path)``, in stream and index order."""
-    out = []
-    for p in out_dir.iterdir():
-        m = PART_RE.match(p.name)
-        if m and (stream is None or m["stream"] == stream):
-            out.append((m["stream"], int(m["index"]), p))
-    return sorted(out, key=lambda x: (x[0], x[1]))
 
 
 def _column_units(names: tuple[str, ...], units_: tuple[str, ...]) -> dict[str, str]:
@@ -305,83 +299,14 @@ class Recorder:
         _fsync_write(self.dir / STATION_JSON, json.dumps(self.doc, indent=1).encode())
 
 
-def read_station_json(out_dir: Path) -> dict[str, Any]:
-    p = out_dir / STATION_JSON
-    if not p.is_file():
-        raise FileFormatError(f"{out_dir}: not a station recording (no {STATION_JSON})")
-    try:
-        doc = json.loads(p.read_text(encoding="utf-8"))
-    except (json.JSONDecodeError, UnicodeDecodeError) as exc:
-        raise FileFormatError(f"{p}: not valid JSON ({exc})") from None
-    if not isinstance(doc, dict) or doc.get("format") != STATION_FORMAT:
-        raise FileFormatError(f"{p}: not a thermocal station file")
-    if int(doc.get("version", 0)) > STATION_VERSION:
-        raise FileFormatError(f"{p}: written by a newer thermocal (version {doc['version']})")
-    return doc
-
-
-def is_station_path(path: Path) -> bool:
-    """``DIR`` or ``DIR/SENSOR`` of a station recording."""
-    if path.is_dir():
-        return (path / STATION_JSON).is_file()
-    return not path.exists() and (path.parent / STATION_JSON).is_file()
-
-
-def sensor_ids(doc: dict[str, Any]) -> list[str]:
-    return [str(s["id"]) for s in (doc.get("config") or {}).get("sensors", [])]
-
-
-def _stream_of(path: Path) -> tuple[Path, str]:
-    """``(DIR, stream)`` of ``DIR`` (its only sensor) or ``DIR/SENSOR``."""
-    if path.is_dir():
-        doc = read_station_json(path)
-        ids = sensor_ids(doc)
-        if len(ids) != 1:
-            raise FileFormatError(
-                f"{path}: a station recording of {len(ids)} sensors ({', '.join(ids)}); "
-                f"name one as {path}/ID (or {path}/{CHAMBER_STREAM})"
-            )
-        return path, ids[0]
-    doc = read_station_json(path.parent)
-    ids = sensor_ids(doc)
-    if path.name not in (*ids, CHAMBER_STREAM):
-        raise FileFormatError(
-            f"{path}: no sensor {path.name!r} in this station recording; sensors: "
-            f"{', '.join([*ids, CHAMBER_STREAM])}"
-        )
-    return path.parent, path.name
-
-
-def station_files(path: Path) -> list[Path]:
-    """The closed parts of ``DIR`` or ``DIR/SENSOR``, in order (the recording's content)."""
-    out_dir, stream = _stream_of(path)
-    parts = closed_parts(out_dir, stream)
-    if not parts:
-        raise FileFormatError(f"{out_dir}: no closed part of {stream!r} yet")
-    return [p for _s, _i, p in parts]
-
-
-def read_station(path: Path) -> tuple[pa.Table, dict[str, Any]]:
-    """A station recording as one table: ``DIR`` (its only sensor) or ``DIR/SENSOR`` (one
-    of several, or ``DIR/chamber``).  The closed parts are concatenated in order; the
-    metadata object is the last part's.  Raises :class:`FileFormatError` naming what is
-    missing."""
-    import pyarrow as pa
-    import pyarrow.parquet as pq
-
-    from thermocal.recording import META_KEY
-
-    files = station_files(path)
-    tables = []
-    for p in files:
-        try:
-            tables.append(pq.read_table(p))
-        except (pa.ArrowInvalid, OSError) as exc:
-            raise FileFormatError(f"{p}: not a readable Parquet part ({exc})") from None
-    raw = (tables[-1].schema.metadata or {}).get(META_KEY.encode())
-    meta: dict[str, Any] = json.loads(raw.decode()) if raw else {}
-    table = pa.concat_tables([t.replace_schema_metadata(None) for t in tables])
-    return table, meta
-
-
-__all__ = ["Recorder", "closed_parts", "is_station_path", "read_station", "read_station_json"]
+__all__ = [
+    "STATION_FORMAT",
+    "STATION_JSON",
+    "STATION_VERSION",
+    "Recorder",
+    "closed_parts",
+    "is_station_path",
+    "read_station",
+    "read_station_json",
+    "station_files",
+]

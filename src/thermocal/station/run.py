@@ -17,13 +17,20 @@ import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Protocol
+from typing import TYPE_CHECKING, Any, Protocol
 
 from thermocal.errors import ThermocalInputError
+from thermocal.readers.station import CHAMBER_STREAM, closed_parts
 from thermocal.station.chamber import Chamber, ChamberError, make_chamber
-from thermocal.station.config import CHAMBER_STREAM, StationConfig
-from thermocal.station.recorder import Recorder, closed_parts
+from thermocal.station.config import StationConfig
+from thermocal.station.recorder import Recorder
 from thermocal.station.sensors import SerialSensor
+
+if TYPE_CHECKING:
+    import numpy as np
+    import numpy.typing as npt
+
+    FloatArray = npt.NDArray[np.float64]
 
 LOOP_S = 0.02
 """Longest sleep of the loop [s]: sensor lines are drained and stop requests seen at least
@@ -117,6 +124,244 @@ def _last_program_s(out_dir: Path) -> float:
     return last
 
 
+class _Loop:
+    """The state of one run while the program plays: the loop's steps as methods (program
+    step, chamber set-point and poll, drift, sensor lines, the safe stop)."""
+
+    def __init__(
+        self,
+        cfg: StationConfig,
+        t_prog: FloatArray,
+        c_prog: FloatArray,
+        p0: float,
+        time_scale: float,
+        rec: Recorder,
+        chamber: Chamber,
+        disp: Display,
+    ) -> None:
+        self.cfg, self.ch_cfg = cfg, cfg.chamber
+        self.t_prog, self.c_prog = t_prog, c_prog
+        self.end_s = float(t_prog[-1])
+        self.p0, self.time_scale = p0, time_scale
+        self.rec, self.chamber, self.disp = rec, chamber, disp
+        self.sensors = [SerialSensor(s) for s in cfg.sensors]
+        self.state = StationState(n_steps=len(t_prog) - 1, end_s=self.end_s, time_scale=time_scale)
+        self.setpoints: list[tuple[float, float]] = []
+        self.samples = {s.id: 0 for s in cfg.sensors} | {CHAMBER_STREAM: 0}
+        self.bad = {s.id: 0 for s in cfg.sensors}
+        self.parts: list[str] = []
+        self.stopped = {s.id: False for s in cfg.sensors}
+        self.anchors: dict[str, float] = {}
+        self.last_time: dict[str, float] = {}
+        self.ended = "end"
+        self.safe: float | None = None
+        self.sp = math.nan
+        self.chamber_c = math.nan
+        self.fail_since: float | None = None
+        self.drift_since: float | None = None
+        self.drift_reported = False
+        self.step = -1
+        self.t_run = time.time()
+        self.next_poll = self.t_run
+        self.p = p0
+
+    def start(self) -> None:
+        """Connect the chamber (its first temperature), open and start the sensors."""
+        try:
+            self.chamber.connect()
+            self.chamber_c = self.chamber.read_temperature()
+        except ChamberError as exc:
+            raise ThermocalInputError(f"{exc} (check [chamber] in {self.cfg.source})") from None
+        for s in self.sensors:
+            s.open()
+        for s in self.sensors:
+            s.start()
+        self.rec.event("start", f"chamber {self.chamber.name}, sensors " + ", ".join(
+            s.cfg.id for s in self.sensors), program_s=self.p0,
+            time_scale=self.time_scale)  # fmt: skip
+        self.t_run = time.time()
+        self.next_poll = self.t_run
+
+    def play(self, should_stop: Callable[[], bool] | None) -> None:
+        """The loop: every ``LOOP_S`` at most, the program's step and set-point, the
+        chamber's poll, drift, the sensors' lines, part rotation and the display."""
+        while True:
+            now = time.time()
+            p = self.p = self.p0 + (now - self.t_run) * self.time_scale
+            if p >= self.end_s or (should_stop is not None and should_stop()):
+                if p < self.end_s:
+                    self.ended = "interrupted"
+                self.p = min(p, self.end_s)
+                break
+            self._program_step(p)
+            self._chamber(now, p)
+            self.state.chamber_ok = self.fail_since is None
+            self._drift(p)
+            views = self._sensors(now, p)
+            self.parts += self.rec.maybe_rotate(now)
+            state = self.state
+            state.step, state.program_s, state.setpoint_c = self.step + 1, p, self.sp
+            state.chamber_c, state.sensors = self.chamber_c, views
+            state.samples, state.parts = sum(self.samples.values()), len(self.parts)
+            self.disp.update(state)
+            time.sleep(LOOP_S)
+
+    def _program_step(self, p: float) -> None:
+        """Log and record a new program step when ``p`` [s] enters one."""
+        import numpy as np
+
+        t_prog, c_prog = self.t_prog, self.c_prog
+        k = int(np.searchsorted(t_prog, p, side="right")) - 1
+        if k != self.step:
+            self.step = k
+            nxt = float(c_prog[min(k + 1, len(c_prog) - 1)])
+            msg = (f"step {k + 1}/{self.state.n_steps}: {float(c_prog[k]):.2f} → {nxt:.2f} °C "
+                   f"from program time {float(t_prog[k]):.0f} s")  # fmt: skip
+            self.disp.log(msg)
+            self.rec.event("step", msg, program_s=p, step=k + 1)
+
+    def _chamber(self, now: float, p: float) -> None:
+        """Write the set-point when its register value changes, poll the chamber every
+        ``poll_s``; a chamber silent for ``timeout_s`` stops the run (:class:`StationStopped`)."""
+        import numpy as np
+
+        ch_cfg, rec = self.ch_cfg, self.rec
+        target = _quantize(float(np.interp(p, self.t_prog, self.c_prog)), ch_cfg.scale,
+                           ch_cfg.signed, ch_cfg.driver)  # fmt: skip
+        try:
+            if target != self.sp:
+                self.chamber.write_setpoint(target)
+                self.sp = target
+                self.setpoints.append((p, target))
+                rec.event("setpoint", f"{target:.3f} °C", program_s=p, setpoint_c=target)
+            if now >= self.next_poll:
+                self.next_poll = max(self.next_poll + ch_cfg.poll_s, now)
+                self.chamber_c = self.chamber.read_temperature()
+                rec.add(CHAMBER_STREAM, {"time": rec.rel(now), "program_s": p,
+                                         "setpoint_c": self.sp,
+                                         "chamber_c": self.chamber_c})  # fmt: skip
+                self.samples[CHAMBER_STREAM] += 1
+            if self.fail_since is not None:
+                rec.event("chamber", "the chamber answers again")
+                self.disp.log("chamber answers again")
+                self.fail_since = None
+        except ChamberError as exc:
+            if self.fail_since is None:
+                self.fail_since = now
+                rec.event("chamber", f"no answer: {exc}")
+                self.disp.log(f"warning: {exc}")
+            elif now - self.fail_since >= ch_cfg.timeout_s:
+                self.ended = "chamber"
+                raise StationStopped(
+                    f"{exc}; no answer for {now - self.fail_since:.0f} s (timeout_s "
+                    f"{ch_cfg.timeout_s:g}): run stopped at program time {p:.1f} s; "
+                    f"continue with --resume"
+                ) from None
+            self.next_poll = now + min(ch_cfg.poll_s, 0.5)
+
+    def _drift(self, p: float) -> None:
+        """Warn once when the chamber stays beyond ``tolerance_c`` of its set-point for
+        ``drift_s`` of program time."""
+        chamber_c, sp, ch_cfg = self.chamber_c, self.sp, self.ch_cfg
+        if math.isfinite(chamber_c) and abs(chamber_c - sp) > ch_cfg.tolerance_c:
+            self.drift_since = p if self.drift_since is None else self.drift_since
+            if not self.drift_reported and p - self.drift_since >= ch_cfg.drift_s:
+                away = abs(chamber_c - sp)
+                msg = (f"warning: chamber {chamber_c:.2f} °C is {away:.2f} °C from its "
+                       f"set-point {sp:.2f} °C for {p - self.drift_since:.0f} s")  # fmt: skip
+                self.rec.event("drift", msg, program_s=p)
+                self.disp.log(msg)
+                self.drift_reported = True
+        else:
+            self.drift_since, self.drift_reported = None, False
+
+    def _add_rows(self, s: SerialSensor, got: list[Any]) -> None:
+        """The sensor's lines as rows of its stream, with the chamber's state."""
+        for smp in got:
+            row = _sensor_row(s, smp.host_unix, smp.index, smp.values, self.rec, self.anchors,
+                              self.last_time)  # fmt: skip
+            program_s = self.p0 + (smp.host_unix - self.t_run) * self.time_scale
+            row.update(chamber_c=self.chamber_c, setpoint_c=self.sp, program_s=program_s)
+            self.rec.add(s.cfg.id, row)
+
+    def _sensors(self, now: float, p: float) -> list[SensorView]:
+        """Drain every sensor's lines into the recorder; report a sensor that stops or
+        sends again; the display's view of each."""
+        rec, views = self.rec, []
+        for s in self.sensors:
+            sid = s.cfg.id
+            got, bads = s.drain()
+            if bads:
+                self.bad[sid] += len(bads)
+                rec.bad_lines(sid, [(b.host_unix, b.index, b.reason, b.text) for b in bads])
+            self._add_rows(s, got)
+            self.samples[sid] += len(got)
+            silent = (now - (s.stats.last_unix if s.stats.good else self.t_run)
+                      > s.cfg.silence_s) or bool(s.stats.error)  # fmt: skip
+            if silent and not self.stopped[sid]:
+                why = s.stats.error or f"no line for {s.cfg.silence_s:g} s"
+                msg = f"warning: sensor {sid} ({s.cfg.device}) stopped: {why}"
+                rec.event("sensor", msg, sensor=sid, program_s=p)
+                self.disp.log(msg)
+            elif not silent and self.stopped[sid]:
+                rec.event("sensor", f"sensor {sid} sends again", sensor=sid, program_s=p)
+                self.disp.log(f"sensor {sid} sends again")
+            self.stopped[sid] = silent
+            views.append(SensorView(sid, s.stats.rate_hz(), s.stats.last_values, s.cfg.names,
+                                    self.bad[sid], self.samples[sid], silent))  # fmt: skip
+        return views
+
+    def finish(self) -> None:
+        """Every way out: the safe set-point, the ports closed, their last lines recorded,
+        the open parts closed, the stop event, the chamber closed."""
+        rec = self.rec
+        self.safe = _safe_stop(self.chamber, self.ch_cfg.safe_setpoint_c, rec, self.disp)
+        for s in self.sensors:
+            s.close()
+        # the last lines that arrived before the ports closed
+        for s in self.sensors:
+            got, bads = s.drain()
+            self.bad[s.cfg.id] += len(bads)
+            rec.bad_lines(s.cfg.id, [(b.host_unix, b.index, b.reason, b.text) for b in bads])
+            self._add_rows(s, got)
+            self.samples[s.cfg.id] += len(got)
+        self.parts += rec.close_parts()
+        rec.event("stop", f"ended: {self.ended}", program_s=self.p, ended=self.ended,
+                  safe_setpoint_c=self.safe)  # fmt: skip
+        self.chamber.close()
+
+
+def _open_recorder(
+    cfg: StationConfig,
+    t_prog: FloatArray,
+    c_prog: FloatArray,
+    out_dir: Path,
+    profile_source: str,
+    resume: bool,
+    time_scale: float,
+    disp: Display,
+) -> tuple[Recorder, float]:
+    """The recorder of ``out_dir`` and the program time to start at [s] (0, or where a
+    resumed recording ends)."""
+    end_s = float(t_prog[-1])
+    p0 = _last_program_s(out_dir) if resume and out_dir.is_dir() else 0.0
+    if resume and p0 >= end_s:
+        raise ThermocalInputError(
+            f"{out_dir}: the recording already reaches the program's end ({end_s:g} s)"
+        )
+    rec = Recorder(
+        out_dir, cfg, (list(map(float, t_prog)), list(map(float, c_prog))),
+        profile_source=profile_source, time_scale=time_scale, resume=resume,
+    )  # fmt: skip
+    if rec.removed_tmp:
+        rec.event("resume", "removed the part open at the interruption: " + ", ".join(
+            rec.removed_tmp))  # fmt: skip
+    if resume:
+        rec.event("resume", f"program continues at {p0:.1f} s", program_s=p0)
+        disp.log(f"resuming at program time {p0:.1f} s of {end_s:.1f} s")
+    return rec, p0
+
+
 def run_station(
     cfg: StationConfig,
     program: tuple[list[float], list[float]],
@@ -143,179 +388,22 @@ def run_station(
     disp = display or LogDisplay()
     t_prog = np.asarray(program[0], dtype=np.float64)
     c_prog = np.asarray(program[1], dtype=np.float64)
-    end_s = float(t_prog[-1])
     ch_cfg = cfg.chamber
     chamber = chamber or make_chamber(ch_cfg, disp.log)
     for c in (*c_prog, ch_cfg.safe_setpoint_c):  # every set-point must fit the register
         _quantize(float(c), ch_cfg.scale, ch_cfg.signed, ch_cfg.driver)
-
-    p0 = _last_program_s(out_dir) if resume and out_dir.is_dir() else 0.0
-    if resume and p0 >= end_s:
-        raise ThermocalInputError(
-            f"{out_dir}: the recording already reaches the program's end ({end_s:g} s)"
-        )
-    rec = Recorder(
-        out_dir, cfg, (list(map(float, t_prog)), list(map(float, c_prog))),
-        profile_source=profile_source, time_scale=time_scale, resume=resume,
-    )  # fmt: skip
-    if rec.removed_tmp:
-        rec.event("resume", "removed the part open at the interruption: " + ", ".join(
-            rec.removed_tmp))  # fmt: skip
-    if resume:
-        rec.event("resume", f"program continues at {p0:.1f} s", program_s=p0)
-        disp.log(f"resuming at program time {p0:.1f} s of {end_s:.1f} s")
-
-    sensors = [SerialSensor(s) for s in cfg.sensors]
-    state = StationState(n_steps=len(t_prog) - 1, end_s=end_s, time_scale=time_scale)
-    setpoints: list[tuple[float, float]] = []
-    samples = {s.id: 0 for s in cfg.sensors} | {CHAMBER_STREAM: 0}
-    bad = {s.id: 0 for s in cfg.sensors}
-    parts: list[str] = []
-    stopped = {s.id: False for s in cfg.sensors}
-    anchors: dict[str, float] = {}
-    last_time: dict[str, float] = {}
-    ended = "end"
-    safe: float | None = None
-    sp = math.nan
-    chamber_c = math.nan
-    fail_since: float | None = None
-    drift_since: float | None = None
-    drift_reported = False
-    step = -1
-    t_run = time.time()
-    p = p0
+    rec, p0 = _open_recorder(cfg, t_prog, c_prog, out_dir, profile_source, resume, time_scale, disp)
+    loop = _Loop(cfg, t_prog, c_prog, p0, time_scale, rec, chamber, disp)
     try:
-        try:
-            chamber.connect()
-            chamber_c = chamber.read_temperature()
-        except ChamberError as exc:
-            raise ThermocalInputError(f"{exc} (check [chamber] in {cfg.source})") from None
-        for s in sensors:
-            s.open()
-        for s in sensors:
-            s.start()
-        rec.event("start", f"chamber {chamber.name}, sensors " + ", ".join(
-            s.cfg.id for s in sensors), program_s=p0, time_scale=time_scale)  # fmt: skip
-        t_run = time.time()
-        next_poll = t_run
-        while True:
-            now = time.time()
-            p = p0 + (now - t_run) * time_scale
-            if p >= end_s or (should_stop is not None and should_stop()):
-                if p < end_s:
-                    ended = "interrupted"
-                p = min(p, end_s)
-                break
-            k = int(np.searchsorted(t_prog, p, side="right")) - 1
-            if k != step:
-                step = k
-                nxt = float(c_prog[min(k + 1, len(c_prog) - 1)])
-                msg = (f"step {k + 1}/{state.n_steps}: {float(c_prog[k]):.2f} → {nxt:.2f} °C "
-                       f"from program time {float(t_prog[k]):.0f} s")  # fmt: skip
-                disp.log(msg)
-                rec.event("step", msg, program_s=p, step=k + 1)
-            target = _quantize(float(np.interp(p, t_prog, c_prog)), ch_cfg.scale, ch_cfg.signed,
-                               ch_cfg.driver)  # fmt: skip
-            try:
-                if target != sp:
-                    chamber.write_setpoint(target)
-                    sp = target
-                    setpoints.append((p, target))
-                    rec.event("setpoint", f"{target:.3f} °C", program_s=p, setpoint_c=target)
-                if now >= next_poll:
-                    next_poll = max(next_poll + ch_cfg.poll_s, now)
-                    chamber_c = chamber.read_temperature()
-                    rec.add(CHAMBER_STREAM, {"time": rec.rel(now), "program_s": p,
-                                             "setpoint_c": sp, "chamber_c": chamber_c})  # fmt: skip
-                    samples[CHAMBER_STREAM] += 1
-                if fail_since is not None:
-                    rec.event("chamber", "the chamber answers again")
-                    disp.log("chamber answers again")
-                    fail_since = None
-            except ChamberError as exc:
-                if fail_since is None:
-                    fail_since = now
-                    rec.event("chamber", f"no answer: {exc}")
-                    disp.log(f"warning: {exc}")
-                elif now - fail_since >= ch_cfg.timeout_s:
-                    ended = "chamber"
-                    raise StationStopped(
-                        f"{exc}; no answer for {now - fail_since:.0f} s (timeout_s "
-                        f"{ch_cfg.timeout_s:g}): run stopped at program time {p:.1f} s; "
-                        f"continue with --resume"
-                    ) from None
-                next_poll = now + min(ch_cfg.poll_s, 0.5)
-            state.chamber_ok = fail_since is None
-            # drift: chamber away from its set-point for drift_s of program time
-            if math.isfinite(chamber_c) and abs(chamber_c - sp) > ch_cfg.tolerance_c:
-                drift_since = p if drift_since is None else drift_since
-                if not drift_reported and p - drift_since >= ch_cfg.drift_s:
-                    away = abs(chamber_c - sp)
-                    msg = (f"warning: chamber {chamber_c:.2f} °C is {away:.2f} °C from its "
-                           f"set-point {sp:.2f} °C for {p - drift_since:.0f} s")  # fmt: skip
-                    rec.event("drift", msg, program_s=p)
-                    disp.log(msg)
-                    drift_reported = True
-            else:
-                drift_since, drift_reported = None, False
-            # sensors
-            views = []
-            for s in sensors:
-                sid = s.cfg.id
-                got, bads = s.drain()
-                if bads:
-                    bad[sid] += len(bads)
-                    rec.bad_lines(sid, [(b.host_unix, b.index, b.reason, b.text) for b in bads])
-                for smp in got:
-                    row = _sensor_row(s, smp.host_unix, smp.index, smp.values, rec, anchors,
-                                      last_time)  # fmt: skip
-                    row.update(chamber_c=chamber_c, setpoint_c=sp,
-                               program_s=p0 + (smp.host_unix - t_run) * time_scale)  # fmt: skip
-                    rec.add(sid, row)
-                samples[sid] += len(got)
-                silent = (now - (s.stats.last_unix if s.stats.good else t_run)
-                          > s.cfg.silence_s) or bool(s.stats.error)  # fmt: skip
-                if silent and not stopped[sid]:
-                    why = s.stats.error or f"no line for {s.cfg.silence_s:g} s"
-                    msg = f"warning: sensor {sid} ({s.cfg.device}) stopped: {why}"
-                    rec.event("sensor", msg, sensor=sid, program_s=p)
-                    disp.log(msg)
-                elif not silent and stopped[sid]:
-                    rec.event("sensor", f"sensor {sid} sends again", sensor=sid, program_s=p)
-                    disp.log(f"sensor {sid} sends again")
-                stopped[sid] = silent
-                views.append(SensorView(sid, s.stats.rate_hz(), s.stats.last_values,
-                                        s.cfg.names, bad[sid], samples[sid], silent))  # fmt: skip
-            parts += rec.maybe_rotate(now)
-            state.step, state.program_s, state.setpoint_c = step + 1, p, sp
-            state.chamber_c, state.sensors = chamber_c, views
-            state.samples, state.parts = sum(samples.values()), len(parts)
-            disp.update(state)
-            time.sleep(LOOP_S)
+        loop.start()
+        loop.play(should_stop)
     except KeyboardInterrupt:
-        ended = "interrupted"
+        loop.ended = "interrupted"
         raise
     finally:
-        safe = _safe_stop(chamber, ch_cfg.safe_setpoint_c, rec, disp)
-        for s in sensors:
-            s.close()
-        # the last lines that arrived before the ports closed
-        for s in sensors:
-            got, bads = s.drain()
-            bad[s.cfg.id] += len(bads)
-            rec.bad_lines(s.cfg.id, [(b.host_unix, b.index, b.reason, b.text) for b in bads])
-            for smp in got:
-                row = _sensor_row(s, smp.host_unix, smp.index, smp.values, rec, anchors, last_time)
-                row.update(chamber_c=chamber_c, setpoint_c=sp,
-                           program_s=p0 + (smp.host_unix - t_run) * time_scale)  # fmt: skip
-                rec.add(s.cfg.id, row)
-                samples[s.cfg.id] += 1
-        parts += rec.close_parts()
-        rec.event("stop", f"ended: {ended}", program_s=p, ended=ended,
-                  safe_setpoint_c=safe)  # fmt: skip
-        chamber.close()
-    return RunResult(out_dir, p0, p, parts, samples, bad, ended, setpoints, safe,
-                     list(rec.doc["events"]))  # fmt: skip
+        loop.finish()
+    return RunResult(out_dir, p0, loop.p, loop.parts, loop.samples, loop.bad, loop.ended,
+                     loop.setpoints, loop.safe, list(rec.doc["events"]))  # fmt: skip
 
 
 def _quantize(c: float, scale: float, signed: bool, driver: str) -> float:

@@ -1,0 +1,353 @@
+"""The file edge of the multi-position calibration (``thermocal multipos``): read the
+session recordings (and a POSES file), calibrate each session
+(:func:`thermocal.multipos.calibrate.calibrate_session`), fit every parameter in
+temperature over several sessions (:func:`thermocal.turntable.thermal.fit_triad`, the
+turntable's own thermal fit) and save the calibration of triads.
+
+The maths of :mod:`thermocal.multipos` reads no file; this module is where files come in
+and go out (file layer, as :mod:`thermocal.compensate.files` for the compensation kernels).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from thermocal import units
+from thermocal.errors import ThermocalInputError
+from thermocal.models.calibration import Calibration, Triad
+from thermocal.models.files import save_calibration
+from thermocal.multipos.calibrate import METHOD, SessionResult, calibrate_session
+from thermocal.multipos.poses import parse_poses
+from thermocal.readers import read_recording
+from thermocal.recording import Recording
+from thermocal.turntable import thermal
+
+NO_TEMPERATURE_TREF_C = 25.0
+"""TREF recorded for a calibration made without a temperature column (it applies
+unchanged at every temperature)."""
+
+
+@dataclass(frozen=True)
+class MultiposOptions:
+    """What ``thermocal multipos`` is told: the accelerometer (and gyro) columns x, y, z and
+    their units (None: the file's), the temperature column, local gravity [m/s²] or
+    latitude [°], the thermal fit's order and TREF [°C], the shortest still pose [s], and
+    the time column and unit."""
+
+    accel: tuple[str, str, str]
+    gyro: tuple[str, str, str] | None = None
+    accel_unit: str | None = None
+    gyro_unit: str | None = None
+    temps: str | None = None
+    gravity_m_s2: float | None = None
+    latitude_deg: float | None = None
+    order: int | None = None
+    tref_c: float | None = None
+    static_s: float = 1.0
+    time: str | None = None
+    time_unit: str | None = None
+
+    def check(self, n_files: int, poses: Path | None) -> None:
+        """The options' own consistency (before any file is read)."""
+        if n_files > 1 and self.temps is None:
+            raise ThermocalInputError(
+                "several files: name their temperature column with --temps (one file per "
+                "temperature)"
+            )
+        if (self.order is not None or self.tref_c is not None) and n_files < 2:
+            raise ThermocalInputError("--order and --tref need several files and --temps")
+        if self.gravity_m_s2 is not None and self.latitude_deg is not None:
+            raise ThermocalInputError("give --gravity or --latitude, not both")
+        if self.static_s is not None and not (math.isfinite(self.static_s) and self.static_s > 0):
+            raise ThermocalInputError(
+                f"--static-s must be a positive number, got {self.static_s!r}"
+            )
+        if poses is not None and n_files > 1:
+            raise ThermocalInputError("--poses names the sections of one file; give one file")
+
+
+@dataclass(frozen=True)
+class SessionRun:
+    """One session file calibrated: its path, result and temperature range [°C] (None
+    without a temperature column)."""
+
+    path: Path
+    result: SessionResult
+    t_range_c: tuple[float, float] | None
+
+
+@dataclass(frozen=True, eq=False)
+class MultiposResult:
+    """The result of :func:`calibrate_files`: the calibration written, the ``--json`` object
+    (INTERFACE.md; ``output`` the file written) and the accelerometer's unit."""
+
+    calibration: Calibration
+    summary: dict[str, Any]
+    accel_unit: str
+
+
+def _unit_of(rec: Any, cols: list[str], option: str | None, kind: str, path: Path) -> str:
+    """The columns' unit: the option, else the file's (metadata, column name)."""
+    stated = [c for c in cols if rec.unit_sources.get(c, "default") != "default"]
+    found = {option} if option else {rec.units.get(c) or "" for c in stated}
+    if not option and len(stated) < 3:
+        found = set()
+    if len(found) != 1 or not next(iter(found)):
+        raise ThermocalInputError(
+            f"{path}: the {kind} columns {cols} state no single unit; give --{kind}-unit"
+        )
+    unit = str(units.normalize_signal_unit(found.pop()))
+    want = "accel" if kind == "accel" else "rate"
+    if units.signal_kind(unit) != want:
+        what = "an acceleration" if kind == "accel" else "a rate"
+        raise ThermocalInputError(
+            f"{path}: the {kind} columns' unit {unit!r} is not {what} unit (raw counts are "
+            "not supported by multipos yet: convert them first)"
+        )
+    return unit
+
+
+def _read_poses(poses: Path | None) -> dict[str, Any] | None:
+    """The POSES file's JSON object (None without one)."""
+    if poses is None:
+        return None
+    try:
+        doc: dict[str, Any] = json.loads(poses.read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
+        raise ThermocalInputError(f"{poses}: not a readable JSON file ({exc})") from None
+    return doc
+
+
+class _Gravity:
+    """The latitude and local gravity of the sessions: the options', else the first file's
+    latitude (and its WGS-84 normal gravity)."""
+
+    def __init__(self, opts: MultiposOptions) -> None:
+        self.latitude_deg = opts.latitude_deg
+        self.g_m_s2 = opts.gravity_m_s2
+        self.opts = opts
+
+    def update(self, rec: Recording, path: Path) -> None:
+        lat = (
+            self.opts.latitude_deg if self.opts.latitude_deg is not None else rec.meta.latitude_deg
+        )
+        if self.latitude_deg is None:
+            self.latitude_deg = lat
+        if self.g_m_s2 is None:
+            if lat is None:
+                raise ThermocalInputError(
+                    f"{path}: give the local gravity (--gravity M/S2) or the latitude "
+                    "(--latitude DEG, WGS-84 normal gravity)"
+                )
+            self.g_m_s2 = units.normal_gravity_m_s2(float(lat))
+
+
+def _session(
+    path: Path,
+    opts: MultiposOptions,
+    grav: _Gravity,
+    sections_d: dict[str, Any] | None,
+    poses: Path | None,
+) -> tuple[SessionRun, str, str | None]:
+    """Read and calibrate one session file; its accelerometer and gyro units."""
+    acc_cols, gyr_cols, temps = list(opts.accel), list(opts.gyro or []) or None, opts.temps
+    given = [opts.accel_unit] * 3 + ([opts.gyro_unit] * 3 if gyr_cols else [])
+    rec = read_recording(
+        path, time=opts.time, time_unit=opts.time_unit, signals=[*acc_cols, *(gyr_cols or [])],
+        signal_unit=",".join(given) if all(given) else None,  # type: ignore[arg-type]
+        temperatures=[temps] if temps else None,
+    )  # fmt: skip
+    rec.validate(required=[*acc_cols, *(gyr_cols or []), *([temps] if temps else [])])
+    au = _unit_of(rec, acc_cols, opts.accel_unit, "accel", path)
+    grav.update(rec, path)
+    acc = units.convert(np.column_stack([rec.column(c) for c in acc_cols]), au, "mg")
+    w, gu = None, None
+    if gyr_cols:
+        gu = _unit_of(rec, gyr_cols, opts.gyro_unit, "gyro", path)
+        w = units.convert(np.column_stack([rec.column(c) for c in gyr_cols]), gu, "rad/s")
+    sections = None
+    if sections_d is not None:
+        sections = parse_poses(sections_d, rec.n_samples, str(poses))
+    temp = rec.temperature_c(temps) if temps else None
+    assert grav.g_m_s2 is not None
+    res = calibrate_session(
+        rec.time_s, acc, w, g_mg=float(grav.g_m_s2) / 9.80665e-3,
+        latitude_deg=grav.latitude_deg, sections=sections, static_s=opts.static_s,
+        temperature_c=temp, where=str(path),
+    )  # fmt: skip
+    t_range = (float(np.min(temp)), float(np.max(temp))) if temp is not None else None
+    return SessionRun(path, res, t_range), au, gu
+
+
+def _fit_triads(
+    runs: list[SessionRun],
+    opts: MultiposOptions,
+    a_unit: str,
+    g_unit: str | None,
+    grav: _Gravity,
+) -> tuple[list[Triad], dict[str, Any]]:
+    """Each triad's thermal model: a polynomial in T − TREF over several sessions, else
+    the one session's parameters as constants."""
+    triads = []
+    models: dict[str, Any] = {}
+    for kind, cols, unit in (("accel", opts.accel, a_unit), ("gyro", opts.gyro, g_unit)):
+        if cols is None or unit is None:
+            continue
+        fits = [r.result.accel if kind == "accel" else r.result.gyro for r in runs]
+        if len(runs) > 1:
+            m = thermal.fit_triad(
+                kind, [float(r.result.temperature_c) for r in runs],  # type: ignore[arg-type]
+                [ft.theta for ft in fits], [ft.sigma for ft in fits],  # type: ignore[union-attr]
+                tref_c=opts.tref_c if kind == "accel" or "accel" not in models
+                else models["accel"].tref_c,
+                order=opts.order, method=METHOD, gravity_m_s2=grav.g_m_s2,
+            )  # fmt: skip
+        else:
+            r = runs[0].result
+            ft = fits[0]
+            assert ft is not None
+            m = thermal.constant_triad(
+                kind, r.temperature_c if r.temperature_c is not None else NO_TEMPERATURE_TREF_C,
+                ft.theta, ft.cov, t_range_c=runs[0].t_range_c, method=METHOD,
+                gravity_m_s2=grav.g_m_s2,
+            )  # fmt: skip
+        models[kind] = m
+        triads.append(
+            Triad(
+                kind, (cols[0], cols[1], cols[2]), unit, opts.temps or "", m,
+                latitude_deg=grav.latitude_deg,
+            )
+        )  # fmt: skip
+    return triads, models
+
+
+def calibrate_files(
+    files: Sequence[Path], output: Path, opts: MultiposOptions, poses: Path | None = None
+) -> MultiposResult:
+    """Calibrate the sessions ``files`` (one per temperature; ``poses`` the named sections
+    of a single file) and write the calibration of triads to ``output`` (module
+    docstring).  Every file's columns must be in one unit per triad."""
+    opts.check(len(files), poses)
+    sections_d = _read_poses(poses)
+    runs: list[SessionRun] = []
+    a_units: set[str] = set()
+    g_units: set[str] = set()
+    grav = _Gravity(opts)
+    for f in files:
+        run, au, gu = _session(f, opts, grav, sections_d, poses)
+        a_units.add(au)
+        if gu is not None:
+            g_units.add(gu)
+        runs.append(run)
+    for what, found in (("accelerometer", a_units), ("gyro", g_units)):
+        if len(found) > 1:
+            raise ThermocalInputError(f"the files' {what} columns differ in unit: {sorted(found)}")
+    a_unit = a_units.pop()
+    g_unit = g_units.pop() if g_units else None
+    triads, models = _fit_triads(runs, opts, a_unit, g_unit, grav)
+    cal = Calibration([], triads)
+    save_calibration(cal, output)
+    assert grav.g_m_s2 is not None
+    out = _summary(runs, models, a_unit, g_unit, float(grav.g_m_s2))
+    out["output"] = str(output)
+    return MultiposResult(cal, out, a_unit)
+
+
+def _triad_dict(theta: Any, sigma: Any, bias_factor: float, bias_unit: str) -> dict[str, Any]:
+    return {
+        "bias": (np.asarray(theta[0:3]) * bias_factor).tolist(),
+        "bias_sigma": (np.asarray(sigma[0:3]) * bias_factor).tolist(),
+        "bias_unit": bias_unit,
+        "scale_factor_ppm": list(theta[3:6]),
+        "scale_factor_ppm_sigma": list(sigma[3:6]),
+        "misalignment_arcsec": list(theta[6:12]),
+        "misalignment_arcsec_sigma": list(sigma[6:12]),
+        "misalignment_names": ["yx", "zx", "xy", "zy", "xz", "yz"],
+    }
+
+
+def _summary(
+    runs: list[SessionRun], models: dict[str, Any], a_unit: str, g_unit: str | None, g_m_s2: float
+) -> dict[str, Any]:
+    """The ``--json`` object (INTERFACE.md): each triad at TREF in the data's units, the
+    poses, the gravity residuals in the accelerometer's unit, and each run's figures."""
+    to_a = float(units.convert(np.array([1.0]), "mg", a_unit)[0])
+    to_g = float(units.convert(np.array([1.0]), "deg/h", g_unit)[0]) if g_unit else 1.0
+    out: dict[str, Any] = {"format": "thermocal-calibration", "gravity_m_s2": g_m_s2}
+    run_dicts = []
+    all_before, all_after = [], []
+    for run in runs:
+        f, r = run.path, run.result
+        rd: dict[str, Any] = {
+            "input": str(f),
+            "temperature_c": r.temperature_c,
+            "n_poses": len(r.poses),
+            "accel": {**_triad_dict(r.accel.theta, r.accel.sigma, to_a, a_unit),
+                      "method": r.accel.method, "reduced_chi2": r.accel.reduced_chi2},
+            "poses": [
+                {**p, "mean_specific_force": (np.asarray(p["mean_specific_force_mg"])
+                                              * to_a).tolist(),
+                 "gravity_residual": p["gravity_residual_mg"] * to_a}
+                for p in r.poses_dict()
+            ],
+            "not_still": list(r.not_still),
+        }  # fmt: skip
+        for p in rd["poses"]:
+            del p["mean_specific_force_mg"], p["gravity_residual_mg"]
+        if r.gyro is not None:
+            rd["gyro"] = {**_triad_dict(r.gyro.theta, r.gyro.sigma, to_g, str(g_unit)),
+                          "method": "rotations between poses"
+                          + (" and 360° turns" if r.gyro.n_turns else ""),
+                          "n_motions": r.gyro.n_motions, "n_turns": r.gyro.n_turns,
+                          "reduced_chi2": r.gyro.reduced_chi2,
+                          "direction_rms_before_deg": math.degrees(
+                              r.gyro.direction_rms_before_rad),
+                          "direction_rms_after_deg": math.degrees(
+                              r.gyro.direction_rms_after_rad)}  # fmt: skip
+        all_before.append(r.accel.residual_rms_before_mg**2 * len(r.poses))
+        all_after.append(r.accel.residual_rms_after_mg**2 * len(r.poses))
+        run_dicts.append(rd)
+    n_poses = sum(len(run.result.poses) for run in runs)
+    out["n_poses"] = n_poses
+    out["gravity_residual_rms_before"] = math.sqrt(sum(all_before) / n_poses) * to_a
+    out["gravity_residual_rms_after"] = math.sqrt(sum(all_after) / n_poses) * to_a
+    out["unit"] = a_unit
+    out["poses"] = [dict(p, file=rd["input"]) for rd in run_dicts for p in rd["poses"]]
+    for kind, m in models.items():
+        theta = np.array([f.coef[0] for f in m.fits])
+        sigma = np.array([f.sigma[0] for f in m.fits])
+        if kind == "accel":
+            d = _triad_dict(theta, sigma, to_a, a_unit)
+            d["method"] = runs[0].result.accel.method
+        else:
+            d = _triad_dict(theta, sigma, to_g, str(g_unit))
+            d["method"] = run_dicts[0]["gyro"]["method"]
+        d["tref_c"] = m.tref_c
+        if len(runs) > 1:
+            d["order"] = m.order
+            d["temperature_range_c"] = [m.t_lo_c, m.t_hi_c]
+            d["parameters"] = {
+                f.name: {"unit": f.unit, "coefficients": f.coef.tolist(),
+                         "coefficients_sigma": f.sigma.tolist(),
+                         "loto_rms": f.loto_rms if math.isfinite(f.loto_rms) else None}
+                for f in m.fits
+            }  # fmt: skip
+        out[kind] = d
+    out["runs"] = run_dicts
+    return out
+
+
+__all__ = [
+    "NO_TEMPERATURE_TREF_C",
+    "MultiposOptions",
+    "MultiposResult",
+    "SessionRun",
+    "calibrate_files",
+]

@@ -1,0 +1,277 @@
+"""The stability analysis of a recording's channels, as ``thermocal allan`` and ``thermocal
+noise`` run it: the library function each command calls once.
+
+Pure maths on a :class:`~thermocal.recording.Recording` already read (no file layer):
+
+* :func:`allan_analysis`: per channel the overlapping Allan deviation with its noise terms
+  (:func:`thermocal.stability.allan.overlapping_adev`,
+  :func:`~thermocal.stability.allan.noise_terms`)
+  and, with ``dynamic_s``, the dynamic ADEV; or the NIST SP 1065 deviations named in
+  ``deviations`` (:func:`thermocal.stability.family.stability`), of rate or phase data.
+* :func:`imu_noise`: the estimator noise model of a gyro (and accelerometer) triad
+  (:mod:`thermocal.stability.noise_model`).
+
+Every figure is in the data's own unit (:func:`thermocal.metrics.data_unit_of`); doubtful
+results are :class:`~thermocal.errors.ConditioningWarning` naming ``where`` (the file).
+"""
+
+from __future__ import annotations
+
+import math
+import re
+import warnings
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any
+
+from thermocal.errors import ConditioningWarning, ThermocalInputError
+from thermocal.stability.allan import ONE_SIGMA_CONFIDENCE
+
+if TYPE_CHECKING:
+    import numpy as np
+    import numpy.typing as npt
+
+    from thermocal.recording import Recording
+    from thermocal.stability.allan import AllanResult, DynamicAllan, NoiseTerms
+    from thermocal.stability.family import StabilityResult
+    from thermocal.stability.noise_model import AxisNoise, NoiseModel
+
+    FloatArray = npt.NDArray[np.float64]
+
+TAU_SETS = ("octave", "decade", "log", "all")
+"""The named τ sets of ``--taus`` (else a list of τ [s])."""
+
+DATA_TYPES = ("rate", "phase")
+"""``--data-type``: rate data (a rate column) or phase data (an integrated quantity)."""
+
+
+def parse_taus(text: str) -> Any:
+    """``--taus``: a named set (:data:`TAU_SETS`) as given, else a list of τ [s]."""
+    if text in TAU_SETS:
+        return text
+    try:
+        return [float(v) for v in text.split(",") if v.strip()]
+    except ValueError:
+        raise ThermocalInputError(
+            f"--taus {text!r}: use octave, decade, log or a comma-separated list of τ [s]"
+        ) from None
+
+
+def column_unit(name: str) -> str:
+    """A phase column's unit from its name (``phase [s]``, ``angle (deg)``), else ``""``:
+    phase units are not signal (rate) units, so the recording's unit resolver cannot give it."""
+    hit = re.search(r"[\[(]([^\])]+)[\])]\s*$", name)
+    return hit.group(1).strip() if hit else ""
+
+
+def signal_in_data_unit(rec: Recording, name: str) -> tuple[FloatArray, str]:
+    """The signal ``name`` in the data's own unit and that unit: the canonical values
+    divided by k of :func:`thermocal.metrics.data_unit_of` (the canonical array itself when
+    k = 1, so a caller may overwrite it)."""
+    from thermocal.metrics import data_unit_of
+
+    canonical, canon_unit = rec.signal(name)
+    unit, k = data_unit_of(rec, name, canon_unit)
+    return (canonical if k == 1.0 else canonical / k), unit
+
+
+@dataclass(frozen=True, eq=False)
+class AllanChannel:
+    """One channel's overlapping ADEV, its noise terms and (``--dynamic``) dynamic ADEV."""
+
+    adev: AllanResult
+    noise: NoiseTerms
+    dynamic: DynamicAllan | None = None
+
+
+@dataclass(frozen=True, eq=False)
+class AllanAnalysis:
+    """The result of :func:`allan_analysis`: ``channels`` (overlapping ADEV and noise terms,
+    the default) or ``family`` (the deviations asked for, or phase data), per channel name
+    in the order asked."""
+
+    names: tuple[str, ...]
+    channels: dict[str, AllanChannel] = field(default_factory=dict)
+    family: dict[str, StabilityResult] = field(default_factory=dict)
+
+    @property
+    def is_family(self) -> bool:
+        """True when the result holds the deviation family (``--deviation``/phase data)."""
+        return bool(self.family)
+
+
+def allan_analysis(
+    rec: Recording,
+    names: list[str],
+    *,
+    taus: Any = "octave",
+    confidence: float = ONE_SIGMA_CONFIDENCE,
+    deviations: str | None = None,
+    data_type: str = "rate",
+    dynamic_s: float | None = None,
+    where: str = "",
+) -> AllanAnalysis:
+    """The stability analysis of the channels ``names`` of ``rec`` (module docstring).
+
+    ``taus``: a named τ set or a list of τ [s] (:func:`parse_taus`); ``deviations``: the
+    comma-separated deviations of :func:`thermocal.stability.family.parse_deviations`
+    (then, or with ``data_type="phase"``, the family replaces the ADEV and noise terms);
+    ``dynamic_s``: the dynamic ADEV's window [s] (rate data, ADEV only).  A poor noise-model
+    fit and a non-stationary record are :class:`ConditioningWarning` naming ``where``
+    (and the channel when there are several).
+    """
+    if data_type not in DATA_TYPES:
+        raise ThermocalInputError(f"--data-type {data_type!r}: use rate or phase")
+    if dynamic_s is not None and (deviations is not None or data_type == "phase"):
+        raise ThermocalInputError(
+            "--dynamic computes the overlapping ADEV of rate data; run it without --deviation "
+            "and --data-type phase"
+        )
+    if deviations is not None or data_type == "phase":
+        return AllanAnalysis(
+            tuple(names), family=_family(rec, names, taus, confidence, deviations, data_type)
+        )
+    channels: dict[str, AllanChannel] = {}
+    for name in names:  # one read of the file, every channel (INTERFACE: several channels)
+        label = where + (f" [{name}]" if len(names) > 1 else "")
+        channels[name] = _allan_channel(
+            rec, name, taus, confidence, dynamic_s, names.count(name) == 1, label
+        )
+    return AllanAnalysis(tuple(names), channels=channels)
+
+
+def _family(
+    rec: Recording,
+    names: list[str],
+    taus: Any,
+    confidence: float,
+    deviations: str | None,
+    data_type: str,
+) -> dict[str, StabilityResult]:
+    """The deviations of every channel (phase data: the column as given, in its own unit)."""
+    from thermocal.stability import family
+
+    devs = family.parse_deviations(deviations or "oadev")
+    results = {}
+    for name in names:
+        if data_type == "phase":  # the column as given, in its own unit
+            values, unit = rec.column(name), column_unit(name)
+        else:
+            values, unit = signal_in_data_unit(rec, name)
+        results[name] = family.stability(
+            values, rec.sample_interval_s, devs, taus, data_type=data_type,
+            segments=rec.segments(), unit=unit, confidence=confidence,
+        )  # fmt: skip
+    return results
+
+
+def _allan_channel(
+    rec: Recording,
+    name: str,
+    taus: Any,
+    confidence: float,
+    dynamic_s: float | None,
+    named_once: bool,
+    where: str,
+) -> AllanChannel:
+    """One channel's ADEV, noise terms and dynamic ADEV, with their warnings."""
+    from thermocal.stability import allan
+
+    # every figure in the data's own unit (°/s data: ADEV in °/s; INTERFACE common rules)
+    values, unit = signal_in_data_unit(rec, name)
+    res = allan.overlapping_adev(
+        values,
+        rec.sample_interval_s,
+        taus,
+        time_s=rec.time_s,
+        segments=rec.segments(),  # one scan of the time column for every channel
+        unit=unit,
+        confidence=confidence,
+        # the phase is accumulated in the column's own buffer (no memory per sample):
+        # the column is not used again unless the channel is named twice or the
+        # dynamic ADEV reads the rate after it (it did, on the floor's numpy/pyarrow,
+        # where the buffer is writeable: windows of phase, found by the floor check)
+        overwrite=named_once and dynamic_s is None,
+    )
+    noise = allan.noise_terms(res)
+    if noise.quality is not None and noise.quality.quality == "poor":
+        warnings.warn(f"{where}: {noise.quality.reason}", ConditioningWarning, stacklevel=1)
+    if dynamic_s is None:
+        return AllanChannel(res, noise)
+    dyn = allan.dynamic_adev(values, rec.sample_interval_s, dynamic_s, res, time_s=rec.time_s)
+    if not dyn.stationary:
+        worst = max(dyn.changes, key=lambda c: abs(math.log(c["adev"] / c["whole_adev"])))
+        warnings.warn(
+            f"{where}: the record is not stationary: in {len(dyn.changes)} (window, τ) "
+            f"cells the {dyn.window_s:g} s windows' ADEV differs from the whole "
+            f"record's beyond both intervals (e.g. {worst['adev']:.4g} against "
+            f"{worst['whole_adev']:.4g} {res.unit} at τ = {worst['tau_s']:.4g} s in "
+            f"the window centred at {worst['t_s']:.4g} s); the noise terms of the "
+            "whole record average over changing noise",
+            ConditioningWarning,
+            stacklevel=1,
+        )
+    return AllanChannel(res, noise, dyn)
+
+
+@dataclass(frozen=True, eq=False)
+class ImuNoise:
+    """The result of :func:`imu_noise`: each axis's terms and the estimator noise model."""
+
+    axes: tuple[AxisNoise, ...]
+    model: NoiseModel
+
+
+def imu_noise(
+    rec: Recording,
+    gyro: list[str],
+    accel: list[str],
+    *,
+    inflate: float = 1.0,
+    rostopic: str = "/imu0",
+    confidence: float = ONE_SIGMA_CONFIDENCE,
+    where: str = "",
+) -> ImuNoise:
+    """The IMU noise model of the gyro (and accelerometer) columns of ``rec``
+    (:func:`thermocal.stability.noise_model.axis_noise` per axis in the data's own unit,
+    :func:`~thermocal.stability.noise_model.noise_model` over them, rate 1/τ0).  A term
+    given only as an upper bound is a :class:`ConditioningWarning` naming ``where`` and
+    the axis."""
+    from thermocal.stability import noise_model as nm
+
+    axes = []
+    for name in gyro + accel:
+        values, unit = signal_in_data_unit(rec, name)
+        axes.append(
+            nm.axis_noise(
+                values, rec.sample_interval_s, name=name,
+                sensor="gyro" if name in gyro else "accel", unit=unit,
+                segments=rec.segments(), time_s=rec.time_s, confidence=confidence,
+            )
+        )  # fmt: skip
+    model = nm.noise_model(
+        axes, 1.0 / rec.sample_interval_s, inflate=inflate, rostopic=rostopic,
+        confidence=confidence,
+    )  # fmt: skip
+    for ax in axes:
+        for t in (ax.density, ax.walk):
+            if t.method == "bound":
+                warnings.warn(
+                    f"{where} [{ax.name}]: {t.term.replace('_', ' ')}: {t.reason}",
+                    ConditioningWarning,
+                    stacklevel=1,
+                )
+    return ImuNoise(tuple(axes), model)
+
+
+__all__ = [
+    "DATA_TYPES",
+    "TAU_SETS",
+    "AllanAnalysis",
+    "AllanChannel",
+    "ImuNoise",
+    "allan_analysis",
+    "column_unit",
+    "imu_noise",
+    "parse_taus",
+    "signal_in_data_unit",
+]
