@@ -10,8 +10,10 @@ import pytest
 from numpy.testing import assert_allclose
 
 from thermocal.cli import main
-from thermocal.profiles import builtin_profile, correlate, read_program, write_program
+from thermocal.profiles import builtin_profile, correlate
 from thermocal.readers.dispatch import read_recording
+from thermocal.readers.program import read_program
+from thermocal.writers import write_program
 
 
 def run(capsys: pytest.CaptureFixture[str], *args: str) -> tuple[int, str, str]:

@@ -25,9 +25,9 @@ from thermocal.profiles import (
     correlate,
     design_validation_profile,
     find_holds,
-    read_program,
-    write_program,
 )
+from thermocal.readers.program import read_program
+from thermocal.writers import write_program
 
 
 def test_segments_expand_exactly() -> None:

@@ -37,7 +37,7 @@ SCENARIO_NAMES: Final = (
 
 PROGRAM_TIME: Final = "time_s"
 PROGRAM_SETPOINT: Final = "setpoint_c"
-"""Columns of a chamber program CSV (:func:`thermocal.profiles.read_program`)."""
+"""Columns of a chamber program CSV (:func:`thermocal.readers.program.read_program`)."""
 
 
 ALLOW_NARROW: Final = "--allow-narrow"

@@ -8,7 +8,8 @@ A :class:`Profile` is a start temperature and a list of segments (SPEC §6):
 
 Expanded, a profile is a continuous piecewise-linear set-point ``setpoint_c(t)``
 (:meth:`Profile.pieces`, :meth:`Profile.knots`), written as a chamber program of
-two columns ``time_s, setpoint_c`` (:meth:`Profile.program`, :func:`write_program`).
+two columns ``time_s, setpoint_c`` (:meth:`Profile.program`,
+:func:`thermocal.writers.write_program`).
 Ramps therefore have exactly their rate and holds exactly their duration.
 
 The built-in profiles (:data:`PROFILE_NAMES`, :func:`builtin_profile`) follow the
@@ -26,7 +27,6 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
-from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -37,9 +37,6 @@ from thermocal.defaults import PROGRAM_TIME as PROGRAM_TIME
 from thermocal.defaults import WEAK_CORRELATION_LIMIT as WEAK_CORRELATION_LIMIT
 from thermocal.errors import (
     DesignError,
-    FileFormatError,
-    MissingColumnError,
-    NonNumericError,
     ThermocalInputError,
     TimestampError,
 )
@@ -482,62 +479,6 @@ def check_program(time_s: npt.ArrayLike, setpoint_c: npt.ArrayLike, what: str = 
             f"{what}: time must increase strictly; row {back[0] + 1} ({float(t[back[0] + 1])!r}) "
             f"follows {float(t[back[0]])!r}"
         )
-
-
-def write_program(path: str | Path, time_s: npt.ArrayLike, setpoint_c: npt.ArrayLike) -> Path:
-    """Write a chamber program CSV with columns ``time_s, setpoint_c`` (atomic)."""
-    import pandas as pd
-
-    from thermocal.writers import atomic_write
-
-    t = np.asarray(time_s, dtype=np.float64)
-    c = np.asarray(setpoint_c, dtype=np.float64)
-    check_program(t, c, str(path))
-    p = Path(path)
-    if p.suffix.lower() != ".csv":
-        raise ThermocalInputError(f"{p}: a chamber program is written as CSV; name it *.csv")
-    df = pd.DataFrame({PROGRAM_TIME: t, PROGRAM_SETPOINT: c})
-    with atomic_write(p, "w") as fh:
-        df.to_csv(fh, index=False, float_format="%.10g", lineterminator="\n")
-    return p
-
-
-def read_program(path: str | Path) -> tuple[FloatArray, FloatArray]:
-    """Read a chamber program CSV (columns ``time_s`` and ``setpoint_c``).
-
-    Raises :class:`FileFormatError`, :class:`MissingColumnError`,
-    :class:`NonNumericError` or :class:`TimestampError` naming the file.
-    """
-    import pandas as pd
-
-    from thermocal.readers.common import csv_float_options
-
-    p = Path(path)
-    if not p.exists():
-        raise FileFormatError(f"{p}: no such file")
-    try:
-        df = pd.read_csv(p, skipinitialspace=True, **csv_float_options())
-    except (pd.errors.EmptyDataError, pd.errors.ParserError, UnicodeDecodeError) as exc:
-        raise FileFormatError(f"{p}: not a readable program CSV ({exc})") from None
-    df.columns = [str(c).strip() for c in df.columns]
-    for col in (PROGRAM_TIME, PROGRAM_SETPOINT):
-        if col not in df.columns:
-            raise MissingColumnError(
-                f"{p}: no column {col!r}; a chamber program has columns time_s, setpoint_c "
-                f"(found: {', '.join(map(repr, df.columns))})"
-            )
-    out = []
-    for col in (PROGRAM_TIME, PROGRAM_SETPOINT):
-        vals = pd.to_numeric(df[col], errors="coerce")
-        bad = np.flatnonzero(vals.isna().to_numpy())
-        if bad.size:
-            raise NonNumericError(
-                f"{p}: missing or non-numeric value {str(df[col].iloc[bad[0]])[:60]!r} in column "
-                f"{col!r} at row {bad[0]} (line {bad[0] + 2})"
-            )
-        out.append(vals.to_numpy(dtype=np.float64))
-    check_program(out[0], out[1], str(p))
-    return out[0], out[1]
 
 
 def find_holds(

@@ -17,7 +17,11 @@ from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+import numpy as np
+import numpy.typing as npt
+
 from thermocal._lazy import LazyModule
+from thermocal.defaults import PROGRAM_SETPOINT, PROGRAM_TIME
 from thermocal.errors import (
     ThermocalInputError,
 )
@@ -282,4 +286,22 @@ def write_recording(
         atomic_write_path(p, lambda tmp: pacsv.write_csv(table, tmp, write_options=opts))
         if sidecar is None or sidecar:
             write_json(sidecar_path(p), info)
+    return p
+
+
+def write_program(path: str | Path, time_s: npt.ArrayLike, setpoint_c: npt.ArrayLike) -> Path:
+    """Write a chamber program CSV with columns ``time_s, setpoint_c`` (atomic; checked by
+    :func:`thermocal.profiles.check_program`; read back by
+    :func:`thermocal.readers.program.read_program`)."""
+    from thermocal.profiles import check_program
+
+    t = np.asarray(time_s, dtype=np.float64)
+    c = np.asarray(setpoint_c, dtype=np.float64)
+    check_program(t, c, str(path))
+    p = Path(path)
+    if p.suffix.lower() != ".csv":
+        raise ThermocalInputError(f"{p}: a chamber program is written as CSV; name it *.csv")
+    df = pd.DataFrame({PROGRAM_TIME: t, PROGRAM_SETPOINT: c})
+    with atomic_write(p, "w") as fh:
+        df.to_csv(fh, index=False, float_format="%.10g", lineterminator="\n")
     return p

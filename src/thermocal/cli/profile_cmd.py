@@ -34,7 +34,7 @@ from thermocal.cli.common import (
     text_options,
 )
 from thermocal.cli.common import RateOpt as TextRateOpt
-from thermocal.errors import FileFormatError, MissingColumnError, ThermocalInputError
+from thermocal.errors import ThermocalInputError
 from thermocal.outputs import check_outputs
 
 if TYPE_CHECKING:
@@ -42,6 +42,7 @@ if TYPE_CHECKING:
 
     import thermocal.profiles as _profiles
     import thermocal.readers as _readers
+    import thermocal.readers.program as _program
     import thermocal.recording as _recording
     import thermocal.writers as _writers
 else:
@@ -49,12 +50,12 @@ else:
     _readers = LazyModule("thermocal.readers")
     _writers = LazyModule("thermocal.writers")
     _profiles = LazyModule("thermocal.profiles")
+    _program = LazyModule("thermocal.readers.program")
     _recording = LazyModule("thermocal.recording")
 
 if TYPE_CHECKING:
     import pandas as pd
 
-    from thermocal.readers.text import TextOptions
 else:
     pd = LazyModule("pandas")
 
@@ -96,7 +97,7 @@ def _write_profile(
     if not (dt >= 0 and math.isfinite(dt)):
         raise ThermocalInputError(f"--dt must be ≥ 0 s (0: corner points only), got {dt:g}")
     t, c = prof.program(dt if dt > 0 else None)
-    _profiles.write_program(output, t, c)
+    _writers.write_program(output, t, c)
     summary = {
         "profile": prof.name,
         "file": str(output),
@@ -120,48 +121,6 @@ def _write_profile(
 
 def _clean(params: dict[str, Any]) -> dict[str, Any]:
     return {k: v for k, v in params.items() if v is not None}
-
-
-def load_history(
-    path: Path,
-    column: str | None = None,
-    *,
-    text: "TextOptions | None" = None,
-    topic: str | None = None,
-) -> "tuple[_recording.FloatArray, _recording.FloatArray, str]":
-    """A temperature history ``(time_s, temperature_c, column)`` from a chamber program CSV
-    (``time_s, setpoint_c``; its set-point unless ``column`` is another of its columns) or a
-    recording (``column``, default its first temperature column, else ``setpoint_c``), read
-    by :func:`thermocal.readers.read_recording` with the text-log options ``text`` and the
-    log topic ``topic`` as every command reads a recording."""
-    if not path.exists():
-        raise FileFormatError(f"{path}: no such file")
-    time_col: str | None = None
-    if _readers.file_kind(path) == "csv":
-        try:
-            header = [str(c).strip() for c in pd.read_csv(path, nrows=0).columns]
-        except (pd.errors.EmptyDataError, pd.errors.ParserError, UnicodeDecodeError) as exc:
-            raise FileFormatError(f"{path}: not a readable CSV file ({exc})") from None
-        is_program = defaults.PROGRAM_TIME in header and defaults.PROGRAM_SETPOINT in header
-        if is_program and (column is None or column not in header):
-            t, c = _profiles.read_program(path)
-            return t, c, defaults.PROGRAM_SETPOINT
-        if defaults.PROGRAM_TIME in header and "time" not in header:
-            time_col = defaults.PROGRAM_TIME
-    rec = _readers.read_recording(path, time=time_col, text=text, topic=topic)
-    if column is None:
-        if rec.temperatures:
-            column = rec.temperatures[0]
-        elif defaults.PROGRAM_SETPOINT in rec.columns:
-            column = defaults.PROGRAM_SETPOINT
-        else:
-            raise MissingColumnError(
-                f"{path}: no temperature column known; name one with --column (available: "
-                + ", ".join(repr(c) for c in rec.columns)
-                + ")"
-            )
-    values = rec.temperature_c(column) if column in rec.temperatures else rec.column(column)
-    return rec.time_s, values, column
 
 
 @profile_app.command("rlg-modelling")
@@ -362,8 +321,8 @@ def correlate_cmd(
 ) -> None:
     """r = Cov(X, Y)/(σX σY) of two temperature histories on a common elapsed-time base."""
     text = text_options(t_names, t_rate, t_bad, t_delim, t_dec)
-    ta, xa, ca = load_history(file_a, column, text=text, topic=topic)
-    tb, xb, cb = load_history(
+    ta, xa, ca = _program.read_history(file_a, column, text=text, topic=topic)
+    tb, xb, cb = _program.read_history(
         file_b, column_b if column_b is not None else column, text=text, topic=topic
     )
     res = _profiles.correlate(ta, xa, tb, xb, r_limit=limit, n_points=points)
@@ -399,7 +358,7 @@ def _design(
     dt: float,
     as_json: bool,
 ) -> None:
-    tm, cm, _ = load_history(model, column)
+    tm, cm, _ = _program.read_history(model, column)
     kwargs: dict[str, Any] = _clean({"n_holds": n_holds, "hold_s": hold_s, "rate_c_per_min": rate})
     prof = _profiles.design_validation_profile(tm, cm, seed, limit, **kwargs)
     tv, cv = prof.knots()

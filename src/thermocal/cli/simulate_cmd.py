@@ -32,6 +32,7 @@ if TYPE_CHECKING:
     import thermocal.outputs as _outputs
     import thermocal.profiles as _profiles
     import thermocal.readers as _readers
+    import thermocal.readers.program as _program
     import thermocal.simulate as _simulate
     import thermocal.writers as _writers
 else:
@@ -39,6 +40,7 @@ else:
     _readers = LazyModule("thermocal.readers")
     _writers = LazyModule("thermocal.writers")
     _profiles = LazyModule("thermocal.profiles")
+    _program = LazyModule("thermocal.readers.program")
     _simulate = LazyModule("thermocal.simulate")
 
 
@@ -140,7 +142,7 @@ def simulate_cmd(
     opts = _simulate.SimulateOptions(rate_hz, latitude, axis, runs, orientation, record_s, run)
     inputs: list[str | Path] = [profile] if profile is not None else []
     _early_gate(output, truth, inputs)
-    prog = _profiles.read_program(profile) if profile is not None else None
+    prog = _program.read_program(profile) if profile is not None else None
     sim = _simulate.simulate_scenario(scenario, seed, prog, opts)
     paths = output_paths(output, scenario, list(sim.labels), fmt)
     sidecars = [_outputs.sidecar_path(p) for p in paths if _readers.file_kind(p) == "csv"]

@@ -19,12 +19,14 @@ from thermocal.cli.interrupt import EXIT_INTERRUPTED
 
 if TYPE_CHECKING:
     import thermocal.profiles as _profiles
+    import thermocal.readers.program as _program
     import thermocal.station.check as _check
     import thermocal.station.config as _config
     import thermocal.station.display as _display
     import thermocal.station.run as _run
 else:
     _profiles = LazyModule("thermocal.profiles")
+    _program = LazyModule("thermocal.readers.program")
     _check = LazyModule("thermocal.station.check")
     _config = LazyModule("thermocal.station.config")
     _display = LazyModule("thermocal.station.display")
@@ -141,7 +143,7 @@ def run_cmd(
     file; continue an interrupted run with --resume.
     """
     cfg = _config.load_station(station)
-    prog_t, prog_c = _profiles.read_program(profile)
+    prog_t, prog_c = _program.read_program(profile)
     live = sys.stderr.isatty() and not as_json
     disp = _display.RichDisplay() if live else _run.LogDisplay()
     if hasattr(signal, "SIGTERM"):

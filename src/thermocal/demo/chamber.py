@@ -45,12 +45,12 @@ from thermocal.errors import ModelFileError, ThermocalWarning
 from thermocal.export.c import export_c
 from thermocal.models.base import RunData, TemperatureModel, make_model
 from thermocal.models.files import save_model
-from thermocal.profiles import design_validation_profile, rlg_modelling, write_program
+from thermocal.profiles import design_validation_profile, rlg_modelling
 from thermocal.recording import Recording
 from thermocal.report import ModelEntry, ReportInputs, write_report
 from thermocal.simulate import run_scenario
 from thermocal.validation import validate
-from thermocal.writers import write_json, write_recording
+from thermocal.writers import write_json, write_program, write_recording
 
 DEMO_STEPS: tuple[str, ...] = (
     "designing chamber profiles",

@@ -44,16 +44,26 @@ rate_hz = 50
 
 
 def run_demo(out: Path, time_scale: float = 200.0) -> dict[str, object]:
-    """Record, fit, validate and export; returns a summary (paths and the slopes)."""
-    from thermocal.cli import main
+    """Record, fit, validate and export; returns a summary (paths and the slopes).
+
+    The library calls behind ``thermocal station run``, ``fit``, ``validate`` and
+    ``export-c`` (:func:`thermocal.station.run.run_station`,
+    :func:`thermocal.pipeline.fit.fit_files`, :func:`thermocal.pipeline.validate.validate_files`,
+    :func:`thermocal.export.c.files.export_c_file`), in the order a user runs the commands."""
     from thermocal.errors import ThermocalInputError
-    from thermocal.profiles import write_program
+    from thermocal.export.c.files import export_c_file
+    from thermocal.pipeline.fit import fit_files
+    from thermocal.pipeline.options import FitOptions, ValidateOptions
+    from thermocal.pipeline.validate import validate_files
+    from thermocal.station.config import load_station
+    from thermocal.station.run import run_station
     from thermocal.station.sim import (
         ChamberModel,
         GyroTruth,
         SimulatedChamber,
         SimulatedSerialSensor,
     )
+    from thermocal.writers import write_program
 
     if out.exists() and any(out.iterdir()):
         raise ThermocalInputError(f"{out}: exists and is not empty")
@@ -65,27 +75,22 @@ def run_demo(out: Path, time_scale: float = 200.0) -> dict[str, object]:
     sensor.start()
     try:
         (out / "station.toml").write_text(_station_toml(sim.port, sensor.device))
+        cfg = load_station(out / "station.toml")
         for name, prog in (("modelling", MODELLING), ("validation", VALIDATION)):
-            write_program(out / f"{name}.csv", prog[0], prog[1])
-            rc = main(["station", "run", str(out / "station.toml"), "--profile",
-                       str(out / f"{name}.csv"), "-o", str(out / name),
-                       "--time-scale", str(time_scale)])  # fmt: skip
-            if rc != 0:
-                raise SystemExit(rc)
+            program = write_program(out / f"{name}.csv", prog[0], prog[1])
+            run_station(
+                cfg, (list(prog[0]), list(prog[1])), out / name,
+                profile_source=str(program), time_scale=time_scale,
+            )  # fmt: skip
     finally:
         sensor.stop()
         sim.stop()
-    steps = [
-        ["fit", str(out / "modelling"), "--model", "poly", "--order", "1", "--signal", "gx",
-         "--temps", "temp", "-o", str(out / "model.json")],
-        ["validate", str(out / "model.json"), str(out / "validation"), "--modeling",
-         str(out / "modelling")],
-        ["export-c", str(out / "model.json"), "-o", str(out / "c")],
-    ]  # fmt: skip
-    for args in steps:
-        rc = main(args)
-        if rc != 0:
-            raise SystemExit(rc)
+    fit_opts = FitOptions(model="poly", order=1, signal="gx", temps="temp")
+    fit_files([out / "modelling"], fit_opts, out / "model.json")
+    validate_files(
+        out / "model.json", out / "validation", ValidateOptions(modeling=out / "modelling")
+    )
+    export_c_file(out / "model.json", out / "c")
     coef = {c["name"]: c for c in json.loads((out / "model.json").read_text())["coefficients"]}
     fitted = float(coef["T1"]["value"]) / 3600.0  # deg/h/°C → deg/s/°C
     return {
