@@ -13,9 +13,9 @@ from thermocal.cli import main
 from thermocal.cli.fit_cmd import build_model
 from thermocal.errors import ThermocalInputError
 from thermocal.models import load_model
-from thermocal.models.base import MODEL_REGISTRY
 from thermocal.models.piecewise import PiecewiseModel
 from thermocal.models.poly import PolyModel
+from thermocal.models.registry import MODEL_REGISTRY
 from thermocal.recording import Recording
 from thermocal.writers import write_recording
 

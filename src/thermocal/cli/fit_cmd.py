@@ -5,7 +5,7 @@ several runs, each with its own turn-on offset unless ``--no-per-run-offset``)
 and writes the self-describing model file (:func:`thermocal.models.files.save_model`)
 with the data files' names and SHA-256 checksums.
 
-The family is looked up in the registry (:func:`thermocal.models.base.get_model_class`).
+The family is looked up in the registry (:func:`thermocal.models.registry.get_model_class`).
 The command collects the model options the user gave into one dict and calls
 ``cls.from_cli_options(options)``, the one option parser of every family
 restricted to its constructor parameters.  Only options given on the command
@@ -91,7 +91,7 @@ from thermocal.cli.common import (
     stdout,
     text_options,
 )
-from thermocal.defaults import overrides_of
+from thermocal.defaults import MODEL_FAMILIES, overrides_of
 from thermocal.errors import ConditioningWarning, ThermocalInputError
 
 if TYPE_CHECKING:
@@ -104,6 +104,7 @@ if TYPE_CHECKING:
     import thermocal.models.calibration as _calibration
     import thermocal.models.files as _files
     import thermocal.models.poly as _poly
+    import thermocal.models.registry as _registry
     import thermocal.recording as _recording
     import thermocal.writers as _writers
     from thermocal import units
@@ -114,6 +115,7 @@ else:
     _adequacy = LazyModule("thermocal.adequacy")
     _writers = LazyModule("thermocal.writers")
     _base = LazyModule("thermocal.models.base")
+    _registry = LazyModule("thermocal.models.registry")
     _calibration = LazyModule("thermocal.models.calibration")
     _files = LazyModule("thermocal.models.files")
     _poly = LazyModule("thermocal.models.poly")
@@ -186,7 +188,7 @@ def build_model(family: str, options: dict[str, Any]) -> "_base.TemperatureModel
     """Instantiate a registered family from the CLI option dict by its one option parser
     (:meth:`TemperatureModel.from_cli_options`: an option the family does not take is
     refused, for every family)."""
-    return _base.get_model_class(family).from_cli_options(options)
+    return _registry.get_model_class(family).from_cli_options(options)
 
 
 @app.command("fit")
@@ -197,7 +199,7 @@ def fit_cmd(
         typer.Argument(help="Recordings (CSV or Parquet); one run each.", show_default=False),
     ],
     model: Annotated[
-        str, typer.Option("--model", help="Model family: poly, piecewise, warmup, bank.")
+        str, typer.Option("--model", help=f"Model family: {', '.join(MODEL_FAMILIES)}.")
     ],
     output: Annotated[Path, typer.Option("-o", "--output", help="Model file to write (JSON).")],
     signal: SignalOpt = None,

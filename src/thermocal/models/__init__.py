@@ -1,24 +1,25 @@
 """Temperature-compensation model families (SPEC §4) behind one contract.
 
-Importing this package registers every family in
-:data:`thermocal.models.base.MODEL_REGISTRY`: ``poly`` (SPEC §4a),
-``piecewise`` (§4b), ``warmup`` (§4c) and ``bank`` (§4d).
+The families are listed once, in :data:`thermocal.models.registry.MODEL_REGISTRY`:
+``poly`` (SPEC §4a), ``piecewise`` (§4b), ``warmup`` (§4c) and ``bank`` (§4d).
 """
 
 from __future__ import annotations
 
-import importlib
 from typing import TYPE_CHECKING, Any
 
 from thermocal.models.base import (
-    MODEL_REGISTRY,
     Coefficient,
     FitStats,
     ModelStream,
     RunData,
     TemperatureModel,
+)
+from thermocal.models.registry import (
+    MODEL_REGISTRY,
     get_model_class,
     make_model,
+    model_from_dict,
     register,
 )
 
@@ -38,15 +39,6 @@ def __getattr__(name: str) -> Any:
     raise AttributeError(f"module 'thermocal.models' has no attribute {name!r}")
 
 
-FAMILY_MODULES = ("poly", "piecewise", "warmup", "bank")
-
-for _mod in FAMILY_MODULES:
-    try:
-        importlib.import_module(f"thermocal.models.{_mod}")
-    except ModuleNotFoundError as _exc:
-        if _exc.name != f"thermocal.models.{_mod}":
-            raise
-
 __all__ = [
     "MODEL_REGISTRY",
     "Coefficient",
@@ -58,6 +50,7 @@ __all__ = [
     "load_model",
     "load_model_dict",
     "make_model",
+    "model_from_dict",
     "register",
     "save_model",
 ]

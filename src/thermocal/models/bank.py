@@ -73,7 +73,7 @@ from __future__ import annotations
 import bisect
 import math
 import warnings
-from collections.abc import Mapping, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, ClassVar, Self
 
@@ -94,7 +94,6 @@ from thermocal.models.base import (
     ModelStream,
     RunData,
     TemperatureModel,
-    register,
     stream_channel,
 )
 from thermocal.models.warmup import CONDITION_WARN, channel_index, lstsq_svd, single_channel
@@ -220,7 +219,6 @@ def _selection(dev: FloatArray, n: int, complete: bool) -> Selection:
 # --- the model ------------------------------------------------------------------------------
 
 
-@register
 class BankModel(TemperatureModel):
     """Bank of piecewise-linear models, one per characteristic curve, chosen at
     power-on (SPEC §4d, seed 004).
@@ -276,14 +274,6 @@ class BankModel(TemperatureModel):
         """Each curve of the bank is judged as a line in its column."""
         j = self.sensor if 0 <= self.sensor < len(temp_names) else 0
         return Needs({temp_names[j]: 1} if temp_names else {}, 2)
-
-    CLI_KEYS: ClassVar[Mapping[str, str] | None] = {
-        k: k
-        for k in (
-            "deviation", "tolerance", "startup_s", "sensor", "knot_spacing_c", "grid_step_c",
-            "hold_min_s", "error_metric",
-        )
-    }  # fmt: skip
 
     def chunk_context(self) -> ChunkContext:
         """The model is chosen from the first ``startup_s`` seconds after power-on."""

@@ -55,7 +55,7 @@ from __future__ import annotations
 import bisect
 import math
 import warnings
-from collections.abc import Iterator, Mapping, Sequence
+from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, ClassVar, Self
 
@@ -77,7 +77,6 @@ from thermocal.models.base import (
     ModelStream,
     RunData,
     TemperatureModel,
-    register,
     stream_channel,
 )
 from thermocal.models.fitting import (
@@ -340,7 +339,6 @@ class _Lines:
     m: int
 
 
-@register
 class PiecewiseModel(TemperatureModel):
     """Piecewise-linear model in one temperature (SPEC §4b); see the module docstring.
 
@@ -381,10 +379,6 @@ class PiecewiseModel(TemperatureModel):
         self.method = method
         self.temperature = temperature
         self.per_run_offset = per_run_offset
-
-    CLI_KEYS: ClassVar[Mapping[str, str] | None] = {
-        k: k for k in ("breakpoints", "segments", "method", "temperature", "per_run_offset")
-    }
 
     def chunk_context(self) -> ChunkContext:
         """Eq. (1) is memoryless: a sample's value depends on its own temperature only."""

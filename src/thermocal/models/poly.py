@@ -95,7 +95,7 @@ from __future__ import annotations
 import math
 import warnings
 from collections import deque
-from collections.abc import Mapping, Sequence
+from collections.abc import Sequence
 from typing import Any, ClassVar, Self, cast
 
 import numpy as np
@@ -109,7 +109,6 @@ from thermocal.models.base import (
     ModelStream,
     RunData,
     TemperatureModel,
-    register,
 )
 from thermocal.models.fitting import Block
 from thermocal.models.fitting import (  # shared with piecewise; re-exported
@@ -185,7 +184,6 @@ DEFAULT_NOISE_THRESHOLD = 10.0
 STATE_LAYOUT = "thermocal-poly-1"
 
 
-@register
 class PolyModel(TemperatureModel):
     """Polynomial in T, Ṫ and TṪ of several sensors (SPEC §4a); see the module docstring.
 
@@ -242,18 +240,6 @@ class PolyModel(TemperatureModel):
         self.noise_threshold = noise_threshold
 
     # -- construction from the command line --
-    CLI_KEYS: ClassVar[Mapping[str, str] | None] = {
-        "terms": "terms",
-        "order": "order",
-        "rate_interval_s": "rate_interval_s",
-        "rate_method": "rate_method",
-        "select": "select",
-        "ridge": "ridge",
-        "rcond": "rcond",
-        "per_run_offset": "per_run_offset",
-        "solver": "solver",
-        "noise_threshold": "noise_threshold",
-    }
 
     def chunk_context(self) -> ChunkContext:
         """Eq. (1) needs the last Δt seconds (the Ṫ interval) and nothing of the start."""

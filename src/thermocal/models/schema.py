@@ -18,7 +18,10 @@ import math
 from collections.abc import Callable
 from typing import Any
 
+from thermocal import units
 from thermocal.errors import ModelFileError
+from thermocal.models.base import check_model_header, checksum
+from thermocal.models.registry import get_model_class
 
 Check = Callable[[Any, str], None]
 
@@ -376,9 +379,6 @@ def check_model_dict(d: dict[str, Any], root: str = "") -> None:
     that a poly model's centres lie in or near the fitted range (:func:`near_range`).
     Units are checked against thermocal's glossary.
     """
-    from thermocal import units
-    from thermocal.models.base import get_model_class
-
     fields(
         {
             "family": string,
@@ -433,6 +433,33 @@ def check_model_dict(d: dict[str, Any], root: str = "") -> None:
             near_range(center, lo, hi, _at(root, f"state.base[{k}].t_center"), "the centre")
 
 
+def verify_model_dict(d: Any, where: str, root: str = "") -> dict[str, Any]:
+    """Check a parsed model dict: header (format, version, sections), checksum and the
+    family's schema (:func:`check_model_dict`); errors name ``where`` (the file) and the key
+    path, prefixed by ``root`` (``channels[0].model`` in a calibration).
+
+    The checksum guards against accidents (truncation, a hand edit, a bit flip), not
+    against tampering: anyone can recompute it, so the content is checked as well."""
+    at = f"{where}: {root}" if root else where
+    try:
+        check_model_header(d)
+    except ModelFileError as exc:
+        raise ModelFileError(f"{at}: {exc}") from None
+    stored = d.get("checksum")
+    if stored is None:
+        raise ModelFileError(f"{at}: model file has no checksum")
+    if stored != checksum(d):
+        raise ModelFileError(
+            f"{at}: checksum mismatch: the model file was corrupted or edited by hand"
+        )
+    try:
+        check_model_dict(d, root)
+    except ModelFileError as exc:
+        raise ModelFileError(f"{where}: {exc}") from None
+    out: dict[str, Any] = d
+    return out
+
+
 __all__ = [
     "MAX_TERM_POWER",
     "STATE_SCHEMAS",
@@ -440,4 +467,5 @@ __all__ = [
     "check_params",
     "near_range",
     "range_margin",
+    "verify_model_dict",
 ]

@@ -66,7 +66,7 @@ from __future__ import annotations
 import dataclasses
 import math
 import warnings
-from collections.abc import Mapping, Sequence
+from collections.abc import Sequence
 from typing import Any, ClassVar, Self
 
 import numpy as np
@@ -87,7 +87,6 @@ from thermocal.models.base import (
     ModelStream,
     RunData,
     TemperatureModel,
-    register,
 )
 from thermocal.recording import FloatArray
 
@@ -272,7 +271,6 @@ class _ScaledFit:
     run_coefs: FloatArray | None
 
 
-@register
 class WarmupModel(TemperatureModel):
     """Two-stage warm-up model ``ΔF = Σ_j a_j(T0) ΔT^j``, ``a_j(T0) = Σ_k b_jk T0^k``
     (SPEC §4c, seed 003).
@@ -331,14 +329,6 @@ class WarmupModel(TemperatureModel):
         j = self.sensor if 0 <= self.sensor < len(temp_names) else 0
         n = (self.order + 1) * (self.t0_order + 1)
         return Needs({temp_names[j]: 1} if temp_names else {}, n)
-
-    CLI_KEYS: ClassVar[Mapping[str, str] | None] = {
-        k: k
-        for k in (
-            "order", "t0_order", "start_window_s", "include_a0", "sensor", "method",
-            "per_run_offset",
-        )
-    }  # fmt: skip
 
     def chunk_context(self) -> ChunkContext:
         """T0 and F0 come from the first ``start_window_s`` seconds of the run; no Ṫ."""
