@@ -281,14 +281,6 @@ def merged_inputs(cal: Calibration, names: Sequence[str] | None = None) -> dict[
     return out
 
 
-def channels_of(signals: Sequence[str], names: Sequence[str] | None = None) -> list[str]:
-    """Channel names for signal columns (the column names unless ``names`` are given)."""
-    out = list(names) if names else list(signals)
-    if len(out) != len(signals):
-        raise ThermocalInputError(f"{len(out)} channel names for {len(signals)} signals")
-    return out
-
-
 __all__ = [
     "CALIBRATION_FORMAT",
     "CALIBRATION_FORMAT_VERSION",

@@ -156,11 +156,6 @@ def evaluate_lines(
     return out
 
 
-def _hinge_design(x: FloatArray, bps: Sequence[float]) -> FloatArray:
-    cols = [np.ones_like(x), x] + [np.maximum(0.0, x - b) for b in bps]
-    return np.column_stack(cols)
-
-
 def _bin_runs(
     temps: Sequence[FloatArray], ys: Sequence[FloatArray], lo: float, hi: float, per_run: bool
 ) -> tuple[FloatArray, FloatArray, FloatArray, npt.NDArray[np.int64], FloatArray]:
