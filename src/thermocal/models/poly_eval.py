@@ -155,21 +155,13 @@ class _BlockEvaluator:
             self._block(s0, a, b, [o[a:b] for o in outs], seen, buf)
         return seen
 
-    def _block(
-        self,
-        s0: int,
-        a: int,
-        b: int,
-        outs: list[FloatArray],
-        seen: _Seen,
-        buf: dict[str, FloatArray],
-    ) -> None:
-        plan, t, temps = self.plan, self.t, self.temps
-        c = b - a
+    def _load_temperatures(
+        self, a: int, b: int, part: int | npt.NDArray[np.intp] | None, buf: dict[str, FloatArray]
+    ) -> tuple[FloatArray, FloatArray | None]:
+        """The block's raw temperatures (columns × rows) and, for a backward Ṫ whose
+        partners lie ``part`` rows back, the partners' (else None), in the buffers."""
+        temps, c = self.temps, b - a
         width = buf["prev"].shape[1]
-        part: int | npt.NDArray[np.intp] | None = None
-        if plan.rate_sensors and self.rates is None:
-            part = backward_partners(t, s0, a, b, self.interval_s, increasing=self.increasing)
         prev: FloatArray | None = None
         if isinstance(part, int) and part <= width:
             raw = buf["raw"][:, : part + c]
@@ -182,6 +174,62 @@ class _BlockEvaluator:
             if isinstance(part, int):
                 prev = buf["prev"][:, :c]
                 np.copyto(prev, temps[a - part : b - part].T)
+        return cur, prev
+
+    def _rates(
+        self,
+        a: int,
+        b: int,
+        part: int | npt.NDArray[np.intp] | None,
+        cura: FloatArray,
+        preva: FloatArray | None,
+        ra: FloatArray,
+        seen: _Seen,
+        buf: dict[str, FloatArray],
+    ) -> None:
+        """Step 1 into ``ra``: Ṫ = (T_i − T_lo)/(t_i − t_lo)·60 [°C/min] from the raw
+        temperatures (or the forward/centred rates computed beforehand); records the range
+        met and clips to the fitted one when asked."""
+        t, temps, c = self.t, self.temps, b - a
+        if self.rates is not None:  # forward / centred forms, computed beforehand
+            np.copyto(ra, self.rates[a:b, self.rows].T)
+        elif preva is not None:
+            assert isinstance(part, int)
+            span = np.subtract(t[a:b], t[a - part : b - part], out=buf["span"][:c])
+            np.subtract(cura, preva, out=ra)
+            np.divide(ra, span, out=ra)
+            np.multiply(ra, SECONDS_PER_MINUTE, out=ra)
+        else:
+            lo = cast(npt.NDArray[np.intp], part)
+            span = t[a:b] - t[lo]
+            ok = span > 0
+            ra.fill(0.0)
+            if ok.any():
+                partner = temps[lo[ok]][:, self.rows].T
+                ra[:, ok] = (cura[:, ok] - partner) / span[ok] * SECONDS_PER_MINUTE
+        rmin = ra.min(axis=1)
+        rmax = ra.max(axis=1)
+        seen.r_mins.append(rmin)
+        seen.r_maxs.append(rmax)
+        if self.clip_rates and (bool(np.any(rmin < self.r_lo1)) or bool(np.any(rmax > self.r_hi1))):
+            np.clip(ra, self.r_lo, self.r_hi, out=ra)
+
+    def _block(
+        self,
+        s0: int,
+        a: int,
+        b: int,
+        outs: list[FloatArray],
+        seen: _Seen,
+        buf: dict[str, FloatArray],
+    ) -> None:
+        """Steps 1–4 on rows ``a:b`` of the segment starting at ``s0``, into ``outs``."""
+        plan, t = self.plan, self.t
+        c = b - a
+        part: int | npt.NDArray[np.intp] | None = None
+        if plan.rate_sensors and self.rates is None:
+            part = backward_partners(t, s0, a, b, self.interval_s, increasing=self.increasing)
+        cur, prev = self._load_temperatures(a, b, part, buf)
         # step 2: the temperature range (every column, raw values)
         mins = cur.min(axis=1)
         maxs = cur.max(axis=1)
@@ -212,44 +260,9 @@ class _BlockEvaluator:
         else:
             ra = buf["rate"][:, :c]
         if plan.rate_sensors:
-            if self.rates is not None:  # forward / centred forms, computed beforehand
-                np.copyto(ra, self.rates[a:b, self.rows].T)
-            elif preva is not None:
-                assert isinstance(part, int)
-                span = np.subtract(t[a:b], t[a - part : b - part], out=buf["span"][:c])
-                np.subtract(cura, preva, out=ra)
-                np.divide(ra, span, out=ra)
-                np.multiply(ra, SECONDS_PER_MINUTE, out=ra)
-            else:
-                lo = cast(npt.NDArray[np.intp], part)
-                span = t[a:b] - t[lo]
-                ok = span > 0
-                ra.fill(0.0)
-                if ok.any():
-                    partner = temps[lo[ok]][:, self.rows].T
-                    ra[:, ok] = (cura[:, ok] - partner) / span[ok] * SECONDS_PER_MINUTE
-            rmin = ra.min(axis=1)
-            rmax = ra.max(axis=1)
-            seen.r_mins.append(rmin)
-            seen.r_maxs.append(rmax)
-            if self.clip_rates and (
-                bool(np.any(rmin < self.r_lo1)) or bool(np.any(rmax > self.r_hi1))
-            ):
-                np.clip(ra, self.r_lo, self.r_hi, out=ra)
+            self._rates(a, b, part, cura, preva, ra, seen, buf)
         # step 3: centred variables, stacked kind by kind
-        d: dict[str, FloatArray] = {}
-        for i, kind in enumerate(plan.kinds):
-            dk = dall[i * nr : (i + 1) * nr]
-            if kind == "u":
-                np.subtract(ta, plan.centres["u"], out=dk)
-            elif kind == "v":
-                if plan.centred["v"]:
-                    np.subtract(ra, plan.centres["v"], out=dk)
-            else:
-                np.multiply(ta, ra, out=dk)
-                if plan.centred["w"]:
-                    np.subtract(dk, plan.centres["w"], out=dk)
-            d[kind] = dk
+        d = _centred(plan, dall, ta, ra, nr)
         # step 4, per plan: on the centred variables themselves (one plan), or on a copy
         # of them for each plan (several plans of one structure: the same operations)
         if len(self.plans) == 1:
@@ -312,6 +325,27 @@ class _BlockEvaluator:
         np.add(s[0], plan.constant, out=o)
         for r in range(1, nr):
             np.add(o, s[r], out=o)
+
+
+def _centred(
+    plan: EvalPlan, dall: FloatArray, ta: FloatArray, ra: FloatArray, nr: int
+) -> dict[str, FloatArray]:
+    """Step 3 in place in ``dall``: ``d_u = T − c_T``, ``d_v = Ṫ − c_R`` (Ṫ itself when the
+    plan folded its centre, already computed there), ``d_w = T·Ṫ − c_W``, kind by kind."""
+    d: dict[str, FloatArray] = {}
+    for i, kind in enumerate(plan.kinds):
+        dk = dall[i * nr : (i + 1) * nr]
+        if kind == "u":
+            np.subtract(ta, plan.centres["u"], out=dk)
+        elif kind == "v":
+            if plan.centred["v"]:
+                np.subtract(ra, plan.centres["v"], out=dk)
+        else:
+            np.multiply(ta, ra, out=dk)
+            if plan.centred["w"]:
+                np.subtract(dk, plan.centres["w"], out=dk)
+        d[kind] = dk
+    return d
 
 
 def warn_temperature_range(
