@@ -84,6 +84,7 @@ from thermocal.adequacy import Needs
 from thermocal.errors import (
     ConditioningWarning,
     DesignError,
+    ModelFileError,
     ThermocalInputError,
 )
 from thermocal.models.base import (
@@ -95,6 +96,16 @@ from thermocal.models.base import (
     RunData,
     TemperatureModel,
     stream_channel,
+)
+from thermocal.models.checks import (
+    ascending,
+    fields,
+    key_path,
+    list_of,
+    number,
+    same_length,
+    sensor_param,
+    string,
 )
 from thermocal.models.warmup import CONDITION_WARN, channel_index, lstsq_svd, single_channel
 from thermocal.preprocess import segment_holds
@@ -582,6 +593,28 @@ class BankModel(TemperatureModel):
                     )
                 )
         return out
+
+    @classmethod
+    def check_state(cls, d: dict[str, Any], root: str = "") -> None:
+        """The ``state`` section of a bank model file: one or more models of at least two
+        ascending breakpoints with a value each; ``params.sensor`` one of the inputs."""
+        sensor_param(d, root)
+        state, path = d["state"], key_path(root, "state")
+        fields(
+            {
+                "sensor_name": string,
+                "models": list_of(
+                    fields({"breakpoints_c": ascending, "values": list_of(number)}), min_len=1
+                ),
+            },
+            optional={"startup_s": number, "deviation": number, "tolerance": number},
+        )(state, path)
+        for i, m in enumerate(state["models"]):
+            if len(m["breakpoints_c"]) < 2:
+                raise ModelFileError(f"{path}.models[{i}].breakpoints_c: needs at least 2 points")
+            same_length(
+                m, f"{path}.models[{i}]", "values", len(m["breakpoints_c"]), "one per point"
+            )
 
     def _state(self) -> dict[str, Any]:
         return {

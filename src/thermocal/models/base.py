@@ -578,6 +578,14 @@ class TemperatureModel(ABC):
     def _set_state(self, state: dict[str, Any]) -> None:
         """Inverse of :meth:`_state`."""
 
+    @classmethod  # noqa: B027 (an optional hook: the default checks nothing)
+    def check_state(cls, d: dict[str, Any], root: str = "") -> None:
+        """Check the ``state`` section of a model file of this family (the layout
+        :meth:`_state` writes) once the common sections passed
+        (:func:`thermocal.models.schema.check_model_dict`); raise
+        :class:`~thermocal.errors.ModelFileError` naming the key path, prefixed by ``root``.
+        The default checks nothing: a family's own module states its layout."""
+
     @classmethod
     def _param_names(cls) -> list[str]:
         sig = inspect.signature(cls.__init__)

@@ -66,6 +66,7 @@ from thermocal._lazy import LazyModule
 from thermocal.adequacy import Needs
 from thermocal.errors import (
     DesignError,
+    ModelFileError,
     ThermocalInputError,
     ThermocalWarning,
 )
@@ -78,6 +79,16 @@ from thermocal.models.base import (
     RunData,
     TemperatureModel,
     stream_channel,
+)
+from thermocal.models.checks import (
+    ascending,
+    fields,
+    integer,
+    key_path,
+    list_of,
+    matrix,
+    number,
+    same_length,
 )
 from thermocal.models.fitting import (
     OffsetDecision,
@@ -777,6 +788,22 @@ class PiecewiseModel(TemperatureModel):
         for i, b in enumerate(self.breakpoints_):
             out.append(Coefficient(f"breakpoint[{i + 1}]", float(b), None, "degC"))
         return out
+
+    @classmethod
+    def check_state(cls, d: dict[str, Any], root: str = "") -> None:
+        """The ``state`` section of a piecewise model file: ascending breakpoints, one
+        intercept and slope per segment, its column one of the inputs."""
+        state, path, n_temps = d["state"], key_path(root, "state"), len(d["temperatures"])
+        fields(
+            {"breakpoints": ascending, "intercepts": list_of(number), "slopes": list_of(number)},
+            optional={"column_index": integer, "offsets": list_of(number), "line_cov": matrix},
+        )(state, path)
+        n_lines = len(state["breakpoints"]) + 1
+        same_length(state, path, "intercepts", n_lines, "one per segment")
+        same_length(state, path, "slopes", n_lines, "one per segment")
+        col = state.get("column_index", 0)
+        if not 0 <= col < n_temps:
+            raise ModelFileError(f"{path}.column_index: {col} is not one of the {n_temps} inputs")
 
     def _state(self) -> dict[str, Any]:
         return {

@@ -101,12 +101,24 @@ from typing import Any, ClassVar, Self
 import numpy as np
 
 from thermocal.adequacy import Needs
-from thermocal.errors import ExtrapolationWarning, ThermocalInputError
+from thermocal.errors import ExtrapolationWarning, ModelFileError, ThermocalInputError
 from thermocal.models.base import (
     ChunkContext,
     Coefficient,
     ModelStream,
     RunData,
+)
+from thermocal.models.checks import (
+    boolean,
+    fields,
+    integer,
+    key_path,
+    list_of,
+    matrix,
+    near_range,
+    number,
+    same_length,
+    string,
 )
 from thermocal.models.fitting import (  # shared with piecewise; re-exported
     OffsetDecision as OffsetDecision,
@@ -169,6 +181,18 @@ from thermocal.models.terms import (
 )
 from thermocal.recording import GAP_FACTOR, FloatArray
 from thermocal.units import SECONDS_PER_MINUTE
+
+MAX_TERM_POWER = 32
+"""Highest power of a poly term's base variable accepted in a file (a polynomial of
+higher order in one temperature is no calibration; a power of 2⁵³ would make export-c
+and compensate run for ever)."""
+
+BASE_KEYS = (
+    "t_center", "t_scale", "rate_center", "rate_scale", "coupling_center", "coupling_scale"
+)  # fmt: skip
+"""The poly family's centre and scale of each base variable (:class:`~thermocal.models.
+terms.BaseScaling`), centres at even positions."""
+
 
 STATE_LAYOUT = "thermocal-poly-1"
 
@@ -324,6 +348,53 @@ class PolyModel(PolyBase):
                 name = "*".join(parts)
             out.append(Coefficient(name, float(v), float(e) if math.isfinite(e) else None, unit))
         return out
+
+    @classmethod
+    def check_state(cls, d: dict[str, Any], root: str = "") -> None:
+        """The ``state`` section of a poly model file (:meth:`_state`'s layout): centres and
+        scales per base variable (scales not 0), terms of powers 0…:data:`MAX_TERM_POWER` on
+        known sensors, one coefficient per term; a used centre in or near its fitted range."""
+        state, path, n_temps = d["state"], key_path(root, "state"), len(d["temperatures"])
+        fields(
+            {
+                "layout": string,
+                "base": list_of(fields({k: number for k in BASE_KEYS}), min_len=1),
+                "terms": list_of(
+                    fields({"sensor": integer, "t_power": integer, "rate_power": integer,
+                            "coupling_power": integer})
+                ),
+                "coef": list_of(number),
+                "constant": number,
+            },
+            optional={"offsets": list_of(number), "cov": matrix, "uses_rate": boolean,
+                      "n_sensors": integer},
+        )(state, path)  # fmt: skip
+        same_length(state, path, "coef", len(state["terms"]), "one per term")
+        for i, base in enumerate(state["base"]):
+            for key in BASE_KEYS[1::2]:
+                if base[key] == 0:
+                    raise ModelFileError(f"{path}.base[{i}].{key}: must not be 0")
+        for i, term in enumerate(state["terms"]):
+            for key in ("t_power", "rate_power", "coupling_power"):
+                if not 0 <= term[key] <= MAX_TERM_POWER:
+                    raise ModelFileError(
+                        f"{path}.terms[{i}].{key}: {term[key]} is not a power 0…{MAX_TERM_POWER}"
+                    )
+            if not 0 <= term["sensor"] < len(state["base"]):
+                raise ModelFileError(
+                    f"{path}.terms[{i}].sensor: {term['sensor']} is not one of the "
+                    f"{len(state['base'])} temperature inputs"
+                )
+        if len(state["base"]) > n_temps:
+            raise ModelFileError(
+                f"{path}.base: {len(state['base'])} temperature inputs but the file names {n_temps}"
+            )
+        ranges, temps = d["range"]["temperature_c"], d["temperatures"]
+        used = {t["sensor"] for t in state["terms"] if t["t_power"] or t["coupling_power"]}
+        for k in sorted(used):
+            lo, hi = ranges[temps[k]]
+            center = state["base"][k]["t_center"]
+            near_range(center, lo, hi, key_path(root, f"state.base[{k}].t_center"), "the centre")
 
     # -- state --
     def _state(self) -> dict[str, Any]:

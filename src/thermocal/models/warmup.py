@@ -78,6 +78,7 @@ from thermocal.errors import (
     ConditioningWarning,
     DesignError,
     ExtrapolationWarning,
+    ModelFileError,
     ThermocalInputError,
 )
 from thermocal.models.base import (
@@ -87,6 +88,16 @@ from thermocal.models.base import (
     ModelStream,
     RunData,
     TemperatureModel,
+)
+from thermocal.models.checks import (
+    fields,
+    integer,
+    interval,
+    key_path,
+    matrix,
+    number,
+    sensor_param,
+    string,
 )
 from thermocal.recording import FloatArray
 
@@ -702,6 +713,29 @@ class WarmupModel(TemperatureModel):
                     )
                 )
         return out
+
+    @classmethod
+    def check_state(cls, d: dict[str, Any], root: str = "") -> None:
+        """The ``state`` section of a warmup model file: ``b`` of (order + 1) × (t0_order +
+        1) (or without the constant row) finite numbers; ``params.sensor`` one of the inputs."""
+        sensor_param(d, root)
+        state, path = d["state"], key_path(root, "state")
+        fields(
+            {"b": matrix, "order": integer, "t0_order": integer, "sensor_name": string,
+             "t0_range_c": interval},
+            optional={"b_stderr": matrix, "start_window_s": number, "duration_range_s": interval},
+        )(state, path)  # fmt: skip
+        rows, cols = len(state["b"]), len(state["b"][0]) if state["b"] else 0
+        want = (state["order"] + 1, state["t0_order"] + 1)
+        if (rows, cols) not in (want, (want[0] - 1, want[1])):
+            raise ModelFileError(
+                f"{path}.b: expected a {want[0]}×{want[1]} (or {want[0] - 1}×{want[1]}, without "
+                f"the constant) matrix for order {state['order']} and t0_order "
+                f"{state['t0_order']}, got {rows}×{cols}"
+            )
+        for i, row in enumerate(state["b"]):
+            for j, v in enumerate(row):
+                number(v, f"{path}.b[{i}][{j}]")
 
     def _state(self) -> dict[str, Any]:
         return {
