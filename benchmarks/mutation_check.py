@@ -202,8 +202,8 @@ MUTANTS: tuple[Mutant, ...] = (
     ),
     Mutant(
         "schema-accepts-short-coefficients",
-        "src/thermocal/models/schema.py",
-        '    _same_length(state, path, "coef", len(state["terms"]), "one per term")\n',
+        "src/thermocal/models/poly.py",
+        '        same_length(state, path, "coef", len(state["terms"]), "one per term")\n',
         "",
         ("tests/attacks/test_attacks.py",),
         "model file with fewer coefficients than terms accepted",

@@ -11,10 +11,10 @@ import pytest
 
 from thermocal.cli import main
 from thermocal.errors import ThermocalInputError
-from thermocal.models import load_model
-from thermocal.models.base import MODEL_REGISTRY
+from thermocal.models.files import load_model
 from thermocal.models.piecewise import PiecewiseModel
 from thermocal.models.poly import PolyModel
+from thermocal.models.registry import MODEL_REGISTRY
 from thermocal.pipeline.fit import build_model
 from thermocal.recording import Recording
 from thermocal.writers import write_recording

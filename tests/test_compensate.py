@@ -38,15 +38,8 @@ from thermocal.errors import (
     TimestampError,
     UnitError,
 )
-from thermocal.models.base import (
-    MODEL_REGISTRY,
-    Coefficient,
-    FitStats,
-    ModelStream,
-    RunData,
-    TemperatureModel,
-    make_model,
-)
+from thermocal.models.base import Coefficient, FitStats, ModelStream, RunData, TemperatureModel
+from thermocal.models.registry import MODEL_REGISTRY, make_model
 from thermocal.preprocess import temperature_rate
 from thermocal.readers.common import csv_float_options
 from thermocal.recording import GAP_FACTOR, FloatArray

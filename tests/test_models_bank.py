@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from thermocal.errors import DesignError, ExtrapolationWarning, ThermocalInputError
-from thermocal.models import get_model_class, load_model, save_model
+from thermocal.models import get_model_class
 from thermocal.models.bank import (
     BankModel,
     Selection,
@@ -19,6 +19,7 @@ from thermocal.models.bank import (
     pwl_evaluate,
 )
 from thermocal.models.base import ModelStream, RunData
+from thermocal.models.files import load_model, save_model
 from thermocal.simulate import SCENARIOS
 
 OFFSETS = (0.0, 1.5, -2.0)

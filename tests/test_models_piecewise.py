@@ -17,7 +17,8 @@ from thermocal.errors import (
     ThermocalInputError,
     ThermocalWarning,
 )
-from thermocal.models import RunData, get_model_class, load_model, save_model
+from thermocal.models import RunData, get_model_class
+from thermocal.models.files import load_model, save_model
 from thermocal.models.piecewise import PiecewiseModel, evaluate_lines
 from thermocal.simulate import SCENARIOS
 

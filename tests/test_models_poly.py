@@ -12,7 +12,8 @@ from numpy.testing import assert_allclose, assert_array_equal
 
 from thermocal import simulate
 from thermocal.errors import DesignError, ExtrapolationWarning, ThermocalInputError
-from thermocal.models import RunData, get_model_class, load_model, save_model
+from thermocal.models import RunData, get_model_class
+from thermocal.models.files import load_model, save_model
 from thermocal.models.poly import PolyModel
 from thermocal.models.terms import (
     Term,

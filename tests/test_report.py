@@ -26,15 +26,9 @@ from numpy.testing import assert_allclose
 from scipy.signal import lfilter
 
 from thermocal.errors import ThermocalInputError
-from thermocal.models.base import (
-    MODEL_REGISTRY,
-    Coefficient,
-    FitStats,
-    ModelStream,
-    RunData,
-    TemperatureModel,
-)
+from thermocal.models.base import Coefficient, FitStats, ModelStream, RunData, TemperatureModel
 from thermocal.models.files import save_model
+from thermocal.models.registry import MODEL_REGISTRY
 from thermocal.recording import FloatArray, Metadata, Recording
 from thermocal.report import (
     ModelEntry,

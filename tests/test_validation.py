@@ -19,16 +19,9 @@ import pytest
 
 from thermocal.cli import main
 from thermocal.errors import CorrelationWarning, ExtrapolationWarning, ThermocalWarning
-from thermocal.models.base import (
-    MODEL_REGISTRY,
-    Coefficient,
-    FitStats,
-    ModelStream,
-    RunData,
-    TemperatureModel,
-    make_model,
-)
+from thermocal.models.base import Coefficient, FitStats, ModelStream, RunData, TemperatureModel
 from thermocal.models.files import save_model
+from thermocal.models.registry import MODEL_REGISTRY, make_model
 from thermocal.profiles import common_base
 from thermocal.recording import FloatArray, Recording
 from thermocal.simulate import SCENARIOS

@@ -16,9 +16,9 @@ for the methods each module implements.
 
 from __future__ import annotations
 
-__version__ = "0.1.0"
-
 from typing import TYPE_CHECKING, Any
+
+from thermocal._version import __version__
 
 if TYPE_CHECKING:
     from thermocal.readers.dispatch import read_recording

@@ -752,6 +752,121 @@ def finite_extrema(arr: FloatArray, block: int = DIFF_BLOCK) -> Extrema | None:
     return Extrema(best[0], best[1], best[2], best[3], best[4])
 
 
+def _temperature_problems(rec: Recording, name: str) -> list[Problem]:
+    """A constant temperature column (warning), one below absolute zero (error) or
+    outside the plausible range in °C (warning, with the likely cause)."""
+    probs: list[Problem] = []
+    arr = rec.columns.get(name)
+    if arr is None or not rec.units.get(name):
+        return probs
+    ext = finite_extrema(arr)
+    if ext is not None and ext.count >= 2 and ext.hi == ext.lo:
+        probs.append(
+            Problem(
+                "implausible_constant_temperature",
+                f"temperature column {name!r} is constant ({ext.lo:.6g} "
+                f"{rec.units[name]}): no temperature dependence can be seen in it",
+                severity="warning",
+                column=name,
+            )
+        )
+    try:
+        temp = rec.temperature_c(name)
+    except units.ConversionOverflowError:
+        raise  # a finite count beyond float64 once converted: no °C to check
+    except ThermocalInputError:
+        return probs  # raw counts without a conversion: checked where they are used
+    ext = finite_extrema(temp)
+    if ext is None:
+        return probs
+    lo_row, hi_row, lo, hi = ext.lo_row, ext.hi_row, ext.lo, ext.hi
+    if lo < ABSOLUTE_ZERO_C:
+        probs.append(
+            Problem(
+                "implausible_temperature",
+                f"temperature column {name!r} reads {lo:.6g} °C at row {lo_row}, below "
+                "absolute zero (−273.15 °C): a wrong unit, offset or conversion",
+                column=name,
+                row=lo_row,
+            )
+        )
+        return probs
+    a, b = PLAUSIBLE_TEMPERATURE_C
+    if lo < a or hi > b:
+        bad_row, bad = (hi_row, hi) if hi > b else (lo_row, lo)
+        vals = temp[np.isfinite(temp)]  # only on this warning's path
+        if lo >= 173.0 and hi <= 473.0:
+            hint = "kelvin? give the data in °C"
+        elif np.all(vals == np.round(vals)) and hi > 1000.0:
+            hint = "raw ADC counts? give --temp-unit counts and --temp-conversion"
+        else:
+            hint = "check the unit and the conversion"
+        probs.append(
+            Problem(
+                "implausible_temperature",
+                f"temperature column {name!r} reads {bad:.6g} °C at row {bad_row}, "
+                f"outside {a:g}…{b:+g} °C ({hint})",
+                severity="warning",
+                column=name,
+                row=bad_row,
+            )
+        )
+    return probs
+
+
+def _signal_problems(rec: Recording, name: str) -> list[Problem]:
+    """The first value of a signal column beyond any sensor once in its canonical unit
+    (an error naming the row), scanned in blocks of :data:`DIFF_BLOCK` rows."""
+    probs: list[Problem] = []
+    arr = rec.columns.get(name)
+    unit = rec.units.get(name)
+    if arr is None or not unit:
+        return probs
+    try:
+        kind = units.signal_kind(unit)
+    except UnitError:
+        return probs
+    found: tuple[int, float] | None = None  # (row, value in the canonical unit)
+    to_physical = _physical_of_counts(rec) if kind == "raw" else None
+    if to_physical is not None:
+        canon_unit = to_physical(arr[:1])[1]
+        limit = PLAUSIBLE_SIGNAL["rate" if canon_unit == "deg/h" else "accel"]
+    elif kind == "raw":
+        canon_unit, limit = unit, PLAUSIBLE_COUNTS  # counts stay counts
+    else:
+        canon_unit, limit = units.canonical_unit(unit), PLAUSIBLE_SIGNAL[kind]
+    for a0 in range(0, arr.size, DIFF_BLOCK):  # in blocks: bounded working memory
+        part = arr[a0 : a0 + DIFF_BLOCK]
+        with np.errstate(over="ignore", invalid="ignore"):
+            if kind != "raw":
+                canon, _ = units.to_canonical(part, unit, finite=False)
+            elif to_physical is None:
+                canon = part
+            else:
+                canon = to_physical(part)[0]
+        finite_in = np.isfinite(part)
+        beyond = finite_in & ~(np.abs(canon) <= limit)  # inf or too big
+        if beyond.any():
+            i = int(np.argmax(beyond))
+            found = (a0 + i, float(canon[i]))
+            break
+    if found is not None:
+        row = found[0]
+        canon_row = found[1]
+        probs.append(
+            Problem(
+                "implausible_signal",
+                f"signal column {name!r} reads {float(arr[row]):.6g} {unit} at row {row} "
+                f"({canon_row:.6g} {canon_unit}), beyond any sensor "
+                f"(|value| ≤ {limit:g} {canon_unit}): wrong unit, scale factor or "
+                "corrupt data",
+                column=name,
+                row=row,
+            )
+        )
+    return probs
+
+
 def plausibility_problems(rec: Recording) -> list[Problem]:
     """Values no sensor or chamber produces, named by column, value and row (issue 14).
 
@@ -772,108 +887,9 @@ def plausibility_problems(rec: Recording) -> list[Problem]:
             )
         )
     for name in rec.temperatures:
-        arr = rec.columns.get(name)
-        if arr is None or not rec.units.get(name):
-            continue
-        ext = finite_extrema(arr)
-        if ext is not None and ext.count >= 2 and ext.hi == ext.lo:
-            probs.append(
-                Problem(
-                    "implausible_constant_temperature",
-                    f"temperature column {name!r} is constant ({ext.lo:.6g} "
-                    f"{rec.units[name]}): no temperature dependence can be seen in it",
-                    severity="warning",
-                    column=name,
-                )
-            )
-        try:
-            temp = rec.temperature_c(name)
-        except units.ConversionOverflowError:
-            raise  # a finite count beyond float64 once converted: no °C to check
-        except ThermocalInputError:
-            continue  # raw counts without a conversion: checked where they are used
-        ext = finite_extrema(temp)
-        if ext is None:
-            continue
-        lo_row, hi_row, lo, hi = ext.lo_row, ext.hi_row, ext.lo, ext.hi
-        if lo < ABSOLUTE_ZERO_C:
-            probs.append(
-                Problem(
-                    "implausible_temperature",
-                    f"temperature column {name!r} reads {lo:.6g} °C at row {lo_row}, below "
-                    "absolute zero (−273.15 °C): a wrong unit, offset or conversion",
-                    column=name,
-                    row=lo_row,
-                )
-            )
-            continue
-        a, b = PLAUSIBLE_TEMPERATURE_C
-        if lo < a or hi > b:
-            bad_row, bad = (hi_row, hi) if hi > b else (lo_row, lo)
-            vals = temp[np.isfinite(temp)]  # only on this warning's path
-            if lo >= 173.0 and hi <= 473.0:
-                hint = "kelvin? give the data in °C"
-            elif np.all(vals == np.round(vals)) and hi > 1000.0:
-                hint = "raw ADC counts? give --temp-unit counts and --temp-conversion"
-            else:
-                hint = "check the unit and the conversion"
-            probs.append(
-                Problem(
-                    "implausible_temperature",
-                    f"temperature column {name!r} reads {bad:.6g} °C at row {bad_row}, "
-                    f"outside {a:g}…{b:+g} °C ({hint})",
-                    severity="warning",
-                    column=name,
-                    row=bad_row,
-                )
-            )
+        probs.extend(_temperature_problems(rec, name))
     for name in rec.signals:
-        arr = rec.columns.get(name)
-        unit = rec.units.get(name)
-        if arr is None or not unit:
-            continue
-        try:
-            kind = units.signal_kind(unit)
-        except UnitError:
-            continue
-        found: tuple[int, float] | None = None  # (row, value in the canonical unit)
-        to_physical = _physical_of_counts(rec) if kind == "raw" else None
-        if to_physical is not None:
-            canon_unit = to_physical(arr[:1])[1]
-            limit = PLAUSIBLE_SIGNAL["rate" if canon_unit == "deg/h" else "accel"]
-        elif kind == "raw":
-            canon_unit, limit = unit, PLAUSIBLE_COUNTS  # counts stay counts
-        else:
-            canon_unit, limit = units.canonical_unit(unit), PLAUSIBLE_SIGNAL[kind]
-        for a0 in range(0, arr.size, DIFF_BLOCK):  # in blocks: bounded working memory
-            part = arr[a0 : a0 + DIFF_BLOCK]
-            with np.errstate(over="ignore", invalid="ignore"):
-                if kind != "raw":
-                    canon, _ = units.to_canonical(part, unit, finite=False)
-                elif to_physical is None:
-                    canon = part
-                else:
-                    canon = to_physical(part)[0]
-            finite_in = np.isfinite(part)
-            beyond = finite_in & ~(np.abs(canon) <= limit)  # inf or too big
-            if beyond.any():
-                i = int(np.argmax(beyond))
-                found = (a0 + i, float(canon[i]))
-                break
-        if found is not None:
-            row = found[0]
-            canon_row = found[1]
-            probs.append(
-                Problem(
-                    "implausible_signal",
-                    f"signal column {name!r} reads {float(arr[row]):.6g} {unit} at row {row} "
-                    f"({canon_row:.6g} {canon_unit}), beyond any sensor "
-                    f"(|value| ≤ {limit:g} {canon_unit}): wrong unit, scale factor or "
-                    "corrupt data",
-                    column=name,
-                    row=row,
-                )
-            )
+        probs.extend(_signal_problems(rec, name))
     probs.extend(_accelerometer_magnitude_problems(rec))
     probs.extend(_sample_interval_problems(rec))
     return probs

@@ -32,6 +32,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from thermocal.cli import main
+from thermocal.defaults import MODEL_FAMILIES
 
 COMMANDS: dict[str, list[str]] = {
     "compensate": ["compensate", "{m}", "{d}", "-o", "{o}/comp.csv"],
@@ -40,7 +41,8 @@ COMMANDS: dict[str, list[str]] = {
     "export-params": ["export-params", "{m}", "--format", "px4", "-o", "{o}/tc.params"],
     "report": ["report", "--model", "{m}", "--recording", "{d}", "-o", "{o}/report.html"],
 }
-KINDS = ("poly", "piecewise", "warmup", "bank", "calibration", "triads")
+KINDS = (*MODEL_FAMILIES, "calibration", "triads")
+"""Every registered model family (thermocal.defaults.MODEL_FAMILIES), and the calibrations."""
 
 UNITS = ["--time-unit", "s", "--temp-unit", "degC"]
 

@@ -23,27 +23,6 @@ import typer
 from thermocal.cli.application import app as _app
 from thermocal.cli.interrupt import report_interrupted
 
-COMMAND_MODULES = (
-    "inspect_cmd",
-    "metrics_cmd",
-    "allan_cmd",
-    "noise_cmd",
-    "profile_cmd",
-    "simulate_cmd",
-    "fit_cmd",
-    "compensate_cmd",
-    "validate_cmd",
-    "export_cmd",
-    "tempcal_cmd",
-    "turntable_cmd",
-    "multipos_cmd",
-    "report_cmd",
-    "fleet_cmd",
-    "demo_cmd",
-    "station_cmd",
-)
-"""Command modules, registered in this order (a missing module is skipped)."""
-
 COMMANDS: dict[str, str] = {
     "inspect": "inspect_cmd",
     "metrics": "metrics_cmd",
@@ -65,7 +44,12 @@ COMMANDS: dict[str, str] = {
     "demo": "demo_cmd",
     "station": "station_cmd",
 }
-"""The module of every command (a test checks it against what the modules register)."""
+"""The one list of commands: each command's module (a test checks it against what the
+modules register).  Everything else that lists commands derives from it."""
+
+COMMAND_MODULES: tuple[str, ...] = tuple(dict.fromkeys(COMMANDS.values()))
+"""Command modules, registered in this order (a missing module is skipped): the modules of
+:data:`COMMANDS`, in its order."""
 
 _REGISTERED: set[str] = set()
 

@@ -8,7 +8,7 @@ several runs, each with its own turn-on offset unless ``--no-per-run-offset``)
 and writes the self-describing model file (:func:`thermocal.models.files.save_model`)
 with the data files' names and SHA-256 checksums.
 
-The family is looked up in the registry (:func:`thermocal.models.base.get_model_class`).
+The family is looked up in the registry (:func:`thermocal.models.registry.get_model_class`).
 The command collects the model options the user gave into one dict and calls
 ``cls.from_cli_options(options)``, the one option parser of every family
 restricted to its constructor parameters.  Only options given on the command
@@ -81,6 +81,7 @@ from thermocal.cli.common import (
     handle_errors,
     stdout,
 )
+from thermocal.defaults import MODEL_FAMILIES
 from thermocal.pipeline.options import FitOptions, options_of
 
 if TYPE_CHECKING:
@@ -99,7 +100,7 @@ FilesArg = Annotated[
 ]
 
 FamilyOpt = Annotated[
-    str, typer.Option("--model", help="Model family: poly, piecewise, warmup, bank.")
+    str, typer.Option("--model", help=f"Model family: {', '.join(MODEL_FAMILIES)}.")
 ]
 
 OutputOpt = Annotated[Path, typer.Option("-o", "--output", help="Model file to write (JSON).")]

@@ -73,7 +73,7 @@ from __future__ import annotations
 import bisect
 import math
 import warnings
-from collections.abc import Mapping, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, ClassVar, Self
 
@@ -84,6 +84,7 @@ from thermocal.adequacy import Needs
 from thermocal.errors import (
     ConditioningWarning,
     DesignError,
+    ModelFileError,
     ThermocalInputError,
 )
 from thermocal.models.base import (
@@ -94,8 +95,17 @@ from thermocal.models.base import (
     ModelStream,
     RunData,
     TemperatureModel,
-    register,
     stream_channel,
+)
+from thermocal.models.checks import (
+    ascending,
+    fields,
+    key_path,
+    list_of,
+    number,
+    same_length,
+    sensor_param,
+    string,
 )
 from thermocal.models.warmup import CONDITION_WARN, channel_index, lstsq_svd, single_channel
 from thermocal.preprocess import segment_holds
@@ -220,7 +230,6 @@ def _selection(dev: FloatArray, n: int, complete: bool) -> Selection:
 # --- the model ------------------------------------------------------------------------------
 
 
-@register
 class BankModel(TemperatureModel):
     """Bank of piecewise-linear models, one per characteristic curve, chosen at
     power-on (SPEC §4d, seed 004).
@@ -277,14 +286,6 @@ class BankModel(TemperatureModel):
         j = self.sensor if 0 <= self.sensor < len(temp_names) else 0
         return Needs({temp_names[j]: 1} if temp_names else {}, 2)
 
-    CLI_KEYS: ClassVar[Mapping[str, str] | None] = {
-        k: k
-        for k in (
-            "deviation", "tolerance", "startup_s", "sensor", "knot_spacing_c", "grid_step_c",
-            "hold_min_s", "error_metric",
-        )
-    }  # fmt: skip
-
     def chunk_context(self) -> ChunkContext:
         """The model is chosen from the first ``startup_s`` seconds after power-on."""
         w = float(self.startup_s)
@@ -324,23 +325,7 @@ class BankModel(TemperatureModel):
         ys = [r.target() for r in one]
         labels = [r.name or f"run {i}" for i, r in enumerate(one)]
 
-        lo = np.array([t.min() for t in temps])
-        hi = np.array([t.max() for t in temps])
-        t_lo, t_hi = float(lo.min()), float(hi.max())
-        slack = 2.0 * float(self.grid_step_c)
-        short = [i for i in range(len(one)) if lo[i] > t_lo + slack or hi[i] < t_hi - slack]
-        if short:
-            ranges = "; ".join(f"{labels[i]} {lo[i]:.1f}…{hi[i]:.1f} °C" for i in range(len(one)))
-            raise DesignError(
-                f"bank: the runs cover different temperature ranges ({ranges}); every run "
-                f"must cover {t_lo:.1f}…{t_hi:.1f} °C to within {slack:g} °C, because the "
-                "characteristic curves are compared at the same temperatures"
-            )
-        if not t_hi - t_lo > self.grid_step_c:
-            raise DesignError(
-                f"bank: the runs span only {t_hi - t_lo:.2f} °C; at least more than one "
-                f"grid step ({self.grid_step_c:g} °C) is needed"
-            )
+        t_lo, t_hi = self._common_range(temps, labels)
 
         # 1-2: binned curves and clustering
         nb = max(1, math.ceil((t_hi - t_lo) / self.grid_step_c))
@@ -364,52 +349,17 @@ class BankModel(TemperatureModel):
         resid_sq = 0.0
         n_res = 0
         for g in groups:
-            tg = np.concatenate([temps[i] for i in g])
-            yg = np.concatenate([ys[i] for i in g])
-            x = hat_basis(knots, tg)
-            res = lstsq_svd(x, yg)
-            if res.rank < nk:
-                empty = [c for c in res.null_columns]
-                where = ", ".join(f"{knots[c]:.1f} °C" for c in empty)
-                raise DesignError(
-                    f"bank: group of {', '.join(labels[i] for i in g)}: no data to determine "
-                    f"the piecewise-linear value(s) at {where}; increase knot_spacing_c"
-                )
-            cond = max(cond, res.condition_number)
-            values = res.coef
-            se = (
-                np.sqrt(np.maximum(np.diag(res.cov_unit) * float(res.sigma2), 0.0))
-                if res.dof > 0
-                else None
+            entry, values, se, cond_g, rss_g = self._fit_group(
+                g, one, temps, ys, labels, knots, curves, curve_t
             )
-            # 4: check against the characteristic lines
-            pts_t, pts_y, check = self._characteristic_points(
-                [one[i] for i in g],
-                [temps[i] for i in g],
-                [ys[i] for i in g],
-                curves[g],
-                curve_t[g],
-            )
-            err = pts_y - pwl_evaluate(knots, values, pts_t)
-            fit_error = (
-                float(np.max(np.abs(err)))
-                if self.error_metric == "max"
-                else float(np.sqrt(np.mean(err**2)))
-            )
-            entry = {
-                "runs": [labels[i] for i in g],
-                "fit_error": fit_error,
-                "check": check,
-                "n_check_points": int(pts_t.size),
-            }
-            if fit_error < self.tolerance:
+            cond = max(cond, cond_g)
+            if rss_g is not None:
                 kept_b.append(knots.copy())
                 kept_v.append(values)
                 kept_se.append(se)
                 info.append(entry)
-                r = yg - x @ values
-                resid_sq += float(np.sum(r**2))
-                n_res += r.size
+                resid_sq += rss_g[0]
+                n_res += rss_g[1]
             else:
                 rejected.append(entry)
         if not kept_v:
@@ -454,6 +404,87 @@ class BankModel(TemperatureModel):
             ),
         )
         return self
+
+    def _common_range(self, temps: list[FloatArray], labels: list[str]) -> tuple[float, float]:
+        """The temperature range every run covers (to within two grid steps) [°C]; runs
+        over different ranges, or a span of one grid step or less, are a design error."""
+        lo = np.array([t.min() for t in temps])
+        hi = np.array([t.max() for t in temps])
+        t_lo, t_hi = float(lo.min()), float(hi.max())
+        slack = 2.0 * float(self.grid_step_c)
+        short = [i for i in range(len(temps)) if lo[i] > t_lo + slack or hi[i] < t_hi - slack]
+        if short:
+            ranges = "; ".join(f"{labels[i]} {lo[i]:.1f}…{hi[i]:.1f} °C" for i in range(len(temps)))
+            raise DesignError(
+                f"bank: the runs cover different temperature ranges ({ranges}); every run "
+                f"must cover {t_lo:.1f}…{t_hi:.1f} °C to within {slack:g} °C, because the "
+                "characteristic curves are compared at the same temperatures"
+            )
+        if not t_hi - t_lo > self.grid_step_c:
+            raise DesignError(
+                f"bank: the runs span only {t_hi - t_lo:.2f} °C; at least more than one "
+                f"grid step ({self.grid_step_c:g} °C) is needed"
+            )
+        return t_lo, t_hi
+
+    def _fit_group(
+        self,
+        g: list[int],
+        one: list[RunData],
+        temps: list[FloatArray],
+        ys: list[FloatArray],
+        labels: list[str],
+        knots: FloatArray,
+        curves: FloatArray,
+        curve_t: FloatArray,
+    ) -> tuple[dict[str, Any], FloatArray, FloatArray | None, float, tuple[float, int] | None]:
+        """Step 3–4 for one group: the piecewise-linear values at the knots (least squares
+        on the group's samples) and their fit error against the characteristic lines;
+        returns (entry, values, standard errors, condition number, (RSS, n) of the samples
+        when the fit error is below the tolerance, else None)."""
+        nk = knots.size
+        tg = np.concatenate([temps[i] for i in g])
+        yg = np.concatenate([ys[i] for i in g])
+        x = hat_basis(knots, tg)
+        res = lstsq_svd(x, yg)
+        if res.rank < nk:
+            empty = [c for c in res.null_columns]
+            where = ", ".join(f"{knots[c]:.1f} °C" for c in empty)
+            raise DesignError(
+                f"bank: group of {', '.join(labels[i] for i in g)}: no data to determine "
+                f"the piecewise-linear value(s) at {where}; increase knot_spacing_c"
+            )
+        values = res.coef
+        se = (
+            np.sqrt(np.maximum(np.diag(res.cov_unit) * float(res.sigma2), 0.0))
+            if res.dof > 0
+            else None
+        )
+        # 4: check against the characteristic lines
+        pts_t, pts_y, check = self._characteristic_points(
+            [one[i] for i in g],
+            [temps[i] for i in g],
+            [ys[i] for i in g],
+            curves[g],
+            curve_t[g],
+        )
+        err = pts_y - pwl_evaluate(knots, values, pts_t)
+        fit_error = (
+            float(np.max(np.abs(err)))
+            if self.error_metric == "max"
+            else float(np.sqrt(np.mean(err**2)))
+        )
+        entry = {
+            "runs": [labels[i] for i in g],
+            "fit_error": fit_error,
+            "check": check,
+            "n_check_points": int(pts_t.size),
+        }
+        kept = None
+        if fit_error < self.tolerance:
+            r = yg - x @ values
+            kept = (float(np.sum(r**2)), int(r.size))
+        return entry, values, se, float(res.condition_number), kept
 
     def _characteristic_points(
         self,
@@ -562,6 +593,28 @@ class BankModel(TemperatureModel):
                     )
                 )
         return out
+
+    @classmethod
+    def check_state(cls, d: dict[str, Any], root: str = "") -> None:
+        """The ``state`` section of a bank model file: one or more models of at least two
+        ascending breakpoints with a value each; ``params.sensor`` one of the inputs."""
+        sensor_param(d, root)
+        state, path = d["state"], key_path(root, "state")
+        fields(
+            {
+                "sensor_name": string,
+                "models": list_of(
+                    fields({"breakpoints_c": ascending, "values": list_of(number)}), min_len=1
+                ),
+            },
+            optional={"startup_s": number, "deviation": number, "tolerance": number},
+        )(state, path)
+        for i, m in enumerate(state["models"]):
+            if len(m["breakpoints_c"]) < 2:
+                raise ModelFileError(f"{path}.models[{i}].breakpoints_c: needs at least 2 points")
+            same_length(
+                m, f"{path}.models[{i}]", "values", len(m["breakpoints_c"]), "one per point"
+            )
 
     def _state(self) -> dict[str, Any]:
         return {

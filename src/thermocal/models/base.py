@@ -4,8 +4,9 @@ Estimator contract (STYLE.md, after scikit-learn): ``__init__`` only stores its
 keyword arguments; ``fit(runs)`` validates, learns values whose names end in
 ``_`` and returns ``self``; ``predict(run)`` returns the temperature-induced
 signal (bias, or scale-factor error, SPEC §4e) in the signal's canonical unit;
-``get_params()`` returns the constructor arguments.  Families register by name
-in :data:`MODEL_REGISTRY` with :func:`register` (STYLE rule 8).
+``get_params()`` returns the constructor arguments.  The families are listed by name in
+the one registry, :data:`thermocal.models.registry.MODEL_REGISTRY` (STYLE rule 8), which
+sits above them: this module knows no family.
 
 A model file is a self-describing, versioned JSON object (SPEC §8)::
 
@@ -47,7 +48,7 @@ hand-edited file is refused).  The checksum guards against accidents (truncation
 hand edit, a bit flip), not against tampering: anyone can recompute it.  So the content
 is checked too, before anything uses it: the reader's bounds (:mod:`thermocal.models.
 filecheck`: 64 MiB, nesting depth 32, finite numbers only, integers within ±2⁵³) and each
-section's types and shapes (:mod:`thermocal.models.schema`; triads:
+section's types and shapes (:func:`thermocal.models.schema.verify_model_dict`; triads:
 :func:`thermocal.turntable.thermal.check_triad_dict`), every error naming the key path.
 """
 
@@ -64,7 +65,7 @@ import warnings
 from abc import ABC, abstractmethod
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
-from typing import Any, ClassVar, Literal, Self, TypeVar
+from typing import Any, ClassVar, Literal, Self
 
 import numpy as np
 
@@ -577,6 +578,14 @@ class TemperatureModel(ABC):
     def _set_state(self, state: dict[str, Any]) -> None:
         """Inverse of :meth:`_state`."""
 
+    @classmethod  # noqa: B027 (an optional hook: the default checks nothing)
+    def check_state(cls, d: dict[str, Any], root: str = "") -> None:
+        """Check the ``state`` section of a model file of this family (the layout
+        :meth:`_state` writes) once the common sections passed
+        (:func:`thermocal.models.schema.check_model_dict`); raise
+        :class:`~thermocal.errors.ModelFileError` naming the key path, prefixed by ``root``.
+        The default checks nothing: a family's own module states its layout."""
+
     @classmethod
     def _param_names(cls) -> list[str]:
         sig = inspect.signature(cls.__init__)
@@ -587,17 +596,24 @@ class TemperatureModel(ABC):
     C code (imported only by ``export-c``); None: no C export."""
 
     CLI_KEYS: ClassVar[Mapping[str, str] | None] = None
-    """``thermocal fit`` option key → constructor parameter; None: the constructor's own
-    parameter names.  The one option parser, :meth:`from_cli_options`, refuses the rest."""
+    """``thermocal fit`` option key → constructor parameter; None (every family of the
+    registry): the constructor's own parameter names.  The one option parser,
+    :meth:`from_cli_options`, refuses the rest."""
+
+    @classmethod
+    def cli_keys(cls) -> dict[str, str]:
+        """``thermocal fit`` option key → constructor parameter: :attr:`CLI_KEYS`, else the
+        constructor's own parameter names, in its order."""
+        if cls.CLI_KEYS is not None:
+            return dict(cls.CLI_KEYS)
+        return {p: p for p in cls._param_names()}
 
     @classmethod
     def from_cli_options(cls, options: Mapping[str, Any]) -> Self:
         """Build from the ``thermocal fit`` option dict: ``None`` values are options not
         given; a given option the family does not take is an input error naming it and
         the options the family does take (the same rule for every family)."""
-        keys = (
-            dict(cls.CLI_KEYS) if cls.CLI_KEYS is not None else {p: p for p in cls._param_names()}
-        )
+        keys = cls.cli_keys()
         given = {k: v for k, v in options.items() if v is not None}
         unknown = [k for k in given if k not in keys]
         if unknown:
@@ -707,7 +723,7 @@ class TemperatureModel(ABC):
     # -- files --
     def to_dict(self) -> dict[str, Any]:
         """The model file's content (without checksum)."""
-        from thermocal import __version__
+        from thermocal._version import __version__
 
         self.check_fitted()
         params = _jsonify(self.get_params())
@@ -776,11 +792,17 @@ class TemperatureModel(ABC):
         return out
 
     @classmethod
-    def from_dict(cls, d: dict[str, Any]) -> TemperatureModel:
-        """Rebuild a fitted model from :meth:`to_dict` output (checks format and family)."""
+    def from_dict(cls, d: dict[str, Any]) -> Self:
+        """Rebuild a fitted model of this family from :meth:`to_dict` output (checks the
+        format and that the dict is of this family).  A dict of any registered family:
+        :func:`thermocal.models.registry.model_from_dict`."""
         check_model_header(d)
-        klass = get_model_class(str(d["family"]))
-        model = klass(**d.get("params", {}))
+        if not cls.family or str(d["family"]) != cls.family:
+            raise ModelFileError(
+                f"a model of family {d['family']!r} is not a {cls.family or cls.__name__!r} "
+                "model (thermocal.models.registry.model_from_dict reads any family)"
+            )
+        model = cls(**d.get("params", {}))
         model._set_state(d["state"])
         model.temp_names_ = tuple(d["temperatures"])
         tr = d["range"]["temperature_c"]
@@ -819,38 +841,6 @@ class TemperatureModel(ABC):
         # files before format version 3 were always fitted in °C (and say so)
         model.temperature_unit = normalize_temperature_unit(str(tu or LEGACY_TEMPERATURE_UNIT))
         return model
-
-
-# --- registry --------------------------------------------------------------------------------
-
-MODEL_REGISTRY: dict[str, type[TemperatureModel]] = {}
-"""Model families by name (``poly``, ``piecewise``, ``warmup``, ``bank``)."""
-
-M = TypeVar("M", bound=type[TemperatureModel])
-
-
-def register(cls: M) -> M:
-    """Class decorator: add a family to :data:`MODEL_REGISTRY` under ``cls.family``."""
-    if not cls.family:
-        raise TypeError(f"{cls.__name__} has no family name")
-    MODEL_REGISTRY[cls.family] = cls
-    return cls
-
-
-def get_model_class(family: str) -> type[TemperatureModel]:
-    """The class of a registered family, or :class:`ModelFileError` naming the known ones."""
-    _load_families()
-    try:
-        return MODEL_REGISTRY[family]
-    except KeyError:
-        raise ModelFileError(
-            f"unknown model family {family!r}; known: {', '.join(sorted(MODEL_REGISTRY))}"
-        ) from None
-
-
-def _load_families() -> None:
-    # importing the package registers every family
-    import thermocal.models  # noqa: F401
 
 
 # --- file I/O ------------------------------------------------------------------------------
@@ -925,41 +915,6 @@ def model_file_dict(model: TemperatureModel) -> dict[str, Any]:
         )
     d["checksum"] = checksum(d)
     return d
-
-
-def verify_model_dict(d: Any, where: str, root: str = "") -> dict[str, Any]:
-    """Check a parsed model dict: header (format, version, sections), checksum and the
-    family's schema (:func:`thermocal.models.schema.check_model_dict`); errors name
-    ``where`` (the file) and the key path, prefixed by ``root`` (``channels[0].model`` in a
-    calibration).
-
-    The checksum guards against accidents (truncation, a hand edit, a bit flip), not
-    against tampering: anyone can recompute it, so the content is checked as well."""
-    at = f"{where}: {root}" if root else where
-    try:
-        check_model_header(d)
-    except ModelFileError as exc:
-        raise ModelFileError(f"{at}: {exc}") from None
-    stored = d.get("checksum")
-    if stored is None:
-        raise ModelFileError(f"{at}: model file has no checksum")
-    if stored != checksum(d):
-        raise ModelFileError(
-            f"{at}: checksum mismatch: the model file was corrupted or edited by hand"
-        )
-    from thermocal.models.schema import check_model_dict
-
-    try:
-        check_model_dict(d, root)
-    except ModelFileError as exc:
-        raise ModelFileError(f"{where}: {exc}") from None
-    out: dict[str, Any] = d
-    return out
-
-
-def make_model(family: str, **params: Any) -> TemperatureModel:
-    """Instantiate a registered family with parameters."""
-    return get_model_class(family)(**params)
 
 
 # --- applicability: how far a run leaves the calibrated ranges --------------------------------

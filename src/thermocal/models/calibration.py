@@ -34,8 +34,9 @@ from thermocal.models.base import (
     TemperatureModel,
     checksum,
     model_file_dict,
-    verify_model_dict,
 )
+from thermocal.models.registry import model_from_dict
+from thermocal.models.schema import verify_model_dict
 
 CALIBRATION_FORMAT = "thermocal-calibration"
 CALIBRATION_FORMAT_VERSION = 1
@@ -130,7 +131,7 @@ class Calibration:
 
     def to_dict(self) -> dict[str, Any]:
         """The file's dict, with every model's own checksum and the calibration's."""
-        from thermocal import __version__
+        from thermocal._version import __version__
 
         d: dict[str, Any] = {
             "format": CALIBRATION_FORMAT,
@@ -205,7 +206,7 @@ def calibration_from_dict(d: dict[str, Any], where: str) -> Calibration:
             raise ModelFileError(f"{at}.role: expected null or {{'kind': gyro|accel, ...}}")
         md = verify_model_dict(ch["model"], where, f"channels[{i}].model")
         try:
-            model = TemperatureModel.from_dict(md)
+            model = model_from_dict(md)
         except (KeyError, TypeError, ValueError) as exc:
             raise ModelFileError(f"{at}.model: malformed ({type(exc).__name__}: {exc})") from None
         channels.append(Channel(ch["name"], ch["signal"], ch["unit"], model, role))
@@ -277,14 +278,6 @@ def merged_inputs(cal: Calibration, names: Sequence[str] | None = None) -> dict[
         out.update(inp)
     out["units"] = units_
     out["temperature_conversion"] = conv
-    return out
-
-
-def channels_of(signals: Sequence[str], names: Sequence[str] | None = None) -> list[str]:
-    """Channel names for signal columns (the column names unless ``names`` are given)."""
-    out = list(names) if names else list(signals)
-    if len(out) != len(signals):
-        raise ThermocalInputError(f"{len(out)} channel names for {len(signals)} signals")
     return out
 
 

@@ -2,7 +2,7 @@
 
 The maths modules (:mod:`thermocal.models.base`, the families, :mod:`thermocal.models.
 calibration`) build and check plain dicts (:func:`~thermocal.models.base.model_file_dict`,
-:func:`~thermocal.models.base.verify_model_dict`, :meth:`Calibration.to_dict`,
+:func:`~thermocal.models.schema.verify_model_dict`, :meth:`Calibration.to_dict`,
 :func:`~thermocal.models.calibration.calibration_from_dict`) and import no I/O; reading and
 writing the files (atomically, :func:`thermocal.writers.write_json`) happens here.
 """
@@ -14,11 +14,11 @@ from pathlib import Path
 from typing import Any
 
 from thermocal.errors import ModelFileError, ThermocalInputError
+from thermocal.models import registry
 from thermocal.models.base import (
     MODEL_FORMAT,
     TemperatureModel,
     model_file_dict,
-    verify_model_dict,
 )
 from thermocal.models.calibration import (
     Calibration,
@@ -28,6 +28,7 @@ from thermocal.models.calibration import (
     is_calibration,
 )
 from thermocal.models.filecheck import read_json
+from thermocal.models.schema import verify_model_dict
 from thermocal.writers import write_json
 
 
@@ -72,7 +73,7 @@ def model_from_dict(d: dict[str, Any], path: str | Path) -> TemperatureModel:
     """The fitted model of a verified model dict (:func:`verify_model_dict`); errors name
     ``path``."""
     try:
-        return TemperatureModel.from_dict(d)
+        return registry.model_from_dict(d)
     except ModelFileError as exc:
         raise ModelFileError(f"{path}: {exc}") from None
     except (KeyError, TypeError, ValueError) as exc:

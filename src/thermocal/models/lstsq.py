@@ -320,6 +320,55 @@ def singular_error(
     )
 
 
+def _filtered_svd(
+    R22: FloatArray,
+    z2: FloatArray,
+    n: int,
+    ridge: float,
+    rcond: float | None,
+    noise_threshold: float | None,
+    sigma_full: float,
+) -> tuple[FloatArray, npt.NDArray[np.bool_], FloatArray]:
+    """The penalised part of :func:`solve_r`: ``R22 = U S Vᵀ``, the components kept
+    (``s_i > rcond · s_max``, or ``|c_i| > k σ̂`` with ``c = Uᵀ z2``) and the map
+    ``H = V diag(s_i/(s_i² + nα)) Uᵀ`` with ``γ_P = H z2``; returns (H, kept, s)."""
+    np_ = R22.shape[0]
+    H = np.zeros((np_, np_))
+    keep = np.zeros(np_, dtype=bool)
+    sv = np.zeros(0)
+    if np_:
+        U, S, Vt = np.linalg.svd(R22)
+        sv = S
+        c = U.T @ z2
+        keep = np.greater(S, (rcond or 0.0) * S[0])
+        if noise_threshold is not None and math.isfinite(sigma_full):
+            # a small-s_i component stays when the data along it stand out of the noise
+            strong = np.abs(c) > noise_threshold * sigma_full
+            keep |= strong & np.greater(S, SINGULAR_RCOND * S[0])
+        f = np.zeros_like(S)
+        f[keep] = S[keep] / (S[keep] ** 2 + n * ridge)
+        H = (Vt.T * f) @ U.T  # γ_P = H z2
+    return H, keep, sv
+
+
+def _free_part(
+    R11: FloatArray, R12: FloatArray, z1: FloatArray, H: FloatArray, gamma_p: FloatArray
+) -> tuple[FloatArray, FloatArray]:
+    """The free part of :func:`solve_r`: ``γ_U = R11⁻¹ (z1 − R12 γ_P)`` and the linear map
+    ``L`` from ``[z1; z2]`` to ``γ`` (for the covariance); returns (γ_U, L)."""
+    nu = R11.shape[0]
+    if not nu:
+        return np.zeros(0), H
+    qq = nu + H.shape[0]
+    Linv_u = sla.solve_triangular(R11, np.eye(nu), lower=False)
+    gamma_u = Linv_u @ (z1 - R12 @ gamma_p)
+    Lmap = np.zeros((qq, qq))
+    Lmap[:nu, :nu] = Linv_u
+    Lmap[:nu, nu:] = -Linv_u @ R12 @ H
+    Lmap[nu:, nu:] = H
+    return gamma_u, Lmap
+
+
 def solve_r(
     r_aug: FloatArray,
     n: int,
@@ -377,35 +426,11 @@ def solve_r(
     z1 = A2[:nu, qq]
     z2 = A2[nu:qq, qq]
     rss0 = float(A2[qq, qq] ** 2) if A2.shape[0] > qq else 0.0
-    np_ = qq - nu
     dof_full = n - qq
     sigma_full = math.sqrt(rss0 / dof_full) if dof_full > 0 else math.nan
-    H = np.zeros((np_, np_))
-    keep = np.zeros(np_, dtype=bool)
-    sv = np.zeros(0)
-    if np_:
-        U, S, Vt = np.linalg.svd(R22)
-        sv = S
-        c = U.T @ z2
-        keep = np.greater(S, (rcond or 0.0) * S[0])
-        if noise_threshold is not None and math.isfinite(sigma_full):
-            # a small-s_i component stays when the data along it stand out of the noise
-            strong = np.abs(c) > noise_threshold * sigma_full
-            keep |= strong & np.greater(S, SINGULAR_RCOND * S[0])
-        f = np.zeros_like(S)
-        f[keep] = S[keep] / (S[keep] ** 2 + n * ridge)
-        H = (Vt.T * f) @ U.T  # γ_P = H z2
+    H, keep, sv = _filtered_svd(R22, z2, n, ridge, rcond, noise_threshold, sigma_full)
     gamma_p = H @ z2
-    if nu:
-        Linv_u = sla.solve_triangular(R11, np.eye(nu), lower=False)
-        gamma_u = Linv_u @ (z1 - R12 @ gamma_p)
-        Lmap = np.zeros((qq, qq))
-        Lmap[:nu, :nu] = Linv_u
-        Lmap[:nu, nu:] = -Linv_u @ R12 @ H
-        Lmap[nu:, nu:] = H
-    else:
-        gamma_u = np.zeros(0)
-        Lmap = H
+    gamma_u, Lmap = _free_part(R11, R12, z1, H, gamma_p)
     gamma = np.r_[gamma_u, gamma_p]
     res2 = z2 - R22 @ gamma_p
     rss = rss0 + float(res2 @ res2)

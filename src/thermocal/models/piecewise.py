@@ -55,7 +55,7 @@ from __future__ import annotations
 import bisect
 import math
 import warnings
-from collections.abc import Iterator, Mapping, Sequence
+from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, ClassVar, Self
 
@@ -66,6 +66,7 @@ from thermocal._lazy import LazyModule
 from thermocal.adequacy import Needs
 from thermocal.errors import (
     DesignError,
+    ModelFileError,
     ThermocalInputError,
     ThermocalWarning,
 )
@@ -77,8 +78,17 @@ from thermocal.models.base import (
     ModelStream,
     RunData,
     TemperatureModel,
-    register,
     stream_channel,
+)
+from thermocal.models.checks import (
+    ascending,
+    fields,
+    integer,
+    key_path,
+    list_of,
+    matrix,
+    number,
+    same_length,
 )
 from thermocal.models.fitting import (
     OffsetDecision,
@@ -157,11 +167,6 @@ def evaluate_lines(
     return out
 
 
-def _hinge_design(x: FloatArray, bps: Sequence[float]) -> FloatArray:
-    cols = [np.ones_like(x), x] + [np.maximum(0.0, x - b) for b in bps]
-    return np.column_stack(cols)
-
-
 def _bin_runs(
     temps: Sequence[FloatArray], ys: Sequence[FloatArray], lo: float, hi: float, per_run: bool
 ) -> tuple[FloatArray, FloatArray, FloatArray, npt.NDArray[np.int64], FloatArray]:
@@ -186,6 +191,105 @@ def _bin_runs(
         np.concatenate(bg),
         np.concatenate(bk),
     )
+
+
+class _BreakpointSearch:
+    """The search of :func:`choose_breakpoints` on the binned data, breakpoints
+    normalised to the temperature range (0 = ``lo``, 1 = ``hi``)."""
+
+    def __init__(
+        self,
+        allx: FloatArray,
+        lo: float,
+        hi: float,
+        X: FloatArray,
+        Y: FloatArray,
+        W: FloatArray,
+        G: npt.NDArray[np.int64],
+        K: FloatArray,
+        groups: int,
+    ) -> None:
+        self.allx, self.lo, self.hi, self.Y, self.W = allx, lo, hi, Y, W
+        self.Z = np.zeros((X.size, groups))
+        self.Z[np.arange(X.size), G] = 1.0
+        self.xc = (X - lo) / (hi - lo)
+        self.sorted_x = np.sort(allx)
+        self.sorted_bins = np.unique(K) / N_BINS  # left edges of occupied bins, normalised
+        self.cand = np.unique((np.quantile(allx, np.linspace(0.01, 0.99, 99)) - lo) / (hi - lo))
+
+    def supported(self, bps_c: Sequence[float]) -> bool:
+        """Every segment wide enough, with enough samples over enough temperatures."""
+        lo, hi, sorted_x = self.lo, self.hi, self.sorted_x
+        b = np.asarray(bps_c, dtype=np.float64)
+        bounds = np.concatenate([[0.0], b, [1.0]])
+        if np.any(np.diff(bounds) < MIN_SEGMENT_WIDTH_FRACTION - 1e-9):
+            return False
+        below = np.searchsorted(sorted_x, lo + b * (hi - lo), side="left")
+        counts = np.diff(np.concatenate([[0], below, [sorted_x.size]]))
+        if np.any(counts < MIN_SEGMENT_SAMPLES):
+            return False
+        # distinct temperatures: occupied bins whose left edge lies in the segment
+        nb_in = np.diff(np.searchsorted(self.sorted_bins, bounds, side="left"))
+        return bool(np.all(nb_in >= MIN_SEGMENT_BINS))
+
+    def rss(self, bps_c: Sequence[float]) -> float:
+        """Weighted RSS of the continuous hinge fit with these breakpoints."""
+        xc, W, Y = self.xc, self.W, self.Y
+        cols = [self.Z, xc[:, None]] + [np.maximum(0.0, xc - b)[:, None] for b in bps_c]
+        A = np.hstack(cols) * W[:, None]
+        beta, _res, _rank, _sv = np.linalg.lstsq(A, Y * W, rcond=None)
+        res = Y * W - A @ beta
+        return float(res @ res)
+
+    def start(self, k: int) -> list[float] | None:
+        """A feasible placement of k − 1 breakpoints (quantiles, else equal widths)."""
+        if k == 1:
+            return []
+        lo, hi = self.lo, self.hi
+        for guess in (
+            (np.quantile(self.allx, np.linspace(0, 1, k + 1)[1:-1]) - lo) / (hi - lo),
+            np.linspace(0, 1, k + 1)[1:-1],
+        ):
+            cur = [float(v) for v in guess]
+            if self.supported(cur):
+                return cur
+        return None
+
+    def search(self, cur: list[float]) -> tuple[list[float], float]:
+        """Coordinate search over the candidate quantiles, then Nelder–Mead; returns the
+        breakpoints and their RSS."""
+        nb = len(cur)
+        best = self.rss(cur)
+        if nb == 0:
+            return cur, best
+        for _sweep in range(10):
+            changed = False
+            for j in range(nb):
+                left = cur[j - 1] if j > 0 else 0.0
+                right = cur[j + 1] if j < nb - 1 else 1.0
+                for c in self.cand:
+                    if not left < c < right:
+                        continue
+                    trial = [*cur[:j], float(c), *cur[j + 1 :]]
+                    if not self.supported(trial):
+                        continue
+                    v = self.rss(trial)
+                    if v < best - 1e-12 * abs(best):
+                        best, cur, changed = v, trial, True
+            if not changed:
+                break
+        worst = best * 10.0 + 1.0
+
+        def penalised(v: FloatArray) -> float:
+            s = sorted(float(b) for b in v)
+            return self.rss(s) if self.supported(s) else worst
+
+        res = optimize.minimize(
+            penalised, np.array(cur), method="Nelder-Mead", options={"xatol": 1e-5, "fatol": 0.0}
+        )
+        if res.fun < best:
+            cur, best = sorted(float(b) for b in res.x), float(res.fun)
+        return cur, best
 
 
 def choose_breakpoints(
@@ -223,88 +327,14 @@ def choose_breakpoints(
     X, Y, cnt, G, K = _bin_runs(temps, ys, lo, hi, per_run_offset)
     W = np.sqrt(cnt)
     groups = int(G.max()) + 1
-    Z = np.zeros((X.size, groups))
-    Z[np.arange(X.size), G] = 1.0
-    xc = (X - lo) / (hi - lo)
-    sorted_x = np.sort(allx)
-    sorted_bins = np.unique(K) / N_BINS  # left edges of occupied bins, normalised
     n_b = X.size
-
-    def supported(bps_c: Sequence[float]) -> bool:
-        b = np.asarray(bps_c, dtype=np.float64)
-        bounds = np.concatenate([[0.0], b, [1.0]])
-        if np.any(np.diff(bounds) < MIN_SEGMENT_WIDTH_FRACTION - 1e-9):
-            return False
-        below = np.searchsorted(sorted_x, lo + b * (hi - lo), side="left")
-        counts = np.diff(np.concatenate([[0], below, [sorted_x.size]]))
-        if np.any(counts < MIN_SEGMENT_SAMPLES):
-            return False
-        # distinct temperatures: occupied bins whose left edge lies in the segment
-        nb_in = np.diff(np.searchsorted(sorted_bins, bounds, side="left"))
-        return bool(np.all(nb_in >= MIN_SEGMENT_BINS))
-
-    def rss(bps_c: Sequence[float]) -> float:
-        cols = [Z, xc[:, None]] + [np.maximum(0.0, xc - b)[:, None] for b in bps_c]
-        A = np.hstack(cols) * W[:, None]
-        beta, _res, _rank, _sv = np.linalg.lstsq(A, Y * W, rcond=None)
-        res = Y * W - A @ beta
-        return float(res @ res)
-
-    def start(k: int) -> list[float] | None:
-        """A feasible placement of k − 1 breakpoints (quantiles, else equal widths)."""
-        if k == 1:
-            return []
-        for guess in (
-            (np.quantile(allx, np.linspace(0, 1, k + 1)[1:-1]) - lo) / (hi - lo),
-            np.linspace(0, 1, k + 1)[1:-1],
-        ):
-            cur = [float(v) for v in guess]
-            if supported(cur):
-                return cur
-        return None
-
-    cand = np.unique((np.quantile(allx, np.linspace(0.01, 0.99, 99)) - lo) / (hi - lo))
-
-    def search(cur: list[float]) -> tuple[list[float], float]:
-        nb = len(cur)
-        best = rss(cur)
-        if nb == 0:
-            return cur, best
-        for _sweep in range(10):
-            changed = False
-            for j in range(nb):
-                left = cur[j - 1] if j > 0 else 0.0
-                right = cur[j + 1] if j < nb - 1 else 1.0
-                for c in cand:
-                    if not left < c < right:
-                        continue
-                    trial = [*cur[:j], float(c), *cur[j + 1 :]]
-                    if not supported(trial):
-                        continue
-                    v = rss(trial)
-                    if v < best - 1e-12 * abs(best):
-                        best, cur, changed = v, trial, True
-            if not changed:
-                break
-        worst = best * 10.0 + 1.0
-
-        def penalised(v: FloatArray) -> float:
-            s = sorted(float(b) for b in v)
-            return rss(s) if supported(s) else worst
-
-        res = optimize.minimize(
-            penalised, np.array(cur), method="Nelder-Mead", options={"xatol": 1e-5, "fatol": 0.0}
-        )
-        if res.fun < best:
-            cur, best = sorted(float(b) for b in res.x), float(res.fun)
-        return cur, best
-
+    searcher = _BreakpointSearch(allx, lo, hi, X, Y, W, G, K, groups)
     fits: list[tuple[list[float], float]] = []
     for k in range(1, n_segments + 1):
-        first = start(k)
+        first = searcher.start(k)
         if first is None:
             break
-        fits.append(search(first))
+        fits.append(searcher.search(first))
     # residuals below float64 resolution of the data are all the same "exact fit": floor
     # RSS there, so that noise-free data keep the fewest segments, not rounding noise
     # (all-zero data: the floor is the smallest positive float, never 0 — log(0) fails)
@@ -340,7 +370,6 @@ class _Lines:
     m: int
 
 
-@register
 class PiecewiseModel(TemperatureModel):
     """Piecewise-linear model in one temperature (SPEC §4b); see the module docstring.
 
@@ -381,10 +410,6 @@ class PiecewiseModel(TemperatureModel):
         self.method = method
         self.temperature = temperature
         self.per_run_offset = per_run_offset
-
-    CLI_KEYS: ClassVar[Mapping[str, str] | None] = {
-        k: k for k in ("breakpoints", "segments", "method", "temperature", "per_run_offset")
-    }
 
     def chunk_context(self) -> ChunkContext:
         """Eq. (1) is memoryless: a sample's value depends on its own temperature only."""
@@ -763,6 +788,22 @@ class PiecewiseModel(TemperatureModel):
         for i, b in enumerate(self.breakpoints_):
             out.append(Coefficient(f"breakpoint[{i + 1}]", float(b), None, "degC"))
         return out
+
+    @classmethod
+    def check_state(cls, d: dict[str, Any], root: str = "") -> None:
+        """The ``state`` section of a piecewise model file: ascending breakpoints, one
+        intercept and slope per segment, its column one of the inputs."""
+        state, path, n_temps = d["state"], key_path(root, "state"), len(d["temperatures"])
+        fields(
+            {"breakpoints": ascending, "intercepts": list_of(number), "slopes": list_of(number)},
+            optional={"column_index": integer, "offsets": list_of(number), "line_cov": matrix},
+        )(state, path)
+        n_lines = len(state["breakpoints"]) + 1
+        same_length(state, path, "intercepts", n_lines, "one per segment")
+        same_length(state, path, "slopes", n_lines, "one per segment")
+        col = state.get("column_index", 0)
+        if not 0 <= col < n_temps:
+            raise ModelFileError(f"{path}.column_index: {col} is not one of the {n_temps} inputs")
 
     def _state(self) -> dict[str, Any]:
         return {

@@ -95,23 +95,31 @@ from __future__ import annotations
 import math
 import warnings
 from collections import deque
-from collections.abc import Mapping, Sequence
-from typing import Any, ClassVar, Self, cast
+from collections.abc import Sequence
+from typing import Any, ClassVar, Self
 
 import numpy as np
-import numpy.typing as npt
 
 from thermocal.adequacy import Needs
-from thermocal.errors import ExtrapolationWarning, ThermocalInputError
+from thermocal.errors import ExtrapolationWarning, ModelFileError, ThermocalInputError
 from thermocal.models.base import (
     ChunkContext,
     Coefficient,
     ModelStream,
     RunData,
-    TemperatureModel,
-    register,
 )
-from thermocal.models.fitting import Block
+from thermocal.models.checks import (
+    boolean,
+    fields,
+    integer,
+    key_path,
+    list_of,
+    matrix,
+    near_range,
+    number,
+    same_length,
+    string,
+)
 from thermocal.models.fitting import (  # shared with piecewise; re-exported
     OffsetDecision as OffsetDecision,
 )
@@ -139,12 +147,6 @@ from thermocal.models.fitting import (
 from thermocal.models.poly_eval import (
     PREDICT_BLOCK_ROWS as PREDICT_BLOCK_ROWS,
 )
-from thermocal.models.poly_eval import (
-    EvalPlan as EvalPlan,
-)
-from thermocal.models.poly_eval import (
-    build_plan as build_plan,
-)
 from thermocal.models.poly_eval import evaluate
 from thermocal.models.poly_eval import (
     evaluation_key as evaluation_key,
@@ -157,36 +159,45 @@ from thermocal.models.poly_eval import (
 )
 from thermocal.models.poly_fit import COND_WARN as COND_WARN
 from thermocal.models.poly_fit import fit_shared as fit_shared
+from thermocal.models.poly_types import (
+    DEFAULT_NOISE_THRESHOLD as DEFAULT_NOISE_THRESHOLD,
+)
+from thermocal.models.poly_types import (
+    DEFAULT_RCOND as DEFAULT_RCOND,
+)
+from thermocal.models.poly_types import (
+    EvalPlan as EvalPlan,
+)
+from thermocal.models.poly_types import PolyBase
+from thermocal.models.poly_types import (
+    build_plan as build_plan,
+)
 from thermocal.models.terms import (
     BaseScaling,
     Term,
     monomial_name,
     parse_terms,
     raw_expansion,
-    segment_rates,
-    temperature_rates,
 )
-from thermocal.preprocess import RATE_METHODS
 from thermocal.recording import GAP_FACTOR, FloatArray
 from thermocal.units import SECONDS_PER_MINUTE
 
-DEFAULT_RCOND = 1.0e-3
-"""Singular values of the equilibrated term design below this × the largest are truncated.
+MAX_TERM_POWER = 32
+"""Highest power of a poly term's base variable accepted in a file (a polynomial of
+higher order in one temperature is no calibration; a power of 2⁵³ would make export-c
+and compensate run for ever)."""
 
-Chosen on the simulator (``rlg`` preset, ``rlg-modelling`` → ``rlg-validation``): the
-seed000 design there has κ ≈ 3e6; without truncation the directions with tiny
-singular values carry noise amplified up to κ× and the model fails on the
-validation profile; with 1e-3 about 8 of 36 directions are dropped and the
-validation removal of the temperature-induced bias rises (noise-free: 97.5 → 99.7 %)."""
+BASE_KEYS = (
+    "t_center", "t_scale", "rate_center", "rate_scale", "coupling_center", "coupling_scale"
+)  # fmt: skip
+"""The poly family's centre and scale of each base variable (:class:`~thermocal.models.
+terms.BaseScaling`), centres at even positions."""
 
-DEFAULT_NOISE_THRESHOLD = 10.0
-"""A truncated component is kept after all when the data along it exceed 10 σ̂ (white-noise σ̂)."""
 
 STATE_LAYOUT = "thermocal-poly-1"
 
 
-@register
-class PolyModel(TemperatureModel):
+class PolyModel(PolyBase):
     """Polynomial in T, Ṫ and TṪ of several sensors (SPEC §4a); see the module docstring.
 
     Parameters
@@ -209,72 +220,11 @@ class PolyModel(TemperatureModel):
     C_GENERATOR: ClassVar[str | None] = "thermocal.export.c.poly"
     uses_rate: ClassVar[bool] = True
 
-    terms_: list[Term]
-    scaling_: BaseScaling
-    coef_: FloatArray
-    constant_: float
-    offsets_: FloatArray
-    cov_: FloatArray
-    selection_: dict[str, Any] | None
-
-    def __init__(
-        self,
-        terms: str | list[str] | None = "seed000",
-        order: int | None = None,
-        rate_interval_s: float = 60.0,
-        rate_method: str = "backward",
-        select: str | None = None,
-        ridge: float = 0.0,
-        rcond: float | None = DEFAULT_RCOND,
-        per_run_offset: bool | None = None,
-        solver: str = "auto",
-        noise_threshold: float | None = DEFAULT_NOISE_THRESHOLD,
-    ) -> None:
-        self.terms = terms
-        self.order = order
-        self.rate_interval_s = rate_interval_s
-        self.rate_method = rate_method
-        self.select = select
-        self.ridge = ridge
-        self.rcond = rcond
-        self.per_run_offset = per_run_offset
-        self.solver = solver
-        self.noise_threshold = noise_threshold
-
     # -- construction from the command line --
-    CLI_KEYS: ClassVar[Mapping[str, str] | None] = {
-        "terms": "terms",
-        "order": "order",
-        "rate_interval_s": "rate_interval_s",
-        "rate_method": "rate_method",
-        "select": "select",
-        "ridge": "ridge",
-        "rcond": "rcond",
-        "per_run_offset": "per_run_offset",
-        "solver": "solver",
-        "noise_threshold": "noise_threshold",
-    }
 
     def chunk_context(self) -> ChunkContext:
         """Eq. (1) needs the last Δt seconds (the Ṫ interval) and nothing of the start."""
         return ChunkContext(head_s=0.0, tail_s=float(self.rate_interval_s))
-
-    # -- helpers --
-    def _check_params(self) -> None:
-        if self.rate_method not in RATE_METHODS:
-            raise ThermocalInputError(
-                f"unknown rate method {self.rate_method!r}; use one of {', '.join(RATE_METHODS)}"
-            )
-        if not (isinstance(self.rate_interval_s, int | float) and self.rate_interval_s > 0):
-            raise ThermocalInputError(
-                f"rate interval must be a positive number of seconds, got {self.rate_interval_s!r}"
-            )
-        if self.select not in (None, "bic", "holdout"):
-            raise ThermocalInputError(f"unknown selection {self.select!r}; use bic or holdout")
-        if self.ridge < 0:
-            raise ThermocalInputError(f"ridge α must be ≥ 0, got {self.ridge}")
-        if self.solver not in ("auto", "qr", "gram"):
-            raise ThermocalInputError(f"unknown solver {self.solver!r}; use auto, qr or gram")
 
     # -- estimator contract --
     def fit(self, runs: Sequence[RunData]) -> Self:
@@ -286,30 +236,6 @@ class PolyModel(TemperatureModel):
         """
         fit_shared([self], [runs])
         return self
-
-    def _params_key(self) -> tuple[Any, ...]:
-        t = self.terms if not isinstance(self.terms, list) else tuple(self.terms)
-        return (t, self.order, float(self.rate_interval_s), self.rate_method, self.select,
-                float(self.ridge), self.rcond, self.per_run_offset, self.solver,
-                self.noise_threshold)  # fmt: skip
-
-    def _rates_at(self, run: RunData, plan: list[Block], idx: npt.NDArray[np.intp]) -> FloatArray:
-        out = np.zeros((idx.size, run.temps_c.shape[1]))
-        for s0, s1 in sorted({(b[0], b[1]) for b in plan}):
-            sel = (idx >= s0) & (idx < s1)
-            if sel.any():
-                out[sel] = segment_rates(
-                    run.time_s[s0:s1],
-                    run.temps_c[s0:s1],
-                    idx[sel] - s0,
-                    float(self.rate_interval_s),
-                    self.rate_method,
-                )
-        return out
-
-    def rates(self, time_s: FloatArray, temps_c: FloatArray) -> FloatArray:
-        """Ṫ of every temperature column [°C/min] with the model's rate form and Δt."""
-        return temperature_rates(time_s, temps_c, float(self.rate_interval_s), self.rate_method)
 
     def data_needs(self, temp_names: Sequence[str], n_runs: int) -> Needs:
         """Order in T per column (T and T·Ṫ powers), the terms plus the constant and the
@@ -330,32 +256,6 @@ class PolyModel(TemperatureModel):
 
     def _rate_sensors(self) -> list[int]:
         return sorted({t.sensor for t in self.terms_ if t.uses_rate})
-
-    def _plan(self) -> EvalPlan:
-        """The :class:`EvalPlan` of the fitted values (cached; rebuilt when they change)."""
-        sc = self.scaling_
-        key = (
-            tuple(self.terms_),
-            self.coef_.tobytes(),
-            float(self.constant_),
-            b"".join(
-                np.asarray(x, dtype=np.float64).tobytes()
-                for x in (
-                    sc.t_center,
-                    sc.t_scale,
-                    sc.rate_center,
-                    sc.rate_scale,
-                    sc.coupling_center,
-                    sc.coupling_scale,
-                )
-            ),
-        )
-        cached = self.__dict__.get("_plan_cache")
-        if cached is not None and cached[0] == key:
-            return cast(EvalPlan, cached[1])
-        plan = build_plan(self.terms_, sc, self.coef_, self.constant_)
-        self.__dict__["_plan_cache"] = (key, plan)
-        return plan
 
     def predict(self, run: RunData, *, extrapolate: bool = False) -> FloatArray:
         """Temperature-induced signal of every sample [signal unit] (module docstring steps 1–4).
@@ -449,16 +349,52 @@ class PolyModel(TemperatureModel):
             out.append(Coefficient(name, float(v), float(e) if math.isfinite(e) else None, unit))
         return out
 
-    def scaled_coefficients(self) -> list[Coefficient]:
-        """Coefficients in the scaled basis actually evaluated (constant first)."""
-        self.check_fitted()
-        se = np.sqrt(np.clip(np.diag(self.cov_), 0.0, None))
-        names = ["const"] + [t.name for t in self.terms_]
-        vals = np.r_[self.constant_, self.coef_]
-        return [
-            Coefficient(n, float(v), float(s) if math.isfinite(s) else None, self.signal_unit)
-            for n, v, s in zip(names, vals, se, strict=True)
-        ]
+    @classmethod
+    def check_state(cls, d: dict[str, Any], root: str = "") -> None:
+        """The ``state`` section of a poly model file (:meth:`_state`'s layout): centres and
+        scales per base variable (scales not 0), terms of powers 0…:data:`MAX_TERM_POWER` on
+        known sensors, one coefficient per term; a used centre in or near its fitted range."""
+        state, path, n_temps = d["state"], key_path(root, "state"), len(d["temperatures"])
+        fields(
+            {
+                "layout": string,
+                "base": list_of(fields({k: number for k in BASE_KEYS}), min_len=1),
+                "terms": list_of(
+                    fields({"sensor": integer, "t_power": integer, "rate_power": integer,
+                            "coupling_power": integer})
+                ),
+                "coef": list_of(number),
+                "constant": number,
+            },
+            optional={"offsets": list_of(number), "cov": matrix, "uses_rate": boolean,
+                      "n_sensors": integer},
+        )(state, path)  # fmt: skip
+        same_length(state, path, "coef", len(state["terms"]), "one per term")
+        for i, base in enumerate(state["base"]):
+            for key in BASE_KEYS[1::2]:
+                if base[key] == 0:
+                    raise ModelFileError(f"{path}.base[{i}].{key}: must not be 0")
+        for i, term in enumerate(state["terms"]):
+            for key in ("t_power", "rate_power", "coupling_power"):
+                if not 0 <= term[key] <= MAX_TERM_POWER:
+                    raise ModelFileError(
+                        f"{path}.terms[{i}].{key}: {term[key]} is not a power 0…{MAX_TERM_POWER}"
+                    )
+            if not 0 <= term["sensor"] < len(state["base"]):
+                raise ModelFileError(
+                    f"{path}.terms[{i}].sensor: {term['sensor']} is not one of the "
+                    f"{len(state['base'])} temperature inputs"
+                )
+        if len(state["base"]) > n_temps:
+            raise ModelFileError(
+                f"{path}.base: {len(state['base'])} temperature inputs but the file names {n_temps}"
+            )
+        ranges, temps = d["range"]["temperature_c"], d["temperatures"]
+        used = {t["sensor"] for t in state["terms"] if t["t_power"] or t["coupling_power"]}
+        for k in sorted(used):
+            lo, hi = ranges[temps[k]]
+            center = state["base"][k]["t_center"]
+            near_range(center, lo, hi, key_path(root, f"state.base[{k}].t_center"), "the centre")
 
     # -- state --
     def _state(self) -> dict[str, Any]:

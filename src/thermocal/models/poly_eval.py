@@ -4,11 +4,10 @@ the stream on Python floats, and several models of one structure evaluated toget
 
 from __future__ import annotations
 
-import math
 import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any, cast
+from typing import Any, cast
 
 import numpy as np
 import numpy.typing as npt
@@ -18,9 +17,8 @@ from thermocal.models.base import (
     RunData,
 )
 from thermocal.models.fitting import warn_rate_range
+from thermocal.models.poly_types import EvalPlan, PolyBase
 from thermocal.models.terms import (
-    BaseScaling,
-    Term,
     backward_partners,
     gap_free_slices,
     step_range,
@@ -29,159 +27,12 @@ from thermocal.models.terms import (
 from thermocal.recording import FloatArray
 from thermocal.units import SECONDS_PER_MINUTE
 
-if TYPE_CHECKING:
-    from thermocal.models.poly import PolyModel
-
 # --- evaluation: one plan for predict (numpy blocks) and the stream (Python floats) ----------
 
 PREDICT_BLOCK_ROWS = 8192
 """Rows per block in :meth:`PolyModel.predict`: the block's temporaries (a few
 (k × rows) arrays, ~1.5 MB for four sensors) stay in the L2 cache.  (More than 4096:
 numpy's broadcast of a coefficient column is slow on smaller rows.)"""
-
-KINDS = ("u", "v", "w")
-"""Base variables of eq. (1) of :mod:`thermocal.models.terms`: T, Ṫ and T·Ṫ."""
-
-PyRow = tuple[
-    int, float, float, float, tuple[tuple[int, float, tuple[float, ...]], ...], tuple[Any, ...]
-]
-"""Stream form of one sensor: (column, c_T, c_R, c_W, ((kind, c_P, (c_{P−1}, …, c_1)), …),
-((coefficient, factor kinds), …)); kinds 0/1/2 = u/v/w."""
-
-
-@dataclass(frozen=True)
-class EvalPlan:
-    """A fitted polynomial arranged for fast evaluation (module docstring, steps 3–4).
-
-    With the centred variables ``d_u = T − c_T``, ``d_v = Ṫ − c_R``, ``d_w = T·Ṫ − c_W``
-    of each used sensor (T, Ṫ clamped) and the scale factors folded into the
-    coefficients (``coef / s^p``), the pure powers of one variable are summed by
-    Horner's rule,
-
-        p(d) = ((c_P·d + c_{P−1})·d + … + c_1)·d,
-
-    per sensor ``s_k = (p_u(d_u) + p_v(d_v)) + p_w(d_w)`` (the variables the terms use,
-    in this order), then ``s_k + c·Π factors`` for each mixed term ``u^a v^b w^c``
-    (two or more variables; factors multiplied left to right: u…, v…, w…), and
-    ``y = ((constant + s_1) + s_2) + …`` over the sensors in column order.  The same
-    operations in the same order run on numpy blocks in :meth:`PolyModel.predict` and
-    on Python floats in :class:`PolyStream`, so both give the same numbers (a
-    zero-padded Horner row only adds and multiplies exact zeros).
-
-    ``sensors``: the used columns (rows of the block arrays); ``kinds``: the variables
-    formed (``"u"``, ``"v"``, ``"w"``), stacked kind by kind in the block arrays;
-    ``horner``: (len(kinds)·len(sensors), 1) coefficient columns ``c_1 … c_P``
-    (zero-padded to the highest power; empty without pure-power terms);
-    ``centres[kind]``: (len(sensors), 1) — 0 for Ṫ and T·Ṫ when :func:`build_plan`
-    folded them into the coefficients (``centred[kind]`` False: no subtraction);
-    ``mixed``: (row, coefficient, factor kinds); ``rate_sensors``: the columns whose Ṫ
-    a term uses; ``py_rows``: the stream form.
-    """
-
-    constant: float
-    sensors: tuple[int, ...]
-    kinds: tuple[str, ...]
-    horner: list[FloatArray]
-    centres: dict[str, FloatArray]
-    centred: dict[str, bool]
-    mixed: tuple[tuple[int, float, tuple[str, ...]], ...]
-    rate_sensors: tuple[int, ...]
-    py_rows: tuple[PyRow, ...]
-
-
-def build_plan(
-    terms: Sequence[Term], scaling: BaseScaling, coef: FloatArray, constant: float
-) -> EvalPlan:
-    """Arrange fitted terms for evaluation (:class:`EvalPlan`): the coefficient of a pure
-    power ``u^p`` becomes ``coef / s_T^p`` (Horner in ``d_u``), likewise for v and w; a
-    mixed term ``u^a v^b w^c`` gets ``coef / (s_T^a s_R^b s_W^c)``.  When no mixed term
-    uses it and every sensor's ``|c| ≤ s``, the centre of Ṫ (of T·Ṫ) is folded in by the
-    binomial re-expansion ``Σ_p a_p (x − c)^p = Σ_j b_j x^j`` (the ``b_0`` join the
-    constant), which saves a pass and loses no accuracy."""
-    sensors = tuple(sorted({t.sensor for t in terms}))
-    row_of = {s: i for i, s in enumerate(sensors)}
-    centre_of = {
-        "u": scaling.t_center,
-        "v": scaling.rate_center,
-        "w": scaling.coupling_center,
-    }
-    scale_of = {"u": scaling.t_scale, "v": scaling.rate_scale, "w": scaling.coupling_scale}
-    pure: dict[tuple[str, int, int], float] = {}  # (kind, row, power) -> coefficient
-    mixed: list[tuple[int, float, tuple[str, ...]]] = []
-    for term, c in zip(terms, coef, strict=True):
-        powers = {"u": term.t_power, "v": term.rate_power, "w": term.coupling_power}
-        used = [k for k in KINDS if powers[k]]
-        j = term.sensor
-        if len(used) == 1:
-            kind = used[0]
-            p = powers[kind]
-            key = (kind, row_of[j], p)
-            pure[key] = pure.get(key, 0.0) + float(c) / float(scale_of[kind][j]) ** p
-        else:
-            div = 1.0
-            for kind in used:
-                div *= float(scale_of[kind][j]) ** powers[kind]
-            factors = tuple(k for k in KINDS for _ in range(powers[k]))
-            mixed.append((row_of[j], float(c) / div, factors))
-    kinds = tuple(
-        k for k in KINDS if any(key[0] == k for key in pure) or any(k in m[2] for m in mixed)
-    )
-    nr = len(sensors)
-    # Ṫ and T·Ṫ: re-expand about 0 when every centre is within one scale of 0 (no loss
-    # of accuracy; saves two passes):  Σ_p a_p (x − c)^p = Σ_j b_j x^j,
-    # b_j = Σ_{p ≥ max(j,1)} a_p C(p, j) (−c)^(p−j);  the b_0 go into the constant.
-    constant = float(constant)
-    centre = {k: [float(centre_of[k][s]) for s in sensors] for k in KINDS}
-    for kind in ("v", "w"):
-        if kind not in kinds or any(kind in m[2] for m in mixed):
-            continue
-        if not all(abs(centre[kind][r]) <= float(scale_of[kind][s]) for r, s in enumerate(sensors)):
-            continue
-        for r in range(nr):
-            a = {p: v for (k2, r2, p), v in pure.items() if k2 == kind and r2 == r}
-            c0 = centre[kind][r]
-            if a and c0 != 0.0:
-                top_p = max(a)
-                for j in range(top_p + 1):
-                    b = 0.0
-                    for p in range(max(j, 1), top_p + 1):
-                        b += a.get(p, 0.0) * math.comb(p, j) * (-c0) ** (p - j)
-                    if j == 0:
-                        constant += b
-                    else:
-                        pure[(kind, r, j)] = b
-            centre[kind][r] = 0.0
-    top = max((key[2] for key, v in pure.items() if v != 0.0), default=0)
-    mat = np.zeros((len(kinds) * nr, top))
-    for (kind, r, p), v in pure.items():
-        if p <= top:
-            mat[kinds.index(kind) * nr + r, p - 1] += v
-    horner = [np.ascontiguousarray(mat[:, p : p + 1]) for p in range(top)]
-    centres = {k: np.array(centre[k], dtype=np.float64).reshape(nr, 1) for k in KINDS}
-    py_rows: list[PyRow] = []
-    for r, s in enumerate(sensors):
-        polys: list[tuple[int, float, tuple[float, ...]]] = []
-        for ki, kind in enumerate(kinds):
-            col = [float(v) for v in mat[ki * nr + r]]
-            while col and col[-1] == 0.0:
-                col.pop()
-            if col:
-                polys.append((KINDS.index(kind), col[-1], tuple(reversed(col[:-1]))))
-        mix = tuple(
-            (cf, tuple(KINDS.index(f) for f in factors)) for row, cf, factors in mixed if row == r
-        )
-        py_rows.append((s, centre["u"][r], centre["v"][r], centre["w"][r], tuple(polys), mix))
-    return EvalPlan(
-        constant=constant,
-        sensors=sensors,
-        kinds=kinds,
-        horner=horner,
-        centres=centres,
-        centred={k: bool(np.any(centres[k] != 0.0)) for k in KINDS},
-        mixed=tuple(mixed),
-        rate_sensors=tuple(sorted({t.sensor for t in terms if t.uses_rate})),
-        py_rows=tuple(py_rows),
-    )
 
 
 @dataclass
@@ -221,7 +72,7 @@ class _BlockEvaluator:
 
     def __init__(
         self,
-        model: PolyModel,
+        model: PolyBase,
         plan: EvalPlan,
         run: RunData,
         *,
@@ -304,21 +155,13 @@ class _BlockEvaluator:
             self._block(s0, a, b, [o[a:b] for o in outs], seen, buf)
         return seen
 
-    def _block(
-        self,
-        s0: int,
-        a: int,
-        b: int,
-        outs: list[FloatArray],
-        seen: _Seen,
-        buf: dict[str, FloatArray],
-    ) -> None:
-        plan, t, temps = self.plan, self.t, self.temps
-        c = b - a
+    def _load_temperatures(
+        self, a: int, b: int, part: int | npt.NDArray[np.intp] | None, buf: dict[str, FloatArray]
+    ) -> tuple[FloatArray, FloatArray | None]:
+        """The block's raw temperatures (columns × rows) and, for a backward Ṫ whose
+        partners lie ``part`` rows back, the partners' (else None), in the buffers."""
+        temps, c = self.temps, b - a
         width = buf["prev"].shape[1]
-        part: int | npt.NDArray[np.intp] | None = None
-        if plan.rate_sensors and self.rates is None:
-            part = backward_partners(t, s0, a, b, self.interval_s, increasing=self.increasing)
         prev: FloatArray | None = None
         if isinstance(part, int) and part <= width:
             raw = buf["raw"][:, : part + c]
@@ -331,6 +174,62 @@ class _BlockEvaluator:
             if isinstance(part, int):
                 prev = buf["prev"][:, :c]
                 np.copyto(prev, temps[a - part : b - part].T)
+        return cur, prev
+
+    def _rates(
+        self,
+        a: int,
+        b: int,
+        part: int | npt.NDArray[np.intp] | None,
+        cura: FloatArray,
+        preva: FloatArray | None,
+        ra: FloatArray,
+        seen: _Seen,
+        buf: dict[str, FloatArray],
+    ) -> None:
+        """Step 1 into ``ra``: Ṫ = (T_i − T_lo)/(t_i − t_lo)·60 [°C/min] from the raw
+        temperatures (or the forward/centred rates computed beforehand); records the range
+        met and clips to the fitted one when asked."""
+        t, temps, c = self.t, self.temps, b - a
+        if self.rates is not None:  # forward / centred forms, computed beforehand
+            np.copyto(ra, self.rates[a:b, self.rows].T)
+        elif preva is not None:
+            assert isinstance(part, int)
+            span = np.subtract(t[a:b], t[a - part : b - part], out=buf["span"][:c])
+            np.subtract(cura, preva, out=ra)
+            np.divide(ra, span, out=ra)
+            np.multiply(ra, SECONDS_PER_MINUTE, out=ra)
+        else:
+            lo = cast(npt.NDArray[np.intp], part)
+            span = t[a:b] - t[lo]
+            ok = span > 0
+            ra.fill(0.0)
+            if ok.any():
+                partner = temps[lo[ok]][:, self.rows].T
+                ra[:, ok] = (cura[:, ok] - partner) / span[ok] * SECONDS_PER_MINUTE
+        rmin = ra.min(axis=1)
+        rmax = ra.max(axis=1)
+        seen.r_mins.append(rmin)
+        seen.r_maxs.append(rmax)
+        if self.clip_rates and (bool(np.any(rmin < self.r_lo1)) or bool(np.any(rmax > self.r_hi1))):
+            np.clip(ra, self.r_lo, self.r_hi, out=ra)
+
+    def _block(
+        self,
+        s0: int,
+        a: int,
+        b: int,
+        outs: list[FloatArray],
+        seen: _Seen,
+        buf: dict[str, FloatArray],
+    ) -> None:
+        """Steps 1–4 on rows ``a:b`` of the segment starting at ``s0``, into ``outs``."""
+        plan, t = self.plan, self.t
+        c = b - a
+        part: int | npt.NDArray[np.intp] | None = None
+        if plan.rate_sensors and self.rates is None:
+            part = backward_partners(t, s0, a, b, self.interval_s, increasing=self.increasing)
+        cur, prev = self._load_temperatures(a, b, part, buf)
         # step 2: the temperature range (every column, raw values)
         mins = cur.min(axis=1)
         maxs = cur.max(axis=1)
@@ -361,44 +260,9 @@ class _BlockEvaluator:
         else:
             ra = buf["rate"][:, :c]
         if plan.rate_sensors:
-            if self.rates is not None:  # forward / centred forms, computed beforehand
-                np.copyto(ra, self.rates[a:b, self.rows].T)
-            elif preva is not None:
-                assert isinstance(part, int)
-                span = np.subtract(t[a:b], t[a - part : b - part], out=buf["span"][:c])
-                np.subtract(cura, preva, out=ra)
-                np.divide(ra, span, out=ra)
-                np.multiply(ra, SECONDS_PER_MINUTE, out=ra)
-            else:
-                lo = cast(npt.NDArray[np.intp], part)
-                span = t[a:b] - t[lo]
-                ok = span > 0
-                ra.fill(0.0)
-                if ok.any():
-                    partner = temps[lo[ok]][:, self.rows].T
-                    ra[:, ok] = (cura[:, ok] - partner) / span[ok] * SECONDS_PER_MINUTE
-            rmin = ra.min(axis=1)
-            rmax = ra.max(axis=1)
-            seen.r_mins.append(rmin)
-            seen.r_maxs.append(rmax)
-            if self.clip_rates and (
-                bool(np.any(rmin < self.r_lo1)) or bool(np.any(rmax > self.r_hi1))
-            ):
-                np.clip(ra, self.r_lo, self.r_hi, out=ra)
+            self._rates(a, b, part, cura, preva, ra, seen, buf)
         # step 3: centred variables, stacked kind by kind
-        d: dict[str, FloatArray] = {}
-        for i, kind in enumerate(plan.kinds):
-            dk = dall[i * nr : (i + 1) * nr]
-            if kind == "u":
-                np.subtract(ta, plan.centres["u"], out=dk)
-            elif kind == "v":
-                if plan.centred["v"]:
-                    np.subtract(ra, plan.centres["v"], out=dk)
-            else:
-                np.multiply(ta, ra, out=dk)
-                if plan.centred["w"]:
-                    np.subtract(dk, plan.centres["w"], out=dk)
-            d[kind] = dk
+        d = _centred(plan, dall, ta, ra, nr)
         # step 4, per plan: on the centred variables themselves (one plan), or on a copy
         # of them for each plan (several plans of one structure: the same operations)
         if len(self.plans) == 1:
@@ -463,6 +327,27 @@ class _BlockEvaluator:
             np.add(o, s[r], out=o)
 
 
+def _centred(
+    plan: EvalPlan, dall: FloatArray, ta: FloatArray, ra: FloatArray, nr: int
+) -> dict[str, FloatArray]:
+    """Step 3 in place in ``dall``: ``d_u = T − c_T``, ``d_v = Ṫ − c_R`` (Ṫ itself when the
+    plan folded its centre, already computed there), ``d_w = T·Ṫ − c_W``, kind by kind."""
+    d: dict[str, FloatArray] = {}
+    for i, kind in enumerate(plan.kinds):
+        dk = dall[i * nr : (i + 1) * nr]
+        if kind == "u":
+            np.subtract(ta, plan.centres["u"], out=dk)
+        elif kind == "v":
+            if plan.centred["v"]:
+                np.subtract(ra, plan.centres["v"], out=dk)
+        else:
+            np.multiply(ta, ra, out=dk)
+            if plan.centred["w"]:
+                np.subtract(dk, plan.centres["w"], out=dk)
+        d[kind] = dk
+    return d
+
+
 def warn_temperature_range(
     seen_min: FloatArray,
     seen_max: FloatArray,
@@ -490,7 +375,7 @@ def warn_temperature_range(
     )
 
 
-def evaluation_key(model: PolyModel) -> tuple[Any, ...]:
+def evaluation_key(model: PolyBase) -> tuple[Any, ...]:
     """What decides how a fitted model's inputs are turned into its centred variables
     (steps 1–3 of the module docstring) and the shape of step 4: models with equal keys
     (channels fitted together by :func:`fit_shared`, unless term selection differs) can
@@ -515,7 +400,7 @@ def evaluation_key(model: PolyModel) -> tuple[Any, ...]:
 
 
 def predict_many(
-    models: Sequence[PolyModel], run: RunData, *, extrapolate: bool = False
+    models: Sequence[PolyBase], run: RunData, *, extrapolate: bool = False
 ) -> list[FloatArray]:
     """:meth:`PolyModel.predict` of several models on one run: the clamped temperatures,
     Ṫ and centred variables once, then each model's polynomial (step 4) on a copy of
@@ -532,7 +417,7 @@ def predict_many(
 
 
 def evaluate(
-    models: Sequence[PolyModel], run: RunData, *, extrapolate: bool = False
+    models: Sequence[PolyBase], run: RunData, *, extrapolate: bool = False
 ) -> list[FloatArray]:
     """Steps 1–4 for models of one :func:`evaluation_key` (one model: :meth:`PolyModel.
     predict`): the inputs, Ṫ and centred variables once, each model's polynomial, and the

@@ -7,7 +7,7 @@ import math
 import warnings
 from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any, cast
+from typing import Any, cast
 
 import numpy as np
 from threadpoolctl import threadpool_limits
@@ -27,6 +27,7 @@ from thermocal.models.fitting import (
     run_blocks,
     short_rate_share,
 )
+from thermocal.models.poly_types import PolyBase
 from thermocal.models.residuals import MAX_SAMPLES_PER_SERIES, residual_correlation
 from thermocal.models.terms import (
     BaseScaling,
@@ -44,9 +45,6 @@ from thermocal.models.terms import (
 )
 from thermocal.recording import FloatArray
 
-if TYPE_CHECKING:
-    from thermocal.models.poly import PolyModel
-
 COND_WARN = 1.0e8
 """Condition number above which a :class:`ConditioningWarning` is raised."""
 
@@ -63,7 +61,7 @@ def _same_inputs(a: RunData, b: RunData) -> bool:
     return same(a.time_s, b.time_s) and same(a.temps_c, b.temps_c)
 
 
-def fit_shared(models: Sequence[PolyModel], runs_by_model: Sequence[Sequence[RunData]]) -> None:
+def fit_shared(models: Sequence[PolyBase], runs_by_model: Sequence[Sequence[RunData]]) -> None:
     """Fit several channels that share one design (issue 15): the same parameters and the
     same runs' times and temperatures, each with its own signal and known input.
 
@@ -98,8 +96,8 @@ def fit_shared(models: Sequence[PolyModel], runs_by_model: Sequence[Sequence[Run
 
 
 def _shared_runs(
-    models: Sequence[PolyModel], runs_by_model: Sequence[Sequence[RunData]]
-) -> tuple[PolyModel, list[list[RunData]]]:
+    models: Sequence[PolyBase], runs_by_model: Sequence[Sequence[RunData]]
+) -> tuple[PolyBase, list[list[RunData]]]:
     """The first model and every channel's checked runs; refuses models with other
     parameters and runs with other times or temperatures."""
     if not models or len(models) != len(runs_by_model):
@@ -125,7 +123,7 @@ class _Design:
     """The design every channel shares: terms, the per-run offset decision, blocks, the
     base-variable scaling (centres and scales from ≤ SCALING_SAMPLES samples)."""
 
-    head: PolyModel
+    head: PolyBase
     runs: list[RunData]
     terms: list[Term]
     uses_rate: bool
@@ -150,7 +148,7 @@ class _Design:
         return [t.name for t in self.terms] + ["const"]
 
 
-def _shared_design(head: PolyModel, rl: list[RunData]) -> _Design:
+def _shared_design(head: PolyBase, rl: list[RunData]) -> _Design:
     """Terms, offsets, blocks and scaling from the runs' temperatures (and the warning for
     a rate taken mostly over short segments)."""
     k = rl[0].temps_c.shape[1]
@@ -180,7 +178,7 @@ def _shared_design(head: PolyModel, rl: list[RunData]) -> _Design:
     return _Design(head, rl, terms, uses_rate, n_total, decision, m, n_folds, plans, scaling)
 
 
-def _warn_short_rates(head: PolyModel, rl: list[RunData], n_total: int) -> None:
+def _warn_short_rates(head: PolyBase, rl: list[RunData], n_total: int) -> None:
     shares = [short_rate_share(r.time_s, float(head.rate_interval_s), head.rate_method) for r in rl]
     n_short = sum(c for c, _ in shares)
     if n_short > SHORT_RATE_WARN_SHARE * n_total:
@@ -290,7 +288,7 @@ _Solved = tuple[list[int], dict[str, Any] | None, LstsqSolution]
 """(kept term columns, selection record or None, the least-squares solution)."""
 
 
-def _solve_channel(mdl: PolyModel, red: Reduced, design: _Design) -> _Solved:
+def _solve_channel(mdl: PolyBase, red: Reduced, design: _Design) -> _Solved:
     """Term selection (if asked) and the least-squares solution of one channel."""
     p, m, names = design.p, design.m, design.names
     required = list(range(p, p + m))
@@ -321,7 +319,7 @@ def _solve_channel(mdl: PolyModel, red: Reduced, design: _Design) -> _Solved:
 
 
 def _finish_channel(
-    mdl: PolyModel,
+    mdl: PolyBase,
     design: _Design,
     dp: _DesignPass,
     j: int,

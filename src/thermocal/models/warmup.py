@@ -66,7 +66,7 @@ from __future__ import annotations
 import dataclasses
 import math
 import warnings
-from collections.abc import Mapping, Sequence
+from collections.abc import Sequence
 from typing import Any, ClassVar, Self
 
 import numpy as np
@@ -78,6 +78,7 @@ from thermocal.errors import (
     ConditioningWarning,
     DesignError,
     ExtrapolationWarning,
+    ModelFileError,
     ThermocalInputError,
 )
 from thermocal.models.base import (
@@ -87,7 +88,16 @@ from thermocal.models.base import (
     ModelStream,
     RunData,
     TemperatureModel,
-    register,
+)
+from thermocal.models.checks import (
+    fields,
+    integer,
+    interval,
+    key_path,
+    matrix,
+    number,
+    sensor_param,
+    string,
 )
 from thermocal.recording import FloatArray
 
@@ -272,7 +282,6 @@ class _ScaledFit:
     run_coefs: FloatArray | None
 
 
-@register
 class WarmupModel(TemperatureModel):
     """Two-stage warm-up model ``ΔF = Σ_j a_j(T0) ΔT^j``, ``a_j(T0) = Σ_k b_jk T0^k``
     (SPEC §4c, seed 003).
@@ -331,14 +340,6 @@ class WarmupModel(TemperatureModel):
         j = self.sensor if 0 <= self.sensor < len(temp_names) else 0
         n = (self.order + 1) * (self.t0_order + 1)
         return Needs({temp_names[j]: 1} if temp_names else {}, n)
-
-    CLI_KEYS: ClassVar[Mapping[str, str] | None] = {
-        k: k
-        for k in (
-            "order", "t0_order", "start_window_s", "include_a0", "sensor", "method",
-            "per_run_offset",
-        )
-    }  # fmt: skip
 
     def chunk_context(self) -> ChunkContext:
         """T0 and F0 come from the first ``start_window_s`` seconds of the run; no Ṫ."""
@@ -712,6 +713,29 @@ class WarmupModel(TemperatureModel):
                     )
                 )
         return out
+
+    @classmethod
+    def check_state(cls, d: dict[str, Any], root: str = "") -> None:
+        """The ``state`` section of a warmup model file: ``b`` of (order + 1) × (t0_order +
+        1) (or without the constant row) finite numbers; ``params.sensor`` one of the inputs."""
+        sensor_param(d, root)
+        state, path = d["state"], key_path(root, "state")
+        fields(
+            {"b": matrix, "order": integer, "t0_order": integer, "sensor_name": string,
+             "t0_range_c": interval},
+            optional={"b_stderr": matrix, "start_window_s": number, "duration_range_s": interval},
+        )(state, path)  # fmt: skip
+        rows, cols = len(state["b"]), len(state["b"][0]) if state["b"] else 0
+        want = (state["order"] + 1, state["t0_order"] + 1)
+        if (rows, cols) not in (want, (want[0] - 1, want[1])):
+            raise ModelFileError(
+                f"{path}.b: expected a {want[0]}×{want[1]} (or {want[0] - 1}×{want[1]}, without "
+                f"the constant) matrix for order {state['order']} and t0_order "
+                f"{state['t0_order']}, got {rows}×{cols}"
+            )
+        for i, row in enumerate(state["b"]):
+            for j, v in enumerate(row):
+                number(v, f"{path}.b[{i}][{j}]")
 
     def _state(self) -> dict[str, Any]:
         return {

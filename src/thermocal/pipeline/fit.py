@@ -5,7 +5,8 @@ Fits one model (one channel) or a calibration of several channels on one or seve
 ``per_run_offset=False``) and writes the self-describing model file
 (:func:`thermocal.models.files.save_model`; several channels:
 :func:`thermocal.models.files.save_calibration`) with the data files' names and SHA-256
-checksums.  The family is looked up in the registry (:func:`thermocal.models.base.get_model_class`)
+checksums.  The family is looked up in the registry
+(:func:`thermocal.models.registry.get_model_class`)
 and built from the options by its one option parser (:meth:`TemperatureModel.from_cli_options`,
 :func:`model_options` gives the keys).  Every file is read once, through
 :func:`thermocal.pipeline.reading.load_recording` with the text-log options and ``topic``.
@@ -44,6 +45,7 @@ if TYPE_CHECKING:
     import thermocal.models.calibration as _calibration
     import thermocal.models.files as _files
     import thermocal.models.poly as _poly
+    import thermocal.models.registry as _registry
     import thermocal.recording as _recording
     import thermocal.writers as _writers
 else:
@@ -52,6 +54,7 @@ else:
     _adequacy = LazyModule("thermocal.adequacy")
     _writers = LazyModule("thermocal.writers")
     _base = LazyModule("thermocal.models.base")
+    _registry = LazyModule("thermocal.models.registry")
     _calibration = LazyModule("thermocal.models.calibration")
     _files = LazyModule("thermocal.models.files")
     _poly = LazyModule("thermocal.models.poly")
@@ -124,7 +127,7 @@ def build_model(family: str, options: dict[str, Any]) -> _base.TemperatureModel:
     """Instantiate a registered family from the CLI option dict by its one option parser
     (:meth:`TemperatureModel.from_cli_options`: an option the family does not take is
     refused, for every family)."""
-    return _base.get_model_class(family).from_cli_options(options)
+    return _registry.get_model_class(family).from_cli_options(options)
 
 
 def earth_rate_known_input(

@@ -348,3 +348,25 @@ def default_time_column(names: Sequence[str], stated: str | None = None) -> str:
         if base.lower() in TIME_COLUMN_NAMES:
             found.append(c)
     return found[0] if len(found) == 1 else "time"
+
+
+# --- flight-controller logs: topics ---------------------------------------------------------
+
+DEFAULT_ULOG_TOPIC = "sensor_gyro.0"
+"""The PX4 ULog topic read when ``--topic`` is not given (:mod:`thermocal.readers.ulog`)."""
+
+DEFAULT_DATAFLASH_TOPIC = "IMU.0"
+"""The ArduPilot DataFlash message read when ``--topic`` is not given
+(:mod:`thermocal.readers.dataflash`)."""
+
+
+def parse_topic(topic: str | None, default: str = DEFAULT_ULOG_TOPIC) -> tuple[str, int]:
+    """``NAME[.N]`` → (name, instance) of a flight-controller log's topic (a ULog topic or a
+    DataFlash message); ``default`` when ``topic`` is None."""
+    text = (topic or default).strip()
+    name, _, inst = text.partition(".")
+    if not name or (inst and not inst.isdigit()):
+        raise ThermocalInputError(
+            f"--topic must be NAME or NAME.N (e.g. sensor_gyro.0), got {text!r}"
+        )
+    return name, int(inst or 0)

@@ -18,8 +18,13 @@ from thermocal.errors import (
     MissingColumnError,
     ThermocalInputError,
 )
-from thermocal.readers.common import library_output_captured, names_list, warn_damage
-from thermocal.readers.ulog import parse_topic
+from thermocal.readers.common import (
+    DEFAULT_DATAFLASH_TOPIC,
+    library_output_captured,
+    names_list,
+    parse_topic,
+    warn_damage,
+)
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -65,9 +70,6 @@ int16 'c', scaled by pymavlink), ``MAG`` "TimeUS,I,MagX,…" units "s#GGG…" wi
 "TimeUS,I,SType,Temp,X,Y,Z,NSamp" (no units declared: Temp the learning's temperature [°C];
 X,Y,Z the mean accelerometer [m/s², relative to the first] for SType 0, gyro [rad/s] for
 SType 1 — set per read by :func:`read_dataflash`).  The time is ``TimeUS`` [µs]."""
-
-DEFAULT_DATAFLASH_TOPIC = "IMU.0"
-
 
 DATAFLASH_PADDING = 528
 """Bytes at the end of a DataFlash log that may be padding rather than messages (block

@@ -174,6 +174,130 @@ def _fc_log_unknown_units(
         )
 
 
+def _open_table(
+    p: Path, text: TextOptions | None, topic: str | None
+) -> tuple[pd.DataFrame | ParquetColumns, dict[str, Any]]:
+    """The table of a file (its extension chooses the reader) or of a station's recording
+    folder (``DIR`` or ``DIR/SENSOR``), and what the file and its sidecar say of it."""
+    station = is_station_path(p)  # a station's recording folder, DIR or DIR/SENSOR
+    kind = "station" if station else file_kind(p)
+    if topic is not None and kind not in ("ulog", "dataflash"):
+        raise ThermocalInputError(f"{p}: --topic is for flight-controller logs (.ulg, .bin)")
+    obj, file_meta = read_station_table(p) if station else read_table(p, kind, text, topic)
+    side = load_sidecar(p)
+    info: dict[str, Any] = {**file_meta, **side}
+    return obj, info
+
+
+def _resolve_units(
+    p: Path,
+    info: dict[str, Any],
+    columns: tuple[str, list[str], list[str]],
+    options: units.UnitOptions,
+    meta: Metadata | None,
+    model: units.StatedUnits | None,
+) -> units.ResolvedInputs:
+    """Units and conversions of the time, signal and temperature ``columns`` by the one
+    resolver (:func:`thermocal.units.resolve_inputs`: option > file > column name > model
+    file > a stated default); ``meta``'s conversions count as the file's.  A flight
+    controller's log first refuses signals whose unit nothing states."""
+    time_col, sig_names, tmp_names = columns
+    if info.get("fc_log"):
+        _fc_log_unknown_units(p, info, sig_names, options.signal_unit, model)
+    where = str(p)
+    stated = units.StatedUnits.from_file_info(info, where)
+    return units.resolve_inputs(
+        time_col,
+        sig_names,
+        tmp_names,
+        options=options,
+        file=dataclasses.replace(
+            stated,
+            conversions={**stated.conversions, **(meta.temperature_conversion if meta else {})},
+        ),
+        model=model,
+        where=where,
+    )
+
+
+def _read_other_columns(
+    p: Path,
+    obj: pd.DataFrame | ParquetColumns,
+    names: list[str],
+    cols: dict[str, FloatArray],
+    unit_map: dict[str, str],
+    info: dict[str, Any],
+    skipped: list[str] | None,
+) -> None:
+    """Add the numeric columns of ``names`` not read yet to ``cols`` (with their units:
+    the file's, else from the name); non-numeric ones are skipped (their names appended to
+    ``skipped``)."""
+    extra_units: dict[str, str] = dict(info.get("units") or {})
+    for c in names:
+        if c in cols:
+            continue
+        try:
+            cols[c] = numeric_column(obj, c, p)
+        except NonNumericError:
+            if skipped is not None:
+                skipped.append(c)
+            continue
+        unit_map[c] = units.other_column_unit(c, extra_units.get(c))
+
+
+def _roles(
+    p: Path,
+    names: list[str],
+    info: dict[str, Any],
+    time: str | None,
+    signals: list[str] | None,
+    temperatures: list[str] | None,
+) -> tuple[str, list[str], list[str]]:
+    """The time, signal and temperature columns: as given, else as the file or its
+    sidecar says; a name the file does not have is refused, listing the available ones."""
+    time_col = time or default_time_column(names, info.get("time"))
+    sig_info: dict[str, str] = dict(info.get("signals") or {})
+    tmp_info: dict[str, str] = dict(info.get("temperatures") or {})
+    sig_names = list(signals) if signals is not None else list(sig_info)
+    tmp_names = list(temperatures) if temperatures is not None else list(tmp_info)
+    present = set(names)
+    for c in [time_col, *sig_names, *tmp_names]:
+        if c not in present:
+            raise MissingColumnError(
+                f"{p}: no column {short_name(c)}; available: {names_list(names)}"
+            )
+    return time_col, sig_names, tmp_names
+
+
+def _read_columns(
+    p: Path,
+    obj: pd.DataFrame | ParquetColumns,
+    n_rows: int,
+    n_used: int,
+    time_col: str,
+    named: list[str],
+) -> tuple[FloatArray, dict[str, FloatArray]]:
+    """The time column (in the file's unit) and the ``named`` columns as float64; a Parquet
+    file is read column by column, only these, once its ``n_used`` columns of ``n_rows``
+    are known to fit in memory."""
+    if isinstance(obj, ParquetColumns):  # read column by column: only what is used
+        check_memory(p, n_rows, n_used)
+        obj.read_f64([time_col, *named])
+    t = numeric_column(obj, time_col, p)
+    return t, {c: numeric_column(obj, c, p) for c in named}
+
+
+def _conversions(
+    md: Metadata, tmp_names: list[str], resolved: units.ResolvedInputs
+) -> dict[str, units.TemperatureConversion]:
+    """The temperature conversions a recording keeps: the resolved ones of its temperature
+    columns, the metadata's for the other (guessed) columns."""
+    return {  # the resolved ones; others kept for guessed columns
+        **{c: v for c, v in md.temperature_conversion.items() if c not in tmp_names},
+        **{c: r.conversion for c, r in resolved.conversions.items() if r.conversion is not None},
+    }
+
+
 def read_recording(
     path: str | Path,
     *,
@@ -229,13 +353,7 @@ def read_recording(
     UnitError : an unknown unit string.
     """
     p = Path(path)
-    station = is_station_path(p)  # a station's recording folder, DIR or DIR/SENSOR
-    kind = "station" if station else file_kind(p)
-    if topic is not None and kind not in ("ulog", "dataflash"):
-        raise ThermocalInputError(f"{p}: --topic is for flight-controller logs (.ulg, .bin)")
-    obj, file_meta = read_station_table(p) if station else read_table(p, kind, text, topic)
-    side = load_sidecar(p)
-    info: dict[str, Any] = {**file_meta, **side}
+    obj, info = _open_table(p, text, topic)
 
     names = list(obj.column_names) if isinstance(obj, ParquetColumns) else list(obj.columns)
     if text is not None and text.rate_hz is not None:
@@ -245,70 +363,27 @@ def read_recording(
     n_rows = obj.num_rows if isinstance(obj, ParquetColumns) else len(obj)
     if n_rows == 0:
         raise FileFormatError(f"{p}: the file has a header but no data rows")
-
-    time_col = time or default_time_column(names, info.get("time"))
-    where = str(p)
-    sig_info: dict[str, str] = dict(info.get("signals") or {})
-    tmp_info: dict[str, str] = dict(info.get("temperatures") or {})
-    sig_names = list(signals) if signals is not None else list(sig_info)
-    tmp_names = list(temperatures) if temperatures is not None else list(tmp_info)
     md = Metadata.from_dict(dict(info.get("metadata") or {}))
     if meta is not None:
         md = md.merged(meta)
-
-    present = set(names)
-    for c in [time_col, *sig_names, *tmp_names]:
-        if c not in present:
-            raise MissingColumnError(
-                f"{p}: no column {short_name(c)}; available: {names_list(names)}"
-            )
-
-    if info.get("fc_log"):
-        _fc_log_unknown_units(p, info, sig_names, signal_unit, model)
-    stated = units.StatedUnits.from_file_info(info, where)
-    resolved = units.resolve_inputs(
-        time_col,
-        sig_names,
-        tmp_names,
-        options=units.UnitOptions(
-            time_unit=time_unit,
-            signal_unit=signal_unit,
-            temp_unit=temp_unit,
-            temp_conversion=temp_conversion,
-        ),
-        file=dataclasses.replace(
-            stated,
-            conversions={**stated.conversions, **(meta.temperature_conversion if meta else {})},
-        ),
-        model=model,
-        where=where,
+    time_col, sig_names, tmp_names = _roles(p, names, info, time, signals, temperatures)
+    options = units.UnitOptions(
+        time_unit=time_unit,
+        signal_unit=signal_unit,
+        temp_unit=temp_unit,
+        temp_conversion=temp_conversion,
     )
-    if isinstance(obj, ParquetColumns):  # read column by column: only what is used
-        used = len(names) if keep_other else 1 + len(sig_names) + len(tmp_names)
-        check_memory(p, n_rows, used)
-        obj.read_f64([time_col, *sig_names, *tmp_names])
-    t = numeric_column(obj, time_col, p)
+    resolved = _resolve_units(p, info, (time_col, sig_names, tmp_names), options, meta, model)
+    n_used = len(names) if keep_other else 1 + len(sig_names) + len(tmp_names)
+    t, cols = _read_columns(p, obj, n_rows, n_used, time_col, [*sig_names, *tmp_names])
     if resolved.time.unit != "s":
         t = t * units.TIME_UNITS[resolved.time.unit]
-
-    cols: dict[str, FloatArray] = {c: numeric_column(obj, c, p) for c in [*sig_names, *tmp_names]}
     unit_map: dict[str, str] = resolved.units()
-    md.temperature_conversion = {  # the resolved ones; others kept for guessed columns
-        **{c: v for c, v in md.temperature_conversion.items() if c not in tmp_names},
-        **{c: r.conversion for c, r in resolved.conversions.items() if r.conversion is not None},
-    }
-    extra_units: dict[str, str] = dict(info.get("units") or {})
+    md.temperature_conversion = _conversions(md, tmp_names, resolved)
     if keep_other:
-        for c in names:
-            if c == time_col or c in cols:
-                continue
-            try:
-                cols[c] = numeric_column(obj, c, p)
-            except NonNumericError:
-                if skipped is not None:
-                    skipped.append(c)
-                continue
-            unit_map[c] = units.other_column_unit(c, extra_units.get(c))
+        _read_other_columns(
+            p, obj, [c for c in names if c != time_col], cols, unit_map, info, skipped
+        )
 
     return Recording(
         time_s=t,

@@ -225,20 +225,9 @@ def csv_chunk_options(path: Path, encoding: str) -> dict[str, Any]:
     }
 
 
-def read_text(
-    path: Path, encoding: str, opts: TextOptions | None
-) -> tuple[pd.DataFrame, dict[str, Any]]:
-    """A text log as a DataFrame of floats: banner skipped, delimiter and decimal mark
-    detected (or given), header taken from ``--names`` when the file has none, mangled
-    lines (another number of fields, a non-number) refused naming the first or, with
-    ``on_bad_lines="skip"``, dropped and counted.  Warnings say what was skipped."""
-    o = opts or TextOptions()
-    head = head_lines(path, encoding, "strict")
-    try:
-        lay = sniff_text(head, o)
-    except FileFormatError as exc:
-        raise FileFormatError(f"{path}: {exc}") from None
-    names: list[str] | None = None
+def _column_names(path: Path, head: list[str], lay: TextLayout, o: TextOptions) -> list[str]:
+    """The header row's names, or ``--names`` for a file without one (refused with a
+    header, or when their number is not the number of fields)."""
     if lay.header:
         names = [c.strip() for c in _split(head[lay.skip], lay.delimiter)]
         check_unique_names(path, names)
@@ -260,12 +249,20 @@ def read_text(
                 f"{path}: --names gives {len(names)} names for {lay.n_fields} columns "
                 f"(line {lay.skip + 1}: {head[lay.skip].strip()[:60]!r})"
             )
+    return names
+
+
+def _data_rows(
+    path: Path, encoding: str, lay: TextLayout, n: int, on_bad_lines: str
+) -> tuple[list[list[float]], list[int], list[tuple[int, str]]]:
+    """The data rows as floats, each kept row's place among the data lines, and the
+    mangled lines dropped (line number, text): another number of fields than ``n``, or a
+    non-number, is an error naming the line unless ``on_bad_lines`` is ``"skip"``."""
     first_data = lay.skip + (1 if lay.header else 0)  # 0-based line of the first data row
     bad: list[tuple[int, str]] = []
     rows: list[list[float]] = []
     ordinal: list[int] = []  # each kept row's place among the data lines (dropped ones too)
     n_data = 0
-    n = len(names)
     with open(path, encoding=encoding, errors="strict", newline="") as fh:
         for lineno, line in enumerate(fh, start=1):
             if lineno <= first_data:
@@ -283,12 +280,30 @@ def read_text(
                 )
                 ordinal.append(n_data - 1)
             except ValueError as exc:
-                if o.on_bad_lines == "error":
+                if on_bad_lines == "error":
                     raise FileFormatError(
                         f"{path}: line {lineno} is not a data row ({exc}): {text.strip()[:80]!r}; "
                         "fix it or pass --on-bad-lines skip to drop such lines"
                     ) from None
                 bad.append((lineno, text))
+    return rows, ordinal, bad
+
+
+def read_text(
+    path: Path, encoding: str, opts: TextOptions | None
+) -> tuple[pd.DataFrame, dict[str, Any]]:
+    """A text log as a DataFrame of floats: banner skipped, delimiter and decimal mark
+    detected (or given), header taken from ``--names`` when the file has none, mangled
+    lines (another number of fields, a non-number) refused naming the first or, with
+    ``on_bad_lines="skip"``, dropped and counted.  Warnings say what was skipped."""
+    o = opts or TextOptions()
+    head = head_lines(path, encoding, "strict")
+    try:
+        lay = sniff_text(head, o)
+    except FileFormatError as exc:
+        raise FileFormatError(f"{path}: {exc}") from None
+    names = _column_names(path, head, lay, o)
+    rows, ordinal, bad = _data_rows(path, encoding, lay, len(names), o.on_bad_lines)
     if not rows:
         raise FileFormatError(f"{path}: the file has a header but no data rows")
     df = pd.DataFrame(np.asarray(rows, dtype=np.float64), columns=names)

@@ -22,6 +22,7 @@ from thermocal.readers.common import (
     LogDamageWarning,
     TrackedReader,
     library_output_captured,
+    parse_topic,
     warn_damage,
 )
 from thermocal.recording import FloatArray
@@ -69,19 +70,6 @@ array's elements ``name[i]``.  ``vehicle_imu`` is also given as rates:
 ``gyro_rad_s[i] = delta_angle[i] / delta_angle_dt`` [rad/s] and
 ``accel_m_s2[i] = delta_velocity[i] / delta_velocity_dt`` [m/s²] (columns added by the
 reader).  The time is ``timestamp`` [µs]."""
-
-DEFAULT_ULOG_TOPIC = "sensor_gyro.0"
-
-
-def parse_topic(topic: str | None, default: str = DEFAULT_ULOG_TOPIC) -> tuple[str, int]:
-    """``NAME[.N]`` → (name, instance); default :data:`DEFAULT_ULOG_TOPIC`."""
-    text = (topic or default).strip()
-    name, _, inst = text.partition(".")
-    if not name or (inst and not inst.isdigit()):
-        raise ThermocalInputError(
-            f"--topic must be NAME or NAME.N (e.g. sensor_gyro.0), got {text!r}"
-        )
-    return name, int(inst or 0)
 
 
 @dataclass(frozen=True)

@@ -15,7 +15,8 @@ import numpy as np
 from thermocal import units
 from thermocal.compensate.kernels import unit_factor
 from thermocal.metrics import RATE_ANGLE_UNITS, DriftReference, compute_metrics, drift_angle
-from thermocal.models.base import RunData, TemperatureModel
+from thermocal.models.base import RunData
+from thermocal.models.registry import model_from_dict
 from thermocal.recording import FloatArray, Metadata, Recording
 from thermocal.stability.allan import AllanResult, NoiseTerms, noise_terms, overlapping_adev
 
@@ -91,7 +92,7 @@ def apply_model(model_dict: dict[str, Any], rec: Recording, signal: str | None) 
     (clamped, as in compensation); :class:`~thermocal.errors.ExtrapolationWarning`
     messages are collected, not raised.
     """
-    model = TemperatureModel.from_dict(model_dict)
+    model = model_from_dict(model_dict)
     sig_name = signal or (model_dict.get("signal") or {}).get("name")
     if sig_name not in rec.columns:
         sig_name = None if not rec.signals else rec.signals[0]

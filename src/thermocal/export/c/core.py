@@ -202,7 +202,7 @@ def family_generator(family: str) -> Generator:
     options, chunk context and C code are declared in one place."""
     import importlib
 
-    from thermocal.models import MODEL_REGISTRY
+    from thermocal.models.registry import MODEL_REGISTRY
 
     cls = MODEL_REGISTRY.get(family)
     module = getattr(cls, "C_GENERATOR", None) if cls is not None else None
