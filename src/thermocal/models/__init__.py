@@ -6,7 +6,6 @@ The families are listed once, in :data:`thermocal.models.registry.MODEL_REGISTRY
 
 from __future__ import annotations
 
-
 from thermocal.models.base import (
     Coefficient,
     FitStats,
