@@ -21,13 +21,15 @@ from typing import TYPE_CHECKING, Any
 from thermocal._version import __version__
 
 if TYPE_CHECKING:
+    from thermocal.models.files import load_calibration, load_model, save_model
     from thermocal.readers.dispatch import read_recording
     from thermocal.recording import Metadata, Recording
     from thermocal.writers import write_recording
 
 
 def __getattr__(name: str) -> Any:
-    """``read_recording`` and ``write_recording`` are imported on first use, so that the
+    """``read_recording``, ``write_recording`` and the model-file functions are imported on
+    first use, so that the
     maths modules (``import thermocal.metrics`` …) do not load the file layer (pandas,
     pyarrow) with the package."""
     if name == "read_recording":
@@ -38,6 +40,10 @@ def __getattr__(name: str) -> Any:
         from thermocal import writers
 
         return writers.write_recording
+    if name in ("load_model", "save_model", "load_calibration"):
+        from thermocal.models import files
+
+        return getattr(files, name)
     if name in ("Metadata", "Recording"):  # numpy: imported on first use too
         from thermocal import recording
 
@@ -45,4 +51,13 @@ def __getattr__(name: str) -> Any:
     raise AttributeError(f"module 'thermocal' has no attribute {name!r}")
 
 
-__all__ = ["Metadata", "Recording", "__version__", "read_recording", "write_recording"]
+__all__ = [
+    "Metadata",
+    "Recording",
+    "__version__",
+    "load_calibration",
+    "load_model",
+    "read_recording",
+    "save_model",
+    "write_recording",
+]

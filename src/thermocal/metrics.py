@@ -550,10 +550,8 @@ def data_unit_of(rec: Recording, name: str, canonical: str) -> tuple[str, float]
     factor K converted them, else ``counts``), so k = 1.
     """
     given = rec.units.get(name)
-    u = units.normalize_signal_unit(given) if given else canonical
-    if u == "counts" or u == canonical:
-        return canonical, 1.0
-    return u, float(units.convert(1.0, u, canonical))
+    shown = units.shown_unit(canonical, units.normalize_signal_unit(given) if given else None)
+    return shown.unit, shown.to_model
 
 
 def _earth_rate(

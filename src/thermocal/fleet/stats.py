@@ -43,13 +43,10 @@ def shown_unit(model_unit: str, data_unit: str) -> tuple[str, float]:
     from thermocal.errors import UnitError
 
     try:
-        mu, du = units.normalize_signal_unit(model_unit), units.normalize_signal_unit(data_unit)
-        kind = units.signal_kind(mu)
-        if kind != "raw" and units.signal_kind(du) == kind:
-            return du, float(units.convert(1.0, mu, du))
+        shown = units.shown_unit(model_unit, units.normalize_signal_unit(data_unit))
     except UnitError:
-        pass
-    return model_unit, 1.0
+        return model_unit, 1.0
+    return shown.unit, shown.to_shown
 
 
 def convert_unit_label(unit: str, model_unit: str, shown: str) -> str | None:

@@ -30,7 +30,6 @@ from typing import TYPE_CHECKING, Any, cast
 
 import numpy as np
 
-from thermocal import errors as _errors
 from thermocal import units
 from thermocal.defaults import overrides_of
 from thermocal.errors import ConditioningWarning, ThermocalInputError
@@ -341,11 +340,8 @@ def _data_unit(first_inputs: dict[str, Any], sig_name: str, unit: str) -> tuple[
     """The data's own unit of a channel (as given in the file, option or column name) and
     the factor from the model's canonical unit to it (raw counts scaled to a physical unit
     stay in the canonical unit)."""
-    given = str((first_inputs.get("units") or {}).get(sig_name, unit))
-    try:
-        return given, float(units.convert(1.0, unit, given))
-    except _errors.UnitError:
-        return unit, 1.0
+    shown = units.shown_unit(unit, str((first_inputs.get("units") or {}).get(sig_name, unit)))
+    return shown.unit, shown.to_shown
 
 
 def _judge_channel(

@@ -39,7 +39,7 @@ from markupsafe import Markup, escape
 
 from thermocal import units
 from thermocal.defaults import DEFAULT_AVERAGING_S, WEAK_CORRELATION_LIMIT
-from thermocal.errors import ThermocalInputError, ThermocalWarning, UnitError
+from thermocal.errors import ThermocalInputError, ThermocalWarning
 from thermocal.metrics import data_unit_of
 from thermocal.models.base import condition_wording
 from thermocal.recording import Recording
@@ -511,12 +511,9 @@ def model_factor(model: dict[str, Any], unit: str | None) -> tuple[str, float]:
     """(the model's signal unit, k) with ``value[model unit] = k · value[unit]``; k = 1 when
     ``unit`` is not given, equal, or of another kind (counts)."""
     mu = str((model.get("signal") or {}).get("unit") or "")
-    if not unit or not mu or unit == mu:
+    if not mu:
         return mu, 1.0
-    try:
-        return mu, float(units.convert(1.0, unit, mu))
-    except (UnitError, ThermocalInputError):
-        return mu, 1.0
+    return mu, units.shown_unit(mu, unit).to_model
 
 
 def _coefficient_rows(

@@ -101,11 +101,8 @@ def judge_sensor(
     minimum sweep for ``firmware="ardupilot"``; refuses (exit 2) what is not overridden."""
     temp = rec.temperature_c("temperature")
     unit = rec.signal(AXES[0])[1]
-    given = rec.units.get(AXES[0], unit)
-    try:
-        factor = float(units.convert(1.0, unit, given))
-    except ThermocalInputError:
-        factor, given = 1.0, unit
+    shown = units.shown_unit(unit, rec.units.get(AXES[0], unit))
+    factor, given = shown.to_shown, shown.unit
     tname = f"{where} temperature"
     judged = adequacy.judge(
         adequacy.Needs({tname: 3}, 4),
