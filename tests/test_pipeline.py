@@ -183,7 +183,8 @@ _WORDS = {"or", "and", "to", "is", "with", "for", "in", "on", "the", "a", "an", 
 """Words that may follow a flag in a sentence (anything else after a flag is a value)."""
 
 FIT_MODULES = ["pipeline/fit.py", "pipeline/reading.py", "cli/fit_cmd.py", "adequacy.py",
-               "gravity.py", "units.py", "recording.py", "readers/*.py", "models/*.py"]  # fmt: skip
+               "gravity.py", "units.py", "recording.py", "readers/[!p]*.py", "models/*.py"]  # fmt: skip
+"""What ``fit`` runs (readers/program.py, the chamber-program reader of ``profile``, is not)."""
 VALIDATE_MODULES = ["pipeline/validate.py", "pipeline/reading.py", "cli/validate_cmd.py",
                     "validation.py", "compensate/kernels.py", "models/base.py",
                     "models/files.py", "models/calibration.py"]  # fmt: skip
