@@ -36,6 +36,7 @@ from thermocal.cli.common import (
     TempUnitOpt,
     TimeOpt,
     TimeUnitOpt,
+    TopicOpt,
     TurntableLatitudeOpt,
     emit,
     fmt,
@@ -190,6 +191,7 @@ def validate_cmd(
     on_bad_lines: OnBadLinesOpt = "error",
     delimiter: DelimiterOpt = None,
     decimal: DecimalOpt = None,
+    topic: TopicOpt = None,
     latitude: TurntableLatitudeOpt = None,
     as_json: JsonOpt = False,
 ) -> None:

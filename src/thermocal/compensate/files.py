@@ -1052,12 +1052,17 @@ def read_for_triads(
     *,
     time: str | None = None,
     time_unit: str | None = None,
+    text: TextOptions | None = None,
+    topic: str | None = None,
 ) -> Recording:
     """A recording read for triad calibrations: their temperature columns as temperatures,
     so that their units go through the resolver (option > metadata > column name); the
-    triads' own columns keep the unit their metadata or name states."""
+    triads' own columns keep the unit their metadata or name states.  ``text`` and ``topic``:
+    the text-log options and log topic every command reads a recording with."""
     temps = list(dict.fromkeys(t.temperature for t in triads if t.temperature))
-    return read_recording(path, time=time, time_unit=time_unit, temperatures=temps)
+    return read_recording(
+        path, time=time, time_unit=time_unit, temperatures=temps, text=text, topic=topic
+    )
 
 
 def compensate_triads(

@@ -79,7 +79,8 @@ class FitOptions:
 class ValidateOptions:
     """``thermocal validate`` (INTERFACE.md; :func:`thermocal.pipeline.validate.validate_files`).
     The text-log options (``names``, ``rate``, ``on_bad_lines``, ``delimiter``, ``decimal``)
-    apply to the validated file and to the ``modeling`` file alike."""
+    apply to the validated file and to the ``modeling`` file alike; the log ``topic`` to each
+    of them that is a flight-controller log (a CSV modelling run of a logged test)."""
 
     modeling: Path | None = None
     ambient: str | None = None
@@ -99,6 +100,7 @@ class ValidateOptions:
     on_bad_lines: str = "error"
     delimiter: str | None = None
     decimal: str | None = None
+    topic: str | None = None
     latitude: float | None = None
 
 

@@ -21,6 +21,7 @@ from typing import TYPE_CHECKING, Any
 from thermocal.errors import ThermocalInputError, UnitWarning
 from thermocal.pipeline.options import ValidateOptions
 from thermocal.pipeline.reading import load_recording, split_names, text_options
+from thermocal.readers.common import file_kind
 
 if TYPE_CHECKING:
     from thermocal.models.base import TemperatureModel
@@ -140,6 +141,7 @@ def _modeling_ambient(
             require_signal=False,
             check=False,
             text=ctx.text,
+            topic=o.topic if file_kind(mod_path) in ("ulog", "dataflash") else None,
         )
         for prob in recording.find_problems(mrec, required=[amb]):
             if prob.severity == "error" and (prob.column in (None, "time", amb)):
@@ -172,6 +174,7 @@ def _validate_channel(
             temp_conversion=o.temp_conversion,
             model=model,
             text=ctx.text,
+            topic=o.topic,
         )
     # the data in the model's units (kinds checked); figures go back to the data's unit
     prepared = compensate.prepare_run(model, rec, sig, temps)
@@ -230,6 +233,7 @@ def _validate_channels(ctx: _Context, cal: Calibration) -> ValidationReport:
         temp_conversion=o.temp_conversion,
         model_inputs=merged_inputs(cal, chosen),
         text=ctx.text,
+        topic=o.topic,
     )
     per = []
     for n in chosen:
@@ -249,7 +253,14 @@ def _validate_triads(
     from thermocal.multipos import validate as _mp_validate
     from thermocal.turntable.calibrate import validate_triads
 
-    rec = read_for_triads(file, cal.triads, time=o.time, time_unit=o.time_unit)
+    rec = read_for_triads(
+        file,
+        cal.triads,
+        time=o.time,
+        time_unit=o.time_unit,
+        text=text_options(o.names, o.rate, o.on_bad_lines, o.delimiter, o.decimal),
+        topic=o.topic,
+    )
     if _mp_validate.is_multipos(cal.triads):  # held-out poses (issue 30)
         results: list[Any] = _mp_validate.validate_triads(cal.triads, rec, o.latitude)
     else:
