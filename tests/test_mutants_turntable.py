@@ -16,7 +16,9 @@ import pytest
 
 from thermocal.turntable import accel, calibrate, simulate_turntable16
 from thermocal.turntable.model import MISALIGNMENT_NAMES, error_matrices
-from thermocal.turntable.schedule import POSITIONS_16, build_schedule, segment
+from thermocal.errors import DesignError
+from thermocal.turntable.calibrate import estimate_arw
+from thermocal.turntable.schedule import POSITIONS_16, Dwell, build_schedule, detect_motion, segment
 from thermocal.turntable.thermal import fit_triad
 
 G = 9.80619
@@ -236,3 +238,72 @@ def test_thermal_fit_loto_rms_and_default_reference_by_hand() -> None:
             pred[i] = np.polyval(c, temps[i])
         want = float(np.sqrt(np.mean((pred - th[:, k]) ** 2)))
         assert fit.fits[k].loto_rms == pytest.approx(want, rel=1e-9)
+
+
+def test_arw_from_short_dwells_by_hand() -> None:
+    """N² = τ · Σ_d Σ_i (g_i − ḡ_d)² / Σ_d (n_d − 1) (IEEE Std 952 annex C) over dwells of
+    4 … 8 samples, where n and n − 1 differ by up to 25 % (mutant turntable-arw-dof)."""
+    rng = np.random.default_rng(8)
+    g = rng.normal(0.0, 1e-4, (60, 3))
+    dt = np.full(59, 0.2)
+    dwells = [Dwell(a, b, 0.2 * a, 0.2 * (b - a), 0.0, 0.0) for a, b in ((0, 4), (10, 16), (30, 38))]
+    ss, dof = np.zeros(3), 0
+    for d in dwells:
+        x = g[1:][d.start : d.stop]
+        ss += ((x - x.mean(axis=0)) ** 2).sum(axis=0)
+        dof += x.shape[0] - 1
+    np.testing.assert_allclose(estimate_arw(g, dt, dwells), np.sqrt(ss / dof * 0.2), rtol=1e-12)
+
+
+def test_the_rest_band_is_eight_jitter_sigmas() -> None:
+    """Encoder readings at rest with 5″ white jitter: the jitter is found from second
+    differences (σ of d² = σ√6) and the band an angle must stay within to count as held is
+    8σ + 2q + 2″ = 42″ (mutant turntable-mad-scale reads σ√3 too large)."""
+    rng = np.random.default_rng(9)
+    t = np.arange(20000) * 0.01
+    a = 12.345678 + rng.normal(0.0, 5.0 / 3600.0, t.size)
+    b = 7.654321 + rng.normal(0.0, 5.0 / 3600.0, t.size)
+    mot = detect_motion(t, a, b)
+    # (a spurious grid of 360/2^24° is found in such readings: reported to the lead; its
+    # 2q is 0.15″ here, counted below)
+    q_arcsec = mot.quantum_deg * 3600.0
+    assert q_arcsec < 0.1
+    assert mot.tolerance_deg * 3600.0 == pytest.approx(8.0 * 5.0 + 2.0 * q_arcsec + 2.0, rel=0.05)
+    assert mot.noise_arcsec == pytest.approx(5.0, rel=0.05)
+
+
+def test_a_rest_just_longer_than_the_pause_is_a_dwell() -> None:
+    """Rests of 12 s and 8 s with a 10 s pause: the first is a dwell, the second is not
+    (mutant turntable-dwell-pause-strict drops the first)."""
+    t = np.arange(0.0, 20.5, 0.5)
+    alpha = np.where(t <= 12.0, 0.0, 90.0)
+    moving = np.zeros(t.size - 1, dtype=bool)
+    moving[24] = True  # 12.0 → 12.5 s
+    seg = segment(t, alpha, np.zeros_like(t), moving, np.ones(t.size - 1, dtype=bool), pause_s=10.0)
+    assert [(d.start, d.stop) for d in seg.dwells] == [(0, 24)]
+    assert seg.dwells[0].duration_s == pytest.approx(12.0)
+
+
+def test_five_attitudes_are_refused_for_an_accelerometer_triad() -> None:
+    """Four unknowns per axis need more than four dwells; six are asked for (SPEC §7: the
+    residual gives the σ): five independent attitudes are a DesignError (mutant
+    turntable-accel-min-dwells fits them)."""
+    pos = np.array([POSITIONS_16[i] for i in (0, 1, 2, 3, 8, 12)], dtype=np.float64)
+    f_true = accel.gravity_in_body(pos[:, 0], pos[:, 1], G)
+    accel.estimate_accel_triad(f_true, f_true, np.full(6, 100.0))
+    with pytest.raises(DesignError, match="at least 6"):
+        accel.estimate_accel_triad(f_true[:5], f_true[:5], np.full(5, 100.0))
+
+
+def test_residuals_three_times_the_stated_noise_are_reported() -> None:
+    """An ARW stated at a third of the true one: the least squares' χ²/dof is ≈ 9, far
+    beyond 1 + 5√(2/dof), and a warning says so (mutant turntable-chi2-warning-threshold
+    reports only beyond 1 + 5000√(2/dof))."""
+    rec, est = _run()
+    arw = [float(v) / 3.0 for v in est.arw_deg_sqrt_h]  # type: ignore[attr-defined]
+    assert not any("white-noise level" in w for w in est.warnings)  # type: ignore[attr-defined]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        low = calibrate(rec, 40.0, arw_deg_sqrt_h=arw)  # type: ignore[arg-type]
+    assert low.chi2_per_dof == pytest.approx(9.0, rel=0.2)
+    assert any("white-noise level" in w for w in low.warnings)
