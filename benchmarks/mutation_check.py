@@ -61,10 +61,10 @@ UNITS = _t("mutants_units", "units", "units_resolver", "units_property", "units_
 TEXT = _t("mutants_units", "text_logs", "tests/attacks/test_text_attacks.py")
 PARAMS = _t("mutants_export", "export_params", "tests/attacks/test_export_params_attacks.py")
 PX4 = _t("mutants_export", "px4_tempcal", "px4_baro_mag", "ardupilot_tempcal")
-ADEQ = _t("adequacy", "fc_gates")
-STAB = _t("stability_reference", "allan", "allan_references")
-NOISE = _t("stability_noise_terms", "noise_cmd")
-MULTI = _t("multipos")
+ADEQ = _t("mutants_maths", "adequacy", "fc_gates")
+STAB = _t("mutants_maths", "stability_reference", "allan", "allan_references")
+NOISE = _t("mutants_maths", "stability_noise_terms", "noise_cmd")
+MULTI = _t("mutants_maths", "multipos")
 STATION = _t("station")
 FC = _t("fc_log_readers", "fc_gates")
 EXPC = _t("export_c", "export_c_edges", "export_c_triads", "export_c_units")
@@ -72,7 +72,7 @@ COMP = _t("compensate", "outside_range", "judge_absolute")
 GRAV = _t("gravity_tilt", "gravity_tref")
 IDS = _t("c_identifiers", "tests/attacks/test_generated_code_attacks.py")
 OUTS = _t("faults", "tests/attacks/test_output_attacks.py")
-METRICS = _t("metrics", "drift_angle", "metrics_runs")
+METRICS = _t("mutants_maths", "metrics", "drift_angle", "metrics_runs")
 
 
 MUTANTS: tuple[Mutant, ...] = (
