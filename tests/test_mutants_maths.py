@@ -31,3 +31,66 @@ def test_the_temperature_rate_is_in_degrees_per_minute() -> None:
     rate = adequacy.temperature_rate_c_per_min(t, 20.0 + 1.5 * t / 60.0)
     assert rate.size == t.size - 60
     np.testing.assert_allclose(rate, 1.5, rtol=1e-12)
+
+
+def test_small_records_span_their_whole_range() -> None:
+    """Under 1000 samples the span is max − min (no percentile cut): 999 samples from 20
+    to 30 °C and one at 40 °C span 20 °C (mutant adequacy-robust-range-small cuts the
+    0.1/99.9 percentiles)."""
+    t = np.r_[np.linspace(20.0, 30.0, 998), 40.0]
+    span = next(x for x in adequacy.temperature_tests(t, "T", 1) if x.name == "temperature_span")
+    assert span.figure == pytest.approx(20.0, abs=1e-12)
+
+
+def test_the_range_ends_figure_is_the_emptier_end() -> None:
+    """989 samples at 20 °C and a ramp of 10 samples to 40 °C: the lowest tenth (≤ 22 °C)
+    holds 990 of 999 samples, the highest tenth (≥ 38 °C) one: 0.1 %, a warning (mutant
+    adequacy-ends-share judges the fuller end)."""
+    t = np.r_[np.full(989, 20.0), np.linspace(20.0, 40.0, 10)]
+    ends = next(x for x in adequacy.temperature_tests(t, "T", 1) if x.name == "range_ends")
+    assert ends.figure == pytest.approx(100.0 / 999.0, rel=1e-12)
+    assert ends.verdict == "warn"
+
+
+def test_a_gyro_moving_a_tenth_of_the_time_is_refused() -> None:
+    """2000 s at 10 Hz, still (10 °/h noise) but for twenty 10 s turns at 3000 °/h (above
+    the 0.3 °/s = 1080 °/h floor, below the 20 °/s of a rotating gyro): moving ≈ 10 % of
+    the record, more than the 2 % allowed: a failure (mutant adequacy-moving-share-strict
+    allows 20 %)."""
+    rng = np.random.default_rng(6)
+    t = np.arange(0.0, 2000.0, 0.1)
+    v = rng.normal(0.0, 10.0, t.size)
+    for k in range(20):
+        v[(t >= 50.0 + 100.0 * k) & (t < 60.0 + 100.0 * k)] += 3000.0
+    res = adequacy.stillness_test(t, v, "gyro", "g")
+    assert res.verdict == "fail"
+    assert 5.0 < res.figure < 20.0  # [%]
+
+
+def test_noise_model_bound_and_discrete_conversion_by_hand() -> None:
+    """White rate noise only (1000 s at 100 Hz, 36 °/h): the rate random walk is not in the
+    record, so it is the bound K ≤ σ_high(τ)·√(3/τ) minimised over τ (the +½ line read at
+    τ = 3 s: mutant noise-model-walk-sqrt3 uses 3 for √3), in rad/s²/√Hz; Kalibr's file
+    states the discrete σ_d = σ_c/√Δt of the density (mutant noise-model-discrete-sqrt-dt
+    writes σ_c·√Δt)."""
+    import math
+
+    from thermocal.stability.noise_model import axis_noise, kalibr_yaml, noise_model
+
+    rng = np.random.default_rng(13)
+    v = rng.normal(0.0, 36.0, 100_000)
+    ax = axis_noise(v, 0.01, name="gx", sensor="gyro", unit="deg/h")
+    assert ax.walk.method == "bound"
+    res = ax.allan
+    ok = np.isfinite(res.adev_high) & (res.adev > 0)
+    bound = np.min(res.adev_high[ok] * np.sqrt(3.0 / res.tau_s[ok]))
+    assert ax.walk.value == pytest.approx(bound * math.pi / 180.0 / 3600.0, rel=1e-12)
+    text = kalibr_yaml(noise_model([ax], 100.0), "test")
+    lines = text.splitlines()
+    k = next(i for i, x in enumerate(lines) if x.startswith("gyroscope_noise_density:"))
+    sigma_c = float(lines[k].split(":")[1])
+    disc = next(x for x in lines[:k][::-1] if "σ_d" in x)
+    assert "σ_c / √Δt" in disc
+    assert float(disc.rsplit("=", 1)[1]) == pytest.approx(sigma_c / math.sqrt(0.01), rel=1e-5)
+    # the density itself: 36 °/h white noise at 100 Hz is 36/√100 °/h/√Hz = 3.6 °/h/√Hz
+    assert sigma_c == pytest.approx(3.6 * math.pi / 180.0 / 3600.0, rel=0.05)
