@@ -94,3 +94,33 @@ def test_noise_model_bound_and_discrete_conversion_by_hand() -> None:
     assert float(disc.rsplit("=", 1)[1]) == pytest.approx(sigma_c / math.sqrt(0.01), rel=1e-5)
     # the density itself: 36 °/h white noise at 100 Hz is 36/√100 °/h/√Hz = 3.6 °/h/√Hz
     assert sigma_c == pytest.approx(3.6 * math.pi / 180.0 / 3600.0, rel=0.05)
+
+
+def test_mtie_of_gapped_data_is_the_largest_over_the_stretches() -> None:
+    """Two gap-free stretches of rate data (τ0 = 1 s), the second wandering more: MTIE(m)
+    of the whole is the larger of the two stretches' own MTIE (mutant stability-mtie-sum
+    adds them); the phase over a gap is unknown, so no window spans it."""
+    from thermocal.stability.family import stability
+
+    rng = np.random.default_rng(17)
+    y = np.r_[rng.normal(0.0, 1.0, 300), rng.normal(0.0, 3.0, 300)]
+    taus = [1.0, 4.0, 16.0]
+    res = stability(y, 1.0, ["mtie"], taus, segments=[slice(0, 300), slice(300, 600)])
+    one = stability(y[:300], 1.0, ["mtie"], taus).curves["mtie"].dev
+    two = stability(y[300:], 1.0, ["mtie"], taus).curves["mtie"].dev
+    np.testing.assert_allclose(res.curves["mtie"].dev, np.maximum(one, two), rtol=1e-12)
+    assert np.all(two > one)
+
+
+def test_mdev_stops_where_its_terms_do() -> None:
+    """Modified Allan deviation of N phase points needs N − 3m + 1 ≥ 1 terms: with 31
+    points every m up to 10 has a finite value with that many terms, and none beyond
+    (mutant stability-mdev-max-factor asks for m = 11)."""
+    from thermocal.stability.family import stability
+
+    x = np.random.default_rng(3).normal(0.0, 1.0, 31)
+    res = stability(x, 1.0, ["mdev"], "all", data_type="phase")
+    c = res.curves["mdev"]
+    assert list(c.m) == list(range(1, 11))
+    assert np.all(np.isfinite(c.dev))
+    np.testing.assert_array_equal(c.n_terms, 31 - 3 * c.m + 1)
