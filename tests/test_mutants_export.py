@@ -81,9 +81,7 @@ def test_a_bias_step_on_one_imu_is_judged_against_the_motion_floor(
     on the other instance 20 s later (within the 60 s stillness window) is the board
     moving, not reported (mutant px4-step-window)."""
     n = 10_000
-    fits = [
-        SensorFit("sensor_gyro", "gyro", i, 0, "deg/h", (20.0, 40.0), n, 40) for i in (0, 1)
-    ]
+    fits = [SensorFit("sensor_gyro", "gyro", i, 0, "deg/h", (20.0, 40.0), n, 40) for i in (0, 1)]
     series = {
         "sensor_gyro.0": _series(n, n // 2, step_deg_h, 1),
         "sensor_gyro.1": _series(n, other_step_at, step_deg_h, 2),
@@ -156,7 +154,9 @@ def test_six_soak_temperatures_are_too_few_bins_for_a_cubic(
     t = np.arange(temp.size) * 0.1
     g = 0.001 * temp[:, None] * np.ones(3) + rng.normal(0.0, 1e-4, (temp.size, 3))
     ts = (1e6 + t * 1e6).astype(np.int64)
-    rows = [(int(s), 2293768, *map(float, v), float(tt)) for s, v, tt in zip(ts, g, temp, strict=True)]
+    rows = [
+        (int(s), 2293768, *map(float, v), float(tt)) for s, v, tt in zip(ts, g, temp, strict=True)
+    ]
     log = tmp_path / "soaks.ulg"
     log.write_bytes(ulog_bytes([("sensor_gyro", 0, SENSOR_FIELDS, rows)]))
     assert main(["px4-tempcal", str(log), "-o", str(tmp_path / "out")]) == 2

@@ -66,8 +66,8 @@ def test_normal_gravity_at_the_equator_and_the_poles() -> None:
 def test_unit_constants_by_hand() -> None:
     """1 mg = 9.80665e-3 m/s²; an ARW of 1 °/h/√Hz is 1/60 °/√h (√3600 s in an hour)
     (mutants units-mg-factor, units-arw-per-60)."""
-    assert units.MG_TO_MS2 == pytest.approx(9.80665e-3, rel=1e-15)
-    assert units.ARW_DEG_SQRT_H_PER_DEG_H_SQRT_HZ == pytest.approx(1.0 / math.sqrt(3600.0))
+    assert pytest.approx(9.80665e-3, rel=1e-15) == units.MG_TO_MS2
+    assert pytest.approx(1.0 / math.sqrt(3600.0)) == units.ARW_DEG_SQRT_H_PER_DEG_H_SQRT_HZ
     assert float(units.convert(1.0, "mg", "m/s^2")) == pytest.approx(9.80665e-3, rel=1e-15)
 
 

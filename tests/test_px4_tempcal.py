@@ -238,7 +238,8 @@ def test_px4_accel_offsets_are_the_truth_relative_to_mid_range(sweep: dict) -> N
 
     def truth(temp: np.ndarray) -> np.ndarray:
         x = (temp - 20.0) / 30.0
-        return np.column_stack([0.05 + 0.08 * x + 0.02 * x**3, -0.03 * x, -G0 + 0.1 * x - 0.03 * x**2])
+        ax = 0.05 + 0.08 * x + 0.02 * x**3
+        return np.column_stack([ax, -0.03 * x, -G0 + 0.1 * x - 0.03 * x**2])
 
     want = truth(T) - truth(np.array([mid]))
     for i in range(3):
