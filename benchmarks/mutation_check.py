@@ -68,9 +68,9 @@ MULTI = _t("mutants_maths", "multipos")
 STATION = _t("station")
 FC = _t("mutants_units", "fc_log_readers", "fc_gates")
 EXPC = _t("export_c", "export_c_edges", "export_c_triads", "export_c_units")
-COMP = _t("compensate", "outside_range", "judge_absolute")
-GRAV = _t("gravity_tilt", "gravity_tref")
-IDS = _t("c_identifiers", "tests/attacks/test_generated_code_attacks.py")
+COMP = _t("mutants_maths", "compensate", "outside_range", "judge_absolute")
+GRAV = _t("mutants_maths", "gravity_tilt", "gravity_tref")
+IDS = _t("mutants_maths", "c_identifiers", "tests/attacks/test_generated_code_attacks.py")
 OUTS = _t("faults", "tests/attacks/test_output_attacks.py")
 METRICS = _t("mutants_maths", "metrics", "drift_angle", "metrics_runs")
 
@@ -1122,7 +1122,7 @@ MUTANTS: tuple[Mutant, ...] = (
         P + "preprocess.py",
         'lo = np.searchsorted(ts, ti - interval_s / 2.0, side="left")',
         'lo = np.searchsorted(ts, ti - interval_s, side="left")',
-        _t("preprocess"),
+        _t("mutants_maths", "preprocess"),
         "centred Ṫ over 1.5 Δ",
     ),
 )

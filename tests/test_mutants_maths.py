@@ -124,3 +124,77 @@ def test_mdev_stops_where_its_terms_do() -> None:
     assert list(c.m) == list(range(1, 11))
     assert np.all(np.isfinite(c.dev))
     np.testing.assert_array_equal(c.n_terms, 31 - 3 * c.m + 1)
+
+
+def test_absolute_figures_and_the_worse_rule_by_hand() -> None:
+    """Errors 3 and 4 about zero: mean 3.5, rms √12.5, max 4 (mutant
+    compensate-abs-rms-about-mean gives the σ 0.5); an rms about zero 1.0 → 1.2 is worse
+    beyond the tolerance, 1.0 → 1.0 + tolerance/2 is not (mutant compensate-worse-strict
+    needs 10× the tolerance)."""
+    from thermocal.compensate.kernels import (
+        ABSOLUTE_WORSE_TOLERANCE,
+        AbsoluteFigures,
+        absolute_error_worse,
+        absolute_figures,
+    )
+
+    f = absolute_figures([3.0, 4.0])
+    assert (f.mean, f.max_abs) == (3.5, 4.0)
+    assert f.rms_about_zero == pytest.approx(np.sqrt(12.5), rel=1e-15)
+    tol = ABSOLUTE_WORSE_TOLERANCE
+    assert 0.0 < tol < 0.1
+    before = AbsoluteFigures(0.0, 1.0, 2.0)
+    assert absolute_error_worse(before, AbsoluteFigures(0.0, 1.0 + 2.0 * tol, 2.0)) == [
+        "rms about zero"
+    ]
+    assert absolute_error_worse(before, AbsoluteFigures(0.0, 1.0 + 0.5 * tol, 2.0)) == []
+
+
+def test_centred_rate_of_a_parabola_is_its_derivative() -> None:
+    """T = 20 + 0.001 t² sampled each second: the centred Ṫ over Δ = 60 s, (T(t+30) −
+    T(t−30))/60 × 60, is exactly 0.002 t × 60 [°C/min] away from the ends (mutant
+    preprocess-centred-half reaches back 60 s: 0.002 t × 60 − 1.8)."""
+    from thermocal.preprocess import temperature_rate
+
+    t = np.arange(0.0, 600.0, 1.0)
+    rate = temperature_rate(t, 20.0 + 0.001 * t**2, 60.0, "centred")
+    inner = (t >= 30.0) & (t <= 569.0)
+    np.testing.assert_allclose(rate[inner], 0.002 * t[inner] * 60.0, rtol=0, atol=1e-9)
+
+
+def test_runs_in_different_directions_are_different_placements() -> None:
+    """Means along +z, +z (0.5° off) and +x [mg]: the first two are one placement within
+    the tolerance, the third another (mutant gravity-placement-tolerance joins all)."""
+    from thermocal.gravity import group_placements
+
+    s = np.sin(np.radians(0.5))
+    dirs, place = group_placements(
+        [(0.0, 0.0, 1000.0), (1000.0 * s, 0.0, 1000.0), (1000.0, 0.0, 0.0)]
+    )
+    assert place == (0, 0, 1)
+    assert dirs[2] == pytest.approx((1.0, 0.0, 0.0))
+
+
+def test_c_identifiers_and_strings_by_hand() -> None:
+    """A 100-character name becomes an identifier of at most 63 characters (C99's
+    significant initial characters; mutant identifiers-length-hash allows 71), and DEL
+    (0x7F) is written as the octal escape \\177 (mutant identifiers-printable-range writes
+    it raw)."""
+    from thermocal.identifiers import c_identifier, c_string
+
+    ident = c_identifier("x" * 100)
+    assert len(ident) <= 63 and ident.startswith("x")
+    assert c_identifier("y" * 63) == "y" * 63
+    assert c_string("a\x7fb~") == '"a\\177b~"'
+
+
+def test_counts_to_a_model_in_degrees_per_second() -> None:
+    """Pulse counts with K = 2 pulses/″ at τ = 0.5 s: one count is 1/(0.5·2) = 1 ″/s =
+    1 °/h = 1/3600 °/s; the factor to a model in °/s is 1/3600 (mutant
+    compensate-counts-tau-default gives 3600)."""
+    from thermocal.compensate.kernels import unit_factor
+    from thermocal.recording import Metadata
+
+    meta = Metadata(scale_factor=2.0, scale_factor_unit="counts/arcsec")
+    f = unit_factor("counts", "deg/s", meta=meta, sample_interval_s=0.5)
+    assert f == pytest.approx(1.0 / 3600.0, rel=1e-12)
