@@ -860,7 +860,7 @@ MUTANTS: tuple[Mutant, ...] = (
         "return n * (n + 1.0) / 6.0",
         "return n * (n - 1.0) / 6.0",
         STAB + NOISE,
-        "B1 bias function for white PM: n(n−1)/6",
+        "B1 of random-walk FM (μ = 2, Hadamard ladder): N(N−1)/6 instead of N(N+1)/6",
     ),
     Mutant(
         "stability-b1-ddof",

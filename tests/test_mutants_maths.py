@@ -198,3 +198,38 @@ def test_counts_to_a_model_in_degrees_per_second() -> None:
     meta = Metadata(scale_factor=2.0, scale_factor_unit="counts/arcsec")
     f = unit_factor("counts", "deg/s", meta=meta, sample_interval_s=0.5)
     assert f == pytest.approx(1.0 / 3600.0, rel=1e-12)
+
+
+def _b1(ym: np.ndarray) -> float:
+    """B1 = standard variance (n − 1) of the averages over their Allan variance."""
+    return float(np.var(ym, ddof=1) / (np.mean(np.diff(ym) ** 2) / 2.0))
+
+
+def _averages_with_b1(lo: float, hi: float, walk: bool) -> np.ndarray:
+    """Ten averages whose B1 lies in [lo, hi] (the first seed that gives one)."""
+    for seed in range(10_000):
+        y = np.random.default_rng(seed).normal(0.0, 1.0, 10)
+        ym = np.cumsum(np.cumsum(y)) if walk else y
+        if lo <= _b1(ym) <= hi:
+            return ym
+    raise AssertionError("no seed")
+
+
+def test_b1_noise_identification_by_hand() -> None:
+    """Ten averages (too few for the lag-1 method): B1 against the boundaries of Howe,
+    Beard, Greenhall & Riley (2000) table 3 for N = 10, worked here: white PM/FM
+    √((N²−1)/(1.5N(N−1)) · 1) = 0.856, white/flicker FM √(N ln N/(2(N−1) ln 2)) = 1.358;
+    flicker/random-walk FM … √(N/2 · N(N+1)/6) = 9.57 (Hadamard only).  B1 = 0.90 is white
+    FM (α = 0; mutant stability-b1-ddof computes B1 with n, 0.81: white PM); B1 = 9.2 on
+    the Hadamard ladder is flicker-walk μ = 1 (α = −2; mutant stability-edf-white-fm puts
+    the boundary at √(N/2 · N(N−1)/6) = 8.66)."""
+    from thermocal.stability.edf import identify_noise
+
+    assert np.sqrt((99.0 / 135.0) * 1.0) == pytest.approx(0.856, abs=1e-3)
+    ym = _averages_with_b1(0.88, 0.95, walk=False)
+    x = np.r_[0.0, np.cumsum(ym)]  # phase of rate samples = the averages at m = 1
+    nid = identify_noise(x, 1, dmax=2, phase_input=False)
+    assert (nid.method, nid.alpha) == ("b1", 0)
+    ym = _averages_with_b1(8.9, 9.4, walk=True)
+    nid = identify_noise(np.r_[0.0, np.cumsum(ym)], 1, dmax=3, phase_input=False)
+    assert (nid.method, nid.alpha) == ("b1", -2)
