@@ -695,9 +695,9 @@ MUTANTS: tuple[Mutant, ...] = (
         "params-accel-x0-constant-error",
         P + "export/params.py",
         "b[0] = 0.0 - (b[1] * mid",
-        "b[0] = 0.01 - (b[1] * mid",
+        "b[0] = 1.0 - (b[1] * mid",
         _t("px4_tempcal") + PARAMS,
-        "accelerometer X0 off by a constant (the weak _removed)",
+        "accelerometer X0 off by one model unit (1 mg or 1 m/s²: the weak _removed)",
     ),
     Mutant(
         "params-px4-tmax-low",
