@@ -1040,7 +1040,7 @@ MUTANTS: tuple[Mutant, ...] = (
         P + "compensate/kernels.py",
         "float(signal) - self.known_input))",
         "float(signal) + self.known_input))",
-        COMP + _t("calibration_stream"),
+        COMP + _t("models_bank", "calibration_stream"),
         "streaming: the known input added instead of removed",
     ),
     # --- gravity, identifiers, outputs ------------------------------------------------------

@@ -381,3 +381,24 @@ def test_predict_equals_every_model_reference_and_stream_warns_once(synthetic: B
         if issubclass(w.category, ExtrapolationWarning) and "samples" not in str(w.message)
     ]
     assert len(stream_warnings) == 1
+
+
+def test_streaming_compensator_removes_the_known_input_before_selecting(
+    synthetic: BankModel,
+) -> None:
+    """A power-on of curve 2 under −1000 (gravity on the axis): the streaming compensator
+    with ``known_input=-1000`` hands the bank F − K, so it selects curve 2 and its output
+    is F − ŷ with ŷ the batch prediction (issue 27 mutant
+    compensate-stream-known-input-sign hands it F + K: another curve, or none)."""
+    from thermocal.compensate.kernels import StreamingCompensator
+
+    run = power_on(2, 10.0, 77, gravity=-1000.0, n=200)
+    batch = synthetic.predict(run)
+    sc = StreamingCompensator(synthetic, 1.0, known_input=-1000.0)
+    out = np.array(
+        [
+            sc.update(float(t), run.temps_c[i], float(run.signal[i]))
+            for i, t in enumerate(run.time_s)
+        ]
+    )
+    np.testing.assert_allclose(out, run.signal - batch, rtol=0, atol=1e-9)
