@@ -56,7 +56,7 @@ TT_THERMAL = _t("mutants_turntable", "turntable_thermal", "turntable_thermal_cli
 TT_ACCEL = _t("mutants_turntable", "turntable_accel", "turntable_thermal")
 TT_ENC = _t("mutants_turntable", "turntable_encoders", "turntable_kinematics", "turntable_cli")
 TT_CAL = _t("mutants_turntable", "turntable_estimation", "turntable_encoders", "turntable_cli")
-FLEET = _t("mutants_fleet", "fleet_units", "fleet", "fleet_reruns")
+FLEET = _t("fleet_units", "fleet", "fleet_reruns")
 UNITS = _t("mutants_units", "units", "units_resolver", "units_property", "units_travel")
 TEXT = _t("mutants_units", "text_logs", "tests/attacks/test_text_attacks.py")
 PARAMS = _t("mutants_export", "export_params", "tests/attacks/test_export_params_attacks.py")
@@ -1194,7 +1194,7 @@ def run_one(mutant: Mutant, copy: Path, full: bool, timeout_s: float) -> Outcome
     last = lines[-1] if lines else proc.stderr.strip()[-200:]
     if proc.returncode == 0:
         return Outcome(mutant, "SURVIVED", dt, last)
-    if proc.returncode in (2, 3, 4):  # interrupted, internal error, usage error
+    if proc.returncode in (2, 3, 4, 5):  # interrupted, internal/usage error, no tests
         failed = [x for x in lines if x.startswith(("FAILED", "ERROR"))]
         if not failed:
             return Outcome(mutant, "ERROR", dt, f"pytest exit {proc.returncode}: {last}")
