@@ -1,25 +1,35 @@
-"""Mutation check: inject small plausible bugs one at a time and see whether the suite
-notices (issue 12 §5: a test that cannot fail is a defect).
+"""Mutation check: inject small plausible bugs one at a time and see whether the tests
+notice (issue 12 §5, issue 27 item 6: a test that cannot fail is a defect).
 
-Each mutant replaces one exact snippet of one source file.  The repository's ``src/``,
-``tests/`` and ``pyproject.toml`` are copied to a temporary directory, the mutant is
-applied there (the work tree is never touched), and pytest runs in the copy with the
-copy's ``src`` first on ``PYTHONPATH``; a mutant is *killed* when the run fails.  By
-default each mutant runs the test files named with it; ``--full`` runs the whole suite.
+Each mutant names ONE file, a short code expression that must occur there exactly once,
+its replacement, and the test files that should catch it.  The whole tracked tree (``git
+ls-files``: src/, tests/, README.md, pyproject.toml, everything the tests read), plus new
+files not yet committed, is copied once per job to a temporary directory; each mutant is
+applied there (the work tree is never touched), its test files run with the copy's ``src``
+first on ``PYTHONPATH`` (``pytest -x -q -p no:randomly``), and the file is restored.
 
-    python benchmarks/mutation_check.py            # the listed test files per mutant
-    python benchmarks/mutation_check.py --full     # the whole suite per mutant (slow)
-    python benchmarks/mutation_check.py allan-rrw-read-at-1s   # some mutants only
+Outcomes: ``killed`` (the tests failed), ``SURVIVED`` (they passed), ``timeout`` (counted
+as killed, listed), ``ERROR`` (the expression is not found, or found more than once, in the
+file, or the file is missing: the mutant did not apply; never counted as killed, always
+listed, and the exit status is 1).  After code moves, ``--check`` lists in a second which
+mutants no longer apply, without running any test.
+
+    python benchmarks/mutation_check.py                      # every mutant, one job
+    python benchmarks/mutation_check.py --jobs 2 fleet- px4  # names containing these words
+    python benchmarks/mutation_check.py --check              # only: does each one apply?
+    python benchmarks/mutation_check.py --full name          # the whole suite per mutant
 """
 
 from __future__ import annotations
 
 import argparse
 import os
+import queue
 import shutil
 import subprocess
 import sys
 import tempfile
+import threading
 import time
 from dataclasses import dataclass
 from pathlib import Path
@@ -37,241 +47,1242 @@ class Mutant:
     what: str
 
 
+def _t(*names: str) -> tuple[str, ...]:
+    return tuple(n if "/" in n else f"tests/test_{n}.py" for n in names)
+
+
+P = "src/thermocal/"
+TT_THERMAL = _t("mutants_turntable", "turntable_thermal", "turntable_thermal_cli")
+TT_ACCEL = _t("mutants_turntable", "turntable_accel", "turntable_thermal")
+TT_ENC = _t("mutants_turntable", "turntable_encoders", "turntable_kinematics", "turntable_cli")
+TT_CAL = _t("mutants_turntable", "turntable_estimation", "turntable_encoders", "turntable_cli")
+FLEET = _t("fleet_units", "fleet", "fleet_reruns")
+UNITS = _t("mutants_units", "units", "units_resolver", "units_property", "units_travel")
+TEXT = _t("mutants_units", "text_logs", "tests/attacks/test_text_attacks.py")
+PARAMS = _t("mutants_export", "export_params", "tests/attacks/test_export_params_attacks.py")
+PX4 = _t("mutants_export", "px4_tempcal", "px4_baro_mag", "ardupilot_tempcal")
+ADEQ = _t("mutants_maths", "adequacy", "fc_gates")
+STAB = _t("mutants_maths", "stability_reference", "allan", "allan_references")
+NOISE = _t("mutants_maths", "stability_noise_terms", "noise_cmd")
+MULTI = _t("mutants_maths", "multipos")
+STATION = _t("station")
+FC = _t("mutants_units", "fc_log_readers", "fc_gates")
+EXPC = _t("export_c", "export_c_edges", "export_c_triads", "export_c_units")
+COMP = _t("mutants_maths", "compensate", "outside_range", "judge_absolute")
+GRAV = _t("mutants_maths", "gravity_tilt", "gravity_tref")
+IDS = _t("mutants_maths", "c_identifiers", "tests/attacks/test_generated_code_attacks.py")
+OUTS = _t("faults", "tests/attacks/test_output_attacks.py")
+METRICS = _t("mutants_maths", "metrics", "drift_angle", "metrics_runs")
+
+
 MUTANTS: tuple[Mutant, ...] = (
-    # --- the eight that survived the audit (issue 12 §5) -------------------------------
+    # --- the project's own 22 (issue 12 §5; the first eight: the audit's survivors) ------
     Mutant(
         "allan-rrw-read-at-1s",
-        "src/thermocal/stability/allan.py",
-        'READ_TAU_S: Final = (math.sqrt(3.0), 1.0, float("nan"), 3.0, math.sqrt(2.0))',
-        'READ_TAU_S: Final = (math.sqrt(3.0), 1.0, float("nan"), 1.0, math.sqrt(2.0))',
-        ("tests/test_allan.py", "tests/test_allan_references.py"),
-        "rate random walk slope line read at τ = 1 s instead of 3 s",
+        P + "stability/allan.py",
+        'float("nan"), 3.0, math.sqrt(2.0))',
+        'float("nan"), 1.0, math.sqrt(2.0))',
+        _t("allan", "allan_references"),
+        "rate random walk line read at τ = 1 s, not 3 s",
     ),
     Mutant(
         "allan-edf-overwritten",
-        "src/thermocal/stability/allan.py",
-        "edf[idx] += edf_simple(n_phase, m[idx], alphas[idx])",
-        "edf[idx] = edf_simple(n_phase, m[idx], alphas[idx])",
-        ("tests/test_allan.py", "tests/test_allan_references.py"),
+        P + "stability/allan.py",
+        "edf[idx] += edf_simple(",
+        "edf[idx] = edf_simple(",
+        _t("allan", "allan_references"),
         "gapped data: each segment's EDF overwrites the pooled one",
     ),
     Mutant(
         "metrics-sensitivity-no-abs",
-        "src/thermocal/metrics.py",
-        "mean_abs = float(np.mean(np.abs(np.diff(B) / dT)))",
-        "mean_abs = float(np.mean(np.diff(B) / dT))",
-        ("tests/test_metrics.py",),
+        P + "metrics.py",
+        "np.mean(np.abs(np.diff(B) / dT))",
+        "np.mean(np.diff(B) / dT)",
+        METRICS,
         "temperature sensitivity without abs()",
     ),
     Mutant(
         "metrics-stages-keep-earth-rate",
-        "src/thermocal/metrics.py",
-        "            temp,\n            values - earth,\n",
-        "            temp,\n            values,\n",
-        ("tests/test_metrics.py",),
+        P + "metrics.py",
+        "bias=s.bias - earth)",
+        "bias=s.bias)",
+        METRICS,
         "hold-stage biases without the earth rate removed",
     ),
     Mutant(
         "poly-constant-cov-without-1/m",
-        "src/thermocal/models/poly.py",
+        P + "models/poly_fit.py",
         "L[0, pk:] = 1.0 / m\n",
         "L[0, pk:] = 1.0\n",
-        ("tests/test_models_poly.py",),
+        _t("models_poly"),
         "multi-run fit: the constant's covariance misses its 1/m",
     ),
     Mutant(
         "kalman-innovation-without-R",
-        "src/thermocal/turntable/kalman.py",
-        "innov_var[j] = np.diag(p)[N_COEFFS:] + np.diag(r)",
-        "innov_var[j] = np.diag(p)[N_COEFFS:]",
-        ("tests/test_turntable_estimation.py", "tests/test_turntable_encoders.py"),
+        P + "turntable/kalman.py",
+        "np.diag(p)[N_COEFFS:] + np.diag(r)",
+        "np.diag(p)[N_COEFFS:]",
+        _t("turntable_estimation", "turntable_encoders"),
         "Kalman: R dropped from the innovation variance",
     ),
     Mutant(
         "c-piecewise-strict-breakpoint",
-        "src/thermocal/export/c.py",
-        'f"while (j < {P}_N_BREAKPOINTS && {P}_BP[j] <= temp) {{",',
-        'f"while (j < {P}_N_BREAKPOINTS && {P}_BP[j] < temp) {{",',
-        ("tests/test_export_c.py", "tests/test_export_c_edges.py"),
+        P + "export/c/piecewise.py",
+        "{P}_BP[j] <= temp)",
+        "{P}_BP[j] < temp)",
+        EXPC,
         "C export: BP < T instead of BP ≤ T",
     ),
     Mutant(
         "c-rate-gap-without-factor",
-        "src/thermocal/export/c.py",
+        P + "export/c/core.py",
         "time_s - s->last_t > {P}_GAP_FACTOR * s->sample_interval_s",
         "time_s - s->last_t > s->sample_interval_s",
-        ("tests/test_export_c.py", "tests/test_export_c_edges.py"),
+        EXPC,
         "C export: the rate buffer's gap test without GAP_FACTOR",
     ),
-    # --- further plausible slips across the package ------------------------------------
     Mutant(
         "piecewise-no-width-rule-no-bic",
-        "src/thermocal/models/piecewise.py",
-        "    chosen = int(np.argmin(bic)) + 1\n",
-        "    chosen = len(fits)\n",
-        ("tests/test_models_piecewise.py", "tests/test_cli_contract.py"),
-        "piecewise: every asked-for breakpoint kept, warranted or not",
+        P + "models/piecewise.py",
+        "chosen = int(np.argmin(bic)) + 1\n",
+        "chosen = len(fits)\n",
+        _t("models_piecewise", "cli_contract"),
+        "piecewise: every asked-for breakpoint kept",
     ),
     Mutant(
         "units-deg-s-to-deg-h-60",
-        "src/thermocal/units.py",
+        P + "units.py",
         "DS_TO_DH: Final = SECONDS_PER_HOUR",
         "DS_TO_DH: Final = SECONDS_PER_MINUTE",
-        ("tests/test_units.py", "tests/test_compensate.py"),
+        _t("units", "compensate"),
         "°/s → °/h by 60 instead of 3600",
     ),
     Mutant(
         "units-earth-rate-typo",
-        "src/thermocal/units.py",
+        P + "units.py",
         "EARTH_RATE_RAD_S: Final = 7.292115e-5",
         "EARTH_RATE_RAD_S: Final = 7.292115e-4",
-        ("tests/test_units.py", "tests/test_metrics.py"),
+        _t("units", "metrics"),
         "earth rate off by a factor 10",
     ),
     Mutant(
         "allan-variance-missing-2",
-        "src/thermocal/stability/allan.py",
+        P + "stability/allan.py",
         "avar = sums / (2.0 * m.astype(np.float64) ** 2 * n_terms)",
         "avar = sums / (m.astype(np.float64) ** 2 * n_terms)",
-        ("tests/test_allan.py",),
+        _t("allan"),
         "Allan variance without the 1/2",
     ),
     Mutant(
         "metrics-stability-ddof-0",
-        "src/thermocal/metrics.py",
+        P + "metrics.py",
         "    stab = float(np.std(means, ddof=1))",
         "    stab = float(np.std(means, ddof=0))",
-        ("tests/test_metrics.py",),
-        "bias stability with the population σ (n instead of n − 1)",
+        METRICS,
+        "bias stability with n instead of n − 1",
     ),
     Mutant(
         "preprocess-rate-per-second",
-        "src/thermocal/preprocess.py",
-        "rate[ok] = (Ts[hi[ok]] - Ts[lo[ok]]) / span[ok] * SECONDS_PER_MINUTE",
-        "rate[ok] = (Ts[hi[ok]] - Ts[lo[ok]]) / span[ok]",
-        ("tests/test_preprocess.py", "tests/test_models_poly.py"),
+        P + "preprocess.py",
+        "            out *= SECONDS_PER_MINUTE\n",
+        "",
+        _t("preprocess", "models_poly"),
         "Ṫ in °C/s where °C/min is stated",
     ),
     Mutant(
         "compensate-unit-factor-inverted",
-        "src/thermocal/compensate/files.py",
-        "y_data = y_model / factor",
-        "y_data = y_model * factor",
-        ("tests/test_compensate.py",),
+        P + "compensate/files.py",
+        "y_data = y_model / plan.factor",
+        "y_data = y_model * plan.factor",
+        _t("compensate"),
         "model value converted to the data's unit the wrong way",
     ),
     Mutant(
         "turntable-band-ignores-noise",
-        "src/thermocal/turntable/schedule.py",
-        "tol = 8.0 * sigma_deg + 2.0 * q + 2.0 / 3600.0",
-        "tol = 2.0 / 3600.0",
-        ("tests/test_turntable_encoders.py",),
+        P + "turntable/schedule.py",
+        "tol = 8.0 * sigma_deg + 2.0 * q + 2.0 * units.ARCSEC_TO_DEG",
+        "tol = 2.0 * units.ARCSEC_TO_DEG",
+        _t("turntable_encoders"),
         "dwell band not scaled to the encoder noise",
     ),
     Mutant(
         "bank-picks-worst-model",
-        "src/thermocal/models/bank.py",
+        P + "models/bank.py",
         "choice = np.argmin(dev, axis=1)",
         "choice = np.argmax(dev, axis=1)",
-        ("tests/test_models_bank.py",),
-        "model bank: start-up selection takes the largest deviation",
+        _t("models_bank"),
+        "bank start-up selection takes the largest deviation",
     ),
     Mutant(
         "time-ms-as-us",
-        "src/thermocal/units.py",
+        P + "units.py",
         '{"s": 1.0, "ms": 1e-3, "us": 1e-6}',
         '{"s": 1.0, "ms": 1e-6, "us": 1e-6}',
-        ("tests/test_io.py", "tests/test_cli_inspect.py"),
+        _t("io", "cli_inspect"),
         "milliseconds converted as microseconds",
     ),
     Mutant(
         "gap-factor-15",
-        "src/thermocal/recording.py",
+        P + "recording.py",
         "GAP_FACTOR = 1.5",
         "GAP_FACTOR = 15.0",
-        ("tests/test_io.py", "tests/test_preprocess.py", "tests/test_cli_inspect.py"),
+        _t("io", "preprocess", "cli_inspect"),
         "gaps only found beyond 15 median intervals",
     ),
     Mutant(
         "warmup-window-cumsum-off-by-one",
-        "src/thermocal/models/warmup.py",
-        "cs = np.cumsum(x[:m]) / np.arange(1, m + 1, dtype=np.float64)",
-        "cs = np.cumsum(x[:m]) / np.arange(2, m + 2, dtype=np.float64)",
-        ("tests/test_models_warmup.py",),
+        P + "models/warmup.py",
+        "np.cumsum(x[:m]) / np.arange(1, m + 1, dtype=np.float64)",
+        "np.cumsum(x[:m]) / np.arange(2, m + 2, dtype=np.float64)",
+        _t("models_warmup"),
         "warm-up start window mean divided by n + 1",
     ),
     Mutant(
         "schema-accepts-short-coefficients",
-        "src/thermocal/models/poly.py",
+        P + "models/poly.py",
         '        same_length(state, path, "coef", len(state["terms"]), "one per term")\n',
         "",
-        ("tests/attacks/test_attacks.py",),
+        _t("tests/attacks/test_attacks.py"),
         "model file with fewer coefficients than terms accepted",
     ),
     Mutant(
         "io-temporary-readable",
-        "src/thermocal/io.py",
+        P + "readers/common.py",
         "    if name.endswith(TEMP_SUFFIX):\n",
         "    if False:\n",
-        ("tests/test_faults.py",),
+        _t("faults"),
         "an interrupted write's temporary accepted by the readers",
+    ),
+    # --- issue 27's named survivors -------------------------------------------------------
+    Mutant(
+        "turntable-thermal-order-margin",
+        P + "turntable/thermal.py",
+        "if score < best * 0.95:",
+        "if score < best:",
+        TT_THERMAL,
+        "thermal order: a higher order taken for any gain, not 5 %",
+    ),
+    Mutant(
+        "turntable-accel-dof",
+        P + "turntable/accel.py",
+        "dof = max(m - 4, 1)",
+        "dof = max(m, 1)",
+        TT_ACCEL,
+        "accelerometer dwell fit: residual dof without the 4 unknowns",
+    ),
+    Mutant(
+        "turntable-accel-weights",
+        P + "turntable/accel.py",
+        "sw = np.sqrt(w)\n",
+        "sw = np.ones_like(w)\n",
+        TT_ACCEL,
+        "accelerometer dwell fit unweighted (samples per dwell ignored)",
+    ),
+    Mutant(
+        "turntable-arw-units",
+        P + "turntable/calibrate.py",
+        "out: FloatArray = arw * units.DEG_TO_RAD / np.sqrt(units.SECONDS_PER_HOUR)",
+        "out: FloatArray = arw * units.DEG_TO_RAD / units.SECONDS_PER_HOUR",
+        TT_CAL,
+        "given ARW [°/√h] converted with /3600 instead of /√3600",
+    ),
+    Mutant(
+        "turntable-azimuth-quantum-sign",
+        P + "turntable/calibrate.py",
+        'v[6 + model.MISALIGNMENT_NAMES.index("xy")] = -1.0',
+        'v[6 + model.MISALIGNMENT_NAMES.index("xy")] = 1.0',
+        TT_CAL,
+        "encoder quantum: azimuth variance added to yx, xy with the same sign",
+    ),
+    Mutant(
+        "turntable-half-turn-sign",
+        P + "turntable/schedule.py",
+        "return 180.0 if d == -180.0 else d",
+        "return -180.0 if d == -180.0 else d",
+        TT_ENC,
+        "schedule: a half turn goes negative",
+    ),
+    Mutant(
+        "turntable-angle-wrap",
+        P + "turntable/schedule.py",
+        "return abs((a - b + 180.0) % 360.0 - 180.0) <= tol",
+        "return abs(a - b) <= tol",
+        TT_ENC,
+        "dwell positions compared without wrapping 359.9° to 0°",
+    ),
+    Mutant(
+        "fleet-resume-skips-failed",
+        P + "fleet/batch.py",
+        'if rec.get("status") != "ok":',
+        'if rec.get("status") == "never":',
+        FLEET,
+        "a failed unit is not redone on the next run",
+    ),
+    Mutant(
+        "fleet-limit-max-strict",
+        P + "fleet/config.py",
+        'value <= self.value if self.bound == "max"',
+        'value < self.value if self.bound == "max"',
+        FLEET,
+        "a figure equal to its _max limit fails",
+    ),
+    Mutant(
+        "fleet-limit-min-strict",
+        P + "fleet/config.py",
+        "else value >= self.value",
+        "else value > self.value",
+        FLEET,
+        "a figure equal to its _min limit fails",
+    ),
+    Mutant(
+        "fleet-nan-limit-passes",
+        P + "fleet/config.py",
+        "if value is None or not math.isfinite(value):\n            return False",
+        "if value is None or not math.isfinite(value):\n            return True",
+        FLEET,
+        "a NaN figure passes its limit",
+    ),
+    Mutant(
+        "fleet-channel-limit-everywhere",
+        P + "fleet/batch.py",
+        "names = [lim.channel] if lim.channel else list(figures)",
+        "names = list(figures)",
+        FLEET,
+        "a [limits.<channel>] limit judged on every channel",
+    ),
+    Mutant(
+        "units-counts-per-degree",
+        P + "units.py",
+        '"counts/deg": (True, SECONDS_PER_HOUR, "deg/h")',
+        '"counts/deg": (True, SECONDS_PER_MINUTE, "deg/h")',
+        UNITS,
+        "pulses per degree: °/s → °/h by 60",
+    ),
+    Mutant(
+        "text-empty-field-not-number",
+        P + "readers/text.py",
+        "if empty and not f:\n        return True",
+        "if empty and not f:\n        return False",
+        TEXT,
+        "text log: a row with an empty field (missing value) is not a data row",
+    ),
+    Mutant(
+        "params-accel-midrange-reference",
+        P + "export/params.py",
+        "mid = 0.5 * (lo + hi) - tref_c",
+        "mid = 0.5 * (lo + hi)",
+        PARAMS,
+        "accelerometer offsets relative to the model at T − TREF = mid, not T = mid",
+    ),
+    Mutant(
+        "params-ardupilot-tmin",
+        P + "export/params.py",
+        'out.params[p + "TMIN"] = max(out.params.get(p + "TMIN", lo), lo)',
+        'out.params[p + "TMIN"] = min(out.params.get(p + "TMIN", lo), lo)',
+        PARAMS,
+        "ArduPilot TMIN: the lowest of the triads' ranges, not the common one",
+    ),
+    Mutant(
+        "px4-holdout-on-training-bins",
+        P + "tempcal/pipeline.py",
+        "held = _cubic(t_med[even], v_med[even], unit, name)",
+        "held = _cubic(t_med, v_med, unit, name)",
+        PX4,
+        "hold-out cubic fitted on every bin, the judged ones too",
+    ),
+    Mutant(
+        "px4-motion-threshold",
+        P + "tempcal/pipeline.py",
+        "adequacy.MOTION_FLOOR_DEG_S * adequacy.DEG_H_PER_DEG_S\n",
+        "adequacy.MOTION_FLOOR_DEG_S\n",
+        PX4,
+        "multi-IMU step check: gyro floor 0.3 °/h instead of 0.3 °/s",
+    ),
+    # --- turntable --------------------------------------------------------------------
+    Mutant(
+        "turntable-thermal-dof-off-by-one",
+        P + "turntable/thermal.py",
+        "dof = len(v) - (order + 1)",
+        "dof = len(v) - order",
+        TT_THERMAL,
+        "thermal WLS: reduced χ² with one dof too many",
+    ),
+    Mutant(
+        "turntable-thermal-chi2-floor",
+        P + "turntable/thermal.py",
+        "(max(chi2, 1.0) if dof > 0 else 1.0)",
+        "(chi2 if dof > 0 else 1.0)",
+        TT_THERMAL,
+        "thermal WLS: covariance shrunk when the scatter is below the σ",
+    ),
+    Mutant(
+        "turntable-thermal-weights-sigma",
+        P + "turntable/thermal.py",
+        "w = 1.0 / np.maximum(sg_k, 1e-12 * float(np.max(sg_k))) ** 2",
+        "w = 1.0 / np.maximum(sg_k, 1e-12 * float(np.max(sg_k)))",
+        TT_THERMAL,
+        "thermal WLS weights 1/σ instead of 1/σ²",
+    ),
+    Mutant(
+        "turntable-thermal-loto-keeps-run",
+        P + "turntable/thermal.py",
+        "keep = np.arange(len(v)) != i",
+        "keep = np.arange(len(v)) >= 0",
+        TT_THERMAL,
+        "leave-one-temperature-out keeps the run it predicts",
+    ),
+    Mutant(
+        "turntable-thermal-tref-low-end",
+        P + "turntable/thermal.py",
+        "tref = float(0.5 * (t.min() + t.max())) if tref_c is None",
+        "tref = float(t.min()) if tref_c is None",
+        TT_THERMAL,
+        "thermal TREF at the coldest run, not mid-range",
+    ),
+    Mutant(
+        "turntable-arw-tau",
+        P + "turntable/calibrate.py",
+        "out: FloatArray = np.sqrt(ss / dof * tau_med)",
+        "out: FloatArray = np.sqrt(ss / dof / tau_med)",
+        TT_CAL,
+        "ARW from the rest scatter divided by τ instead of multiplied",
+    ),
+    Mutant(
+        "turntable-arw-dof",
+        P + "turntable/calibrate.py",
+        "dof += g.shape[0] - 1",
+        "dof += g.shape[0]",
+        TT_CAL,
+        "ARW: dwell scatter with n instead of n − 1",
+    ),
+    Mutant(
+        "turntable-quantum-sigma-sqrt12",
+        P + "turntable/schedule.py",
+        "self.quantum_deg * units.DEG_TO_ARCSEC / np.sqrt(12.0)",
+        "self.quantum_deg * units.DEG_TO_ARCSEC / 12.0",
+        TT_ENC,
+        "quantisation σ q/12 instead of q/√12",
+    ),
+    Mutant(
+        "turntable-mad-scale",
+        P + "turntable/schedule.py",
+        "sig.append(1.4826 * float(np.median(np.abs(d2 - np.median(d2)))) / np.sqrt(6.0))",
+        "sig.append(1.4826 * float(np.median(np.abs(d2 - np.median(d2)))) / np.sqrt(2.0))",
+        TT_ENC,
+        "encoder jitter from second differences with √2 instead of √6",
+    ),
+    Mutant(
+        "turntable-dwell-pause-strict",
+        P + "turntable/schedule.py",
+        "if dur >= pause_s",
+        "if dur > pause_s + 5.0",
+        TT_ENC,
+        "dwells shorter than pause + 5 s dropped",
+    ),
+    Mutant(
+        "turntable-accel-bias-mg",
+        P + "turntable/accel.py",
+        "scale = np.array([1.0 / g, 1.0 / g, 1.0 / g, 1.0 / units.MG_TO_MS2])",
+        "scale = np.array([1.0 / g, 1.0 / g, 1.0 / g, 1.0])",
+        TT_ACCEL,
+        "accelerometer bias left in m/s² where mg is stated",
+    ),
+    Mutant(
+        "turntable-accel-min-dwells",
+        P + "turntable/accel.py",
+        "if m < 6:",
+        "if m < 4:",
+        TT_ACCEL,
+        "accelerometer triad fitted from 4 or 5 attitudes",
+    ),
+    Mutant(
+        "turntable-chi2-warning-threshold",
+        P + "turntable/calibrate.py",
+        "chi2 > 1.0 + 5.0 * np.sqrt(2.0 / est.dof)",
+        "chi2 > 1.0 + 5000.0 * np.sqrt(2.0 / est.dof)",
+        TT_CAL,
+        "residuals far above the white-noise level not reported",
+    ),
+    # --- fleet -----------------------------------------------------------------------------
+    Mutant(
+        "fleet-missing-channel-passes",
+        P + "fleet/batch.py",
+        'failed.append(f"{lim.label}: no channel {ch!r}")',
+        "pass",
+        FLEET,
+        "a limit on a channel the unit lacks passes",
+    ),
+    Mutant(
+        "fleet-limit-options-not-compared",
+        P + "fleet/batch.py",
+        '("validate", "[validate]"), ("limits", "[limits]")',
+        '("validate", "[validate]")',
+        FLEET,
+        "changed [limits] do not redo a unit",
+    ),
+    Mutant(
+        "fleet-missing-figure-passes",
+        P + "fleet/batch.py",
+        'failed.append(f"{ch}.{lim.figure} {why} ({lim.label})")',
+        "pass",
+        FLEET,
+        "a limit on a figure not computed passes",
+    ),
+    Mutant(
+        "fleet-changed-input-ignored",
+        P + "fleet/batch.py",
+        "elif before[f] != digest:",
+        "elif False:",
+        FLEET,
+        "a changed input file does not redo the unit",
+    ),
+    # --- units -------------------------------------------------------------------------
+    Mutant(
+        "units-counts-per-rad",
+        P + "units.py",
+        '"counts/rad": (True, RS_TO_DH, "deg/h")',
+        '"counts/rad": (True, RAD_TO_DEG, "deg/h")',
+        UNITS,
+        "pulses per radian converted to °/s, called °/h",
+    ),
+    Mutant(
+        "units-counts-per-g",
+        P + "units.py",
+        '"counts/g": (False, G_TO_MG, "mg")',
+        '"counts/g": (False, 1.0, "mg")',
+        UNITS,
+        "LSB per g read as LSB per mg",
+    ),
+    Mutant(
+        "units-pulse-without-tau",
+        P + "units.py",
+        "gain = factor / (interval_s * scale_factor)",
+        "gain = factor / scale_factor * interval_s",
+        UNITS,
+        "pulse counts: N·τ/K instead of N/(τK)",
+    ),
+    Mutant(
+        "units-int16-sign",
+        P + "units.py",
+        "v = np.where(v >= INT16_SIGN_BIT, v - UINT16_MODULUS, v)",
+        "v = np.where(v > INT16_SIGN_BIT, v - UINT16_MODULUS, v)",
+        UNITS,
+        "int16 temperature: 32768 read as +32768, not −32768",
+    ),
+    Mutant(
+        "units-somigliana-sign",
+        P + "units.py",
+        "* (1.0 + WGS84_SOMIGLIANA_K * s2)",
+        "* (1.0 - WGS84_SOMIGLIANA_K * s2)",
+        UNITS + GRAV,
+        "normal gravity decreasing towards the poles",
+    ),
+    Mutant(
+        "units-mg-factor",
+        P + "units.py",
+        "MG_TO_MS2: Final = STANDARD_GRAVITY_M_S2 * 1e-3",
+        "MG_TO_MS2: Final = STANDARD_GRAVITY_M_S2 * 1e-2",
+        UNITS,
+        "1 mg = 0.098 m/s²",
+    ),
+    Mutant(
+        "units-arw-per-60",
+        P + "units.py",
+        "ARW_DEG_SQRT_H_PER_DEG_H_SQRT_HZ: Final = 1.0 / 60.0",
+        "ARW_DEG_SQRT_H_PER_DEG_H_SQRT_HZ: Final = 1.0 / 3600.0",
+        UNITS + NOISE,
+        "ARW °/√h from a density in °/h/√Hz divided by 3600, not 60",
+    ),
+    Mutant(
+        "units-latitude-bound-strict",
+        P + "units.py",
+        "if not -90.0 <= latitude_deg <= 90.0:",
+        "if not -90.0 < latitude_deg < 90.0:",
+        UNITS + GRAV,
+        "normal gravity refused at the poles",
+    ),
+    # --- text logs ---------------------------------------------------------------------
+    Mutant(
+        "text-header-empty-name",
+        P + "readers/text.py",
+        "is_names = all(f and not _is_number(f, dec) for f in names)",
+        "is_names = all(not _is_number(f, dec) for f in names)",
+        TEXT,
+        "a header line with an empty name taken as the header",
+    ),
+    Mutant(
+        "text-decimal-tie-comma",
+        P + "readers/text.py",
+        'c == "."))',
+        'c == ","))',
+        TEXT,
+        "decimal mark: a tie goes to the comma",
+    ),
+    Mutant(
+        "text-underscore-number",
+        P + "readers/text.py",
+        'if "_" in field or not field.isascii():',
+        "if not field.isascii():",
+        TEXT,
+        "digit-group underscores (0_5) read as numbers",
+    ),
+    Mutant(
+        "text-wrong-field-count-kept",
+        P + "readers/text.py",
+        "if len(fields) != n:",
+        "if len(fields) < n:",
+        TEXT,
+        "a row with too many fields is not a bad line",
+    ),
+    # --- parameter export ------------------------------------------------------------
+    Mutant(
+        "params-ardupilot-tmax",
+        P + "export/params.py",
+        'out.params[p + "TMAX"] = min(out.params.get(p + "TMAX", hi), hi)',
+        'out.params[p + "TMAX"] = max(out.params.get(p + "TMAX", hi), hi)',
+        PARAMS,
+        "ArduPilot TMAX: the highest of the triads' ranges",
+    ),
+    Mutant(
+        "params-ardupilot-scale",
+        P + "export/params.py",
+        "poly.coef[k] / ARDUPILOT_SCALE",
+        "poly.coef[k] * ARDUPILOT_SCALE",
+        PARAMS,
+        "ArduPilot coefficients multiplied by 1e-6 instead of divided",
+    ),
+    Mutant(
+        "params-ardupilot-tref",
+        P + "export/params.py",
+        "ARDUPILOT_TREF_C = 35.0",
+        "ARDUPILOT_TREF_C = 25.0",
+        PARAMS,
+        "ArduPilot's polynomial about 25 °C (the firmware's is 35 °C)",
+    ),
+    Mutant(
+        "params-px4-tref-low-end",
+        P + "export/params.py",
+        "tref = 0.5 * (lo + hi) if tref_c is None else float(tref_c)",
+        "tref = lo if tref_c is None else float(tref_c)",
+        PARAMS,
+        "PX4 TREF at the low end of the range, not mid-range",
+    ),
+    Mutant(
+        "params-range-union",
+        P + "export/params.py",
+        "lo = max(float(m.temp_range_[0, 0]) for m in models.values())",
+        "lo = min(float(m.temp_range_[0, 0]) for m in models.values())",
+        PARAMS,
+        "a triad's TMIN below one channel's fitted range",
+    ),
+    Mutant(
+        "params-gyro-unit-per-minute",
+        P + "export/params.py",
+        'float(units.convert(1.0, model_unit, "deg/h")) * units.DH_TO_RS',
+        'float(units.convert(1.0, model_unit, "deg/h")) * units.DEG_TO_RAD / 60.0',
+        PARAMS,
+        "°/h → rad/s by /60",
+    ),
+    Mutant(
+        "params-accel-offset-sign",
+        P + "export/params.py",
+        "b[0] = 0.0 - (b[1] * mid",
+        "b[0] = 0.0 + (b[1] * mid",
+        PARAMS,
+        "accelerometer X0 of the wrong sign",
+    ),
+    Mutant(
+        "params-accel-x0-constant-error",
+        P + "export/params.py",
+        "b[0] = 0.0 - (b[1] * mid",
+        "b[0] = 1.0 - (b[1] * mid",
+        _t("px4_tempcal") + PARAMS,
+        "accelerometer X0 off by one model unit (1 mg or 1 m/s²: the weak _removed)",
+    ),
+    Mutant(
+        "params-px4-tmax-low",
+        P + "export/params.py",
+        'out.params[p + "TMAX"] = hi\n',
+        'out.params[p + "TMAX"] = lo\n',
+        PARAMS,
+        "PX4 TMAX written as the range's low end",
+    ),
+    # --- px4 / ardupilot tempcal --------------------------------------------------------
+    Mutant(
+        "px4-baro-holdout-on-training",
+        P + "tempcal/px4.py",
+        "held = np.polynomial.polynomial.polyfit(x[even], v_med[even, j], order)",
+        "held = np.polynomial.polynomial.polyfit(x, v_med[:, j], order)",
+        PX4,
+        "baro/mag hold-out fitted on every bin",
+    ),
+    Mutant(
+        "px4-min-bins",
+        P + "tempcal/pipeline.py",
+        "if t_med.size < MIN_BINS:",
+        "if t_med.size < 4:",
+        PX4,
+        "a cubic judged and fitted on 4 bins",
+    ),
+    Mutant(
+        "px4-bin-median-to-mean",
+        P + "tempcal/binning.py",
+        "[np.median(values[order[a:b]], axis=0)",
+        "[np.mean(values[order[a:b]], axis=0)",
+        PX4,
+        "bin statistic the mean: spikes move the fit",
+    ),
+    Mutant(
+        "px4-baro-tref-low-end",
+        P + "tempcal/px4.py",
+        "tref = 0.5 * (lo + hi) if tref_c is None else float(tref_c)\n    x = t_med - tref",
+        "tref = lo if tref_c is None else float(tref_c)\n    x = t_med - tref",
+        PX4,
+        "baro/mag TREF at the low end",
+    ),
+    Mutant(
+        "px4-step-window",
+        P + "tempcal/pipeline.py",
+        "if not any(abs(s[0] - o[0]) <= adequacy.STILL_WINDOW_S for o in others)",
+        "if not any(abs(s[0] - o[0]) <= 0.0 for o in others)",
+        PX4,
+        "a board move seen by every IMU reported as one IMU's bias step",
+    ),
+    # --- adequacy ------------------------------------------------------------------------
+    Mutant(
+        "adequacy-samples-strict",
+        P + "adequacy.py",
+        "ok = ratio >= MIN_SAMPLES_PER_COEFFICIENT",
+        "ok = ratio > MIN_SAMPLES_PER_COEFFICIENT",
+        ADEQ,
+        "exactly 10 samples per coefficient refused",
+    ),
+    Mutant(
+        "adequacy-span-per-order",
+        P + "adequacy.py",
+        "need = MIN_SPAN_PER_ORDER_C * max(order, 1)",
+        "need = MIN_SPAN_PER_ORDER_C",
+        ADEQ,
+        "the span needed does not grow with the order",
+    ),
+    Mutant(
+        "adequacy-distinct-order",
+        P + "adequacy.py",
+        "if distinct < order + 1:",
+        "if distinct < order:",
+        ADEQ,
+        "order p fitted through p distinct temperatures",
+    ),
+    Mutant(
+        "adequacy-rate-per-second",
+        P + "adequacy.py",
+        "return (temps[keep] - back) / interval_s * 60.0",
+        "return (temps[keep] - back) / interval_s",
+        ADEQ,
+        "Ṫ for the rate test in °C/s",
+    ),
+    Mutant(
+        "adequacy-firmware-strict",
+        P + "adequacy.py",
+        "ok = span_c >= minimum_c",
+        "ok = span_c > minimum_c",
+        ADEQ,
+        "a sweep exactly at the firmware minimum refused",
+    ),
+    Mutant(
+        "adequacy-moving-share-strict",
+        P + "adequacy.py",
+        "if mot.share > MAX_MOVING_SHARE:",
+        "if mot.share > 10.0 * MAX_MOVING_SHARE:",
+        ADEQ,
+        "a record moving 2…20 % of the time accepted",
+    ),
+    Mutant(
+        "adequacy-ends-share",
+        P + "adequacy.py",
+        "share = min(low, high)",
+        "share = max(low, high)",
+        ADEQ,
+        "range ends: the better end judged",
+    ),
+    Mutant(
+        "adequacy-robust-range-small",
+        P + "adequacy.py",
+        "if t.size < 1000:",
+        "if t.size < 10:",
+        ADEQ,
+        "small records' range cut at the 0.1/99.9 percentiles",
+    ),
+    # --- stability -------------------------------------------------------------------------
+    Mutant(
+        "stability-mdev-max-factor",
+        P + "stability/deviations.py",
+        "return (n_phase + 1) // 3 if name",
+        "return (n_phase + 4) // 3 if name",
+        STAB,
+        "mdev evaluated one m beyond the data",
+    ),
+    Mutant(
+        "stability-totdev-reflection-sign",
+        P + "stability/deviations.py",
+        "v = (s[:, : 6 * m] - 2.0 * s[:, m : 7 * m] + s[:, 2 * m : 8 * m]) / m",
+        "v = (s[:, : 6 * m] - 2.0 * s[:, m : 7 * m] - s[:, 2 * m : 8 * m]) / m",
+        STAB,
+        "total-deviation second difference S1 − 2S2 − S3",
+    ),
+    Mutant(
+        "stability-theo1-tau",
+        P + "stability/deviations.py",
+        "return np.asarray(0.75 * np.asarray(m, dtype=np.float64) * tau0_s)",
+        "return np.asarray(np.asarray(m, dtype=np.float64) * tau0_s)",
+        STAB,
+        "Theo1's τ = m τ0 instead of 0.75 m τ0",
+    ),
+    Mutant(
+        "stability-phase-tau0",
+        P + "stability/deviations.py",
+        "    x *= tau0_s\n",
+        "",
+        STAB,
+        "rate integrated to phase without τ0",
+    ),
+    Mutant(
+        "stability-mtie-sum",
+        P + "stability/deviations.py",
+        "num = np.maximum(num, np.where(b > 0, a, 0.0))",
+        "num = num + np.where(b > 0, a, 0.0)",
+        STAB,
+        "MTIE of gapped data summed over stretches instead of the maximum",
+    ),
+    Mutant(
+        "stability-edf-white-fm",
+        P + "stability/edf.py",
+        "return n * (n + 1.0) / 6.0",
+        "return n * (n - 1.0) / 6.0",
+        STAB + NOISE,
+        "B1 of random-walk FM (μ = 2, Hadamard ladder): N(N−1)/6 instead of N(N+1)/6",
+    ),
+    Mutant(
+        "stability-b1-ddof",
+        P + "stability/edf.py",
+        "b1 = float(np.var(ym, ddof=1)) / avar",
+        "b1 = float(np.var(ym, ddof=0)) / avar",
+        STAB + NOISE,
+        "noise identification: B1 from the population variance",
+    ),
+    Mutant(
+        "noise-model-walk-sqrt3",
+        P + "stability/noise_model.py",
+        '(1.0 if kind == "density" else math.sqrt(3.0))',
+        '(1.0 if kind == "density" else 3.0)',
+        NOISE,
+        "random-walk read from the slope line with 3 instead of √3",
+    ),
+    Mutant(
+        "noise-model-discrete-sqrt-dt",
+        P + "stability/noise_model.py",
+        'f"{_yaml_float(v / math.sqrt(dt))}"',
+        'f"{_yaml_float(v * math.sqrt(dt))}"',
+        NOISE,
+        "discrete noise σ = density·√dt instead of /√dt",
+    ),
+    # --- multipos ------------------------------------------------------------------------
+    Mutant(
+        "multipos-gap-factor",
+        P + "multipos/gyro.py",
+        "> 1.5 * dt_med)",
+        "> 15.0 * dt_med)",
+        MULTI,
+        "multi-position: a turn across a gap of 10 samples integrated",
+    ),
+    Mutant(
+        "multipos-turn-sense",
+        P + "multipos/gyro.py",
+        "sense = 1.0 if float(tot @ u[k]) >= 0 else -1.0",
+        "sense = 1.0",
+        MULTI,
+        "multi-position: a turn the other way taken positive",
+    ),
+    Mutant(
+        "multipos-rotation-angle",
+        P + "multipos/geometry.py",
+        "(np.trace(m, axis1=-2, axis2=-1) - 1.0) / 2.0",
+        "(np.trace(m, axis1=-2, axis2=-1) - 1.0) / 3.0",
+        MULTI,
+        "rotation angle from the trace with /3",
+    ),
+    Mutant(
+        "multipos-bias-cov-dropped",
+        P + "multipos/gyro.py",
+        "cov_p = cov_p + gain @ jb @ bias_cov @ jb.T @ gain.T",
+        "cov_p = cov_p",
+        MULTI,
+        "gyro scale σ without the bias uncertainty",
+    ),
+    # --- station -----------------------------------------------------------------------------
+    Mutant(
+        "station-part-rotation-strict",
+        P + "station/recorder.py",
+        "if now_unix - self.part_started >= self.cfg.part_s:",
+        "if now_unix - self.part_started > 2.0 * self.cfg.part_s:",
+        STATION,
+        "recorder parts closed after twice their length",
+    ),
+    Mutant(
+        "station-unit-id-range",
+        P + "station/config.py",
+        "if not 0 <= c.unit <= 247:",
+        "if not 0 <= c.unit <= 255:",
+        STATION,
+        "Modbus slave id 248…255 accepted",
+    ),
+    Mutant(
+        "station-register-range",
+        P + "station/config.py",
+        "if not 0 <= getattr(c, key) <= 0xFFFF:",
+        "if not 0 <= getattr(c, key) <= 0x1FFFF:",
+        STATION,
+        "register address beyond 65535 accepted",
+    ),
+    Mutant(
+        "station-positive-interval",
+        P + "station/config.py",
+        "    if not v > 0:\n",
+        "    if not v >= 0:\n",
+        STATION,
+        "a zero interval/period accepted",
+    ),
+    Mutant(
+        "station-newer-version",
+        P + "readers/station.py",
+        'if int(doc.get("version", 0)) > STATION_VERSION:',
+        "if False:",
+        STATION,
+        "a station folder of a newer format read",
+    ),
+    # --- readers: ULog / DataFlash --------------------------------------------------------
+    Mutant(
+        "ulog-delta-dt-us",
+        P + "readers/ulog.py",
+        "dt_s = cols[dt_col] * 1e-6",
+        "dt_s = cols[dt_col] * 1e-3",
+        FC,
+        "ULog vehicle_imu: Δt in ms, rates 1000× too small",
+    ),
+    Mutant(
+        "ulog-time-unit",
+        P + "readers/ulog.py",
+        '"time": "timestamp", "time_unit": "us"',
+        '"time": "timestamp", "time_unit": "ms"',
+        FC,
+        "ULog timestamps read as milliseconds",
+    ),
+    # --- C export -----------------------------------------------------------------------
+    Mutant(
+        "c-triad-clamp-swapped",
+        P + "export/c/triad.py",
+        "temp_c < {P}_T_LO ? {P}_T_LO : (temp_c > {P}_T_HI ? {P}_T_HI : temp_c)",
+        "temp_c < {P}_T_LO ? {P}_T_HI : (temp_c > {P}_T_HI ? {P}_T_LO : temp_c)",
+        EXPC,
+        "C triad: below the range clamped to the top and vice versa",
+    ),
+    Mutant(
+        "c-triad-bias-sign",
+        P + "export/c/triad.py",
+        '"    r[1] = (double)x[1] - th[1] * {P}_BIAS_TO_DATA;"',
+        '"    r[1] = (double)x[1] + th[1] * {P}_BIAS_TO_DATA;"',
+        EXPC,
+        "C triad: y bias added instead of subtracted",
+    ),
+    Mutant(
+        "c-triad-scale-ppm",
+        P + "export/c/triad.py",
+        '"    m[1][1] = 1.0 + th[4] * 1e-6;"',
+        '"    m[1][1] = 1.0 + th[4] * 1e-3;"',
+        EXPC,
+        "C triad: y scale factor read in ppt, not ppm",
+    ),
+    Mutant(
+        "c-triad-horner-order",
+        P + "export/c/triad.py",
+        "for (j = {order - 2}; j >= 0; --j)",
+        "for (j = {order - 2}; j > 0; --j)",
+        EXPC,
+        "C triad: the constant coefficient left out of Horner's scheme",
+    ),
+    # --- compensate kernels --------------------------------------------------------------
+    Mutant(
+        "compensate-worse-strict",
+        P + "compensate/kernels.py",
+        "if finite and a > (1.0 + tolerance) * b:",
+        "if finite and a > (1.0 + 10.0 * tolerance) * b:",
+        COMP,
+        "a worse absolute rms not reported within 10× the tolerance",
+    ),
+    Mutant(
+        "compensate-abs-rms-about-mean",
+        P + "compensate/kernels.py",
+        "float(np.sqrt(np.mean(e * e)))",
+        "float(np.std(e))",
+        COMP,
+        "rms about zero computed about the mean",
+    ),
+    Mutant(
+        "compensate-counts-tau-default",
+        P + "compensate/kernels.py",
+        "return float(phys_per_count) * unit_factor(phys_unit, mu, where=where)",
+        "return float(phys_per_count) / unit_factor(phys_unit, mu, where=where)",
+        COMP + _t("export_c_units"),
+        "counts → model unit: second factor inverted",
+    ),
+    Mutant(
+        "compensate-stream-known-input-sign",
+        P + "compensate/kernels.py",
+        "float(signal) - self.known_input))",
+        "float(signal) + self.known_input))",
+        COMP + _t("models_bank", "calibration_stream"),
+        "streaming: the known input added instead of removed",
+    ),
+    # --- gravity, identifiers, outputs ------------------------------------------------------
+    Mutant(
+        "gravity-placement-tolerance",
+        P + "gravity.py",
+        "if float(np.dot(d, s / np.linalg.norm(s))) >= cos_tol:",
+        "if float(np.dot(d, s / np.linalg.norm(s))) >= -1.0:",
+        GRAV,
+        "every run joins the first placement whatever its direction",
+    ),
+    Mutant(
+        "gravity-tilt-clamp",
+        P + "gravity.py",
+        "return math.degrees(math.acos(max(-1.0, min(1.0, c))))",
+        "return math.degrees(math.asin(max(-1.0, min(1.0, c))))",
+        GRAV,
+        "tilt from asin instead of acos",
+    ),
+    Mutant(
+        "identifiers-length-hash",
+        P + "identifiers.py",
+        "if len(s) > max_len:",
+        "if len(s) > max_len + 8:",
+        IDS,
+        "C identifiers up to 8 characters too long",
+    ),
+    Mutant(
+        "identifiers-printable-range",
+        P + "identifiers.py",
+        "elif 0x20 <= b < 0x7F:",
+        "elif 0x20 <= b <= 0x7F:",
+        IDS,
+        "DEL written raw inside a C string",
+    ),
+    Mutant(
+        "outputs-fifo-accepted",
+        P + "outputs.py",
+        '(stat.S_ISFIFO, "a FIFO"),',
+        '(stat.S_ISREG, "a FIFO"),',
+        OUTS,
+        "output gate: a FIFO taken for a file (and every plain file refused)",
+    ),
+    Mutant(
+        "outputs-file-over-directory",
+        P + "outputs.py",
+        'raise ThermocalInputError(f"{f}: is a directory, expected a file name")',
+        "pass",
+        OUTS,
+        "output gate: a directory accepted as an output file name",
+    ),
+    # --- models, metrics, preprocess --------------------------------------------------------
+    Mutant(
+        "metrics-drift-trapezoid",
+        P + "metrics.py",
+        "inc = 0.5 * (e[1:] + e[:-1]) * np.diff(t) / float(time_unit_s)",
+        "inc = e[1:] * np.diff(t) / float(time_unit_s)",
+        METRICS,
+        "drift angle by the right-hand rectangle rule",
+    ),
+    Mutant(
+        "metrics-drift-reference-earth",
+        P + "metrics.py",
+        "b0 = float(np.mean(selected)) - float(earth_rate)",
+        "b0 = float(np.mean(selected))",
+        METRICS,
+        "drift reference bias keeps the earth rate",
+    ),
+    Mutant(
+        "metrics-drift-ref-window-end",
+        P + "metrics.py",
+        "key=lambda i: bool(t[i] - t0 > end))",
+        "key=lambda i: bool(t[i] - t0 >= 2.0 * end))",
+        METRICS,
+        "drift reference window twice as long as asked",
+    ),
+    Mutant(
+        "preprocess-centred-half",
+        P + "preprocess.py",
+        'lo = np.searchsorted(ts, ti - interval_s / 2.0, side="left")',
+        'lo = np.searchsorted(ts, ti - interval_s, side="left")',
+        _t("mutants_maths", "preprocess"),
+        "centred Ṫ over 1.5 Δ",
     ),
 )
 
 
-def _copy_repo(dst: Path) -> None:
-    shutil.copytree(ROOT / "src", dst / "src", ignore=shutil.ignore_patterns("__pycache__"))
-    shutil.copytree(ROOT / "tests", dst / "tests", ignore=shutil.ignore_patterns("__pycache__"))
-    shutil.copy2(ROOT / "pyproject.toml", dst / "pyproject.toml")
+def _tree_files() -> list[str]:
+    """Every file of the work tree git knows or would add (tracked and new, not ignored)."""
+    out = subprocess.run(
+        ["git", "-C", str(ROOT), "ls-files", "-z", "--cached", "--others", "--exclude-standard"],
+        capture_output=True, check=True,
+    )  # fmt: skip
+    names = sorted({n for n in out.stdout.decode().split("\0") if n})
+    return [n for n in names if (ROOT / n).is_file()]
 
 
-def run_one(mutant: Mutant, full: bool) -> tuple[str, float, str]:
-    """Apply ``mutant`` in a copy and run its tests; returns (status, seconds, detail)."""
+def _copy_tree(dst: Path) -> None:
+    for name in _tree_files():
+        target = dst / name
+        target.parent.mkdir(parents=True, exist_ok=True)
+        shutil.copy2(ROOT / name, target)
+
+
+def applies(mutant: Mutant, root: Path = ROOT) -> str | None:
+    """None when ``mutant.old`` occurs exactly once in its file, else why not."""
+    path = root / mutant.file
+    if not path.is_file():
+        return f"{mutant.file} does not exist"
+    n = path.read_text(encoding="utf-8").count(mutant.old)
+    if n != 1:
+        return f"expression found {n} times in {mutant.file} (must be exactly once)"
+    missing = [t for t in mutant.tests if not (root / t).exists()]
+    if missing:
+        return f"test file(s) missing: {', '.join(missing)}"
+    return None
+
+
+@dataclass(frozen=True)
+class Outcome:
+    mutant: Mutant
+    status: str  # killed | SURVIVED | timeout | ERROR
+    seconds: float
+    detail: str
+
+
+def run_one(mutant: Mutant, copy: Path, full: bool, timeout_s: float) -> Outcome:
+    """Apply ``mutant`` in ``copy``, run its tests, restore the file."""
+    why = applies(mutant, copy)
+    if why is not None:
+        return Outcome(mutant, "ERROR", 0.0, why)
+    target = copy / mutant.file
+    original = target.read_text(encoding="utf-8")
+    target.write_text(original.replace(mutant.old, mutant.new), encoding="utf-8")
+    env = {**os.environ, "PYTHONPATH": str(copy / "src"), "PYTHONDONTWRITEBYTECODE": "1"}
+    tests = ["tests"] if full else list(mutant.tests)
+    cmd = [sys.executable, "-m", "pytest", "-x", "-q", "-p", "no:cacheprovider",
+           "-p", "no:randomly", *tests]  # fmt: skip
+    t0 = time.perf_counter()
+    try:
+        proc = subprocess.run(
+            cmd, cwd=copy, env=env, capture_output=True, text=True, check=False,
+            timeout=timeout_s,
+        )  # fmt: skip
+    except subprocess.TimeoutExpired:
+        return Outcome(mutant, "timeout", time.perf_counter() - t0, f"> {timeout_s:g} s")
+    finally:
+        target.write_text(original, encoding="utf-8")
+    dt = time.perf_counter() - t0
+    lines = proc.stdout.strip().splitlines()
+    last = lines[-1] if lines else proc.stderr.strip()[-200:]
+    if proc.returncode == 0:
+        return Outcome(mutant, "SURVIVED", dt, last)
+    if proc.returncode in (2, 3, 4, 5):  # interrupted, internal/usage error, no tests
+        failed = [x for x in lines if x.startswith(("FAILED", "ERROR"))]
+        if not failed:
+            return Outcome(mutant, "ERROR", dt, f"pytest exit {proc.returncode}: {last}")
+    first = next((x for x in lines if x.startswith(("FAILED", "ERROR"))), last)
+    return Outcome(mutant, "killed", dt, first)
+
+
+def _worker(jobs: queue.Queue[Mutant], results: list[Outcome], lock: threading.Lock,
+            full: bool, timeout_s: float) -> None:  # fmt: skip
     with tempfile.TemporaryDirectory(prefix="thermocal-mutant-") as tmp:
-        d = Path(tmp)
-        _copy_repo(d)
-        target = d / mutant.file
-        text = target.read_text(encoding="utf-8")
-        if text.count(mutant.old) != 1:
-            return "not-applied", 0.0, f"snippet found {text.count(mutant.old)} times"
-        target.write_text(text.replace(mutant.old, mutant.new), encoding="utf-8")
-        env = {**os.environ, "PYTHONPATH": str(d / "src"), "PYTHONDONTWRITEBYTECODE": "1"}
+        copy = Path(tmp)
+        _copy_tree(copy)
+        env = {**os.environ, "PYTHONPATH": str(copy / "src")}
         probe = subprocess.run(
             [sys.executable, "-c", "import thermocal; print(thermocal.__file__)"],
-            cwd=d, env=env, capture_output=True, text=True, check=False,
+            cwd=copy, env=env, capture_output=True, text=True, check=False,
         )  # fmt: skip
-        if not probe.stdout.strip().startswith(str(d)):
-            return "not-applied", 0.0, f"imported {probe.stdout.strip()} instead of the copy"
-        tests = ["tests"] if full else list(mutant.tests)
-        t0 = time.perf_counter()
-        proc = subprocess.run(
-            [sys.executable, "-m", "pytest", "-q", "-x", "-n", "2", "-p", "no:cacheprovider",
-             *tests],
-            cwd=d, env=env, capture_output=True, text=True, check=False,
-        )  # fmt: skip
-        dt = time.perf_counter() - t0
-        last = proc.stdout.strip().splitlines()[-1] if proc.stdout.strip() else ""
-        return ("killed" if proc.returncode != 0 else "SURVIVED"), dt, last
+        if not probe.stdout.strip().startswith(str(copy)):
+            raise SystemExit(f"error: the copy imports {probe.stdout.strip()!r}, not itself")
+        while True:
+            try:
+                m = jobs.get_nowait()
+            except queue.Empty:
+                return
+            out = run_one(m, copy, full, timeout_s)
+            with lock:
+                results.append(out)
+                print(f"{out.status:8s} {out.seconds:6.1f} s  {m.name:40s} {m.what}", flush=True)
+                if out.status in ("ERROR", "SURVIVED"):
+                    print(f"         {out.detail}", flush=True)
 
 
 def main(argv: list[str] | None = None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("names", nargs="*", help="mutants to run (default: all)")
+    ap = argparse.ArgumentParser(description=(__doc__ or "").splitlines()[0])
+    ap.add_argument("names", nargs="*", help="run the mutants whose name contains one of these")
+    ap.add_argument("--jobs", type=int, default=1, help="mutants run at once (default 1)")
     ap.add_argument("--full", action="store_true", help="run the whole suite per mutant")
+    ap.add_argument("--timeout", type=float, default=900.0, help="seconds per mutant")
+    ap.add_argument("--check", action="store_true", help="only check that each mutant applies")
+    ap.add_argument("--list", action="store_true", help="list the mutants and exit")
     args = ap.parse_args(argv)
-    chosen = [m for m in MUTANTS if not args.names or m.name in args.names]
-    rows = []
+    names = [m.name for m in MUTANTS]
+    dup = sorted({n for n in names if names.count(n) > 1})
+    if dup:
+        print(f"error: duplicate mutant names: {', '.join(dup)}", file=sys.stderr)
+        return 2
+    chosen = [m for m in MUTANTS if not args.names or any(w in m.name for w in args.names)]
+    if args.list:
+        for m in chosen:
+            print(f"{m.name:40s} {m.file}  {m.what}")
+        return 0
+    if args.check:
+        bad = [(m, why) for m in chosen if (why := applies(m)) is not None]
+        for m, why in bad:
+            print(f"ERROR    {m.name}: {why}")
+        print(f"{len(chosen) - len(bad)} of {len(chosen)} mutants apply; {len(bad)} do not")
+        return 1 if bad else 0
+    jobs: queue.Queue[Mutant] = queue.Queue()
     for m in chosen:
-        status, dt, detail = run_one(m, args.full)
-        rows.append((m, status, dt, detail))
-        print(f"{status:11s} {dt:6.1f} s  {m.name:34s} {m.what}", flush=True)
-    killed = sum(1 for _, s, _, _ in rows if s == "killed")
-    applied = sum(1 for _, s, _, _ in rows if s != "not-applied")
-    print(f"\nkilled {killed} of {applied} mutants ({100.0 * killed / max(applied, 1):.0f} %)")
-    for m, s, _, detail in rows:
-        if s != "killed":
-            print(f"  {s}: {m.name}: {detail}")
-    return 0 if killed == applied == len(chosen) else 1
+        jobs.put(m)
+    results: list[Outcome] = []
+    lock = threading.Lock()
+    t0 = time.perf_counter()
+    threads = [
+        threading.Thread(target=_worker, args=(jobs, results, lock, args.full, args.timeout))
+        for _ in range(max(1, min(args.jobs, len(chosen))))
+    ]
+    for th in threads:
+        th.start()
+    for th in threads:
+        th.join()
+    order = {m.name: i for i, m in enumerate(MUTANTS)}
+    results.sort(key=lambda o: order[o.mutant.name])
+    by = {
+        s: [o for o in results if o.status == s] for s in ("killed", "timeout", "SURVIVED", "ERROR")
+    }
+    killed = len(by["killed"]) + len(by["timeout"])
+    total = len(results)
+    print(
+        f"\n{total} mutants in {time.perf_counter() - t0:.0f} s: killed {killed} "
+        f"({len(by['timeout'])} by timeout), survived {len(by['SURVIVED'])}, "
+        f"errors {len(by['ERROR'])} (did not apply: not counted as killed)"
+    )
+    print(f"kill rate {100.0 * killed / max(total, 1):.1f} % of all {total}")
+    for status in ("SURVIVED", "ERROR", "timeout"):
+        for o in by[status]:
+            print(f"  {status}: {o.mutant.name} ({o.mutant.file}): {o.detail}")
+    return 0 if killed == total else 1
 
 
 if __name__ == "__main__":

@@ -382,3 +382,25 @@ def test_predict_equals_every_model_reference_and_stream_warns_once(synthetic: B
         if issubclass(w.category, ExtrapolationWarning) and "samples" not in str(w.message)
     ]
     assert len(stream_warnings) == 1
+
+
+def test_streaming_compensator_removes_the_known_input_before_selecting(
+    synthetic: BankModel,
+) -> None:
+    """A power-on of curve 2 under a known input K = +1 (curves 0, 1, 2 lie at 0.2, 1.7,
+    −1.8 at 10 °C): the streaming compensator with ``known_input=1`` hands the bank F − K,
+    so it selects curve 2 and its output is F − ŷ with ŷ the batch prediction (issue 27
+    mutant compensate-stream-known-input-sign hands it F + K = curve 2 + 2: curve 0).  A
+    far larger K (−1000) moves every deviation alike and cannot tell the sign."""
+    from thermocal.compensate.kernels import StreamingCompensator
+
+    run = power_on(2, 10.0, 77, gravity=1.0, n=200)
+    batch = synthetic.predict(run)
+    sc = StreamingCompensator(synthetic, 1.0, known_input=1.0)
+    out = np.array(
+        [
+            sc.update(float(t), run.temps_c[i], float(run.signal[i]))
+            for i, t in enumerate(run.time_s)
+        ]
+    )
+    np.testing.assert_allclose(out, run.signal - batch, rtol=0, atol=1e-9)

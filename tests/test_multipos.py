@@ -298,3 +298,21 @@ def test_over_temperature(tmp_path: Path, capsys: pytest.CaptureFixture[str]) ->
     # the calibration applies per sample's temperature: compensate reads T_imu
     tri = load_calibration(cal).triads
     assert {t.temperature for t in tri} == {"T_imu"} and tri[0].model.order == 1
+
+
+def test_a_gap_inside_a_motion_drops_that_motion() -> None:
+    """Five samples lost in the middle of the first motion (between poses 0 and 1): the
+    rotation across the gap is unknown, so that motion is left out (13 → 12 motions) and
+    the others still give the calibration (issue 27 mutant multipos-gap-factor integrates
+    across gaps of up to 15 sample intervals)."""
+    s, _ta, _tg = _session(0)
+    full = _calibrate(s)
+    (_a0, e0), (s1, _e1) = s["poses"][0], s["poses"][1]
+    mid = (e0 + s1) // 2
+    keep = np.ones(s["time_s"].size, dtype=bool)
+    keep[mid : mid + 5] = False
+    gapped = {**s, "time_s": s["time_s"][keep], "accel_mg": s["accel_mg"][keep],
+              "gyro_deg_s": s["gyro_deg_s"][keep]}  # fmt: skip
+    res = _calibrate(gapped)
+    assert full.gyro is not None and res.gyro is not None
+    assert (full.gyro.n_motions, res.gyro.n_motions) == (13, 12)

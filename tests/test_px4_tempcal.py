@@ -222,3 +222,29 @@ def test_the_holdout_is_held_out(sweep: dict) -> None:
         leak = float(np.sqrt(np.mean((v_med[odd] - insample) ** 2)))
         assert want != pytest.approx(leak, rel=1e-3)  # the two are told apart here
         assert got[axis] == pytest.approx(want, rel=1e-6), axis
+
+
+def test_px4_accel_offsets_are_the_truth_relative_to_mid_range(sweep: dict) -> None:
+    """The accelerometer offsets, without removing means first (issue 27: ``_removed``
+    subtracts them, so a constant error in X0 passed): PX4's convention is the bias
+    relative to its value at mid-range, so ``X0 + X1·dT + …`` must equal
+    ``a(T) − a(T_mid)`` of the simulated truth itself, at every temperature of the sweep
+    (the truth moves 0.1 m/s² over the sweep; the fit's own error, 0.02 m/s² a sample
+    over ~160 samples a 0.5 °C bin, is ≈ 2 mm/s² a bin: rms 3 mm/s², 8 at the ends)."""
+    p = _params(sweep["dir"] / "px4.params")
+    lo, hi, tref = p["TC_A0_TMIN"], p["TC_A0_TMAX"], p["TC_A0_TREF"]
+    mid = 0.5 * (lo + hi)
+    T = np.linspace(lo, hi, 61)
+
+    def truth(temp: np.ndarray) -> np.ndarray:
+        x = (temp - 20.0) / 30.0
+        ax = 0.05 + 0.08 * x + 0.02 * x**3
+        return np.column_stack([ax, -0.03 * x, -G0 + 0.1 * x - 0.03 * x**2])
+
+    want = truth(T) - truth(np.array([mid]))
+    for i in range(3):
+        x = [p[f"TC_A0_X{k}_{i}"] for k in range(4)]
+        dT = T - tref
+        offset = x[0] + x[1] * dT + x[2] * dT**2 + x[3] * dT**3
+        err = offset - want[:, i]
+        assert float(np.sqrt(np.mean(err**2))) < 3e-3 and np.max(np.abs(err)) < 8e-3, i
