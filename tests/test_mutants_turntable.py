@@ -314,3 +314,21 @@ def test_residuals_three_times_the_stated_noise_are_reported() -> None:
         low = calibrate(rec, 40.0, arw_deg_sqrt_h=arw)  # type: ignore[arg-type]
     assert low.chi2_per_dof == pytest.approx(9.0, rel=0.2)
     assert any("white-noise level" in w for w in low.warnings)
+
+
+def test_jittered_readings_far_from_zero_are_not_read_as_quantised() -> None:
+    """1000 still readings at 12.35° with 5″ of jitter lie on no grid: the reading
+    resolution is 0 (the old tolerance, 1e-6 of x/q steps, took them for a 2^24-count
+    encoder: 360/2^24 ≈ 2.1e-5°); the same readings snapped to a 2^20-count grid are read as
+    that grid, exactly."""
+    from thermocal.turntable.schedule import detect_motion
+
+    rng = np.random.default_rng(5)
+    n = 1000
+    t = np.arange(n) * 0.01
+    beta = np.zeros(n)
+    alpha = 12.35 + rng.normal(0.0, 5.0 / 3600.0, n)
+    assert detect_motion(t, alpha, beta).quantum_deg == 0.0
+    q = 360.0 / 2.0**20
+    snapped = np.round(alpha / q) * q
+    assert detect_motion(t, snapped, np.round(beta / q) * q).quantum_deg == q

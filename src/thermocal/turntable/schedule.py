@@ -209,9 +209,14 @@ MAX_QUANTUM_DEG: Final = 0.01
 """Coarsest reading resolution taken for an encoder grid [°] (36″)."""
 
 
+_EPS: Final = float(np.finfo(np.float64).eps)
+
+
 def _quantum(readings_deg: FloatArray, max_values: int = 100_000) -> float:
     """Reading resolution [°]: the largest of :data:`QUANTUM_CANDIDATES_DEG` on whose grid
-    every reading lies (to 1e-6 of a grid step), else 0 (not quantised)."""
+    every reading lies, to 1e-6 of a grid step plus the float64 rounding of the reading
+    (4 ulp of |x|, i.e. ``4·eps·|x|/q`` steps), else 0 (not quantised).  A tolerance that grew
+    with x/q (as it did) let jittered readings far from 0° pass every fine grid."""
     x = np.mod(np.asarray(readings_deg, dtype=np.float64), 360.0)
     if x.size > max_values:
         x = x[:: x.size // max_values + 1]
@@ -220,7 +225,7 @@ def _quantum(readings_deg: FloatArray, max_values: int = 100_000) -> float:
         return 0.0
     for q in QUANTUM_CANDIDATES_DEG:
         r = x / q
-        if np.all(np.abs(r - np.round(r)) < 1e-6 * np.maximum(1.0, np.abs(r)) + 1e-9):
+        if np.all(np.abs(r - np.round(r)) < 1e-6 + 4.0 * _EPS * np.abs(x) / q):
             # on a grid coarser than any calibration-table encoder: the angles are exact
             # round numbers (a programmed trajectory), not readings of a coarse encoder
             return float(q) if q <= MAX_QUANTUM_DEG else 0.0
