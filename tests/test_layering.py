@@ -422,3 +422,42 @@ def test_the_private_name_check_sees_its_three_forms(tmp_path: Path) -> None:
         "uses base._canonical",
         "uses fit._plan",
     ]
+
+
+# --- 4. small functions ---------------------------------------------------------------------
+
+LONGEST_FUNCTION_LINES = 100
+"""Issue 27: no function of 100 lines or more (signature and docstring counted)."""
+
+
+def long_functions(root: Path, limit: int = LONGEST_FUNCTION_LINES) -> list[str]:
+    """``file:function (n lines)`` of every function or method of ``limit`` lines or more."""
+    out = []
+    for path in sorted(root.rglob("*.py")):
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            if isinstance(node, ast.FunctionDef | ast.AsyncFunctionDef):
+                n = (node.end_lineno or node.lineno) - node.lineno + 1
+                if n >= limit:
+                    out.append(f"{path.relative_to(root)}:{node.name} ({n} lines)")
+    return out
+
+
+def test_no_function_reaches_100_lines() -> None:
+    assert long_functions(SRC) == []
+
+
+def test_the_length_check_sees_a_long_function(tmp_path: Path) -> None:
+    body = "".join(f"    x{i} = {i}\n" for i in range(98))
+    (tmp_path / "m.py").write_text(f"def short():\n    pass\n\n\ndef long():\n{body}    return 0\n")
+    assert long_functions(tmp_path) == ["m.py:long (100 lines)"]
+
+
+def test_the_drawn_structure_has_every_room_placed_and_no_arrow_up() -> None:
+    """``scripts/import_graph.py`` (ARCHITECTURE.md's drawing command) places every module
+    in a layer and finds no circle and no arrow that climbs a layer."""
+    script = Path(__file__).resolve().parents[1] / "scripts" / "import_graph.py"
+    out = subprocess.run([sys.executable, str(script)], capture_output=True, text=True, check=False)
+    problems = [
+        ln for ln in out.stdout.splitlines() if ln.startswith(("UPWARD", "CIRCLE", "UNPLACED"))
+    ]
+    assert (out.returncode, problems) == (0, [])
