@@ -181,6 +181,7 @@ def test_an_interrupted_batch_resumes(batch: Path, tmp_path: Path) -> None:
     # a plain rerun retries exactly the failed units (they ran and failed above)
     res = fleet.run_fleet(cfg, out)
     assert set(res.ran) == {"bad", "gone"} and set(res.skipped) == set(SLOPES)
+    assert all("it failed before" in res.redone[u] for u in ("bad", "gone")), res.redone
     res = fleet.run_fleet(cfg, out, force=True)
     assert res.skipped == () and len(res.ran) == 8
 

@@ -150,3 +150,20 @@ def test_a_limit_passes_just_inside_and_fails_just_outside(
         if not passes:
             assert len(rec["fail_reasons"]) == 3
             assert "U1" in res["redone"] and "[limits]" in res["redone"]["U1"]
+
+
+def test_a_figure_equal_to_its_limit_passes_and_a_missing_one_fails() -> None:
+    """Limits are inclusive (``figure ≤ max``, ``≥ min``: INTERFACE.md's fleet limits); a
+    figure that was not computed (None, NaN) fails its limit, never passes it; a channel
+    limit judges only its channel."""
+    from thermocal.fleet.batch import judge
+    from thermocal.fleet.config import Limit
+
+    figs = {"gx": {"rms_after": 0.05, "r": float("nan")}, "gy": {"rms_after": 0.07}}
+    assert judge(figs, [Limit("rms_after", "max", 0.07)]) == []
+    assert judge(figs, [Limit("rms_after", "min", 0.05)]) == []
+    assert judge({"gx": {"r": 0.5}}, [Limit("r", "min", 0.5), Limit("r", "max", 0.5)]) == []
+    assert len(judge(figs, [Limit("rms_after", "max", 0.06)])) == 1  # gy only
+    assert judge(figs, [Limit("rms_after", "max", 0.06, channel="gx")]) == []
+    assert len(judge({"gx": {"r": float("nan")}}, [Limit("r", "min", 0.0)])) == 1
+    assert not Limit("r", "max", 1.0).check(None)
