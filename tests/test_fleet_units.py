@@ -167,3 +167,8 @@ def test_a_figure_equal_to_its_limit_passes_and_a_missing_one_fails() -> None:
     assert judge(figs, [Limit("rms_after", "max", 0.06, channel="gx")]) == []
     assert len(judge({"gx": {"r": float("nan")}}, [Limit("r", "min", 0.0)])) == 1
     assert not Limit("r", "max", 1.0).check(None)
+    # a limit on a channel the unit lacks, or on a figure it did not compute, fails
+    (missing_channel,) = judge(figs, [Limit("rms_after", "max", 1.0, channel="gz")])
+    assert "no channel 'gz'" in missing_channel
+    (missing_figure,) = judge({"gx": {"rms_after": 0.05}}, [Limit("r", "min", 0.0)])
+    assert missing_figure.startswith("gx.r ")
