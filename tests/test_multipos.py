@@ -443,3 +443,40 @@ def test_simulate_turns_through_the_cli(tmp_path: Path, capsys: pytest.CaptureFi
         out["gyro"]["scale_factor_ppm_sigma"]
     )
     assert np.all(np.abs(z) < 3.5), z
+
+
+def test_report_poses_on_the_sphere(chain: dict[str, Any]) -> None:
+    """``report`` of a multipos calibration on the held-out session: the poses on the
+    sphere (a figure) and a table of each pose's gravity direction and residual, the
+    residual recomputed here from the raw file over the table's sample ranges."""
+    import re
+
+    d, tr, cal = chain["dir"], chain["truth"], chain["cal"]
+    held = next(f for f in tr["files"] if f["label"] == "held-out")
+    html_path = d / "poses.html"
+    assert main(["report", "--model", str(cal), "--recording", held["file"], "-o",
+                 str(html_path)]) == 0  # fmt: skip
+    html = html_path.read_text()
+    assert 'id="fig-poses"' in html and "Poses on the sphere" in html
+    table = html.split('id="pose-residuals"')[1].split("</table>")[0]
+    rows = re.findall(r"<tr><td>(\d+)</td><td>(\d+)–(\d+)</td><td>([^<]+)</td><td>([^<]+)</td>"
+                      r"<td>([^<]+)</td></tr>", table)  # fmt: skip
+    assert len(rows) == len(held["poses"])
+    df = pd.read_csv(held["file"])
+    acc = df[[f"accel_{a}" for a in "xyz"]].to_numpy() / MG  # m/s² → mg
+    ta = np.array(held["accel_theta"])
+    tri = load_calibration(cal).triads[0]
+    assert tri.model.order == 0  # one session: constants
+    theta = np.asarray(tri.model.theta_at(tri.model.tref_c)).reshape(12)
+    g = tr["files"][0]["gravity_m_s2"]
+    for _k, a, b, u_txt, before, after in rows:
+        f = acc[int(a) : int(b)].mean(axis=0)
+        fc = np.linalg.solve(np.eye(3) + _e(theta), f - theta[0:3])
+        u = np.array([float(v) for v in u_txt.split(",")])
+        np.testing.assert_allclose(u, fc / np.linalg.norm(fc), atol=1.5e-4)
+        assert float(before) == pytest.approx((np.linalg.norm(f) - g / MG) * MG, rel=1e-3)
+        assert float(after) == pytest.approx((np.linalg.norm(fc) - g / MG) * MG, rel=1e-3,
+                                             abs=1e-6)  # fmt: skip
+        # and the truth gives as small a residual (the noise of the pose mean)
+        ft = np.linalg.solve(np.eye(3) + _e(ta), f - ta[0:3])
+        assert abs(float(after)) < abs((np.linalg.norm(ft) - g / MG) * MG) + 0.5 * MG
