@@ -316,3 +316,167 @@ def test_a_gap_inside_a_motion_drops_that_motion() -> None:
     res = _calibrate(gapped)
     assert full.gyro is not None and res.gyro is not None
     assert (full.gyro.n_motions, res.gyro.n_motions) == (13, 12)
+
+
+# --- the six faces and the Ferraris method (360° turns); a held-out 90° turn -------------
+
+
+def _rot_angle_deg(r: np.ndarray) -> float:
+    """Angle of a rotation matrix, written here: acos((tr R − 1)/2)."""
+    return math.degrees(math.acos(max(-1.0, min(1.0, (float(np.trace(r)) - 1.0) / 2.0))))
+
+
+def _integrate(w: np.ndarray, dt: float) -> np.ndarray:
+    """Π exp([ω τ×]) by Rodrigues' formula, one sample at a time (written here)."""
+    out = np.eye(3)
+    for v in w * dt:
+        th = float(np.linalg.norm(v))
+        if th == 0.0:
+            continue
+        k = np.array([[0, -v[2], v[1]], [v[2], 0, -v[0]], [-v[1], v[0], 0]]) / th
+        out = out @ (np.eye(3) + math.sin(th) * k + (1 - math.cos(th)) * k @ k)
+    return out
+
+
+@pytest.fixture(scope="module")
+def ferraris() -> list[dict[str, Any]]:
+    """Twelve IMUs, each calibrated on a Ferraris session (the six faces named, three 360°
+    turns, y_rot and z_rot clockwise seen from above), with a held-out session of one 90°
+    turn about a random axis between two still poses."""
+    from thermocal.multipos.geometry import rotvec_to_matrix
+    from thermocal.multipos.poses import parse_poses
+    from thermocal.multipos.simulate import simulate_attitudes, simulate_ferraris
+
+    out = []
+    for seed in range(12):
+        rng = np.random.default_rng(1000 + seed)
+        t0, _t1 = random_truth(rng)
+        s = simulate_ferraris(rng, t0.accel, t0.gyro)
+        secs = parse_poses(s["sections"], s["time_s"].size, "ferraris")
+        res = calibrate_session(s["time_s"], s["accel_mg"], s["gyro_deg_s"] * DEG,
+                                g_mg=s["g_m_s2"] / MG, latitude_deg=45.0,
+                                sections=secs)  # fmt: skip
+        q, _r = np.linalg.qr(rng.normal(size=(3, 3)))
+        c0 = q * np.sign(np.linalg.det(q))
+        axis = rng.normal(size=3)
+        c1 = c0 @ rotvec_to_matrix(axis / np.linalg.norm(axis) * math.pi / 2)
+        held = simulate_attitudes(rng, [c0, c1], t0.accel, t0.gyro)
+        out.append({"s": s, "ta": t0.accel, "tg": t0.gyro, "res": res, "held": held})
+    return out
+
+
+def test_six_faces_closed_form_within_3_sigma(ferraris: list[dict[str, Any]]) -> None:
+    """With the six faces named (and fewer than nine poses) the accelerometer comes from
+    the closed form: bias and scale factors within 3σ of the truth, z-rms near 1."""
+    z = []
+    for d in ferraris:
+        res = d["res"]
+        assert res.accel.method == "six-face"
+        assert [p.section.name for p in res.poses] == ["x_p", "y_p", "z_p", "x_a", "y_a", "z_a"]
+        z.append((res.accel.theta[0:6] - d["ta"][0:6]) / res.accel.sigma[0:6])
+    z_ = np.array(z)
+    assert np.abs(z_).max() < 3.5, np.abs(z_).max(axis=0)
+    assert np.mean(np.abs(z_) > 3.0) < 0.02
+    assert 0.7 < float(np.sqrt(np.mean(z_**2))) < 1.3, np.sqrt(np.mean(z_**2, axis=0))
+
+
+def test_ferraris_turns_recover_gyro_scale_factors(ferraris: list[dict[str, Any]]) -> None:
+    """The three known 360° turns (one of them the other way about the vertical: the
+    mutant multipos-turn-sense takes every turn positive) give each gyro scale factor
+    within 3σ, σ below 150 ppm."""
+    z = []
+    for d in ferraris:
+        g = d["res"].gyro
+        assert g is not None and g.n_turns == 3
+        assert np.all(g.sigma[3:6] < 150.0), g.sigma[3:6]
+        z.append((g.theta[3:6] - d["tg"][3:6]) / g.sigma[3:6])
+    z_ = np.array(z)
+    assert np.abs(z_).max() < 3.5, z_
+    assert float(np.sqrt(np.mean(z_**2))) < 1.4
+
+
+def test_held_out_90_degree_turn_within_1_5_times_the_truth(
+    ferraris: list[dict[str, Any]],
+) -> None:
+    """The rotation-angle error of a held-out 90° turn, integrated from the gyro corrected
+    with the calibration, against the same with the true parameters (the noise and the
+    earth rate left in both): rms over the IMUs within 1.5×."""
+    err_cal, err_true = [], []
+    for d in ferraris:
+        h = d["held"]
+        (_a0, e0), (s1, _b1) = h["poses"]
+        w = h["gyro_deg_s"][e0:s1] * DEG
+        r_true = h["attitude"][e0].T @ h["attitude"][s1]
+        assert abs(_rot_angle_deg(r_true) - 90.0) < 0.01
+        for theta, errs in ((d["res"].gyro.theta, err_cal), (d["tg"], err_true)):
+            wc = np.linalg.solve(np.eye(3) + _e(theta), (w - theta[0:3] * DEG / 3600).T).T
+            errs.append(_rot_angle_deg(_integrate(wc, 0.01).T @ r_true))
+    rms_cal = math.sqrt(np.mean(np.square(err_cal)))
+    rms_true = math.sqrt(np.mean(np.square(err_true)))
+    assert rms_cal < 1.5 * rms_true, (rms_cal, rms_true)
+    # the raw gyro (bias, scale, misalignment uncorrected) is far off
+    raw = [_rot_angle_deg(_integrate(d["held"]["gyro_deg_s"][e:s] * DEG, 0.01).T
+                          @ d["held"]["attitude"][e].T @ d["held"]["attitude"][s])
+           for d in ferraris for (_a, e), (s, _b) in [d["held"]["poses"]]]  # fmt: skip
+    assert math.sqrt(np.mean(np.square(raw))) > 20 * rms_true
+
+
+def test_simulate_turns_through_the_cli(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """``simulate multipos --turns`` writes Ferraris sessions and their sections in the
+    truth; ``multipos --poses`` on them uses the six faces and the three turns."""
+    truth = tmp_path / "t.json"
+    assert main(["simulate", "multipos", "-o", str(tmp_path), "--seed", "4", "--turns",
+                 "--truth", str(truth)]) == 0  # fmt: skip
+    run = next(f for f in json.loads(truth.read_text())["files"] if f["label"] == "T+25")
+    assert set(run["sections"]) == {"x_p", "x_a", "y_p", "y_a", "z_p", "z_a", "x_rot",
+                                    "y_rot", "z_rot"}  # fmt: skip
+    poses = tmp_path / "poses.json"
+    poses.write_text(json.dumps(run["sections"]))
+    capsys.readouterr()
+    assert main(["multipos", run["file"], "--accel", A_COLS, "--gyro", G_COLS, "--poses",
+                 str(poses), "--latitude", "45", "-o", str(tmp_path / "c.json"),
+                 "--json"]) == 0  # fmt: skip
+    out = json.loads(capsys.readouterr().out)
+    assert out["accel"]["method"] == "six-face" and out["runs"][0]["gyro"]["n_turns"] == 3
+    tg = np.array(run["gyro_theta"])
+    z = (np.array(out["gyro"]["scale_factor_ppm"]) - tg[3:6]) / np.array(
+        out["gyro"]["scale_factor_ppm_sigma"]
+    )
+    assert np.all(np.abs(z) < 3.5), z
+
+
+def test_report_poses_on_the_sphere(chain: dict[str, Any]) -> None:
+    """``report`` of a multipos calibration on the held-out session: the poses on the
+    sphere (a figure) and a table of each pose's gravity direction and residual, the
+    residual recomputed here from the raw file over the table's sample ranges."""
+    import re
+
+    d, tr, cal = chain["dir"], chain["truth"], chain["cal"]
+    held = next(f for f in tr["files"] if f["label"] == "held-out")
+    html_path = d / "poses.html"
+    assert main(["report", "--model", str(cal), "--recording", held["file"], "-o",
+                 str(html_path)]) == 0  # fmt: skip
+    html = html_path.read_text()
+    assert 'id="fig-poses"' in html and "Poses on the sphere" in html
+    table = html.split('id="pose-residuals"')[1].split("</table>")[0]
+    rows = re.findall(r"<tr><td>(\d+)</td><td>(\d+)–(\d+)</td><td>([^<]+)</td><td>([^<]+)</td>"
+                      r"<td>([^<]+)</td></tr>", table)  # fmt: skip
+    assert len(rows) == len(held["poses"])
+    df = pd.read_csv(held["file"])
+    acc = df[[f"accel_{a}" for a in "xyz"]].to_numpy() / MG  # m/s² → mg
+    ta = np.array(held["accel_theta"])
+    tri = load_calibration(cal).triads[0]
+    assert tri.model.order == 0  # one session: constants
+    theta = np.asarray(tri.model.theta_at(tri.model.tref_c)).reshape(12)
+    g = tr["files"][0]["gravity_m_s2"]
+    for _k, a, b, u_txt, before, after in rows:
+        f = acc[int(a) : int(b)].mean(axis=0)
+        fc = np.linalg.solve(np.eye(3) + _e(theta), f - theta[0:3])
+        u = np.array([float(v) for v in u_txt.split(",")])
+        np.testing.assert_allclose(u, fc / np.linalg.norm(fc), atol=1.5e-4)
+        assert float(before) == pytest.approx((np.linalg.norm(f) - g / MG) * MG, rel=1e-3)
+        assert float(after) == pytest.approx((np.linalg.norm(fc) - g / MG) * MG, rel=1e-3,
+                                             abs=1e-6)  # fmt: skip
+        # and the truth gives as small a residual (the noise of the pose mean)
+        ft = np.linalg.solve(np.eye(3) + _e(ta), f - ta[0:3])
+        assert abs(float(after)) < abs((np.linalg.norm(ft) - g / MG) * MG) + 0.5 * MG

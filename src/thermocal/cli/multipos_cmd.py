@@ -90,6 +90,20 @@ OrderOpt = Annotated[
     typer.Option("--order", help="Polynomial order in temperature (default: by LOTO)."),
 ]
 TrefOpt = Annotated[float | None, typer.Option("--tref", help="Reference temperature [°C].")]
+AccelScaleOpt = Annotated[
+    str | None,
+    typer.Option(
+        "--accel-scale",
+        help="Raw-count accelerometer: one count as VALUE,UNIT (e.g. 0.061,mg); figures "
+        "are then in UNIT.",
+    ),
+]
+GyroScaleOpt = Annotated[
+    str | None,
+    typer.Option(
+        "--gyro-scale", help="Raw-count gyro: one count as VALUE,UNIT (e.g. 0.00763,deg/s)."
+    ),
+]
 StaticOpt = Annotated[float, typer.Option("--static-s", help="Shortest still pose [s].")]
 
 
@@ -111,6 +125,8 @@ def multipos_cmd(
     static_s: StaticOpt = 1.0,
     time: TimeOpt = None,
     time_unit: TimeUnitOpt = None,
+    accel_scale: AccelScaleOpt = None,
+    gyro_scale: GyroScaleOpt = None,
     as_json: JsonOpt = False,
 ) -> None:
     """Accelerometer (and gyro) triad bias, scale factors and misalignments from hand-placed
@@ -124,6 +140,7 @@ def multipos_cmd(
         (acc_cols[0], acc_cols[1], acc_cols[2]),
         (gyr_cols[0], gyr_cols[1], gyr_cols[2]) if gyr_cols else None,
         accel_unit, gyro_unit, temps, gravity, latitude, order, tref, static_s, time, time_unit,
+        _mpf.count_scale(accel_scale, "accel"), _mpf.count_scale(gyro_scale, "gyro"),
     )  # fmt: skip
     res = _mpf.calibrate_files(files, output, opts, poses)
     out, a_unit = res.summary, res.accel_unit

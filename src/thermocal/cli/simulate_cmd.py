@@ -113,6 +113,14 @@ RunOpt = Annotated[
     str | None,
     typer.Option("--run", help="modelling or validation (mems-imu: the same unit)."),
 ]
+TurnsOpt = Annotated[
+    bool,
+    typer.Option(
+        "--turns",
+        help="multipos: Ferraris sessions, the six faces and 360° turns (their sections, "
+        "the --poses object, in the truth).",
+    ),
+]
 FormatOpt = Annotated[str, typer.Option("--format", help="File format inside an output directory.")]
 
 
@@ -131,6 +139,7 @@ def simulate_cmd(
     orientation: OrientationOpt = None,
     record_s: RecordOpt = None,
     run: RunOpt = None,
+    turns: TurnsOpt = False,
     fmt: FormatOpt = "csv",
     as_json: JsonOpt = False,
 ) -> None:
@@ -139,7 +148,9 @@ def simulate_cmd(
         raise ThermocalInputError(
             f"unknown scenario {scenario!r}; known scenarios: {', '.join(defaults.SCENARIO_NAMES)}"
         )
-    opts = _simulate.SimulateOptions(rate_hz, latitude, axis, runs, orientation, record_s, run)
+    opts = _simulate.SimulateOptions(
+        rate_hz, latitude, axis, runs, orientation, record_s, run, turns or None
+    )
     inputs: list[str | Path] = [profile] if profile is not None else []
     _early_gate(output, truth, inputs)
     prog = _program.read_program(profile) if profile is not None else None

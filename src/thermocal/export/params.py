@@ -556,6 +556,13 @@ def export_params_file(
 
     check_not_input(output, [calibration])
     cal = load_calibration(calibration)
+    if not cal.channels and cal.triads:  # issue 30: a calibration of triads
+        if tref_c is not None:
+            raise ThermocalInputError(
+                "--tref is for thermal parameters; a triad's values are taken at its own TREF"
+            )
+        return _triad_params_file(cal, calibration, fmt, output, gyro, accel, instance,
+                                  device_id)  # fmt: skip
     cal.require_channels("export-params")
     check_firmware_adequacy(cal, calibration, fmt)
     ids = {"gyro": device_id, "accel": device_id} if device_id is not None else None
@@ -564,4 +571,28 @@ def export_params_file(
     )
     with atomic_write(output, "w") as fh:
         fh.write(ps.text())
+    return ParamsFileResult(str(output), fmt, ps)
+
+
+def _triad_params_file(
+    cal: Calibration,
+    calibration: str | Path,
+    fmt: str,
+    output: str | Path,
+    gyro: Sequence[str] | None,
+    accel: Sequence[str] | None,
+    instance: int,
+    device_id: int | None,
+) -> ParamsFileResult:
+    """``export-params`` of a calibration of triads: the firmware's sensor-calibration
+    offsets and scales (:mod:`thermocal.export.triad_params`), written atomically."""
+    from thermocal.export.checks import check_firmware_adequacy
+    from thermocal.export.triad_params import triad_params
+    from thermocal.writers import atomic_write
+
+    check_firmware_adequacy(cal, calibration, None)
+    tp = triad_params(cal, fmt, instance=instance, device_id=device_id, gyro=gyro, accel=accel)
+    with atomic_write(output, "w") as fh:
+        fh.write(tp.text())
+    ps = ParamSet(fmt, dict(tp.params), dict(tp.types), [], list(tp.notes))
     return ParamsFileResult(str(output), fmt, ps)

@@ -230,11 +230,17 @@ class MultiposValidation:
     n: int
     what: str
     outside_range_fraction: float = 0.0
+    per_pose: tuple[tuple[float, ...], ...] = ()
+    """Accelerometer: per pose (start, end, u_x, u_y, u_z, error before, error after): the
+    compensated gravity direction (unit, body axes) and the gravity-magnitude errors
+    [``unit``], for the report's poses on the sphere (not in ``to_dict``)."""
 
     def to_dict(self) -> dict[str, Any]:
         from dataclasses import asdict
 
-        return asdict(self)
+        out = asdict(self)
+        del out["per_pose"]
+        return out
 
     def rows(self) -> list[tuple[str, tuple[float, ...], tuple[float, ...]]]:
         return [

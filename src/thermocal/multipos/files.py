@@ -20,7 +20,7 @@ from typing import Any
 import numpy as np
 
 from thermocal import units
-from thermocal.errors import ThermocalInputError
+from thermocal.errors import ThermocalInputError, UnitError
 from thermocal.models.calibration import Calibration, Triad
 from thermocal.models.files import save_calibration
 from thermocal.multipos.calibrate import METHOD, SessionResult, calibrate_session
@@ -53,6 +53,9 @@ class MultiposOptions:
     static_s: float = 1.0
     time: str | None = None
     time_unit: str | None = None
+    accel_scale: tuple[float, str] | None = None
+    gyro_scale: tuple[float, str] | None = None
+    """Raw-count columns: one count is ``value`` ``unit`` (``--accel-scale 0.061,mg``)."""
 
     def check(self, n_files: int, poses: Path | None) -> None:
         """The options' own consistency (before any file is read)."""
@@ -93,8 +96,38 @@ class MultiposResult:
     accel_unit: str
 
 
-def _unit_of(rec: Any, cols: list[str], option: str | None, kind: str, path: Path) -> str:
-    """The columns' unit: the option, else the file's (metadata, column name)."""
+def count_scale(text: str | None, kind: str) -> tuple[float, str] | None:
+    """``--accel-scale``/``--gyro-scale VALUE,UNIT``: one raw count is ``VALUE`` ``UNIT``
+    (a datasheet's sensitivity, e.g. ``0.061,mg`` or ``0.00763,deg/s``), a positive
+    finite number and a unit of the triad's kind."""
+    if text is None:
+        return None
+    parts = [p.strip() for p in text.split(",")]
+    want = "accel" if kind == "accel" else "rate"
+    try:
+        value = float(parts[0])
+        unit = str(units.normalize_signal_unit(parts[1])) if len(parts) == 2 else ""
+    except (ValueError, UnitError):
+        value, unit = math.nan, ""
+    if not (math.isfinite(value) and value > 0 and unit and units.signal_kind(unit) == want):
+        example = "0.061,mg" if kind == "accel" else "0.00763,deg/s"
+        raise ThermocalInputError(
+            f"--{kind}-scale takes VALUE,UNIT (one count in a {want} unit, e.g. {example}), "
+            f"got {text!r}"
+        )
+    return value, unit
+
+
+def _unit_of(
+    rec: Any,
+    cols: list[str],
+    option: str | None,
+    kind: str,
+    path: Path,
+    scale: tuple[float, str] | None = None,
+) -> tuple[str, float]:
+    """The columns' unit and the factor to it: the option, else the file's (metadata,
+    column name); raw counts need ``scale`` (their unit is then the scale's)."""
     stated = [c for c in cols if rec.unit_sources.get(c, "default") != "default"]
     found = {option} if option else {rec.units.get(c) or "" for c in stated}
     if not option and len(stated) < 3:
@@ -105,13 +138,22 @@ def _unit_of(rec: Any, cols: list[str], option: str | None, kind: str, path: Pat
         )
     unit = str(units.normalize_signal_unit(found.pop()))
     want = "accel" if kind == "accel" else "rate"
+    if unit == "counts":
+        if scale is None:
+            example = "0.061,mg" if kind == "accel" else "0.00763,deg/s"
+            raise ThermocalInputError(
+                f"{path}: the {kind} columns are raw counts; give --{kind}-scale VALUE,UNIT "
+                f"(one count, from the datasheet's sensitivity, e.g. {example})"
+            )
+        return scale[1], scale[0]
+    if scale is not None:
+        raise ThermocalInputError(
+            f"{path}: --{kind}-scale is for raw counts; the {kind} columns are in {unit}"
+        )
     if units.signal_kind(unit) != want:
         what = "an acceleration" if kind == "accel" else "a rate"
-        raise ThermocalInputError(
-            f"{path}: the {kind} columns' unit {unit!r} is not {what} unit (raw counts are "
-            "not supported by multipos yet: convert them first)"
-        )
-    return unit
+        raise ThermocalInputError(f"{path}: the {kind} columns' unit {unit!r} is not {what} unit")
+    return unit, 1.0
 
 
 def _read_poses(poses: Path | None) -> dict[str, Any] | None:
@@ -165,13 +207,13 @@ def _session(
         temperatures=[temps] if temps else None,
     )  # fmt: skip
     rec.validate(required=[*acc_cols, *(gyr_cols or []), *([temps] if temps else [])])
-    au = _unit_of(rec, acc_cols, opts.accel_unit, "accel", path)
+    au, af = _unit_of(rec, acc_cols, opts.accel_unit, "accel", path, opts.accel_scale)
     grav.update(rec, path)
-    acc = units.convert(np.column_stack([rec.column(c) for c in acc_cols]), au, "mg")
+    acc = units.convert(np.column_stack([rec.column(c) for c in acc_cols]) * af, au, "mg")
     w, gu = None, None
     if gyr_cols:
-        gu = _unit_of(rec, gyr_cols, opts.gyro_unit, "gyro", path)
-        w = units.convert(np.column_stack([rec.column(c) for c in gyr_cols]), gu, "rad/s")
+        gu, gf = _unit_of(rec, gyr_cols, opts.gyro_unit, "gyro", path, opts.gyro_scale)
+        w = units.convert(np.column_stack([rec.column(c) for c in gyr_cols]) * gf, gu, "rad/s")
     sections = None
     if sections_d is not None:
         sections = parse_poses(sections_d, rec.n_samples, str(poses))
@@ -256,6 +298,9 @@ def calibrate_files(
     save_calibration(cal, output)
     assert grav.g_m_s2 is not None
     out = _summary(runs, models, a_unit, g_unit, float(grav.g_m_s2))
+    for kind, sc in (("accel", opts.accel_scale), ("gyro", opts.gyro_scale)):
+        if sc is not None and kind in out:  # raw counts: the figures are in the scale's unit
+            out[kind]["count_scale"] = {"value": sc[0], "unit": sc[1]}
     out["output"] = str(output)
     return MultiposResult(cal, out, a_unit)
 
@@ -350,4 +395,5 @@ __all__ = [
     "MultiposResult",
     "SessionRun",
     "calibrate_files",
+    "count_scale",
 ]

@@ -89,39 +89,177 @@ def simulate_session(
     """One session (module docstring): ``time_s``, ``accel_mg`` (n, 3), ``gyro_deg_s``
     (n, 3), the true ``attitude`` (n, 3, 3, body → local), ``poses`` (start, end) of the
     still windows and ``g_m_s2``."""
-    dt = 1.0 / rate_hz
     cs = [_random_rotation(rng)]
     while len(cs) < n_poses:
         c = _random_rotation(rng)
         ang = np.linalg.norm(matrix_to_rotvec(cs[-1].T @ c))
         if ang < math.radians(max_angle_deg) and ang > math.radians(30.0):
             cs.append(c)
+    return simulate_attitudes(rng, cs, accel_theta, gyro_theta, rate_hz=rate_hz,
+                              dwell_s=dwell_s, move_s=move_s, accel_noise_mg=accel_noise_mg,
+                              gyro_noise_deg_s=gyro_noise_deg_s, tremor_deg=tremor_deg,
+                              latitude_deg=latitude_deg)  # fmt: skip
+
+
+def simulate_attitudes(
+    rng: np.random.Generator,
+    attitudes: list[FloatArray],
+    accel_theta: FloatArray,
+    gyro_theta: FloatArray,
+    *,
+    rate_hz: float = 100.0,
+    dwell_s: float = 5.0,
+    move_s: float = 2.0,
+    accel_noise_mg: float = 2.0,
+    gyro_noise_deg_s: float = 0.03,
+    tremor_deg: float = 0.003,
+    latitude_deg: float = 45.0,
+) -> dict[str, Any]:
+    """A session through the given still ``attitudes`` (body → local ENU rotations, each
+    move shorter than a half turn), as :func:`simulate_session` (which draws them at
+    random): for a held-out turn of a known angle."""
+    spec = _Spec(rate_hz, dwell_s, move_s, tremor_deg, 6.0)
+    w_nb, poses, _turns = _body_rates(rng, attitudes, {}, spec)
+    return _measure(rng, attitudes[0], w_nb, poses, accel_theta, gyro_theta,
+                    accel_noise_mg, gyro_noise_deg_s, latitude_deg, rate_hz)  # fmt: skip
+
+
+FERRARIS_TURNS: dict[str, tuple[str, float]] = {
+    "x_p": ("x_rot", 1.0),
+    "y_a": ("y_rot", -1.0),
+    "z_p": ("z_rot", -1.0),
+}
+"""The Ferraris session's 360° turns: after which face, its name, and its sense about the
+local vertical (+1 counter-clockwise seen from above): one of them the other way."""
+
+
+def face_rotation(face: str, heading_rad: float = 0.0) -> FloatArray:
+    """Body → local (ENU) rotation of a face (``x_p``: body x up, ``x_a``: body x down…),
+    turned by ``heading_rad`` about the vertical."""
+    from thermocal.multipos.geometry import rotvec_to_matrix
+
+    axis = np.eye(3)["xyz".index(face[0])] * (1.0 if face.endswith("_p") else -1.0)
+    up = np.array([0.0, 0.0, 1.0])
+    c_ax = np.cross(axis, up)
+    if np.linalg.norm(c_ax) < 1e-12:
+        c0 = np.eye(3) if axis[2] > 0 else rotvec_to_matrix([math.pi, 0.0, 0.0])
+    else:
+        ang = math.acos(float(np.clip(axis @ up, -1.0, 1.0)))
+        c0 = rotvec_to_matrix(c_ax / np.linalg.norm(c_ax) * ang)
+    out: FloatArray = rotvec_to_matrix(up * heading_rad) @ c0
+    return out
+
+
+def simulate_ferraris(
+    rng: np.random.Generator,
+    accel_theta: FloatArray,
+    gyro_theta: FloatArray,
+    *,
+    rate_hz: float = 100.0,
+    dwell_s: float = 5.0,
+    move_s: float = 2.0,
+    turn_s: float = 6.0,
+    accel_noise_mg: float = 2.0,
+    gyro_noise_deg_s: float = 0.03,
+    tremor_deg: float = 0.003,
+    latitude_deg: float = 45.0,
+) -> dict[str, Any]:
+    """A Ferraris session (imucal's form): the six faces ``x_p``, ``y_p``, ``z_p``, ``x_a``,
+    ``y_a``, ``z_a`` in that order (no flip to the opposite face: a half turn; random
+    headings, each move between 30° and 150°)
+    and, after the faces of :data:`FERRARIS_TURNS`, a full 360° turn about the vertical
+    over ``turn_s`` with the sense given there.  As :func:`simulate_session`, plus
+    ``sections``: the POSES file's object ``{name: {"start": i, "end": j}}`` (faces and
+    turns)."""
+    order = ("x_p", "y_p", "z_p", "x_a", "y_a", "z_a")  # no face after its opposite
+    cs: list[FloatArray] = []
+    for f in order:  # headings that keep every move well short of a half turn
+        c = face_rotation(f, rng.uniform(0, 2 * math.pi))
+        while cs and not 0.5 < np.linalg.norm(matrix_to_rotvec(cs[-1].T @ c)) < 2.6:
+            c = face_rotation(f, rng.uniform(0, 2 * math.pi))
+        cs.append(c)
+    turn_after = {order.index(f): sense for f, (_n, sense) in FERRARIS_TURNS.items()}
+    spec = _Spec(rate_hz, dwell_s, move_s, tremor_deg, turn_s)
+    w_nb, poses, turns = _body_rates(rng, cs, turn_after, spec)
+    out = _measure(rng, cs[0], w_nb, poses, accel_theta, gyro_theta, accel_noise_mg,
+                   gyro_noise_deg_s, latitude_deg, rate_hz)  # fmt: skip
+    sections = {f: {"start": a, "end": b} for f, (a, b) in zip(order, poses, strict=True)}
+    for k, (a, b) in turns.items():
+        sections[FERRARIS_TURNS[order[k]][0]] = {"start": a, "end": b}
+    out["sections"] = sections
+    return out
+
+
+@dataclass(frozen=True)
+class _Spec:
+    rate_hz: float
+    dwell_s: float
+    move_s: float
+    tremor_deg: float
+    turn_s: float
+
+
+def _body_rates(
+    rng: np.random.Generator,
+    cs: list[FloatArray],
+    turn_after: dict[int, float],
+    spec: _Spec,
+) -> tuple[FloatArray, list[tuple[int, int]], dict[int, tuple[int, int]]]:
+    """The body rate through the poses ``cs`` (dwell with tremor, then the move to the
+    next), with a 360° turn about the vertical after pose k of sense ``turn_after[k]``;
+    the still windows and the turns' sample ranges."""
+    dt = 1.0 / spec.rate_hz
     rates = []
     poses = []
+    turns = {}
     n0 = 0
-    for k in range(n_poses):
-        n_d = round(dwell_s * rng.uniform(0.7, 1.3) * rate_hz)
+    for k in range(len(cs)):
+        n_d = round(spec.dwell_s * rng.uniform(0.7, 1.3) * spec.rate_hz)
         tt = np.arange(n_d + 1) * dt
         axis = rng.normal(size=3)
         axis /= np.linalg.norm(axis)
-        ang = math.radians(tremor_deg) * np.sin(2 * math.pi * rng.uniform(1.5, 4.0) * tt
-                                                + rng.uniform(0, 2 * math.pi))  # fmt: skip
+        ang = math.radians(spec.tremor_deg) * np.sin(2 * math.pi * rng.uniform(1.5, 4.0) * tt
+                                                     + rng.uniform(0, 2 * math.pi))  # fmt: skip
         ang -= ang[0]
         rates.append(np.diff(ang)[:, None] / dt * axis[None, :])
         poses.append((n0, n0 + n_d))
         n0 += n_d
-        if k + 1 < n_poses:
+        c_now = cs[k] @ _rodrigues(axis * ang[-1])
+        if k in turn_after:
+            # a full turn about the vertical: the body axis now up, back to c_now
+            up_b = c_now.T @ np.array([0.0, 0.0, 1.0])
+            n_t = round(spec.turn_s * spec.rate_hz)
+            s = (1 - np.cos(np.pi * np.arange(n_t + 1) / n_t)) / 2
+            rates.append(np.diff(s)[:, None] / dt * (2 * math.pi * turn_after[k]) * up_b)
+            turns[k] = (n0, n0 + n_t)
+            n0 += n_t
+        if k + 1 < len(cs):
             # the tremor leaves the attitude at exp(ang[-1] axis): rotate from there
-            c_now = cs[k] @ _rodrigues(axis * ang[-1])
             phi = matrix_to_rotvec(c_now.T @ cs[k + 1])
-            n_m = round(move_s * rng.uniform(0.7, 1.3) * rate_hz)
+            n_m = round(spec.move_s * rng.uniform(0.7, 1.3) * spec.rate_hz)
             s = (1 - np.cos(np.pi * np.arange(n_m + 1) / n_m)) / 2
             rates.append(np.diff(s)[:, None] / dt * phi[None, :])
             n0 += n_m
-    w_nb = np.vstack(rates)
+    return np.vstack(rates), poses, turns
+
+
+def _measure(
+    rng: np.random.Generator,
+    c0: FloatArray,
+    w_nb: FloatArray,
+    poses: list[tuple[int, int]],
+    accel_theta: FloatArray,
+    gyro_theta: FloatArray,
+    accel_noise_mg: float,
+    gyro_noise_deg_s: float,
+    latitude_deg: float,
+    rate_hz: float,
+) -> dict[str, Any]:
+    """The attitude from the body rate, and what the triads read (module docstring)."""
+    dt = 1.0 / rate_hz
     n = w_nb.shape[0]
     d = attitude_along(np.vstack([w_nb, np.zeros((1, 3))]), np.full(n + 1, dt))
-    att = cs[0][None] @ d  # body → local (ENU), n + 1 samples
+    att = c0[None] @ d  # body → local (ENU), n + 1 samples
     g = units.normal_gravity_m_s2(latitude_deg)
     f_true = np.einsum("nji,j->ni", att, np.array([0.0, 0.0, g])) / MG_M_S2  # mg
     # the hand's acceleration during the moves (local frame), ≤ 0.05 g
@@ -174,6 +312,7 @@ def simulate_runs(
     n_poses: int = 16,
     temperatures_c: tuple[float, ...] | None = None,
     held_out: bool = True,
+    turns: bool = False,
 ) -> list[tuple[Any, dict[str, Any]]]:
     """``runs`` sessions of one IMU at temperatures spread over −10…+50 °C (one: 25 °C),
     each a :class:`~thermocal.recording.Recording` (accelerometer in m/s², gyro in °/s,
@@ -181,7 +320,9 @@ def simulate_runs(
     θ₀ and θ₁ of :func:`random_truth`, the still windows, g and the latitude.  With
     ``held_out`` one more session of the same IMU (other poses, other noise), labelled
     ``held-out``, at the first temperature (several runs: midway between the first two),
-    for validation."""
+    for validation.  With ``turns`` every session but the held-out one is a Ferraris
+    session (:func:`simulate_ferraris`: the six faces and three 360° turns, one the other
+    way), its truth carrying ``sections``, the POSES file's object for ``--poses``."""
     from thermocal.recording import Metadata, Recording
 
     if runs < 1:
@@ -198,8 +339,12 @@ def simulate_runs(
         rng = np.random.default_rng(seed_rngs[1].integers(2**63) + i)
         ta = truth0.accel + slope.accel * (tc - TREF_TRUTH_C)
         tg = truth0.gyro + slope.gyro * (tc - TREF_TRUTH_C)
-        s = simulate_session(rng, ta, tg, n_poses=n_poses, rate_hz=rate_hz,
-                             latitude_deg=latitude_deg)  # fmt: skip
+        is_held = held_out and i == len(temps) - 1
+        if turns and not is_held:
+            s = simulate_ferraris(rng, ta, tg, rate_hz=rate_hz, latitude_deg=latitude_deg)
+        else:
+            s = simulate_session(rng, ta, tg, n_poses=n_poses, rate_hz=rate_hz,
+                                 latitude_deg=latitude_deg)  # fmt: skip
         n = s["time_s"].size
         temp = tc + 0.2 * np.sin(np.linspace(0, np.pi, n))
         acc = s["accel_mg"] * MG_M_S2
@@ -210,7 +355,6 @@ def simulate_runs(
             s["time_s"], sig, {TEMPERATURE_COLUMN: temp}, signal_unit=unit,
             meta=Metadata(latitude_deg=latitude_deg, sample_interval_s=1.0 / rate_hz),
         )  # fmt: skip
-        is_held = held_out and i == len(temps) - 1
         label = "held-out" if is_held else f"T{tc:+.0f}"
         out.append(
             (
@@ -231,10 +375,20 @@ def simulate_runs(
                     "gravity_m_s2": s["g_m_s2"],
                     "latitude_deg": latitude_deg,
                     "misalignment_names": list(model.MISALIGNMENT_NAMES),
+                    **({"sections": s["sections"]} if "sections" in s else {}),
                 },
             )
         )
     return out
 
 
-__all__ = ["Truth", "random_truth", "simulate_runs", "simulate_session"]
+__all__ = [
+    "FERRARIS_TURNS",
+    "Truth",
+    "face_rotation",
+    "random_truth",
+    "simulate_attitudes",
+    "simulate_ferraris",
+    "simulate_runs",
+    "simulate_session",
+]

@@ -91,6 +91,12 @@ def validate_triads(
         )
     g = float(units.convert(np.array([g_m_s2]), "m/s^2", a_unit)[0])
     eb, ea, pb, pa = gravity_errors(xa, xa_c, sections, g)
+    means = np.asarray([xa_c[s.start : s.end].mean(axis=0) for s in sections])
+    up = means / np.linalg.norm(means, axis=1)[:, None]
+    per_pose = tuple(
+        (float(s.start), float(s.end), *(float(v) for v in u), float(b), float(a))
+        for s, u, b, a in zip(sections, up, eb, ea, strict=True)
+    )
     out = [
         MultiposValidation(
             acc.name,
@@ -102,6 +108,7 @@ def validate_triads(
             len(sections),
             "gravity-magnitude error",
             outside(acc, ta),
+            per_pose,
         )
     ]
     if gyr is not None and xg is not None and xg_c is not None:

@@ -59,6 +59,7 @@ def build_triad_report(
 ) -> str:
     from thermocal import __version__
     from thermocal.report.build import _env
+    from thermocal.report.multipos import pose_section
 
     triads = []
     for tri in cal.triads:
@@ -110,6 +111,7 @@ def build_triad_report(
             triads=triads,
             validation=val,
             recording=str(recording_path) if recording_path else None,
+            multipos=pose_section(validation),
         )
     )
     return html

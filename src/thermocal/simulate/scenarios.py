@@ -630,6 +630,8 @@ class SimulateOptions:
     orientation: str | None = None
     record_s: float | None = None
     run: str | None = None
+    turns: bool | None = None
+    """multipos: Ferraris sessions (six named faces and 360° turns)."""
 
     def __post_init__(self) -> None:
         rate, lat = self.rate_hz, self.latitude_deg
