@@ -216,12 +216,28 @@ def px4_tempcal(
     written).  Each IMU instance goes through the pipeline (:func:`.pipeline.fit_sensor`: a
     cubic per axis about ``tref_c`` [°C], mid-range unless given); barometers and
     magnetometers are offsets (:func:`fit_offset_sensor`).  ``overrides`` the adequacy
-    checks let through (``narrow``, ``motion``)."""
-    from thermocal.export.params import ParamSet
+    checks let through (``narrow``, ``motion``).  The log is parsed once
+    (:func:`thermocal.readers.ulog.parsed_once`) for every topic read."""
 
     # DIR may hold the log; the files of the set (replaced by name) may not be it
+    from thermocal.readers.ulog import parsed_once
+
     check_outputs([output / "calibration.json", output / PARAMS_NAME], [log], dirs=[output])
     check_output_dir(output)
+    with parsed_once(log, (*TOPICS, *OFFSET_TOPICS)):  # the log is parsed once
+        return _px4_tempcal(log, output, tref_c, overrides, reporter)
+
+
+def _px4_tempcal(
+    log: Path,
+    output: Path,
+    tref_c: float | None,
+    overrides: tuple[str, ...],
+    reporter: Reporter | None,
+) -> Px4TempcalResult:
+    """:func:`px4_tempcal` after its output checks."""
+    from thermocal.export.params import ParamSet
+
     topics = log_topics(log)
     if not topics:
         raise ThermocalInputError(f"{log}: {NO_SENSOR}")
