@@ -246,16 +246,19 @@ def _px4_tempcal(
     offset_fits: list[OffsetFit] = []
     gates: list[str | None] = []
     series: dict[str, tuple[FloatArray, FloatArray]] = {}
+    motions: dict[str, adequacy.Motion] = {}
     params = ParamSet("px4")
     with staged_set(output, reporter) as out_set:  # moved into place whole, or removed
         for name, inst in topics:
             if name in OFFSET_TOPICS:  # barometers and magnetometers: TC_B / TC_M
                 offset_fits.append(_offset_instance(log, name, inst, tref_c, overrides, params))
                 continue
-            fit, more = _imu_instance(log, name, inst, tref_c, overrides, params, out_set, series)
+            fit, more = _imu_instance(
+                log, name, inst, tref_c, overrides, params, out_set, (series, motions)
+            )
             fits.append(fit)
             gates.extend(more)
-        gates.extend(step_warnings(fits, series))
+        gates.extend(step_warnings(fits, series, motions))
         warn_gates(gates)
         if not fits:
             raise ThermocalInputError(f"{log}: {NO_SENSOR}")
@@ -304,17 +307,19 @@ def _imu_instance(
     overrides: tuple[str, ...],
     params: Any,
     out_set: OutputSet,
-    series: dict[str, tuple[FloatArray, FloatArray]],
+    found: tuple[dict[str, tuple[FloatArray, FloatArray]], dict[str, adequacy.Motion]],
 ) -> tuple[SensorFit, list[str | None]]:
     """A gyro or accelerometer instance through the pipeline: read, fit, its gates, its
-    ``TC_G``/``TC_A`` parameters merged into ``params``, its report; ``series`` gets its
-    (time [s], x/y/z in the canonical unit) for the step check across instances."""
+    ``TC_G``/``TC_A`` parameters merged into ``params``, its report; ``found`` (series,
+    motions) gets its (time [s], x/y/z in the canonical unit) and its stillness result for
+    the step check across instances."""
     from thermocal.export.params import export_params
 
     kind = "gyro" if name == "sensor_gyro" else "accel"
     where = f"{name}.{inst}"
     rec = read_sensor_topic(log, where)
-    fit = fit_sensor(rec, name, kind, inst, overrides=overrides)
+    series, motions = found
+    fit = fit_sensor(rec, name, kind, inst, overrides=overrides, motions=motions)
     temp_c = rec.temperature_c("temperature")
     series[where] = (rec.time_s, np.column_stack([rec.signal(a)[0] for a in AXES]))
     gates = [stall_warning(where, rec.time_s, temp_c)]
