@@ -19,7 +19,7 @@ import pytest
 from thermocal.cli import main
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))
-import bench_px4_algorithm as px4  # noqa: E402
+import bench_px4_algorithm as px4
 
 
 def test_thermocal_leaves_at_most_0_8_of_px4s_residual_on_every_axis(

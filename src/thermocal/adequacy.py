@@ -480,7 +480,9 @@ def _window_medians(t_block: FloatArray, x: FloatArray, window_s: float) -> Floa
     return np.stack([c, before, after])
 
 
-def _ragged_medians(x: FloatArray, lo: npt.NDArray[np.intp], hi: npt.NDArray[np.intp]) -> FloatArray:
+def _ragged_medians(
+    x: FloatArray, lo: npt.NDArray[np.intp], hi: npt.NDArray[np.intp]
+) -> FloatArray:
     """Per i, the median of the rows ``x[lo[i]:hi[i]]`` (n, m) (NaN for an empty window),
     at once: the windows side by side, padded with NaN (``np.nanmedian``: the median of
     what is not padding), in pieces of a bounded size."""
