@@ -474,14 +474,33 @@ def _window_medians(t_block: FloatArray, x: FloatArray, window_s: float) -> Floa
     lo = np.searchsorted(t_block, t_block - half, side="left")
     hi = np.searchsorted(t_block, t_block + half, side="right")
     me = np.arange(n)
-    c = np.array([np.median(x[a:b], axis=0) for a, b in zip(lo, hi, strict=True)])
-    before = np.array(
-        [np.median(x[a:b], axis=0) if b > a else x[b] for a, b in zip(lo, me, strict=True)]
-    )
-    after = np.array(
-        [np.median(x[a:b], axis=0) if b > a else x[a - 1] for a, b in zip(me + 1, hi, strict=True)]
-    )
+    c = _ragged_medians(x, lo, hi)
+    before = np.where((me > lo)[:, None], _ragged_medians(x, lo, me), x)
+    after = np.where((hi > me + 1)[:, None], _ragged_medians(x, me + 1, hi), x)
     return np.stack([c, before, after])
+
+
+def _ragged_medians(
+    x: FloatArray, lo: npt.NDArray[np.intp], hi: npt.NDArray[np.intp]
+) -> FloatArray:
+    """Per i, the median of the rows ``x[lo[i]:hi[i]]`` (n, m) (NaN for an empty window),
+    at once: the windows side by side, padded with NaN (``np.nanmedian``: the median of
+    what is not padding), in pieces of a bounded size."""
+    n, m = x.shape
+    out = np.full((lo.size, m), np.nan)
+    width = int(np.max(hi - lo, initial=0))
+    if width == 0:
+        return out
+    padded = np.vstack([x, np.full((1, m), np.nan)])
+    step = max(1, 2_000_000 // (width * m))
+    cols = np.arange(width)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)  # an empty window: NaN, not used
+        for a in range(0, lo.size, step):
+            rows = lo[a : a + step, None] + cols
+            rows = np.where(rows < hi[a : a + step, None], rows, n)
+            out[a : a + step] = np.nanmedian(padded[rows], axis=1)
+    return out
 
 
 def _runs_of(mask: npt.NDArray[np.bool_]) -> list[tuple[int, int]]:

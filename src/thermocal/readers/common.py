@@ -288,19 +288,36 @@ class TrackedReader(io.BufferedReader):
     a clean end is a read of nothing)."""
 
     def __init__(self, path: Path) -> None:
-        super().__init__(io.FileIO(path, "rb"))
+        super().__init__(io.FileIO(path, "rb"), buffer_size=1 << 20)
         self.stopped_at: int | None = None
-        self.short_read = False
+        self._short_at: int | None = None
+
+    @property
+    def short_read(self) -> bool:
+        """The last read came back short (some bytes, fewer than asked): a short read can
+        only be the last read with data (the file ends there), so it is the last read when
+        nothing was read after it (the position is still where it left off)."""
+        end = self.stopped_at if self.closed else self.tell()
+        return self._short_at is not None and self._short_at == end and not self._empty_after
 
     def read(self, size: int | None = -1) -> bytes:
-        data = super().read(size)
-        self.short_read = size is not None and size > 0 and 0 < len(data) < size
+        data = _BUFFERED_READ(self, size)
+        if size is None or len(data) != size:  # rare: only at the end of the file
+            if data and size is not None and size > 0:
+                self._short_at, self._empty_after = self.tell(), False
+            elif not data and size:
+                self._empty_after = True  # a read of nothing after it: a clean end
         return data
+
+    _empty_after = False
 
     def close(self) -> None:
         if self.stopped_at is None and not self.closed:
             self.stopped_at = self.tell()
         super().close()
+
+
+_BUFFERED_READ = io.BufferedReader.read
 
 
 def warn_damage(path: Path, notes: Sequence[str]) -> None:

@@ -2,9 +2,11 @@
 
 from __future__ import annotations
 
+import contextlib
+import contextvars
 import math
 import warnings
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -83,7 +85,42 @@ class _ULogRead:
     notes: tuple[str, ...]
 
 
+_Cache = dict[tuple[Path, tuple[str, ...]], "_ULogRead | None"]
+_PARSED: contextvars.ContextVar[_Cache | None] = contextvars.ContextVar(
+    "thermocal_ulog_parsed", default=None
+)
+
+
+@contextlib.contextmanager
+def parsed_once(path: str | Path, names: Sequence[str]) -> Iterator[None]:
+    """Within the block, every read of the ULog ``path`` asking for topics among ``names``
+    (:func:`ulog_sensor_instances`, :func:`read_ulog`, so :func:`read_recording` with a
+    topic) is served from ONE pyulog parse of those topics, made at the first read: a
+    command that takes several topics of one log reads the file once.  What is read, and
+    every warning said, is the same as without the block (the parse is the same, only
+    shared)."""
+    cache: _Cache = {(Path(path).resolve(), tuple(sorted(set(names)))): None}  # parsed lazily
+    token = _PARSED.set(cache)
+    try:
+        yield
+    finally:
+        _PARSED.reset(token)
+
+
 def _parse_ulog(path: Path, names: list[str] | None) -> _ULogRead:
+    """Parse a ULog (:func:`_parse_ulog_file`), or, within :func:`parsed_once` for this file
+    and a superset of ``names``, take the block's one parse."""
+    cache = _PARSED.get()
+    if cache is not None and names is not None:
+        for (where, have), read in cache.items():
+            if set(names) <= set(have) and where == path.resolve():
+                if read is None:
+                    read = cache[(where, have)] = _parse_ulog_file(path, list(have))
+                return read
+    return _parse_ulog_file(path, names)
+
+
+def _parse_ulog_file(path: Path, names: list[str] | None) -> _ULogRead:
     """Parse a ULog with pyulog (only the topics ``names``, all when None), its printed
     noise captured, and measure what was lost:
 

@@ -28,6 +28,7 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+import numpy.typing as npt
 
 from thermocal import adequacy, units
 from thermocal.errors import GapWarning, ThermocalInputError, ThermocalWarning
@@ -127,6 +128,26 @@ def judge_sensor(
     return judged.enforce().to_dict()
 
 
+def motion_floor(kind: str) -> float:
+    """The smallest departure :func:`thermocal.adequacy.stillness` calls motion, in the
+    canonical unit of ``kind`` (°/h for a gyro, mg for an accelerometer)."""
+    if kind == "gyro":
+        return adequacy.MOTION_FLOOR_DEG_S * adequacy.DEG_H_PER_DEG_S
+    return adequacy.MOTION_FLOOR_MG
+
+
+def still_mask(time_s: FloatArray, motion: adequacy.Motion) -> npt.NDArray[np.bool_]:
+    """The samples outside every bump :func:`thermocal.adequacy.stillness` found (each
+    episode ``[start, end]`` [s] widened by :data:`adequacy.STILL_BLOCK_S` on both sides:
+    the block edges are where a bump begins and ends, not where it is over)."""
+    keep = np.ones(time_s.size, dtype=bool)
+    pad = adequacy.STILL_BLOCK_S
+    for start, end, _peak in motion.episodes:
+        a, b = np.searchsorted(time_s, [start - pad, end + pad])
+        keep[a:b] = False
+    return keep
+
+
 def fit_sensor(
     rec: Recording,
     topic: str,
@@ -135,17 +156,29 @@ def fit_sensor(
     *,
     overrides: tuple[str, ...] = (),
     firmware: str = "px4",
+    motions: dict[str, adequacy.Motion] | None = None,
 ) -> SensorFit:
-    """Judge the log (:func:`judge_sensor`), then bin (:func:`.binning.temperature_bins`),
-    judge on held-out bins (:func:`holdout_rms`) and fit one sensor instance's three axes
-    (a cubic in T per axis, to every bin)."""
+    """Judge the log (:func:`judge_sensor`), leave out the bumps (the board handled,
+    knocked: :func:`thermocal.adequacy.stillness`'s episodes, :func:`still_mask`; a bump
+    fills whole temperature bins where the sweep is fast, and no statistic of the bin can
+    tell it from the bias), then bin (:func:`.binning.temperature_bins`), judge on held-out
+    bins (:func:`holdout_rms`) and fit one sensor instance's three axes (a cubic in T per
+    axis, to every bin).  ``motions`` (when given) gets the stillness result under
+    ``TOPIC.N`` (for :func:`step_warnings`, not computed twice)."""
     temp = rec.temperature_c("temperature")
     lo, hi = float(np.min(temp)), float(np.max(temp))
     where = f"{topic}.{instance}"
     vals = np.column_stack([rec.signal(a)[0] for a in AXES])  # canonical unit (°/h or mg)
     unit = rec.signal(AXES[0])[1]
     record = judge_sensor(rec, where, kind, vals, overrides, firmware)
-    _c, t_med, v_med = temperature_bins(temp, vals)
+    motion = adequacy.stillness(rec.time_s, vals, motion_floor(kind))
+    if motions is not None:
+        motions[where] = motion
+    keep = still_mask(rec.time_s, motion)
+    if motion.episodes and np.count_nonzero(keep) < temp.size:
+        _c, t_med, v_med = temperature_bins(temp[keep], vals[keep])
+    else:
+        _c, t_med, v_med = temperature_bins(temp, vals)
     if t_med.size < MIN_BINS:
         raise ThermocalInputError(
             f"{where}: the temperature covers {t_med.size} bins of {BIN_WIDTH_C:g} °C; a cubic "
@@ -343,13 +376,15 @@ def stall_warning(where: str, time_s: FloatArray, temp_c: FloatArray) -> str | N
 
 
 def step_warnings(
-    fits: Sequence[SensorFit], series: Mapping[str, tuple[FloatArray, FloatArray]]
+    fits: Sequence[SensorFit],
+    series: Mapping[str, tuple[FloatArray, FloatArray]],
+    motions: Mapping[str, adequacy.Motion] | None = None,
 ) -> list[str]:
     """A step-like bias on one instance of a multi-IMU board:
     :func:`thermocal.adequacy.stillness` of every instance of a kind (``series``: name →
-    (time [s], values in the canonical unit)); a step on one instance not seen on another
-    within the stillness window is a bias jump of that sensor, not the board moving (which
-    every instance would see)."""
+    (time [s], values in the canonical unit), or its result already in ``motions``); a step
+    on one instance not seen on another within the stillness window is a bias jump of that
+    sensor, not the board moving (which every instance would see)."""
     out: list[str] = []
     by_kind: dict[str, list[SensorFit]] = {}
     for f in fits:
@@ -365,7 +400,9 @@ def step_warnings(
         steps = {}
         for f in group:
             key = f"{f.topic}.{f.instance}"
-            if key in series:
+            if motions is not None and key in motions:
+                steps[key] = motions[key].steps
+            elif key in series:
                 t, v = series[key]
                 steps[key] = adequacy.stillness(t, v, floor).steps
         for key, mine in steps.items():

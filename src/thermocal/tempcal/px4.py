@@ -216,12 +216,28 @@ def px4_tempcal(
     written).  Each IMU instance goes through the pipeline (:func:`.pipeline.fit_sensor`: a
     cubic per axis about ``tref_c`` [°C], mid-range unless given); barometers and
     magnetometers are offsets (:func:`fit_offset_sensor`).  ``overrides`` the adequacy
-    checks let through (``narrow``, ``motion``)."""
-    from thermocal.export.params import ParamSet
+    checks let through (``narrow``, ``motion``).  The log is parsed once
+    (:func:`thermocal.readers.ulog.parsed_once`) for every topic read."""
 
     # DIR may hold the log; the files of the set (replaced by name) may not be it
+    from thermocal.readers.ulog import parsed_once
+
     check_outputs([output / "calibration.json", output / PARAMS_NAME], [log], dirs=[output])
     check_output_dir(output)
+    with parsed_once(log, (*TOPICS, *OFFSET_TOPICS)):  # the log is parsed once
+        return _px4_tempcal(log, output, tref_c, overrides, reporter)
+
+
+def _px4_tempcal(
+    log: Path,
+    output: Path,
+    tref_c: float | None,
+    overrides: tuple[str, ...],
+    reporter: Reporter | None,
+) -> Px4TempcalResult:
+    """:func:`px4_tempcal` after its output checks."""
+    from thermocal.export.params import ParamSet
+
     topics = log_topics(log)
     if not topics:
         raise ThermocalInputError(f"{log}: {NO_SENSOR}")
@@ -230,16 +246,19 @@ def px4_tempcal(
     offset_fits: list[OffsetFit] = []
     gates: list[str | None] = []
     series: dict[str, tuple[FloatArray, FloatArray]] = {}
+    motions: dict[str, adequacy.Motion] = {}
     params = ParamSet("px4")
     with staged_set(output, reporter) as out_set:  # moved into place whole, or removed
         for name, inst in topics:
             if name in OFFSET_TOPICS:  # barometers and magnetometers: TC_B / TC_M
                 offset_fits.append(_offset_instance(log, name, inst, tref_c, overrides, params))
                 continue
-            fit, more = _imu_instance(log, name, inst, tref_c, overrides, params, out_set, series)
+            fit, more = _imu_instance(
+                log, name, inst, tref_c, overrides, params, out_set, (series, motions)
+            )
             fits.append(fit)
             gates.extend(more)
-        gates.extend(step_warnings(fits, series))
+        gates.extend(step_warnings(fits, series, motions))
         warn_gates(gates)
         if not fits:
             raise ThermocalInputError(f"{log}: {NO_SENSOR}")
@@ -288,17 +307,19 @@ def _imu_instance(
     overrides: tuple[str, ...],
     params: Any,
     out_set: OutputSet,
-    series: dict[str, tuple[FloatArray, FloatArray]],
+    found: tuple[dict[str, tuple[FloatArray, FloatArray]], dict[str, adequacy.Motion]],
 ) -> tuple[SensorFit, list[str | None]]:
     """A gyro or accelerometer instance through the pipeline: read, fit, its gates, its
-    ``TC_G``/``TC_A`` parameters merged into ``params``, its report; ``series`` gets its
-    (time [s], x/y/z in the canonical unit) for the step check across instances."""
+    ``TC_G``/``TC_A`` parameters merged into ``params``, its report; ``found`` (series,
+    motions) gets its (time [s], x/y/z in the canonical unit) and its stillness result for
+    the step check across instances."""
     from thermocal.export.params import export_params
 
     kind = "gyro" if name == "sensor_gyro" else "accel"
     where = f"{name}.{inst}"
     rec = read_sensor_topic(log, where)
-    fit = fit_sensor(rec, name, kind, inst, overrides=overrides)
+    series, motions = found
+    fit = fit_sensor(rec, name, kind, inst, overrides=overrides, motions=motions)
     temp_c = rec.temperature_c("temperature")
     series[where] = (rec.time_s, np.column_stack([rec.signal(a)[0] for a in AXES]))
     gates = [stall_warning(where, rec.time_s, temp_c)]
