@@ -40,6 +40,7 @@ OutDirOpt = Annotated[Path, typer.Option("-o", "--output", help="Directory to wr
 def write_report(path: Path, req: "ReportRequest") -> None:
     """One sensor's HTML report (:func:`thermocal.report.calibration.write_calibration_report`)."""
     from thermocal.report.calibration import CalibrationReportInputs, write_calibration_report
+    from thermocal.report.tempcal import comparison_html
 
     write_calibration_report(
         path,
@@ -47,6 +48,7 @@ def write_report(path: Path, req: "ReportRequest") -> None:
             calibration=req.calibration, recording=req.recording,
             recording_path=req.recording_path, title=req.title, sensor=req.sensor,
             generated_by=req.generated_by, extra=req.extra, notes=req.notes,
+            appendix=(comparison_html(req.previous),) if req.previous is not None else (),
         ),
     )  # fmt: skip
 

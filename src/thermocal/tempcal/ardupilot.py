@@ -10,8 +10,10 @@ an active ``INS_TCAL`` the firmware had subtracted are undone before fitting
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import warnings
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -22,6 +24,7 @@ from thermocal.errors import ThermocalInputError
 from thermocal.models.calibration import Calibration
 from thermocal.outputs import check_outputs
 from thermocal.recording import FloatArray, Recording
+from thermocal.tempcal.compare import CoefficientComparison, compare_coefficients
 from thermocal.tempcal.pipeline import (
     AXES,
     GateWarning,
@@ -127,6 +130,53 @@ class ActiveTcal:
         return poly(t - AP_TREF_C) - poly(np.array([tcal - AP_TREF_C]))
 
 
+AP_CURVE_FORMULA = (
+    "poly(clamp(T, TMIN, TMAX) − 35 °C), poly(t) = (c1 + (c2 + c3·t)·t)·t·1e-6 "
+    "(AP_InertialSensor_tempcal.cpp correct_sensor, without its constant CALTEMP term)"
+)
+
+
+def ardupilot_poly_curve(
+    coef: Sequence[Sequence[float]], tmin_c: float, tmax_c: float
+) -> Callable[[FloatArray], FloatArray]:
+    """The temperature-dependent part of ArduPilot's correction for stored coefficients
+    ``coef[k-1][axis]`` (×1e6): :data:`AP_CURVE_FORMULA`, (n, 3) [rad/s or m/s²]."""
+    c = np.asarray(coef, dtype=np.float64)
+
+    def curve(temp_c: FloatArray) -> FloatArray:
+        t = (np.clip(np.asarray(temp_c, dtype=np.float64), tmin_c, tmax_c) - AP_TREF_C)[:, None]
+        out: FloatArray = (c[0] + (c[1] + c[2] * t) * t) * t * 1e-6
+        return out
+
+    return curve
+
+
+def ardupilot_comparison(
+    active: ActiveTcal, new_params: Mapping[str, float], kind: str, unit: str,
+    sweep_c: tuple[float, float],
+) -> CoefficientComparison:  # fmt: skip
+    """IMU ``active.instance``'s ``kind`` coefficients active in the log against the new
+    ``INS_TCAL<n>_*`` (``new_params``): each parameter old → new, and both corrections
+    (:func:`ardupilot_poly_curve`, each clamped to its own TMIN…TMAX) over ``sweep_c``."""
+    n = active.instance + 1
+    tag = "GYR" if kind == "gyro" else "ACC"
+    names = [[f"INS_TCAL{n}_{tag}{k}_{a}" for a in "XYZ"] for k in (1, 2, 3)]
+    new = [[float(new_params[p]) for p in row] for row in names]
+    old = active.coefficients[kind]
+    rows = [(names[k][j], old[k][j], new[k][j]) for k in range(3) for j in range(3)]
+    rows += [
+        (f"INS_TCAL{n}_TMIN", active.tmin_c, float(new_params[f"INS_TCAL{n}_TMIN"])),
+        (f"INS_TCAL{n}_TMAX", active.tmax_c, float(new_params[f"INS_TCAL{n}_TMAX"])),
+    ]
+    return compare_coefficients(
+        f"IMU.{active.instance} {kind}", unit, rows, sweep_c,
+        ardupilot_poly_curve(old, active.tmin_c, active.tmax_c),
+        ardupilot_poly_curve(new, new_params[f"INS_TCAL{n}_TMIN"],
+                             new_params[f"INS_TCAL{n}_TMAX"]),
+        AP_CURVE_FORMULA,
+    )  # fmt: skip
+
+
 def ardupilot_active(params: dict[str, float], instance: int) -> ActiveTcal | None:
     """The active temperature calibration of IMU ``instance`` in a log's ``PARM`` values
     (``INS_TCAL<n>_ENABLE`` = 1, n = instance + 1), or None."""
@@ -181,6 +231,7 @@ class ArdupilotTempcalResult:
     notes: tuple[str, ...]
     orientation: int
     hygiene: dict[str, dict[str, Any]]
+    previous: dict[str, CoefficientComparison] = dataclasses.field(default_factory=dict)
 
     @property
     def active_found(self) -> list[str]:
@@ -194,7 +245,10 @@ class ArdupilotTempcalResult:
             "params": str(self.params_path),
             "calibration": str(self.calibration_path),
             "reports": [str(p) for p in self.reports],
-            "sensors": summary(self.fits),
+            "sensors": {
+                k: {**v, "previous": p.to_dict() if (p := self.previous.get(k)) else None}
+                for k, v in summary(self.fits).items()
+            },
             "notes": list(self.notes),
             "log_hygiene": {
                 "AHRS_ORIENTATION": self.orientation,
@@ -218,6 +272,7 @@ class _Run:
     series: dict[str, tuple[FloatArray, FloatArray]]
     hygiene: dict[str, dict[str, Any]]
     orientation: int = 0
+    previous: dict[str, CoefficientComparison] = dataclasses.field(default_factory=dict)
 
 
 def ardupilot_tempcal(
@@ -269,7 +324,7 @@ def ardupilot_tempcal(
         )
     return ArdupilotTempcalResult(
         log, output / PARAMS_NAME, output / "calibration.json", tuple(out_set.reports),
-        tuple(run.fits), tuple(notes), run.orientation, run.hygiene,
+        tuple(run.fits), tuple(notes), run.orientation, run.hygiene, run.previous,
     )  # fmt: skip
 
 
@@ -333,7 +388,14 @@ def _imu(run: _Run, df: Any, inst: int) -> None:
         ps = export_params(sub, "ardupilot", instance=inst)
     run.params.merge(ps, f"IMU.{inst}")
     _hygiene_and_gates(run, inst, ps)
+    active = ardupilot_active(run.dlog.params, inst)
     for fit, sub_rec in per_kind:
+        key = f"{fit.topic}.{inst}"
+        if active is not None:  # the log's coefficients against the new ones
+            run.previous[key] = ardupilot_comparison(
+                active, ps.params, fit.kind, dict((k, u) for k, _p, u in KINDS)[fit.kind],
+                fit.sweep_c,
+            )  # fmt: skip
         run.out_set.report(
             f"report_IMU_{inst}_{fit.kind}.html",
             ReportRequest(
@@ -341,6 +403,7 @@ def _imu(run: _Run, df: Any, inst: int) -> None:
                 recording_path=str(run.log), title=f"ArduPilot thermal calibration — IMU {inst} "
                 f"{fit.kind}", generated_by="thermocal ardupilot-tempcal",
                 notes=tuple(f"Firmware: {n}" for n in ps.notes),
+                previous=run.previous.get(key),
             ),
         )  # fmt: skip
 
@@ -351,7 +414,8 @@ def _hygiene_and_gates(run: _Run, inst: int, ps: Any) -> None:
     hyg = run.hygiene[f"IMU.{inst}"]
     old_coef = {n: run.dlog.params[n] for n in ps.params if n in run.dlog.params}
     hyg["coefficients"] = {
-        n: {"old": old_coef.get(n), "new": float(v)}
+        n: {"old": (o := old_coef.get(n)), "new": float(v),
+            "difference": None if o is None else float(v) - o}
         for n, v in ps.params.items() if "_ACC" in n or "_GYR" in n
     }  # fmt: skip
     for kind in ("accel", "gyro"):

@@ -36,6 +36,7 @@ from thermocal.models.calibration import Calibration, Channel
 from thermocal.models.poly import PolyModel
 from thermocal.recording import FloatArray, Recording
 from thermocal.tempcal.binning import BIN_WIDTH_C, MIN_BINS, even_odd_split, temperature_bins
+from thermocal.tempcal.compare import CoefficientComparison
 
 MIN_SWEEP_C = adequacy.ARDUPILOT_MIN_SPAN_C
 """ArduPilot's learning requires a 10 °C sweep (the firmware minimum of the adequacy check)."""
@@ -236,6 +237,8 @@ class ReportRequest:
     sensor: str | None = None
     extra: Mapping[str, Mapping[str, float]] = field(default_factory=dict)
     notes: tuple[str, ...] = ()
+    previous: CoefficientComparison | None = None
+    """The coefficients active in the log against the new ones (a table and figure)."""
 
 
 Reporter = Callable[[Path, ReportRequest], object]
