@@ -93,3 +93,84 @@ def test_no_previous_without_active_coefficients(tmp_path: Path) -> None:
         'id="previous-coefficients"'
         not in (tmp_path / "out" / "report_IMU_0_gyro.html").read_text()
     )
+
+
+# --- barometer and magnetometer reports (issue 28, item 3) -------------------------------
+
+
+def baro_mag_log(path: Path) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """A ULog (:mod:`ulog_writer`) with a gyro, a barometer drifting 5th-order in Pa and a
+    magnetometer with cubic offsets in gauss; returns (temperature, pressure, mag)."""
+    from test_px4_baro_mag import BARO
+    from ulog_writer import SENSOR_FIELDS, ulog_bytes
+
+    rng = np.random.default_rng(8)
+    n = 12000
+    t = np.arange(n) * 0.1
+    temp = -5.0 + 55.0 * (0.5 - 0.5 * np.cos(np.pi * t / t[-1]))
+    x = (temp - 20.0) / 25.0
+    pressure = 101325.0 + 40.0 * x + 12.0 * x**2 - 9.0 * x**3 + 4.0 * x**5 + rng.normal(0, 1, n)
+    mag = np.array([0.2, 0.05, -0.4]) + np.column_stack(
+        [0.01 * x, -0.006 * x + 0.004 * x**3, 0.008 * x**2]
+    ) + rng.normal(0.0, 5e-4, (n, 3))  # fmt: skip
+    ts = (1e6 + t * 1e6).astype(np.int64)
+    gyro = [
+        (int(s), 11, *rng.normal(0, 1e-3, 3), float(tt)) for s, tt in zip(ts, temp, strict=True)
+    ]
+    baro = [(int(s), 22, float(p), float(tt)) for s, p, tt in zip(ts, pressure, temp, strict=True)]
+    mags = [(int(s), 33, *map(float, m), float(tt)) for s, m, tt in zip(ts, mag, temp, strict=True)]
+    path.write_bytes(ulog_bytes([("sensor_gyro", 0, SENSOR_FIELDS, gyro),
+                                 ("sensor_baro", 0, BARO, baro),
+                                 ("sensor_mag", 0, SENSOR_FIELDS, mags)]))  # fmt: skip
+    f32 = np.float32
+    return (
+        temp.astype(f32).astype(float),
+        pressure.astype(f32).astype(float),
+        mag.astype(f32).astype(float),
+    )
+
+
+def bin_medians(temp: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """Medians of ``v`` in the occupied 0.5 °C bins from ⌊min T / 0.5⌋·0.5 (written here)."""
+    k = np.floor((temp - np.floor(temp.min() / 0.5) * 0.5) / 0.5).astype(int)
+    return np.array([np.median(v[k == b], axis=0) for b in np.unique(k)])
+
+
+def test_baro_and_mag_reports(tmp_path: Path) -> None:
+    log = tmp_path / "bench.ulg"
+    temp, pressure, mag = baro_mag_log(log)
+    out_dir = tmp_path / "out"
+    code, text = run_cli(["px4-tempcal", str(log), "-o", str(out_dir), "--json"])
+    assert code == 0, text
+    out = json.loads(text)
+    p = {}
+    for line in (out_dir / "px4.params").read_text().splitlines():
+        if not line.startswith("#"):
+            _v, _c, name, value, _t = line.split("\t")
+            p[name] = float(value)
+    cases = (("sensor_baro", "TC_B0_", 5, pressure[:, None], [""], ["pressure"]),
+             ("sensor_mag", "TC_M0_", 3, mag, ["_0", "_1", "_2"], ["x", "y", "z"]))  # fmt: skip
+    for topic, prefix, order, values, suffixes, axes in cases:
+        report = out_dir / f"report_{topic}_0.html"
+        assert str(report) in out["reports"]
+        html = report.read_text()
+        assert html.count('class="figure"') == 2
+        assert 'id="offset-residual"' in html and 'id="offset-holdout"' in html
+        rows = {
+            a: (float(h), float(b), float(af))
+            for a, h, b, af in re.findall(
+                r'data-axis="([^"]+)" data-holdout="([^"]+)" data-before="([^"]+)" '
+                r'data-after="([^"]+)"', html)
+        }  # fmt: skip
+        assert list(rows) == axes
+        dt = np.clip(temp, p[prefix + "TMIN"], p[prefix + "TMAX"]) - p[prefix + "TREF"]
+        for j, (a, suf) in enumerate(zip(axes, suffixes, strict=True)):
+            before = values[:, j] - np.median(values[:, j])
+            after = before - sum(p[f"{prefix}X{k}{suf}"] * dt**k for k in range(order + 1))
+            b_rms = float(np.sqrt(np.mean(bin_medians(temp, before) ** 2)))
+            a_rms = float(np.sqrt(np.mean(bin_medians(temp, after) ** 2)))
+            holdout, shown_before, shown_after = rows[a]
+            assert holdout == pytest.approx(out["sensors"][f"{topic}.0"]["holdout_rms"][a])
+            assert shown_before == pytest.approx(b_rms, rel=1e-6)
+            assert shown_after == pytest.approx(a_rms, rel=2e-3, abs=1e-3 * b_rms)
+            assert shown_after < 0.05 * shown_before, (topic, a)

@@ -234,7 +234,9 @@ def px4_tempcal(
     with staged_set(output, reporter) as out_set:  # moved into place whole, or removed
         for name, inst in topics:
             if name in OFFSET_TOPICS:  # barometers and magnetometers: TC_B / TC_M
-                offset_fits.append(_offset_instance(log, name, inst, tref_c, overrides, params))
+                offset_fits.append(
+                    _offset_instance(log, name, inst, tref_c, overrides, params, out_set)
+                )
                 continue
             fit, more = _imu_instance(log, name, inst, tref_c, overrides, params, out_set, series)
             fits.append(fit)
@@ -256,22 +258,37 @@ def px4_tempcal(
 
 
 def _offset_instance(
-    log: Path, name: str, inst: int, tref_c: float | None, overrides: tuple[str, ...], params: Any
+    log: Path,
+    name: str,
+    inst: int,
+    tref_c: float | None,
+    overrides: tuple[str, ...],
+    params: Any,
+    out_set: OutputSet,
 ) -> OffsetFit:
     """A barometer or magnetometer instance: read, fit (:func:`fit_offset_sensor`), its
-    ``TC_B``/``TC_M`` parameters merged into ``params``."""
+    ``TC_B``/``TC_M`` parameters merged into ``params``, its report
+    (:func:`.offset_report.offset_report_request`)."""
     from thermocal.export.params import px4_offset_params
     from thermocal.readers.dispatch import read_log_table
+    from thermocal.tempcal.offset_report import offset_report_request
 
     df, _info = read_log_table(log, f"{name}.{inst}")
     fields = OFFSET_TOPICS[name][1]
     require_fields(df, ["timestamp", "temperature", *fields], log, f"{name}.{inst}")
     ids = df["device_id"].to_numpy() if "device_id" in df.columns else np.zeros(1)
+    temp_c, values = (
+        df["temperature"].to_numpy(),
+        np.column_stack([df[f].to_numpy() for f in fields]),
+    )
     ofit = fit_offset_sensor(
-        df["timestamp"].to_numpy() * 1e-6, df["temperature"].to_numpy(),
-        np.column_stack([df[f].to_numpy() for f in fields]), name, inst,
+        df["timestamp"].to_numpy() * 1e-6, temp_c, values, name, inst,
         int(np.median(ids)), tref_c=tref_c, overrides=overrides,
     )  # fmt: skip
+    out_set.report(
+        f"report_{name}_{inst}.html",
+        offset_report_request(ofit, temp_c, values, str(log), "thermocal px4-tempcal"),
+    )
     params.merge(
         px4_offset_params(ofit.kind, inst, ofit.device_id, *ofit.sweep_c, ofit.tref_c,
                           ofit.coefficients),
