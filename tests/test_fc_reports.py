@@ -174,3 +174,84 @@ def test_baro_and_mag_reports(tmp_path: Path) -> None:
             assert shown_before == pytest.approx(b_rms, rel=1e-6)
             assert shown_after == pytest.approx(a_rms, rel=2e-3, abs=1e-3 * b_rms)
             assert shown_after < 0.05 * shown_before, (topic, a)
+
+
+# --- ArduPilot's own learning: TCLR (issue 28, item 2) -----------------------------------
+
+TCLR_TYPE = 130
+TCLR_FORMAT = (TCLR_TYPE, "TCLR", "QBBffffI", ("TimeUS", "I", "SType", "Temp", "X", "Y", "Z",
+                                               "NSamp"))  # fmt: skip
+"""AP_InertialSensor_tempcal.cpp ``Learn::add_sample``: ``Write("TCLR",
+"TimeUS,I,SType,Temp,X,Y,Z,NSamp", …, "QBBffffI", …)``."""
+
+
+def firmware_windows(temp: np.ndarray, v: np.ndarray, relative: bool) -> list[tuple]:
+    """The firmware's learning windows, restated: sum samples until there are ≥ 100 and the
+    temperature rose ≥ 0.5 °C since the last window; log T = (T + T_last)/2 and the mean
+    (the accelerometer relative to its first window)."""
+    out, start, last_t, first = [], 0, temp[0], None
+    for i in range(temp.size):
+        if i + 1 - start < 100 or temp[i] - last_t < 0.5:
+            continue
+        mean = v[start : i + 1].mean(axis=0)
+        if relative:
+            first = mean if first is None else first
+            mean = mean - first
+        out.append((0.5 * (temp[i] + last_t), mean, i + 1 - start))
+        start, last_t = i + 1, temp[i]
+    return out
+
+
+def test_firmware_learning_tclr_compared(tmp_path: Path) -> None:
+    from dataflash_writer import NEW_IMU_FMT, NEW_IMU_LABELS, PARM_FORMAT, dataflash_log, parm
+
+    m = imu_truth(12000, 9, 1.0)
+    temp = m["temp"].astype(np.float32).astype(np.float64)
+    msgs: list = [parm("INS_TCAL1_ENABLE", 2), parm("INS_TCAL1_TMAX", 50.0)]
+    windows = {}
+    for stype, key in ((0, "accel_meas"), (1, "gyro_meas")):
+        windows[stype] = firmware_windows(temp, m[key], relative=stype == 0)
+        for t_mid, mean, n in windows[stype]:
+            msgs.append((TCLR_TYPE, (5000, 0, stype, float(t_mid), *map(float, mean), n)))
+    for i in range(temp.size):
+        msgs.append((100, (int(m["time_us"][i]), 0, *m["gyro_meas"][i], *m["accel_meas"][i],
+                           0, 0, float(m["temp"][i]), 1, 1, 1000, 1000)))  # fmt: skip
+    log = tmp_path / "learning.bin"
+    log.write_bytes(
+        dataflash_log([PARM_FORMAT, TCLR_FORMAT, (100, "IMU", NEW_IMU_FMT, NEW_IMU_LABELS)], msgs)
+    )
+    code, text = run_cli(["ardupilot-tempcal", str(log), "-o", str(tmp_path / "out"), "--json"])
+    assert code == 0, text
+    out = json.loads(text)
+    new = parm_file(tmp_path / "out" / "ardupilot.parm")
+    for key, stype, tag, truth in (("IMU.Acc.0", 0, "ACC", m["accel"]),
+                                   ("IMU.Gyr.0", 1, "GYR", m["gyro"])):  # fmt: skip
+        fl = out["sensors"][key]["firmware_learning"]
+        assert out["sensors"][key]["previous"] is None  # learning: nothing was active
+        t_pts = np.array([w[0] for w in windows[stype]], dtype=np.float32).astype(float)
+        v_pts = np.array([w[1] for w in windows[stype]], dtype=np.float32).astype(float)
+        for j, ax in enumerate("XYZ"):
+            p = np.polyfit(t_pts - 35.0, v_pts[:, j], 3)  # highest power first
+            for k in (1, 2, 3):
+                name = f"INS_TCAL1_{tag}{k}_{ax}"
+                got = fl["parameters"][name]
+                assert got["firmware"] == pytest.approx(p[3 - k] * 1e6, rel=1e-6, abs=1e-6), name
+                assert got["thermocal"] == pytest.approx(new[name], rel=1e-5, abs=1e-9), name
+        # both learned the same sensor: their corrections agree to a few % of the drift
+        tt = np.asarray(fl["curves"]["temperature_c"])
+        for j, ax in enumerate("xyz"):
+            fw, tc = (
+                np.asarray(fl["curves"]["firmware"][ax]),
+                np.asarray(fl["curves"]["thermocal"][ax]),
+            )
+            span = float(np.ptp(np.interp(tt, m["temp"], truth[:, j])))
+            assert np.max(np.abs(fw - tc)) < 0.08 * span, (key, ax)
+    html = (tmp_path / "out" / "report_IMU_0_gyro.html").read_text()
+    section = html[html.index('<section id="firmware-learning">') :]
+    section = section[: section.index("</section>")]
+    assert 'id="firmware-learning-figure"' in section
+    found = dict(re.findall(r'data-param="(INS_TCAL1_GYR1_X)" data-old="([^"]+)"', section))
+    assert float(found["INS_TCAL1_GYR1_X"]) == pytest.approx(
+        fl["parameters"]["INS_TCAL1_GYR1_X"]["firmware"]
+    )
+    assert any("TCLR" in n for n in out["notes"])

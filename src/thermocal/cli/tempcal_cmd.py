@@ -55,7 +55,9 @@ def write_report(path: Path, req: "ReportRequest | OffsetReportRequest") -> None
             calibration=req.calibration, recording=req.recording,
             recording_path=req.recording_path, title=req.title, sensor=req.sensor,
             generated_by=req.generated_by, extra=req.extra, notes=req.notes,
-            appendix=(comparison_html(req.previous),) if req.previous is not None else (),
+            appendix=tuple(
+                comparison_html(c) for c in (req.previous, req.firmware_learning) if c is not None
+            ),
         ),
     )  # fmt: skip
 

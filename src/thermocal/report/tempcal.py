@@ -34,19 +34,17 @@ def comparison_figure(cmp: CoefficientComparison) -> bytes:
     axes_names = list(cmp.new_curve)
     with _figure(len(axes_names), height_in=2.2, sharex=True) as (fig, axes):
         for ax, name in zip(axes, axes_names, strict=True):
-            ax.plot(t, cmp.old_curve[name], color=OLD_COLOR, lw=1.4, label="in the log (old)")
+            ax.plot(t, cmp.old_curve[name], color=OLD_COLOR, lw=1.4, label=cmp.old_label)
             ax.plot(t, cmp.new_curve[name], color=NEW_COLOR, lw=1.4, ls="--", label="new")
             ax.set_ylabel(f"{name} [{unit_label(cmp.unit)}]", fontsize=9)
         axes[0].legend(fontsize=8, loc="best")
-        axes[0].set_title(
-            f"{cmp.sensor}: correction of the old and the new coefficients", fontsize=10
-        )
+        axes[0].set_title(f"{cmp.sensor}: {cmp.title.lower()}", fontsize=10)
         axes[-1].set_xlabel("temperature [°C]", fontsize=9)
         return _png(fig)
 
 
 def comparison_html(cmp: CoefficientComparison) -> str:
-    """The section ``#previous`` of a report: table and figure of :func:`comparison_figure`
+    """The section ``#<cmp.anchor>`` of a report: table and figure of :func:`comparison_figure`
     (each number also in ``data-old``/``data-new``/``data-difference`` at full precision)."""
     from markupsafe import escape
 
@@ -57,18 +55,19 @@ def comparison_html(cmp: CoefficientComparison) -> str:
         f'<td class="n">{new - old:+.6g}</td></tr>'
         for n, old, new in cmp.parameters
     )
+    a = escape(cmp.anchor)
     return (
-        '<section id="previous">\n<h2>Coefficients in the log against the new ones</h2>\n'
-        f"<p>The log was recorded with a thermal calibration active on {escape(cmp.sensor)}; "
-        "it was removed from the data before fitting. Each parameter as the firmware stores "
-        "it, old → new; the figure shows the correction each set applies over the calibrated "
-        f"range, in {escape(unit_label(cmp.unit))}: {escape(cmp.curve_formula)}.</p>\n"
-        '<table class="compact" id="previous-coefficients">\n<thead><tr><th>Parameter</th>'
-        '<th class="n">old (in the log)</th><th class="n">new</th>'
+        f'<section id="{a}">\n<h2>{escape(cmp.title)} — {escape(cmp.sensor)}</h2>\n'
+        f"<p>{escape(cmp.intro)} Each parameter as the firmware stores it, "
+        f"{escape(cmp.old_label)} → new; the figure shows the correction each set applies over "
+        f"the calibrated range, in {escape(unit_label(cmp.unit))}: "
+        f"{escape(cmp.curve_formula)}.</p>\n"
+        f'<table class="compact" id="{a}-coefficients">\n<thead><tr><th>Parameter</th>'
+        f'<th class="n">{escape(cmp.old_label)}</th><th class="n">new (thermocal)</th>'
         '<th class="n">difference</th></tr></thead>\n'
         f"<tbody>\n{rows}\n</tbody></table>\n"
-        f'<figure><img class="figure" id="previous-figure" src="{_b64(comparison_figure(cmp))}" '
-        f'alt="old and new correction of {escape(cmp.sensor)} against temperature"></figure>\n'
+        f'<figure><img class="figure" id="{a}-figure" src="{_b64(comparison_figure(cmp))}" '
+        f'alt="{escape(cmp.title)}: correction against temperature"></figure>\n'
         "</section>"
     )
 

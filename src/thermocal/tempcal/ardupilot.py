@@ -214,6 +214,65 @@ def ardupilot_raw(
     return out, active, code
 
 
+# --- the firmware's own learning: TCLR ----------------------------------------------------------
+
+TCLR_STYPES = {"accel": 0, "gyro": 1}
+"""``TCLR`` (AP_InertialSensor_tempcal.cpp ``Learn::add_sample``: ``AP::logger().Write("TCLR",
+"TimeUS,I,SType,Temp,X,Y,Z,NSamp", "s#------", "F000000-", "QBBffffI", …)``): IMU ``I``,
+sensor ``SType`` (0 accelerometer, 1 gyro), ``Temp`` the mid temperature of the averaging
+window [°C], ``X, Y, Z`` the mean of ``NSamp`` (≥ 100) samples over a ≥ 0.5 °C rise in the
+sensor's frame before the temperature correction [m/s², relative to the first window's
+mean, or rad/s], logged while ``INS_TCAL<n>_ENABLE`` = 2 (learning)."""
+
+
+def tclr_points(
+    rows: Sequence[Mapping[str, float]], instance: int, kind: str
+) -> tuple[FloatArray, FloatArray]:
+    """(Temp [°C], X/Y/Z (n, 3)) of the ``TCLR`` messages of IMU ``instance``'s ``kind``."""
+    st = TCLR_STYPES[kind]
+    sel = [r for r in rows if int(r.get("I", 0)) == instance and int(r.get("SType", -1)) == st]
+    temp = np.array([r["Temp"] for r in sel], dtype=np.float64)
+    xyz = np.array([[r["X"], r["Y"], r["Z"]] for r in sel], dtype=np.float64).reshape(-1, 3)
+    return temp, xyz
+
+
+def tclr_learned(temp_c: FloatArray, xyz: FloatArray) -> list[list[float]]:
+    """The coefficients the firmware learns from its ``TCLR`` points: its ``PolyFit<4>``
+    (AP_Math/polyfit.h) is the least-squares cubic with constant of X, Y, Z in ``T − 35``,
+    ``p0 + p1·t + p2·t² + p3·t³``; ``save_calibration`` stores ``c_k = p_k·1e6``,
+    k = 1…3 (the constant dropped).  Returns ``c[k-1][axis]`` as stored."""
+    v = np.vander(np.asarray(temp_c, dtype=np.float64) - AP_TREF_C, 4, increasing=True)
+    p, *_ = np.linalg.lstsq(v, np.asarray(xyz, dtype=np.float64), rcond=None)
+    return [[float(x) * 1e6 for x in p[k]] for k in (1, 2, 3)]
+
+
+def tclr_comparison(
+    rows: Sequence[Mapping[str, float]], instance: int, kind: str, unit: str,
+    new_params: Mapping[str, float], sweep_c: tuple[float, float],
+) -> CoefficientComparison | None:  # fmt: skip
+    """The firmware's learned coefficients of IMU ``instance``'s ``kind`` (:func:`tclr_learned`
+    of its ``TCLR`` points, valid over their temperatures as the firmware saves TMIN/TMAX)
+    against thermocal's ``new_params``; None with fewer than 4 points at distinct
+    temperatures (no cubic)."""
+    temp, xyz = tclr_points(rows, instance, kind)
+    if np.unique(temp).size < 4:
+        return None
+    learned = tclr_learned(temp, xyz)
+    tmin, tmax = float(np.min(temp)), float(np.max(temp))
+    fw = ActiveTcal(instance, tmin, tmax, {kind: learned}, {kind: AP_TREF_C})
+    cmp = ardupilot_comparison(fw, new_params, kind, unit, sweep_c)
+    return dataclasses.replace(
+        cmp, old_key="firmware", new_key="thermocal", anchor="firmware-learning",
+        title="The firmware's own learning (TCLR) against thermocal's coefficients",
+        old_label="firmware (TCLR)",
+        intro=(
+            f"The log holds {temp.size} TCLR points of this sensor ({tmin:.1f}…{tmax:.1f} °C): "
+            "the firmware's own temperature learning; its coefficients are restated here as "
+            "the firmware computes them (a least-squares cubic of the points in T − 35 °C)."
+        ),
+    )  # fmt: skip
+
+
 # --- the whole command -----------------------------------------------------------------------
 
 
@@ -232,6 +291,7 @@ class ArdupilotTempcalResult:
     orientation: int
     hygiene: dict[str, dict[str, Any]]
     previous: dict[str, CoefficientComparison] = dataclasses.field(default_factory=dict)
+    firmware_learning: dict[str, CoefficientComparison] = dataclasses.field(default_factory=dict)
 
     @property
     def active_found(self) -> list[str]:
@@ -246,7 +306,13 @@ class ArdupilotTempcalResult:
             "calibration": str(self.calibration_path),
             "reports": [str(p) for p in self.reports],
             "sensors": {
-                k: {**v, "previous": p.to_dict() if (p := self.previous.get(k)) else None}
+                k: {
+                    **v,
+                    "previous": p.to_dict() if (p := self.previous.get(k)) else None,
+                    "firmware_learning": f.to_dict()
+                    if (f := self.firmware_learning.get(k))
+                    else None,
+                }
                 for k, v in summary(self.fits).items()
             },
             "notes": list(self.notes),
@@ -273,6 +339,7 @@ class _Run:
     hygiene: dict[str, dict[str, Any]]
     orientation: int = 0
     previous: dict[str, CoefficientComparison] = dataclasses.field(default_factory=dict)
+    learning: dict[str, CoefficientComparison] = dataclasses.field(default_factory=dict)
 
 
 def ardupilot_tempcal(
@@ -295,7 +362,7 @@ def ardupilot_tempcal(
     check_outputs([output / n for n in names], [log], dirs=[output])
     check_output_dir(output)
     with staged_set(output, reporter) as out_set:  # moved into place whole, or removed
-        dlog = read_dataflash_log(log, ["IMU", "IMU2", "IMU3"])  # the log is read once
+        dlog = read_dataflash_log(log, ["IMU", "IMU2", "IMU3", "TCLR"])  # the log is read once
         run = _Run(log, dlog, overrides, ParamSet("ardupilot"), out_set, [], [], {}, {})
         for inst in range(MAX_IMUS):
             try:
@@ -317,6 +384,12 @@ def ardupilot_tempcal(
             "active INS_TCAL coefficients found in the log and removed from the data before "
             "fitting (the firmware had subtracted them): " + ", ".join(found)
         )
+    if run.learning:
+        notes.append(
+            "the firmware's own temperature learning (TCLR) found in the log for "
+            + ", ".join(run.learning)
+            + ": its coefficients restated and compared with thermocal's (firmware_learning)"
+        )
     if run.orientation:
         notes.append(
             f"AHRS_ORIENTATION {run.orientation} ({AP_ROTATIONS[run.orientation]}): the data "
@@ -325,6 +398,7 @@ def ardupilot_tempcal(
     return ArdupilotTempcalResult(
         log, output / PARAMS_NAME, output / "calibration.json", tuple(out_set.reports),
         tuple(run.fits), tuple(notes), run.orientation, run.hygiene, run.previous,
+        run.learning,
     )  # fmt: skip
 
 
@@ -396,6 +470,12 @@ def _imu(run: _Run, df: Any, inst: int) -> None:
                 active, ps.params, fit.kind, dict((k, u) for k, _p, u in KINDS)[fit.kind],
                 fit.sweep_c,
             )  # fmt: skip
+        learned = tclr_comparison(
+            run.dlog.rows.get("TCLR", []), inst, fit.kind,
+            dict((k, u) for k, _p, u in KINDS)[fit.kind], ps.params, fit.sweep_c,
+        )  # fmt: skip
+        if learned is not None:
+            run.learning[key] = learned
         run.out_set.report(
             f"report_IMU_{inst}_{fit.kind}.html",
             ReportRequest(
@@ -404,6 +484,7 @@ def _imu(run: _Run, df: Any, inst: int) -> None:
                 f"{fit.kind}", generated_by="thermocal ardupilot-tempcal",
                 notes=tuple(f"Firmware: {n}" for n in ps.notes),
                 previous=run.previous.get(key),
+                firmware_learning=run.learning.get(key),
             ),
         )  # fmt: skip
 
@@ -437,4 +518,6 @@ __all__ = [
     "ardupilot_raw",
     "ardupilot_rotation",
     "ardupilot_tempcal",
+    "tclr_learned",
+    "tclr_points",
 ]

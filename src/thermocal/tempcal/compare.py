@@ -39,21 +39,34 @@ class CoefficientComparison:
     old_curve: Mapping[str, tuple[float, ...]]
     new_curve: Mapping[str, tuple[float, ...]]
     curve_formula: str
+    old_key: str = "old"
+    """What the old set is called in the JSON (``firmware`` for the firmware's learning)."""
+    new_key: str = "new"
+    title: str = "Coefficients in the log against the new ones"
+    old_label: str = "old (in the log)"
+    anchor: str = "previous"
+    """The HTML id of the report's section (its table ``<anchor>-coefficients``, its
+    figure ``<anchor>-figure``)."""
+    intro: str = (
+        "The log was recorded with a thermal calibration active; it was removed from the data "
+        "before fitting."
+    )
 
     def to_dict(self) -> dict[str, Any]:
-        """The ``previous`` object of a sensor in ``--json``: per parameter old, new and
-        ``difference`` = new − old; the curves per axis [``unit``]."""
+        """The ``previous`` (or ``firmware_learning``) object of a sensor in ``--json``: per
+        parameter old, new (named :attr:`old_key`, :attr:`new_key`) and ``difference`` =
+        new − old; the curves per axis [``unit``]."""
+        ok, nk = self.old_key, self.new_key
         return {
             "sensor": self.sensor,
             "unit": self.unit,
             "parameters": {
-                n: {"old": old, "new": new, "difference": new - old}
-                for n, old, new in self.parameters
+                n: {ok: old, nk: new, "difference": new - old} for n, old, new in self.parameters
             },
             "curves": {
                 "temperature_c": list(self.temp_c),
-                "old": {a: list(v) for a, v in self.old_curve.items()},
-                "new": {a: list(v) for a, v in self.new_curve.items()},
+                ok: {a: list(v) for a, v in self.old_curve.items()},
+                nk: {a: list(v) for a, v in self.new_curve.items()},
                 "formula": self.curve_formula,
             },
         }
@@ -68,10 +81,12 @@ def compare_coefficients(
     new: Callable[[FloatArray], FloatArray],
     formula: str,
     axes: Sequence[str] = ("x", "y", "z"),
+    **labels: str,
 ) -> CoefficientComparison:
     """The comparison of one sensor: ``old``/``new`` map temperatures (n,) [°C] to the
     correction (n, axes) [``unit``]; evaluated at :data:`CURVE_POINTS` temperatures over
-    ``range_c`` (the new calibration's range)."""
+    ``range_c`` (the new calibration's range); ``labels``: the naming fields of
+    :class:`CoefficientComparison` (``old_key``, ``title``, …)."""
     t = np.linspace(range_c[0], range_c[1], CURVE_POINTS)
     o, n = np.asarray(old(t)).reshape(t.size, -1), np.asarray(new(t)).reshape(t.size, -1)
     return CoefficientComparison(
@@ -79,7 +94,7 @@ def compare_coefficients(
         tuple(float(x) for x in t),
         {a: tuple(float(x) for x in o[:, j]) for j, a in enumerate(axes)},
         {a: tuple(float(x) for x in n[:, j]) for j, a in enumerate(axes)},
-        formula,
+        formula, **labels,
     )  # fmt: skip
 
 

@@ -240,6 +240,8 @@ class ReportRequest:
     notes: tuple[str, ...] = ()
     previous: CoefficientComparison | None = None
     """The coefficients active in the log against the new ones (a table and figure)."""
+    firmware_learning: CoefficientComparison | None = None
+    """The firmware's own learned coefficients (ArduPilot ``TCLR``) against the new ones."""
 
 
 Reporter = Callable[[Path, ReportRequest | OffsetReportRequest], object]
