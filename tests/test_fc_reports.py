@@ -255,3 +255,71 @@ def test_firmware_learning_tclr_compared(tmp_path: Path) -> None:
         fl["parameters"]["INS_TCAL1_GYR1_X"]["firmware"]
     )
     assert any("TCLR" in n for n in out["notes"])
+
+
+# --- ArduPilot's barometer temperature calibration: TCAL_BARO_EXP -------------------------
+
+BARO_TYPE = 131
+BARO_FORMAT = (BARO_TYPE, "BARO", "QBfffcfIffB", ("TimeUS", "I", "Alt", "AltAMSL", "Press",
+                                                  "Temp", "CRt", "SMS", "Offset", "GndTemp",
+                                                  "H"))  # fmt: skip
+"""AP_Baro_Logging / LogStructure.h ``BARO``: ``Temp`` an int16 of centi-degrees ('c')."""
+
+
+def baro_log(path: Path, exponent_true: float, sign: float) -> tuple[np.ndarray, np.ndarray]:
+    """An IMU and a barometer whose pressure drops by ``max(T − 25, 0)^e`` Pa (``sign`` +1:
+    the drift ArduPilot's correction adds back; −1: a rise it cannot follow)."""
+    from dataflash_writer import NEW_IMU_FMT, NEW_IMU_LABELS, PARM_FORMAT, dataflash_log
+
+    m = imu_truth(12000, 9, 1.0)
+    rng = np.random.default_rng(3)
+    temp_c100 = np.round(m["temp"] * 100.0)
+    temp = temp_c100 / 100.0
+    press = 101325.0 - sign * np.maximum(temp - 25.0, 0.0) ** exponent_true
+    press = press + rng.normal(0.0, 0.5, temp.size)
+    msgs: list = []
+    for i in range(temp.size):
+        msgs.append((100, (int(m["time_us"][i]), 0, *m["gyro_meas"][i], *m["accel_meas"][i],
+                           0, 0, float(m["temp"][i]), 1, 1, 1000, 1000)))  # fmt: skip
+        msgs.append((BARO_TYPE, (int(m["time_us"][i]) + 10, 0, 0.0, 0.0, float(press[i]),
+                                 int(temp_c100[i]), 0.0, 0, 0.0, 20.0, 1)))  # fmt: skip
+    fmts = [PARM_FORMAT, (100, "IMU", NEW_IMU_FMT, NEW_IMU_LABELS), BARO_FORMAT]
+    path.write_bytes(dataflash_log(fmts, msgs))
+    return temp, press.astype(np.float32).astype(float)
+
+
+def test_ardupilot_baro_exponent(tmp_path: Path) -> None:
+    log = tmp_path / "baro.bin"
+    temp, press = baro_log(log, 1.35, +1.0)
+    code, text = run_cli(["ardupilot-tempcal", str(log), "-o", str(tmp_path / "out"), "--json"])
+    assert code == 0, text
+    out = json.loads(text)
+    p = parm_file(tmp_path / "out" / "ardupilot.parm")
+    assert p["TCAL_ENABLED"] == 1
+    assert p["TCAL_BARO_EXP"] == pytest.approx(1.35, abs=0.01)
+    assert p["TCAL_TEMP_MIN"] == round(temp.min()) and p["TCAL_TEMP_MAX"] == round(temp.max())
+    baro = out["sensors"]["BARO.0"]
+    assert baro["exponent"] == pytest.approx(p["TCAL_BARO_EXP"]) and not baro["at_limit"]
+    # the firmware's correction with the written exponent, applied here to the log's pressure
+    corrected = press + np.maximum(temp - 25.0, 0.0) ** p["TCAL_BARO_EXP"]
+    drift = float(np.ptp(np.maximum(temp - 25.0, 0.0) ** 1.35))  # [Pa]
+    assert np.ptp(corrected) < np.ptp(press) and drift > 50.0
+    k = np.floor((temp - np.floor(temp.min() / 0.5) * 0.5) / 0.5).astype(int)
+    bins = np.array([np.median(corrected[k == b]) for b in np.unique(k)])
+    assert float(np.std(bins)) < 0.05 * drift
+    assert baro["rms_after_pa"] == pytest.approx(float(np.std(bins)), rel=0.05, abs=0.05)
+    assert baro["holdout_rms_pa"] < 1.0
+
+
+def test_ardupilot_baro_drift_the_firmware_cannot_follow(tmp_path: Path) -> None:
+    log = tmp_path / "baro_up.bin"
+    baro_log(log, 1.2, -1.0)  # the pressure rises with temperature
+    from thermocal.cli import main
+
+    buf, err = io.StringIO(), io.StringIO()
+    with contextlib.redirect_stdout(buf), contextlib.redirect_stderr(err):
+        code = main(["ardupilot-tempcal", str(log), "-o", str(tmp_path / "out"), "--json"])
+    assert code == 0, buf.getvalue()
+    baro = json.loads(buf.getvalue())["sensors"]["BARO.0"]
+    assert baro["at_limit"] and baro["exponent"] == pytest.approx(0.0, abs=1e-3)
+    assert "TCAL_BARO_EXP" in err.getvalue() and "does not follow" in err.getvalue()

@@ -5,7 +5,9 @@ messages (up to three instances; temperature ``T``, ``Temp`` in Copter 3.4–3.6
 ``INS_TCAL<n>_*`` parameters (a polynomial about :data:`AP_TREF_C` = 35 °C without constant,
 as the firmware takes it), and the log's hygiene: the board rotation ``AHRS_ORIENTATION`` and
 an active ``INS_TCAL`` the firmware had subtracted are undone before fitting
-(:func:`ardupilot_raw`).
+(:func:`ardupilot_raw`).  The coefficients active in the log and the firmware's own learning
+(``TCLR``) are compared with the new ones; the first barometer gets ``TCAL_BARO_EXP``
+(:mod:`thermocal.tempcal.ardupilot_baro`).
 """
 
 from __future__ import annotations
@@ -24,6 +26,7 @@ from thermocal.errors import ThermocalInputError
 from thermocal.models.calibration import Calibration
 from thermocal.outputs import check_outputs
 from thermocal.recording import FloatArray, Recording
+from thermocal.tempcal.ardupilot_baro import ArdupilotBaroFit, fit_ardupilot_baro
 from thermocal.tempcal.compare import CoefficientComparison, compare_coefficients
 from thermocal.tempcal.pipeline import (
     AXES,
@@ -292,6 +295,7 @@ class ArdupilotTempcalResult:
     hygiene: dict[str, dict[str, Any]]
     previous: dict[str, CoefficientComparison] = dataclasses.field(default_factory=dict)
     firmware_learning: dict[str, CoefficientComparison] = dataclasses.field(default_factory=dict)
+    baro: ArdupilotBaroFit | None = None
 
     @property
     def active_found(self) -> list[str]:
@@ -314,7 +318,8 @@ class ArdupilotTempcalResult:
                     else None,
                 }
                 for k, v in summary(self.fits).items()
-            },
+            }
+            | ({f"BARO.{self.baro.instance}": self.baro.to_dict()} if self.baro else {}),
             "notes": list(self.notes),
             "log_hygiene": {
                 "AHRS_ORIENTATION": self.orientation,
@@ -340,6 +345,7 @@ class _Run:
     orientation: int = 0
     previous: dict[str, CoefficientComparison] = dataclasses.field(default_factory=dict)
     learning: dict[str, CoefficientComparison] = dataclasses.field(default_factory=dict)
+    baro: ArdupilotBaroFit | None = None
 
 
 def ardupilot_tempcal(
@@ -362,7 +368,9 @@ def ardupilot_tempcal(
     check_outputs([output / n for n in names], [log], dirs=[output])
     check_output_dir(output)
     with staged_set(output, reporter) as out_set:  # moved into place whole, or removed
-        dlog = read_dataflash_log(log, ["IMU", "IMU2", "IMU3", "TCLR"])  # the log is read once
+        dlog = read_dataflash_log(
+            log, ["IMU", "IMU2", "IMU3", "TCLR", "BARO"]
+        )  # the log is read once
         run = _Run(log, dlog, overrides, ParamSet("ardupilot"), out_set, [], [], {}, {})
         for inst in range(MAX_IMUS):
             try:
@@ -374,6 +382,7 @@ def ardupilot_tempcal(
             _imu(run, df, inst)
         if not run.fits:
             raise ThermocalInputError(f"{log}: no IMU with a usable temperature in the log")
+        _baro(run)
         run.gates.extend(step_warnings(run.fits, run.series))
         warn_gates(run.gates)
         out_set.commit(calibration_of(run.fits), PARAMS_NAME, run.params.text())
@@ -390,6 +399,14 @@ def ardupilot_tempcal(
             + ", ".join(run.learning)
             + ": its coefficients restated and compared with thermocal's (firmware_learning)"
         )
+    if run.baro is not None:
+        b = run.baro
+        notes.append(
+            f"BARO.0: TCAL_BARO_EXP {b.exponent:.4g} (ArduPilot's barometer temperature "
+            f"correction max(T − 25, 0)^e Pa, AP_TempCalibration): rms over the temperature "
+            f"bins {b.rms_before_pa:.3g} → {b.rms_after_pa:.3g} Pa, hold-out "
+            f"{b.holdout_rms_pa:.3g} Pa"
+        )
     if run.orientation:
         notes.append(
             f"AHRS_ORIENTATION {run.orientation} ({AP_ROTATIONS[run.orientation]}): the data "
@@ -398,7 +415,7 @@ def ardupilot_tempcal(
     return ArdupilotTempcalResult(
         log, output / PARAMS_NAME, output / "calibration.json", tuple(out_set.reports),
         tuple(run.fits), tuple(notes), run.orientation, run.hygiene, run.previous,
-        run.learning,
+        run.learning, run.baro,
     )  # fmt: skip
 
 
@@ -487,6 +504,45 @@ def _imu(run: _Run, df: Any, inst: int) -> None:
                 firmware_learning=run.learning.get(key),
             ),
         )  # fmt: skip
+
+
+def _baro(run: _Run) -> None:
+    """The first barometer's ``TCAL_BARO_EXP`` (:func:`.ardupilot_baro.fit_ardupilot_baro`;
+    the firmware corrects instance 0 only), merged into the parameters; a barometer whose
+    temperature stays below 25 °C, or whose drift the firmware's model cannot follow, is
+    named in a warning."""
+    from thermocal.errors import MissingColumnError
+
+    try:
+        df, _info = _table(run, "BARO", 0)
+    except MissingColumnError:
+        return  # no barometer in the log
+    require_fields(df, ["Press", "Temp"], run.log, "BARO.0")
+    fit = fit_ardupilot_baro(df["Temp"].to_numpy(), df["Press"].to_numpy())
+    if fit is None:
+        run.gates.append(
+            "BARO.0: its temperature stays (almost) below 25 °C: ArduPilot's barometer "
+            "calibration (TCAL_BARO_EXP, AP_TempCalibration) corrects above 25 °C only; "
+            "not fitted"
+        )
+        return
+    if fit.at_limit:
+        run.gates.append(
+            f"BARO.0: TCAL_BARO_EXP {fit.exponent:g} is at a limit of 0…2: the firmware's "
+            "one-parameter correction max(T − 25, 0)^e added to the pressure does not follow "
+            f"this barometer's drift (rms {fit.rms_before_pa:.3g} → {fit.rms_after_pa:.3g} Pa)"
+        )
+    for name, value in fit.params().items():
+        run.params.params[name] = value
+        run.params.types[name] = 9 if name == "TCAL_BARO_EXP" else 6
+    run.baro = fit
+
+
+def _table(run: _Run, name: str, inst: int) -> tuple[Any, dict[str, Any]]:
+    """Instance ``inst`` of message ``name`` from the run's one pass over the log."""
+    from thermocal.readers.dataflash import dataflash_table
+
+    return dataflash_table(run.dlog, run.log, name, inst)
 
 
 def _hygiene_and_gates(run: _Run, inst: int, ps: Any) -> None:
