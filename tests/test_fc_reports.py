@@ -98,7 +98,9 @@ def test_no_previous_without_active_coefficients(tmp_path: Path) -> None:
 # --- barometer and magnetometer reports (issue 28, item 3) -------------------------------
 
 
-def baro_mag_log(path: Path) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def baro_mag_log(
+    path: Path, params: dict | None = None
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """A ULog (:mod:`ulog_writer`) with a gyro, a barometer drifting 5th-order in Pa and a
     magnetometer with cubic offsets in gauss; returns (temperature, pressure, mag)."""
     from test_px4_baro_mag import BARO
@@ -121,7 +123,7 @@ def baro_mag_log(path: Path) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     mags = [(int(s), 33, *map(float, m), float(tt)) for s, m, tt in zip(ts, mag, temp, strict=True)]
     path.write_bytes(ulog_bytes([("sensor_gyro", 0, SENSOR_FIELDS, gyro),
                                  ("sensor_baro", 0, BARO, baro),
-                                 ("sensor_mag", 0, SENSOR_FIELDS, mags)]))  # fmt: skip
+                                 ("sensor_mag", 0, SENSOR_FIELDS, mags)], params))  # fmt: skip
     f32 = np.float32
     return (
         temp.astype(f32).astype(float),
@@ -323,3 +325,59 @@ def test_ardupilot_baro_drift_the_firmware_cannot_follow(tmp_path: Path) -> None
     baro = json.loads(buf.getvalue())["sensors"]["BARO.0"]
     assert baro["at_limit"] and baro["exponent"] == pytest.approx(0.0, abs=1e-3)
     assert "TCAL_BARO_EXP" in err.getvalue() and "does not follow" in err.getvalue()
+
+
+# --- PX4: the log's TC_* parameters against the new ones ----------------------------------
+
+OLD_G = {
+    "TMIN": 0.0, "TMAX": 45.0, "TREF": 25.0,
+    **{f"X{k}_{i}": 1e-3 * (i + 1) * (-0.1) ** k for k in range(4) for i in range(3)},
+}  # fmt: skip
+OLD_B = {"TMIN": 5.0, "TMAX": 40.0, "TREF": 20.0, **{f"X{k}": 30.0 / 4**k for k in range(6)}}
+
+
+def px4_offset(p: dict, prefix: str, order: int, suffix: str, temp: np.ndarray) -> np.ndarray:
+    """PX4's offset Σ X_k·(clamp(T, TMIN, TMAX) − TREF)^k, written here."""
+    x = np.clip(temp, p[prefix + "TMIN"], p[prefix + "TMAX"]) - p[prefix + "TREF"]
+    return sum(p[f"{prefix}X{k}{suffix}"] * x**k for k in range(order + 1))
+
+
+def test_px4_previous_tc_parameters(tmp_path: Path) -> None:
+    old: dict = {"TC_G_ENABLE": 1, "TC_G1_ID": 11, "TC_B_ENABLE": 1, "TC_B0_ID": 22,
+                 "TC_G0_ID": 999}  # fmt: skip  # the gyro's calibration is at index 1
+    old |= {f"TC_G1_{k}": v for k, v in OLD_G.items()} | {f"TC_B0_{k}": v for k, v in OLD_B.items()}
+    old |= {f"TC_G0_{k}": 7.0 for k in OLD_G}  # another device's: not this gyro's
+    log = tmp_path / "bench.ulg"
+    baro_mag_log(log, old)
+    out_dir = tmp_path / "out"
+    code, text = run_cli(["px4-tempcal", str(log), "-o", str(out_dir), "--json"])
+    assert code == 0, text
+    out = json.loads(text)
+    new = {}
+    for line in (out_dir / "px4.params").read_text().splitlines():
+        if not line.startswith("#"):
+            _v, _c, name, value, _t = line.split("\t")
+            new[name] = float(value)
+    f32 = lambda v: float(np.float32(v))  # noqa: E731  (ULog parameters are float32)
+    gyro = out["sensors"]["sensor_gyro.0"]["previous"]
+    assert gyro["unit"] == "rad/s"
+    for k, v in OLD_G.items():
+        row = gyro["parameters"][f"TC_G0_{k}"]
+        assert row["old"] == pytest.approx(f32(v), rel=1e-7), k
+        assert row["new"] == pytest.approx(new[f"TC_G0_{k}"], rel=1e-6), k
+        assert row["difference"] == pytest.approx(row["new"] - row["old"]), k
+    temp = np.asarray(gyro["curves"]["temperature_c"])
+    old32 = {f"TC_G1_{k}": f32(v) for k, v in OLD_G.items()}
+    for i, ax in enumerate("xyz"):
+        want_old = px4_offset(old32, "TC_G1_", 3, f"_{i}", temp)
+        want_new = px4_offset(new, "TC_G0_", 3, f"_{i}", temp)
+        assert np.allclose(gyro["curves"]["old"][ax], want_old, rtol=1e-6, atol=1e-12), ax
+        assert np.allclose(gyro["curves"]["new"][ax], want_new, rtol=1e-5, atol=1e-9), ax
+    baro = out["sensors"]["sensor_baro.0"]["previous"]
+    assert baro["unit"] == "Pa"
+    assert baro["parameters"]["TC_B0_X1"]["old"] == pytest.approx(7.5)
+    assert baro["parameters"]["TC_B0_X5"]["new"] == pytest.approx(new["TC_B0_X5"], rel=1e-6)
+    assert out["sensors"]["sensor_mag.0"]["previous"] is None  # the log has no TC_M
+    html = (out_dir / "report_sensor_baro_0.html").read_text()
+    assert 'data-param="TC_B0_X1" data-old="7.5"' in html
+    assert 'id="previous-figure"' in (out_dir / "report_sensor_gyro_0.html").read_text()

@@ -140,6 +140,7 @@ def build_offset_report(req: OffsetReportRequest) -> str:
             residual_fig=_b64(offset_residual_figure(req)),
             holdout_fig=_b64(offset_holdout_figure(req)),
             files=[("log", req.log_path, sha256_of(req.log_path))],
+            appendix=[comparison_html(req.previous)] if req.previous is not None else [],
         )
     )  # fmt: skip
     return html

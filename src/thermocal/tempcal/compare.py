@@ -98,4 +98,80 @@ def compare_coefficients(
     )  # fmt: skip
 
 
-__all__ = ["CURVE_POINTS", "CoefficientComparison", "compare_coefficients"]
+# --- PX4: the TC_* parameters of the ULog against the new ones --------------------------------
+
+PX4_TC = {
+    "gyro": ("G", 3, ("_0", "_1", "_2"), ("x", "y", "z")),
+    "accel": ("A", 3, ("_0", "_1", "_2"), ("x", "y", "z")),
+    "baro": ("B", 5, ("",), ("pressure",)),
+    "mag": ("M", 3, ("_0", "_1", "_2"), ("x", "y", "z")),
+}
+"""Per sensor kind: the letter of PX4's ``TC_<letter><n>_*``, the polynomial order, the axis
+suffixes of ``X<k><suffix>``, the axes (PX4 ``temperature_compensation`` parameters)."""
+PX4_INSTANCES = 4
+PX4_CURVE_FORMULA = (
+    "Σ X_k·(clamp(T, TMIN, TMAX) − TREF)^k (PX4 temperature_compensation: the offset "
+    "subtracted from the measurement)"
+)
+
+
+def px4_poly_curve(
+    params: Mapping[str, float], prefix: str, order: int, suffixes: Sequence[str]
+) -> Callable[[FloatArray], FloatArray]:
+    """PX4's offset of the parameters ``<prefix>X<k><suffix>`` (:data:`PX4_CURVE_FORMULA`),
+    (n, axes) [the sensor's unit]."""
+    lo, hi, tref = (params[prefix + k] for k in ("TMIN", "TMAX", "TREF"))
+    c = np.array([[params[f"{prefix}X{k}{s}"] for s in suffixes] for k in range(order + 1)])
+
+    def curve(temp_c: FloatArray) -> FloatArray:
+        x = np.clip(np.asarray(temp_c, dtype=np.float64), lo, hi) - tref
+        out: FloatArray = np.polynomial.polynomial.polyval(x, c).T.reshape(x.size, -1)
+        return out
+
+    return curve
+
+
+def px4_comparison(
+    old: Mapping[str, float], new: Mapping[str, float], kind: str, instance: int,
+    device_id: int, unit: str, range_c: tuple[float, float],
+) -> CoefficientComparison | None:  # fmt: skip
+    """The ``TC_*`` of the sensor with ``device_id`` in the log's parameters ``old`` (the
+    calibration index ``m`` whose ``TC_<letter><m>_ID`` is it: PX4 matches by device id, not
+    by instance) against the new ``TC_<letter><instance>_*``; None when the log has none for
+    this device (or its device id is 0, unknown)."""
+    letter, order, suffixes, axes = PX4_TC[kind]
+    m = next(
+        (
+            k
+            for k in range(PX4_INSTANCES)
+            if device_id and old.get(f"TC_{letter}{k}_ID") == device_id
+        ),
+        None,
+    )
+    if m is None:
+        return None
+    po, pn = f"TC_{letter}{m}_", f"TC_{letter}{instance}_"
+    keys = ["TMIN", "TMAX", "TREF"] + [f"X{k}{s}" for k in range(order + 1) for s in suffixes]
+    if any(po + k not in old for k in keys) or any(pn + k not in new for k in keys):
+        return None
+    rows = [(pn + k, float(old[po + k]), float(new[pn + k])) for k in keys]
+    enabled = old.get(f"TC_{letter}_ENABLE", 0) == 1
+    return compare_coefficients(
+        f"{kind} {instance} (device id {device_id})", unit, rows, range_c,
+        px4_poly_curve(old, po, order, suffixes), px4_poly_curve(new, pn, order, suffixes),
+        PX4_CURVE_FORMULA, axes,
+        intro=(
+            f"The log's parameters hold TC_{letter}{m}_* for this device "
+            f"(TC_{letter}_ENABLE {'1: active' if enabled else 'not 1: inactive'} while it was "
+            "recorded; PX4 logs its sensor topics uncorrected, so nothing was removed)."
+        ),
+    )  # fmt: skip
+
+
+__all__ = [
+    "CURVE_POINTS",
+    "CoefficientComparison",
+    "compare_coefficients",
+    "px4_comparison",
+    "px4_poly_curve",
+]

@@ -23,6 +23,7 @@ from thermocal.recording import FloatArray
 from thermocal.tempcal.binning import even_odd_split, temperature_bins
 
 if TYPE_CHECKING:
+    from thermocal.tempcal.compare import CoefficientComparison
     from thermocal.tempcal.px4 import OffsetFit
 
 
@@ -45,6 +46,8 @@ class OffsetReportRequest:
     bin_after: FloatArray
     odd_temp_c: FloatArray
     odd_residual: FloatArray
+    previous: CoefficientComparison | None = None
+    """The log's ``TC_*`` for this device against the new ones."""
 
 
 def firmware_offset(fit: OffsetFit, temp_c: FloatArray) -> FloatArray:
@@ -57,7 +60,12 @@ def firmware_offset(fit: OffsetFit, temp_c: FloatArray) -> FloatArray:
 
 
 def offset_report_request(
-    fit: OffsetFit, temp_c: FloatArray, values: FloatArray, log_path: str, generated_by: str
+    fit: OffsetFit,
+    temp_c: FloatArray,
+    values: FloatArray,
+    log_path: str,
+    generated_by: str,
+    previous: CoefficientComparison | None = None,
 ) -> OffsetReportRequest:
     """The numbers of one barometer's or magnetometer's report (module docstring);
     ``values`` (n, axes) [``fit.unit``] as logged."""
@@ -79,7 +87,7 @@ def offset_report_request(
     where = f"{fit.topic}.{fit.instance}"
     return OffsetReportRequest(
         fit, log_path, f"PX4 thermal calibration — {where} ({fit.kind})", generated_by, axes,
-        temp, before, after, t_med, b_med, a_med, t_med[odd], resid,
+        temp, before, after, t_med, b_med, a_med, t_med[odd], resid, previous,
     )  # fmt: skip
 
 
