@@ -53,6 +53,7 @@ MAX_IMUS = 3
 """ArduPilot logs up to three IMUs (``IMU``, instances 0…2)."""
 KINDS = (("gyro", "Gyr", "rad/s"), ("accel", "Acc", "m/s^2"))
 """(kind, field prefix of the ``IMU`` message, its unit) per sensor of an IMU."""
+KIND_UNITS = {kind: unit for kind, _prefix, unit in KINDS}
 
 
 # --- ArduPilot log hygiene (issue 28, item 4) ---------------------------------------------
@@ -283,7 +284,10 @@ def tclr_comparison(
 class ArdupilotTempcalResult:
     """What :func:`ardupilot_tempcal` wrote and found: the files of the set, every IMU
     sensor's fit, the parameter file's notes and the log's hygiene (``AHRS_ORIENTATION``,
-    per IMU the active ``INS_TCAL`` removed and its coefficients old → new)."""
+    per IMU the active ``INS_TCAL`` removed and its coefficients old → new); per sensor
+    (``IMU.Gyr.<n>``/``IMU.Acc.<n>``) the active coefficients against the new ones
+    (``previous``) and the firmware's own learning against them (``firmware_learning``,
+    from ``TCLR``); the first barometer's ``TCAL_BARO_EXP`` (``baro``)."""
 
     log: Path
     params_path: Path
@@ -484,12 +488,12 @@ def _imu(run: _Run, df: Any, inst: int) -> None:
         key = f"{fit.topic}.{inst}"
         if active is not None:  # the log's coefficients against the new ones
             run.previous[key] = ardupilot_comparison(
-                active, ps.params, fit.kind, dict((k, u) for k, _p, u in KINDS)[fit.kind],
+                active, ps.params, fit.kind, KIND_UNITS[fit.kind],
                 fit.sweep_c,
             )  # fmt: skip
         learned = tclr_comparison(
             run.dlog.rows.get("TCLR", []), inst, fit.kind,
-            dict((k, u) for k, _p, u in KINDS)[fit.kind], ps.params, fit.sweep_c,
+            KIND_UNITS[fit.kind], ps.params, fit.sweep_c,
         )  # fmt: skip
         if learned is not None:
             run.learning[key] = learned
