@@ -18,6 +18,7 @@ CODES = {
     "H": "H",
     "i": "i",
     "h": "h",
+    "c": "h",  # int16 ×100 (LogStructure.h), pass round(value·100)
     "d": "d",
     "n": "4s",
     "N": "16s",

@@ -6,7 +6,7 @@ reader is tested on a file not made by the library it uses."""
 from __future__ import annotations
 
 import struct
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 
 TYPE_CODES = {"uint64_t": "Q", "uint32_t": "I", "int32_t": "i", "float": "f", "uint8_t": "B"}
 SENSOR_FIELDS = [
@@ -24,8 +24,11 @@ def _code(type_name: str) -> str:
 
 def ulog_bytes(
     topics: Sequence[tuple[str, int, Sequence[tuple[str, str]], Sequence[Sequence[float]]]],
+    params: Mapping[str, float | int] | None = None,
 ) -> bytes:
-    """``topics``: (name, instance, fields [(type, name)], rows) → the ULog file's bytes."""
+    """``topics``: (name, instance, fields [(type, name)], rows) → the ULog file's bytes;
+    ``params``: initial parameters (``P`` messages: ``uint8 key_len``, ``"<type> <name>"``,
+    the value; an ``int`` as ``int32_t``, a ``float`` as ``float``)."""
     out = bytearray(b"ULog\x01\x12\x35" + bytes([1]) + struct.pack("<Q", 0))
 
     def msg(kind: str, payload: bytes) -> None:
@@ -33,6 +36,10 @@ def ulog_bytes(
         out.extend(payload)
 
     msg("B", bytes(16) + struct.pack("<3Q", 0, 0, 0))
+    for pname, value in (params or {}).items():
+        typed = ("int32_t " if isinstance(value, int) else "float ") + pname
+        code = "<i" if isinstance(value, int) else "<f"
+        msg("P", bytes([len(typed)]) + typed.encode() + struct.pack(code, value))
     seen: set[str] = set()
     for name, _inst, fields, _rows in topics:
         if name not in seen:

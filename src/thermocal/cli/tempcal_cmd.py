@@ -29,6 +29,7 @@ if TYPE_CHECKING:
     import rich.table as _rich_table
 
     from thermocal.tempcal.ardupilot import ArdupilotTempcalResult
+    from thermocal.tempcal.offset_report import OffsetReportRequest
     from thermocal.tempcal.pipeline import ReportRequest, SensorFit
     from thermocal.tempcal.px4 import OffsetFit, Px4TempcalResult
 else:
@@ -37,9 +38,16 @@ else:
 OutDirOpt = Annotated[Path, typer.Option("-o", "--output", help="Directory to write.")]
 
 
-def write_report(path: Path, req: "ReportRequest") -> None:
-    """One sensor's HTML report (:func:`thermocal.report.calibration.write_calibration_report`)."""
+def write_report(path: Path, req: "ReportRequest | OffsetReportRequest") -> None:
+    """One sensor's HTML report (:func:`thermocal.report.calibration.write_calibration_report`;
+    a barometer's or magnetometer's: :func:`thermocal.report.tempcal.write_offset_report`)."""
     from thermocal.report.calibration import CalibrationReportInputs, write_calibration_report
+    from thermocal.report.tempcal import comparison_html, write_offset_report
+    from thermocal.tempcal.offset_report import OffsetReportRequest
+
+    if isinstance(req, OffsetReportRequest):
+        write_offset_report(path, req)
+        return
 
     write_calibration_report(
         path,
@@ -47,6 +55,9 @@ def write_report(path: Path, req: "ReportRequest") -> None:
             calibration=req.calibration, recording=req.recording,
             recording_path=req.recording_path, title=req.title, sensor=req.sensor,
             generated_by=req.generated_by, extra=req.extra, notes=req.notes,
+            appendix=tuple(
+                comparison_html(c) for c in (req.previous, req.firmware_learning) if c is not None
+            ),
         ),
     )  # fmt: skip
 

@@ -78,6 +78,9 @@ class CalibrationReportInputs:
     channels: Sequence[str] | None = None
     extra: Mapping[str, Mapping[str, float]] = field(default_factory=dict)
     notes: tuple[str, ...] = ()
+    appendix: tuple[str, ...] = ()
+    """Sections of HTML made by thermocal's report code (e.g.
+    :func:`thermocal.report.tempcal.comparison_html`), shown before the warnings."""
 
 
 def _validation_of(v: Mapping[str, Any] | None, name: str, single: bool) -> dict[str, Any] | None:
@@ -318,6 +321,7 @@ def build_calibration_report(inputs: CalibrationReportInputs) -> str:
             allan=_b64(allan),
             files=files,
             notes=notes,
+            appendix=list(inputs.appendix),
             any_warnings=any(s["warnings"] for s in sections),
         )
     )

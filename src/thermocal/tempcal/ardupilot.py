@@ -5,13 +5,17 @@ messages (up to three instances; temperature ``T``, ``Temp`` in Copter 3.4–3.6
 ``INS_TCAL<n>_*`` parameters (a polynomial about :data:`AP_TREF_C` = 35 °C without constant,
 as the firmware takes it), and the log's hygiene: the board rotation ``AHRS_ORIENTATION`` and
 an active ``INS_TCAL`` the firmware had subtracted are undone before fitting
-(:func:`ardupilot_raw`).
+(:func:`ardupilot_raw`).  The coefficients active in the log and the firmware's own learning
+(``TCLR``) are compared with the new ones; the first barometer gets ``TCAL_BARO_EXP``
+(:mod:`thermocal.tempcal.ardupilot_baro`).
 """
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import warnings
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -22,6 +26,8 @@ from thermocal.errors import ThermocalInputError
 from thermocal.models.calibration import Calibration
 from thermocal.outputs import check_outputs
 from thermocal.recording import FloatArray, Recording
+from thermocal.tempcal.ardupilot_baro import ArdupilotBaroFit, fit_ardupilot_baro
+from thermocal.tempcal.compare import CoefficientComparison, compare_coefficients
 from thermocal.tempcal.pipeline import (
     AXES,
     GateWarning,
@@ -47,6 +53,7 @@ MAX_IMUS = 3
 """ArduPilot logs up to three IMUs (``IMU``, instances 0…2)."""
 KINDS = (("gyro", "Gyr", "rad/s"), ("accel", "Acc", "m/s^2"))
 """(kind, field prefix of the ``IMU`` message, its unit) per sensor of an IMU."""
+KIND_UNITS = {kind: unit for kind, _prefix, unit in KINDS}
 
 
 # --- ArduPilot log hygiene (issue 28, item 4) ---------------------------------------------
@@ -127,6 +134,53 @@ class ActiveTcal:
         return poly(t - AP_TREF_C) - poly(np.array([tcal - AP_TREF_C]))
 
 
+AP_CURVE_FORMULA = (
+    "poly(clamp(T, TMIN, TMAX) − 35 °C), poly(t) = (c1 + (c2 + c3·t)·t)·t·1e-6 "
+    "(AP_InertialSensor_tempcal.cpp correct_sensor, without its constant CALTEMP term)"
+)
+
+
+def ardupilot_poly_curve(
+    coef: Sequence[Sequence[float]], tmin_c: float, tmax_c: float
+) -> Callable[[FloatArray], FloatArray]:
+    """The temperature-dependent part of ArduPilot's correction for stored coefficients
+    ``coef[k-1][axis]`` (×1e6): :data:`AP_CURVE_FORMULA`, (n, 3) [rad/s or m/s²]."""
+    c = np.asarray(coef, dtype=np.float64)
+
+    def curve(temp_c: FloatArray) -> FloatArray:
+        t = (np.clip(np.asarray(temp_c, dtype=np.float64), tmin_c, tmax_c) - AP_TREF_C)[:, None]
+        out: FloatArray = (c[0] + (c[1] + c[2] * t) * t) * t * 1e-6
+        return out
+
+    return curve
+
+
+def ardupilot_comparison(
+    active: ActiveTcal, new_params: Mapping[str, float], kind: str, unit: str,
+    sweep_c: tuple[float, float],
+) -> CoefficientComparison:  # fmt: skip
+    """IMU ``active.instance``'s ``kind`` coefficients active in the log against the new
+    ``INS_TCAL<n>_*`` (``new_params``): each parameter old → new, and both corrections
+    (:func:`ardupilot_poly_curve`, each clamped to its own TMIN…TMAX) over ``sweep_c``."""
+    n = active.instance + 1
+    tag = "GYR" if kind == "gyro" else "ACC"
+    names = [[f"INS_TCAL{n}_{tag}{k}_{a}" for a in "XYZ"] for k in (1, 2, 3)]
+    new = [[float(new_params[p]) for p in row] for row in names]
+    old = active.coefficients[kind]
+    rows = [(names[k][j], old[k][j], new[k][j]) for k in range(3) for j in range(3)]
+    rows += [
+        (f"INS_TCAL{n}_TMIN", active.tmin_c, float(new_params[f"INS_TCAL{n}_TMIN"])),
+        (f"INS_TCAL{n}_TMAX", active.tmax_c, float(new_params[f"INS_TCAL{n}_TMAX"])),
+    ]
+    return compare_coefficients(
+        f"IMU.{active.instance} {kind}", unit, rows, sweep_c,
+        ardupilot_poly_curve(old, active.tmin_c, active.tmax_c),
+        ardupilot_poly_curve(new, new_params[f"INS_TCAL{n}_TMIN"],
+                             new_params[f"INS_TCAL{n}_TMAX"]),
+        AP_CURVE_FORMULA,
+    )  # fmt: skip
+
+
 def ardupilot_active(params: dict[str, float], instance: int) -> ActiveTcal | None:
     """The active temperature calibration of IMU ``instance`` in a log's ``PARM`` values
     (``INS_TCAL<n>_ENABLE`` = 1, n = instance + 1), or None."""
@@ -164,6 +218,65 @@ def ardupilot_raw(
     return out, active, code
 
 
+# --- the firmware's own learning: TCLR ----------------------------------------------------------
+
+TCLR_STYPES = {"accel": 0, "gyro": 1}
+"""``TCLR`` (AP_InertialSensor_tempcal.cpp ``Learn::add_sample``: ``AP::logger().Write("TCLR",
+"TimeUS,I,SType,Temp,X,Y,Z,NSamp", "s#------", "F000000-", "QBBffffI", …)``): IMU ``I``,
+sensor ``SType`` (0 accelerometer, 1 gyro), ``Temp`` the mid temperature of the averaging
+window [°C], ``X, Y, Z`` the mean of ``NSamp`` (≥ 100) samples over a ≥ 0.5 °C rise in the
+sensor's frame before the temperature correction [m/s², relative to the first window's
+mean, or rad/s], logged while ``INS_TCAL<n>_ENABLE`` = 2 (learning)."""
+
+
+def tclr_points(
+    rows: Sequence[Mapping[str, float]], instance: int, kind: str
+) -> tuple[FloatArray, FloatArray]:
+    """(Temp [°C], X/Y/Z (n, 3)) of the ``TCLR`` messages of IMU ``instance``'s ``kind``."""
+    st = TCLR_STYPES[kind]
+    sel = [r for r in rows if int(r.get("I", 0)) == instance and int(r.get("SType", -1)) == st]
+    temp = np.array([r["Temp"] for r in sel], dtype=np.float64)
+    xyz = np.array([[r["X"], r["Y"], r["Z"]] for r in sel], dtype=np.float64).reshape(-1, 3)
+    return temp, xyz
+
+
+def tclr_learned(temp_c: FloatArray, xyz: FloatArray) -> list[list[float]]:
+    """The coefficients the firmware learns from its ``TCLR`` points: its ``PolyFit<4>``
+    (AP_Math/polyfit.h) is the least-squares cubic with constant of X, Y, Z in ``T − 35``,
+    ``p0 + p1·t + p2·t² + p3·t³``; ``save_calibration`` stores ``c_k = p_k·1e6``,
+    k = 1…3 (the constant dropped).  Returns ``c[k-1][axis]`` as stored."""
+    v = np.vander(np.asarray(temp_c, dtype=np.float64) - AP_TREF_C, 4, increasing=True)
+    p, *_ = np.linalg.lstsq(v, np.asarray(xyz, dtype=np.float64), rcond=None)
+    return [[float(x) * 1e6 for x in p[k]] for k in (1, 2, 3)]
+
+
+def tclr_comparison(
+    rows: Sequence[Mapping[str, float]], instance: int, kind: str, unit: str,
+    new_params: Mapping[str, float], sweep_c: tuple[float, float],
+) -> CoefficientComparison | None:  # fmt: skip
+    """The firmware's learned coefficients of IMU ``instance``'s ``kind`` (:func:`tclr_learned`
+    of its ``TCLR`` points, valid over their temperatures as the firmware saves TMIN/TMAX)
+    against thermocal's ``new_params``; None with fewer than 4 points at distinct
+    temperatures (no cubic)."""
+    temp, xyz = tclr_points(rows, instance, kind)
+    if np.unique(temp).size < 4:
+        return None
+    learned = tclr_learned(temp, xyz)
+    tmin, tmax = float(np.min(temp)), float(np.max(temp))
+    fw = ActiveTcal(instance, tmin, tmax, {kind: learned}, {kind: AP_TREF_C})
+    cmp = ardupilot_comparison(fw, new_params, kind, unit, sweep_c)
+    return dataclasses.replace(
+        cmp, old_key="firmware", new_key="thermocal", anchor="firmware-learning",
+        title="The firmware's own learning (TCLR) against thermocal's coefficients",
+        old_label="firmware (TCLR)",
+        intro=(
+            f"The log holds {temp.size} TCLR points of this sensor ({tmin:.1f}…{tmax:.1f} °C): "
+            "the firmware's own temperature learning; its coefficients are restated here as "
+            "the firmware computes them (a least-squares cubic of the points in T − 35 °C)."
+        ),
+    )  # fmt: skip
+
+
 # --- the whole command -----------------------------------------------------------------------
 
 
@@ -171,7 +284,10 @@ def ardupilot_raw(
 class ArdupilotTempcalResult:
     """What :func:`ardupilot_tempcal` wrote and found: the files of the set, every IMU
     sensor's fit, the parameter file's notes and the log's hygiene (``AHRS_ORIENTATION``,
-    per IMU the active ``INS_TCAL`` removed and its coefficients old → new)."""
+    per IMU the active ``INS_TCAL`` removed and its coefficients old → new); per sensor
+    (``IMU.Gyr.<n>``/``IMU.Acc.<n>``) the active coefficients against the new ones
+    (``previous``) and the firmware's own learning against them (``firmware_learning``,
+    from ``TCLR``); the first barometer's ``TCAL_BARO_EXP`` (``baro``)."""
 
     log: Path
     params_path: Path
@@ -181,6 +297,9 @@ class ArdupilotTempcalResult:
     notes: tuple[str, ...]
     orientation: int
     hygiene: dict[str, dict[str, Any]]
+    previous: dict[str, CoefficientComparison] = dataclasses.field(default_factory=dict)
+    firmware_learning: dict[str, CoefficientComparison] = dataclasses.field(default_factory=dict)
+    baro: ArdupilotBaroFit | None = None
 
     @property
     def active_found(self) -> list[str]:
@@ -194,7 +313,17 @@ class ArdupilotTempcalResult:
             "params": str(self.params_path),
             "calibration": str(self.calibration_path),
             "reports": [str(p) for p in self.reports],
-            "sensors": summary(self.fits),
+            "sensors": {
+                k: {
+                    **v,
+                    "previous": p.to_dict() if (p := self.previous.get(k)) else None,
+                    "firmware_learning": f.to_dict()
+                    if (f := self.firmware_learning.get(k))
+                    else None,
+                }
+                for k, v in summary(self.fits).items()
+            }
+            | ({f"BARO.{self.baro.instance}": self.baro.to_dict()} if self.baro else {}),
             "notes": list(self.notes),
             "log_hygiene": {
                 "AHRS_ORIENTATION": self.orientation,
@@ -218,6 +347,9 @@ class _Run:
     series: dict[str, tuple[FloatArray, FloatArray]]
     hygiene: dict[str, dict[str, Any]]
     orientation: int = 0
+    previous: dict[str, CoefficientComparison] = dataclasses.field(default_factory=dict)
+    learning: dict[str, CoefficientComparison] = dataclasses.field(default_factory=dict)
+    baro: ArdupilotBaroFit | None = None
 
 
 def ardupilot_tempcal(
@@ -240,7 +372,9 @@ def ardupilot_tempcal(
     check_outputs([output / n for n in names], [log], dirs=[output])
     check_output_dir(output)
     with staged_set(output, reporter) as out_set:  # moved into place whole, or removed
-        dlog = read_dataflash_log(log, ["IMU", "IMU2", "IMU3"])  # the log is read once
+        dlog = read_dataflash_log(
+            log, ["IMU", "IMU2", "IMU3", "TCLR", "BARO"]
+        )  # the log is read once
         run = _Run(log, dlog, overrides, ParamSet("ardupilot"), out_set, [], [], {}, {})
         for inst in range(MAX_IMUS):
             try:
@@ -252,6 +386,7 @@ def ardupilot_tempcal(
             _imu(run, df, inst)
         if not run.fits:
             raise ThermocalInputError(f"{log}: no IMU with a usable temperature in the log")
+        _baro(run)
         run.gates.extend(step_warnings(run.fits, run.series))
         warn_gates(run.gates)
         out_set.commit(calibration_of(run.fits), PARAMS_NAME, run.params.text())
@@ -262,6 +397,20 @@ def ardupilot_tempcal(
             "active INS_TCAL coefficients found in the log and removed from the data before "
             "fitting (the firmware had subtracted them): " + ", ".join(found)
         )
+    if run.learning:
+        notes.append(
+            "the firmware's own temperature learning (TCLR) found in the log for "
+            + ", ".join(run.learning)
+            + ": its coefficients restated and compared with thermocal's (firmware_learning)"
+        )
+    if run.baro is not None:
+        b = run.baro
+        notes.append(
+            f"BARO.0: TCAL_BARO_EXP {b.exponent:.4g} (ArduPilot's barometer temperature "
+            f"correction max(T − 25, 0)^e Pa, AP_TempCalibration): rms over the temperature "
+            f"bins {b.rms_before_pa:.3g} → {b.rms_after_pa:.3g} Pa, hold-out "
+            f"{b.holdout_rms_pa:.3g} Pa"
+        )
     if run.orientation:
         notes.append(
             f"AHRS_ORIENTATION {run.orientation} ({AP_ROTATIONS[run.orientation]}): the data "
@@ -269,7 +418,8 @@ def ardupilot_tempcal(
         )
     return ArdupilotTempcalResult(
         log, output / PARAMS_NAME, output / "calibration.json", tuple(out_set.reports),
-        tuple(run.fits), tuple(notes), run.orientation, run.hygiene,
+        tuple(run.fits), tuple(notes), run.orientation, run.hygiene, run.previous,
+        run.learning, run.baro,
     )  # fmt: skip
 
 
@@ -333,7 +483,20 @@ def _imu(run: _Run, df: Any, inst: int) -> None:
         ps = export_params(sub, "ardupilot", instance=inst)
     run.params.merge(ps, f"IMU.{inst}")
     _hygiene_and_gates(run, inst, ps)
+    active = ardupilot_active(run.dlog.params, inst)
     for fit, sub_rec in per_kind:
+        key = f"{fit.topic}.{inst}"
+        if active is not None:  # the log's coefficients against the new ones
+            run.previous[key] = ardupilot_comparison(
+                active, ps.params, fit.kind, KIND_UNITS[fit.kind],
+                fit.sweep_c,
+            )  # fmt: skip
+        learned = tclr_comparison(
+            run.dlog.rows.get("TCLR", []), inst, fit.kind,
+            KIND_UNITS[fit.kind], ps.params, fit.sweep_c,
+        )  # fmt: skip
+        if learned is not None:
+            run.learning[key] = learned
         run.out_set.report(
             f"report_IMU_{inst}_{fit.kind}.html",
             ReportRequest(
@@ -341,8 +504,49 @@ def _imu(run: _Run, df: Any, inst: int) -> None:
                 recording_path=str(run.log), title=f"ArduPilot thermal calibration — IMU {inst} "
                 f"{fit.kind}", generated_by="thermocal ardupilot-tempcal",
                 notes=tuple(f"Firmware: {n}" for n in ps.notes),
+                previous=run.previous.get(key),
+                firmware_learning=run.learning.get(key),
             ),
         )  # fmt: skip
+
+
+def _baro(run: _Run) -> None:
+    """The first barometer's ``TCAL_BARO_EXP`` (:func:`.ardupilot_baro.fit_ardupilot_baro`;
+    the firmware corrects instance 0 only), merged into the parameters; a barometer whose
+    temperature stays below 25 °C, or whose drift the firmware's model cannot follow, is
+    named in a warning."""
+    from thermocal.errors import MissingColumnError
+
+    try:
+        df, _info = _table(run, "BARO", 0)
+    except MissingColumnError:
+        return  # no barometer in the log
+    require_fields(df, ["Press", "Temp"], run.log, "BARO.0")
+    fit = fit_ardupilot_baro(df["Temp"].to_numpy(), df["Press"].to_numpy())
+    if fit is None:
+        run.gates.append(
+            "BARO.0: its temperature stays (almost) below 25 °C: ArduPilot's barometer "
+            "calibration (TCAL_BARO_EXP, AP_TempCalibration) corrects above 25 °C only; "
+            "not fitted"
+        )
+        return
+    if fit.at_limit:
+        run.gates.append(
+            f"BARO.0: TCAL_BARO_EXP {fit.exponent:g} is at a limit of 0…2: the firmware's "
+            "one-parameter correction max(T − 25, 0)^e added to the pressure does not follow "
+            f"this barometer's drift (rms {fit.rms_before_pa:.3g} → {fit.rms_after_pa:.3g} Pa)"
+        )
+    for name, value in fit.params().items():
+        run.params.params[name] = value
+        run.params.types[name] = 9 if name == "TCAL_BARO_EXP" else 6
+    run.baro = fit
+
+
+def _table(run: _Run, name: str, inst: int) -> tuple[Any, dict[str, Any]]:
+    """Instance ``inst`` of message ``name`` from the run's one pass over the log."""
+    from thermocal.readers.dataflash import dataflash_table
+
+    return dataflash_table(run.dlog, run.log, name, inst)
 
 
 def _hygiene_and_gates(run: _Run, inst: int, ps: Any) -> None:
@@ -351,7 +555,8 @@ def _hygiene_and_gates(run: _Run, inst: int, ps: Any) -> None:
     hyg = run.hygiene[f"IMU.{inst}"]
     old_coef = {n: run.dlog.params[n] for n in ps.params if n in run.dlog.params}
     hyg["coefficients"] = {
-        n: {"old": old_coef.get(n), "new": float(v)}
+        n: {"old": (o := old_coef.get(n)), "new": float(v),
+            "difference": None if o is None else float(v) - o}
         for n, v in ps.params.items() if "_ACC" in n or "_GYR" in n
     }  # fmt: skip
     for kind in ("accel", "gyro"):
@@ -373,4 +578,6 @@ __all__ = [
     "ardupilot_raw",
     "ardupilot_rotation",
     "ardupilot_tempcal",
+    "tclr_learned",
+    "tclr_points",
 ]

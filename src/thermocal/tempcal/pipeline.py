@@ -37,6 +37,8 @@ from thermocal.models.calibration import Calibration, Channel
 from thermocal.models.poly import PolyModel
 from thermocal.recording import FloatArray, Recording
 from thermocal.tempcal.binning import BIN_WIDTH_C, MIN_BINS, even_odd_split, temperature_bins
+from thermocal.tempcal.compare import CoefficientComparison
+from thermocal.tempcal.offset_report import OffsetReportRequest
 
 MIN_SWEEP_C = adequacy.ARDUPILOT_MIN_SPAN_C
 """ArduPilot's learning requires a 10 °C sweep (the firmware minimum of the adequacy check)."""
@@ -269,9 +271,13 @@ class ReportRequest:
     sensor: str | None = None
     extra: Mapping[str, Mapping[str, float]] = field(default_factory=dict)
     notes: tuple[str, ...] = ()
+    previous: CoefficientComparison | None = None
+    """The coefficients active in the log against the new ones (a table and figure)."""
+    firmware_learning: CoefficientComparison | None = None
+    """The firmware's own learned coefficients (ArduPilot ``TCLR``) against the new ones."""
 
 
-Reporter = Callable[[Path, ReportRequest], object]
+Reporter = Callable[[Path, ReportRequest | OffsetReportRequest], object]
 """Writes one report (HTML) to the path; given by the caller (the CLI), so that this file
 layer does not import the presentation layer."""
 
@@ -286,7 +292,7 @@ class OutputSet:
     reporter: Reporter | None
     reports: list[Path] = field(default_factory=list)
 
-    def report(self, name: str, request: ReportRequest) -> None:
+    def report(self, name: str, request: ReportRequest | OffsetReportRequest) -> None:
         """Write the report ``name`` into the stage (when a reporter is given)."""
         path = self.output / name
         if self.reporter is not None:

@@ -38,8 +38,10 @@ from thermocal import adequacy
 from thermocal.errors import ThermocalInputError
 from thermocal.models.calibration import Calibration
 from thermocal.outputs import check_outputs
+from thermocal.readers.ulog_params import ulog_parameters
 from thermocal.recording import FloatArray
 from thermocal.tempcal.binning import BIN_WIDTH_C, MIN_BINS, temperature_bins
+from thermocal.tempcal.compare import CoefficientComparison, px4_comparison
 from thermocal.tempcal.pipeline import (
     AXES,
     OutputSet,
@@ -186,6 +188,8 @@ class Px4TempcalResult:
     fits: tuple[SensorFit, ...]
     offset_fits: tuple[OffsetFit, ...]
     notes: tuple[str, ...]
+    previous: dict[str, CoefficientComparison] = dataclasses.field(default_factory=dict)
+    """Per sensor, the log's ``TC_*`` for its device against the new ones."""
 
     def to_dict(self) -> dict[str, Any]:
         """The JSON of ``px4-tempcal --json`` (INTERFACE.md)."""
@@ -194,7 +198,10 @@ class Px4TempcalResult:
             "params": str(self.params_path),
             "calibration": str(self.calibration_path),
             "reports": [str(p) for p in self.reports],
-            "sensors": {**summary(self.fits), **offset_summary(self.offset_fits)},
+            "sensors": {
+                k: {**v, "previous": p.to_dict() if (p := self.previous.get(k)) else None}
+                for k, v in {**summary(self.fits), **offset_summary(self.offset_fits)}.items()
+            },
             "notes": list(self.notes),
         }
 
@@ -248,13 +255,16 @@ def _px4_tempcal(
     series: dict[str, tuple[FloatArray, FloatArray]] = {}
     motions: dict[str, adequacy.Motion] = {}
     params = ParamSet("px4")
+    old = _Prior(ulog_parameters(log), {})  # the TC_* the log was recorded with
     with staged_set(output, reporter) as out_set:  # moved into place whole, or removed
         for name, inst in topics:
             if name in OFFSET_TOPICS:  # barometers and magnetometers: TC_B / TC_M
-                offset_fits.append(_offset_instance(log, name, inst, tref_c, overrides, params))
+                offset_fits.append(
+                    _offset_instance(log, name, inst, tref_c, overrides, params, out_set, old)
+                )
                 continue
             fit, more = _imu_instance(
-                log, name, inst, tref_c, overrides, params, out_set, (series, motions)
+                log, name, inst, tref_c, overrides, params, out_set, (series, motions), old
             )
             fits.append(fit)
             gates.extend(more)
@@ -270,32 +280,69 @@ def _px4_tempcal(
         )
     return Px4TempcalResult(
         log, output / PARAMS_NAME, output / "calibration.json", tuple(out_set.reports),
-        tuple(fits), tuple(offset_fits), tuple(params.notes),
+        tuple(fits), tuple(offset_fits), tuple(params.notes), old.found,
     )  # fmt: skip
 
 
+@dataclass(frozen=True)
+class _Prior:
+    """The log's parameters (:func:`thermocal.readers.ulog_params.ulog_parameters`) and,
+    per sensor, its ``TC_*`` compared with the new ones (:func:`.compare.px4_comparison`)."""
+
+    params: dict[str, float]
+    found: dict[str, CoefficientComparison]
+
+    def compare(
+        self, key: str, new: dict[str, float], kind: str, inst: int, device_id: int, unit: str,
+        sweep_c: tuple[float, float],
+    ) -> CoefficientComparison | None:  # fmt: skip
+        """Compare and remember sensor ``key``'s old and new parameters (None: none old)."""
+        cmp = px4_comparison(self.params, new, kind, inst, device_id, unit, sweep_c)
+        if cmp is not None:
+            self.found[key] = cmp
+        return cmp
+
+
 def _offset_instance(
-    log: Path, name: str, inst: int, tref_c: float | None, overrides: tuple[str, ...], params: Any
+    log: Path,
+    name: str,
+    inst: int,
+    tref_c: float | None,
+    overrides: tuple[str, ...],
+    params: Any,
+    out_set: OutputSet,
+    old: _Prior,
 ) -> OffsetFit:
     """A barometer or magnetometer instance: read, fit (:func:`fit_offset_sensor`), its
-    ``TC_B``/``TC_M`` parameters merged into ``params``."""
+    ``TC_B``/``TC_M`` parameters merged into ``params``, its report
+    (:func:`.offset_report.offset_report_request`)."""
     from thermocal.export.params import px4_offset_params
     from thermocal.readers.dispatch import read_log_table
+    from thermocal.tempcal.offset_report import offset_report_request
 
     df, _info = read_log_table(log, f"{name}.{inst}")
     fields = OFFSET_TOPICS[name][1]
     require_fields(df, ["timestamp", "temperature", *fields], log, f"{name}.{inst}")
     ids = df["device_id"].to_numpy() if "device_id" in df.columns else np.zeros(1)
+    temp_c, values = (
+        df["temperature"].to_numpy(),
+        np.column_stack([df[f].to_numpy() for f in fields]),
+    )
     ofit = fit_offset_sensor(
-        df["timestamp"].to_numpy() * 1e-6, df["temperature"].to_numpy(),
-        np.column_stack([df[f].to_numpy() for f in fields]), name, inst,
+        df["timestamp"].to_numpy() * 1e-6, temp_c, values, name, inst,
         int(np.median(ids)), tref_c=tref_c, overrides=overrides,
     )  # fmt: skip
-    params.merge(
-        px4_offset_params(ofit.kind, inst, ofit.device_id, *ofit.sweep_c, ofit.tref_c,
-                          ofit.coefficients),
-        f"{name}.{inst}",
-    )  # fmt: skip
+    ps = px4_offset_params(
+        ofit.kind, inst, ofit.device_id, *ofit.sweep_c, ofit.tref_c, ofit.coefficients
+    )
+    params.merge(ps, f"{name}.{inst}")
+    prev = old.compare(
+        f"{name}.{inst}", ps.params, ofit.kind, inst, ofit.device_id, ofit.unit, ofit.sweep_c
+    )
+    out_set.report(
+        f"report_{name}_{inst}.html",
+        offset_report_request(ofit, temp_c, values, str(log), "thermocal px4-tempcal", prev),
+    )
     return ofit
 
 
@@ -308,6 +355,7 @@ def _imu_instance(
     params: Any,
     out_set: OutputSet,
     found: tuple[dict[str, tuple[FloatArray, FloatArray]], dict[str, adequacy.Motion]],
+    old: _Prior,
 ) -> tuple[SensorFit, list[str | None]]:
     """A gyro or accelerometer instance through the pipeline: read, fit, its gates, its
     ``TC_G``/``TC_A`` parameters merged into ``params``, its report; ``found`` (series,
@@ -332,6 +380,10 @@ def _imu_instance(
             sub, "px4", instance=inst, device_id={kind: fit.device_id}, tref_c=tref_c
         )
     params.merge(ps, where)
+    prev = old.compare(
+        where, ps.params, kind, inst, fit.device_id, "rad/s" if kind == "gyro" else "m/s^2",
+        fit.sweep_c,
+    )  # fmt: skip
     out_set.report(
         f"report_{name}_{inst}.html",
         ReportRequest(
@@ -348,6 +400,7 @@ def _imu_instance(
                 "ones, in the canonical unit (°/h or mg).",
                 *(f"Firmware: {n}" for n in ps.notes),
             ),
+            previous=prev,
         ),
     )  # fmt: skip
     return fit, gates

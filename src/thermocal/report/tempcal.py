@@ -1,0 +1,165 @@
+"""Report content of the flight-controller calibrations (issue 28, items 2 and 3).
+
+:func:`comparison_html`: the coefficients active in the log against the new ones, a table
+(per parameter old, new, difference) and a figure (the correction of each set over the
+calibrated range, per axis), as a section of the sensor's calibration report.
+:func:`write_offset_report`: the report of a barometer or magnetometer calibration (PX4
+``TC_B``/``TC_M``): residual before/after against the temperature, the held-out bins.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from thermocal.recording import FloatArray
+from thermocal.report.build import _b64, unit_label
+
+if TYPE_CHECKING:
+    from thermocal.tempcal.compare import CoefficientComparison
+    from thermocal.tempcal.offset_report import OffsetReportRequest
+
+OLD_COLOR = "#c0392b"
+NEW_COLOR = "#1f6fb2"
+
+
+def comparison_figure(cmp: CoefficientComparison) -> bytes:
+    """One panel per axis: the old and the new correction [cmp.unit] against the
+    temperature [°C] over the calibrated range (PNG)."""
+    from thermocal.report.figures import _figure, _png
+
+    t = np.asarray(cmp.temp_c)
+    axes_names = list(cmp.new_curve)
+    with _figure(len(axes_names), height_in=2.2, sharex=True) as (fig, axes):
+        for ax, name in zip(axes, axes_names, strict=True):
+            ax.plot(t, cmp.old_curve[name], color=OLD_COLOR, lw=1.4, label=cmp.old_label)
+            ax.plot(t, cmp.new_curve[name], color=NEW_COLOR, lw=1.4, ls="--", label="new")
+            ax.set_ylabel(f"{name} [{unit_label(cmp.unit)}]", fontsize=9)
+        axes[0].legend(fontsize=8, loc="best")
+        axes[0].set_title(f"{cmp.sensor}: {cmp.title.lower()}", fontsize=10)
+        axes[-1].set_xlabel("temperature [°C]", fontsize=9)
+        return _png(fig)
+
+
+def comparison_html(cmp: CoefficientComparison) -> str:
+    """The section ``#<cmp.anchor>`` of a report: table and figure of :func:`comparison_figure`
+    (each number also in ``data-old``/``data-new``/``data-difference`` at full precision)."""
+    from markupsafe import escape
+
+    rows = "\n".join(
+        f'<tr data-param="{escape(n)}" data-old="{old!r}" data-new="{new!r}" '
+        f'data-difference="{new - old!r}"><td><code>{escape(n)}</code></td>'
+        f'<td class="n">{old:.6g}</td><td class="n">{new:.6g}</td>'
+        f'<td class="n">{new - old:+.6g}</td></tr>'
+        for n, old, new in cmp.parameters
+    )
+    a = escape(cmp.anchor)
+    return (
+        f'<section id="{a}">\n<h2>{escape(cmp.title)} — {escape(cmp.sensor)}</h2>\n'
+        f"<p>{escape(cmp.intro)} Each parameter as the firmware stores it, "
+        f"{escape(cmp.old_label)} → new; the figure shows the correction each set applies over "
+        f"the calibrated range, in {escape(unit_label(cmp.unit))}: "
+        f"{escape(cmp.curve_formula)}.</p>\n"
+        f'<table class="compact" id="{a}-coefficients">\n<thead><tr><th>Parameter</th>'
+        f'<th class="n">{escape(cmp.old_label)}</th><th class="n">new (thermocal)</th>'
+        '<th class="n">difference</th></tr></thead>\n'
+        f"<tbody>\n{rows}\n</tbody></table>\n"
+        f'<figure><img class="figure" id="{a}-figure" src="{_b64(comparison_figure(cmp))}" '
+        f'alt="{escape(cmp.title)}: correction against temperature"></figure>\n'
+        "</section>"
+    )
+
+
+# --- barometers and magnetometers (issue 28, item 3) -------------------------------------
+
+
+def offset_residual_figure(req: OffsetReportRequest) -> bytes:
+    """One panel per axis: the residual before (samples relative to their median) and after
+    the firmware's correction [unit] against the temperature [°C]; the samples (block means,
+    in time order) light, the bin medians dark (PNG)."""
+    from thermocal.report.figures import _figure, _png, decimate_for_plot
+
+    unit = unit_label(req.fit.unit)
+    with _figure(len(req.axes), height_in=2.4, sharex=True) as (fig, axes):
+        for j, (ax, name) in enumerate(zip(axes, req.axes, strict=True)):
+            t, b, a = decimate_for_plot(req.temp_c, req.before[:, j], req.after[:, j])
+            ax.plot(t, b, ".", ms=1.5, color=OLD_COLOR, alpha=0.25)
+            ax.plot(t, a, ".", ms=1.5, color=NEW_COLOR, alpha=0.25)
+            ax.plot(req.bin_temp_c, req.bin_before[:, j], color=OLD_COLOR, lw=1.3,
+                    label="before (bin medians)")  # fmt: skip
+            ax.plot(req.bin_temp_c, req.bin_after[:, j], color=NEW_COLOR, lw=1.3,
+                    label="after the TC correction")  # fmt: skip
+            ax.set_ylabel(f"{name} [{unit}]", fontsize=9)
+        axes[0].legend(fontsize=8, loc="best")
+        axes[-1].set_xlabel("temperature [°C]", fontsize=9)
+        return _png(fig)
+
+
+def offset_holdout_figure(req: OffsetReportRequest) -> bytes:
+    """One panel per axis: the odd temperature bins' residual [unit] to the polynomial
+    fitted to the even bins only, with its rms (the fit's hold-out rms) (PNG)."""
+    from thermocal.report.figures import _figure, _png
+
+    unit = unit_label(req.fit.unit)
+    with _figure(len(req.axes), height_in=2.0, sharex=True) as (fig, axes):
+        for j, (ax, name) in enumerate(zip(axes, req.axes, strict=True)):
+            ax.axhline(0.0, color="#888888", lw=0.8)
+            ax.plot(req.odd_temp_c, req.odd_residual[:, j], "o", ms=2.5, color=NEW_COLOR)
+            ax.set_ylabel(f"{name} [{unit}]", fontsize=9)
+            ax.set_title(
+                f"held-out rms {req.fit.holdout_rms[name]:.4g} {unit}", fontsize=9, loc="right"
+            )
+        axes[-1].set_xlabel("temperature of the held-out (odd) bins [°C]", fontsize=9)
+        return _png(fig)
+
+
+def build_offset_report(req: OffsetReportRequest) -> str:
+    """The HTML report of one barometer or magnetometer calibration: its parameters, the
+    residual before/after against the temperature and the held-out bins
+    (:func:`offset_residual_figure`, :func:`offset_holdout_figure`)."""
+    import datetime as _dt
+
+    from thermocal import __version__
+    from thermocal.report.build import _env, sha256_of
+
+    f = req.fit
+
+    def rms(x: FloatArray) -> list[float]:
+        return [float(v) for v in np.sqrt(np.mean(x**2, axis=0))]
+
+    html: str = (
+        _env()
+        .get_template("tempcal_offset.html.j2")
+        .render(
+            title=req.title, version=__version__, generated_by=req.generated_by,
+            generated_utc=_dt.datetime.now(_dt.UTC).strftime("%Y-%m-%d %H:%M UTC"),
+            fit=f, unit=unit_label(f.unit), axes=list(req.axes),
+            bins_before=rms(req.bin_before), bins_after=rms(req.bin_after),
+            residual_fig=_b64(offset_residual_figure(req)),
+            holdout_fig=_b64(offset_holdout_figure(req)),
+            files=[("log", req.log_path, sha256_of(req.log_path))],
+            appendix=[comparison_html(req.previous)] if req.previous is not None else [],
+        )
+    )  # fmt: skip
+    return html
+
+
+def write_offset_report(path: str | Path, req: OffsetReportRequest) -> Path:
+    """:func:`build_offset_report` written atomically to ``path``."""
+    from thermocal.writers import atomic_write
+
+    with atomic_write(path, "wb") as fh:
+        fh.write(build_offset_report(req).encode("utf-8"))
+    return Path(path)
+
+
+__all__ = [
+    "build_offset_report",
+    "comparison_figure",
+    "comparison_html",
+    "offset_holdout_figure",
+    "offset_residual_figure",
+    "write_offset_report",
+]

@@ -1,0 +1,132 @@
+"""ArduPilot's barometer temperature calibration (issue 28, item 3): ``TCAL_BARO_EXP``.
+
+ArduPilot's ``AP_TempCalibration`` (libraries/AP_TempCalibration/AP_TempCalibration.cpp,
+.h) documents four parameters: ``TCAL_ENABLED`` (0 disabled, 1 use, 2 learn and use),
+``TCAL_TEMP_MIN``/``TCAL_TEMP_MAX`` (the learned range [°C], int8, informational: the
+correction is not clamped to it) and ``TCAL_BARO_EXP``, the exponent ``e`` of a one-parameter
+correction of the **first** barometer only::
+
+    p_correction = max(T − Tzero, 0)^e  [Pa],  Tzero = 25 °C,  0 ≤ e ≤ 2
+
+*added* to its pressure (``AP_Baro``: ``pressure + p_correction``; the logged ``BARO.Press``
+is ``get_pressure``, without it, so a log needs no undoing).  The firmware learns ``e``
+while still, by minimising the spread of the corrected pressure over 0.25 °C bins relative
+to the first bin, in steps of 0.01.
+
+thermocal fits the same ``e`` from the log: the pressure reduced to the medians of
+:data:`~thermocal.tempcal.binning.BIN_WIDTH_C` temperature bins (robust to spikes, equal
+weight across the range), ``e`` the value in [0, 2] (resolution :data:`EXP_STEP`) that
+minimises the variance of ``P_bin + max(T_bin − 25, 0)^e`` about its mean; judged on
+held-out bins (``e`` fitted to the even bins, the rms of the corrected odd bins about the even
+bins' corrected mean).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass
+from typing import Any
+
+import numpy as np
+
+from thermocal.recording import FloatArray
+from thermocal.tempcal.binning import even_odd_split, temperature_bins
+
+TZERO_C = 25.0
+"""``AP_TempCalibration::Tzero``: the temperature at which the correction starts [°C]."""
+EXP_LIMITS = (0.0, 2.0)
+"""``exp_limit_min``, ``exp_limit_max``: the exponents the firmware accepts."""
+EXP_STEP = 1e-4
+"""The resolution of thermocal's search for the exponent (the firmware's is 0.01)."""
+MIN_BINS_ABOVE = 4
+"""Fewest temperature bins above :data:`TZERO_C` an exponent is fitted to."""
+
+
+def baro_correction(temp_c: FloatArray, exponent: float) -> FloatArray:
+    """The firmware's correction ``max(T − 25, 0)^e`` [Pa], added to the pressure
+    (``AP_TempCalibration::calculate_correction``)."""
+    out: FloatArray = np.maximum(np.asarray(temp_c, dtype=np.float64) - TZERO_C, 0.0) ** exponent
+    return out
+
+
+def best_exponent(temp_c: FloatArray, press_pa: FloatArray) -> tuple[float, float]:
+    """(the exponent in :data:`EXP_LIMITS` minimising the variance of ``press_pa +``
+    :func:`baro_correction` about its mean, that mean [Pa]), on a grid of :data:`EXP_STEP`."""
+    grid = np.arange(EXP_LIMITS[0], EXP_LIMITS[1] + EXP_STEP / 2, EXP_STEP)
+    dt = np.maximum(np.asarray(temp_c, dtype=np.float64) - TZERO_C, 0.0)
+    corrected = np.asarray(press_pa, dtype=np.float64)[None, :] + dt[None, :] ** grid[:, None]
+    k = int(np.argmin(corrected.var(axis=1)))
+    return float(grid[k]), float(corrected[k].mean())
+
+
+@dataclass(frozen=True)
+class ArdupilotBaroFit:
+    """``TCAL_BARO_EXP`` of barometer ``instance`` (the firmware corrects instance 0 only):
+    the sweep [°C], samples and bins, the exponent, the rms of the bin medians about their
+    mean before and after the correction [Pa], the hold-out rms [Pa], whether the exponent
+    is at a limit of :data:`EXP_LIMITS` (the model does not fit this barometer)."""
+
+    instance: int
+    sweep_c: tuple[float, float]
+    n_samples: int
+    n_bins: int
+    exponent: float
+    rms_before_pa: float
+    rms_after_pa: float
+    holdout_rms_pa: float
+    at_limit: bool
+
+    def params(self) -> dict[str, float]:
+        """``TCAL_ENABLED`` = 1, ``TCAL_TEMP_MIN``/``MAX`` (int8, rounded), ``TCAL_BARO_EXP``."""
+        lo, hi = (max(-128, min(127, round(v))) for v in self.sweep_c)
+        return {
+            "TCAL_ENABLED": 1,
+            "TCAL_TEMP_MIN": lo,
+            "TCAL_TEMP_MAX": hi,
+            "TCAL_BARO_EXP": self.exponent,
+        }
+
+    def to_dict(self) -> dict[str, Any]:
+        """The ``BARO.<n>`` object of ``ardupilot-tempcal --json``."""
+        return {**asdict(self), "parameters": self.params(), "unit": "Pa"}
+
+
+def fit_ardupilot_baro(
+    temp_c: FloatArray, press_pa: FloatArray, instance: int = 0
+) -> ArdupilotBaroFit | None:
+    """The firmware's exponent fitted to a log's barometer (module docstring); None when
+    fewer than :data:`MIN_BINS_ABOVE` temperature bins lie above 25 °C (the correction is
+    zero below)."""
+    temp = np.asarray(temp_c, dtype=np.float64)
+    press = np.asarray(press_pa, dtype=np.float64)
+    ok = np.isfinite(temp) & np.isfinite(press)
+    temp, press = temp[ok], press[ok]
+    if temp.size == 0:
+        return None
+    _c, t_med, p_med = temperature_bins(temp, press.reshape(-1, 1))
+    p_med = p_med[:, 0]
+    if int(np.sum(t_med > TZERO_C)) < MIN_BINS_ABOVE:
+        return None
+    exponent, mean = best_exponent(t_med, p_med)
+    after = p_med + baro_correction(t_med, exponent)
+    even, odd = even_odd_split(t_med.size)
+    e_even, mean_even = best_exponent(t_med[even], p_med[even])
+    held = p_med[odd] + baro_correction(t_med[odd], e_even) - mean_even
+    at_limit = math.isclose(exponent, EXP_LIMITS[0], abs_tol=EXP_STEP) or math.isclose(
+        exponent, EXP_LIMITS[1], abs_tol=EXP_STEP
+    )
+    return ArdupilotBaroFit(
+        instance, (float(np.min(temp)), float(np.max(temp))), int(temp.size), int(t_med.size),
+        exponent, float(np.std(p_med)), float(np.sqrt(np.mean((after - mean) ** 2))),
+        float(np.sqrt(np.mean(held**2))), at_limit,
+    )  # fmt: skip
+
+
+__all__ = [
+    "EXP_LIMITS",
+    "TZERO_C",
+    "ArdupilotBaroFit",
+    "baro_correction",
+    "best_exponent",
+    "fit_ardupilot_baro",
+]
