@@ -53,6 +53,9 @@ def main() -> int:
     y = rng.standard_normal(args.n) + np.cumsum(rng.standard_normal(args.n)) * 1e-4 + 10.0
     tau0, rate = 0.01, 100.0
     names = args.only.split(",") if args.only else list(ALL)
+    # warm-up on 10⁴ points: scipy's import and first calls outside the timings (allantools
+    # imported scipy above, at its own import)
+    stability(y[:10_000], tau0, list(ALL), "octave")
     ok = True
     print(f"deviation family at N = {args.n:.3g} rate samples, octave τ, best of {args.repeat}")
     for name in names:

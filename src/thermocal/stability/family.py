@@ -163,12 +163,9 @@ def _segment_phases(
         )
     slices = segments if segments is not None else [slice(0, y.size)]
     phases = [
-        dv.as_phase(
-            y[sl] - (y[sl].mean() if data_type == "rate" and sl.stop > sl.start else 0.0),
-            tau0_s,
-            data_type,
-        )
+        dv.as_phase(y[sl], tau0_s, data_type, y[sl].mean() if data_type == "rate" else 0.0)
         for sl in slices
+        if sl.stop > sl.start
     ]
     phases = [x for x in phases if x.size >= 3]
     if not phases:
@@ -259,7 +256,12 @@ def stability(
     )
     curves: dict[str, DeviationCurve] = {}
     id_cache: dict[tuple[int, int], ed.NoiseId] = {}
-    centred = [dv.centred(x) for x in phases]
+    # the line through the end points removed (in place unless mtie/tierms need the raw
+    # phase); noise identification reads the centred phase (a line changes no α: the rate
+    # averages shift by a constant, the phase's quadratic detrend removes it)
+    raw = any(n in ("mtie", "tierms") for n in names)
+    centred = [dv.centred(x, inplace=not raw) for x in phases]
+    longest = max(centred, key=lambda x: x.size)
     for name in names:
         m = (
             factors(taus, tau0_s, dv.max_factor(name, n_long), theo1=True)
