@@ -89,6 +89,8 @@ def max_factor(name: str, n_phase: int) -> int:
 _CHUNK: Final = 1 << 17
 """Terms per block of :func:`_difference_sum` (a few cache-sized buffers, reused)."""
 
+_INDEX: Final = np.arange(_CHUNK, dtype=np.float64)
+
 _WORKERS: Final = max(1, min(2, os.cpu_count() or 1))
 
 SECOND: Final = ((2, 1.0), (1, -2.0), (0, 1.0))
@@ -327,14 +329,15 @@ def centred(x: FloatArray, *, inplace: bool = False) -> FloatArray:
     if x.size < 2:
         return x
     x0 = float(x[0])
-    line = np.arange(x.size, dtype=np.float64)
-    line *= (float(x[-1]) - x0) / (x.size - 1)
-    line += x0
-    if inplace:
-        x -= line
-        out = x
-    else:
-        out = np.asarray(x - line, dtype=np.float64)
+    slope = (float(x[-1]) - x0) / (x.size - 1)
+    out = x if inplace else np.empty_like(x)
+    line = np.empty(min(_CHUNK, x.size))
+    for a in range(0, x.size, _CHUNK):  # in blocks: no array of n indices
+        b = min(a + _CHUNK, x.size)
+        seg = line[: b - a]
+        np.multiply(_INDEX[: b - a] + a, slope, out=seg)
+        seg += x0
+        np.subtract(x[a:b], seg, out=out[a:b])
     out[0] = 0.0
     return out
 

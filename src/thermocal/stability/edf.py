@@ -278,17 +278,20 @@ def _detrend(z: FloatArray, deg: int) -> FloatArray:
     return np.asarray(out, dtype=np.float64)
 
 
-_ARANGE: list[FloatArray] = [np.zeros(0)]
-"""0, 1, 2, … as float64, grown on demand and sliced (one index array for every τ)."""
+_BLOCK: Final = 1 << 16
+_BLOCK_INDEX: Final = np.arange(_BLOCK, dtype=np.float64)
 
 
-def _index(n: int) -> FloatArray:
-    if _ARANGE[0].size < n:
-        _ARANGE[0] = np.arange(max(n, 2 * _ARANGE[0].size), dtype=np.float64)
-    return _ARANGE[0][:n]
+def _index_dot(z: FloatArray) -> float:
+    """Σ_k k z_k, in blocks against one small index array (no array of n indices)."""
+    total = 0.0
+    for a in range(0, z.size, _BLOCK):
+        blk = z[a : a + _BLOCK]
+        total += float(_BLOCK_INDEX[: blk.size] @ blk) + a * float(blk.sum())
+    return total
 
 
-def _lag1_linear_detrended(z: FloatArray) -> float:
+def _lag1_linear_detrended(z: FloatArray, *, own: bool = False) -> float:
     """r1 of ``z`` minus its least-squares line, from sums over ``z`` alone (one centred
     copy, no detrended one).  With z_c = z − z̄, u_k = k − (n−1)/2, b = Σ u z_c / Σ u² and
     c = z_c − b u (Σ c = 0):
@@ -298,14 +301,19 @@ def _lag1_linear_detrended(z: FloatArray) -> float:
     + b² (Σ u² − u_{n−1}² − u_{n−1}).
 
     Where the line carries nearly all of Σ z_c² (the subtraction would lose digits) the
-    detrended series is formed explicitly (:func:`_detrend`)."""
+    detrended series is formed explicitly (:func:`_detrend`).  ``own``: ``z`` may be
+    centred in place (its differences are unchanged)."""
     n = z.size
-    zc = z - z.mean()
+    if own:
+        z -= z.mean()
+        zc = z
+    else:
+        zc = z - z.mean()
     szz = float(zc @ zc)
     if szz <= 0:
         return 0.0
     uu = n * (n * n - 1.0) / 12.0
-    uz = float(_index(n) @ zc)  # Σ k z_c = Σ u z_c, since Σ z_c = 0
+    uz = _index_dot(zc)  # Σ k z_c = Σ u z_c, since Σ z_c = 0
     b = uz / uu
     scc = szz - b * b * uu
     if not scc > 1e-6 * szz:
@@ -349,7 +357,9 @@ def identify_noise(x: FloatArray, m: int, *, dmax: int, phase_input: bool) -> No
     flicker PM and reports white PM (α = +2).
     """
     nb = (x.size - 1) // m  # m-averages of the rate: (x_{(k+1)m} − x_{km}) / m
-    ym = np.diff(x[: nb * m + 1 : m]) / m if nb else x[:0]
+    ym = np.diff(x[: nb * m + 1 : m]) if nb else x[:0].copy()
+    if m > 1:
+        ym /= m
     if phase_input:
         z = x[:: max(m, 1)]
         deg, add, dm = 2, 2, dmax
@@ -359,7 +369,7 @@ def identify_noise(x: FloatArray, m: int, *, dmax: int, phase_input: bool) -> No
     if z.size >= MIN_ACF_POINTS:
         d = 0
         if deg == 1:  # rate: r1 of the detrended averages from sums (no detrended copy)
-            r1 = _lag1_linear_detrended(z)
+            r1 = _lag1_linear_detrended(z, own=True)  # ym, our own: centred in place
             # differencing cancels the line but its constant slope, which r1's mean removes
         else:
             z = _detrend(z, deg)

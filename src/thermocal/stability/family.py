@@ -27,6 +27,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 import numpy.typing as npt
+from threadpoolctl import threadpool_limits
 
 from thermocal.errors import MissingValueError, ThermocalInputError
 from thermocal.stability import deviations as dv
@@ -221,6 +222,7 @@ def _pooled_edf(name: str, m: IntArray, alphas: IntArray, phases: list[FloatArra
     return edf
 
 
+@threadpool_limits.wrap(limits=1, user_api="blas")  # many short dots: BLAS threads only wait
 def stability(
     values: npt.ArrayLike,
     tau0_s: float,
