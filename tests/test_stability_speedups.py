@@ -56,6 +56,7 @@ def test_noise_id_on_decimated_phase_equals_block_averages(m: int) -> None:
         rho = r1 / (1.0 + r1)
         if rho < 0.25 or d >= 1:  # dmax = 2 on phase: one difference of the rate
             want = -round(2.0 * rho) - 2 * d
+            want_float = -2.0 * (rho + d)
             break
         zz = np.diff(zz)
         d += 1
@@ -64,6 +65,7 @@ def test_noise_id_on_decimated_phase_equals_block_averages(m: int) -> None:
     nid = ed.identify_noise(x, m, dmax=2, phase_input=False)
     assert nid.method == "lag1"
     assert nid.alpha == want
+    assert nid.alpha_float == pytest.approx(want_float, rel=1e-9, abs=1e-12)
 
 
 def test_blocked_sums_equal_whole_array_sums() -> None:

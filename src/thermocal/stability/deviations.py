@@ -93,41 +93,37 @@ _INDEX: Final = np.arange(_CHUNK, dtype=np.float64)
 
 _WORKERS: Final = max(1, min(2, os.cpu_count() or 1))
 
-SECOND: Final = ((2, 1.0), (1, -2.0), (0, 1.0))
-"""x_{k+2m} − 2x_{k+m} + x_k, evaluated in this order (offset in m, coefficient)."""
-THIRD: Final = ((3, 1.0), (2, -3.0), (1, 3.0), (0, -1.0))
-"""x_{k+3m} − 3x_{k+2m} + 3x_{k+m} − x_k."""
-SECOND_CENTRED: Final = ((0, 1.0), (1, -2.0), (2, 1.0))
-"""x_k − 2x_{k+m} + x_{k+2m} (totdev's order)."""
+SECOND: Final = ((2, 1.0), (0, 1.0), (1, -2.0))
+"""x_{k+2m} + x_k − 2x_{k+m} (offset in m, coefficient; evaluated in this order)."""
+THIRD: Final = ((3, 1.0), (0, -1.0), (2, -3.0), (1, 3.0))
+"""x_{k+3m} − x_k − 3x_{k+2m} + 3x_{k+m}."""
 
 
 def _difference_sum(
     x: FloatArray, m: int, n_terms: int, taps: tuple[tuple[int, float], ...]
 ) -> float:
     """Σ_{k<n_terms} (Σ_j c_j x_{k + o_j m})² for taps (o_j, c_j), in blocks of
-    :data:`_CHUNK` terms with two reused buffers (no array per sample; the same rounding,
-    term by term, as the whole-array expression evaluated left to right)."""
+    :data:`_CHUNK` terms with two reused buffers (no array per sample).  The first two taps
+    must have c = ±1 (one add or subtract forms them, as :func:`thermocal.stability.allan.
+    second_difference_sums` does: x_{k+2m} + x_k − 2 x_{k+m}); the others are added after."""
     size = min(_CHUNK, max(n_terms, 1))
     buf = np.empty(size)
     tmp = np.empty(size)
     total = 0.0
+    (o0, c0), (o1, c1), rest = taps[0], taps[1], taps[2:]
     for a in range(0, n_terms, _CHUNK):
         b = min(a + _CHUNK, n_terms)
         t, u = buf[: b - a], tmp[: b - a]
-        (o0, c0), rest = taps[0], taps[1:]
-        if c0 == 1.0:
-            t[:] = x[a + o0 * m : b + o0 * m]
-        else:
-            np.multiply(x[a + o0 * m : b + o0 * m], c0, out=t)
+        first, second = x[a + o0 * m : b + o0 * m], x[a + o1 * m : b + o1 * m]
+        (np.add if c0 == c1 else np.subtract)(first, second, out=t)
+        if c0 < 0:
+            np.negative(t, out=t)
         for o, c in rest:
-            seg = x[a + o * m : b + o * m]
-            if abs(c) != 1.0:
-                np.multiply(seg, abs(c), out=u)
-                seg = u
+            np.multiply(x[a + o * m : b + o * m], abs(c), out=u)
             if c > 0:
-                t += seg
+                t += u
             else:
-                t -= seg
+                t -= u
         total += float(t @ t)
     return total
 
@@ -147,9 +143,9 @@ def difference_sums(
         return _difference_sum(arr, step, n_terms, taps)
 
     ms = [int(v) for v in m.tolist()]
-    if len(ms) <= 1 or _WORKERS <= 1:
-        return np.array([one(mm) for mm in ms], dtype=np.float64)
     with threadpool_limits(limits=1, user_api="blas"):
+        if len(ms) <= 1 or _WORKERS <= 1:
+            return np.array([one(mm) for mm in ms], dtype=np.float64)
         with ThreadPoolExecutor(max_workers=_WORKERS) as pool:
             vals = list(pool.map(one, ms))
     return np.asarray(vals, dtype=np.float64)
@@ -224,7 +220,7 @@ def _fast_sums(name: str, x: FloatArray, m: IntArray) -> tuple[FloatArray, Float
     ext = np.concatenate([2.0 * x[0] - x[n - 2 : 0 : -1], x, 2.0 * x[-1] - x[-2:0:-1]])
     mid = n - 2
     c = mid + 1
-    sums = difference_sums(lambda mm: (ext[c - mm :], mm, mid), m, SECOND_CENTRED)
+    sums = difference_sums(lambda mm: (ext[c - mm :], mm, mid), m, SECOND)
     return sums, np.full(m.size, float(mid))
 
 
