@@ -303,9 +303,7 @@ def theo1_tau(m: npt.ArrayLike, tau0_s: float) -> FloatArray:
     return np.asarray(0.75 * np.asarray(m, dtype=np.float64) * tau0_s)
 
 
-def as_phase(
-    values: FloatArray, tau0_s: float, data_type: str, offset: float = 0.0
-) -> FloatArray:
+def as_phase(values: FloatArray, tau0_s: float, data_type: str, offset: float = 0.0) -> FloatArray:
     """Phase points of one stretch: rate y → x_k = τ0 Σ_{i<k} (y_i − offset) (N = n + 1);
     phase as given, copied (``offset`` unused; the copy may be centred in place)."""
     if data_type == "phase":

@@ -45,7 +45,9 @@ class DeviationCurve:
 
     ``tau_s`` [s] (theo1: 0.75 m τ0), ``m`` averaging factors, ``dev`` [``unit``],
     ``low``/``high`` its interval (NaN where none), ``edf``, ``n_terms``, ``alpha`` the noise
-    exponent used for the EDF, ``alpha_method`` ``lag1``/``b1``/``none`` per τ.
+    exponent used for the EDF, ``alpha_method`` per τ: ``lag1``, ``b1``, ``b1-previous`` (B1
+    read a higher α than the shorter τ's, which is kept), ``previous`` (too few averages),
+    ``given``.
     """
 
     name: str
@@ -205,6 +207,13 @@ def _noise_exponents(
             methods.append("previous")
             continue
         alphas[i] = max(min(nid.alpha, 2), -2 if dmax == 2 else -4)
+        if nid.method == "b1" and i > 0 and alphas[i] > alphas[i - 1]:
+            # B1 from 8–29 averages misreads random-walk FM as flicker or white FM in ≈ 40 %
+            # of records (α read higher than at the shorter τ, where power-law noise can only
+            # steepen): the shorter τ's α is kept (Monte-Carlo coverage, issue 29 item 3)
+            alphas[i] = alphas[i - 1]
+            methods.append("b1-previous")
+            continue
         methods.append(nid.method)
     return alphas, tuple(methods)
 
