@@ -93,6 +93,8 @@ _INDEX: Final = np.arange(_CHUNK, dtype=np.float64)
 
 _WORKERS: Final = max(1, min(2, os.cpu_count() or 1))
 
+FIRST: Final = ((1, 1.0), (0, -1.0))
+"""x_{k+m} − x_k."""
 SECOND: Final = ((2, 1.0), (0, 1.0), (1, -2.0))
 """x_{k+2m} + x_k − 2x_{k+m} (offset in m, coefficient; evaluated in this order)."""
 THIRD: Final = ((3, 1.0), (0, -1.0), (2, -3.0), (1, 3.0))
@@ -194,6 +196,10 @@ _FAST: Final = frozenset({"adev", "oadev", "hdev", "ohdev", "mdev", "tdev", "tot
 """Deviations whose sums :func:`_fast_sums` takes in blocks, every τ at once."""
 
 
+_OVERLAPPING: Final = {"oadev": (2, SECOND), "ohdev": (3, THIRD), "tierms": (1, FIRST)}
+"""Differences taken and taps of the overlapping deviations of :func:`_fast_sums`."""
+
+
 def _fast_sums(name: str, x: FloatArray, m: IntArray) -> tuple[FloatArray, FloatArray]:
     """(Σ of squared differences, terms) per valid m of the finite-difference deviations
     (:data:`_FAST`), through :func:`difference_sums`."""
@@ -201,14 +207,13 @@ def _fast_sums(name: str, x: FloatArray, m: IntArray) -> tuple[FloatArray, Float
     if name in ("adev", "hdev"):  # non-overlapping: the phase decimated by m, differenced
         d = 2 if name == "adev" else 3
         cnt = np.array([(n - 1) // int(mm) + 1 - d for mm in m.tolist()], dtype=np.float64)
-        taps = SECOND if d == 2 else THIRD
+        taps: tuple[tuple[int, float], ...] = SECOND if d == 2 else THIRD
         sums = difference_sums(lambda mm: (x[::mm], 1, (n - 1) // mm + 1 - d), m, taps)
         return sums, cnt
     if name in ("oadev", "ohdev", "tierms"):
-        d, taps = {"oadev": (2, SECOND), "ohdev": (3, THIRD), "tierms": (1, ((1, 1.0), (0, -1.0)))}[name]  # fmt: skip
-        return difference_sums(lambda mm: (x, mm, n - d * mm), m, taps), (n - d * m).astype(
-            np.float64
-        )
+        d, taps = _OVERLAPPING[name]
+        sums = difference_sums(lambda mm: (x, mm, n - d * mm), m, taps)
+        return sums, (n - d * m).astype(np.float64)
     if name in ("mdev", "tdev"):  # v_j = s_{j+2m} − 2s_{j+m} + s_j, s_j = c_{j+m} − c_j
         cs = np.empty(n + 1)  # c: the running sum, once for every m
         cs[0] = 0.0
@@ -239,8 +244,8 @@ def segment_sums(
         num[one], cnt[one] = segment_sums("ohdev", x, tau0_s, m[one])
         ok = ok[m[ok] > 1]
     if name in _FAST and ok.size:
-        sums, k = _fast_sums(name, x, m[ok])
-        tau = m[ok] * float(tau0_s)
+        sums, terms = _fast_sums(name, x, m[ok])
+        tau = np.asarray(m[ok] * float(tau0_s), dtype=np.float64)
         scale = {"adev": 2.0, "oadev": 2.0, "totdev": 2.0, "hdev": 6.0, "ohdev": 6.0}
         if name in scale:
             num[ok] = sums / (scale[name] * tau * tau)
@@ -250,22 +255,22 @@ def segment_sums(
             num[ok] = sums / (6.0 * m[ok] ** 2)  # τ²/3 · Mod σ²
         else:  # tierms
             num[ok] = sums
-        cnt[ok] = k
+        cnt[ok] = terms
         return num, cnt
     for i in ok.tolist():
         mm = int(m[i])
-        tau = mm * tau0_s
+        tau_s = mm * tau0_s
         if name in ("mtotdev", "ttotdev"):
             s, k = _tot_kernel(x, mm)
-            val = s / (2.0 * tau * tau)
-            num[i], cnt[i] = (val * tau * tau / 3.0 if name == "ttotdev" else val), k
+            val = s / (2.0 * tau_s * tau_s)
+            num[i], cnt[i] = (val * tau_s * tau_s / 3.0 if name == "ttotdev" else val), k
         elif name == "htotdev":
             s, k = _tot_kernel(np.diff(x) / tau0_s, mm)
             num[i], cnt[i] = s / 6.0, k
         elif name == "theo1":
             if mm % 2:
                 continue
-            num[i], cnt[i] = _theo1_sum(x, mm) / (0.75 * tau * tau), n - mm
+            num[i], cnt[i] = _theo1_sum(x, mm) / (0.75 * tau_s * tau_s), n - mm
         elif name == "mtie":
             w = mm + 1
             # window [k, k + m]: the filters centre their window; shift it to start at k

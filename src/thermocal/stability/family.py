@@ -231,7 +231,6 @@ def _pooled_edf(name: str, m: IntArray, alphas: IntArray, phases: list[FloatArra
     return edf
 
 
-@threadpool_limits.wrap(limits=1, user_api="blas")  # many short dots: BLAS threads only wait
 def stability(
     values: npt.ArrayLike,
     tau0_s: float,
@@ -253,61 +252,62 @@ def stability(
     """
     from thermocal.stability.allan import confidence_interval
 
-    if data_type not in ("rate", "phase"):
-        raise ThermocalInputError(f"--data-type {data_type!r}: use rate or phase")
-    phases = _segment_phases(values, tau0_s, data_type, segments)
-    longest = max(phases, key=lambda x: x.size)
-    n_long = longest.size
-    m_common = factors(
-        taus,
-        tau0_s,
-        max(dv.max_factor(n, n_long) for n in names if n != "theo1")
-        if any(n != "theo1" for n in names)
-        else 1,
-    )
-    curves: dict[str, DeviationCurve] = {}
-    id_cache: dict[tuple[int, int], ed.NoiseId] = {}
-    # the line through the end points removed (in place unless mtie/tierms need the raw
-    # phase); noise identification reads the centred phase (a line changes no α: the rate
-    # averages shift by a constant, the phase's quadratic detrend removes it)
-    raw = any(n in ("mtie", "tierms") for n in names)
-    centred = [dv.centred(x, inplace=not raw) for x in phases]
-    longest = max(centred, key=lambda x: x.size)
-    for name in names:
-        m = (
-            factors(taus, tau0_s, dv.max_factor(name, n_long), theo1=True)
-            if name == "theo1"
-            else m_common
+    with threadpool_limits(limits=1, user_api="blas"):  # many short dots: BLAS threads wait
+        if data_type not in ("rate", "phase"):
+            raise ThermocalInputError(f"--data-type {data_type!r}: use rate or phase")
+        phases = _segment_phases(values, tau0_s, data_type, segments)
+        longest = max(phases, key=lambda x: x.size)
+        n_long = longest.size
+        m_common = factors(
+            taus,
+            tau0_s,
+            max(dv.max_factor(n, n_long) for n in names if n != "theo1")
+            if any(n != "theo1" for n in names)
+            else 1,
         )
-        parts = [
-            dv.segment_sums(name, xr if name in ("mtie", "tierms") else xc, tau0_s, m)
-            for xr, xc in zip(phases, centred, strict=True)
-        ]
-        dev, cnt = dv.pool(name, parts, m.size)
-        alphas, methods = _noise_exponents(name, m, longest, data_type, alpha, id_cache)
-        edf = _pooled_edf(name, m, alphas, phases)
-        ok = np.isfinite(edf) & np.isfinite(dev)
-        lo = np.full(m.size, np.nan)
-        hi = np.full(m.size, np.nan)
-        if ok.any():
-            lo_ok, hi_ok = confidence_interval(dev[ok], edf[ok], confidence)
-            lo[ok], hi[ok] = lo_ok, hi_ok
-        tau = dv.theo1_tau(m, tau0_s) if name == "theo1" else m * float(tau0_s)
-        curves[name] = DeviationCurve(
-            name, np.asarray(tau, dtype=np.float64), m, dev, lo, hi, edf, cnt, alphas,
-            methods, _unit(name, unit, data_type),
-        )  # fmt: skip
-    return StabilityResult(
-        curves=curves,
-        tau_s=np.asarray(m_common * float(tau0_s), dtype=np.float64),
-        m=m_common,
-        tau0_s=float(tau0_s),
-        data_type=data_type,
-        confidence=float(confidence),
-        n_segments=len(phases),
-        n_points=int(sum(x.size for x in phases)),
-        unit=unit,
-    )
+        curves: dict[str, DeviationCurve] = {}
+        id_cache: dict[tuple[int, int], ed.NoiseId] = {}
+        # the line through the end points removed (in place unless mtie/tierms need the raw
+        # phase); noise identification reads the centred phase (a line changes no α: the rate
+        # averages shift by a constant, the phase's quadratic detrend removes it)
+        raw = any(n in ("mtie", "tierms") for n in names)
+        centred = [dv.centred(x, inplace=not raw) for x in phases]
+        longest = max(centred, key=lambda x: x.size)
+        for name in names:
+            m = (
+                factors(taus, tau0_s, dv.max_factor(name, n_long), theo1=True)
+                if name == "theo1"
+                else m_common
+            )
+            parts = [
+                dv.segment_sums(name, xr if name in ("mtie", "tierms") else xc, tau0_s, m)
+                for xr, xc in zip(phases, centred, strict=True)
+            ]
+            dev, cnt = dv.pool(name, parts, m.size)
+            alphas, methods = _noise_exponents(name, m, longest, data_type, alpha, id_cache)
+            edf = _pooled_edf(name, m, alphas, phases)
+            ok = np.isfinite(edf) & np.isfinite(dev)
+            lo = np.full(m.size, np.nan)
+            hi = np.full(m.size, np.nan)
+            if ok.any():
+                lo_ok, hi_ok = confidence_interval(dev[ok], edf[ok], confidence)
+                lo[ok], hi[ok] = lo_ok, hi_ok
+            tau = dv.theo1_tau(m, tau0_s) if name == "theo1" else m * float(tau0_s)
+            curves[name] = DeviationCurve(
+                name, np.asarray(tau, dtype=np.float64), m, dev, lo, hi, edf, cnt, alphas,
+                methods, _unit(name, unit, data_type),
+            )  # fmt: skip
+        return StabilityResult(
+            curves=curves,
+            tau_s=np.asarray(m_common * float(tau0_s), dtype=np.float64),
+            m=m_common,
+            tau0_s=float(tau0_s),
+            data_type=data_type,
+            confidence=float(confidence),
+            n_segments=len(phases),
+            n_points=int(sum(x.size for x in phases)),
+            unit=unit,
+        )
 
 
 def _unit(name: str, unit: str, data_type: str) -> str:
