@@ -14,7 +14,7 @@ hdev / ohdev               Greenhall d = 3, S = 1 / m, F = m
 totdev                     SP 1065 Table 7 (α = 0, −1, −2), else as oadev
 mtotdev, ttotdev           SP 1065 Table 8
 htotdev                    SP 1065 §5.2.14 (α = 0, −1, −2), else as ohdev; m = 1 as ohdev
-theo1, mtie, tierms        none (NaN: no interval is reported)
+theo1, mtie, tierms        none (NaN; JSON ``<name>_interval`` says why: NO_INTERVAL)
 =========================  =========================================================
 
 The EDFs of gap-separated stretches add (independent estimates).
@@ -37,6 +37,14 @@ FloatArray = npt.NDArray[np.float64]
 IntArray = npt.NDArray[np.int64]
 
 HADAMARD = frozenset({"hdev", "ohdev", "htotdev"})
+
+NO_INTERVAL: dict[str, str] = {
+    "mtie": "none: MTIE is a maximum over windows, not a variance; no chi-square EDF applies "
+    "and neither NIST SP 1065 nor Stable32 gives it an interval",
+    "tierms": "none: NIST SP 1065 gives TIE rms no EDF",
+    "theo1": "none: Theo1's EDF (Howe & Tasset) is not implemented yet",
+}
+"""The deviations whose ``low``/``high`` are NaN, and why (``<name>_interval`` in JSON)."""
 
 
 @dataclass(frozen=True, eq=False)
