@@ -46,11 +46,13 @@ else:
     _rich_table = LazyModule("rich.table")
     _writers = LazyModule("thermocal.writers")
     _analysis = LazyModule("thermocal.stability.analysis")
+    _family = LazyModule("thermocal.stability.family")
 
 
 def family_json(res: "_family.StabilityResult") -> dict[str, Any]:
     """The ``--json`` object of ``allan --deviation``: ``tau_s`` and per deviation NAME the
-    keys NAME, NAME_low, NAME_high, NAME_edf, NAME_alpha, NAME_n, NAME_tau_s, NAME_unit;
+    keys NAME, NAME_low, NAME_high, NAME_edf, NAME_alpha, NAME_n, NAME_tau_s, NAME_unit and
+    NAME_interval (how the interval was found, or "none: why" where low/high are null);
     ``alpha`` the noise identified per ``tau_s`` (first Allan-family deviation)."""
     out: dict[str, Any] = {
         "tau_s": res.tau_s,
@@ -75,6 +77,9 @@ def family_json(res: "_family.StabilityResult") -> dict[str, Any]:
         out[f"{name}_n"] = c.n_terms
         out[f"{name}_tau_s"] = c.tau_s
         out[f"{name}_unit"] = c.unit
+        out[f"{name}_interval"] = _family.NO_INTERVAL.get(
+            name, f"chi-square, {100 * res.confidence:.1f} %, Greenhall/SP 1065 EDF"
+        )
     return dict(jsonable(out))
 
 
@@ -92,6 +97,8 @@ def _family_human(file: Path, res: "_family.StabilityResult") -> None:
                 str(int(c.n_terms[i])),
             )  # fmt: skip
         stdout.print(t)
+        if name in _family.NO_INTERVAL:
+            stdout.print(f"{name}: interval {_family.NO_INTERVAL[name]}")
 
 
 def _terms_json(terms: dict[str, Any]) -> dict[str, Any]:

@@ -418,7 +418,7 @@ def _second_difference_sum(x1: FloatArray, mm: int) -> float:
     return total
 
 
-def _second_difference_sums(x1: FloatArray, m: IntArray) -> FloatArray:
+def second_difference_sums(x1: FloatArray, m: IntArray) -> FloatArray:
     """S(m) for each averaging factor m (see :func:`_second_difference_sum`; ``x1`` the
     phase without x_0).
 
@@ -557,7 +557,7 @@ def _pooled_sums(
         if not np.any(ok):
             continue
         x1 = _phase(seg, overwrite)
-        sums[ok] += _second_difference_sums(x1, m[ok])
+        sums[ok] += second_difference_sums(x1, m[ok])
         del x1
         n_terms[ok] += n_phase - 2 * m[ok]
         used += seg.size

@@ -29,10 +29,14 @@ sums of squares and term counts per τ, pooled as Σ S / Σ count (MTIE: the lar
 
 from __future__ import annotations
 
+import os
+from collections.abc import Callable
+from concurrent.futures import ThreadPoolExecutor
 from typing import Final
 
 import numpy as np
 import numpy.typing as npt
+from threadpoolctl import threadpool_limits
 
 from thermocal._lazy import LazyModule
 
@@ -82,20 +86,71 @@ def max_factor(name: str, n_phase: int) -> int:
     raise ValueError(name)
 
 
-def _second(x: FloatArray, m: int, stride: int) -> FloatArray:
-    xs = x[::stride] if stride > 1 else x
-    k = m // stride
-    return np.asarray(xs[2 * k :] - 2.0 * xs[k:-k] + xs[: -2 * k], dtype=np.float64)
+_CHUNK: Final = 1 << 17
+"""Terms per block of :func:`_difference_sum` (a few cache-sized buffers, reused)."""
+
+_INDEX: Final = np.arange(_CHUNK, dtype=np.float64)
+
+_WORKERS: Final = max(1, min(2, os.cpu_count() or 1))
+
+FIRST: Final = ((1, 1.0), (0, -1.0))
+"""x_{k+m} − x_k."""
+SECOND: Final = ((2, 1.0), (0, 1.0), (1, -2.0))
+"""x_{k+2m} + x_k − 2x_{k+m} (offset in m, coefficient; evaluated in this order)."""
+THIRD: Final = ((3, 1.0), (0, -1.0), (2, -3.0), (1, 3.0))
+"""x_{k+3m} − x_k − 3x_{k+2m} + 3x_{k+m}."""
 
 
-def _third(x: FloatArray, m: int, stride: int) -> FloatArray:
-    xs = x[::stride] if stride > 1 else x
-    k = m // stride
-    n = xs.size - 3 * k
-    return np.asarray(
-        xs[3 * k : 3 * k + n] - 3.0 * xs[2 * k : 2 * k + n] + 3.0 * xs[k : k + n] - xs[:n],
-        dtype=np.float64,
-    )
+def _difference_sum(
+    x: FloatArray, m: int, n_terms: int, taps: tuple[tuple[int, float], ...]
+) -> float:
+    """Σ_{k<n_terms} (Σ_j c_j x_{k + o_j m})² for taps (o_j, c_j), in blocks of
+    :data:`_CHUNK` terms with two reused buffers (no array per sample).  The first two taps
+    must have c = ±1 (one add or subtract forms them, as :func:`thermocal.stability.allan.
+    second_difference_sums` does: x_{k+2m} + x_k − 2 x_{k+m}); the others are added after."""
+    size = min(_CHUNK, max(n_terms, 1))
+    buf = np.empty(size)
+    tmp = np.empty(size)
+    total = 0.0
+    (o0, c0), (o1, c1), rest = taps[0], taps[1], taps[2:]
+    for a in range(0, n_terms, _CHUNK):
+        b = min(a + _CHUNK, n_terms)
+        t, u = buf[: b - a], tmp[: b - a]
+        first, second = x[a + o0 * m : b + o0 * m], x[a + o1 * m : b + o1 * m]
+        (np.add if c0 == c1 else np.subtract)(first, second, out=t)
+        if c0 < 0:
+            np.negative(t, out=t)
+        for o, c in rest:
+            np.multiply(x[a + o * m : b + o * m], abs(c), out=u)
+            if c > 0:
+                t += u
+            else:
+                t -= u
+        total += float(t @ t)
+    return total
+
+
+def difference_sums(
+    base: Callable[[int], tuple[FloatArray, int, int]],
+    m: IntArray,
+    taps: tuple[tuple[int, float], ...],
+) -> FloatArray:
+    """:func:`_difference_sum` for each factor m: ``base(m)`` gives (array, offset unit,
+    term count) — the phase with m itself, or a decimated phase with 1 — shared between
+    :data:`_WORKERS` threads (numpy releases the GIL in its loops; BLAS held to one thread
+    meanwhile)."""
+
+    def one(mm: int) -> float:
+        arr, step, n_terms = base(mm)
+        return _difference_sum(arr, step, n_terms, taps)
+
+    ms = [int(v) for v in m.tolist()]
+    with threadpool_limits(limits=1, user_api="blas"):
+        if len(ms) <= 1 or _WORKERS <= 1:
+            return np.array([one(mm) for mm in ms], dtype=np.float64)
+        with ThreadPoolExecutor(max_workers=_WORKERS) as pool:
+            vals = list(pool.map(one, ms))
+    return np.asarray(vals, dtype=np.float64)
 
 
 def _tot_kernel(z: FloatArray, m: int) -> tuple[float, int]:
@@ -137,53 +192,85 @@ def _theo1_sum(x: FloatArray, m: int) -> float:
     return total
 
 
+_FAST: Final = frozenset({"adev", "oadev", "hdev", "ohdev", "mdev", "tdev", "totdev", "tierms"})
+"""Deviations whose sums :func:`_fast_sums` takes in blocks, every τ at once."""
+
+
+_OVERLAPPING: Final = {"oadev": (2, SECOND), "ohdev": (3, THIRD), "tierms": (1, FIRST)}
+"""Differences taken and taps of the overlapping deviations of :func:`_fast_sums`."""
+
+
+def _fast_sums(name: str, x: FloatArray, m: IntArray) -> tuple[FloatArray, FloatArray]:
+    """(Σ of squared differences, terms) per valid m of the finite-difference deviations
+    (:data:`_FAST`), through :func:`difference_sums`."""
+    n = x.size
+    if name in ("adev", "hdev"):  # non-overlapping: the phase decimated by m, differenced
+        d = 2 if name == "adev" else 3
+        cnt = np.array([(n - 1) // int(mm) + 1 - d for mm in m.tolist()], dtype=np.float64)
+        taps: tuple[tuple[int, float], ...] = SECOND if d == 2 else THIRD
+        sums = difference_sums(lambda mm: (x[::mm], 1, (n - 1) // mm + 1 - d), m, taps)
+        return sums, cnt
+    if name in ("oadev", "ohdev", "tierms"):
+        d, taps = _OVERLAPPING[name]
+        sums = difference_sums(lambda mm: (x, mm, n - d * mm), m, taps)
+        return sums, (n - d * m).astype(np.float64)
+    if name in ("mdev", "tdev"):  # v_j = s_{j+2m} − 2s_{j+m} + s_j, s_j = c_{j+m} − c_j
+        cs = np.empty(n + 1)  # c: the running sum, once for every m
+        cs[0] = 0.0
+        np.cumsum(x, out=cs[1:])
+        return difference_sums(lambda mm: (cs, mm, n - 3 * mm + 1), m, THIRD), (
+            n - 3 * m + 1
+        ).astype(np.float64)
+    # totdev: the series extended by odd reflection at both ends, N − 2 terms centred on it
+    ext = np.concatenate([2.0 * x[0] - x[n - 2 : 0 : -1], x, 2.0 * x[-1] - x[-2:0:-1]])
+    mid = n - 2
+    c = mid + 1
+    sums = difference_sums(lambda mm: (ext[c - mm :], mm, mid), m, SECOND)
+    return sums, np.full(m.size, float(mid))
+
+
 def segment_sums(
     name: str, x: FloatArray, tau0_s: float, m: IntArray
 ) -> tuple[FloatArray, FloatArray]:
     """(numerator, terms) per m for one gap-free stretch of phase ``x``: the variance is
     numerator / terms (for mtie the numerator is the MTIE itself and terms its window count).
-    ``m`` must respect :func:`max_factor`; a factor without a term gives (0, 0)."""
+    A factor beyond :func:`max_factor` (or below 1) gives (0, 0)."""
     num = np.zeros(m.size)
     cnt = np.zeros(m.size)
     n = x.size
-    if name == "totdev":
-        ext = np.concatenate([2.0 * x[0] - x[n - 2 : 0 : -1], x, 2.0 * x[-1] - x[-2:0:-1]])
-        mid = n - 2
-    for i, mm in enumerate(int(v) for v in m.tolist()):
-        tau = mm * tau0_s
-        if mm < 1 or mm > max_factor(name, n):
-            continue
-        if name in ("adev", "oadev"):
-            v = _second(x, mm, mm if name == "adev" else 1)
-            num[i], cnt[i] = float(v @ v) / (2.0 * tau * tau), v.size
-        elif name in ("mdev", "tdev"):
-            cs = np.concatenate([[0.0], np.cumsum(x)])
-            s = cs[mm:] - cs[:-mm]
-            k = n - 3 * mm + 1
-            v = s[2 * mm : 2 * mm + k] - 2.0 * s[mm : mm + k] + s[:k]
-            val = float(v @ v) / (2.0 * mm * mm * tau * tau)
-            num[i], cnt[i] = (val * tau * tau / 3.0 if name == "tdev" else val), k
-        elif name in ("hdev", "ohdev") or (name == "htotdev" and mm == 1):
-            v = _third(x, mm, mm if name == "hdev" else 1)
-            num[i], cnt[i] = float(v @ v) / (6.0 * tau * tau), v.size
-        elif name == "totdev":
-            c = mid + 1
-            v = ext[c - mm : c - mm + mid] - 2.0 * ext[c : c + mid] + ext[c + mm : c + mm + mid]
-            num[i], cnt[i] = float(v @ v) / (2.0 * tau * tau), mid
-        elif name in ("mtotdev", "ttotdev"):
+    ok = np.flatnonzero((m >= 1) & (m <= max_factor(name, n)))
+    if name == "htotdev":  # m = 1 is ohdev (as Stable32)
+        one = ok[m[ok] == 1]
+        num[one], cnt[one] = segment_sums("ohdev", x, tau0_s, m[one])
+        ok = ok[m[ok] > 1]
+    if name in _FAST and ok.size:
+        sums, terms = _fast_sums(name, x, m[ok])
+        tau = np.asarray(m[ok] * float(tau0_s), dtype=np.float64)
+        scale = {"adev": 2.0, "oadev": 2.0, "totdev": 2.0, "hdev": 6.0, "ohdev": 6.0}
+        if name in scale:
+            num[ok] = sums / (scale[name] * tau * tau)
+        elif name == "mdev":
+            num[ok] = sums / (2.0 * m[ok] ** 2 * tau * tau)
+        elif name == "tdev":
+            num[ok] = sums / (6.0 * m[ok] ** 2)  # τ²/3 · Mod σ²
+        else:  # tierms
+            num[ok] = sums
+        cnt[ok] = terms
+        return num, cnt
+    for i in ok.tolist():
+        mm = int(m[i])
+        tau_s = mm * tau0_s
+        if name in ("mtotdev", "ttotdev"):
             s, k = _tot_kernel(x, mm)
-            val = s / (2.0 * tau * tau)
-            num[i], cnt[i] = (val * tau * tau / 3.0 if name == "ttotdev" else val), k
+            val = s / (2.0 * tau_s * tau_s)
+            num[i], cnt[i] = (val * tau_s * tau_s / 3.0 if name == "ttotdev" else val), k
         elif name == "htotdev":
             s, k = _tot_kernel(np.diff(x) / tau0_s, mm)
             num[i], cnt[i] = s / 6.0, k
         elif name == "theo1":
             if mm % 2:
                 continue
-            num[i], cnt[i] = _theo1_sum(x, mm) / (0.75 * tau * tau), n - mm
-        elif name == "tierms":
-            v = x[mm:] - x[:-mm]
-            num[i], cnt[i] = float(v @ v), n - mm
+            num[i], cnt[i] = _theo1_sum(x, mm) / (0.75 * tau_s * tau_s), n - mm
         elif name == "mtie":
             w = mm + 1
             # window [k, k + m]: the filters centre their window; shift it to start at k
@@ -221,24 +308,37 @@ def theo1_tau(m: npt.ArrayLike, tau0_s: float) -> FloatArray:
     return np.asarray(0.75 * np.asarray(m, dtype=np.float64) * tau0_s)
 
 
-def as_phase(values: FloatArray, tau0_s: float, data_type: str) -> FloatArray:
-    """Phase points of one stretch: rate y → x_k = τ0 Σ_{i<k} y_i (N = n + 1); phase as given."""
+def as_phase(values: FloatArray, tau0_s: float, data_type: str, offset: float = 0.0) -> FloatArray:
+    """Phase points of one stretch: rate y → x_k = τ0 Σ_{i<k} (y_i − offset) (N = n + 1);
+    phase as given, copied (``offset`` unused; the copy may be centred in place)."""
     if data_type == "phase":
-        return np.asarray(values, dtype=np.float64)
+        return np.array(values, dtype=np.float64)
     x = np.empty(values.size + 1)
     x[0] = 0.0
-    np.cumsum(values, out=x[1:])
+    np.subtract(values, offset, out=x[1:])
+    np.cumsum(x[1:], out=x[1:])
     x *= tau0_s
     return x
 
 
-def centred(x: FloatArray) -> FloatArray:
+def centred(x: FloatArray, *, inplace: bool = False) -> FloatArray:
     """x minus the straight line through its end points: every variance here cancels a linear
-    phase (a constant rate) exactly; removing it keeps the sums free of rounding growth."""
+    phase (a constant rate) exactly; removing it keeps the sums free of rounding growth.
+    ``inplace``: in ``x``'s own buffer.  The result's first point is exactly 0."""
     if x.size < 2:
         return x
-    k = np.arange(x.size, dtype=np.float64)
-    return np.asarray(x - x[0] - (x[-1] - x[0]) * k / (x.size - 1), dtype=np.float64)
+    x0 = float(x[0])
+    slope = (float(x[-1]) - x0) / (x.size - 1)
+    out = x if inplace else np.empty_like(x)
+    line = np.empty(min(_CHUNK, x.size))
+    for a in range(0, x.size, _CHUNK):  # in blocks: no array of n indices
+        b = min(a + _CHUNK, x.size)
+        seg = line[: b - a]
+        np.multiply(_INDEX[: b - a] + a, slope, out=seg)
+        seg += x0
+        np.subtract(x[a:b], seg, out=out[a:b])
+    out[0] = 0.0
+    return out
 
 
 __all__ = [

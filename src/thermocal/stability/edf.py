@@ -259,10 +259,70 @@ def lag1_autocorrelation(z: FloatArray) -> float:
 
 
 def _detrend(z: FloatArray, deg: int) -> FloatArray:
-    t = np.arange(z.size, dtype=np.float64)
-    t = (t - t.mean()) / max(float(t.std()), 1.0)
-    coef = np.polynomial.polynomial.polyfit(t, z, deg)
-    return np.asarray(z - np.polynomial.polynomial.polyval(t, coef), dtype=np.float64)
+    """``z`` minus its least-squares polynomial of degree ``deg`` (1 or 2) in the index,
+    by projection on the discrete orthogonal polynomials 1, u, u² − ⟨u²⟩ (u = k − k̄): two
+    or three dot products, no design matrix (the same fit as a least-squares polyfit)."""
+    n = z.size
+    u = np.arange(n, dtype=np.float64)
+    u -= (n - 1) / 2.0
+    out = z - z.mean()
+    uu = float(u @ u)
+    if uu > 0:
+        out -= (float(u @ out) / uu) * u
+    if deg >= 2 and n > 2:
+        p2 = u * u
+        p2 -= uu / n
+        pp = float(p2 @ p2)
+        if pp > 0:
+            out -= (float(p2 @ out) / pp) * p2
+    return np.asarray(out, dtype=np.float64)
+
+
+_BLOCK: Final = 1 << 16
+_BLOCK_INDEX: Final = np.arange(_BLOCK, dtype=np.float64)
+
+
+def _index_dot(z: FloatArray) -> float:
+    """Σ_k k z_k, in blocks against one small index array (no array of n indices)."""
+    total = 0.0
+    for a in range(0, z.size, _BLOCK):
+        blk = z[a : a + _BLOCK]
+        total += float(_BLOCK_INDEX[: blk.size] @ blk) + a * float(blk.sum())
+    return total
+
+
+def _lag1_linear_detrended(z: FloatArray, *, own: bool = False) -> float:
+    """r1 of ``z`` minus its least-squares line, from sums over ``z`` alone (one centred
+    copy, no detrended one).  With z_c = z − z̄, u_k = k − (n−1)/2, b = Σ u z_c / Σ u² and
+    c = z_c − b u (Σ c = 0):
+
+    Σ c_k² = Σ z_c² − b² Σ u²,   Σ u² = n(n² − 1)/12;
+    Σ c_k c_{k+1} = Σ z_c,k z_c,k+1 − b (2 Σ u z_c − (u_0 − 1) z_c,0 − (u_{n−1} + 1) z_c,n−1)
+    + b² (Σ u² − u_{n−1}² − u_{n−1}).
+
+    Where the line carries nearly all of Σ z_c² (the subtraction would lose digits) the
+    detrended series is formed explicitly (:func:`_detrend`).  ``own``: ``z`` may be
+    centred in place (its differences are unchanged)."""
+    n = z.size
+    if own:
+        z -= z.mean()
+        zc = z
+    else:
+        zc = z - z.mean()
+    szz = float(zc @ zc)
+    if szz <= 0:
+        return 0.0
+    uu = n * (n * n - 1.0) / 12.0
+    uz = _index_dot(zc)  # Σ k z_c = Σ u z_c, since Σ z_c = 0
+    b = uz / uu
+    scc = szz - b * b * uu
+    if not scc > 1e-6 * szz:
+        return lag1_autocorrelation(_detrend(z, 1))
+    u0, un = -(n - 1) / 2.0, (n - 1) / 2.0
+    cross = float(zc[:-1] @ zc[1:])
+    cross -= b * (2.0 * uz - (u0 - 1.0) * float(zc[0]) - (un + 1.0) * float(zc[-1]))
+    cross += b * b * (uu - un * un - un)
+    return cross / scc
 
 
 def _b1_theory(n: int, mu: int) -> float:
@@ -296,30 +356,34 @@ def identify_noise(x: FloatArray, m: int, *, dmax: int, phase_input: bool) -> No
     theoretical B1 of each noise (boundaries at geometric means); B1 cannot tell white from
     flicker PM and reports white PM (α = +2).
     """
+    nb = (x.size - 1) // m  # m-averages of the rate: (x_{(k+1)m} − x_{km}) / m
+    ym = np.diff(x[: nb * m + 1 : m]) if nb else x[:0].copy()
+    if m > 1:
+        ym /= m
     if phase_input:
         z = x[:: max(m, 1)]
         deg, add, dm = 2, 2, dmax
     else:
-        y = np.diff(x)
-        nb = y.size // m
-        z = y[: nb * m].reshape(nb, m).mean(axis=1) if nb else y[:0]
+        z = ym
         deg, add, dm = 1, 0, dmax - 1
     if z.size >= MIN_ACF_POINTS:
-        z = _detrend(z, deg)
         d = 0
-        while True:
+        if deg == 1:  # rate: r1 of the detrended averages from sums (no detrended copy)
+            r1 = _lag1_linear_detrended(z, own=True)  # ym, our own: centred in place
+            # differencing cancels the line but its constant slope, which r1's mean removes
+        else:
+            z = _detrend(z, deg)
             r1 = lag1_autocorrelation(z)
+        while True:
             rho = r1 / (1.0 + r1) if r1 > -1.0 else 0.0
             if rho < 0.25 or d >= dm:
                 a = -round(2.0 * rho) - 2 * d + add
                 return NoiseId(int(a), -2.0 * (rho + d) + add, "lag1", d)
             z = np.diff(z)
             d += 1
-    y = np.diff(x)
-    nb = y.size // m
+            r1 = lag1_autocorrelation(z)
     if nb < MIN_B1_GROUPS:
         return NoiseId(0, float("nan"), "none", 0)
-    ym = y[: nb * m].reshape(nb, m).mean(axis=1)
     avar = float(np.mean(np.diff(ym) ** 2)) / 2.0
     if avar <= 0:
         return NoiseId(0, float("nan"), "none", 0)

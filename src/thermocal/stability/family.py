@@ -14,7 +14,7 @@ hdev / ohdev               Greenhall d = 3, S = 1 / m, F = m
 totdev                     SP 1065 Table 7 (α = 0, −1, −2), else as oadev
 mtotdev, ttotdev           SP 1065 Table 8
 htotdev                    SP 1065 §5.2.14 (α = 0, −1, −2), else as ohdev; m = 1 as ohdev
-theo1, mtie, tierms        none (NaN: no interval is reported)
+theo1, mtie, tierms        none (NaN; JSON ``<name>_interval`` says why: NO_INTERVAL)
 =========================  =========================================================
 
 The EDFs of gap-separated stretches add (independent estimates).
@@ -27,6 +27,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 import numpy.typing as npt
+from threadpoolctl import threadpool_limits
 
 from thermocal.errors import MissingValueError, ThermocalInputError
 from thermocal.stability import deviations as dv
@@ -37,6 +38,14 @@ IntArray = npt.NDArray[np.int64]
 
 HADAMARD = frozenset({"hdev", "ohdev", "htotdev"})
 
+NO_INTERVAL: dict[str, str] = {
+    "mtie": "none: MTIE is a maximum over windows, not a variance; no chi-square EDF applies "
+    "and neither NIST SP 1065 nor Stable32 gives it an interval",
+    "tierms": "none: NIST SP 1065 gives TIE rms no EDF",
+    "theo1": "none: Theo1's EDF (Howe & Tasset) is not implemented yet",
+}
+"""The deviations whose ``low``/``high`` are NaN, and why (``<name>_interval`` in JSON)."""
+
 
 @dataclass(frozen=True, eq=False)
 class DeviationCurve:
@@ -44,7 +53,9 @@ class DeviationCurve:
 
     ``tau_s`` [s] (theo1: 0.75 m τ0), ``m`` averaging factors, ``dev`` [``unit``],
     ``low``/``high`` its interval (NaN where none), ``edf``, ``n_terms``, ``alpha`` the noise
-    exponent used for the EDF, ``alpha_method`` ``lag1``/``b1``/``none`` per τ.
+    exponent used for the EDF, ``alpha_method`` per τ: ``lag1``, ``b1``, ``b1-previous`` (B1
+    read a higher α than the shorter τ's, which is kept), ``previous`` (too few averages),
+    ``given``.
     """
 
     name: str
@@ -163,12 +174,9 @@ def _segment_phases(
         )
     slices = segments if segments is not None else [slice(0, y.size)]
     phases = [
-        dv.as_phase(
-            y[sl] - (y[sl].mean() if data_type == "rate" and sl.stop > sl.start else 0.0),
-            tau0_s,
-            data_type,
-        )
+        dv.as_phase(y[sl], tau0_s, data_type, y[sl].mean() if data_type == "rate" else 0.0)
         for sl in slices
+        if sl.stop > sl.start
     ]
     phases = [x for x in phases if x.size >= 3]
     if not phases:
@@ -207,6 +215,13 @@ def _noise_exponents(
             methods.append("previous")
             continue
         alphas[i] = max(min(nid.alpha, 2), -2 if dmax == 2 else -4)
+        if nid.method == "b1" and i > 0 and alphas[i] > alphas[i - 1]:
+            # B1 from 8–29 averages misreads random-walk FM as flicker or white FM in ≈ 40 %
+            # of records (α read higher than at the shorter τ, where power-law noise can only
+            # steepen): the shorter τ's α is kept (Monte-Carlo coverage, issue 29 item 3)
+            alphas[i] = alphas[i - 1]
+            methods.append("b1-previous")
+            continue
         methods.append(nid.method)
     return alphas, tuple(methods)
 
@@ -245,56 +260,62 @@ def stability(
     """
     from thermocal.stability.allan import confidence_interval
 
-    if data_type not in ("rate", "phase"):
-        raise ThermocalInputError(f"--data-type {data_type!r}: use rate or phase")
-    phases = _segment_phases(values, tau0_s, data_type, segments)
-    longest = max(phases, key=lambda x: x.size)
-    n_long = longest.size
-    m_common = factors(
-        taus,
-        tau0_s,
-        max(dv.max_factor(n, n_long) for n in names if n != "theo1")
-        if any(n != "theo1" for n in names)
-        else 1,
-    )
-    curves: dict[str, DeviationCurve] = {}
-    id_cache: dict[tuple[int, int], ed.NoiseId] = {}
-    centred = [dv.centred(x) for x in phases]
-    for name in names:
-        m = (
-            factors(taus, tau0_s, dv.max_factor(name, n_long), theo1=True)
-            if name == "theo1"
-            else m_common
+    with threadpool_limits(limits=1, user_api="blas"):  # many short dots: BLAS threads wait
+        if data_type not in ("rate", "phase"):
+            raise ThermocalInputError(f"--data-type {data_type!r}: use rate or phase")
+        phases = _segment_phases(values, tau0_s, data_type, segments)
+        longest = max(phases, key=lambda x: x.size)
+        n_long = longest.size
+        m_common = factors(
+            taus,
+            tau0_s,
+            max(dv.max_factor(n, n_long) for n in names if n != "theo1")
+            if any(n != "theo1" for n in names)
+            else 1,
         )
-        parts = [
-            dv.segment_sums(name, xr if name in ("mtie", "tierms") else xc, tau0_s, m)
-            for xr, xc in zip(phases, centred, strict=True)
-        ]
-        dev, cnt = dv.pool(name, parts, m.size)
-        alphas, methods = _noise_exponents(name, m, longest, data_type, alpha, id_cache)
-        edf = _pooled_edf(name, m, alphas, phases)
-        ok = np.isfinite(edf) & np.isfinite(dev)
-        lo = np.full(m.size, np.nan)
-        hi = np.full(m.size, np.nan)
-        if ok.any():
-            lo_ok, hi_ok = confidence_interval(dev[ok], edf[ok], confidence)
-            lo[ok], hi[ok] = lo_ok, hi_ok
-        tau = dv.theo1_tau(m, tau0_s) if name == "theo1" else m * float(tau0_s)
-        curves[name] = DeviationCurve(
-            name, np.asarray(tau, dtype=np.float64), m, dev, lo, hi, edf, cnt, alphas,
-            methods, _unit(name, unit, data_type),
-        )  # fmt: skip
-    return StabilityResult(
-        curves=curves,
-        tau_s=np.asarray(m_common * float(tau0_s), dtype=np.float64),
-        m=m_common,
-        tau0_s=float(tau0_s),
-        data_type=data_type,
-        confidence=float(confidence),
-        n_segments=len(phases),
-        n_points=int(sum(x.size for x in phases)),
-        unit=unit,
-    )
+        curves: dict[str, DeviationCurve] = {}
+        id_cache: dict[tuple[int, int], ed.NoiseId] = {}
+        # the line through the end points removed (in place unless mtie/tierms need the raw
+        # phase); noise identification reads the centred phase (a line changes no α: the rate
+        # averages shift by a constant, the phase's quadratic detrend removes it)
+        raw = any(n in ("mtie", "tierms") for n in names)
+        centred = [dv.centred(x, inplace=not raw) for x in phases]
+        longest = max(centred, key=lambda x: x.size)
+        for name in names:
+            m = (
+                factors(taus, tau0_s, dv.max_factor(name, n_long), theo1=True)
+                if name == "theo1"
+                else m_common
+            )
+            parts = [
+                dv.segment_sums(name, xr if name in ("mtie", "tierms") else xc, tau0_s, m)
+                for xr, xc in zip(phases, centred, strict=True)
+            ]
+            dev, cnt = dv.pool(name, parts, m.size)
+            alphas, methods = _noise_exponents(name, m, longest, data_type, alpha, id_cache)
+            edf = _pooled_edf(name, m, alphas, phases)
+            ok = np.isfinite(edf) & np.isfinite(dev)
+            lo = np.full(m.size, np.nan)
+            hi = np.full(m.size, np.nan)
+            if ok.any():
+                lo_ok, hi_ok = confidence_interval(dev[ok], edf[ok], confidence)
+                lo[ok], hi[ok] = lo_ok, hi_ok
+            tau = dv.theo1_tau(m, tau0_s) if name == "theo1" else m * float(tau0_s)
+            curves[name] = DeviationCurve(
+                name, np.asarray(tau, dtype=np.float64), m, dev, lo, hi, edf, cnt, alphas,
+                methods, _unit(name, unit, data_type),
+            )  # fmt: skip
+        return StabilityResult(
+            curves=curves,
+            tau_s=np.asarray(m_common * float(tau0_s), dtype=np.float64),
+            m=m_common,
+            tau0_s=float(tau0_s),
+            data_type=data_type,
+            confidence=float(confidence),
+            n_segments=len(phases),
+            n_points=int(sum(x.size for x in phases)),
+            unit=unit,
+        )
 
 
 def _unit(name: str, unit: str, data_type: str) -> str:
