@@ -48,14 +48,33 @@ def demo_cmd(
             "into one calibration, one C module and one report.",
         ),
     ] = False,
+    station: Annotated[
+        bool,
+        typer.Option(
+            "--station",
+            help="The test station: a simulated chamber (Modbus TCP server) and serial IMU "
+            "(pseudo-terminal) driven by the station, then fit, validate and export-c "
+            "(needs thermocal[station]).",
+        ),
+    ] = False,
+    time_scale: Annotated[
+        float, typer.Option("--time-scale", help="--station: run the programs K times faster.")
+    ] = 200.0,
     as_json: JsonOpt = False,
 ) -> None:
     """Simulate, fit, validate, compensate and export a ring-laser gyro model; write a report.
 
-    With ``--imu``: the same for a six-channel MEMS IMU, into one calibration file.
+    With ``--imu``: the same for a six-channel MEMS IMU, into one calibration file.  With
+    ``--station``: record a simulated chamber and serial IMU through the test station first.
     """
+    if imu and station:
+        from thermocal.errors import ThermocalInputError
+
+        raise ThermocalInputError("--imu and --station are two demos: give one")
     if imu and output == Path("thermocal-demo"):
         output = Path("thermocal-imu-demo")
+    if station and output == Path("thermocal-demo"):
+        output = Path("thermocal-station-demo")
     check_outputs([], [], dirs=[output])  # no FIFO, device, /proc… (the demo reads no file)
     if output.exists() and not output.is_dir():
         from thermocal.errors import ThermocalInputError
@@ -63,6 +82,9 @@ def demo_cmd(
         raise ThermocalInputError(f"{output}: exists and is not a directory")
     if imu:
         _imu_demo(output, seed, quick, as_json)
+        return
+    if station:
+        _station_demo(output, time_scale, as_json)
         return
     with progress("thermocal demo", total=len(_demo.DEMO_STEPS)) as advance:
         res = _demo.run_demo(output, seed=seed, config=_demo.QUICK if quick else None,
@@ -173,3 +195,20 @@ def _imu_demo(output: Path, seed: int, quick: bool, as_json: bool) -> None:
         stdout.print(f"report: [bold]{_markup.escape(str(res.report_path))}[/bold]", markup=True)
 
     emit(out, as_json, human)
+
+
+def _station_demo(output: Path, time_scale: float, as_json: bool) -> None:
+    """:func:`thermocal.demo.station.run_demo`: the fitted thermal slope against the
+    simulated sensor's."""
+    from thermocal.demo.station import run_demo
+
+    res = run_demo(output, time_scale)
+
+    def human() -> None:
+        stdout.print(
+            f"fitted thermal slope {res['slope_deg_s_per_c']:.6f} deg/s/°C, simulated "
+            f"{res['truth_deg_s_per_c']:.6f} deg/s/°C; everything in "
+            f"{_markup.escape(str(res['out_dir']))}"
+        )
+
+    emit(dict(res), as_json, human)

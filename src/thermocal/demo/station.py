@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 import sys
 from pathlib import Path
 
@@ -65,6 +66,8 @@ def run_demo(out: Path, time_scale: float = 200.0) -> dict[str, object]:
     )
     from thermocal.writers import write_program
 
+    if not (math.isfinite(time_scale) and time_scale > 0):
+        raise ThermocalInputError(f"--time-scale must be a number > 0, got {time_scale}")
     if out.exists() and any(out.iterdir()):
         raise ThermocalInputError(f"{out}: exists and is not empty")
     out.mkdir(parents=True, exist_ok=True)

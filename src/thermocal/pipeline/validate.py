@@ -18,7 +18,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from thermocal.errors import ThermocalInputError, UnitWarning
+from thermocal.errors import FileFormatError, ThermocalInputError, UnitWarning
 from thermocal.pipeline.options import ValidateOptions
 from thermocal.pipeline.reading import load_recording, split_names, text_options
 from thermocal.readers.common import file_kind
@@ -141,13 +141,22 @@ def _modeling_ambient(
             require_signal=False,
             check=False,
             text=ctx.text,
-            topic=o.topic if file_kind(mod_path) in ("ulog", "dataflash") else None,
+            topic=o.topic if _is_log(mod_path) else None,
         )
         for prob in recording.find_problems(mrec, required=[amb]):
             if prob.severity == "error" and (prob.column in (None, "time", amb)):
                 raise ThermocalInputError(f"{mod_path}: {prob.message}")
         ctx.modeling[mod_path] = mrec
     return mod_path, (mrec.time_s, ambient_c(mrec, amb))
+
+
+def _is_log(path: Path) -> bool:
+    """A flight-controller log (``.ulg``, ``.bin``), which ``--topic`` applies to; a station
+    folder, a CSV or Parquet file is not (and a name no reader accepts is said by the reader)."""
+    try:
+        return file_kind(path) in ("ulog", "dataflash")
+    except FileFormatError:
+        return False
 
 
 def _validate_channel(
