@@ -30,36 +30,42 @@ def _pct(value: float | None) -> str:
     return "—" if value is None else f"{value:+.1f} %"
 
 
+OutputOpt = Annotated[
+    Path, typer.Option("-o", "--output", help="Directory for the report, models and C files.")
+]
+SeedOpt = Annotated[int, typer.Option("--seed", help="Seed of the simulated data.")]
+QuickOpt = Annotated[bool, typer.Option("--quick", help="Smaller data (5 s samples, fewer ramps).")]
+ImuOpt = Annotated[
+    bool,
+    typer.Option(
+        "--imu",
+        help="The six-channel MEMS IMU workflow (gx..az, one die temperature) "
+        "into one calibration, one C module and one report.",
+    ),
+]
+StationOpt = Annotated[
+    bool,
+    typer.Option(
+        "--station",
+        help="The test station: a simulated chamber (Modbus TCP server) and serial IMU "
+        "(pseudo-terminal) driven by the station, then fit, validate and export-c "
+        "(needs thermocal[station]).",
+    ),
+]
+TimeScaleOpt = Annotated[
+    float, typer.Option("--time-scale", help="--station: run the programs K times faster.")
+]
+
+
 @app.command("demo")
 @handle_errors
 def demo_cmd(
-    output: Annotated[
-        Path, typer.Option("-o", "--output", help="Directory for the report, models and C files.")
-    ] = Path("thermocal-demo"),
-    seed: Annotated[int, typer.Option("--seed", help="Seed of the simulated data.")] = 1,
-    quick: Annotated[
-        bool, typer.Option("--quick", help="Smaller data (5 s samples, fewer ramps).")
-    ] = False,
-    imu: Annotated[
-        bool,
-        typer.Option(
-            "--imu",
-            help="The six-channel MEMS IMU workflow (gx..az, one die temperature) "
-            "into one calibration, one C module and one report.",
-        ),
-    ] = False,
-    station: Annotated[
-        bool,
-        typer.Option(
-            "--station",
-            help="The test station: a simulated chamber (Modbus TCP server) and serial IMU "
-            "(pseudo-terminal) driven by the station, then fit, validate and export-c "
-            "(needs thermocal[station]).",
-        ),
-    ] = False,
-    time_scale: Annotated[
-        float, typer.Option("--time-scale", help="--station: run the programs K times faster.")
-    ] = 200.0,
+    output: OutputOpt = Path("thermocal-demo"),
+    seed: SeedOpt = 1,
+    quick: QuickOpt = False,
+    imu: ImuOpt = False,
+    station: StationOpt = False,
+    time_scale: TimeScaleOpt = 200.0,
     as_json: JsonOpt = False,
 ) -> None:
     """Simulate, fit, validate, compensate and export a ring-laser gyro model; write a report.
@@ -86,6 +92,11 @@ def demo_cmd(
     if station:
         _station_demo(output, time_scale, as_json)
         return
+    _chamber_demo(output, seed, quick, as_json)
+
+
+def _chamber_demo(output: Path, seed: int, quick: bool, as_json: bool) -> None:
+    """:func:`thermocal.demo.chamber.run_demo` with a progress bar, then its summary."""
     with progress("thermocal demo", total=len(_demo.DEMO_STEPS)) as advance:
         res = _demo.run_demo(output, seed=seed, config=_demo.QUICK if quick else None,
                        progress=lambda _step: advance(1))  # fmt: skip
