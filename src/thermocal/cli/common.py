@@ -11,7 +11,6 @@ INTERFACE.md common rules implemented here:
 
 from __future__ import annotations
 
-import errno
 import functools
 import json
 import math
@@ -27,10 +26,10 @@ import typer
 
 from thermocal._lazy import LazyModule
 from thermocal.cli.interrupt import report_interrupted
-from thermocal.errors import ThermocalInputError, ThermocalWarning
+from thermocal.errors import ThermocalWarning
+from thermocal.pipeline.messages import error_text, warning_lines
 from thermocal.pipeline.messages import jsonable as jsonable
 from thermocal.pipeline.messages import one_line as one_line
-from thermocal.pipeline.messages import warning_lines
 from thermocal.pipeline.reading import load_recording as load_recording
 from thermocal.pipeline.reading import split_floats as split_floats
 from thermocal.pipeline.reading import split_names as split_names
@@ -201,24 +200,6 @@ def parse_temp_conversion(text: str) -> units.TemperatureConversion:
 # --- errors ----------------------------------------------------------------------------
 
 
-USER_OS_ERRORS: frozenset[int] = frozenset(
-    {
-        errno.EACCES,
-        errno.EPERM,
-        errno.EROFS,
-        errno.ENOSPC,
-        errno.EDQUOT,
-        errno.ENAMETOOLONG,
-        errno.ENOTDIR,
-        errno.EISDIR,
-        errno.ENOENT,
-        errno.EEXIST,
-        errno.EMFILE,
-    }
-)
-"""OS errors a user causes (exit 2 with ``error:``), as opposed to bugs (exit 1)."""
-
-
 def handle_errors(fn: Callable[P, R]) -> Callable[P, R]:
     """Map exceptions to INTERFACE.md exit statuses.
 
@@ -240,24 +221,13 @@ def handle_errors(fn: Callable[P, R]) -> Callable[P, R]:
             except KeyboardInterrupt:
                 _show_warnings(caught)
                 raise typer.Exit(report_interrupted()) from None
-            except (ThermocalInputError, FileNotFoundError, IsADirectoryError) as exc:
+            except Exception as exc:  # the mapping the fleet uses too (error_text)
                 _show_warnings(caught)
-                print(f"error: {one_line(str(exc))}", file=sys.stderr)
-                raise typer.Exit(2) from None
-            except Exception as exc:
-                _show_warnings(caught)
-                if isinstance(exc, OSError) and exc.errno in USER_OS_ERRORS:
-                    # the user's environment, not a bug: permissions, a full disk, ...
-                    where = exc.filename if exc.filename is not None else "output"
-                    print(f"error: {where}: {exc.strerror or one_line(str(exc))}", file=sys.stderr)
-                    raise typer.Exit(2) from None
-                if os.environ.get("THERMOCAL_DEBUG"):
+                text, users = error_text(exc)
+                if not users and os.environ.get("THERMOCAL_DEBUG"):
                     raise
-                print(
-                    f"error: internal: {type(exc).__name__}: {one_line(str(exc))}",
-                    file=sys.stderr,
-                )
-                raise typer.Exit(1) from None
+                print(f"error: {text}", file=sys.stderr)
+                raise typer.Exit(2 if users else 1) from None
         _show_warnings(caught)
         return result
 
