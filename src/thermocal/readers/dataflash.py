@@ -28,14 +28,8 @@ from thermocal.readers.common import (
 
 if TYPE_CHECKING:
     import pandas as pd
-    import pyarrow as pa
-    import pyarrow.csv as pacsv
-    import pyarrow.parquet as pq
 else:
     pd = LazyModule("pandas")
-    pa = LazyModule("pyarrow")
-    pacsv = LazyModule("pyarrow.csv")
-    pq = LazyModule("pyarrow.parquet")
 
 
 # --- ArduPilot DataFlash --------------------------------------------------------------------

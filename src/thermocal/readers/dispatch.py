@@ -40,12 +40,10 @@ from thermocal.recording import META_FORMAT, META_KEY, META_VERSION, FloatArray,
 if TYPE_CHECKING:
     import pandas as pd
     import pyarrow as pa
-    import pyarrow.csv as pacsv
     import pyarrow.parquet as pq
 else:
     pd = LazyModule("pandas")
     pa = LazyModule("pyarrow")
-    pacsv = LazyModule("pyarrow.csv")
     pq = LazyModule("pyarrow.parquet")
 
 

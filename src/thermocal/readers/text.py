@@ -23,14 +23,8 @@ from thermocal.readers.table import ParquetColumns
 
 if TYPE_CHECKING:
     import pandas as pd
-    import pyarrow as pa
-    import pyarrow.csv as pacsv
-    import pyarrow.parquet as pq
 else:
     pd = LazyModule("pandas")
-    pa = LazyModule("pyarrow")
-    pacsv = LazyModule("pyarrow.csv")
-    pq = LazyModule("pyarrow.parquet")
 
 
 # --- text logs (serial terminals, spreadsheets of other locales) ----------------------------

@@ -31,14 +31,8 @@ from thermocal.recording import FloatArray
 
 if TYPE_CHECKING:
     import pandas as pd
-    import pyarrow as pa
-    import pyarrow.csv as pacsv
-    import pyarrow.parquet as pq
 else:
     pd = LazyModule("pandas")
-    pa = LazyModule("pyarrow")
-    pacsv = LazyModule("pyarrow.csv")
-    pq = LazyModule("pyarrow.parquet")
 
 
 # --- PX4 ULog ------------------------------------------------------------------------------
