@@ -17,8 +17,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from thermocal import units
-from thermocal.errors import FileFormatError, GapWarning, ThermocalInputError, ThermocalWarning
+from thermocal.errors import FileFormatError, ThermocalInputError, ThermocalWarning
+from thermocal.pipeline.reading import split_names
 
 if TYPE_CHECKING:
     from contextlib import AbstractContextManager
@@ -76,11 +76,6 @@ class ReadOptions:
     topic: str | None = None
 
 
-def _names(text: str | None) -> list[str] | None:
-    """``"a, b"`` → ``["a", "b"]``; None stays None."""
-    return None if text is None else [t.strip() for t in text.split(",") if t.strip()]
-
-
 def read_run(
     path: Path, signals: str, temps: Sequence[str], model_inputs: dict[str, Any], opts: ReadOptions
 ) -> Recording:
@@ -90,43 +85,21 @@ def read_run(
     (:func:`thermocal.units.resolve_inputs`); the sensor id compared with the model's; a
     signal required; time finite and increasing, no NaN (:meth:`Recording.validate`),
     gaps reported in one :class:`GapWarning`."""
-    from thermocal.models.base import check_sensor_id
-    from thermocal.readers.dispatch import read_recording
+    from thermocal.pipeline.reading import load_recording
 
-    conv = opts.temp_conversion
-    rec = read_recording(
+    return load_recording(
         path,
         time=opts.time,
         time_unit=opts.time_unit,
-        signals=_names(signals) if signals else None,
-        temperatures=_names(",".join(temps)) if temps else None,
+        signal=signals or None,
+        temps=",".join(temps) if temps else None,
         signal_unit=opts.signal_unit,
         temp_unit=opts.temp_unit,
-        temp_conversion=(
-            units.temperature_conversion(conv, "--temp-conversion") if conv is not None else None
-        ),
-        model=units.StatedUnits.from_model_inputs(model_inputs),
+        temp_conversion=opts.temp_conversion,
+        model_inputs=model_inputs,
         text=opts.text,
         topic=opts.topic,
     )
-    check_sensor_id(model_inputs, rec.meta.sensor_id, str(path))
-    if not rec.signals:
-        raise ThermocalInputError(
-            f"{path}: name the signal column with --signal; available: "
-            + ", ".join(repr(c) for c in rec.columns)
-        )
-    rec.validate()
-    gaps = rec.gaps()
-    if gaps:
-        total = sum(g.length_s for g in gaps)
-        warnings.warn(
-            GapWarning(
-                f"{path}: {len(gaps)} gaps in time ({total:.6g} s in all), first after "
-                f"row {gaps[0].index} at {gaps[0].start_s:.6g} s"
-            ),
-            stacklevel=2,
-        )
-    return rec
 
 
 @dataclass(frozen=True)
@@ -187,7 +160,7 @@ def make_report(
     if cal.triads and not cal.channels:  # a turntable calibration over temperature
         return _triad_report(cal, models[0], recording, output, opts, latitude_deg)
     cal.require_channels("report")
-    if len(cal.channels) > 1 or len(_names(signal) or []) > 1:
+    if len(cal.channels) > 1 or len(split_names(signal) or []) > 1:
         if len(models) > 1:
             raise ThermocalInputError(
                 f"{models[0]} is a calibration of {len(cal.channels)} channels: give it as the "
@@ -322,7 +295,7 @@ def _calibration_report(
     from thermocal.models.calibration import merged_inputs, temperatures_of
     from thermocal.report.calibration import CalibrationReportInputs, write_calibration_report
 
-    names = _names(signal) or cal.names
+    names = split_names(signal) or cal.names
     missing = [n for n in names if n not in cal.names]
     if missing:
         raise ThermocalInputError(

@@ -31,7 +31,7 @@ import numpy as np
 import numpy.typing as npt
 
 from thermocal import adequacy, units
-from thermocal.errors import GapWarning, ThermocalInputError, ThermocalWarning
+from thermocal.errors import ThermocalInputError, ThermocalWarning
 from thermocal.models.base import RunData, model_inputs
 from thermocal.models.calibration import Calibration, Channel
 from thermocal.models.poly import PolyModel
@@ -238,21 +238,9 @@ def read_sensor_topic(log: Path, topic: str) -> Recording:
     """One ULog topic instance (``NAME.N``) as a recording of x, y, z and ``temperature``
     (:func:`thermocal.readers.read_recording`), checked (finite, increasing time) and its
     gaps stated in one :class:`GapWarning`."""
-    from thermocal.readers.dispatch import read_recording
+    from thermocal.pipeline.reading import load_recording
 
-    rec = read_recording(log, signals=["x", "y", "z"], temperatures=["temperature"], topic=topic)
-    rec.validate()
-    gaps = rec.gaps()
-    if gaps:
-        total = sum(g.length_s for g in gaps)
-        warnings.warn(
-            GapWarning(
-                f"{log}: {len(gaps)} gaps in time ({total:.6g} s in all), first after "
-                f"row {gaps[0].index} at {gaps[0].start_s:.6g} s"
-            ),
-            stacklevel=2,
-        )
-    return rec
+    return load_recording(log, signal="x,y,z", temps="temperature", topic=topic)
 
 
 # --- the output set ------------------------------------------------------------------------
