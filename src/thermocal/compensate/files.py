@@ -87,7 +87,7 @@ from thermocal.models.base import (
 from thermocal.outputs import sidecar_path
 from thermocal.readers.common import csv_encoding, csv_float_options, default_time_column, file_kind
 from thermocal.readers.dispatch import read_log_table, read_recording, read_text_table
-from thermocal.readers.table import numeric_column
+from thermocal.readers.table import load_sidecar, numeric_column
 from thermocal.readers.text import TextOptions, csv_chunk_options
 from thermocal.recording import (
     ABSOLUTE_ZERO_C,
@@ -277,15 +277,7 @@ def _file_info(
             msg = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
             raise FileFormatError(f"{path}: not a readable CSV file ({msg})") from None
         names = [str(c).strip() for c in head.columns]
-    side = sidecar_path(path)
-    if side.exists():
-        try:
-            obj = json.loads(side.read_text(encoding="utf-8"))
-        except (json.JSONDecodeError, UnicodeDecodeError) as exc:
-            raise FileFormatError(f"{side}: not valid JSON ({exc})") from None
-        if not isinstance(obj, dict):
-            raise FileFormatError(f"{side}: expected a JSON object")
-        meta = {**meta, **obj}
+    meta = {**meta, **load_sidecar(path)}
     return names, meta, n_rows
 
 
