@@ -76,6 +76,7 @@ from thermocal.fleet.stats import (
 )
 from thermocal.pipeline.messages import error_text, json_text, jsonable, warning_lines
 from thermocal.pipeline.options import FitOptions, ValidateOptions
+from thermocal.readers.common import sha256_of
 
 if TYPE_CHECKING:
     from multiprocessing.context import BaseContext
@@ -326,19 +327,6 @@ def read_unit(out_dir: Path, uid: str) -> dict[str, Any] | None:
 # --- what a unit depends on, and whether its folder is still right --------------------------
 
 
-def file_sha256(path: str | Path) -> str | None:
-    """SHA-256 of a file's content; None when it cannot be read (missing: the unit fails
-    and is retried)."""
-    h = hashlib.sha256()
-    try:
-        with open(path, "rb") as fh:
-            while block := fh.read(1 << 20):
-                h.update(block)
-    except OSError:
-        return None
-    return h.hexdigest()
-
-
 def unit_input_paths(u: UnitSpec) -> list[str]:
     """The files a unit reads: its modelling files, its validation file, and the
     ``FILE.meta.json`` sidecar of each where one exists (it sets units and conversions)."""
@@ -355,7 +343,7 @@ def unit_input_paths(u: UnitSpec) -> list[str]:
 
 def unit_inputs(u: UnitSpec) -> dict[str, str | None]:
     """``{path: sha256}`` of :func:`unit_input_paths` (recorded in ``unit.json``)."""
-    return {f: file_sha256(f) for f in unit_input_paths(u)}
+    return {f: sha256_of(f) for f in unit_input_paths(u)}
 
 
 def unit_options(config: FleetConfig, u: UnitSpec) -> dict[str, Any]:
@@ -390,7 +378,7 @@ def verify_unit_folder(folder: Path, rec: Mapping[str, Any]) -> list[str]:
         if not isinstance(name, str) or "/" in name or name.startswith("."):
             problems.append(f"unit.json lists a file {name!r} outside its folder")
             continue
-        got = file_sha256(folder / name)
+        got = sha256_of(folder / name)
         if got is None:
             problems.append(f"{name} is missing")
         elif got != digest:

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import contextlib
 import functools
+import hashlib
 import io
 import math
 import os
@@ -383,3 +384,18 @@ def parse_topic(topic: str | None, default: str = DEFAULT_ULOG_TOPIC) -> tuple[s
             f"--topic must be NAME or NAME.N (e.g. sensor_gyro.0), got {text!r}"
         )
     return name, int(inst or 0)
+
+
+def sha256_of(path: str | Path) -> str | None:
+    """SHA-256 of a file's content, read in 1 MiB blocks; None when it cannot be read (a
+    report states it unknown; the fleet redoes a unit whose input is missing).  A model
+    file's provenance uses :func:`thermocal.models.files.file_sha256`, which also reads a
+    station folder and lets a read error through."""
+    h = hashlib.sha256()
+    try:
+        with open(path, "rb") as fh:
+            while block := fh.read(1 << 20):
+                h.update(block)
+    except OSError:
+        return None
+    return h.hexdigest()

@@ -25,7 +25,6 @@ from __future__ import annotations
 
 import base64
 import datetime as _dt
-import hashlib
 import math
 import re
 import warnings
@@ -42,6 +41,7 @@ from thermocal.defaults import DEFAULT_AVERAGING_S, WEAK_CORRELATION_LIMIT
 from thermocal.errors import ThermocalInputError, ThermocalWarning
 from thermocal.metrics import data_unit_of
 from thermocal.models.base import condition_wording
+from thermocal.readers.common import sha256_of
 from thermocal.recording import Recording
 from thermocal.report.analysis import (
     NOISE_TERMS as NOISE_TERMS,
@@ -219,18 +219,6 @@ def unit_label(unit: str) -> str:
 
 
 # --- provenance ------------------------------------------------------------------------------
-
-
-def sha256_of(path: str | Path) -> str | None:
-    """SHA-256 of a file, or None if it cannot be read."""
-    h = hashlib.sha256()
-    try:
-        with open(path, "rb") as fh:
-            while block := fh.read(1 << 20):
-                h.update(block)
-    except OSError:
-        return None
-    return h.hexdigest()
 
 
 GAP_SHARE_WARN = 0.10

@@ -37,6 +37,7 @@ from thermocal.defaults import DEFAULT_AVERAGING_S
 from thermocal.errors import ThermocalInputError
 from thermocal.models.base import model_file_dict
 from thermocal.models.calibration import Calibration
+from thermocal.readers.common import sha256_of
 from thermocal.recording import Recording
 from thermocal.report.analysis import allan_of, apply_model, figures_of_merit
 from thermocal.report.build import (
@@ -47,7 +48,6 @@ from thermocal.report.build import (
     _range_rows,
     adequacy_rows,
     improvement_pct,
-    sha256_of,
     unit_label,
 )
 from thermocal.writers import atomic_write

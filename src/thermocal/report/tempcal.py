@@ -122,7 +122,8 @@ def build_offset_report(req: OffsetReportRequest) -> str:
     import datetime as _dt
 
     from thermocal import __version__
-    from thermocal.report.build import _env, sha256_of
+    from thermocal.readers.common import sha256_of
+    from thermocal.report.build import _env
 
     f = req.fit
 
