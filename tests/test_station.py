@@ -308,7 +308,7 @@ def test_two_sensors_each_read_as_a_recording(
     finally:
         sen2.stop()
     assert main(["inspect", str(out)]) == 2
-    assert "name one as" in capsys.readouterr().err
+    assert "name one with --sensor ID" in capsys.readouterr().err
     for sid, s in (("a", sen), ("b", sen2)):
         assert main(["inspect", str(out / sid), "--json"]) == 0
         info = json.loads(capsys.readouterr().out)

@@ -129,6 +129,22 @@ def _inputs(inputs: Iterable[str | Path]) -> list[_Input]:
     return out
 
 
+_STATION_JSON = "station.json"  # thermocal.readers.station.STATION_JSON (no upward import)
+
+
+def _station_folders(inputs: Iterable[str | Path]) -> list[Path]:
+    """The station recording folders among the inputs (``DIR`` or ``DIR/SENSOR``), resolved:
+    nothing may be written inside one, where a file could become part of the recording."""
+    out = []
+    for given in inputs:
+        p = Path(given)
+        for d in (p, p.parent):
+            if d.is_dir() and (d / _STATION_JSON).is_file():
+                out.append(d.resolve())
+                break
+    return out
+
+
 def _temporaries(target: Path) -> list[Path]:
     """The temporaries of ``target`` (files or staging folders) a later run removes."""
     from thermocal.outputs import TEMP_SUFFIX
@@ -158,6 +174,8 @@ def check_outputs(
         i.inode: i for i in ins if i.inode is not None
     }
 
+    stations = _station_folders(inputs)
+
     def refuse(target: Path, why: str) -> None:
         raise ThermocalInputError(f"{target}: refusing to write {what} there: {why}")
 
@@ -166,6 +184,9 @@ def check_outputs(
         if why is not None:
             refuse(target, why)
         r = target.resolve()
+        inside = next((d for d in stations if r.is_relative_to(d)), None)
+        if inside is not None:
+            refuse(target, f"it is inside the input station recording {inside}")
         hit = next((i for i in ins if i.resolved == r), None)
         link = ""
         if hit is None and target.exists():

@@ -88,7 +88,10 @@ TimeOpt = Annotated[str | None, typer.Option("--time", help="Name of the time co
 TopicOpt = Annotated[
     str | None,
     typer.Option(
-        "--topic", help="PX4 ULog (.ulg): the topic instance, NAME[.N] (default sensor_gyro.0)."
+        "--topic",
+        "--sensor",
+        help="Flight-controller log: the message/topic instance, NAME[.N] (default "
+        "sensor_gyro.0 for a .ulg); station recording folder: the sensor's ID.",
     ),
 ]
 NamesOpt = Annotated[

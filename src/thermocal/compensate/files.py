@@ -87,6 +87,7 @@ from thermocal.models.base import (
 from thermocal.outputs import sidecar_path
 from thermocal.readers.common import csv_encoding, csv_float_options, default_time_column, file_kind
 from thermocal.readers.dispatch import read_log_table, read_recording, read_text_table
+from thermocal.readers.station import is_station_path, station_files, with_sensor
 from thermocal.readers.table import load_sidecar, numeric_column
 from thermocal.readers.text import TextOptions, csv_chunk_options
 from thermocal.recording import (
@@ -249,6 +250,8 @@ def _file_info(
     (``table``: a text log already read whole, with its metadata)."""
     if table is not None:
         return [str(c) for c in table.columns], dict(table_info or {}), len(table)
+    if kind == "station":
+        return _station_info(path)
     if not path.exists():
         raise FileFormatError(f"{path}: no such file")
     if path.stat().st_size == 0:
@@ -262,12 +265,7 @@ def _file_info(
             raise FileFormatError(f"{path}: not a readable Parquet file ({exc})") from None
         names = list(pf.schema_arrow.names)
         n_rows = int(pf.metadata.num_rows)
-        raw = (pf.schema_arrow.metadata or {}).get(META_KEY.encode())
-        if raw:
-            try:
-                meta = json.loads(raw.decode("utf-8"))
-            except (json.JSONDecodeError, UnicodeDecodeError):
-                raise FileFormatError(f"{path}: corrupt thermocal metadata") from None
+        meta = _parquet_meta(pf, path)
     else:
         enc = csv_encoding(path)
         opts = csv_chunk_options(path, enc)
@@ -281,6 +279,48 @@ def _file_info(
     return names, meta, n_rows
 
 
+def _parquet_meta(pf: pq.ParquetFile, path: Path) -> dict[str, Any]:
+    """The thermocal metadata object of a Parquet file (empty when it has none)."""
+    raw = (pf.schema_arrow.metadata or {}).get(META_KEY.encode())
+    if not raw:
+        return {}
+    try:
+        meta: dict[str, Any] = json.loads(raw.decode("utf-8"))
+    except (json.JSONDecodeError, UnicodeDecodeError):
+        raise FileFormatError(f"{path}: corrupt thermocal metadata") from None
+    return meta
+
+
+def _station_info(path: Path) -> tuple[list[str], dict[str, Any], int | None]:
+    """Columns, metadata (the last closed part's, as :func:`read_station` reads it) and row
+    count of a station recording ``DIR/SENSOR`` (its closed Parquet parts, in order)."""
+    files = station_files(path)
+    names: list[str] | None = None
+    n_rows, meta = 0, {}
+    for f in files:
+        try:
+            pf = pq.ParquetFile(f)
+        except (pa.ArrowInvalid, OSError) as exc:
+            raise FileFormatError(f"{f}: not a readable Parquet part ({exc})") from None
+        these = list(pf.schema_arrow.names)
+        if names is not None and these != names:
+            raise FileFormatError(f"{f}: columns {these} differ from the first part's {names}")
+        names = these
+        n_rows += int(pf.metadata.num_rows)
+        meta = _parquet_meta(pf, f)
+    return names or [], meta, n_rows
+
+
+def _input_kind(src: Path, topic: str | None) -> tuple[Path, str, str | None]:
+    """``(path, kind, topic)`` of an input: a station recording folder (``DIR``, ``DIR/ID``,
+    or ``DIR`` with ``--sensor ID``) is read part after part as kind ``"station"`` (its path
+    ``DIR/ID``; INTERFACE.md: every command reads DIR as one recording); any other file by
+    its extension, with ``topic`` for a flight-controller log."""
+    if is_station_path(src):
+        return with_sensor(src, topic), "station", None
+    return src, file_kind(src), topic
+
+
 def _iter_chunks(
     path: Path, kind: str, chunk_rows: int, table: pd.DataFrame | None = None
 ) -> Iterator[pd.DataFrame | pa.RecordBatch]:
@@ -290,6 +330,10 @@ def _iter_chunks(
     if table is not None:
         for a in range(0, len(table), chunk_rows):
             yield table.iloc[a : a + chunk_rows].reset_index(drop=True)
+        return
+    if kind == "station":  # the closed parts in order, each in chunks (constant memory)
+        for f in station_files(path):
+            yield from _iter_chunks(f, "parquet", chunk_rows)
         return
     if kind == "parquet":
         try:
@@ -555,9 +599,8 @@ def compensate_channels(
     :func:`compensate_file` for the rules of one channel). ``signal_unit`` is one unit
     for all or one per channel (``"deg/s,deg/s,deg/s,mg,mg,mg"``).
     """
-    src = Path(path)
+    src, kind_in, topic = _input_kind(Path(path), topic)
     dst = Path(out)
-    kind_in = file_kind(src)
     kind_out = file_kind(dst)
     check_not_input(dst, [src])
     _check_chunk_rows(chunk_rows)
@@ -1065,6 +1108,7 @@ def compensate_triads(
     time: str | None = None,
     time_unit: str | None = None,
     chunk_rows: int = DEFAULT_CHUNK_ROWS,
+    topic: str | None = None,
 ) -> list[TriadCompensation]:
     """Apply triad calibrations (issue 19) to a recording: for each triad and each of its
     axes a column ``<col>_comp = [(I + E(T))⁻¹ (x − b(T))]_axis`` in the column's own unit,
@@ -1078,11 +1122,12 @@ def compensate_triads(
     metadata > a unit in the column name > the unit the triad was calibrated on
     (:func:`thermocal.units.resolve_inputs`).
     """
-    src, dst = Path(path), Path(out)
-    kind_in, kind_out = file_kind(src), file_kind(dst)
+    src, kind_in, topic = _input_kind(Path(path), topic)
+    dst = Path(out)
+    kind_out = file_kind(dst)
     check_not_input(dst, [src])
     _check_chunk_rows(chunk_rows)
-    source = _open_source(src, kind_in, time, None, None)
+    source = _open_source(src, kind_in, time, None, topic)
     plans = [_triad_plan(tri, source.names, source.available, src) for tri in triads]
     resolved = _resolve_triads(source, plans, time_unit)
     out_info = _triad_output_info(source.info, source.time_col, resolved, plans)
@@ -1379,8 +1424,9 @@ def compensate_calibration_file(
                 "applied yet; split it"
             )
         done = compensate_triads(
-            cal.triads, path, out, time=time, time_unit=time_unit, chunk_rows=chunk_rows
-        )
+            cal.triads, path, out, time=time, time_unit=time_unit, chunk_rows=chunk_rows,
+            topic=topic,
+        )  # fmt: skip
         return CalibrationCompensation(str(model_file), str(out), "triads", tuple(done))
     common: dict[str, Any] = dict(
         time=time, time_unit=time_unit, signal_unit=signal_unit, temp_unit=temp_unit,

@@ -36,6 +36,7 @@ from thermocal.errors import ConditioningWarning, ThermocalInputError
 from thermocal.pipeline.messages import one_line
 from thermocal.pipeline.options import FitOptions
 from thermocal.pipeline.reading import load_recording, split_floats, split_names, text_options
+from thermocal.readers.station import station_sensor_paths
 
 if TYPE_CHECKING:
     import thermocal.adequacy as _adequacy
@@ -578,7 +579,7 @@ def fit_files(paths: Sequence[Path], options: FitOptions, output: Path) -> FitRe
                 topic=o.topic,
             ),
         )
-        for path in paths
+        for path in station_sensor_paths(paths, o.topic)
     ]
     if o.tref is not None and o.model != "poly":
         raise ThermocalInputError(

@@ -31,7 +31,7 @@ from thermocal.readers.common import (
     short_name,
 )
 from thermocal.readers.dataflash import read_dataflash
-from thermocal.readers.station import is_station_path, read_station_table
+from thermocal.readers.station import is_station_path, read_station_table, with_sensor
 from thermocal.readers.table import ParquetColumns, csv_header_names, load_sidecar, numeric_column
 from thermocal.readers.text import TextOptions, head_lines, rate_time, read_text, sniff_text
 from thermocal.readers.ulog import read_ulog
@@ -179,9 +179,16 @@ def _open_table(
     folder (``DIR`` or ``DIR/SENSOR``), and what the file and its sidecar say of it."""
     station = is_station_path(p)  # a station's recording folder, DIR or DIR/SENSOR
     kind = "station" if station else file_kind(p)
-    if topic is not None and kind not in ("ulog", "dataflash"):
-        raise ThermocalInputError(f"{p}: --topic is for flight-controller logs (.ulg, .bin)")
-    obj, file_meta = read_station_table(p) if station else read_table(p, kind, text, topic)
+    if topic is not None and kind not in ("ulog", "dataflash", "station"):
+        raise ThermocalInputError(
+            f"{p}: --topic/--sensor is for flight-controller logs (.ulg, .bin) and station "
+            "recordings"
+        )
+    obj: pd.DataFrame | ParquetColumns
+    if station:  # --sensor ID (the same option as --topic) picks DIR/ID
+        obj, file_meta = read_station_table(with_sensor(p, topic))
+    else:
+        obj, file_meta = read_table(p, kind, text, topic)
     side = load_sidecar(p)
     info: dict[str, Any] = {**file_meta, **side}
     return obj, info

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import json
 import re
+from collections.abc import Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -70,7 +71,7 @@ def _stream_of(path: Path) -> tuple[Path, str]:
         if len(ids) != 1:
             raise FileFormatError(
                 f"{path}: a station recording of {len(ids)} sensors ({', '.join(ids)}); "
-                f"name one as {path}/ID (or {path}/{CHAMBER_STREAM})"
+                f"name one with --sensor ID or as {path}/ID (or {path}/{CHAMBER_STREAM})"
             )
         return path, ids[0]
     doc = read_station_json(path.parent)
@@ -81,6 +82,34 @@ def _stream_of(path: Path) -> tuple[Path, str]:
             f"{', '.join([*ids, CHAMBER_STREAM])}"
         )
     return path.parent, path.name
+
+
+def with_sensor(path: Path, sensor: str | None) -> Path:
+    """``DIR/SENSOR`` for ``--sensor SENSOR`` (INTERFACE.md, test station: "every command reads
+    DIR as one recording, --sensor ID when there are several").  ``path`` is ``DIR`` or
+    ``DIR/ID``; without ``sensor`` it is returned as it is.  A sensor the recording does not
+    have, or ``DIR/A`` with ``--sensor B``, is a :class:`FileFormatError` naming the sensors."""
+    if sensor is None:
+        return path
+    if not path.is_dir():
+        if path.name != sensor:
+            raise FileFormatError(
+                f"{path}: names sensor {path.name!r} and --sensor names {sensor!r}; give one"
+            )
+        return path
+    ids = sensor_ids(read_station_json(path))
+    if sensor not in (*ids, CHAMBER_STREAM):
+        raise FileFormatError(
+            f"{path}: no sensor {sensor!r} in this station recording; sensors: "
+            f"{', '.join([*ids, CHAMBER_STREAM])}"
+        )
+    return path / sensor
+
+
+def station_sensor_paths(paths: Sequence[Path], sensor: str | None) -> list[Path]:
+    """``paths`` with every station folder given as ``DIR`` turned into ``DIR/SENSOR``
+    (:func:`with_sensor`): what provenance records and hashes.  Other files are unchanged."""
+    return [with_sensor(p, sensor) if is_station_path(p) else p for p in paths]
 
 
 def station_files(path: Path) -> list[Path]:
@@ -133,4 +162,6 @@ __all__ = [
     "read_station_table",
     "sensor_ids",
     "station_files",
+    "station_sensor_paths",
+    "with_sensor",
 ]
