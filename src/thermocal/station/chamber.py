@@ -6,7 +6,8 @@ set-point, one holding or input register for the temperature, a scale in °C per
 16-bit signed or unsigned counts).  ``none`` is a chamber run by hand: each new set-point is
 shown to the operator and the chamber's temperature is unknown (NaN).
 
-No presets: the register maps of commercial controllers (Watlow F4, ESPEC, Vötsch/Weiss)
+Presets (:mod:`thermocal.station.presets`) hold the maps read in makers' manuals; the maps of
+other controllers (Watlow F4, ESPEC, Vötsch/Weiss)
 depend on the controller's firmware and configured decimal places; a map copied from memory
 would write set-points to the wrong register.  Give the map from your controller's manual
 in ``STATION.toml``.

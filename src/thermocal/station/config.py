@@ -17,6 +17,8 @@ Example::
     signed = true                    # 16-bit two's complement
     poll_s = 1                       # [s]
     safe_setpoint_c = 25             # written on stop, error or Ctrl-C [°C]
+    # or, for a controller whose manual gives the map (thermocal.station.presets):
+    # preset = "eurotherm-2000"      # sets the registers, their kind and sign; give scale
 
     [[sensor]]
     id = "imu1"
@@ -61,6 +63,7 @@ class ChamberConfig:
     """The ``[chamber]`` table.  Temperatures [°C], times [s]."""
 
     driver: str = "none"
+    preset: str = ""
     host: str = "127.0.0.1"
     port: int = 502
     device: str = ""
@@ -148,12 +151,42 @@ def _positive(v: float, key: str, where: str) -> float:
     return v
 
 
+def _with_preset(t: dict[str, Any], w: str) -> dict[str, Any]:
+    """``[chamber]`` with a controller preset's register map filled in
+    (:mod:`thermocal.station.presets`): a map key given beside the preset must agree with
+    it, and ``scale`` must be given (the controller's configured resolution)."""
+    if "preset" not in t:
+        return t
+    from thermocal.station.presets import MAP_KEYS, PRESETS
+
+    name = _take(t, "preset", str, w, "")
+    preset = PRESETS.get(name)
+    if preset is None:
+        raise _err(w, f"unknown preset {name!r}; known: {', '.join(sorted(PRESETS))}")
+    filled = dict(t)
+    for key in MAP_KEYS:
+        value = getattr(preset, key)
+        if key in t and t[key] != value:
+            raise _err(
+                w, f"{key} = {t[key]!r} disagrees with preset {name!r} ({key} = {value!r}, "
+                f"from {preset.source}); remove one of them"
+            )  # fmt: skip
+        filled[key] = value
+    if "scale" not in t:
+        raise _err(
+            w, f"preset {name!r} needs scale: the controller sends temperatures at the "
+            "resolution configured on its display (0.1 for one decimal place, 1 for none)"
+        )  # fmt: skip
+    return filled
+
+
 def _chamber(t: dict[str, Any], where: str) -> ChamberConfig:
     w = f"{where} [chamber]"
     known = set(ChamberConfig.__dataclass_fields__)
     unknown = sorted(set(t) - known)
     if unknown:
         raise _err(w, f"unknown key {unknown[0]!r}; known: {', '.join(sorted(known))}")
+    t = _with_preset(t, w)
     d = ChamberConfig()
     driver = _take(t, "driver", str, w, d.driver)
     if driver not in DRIVERS:
@@ -163,6 +196,7 @@ def _chamber(t: dict[str, Any], where: str) -> ChamberConfig:
         raise _err(w, f"register_kind must be holding or input, got {kind!r}")
     c = ChamberConfig(
         driver=driver,
+        preset=_take(t, "preset", str, w, d.preset),
         host=_take(t, "host", str, w, d.host),
         port=_take(t, "port", int, w, d.port),
         device=_take(t, "device", str, w, d.device),

@@ -57,8 +57,9 @@ class ChamberModel:
 
 class SimulatedChamber:
     """A Modbus server (TCP on 127.0.0.1 with an OS-chosen port, or RTU on a serial port)
-    in its own thread, holding the set-point in holding register :data:`SETPOINT_REGISTER`
-    and the temperature in register :data:`TEMPERATURE_REGISTER` (holding and input share
+    in its own thread, holding the set-point in holding register ``setpoint_register``
+    and the temperature in register ``temperature_register`` (defaults
+    :data:`SETPOINT_REGISTER`, :data:`TEMPERATURE_REGISTER`; holding and input share
     one block), ``scale`` °C per count, signed.  ``answer = False`` makes it stop answering
     without closing (requests time out)."""
 
@@ -69,9 +70,11 @@ class SimulatedChamber:
         scale: float = 0.01,
         rtu_port: str | None = None,
         unit: int = 1,
+        setpoint_register: int = SETPOINT_REGISTER,
+        temperature_register: int = TEMPERATURE_REGISTER,
     ) -> None:
         self.model = model or ChamberModel()
-        self.map = RegisterMap(SETPOINT_REGISTER, TEMPERATURE_REGISTER, "holding", scale, True)
+        self.map = RegisterMap(setpoint_register, temperature_register, "holding", scale, True)
         self.rtu_port = rtu_port
         self.unit = unit
         self.port = 0
@@ -101,13 +104,14 @@ class SimulatedChamber:
             await asyncio.sleep(3600)  # silent: the client times out
         now = time.time()
         self.model.advance(now)
-        sp_off = SETPOINT_REGISTER - start_address
-        if set_values and address <= SETPOINT_REGISTER < address + len(set_values):
-            word = int(set_values[SETPOINT_REGISTER - address])
+        sp_reg, t_reg = self.map.setpoint_register, self.map.temperature_register
+        sp_off = sp_reg - start_address
+        if set_values and address <= sp_reg < address + len(set_values):
+            word = int(set_values[sp_reg - address])
             with self.model.lock:
                 self.model.setpoint_c = self.map.decode(word)
                 self.model.writes.append((now, self.model.setpoint_c))
-        registers[TEMPERATURE_REGISTER - start_address] = self.map.encode(self.model.temperature_c)
+        registers[t_reg - start_address] = self.map.encode(self.model.temperature_c)
         if not set_values:
             registers[sp_off] = self.map.encode(self.model.setpoint_c)
         return None
@@ -125,8 +129,8 @@ class SimulatedChamber:
         from pymodbus.simulator import DataType, SimData, SimDevice
 
         values = [0] * N_REGISTERS
-        values[SETPOINT_REGISTER] = self.map.encode(self.model.setpoint_c)
-        values[TEMPERATURE_REGISTER] = self.map.encode(self.model.temperature_c)
+        values[self.map.setpoint_register] = self.map.encode(self.model.setpoint_c)
+        values[self.map.temperature_register] = self.map.encode(self.model.temperature_c)
         device = SimDevice(
             id=self.unit,
             simdata=[SimData(0, values=values, datatype=DataType.REGISTERS)],
