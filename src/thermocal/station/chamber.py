@@ -93,8 +93,9 @@ class ManualChamber:
         return None
 
     def write_setpoint(self, setpoint_c: float) -> None:
+        """The step's goal, shown once per program step (the loop asks no more often)."""
         self._setpoint = setpoint_c
-        self._show(f"set the chamber to {setpoint_c:.2f} °C")
+        self._show(f"operator: set the chamber to {setpoint_c:.2f} °C")
 
     def read_temperature(self) -> float:
         return math.nan

@@ -226,8 +226,11 @@ class _Loop:
         import numpy as np
 
         ch_cfg, rec = self.ch_cfg, self.rec
-        target = _quantize(float(np.interp(p, self.t_prog, self.c_prog)), ch_cfg.scale,
-                           ch_cfg.signed, ch_cfg.driver)  # fmt: skip
+        if ch_cfg.driver == "none":  # by hand: each step's goal once, not every value of a ramp
+            target = float(self.c_prog[min(self.step + 1, len(self.c_prog) - 1)])
+        else:
+            target = _quantize(float(np.interp(p, self.t_prog, self.c_prog)), ch_cfg.scale,
+                               ch_cfg.signed, ch_cfg.driver)  # fmt: skip
         try:
             if target != self.sp:
                 self.chamber.write_setpoint(target)
