@@ -6,7 +6,12 @@ Program time ``p`` [s] runs ``time_scale`` times faster than the host clock:
 ``program_s`` the recording holds (the program continues where the recording ends).  The
 set-point is the program interpolated linearly at ``p`` (``numpy.interp``: steps where the
 program has them, ramps where it ramps), rounded to the register's resolution, and written
-whenever that rounded value changes.
+whenever that rounded value changes (``driver = "none"``: each step's goal, once).
+
+The recording's ``time`` is the sensor's own clock (``rate_hz``) or the host's, never the
+program's: with ``--time-scale K`` a real chamber still heats at its own pace, so rates of
+change in the recording are physical; the program time of every row is its ``program_s``
+column, and the metadata's ``station.time_scale`` says the run was accelerated.
 """
 
 from __future__ import annotations
