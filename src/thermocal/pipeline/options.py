@@ -104,7 +104,10 @@ class ValidateOptions:
     latitude: float | None = None
 
 
-ALIASES: dict[str, dict[str, str]] = {"validate": {"average": "averaging"}}
+ALIASES: dict[str, dict[str, str]] = {
+    "fit": {"sensor": "topic"},
+    "validate": {"average": "averaging", "sensor": "topic"},
+}
 """Second names of an option (``--average`` is ``--averaging``), per command."""
 
 NOT_IN_TABLES = frozenset({"modeling"})
