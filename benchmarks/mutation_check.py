@@ -914,9 +914,9 @@ MUTANTS: tuple[Mutant, ...] = (
     Mutant(
         "multipos-bias-cov-dropped",
         P + "multipos/gyro.py",
-        "cov_p = cov_p + gain @ jb @ bias_cov @ jb.T @ gain.T",
-        "cov_p = cov_p",
-        MULTI,
+        "c_sys = jb @ bias_cov @ jb.T + ga @ accel_free_cov @ ga.T",
+        "c_sys = ga @ accel_free_cov @ ga.T",
+        (*MULTI, "tests/test_multipos_sigma.py"),
         "gyro scale σ without the bias uncertainty",
     ),
     # --- station -----------------------------------------------------------------------------

@@ -108,13 +108,19 @@ class SessionResult:
         ]
 
 
-def _up_function(theta: FloatArray, idx: Sequence[int], f_mg: FloatArray) -> Any:
+def _up_function(
+    theta: FloatArray, idx: Sequence[int], f_mg: FloatArray, held: FloatArray | None = None
+) -> Any:
     """``p ↦`` unit up directions of the poses for the accelerometer parameters ``p`` at
-    ``idx`` of θ (the others held)."""
+    ``idx`` of θ (the others held).  The poses where ``held`` is true keep their direction
+    at ``theta`` whatever ``p``: the faces of the six-face closed form, whose calibrated
+    direction ``(I + Ê)⁻¹(f_j± − b̂) = ±g e_j + (f_j+ + f_j−)/2 − b̂`` (to first order)
+    does not move with the calibration's error (E's column j is made of that very
+    pose's mean): their error is only the direction noise of :func:`_direction_sigma`."""
     base = theta.copy()
     ids = np.asarray(idx)
 
-    def up_of(p: FloatArray) -> FloatArray:
+    def up_at(p: FloatArray) -> FloatArray:
         th = base.copy()
         th[ids] = p
         e = model.error_matrices(th)
@@ -122,7 +128,30 @@ def _up_function(theta: FloatArray, idx: Sequence[int], f_mg: FloatArray) -> Any
         out: FloatArray = c / np.linalg.norm(c, axis=1)[:, None]
         return out
 
+    if held is None or not np.any(held):
+        return up_at
+    u0 = up_at(base[ids])
+
+    def up_of(p: FloatArray) -> FloatArray:
+        out = up_at(p)
+        out[held] = u0[held]
+        return out
+
     return up_of
+
+
+def _direction_sigma(
+    sigma_mg: FloatArray, names: Sequence[str], method: str, g_mg: float
+) -> FloatArray:
+    """Each pose's direction noise [rad] not already in the accelerometer's calibration
+    error (:mod:`.gyro`): ``σ_f/g``, times ``√(1/3)`` for a face of the six-face closed
+    form (its calibrated direction keeps ``(f_j+ + f_j−)/2 − b`` only: variance
+    ``σ²(1/9 + 1/9 + 4/36) = σ²/3``, uncorrelated with ``b`` and E)."""
+    factor = np.array(
+        [math.sqrt(1.0 / 3.0) if method == "six-face" and n in FACES else 1.0 for n in names]
+    )
+    out: FloatArray = np.asarray(sigma_mg) / g_mg * factor
+    return out
 
 
 def calibrate_session(
@@ -188,7 +217,8 @@ def calibrate_session(
         temp = float(np.nanmean(np.concatenate([tc[s.start : s.end] for s in statics])))
     gfit = None
     if w is not None:
-        up_of = _up_function(acc.theta, idx, f)
+        held = np.array([acc.method == "six-face" and n in FACES for n in names])
+        up_of = _up_function(acc.theta, idx, f, held)
         free = acc.theta[np.asarray(idx)]
         free_cov = acc.cov[np.ix_(np.asarray(idx), np.asarray(idx))]
         up = up_of(free)
@@ -210,7 +240,8 @@ def calibrate_session(
             turn_pairs.append((tr, before[-1]))
         gfit = _gyro.fit_rotations(
             w, dt, [p.section for p in stats], up_of, free, free_cov, bias, bias_cov,
-            np.asarray(sig) / g_mg, float(np.sqrt(np.mean(ws**2))), turn_pairs,
+            _direction_sigma(sig, names, acc.method, g_mg), float(np.sqrt(np.mean(ws**2))),
+            turn_pairs, latitude_deg=latitude_deg,
         )  # fmt: skip
     return SessionResult(acc, gfit, tuple(stats), tuple(turns), g_mg, temp, not_still)
 

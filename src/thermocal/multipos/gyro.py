@@ -20,19 +20,34 @@ Gauss–Newton: a perturbation ``δE`` turns the total rotation R by
 ``ε = −Rᵀ Σ_t D(t) δE ω_c(t) τ``, so ``∂r/∂E_ij = [p×] Rᵀ Σ_t D(t) e_i ω_cj(t) τ`` with
 ``p = A_{k+1}ᵀ A_k⁻ᵀ u_k``; the attitude is integrated again at each iteration.
 
-Each motion's residual has, per component, the variance
-``σ_u,k² + σ_u,k+1² + σ_ω² τ T_eff + (Ω T_span)²/3`` (accelerometer direction noise of
-the two pose means, angle random walk over ``T_eff = T_motion + (T_k + T_{k+1})/3``, the
-earth rate not integrated out over the span); the covariance ``(JᵀJ)⁻¹`` of the whitened
-problem (scaled by a significant reduced χ², as :mod:`.accel`) is widened by the
-propagated uncertainties of the gyro bias and of the accelerometer calibration that
+Each motion's residual lies in the plane normal to ``u_{k+1}`` and has there, per
+component, the variance ``c_k σ_u,k² + c_k+1 σ_u,k+1² + σ_ω² τ T_eff + V_Ω``: the
+direction noise of the two pose means (``σ_u = σ_f/g``, the pose mean's noise across
+gravity; ``c = 1`` for a pose the gravity-magnitude fit does not use across gravity,
+``c = 1/3`` for a face of the six-face closed form, whose calibrated direction keeps only
+``(f_j+ + f_j−)/2 − b``, of variance ``σ_f²/3`` and uncorrelated with ``b`` and E: the rest
+of the pose's noise *is* the accelerometer's calibration error, counted once below), the
+angle random walk over ``T_eff = T_motion + (T_k + T_{k+1})/3`` and the earth's turn of
+gravity against inertial space over the span ``T = T_motion + (T_k + T_{k+1})/2``, about
+the north axis whose heading in the board is unknown: ``V_Ω = (Ω cos L T)²/2`` (without
+L, ``(Ω T)²/3``: an earth axis of unknown direction); the vertical earth rate only turns
+the board about gravity and leaves ``u`` alone.  The covariance ``(JᵀJ)⁻¹`` of the
+whitened problem (scaled by a significant reduced χ², as :mod:`.accel`) is widened by
+the propagated uncertainties of the gyro bias and of the accelerometer calibration that
 defines ``u`` (``K G C Gᵀ Kᵀ``, ``K = (JᵀJ)⁻¹Jᵀ``).  Rotations all about one axis leave
 ``E_g``'s other columns unseen: refused.
 
 **360° turns** (Ferraris et al., Sensors and Actuators A 46, 1995,
 doi:10.1016/0924-4247(94)00969-1): a full turn about the vertical adds
-``Σ ω_c τ − 2π s u = 0`` (``u`` the up direction of the pose before it, ``s = ±1`` the
-sense), three linear rows of the same least squares.
+``Σ ω_c τ − (2π s + Ω sin L T) u = 0`` (``u`` the up direction of the pose before it,
+``s = ±1`` the sense, the vertical earth rate over the turn's duration T known from the
+latitude), three linear rows of the same least squares with the 3×3 covariance
+``σ_ω² τ T I + (c (2π σ_u)² + (Ω cos L T ρ)²/2)(I − u uᵀ)``: angle random walk, the
+direction noise of u (across u only) and the horizontal earth rate, which turns with
+the board and integrates to ``Ω cos L T ρ`` in an unknown horizontal direction, with
+``ρ = |mean_t exp(i ψ(t))|`` from the turn's own heading ``ψ(t) = ∫ ω_c·u dt`` (0 for a
+uniform full turn); without L, ``(Ω T)²/3 I`` for the whole earth rate.  The rows are
+whitened by ``C^(−1/2)``.
 """
 
 from __future__ import annotations
@@ -112,8 +127,11 @@ def _direction(u0: FloatArray, a0: FloatArray, a1: FloatArray) -> FloatArray:
     return out
 
 
-_Held = tuple[list[tuple[FloatArray, FloatArray]], list[tuple[FloatArray, float, float]]]
-"""The attitudes at each motion's ends and each turn's (integrated rate, sense, weight)."""
+_Held = tuple[
+    list[tuple[FloatArray, FloatArray]], list[tuple[FloatArray, float, float, FloatArray]]
+]
+"""The attitudes at each motion's ends and each turn's (integrated rate, sense, vertical
+earth-rate angle [rad], whitening matrix)."""
 
 
 def _motions(
@@ -122,12 +140,18 @@ def _motions(
     dt_med: float,
     dir_sigma_rad: FloatArray,
     rate_sigma_rad_s: float,
+    latitude_deg: float | None,
 ) -> list[_Motion]:
     """The motions between consecutive poses not split by a gap in time, each with the
-    variance of its residual per component [rad²]: the two poses' direction noise, the
-    rate noise integrated over ``T_m + (T_k + T_k+1)/3`` and the earth rate's unmodelled
-    turn over ``T_m + (T_k + T_k+1)/2`` (uniform, ``(Ω T)²/3``)."""
+    variance of its residual per component across gravity [rad²] (module docstring): the
+    two poses' direction noise, the rate noise integrated over ``T_m + (T_k + T_k+1)/3``
+    and the earth's turn of gravity over ``T = T_m + (T_k + T_k+1)/2``,
+    ``(Ω cos L T)²/2`` (``(Ω T)²/3`` without L)."""
     om = units.EARTH_RATE_RAD_S
+    if latitude_deg is None:
+        earth_per_s2 = om**2 / 3.0
+    else:
+        earth_per_s2 = (om * math.cos(math.radians(latitude_deg))) ** 2 / 2.0
     motions: list[_Motion] = []
     for k in range(len(poses) - 1):
         p0, p1 = poses[k], poses[k + 1]
@@ -138,7 +162,7 @@ def _motions(
         t_eff = t_m + (t_k + t_k1) / 3.0
         t_span = t_m + (t_k + t_k1) / 2.0
         var = (dir_sigma_rad[k] ** 2 + dir_sigma_rad[k + 1] ** 2
-               + rate_sigma_rad_s**2 * dt_med * t_eff + (om * t_span) ** 2 / 3.0)  # fmt: skip
+               + rate_sigma_rad_s**2 * dt_med * t_eff + earth_per_s2 * t_span**2)  # fmt: skip
         motions.append(_Motion(p0.start, p0.end, p1.start, p1.end, var, k, k + 1))
     return motions
 
@@ -154,6 +178,7 @@ class _Rotations:
     turns: Sequence[tuple[Section, int]]
     dir_sigma_rad: FloatArray
     rate_sigma_rad_s: float
+    latitude_deg: float | None
 
     @property
     def n_rows(self) -> int:
@@ -164,7 +189,6 @@ class _Rotations:
     ) -> tuple[FloatArray, FloatArray, FloatArray, _Held]:
         """Residuals r, ∂r/∂E (row-major), ∂r/∂b and the attitudes held, for the error
         matrix ``e``, the bias ``b`` [rad/s] and the poses' up directions ``u``."""
-        om = units.EARTH_RATE_RAD_S
         rate_rad_s, dt_s, dt_med = self.rate_rad_s, self.dt_s, self.dt_med
         motions, turns = self.motions, self.turns
         n_rows = self.n_rows
@@ -173,7 +197,7 @@ class _Rotations:
         j = np.zeros((n_rows, 9))
         jb = np.zeros((n_rows, 3))
         atts: list[tuple[FloatArray, FloatArray]] = []
-        turn_info: list[tuple[FloatArray, float, float]] = []
+        turn_info: list[tuple[FloatArray, float, float, FloatArray]] = []
         for m_i, mo in enumerate(motions):
             sl = slice(mo.start, mo.stop)
             wc = (rate_rad_s[sl] - b) @ ie_inv.T
@@ -198,20 +222,40 @@ class _Rotations:
             tot = (wc * tau).sum(axis=0)
             sense = 1.0 if float(tot @ u[k]) >= 0 else -1.0
             t_turn = sec.n * dt_med
-            var = (self.rate_sigma_rad_s**2 * dt_med * t_turn
-                   + (2 * math.pi * self.dir_sigma_rad[k]) ** 2
-                   + (om * t_turn) ** 2 / 3.0)  # fmt: skip
-            s = 1.0 / math.sqrt(var)
+            vert, w_mat = self._turn_whitening(wc, tau, u[k], t_turn, self.dir_sigma_rad[k])
             row = slice(3 * len(motions) + 3 * t_i, 3 * len(motions) + 3 * t_i + 3)
-            r[row] = (tot - 2.0 * math.pi * sense * u[k]) * s
-            turn_info.append((tot, sense, s))
+            r[row] = w_mat @ (tot - (2.0 * math.pi * sense + vert) * u[k])
+            turn_info.append((tot, sense, vert, w_mat))
             if jac:
                 # ∂/∂E_ij of Σ (I+E)⁻¹ ω' τ ≈ −e_i Σ ω_cj τ ; ∂/∂b ≈ −T I
                 colsum = (wc * tau).sum(axis=0)
+                jt = np.zeros((3, 9))
                 for i in range(3):
-                    j[row.start + i, 3 * i : 3 * i + 3] = -colsum * s
-                jb[row] = -np.eye(3) * t_turn * s
+                    jt[i, 3 * i : 3 * i + 3] = -colsum
+                j[row] = w_mat @ jt
+                jb[row] = -w_mat * t_turn
         return r, j, jb, (atts, turn_info)
+
+    def _turn_whitening(
+        self, wc: FloatArray, tau: FloatArray, u: FloatArray, t_turn: float, dir_sigma: float
+    ) -> tuple[float, FloatArray]:
+        """The vertical earth rate's angle over a turn [rad] and ``C^(−1/2)`` of the turn's
+        residual covariance (module docstring)."""
+        om = units.EARTH_RATE_RAD_S
+        along = self.rate_sigma_rad_s**2 * self.dt_med * t_turn
+        across = along + (2 * math.pi * dir_sigma) ** 2
+        if self.latitude_deg is None:
+            vert = 0.0
+            along += (om * t_turn) ** 2 / 3.0
+            across += (om * t_turn) ** 2 / 3.0
+        else:
+            lat = math.radians(self.latitude_deg)
+            vert = om * math.sin(lat) * t_turn
+            psi = np.cumsum((wc @ u) * tau[:, 0])
+            rho = abs(complex(np.mean(np.exp(1j * psi))))
+            across += (om * math.cos(lat) * t_turn * rho) ** 2 / 2.0
+        uu = np.outer(u, u)
+        return vert, uu / math.sqrt(along) + (np.eye(3) - uu) / math.sqrt(across)
 
 
 _SCALE = 1e-3
@@ -243,9 +287,17 @@ def _error_matrix_cov(
     accel_free_cov: FloatArray,
     bias_cov: FloatArray,
 ) -> tuple[FloatArray, float]:
-    """Covariance of E's nine elements (row-major) and the reduced χ²: ``(JᵀJ)⁻¹`` of the
-    whitened fit (scaled by χ²/ν when above 1 + 3√(2/ν)), plus the bias's and the
-    accelerometer's covariances carried through ``K = (JᵀJ)⁻¹Jᵀ``."""
+    """Covariance of E's nine elements (row-major) and the reduced χ²::
+
+        C_E = (JᵀJ)⁻¹ [· χ²/ν when significant] + K (J_b C_b J_bᵀ + G C_a Gᵀ) Kᵀ
+
+    with ``K = (JᵀJ)⁻¹Jᵀ`` of the whitened fit (never scaled: it is the map from the
+    rows to E), ``J_b`` the rows' derivative by the gyro bias (covariance ``C_b``) and
+    ``G`` by the accelerometer's free parameters (``C_a``, numerical derivative, the
+    attitudes held).  The reduced χ² is that of the residuals against their whole
+    covariance ``I + J_b C_b J_bᵀ + G C_a Gᵀ`` (a bias error known to be there is not
+    taken for unmodelled scatter and counted a second time); ``(JᵀJ)⁻¹`` is scaled by it
+    only when above ``1 + 3√(2/ν)``."""
     _u, s_, vt = np.linalg.svd(j * _SCALE, full_matrices=False)
     if not s_[-1] > 1e-6 * s_[0]:
         raise DesignError(
@@ -253,13 +305,8 @@ def _error_matrix_cov(
             "scale factors and misalignments of the other axes are unseen; turn the board "
             "about at least two different axes between poses"
         )
-    cov_p = (vt.T / s_**2) @ vt * _SCALE**2  # covariance of E's nine elements
-    dof = (2 * len(rot.motions) + 3 * len(rot.turns)) - 9
-    chi2 = float(r @ r) / dof if dof > 0 else float("nan")
-    if dof > 0 and chi2 > 1.0 + 3.0 * math.sqrt(2.0 / dof):
-        cov_p = cov_p * chi2
-    gain = cov_p @ j.T  # K = (JᵀJ)⁻¹ Jᵀ (whitened)
-    cov_p = cov_p + gain @ jb @ bias_cov @ jb.T @ gain.T
+    cov0 = (vt.T / s_**2) @ vt * _SCALE**2  # (JᵀJ)⁻¹ of E's nine elements
+    gain = cov0 @ j.T  # K = (JᵀJ)⁻¹ Jᵀ (whitened)
     # the accelerometer's uncertainty through u (numerical derivative of the residuals)
     ga = np.zeros((rot.n_rows, accel_free.size))
     for q in range(accel_free.size):
@@ -268,7 +315,14 @@ def _error_matrix_cov(
         pq[q] += h
         r_q = _residuals_fixed_att(rot.motions, rot.turns, held, up_of(pq), r)
         ga[:, q] = (r_q - r) / h
-    return cov_p + gain @ ga @ accel_free_cov @ ga.T @ gain.T, chi2
+    c_sys = jb @ bias_cov @ jb.T + ga @ accel_free_cov @ ga.T
+    dof = (2 * len(rot.motions) + 3 * len(rot.turns)) - 9
+    c_rows = np.eye(rot.n_rows) + c_sys
+    chi2 = float(r @ np.linalg.solve(c_rows, r)) / dof if dof > 0 else float("nan")
+    cov_p = cov0
+    if dof > 0 and chi2 > 1.0 + 3.0 * math.sqrt(2.0 / dof):
+        cov_p = cov0 * chi2
+    return cov_p + gain @ c_sys @ gain.T, chi2
 
 
 def _coefficients(
@@ -304,6 +358,7 @@ def fit_rotations(
     rate_sigma_rad_s: float,
     turns: Sequence[tuple[Section, int]] = (),
     *,
+    latitude_deg: float | None = None,
     max_iter: int = 8,
 ) -> GyroFit:
     """``E_g`` from the motions between consecutive ``poses`` (module docstring).
@@ -311,11 +366,13 @@ def fit_rotations(
     ``up_of(p)`` gives the poses' calibrated unit up directions (m, 3) for accelerometer
     parameters ``p`` (``accel_free`` at the solution, covariance ``accel_free_cov``);
     ``dir_sigma_rad`` (m,) the noise of each pose's direction; ``turns`` the 360° turns with
-    the index of the pose before each."""
+    the index of the pose before each; ``latitude_deg`` (None: unknown) the earth rate's
+    split into the vertical, known, and the horizontal, of unknown heading."""
     dt_med = float(np.median(dt_s))
     up = up_of(accel_free)
-    motions = _motions(dt_s, poses, dt_med, dir_sigma_rad, rate_sigma_rad_s)
-    rot = _Rotations(rate_rad_s, dt_s, dt_med, motions, turns, dir_sigma_rad, rate_sigma_rad_s)
+    motions = _motions(dt_s, poses, dt_med, dir_sigma_rad, rate_sigma_rad_s, latitude_deg)
+    rot = _Rotations(rate_rad_s, dt_s, dt_med, motions, turns, dir_sigma_rad,
+                     rate_sigma_rad_s, latitude_deg)  # fmt: skip
     if rot.n_rows < 9 + 3:
         raise DesignError(
             f"{len(motions)} motions between static poses: the gyro's scale factors and "
@@ -359,9 +416,11 @@ def _residuals_fixed_att(
         a0, a1 = atts[m_i]
         s = 1.0 / math.sqrt(mo.var)
         out[3 * m_i : 3 * m_i + 3] = (u[mo.pose_k1] - _direction(u[mo.pose_k], a0, a1)) * s
-    for t_i, ((_sec, k), (tot, sense, s)) in enumerate(zip(turns, turn_info, strict=True)):
+    for t_i, ((_sec, k), (tot, sense, vert, w_mat)) in enumerate(
+        zip(turns, turn_info, strict=True)
+    ):
         row = slice(3 * len(motions) + 3 * t_i, 3 * len(motions) + 3 * t_i + 3)
-        out[row] = (tot - 2.0 * math.pi * sense * u[k]) * s
+        out[row] = w_mat @ (tot - (2.0 * math.pi * sense + vert) * u[k])
     return out
 
 
