@@ -102,3 +102,24 @@ def test_fit_and_compensate_read_the_named_sensor(
     assert main(["compensate", str(model), str(d), "--sensor", "b", "-o", str(inside)]) == 2
     assert "inside the input station recording" in capsys.readouterr().err
     assert _listing(d) == before
+
+
+def test_report_sensor_labels_and_picks_the_station_sensor(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``report`` has its own ``--sensor`` (the report's label): on a station folder of
+    several sensors it also picks the sensor read."""
+    d = _station(tmp_path)
+    model = tmp_path / "m.json"
+    argv = ["fit", str(d / "b"), "--signal", "gx_deg_h", "--temps", "temp_c", "--model", "poly"]
+    assert main([*argv, "-o", str(model)]) == 0
+    out = tmp_path / "r.html"
+    argv = ["report", "--model", str(model), "--recording", str(d), "--sensor", "b"]
+    assert main([*argv, "-o", str(out)]) == 0, capsys.readouterr().err
+    capsys.readouterr()
+    argv = ["report", "--model", str(model), "--recording", str(d)]
+    assert main([*argv, "-o", str(tmp_path / "r1.html")]) == 2  # which of the two?
+    assert "--sensor ID" in capsys.readouterr().err
+    argv = ["report", "--model", str(model), "--recording", str(d), "--sensor", "zz"]
+    assert main([*argv, "-o", str(tmp_path / "r2.html")]) == 2
+    assert "no sensor 'zz'" in capsys.readouterr().err

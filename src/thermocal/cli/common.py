@@ -94,6 +94,15 @@ TopicOpt = Annotated[
         "sensor_gyro.0 for a .ulg); station recording folder: the sensor's ID.",
     ),
 ]
+LogTopicOpt = Annotated[
+    str | None,
+    typer.Option(
+        "--topic",
+        help="Flight-controller log: the message/topic instance, NAME[.N]; station "
+        "recording folder: the sensor's ID (--sensor also picks it and labels the report).",
+    ),
+]
+"""``--topic`` without ``--sensor`` (``report`` has its own ``--sensor``: the report's label)."""
 NamesOpt = Annotated[
     str | None,
     typer.Option("--names", help="Text logs without a header row: the column names, a,b,c."),

@@ -18,6 +18,7 @@ from thermocal.cli.application import app
 from thermocal.cli.common import (
     DecimalOpt,
     DelimiterOpt,
+    LogTopicOpt,
     ModelSignalOpt,
     NamesOpt,
     OnBadLinesOpt,
@@ -27,7 +28,6 @@ from thermocal.cli.common import (
     TempUnitOpt,
     TimeOpt,
     TimeUnitOpt,
-    TopicOpt,
     TurntableLatitudeOpt,
     handle_errors,
     progress,
@@ -71,7 +71,12 @@ def report_cmd(
         str, typer.Option("--title", help="Report title.")
     ] = "Temperature compensation report",
     sensor: Annotated[
-        str | None, typer.Option("--sensor", help="Sensor name or serial number.")
+        str | None,
+        typer.Option(
+            "--sensor",
+            help="Sensor name or serial number; with a station recording folder of several "
+            "sensors, also the sensor read (its ID).",
+        ),
     ] = None,
     time: TimeOpt = None,
     time_unit: TimeUnitOpt = None,
@@ -87,7 +92,7 @@ def report_cmd(
             "validation result's, else 100 s).",
         ),
     ] = None,
-    topic: TopicOpt = None,
+    topic: LogTopicOpt = None,
     t_names: NamesOpt = None,
     t_rate: RateOpt = None,
     t_bad: OnBadLinesOpt = "error",
@@ -100,6 +105,11 @@ def report_cmd(
     Every model given is shown (fit, range of validity, coefficients); a PASS/ATTENTION
     verdict is stated only from a validation result given with --validation.
     """
+    if topic is None and sensor is not None:  # a station folder's sensor is the report's
+        from thermocal.readers.station import is_station_path
+
+        if any(p is not None and p.is_dir() and is_station_path(p) for p in (recording, modeling)):
+            topic = sensor
     read = _report_files.ReadOptions(
         time=time, time_unit=time_unit, signal_unit=signal_unit, temp_unit=temp_unit,
         temp_conversion=temp_conversion,
