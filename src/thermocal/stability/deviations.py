@@ -29,9 +29,11 @@ sums of squares and term counts per τ, pooled as Σ S / Σ count (MTIE: the lar
 
 from __future__ import annotations
 
+import math
 import os
 from collections.abc import Callable
 from concurrent.futures import ThreadPoolExecutor
+from dataclasses import dataclass
 from typing import Final
 
 import numpy as np
@@ -39,6 +41,7 @@ import numpy.typing as npt
 from threadpoolctl import threadpool_limits
 
 from thermocal._lazy import LazyModule
+from thermocal.stability import edf as ed
 
 ndimage = LazyModule("scipy.ndimage")
 
@@ -229,6 +232,113 @@ def _fast_sums(name: str, x: FloatArray, m: IntArray) -> tuple[FloatArray, Float
     return sums, np.full(m.size, float(mid))
 
 
+@dataclass(frozen=True, eq=False)
+class OctaveLevel:
+    """Level k of the octave pyramid of one gap-free stretch of rate samples y_i: the block
+    sums S_j = Σ_{i=jm}^{(j+1)m−1} (y_i − ȳ) for m = 2^k, j < n // m (level 0: ``z`` is the
+    samples themselves and ``offset`` = ȳ; above, ``z`` = S and ``offset`` = 0).
+
+    ``d1`` = Σ_j (S_{j+1} − S_j)², ``d2`` = Σ_j (S_{j+2} − 2S_{j+1} + S_j)² (NaN when not
+    asked); ``lag`` the :class:`thermocal.stability.edf.LagSums` of S (noise
+    identification).  With phase x_k = τ0 Σ_{i<k}(y_i − ȳ), x_{(j+1)m} − x_{jm} = τ0 S_j:
+    the Allan second difference at m is τ0 (S_{j+1} − S_j), the Hadamard third difference
+    τ0 (S_{j+2} − 2S_{j+1} + S_j) (SP 1065 eqs. 7, 17)."""
+
+    m: int
+    z: FloatArray
+    offset: float
+    d1: float
+    d2: float
+    lag: ed.LagSums
+
+
+_LEVEL_BLOCK: Final = 1 << 15
+"""Elements per block of :func:`_level_pass` (a few buffers that stay in the L2 cache)."""
+
+
+def _level_pass(
+    z: FloatArray, offset: float, *, d1: bool, d2: bool, nxt: FloatArray | None
+) -> tuple[float, float, ed.LagSums]:
+    """One pass over ``z`` in cache-sized blocks of c = z − offset: Σ (Δc)², Σ (Δ²c)², the
+    sums of :class:`thermocal.stability.edf.LagSums` and (``nxt``) the pairwise sums
+    c_{2i} + c_{2i+1}, the next level."""
+    n = z.size
+    big = _LEVEL_BLOCK
+    buf, t1, t2 = np.empty(big + 2), np.empty(big + 1), np.empty(big)
+    s1 = s2 = sl = sk = q1 = q2 = 0.0
+    for a in range(0, n, big):
+        b = min(a + big, n)
+        e = min(b + 2, n)  # two points past the block for the differences
+        c = buf[: e - a]
+        np.subtract(z[a:e], offset, out=c)
+        own = c[: b - a]
+        tot = float(own.sum())
+        s1 += tot
+        s2 += float(own @ own)
+        sk += float(_INDEX[: b - a] @ own) + a * tot
+        lp = min(b - a, e - a - 1)  # pairs (k, k + 1) with k in the block, k + 1 < n
+        sl += float(c[:lp] @ c[1 : lp + 1])
+        if d1 or d2:
+            u = t1[: e - a - 1]
+            np.subtract(c[1:], c[:-1], out=u)
+            if d1:
+                q1 += float(u[:lp] @ u[:lp])
+            l2 = min(b - a, e - a - 2)
+            if d2 and l2 > 0:
+                v = t2[:l2]
+                np.subtract(u[1 : l2 + 1], u[:l2], out=v)
+                q2 += float(v @ v)
+        if nxt is not None:
+            h = min((b - a) // 2, nxt.size - a // 2)
+            np.add(c[0 : 2 * h : 2], c[1 : 2 * h : 2], out=nxt[a // 2 : a // 2 + h])
+    delta = s1 / n  # c's own mean: the centring made exact (z_c = c − δ)
+    first, last = float(z[0]) - offset - delta, float(z[-1]) - offset - delta
+    lag = ed.LagSums(
+        n,
+        s2 - s1 * delta,
+        sk - delta * n * (n - 1) / 2.0,
+        sl - delta * (2.0 * s1 - (first + delta) - (last + delta)) + (n - 1) * delta * delta,
+        first,
+        last,
+    )
+    return (q1 if d1 else math.nan), (q2 if d2 else math.nan), lag
+
+
+def octave_levels(
+    y: FloatArray, mean: float, m_max: int, *, d1: bool = False, d2: bool = False
+) -> list[OctaveLevel]:
+    """The :class:`OctaveLevel` for m = 1, 2, 4 … ≤ ``m_max`` (while a block remains) of
+    rate samples ``y`` with mean ``mean``: each level from the one below in one blocked pass
+    (O(n) in all; no phase array).  ``d1``/``d2``: take the Allan/Hadamard sums too."""
+    out: list[OctaveLevel] = []
+    z, offset, m = np.asarray(y, dtype=np.float64), float(mean), 1
+    while z.size >= 1 and m <= m_max:
+        nxt = np.empty(z.size // 2) if 2 * m <= m_max and z.size >= 2 else None
+        q1, q2, lag = _level_pass(z, offset, d1=d1, d2=d2, nxt=nxt)
+        out.append(OctaveLevel(m, z, offset, q1, q2, lag))
+        if nxt is None:
+            break
+        z, offset, m = nxt, 0.0, 2 * m
+    return out
+
+
+def octave_sums(name: str, levels: list[OctaveLevel], m: IntArray) -> tuple[FloatArray, FloatArray]:
+    """(numerator, terms) per m of ``adev``/``hdev`` from one stretch's octave levels, as
+    :func:`segment_sums` gives them: Σ (τ0 ΔS)² / (2τ²) = Σ (ΔS)² / (2m²) over n//m − 1 terms
+    (adev), Σ (Δ²S)² / (6m²) over n//m − 2 (hdev); (0, 0) where too few blocks remain."""
+    d = 2 if name == "adev" else 3
+    by_m = {lv.m: lv for lv in levels}
+    num, cnt = np.zeros(m.size), np.zeros(m.size)
+    for i, mm in enumerate(m.tolist()):
+        lv = by_m.get(int(mm))
+        if lv is None or lv.z.size < d:
+            continue
+        q = lv.d1 if d == 2 else lv.d2
+        num[i] = q / ((2.0 if d == 2 else 6.0) * float(mm) * float(mm))
+        cnt[i] = lv.z.size + 1 - d
+    return num, cnt
+
+
 def segment_sums(
     name: str, x: FloatArray, tau0_s: float, m: IntArray
 ) -> tuple[FloatArray, FloatArray]:
@@ -347,6 +457,8 @@ __all__ = [
     "as_phase",
     "centred",
     "max_factor",
+    "octave_levels",
+    "octave_sums",
     "pool",
     "segment_sums",
     "theo1_tau",
