@@ -256,21 +256,25 @@ _LEVEL_BLOCK: Final = 1 << 15
 """Elements per block of :func:`_level_pass` (a few buffers that stay in the L2 cache)."""
 
 
-def _level_pass(
-    z: FloatArray, offset: float, *, d1: bool, d2: bool, nxt: FloatArray | None
-) -> tuple[float, float, ed.LagSums]:
-    """One pass over ``z`` in cache-sized blocks of c = z − offset: Σ (Δc)², Σ (Δ²c)², the
-    sums of :class:`thermocal.stability.edf.LagSums` and (``nxt``) the pairwise sums
-    c_{2i} + c_{2i+1}, the next level."""
+def _level_range(
+    z: FloatArray, offset: float, lo: int, hi: int, d1: bool, d2: bool, nxt: FloatArray | None
+) -> tuple[float, ...]:
+    """Σ c, Σ c², Σ c_k c_{k+1}, Σ k c_k, Σ (Δc)², Σ (Δ²c)² over the terms starting at k in
+    [lo, hi) (c = z − offset; a difference or pair may reach past ``hi``), in cache-sized
+    blocks, writing the pairwise sums c_{2i} + c_{2i+1} of the range into ``nxt`` (lo even)."""
     n = z.size
     big = _LEVEL_BLOCK
     buf, t1, t2 = np.empty(big + 2), np.empty(big + 1), np.empty(big)
     s1 = s2 = sl = sk = q1 = q2 = 0.0
-    for a in range(0, n, big):
-        b = min(a + big, n)
+    c: FloatArray
+    for a in range(lo, hi, big):
+        b = min(a + big, hi)
         e = min(b + 2, n)  # two points past the block for the differences
-        c = buf[: e - a]
-        np.subtract(z[a:e], offset, out=c)
+        if offset:
+            c = buf[: e - a]
+            np.subtract(z[a:e], offset, out=c)
+        else:  # the levels above 0 are centred already: read in place
+            c = z[a:e]
         own = c[: b - a]
         tot = float(own.sum())
         s1 += tot
@@ -291,6 +295,31 @@ def _level_pass(
         if nxt is not None:
             h = min((b - a) // 2, nxt.size - a // 2)
             np.add(c[0 : 2 * h : 2], c[1 : 2 * h : 2], out=nxt[a // 2 : a // 2 + h])
+    return s1, s2, sl, sk, q1, q2
+
+
+_SPLIT: Final = 1 << 20
+"""Levels of at least this many points are passed over by :data:`_WORKERS` threads."""
+
+
+def _level_pass(
+    z: FloatArray, offset: float, *, d1: bool, d2: bool, nxt: FloatArray | None
+) -> tuple[float, float, ed.LagSums]:
+    """One pass over ``z`` (two threads on halves when long; numpy releases the GIL) in
+    cache-sized blocks of c = z − offset: Σ (Δc)², Σ (Δ²c)², the sums of
+    :class:`thermocal.stability.edf.LagSums` and (``nxt``) the next level."""
+    n = z.size
+    if n >= _SPLIT and _WORKERS > 1:
+        half = (n // 2) & ~1
+        with ThreadPoolExecutor(max_workers=2) as pool:
+            jobs = [
+                pool.submit(_level_range, z, offset, lo, hi, d1, d2, nxt)
+                for lo, hi in ((0, half), (half, n))
+            ]
+            parts = [j.result() for j in jobs]
+        s1, s2, sl, sk, q1, q2 = (p + q for p, q in zip(*parts, strict=True))
+    else:
+        s1, s2, sl, sk, q1, q2 = _level_range(z, offset, 0, n, d1, d2, nxt)
     delta = s1 / n  # c's own mean: the centring made exact (z_c = c − δ)
     first, last = float(z[0]) - offset - delta, float(z[-1]) - offset - delta
     lag = ed.LagSums(

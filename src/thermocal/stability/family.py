@@ -164,7 +164,11 @@ def _stretches(
     y = np.asarray(values, dtype=np.float64).ravel()
     if not (math.isfinite(tau0_s) and tau0_s > 0):
         raise ThermocalInputError(f"sample interval τ0 must be positive, got {tau0_s!r}")
-    bad = np.flatnonzero(~np.isfinite(y))
+    # a NaN or ±inf sample makes the sum non-finite (the sum alone overflowing is rare):
+    # the full O(n) mask only then
+    bad = np.zeros(0, dtype=np.int64)
+    if not math.isfinite(float(y.sum())):
+        bad = np.flatnonzero(~np.isfinite(y))
     if bad.size:
         raise MissingValueError(
             f"data have {bad.size} NaN/infinite samples (first at row {bad[0]}); "
