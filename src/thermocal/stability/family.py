@@ -159,15 +159,17 @@ def _edf(name: str, alpha: int, m: int, n_phase: int) -> float:
 
 def _stretches(
     values: npt.ArrayLike, tau0_s: float, data_type: str, segments: list[slice] | None
-) -> tuple[FloatArray, list[slice]]:
-    """The checked samples and the gap-free stretches giving at least 3 phase points."""
+) -> tuple[FloatArray, list[slice], float]:
+    """The checked samples, the gap-free stretches giving at least 3 phase points and the
+    samples' sum."""
     y = np.asarray(values, dtype=np.float64).ravel()
     if not (math.isfinite(tau0_s) and tau0_s > 0):
         raise ThermocalInputError(f"sample interval τ0 must be positive, got {tau0_s!r}")
     # a NaN or ±inf sample makes the sum non-finite (the sum alone overflowing is rare):
     # the full O(n) mask only then
     bad = np.zeros(0, dtype=np.int64)
-    if not math.isfinite(float(y.sum())):
+    total = float(y.sum())
+    if not math.isfinite(total):
         bad = np.flatnonzero(~np.isfinite(y))
     if bad.size:
         raise MissingValueError(
@@ -181,7 +183,7 @@ def _stretches(
     ]  # fmt: skip
     if not kept:
         raise ThermocalInputError("stability analysis needs at least 3 contiguous points")
-    return y, kept
+    return y, kept, total
 
 
 class _Record:
@@ -201,15 +203,25 @@ class _Record:
         self._phases: list[FloatArray] | None = None
         self._centred: list[FloatArray] | None = None
         self._levels: dict[int, list[dv.OctaveLevel]] = {}
+        self._means: dict[int, float] = {}
         self.m_max = 0
         """Octave levels up to this factor (0: no octave levels; set by the caller)."""
 
+    def mean(self, i: int) -> float:
+        """Stretch i's mean sample (numpy's, as ``y[sl].mean()``)."""
+        if i not in self._means:
+            self._means[i] = float(self.y[self.kept[i]].mean())
+        return self._means[i]
+
+    def preset_mean(self, i: int, mean: float) -> None:
+        self._means[i] = mean
+
     def phases(self) -> list[FloatArray]:
         if self._phases is None:
-            y, rate = self.y, self.data_type == "rate"
+            rate = self.data_type == "rate"
             self._phases = [
-                dv.as_phase(y[sl], self.tau0_s, self.data_type, y[sl].mean() if rate else 0.0)
-                for sl in self.kept
+                dv.as_phase(self.y[sl], self.tau0_s, self.data_type, self.mean(i) if rate else 0.0)
+                for i, sl in enumerate(self.kept)
             ]
         return self._phases
 
@@ -225,9 +237,8 @@ class _Record:
     def levels(self, i: int) -> list[dv.OctaveLevel]:
         """Stretch i's octave pyramid (rate data), with the Allan/Hadamard sums if asked."""
         if i not in self._levels:
-            seg = self.y[self.kept[i]]
             self._levels[i] = dv.octave_levels(
-                seg, float(seg.mean()), self.m_max,
+                self.y[self.kept[i]], self.mean(i), self.m_max,
                 d1="adev" in self.names, d2="hdev" in self.names,
             )  # fmt: skip
         return self._levels[i]
@@ -339,8 +350,10 @@ def stability(
     with threadpool_limits(limits=1, user_api="blas"):  # many short dots: BLAS threads wait
         if data_type not in ("rate", "phase"):
             raise ThermocalInputError(f"--data-type {data_type!r}: use rate or phase")
-        y, kept = _stretches(values, tau0_s, data_type, segments)
+        y, kept, total = _stretches(values, tau0_s, data_type, segments)
         record = _Record(y, kept, tau0_s, data_type, names)
+        if len(kept) == 1 and kept[0].indices(y.size)[:2] == (0, y.size):
+            record.preset_mean(0, total / y.size)  # numpy's mean: the same sum over n
         n_long = max(record.sizes)
         m_common = factors(
             taus,
