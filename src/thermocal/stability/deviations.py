@@ -116,14 +116,14 @@ THIRD: Final = ((3, 1.0), (0, -1.0), (2, -3.0), (1, 3.0))
 
 
 def _difference_sum(
-    x: FloatArray, m: int, n_terms: int, taps: tuple[tuple[int, float], ...]
+    x: FloatArray, m: int, n_terms: int, taps: tuple[tuple[int, float], ...], nested: bool = False
 ) -> float:
     """Σ_{k<n_terms} (Σ_j c_j x_{k + o_j m})² for taps (o_j, c_j), in blocks of
     :data:`_CHUNK` terms with two reused buffers (no array per sample).  The first two taps
     must have c = ±1 (one add or subtract forms them, as :func:`thermocal.stability.allan.
     second_difference_sums` does: x_{k+2m} + x_k − 2 x_{k+m}); the others are added after."""
-    if taps == SECOND and step_small(m):
-        return _second_difference_sum(x, m, n_terms)
+    if (taps == SECOND or (nested and taps == THIRD)) and step_small(m):
+        return _nested_difference_sum(x, m, n_terms, 2 if taps == SECOND else 3)
     size = min(_CHUNK, max(n_terms, 1))
     buf = np.empty(size)
     tmp = np.empty(size)
@@ -151,21 +151,23 @@ def step_small(m: int) -> bool:
     return 0 < m < _CHUNK
 
 
-def _second_difference_sum(x: FloatArray, m: int, n_terms: int) -> float:
-    """Σ_{k<n_terms} (x_{k+2m} − 2x_{k+m} + x_k)² as Σ (D_{k+m} − D_k)² with D_k = x_{k+m} −
-    x_k, formed once per block for the block and m beyond it: two subtractions and a dot
-    per term instead of three operations (for m below a block, where D's overlap is short)."""
+def _nested_difference_sum(x: FloatArray, m: int, n_terms: int, d: int) -> float:
+    """Σ_{k<n_terms} (Δ_m^d x)_k² for d = 2 (x_{k+2m} − 2x_{k+m} + x_k) or 3 (x_{k+3m} −
+    3x_{k+2m} + 3x_{k+m} − x_k), as differences of differences formed once per block over
+    the block and (d − 1)m beyond it: d subtractions and a dot per term instead of 3 or 5
+    operations (for m below a block, where the overlap is short)."""
     size = min(_CHUNK, max(n_terms, 1))
-    dbuf = np.empty(size + m)
-    vbuf = np.empty(size)
+    bufs = [np.empty(size + (d - 1 - j) * m) for j in range(d)]
     total = 0.0
     for a in range(0, n_terms, _CHUNK):
-        b = min(a + _CHUNK, n_terms)
-        d = dbuf[: b - a + m]
-        np.subtract(x[a + m : b + 2 * m], x[a : b + m], out=d)
-        v = vbuf[: b - a]
-        np.subtract(d[m:], d[: b - a], out=v)
-        total += float(v @ v)
+        n_b = min(a + _CHUNK, n_terms) - a
+        cur = bufs[0][: n_b + (d - 1) * m]
+        np.subtract(x[a + m : a + n_b + d * m], x[a : a + n_b + (d - 1) * m], out=cur)
+        for j in range(1, d):  # the next difference, (d − 1 − j) m beyond the block
+            nxt = bufs[j][: n_b + (d - 1 - j) * m]
+            np.subtract(cur[m : m + nxt.size], cur[: nxt.size], out=nxt)
+            cur = nxt
+        total += float(cur @ cur)
     return total
 
 
@@ -173,6 +175,7 @@ def difference_sums(
     base: Callable[[int], tuple[FloatArray, int, int]],
     m: IntArray,
     taps: tuple[tuple[int, float], ...],
+    nested: bool = False,
 ) -> FloatArray:
     """:func:`_difference_sum` for each factor m: ``base(m)`` gives (array, offset unit,
     term count) — the phase with m itself, or a decimated phase with 1 — shared between
@@ -181,7 +184,7 @@ def difference_sums(
 
     def one(mm: int) -> float:
         arr, step, n_terms = base(mm)
-        return _difference_sum(arr, step, n_terms, taps)
+        return _difference_sum(arr, step, n_terms, taps, nested)
 
     ms = [int(v) for v in m.tolist()]
     with threadpool_limits(limits=1, user_api="blas"):
@@ -249,8 +252,8 @@ def _fast_sums(name: str, x: FloatArray, m: IntArray) -> tuple[FloatArray, Float
         sums = difference_sums(lambda mm: (x[::mm], 1, (n - 1) // mm + 1 - d), m, taps)
         return sums, cnt
     if name in ("oadev", "ohdev", "tierms"):
-        d, taps = _OVERLAPPING[name]
-        sums = difference_sums(lambda mm: (x, mm, n - d * mm), m, taps)
+        d, taps = _OVERLAPPING[name]  # ohdev: nested differences (not mdev's running sum)
+        sums = difference_sums(lambda mm: (x, mm, n - d * mm), m, taps, nested=True)
         return sums, (n - d * m).astype(np.float64)
     if name in ("mdev", "tdev"):  # v_j = s_{j+2m} − 2s_{j+m} + s_j, s_j = c_{j+m} − c_j
         cs = np.empty(n + 1)  # c: the running sum, once for every m
