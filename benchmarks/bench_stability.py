@@ -6,7 +6,9 @@ EDF, the noise identification and the intervals) against allantools' function of
 name (``allantools.<name>(y, rate, data_type="freq", taus="octave")``), best of
 ``--repeat`` each, interleaved (one of ours, one of theirs, …) in the same run after a
 warm-up call on 10⁴ points; the ratio allantools / thermocal is printed with the
-target (≥ 3×) and the deviations are compared (relative 1e-6).
+target (≥ 3×) and the deviations are compared (relative 1e-6); the load average at the
+start and end is printed (the machine may be shared: ratios measured in the same run are
+what counts).
 
 Skipped at 10⁷ (``--n`` smaller runs them): mtotdev, ttotdev, htotdev and theo1 are
 O(N·m) per τ in both programs (≈ N²/2 element operations at the largest octave τ: hours);
@@ -19,6 +21,7 @@ Run: .venv/bin/python benchmarks/bench_stability.py [--n 10000000] [--repeat 2]
 from __future__ import annotations
 
 import argparse
+import os
 import time
 
 import numpy as np
@@ -58,7 +61,9 @@ def main() -> int:
     # imported scipy above, at its own import)
     stability(y[:10_000], tau0, list(ALL), "octave")
     ok = True
+    load = "load average {:.2f} {:.2f} {:.2f}".format(*os.getloadavg())
     print(f"deviation family at N = {args.n:.3g} rate samples, octave τ, best of {args.repeat}")
+    print(f"start: {load} (1, 5, 15 min; other jobs on the machine)")
     for name in names:
         if args.n > BIG and name in SLOW_ON_BOTH:
             print(f"{name:8s} skipped: O(N·m) per τ in both programs at this size")
@@ -92,6 +97,7 @@ def main() -> int:
             f"(target ≥ 3×: {'met' if met else 'NOT met'})  max rel. diff {err:.1e} "
             f"over {common.size} τ"
         )
+    print("end: load average {:.2f} {:.2f} {:.2f}".format(*os.getloadavg()))
     return 0 if ok else 1
 
 

@@ -29,9 +29,11 @@ sums of squares and term counts per τ, pooled as Σ S / Σ count (MTIE: the lar
 
 from __future__ import annotations
 
+import math
 import os
 from collections.abc import Callable
 from concurrent.futures import ThreadPoolExecutor
+from dataclasses import dataclass
 from typing import Final
 
 import numpy as np
@@ -39,6 +41,7 @@ import numpy.typing as npt
 from threadpoolctl import threadpool_limits
 
 from thermocal._lazy import LazyModule
+from thermocal.stability import edf as ed
 
 ndimage = LazyModule("scipy.ndimage")
 
@@ -93,6 +96,17 @@ _INDEX: Final = np.arange(_CHUNK, dtype=np.float64)
 
 _WORKERS: Final = max(1, min(2, os.cpu_count() or 1))
 
+_EXECUTOR: list[ThreadPoolExecutor] = []
+
+
+def _pool() -> ThreadPoolExecutor:
+    """One pool of :data:`_WORKERS` threads for the module, made on first use (starting
+    threads per call costs milliseconds on a loaded machine)."""
+    if not _EXECUTOR:
+        _EXECUTOR.append(ThreadPoolExecutor(max_workers=_WORKERS))
+    return _EXECUTOR[0]
+
+
 FIRST: Final = ((1, 1.0), (0, -1.0))
 """x_{k+m} − x_k."""
 SECOND: Final = ((2, 1.0), (0, 1.0), (1, -2.0))
@@ -102,12 +116,14 @@ THIRD: Final = ((3, 1.0), (0, -1.0), (2, -3.0), (1, 3.0))
 
 
 def _difference_sum(
-    x: FloatArray, m: int, n_terms: int, taps: tuple[tuple[int, float], ...]
+    x: FloatArray, m: int, n_terms: int, taps: tuple[tuple[int, float], ...], nested: bool = False
 ) -> float:
     """Σ_{k<n_terms} (Σ_j c_j x_{k + o_j m})² for taps (o_j, c_j), in blocks of
     :data:`_CHUNK` terms with two reused buffers (no array per sample).  The first two taps
     must have c = ±1 (one add or subtract forms them, as :func:`thermocal.stability.allan.
     second_difference_sums` does: x_{k+2m} + x_k − 2 x_{k+m}); the others are added after."""
+    if (taps == SECOND or (nested and taps == THIRD)) and step_small(m):
+        return _nested_difference_sum(x, m, n_terms, 2 if taps == SECOND else 3)
     size = min(_CHUNK, max(n_terms, 1))
     buf = np.empty(size)
     tmp = np.empty(size)
@@ -130,10 +146,36 @@ def _difference_sum(
     return total
 
 
+def step_small(m: int) -> bool:
+    """Whether x_k … x_{k+2m} of a block of terms lie within two blocks (cache-resident)."""
+    return 0 < m < _CHUNK
+
+
+def _nested_difference_sum(x: FloatArray, m: int, n_terms: int, d: int) -> float:
+    """Σ_{k<n_terms} (Δ_m^d x)_k² for d = 2 (x_{k+2m} − 2x_{k+m} + x_k) or 3 (x_{k+3m} −
+    3x_{k+2m} + 3x_{k+m} − x_k), as differences of differences formed once per block over
+    the block and (d − 1)m beyond it: d subtractions and a dot per term instead of 3 or 5
+    operations (for m below a block, where the overlap is short)."""
+    size = min(_CHUNK, max(n_terms, 1))
+    bufs = [np.empty(size + (d - 1 - j) * m) for j in range(d)]
+    total = 0.0
+    for a in range(0, n_terms, _CHUNK):
+        n_b = min(a + _CHUNK, n_terms) - a
+        cur = bufs[0][: n_b + (d - 1) * m]
+        np.subtract(x[a + m : a + n_b + d * m], x[a : a + n_b + (d - 1) * m], out=cur)
+        for j in range(1, d):  # the next difference, (d − 1 − j) m beyond the block
+            nxt = bufs[j][: n_b + (d - 1 - j) * m]
+            np.subtract(cur[m : m + nxt.size], cur[: nxt.size], out=nxt)
+            cur = nxt
+        total += float(cur @ cur)
+    return total
+
+
 def difference_sums(
     base: Callable[[int], tuple[FloatArray, int, int]],
     m: IntArray,
     taps: tuple[tuple[int, float], ...],
+    nested: bool = False,
 ) -> FloatArray:
     """:func:`_difference_sum` for each factor m: ``base(m)`` gives (array, offset unit,
     term count) — the phase with m itself, or a decimated phase with 1 — shared between
@@ -142,14 +184,13 @@ def difference_sums(
 
     def one(mm: int) -> float:
         arr, step, n_terms = base(mm)
-        return _difference_sum(arr, step, n_terms, taps)
+        return _difference_sum(arr, step, n_terms, taps, nested)
 
     ms = [int(v) for v in m.tolist()]
     with threadpool_limits(limits=1, user_api="blas"):
         if len(ms) <= 1 or _WORKERS <= 1:
             return np.array([one(mm) for mm in ms], dtype=np.float64)
-        with ThreadPoolExecutor(max_workers=_WORKERS) as pool:
-            vals = list(pool.map(one, ms))
+        vals = list(_pool().map(one, ms))
     return np.asarray(vals, dtype=np.float64)
 
 
@@ -211,8 +252,8 @@ def _fast_sums(name: str, x: FloatArray, m: IntArray) -> tuple[FloatArray, Float
         sums = difference_sums(lambda mm: (x[::mm], 1, (n - 1) // mm + 1 - d), m, taps)
         return sums, cnt
     if name in ("oadev", "ohdev", "tierms"):
-        d, taps = _OVERLAPPING[name]
-        sums = difference_sums(lambda mm: (x, mm, n - d * mm), m, taps)
+        d, taps = _OVERLAPPING[name]  # ohdev: nested differences (not mdev's running sum)
+        sums = difference_sums(lambda mm: (x, mm, n - d * mm), m, taps, nested=True)
         return sums, (n - d * m).astype(np.float64)
     if name in ("mdev", "tdev"):  # v_j = s_{j+2m} − 2s_{j+m} + s_j, s_j = c_{j+m} − c_j
         cs = np.empty(n + 1)  # c: the running sum, once for every m
@@ -227,6 +268,141 @@ def _fast_sums(name: str, x: FloatArray, m: IntArray) -> tuple[FloatArray, Float
     c = mid + 1
     sums = difference_sums(lambda mm: (ext[c - mm :], mm, mid), m, SECOND)
     return sums, np.full(m.size, float(mid))
+
+
+@dataclass(frozen=True, eq=False)
+class OctaveLevel:
+    """Level k of the octave pyramid of one gap-free stretch of rate samples y_i: the block
+    sums S_j = Σ_{i=jm}^{(j+1)m−1} (y_i − ȳ) for m = 2^k, j < n // m (level 0: ``z`` is the
+    samples themselves and ``offset`` = ȳ; above, ``z`` = S and ``offset`` = 0).
+
+    ``d1`` = Σ_j (S_{j+1} − S_j)², ``d2`` = Σ_j (S_{j+2} − 2S_{j+1} + S_j)² (NaN when not
+    asked); ``lag`` the :class:`thermocal.stability.edf.LagSums` of S (noise
+    identification).  With phase x_k = τ0 Σ_{i<k}(y_i − ȳ), x_{(j+1)m} − x_{jm} = τ0 S_j:
+    the Allan second difference at m is τ0 (S_{j+1} − S_j), the Hadamard third difference
+    τ0 (S_{j+2} − 2S_{j+1} + S_j) (SP 1065 eqs. 7, 17)."""
+
+    m: int
+    z: FloatArray
+    offset: float
+    d1: float
+    d2: float
+    lag: ed.LagSums
+
+
+_LEVEL_BLOCK: Final = 1 << 15
+"""Elements per block of :func:`_level_pass` (a few buffers that stay in the L2 cache)."""
+
+
+def _level_range(
+    z: FloatArray, offset: float, lo: int, hi: int, d1: bool, d2: bool, nxt: FloatArray | None
+) -> tuple[float, ...]:
+    """Σ c, Σ c², Σ c_k c_{k+1}, Σ k c_k, Σ (Δc)², Σ (Δ²c)² over the terms starting at k in
+    [lo, hi) (c = z − offset; a difference or pair may reach past ``hi``), in cache-sized
+    blocks, writing the pairwise sums c_{2i} + c_{2i+1} of the range into ``nxt`` (lo even)."""
+    n = z.size
+    big = _LEVEL_BLOCK
+    buf, t1, t2 = np.empty(big + 2), np.empty(big + 1), np.empty(big)
+    s1 = s2 = sl = sk = q1 = q2 = 0.0
+    c: FloatArray
+    for a in range(lo, hi, big):
+        b = min(a + big, hi)
+        e = min(b + 2, n)  # two points past the block for the differences
+        if offset:
+            c = buf[: e - a]
+            np.subtract(z[a:e], offset, out=c)
+        else:  # the levels above 0 are centred already: read in place
+            c = z[a:e]
+        own = c[: b - a]
+        tot = float(own.sum())
+        s1 += tot
+        s2 += float(own @ own)
+        sk += float(_INDEX[: b - a] @ own) + a * tot
+        lp = min(b - a, e - a - 1)  # pairs (k, k + 1) with k in the block, k + 1 < n
+        sl += float(c[:lp] @ c[1 : lp + 1])
+        if d1 or d2:
+            u = t1[: e - a - 1]
+            np.subtract(c[1:], c[:-1], out=u)
+            if d1:
+                q1 += float(u[:lp] @ u[:lp])
+            l2 = min(b - a, e - a - 2)
+            if d2 and l2 > 0:
+                v = t2[:l2]
+                np.subtract(u[1 : l2 + 1], u[:l2], out=v)
+                q2 += float(v @ v)
+        if nxt is not None:
+            h = min((b - a) // 2, nxt.size - a // 2)
+            np.add(c[0 : 2 * h : 2], c[1 : 2 * h : 2], out=nxt[a // 2 : a // 2 + h])
+    return s1, s2, sl, sk, q1, q2
+
+
+_SPLIT: Final = 1 << 20
+"""Levels of at least this many points are passed over by :data:`_WORKERS` threads."""
+
+
+def _level_pass(
+    z: FloatArray, offset: float, *, d1: bool, d2: bool, nxt: FloatArray | None
+) -> tuple[float, float, ed.LagSums]:
+    """One pass over ``z`` (two threads on halves when long; numpy releases the GIL) in
+    cache-sized blocks of c = z − offset: Σ (Δc)², Σ (Δ²c)², the sums of
+    :class:`thermocal.stability.edf.LagSums` and (``nxt``) the next level."""
+    n = z.size
+    if n >= _SPLIT and _WORKERS > 1:
+        half = (n // 2) & ~1
+        jobs = [
+            _pool().submit(_level_range, z, offset, lo, hi, d1, d2, nxt)
+            for lo, hi in ((0, half), (half, n))
+        ]
+        parts = [j.result() for j in jobs]
+        s1, s2, sl, sk, q1, q2 = (p + q for p, q in zip(*parts, strict=True))
+    else:
+        s1, s2, sl, sk, q1, q2 = _level_range(z, offset, 0, n, d1, d2, nxt)
+    delta = s1 / n  # c's own mean: the centring made exact (z_c = c − δ)
+    first, last = float(z[0]) - offset - delta, float(z[-1]) - offset - delta
+    lag = ed.LagSums(
+        n,
+        s2 - s1 * delta,
+        sk - delta * n * (n - 1) / 2.0,
+        sl - delta * (2.0 * s1 - (first + delta) - (last + delta)) + (n - 1) * delta * delta,
+        first,
+        last,
+    )
+    return (q1 if d1 else math.nan), (q2 if d2 else math.nan), lag
+
+
+def octave_levels(
+    y: FloatArray, mean: float, m_max: int, *, d1: bool = False, d2: bool = False
+) -> list[OctaveLevel]:
+    """The :class:`OctaveLevel` for m = 1, 2, 4 … ≤ ``m_max`` (while a block remains) of
+    rate samples ``y`` with mean ``mean``: each level from the one below in one blocked pass
+    (O(n) in all; no phase array).  ``d1``/``d2``: take the Allan/Hadamard sums too."""
+    out: list[OctaveLevel] = []
+    z, offset, m = np.asarray(y, dtype=np.float64), float(mean), 1
+    while z.size >= 1 and m <= m_max:
+        nxt = np.empty(z.size // 2) if 2 * m <= m_max and z.size >= 2 else None
+        q1, q2, lag = _level_pass(z, offset, d1=d1, d2=d2, nxt=nxt)
+        out.append(OctaveLevel(m, z, offset, q1, q2, lag))
+        if nxt is None:
+            break
+        z, offset, m = nxt, 0.0, 2 * m
+    return out
+
+
+def octave_sums(name: str, levels: list[OctaveLevel], m: IntArray) -> tuple[FloatArray, FloatArray]:
+    """(numerator, terms) per m of ``adev``/``hdev`` from one stretch's octave levels, as
+    :func:`segment_sums` gives them: Σ (τ0 ΔS)² / (2τ²) = Σ (ΔS)² / (2m²) over n//m − 1 terms
+    (adev), Σ (Δ²S)² / (6m²) over n//m − 2 (hdev); (0, 0) where too few blocks remain."""
+    d = 2 if name == "adev" else 3
+    by_m = {lv.m: lv for lv in levels}
+    num, cnt = np.zeros(m.size), np.zeros(m.size)
+    for i, mm in enumerate(m.tolist()):
+        lv = by_m.get(int(mm))
+        if lv is None or lv.z.size < d:
+            continue
+        q = lv.d1 if d == 2 else lv.d2
+        num[i] = q / ((2.0 if d == 2 else 6.0) * float(mm) * float(mm))
+        cnt[i] = lv.z.size + 1 - d
+    return num, cnt
 
 
 def segment_sums(
@@ -347,6 +523,8 @@ __all__ = [
     "as_phase",
     "centred",
     "max_factor",
+    "octave_levels",
+    "octave_sums",
     "pool",
     "segment_sums",
     "theo1_tau",

@@ -312,15 +312,39 @@ def _lag1_linear_detrended(z: FloatArray, *, own: bool = False) -> float:
     szz = float(zc @ zc)
     if szz <= 0:
         return 0.0
+    sums = LagSums(n, szz, _index_dot(zc), float(zc[:-1] @ zc[1:]), float(zc[0]), float(zc[-1]))
+    r1 = _lag1_from_sums(sums)
+    return lag1_autocorrelation(_detrend(z, 1)) if r1 is None else r1
+
+
+@dataclass(frozen=True)
+class LagSums:
+    """Sums over a series z of n points, centred (z_c = z − z̄): ``szz`` Σ z_c², ``uz``
+    Σ k z_c,k, ``cross`` Σ z_c,k z_c,k+1, ``first``/``last`` z_c,0 and z_c,n−1."""
+
+    n: int
+    szz: float
+    uz: float
+    cross: float
+    first: float
+    last: float
+
+
+def _lag1_from_sums(s: LagSums) -> float | None:
+    """r1 of the linearly detrended series from its :class:`LagSums` (formulas of
+    :func:`_lag1_linear_detrended`); None where the line carries nearly all of Σ z_c²
+    (the caller detrends explicitly); 0 for a constant series."""
+    n = s.n
+    if s.szz <= 0:
+        return 0.0
     uu = n * (n * n - 1.0) / 12.0
-    uz = _index_dot(zc)  # Σ k z_c = Σ u z_c, since Σ z_c = 0
-    b = uz / uu
-    scc = szz - b * b * uu
-    if not scc > 1e-6 * szz:
-        return lag1_autocorrelation(_detrend(z, 1))
+    b = s.uz / uu
+    scc = s.szz - b * b * uu
+    if not scc > 1e-6 * s.szz:
+        return None
     u0, un = -(n - 1) / 2.0, (n - 1) / 2.0
-    cross = float(zc[:-1] @ zc[1:])
-    cross -= b * (2.0 * uz - (u0 - 1.0) * float(zc[0]) - (un + 1.0) * float(zc[-1]))
+    cross = s.cross
+    cross -= b * (2.0 * s.uz - (u0 - 1.0) * s.first - (un + 1.0) * s.last)
     cross += b * b * (uu - un * un - un)
     return cross / scc
 
@@ -360,28 +384,48 @@ def identify_noise(x: FloatArray, m: int, *, dmax: int, phase_input: bool) -> No
     ym = np.diff(x[: nb * m + 1 : m]) if nb else x[:0].copy()
     if m > 1:
         ym /= m
-    if phase_input:
-        z = x[:: max(m, 1)]
-        deg, add, dm = 2, 2, dmax
-    else:
-        z = ym
-        deg, add, dm = 1, 0, dmax - 1
+    if not phase_input:
+        return identify_rate_averages(ym, dmax=dmax, own=True)
+    z = x[:: max(m, 1)]
     if z.size >= MIN_ACF_POINTS:
-        d = 0
-        if deg == 1:  # rate: r1 of the detrended averages from sums (no detrended copy)
-            r1 = _lag1_linear_detrended(z, own=True)  # ym, our own: centred in place
-            # differencing cancels the line but its constant slope, which r1's mean removes
-        else:
-            z = _detrend(z, deg)
-            r1 = lag1_autocorrelation(z)
-        while True:
-            rho = r1 / (1.0 + r1) if r1 > -1.0 else 0.0
-            if rho < 0.25 or d >= dm:
-                a = -round(2.0 * rho) - 2 * d + add
-                return NoiseId(int(a), -2.0 * (rho + d) + add, "lag1", d)
-            z = np.diff(z)
-            d += 1
-            r1 = lag1_autocorrelation(z)
+        zd = _detrend(z, 2)
+        return _lag1_differenced(lag1_autocorrelation(zd), zd, dmax, 2)
+    return _b1_identify(ym, dmax)
+
+
+def identify_rate_averages(
+    z: FloatArray, *, dmax: int, own: bool = False, sums: LagSums | None = None
+) -> NoiseId:
+    """The rate branch of :func:`identify_noise` from the m-averages ``z`` of the rate
+    (any scale and offset: block sums serve as well).  ``own``: ``z`` may be centred in
+    place; ``sums``: its :class:`LagSums` already taken (``z`` is then only read where the
+    sums cannot decide: explicit detrending, differencing, B1)."""
+    if z.size >= MIN_ACF_POINTS:
+        r1 = _lag1_from_sums(sums) if sums is not None else None
+        if r1 is None:  # r1 of the detrended averages from sums (no detrended copy)
+            r1 = _lag1_linear_detrended(z, own=own)
+        # differencing cancels the line but its constant slope, which r1's mean removes
+        return _lag1_differenced(r1, z, dmax - 1, 0)
+    return _b1_identify(z, dmax)
+
+
+def _lag1_differenced(r1: float, z: FloatArray, dm: int, add: int) -> NoiseId:
+    """Riley & Greenhall's rule: difference ``z`` until ρ = r1/(1 + r1) < 0.25 or d = dm;
+    α = −round(2ρ) − 2d + ``add``."""
+    d = 0
+    while True:
+        rho = r1 / (1.0 + r1) if r1 > -1.0 else 0.0
+        if rho < 0.25 or d >= dm:
+            a = -round(2.0 * rho) - 2 * d + add
+            return NoiseId(int(a), -2.0 * (rho + d) + add, "lag1", d)
+        z = np.diff(z)
+        d += 1
+        r1 = lag1_autocorrelation(z)
+
+
+def _b1_identify(ym: FloatArray, dmax: int) -> NoiseId:
+    """The B1 ratio of the m-averages ``ym`` against its theoretical value per noise."""
+    nb = ym.size
     if nb < MIN_B1_GROUPS:
         return NoiseId(0, float("nan"), "none", 0)
     avar = float(np.mean(np.diff(ym) ** 2)) / 2.0

@@ -157,38 +157,123 @@ def _edf(name: str, alpha: int, m: int, n_phase: int) -> float:
     return float("nan")
 
 
-def _segment_phases(
+def _stretches(
     values: npt.ArrayLike, tau0_s: float, data_type: str, segments: list[slice] | None
-) -> list[FloatArray]:
-    """The phase of each gap-free stretch of at least 3 points.  Rate data: the phase of
-    the fluctuation about each stretch's mean rate (as allantools' frequency2phase; a
-    constant rate would make TIE/MTIE the bias times τ)."""
+) -> tuple[FloatArray, list[slice], float]:
+    """The checked samples, the gap-free stretches giving at least 3 phase points and the
+    samples' sum."""
     y = np.asarray(values, dtype=np.float64).ravel()
     if not (math.isfinite(tau0_s) and tau0_s > 0):
         raise ThermocalInputError(f"sample interval τ0 must be positive, got {tau0_s!r}")
-    bad = np.flatnonzero(~np.isfinite(y))
+    # a NaN or ±inf sample makes the sum non-finite (the sum alone overflowing is rare):
+    # the full O(n) mask only then
+    bad = np.zeros(0, dtype=np.int64)
+    total = float(y.sum())
+    if not math.isfinite(total):
+        bad = np.flatnonzero(~np.isfinite(y))
     if bad.size:
         raise MissingValueError(
             f"data have {bad.size} NaN/infinite samples (first at row {bad[0]}); "
             "remove them or split the record"
         )
     slices = segments if segments is not None else [slice(0, y.size)]
-    phases = [
-        dv.as_phase(y[sl], tau0_s, data_type, y[sl].mean() if data_type == "rate" else 0.0)
-        for sl in slices
-        if sl.stop > sl.start
-    ]
-    phases = [x for x in phases if x.size >= 3]
-    if not phases:
+    extra = 1 if data_type == "rate" else 0  # rate: n samples give n + 1 phase points
+    kept = [
+        sl for sl in slices if sl.stop > sl.start and y[sl].size + extra >= 3
+    ]  # fmt: skip
+    if not kept:
         raise ThermocalInputError("stability analysis needs at least 3 contiguous points")
-    return phases
+    return y, kept, total
+
+
+class _Record:
+    """The gap-free stretches of one record, each form (phase, centred phase, octave
+    levels) built once, when a deviation first asks for it."""
+
+    def __init__(
+        self, y: FloatArray, kept: list[slice], tau0_s: float, data_type: str, names: list[str]
+    ) -> None:
+        self.y, self.kept, self.tau0_s, self.data_type, self.names = (
+            y, kept, tau0_s, data_type, names,
+        )  # fmt: skip
+        rate = data_type == "rate"
+        self.sizes = [y[sl].size + (1 if rate else 0) for sl in kept]
+        """Phase points per stretch."""
+        self.longest = self.sizes.index(max(self.sizes))
+        self._phases: list[FloatArray] | None = None
+        self._centred: list[FloatArray] | None = None
+        self._levels: dict[int, list[dv.OctaveLevel]] = {}
+        self._means: dict[int, float] = {}
+        self.m_max = 0
+        """Octave levels up to this factor (0: no octave levels; set by the caller)."""
+
+    def mean(self, i: int) -> float:
+        """Stretch i's mean sample (numpy's, as ``y[sl].mean()``)."""
+        if i not in self._means:
+            self._means[i] = float(self.y[self.kept[i]].mean())
+        return self._means[i]
+
+    def preset_mean(self, i: int, mean: float) -> None:
+        self._means[i] = mean
+
+    def phases(self) -> list[FloatArray]:
+        if self._phases is None:
+            rate = self.data_type == "rate"
+            self._phases = [
+                dv.as_phase(self.y[sl], self.tau0_s, self.data_type, self.mean(i) if rate else 0.0)
+                for i, sl in enumerate(self.kept)
+            ]
+        return self._phases
+
+    def centred(self) -> list[FloatArray]:
+        """The phases minus their end-point lines (in place unless mtie/tierms need the raw
+        phase; a line changes no α: the rate averages shift by a constant, the phase's
+        quadratic detrend removes it)."""
+        if self._centred is None:
+            raw = any(n in ("mtie", "tierms") for n in self.names)
+            self._centred = [dv.centred(x, inplace=not raw) for x in self.phases()]
+        return self._centred
+
+    def levels(self, i: int) -> list[dv.OctaveLevel]:
+        """Stretch i's octave pyramid (rate data), with the Allan/Hadamard sums if asked."""
+        if i not in self._levels:
+            self._levels[i] = dv.octave_levels(
+                self.y[self.kept[i]], self.mean(i), self.m_max,
+                d1="adev" in self.names, d2="hdev" in self.names,
+            )  # fmt: skip
+        return self._levels[i]
+
+    def identify(self, m: int, dmax: int) -> ed.NoiseId:
+        """:func:`thermocal.stability.edf.identify_noise` on the longest stretch at m: from
+        its octave level when there is one (the same m-averages, as block sums), else from
+        its centred phase."""
+        if 1 <= m <= self.m_max and m & (m - 1) == 0:
+            by_m = {lv.m: lv for lv in self.levels(self.longest)}
+            if m in by_m:
+                lv = by_m[m]
+                return ed.identify_rate_averages(lv.z, dmax=dmax, sums=lv.lag)
+            if self.sizes[self.longest] - 1 < m:  # no m-average: nothing to identify
+                return ed.identify_rate_averages(np.zeros(0), dmax=dmax)
+        x = self.centred()[self.longest]
+        return ed.identify_noise(x, m, dmax=dmax, phase_input=self.data_type == "phase")
+
+    def sums(self, name: str, m: IntArray) -> tuple[FloatArray, FloatArray]:
+        """The pooled deviation and term count of ``name`` per m over the stretches."""
+        if name in ("adev", "hdev") and self.m_max:
+            parts = [dv.octave_sums(name, self.levels(i), m) for i in range(len(self.kept))]
+        else:
+            raw = name in ("mtie", "tierms")
+            parts = [
+                dv.segment_sums(name, xr if raw else xc, self.tau0_s, m)
+                for xr, xc in zip(self.phases(), self.centred(), strict=True)
+            ]
+        return dv.pool(name, parts, m.size)
 
 
 def _noise_exponents(
     name: str,
     m: IntArray,
-    longest: FloatArray,
-    data_type: str,
+    record: _Record,
     alpha: int | None,
     id_cache: dict[tuple[int, int], ed.NoiseId],
 ) -> tuple[IntArray, tuple[str, ...]]:
@@ -206,9 +291,7 @@ def _noise_exponents(
             continue
         key = (int(mm), dmax)
         if key not in id_cache:
-            id_cache[key] = ed.identify_noise(
-                longest, int(mm), dmax=dmax, phase_input=data_type == "phase"
-            )
+            id_cache[key] = record.identify(int(mm), dmax)
         nid = id_cache[key]
         if nid.method == "none" and i > 0:  # too few averages: the shorter τ's noise
             alphas[i] = alphas[i - 1]
@@ -226,14 +309,14 @@ def _noise_exponents(
     return alphas, tuple(methods)
 
 
-def _pooled_edf(name: str, m: IntArray, alphas: IntArray, phases: list[FloatArray]) -> FloatArray:
-    """The equivalent degrees of freedom summed over the stretches long enough for each
-    factor (NaN where none contributes)."""
+def _pooled_edf(name: str, m: IntArray, alphas: IntArray, sizes: list[int]) -> FloatArray:
+    """The equivalent degrees of freedom summed over the stretches (``sizes``: their phase
+    points) long enough for each factor (NaN where none contributes)."""
     edf = np.zeros(m.size)
-    for x in phases:
+    for n_phase in sizes:
         for i, mm in enumerate(m.tolist()):
-            if mm <= dv.max_factor(name, x.size):
-                e = _edf(name, int(alphas[i]), int(mm), x.size)
+            if mm <= dv.max_factor(name, n_phase):
+                e = _edf(name, int(alphas[i]), int(mm), n_phase)
                 edf[i] += e if math.isfinite(e) and e > 0 else 0.0
     edf[edf <= 0] = np.nan
     return edf
@@ -257,15 +340,21 @@ def stability(
     exponent of the EDF instead of identifying it.  Rate data give deviations in ``unit``
     and time deviations (tdev, ttotdev, mtie, tierms) in ``unit*s``; phase data give
     deviations in ``unit/s`` and time deviations in ``unit``.
+
+    Rate data at octave τ (every m a power of 2): adev and hdev and the noise identification
+    come from each stretch's octave pyramid of block sums (:func:`.deviations.octave_levels`,
+    O(n) for all τ, no phase array); the same numbers as the phase-difference path.
     """
     from thermocal.stability.allan import confidence_interval
 
     with threadpool_limits(limits=1, user_api="blas"):  # many short dots: BLAS threads wait
         if data_type not in ("rate", "phase"):
             raise ThermocalInputError(f"--data-type {data_type!r}: use rate or phase")
-        phases = _segment_phases(values, tau0_s, data_type, segments)
-        longest = max(phases, key=lambda x: x.size)
-        n_long = longest.size
+        y, kept, total = _stretches(values, tau0_s, data_type, segments)
+        record = _Record(y, kept, tau0_s, data_type, names)
+        if len(kept) == 1 and kept[0].indices(y.size)[:2] == (0, y.size):
+            record.preset_mean(0, total / y.size)  # numpy's mean: the same sum over n
+        n_long = max(record.sizes)
         m_common = factors(
             taus,
             tau0_s,
@@ -273,27 +362,19 @@ def stability(
             if any(n != "theo1" for n in names)
             else 1,
         )
+        if data_type == "rate" and m_common.size and np.all(m_common & (m_common - 1) == 0):
+            record.m_max = int(m_common.max())
         curves: dict[str, DeviationCurve] = {}
         id_cache: dict[tuple[int, int], ed.NoiseId] = {}
-        # the line through the end points removed (in place unless mtie/tierms need the raw
-        # phase); noise identification reads the centred phase (a line changes no α: the rate
-        # averages shift by a constant, the phase's quadratic detrend removes it)
-        raw = any(n in ("mtie", "tierms") for n in names)
-        centred = [dv.centred(x, inplace=not raw) for x in phases]
-        longest = max(centred, key=lambda x: x.size)
         for name in names:
             m = (
                 factors(taus, tau0_s, dv.max_factor(name, n_long), theo1=True)
                 if name == "theo1"
                 else m_common
             )
-            parts = [
-                dv.segment_sums(name, xr if name in ("mtie", "tierms") else xc, tau0_s, m)
-                for xr, xc in zip(phases, centred, strict=True)
-            ]
-            dev, cnt = dv.pool(name, parts, m.size)
-            alphas, methods = _noise_exponents(name, m, longest, data_type, alpha, id_cache)
-            edf = _pooled_edf(name, m, alphas, phases)
+            dev, cnt = record.sums(name, m)
+            alphas, methods = _noise_exponents(name, m, record, alpha, id_cache)
+            edf = _pooled_edf(name, m, alphas, record.sizes)
             ok = np.isfinite(edf) & np.isfinite(dev)
             lo = np.full(m.size, np.nan)
             hi = np.full(m.size, np.nan)
@@ -312,8 +393,8 @@ def stability(
             tau0_s=float(tau0_s),
             data_type=data_type,
             confidence=float(confidence),
-            n_segments=len(phases),
-            n_points=int(sum(x.size for x in phases)),
+            n_segments=len(kept),
+            n_points=int(sum(record.sizes)),
             unit=unit,
         )
 
