@@ -41,6 +41,7 @@ if TYPE_CHECKING:
     import thermocal.stability.allan as _allan
     import thermocal.stability.analysis as _analysis
     import thermocal.stability.family as _family
+    import thermocal.stability.noise_model as _nm
     import thermocal.writers as _writers
 else:
     _rich_table = LazyModule("rich.table")
@@ -140,10 +141,13 @@ def allan_json(
     res: "_allan.AllanResult",
     noise: "_allan.NoiseTerms",
     dyn: "_allan.DynamicAllan | None" = None,
+    quant: "_nm.OutputQuantization | None" = None,
 ) -> dict[str, Any]:
     """The ``--json`` object of ``thermocal allan``: ``noise`` holds the fit-method
     terms, ``noise_slope`` the slope-line terms (each value or null with a reason);
-    ``dynamic`` with ``--dynamic``."""
+    ``output_quantization`` the quantisation step found in the samples (value, unit,
+    source, the noise it makes; null when they lie on no lattice); ``dynamic`` with
+    ``--dynamic``."""
     out: dict[str, Any] = {
         "tau_s": res.tau_s,
         "adev": res.adev,
@@ -164,6 +168,7 @@ def allan_json(
         "fit_coefficients": noise.fit_coefficients,
         "fit_reduced_chi2": noise.reduced_chi2,
         "fit_quality": noise.quality.to_dict() if noise.quality is not None else None,
+        "output_quantization": quant.to_dict() if quant is not None else None,
     }
     if dyn is not None:
         out["dynamic"] = dynamic_json(dyn)
@@ -176,6 +181,7 @@ def _emit_channels(
     as_json: bool,
     plot: Path | None,
     dynamics: "dict[str, _allan.DynamicAllan]",
+    quants: "dict[str, _nm.OutputQuantization | None] | None" = None,
 ) -> None:
     """Several channels: ``{"channels": {NAME: {…}}}`` or one noise-term table with a
     column per channel (the ADEV points are in the JSON and the plots)."""
@@ -200,13 +206,17 @@ def _emit_channels(
             ],
         )
         stdout.print(t)
+        for name, oq in (quants or {}).items():
+            if oq is not None:
+                stdout.print(f"{name}: {oq.line()}")
         if plot is not None:
             stdout.print(f"plots written to {plot.stem}_<channel>{plot.suffix} in {plot.parent}")
 
     emit(
         {
             "channels": {
-                name: allan_json(r, n, dynamics.get(name)) for name, (r, n) in analyses.items()
+                name: allan_json(r, n, dynamics.get(name), (quants or {}).get(name))
+                for name, (r, n) in analyses.items()
             }
         },
         as_json,
@@ -355,7 +365,8 @@ def _emit_allan(
     dynamics = {n: c.dynamic for n, c in analysis.channels.items() if c.dynamic is not None}
     if len(names) > 1:
         pairs = {n: (c.adev, c.noise) for n, c in analysis.channels.items()}
-        _emit_channels(file, pairs, as_json, plot, dynamics)
+        quants = {n: c.quantization for n, c in analysis.channels.items()}
+        _emit_channels(file, pairs, as_json, plot, dynamics, quants)
         return
     ch = analysis.channels[names[0]]
     res, noise = ch.adev, ch.noise
@@ -396,6 +407,8 @@ def _emit_allan(
                 f"noise-model fit: reduced χ² {noise.quality.reduced_chi2:.3g} on "
                 f"{noise.quality.dof} degrees of freedom — {noise.quality.quality}"
             )
+        if ch.quantization is not None:
+            stdout.print(ch.quantization.line())
         dyn = ch.dynamic
         if dyn is not None:
             stdout.print(
@@ -405,4 +418,4 @@ def _emit_allan(
         if plot is not None:
             stdout.print(f"plot written to {plot}")
 
-    emit(allan_json(res, noise, ch.dynamic), as_json, human)
+    emit(allan_json(res, noise, ch.dynamic, ch.quantization), as_json, human)

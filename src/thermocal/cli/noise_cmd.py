@@ -157,4 +157,7 @@ def noise_cmd(
             f"{ax.density.unit}; {ax.walk.unit}", f"{ax.density.method}; {ax.walk.method}",
         )  # fmt: skip
     stdout.print(table)
+    for ax in res.axes:
+        if ax.quantization is not None:
+            stdout.print(f"{ax.name}: {ax.quantization.line()}")
     stdout.print(f"{out_format} noise model written to {output} (per sensor the largest axis)")

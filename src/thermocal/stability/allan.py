@@ -49,7 +49,14 @@ rate_ramp R          °/h/h               µg/h                         U/s
 (``(°/h)·s`` is exactly one arcsec; ``(°/h)·√s = (°/√h)/60``.)  Rates in ``deg/s``
 or ``rad/s`` keep the data's own unit (:data:`ANGLE_RATE_TERMS`): Q in arcsec or µrad,
 N in °/√h or rad/√h, B in °/s or rad/s, K in (°/s)/√h or (rad/s)/√h, R in (°/s)/h or
-(rad/s)/h.  Accelerations in ``g``, ``ug``, ``m/s^2`` are first scaled to [mg].
+(rad/s)/h.  Accelerations in ``g`` and ``ug`` are first scaled to [mg] (their g family);
+in ``m/s^2`` they keep the SI family (:data:`SI_ACCEL_TERMS`): Q in m/s, N in m/s/√h,
+B in m/s², K in (m/s²)/√h, R in (m/s²)/h.
+
+These are IEEE Std 952's coefficient units (IEEE Std 952-1997 Annex C; the INTERFACE's
+list for IEEE 952-2020: Q in angle, ″ or µrad; N in °/√h; K in (°/h)/√h; B in °/h; R in
+(°/h)/h = °/h²), expressed in the data's unit family as the project's rule asks.  The
+2020 text itself was not at hand to check against (issue 29 item 2 review).
 
 References: IEEE Std 952-1997 (R2008) Annex C; W. J. Riley, *Handbook of
 Frequency Stability Analysis*, NIST SP 1065 (2008); IEEE Std 1554-2005.
@@ -791,6 +798,17 @@ ANGLE_RATE_TERMS: Final[dict[str, tuple[tuple[float, str, str], ...]]] = {
 (rate terms in the data's rate unit, angle terms in its angle unit) on IEEE 952's time
 bases (√h, h); (factor, unit, label) per term as :func:`term_units` gives them."""
 
+SI_ACCEL_TERMS: Final[tuple[tuple[float, str, str], ...]] = (
+    (1.0, "m/s", "velocity quantization"),  # (m/s²)·s = m/s
+    (_SQRT_H_PER_SQRT_S, "m/s/sqrt(h)", "velocity random walk"),  # m/s/√s = 60 m/s/√h
+    (1.0, "m/s^2", "bias instability"),
+    (_SQRT_H_PER_SQRT_S, "m/s^2/sqrt(h)", "acceleration random walk"),
+    (units.SECONDS_PER_HOUR, "m/s^2/h", "acceleration ramp"),
+)
+"""Noise-term units of accelerations in [m/s²]: the data's SI family (issue 29: before,
+m/s² data were reported in µg), on IEEE 952's time bases (√h, h): velocity random walk in
+m/s/√h as the INTERFACE's "Stability analysis" row gives it."""
+
 
 def term_units(unit: str) -> tuple[float, tuple[tuple[float, str, str], ...]]:
     """Scale to the base unit and, per term, (factor, unit string, label).
@@ -804,6 +822,8 @@ def term_units(unit: str) -> tuple[float, tuple[tuple[float, str, str], ...]]:
         u = unit
     if u in ANGLE_RATE_TERMS:
         return 1.0, ANGLE_RATE_TERMS[u]
+    if u == "m/s^2":
+        return 1.0, SI_ACCEL_TERMS
     if u in units.RATE_UNITS:
         return units.RATE_UNITS[u], (
             (1.0, "arcsec", "quantization"),
@@ -1153,6 +1173,7 @@ def noise_terms(
 __all__ = [
     "BIAS_INSTABILITY_FACTOR",
     "ONE_SIGMA_CONFIDENCE",
+    "SI_ACCEL_TERMS",
     "TERM_NAMES",
     "AllanResult",
     "DynamicAllan",

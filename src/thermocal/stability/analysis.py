@@ -33,7 +33,7 @@ if TYPE_CHECKING:
     from thermocal.recording import Recording
     from thermocal.stability.allan import AllanResult, DynamicAllan, NoiseTerms
     from thermocal.stability.family import StabilityResult
-    from thermocal.stability.noise_model import AxisNoise, NoiseModel
+    from thermocal.stability.noise_model import AxisNoise, NoiseModel, OutputQuantization
 
     FloatArray = npt.NDArray[np.float64]
 
@@ -76,11 +76,14 @@ def signal_in_data_unit(rec: Recording, name: str) -> tuple[FloatArray, str]:
 
 @dataclass(frozen=True, eq=False)
 class AllanChannel:
-    """One channel's overlapping ADEV, its noise terms and (``--dynamic``) dynamic ADEV."""
+    """One channel's overlapping ADEV, its noise terms, (``--dynamic``) dynamic ADEV and
+    the output quantisation found in the samples
+    (:func:`thermocal.stability.noise_model.output_quantization`; None: not quantised)."""
 
     adev: AllanResult
     noise: NoiseTerms
     dynamic: DynamicAllan | None = None
+    quantization: OutputQuantization | None = None
 
 
 @dataclass(frozen=True, eq=False)
@@ -175,9 +178,11 @@ def _allan_channel(
 ) -> AllanChannel:
     """One channel's ADEV, noise terms and dynamic ADEV, with their warnings."""
     from thermocal.stability import allan
+    from thermocal.stability import noise_model as nm
 
     # every figure in the data's own unit (°/s data: ADEV in °/s; INTERFACE common rules)
     values, unit = signal_in_data_unit(rec, name)
+    lattice = nm.lattice_step(values)  # before the ADEV overwrites the values
     res = allan.overlapping_adev(
         values,
         rec.sample_interval_s,
@@ -193,10 +198,12 @@ def _allan_channel(
         overwrite=named_once and dynamic_s is None,
     )
     noise = allan.noise_terms(res)
+    quant = nm.quantization_from_lattice(lattice, rec.sample_interval_s, unit, noise)
+    noise = nm.annotate_quantization(noise, quant)
     if noise.quality is not None and noise.quality.quality == "poor":
         warnings.warn(f"{where}: {noise.quality.reason}", ConditioningWarning, stacklevel=1)
     if dynamic_s is None:
-        return AllanChannel(res, noise)
+        return AllanChannel(res, noise, quantization=quant)
     dyn = allan.dynamic_adev(values, rec.sample_interval_s, dynamic_s, res, time_s=rec.time_s)
     if not dyn.stationary:
         worst = max(dyn.changes, key=lambda c: abs(math.log(c["adev"] / c["whole_adev"])))
@@ -210,7 +217,7 @@ def _allan_channel(
             ConditioningWarning,
             stacklevel=1,
         )
-    return AllanChannel(res, noise, dyn)
+    return AllanChannel(res, noise, dyn, quant)
 
 
 @dataclass(frozen=True, eq=False)

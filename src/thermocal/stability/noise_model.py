@@ -29,6 +29,7 @@ random walk ``σ_d = σ_c · √Δt``.
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
 from dataclasses import dataclass
@@ -104,7 +105,9 @@ class AxisNoise:
     """The Allan analysis of one axis and its two Kalibr coefficients.
 
     ``unit`` the data's own unit (of ``allan`` and ``terms``); ``density`` the white-noise
-    density, ``walk`` the random-walk strength, both in SI (:data:`SI_UNIT` per √Hz).
+    density, ``walk`` the random-walk strength, both in SI (:data:`SI_UNIT` per √Hz);
+    ``quantization`` the output quantisation found in the samples (None: not quantised;
+    a rate quantisation's white noise is part of ``density``).
     """
 
     name: str
@@ -114,6 +117,7 @@ class AxisNoise:
     terms: NoiseTerms
     density: ContinuousTerm
     walk: ContinuousTerm
+    quantization: OutputQuantization | None = None
 
 
 @dataclass(frozen=True, eq=False)
@@ -238,16 +242,20 @@ def axis_noise(
             f"the noise model needs one of {', '.join(kind_units)} "
             f"(--{'gyro' if sensor == 'gyro' else 'accel'}-unit)"
         )
+    lattice = lattice_step(values)
     res = overlapping_adev(
         values, tau0_s, taus, time_s=time_s, segments=segments, unit=u, confidence=confidence
     )
     terms = noise_terms(res)
+    quant = quantization_from_lattice(lattice, tau0_s, u, terms)
+    terms = annotate_quantization(terms, quant)
     return AxisNoise(
         name=name,
         sensor=sensor,
         unit=u,
         allan=res,
         terms=terms,
+        quantization=quant,
         density=_choose("density", sensor, u, res, terms),
         walk=_choose("walk", sensor, u, res, terms),
     )
@@ -327,6 +335,13 @@ def kalibr_yaml(model: NoiseModel, source: str) -> str:
             )
             lines.append(f"# {key} [{t.unit}]: {words} of axis {ax.name}, from {how}.")
             lines.append(f"#   quality {t.quality}; axes: {others}.")
+            oq = ax.quantization
+            if white and oq is not None and oq.kind == "rate":
+                lines.append(
+                    f"#   {ax.name} is quantised at {oq.step:.6g} {oq.unit}: its rounding, "
+                    f"white noise of {oq.white_density:.4g} {oq.white_density_unit}, is "
+                    "part of this density."
+                )
             if t.low is not None and t.high is not None:
                 lines.append(
                     f"#   {model.confidence * 100:.1f} % interval of {ax.name}: "
@@ -393,7 +408,8 @@ def model_json(model: NoiseModel, source: str) -> dict[str, Any]:
     axis ``terms`` (every IEEE 952 term in the data's unit: the slope reading where it
     exists, else the fit; ``value``, ``unit``, ``low``, ``high``, ``tau_s``, ``method``,
     ``quality``, ``reason``), ``terms_fit`` (all fitted terms), ``noise_density`` and
-    ``random_walk`` (continuous time, SI)."""
+    ``random_walk`` (continuous time, SI), ``output_quantization``
+    (:meth:`OutputQuantization.to_dict`, null when the samples lie on no lattice)."""
     axes: dict[str, Any] = {}
     for ax in model.axes:
         slope, fit = ax.terms.slope.terms(), ax.terms.fit.terms()
@@ -403,6 +419,7 @@ def model_json(model: NoiseModel, source: str) -> dict[str, Any]:
             "terms": {k: _best(slope[k], fit[k]) for k in slope},
             "terms_fit": {k: _term_json(fit[k], "fit") for k in fit},
             "fit_quality": ax.terms.quality.to_dict() if ax.terms.quality else None,
+            "output_quantization": ax.quantization.to_dict() if ax.quantization else None,
             "noise_density": _continuous_json(ax.density),
             "random_walk": _continuous_json(ax.walk),
         }
@@ -419,14 +436,262 @@ def model_json(model: NoiseModel, source: str) -> dict[str, Any]:
     }
 
 
+# --- output quantisation (issue 29 item 2) ---------------------------------------------------
+
+QUANT_MIN_LEVELS: Final = 3
+"""Distinct output levels a quantised record must show (two levels give no lattice)."""
+
+QUANT_MIN_REPEAT: Final = 20
+"""A quantised record visits each level this many times on average at least: ordinary
+floating-point data have about as many distinct values as samples."""
+
+QUANT_RTOL: Final = 1e-3
+"""Every sample lies within this fraction of a step of the lattice (unit conversions
+of the stored values leave ~1e-12 of a step; float32 storage ~1e-4)."""
+
+_QUANT_PROBE: Final = 200_000
+"""Samples (evenly strided) the lattice step is found from before the whole record is checked."""
+
+_QUANT_MERGE: Final = 1e-9
+"""Distinct values closer than this fraction of the sample range are one level."""
+
+_SQRT12: Final = math.sqrt(12.0)
+
+
+@dataclass(frozen=True)
+class OutputQuantization:
+    """A sensor output found quantised: every sample lies on ``offset + k·step``.
+
+    ``step`` [``unit``, the data's own unit]; ``levels`` distinct levels used; ``kind``
+    ``"rate"`` (the rate output is rounded: the rounding errors are independent from
+    sample to sample, i.e. white rate noise) or ``"angle"`` (the integrated output is
+    rounded and the remainder carried, as a pulse-output or delta-angle sensor does: the
+    angle error stays bounded and the Allan deviation falls as τ⁻¹).
+
+    Relations (a uniform rounding error has variance step²/12):
+
+    * rate quantisation: white rate noise of variance step²/12 per sample, the angle random
+      walk ``N_q = step·√(τ0/12)`` [unit·√s] (``σ_q²(τ) = N_q²/τ``, slope −½): it is part
+      of the measured N, not a separate τ⁻¹ term;
+    * angle quantisation at the angle step ``step·τ0``: IEEE Std 952-1997 Annex C.1,
+      ``σ²(τ) = 3Q²/τ²`` (slope −1, read at τ = √3 s) with ``Q = step·τ0/√12`` [unit·s].
+
+    ``white_density``/``angle_q`` are N_q and Q in the units the noise terms use
+    (:func:`thermocal.stability.allan.term_units`); ``share`` the fraction of the measured
+    term's variance explained by the quantisation (rate: N_q²/N² with N the slope line's,
+    else the fit's; angle: Q²/Q_fit²), None when the
+    record shows no such term; ``quality`` ``good`` or ``rough`` with ``reason``.
+    """
+
+    step: float
+    unit: str
+    offset: float
+    levels: int
+    n_samples: int
+    kind: str
+    white_density: float
+    white_density_unit: str
+    angle_q: float
+    angle_q_unit: str
+    share: float | None
+    quality: str
+    reason: str | None
+    source: str
+
+    def to_dict(self) -> dict[str, Any]:
+        """The ``output_quantization`` JSON object (a noise term: value, unit, source)."""
+        return {
+            "value": self.step,
+            "unit": self.unit,
+            "term": f"{self.kind} quantization step",
+            "kind": self.kind,
+            "levels": self.levels,
+            "n_samples": self.n_samples,
+            "white_density": {"value": self.white_density, "unit": self.white_density_unit},
+            "angle_q": {"value": self.angle_q, "unit": self.angle_q_unit},
+            "share": self.share,
+            "quality": self.quality,
+            "reason": self.reason,
+            "source": self.source,
+        }
+
+    def line(self) -> str:
+        """One line for the text output."""
+        if self.kind == "rate":
+            how = (
+                f"rate quantisation = white rate noise N_q = {self.white_density:.4g} "
+                f"{self.white_density_unit}"
+            )
+            if self.share is not None:
+                how += f" ({100 * self.share:.3g} % of the measured N²)"
+        else:
+            how = f"angle quantisation Q = {self.angle_q:.4g} {self.angle_q_unit}"
+            if self.share is not None:
+                how += f" ({100 * self.share:.3g} % of the fitted Q²)"
+        return (
+            f"output quantised: step {self.step:.6g} {self.unit} ({self.levels} levels): {how}"
+            + (f"; rough: {self.reason}" if self.reason else "")
+        )
+
+
+def lattice_step(
+    values: npt.ArrayLike, *, rtol: float = QUANT_RTOL
+) -> tuple[float, float, int, int] | None:
+    """The lattice ``offset + k·step`` the finite samples lie on, as (step, offset, levels,
+    finite samples),
+    or None when they lie on none (:data:`QUANT_MIN_LEVELS`, :data:`QUANT_MIN_REPEAT`).
+
+    The step is found on at most :data:`_QUANT_PROBE` evenly strided samples: the distinct
+    values u sorted, their gaps d, the smallest gap d_min; the step is d_min / j for the
+    smallest j = 1 … 10 that makes every gap an integer multiple within ``rtol`` (a gcd of
+    the gaps with a tolerance; gaps below 1e-9 of the range are rounding within one level);
+    refined as (u_max − u_min) / Σ k.  Then every sample of the
+    record is checked: |(v − offset)/step − round(·)| ≤ ``rtol``.
+    """
+    v = np.asarray(values, dtype=np.float64)
+    v = v[np.isfinite(v)]
+    n = v.size
+    if n < QUANT_MIN_LEVELS * QUANT_MIN_REPEAT:
+        return None
+    probe = v[:: max(1, n // _QUANT_PROBE)]
+    u = np.unique(probe)
+    if u.size < QUANT_MIN_LEVELS or u.size * QUANT_MIN_REPEAT > probe.size:
+        return None
+    d = np.diff(u)
+    # values a few ulps apart are one level (a rate formed as Δangle/τ0 is not exact)
+    d = d[d > _QUANT_MERGE * float(u[-1] - u[0])]
+    if d.size + 1 < QUANT_MIN_LEVELS:
+        return None
+    d_min = float(d.min())
+    for j in range(1, 11):
+        r = d / (d_min / j)
+        k = np.rint(r)
+        if float(np.max(np.abs(r - k))) <= rtol:
+            break
+    else:
+        return None
+    step = float(u[-1] - u[0]) / float(k.sum())  # the gaps between the extreme levels
+    offset = float(u[0])
+    # the whole record, in blocks (no array of n quotients)
+    lo_k, hi_k = math.inf, -math.inf
+    for a in range(0, n, 1 << 20):
+        q = (v[a : a + (1 << 20)] - offset) / step
+        kk = np.rint(q)
+        if float(np.max(np.abs(q - kk))) > rtol:
+            return None
+        lo_k, hi_k = min(lo_k, float(kk.min())), max(hi_k, float(kk.max()))
+    span = int(hi_k - lo_k) + 1
+    if span > 1 << 24:  # a lattice of more levels than that is no quantisation to report
+        return None
+    seen = np.zeros(span, dtype=bool)
+    for a in range(0, n, 1 << 20):
+        kk = np.rint((v[a : a + (1 << 20)] - offset) / step) - lo_k
+        seen[kk.astype(np.int64)] = True
+    levels = int(np.count_nonzero(seen))
+    if levels < QUANT_MIN_LEVELS or levels * QUANT_MIN_REPEAT > n:
+        return None
+    return step, offset, levels, n
+
+
+def output_quantization(
+    values: npt.ArrayLike, tau0_s: float, unit: str, terms: NoiseTerms | None = None
+) -> OutputQuantization | None:
+    """The output quantisation of a rate record in its own unit ``unit`` (sampled every
+    ``tau0_s`` [s]) found from the data (:func:`lattice_step`), or None when the samples
+    lie on no lattice.  Call it before the Allan deviation overwrites ``values``.
+
+    ``terms`` (the record's noise terms) decide the kind and the share: ``angle`` when the
+    least-squares fit finds a significant τ⁻¹ (Q) term — rounding a rate does not make one,
+    carrying the rounding remainder of an integrated output does (IEEE 952 C.1) — else
+    ``rate`` (see :class:`OutputQuantization` for both relations).
+    """
+    return quantization_from_lattice(lattice_step(values), tau0_s, unit, terms)
+
+
+def quantization_from_lattice(
+    found: tuple[float, float, int, int] | None,
+    tau0_s: float,
+    unit: str,
+    terms: NoiseTerms | None = None,
+) -> OutputQuantization | None:
+    """:func:`output_quantization` from the lattice :func:`lattice_step` found (None: none)."""
+    if found is None:
+        return None
+    step, offset, levels, n = found
+    scale, specs = term_units(unit)
+    n_q = step * math.sqrt(tau0_s / 12.0) * scale * specs[1][0]  # unit·√s → N's unit
+    q_q = step * tau0_s / _SQRT12 * scale * specs[0][0]  # unit·s → Q's unit
+    kind, share = "rate", None
+    if terms is not None:
+        q_fit = terms.fit.quantization
+        if q_fit.value is not None:
+            kind, share = "angle", (q_q / q_fit.value) ** 2
+        else:
+            arw = terms.slope.angle_random_walk
+            if arw.value is None:
+                arw = terms.fit.angle_random_walk
+            if arw.value is not None and arw.value > 0:
+                share = (n_q / arw.value) ** 2
+    rough = levels < 5
+    return OutputQuantization(
+        step=step, unit=unit, offset=offset, levels=levels, n_samples=n, kind=kind,
+        white_density=n_q, white_density_unit=specs[1][1], angle_q=q_q,
+        angle_q_unit=specs[0][1], share=share, quality="rough" if rough else "good",
+        reason=(
+            f"only {levels} levels: the noise is not much larger than the step, so the "
+            "rounding error is not independent of the signal and step²/12 holds roughly"
+            if rough
+            else None
+        ),
+        source=(
+            "the samples lie on a lattice of this step (the gcd of the gaps between the "
+            "distinct sample values, every sample within "
+            f"{QUANT_RTOL:g} step of it); a uniform rounding error has variance step²/12 "
+            "(IEEE Std 952-1997 Annex C.1)"
+        ),
+    )  # fmt: skip
+
+
+def annotate_quantization(terms: NoiseTerms, quant: OutputQuantization | None) -> NoiseTerms:
+    """``terms`` with the quantization term's reason naming a rate quantisation: rounding a
+    rate is white rate noise (inside N), so IEEE 952's τ⁻¹ term stays null."""
+    if quant is None or quant.kind != "rate":
+        return terms
+
+    def note(t: NoiseTerm) -> NoiseTerm:
+        if t.value is not None:
+            return t
+        why = (
+            f"the rate output is quantised (step {quant.step:.6g} {quant.unit}): rounding a "
+            "rate is white rate noise, inside the angle random walk (N_q = "
+            f"{quant.white_density:.4g} {quant.white_density_unit}), not a τ⁻¹ term; "
+            f"{t.reason}"
+        )
+        return dataclasses.replace(t, reason=why)
+
+    return dataclasses.replace(
+        terms,
+        slope=dataclasses.replace(terms.slope, quantization=note(terms.slope.quantization)),
+        fit=dataclasses.replace(terms.fit, quantization=note(terms.fit.quantization)),
+    )
+
+
 __all__ = [
     "KALIBR_KEYS",
+    "QUANT_MIN_LEVELS",
+    "QUANT_MIN_REPEAT",
+    "QUANT_RTOL",
     "SI_UNIT",
     "AxisNoise",
     "ContinuousTerm",
     "NoiseModel",
+    "OutputQuantization",
+    "annotate_quantization",
     "axis_noise",
     "kalibr_yaml",
+    "lattice_step",
     "model_json",
     "noise_model",
+    "output_quantization",
+    "quantization_from_lattice",
 ]
