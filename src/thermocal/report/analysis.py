@@ -257,7 +257,7 @@ def shown_figures(
     from thermocal.recording import contiguous_slices
 
     def each() -> list[tuple[float | None, float | None]]:
-        out = []
+        out: list[tuple[float | None, float | None]] = []
         for x in series:
             f = figures_of_merit(time_s, x, unit, averaging_s=averaging_s, meta=meta,
                                  temp_name=temp_name, temp_c=temp_c)  # fmt: skip

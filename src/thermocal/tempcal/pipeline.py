@@ -337,13 +337,15 @@ class OutputSet:
 
     def finish_reports(self) -> None:
         """Every report of the set written: those not begun by the worker are built here,
-        in their order, then the worker's awaited (the class docstring)."""
+        the last first (the worker goes on with the earlier ones), then the worker's
+        awaited (the class docstring)."""
         from thermocal.writers import WRITTEN
 
         pending, self._pending = self._pending, []
         assert self.reporter is not None or not pending
-        mine = [(f, p, r) for f, p, r in reversed(pending) if f.cancel()]  # not begun there
-        for _f, path, request in reversed(mine):
+        for fut, path, request in reversed(pending):  # the last first: the worker goes on
+            if not fut.cancel():  # begun (or done) there, and so every one before it
+                break
             self.reporter(path, request)  # type: ignore[misc]
         for fut, path, request in pending:
             if fut.cancelled():
@@ -388,6 +390,39 @@ def _report_pool() -> Any:
     return ProcessPoolExecutor(max_workers=1, mp_context=multiprocessing.get_context(method))
 
 
+PARALLEL_MIN_BYTES = 10_000_000
+"""A log of at least this size [bytes] starts the report worker before it is read
+(:func:`report_worker`)."""
+
+
+def _warm_job(reporter: Reporter) -> None:
+    """In the worker: the reporter's ``warm()`` when it has one (imports, fonts)."""
+    warm = getattr(reporter, "warm", None)
+    if callable(warm):
+        warm()
+
+
+@contextlib.contextmanager
+def report_worker(reporter: Reporter | None, log: Path) -> Iterator[Any]:
+    """The report worker of :class:`OutputSet` started before a large log
+    (:data:`PARALLEL_MIN_BYTES`) is read, so that its start and the reporter's ``warm()``
+    (imports, fonts: a second or so) overlap the reading; None when the reports are built
+    here (:func:`report_workers`, a small log).  Stopped at the end of the block."""
+    pool = None
+    try:
+        big = log.stat().st_size >= PARALLEL_MIN_BYTES
+    except OSError:  # said by the reader
+        big = False
+    if reporter is not None and big and report_workers() > 0:
+        pool = _report_pool()
+        pool.submit(_warm_job, reporter)
+    try:
+        yield pool
+    finally:
+        if pool is not None:
+            pool.shutdown(wait=True, cancel_futures=True)
+
+
 def report_workers() -> int:
     """Worker processes for reports: 1 on a machine with two cores or more, else 0."""
     import os
@@ -402,13 +437,15 @@ def check_output_dir(output: Path) -> None:
 
 
 @contextlib.contextmanager
-def staged_set(output: Path, reporter: Reporter | None) -> Iterator[OutputSet]:
+def staged_set(output: Path, reporter: Reporter | None, pool: Any = None) -> Iterator[OutputSet]:
     """A new staging directory for ``output`` (:func:`thermocal.writers.staging_directory`);
     on any failure — a later sensor's error, Ctrl-C — it is removed
-    (:func:`thermocal.writers.discard_staging`), so that no part of the set is left."""
+    (:func:`thermocal.writers.discard_staging`), so that no part of the set is left.
+    ``pool``: the report worker already started (:func:`report_worker`)."""
     from thermocal.writers import discard_staging, staging_directory
 
     out = OutputSet(output, staging_directory(output), reporter, workers=report_workers())
+    out._pool = pool
     try:
         yield out
     except BaseException:
