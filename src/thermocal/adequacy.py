@@ -51,9 +51,11 @@ ramps; the temperature-rate terms need ramps of both signs), IEEE Std 952-2020 A
 
 from __future__ import annotations
 
+import contextlib
+import contextvars
 import math
 import warnings
-from collections.abc import Iterable, Sequence
+from collections.abc import Iterable, Iterator, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -508,7 +510,41 @@ def _runs_of(mask: npt.NDArray[np.bool_]) -> list[tuple[int, int]]:
     return [(int(a), int(b)) for a, b in zip(edges[::2], edges[1::2], strict=True)]
 
 
+_STILL_MEMO: contextvars.ContextVar[list[tuple[Any, Any, float, float, Motion]] | None] = (
+    contextvars.ContextVar("thermocal_stillness_memo", default=None)
+)
+
+
+@contextlib.contextmanager
+def stillness_remembered() -> Iterator[None]:
+    """Within the block, :func:`stillness` of the same two array objects (identity, not
+    equality), floor and k_sigma is computed once and its :class:`Motion` returned again
+    (the adequacy judgement and the bump mask of one sensor ask for it twice).  The
+    arrays must not be changed in place within the block."""
+    token = _STILL_MEMO.set([])
+    try:
+        yield
+    finally:
+        _STILL_MEMO.reset(token)
+
+
 def stillness(
+    time_s: npt.ArrayLike, values: npt.ArrayLike, floor: float, *, k_sigma: float = STILL_K_SIGMA
+) -> Motion:
+    """Tell motion from thermal drift (the formula and its source: :func:`_stillness`);
+    remembered within :func:`stillness_remembered`."""
+    memo = _STILL_MEMO.get()
+    if memo is None:
+        return _stillness(time_s, values, floor, k_sigma=k_sigma)
+    for t_seen, v_seen, f_seen, k_seen, got in memo:
+        if t_seen is time_s and v_seen is values and f_seen == floor and k_seen == k_sigma:
+            return got
+    got = _stillness(time_s, values, floor, k_sigma=k_sigma)
+    memo.append((time_s, values, floor, k_sigma, got))
+    return got
+
+
+def _stillness(
     time_s: npt.ArrayLike, values: npt.ArrayLike, floor: float, *, k_sigma: float = STILL_K_SIGMA
 ) -> Motion:
     """Tell motion from thermal drift.

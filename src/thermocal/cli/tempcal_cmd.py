@@ -62,6 +62,22 @@ def write_report(path: Path, req: "ReportRequest | OffsetReportRequest") -> None
     )  # fmt: skip
 
 
+def _warm_reports() -> None:
+    """What the first report costs beyond its own work (the report modules imported, a
+    log-axis figure drawn: fonts and tick labels), paid by the report worker while the log
+    is read (:func:`thermocal.tempcal.pipeline.report_worker`)."""
+    import numpy as np
+
+    from thermocal.report import calibration as _calibration  # noqa: F401
+    from thermocal.report import figures as F
+
+    tau = np.logspace(-2, 3, 12)
+    F.allan_grid([("x", "unit", [F.AllanCurve("before", tau, 1.0 / tau, None, None)])] * 3)
+
+
+write_report.warm = _warm_reports  # type: ignore[attr-defined]
+
+
 @app.command("px4-tempcal")
 @handle_errors
 def px4_tempcal_cmd(

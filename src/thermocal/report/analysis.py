@@ -233,6 +233,73 @@ def figures_of_merit(
     )
 
 
+def shown_figures(
+    time_s: FloatArray,
+    series: tuple[FloatArray, ...],
+    unit: str,
+    *,
+    averaging_s: float,
+    meta: Metadata,
+    temp_name: str,
+    temp_c: FloatArray,
+) -> list[tuple[float | None, float | None]]:
+    """(bias stability, least-squares temperature sensitivity) [``unit``, ``unit``/°C] of
+    each of ``series`` — the two figures of :func:`figures_of_merit` a calibration report
+    shows, by the same formulas (:func:`thermocal.metrics.compute_metrics`: the standard
+    deviation of the ``averaging_s`` block means, never across a gap; the slope of the hold
+    stages' mean biases, pooled by set-point within 0.5 °C, against their temperatures),
+    with the gaps, the sample interval and the hold stages found once for all the series
+    (they depend on the time and temperature only; issue 28: the report of a long log
+    found them dozens of times).  With an earth rate to remove (a latitude or axis in
+    ``meta``), or fewer than two averages (its error), :func:`figures_of_merit` per series."""
+    from thermocal.metrics import block_means, data_unit_of, temperature_sensitivity
+    from thermocal.preprocess import segment_holds
+    from thermocal.recording import contiguous_slices
+
+    def each() -> list[tuple[float | None, float | None]]:
+        out: list[tuple[float | None, float | None]] = []
+        for x in series:
+            f = figures_of_merit(time_s, x, unit, averaging_s=averaging_s, meta=meta,
+                                 temp_name=temp_name, temp_c=temp_c)  # fmt: skip
+            out.append((f.bias_stability, f.sensitivity_slope))
+        return out
+
+    if meta.latitude_deg is not None or meta.axis is not None:
+        return each()
+    m = dataclasses.replace(meta, scale_factor=None, scale_factor_unit=None)
+    rec = Recording.from_arrays(time_s, {"signal": series[0]}, {temp_name: temp_c},
+                                signal_unit=unit, meta=m)  # fmt: skip
+    t, temp = rec.time_s, rec.temperature_c(temp_name)
+    tau0 = rec.sample_interval_s
+    slices = contiguous_slices(t, scan=rec.time_scan())
+    holds = [
+        s for s in segment_holds(t, temp, rate_threshold_c_per_min=0.05, min_duration_s=600.0)
+        if s.kind == "hold" and s.stop > s.start
+    ]  # compute_metrics' defaults  # fmt: skip
+    st_temps = np.array([float(np.mean(temp[s.start : s.stop])) for s in holds])
+    key = np.round(st_temps * 2.0) / 2.0  # hold stages at one set-point (0.5 °C) are pooled
+    uniq = np.unique(key)
+    out: list[tuple[float | None, float | None]] = []
+    for x in series:
+        one = dataclasses.replace(rec, columns={**rec.columns, "signal": np.asarray(x)})
+        canon_values, canon = one.signal("signal")
+        shown, k = data_unit_of(one, "signal", canon)
+        values = np.asarray(canon_values, dtype=np.float64).ravel()
+        values = values if k == 1.0 else values / k
+        parts = [block_means(values[sl], tau0, averaging_s) for sl in slices]
+        means = np.concatenate(parts) if parts else np.zeros(0)
+        if means.size < 2:
+            return each()
+        slope = None
+        if len(holds) >= 2 and uniq.size >= 2:
+            st_bias = np.array([float(np.mean(values[s.start : s.stop])) for s in holds])
+            pt = np.array([st_temps[key == q].mean() for q in uniq])
+            pb = np.array([st_bias[key == q].mean() for q in uniq])
+            slope = temperature_sensitivity(pt, pb, unit=shown).ls_slope
+        out.append((float(np.std(means, ddof=1)), slope))
+    return out
+
+
 NOISE_TERMS = (
     ("quantization", "Quantization noise Q"),
     ("angle_random_walk", "Angle random walk N"),

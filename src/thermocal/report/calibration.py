@@ -39,7 +39,7 @@ from thermocal.models.base import model_file_dict
 from thermocal.models.calibration import Calibration
 from thermocal.readers.common import sha256_of
 from thermocal.recording import Recording
-from thermocal.report.analysis import allan_of, apply_model, figures_of_merit
+from thermocal.report.analysis import allan_of, apply_model, shown_figures
 from thermocal.report.build import (
     ILL_CONDITIONED,
     _b64,
@@ -114,17 +114,15 @@ def _verdict(v: dict[str, Any] | None) -> tuple[str, str]:
     return ("pass" if text == "improved" else "fail"), text
 
 
-def _figures_in(fom: Any, k: float) -> dict[str, float | None]:
-    """Bias stability and temperature sensitivity of a :class:`FiguresOfMerit` (canonical
-    unit) in the data's unit (``value[data] = value[canonical] / k``)."""
+def _figures_in(stab: float | None, slope: float | None, k: float) -> dict[str, float | None]:
+    """Bias stability and temperature sensitivity (canonical unit,
+    :func:`thermocal.report.analysis.shown_figures`) in the data's unit
+    (``value[data] = value[canonical] / k``)."""
 
     def div(v: float | None) -> float | None:
         return None if v is None else float(v) / k
 
-    return {
-        "bias_stability": div(fom.bias_stability),
-        "sensitivity_slope": div(fom.sensitivity_slope),
-    }
+    return {"bias_stability": div(stab), "sensitivity_slope": div(slope)}
 
 
 def _channel_merits(
@@ -135,21 +133,16 @@ def _channel_merits(
     before, after = applied.before / k, applied.after / k
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        fom = [
-            _figures_in(
-                figures_of_merit(
-                    rec.time_s,
-                    x,
-                    applied.unit,
-                    averaging_s=averaging_s,
-                    meta=rec.meta,
-                    temp_name=applied.temp_names[0],
-                    temp_c=applied.temps_c[:, 0],
-                ),
-                k,
-            )
-            for x in (applied.before, applied.after)
-        ]
+        shown = shown_figures(
+            rec.time_s,
+            (applied.before, applied.after),
+            applied.unit,
+            averaging_s=averaging_s,
+            meta=rec.meta,
+            temp_name=applied.temp_names[0],
+            temp_c=applied.temps_c[:, 0],
+        )
+        fom = [_figures_in(stab, slope, k) for stab, slope in shown]
         allan = [allan_of(rec.time_s, x, tau0, unit) for x in (before, after)]
     return fom, allan, [" ".join(str(w.message).split()) for w in caught]
 

@@ -172,8 +172,9 @@ def fit_sensor(
     where = f"{topic}.{instance}"
     vals = np.column_stack([rec.signal(a)[0] for a in AXES])  # canonical unit (°/h or mg)
     unit = rec.signal(AXES[0])[1]
-    record = judge_sensor(rec, where, kind, vals, overrides, firmware)
-    motion = adequacy.stillness(rec.time_s, vals, motion_floor(kind))
+    with adequacy.stillness_remembered():  # the judgement's stillness, not computed twice
+        record = judge_sensor(rec, where, kind, vals, overrides, firmware)
+        motion = adequacy.stillness(rec.time_s, vals, motion_floor(kind))
     if motions is not None:
         motions[where] = motion
     keep = still_mask(rec.time_s, motion)
@@ -270,32 +271,163 @@ Reporter = Callable[[Path, ReportRequest | OffsetReportRequest], object]
 layer does not import the presentation layer."""
 
 
+PARALLEL_MIN_SAMPLES = 100_000
+"""A sensor's report is built in a worker process, beside the fits of the next sensors,
+when its recording has at least this many samples and the machine at least two cores
+(:class:`OutputSet`); smaller ones are built here (starting a process costs more)."""
+
+
+def _report_job(
+    reporter: Reporter, path: Path, request: ReportRequest | OffsetReportRequest
+) -> list[tuple[Warning, str, int]]:
+    """In the worker: write one report; its warnings (message, file, line) are returned to
+    be said again by the parent process, in whose warning filters they belong."""
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        reporter(path, request)
+    return [
+        (w.message if isinstance(w.message, Warning) else w.category(str(w.message)),
+         w.filename, w.lineno)
+        for w in caught
+    ]  # fmt: skip
+
+
+def _n_samples(request: ReportRequest | OffsetReportRequest) -> int:
+    if isinstance(request, ReportRequest):
+        return int(request.recording.time_s.size)
+    return int(np.asarray(request.temp_c).size)
+
+
 @dataclass
 class OutputSet:
     """The files of one calibration set, built in ``stage`` beside ``output`` and moved into
-    place whole by :meth:`commit` (:func:`thermocal.writers.commit_directory`)."""
+    place whole by :meth:`commit` (:func:`thermocal.writers.commit_directory`).
+
+    Reports of large recordings (:data:`PARALLEL_MIN_SAMPLES`) are built by one worker
+    process while this one goes on with the next sensors (``workers`` 1; 0: all here).  At
+    :meth:`commit` every report not yet begun there is taken back and built here, the others
+    awaited; a report that failed in the worker (or could not be sent to it) is built again
+    here, so that its error is raised as without the worker.  The reports are the same
+    either way; the worker's warnings are said again here."""
 
     output: Path
     stage: Path
     reporter: Reporter | None
     reports: list[Path] = field(default_factory=list)
+    workers: int = 0
+    _pool: Any = None
+    _pending: list[tuple[Any, Path, ReportRequest | OffsetReportRequest]] = field(
+        default_factory=list
+    )
 
     def report(self, name: str, request: ReportRequest | OffsetReportRequest) -> None:
-        """Write the report ``name`` into the stage (when a reporter is given)."""
+        """Write the report ``name`` into the stage (when a reporter is given): here, or
+        in the worker process (the class docstring)."""
         path = self.output / name
-        if self.reporter is not None:
-            self.reporter(self.stage / name, request)
         self.reports.append(path)
+        if self.reporter is None:
+            return
+        if self.workers > 0 and _n_samples(request) >= PARALLEL_MIN_SAMPLES:
+            if self._pool is None:
+                self._pool = _report_pool()
+            fut = self._pool.submit(_report_job, self.reporter, self.stage / name, request)
+            self._pending.append((fut, self.stage / name, request))
+            return
+        self.reporter(self.stage / name, request)
+
+    def finish_reports(self) -> None:
+        """Every report of the set written: those not begun by the worker are built here,
+        the last first (the worker goes on with the earlier ones), then the worker's
+        awaited (the class docstring)."""
+        from thermocal.writers import WRITTEN
+
+        pending, self._pending = self._pending, []
+        assert self.reporter is not None or not pending
+        for fut, path, request in reversed(pending):  # the last first: the worker goes on
+            if not fut.cancel():  # begun (or done) there, and so every one before it
+                break
+            self.reporter(path, request)  # type: ignore[misc]
+        for fut, path, request in pending:
+            if fut.cancelled():
+                continue
+            try:
+                said = fut.result()
+            except Exception:  # failed there (or not sent): here, with its own error
+                self.reporter(path, request)  # type: ignore[misc]
+                continue
+            for message, filename, lineno in said:
+                warnings.warn_explicit(message, type(message), filename, lineno)
+            WRITTEN.append(path)
+        self.close()
+
+    def close(self) -> None:
+        """Stop the worker (a report it is building is finished first)."""
+        if self._pool is not None:
+            self._pool.shutdown(wait=True, cancel_futures=True)
+            self._pool = None
 
     def commit(self, calibration: Calibration, params_name: str, params_text: str) -> None:
-        """Write ``calibration.json`` and the parameter file, then move the set into place."""
+        """Write the reports left (:meth:`finish_reports`), ``calibration.json`` and the
+        parameter file, then move the set into place."""
         from thermocal.models.files import save_calibration
         from thermocal.writers import atomic_write, commit_directory
 
+        self.finish_reports()
         save_calibration(calibration, self.stage / "calibration.json")
         with atomic_write(self.stage / params_name, "w") as fh:
             fh.write(params_text)
         commit_directory(self.stage, self.output)
+
+
+def _report_pool() -> Any:
+    """One worker process for reports: forked where fork is safe (Linux: the worker
+    starts with this process's modules and costs no import), else spawned."""
+    import multiprocessing
+    import sys
+    from concurrent.futures import ProcessPoolExecutor
+
+    method = "fork" if sys.platform.startswith("linux") else "spawn"
+    return ProcessPoolExecutor(max_workers=1, mp_context=multiprocessing.get_context(method))
+
+
+PARALLEL_MIN_BYTES = 10_000_000
+"""A log of at least this size [bytes] starts the report worker before it is read
+(:func:`report_worker`)."""
+
+
+def _warm_job(reporter: Reporter) -> None:
+    """In the worker: the reporter's ``warm()`` when it has one (imports, fonts)."""
+    warm = getattr(reporter, "warm", None)
+    if callable(warm):
+        warm()
+
+
+@contextlib.contextmanager
+def report_worker(reporter: Reporter | None, log: Path) -> Iterator[Any]:
+    """The report worker of :class:`OutputSet` started before a large log
+    (:data:`PARALLEL_MIN_BYTES`) is read, so that its start and the reporter's ``warm()``
+    (imports, fonts: a second or so) overlap the reading; None when the reports are built
+    here (:func:`report_workers`, a small log).  Stopped at the end of the block."""
+    pool = None
+    try:
+        big = log.stat().st_size >= PARALLEL_MIN_BYTES
+    except OSError:  # said by the reader
+        big = False
+    if reporter is not None and big and report_workers() > 0:
+        pool = _report_pool()
+        pool.submit(_warm_job, reporter)
+    try:
+        yield pool
+    finally:
+        if pool is not None:
+            pool.shutdown(wait=True, cancel_futures=True)
+
+
+def report_workers() -> int:
+    """Worker processes for reports: 1 on a machine with two cores or more, else 0."""
+    import os
+
+    return 1 if (os.cpu_count() or 1) > 1 else 0
 
 
 def check_output_dir(output: Path) -> None:
@@ -305,17 +437,22 @@ def check_output_dir(output: Path) -> None:
 
 
 @contextlib.contextmanager
-def staged_set(output: Path, reporter: Reporter | None) -> Iterator[OutputSet]:
+def staged_set(output: Path, reporter: Reporter | None, pool: Any = None) -> Iterator[OutputSet]:
     """A new staging directory for ``output`` (:func:`thermocal.writers.staging_directory`);
     on any failure — a later sensor's error, Ctrl-C — it is removed
-    (:func:`thermocal.writers.discard_staging`), so that no part of the set is left."""
+    (:func:`thermocal.writers.discard_staging`), so that no part of the set is left.
+    ``pool``: the report worker already started (:func:`report_worker`)."""
     from thermocal.writers import discard_staging, staging_directory
 
+    out = OutputSet(output, staging_directory(output), reporter, workers=report_workers())
+    out._pool = pool
     try:
-        yield OutputSet(output, staging_directory(output), reporter)
+        yield out
     except BaseException:
+        out.close()  # the worker stops writing into the stage before it is removed
         discard_staging()
         raise
+    out.close()
 
 
 # --- gates (issue 28, item 5): doubtful, named in a warning --------------------------------

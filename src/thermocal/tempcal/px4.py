@@ -53,6 +53,7 @@ from thermocal.tempcal.pipeline import (
     end_warning,
     fit_sensor,
     read_sensor_topic,
+    report_worker,
     require_fields,
     staged_set,
     stall_warning,
@@ -231,8 +232,11 @@ def px4_tempcal(
 
     check_outputs([output / "calibration.json", output / PARAMS_NAME], [log], dirs=[output])
     check_output_dir(output)
-    with parsed_once(log, (*TOPICS, *OFFSET_TOPICS)):  # the log is parsed once
-        return _px4_tempcal(log, output, tref_c, overrides, reporter)
+    with (
+        report_worker(reporter, log) as pool,  # starts while the log is read
+        parsed_once(log, (*TOPICS, *OFFSET_TOPICS)),  # the log is parsed once
+    ):
+        return _px4_tempcal(log, output, tref_c, overrides, reporter, pool)
 
 
 def _px4_tempcal(
@@ -241,8 +245,9 @@ def _px4_tempcal(
     tref_c: float | None,
     overrides: tuple[str, ...],
     reporter: Reporter | None,
+    pool: Any = None,
 ) -> Px4TempcalResult:
-    """:func:`px4_tempcal` after its output checks."""
+    """:func:`px4_tempcal` after its output checks (``pool``: the report worker)."""
     from thermocal.export.params import ParamSet
 
     topics = log_topics(log)
@@ -256,7 +261,7 @@ def _px4_tempcal(
     motions: dict[str, adequacy.Motion] = {}
     params = ParamSet("px4")
     old = _Prior(ulog_parameters(log), {})  # the TC_* the log was recorded with
-    with staged_set(output, reporter) as out_set:  # moved into place whole, or removed
+    with staged_set(output, reporter, pool) as out_set:  # moved into place whole, or removed
         for name, inst in topics:
             if name in OFFSET_TOPICS:  # barometers and magnetometers: TC_B / TC_M
                 offset_fits.append(
