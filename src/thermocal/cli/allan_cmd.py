@@ -79,7 +79,7 @@ def family_json(res: "_family.StabilityResult") -> dict[str, Any]:
         out[f"{name}_tau_s"] = c.tau_s
         out[f"{name}_unit"] = c.unit
         out[f"{name}_interval"] = _family.NO_INTERVAL.get(
-            name, f"chi-square, {100 * res.confidence:.1f} %, Greenhall/SP 1065 EDF"
+            name, f"chi-square, {100 * res.confidence:.1f} %, {_family.edf_source(name)}"
         )
     return dict(jsonable(out))
 

@@ -14,7 +14,9 @@ hdev / ohdev               Greenhall d = 3, S = 1 / m, F = m
 totdev                     SP 1065 Table 7 (α = 0, −1, −2), else as oadev
 mtotdev, ttotdev           SP 1065 Table 8
 htotdev                    SP 1065 §5.2.14 (α = 0, −1, −2), else as ohdev; m = 1 as ohdev
-theo1, mtie, tierms        none (NaN; JSON ``<name>_interval`` says why: NO_INTERVAL)
+theo1                      Howe's empirical fits (:func:`.edf.edf_theo1`), α identified
+                           at the averaging factor of τ = 0.75 m τ0
+mtie, tierms               none (NaN; JSON ``<name>_interval`` says why: NO_INTERVAL)
 =========================  =========================================================
 
 The EDFs of gap-separated stretches add (independent estimates).
@@ -42,9 +44,18 @@ NO_INTERVAL: dict[str, str] = {
     "mtie": "none: MTIE is a maximum over windows, not a variance; no chi-square EDF applies "
     "and neither NIST SP 1065 nor Stable32 gives it an interval",
     "tierms": "none: NIST SP 1065 gives TIE rms no EDF",
-    "theo1": "none: Theo1's EDF (Howe & Tasset) is not implemented yet",
 }
 """The deviations whose ``low``/``high`` are NaN, and why (``<name>_interval`` in JSON)."""
+
+
+def edf_source(name: str) -> str:
+    """Where a deviation's EDF comes from, as the ``<name>_interval`` text states it."""
+    if name == "theo1":
+        return (
+            "Howe's empirical Theo1 EDF (its random-walk FM fit is far too small, the "
+            "interval too wide, beyond τ ≈ 0.2 of the record)"
+        )
+    return "Greenhall/SP 1065 EDF"
 
 
 @dataclass(frozen=True, eq=False)
@@ -152,6 +163,8 @@ def _edf(name: str, alpha: int, m: int, n_phase: int) -> float:
             return ed.edf_mtotdev(n_phase, m, alpha)
         if name == "htotdev":
             return ed.edf_htotdev(n_phase, m, alpha)
+        if name == "theo1":
+            return ed.edf_theo1(n_phase, m, alpha)
     except ValueError:
         return float("nan")
     return float("nan")
@@ -289,6 +302,8 @@ def _noise_exponents(
             alphas[i] = alpha
             methods.append("given")
             continue
+        if name == "theo1":  # Theo1's τ is 0.75 m τ0: the noise of that averaging time
+            mm = max(1, round(0.75 * mm))
         key = (int(mm), dmax)
         if key not in id_cache:
             id_cache[key] = record.identify(int(mm), dmax)
