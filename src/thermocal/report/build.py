@@ -71,6 +71,11 @@ from thermocal.report.analysis import (
     known_input_of as known_input_of,
 )
 from thermocal.stability.allan import DynamicAllan
+from thermocal.stability.noise_model import (
+    OutputQuantization,
+    annotate_quantization,
+    output_quantization,
+)
 from thermocal.writers import atomic_write
 
 ILL_CONDITIONED = 1.0e6
@@ -843,6 +848,9 @@ class _Analysis:
     :class:`~thermocal.stability.allan.DynamicAllan`, ``--dynamic``) or None."""
     dynamic_warning: str | None = None
     """The non-stationarity warning of :attr:`dynamic` (None: stationary, or no map)."""
+    quantization: OutputQuantization | None = None
+    """The output quantisation of the uncompensated run in the data's unit
+    (:func:`thermocal.stability.noise_model.output_quantization`; None: not quantised)."""
 
     @property
     def run_name(self) -> str:
@@ -914,14 +922,19 @@ def _analyse(inputs: ReportInputs) -> _Analysis:
         )
         for x, drift_bias in ((main.signal, inputs.drift_bias), (main.after_raw, 0.0))
     )
+    allan_before = allan_of(main.time_s, main.before, tau0, unit)
     allan_after = allan_of(main.time_s, main.after, tau0, unit)
     dyn, dyn_warning = _dynamic_of(inputs, main, allan_after, tau0, role)
+    # the sensor's own output: a quantised rate lies on a lattice (the known input taken
+    # off is a constant, which moves the lattice, not its step); the model's output does not
+    quant = output_quantization(main.before, tau0, unit, allan_before.terms)
+    # the Q row's reason then names the rate quantisation, as thermocal allan's does
+    terms = annotate_quantization(allan_before.terms, quant)
+    allan_before = AllanAnalysis(allan_before.result, terms)
     return _Analysis(
         primary, signal, unit, applied, main, temp_names, averaging_s, tau0, stage_temp,
-        fom_before, fom_after,
-        allan_of(main.time_s, main.before, tau0, unit),
-        allan_after,
-        k, role, rec_sha, dyn, dyn_warning,
+        fom_before, fom_after, allan_before, allan_after,
+        k, role, rec_sha, dyn, dyn_warning, quant,
     )  # fmt: skip
 
 
@@ -1130,6 +1143,39 @@ def _dynamic_context(an: _Analysis) -> dict[str, Any] | None:
         "n_changes": num(len(dyn.changes), "dynamic.n_changes"),
         "stationary": dyn.stationary,
         "warning": an.dynamic_warning,
+    }
+
+
+def _quantization_context(an: _Analysis) -> dict[str, Any] | None:
+    """The template's ``quantization`` (the ``output_quantization`` of ``thermocal allan``):
+    step [the data's unit] and levels, kind (rate: white rate noise N_q = q·√(τ0/12); angle:
+    Q = q·τ0/√12), that noise in the noise terms' unit and its share of the measured term's
+    variance [%], all tagged ``allan.before.output_quantization.*``."""
+    q = an.quantization
+    if q is None:
+        return None
+    key = "allan.before.output_quantization"
+    if q.kind == "rate":
+        label, name, value, vunit = (
+            "white rate noise N_q = q·√(τ0/12)", "white_density", q.white_density,
+            q.white_density_unit,
+        )  # fmt: skip
+    else:
+        label, name, value, vunit = (
+            "angle quantization Q = q·τ0/√12",
+            "angle_q",
+            q.angle_q,
+            q.angle_q_unit,
+        )
+    return {
+        "step": num(q.step, f"{key}.step", 6, unit_label(q.unit)),
+        "levels": num(q.levels, f"{key}.levels"),
+        "kind": q.kind,
+        "noise_label": label,
+        "noise": num(value, f"{key}.{name}", 4, unit_label(vunit)),
+        "share": num(None if q.share is None else 100.0 * q.share, f"{key}.share_pct", 3),
+        "of": "the measured N²" if q.kind == "rate" else "the fitted Q²",
+        "reason": q.reason,
     }
 
 
@@ -1361,6 +1407,7 @@ def build_report(inputs: ReportInputs) -> str:
         ),
         "noise_rows": _noise_rows(an),
         "dynamic": _dynamic_context(an),
+        "quantization": _quantization_context(an),
         "model_details": _model_details(inputs, unit),
         "coefficients": _coefficient_rows(primary.model, "model", unit),
         "ranges": _range_rows(primary.model),
