@@ -102,7 +102,10 @@ def _family_human(file: Path, res: "_family.StabilityResult") -> None:
             stdout.print(f"{name}: interval {_family.NO_INTERVAL[name]}")
 
 
-def _terms_json(terms: dict[str, Any]) -> dict[str, Any]:
+def _terms_json(terms: dict[str, Any], method: str) -> dict[str, Any]:
+    """Each noise term's JSON object; ``method`` how it was read, the same word ``noise
+    --format json`` gives (``slope``: the IEEE 952 slope line, ``fit``: the weighted
+    least-squares fit; :attr:`thermocal.stability.allan.NoiseTermSet.method`)."""
     return {
         name: {
             "value": t.value,
@@ -113,6 +116,7 @@ def _terms_json(terms: dict[str, Any]) -> dict[str, Any]:
             "tau_s": t.tau_s,
             "label": t.label,
             "quality": t.quality,
+            "method": method,
         }
         for name, t in terms.items()
     }
@@ -161,9 +165,9 @@ def allan_json(
         "tau0_s": res.tau0_s,
         "n_samples": res.n_samples,
         "n_segments": res.n_segments,
-        "noise": _terms_json(noise.fit.terms()),
+        "noise": _terms_json(noise.fit.terms(), noise.fit.method),
         "noise_method": "weighted non-negative least squares (IEEE 952 C.2)",
-        "noise_slope": _terms_json(noise.slope.terms()),
+        "noise_slope": _terms_json(noise.slope.terms(), noise.slope.method),
         "noise_slope_method": "slope lines (IEEE 952 C.3)",
         "fit_coefficients": noise.fit_coefficients,
         "fit_reduced_chi2": noise.reduced_chi2,

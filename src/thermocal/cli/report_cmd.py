@@ -99,6 +99,15 @@ def report_cmd(
     t_delim: DelimiterOpt = None,
     t_dec: DecimalOpt = None,
     latitude: TurntableLatitudeOpt = None,
+    dynamic: Annotated[
+        float | None,
+        typer.Option(
+            "--dynamic",
+            help="Dynamic ADEV of the compensated output: the overlapping ADEV in sliding "
+            "windows of this many seconds (half-window steps), a heat map in the stability "
+            "section and a warning when the output is not stationary (as allan --dynamic).",
+        ),
+    ] = None,
 ) -> None:
     """Write a self-contained HTML report (figures embedded, no network needed).
 
@@ -119,6 +128,7 @@ def report_cmd(
         model, recording, output, validations=list(validation or []), modeling=modeling,
         signal=signal, labels=list(label or []), title=title, sensor=sensor,
         averaging_s=averaging, latitude_deg=latitude, read=read, progress=progress,
+        dynamic_s=dynamic,
     )  # fmt: skip
     if res.kind == "triads":
         stderr.print(f"report: {res.path}")

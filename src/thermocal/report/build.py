@@ -70,6 +70,12 @@ from thermocal.report.analysis import (
 from thermocal.report.analysis import (
     known_input_of as known_input_of,
 )
+from thermocal.stability.allan import DynamicAllan
+from thermocal.stability.noise_model import (
+    OutputQuantization,
+    annotate_quantization,
+    output_quantization,
+)
 from thermocal.writers import atomic_write
 
 ILL_CONDITIONED = 1.0e6
@@ -141,6 +147,9 @@ class ReportInputs:
     """Drift angle before compensation: this b0 [the data's unit] instead of a window."""
     warnings_caught: tuple[str, ...] = ()
     """``warning:`` lines thermocal printed while reading the runs (shown in the report)."""
+    dynamic_s: float | None = None
+    """``--dynamic``: window [s] of the dynamic Allan deviation of the compensated output
+    (:func:`thermocal.stability.allan.dynamic_adev`, half-window steps); None: none."""
 
 
 # --- number formatting -------------------------------------------------------------------
@@ -834,6 +843,14 @@ class _Analysis:
     """The recording's role: ``modelling`` (a model was fitted on it), ``validation`` (a
     validation result was given) or ``test`` (:func:`recording_role`)."""
     recording_sha256: str | None = None
+    dynamic: DynamicAllan | None = None
+    """The dynamic ADEV of the compensated output (a
+    :class:`~thermocal.stability.allan.DynamicAllan`, ``--dynamic``) or None."""
+    dynamic_warning: str | None = None
+    """The non-stationarity warning of :attr:`dynamic` (None: stationary, or no map)."""
+    quantization: OutputQuantization | None = None
+    """The output quantisation of the uncompensated run in the data's unit
+    (:func:`thermocal.stability.noise_model.output_quantization`; None: not quantised)."""
 
     @property
     def run_name(self) -> str:
@@ -905,13 +922,43 @@ def _analyse(inputs: ReportInputs) -> _Analysis:
         )
         for x, drift_bias in ((main.signal, inputs.drift_bias), (main.after_raw, 0.0))
     )
+    allan_before = allan_of(main.time_s, main.before, tau0, unit)
+    allan_after = allan_of(main.time_s, main.after, tau0, unit)
+    dyn, dyn_warning = _dynamic_of(inputs, main, allan_after, tau0, role)
+    # the sensor's own output: a quantised rate lies on a lattice (the known input taken
+    # off is a constant, which moves the lattice, not its step); the model's output does not
+    quant = output_quantization(main.before, tau0, unit, allan_before.terms)
+    # the Q row's reason then names the rate quantisation, as thermocal allan's does
+    terms = annotate_quantization(allan_before.terms, quant)
+    allan_before = AllanAnalysis(allan_before.result, terms)
     return _Analysis(
         primary, signal, unit, applied, main, temp_names, averaging_s, tau0, stage_temp,
-        fom_before, fom_after,
-        allan_of(main.time_s, main.before, tau0, unit),
-        allan_of(main.time_s, main.after, tau0, unit),
-        k, role, rec_sha,
+        fom_before, fom_after, allan_before, allan_after,
+        k, role, rec_sha, dyn, dyn_warning, quant,
     )  # fmt: skip
+
+
+def _dynamic_of(
+    inputs: ReportInputs, main: RunSignals, allan_after: AllanAnalysis, tau0: float, role: str
+) -> tuple[DynamicAllan | None, str | None]:
+    """``--dynamic``: the dynamic ADEV of the compensated output in windows of
+    ``inputs.dynamic_s`` [s] (:func:`thermocal.stability.allan.dynamic_adev`, at the whole
+    run's τ and confidence; input errors as ``thermocal allan --dynamic``), and, when it is
+    not stationary, the warning (:func:`thermocal.stability.analysis.nonstationary_message`)
+    issued as a :class:`~thermocal.errors.ConditioningWarning` (stderr and the report)."""
+    if inputs.dynamic_s is None:
+        return None, None
+    from thermocal.errors import ConditioningWarning
+    from thermocal.stability.allan import dynamic_adev
+    from thermocal.stability.analysis import nonstationary_message
+
+    dyn = dynamic_adev(main.after, tau0, inputs.dynamic_s, allan_after.result, time_s=main.time_s)
+    if dyn.stationary:
+        return dyn, None
+    where = Path(inputs.recording_path).name if inputs.recording_path else "recording"
+    text = nonstationary_message(dyn, where, f"the compensated output of the {role} run")
+    warnings.warn(text, ConditioningWarning, stacklevel=1)
+    return dyn, text
 
 
 @dataclass
@@ -943,6 +990,7 @@ def _report_figures(inputs: ReportInputs, an: _Analysis) -> dict[str, dict[str, 
         _fit_figure(fs, inputs.modeling, an, block, avg_text)
     _bias_figures(fs, an, block, avg_text)
     _allan_figure(fs, an)
+    _dynamic_figure(fs, an)
     _drift_figure(fs, an)
     return fs.figs
 
@@ -1054,6 +1102,81 @@ def _allan_figure(fs: _FigureSet, an: _Analysis) -> None:
         f"Overlapping Allan deviation of the {an.run_name} before and after "
         "compensation; bars: confidence intervals.",
     )
+
+
+def _dynamic_figure(fs: _FigureSet, an: _Analysis) -> None:
+    """``--dynamic``: the heat map of the compensated output's dynamic Allan deviation
+    (:func:`thermocal.report.allan_plots.plot_dynamic`)."""
+    import tempfile
+
+    from thermocal.report.allan_plots import plot_dynamic
+
+    dyn = an.dynamic
+    if dyn is None:
+        return
+    with tempfile.TemporaryDirectory(prefix="thermocal-dyn-") as tmp:
+        png = plot_dynamic(
+            dyn, Path(tmp) / "dynamic.png", title="dynamic Allan deviation, after compensation"
+        ).read_bytes()
+    fs.add(
+        "dynamic",
+        png,
+        "Dynamic Allan deviation after compensation",
+        f"Dynamic Allan deviation of the {an.run_name} after compensation: the overlapping "
+        f"ADEV in sliding windows of {fmt_num(dyn.window_s)} s stepped by "
+        f"{fmt_num(dyn.step_s)} s ({dyn.t_s.size} windows; half a window), at the τ that fit "
+        f"a window; colour log10 ADEV [{unit_label(an.unit)}]; crosses: (window, τ) where the "
+        "window's ADEV and the whole run's differ beyond both their confidence intervals "
+        f"(test at {100 * dyn.test_confidence:.4g} %, Bonferroni over every cell).",
+    )
+
+
+def _dynamic_context(an: _Analysis) -> dict[str, Any] | None:
+    """The template's ``dynamic``: window, step and windows (tagged), changes, warning."""
+    dyn = an.dynamic
+    if dyn is None:
+        return None
+    return {
+        "window_s": num(dyn.window_s, "dynamic.window_s"),
+        "step_s": num(dyn.step_s, "dynamic.step_s"),
+        "n_windows": num(dyn.t_s.size, "dynamic.n_windows"),
+        "n_changes": num(len(dyn.changes), "dynamic.n_changes"),
+        "stationary": dyn.stationary,
+        "warning": an.dynamic_warning,
+    }
+
+
+def _quantization_context(an: _Analysis) -> dict[str, Any] | None:
+    """The template's ``quantization`` (the ``output_quantization`` of ``thermocal allan``):
+    step [the data's unit] and levels, kind (rate: white rate noise N_q = q·√(τ0/12); angle:
+    Q = q·τ0/√12), that noise in the noise terms' unit and its share of the measured term's
+    variance [%], all tagged ``allan.before.output_quantization.*``."""
+    q = an.quantization
+    if q is None:
+        return None
+    key = "allan.before.output_quantization"
+    if q.kind == "rate":
+        label, name, value, vunit = (
+            "white rate noise N_q = q·√(τ0/12)", "white_density", q.white_density,
+            q.white_density_unit,
+        )  # fmt: skip
+    else:
+        label, name, value, vunit = (
+            "angle quantization Q = q·τ0/√12",
+            "angle_q",
+            q.angle_q,
+            q.angle_q_unit,
+        )
+    return {
+        "step": num(q.step, f"{key}.step", 6, unit_label(q.unit)),
+        "levels": num(q.levels, f"{key}.levels"),
+        "kind": q.kind,
+        "noise_label": label,
+        "noise": num(value, f"{key}.{name}", 4, unit_label(vunit)),
+        "share": num(None if q.share is None else 100.0 * q.share, f"{key}.share_pct", 3),
+        "of": "the measured N²" if q.kind == "rate" else "the fitted Q²",
+        "reason": q.reason,
+    }
 
 
 def _drift_figure(fs: _FigureSet, an: _Analysis) -> None:
@@ -1283,6 +1406,8 @@ def build_report(inputs: ReportInputs) -> str:
             else None
         ),
         "noise_rows": _noise_rows(an),
+        "dynamic": _dynamic_context(an),
+        "quantization": _quantization_context(an),
         "model_details": _model_details(inputs, unit),
         "coefficients": _coefficient_rows(primary.model, "model", unit),
         "ranges": _range_rows(primary.model),

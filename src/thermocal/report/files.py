@@ -126,6 +126,7 @@ def make_report(
     latitude_deg: float | None = None,
     read: ReadOptions | None = None,
     progress: Progress | None = None,
+    dynamic_s: float | None = None,
 ) -> ReportResult:
     """``thermocal report``: a self-contained HTML report written atomically to ``output``.
 
@@ -137,6 +138,8 @@ def make_report(
     (:func:`thermocal.report.calibration.write_calibration_report`); model files are
     reported and compared (:func:`thermocal.report.write_report`; one ``validations``
     file and one label per model, in the same order).  ``progress`` draws the steps.
+    ``dynamic_s``: window [s] of the dynamic Allan deviation of the compensated output
+    (model reports only; :attr:`thermocal.report.build.ReportInputs.dynamic_s`).
     Input errors (:class:`ThermocalInputError`): counts that do not match, the output
     being an input, a calibration of channels given with other models.
     """
@@ -157,6 +160,15 @@ def make_report(
         inputs_files.append(modeling)
     check_not_input(output, inputs_files)
     cal = load_calibration(models[0])
+    one_channel = not (cal.triads and not cal.channels) and not (
+        len(cal.channels) > 1 or len(split_names(signal) or []) > 1
+    )
+    if dynamic_s is not None and not one_channel:
+        raise ThermocalInputError(
+            "--dynamic maps one channel's compensated output: it applies to the report of a "
+            "single-signal model, not of a calibration of triads or several channels (run "
+            "thermocal allan --dynamic on each channel)"
+        )
     if cal.triads and not cal.channels:  # a turntable calibration over temperature
         return _triad_report(cal, models[0], recording, output, opts, latitude_deg)
     cal.require_channels("report")
@@ -174,6 +186,7 @@ def make_report(
     return _models_report(
         models, recording, output, opts, bar, validations=validations, modeling=modeling,
         signal=signal, labels=labels, title=title, sensor=sensor, averaging_s=averaging_s,
+        dynamic_s=dynamic_s,
     )  # fmt: skip
 
 
@@ -214,6 +227,7 @@ def _models_report(
     title: str,
     sensor: str | None,
     averaging_s: float | None,
+    dynamic_s: float | None = None,
 ) -> ReportResult:
     """Model files reported and compared: both runs read with the same options (what they
     warn shown in the report too, issue 25)."""
@@ -268,6 +282,7 @@ def _models_report(
             generated_by="thermocal report",
             averaging_s=averaging_s,
             warnings_caught=read_warnings,
+            dynamic_s=dynamic_s,
         )
         advance(1)
         path = write_report(output, inputs)

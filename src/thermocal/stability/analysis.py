@@ -206,18 +206,23 @@ def _allan_channel(
         return AllanChannel(res, noise, quantization=quant)
     dyn = allan.dynamic_adev(values, rec.sample_interval_s, dynamic_s, res, time_s=rec.time_s)
     if not dyn.stationary:
-        worst = max(dyn.changes, key=lambda c: abs(math.log(c["adev"] / c["whole_adev"])))
-        warnings.warn(
-            f"{where}: the record is not stationary: in {len(dyn.changes)} (window, τ) "
-            f"cells the {dyn.window_s:g} s windows' ADEV differs from the whole "
-            f"record's beyond both intervals (e.g. {worst['adev']:.4g} against "
-            f"{worst['whole_adev']:.4g} {res.unit} at τ = {worst['tau_s']:.4g} s in "
-            f"the window centred at {worst['t_s']:.4g} s); the noise terms of the "
-            "whole record average over changing noise",
-            ConditioningWarning,
-            stacklevel=1,
-        )
+        warnings.warn(nonstationary_message(dyn, where), ConditioningWarning, stacklevel=1)
     return AllanChannel(res, noise, dyn, quant)
+
+
+def nonstationary_message(dyn: DynamicAllan, where: str, what: str = "the record") -> str:
+    """The warning of a non-stationary record (``dyn.changes`` not empty): how many
+    (window, τ) cells differ from the whole record's ADEV beyond both intervals and the
+    largest such change [``dyn.unit``]; ``where`` names the file, ``what`` the series."""
+    worst = max(dyn.changes, key=lambda c: abs(math.log(c["adev"] / c["whole_adev"])))
+    return (
+        f"{where}: {what} is not stationary: in {len(dyn.changes)} (window, τ) "
+        f"cells the {dyn.window_s:g} s windows' ADEV differs from the whole "
+        f"record's beyond both intervals (e.g. {worst['adev']:.4g} against "
+        f"{worst['whole_adev']:.4g} {dyn.unit} at τ = {worst['tau_s']:.4g} s in "
+        f"the window centred at {worst['t_s']:.4g} s); the noise terms of the "
+        "whole record average over changing noise"
+    )
 
 
 @dataclass(frozen=True, eq=False)
@@ -279,6 +284,7 @@ __all__ = [
     "allan_analysis",
     "column_unit",
     "imu_noise",
+    "nonstationary_message",
     "parse_taus",
     "signal_in_data_unit",
 ]
