@@ -104,7 +104,7 @@ class Triad:
     adequacy: dict[str, Any] | None = None
     """The adequacy record of the soaks it was fitted on (:mod:`thermocal.adequacy`)."""
     count_scale: float | None = None
-    """A triad calibrated on raw counts (``multipos --accel-scale/--gyro-scale``, issue 30):
+    """A triad calibrated on raw counts (``thermocal multipos`` given the count scales, issue 30):
     one count is ``count_scale`` ``unit`` (the datasheet's sensitivity), and ``unit`` is the
     physical unit the parameters and the compensated columns are in.  Compensation converts
     raw-count columns first, ``x [unit] = count_scale · N``; None: the triad was calibrated on
