@@ -95,7 +95,12 @@ def compensate_cmd(
 
 def _show_triads(run: "_compensate.CalibrationCompensation", _file: Path) -> None:
     for d in run.triads:
-        stdout.print(f"{d.triad}: {', '.join(d.comp_columns)} [{d.unit}]")
+        scale = (
+            f" (from raw counts: one count = {d.count_scale:.10g} {d.unit})"
+            if d.count_scale is not None
+            else ""
+        )
+        stdout.print(f"{d.triad}: {', '.join(d.comp_columns)} [{d.unit}]{scale}")
     stdout.print(f"written: {run.output}")
 
 

@@ -1069,13 +1069,17 @@ __all__ = [
 @dataclass(frozen=True)
 class TriadCompensation:
     """What :func:`compensate_triads` did for one triad: its columns, the added ones, the
-    data unit and the share of samples outside the calibrated temperature range."""
+    unit of the added ones, the share of samples outside the calibrated temperature range,
+    the unit of the input columns and, for raw counts, the count scale applied (one count
+    is ``count_scale`` ``unit``; None for columns already in a physical unit)."""
 
     triad: str
     columns: tuple[str, ...]
     comp_columns: tuple[str, ...]
     unit: str
     outside_range_fraction: float
+    input_unit: str = ""
+    count_scale: float | None = None
 
     def to_dict(self) -> dict[str, Any]:
         return dataclasses.asdict(self)
@@ -1109,11 +1113,17 @@ def compensate_triads(
     time_unit: str | None = None,
     chunk_rows: int = DEFAULT_CHUNK_ROWS,
     topic: str | None = None,
+    signal_unit: str | None = None,
 ) -> list[TriadCompensation]:
     """Apply triad calibrations (issue 19) to a recording: for each triad and each of its
     axes a column ``<col>_comp = [(I + E(T))⁻¹ (x − b(T))]_axis`` in the column's own unit,
     ``T`` the triad's temperature column at each sample (clamped to the calibrated range,
     with a warning when samples leave it; :func:`thermocal.turntable.thermal.correct`).
+    Raw-count columns of a triad calibrated on counts (``Triad.count_scale``, issue 30) are
+    converted first, ``x = count_scale · N``, and their ``_comp`` columns are in the
+    triad's physical unit; raw counts for a triad without a count scale are refused.
+    ``signal_unit`` (``--signal-unit``): one unit for every triad column, or one per column
+    in the triads' order.
 
     In chunks of ``chunk_rows`` rows with constant memory, like :func:`compensate_channels`
     (issue 26): the correction is per sample, so each chunk's values equal those of a
@@ -1129,7 +1139,7 @@ def compensate_triads(
     _check_chunk_rows(chunk_rows)
     source = _open_source(src, kind_in, time, None, topic)
     plans = [_triad_plan(tri, source.names, source.available, src) for tri in triads]
-    resolved = _resolve_triads(source, plans, time_unit)
+    resolved = _resolve_triads(source, plans, time_unit, signal_unit)
     out_info = _triad_output_info(source.info, source.time_col, resolved, plans)
     state = _PassState()
     atomic_write_path(
@@ -1152,14 +1162,18 @@ def compensate_triads(
             )
         results.append(
             TriadCompensation(
-                p.tri.name, tuple(p.columns), tuple(p.comp_columns), p.data_unit, outside
+                p.tri.name, tuple(p.columns), tuple(p.comp_columns), p.out_unit, outside,
+                p.data_unit, p.count_scale,
             )
-        )
+        )  # fmt: skip
     return results
 
 
 def _resolve_triads(
-    source: _Source, plans: Sequence[_TriadPlan], time_unit: str | None
+    source: _Source,
+    plans: Sequence[_TriadPlan],
+    time_unit: str | None,
+    signal_unit: str | None = None,
 ) -> units.ResolvedInputs:
     """The units of the triads' columns and temperatures resolved once (option > metadata >
     column name > the unit each triad was calibrated on); raw-count temperatures without a
@@ -1170,9 +1184,9 @@ def _resolve_triads(
         source.time_col,
         list(dict.fromkeys(signals)),
         _triad_temperatures(plans),
-        options=units.UnitOptions(time_unit=time_unit),
+        options=units.UnitOptions(time_unit=time_unit, signal_unit=signal_unit),
         file=units.StatedUnits.from_file_info(source.info, str(src)),
-        model=units.StatedUnits(None, {c: p.tri.unit for p in plans for c in p.columns}),
+        model=units.StatedUnits(None, {c: p.calibrated_unit() for p in plans for c in p.columns}),
         where=str(src),
     )
     unconverted = resolved.unconverted_counts()
@@ -1244,24 +1258,42 @@ class _TriadPlan:
     temperature: str
     comp_columns: list[str]
     data_unit: str = ""
+    out_unit: str = ""
+    count_scale: float | None = None
     to_data: float = 1.0
     n_outside: int = 0
 
+    def calibrated_unit(self) -> str:
+        """The unit of the columns the triad was calibrated on: raw counts for a triad with
+        a count scale, else its unit (the unit of a column that states none)."""
+        return "counts" if getattr(self.tri, "count_scale", None) is not None else self.tri.unit
+
     def resolve(self, resolved: units.ResolvedInputs, src: Path) -> None:
-        """The data unit of the triad's columns (one for all three) and the factor from
-        its bias unit (°/h or mg) to it."""
+        """The data unit of the triad's columns (one for all three), the unit of their
+        ``_comp`` columns (the data's, or the triad's for raw counts with a count scale)
+        and the factor from its bias unit (°/h or mg) to the latter."""
         tri = self.tri
         data_units = {resolved.signals[c].unit for c in self.columns}
         if len(data_units) != 1:
             raise ThermocalInputError(f"{src}: the {tri.name} triad's columns differ in unit")
-        self.data_unit = data_units.pop()
-        if units.canonical_unit(self.data_unit) != units.canonical_unit(tri.unit):
+        self.data_unit = self.out_unit = data_units.pop()
+        scale = getattr(tri, "count_scale", None)
+        if self.data_unit == "counts" and scale is not None:
+            self.out_unit, self.count_scale = tri.unit, float(scale)
+        elif self.data_unit == "counts":
+            raise UnitError(
+                f"{src}: the {tri.name} triad's columns are raw counts, and the calibration "
+                f"states no count scale (it was calibrated on {tri.unit} data): convert the "
+                f"columns to {tri.unit}, or calibrate the counts with multipos "
+                f"--{tri.model.kind}-scale VALUE,UNIT"
+            )
+        elif units.canonical_unit(self.data_unit) != units.canonical_unit(tri.unit):
             raise UnitError(
                 f"{src}: the {tri.name} triad was calibrated on {tri.unit} data; these columns "
                 f"are in {self.data_unit}"
             )
         bias_unit = "deg/h" if tri.model.kind == "gyro" else "mg"
-        self.to_data = float(units.convert(np.array([1.0]), bias_unit, self.data_unit)[0])
+        self.to_data = float(units.convert(np.array([1.0]), bias_unit, self.out_unit)[0])
 
     def correct(
         self,
@@ -1276,7 +1308,9 @@ class _TriadPlan:
         for k, c in enumerate(self.columns):
             v = numeric_column(chunk, c, src, row0)
             _check_finite(v, f"signal column {c!r}", src, row0)
-            _check_plausible(temp[:0, None], [], v, self.data_unit, src, row0, c)
+            if self.count_scale is not None:  # raw counts → the triad's unit
+                v = v * self.count_scale
+            _check_plausible(temp[:0, None], [], v, self.out_unit, src, row0, c)
             x[:, k] = v
         m = self.tri.model
         self.n_outside += int(np.count_nonzero((temp < m.t_lo_c) | (temp > m.t_hi_c)))
@@ -1320,7 +1354,7 @@ def _triad_output_info(
     for p in plans:
         for c, comp in zip(p.columns, p.comp_columns, strict=True):
             (signals if c in signals else extra)[c] = p.data_unit
-            extra[comp] = p.data_unit
+            extra[comp] = p.out_unit
     temps = dict(info.get("temperatures") or {})
     temps.update({c: r.unit for c, r in resolved.temperatures.items()})
     out_info["signals"] = signals
@@ -1425,7 +1459,7 @@ def compensate_calibration_file(
             )
         done = compensate_triads(
             cal.triads, path, out, time=time, time_unit=time_unit, chunk_rows=chunk_rows,
-            topic=topic,
+            topic=topic, signal_unit=signal_unit,
         )  # fmt: skip
         return CalibrationCompensation(str(model_file), str(out), "triads", tuple(done))
     common: dict[str, Any] = dict(

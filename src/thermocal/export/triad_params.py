@@ -64,6 +64,8 @@ class TriadFirmware:
     scale_lost_ppm: float
     temperature_dependent: bool
     tref_c: float
+    count_scale: tuple[float, str] | None = None
+    """A triad calibrated on raw counts: one count is ``value`` ``unit`` (issue 30)."""
 
 
 def triad_firmware(triad: Triad) -> TriadFirmware:
@@ -89,6 +91,7 @@ def triad_firmware(triad: Triad) -> TriadFirmware:
         triad.name, (float(offset[0]), float(offset[1]), float(offset[2])),
         (float(scale[0]), float(scale[1]), float(scale[2])), lost, scale_lost, dependent,
         float(m.tref_c),
+        None if triad.count_scale is None else (float(triad.count_scale), triad.unit),
     )  # fmt: skip
 
 
@@ -163,6 +166,12 @@ def _lost_notes(t: TriadFirmware) -> list[str]:
         out.append(
             f"{t.kind}: scale-factor errors up to {t.scale_lost_ppm:.4g} ppm are not held (the "
             "firmware has no gyro scale)"
+        )
+    if t.count_scale is not None:
+        out.append(
+            f"{t.kind}: calibrated on raw counts (one count = {t.count_scale[0]:.10g} "
+            f"{t.count_scale[1]}); the firmware's input is its driver's physical output ({unit}), "
+            "not counts: the values hold if the driver's sensitivity is that count scale"
         )
     if t.temperature_dependent:
         out.append(

@@ -25,6 +25,7 @@ calibration also takes the model files written before.
 from __future__ import annotations
 
 import datetime as _dt
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Any
@@ -39,7 +40,12 @@ from thermocal.models.registry import model_from_dict
 from thermocal.models.schema import verify_model_dict
 
 CALIBRATION_FORMAT = "thermocal-calibration"
-CALIBRATION_FORMAT_VERSION = 1
+CALIBRATION_FORMAT_VERSION = 2
+"""The newest version this thermocal reads.  Version 2 added a triad's ``count_scale``
+(issue 30); a file is written as version 1 unless one of its triads has one, so a file
+without it is what it was, and a thermocal that knows only version 1 refuses a file whose
+counts it could not convert rather than apply it to the wrong unit."""
+COUNT_SCALE_FORMAT_VERSION = 2
 
 ROLE_KINDS = ("gyro", "accel")
 """Roles a channel may declare."""
@@ -97,6 +103,12 @@ class Triad:
     latitude_deg: float | None = None
     adequacy: dict[str, Any] | None = None
     """The adequacy record of the soaks it was fitted on (:mod:`thermocal.adequacy`)."""
+    count_scale: float | None = None
+    """A triad calibrated on raw counts (``thermocal multipos`` given the count scales, issue 30):
+    one count is ``count_scale`` ``unit`` (the datasheet's sensitivity), and ``unit`` is the
+    physical unit the parameters and the compensated columns are in.  Compensation converts
+    raw-count columns first, ``x [unit] = count_scale · N``; None: the triad was calibrated on
+    data in ``unit`` (files of format version 1 have no such key)."""
 
 
 @dataclass
@@ -135,7 +147,11 @@ class Calibration:
 
         d: dict[str, Any] = {
             "format": CALIBRATION_FORMAT,
-            "format_version": CALIBRATION_FORMAT_VERSION,
+            "format_version": (
+                COUNT_SCALE_FORMAT_VERSION
+                if any(t.count_scale is not None for t in self.triads)
+                else 1
+            ),
             "created_utc": _dt.datetime.now(_dt.UTC).isoformat(timespec="seconds"),
             "thermocal_version": __version__,
             "channels": [
@@ -160,6 +176,11 @@ class Calibration:
                     "latitude_deg": t.latitude_deg,
                     "model": t.model.to_dict(),
                     **({"adequacy": t.adequacy} if t.adequacy is not None else {}),
+                    **(
+                        {"count_scale": {"value": t.count_scale, "unit": t.unit}}
+                        if t.count_scale is not None
+                        else {}
+                    ),
                 }
                 for t in self.triads
             ]
@@ -250,7 +271,29 @@ def _triad_from_dict(t: Any, at: str) -> Triad:
         (enc[0], enc[1]),
         None if lat is None else float(lat),
         t["adequacy"] if isinstance(t.get("adequacy"), dict) else None,
+        _count_scale_from_dict(t.get("count_scale"), t["unit"], at),
     )
+
+
+def _count_scale_from_dict(cs: Any, unit: str, at: str) -> float | None:
+    """A triad's ``count_scale`` object ``{"value": K, "unit": U}`` (format version 2): K a
+    positive finite number, U the triad's own unit; None when absent."""
+    if cs is None:
+        return None
+    value = cs.get("value") if isinstance(cs, dict) else None
+    if (
+        not isinstance(cs, dict)
+        or isinstance(value, bool)
+        or not isinstance(value, int | float)
+        or not math.isfinite(value)
+        or value <= 0
+        or cs.get("unit") != unit
+    ):
+        raise ModelFileError(
+            f"{at}.count_scale: expected {{'value': a positive number, 'unit': {unit!r}}}, "
+            f"got {cs!r}"
+        )
+    return float(value)
 
 
 def temperatures_of(cal: Calibration, names: Sequence[str] | None = None) -> list[str]:

@@ -261,10 +261,11 @@ def _fit_triads(
                 gravity_m_s2=grav.g_m_s2,
             )  # fmt: skip
         models[kind] = m
+        sc = opts.accel_scale if kind == "accel" else opts.gyro_scale
         triads.append(
             Triad(
                 kind, (cols[0], cols[1], cols[2]), unit, opts.temps or "", m,
-                latitude_deg=grav.latitude_deg,
+                latitude_deg=grav.latitude_deg, count_scale=None if sc is None else sc[0],
             )
         )  # fmt: skip
     return triads, models

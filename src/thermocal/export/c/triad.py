@@ -7,6 +7,12 @@ calibrated range, every parameter a polynomial in ``T − TREF`` (Horner), ``E``
 ``E_ii = θ_ppm·10⁻⁶`` and ``E_ij = θ_″·π/648000``, the 3×3 solve by the adjugate over the
 determinant (no allocation, no library call; ``I + E`` is within 10⁻³ of the identity, so
 the determinant is near 1).  Matches :func:`thermocal.turntable.thermal.correct`.
+
+A triad calibrated on raw counts (``multipos --accel-scale/--gyro-scale``, issue 30) takes
+``x`` in its physical unit all the same; the header defines the count scale
+``<P>_<TRIAD>_COUNT_SCALE`` (one count in that unit) and states the conversion
+``x = <P>_<TRIAD>_COUNT_SCALE · counts`` that the caller applies to the raw registers first,
+as :func:`thermocal.compensate.files.compensate_triads` does.
 """
 
 from __future__ import annotations
@@ -96,7 +102,15 @@ def _triad_code(p: str, tri: Any, bias_to_data: float, real: str, ident: str) ->
         f"{', '.join(map(str, tri.columns))}; T [degC] of {tri.temperature}, clamped to "
         f"[{m.t_lo_c:g}, {m.t_hi_c:g}]"
     )
-    decl = f"/* {about} */\nvoid {name}_correct(double temp_c, const {real} x[3], {real} out[3]);"
+    decl = f"/* {about} */\n"
+    if tri.count_scale is not None:
+        unit = c_comment(tri.unit)
+        decl += (
+            f"/* calibrated on raw counts: one count = {P}_COUNT_SCALE {unit}; convert the raw\n"
+            f" * registers first, x[i] = {P}_COUNT_SCALE * counts[i] [{unit}] */\n"
+            f"#define {P}_COUNT_SCALE {_lit(tri.count_scale)}\n"
+        )
+    decl += f"void {name}_correct(double temp_c, const {real} x[3], {real} out[3]);"
     return decl, "\n".join(lines)
 
 
