@@ -523,11 +523,7 @@ def step_warnings(
     for kind, group in by_kind.items():
         if len(group) < 2:
             continue
-        floor = (
-            adequacy.MOTION_FLOOR_DEG_S * adequacy.DEG_H_PER_DEG_S
-            if kind == "gyro"
-            else adequacy.MOTION_FLOOR_MG
-        )
+        floor = motion_floor(kind)
         steps = {}
         for f in group:
             key = f"{f.topic}.{f.instance}"
