@@ -311,19 +311,70 @@ def tclr_learned(temp_c: FloatArray, xyz: FloatArray) -> list[list[float]]:
     return [[float(x) * 1e6 for x in p[k]] for k in (1, 2, 3)]
 
 
+@dataclass(frozen=True)
+class TclrRange:
+    """The range ``TMIN…TMAX`` [°C] the firmware saves with its learned coefficients of one
+    IMU (both its sensors: ``INS_TCAL<n>_TMIN/TMAX`` are per IMU), and where it was found."""
+
+    tmin_c: float
+    tmax_c: float
+    source: str
+
+
+def tclr_range(
+    rows: Sequence[Mapping[str, float]], instance: int, changes: Sequence[Any],
+    imu_time_s: FloatArray, imu_temp_c: FloatArray,
+) -> TclrRange | None:  # fmt: skip
+    """IMU ``instance``'s learned range as the firmware defines it
+    (AP_InertialSensor_tempcal.cpp ``Learn::save_calibration``: ``temp_min = start_temp``,
+    ``temp_max = temperature``): ``start_temp`` is the mid temperature ``T`` of the
+    accelerometer's first window (``add_sample``, ``si == 0``: its first ``TCLR`` with
+    SType 0), the same for the gyro; ``temperature`` is the (filtered) temperature when the
+    last window closed.  In order of preference: the ``INS_TCAL<n>_TMIN/TMAX`` the firmware
+    saved during the log (``changes``, :class:`~thermocal.readers.dataflash.ParamChange`, set
+    at or after the instance's first ``TCLR``: exact); else TMIN from the first accelerometer
+    window and TMAX the IMU temperature (``imu_temp_c`` over ``imu_time_s`` [s]) at the last
+    ``TCLR``'s ``TimeUS``; else (times outside the IMU's) the highest window temperature, a
+    lower bound.  None without ``TCLR`` of this IMU."""
+    mine = [r for r in rows if int(r.get("I", 0)) == instance and "Temp" in r]
+    if not mine:
+        return None
+    acc = [r for r in mine if int(r.get("SType", -1)) == TCLR_STYPES["accel"]]
+    t_first = min(float(r.get("TimeUS", 0.0)) for r in mine) * 1e-6
+    t_last = max(float(r.get("TimeUS", 0.0)) for r in mine) * 1e-6
+    n = instance + 1
+    lo_name, hi_name = f"INS_TCAL{n}_TMIN", f"INS_TCAL{n}_TMAX"
+    saved = {c.name: c.new for c in changes if c.name in (lo_name, hi_name) and c.time_s >= t_first}
+    if len(saved) == 2:
+        return TclrRange(
+            saved[lo_name], saved[hi_name], f"{lo_name}/TMAX as the firmware saved them in the log"
+        )
+    tmin = float(acc[0]["Temp"]) if acc else min(float(r["Temp"]) for r in mine)
+    how = "TMIN the accelerometer's first window" if acc else "TMIN the lowest window"
+    t = np.asarray(imu_time_s, dtype=np.float64)
+    ok = np.isfinite(t) & np.isfinite(np.asarray(imu_temp_c, dtype=np.float64))
+    if ok.any() and t[ok][0] <= t_last <= t[ok][-1]:
+        tmax = float(np.interp(t_last, t[ok], np.asarray(imu_temp_c, dtype=np.float64)[ok]))
+        how += ", TMAX the IMU temperature when the last window closed"
+    else:
+        tmax = max(float(r["Temp"]) for r in mine)
+        how += ", TMAX the highest window (a lower bound: the firmware's is its end)"
+    return TclrRange(tmin, max(tmax, tmin), how + " (AP_InertialSensor_tempcal.cpp)")
+
+
 def tclr_comparison(
     rows: Sequence[Mapping[str, float]], instance: int, kind: str, unit: str,
-    new_params: Mapping[str, float], sweep_c: tuple[float, float],
+    new_params: Mapping[str, float], sweep_c: tuple[float, float], learned_range: TclrRange,
 ) -> CoefficientComparison | None:  # fmt: skip
     """The firmware's learned coefficients of IMU ``instance``'s ``kind`` (:func:`tclr_learned`
-    of its ``TCLR`` points, valid over their temperatures as the firmware saves TMIN/TMAX)
-    against thermocal's ``new_params``; None with fewer than 4 points at distinct
-    temperatures (no cubic)."""
+    of its ``TCLR`` points, valid over the IMU's learned range ``learned_range``,
+    :func:`tclr_range`) against thermocal's ``new_params``; None with fewer than 4 points at
+    distinct temperatures (no cubic)."""
     temp, xyz = tclr_points(rows, instance, kind)
     if np.unique(temp).size < 4:
         return None
     learned = tclr_learned(temp, xyz)
-    tmin, tmax = float(np.min(temp)), float(np.max(temp))
+    tmin, tmax = learned_range.tmin_c, learned_range.tmax_c
     fw = ActiveTcal(instance, tmin, tmax, {kind: learned}, {kind: AP_TREF_C})
     cmp = ardupilot_comparison(fw, new_params, kind, unit, sweep_c)
     return dataclasses.replace(
@@ -331,9 +382,11 @@ def tclr_comparison(
         title="The firmware's own learning (TCLR) against thermocal's coefficients",
         old_label="firmware (TCLR)",
         intro=(
-            f"The log holds {temp.size} TCLR points of this sensor ({tmin:.1f}…{tmax:.1f} °C): "
-            "the firmware's own temperature learning; its coefficients are restated here as "
-            "the firmware computes them (a least-squares cubic of the points in T − 35 °C)."
+            f"The log holds {temp.size} TCLR points of this sensor "
+            f"({float(np.min(temp)):.1f}…{float(np.max(temp)):.1f} °C): the firmware's own "
+            "temperature learning; its coefficients are restated here as the firmware "
+            "computes them (a least-squares cubic of the points in T − 35 °C), valid over "
+            f"the IMU's learned range {tmin:.2f}…{tmax:.2f} °C ({learned_range.source})."
         ),
     )  # fmt: skip
 
@@ -576,6 +629,9 @@ def _imu(run: _Run, df: Any, inst: int) -> None:
     run.params.merge(ps, f"IMU.{inst}")
     _hygiene_and_gates(run, inst, ps, prev_params)
     active = ardupilot_active(prev_params, inst)
+    fw_range = tclr_range(
+        run.dlog.rows.get("TCLR", []), inst, run.dlog.param_changes, time_s, temp_c
+    )
     for fit, sub_rec in per_kind:
         key = f"{fit.topic}.{inst}"
         if active is not None:  # the log's coefficients against the new ones
@@ -583,9 +639,9 @@ def _imu(run: _Run, df: Any, inst: int) -> None:
                 active, ps.params, fit.kind, KIND_UNITS[fit.kind],
                 fit.sweep_c,
             )  # fmt: skip
-        learned = tclr_comparison(
+        learned = None if fw_range is None else tclr_comparison(
             run.dlog.rows.get("TCLR", []), inst, fit.kind,
-            KIND_UNITS[fit.kind], ps.params, fit.sweep_c,
+            KIND_UNITS[fit.kind], ps.params, fit.sweep_c, fw_range,
         )  # fmt: skip
         if learned is not None:
             run.learning[key] = learned
@@ -706,4 +762,5 @@ __all__ = [
     "param_intervals",
     "tclr_learned",
     "tclr_points",
+    "tclr_range",
 ]
