@@ -26,7 +26,11 @@ from thermocal.errors import ThermocalInputError
 from thermocal.models.calibration import Calibration
 from thermocal.outputs import check_outputs
 from thermocal.recording import FloatArray, Recording
-from thermocal.tempcal.ardupilot_baro import ArdupilotBaroFit, fit_ardupilot_baro
+from thermocal.tempcal.ardupilot_baro import (
+    ArdupilotBaroFit,
+    baro_report_request,
+    fit_ardupilot_baro,
+)
 from thermocal.tempcal.compare import CoefficientComparison, compare_coefficients
 from thermocal.tempcal.pipeline import (
     AXES,
@@ -54,6 +58,8 @@ MAX_IMUS = 3
 KINDS = (("gyro", "Gyr", "rad/s"), ("accel", "Acc", "m/s^2"))
 """(kind, field prefix of the ``IMU`` message, its unit) per sensor of an IMU."""
 KIND_UNITS = {kind: unit for kind, _prefix, unit in KINDS}
+BARO_REPORT = "report_BARO_0.html"
+"""The report of the first barometer's ``TCAL_BARO_EXP``."""
 
 
 # --- ArduPilot log hygiene (issue 28, item 4) ---------------------------------------------
@@ -492,6 +498,7 @@ def ardupilot_tempcal(
     # DIR may hold the log; the files of the set (replaced by name) may not be it
     names = ["calibration.json", PARAMS_NAME]
     names += [f"report_IMU_{i}_{k}.html" for i in range(MAX_IMUS) for k in ("gyro", "accel")]
+    names.append(BARO_REPORT)
     check_outputs([output / n for n in names], [log], dirs=[output])
     check_output_dir(output)
     with staged_set(output, reporter) as out_set:  # moved into place whole, or removed
@@ -670,7 +677,8 @@ def _baro(run: _Run) -> None:
     except MissingColumnError:
         return  # no barometer in the log
     require_fields(df, ["Press", "Temp"], run.log, "BARO.0")
-    fit = fit_ardupilot_baro(df["Temp"].to_numpy(), df["Press"].to_numpy())
+    temp_c, press_pa = df["Temp"].to_numpy(), df["Press"].to_numpy()
+    fit = fit_ardupilot_baro(temp_c, press_pa)
     if fit is None:
         run.gates.append(
             "BARO.0: its temperature stays (almost) below 25 °C: ArduPilot's barometer "
@@ -688,6 +696,14 @@ def _baro(run: _Run) -> None:
         run.params.params[name] = value
         run.params.types[name] = 9 if name == "TCAL_BARO_EXP" else 6
     run.baro = fit
+    said = tuple(g for g in run.gates if g is not None and g.startswith("BARO."))
+    run.out_set.report(
+        BARO_REPORT,
+        baro_report_request(
+            fit, temp_c, press_pa, str(run.log), "thermocal ardupilot-tempcal",
+            run.dlog.params_at_end(), said,
+        ),
+    )  # fmt: skip
 
 
 def _table(run: _Run, name: str, inst: int) -> tuple[Any, dict[str, Any]]:
