@@ -25,10 +25,12 @@ def _code(type_name: str) -> str:
 def ulog_bytes(
     topics: Sequence[tuple[str, int, Sequence[tuple[str, str]], Sequence[Sequence[float]]]],
     params: Mapping[str, float | int] | None = None,
+    changed: Sequence[tuple[str, float | int]] = (),
 ) -> bytes:
     """``topics``: (name, instance, fields [(type, name)], rows) → the ULog file's bytes;
     ``params``: initial parameters (``P`` messages: ``uint8 key_len``, ``"<type> <name>"``,
-    the value; an ``int`` as ``int32_t``, a ``float`` as ``float``)."""
+    the value; an ``int`` as ``int32_t``, a ``float`` as ``float``); ``changed``: parameters
+    set during the recording (the same ``P`` messages in the data section, after the data)."""
     out = bytearray(b"ULog\x01\x12\x35" + bytes([1]) + struct.pack("<Q", 0))
 
     def msg(kind: str, payload: bytes) -> None:
@@ -36,10 +38,14 @@ def ulog_bytes(
         out.extend(payload)
 
     msg("B", bytes(16) + struct.pack("<3Q", 0, 0, 0))
-    for pname, value in (params or {}).items():
+
+    def param(pname: str, value: float | int) -> None:
         typed = ("int32_t " if isinstance(value, int) else "float ") + pname
         code = "<i" if isinstance(value, int) else "<f"
         msg("P", bytes([len(typed)]) + typed.encode() + struct.pack(code, value))
+
+    for pname, value in (params or {}).items():
+        param(pname, value)
     seen: set[str] = set()
     for name, _inst, fields, _rows in topics:
         if name not in seen:
@@ -51,4 +57,6 @@ def ulog_bytes(
         code = "<" + "".join(_code(t) for t, _n in fields)
         for row in rows:
             msg("D", struct.pack("<H", msg_id) + struct.pack(code, *row))
+    for pname, value in changed:
+        param(pname, value)
     return bytes(out)

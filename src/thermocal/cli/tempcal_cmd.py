@@ -29,8 +29,7 @@ if TYPE_CHECKING:
     import rich.table as _rich_table
 
     from thermocal.tempcal.ardupilot import ArdupilotTempcalResult
-    from thermocal.tempcal.offset_report import OffsetReportRequest
-    from thermocal.tempcal.pipeline import ReportRequest, SensorFit
+    from thermocal.tempcal.pipeline import AnyReportRequest, SensorFit
     from thermocal.tempcal.px4 import OffsetFit, Px4TempcalResult
 else:
     _rich_table = LazyModule("rich.table")
@@ -38,15 +37,22 @@ else:
 OutDirOpt = Annotated[Path, typer.Option("-o", "--output", help="Directory to write.")]
 
 
-def write_report(path: Path, req: "ReportRequest | OffsetReportRequest") -> None:
+def write_report(path: Path, req: "AnyReportRequest") -> None:
     """One sensor's HTML report (:func:`thermocal.report.calibration.write_calibration_report`;
-    a barometer's or magnetometer's: :func:`thermocal.report.tempcal.write_offset_report`)."""
+    a barometer's or magnetometer's: :func:`thermocal.report.tempcal.write_offset_report`;
+    ArduPilot's ``TCAL_BARO_EXP``: :func:`thermocal.report.tempcal.write_ardupilot_baro_report`)."""
     from thermocal.report.calibration import CalibrationReportInputs, write_calibration_report
     from thermocal.report.tempcal import comparison_html, write_offset_report
+    from thermocal.tempcal.ardupilot_baro import ArdupilotBaroReportRequest
     from thermocal.tempcal.offset_report import OffsetReportRequest
 
     if isinstance(req, OffsetReportRequest):
         write_offset_report(path, req)
+        return
+    if isinstance(req, ArdupilotBaroReportRequest):  # TCAL_BARO_EXP
+        from thermocal.report.tempcal import write_ardupilot_baro_report
+
+        write_ardupilot_baro_report(path, req)
         return
 
     write_calibration_report(

@@ -71,15 +71,40 @@ logging fills its last page; pymavlink ignores up to this many, DFReader.py)."""
 
 
 @dataclass(frozen=True)
+class ParamChange:
+    """A parameter set again later in a DataFlash log with another value: a ``PARM`` message
+    (``TimeUS`` [µs] → ``time_s`` [s], the log's clock) whose value differs from the value of
+    that name in force before it (``old``)."""
+
+    time_s: float
+    name: str
+    old: float
+    new: float
+
+    def to_dict(self) -> dict[str, float | str]:
+        return {"time_s": self.time_s, "name": self.name, "old": self.old, "new": self.new}
+
+
+@dataclass(frozen=True)
 class DataflashLog:
     """What one pass over a DataFlash log kept: the rows of the wanted message types (numeric
-    fields), every message type seen, the parameters (``PARM``: the last value of each name)
-    and the sentences on what was lost (:func:`_dataflash_loss`)."""
+    fields), every message type seen, the parameters (``params``: the first value of each
+    name, the parameters the recording started with; ``param_changes``: every later ``PARM``
+    that changed a value, in log order) and the sentences on what was lost
+    (:func:`_dataflash_loss`)."""
 
     rows: dict[str, list[dict[str, float]]]
     names_seen: frozenset[str]
     params: dict[str, float]
     notes: tuple[str, ...]
+    param_changes: tuple[ParamChange, ...] = ()
+
+    def params_at_end(self) -> dict[str, float]:
+        """The parameters in force at the end of the log (initial values and every change)."""
+        out = dict(self.params)
+        for c in self.param_changes:
+            out[c.name] = c.new
+        return out
 
 
 def read_dataflash_log(path: str | Path, messages: Sequence[str]) -> DataflashLog:
@@ -99,6 +124,8 @@ def read_dataflash_log(path: str | Path, messages: Sequence[str]) -> DataflashLo
     keep = set(messages)
     rows: dict[str, list[dict[str, float]]] = {m: [] for m in keep}
     params: dict[str, float] = {}
+    current: dict[str, float] = {}
+    changes: list[ParamChange] = []
     names_seen: set[str] = set()
     accounted = 0  # bytes in whole messages
     last_end = 0
@@ -139,7 +166,7 @@ def read_dataflash_log(path: str | Path, messages: Sequence[str]) -> DataflashLo
                     )
                 elif mtype == "PARM":
                     with contextlib.suppress(AttributeError, TypeError, ValueError):
-                        params[str(m.Name)] = float(m.Value)
+                        _parm(m, params, current, changes)
         finally:  # pymavlink keeps the file and its memory map open
             for attr in ("data_map", "filehandle"):
                 h = getattr(log, attr, None)
@@ -150,7 +177,23 @@ def read_dataflash_log(path: str | Path, messages: Sequence[str]) -> DataflashLo
     if said and notes:
         notes.append(said)
     warn_damage(path, notes)
-    return DataflashLog(rows, frozenset(names_seen), params, tuple(notes))
+    return DataflashLog(rows, frozenset(names_seen), params, tuple(notes), tuple(changes))
+
+
+def _parm(
+    m: Any, first: dict[str, float], current: dict[str, float], changes: list[ParamChange]
+) -> None:
+    """One ``PARM`` (LogStructure.h "TimeUS,Name,Value"): the first value of a name is its
+    initial value (the log's parameter dump at start); a later one with another value is a
+    change, at ``TimeUS``."""
+    name, value = str(m.Name), float(m.Value)
+    if name not in current:
+        first[name] = value
+    elif value != current[name] and not (value != value and current[name] != current[name]):
+        changes.append(
+            ParamChange(float(getattr(m, "TimeUS", 0)) * 1e-6, name, current[name], value)
+        )
+    current[name] = value
 
 
 def dataflash_table(

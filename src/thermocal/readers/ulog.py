@@ -179,6 +179,19 @@ def _topic_loss(time_us: FloatArray) -> tuple[int, int]:
     return max(0, expected - n), max(expected, n)
 
 
+def ulog_parameter_changes(
+    path: str | Path, topics: Sequence[str]
+) -> list[tuple[float, str, float]]:
+    """The parameters set during the recording of a ULog: (time [s], name, value) of each
+    ``P`` message of its data section (ULog File Format: a parameter changed in flight;
+    pyulog's ``changed_parameters``, timed by the last data message before it), in log
+    order, from the parse of ``topics`` (:func:`_parse_ulog`: within :func:`parsed_once`,
+    no second read).  Values equal to those already in force are kept; the caller
+    compares."""
+    read = _parse_ulog(Path(path), list(topics))
+    return [(float(t) * 1e-6, str(n), float(v)) for t, n, v in read.ulog.changed_parameters]
+
+
 def ulog_sensor_instances(path: str | Path, topics: Sequence[str]) -> list[tuple[str, int]]:
     """The instances of ``topics`` in a ULog that carry a temperature, sorted; every instance
     left out (no ``temperature`` field, or one that is all 0 or NaN: no sensor behind it) is

@@ -5,6 +5,7 @@
 calibrated range, per axis), as a section of the sensor's calibration report.
 :func:`write_offset_report`: the report of a barometer or magnetometer calibration (PX4
 ``TC_B``/``TC_M``): residual before/after against the temperature, the held-out bins.
+:func:`write_ardupilot_baro_report`: the same for ArduPilot's ``TCAL_BARO_EXP``.
 """
 
 from __future__ import annotations
@@ -18,6 +19,7 @@ from thermocal.recording import FloatArray
 from thermocal.report.build import _b64, unit_label
 
 if TYPE_CHECKING:
+    from thermocal.tempcal.ardupilot_baro import ArdupilotBaroReportRequest
     from thermocal.tempcal.compare import CoefficientComparison
     from thermocal.tempcal.offset_report import OffsetReportRequest
 
@@ -156,11 +158,83 @@ def write_offset_report(path: str | Path, req: OffsetReportRequest) -> Path:
     return Path(path)
 
 
+# --- ArduPilot's barometer: TCAL_BARO_EXP (issue 28, item 3) ----------------------------
+
+
+def ardupilot_baro_figures(req: ArdupilotBaroReportRequest) -> tuple[bytes, bytes]:
+    """(the pressure residual before and after the firmware's correction ``max(T − 25, 0)^e``
+    [Pa] against the temperature [°C], samples light and bin means dark; the odd bins'
+    residual [Pa] to the exponent fitted to the even bins) as PNGs."""
+    from thermocal.report.figures import _figure, _png, decimate_for_plot
+
+    with _figure(1, height_in=2.8) as (fig, axes):
+        ax = axes[0]
+        t, b, a = decimate_for_plot(req.temp_c, req.before, req.after)
+        ax.plot(t, b, ".", ms=1.5, color=OLD_COLOR, alpha=0.25)
+        ax.plot(t, a, ".", ms=1.5, color=NEW_COLOR, alpha=0.25)
+        ax.plot(req.bin_temp_c, req.bin_before, color=OLD_COLOR, lw=1.3, label="before (bins)")
+        ax.plot(req.bin_temp_c, req.bin_after, color=NEW_COLOR, lw=1.3,
+                label=f"after TCAL_BARO_EXP {req.fit.exponent:.4g}")  # fmt: skip
+        ax.axvline(25.0, color="#888888", lw=0.8, ls=":")
+        ax.set_ylabel("pressure [Pa]", fontsize=9)
+        ax.set_xlabel("temperature [°C]", fontsize=9)
+        ax.legend(fontsize=8, loc="best")
+        residual = _png(fig)
+    with _figure(1, height_in=2.2) as (fig, axes):
+        ax = axes[0]
+        ax.axhline(0.0, color="#888888", lw=0.8)
+        ax.plot(req.odd_temp_c, req.odd_residual, "o", ms=2.5, color=NEW_COLOR)
+        ax.set_ylabel("pressure [Pa]", fontsize=9)
+        ax.set_xlabel("temperature of the held-out (odd) bins [°C]", fontsize=9)
+        ax.set_title(f"held-out rms {req.fit.holdout_rms_pa:.4g} Pa", fontsize=9, loc="right")
+        holdout = _png(fig)
+    return residual, holdout
+
+
+def build_ardupilot_baro_report(req: ArdupilotBaroReportRequest) -> str:
+    """The HTML report of ArduPilot's barometer calibration: the parameters
+    ``TCAL_ENABLED``/``TEMP_MIN``/``TEMP_MAX``/``BARO_EXP`` (the log's beside the new), the
+    rms before/after, the residual figure, the held-out bins, the warnings
+    (:func:`ardupilot_baro_figures`)."""
+    import datetime as _dt
+
+    from thermocal import __version__
+    from thermocal.readers.common import sha256_of
+    from thermocal.report.build import _env
+
+    residual, holdout = ardupilot_baro_figures(req)
+    html: str = (
+        _env()
+        .get_template("tempcal_ardupilot_baro.html.j2")
+        .render(
+            title=req.title, version=__version__, generated_by=req.generated_by,
+            generated_utc=_dt.datetime.now(_dt.UTC).strftime("%Y-%m-%d %H:%M UTC"),
+            fit=req.fit, params=req.fit.params(), old=req.old, warnings=list(req.warnings),
+            holdout_exponent=req.holdout_exponent,
+            residual_fig=_b64(residual), holdout_fig=_b64(holdout),
+            files=[("log", req.log_path, sha256_of(req.log_path))],
+        )
+    )  # fmt: skip
+    return html
+
+
+def write_ardupilot_baro_report(path: str | Path, req: ArdupilotBaroReportRequest) -> Path:
+    """:func:`build_ardupilot_baro_report` written atomically to ``path``."""
+    from thermocal.writers import atomic_write
+
+    with atomic_write(path, "wb") as fh:
+        fh.write(build_ardupilot_baro_report(req).encode("utf-8"))
+    return Path(path)
+
+
 __all__ = [
+    "ardupilot_baro_figures",
+    "build_ardupilot_baro_report",
     "build_offset_report",
     "comparison_figure",
     "comparison_html",
     "offset_holdout_figure",
     "offset_residual_figure",
+    "write_ardupilot_baro_report",
     "write_offset_report",
 ]

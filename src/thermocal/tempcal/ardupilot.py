@@ -26,7 +26,11 @@ from thermocal.errors import ThermocalInputError
 from thermocal.models.calibration import Calibration
 from thermocal.outputs import check_outputs
 from thermocal.recording import FloatArray, Recording
-from thermocal.tempcal.ardupilot_baro import ArdupilotBaroFit, fit_ardupilot_baro
+from thermocal.tempcal.ardupilot_baro import (
+    ArdupilotBaroFit,
+    baro_report_request,
+    fit_ardupilot_baro,
+)
 from thermocal.tempcal.compare import CoefficientComparison, compare_coefficients
 from thermocal.tempcal.pipeline import (
     AXES,
@@ -54,6 +58,8 @@ MAX_IMUS = 3
 KINDS = (("gyro", "Gyr", "rad/s"), ("accel", "Acc", "m/s^2"))
 """(kind, field prefix of the ``IMU`` message, its unit) per sensor of an IMU."""
 KIND_UNITS = {kind: unit for kind, _prefix, unit in KINDS}
+BARO_REPORT = "report_BARO_0.html"
+"""The report of the first barometer's ``TCAL_BARO_EXP``."""
 
 
 # --- ArduPilot log hygiene (issue 28, item 4) ---------------------------------------------
@@ -218,6 +224,67 @@ def ardupilot_raw(
     return out, active, code
 
 
+def imu_hygiene_params(name: str, instance: int) -> bool:
+    """Whether parameter ``name`` changes what the firmware did to IMU ``instance``'s logged
+    data: ``AHRS_ORIENTATION``, ``INS_TCAL<n>_*``, ``INS_ACC<n>_CALTEMP``,
+    ``INS_GYR<n>_CALTEMP`` (n = instance + 1)."""
+    n = instance + 1
+    return name == "AHRS_ORIENTATION" or name.startswith(f"INS_TCAL{n}_") or name in (
+        f"INS_ACC{n}_CALTEMP", f"INS_GYR{n}_CALTEMP",
+    )  # fmt: skip
+
+
+@dataclass(frozen=True)
+class ParamInterval:
+    """A stretch of the log ``[start_s, end_s)`` [s, the log's ``TimeUS`` clock; ±inf at the
+    ends] over which the parameters ``params`` were in force."""
+
+    start_s: float
+    end_s: float
+    params: dict[str, float]
+
+
+def param_intervals(
+    initial: Mapping[str, float], changes: Sequence[Any], relevant: Callable[[str], bool]
+) -> tuple[list[ParamInterval], list[Any]]:
+    """The log cut where a ``relevant`` parameter changed (``changes``: the reader's
+    :class:`~thermocal.readers.dataflash.ParamChange`, in log order), each piece with the
+    values in force; and those changes.  ArduPilot reads ``INS_TCAL*``, its ``CALTEMP`` and
+    ``AHRS_ORIENTATION`` live (AP_InertialSensor_tempcal.cpp ``correct_sensor`` reads the
+    parameters at each sample), so a sample logged at ``t`` was corrected with the values set
+    last before ``t``."""
+    cur = dict(initial)
+    out: list[ParamInterval] = []
+    used = [c for c in changes if relevant(c.name)]
+    start = -math.inf
+    for c in used:
+        if c.time_s > start:
+            out.append(ParamInterval(start, c.time_s, dict(cur)))
+            start = c.time_s
+        cur[c.name] = c.new
+    out.append(ParamInterval(start, math.inf, dict(cur)))
+    return out, used
+
+
+def ardupilot_raw_intervals(
+    intervals: Sequence[ParamInterval], instance: int, kind: str, time_s: FloatArray,
+    temp_c: FloatArray, xyz: FloatArray,
+) -> tuple[FloatArray, list[ActiveTcal | None], list[int]]:  # fmt: skip
+    """:func:`ardupilot_raw` per interval of the log: each sample undone with the parameters
+    in force when it was recorded (:func:`param_intervals`).  Returns (v, per interval the
+    active calibration or None, per interval the orientation code)."""
+    out = np.asarray(xyz, dtype=np.float64).copy()
+    actives: list[ActiveTcal | None] = []
+    codes: list[int] = []
+    for iv in intervals:
+        sel = (time_s >= iv.start_s) & (time_s < iv.end_s)
+        part, active, code = ardupilot_raw(iv.params, instance, kind, temp_c[sel], out[sel])
+        out[sel] = part
+        actives.append(active)
+        codes.append(code)
+    return out, actives, codes
+
+
 # --- the firmware's own learning: TCLR ----------------------------------------------------------
 
 TCLR_STYPES = {"accel": 0, "gyro": 1}
@@ -250,19 +317,70 @@ def tclr_learned(temp_c: FloatArray, xyz: FloatArray) -> list[list[float]]:
     return [[float(x) * 1e6 for x in p[k]] for k in (1, 2, 3)]
 
 
+@dataclass(frozen=True)
+class TclrRange:
+    """The range ``TMIN…TMAX`` [°C] the firmware saves with its learned coefficients of one
+    IMU (both its sensors: ``INS_TCAL<n>_TMIN/TMAX`` are per IMU), and where it was found."""
+
+    tmin_c: float
+    tmax_c: float
+    source: str
+
+
+def tclr_range(
+    rows: Sequence[Mapping[str, float]], instance: int, changes: Sequence[Any],
+    imu_time_s: FloatArray, imu_temp_c: FloatArray,
+) -> TclrRange | None:  # fmt: skip
+    """IMU ``instance``'s learned range as the firmware defines it
+    (AP_InertialSensor_tempcal.cpp ``Learn::save_calibration``: ``temp_min = start_temp``,
+    ``temp_max = temperature``): ``start_temp`` is the mid temperature ``T`` of the
+    accelerometer's first window (``add_sample``, ``si == 0``: its first ``TCLR`` with
+    SType 0), the same for the gyro; ``temperature`` is the (filtered) temperature when the
+    last window closed.  In order of preference: the ``INS_TCAL<n>_TMIN/TMAX`` the firmware
+    saved during the log (``changes``, :class:`~thermocal.readers.dataflash.ParamChange`, set
+    at or after the instance's first ``TCLR``: exact); else TMIN from the first accelerometer
+    window and TMAX the IMU temperature (``imu_temp_c`` over ``imu_time_s`` [s]) at the last
+    ``TCLR``'s ``TimeUS``; else (times outside the IMU's) the highest window temperature, a
+    lower bound.  None without ``TCLR`` of this IMU."""
+    mine = [r for r in rows if int(r.get("I", 0)) == instance and "Temp" in r]
+    if not mine:
+        return None
+    acc = [r for r in mine if int(r.get("SType", -1)) == TCLR_STYPES["accel"]]
+    t_first = min(float(r.get("TimeUS", 0.0)) for r in mine) * 1e-6
+    t_last = max(float(r.get("TimeUS", 0.0)) for r in mine) * 1e-6
+    n = instance + 1
+    lo_name, hi_name = f"INS_TCAL{n}_TMIN", f"INS_TCAL{n}_TMAX"
+    saved = {c.name: c.new for c in changes if c.name in (lo_name, hi_name) and c.time_s >= t_first}
+    if len(saved) == 2:
+        return TclrRange(
+            saved[lo_name], saved[hi_name], f"{lo_name}/TMAX as the firmware saved them in the log"
+        )
+    tmin = float(acc[0]["Temp"]) if acc else min(float(r["Temp"]) for r in mine)
+    how = "TMIN the accelerometer's first window" if acc else "TMIN the lowest window"
+    t = np.asarray(imu_time_s, dtype=np.float64)
+    ok = np.isfinite(t) & np.isfinite(np.asarray(imu_temp_c, dtype=np.float64))
+    if ok.any() and t[ok][0] <= t_last <= t[ok][-1]:
+        tmax = float(np.interp(t_last, t[ok], np.asarray(imu_temp_c, dtype=np.float64)[ok]))
+        how += ", TMAX the IMU temperature when the last window closed"
+    else:
+        tmax = max(float(r["Temp"]) for r in mine)
+        how += ", TMAX the highest window (a lower bound: the firmware's is its end)"
+    return TclrRange(tmin, max(tmax, tmin), how + " (AP_InertialSensor_tempcal.cpp)")
+
+
 def tclr_comparison(
     rows: Sequence[Mapping[str, float]], instance: int, kind: str, unit: str,
-    new_params: Mapping[str, float], sweep_c: tuple[float, float],
+    new_params: Mapping[str, float], sweep_c: tuple[float, float], learned_range: TclrRange,
 ) -> CoefficientComparison | None:  # fmt: skip
     """The firmware's learned coefficients of IMU ``instance``'s ``kind`` (:func:`tclr_learned`
-    of its ``TCLR`` points, valid over their temperatures as the firmware saves TMIN/TMAX)
-    against thermocal's ``new_params``; None with fewer than 4 points at distinct
-    temperatures (no cubic)."""
+    of its ``TCLR`` points, valid over the IMU's learned range ``learned_range``,
+    :func:`tclr_range`) against thermocal's ``new_params``; None with fewer than 4 points at
+    distinct temperatures (no cubic)."""
     temp, xyz = tclr_points(rows, instance, kind)
     if np.unique(temp).size < 4:
         return None
     learned = tclr_learned(temp, xyz)
-    tmin, tmax = float(np.min(temp)), float(np.max(temp))
+    tmin, tmax = learned_range.tmin_c, learned_range.tmax_c
     fw = ActiveTcal(instance, tmin, tmax, {kind: learned}, {kind: AP_TREF_C})
     cmp = ardupilot_comparison(fw, new_params, kind, unit, sweep_c)
     return dataclasses.replace(
@@ -270,9 +388,11 @@ def tclr_comparison(
         title="The firmware's own learning (TCLR) against thermocal's coefficients",
         old_label="firmware (TCLR)",
         intro=(
-            f"The log holds {temp.size} TCLR points of this sensor ({tmin:.1f}…{tmax:.1f} °C): "
-            "the firmware's own temperature learning; its coefficients are restated here as "
-            "the firmware computes them (a least-squares cubic of the points in T − 35 °C)."
+            f"The log holds {temp.size} TCLR points of this sensor "
+            f"({float(np.min(temp)):.1f}…{float(np.max(temp)):.1f} °C): the firmware's own "
+            "temperature learning; its coefficients are restated here as the firmware "
+            "computes them (a least-squares cubic of the points in T − 35 °C), valid over "
+            f"the IMU's learned range {tmin:.2f}…{tmax:.2f} °C ({learned_range.source})."
         ),
     )  # fmt: skip
 
@@ -300,6 +420,12 @@ class ArdupilotTempcalResult:
     previous: dict[str, CoefficientComparison] = dataclasses.field(default_factory=dict)
     firmware_learning: dict[str, CoefficientComparison] = dataclasses.field(default_factory=dict)
     baro: ArdupilotBaroFit | None = None
+    rotated: bool = False
+    """Some of the data were recorded with ``AHRS_ORIENTATION`` ≠ 0 (``orientation`` is the
+    value at the end of the log)."""
+    parameter_changes: tuple[dict[str, Any], ...] = ()
+    """The changes during the log of the parameters undone (``time_s`` [s], ``name``,
+    ``old``, ``new``); the data were undone per interval."""
 
     @property
     def active_found(self) -> list[str]:
@@ -327,7 +453,8 @@ class ArdupilotTempcalResult:
             "notes": list(self.notes),
             "log_hygiene": {
                 "AHRS_ORIENTATION": self.orientation,
-                "rotated_back_to_sensor_frame": self.orientation != 0,
+                "rotated_back_to_sensor_frame": self.rotated or self.orientation != 0,
+                "parameter_changes": list(self.parameter_changes),
                 "imus": self.hygiene,
             },
         }
@@ -347,6 +474,8 @@ class _Run:
     series: dict[str, tuple[FloatArray, FloatArray]]
     hygiene: dict[str, dict[str, Any]]
     orientation: int = 0
+    rotated: bool = False
+    param_notes: list[str] = dataclasses.field(default_factory=list)
     previous: dict[str, CoefficientComparison] = dataclasses.field(default_factory=dict)
     learning: dict[str, CoefficientComparison] = dataclasses.field(default_factory=dict)
     baro: ArdupilotBaroFit | None = None
@@ -369,6 +498,7 @@ def ardupilot_tempcal(
     # DIR may hold the log; the files of the set (replaced by name) may not be it
     names = ["calibration.json", PARAMS_NAME]
     names += [f"report_IMU_{i}_{k}.html" for i in range(MAX_IMUS) for k in ("gyro", "accel")]
+    names.append(BARO_REPORT)
     check_outputs([output / n for n in names], [log], dirs=[output])
     check_output_dir(output)
     with staged_set(output, reporter) as out_set:  # moved into place whole, or removed
@@ -411,6 +541,7 @@ def ardupilot_tempcal(
             f"bins {b.rms_before_pa:.3g} → {b.rms_after_pa:.3g} Pa, hold-out "
             f"{b.holdout_rms_pa:.3g} Pa"
         )
+    notes.extend(run.param_notes)
     if run.orientation:
         notes.append(
             f"AHRS_ORIENTATION {run.orientation} ({AP_ROTATIONS[run.orientation]}): the data "
@@ -419,8 +550,18 @@ def ardupilot_tempcal(
     return ArdupilotTempcalResult(
         log, output / PARAMS_NAME, output / "calibration.json", tuple(out_set.reports),
         tuple(run.fits), tuple(notes), run.orientation, run.hygiene, run.previous,
-        run.learning, run.baro,
+        run.learning, run.baro, run.rotated, _changes_said(run),
     )  # fmt: skip
+
+
+def _changes_said(run: _Run) -> tuple[dict[str, Any], ...]:
+    """Every change of a parameter undone for some IMU, once, in log order."""
+    seen: list[dict[str, Any]] = []
+    for h in run.hygiene.values():
+        for c in h.get("parameter_changes", []):
+            if c not in seen:
+                seen.append(c)
+    return tuple(sorted(seen, key=lambda c: float(c["time_s"])))
 
 
 def _imu_temperature(run: _Run, df: Any, inst: int) -> FloatArray | None:
@@ -457,12 +598,23 @@ def _imu(run: _Run, df: Any, inst: int) -> None:
     time_s = df["TimeUS"].to_numpy() * 1e-6
     run.gates.append(stall_warning(f"IMU.{inst}", time_s, temp_c))
     per_kind: list[tuple[SensorFit, Recording]] = []
+    intervals, changes = param_intervals(
+        run.dlog.params, run.dlog.param_changes, lambda n: imu_hygiene_params(n, inst)
+    )
+    prev_params = _previous_params(run, inst, intervals, changes, time_s)
     for kind, prefix, unit in KINDS:
         xyz = np.column_stack([df[f"{prefix}{a.upper()}"].to_numpy() for a in AXES])
-        xyz, active, run.orientation = ardupilot_raw(run.dlog.params, inst, kind, temp_c, xyz)
-        hyg = run.hygiene.setdefault(f"IMU.{inst}", {"active_tcal_removed": active is not None})
+        xyz, actives, codes = ardupilot_raw_intervals(intervals, inst, kind, time_s, temp_c, xyz)
+        run.orientation = codes[-1]
+        run.rotated = run.rotated or any(codes)
+        active = ardupilot_active(prev_params, inst)
+        hyg = run.hygiene.setdefault(
+            f"IMU.{inst}", {"active_tcal_removed": any(a is not None for a in actives)}
+        )
         if active is not None:
             hyg.update(tmin_c=active.tmin_c, tmax_c=active.tmax_c, caltemp_c=active.caltemp_c)
+        if changes:
+            hyg["parameter_changes"] = [c.to_dict() for c in changes]
         sub_rec = Recording.from_arrays(
             time_s, {a: xyz[:, j] for j, a in enumerate(AXES)},
             {"temperature": temp_c}, signal_unit=unit,
@@ -482,8 +634,11 @@ def _imu(run: _Run, df: Any, inst: int) -> None:
         warnings.simplefilter("ignore")
         ps = export_params(sub, "ardupilot", instance=inst)
     run.params.merge(ps, f"IMU.{inst}")
-    _hygiene_and_gates(run, inst, ps)
-    active = ardupilot_active(run.dlog.params, inst)
+    _hygiene_and_gates(run, inst, ps, prev_params)
+    active = ardupilot_active(prev_params, inst)
+    fw_range = tclr_range(
+        run.dlog.rows.get("TCLR", []), inst, run.dlog.param_changes, time_s, temp_c
+    )
     for fit, sub_rec in per_kind:
         key = f"{fit.topic}.{inst}"
         if active is not None:  # the log's coefficients against the new ones
@@ -491,9 +646,9 @@ def _imu(run: _Run, df: Any, inst: int) -> None:
                 active, ps.params, fit.kind, KIND_UNITS[fit.kind],
                 fit.sweep_c,
             )  # fmt: skip
-        learned = tclr_comparison(
+        learned = None if fw_range is None else tclr_comparison(
             run.dlog.rows.get("TCLR", []), inst, fit.kind,
-            KIND_UNITS[fit.kind], ps.params, fit.sweep_c,
+            KIND_UNITS[fit.kind], ps.params, fit.sweep_c, fw_range,
         )  # fmt: skip
         if learned is not None:
             run.learning[key] = learned
@@ -522,7 +677,8 @@ def _baro(run: _Run) -> None:
     except MissingColumnError:
         return  # no barometer in the log
     require_fields(df, ["Press", "Temp"], run.log, "BARO.0")
-    fit = fit_ardupilot_baro(df["Temp"].to_numpy(), df["Press"].to_numpy())
+    temp_c, press_pa = df["Temp"].to_numpy(), df["Press"].to_numpy()
+    fit = fit_ardupilot_baro(temp_c, press_pa)
     if fit is None:
         run.gates.append(
             "BARO.0: its temperature stays (almost) below 25 °C: ArduPilot's barometer "
@@ -540,6 +696,14 @@ def _baro(run: _Run) -> None:
         run.params.params[name] = value
         run.params.types[name] = 9 if name == "TCAL_BARO_EXP" else 6
     run.baro = fit
+    said = tuple(g for g in run.gates if g is not None and g.startswith("BARO."))
+    run.out_set.report(
+        BARO_REPORT,
+        baro_report_request(
+            fit, temp_c, press_pa, str(run.log), "thermocal ardupilot-tempcal",
+            run.dlog.params_at_end(), said,
+        ),
+    )  # fmt: skip
 
 
 def _table(run: _Run, name: str, inst: int) -> tuple[Any, dict[str, Any]]:
@@ -549,11 +713,42 @@ def _table(run: _Run, name: str, inst: int) -> tuple[Any, dict[str, Any]]:
     return dataflash_table(run.dlog, run.log, name, inst)
 
 
-def _hygiene_and_gates(run: _Run, inst: int, ps: Any) -> None:
-    """IMU ``inst``'s coefficients in the log (old) beside the new ones, and the gate of a
-    ``CALTEMP`` too close to the calibrated range's ends."""
+def _previous_params(
+    run: _Run, inst: int, intervals: Sequence[ParamInterval], changes: Sequence[Any],
+    time_s: FloatArray,
+) -> dict[str, float]:  # fmt: skip
+    """The parameters IMU ``inst``'s new coefficients are compared with (``previous``, the
+    hygiene's ``old``): those in force at the end of the log, the board's calibration the new
+    one replaces; when ``INS_TCAL<n>`` was not active then, those of the last interval in
+    which it was.  Each change of a relevant parameter is said in a note (name, old → new,
+    log time) with the values used."""
+    chosen = intervals[-1]
+    for iv in reversed(intervals):
+        if ardupilot_active(iv.params, inst) is not None:
+            chosen = iv
+            break
+    if changes:
+        t0, t1 = float(np.nanmin(time_s)), float(np.nanmax(time_s))
+        said = "; ".join(
+            f"{c.name} {c.old:g} → {c.new:g} at log time {c.time_s:.3f} s" for c in changes
+        )
+        lo = max(chosen.start_s, t0)
+        hi = min(chosen.end_s, t1)
+        run.param_notes.append(
+            f"IMU.{inst}: parameters of its temperature correction changed during the "
+            f"recording ({said}; data {t0:.3f}…{t1:.3f} s): each sample was undone with the "
+            f"values in force when it was recorded ({len(intervals)} intervals); the "
+            f"coefficients compared (previous) are those in force over {lo:.3f}…{hi:.3f} s"
+        )
+    return chosen.params
+
+
+def _hygiene_and_gates(run: _Run, inst: int, ps: Any, prev_params: Mapping[str, float]) -> None:
+    """IMU ``inst``'s coefficients in the log (old: ``prev_params``, :func:`_previous_params`)
+    beside the new ones, and the gate of a ``CALTEMP`` too close to the calibrated range's
+    ends."""
     hyg = run.hygiene[f"IMU.{inst}"]
-    old_coef = {n: run.dlog.params[n] for n in ps.params if n in run.dlog.params}
+    old_coef = {n: prev_params[n] for n in ps.params if n in prev_params}
     hyg["coefficients"] = {
         n: {"old": (o := old_coef.get(n)), "new": float(v),
             "difference": None if o is None else float(v) - o}
@@ -576,8 +771,12 @@ __all__ = [
     "ArdupilotTempcalResult",
     "ardupilot_active",
     "ardupilot_raw",
+    "ardupilot_raw_intervals",
     "ardupilot_rotation",
     "ardupilot_tempcal",
+    "imu_hygiene_params",
+    "param_intervals",
     "tclr_learned",
     "tclr_points",
+    "tclr_range",
 ]

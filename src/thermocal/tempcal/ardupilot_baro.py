@@ -24,7 +24,8 @@ bins' corrected mean).
 from __future__ import annotations
 
 import math
-from dataclasses import asdict, dataclass
+from collections.abc import Mapping
+from dataclasses import asdict, dataclass, field
 from typing import Any
 
 import numpy as np
@@ -122,11 +123,70 @@ def fit_ardupilot_baro(
     )  # fmt: skip
 
 
+@dataclass(frozen=True)
+class ArdupilotBaroReportRequest:
+    """The numbers of the report of a ``TCAL_BARO_EXP`` fit (:func:`baro_report_request`):
+    the samples' temperature [°C] and pressure residual before/after the firmware's
+    correction [Pa] (before: the pressure relative to its median; after: the corrected
+    pressure ``P + max(T − 25, 0)^e`` relative to its median), the same per temperature bin
+    (the bins' medians, relative to the same medians), the odd bins' temperature
+    and residual to the even bins' fit (:func:`fit_ardupilot_baro`'s hold-out), the log's
+    own ``TCAL_*`` values (``old``, those present) and the warnings said about this
+    barometer."""
+
+    fit: ArdupilotBaroFit
+    log_path: str
+    title: str
+    generated_by: str
+    temp_c: FloatArray
+    before: FloatArray
+    after: FloatArray
+    bin_temp_c: FloatArray
+    bin_before: FloatArray
+    bin_after: FloatArray
+    odd_temp_c: FloatArray
+    odd_residual: FloatArray
+    holdout_exponent: float
+    old: dict[str, float] = field(default_factory=dict)
+    warnings: tuple[str, ...] = ()
+
+
+def baro_report_request(
+    fit: ArdupilotBaroFit, temp_c: FloatArray, press_pa: FloatArray, log_path: str,
+    generated_by: str, log_params: Mapping[str, float], said: tuple[str, ...] = (),
+) -> ArdupilotBaroReportRequest:  # fmt: skip
+    """The report's numbers (:class:`ArdupilotBaroReportRequest`) of ``fit`` on the log's
+    barometer samples (``temp_c`` [°C], ``press_pa`` [Pa] as logged: ``BARO.Press`` is
+    uncorrected); ``log_params`` the log's parameters (their ``TCAL_*`` are shown beside the
+    new ones)."""
+    temp = np.asarray(temp_c, dtype=np.float64)
+    press = np.asarray(press_pa, dtype=np.float64)
+    ok = np.isfinite(temp) & np.isfinite(press)
+    temp, press = temp[ok], press[ok]
+    corrected = press + baro_correction(temp, fit.exponent)
+    before, after = press - np.median(press), corrected - np.median(corrected)
+    _c, t_med, p_med = temperature_bins(temp, press.reshape(-1, 1))
+    p_med = p_med[:, 0]
+    c_med = p_med + baro_correction(t_med, fit.exponent)
+    even, odd = even_odd_split(t_med.size)
+    e_even, mean_even = best_exponent(t_med[even], p_med[even])
+    held = p_med[odd] + baro_correction(t_med[odd], e_even) - mean_even
+    old = {k: float(log_params[k]) for k in fit.params() if k in log_params}
+    return ArdupilotBaroReportRequest(
+        fit, log_path, f"ArduPilot barometer temperature calibration — BARO.{fit.instance}",
+        generated_by, temp, before, after, t_med, p_med - np.median(press),
+        c_med - np.median(corrected),
+        t_med[odd], held, e_even, old, said,
+    )  # fmt: skip
+
+
 __all__ = [
     "EXP_LIMITS",
     "TZERO_C",
     "ArdupilotBaroFit",
+    "ArdupilotBaroReportRequest",
     "baro_correction",
+    "baro_report_request",
     "best_exponent",
     "fit_ardupilot_baro",
 ]

@@ -36,6 +36,7 @@ from thermocal.models.base import RunData, model_inputs
 from thermocal.models.calibration import Calibration, Channel
 from thermocal.models.poly import PolyModel
 from thermocal.recording import FloatArray, Recording
+from thermocal.tempcal.ardupilot_baro import ArdupilotBaroReportRequest
 from thermocal.tempcal.binning import BIN_WIDTH_C, MIN_BINS, even_odd_split, temperature_bins
 from thermocal.tempcal.compare import CoefficientComparison
 from thermocal.tempcal.offset_report import OffsetReportRequest
@@ -266,7 +267,10 @@ class ReportRequest:
     """The firmware's own learned coefficients (ArduPilot ``TCLR``) against the new ones."""
 
 
-Reporter = Callable[[Path, ReportRequest | OffsetReportRequest], object]
+AnyReportRequest = ReportRequest | OffsetReportRequest | ArdupilotBaroReportRequest
+"""What a report is built from: a sensor's calibration, a PX4 barometer's or magnetometer's
+``TC_B``/``TC_M``, ArduPilot's ``TCAL_BARO_EXP``."""
+Reporter = Callable[[Path, AnyReportRequest], object]
 """Writes one report (HTML) to the path; given by the caller (the CLI), so that this file
 layer does not import the presentation layer."""
 
@@ -278,7 +282,7 @@ when its recording has at least this many samples and the machine at least two c
 
 
 def _report_job(
-    reporter: Reporter, path: Path, request: ReportRequest | OffsetReportRequest
+    reporter: Reporter, path: Path, request: AnyReportRequest
 ) -> list[tuple[Warning, str, int]]:
     """In the worker: write one report; its warnings (message, file, line) are returned to
     be said again by the parent process, in whose warning filters they belong."""
@@ -292,7 +296,7 @@ def _report_job(
     ]  # fmt: skip
 
 
-def _n_samples(request: ReportRequest | OffsetReportRequest) -> int:
+def _n_samples(request: AnyReportRequest) -> int:
     if isinstance(request, ReportRequest):
         return int(request.recording.time_s.size)
     return int(np.asarray(request.temp_c).size)
@@ -316,11 +320,9 @@ class OutputSet:
     reports: list[Path] = field(default_factory=list)
     workers: int = 0
     _pool: Any = None
-    _pending: list[tuple[Any, Path, ReportRequest | OffsetReportRequest]] = field(
-        default_factory=list
-    )
+    _pending: list[tuple[Any, Path, AnyReportRequest]] = field(default_factory=list)
 
-    def report(self, name: str, request: ReportRequest | OffsetReportRequest) -> None:
+    def report(self, name: str, request: AnyReportRequest) -> None:
         """Write the report ``name`` into the stage (when a reporter is given): here, or
         in the worker process (the class docstring)."""
         path = self.output / name

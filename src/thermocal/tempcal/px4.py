@@ -260,7 +260,7 @@ def _px4_tempcal(
     series: dict[str, tuple[FloatArray, FloatArray]] = {}
     motions: dict[str, adequacy.Motion] = {}
     params = ParamSet("px4")
-    old = _Prior(ulog_parameters(log), {})  # the TC_* the log was recorded with
+    old = _Prior(_tc_in_force(log, params.notes), {})  # the TC_* the log was recorded with
     with staged_set(output, reporter, pool) as out_set:  # moved into place whole, or removed
         for name, inst in topics:
             if name in OFFSET_TOPICS:  # barometers and magnetometers: TC_B / TC_M
@@ -287,6 +287,32 @@ def _px4_tempcal(
         log, output / PARAMS_NAME, output / "calibration.json", tuple(out_set.reports),
         tuple(fits), tuple(offset_fits), tuple(params.notes), old.found,
     )  # fmt: skip
+
+
+def _tc_in_force(log: Path, notes: list[str]) -> dict[str, float]:
+    """The log's parameters the new ``TC_*`` are compared with: the initial ones
+    (:func:`thermocal.readers.ulog_params.ulog_parameters`) updated by every ``TC_*`` changed
+    during the recording (:func:`thermocal.readers.ulog.ulog_parameter_changes`), i.e. those
+    in force at the end of the log, the board's calibration the new one replaces.  PX4 logs
+    ``sensor_gyro``/``_accel``/``_baro``/``_mag`` before its temperature compensation
+    (applied downstream, sensors/vehicle_imu), so such a change leaves the data as they are;
+    each is said in ``notes`` (name, old → new, log time) with the values compared."""
+    from thermocal.readers.ulog import ulog_parameter_changes
+
+    params = ulog_parameters(log)
+    said: list[str] = []
+    for t, name, value in ulog_parameter_changes(log, (*TOPICS, *OFFSET_TOPICS)):
+        before = params.get(name)
+        if name.startswith("TC_") and before is not None and before != value:
+            said.append(f"{name} {before:g} → {value:g} at log time {t:.3f} s")
+        params[name] = value
+    if said:
+        notes.append(
+            "TC_* parameters changed during the recording (" + "; ".join(said) + "): the "
+            "logged sensor data are uncompensated, so the fit is unaffected; the coefficients "
+            "compared (previous) are those in force at the end of the log"
+        )
+    return params
 
 
 @dataclass(frozen=True)
