@@ -87,9 +87,9 @@ MUTANTS: tuple[Mutant, ...] = (
     ),
     Mutant(
         "allan-edf-overwritten",
-        P + "stability/allan.py",
-        "edf[idx] += edf_simple(",
-        "edf[idx] = edf_simple(",
+        P + "stability/family.py",
+        "edf[i] += e if",
+        "edf[i] = e if",
         _t("allan", "allan_references"),
         "gapped data: each segment's EDF overwrites the pooled one",
     ),

@@ -102,19 +102,22 @@ def test_edf_matches_sp1065_table5(alpha: int) -> None:
 
 
 def test_confidence_interval_chi_square() -> None:
+    """The default path's EDF is Greenhall & Riley's (allantools' edf_greenhall as the
+    independent reference), the interval SP 1065 eq. 45 (issue 29 item 1: the same
+    intervals as ``--deviation oadev`` and Stable32)."""
     y = nbs14_1000()
     res = allan.overlapping_adev(y, 1.0, [1.0, 10.0, 100.0], alpha=0, confidence=0.95, unit="")
     for i, m in enumerate(res.m):
-        edf = at_ci.edf_simple(1001, int(m), 0)
+        edf = at_ci.edf_greenhall(alpha=0, d=2, m=int(m), N=1001, overlapping=True, modified=False)
         lo, hi = at_ci.confidence_interval(res.adev[i], edf, ci=0.95)
         assert res.edf[i] == pytest.approx(edf, rel=1e-12)
         assert res.adev_low[i] == pytest.approx(lo, rel=1e-10)
         assert res.adev_high[i] == pytest.approx(hi, rel=1e-10)
-    # white FM at τ = 1 s, n = 1000: edf = 665.8, so the 95 % interval is about
-    # ±1.96/√(2·665.8) = ±5.4 % of σ
-    assert res.edf[0] == pytest.approx(665.78, abs=0.01)
-    assert 0.94 < res.adev_low[0] / res.adev[0] < 0.955
-    assert 1.045 < res.adev_high[0] / res.adev[0] < 1.06
+    # white FM at τ = 1 s, n = 1000: Greenhall's edf = 782.0 (SP 1065 Table 5's simple
+    # formula: 665.8), so the 95 % interval is about ±1.96/√(2·782) = ±5.0 % of σ
+    assert res.edf[0] == pytest.approx(782.03, abs=0.01)
+    assert 0.945 < res.adev_low[0] / res.adev[0] < 0.955
+    assert 1.045 < res.adev_high[0] / res.adev[0] < 1.055
 
 
 def test_noise_type_identification() -> None:

@@ -151,7 +151,9 @@ def allan_json(
     terms, ``noise_slope`` the slope-line terms (each value or null with a reason);
     ``output_quantization`` the quantisation step found in the samples (value, unit,
     source, the noise it makes; null when they lie on no lattice); ``dynamic`` with
-    ``--dynamic``."""
+    ``--dynamic``; ``interval`` how ``adev_low``/``adev_high`` were found (Greenhall's EDF
+    with α identified per τ, ``alpha_method``: the implementation of ``--deviation
+    oadev``)."""
     out: dict[str, Any] = {
         "tau_s": res.tau_s,
         "adev": res.adev,
@@ -161,6 +163,10 @@ def allan_json(
         "n_terms": res.n_terms,
         "edf": res.edf,
         "alpha": res.alpha,
+        "alpha_method": list(res.alpha_method),
+        "interval": f"chi-square, {100 * res.confidence:.1f} %, "
+        + _family.edf_source("oadev")
+        + ", α identified per τ (as --deviation oadev)",
         "confidence": res.confidence,
         "tau0_s": res.tau0_s,
         "n_samples": res.n_samples,

@@ -15,12 +15,16 @@ with ``N − 2m`` terms.  The mean rate is removed before the cumulative sum (th
 second difference cancels it exactly, and it keeps the cumulative sum small so
 rounding does not grow with the bias).
 
-Confidence intervals (SP 1065 §5.3, eq. 45): ``edf · σ̂² / χ²_{p}(edf)`` with the
-equivalent degrees of freedom of SP 1065 Table 5 ("simple" approximations of
-Howe, Allan & Barnes) for the power-law noise type α identified at each τ from
-the local log-log slope of the curve (``σ² ∝ τ^μ``, ``α = −μ − 1``; gyro terms:
-quantization ↔ α = +2, angle random walk ↔ α = 0, bias instability ↔ α = −1,
-rate random walk ↔ α = −2).
+Confidence intervals (SP 1065 §5.3, eq. 45): ``edf · σ̂² / χ²_{p}(edf)`` with
+Greenhall & Riley's equivalent degrees of freedom (Greenhall & Riley 2003; SP 1065
+§5.3.3) for the power-law noise type α identified at each τ by the lag-1 autocorrelation
+of the m-averages (Riley & Greenhall 2004; the B1 ratio where too few averages remain) —
+the one implementation of ``thermocal allan --deviation oadev``
+(:func:`thermocal.stability.family.oadev_edf`), so both give the same intervals, equal to
+Stable32's (gyro terms: quantization ↔ α = +2, angle random walk ↔ α = 0, bias
+instability ↔ α = −1, rate random walk ↔ α = −2).  SP 1065 Table 5's simple EDF
+(:func:`edf_simple`) is kept as a reference formula only: it is too small at the largest m
+(the random-walk-FM interval at m ≈ N/3 is too wide).
 
 Noise terms (IEEE Std 952-1997 Annex C; SPEC §1): the model ::
 
@@ -78,6 +82,8 @@ from thermocal import units
 from thermocal._lazy import LazyModule
 from thermocal.errors import MissingValueError, ThermocalInputError
 from thermocal.recording import contiguous_slices
+from thermocal.stability import family
+from thermocal.stability.edf import ONE_SIGMA_CONFIDENCE, confidence_interval
 
 # scipy is imported when first needed (a command that reads the help does not pay for it)
 linalg = LazyModule("scipy.linalg")
@@ -88,9 +94,6 @@ FloatArray = npt.NDArray[np.float64]
 IntArray = npt.NDArray[np.int64]
 
 TauSpec = Literal["octave", "decade", "log"] | npt.ArrayLike
-
-ONE_SIGMA_CONFIDENCE: Final = math.erf(1.0 / math.sqrt(2.0))
-"""0.6827, the confidence of a ±1σ interval (the Stable32 default)."""
 
 BIAS_INSTABILITY_FACTOR: Final = math.sqrt(2.0 * math.log(2.0) / math.pi)
 """0.6643: flat-region Allan deviation of bias instability is 0.6643 B (IEEE 952 C.3)."""
@@ -144,8 +147,10 @@ class AllanResult:
     adev : overlapping Allan deviation [unit].
     adev_low, adev_high : confidence interval at ``confidence`` [unit].
     n_terms : number of second differences behind each point (summed over segments).
-    edf : equivalent degrees of freedom (summed over segments).
+    edf : Greenhall's equivalent degrees of freedom (summed over segments).
     alpha : power-law noise exponent used for the EDF at each τ.
+    alpha_method : how each α was found (``lag1``, ``b1``, ``b1-previous``, ``previous``,
+        ``given``; :class:`thermocal.stability.family.DeviationCurve`).
     unit : unit of the rate data and of ``adev``.
     confidence : confidence level of the interval (0.683 = ±1σ).
     tau0_s : sample interval [s].
@@ -166,6 +171,7 @@ class AllanResult:
     tau0_s: float
     n_samples: int
     n_segments: int
+    alpha_method: tuple[str, ...] = ()
 
     @property
     def avar(self) -> FloatArray:
@@ -445,7 +451,9 @@ def second_difference_sums(x1: FloatArray, m: IntArray) -> FloatArray:
 
 
 def edf_simple(n_phase: npt.ArrayLike, m: npt.ArrayLike, alpha: npt.ArrayLike) -> FloatArray:
-    """Equivalent degrees of freedom of the overlapping Allan variance.
+    """Simple equivalent degrees of freedom of the overlapping Allan variance (a reference
+    formula: :func:`overlapping_adev` uses Greenhall's EDF, which this underestimates at
+    large m — its 68.3 % interval over-covers near m = N/3).
 
     NIST SP 1065 Table 5 (Howe, Allan & Barnes simple approximations), with
     N phase points, averaging factor m and noise exponent α:
@@ -474,45 +482,6 @@ def edf_simple(n_phase: npt.ArrayLike, m: npt.ArrayLike, alpha: npt.ArrayLike) -
         rwfm = (N - 2) / (mm * (N - 3) ** 2) * ((N - 1) ** 2 - 3 * mm * (N - 1) + 4 * mm**2)
     out = np.select([a == 2, a == 1, a == 0, a == -1, a == -2], [wpm, fpm, wfm, ffm, rwfm], out)
     return np.asarray(out, dtype=np.float64)
-
-
-def identify_alpha(tau_s: FloatArray, adev: FloatArray) -> IntArray:
-    """Power-law noise exponent α per τ from the local log-log slope of the curve.
-
-    μ = d ln σ² / d ln τ (centred differences, one-sided at the ends), α = −μ − 1
-    rounded and clipped to [−2, 2]; μ ≤ −1.5 is taken as white PM (α = 2), the
-    quantization region of a gyro (ADEV cannot tell white from flicker PM).
-    α is then made non-increasing in τ (σ² of a sum of power laws is convex in
-    ln τ).  A single point is taken as white FM (α = 0).
-    """
-    if tau_s.size < 2:
-        return np.zeros(tau_s.size, dtype=np.int64)
-    ok = adev > 0
-    logs = np.log(np.where(ok, adev, np.nan) ** 2)
-    mu = np.gradient(logs, np.log(tau_s))
-    mu = np.where(np.isfinite(mu), mu, -1.0)
-    alpha = np.clip(np.round(-mu - 1.0), -2, 2).astype(np.int64)
-    alpha[mu <= -1.5] = 2
-    # σ² of a sum of power laws is convex in ln τ: its slope μ never decreases,
-    # so α never increases with τ (this stops a noisy tail point reading as white PM).
-    return np.minimum.accumulate(alpha)
-
-
-def confidence_interval(
-    adev: npt.ArrayLike, edf: npt.ArrayLike, confidence: float = ONE_SIGMA_CONFIDENCE
-) -> tuple[FloatArray, FloatArray]:
-    """Chi-square confidence interval of a deviation (NIST SP 1065 eq. 45).
-
-    ``σ_low = σ̂ √(edf / χ²_{(1+c)/2}(edf))``, ``σ_high = σ̂ √(edf / χ²_{(1−c)/2}(edf))``.
-    """
-    if not 0.0 < confidence < 1.0:
-        raise ThermocalInputError(f"confidence must be in (0, 1), got {confidence!r}")
-    dev = np.asarray(adev, dtype=np.float64)
-    nu = np.asarray(edf, dtype=np.float64)
-    p_lo = (1.0 - confidence) / 2.0
-    chi_hi = special.chdtri(nu, p_lo)  # upper quantile: inverse survival function
-    chi_lo = 2.0 * special.gammaincinv(nu / 2.0, p_lo)  # lower quantile: inverse CDF
-    return dev * np.sqrt(nu / chi_hi), dev * np.sqrt(nu / chi_lo)
 
 
 def _checked_rate(rate: npt.ArrayLike, tau0_s: float, overwrite: bool) -> tuple[FloatArray, bool]:
@@ -602,8 +571,9 @@ def overlapping_adev(
         (:meth:`thermocal.recording.Recording.segments`, computed once per recording).
     unit : unit string of ``rate`` (reported, and used by :func:`noise_terms`).
     confidence : confidence level of ``adev_low``/``adev_high`` (default ±1σ).
-    alpha : force the noise exponent of the EDF (default: identified per τ by
-        :func:`identify_alpha`).
+    alpha : force the noise exponent of the EDF (default: identified per τ; α, the
+        method per τ and the EDF from :func:`thermocal.stability.family.oadev_edf`,
+        Greenhall's EDF summed over the segments).
     overwrite : the phase may be accumulated in ``rate``'s own buffer (a writeable
         float64 array the caller no longer needs: its values are destroyed), so that the
         computation holds no array per sample beyond the data (issue 26).
@@ -617,20 +587,18 @@ def overlapping_adev(
     slices = _gap_free_slices(y, time_s, segments)
     longest = max(sl.stop - sl.start for sl in slices)
     m = averaging_factors(taus, tau0_s, longest)
-    sums, n_terms, used, segs, seg_terms = _pooled_sums(y, slices, m, overwrite)
+    if alpha is not None and alpha not in (-2, -1, 0, 1, 2):
+        raise ThermocalInputError(f"noise exponent alpha must be −2…2, got {alpha!r}")
+    # α and EDF per τ exactly as `allan --deviation oadev` has them (one implementation),
+    # from the segments that give the sums a term, before the phase may overwrite the rate
+    alphas, methods, edf = family.oadev_edf(
+        y, tau0_s, m, segments=[sl for sl in slices if sl.stop - sl.start >= 3], alpha=alpha
+    )
+    sums, n_terms, used, segs, _seg_terms = _pooled_sums(y, slices, m, overwrite)
 
     avar = sums / (2.0 * m.astype(np.float64) ** 2 * n_terms)
     adev = np.sqrt(avar)
     tau = np.asarray(m * float(tau0_s), dtype=np.float64)
-    if alpha is None:
-        alphas = identify_alpha(tau, adev)
-    else:
-        if alpha not in (-2, -1, 0, 1, 2):
-            raise ThermocalInputError(f"noise exponent alpha must be −2…2, got {alpha!r}")
-        alphas = np.full(m.size, alpha, dtype=np.int64)
-    edf = np.zeros(m.size)
-    for n_phase, idx in seg_terms:
-        edf[idx] += edf_simple(n_phase, m[idx], alphas[idx])
     lo, hi = confidence_interval(adev, edf, confidence)
     return AllanResult(
         tau_s=tau,
@@ -646,6 +614,7 @@ def overlapping_adev(
         tau0_s=float(tau0_s),
         n_samples=used,
         n_segments=segs,
+        alpha_method=methods,
     )
 
 
@@ -1186,7 +1155,6 @@ __all__ = [
     "dynamic_adev",
     "edf_simple",
     "fit_quality",
-    "identify_alpha",
     "noise_terms",
     "overlapping_adev",
     "term_units",

@@ -27,7 +27,16 @@ from typing import Final
 import numpy as np
 import numpy.typing as npt
 
+from thermocal._lazy import LazyModule
+from thermocal.errors import ThermocalInputError
+
+# the chi-square quantiles from scipy.special (0.2 s to import), when first needed
+special = LazyModule("scipy.special")
+
 FloatArray = npt.NDArray[np.float64]
+
+ONE_SIGMA_CONFIDENCE: Final = math.erf(1.0 / math.sqrt(2.0))
+"""0.6827, the confidence of a ±1σ interval (the Stable32 default)."""
 
 J_MAX: Final = 100
 """Greenhall's summation limit beyond which the large-sample approximations are used."""
@@ -515,3 +524,20 @@ def _b1_identify(ym: FloatArray, dmax: int) -> NoiseId:
             chosen = lo
             break
     return NoiseId(_MU_TO_ALPHA[chosen], float("nan"), "b1", 0)
+
+
+def confidence_interval(
+    adev: npt.ArrayLike, edf: npt.ArrayLike, confidence: float = ONE_SIGMA_CONFIDENCE
+) -> tuple[FloatArray, FloatArray]:
+    """Chi-square confidence interval of a deviation (NIST SP 1065 eq. 45).
+
+    ``σ_low = σ̂ √(edf / χ²_{(1+c)/2}(edf))``, ``σ_high = σ̂ √(edf / χ²_{(1−c)/2}(edf))``.
+    """
+    if not 0.0 < confidence < 1.0:
+        raise ThermocalInputError(f"confidence must be in (0, 1), got {confidence!r}")
+    dev = np.asarray(adev, dtype=np.float64)
+    nu = np.asarray(edf, dtype=np.float64)
+    p_lo = (1.0 - confidence) / 2.0
+    chi_hi = special.chdtri(nu, p_lo)  # upper quantile: inverse survival function
+    chi_lo = 2.0 * special.gammaincinv(nu / 2.0, p_lo)  # lower quantile: inverse CDF
+    return dev * np.sqrt(nu / chi_hi), dev * np.sqrt(nu / chi_lo)

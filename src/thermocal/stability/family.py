@@ -220,6 +220,12 @@ class _Record:
         self.m_max = 0
         """Octave levels up to this factor (0: no octave levels; set by the caller)."""
 
+    def set_octave(self, m: IntArray) -> None:
+        """Rate data at octave factors only (every m a power of 2): adev, hdev and the noise
+        identification up to the largest m come from the octave levels."""
+        if self.data_type == "rate" and m.size and np.all(m & (m - 1) == 0):
+            self.m_max = int(m.max())
+
     def mean(self, i: int) -> float:
         """Stretch i's mean sample (numpy's, as ``y[sl].mean()``)."""
         if i not in self._means:
@@ -281,6 +287,50 @@ class _Record:
                 for xr, xc in zip(self.phases(), self.centred(), strict=True)
             ]
         return dv.pool(name, parts, m.size)
+
+
+def _new_record(
+    values: npt.ArrayLike,
+    tau0_s: float,
+    data_type: str,
+    segments: list[slice] | None,
+    names: list[str],
+) -> _Record:
+    """The checked record (:func:`_stretches`) with the whole record's mean preset."""
+    y, kept, total = _stretches(values, tau0_s, data_type, segments)
+    record = _Record(y, kept, tau0_s, data_type, names)
+    if len(kept) == 1 and kept[0].indices(y.size)[:2] == (0, y.size):
+        record.preset_mean(0, total / y.size)  # numpy's mean: the same sum over n
+    return record
+
+
+def oadev_edf(
+    rate: npt.ArrayLike,
+    tau0_s: float,
+    m: IntArray,
+    *,
+    segments: list[slice] | None = None,
+    alpha: int | None = None,
+) -> tuple[IntArray, tuple[str, ...], FloatArray]:
+    """Per averaging factor m of the overlapping Allan deviation of ``rate`` [any unit]
+    sampled every ``tau0_s`` [s] in the gap-free ``segments``: the noise exponent α, how it
+    was found and the equivalent degrees of freedom summed over the segments (NaN where
+    none) — exactly what :func:`stability` gives ``oadev`` (the default ``thermocal allan``
+    path takes its intervals from here: one implementation).
+
+    α per τ from :func:`.edf.identify_noise` on the longest segment (lag-1 autocorrelation
+    of the m-averages, Riley & Greenhall 2004; the B1 ratio where too few averages remain),
+    bounded by the shorter τ's α as in :func:`stability`; or ``alpha`` when given.  EDF:
+    Greenhall & Riley's algorithm (:func:`.edf.greenhall_edf`, d = 2, S = 1/m, F = m) per
+    segment, added over the segments (independent estimates).  Reads ``rate`` only (call it
+    before a computation that overwrites the buffer); holds the octave block sums of the
+    longest segment (octave m) or its phase (other m) while it runs.
+    """
+    record = _new_record(rate, tau0_s, "rate", segments, ["oadev"])
+    m = np.asarray(m, dtype=np.int64)
+    record.set_octave(m)
+    alphas, methods = _noise_exponents("oadev", m, record, alpha, {})
+    return alphas, methods, _pooled_edf("oadev", m, alphas, record.sizes)
 
 
 def _noise_exponents(
@@ -360,15 +410,10 @@ def stability(
     come from each stretch's octave pyramid of block sums (:func:`.deviations.octave_levels`,
     O(n) for all τ, no phase array); the same numbers as the phase-difference path.
     """
-    from thermocal.stability.allan import confidence_interval
-
     with threadpool_limits(limits=1, user_api="blas"):  # many short dots: BLAS threads wait
         if data_type not in ("rate", "phase"):
             raise ThermocalInputError(f"--data-type {data_type!r}: use rate or phase")
-        y, kept, total = _stretches(values, tau0_s, data_type, segments)
-        record = _Record(y, kept, tau0_s, data_type, names)
-        if len(kept) == 1 and kept[0].indices(y.size)[:2] == (0, y.size):
-            record.preset_mean(0, total / y.size)  # numpy's mean: the same sum over n
+        record = _new_record(values, tau0_s, data_type, segments, names)
         n_long = max(record.sizes)
         m_common = factors(
             taus,
@@ -377,8 +422,7 @@ def stability(
             if any(n != "theo1" for n in names)
             else 1,
         )
-        if data_type == "rate" and m_common.size and np.all(m_common & (m_common - 1) == 0):
-            record.m_max = int(m_common.max())
+        record.set_octave(m_common)
         curves: dict[str, DeviationCurve] = {}
         id_cache: dict[tuple[int, int], ed.NoiseId] = {}
         for name in names:
@@ -394,7 +438,7 @@ def stability(
             lo = np.full(m.size, np.nan)
             hi = np.full(m.size, np.nan)
             if ok.any():
-                lo_ok, hi_ok = confidence_interval(dev[ok], edf[ok], confidence)
+                lo_ok, hi_ok = ed.confidence_interval(dev[ok], edf[ok], confidence)
                 lo[ok], hi[ok] = lo_ok, hi_ok
             tau = dv.theo1_tau(m, tau0_s) if name == "theo1" else m * float(tau0_s)
             curves[name] = DeviationCurve(
@@ -408,7 +452,7 @@ def stability(
             tau0_s=float(tau0_s),
             data_type=data_type,
             confidence=float(confidence),
-            n_segments=len(kept),
+            n_segments=len(record.kept),
             n_points=int(sum(record.sizes)),
             unit=unit,
         )
