@@ -548,8 +548,9 @@ def lattice_step(
     refined as (u_max − u_min) / Σ k.  Then every sample of the
     record is checked: |(v − offset)/step − round(·)| ≤ ``rtol``.
     """
-    v = np.asarray(values, dtype=np.float64)
-    v = v[np.isfinite(v)]
+    v = np.asarray(values, dtype=np.float64).ravel()
+    if not math.isfinite(float(v.sum())):  # a copy of the finite samples only when needed
+        v = v[np.isfinite(v)]
     n = v.size
     if n < QUANT_MIN_LEVELS * QUANT_MIN_REPEAT:
         return None
