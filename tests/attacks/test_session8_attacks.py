@@ -32,6 +32,7 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+import pandas as pd
 import pyarrow as pa
 import pyarrow.parquet as pq
 import pytest
@@ -439,3 +440,135 @@ def test_export_c_of_a_hostile_triad_name_compiles(counts_cal: Path, tmp_path: P
             r = subprocess.run([cc, "-std=c99", "-Wall", "-Werror", "-c", str(f), "-o",
                                 str(tmp_path / "x.o")], capture_output=True, text=True)  # fmt: skip
             assert r.returncode == 0, r.stderr
+
+
+# --- 4. report --dynamic W -------------------------------------------------------------------
+
+
+@pytest.fixture(scope="module")
+def dyn_work(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """test_report_dynamic's records: 20 000 s at 1 Hz, a linear model fitted on one."""
+    from test_report_dynamic import work
+
+    made: Path = work.__wrapped__(tmp_path_factory)  # type: ignore[attr-defined]
+    return made
+
+
+DYN = ["--signal", "gyro [deg/h]", "--time", "time [s]"]
+
+
+@pytest.mark.parametrize(
+    ("window", "words"),
+    [
+        ("nan", ("--dynamic", "> 0")),
+        ("inf", ("--dynamic", "> 0")),
+        ("-5", ("--dynamic", "> 0")),
+        ("0", ("--dynamic", "> 0")),
+        ("1e300", ("fewer than two windows",)),
+        ("10001", ("fewer than two windows",)),
+        ("0.5", ("holds 0 samples",)),
+        ("2000s", ("--dynamic",)),
+        ("", ("--dynamic",)),
+    ],
+)
+def test_report_dynamic_window_that_is_no_length(
+    dyn_work: Path, window: str, words: tuple[str, ...]
+) -> None:
+    out = dyn_work / "r.html"
+    argv = [
+        "report",
+        "--model",
+        str(dyn_work / "lin.json"),
+        "--recording",
+        str(dyn_work / "steady.csv"),
+    ]
+    _refused([*argv, *DYN, "-o", str(out), "--dynamic", window], *words)
+    assert not out.exists()
+
+
+def test_report_dynamic_on_a_record_with_a_gap(dyn_work: Path) -> None:
+    """4000 s cut out of the steady record: the report is written, the gap said; the map's
+    window is the one asked for, and a stationary output draws no warning."""
+    df = pd.read_csv(dyn_work / "steady.csv").drop(index=range(5000, 9000))
+    df.to_csv(dyn_work / "gap.csv", index=False)
+    out = dyn_work / "rg.html"
+    argv = [
+        "report",
+        "--model",
+        str(dyn_work / "lin.json"),
+        "--recording",
+        str(dyn_work / "gap.csv"),
+    ]
+    code, _o, err = _run([*argv, *DYN, "-o", str(out), "--dynamic", "2000"])
+    assert code == 0, err
+    assert "gaps in time" in err and "not stationary" not in err, err
+    html = out.read_text()
+    assert 'data-key="dynamic.window_s" data-value="2000.0"' in html
+
+
+# --- 5. output quantisation found from the samples -------------------------------------------
+
+
+def _lattice(v: np.ndarray) -> Any:
+    from thermocal.stability.noise_model import lattice_step
+
+    return lattice_step(v)
+
+
+def test_quantisation_no_claim_on_records_that_show_no_lattice() -> None:
+    rng = np.random.default_rng(8)
+    n = 20_000
+    assert _lattice(np.full(n, 3.3)) is None  # constant
+    assert _lattice(np.where(rng.random(n) < 0.5, 0.0, 0.05)) is None  # two levels
+    assert _lattice(np.round(rng.normal(0, 1, 10) / 0.05) * 0.05) is None  # 10 samples
+    assert _lattice(rng.normal(0.0, 1.0, n)) is None  # ordinary floating point
+    assert _lattice(rng.normal(0.0, 1.0, n) * 1e300) is None
+
+
+def test_quantisation_ignores_nan_and_inf_and_finds_the_step() -> None:
+    rng = np.random.default_rng(9)
+    k = np.round(rng.normal(0.0, 1.0, 20_000) / 0.05)
+    v = np.r_[k * 0.05, np.nan, np.inf, -np.inf]
+    step, offset, levels, n = _lattice(v)
+    assert step == pytest.approx(0.05, rel=1e-9)
+    assert offset == pytest.approx(k.min() * 0.05)
+    assert levels == np.unique(k).size and n == 20_000
+
+
+def test_quantisation_integers_at_1e15_lie_on_a_step_of_one() -> None:
+    """1e15 + 0…9: integers, exactly representable (float64 spacing there is 0.125): the
+    lattice is real, its step 1 and its 10 levels."""
+    rng = np.random.default_rng(10)
+    found = _lattice(1e15 + rng.integers(0, 10, 20_000).astype(np.float64))
+    assert found is not None and found[0] == 1.0 and found[2] == 10
+
+
+def test_quantisation_not_claimed_for_the_storage_precision() -> None:
+    """Seen red before the fix: a float64 record at 1e15 lies on float64's own 0.125
+    spacing, and a float32 record (a ULog field, a float32 Parquet column) on float32's —
+    the storage's rounding, reported as the sensor's output quantisation."""
+    rng = np.random.default_rng(11)
+    n = 20_000
+    assert _lattice(1e15 + rng.normal(0.0, 1.0, n)) is None
+    assert _lattice((9.8 + rng.normal(0.0, 1e-5, n)).astype(np.float32).astype(np.float64)) is None
+    # a real step stored as float32 is still found (0.05 deg/s, float32-rounded)
+    k = np.round(rng.normal(0.0, 1.0, n) / 0.05)
+    found = _lattice((k * 0.05).astype(np.float32).astype(np.float64))
+    assert found is not None and found[0] == pytest.approx(0.05, rel=1e-6)
+
+
+def test_allan_on_a_float32_accelerometer_claims_no_quantisation(tmp_path: Path) -> None:
+    """A still accelerometer at 9.8 m/s² (0.01 mg noise) stored float32 in Parquet, 100 Hz:
+    allan's JSON gives no output quantisation (seen red before the fix: a
+    9.5e-7 m/s² "rate quantization step")."""
+    rng = np.random.default_rng(12)
+    n = 20_000
+    t = np.arange(n) * 0.01
+    cols = {"time [s]": t}
+    for name, g in (("ax", 0.0), ("ay", 0.0), ("az", 9.8)):
+        cols[name] = (g + rng.normal(0.0, 1e-4, n)).astype(np.float32)
+    pd.DataFrame(cols).to_parquet(tmp_path / "acc.parquet")
+    argv = ["allan", str(tmp_path / "acc.parquet"), "--signal", "az", "--signal-unit", "m/s^2"]
+    code, out, err = _run([*argv, "--time", "time [s]", "--json"])
+    assert code == 0, err
+    assert json.loads(out)["output_quantization"] is None
