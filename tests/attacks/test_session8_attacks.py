@@ -696,3 +696,24 @@ def test_ardupilot_change_before_the_first_sample_is_the_initial_value(tmp_path:
     assert (tmp_path / "c" / "ardupilot.parm").read_text() == (
         tmp_path / "f" / "ardupilot.parm"
     ).read_text()
+
+
+def test_validate_on_a_station_folder_reads_the_named_sensor(tmp_path: Path) -> None:
+    """Sensor a's model (slope +0.5) validated on sensor b (slope −1.0) leaves 1.5 deg/h/°C ×
+    the temperature's excursion: the residual's rms is 1.5 × 20/√2 deg/h (a sine of
+    amplitude 20 °C over whole periods), computed here; on sensor a it is ≈ 0."""
+    d = _station(tmp_path)
+    model = tmp_path / "m.json"
+    argv = ["fit", str(d), "--sensor", "a", "--signal", "gx_deg_h", "--signal-unit", "deg/h",
+            "--temps", "temp_c", "--model", "poly", "--order", "1", "-o", str(model)]  # fmt: skip
+    code, _o, err = _run(argv)
+    assert code == 0, err
+    _refused(["validate", str(model), str(d)], "--sensor ID")
+    _refused(["validate", str(model), str(d), "--sensor", "../rec"], "no sensor '../rec'")
+    rms = {}
+    for sid in ("a", "b"):
+        code, out, err = _run(["validate", str(model), str(d), "--sensor", sid, "--json"])
+        assert code == 0, err
+        rms[sid] = json.loads(out)["rms_after"]
+    assert rms["a"] < 1e-6
+    assert rms["b"] == pytest.approx(1.5 * 20.0 / np.sqrt(2.0), rel=1e-3)
