@@ -1309,7 +1309,8 @@ class _TriadPlan:
             v = numeric_column(chunk, c, src, row0)
             _check_finite(v, f"signal column {c!r}", src, row0)
             if self.count_scale is not None:  # raw counts → the triad's unit
-                v = v * self.count_scale
+                with np.errstate(over="ignore"):  # an overflow is refused just below
+                    v = v * self.count_scale
             _check_plausible(temp[:0, None], [], v, self.out_unit, src, row0, c)
             x[:, k] = v
         m = self.tri.model

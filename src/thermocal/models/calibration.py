@@ -232,6 +232,13 @@ def calibration_from_dict(d: dict[str, Any], where: str) -> Calibration:
             raise ModelFileError(f"{at}.model: malformed ({type(exc).__name__}: {exc})") from None
         channels.append(Channel(ch["name"], ch["signal"], ch["unit"], model, role))
     triads = [_triad_from_dict(t, f"{where}: triads[{i}]") for i, t in enumerate(raw_triads)]
+    scaled = next((t.name for t in triads if t.count_scale is not None), None)
+    if scaled is not None and ver < COUNT_SCALE_FORMAT_VERSION:
+        # a thermocal of version 1 would ignore the count scale and apply the triad to counts
+        raise ModelFileError(
+            f"{where}: triad {scaled!r} has a count_scale, which needs format_version "
+            f"{COUNT_SCALE_FORMAT_VERSION}; the file says {ver}"
+        )
     try:
         return Calibration(channels, triads)
     except ThermocalInputError as exc:

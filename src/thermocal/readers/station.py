@@ -47,8 +47,12 @@ def read_station_json(out_dir: Path) -> dict[str, Any]:
         raise FileFormatError(f"{p}: not valid JSON ({exc})") from None
     if not isinstance(doc, dict) or doc.get("format") != STATION_FORMAT:
         raise FileFormatError(f"{p}: not a thermocal station file")
-    if int(doc.get("version", 0)) > STATION_VERSION:
-        raise FileFormatError(f"{p}: written by a newer thermocal (version {doc['version']})")
+    version = doc.get("version", 0)
+    if not isinstance(version, int) or isinstance(version, bool):
+        raise FileFormatError(f"{p}: 'version' must be an integer, got {version!r}")
+    if version > STATION_VERSION:
+        raise FileFormatError(f"{p}: written by a newer thermocal (version {version})")
+    _checked_sensor_ids(doc, p)
     return doc
 
 
@@ -59,8 +63,30 @@ def is_station_path(path: Path) -> bool:
     return not path.exists() and (path.parent / STATION_JSON).is_file()
 
 
+def _checked_sensor_ids(doc: dict[str, Any], where: Path) -> list[str]:
+    """The sensor ids of ``config.sensors``, each a stream name as the recorder writes it
+    (letters, digits and ``_``, not the chamber's): an id with ``/`` or ``..`` would name a
+    path outside the folder.  A malformed list is a :class:`FileFormatError` naming it."""
+    config = doc.get("config") or {}
+    sensors = config.get("sensors", []) if isinstance(config, dict) else None
+    if not isinstance(sensors, list):
+        raise FileFormatError(f"{where}: 'config.sensors' must be a list of {{\"id\": ...}}")
+    ids = []
+    for s in sensors:
+        sid = s.get("id") if isinstance(s, dict) else None
+        m = PART_RE.match(f"{sid}-0000.parquet") if isinstance(sid, str) else None
+        if m is None or m["stream"] != sid or sid == CHAMBER_STREAM:
+            raise FileFormatError(
+                f"{where}: sensor id {sid!r} in 'config.sensors' is not a stream name "
+                f"(letters, digits and _, not {CHAMBER_STREAM!r})"
+            )
+        ids.append(sid)
+    return ids
+
+
 def sensor_ids(doc: dict[str, Any]) -> list[str]:
-    return [str(s["id"]) for s in (doc.get("config") or {}).get("sensors", [])]
+    """The sensor ids of a station file read by :func:`read_station_json` (checked there)."""
+    return _checked_sensor_ids(doc, Path(STATION_JSON))
 
 
 def _stream_of(path: Path) -> tuple[Path, str]:
@@ -138,9 +164,25 @@ def read_station(path: Path) -> tuple[pa.Table, dict[str, Any]]:
             tables.append(pq.read_table(p))
         except (pa.ArrowInvalid, OSError) as exc:
             raise FileFormatError(f"{p}: not a readable Parquet part ({exc})") from None
+    for p, t in zip(files[1:], tables[1:], strict=True):
+        if t.schema.names != tables[0].schema.names:
+            raise FileFormatError(
+                f"{p}: columns {t.schema.names} differ from the first part's "
+                f"{tables[0].schema.names}"
+            )
     raw = (tables[-1].schema.metadata or {}).get(META_KEY.encode())
-    meta: dict[str, Any] = json.loads(raw.decode()) if raw else {}
-    table = pa.concat_tables([t.replace_schema_metadata(None) for t in tables])
+    try:
+        meta: dict[str, Any] = json.loads(raw.decode("utf-8")) if raw else {}
+    except (json.JSONDecodeError, UnicodeDecodeError):
+        raise FileFormatError(f"{files[-1]}: corrupt thermocal metadata") from None
+    if not isinstance(meta, dict):
+        raise FileFormatError(f"{files[-1]}: corrupt thermocal metadata (not an object)")
+    try:  # a column stored float32 in one part and float64 in another is widened
+        table = pa.concat_tables(
+            [t.replace_schema_metadata(None) for t in tables], promote_options="permissive"
+        )
+    except (pa.ArrowInvalid, pa.ArrowTypeError) as exc:
+        raise FileFormatError(f"{path}: parts whose column types disagree ({exc})") from None
     return table, meta
 
 

@@ -455,6 +455,12 @@ _QUANT_PROBE: Final = 200_000
 _QUANT_MERGE: Final = 1e-9
 """Distinct values closer than this fraction of the sample range are one level."""
 
+QUANT_MIN_ULPS: Final = 4
+"""A lattice step of at most this many units in the last place of the storage's precision
+at the record's largest magnitude (float32 when every probed sample is a float32 value,
+else float64) is the storage's rounding, not the sensor's output quantisation: a float32
+accelerometer at 9.8 m/s² lies on a 9.5e-7 lattice, a float64 record at 1e15 on 0.125."""
+
 _SQRT12: Final = math.sqrt(12.0)
 
 
@@ -573,6 +579,8 @@ def lattice_step(
         return None
     step = float(u[-1] - u[0]) / float(k.sum())  # the gaps between the extreme levels
     offset = float(u[0])
+    if step <= QUANT_MIN_ULPS * _storage_ulp(probe, max(abs(float(u[0])), abs(float(u[-1])))):
+        return None
     # the whole record, in blocks (no array of n quotients)
     lo_k, hi_k = math.inf, -math.inf
     for a in range(0, n, 1 << 20):
@@ -592,6 +600,13 @@ def lattice_step(
     if levels < QUANT_MIN_LEVELS or levels * QUANT_MIN_REPEAT > n:
         return None
     return step, offset, levels, n
+
+
+def _storage_ulp(probe: npt.NDArray[np.float64], top: float) -> float:
+    """The spacing of the stored numbers at magnitude ``top``: float32's when every probed
+    sample is a float32 value (a ULog field, a float32 Parquet column), else float64's."""
+    f32 = bool(np.all(probe.astype(np.float32).astype(np.float64) == probe))
+    return float(np.spacing(np.float32(top)) if f32 else np.spacing(top))
 
 
 def output_quantization(

@@ -45,9 +45,10 @@ class RegisterMap:
 
     def encode(self, temperature_c: float) -> int:
         """°C → the unsigned 16-bit word written to the register."""
-        counts = round(temperature_c / self.scale)
+        ratio = temperature_c / self.scale  # inf for a tiny scale: refused, not rounded
         lo, hi = (-32768, 32767) if self.signed else (0, 65535)
-        if not (math.isfinite(temperature_c) and lo <= counts <= hi):
+        counts = round(ratio) if math.isfinite(ratio) else None
+        if counts is None or not lo <= counts <= hi:
             kind = "signed" if self.signed else "unsigned"
             raise ThermocalInputError(
                 f"set-point {temperature_c:g} °C does not fit a {kind} 16-bit register at "

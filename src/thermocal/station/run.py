@@ -27,7 +27,7 @@ from typing import TYPE_CHECKING, Any, Protocol
 from thermocal.errors import ThermocalInputError
 from thermocal.readers.station import CHAMBER_STREAM, closed_parts
 from thermocal.station.chamber import Chamber, ChamberError, make_chamber
-from thermocal.station.config import StationConfig
+from thermocal.station.config import ChamberConfig, StationConfig
 from thermocal.station.recorder import Recorder
 from thermocal.station.sensors import SerialSensor
 
@@ -399,7 +399,7 @@ def run_station(
     ch_cfg = cfg.chamber
     chamber = chamber or make_chamber(ch_cfg, disp.log)
     for c in (*c_prog, ch_cfg.safe_setpoint_c):  # every set-point must fit the register
-        _quantize(float(c), ch_cfg.scale, ch_cfg.signed, ch_cfg.driver)
+        _check_setpoint(float(c), ch_cfg)
     rec, p0 = _open_recorder(cfg, t_prog, c_prog, out_dir, profile_source, resume, time_scale, disp)
     loop = _Loop(cfg, t_prog, c_prog, p0, time_scale, rec, chamber, disp)
     try:
@@ -412,6 +412,18 @@ def run_station(
         loop.finish()
     return RunResult(out_dir, p0, loop.p, loop.parts, loop.samples, loop.bad, loop.ended,
                      loop.setpoints, loop.safe, list(rec.doc["events"]))  # fmt: skip
+
+
+def _check_setpoint(c: float, ch: ChamberConfig) -> None:
+    """Refuse a set-point the register cannot hold: out of its 16-bit range (``encode``), or
+    rounded by a coarse ``scale`` to a value further than ``tolerance_c`` from the program's
+    (``scale = 100`` would write 60 °C as 100 °C)."""
+    q = _quantize(c, ch.scale, ch.signed, ch.driver)
+    if abs(q - c) > ch.tolerance_c:
+        raise ThermocalInputError(
+            f"set-point {c:g} °C would be written as {q:g} °C at scale {ch.scale:g} °C/count "
+            f"(more than tolerance_c = {ch.tolerance_c:g} °C away); check [chamber] scale"
+        )
 
 
 def _quantize(c: float, scale: float, signed: bool, driver: str) -> float:

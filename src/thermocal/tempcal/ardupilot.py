@@ -214,7 +214,13 @@ def ardupilot_raw(
     the logged vector is ``R·(v − correction)`` (the temperature correction in the sensor
     frame, then the board's rotation ``AHRS_ORIENTATION``), so ``v = Rᵀ·logged +
     correction``.  Returns (v, the active calibration or None, the orientation code)."""
-    code = int(params.get("AHRS_ORIENTATION", 0))
+    value = params.get("AHRS_ORIENTATION", 0)
+    if not (math.isfinite(value) and float(value).is_integer()):
+        raise ThermocalInputError(  # int(2.5) would rotate by YAW_90 without a word
+            f"AHRS_ORIENTATION {value:g} is not a rotation code (an integer): the data cannot "
+            "be rotated back to the sensor frame"
+        )
+    code = int(value)
     out = np.asarray(xyz, dtype=np.float64)
     if code:
         out = out @ ardupilot_rotation(code)  # row vectors: (Rᵀ·v)ᵀ = vᵀ·R
@@ -244,6 +250,11 @@ class ParamInterval:
     params: dict[str, float]
 
 
+NOTE_CHANGES = 50
+"""Parameter changes a note names one by one (the JSON's ``parameter_changes`` holds all):
+a whole INS_TCAL set replaced twice (2 × 22 values) is named in full."""
+
+
 def param_intervals(
     initial: Mapping[str, float], changes: Sequence[Any], relevant: Callable[[str], bool]
 ) -> tuple[list[ParamInterval], list[Any]]:
@@ -256,6 +267,12 @@ def param_intervals(
     cur = dict(initial)
     out: list[ParamInterval] = []
     used = [c for c in changes if relevant(c.name)]
+    bad = next((c for c in used if not math.isfinite(c.new) and "CALTEMP" not in c.name), None)
+    if bad is not None:  # (a CALTEMP not finite is the firmware's "not set", AP_TREF_C)
+        raise ThermocalInputError(
+            f"{bad.name} set to {bad.new} at log time {bad.time_s:.3f} s: the samples after it "
+            "cannot be undone (the firmware corrected them with a value that is not a number)"
+        )
     start = -math.inf
     for c in used:
         if c.time_s > start:
@@ -276,8 +293,14 @@ def ardupilot_raw_intervals(
     out = np.asarray(xyz, dtype=np.float64).copy()
     actives: list[ActiveTcal | None] = []
     codes: list[int] = []
-    for iv in intervals:
-        sel = (time_s >= iv.start_s) & (time_s < iv.end_s)
+    # each sample's interval, the samples grouped by it (one pass, not a mask per interval:
+    # a parameter set at every sample makes as many intervals as samples)
+    starts = np.array([iv.start_s for iv in intervals[1:]], dtype=np.float64)
+    which = np.searchsorted(starts, np.asarray(time_s, dtype=np.float64), side="right")
+    order = np.argsort(which, kind="stable")
+    bounds = np.searchsorted(which[order], np.arange(len(intervals) + 1), side="left")
+    for k, iv in enumerate(intervals):
+        sel = order[bounds[k] : bounds[k + 1]]
         part, active, code = ardupilot_raw(iv.params, instance, kind, temp_c[sel], out[sel])
         out[sel] = part
         actives.append(active)
@@ -556,12 +579,11 @@ def ardupilot_tempcal(
 
 def _changes_said(run: _Run) -> tuple[dict[str, Any], ...]:
     """Every change of a parameter undone for some IMU, once, in log order."""
-    seen: list[dict[str, Any]] = []
+    seen: dict[tuple[Any, ...], dict[str, Any]] = {}  # keyed: a list search is O(n²)
     for h in run.hygiene.values():
         for c in h.get("parameter_changes", []):
-            if c not in seen:
-                seen.append(c)
-    return tuple(sorted(seen, key=lambda c: float(c["time_s"])))
+            seen.setdefault((c["time_s"], c["name"], c["old"], c["new"]), c)
+    return tuple(sorted(seen.values(), key=lambda c: float(c["time_s"])))
 
 
 def _imu_temperature(run: _Run, df: Any, inst: int) -> FloatArray | None:
@@ -730,8 +752,14 @@ def _previous_params(
     if changes:
         t0, t1 = float(np.nanmin(time_s)), float(np.nanmax(time_s))
         said = "; ".join(
-            f"{c.name} {c.old:g} → {c.new:g} at log time {c.time_s:.3f} s" for c in changes
+            f"{c.name} {c.old:g} → {c.new:g} at log time {c.time_s:.3f} s"
+            for c in changes[:NOTE_CHANGES]
         )
+        if len(changes) > NOTE_CHANGES:
+            said += (
+                f"; … {len(changes) - NOTE_CHANGES} more, every one in "
+                "log_hygiene.parameter_changes"
+            )
         lo = max(chosen.start_s, t0)
         hi = min(chosen.end_s, t1)
         run.param_notes.append(
