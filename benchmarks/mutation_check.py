@@ -955,7 +955,7 @@ MUTANTS: tuple[Mutant, ...] = (
     Mutant(
         "station-newer-version",
         P + "readers/station.py",
-        'if int(doc.get("version", 0)) > STATION_VERSION:',
+        "if version > STATION_VERSION:",
         "if False:",
         STATION,
         "a station folder of a newer format read",
