@@ -29,6 +29,7 @@ from __future__ import annotations
 
 import io
 import struct
+from array import array
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
@@ -56,19 +57,19 @@ class _DefinitionsStream(io.BytesIO):
         super().close()
 
 
-def message_offsets(buf: bytes, start: int) -> tuple[list[int], int]:
-    """Offsets of the messages of ``buf`` from ``start`` (``uint16`` size, ``uint8`` type,
-    payload) and the position after the last one (``len(buf)`` for a chain that ends
+def message_offsets(buf: bytes, start: int) -> tuple[np.ndarray, int]:
+    """Offsets (int64) of the messages of ``buf`` from ``start`` (``uint16`` size, ``uint8``
+    type, payload) and the position after the last one (``len(buf)`` for a chain that ends
     exactly at the end of the file)."""
     unpack = _HEADER.unpack_from
-    out: list[int] = []
+    out = array("q")  # compact and faster to append to than a list
     add = out.append
     pos = start
     last = len(buf) - 3
     while pos <= last:
         add(pos)
         pos += 3 + unpack(buf, pos)[0]
-    return out, pos
+    return np.frombuffer(out, dtype=np.int64), pos
 
 
 def _u16(arr: np.ndarray, at: np.ndarray) -> np.ndarray:
@@ -108,7 +109,7 @@ def fast_ulog(path: Path, names: Sequence[str] | None) -> Any | None:
     if end != len(buf):
         return None
     try:
-        return _fill(ulog, buf, np.asarray(offsets, dtype=np.int64), names)
+        return _fill(ulog, buf, offsets, names)
     except (IndexError, KeyError, ValueError, OverflowError, struct.error):
         return None
 
