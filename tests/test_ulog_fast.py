@@ -186,6 +186,8 @@ def _damaged(tmp_path: Path) -> dict[str, Path]:
         "trailing byte": good + b"\x01",
         # pyulog takes a payload longer than its format less the trailing padding as damaged
         "padding written": _rich_log(padded=True),
+        # no data section at all (definitions only): nothing to gain, pyulog reads it
+        "definitions only": good[: next(o for o, _s, t in _messages(good) if t == "A")],
     }
     cases["appended data"] = (
         good[:16]
@@ -237,7 +239,7 @@ def test_damaged_logs_take_pyulogs_path_and_keep_their_notes(
         assert "damaged messages" in said[why], why
     # pyulog skips a message of a type it does not know (a newer logger's) without a word,
     # and reads appended data its own way: the fast reader leaves both to it all the same
-    assert said["unknown type"] == ""
+    assert said["unknown type"] == said["definitions only"] == ""
     # a clean log takes the fast path: the object returned is the fast reader's
     taken.clear()
     clean = tmp_path / "clean.ulg"

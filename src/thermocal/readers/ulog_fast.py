@@ -27,7 +27,9 @@ is subscribed twice, every subscribed format has a ``uint64_t timestamp``.
 
 from __future__ import annotations
 
-import io
+import contextlib
+import mmap
+import os
 import struct
 from array import array
 from collections.abc import Sequence
@@ -36,7 +38,7 @@ from typing import Any
 
 import numpy as np
 
-from thermocal.readers.common import library_output_captured
+from thermocal.readers.common import TrackedReader, library_output_captured
 
 _HEADER = struct.Struct("<H")
 _KNOWN = {ord(c) for c in "ADPOLCSIMQR"}
@@ -45,19 +47,7 @@ _SYNC_BYTES = 8
 an unknown message's payload for it)."""
 
 
-class _DefinitionsStream(io.BytesIO):
-    """The file's bytes as pyulog reads them, noting where its definitions parse stopped
-    (the position when pyulog closes the stream)."""
-
-    stopped_at = -1
-
-    def close(self) -> None:
-        if not self.closed:
-            self.stopped_at = self.tell()
-        super().close()
-
-
-def message_offsets(buf: bytes, start: int) -> tuple[np.ndarray, int]:
+def message_offsets(buf: bytes | mmap.mmap, start: int) -> tuple[np.ndarray, int]:
     """Offsets (int64) of the messages of ``buf`` from ``start`` (``uint16`` size, ``uint8``
     type, payload) and the position after the last one (``len(buf)`` for a chain that ends
     exactly at the end of the file)."""
@@ -78,7 +68,7 @@ def _u16(arr: np.ndarray, at: np.ndarray) -> np.ndarray:
     return out
 
 
-def _rows(buf: bytes, at: np.ndarray, itemsize: int) -> np.ndarray:
+def _rows(buf: mmap.mmap, at: np.ndarray, itemsize: int) -> np.ndarray:
     """The ``itemsize`` bytes at each offset ``at`` of ``buf``, as one contiguous (n,)
     array of ``V<itemsize>``, gathered through a view of ``buf`` whose element ``i`` is the
     ``itemsize`` bytes from byte ``i`` (a stride of one byte)."""
@@ -93,28 +83,33 @@ def fast_ulog(path: Path, names: Sequence[str] | None) -> Any | None:
     the module's docstring): the caller then parses it with pyulog."""
     from pyulog import ULog
 
-    buf = path.read_bytes()
-    stream = _DefinitionsStream(buf)
+    fh = TrackedReader(path)  # pyulog closes it where its definitions parse stopped
     try:
         with library_output_captured() as noise:
-            ulog = ULog(stream, message_name_filter_list=names, parse_header_only=True)
+            ulog = ULog(fh, message_name_filter_list=names, parse_header_only=True)
     except Exception:  # the caller's pyulog parse says what is wrong
         return None
+    finally:
+        fh.close()
     if noise.summary("pyulog") or ulog.file_corruption or ulog.has_data_appended:
         return None
-    start = stream.stopped_at
-    if start < 0:
-        return None
-    offsets, end = message_offsets(buf, start)
-    if end != len(buf):
-        return None
+    with open(path, "rb") as raw:
+        if fh.stopped_at is None or os.fstat(raw.fileno()).st_size <= fh.stopped_at:
+            return None  # no data section: pyulog's parse says what there is
+        buf = mmap.mmap(raw.fileno(), 0, access=mmap.ACCESS_READ)
     try:
+        offsets, end = message_offsets(buf, fh.stopped_at)
+        if end != len(buf):
+            return None
         return _fill(ulog, buf, offsets, names)
     except (IndexError, KeyError, ValueError, OverflowError, struct.error):
         return None
+    finally:
+        with contextlib.suppress(BufferError):  # no view of the file is left: copies only
+            buf.close()
 
 
-def _fill(ulog: Any, buf: bytes, offs: np.ndarray, names: Sequence[str] | None) -> Any | None:
+def _fill(ulog: Any, buf: mmap.mmap, offs: np.ndarray, names: Sequence[str] | None) -> Any | None:
     """Give ``ulog`` (definitions parsed) its data section from the messages at ``offs``,
     as pyulog's own data parse does; None when something is not clean."""
     ULog = type(ulog)
@@ -162,7 +157,7 @@ timestamp is the last data timestamp before them, set by :func:`_timestamps`."""
 
 
 def _rare_messages(
-    ulog: Any, buf: bytes, rare: np.ndarray, names: Sequence[str] | None
+    ulog: Any, buf: mmap.mmap, rare: np.ndarray, names: Sequence[str] | None
 ) -> tuple[dict[int, Any] | None, dict[int, int], dict[int, int], list[_Step]]:
     """Every message of the data section but ``D``, in file order, handled as pyulog's data
     parse does (with its message classes): the subscriptions (msg_id → ``_MessageAddLogged``
