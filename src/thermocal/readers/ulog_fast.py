@@ -102,7 +102,7 @@ def fast_ulog(path: Path, names: Sequence[str] | None) -> Any | None:
         if end != len(buf):
             return None
         return _fill(ulog, buf, offsets, names)
-    except (IndexError, KeyError, ValueError, OverflowError, struct.error):
+    except Exception:  # anything unexpected: pyulog's own parse, which says what is wrong
         return None
     finally:
         with contextlib.suppress(BufferError):  # no view of the file is left: copies only
