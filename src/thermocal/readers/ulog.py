@@ -125,7 +125,7 @@ def _parse_ulog_file(path: Path, names: list[str] | None) -> _ULogRead:
       samples are estimated from their sample interval, :func:`_topic_loss`).
 
     A clean log is read by :func:`thermocal.readers.ulog_fast.fast_ulog` (the same
-    ``ULog`` object, its data messages gathered with numpy: ≈ 4× faster); any log it does
+    ``ULog`` object, its data messages gathered with numpy: 3–5× faster); any log it does
     not take as clean is parsed by pyulog as above.
     """
     try:
