@@ -33,7 +33,7 @@ seconds of rotation rate and of gravity on other axes), one logging drop-out of 
 Usage::
 
     PYTHONPATH=src .venv/bin/python benchmarks/bench_px4_algorithm.py [--size small|large]
-        [--plots | --as-script] [--keep DIR]
+        [--plots | --as-script | --parse] [--keep DIR]
 
 ``small`` ≈ 5 MB (seconds), ``large`` ≈ 50 MB (the issue's size).  Timed (wall, each a fresh
 process as a user runs it): ``thermocal px4-tempcal LOG -o DIR`` (reports included) and this
@@ -43,6 +43,7 @@ file's ``--px4-only LOG`` (PX4's algorithm; with ``--plots``, its PDF too).
 from __future__ import annotations
 
 import argparse
+import math
 import os
 import subprocess
 import sys
@@ -293,6 +294,31 @@ def _timed(cmd: list[str]) -> float:
     return dt
 
 
+def _time_parse(log: Path) -> None:
+    """pyulog's parse of the four sensor topics against :func:`fast_ulog`'s (the same
+    object, asserted), best of 3 each after a warm-up read of the file."""
+    from pyulog import ULog
+
+    from thermocal.readers.ulog_fast import fast_ulog
+
+    names = ["sensor_gyro", "sensor_accel", "sensor_baro", "sensor_mag"]
+    log.read_bytes()  # warm: the file in the page cache
+    best: dict[str, float] = {}
+    got: dict[str, Any] = {}
+    for _ in range(3):
+        for how, parse in (
+            ("pyulog", lambda: ULog(str(log), message_name_filter_list=names)),
+            ("fast", lambda: fast_ulog(log, names)),
+        ):
+            t0 = time.perf_counter()
+            got[how] = parse()
+            best[how] = min(best.get(how, math.inf), time.perf_counter() - t0)
+    assert got["fast"] is not None and got["fast"] == got["pyulog"]
+    print(f"parse: pyulog {best['pyulog']:.3f} s, fast {best['fast']:.3f} s, "
+          f"ratio {best['fast'] / best['pyulog']:.2f}")  # fmt: skip
+    print(f"load average after: {os.getloadavg()[0]:.2f}")
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--size", choices=sorted(SIZES), default="small")
@@ -303,6 +329,12 @@ def main() -> None:
         help="PX4's algorithm as the script runs it: its PDF and its per-sample binning loop",
     )
     ap.add_argument("--keep", type=Path, help="write the log and outputs here")
+    ap.add_argument(
+        "--parse",
+        action="store_true",
+        help="only time the ULog parse of the log's four sensor topics: pyulog against "
+        "thermocal's fast reader (readers.ulog_fast), same process, best of 3 each, warm",
+    )
     ap.add_argument("--px4-only", type=Path, help=argparse.SUPPRESS)
     ap.add_argument("--out", type=Path, help=argparse.SUPPRESS)
     a = ap.parse_args()
@@ -319,6 +351,9 @@ def main() -> None:
     log.write_bytes(data)
     print(f"log {log}: {log.stat().st_size / 1e6:.1f} MB, {SIZES[a.size]} samples per instance")
     print(f"load average before: {os.getloadavg()[0]:.2f}")
+    if a.parse:
+        _time_parse(log)
+        return
     exe = str(Path(sys.executable).parent / "thermocal")
     cmd = [exe, "px4-tempcal", str(log), "-o", str(work / "out"), "--allow-motion", "--json"]
     t_ours = _timed(cmd)  # the bumps are motion: refused without --allow-motion

