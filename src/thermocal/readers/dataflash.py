@@ -5,7 +5,7 @@ from __future__ import annotations
 import contextlib
 import gc
 import warnings
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -107,7 +107,69 @@ class DataflashLog:
         return out
 
 
+READ_BUDGET_S = 60.0
+"""Seconds pymavlink may take over a DataFlash log, plus :data:`READ_BUDGET_S_PER_MB` per MB
+of the file (it reads a few MB/s; far more than a sound log needs)."""
+READ_BUDGET_S_PER_MB = 4.0
+
+
+class _OverBudget(BaseException):
+    """Raised by :func:`_time_budget`'s alarm inside pymavlink's read (a BaseException: the
+    reader's ``except Exception`` around pymavlink must not turn it into another error)."""
+
+
+@contextlib.contextmanager
+def _time_budget(seconds: float) -> Iterator[None]:
+    """Raise :class:`_OverBudget` in the block after ``seconds`` [s] of wall time: a damaged
+    log once kept pymavlink's reader (pure Python) looping for ever (in
+    ``DFReader.init_clock``); the alarm turns that into an error.  Only in the main thread
+    of a platform with ``SIGALRM`` and when no other interval timer runs; else no limit."""
+    import signal
+    import threading
+
+    usable = (
+        hasattr(signal, "setitimer")
+        and threading.current_thread() is threading.main_thread()
+        and signal.getitimer(signal.ITIMER_REAL)[0] == 0.0
+    )
+    if not usable:
+        yield
+        return
+
+    def alarm(signum: int, frame: Any) -> None:
+        raise _OverBudget
+
+    old = signal.signal(signal.SIGALRM, alarm)
+    signal.setitimer(signal.ITIMER_REAL, seconds)
+    try:
+        yield
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0.0)
+        signal.signal(signal.SIGALRM, old)
+
+
 def read_dataflash_log(path: str | Path, messages: Sequence[str]) -> DataflashLog:
+    """Read an ArduPilot DataFlash log (:func:`_read_dataflash_log`) within a time budget
+    (:data:`READ_BUDGET_S` + :data:`READ_BUDGET_S_PER_MB` per MB): a log pymavlink cannot
+    finish is a :class:`FileFormatError`, never a hang."""
+    p = Path(path)
+    try:
+        size_mb = p.stat().st_size / 1e6
+    except OSError:
+        size_mb = 0.0
+    budget = READ_BUDGET_S + READ_BUDGET_S_PER_MB * size_mb
+    try:
+        with _time_budget(budget):
+            return _read_dataflash_log(p, messages)
+    except _OverBudget:
+        gc.collect()  # the file pymavlink holds
+        raise FileFormatError(
+            f"{p}: pymavlink did not finish reading this DataFlash log in {budget:.0f} s "
+            "(a damaged log can keep it looping); nothing was read"
+        ) from None
+
+
+def _read_dataflash_log(path: str | Path, messages: Sequence[str]) -> DataflashLog:
     """Read an ArduPilot DataFlash log once, keeping the messages named in ``messages`` and
     every ``PARM``.  pymavlink's printed complaints are captured; bytes of the file that are
     not whole messages (file size − Σ message lengths, trailing padding of one fill byte
