@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import contextlib
 import gc
+import math
 import warnings
 from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
@@ -16,6 +17,7 @@ from thermocal._lazy import LazyModule
 from thermocal.errors import (
     FileFormatError,
     MissingColumnError,
+    PlausibilityWarning,
     ThermocalInputError,
 )
 from thermocal.readers.common import (
@@ -191,6 +193,8 @@ def _read_dataflash_log(path: str | Path, messages: Sequence[str]) -> DataflashL
     names_seen: set[str] = set()
     accounted = 0  # bytes in whole messages
     last_end = 0
+    t_max_us = -math.inf  # the latest TimeUS read so far
+    backwards = 0  # parameter changes stamped before data already logged
     size = path.stat().st_size
     with library_output_captured() as noise:
         failure = None
@@ -228,12 +232,24 @@ def _read_dataflash_log(path: str | Path, messages: Sequence[str]) -> DataflashL
                     )
                 elif mtype == "PARM":
                     with contextlib.suppress(AttributeError, TypeError, ValueError):
-                        _parm(m, params, current, changes)
+                        backwards += _parm(m, params, current, changes, t_max_us)
+                t_us = getattr(m, "TimeUS", None)
+                if isinstance(t_us, int | float) and t_us > t_max_us:
+                    t_max_us = float(t_us)
         finally:  # pymavlink keeps the file and its memory map open
             for attr in ("data_map", "filehandle"):
                 h = getattr(log, attr, None)
                 if h is not None:
                     h.close()
+    if backwards:
+        warnings.warn(
+            PlausibilityWarning(
+                f"{path}: {backwards} parameter change(s) carry a TimeUS earlier than data "
+                "logged before them (the clock went backwards): each is taken at the latest "
+                "time logged before it, where the firmware applied it"
+            ),
+            stacklevel=3,
+        )
     notes = _dataflash_loss(path, size, accounted, last_end)
     said = noise.summary("pymavlink")
     if said and notes:
@@ -243,19 +259,28 @@ def _read_dataflash_log(path: str | Path, messages: Sequence[str]) -> DataflashL
 
 
 def _parm(
-    m: Any, first: dict[str, float], current: dict[str, float], changes: list[ParamChange]
-) -> None:
+    m: Any,
+    first: dict[str, float],
+    current: dict[str, float],
+    changes: list[ParamChange],
+    t_floor_us: float = -math.inf,
+) -> int:
     """One ``PARM`` (LogStructure.h "TimeUS,Name,Value"): the first value of a name is its
     initial value (the log's parameter dump at start); a later one with another value is a
-    change, at ``TimeUS``."""
+    change, at ``TimeUS`` — or at ``t_floor_us``, the latest time logged before it, when its
+    stamp is earlier (a parameter takes effect where it is logged).  Returns 1 for a change
+    so moved, else 0."""
     name, value = str(m.Name), float(m.Value)
+    moved = 0
     if name not in current:
         first[name] = value
     elif value != current[name] and not (value != value and current[name] != current[name]):
-        changes.append(
-            ParamChange(float(getattr(m, "TimeUS", 0)) * 1e-6, name, current[name], value)
-        )
+        t_us = float(getattr(m, "TimeUS", 0))
+        if t_us < t_floor_us:
+            t_us, moved = t_floor_us, 1
+        changes.append(ParamChange(t_us * 1e-6, name, current[name], value))
     current[name] = value
+    return moved
 
 
 def dataflash_table(
