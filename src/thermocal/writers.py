@@ -242,6 +242,13 @@ def discard_staging() -> None:
         WRITTEN[:] = [w for w in WRITTEN if w.parent != stage]
 
 
+def write_html(path: str | Path, html: str) -> Path:
+    """Write an HTML page (a report) atomically as UTF-8; returns the path."""
+    with atomic_write(path, "wb") as fh:
+        fh.write(html.encode("utf-8"))
+    return Path(path)
+
+
 def write_json(path: str | Path, obj: Any) -> None:
     """Write JSON atomically (indent 2, UTF-8)."""
     text = json.dumps(obj, indent=2, ensure_ascii=False, allow_nan=False)

@@ -20,7 +20,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from thermocal.fleet.stats import HISTOGRAM_FIGURES, OUTLIER_Z, channel_series, outliers, robust_z
-from thermocal.writers import atomic_write
+from thermocal.writers import write_html
 
 if TYPE_CHECKING:
     from thermocal.fleet.config import FleetConfig
@@ -171,10 +171,7 @@ def write_fleet_report(
     redone: Mapping[str, str] | None = None,
 ) -> Path:
     """Build the batch report and write it atomically; returns the path."""
-    html = build_fleet_report(config, records, redone)
-    with atomic_write(path, "wb") as fh:
-        fh.write(html.encode("utf-8"))
-    return Path(path)
+    return write_html(path, build_fleet_report(config, records, redone))
 
 
 __all__ = ["build_fleet_report", "write_fleet_report"]

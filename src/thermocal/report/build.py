@@ -76,7 +76,7 @@ from thermocal.stability.noise_model import (
     annotate_quantization,
     output_quantization,
 )
-from thermocal.writers import atomic_write
+from thermocal.writers import write_html
 
 ILL_CONDITIONED = 1.0e6
 """Condition number (scaled design) above which the report warns: ill-conditioned in the
@@ -1424,10 +1424,7 @@ def build_report(inputs: ReportInputs) -> str:
 
 def write_report(path: str | Path, inputs: ReportInputs) -> Path:
     """Build the report and write it atomically to ``path`` (UTF-8); returns the path."""
-    html = build_report(inputs)
-    with atomic_write(path, "wb") as fh:
-        fh.write(html.encode("utf-8"))
-    return Path(path)
+    return write_html(path, build_report(inputs))
 
 
 __all__ = [

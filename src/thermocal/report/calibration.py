@@ -50,7 +50,7 @@ from thermocal.report.build import (
     improvement_pct,
     unit_label,
 )
-from thermocal.writers import atomic_write
+from thermocal.writers import write_html
 
 
 @dataclass(frozen=True)
@@ -323,10 +323,7 @@ def build_calibration_report(inputs: CalibrationReportInputs) -> str:
 
 def write_calibration_report(path: str | Path, inputs: CalibrationReportInputs) -> Path:
     """Build the calibration report and write it atomically to ``path``; returns the path."""
-    html = build_calibration_report(inputs)
-    with atomic_write(path, "wb") as fh:
-        fh.write(html.encode("utf-8"))
-    return Path(path)
+    return write_html(path, build_calibration_report(inputs))
 
 
 __all__ = [

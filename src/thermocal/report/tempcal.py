@@ -151,11 +151,9 @@ def build_offset_report(req: OffsetReportRequest) -> str:
 
 def write_offset_report(path: str | Path, req: OffsetReportRequest) -> Path:
     """:func:`build_offset_report` written atomically to ``path``."""
-    from thermocal.writers import atomic_write
+    from thermocal.writers import write_html
 
-    with atomic_write(path, "wb") as fh:
-        fh.write(build_offset_report(req).encode("utf-8"))
-    return Path(path)
+    return write_html(path, build_offset_report(req))
 
 
 # --- ArduPilot's barometer: TCAL_BARO_EXP (issue 28, item 3) ----------------------------
@@ -220,11 +218,9 @@ def build_ardupilot_baro_report(req: ArdupilotBaroReportRequest) -> str:
 
 def write_ardupilot_baro_report(path: str | Path, req: ArdupilotBaroReportRequest) -> Path:
     """:func:`build_ardupilot_baro_report` written atomically to ``path``."""
-    from thermocal.writers import atomic_write
+    from thermocal.writers import write_html
 
-    with atomic_write(path, "wb") as fh:
-        fh.write(build_ardupilot_baro_report(req).encode("utf-8"))
-    return Path(path)
+    return write_html(path, build_ardupilot_baro_report(req))
 
 
 __all__ = [

@@ -14,7 +14,7 @@ from typing import Any
 
 import numpy as np
 
-from thermocal.writers import atomic_write
+from thermocal.writers import write_html
 
 
 def _b64(png: bytes) -> str:
@@ -118,10 +118,7 @@ def build_triad_report(
 
 
 def write_triad_report(path: str | Path, *args: Any) -> Path:
-    html = build_triad_report(*args)
-    with atomic_write(path, "wb") as fh:
-        fh.write(html.encode("utf-8"))
-    return Path(path)
+    return write_html(path, build_triad_report(*args))
 
 
 __all__ = ["build_triad_report", "write_triad_report"]
