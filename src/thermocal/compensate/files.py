@@ -85,7 +85,13 @@ from thermocal.models.base import (
     outside_range_dict,
 )
 from thermocal.outputs import sidecar_path
-from thermocal.readers.common import csv_encoding, csv_float_options, default_time_column, file_kind
+from thermocal.readers.common import (
+    csv_encoding,
+    csv_float_options,
+    default_time_column,
+    file_kind,
+    thermocal_metadata,
+)
 from thermocal.readers.dispatch import read_log_table, read_recording, read_text_table
 from thermocal.readers.station import is_station_path, station_files, with_sensor
 from thermocal.readers.table import load_sidecar, numeric_column
@@ -265,7 +271,7 @@ def _file_info(
             raise FileFormatError(f"{path}: not a readable Parquet file ({exc})") from None
         names = list(pf.schema_arrow.names)
         n_rows = int(pf.metadata.num_rows)
-        meta = _parquet_meta(pf, path)
+        meta = thermocal_metadata(pf.schema_arrow.metadata, path)
     else:
         enc = csv_encoding(path)
         opts = csv_chunk_options(path, enc)
@@ -277,18 +283,6 @@ def _file_info(
         names = [str(c).strip() for c in head.columns]
     meta = {**meta, **load_sidecar(path)}
     return names, meta, n_rows
-
-
-def _parquet_meta(pf: pq.ParquetFile, path: Path) -> dict[str, Any]:
-    """The thermocal metadata object of a Parquet file (empty when it has none)."""
-    raw = (pf.schema_arrow.metadata or {}).get(META_KEY.encode())
-    if not raw:
-        return {}
-    try:
-        meta: dict[str, Any] = json.loads(raw.decode("utf-8"))
-    except (json.JSONDecodeError, UnicodeDecodeError):
-        raise FileFormatError(f"{path}: corrupt thermocal metadata") from None
-    return meta
 
 
 def _station_info(path: Path) -> tuple[list[str], dict[str, Any], int | None]:
@@ -307,7 +301,7 @@ def _station_info(path: Path) -> tuple[list[str], dict[str, Any], int | None]:
             raise FileFormatError(f"{f}: columns {these} differ from the first part's {names}")
         names = these
         n_rows += int(pf.metadata.num_rows)
-        meta = _parquet_meta(pf, f)
+        meta = thermocal_metadata(pf.schema_arrow.metadata, f)
     return names or [], meta, n_rows
 
 

@@ -386,6 +386,26 @@ def parse_topic(topic: str | None, default: str = DEFAULT_ULOG_TOPIC) -> tuple[s
     return name, int(inst or 0)
 
 
+def thermocal_metadata(kv: Any, where: str | Path) -> dict[str, Any]:
+    """The thermocal metadata object (JSON under :data:`thermocal.recording.META_KEY`) of a
+    Parquet file's key-value map ``kv`` (None or without the key: ``{}``); anything that is
+    not a JSON object is a :class:`FileFormatError` naming ``where``."""
+    import json
+
+    from thermocal.recording import META_KEY
+
+    raw = (kv or {}).get(META_KEY.encode())
+    if not raw:
+        return {}
+    try:
+        meta = json.loads(raw.decode("utf-8"))
+    except (json.JSONDecodeError, UnicodeDecodeError):
+        raise FileFormatError(f"{where}: corrupt thermocal metadata") from None
+    if not isinstance(meta, dict):
+        raise FileFormatError(f"{where}: corrupt thermocal metadata (not an object)")
+    return meta
+
+
 def sha256_of(path: str | Path) -> str | None:
     """SHA-256 of a file's content, read in 1 MiB blocks; None when it cannot be read (a
     report states it unknown; the fleet redoes a unit whose input is missing).  A model

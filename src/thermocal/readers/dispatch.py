@@ -4,7 +4,6 @@
 from __future__ import annotations
 
 import dataclasses
-import json
 import warnings
 from collections.abc import Sequence
 from pathlib import Path
@@ -29,13 +28,14 @@ from thermocal.readers.common import (
     file_kind,
     names_list,
     short_name,
+    thermocal_metadata,
 )
 from thermocal.readers.dataflash import read_dataflash
 from thermocal.readers.station import is_station_path, read_station_table, with_sensor
 from thermocal.readers.table import ParquetColumns, csv_header_names, load_sidecar, numeric_column
 from thermocal.readers.text import TextOptions, head_lines, rate_time, read_text, sniff_text
 from thermocal.readers.ulog import read_ulog
-from thermocal.recording import META_FORMAT, META_KEY, META_VERSION, FloatArray, Metadata, Recording
+from thermocal.recording import META_FORMAT, META_VERSION, FloatArray, Metadata, Recording
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -64,14 +64,7 @@ def read_table(
         except (pa.ArrowInvalid, OSError) as exc:
             raise FileFormatError(f"{path}: not a readable Parquet file ({exc})") from None
         check_unique_names(path, table.column_names)
-        meta: dict[str, Any] = {}
-        raw = table.metadata.get(META_KEY.encode())
-        if raw:
-            try:
-                meta = json.loads(raw.decode("utf-8"))
-            except (json.JSONDecodeError, UnicodeDecodeError):
-                raise FileFormatError(f"{path}: corrupt thermocal metadata") from None
-        return table, meta
+        return table, thermocal_metadata(table.metadata, path)
     encoding = csv_encoding(path)
     # pandas holds every column of a CSV (and its parser about as much again)
     rows_est, cols_est = csv_rows_estimate(path)

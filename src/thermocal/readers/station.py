@@ -14,6 +14,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from thermocal.errors import FileFormatError
+from thermocal.readers.common import thermocal_metadata
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -155,8 +156,6 @@ def read_station(path: Path) -> tuple[pa.Table, dict[str, Any]]:
     import pyarrow as pa
     import pyarrow.parquet as pq
 
-    from thermocal.recording import META_KEY
-
     files = station_files(path)
     tables = []
     for p in files:
@@ -170,13 +169,7 @@ def read_station(path: Path) -> tuple[pa.Table, dict[str, Any]]:
                 f"{p}: columns {t.schema.names} differ from the first part's "
                 f"{tables[0].schema.names}"
             )
-    raw = (tables[-1].schema.metadata or {}).get(META_KEY.encode())
-    try:
-        meta: dict[str, Any] = json.loads(raw.decode("utf-8")) if raw else {}
-    except (json.JSONDecodeError, UnicodeDecodeError):
-        raise FileFormatError(f"{files[-1]}: corrupt thermocal metadata") from None
-    if not isinstance(meta, dict):
-        raise FileFormatError(f"{files[-1]}: corrupt thermocal metadata (not an object)")
+    meta = thermocal_metadata(tables[-1].schema.metadata, files[-1])
     try:  # a column stored float32 in one part and float64 in another is widened
         table = pa.concat_tables(
             [t.replace_schema_metadata(None) for t in tables], promote_options="permissive"
