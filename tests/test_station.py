@@ -25,6 +25,7 @@ import pytest
 pytest.importorskip("pymodbus")
 pytest.importorskip("serial")
 
+from station_toml import sensor_toml
 from thermocal.cli import main
 from thermocal.station.config import parse_station
 from thermocal.station.run import run_station
@@ -57,17 +58,7 @@ io_timeout_s = 0.3
 {ch}
 """
     for sid, dev in sensors:
-        text += f"""
-[[sensor]]
-id = "{sid}"
-device = "{dev}"
-baud = 115200
-names = ["gx", "temp"]
-units = ["deg/s", "degC"]
-delimiter = ","
-rate_hz = 50
-stale_s = 0.5
-"""
+        text += sensor_toml(dev, sid)
     return text
 
 

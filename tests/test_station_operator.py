@@ -16,6 +16,7 @@ import pytest
 pytest.importorskip("pymodbus")
 pytest.importorskip("serial")
 
+from station_toml import sensor_toml
 from thermocal.cli import main
 from thermocal.station.display import render
 from thermocal.station.run import SensorView, StationState
@@ -33,20 +34,6 @@ def _profile(tmp: Path) -> Path:
     return p
 
 
-def _sensor_toml(device: str) -> str:
-    return f"""
-[[sensor]]
-id = "imu"
-device = "{device}"
-baud = 115200
-names = ["gx", "temp"]
-units = ["deg/s", "degC"]
-delimiter = ","
-rate_hz = 50
-stale_s = 0.5
-"""
-
-
 def test_a_chamber_run_by_hand_is_told_each_step_once(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
@@ -55,7 +42,7 @@ def test_a_chamber_run_by_hand_is_told_each_step_once(
     try:
         toml = tmp_path / "st.toml"
         toml.write_text('part_s = 0.5\n[chamber]\ndriver = "none"\nsafe_setpoint_c = 22\n'
-                        + _sensor_toml(sen.device))  # fmt: skip
+                        + sensor_toml(sen.device))  # fmt: skip
         out = tmp_path / "rec"
         rc = main(["station", "run", str(toml), "--profile", str(_profile(tmp_path)),
                    "-o", str(out), "--time-scale", str(K)])  # fmt: skip
@@ -96,7 +83,7 @@ scale = 0.1
 poll_s = 0.05
 tolerance_c = 5
 drift_s = 200
-""" + _sensor_toml(sen.device))  # fmt: skip
+""" + sensor_toml(sen.device))  # fmt: skip
         out = tmp_path / "rec"
         rc = main(["station", "run", str(toml), "--profile", str(_profile(tmp_path)),
                    "-o", str(out), "--time-scale", str(K)])  # fmt: skip

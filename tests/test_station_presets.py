@@ -16,6 +16,7 @@ import pytest
 pytest.importorskip("pymodbus")
 pytest.importorskip("serial")
 
+from station_toml import sensor_toml
 from thermocal.cli import main
 from thermocal.station.config import parse_station
 from thermocal.station.run import run_station
@@ -34,17 +35,7 @@ port = {port}
 poll_s = 0.1
 io_timeout_s = 0.5
 {chamber}
-
-[[sensor]]
-id = "imu"
-device = "{device}"
-baud = 115200
-names = ["gx", "temp"]
-units = ["deg/s", "degC"]
-delimiter = ","
-rate_hz = 50
-stale_s = 0.5
-"""
+""" + sensor_toml(device)
 
 
 def test_preset_fills_the_handbook_map_and_refuses_a_disagreement(

@@ -37,6 +37,7 @@ import pyarrow as pa
 import pyarrow.parquet as pq
 import pytest
 
+from station_toml import sensor_toml
 from thermocal.cli import main
 from thermocal.recording import META_KEY
 
@@ -228,16 +229,7 @@ def test_fleet_reads_a_station_sensor_and_asks_for_one(tmp_path: Path) -> None:
 
 # --- 2. [chamber] preset and the set-point register ----------------------------------------
 
-STATION_SENSOR = """
-[[sensor]]
-id = "imu"
-device = "/dev/null"
-baud = 115200
-names = ["gx", "temp"]
-units = ["deg/s", "degC"]
-delimiter = ","
-rate_hz = 50
-"""
+STATION_SENSOR = sensor_toml("/dev/null", stale_s=None)
 
 
 def _station_toml(tmp: Path, chamber: str) -> Path:
