@@ -863,6 +863,22 @@ MUTANTS: tuple[Mutant, ...] = (
         "B1 of random-walk FM (μ = 2, Hadamard ladder): N(N−1)/6 instead of N(N+1)/6",
     ),
     Mutant(
+        "stability-mtot-sp1065",
+        P + "stability/edf.py",
+        "    if alpha in _MTOT_STABLE32:\n        b, c = _MTOT_STABLE32[alpha]",
+        "    if alpha in _MTOT:\n        b, c = _MTOT[alpha]",
+        STAB + _t("total_edf_stable32"),
+        "MTOT/TTOT EDF at m ≥ 10 from SP 1065 Table 8 instead of Stable32's line",
+    ),
+    Mutant(
+        "stability-mtot-no-greenhall",
+        P + "stability/edf.py",
+        "    if m < MTOT_GREENHALL_BELOW:",
+        "    if m < 1:",
+        STAB + _t("total_edf_stable32"),
+        "MTOT/TTOT EDF below m = 10 from the line instead of Greenhall's modified-Allan EDF",
+    ),
+    Mutant(
         "stability-b1-ddof",
         P + "stability/edf.py",
         "b1 = float(np.var(ym, ddof=1)) / avar",

@@ -4,7 +4,8 @@ and against allantools' own functions (installed as a dev dependency).
 
 Values to 1e-4 relative (Stable32 prints five digits); 68.3 % interval bounds to 2e-3 for
 the deviations whose EDF Stable32 takes from Greenhall's algorithm (adev, oadev, mdev, tdev,
-hdev, ohdev) and from SP 1065 Table 7 (totdev); the identified α equals Stable32's column."""
+hdev, ohdev), from SP 1065 Table 7 (totdev) and from its own MTOT rule (mtotdev, ttotdev);
+the identified α equals Stable32's column (the total family: to m = 64)."""
 
 from __future__ import annotations
 
@@ -19,11 +20,20 @@ from thermocal.cli import main
 DATA = Path(__file__).parent / "data" / "stable32_phasedat"
 
 
-def _rows(name: str) -> np.ndarray:
+def _rows(name: str, *, commented: bool = False) -> np.ndarray:
+    """The numeric rows; ``commented``: also the rows allantools' copy comments out with '#'
+    (printed by Stable32 all the same)."""
     lines = (DATA / name).read_text(encoding="latin-1").splitlines()
-    return np.array(
-        [[float(v) for v in ln.split()] for ln in lines if ln.strip() and not ln.startswith("#")]
-    )
+    out = []
+    for ln in lines:
+        body = ln[1:] if commented and ln.startswith("#") else ln
+        if not body.strip() or body.startswith("#"):
+            continue
+        try:
+            out.append([float(v) for v in body.split()])
+        except ValueError:  # a commented header line
+            continue
+    return np.array(out)
 
 
 def _phase_csv(tmp_path: Path) -> Path:
@@ -71,8 +81,8 @@ def test_values_intervals_and_alpha_equal_stable32(
 
 
 VALUES_ONLY = [
-    ("mtotdev", "phase_dat_mtotdev_octave.txt", 5),
-    ("ttotdev", "phase_dat_ttotdev_octave.txt", 5),
+    ("mtotdev", "phase_dat_mtotdev_octave.txt", 9),
+    ("ttotdev", "phase_dat_ttotdev_octave.txt", 9),
     ("htotdev", "phase_dat_htotdev_octave_nobias.txt", 5),
     ("theo1", "phase_dat_theo1_alpha0_decade.txt", 7),
 ]
@@ -82,15 +92,49 @@ VALUES_ONLY = [
 def test_total_and_theo1_values_equal_stable32(
     tmp_path: Path, capsys: pytest.CaptureFixture[str], dev: str, ref: str, rows: int
 ) -> None:
-    """The rows Stable32 printed without bias correction (the first five of mtotdev,
-    ttotdev, htotdev; Theo1 with α = 0, whose bias factor is 1)."""
-    r = _rows(ref)[:rows]
+    """The rows Stable32 printed without bias correction (every row of mtotdev and ttotdev,
+    the first five of htotdev; Theo1 with α = 0, whose bias factor is 1)."""
+    r = _rows(ref, commented=True)[:rows]
+    assert r.shape[0] == rows
     obj = _run(capsys, _phase_csv(tmp_path), dev, r[:, 1])
     np.testing.assert_allclose(obj[f"{dev}_tau_s"], r[:, 1], rtol=1e-12)
     col = 5
     np.testing.assert_allclose(obj[dev], r[:, col], rtol=1e-4)
     if dev != "theo1":
         np.testing.assert_array_equal(obj[f"{dev}_n"], r[:, 2])
+
+
+MODIFIED_TOTAL = [
+    ("mtotdev", "phase_dat_mtotdev_octave.txt"),
+    ("ttotdev", "phase_dat_ttotdev_octave.txt"),
+]
+
+
+@pytest.mark.parametrize(("dev", "ref"), MODIFIED_TOTAL)
+def test_modified_total_intervals_equal_stable32(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], dev: str, ref: str
+) -> None:
+    """MTOT/TTOT bounds (Stable32's EDF rule, thermocal.stability.edf.edf_mtotdev) to 2e-3.
+
+    Rows m = 1–64 through the CLI, with the α thermocal identifies (equal to Stable32's).  At
+    m = 128 and 256 (7 and 3 averages) Stable32 identifies flicker PM for the total family
+    where thermocal keeps the shorter τ's white FM, as Stable32 itself does for oadev at
+    m = 128; with Stable32's α given (the library's ``alpha``) those bounds equal too."""
+    from thermocal.stability.family import stability
+
+    r = _rows(ref, commented=True)
+    assert r.shape[0] == 9
+    obj = _run(capsys, _phase_csv(tmp_path), dev, r[:, 1])
+    k = 7
+    np.testing.assert_array_equal(obj[f"{dev}_alpha"][:k], r[:k, 3].astype(int))
+    np.testing.assert_allclose(obj[f"{dev}_low"][:k], r[:k, 4], rtol=2e-3)
+    np.testing.assert_allclose(obj[f"{dev}_high"][:k], r[:k, 6], rtol=2e-3)
+    assert "Stable32's MTOT EDF" in obj[f"{dev}_interval"]
+    x = np.loadtxt(DATA / "PHASE.DAT", comments="#")
+    assert (r[k:, 3] == 1).all()
+    curve = stability(x, 1.0, [dev], r[k:, 1], data_type="phase", alpha=1).curves[dev]
+    np.testing.assert_allclose(curve.low, r[k:, 4], rtol=2e-3)
+    np.testing.assert_allclose(curve.high, r[k:, 6], rtol=2e-3)
 
 
 @pytest.mark.parametrize(

@@ -8,9 +8,11 @@ averaging factor (τ = m τ0).
 * :func:`greenhall_edf`: C. A. Greenhall and W. J. Riley, "Uncertainty of stability
   variances based on finite differences", Proc. 35th PTTI Meeting (2003), eqs. (7)–(13) and
   Tables 1–3 (the algorithm Stable32 uses); written here from the paper's equations.
-* :func:`edf_totdev`, :func:`edf_mtotdev`, :func:`edf_htotdev`: NIST SP 1065 (2008) §5.2.11,
-  §5.2.12, §5.2.14 (``b·(N/m) − c``; Htot ``(N/m)/(b0 + b1·m/N)``); how far the last two
-  are from Stable32's intervals is stated in their docstrings.
+* :func:`edf_totdev`, :func:`edf_htotdev`: NIST SP 1065 (2008) §5.2.11, §5.2.14
+  (``b·(N/m) − c``; Htot ``(N/m)/(b0 + b1·m/N)``); how far Htot's is from Stable32's
+  intervals below m = 16 is stated in its docstring.
+* :func:`edf_mtotdev`: the rule Stable32's MTOT/TTOT intervals follow (Greenhall's modified
+  Allan EDF below m = 10, a line in N/m above), read from Stable32's printed bounds.
 * :func:`edf_theo1`: Howe's empirical Theo1 EDF per noise type (SP 1065 §5.2.16).
 * :func:`identify_noise`: lag-1 autocorrelation (W. J. Riley and C. A. Greenhall, "Power law
   noise identification using the lag 1 autocorrelation", Proc. 18th EFTF, 2004), with the
@@ -229,21 +231,45 @@ def edf_totdev(n_phase: int, m: int, alpha: int) -> float:
     return greenhall_edf(max(alpha, -2), 2, m, n_phase, overlapping=True, modified=False)
 
 
-def edf_mtotdev(n_phase: int, m: int, alpha: int) -> float:
-    """Modified total (and time total) variance EDF, SP 1065 Table 8: ``b·(N/m) − c``
-    (b, c = 1.90, 2.10 | 1.20, 1.40 | 1.10, 1.20 | 0.85, 0.50 | 0.75, 0.31 for α = 2 … −2),
-    as printed (allantools uses the same table).
+MTOT_GREENHALL_BELOW: Final = 10
+"""Averaging factors below this take Greenhall's EDF of the modified Allan variance for
+MTOT/TTOT, as Stable32 does (its printed bounds: m ≤ 8 Greenhall, m ≥ 10 the linear rule;
+m = 9 was in no reference output and follows the Greenhall side)."""
 
-    Not Stable32's EDF: on PHASE.DAT (N = 1001, α = 0 identified by both) Stable32's
-    printed 68.3 % bounds imply EDF 790, 484, 243, 120, 81 at m = 1, 2, 4, 8, 16, where
-    this table gives 1100, 549, 274, 136, 67.6; the bounds therefore differ from Stable32's
-    by +3.7/−4.0, +1.8/−2.1, +2.4/−2.9, +3.5/−4.5 and −6.4/+9.0 ×10⁻³ (low/high), the
-    same for ttotdev — beyond the 2×10⁻³ asked.  Greenhall's EDF of the modified Allan
-    variance (782, 479, 240, 119, 58) is within 1.3 % of Stable32's at m ≤ 8 but 28 %
-    below at m = 16, so neither published rule reproduces Stable32's column; the rule
-    Stable32 uses for MTOT is not known here (its help text was not at hand).
+_MTOT_STABLE32: Final = {1: (1.730, 2.987), 0: (1.330, 1.891), -1: (0.920, 0.759)}
+"""(b, c) of Stable32's MTOT/TTOT EDF ``b·N/m − c`` at m ≥ 10, read here from Stable32's
+printed 68.3 % bounds (see :func:`edf_mtotdev`)."""
+
+
+def edf_mtotdev(n_phase: int, m: int, alpha: int) -> float:
+    """Modified total (and time total) variance EDF, the rule Stable32's intervals follow.
+
+    * m < 10 (:data:`MTOT_GREENHALL_BELOW`): Greenhall's EDF of the modified Allan variance
+      (:func:`greenhall_edf`, d = 2, overlapping, F = 1), every α.
+    * m ≥ 10: ``b·N/m − c`` with (b, c) = (1.730, 2.987) for α = +1, (1.330, 1.891) for
+      α = 0, (0.920, 0.759) for α = −1.  α = +2 and −2, which no Stable32 output at hand
+      shows at m ≥ 10, take NIST SP 1065 Table 8 (1.90, 2.10 | 0.75, 0.31): not checked
+      against Stable32.
+
+    Source of the rule: Stable32's printed bounds are exact chi-square intervals (both
+    bounds give one EDF, to 1e-4; Stable32 computes χ² by Abramowitz & Stegun 26.4.17 with
+    26.2.22 above EDF 100, which explains its 1 % offset there), so each printed row gives
+    Stable32's EDF.  On PHASE.DAT (N = 1001, this package's tests/data) and on the public
+    Sr87 clock record (N = 1253, Stable32 1.60 outputs in the allantoolkit project's
+    test assets) the rows at m ≤ 8 equal Greenhall's modified-Allan EDF (N = 1001, m = 1, 2,
+    4, 8: 780.3–781.7, 478.7–479.3, 240.0, 118.9 against 782.0, 479.0, 240.0, 118.9); the
+    rows at m ≥ 10 lie on one line in N/m per α.  The coefficients were fitted on Sr87's
+    octave rows (α = 0), PHASE.DAT's m = 128, 256 (α = +1) and Sr87's decade m = 200, 400
+    (α = −1) and predict the other rows (PHASE.DAT m = 16–64, Sr87 m = 10, 20, 40, 100 and
+    the frequency-data run) within 0.07 % of EDF (bounds within 2e-5).  SP 1065 Table 8
+    (1.10, 1.20 for α = 0) gives EDFs 12–28 % off Stable32's (bounds off 0.4–2 %).
     """
-    b, c = _MTOT[max(min(alpha, 2), -2)]
+    if m < MTOT_GREENHALL_BELOW:
+        return greenhall_edf(max(min(alpha, 2), -2), 2, m, n_phase, overlapping=True, modified=True)
+    if alpha in _MTOT_STABLE32:
+        b, c = _MTOT_STABLE32[alpha]
+    else:
+        b, c = _MTOT[max(min(alpha, 2), -2)]
     return b * n_phase / m - c
 
 
@@ -251,14 +277,16 @@ def edf_htotdev(n_phase: int, m: int, alpha: int) -> float:
     """Hadamard total variance EDF, SP 1065 §5.2.14: ``(N/m)/(b0 + b1·m/N)`` for α = 0, −1,
     −2 (other α take the overlapping Hadamard EDF of Greenhall).
 
-    Not Stable32's EDF below m = 16: on PHASE.DAT with α = 0 (Stable32's bias-corrected
-    run) its printed bounds imply EDF 675, 577, 352, 186, 110 at m = 1, 2, 4, 8, 16,
-    where thermocal gives 608 (m = 1: ohdev's Greenhall EDF), 892, 444, 221, 109; the
-    bound ratios differ by −1.4/+1.5, +5.4/−6.1, +3.9/−4.5, +3.8/−4.7, −0.4/+0.4 ×10⁻³
-    (low/high).  At m = 16 this formula agrees; below it Stable32 uses something else,
-    and neither the non-overlapping Hadamard EDF (608, 272, 131, 64) that one
-    re-implementation of Stable32 uses for m < 16 nor the overlapping one (608, 452, 257,
-    140) gives Stable32's numbers.
+    Against Stable32's printed bounds (read as exact chi-square intervals, with Stable32's
+    Abramowitz & Stegun χ² above EDF 100; see :func:`edf_mtotdev`): at m ≥ 16 this is
+    Stable32's EDF for α = 0 and −1 (PHASE.DAT m = 16–64: 108.8, 52.9, 25.1 against 108.8,
+    52.9, 25.1; Sr87 N = 1253, m = 16–256 and 200, 400: within 0.1 %).  Below m = 16
+    Stable32 uses another rule, not found here: PHASE.DAT, α = 0, m = 1, 2, 4, 8 give 668,
+    571, 348, 184 (this function: 608 at m = 1 from the overlapping Hadamard EDF, then 892,
+    444, 221; Greenhall's overlapping Hadamard EDF 608, 452, 257, 140; the non-overlapping
+    one 608, 272, 131, 64), so the bounds there differ from Stable32's by up to 8.5e-3.  For
+    α = +1 Stable32's EDF is also larger than Greenhall's overlapping Hadamard EDF used here
+    (PHASE.DAT m = 128, 256: 50.6, 18.6 against 32.8, 15.9).
     """
     if alpha in _HTOT:
         b0, b1 = _HTOT[alpha]

@@ -55,6 +55,16 @@ def edf_source(name: str) -> str:
             "Howe's empirical Theo1 EDF (its random-walk FM fit is far too small, the "
             "interval too wide, beyond τ ≈ 0.2 of the record)"
         )
+    if name in ("mtotdev", "ttotdev"):
+        return (
+            "Stable32's MTOT EDF (Greenhall's modified-Allan EDF below m = 10, a line in N/m "
+            "above, read from Stable32's bounds)"
+        )
+    if name == "htotdev":
+        return (
+            "SP 1065 Htot EDF (Stable32's below m = 16 not reproduced: bounds there up to "
+            "0.9 % apart)"
+        )
     return "Greenhall/SP 1065 EDF"
 
 
