@@ -149,7 +149,7 @@ class AllanResult:
     n_terms : number of second differences behind each point (summed over segments).
     edf : Greenhall's equivalent degrees of freedom (summed over segments).
     alpha : power-law noise exponent used for the EDF at each τ.
-    alpha_method : how each α was found (``lag1``, ``b1``, ``b1-previous``, ``previous``,
+    alpha_method : how each α was found (``lag1``, ``b1``, ``b1-rn``, ``b1-previous``, ``previous``,
         ``given``; :class:`thermocal.stability.family.DeviationCurve`).
     unit : unit of the rate data and of ``adev``.
     confidence : confidence level of the interval (0.683 = ±1σ).

@@ -354,7 +354,8 @@ class NoiseId:
     """The identified power-law noise at one averaging factor.
 
     ``alpha`` the integer exponent; ``alpha_float`` the unrounded lag-1 estimate (NaN for
-    B1); ``method`` ``"lag1"`` or ``"b1"`` (or ``"none"`` when neither could run: α = 0
+    B1); ``method`` ``"lag1"``, ``"b1"`` or ``"b1-rn"`` (B1 then R(n), :func:`split_pm`)
+    (or ``"none"`` when neither could run: α = 0
     assumed); ``d`` differences taken (lag-1 method).
     """
 
@@ -485,25 +486,79 @@ def identify_noise(x: FloatArray, m: int, *, dmax: int, phase_input: bool) -> No
     """Power-law noise α at averaging factor m (Riley & Greenhall 2004; B1 otherwise).
 
     ``x``: phase points of one gap-free stretch.  Lag-1 method: the phase decimated by m
-    (quadratic trend removed) when the data were given as phase, else the rate averaged
-    over blocks of m (linear trend removed); difference until ρ = r1/(1 + r1) < 0.25 or d =
-    dmax (``dmax`` counted on phase: 2 for the Allan family, 3 for Hadamard; one less on
-    rate); α = −round(2ρ) − 2d (+2 for phase).  With fewer than 30 averaged points: the B1
-    ratio of the standard variance of the m-averages to their Allan variance, against the
-    theoretical B1 of each noise (boundaries at geometric means); B1 cannot tell white from
-    flicker PM and reports white PM (α = +2).
+    (its mean removed, nothing else) when the data were given as phase, else the rate
+    averaged over blocks of m (linear trend removed); difference until ρ = r1/(1 + r1) <
+    0.25 or d = dmax (``dmax`` counted on phase: 2 for the Allan family, 3 for Hadamard; one
+    less on rate); α = −round(2ρ) − 2d (+2 for phase).  With fewer than 30 averaged points:
+    the B1 ratio of the standard variance of the m-averages to their Allan variance, against
+    the theoretical B1 of each noise (boundaries at geometric means); where B1 reads phase
+    noise, the R(n) ratio tells white from flicker PM (:func:`split_pm`).
+
+    The decimated phase is not detrended (the differencing removes a line), as in
+    Stable32's identification: with a quadratic removed, the 32 points of the Sr87 clock
+    record at m = 40 (Stable32 1.60's α column in the allantoolkit project's test assets)
+    read white PM where Stable32 reads white FM, in every deviation; with a line removed,
+    the 56 points of allantools' Cs 5071A record at m = 10⁴ read white PM where Stable32
+    reads white FM.  Without either, every lag-1 α of PHASE.DAT, Sr87, the Cs 5071A, GPS
+    and Keysight 53230A records equals Stable32's.  Frequency drift is therefore not removed
+    here: remove it from the data first (as Stable32's users do).
     """
     nb = (x.size - 1) // m  # m-averages of the rate: (x_{(k+1)m} − x_{km}) / m
     ym = np.diff(x[: nb * m + 1 : m]) if nb else x[:0].copy()
     if m > 1:
         ym /= m
     if not phase_input:
-        return identify_rate_averages(ym, dmax=dmax, own=True)
+        return split_pm(identify_rate_averages(ym, dmax=dmax, own=True), x, m)
     z = x[:: max(m, 1)]
     if z.size >= MIN_ACF_POINTS:
-        zd = _detrend(z, 2)
-        return _lag1_differenced(lag1_autocorrelation(zd), zd, dmax, 2)
-    return _b1_identify(ym, dmax)
+        zc = z - z.mean()
+        return _lag1_differenced(lag1_autocorrelation(zc), zc, dmax, 2)
+    return split_pm(_b1_identify(ym, dmax), x, m)
+
+
+def modified_allan_ratio(x: FloatArray, m: int) -> float:
+    """R(n) = Mod σ²_y(τ) / σ²_y(τ) at τ = m τ0 from the phase ``x`` (both overlapping; τ0
+    cancels): ``(Σ_j s_j² / (m² (N − 3m + 1))) / (Σ_i d_i² / (N − 2m))`` with d_i = x_{i+2m}
+    − 2 x_{i+m} + x_i and s_j = Σ_{i=j}^{j+m−1} d_i (NIST SP 1065 eqs. 13 and 14).  NaN when
+    the record is shorter than 3m + 1 points or has no second difference."""
+    n = x.size
+    if m < 1 or n < 3 * m + 1:
+        return float("nan")
+    d = x[2 * m :] - 2.0 * x[m:-m] + x[: n - 2 * m]
+    den = float(d @ d) / d.size
+    if not den > 0:
+        return float("nan")
+    c = np.concatenate(([0.0], np.cumsum(d)))
+    s = c[m:] - c[:-m]
+    return float(s @ s) / s.size / (m * m) / den
+
+
+def _r_theory(m: int, alpha: int) -> float:
+    """Theoretical R(n) at n = m (D. W. Allan and J. A. Barnes, "A modified Allan variance
+    with increased oscillator characterization ability", Proc. 35th FCS, 1981; W. J. Riley,
+    NIST SP 1065 §5.6): white PM 1/n; flicker PM ``3 ln(256/27) / (2 (1.038 + 3 ln(2π f_h
+    τ)))`` with the measurement bandwidth f_h = 1/(2 τ0), so 2π f_h τ = π n."""
+    if alpha == 2:
+        return 1.0 / m
+    return 3.0 * math.log(256.0 / 27.0) / (2.0 * (1.038 + 3.0 * math.log(math.pi * m)))
+
+
+def split_pm(nid: NoiseId, x: FloatArray, m: int) -> NoiseId:
+    """Where B1 read phase noise (α = +2, which it cannot split), white or flicker PM by
+    the R(n) ratio (:func:`modified_allan_ratio`) against the geometric mean of the two
+    noises' theoretical R(n) (Riley, SP 1065 §5.6, the B1/R(n) identification Stable32
+    uses): above it flicker PM (α = +1, method ``b1-rn``), else white PM.
+
+    Stable32 reads flicker PM there on PHASE.DAT's total family at m = 128, Sr87 at m = 100
+    and a Keysight 53230A time-interval record at m = 2048, 4096 (allantools' test data),
+    where B1 alone gave white PM."""
+    if nid.method != "b1" or nid.alpha != 2:
+        return nid
+    r = modified_allan_ratio(x, m)
+    if not math.isfinite(r):
+        return nid
+    bound = math.sqrt(_r_theory(m, 2) * _r_theory(m, 1))
+    return NoiseId(1 if r > bound else 2, float("nan"), "b1-rn", 0)
 
 
 def identify_rate_averages(

@@ -74,9 +74,9 @@ class DeviationCurve:
 
     ``tau_s`` [s] (theo1: 0.75 m τ0), ``m`` averaging factors, ``dev`` [``unit``],
     ``low``/``high`` its interval (NaN where none), ``edf``, ``n_terms``, ``alpha`` the noise
-    exponent used for the EDF, ``alpha_method`` per τ: ``lag1``, ``b1``, ``b1-previous`` (B1
-    read a higher α than the shorter τ's, which is kept), ``previous`` (too few averages),
-    ``given``.
+    exponent used for the EDF, ``alpha_method`` per τ: ``lag1``, ``b1``, ``b1-rn`` (B1 read
+    phase noise, R(n) split white from flicker PM), ``b1-previous`` (B1 read a higher α than
+    the shorter τ's, which is kept), ``previous`` (too few averages), ``given``.
     """
 
     name: str
@@ -257,7 +257,7 @@ class _Record:
     def centred(self) -> list[FloatArray]:
         """The phases minus their end-point lines (in place unless mtie/tierms need the raw
         phase; a line changes no α: the rate averages shift by a constant, the phase's
-        quadratic detrend removes it)."""
+        linear detrend removes it)."""
         if self._centred is None:
             raw = any(n in ("mtie", "tierms") for n in self.names)
             self._centred = [dv.centred(x, inplace=not raw) for x in self.phases()]
@@ -280,7 +280,10 @@ class _Record:
             by_m = {lv.m: lv for lv in self.levels(self.longest)}
             if m in by_m:
                 lv = by_m[m]
-                return ed.identify_rate_averages(lv.z, dmax=dmax, sums=lv.lag)
+                nid = ed.identify_rate_averages(lv.z, dmax=dmax, sums=lv.lag)
+                if nid.method == "b1" and nid.alpha == 2:  # B1 read PM: R(n) from the phase
+                    nid = ed.split_pm(nid, self.centred()[self.longest], m)
+                return nid
             if self.sizes[self.longest] - 1 < m:  # no m-average: nothing to identify
                 return ed.identify_rate_averages(np.zeros(0), dmax=dmax)
         x = self.centred()[self.longest]
@@ -376,7 +379,10 @@ def _noise_exponents(
         if nid.method == "b1" and i > 0 and alphas[i] > alphas[i - 1]:
             # B1 from 8–29 averages misreads random-walk FM as flicker or white FM in ≈ 40 %
             # of records (α read higher than at the shorter τ, where power-law noise can only
-            # steepen): the shorter τ's α is kept (Monte-Carlo coverage, issue 29 item 3)
+            # steepen): the shorter τ's α is kept (Monte-Carlo coverage, issue 29 item 3).
+            # A phase-noise reading split by R(n) (``b1-rn``) is no such misreading (B1 of
+            # random-walk FM is ≈ N/2, of PM ≈ 2/3) and stands, as in Stable32 (Sr87 m = 100,
+            # PHASE.DAT m = 100: flicker PM after white FM)
             alphas[i] = alphas[i - 1]
             methods.append("b1-previous")
             continue
