@@ -881,8 +881,10 @@ MUTANTS: tuple[Mutant, ...] = (
     Mutant(
         "stability-lag1-phase-detrend",
         P + "stability/edf.py",
-        "        zc = z - z.mean()\n        return _lag1_differenced(lag1_autocorrelation(zc), zc, dmax, 2)",
-        "        zc = _detrend(z, 1)\n        return _lag1_differenced(lag1_autocorrelation(zc), zc, dmax, 2)",
+        "        zc = z - z.mean()\n"
+        "        return _lag1_differenced(lag1_autocorrelation(zc), zc, dmax, 2)",
+        "        zc = _detrend(z, 1)\n"
+        "        return _lag1_differenced(lag1_autocorrelation(zc), zc, dmax, 2)",
         STAB + _t("noise_id_stable32"),
         "lag-1 identification of phase data removes a line (Stable32 removes nothing)",
     ),
@@ -901,6 +903,14 @@ MUTANTS: tuple[Mutant, ...] = (
         '        if nid.method.startswith("b1") and i > 0 and alphas[i] > alphas[i - 1]:',
         STAB + _t("noise_id_stable32"),
         "an R(n) flicker-PM reading overridden by the shorter τ's α",
+    ),
+    Mutant(
+        "stability-totvar-bias-ffm",
+        P + "stability/family.py",
+        "_TOTVAR_BIAS: Final = {-1: 1.0 / (3.0 * math.log(2.0)), -2: 0.75}",
+        "_TOTVAR_BIAS: Final = {-1: 1.0 / (2.0 * math.log(2.0)), -2: 0.75}",
+        STAB + _t("bias_stable32"),
+        "totdev's flicker-FM bias with 1/(2 ln 2) instead of Howe's 1/(3 ln 2)",
     ),
     Mutant(
         "stability-b1-ddof",

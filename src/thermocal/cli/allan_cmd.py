@@ -53,7 +53,8 @@ else:
 def family_json(res: "_family.StabilityResult") -> dict[str, Any]:
     """The ``--json`` object of ``allan --deviation``: ``tau_s`` and per deviation NAME the
     keys NAME, NAME_low, NAME_high, NAME_edf, NAME_alpha, NAME_n, NAME_tau_s, NAME_unit and
-    NAME_interval (how the interval was found, or "none: why" where low/high are null);
+    NAME_interval (how the interval was found, or "none: why" where low/high are null),
+    NAME_bias_factor with ``--bias-correct`` (the factor NAME, low and high carry);
     ``alpha`` the noise identified per ``tau_s`` (first Allan-family deviation)."""
     out: dict[str, Any] = {
         "tau_s": res.tau_s,
@@ -81,12 +82,15 @@ def family_json(res: "_family.StabilityResult") -> dict[str, Any]:
         out[f"{name}_interval"] = _family.NO_INTERVAL.get(
             name, f"chi-square, {100 * res.confidence:.1f} %, {_family.edf_source(name)}"
         )
+        if c.bias is not None:
+            out[f"{name}_bias_factor"] = c.bias
     return dict(jsonable(out))
 
 
 def _family_human(file: Path, res: "_family.StabilityResult") -> None:
     for name, c in res.curves.items():
-        t = _rich_table.Table(title=f"{file} — {name} [{c.unit}] ({res.data_type} data)")
+        corrected = ", bias-corrected as Stable32" if c.bias is not None else ""
+        t = _rich_table.Table(title=f"{file} — {name} [{c.unit}] ({res.data_type} data{corrected})")
         for col in ("τ [s]", name, "low", "high", "edf", "α", "terms"):
             t.add_column(col, justify="right")
         for i in range(c.tau_s.size):
@@ -258,6 +262,14 @@ DataTypeOpt = Annotated[
         "angle, velocity, seconds of a clock).",
     ),
 ]
+BiasCorrectOpt = Annotated[
+    bool,
+    typer.Option(
+        "--bias-correct",
+        help="Remove the bias of totdev (flicker and random-walk FM) and htotdev (FM noises, "
+        "m ≥ 2) as Stable32 does; the factor per τ is NAME_bias_factor in --json.",
+    ),
+]
 DynamicOpt = Annotated[
     float | None,
     typer.Option(
@@ -319,6 +331,7 @@ def allan_cmd(
     deviation: DeviationOpt = None,
     data_type: DataTypeOpt = "rate",
     dynamic: DynamicOpt = None,
+    bias_correct: BiasCorrectOpt = False,
     as_json: JsonOpt = False,
 ) -> None:
     """Overlapping Allan deviation with chi-square confidence intervals and the noise
@@ -344,6 +357,7 @@ def allan_cmd(
     res = _analysis.allan_analysis(
         rec, split_names(signal) or [rec.signals[0]], taus=tau_spec, confidence=confidence,
         deviations=deviation, data_type=data_type, dynamic_s=dynamic, where=str(file),
+        bias_correct=bias_correct,
     )  # fmt: skip
     if res.is_family:
         _emit_family(file, res, as_json)

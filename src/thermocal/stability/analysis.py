@@ -112,13 +112,15 @@ def allan_analysis(
     data_type: str = "rate",
     dynamic_s: float | None = None,
     where: str = "",
+    bias_correct: bool = False,
 ) -> AllanAnalysis:
     """The stability analysis of the channels ``names`` of ``rec`` (module docstring).
 
     ``taus``: a named τ set or a list of τ [s] (:func:`parse_taus`); ``deviations``: the
     comma-separated deviations of :func:`thermocal.stability.family.parse_deviations`
     (then, or with ``data_type="phase"``, the family replaces the ADEV and noise terms);
-    ``dynamic_s``: the dynamic ADEV's window [s] (rate data, ADEV only).  A poor noise-model
+    ``dynamic_s``: the dynamic ADEV's window [s] (rate data, ADEV only); ``bias_correct``:
+    Stable32's bias correction of totdev and htotdev (the family only).  A poor noise-model
     fit and a non-stationary record are :class:`ConditioningWarning` naming ``where``
     (and the channel when there are several).
     """
@@ -131,7 +133,13 @@ def allan_analysis(
         )
     if deviations is not None or data_type == "phase":
         return AllanAnalysis(
-            tuple(names), family=_family(rec, names, taus, confidence, deviations, data_type)
+            tuple(names),
+            family=_family(rec, names, taus, confidence, deviations, data_type, bias_correct),
+        )
+    if bias_correct:
+        raise ThermocalInputError(
+            "--bias-correct corrects the total deviations (totdev, htotdev): give them with "
+            "--deviation"
         )
     channels: dict[str, AllanChannel] = {}
     for name in names:  # one read of the file, every channel (INTERFACE: several channels)
@@ -149,6 +157,7 @@ def _family(
     confidence: float,
     deviations: str | None,
     data_type: str,
+    bias_correct: bool = False,
 ) -> dict[str, StabilityResult]:
     """The deviations of every channel (phase data: the column as given, in its own unit)."""
     from thermocal.stability import family
@@ -162,7 +171,7 @@ def _family(
             values, unit = signal_in_data_unit(rec, name)
         results[name] = family.stability(
             values, rec.sample_interval_s, devs, taus, data_type=data_type,
-            segments=rec.segments(), unit=unit, confidence=confidence,
+            segments=rec.segments(), unit=unit, confidence=confidence, bias_correct=bias_correct,
         )  # fmt: skip
     return results
 

@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from typing import Final
 
 import numpy as np
 import numpy.typing as npt
@@ -76,7 +77,9 @@ class DeviationCurve:
     ``low``/``high`` its interval (NaN where none), ``edf``, ``n_terms``, ``alpha`` the noise
     exponent used for the EDF, ``alpha_method`` per τ: ``lag1``, ``b1``, ``b1-rn`` (B1 read
     phase noise, R(n) split white from flicker PM), ``b1-previous`` (B1 read a higher α than
-    the shorter τ's, which is kept), ``previous`` (too few averages), ``given``.
+    the shorter τ's, which is kept), ``previous`` (too few averages), ``given``; ``bias``
+    the factor ``dev``, ``low`` and ``high`` were multiplied by (:func:`stable32_bias`; None
+    when no correction was asked).
     """
 
     name: str
@@ -90,6 +93,7 @@ class DeviationCurve:
     alpha: IntArray
     alpha_method: tuple[str, ...]
     unit: str
+    bias: FloatArray | None = None
 
 
 @dataclass(frozen=True, eq=False)
@@ -107,6 +111,38 @@ class StabilityResult:
     n_points: int
     unit: str
     notes: tuple[str, ...] = field(default=())
+
+
+BIAS_CORRECTED: Final = frozenset({"totdev", "htotdev"})
+"""The deviations :func:`stable32_bias` corrects (Stable32 prints MTOT and TTOT uncorrected)."""
+
+_TOTVAR_BIAS: Final = {-1: 1.0 / (3.0 * math.log(2.0)), -2: 0.75}
+_HTOTVAR_BIAS: Final = {0: -0.005, -1: -0.149, -2: -0.229, -3: -0.283, -4: -0.321}
+
+
+def stable32_bias(name: str, alpha: int, m: int, n_phase: int) -> float:
+    """The factor Stable32 multiplies a total deviation by to remove its bias.
+
+    * totdev: ``1/√(1 − a·τ/T)`` with a = 1/(3 ln 2) for flicker FM, 3/4 for random-walk FM,
+      0 otherwise, and T = (N − 1) τ0 the record length (D. A. Howe, "Total variance
+      explained", Proc. 1999 Joint EFTF/FCS, Table 1; NIST SP 1065 §5.2.11).
+    * htotdev at m ≥ 2: ``1/√(1 + a)`` with a = −0.005, −0.149, −0.229, −0.283, −0.321 for
+      α = 0 … −4 (D. A. Howe et al., "A total estimator of the Hadamard function used for
+      GPS operations", Proc. 32nd PTTI, 2000; SP 1065 §5.2.14); at m = 1 Htot is the
+      overlapping Hadamard deviation and is not corrected; phase noise is not corrected.
+    * every other deviation: 1.
+
+    Checked against Stable32's printed values (which are so corrected): PHASE.DAT's Htot
+    (÷√0.995 from m = 2), the Sr87 record's Htot at α = −1, −2 (factors 1.0840, 1.1389) and
+    its totdev at α = −1, −2 (m = 1–400: within the five printed digits).
+    """
+    if name == "totdev":
+        a = _TOTVAR_BIAS.get(alpha, 0.0)
+        ratio = m / max(n_phase - 1, 1)
+        return 1.0 / math.sqrt(1.0 - a * ratio) if a * ratio < 1.0 else float("nan")
+    if name == "htotdev" and m >= 2 and alpha in _HTOTVAR_BIAS:
+        return 1.0 / math.sqrt(1.0 + _HTOTVAR_BIAS[alpha])
+    return 1.0
 
 
 def parse_deviations(spec: str) -> list[str]:
@@ -414,11 +450,14 @@ def stability(
     unit: str = "",
     confidence: float = 0.6826894921370859,
     alpha: int | None = None,
+    bias_correct: bool = False,
 ) -> StabilityResult:
     """Deviations ``names`` of rate or phase data [unit] sampled every ``tau0_s`` [s].
 
     ``segments``: the gap-free index ranges (default: one); ``alpha``: force the noise
-    exponent of the EDF instead of identifying it.  Rate data give deviations in ``unit``
+    exponent of the EDF instead of identifying it; ``bias_correct``: totdev and htotdev
+    (value and interval) multiplied by Stable32's bias factor (:func:`stable32_bias`, with
+    the record length summed over the stretches).  Rate data give deviations in ``unit``
     and time deviations (tdev, ttotdev, mtie, tierms) in ``unit*s``; phase data give
     deviations in ``unit/s`` and time deviations in ``unit``.
 
@@ -456,10 +495,20 @@ def stability(
             if ok.any():
                 lo_ok, hi_ok = ed.confidence_interval(dev[ok], edf[ok], confidence)
                 lo[ok], hi[ok] = lo_ok, hi_ok
+            bias = None
+            if bias_correct:
+                n_rec = sum(record.sizes) - len(record.sizes) + 1
+                bias = np.array(
+                    [
+                        stable32_bias(name, int(a), int(mm), n_rec)
+                        for a, mm in zip(alphas, m, strict=True)
+                    ]
+                )
+                dev, lo, hi = dev * bias, lo * bias, hi * bias
             tau = dv.theo1_tau(m, tau0_s) if name == "theo1" else m * float(tau0_s)
             curves[name] = DeviationCurve(
                 name, np.asarray(tau, dtype=np.float64), m, dev, lo, hi, edf, cnt, alphas,
-                methods, _unit(name, unit, data_type),
+                methods, _unit(name, unit, data_type), bias,
             )  # fmt: skip
         return StabilityResult(
             curves=curves,
