@@ -913,6 +913,14 @@ MUTANTS: tuple[Mutant, ...] = (
         "totdev's flicker-FM bias with 1/(2 ln 2) instead of Howe's 1/(3 ln 2)",
     ),
     Mutant(
+        "stability-htot-short-white-fm",
+        P + "stability/edf.py",
+        "        return n_phase / (2.0 * m / 3.0 + 5.0 / (6.0 * m))",
+        "        return n_phase / (2.0 * m / 3.0 + 5.0 / (3.0 * m))",
+        STAB + _t("total_edf_stable32", "bias_stable32"),
+        "Htot's white-FM EDF below m = 16 with 5/(3m) instead of 5/(6m)",
+    ),
+    Mutant(
         "stability-b1-ddof",
         P + "stability/edf.py",
         "b1 = float(np.var(ym, ddof=1)) / avar",

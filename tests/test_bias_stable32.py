@@ -60,7 +60,7 @@ def test_htotdev_bias_corrected_equals_stable32_on_phasedat(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     """Rows m = 1–64 (Stable32's α = 0 there, as thermocal's): values to 1e-4 (÷√0.995 from
-    m = 2); bounds to 2e-3 from m = 16, where the Htot EDF is Stable32's."""
+    m = 2) and bounds to 2e-3 (Stable32's Htot EDF: its white-FM rule below m = 16)."""
     lines = (DATA / "phase_dat_htotdev_octave.txt").read_text(encoding="latin-1").splitlines()
     r = np.array([[float(v) for v in ln.lstrip("#").split()] for ln in lines[10:]])[:7]
     code = main(["allan", str(_phase_csv(tmp_path)), "--signal", "phase [s]", "--data-type",
@@ -71,8 +71,8 @@ def test_htotdev_bias_corrected_equals_stable32_on_phasedat(
     obj = json.loads(cap.out)
     np.testing.assert_array_equal(obj["htotdev_alpha"], r[:, 3].astype(int))
     np.testing.assert_allclose(obj["htotdev"], r[:, 5], rtol=1e-4)
-    np.testing.assert_allclose(obj["htotdev_low"][4:], r[4:, 4], rtol=2e-3)
-    np.testing.assert_allclose(obj["htotdev_high"][4:], r[4:, 6], rtol=2e-3)
+    np.testing.assert_allclose(obj["htotdev_low"], r[:, 4], rtol=2e-3)
+    np.testing.assert_allclose(obj["htotdev_high"], r[:, 6], rtol=2e-3)
     assert obj["htotdev_bias_factor"][0] == 1.0
     assert obj["htotdev_bias_factor"][1] == pytest.approx(1 / np.sqrt(0.995), rel=1e-12)
 

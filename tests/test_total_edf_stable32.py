@@ -43,12 +43,22 @@ HTOT_SR87_LONG = [
     (400, -1, 1.1419e-17, 1.5213e-17, 3.1436e-17),
 ]
 
-# Stable32 Hadamard Total below m = 16 on PHASE.DAT (1001 points, α = 0; tests/data), where
-# its EDF rule is not reproduced: Stable32's EDF 571, 348, 184 at m = 2, 4, 8
-HTOT_PHASEDAT_SHORT = [
-    (2, 0, 1.9726e-01, 2.0297e-01, 2.0922e-01),
-    (4, 0, 1.3744e-01, 1.4252e-01, 1.4821e-01),
-    (8, 0, 1.0303e-01, 1.0822e-01, 1.1430e-01),
+# Stable32 Hadamard Total below m = 16 on PHASE.DAT (1001 points, α = 0; tests/data; printed
+# with Stable32's bias correction, which scales value and bounds alike): Stable32's white-FM
+# rule there was read from these rows; the Sr87 rows at m = 8, 10 check it on another record
+HTOT_WHITE_FM_SHORT = [
+    (1001, 1, 2.8670e-01, 2.9439e-01, 3.0274e-01),
+    (1001, 2, 1.9726e-01, 2.0297e-01, 2.0922e-01),
+    (1001, 4, 1.3744e-01, 1.4252e-01, 1.4821e-01),
+    (1001, 8, 1.0303e-01, 1.0822e-01, 1.1430e-01),
+    (N_SR87, 8, 8.5090e-17, 8.8938e-17, 9.3364e-17),
+    (N_SR87, 10, 8.1805e-17, 8.5915e-17, 9.0718e-17),
+]
+
+# Stable32 Hadamard Total at flicker PM (PHASE.DAT m = 128, 256; no bias correction there)
+HTOT_FLICKER_PM = [
+    (128, 1, 2.6309e-02, 2.8790e-02, 3.2137e-02),
+    (256, 1, 1.2846e-02, 1.4773e-02, 1.7946e-02),
 ]
 
 
@@ -70,11 +80,20 @@ def test_htot_bounds_equal_stable32_on_sr87_from_m16(
     assert float(hi) == pytest.approx(high, rel=2e-3, abs=0.0)
 
 
+@pytest.mark.parametrize(("n", "m", "low", "dev", "high"), HTOT_WHITE_FM_SHORT)
+def test_htot_white_fm_bounds_below_m16_equal_stable32(
+    n: int, m: int, low: float, dev: float, high: float
+) -> None:
+    lo, hi = confidence_interval(dev, edf_htotdev(n, m, 0))
+    assert float(lo) == pytest.approx(low, rel=2e-3, abs=0.0)
+    assert float(hi) == pytest.approx(high, rel=2e-3, abs=0.0)
+
+
 @pytest.mark.xfail(
-    strict=True, reason="Stable32's Htot EDF below m = 16 is not reproduced (edf_htotdev)"
+    strict=True, reason="Stable32's Htot EDF at flicker PM is not reproduced (edf_htotdev)"
 )
-def test_htot_bounds_below_m16_not_yet_stable32() -> None:
-    for m, alpha, low, dev, high in HTOT_PHASEDAT_SHORT:
+def test_htot_flicker_pm_bounds_not_yet_stable32() -> None:
+    for m, alpha, low, dev, high in HTOT_FLICKER_PM:
         lo, hi = confidence_interval(dev, edf_htotdev(1001, m, alpha))
         assert float(lo) == pytest.approx(low, rel=2e-3, abs=0.0)
         assert float(hi) == pytest.approx(high, rel=2e-3, abs=0.0)

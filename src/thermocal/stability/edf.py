@@ -9,8 +9,8 @@ averaging factor (τ = m τ0).
   variances based on finite differences", Proc. 35th PTTI Meeting (2003), eqs. (7)–(13) and
   Tables 1–3 (the algorithm Stable32 uses); written here from the paper's equations.
 * :func:`edf_totdev`, :func:`edf_htotdev`: NIST SP 1065 (2008) §5.2.11, §5.2.14
-  (``b·(N/m) − c``; Htot ``(N/m)/(b0 + b1·m/N)``); how far Htot's is from Stable32's
-  intervals below m = 16 is stated in its docstring.
+  (``b·(N/m) − c``; Htot ``(N/m)/(b0 + b1·m/N)``, with Stable32's white-FM rule below
+  m = 16); what of Stable32's Htot intervals is not reproduced is stated in its docstring.
 * :func:`edf_mtotdev`: the rule Stable32's MTOT/TTOT intervals follow (Greenhall's modified
   Allan EDF below m = 10, a line in N/m above), read from Stable32's printed bounds.
 * :func:`edf_theo1`: Howe's empirical Theo1 EDF per noise type (SP 1065 §5.2.16).
@@ -273,22 +273,34 @@ def edf_mtotdev(n_phase: int, m: int, alpha: int) -> float:
     return b * n_phase / m - c
 
 
+HTOT_FORMULA_FROM: Final = 16
+"""From this averaging factor Stable32's Htot EDF is SP 1065's ``(N/m)/(b0 + b1·m/N)``."""
+
+
 def edf_htotdev(n_phase: int, m: int, alpha: int) -> float:
-    """Hadamard total variance EDF, SP 1065 §5.2.14: ``(N/m)/(b0 + b1·m/N)`` for α = 0, −1,
-    −2 (other α take the overlapping Hadamard EDF of Greenhall).
+    """Hadamard total variance EDF as Stable32's intervals follow it, where that is known.
+
+    * m ≥ 16, α = 0, −1, −2: SP 1065 §5.2.14, ``(N/m)/(b0 + b1·m/N)`` with (b0, b1) =
+      (0.559, 1.004), (0.868, 1.140), (0.938, 1.696) (Howe et al., PTTI 2000, Table 1).
+    * m < 16, α = 0 (white FM): ``N / (2m/3 + 5/(6m))``, read here from Stable32's bounds.
+    * otherwise: Greenhall's EDF of the overlapping Hadamard variance at m = 1 (Htot is
+      that variance there) and for α outside −2…0; SP 1065's formula for α = −1, −2 at
+      1 < m < 16.
 
     Against Stable32's printed bounds (read as exact chi-square intervals, with Stable32's
-    Abramowitz & Stegun χ² above EDF 100; see :func:`edf_mtotdev`): at m ≥ 16 this is
-    Stable32's EDF for α = 0 and −1 (PHASE.DAT m = 16–64: 108.8, 52.9, 25.1 against 108.8,
-    52.9, 25.1; Sr87 N = 1253, m = 16–256 and 200, 400: within 0.1 %).  Below m = 16
-    Stable32 uses another rule, not found here: PHASE.DAT, α = 0, m = 1, 2, 4, 8 give 668,
-    571, 348, 184 (this function: 608 at m = 1 from the overlapping Hadamard EDF, then 892,
-    444, 221; Greenhall's overlapping Hadamard EDF 608, 452, 257, 140; the non-overlapping
-    one 608, 272, 131, 64), so the bounds there differ from Stable32's by up to 8.5e-3.  For
-    α = +1 Stable32's EDF is also larger than Greenhall's overlapping Hadamard EDF used here
-    (PHASE.DAT m = 128, 256: 50.6, 18.6 against 32.8, 15.9).
+    Abramowitz & Stegun χ² above EDF 100; see :func:`edf_mtotdev`): at m ≥ 16 the formula
+    is Stable32's EDF for α = 0 and −1 (PHASE.DAT m = 16–64: 108.8, 52.9, 25.1 against 108.8,
+    52.9, 25.1; Sr87 N = 1253, m = 16–256 and 200, 400: within 0.1 %).  Below m = 16, white
+    FM: PHASE.DAT (N = 1001) m = 1, 2, 4, 8 give 668.0, 571.4, 348.1, 184.2 and Sr87 (N =
+    1253) m = 8, 10 give 230.3, 185.5; N/EDF = 2m/3 + 5/(6m) fits all six within 0.11 % (fitted
+    on PHASE.DAT alone it predicts Sr87's within 0.11 %); 2/3 is the TOTVAR white-FM 1/b.
+    Not reproduced: α = −1, −2 below m = 16 (Sr87 m = 1, 4 at α = −1: 1090, 390; m = 2 at
+    α = −2: 627; this function 897, 359, 666; bounds within 2.5e-3 there) and flicker PM
+    (PHASE.DAT m = 128, 256: 50.6, 18.6 against 32.8, 15.9 here).
     """
-    if alpha in _HTOT:
+    if m < HTOT_FORMULA_FROM and alpha == 0:
+        return n_phase / (2.0 * m / 3.0 + 5.0 / (6.0 * m))
+    if m > 1 and alpha in _HTOT:
         b0, b1 = _HTOT[alpha]
         return (n_phase / m) / (b0 + b1 * m / n_phase)
     return greenhall_edf(max(alpha, -4), 3, m, n_phase, overlapping=True, modified=False)

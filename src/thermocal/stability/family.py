@@ -63,8 +63,8 @@ def edf_source(name: str) -> str:
         )
     if name == "htotdev":
         return (
-            "SP 1065 Htot EDF (Stable32's below m = 16 not reproduced: bounds there up to "
-            "0.9 % apart)"
+            "SP 1065 Htot EDF, Stable32's white-FM rule below m = 16 (its rule for other "
+            "noises below m = 16 and for flicker PM not reproduced)"
         )
     return "Greenhall/SP 1065 EDF"
 
@@ -201,7 +201,7 @@ def _edf(name: str, alpha: int, m: int, n_phase: int) -> float:
             return ed.greenhall_edf(alpha, 2, m, n_phase, overlapping=True, modified=True)
         if name == "hdev":
             return ed.greenhall_edf(alpha, 3, m, n_phase, overlapping=False, modified=False)
-        if name == "ohdev" or (name == "htotdev" and m == 1):
+        if name == "ohdev":
             return ed.greenhall_edf(alpha, 3, m, n_phase, overlapping=True, modified=False)
         if name == "totdev":
             return ed.edf_totdev(n_phase, m, alpha)
