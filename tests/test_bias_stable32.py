@@ -8,16 +8,14 @@ Htot run is in tests/data (allantools' test data, LGPL-3.0)."""
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 
 import numpy as np
 import pytest
 
+from stable32_phasedat import phase_csv, rows, run_allan
 from thermocal.cli import main
 from thermocal.stability.family import stable32_bias
-
-DATA = Path(__file__).parent / "data" / "stable32_phasedat"
 
 # (deviation, m, α Stable32 identified, allantools' uncorrected value, Stable32's printed value)
 SR87 = [
@@ -47,28 +45,13 @@ def test_no_correction_where_stable32_makes_none() -> None:
     assert stable32_bias("mtotdev", -2, 64, 1001) == 1.0
 
 
-def _phase_csv(tmp_path: Path) -> Path:
-    x = np.loadtxt(DATA / "PHASE.DAT", comments="#")
-    path = tmp_path / "phase.csv"
-    path.write_text(
-        "time (s),phase [s]\n" + "".join(f"{i}.0,{float(v)!r}\n" for i, v in enumerate(x))
-    )
-    return path
-
-
 def test_htotdev_bias_corrected_equals_stable32_on_phasedat(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     """Rows m = 1–64 (Stable32's α = 0 there, as thermocal's): values to 1e-4 (÷√0.995 from
     m = 2) and bounds to 2e-3 (Stable32's Htot EDF: its white-FM rule below m = 16)."""
-    lines = (DATA / "phase_dat_htotdev_octave.txt").read_text(encoding="latin-1").splitlines()
-    r = np.array([[float(v) for v in ln.lstrip("#").split()] for ln in lines[10:]])[:7]
-    code = main(["allan", str(_phase_csv(tmp_path)), "--signal", "phase [s]", "--data-type",
-                 "phase", "--deviation", "htotdev", "--taus",
-                 ",".join(f"{t:g}" for t in r[:, 1]), "--bias-correct", "--json"])  # fmt: skip
-    cap = capsys.readouterr()
-    assert code == 0, cap.err
-    obj = json.loads(cap.out)
+    r = rows("phase_dat_htotdev_octave.txt", commented=True)[:7]
+    obj = run_allan(capsys, phase_csv(tmp_path), "htotdev", r[:, 1], "--bias-correct")
     np.testing.assert_array_equal(obj["htotdev_alpha"], r[:, 3].astype(int))
     np.testing.assert_allclose(obj["htotdev"], r[:, 5], rtol=1e-4)
     np.testing.assert_allclose(obj["htotdev_low"], r[:, 4], rtol=2e-3)

@@ -13,16 +13,13 @@
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 
 import numpy as np
 import pytest
 
-from thermocal.cli import main
+from stable32_phasedat import phase_csv, rows, run_allan
 from thermocal.stability.edf import identify_noise, modified_allan_ratio
-
-DATA = Path(__file__).parent / "data" / "stable32_phasedat"
 
 CS5071A_EVERY_10000 = [
     7.64278624201e-07, 7.84350492714e-07, 7.847157191e-07, 7.85515800438e-07,
@@ -49,11 +46,6 @@ def test_lag1_on_phase_does_not_detrend_as_stable32() -> None:
     assert (nid.method, nid.alpha) == ("lag1", 0)
 
 
-def _rows(name: str) -> np.ndarray:
-    lines = (DATA / name).read_text(encoding="latin-1").splitlines()
-    return np.array([[float(v) for v in ln.split()] for ln in lines if ln and ln[0] != "#"])
-
-
 @pytest.mark.parametrize(
     ("dev", "ref"),
     [("mtotdev", "phase_dat_mtotdev_decade.txt"), ("ttotdev", "phase_dat_ttotdev_decade.txt")],
@@ -61,19 +53,9 @@ def _rows(name: str) -> np.ndarray:
 def test_flicker_pm_read_as_stable32_on_phasedat_decade(
     tmp_path: Path, capsys: pytest.CaptureFixture[str], dev: str, ref: str
 ) -> None:
-    r = _rows(ref)
+    r = rows(ref)
     assert r.shape[0] == 8
-    x = np.loadtxt(DATA / "PHASE.DAT", comments="#")
-    path = tmp_path / "phase.csv"
-    path.write_text(
-        "time (s),phase [s]\n" + "".join(f"{i}.0,{float(v)!r}\n" for i, v in enumerate(x))
-    )
-    code = main(["allan", str(path), "--signal", "phase [s]", "--data-type", "phase",
-                 "--deviation", dev, "--taus", ",".join(f"{t:g}" for t in r[:, 1]),
-                 "--json"])  # fmt: skip
-    cap = capsys.readouterr()
-    assert code == 0, cap.err
-    obj = json.loads(cap.out)
+    obj = run_allan(capsys, phase_csv(tmp_path), dev, r[:, 1])
     np.testing.assert_array_equal(obj[f"{dev}_alpha"], r[:, 3].astype(int))
     assert obj[f"{dev}_alpha_method"][6] == "b1-rn"  # m = 100: B1 read PM, R(n) flicker
     np.testing.assert_allclose(obj[dev], r[:, 5], rtol=1e-4)

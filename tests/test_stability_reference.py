@@ -15,44 +15,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from stable32_phasedat import DATA
+from stable32_phasedat import phase_csv as _phase_csv
+from stable32_phasedat import rows as _rows
+from stable32_phasedat import run_allan as _run
 from thermocal.cli import main
-
-DATA = Path(__file__).parent / "data" / "stable32_phasedat"
-
-
-def _rows(name: str, *, commented: bool = False) -> np.ndarray:
-    """The numeric rows; ``commented``: also the rows allantools' copy comments out with '#'
-    (printed by Stable32 all the same)."""
-    lines = (DATA / name).read_text(encoding="latin-1").splitlines()
-    out = []
-    for ln in lines:
-        body = ln[1:] if commented and ln.startswith("#") else ln
-        if not body.strip() or body.startswith("#"):
-            continue
-        try:
-            out.append([float(v) for v in body.split()])
-        except ValueError:  # a commented header line
-            continue
-    return np.array(out)
-
-
-def _phase_csv(tmp_path: Path) -> Path:
-    x = np.loadtxt(DATA / "PHASE.DAT", comments="#")
-    assert x.size == 1001
-    path = tmp_path / "phase.csv"
-    body = "".join(f"{i}.0,{float(v)!r}\n" for i, v in enumerate(x))
-    path.write_text("time (s),phase [s]\n" + body)
-    return path
-
-
-def _run(capsys: pytest.CaptureFixture[str], path: Path, dev: str, taus: np.ndarray) -> dict:  # type: ignore[type-arg]
-    tau_list = ",".join(f"{t:g}" for t in taus)
-    code = main(["allan", str(path), "--signal", "phase [s]", "--data-type", "phase",
-                 "--deviation", dev, "--taus", tau_list, "--json"])  # fmt: skip
-    cap = capsys.readouterr()
-    assert code == 0, cap.err
-    return json.loads(cap.out)  # type: ignore[no-any-return]
-
 
 WITH_INTERVALS = [
     ("adev", "phase_dat_adev_octave.txt"),
