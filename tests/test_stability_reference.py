@@ -194,3 +194,25 @@ def test_unknown_deviation_is_exit_2(tmp_path: Path, capsys: pytest.CaptureFixtu
     assert main(["allan", str(path), "--signal", "phase [s]", "--deviation", "oadev,foo"]) == 2
     assert "error:" in capsys.readouterr().err
     assert main(["allan", str(path), "--signal", "phase [s]", "--data-type", "angle"]) == 2
+
+
+def test_phase_column_unit_is_not_taken_for_a_rate_unit(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``phase [s]`` with --data-type phase: the deviations are in the column's own unit, and
+    no warning says a rate unit (deg/h) was assumed; a phase column naming no unit is told."""
+    path = _phase_csv(tmp_path)
+    code = main(["allan", str(path), "--signal", "phase [s]", "--data-type", "phase",
+                 "--deviation", "mdev", "--taus", "1,2", "--json"])  # fmt: skip
+    cap = capsys.readouterr()
+    assert code == 0, cap.err
+    assert "assuming" not in cap.err and "warning" not in cap.err
+    assert json.loads(cap.out)["mdev_unit"] == "s/s"
+    bare = tmp_path / "bare.csv"
+    bare.write_text(path.read_text().replace("phase [s]", "phase", 1))
+    code = main(["allan", str(bare), "--signal", "phase", "--data-type", "phase",
+                 "--deviation", "mdev", "--taus", "1,2", "--json"])  # fmt: skip
+    cap = capsys.readouterr()
+    assert code == 0, cap.err
+    assert "assuming deg/h" not in cap.err
+    assert "phase column 'phase' names no unit" in cap.err

@@ -2,6 +2,7 @@
 IEEE 952 noise terms by slope lines and by least squares."""
 
 import math
+import warnings
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated, Any
 
@@ -33,7 +34,7 @@ from thermocal.cli.common import (
     stdout,
     text_options,
 )
-from thermocal.errors import ThermocalInputError
+from thermocal.errors import ThermocalInputError, UnitWarning
 
 if TYPE_CHECKING:
     import rich.table as _rich_table
@@ -339,19 +340,24 @@ def allan_cmd(
     ramp) by least squares and by IEEE 952 slope lines.  Gaps are never
     differenced across: each contiguous stretch is processed alone and pooled."""
     prefetch("scipy.special", "scipy.linalg", "rich.table")  # imported while the file is read
-    rec = load_recording(
-        file,
-        text=text_options(t_names, t_rate, t_bad, t_delim, t_dec),
-        topic=topic,
-        time=time,
-        time_unit=time_unit,
-        signal=signal,
-        temps=temps if temps is not None else "",  # no temperature column is read
-        signal_unit=signal_unit,
-        temp_unit=temp_unit,
-        temp_conversion=temp_conversion,
-        keep_other=False,  # the Allan deviation uses the time and the signal only
-    )
+    with warnings.catch_warnings():
+        if data_type == "phase":  # the column's own unit is used (angle, s): no rate unit
+            warnings.filterwarnings(
+                "ignore", ".*no unit stated for the signal column", category=UnitWarning
+            )
+        rec = load_recording(
+            file,
+            text=text_options(t_names, t_rate, t_bad, t_delim, t_dec),
+            topic=topic,
+            time=time,
+            time_unit=time_unit,
+            signal=signal,
+            temps=temps if temps is not None else "",  # no temperature column is read
+            signal_unit=signal_unit,
+            temp_unit=temp_unit,
+            temp_conversion=temp_conversion,
+            keep_other=False,  # the Allan deviation uses the time and the signal only
+        )
     _check_plot(plot, file)
     tau_spec = _analysis.parse_taus(taus)
     res = _analysis.allan_analysis(

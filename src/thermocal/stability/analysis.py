@@ -23,7 +23,7 @@ import warnings
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
-from thermocal.errors import ConditioningWarning, ThermocalInputError
+from thermocal.errors import ConditioningWarning, ThermocalInputError, UnitWarning
 from thermocal.stability.allan import ONE_SIGMA_CONFIDENCE
 
 if TYPE_CHECKING:
@@ -167,6 +167,14 @@ def _family(
     for name in names:
         if data_type == "phase":  # the column as given, in its own unit
             values, unit = rec.column(name), column_unit(name)
+            if not unit:
+                warnings.warn(
+                    UnitWarning(
+                        f"the phase column {name!r} names no unit (as 'phase [s]' or "
+                        "'angle (deg)'): its deviations are given without one"
+                    ),
+                    stacklevel=1,
+                )
         else:
             values, unit = signal_in_data_unit(rec, name)
         results[name] = family.stability(
