@@ -113,9 +113,6 @@ class StabilityResult:
     notes: tuple[str, ...] = field(default=())
 
 
-BIAS_CORRECTED: Final = frozenset({"totdev", "htotdev"})
-"""The deviations :func:`stable32_bias` corrects (Stable32 prints MTOT and TTOT uncorrected)."""
-
 _TOTVAR_BIAS: Final = {-1: 1.0 / (3.0 * math.log(2.0)), -2: 0.75}
 _HTOTVAR_BIAS: Final = {0: -0.005, -1: -0.149, -2: -0.229, -3: -0.283, -4: -0.321}
 
@@ -292,8 +289,9 @@ class _Record:
 
     def centred(self) -> list[FloatArray]:
         """The phases minus their end-point lines (in place unless mtie/tierms need the raw
-        phase; a line changes no α: the rate averages shift by a constant, the phase's
-        linear detrend removes it)."""
+        phase).  The noise identification reads these: for rate data the m-averages only
+        shift by a constant; for phase data the frequency offset is gone before the lag-1
+        test, which removes nothing else (:func:`.edf.identify_noise`)."""
         if self._centred is None:
             raw = any(n in ("mtie", "tierms") for n in self.names)
             self._centred = [dv.centred(x, inplace=not raw) for x in self.phases()]
