@@ -1,0 +1,142 @@
+"""Conformance with Stable32 on public records thermocal's tests do not ship (issue 29).
+
+For every Stable32 output file with interval bounds in the public test data of allantools
+(``tests/`` of a checkout: PHASE.DAT, GPS 1PPS, Cs 5071A, Keysight 53230A, OCXO) and,
+optionally, of allantoolkit (``tests/assets/Sr87``), thermocal's deviation family is run on
+the same record and τ and each printed row is judged: the noise exponent α equal to
+Stable32's column, the value within 1e-4 and both bounds within 2e-3 (relative; a constant
+scale between the two programs, as OCXO's normalisation by its nominal frequency, is divided
+out, and bounds are compared as ratios to the value).  totdev and htotdev are compared with
+``bias_correct=True`` (Stable32's default) except in files named ``*nobias*``.
+
+Fetch the repositories yourself (they are not a dependency); nothing here runs in CI.
+
+Run: .venv/bin/python benchmarks/stable32_conformance.py --allantools PATH/allantools/tests
+     [--allantoolkit PATH/allantoolkit/tests/assets] [--rows]
+"""
+
+from __future__ import annotations
+
+import argparse
+import gzip
+from pathlib import Path
+
+import numpy as np
+
+from thermocal.stability.family import stability
+
+DEVS = ("adev", "oadev", "mdev", "tdev", "hdev", "ohdev", "totdev", "mtotdev", "ttotdev",
+        "htotdev")  # fmt: skip
+
+
+def _load(path: Path) -> np.ndarray:
+    """The first number of every data line (Stable32 headers and '#'/'%' lines skipped)."""
+    opener = gzip.open if path.suffix == ".gz" else open
+    vals = []
+    with opener(path, "rt", encoding="latin-1") as f:
+        for ln in f:
+            s = ln.strip()
+            if not s or s[0] in "#%":
+                continue
+            try:
+                vals.append(float(s.split()[0]))
+            except ValueError:
+                continue
+    return np.asarray(vals)
+
+
+def _rows(path: Path) -> np.ndarray:
+    """Stable32's printed rows (AF, τ, n, α, low, value, high), commented ones included."""
+    out = []
+    for ln in path.read_text(encoding="latin-1").splitlines():
+        s = ln.strip().lstrip("#").strip()
+        try:
+            v = [float(t) for t in s.split()]
+        except ValueError:
+            continue
+        if len(v) == 7 and v[4] > 0:
+            out.append(v)
+    return np.asarray(out)
+
+
+def _dev_of(name: str) -> str | None:
+    low = name.lower()
+    for d in sorted(DEVS, key=len, reverse=True):
+        if d in low:
+            return d
+    return None
+
+
+def _judge(tag: str, x: np.ndarray, dtype: str, tau0: float, f: Path, show: bool) -> list[int]:
+    dev = _dev_of(f.name)
+    r = _rows(f)
+    if dev is None or r.size == 0:
+        return [0, 0, 0, 0]
+    bias = dev in ("totdev", "htotdev") and "nobias" not in f.name
+    res = stability(x, tau0, [dev], r[:, 1], data_type=dtype, bias_correct=bias)
+    c = res.curves[dev]
+    where = {round(t / tau0): i for i, t in enumerate(c.tau_s)}
+    scale = c.dev[where[round(r[0, 1] / tau0)]] / r[0, 5]
+    ok = [len(r), 0, 0, 0]
+    for row in r:
+        j = where[round(row[1] / tau0)]
+        a_ok = int(c.alpha[j]) == int(row[3])
+        v_ok = abs(c.dev[j] / row[5] / scale - 1) < 1e-4
+        lo = (c.low[j] / c.dev[j]) / (row[4] / row[5]) - 1
+        hi = (c.high[j] / c.dev[j]) / (row[6] / row[5]) - 1
+        b_ok = abs(lo) < 2e-3 and abs(hi) < 2e-3
+        ok[1] += a_ok
+        ok[2] += v_ok
+        ok[3] += b_ok
+        if show and not (a_ok and v_ok and b_ok):
+            print(f"  {tag} {f.name} m={int(row[0])}: α {int(c.alpha[j])} vs {int(row[3])} "
+                  f"({c.alpha_method[j]}), value {c.dev[j] / row[5] / scale - 1:+.1e}, "
+                  f"bounds {lo:+.1e}/{hi:+.1e}")  # fmt: skip
+    return ok
+
+
+def main() -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--allantools", type=Path, required=True, help="allantools' tests/ folder")
+    ap.add_argument("--allantoolkit", type=Path, help="allantoolkit's tests/assets/ folder")
+    ap.add_argument("--rows", action="store_true", help="print every row that is off")
+    a = ap.parse_args()
+    at = a.allantools
+    sets: list[tuple[str, Path, str, float, list[Path]]] = [
+        ("PHASE.DAT", at / "phasedat/PHASE.DAT", "phase", 1.0,
+         sorted((at / "phasedat").glob("phase_dat_*_octave*.txt"))
+         + sorted((at / "phasedat").glob("phase_dat_*_decade.txt"))),
+        ("GPS", at / "gps/gps_1pps_phase_data.txt.gz", "phase", 1.0,
+         sorted((at / "gps").glob("stable32_*.txt"))),
+        ("Cs 5071A", at / "Cs5071A/5071A_phase.txt.gz", "phase", 1.0,
+         sorted((at / "Cs5071A").glob("*_decade.txt"))),
+        ("53230A", at / "Keysight53230A_ti_noise_floor/tic_phase.txt", "phase", 1.0,
+         sorted((at / "Keysight53230A_ti_noise_floor").glob("tic_*dev.txt"))),
+        ("OCXO", at / "ocxo/ocxo_frequency.txt", "rate", 1.0,
+         sorted((at / "ocxo").glob("*_octave.txt"))),
+    ]  # fmt: skip
+    if a.allantoolkit:
+        sr = a.allantoolkit / "Sr87"
+        files = sorted((sr / "phase0/octave").glob("*.txt"))
+        files += sorted((sr / "phase0/decade").glob("*.txt"))
+        sets.append(("Sr87", sr / "phase0/phase0_data.txt", "phase", 2.5, files))
+    print(
+        f"{'record':10s} {'deviation file':44s} {'rows':>4s} {'α':>4s} {'value':>5s} {'bounds':>6s}"
+    )
+    total = np.zeros(4, dtype=int)
+    for tag, data, dtype, tau0, files in sets:
+        x = _load(data)
+        for f in files:
+            if _dev_of(f.name) is None:
+                continue
+            ok = _judge(tag, x, dtype, tau0, f, a.rows)
+            if ok[0]:
+                name = f"{f.parent.name}/{f.name}"
+                print(f"{tag:10s} {name:44s} {ok[0]:4d} {ok[1]:4d} {ok[2]:5d} {ok[3]:6d}")
+                total += ok
+    print(f"{'all':10s} {'':44s} {total[0]:4d} {total[1]:4d} {total[2]:5d} {total[3]:6d}")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
