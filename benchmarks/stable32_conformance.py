@@ -29,6 +29,19 @@ DEVS = ("adev", "oadev", "mdev", "tdev", "hdev", "ohdev", "totdev", "mtotdev", "
         "htotdev")  # fmt: skip
 
 
+FORCED = {
+    "phase_dat_mtotdev_octave_alpha0.txt": 0,
+    "phase_dat_htotdev_octave_nobias.txt": 2,
+    "totdev_decade.txt": 0,
+}
+"""Outputs Stable32 printed with its noise type set by hand (``--noise-type``): one α in every
+row where the same program identified others on the same record and τ (PHASE.DAT Htot
+identified white FM, then flicker PM: the "nobias" run is white PM throughout, the noise
+Stable32 gives no bias factor; the Cs 5071A's OADEV reads white and flicker PM up to
+m = 100 and its TOTDEV white FM throughout, with no bias factor where OADEV reads flicker
+FM)."""
+
+
 def _load(path: Path) -> np.ndarray:
     """The first number of every data line (Stable32 headers and '#'/'%' lines skipped)."""
     opener = gzip.open if path.suffix == ".gz" else open
@@ -73,7 +86,8 @@ def _judge(tag: str, x: np.ndarray, dtype: str, tau0: float, f: Path, show: bool
     if dev is None or r.size == 0:
         return [0, 0, 0, 0]
     bias = dev in ("totdev", "htotdev") and "nobias" not in f.name
-    res = stability(x, tau0, [dev], r[:, 1], data_type=dtype, bias_correct=bias)
+    forced = FORCED.get(f.name) if f.parent.name in ("phasedat", "Cs5071A") else None
+    res = stability(x, tau0, [dev], r[:, 1], data_type=dtype, bias_correct=bias, alpha=forced)
     c = res.curves[dev]
     where = {round(t / tau0): i for i, t in enumerate(c.tau_s)}
     scale = c.dev[where[round(r[0, 1] / tau0)]] / r[0, 5]

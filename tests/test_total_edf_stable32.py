@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import pytest
 
-from thermocal.stability.edf import confidence_interval, edf_htotdev, edf_mtotdev
+from thermocal.stability.edf import confidence_interval, edf_htotdev, edf_mtotdev, edf_totdev
 
 N_SR87 = 1253
 
@@ -89,11 +89,45 @@ def test_htot_white_fm_bounds_below_m16_equal_stable32(
     assert float(hi) == pytest.approx(high, rel=2e-3, abs=0.0)
 
 
-@pytest.mark.xfail(
-    strict=True, reason="Stable32's Htot EDF at flicker PM is not reproduced (edf_htotdev)"
-)
-def test_htot_flicker_pm_bounds_not_yet_stable32() -> None:
-    for m, alpha, low, dev, high in HTOT_FLICKER_PM:
-        lo, hi = confidence_interval(dev, edf_htotdev(1001, m, alpha))
-        assert float(lo) == pytest.approx(low, rel=2e-3, abs=0.0)
-        assert float(hi) == pytest.approx(high, rel=2e-3, abs=0.0)
+@pytest.mark.parametrize(("m", "alpha", "low", "dev", "high"), HTOT_FLICKER_PM)
+def test_htot_flicker_pm_bounds_equal_stable32(
+    m: int, alpha: int, low: float, dev: float, high: float
+) -> None:
+    """Stable32's phase-noise rule (simple EDF + 2); Greenhall's ohdev EDF (32.8, 15.9 where
+    Stable32's is 50.6, 18.6) put these bounds 8–30 % off."""
+    lo, hi = confidence_interval(dev, edf_htotdev(1001, m, alpha))
+    assert float(lo) == pytest.approx(low, rel=2e-3, abs=0.0)
+    assert float(hi) == pytest.approx(high, rel=2e-3, abs=0.0)
+
+
+# Stable32 TOTDEV rows at flicker PM on two more public records of allantools' test data
+# (LGPL-3.0; figures quoted): the GPS 1PPS phase record (tests/gps, N = 241218) and the
+# Keysight 53230A noise-floor record (tests/Keysight53230A_ti_noise_floor, N = 55688).
+# (N, m, lower bound, deviation, upper bound); bias factor 1 at phase noise
+TOTDEV_FLICKER_PM = [
+    (241218, 2, 3.2009e-09, 3.2071e-09, 3.2133e-09),
+    (241218, 16, 5.6984e-10, 5.7119e-10, 5.7255e-10),
+    (241218, 1024, 1.1923e-11, 1.1998e-11, 1.2074e-11),
+    (241218, 4096, 3.5895e-12, 3.6305e-12, 3.6730e-12),
+    (241218, 32768, 7.2339e-13, 7.5714e-13, 7.9613e-13),
+    (241218, 65536, 3.7976e-13, 4.1817e-13, 4.7121e-13),
+    (55688, 2048, 8.7523e-15, 8.9523e-15, 9.1668e-15),
+    (55688, 4096, 4.3980e-15, 4.5516e-15, 4.7226e-15),
+]
+
+
+@pytest.mark.parametrize(("n", "m", "low", "dev", "high"), TOTDEV_FLICKER_PM)
+def test_totdev_flicker_pm_bounds_equal_stable32(
+    n: int, m: int, low: float, dev: float, high: float
+) -> None:
+    """Greenhall's overlapping-Allan EDF, used before, put m = 1024–65536 0.7–25 % off."""
+    lo, hi = confidence_interval(dev, edf_totdev(n, m, 1))
+    assert float(lo) == pytest.approx(low, rel=2e-3, abs=0.0)
+    assert float(hi) == pytest.approx(high, rel=2e-3, abs=0.0)
+
+
+def test_total_pm_edf_is_the_simple_formula_plus_two() -> None:
+    """The simple formulas by hand (Howe, Allan & Barnes 1981) at N = 1001, m = 128:
+    white PM 1002·745/(2·873) = 427.55, flicker PM exp(√(ln(1000/256)·ln(257·250))) = 48.612."""
+    assert edf_totdev(1001, 128, 2) == pytest.approx(1002 * 745 / (2 * 873) + 2, rel=1e-12)
+    assert edf_htotdev(1001, 128, 1) == pytest.approx(48.6121 + 2, rel=1e-5)

@@ -271,6 +271,15 @@ BiasCorrectOpt = Annotated[
         "m ≥ 2) as Stable32 does; the factor per τ is NAME_bias_factor in --json.",
     ),
 ]
+NoiseTypeOpt = Annotated[
+    str | None,
+    typer.Option(
+        "--noise-type",
+        help="The power-law noise the intervals (and --bias-correct) assume at every τ, as "
+        "Stable32's noise-type setting: auto (default: identified per τ), wpm, fpm, wfm, "
+        "ffm, rwfm (fwfm, rrfm: Hadamard deviations only) or α from -4 to 2.",
+    ),
+]
 DynamicOpt = Annotated[
     float | None,
     typer.Option(
@@ -333,6 +342,7 @@ def allan_cmd(
     data_type: DataTypeOpt = "rate",
     dynamic: DynamicOpt = None,
     bias_correct: BiasCorrectOpt = False,
+    noise_type: NoiseTypeOpt = None,
     as_json: JsonOpt = False,
 ) -> None:
     """Overlapping Allan deviation with chi-square confidence intervals and the noise
@@ -363,7 +373,7 @@ def allan_cmd(
     res = _analysis.allan_analysis(
         rec, split_names(signal) or [rec.signals[0]], taus=tau_spec, confidence=confidence,
         deviations=deviation, data_type=data_type, dynamic_s=dynamic, where=str(file),
-        bias_correct=bias_correct,
+        bias_correct=bias_correct, noise_type=noise_type,
     )  # fmt: skip
     if res.is_family:
         _emit_family(file, res, as_json)

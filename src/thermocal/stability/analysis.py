@@ -113,6 +113,7 @@ def allan_analysis(
     dynamic_s: float | None = None,
     where: str = "",
     bias_correct: bool = False,
+    noise_type: str | None = None,
 ) -> AllanAnalysis:
     """The stability analysis of the channels ``names`` of ``rec`` (module docstring).
 
@@ -120,9 +121,11 @@ def allan_analysis(
     comma-separated deviations of :func:`thermocal.stability.family.parse_deviations`
     (then, or with ``data_type="phase"``, the family replaces the ADEV and noise terms);
     ``dynamic_s``: the dynamic ADEV's window [s] (rate data, ADEV only); ``bias_correct``:
-    Stable32's bias correction of totdev and htotdev (the family only).  A poor noise-model
-    fit and a non-stationary record are :class:`ConditioningWarning` naming ``where``
-    (and the channel when there are several).
+    Stable32's bias correction of totdev and htotdev (the family only); ``noise_type``: the
+    power-law noise the intervals and bias factors assume at every τ instead of the one
+    identified (:func:`thermocal.stability.family.parse_noise_type`; the family only).  A
+    poor noise-model fit and a non-stationary record are :class:`ConditioningWarning`
+    naming ``where`` (and the channel when there are several).
     """
     if data_type not in DATA_TYPES:
         raise ThermocalInputError(f"--data-type {data_type!r}: use rate or phase")
@@ -134,12 +137,19 @@ def allan_analysis(
     if deviations is not None or data_type == "phase":
         return AllanAnalysis(
             tuple(names),
-            family=_family(rec, names, taus, confidence, deviations, data_type, bias_correct),
+            family=_family(
+                rec, names, taus, confidence, deviations, data_type, bias_correct, noise_type
+            ),
         )
     if bias_correct:
         raise ThermocalInputError(
             "--bias-correct corrects the total deviations (totdev, htotdev): give them with "
             "--deviation"
+        )
+    if noise_type is not None and noise_type.strip().lower() not in ("", "auto"):
+        raise ThermocalInputError(
+            "--noise-type sets the noise of the deviation family's intervals: give the "
+            "deviations with --deviation (the overlapping ADEV: --deviation oadev)"
         )
     channels: dict[str, AllanChannel] = {}
     for name in names:  # one read of the file, every channel (INTERFACE: several channels)
@@ -158,11 +168,13 @@ def _family(
     deviations: str | None,
     data_type: str,
     bias_correct: bool = False,
+    noise_type: str | None = None,
 ) -> dict[str, StabilityResult]:
     """The deviations of every channel (phase data: the column as given, in its own unit)."""
     from thermocal.stability import family
 
     devs = family.parse_deviations(deviations or "oadev")
+    alpha = family.parse_noise_type(noise_type, devs)
     results = {}
     for name in names:
         if data_type == "phase":  # the column as given, in its own unit
@@ -180,6 +192,7 @@ def _family(
         results[name] = family.stability(
             values, rec.sample_interval_s, devs, taus, data_type=data_type,
             segments=rec.segments(), unit=unit, confidence=confidence, bias_correct=bias_correct,
+            alpha=alpha,
         )  # fmt: skip
     return results
 

@@ -222,12 +222,60 @@ _MTOT: Final = {
 _HTOT: Final = {0: (0.559, 1.004), -1: (0.868, 1.140), -2: (0.938, 1.696)}
 
 
+STABLE32_PM_OFFSET: Final = 2.0
+"""What Stable32 adds to the simple phase-noise EDF of the total deviations (read from its
+printed bounds; see :func:`edf_total_pm`)."""
+
+
+def edf_simple_pm(n_phase: int, m: int, alpha: int) -> float:
+    """The "simple" EDF approximations of the Allan variance for phase noise (D. A. Howe,
+    D. W. Allan and J. A. Barnes, "Properties of signal sources and measurement methods",
+    Proc. 35th Frequency Control Symposium, 1981; NIST SP 1065 §5.3.3):
+
+    * α = +2 (white PM): ``(N + 1)(N − 2m) / (2(N − m))``
+    * α = +1 (flicker PM): ``exp(√(ln((N − 1)/(2m)) · ln((2m + 1)(N − 1)/4)))``
+
+    N phase points; NaN outside their domain (N ≤ 2m)."""
+    n = float(n_phase)
+    if n <= 2 * m:
+        return float("nan")
+    if alpha >= 2:
+        return (n + 1.0) * (n - 2.0 * m) / (2.0 * (n - m))
+    if alpha == 1:
+        a = math.log((n - 1.0) / (2.0 * m))
+        b = math.log((2.0 * m + 1.0) * (n - 1.0) / 4.0)
+        return math.exp(math.sqrt(a * b))
+    raise ValueError(f"edf_simple_pm is for phase noise (α = 1, 2), not α = {alpha}")
+
+
+def edf_total_pm(n_phase: int, m: int, alpha: int) -> float:
+    """EDF of the total deviations (totdev, htotdev) at phase noise (α = +1, +2), where the
+    total-variance EDF tables (SP 1065 Tables 7, 9) have no entry: the simple approximation
+    (:func:`edf_simple_pm`) plus 2 (:data:`STABLE32_PM_OFFSET`), the rule Stable32's
+    intervals follow.
+
+    Read from Stable32's printed bounds (exact chi-square intervals, see
+    :func:`edf_mtotdev`), none of them written by thermocal: TOTDEV at flicker PM on the GPS
+    1PPS record of allantools' test data (N = 241218; m = 32768, 65536: EDF 216.0, 43.6)
+    and on the Keysight 53230A record (N = 55688; m = 2048, 4096: 924.3, 390.6), HTOT at
+    flicker PM on PHASE.DAT (N = 1001; m = 128, 256: 50.6, 18.6) exceed the simple formula
+    (214.0, 41.6, 922.4, 388.8, 48.6, 16.5) by 1.84–2.06, the same at EDF 18 as at 924, so an
+    offset, not a change of N or m; the Htot run PHASE.DAT forced to white PM (m = 1–256,
+    EDF 330–502) exceeds it by 1.2–2.0 (its bounds resolve EDF to ±0.3 %).  GPS m = 2, 16,
+    1024, 4096 (EDF 3741–1.3e5) agree with either, within their resolution.  Greenhall's
+    overlapping-Allan (or Hadamard) EDF, used here before, put those bounds 0.3–30 % off.
+    """
+    return edf_simple_pm(n_phase, m, alpha) + STABLE32_PM_OFFSET
+
+
 def edf_totdev(n_phase: int, m: int, alpha: int) -> float:
     """Total variance EDF, SP 1065 Table 7: ``b·(N/m) − c`` for α = 0, −1, −2; phase
-    noise (α > 0) takes the overlapping Allan EDF (Greenhall)."""
+    noise (α > 0): :func:`edf_total_pm`, as Stable32."""
     if alpha in _TOT:
         b, c = _TOT[alpha]
         return b * n_phase / m - c
+    if alpha > 0:
+        return edf_total_pm(n_phase, m, alpha)
     return greenhall_edf(max(alpha, -2), 2, m, n_phase, overlapping=True, modified=False)
 
 
@@ -283,8 +331,9 @@ def edf_htotdev(n_phase: int, m: int, alpha: int) -> float:
     * m ≥ 16, α = 0, −1, −2: SP 1065 §5.2.14, ``(N/m)/(b0 + b1·m/N)`` with (b0, b1) =
       (0.559, 1.004), (0.868, 1.140), (0.938, 1.696) (Howe et al., PTTI 2000, Table 1).
     * m < 16, α = 0 (white FM): ``N / (2m/3 + 5/(6m))``, read here from Stable32's bounds.
+    * α = +1, +2 (phase noise): :func:`edf_total_pm`, as Stable32 (every m).
     * otherwise: Greenhall's EDF of the overlapping Hadamard variance at m = 1 (Htot is
-      that variance there) and for α outside −2…0; SP 1065's formula for α = −1, −2 at
+      that variance there) and for α = −3, −4; SP 1065's formula for α = −1, −2 at
       1 < m < 16.
 
     Against Stable32's printed bounds (read as exact chi-square intervals, with Stable32's
@@ -295,9 +344,10 @@ def edf_htotdev(n_phase: int, m: int, alpha: int) -> float:
     1253) m = 8, 10 give 230.3, 185.5; N/EDF = 2m/3 + 5/(6m) fits all six within 0.11 % (fitted
     on PHASE.DAT alone it predicts Sr87's within 0.11 %); 2/3 is the TOTVAR white-FM 1/b.
     Not reproduced: α = −1, −2 below m = 16 (Sr87 m = 1, 4 at α = −1: 1090, 390; m = 2 at
-    α = −2: 627; this function 897, 359, 666; bounds within 2.5e-3 there) and flicker PM
-    (PHASE.DAT m = 128, 256: 50.6, 18.6 against 32.8, 15.9 here).
+    α = −2: 627; this function 897, 359, 666; bounds within 2.5e-3 there).
     """
+    if alpha > 0:
+        return edf_total_pm(n_phase, m, alpha)
     if m < HTOT_FORMULA_FROM and alpha == 0:
         return n_phase / (2.0 * m / 3.0 + 5.0 / (6.0 * m))
     if m > 1 and alpha in _HTOT:

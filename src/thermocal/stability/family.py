@@ -63,9 +63,12 @@ def edf_source(name: str) -> str:
         )
     if name == "htotdev":
         return (
-            "SP 1065 Htot EDF, Stable32's white-FM rule below m = 16 (its rule for other "
-            "noises below m = 16 and for flicker PM not reproduced)"
+            "SP 1065 Htot EDF, Stable32's white-FM rule below m = 16 and its phase-noise rule "
+            "(simple EDF + 2); its rule for flicker and random-walk FM below m = 16 is not "
+            "reproduced"
         )
+    if name == "totdev":
+        return "SP 1065 TOTVAR EDF, Stable32's phase-noise rule (simple EDF + 2)"
     return "Greenhall/SP 1065 EDF"
 
 
@@ -152,6 +155,36 @@ def parse_deviations(spec: str) -> list[str]:
             + ", ".join(dv.DEVIATIONS)
         )
     return list(dict.fromkeys(names))
+
+
+NOISE_TYPES: Final = {"wpm": 2, "fpm": 1, "wfm": 0, "ffm": -1, "rwfm": -2, "fwfm": -3, "rrfm": -4}
+"""Power-law noise names → α (S_y(f) ∝ f^α; NIST SP 1065 Table 1): white and flicker PM,
+white, flicker and random-walk FM, flicker-walk and random-run FM (Hadamard family only)."""
+
+
+def parse_noise_type(spec: str | None, names: list[str]) -> int | None:
+    """``--noise-type``: ``auto`` (None: identified per τ), a name of :data:`NOISE_TYPES`
+    or α itself (−4…2).  Stable32's noise-type setting: the EDF and the bias corrections
+    use this α at every τ.  α < −2 only for the Hadamard family (hdev, ohdev, htotdev):
+    the Allan-family EDF (Greenhall & Riley 2003) needs α + 2d > 1, d = 2."""
+    if spec is None or spec.strip().lower() in ("", "auto"):
+        return None
+    key = spec.strip().lower()
+    try:
+        alpha = NOISE_TYPES[key] if key in NOISE_TYPES else int(key)
+    except ValueError:
+        alpha = 99
+    if not -4 <= alpha <= 2:
+        raise ThermocalInputError(
+            f"--noise-type {spec!r}: use auto, {', '.join(NOISE_TYPES)} or α from -4 to 2"
+        )
+    not_h = [n for n in names if n not in HADAMARD and n not in ("mtie", "tierms")]
+    if alpha < -2 and not_h:
+        raise ThermocalInputError(
+            f"--noise-type {spec!r} (α = {alpha}) is defined for the Hadamard deviations "
+            f"(hdev, ohdev, htotdev) only, not {', '.join(not_h)}"
+        )
+    return alpha
 
 
 def factors(
