@@ -33,6 +33,7 @@ FORCED = {
     "phase_dat_mtotdev_octave_alpha0.txt": 0,
     "phase_dat_htotdev_octave_nobias.txt": 2,
     "totdev_decade.txt": 0,
+    "stable32_totdev_alltau.txt": 0,
 }
 """Outputs Stable32 printed with its noise type set by hand (``--noise-type``): one α in every
 row where the same program identified others on the same record and τ (PHASE.DAT Htot
@@ -58,8 +59,9 @@ def _load(path: Path) -> np.ndarray:
     return np.asarray(vals)
 
 
-def _rows(path: Path) -> np.ndarray:
-    """Stable32's printed rows (AF, τ, n, α, low, value, high), commented ones included."""
+def _rows(path: Path, *, values_only: bool = False) -> np.ndarray:
+    """Stable32's printed rows (AF, τ, n, α, low, value, high), commented ones included;
+    ``values_only``: also rows printed without bounds (0)."""
     out = []
     for ln in path.read_text(encoding="latin-1").splitlines():
         s = ln.strip().lstrip("#").strip()
@@ -67,7 +69,7 @@ def _rows(path: Path) -> np.ndarray:
             v = [float(t) for t in s.split()]
         except ValueError:
             continue
-        if len(v) == 7 and v[4] > 0:
+        if len(v) == 7 and (v[4] > 0 or (values_only and v[5] > 0)):
             out.append(v)
     return np.asarray(out)
 
@@ -82,11 +84,12 @@ def _dev_of(name: str) -> str | None:
 
 def _judge(tag: str, x: np.ndarray, dtype: str, tau0: float, f: Path, show: bool) -> list[int]:
     dev = _dev_of(f.name)
-    r = _rows(f)
+    values_only = "alltau" in f.name  # Stable32 printed no bounds there
+    r = _rows(f, values_only=values_only)
     if dev is None or r.size == 0:
         return [0, 0, 0, 0]
     bias = dev in ("totdev", "htotdev") and "nobias" not in f.name
-    forced = FORCED.get(f.name) if f.parent.name in ("phasedat", "Cs5071A") else None
+    forced = FORCED.get(f.name) if f.parent.name in ("phasedat", "Cs5071A", "ocxo") else None
     res = stability(x, tau0, [dev], r[:, 1], data_type=dtype, bias_correct=bias, alpha=forced)
     c = res.curves[dev]
     where = {round(t / tau0): i for i, t in enumerate(c.tau_s)}
@@ -98,7 +101,7 @@ def _judge(tag: str, x: np.ndarray, dtype: str, tau0: float, f: Path, show: bool
         v_ok = abs(c.dev[j] / row[5] / scale - 1) < 1e-4
         lo = (c.low[j] / c.dev[j]) / (row[4] / row[5]) - 1
         hi = (c.high[j] / c.dev[j]) / (row[6] / row[5]) - 1
-        b_ok = abs(lo) < 2e-3 and abs(hi) < 2e-3
+        b_ok = values_only or (abs(lo) < 2e-3 and abs(hi) < 2e-3)
         ok[1] += a_ok
         ok[2] += v_ok
         ok[3] += b_ok
@@ -106,6 +109,8 @@ def _judge(tag: str, x: np.ndarray, dtype: str, tau0: float, f: Path, show: bool
             print(f"  {tag} {f.name} m={int(row[0])}: α {int(c.alpha[j])} vs {int(row[3])} "
                   f"({c.alpha_method[j]}), value {c.dev[j] / row[5] / scale - 1:+.1e}, "
                   f"bounds {lo:+.1e}/{hi:+.1e}")  # fmt: skip
+    if values_only:
+        ok[3] = -1  # not judged
     return ok
 
 
@@ -128,6 +133,8 @@ def main() -> int:
          sorted((at / "Keysight53230A_ti_noise_floor").glob("tic_*dev.txt"))),
         ("OCXO", at / "ocxo/ocxo_frequency.txt", "rate", 1.0,
          sorted((at / "ocxo").glob("*_octave.txt"))),
+        ("OCXO frac", at / "ocxo/ocxo_frequency.txt", "fractional", 1.0,
+         sorted((at / "ocxo").glob("stable32_*_alltau.txt"))),
     ]  # fmt: skip
     if a.allantoolkit:
         sr = a.allantoolkit / "Sr87"
@@ -138,17 +145,27 @@ def main() -> int:
         f"{'record':10s} {'deviation file':44s} {'rows':>4s} {'α':>4s} {'value':>5s} {'bounds':>6s}"
     )
     total = np.zeros(4, dtype=int)
+    values = np.zeros(3, dtype=int)
     for tag, data, dtype, tau0, files in sets:
         x = _load(data)
+        if dtype == "fractional":  # Hz about 10 MHz → (f − f0)/f0, as Stable32's .003 file
+            x, dtype = (x - 1.0e7) / 1.0e7, "rate"
         for f in files:
             if _dev_of(f.name) is None:
                 continue
             ok = _judge(tag, x, dtype, tau0, f, a.rows)
             if ok[0]:
                 name = f"{f.parent.name}/{f.name}"
-                print(f"{tag:10s} {name:44s} {ok[0]:4d} {ok[1]:4d} {ok[2]:5d} {ok[3]:6d}")
-                total += ok
-    print(f"{'all':10s} {'':44s} {total[0]:4d} {total[1]:4d} {total[2]:5d} {total[3]:6d}")
+                b = f"{ok[3]:6d}" if ok[3] >= 0 else f"{'–':>6s}"
+                print(f"{tag:10s} {name:44s} {ok[0]:4d} {ok[1]:4d} {ok[2]:5d} {b}")
+                if ok[3] >= 0:
+                    total += ok
+                else:
+                    values[:3] += ok[:3]
+    print(f"{'all':10s} {'with bounds':44s} {total[0]:4d} {total[1]:4d} {total[2]:5d} {total[3]:6d}")
+    if values[0]:
+        print(f"{'all':10s} {'values only (no bounds printed)':44s} {values[0]:4d} {values[1]:4d} "
+              f"{values[2]:5d} {'–':>6s}")  # fmt: skip
     return 0
 
 

@@ -49,7 +49,7 @@ def test_htotdev_bias_corrected_equals_stable32_on_phasedat(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     """Rows m = 1–64 (Stable32's α = 0 there, as thermocal's): values to 1e-4 (÷√0.995 from
-    m = 2) and bounds to 2e-3 (Stable32's Htot EDF: its white-FM rule below m = 16)."""
+    m = 2) and bounds to 2e-3 (Stable32's Htot EDF: the simple EDF + 2 below m = 16)."""
     r = rows("phase_dat_htotdev_octave.txt", commented=True)[:7]
     obj = run_allan(capsys, phase_csv(tmp_path), "htotdev", r[:, 1], "--bias-correct")
     np.testing.assert_array_equal(obj["htotdev_alpha"], r[:, 3].astype(int))

@@ -55,6 +55,15 @@ HTOT_WHITE_FM_SHORT = [
     (N_SR87, 10, 8.1805e-17, 8.5915e-17, 9.0718e-17),
 ]
 
+# Stable32 Hadamard Total below m = 16 on Sr87 at flicker FM (m = 1, 4) and random-walk FM
+# (m = 2), printed with the bias correction (scales value and bounds alike): the simple EDF + 2
+# (1090.0, 389.9, 626.5), where Greenhall's overlapping-Hadamard EDF gives 897, 359, 666
+HTOT_SR87_SHORT = [
+    (1, -1, 8.0946e-17, 8.2651e-17, 8.4469e-17),
+    (2, -2, 7.5923e-17, 7.8025e-17, 8.0313e-17),
+    (4, -1, 8.8264e-17, 9.1349e-17, 9.4785e-17),
+]
+
 # Stable32 Hadamard Total at flicker PM (PHASE.DAT m = 128, 256; no bias correction there)
 HTOT_FLICKER_PM = [
     (128, 1, 2.6309e-02, 2.8790e-02, 3.2137e-02),
@@ -87,6 +96,15 @@ def test_htot_white_fm_bounds_below_m16_equal_stable32(
     lo, hi = confidence_interval(dev, edf_htotdev(n, m, 0))
     assert float(lo) == pytest.approx(low, rel=2e-3, abs=0.0)
     assert float(hi) == pytest.approx(high, rel=2e-3, abs=0.0)
+
+
+@pytest.mark.parametrize(("m", "alpha", "low", "dev", "high"), HTOT_SR87_SHORT)
+def test_htot_flicker_and_random_walk_fm_below_m16_equal_stable32(
+    m: int, alpha: int, low: float, dev: float, high: float
+) -> None:
+    lo, hi = confidence_interval(dev, edf_htotdev(N_SR87, m, alpha))
+    assert float(lo) == pytest.approx(low, rel=5e-4, abs=0.0)
+    assert float(hi) == pytest.approx(high, rel=5e-4, abs=0.0)
 
 
 @pytest.mark.parametrize(("m", "alpha", "low", "dev", "high"), HTOT_FLICKER_PM)

@@ -9,8 +9,9 @@ averaging factor (τ = m τ0).
   variances based on finite differences", Proc. 35th PTTI Meeting (2003), eqs. (7)–(13) and
   Tables 1–3 (the algorithm Stable32 uses); written here from the paper's equations.
 * :func:`edf_totdev`, :func:`edf_htotdev`: NIST SP 1065 (2008) §5.2.11, §5.2.14
-  (``b·(N/m) − c``; Htot ``(N/m)/(b0 + b1·m/N)``, with Stable32's white-FM rule below
-  m = 16); what of Stable32's Htot intervals is not reproduced is stated in its docstring.
+  (``b·(N/m) − c``; Htot ``(N/m)/(b0 + b1·m/N)``), with Stable32's rule where those do not
+  serve (phase noise; Htot below m = 16): the simple EDF of :func:`edf_simple` (Howe,
+  Allan & Barnes 1981) + 2, read from Stable32's printed bounds.
 * :func:`edf_mtotdev`: the rule Stable32's MTOT/TTOT intervals follow (Greenhall's modified
   Allan EDF below m = 10, a line in N/m above), read from Stable32's printed bounds.
 * :func:`edf_theo1`: Howe's empirical Theo1 EDF per noise type (SP 1065 §5.2.16).
@@ -222,60 +223,77 @@ _MTOT: Final = {
 _HTOT: Final = {0: (0.559, 1.004), -1: (0.868, 1.140), -2: (0.938, 1.696)}
 
 
-STABLE32_PM_OFFSET: Final = 2.0
-"""What Stable32 adds to the simple phase-noise EDF of the total deviations (read from its
-printed bounds; see :func:`edf_total_pm`)."""
+STABLE32_SIMPLE_OFFSET: Final = 2.0
+"""What Stable32 adds to the simple EDF where its total deviations use it (read from its
+printed bounds; see :func:`edf_stable32_simple`)."""
 
 
-def edf_simple_pm(n_phase: int, m: int, alpha: int) -> float:
-    """The "simple" EDF approximations of the Allan variance for phase noise (D. A. Howe,
+def edf_simple(n_phase: int, m: int, alpha: int) -> float:
+    """The "simple" EDF approximations of the overlapping Allan variance (D. A. Howe,
     D. W. Allan and J. A. Barnes, "Properties of signal sources and measurement methods",
-    Proc. 35th Frequency Control Symposium, 1981; NIST SP 1065 §5.3.3):
+    Proc. 35th Frequency Control Symposium, 1981; NIST SP 1065 §5.3.3), N phase points:
 
     * α = +2 (white PM): ``(N + 1)(N − 2m) / (2(N − m))``
     * α = +1 (flicker PM): ``exp(√(ln((N − 1)/(2m)) · ln((2m + 1)(N − 1)/4)))``
+    * α = 0 (white FM): ``(3(N − 1)/(2m) − 2(N − 2)/N) · 4m²/(4m² + 5)``
+    * α = −1 (flicker FM): ``2(N − 2)²/(2.3N − 4.9)`` at m = 1, ``5N²/(4m(N + 3m))`` above
+    * α = −2 (random-walk FM): ``(N − 2)/m · ((N − 1)² − 3m(N − 1) + 4m²)/(N − 3)²``
 
-    N phase points; NaN outside their domain (N ≤ 2m)."""
+    NaN outside their domain (N ≤ 2m); α outside −2…2 is refused."""
     n = float(n_phase)
     if n <= 2 * m:
         return float("nan")
-    if alpha >= 2:
+    if alpha == 2:
         return (n + 1.0) * (n - 2.0 * m) / (2.0 * (n - m))
     if alpha == 1:
         a = math.log((n - 1.0) / (2.0 * m))
         b = math.log((2.0 * m + 1.0) * (n - 1.0) / 4.0)
         return math.exp(math.sqrt(a * b))
-    raise ValueError(f"edf_simple_pm is for phase noise (α = 1, 2), not α = {alpha}")
+    if alpha == 0:
+        return (
+            (3.0 * (n - 1.0) / (2.0 * m) - 2.0 * (n - 2.0) / n) * 4.0 * m * m / (4.0 * m * m + 5.0)
+        )
+    if alpha == -1:
+        if m == 1:
+            return 2.0 * (n - 2.0) ** 2 / (2.3 * n - 4.9)
+        return 5.0 * n * n / (4.0 * m * (n + 3.0 * m))
+    if alpha == -2:
+        return (n - 2.0) / m * ((n - 1.0) ** 2 - 3.0 * m * (n - 1.0) + 4.0 * m * m) / (n - 3.0) ** 2
+    raise ValueError(f"the simple EDF covers α = −2 … 2, not α = {alpha}")
 
 
-def edf_total_pm(n_phase: int, m: int, alpha: int) -> float:
-    """EDF of the total deviations (totdev, htotdev) at phase noise (α = +1, +2), where the
-    total-variance EDF tables (SP 1065 Tables 7, 9) have no entry: the simple approximation
-    (:func:`edf_simple_pm`) plus 2 (:data:`STABLE32_PM_OFFSET`), the rule Stable32's
-    intervals follow.
+def edf_stable32_simple(n_phase: int, m: int, alpha: int) -> float:
+    """The simple EDF (:func:`edf_simple`) plus 2 (:data:`STABLE32_SIMPLE_OFFSET`): the rule
+    Stable32's intervals follow for the total deviations where the total-variance EDF
+    tables (SP 1065 Tables 7, 9) do not serve: TOTDEV at phase noise (α = +1, +2), Htot at
+    phase noise and below m = 16 for white, flicker and random-walk FM.
 
     Read from Stable32's printed bounds (exact chi-square intervals, see
-    :func:`edf_mtotdev`), none of them written by thermocal: TOTDEV at flicker PM on the GPS
-    1PPS record of allantools' test data (N = 241218; m = 32768, 65536: EDF 216.0, 43.6)
-    and on the Keysight 53230A record (N = 55688; m = 2048, 4096: 924.3, 390.6), HTOT at
-    flicker PM on PHASE.DAT (N = 1001; m = 128, 256: 50.6, 18.6) exceed the simple formula
-    (214.0, 41.6, 922.4, 388.8, 48.6, 16.5) by 1.84–2.06, the same at EDF 18 as at 924, so an
-    offset, not a change of N or m; the Htot run PHASE.DAT forced to white PM (m = 1–256,
-    EDF 330–502) exceeds it by 1.2–2.0 (its bounds resolve EDF to ±0.3 %).  GPS m = 2, 16,
-    1024, 4096 (EDF 3741–1.3e5) agree with either, within their resolution.  Greenhall's
-    overlapping-Allan (or Hadamard) EDF, used here before, put those bounds 0.3–30 % off.
-    """
-    return edf_simple_pm(n_phase, m, alpha) + STABLE32_PM_OFFSET
+    :func:`edf_mtotdev`), none of them written by thermocal; Stable32 − simple formula:
+
+    * TOTDEV, flicker PM: GPS 1PPS record of allantools' test data (N = 241218) m = 32768,
+      65536: 216.0 − 214.0, 43.6 − 41.6; Keysight 53230A record (N = 55688) m = 2048, 4096:
+      924.3 − 922.4, 390.6 − 388.8.
+    * Htot, flicker PM: PHASE.DAT (N = 1001) m = 128, 256: 50.6 − 48.6, 18.6 − 16.5; white PM
+      (Stable32's run with the noise set by hand) m = 1–256: 330–502, 1.2–2.0 above.
+    * Htot below m = 16 on the Sr87 clock record (N = 1253; allantoolkit's test assets):
+      flicker FM m = 1, 4: 1090 − 1088.0, 390 − 387.9; random-walk FM m = 2: 627 − 624.5;
+      white FM m = 8, 10 and PHASE.DAT m = 1, 2, 4, 8: within 0.1 % of simple + 2.
+
+    The same 1.8–2.1 at EDF 18 as at 924: an offset, not a change of N or m.  Greenhall's
+    overlapping Allan/Hadamard EDF, used here before for these cases, put bounds 0.3–30 %
+    off (flicker PM) and 2–2.5 ‰ off (Htot flicker and random-walk FM below m = 16)."""
+    return edf_simple(n_phase, m, alpha) + STABLE32_SIMPLE_OFFSET
 
 
 def edf_totdev(n_phase: int, m: int, alpha: int) -> float:
     """Total variance EDF, SP 1065 Table 7: ``b·(N/m) − c`` for α = 0, −1, −2; phase
-    noise (α > 0): :func:`edf_total_pm`, as Stable32."""
+    noise (α > 0): :func:`edf_stable32_simple`, as Stable32."""
     if alpha in _TOT:
         b, c = _TOT[alpha]
         return b * n_phase / m - c
     if alpha > 0:
-        return edf_total_pm(n_phase, m, alpha)
+        return edf_stable32_simple(n_phase, m, min(alpha, 2))
     return greenhall_edf(max(alpha, -2), 2, m, n_phase, overlapping=True, modified=False)
 
 
@@ -322,35 +340,32 @@ def edf_mtotdev(n_phase: int, m: int, alpha: int) -> float:
 
 
 HTOT_FORMULA_FROM: Final = 16
-"""From this averaging factor Stable32's Htot EDF is SP 1065's ``(N/m)/(b0 + b1·m/N)``."""
+"""From this averaging factor Stable32's Htot EDF for FM noise is SP 1065's
+``(N/m)/(b0 + b1·m/N)``; below it, the simple EDF + 2 (:func:`edf_htotdev`)."""
 
 
 def edf_htotdev(n_phase: int, m: int, alpha: int) -> float:
-    """Hadamard total variance EDF as Stable32's intervals follow it, where that is known.
+    """Hadamard total variance EDF, the rule Stable32's intervals follow.
 
+    * α = +2, +1 (phase noise), every m, and α = 0, −1, −2 below m = 16
+      (:data:`HTOT_FORMULA_FROM`): the simple EDF + 2 (:func:`edf_stable32_simple`).
     * m ≥ 16, α = 0, −1, −2: SP 1065 §5.2.14, ``(N/m)/(b0 + b1·m/N)`` with (b0, b1) =
       (0.559, 1.004), (0.868, 1.140), (0.938, 1.696) (Howe et al., PTTI 2000, Table 1).
-    * m < 16, α = 0 (white FM): ``N / (2m/3 + 5/(6m))``, read here from Stable32's bounds.
-    * α = +1, +2 (phase noise): :func:`edf_total_pm`, as Stable32 (every m).
-    * otherwise: Greenhall's EDF of the overlapping Hadamard variance at m = 1 (Htot is
-      that variance there) and for α = −3, −4; SP 1065's formula for α = −1, −2 at
-      1 < m < 16.
+    * α = −3, −4 (no Stable32 output at hand shows them): Greenhall's EDF of the
+      overlapping Hadamard variance, which Htot equals at m = 1.
 
     Against Stable32's printed bounds (read as exact chi-square intervals, with Stable32's
     Abramowitz & Stegun χ² above EDF 100; see :func:`edf_mtotdev`): at m ≥ 16 the formula
     is Stable32's EDF for α = 0 and −1 (PHASE.DAT m = 16–64: 108.8, 52.9, 25.1 against 108.8,
-    52.9, 25.1; Sr87 N = 1253, m = 16–256 and 200, 400: within 0.1 %).  Below m = 16, white
-    FM: PHASE.DAT (N = 1001) m = 1, 2, 4, 8 give 668.0, 571.4, 348.1, 184.2 and Sr87 (N =
-    1253) m = 8, 10 give 230.3, 185.5; N/EDF = 2m/3 + 5/(6m) fits all six within 0.11 % (fitted
-    on PHASE.DAT alone it predicts Sr87's within 0.11 %); 2/3 is the TOTVAR white-FM 1/b.
-    Not reproduced: α = −1, −2 below m = 16 (Sr87 m = 1, 4 at α = −1: 1090, 390; m = 2 at
-    α = −2: 627; this function 897, 359, 666; bounds within 2.5e-3 there).
+    52.9, 25.1; Sr87 N = 1253, m = 16–256 and 200, 400: within 0.1 %).  Below m = 16:
+    PHASE.DAT (N = 1001) white FM m = 1, 2, 4, 8: 668.0, 571.4, 348.1, 184.2 (simple + 2:
+    667.8, 571.9, 348.4, 184.0); Sr87 white FM m = 8, 10: 230.3, 185.5 (230.2, 185.5),
+    flicker FM m = 1, 4: 1090, 390 (1090.0, 389.9), random-walk FM m = 2: 627 (626.5).
+    Greenhall's overlapping-Hadamard EDF gives 897, 359 and 666 for the last three.
     """
-    if alpha > 0:
-        return edf_total_pm(n_phase, m, alpha)
-    if m < HTOT_FORMULA_FROM and alpha == 0:
-        return n_phase / (2.0 * m / 3.0 + 5.0 / (6.0 * m))
-    if m > 1 and alpha in _HTOT:
+    if alpha > 0 or (m < HTOT_FORMULA_FROM and alpha >= -2):
+        return edf_stable32_simple(n_phase, m, min(alpha, 2))
+    if alpha in _HTOT:
         b0, b1 = _HTOT[alpha]
         return (n_phase / m) / (b0 + b1 * m / n_phase)
     return greenhall_edf(max(alpha, -4), 3, m, n_phase, overlapping=True, modified=False)

@@ -63,9 +63,8 @@ def edf_source(name: str) -> str:
         )
     if name == "htotdev":
         return (
-            "SP 1065 Htot EDF, Stable32's white-FM rule below m = 16 and its phase-noise rule "
-            "(simple EDF + 2); its rule for flicker and random-walk FM below m = 16 is not "
-            "reproduced"
+            "SP 1065 Htot EDF from m = 16, Stable32's rule (the simple EDF + 2) below m = 16 "
+            "and at phase noise"
         )
     if name == "totdev":
         return "SP 1065 TOTVAR EDF, Stable32's phase-noise rule (simple EDF + 2)"
