@@ -7,12 +7,15 @@ the same record and τ and each printed row is judged: the noise exponent α equ
 Stable32's column, the value within 1e-4 and both bounds within 2e-3 (relative; a constant
 scale between the two programs, as OCXO's normalisation by its nominal frequency, is divided
 out, and bounds are compared as ratios to the value).  totdev and htotdev are compared with
-``bias_correct=True`` (Stable32's default) except in files named ``*nobias*``.
+``bias_correct=True`` (Stable32's default) except in files named ``*nobias*``.  Outputs
+Stable32 printed with the noise type set by hand run with that α (:data:`FORCED`); the
+OCXO all-τ outputs (no bounds printed) are judged on α and value only.  ``--noise-id``:
+the identification's rules (default ``stable32``; ``thermocal`` for the package default).
 
 Fetch the repositories yourself (they are not a dependency); nothing here runs in CI.
 
 Run: .venv/bin/python benchmarks/stable32_conformance.py --allantools PATH/allantools/tests
-     [--allantoolkit PATH/allantoolkit/tests/assets] [--rows]
+     [--allantoolkit PATH/allantoolkit/tests/assets] [--rows] [--noise-id thermocal]
 """
 
 from __future__ import annotations
@@ -34,13 +37,18 @@ FORCED = {
     "phase_dat_htotdev_octave_nobias.txt": 2,
     "totdev_decade.txt": 0,
     "stable32_totdev_alltau.txt": 0,
+    "phase_dat_totdev_octave.txt": 0,
 }
 """Outputs Stable32 printed with its noise type set by hand (``--noise-type``): one α in every
 row where the same program identified others on the same record and τ (PHASE.DAT Htot
 identified white FM, then flicker PM: the "nobias" run is white PM throughout, the noise
 Stable32 gives no bias factor; the Cs 5071A's OADEV reads white and flicker PM up to
 m = 100 and its TOTDEV white FM throughout, with no bias factor where OADEV reads flicker
-FM)."""
+FM; the OCXO all-τ TOTDEV is white FM at every τ, OADEV's α runs from +1 to −2).  PHASE.DAT's
+TOTDEV is inferred: white FM at every τ, also at m = 128 where Stable32's TOTDEV rule (B1
+down to 6 averages, :data:`thermocal.stability.edf.STABLE32_B1_MIN_TOTAL`) reads flicker PM
+as MTOT's and Htot's output of the same record do, and as TOTDEV on GPS, 53230A, Sr87 and
+OCXO shows the rule at 4–7 averages."""
 
 
 def _load(path: Path) -> np.ndarray:
@@ -82,7 +90,9 @@ def _dev_of(name: str) -> str | None:
     return None
 
 
-def _judge(tag: str, x: np.ndarray, dtype: str, tau0: float, f: Path, show: bool) -> list[int]:
+def _judge(
+    tag: str, x: np.ndarray, dtype: str, tau0: float, f: Path, show: bool, noise_id: str
+) -> list[int]:
     dev = _dev_of(f.name)
     values_only = "alltau" in f.name  # Stable32 printed no bounds there
     r = _rows(f, values_only=values_only)
@@ -90,7 +100,10 @@ def _judge(tag: str, x: np.ndarray, dtype: str, tau0: float, f: Path, show: bool
         return [0, 0, 0, 0]
     bias = dev in ("totdev", "htotdev") and "nobias" not in f.name
     forced = FORCED.get(f.name) if f.parent.name in ("phasedat", "Cs5071A", "ocxo") else None
-    res = stability(x, tau0, [dev], r[:, 1], data_type=dtype, bias_correct=bias, alpha=forced)
+    res = stability(
+        x, tau0, [dev], r[:, 1], data_type=dtype, bias_correct=bias, alpha=forced,
+        noise_id=noise_id,
+    )  # fmt: skip
     c = res.curves[dev]
     where = {round(t / tau0): i for i, t in enumerate(c.tau_s)}
     scale = c.dev[where[round(r[0, 1] / tau0)]] / r[0, 5]
@@ -99,8 +112,10 @@ def _judge(tag: str, x: np.ndarray, dtype: str, tau0: float, f: Path, show: bool
         j = where[round(row[1] / tau0)]
         a_ok = int(c.alpha[j]) == int(row[3])
         v_ok = abs(c.dev[j] / row[5] / scale - 1) < 1e-4
-        lo = (c.low[j] / c.dev[j]) / (row[4] / row[5]) - 1
-        hi = (c.high[j] / c.dev[j]) / (row[6] / row[5]) - 1
+        lo = hi = 0.0
+        if not values_only:
+            lo = (c.low[j] / c.dev[j]) / (row[4] / row[5]) - 1
+            hi = (c.high[j] / c.dev[j]) / (row[6] / row[5]) - 1
         b_ok = values_only or (abs(lo) < 2e-3 and abs(hi) < 2e-3)
         ok[1] += a_ok
         ok[2] += v_ok
@@ -119,6 +134,10 @@ def main() -> int:
     ap.add_argument("--allantools", type=Path, required=True, help="allantools' tests/ folder")
     ap.add_argument("--allantoolkit", type=Path, help="allantoolkit's tests/assets/ folder")
     ap.add_argument("--rows", action="store_true", help="print every row that is off")
+    ap.add_argument(
+        "--noise-id", default="stable32", choices=("stable32", "thermocal"),
+        help="the noise identification's rules (allan --noise-id)",
+    )  # fmt: skip
     a = ap.parse_args()
     at = a.allantools
     sets: list[tuple[str, Path, str, float, list[Path]]] = [
@@ -153,7 +172,7 @@ def main() -> int:
         for f in files:
             if _dev_of(f.name) is None:
                 continue
-            ok = _judge(tag, x, dtype, tau0, f, a.rows)
+            ok = _judge(tag, x, dtype, tau0, f, a.rows, a.noise_id)
             if ok[0]:
                 name = f"{f.parent.name}/{f.name}"
                 b = f"{ok[3]:6d}" if ok[3] >= 0 else f"{'–':>6s}"
@@ -162,7 +181,9 @@ def main() -> int:
                     total += ok
                 else:
                     values[:3] += ok[:3]
-    print(f"{'all':10s} {'with bounds':44s} {total[0]:4d} {total[1]:4d} {total[2]:5d} {total[3]:6d}")
+    print(
+        f"{'all':10s} {'with bounds':44s} {total[0]:4d} {total[1]:4d} {total[2]:5d} {total[3]:6d}"
+    )
     if values[0]:
         print(f"{'all':10s} {'values only (no bounds printed)':44s} {values[0]:4d} {values[1]:4d} "
               f"{values[2]:5d} {'–':>6s}")  # fmt: skip

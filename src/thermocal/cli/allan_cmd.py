@@ -64,6 +64,7 @@ def family_json(res: "_family.StabilityResult") -> dict[str, Any]:
         "tau0_s": res.tau0_s,
         "n_segments": res.n_segments,
         "deviations": list(res.curves),
+        "noise_id": res.noise_id,
     }
     alpha_src = next(
         (c for c in res.curves.values() if c.name not in ("theo1", "hdev", "ohdev", "htotdev")),
@@ -280,6 +281,16 @@ NoiseTypeOpt = Annotated[
         "ffm, rwfm (fwfm, rrfm: Hadamard deviations only) or α from -4 to 2.",
     ),
 ]
+NoiseIdOpt = Annotated[
+    str | None,
+    typer.Option(
+        "--noise-id",
+        help="The noise identification's rules: thermocal (default: B1 judged at its number "
+        "of averages and bounded by the shorter τ's noise) or stable32 (Stable32's α column "
+        "exactly: B1 judged at the deviation's number of terms, the total family down to 6 "
+        "averages).",
+    ),
+]
 DynamicOpt = Annotated[
     float | None,
     typer.Option(
@@ -343,6 +354,7 @@ def allan_cmd(
     dynamic: DynamicOpt = None,
     bias_correct: BiasCorrectOpt = False,
     noise_type: NoiseTypeOpt = None,
+    noise_id: NoiseIdOpt = None,
     as_json: JsonOpt = False,
 ) -> None:
     """Overlapping Allan deviation with chi-square confidence intervals and the noise
@@ -373,7 +385,7 @@ def allan_cmd(
     res = _analysis.allan_analysis(
         rec, split_names(signal) or [rec.signals[0]], taus=tau_spec, confidence=confidence,
         deviations=deviation, data_type=data_type, dynamic_s=dynamic, where=str(file),
-        bias_correct=bias_correct, noise_type=noise_type,
+        bias_correct=bias_correct, noise_type=noise_type, noise_id=noise_id,
     )  # fmt: skip
     if res.is_family:
         _emit_family(file, res, as_json)

@@ -114,6 +114,7 @@ def allan_analysis(
     where: str = "",
     bias_correct: bool = False,
     noise_type: str | None = None,
+    noise_id: str | None = None,
 ) -> AllanAnalysis:
     """The stability analysis of the channels ``names`` of ``rec`` (module docstring).
 
@@ -123,9 +124,11 @@ def allan_analysis(
     ``dynamic_s``: the dynamic ADEV's window [s] (rate data, ADEV only); ``bias_correct``:
     Stable32's bias correction of totdev and htotdev (the family only); ``noise_type``: the
     power-law noise the intervals and bias factors assume at every τ instead of the one
-    identified (:func:`thermocal.stability.family.parse_noise_type`; the family only).  A
-    poor noise-model fit and a non-stationary record are :class:`ConditioningWarning`
-    naming ``where`` (and the channel when there are several).
+    identified (:func:`thermocal.stability.family.parse_noise_type`; the family only);
+    ``noise_id``: the identification's rules, ``thermocal`` (default) or ``stable32`` (the
+    family only, :func:`thermocal.stability.family.stability`).  A poor noise-model fit and
+    a non-stationary record are :class:`ConditioningWarning` naming ``where`` (and the
+    channel when there are several).
     """
     if data_type not in DATA_TYPES:
         raise ThermocalInputError(f"--data-type {data_type!r}: use rate or phase")
@@ -138,9 +141,10 @@ def allan_analysis(
         return AllanAnalysis(
             tuple(names),
             family=_family(
-                rec, names, taus, confidence, deviations, data_type, bias_correct, noise_type
+                rec, names, taus, confidence, deviations, data_type, bias_correct, noise_type,
+                noise_id or "thermocal",
             ),
-        )
+        )  # fmt: skip
     if bias_correct:
         raise ThermocalInputError(
             "--bias-correct corrects the total deviations (totdev, htotdev): give them with "
@@ -149,6 +153,11 @@ def allan_analysis(
     if noise_type is not None and noise_type.strip().lower() not in ("", "auto"):
         raise ThermocalInputError(
             "--noise-type sets the noise of the deviation family's intervals: give the "
+            "deviations with --deviation (the overlapping ADEV: --deviation oadev)"
+        )
+    if noise_id is not None:
+        raise ThermocalInputError(
+            "--noise-id chooses the deviation family's noise identification: give the "
             "deviations with --deviation (the overlapping ADEV: --deviation oadev)"
         )
     channels: dict[str, AllanChannel] = {}
@@ -169,6 +178,7 @@ def _family(
     data_type: str,
     bias_correct: bool = False,
     noise_type: str | None = None,
+    noise_id: str = "thermocal",
 ) -> dict[str, StabilityResult]:
     """The deviations of every channel (phase data: the column as given, in its own unit)."""
     from thermocal.stability import family
@@ -192,7 +202,7 @@ def _family(
         results[name] = family.stability(
             values, rec.sample_interval_s, devs, taus, data_type=data_type,
             segments=rec.segments(), unit=unit, confidence=confidence, bias_correct=bias_correct,
-            alpha=alpha,
+            alpha=alpha, noise_id=noise_id,
         )  # fmt: skip
     return results
 

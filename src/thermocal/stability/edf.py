@@ -52,6 +52,30 @@ MIN_B1_GROUPS: Final = 8
 the caller carries the α of the next shorter τ (the choice that reproduces Stable32's α column
 on its PHASE.DAT: its last octave point, 7 averages, keeps the white FM of the one before)."""
 
+STABLE32_B1_MIN_TOTAL: Final = 6
+"""Stable32's noise identification (``noise_id="stable32"`` in
+:func:`thermocal.stability.family.stability`, ``allan --noise-id stable32``), read from its
+printed α columns (none written by thermocal):
+
+* B1 is judged against the theoretical B1(n, μ) at n = the deviation's number of terms
+  (Stable32's "#" column: N − 2m for OADEV, the averages − 1 for ADEV, …), not at the
+  number of m-averages the ratio is taken over.  On the OCXO record of allantools' test
+  data (19982 points), Stable32's all-τ OADEV, MDEV, TDEV and OHDEV outputs have 69 τ each
+  with 8–29 averages: all 69 read Stable32's α that way (OADEV: 41 at n = the averages);
+  ADEV 66 of 69 (61 at n = the averages).  The Cs 5071A's m = 2·10⁴, 4·10⁴ (27, 13 averages) read
+  white FM only that way.  For the overlapping deviations B1 then cannot read random-walk
+  FM (its boundary grows with the record), which is why thermocal's own rule keeps Barnes'
+  n and bounds B1's reading by the shorter τ's α.
+* No bound by the shorter τ's α.
+* Rate data: the lag-1 method reads the m-averages with their mean removed, not their line
+  (OCXO all-τ outputs: 165 of the 167 τ with ≥ 30 averages read Stable32's α that way, 164
+  with the line removed; m = 5 reads flicker PM only that way, as Stable32).
+* Below 8 averages the Allan and Hadamard families keep the shorter τ's α; the total family
+  (totdev, mtotdev, ttotdev, htotdev) reads B1 down to this many averages: PHASE.DAT
+  m = 128 (MTOT, TTOT, Htot), Sr87 m = 200, GPS m = 32768, 53230A m = 8192 (6–7 averages)
+  read Stable32's α that way and not by keeping the shorter τ's, PHASE.DAT's decade
+  m = 200 (5 averages) and the rows with 2–4 averages keep it."""
+
 # Table 1 (modified variances, F = 1) and Table 2 (unmodified, F = m) of Greenhall & Riley
 # 2003: (a0, a1) of 1/edf ≈ (a0 − a1/r)/r, indexed [α][d] with d = 1, 2, 3.
 _TABLE1: Final[dict[int, tuple[tuple[float, float] | None, ...]]] = {
@@ -559,7 +583,16 @@ def _b1_theory(n: int, mu: int) -> float:
 _MU_TO_ALPHA: Final = {-2: 2, -1: 0, 0: -1, 1: -2, 2: -3, 3: -4}
 
 
-def identify_noise(x: FloatArray, m: int, *, dmax: int, phase_input: bool) -> NoiseId:
+def identify_noise(
+    x: FloatArray,
+    m: int,
+    *,
+    dmax: int,
+    phase_input: bool,
+    b1_n: int | None = None,
+    b1_min: int = MIN_B1_GROUPS,
+    rate_detrend: bool = True,
+) -> NoiseId:
     """Power-law noise α at averaging factor m (Riley & Greenhall 2004; B1 otherwise).
 
     ``x``: phase points of one gap-free stretch.  Lag-1 method: the phase decimated by m
@@ -569,7 +602,11 @@ def identify_noise(x: FloatArray, m: int, *, dmax: int, phase_input: bool) -> No
     less on rate); α = −round(2ρ) − 2d (+2 for phase).  With fewer than 30 averaged points:
     the B1 ratio of the standard variance of the m-averages to their Allan variance, against
     the theoretical B1 of each noise (boundaries at geometric means); where B1 reads phase
-    noise, the R(n) ratio tells white from flicker PM (:func:`split_pm`).
+    noise, the R(n) ratio tells white from flicker PM (:func:`split_pm`).  ``b1_n``: the n
+    of the theoretical B1 (default: the number of averages; Stable32 takes the deviation's
+    number of terms, see :data:`STABLE32_B1_MIN_TOTAL`); ``b1_min``: the fewest averages B1
+    reads; ``rate_detrend``: the rate averages' line removed before the lag-1 method (False:
+    the mean only, as Stable32, see :data:`STABLE32_B1_MIN_TOTAL`).
 
     The decimated phase is not detrended (the differencing removes a line), as in
     Stable32's identification: with a quadratic removed, the 32 points of the Sr87 clock
@@ -585,12 +622,15 @@ def identify_noise(x: FloatArray, m: int, *, dmax: int, phase_input: bool) -> No
     if m > 1:
         ym /= m
     if not phase_input:
-        return split_pm(identify_rate_averages(ym, dmax=dmax, own=True), x, m)
+        nid = identify_rate_averages(
+            ym, dmax=dmax, own=True, b1_n=b1_n, b1_min=b1_min, detrend=rate_detrend
+        )
+        return split_pm(nid, x, m)
     z = x[:: max(m, 1)]
     if z.size >= MIN_ACF_POINTS:
         zc = z - z.mean()
         return _lag1_differenced(lag1_autocorrelation(zc), zc, dmax, 2)
-    return split_pm(_b1_identify(ym, dmax), x, m)
+    return split_pm(_b1_identify(ym, dmax, n_theory=b1_n, min_groups=b1_min), x, m)
 
 
 def modified_allan_ratio(x: FloatArray, m: int) -> float:
@@ -639,19 +679,29 @@ def split_pm(nid: NoiseId, x: FloatArray, m: int) -> NoiseId:
 
 
 def identify_rate_averages(
-    z: FloatArray, *, dmax: int, own: bool = False, sums: LagSums | None = None
+    z: FloatArray,
+    *,
+    dmax: int,
+    own: bool = False,
+    sums: LagSums | None = None,
+    b1_n: int | None = None,
+    b1_min: int = MIN_B1_GROUPS,
+    detrend: bool = True,
 ) -> NoiseId:
     """The rate branch of :func:`identify_noise` from the m-averages ``z`` of the rate
     (any scale and offset: block sums serve as well).  ``own``: ``z`` may be centred in
     place; ``sums``: its :class:`LagSums` already taken (``z`` is then only read where the
-    sums cannot decide: explicit detrending, differencing, B1)."""
+    sums cannot decide: explicit detrending, differencing, B1); ``b1_n``, ``b1_min``,
+    ``detrend``: see :func:`identify_noise`."""
+    if z.size >= MIN_ACF_POINTS and not detrend:  # Stable32: the mean removed, nothing else
+        return _lag1_differenced(lag1_autocorrelation(z), z, dmax - 1, 0)
     if z.size >= MIN_ACF_POINTS:
         r1 = _lag1_from_sums(sums) if sums is not None else None
         if r1 is None:  # r1 of the detrended averages from sums (no detrended copy)
             r1 = _lag1_linear_detrended(z, own=own)
         # differencing cancels the line but its constant slope, which r1's mean removes
         return _lag1_differenced(r1, z, dmax - 1, 0)
-    return _b1_identify(z, dmax)
+    return _b1_identify(z, dmax, n_theory=b1_n, min_groups=b1_min)
 
 
 _DIFF_BLOCK = 1 << 20
@@ -697,11 +747,17 @@ def _lag1_differenced(r1: float, z: FloatArray, dm: int, add: int) -> NoiseId:
         r1 = _lag1_of_difference(z, d)
 
 
-def _b1_identify(ym: FloatArray, dmax: int) -> NoiseId:
-    """The B1 ratio of the m-averages ``ym`` against its theoretical value per noise."""
+def _b1_identify(
+    ym: FloatArray, dmax: int, *, n_theory: int | None = None, min_groups: int = MIN_B1_GROUPS
+) -> NoiseId:
+    """The B1 ratio of the m-averages ``ym`` against its theoretical value per noise, B1(n, μ)
+    at n = the number of averages (Barnes' definition) or ``n_theory`` (Stable32: the
+    deviation's number of terms, :data:`STABLE32_B1_MIN_TOTAL`); nothing with fewer than
+    ``min_groups`` averages."""
     nb = ym.size
-    if nb < MIN_B1_GROUPS:
+    if nb < max(min_groups, 2):
         return NoiseId(0, float("nan"), "none", 0)
+    n_th = nb if n_theory is None else max(int(n_theory), 2)
     avar = float(np.mean(np.diff(ym) ** 2)) / 2.0
     if avar <= 0:
         return NoiseId(0, float("nan"), "none", 0)
@@ -709,7 +765,7 @@ def _b1_identify(ym: FloatArray, dmax: int) -> NoiseId:
     mus = [-2, -1, 0, 1, 2, 3][: 4 + max(dmax - 2, 0) * 2]
     chosen = mus[-1]
     for lo, hi in itertools.pairwise(mus):
-        if b1 < math.sqrt(_b1_theory(nb, lo) * _b1_theory(nb, hi)):
+        if b1 < math.sqrt(_b1_theory(n_th, lo) * _b1_theory(n_th, hi)):
             chosen = lo
             break
     return NoiseId(_MU_TO_ALPHA[chosen], float("nan"), "b1", 0)

@@ -40,6 +40,10 @@ FloatArray = npt.NDArray[np.float64]
 IntArray = npt.NDArray[np.int64]
 
 HADAMARD = frozenset({"hdev", "ohdev", "htotdev"})
+TOTAL = frozenset({"totdev", "mtotdev", "ttotdev", "htotdev"})
+NOISE_IDS: Final = ("thermocal", "stable32")
+"""Noise-identification rules (:func:`stability`): thermocal's (B1 against Barnes' theory at
+the number of averages, bounded by the shorter τ's α) or Stable32's."""
 
 NO_INTERVAL: dict[str, str] = {
     "mtie": "none: MTIE is a maximum over windows, not a variance; no chi-square EDF applies "
@@ -113,6 +117,7 @@ class StabilityResult:
     n_points: int
     unit: str
     notes: tuple[str, ...] = field(default=())
+    noise_id: str = "thermocal"
 
 
 _TOTVAR_BIAS: Final = {-1: 1.0 / (3.0 * math.log(2.0)), -2: 0.75}
@@ -338,22 +343,34 @@ class _Record:
             )  # fmt: skip
         return self._levels[i]
 
-    def identify(self, m: int, dmax: int) -> ed.NoiseId:
+    def identify(
+        self,
+        m: int,
+        dmax: int,
+        b1_n: int | None = None,
+        b1_min: int = ed.MIN_B1_GROUPS,
+        rate_detrend: bool = True,
+    ) -> ed.NoiseId:
         """:func:`thermocal.stability.edf.identify_noise` on the longest stretch at m: from
         its octave level when there is one (the same m-averages, as block sums), else from
-        its centred phase."""
+        its centred phase (``b1_n``, ``b1_min``, ``rate_detrend``: as there)."""
         if 1 <= m <= self.m_max and m & (m - 1) == 0:
             by_m = {lv.m: lv for lv in self.levels(self.longest)}
             if m in by_m:
                 lv = by_m[m]
-                nid = ed.identify_rate_averages(lv.z, dmax=dmax, sums=lv.lag)
+                nid = ed.identify_rate_averages(
+                    lv.z, dmax=dmax, sums=lv.lag, b1_n=b1_n, b1_min=b1_min, detrend=rate_detrend
+                )
                 if nid.method == "b1" and nid.alpha == 2:  # B1 read PM: R(n) from the phase
                     nid = ed.split_pm(nid, self.centred()[self.longest], m)
                 return nid
             if self.sizes[self.longest] - 1 < m:  # no m-average: nothing to identify
                 return ed.identify_rate_averages(np.zeros(0), dmax=dmax)
         x = self.centred()[self.longest]
-        return ed.identify_noise(x, m, dmax=dmax, phase_input=self.data_type == "phase")
+        return ed.identify_noise(
+            x, m, dmax=dmax, phase_input=self.data_type == "phase", b1_n=b1_n, b1_min=b1_min,
+            rate_detrend=rate_detrend,
+        )  # fmt: skip
 
     def sums(self, name: str, m: IntArray) -> tuple[FloatArray, FloatArray]:
         """The pooled deviation and term count of ``name`` per m over the stretches."""
@@ -417,13 +434,21 @@ def _noise_exponents(
     m: IntArray,
     record: _Record,
     alpha: int | None,
-    id_cache: dict[tuple[int, int], ed.NoiseId],
+    id_cache: dict[tuple[int, int, int, int], ed.NoiseId],
+    noise_id: str = "thermocal",
+    n_terms: FloatArray | None = None,
 ) -> tuple[IntArray, tuple[str, ...]]:
     """Per averaging factor, the noise exponent α for the EDF and how it was found: given,
     identified on the longest stretch (:func:`thermocal.stability.edf.identify_noise`,
     d = 3 for the Hadamard family, else 2; clipped to −2…2, −4…2 for Hadamard), or the
-    shorter τ's where too few averages identify nothing."""
+    shorter τ's where too few averages identify nothing.  ``noise_id="stable32"``:
+    Stable32's rules (:data:`thermocal.stability.edf.STABLE32_B1_MIN_TOTAL`): B1 against
+    the theory at n = the deviation's number of terms (``n_terms``, Stable32's "#"
+    column), down to 6 averages for the total family, never bounded by the shorter τ's
+    α; rate averages not detrended for the lag-1 method."""
     dmax = 3 if name in HADAMARD else 2
+    stable32 = noise_id == "stable32"
+    b1_min = ed.STABLE32_B1_MIN_TOTAL if stable32 and name in TOTAL else ed.MIN_B1_GROUPS
     alphas = np.zeros(m.size, dtype=np.int64)
     methods: list[str] = []
     for i, mm in enumerate(m.tolist()):
@@ -433,16 +458,20 @@ def _noise_exponents(
             continue
         if name == "theo1":  # Theo1's τ is 0.75 m τ0: the noise of that averaging time
             mm = max(1, round(0.75 * mm))
-        key = (int(mm), dmax)
+        b1_n = None
+        if stable32:
+            cnt = n_terms[i] if n_terms is not None and name != "theo1" else math.nan
+            b1_n = int(cnt) if math.isfinite(cnt) and cnt > 0 else sum(record.sizes) - 1
+        key = (int(mm), dmax, b1_min, b1_n or 0)
         if key not in id_cache:
-            id_cache[key] = record.identify(int(mm), dmax)
+            id_cache[key] = record.identify(int(mm), dmax, b1_n, b1_min, not stable32)
         nid = id_cache[key]
         if nid.method == "none" and i > 0:  # too few averages: the shorter τ's noise
             alphas[i] = alphas[i - 1]
             methods.append("previous")
             continue
         alphas[i] = max(min(nid.alpha, 2), -2 if dmax == 2 else -4)
-        if nid.method == "b1" and i > 0 and alphas[i] > alphas[i - 1]:
+        if not stable32 and nid.method == "b1" and i > 0 and alphas[i] > alphas[i - 1]:
             # B1 from 8–29 averages misreads random-walk FM as flicker or white FM in ≈ 40 %
             # of records (α read higher than at the shorter τ, where power-law noise can only
             # steepen): the shorter τ's α is kept (Monte-Carlo coverage, issue 29 item 3).
@@ -481,11 +510,13 @@ def stability(
     confidence: float = 0.6826894921370859,
     alpha: int | None = None,
     bias_correct: bool = False,
+    noise_id: str = "thermocal",
 ) -> StabilityResult:
     """Deviations ``names`` of rate or phase data [unit] sampled every ``tau0_s`` [s].
 
     ``segments``: the gap-free index ranges (default: one); ``alpha``: force the noise
-    exponent of the EDF instead of identifying it; ``bias_correct``: totdev and htotdev
+    exponent of the EDF instead of identifying it; ``noise_id``: the identification's rules,
+    ``thermocal`` or ``stable32`` (:func:`_noise_exponents`); ``bias_correct``: totdev and htotdev
     (value and interval) multiplied by Stable32's bias factor (:func:`stable32_bias`, with
     the record length summed over the stretches).  Rate data give deviations in ``unit``
     and time deviations (tdev, ttotdev, mtie, tierms) in ``unit*s``; phase data give
@@ -498,6 +529,8 @@ def stability(
     with threadpool_limits(limits=1, user_api="blas"):  # many short dots: BLAS threads wait
         if data_type not in ("rate", "phase"):
             raise ThermocalInputError(f"--data-type {data_type!r}: use rate or phase")
+        if noise_id not in NOISE_IDS:
+            raise ThermocalInputError(f"--noise-id {noise_id!r}: use {' or '.join(NOISE_IDS)}")
         record = _new_record(values, tau0_s, data_type, segments, names)
         n_long = max(record.sizes)
         m_common = factors(
@@ -509,7 +542,7 @@ def stability(
         )
         record.set_octave(m_common)
         curves: dict[str, DeviationCurve] = {}
-        id_cache: dict[tuple[int, int], ed.NoiseId] = {}
+        id_cache: dict[tuple[int, int, int, int], ed.NoiseId] = {}
         for name in names:
             m = (
                 factors(taus, tau0_s, dv.max_factor(name, n_long), theo1=True)
@@ -517,7 +550,9 @@ def stability(
                 else m_common
             )
             dev, cnt = record.sums(name, m)
-            alphas, methods = _noise_exponents(name, m, record, alpha, id_cache)
+            alphas, methods = _noise_exponents(
+                name, m, record, alpha, id_cache, noise_id, np.asarray(cnt, dtype=np.float64)
+            )
             edf = _pooled_edf(name, m, alphas, record.sizes)
             ok = np.isfinite(edf) & np.isfinite(dev)
             lo = np.full(m.size, np.nan)
@@ -550,6 +585,7 @@ def stability(
             n_segments=len(record.kept),
             n_points=int(sum(record.sizes)),
             unit=unit,
+            noise_id=noise_id,
         )
 
 
