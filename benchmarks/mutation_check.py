@@ -993,6 +993,22 @@ MUTANTS: tuple[Mutant, ...] = (
         "--noise-id stable32: rate averages detrended before the lag-1 method",
     ),
     Mutant(
+        "text-single-column-refused",
+        P + "readers/text.py",
+        '            best = (0, 0, " ")',
+        "            best = None",
+        _t("text_single_column"),
+        "a one-value-a-line text file (Stable32's) refused",
+    ),
+    Mutant(
+        "text-comments-as-banner",
+        P + "readers/text.py",
+        'return tuple(x for x in lines if x.strip() and not x.lstrip().startswith("#"))',
+        "return tuple(x for x in lines if x.strip())",
+        _t("text_single_column"),
+        "'#' comment lines before the data reported as a banner",
+    ),
+    Mutant(
         "stability-b1-ddof",
         P + "stability/edf.py",
         "b1 = float(np.var(ym, ddof=1)) / avar",

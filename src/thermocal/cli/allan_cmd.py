@@ -362,6 +362,9 @@ def allan_cmd(
     ramp) by least squares and by IEEE 952 slope lines.  Gaps are never
     differenced across: each contiguous stretch is processed alone and pooled."""
     prefetch("scipy.special", "scipy.linalg", "rich.table")  # imported while the file is read
+    one = split_names(t_names) if t_names is not None else None
+    if signal is None and one is not None and len(one) == 1:
+        signal = one[0]  # a one-column text log (Stable32's data files): its column
     with warnings.catch_warnings():
         if data_type == "phase":  # the column's own unit is used (angle, s): no rate unit
             warnings.filterwarnings(

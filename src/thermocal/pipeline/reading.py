@@ -133,7 +133,7 @@ def load_recording(
     if require_signal and not rec.signals:
         raise ThermocalInputError(
             f"{path}: name the signal column with --signal; available: "
-            + ", ".join(repr(c) for c in rec.columns)
+            + (", ".join(repr(c) for c in rec.columns) or "see thermocal inspect FILE")
         )
     if check:
         rec.validate()

@@ -261,8 +261,13 @@ def _roles(
     present = set(names)
     for c in [time_col, *sig_names, *tmp_names]:
         if c not in present:
+            hint = (
+                " (name the time column with --time, or give --rate HZ for a text log without one)"
+                if c == time_col and time is None
+                else ""
+            )
             raise MissingColumnError(
-                f"{p}: no column {short_name(c)}; available: {names_list(names)}"
+                f"{p}: no column {short_name(c)}; available: {names_list(names)}{hint}"
             )
     return time_col, sig_names, tmp_names
 

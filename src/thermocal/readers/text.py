@@ -114,13 +114,14 @@ def sniff_text(lines: Sequence[str], opts: TextOptions | None = None) -> TextLay
 
     For each candidate delimiter (``, ; tab blanks``, or the one given) the modal number of
     fields m (≥ 2) of the non-empty, non-``#`` lines; the delimiter whose modal count
-    covers most lines wins (ties: in that order).  The data start at the first line with m
-    fields that is numeric (empty fields allowed: missing values), or that names the
-    columns (no field a number) and is followed by a line of m fields (the header); the
-    lines before
-    are a banner (a terminal's, a logger's) and are skipped.  Lines further down that do
-    not fit are mangled lines, for ``--on-bad-lines``.  The decimal mark is ``,`` when the
-    delimiter is not a comma and the data parse with ``,`` but not with ``.``.
+    covers most lines wins (ties: in that order).  Where no line has two fields and most
+    lines are one number, one column (m = 1: Stable32's phase/frequency files).  The data
+    start at the first line with m fields that is numeric (empty fields allowed: missing
+    values), or that names the columns (no field a number) and is followed by a line of m
+    fields (the header); the lines before are skipped, those but ``#`` comments as a
+    banner (a terminal's, a logger's).  Lines further down that do not fit are mangled
+    lines, for ``--on-bad-lines``.  The decimal mark is ``,`` when the delimiter is not a
+    comma and the data parse with ``,`` but not with ``.``.
     """
     o = opts or TextOptions()
     delims = [o.delimiter] if o.delimiter else list(_DELIMS)
@@ -137,15 +138,24 @@ def sniff_text(lines: Sequence[str], opts: TextOptions | None = None) -> TextLay
         if best is None or key < best:
             best = key
     if best is None:
-        raise FileFormatError(
-            "no lines with two or more fields were found (is it a data log? give "
-            "--delimiter and --decimal if it uses others than , ; tab blanks)"
-        )
+        # one value a line (Stable32's phase and frequency files, a logger's single column):
+        # one column when most lines are one number each
+        single = [x for x in body if len(x.split()) == 1]
+        dec1 = o.decimal or "."
+        if (
+            single
+            and 2 * sum(_is_number(x, dec1) for x in single) > len(body)
+            and (o.delimiter in (None, " "))
+        ):
+            best = (0, 0, " ")
+        else:
+            raise FileFormatError(
+                "no lines with two or more fields were found (is it a data log? give "
+                "--delimiter and --decimal if it uses others than , ; tab blanks)"
+            )
     d = best[2]
-    m = max(
-        set(c for c in (len(_split(x, d)) for x in body) if c >= 2),
-        key=[len(_split(x, d)) for x in body].count,
-    )
+    counts_d = [len(_split(x, d)) for x in body]
+    m = max(set(c for c in counts_d if c >= 2) or {1}, key=counts_d.count)
     decimals = [o.decimal] if o.decimal else ([".", ","] if d != "," else ["."])
 
     def numeric(line: str, dec: str) -> bool:
@@ -171,7 +181,8 @@ def sniff_text(lines: Sequence[str], opts: TextOptions | None = None) -> TextLay
 
 
 def _banner(lines: Sequence[str]) -> tuple[str, ...]:
-    return tuple(x for x in lines if x.strip())
+    """The lines before the data that are neither empty nor ``#`` comments."""
+    return tuple(x for x in lines if x.strip() and not x.lstrip().startswith("#"))
 
 
 def head_lines(path: Path, encoding: str, errors: str) -> list[str]:
@@ -231,10 +242,14 @@ def _column_names(path: Path, head: list[str], lay: TextLayout, o: TextOptions) 
                 "files without one"
             )
     elif o.names is None:
+        what = (
+            "name its column with --names NAME (and give --rate HZ: no time column)"
+            if lay.n_fields == 1
+            else f"name its {lay.n_fields} columns with --names a,b,c"
+        )
         raise ThermocalInputError(
             f"{path}: no header row (line {lay.skip + 1} is data: "
-            f"{head[lay.skip].strip()[:60]!r}); name its {lay.n_fields} columns with "
-            "--names a,b,c"
+            f"{head[lay.skip].strip()[:60]!r}); {what}"
         )
     else:
         names = list(o.names)
@@ -312,7 +327,7 @@ def read_text(
             "bad_lines": [ln for ln, _t in bad],
         }
     }
-    if lay.delimiter != "," or lay.decimal != ".":
+    if (lay.delimiter != "," and lay.n_fields > 1) or lay.decimal != ".":
         warnings.warn(
             TextLayoutWarning(
                 f"{path}: read as {delimiter_name(lay.delimiter)}-separated text with decimal "
