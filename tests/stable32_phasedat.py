@@ -1,6 +1,6 @@
 """Stable32's PHASE.DAT and its printed outputs (tests/data/stable32_phasedat, allantools'
 test data, LGPL-3.0): the rows of an output file, PHASE.DAT as a CSV, one ``allan --json``
-run of it."""
+run of it; ``allan`` refusing options on a small rate record (exit 2)."""
 
 from __future__ import annotations
 
@@ -52,3 +52,16 @@ def run_allan(
     cap = capsys.readouterr()
     assert code == 0, cap.err
     return json.loads(cap.out)  # type: ignore[no-any-return]
+
+
+def allan_refuses(tmp_path: Path, capsys: pytest.CaptureFixture[str], *extra: str) -> str:
+    """``allan`` on a 400-sample rate record with ``extra`` options: exit 2; its stderr."""
+    path = tmp_path / "gyro.csv"
+    y = np.random.default_rng(3).standard_normal(400)
+    path.write_text(
+        "time (s),rate [deg/h]\n" + "".join(f"{i},{float(v)!r}\n" for i, v in enumerate(y))
+    )
+    code = main(["allan", str(path), "--signal", "rate [deg/h]", *extra])
+    err = capsys.readouterr().err
+    assert code == 2, err
+    return err

@@ -71,40 +71,39 @@ HTOT_FLICKER_PM = [
 ]
 
 
+def _bounds_equal(edf: float, low: float, dev: float, high: float, rel: float = 2e-3) -> None:
+    """The chi-square 68.3 % bounds of ``dev`` with ``edf`` against Stable32's printed ones."""
+    lo, hi = confidence_interval(dev, edf)
+    assert float(lo) == pytest.approx(low, rel=rel, abs=0.0)
+    assert float(hi) == pytest.approx(high, rel=rel, abs=0.0)
+
+
 @pytest.mark.parametrize(("m", "alpha", "low", "dev", "high"), MTOT_SR87_DECADE)
 def test_mtot_bounds_equal_stable32_on_sr87(
     m: int, alpha: int, low: float, dev: float, high: float
 ) -> None:
-    lo, hi = confidence_interval(dev, edf_mtotdev(N_SR87, m, alpha))
-    assert float(lo) == pytest.approx(low, rel=2e-3, abs=0.0)
-    assert float(hi) == pytest.approx(high, rel=2e-3, abs=0.0)
+    _bounds_equal(edf_mtotdev(N_SR87, m, alpha), low, dev, high)
 
 
 @pytest.mark.parametrize(("m", "alpha", "low", "dev", "high"), HTOT_SR87_LONG)
 def test_htot_bounds_equal_stable32_on_sr87_from_m16(
     m: int, alpha: int, low: float, dev: float, high: float
 ) -> None:
-    lo, hi = confidence_interval(dev, edf_htotdev(N_SR87, m, alpha))
-    assert float(lo) == pytest.approx(low, rel=2e-3, abs=0.0)
-    assert float(hi) == pytest.approx(high, rel=2e-3, abs=0.0)
+    _bounds_equal(edf_htotdev(N_SR87, m, alpha), low, dev, high)
 
 
 @pytest.mark.parametrize(("n", "m", "low", "dev", "high"), HTOT_WHITE_FM_SHORT)
 def test_htot_white_fm_bounds_below_m16_equal_stable32(
     n: int, m: int, low: float, dev: float, high: float
 ) -> None:
-    lo, hi = confidence_interval(dev, edf_htotdev(n, m, 0))
-    assert float(lo) == pytest.approx(low, rel=2e-3, abs=0.0)
-    assert float(hi) == pytest.approx(high, rel=2e-3, abs=0.0)
+    _bounds_equal(edf_htotdev(n, m, 0), low, dev, high)
 
 
 @pytest.mark.parametrize(("m", "alpha", "low", "dev", "high"), HTOT_SR87_SHORT)
 def test_htot_flicker_and_random_walk_fm_below_m16_equal_stable32(
     m: int, alpha: int, low: float, dev: float, high: float
 ) -> None:
-    lo, hi = confidence_interval(dev, edf_htotdev(N_SR87, m, alpha))
-    assert float(lo) == pytest.approx(low, rel=5e-4, abs=0.0)
-    assert float(hi) == pytest.approx(high, rel=5e-4, abs=0.0)
+    _bounds_equal(edf_htotdev(N_SR87, m, alpha), low, dev, high, rel=5e-4)
 
 
 @pytest.mark.parametrize(("m", "alpha", "low", "dev", "high"), HTOT_FLICKER_PM)
@@ -113,9 +112,7 @@ def test_htot_flicker_pm_bounds_equal_stable32(
 ) -> None:
     """Stable32's phase-noise rule (simple EDF + 2); Greenhall's ohdev EDF (32.8, 15.9 where
     Stable32's is 50.6, 18.6) put these bounds 8–30 % off."""
-    lo, hi = confidence_interval(dev, edf_htotdev(1001, m, alpha))
-    assert float(lo) == pytest.approx(low, rel=2e-3, abs=0.0)
-    assert float(hi) == pytest.approx(high, rel=2e-3, abs=0.0)
+    _bounds_equal(edf_htotdev(1001, m, alpha), low, dev, high)
 
 
 # Stable32 TOTDEV rows at flicker PM on two more public records of allantools' test data
@@ -139,9 +136,7 @@ def test_totdev_flicker_pm_bounds_equal_stable32(
     n: int, m: int, low: float, dev: float, high: float
 ) -> None:
     """Greenhall's overlapping-Allan EDF, used before, put m = 1024–65536 0.7–25 % off."""
-    lo, hi = confidence_interval(dev, edf_totdev(n, m, 1))
-    assert float(lo) == pytest.approx(low, rel=2e-3, abs=0.0)
-    assert float(hi) == pytest.approx(high, rel=2e-3, abs=0.0)
+    _bounds_equal(edf_totdev(n, m, 1), low, dev, high)
 
 
 def test_total_pm_edf_is_the_simple_formula_plus_two() -> None:
