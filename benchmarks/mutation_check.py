@@ -1009,6 +1009,14 @@ MUTANTS: tuple[Mutant, ...] = (
         "'#' comment lines before the data reported as a banner",
     ),
     Mutant(
+        "reading-signal-message-lists-nothing",
+        P + "pipeline/reading.py",
+        "        if not names and not keep_other:",
+        "        if False:",
+        _t("text_single_column"),
+        "the --signal message lists no columns when only the named ones were read",
+    ),
+    Mutant(
         "stability-b1-ddof",
         P + "stability/edf.py",
         "b1 = float(np.var(ym, ddof=1)) / avar",

@@ -66,3 +66,16 @@ def test_a_text_file_of_words_is_still_refused(tmp_path: Path) -> None:
 
     with pytest.raises(FileFormatError, match="two or more fields"):
         sniff_text(path.read_text().splitlines())
+
+
+def test_signal_message_lists_the_files_columns(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """allan reads only the columns it uses; when none is named the message still lists the
+    file's columns (it listed nothing before)."""
+    path = tmp_path / "one.txt"
+    path.write_text("phase [s]\n" + "".join(f"{0.1 * k + 0.01 * (k % 3)!r}\n" for k in range(40)))
+    code = main(["allan", str(path), "--rate", "1", "--data-type", "phase"])
+    err = capsys.readouterr().err
+    assert code == 2, err
+    assert "--signal; available: 'phase [s]'" in err

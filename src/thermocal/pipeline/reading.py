@@ -131,9 +131,18 @@ def load_recording(
         fitted = getattr(model, "inputs_", None) if model is not None else model_inputs
         check_sensor_id(fitted, rec.meta.sensor_id, str(path))
     if require_signal and not rec.signals:
+        names = list(rec.columns)
+        if not names and not keep_other:  # only the named columns were read: list them all
+            try:
+                with warnings.catch_warnings():  # said once already, by the first read
+                    warnings.simplefilter("ignore")
+                    again = read_recording(path, time=time, text=text, topic=topic)
+                names = list(again.columns)
+            except Exception:  # the listing is a courtesy; the error stands as it is
+                names = []
         raise ThermocalInputError(
             f"{path}: name the signal column with --signal; available: "
-            + (", ".join(repr(c) for c in rec.columns) or "see thermocal inspect FILE")
+            + (", ".join(repr(c) for c in names) or "see thermocal inspect FILE")
         )
     if check:
         rec.validate()
