@@ -1017,6 +1017,14 @@ MUTANTS: tuple[Mutant, ...] = (
         "the --signal message lists no columns when only the named ones were read",
     ),
     Mutant(
+        "stability-s32-nonoverlapping-min-8",
+        P + "stability/edf.py",
+        "STABLE32_B1_MIN_NONOVERLAPPING: Final = 10",
+        "STABLE32_B1_MIN_NONOVERLAPPING: Final = 8",
+        STAB + _t("noise_id_rules_stable32"),
+        "--noise-id stable32: ADEV/HDEV read by B1 down to 8 averages",
+    ),
+    Mutant(
         "stability-b1-ddof",
         P + "stability/edf.py",
         "b1 = float(np.var(ym, ddof=1)) / avar",

@@ -1,17 +1,18 @@
 """``allan --noise-id stable32``: Stable32's α column, from outputs Stable32 printed.
 
 References from outside thermocal:
-* the OCXO frequency record and Stable32 1.60's all-τ OADEV and ADEV outputs of it
-  (tests/data/stable32_ocxo, allantools' test data, LGPL-3.0): 273 and 261 averaging
-  factors, 69 of them with 8–29 averages, where the B1 ratio decides;
+* the OCXO frequency record and Stable32 1.60's all-τ OADEV, ADEV and HDEV outputs of it
+  (tests/data/stable32_ocxo, allantools' test data, LGPL-3.0): 273, 261 and 261 averaging
+  factors, 69 of each with 8–29 averages, where the B1 ratio decides;
 * PHASE.DAT's MTOT, TTOT and Htot outputs (tests/data/stable32_phasedat): m = 128, 256 and
   decade m = 200, with 7, 3 and 5 averages, where the total family's rule decides.
 
 What the two rules do differently is stated in thermocal.stability.edf.STABLE32_B1_MIN_TOTAL:
 Stable32 judges B1 against its theory at n = the deviation's number of terms (not at the
-number of averages) and reads the total family down to 6 averages; thermocal's default keeps
-Barnes' n and bounds B1 by the shorter τ's α (better interval coverage for random-walk FM,
-tests/test_stability_coverage.py), so it differs from Stable32 there."""
+number of averages), reads the total family down to 6 averages and ADEV/HDEV down to 10;
+thermocal's default keeps Barnes' n and bounds B1 by the shorter τ's α (better interval
+coverage for random-walk FM, tests/test_stability_coverage.py), so it differs from Stable32
+there."""
 
 from __future__ import annotations
 
@@ -71,16 +72,19 @@ def test_oadev_alpha_column_equals_stable32_where_b1_decides(ocxo: np.ndarray) -
     assert (own.alpha == r[:, 3]).sum() < 200
 
 
-def test_adev_b1_judged_at_its_number_of_terms(ocxo: np.ndarray) -> None:
-    """Non-overlapping ADEV: n = its terms (averages − 1); 66 of the 69 B1 rows equal
-    Stable32's (the three others, at 8–9 averages, sit within 10 % of a B1 boundary)."""
-    r = _ocxo_rows("stable32_adev_alltau.txt")
-    c = stability(ocxo, 1.0, ["adev"], r[:, 1], noise_id="stable32").curves["adev"]
+@pytest.mark.parametrize("dev", ["adev", "hdev"])
+def test_non_overlapping_b1_from_10_averages(ocxo: np.ndarray, dev: str) -> None:
+    """Non-overlapping ADEV and HDEV: B1 at n = their terms (averages − 1, − 2) and from 10
+    averages (below: the shorter τ's α): all 69 B1 rows equal Stable32's α (66 and 60 with
+    B1 read down to 8 averages), every row but the two lag-1 ones."""
+    r = _ocxo_rows(f"stable32_{dev}_alltau.txt")
+    c = stability(ocxo, 1.0, [dev], r[:, 1], noise_id="stable32").curves[dev]
     np.testing.assert_allclose(c.dev, r[:, 5], rtol=1e-4)
     np.testing.assert_array_equal(c.n_terms, r[:, 2])
     sel = _b1_range(r, ocxo.size)
     assert sel.sum() == 69
-    assert (c.alpha[sel] == r[sel, 3]).sum() == 66
+    assert (c.alpha[sel] == r[sel, 3]).all()
+    assert (c.alpha == r[:, 3]).sum() == r.shape[0] - 2
 
 
 @pytest.mark.parametrize(

@@ -288,7 +288,7 @@ NoiseIdOpt = Annotated[
         help="The noise identification's rules: thermocal (default: B1 judged at its number "
         "of averages and bounded by the shorter τ's noise) or stable32 (Stable32's α column "
         "exactly: B1 judged at the deviation's number of terms, the total family down to 6 "
-        "averages).",
+        "averages, ADEV and HDEV from 10).",
     ),
 ]
 DynamicOpt = Annotated[

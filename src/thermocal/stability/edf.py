@@ -70,11 +70,20 @@ printed α columns (none written by thermocal):
 * Rate data: the lag-1 method reads the m-averages with their mean removed, not their line
   (OCXO all-τ outputs: 165 of the 167 τ with ≥ 30 averages read Stable32's α that way, 164
   with the line removed; m = 5 reads flicker PM only that way, as Stable32).
-* Below 8 averages the Allan and Hadamard families keep the shorter τ's α; the total family
+* Below 8 averages the overlapping Allan and Hadamard deviations keep the shorter τ's α,
+  the non-overlapping ADEV and HDEV below 10 (:data:`STABLE32_B1_MIN_NONOVERLAPPING`); the
+  total family
   (totdev, mtotdev, ttotdev, htotdev) reads B1 down to this many averages: PHASE.DAT
   m = 128 (MTOT, TTOT, Htot), Sr87 m = 200, GPS m = 32768, 53230A m = 8192 (6–7 averages)
   read Stable32's α that way and not by keeping the shorter τ's, PHASE.DAT's decade
   m = 200 (5 averages) and the rows with 2–4 averages keep it."""
+
+STABLE32_B1_MIN_NONOVERLAPPING: Final = 10
+"""The fewest averages Stable32's B1 reads for the non-overlapping ADEV and HDEV (below: the
+shorter τ's α).  On the OCXO all-τ outputs the ADEV and HDEV rows with 8–9 averages carry
+the α of the last row with 10 (flicker FM), where their B1 reads random-walk FM; the ADEV
+row at m = 1884 (10 averages) reads random-walk FM by B1, as Stable32.  With this bound all
+69 B1 rows of each equal Stable32's α (66 and 60 without it)."""
 
 # Table 1 (modified variances, F = 1) and Table 2 (unmodified, F = m) of Greenhall & Riley
 # 2003: (a0, a1) of 1/edf ≈ (a0 − a1/r)/r, indexed [α][d] with d = 1, 2, 3.

@@ -444,11 +444,15 @@ def _noise_exponents(
     shorter τ's where too few averages identify nothing.  ``noise_id="stable32"``:
     Stable32's rules (:data:`thermocal.stability.edf.STABLE32_B1_MIN_TOTAL`): B1 against
     the theory at n = the deviation's number of terms (``n_terms``, Stable32's "#"
-    column), down to 6 averages for the total family, never bounded by the shorter τ's
-    α; rate averages not detrended for the lag-1 method."""
+    column), down to 6 averages for the total family and 10 for ADEV and HDEV, never
+    bounded by the shorter τ's α; rate averages not detrended for the lag-1 method."""
     dmax = 3 if name in HADAMARD else 2
     stable32 = noise_id == "stable32"
-    b1_min = ed.STABLE32_B1_MIN_TOTAL if stable32 and name in TOTAL else ed.MIN_B1_GROUPS
+    b1_min = ed.MIN_B1_GROUPS
+    if stable32 and name in TOTAL:
+        b1_min = ed.STABLE32_B1_MIN_TOTAL
+    elif stable32 and name in ("adev", "hdev"):
+        b1_min = ed.STABLE32_B1_MIN_NONOVERLAPPING
     alphas = np.zeros(m.size, dtype=np.int64)
     methods: list[str] = []
     for i, mm in enumerate(m.tolist()):
