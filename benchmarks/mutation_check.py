@@ -882,9 +882,9 @@ MUTANTS: tuple[Mutant, ...] = (
         "stability-lag1-phase-detrend",
         P + "stability/edf.py",
         "        zc = z - z.mean()\n"
-        "        return _lag1_differenced(lag1_autocorrelation(zc), zc, dmax, 2)",
+        "        return _lag1_differenced(lag1_autocorrelation(zc), zc, dmax, 2, rules.r1_sample)",
         "        zc = _detrend(z, 1)\n"
-        "        return _lag1_differenced(lag1_autocorrelation(zc), zc, dmax, 2)",
+        "        return _lag1_differenced(lag1_autocorrelation(zc), zc, dmax, 2, rules.r1_sample)",
         STAB + _t("noise_id_stable32"),
         "lag-1 identification of phase data removes a line (Stable32 removes nothing)",
     ),
@@ -987,8 +987,8 @@ MUTANTS: tuple[Mutant, ...] = (
     Mutant(
         "stability-s32-rate-detrended",
         P + "stability/family.py",
-        "record.identify(int(mm), dmax, b1_n, b1_min, not stable32)",
-        "record.identify(int(mm), dmax, b1_n, b1_min, True)",
+        "ed.IdRules(b1_n, b1_min, rate_detrend=False, r1_sample=True)",
+        "ed.IdRules(b1_n, b1_min, rate_detrend=True, r1_sample=True)",
         STAB + _t("noise_id_rules_stable32"),
         "--noise-id stable32: rate averages detrended before the lag-1 method",
     ),
@@ -1023,6 +1023,14 @@ MUTANTS: tuple[Mutant, ...] = (
         "STABLE32_B1_MIN_NONOVERLAPPING: Final = 8",
         STAB + _t("noise_id_rules_stable32"),
         "--noise-id stable32: ADEV/HDEV read by B1 down to 8 averages",
+    ),
+    Mutant(
+        "stability-s32-r1-population",
+        P + "stability/family.py",
+        "ed.IdRules(b1_n, b1_min, rate_detrend=False, r1_sample=True)",
+        "ed.IdRules(b1_n, b1_min, rate_detrend=False, r1_sample=False)",
+        STAB + _t("noise_id_rules_stable32"),
+        "--noise-id stable32: r1 as Riley & Greenhall print it, not Stable32's (n − 1)/n",
     ),
     Mutant(
         "stability-b1-ddof",

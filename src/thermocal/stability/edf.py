@@ -55,28 +55,33 @@ on its PHASE.DAT: its last octave point, 7 averages, keeps the white FM of the o
 STABLE32_B1_MIN_TOTAL: Final = 6
 """Stable32's noise identification (``noise_id="stable32"`` in
 :func:`thermocal.stability.family.stability`, ``allan --noise-id stable32``), read from its
-printed α columns (none written by thermocal):
+printed α columns (none written by thermocal); the evidence is every Stable32 output in
+allantools' and allantoolkit's test data (benchmarks/stable32_conformance.py: with these
+rules all 691 rows with bounds and all 1924 all-τ rows of the OCXO record carry Stable32's
+α):
 
 * B1 is judged against the theoretical B1(n, μ) at n = the deviation's number of terms
   (Stable32's "#" column: N − 2m for OADEV, the averages − 1 for ADEV, …), not at the
-  number of m-averages the ratio is taken over.  On the OCXO record of allantools' test
-  data (19982 points), Stable32's all-τ OADEV, MDEV, TDEV and OHDEV outputs have 69 τ each
-  with 8–29 averages: all 69 read Stable32's α that way (OADEV: 41 at n = the averages);
-  ADEV 66 of 69 (61 at n = the averages).  The Cs 5071A's m = 2·10⁴, 4·10⁴ (27, 13 averages) read
+  number of m-averages the ratio is taken over.  The OCXO all-τ OADEV, MDEV, TDEV and
+  OHDEV outputs have 69 τ each with 8–29 averages: all 69 read Stable32's α that way
+  (OADEV: 41 at n = the averages); the Cs 5071A's m = 2·10⁴, 4·10⁴ (27, 13 averages) read
   white FM only that way.  For the overlapping deviations B1 then cannot read random-walk
   FM (its boundary grows with the record), which is why thermocal's own rule keeps Barnes'
   n and bounds B1's reading by the shorter τ's α.
 * No bound by the shorter τ's α.
-* Rate data: the lag-1 method reads the m-averages with their mean removed, not their line
-  (OCXO all-τ outputs: 165 of the 167 τ with ≥ 30 averages read Stable32's α that way, 164
-  with the line removed; m = 5 reads flicker PM only that way, as Stable32).
+* r1 of n points is taken as r1·(n − 1)/n (the variance under it with n − 1): the OCXO
+  all-τ m = 113 and 463 (2δ = −0.503, −0.509 with r1 as Riley & Greenhall print it, a hair
+  past −0.5) read Stable32's random-walk FM only that way, in every deviation, and no
+  other lag-1 row of the six records changes.
+* Rate data: the lag-1 method reads the m-averages with their mean removed, not their
+  line: all 167 OCXO all-τ rows with ≥ 30 averages read Stable32's α that way, m = 5
+  (flicker PM) only that way.
 * Below 8 averages the overlapping Allan and Hadamard deviations keep the shorter τ's α,
   the non-overlapping ADEV and HDEV below 10 (:data:`STABLE32_B1_MIN_NONOVERLAPPING`); the
-  total family
-  (totdev, mtotdev, ttotdev, htotdev) reads B1 down to this many averages: PHASE.DAT
-  m = 128 (MTOT, TTOT, Htot), Sr87 m = 200, GPS m = 32768, 53230A m = 8192 (6–7 averages)
-  read Stable32's α that way and not by keeping the shorter τ's, PHASE.DAT's decade
-  m = 200 (5 averages) and the rows with 2–4 averages keep it."""
+  total family (totdev, mtotdev, ttotdev, htotdev) reads B1 down to this many averages:
+  PHASE.DAT m = 128 (MTOT, TTOT, Htot), Sr87 m = 200, GPS m = 32768, 53230A m = 8192
+  (6–7 averages) read Stable32's α that way and not by keeping the shorter τ's, PHASE.DAT's
+  decade m = 200 (5 averages) and the rows with 2–4 averages keep it."""
 
 STABLE32_B1_MIN_NONOVERLAPPING: Final = 10
 """The fewest averages Stable32's B1 reads for the non-overlapping ADEV and HDEV (below: the
@@ -592,15 +597,31 @@ def _b1_theory(n: int, mu: int) -> float:
 _MU_TO_ALPHA: Final = {-2: 2, -1: 0, 0: -1, 1: -2, 2: -3, 3: -4}
 
 
+@dataclass(frozen=True)
+class IdRules:
+    """How :func:`identify_noise` reads the noise.  Defaults: thermocal's (Riley & Greenhall
+    2004 and Barnes' B1 as published).  ``b1_n``: the n of the theoretical B1 (None: the
+    number of averages); ``b1_min``: the fewest averages B1 reads; ``rate_detrend``: the rate
+    averages' line removed before the lag-1 method (else only their mean); ``r1_sample``: r1
+    with the sample variance (÷ (n − 1)) under the lag product summed over n − 1 pairs and
+    divided by n, i.e. r1·(n − 1)/n.  Stable32's rules: :data:`STABLE32_B1_MIN_TOTAL`."""
+
+    b1_n: int | None = None
+    b1_min: int = MIN_B1_GROUPS
+    rate_detrend: bool = True
+    r1_sample: bool = False
+
+
+THERMOCAL_RULES: Final = IdRules()
+
+
 def identify_noise(
     x: FloatArray,
     m: int,
     *,
     dmax: int,
     phase_input: bool,
-    b1_n: int | None = None,
-    b1_min: int = MIN_B1_GROUPS,
-    rate_detrend: bool = True,
+    rules: IdRules = THERMOCAL_RULES,
 ) -> NoiseId:
     """Power-law noise α at averaging factor m (Riley & Greenhall 2004; B1 otherwise).
 
@@ -611,11 +632,8 @@ def identify_noise(
     less on rate); α = −round(2ρ) − 2d (+2 for phase).  With fewer than 30 averaged points:
     the B1 ratio of the standard variance of the m-averages to their Allan variance, against
     the theoretical B1 of each noise (boundaries at geometric means); where B1 reads phase
-    noise, the R(n) ratio tells white from flicker PM (:func:`split_pm`).  ``b1_n``: the n
-    of the theoretical B1 (default: the number of averages; Stable32 takes the deviation's
-    number of terms, see :data:`STABLE32_B1_MIN_TOTAL`); ``b1_min``: the fewest averages B1
-    reads; ``rate_detrend``: the rate averages' line removed before the lag-1 method (False:
-    the mean only, as Stable32, see :data:`STABLE32_B1_MIN_TOTAL`).
+    noise, the R(n) ratio tells white from flicker PM (:func:`split_pm`).  ``rules``: the
+    variants of :class:`IdRules` (Stable32's: :data:`STABLE32_B1_MIN_TOTAL`).
 
     The decimated phase is not detrended (the differencing removes a line), as in
     Stable32's identification: with a quadratic removed, the 32 points of the Sr87 clock
@@ -631,15 +649,12 @@ def identify_noise(
     if m > 1:
         ym /= m
     if not phase_input:
-        nid = identify_rate_averages(
-            ym, dmax=dmax, own=True, b1_n=b1_n, b1_min=b1_min, detrend=rate_detrend
-        )
-        return split_pm(nid, x, m)
+        return split_pm(identify_rate_averages(ym, dmax=dmax, own=True, rules=rules), x, m)
     z = x[:: max(m, 1)]
     if z.size >= MIN_ACF_POINTS:
         zc = z - z.mean()
-        return _lag1_differenced(lag1_autocorrelation(zc), zc, dmax, 2)
-    return split_pm(_b1_identify(ym, dmax, n_theory=b1_n, min_groups=b1_min), x, m)
+        return _lag1_differenced(lag1_autocorrelation(zc), zc, dmax, 2, rules.r1_sample)
+    return split_pm(_b1_identify(ym, dmax, n_theory=rules.b1_n, min_groups=rules.b1_min), x, m)
 
 
 def modified_allan_ratio(x: FloatArray, m: int) -> float:
@@ -693,24 +708,22 @@ def identify_rate_averages(
     dmax: int,
     own: bool = False,
     sums: LagSums | None = None,
-    b1_n: int | None = None,
-    b1_min: int = MIN_B1_GROUPS,
-    detrend: bool = True,
+    rules: IdRules = THERMOCAL_RULES,
 ) -> NoiseId:
     """The rate branch of :func:`identify_noise` from the m-averages ``z`` of the rate
     (any scale and offset: block sums serve as well).  ``own``: ``z`` may be centred in
     place; ``sums``: its :class:`LagSums` already taken (``z`` is then only read where the
-    sums cannot decide: explicit detrending, differencing, B1); ``b1_n``, ``b1_min``,
-    ``detrend``: see :func:`identify_noise`."""
-    if z.size >= MIN_ACF_POINTS and not detrend:  # Stable32: the mean removed, nothing else
-        return _lag1_differenced(lag1_autocorrelation(z), z, dmax - 1, 0)
+    sums cannot decide: explicit detrending, differencing, B1); ``rules``: see
+    :func:`identify_noise`."""
+    if z.size >= MIN_ACF_POINTS and not rules.rate_detrend:  # the mean removed, no line
+        return _lag1_differenced(lag1_autocorrelation(z), z, dmax - 1, 0, rules.r1_sample)
     if z.size >= MIN_ACF_POINTS:
         r1 = _lag1_from_sums(sums) if sums is not None else None
         if r1 is None:  # r1 of the detrended averages from sums (no detrended copy)
             r1 = _lag1_linear_detrended(z, own=own)
         # differencing cancels the line but its constant slope, which r1's mean removes
-        return _lag1_differenced(r1, z, dmax - 1, 0)
-    return _b1_identify(z, dmax, n_theory=b1_n, min_groups=b1_min)
+        return _lag1_differenced(r1, z, dmax - 1, 0, rules.r1_sample)
+    return _b1_identify(z, dmax, n_theory=rules.b1_n, min_groups=rules.b1_min)
 
 
 _DIFF_BLOCK = 1 << 20
@@ -742,12 +755,16 @@ def _lag1_of_difference(z: FloatArray, d: int) -> float:
     return num / den if den > 0 else 0.0
 
 
-def _lag1_differenced(r1: float, z: FloatArray, dm: int, add: int) -> NoiseId:
+def _lag1_differenced(r1: float, z: FloatArray, dm: int, add: int, sample: bool = False) -> NoiseId:
     """Riley & Greenhall's rule: difference ``z`` until ρ = r1/(1 + r1) < 0.25 or d = dm;
     α = −round(2ρ) − 2d + ``add`` (the differences' r1 by :func:`_lag1_of_difference`: a
-    10⁷-sample m = 1 level needs no differenced copy)."""
+    10⁷-sample m = 1 level needs no differenced copy).  ``sample``: every r1 (of n points)
+    taken as r1·(n − 1)/n, Stable32's normalisation (:class:`IdRules`)."""
     d = 0
     while True:
+        if sample:
+            n = z.size - d
+            r1 = r1 * (n - 1) / n if n > 1 else r1
         rho = r1 / (1.0 + r1) if r1 > -1.0 else 0.0
         if rho < 0.25 or d >= dm:
             a = -round(2.0 * rho) - 2 * d + add

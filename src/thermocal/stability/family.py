@@ -343,24 +343,15 @@ class _Record:
             )  # fmt: skip
         return self._levels[i]
 
-    def identify(
-        self,
-        m: int,
-        dmax: int,
-        b1_n: int | None = None,
-        b1_min: int = ed.MIN_B1_GROUPS,
-        rate_detrend: bool = True,
-    ) -> ed.NoiseId:
+    def identify(self, m: int, dmax: int, rules: ed.IdRules = ed.THERMOCAL_RULES) -> ed.NoiseId:
         """:func:`thermocal.stability.edf.identify_noise` on the longest stretch at m: from
         its octave level when there is one (the same m-averages, as block sums), else from
-        its centred phase (``b1_n``, ``b1_min``, ``rate_detrend``: as there)."""
+        its centred phase (``rules``: as there)."""
         if 1 <= m <= self.m_max and m & (m - 1) == 0:
             by_m = {lv.m: lv for lv in self.levels(self.longest)}
             if m in by_m:
                 lv = by_m[m]
-                nid = ed.identify_rate_averages(
-                    lv.z, dmax=dmax, sums=lv.lag, b1_n=b1_n, b1_min=b1_min, detrend=rate_detrend
-                )
+                nid = ed.identify_rate_averages(lv.z, dmax=dmax, sums=lv.lag, rules=rules)
                 if nid.method == "b1" and nid.alpha == 2:  # B1 read PM: R(n) from the phase
                     nid = ed.split_pm(nid, self.centred()[self.longest], m)
                 return nid
@@ -368,9 +359,8 @@ class _Record:
                 return ed.identify_rate_averages(np.zeros(0), dmax=dmax)
         x = self.centred()[self.longest]
         return ed.identify_noise(
-            x, m, dmax=dmax, phase_input=self.data_type == "phase", b1_n=b1_n, b1_min=b1_min,
-            rate_detrend=rate_detrend,
-        )  # fmt: skip
+            x, m, dmax=dmax, phase_input=self.data_type == "phase", rules=rules
+        )
 
     def sums(self, name: str, m: IntArray) -> tuple[FloatArray, FloatArray]:
         """The pooled deviation and term count of ``name`` per m over the stretches."""
@@ -434,7 +424,7 @@ def _noise_exponents(
     m: IntArray,
     record: _Record,
     alpha: int | None,
-    id_cache: dict[tuple[int, int, int, int], ed.NoiseId],
+    id_cache: dict[tuple[int, int, ed.IdRules], ed.NoiseId],
     noise_id: str = "thermocal",
     n_terms: FloatArray | None = None,
 ) -> tuple[IntArray, tuple[str, ...]]:
@@ -445,7 +435,8 @@ def _noise_exponents(
     Stable32's rules (:data:`thermocal.stability.edf.STABLE32_B1_MIN_TOTAL`): B1 against
     the theory at n = the deviation's number of terms (``n_terms``, Stable32's "#"
     column), down to 6 averages for the total family and 10 for ADEV and HDEV, never
-    bounded by the shorter τ's α; rate averages not detrended for the lag-1 method."""
+    bounded by the shorter τ's α; the lag-1 method on rate averages with their mean removed
+    (not their line) and r1 normalised as Stable32's (:class:`thermocal.stability.edf.IdRules`)."""
     dmax = 3 if name in HADAMARD else 2
     stable32 = noise_id == "stable32"
     b1_min = ed.MIN_B1_GROUPS
@@ -466,9 +457,14 @@ def _noise_exponents(
         if stable32:
             cnt = n_terms[i] if n_terms is not None and name != "theo1" else math.nan
             b1_n = int(cnt) if math.isfinite(cnt) and cnt > 0 else sum(record.sizes) - 1
-        key = (int(mm), dmax, b1_min, b1_n or 0)
+        rules = (
+            ed.IdRules(b1_n, b1_min, rate_detrend=False, r1_sample=True)
+            if stable32
+            else ed.THERMOCAL_RULES
+        )
+        key = (int(mm), dmax, rules)
         if key not in id_cache:
-            id_cache[key] = record.identify(int(mm), dmax, b1_n, b1_min, not stable32)
+            id_cache[key] = record.identify(int(mm), dmax, rules)
         nid = id_cache[key]
         if nid.method == "none" and i > 0:  # too few averages: the shorter τ's noise
             alphas[i] = alphas[i - 1]
@@ -546,7 +542,7 @@ def stability(
         )
         record.set_octave(m_common)
         curves: dict[str, DeviationCurve] = {}
-        id_cache: dict[tuple[int, int, int, int], ed.NoiseId] = {}
+        id_cache: dict[tuple[int, int, ed.IdRules], ed.NoiseId] = {}
         for name in names:
             m = (
                 factors(taus, tau0_s, dv.max_factor(name, n_long), theo1=True)
