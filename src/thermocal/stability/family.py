@@ -25,7 +25,7 @@ The EDFs of gap-separated stretches add (independent estimates).
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Final
 
 import numpy as np
@@ -453,15 +453,14 @@ def _noise_exponents(
             continue
         if name == "theo1":  # Theo1's τ is 0.75 m τ0: the noise of that averaging time
             mm = max(1, round(0.75 * mm))
-        b1_n = None
+        rules = ed.THERMOCAL_RULES
         if stable32:
             cnt = n_terms[i] if n_terms is not None and name != "theo1" else math.nan
             b1_n = int(cnt) if math.isfinite(cnt) and cnt > 0 else sum(record.sizes) - 1
-        rules = (
-            ed.IdRules(b1_n, b1_min, rate_detrend=False, r1_sample=True)
-            if stable32
-            else ed.THERMOCAL_RULES
-        )
+            rules = ed.IdRules(b1_n, b1_min, rate_detrend=False, r1_sample=True)
+            if (record.sizes[record.longest] - 1) // int(mm) >= ed.MIN_ACF_POINTS:
+                # lag-1 decides, B1's n and minimum play no part: one read for every deviation
+                rules = replace(rules, b1_n=None, b1_min=ed.MIN_B1_GROUPS)
         key = (int(mm), dmax, rules)
         if key not in id_cache:
             id_cache[key] = record.identify(int(mm), dmax, rules)
