@@ -145,19 +145,21 @@ def allan_analysis(
                 noise_id or "thermocal",
             ),
         )  # fmt: skip
-    if bias_correct:
-        raise ThermocalInputError(
-            "--bias-correct corrects the total deviations (totdev, htotdev): give them with "
-            "--deviation"
+    family_only = [
+        opt
+        for opt, given in (
+            ("--bias-correct (totdev, htotdev)", bias_correct),
+            (
+                "--noise-type",
+                noise_type is not None and noise_type.strip().lower() not in ("", "auto"),
+            ),
+            ("--noise-id", noise_id is not None),
         )
-    if noise_type is not None and noise_type.strip().lower() not in ("", "auto"):
+        if given
+    ]
+    if family_only:
         raise ThermocalInputError(
-            "--noise-type sets the noise of the deviation family's intervals: give the "
-            "deviations with --deviation (the overlapping ADEV: --deviation oadev)"
-        )
-    if noise_id is not None:
-        raise ThermocalInputError(
-            "--noise-id chooses the deviation family's noise identification: give the "
+            f"{', '.join(family_only)}: for the deviation family's intervals; give the "
             "deviations with --deviation (the overlapping ADEV: --deviation oadev)"
         )
     channels: dict[str, AllanChannel] = {}
