@@ -1295,6 +1295,23 @@ MUTANTS: tuple[Mutant, ...] = (
         _t("mutants_maths", "preprocess"),
         "centred Ṫ over 1.5 Δ",
     ),
+    # issue 38, reports and messages (h38-reports)
+    Mutant(
+        "report-average-fallback-two",
+        P + "report/analysis.py",
+        ">= MIN_FALLBACK_AVERAGES]",
+        ">= 2]",
+        _t("h38_messages"),
+        "a short record's fallback averaging time gives only two averages",
+    ),
+    Mutant(
+        "metrics-average-advice-whole-record",
+        P + "metrics.py",
+        "{option} {longest_s / 2.0:.3g} or less",
+        "{option} {longest_s:.3g} or less",
+        _t("h38_messages"),
+        "the advised --average is the whole record (one average), not half",
+    ),
 )
 
 

@@ -175,6 +175,57 @@ def _in_degrees(value: float | None, unit: str | None) -> float | None:
     return value * units.RAD_TO_DEG if unit == "rad" else value
 
 
+NICE_AVERAGES_S = (1.0, 2.0, 5.0, 10.0, 20.0, 50.0, 100.0, 200.0, 500.0, 1000.0)
+"""Averaging times [s] a report falls back to, largest first, when the default averaging
+time does not fit the record (:func:`averaging_for`)."""
+MIN_FALLBACK_AVERAGES = 10
+"""Averages a fallback averaging time gives at least (a stated bias stability needs a
+handful of averages; IEEE Std 952 reads the Allan curve up to a tenth of the record)."""
+
+
+def _n_means(slices: list[slice], tau0_s: float, averaging_s: float) -> int:
+    m = max(round(averaging_s / tau0_s), 1)
+    return sum((sl.stop - sl.start) // m for sl in slices)
+
+
+def averaging_for(
+    time_s: FloatArray, wanted_s: float, *, given: bool, where: str | None, option: str | None
+) -> tuple[float, str | None]:
+    """The averaging time [s] of a report's bias stability and peak-to-peak on a record
+    with times ``time_s`` [s], and the note that says why it is not ``wanted_s``.
+
+    ``wanted_s`` when the record gives at least two non-overlapping averages of it (never
+    across a gap, as :func:`thermocal.metrics.block_means`).  Else, when the user ``given``
+    it, an error naming the file ``where`` and the option ``option``
+    (:func:`thermocal.metrics.too_few_averages`); when it is a default, the largest of
+    :data:`NICE_AVERAGES_S` giving at least :data:`MIN_FALLBACK_AVERAGES` averages (the
+    sample interval if none does), stated in the note.
+    """
+    from thermocal.errors import ThermocalInputError
+    from thermocal.metrics import too_few_averages
+    from thermocal.recording import contiguous_slices
+
+    t = np.asarray(time_s, dtype=np.float64)
+    if t.size < 2:
+        return wanted_s, None
+    tau0 = float(np.median(np.diff(t)))
+    slices = contiguous_slices(t)
+    n = _n_means(slices, tau0, wanted_s)
+    if n >= 2:
+        return wanted_s, None
+    longest = max(sl.stop - sl.start for sl in slices) * tau0
+    if given:
+        raise ThermocalInputError(too_few_averages(where, wanted_s, n, longest, option))
+    fits = [a for a in NICE_AVERAGES_S if _n_means(slices, tau0, a) >= MIN_FALLBACK_AVERAGES]
+    chosen = max(fits) if fits else tau0
+    note = (
+        f"Bias stability and peak-to-peak are over {chosen:g} s averages: the record "
+        f"(longest stretch without a gap {longest:.3g} s) gives fewer than two of the "
+        f"default {wanted_s:g} s."
+    )
+    return chosen, note
+
+
 def figures_of_merit(
     time_s: FloatArray,
     x: FloatArray,
@@ -186,6 +237,8 @@ def figures_of_merit(
     temp_c: FloatArray,
     drift_bias: float | None = None,
     drift_reference_s: tuple[float, float] | None = None,
+    where: str | None = None,
+    average_option: str | None = "--average",
 ) -> FiguresOfMerit:
     """Figures of merit of a rate ``x`` [``unit``, known input included] (SPEC §1).
 
@@ -195,7 +248,8 @@ def figures_of_merit(
     gaps) removes a stated constant b0, never the run's own mean: ``drift_bias`` when
     given (0 on a compensated output: the model is what removes the bias), else the mean
     over ``drift_reference_s`` (default the first 10 % of the run,
-    :func:`thermocal.metrics.reference_bias`).
+    :func:`thermocal.metrics.reference_bias`).  ``where`` (the file) and ``average_option``
+    are named when the record gives fewer than two averages.
     """
     rec = Recording.from_arrays(
         time_s,
@@ -204,6 +258,7 @@ def figures_of_merit(
         signal_unit=unit,
         meta=dataclasses.replace(meta, scale_factor=None, scale_factor_unit=None),
     )
+    rec = dataclasses.replace(rec, source=where) if where else rec
     m = compute_metrics(
         rec,
         "signal",
@@ -211,6 +266,7 @@ def figures_of_merit(
         temps=[temp_name],
         drift_bias=drift_bias,
         drift_reference_s=drift_reference_s,
+        average_option=average_option,
     )
     sens = m.temperature_sensitivity
     ang: FloatArray | None = None

@@ -919,6 +919,7 @@ def _analyse(inputs: ReportInputs) -> _Analysis:
             temp_c=stage_temp_c,
             drift_bias=drift_bias,
             drift_reference_s=None if drift_bias is not None else inputs.drift_reference_s,
+            where=inputs.recording_path or rec.source,
         )
         for x, drift_bias in ((main.signal, inputs.drift_bias), (main.after_raw, 0.0))
     )

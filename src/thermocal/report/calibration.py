@@ -39,7 +39,7 @@ from thermocal.models.base import model_file_dict
 from thermocal.models.calibration import Calibration
 from thermocal.readers.common import sha256_of
 from thermocal.recording import Recording
-from thermocal.report.analysis import allan_of, apply_model, shown_figures
+from thermocal.report.analysis import allan_of, apply_model, averaging_for, shown_figures
 from thermocal.report.build import (
     ILL_CONDITIONED,
     _b64,
@@ -266,8 +266,12 @@ def build_calibration_report(inputs: CalibrationReportInputs) -> str:
     else:
         default_avg = (inputs.validation or {}).get("averaging_s")
     averaging_s = float(inputs.averaging_s or default_avg or DEFAULT_AVERAGING_S)
+    averaging_s, avg_note = averaging_for(
+        rec.time_s, averaging_s, given=inputs.averaging_s is not None,
+        where=inputs.recording_path or rec.source or rec.name, option="--average",
+    )  # fmt: skip
     # several axes: the earth rate differs per axis, so none is removed (stated below)
-    notes = list(inputs.notes)
+    notes = list(inputs.notes) + ([avg_note] if avg_note else [])
     if rec.meta.latitude_deg is not None and len(names) > 1:
         notes.append(
             "The earth rate is not removed from gyro channels in this report (each axis "
