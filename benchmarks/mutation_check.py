@@ -1312,6 +1312,14 @@ MUTANTS: tuple[Mutant, ...] = (
         _t("h38_messages"),
         "the advised --average is the whole record (one average), not half",
     ),
+    Mutant(
+        "export-c-known-input-wrong-way",
+        P + "export/c/core.py",
+        "units.convert([value], unit, su)",
+        "units.convert([value], su, unit)",
+        _t("h38_export_c"),
+        "the header's known input converted the wrong way (deg/h shown as deg/s)",
+    ),
 )
 
 
