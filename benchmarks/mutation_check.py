@@ -1320,6 +1320,22 @@ MUTANTS: tuple[Mutant, ...] = (
         _t("h38_export_c"),
         "the header's known input converted the wrong way (deg/h shown as deg/s)",
     ),
+    Mutant(
+        "report-drift-after-raw",
+        P + "report/build.py",
+        "(main.after_raw, None)",
+        "(main.after_raw, 0.0)",
+        _t("report"),
+        "the after drift angle with nothing removed against a bias-removed before",
+    ),
+    Mutant(
+        "report-no-change-never",
+        P + "report/build.py",
+        "abs(a - b) <= NO_CHANGE_REL",
+        "abs(a - b) < 0.0 * NO_CHANGE_REL",
+        _t("report"),
+        "equal figures shown as a percentage of rounding",
+    ),
 )
 
 

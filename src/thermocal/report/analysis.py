@@ -14,7 +14,13 @@ import numpy as np
 
 from thermocal import units
 from thermocal.compensate.kernels import unit_factor
-from thermocal.metrics import RATE_ANGLE_UNITS, DriftReference, compute_metrics, drift_angle
+from thermocal.metrics import (
+    RATE_ANGLE_UNITS,
+    DriftReference,
+    compute_metrics,
+    drift_angle,
+    drift_angle_extreme,
+)
 from thermocal.models.base import RunData
 from thermocal.models.registry import model_from_dict
 from thermocal.recording import FloatArray, Metadata, Recording
@@ -143,7 +149,7 @@ class FiguresOfMerit:
     the hold stages (least-squares slope and mean |ΔB/ΔT|) [unit/°C], and the drift
     angle θ(t) = ∫ (ω − Ω − b0) dt [``drift_angle_unit``] (gyros), b0 the constant of
     ``drift_reference``: its curve, end value, largest magnitude and when it is reached
-    [s since the first sample]."""
+    [s since the first sample]; and the largest |θ| with no bias removed (b0 = 0)."""
 
     bias: float
     bias_stability: float
@@ -157,11 +163,19 @@ class FiguresOfMerit:
     drift_angle_max_time_s: float | None = None
     drift_angle_unit: str | None = None
     drift_reference: DriftReference | None = None
+    drift_angle_raw_max: float | None = None
+    """The largest |θ| of ``θ(t) = ∫ (ω − Ω_axis) dt`` [``drift_angle_unit``]: no bias
+    removed (gyros), the figure to compare with another series' of the same definition."""
 
     @property
     def drift_angle_max_deg(self) -> float | None:
         """The largest |drift angle| in degrees [°] (converted from rad for rad/s data)."""
         return _in_degrees(self.drift_angle_max, self.drift_angle_unit)
+
+    @property
+    def drift_angle_raw_max_deg(self) -> float | None:
+        """:attr:`drift_angle_raw_max` in degrees [°]."""
+        return _in_degrees(self.drift_angle_raw_max, self.drift_angle_unit)
 
     @property
     def drift_angle_end_deg(self) -> float | None:
@@ -270,9 +284,11 @@ def figures_of_merit(
     )
     sens = m.temperature_sensitivity
     ang: FloatArray | None = None
+    raw_max: float | None = None
     if m.drift_reference is not None and m.unit in RATE_ANGLE_UNITS:
         per = RATE_ANGLE_UNITS[m.unit][1]
         ang = drift_angle(time_s, x, m.drift_reference.bias + m.earth_rate_removed, time_unit_s=per)
+        raw_max = drift_angle_extreme(time_s, x, m.earth_rate_removed, time_unit_s=per).max_abs
     return FiguresOfMerit(
         bias=m.bias,
         bias_stability=m.bias_stability,
@@ -286,6 +302,7 @@ def figures_of_merit(
         drift_angle_max_time_s=m.drift_angle_max_time_s,
         drift_angle_unit=m.drift_angle_unit,
         drift_reference=m.drift_reference,
+        drift_angle_raw_max=raw_max,
     )
 
 
