@@ -1336,6 +1336,14 @@ MUTANTS: tuple[Mutant, ...] = (
         _t("report"),
         "equal figures shown as a percentage of rounding",
     ),
+    Mutant(
+        "piecewise-segments-judged-on-the-first",
+        P + "models/piecewise.py",
+        "parts[k].append(x[idx == k])",
+        "parts[k].append(x[idx == 0])",
+        _t("h38_piecewise"),
+        "every segment judged on the first segment's samples",
+    ),
 )
 
 
