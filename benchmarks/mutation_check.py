@@ -1344,6 +1344,14 @@ MUTANTS: tuple[Mutant, ...] = (
         _t("h38_piecewise"),
         "every segment judged on the first segment's samples",
     ),
+    Mutant(
+        "report-coverage-gap-whole-step",
+        P + "report/analysis.py",
+        "sum(g.length_s - tau0_s for g in gaps)",
+        "sum(g.length_s for g in gaps)",
+        _t("report_calibration"),
+        "a gap counted as the whole step, its last sample interval included",
+    ),
 )
 
 
