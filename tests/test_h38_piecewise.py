@@ -96,3 +96,15 @@ def test_a_sweep_that_supports_three_segments_is_fitted(
     tests = json.loads(model.read_text())["adequacy"]["tests"]
     spans = [x for x in tests if x["name"].startswith("segment_") and "span" in x["name"]]
     assert len(spans) == 3 and all(x["verdict"] == "pass" and x["figure"] > 5 for x in spans)
+
+
+def test_raw_count_temperatures_are_not_judged_in_degrees(tmp_path: Path) -> None:
+    """A segment's span in raw counts is not a span in °C: not judged (as the whole-run
+    test does), instead of refusing 0.28 counts as 0.28 °C."""
+    import dataclasses
+
+    _path, t, temp, y = _bursts(tmp_path)
+    run = RunData.from_recording(Recording.from_arrays(t, {"gyro": y}, {"T": temp}), "gyro", ["T"])
+    m = PiecewiseModel(segments=3).fit([dataclasses.replace(run, temperature_unit="counts")])
+    spans = [x for x in m.segment_tests_ if x.name.endswith("temperature_span")]
+    assert len(spans) == 3 and all(x.verdict == "n/a" for x in spans)

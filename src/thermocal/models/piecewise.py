@@ -363,6 +363,7 @@ def segment_tests(
     hi: float,
     *,
     given: bool,
+    unit: str = "°C",
 ) -> tuple[AdequacyTest, ...]:
     """Every segment of a fitted piecewise model judged as the line it is, by the common
     rules of :mod:`thermocal.adequacy` (issue 38: a 0.28 °C segment holding one burst was
@@ -370,7 +371,9 @@ def segment_tests(
     its distinct temperatures (≥ 2) and its samples per coefficient (≥
     ``MIN_SAMPLES_PER_COEFFICIENT`` for 2), over the samples of every run in
     ``[b_j, b_{j+1})`` of the final ``breakpoints_c`` [°C] (``lo``/``hi`` the range's ends).
-    Each message names the segment and the option that helps: move or drop a breakpoint
+    Raw-count temperatures (``unit`` not °C): the span is not judged (as
+    :func:`thermocal.adequacy.temperature_tests`).  Each message names the segment and the
+    option that helps: move or drop a breakpoint
     (``--breakpoints``, when ``given``) or fewer ``--segments``; a failed span or sample
     count can be fitted anyway with ``--allow-narrow`` (recorded, and ``export-c`` warns).
     """
@@ -394,7 +397,7 @@ def segment_tests(
         label = f"{name} segment {k + 1} of {n_seg} ({edges[k]:.4g}…{edges[k + 1]:.4g} °C)"
         judged = [
             samples_test(int(seg.size), 2, label),
-            *(t for t in temperature_tests(seg, label, 1) if t.name != "range_ends"),
+            *(t for t in temperature_tests(seg, label, 1, unit=unit) if t.name != "range_ends"),
         ]
         out += [
             dataclasses.replace(
@@ -546,8 +549,9 @@ class PiecewiseModel(TemperatureModel):
         self._set_fitted(rl, names, j, xs, ys, bp, final, discontinuities, lines, decision,
                          choice)  # fmt: skip
         self.segment_tests_ = segment_tests(
-            final, xs, names[j], lo, hi, given=self.breakpoints is not None
-        )
+            final, xs, names[j], lo, hi, given=self.breakpoints is not None,
+            unit="°C" if rl[0].temperature_unit == "degC" else str(rl[0].temperature_unit),
+        )  # fmt: skip
         return self
 
     def _initial_breakpoints(
