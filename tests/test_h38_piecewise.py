@@ -66,6 +66,12 @@ def test_fit_refuses_a_one_burst_segment_and_export_c_flags_an_override(
     last = err.strip().splitlines()[-1]
     assert last.startswith(f"error: {path.name}: ") and "spans 0.28 °C" in last
     assert "--segments 2" in last and "--allow-narrow" in last
+    with warnings.catch_warnings():  # breakpoints given: the advice is to move them
+        warnings.simplefilter("ignore")
+        code = main(["fit", str(path), *ARGS, "--breakpoints", "20,24", "--method",
+                     "continuous", "-o", str(model)])  # fmt: skip
+    last = capsys.readouterr().err.strip().splitlines()[-1]
+    assert code == 2 and "move or drop a breakpoint (--breakpoints)" in last, last
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         code = main(["fit", str(path), *ARGS, "--segments", "3", "--allow-narrow",
