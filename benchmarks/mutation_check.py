@@ -1345,6 +1345,14 @@ MUTANTS: tuple[Mutant, ...] = (
         "every segment judged on the first segment's samples",
     ),
     Mutant(
+        "piecewise-segment-advice-ignores-breakpoints",
+        P + "models/piecewise.py",
+        "given=self.breakpoints is not None,",
+        "given=False,",
+        _t("h38_piecewise"),
+        "breakpoints given, the refusal advises --segments instead of moving them",
+    ),
+    Mutant(
         "report-coverage-gap-whole-step",
         P + "report/analysis.py",
         "sum(g.length_s - tau0_s for g in gaps)",
