@@ -544,6 +544,10 @@ def test_report_equal_figures_say_no_change(case: dict[str, Any]) -> None:
     assert ">no change<" in card and "e-13" not in card and "%" not in card
     assert 'badge fail">no change<' in card  # no change is not an improvement
     assert tagged_numbers(card)["validation.linear.peak_to_peak_improvement_pct"][0] == "0.0"
+    # every card states its definition, the same before and after (averaging_s = 100 s)
+    assert "max − min of the run's 100 s averages, before and after" in html.unescape(card)
+    stab = _card(text, "Bias stability")
+    assert "std of the 100 s averages within each hold stage" in stab
 
 
 def test_report_warns_on_extrapolation_and_conditioning(case: dict[str, Any]) -> None:

@@ -474,11 +474,13 @@ def _summary(
                 "flag_text": "weakly correlated" if ok else "too correlated",
             }
         )
-    for name, label in (
-        ("bias_stability", "Bias stability"),
-        ("bias_repeatability", "Bias repeatability"),
-        ("peak_to_peak", "Peak-to-peak bias"),
-    ):
+    avg = fmt_num(v.get("averaging_s"))
+    for name, label, definition in (
+        ("bias_stability", "Bias stability",
+         f"std of the {avg} s averages within each hold stage, rms over the stages"),
+        ("bias_repeatability", "Bias repeatability", "std of the hold stages' mean biases"),
+        ("peak_to_peak", "Peak-to-peak bias", f"max − min of the run's {avg} s averages"),
+    ):  # fmt: skip
         b, a = v.get(f"{name}_before"), v.get(f"{name}_after")
         if b is None or a is None:
             continue
@@ -491,7 +493,7 @@ def _summary(
                 "before": num(b, f"{key}.{name}_before", unit=unit_label(unit)),
                 "after": num(a, f"{key}.{name}_after", unit=unit_label(unit)),
                 "value": change_html(b, a, imp, f"{key}.{name}_improvement_pct"),
-                "note": "improvement",
+                "note": f"improvement; {definition}, before and after (validate)",
                 "flag": _flag(ok),
                 "flag_text": "no change" if same else "improved" if ok else "not improved",
             }
@@ -506,7 +508,9 @@ def _summary(
                 "before": num(b, f"{key}.rms_about_zero_before", unit=unit_label(unit)),
                 "after": num(a, f"{key}.rms_about_zero_after", unit=unit_label(unit)),
                 "value": change_html(b, a, imp, f"{key}.rms_about_zero_improvement_pct"),
-                "note": "improvement",
+                "note": "improvement; rms of (output − reference) per sample, reference "
+                + str((v.get("zero_reference") or {}).get("what") or "0")
+                + ", before and after (validate)",
                 "flag": _flag(not worse),
                 "flag_text": "absolute error worse" if worse else "not worse",
             }
