@@ -13,7 +13,7 @@ calibration recorded (else normal gravity at the latitude).
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from typing import Any
 
 import numpy as np
@@ -29,11 +29,32 @@ from thermocal.multipos.calibrate import (
 from thermocal.multipos.poses import detect_poses
 
 
-def _columns(rec: Any, tri: Any) -> tuple[Any, str]:
-    x = np.column_stack([rec.column(c) for c in tri.columns])
-    found = {rec.units.get(c) or tri.unit for c in tri.columns}
-    unit = found.pop() if len(found) == 1 else tri.unit
-    return x, unit
+def triad_columns(
+    rec: Any, tri: Any, unit_options: Mapping[str, str | None] | None = None
+) -> tuple[Any, Any]:
+    """A triad's three columns of ``rec`` in the physical unit its model takes, and how
+    (:class:`~thermocal.models.calibration.TriadInput`).  Each column's unit is resolved as
+    ``compensate`` resolves it (:func:`thermocal.units.resolve_unit`: ``unit_options`` (column
+    → the ``--signal-unit`` option's unit, :func:`thermocal.units.per_signal_option`) > the
+    file's metadata or column name > the unit the triad was calibrated on, raw counts for a
+    triad with a count scale), and raw counts become ``count_scale · N`` (:meth:`Triad.input_in
+    <thermocal.models.calibration.Triad.input_in>`, the path ``compensate`` takes)."""
+    opts = unit_options or {}
+    found = [
+        units.resolve_unit(
+            c, "signal", option=opts.get(c), metadata=rec.units.get(c) or None,
+            model=tri.calibrated_unit(), where=rec.name,
+        ).unit
+        for c in tri.columns
+    ]  # fmt: skip
+    inp = tri.input_in(found, rec.name)
+    x = inp.physical(np.column_stack([rec.column(c) for c in tri.columns]).astype(np.float64))
+    if not np.all(np.isfinite(x)):
+        raise ThermocalInputError(
+            f"{rec.name}: the {tri.name} triad's columns are not finite in {inp.unit} "
+            "(a count scale that overflows, or missing values)"
+        )
+    return x, inp
 
 
 def validate_triads(
@@ -42,8 +63,11 @@ def validate_triads(
     latitude_deg: float | None = None,
     *,
     static_s: float = 1.0,
+    signal_unit: str | None = None,
 ) -> list[MultiposValidation]:
-    """Held-out figures of each triad (module docstring)."""
+    """Held-out figures of each triad (module docstring); ``signal_unit`` (``--signal-unit``):
+    one unit for every triad column, or one per column in the triads' order, as
+    ``compensate`` takes it."""
     from thermocal.turntable import thermal
 
     by = {t.model.kind: t for t in triads}
@@ -62,6 +86,7 @@ def validate_triads(
             raise ThermocalInputError(f"{rec.name}: give the latitude (--latitude DEG)")
         g_m_s2 = units.normal_gravity_m_s2(float(lat))
     t = rec.time_s
+    unit_opts = units.per_signal_option(signal_unit, [c for tr in triads for c in tr.columns])
 
     def temp_of(tri: Any) -> Any:
         if tri.temperature:
@@ -71,17 +96,17 @@ def validate_triads(
     def outside(tri: Any, temp: Any) -> float:
         return float(np.mean((temp < tri.model.t_lo_c) | (temp > tri.model.t_hi_c)))
 
-    xa, a_unit = _columns(rec, acc)
+    xa, a_in = triad_columns(rec, acc, unit_opts)
+    a_unit = a_in.unit
     ta = temp_of(acc)
-    a_to = float(units.convert(np.array([1.0]), "mg", a_unit)[0])
-    xa_c = thermal.correct(acc.model, xa, ta, a_to)
+    xa_c = thermal.correct(acc.model, xa, ta, a_in.to_data)
     gyr = by.get("gyro")
     xg = xg_c = None
     if gyr is not None:
-        xg, g_unit = _columns(rec, gyr)
+        xg, g_in = triad_columns(rec, gyr, unit_opts)
+        g_unit = g_in.unit
         tg = temp_of(gyr)
-        g_to = float(units.convert(np.array([1.0]), "deg/h", g_unit)[0])
-        xg_c = thermal.correct(gyr.model, xg, tg, g_to)
+        xg_c = thermal.correct(gyr.model, xg, tg, g_in.to_data)
         xg = units.convert(xg, g_unit, "rad/s")
         xg_c = units.convert(xg_c, g_unit, "rad/s")
     sections = detect_poses(t, xa, xg, static_s=static_s)

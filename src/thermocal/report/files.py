@@ -206,7 +206,9 @@ def _triad_report(
 
     rec = read_for_triads(recording, cal.triads, time=opts.time, time_unit=opts.time_unit)
     if _mp_validate.is_multipos(cal.triads):  # held-out poses (issue 30)
-        results: list[Any] = _mp_validate.validate_triads(cal.triads, rec, latitude_deg)
+        results: list[Any] = _mp_validate.validate_triads(
+            cal.triads, rec, latitude_deg, signal_unit=opts.signal_unit
+        )
     else:
         results = validate_triads(cal.triads, rec, latitude_deg)
     path = write_triad_report(output, cal, cal_path, results, recording)

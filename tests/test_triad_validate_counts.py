@@ -1,0 +1,201 @@
+"""``thermocal validate`` of a multipos calibration made on raw counts (issue 38): the
+held-out session, in the same int16 counts, is read through the count scale the calibration
+stores, exactly as ``compensate`` reads it (one code path, ``Triad.input_in``), so a good
+calibration validates as good, with its figures in the calibration's units (mg, °).
+
+Before the fix the counts were read as mg and °/s: a good calibration read
+"gravity-magnitude error 7234 → 7222 mg", "rotation-angle error 42.9 → 43.7°" on this
+session (issue 38's "380 → 804°" on the real MPU-6050's).
+
+The sessions are written the way a consumer-IMU logger writes them (``timestamp, ax, ay,
+az, gx, gy, gz``, int16 register counts of an MPU-6050 at ±4 g, 8192 LSB/g, and ±2000 °/s,
+16.4 LSB/(°/s), no unit in the header); :mod:`thermocal.multipos.simulate` only gives the
+truth.  The references are computed here, with numpy and scipy, on the truth's still
+windows (0.3 s trimmed at each end):
+
+* accelerometer "before": rms over the poses of ``|mean(count_scale · N)| − g`` [mg];
+  "after" below 3× the noise floor (rms over the poses of σ/√n, σ = 1.5 mg the simulated
+  white noise);
+* gyro "before": per motion between consecutive poses, the raw rate (counts × scale)
+  integrated by scipy's ``Rotation`` from the middle of one pose to the middle of the
+  next carries the first up direction to the second; the angle between it and the second
+  up direction, rms over the motions [°]; "after": the same with the rate corrected by the
+  TRUE parameters, ``(I + E)⁻¹ (ω − b)``, which a good calibration approaches.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import io
+import itertools
+import json
+import math
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+from scipy.spatial.transform import Rotation
+
+from thermocal.cli import main
+from thermocal.multipos.simulate import simulate_session
+
+ACC_MG_PER_COUNT = 1000.0 / 8192.0
+GYR_DPS_PER_COUNT = 1.0 / 16.4
+MG_M_S2 = 9.80665e-3
+ACC_NOISE_MG = 1.5
+TRIM = 30  # samples (0.3 s at 100 Hz) off each end of a still window
+DH_TO_RS = math.pi / 180.0 / 3600.0
+ARCSEC = math.pi / 648000.0
+
+
+def _run(args: list[str]) -> tuple[int, str, str]:
+    o, e = io.StringIO(), io.StringIO()
+    with contextlib.redirect_stdout(o), contextlib.redirect_stderr(e):
+        code = main(args)
+    return code, o.getvalue(), e.getvalue()
+
+
+def _truth() -> tuple[np.ndarray, np.ndarray]:
+    ta, tg = np.zeros(12), np.zeros(12)
+    ta[0:3], ta[3:6], ta[[8, 10, 11]] = [30.0, -45.0, 25.0], [6000.0, -4000.0, 3000.0], [
+        300.0, -250.0, 200.0]  # fmt: skip
+    tg[0:3], tg[3:6] = [3000.0, -2000.0, 1500.0], [4000.0, -3000.0, 2500.0]
+    return ta, tg
+
+
+def _write_session(path: Path, seed: int, n_poses: int = 16) -> dict[str, Any]:
+    """A simulated session written as a logger writes it; the truth and the counts."""
+    ta, tg = _truth()
+    s = simulate_session(np.random.default_rng(seed), ta, tg, n_poses=n_poses,
+                         accel_noise_mg=ACC_NOISE_MG)  # fmt: skip
+    acc = np.clip(np.round(s["accel_mg"] / ACC_MG_PER_COUNT), -32768, 32767).astype(np.int16)
+    gyr = np.clip(np.round(s["gyro_deg_s"] / GYR_DPS_PER_COUNT), -32768, 32767).astype(np.int16)
+    t = np.round(s["time_s"], 3)
+    lines = ["timestamp,ax,ay,az,gx,gy,gz"]
+    lines += [f"{t[i]:.3f},{acc[i, 0]},{acc[i, 1]},{acc[i, 2]},{gyr[i, 0]},{gyr[i, 1]},"
+              f"{gyr[i, 2]}" for i in range(t.size)]  # fmt: skip
+    path.write_text("\n".join(lines) + "\n", encoding="ascii")
+    return {"sim": s, "acc": acc.astype(np.float64), "gyr": gyr.astype(np.float64), "t": t}
+
+
+CAL_ARGS = ["--time", "timestamp", "--time-unit", "s", "--accel", "ax,ay,az", "--gyro",
+            "gx,gy,gz", "--accel-unit", "counts", "--gyro-unit", "counts", "--accel-scale",
+            f"{ACC_MG_PER_COUNT!r},mg", "--gyro-scale", f"{GYR_DPS_PER_COUNT!r},deg/s",
+            "--latitude", "45"]  # fmt: skip
+
+
+@pytest.fixture(scope="module")
+def sessions(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
+    d = tmp_path_factory.mktemp("triadval")
+    _write_session(d / "cal.csv", 11)
+    held = _write_session(d / "held.csv", 12)
+    code, _o, err = _run(["multipos", str(d / "cal.csv"), *CAL_ARGS, "-o", str(d / "cal.json")])
+    assert code == 0, err
+    return {"dir": d, **held}
+
+
+def _windows(sim: dict[str, Any]) -> list[tuple[int, int]]:
+    return [(p0 + TRIM, p1 - TRIM) for p0, p1 in sim["poses"]]
+
+
+def _accel_reference(h: dict[str, Any]) -> tuple[float, float]:
+    """(rms over poses of |mean f| − g before [mg], the noise floor [mg])."""
+    f = h["acc"] * ACC_MG_PER_COUNT
+    g_mg = h["sim"]["g_m_s2"] / MG_M_S2
+    w = _windows(h["sim"])
+    e = [np.linalg.norm(f[a:b].mean(axis=0)) - g_mg for a, b in w]
+    floor = [ACC_NOISE_MG / math.sqrt(b - a) for a, b in w]
+    return float(np.sqrt(np.mean(np.square(e)))), float(np.sqrt(np.mean(np.square(floor))))
+
+
+def _angle_errors(h: dict[str, Any], rate_rad_s: np.ndarray) -> float:
+    """rms over motions of the angle between the integrated first up direction and the
+    second [°] (module docstring)."""
+    f = h["acc"] * ACC_MG_PER_COUNT
+    dt = np.diff(h["t"])
+    errs = []
+    w = _windows(h["sim"])
+    for (a0, b0), (a1, b1) in itertools.pairwise(w):
+        i0, i1 = (a0 + b0) // 2, (a1 + b1) // 2
+        steps = Rotation.from_rotvec(rate_rad_s[i0:i1] * dt[i0:i1, None])
+        rot = Rotation.identity()
+        for k in range(len(steps)):
+            rot = rot * steps[k]
+        u0, u1 = f[a0:b0].mean(axis=0), f[a1:b1].mean(axis=0)
+        u0, u1 = u0 / np.linalg.norm(u0), u1 / np.linalg.norm(u1)
+        errs.append(math.degrees(math.asin(np.linalg.norm(np.cross(u1, rot.inv().apply(u0))))))
+    return float(np.sqrt(np.mean(np.square(errs))))
+
+
+def _gyro_reference(h: dict[str, Any]) -> tuple[float, float]:
+    """(rms angle error with the raw rate, with the rate corrected by the truth) [°]."""
+    _ta, tg = _truth()
+    w = np.radians(h["gyr"] * GYR_DPS_PER_COUNT)
+    i_e = np.eye(3) + np.diag(tg[3:6] * 1e-6)  # no misalignment in the truth
+    w_true = np.linalg.solve(i_e, (w - tg[0:3] * DH_TO_RS).T).T
+    return _angle_errors(h, w), _angle_errors(h, w_true)
+
+
+def test_validate_reads_the_counts_through_the_count_scale(sessions: dict[str, Any]) -> None:
+    d = sessions["dir"]
+    code, out, err = _run(["validate", str(d / "cal.json"), str(d / "held.csv"), "--time",
+                           "timestamp", "--time-unit", "s", "--json"])  # fmt: skip
+    assert code == 0, err
+    tri = json.loads(out)["triads"]
+    acc, gyr = tri["accel"], tri["gyro"]
+    assert acc["unit"] == "mg" and gyr["unit"] == "deg"
+    before, floor = _accel_reference(sessions)
+    assert acc["rms_before"] == pytest.approx(before, rel=2e-3)
+    assert acc["rms_after"] < 3.0 * floor, (acc["rms_after"], floor)
+    g_before, g_after = _gyro_reference(sessions)
+    assert gyr["rms_before"] == pytest.approx(g_before, rel=0.02)
+    assert gyr["rms_after"] < 2.0 * g_after + 0.01, (gyr["rms_after"], g_after)
+
+
+def test_validate_and_compensate_share_the_count_scale(sessions: dict[str, Any]) -> None:
+    """The Python API: the same figures as the CLI, and each pose's compensated gravity
+    magnitude equals the one of ``compensate``'s ``_comp`` columns over the same samples."""
+    import pandas as pd
+
+    from thermocal.pipeline.options import ValidateOptions
+    from thermocal.pipeline.validate import validate_files
+
+    d = sessions["dir"]
+    rep = validate_files(d / "cal.json", d / "held.csv",
+                         ValidateOptions(time="timestamp", time_unit="s"))  # fmt: skip
+    acc = next(r for r in rep.triads if r.triad == "accel")
+    assert acc.unit == "mg" and len(acc.per_pose) == len(sessions["sim"]["poses"])
+    code, _o, err = _run(["compensate", str(d / "cal.json"), str(d / "held.csv"), "-o",
+                          str(d / "comp.csv"), "--time", "timestamp", "--time-unit",
+                          "s"])  # fmt: skip
+    assert code == 0, err
+    comp = pd.read_csv(d / "comp.csv")[["ax_comp", "ay_comp", "az_comp"]].to_numpy()
+    g_mg = sessions["sim"]["g_m_s2"] / MG_M_S2
+    for p in acc.per_pose:
+        a, b = int(p[0]), int(p[1])
+        assert p[6] == pytest.approx(np.linalg.norm(comp[a:b].mean(axis=0)) - g_mg, abs=1e-6)
+
+
+def test_raw_counts_without_a_count_scale_refused(sessions: dict[str, Any]) -> None:
+    """A calibration made on mg (the session converted here) and a raw-count file: one error
+    line, as compensate says it."""
+    d = sessions["dir"]
+    phys = d / "cal_mg.csv"
+    lines = (d / "cal.csv").read_text().splitlines()
+    out = ["timestamp,ax,ay,az,gx,gy,gz"]
+    for ln in lines[1:]:
+        v = [float(x) for x in ln.split(",")]
+        out.append(",".join([f"{v[0]:.3f}", *(f"{x * ACC_MG_PER_COUNT:.6f}" for x in v[1:4]),
+                             *(f"{x * GYR_DPS_PER_COUNT:.6f}" for x in v[4:7])]))  # fmt: skip
+    phys.write_text("\n".join(out) + "\n")
+    code, _o, err = _run(["multipos", str(phys), "--time", "timestamp", "--time-unit", "s",
+                          "--accel", "ax,ay,az", "--gyro", "gx,gy,gz", "--accel-unit", "mg",
+                          "--gyro-unit", "deg/s", "--latitude", "45", "-o",
+                          str(d / "cal_mg.json")])  # fmt: skip
+    assert code == 0, err
+    code, _o, err = _run(["validate", str(d / "cal_mg.json"), str(d / "held.csv"), "--time",
+                          "timestamp", "--time-unit", "s", "--signal-unit", "counts"])  # fmt: skip
+    assert code == 2, err
+    assert err.count("error:") == 1 and "held.csv" in err and "no count scale" in err, err
+    assert "--accel-scale" in err, err
