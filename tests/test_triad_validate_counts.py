@@ -38,13 +38,16 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 from thermocal.cli import main
-from thermocal.multipos.simulate import simulate_session
+from thermocal.multipos.simulate import simulate_attitudes, simulate_session
 
 ACC_MG_PER_COUNT = 1000.0 / 8192.0
 GYR_DPS_PER_COUNT = 1.0 / 16.4
 MG_M_S2 = 9.80665e-3
 ACC_NOISE_MG = 1.5
 TRIM = 30  # samples (0.3 s at 100 Hz) off each end of a still window
+GYR_NOISE_DPS = 0.03  # the simulator's default
+EARTH_RATE_RAD_S = 7.2921150e-5  # WGS-84
+LATITUDE_DEG = 45.0
 DH_TO_RS = math.pi / 180.0 / 3600.0
 ARCSEC = math.pi / 648000.0
 
@@ -64,11 +67,16 @@ def _truth() -> tuple[np.ndarray, np.ndarray]:
     return ta, tg
 
 
-def _write_session(path: Path, seed: int, n_poses: int = 16) -> dict[str, Any]:
-    """A simulated session written as a logger writes it; the truth and the counts."""
+def _write_session(path: Path, seed: int, static_s: float | None = None) -> dict[str, Any]:
+    """A simulated session written as a logger writes it (``static_s``: one still pose of
+    that length, at a random attitude); the truth and the counts."""
     ta, tg = _truth()
-    s = simulate_session(np.random.default_rng(seed), ta, tg, n_poses=n_poses,
-                         accel_noise_mg=ACC_NOISE_MG)  # fmt: skip
+    rng = np.random.default_rng(seed)
+    if static_s is None:
+        s = simulate_session(rng, ta, tg, n_poses=16, accel_noise_mg=ACC_NOISE_MG)
+    else:
+        att = Rotation.random(random_state=seed).as_matrix()
+        s = simulate_attitudes(rng, [att], ta, tg, dwell_s=static_s, accel_noise_mg=ACC_NOISE_MG)
     acc = np.clip(np.round(s["accel_mg"] / ACC_MG_PER_COUNT), -32768, 32767).astype(np.int16)
     gyr = np.clip(np.round(s["gyro_deg_s"] / GYR_DPS_PER_COUNT), -32768, 32767).astype(np.int16)
     t = np.round(s["time_s"], 3)
@@ -90,9 +98,10 @@ def sessions(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
     d = tmp_path_factory.mktemp("triadval")
     _write_session(d / "cal.csv", 11)
     held = _write_session(d / "held.csv", 12)
-    code, _o, err = _run(["multipos", str(d / "cal.csv"), *CAL_ARGS, "-o", str(d / "cal.json")])
+    code, out, err = _run(["multipos", str(d / "cal.csv"), *CAL_ARGS, "-o", str(d / "cal.json"),
+                           "--json"])  # fmt: skip
     assert code == 0, err
-    return {"dir": d, **held}
+    return {"dir": d, "cal": json.loads(out), **held}
 
 
 def _windows(sim: dict[str, Any]) -> list[tuple[int, int]]:
@@ -199,3 +208,48 @@ def test_raw_counts_without_a_count_scale_refused(sessions: dict[str, Any]) -> N
     assert code == 2, err
     assert err.count("error:") == 1 and "held.csv" in err and "no count scale" in err, err
     assert "--accel-scale" in err, err
+
+
+def test_one_static_pose(sessions: dict[str, Any]) -> None:
+    """One still pose of 20 s: validated, not refused.  The gravity magnitude there before
+    and after (the test's |mean f| − g, and the noise), the gyro's mean rate at rest in the
+    calibration's unit (°/s): before, the raw mean; after, the earth rate in body axes
+    (the truth's attitude, ``Cᵀ Ω``, Ω = Ω_E (0, cos φ, sin φ) in ENU) within 4σ of the
+    calibration's bias σ and the mean's noise; and what one pose cannot judge, said."""
+    d = sessions["dir"]
+    h = _write_session(d / "static.csv", 21, static_s=20.0)
+    code, out, err = _run(["validate", str(d / "cal.json"), str(d / "static.csv"), "--time",
+                           "timestamp", "--time-unit", "s", "--json"])  # fmt: skip
+    assert code == 0, err
+    tri = json.loads(out)["triads"]
+    acc, gyr = tri["accel"], tri["gyro"]
+    ((a, b),) = _windows(h["sim"])
+    f = h["acc"][a:b] * ACC_MG_PER_COUNT
+    g_mg = h["sim"]["g_m_s2"] / MG_M_S2
+    assert acc["n"] == 1 and acc["unit"] == "mg"
+    assert acc["rms_before"] == pytest.approx(abs(np.linalg.norm(f.mean(axis=0)) - g_mg), rel=0.01)
+    assert acc["rms_after"] < 4.0 * ACC_NOISE_MG / math.sqrt(b - a) + 0.1  # + the cal's σ
+    assert gyr["unit"] == "deg/s" and gyr["what"] == "mean rate at rest"
+    raw = h["gyr"][a:b].mean(axis=0) * GYR_DPS_PER_COUNT
+    sigma_mean = GYR_NOISE_DPS / math.sqrt(b - a)
+    np.testing.assert_allclose(gyr["per_axis_before"], raw, atol=4 * sigma_mean)
+    lat = math.radians(LATITUDE_DEG)
+    om_n = EARTH_RATE_RAD_S * np.array([0.0, math.cos(lat), math.sin(lat)])
+    earth_body = np.degrees(h["sim"]["attitude"][(a + b) // 2].T @ om_n)
+    sig = np.hypot(np.array(sessions["cal"]["gyro"]["bias_sigma"]), sigma_mean)
+    assert np.all(np.abs(np.array(gyr["per_axis_after"]) - earth_body) < 4 * sig), (
+        gyr["per_axis_after"], earth_body, sig)  # fmt: skip
+    assert "needs motions between poses" in acc["not_judged"]
+    assert "earth rate" in gyr["not_judged"]
+    code, out, err = _run(["validate", str(d / "cal.json"), str(d / "static.csv"), "--time",
+                           "timestamp", "--time-unit", "s"])  # fmt: skip
+    assert code == 0 and "not judged: one still pose" in out, err
+
+
+def test_static_s_refused_when_not_a_positive_number(sessions: dict[str, Any]) -> None:
+    d = sessions["dir"]
+    for bad in ("inf", "0", "nan"):
+        code, _o, err = _run(["validate", str(d / "cal.json"), str(d / "held.csv"), "--time",
+                              "timestamp", "--time-unit", "s", "--static-s", bad])  # fmt: skip
+        assert code == 2 and err.count("error:") == 1 and "--static-s" in err, err
+        assert "held.csv" in err, err

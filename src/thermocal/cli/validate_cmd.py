@@ -79,6 +79,13 @@ StageRateOpt = Annotated[
 MinStageOpt = Annotated[
     float, typer.Option("--min-stage", help="Hold detection: shortest stage [s].")
 ]
+StaticSOpt = Annotated[
+    float,
+    typer.Option(
+        "--static-s",
+        help="A multi-position calibration's held-out session: shortest still pose [s].",
+    ),
+]
 SettleOpt = Annotated[
     float, typer.Option("--settle", help="Seconds cut from the start of each stage.")
 ]
@@ -166,6 +173,8 @@ def _human_triads(report: "_validate.ValidationReport") -> None:
             cells = [f"{fmt(b)} → {fmt(a)}" for b, a in zip(before, after, strict=True)]
             table.add_row(r.triad, label, *cells)
     stdout.print(table)
+    for note in dict.fromkeys(r.not_judged for r in results if getattr(r, "not_judged", "")):
+        stdout.print(f"not judged: {note}")
 
 
 @app.command("validate")
@@ -193,6 +202,7 @@ def validate_cmd(
     decimal: DecimalOpt = None,
     topic: TopicOpt = None,
     latitude: TurntableLatitudeOpt = None,
+    static_s: StaticSOpt = 1.0,
     as_json: JsonOpt = False,
 ) -> None:
     """Validate MODEL on FILE: correlation r, bias stability and repeatability over the

@@ -12,6 +12,7 @@ calibration recorded (else normal gravity at the latitude).
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Mapping, Sequence
 from typing import Any
@@ -70,6 +71,10 @@ def validate_triads(
     ``compensate`` takes it."""
     from thermocal.turntable import thermal
 
+    if not (math.isfinite(static_s) and static_s > 0):
+        raise ThermocalInputError(
+            f"{rec.name}: --static-s must be a positive number of seconds, got {static_s!r}"
+        )
     by = {t.model.kind: t for t in triads}
     acc = by.get("accel")
     if acc is None:
@@ -110,11 +115,61 @@ def validate_triads(
         xg = units.convert(xg, g_unit, "rad/s")
         xg_c = units.convert(xg_c, g_unit, "rad/s")
     sections = detect_poses(t, xa, xg, static_s=static_s)
-    if len(sections) < 2:
+    if not sections:
         raise ThermocalInputError(
-            f"{rec.name}: {len(sections)} still poses found: not a multi-position session"
+            f"{rec.name}: no still pose of {static_s:g} s or longer found: nothing to judge "
+            "the calibration on (record the sensor still; thermocal validate --static-s "
+            "sets the shortest pose)"
         )
     g = float(units.convert(np.array([g_m_s2]), "m/s^2", a_unit)[0])
+    out = [_accel_figures(acc.name, a_unit, xa, xa_c, sections, g, outside(acc, ta))]
+    if gyr is None or xg is None or xg_c is None:
+        if len(sections) == 1:
+            out[0] = dataclasses.replace(out[0], not_judged=ONE_POSE_NOT_JUDGED)
+        return out
+    if len(sections) == 1:
+        mb = xg[sections[0].start : sections[0].end].mean(axis=0)
+        ma = xg_c[sections[0].start : sections[0].end].mean(axis=0)
+        mb, ma = units.convert(mb, "rad/s", g_unit), units.convert(ma, "rad/s", g_unit)
+        earth = float(units.convert(np.array([units.EARTH_RATE_RAD_S]), "rad/s", g_unit)[0])
+        note = (f"the mean rate at rest holds the earth rate, |Ω| = {earth:.4g} {g_unit}, in "
+                "a direction one pose does not give")  # fmt: skip
+        out[0] = dataclasses.replace(out[0], not_judged=ONE_POSE_NOT_JUDGED)
+        out.append(
+            MultiposValidation(
+                gyr.name, g_unit, float(np.linalg.norm(mb)), float(np.linalg.norm(ma)),
+                _vec3(mb), _vec3(ma), 1, "mean rate at rest", outside(gyr, temp_of(gyr)),
+                not_judged=note,
+            )
+        )  # fmt: skip
+        return out
+    dt = np.diff(t)
+    dt = np.concatenate([dt, dt[-1:]])
+    vb = rotation_errors(xg, dt, xa, sections) * units.RAD_TO_DEG
+    va = rotation_errors(xg_c, dt, xa_c, sections) * units.RAD_TO_DEG
+    nb, na = np.linalg.norm(vb, axis=1), np.linalg.norm(va, axis=1)
+    out.append(
+        MultiposValidation(
+            gyr.name, "deg", float(math.sqrt(np.mean(nb**2))), float(math.sqrt(np.mean(na**2))),
+            _rms3(vb), _rms3(va), len(nb), "rotation-angle error", outside(gyr, temp_of(gyr)),
+        )
+    )  # fmt: skip
+    return out
+
+
+ONE_POSE_NOT_JUDGED = (
+    "one still pose: not judged are the gyro's scale factors and misalignments (the "
+    "rotation-angle error needs motions between poses) and the accelerometer's scale factors "
+    "and misalignments beyond this one direction (they need poses in several directions)"
+)
+"""What a validation on one static pose cannot judge (said beside its figures)."""
+
+
+def _accel_figures(
+    name: str, unit: str, xa: Any, xa_c: Any, sections: Sequence[Any], g: float, out: float
+) -> MultiposValidation:
+    """The accelerometer's gravity-magnitude errors ``|mean f| − g`` per pose, before and
+    after, rms over the poses [``unit``], and each pose's up direction."""
     eb, ea, pb, pa = gravity_errors(xa, xa_c, sections, g)
     means = np.asarray([xa_c[s.start : s.end].mean(axis=0) for s in sections])
     up = means / np.linalg.norm(means, axis=1)[:, None]
@@ -122,40 +177,14 @@ def validate_triads(
         (float(s.start), float(s.end), *(float(v) for v in u), float(b), float(a))
         for s, u, b, a in zip(sections, up, eb, ea, strict=True)
     )
-    out = [
-        MultiposValidation(
-            acc.name,
-            a_unit,
-            float(np.sqrt(np.mean(eb**2))),
-            float(np.sqrt(np.mean(ea**2))),
-            _rms3(pb),
-            _rms3(pa),
-            len(sections),
-            "gravity-magnitude error",
-            outside(acc, ta),
-            per_pose,
-        )
-    ]
-    if gyr is not None and xg is not None and xg_c is not None:
-        dt = np.diff(t)
-        dt = np.concatenate([dt, dt[-1:]])
-        vb = rotation_errors(xg, dt, xa, sections) * units.RAD_TO_DEG
-        va = rotation_errors(xg_c, dt, xa_c, sections) * units.RAD_TO_DEG
-        nb, na = np.linalg.norm(vb, axis=1), np.linalg.norm(va, axis=1)
-        out.append(
-            MultiposValidation(
-                gyr.name,
-                "deg",
-                float(math.sqrt(np.mean(nb**2))),
-                float(math.sqrt(np.mean(na**2))),
-                _rms3(vb),
-                _rms3(va),
-                len(nb),
-                "rotation-angle error",
-                outside(gyr, temp_of(gyr)),
-            )
-        )
-    return out
+    return MultiposValidation(
+        name, unit, float(np.sqrt(np.mean(eb**2))), float(np.sqrt(np.mean(ea**2))),
+        _rms3(pb), _rms3(pa), len(sections), "gravity-magnitude error", out, per_pose,
+    )  # fmt: skip
+
+
+def _vec3(v: Any) -> tuple[float, float, float]:
+    return (float(v[0]), float(v[1]), float(v[2]))
 
 
 def _rms3(v: Any) -> tuple[float, float, float]:
