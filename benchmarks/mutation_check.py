@@ -1089,6 +1089,39 @@ MUTANTS: tuple[Mutant, ...] = (
         (*MULTI, "tests/test_multipos_sigma.py"),
         "gyro scale σ without the bias uncertainty",
     ),
+    # --- triad validation and report on raw counts (issue 38) ------------------------------
+    Mutant(
+        "triad-count-scale-divided",
+        P + "models/calibration.py",
+        "return x * self.count_scale",
+        "return x / self.count_scale",
+        _t("triad_validate_counts"),
+        "validate: raw counts divided by the count scale",
+    ),
+    Mutant(
+        "triad-one-pose-after-raw",
+        P + "multipos/validate.py",
+        "ma = xg_c[sections[0].start : sections[0].end].mean(axis=0)",
+        "ma = xg[sections[0].start : sections[0].end].mean(axis=0)",
+        _t("triad_validate_counts"),
+        "one still pose: the gyro's rate at rest after = before",
+    ),
+    Mutant(
+        "triad-report-bias-as-stored",
+        P + "report/triads.py",
+        'if f.name.startswith("bias") and f.unit != tri.unit:',
+        'if f.name.startswith("bias") and f.unit == tri.unit:',
+        _t("report_triads"),
+        "triad report: a deg/s gyro's bias shown in deg/h",
+    ),
+    Mutant(
+        "triad-report-one-temperature-plotted",
+        P + "report/triads.py",
+        "over_t = len(temps) >= 2",
+        "over_t = len(temps) >= 1",
+        _t("report_triads"),
+        "triad report: one temperature plotted against temperature",
+    ),
     # --- station -----------------------------------------------------------------------------
     Mutant(
         "station-part-rotation-strict",
