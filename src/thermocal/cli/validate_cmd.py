@@ -167,7 +167,7 @@ def _human_triads(report: "_validate.ValidationReport") -> None:
     model_file, file, results = report.model_file, report.file, report.triads
     table = _rich_table.Table(title=f"{model_file} on {file}")
     for col in ("triad", "figure", "x before → after", "y before → after", "z before → after"):
-        table.add_column(col)
+        table.add_column(col, overflow="fold")  # wrapped, never cut
     for r in results:
         for label, before, after in r.rows():
             cells = [f"{fmt(b)} → {fmt(a)}" for b, a in zip(before, after, strict=True)]

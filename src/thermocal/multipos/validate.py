@@ -8,6 +8,14 @@ the accelerometer triad, which gives the up directions): per motion between cons
 poses, the rotation-angle error ``|u_{k+1} × A_{k+1}ᵀ A_k⁻ᵀ u_k|`` [°] (:func:`.calibrate.
 rotation_errors`) with raw data before and compensated data after.  ``g`` is the one the
 calibration recorded (else normal gravity at the latitude).
+
+The triads' columns enter as ``compensate`` takes them (:func:`triad_columns`): raw counts
+of a triad calibrated on counts through its count scale, so the figures are in the
+calibration's units.  A session of ONE still pose is judged on what it can show: the
+gravity-magnitude error of that pose and the gyro's mean rate at rest before and after
+[gyro unit] (per axis the signed mean; its magnitude as the total), which holds the earth
+rate in a direction one pose does not give; ``not_judged`` says what needs motions or other
+directions.
 """
 
 from __future__ import annotations
