@@ -253,3 +253,28 @@ def test_static_s_refused_when_not_a_positive_number(sessions: dict[str, Any]) -
                               "timestamp", "--time-unit", "s", "--static-s", bad])  # fmt: skip
         assert code == 2 and err.count("error:") == 1 and "--static-s" in err, err
         assert "held.csv" in err, err
+
+
+def test_one_static_pose_of_an_accelerometer_alone(sessions: dict[str, Any]) -> None:
+    """An accelerometer triad alone on one still pose: its figures, and a note that names
+    only what it cannot judge (no gyro it does not have)."""
+    d = sessions["dir"]
+    code, _o, err = _run(["multipos", str(d / "cal.csv"), "--time", "timestamp", "--time-unit",
+                          "s", "--accel", "ax,ay,az", "--accel-unit", "counts", "--accel-scale",
+                          f"{ACC_MG_PER_COUNT!r},mg", "--latitude", "45", "-o",
+                          str(d / "cal_acc.json")])  # fmt: skip
+    assert code == 0, err
+    h = _write_session(d / "static_acc.csv", 22, static_s=20.0)
+    code, out, err = _run(["validate", str(d / "cal_acc.json"), str(d / "static_acc.csv"),
+                           "--time", "timestamp", "--time-unit", "s", "--json"])  # fmt: skip
+    assert code == 0, err
+    tri = json.loads(out)["triads"]
+    assert list(tri) == ["accel"] and tri["accel"]["n"] == 1
+    ((a, b),) = _windows(h["sim"])
+    f = h["acc"][a:b] * ACC_MG_PER_COUNT
+    g_mg = h["sim"]["g_m_s2"] / MG_M_S2
+    assert tri["accel"]["rms_before"] == pytest.approx(
+        abs(np.linalg.norm(f.mean(axis=0)) - g_mg), rel=0.01
+    )
+    note = tri["accel"]["not_judged"]
+    assert "accelerometer's scale factors" in note and "gyro" not in note

@@ -133,7 +133,7 @@ def validate_triads(
     out = [_accel_figures(acc.name, a_unit, xa, xa_c, sections, g, outside(acc, ta))]
     if gyr is None or xg is None or xg_c is None:
         if len(sections) == 1:
-            out[0] = dataclasses.replace(out[0], not_judged=ONE_POSE_NOT_JUDGED)
+            out[0] = dataclasses.replace(out[0], not_judged=ONE_POSE_ACCEL_NOT_JUDGED)
         return out
     if len(sections) == 1:
         mb = xg[sections[0].start : sections[0].end].mean(axis=0)
@@ -165,12 +165,17 @@ def validate_triads(
     return out
 
 
+ONE_POSE_ACCEL_NOT_JUDGED = (
+    "one still pose: not judged are the accelerometer's scale factors and misalignments "
+    "beyond this one direction (they need poses in several directions)"
+)
 ONE_POSE_NOT_JUDGED = (
     "one still pose: not judged are the gyro's scale factors and misalignments (the "
     "rotation-angle error needs motions between poses) and the accelerometer's scale factors "
     "and misalignments beyond this one direction (they need poses in several directions)"
 )
-"""What a validation on one static pose cannot judge (said beside its figures)."""
+"""What a validation on one static pose cannot judge (said beside its figures; the first
+for an accelerometer triad alone)."""
 
 
 def _accel_figures(
