@@ -154,6 +154,11 @@ def test_validate_reads_the_counts_through_the_count_scale(sessions: dict[str, A
     tri = json.loads(out)["triads"]
     acc, gyr = tri["accel"], tri["gyro"]
     assert acc["unit"] == "mg" and gyr["unit"] == "deg"
+    # what was read and how, as compensate says it
+    assert (acc["input_unit"], acc["count_scale"], acc["physical_unit"]) == (
+        "counts", ACC_MG_PER_COUNT, "mg")  # fmt: skip
+    assert (gyr["input_unit"], gyr["count_scale"], gyr["physical_unit"]) == (
+        "counts", GYR_DPS_PER_COUNT, "deg/s")  # fmt: skip
     before, floor = _accel_reference(sessions)
     assert acc["rms_before"] == pytest.approx(before, rel=2e-3)
     assert acc["rms_after"] < 3.0 * floor, (acc["rms_after"], floor)

@@ -173,6 +173,13 @@ def _human_triads(report: "_validate.ValidationReport") -> None:
             cells = [f"{fmt(b)} → {fmt(a)}" for b, a in zip(before, after, strict=True)]
             table.add_row(r.triad, label, *cells)
     stdout.print(table)
+    for r in results:
+        scale = getattr(r, "count_scale", None)
+        if scale is not None:
+            stdout.print(
+                f"{r.triad}: read from raw counts, one count = {scale:.10g} {r.physical_unit} (the "
+                "calibration's count scale, as compensate applies it)"
+            )
     for note in dict.fromkeys(r.not_judged for r in results if getattr(r, "not_judged", "")):
         stdout.print(f"not judged: {note}")
 

@@ -267,6 +267,13 @@ class MultiposValidation:
     [``unit``], for the report's poses on the sphere (not in ``to_dict``)."""
     not_judged: str = ""
     """What these figures cannot judge (a validation on one still pose), else empty."""
+    input_unit: str = ""
+    """The unit the triad's columns were read in (``counts`` for raw counts)."""
+    count_scale: float | None = None
+    """Raw counts: one count is ``count_scale`` ``physical_unit`` (the calibration's), as
+    ``compensate`` applies it; None for columns already in a physical unit."""
+    physical_unit: str = ""
+    """The triad's own unit, the one its columns are judged in."""
 
     def to_dict(self) -> dict[str, Any]:
         from dataclasses import asdict

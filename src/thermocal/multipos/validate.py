@@ -131,6 +131,7 @@ def validate_triads(
         )
     g = float(units.convert(np.array([g_m_s2]), "m/s^2", a_unit)[0])
     out = [_accel_figures(acc.name, a_unit, xa, xa_c, sections, g, outside(acc, ta))]
+    out = _with_input(out, a_in)
     if gyr is None or xg is None or xg_c is None:
         if len(sections) == 1:
             out[0] = dataclasses.replace(out[0], not_judged=ONE_POSE_ACCEL_NOT_JUDGED)
@@ -147,7 +148,8 @@ def validate_triads(
             MultiposValidation(
                 gyr.name, g_unit, float(np.linalg.norm(mb)), float(np.linalg.norm(ma)),
                 _vec3(mb), _vec3(ma), 1, "mean rate at rest", outside(gyr, temp_of(gyr)),
-                not_judged=note,
+                not_judged=note, input_unit=g_in.data_unit, count_scale=g_in.count_scale,
+                physical_unit=g_in.unit,
             )
         )  # fmt: skip
         return out
@@ -160,6 +162,7 @@ def validate_triads(
         MultiposValidation(
             gyr.name, "deg", float(math.sqrt(np.mean(nb**2))), float(math.sqrt(np.mean(na**2))),
             _rms3(vb), _rms3(va), len(nb), "rotation-angle error", outside(gyr, temp_of(gyr)),
+            input_unit=g_in.data_unit, count_scale=g_in.count_scale, physical_unit=g_in.unit,
         )
     )  # fmt: skip
     return out
@@ -194,6 +197,16 @@ def _accel_figures(
         name, unit, float(np.sqrt(np.mean(eb**2))), float(np.sqrt(np.mean(ea**2))),
         _rms3(pb), _rms3(pa), len(sections), "gravity-magnitude error", out, per_pose,
     )  # fmt: skip
+
+
+def _with_input(out: list[MultiposValidation], inp: Any) -> list[MultiposValidation]:
+    """The accelerometer's figures with the unit its columns were read in and the count
+    scale applied (:class:`~thermocal.models.calibration.TriadInput`)."""
+    return [
+        dataclasses.replace(
+            out[0], input_unit=inp.data_unit, count_scale=inp.count_scale, physical_unit=inp.unit
+        )
+    ]
 
 
 def _vec3(v: Any) -> tuple[float, float, float]:
