@@ -1101,8 +1101,8 @@ MUTANTS: tuple[Mutant, ...] = (
     Mutant(
         "triad-one-pose-after-raw",
         P + "multipos/validate.py",
-        "ma = xg_c[sections[0].start : sections[0].end].mean(axis=0)",
-        "ma = xg[sections[0].start : sections[0].end].mean(axis=0)",
+        'ma = units.convert(xg_c[pose.start : pose.end].mean(axis=0), "rad/s", unit)',
+        'ma = units.convert(xg[pose.start : pose.end].mean(axis=0), "rad/s", unit)',
         _t("triad_validate_counts"),
         "one still pose: the gyro's rate at rest after = before",
     ),

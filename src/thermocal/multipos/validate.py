@@ -137,22 +137,9 @@ def validate_triads(
             out[0] = dataclasses.replace(out[0], not_judged=ONE_POSE_ACCEL_NOT_JUDGED)
         return out
     if len(sections) == 1:
-        mb = xg[sections[0].start : sections[0].end].mean(axis=0)
-        ma = xg_c[sections[0].start : sections[0].end].mean(axis=0)
-        mb, ma = units.convert(mb, "rad/s", g_unit), units.convert(ma, "rad/s", g_unit)
-        earth = float(units.convert(np.array([units.EARTH_RATE_RAD_S]), "rad/s", g_unit)[0])
-        note = (f"the mean rate at rest holds the earth rate, |Ω| = {earth:.4g} {g_unit}, in "
-                "a direction one pose does not give")  # fmt: skip
         out[0] = dataclasses.replace(out[0], not_judged=ONE_POSE_NOT_JUDGED)
-        out.append(
-            MultiposValidation(
-                gyr.name, g_unit, float(np.linalg.norm(mb)), float(np.linalg.norm(ma)),
-                _vec3(mb), _vec3(ma), 1, "mean rate at rest", outside(gyr, temp_of(gyr)),
-                not_judged=note, input_unit=g_in.data_unit, count_scale=g_in.count_scale,
-                physical_unit=g_in.unit,
-            )
-        )  # fmt: skip
-        return out
+        return [*out, _rate_at_rest(gyr.name, xg, xg_c, sections[0], g_in,
+                                    outside(gyr, temp_of(gyr)))]  # fmt: skip
     dt = np.diff(t)
     dt = np.concatenate([dt, dt[-1:]])
     vb = rotation_errors(xg, dt, xa, sections) * units.RAD_TO_DEG
@@ -196,6 +183,25 @@ def _accel_figures(
     return MultiposValidation(
         name, unit, float(np.sqrt(np.mean(eb**2))), float(np.sqrt(np.mean(ea**2))),
         _rms3(pb), _rms3(pa), len(sections), "gravity-magnitude error", out, per_pose,
+    )  # fmt: skip
+
+
+def _rate_at_rest(
+    name: str, xg: Any, xg_c: Any, pose: Any, g_in: Any, out: float
+) -> MultiposValidation:
+    """The gyro on one still pose: its mean rate before (raw) and after compensation, per
+    axis (signed) and in magnitude, in the triad's unit ``g_in.unit`` (``xg``, ``xg_c`` in
+    rad/s); the earth rate it holds, named in ``not_judged``."""
+    unit = g_in.unit
+    mb = units.convert(xg[pose.start : pose.end].mean(axis=0), "rad/s", unit)
+    ma = units.convert(xg_c[pose.start : pose.end].mean(axis=0), "rad/s", unit)
+    earth = float(units.convert(np.array([units.EARTH_RATE_RAD_S]), "rad/s", unit)[0])
+    note = (f"the mean rate at rest holds the earth rate, |Ω| = {earth:.4g} {unit}, in a "
+            "direction one pose does not give")  # fmt: skip
+    return MultiposValidation(
+        name, unit, float(np.linalg.norm(mb)), float(np.linalg.norm(ma)), _vec3(mb), _vec3(ma),
+        1, "mean rate at rest", out, not_judged=note, input_unit=g_in.data_unit,
+        count_scale=g_in.count_scale, physical_unit=unit,
     )  # fmt: skip
 
 
