@@ -283,3 +283,28 @@ def test_one_static_pose_of_an_accelerometer_alone(sessions: dict[str, Any]) -> 
     )
     note = tri["accel"]["not_judged"]
     assert "accelerometer's scale factors" in note and "gyro" not in note
+
+
+def test_the_same_session_in_physical_units_validates_alike(sessions: dict[str, Any]) -> None:
+    """The held-out session converted here to mg and °/s (``--signal-unit``, one unit per
+    column in the triads' order, as compensate takes it) gives the figures of its counts."""
+    d = sessions["dir"]
+    lines = (d / "held.csv").read_text().splitlines()
+    out = [lines[0]]
+    for ln in lines[1:]:
+        v = [float(x) for x in ln.split(",")]
+        out.append(",".join([f"{v[0]:.3f}", *(repr(x * ACC_MG_PER_COUNT) for x in v[1:4]),
+                             *(repr(x * GYR_DPS_PER_COUNT) for x in v[4:7])]))  # fmt: skip
+    (d / "held_phys.csv").write_text("\n".join(out) + "\n")
+    res = {}
+    per_column = ["--signal-unit", "mg,mg,mg,deg/s,deg/s,deg/s"]
+    for name, extra in (("held.csv", []), ("held_phys.csv", per_column)):
+        code, o, err = _run(["validate", str(d / "cal.json"), str(d / name), "--time",
+                             "timestamp", "--time-unit", "s", "--json", *extra])  # fmt: skip
+        assert code == 0, err
+        res[name] = json.loads(o)["triads"]
+    for tri in ("accel", "gyro"):
+        a, b = res["held.csv"][tri], res["held_phys.csv"][tri]
+        assert b["input_unit"] != "counts" and b["count_scale"] is None
+        for k in ("rms_before", "rms_after", "per_axis_before", "per_axis_after"):
+            np.testing.assert_allclose(b[k], a[k], rtol=1e-9, atol=1e-12)
