@@ -1089,39 +1089,6 @@ MUTANTS: tuple[Mutant, ...] = (
         (*MULTI, "tests/test_multipos_sigma.py"),
         "gyro scale σ without the bias uncertainty",
     ),
-    # --- triad validation and report on raw counts (issue 38) ------------------------------
-    Mutant(
-        "triad-count-scale-divided",
-        P + "models/calibration.py",
-        "return x * self.count_scale",
-        "return x / self.count_scale",
-        _t("triad_validate_counts"),
-        "validate: raw counts divided by the count scale",
-    ),
-    Mutant(
-        "triad-one-pose-after-raw",
-        P + "multipos/validate.py",
-        'ma = units.convert(xg_c[pose.start : pose.end].mean(axis=0), "rad/s", unit)',
-        'ma = units.convert(xg[pose.start : pose.end].mean(axis=0), "rad/s", unit)',
-        _t("triad_validate_counts"),
-        "one still pose: the gyro's rate at rest after = before",
-    ),
-    Mutant(
-        "triad-report-bias-as-stored",
-        P + "report/triads.py",
-        'if f.name.startswith("bias") and f.unit != tri.unit:',
-        'if f.name.startswith("bias") and f.unit == tri.unit:',
-        _t("report_triads"),
-        "triad report: a deg/s gyro's bias shown in deg/h",
-    ),
-    Mutant(
-        "triad-report-one-temperature-plotted",
-        P + "report/triads.py",
-        "over_t = len(temps) >= 2",
-        "over_t = len(temps) >= 1",
-        _t("report_triads"),
-        "triad report: one temperature plotted against temperature",
-    ),
     # --- station -----------------------------------------------------------------------------
     Mutant(
         "station-part-rotation-strict",
@@ -1179,6 +1146,39 @@ MUTANTS: tuple[Mutant, ...] = (
         '"time": "timestamp", "time_unit": "ms"',
         FC,
         "ULog timestamps read as milliseconds",
+    ),
+    # --- triad validation and report on raw counts (issue 38) ------------------------------
+    Mutant(
+        "triad-count-scale-divided",
+        P + "models/calibration.py",
+        "return x * self.count_scale",
+        "return x / self.count_scale",
+        _t("triad_validate_counts"),
+        "validate: raw counts divided by the count scale",
+    ),
+    Mutant(
+        "triad-one-pose-after-raw",
+        P + "multipos/validate.py",
+        'ma = units.convert(xg_c[pose.start : pose.end].mean(axis=0), "rad/s", unit)',
+        'ma = units.convert(xg[pose.start : pose.end].mean(axis=0), "rad/s", unit)',
+        _t("triad_validate_counts"),
+        "one still pose: the gyro's rate at rest after = before",
+    ),
+    Mutant(
+        "triad-report-bias-as-stored",
+        P + "report/triads.py",
+        'if f.name.startswith("bias") and f.unit != tri.unit:',
+        'if f.name.startswith("bias") and f.unit == tri.unit:',
+        _t("report_triads"),
+        "triad report: a deg/s gyro's bias shown in deg/h",
+    ),
+    Mutant(
+        "triad-report-one-temperature-plotted",
+        P + "report/triads.py",
+        "over_t = len(temps) >= 2",
+        "over_t = len(temps) >= 1",
+        _t("report_triads"),
+        "triad report: one temperature plotted against temperature",
     ),
     # --- C export -----------------------------------------------------------------------
     Mutant(
