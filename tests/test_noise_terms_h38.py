@@ -1,0 +1,135 @@
+"""Noise terms read where the curve follows them (issue 38, "Noise on real sensors").
+
+Records built here with known truth, shaped like the issue's static MEMS IMU:
+
+* white rate noise through the sensor's own first-order low-pass filter at 20 Hz (sampled at
+  100 Hz: local ADEV slopes near −0.3 and −0.4 at τ = 0.01–0.04 s, not −½), a flicker floor
+  (IEEE 952 PSD (B²/2π)/f, flat ADEV 0.6643·B) and rate random walk.  The angle random walk
+  must be read on the −½ stretch found in the data (the filtered points lie below the white
+  noise's line), the bias instability at the curve's minimum with τ, interval and quality.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from scipy import signal
+
+from thermocal.stability import allan
+from thermocal.stability import noise_model as nm
+
+FS = 100.0
+N_DEG_SQRT_H = 0.3  # angle random walk [°/√h]
+B_DEG_H = 4.0  # bias instability [°/h]
+K_DEG_H_SQRT_H = 10.0  # rate random walk [°/h/√h]: the curve turns up after ~300 s
+F_CUT_HZ = 20.0  # the sensor's own first-order low-pass filter
+
+
+def _flicker(rng: np.random.Generator, n: int, b: float, fs: float = FS) -> np.ndarray:
+    """Flicker with IEEE 952's two-sided PSD (B²/2π)/f (one-sided B²/(πf))."""
+    f = np.fft.rfftfreq(n, 1.0 / fs)
+    s = np.zeros_like(f)
+    s[1:] = b**2 / (math.pi * f[1:])
+    z = (rng.standard_normal(f.size) + 1j * rng.standard_normal(f.size)) / math.sqrt(2.0)
+    return np.asarray(np.fft.irfft(z * np.sqrt(s * fs * n / 2.0), n))
+
+
+def _filtered_record(seed: int, hours: float = 1.5) -> np.ndarray:
+    """Rate [°/h]: white noise of density N through a unit-gain first-order low-pass filter
+    at 20 Hz (its DC gain 1 keeps σ² → N²/τ at long τ), flicker B, random walk K."""
+    rng = np.random.default_rng(seed)
+    n = int(hours * 3600 * FS)
+    white = rng.standard_normal(n) * (N_DEG_SQRT_H * 60.0) * math.sqrt(FS)
+    a = math.exp(-2.0 * math.pi * F_CUT_HZ / FS)
+    shaped = signal.lfilter([1.0 - a], [1.0, -a], white)
+    rrw = np.cumsum(rng.standard_normal(n)) * (K_DEG_H_SQRT_H / 60.0) / math.sqrt(FS)
+    return np.asarray(12.0 + shaped + _flicker(rng, n, B_DEG_H) + rrw)
+
+
+@pytest.fixture(scope="module")
+def filtered() -> tuple[allan.AllanResult, allan.NoiseTerms]:
+    res = allan.overlapping_adev(_filtered_record(38), 1.0 / FS, "octave", unit="deg/h")
+    return res, allan.noise_terms(res)
+
+
+def test_the_record_has_the_issues_filtered_short_tau(
+    filtered: tuple[allan.AllanResult, allan.NoiseTerms],
+) -> None:
+    # the scenario, computed from the curve here: slopes between the points at 0.01–0.04 s
+    # are far from −½ (the sensor's own filter), and those points lie below N/√τ
+    res, _nt = filtered
+    lt, ld = np.log(res.tau_s), np.log(res.adev)
+    slopes = np.diff(ld) / np.diff(lt)
+    assert slopes[0] > -0.35 and slopes[1] > -0.46, slopes[:3]
+    n_native = N_DEG_SQRT_H * 60.0
+    assert res.adev[0] < 0.8 * n_native / math.sqrt(res.tau_s[0])
+
+
+def test_arw_is_read_on_the_half_stretch(
+    filtered: tuple[allan.AllanResult, allan.NoiseTerms],
+) -> None:
+    _res, nt = filtered
+    arw = nt.slope.angle_random_walk
+    assert arw.value is not None and arw.low is not None and arw.high is not None, arw.reason
+    assert arw.low <= N_DEG_SQRT_H <= arw.high, (arw.low, arw.high)
+    assert arw.value == pytest.approx(N_DEG_SQRT_H, rel=0.03)  # before the fix: −11 %
+    assert arw.tau_range_s is not None and arw.tau_range_s[0] >= 0.08  # above the filter
+    assert arw.tau_range_s[1] > 2.0 * arw.tau_range_s[0]
+    # the filtered points are left out of the fit, which then finds N too
+    assert nt.shaped_below_s is not None and 0.02 < nt.shaped_below_s <= arw.tau_range_s[0]
+    fit = nt.fit.angle_random_walk
+    assert fit.value == pytest.approx(N_DEG_SQRT_H, rel=0.03)
+
+
+def test_kalibr_density_inherits_the_half_stretch() -> None:
+    ax = nm.axis_noise(_filtered_record(39, 1.0), 1.0 / FS, name="gz", sensor="gyro", unit="deg/h")
+    n_si = N_DEG_SQRT_H * math.pi / 180.0 / 60.0  # °/√h → rad/s/√Hz
+    assert ax.density.method == "slope"
+    assert ax.density.value == pytest.approx(n_si, rel=0.04)
+    assert ax.density.low is not None and ax.density.high is not None
+    assert ax.density.low <= n_si <= ax.density.high
+
+
+def _long_record(seed: int, fs: float = 10.0, hours: float = 20.0) -> np.ndarray:
+    """Rate [°/h] of a day-long static record at 10 Hz: white N, flicker B, random walk K."""
+    rng = np.random.default_rng(seed)
+    n = int(hours * 3600 * fs)
+    white = rng.standard_normal(n) * (N_DEG_SQRT_H * 60.0) * math.sqrt(fs)
+    rrw = np.cumsum(rng.standard_normal(n)) * (K_DEG_H_SQRT_H / 60.0) / math.sqrt(fs)
+    return np.asarray(white + _flicker(rng, n, B_DEG_H, fs) + rrw)
+
+
+@pytest.mark.parametrize("seed", [381, 382])
+def test_bias_instability_at_the_minimum(seed: int) -> None:
+    res = allan.overlapping_adev(_long_record(seed), 0.1, "octave", unit="deg/h")
+    nt = allan.noise_terms(res)
+    bi = nt.bias_minimum
+    assert bi is not None and bi.value is not None and bi.tau_s is not None
+    assert bi.low is not None and bi.high is not None and bi.unit == "deg/h"
+    # the minimum among the points of ≥ 5 degrees of freedom (the last points of one or two
+    # fall far below the curve by chance)
+    sure = res.edf >= 5.0
+    k = int(np.argmin(np.where(sure, res.adev, np.inf)))
+    assert bi.tau_s == res.tau_s[k] and bi.tau_s < res.tau_s[sure][-1]
+    assert bi.value == pytest.approx(res.adev[k] / 0.6643, rel=1e-3)  # IEEE 952 C.3
+    # the truth's curve at that τ (its other terms add to the floor), inside the interval
+    tau = bi.tau_s
+    level = math.sqrt(
+        (0.6643 * B_DEG_H) ** 2
+        + (N_DEG_SQRT_H * 60.0) ** 2 / tau
+        + (K_DEG_H_SQRT_H / 60) ** 2 * tau / 3
+    )
+    assert bi.low <= level / 0.6643 <= bi.high, (bi.low, level / 0.6643, bi.high)
+    assert bi.value == pytest.approx(B_DEG_H, rel=0.25)
+    assert bi.quality == "good", bi.reason  # the curve rises beyond both intervals after it
+
+
+def test_bias_minimum_at_the_records_end_is_flagged() -> None:
+    rng = np.random.default_rng(7)
+    res = allan.overlapping_adev(rng.standard_normal(2**14), 1.0, "octave")
+    bi = allan.noise_terms(res).bias_minimum
+    assert bi is not None and bi.quality == "poor"
+    assert bi.tau_s == res.tau_s[res.edf >= 5.0][-1]
+    assert "record's end" in (bi.reason or "")
