@@ -11,12 +11,16 @@ Records built here with known truth, shaped like the issue's static MEMS IMU:
 
 from __future__ import annotations
 
+import json
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
+import yaml
 from scipy import signal
 
+from thermocal.cli import main
 from thermocal.stability import allan
 from thermocal.stability import noise_model as nm
 
@@ -133,3 +137,69 @@ def test_bias_minimum_at_the_records_end_is_flagged() -> None:
     assert bi is not None and bi.quality == "poor"
     assert bi.tau_s == res.tau_s[res.edf >= 5.0][-1]
     assert "record's end" in (bi.reason or "")
+
+
+# --- through the command line, as a user runs it -------------------------------------------
+
+
+@pytest.fixture(scope="module")
+def imu_csv(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """Half an hour at 100 Hz: three filtered gyro axes [°/h] and three accelerometer axes
+    [mg] of white noise only (N_a = 0.05 mg·√s), as a CSV with units in the column names."""
+    rng = np.random.default_rng(3838)
+    n = int(0.5 * 3600 * FS)
+    cols = {"time [s]": np.arange(n) / FS}
+    for i, ax in enumerate("xyz"):
+        cols[f"g{ax} [deg/h]"] = _filtered_record(100 + i, 0.5)
+    for ax in "xyz":
+        cols[f"a{ax} [mg]"] = rng.standard_normal(n) * ACC_N_MG * math.sqrt(FS)
+    path = tmp_path_factory.mktemp("h38") / "static.csv"
+    np.savetxt(path, np.column_stack(list(cols.values())), delimiter=",",
+               header=",".join(cols), comments="", fmt="%.7g")  # fmt: skip
+    return path
+
+
+ACC_N_MG = 0.05  # accelerometer white noise [mg·√s]
+GYRO = "gx [deg/h],gy [deg/h],gz [deg/h]"
+
+
+def test_allan_json_states_the_stretch_and_the_minimum(
+    imu_csv: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    assert main(["allan", str(imu_csv), "--signal", "gx [deg/h]", "--json"]) == 0
+    doc = json.loads(capsys.readouterr().out)
+    arw = doc["noise_slope"]["angle_random_walk"]
+    assert arw["value"] == pytest.approx(N_DEG_SQRT_H, rel=0.04)
+    assert arw["low"] <= N_DEG_SQRT_H <= arw["high"]
+    assert arw["tau_range_s"][0] >= 0.08  # not the filtered short τ
+    assert doc["shaped_below_s"] is not None and doc["shaped_below_s"] >= 0.04
+    bm = doc["bias_instability_minimum"]
+    k = int(np.argmin(np.where(np.asarray(doc["edf"]) >= 5.0, doc["adev"], np.inf)))
+    assert bm["tau_s"] == doc["tau_s"][k]
+    assert bm["value"] == pytest.approx(doc["adev"][k] / 0.6643, rel=1e-3)
+    assert bm["quality"] in ("good", "rough", "poor") and bm["unit"] == "deg/h"
+
+
+def test_allan_table_never_shows_a_dash_for_the_bias_instability(
+    imu_csv: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.setenv("COLUMNS", "200")
+    assert main(["allan", str(imu_csv), "--signal", GYRO]) == 0
+    out = capsys.readouterr().out
+    row = next(line for line in out.splitlines() if "at the curve's minimum" in line)
+    cells = [c.strip() for c in row.split("│")[2:-1]]
+    assert len(cells) == 3 and all("deg/h (τ" in c for c in cells), row
+
+
+def test_kalibr_file_inherits_the_half_stretch(imu_csv: Path, tmp_path: Path) -> None:
+    out = tmp_path / "imu.yaml"
+    rc = main(["noise", str(imu_csv), "--gyro", GYRO, "--accel", "ax [mg],ay [mg],az [mg]",
+               "-o", str(out)])  # fmt: skip
+    assert rc == 0
+    text = out.read_text(encoding="utf-8")
+    doc = yaml.safe_load(text)
+    n_si = N_DEG_SQRT_H * math.pi / 180.0 / 60.0  # °/√h → rad/s/√Hz
+    # the largest of three axes: above the truth by at most the spread of three estimates
+    assert n_si * 0.99 <= doc["gyroscope_noise_density"] <= n_si * 1.05
+    assert doc["accelerometer_noise_density"] == pytest.approx(ACC_N_MG * 9.80665e-3, rel=0.03)
+    assert "stretch τ =" in text.split("gyroscope_noise_density:")[0]

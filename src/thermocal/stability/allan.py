@@ -1017,8 +1017,8 @@ class WhiteStretch:
 
     ``start``/``stop`` the index range of the points used (into the arrays given);
     ``intercept`` c of the line ``ln σ = c − ½ ln τ`` (σ(1 s) = e^c, the white-noise
-    coefficient N [unit·√s]); ``shaped_stop`` the points ``[0, shaped_stop)`` before the
-    stretch that lie below its line beyond their intervals (the sensor's own low-pass
+    coefficient N [unit·√s]); ``shaped_stop`` the leading points ``[0, shaped_stop)`` before
+    the stretch that each lie below its line beyond their intervals (the sensor's own low-pass
     filter shapes the short τ: a sum of noise terms never lies below one of them), 0 when
     none.
     """
@@ -1077,9 +1077,9 @@ def white_stretch(
         return None
     a, b = best[3], best[4]
     c = float(np.average(g[a:b], weights=w[a:b]))
-    shaped = 0
-    if a > 0 and bool(np.all(hi[:a] < c)):
-        shaped = a
+    shaped = 0  # the leading points that lie below the line beyond their intervals
+    while shaped < a and hi[shaped] < c:
+        shaped += 1
     return WhiteStretch(a, b, c, shaped)
 
 

@@ -98,6 +98,8 @@ class ContinuousTerm:
     read_at_tau_s: float
     quality: str
     reason: str | None
+    tau_range_s: tuple[float, float] | None = None
+    """The τ range [s] the slope line was fitted on (the −½ stretch found in the data)."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -189,6 +191,7 @@ def _choose(
             read_at_tau_s=_READ_AT[kind],
             quality=term.quality or "good",
             reason=term.reason,
+            tau_range_s=term.tau_range_s if method == "slope" else None,
         )
     # not in the data: the largest coefficient the curve allows (every term lies below it)
     ok = np.isfinite(res.adev_high) & (res.adev > 0)
@@ -313,7 +316,14 @@ def kalibr_yaml(model: NoiseModel, source: str) -> str:
             t = _term_for(key, ax)
             white = key.endswith("noise_density")
             words = _TERM_WORDS[(ax.sensor, "density" if white else "walk")]
-            if t.method == "slope":
+            if t.method == "slope" and t.tau_range_s is not None:
+                how = (
+                    f"the {_SLOPE['density' if white else 'walk']} slope line of the ADEV "
+                    f"(fitted on its {_SLOPE['density' if white else 'walk']} stretch τ = "
+                    f"{t.tau_range_s[0]:.4g} … {t.tau_range_s[1]:.4g} s) read at τ = "
+                    f"{t.read_at_tau_s:g} s"
+                )
+            elif t.method == "slope":
                 how = (
                     f"the {_SLOPE['density' if white else 'walk']} slope line of the ADEV "
                     f"(touching the curve at τ = {t.tau_s:.4g} s) read at τ = "
@@ -380,6 +390,7 @@ def _term_json(t: NoiseTerm, method: str) -> dict[str, Any]:
         "quality": None if t.value is None else (t.quality or "good"),
         "reason": t.reason,
         "label": t.label,
+        "tau_range_s": list(t.tau_range_s) if t.tau_range_s is not None else None,
     }
 
 
@@ -400,7 +411,17 @@ def _continuous_json(t: ContinuousTerm) -> dict[str, Any]:
         "read_at_tau_s": t.read_at_tau_s,
         "quality": t.quality,
         "reason": t.reason,
+        "tau_range_s": list(t.tau_range_s) if t.tau_range_s is not None else None,
     }
+
+
+def _minimum_json(t: NoiseTerm | None) -> dict[str, Any] | None:
+    """The bias instability at the curve's minimum (always; IEEE 952 C.3)."""
+    if t is None:
+        return None
+    out = _term_json(t, "minimum")
+    out["quality"] = t.quality
+    return out
 
 
 def model_json(model: NoiseModel, source: str) -> dict[str, Any]:
@@ -408,7 +429,9 @@ def model_json(model: NoiseModel, source: str) -> dict[str, Any]:
     axis ``terms`` (every IEEE 952 term in the data's unit: the slope reading where it
     exists, else the fit; ``value``, ``unit``, ``low``, ``high``, ``tau_s``, ``method``,
     ``quality``, ``reason``), ``terms_fit`` (all fitted terms), ``noise_density`` and
-    ``random_walk`` (continuous time, SI), ``output_quantization``
+    ``random_walk`` (continuous time, SI; ``tau_range_s`` the stretch a slope line was
+    fitted on), ``bias_instability_minimum`` (the bias instability at the curve's minimum,
+    always, with ``tau_s``, interval and ``quality``), ``output_quantization``
     (:meth:`OutputQuantization.to_dict`, null when the samples lie on no lattice)."""
     axes: dict[str, Any] = {}
     for ax in model.axes:
@@ -422,6 +445,7 @@ def model_json(model: NoiseModel, source: str) -> dict[str, Any]:
             "output_quantization": ax.quantization.to_dict() if ax.quantization else None,
             "noise_density": _continuous_json(ax.density),
             "random_walk": _continuous_json(ax.walk),
+            "bias_instability_minimum": _minimum_json(ax.terms.bias_minimum),
         }
     return {
         "source": source,
