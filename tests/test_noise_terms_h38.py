@@ -203,3 +203,52 @@ def test_kalibr_file_inherits_the_half_stretch(imu_csv: Path, tmp_path: Path) ->
     assert n_si * 0.99 <= doc["gyroscope_noise_density"] <= n_si * 1.05
     assert doc["accelerometer_noise_density"] == pytest.approx(ACC_N_MG * 9.80665e-3, rel=0.03)
     assert "stretch τ =" in text.split("gyroscope_noise_density:")[0]
+
+
+# --- a pulse-quantised ring-laser gyro stored on a finer grid ---------------------------------
+
+RLG_STEP = 0.00816  # rate of one angle pulse per sample [°/s]: 8.16e-5 ° per pulse at 100 Hz
+STORAGE = 2.0**-13  # the logger's storage grid [°/s] (1.22e-4, 67× finer than the step)
+
+
+def _rlg_record(seed: int, n: int = 200_000) -> tuple[np.ndarray, np.ndarray]:
+    """(stored rate [°/s], pulse counts): a rate with dither noise integrated to angle,
+    counted in pulses of RLG_STEP·τ0 with the remainder carried (IEEE 952 C.1), the rate
+    pulses·RLG_STEP stored rounded to the storage grid, three samples corrupted."""
+    rng = np.random.default_rng(seed)
+    rate = 0.004 + rng.standard_normal(n) * 0.07
+    theta = np.concatenate([[0.0], np.cumsum(rate) / FS])
+    pulses = np.diff(np.floor(theta / (RLG_STEP / FS)))
+    stored = np.round(pulses * RLG_STEP / STORAGE) * STORAGE
+    stored[[10, 5000, 77777]] += STORAGE * np.array([3.0, -5.0, 11.0])  # glitches
+    return stored, pulses
+
+
+def test_pulse_quantisation_step_is_the_sensors_lattice() -> None:
+    stored, pulses = _rlg_record(77)
+    found = nm.lattice_step(stored)
+    assert found is not None  # before the fix: the storage grid, 1.22e-4 °/s
+    step, offset, levels, n = found
+    assert step == pytest.approx(RLG_STEP, rel=1e-4)
+    assert levels == np.unique(pulses).size and n == stored.size
+    assert offset == pytest.approx(pulses.min() * RLG_STEP, abs=STORAGE)
+
+
+def test_storage_grid_alone_is_still_found() -> None:
+    # an ordinary rate rounded to the grid (no coarser lattice): the grid is the step
+    rng = np.random.default_rng(78)
+    v = np.round(rng.standard_normal(100_000) * 20.0 * STORAGE / STORAGE) * STORAGE
+    found = nm.lattice_step(v)
+    assert found is not None and found[0] == pytest.approx(STORAGE, rel=1e-9)
+
+
+def test_allan_reports_the_pulse_step(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    stored, pulses = _rlg_record(79)
+    path = tmp_path / "rlg.csv"
+    t = np.arange(stored.size) / FS
+    np.savetxt(path, np.column_stack([t, stored]), delimiter=",", header="time [s],gz [deg/s]",
+               comments="", fmt=["%.2f", "%.12g"])  # fmt: skip
+    assert main(["allan", str(path), "--signal", "gz [deg/s]", "--json"]) == 0
+    oq = json.loads(capsys.readouterr().out)["output_quantization"]
+    assert oq["value"] == pytest.approx(RLG_STEP, rel=1e-4) and oq["unit"] == "deg/s"
+    assert oq["levels"] == np.unique(pulses).size

@@ -470,8 +470,8 @@ QUANT_MIN_REPEAT: Final = 20
 floating-point data have about as many distinct values as samples."""
 
 QUANT_RTOL: Final = 1e-3
-"""Every sample lies within this fraction of a step of the lattice (unit conversions
-of the stored values leave ~1e-12 of a step; float32 storage ~1e-4)."""
+"""Kept for callers: the former tolerance (every sample within this fraction of a step);
+:func:`lattice_step` uses :data:`QUANT_LEVEL_TOL` and :data:`QUANT_MAX_OFF`."""
 
 _QUANT_PROBE: Final = 200_000
 """Samples (evenly strided) the lattice step is found from before the whole record is checked."""
@@ -564,19 +564,32 @@ class OutputQuantization:
         )
 
 
-def lattice_step(
-    values: npt.ArrayLike, *, rtol: float = QUANT_RTOL
-) -> tuple[float, float, int, int] | None:
-    """The lattice ``offset + k·step`` the finite samples lie on, as (step, offset, levels,
-    finite samples),
-    or None when they lie on none (:data:`QUANT_MIN_LEVELS`, :data:`QUANT_MIN_REPEAT`).
+QUANT_LEVEL_TOL: Final = 0.02
+"""A level lies on the sensor's lattice when within this fraction of a step of it: a storage
+grid up to 25× finer than the step rounds each level by at most half a grid step."""
 
-    The step is found on at most :data:`_QUANT_PROBE` evenly strided samples: the distinct
-    values u sorted, their gaps d, the smallest gap d_min; the step is d_min / j for the
-    smallest j = 1 … 10 that makes every gap an integer multiple within ``rtol`` (a gcd of
-    the gaps with a tolerance; gaps below 1e-9 of the range are rounding within one level);
-    refined as (u_max − u_min) / Σ k.  Then every sample of the
-    record is checked: |(v − offset)/step − round(·)| ≤ ``rtol``.
+QUANT_MAX_OFF: Final = 1e-3
+"""At most this fraction of the samples may lie off the lattice (glitches, outliers)."""
+
+
+def lattice_step(
+    values: npt.ArrayLike, *, rtol: float = QUANT_LEVEL_TOL
+) -> tuple[float, float, int, int] | None:
+    """The sensor's lattice ``offset + k·step`` among the finite samples' distinct levels,
+    as (step, offset, levels, finite samples), or None when they lie on none
+    (:data:`QUANT_MIN_LEVELS`, :data:`QUANT_MIN_REPEAT`).
+
+    The step is the greatest common spacing that explains the levels, robust to a finer
+    storage grid and a few outliers (a pulse-quantised gyro with 77 levels 0.00816 °/s
+    apart stored on a 1.22e-4 °/s grid has step 0.00816, not 1.22e-4): on at most
+    :data:`_QUANT_PROBE` evenly strided samples, the distinct values u with their counts,
+    the first guess the median gap between neighbouring levels among the most-visited
+    ones (adjacent lattice points where the samples are dense), refined by the
+    count-weighted least-squares line ``u = o + step·k`` with k = round((u − o)/step),
+    over ±5, ±20 and then all steps of the most-visited level.  Then every sample of the
+    record is checked: at least 1 − :data:`QUANT_MAX_OFF` of them lie within ``rtol`` of a
+    step of the lattice.  A step of at most :data:`QUANT_MIN_ULPS` storage ulps is the
+    storage's rounding, not the sensor's.
     """
     v = np.asarray(values, dtype=np.float64).ravel()
     if not math.isfinite(float(v.sum())):  # a copy of the finite samples only when needed
@@ -585,45 +598,72 @@ def lattice_step(
     if n < QUANT_MIN_LEVELS * QUANT_MIN_REPEAT:
         return None
     probe = v[:: max(1, n // _QUANT_PROBE)]
-    u = np.unique(probe)
+    u, c = np.unique(probe, return_counts=True)
     if u.size < QUANT_MIN_LEVELS or u.size * QUANT_MIN_REPEAT > probe.size:
         return None
-    d = np.diff(u)
-    # values a few ulps apart are one level (a rate formed as Δangle/τ0 is not exact)
-    d = d[d > _QUANT_MERGE * float(u[-1] - u[0])]
-    if d.size + 1 < QUANT_MIN_LEVELS:
+    guess = _level_lattice(u, c.astype(np.float64), rtol)
+    if guess is None:
         return None
-    d_min = float(d.min())
-    for j in range(1, 11):
-        r = d / (d_min / j)
-        k = np.rint(r)
-        if float(np.max(np.abs(r - k))) <= rtol:
-            break
-    else:
-        return None
-    step = float(u[-1] - u[0]) / float(k.sum())  # the gaps between the extreme levels
-    offset = float(u[0])
+    step, origin = guess
     if step <= QUANT_MIN_ULPS * _storage_ulp(probe, max(abs(float(u[0])), abs(float(u[-1])))):
         return None
     # the whole record, in blocks (no array of n quotients)
+    off = 0
     lo_k, hi_k = math.inf, -math.inf
     for a in range(0, n, 1 << 20):
-        q = (v[a : a + (1 << 20)] - offset) / step
+        q = (v[a : a + (1 << 20)] - origin) / step
         kk = np.rint(q)
-        if float(np.max(np.abs(q - kk))) > rtol:
-            return None
-        lo_k, hi_k = min(lo_k, float(kk.min())), max(hi_k, float(kk.max()))
+        on = np.abs(q - kk) <= rtol
+        off += int(on.size - np.count_nonzero(on))
+        if on.any():
+            lo_k, hi_k = min(lo_k, float(kk[on].min())), max(hi_k, float(kk[on].max()))
+    if off > QUANT_MAX_OFF * n or not math.isfinite(lo_k):
+        return None
     span = int(hi_k - lo_k) + 1
     if span > 1 << 24:  # a lattice of more levels than that is no quantisation to report
         return None
     seen = np.zeros(span, dtype=bool)
     for a in range(0, n, 1 << 20):
-        kk = np.rint((v[a : a + (1 << 20)] - offset) / step) - lo_k
-        seen[kk.astype(np.int64)] = True
+        q = (v[a : a + (1 << 20)] - origin) / step
+        kk = np.rint(q)
+        seen[(kk[np.abs(q - kk) <= rtol] - lo_k).astype(np.int64)] = True
     levels = int(np.count_nonzero(seen))
     if levels < QUANT_MIN_LEVELS or levels * QUANT_MIN_REPEAT > n:
         return None
-    return step, offset, levels, n
+    return step, origin + lo_k * step, levels, n
+
+
+def _level_lattice(
+    u: npt.NDArray[np.float64], c: npt.NDArray[np.float64], rtol: float
+) -> tuple[float, float] | None:
+    """(step, origin) of the lattice the distinct levels ``u`` (visited ``c`` times) lie on,
+    or None (:func:`lattice_step`): the median gap between neighbouring levels among those
+    visited at least as often as the median level, refined by weighted least squares."""
+    top = u[c >= np.median(c)]
+    d = np.diff(top)
+    d = d[d > _QUANT_MERGE * float(u[-1] - u[0])]
+    if d.size == 0:
+        return None
+    step = float(np.median(d))
+    ref = float(u[int(np.argmax(c))])
+    origin = ref
+    for reach in (5.0, 20.0, math.inf):
+        k = np.rint((u - origin) / step)
+        sel = np.abs((u - ref) / step) <= reach + 0.5
+        kk, uu, w = k[sel], u[sel], c[sel]
+        if np.unique(kk).size < 2:
+            return None
+        km = float(np.average(kk, weights=w))
+        um = float(np.average(uu, weights=w))
+        step = float(np.sum(w * (kk - km) * (uu - um)) / np.sum(w * (kk - km) ** 2))
+        if not step > 0:
+            return None
+        origin = um - step * km
+    r = (u - origin) / step
+    on = np.abs(r - np.rint(r)) <= rtol
+    if float(c[on].sum()) < (1.0 - QUANT_MAX_OFF) * float(c.sum()):
+        return None
+    return step, origin
 
 
 def _storage_ulp(probe: npt.NDArray[np.float64], top: float) -> float:
@@ -684,9 +724,10 @@ def quantization_from_lattice(
             else None
         ),
         source=(
-            "the samples lie on a lattice of this step (the gcd of the gaps between the "
-            "distinct sample values, every sample within "
-            f"{QUANT_RTOL:g} step of it); a uniform rounding error has variance step²/12 "
+            "the samples lie on a lattice of this step (the greatest common spacing of the "
+            "distinct sample values, a finer storage grid aside; at least "
+            f"{100 * (1 - QUANT_MAX_OFF):g} % of the samples within {QUANT_LEVEL_TOL:g} "
+            "step of it); a uniform rounding error has variance step²/12 "
             "(IEEE Std 952-1997 Annex C.1)"
         ),
     )  # fmt: skip
@@ -718,6 +759,8 @@ def annotate_quantization(terms: NoiseTerms, quant: OutputQuantization | None) -
 
 __all__ = [
     "KALIBR_KEYS",
+    "QUANT_LEVEL_TOL",
+    "QUANT_MAX_OFF",
     "QUANT_MIN_LEVELS",
     "QUANT_MIN_REPEAT",
     "QUANT_RTOL",
