@@ -21,7 +21,7 @@ import yaml
 from scipy import signal
 
 from thermocal.cli import main
-from thermocal.stability import allan
+from thermocal.stability import allan, periodic
 from thermocal.stability import noise_model as nm
 
 FS = 100.0
@@ -252,3 +252,68 @@ def test_allan_reports_the_pulse_step(tmp_path: Path, capsys: pytest.CaptureFixt
     oq = json.loads(capsys.readouterr().out)["output_quantization"]
     assert oq["value"] == pytest.approx(RLG_STEP, rel=1e-4) and oq["unit"] == "deg/s"
     assert oq["levels"] == np.unique(pulses).size
+
+
+# --- a periodic term -------------------------------------------------------------------------
+
+SINE_HZ, SINE_MG, ACC_WHITE = 0.56, 0.2, 0.05  # 0.56 Hz, 0.2 mg amplitude; N_a [mg·√s]
+
+
+def _sine_record(seed: int, hours: float = 1.0) -> np.ndarray:
+    """Accelerometer [mg] at 100 Hz: white noise and a 0.56 Hz sinusoid of 0.2 mg."""
+    rng = np.random.default_rng(seed)
+    n = int(hours * 3600 * FS)
+    t = np.arange(n) / FS
+    return np.asarray(
+        rng.standard_normal(n) * ACC_WHITE * math.sqrt(FS)
+        + SINE_MG * np.sin(2.0 * math.pi * SINE_HZ * t + 0.7)
+    )
+
+
+def test_periodic_term_named_with_its_frequency() -> None:
+    y = _sine_record(56)
+    res = allan.overlapping_adev(y, 1.0 / FS, "octave", unit="mg")
+    found = periodic.periodic_terms(y, 1.0 / FS, "mg")
+    nt = allan.annotate_periodic(allan.noise_terms(res), res, found)
+    assert len(nt.periodic) == 1
+    p = nt.periodic[0]
+    assert abs(p.frequency_hz - SINE_HZ) <= p.resolution_hz
+    assert p.amplitude == pytest.approx(SINE_MG, rel=0.05)
+    # the ADEV bump the term names is the measured curve's (IEEE 952 C.1.7, written here)
+    x = math.pi * SINE_HZ * res.tau_s
+    model = np.sqrt(ACC_WHITE**2 / res.tau_s + (SINE_MG * np.sin(x) ** 2 / x) ** 2)
+    near = (res.tau_s > 0.1) & (res.tau_s < 10.0)
+    assert np.all(np.abs(res.adev[near] / model[near] - 1.0) < 0.05)
+    assert nt.quality is not None and nt.quality.quality == "poor"
+    assert "0.56 Hz" in (nt.quality.reason or "")
+    assert "another noise process" not in (nt.quality.reason or "")
+
+
+def test_no_periodic_term_in_noise_alone() -> None:
+    rng = np.random.default_rng(57)
+    n = int(3600 * FS)
+    y = rng.standard_normal(n) + _flicker(rng, n, 0.5) + np.cumsum(rng.standard_normal(n)) * 0.01
+    assert periodic.periodic_terms(y, 1.0 / FS, "mg") == ()
+
+
+def test_welch_equals_scipys() -> None:
+    rng = np.random.default_rng(58)
+    x = rng.standard_normal(50_000) + np.arange(50_000) * 1e-4
+    f, s, _n = periodic.welch(x, 100.0, 4096)
+    f2, s2 = signal.welch(x, 100.0, "hann", 4096, detrend="linear")
+    assert np.allclose(f, f2) and np.allclose(s, s2, rtol=1e-10)
+
+
+def test_allan_warning_names_the_frequency(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    y = _sine_record(59, 0.5)
+    path = tmp_path / "acc.csv"
+    np.savetxt(path, np.column_stack([np.arange(y.size) / FS, y]), delimiter=",",
+               header="time [s],az [mg]", comments="", fmt=["%.2f", "%.8g"])  # fmt: skip
+    assert main(["allan", str(path), "--signal", "az [mg]", "--json"]) == 0
+    cap = capsys.readouterr()
+    assert "periodic term at 0.56 Hz" in cap.err and "another noise process" not in cap.err
+    (p,) = json.loads(cap.out)["periodic"]
+    assert abs(p["frequency_hz"] - SINE_HZ) <= p["resolution_hz"]
+    assert p["amplitude"] == pytest.approx(SINE_MG, rel=0.05) and p["unit"] == "mg"

@@ -224,6 +224,7 @@ def allan_json(
         "output_quantization": quant.to_dict() if quant is not None else None,
         "bias_instability_minimum": minimum_json(noise.bias_minimum),
         "shaped_below_s": noise.shaped_below_s,
+        "periodic": [p.to_dict() for p in noise.periodic],
     }
     if dyn is not None:
         out["dynamic"] = dynamic_json(dyn)
@@ -274,6 +275,9 @@ def _emit_channels(
         for name, oq in (quants or {}).items():
             if oq is not None:
                 stdout.print(f"{name}: {oq.line()}")
+        for name, (_r, n) in analyses.items():
+            for p in n.periodic:
+                stdout.print(f"{name}: periodic term: {p.words()}")
         if plot is not None:
             stdout.print(f"plots written to {plot.stem}_<channel>{plot.suffix} in {plot.parent}")
 
@@ -525,6 +529,8 @@ def _emit_allan(
         line = minimum_line(noise.bias_minimum)
         if line is not None:
             stdout.print(line)
+        for p in noise.periodic:
+            stdout.print(f"periodic term: {p.words()}; {100 * (p.share or 0):.3g} % of σ² there")
         if noise.shaped_below_s is not None:
             stdout.print(
                 f"τ < {fmt(noise.shaped_below_s)} s lies below the −½ line (the sensor's own "

@@ -68,6 +68,7 @@ Frequency Stability Analysis*, NIST SP 1065 (2008); IEEE Std 1554-2005.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import os
 from concurrent.futures import ThreadPoolExecutor
@@ -84,6 +85,7 @@ from thermocal.errors import MissingValueError, ThermocalInputError
 from thermocal.recording import contiguous_slices
 from thermocal.stability import family
 from thermocal.stability.edf import ONE_SIGMA_CONFIDENCE, confidence_interval
+from thermocal.stability.periodic import PeriodicTerm, shaping_terms
 
 # scipy is imported when first needed (a command that reads the help does not pay for it)
 linalg = LazyModule("scipy.linalg")
@@ -236,6 +238,12 @@ class FitQuality:
         }
 
 
+_OTHER_PROCESS: Final = (
+    "(another noise process — flicker of a different kind, a periodic term, a drift or a "
+    "step — or a wrong time base)"
+)
+"""The fit quality's words when nothing names what the noise model misses."""
+
 POOR_CHI2 = 4.0
 """Reduced χ² above which the noise model is reported as a poor description."""
 MISFIT_RUN = 4
@@ -284,8 +292,7 @@ def fit_quality(tau_s: FloatArray, normalised_residuals: FloatArray, n_active: i
     reason = (
         "the noise model σ² = Σ C_p τ^p does not describe this curve: "
         + "; ".join(reasons)
-        + " (another noise process — flicker of a different kind, a periodic term, a drift "
-        "or a step — or a wrong time base); the noise terms are rough"
+        + f" {_OTHER_PROCESS}; the noise terms are rough"
         if poor
         else None
     )
@@ -334,6 +341,8 @@ class NoiseTerms:
     shaped_below_s: float | None = None
     """The points at τ below this [s] lie under the −½ stretch's line beyond their
     intervals (the sensor's own filter): left out of the fit and the slope lines."""
+    periodic: tuple[PeriodicTerm, ...] = ()
+    """Sinusoids found in the record that shape the curve (:func:`annotate_periodic`)."""
 
     def fit_curve(self, tau_s: npt.ArrayLike) -> FloatArray:
         """Fitted Allan deviation sqrt(Σ C_p τ^p) [unit] at ``tau_s``."""
@@ -1392,6 +1401,40 @@ def noise_terms(
     )
 
 
+def annotate_periodic(
+    terms: NoiseTerms, result: AllanResult, found: tuple[PeriodicTerm, ...]
+) -> NoiseTerms:
+    """``terms`` with the periodic terms ``found`` in the record
+    (:func:`thermocal.stability.periodic.periodic_terms`) that shape its curve
+    (:func:`~thermocal.stability.periodic.shaping_terms`: ≥ 5 % of the Allan variance at
+    τ = 0.371/f₀) in ``periodic``, and every reason that blamed "another noise process"
+    naming them with their frequency and amplitude instead (IEEE Std 952-1997 C.1.7: a
+    sinusoid's Allan deviation A·sin²(πf₀τ)/(πf₀τ) is not in the noise model)."""
+    shaping = shaping_terms(found, result.tau_s, result.adev)
+    if not shaping:
+        return terms
+    named = (
+        "(" + "; ".join(p.words() for p in shaping) + ": not a term of the noise model; "
+        "remove it — a notch at its frequency — or read the terms away from that τ)"
+    )
+
+    def fix(t: NoiseTerm) -> NoiseTerm:
+        if t.reason is None or _OTHER_PROCESS not in t.reason:
+            return t
+        return dataclasses.replace(t, reason=t.reason.replace(_OTHER_PROCESS, named))
+
+    def fix_set(ts: NoiseTermSet) -> NoiseTermSet:
+        return NoiseTermSet(ts.method, *(fix(t) for t in ts.terms().values()))
+
+    quality = terms.quality
+    if quality is not None and quality.reason is not None:
+        quality = dataclasses.replace(quality, reason=quality.reason.replace(_OTHER_PROCESS, named))
+    return dataclasses.replace(
+        terms, slope=fix_set(terms.slope), fit=fix_set(terms.fit), quality=quality,
+        periodic=shaping,
+    )  # fmt: skip
+
+
 __all__ = [
     "BIAS_INSTABILITY_FACTOR",
     "ONE_SIGMA_CONFIDENCE",
@@ -1404,6 +1447,7 @@ __all__ = [
     "NoiseTermSet",
     "NoiseTerms",
     "WhiteStretch",
+    "annotate_periodic",
     "averaging_factors",
     "bias_at_minimum",
     "confidence_interval",

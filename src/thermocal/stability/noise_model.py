@@ -44,10 +44,12 @@ from thermocal.stability.allan import (
     AllanResult,
     NoiseTerm,
     NoiseTerms,
+    annotate_periodic,
     noise_terms,
     overlapping_adev,
     term_units,
 )
+from thermocal.stability.periodic import periodic_terms
 
 Sensor = Literal["gyro", "accel"]
 
@@ -246,12 +248,16 @@ def axis_noise(
             f"(--{'gyro' if sensor == 'gyro' else 'accel'}-unit)"
         )
     lattice = lattice_step(values)
+    v = np.asarray(values, dtype=np.float64).ravel()
+    longest = max(segments, key=lambda sl: sl.stop - sl.start) if segments else slice(None)
+    found = periodic_terms(v[longest], tau0_s, u)
     res = overlapping_adev(
         values, tau0_s, taus, time_s=time_s, segments=segments, unit=u, confidence=confidence
     )
     terms = noise_terms(res)
     quant = quantization_from_lattice(lattice, tau0_s, u, terms)
     terms = annotate_quantization(terms, quant)
+    terms = annotate_periodic(terms, res, found)
     return AxisNoise(
         name=name,
         sensor=sensor,
@@ -446,6 +452,7 @@ def model_json(model: NoiseModel, source: str) -> dict[str, Any]:
             "noise_density": _continuous_json(ax.density),
             "random_walk": _continuous_json(ax.walk),
             "bias_instability_minimum": _minimum_json(ax.terms.bias_minimum),
+            "periodic": [p.to_dict() for p in ax.terms.periodic],
         }
     return {
         "source": source,
