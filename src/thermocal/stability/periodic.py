@@ -56,6 +56,10 @@ _MIN_SEGMENTS: Final = 8
 _FLOOR_BINS: Final = 32
 """The local floor: the median density over this many bins either side."""
 
+_MAX_SAMPLES: Final = 1 << 23
+"""The periodogram reads at most this many samples (the first): 8.4 million give hundreds of
+segments at the longest segment length, and a day at 1 kHz costs no more than that."""
+
 _PEAK_BINS: Final = 3
 """Bins either side of a peak's maximum that hold its power (a Hann window's main lobe
 spans ±2 bins)."""
@@ -152,9 +156,10 @@ def periodic_terms(
     (module docstring), strongest first, at most ``max_terms``; () when none stands out or
     the record is too short for :data:`_MIN_SEGMENTS` segments of 256 samples.
 
-    Gaps are the caller's: pass one contiguous stretch.
+    Gaps are the caller's: pass one contiguous stretch (its first :data:`_MAX_SAMPLES`
+    samples are read).
     """
-    x = np.asarray(values, dtype=np.float64).ravel()
+    x = np.asarray(values, dtype=np.float64).ravel()[:_MAX_SAMPLES]
     x = x[np.isfinite(x)]
     if x.size < 256 * _MIN_SEGMENTS:
         return ()
