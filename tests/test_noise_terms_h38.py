@@ -153,6 +153,11 @@ def imu_csv(tmp_path_factory: pytest.TempPathFactory) -> Path:
         cols[f"g{ax} [deg/h]"] = _filtered_record(100 + i, 0.5)
     for ax in "xyz":
         cols[f"a{ax} [mg]"] = rng.standard_normal(n) * ACC_N_MG * math.sqrt(FS)
+    # a gyro of white noise and rate random walk only: a clear minimum, no flicker term for
+    # the least-squares fit to find
+    cols["gw [deg/h]"] = rng.standard_normal(n) * 18.0 * math.sqrt(FS) + np.cumsum(
+        rng.standard_normal(n)
+    ) * (600.0 / 60.0) / math.sqrt(FS)
     path = tmp_path_factory.mktemp("h38") / "static.csv"
     np.savetxt(path, np.column_stack(list(cols.values())), delimiter=",",
                header=",".join(cols), comments="", fmt="%.7g")  # fmt: skip
@@ -184,11 +189,15 @@ def test_allan_table_never_shows_a_dash_for_the_bias_instability(
     imu_csv: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
 ) -> None:
     monkeypatch.setenv("COLUMNS", "200")
-    assert main(["allan", str(imu_csv), "--signal", GYRO]) == 0
+    assert main(["allan", str(imu_csv), "--signal", GYRO + ",gw [deg/h]"]) == 0
     out = capsys.readouterr().out
     row = next(line for line in out.splitlines() if "at the curve's minimum" in line)
     cells = [c.strip() for c in row.split("│")[2:-1]]
-    assert len(cells) == 3 and all("deg/h (τ" in c for c in cells), row
+    assert len(cells) == 4 and all("deg/h (τ" in c for c in cells), row
+    b_row = next(line for line in out.splitlines() if line.startswith("│ bias instability"))
+    b_cells = [c.strip() for c in b_row.split("│")[2:-1]]
+    # the fit's value where it finds the term, else the minimum (never a bare dash)
+    assert "—" not in "".join(b_cells[:3]) and b_cells[3].endswith("(minimum; fit: —)"), b_row
 
 
 def test_kalibr_file_inherits_the_half_stretch(imu_csv: Path, tmp_path: Path) -> None:

@@ -252,7 +252,13 @@ def _emit_channels(
             cells = []
             for _res, noise in analyses.values():
                 tt = noise.fit.terms()[key]
-                cells.append(f"{fmt(tt.value)} {tt.unit}" if tt.value is not None else "—")
+                bm = noise.bias_minimum
+                if tt.value is not None:
+                    cells.append(f"{fmt(tt.value)} {tt.unit}")
+                elif key == "bias_instability" and bm is not None and bm.value is not None:
+                    cells.append(f"{fmt(bm.value)} {bm.unit} (minimum; fit: —)")
+                else:
+                    cells.append("—")
             t.add_row(term.label, *cells)
             if key == "angle_random_walk":
                 t.add_row(
