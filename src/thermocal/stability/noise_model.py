@@ -11,7 +11,9 @@ kalibr*, ICRA 2016; the Kalibr wiki "IMU Noise Model")::
 
 * ``σ_n`` noise density [rad/s/√Hz] (gyro) or [m/s²/√Hz] (accelerometer) is the white-noise
   coefficient N of the Allan variance ``σ²(τ) = N²/τ``: the −½ slope line read at τ = 1 s
-  (IEEE 952-1997 C.3; N in (rad/s)·√s = rad/s/√Hz).
+  (IEEE 952-1997 C.3; N in (rad/s)·√s = rad/s/√Hz), fitted on the −½ stretch found in the
+  data (:func:`thermocal.stability.allan.white_stretch`), not at the shortest τ a sensor's
+  own filter shapes.
 * ``σ_b`` random walk [rad/s²/√Hz] or [m/s³/√Hz] is the rate random walk coefficient K of
   ``σ²(τ) = K² τ / 3``: the +½ slope line read at τ = 3 s (K in (rad/s)/√s = rad/s²/√Hz).
 
