@@ -1071,6 +1071,8 @@ def white_stretch(
     lt = np.log(tau)
     b_prev = 0
     for a in range(tau.size):
+        if b_prev == tau.size:  # a run reached the last point: later ones are its sub-runs
+            break
         if not ok[a]:
             continue
         low, high, b = lo[a], hi[a], a + 1
