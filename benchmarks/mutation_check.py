@@ -64,6 +64,7 @@ PX4 = _t("mutants_export", "px4_tempcal", "px4_baro_mag", "ardupilot_tempcal")
 ADEQ = _t("mutants_maths", "adequacy", "fc_gates")
 STAB = _t("mutants_maths", "stability_reference", "allan", "allan_references")
 NOISE = _t("mutants_maths", "stability_noise_terms", "noise_cmd")
+H38 = _t("noise_terms_h38")
 MULTI = _t("mutants_maths", "multipos")
 STATION = _t("station", "readers_station")
 FC = _t("mutants_units", "fc_log_readers", "fc_gates")
@@ -1056,6 +1057,47 @@ MUTANTS: tuple[Mutant, ...] = (
         NOISE,
         "discrete noise σ = density·√dt instead of /√dt",
     ),
+    # --- issue 38: noise terms read where the curve follows them ----------------------------
+    Mutant(
+        "noise-white-stretch-slack",
+        P + "stability/allan.py",
+        "_STRETCH_SLACK: Final = math.log(1.01)",
+        "_STRETCH_SLACK: Final = math.log(1.08)",
+        H38,
+        "−½ stretch admits points 8 % off its line (the filtered short τ)",
+    ),
+    Mutant(
+        "noise-bias-minimum-factor",
+        P + "stability/allan.py",
+        "val = float(dev[k]) / BIAS_INSTABILITY_FACTOR",
+        "val = float(dev[k]) * BIAS_INSTABILITY_FACTOR",
+        H38,
+        "bias instability at the minimum σ_min·0.664 instead of /0.664",
+    ),
+    Mutant(
+        "noise-bias-minimum-edf",
+        P + "stability/allan.py",
+        "keep = np.asarray(edf >= BIAS_MIN_EDF)",
+        "keep = np.asarray(edf >= 0.0)",
+        H38,
+        "minimum sought among the last points of one or two degrees of freedom",
+    ),
+    Mutant(
+        "noise-periodic-amplitude",
+        P + "stability/periodic.py",
+        "amp = math.sqrt(2.0 * power)",
+        "amp = math.sqrt(power)",
+        H38,
+        "sinusoid amplitude from its power without the factor 2",
+    ),
+    Mutant(
+        "noise-lattice-no-glitch",
+        P + "stability/noise_model.py",
+        "if off > QUANT_MAX_OFF * n or not math.isfinite(lo_k):",
+        "if off > 0 or not math.isfinite(lo_k):",
+        H38,
+        "one glitch off the lattice hides the sensor's quantisation",
+    ),
     # --- multipos ------------------------------------------------------------------------
     Mutant(
         "multipos-gap-factor",
@@ -1146,6 +1188,39 @@ MUTANTS: tuple[Mutant, ...] = (
         '"time": "timestamp", "time_unit": "ms"',
         FC,
         "ULog timestamps read as milliseconds",
+    ),
+    # --- triad validation and report on raw counts (issue 38) ------------------------------
+    Mutant(
+        "triad-count-scale-divided",
+        P + "models/calibration.py",
+        "return x * self.count_scale",
+        "return x / self.count_scale",
+        _t("triad_validate_counts"),
+        "validate: raw counts divided by the count scale",
+    ),
+    Mutant(
+        "triad-one-pose-after-raw",
+        P + "multipos/validate.py",
+        'ma = units.convert(xg_c[pose.start : pose.end].mean(axis=0), "rad/s", unit)',
+        'ma = units.convert(xg[pose.start : pose.end].mean(axis=0), "rad/s", unit)',
+        _t("triad_validate_counts"),
+        "one still pose: the gyro's rate at rest after = before",
+    ),
+    Mutant(
+        "triad-report-bias-as-stored",
+        P + "report/triads.py",
+        'if f.name.startswith("bias") and f.unit != tri.unit:',
+        'if f.name.startswith("bias") and f.unit == tri.unit:',
+        _t("report_triads"),
+        "triad report: a deg/s gyro's bias shown in deg/h",
+    ),
+    Mutant(
+        "triad-report-one-temperature-plotted",
+        P + "report/triads.py",
+        "over_t = len(temps) >= 2",
+        "over_t = len(temps) >= 1",
+        _t("report_triads"),
+        "triad report: one temperature plotted against temperature",
     ),
     # --- C export -----------------------------------------------------------------------
     Mutant(

@@ -99,6 +99,9 @@ def test_calibration_report_every_channel_in_its_own_unit(
         for key in ("r", "rms_before", "rms_after"):
             check_number(tags, f"channels.{n}.validation.{key}",
                          files["v"]["channels"][n][key])  # fmt: skip
+        # issue 38: the bias instability is read at the curve's minimum, never "—"
+        for when in ("before", "after"):
+            assert tags[f"channels.{n}.bias_instability_{when}"][1] != "—", (n, when)
     # the gy figures are in rad/s: its validation rms is the deg/s one times π/180
     assert files["v"]["channels"]["gy"]["unit"] == "rad/s"
     assert '<tr data-channel="gy"><td><a href="#ch-gy">gy</a> <span class="unit">[rad/s]' in html

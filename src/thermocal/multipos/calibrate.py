@@ -265,6 +265,15 @@ class MultiposValidation:
     """Accelerometer: per pose (start, end, u_x, u_y, u_z, error before, error after): the
     compensated gravity direction (unit, body axes) and the gravity-magnitude errors
     [``unit``], for the report's poses on the sphere (not in ``to_dict``)."""
+    not_judged: str = ""
+    """What these figures cannot judge (a validation on one still pose), else empty."""
+    input_unit: str = ""
+    """The unit the triad's columns were read in (``counts`` for raw counts)."""
+    count_scale: float | None = None
+    """Raw counts: one count is ``count_scale`` ``physical_unit`` (the calibration's), as
+    ``compensate`` applies it; None for columns already in a physical unit."""
+    physical_unit: str = ""
+    """The triad's own unit, the one its columns are judged in."""
 
     def to_dict(self) -> dict[str, Any]:
         from dataclasses import asdict
@@ -275,8 +284,9 @@ class MultiposValidation:
 
     def rows(self) -> list[tuple[str, tuple[float, ...], tuple[float, ...]]]:
         return [
-            (f"{self.what} rms [{self.unit}] (total {self.rms_before:.4g} → "
-             f"{self.rms_after:.4g})", self.per_axis_before, self.per_axis_after)
+            (f"{self.what}{' rms' if self.n > 1 else ''} [{self.unit}] (total "
+             f"{self.rms_before:.4g} → {self.rms_after:.4g})", self.per_axis_before,
+             self.per_axis_after)
         ]  # fmt: skip
 
 

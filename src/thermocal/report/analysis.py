@@ -24,7 +24,14 @@ from thermocal.metrics import (
 from thermocal.models.base import RunData
 from thermocal.models.registry import model_from_dict
 from thermocal.recording import FloatArray, Metadata, Recording
-from thermocal.stability.allan import AllanResult, NoiseTerms, noise_terms, overlapping_adev
+from thermocal.stability.allan import (
+    AllanResult,
+    NoiseTerms,
+    annotate_periodic,
+    noise_terms,
+    overlapping_adev,
+)
+from thermocal.stability.periodic import periodic_terms
 
 ILL_CONDITIONED = 1.0e6
 """Condition number (scaled design) above which the report warns: ill-conditioned in the
@@ -423,6 +430,13 @@ class AllanAnalysis:
 def allan_of(time_s: FloatArray, x: FloatArray, tau0_s: float, unit: str) -> AllanAnalysis:
     """Overlapping Allan deviation (octave τ, ±1σ confidence intervals, split at gaps) and
     the IEEE Std 952 noise terms, by :func:`thermocal.stability.allan.overlapping_adev` and
-    :func:`thermocal.stability.allan.noise_terms` (NIST SP 1065 eq. 11; SPEC §1)."""
+    :func:`thermocal.stability.allan.noise_terms` (NIST SP 1065 eq. 11; SPEC §1), with the
+    periodic terms of the longest gap-free stretch that shape the curve named
+    (:func:`thermocal.stability.allan.annotate_periodic`)."""
+    from thermocal.recording import contiguous_slices
+
+    segs = contiguous_slices(np.asarray(time_s, dtype=np.float64))
+    longest = max(segs, key=lambda sl: sl.stop - sl.start) if segs else slice(None)
+    found = periodic_terms(np.asarray(x, dtype=np.float64)[longest], tau0_s, unit)
     res = overlapping_adev(x, tau0_s, "octave", time_s=time_s, unit=unit)
-    return AllanAnalysis(result=res, terms=noise_terms(res))
+    return AllanAnalysis(result=res, terms=annotate_periodic(noise_terms(res), res, found))

@@ -1285,6 +1285,18 @@ def _noise_rows(an: _Analysis) -> list[dict[str, Any]]:
                     }
                 )
         noise_rows.append({"label": label, "unit": unit_label(term_unit), "cells": cells})
+        if key == "bias_instability":  # IEEE 952 C.3: always at the minimum (issue 38)
+            mins = [al.terms.bias_minimum for al in (allan_before, allan_after)]
+            cells = []
+            for when, m in zip(("before", "after"), mins, strict=True):
+                v = None if m is None else m.value
+                cells.append({"html": num(v, f"allan.{when}.minimum.{key}", 3),
+                              "reason": "" if m is None else m.reason or ""})  # fmt: skip
+                cells.append({"html": num(None), "reason": ""})
+            noise_rows.append(
+                {"label": "  at the curve's minimum", "unit": unit_label(term_unit),
+                 "cells": cells}
+            )  # fmt: skip
     return noise_rows
 
 

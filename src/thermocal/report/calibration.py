@@ -250,9 +250,14 @@ def _channel_section(
         "stability_improvement": improvement_pct(
             fom[0]["bias_stability"], fom[1]["bias_stability"]
         ),
-        "bi_before": terms[0].bias_instability,
-        "bi_after": terms[1].bias_instability,
-        "rw_after": terms[1].angle_random_walk,
+        # IEEE 952 C.3: B at the curve's minimum, always (issue 38), N on the −½ stretch
+        "bi_before": allan[0].terms.bias_minimum or terms[0].bias_instability,
+        "bi_after": allan[1].terms.bias_minimum or terms[1].bias_instability,
+        "rw_after": (
+            allan[1].terms.slope.angle_random_walk
+            if allan[1].terms.slope.angle_random_walk.value is not None
+            else terms[1].angle_random_walk
+        ),
         "validation": v,
         "absolute_change": _absolute_change(v, key),
         "adequacy": adequacy,
