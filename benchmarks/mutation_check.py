@@ -1089,6 +1089,14 @@ MUTANTS: tuple[Mutant, ...] = (
         (*MULTI, "tests/test_multipos_sigma.py"),
         "gyro scale σ without the bias uncertainty",
     ),
+    Mutant(
+        "multipos-poses-noise-only",
+        P + "multipos/poses.py",
+        "by_motion = motion_fraction * motion",
+        "by_motion = 0.0 * motion",
+        ("tests/test_multipos_real_sessions.py",),
+        "pose detector: the still limit from the noise alone (hand-held poses lost: 4 of 10)",
+    ),
     # --- station -----------------------------------------------------------------------------
     Mutant(
         "station-part-rotation-strict",
