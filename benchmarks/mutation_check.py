@@ -1097,6 +1097,22 @@ MUTANTS: tuple[Mutant, ...] = (
         ("tests/test_multipos_real_sessions.py",),
         "pose detector: the still limit from the noise alone (hand-held poses lost: 4 of 10)",
     ),
+    Mutant(
+        "multipos-misfit-weights-off",
+        P + "multipos/accel.py",
+        "for _ in range(MISFIT_ITERATIONS):",
+        "for _ in range(0):",
+        ("tests/test_multipos_real_sessions.py",),
+        "misfit sensor fitted with its white-noise weights (imu_tk's Xsens: 1.09× the residual)",
+    ),
+    Mutant(
+        "multipos-offset-ignored",
+        P + "multipos/files.py",
+        "        return float(given)\n",
+        "        return 0.0\n",
+        ("tests/test_multipos_real_sessions.py",),
+        "--accel-offset/--gyro-offset ignored (unsigned counts: 1 distinct pose)",
+    ),
     # --- station -----------------------------------------------------------------------------
     Mutant(
         "station-part-rotation-strict",

@@ -88,3 +88,124 @@ def test_mpu_explanation_in_the_human_output(mpu: dict[str, Any]) -> None:
     code, out, err = _run(args)
     assert code == 0, err
     assert "10 poses (window 0.5 s" in out and "set by the motions" in out
+
+
+# --- imu_tk's Xsens session -------------------------------------------------------------
+
+XSENS = DATA / "imu_tk_xsens" / "xsens_imu_tk.parquet"
+X_ACC = "0.27,mg"  # ≈ g/3700: one count, from the initial static's own magnitude
+X_GYR = "0.0091554,deg/s"  # imu_tk's test program: 1/6258 (rad/s)/count
+X_G_M_S2 = 9.81744  # imu_tk's test program
+MID = 32768.0
+MG_M_S2 = 9.80665e-3
+
+
+def _xsens_args(out: Path, *extra: str) -> list[str]:
+    acc = ",".join(f"acc_{a} [counts]" for a in "xyz")
+    gyr = ",".join(f"gyro_{a} [counts]" for a in "xyz")
+    return ["multipos", str(XSENS), "--accel", acc, "--gyro", gyr, "--accel-scale", X_ACC,
+            "--gyro-scale", X_GYR, "--gravity", str(X_G_M_S2), "-o", str(out), "--json",
+            *extra]  # fmt: skip
+
+
+@pytest.fixture(scope="module")
+def xsens(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
+    d = tmp_path_factory.mktemp("xsens")
+    code, out, err = _run(_xsens_args(d / "cal.json", "--accel-offset", "32768",
+                                      "--gyro-offset", "32768"))  # fmt: skip
+    assert code == 0, err
+    import pandas as pd
+
+    df = pd.read_parquet(XSENS)
+    counts = df[[f"acc_{a} [counts]" for a in "xyz"]].to_numpy(dtype=np.float64)
+    return {"dir": d, "summary": json.loads(out), "err": err, "counts": counts}
+
+
+def _distinct(u: np.ndarray, deg: float = 10.0) -> int:
+    """Directions more than ``deg`` apart (greedy, in order), written here."""
+    kept: list[np.ndarray] = []
+    for v in u / np.linalg.norm(u, axis=1)[:, None]:
+        if all(float(v @ k) < np.cos(np.radians(deg)) for k in kept):
+            kept.append(v)
+    return len(kept)
+
+
+def test_xsens_offset_counts_give_its_thirty_odd_poses(xsens: dict[str, Any]) -> None:
+    s, counts = xsens["summary"], xsens["counts"]
+    assert 30 <= s["n_poses"] <= 45
+    means = np.array([counts[p["start"] : p["end"]].mean(axis=0) for p in s["poses"]])
+    # every placement is a real move (consecutive poses ≥ 30° apart); the session revisits
+    # orientations, 14 of them more than 10° from each other (the fit needs 9)
+    u = (means - MID) / np.linalg.norm(means - MID, axis=1)[:, None]
+    assert np.all(np.degrees(np.arccos(np.sum(u[1:] * u[:-1], axis=1))) > 30)
+    assert _distinct(means - MID) >= 12
+    # the pose means reported are the columns' own (offset put back), in the scale's unit
+    got = np.array([p["mean_specific_force"] for p in s["poses"]])
+    np.testing.assert_allclose(got, means * 0.27, rtol=1e-9)
+    assert s["runs"][0]["offset"] == {"accel": pytest.approx(MID * 0.27),
+                                      "gyro": pytest.approx(MID * 0.0091554)}  # fmt: skip
+
+
+def test_xsens_without_the_offset_is_one_direction(tmp_path: Path) -> None:
+    """Raw counts judged with their mid-scale in: every pose points to (+, +, +)."""
+    code, _out, err = _run(_xsens_args(tmp_path / "c.json", "--accel-offset", "0",
+                                       "--gyro-offset", "0"))  # fmt: skip
+    assert code == 2 and "1 distinct poses" in err and "--accel-offset" in err, err
+
+
+def test_xsens_mid_scale_found_with_a_warning(tmp_path: Path, xsens: dict[str, Any]) -> None:
+    code, out, err = _run(_xsens_args(tmp_path / "c.json"))
+    assert code == 0, err
+    assert "warning:" in err and "32768 taken as their zero; give --accel-offset" in err
+    assert json.loads(out)["accel"]["bias"] == pytest.approx(xsens["summary"]["accel"]["bias"])
+
+
+def _tedaldi(means: np.ndarray, g: float, sigma: np.ndarray) -> np.ndarray:
+    """Tedaldi et al. 2014's gravity-magnitude fit written here (scipy): ``m = (I + E) f +
+    b``, E lower triangular (scale on the diagonal, xy, xz, yz below), residual
+    ``(|(I + E)⁻¹ (m − b)| − g)/σ_k``; returns (b, scale ×10⁻³, xy/xz/yz ×10⁻³)."""
+    from scipy.optimize import least_squares
+
+    def resid(p: np.ndarray) -> np.ndarray:
+        e = np.diag(p[3:6] * 1e-3)
+        e[1, 0], e[2, 0], e[2, 1] = p[6:9] * 1e-3
+        f = np.linalg.solve(np.eye(3) + e, (means - p[0:3]).T).T
+        out: np.ndarray = (np.linalg.norm(f, axis=1) - g) / sigma
+        return out
+
+    sol = least_squares(resid, np.zeros(9), xtol=1e-14, ftol=1e-14, gtol=1e-14)
+    return np.asarray(sol.x)
+
+
+def _resid_rms(p: np.ndarray, means: np.ndarray, g: float) -> float:
+    e = np.diag(p[3:6] * 1e-3)
+    e[1, 0], e[2, 0], e[2, 1] = p[6:9] * 1e-3
+    f = np.linalg.solve(np.eye(3) + e, (means - p[0:3]).T).T
+    return float(np.sqrt(np.mean((np.linalg.norm(f, axis=1) - g) ** 2)))
+
+
+def test_xsens_calibration_as_imu_tks_unweighted_cost(xsens: dict[str, Any]) -> None:
+    """imu_tk's cost counts every pose alike (``MultiPosAccResidual``: ``g − |calib(a)|``,
+    squared loss, no weights).  On this misfit sensor (reduced χ² ≈ 16 with the white-noise
+    weights) thermocal inflates each pose's σ by the misfit, so its residual is within 1 %
+    of the unweighted solution written here on the same poses (it was 9 % above with the
+    white-noise weights, the long initial static pulling the fit) and its parameters within
+    their stated σ of it."""
+    s, counts = xsens["summary"], xsens["counts"]
+    g = X_G_M_S2 / MG_M_S2
+    means = np.array([(counts[p["start"] : p["end"]] - MID).mean(axis=0) * 0.27
+                      for p in s["poses"]])  # fmt: skip
+    ref = _tedaldi(means, g, np.ones(len(means)))
+    assert s["gravity_residual_rms_after"] <= 1.01 * _resid_rms(ref, means, g)
+    run = s["runs"][0]["accel"]
+    assert run["reduced_chi2"] > 10 and run["misfit"] > 0
+    a = s["accel"]
+    names = a["misalignment_names"]
+    idx = [names.index(n) for n in ("xy", "xz", "yz")]
+    mine = np.concatenate([np.asarray(a["bias"]) - MID * 0.27, a["scale_factor_ppm"],
+                           np.asarray(a["misalignment_arcsec"])[idx]])  # fmt: skip
+    theirs = np.concatenate([ref[0:3], ref[3:6] * 1e3, ref[6:9] * 1e-3 * 206264.80624709636])
+    sig = np.concatenate([a["bias_sigma"], a["scale_factor_ppm_sigma"],
+                          np.asarray(a["misalignment_arcsec_sigma"])[idx]])  # fmt: skip
+    z = (mine - theirs) / sig
+    assert np.all(np.abs(z) < 1.0), z

@@ -223,6 +223,14 @@ def multipos_cmd(
             f"{fmt(out['gravity_residual_rms_before'], 3)} → "
             f"{fmt(out['gravity_residual_rms_after'], 3)} {a_unit}; written {output}"
         )
+        for run in out["runs"]:
+            if run["accel"].get("misfit"):
+                stdout.print(
+                    f"{run['input']}: the poses scatter more than their noise (reduced χ² "
+                    f"{fmt(run['accel']['reduced_chi2'], 3)}): each pose's σ inflated by a "
+                    f"misfit of {fmt(run['accel']['misfit'], 3)} {a_unit}, so that each "
+                    "counts as the misfit says"
+                )
         _explain(out)
 
     emit(out, as_json, human)

@@ -323,11 +323,19 @@ def _session(
         sections = list(det.poses)
     temp = rec.temperature_c(temps) if temps else None
     assert grav.g_m_s2 is not None
-    res = calibrate_session(
-        rec.time_s, acc, w, g_mg=float(grav.g_m_s2) / 9.80665e-3,
-        latitude_deg=grav.latitude_deg, sections=sections, static_s=opts.static_s,
-        temperature_c=temp, where=str(path),
-    )  # fmt: skip
+    try:
+        res = calibrate_session(
+            rec.time_s, acc, w, g_mg=float(grav.g_m_s2) / 9.80665e-3,
+            latitude_deg=grav.latitude_deg, sections=sections, static_s=opts.static_s,
+            temperature_c=temp, where=str(path),
+        )  # fmt: skip
+    except DesignError as exc:
+        if opts.accel_scale is None or "distinct poses" not in str(exc):
+            raise
+        raise DesignError(
+            f"{path}: {exc}; or, if the raw counts' zero is not 0 (unsigned ADC counts sit "
+            "around mid-scale), give it with --accel-offset (e.g. 32768)"
+        ) from None
     acc_off_mg = float(units.convert(np.array([a_off]), au, "mg")[0]) if a_off else 0.0
     g_off_dh = float(units.convert(np.array([g_off]), str(gu), "deg/h")[0]) if g_off else 0.0
     res = _with_offsets(res, acc_off_mg, g_off_dh)
@@ -444,7 +452,8 @@ def _summary(
             "temperature_c": r.temperature_c,
             "n_poses": len(r.poses),
             "accel": {**_triad_dict(r.accel.theta, r.accel.sigma, to_a, a_unit),
-                      "method": r.accel.method, "reduced_chi2": r.accel.reduced_chi2},
+                      "method": r.accel.method, "reduced_chi2": r.accel.reduced_chi2,
+                      "misfit": r.accel.misfit_mg * to_a},
             "poses": [
                 {**p, "mean_specific_force": (np.asarray(p["mean_specific_force_mg"])
                                               * to_a).tolist(),
