@@ -1113,6 +1113,22 @@ MUTANTS: tuple[Mutant, ...] = (
         ("tests/test_multipos_real_sessions.py",),
         "--accel-offset/--gyro-offset ignored (unsigned counts: 1 distinct pose)",
     ),
+    Mutant(
+        "multipos-saturated-motions-kept",
+        P + "multipos/gyro.py",
+        "motions = unsaturated(motions, saturated)",
+        "motions = unsaturated(motions, None)",
+        ("tests/test_multipos_real_sessions.py",),
+        "motions across clipped gyro samples integrated into the gyro fit",
+    ),
+    Mutant(
+        "inspect-saturation-unreported",
+        P + "inspection.py",
+        "            problems.extend(_saturation_problems(name, arr))",
+        "            pass",
+        ("tests/test_multipos_real_sessions.py",),
+        "inspect says nothing of samples on the int16 rails",
+    ),
     # --- station -----------------------------------------------------------------------------
     Mutant(
         "station-part-rotation-strict",

@@ -10,6 +10,7 @@ and go out (file layer, as :mod:`thermocal.compensate.files` for the compensatio
 
 from __future__ import annotations
 
+import itertools
 import json
 import math
 import warnings
@@ -22,6 +23,7 @@ import numpy as np
 
 from thermocal import units
 from thermocal.errors import DesignError, ThermocalInputError, ThermocalWarning, UnitError
+from thermocal.inspection import saturated_mask
 from thermocal.models.calibration import Calibration, Triad
 from thermocal.models.files import save_calibration
 from thermocal.multipos.calibrate import METHOD, SessionResult, calibrate_session
@@ -31,6 +33,7 @@ from thermocal.multipos.poses import (
     STILL_THRESHOLD,
     WINDOW_S,
     PoseDetection,
+    Section,
     find_poses,
     parse_poses,
 )
@@ -294,6 +297,42 @@ def _detect(t: np.ndarray, acc: np.ndarray, w: np.ndarray | None, opts: Multipos
     return det
 
 
+def _saturation(
+    rec: Recording, cols: list[str], sections: list[Section], path: Path
+) -> np.ndarray | None:
+    """The samples with a gyro column on its rails (:func:`thermocal.inspection.saturated_mask`),
+    None when there are none.  A 360° turn across them is refused; each motion between
+    consecutive static poses across them is named in a warning (the gyro fit leaves it out)."""
+    sat = np.zeros(rec.n_samples, dtype=bool)
+    for c in cols:
+        sat |= saturated_mask(rec.column(c))
+    if not sat.any():
+        return None
+    for sec in sections:
+        if sec.is_turn and sat[sec.start : sec.end].any():
+            k = sec.start + int(np.argmax(sat[sec.start : sec.end]))
+            raise ThermocalInputError(
+                f"{path}: the turn {sec.name!r} has gyro samples on their rails (first at row "
+                f"{k}): its rotation is unknown; record it slower, or with a wider gyro range"
+            )
+    statics = [s for s in sections if not s.is_turn]
+    hit = [
+        f"{a.name} → {b.name} (rows {a.end + int(np.argmax(sat[a.end : b.start]))}…)"
+        for a, b in itertools.pairwise(statics)
+        if sat[a.start : b.end].any()
+    ]
+    if hit:
+        warnings.warn(
+            ThermocalWarning(
+                f"{path}: the gyro is on its rails (clipped) during {len(hit)} motion(s): "
+                f"{', '.join(hit[:6])}{' …' if len(hit) > 6 else ''}; left out of the gyro "
+                "fit (`thermocal inspect` lists the samples)"
+            ),
+            stacklevel=3,
+        )
+    return sat
+
+
 def _session(
     path: Path,
     opts: MultiposOptions,
@@ -321,13 +360,14 @@ def _session(
     else:
         det = _detect(rec.time_s, acc, w, opts, path)
         sections = list(det.poses)
+    sat = _saturation(rec, gyr_cols, sections, path) if gyr_cols else None
     temp = rec.temperature_c(temps) if temps else None
     assert grav.g_m_s2 is not None
     try:
         res = calibrate_session(
             rec.time_s, acc, w, g_mg=float(grav.g_m_s2) / 9.80665e-3,
             latitude_deg=grav.latitude_deg, sections=sections, static_s=opts.static_s,
-            temperature_c=temp, where=str(path),
+            temperature_c=temp, where=str(path), saturated=sat,
         )  # fmt: skip
     except DesignError as exc:
         if opts.accel_scale is None or "distinct poses" not in str(exc):

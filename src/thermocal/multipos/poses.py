@@ -14,11 +14,12 @@ is the white-noise variance itself when at least a tenth of the session is still
 the noise, or — for a hand-held board, whose tremor is many times a quiet sensor's noise
 but far below the moves between poses — below a hundredth of the motions' variance
 (a tenth of their rms), so that a low-noise and a noisier sensor on the same board find
-the same poses.  A pose is a run of still samples at least ``static_s`` long once
-shortened by ``w/2`` at each end that borders motion (the window straddles it there);
-shorter pauses are *rejected, too short*, and a run whose gravity direction turns more
-than ``drift_deg`` (default 2°) between its first and last thirds is *rejected, moving*
-(a slow turn, which the window variance hardly sees).  Each pose carries its mean window
+the same poses.  A pose is a run of still samples at least ``static_s`` long (a sample
+is still only when its whole centred window is, so a run already keeps ``w/2`` samples
+away from the motions on either side); shorter pauses are *rejected, too short*, and a
+run whose gravity direction turns more than ``drift_deg`` (default 2°) between its first
+and last thirds is *rejected, moving* (a slow turn, which the window variance hardly
+sees).  Each pose carries its mean window
 variance over the accelerometer's noise floor (≈ 1 when still; more: tremor).
 
 POSES file (imucal's session list): ``{"name": {"start": i, "end": j}, …}`` by sample
@@ -240,12 +241,11 @@ def find_poses(
         still &= vg.sum(axis=1) < lim_g.limit
     score = (va / lim_a.floor).mean(axis=1)
     edges = np.flatnonzero(np.diff(np.concatenate([[0], still.astype(np.int8), [0]])))
-    h = w // 2
     min_n = max(2, round(static_s / dt))
     poses: list[Section] = []
     rejected: list[Rejected] = []
     for s0, e0 in zip(edges[0::2], edges[1::2], strict=True):
-        s, e = int(s0) + (h if s0 > 0 else 0), int(e0) - (h if e0 < n else 0)
+        s, e = int(s0), int(e0)
         if e - s < min_n:
             if int(e0) - int(s0) >= w:  # a real pause, not a crossing of the limit
                 rejected.append(Rejected(int(s0), int(e0), (
