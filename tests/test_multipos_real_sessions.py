@@ -96,6 +96,108 @@ def test_mpu_explanation_in_the_human_output(mpu: dict[str, Any]) -> None:
     assert "10 poses (window 0.5 s" in out and "set by the motions" in out
 
 
+AUTHOR_ACC = (1.043860522409845042e-05, 2.098452816658057195e-06,
+              2.005985606930172646e-06, 6.020083400010406817e-04,
+              5.968449488725015338e-04, 5.859241382355084718e-04,
+              -7.115163422327075295e02, 3.585054836108664063e02,
+              1.840128451085784491e03)  # fmt: skip
+"""The authors' accelerometer calibration (``optmization result data/params_acc.csv``):
+misalignments yz, zy, zx, scales [(m/s²)/count], biases [counts]."""
+AUTHOR_GYR = (-9.967394130262499652e-03, 9.183836411500549690e-03, -2.912198601931083493e-03,
+              7.234881652289322680e-03, -9.841957371310869340e-03, 5.795923574753897821e-03,
+              1.373743743438648286e-04, 1.329249743689399734e-04, 1.339443406342994032e-04,
+              -4.274617614746093750e02, 1.479479370117187500e02,
+              -8.072266387939453125e01)  # fmt: skip
+"""The authors' gyro calibration (``params_gyro.csv``): six misalignments, scales
+[(rad/s)/count], biases [counts]."""
+TURN_BEFORE, TURN_AFTER = (100, 1450), (2400, 4300)
+"""The held-out session's still stretches around its +90° turn about x (rows; the gyro
+stays within 0.5 °/s of its rest there, the turn spans rows ≈1475–2225)."""
+
+
+def _author_acc(raw: np.ndarray) -> np.ndarray:
+    """The authors' ``apply_accel_calibration``: ``T K (raw + b)``, written here."""
+    m, k, b = np.split(np.asarray(AUTHOR_ACC), [3, 6])
+    t = np.array([[1.0, -m[0], m[1]], [0.0, 1.0, -m[2]], [0.0, 0.0, 1.0]])
+    out: np.ndarray = (raw + b) @ (t @ np.diag(k)).T
+    return out
+
+
+def _author_gyr(raw: np.ndarray) -> np.ndarray:
+    """The authors' ``apply_gyro_calibration``: ``T K (raw − b)`` [rad/s], written here."""
+    m, k, b = np.split(np.asarray(AUTHOR_GYR), [6, 9])
+    t = np.array([[1.0, -m[0], m[1]], [m[2], 1.0, -m[3]], [-m[4], m[5], 1.0]])
+    out: np.ndarray = (raw - b) @ (t @ np.diag(k)).T
+    return out
+
+
+def _turn_error_deg(acc: np.ndarray, rate_rad_s: np.ndarray, dt: float = 0.01) -> float:
+    """The angle [°] between gravity measured after the turn and gravity before it carried
+    by the integrated rate (body frame, scipy rotations composed sample by sample)."""
+    from scipy.spatial.transform import Rotation
+
+    (a0, a1), (b0, b1) = TURN_BEFORE, TURN_AFTER
+    u0 = acc[a0:a1].mean(axis=0)
+    u1 = acc[b0:b1].mean(axis=0)
+    rot = Rotation.identity()
+    for w in rate_rad_s[a1:b0]:
+        rot = rot * Rotation.from_rotvec(w * dt)
+    p = rot.apply(u0 / np.linalg.norm(u0), inverse=True)
+    c = float(p @ u1 / np.linalg.norm(u1))
+    return float(np.degrees(np.arccos(np.clip(c, -1.0, 1.0))))
+
+
+def test_mpu_held_out_90_degree_turn(mpu: dict[str, Any]) -> None:
+    """The held-out turn compensated by ``thermocal compensate`` with the session's
+    calibration, against the authors' own calibration applied as their code does (both
+    computed here).  The authors' error is 1.54°.  thermocal's, with the three clipped
+    motions left out (6 motions for 9 gyro parameters), is 7.0°, within what its stated
+    uncertainty predicts for a turn about x, 7.3° (the σ of the x scale factor and of the
+    misalignments of x into y and z, ``xy`` and ``xz``, times the 90° turned): worse than
+    the datasheet's nominal gyro scale with thermocal's accelerometer (2.23°); with the
+    clipped motions integrated it was 2.4°.  The issue's "within 1.2× the authors' error"
+    is NOT reached (the xfail below)."""
+    import pandas as pd
+
+    held = _mpu_csv("imu_90_x_rot.csv", mpu["dir"] / "held.csv")
+    comp = mpu["dir"] / "held_comp.csv"
+    code, _o, err = _run(["compensate", str(mpu["cal"]), str(held), "-o", str(comp)])
+    assert code == 0, err
+    df = pd.read_csv(comp)
+    acc = df[[f"a{a} [counts]_comp" for a in "xyz"]].to_numpy()
+    rate = np.radians(df[[f"g{a} [counts]_comp" for a in "xyz"]].to_numpy())
+    raw = np.loadtxt(MPU / "imu_90_x_rot.csv", delimiter=",", skiprows=5)
+    author = _turn_error_deg(_author_acc(raw[:, :3]), _author_gyr(raw[:, 3:]))
+    assert author == pytest.approx(1.54, abs=0.01)
+    mine = _turn_error_deg(acc, rate)
+    g = mpu["summary"]["gyro"]
+    names = g["misalignment_names"]
+    arcsec = 1.0 / 206264.80624709636
+    sig = np.array([g["scale_factor_ppm_sigma"][0] * 1e-6,  # E[0, 0], E[1, 0], E[2, 0]
+                    g["misalignment_arcsec_sigma"][names.index("xy")] * arcsec,
+                    g["misalignment_arcsec_sigma"][names.index("xz")] * arcsec])  # fmt: skip
+    predicted = 90.0 * float(np.linalg.norm(sig))
+    assert mine <= 1.5 * predicted, (mine, predicted)
+    nominal = np.radians((raw[:, 3:] - raw[100:1450, 3:].mean(axis=0)) * 250 / 32768)
+    assert _turn_error_deg(raw[:, :3], nominal) > 10.0  # nothing calibrated: 10.3°
+    # thermocal's accelerometer with the datasheet's gyro scale: 2.23°, within 1.5× the
+    # authors': the accelerometer part holds; the gyro fit on 6 hand-held motions does not
+    assert _turn_error_deg(acc, nominal) <= 1.5 * author
+    mpu["turn"] = (mine, author)
+
+
+@pytest.mark.xfail(
+    strict=True,
+    reason="issue 38: the held-out turn within 1.2× the authors' "
+    "error is not reached (7.0° vs 1.54°; 2.4° with the clipped motions in)",
+)
+def test_mpu_held_out_turn_within_1p2_of_the_authors(mpu: dict[str, Any]) -> None:
+    if "turn" not in mpu:
+        test_mpu_held_out_90_degree_turn(mpu)
+    mine, author = mpu["turn"]
+    assert mine <= 1.2 * author
+
+
 # --- imu_tk's Xsens session -------------------------------------------------------------
 
 XSENS = DATA / "imu_tk_xsens" / "xsens_imu_tk.parquet"
