@@ -1129,6 +1129,14 @@ MUTANTS: tuple[Mutant, ...] = (
         ("tests/test_multipos_real_sessions.py",),
         "inspect says nothing of samples on the int16 rails",
     ),
+    Mutant(
+        "multipos-poses-drift-off",
+        P + "multipos/poses.py",
+        "        if turn > drift_deg:",
+        "        if turn > 1e9 * drift_deg:",
+        ("tests/test_multipos_real_sessions.py",),
+        "pose detector: a slow 10° turn taken as a pose",
+    ),
     # --- station -----------------------------------------------------------------------------
     Mutant(
         "station-part-rotation-strict",

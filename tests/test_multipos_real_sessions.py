@@ -421,3 +421,45 @@ def test_clipped_motions_named_and_kept_out_of_the_gyro_fit(clipped: dict[str, A
     )
     assert np.all(np.abs(z) < 4.0), z
     assert max(g["scale_factor_ppm_sigma"]) < 500.0
+
+
+def test_a_slow_turn_is_rejected_as_moving() -> None:
+    """Eight 3 s rests between 1 s shaken moves (2 mg noise); the fifth rest turns slowly by
+    10° (its window variance stays at the noise): rejected as *moving*, the gravity
+    direction turning (10°)·(2/3) ≈ 6.7° between the means of its first and last thirds
+    (their centres are 2 s apart; the means average over a third each: 5–7°), and the
+    other seven found."""
+    from scipy.spatial.transform import Rotation
+
+    from thermocal.multipos.poses import find_poses
+
+    rng = np.random.default_rng(5)
+    cur = np.array([0.0, 0.0, 1000.0])
+    dirs = [Rotation.from_rotvec(v).apply(cur) for v in rng.normal(0, 1.2, (8, 3))]
+    segs, truth, n = [], [], 0
+    for k, d in enumerate(dirs):
+        s = np.linspace(0, 1, 100)[:, None]
+        segs.append(cur + (d - cur) * (0.5 - 0.5 * np.cos(np.pi * s)) + rng.normal(0, 60, (100, 3)))
+        n += 100
+        if k == 4:
+            ax = np.cross(d, [1.0, 0.0, 0.0])
+            ax /= np.linalg.norm(ax)
+            rest = np.array([Rotation.from_rotvec(ax * a).apply(d)
+                             for a in np.linspace(0, np.radians(10.0), 300)])  # fmt: skip
+        else:
+            rest = np.tile(d, (300, 1))
+        cur = rest[-1]
+        truth.append((n, n + 300))
+        segs.append(rest + rng.normal(0, 2.0, rest.shape))
+        n += 300
+    acc = np.vstack(segs)
+    det = find_poses(np.arange(n) / 100.0, acc)
+    assert len(det.poses) == 7
+    assert len(det.rejected) == 1
+    r = det.rejected[0]
+    assert truth[4][0] <= r.start < r.end <= truth[4][1]
+    assert r.reason.startswith("moving: the gravity direction turns ")
+    turned = float(r.reason.split("turns ")[1].split("°")[0])
+    assert 5.0 < turned < 7.0
+    kept = [t for k, t in enumerate(truth) if k != 4]
+    assert all(sum(1 for p in det.poses if p.start < b and a < p.end) == 1 for a, b in kept)
