@@ -1137,6 +1137,14 @@ MUTANTS: tuple[Mutant, ...] = (
         ("tests/test_multipos_real_sessions.py",),
         "pose detector: a slow 10° turn taken as a pose",
     ),
+    Mutant(
+        "multipos-poses-tremor-unexplained",
+        P + "multipos/poses.py",
+        "    rejected += _tremor(ratio, poses, rejected, min_n)",
+        "    rejected += _tremor(ratio, poses, rejected, min_n)[:0]",
+        ("tests/test_multipos_real_sessions.py",),
+        "pose detector: stretches lost to tremor not reported",
+    ),
     # --- station -----------------------------------------------------------------------------
     Mutant(
         "station-part-rotation-strict",

@@ -463,3 +463,35 @@ def test_a_slow_turn_is_rejected_as_moving() -> None:
     assert 5.0 < turned < 7.0
     kept = [t for k, t in enumerate(truth) if k != 4]
     assert all(sum(1 for p in det.poses if p.start < b and a < p.end) == 1 for a, b in kept)
+
+
+def test_tremor_rejections_explained_and_motion_fraction_takes_them(tmp_path: Path) -> None:
+    """20 poses held with a heavy tremor (0.2° at 6 Hz: ≈ 5 °/s rms on the gyro, beyond a
+    hundredth of the motions' variance): 13 are still for both sensors and 7 are reported
+    rejected for the gyro's tremor, naming the option; with ``--motion-fraction 0.03`` all
+    20 of the truth are poses."""
+    from thermocal.multipos.simulate import simulate_session
+
+    s = simulate_session(np.random.default_rng(7), np.zeros(12), np.zeros(12), n_poses=20,
+                         dwell_s=2.0, move_s=1.5, accel_noise_mg=0.3,
+                         tremor_deg=0.2)  # fmt: skip
+    cols = {"time [s]": s["time_s"]}
+    cols.update({f"acc_{a} [mg]": s["accel_mg"][:, k] for k, a in enumerate("xyz")})
+    cols.update({f"gyr_{a} [deg/s]": s["gyro_deg_s"][:, k] for k, a in enumerate("xyz")})
+    f = _write(tmp_path / "tremor.csv", cols)
+    base = ["multipos", str(f), "--accel", "acc_x [mg],acc_y [mg],acc_z [mg]", "--gyro",
+            "gyr_x [deg/s],gyr_y [deg/s],gyr_z [deg/s]", "--latitude", "45"]  # fmt: skip
+    code, out, err = _run([*base, "-o", str(tmp_path / "a.json"), "--json"])
+    assert code == 0, err
+    det = json.loads(out)["pose_detection"][0]
+    assert det["n_poses"] == 13
+    tremor = [r for r in det["rejected"] if r["reason"].startswith("tremor: the gyro's variance")]
+    assert len(tremor) == 7 and len(det["rejected"]) == 7
+    assert all("raise --motion-fraction" in r["reason"] for r in tremor)
+    truth = list(s["poses"])
+    found = [(p["start"], p["end"]) for p in json.loads(out)["poses"]]
+    found += [(r["start"], r["end"]) for r in tremor]
+    assert all(sum(1 for a, b in found if a < t1 and t0 < b) == 1 for t0, t1 in truth)
+    code, out, err = _run([*base, "-o", str(tmp_path / "b.json"), "--motion-fraction", "0.03"])
+    assert code == 0, err
+    assert "20 poses (window 0.5 s" in out and "0 rejected" in out

@@ -19,8 +19,10 @@ is still only when its whole centred window is, so a run already keeps ``w/2`` s
 away from the motions on either side); shorter pauses are *rejected, too short*, and a
 run whose gravity direction turns more than ``drift_deg`` (default 2°) between its first
 and last thirds is *rejected, moving* (a slow turn, which the window variance hardly
-sees).  Each pose carries its mean window
-variance over the accelerometer's noise floor (≈ 1 when still; more: tremor).
+sees); a stretch of at least ``static_s`` below ten times the limit that holds no pose is
+*rejected, tremor* (the sensor and how far above the limit it sat are named).  Each pose
+carries its mean window variance over the accelerometer's noise floor (≈ 1 when still;
+more: tremor).
 
 POSES file (imucal's session list): ``{"name": {"start": i, "end": j}, …}`` by sample
 index, ``end`` exclusive; ``x_p``, ``x_a``, ``y_p``, ``y_a``, ``z_p``, ``z_a`` are the six
@@ -201,6 +203,72 @@ def _drift_deg(a: FloatArray) -> float:
     return math.degrees(math.acos(c))
 
 
+TREMOR_FACTOR: Final = 10.0
+"""A stretch of at least ``static_s`` whose variance stays below this many times the still
+limit, and that holds no pose, is reported as rejected for tremor."""
+
+
+def _runs(
+    a: FloatArray,
+    still: npt.NDArray[np.bool_],
+    score: FloatArray,
+    w: int,
+    min_n: int,
+    dt: float,
+    static_s: float,
+    drift_deg: float,
+) -> tuple[list[Section], list[Rejected]]:
+    """The runs of still samples: poses, or rejected as too short or moving."""
+    edges = np.flatnonzero(np.diff(np.concatenate([[0], still.astype(np.int8), [0]])))
+    poses: list[Section] = []
+    rejected: list[Rejected] = []
+    for s0, e0 in zip(edges[0::2], edges[1::2], strict=True):
+        s, e = int(s0), int(e0)
+        if e - s < min_n:
+            if e - s >= w:  # a real pause, not a crossing of the limit
+                rejected.append(Rejected(s, e, (
+                    f"too short: {(e - s) * dt:.3g} s still < --static-s {static_s:g} s"
+                )))  # fmt: skip
+            continue
+        turn = _drift_deg(a[s:e])
+        if turn > drift_deg:
+            rejected.append(Rejected(s, e, (
+                f"moving: the gravity direction turns {turn:.3g}° across it "
+                f"(> --drift-deg {drift_deg:g})"
+            )))  # fmt: skip
+            continue
+        poses.append(Section(f"pose_{len(poses) + 1}", s, e, float(np.mean(score[s:e]))))
+    return poses, rejected
+
+
+def _tremor(
+    ratio: dict[str, FloatArray], poses: list[Section], rejected: list[Rejected], min_n: int
+) -> list[Rejected]:
+    """Stretches of at least ``min_n`` samples below :data:`TREMOR_FACTOR` times the still
+    limit (``ratio``: each sensor's window variance over its limit) that overlap no pose
+    and no stretch already rejected: rejected for tremor, with the sensor and factor."""
+    worst = np.max(np.vstack(list(ratio.values())), axis=0)
+    calm = worst < TREMOR_FACTOR
+    edges = np.flatnonzero(np.diff(np.concatenate([[0], calm.astype(np.int8), [0]])))
+    taken = [(p.start, p.end) for p in poses] + [(r.start, r.end) for r in rejected]
+    out = []
+    for s0, e0 in zip(edges[0::2], edges[1::2], strict=True):
+        s, e = int(s0), int(e0)
+        if e - s < min_n or any(a < e and s < b for a, b in taken):
+            continue
+        name, frac, p90 = max(
+            ((k, float(np.mean(v[s:e] >= 1.0)), float(np.percentile(v[s:e], 90)))
+             for k, v in ratio.items()),
+            key=lambda kv: kv[1],
+        )  # fmt: skip
+        out.append(Rejected(s, e, (
+            f"tremor: the {name}'s variance above the still limit in {frac:.0%} of it (90th "
+            f"percentile {p90:.3g}× the limit); raise --motion-fraction or --still-threshold "
+            "to take it"
+        )))  # fmt: skip
+    return out
+
+
 def find_poses(
     time_s: npt.ArrayLike,
     accel: npt.ArrayLike,
@@ -235,31 +303,19 @@ def find_poses(
     lim_a = _limit(va, w, threshold, motion_fraction)
     still = va.sum(axis=1) < lim_a.limit
     lim_g = None
+    vg = va
     if gyro is not None:
         vg = _axis_variances(np.asarray(gyro, dtype=np.float64), w)
         lim_g = _limit(vg, w, threshold, motion_fraction)
         still &= vg.sum(axis=1) < lim_g.limit
     score = (va / lim_a.floor).mean(axis=1)
-    edges = np.flatnonzero(np.diff(np.concatenate([[0], still.astype(np.int8), [0]])))
     min_n = max(2, round(static_s / dt))
-    poses: list[Section] = []
-    rejected: list[Rejected] = []
-    for s0, e0 in zip(edges[0::2], edges[1::2], strict=True):
-        s, e = int(s0), int(e0)
-        if e - s < min_n:
-            if int(e0) - int(s0) >= w:  # a real pause, not a crossing of the limit
-                rejected.append(Rejected(int(s0), int(e0), (
-                    f"too short: {max(e - s, 0) * dt:.3g} s still < --static-s {static_s:g} s"
-                )))  # fmt: skip
-            continue
-        turn = _drift_deg(a[s:e])
-        if turn > drift_deg:
-            rejected.append(Rejected(s, e, (
-                f"moving: the gravity direction turns {turn:.3g}° across it "
-                f"(> --drift-deg {drift_deg:g})"
-            )))  # fmt: skip
-            continue
-        poses.append(Section(f"pose_{len(poses) + 1}", s, e, float(np.mean(score[s:e]))))
+    poses, rejected = _runs(a, still, score, w, min_n, dt, static_s, drift_deg)
+    ratio = {"accelerometer": va.sum(axis=1) / lim_a.limit}
+    if lim_g is not None:
+        ratio["gyro"] = vg.sum(axis=1) / lim_g.limit
+    rejected += _tremor(ratio, poses, rejected, min_n)
+    rejected.sort(key=lambda r: r.start)
     return PoseDetection(tuple(poses), tuple(rejected), w, dt, lim_a, lim_g, threshold,
                          motion_fraction, static_s)  # fmt: skip
 
