@@ -1145,6 +1145,14 @@ MUTANTS: tuple[Mutant, ...] = (
         ("tests/test_multipos_real_sessions.py",),
         "pose detector: stretches lost to tremor not reported",
     ),
+    Mutant(
+        "multipos-offset-not-in-bias",
+        P + "multipos/files.py",
+        "    if acc_off_mg == 0.0 and gyr_off_deg_h == 0.0:",
+        "    if True:",
+        ("tests/test_multipos_real_sessions.py",),
+        "--accel-offset removed before the fit but not put back into the biases",
+    ),
     # --- station -----------------------------------------------------------------------------
     Mutant(
         "station-part-rotation-strict",

@@ -495,3 +495,56 @@ def test_tremor_rejections_explained_and_motion_fraction_takes_them(tmp_path: Pa
     code, out, err = _run([*base, "-o", str(tmp_path / "b.json"), "--motion-fraction", "0.03"])
     assert code == 0, err
     assert "20 poses (window 0.5 s" in out and "0 rejected" in out
+
+
+def test_unsigned_offset_counts_give_the_truth_with_the_offset_in_the_bias(
+    tmp_path: Path,
+) -> None:
+    """A simulated session stored as unsigned 16-bit counts around 32768 (±2 g at 16384
+    LSB/g, ±250 °/s at 131 LSB/(°/s)): with ``--accel-offset``/``--gyro-offset 32768`` the
+    biases are the truth plus the offset (in the scale's unit) within 4σ, the scale factors
+    the truth within 4σ, and ``thermocal compensate`` with the calibration gives gravity's
+    magnitude at every pose; with a zero of 0, exit 2 naming ``--accel-offset``; without
+    one, mid-scale taken with a warning."""
+    import pandas as pd
+
+    from thermocal.multipos.simulate import simulate_session
+
+    ta, tg = np.zeros(12), np.zeros(12)
+    ta[0:3], ta[3:6] = [25.0, -40.0, 10.0], [4000.0, -2500.0, 1500.0]
+    tg[0:3] = [400.0, -600.0, 250.0]
+    s = simulate_session(np.random.default_rng(38), ta, tg, n_poses=16)
+    ac = np.round(s["accel_mg"] * 16.384) + MID
+    gc = np.round(s["gyro_deg_s"] * 131.0) + MID
+    assert ac.min() >= 0 and gc.min() >= 0 and max(ac.max(), gc.max()) <= 65535
+    cols: dict[str, np.ndarray] = {"time [s]": s["time_s"]}
+    cols.update({f"a{a} [counts]": ac[:, k].astype(np.int64) for k, a in enumerate("xyz")})
+    cols.update({f"g{a} [counts]": gc[:, k].astype(np.int64) for k, a in enumerate("xyz")})
+    f = _write(tmp_path / "u16.csv", cols)
+    acc_lsb, gyr_lsb = 1000.0 / 16384.0, 1.0 / 131.0
+    base = ["multipos", str(f), "--accel", _cols("ax,ay,az"), "--gyro", _cols("gx,gy,gz"),
+            "--accel-scale", f"{acc_lsb!r},mg", "--gyro-scale", f"{gyr_lsb!r},deg/s",
+            "--latitude", "45"]  # fmt: skip
+    code, _o, err = _run([*base, "--accel-offset", "0", "--gyro-offset", "0",
+                          "-o", str(tmp_path / "no.json")])  # fmt: skip
+    assert code == 2 and "--accel-offset" in err, err
+    code, _o, err = _run([*base, "-o", str(tmp_path / "auto.json")])
+    assert code == 0 and "32768 taken as their zero; give --accel-offset" in err, err
+    code, out, err = _run([*base, "--accel-offset", "32768", "--gyro-offset", "32768",
+                           "-o", str(tmp_path / "cal.json"), "--json"])  # fmt: skip
+    assert code == 0, err
+    r = json.loads(out)
+    a, g = r["accel"], r["gyro"]
+    want_b = ta[0:3] + MID * acc_lsb
+    assert np.all(np.abs((np.asarray(a["bias"]) - want_b) / np.asarray(a["bias_sigma"])) < 4)
+    z = (np.asarray(a["scale_factor_ppm"]) - ta[3:6]) / np.asarray(a["scale_factor_ppm_sigma"])
+    assert np.all(np.abs(z) < 4), z
+    want_g = tg[0:3] / 3600.0 + MID * gyr_lsb  # °/h → °/s
+    assert np.all(np.abs((np.asarray(g["bias"]) - want_g) / np.asarray(g["bias_sigma"])) < 4)
+    comp = tmp_path / "comp.csv"
+    code, _o, err = _run(["compensate", str(tmp_path / "cal.json"), str(f), "-o", str(comp)])
+    assert code == 0, err
+    fc = pd.read_csv(comp)[[f"a{a} [counts]_comp" for a in "xyz"]].to_numpy()
+    g_mg = s["g_m_s2"] / MG_M_S2
+    mags = [np.linalg.norm(fc[p0 + 30 : p1 - 30].mean(axis=0)) for p0, p1 in s["poses"]]
+    assert np.max(np.abs(np.asarray(mags) - g_mg)) < 1.0  # mg
