@@ -7,7 +7,17 @@ MIT): a 36.5 s static on the table, then nine places where the board is held by 
 judged against the sensor's noise and the motions around the poses, must find the same 10
 places (each of the authors' intervals inside exactly one pose, one to one).  The file has
 no time column (``Fs,100`` in its banner): the test writes it as a user's export with
-``time = row / 100 Hz``.
+``time = row / 100 Hz``.  Its held-out +90° turn is compared with the authors' own
+calibration applied as their code does (written here).
+
+**imu_tk's Xsens session** (``tests/data/imu_tk_xsens``, BSD-2): unsigned ADC counts
+around 32768; its poses with the offset stated (or found, with a warning), and the
+accelerometer calibration against imu_tk's unweighted gravity-magnitude cost solved here
+with scipy on the same poses.
+
+**Simulated sessions** (:mod:`thermocal.multipos.simulate` gives the truth): hand-held 2 s
+poses read by a quiet and a noisy accelerometer, heavy tremor, a slow turn inside a rest,
+a gyro clipping on its int16 rails, unsigned offset counts.
 """
 
 from __future__ import annotations
