@@ -165,10 +165,12 @@ def calibrate_session(
     static_s: float = 1.0,
     temperature_c: npt.ArrayLike | None = None,
     where: str = "session",
+    saturated: npt.ArrayLike | None = None,
 ) -> SessionResult:
     """Calibrate the accelerometer (and gyro) triad of one session (module docstring).
     ``accel_mg`` (n, 3) [mg], ``gyro_rad_s`` (n, 3) [rad/s] or None, ``g_mg`` local
-    gravity [mg]; ``sections`` from a POSES file, else found from the data."""
+    gravity [mg]; ``sections`` from a POSES file, else found from the data; ``saturated``
+    (n,) the samples with a gyro axis on its rails (their motions left out of the gyro fit)."""
     t = np.asarray(time_s, dtype=np.float64)
     a = np.asarray(accel_mg, dtype=np.float64)
     w = None if gyro_rad_s is None else np.asarray(gyro_rad_s, dtype=np.float64)
@@ -242,6 +244,7 @@ def calibrate_session(
             w, dt, [p.section for p in stats], up_of, free, free_cov, bias, bias_cov,
             _direction_sigma(sig, names, acc.method, g_mg), float(np.sqrt(np.mean(ws**2))),
             turn_pairs, latitude_deg=latitude_deg,
+            saturated=None if saturated is None else np.asarray(saturated, dtype=bool),
         )  # fmt: skip
     return SessionResult(acc, gfit, tuple(stats), tuple(turns), g_mg, temp, not_still)
 
