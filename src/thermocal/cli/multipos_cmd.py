@@ -13,8 +13,13 @@ import typer
 from thermocal._lazy import LazyModule
 from thermocal.cli.application import app
 from thermocal.cli.common import (
+    DecimalOpt,
+    DelimiterOpt,
     JsonOpt,
+    NamesOpt,
+    OnBadLinesOpt,
     OutOpt,
+    RateOpt,
     TimeOpt,
     TimeUnitOpt,
     emit,
@@ -22,6 +27,7 @@ from thermocal.cli.common import (
     handle_errors,
     split_names,
     stdout,
+    text_options,
 )
 from thermocal.errors import ThermocalInputError
 
@@ -127,6 +133,11 @@ def multipos_cmd(
     time_unit: TimeUnitOpt = None,
     accel_scale: AccelScaleOpt = None,
     gyro_scale: GyroScaleOpt = None,
+    t_names: NamesOpt = None,
+    t_rate: RateOpt = None,
+    t_bad: OnBadLinesOpt = "error",
+    t_delim: DelimiterOpt = None,
+    t_dec: DecimalOpt = None,
     as_json: JsonOpt = False,
 ) -> None:
     """Accelerometer (and gyro) triad bias, scale factors and misalignments from hand-placed
@@ -141,6 +152,7 @@ def multipos_cmd(
         (gyr_cols[0], gyr_cols[1], gyr_cols[2]) if gyr_cols else None,
         accel_unit, gyro_unit, temps, gravity, latitude, order, tref, static_s, time, time_unit,
         _mpf.count_scale(accel_scale, "accel"), _mpf.count_scale(gyro_scale, "gyro"),
+        text=text_options(t_names, t_rate, t_bad, t_delim, t_dec),
     )  # fmt: skip
     res = _mpf.calibrate_files(files, output, opts, poses)
     out, a_unit = res.summary, res.accel_unit

@@ -26,6 +26,7 @@ from thermocal.models.files import save_calibration
 from thermocal.multipos.calibrate import METHOD, SessionResult, calibrate_session
 from thermocal.multipos.poses import parse_poses
 from thermocal.readers import read_recording
+from thermocal.readers.text import TextOptions
 from thermocal.recording import Recording
 from thermocal.turntable import thermal
 
@@ -56,6 +57,9 @@ class MultiposOptions:
     accel_scale: tuple[float, str] | None = None
     gyro_scale: tuple[float, str] | None = None
     """Raw-count columns: one count is ``value`` ``unit`` (``--accel-scale 0.061,mg``)."""
+    text: TextOptions | None = None
+    """How to read a text log and its time (``--rate HZ``: a sample counter, or samples at
+    the nominal rate; ``--names`` …), as every command reads it."""
 
     def check(self, n_files: int, poses: Path | None) -> None:
         """The options' own consistency (before any file is read)."""
@@ -204,7 +208,9 @@ def _session(
     rec = read_recording(
         path, time=opts.time, time_unit=opts.time_unit, signals=[*acc_cols, *(gyr_cols or [])],
         signal_unit=",".join(given) if all(given) else None,  # type: ignore[arg-type]
-        temperatures=[temps] if temps else None,
+        temperatures=[temps] if temps else None, text=opts.text,
+        ask_units={**dict.fromkeys(acc_cols, "--accel-unit"),
+                   **dict.fromkeys(gyr_cols or [], "--gyro-unit")},
     )  # fmt: skip
     rec.validate(required=[*acc_cols, *(gyr_cols or []), *([temps] if temps else [])])
     au, af = _unit_of(rec, acc_cols, opts.accel_unit, "accel", path, opts.accel_scale)

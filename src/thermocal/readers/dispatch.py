@@ -26,6 +26,7 @@ from thermocal.readers.common import (
     csv_rows_estimate,
     default_time_column,
     file_kind,
+    named_like_temperature,
     names_list,
     short_name,
     thermocal_metadata,
@@ -33,9 +34,25 @@ from thermocal.readers.common import (
 from thermocal.readers.dataflash import read_dataflash
 from thermocal.readers.station import is_station_path, read_station_table, with_sensor
 from thermocal.readers.table import ParquetColumns, csv_header_names, load_sidecar, numeric_column
-from thermocal.readers.text import TextOptions, head_lines, rate_time, read_text, sniff_text
+from thermocal.readers.text import (
+    TextOptions,
+    counter_column,
+    counter_time,
+    head_lines,
+    rate_time,
+    read_text,
+    sniff_text,
+)
 from thermocal.readers.ulog import read_ulog
-from thermocal.recording import META_FORMAT, META_VERSION, FloatArray, Metadata, Recording
+from thermocal.recording import (
+    META_FORMAT,
+    META_VERSION,
+    FloatArray,
+    Metadata,
+    Recording,
+    all_finite,
+    nominal_time,
+)
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -129,7 +146,9 @@ def read_text_table(
     assert isinstance(obj, pd.DataFrame)
     names = list(obj.columns)
     if text.rate_hz is not None:
-        obj, names, t_col, t_unit = rate_time(p, obj, names, info, time, None, text)
+        obj, names, t_col, t_unit, _mode = rate_time(
+            p, obj, names, info, time, None, text, allow_column=False
+        )
         info["time"], info["time_unit"] = t_col, t_unit
     return obj, info
 
@@ -243,6 +262,21 @@ def _read_other_columns(
         unit_map[c] = units.other_column_unit(c, extra_units.get(c))
 
 
+def _time_hint(names: list[str]) -> str:
+    """What to give when no time column is found: ``--time`` or ``--rate``, naming a
+    sample counter (the time with ``--rate``) or a column named like a temperature (not
+    time) among ``names``."""
+    counter = counter_column(names)
+    temp_like = [n for n in names if named_like_temperature(n)]
+    if counter is not None:
+        why = f"; {short_name(counter)} is a sample counter: give --rate HZ"
+    elif temp_like:
+        why = f"; {short_name(temp_like[0])} is named like a temperature, not time"
+    else:
+        why = ""
+    return f" (name the time column with --time, or give --rate HZ for a log without one{why})"
+
+
 def _roles(
     p: Path,
     names: list[str],
@@ -250,22 +284,27 @@ def _roles(
     time: str | None,
     signals: list[str] | None,
     temperatures: list[str] | None,
+    guess_temperatures: bool = False,
 ) -> tuple[str, list[str], list[str]]:
     """The time, signal and temperature columns: as given, else as the file or its
-    sidecar says; a name the file does not have is refused, listing the available ones."""
+    sidecar says (else, with ``guess_temperatures``, the columns named like temperatures,
+    :func:`~thermocal.readers.common.named_like_temperature`); a name the file does not have is
+    refused, listing the available ones."""
     time_col = time or default_time_column(names, info.get("time"))
     sig_info: dict[str, str] = dict(info.get("signals") or {})
     tmp_info: dict[str, str] = dict(info.get("temperatures") or {})
     sig_names = list(signals) if signals is not None else list(sig_info)
     tmp_names = list(temperatures) if temperatures is not None else list(tmp_info)
+    if guess_temperatures and temperatures is None and not tmp_names:
+        tmp_names = [
+            c for c in names if named_like_temperature(c) and c != time_col and c not in sig_names
+        ]
     present = set(names)
     for c in [time_col, *sig_names, *tmp_names]:
         if c not in present:
-            hint = (
-                " (name the time column with --time, or give --rate HZ for a text log without one)"
-                if c == time_col and time is None
-                else ""
-            )
+            hint = ""
+            if c == time_col and time is None:
+                hint = _time_hint(names)
             raise MissingColumnError(
                 f"{p}: no column {short_name(c)}; available: {names_list(names)}{hint}"
             )
@@ -288,6 +327,39 @@ def _read_columns(
         obj.read_f64([time_col, *named])
     t = numeric_column(obj, time_col, p)
     return t, {c: numeric_column(obj, c, p) for c in named}
+
+
+STAMPS_RATE_RANGE = (0.8, 3.0)
+"""With ``--rate`` on a file with a time column, the mean step of its stamps must lie
+within these multiples of the nominal period (fewer samples than the rate: some lost;
+more, or far fewer: the wrong rate or time unit)."""
+
+
+def _stamps_at_rate(p: Path, col: str, t: FloatArray, rate_hz: float) -> FloatArray:
+    """``--rate`` on a file whose time column holds host timestamps [s]: the samples at the
+    sensor's nominal rate (:func:`thermocal.recording.nominal_time`, lost samples kept as
+    gaps); refused when the stamps are not finite or their mean step is not near the
+    nominal period (:data:`STAMPS_RATE_RANGE`)."""
+    if t.size < 2:
+        return t
+    if not all_finite(t):
+        raise ThermocalInputError(
+            f"{p}: the time column {col!r} has missing or non-finite values; --rate "
+            f"{rate_hz:g} Hz takes the samples at the nominal rate only from finite stamps"
+        )
+    mean_step = float(t[-1] - t[0]) / (t.size - 1)
+    lo, hi = STAMPS_RATE_RANGE
+    if not lo / rate_hz <= mean_step <= hi / rate_hz:
+        raise ThermocalInputError(
+            f"{p}: --rate {rate_hz:g} Hz given but the file has a time column {col!r} whose "
+            f"samples are {mean_step:.6g} s apart on average ({1.0 / mean_step:.6g} Hz); "
+            "check --rate and --time-unit, or drop --rate"
+            if mean_step > 0
+            else f"{p}: --rate {rate_hz:g} Hz given but the file has a time column {col!r} "
+            "that does not advance; drop --rate"
+        )
+    out, _lost = nominal_time(t, rate_hz)
+    return out
 
 
 def _conversions(
@@ -317,6 +389,8 @@ def read_recording(
     model: units.StatedUnits | None = None,
     text: TextOptions | None = None,
     topic: str | None = None,
+    guess_temperatures: bool = False,
+    ask_units: dict[str, str] | None = None,
 ) -> Recording:
     """Read a CSV, text log or Parquet recording, or a station's recording folder.
 
@@ -342,6 +416,10 @@ def read_recording(
         ``--on-bad-lines``, ``--delimiter``, ``--decimal``); banners, other delimiters and
         decimal commas are detected without it.
     topic : a PX4 ULog's topic instance, ``NAME[.N]`` (default ``sensor_gyro.0``).
+    guess_temperatures : without ``temperatures`` and a sidecar's, take the columns named
+        like temperatures (``T1``, ``temp``, ``… (°C)``) as temperatures (``inspect``).
+    ask_units : signal column → the option to ask for when nothing states its unit
+        (:class:`thermocal.units.UnitOptions`): a :class:`UnitError` instead of a default.
 
     Units and temperature conversions are resolved once by
     :func:`thermocal.units.resolve_inputs` (option > file metadata > column name > model
@@ -359,8 +437,9 @@ def read_recording(
     obj, info = _open_table(p, text, topic)
 
     names = list(obj.column_names) if isinstance(obj, ParquetColumns) else list(obj.columns)
+    mode = None  # --rate: "rows", "counter" or "stamps" (rate_time)
     if text is not None and text.rate_hz is not None:
-        obj, names, time, time_unit = rate_time(p, obj, names, info, time, time_unit, text)
+        obj, names, time, time_unit, mode = rate_time(p, obj, names, info, time, time_unit, text)
     if not names:
         raise FileFormatError(f"{p}: the file has no columns")
     n_rows = obj.num_rows if isinstance(obj, ParquetColumns) else len(obj)
@@ -369,18 +448,27 @@ def read_recording(
     md = Metadata.from_dict(dict(info.get("metadata") or {}))
     if meta is not None:
         md = md.merged(meta)
-    time_col, sig_names, tmp_names = _roles(p, names, info, time, signals, temperatures)
+    time_col, sig_names, tmp_names = _roles(
+        p, names, info, time, signals, temperatures, guess_temperatures
+    )
     options = units.UnitOptions(
-        time_unit=time_unit,
+        time_unit="s" if mode == "counter" else time_unit,  # a counter / rate is in s
         signal_unit=signal_unit,
         temp_unit=temp_unit,
         temp_conversion=temp_conversion,
+        ask=dict(ask_units or {}),
     )
     resolved = _resolve_units(p, info, (time_col, sig_names, tmp_names), options, meta, model)
     n_used = len(names) if keep_other else 1 + len(sig_names) + len(tmp_names)
     t, cols = _read_columns(p, obj, n_rows, n_used, time_col, [*sig_names, *tmp_names])
-    if resolved.time.unit != "s":
+    if mode == "counter":
+        assert text is not None and text.rate_hz is not None
+        t = counter_time(p, time_col, t, text.rate_hz)
+    elif resolved.time.unit != "s":
         t = t * units.TIME_UNITS[resolved.time.unit]
+    if mode == "stamps":
+        assert text is not None and text.rate_hz is not None
+        t = _stamps_at_rate(p, time_col, t, text.rate_hz)
     unit_map: dict[str, str] = resolved.units()
     md.temperature_conversion = _conversions(md, tmp_names, resolved)
     if keep_other:
