@@ -226,7 +226,8 @@ def test_jitter_is_said_and_rate_takes_the_nominal_grid(
     code, out, err = _run(capsys, "inspect", str(path), *base, "--json")
     assert code == 2  # bursts: samples share a stamp
     assert "give --rate HZ" in err.splitlines()[-1]
-    kinds = {p["kind"]: p for p in json.loads(out)["problems"]}
+    d = json.loads(out)
+    kinds = {p["kind"]: p for p in d["problems"]}
     assert "give --rate HZ" in kinds["timestamp_jitter"]["message"]
     stamps = np.loadtxt(path, delimiter=",", skiprows=1, usecols=0)
     dt = np.diff(stamps)
@@ -235,6 +236,8 @@ def test_jitter_is_said_and_rate_takes_the_nominal_grid(
     assert jit is not None
     assert_allclose(jit.relative, want)
     assert jit.n_same == int(np.count_nonzero(dt == 0)) > 0
+    assert_allclose(d["timestamp_jitter"]["relative"], want)
+    assert d["timestamp_jitter"]["n_same"] == jit.n_same
     # --rate: the samples at the nominal rate, the lost ones as gaps (the truth, to 1e-9 s)
     code, out, err = _run(capsys, "inspect", str(path), *base, "--rate", "100", "--json")
     assert code == 0, err
@@ -314,7 +317,7 @@ def test_a_text_column_not_used_is_read_past(
     assert_allclose(d["sample_rate_hz"], 100.0)
     assert [p["column"] for p in d["problems"] if p["kind"] == "non_numeric"] == ["mac"]
     skipped: list[str] = []
-    with pytest.warns(TextLayoutWarning, match="banner"):  # the layout is stated
+    with pytest.warns(TextLayoutWarning):  # the banner and the layout are stated
         rec = read_recording(path, time_unit="s", signals=["ax"], signal_unit="g", skipped=skipped)
     assert_allclose(rec.columns["ax"], ax)
     assert skipped == ["mac"]
@@ -337,3 +340,18 @@ def test_a_stray_word_is_still_a_mangled_line(tmp_path: Path) -> None:
     path.write_text("\n".join(lines) + "\n")
     with pytest.raises(FileFormatError, match="line 11 is not a data row"):
         read_recording(path, time_unit="s", signals=["g"], signal_unit="deg/h")
+
+
+READING_COMMANDS = (
+    "inspect", "allan", "metrics", "noise", "fit", "validate", "compensate", "report",
+    "turntable", "multipos",
+)  # fmt: skip
+"""The commands that read a recording through the one reader, whose messages may say --rate."""
+
+
+@pytest.mark.parametrize("command", READING_COMMANDS)
+def test_every_reading_command_takes_rate(command: str, capsys: pytest.CaptureFixture[str]) -> None:
+    assert main([command, "--help"]) == 0
+    out = capsys.readouterr().out
+    for option in ("--rate", "--names", "--on-bad-lines", "--delimiter", "--decimal"):
+        assert f"{option} " in out, f"{command} lacks {option}"

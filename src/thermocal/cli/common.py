@@ -125,7 +125,11 @@ NamesOpt = Annotated[
 ]
 RateOpt = Annotated[
     float | None,
-    typer.Option("--rate", help="Text logs without a time column: sample rate [Hz]."),
+    typer.Option(
+        "--rate",
+        help="Sample rate [Hz]: the time of a log without a time column, of a sample counter "
+        "(n_samples, or --time N), or host timestamps taken at this nominal rate.",
+    ),
 ]
 OnBadLinesOpt = Annotated[
     str,
