@@ -1337,6 +1337,14 @@ MUTANTS: tuple[Mutant, ...] = (
         "every field taken for a text column",
     ),
     Mutant(
+        "readers-stamps-kept",
+        P + "readers/dispatch.py",
+        "out, _lost = nominal_time(t, rate_hz)",
+        "out = t",
+        H38R,
+        "--rate on host timestamps keeps the jittery stamps",
+    ),
+    Mutant(
         "readers-t-is-time",
         P + "readers/common.py",
         'return name.strip() == "T" or TEMPERATURE_NAME',

@@ -176,9 +176,7 @@ def sniff_text(lines: Sequence[str], opts: TextOptions | None = None) -> TextLay
 
     # the decimal mark under which most lines of m fields are numbers, with the fewest
     # text columns (ties: ".")
-    dec = max(
-        decimals, key=lambda c: (sum(numeric(x, c) for x in body), -len(texts[c]), c == ".")
-    )
+    dec = max(decimals, key=lambda c: (sum(numeric(x, c) for x in body), -len(texts[c]), c == "."))
     for k, line in enumerate(lines):
         if not line.strip() or line.lstrip().startswith("#") or len(_split(line, d)) != m:
             continue
@@ -451,11 +449,6 @@ def rate_time(
         named = counter_column(names)
     col = named or "time"
     if col in names:
-        if not allow_column:
-            raise ThermocalInputError(
-                f"{p}: --rate {text.rate_hz:g} Hz given but the file has a time column "
-                f"{col!r}; drop --rate"
-            )
         is_counter = col.strip().lower() in COUNTER_COLUMN_NAMES or (
             time is not None
             and col == time
@@ -463,6 +456,15 @@ def rate_time(
             and col.strip().lower() not in TIME_COLUMN_NAMES
             and units.unit_in_column_name(col, "time") is None
         )
+        if not allow_column:
+            raise ThermocalInputError(
+                f"{p}: --rate {text.rate_hz:g} Hz given but the file has a time column "
+                f"{col!r}; drop --rate"
+                if not is_counter
+                else f"{p}: this command streams the file and cannot take the sample counter "
+                f"{col!r} as time; add a time column (time = {col} / {text.rate_hz:g} Hz) "
+                "and drop --rate"
+            )
         if is_counter and time_unit not in (None, "s"):
             raise ThermocalInputError(
                 f"{p}: --rate {text.rate_hz:g} Hz counts the samples of {col!r}; drop --time-unit"
