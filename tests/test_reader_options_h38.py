@@ -326,8 +326,9 @@ def test_a_text_column_not_used_is_read_past(
         capsys, "inspect", str(path), "--time-unit", "s", "--signal", "mac", "--signal-unit", "g"
     )
     assert code == 2
-    assert err.splitlines()[-1].startswith(
-        f"error: {path}: non-numeric value 'AA:BB:CC:DD:EE:00' in column 'mac'"
+    assert err.splitlines()[-1] == (
+        f"error: {path}: non-numeric value 'AA:BB:CC:DD:EE:00' in column 'mac' at row 0 "
+        "(line 3 of the file)"  # after the banner and the header
     )
 
 

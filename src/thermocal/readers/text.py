@@ -298,14 +298,16 @@ def _column_names(path: Path, head: list[str], lay: TextLayout, o: TextOptions) 
 
 def _data_rows(
     path: Path, encoding: str, lay: TextLayout, n: int, on_bad_lines: str
-) -> tuple[list[list[float]], list[int], list[tuple[int, str]], dict[int, list[str]]]:
+) -> tuple[list[list[float]], list[int], list[tuple[int, str]], dict[int, list[str]], list[int]]:
     """The data rows as floats, each kept row's place among the data lines, the mangled
-    lines dropped (line number, text) and the text columns' fields (position → the kept
-    rows' texts; NaN stands in their place among the floats): another number of fields
+    lines dropped (line number, text), the text columns' fields (position → the kept
+    rows' texts; NaN stands in their place among the floats) and each kept row's line in
+    the file (for messages): another number of fields
     than ``n``, or a non-number outside a text column, is an error naming the line unless
     ``on_bad_lines`` is ``"skip"``."""
     tp = set(lay.text_columns)
     texts: dict[int, list[str]] = {j: [] for j in lay.text_columns}
+    linenos: list[int] = []  # each kept row's line in the file (1-based)
     first_data = lay.skip + (1 if lay.header else 0)  # 0-based line of the first data row
     bad: list[tuple[int, str]] = []
     rows: list[list[float]] = []
@@ -334,6 +336,7 @@ def _data_rows(
                 for j in tp:
                     texts[j].append(fields[j])
                 ordinal.append(n_data - 1)
+                linenos.append(lineno)
             except ValueError as exc:
                 if on_bad_lines == "error":
                     raise FileFormatError(
@@ -341,7 +344,7 @@ def _data_rows(
                         "fix it or pass --on-bad-lines skip to drop such lines"
                     ) from None
                 bad.append((lineno, text))
-    return rows, ordinal, bad, texts
+    return rows, ordinal, bad, texts, linenos
 
 
 def read_text(
@@ -358,10 +361,11 @@ def read_text(
     except FileFormatError as exc:
         raise FileFormatError(f"{path}: {exc}") from None
     names = _column_names(path, head, lay, o)
-    rows, ordinal, bad, texts = _data_rows(path, encoding, lay, len(names), o.on_bad_lines)
+    rows, ordinal, bad, texts, linenos = _data_rows(path, encoding, lay, len(names), o.on_bad_lines)
     if not rows:
         raise FileFormatError(f"{path}: the file has a header but no data rows")
     df = pd.DataFrame(np.asarray(rows, dtype=np.float64), columns=names)
+    df.attrs["file_lines"] = np.asarray(linenos, dtype=np.int64)  # for messages
     for j, values in texts.items():  # kept as text: refused only where a command uses it
         df[names[j]] = pd.Series(values, dtype=object)
     # --rate: time = data-line number / rate, so a dropped line leaves a gap, not a shift
