@@ -626,6 +626,45 @@ def nominal_time(time_s: FloatArray, rate_hz: float) -> tuple[FloatArray, int]:
     return out, int(k[-1])
 
 
+def _nan_problems(rec: Recording) -> list[Problem]:
+    """NaN, empty or infinite values per column, with the first row: an error in a signal
+    or temperature column, a warning in another."""
+    probs: list[Problem] = []
+    for name, arr in rec.columns.items():
+        nan = ~np.isfinite(arr)
+        n_nan = int(np.count_nonzero(nan))
+        if n_nan:
+            first = int(np.argmax(nan))
+            sev: Literal["error", "warning"] = (
+                "error" if name in rec.signals or name in rec.temperatures else "warning"
+            )
+            probs.append(
+                Problem(
+                    "nan",
+                    f"column {name!r} has {n_nan} NaN/empty/infinite values, first at row {first}",
+                    severity=sev,
+                    column=name,
+                    row=first,
+                )
+            )
+    return probs
+
+
+RATE_HINT = "host timestamps? give --rate HZ to take the samples at the sensor's nominal rate"
+"""What a duplicate timestamp's message says to do."""
+
+
+def _jitter_problems(t: FloatArray, found: list[Problem]) -> list[Problem]:
+    """Timestamp jitter (:func:`time_jitter`) as a warning, unless the time is already
+    refused as not finite or going backwards (``found``)."""
+    if any(p.kind in ("nonfinite_time", "backwards_time") for p in found):
+        return []
+    jit = time_jitter(t)
+    if jit is None or not jit.significant:
+        return []
+    return [Problem("timestamp_jitter", jit.message(), severity="warning", column="time")]
+
+
 def find_problems(rec: Recording, required: list[str] | None = None) -> list[Problem]:
     """Everything wrong with a recording, errors first, without raising.
 
@@ -665,8 +704,7 @@ def find_problems(rec: Recording, required: list[str] | None = None) -> list[Pro
                 Problem(
                     "duplicate_time",
                     f"duplicate timestamp {float(t[dup[0] + 1])!r} at row {dup[0] + 1} "
-                    f"({dup.size} duplicates in all; host timestamps? give --rate HZ to take "
-                    "the samples at the sensor's nominal rate)",
+                    f"({dup.size} duplicates in all; {RATE_HINT})",
                     column="time",
                     row=int(dup[0] + 1),
                 )
@@ -681,23 +719,7 @@ def find_problems(rec: Recording, required: list[str] | None = None) -> list[Pro
                     row=int(back[0] + 1),
                 )
             )
-    for name, arr in rec.columns.items():
-        nan = ~np.isfinite(arr)
-        n_nan = int(np.count_nonzero(nan))
-        if n_nan:
-            first = int(np.argmax(nan))
-            sev: Literal["error", "warning"] = (
-                "error" if name in rec.signals or name in rec.temperatures else "warning"
-            )
-            probs.append(
-                Problem(
-                    "nan",
-                    f"column {name!r} has {n_nan} NaN/empty/infinite values, first at row {first}",
-                    severity=sev,
-                    column=name,
-                    row=first,
-                )
-            )
+    probs.extend(_nan_problems(rec))
     for name in rec.signals:
         u = rec.units.get(name, "")
         if u:
@@ -707,12 +729,7 @@ def find_problems(rec: Recording, required: list[str] | None = None) -> list[Pro
                 probs.append(Problem("unit", f"column {name!r}: {exc}", column=name))
     if t.size < 2:
         probs.append(Problem("too_short", "the recording has fewer than 2 samples"))
-    if not any(p.kind in ("nonfinite_time", "backwards_time") for p in probs):
-        jit = time_jitter(t)
-        if jit is not None and jit.significant:
-            probs.append(
-                Problem("timestamp_jitter", jit.message(), severity="warning", column="time")
-            )
+    probs.extend(_jitter_problems(t, probs))
     if not any(p.kind in ("nonfinite_time", "duplicate_time", "backwards_time") for p in probs):
         gaps = rec.gaps()
         if gaps:

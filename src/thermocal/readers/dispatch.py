@@ -329,6 +329,32 @@ def _read_columns(
     return t, {c: numeric_column(obj, c, p) for c in named}
 
 
+def _n_rows(p: Path, obj: pd.DataFrame | ParquetColumns, names: list[str]) -> int:
+    """The table's number of rows; a table without columns or rows is refused."""
+    if not names:
+        raise FileFormatError(f"{p}: the file has no columns")
+    n_rows = obj.num_rows if isinstance(obj, ParquetColumns) else len(obj)
+    if n_rows == 0:
+        raise FileFormatError(f"{p}: the file has a header but no data rows")
+    return n_rows
+
+
+def _time_s(
+    p: Path, col: str, t: FloatArray, unit: str, mode: str | None, text: TextOptions | None
+) -> FloatArray:
+    """The time column ``t`` (as read, in ``unit``) in seconds: with ``--rate`` a sample
+    counter's ``n / rate`` (``mode`` ``"counter"``) or host stamps at the nominal rate
+    (``"stamps"``), as :func:`~thermocal.readers.text.rate_time` found them."""
+    rate = text.rate_hz if text is not None else None
+    if mode == "counter" and rate is not None:
+        return counter_time(p, col, t, rate)
+    if unit != "s":
+        t = t * units.TIME_UNITS[unit]
+    if mode == "stamps" and rate is not None:
+        t = _stamps_at_rate(p, col, t, rate)
+    return t
+
+
 STAMPS_RATE_RANGE = (0.8, 3.0)
 """With ``--rate`` on a file with a time column, the mean step of its stamps must lie
 within these multiples of the nominal period (fewer samples than the rate: some lost;
@@ -416,10 +442,9 @@ def read_recording(
         ``--on-bad-lines``, ``--delimiter``, ``--decimal``); banners, other delimiters and
         decimal commas are detected without it.
     topic : a PX4 ULog's topic instance, ``NAME[.N]`` (default ``sensor_gyro.0``).
-    guess_temperatures : without ``temperatures`` and a sidecar's, take the columns named
-        like temperatures (``T1``, ``temp``, ``… (°C)``) as temperatures (``inspect``).
-    ask_units : signal column → the option to ask for when nothing states its unit
-        (:class:`thermocal.units.UnitOptions`): a :class:`UnitError` instead of a default.
+    guess_temperatures : no temperatures given or in a sidecar: those named like one.
+    ask_units : signal column → the option a :class:`UnitError` asks for when nothing
+        states its unit (:class:`thermocal.units.UnitOptions`; no default is assumed).
 
     Units and temperature conversions are resolved once by
     :func:`thermocal.units.resolve_inputs` (option > file metadata > column name > model
@@ -440,35 +465,21 @@ def read_recording(
     mode = None  # --rate: "rows", "counter" or "stamps" (rate_time)
     if text is not None and text.rate_hz is not None:
         obj, names, time, time_unit, mode = rate_time(p, obj, names, info, time, time_unit, text)
-    if not names:
-        raise FileFormatError(f"{p}: the file has no columns")
-    n_rows = obj.num_rows if isinstance(obj, ParquetColumns) else len(obj)
-    if n_rows == 0:
-        raise FileFormatError(f"{p}: the file has a header but no data rows")
+    n_rows = _n_rows(p, obj, names)
     md = Metadata.from_dict(dict(info.get("metadata") or {}))
     if meta is not None:
         md = md.merged(meta)
     time_col, sig_names, tmp_names = _roles(
         p, names, info, time, signals, temperatures, guess_temperatures
     )
-    options = units.UnitOptions(
-        time_unit="s" if mode == "counter" else time_unit,  # a counter / rate is in s
-        signal_unit=signal_unit,
-        temp_unit=temp_unit,
-        temp_conversion=temp_conversion,
-        ask=dict(ask_units or {}),
-    )
+    options = units.UnitOptions(  # a counter / rate is in s
+        "s" if mode == "counter" else time_unit, signal_unit, temp_unit, temp_conversion,
+        dict(ask_units or {}),
+    )  # fmt: skip
     resolved = _resolve_units(p, info, (time_col, sig_names, tmp_names), options, meta, model)
     n_used = len(names) if keep_other else 1 + len(sig_names) + len(tmp_names)
     t, cols = _read_columns(p, obj, n_rows, n_used, time_col, [*sig_names, *tmp_names])
-    if mode == "counter":
-        assert text is not None and text.rate_hz is not None
-        t = counter_time(p, time_col, t, text.rate_hz)
-    elif resolved.time.unit != "s":
-        t = t * units.TIME_UNITS[resolved.time.unit]
-    if mode == "stamps":
-        assert text is not None and text.rate_hz is not None
-        t = _stamps_at_rate(p, time_col, t, text.rate_hz)
+    t = _time_s(p, time_col, t, resolved.time.unit, mode, text)
     unit_map: dict[str, str] = resolved.units()
     md.temperature_conversion = _conversions(md, tmp_names, resolved)
     if keep_other:
