@@ -145,6 +145,15 @@ def test_counter_gaps_are_gaps(tmp_path: Path, capsys: pytest.CaptureFixture[str
     assert code == 0, err
     d = json.loads(out)
     assert [(g["after_row"], round(g["length_s"], 9)) for g in d["gaps"]] == [(39, 0.4)]
+    named = tmp_path / "frame.csv"  # a counter of any name, named with --time
+    named.write_text("frame,gx\n" + "".join(f"{c + 7},{c % 5}\n" for c in counts))
+    code, out, err = _run(
+        capsys, "inspect", str(named), "--time", "frame", "--rate", "10", "--json"
+    )
+    assert code == 0, err
+    d = json.loads(out)
+    assert [(g["after_row"], round(g["length_s"], 9)) for g in d["gaps"]] == [(39, 0.4)]
+    assert_allclose(d["duration_s"], (counts[-1] - counts[0]) / 10.0)
     bad = tmp_path / "b.csv"
     bad.write_text("seq,gx\n0,1\n1,1\n1.5,1\n2,1\n")
     code, _out, err = _run(capsys, "inspect", str(bad), "--rate", "10")
