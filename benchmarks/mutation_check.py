@@ -1307,8 +1307,8 @@ MUTANTS: tuple[Mutant, ...] = (
     Mutant(
         "readers-lost-sample-jump",
         P + "recording.py",
-        "        if rise > LOST_SAMPLE_JUMP:\n            lost[j + 1] = round(rise)",
-        "        if rise > LOST_SAMPLE_JUMP:\n            lost[j + 1] = rise",
+        "n_lost = round(rise)",
+        "n_lost = rise",
         H38R,
         "lost samples not rounded to whole periods",
     ),
@@ -1335,6 +1335,14 @@ MUTANTS: tuple[Mutant, ...] = (
         ">= 0.0 * len(mixed)",
         H38R,
         "every field taken for a text column",
+    ),
+    Mutant(
+        "readers-lost-late-sample",
+        P + "recording.py",
+        "and o[j + 1] - q[j] - earlier > n_lost - LOST_SAMPLE_JUMP / 2:",
+        ":",
+        H38R,
+        "a late sample before a loss (or at the end) taken for the loss",
     ),
     Mutant(
         "readers-stamps-kept",

@@ -203,7 +203,7 @@ def test_multipos_asks_for_the_accel_unit(
 # --- 4: host timestamps with Bluetooth jitter ---------------------------------------------
 
 
-def _bluetooth(path: Path, lost: list[int], bursts: bool = True) -> np.ndarray:
+def _bluetooth(path: Path, lost: list[int], bursts: bool = True, ms: bool = True) -> np.ndarray:
     """A 100 Hz sensor stamped by a host: latency uniform over 0…60 % of the period, every
     50th sample a burst of 5 delivered at once, stamps in whole ms, rows ``lost`` dropped.
     Returns the true sample times of the rows kept (the simulator's truth)."""
@@ -214,12 +214,14 @@ def _bluetooth(path: Path, lost: list[int], bursts: bool = True) -> np.ndarray:
     if bursts:
         for b in range(10, n - 10, 50):
             stamp[b : b + 5] = stamp[b + 4]
-    stamp = np.maximum.accumulate(np.floor(stamp * 1000.0) / 1000.0)
+    if ms:
+        stamp = np.floor(stamp * 1000.0) / 1000.0
+    stamp = np.maximum.accumulate(stamp)
     keep = np.ones(n, dtype=bool)
     keep[lost] = False
     g = rng.normal(size=n)
     path.write_text(
-        "time,gx\n" + "".join(f"{stamp[i]:.3f},{g[i]:.5f}\n" for i in np.flatnonzero(keep))
+        "time,gx\n" + "".join(f"{float(stamp[i])!r},{g[i]:.5f}\n" for i in np.flatnonzero(keep))
     )
     return truth[keep]
 
@@ -272,6 +274,17 @@ def test_jitter_without_bursts_is_a_warning_of_every_command(tmp_path: Path) -> 
         rec.validate()
     jit = rec.time_jitter()
     assert jit is not None and 0.2 < jit.relative < 0.4 and jit.n_same == 0
+
+
+def test_rate_on_exact_stamps_recovers_whole_lost_periods(tmp_path: Path) -> None:
+    """Stamps not rounded to ms: the latency floors before and after a loss differ by a
+    fraction of a period, the samples lost are still whole periods (the truth to 1e-9 s)."""
+    path = tmp_path / "bt.csv"
+    truth = _bluetooth(path, [700, 1500, 1501, 2300], ms=False)
+    rec = read_recording(
+        path, text=_rate(100.0), time_unit="s", signals=["gx"], signal_unit="deg/s"
+    )
+    assert_allclose(rec.time_s - rec.time_s[0], truth - truth[0], rtol=0, atol=1e-9)
 
 
 # --- 9: tables outside a terminal are not cut ------------------------------------------------
@@ -419,3 +432,23 @@ def test_multipos_on_bluetooth_stamps_with_rate_equals_true_time(
         g_got["misalignment_arcsec_sigma"]
     )
     assert np.all(np.abs(z) < 5.0), z
+
+
+@pytest.mark.parametrize("seed", range(12))
+def test_nominal_time_recovers_lost_samples_of_random_sessions(seed: int) -> None:
+    """A 100 Hz sensor, a host whose latency is uniform over 0…60 % of a period (stamps
+    exact or in whole ms), six samples lost at random places (two may be adjacent), a
+    host clock 20 ppm slow: every sample back on the true grid (1e-9 s), six found lost."""
+    from thermocal.recording import nominal_time
+
+    rng = np.random.default_rng(seed)
+    r, n = 100.0, 5000
+    truth = 3.0 + np.arange(n) / r
+    stamp = truth * (1.0 + 20e-6) + rng.uniform(0.0, 0.6 / r, n)
+    if seed % 2:
+        stamp = np.floor(stamp * 1000.0) / 1000.0
+    keep = np.ones(n, dtype=bool)
+    keep[rng.choice(np.arange(50, n - 50), size=6, replace=False)] = False
+    t, lost = nominal_time(np.maximum.accumulate(stamp)[keep], r)
+    assert lost == 6
+    assert_allclose(t - t[0], truth[keep] - truth[keep][0], rtol=0, atol=1e-9)

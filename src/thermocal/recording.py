@@ -602,9 +602,13 @@ def nominal_time(time_s: FloatArray, rate_hz: float) -> tuple[FloatArray, int]:
     the floor after it, the suffix minimum ``m_{i+1} = min_{j>i} o_j``, is compared with
     the floor before it, ``q_i = min(o_{i−W+1} … o_i)`` (``W`` = :data:`LATENCY_WINDOW`);
     where ``m_{i+1} − q_i``, less the samples already counted lost within the window,
-    exceeds :data:`LOST_SAMPLE_JUMP`, ``round`` of it is lost there.  A slow drift of the
-    host's clock against the sensor's (``W`` samples of it are far below one period)
-    adds none.  Returns ``t'_i = t_0 + (m_0 + i + k_i)/r`` [s] and the total lost.  The
+    exceeds :data:`LOST_SAMPLE_JUMP`, ``round`` of it is lost there, when sample ``i + 1``
+    itself lies that many periods up (within half that margin): a sample that only came
+    late, just before a loss or at the end, is not taken for the loss.  Within a burst
+    (samples delivered at one instant) next to a loss the stamps cannot tell a late sample
+    before the loss from one after it: such samples may be placed one period off.  A slow
+    drift of the host's clock against the sensor's (``W`` samples of it are far below one
+    period) adds none.  Returns ``t'_i = t_0 + (m_0 + i + k_i)/r`` [s] and the total lost.  The
     input must be finite, in seconds, with at least 2 samples.
     """
     n = int(time_s.size)
@@ -619,8 +623,10 @@ def nominal_time(time_s: FloatArray, rate_hz: float) -> tuple[FloatArray, int]:
     for j in np.flatnonzero(jump > LOST_SAMPLE_JUMP):
         earlier = float(lost[max(0, j - w + 2) : j + 1].sum())
         rise = float(jump[j]) - earlier
-        if rise > LOST_SAMPLE_JUMP:
-            lost[j + 1] = round(rise)
+        n_lost = round(rise)
+        # sample j + 1 itself must lie n_lost periods up (not merely late, before the loss)
+        if rise > LOST_SAMPLE_JUMP and o[j + 1] - q[j] - earlier > n_lost - LOST_SAMPLE_JUMP / 2:
+            lost[j + 1] = n_lost
     k = np.cumsum(lost)
     out: FloatArray = time_s[0] + (m[0] + i + k) / rate_hz
     return out, int(k[-1])
