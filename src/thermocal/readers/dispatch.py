@@ -16,6 +16,7 @@ from thermocal.errors import (
     MissingColumnError,
     NonNumericError,
     ThermocalInputError,
+    TimestampWarning,
     UnitWarning,
 )
 from thermocal.readers.common import (
@@ -361,6 +362,12 @@ within these multiples of the nominal period (fewer samples than the rate: some 
 more, or far fewer: the wrong rate or time unit)."""
 
 
+STAMPS_RATE_TOLERANCE = 0.005
+"""With ``--rate`` on host timestamps, a rate the stamps' span contradicts by more than
+this fraction (lost samples counted) is stated in a warning: a wrong nominal rate lifts the
+latency floor by a period every few dozen samples, read as samples lost."""
+
+
 def _stamps_at_rate(p: Path, col: str, t: FloatArray, rate_hz: float) -> FloatArray:
     """``--rate`` on a file whose time column holds host timestamps [s]: the samples at the
     sensor's nominal rate (:func:`thermocal.recording.nominal_time`, lost samples kept as
@@ -384,7 +391,18 @@ def _stamps_at_rate(p: Path, col: str, t: FloatArray, rate_hz: float) -> FloatAr
             else f"{p}: --rate {rate_hz:g} Hz given but the file has a time column {col!r} "
             "that does not advance; drop --rate"
         )
-    out, _lost = nominal_time(t, rate_hz)
+    out, lost = nominal_time(t, rate_hz)
+    seen_hz = (t.size - 1 + lost) / float(t[-1] - t[0])
+    if abs(seen_hz / rate_hz - 1.0) > STAMPS_RATE_TOLERANCE:
+        warnings.warn(
+            TimestampWarning(
+                f"{p}: --rate {rate_hz:g} Hz, but the time column {col!r} spans "
+                f"{float(t[-1] - t[0]):.6g} s for {t.size} samples "
+                f"({(t.size - 1) / float(t[-1] - t[0]):.6g} Hz) and {lost} more would be lost "
+                "at that rate; check --rate (the nominal rate, not a rounded one)"
+            ),
+            stacklevel=3,
+        )
     return out
 
 
