@@ -44,6 +44,11 @@ def test_inspect_names_the_real_time_column_once(
         "--time-unit, or the unit in the file's metadata or column name)"
     ]
     assert "<time>" not in err
+    with pytest.warns(UnitWarning) as caught:  # the library: one read, the real name
+        rec = read_recording(path, guess_temperatures=True)
+    said = [str(w.message) for w in caught]
+    assert [m for m in said if "time column" in m] == [timing[0].removeprefix("warning: ")]
+    assert rec.temperatures == ("temp",) and rec.unit_sources["temp"] == "default"
 
 
 def test_inspect_with_time_unit_or_named_unit_says_nothing_of_time(
@@ -98,6 +103,14 @@ def test_names_with_a_temperature_first_is_not_time(
         "column with --time, or give --rate HZ for a log without one; 'T' is named like a "
         "temperature, not time)"
     )
+    from thermocal.errors import MissingColumnError
+    from thermocal.readers.text import TextOptions
+
+    with (
+        pytest.warns(TextLayoutWarning, match="blank-separated"),
+        pytest.raises(MissingColumnError, match="'T' is named like a temperature, not time"),
+    ):
+        read_recording(path, text=TextOptions(names=("T", "ax", "ay", "az")))
     code, out, err = _run(
         capsys, "inspect", str(path), "--names", "T,ax,ay,az", "--rate", "50", "--json"
     )
