@@ -1347,8 +1347,8 @@ MUTANTS: tuple[Mutant, ...] = (
     Mutant(
         "readers-stamps-kept",
         P + "readers/dispatch.py",
-        "out, _lost = nominal_time(t, rate_hz)",
-        "out = t",
+        "out, lost = nominal_time(t, rate_hz)",
+        "out, lost = t, 0",
         H38R,
         "--rate on host timestamps keeps the jittery stamps",
     ),
