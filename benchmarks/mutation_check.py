@@ -58,6 +58,7 @@ TT_ENC = _t("mutants_turntable", "turntable_encoders", "turntable_kinematics", "
 TT_CAL = _t("mutants_turntable", "turntable_estimation", "turntable_encoders", "turntable_cli")
 FLEET = _t("fleet_units", "fleet", "fleet_reruns")
 UNITS = _t("mutants_units", "units", "units_resolver", "units_property", "units_travel")
+H38R = _t("reader_options_h38")
 TEXT = _t("mutants_units", "text_logs", "tests/attacks/test_text_attacks.py")
 PARAMS = _t("mutants_export", "export_params", "tests/attacks/test_export_params_attacks.py")
 PX4 = _t("mutants_export", "px4_tempcal", "px4_baro_mag", "ardupilot_tempcal")
@@ -614,8 +615,8 @@ MUTANTS: tuple[Mutant, ...] = (
     Mutant(
         "text-decimal-tie-comma",
         P + "readers/text.py",
-        'c == "."))',
-        'c == ","))',
+        '-len(texts[c]), c == ".")',
+        '-len(texts[c]), c == ",")',
         TEXT,
         "decimal mark: a tie goes to the comma",
     ),
@@ -1498,6 +1499,70 @@ MUTANTS: tuple[Mutant, ...] = (
         "sum(g.length_s for g in gaps)",
         _t("report_calibration"),
         "a gap counted as the whole step, its last sample interval included",
+    ),
+    Mutant(
+        "readers-counter-rate",
+        P + "readers/text.py",
+        "out: FloatArray = counts / float(rate_hz)",
+        "out: FloatArray = counts * (1.0 / float(rate_hz) + 1e-6)",
+        H38R,
+        "a sample counter's time off by 1e-6 s a sample",
+    ),
+    Mutant(
+        "readers-lost-sample-jump",
+        P + "recording.py",
+        "n_lost = round(rise)",
+        "n_lost = rise",
+        H38R,
+        "lost samples not rounded to whole periods",
+    ),
+    Mutant(
+        "readers-lost-window-earlier",
+        P + "recording.py",
+        "rise = float(jump[j]) - earlier",
+        "rise = float(jump[j])",
+        H38R,
+        "a lost sample counted again at every step of the latency window",
+    ),
+    Mutant(
+        "readers-jitter-half-range",
+        P + "recording.py",
+        "float(p95 - p5) / (2.0 * med)",
+        "float(p95 - p5) / med",
+        H38R,
+        "jitter as the whole 5–95 % range, not its half",
+    ),
+    Mutant(
+        "readers-text-column-share",
+        P + "readers/text.py",
+        ">= TEXT_COLUMN_SHARE * len(mixed)",
+        ">= 0.0 * len(mixed)",
+        H38R,
+        "every field taken for a text column",
+    ),
+    Mutant(
+        "readers-lost-late-sample",
+        P + "recording.py",
+        "and o[j + 1] - q[j] - earlier > n_lost - LOST_SAMPLE_JUMP / 2:",
+        ":",
+        H38R,
+        "a late sample before a loss (or at the end) taken for the loss",
+    ),
+    Mutant(
+        "readers-stamps-kept",
+        P + "readers/dispatch.py",
+        "out, lost = nominal_time(t, rate_hz)",
+        "out, lost = t, 0",
+        H38R,
+        "--rate on host timestamps keeps the jittery stamps",
+    ),
+    Mutant(
+        "readers-t-is-time",
+        P + "readers/common.py",
+        'return name.strip() == "T" or TEMPERATURE_NAME',
+        "return TEMPERATURE_NAME",
+        H38R,
+        "a capital T taken for time",
     ),
 )
 

@@ -21,6 +21,7 @@ from thermocal.recording import (
     FloatArray,
     Problem,
     Recording,
+    TimeJitter,
     contiguous_slices,
     find_gaps,
     find_problems,
@@ -126,6 +127,8 @@ class Inspection:
     time_ok: bool = True
     """Time is finite and strictly increasing, so duration, rate, gaps and segments mean
     something."""
+    timestamp_jitter: TimeJitter | None = None
+    """The scatter of the time steps (:func:`thermocal.recording.time_jitter`)."""
 
     @property
     def fatal(self) -> list[Problem]:
@@ -147,6 +150,9 @@ class Inspection:
             "problems": [p.to_dict() for p in self.problems],
             "time_ok": self.time_ok,
             "usable": not self.fatal,
+            "timestamp_jitter": (
+                self.timestamp_jitter.to_dict() if self.timestamp_jitter is not None else None
+            ),
         }
 
 
@@ -325,6 +331,7 @@ def inspect_recording(rec: Recording) -> Inspection:
         temperature_span=span,
         problems=problems,
         time_ok=time_ok,
+        timestamp_jitter=rec.time_jitter(),
     )
 
 

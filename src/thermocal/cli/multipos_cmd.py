@@ -14,8 +14,13 @@ from thermocal import defaults as _poses
 from thermocal._lazy import LazyModule
 from thermocal.cli.application import app
 from thermocal.cli.common import (
+    DecimalOpt,
+    DelimiterOpt,
     JsonOpt,
+    NamesOpt,
+    OnBadLinesOpt,
     OutOpt,
+    RateOpt,
     TimeOpt,
     TimeUnitOpt,
     emit,
@@ -23,6 +28,7 @@ from thermocal.cli.common import (
     handle_errors,
     split_names,
     stdout,
+    text_options,
 )
 from thermocal.errors import ThermocalInputError
 
@@ -181,6 +187,11 @@ def multipos_cmd(
     time_unit: TimeUnitOpt = None,
     accel_scale: AccelScaleOpt = None,
     gyro_scale: GyroScaleOpt = None,
+    t_names: NamesOpt = None,
+    t_rate: RateOpt = None,
+    t_bad: OnBadLinesOpt = "error",
+    t_delim: DelimiterOpt = None,
+    t_dec: DecimalOpt = None,
     as_json: JsonOpt = False,
 ) -> None:
     """Accelerometer (and gyro) triad bias, scale factors and misalignments from hand-placed
@@ -196,6 +207,7 @@ def multipos_cmd(
         accel_unit, gyro_unit, temps, gravity, latitude, order, tref, static_s, time, time_unit,
         _mpf.count_scale(accel_scale, "accel"), _mpf.count_scale(gyro_scale, "gyro"),
         window_s, still_threshold, motion_fraction, drift_deg, accel_offset, gyro_offset,
+        text=text_options(t_names, t_rate, t_bad, t_delim, t_dec),
     )  # fmt: skip
     res = _mpf.calibrate_files(files, output, opts, poses)
     out, a_unit = res.summary, res.accel_unit

@@ -38,6 +38,7 @@ from thermocal.multipos.poses import (
     parse_poses,
 )
 from thermocal.readers import read_recording
+from thermocal.readers.text import TextOptions
 from thermocal.recording import Recording
 from thermocal.turntable import thermal
 
@@ -77,6 +78,9 @@ class MultiposOptions:
     gyro_offset: float | None = None
     """Zero of the columns in their own unit (counts: ``--accel-offset 32768`` for unsigned
     ADC counts); None: none, or mid-scale found in unsigned counts (a warning)."""
+    text: TextOptions | None = None
+    """How to read a text log and its time (``--rate HZ``: a sample counter, or samples at
+    the nominal rate; ``--names`` …), as every command reads it."""
 
     def check(self, n_files: int, poses: Path | None) -> None:
         """The options' own consistency (before any file is read)."""
@@ -346,7 +350,9 @@ def _session(
     rec = read_recording(
         path, time=opts.time, time_unit=opts.time_unit, signals=[*acc_cols, *(gyr_cols or [])],
         signal_unit=",".join(given) if all(given) else None,  # type: ignore[arg-type]
-        temperatures=[temps] if temps else None,
+        temperatures=[temps] if temps else None, text=opts.text,
+        ask_units={**dict.fromkeys(acc_cols, "--accel-unit"),
+                   **dict.fromkeys(gyr_cols or [], "--gyro-unit")},
     )  # fmt: skip
     rec.validate(required=[*acc_cols, *(gyr_cols or []), *([temps] if temps else [])])
     acc, au, a_off = _triad(rec, acc_cols, opts, "accel", path)
