@@ -222,7 +222,7 @@ def _session(
     res = calibrate_session(
         rec.time_s, acc, w, g_mg=float(grav.g_m_s2) / 9.80665e-3,
         latitude_deg=grav.latitude_deg, sections=sections, static_s=opts.static_s,
-        temperature_c=temp, where=str(path),
+        temperature_c=temp, where=str(path), sections_from=str(poses),
     )  # fmt: skip
     t_range = (float(np.min(temp)), float(np.max(temp))) if temp is not None else None
     return SessionRun(path, res, t_range), au, gu

@@ -38,16 +38,24 @@ defines ``u`` (``K G C Gᵀ Kᵀ``, ``K = (JᵀJ)⁻¹Jᵀ``).  Rotations all ab
 ``E_g``'s other columns unseen: refused.
 
 **360° turns** (Ferraris et al., Sensors and Actuators A 46, 1995,
-doi:10.1016/0924-4247(94)00969-1): a full turn about the vertical adds
-``Σ ω_c τ − (2π s + Ω sin L T) u = 0`` (``u`` the up direction of the pose before it,
-``s = ±1`` the sense, the vertical earth rate over the turn's duration T known from the
-latitude), three linear rows of the same least squares with the 3×3 covariance
-``σ_ω² τ T I + (c (2π σ_u)² + (Ω cos L T ρ)²/2)(I − u uᵀ)``: angle random walk, the
-direction noise of u (across u only) and the horizontal earth rate, which turns with
-the board and integrates to ``Ω cos L T ρ`` in an unknown horizontal direction, with
-``ρ = |mean_t exp(i ψ(t))|`` from the turn's own heading ``ψ(t) = ∫ ω_c·u dt`` (0 for a
-uniform full turn); without L, ``(Ω T)²/3 I`` for the whole earth rate.  The rows are
-whitened by ``C^(−1/2)``.
+doi:10.1016/0924-4247(94)00969-1; imucal's ``x_rot``, ``y_rot``, ``z_rot``): a turn
+named about the sensor's axis ``e_j`` (j = x, y, z, whatever pose came before it: users
+do the turns after the six faces) adds
+``Σ ω_c τ − 2π s e_j − Ω sin L T u = 0``, three linear rows of the same least squares
+(``s = ±1`` the sense, the sign of ``Σ ω_c τ · e_j``; ``u`` the calibrated up direction
+during the turn, along which the vertical earth rate over its duration T is known from
+the latitude).  The axis is the calibrated frame's, as in Ferraris's and imucal's
+``W_s = (I + E_g) (±360°) I`` (imucal ``K_g R_g = I + E_g``).  The 3×3 covariance is
+``σ_ω² τ T I + (2π σ_a)² (I − e_j e_jᵀ) + (Ω cos L T ρ)²/2 (I − u uᵀ)``: angle random
+walk, the direction noise ``σ_a`` of the calibrated axis (across it only: the
+accelerometer calibration's σ of the misalignments of its column j, the frame being the
+accelerometer's) and the horizontal earth rate, which turns with the board and integrates to ``Ω cos L T ρ``
+in an unknown horizontal direction, with ``ρ = |mean_t exp(i ψ(t))|`` from the turn's own
+heading ``ψ(t) = ∫ ω_c·u dt`` (0 for a uniform full turn); without L, ``(Ω T)²/3 I`` for
+the whole earth rate.  The rows are whitened by ``C^(−1/2)``.  Before any fit a turn is
+judged by :func:`check_turn`: its rotation vector (raw rate, bias removed) within
+:data:`TURN_AXIS_TOLERANCE_DEG` of its named axis and its angle within
+:data:`TURN_ANGLE_TOLERANCE` of 360°, else refused.
 """
 
 from __future__ import annotations
@@ -60,12 +68,76 @@ import numpy as np
 import numpy.typing as npt
 
 from thermocal import units
-from thermocal.errors import DesignError
+from thermocal.errors import DesignError, ThermocalInputError
 from thermocal.multipos.geometry import attitude_along, skew
 from thermocal.multipos.poses import Section
 from thermocal.turntable import model
 
 FloatArray = npt.NDArray[np.float64]
+
+
+TURN_ANGLE_TOLERANCE: float = 0.10
+"""A named turn's angle (raw rate, bias removed) may differ from 360° by this fraction;
+more (a quarter turn, two turns, a wrong gyro unit) is refused (:func:`check_turn`).
+It bounds the scale factor a turn can give to ±10 %."""
+TURN_AXIS_TOLERANCE_DEG: float = 15.0
+"""A named turn's rotation vector may be this far [°] from its named axis (consumer
+gyro misalignments and a hand's wobble are a few degrees); more is refused: a turn named
+``x_rot`` that turns about y (:func:`check_turn`)."""
+
+
+@dataclass(frozen=True)
+class Turn:
+    """A named 360° turn (module docstring): its ``section``, the sensor axis it is named
+    about (``axis`` 0, 1, 2 for ``x_rot``, ``y_rot``, ``z_rot``), the calibrated unit up
+    direction during it ``up`` (body axes: the vertical earth rate) and the direction
+    noise ``axis_sigma_rad`` [rad] of the axis across itself."""
+
+    section: Section
+    axis: int
+    up: FloatArray
+    axis_sigma_rad: float
+
+
+def turn_rotation(
+    rate_rad_s: FloatArray, dt_s: FloatArray, bias_rad_s: FloatArray, section: Section
+) -> FloatArray:
+    """The rotation vector of a turn [rad]: ``Σ (ω − b) τ`` over its samples (raw rate,
+    bias removed; Ferraris et al. 1995, eq. 13–14 of imucal's implementation)."""
+    sl = slice(section.start, section.end)
+    out: FloatArray = ((rate_rad_s[sl] - bias_rad_s) * dt_s[sl][:, None]).sum(axis=0)
+    return out
+
+
+def check_turn(
+    rotation_rad: FloatArray, name: str, axis: int, where: str, source: str = "the POSES file"
+) -> None:
+    """Refuse a named turn whose rotation vector (:func:`turn_rotation`) is more than
+    :data:`TURN_AXIS_TOLERANCE_DEG` from the sensor axis ``axis`` it is named about, or
+    whose angle differs from 360° by more than :data:`TURN_ANGLE_TOLERANCE` (Ferraris et
+    al. 1995: a full turn about each axis).  ``where`` names the file and the section,
+    ``source`` the file that named it (the remedy)."""
+    v = np.asarray(rotation_rad, dtype=np.float64)
+    ang = float(np.linalg.norm(v))
+    ax = "xyz"[axis]
+    deg = np.degrees(v)
+    shown = f"rotation vector ({deg[0]:+.1f}°, {deg[1]:+.1f}°, {deg[2]:+.1f}°) bias removed"
+    off = math.degrees(math.acos(min(1.0, abs(float(v[axis])) / ang))) if ang > 0 else 90.0
+    if off > TURN_AXIS_TOLERANCE_DEG:
+        most = "xyz"[int(np.argmax(np.abs(v)))]
+        raise ThermocalInputError(
+            f"{where}: the gyro turns {math.degrees(ang):.1f}° mostly about {most} "
+            f"({shown}), {off:.1f}° from the sensor's {ax} axis that {name!r} names, "
+            f"which must hold one full turn about {ax}: fix the section's name or its "
+            f"start and end in {source}"
+        )
+    if abs(ang / (2.0 * math.pi) - 1.0) > TURN_ANGLE_TOLERANCE:
+        raise ThermocalInputError(
+            f"{where}: the gyro turns {math.degrees(ang):.1f}° about {ax} ({shown}), not "
+            f"one full turn (360° ± {TURN_ANGLE_TOLERANCE:.0%}): fix the section's start "
+            f"and end in {source} to hold exactly one turn, or the gyro's unit "
+            "(--gyro-unit, --gyro-scale)"
+        )
 
 
 @dataclass(frozen=True)
@@ -127,11 +199,9 @@ def _direction(u0: FloatArray, a0: FloatArray, a1: FloatArray) -> FloatArray:
     return out
 
 
-_Held = tuple[
-    list[tuple[FloatArray, FloatArray]], list[tuple[FloatArray, float, float, FloatArray]]
-]
-"""The attitudes at each motion's ends and each turn's (integrated rate, sense, vertical
-earth-rate angle [rad], whitening matrix)."""
+_Held = tuple[list[tuple[FloatArray, FloatArray]], list[tuple[FloatArray, FloatArray, FloatArray]]]
+"""The attitudes at each motion's ends and each turn's (integrated rate, expected rotation
+vector [rad], whitening matrix)."""
 
 
 def _motions(
@@ -175,8 +245,7 @@ class _Rotations:
     dt_s: FloatArray
     dt_med: float
     motions: list[_Motion]
-    turns: Sequence[tuple[Section, int]]
-    dir_sigma_rad: FloatArray
+    turns: Sequence[Turn]
     rate_sigma_rad_s: float
     latitude_deg: float | None
 
@@ -197,7 +266,7 @@ class _Rotations:
         j = np.zeros((n_rows, 9))
         jb = np.zeros((n_rows, 3))
         atts: list[tuple[FloatArray, FloatArray]] = []
-        turn_info: list[tuple[FloatArray, float, float, FloatArray]] = []
+        turn_info: list[tuple[FloatArray, FloatArray, FloatArray]] = []
         for m_i, mo in enumerate(motions):
             sl = slice(mo.start, mo.stop)
             wc = (rate_rad_s[sl] - b) @ ie_inv.T
@@ -215,17 +284,18 @@ class _Rotations:
                 px = skew(p) @ rot.T
                 j[3 * m_i : 3 * m_i + 3] = px @ sij * s
                 jb[3 * m_i : 3 * m_i + 3] = px @ d.sum(axis=0) * dt_med * s
-        for t_i, (sec, k) in enumerate(turns):
-            sl = slice(sec.start, sec.end)
+        for t_i, tn in enumerate(turns):
+            sl = slice(tn.section.start, tn.section.end)
             wc = (rate_rad_s[sl] - b) @ ie_inv.T
             tau = dt_s[sl][:, None]
             tot = (wc * tau).sum(axis=0)
-            sense = 1.0 if float(tot @ u[k]) >= 0 else -1.0
-            t_turn = sec.n * dt_med
-            vert, w_mat = self._turn_whitening(wc, tau, u[k], t_turn, self.dir_sigma_rad[k])
+            sense = 1.0 if float(tot[tn.axis]) >= 0 else -1.0
+            t_turn = tn.section.n * dt_med
+            vert, w_mat = self._turn_whitening(wc, tau, tn, t_turn)
             row = slice(3 * len(motions) + 3 * t_i, 3 * len(motions) + 3 * t_i + 3)
-            r[row] = w_mat @ (tot - (2.0 * math.pi * sense + vert) * u[k])
-            turn_info.append((tot, sense, vert, w_mat))
+            want = 2.0 * math.pi * sense * np.eye(3)[tn.axis] + vert * tn.up
+            r[row] = w_mat @ (tot - want)
+            turn_info.append((tot, want, w_mat))
             if jac:
                 # ∂/∂E_ij of Σ (I+E)⁻¹ ω' τ ≈ −e_i Σ ω_cj τ ; ∂/∂b ≈ −T I
                 colsum = (wc * tau).sum(axis=0)
@@ -237,13 +307,15 @@ class _Rotations:
         return r, j, jb, (atts, turn_info)
 
     def _turn_whitening(
-        self, wc: FloatArray, tau: FloatArray, u: FloatArray, t_turn: float, dir_sigma: float
+        self, wc: FloatArray, tau: FloatArray, tn: Turn, t_turn: float
     ) -> tuple[float, FloatArray]:
         """The vertical earth rate's angle over a turn [rad] and ``C^(−1/2)`` of the turn's
-        residual covariance (module docstring)."""
+        residual covariance (module docstring), along and across the named axis (the
+        horizontal earth rate, across ``up``, counted across the axis: ``up`` is the axis
+        of a turn on a level table)."""
         om = units.EARTH_RATE_RAD_S
         along = self.rate_sigma_rad_s**2 * self.dt_med * t_turn
-        across = along + (2 * math.pi * dir_sigma) ** 2
+        across = along + (2 * math.pi * tn.axis_sigma_rad) ** 2
         if self.latitude_deg is None:
             vert = 0.0
             along += (om * t_turn) ** 2 / 3.0
@@ -251,10 +323,10 @@ class _Rotations:
         else:
             lat = math.radians(self.latitude_deg)
             vert = om * math.sin(lat) * t_turn
-            psi = np.cumsum((wc @ u) * tau[:, 0])
+            psi = np.cumsum((wc @ tn.up) * tau[:, 0])
             rho = abs(complex(np.mean(np.exp(1j * psi))))
             across += (om * math.cos(lat) * t_turn * rho) ** 2 / 2.0
-        uu = np.outer(u, u)
+        uu = np.outer(np.eye(3)[tn.axis], np.eye(3)[tn.axis])
         return vert, uu / math.sqrt(along) + (np.eye(3) - uu) / math.sqrt(across)
 
 
@@ -313,7 +385,7 @@ def _error_matrix_cov(
         h = max(1e-6, 1e-3 * math.sqrt(max(float(accel_free_cov[q, q]), 0.0)))
         pq = accel_free.copy()
         pq[q] += h
-        r_q = _residuals_fixed_att(rot.motions, rot.turns, held, up_of(pq), r)
+        r_q = _residuals_fixed_att(rot.motions, held, up_of(pq), r)
         ga[:, q] = (r_q - r) / h
     c_sys = jb @ bias_cov @ jb.T + ga @ accel_free_cov @ ga.T
     dof = (2 * len(rot.motions) + 3 * len(rot.turns)) - 9
@@ -356,7 +428,7 @@ def fit_rotations(
     bias_cov: FloatArray,
     dir_sigma_rad: FloatArray,
     rate_sigma_rad_s: float,
-    turns: Sequence[tuple[Section, int]] = (),
+    turns: Sequence[Turn] = (),
     *,
     latitude_deg: float | None = None,
     max_iter: int = 8,
@@ -366,13 +438,13 @@ def fit_rotations(
     ``up_of(p)`` gives the poses' calibrated unit up directions (m, 3) for accelerometer
     parameters ``p`` (``accel_free`` at the solution, covariance ``accel_free_cov``);
     ``dir_sigma_rad`` (m,) the noise of each pose's direction; ``turns`` the 360° turns with
-    the index of the pose before each; ``latitude_deg`` (None: unknown) the earth rate's
+    their named axes (:class:`Turn`); ``latitude_deg`` (None: unknown) the earth rate's
     split into the vertical, known, and the horizontal, of unknown heading."""
     dt_med = float(np.median(dt_s))
     up = up_of(accel_free)
     motions = _motions(dt_s, poses, dt_med, dir_sigma_rad, rate_sigma_rad_s, latitude_deg)
-    rot = _Rotations(rate_rad_s, dt_s, dt_med, motions, turns, dir_sigma_rad,
-                     rate_sigma_rad_s, latitude_deg)  # fmt: skip
+    rot = _Rotations(rate_rad_s, dt_s, dt_med, motions, turns, rate_sigma_rad_s,
+                     latitude_deg)  # fmt: skip
     if rot.n_rows < 9 + 3:
         raise DesignError(
             f"{len(motions)} motions between static poses: the gyro's scale factors and "
@@ -402,26 +474,27 @@ def fit_rotations(
 
 
 def _residuals_fixed_att(
-    motions: Sequence[_Motion],
-    turns: Sequence[tuple[Section, int]],
-    held: _Held,
-    u: FloatArray,
-    r_ref: FloatArray,
+    motions: Sequence[_Motion], held: _Held, u: FloatArray, r_ref: FloatArray
 ) -> FloatArray:
-    """The whitened residuals for other up directions ``u``, the attitudes (and the turns'
-    integrated rates) held."""
-    atts, turn_info = held
+    """The whitened residuals for other up directions ``u`` of the poses, the attitudes
+    held (the turns' rows, about the calibrated frame's named axes, do not move with the
+    poses' directions)."""
+    atts, _turn_info = held
     out = r_ref.copy()
     for m_i, mo in enumerate(motions):
         a0, a1 = atts[m_i]
         s = 1.0 / math.sqrt(mo.var)
         out[3 * m_i : 3 * m_i + 3] = (u[mo.pose_k1] - _direction(u[mo.pose_k], a0, a1)) * s
-    for t_i, ((_sec, k), (tot, sense, vert, w_mat)) in enumerate(
-        zip(turns, turn_info, strict=True)
-    ):
-        row = slice(3 * len(motions) + 3 * t_i, 3 * len(motions) + 3 * t_i + 3)
-        out[row] = w_mat @ (tot - (2.0 * math.pi * sense + vert) * u[k])
     return out
 
 
-__all__ = ["GyroFit", "fit_rotations", "static_bias"]
+__all__ = [
+    "TURN_ANGLE_TOLERANCE",
+    "TURN_AXIS_TOLERANCE_DEG",
+    "GyroFit",
+    "Turn",
+    "check_turn",
+    "fit_rotations",
+    "static_bias",
+    "turn_rotation",
+]
