@@ -251,3 +251,37 @@ def test_implausible_gyro_scale_is_warned() -> None:
     np.testing.assert_allclose(res.gyro.theta[3:6], (1.25 * (1 + t0.gyro[3:6] * 1e-6) - 1)
                                * 1e6, atol=2000.0)  # fmt: skip
     assert any("--gyro-unit" in str(w.message) for w in rec)
+
+
+@pytest.mark.parametrize("form", ["csv", "columns-json"])
+def test_section_list_as_imucal_users_save_it(session: dict[str, Any], form: str) -> None:
+    """imucal's example reads its list with ``pd.read_json(...).T`` and its docstring saves
+    one with ``section_list.to_csv(...)``; ``section_list.to_json()`` writes pandas'
+    column orientation.  Both, written here by pandas, give the gyro figures of the
+    example's own JSON file."""
+    import pandas as pd
+
+    d = session["dir"]
+    section_list = pd.read_json(POSES).T
+    if form == "csv":
+        poses = d / "calibration_sections.csv"
+        section_list.to_csv(poses)
+    else:
+        poses = d / "calibration_sections.json"
+        section_list.to_json(poses)
+        assert set(json.loads(poses.read_text(encoding="utf-8"))) == {"start", "end"}
+    code, out, err = _run([*_cli_args(session["csv"], poses, d / f"cal_{form}.json"), "--json"])
+    assert code == 0, err
+    g, ref = json.loads(out)["gyro"], session["cli"]["gyro"]
+    np.testing.assert_allclose(g["scale_factor_ppm"], ref["scale_factor_ppm"], rtol=1e-12)
+    np.testing.assert_allclose(g["misalignment_arcsec"], ref["misalignment_arcsec"], rtol=1e-12)
+
+
+def test_csv_section_list_without_start_end_refused(session: dict[str, Any]) -> None:
+    """A CSV section list whose header lacks ``start``/``end``: exit 2, one line naming it."""
+    d = session["dir"]
+    poses = d / "sections_bad.csv"
+    poses.write_text("part,from,to\nx_p,540,1271\n", encoding="utf-8")
+    code, _o, err = _run(_cli_args(session["csv"], poses, d / "cal_bad.json"))
+    line = _one_error_line(err)
+    assert code == 2 and str(poses) in line and "'start' and 'end'" in line, line

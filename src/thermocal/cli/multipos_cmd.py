@@ -76,8 +76,9 @@ PosesOpt = Annotated[
     Path | None,
     typer.Option(
         "--poses",
-        help='Named sections {"name": {"start": i, "end": j}} by sample index (x_p…z_a '
-        "faces, x_rot… 360° turns) instead of the poses found in the data (one file).",
+        help='Named sections {"name": {"start": i, "end": j}} by sample index, or '
+        "imucal's section list as CSV (x_p…z_a faces, x_rot… 360° turns about that "
+        "axis) instead of the poses found in the data (one file).",
     ),
 ]
 GravityOpt = Annotated[float | None, typer.Option("--gravity", help="Local gravity [m/s²].")]
