@@ -171,14 +171,18 @@ def _named_turns(
     bias_rad_s: FloatArray,
     accel_mg: FloatArray,
     acc: _accel.AccelFit,
+    face_sigma_rad: dict[str, float],
     where: str,
     sections_from: str,
 ) -> list[_gyro.Turn]:
     """Each named turn about the sensor axis of its name (``x_rot``: x), judged first
     (:func:`.gyro.check_turn`), with the calibrated up direction during it and the
-    direction noise of that axis across itself: the accelerometer calibration's σ of the
-    two misalignments of column j (the calibrated frame's axis j is the accelerometer's,
-    known to that σ) [rad]."""
+    direction noise of that axis across itself [rad]: a hand turns the board about the
+    vertical of the face it lies on (``x_p`` or ``x_a``, by the sign of the up
+    direction's x during the turn), whose calibrated direction is ``e_j`` to within its
+    direction noise ``face_sigma_rad[face]`` (:func:`_direction_sigma`); without that
+    face among the poses, the accelerometer calibration's σ of the two misalignments of
+    column j (the frame is the accelerometer's)."""
     e_a = model.error_matrices(acc.theta)
     var = np.diag(acc.cov)
     out = []
@@ -190,8 +194,9 @@ def _named_turns(
                             - acc.theta[0:3])  # fmt: skip
         col = [6 + k for k, n in enumerate(model.MISALIGNMENT_NAMES)
                if model.MISALIGNMENT_INDEX[n][1] == j]  # fmt: skip
-        sig = math.sqrt(float(np.mean(var[col]))) * units.ARCSEC_TO_RAD
-        out.append(_gyro.Turn(tr, j, c / np.linalg.norm(c), sig))
+        face = f"{'xyz'[j]}_{'p' if c[j] >= 0 else 'a'}"
+        sig = face_sigma_rad.get(face, math.sqrt(float(np.mean(var[col]))) * units.ARCSEC_TO_RAD)
+        out.append(_gyro.Turn(tr, j, c / np.linalg.norm(c), float(sig)))
     return out
 
 
@@ -291,11 +296,12 @@ def calibrate_session(
         bias, bias_cov = _gyro.static_bias(wm, n, ws, up, latitude_deg)
         dt = np.diff(t)
         dt = np.concatenate([dt, dt[-1:]])
-        named = _named_turns(turns, w, dt, bias, a, acc, f"{where}: section", sections_from)
+        dir_sig = _direction_sigma(sig, names, acc.method, g_mg)
+        named = _named_turns(turns, w, dt, bias, a, acc, dict(zip(names, dir_sig, strict=True)),
+                             f"{where}: section", sections_from)  # fmt: skip
         gfit = _gyro.fit_rotations(
             w, dt, [p.section for p in stats], up_of, free, free_cov, bias, bias_cov,
-            _direction_sigma(sig, names, acc.method, g_mg), float(np.sqrt(np.mean(ws**2))),
-            named, latitude_deg=latitude_deg,
+            dir_sig, float(np.sqrt(np.mean(ws**2))), named, latitude_deg=latitude_deg,
         )  # fmt: skip
         _warn_implausible(gfit, where)
     return SessionResult(acc, gfit, tuple(stats), tuple(turns), g_mg, temp, not_still)

@@ -47,15 +47,16 @@ during the turn, along which the vertical earth rate over its duration T is know
 the latitude).  The axis is the calibrated frame's, as in Ferraris's and imucal's
 ``W_s = (I + E_g) (±360°) I`` (imucal ``K_g R_g = I + E_g``).  The 3×3 covariance is
 ``σ_ω² τ T I + (2π σ_a)² (I − e_j e_jᵀ) + (Ω cos L T ρ)²/2 (I − u uᵀ)``: angle random
-walk, the direction noise ``σ_a`` of the calibrated axis (across it only: the
-accelerometer calibration's σ of the misalignments of its column j, the frame being the
-accelerometer's) and the horizontal earth rate, which turns with the board and integrates to ``Ω cos L T ρ``
-in an unknown horizontal direction, with ``ρ = |mean_t exp(i ψ(t))|`` from the turn's own
-heading ``ψ(t) = ∫ ω_c·u dt`` (0 for a uniform full turn); without L, ``(Ω T)²/3 I`` for
-the whole earth rate.  The rows are whitened by ``C^(−1/2)``.  Before any fit a turn is
-judged by :func:`check_turn`: its rotation vector (raw rate, bias removed) within
-:data:`TURN_AXIS_TOLERANCE_DEG` of its named axis and its angle within
-:data:`TURN_ANGLE_TOLERANCE` of 360°, else refused.
+walk, the direction noise ``σ_a`` of the axis (across it only: a hand turns the board
+about the vertical of the face it lies on, ``e_j`` to within that face's direction noise
+``σ_u``; without the face, the accelerometer calibration's σ of the misalignments of
+column j) and the horizontal earth rate, which turns with the board and integrates to
+``Ω cos L T ρ`` in an unknown horizontal direction, with ``ρ = |mean_t exp(i ψ(t))|`` from
+the turn's own heading ``ψ(t) = ∫ ω_c·u dt`` (0 for a uniform full turn); without L,
+``(Ω T)²/3 I`` for the whole earth rate.  The rows are whitened by ``C^(−1/2)``.
+Before any fit a turn is judged by :func:`check_turn`: its rotation vector (raw rate,
+bias removed) within :data:`TURN_AXIS_TOLERANCE_DEG` of its named axis and its angle
+within :data:`TURN_ANGLE_TOLERANCE` of 360°, else refused.
 """
 
 from __future__ import annotations
