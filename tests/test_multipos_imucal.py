@@ -285,3 +285,22 @@ def test_csv_section_list_without_start_end_refused(session: dict[str, Any]) -> 
     code, _o, err = _run(_cli_args(session["csv"], poses, d / "cal_bad.json"))
     line = _one_error_line(err)
     assert code == 2 and str(poses) in line and "'start' and 'end'" in line, line
+
+
+def test_turns_without_gyro_columns_are_said(session: dict[str, Any]) -> None:
+    """The section list names three turns but --gyro is not given: the accelerometer is
+    calibrated (exit 0, imucal's E) and one warning says the turns are not used and
+    which option uses them."""
+    args = _cli_args(session["csv"], POSES, session["dir"] / "acc_only.json")
+    i = args.index("--gyro")
+    del args[i : i + 2]
+    j = args.index("--gyro-unit")
+    del args[j : j + 2]
+    code, out, err = _run([*args, "--json"])
+    assert code == 0, err
+    lines = [ln for ln in err.splitlines() if ln.strip()]
+    assert len(lines) == 1 and lines[0].startswith("warning:"), err
+    assert "x_rot, y_rot, z_rot" in lines[0] and "--gyro X,Y,Z" in lines[0], lines[0]
+    a = json.loads(out)["accel"]
+    mine = np.concatenate([a["scale_factor_ppm"], a["misalignment_arcsec"]])
+    np.testing.assert_allclose(mine, _theta_of(IMUCAL_KA_RA), rtol=0, atol=1e-6)

@@ -243,6 +243,14 @@ def calibrate_session(
         sections = detect_poses(t, a, w, static_s=static_s)
     statics = [s for s in sections if not s.is_turn]
     turns = [s for s in sections if s.is_turn]
+    if turns and w is None:
+        warnings.warn(
+            ThermocalWarning(
+                f"{where}: {', '.join(s.name for s in turns)} in {sections_from} are 360° "
+                "turns for the gyro; without its columns (--gyro X,Y,Z) they are not used"
+            ),
+            stacklevel=2,
+        )
     not_still = tuple(s.name for s in statics if s.still_ratio > 2.0)
     if not_still:
         warnings.warn(
