@@ -304,3 +304,14 @@ def test_turns_without_gyro_columns_are_said(session: dict[str, Any]) -> None:
     a = json.loads(out)["accel"]
     mine = np.concatenate([a["scale_factor_ppm"], a["misalignment_arcsec"]])
     np.testing.assert_allclose(mine, _theta_of(IMUCAL_KA_RA), rtol=0, atol=1e-6)
+
+
+def test_gyro_columns_in_another_order_refused(session: dict[str, Any]) -> None:
+    """--gyro gyr_y,gyr_x,gyr_z (x and y exchanged): x_rot now turns about the gyro's
+    second column, exit 2, and the line points at the --gyro columns too."""
+    args = _cli_args(session["csv"], POSES, session["dir"] / "cal_order.json")
+    args[args.index("gyr_x,gyr_y,gyr_z")] = "gyr_y,gyr_x,gyr_z"
+    code, _o, err = _run(args)
+    line = _one_error_line(err)
+    assert code == 2 and "'x_rot'" in line and "mostly about y" in line, line
+    assert "order of the --gyro columns" in line, line

@@ -130,7 +130,7 @@ def check_turn(
             f"{where}: the gyro turns {math.degrees(ang):.1f}° mostly about {most} "
             f"({shown}), {off:.1f}° from the sensor's {ax} axis that {name!r} names, "
             f"which must hold one full turn about {ax}: fix the section's name or its "
-            f"start and end in {source}"
+            f"start and end in {source} (or the order of the --gyro columns)"
         )
     if abs(ang / (2.0 * math.pi) - 1.0) > TURN_ANGLE_TOLERANCE:
         raise ThermocalInputError(
