@@ -1098,6 +1098,14 @@ MUTANTS: tuple[Mutant, ...] = (
         "multi-position: half a turn taken for a full one",
     ),
     Mutant(
+        "multipos-turn-lean-ignored",
+        P + "multipos/gyro.py",
+        "rot, e = _turn_axis_scatter(rot, e, bias_rad_s, up, max_iter)",
+        "rot, e = rot, e",
+        (*MULTI, "tests/test_multipos_sigma.py", "tests/test_multipos_imucal.py"),
+        "multi-position: a hand's turn taken exactly about its axis (misalignment σ 5× small)",
+    ),
+    Mutant(
         "multipos-gyro-plausible",
         P + "multipos/calibrate.py",
         "if abs(th[3 + i] * units.PPM) > GYRO_E_PLAUSIBLE]",

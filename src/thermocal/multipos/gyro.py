@@ -54,7 +54,9 @@ column j) and the horizontal earth rate, which turns with the board and integrat
 ``Ω cos L T ρ`` in an unknown horizontal direction, with ``ρ = |mean_t exp(i ψ(t))|`` from
 the turn's own heading ``ψ(t) = ∫ ω_c·u dt`` (0 for a uniform full turn); without L,
 ``(Ω T)²/3 I`` for the whole earth rate.  The rows are whitened by ``C^(−1/2)``.
-Before any fit a turn is judged by :func:`check_turn`: its rotation vector (raw rate,
+A hand's turn leans off its axis: the lean's variance, found in the data when the
+turns disagree with the motions (:func:`_turn_axis_scatter`), is added to the turns'
+covariance.  Before any fit a turn is judged by :func:`check_turn`: its rotation vector (raw rate,
 bias removed) within :data:`TURN_AXIS_TOLERANCE_DEG` of its named axis and its angle
 within :data:`TURN_ANGLE_TOLERANCE` of 360°, else refused.
 """
@@ -63,7 +65,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 import numpy.typing as npt
@@ -145,7 +147,9 @@ def check_turn(
 class GyroFit:
     """θ (12: bias [°/h], scale factors [ppm], misalignments [″]) and its covariance, the
     rms of the motions' gravity-direction residuals before (raw rate, bias removed) and
-    after calibration [rad], the reduced χ² and the number of motions and turns used."""
+    after calibration [rad], the reduced χ² and the number of motions and turns used, and
+    the turns' axis lean found in the data [rad] (sd per component, 0 when not
+    significant: :func:`_turn_axis_scatter`)."""
 
     theta: FloatArray
     cov: FloatArray
@@ -154,6 +158,7 @@ class GyroFit:
     reduced_chi2: float
     n_motions: int
     n_turns: int
+    turn_axis_lean_rad: float = 0.0
 
     @property
     def sigma(self) -> FloatArray:
@@ -249,10 +254,21 @@ class _Rotations:
     turns: Sequence[Turn]
     rate_sigma_rad_s: float
     latitude_deg: float | None
+    tilt_var: float = 0.0
+    """τ²: the variance [rad²] of a turn's axis lean off ``e_j`` per component beyond the
+    face's noise (:func:`_turn_axis_scatter`)."""
 
     @property
     def n_rows(self) -> int:
         return 3 * len(self.motions) + 3 * len(self.turns)
+
+    def across_rows(self) -> FloatArray:
+        """Indices of the turns' across-axis rows (the whitening is diagonal in body axes:
+        row ``axis`` of a turn's three is along it, the other two across)."""
+        n_m = 3 * len(self.motions)
+        out = [n_m + 3 * t_i + k for t_i, tn in enumerate(self.turns) for k in range(3)
+               if k != tn.axis]  # fmt: skip
+        return np.asarray(out, dtype=np.int64)
 
     def evaluate(
         self, e: FloatArray, b: FloatArray, u: FloatArray, jac: bool
@@ -316,7 +332,9 @@ class _Rotations:
         of a turn on a level table)."""
         om = units.EARTH_RATE_RAD_S
         along = self.rate_sigma_rad_s**2 * self.dt_med * t_turn
-        across = along + (2 * math.pi * tn.axis_sigma_rad) ** 2
+        lean = (2 * math.pi) ** 2 * self.tilt_var
+        across = along + (2 * math.pi * tn.axis_sigma_rad) ** 2 + lean
+        along += 2.0 * (2 * math.pi * self.tilt_var) ** 2
         if self.latitude_deg is None:
             vert = 0.0
             along += (om * t_turn) ** 2 / 3.0
@@ -347,6 +365,40 @@ def _solve_error_matrix(
         if float(np.max(np.abs(step * _SCALE))) < 1e-10:
             break
     return e
+
+
+def _turn_axis_scatter(
+    rot: _Rotations, e: FloatArray, bias_rad_s: FloatArray, up: FloatArray, max_iter: int
+) -> tuple[_Rotations, FloatArray]:
+    """The turns' axis lean by Helmert's variance-component estimate (Koch, *Parameter
+    Estimation and Hypothesis Testing in Linear Models*, 1999, §3.6): a hand's turn
+    wobbles, its axis leans off ``e_j`` by more than the face's noise, and the
+    misalignments would take that lean as theirs with the turns' small σ.  The lean, of
+    variance τ² per component, adds ``(2π)² τ²`` across the axis and ``2 (2π τ²)²`` along
+    it (``2π (1 − cos θ)`` ≈ ``π θ²``: mean and sd ``2π τ²``).  With the redundancy of the
+    across rows ``r_a = n_a − tr(H_aa)`` (``H`` the hat matrix of the whitened fit) and
+    ``f = e_aᵀe_a / r_a``, ``τ² ← τ² + (f − 1) C_a / (2π)²`` (``C_a`` the rows' mean
+    across variance) and E is fitted again, until f settles (at most 8 times), when the
+    first f exceeds ``1 + 3√(2/r_a)``; the motions then hold what the turns cannot."""
+    rows = rot.across_rows()
+    if rows.size == 0 or not rot.motions:
+        return rot, e
+    for it in range(8):
+        r, j, _jb, (_a, turn_info) = rot.evaluate(e, bias_rad_s, up, jac=True)
+        u_, s_, _vt = np.linalg.svd(j, full_matrices=False)
+        keep = s_ > 1e-12 * s_[0]
+        hat = np.sum(u_[:, keep] ** 2, axis=1)
+        red = float(rows.size - hat[rows].sum())
+        if red < 0.05:
+            break
+        f = float(r[rows] @ r[rows]) / red
+        if (it == 0 and f <= 1.0 + 3.0 * math.sqrt(2.0 / red)) or abs(f - 1.0) < 0.01:
+            break
+        across = float(np.mean([1.0 / float(np.min(np.diag(w))) ** 2 for *_x, w in turn_info]))
+        tau2 = rot.tilt_var + (f - 1.0) * across / (2 * math.pi) ** 2
+        rot = replace(rot, tilt_var=max(0.0, tau2))
+        e = _solve_error_matrix(rot, bias_rad_s, up, max_iter)
+    return rot, e
 
 
 def _error_matrix_cov(
@@ -454,6 +506,7 @@ def fit_rotations(
         )
     r0, _j, _jb, _a = rot.evaluate(np.zeros((3, 3)), bias_rad_s, up, jac=False)
     e = _solve_error_matrix(rot, bias_rad_s, up, max_iter)
+    rot, e = _turn_axis_scatter(rot, e, bias_rad_s, up, max_iter)
     r, j, jb, held = rot.evaluate(e, bias_rad_s, up, jac=True)
     cov_p, chi2 = _error_matrix_cov(
         rot, r, j, jb, held, up_of, accel_free, accel_free_cov, bias_cov
@@ -471,6 +524,7 @@ def fit_rotations(
         chi2,
         len(motions),
         len(turns),
+        math.sqrt(rot.tilt_var),
     )
 
 

@@ -165,6 +165,7 @@ def simulate_ferraris(
     dwell_s: float = 5.0,
     move_s: float = 2.0,
     turn_s: float = 6.0,
+    turn_tilt_deg: float = 0.0,
     accel_noise_mg: float = 2.0,
     gyro_noise_deg_s: float = 0.03,
     tremor_deg: float = 0.003,
@@ -179,7 +180,9 @@ def simulate_ferraris(
     (what users record, imucal's guide), the turns after the six faces, ``x_rot``,
     ``y_rot``, ``z_rot``, each from the pose the board is in: moved onto the turn's face
     (a new heading), held still ``dwell_s`` (a pose that is no section), turned and moved
-    on; ``turn-after-face``, each turn right after its face.  As
+    on; ``turn-after-face``, each turn right after its face.  ``turn_tilt_deg``: each
+    turn's axis tilted from the vertical by that angle about a random horizontal axis
+    (a box not flat against its guide, a hand's wobble).  As
     :func:`simulate_session`, plus ``sections``: the POSES file's object
     ``{name: {"start": i, "end": j}}`` (faces and turns); ``poses`` lists every still
     window (with the faces-then-turns order, the three before the turns too)."""
@@ -198,7 +201,7 @@ def simulate_ferraris(
         while cs and not 0.5 < np.linalg.norm(matrix_to_rotvec(cs[-1].T @ c)) < 2.6:
             c = face_rotation(f, rng.uniform(0, 2 * math.pi))
         cs.append(c)
-    spec = _Spec(rate_hz, dwell_s, move_s, tremor_deg, turn_s)
+    spec = _Spec(rate_hz, dwell_s, move_s, tremor_deg, turn_s, turn_tilt_deg)
     w_nb, poses, turns = _body_rates(rng, cs, turn_after, spec)
     out = _measure(rng, cs[0], w_nb, poses, accel_theta, gyro_theta, accel_noise_mg,
                    gyro_noise_deg_s, latitude_deg, rate_hz)  # fmt: skip
@@ -216,6 +219,7 @@ class _Spec:
     move_s: float
     tremor_deg: float
     turn_s: float
+    turn_tilt_deg: float = 0.0
 
 
 def _body_rates(
@@ -247,6 +251,11 @@ def _body_rates(
         if k in turn_after:
             # a full turn about the vertical: the body axis now up, back to c_now
             up_b = c_now.T @ np.array([0.0, 0.0, 1.0])
+            if spec.turn_tilt_deg:
+                h = rng.normal(size=3)
+                h -= (h @ up_b) * up_b
+                tilt = math.radians(spec.turn_tilt_deg) * h / np.linalg.norm(h)
+                up_b = _rodrigues(tilt) @ up_b
             n_t = round(spec.turn_s * spec.rate_hz)
             s = (1 - np.cos(np.pi * np.arange(n_t + 1) / n_t)) / 2
             rates.append(np.diff(s)[:, None] / dt * (2 * math.pi * turn_after[k]) * up_b)
