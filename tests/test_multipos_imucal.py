@@ -347,3 +347,13 @@ def test_gyro_columns_in_another_order_refused(session: dict[str, Any]) -> None:
     line = _one_error_line(err)
     assert code == 2 and "'x_rot'" in line and "mostly about y" in line, line
     assert "order of the --gyro columns" in line, line
+
+
+def test_the_lean_is_said_in_the_table_output(session: dict[str, Any]) -> None:
+    """Without --json the lean the JSON reports is said in words, with what it means."""
+    lean = session["cli"]["runs"][0]["gyro"]["turn_axis_lean_deg"]
+    code, out, err = _run(_cli_args(session["csv"], POSES, session["dir"] / "cal_human.json"))
+    assert code == 0, err
+    text = " ".join(out.split())
+    assert f"the 360° turns lean {lean:.2g}° off their axes" in text, text[-400:]
+    assert "misalignments rest on the motions" in text
