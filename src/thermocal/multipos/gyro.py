@@ -105,8 +105,27 @@ class Turn:
 def turn_rotation(
     rate_rad_s: FloatArray, dt_s: FloatArray, bias_rad_s: FloatArray, section: Section
 ) -> FloatArray:
-    """The rotation vector of a turn [rad]: ``Σ (ω − b) τ`` over its samples (raw rate,
-    bias removed; Ferraris et al. 1995, eq. 13–14 of imucal's implementation)."""
+    """The rotation vector of a turn: ``Σ (ω − b) τ`` over its samples.
+
+    The raw rate with the bias removed, integrated as Ferraris et al. (1995,
+    doi:10.1016/0924-4247(94)00969-1) integrate a turn (imucal's ``W_s``, its eq. 13–14).
+
+    Parameters
+    ----------
+    rate_rad_s : ndarray, shape (n, 3)
+        Gyro rate [rad/s].
+    dt_s : ndarray, shape (n,)
+        Each sample's interval τ [s].
+    bias_rad_s : ndarray, shape (3,)
+        Gyro bias b [rad/s].
+    section : Section
+        The turn's samples.
+
+    Returns
+    -------
+    ndarray, shape (3,)
+        The rotation vector [rad], in the gyro's own axes.
+    """
     sl = slice(section.start, section.end)
     out: FloatArray = ((rate_rad_s[sl] - bias_rad_s) * dt_s[sl][:, None]).sum(axis=0)
     return out
@@ -115,11 +134,31 @@ def turn_rotation(
 def check_turn(
     rotation_rad: FloatArray, name: str, axis: int, where: str, source: str = "the POSES file"
 ) -> None:
-    """Refuse a named turn whose rotation vector (:func:`turn_rotation`) is more than
-    :data:`TURN_AXIS_TOLERANCE_DEG` from the sensor axis ``axis`` it is named about, or
-    whose angle differs from 360° by more than :data:`TURN_ANGLE_TOLERANCE` (Ferraris et
-    al. 1995: a full turn about each axis).  ``where`` names the file and the section,
-    ``source`` the file that named it (the remedy)."""
+    """Refuse a named turn that is not one full turn about its named axis.
+
+    Ferraris et al. (1995) turn the board once about each sensor axis: the rotation
+    vector ``v`` (:func:`turn_rotation`) must lie within :data:`TURN_AXIS_TOLERANCE_DEG`
+    of ``±e_axis`` (``acos(|v_axis| / |v|)``) and its angle ``|v|`` within
+    :data:`TURN_ANGLE_TOLERANCE` of 2π.
+
+    Parameters
+    ----------
+    rotation_rad : ndarray, shape (3,)
+        The turn's rotation vector [rad].
+    name : str
+        The section's name (``x_rot`` …).
+    axis : int
+        The axis it names (0, 1, 2).
+    where : str
+        The file and section, for the message.
+    source : str
+        The file that named the section (the remedy).
+
+    Raises
+    ------
+    ThermocalInputError
+        One line with the measured rotation vector and what to fix.
+    """
     v = np.asarray(rotation_rad, dtype=np.float64)
     ang = float(np.linalg.norm(v))
     ax = "xyz"[axis]
