@@ -77,8 +77,9 @@ PosesOpt = Annotated[
     Path | None,
     typer.Option(
         "--poses",
-        help='Named sections {"name": {"start": i, "end": j}} by sample index (x_p…z_a '
-        "faces, x_rot… 360° turns) instead of the poses found in the data (one file).",
+        help='Named sections {"name": {"start": i, "end": j}} by sample index, or '
+        "imucal's section list as CSV (x_p…z_a faces, x_rot… 360° turns about that "
+        "axis) instead of the poses found in the data (one file).",
     ),
 ]
 GravityOpt = Annotated[float | None, typer.Option("--gravity", help="Local gravity [m/s²].")]
@@ -218,6 +219,14 @@ def multipos_cmd(
                 table.add_row(f"misalignment {n}", fmt(d["misalignment_arcsec"][i], 5),
                               fmt(d["misalignment_arcsec_sigma"][i], 3), "″")  # fmt: skip
             stdout.print(table)
+        for run in out["runs"]:
+            lean = run.get("gyro", {}).get("turn_axis_lean_deg", 0.0)
+            if lean > 0:
+                stdout.print(
+                    f"{run['input']}: the 360° turns lean {fmt(lean, 2)}° off their axes "
+                    "(per component, found in the data): counted in the σ, the misalignments "
+                    "rest on the motions between poses"
+                )
         stdout.print(
             f"{out['n_poses']} poses; gravity-magnitude residual rms "
             f"{fmt(out['gravity_residual_rms_before'], 3)} → "
