@@ -137,6 +137,14 @@ GyroOffsetOpt = Annotated[
     float | None,
     typer.Option("--gyro-offset", help="Zero of the gyro columns in their unit."),
 ]
+GyroModelOpt = Annotated[
+    str,
+    typer.Option(
+        "--gyro-model",
+        help="Gyro elements fitted: full (3 scale factors, 6 misalignments) or scale (3 "
+        "scale factors, misalignments 0: few motions).",
+    ),
+]
 
 
 def _explain(out: dict[str, Any]) -> None:
@@ -178,6 +186,7 @@ def multipos_cmd(
     drift_deg: DriftOpt = _poses.POSE_DRIFT_DEG,
     accel_offset: AccelOffsetOpt = None,
     gyro_offset: GyroOffsetOpt = None,
+    gyro_model: GyroModelOpt = "full",
     time: TimeOpt = None,
     time_unit: TimeUnitOpt = None,
     accel_scale: AccelScaleOpt = None,
@@ -189,6 +198,8 @@ def multipos_cmd(
     _writers.check_not_input(output, [*files, *([poses] if poses else [])])
     if output.suffix.lower() != ".json":
         raise ThermocalInputError(f"{output}: the calibration is JSON; use a .json name")
+    if gyro_model not in ("full", "scale"):
+        raise ThermocalInputError(f"--gyro-model {gyro_model!r}: full or scale")
     acc_cols = _three(accel, "--accel") or []
     gyr_cols = _three(gyro, "--gyro")
     opts = _mpf.MultiposOptions(
@@ -197,6 +208,7 @@ def multipos_cmd(
         accel_unit, gyro_unit, temps, gravity, latitude, order, tref, static_s, time, time_unit,
         _mpf.count_scale(accel_scale, "accel"), _mpf.count_scale(gyro_scale, "gyro"),
         window_s, still_threshold, motion_fraction, drift_deg, accel_offset, gyro_offset,
+        gyro_model,
     )  # fmt: skip
     res = _mpf.calibrate_files(files, output, opts, poses)
     out, a_unit = res.summary, res.accel_unit

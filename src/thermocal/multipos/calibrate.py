@@ -219,6 +219,24 @@ def _warn_implausible(gfit: _gyro.GyroFit, where: str) -> None:
         )
 
 
+def _warn_too_few_motions(gfit: _gyro.GyroFit, where: str) -> None:
+    """A warning when the motions cannot carry the model's elements of E
+    (:func:`.gyro.too_few_motions`), naming the reduced model."""
+    if gfit.model != "full" or not _gyro.too_few_motions(gfit):
+        return
+    worst = float(np.max(gfit.sigma[3:6])) * units.PPM
+    warnings.warn(
+        ThermocalWarning(
+            f"{where}: {gfit.n_motions} motions between poses for the gyro's 9 scale factors "
+            f"and misalignments leave {gfit.dof} degree(s) of freedom, and they misfit their "
+            f"noise (reduced χ² {gfit.reduced_chi2:.3g}): the misfit goes into E (scale "
+            f"factor σ up to {worst:.1%}); fit the 3 scale factors only with "
+            "--gyro-model scale (misalignments held at 0), or record more motions"
+        ),
+        stacklevel=3,
+    )
+
+
 def calibrate_session(
     time_s: npt.ArrayLike,
     accel_mg: npt.ArrayLike,
@@ -232,12 +250,14 @@ def calibrate_session(
     where: str = "session",
     sections_from: str = "the POSES file",
     saturated: npt.ArrayLike | None = None,
+    gyro_model: str = "full",
 ) -> SessionResult:
     """Calibrate the accelerometer (and gyro) triad of one session (module docstring).
     ``accel_mg`` (n, 3) [mg], ``gyro_rad_s`` (n, 3) [rad/s] or None, ``g_mg`` local
     gravity [mg]; ``sections`` from a POSES file (named ``sections_from`` in messages),
     else found from the data; ``saturated``
-    (n,) the samples with a gyro axis on its rails (their motions left out of the gyro fit)."""
+    (n,) the samples with a gyro axis on its rails (their motions left out of the gyro fit);
+    ``gyro_model`` the elements of the gyro's E fitted (:data:`.gyro.GYRO_MODELS`)."""
     t = np.asarray(time_s, dtype=np.float64)
     a = np.asarray(accel_mg, dtype=np.float64)
     w = None if gyro_rad_s is None else np.asarray(gyro_rad_s, dtype=np.float64)
@@ -313,8 +333,10 @@ def calibrate_session(
             w, dt, [p.section for p in stats], up_of, free, free_cov, bias, bias_cov,
             dir_sig, float(np.sqrt(np.mean(ws**2))), named, latitude_deg=latitude_deg,
             saturated=None if saturated is None else np.asarray(saturated, dtype=bool),
+            model=gyro_model,
         )  # fmt: skip
         _warn_implausible(gfit, where)
+        _warn_too_few_motions(gfit, where)
     return SessionResult(acc, gfit, tuple(stats), tuple(turns), g_mg, temp, not_still)
 
 

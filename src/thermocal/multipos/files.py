@@ -77,6 +77,8 @@ class MultiposOptions:
     gyro_offset: float | None = None
     """Zero of the columns in their own unit (counts: ``--accel-offset 32768`` for unsigned
     ADC counts); None: none, or mid-scale found in unsigned counts (a warning)."""
+    gyro_model: str = "full"
+    """The gyro's elements of E fitted (:data:`thermocal.multipos.gyro.GYRO_MODELS`)."""
 
     def check(self, n_files: int, poses: Path | None) -> None:
         """The options' own consistency (before any file is read)."""
@@ -396,6 +398,7 @@ def _session(
             rec.time_s, acc, w, g_mg=float(grav.g_m_s2) / 9.80665e-3,
             latitude_deg=grav.latitude_deg, sections=sections, static_s=opts.static_s,
             temperature_c=temp, where=str(path), saturated=sat, sections_from=str(poses),
+            gyro_model=opts.gyro_model,
         )  # fmt: skip
     except DesignError as exc:
         if opts.accel_scale is None or "distinct poses" not in str(exc):
@@ -542,7 +545,7 @@ def _summary(
                           "method": "rotations between poses"
                           + (" and 360° turns" if r.gyro.n_turns else ""),
                           "n_motions": r.gyro.n_motions, "n_turns": r.gyro.n_turns,
-                          "reduced_chi2": r.gyro.reduced_chi2,
+                          "model": r.gyro.model, "reduced_chi2": r.gyro.reduced_chi2,
                           "turn_axis_lean_deg": math.degrees(r.gyro.turn_axis_lean_rad),
                           "direction_rms_before_deg": math.degrees(
                               r.gyro.direction_rms_before_rad),

@@ -83,6 +83,11 @@ TURN_ANGLE_TOLERANCE: float = 0.10
 """A named turn's angle (raw rate, bias removed) may differ from 360° by this fraction;
 more (a quarter turn, two turns, a wrong gyro unit) is refused (:func:`check_turn`).
 It bounds the scale factor a turn can give to ±10 %."""
+GYRO_MODELS: dict[str, tuple[int, ...]] = {"full": tuple(range(9)), "scale": (0, 4, 8)}
+"""The elements of ``E_g`` (row-major) each gyro model fits: ``full`` all nine (three
+scale factors, six misalignments), ``scale`` the three scale factors only, the
+misalignments held at 0 (the gyro's axes taken as the accelerometer's calibrated axes:
+one chip, one die), for sessions whose motions cannot carry nine (:func:`too_few_motions`)."""
 TURN_AXIS_TOLERANCE_DEG: float = 15.0
 """A named turn's rotation vector may be this far [°] from its named axis (consumer
 gyro misalignments and a hand's wobble are a few degrees); more is refused: a turn named
@@ -198,6 +203,13 @@ class GyroFit:
     n_motions: int
     n_turns: int
     turn_axis_lean_rad: float = 0.0
+    model: str = "full"
+
+    @property
+    def dof(self) -> int:
+        """The fit's degrees of freedom: two per motion (the residual lies across
+        gravity), three per turn, less the elements of E the model fits."""
+        return 2 * self.n_motions + 3 * self.n_turns - len(GYRO_MODELS[self.model])
 
     @property
     def sigma(self) -> FloatArray:
@@ -305,6 +317,8 @@ class _Rotations:
     tilt_var: float = 0.0
     """τ²: the variance [rad²] of a turn's axis lean off ``e_j`` per component beyond the
     face's noise (:func:`_turn_axis_scatter`)."""
+    free: tuple[int, ...] = tuple(range(9))
+    """The elements of E fitted (row-major, :data:`GYRO_MODELS`); the others stay 0."""
 
     @property
     def n_rows(self) -> int:
@@ -406,10 +420,13 @@ def _solve_error_matrix(
 ) -> FloatArray:
     """Gauss-Newton on E from E = 0 until the largest step is below 1e-10."""
     e = np.zeros((3, 3))
+    free = list(rot.free)
     for _ in range(max_iter):
         r, j, _jb, _atts = rot.evaluate(e, bias_rad_s, up, jac=True)
-        step, *_ = np.linalg.lstsq(j * _SCALE, -r, rcond=None)
-        e = e + (step * _SCALE).reshape(3, 3)
+        step, *_ = np.linalg.lstsq(j[:, free] * _SCALE, -r, rcond=None)
+        full = np.zeros(9)
+        full[free] = step
+        e = e + (full * _SCALE).reshape(3, 3)
         if float(np.max(np.abs(step * _SCALE))) < 1e-10:
             break
     return e
@@ -433,7 +450,7 @@ def _turn_axis_scatter(
         return rot, e
     for it in range(8):
         r, j, _jb, (_a, turn_info) = rot.evaluate(e, bias_rad_s, up, jac=True)
-        u_, s_, _vt = np.linalg.svd(j, full_matrices=False)
+        u_, s_, _vt = np.linalg.svd(j[:, list(rot.free)], full_matrices=False)
         keep = s_ > 1e-12 * s_[0]
         hat = np.sum(u_[:, keep] ** 2, axis=1)
         red = float(rows.size - hat[rows].sum())
@@ -471,14 +488,16 @@ def _error_matrix_cov(
     covariance ``I + J_b C_b J_bᵀ + G C_a Gᵀ`` (a bias error known to be there is not
     taken for unmodelled scatter and counted a second time); ``(JᵀJ)⁻¹`` is scaled by it
     only when above ``1 + 3√(2/ν)``."""
-    _u, s_, vt = np.linalg.svd(j * _SCALE, full_matrices=False)
+    free = list(rot.free)
+    _u, s_, vt = np.linalg.svd(j[:, free] * _SCALE, full_matrices=False)
     if not s_[-1] > 1e-6 * s_[0]:
         raise DesignError(
             "the rotations between poses are all about one axis (or too small): the gyro's "
             "scale factors and misalignments of the other axes are unseen; turn the board "
             "about at least two different axes between poses"
         )
-    cov0 = (vt.T / s_**2) @ vt * _SCALE**2  # (JᵀJ)⁻¹ of E's nine elements
+    cov0 = np.zeros((9, 9))  # (JᵀJ)⁻¹ of E's fitted elements, 0 for those held at 0
+    cov0[np.ix_(free, free)] = (vt.T / s_**2) @ vt * _SCALE**2
     gain = cov0 @ j.T  # K = (JᵀJ)⁻¹ Jᵀ (whitened)
     # the accelerometer's uncertainty through u (numerical derivative of the residuals)
     ga = np.zeros((rot.n_rows, accel_free.size))
@@ -489,7 +508,7 @@ def _error_matrix_cov(
         r_q = _residuals_fixed_att(rot.motions, held, up_of(pq), r)
         ga[:, q] = (r_q - r) / h
     c_sys = jb @ bias_cov @ jb.T + ga @ accel_free_cov @ ga.T
-    dof = (2 * len(rot.motions) + 3 * len(rot.turns)) - 9
+    dof = (2 * len(rot.motions) + 3 * len(rot.turns)) - len(free)
     c_rows = np.eye(rot.n_rows) + c_sys
     chi2 = float(r @ np.linalg.solve(c_rows, r)) / dof if dof > 0 else float("nan")
     cov_p = cov0
@@ -534,6 +553,7 @@ def fit_rotations(
     latitude_deg: float | None = None,
     max_iter: int = 8,
     saturated: npt.NDArray[np.bool_] | None = None,
+    model: str = "full",
 ) -> GyroFit:
     """``E_g`` from the motions between consecutive ``poses`` (module docstring).
 
@@ -541,14 +561,17 @@ def fit_rotations(
     parameters ``p`` (``accel_free`` at the solution, covariance ``accel_free_cov``);
     ``dir_sigma_rad`` (m,) the noise of each pose's direction; ``turns`` the 360° turns with
     their named axes (:class:`Turn`); ``latitude_deg`` (None: unknown) the earth rate's
-    split into the vertical, known, and the horizontal, of unknown heading."""
+    split into the vertical, known, and the horizontal, of unknown heading; ``model`` the
+    elements of E fitted (:data:`GYRO_MODELS`: ``full`` nine, ``scale`` three)."""
+    if model not in GYRO_MODELS:
+        raise ThermocalInputError(f"gyro model {model!r}: one of {', '.join(GYRO_MODELS)}")
     dt_med = float(np.median(dt_s))
     up = up_of(accel_free)
     motions = _motions(dt_s, poses, dt_med, dir_sigma_rad, rate_sigma_rad_s, latitude_deg)
     motions = unsaturated(motions, saturated)
     rot = _Rotations(rate_rad_s, dt_s, dt_med, motions, turns, rate_sigma_rad_s,
-                     latitude_deg)  # fmt: skip
-    if rot.n_rows < 9 + 3:
+                     latitude_deg, free=GYRO_MODELS[model])  # fmt: skip
+    if rot.n_rows < len(rot.free) + 3:
         raise DesignError(
             f"{len(motions)} motions between static poses: the gyro's scale factors and "
             "misalignments need rotations about at least two different axes (and a still "
@@ -575,7 +598,39 @@ def fit_rotations(
         len(motions),
         len(turns),
         math.sqrt(rot.tilt_var),
+        model,
     )
+
+
+def too_few_motions(fit: GyroFit) -> bool:
+    """Whether the motions cannot carry the model's elements of E: a redundancy
+    (:attr:`GyroFit.dof`) below the number of elements fitted, with a misfit beyond the
+    noise (reduced χ² above ``1 + 3√(2/ν)``, ν the dof).
+
+    A least-squares fit of ``u`` unknowns on ``n`` rows averages an unmodelled error of
+    the rows over their redundancy ``n − u`` only (the hat matrix keeps ``u/n`` of each
+    row's error in the fit, Koch 1999, §3.2): with fewer redundant rows than unknowns, a
+    misfit of the motions (χ² ≫ 1: something the model does not hold) goes mostly into
+    E.  A session of a hand-held consumer IMU (six usable motions for nine elements,
+    reduced χ² 704: tomisuarez2/ImuCalibration's MPU-6050) is one; fitting only the scale
+    factors (``model="scale"``) leaves it nine rows of redundancy.
+
+    Parameters
+    ----------
+    fit : GyroFit
+        The fit to judge.
+
+    Returns
+    -------
+    bool
+        True when the redundancy is below the number of elements fitted and the reduced
+        χ² is significant.
+    """
+    nu = fit.dof
+    if nu <= 0:
+        return True
+    significant = fit.reduced_chi2 > 1.0 + 3.0 * math.sqrt(2.0 / nu)
+    return nu < len(GYRO_MODELS[fit.model]) and significant
 
 
 def _residuals_fixed_att(
@@ -594,6 +649,7 @@ def _residuals_fixed_att(
 
 
 __all__ = [
+    "GYRO_MODELS",
     "TURN_ANGLE_TOLERANCE",
     "TURN_AXIS_TOLERANCE_DEG",
     "GyroFit",
@@ -601,5 +657,6 @@ __all__ = [
     "check_turn",
     "fit_rotations",
     "static_bias",
+    "too_few_motions",
     "turn_rotation",
 ]
