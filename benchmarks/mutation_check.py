@@ -1193,6 +1193,22 @@ MUTANTS: tuple[Mutant, ...] = (
         ("tests/test_multipos_real_sessions.py",),
         "--accel-offset removed before the fit but not put back into the biases",
     ),
+    Mutant(
+        "multipos-gyro-scale-model-all-nine",
+        P + "multipos/gyro.py",
+        '"scale": (0, 4, 8)}',
+        '"scale": tuple(range(9))}',
+        ("tests/test_multipos_real_sessions.py",),
+        "--gyro-model scale fits the misalignments too (MPU held-out turn 6.96°)",
+    ),
+    Mutant(
+        "multipos-too-few-motions-redundancy",
+        P + "multipos/gyro.py",
+        "return nu < len(GYRO_MODELS[fit.model]) and significant",
+        "return nu < 3 and significant",
+        ("tests/test_multipos_real_sessions.py",),
+        "6 motions for 9 gyro elements (3 dof, χ² 704) not warned of",
+    ),
     # --- station -----------------------------------------------------------------------------
     Mutant(
         "station-part-rotation-strict",
