@@ -108,6 +108,9 @@ def test_mpu_explanation_in_the_human_output(mpu: dict[str, Any]) -> None:
     code, out, err = _run(args)
     assert code == 0, err
     assert "10 poses (window 0.5 s" in out and "set by the motions" in out
+    # the gyro's misfit said beside its σ: χ² of the 6 motions' residuals against their
+    # noise (≈ 0.05° per motion; the residuals are ≈ 1°)
+    assert "the gyro's 6 motions scatter beyond their noise (reduced χ² 704 on 3 degrees" in out
 
 
 AUTHOR_ACC = (1.043860522409845042e-05, 2.098452816658057195e-06,

@@ -147,6 +147,21 @@ GyroModelOpt = Annotated[
 ]
 
 
+def _gyro_misfit(run: dict[str, Any]) -> None:
+    """A line when the motions scatter beyond their noise (reduced χ² above
+    ``1 + 3√(2/ν)``): the gyro's σ are scaled by it."""
+    g = run.get("gyro")
+    if not g or not g["dof"] > 0 or g["reduced_chi2"] is None:
+        return
+    chi2, dof = float(g["reduced_chi2"]), int(g["dof"])
+    if chi2 > 1.0 + 3.0 * (2.0 / dof) ** 0.5:
+        stdout.print(
+            f"{run['input']}: the gyro's {g['n_motions']} motions scatter beyond their noise "
+            f"(reduced χ² {fmt(chi2, 3)} on {dof} degrees of freedom, {g['model']} model): "
+            "its σ are scaled by it"
+        )
+
+
 def _explain(out: dict[str, Any]) -> None:
     """The pose detector's choice, per file: poses found, the still limit and what set
     it, the stretches rejected and why."""
@@ -245,6 +260,7 @@ def multipos_cmd(
             f"{fmt(out['gravity_residual_rms_after'], 3)} {a_unit}; written {output}"
         )
         for run in out["runs"]:
+            _gyro_misfit(run)
             if run["accel"].get("misfit"):
                 stdout.print(
                     f"{run['input']}: the poses scatter more than their noise (reduced χ² "

@@ -545,7 +545,8 @@ def _summary(
                           "method": "rotations between poses"
                           + (" and 360° turns" if r.gyro.n_turns else ""),
                           "n_motions": r.gyro.n_motions, "n_turns": r.gyro.n_turns,
-                          "model": r.gyro.model, "reduced_chi2": r.gyro.reduced_chi2,
+                          "model": r.gyro.model, "dof": r.gyro.dof,
+                          "reduced_chi2": r.gyro.reduced_chi2,
                           "turn_axis_lean_deg": math.degrees(r.gyro.turn_axis_lean_rad),
                           "direction_rms_before_deg": math.degrees(
                               r.gyro.direction_rms_before_rad),
