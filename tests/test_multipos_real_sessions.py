@@ -589,3 +589,20 @@ def test_unsigned_offset_counts_give_the_truth_with_the_offset_in_the_bias(
     g_mg = s["g_m_s2"] / MG_M_S2
     mags = [np.linalg.norm(fc[p0 + 30 : p1 - 30].mean(axis=0)) for p0, p1 in s["poses"]]
     assert np.max(np.abs(np.asarray(mags) - g_mg)) < 1.0  # mg
+
+
+def test_too_few_motions_rule() -> None:
+    """The rule behind the warning (:func:`thermocal.multipos.gyro.too_few_motions`): a
+    redundancy below the elements fitted AND a reduced χ² above ``1 + 3√(2/ν)``."""
+    from thermocal.multipos.gyro import GyroFit, too_few_motions
+
+    def fit(n_motions: int, chi2: float, model: str = "full") -> GyroFit:
+        z = np.zeros(12)
+        return GyroFit(z, np.zeros((12, 12)), 0.0, 0.0, chi2, n_motions, 0, 0.0, model)
+
+    limit3 = 1.0 + 3.0 * np.sqrt(2.0 / 3.0)  # 3.449 for ν = 2·6 − 9 = 3
+    assert fit(6, 704.0).dof == 3 and too_few_motions(fit(6, 704.0))
+    assert too_few_motions(fit(6, limit3 * 1.01)) and not too_few_motions(fit(6, limit3 * 0.99))
+    assert fit(9, 704.0).dof == 9 and not too_few_motions(fit(9, 704.0))  # ν = 9: enough
+    assert fit(6, 794.0, "scale").dof == 9 and not too_few_motions(fit(6, 794.0, "scale"))
+    assert too_few_motions(fit(4, 1.0))  # ν = −1: nothing left to judge the fit
