@@ -242,6 +242,10 @@ def test_gyro_model_unknown_is_refused(mpu: dict[str, Any]) -> None:
     code, _out, err = _run([*args, "--gyro-model", "diag"])
     assert code == 2
     assert err.strip().count("\n") == 0 and "error: --gyro-model 'diag': full or scale" in err
+    no_gyro = args[: args.index("--gyro")] + args[args.index("--gyro") + 2 :]
+    code, _out, err = _run([*no_gyro, "--gyro-model", "scale"])
+    assert code == 2 and err.strip().count("\n") == 0
+    assert "error: --gyro-model scale: no gyro columns to fit; name them with --gyro" in err
 
 
 # --- imu_tk's Xsens session -------------------------------------------------------------

@@ -215,6 +215,10 @@ def multipos_cmd(
         raise ThermocalInputError(f"{output}: the calibration is JSON; use a .json name")
     if gyro_model not in ("full", "scale"):
         raise ThermocalInputError(f"--gyro-model {gyro_model!r}: full or scale")
+    if gyro_model != "full" and gyro is None:
+        raise ThermocalInputError(
+            f"--gyro-model {gyro_model}: no gyro columns to fit; name them with --gyro X,Y,Z"
+        )
     acc_cols = _three(accel, "--accel") or []
     gyr_cols = _three(gyro, "--gyro")
     opts = _mpf.MultiposOptions(
