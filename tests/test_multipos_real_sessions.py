@@ -81,6 +81,10 @@ def mpu(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
         "the gyro is on its rails (clipped) during 3 motion(s): pose_1 → pose_2 (rows "
         "3910…), pose_5 → pose_6 (rows 6662…), pose_8 → pose_9 (rows 8766…)" in err
     ), err
+    # 6 motions left for 9 gyro elements (3 degrees of freedom) misfitting their noise
+    # (reduced χ² ≈ 700): the default full model is warned of, naming the reduced one
+    assert "6 motions between poses for the gyro's 9 scale factors" in err, err
+    assert "--gyro-model scale" in err
     return {"dir": d, "summary": json.loads(out), "cal": d / "cal.json", "args": args}
 
 
@@ -104,6 +108,9 @@ def test_mpu_explanation_in_the_human_output(mpu: dict[str, Any]) -> None:
     code, out, err = _run(args)
     assert code == 0, err
     assert "10 poses (window 0.5 s" in out and "set by the motions" in out
+    # the gyro's misfit said beside its σ: χ² of the 6 motions' residuals against their
+    # noise (≈ 0.05° per motion; the residuals are ≈ 1°)
+    assert "the gyro's 6 motions scatter beyond their noise (reduced χ² 704 on 3 degrees" in out
 
 
 AUTHOR_ACC = (1.043860522409845042e-05, 2.098452816658057195e-06,
@@ -157,25 +164,31 @@ def _turn_error_deg(acc: np.ndarray, rate_rad_s: np.ndarray, dt: float = 0.01) -
     return float(np.degrees(np.arccos(np.clip(c, -1.0, 1.0))))
 
 
-def test_mpu_held_out_90_degree_turn(mpu: dict[str, Any]) -> None:
-    """The held-out turn compensated by ``thermocal compensate`` with the session's
-    calibration, against the authors' own calibration applied as their code does (both
-    computed here).  The authors' error is 1.54°.  thermocal's, with the three clipped
-    motions left out (6 motions for 9 gyro parameters), is 7.0°, within what its stated
-    uncertainty predicts for a turn about x, 7.3° (the σ of the x scale factor and of the
-    misalignments of x into y and z, ``xy`` and ``xz``, times the 90° turned): worse than
-    the datasheet's nominal gyro scale with thermocal's accelerometer (2.23°); with the
-    clipped motions integrated it was 2.4°.  The issue's "within 1.2× the authors' error"
-    is NOT reached (the xfail below)."""
+def _held_out(cal: Path, d: Path) -> tuple[np.ndarray, np.ndarray]:
+    """The held-out session compensated by ``thermocal compensate`` with ``cal``: the
+    accelerometer [counts' unit] and the rate [rad/s]."""
     import pandas as pd
 
-    held = _mpu_csv("imu_90_x_rot.csv", mpu["dir"] / "held.csv")
-    comp = mpu["dir"] / "held_comp.csv"
-    code, _o, err = _run(["compensate", str(mpu["cal"]), str(held), "-o", str(comp)])
+    held = _mpu_csv("imu_90_x_rot.csv", d / "held.csv")
+    comp = d / f"held_comp_{cal.stem}.csv"
+    code, _o, err = _run(["compensate", str(cal), str(held), "-o", str(comp)])
     assert code == 0, err
     df = pd.read_csv(comp)
     acc = df[[f"a{a} [counts]_comp" for a in "xyz"]].to_numpy()
     rate = np.radians(df[[f"g{a} [counts]_comp" for a in "xyz"]].to_numpy())
+    return acc, rate
+
+
+def test_mpu_held_out_90_degree_turn(mpu: dict[str, Any]) -> None:
+    """The held-out turn compensated by ``thermocal compensate`` with the session's
+    calibration, against the authors' own calibration applied as their code does (both
+    computed here).  The authors' error is 1.54°.  thermocal's full model, with the three
+    clipped motions left out (6 motions for 9 gyro parameters, warned of), is 7.0°,
+    within what its stated uncertainty predicts for a turn about x, 7.3° (the σ of the x
+    scale factor and of the misalignments of x into y and z, ``xy`` and ``xz``, times the
+    90° turned): worse than the datasheet's nominal gyro scale with thermocal's
+    accelerometer (2.23°).  ``--gyro-model scale`` (below) reaches the target."""
+    acc, rate = _held_out(mpu["cal"], mpu["dir"])
     raw = np.loadtxt(MPU / "imu_90_x_rot.csv", delimiter=",", skiprows=5)
     author = _turn_error_deg(_author_acc(raw[:, :3]), _author_gyr(raw[:, 3:]))
     assert author == pytest.approx(1.54, abs=0.01)
@@ -193,19 +206,46 @@ def test_mpu_held_out_90_degree_turn(mpu: dict[str, Any]) -> None:
     # thermocal's accelerometer with the datasheet's gyro scale: 2.23°, within 1.5× the
     # authors': the accelerometer part holds; the gyro fit on 6 hand-held motions does not
     assert _turn_error_deg(acc, nominal) <= 1.5 * author
-    mpu["turn"] = (mine, author)
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="issue 38: the held-out turn within 1.2× the authors' "
-    "error is not reached (7.0° vs 1.54°; 2.4° with the clipped motions in)",
-)
 def test_mpu_held_out_turn_within_1p2_of_the_authors(mpu: dict[str, Any]) -> None:
-    if "turn" not in mpu:
-        test_mpu_held_out_90_degree_turn(mpu)
-    mine, author = mpu["turn"]
-    assert mine <= 1.2 * author
+    """What the default's warning says, done: ``--gyro-model scale`` fits the 3 gyro
+    scale factors on the 6 unclipped motions (9 degrees of freedom), the misalignments
+    held at 0; the held-out turn, compensated by ``thermocal compensate``, is then 0.90°
+    from gravity, within 1.2× the authors' 1.54° (their 9 elements on all 9 motions,
+    clipped ones included; computed here as their code does).  Seen red with the scale
+    model fitting all nine elements (6.96°)."""
+    args = [a for a in mpu["args"]]
+    args[args.index("-o") + 1] = str(mpu["dir"] / "cal_scale.json")
+    code, out, err = _run([*args, "--gyro-model", "scale"])
+    assert code == 0, err
+    assert "--gyro-model" not in err  # the reduced model is not warned of
+    g = json.loads(out)["runs"][0]["gyro"]
+    assert g["model"] == "scale" and g["n_motions"] == 6
+    assert g["misalignment_arcsec"] == [0.0] * 6 and g["misalignment_arcsec_sigma"] == [0.0] * 6
+    acc, rate = _held_out(mpu["dir"] / "cal_scale.json", mpu["dir"])
+    raw = np.loadtxt(MPU / "imu_90_x_rot.csv", delimiter=",", skiprows=5)
+    author = _turn_error_deg(_author_acc(raw[:, :3]), _author_gyr(raw[:, 3:]))
+    mine = _turn_error_deg(acc, rate)
+    assert mine <= 1.2 * author, (mine, author)
+    assert mine == pytest.approx(0.90, abs=0.05)
+    # what thermocal states for it: the x scale factor's σ (scaled by the misfit, χ² 794
+    # on 9 dof) times the 90° turned, 2.2°: the 0.90° is inside, the data do not pin the
+    # scale factors below ≈ 2.5 % (leaving one of the 6 motions out moves it to 0.4–4.6°)
+    predicted = 90.0 * g["scale_factor_ppm_sigma"][0] * 1e-6
+    assert predicted == pytest.approx(2.2, abs=0.1) and mine <= predicted
+
+
+def test_gyro_model_unknown_is_refused(mpu: dict[str, Any]) -> None:
+    args = [a for a in mpu["args"]]
+    args[args.index("-o") + 1] = str(mpu["dir"] / "cal_bad.json")
+    code, _out, err = _run([*args, "--gyro-model", "diag"])
+    assert code == 2
+    assert err.strip().count("\n") == 0 and "error: --gyro-model 'diag': full or scale" in err
+    no_gyro = args[: args.index("--gyro")] + args[args.index("--gyro") + 2 :]
+    code, _out, err = _run([*no_gyro, "--gyro-model", "scale"])
+    assert code == 2 and err.strip().count("\n") == 0
+    assert "error: --gyro-model scale: no gyro columns to fit; name them with --gyro" in err
 
 
 # --- imu_tk's Xsens session -------------------------------------------------------------
@@ -558,3 +598,20 @@ def test_unsigned_offset_counts_give_the_truth_with_the_offset_in_the_bias(
     g_mg = s["g_m_s2"] / MG_M_S2
     mags = [np.linalg.norm(fc[p0 + 30 : p1 - 30].mean(axis=0)) for p0, p1 in s["poses"]]
     assert np.max(np.abs(np.asarray(mags) - g_mg)) < 1.0  # mg
+
+
+def test_too_few_motions_rule() -> None:
+    """The rule behind the warning (:func:`thermocal.multipos.gyro.too_few_motions`): a
+    redundancy below the elements fitted AND a reduced χ² above ``1 + 3√(2/ν)``."""
+    from thermocal.multipos.gyro import GyroFit, too_few_motions
+
+    def fit(n_motions: int, chi2: float, model: str = "full") -> GyroFit:
+        z = np.zeros(12)
+        return GyroFit(z, np.zeros((12, 12)), 0.0, 0.0, chi2, n_motions, 0, 0.0, model)
+
+    limit3 = 1.0 + 3.0 * np.sqrt(2.0 / 3.0)  # 3.449 for ν = 2·6 − 9 = 3
+    assert fit(6, 704.0).dof == 3 and too_few_motions(fit(6, 704.0))
+    assert too_few_motions(fit(6, limit3 * 1.01)) and not too_few_motions(fit(6, limit3 * 0.99))
+    assert fit(9, 704.0).dof == 9 and not too_few_motions(fit(9, 704.0))  # ν = 9: enough
+    assert fit(6, 794.0, "scale").dof == 9 and not too_few_motions(fit(6, 794.0, "scale"))
+    assert too_few_motions(fit(4, 1.0))  # ν = −1: nothing left to judge the fit

@@ -83,8 +83,9 @@ PosesOpt = Annotated[
     Path | None,
     typer.Option(
         "--poses",
-        help='Named sections {"name": {"start": i, "end": j}} by sample index (x_p…z_a '
-        "faces, x_rot… 360° turns) instead of the poses found in the data (one file).",
+        help='Named sections {"name": {"start": i, "end": j}} by sample index, or '
+        "imucal's section list as CSV (x_p…z_a faces, x_rot… 360° turns about that "
+        "axis) instead of the poses found in the data (one file).",
     ),
 ]
 GravityOpt = Annotated[float | None, typer.Option("--gravity", help="Local gravity [m/s²].")]
@@ -142,6 +143,29 @@ GyroOffsetOpt = Annotated[
     float | None,
     typer.Option("--gyro-offset", help="Zero of the gyro columns in their unit."),
 ]
+GyroModelOpt = Annotated[
+    str,
+    typer.Option(
+        "--gyro-model",
+        help="Gyro elements fitted: full (3 scale factors, 6 misalignments) or scale (3 "
+        "scale factors, misalignments 0: few motions).",
+    ),
+]
+
+
+def _gyro_misfit(run: dict[str, Any]) -> None:
+    """A line when the motions scatter beyond their noise (reduced χ² above
+    ``1 + 3√(2/ν)``): the gyro's σ are scaled by it."""
+    g = run.get("gyro")
+    if not g or not g["dof"] > 0 or g["reduced_chi2"] is None:
+        return
+    chi2, dof = float(g["reduced_chi2"]), int(g["dof"])
+    if chi2 > 1.0 + 3.0 * (2.0 / dof) ** 0.5:
+        stdout.print(
+            f"{run['input']}: the gyro's {g['n_motions']} motions scatter beyond their noise "
+            f"(reduced χ² {fmt(chi2, 3)} on {dof} degrees of freedom, {g['model']} model): "
+            "its σ are scaled by it"
+        )
 
 
 def _explain(out: dict[str, Any]) -> None:
@@ -183,6 +207,7 @@ def multipos_cmd(
     drift_deg: DriftOpt = _poses.POSE_DRIFT_DEG,
     accel_offset: AccelOffsetOpt = None,
     gyro_offset: GyroOffsetOpt = None,
+    gyro_model: GyroModelOpt = "full",
     time: TimeOpt = None,
     time_unit: TimeUnitOpt = None,
     accel_scale: AccelScaleOpt = None,
@@ -199,6 +224,12 @@ def multipos_cmd(
     _writers.check_not_input(output, [*files, *([poses] if poses else [])])
     if output.suffix.lower() != ".json":
         raise ThermocalInputError(f"{output}: the calibration is JSON; use a .json name")
+    if gyro_model not in ("full", "scale"):
+        raise ThermocalInputError(f"--gyro-model {gyro_model!r}: full or scale")
+    if gyro_model != "full" and gyro is None:
+        raise ThermocalInputError(
+            f"--gyro-model {gyro_model}: no gyro columns to fit; name them with --gyro X,Y,Z"
+        )
     acc_cols = _three(accel, "--accel") or []
     gyr_cols = _three(gyro, "--gyro")
     opts = _mpf.MultiposOptions(
@@ -207,6 +238,7 @@ def multipos_cmd(
         accel_unit, gyro_unit, temps, gravity, latitude, order, tref, static_s, time, time_unit,
         _mpf.count_scale(accel_scale, "accel"), _mpf.count_scale(gyro_scale, "gyro"),
         window_s, still_threshold, motion_fraction, drift_deg, accel_offset, gyro_offset,
+        gyro_model,
         text=text_options(t_names, t_rate, t_bad, t_delim, t_dec),
     )  # fmt: skip
     res = _mpf.calibrate_files(files, output, opts, poses)
@@ -230,12 +262,21 @@ def multipos_cmd(
                 table.add_row(f"misalignment {n}", fmt(d["misalignment_arcsec"][i], 5),
                               fmt(d["misalignment_arcsec_sigma"][i], 3), "″")  # fmt: skip
             stdout.print(table)
+        for run in out["runs"]:
+            lean = run.get("gyro", {}).get("turn_axis_lean_deg", 0.0)
+            if lean > 0:
+                stdout.print(
+                    f"{run['input']}: the 360° turns lean {fmt(lean, 2)}° off their axes "
+                    "(per component, found in the data): counted in the σ, the misalignments "
+                    "rest on the motions between poses"
+                )
         stdout.print(
             f"{out['n_poses']} poses; gravity-magnitude residual rms "
             f"{fmt(out['gravity_residual_rms_before'], 3)} → "
             f"{fmt(out['gravity_residual_rms_after'], 3)} {a_unit}; written {output}"
         )
         for run in out["runs"]:
+            _gyro_misfit(run)
             if run["accel"].get("misfit"):
                 stdout.print(
                     f"{run['input']}: the poses scatter more than their noise (reduced χ² "

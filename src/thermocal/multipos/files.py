@@ -78,6 +78,8 @@ class MultiposOptions:
     gyro_offset: float | None = None
     """Zero of the columns in their own unit (counts: ``--accel-offset 32768`` for unsigned
     ADC counts); None: none, or mid-scale found in unsigned counts (a warning)."""
+    gyro_model: str = "full"
+    """The gyro's elements of E fitted (:data:`thermocal.multipos.gyro.GYRO_MODELS`)."""
     text: TextOptions | None = None
     """How to read a text log and its time (``--rate HZ``: a sample counter, or samples at
     the nominal rate; ``--names`` …), as every command reads it."""
@@ -186,14 +188,42 @@ def _unit_of(
 
 
 def _read_poses(poses: Path | None) -> dict[str, Any] | None:
-    """The POSES file's JSON object (None without one)."""
+    """The POSES file's JSON object (None without one); a ``.csv`` is imucal's section list
+    as pandas writes it (``section_list.to_csv``: a header ``,start,end`` and one row
+    ``name,i,j`` per section)."""
     if poses is None:
         return None
     try:
-        doc: dict[str, Any] = json.loads(poses.read_text(encoding="utf-8"))
+        text = poses.read_text(encoding="utf-8")
+        if poses.suffix.lower() == ".csv":
+            return _poses_csv(text, poses)
+        doc: dict[str, Any] = json.loads(text)
     except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
         raise ThermocalInputError(f"{poses}: not a readable JSON file ({exc})") from None
     return doc
+
+
+def _poses_csv(text: str, poses: Path) -> dict[str, Any]:
+    """imucal's section list written by pandas as CSV (:func:`_read_poses`)."""
+    import csv
+
+    rows = [r for r in csv.reader(text.splitlines()) if any(c.strip() for c in r)]
+    head = [c.strip() for c in rows[0]] if rows else []
+    if "start" not in head or "end" not in head:
+        raise ThermocalInputError(
+            f"{poses}: a CSV section list needs a header with 'start' and 'end' (and the "
+            "section names in the first column), or give the sections as JSON"
+        )
+    i0, i1 = head.index("start"), head.index("end")
+    out: dict[str, Any] = {}
+    for r in rows[1:]:
+        try:
+            out[r[0].strip()] = {"start": int(r[i0]), "end": int(r[i1])}
+        except (IndexError, ValueError):
+            raise ThermocalInputError(
+                f"{poses}: section row {','.join(r)!r} needs integer start and end"
+            ) from None
+    return out
 
 
 class _Gravity:
@@ -373,7 +403,8 @@ def _session(
         res = calibrate_session(
             rec.time_s, acc, w, g_mg=float(grav.g_m_s2) / 9.80665e-3,
             latitude_deg=grav.latitude_deg, sections=sections, static_s=opts.static_s,
-            temperature_c=temp, where=str(path), saturated=sat,
+            temperature_c=temp, where=str(path), saturated=sat, sections_from=str(poses),
+            gyro_model=opts.gyro_model,
         )  # fmt: skip
     except DesignError as exc:
         if opts.accel_scale is None or "distinct poses" not in str(exc):
@@ -520,7 +551,9 @@ def _summary(
                           "method": "rotations between poses"
                           + (" and 360° turns" if r.gyro.n_turns else ""),
                           "n_motions": r.gyro.n_motions, "n_turns": r.gyro.n_turns,
+                          "model": r.gyro.model, "dof": r.gyro.dof,
                           "reduced_chi2": r.gyro.reduced_chi2,
+                          "turn_axis_lean_deg": math.degrees(r.gyro.turn_axis_lean_rad),
                           "direction_rms_before_deg": math.degrees(
                               r.gyro.direction_rms_before_rad),
                           "direction_rms_after_deg": math.degrees(

@@ -25,9 +25,12 @@ carries its mean window variance over the accelerometer's noise floor (≈ 1 whe
 more: tremor).
 
 POSES file (imucal's session list): ``{"name": {"start": i, "end": j}, …}`` by sample
-index, ``end`` exclusive; ``x_p``, ``x_a``, ``y_p``, ``y_a``, ``z_p``, ``z_a`` are the six
-faces (that axis up / down), ``x_rot``, ``y_rot``, ``z_rot`` full 360° turns about that
-axis (the Ferraris method); any other name is a static pose.
+index, ``end`` exclusive (imucal's example file), or the same list as pandas writes it
+(``section_list.to_json()``: ``{"start": {"name": i, …}, "end": {"name": j, …}}``);
+``x_p``, ``x_a``, ``y_p``, ``y_a``, ``z_p``, ``z_a`` are the six faces (that axis up /
+down), ``x_rot``, ``y_rot``, ``z_rot`` full 360° turns about that sensor axis (the
+Ferraris method), whatever pose comes before them (users turn after the six faces);
+any other name is a static pose.
 """
 
 from __future__ import annotations
@@ -335,8 +338,38 @@ def detect_poses(
     return list(det.poses)
 
 
+def _by_section(d: Any, where: str) -> Any:
+    """``{"start": {name: i}, "end": {name: j}}`` (pandas' column orientation of imucal's
+    section list) turned into ``{name: {"start": i, "end": j}}``; anything else as is."""
+    if not (isinstance(d, dict) and set(d) == {"start", "end"}
+            and all(isinstance(v, dict) for v in d.values())):  # fmt: skip
+        return d
+    if set(d["start"]) != set(d["end"]):
+        odd = sorted(set(d["start"]) ^ set(d["end"]))
+        raise ThermocalInputError(f"{where}: sections {odd} have a start or an end only")
+    return {n: {"start": d["start"][n], "end": d["end"][n]} for n in d["start"]}
+
+
 def parse_poses(d: Any, n_samples: int, where: str = "--poses") -> list[Section]:
-    """The sections of a POSES object (module docstring), in order of ``start``."""
+    """The sections of a POSES object (module docstring), in order of ``start``.
+
+    Parameters
+    ----------
+    d : dict
+        ``{name: {"start": i, "end": j}}`` by sample index, ``end`` exclusive, or pandas'
+        column orientation ``{"start": {name: i}, "end": {name: j}}`` (imucal's section
+        list, Ferraris et al. 1995's faces and turns by name).
+    n_samples : int
+        Samples of the recording the indices refer to.
+    where : str
+        The file named in messages.
+
+    Returns
+    -------
+    list of Section
+        Sorted by ``start``; a section named ``x_rot``, ``y_rot`` or ``z_rot`` is a turn.
+    """
+    d = _by_section(d, where)
     if not isinstance(d, dict) or not d:
         raise ThermocalInputError(f"{where}: expected an object of named sections")
     out = []
