@@ -32,7 +32,7 @@ def rng():  # type: ignore[no-untyped-def]
 
 
 @pytest.fixture(autouse=True)
-def _fresh_consoles():  # type: ignore[no-untyped-def]
+def _fresh_consoles() -> None:
     """Each test's CLI run builds its consoles anew, as a new process does: their width is
     decided on first use (``COLUMNS``, a terminal or not), so a console kept from an earlier
     test would carry that test's ``COLUMNS`` into this one (an order-dependent failure)."""
@@ -40,4 +40,3 @@ def _fresh_consoles():  # type: ignore[no-untyped-def]
 
     for console in (common.stdout, common.stderr):
         console._console = None  # type: ignore[attr-defined]
-    yield

@@ -185,6 +185,50 @@ def _explain(out: dict[str, Any]) -> None:
             stdout.print(f"  rejected {r['start']}…{r['end']}: {r['reason']}")
 
 
+def _human(out: dict[str, Any], a_unit: str, output: Path) -> None:
+    """The calibration's tables and what the run said, for a person."""
+    for kind in ("accel", "gyro"):
+        if kind not in out:
+            continue
+        d = out[kind]
+        table = _rich_table.Table(title=f"{kind} triad ({d['method']})")
+        for col in ("parameter", "value", "σ", "unit"):
+            table.add_column(col)
+        for i, ax in enumerate("xyz"):
+            table.add_row(f"bias {ax}", fmt(d["bias"][i], 5), fmt(d["bias_sigma"][i], 3),
+                          d["bias_unit"])  # fmt: skip
+        for i, ax in enumerate("xyz"):
+            table.add_row(f"scale factor {ax}", fmt(d["scale_factor_ppm"][i], 5),
+                          fmt(d["scale_factor_ppm_sigma"][i], 3), "ppm")  # fmt: skip
+        for i, n in enumerate(d["misalignment_names"]):
+            table.add_row(f"misalignment {n}", fmt(d["misalignment_arcsec"][i], 5),
+                          fmt(d["misalignment_arcsec_sigma"][i], 3), "″")  # fmt: skip
+        stdout.print(table)
+    for run in out["runs"]:
+        lean = run.get("gyro", {}).get("turn_axis_lean_deg", 0.0)
+        if lean > 0:
+            stdout.print(
+                f"{run['input']}: the 360° turns lean {fmt(lean, 2)}° off their axes "
+                "(per component, found in the data): counted in the σ, the misalignments "
+                "rest on the motions between poses"
+            )
+    stdout.print(
+        f"{out['n_poses']} poses; gravity-magnitude residual rms "
+        f"{fmt(out['gravity_residual_rms_before'], 3)} → "
+        f"{fmt(out['gravity_residual_rms_after'], 3)} {a_unit}; written {output}"
+    )
+    for run in out["runs"]:
+        _gyro_misfit(run)
+        if run["accel"].get("misfit"):
+            stdout.print(
+                f"{run['input']}: the poses scatter more than their noise (reduced χ² "
+                f"{fmt(run['accel']['reduced_chi2'], 3)}): each pose's σ inflated by a "
+                f"misfit of {fmt(run['accel']['misfit'], 3)} {a_unit}, so that each "
+                "counts as the misfit says"
+            )
+    _explain(out)
+
+
 @app.command("multipos")
 @handle_errors
 def multipos_cmd(
@@ -224,12 +268,6 @@ def multipos_cmd(
     _writers.check_not_input(output, [*files, *([poses] if poses else [])])
     if output.suffix.lower() != ".json":
         raise ThermocalInputError(f"{output}: the calibration is JSON; use a .json name")
-    if gyro_model not in ("full", "scale"):
-        raise ThermocalInputError(f"--gyro-model {gyro_model!r}: full or scale")
-    if gyro_model != "full" and gyro is None:
-        raise ThermocalInputError(
-            f"--gyro-model {gyro_model}: no gyro columns to fit; name them with --gyro X,Y,Z"
-        )
     acc_cols = _three(accel, "--accel") or []
     gyr_cols = _three(gyro, "--gyro")
     opts = _mpf.MultiposOptions(
@@ -244,49 +282,7 @@ def multipos_cmd(
     res = _mpf.calibrate_files(files, output, opts, poses)
     out, a_unit = res.summary, res.accel_unit
 
-    def human() -> None:
-        for kind in ("accel", "gyro"):
-            if kind not in out:
-                continue
-            d = out[kind]
-            table = _rich_table.Table(title=f"{kind} triad ({d['method']})")
-            for col in ("parameter", "value", "σ", "unit"):
-                table.add_column(col)
-            for i, ax in enumerate("xyz"):
-                table.add_row(f"bias {ax}", fmt(d["bias"][i], 5), fmt(d["bias_sigma"][i], 3),
-                              d["bias_unit"])  # fmt: skip
-            for i, ax in enumerate("xyz"):
-                table.add_row(f"scale factor {ax}", fmt(d["scale_factor_ppm"][i], 5),
-                              fmt(d["scale_factor_ppm_sigma"][i], 3), "ppm")  # fmt: skip
-            for i, n in enumerate(d["misalignment_names"]):
-                table.add_row(f"misalignment {n}", fmt(d["misalignment_arcsec"][i], 5),
-                              fmt(d["misalignment_arcsec_sigma"][i], 3), "″")  # fmt: skip
-            stdout.print(table)
-        for run in out["runs"]:
-            lean = run.get("gyro", {}).get("turn_axis_lean_deg", 0.0)
-            if lean > 0:
-                stdout.print(
-                    f"{run['input']}: the 360° turns lean {fmt(lean, 2)}° off their axes "
-                    "(per component, found in the data): counted in the σ, the misalignments "
-                    "rest on the motions between poses"
-                )
-        stdout.print(
-            f"{out['n_poses']} poses; gravity-magnitude residual rms "
-            f"{fmt(out['gravity_residual_rms_before'], 3)} → "
-            f"{fmt(out['gravity_residual_rms_after'], 3)} {a_unit}; written {output}"
-        )
-        for run in out["runs"]:
-            _gyro_misfit(run)
-            if run["accel"].get("misfit"):
-                stdout.print(
-                    f"{run['input']}: the poses scatter more than their noise (reduced χ² "
-                    f"{fmt(run['accel']['reduced_chi2'], 3)}): each pose's σ inflated by a "
-                    f"misfit of {fmt(run['accel']['misfit'], 3)} {a_unit}, so that each "
-                    "counts as the misfit says"
-                )
-        _explain(out)
-
-    emit(out, as_json, human)
+    emit(out, as_json, lambda: _human(out, a_unit, output))
 
 
 __all__ = ["multipos_cmd"]

@@ -86,6 +86,13 @@ class MultiposOptions:
 
     def check(self, n_files: int, poses: Path | None) -> None:
         """The options' own consistency (before any file is read)."""
+        if self.gyro_model not in ("full", "scale"):
+            raise ThermocalInputError(f"--gyro-model {self.gyro_model!r}: full or scale")
+        if self.gyro_model != "full" and self.gyro is None:
+            raise ThermocalInputError(
+                f"--gyro-model {self.gyro_model}: no gyro columns to fit; name them with "
+                "--gyro X,Y,Z"
+            )
         if n_files > 1 and self.temps is None:
             raise ThermocalInputError(
                 "several files: name their temperature column with --temps (one file per "
