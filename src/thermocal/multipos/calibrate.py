@@ -30,7 +30,7 @@ import numpy as np
 import numpy.typing as npt
 
 from thermocal import units
-from thermocal.errors import DesignError, ThermocalWarning
+from thermocal.errors import DesignError, ThermocalInputError, ThermocalWarning
 from thermocal.multipos import accel as _accel
 from thermocal.multipos import gyro as _gyro
 from thermocal.multipos.geometry import attitude_along
@@ -186,8 +186,16 @@ def _named_turns(
     e_a = model.error_matrices(acc.theta)
     var = np.diag(acc.cov)
     out = []
+    dt_med = float(np.median(dt_s))
     for tr in turns:
         j = "xyz".index(tr.name[0])
+        gap = _gyro.turn_gap(dt_s, tr, dt_med)
+        if gap is not None:
+            raise ThermocalInputError(
+                f"{where} {tr.name!r}: a gap in time of {gap[1]:.3g} s after sample {gap[0]} "
+                "inside the turn: the rotation across it is unknown; fix its start and end "
+                f"in {sections_from}, or record the turn again"
+            )
         rot = _gyro.turn_rotation(rate_rad_s, dt_s, bias_rad_s, tr)
         _gyro.check_turn(rot, tr.name, j, f"{where} {tr.name!r}", sections_from)
         c = np.linalg.solve(np.eye(3) + e_a, accel_mg[tr.start : tr.end].mean(axis=0)
@@ -200,9 +208,50 @@ def _named_turns(
     return out
 
 
+def _section_warnings(
+    statics: Sequence[Section],
+    turns: Sequence[Section],
+    has_gyro: bool,
+    where: str,
+    sections_from: str,
+) -> tuple[str, ...]:
+    """Warnings on the sections before any fit (turns named without a gyro, poses not
+    still); the names of the poses not still."""
+    if turns and not has_gyro:
+        warnings.warn(
+            ThermocalWarning(
+                f"{where}: {', '.join(s.name for s in turns)} in {sections_from} are 360° "
+                "turns for the gyro; without its columns (--gyro X,Y,Z) they are not used"
+            ),
+            stacklevel=3,
+        )
+    not_still = tuple(s.name for s in statics if s.still_ratio > 2.0)
+    if not_still:
+        warnings.warn(
+            ThermocalWarning(
+                f"{where}: {len(not_still)} poses are not still (window variance more than "
+                f"twice the quietest): {', '.join(not_still[:8])}"
+                f"{' …' if len(not_still) > 8 else ''}; their means carry the motion"
+            ),
+            stacklevel=3,
+        )
+    return not_still
+
+
 def _warn_implausible(gfit: _gyro.GyroFit, where: str) -> None:
     """A warning when a gyro scale factor or misalignment is beyond
-    :data:`GYRO_E_PLAUSIBLE` (no sensor's: a unit, count scale or pose is wrong)."""
+    :data:`GYRO_E_PLAUSIBLE` (no sensor's: a unit, count scale or pose is wrong), and
+    when the gyro comes from the three turns alone (nothing checks them)."""
+    if gfit.n_motions == 0:
+        warnings.warn(
+            ThermocalWarning(
+                f"{where}: the gyro from the three turns alone (no motion between still "
+                "poses without a gap in time): nothing checks them, a lean of their axes "
+                "is taken for misalignment and σ counts the noise only; record the faces "
+                "and turns in one piece for the motions between them"
+            ),
+            stacklevel=3,
+        )
     th = gfit.theta
     bad = [f"scale factor {ax} {th[3 + i] * units.PPM:+.1%}" for i, ax in enumerate("xyz")
            if abs(th[3 + i] * units.PPM) > GYRO_E_PLAUSIBLE]  # fmt: skip
@@ -243,24 +292,7 @@ def calibrate_session(
         sections = detect_poses(t, a, w, static_s=static_s)
     statics = [s for s in sections if not s.is_turn]
     turns = [s for s in sections if s.is_turn]
-    if turns and w is None:
-        warnings.warn(
-            ThermocalWarning(
-                f"{where}: {', '.join(s.name for s in turns)} in {sections_from} are 360° "
-                "turns for the gyro; without its columns (--gyro X,Y,Z) they are not used"
-            ),
-            stacklevel=2,
-        )
-    not_still = tuple(s.name for s in statics if s.still_ratio > 2.0)
-    if not_still:
-        warnings.warn(
-            ThermocalWarning(
-                f"{where}: {len(not_still)} poses are not still (window variance more than "
-                f"twice the quietest): {', '.join(not_still[:8])}"
-                f"{' …' if len(not_still) > 8 else ''}; their means carry the motion"
-            ),
-            stacklevel=2,
-        )
+    not_still = _section_warnings(statics, turns, w is not None, where, sections_from)
     stats = pose_stats(a, w, statics)
     if len(stats) < 6:
         raise DesignError(
