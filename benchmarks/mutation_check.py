@@ -64,6 +64,7 @@ PX4 = _t("mutants_export", "px4_tempcal", "px4_baro_mag", "ardupilot_tempcal")
 ADEQ = _t("mutants_maths", "adequacy", "fc_gates")
 STAB = _t("mutants_maths", "stability_reference", "allan", "allan_references")
 NOISE = _t("mutants_maths", "stability_noise_terms", "noise_cmd")
+H38 = _t("noise_terms_h38")
 MULTI = _t("mutants_maths", "multipos")
 STATION = _t("station", "readers_station")
 FC = _t("mutants_units", "fc_log_readers", "fc_gates")
@@ -1056,6 +1057,47 @@ MUTANTS: tuple[Mutant, ...] = (
         NOISE,
         "discrete noise σ = density·√dt instead of /√dt",
     ),
+    # --- issue 38: noise terms read where the curve follows them ----------------------------
+    Mutant(
+        "noise-white-stretch-slack",
+        P + "stability/allan.py",
+        "_STRETCH_SLACK: Final = math.log(1.01)",
+        "_STRETCH_SLACK: Final = math.log(1.08)",
+        H38,
+        "−½ stretch admits points 8 % off its line (the filtered short τ)",
+    ),
+    Mutant(
+        "noise-bias-minimum-factor",
+        P + "stability/allan.py",
+        "val = float(dev[k]) / BIAS_INSTABILITY_FACTOR",
+        "val = float(dev[k]) * BIAS_INSTABILITY_FACTOR",
+        H38,
+        "bias instability at the minimum σ_min·0.664 instead of /0.664",
+    ),
+    Mutant(
+        "noise-bias-minimum-edf",
+        P + "stability/allan.py",
+        "keep = np.asarray(edf >= BIAS_MIN_EDF)",
+        "keep = np.asarray(edf >= 0.0)",
+        H38,
+        "minimum sought among the last points of one or two degrees of freedom",
+    ),
+    Mutant(
+        "noise-periodic-amplitude",
+        P + "stability/periodic.py",
+        "amp = math.sqrt(2.0 * power)",
+        "amp = math.sqrt(power)",
+        H38,
+        "sinusoid amplitude from its power without the factor 2",
+    ),
+    Mutant(
+        "noise-lattice-no-glitch",
+        P + "stability/noise_model.py",
+        "if off > QUANT_MAX_OFF * n or not math.isfinite(lo_k):",
+        "if off > 0 or not math.isfinite(lo_k):",
+        H38,
+        "one glitch off the lattice hides the sensor's quantisation",
+    ),
     # --- multipos ------------------------------------------------------------------------
     Mutant(
         "multipos-gap-factor",
@@ -1129,6 +1171,70 @@ MUTANTS: tuple[Mutant, ...] = (
         (*MULTI, "tests/test_multipos_sigma.py"),
         "gyro scale σ without the bias uncertainty",
     ),
+    Mutant(
+        "multipos-poses-noise-only",
+        P + "multipos/poses.py",
+        "by_motion = motion_fraction * motion",
+        "by_motion = 0.0 * motion",
+        ("tests/test_multipos_real_sessions.py",),
+        "pose detector: the still limit from the noise alone (hand-held poses lost: 4 of 10)",
+    ),
+    Mutant(
+        "multipos-misfit-weights-off",
+        P + "multipos/accel.py",
+        "for _ in range(MISFIT_ITERATIONS):",
+        "for _ in range(0):",
+        ("tests/test_multipos_real_sessions.py",),
+        "misfit sensor fitted with its white-noise weights (imu_tk's Xsens: 1.09× the residual)",
+    ),
+    Mutant(
+        "multipos-offset-ignored",
+        P + "multipos/files.py",
+        "        return float(given)\n",
+        "        return 0.0\n",
+        ("tests/test_multipos_real_sessions.py",),
+        "--accel-offset/--gyro-offset ignored (unsigned counts: 1 distinct pose)",
+    ),
+    Mutant(
+        "multipos-saturated-motions-kept",
+        P + "multipos/gyro.py",
+        "motions = unsaturated(motions, saturated)",
+        "motions = unsaturated(motions, None)",
+        ("tests/test_multipos_real_sessions.py",),
+        "motions across clipped gyro samples integrated into the gyro fit",
+    ),
+    Mutant(
+        "inspect-saturation-unreported",
+        P + "inspection.py",
+        "            problems.extend(_saturation_problems(name, arr))",
+        "            pass",
+        ("tests/test_multipos_real_sessions.py",),
+        "inspect says nothing of samples on the int16 rails",
+    ),
+    Mutant(
+        "multipos-poses-drift-off",
+        P + "multipos/poses.py",
+        "        if turn > drift_deg:",
+        "        if turn > 1e9 * drift_deg:",
+        ("tests/test_multipos_real_sessions.py",),
+        "pose detector: a slow 10° turn taken as a pose",
+    ),
+    Mutant(
+        "multipos-poses-tremor-unexplained",
+        P + "multipos/poses.py",
+        "    rejected += _tremor(ratio, poses, rejected, min_n)",
+        "    rejected += _tremor(ratio, poses, rejected, min_n)[:0]",
+        ("tests/test_multipos_real_sessions.py",),
+        "pose detector: stretches lost to tremor not reported",
+    ),
+    Mutant(
+        "multipos-offset-not-in-bias",
+        P + "multipos/files.py",
+        "    if acc_off_mg == 0.0 and gyr_off_deg_h == 0.0:",
+        "    if True:",
+        ("tests/test_multipos_real_sessions.py",),
+        "--accel-offset removed before the fit but not put back into the biases",
+    ),
     # --- station -----------------------------------------------------------------------------
     Mutant(
         "station-part-rotation-strict",
@@ -1186,6 +1292,39 @@ MUTANTS: tuple[Mutant, ...] = (
         '"time": "timestamp", "time_unit": "ms"',
         FC,
         "ULog timestamps read as milliseconds",
+    ),
+    # --- triad validation and report on raw counts (issue 38) ------------------------------
+    Mutant(
+        "triad-count-scale-divided",
+        P + "models/calibration.py",
+        "return x * self.count_scale",
+        "return x / self.count_scale",
+        _t("triad_validate_counts"),
+        "validate: raw counts divided by the count scale",
+    ),
+    Mutant(
+        "triad-one-pose-after-raw",
+        P + "multipos/validate.py",
+        'ma = units.convert(xg_c[pose.start : pose.end].mean(axis=0), "rad/s", unit)',
+        'ma = units.convert(xg[pose.start : pose.end].mean(axis=0), "rad/s", unit)',
+        _t("triad_validate_counts"),
+        "one still pose: the gyro's rate at rest after = before",
+    ),
+    Mutant(
+        "triad-report-bias-as-stored",
+        P + "report/triads.py",
+        'if f.name.startswith("bias") and f.unit != tri.unit:',
+        'if f.name.startswith("bias") and f.unit == tri.unit:',
+        _t("report_triads"),
+        "triad report: a deg/s gyro's bias shown in deg/h",
+    ),
+    Mutant(
+        "triad-report-one-temperature-plotted",
+        P + "report/triads.py",
+        "over_t = len(temps) >= 2",
+        "over_t = len(temps) >= 1",
+        _t("report_triads"),
+        "triad report: one temperature plotted against temperature",
     ),
     # --- C export -----------------------------------------------------------------------
     Mutant(
@@ -1334,6 +1473,71 @@ MUTANTS: tuple[Mutant, ...] = (
         'lo = np.searchsorted(ts, ti - interval_s, side="left")',
         _t("mutants_maths", "preprocess"),
         "centred Ṫ over 1.5 Δ",
+    ),
+    # issue 38, reports and messages (h38-reports)
+    Mutant(
+        "report-average-fallback-two",
+        P + "report/analysis.py",
+        ">= MIN_FALLBACK_AVERAGES]",
+        ">= 2]",
+        _t("h38_messages"),
+        "a short record's fallback averaging time gives only two averages",
+    ),
+    Mutant(
+        "metrics-average-advice-whole-record",
+        P + "metrics.py",
+        "{option} {longest_s / 2.0:.3g} or less",
+        "{option} {longest_s:.3g} or less",
+        _t("h38_messages"),
+        "the advised --average is the whole record (one average), not half",
+    ),
+    Mutant(
+        "export-c-known-input-wrong-way",
+        P + "export/c/core.py",
+        "units.convert([value], unit, su)",
+        "units.convert([value], su, unit)",
+        _t("h38_export_c"),
+        "the header's known input converted the wrong way (deg/h shown as deg/s)",
+    ),
+    Mutant(
+        "report-drift-after-raw",
+        P + "report/build.py",
+        "(main.after_raw, None)",
+        "(main.after_raw, 0.0)",
+        _t("report"),
+        "the after drift angle with nothing removed against a bias-removed before",
+    ),
+    Mutant(
+        "report-no-change-never",
+        P + "report/build.py",
+        "abs(a - b) <= NO_CHANGE_REL",
+        "abs(a - b) < 0.0 * NO_CHANGE_REL",
+        _t("report"),
+        "equal figures shown as a percentage of rounding",
+    ),
+    Mutant(
+        "piecewise-segments-judged-on-the-first",
+        P + "models/piecewise.py",
+        "parts[k].append(x[idx == k])",
+        "parts[k].append(x[idx == 0])",
+        _t("h38_piecewise"),
+        "every segment judged on the first segment's samples",
+    ),
+    Mutant(
+        "piecewise-segment-advice-ignores-breakpoints",
+        P + "models/piecewise.py",
+        "given=self.breakpoints is not None,",
+        "given=False,",
+        _t("h38_piecewise"),
+        "breakpoints given, the refusal advises --segments instead of moving them",
+    ),
+    Mutant(
+        "report-coverage-gap-whole-step",
+        P + "report/analysis.py",
+        "sum(g.length_s - tau0_s for g in gaps)",
+        "sum(g.length_s for g in gaps)",
+        _t("report_calibration"),
+        "a gap counted as the whole step, its last sample interval included",
     ),
 )
 

@@ -184,3 +184,17 @@ def test_a_gap_inside_a_turn_is_refused() -> None:
         calibrate_session(cut["time_s"][keep], cut["accel_mg"][keep], cut["gyro_rad_s"][keep],
                           g_mg=cut["g_mg"], latitude_deg=45.0,
                           sections=parse_poses(secs, keep.size))  # fmt: skip
+
+
+def test_a_turn_on_the_gyro_rails_is_refused() -> None:
+    """A sample of y_rot marked saturated (the gyro on its rails, as ``inspect`` finds
+    it): the turn's rotation is unknown, refused naming the section and the sample."""
+    _tg, cut, secs = _sections_apart(1)
+    sat = np.zeros(cut["time_s"].size, dtype=bool)
+    i = (secs["y_rot"]["start"] + secs["y_rot"]["end"]) // 2
+    sat[i] = True
+    with pytest.raises(ThermocalInputError, match=rf"'y_rot': the gyro sits on its rails at "
+                       rf"sample {i} inside the turn"):  # fmt: skip
+        calibrate_session(cut["time_s"], cut["accel_mg"], cut["gyro_rad_s"], g_mg=cut["g_mg"],
+                          latitude_deg=45.0, sections=parse_poses(secs, sat.size),
+                          saturated=sat)  # fmt: skip

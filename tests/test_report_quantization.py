@@ -85,6 +85,9 @@ def test_quantised_output_shows_its_step(work: Path, capsys: pytest.CaptureFixtu
         r'title="([^"]*)"><span class="num" data-key="allan.before.slope.quant', html
     )
     assert q_cell is not None and "the rate output is quantised (step 0.05" in q_cell.group(1)
+    # issue 38: the bias instability at the curve's minimum is a row of its own, a number
+    for when in ("before", "after"):
+        assert math.isfinite(_value(html, f"allan.{when}.minimum.bias_instability"))
 
 
 def test_unquantised_output_shows_none(work: Path, capsys: pytest.CaptureFixture[str]) -> None:

@@ -123,9 +123,46 @@ def _terms_json(terms: dict[str, Any], method: str) -> dict[str, Any]:
             "label": t.label,
             "quality": t.quality,
             "method": method,
+            "tau_range_s": list(t.tau_range_s) if t.tau_range_s is not None else None,
         }
         for name, t in terms.items()
     }
+
+
+def minimum_json(t: "_allan.NoiseTerm | None") -> dict[str, Any] | None:
+    """``bias_instability_minimum``: the bias instability at the curve's minimum (IEEE 952
+    C.3, σ_min/0.6643), always given: ``value``, ``unit``, ``low``/``high`` (the minimum
+    point's interval / 0.6643), ``tau_s`` (the minimum), ``quality`` (good, rough: poorly
+    defined, poor: at the record's end, an upper bound) and ``reason``."""
+    if t is None:
+        return None
+    return {
+        "value": t.value,
+        "unit": t.unit,
+        "low": t.low,
+        "high": t.high,
+        "tau_s": t.tau_s,
+        "quality": t.quality,
+        "reason": t.reason,
+        "method": "minimum",
+    }
+
+
+def minimum_cell(t: "_allan.NoiseTerm | None") -> str:
+    """The bias instability at the minimum in one table cell: value, unit, τ, quality."""
+    if t is None or t.value is None:
+        return "—"
+    return f"{fmt(t.value)} {t.unit} (τ {fmt(t.tau_s)} s, {t.quality})"
+
+
+def minimum_line(t: "_allan.NoiseTerm | None") -> str | None:
+    """One line for the text output: the bias instability at the minimum and its interval."""
+    if t is None or t.value is None:
+        return None
+    return (
+        f"bias instability at the curve's minimum: {fmt(t.value)} {t.unit} "
+        f"({fmt(t.low)} … {fmt(t.high)}), quality {t.quality}: {t.reason}"
+    )
 
 
 def dynamic_json(dyn: "_allan.DynamicAllan") -> dict[str, Any]:
@@ -185,6 +222,9 @@ def allan_json(
         "fit_reduced_chi2": noise.reduced_chi2,
         "fit_quality": noise.quality.to_dict() if noise.quality is not None else None,
         "output_quantization": quant.to_dict() if quant is not None else None,
+        "bias_instability_minimum": minimum_json(noise.bias_minimum),
+        "shaped_below_s": noise.shaped_below_s,
+        "periodic": [p.to_dict() for p in noise.periodic],
     }
     if dyn is not None:
         out["dynamic"] = dynamic_json(dyn)
@@ -212,8 +252,24 @@ def _emit_channels(
             cells = []
             for _res, noise in analyses.values():
                 tt = noise.fit.terms()[key]
-                cells.append(f"{fmt(tt.value)} {tt.unit}" if tt.value is not None else "—")
+                bm = noise.bias_minimum
+                if tt.value is not None:
+                    cells.append(f"{fmt(tt.value)} {tt.unit}")
+                elif key == "bias_instability" and bm is not None and bm.value is not None:
+                    cells.append(f"{fmt(bm.value)} {bm.unit} (minimum; fit: —)")
+                else:
+                    cells.append("—")
             t.add_row(term.label, *cells)
+            if key == "angle_random_walk":
+                t.add_row(
+                    "  on the −½ stretch",
+                    *[_stretch_cell(n.slope.angle_random_walk) for _r, n in analyses.values()],
+                )
+            elif key == "bias_instability":
+                t.add_row(
+                    "  at the curve's minimum",
+                    *[minimum_cell(n.bias_minimum) for _r, n in analyses.values()],
+                )
         t.add_row(
             "fit quality",
             *[
@@ -225,6 +281,9 @@ def _emit_channels(
         for name, oq in (quants or {}).items():
             if oq is not None:
                 stdout.print(f"{name}: {oq.line()}")
+        for name, (_r, n) in analyses.items():
+            for p in n.periodic:
+                stdout.print(f"{name}: periodic term: {p.words()}")
         if plot is not None:
             stdout.print(f"plots written to {plot.stem}_<channel>{plot.suffix} in {plot.parent}")
 
@@ -238,6 +297,14 @@ def _emit_channels(
         as_json,
         human,
     )
+
+
+def _stretch_cell(t: "_allan.NoiseTerm") -> str:
+    """The angle random walk on the −½ stretch in one cell: value, unit, τ range."""
+    if t.value is None:
+        return "—"
+    rng = f" (τ {fmt(t.tau_range_s[0])}…{fmt(t.tau_range_s[1])} s)" if t.tau_range_s else ""
+    return f"{fmt(t.value)} {t.unit}{rng}"
 
 
 TausOpt = Annotated[
@@ -449,6 +516,8 @@ def _emit_allan(
             f, s = fit[name], slope[name]
             note = "poor fit (see the warning)" if poor else (f.reason or s.reason or "")
             mark = " ?" if poor else ""
+            if name == "angle_random_walk" and s.tau_range_s is not None:
+                note = f"−½ stretch τ {fmt(s.tau_range_s[0])}…{fmt(s.tau_range_s[1])} s; " + note
             t2.add_row(
                 f.label,
                 fmt(f.value) + (mark if f.value is not None else ""),
@@ -456,7 +525,23 @@ def _emit_allan(
                 f.unit,
                 note,
             )
+            bm = noise.bias_minimum
+            if name == "bias_instability" and bm is not None and bm.value is not None:
+                t2.add_row(
+                    "  at the curve's minimum", "", fmt(bm.value), bm.unit,
+                    f"τ = {fmt(bm.tau_s)} s, {bm.quality} (IEEE 952 C.3)",
+                )  # fmt: skip
         stdout.print(t2)
+        line = minimum_line(noise.bias_minimum)
+        if line is not None:
+            stdout.print(line)
+        for p in noise.periodic:
+            stdout.print(f"periodic term: {p.words()}; {100 * (p.share or 0):.3g} % of σ² there")
+        if noise.shaped_below_s is not None:
+            stdout.print(
+                f"τ < {fmt(noise.shaped_below_s)} s lies below the −½ line (the sensor's own "
+                "filter): left out of the noise terms"
+            )
         if noise.quality is not None:
             stdout.print(
                 f"noise-model fit: reduced χ² {noise.quality.reduced_chi2:.3g} on "

@@ -6,10 +6,11 @@ polynomial in T − TREF (:func:`thermocal.turntable.thermal.fit_triad`, the tur
 thermal fit).  Writes a calibration of triads, the file type of ``thermocal turntable``."""
 
 from pathlib import Path
-from typing import TYPE_CHECKING, Annotated
+from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
 
+from thermocal import defaults as _poses
 from thermocal._lazy import LazyModule
 from thermocal.cli.application import app
 from thermocal.cli.common import (
@@ -106,6 +107,53 @@ GyroScaleOpt = Annotated[
     ),
 ]
 StaticOpt = Annotated[float, typer.Option("--static-s", help="Shortest still pose [s].")]
+WindowOpt = Annotated[float, typer.Option("--window-s", help="Pose detector: variance window [s].")]
+StillThresholdOpt = Annotated[
+    float,
+    typer.Option(
+        "--still-threshold",
+        help="Pose detector: still below this many times the sensor's noise variance…",
+    ),
+]
+MotionFractionOpt = Annotated[
+    float,
+    typer.Option(
+        "--motion-fraction",
+        help="…or below this fraction of the motions' variance (hand-held tremor).",
+    ),
+]
+DriftOpt = Annotated[
+    float,
+    typer.Option("--drift-deg", help="Pose detector: a pose turning more than this [°] is moving."),
+]
+AccelOffsetOpt = Annotated[
+    float | None,
+    typer.Option(
+        "--accel-offset",
+        help="Zero of the accelerometer columns in their unit (32768 for unsigned counts).",
+    ),
+]
+GyroOffsetOpt = Annotated[
+    float | None,
+    typer.Option("--gyro-offset", help="Zero of the gyro columns in their unit."),
+]
+
+
+def _explain(out: dict[str, Any]) -> None:
+    """The pose detector's choice, per file: poses found, the still limit and what set
+    it, the stretches rejected and why."""
+    for d in out.get("pose_detection", []):
+        a = d["accel"]
+        stdout.print(
+            f"{d['input']}: {d['n_poses']} poses (window {fmt(d['window_s'], 3)} s, still "
+            f"for ≥ {fmt(d['static_s'], 3)} s below an accelerometer rms of "
+            f"{fmt(a['still_limit_rms'], 3)} {out['unit']}, set by the "
+            + ("noise" if a["limit_set_by"] == "noise" else "motions")
+            + f": noise {', '.join(fmt(v, 3) for v in a['noise_sigma'])}, motions "
+            f"{fmt(a['motion_rms'], 3)}); {len(d['rejected'])} rejected"
+        )
+        for r in d["rejected"]:
+            stdout.print(f"  rejected {r['start']}…{r['end']}: {r['reason']}")
 
 
 @app.command("multipos")
@@ -124,6 +172,12 @@ def multipos_cmd(
     order: OrderOpt = None,
     tref: TrefOpt = None,
     static_s: StaticOpt = 1.0,
+    window_s: WindowOpt = _poses.POSE_WINDOW_S,
+    still_threshold: StillThresholdOpt = _poses.POSE_STILL_THRESHOLD,
+    motion_fraction: MotionFractionOpt = _poses.POSE_MOTION_FRACTION,
+    drift_deg: DriftOpt = _poses.POSE_DRIFT_DEG,
+    accel_offset: AccelOffsetOpt = None,
+    gyro_offset: GyroOffsetOpt = None,
     time: TimeOpt = None,
     time_unit: TimeUnitOpt = None,
     accel_scale: AccelScaleOpt = None,
@@ -142,6 +196,7 @@ def multipos_cmd(
         (gyr_cols[0], gyr_cols[1], gyr_cols[2]) if gyr_cols else None,
         accel_unit, gyro_unit, temps, gravity, latitude, order, tref, static_s, time, time_unit,
         _mpf.count_scale(accel_scale, "accel"), _mpf.count_scale(gyro_scale, "gyro"),
+        window_s, still_threshold, motion_fraction, drift_deg, accel_offset, gyro_offset,
     )  # fmt: skip
     res = _mpf.calibrate_files(files, output, opts, poses)
     out, a_unit = res.summary, res.accel_unit
@@ -177,6 +232,15 @@ def multipos_cmd(
             f"{fmt(out['gravity_residual_rms_before'], 3)} → "
             f"{fmt(out['gravity_residual_rms_after'], 3)} {a_unit}; written {output}"
         )
+        for run in out["runs"]:
+            if run["accel"].get("misfit"):
+                stdout.print(
+                    f"{run['input']}: the poses scatter more than their noise (reduced χ² "
+                    f"{fmt(run['accel']['reduced_chi2'], 3)}): each pose's σ inflated by a "
+                    f"misfit of {fmt(run['accel']['misfit'], 3)} {a_unit}, so that each "
+                    "counts as the misfit says"
+                )
+        _explain(out)
 
     emit(out, as_json, human)
 

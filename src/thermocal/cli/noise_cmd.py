@@ -149,12 +149,22 @@ def noise_cmd(
         fh.write(text + ("" if text.endswith("\n") else "\n"))
 
     table = _rich_table.Table(title=f"{file} — IMU noise model (continuous time)")
-    for col in ("axis", "noise density", "random walk", "unit (density; walk)", "from"):
+    for col in (
+        "axis", "noise density", "random walk", "unit (density; walk)", "from",
+        "bias instability (minimum)",
+    ):  # fmt: skip
         table.add_column(col)
     for ax in res.axes:
+        bm = ax.terms.bias_minimum
+        d = ax.density
+        how = d.method + (
+            f" τ {fmt(d.tau_range_s[0])}…{fmt(d.tau_range_s[1])} s" if d.tau_range_s else ""
+        )
         table.add_row(
-            ax.name, fmt(ax.density.value), fmt(ax.walk.value),
-            f"{ax.density.unit}; {ax.walk.unit}", f"{ax.density.method}; {ax.walk.method}",
+            ax.name, fmt(d.value), fmt(ax.walk.value), f"{d.unit}; {ax.walk.unit}",
+            f"{how}; {ax.walk.method}",
+            "—" if bm is None or bm.value is None
+            else f"{fmt(bm.value)} {bm.unit} (τ {fmt(bm.tau_s)} s, {bm.quality})",
         )  # fmt: skip
     stdout.print(table)
     for ax in res.axes:

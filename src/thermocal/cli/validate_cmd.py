@@ -79,6 +79,13 @@ StageRateOpt = Annotated[
 MinStageOpt = Annotated[
     float, typer.Option("--min-stage", help="Hold detection: shortest stage [s].")
 ]
+StaticSOpt = Annotated[
+    float,
+    typer.Option(
+        "--static-s",
+        help="A multi-position calibration's held-out session: shortest still pose [s].",
+    ),
+]
 SettleOpt = Annotated[
     float, typer.Option("--settle", help="Seconds cut from the start of each stage.")
 ]
@@ -160,12 +167,21 @@ def _human_triads(report: "_validate.ValidationReport") -> None:
     model_file, file, results = report.model_file, report.file, report.triads
     table = _rich_table.Table(title=f"{model_file} on {file}")
     for col in ("triad", "figure", "x before → after", "y before → after", "z before → after"):
-        table.add_column(col)
+        table.add_column(col, overflow="fold")  # wrapped, never cut
     for r in results:
         for label, before, after in r.rows():
             cells = [f"{fmt(b)} → {fmt(a)}" for b, a in zip(before, after, strict=True)]
             table.add_row(r.triad, label, *cells)
     stdout.print(table)
+    for r in results:
+        scale = getattr(r, "count_scale", None)
+        if scale is not None:
+            stdout.print(
+                f"{r.triad}: read from raw counts, one count = {scale:.10g} {r.physical_unit} (the "
+                "calibration's count scale, as compensate applies it)"
+            )
+    for note in dict.fromkeys(r.not_judged for r in results if getattr(r, "not_judged", "")):
+        stdout.print(f"not judged: {note}")
 
 
 @app.command("validate")
@@ -193,6 +209,7 @@ def validate_cmd(
     decimal: DecimalOpt = None,
     topic: TopicOpt = None,
     latitude: TurntableLatitudeOpt = None,
+    static_s: StaticSOpt = 1.0,
     as_json: JsonOpt = False,
 ) -> None:
     """Validate MODEL on FILE: correlation r, bias stability and repeatability over the

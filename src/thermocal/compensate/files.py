@@ -1258,36 +1258,18 @@ class _TriadPlan:
     n_outside: int = 0
 
     def calibrated_unit(self) -> str:
-        """The unit of the columns the triad was calibrated on: raw counts for a triad with
-        a count scale, else its unit (the unit of a column that states none)."""
-        return "counts" if getattr(self.tri, "count_scale", None) is not None else self.tri.unit
+        """The unit of the columns the triad was calibrated on (:meth:`Triad.calibrated_unit
+        <thermocal.models.calibration.Triad.calibrated_unit>`)."""
+        return str(self.tri.calibrated_unit())
 
     def resolve(self, resolved: units.ResolvedInputs, src: Path) -> None:
         """The data unit of the triad's columns (one for all three), the unit of their
         ``_comp`` columns (the data's, or the triad's for raw counts with a count scale)
-        and the factor from its bias unit (°/h or mg) to the latter."""
-        tri = self.tri
-        data_units = {resolved.signals[c].unit for c in self.columns}
-        if len(data_units) != 1:
-            raise ThermocalInputError(f"{src}: the {tri.name} triad's columns differ in unit")
-        self.data_unit = self.out_unit = data_units.pop()
-        scale = getattr(tri, "count_scale", None)
-        if self.data_unit == "counts" and scale is not None:
-            self.out_unit, self.count_scale = tri.unit, float(scale)
-        elif self.data_unit == "counts":
-            raise UnitError(
-                f"{src}: the {tri.name} triad's columns are raw counts, and the calibration "
-                f"states no count scale (it was calibrated on {tri.unit} data): convert the "
-                f"columns to {tri.unit}, or calibrate the counts with multipos "
-                f"--{tri.model.kind}-scale VALUE,UNIT"
-            )
-        elif units.canonical_unit(self.data_unit) != units.canonical_unit(tri.unit):
-            raise UnitError(
-                f"{src}: the {tri.name} triad was calibrated on {tri.unit} data; these columns "
-                f"are in {self.data_unit}"
-            )
-        bias_unit = "deg/h" if tri.model.kind == "gyro" else "mg"
-        self.to_data = float(units.convert(np.array([1.0]), bias_unit, self.out_unit)[0])
+        and the factor from its bias unit (°/h or mg) to the latter (:meth:`Triad.input_in
+        <thermocal.models.calibration.Triad.input_in>`, shared with ``validate``)."""
+        inp = self.tri.input_in([resolved.signals[c].unit for c in self.columns], str(src))
+        self.data_unit, self.out_unit = inp.data_unit, inp.unit
+        self.count_scale, self.to_data = inp.count_scale, inp.to_data
 
     def correct(
         self,

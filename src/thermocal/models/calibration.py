@@ -26,9 +26,11 @@ from __future__ import annotations
 
 import datetime as _dt
 import math
-from collections.abc import Sequence
+from collections.abc import Collection, Sequence
 from dataclasses import dataclass, field
 from typing import Any
+
+import numpy as np
 
 from thermocal.errors import ModelFileError, ThermocalInputError
 from thermocal.models.base import (
@@ -109,6 +111,71 @@ class Triad:
     physical unit the parameters and the compensated columns are in.  Compensation converts
     raw-count columns first, ``x [unit] = count_scale · N``; None: the triad was calibrated on
     data in ``unit`` (files of format version 1 have no such key)."""
+
+    def calibrated_unit(self) -> str:
+        """The unit of the columns the triad was calibrated on: raw counts for a triad with
+        a count scale, else its unit (the unit of a column that states none)."""
+        return "counts" if self.count_scale is not None else self.unit
+
+    def input_in(self, data_units: Collection[str], where: str) -> TriadInput:
+        """How this triad's columns, read in ``data_units`` (one unit for the three), enter
+        its model: raw counts of a triad with a count scale become ``count_scale · N`` in
+        ``unit``; data in ``unit``'s kind are taken as they are.  The one path shared by
+        ``compensate`` and ``validate`` (and the report).
+
+        Raises
+        ------
+        UnitError
+            The columns differ in unit, are raw counts the triad has no count scale for,
+            or are of another kind than the triad's unit (exit status 2).
+        """
+        from thermocal import units
+        from thermocal.errors import UnitError
+
+        found = set(data_units)
+        if len(found) != 1:
+            raise UnitError(f"{where}: the {self.name} triad's columns differ in unit")
+        data_unit = found.pop()
+        out_unit, scale = data_unit, None
+        if data_unit == "counts" and self.count_scale is not None:
+            out_unit, scale = self.unit, float(self.count_scale)
+        elif data_unit == "counts":
+            raise UnitError(
+                f"{where}: the {self.name} triad's columns are raw counts, and the calibration "
+                f"states no count scale (it was calibrated on {self.unit} data): convert the "
+                f"columns to {self.unit}, or calibrate the counts with multipos "
+                f"--{self.model.kind}-scale VALUE,UNIT"
+            )
+        elif units.canonical_unit(data_unit) != units.canonical_unit(self.unit):
+            raise UnitError(
+                f"{where}: the {self.name} triad was calibrated on {self.unit} data; these "
+                f"columns are in {data_unit}"
+            )
+        bias_unit = "deg/h" if self.model.kind == "gyro" else "mg"
+        to_data = float(units.convert(np.array([1.0]), bias_unit, out_unit)[0])
+        return TriadInput(data_unit, out_unit, scale, to_data)
+
+
+@dataclass(frozen=True)
+class TriadInput:
+    """A triad's columns as its model takes them (:meth:`Triad.input_in`): the unit they were
+    read in (``data_unit``), the physical ``unit`` of their values and of the compensated
+    output, the ``count_scale`` applied to raw counts (one count is ``count_scale`` ``unit``;
+    None for columns already in a physical unit) and ``to_data``, the factor from the
+    model's bias unit (°/h for a gyro, mg for an accelerometer) to ``unit``."""
+
+    data_unit: str
+    unit: str
+    count_scale: float | None
+    to_data: float
+
+    def physical(self, x: Any) -> Any:
+        """The values ``x`` (raw counts or already physical) in ``unit``:
+        ``x_phys = count_scale · N`` for raw counts, else ``x`` unchanged."""
+        if self.count_scale is None:
+            return x
+        with np.errstate(over="ignore"):  # an overflow is refused by the caller
+            return x * self.count_scale
 
 
 @dataclass

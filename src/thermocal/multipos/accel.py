@@ -12,9 +12,17 @@ of a lower-triangular ``E`` (the accelerometer frame, package docstring) — min
 (scipy.optimize.least_squares, trust-region reflective, from ``p = 0``).  ``σ_k`` is the
 noise of the pose mean along gravity: the white-noise variance of the pose's samples
 (from first differences, ``var(Δx)/2``, which a slow tremor hardly touches) over its
-sample count.  Covariance ``(JᵀJ)⁻¹`` at the solution (J of the weighted residuals), scaled
-by the reduced χ² when that exceeds its 3-σ range ``1 + 3·√(2/(m − 9))`` (the poses scatter
-more than their noise says: tremor, coloured noise, a model that does not fit).
+sample count.
+
+**A misfit sensor.**  When the reduced χ² exceeds its 3-σ range ``1 + 3·√(2/(m − 9))``
+(the poses scatter more than their noise says: tremor, coloured noise, a model that does
+not fit), the white-noise weights would let the longest poses pull the fit.  Each pose's
+σ is then inflated by a misfit ``τ`` common to all poses, ``σ_k² → σ_k² + τ²``, with ``τ``
+such that the reduced χ² of the refitted poses is 1 (the additive-variance estimate of a
+random-effects fit, e.g. Paule & Mandel, J. Res. NBS 87 (1982) 377), repeated to a fixed
+point: when ``τ ≫ σ_k`` every pose counts alike (imu_tk's unweighted cost).
+Covariance ``(JᵀJ)⁻¹`` at the solution (J of the weighted residuals); ``reduced_chi2``
+is the one with the white-noise weights, ``misfit_mg`` the ``τ`` added.
 
 **Six faces** (closed form): with gravity along ±each body axis,
 ``f_{j±} = ±g (I + E) e_j + b``, so ``b = Σ_faces f / 6`` and the column ``j`` of ``I + E``
@@ -60,6 +68,8 @@ class AccelFit:
     n_poses: int
     residuals_mg: tuple[float, ...]
     """Each pose's gravity-magnitude error after calibration [mg]."""
+    misfit_mg: float = 0.0
+    """The misfit τ added in quadrature to each pose's σ [mg] (0: the white-noise weights)."""
 
     @property
     def sigma(self) -> FloatArray:
@@ -116,15 +126,13 @@ def check_poses(f_mg: FloatArray) -> None:
         )
 
 
-def fit_gravity_magnitude(f_mg: npt.ArrayLike, sigma_mg: npt.ArrayLike, g_mg: float) -> AccelFit:
-    """The nine parameters from the pose means ``f_mg`` (m, 3) [mg] with their noise along
-    gravity ``sigma_mg`` (m,) [mg] and local gravity ``g_mg`` [mg] (module docstring)."""
-    from scipy.optimize import least_squares
+MISFIT_ITERATIONS: Final = 20
+"""Refits at most, while the misfit τ moves by more than 10⁻⁶ of itself."""
 
-    f = np.asarray(f_mg, dtype=np.float64)
-    sg = np.asarray(sigma_mg, dtype=np.float64)
-    m = f.shape[0]
-    check_poses(f)
+
+def _solve(f: FloatArray, sg: FloatArray, g_mg: float, p0: FloatArray) -> Any:
+    """Least squares of the weighted gravity-magnitude residuals (module docstring)."""
+    from scipy.optimize import least_squares
 
     def resid(p: FloatArray) -> FloatArray:
         b, e = _unpack(p)
@@ -132,8 +140,55 @@ def fit_gravity_magnitude(f_mg: npt.ArrayLike, sigma_mg: npt.ArrayLike, g_mg: fl
         out: FloatArray = (np.linalg.norm(c, axis=1) - g_mg) / sg
         return out
 
-    sol = least_squares(resid, np.zeros(9), method="trf", x_scale="jac", xtol=1e-12,
-                        ftol=1e-12, gtol=1e-12)  # fmt: skip
+    return least_squares(resid, p0, method="trf", x_scale="jac", xtol=1e-12, ftol=1e-12,
+                         gtol=1e-12)  # fmt: skip
+
+
+def misfit_tau(r_mg: FloatArray, sigma_mg: FloatArray, dof: int) -> float:
+    """``τ ≥ 0`` [mg] with ``Σ r_k²/(σ_k² + τ²) = dof`` (0 when already below): the root of
+    a decreasing function, by bisection on ``τ²`` in ``[0, Σ r²/dof]``."""
+    r2 = r_mg**2
+    s2 = sigma_mg**2
+
+    def h(t2: float) -> float:
+        return float(np.sum(r2 / (s2 + t2))) - dof
+
+    if dof <= 0 or h(0.0) <= 0:
+        return 0.0
+    lo, hi = 0.0, float(r2.sum()) / dof
+    for _ in range(200):
+        mid = 0.5 * (lo + hi)
+        if h(mid) > 0:
+            lo = mid
+        else:
+            hi = mid
+        if hi - lo <= 1e-12 * hi:
+            break
+    return math.sqrt(0.5 * (lo + hi))
+
+
+def fit_gravity_magnitude(f_mg: npt.ArrayLike, sigma_mg: npt.ArrayLike, g_mg: float) -> AccelFit:
+    """The nine parameters from the pose means ``f_mg`` (m, 3) [mg] with their noise along
+    gravity ``sigma_mg`` (m,) [mg] and local gravity ``g_mg`` [mg] (module docstring)."""
+    f = np.asarray(f_mg, dtype=np.float64)
+    sg0 = np.asarray(sigma_mg, dtype=np.float64)
+    m = f.shape[0]
+    check_poses(f)
+    dof = m - 9
+    sol = _solve(f, sg0, g_mg, np.zeros(9))
+    r0 = np.asarray(sol.fun)
+    chi2 = float(r0 @ r0) / dof if dof > 0 else float("nan")
+    tau = 0.0
+    sg = sg0
+    if dof > 0 and chi2 > 1.0 + 3.0 * math.sqrt(2.0 / dof):
+        for _ in range(MISFIT_ITERATIONS):
+            new = misfit_tau(np.asarray(sol.fun) * sg, sg0, dof)
+            sg = np.sqrt(sg0**2 + new**2)
+            sol = _solve(f, sg, g_mg, sol.x)
+            done = abs(new - tau) <= 1e-6 * new
+            tau = new
+            if done:
+                break
     jac = np.asarray(sol.jac)
     _u, s_, vt = np.linalg.svd(jac, full_matrices=False)
     if not s_[-1] > 1e-10 * s_[0]:
@@ -143,10 +198,6 @@ def fit_gravity_magnitude(f_mg: npt.ArrayLike, sigma_mg: npt.ArrayLike, g_mg: fl
         )
     cov_p = (vt.T / s_**2) @ vt
     r = np.asarray(sol.fun)
-    dof = m - 9
-    chi2 = float(r @ r) / dof if dof > 0 else float("nan")
-    if dof > 0 and chi2 > 1.0 + 3.0 * math.sqrt(2.0 / dof):
-        cov_p = cov_p * chi2
     theta = np.zeros(12)
     cov = np.zeros((12, 12))
     idx = np.array(FREE_INDEX)
@@ -163,6 +214,7 @@ def fit_gravity_magnitude(f_mg: npt.ArrayLike, sigma_mg: npt.ArrayLike, g_mg: fl
         "gravity-magnitude",
         m,
         tuple(float(v) for v in after),
+        tau,
     )
 
 
@@ -221,8 +273,10 @@ def to_dict(fit: AccelFit) -> dict[str, Any]:
 
 __all__ = [
     "FREE_INDEX",
+    "MISFIT_ITERATIONS",
     "AccelFit",
     "check_poses",
     "fit_gravity_magnitude",
     "fit_six_faces",
+    "misfit_tau",
 ]

@@ -174,6 +174,7 @@ def _named_turns(
     face_sigma_rad: dict[str, float],
     where: str,
     sections_from: str,
+    saturated: npt.NDArray[np.bool_] | None = None,
 ) -> list[_gyro.Turn]:
     """Each named turn about the sensor axis of its name (``x_rot``: x), judged first
     (:func:`.gyro.check_turn`), with the calibrated up direction during it and the
@@ -195,6 +196,13 @@ def _named_turns(
                 f"{where} {tr.name!r}: a gap in time of {gap[1]:.3g} s after sample {gap[0]} "
                 "inside the turn: the rotation across it is unknown; fix its start and end "
                 f"in {sections_from}, or record the turn again"
+            )
+        if saturated is not None and np.any(saturated[tr.start : tr.end]):
+            i = tr.start + int(np.argmax(saturated[tr.start : tr.end]))
+            raise ThermocalInputError(
+                f"{where} {tr.name!r}: the gyro sits on its rails at sample {i} inside the "
+                "turn: the rotation is unknown; turn more slowly (or at a wider gyro range) "
+                f"and record it again, or leave the turn out of {sections_from}"
             )
         rot = _gyro.turn_rotation(rate_rad_s, dt_s, bias_rad_s, tr)
         _gyro.check_turn(rot, tr.name, j, f"{where} {tr.name!r}", sections_from)
@@ -279,12 +287,14 @@ def calibrate_session(
     static_s: float = 1.0,
     temperature_c: npt.ArrayLike | None = None,
     where: str = "session",
+    saturated: npt.ArrayLike | None = None,
     sections_from: str = "the POSES file",
 ) -> SessionResult:
     """Calibrate the accelerometer (and gyro) triad of one session (module docstring).
     ``accel_mg`` (n, 3) [mg], ``gyro_rad_s`` (n, 3) [rad/s] or None, ``g_mg`` local
     gravity [mg]; ``sections`` from a POSES file (named ``sections_from`` in messages),
-    else found from the data."""
+    else found from the data; ``saturated`` (n,) the samples with a gyro axis on its rails
+    (their motions left out of the gyro fit, a turn holding one refused)."""
     t = np.asarray(time_s, dtype=np.float64)
     a = np.asarray(accel_mg, dtype=np.float64)
     w = None if gyro_rad_s is None else np.asarray(gyro_rad_s, dtype=np.float64)
@@ -337,11 +347,13 @@ def calibrate_session(
         dt = np.diff(t)
         dt = np.concatenate([dt, dt[-1:]])
         dir_sig = _direction_sigma(sig, names, acc.method, g_mg)
+        sat = None if saturated is None else np.asarray(saturated, dtype=bool)
         named = _named_turns(turns, w, dt, bias, a, acc, dict(zip(names, dir_sig, strict=True)),
-                             f"{where}: section", sections_from)  # fmt: skip
+                             f"{where}: section", sections_from, sat)  # fmt: skip
         gfit = _gyro.fit_rotations(
             w, dt, [p.section for p in stats], up_of, free, free_cov, bias, bias_cov,
             dir_sig, float(np.sqrt(np.mean(ws**2))), named, latitude_deg=latitude_deg,
+            saturated=sat,
         )  # fmt: skip
         _warn_implausible(gfit, where)
     return SessionResult(acc, gfit, tuple(stats), tuple(turns), g_mg, temp, not_still)
@@ -366,6 +378,15 @@ class MultiposValidation:
     """Accelerometer: per pose (start, end, u_x, u_y, u_z, error before, error after): the
     compensated gravity direction (unit, body axes) and the gravity-magnitude errors
     [``unit``], for the report's poses on the sphere (not in ``to_dict``)."""
+    not_judged: str = ""
+    """What these figures cannot judge (a validation on one still pose), else empty."""
+    input_unit: str = ""
+    """The unit the triad's columns were read in (``counts`` for raw counts)."""
+    count_scale: float | None = None
+    """Raw counts: one count is ``count_scale`` ``physical_unit`` (the calibration's), as
+    ``compensate`` applies it; None for columns already in a physical unit."""
+    physical_unit: str = ""
+    """The triad's own unit, the one its columns are judged in."""
 
     def to_dict(self) -> dict[str, Any]:
         from dataclasses import asdict
@@ -376,8 +397,9 @@ class MultiposValidation:
 
     def rows(self) -> list[tuple[str, tuple[float, ...], tuple[float, ...]]]:
         return [
-            (f"{self.what} rms [{self.unit}] (total {self.rms_before:.4g} → "
-             f"{self.rms_after:.4g})", self.per_axis_before, self.per_axis_after)
+            (f"{self.what}{' rms' if self.n > 1 else ''} [{self.unit}] (total "
+             f"{self.rms_before:.4g} → {self.rms_after:.4g})", self.per_axis_before,
+             self.per_axis_after)
         ]  # fmt: skip
 
 

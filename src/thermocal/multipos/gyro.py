@@ -304,6 +304,15 @@ def _motions(
     return motions
 
 
+def unsaturated(motions: list[_Motion], saturated: npt.NDArray[np.bool_] | None) -> list[_Motion]:
+    """The motions with no sample on the gyro's rails between pose k's start and pose
+    k+1's end (``saturated`` per sample, None: none): the rotation across a clipped rate is
+    unknown, as across a gap in time."""
+    if saturated is None:
+        return motions
+    return [m for m in motions if not np.any(saturated[m.start : m.stop])]
+
+
 @dataclass(frozen=True, eq=False)
 class _Rotations:
     """The whitened residuals of the rotation fit (module docstring) and their Jacobians."""
@@ -546,6 +555,7 @@ def fit_rotations(
     *,
     latitude_deg: float | None = None,
     max_iter: int = 8,
+    saturated: npt.NDArray[np.bool_] | None = None,
 ) -> GyroFit:
     """``E_g`` from the motions between consecutive ``poses`` (module docstring).
 
@@ -557,6 +567,7 @@ def fit_rotations(
     dt_med = float(np.median(dt_s))
     up = up_of(accel_free)
     motions = _motions(dt_s, poses, dt_med, dir_sigma_rad, rate_sigma_rad_s, latitude_deg)
+    motions = unsaturated(motions, saturated)
     rot = _Rotations(rate_rad_s, dt_s, dt_med, motions, turns, rate_sigma_rad_s,
                      latitude_deg)  # fmt: skip
     three_turns = {tn.axis for tn in turns} == {0, 1, 2}

@@ -8,12 +8,21 @@ the accelerometer triad, which gives the up directions): per motion between cons
 poses, the rotation-angle error ``|u_{k+1} × A_{k+1}ᵀ A_k⁻ᵀ u_k|`` [°] (:func:`.calibrate.
 rotation_errors`) with raw data before and compensated data after.  ``g`` is the one the
 calibration recorded (else normal gravity at the latitude).
+
+The triads' columns enter as ``compensate`` takes them (:func:`triad_columns`): raw counts
+of a triad calibrated on counts through its count scale, so the figures are in the
+calibration's units.  A session of ONE still pose is judged on what it can show: the
+gravity-magnitude error of that pose and the gyro's mean rate at rest before and after
+[gyro unit] (per axis the signed mean; its magnitude as the total), which holds the earth
+rate in a direction one pose does not give; ``not_judged`` says what needs motions or other
+directions.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import math
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from typing import Any
 
 import numpy as np
@@ -29,11 +38,32 @@ from thermocal.multipos.calibrate import (
 from thermocal.multipos.poses import detect_poses
 
 
-def _columns(rec: Any, tri: Any) -> tuple[Any, str]:
-    x = np.column_stack([rec.column(c) for c in tri.columns])
-    found = {rec.units.get(c) or tri.unit for c in tri.columns}
-    unit = found.pop() if len(found) == 1 else tri.unit
-    return x, unit
+def triad_columns(
+    rec: Any, tri: Any, unit_options: Mapping[str, str | None] | None = None
+) -> tuple[Any, Any]:
+    """A triad's three columns of ``rec`` in the physical unit its model takes, and how
+    (:class:`~thermocal.models.calibration.TriadInput`).  Each column's unit is resolved as
+    ``compensate`` resolves it (:func:`thermocal.units.resolve_unit`: ``unit_options`` (column
+    → the ``--signal-unit`` option's unit, :func:`thermocal.units.per_signal_option`) > the
+    file's metadata or column name > the unit the triad was calibrated on, raw counts for a
+    triad with a count scale), and raw counts become ``count_scale · N`` (:meth:`Triad.input_in
+    <thermocal.models.calibration.Triad.input_in>`, the path ``compensate`` takes)."""
+    opts = unit_options or {}
+    found = [
+        units.resolve_unit(
+            c, "signal", option=opts.get(c), metadata=rec.units.get(c) or None,
+            model=tri.calibrated_unit(), where=rec.name,
+        ).unit
+        for c in tri.columns
+    ]  # fmt: skip
+    inp = tri.input_in(found, rec.name)
+    x = inp.physical(np.column_stack([rec.column(c) for c in tri.columns]).astype(np.float64))
+    if not np.all(np.isfinite(x)):
+        raise ThermocalInputError(
+            f"{rec.name}: the {tri.name} triad's columns are not finite in {inp.unit} "
+            "(a count scale that overflows, or missing values)"
+        )
+    return x, inp
 
 
 def validate_triads(
@@ -42,10 +72,17 @@ def validate_triads(
     latitude_deg: float | None = None,
     *,
     static_s: float = 1.0,
+    signal_unit: str | None = None,
 ) -> list[MultiposValidation]:
-    """Held-out figures of each triad (module docstring)."""
+    """Held-out figures of each triad (module docstring); ``signal_unit`` (``--signal-unit``):
+    one unit for every triad column, or one per column in the triads' order, as
+    ``compensate`` takes it."""
     from thermocal.turntable import thermal
 
+    if not (math.isfinite(static_s) and static_s > 0):
+        raise ThermocalInputError(
+            f"{rec.name}: --static-s must be a positive number of seconds, got {static_s!r}"
+        )
     by = {t.model.kind: t for t in triads}
     acc = by.get("accel")
     if acc is None:
@@ -62,6 +99,7 @@ def validate_triads(
             raise ThermocalInputError(f"{rec.name}: give the latitude (--latitude DEG)")
         g_m_s2 = units.normal_gravity_m_s2(float(lat))
     t = rec.time_s
+    unit_opts = units.per_signal_option(signal_unit, [c for tr in triads for c in tr.columns])
 
     def temp_of(tri: Any) -> Any:
         if tri.temperature:
@@ -71,25 +109,70 @@ def validate_triads(
     def outside(tri: Any, temp: Any) -> float:
         return float(np.mean((temp < tri.model.t_lo_c) | (temp > tri.model.t_hi_c)))
 
-    xa, a_unit = _columns(rec, acc)
+    xa, a_in = triad_columns(rec, acc, unit_opts)
+    a_unit = a_in.unit
     ta = temp_of(acc)
-    a_to = float(units.convert(np.array([1.0]), "mg", a_unit)[0])
-    xa_c = thermal.correct(acc.model, xa, ta, a_to)
+    xa_c = thermal.correct(acc.model, xa, ta, a_in.to_data)
     gyr = by.get("gyro")
     xg = xg_c = None
     if gyr is not None:
-        xg, g_unit = _columns(rec, gyr)
+        xg, g_in = triad_columns(rec, gyr, unit_opts)
+        g_unit = g_in.unit
         tg = temp_of(gyr)
-        g_to = float(units.convert(np.array([1.0]), "deg/h", g_unit)[0])
-        xg_c = thermal.correct(gyr.model, xg, tg, g_to)
+        xg_c = thermal.correct(gyr.model, xg, tg, g_in.to_data)
         xg = units.convert(xg, g_unit, "rad/s")
         xg_c = units.convert(xg_c, g_unit, "rad/s")
     sections = detect_poses(t, xa, xg, static_s=static_s)
-    if len(sections) < 2:
+    if not sections:
         raise ThermocalInputError(
-            f"{rec.name}: {len(sections)} still poses found: not a multi-position session"
+            f"{rec.name}: no still pose of {static_s:g} s or longer found: nothing to judge "
+            "the calibration on (record the sensor still; thermocal validate --static-s "
+            "sets the shortest pose)"
         )
     g = float(units.convert(np.array([g_m_s2]), "m/s^2", a_unit)[0])
+    out = [_accel_figures(acc.name, a_unit, xa, xa_c, sections, g, outside(acc, ta))]
+    out = _with_input(out, a_in)
+    if gyr is None or xg is None or xg_c is None:
+        if len(sections) == 1:
+            out[0] = dataclasses.replace(out[0], not_judged=ONE_POSE_ACCEL_NOT_JUDGED)
+        return out
+    if len(sections) == 1:
+        out[0] = dataclasses.replace(out[0], not_judged=ONE_POSE_NOT_JUDGED)
+        return [*out, _rate_at_rest(gyr.name, xg, xg_c, sections[0], g_in,
+                                    outside(gyr, temp_of(gyr)))]  # fmt: skip
+    dt = np.diff(t)
+    dt = np.concatenate([dt, dt[-1:]])
+    vb = rotation_errors(xg, dt, xa, sections) * units.RAD_TO_DEG
+    va = rotation_errors(xg_c, dt, xa_c, sections) * units.RAD_TO_DEG
+    nb, na = np.linalg.norm(vb, axis=1), np.linalg.norm(va, axis=1)
+    out.append(
+        MultiposValidation(
+            gyr.name, "deg", float(math.sqrt(np.mean(nb**2))), float(math.sqrt(np.mean(na**2))),
+            _rms3(vb), _rms3(va), len(nb), "rotation-angle error", outside(gyr, temp_of(gyr)),
+            input_unit=g_in.data_unit, count_scale=g_in.count_scale, physical_unit=g_in.unit,
+        )
+    )  # fmt: skip
+    return out
+
+
+ONE_POSE_ACCEL_NOT_JUDGED = (
+    "one still pose: not judged are the accelerometer's scale factors and misalignments "
+    "beyond this one direction (they need poses in several directions)"
+)
+ONE_POSE_NOT_JUDGED = (
+    "one still pose: not judged are the gyro's scale factors and misalignments (the "
+    "rotation-angle error needs motions between poses) and the accelerometer's scale factors "
+    "and misalignments beyond this one direction (they need poses in several directions)"
+)
+"""What a validation on one static pose cannot judge (said beside its figures; the first
+for an accelerometer triad alone)."""
+
+
+def _accel_figures(
+    name: str, unit: str, xa: Any, xa_c: Any, sections: Sequence[Any], g: float, out: float
+) -> MultiposValidation:
+    """The accelerometer's gravity-magnitude errors ``|mean f| − g`` per pose, before and
+    after, rms over the poses [``unit``], and each pose's up direction."""
     eb, ea, pb, pa = gravity_errors(xa, xa_c, sections, g)
     means = np.asarray([xa_c[s.start : s.end].mean(axis=0) for s in sections])
     up = means / np.linalg.norm(means, axis=1)[:, None]
@@ -97,40 +180,43 @@ def validate_triads(
         (float(s.start), float(s.end), *(float(v) for v in u), float(b), float(a))
         for s, u, b, a in zip(sections, up, eb, ea, strict=True)
     )
-    out = [
-        MultiposValidation(
-            acc.name,
-            a_unit,
-            float(np.sqrt(np.mean(eb**2))),
-            float(np.sqrt(np.mean(ea**2))),
-            _rms3(pb),
-            _rms3(pa),
-            len(sections),
-            "gravity-magnitude error",
-            outside(acc, ta),
-            per_pose,
+    return MultiposValidation(
+        name, unit, float(np.sqrt(np.mean(eb**2))), float(np.sqrt(np.mean(ea**2))),
+        _rms3(pb), _rms3(pa), len(sections), "gravity-magnitude error", out, per_pose,
+    )  # fmt: skip
+
+
+def _rate_at_rest(
+    name: str, xg: Any, xg_c: Any, pose: Any, g_in: Any, out: float
+) -> MultiposValidation:
+    """The gyro on one still pose: its mean rate before (raw) and after compensation, per
+    axis (signed) and in magnitude, in the triad's unit ``g_in.unit`` (``xg``, ``xg_c`` in
+    rad/s); the earth rate it holds, named in ``not_judged``."""
+    unit = g_in.unit
+    mb = units.convert(xg[pose.start : pose.end].mean(axis=0), "rad/s", unit)
+    ma = units.convert(xg_c[pose.start : pose.end].mean(axis=0), "rad/s", unit)
+    earth = float(units.convert(np.array([units.EARTH_RATE_RAD_S]), "rad/s", unit)[0])
+    note = (f"the mean rate at rest holds the earth rate, |Ω| = {earth:.4g} {unit}, in a "
+            "direction one pose does not give")  # fmt: skip
+    return MultiposValidation(
+        name, unit, float(np.linalg.norm(mb)), float(np.linalg.norm(ma)), _vec3(mb), _vec3(ma),
+        1, "mean rate at rest", out, not_judged=note, input_unit=g_in.data_unit,
+        count_scale=g_in.count_scale, physical_unit=unit,
+    )  # fmt: skip
+
+
+def _with_input(out: list[MultiposValidation], inp: Any) -> list[MultiposValidation]:
+    """The accelerometer's figures with the unit its columns were read in and the count
+    scale applied (:class:`~thermocal.models.calibration.TriadInput`)."""
+    return [
+        dataclasses.replace(
+            out[0], input_unit=inp.data_unit, count_scale=inp.count_scale, physical_unit=inp.unit
         )
     ]
-    if gyr is not None and xg is not None and xg_c is not None:
-        dt = np.diff(t)
-        dt = np.concatenate([dt, dt[-1:]])
-        vb = rotation_errors(xg, dt, xa, sections) * units.RAD_TO_DEG
-        va = rotation_errors(xg_c, dt, xa_c, sections) * units.RAD_TO_DEG
-        nb, na = np.linalg.norm(vb, axis=1), np.linalg.norm(va, axis=1)
-        out.append(
-            MultiposValidation(
-                gyr.name,
-                "deg",
-                float(math.sqrt(np.mean(nb**2))),
-                float(math.sqrt(np.mean(na**2))),
-                _rms3(vb),
-                _rms3(va),
-                len(nb),
-                "rotation-angle error",
-                outside(gyr, temp_of(gyr)),
-            )
-        )
-    return out
+
+
+def _vec3(v: Any) -> tuple[float, float, float]:
+    return (float(v[0]), float(v[1]), float(v[2]))
 
 
 def _rms3(v: Any) -> tuple[float, float, float]:

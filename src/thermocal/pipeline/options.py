@@ -102,6 +102,7 @@ class ValidateOptions:
     decimal: str | None = None
     topic: str | None = None
     latitude: float | None = None
+    static_s: float = 1.0
 
 
 ALIASES: dict[str, dict[str, str]] = {

@@ -271,7 +271,9 @@ def _validate_triads(
         topic=o.topic,
     )
     if _mp_validate.is_multipos(cal.triads):  # held-out poses (issue 30)
-        results: list[Any] = _mp_validate.validate_triads(cal.triads, rec, o.latitude)
+        results: list[Any] = _mp_validate.validate_triads(
+            cal.triads, rec, o.latitude, static_s=o.static_s, signal_unit=o.signal_unit
+        )
     else:
         results = validate_triads(cal.triads, rec, o.latitude)
     for r in results:

@@ -7,6 +7,7 @@ Plotting stays at the edge: matplotlib (Agg backend) is imported inside
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -22,7 +23,9 @@ def plot_allan(
     title: str | None = None,
 ) -> Path:
     """Write a PNG: σ(τ) with its confidence bars, the fitted model and each
-    significant fitted term (IEEE 952 slope lines).  Written atomically."""
+    significant fitted term (IEEE 952 slope lines), the −½ stretch's line over the τ it was
+    fitted on and the curve's minimum (bias instability, IEEE 952 C.3).  Written
+    atomically."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -54,6 +57,7 @@ def plot_allan(
                     lw=0.9,
                     label=f"{term.label}: {term.value:.4g} {term.unit}",
                 )
+            _mark_readings(ax, result, noise)
         ax.set_xscale("log")
         ax.set_yscale("log")
         ax.set_xlabel("averaging time τ [s]")
@@ -74,6 +78,37 @@ def plot_allan(
     finally:
         plt.close(fig)
     return out
+
+
+def _mark_readings(ax: Any, result: AllanResult, noise: NoiseTerms) -> None:
+    """The −½ stretch's line N/√τ (N in the data's √s unit: σ at τ = 1 s) over its τ range,
+    and the minimum's point, on the axes ``ax``."""
+    arw = noise.slope.angle_random_walk
+    if arw.tau_range_s is not None and arw.value is not None:
+        lo, hi = arw.tau_range_s
+        ok = (result.tau_s >= lo) & (result.tau_s <= hi) & (result.adev > 0)
+        if ok.any():  # the line through the stretch's points, in the ADEV's own unit
+            c = float(np.exp(np.mean(np.log(result.adev[ok] * np.sqrt(result.tau_s[ok])))))
+            tt = np.geomspace(lo, hi, 20)
+            ax.plot(
+                tt,
+                c / np.sqrt(tt),
+                "-",
+                lw=3.0,
+                alpha=0.4,
+                label=f"−½ stretch τ {lo:.3g}…{hi:.3g} s: N = {arw.value:.4g} {arw.unit}",
+            )
+    bm = noise.bias_minimum
+    if bm is not None and bm.value is not None and bm.tau_s is not None:
+        k = int(np.argmin(np.abs(result.tau_s - bm.tau_s)))
+        ax.plot(
+            [bm.tau_s],
+            [result.adev[k]],
+            "v",
+            ms=9,
+            mfc="none",
+            label=f"minimum: B = {bm.value:.4g} {bm.unit} ({bm.quality})",
+        )
 
 
 def plot_dynamic(dyn: DynamicAllan, path: str | Path, *, title: str | None = None) -> Path:

@@ -170,7 +170,16 @@ def make_report(
             "thermocal allan --dynamic on each channel)"
         )
     if cal.triads and not cal.channels:  # a turntable calibration over temperature
-        return _triad_report(cal, models[0], recording, output, opts, latitude_deg)
+        return _triad_report(
+            cal,
+            models[0],
+            recording,
+            output,
+            opts,
+            latitude_deg,
+            title=None if title == DEFAULT_TITLE else title,
+            sensor=sensor,
+        )
     cal.require_channels("report")
     if len(cal.channels) > 1 or len(split_names(signal) or []) > 1:
         if len(models) > 1:
@@ -197,19 +206,32 @@ def _triad_report(
     output: Path,
     opts: ReadOptions,
     latitude_deg: float | None,
+    *,
+    title: str | None = None,
+    sensor: str | None = None,
 ) -> ReportResult:
-    """A calibration of triads judged on ``recording`` and reported."""
+    """A calibration of triads judged on ``recording`` and reported (``title`` None: the
+    triad report's own)."""
     from thermocal.compensate.files import read_for_triads
     from thermocal.multipos import validate as _mp_validate
     from thermocal.report.triads import write_triad_report
     from thermocal.turntable.calibrate import validate_triads
 
-    rec = read_for_triads(recording, cal.triads, time=opts.time, time_unit=opts.time_unit)
+    rec = read_for_triads(
+        recording,
+        cal.triads,
+        time=opts.time,
+        time_unit=opts.time_unit,
+        text=opts.text,
+        topic=opts.topic,
+    )
     if _mp_validate.is_multipos(cal.triads):  # held-out poses (issue 30)
-        results: list[Any] = _mp_validate.validate_triads(cal.triads, rec, latitude_deg)
+        results: list[Any] = _mp_validate.validate_triads(
+            cal.triads, rec, latitude_deg, signal_unit=opts.signal_unit
+        )
     else:
         results = validate_triads(cal.triads, rec, latitude_deg)
-    path = write_triad_report(output, cal, cal_path, results, recording)
+    path = write_triad_report(output, cal, cal_path, results, recording, title=title, sensor=sensor)
     return ReportResult(Path(path), "triads")
 
 

@@ -1,19 +1,33 @@
-"""HTML report of a calibration of triads over temperature (issue 19): for each triad every
-parameter against temperature — the per-run estimates with their ±1σ error bars, the fitted
-polynomial and its ±1σ band — a table of the polynomials (order, value at TREF, LOTO rms) and
-of the runs, and, on an independent turntable run, the dwell-mean and move-angle errors
-before and after compensation (:func:`thermocal.turntable.calibrate.validate_triads`).
+"""HTML report of a calibration of triads (issues 19, 30, 38): for each triad its parameters
+in the calibration's own units (a bias in the triad's unit, °/s for a °/s calibration; scale
+factors [ppm], misalignments [″]) with their σ, and, on an independent run, the figures
+before and after compensation: a turntable run's dwell-mean and move-angle errors
+(:func:`thermocal.turntable.calibrate.validate_triads`) or a multipos held-out session's
+gravity-magnitude and rotation-angle errors (:func:`thermocal.multipos.validate.
+validate_triads`), first as the absolute figures (rms over poses or motions, before → after,
+the change in %), then per axis.
+
+Against temperature only what was measured against it: a triad calibrated over several
+temperatures (``multipos --temps`` with a file per temperature, or a turntable over
+temperature) gets every parameter plotted against the real run temperatures with the fitted
+polynomial and its ±1σ band, and a table of the runs; a triad calibrated at one temperature,
+or without a temperature column, gets the table only and says so (no point is plotted
+against a temperature nobody measured).  A column with nothing to show (the leave-one-
+temperature-out rms of a one-temperature calibration) is left out and the reason given.
 One self-contained file; matplotlib and jinja2 are imported here only."""
 
 from __future__ import annotations
 
 import base64
 import datetime as _dt
+import math
+import re
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from thermocal import units
 from thermocal.writers import write_html
 
 
@@ -21,8 +35,28 @@ def _b64(png: bytes) -> str:
     return "data:image/png;base64," + base64.b64encode(png).decode("ascii")
 
 
-def _figure(tri: Any) -> bytes:
-    """Twelve panels: each parameter against temperature."""
+def display_factors(tri: Any) -> list[tuple[float, str]]:
+    """Per parameter of ``tri``'s model, the factor and unit it is shown in: a bias
+    (stored in °/h or mg) in the triad's own unit (``Triad.unit``), the others as stored."""
+    out = []
+    for f in tri.model.fits:
+        if f.name.startswith("bias") and f.unit != tri.unit:
+            out.append((float(units.convert(np.array([1.0]), f.unit, tri.unit)[0]), tri.unit))
+        else:
+            out.append((1.0, str(f.unit)))
+    return out
+
+
+def run_temperatures(tri: Any) -> list[float]:
+    """The distinct temperatures [°C] the triad was calibrated at (none without a
+    temperature column: the TREF recorded then is no measurement)."""
+    if not tri.temperature:
+        return []
+    return sorted({round(float(r[0]), 6) for r in tri.model.runs})
+
+
+def _figure(tri: Any, shown: list[tuple[float, str]]) -> bytes:
+    """Twelve panels: each parameter against the runs' temperatures, in its shown unit."""
     from thermocal.report.figures import _figure as new_figure
     from thermocal.report.figures import _png
 
@@ -35,15 +69,15 @@ def _figure(tri: Any) -> bytes:
         axes = fig.subplots(4, 3)
         for k, f in enumerate(m.fits):
             ax = axes.flat[k]
-            ax.fill_between(grid, curve[:, k] - band[:, k], curve[:, k] + band[:, k],
+            c, u = shown[k]
+            ax.fill_between(grid, c * (curve[:, k] - band[:, k]), c * (curve[:, k] + band[:, k]),
                             color="#1f6fb2", alpha=0.2, linewidth=0)  # fmt: skip
-            ax.plot(grid, curve[:, k], color="#1f6fb2", linewidth=1.2)
-            if m.runs:
-                t = [r[0] for r in m.runs]
-                v = [r[1][k] for r in m.runs]
-                e = [r[2][k] for r in m.runs]
-                ax.errorbar(t, v, yerr=e, fmt="o", color="#c0392b", markersize=3, capsize=2)
-            ax.set_title(f"{f.name} [{f.unit}] (order {len(f.coef) - 1})", fontsize=8)
+            ax.plot(grid, c * curve[:, k], color="#1f6fb2", linewidth=1.2)
+            t = [r[0] for r in m.runs]
+            v = [c * r[1][k] for r in m.runs]
+            e = [c * r[2][k] for r in m.runs]
+            ax.errorbar(t, v, yerr=e, fmt="o", color="#c0392b", markersize=3, capsize=2)
+            ax.set_title(f"{f.name} [{u}] (order {len(f.coef) - 1})", fontsize=8)
             ax.tick_params(labelsize=7)
             ax.grid(True, color="#dddddd", linewidth=0.5)
         for ax in axes[-1, :]:
@@ -51,65 +85,150 @@ def _figure(tri: Any) -> bytes:
         return _png(fig)
 
 
+def _temperature_text(tri: Any, temps: list[float]) -> str:
+    """What the triad's parameters hold against temperature, in words."""
+    m = tri.model
+    if not tri.temperature:
+        return ("Calibrated without a temperature column: the parameters apply unchanged at "
+                "every temperature (nothing to plot against temperature).")  # fmt: skip
+    if len(temps) < 2:
+        return (f"Calibrated at one temperature, {temps[0]:.4g} °C (column {tri.temperature}): "
+                "the parameters are held at every temperature; a plot against temperature "
+                "needs sessions at several.")  # fmt: skip
+    return (
+        f"Every parameter against temperature: the runs at {len(temps)} temperatures (±1σ), "
+        f"the fitted polynomial in T − {m.tref_c:g} °C and its ±1σ band; calibrated range "
+        f"{m.t_lo_c:g} … {m.t_hi_c:g} °C (held at the ends outside it)."
+    )
+
+
+LOTO_NOTE = (
+    "LOTO rms (leave one temperature out) not shown: it needs more temperatures than the "
+    "polynomial order + 1"
+)
+
+
+def _sigma_text(c: float, f: Any) -> str:
+    """A parameter's σ at TREF; "fixed (not estimated)" for one the model holds at zero
+    (the accelerometer's upper misalignments: its axes define the body frame)."""
+    if f.sigma[0] == 0 and not np.any(f.coef):
+        return "fixed (not estimated)"
+    return f"{c * f.sigma[0]:.3g}"
+
+
+def _runs(runs: Any, shown: list[tuple[float, str]]) -> list[dict[str, Any]]:
+    """The runs' table rows: temperature [°C] and each parameter in its shown unit."""
+    return [
+        {"t": f"{t:.4g}", "theta": [f"{c * v:.4g}" for v, (c, _u) in zip(th, shown, strict=True)]}
+        for t, th, _s in runs
+    ]
+
+
+def _triad_section(tri: Any) -> dict[str, Any]:
+    """One triad's part of the report (module docstring)."""
+    m = tri.model
+    shown = display_factors(tri)
+    temps = run_temperatures(tri)
+    over_t = len(temps) >= 2
+    loto = [f.loto_rms for f in m.fits]
+    has_loto = over_t and any(math.isfinite(v) for v in loto)
+    scale = getattr(tri, "count_scale", None)
+    params = []
+    for f, (c, u) in zip(m.fits, shown, strict=True):
+        row = {"name": f.name, "unit": u, "order": len(f.coef) - 1,
+               "at_tref": f"{c * f.coef[0]:.5g}", "sigma": _sigma_text(c, f),
+               "loto": f"{c * f.loto_rms:.3g}" if math.isfinite(f.loto_rms) else "—"}  # fmt: skip
+        params.append(row)
+    return {
+        "name": tri.name,
+        "kind": m.kind,
+        "columns": ", ".join(tri.columns),
+        "unit": tri.unit,
+        "counts": None if scale is None else f"{scale:.10g} {tri.unit}",
+        "temperature": tri.temperature,
+        "temperature_text": _temperature_text(tri, temps),
+        "over_temperature": over_t,
+        "has_loto": has_loto,
+        "loto_note": None if has_loto or not over_t else LOTO_NOTE,
+        "tref": m.tref_c,
+        "img": _b64(_figure(tri, shown)) if over_t else None,
+        "params": params,
+        "runs": _runs(m.runs, shown) if over_t else [],
+        "names": [f"{f.name} [{u}]" for f, (_c, u) in zip(m.fits, shown, strict=True)],
+    }
+
+
+def _change(before: float, after: float) -> str:
+    return f"{100.0 * (before - after) / before:.1f} %" if before else "—"
+
+
+def _summary_of(r: Any) -> list[dict[str, Any]]:
+    """One result's absolute figures: a multipos result's own totals (rms over poses or
+    motions); a turntable result's per-figure 3-axis rms, ``√(Σ axis²)`` of the per-axis
+    rms over the dwells or moves."""
+    if hasattr(r, "rms_before"):
+        what = f"{r.what} rms" if r.n > 1 else r.what
+        return [{"triad": r.triad, "what": what, "n": r.n, "unit": r.unit,
+                 "before": f"{r.rms_before:.4g}", "after": f"{r.rms_after:.4g}",
+                 "change": _change(r.rms_before, r.rms_after)}]  # fmt: skip
+    out = []
+    for label, before, after in r.rows():
+        m = re.fullmatch(r"(.*) \[(.*)\]", label)
+        what, unit = (m.group(1), m.group(2)) if m else (label, "")
+        b, a = float(np.sqrt(np.sum(np.square(before)))), float(np.sqrt(np.sum(np.square(after))))
+        out.append({"triad": r.triad, "what": f"{what} (3-axis, √Σ axis²)",
+                    "n": getattr(r, "n_dwells", ""), "unit": unit, "before": f"{b:.4g}",
+                    "after": f"{a:.4g}", "change": _change(b, a)})  # fmt: skip
+    return out
+
+
+def validation_rows(validation: list[Any] | None) -> tuple[list[dict[str, Any]], ...]:
+    """The validation's absolute figures (one row per figure: n, before, after, change in %
+    and unit), its per-axis rows, and what it could not judge."""
+    summary: list[dict[str, Any]] = []
+    per_axis: list[dict[str, Any]] = []
+    notes: list[dict[str, Any]] = []
+    for r in validation or []:
+        summary += _summary_of(r)
+        for label, before, after in r.rows():
+            per_axis.append({"triad": r.triad, "label": label,
+                             "cells": [f"{b:.4g} → {a:.4g}"
+                                       for b, a in zip(before, after, strict=True)]})  # fmt: skip
+        note = getattr(r, "not_judged", "")
+        if note and note not in [n["text"] for n in notes]:
+            notes.append({"triad": r.triad, "text": note})
+    return summary, per_axis, notes
+
+
 def build_triad_report(
     cal: Any,
     cal_path: str | Path,
     validation: list[Any] | None,
     recording_path: str | Path | None,
+    *,
+    title: str | None = None,
+    sensor: str | None = None,
 ) -> str:
+    """The report's HTML (module docstring); ``title`` default "Triad calibration —
+    <file name>", ``sensor`` the sensor's name or serial number shown under it."""
     from thermocal import __version__
     from thermocal.report.build import _env
     from thermocal.report.multipos import pose_section
 
-    triads = []
-    for tri in cal.triads:
-        m = tri.model
-        triads.append(
-            {
-                "name": tri.name,
-                "kind": m.kind,
-                "columns": ", ".join(tri.columns),
-                "unit": tri.unit,
-                "temperature": tri.temperature,
-                "tref": m.tref_c,
-                "range": f"{m.t_lo_c:g} … {m.t_hi_c:g}",
-                "img": _b64(_figure(tri)),
-                "params": [
-                    {
-                        "name": f.name,
-                        "unit": f.unit,
-                        "order": len(f.coef) - 1,
-                        "at_tref": f"{f.coef[0]:.5g}",
-                        "sigma": f"{f.sigma[0]:.3g}",
-                        "loto": f"{f.loto_rms:.3g}",
-                    }
-                    for f in m.fits
-                ],
-                "runs": [
-                    {"t": f"{t:.3g}", "theta": [f"{v:.4g}" for v in th]} for t, th, _s in m.runs
-                ],
-                "names": [f.name for f in m.fits],
-            }
-        )
-    val = []
-    for r in validation or []:
-        for label, before, after in r.rows():
-            val.append(
-                {
-                    "triad": r.triad,
-                    "label": label,
-                    "cells": [f"{b:.4g} → {a:.4g}" for b, a in zip(before, after, strict=True)],
-                }
-            )
+    summary, per_axis, notes = validation_rows(validation)
     html: str = (
         _env()
         .get_template("triads.html.j2")
         .render(
-            title=f"Triad calibration over temperature — {Path(cal_path).name}",
+            title=title or f"Triad calibration — {Path(cal_path).name}",
+            sensor=sensor,
+            calibration=Path(cal_path).name,
             version=__version__,
             generated_utc=_dt.datetime.now(_dt.UTC).strftime("%Y-%m-%d %H:%M UTC"),
-            triads=triads,
-            validation=val,
+            triads=[_triad_section(tri) for tri in cal.triads],
+            summary=summary,
+            validation=per_axis,
+            notes=notes,
             recording=str(recording_path) if recording_path else None,
             multipos=pose_section(validation),
         )
@@ -117,8 +236,15 @@ def build_triad_report(
     return html
 
 
-def write_triad_report(path: str | Path, *args: Any) -> Path:
-    return write_html(path, build_triad_report(*args))
+def write_triad_report(path: str | Path, *args: Any, **kwargs: Any) -> Path:
+    """Write :func:`build_triad_report`'s HTML to ``path`` (a temporary, then renamed)."""
+    return write_html(path, build_triad_report(*args, **kwargs))
 
 
-__all__ = ["build_triad_report", "write_triad_report"]
+__all__ = [
+    "build_triad_report",
+    "display_factors",
+    "run_temperatures",
+    "validation_rows",
+    "write_triad_report",
+]

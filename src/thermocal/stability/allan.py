@@ -68,6 +68,7 @@ Frequency Stability Analysis*, NIST SP 1065 (2008); IEEE Std 1554-2005.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import os
 from concurrent.futures import ThreadPoolExecutor
@@ -84,6 +85,7 @@ from thermocal.errors import MissingValueError, ThermocalInputError
 from thermocal.recording import contiguous_slices
 from thermocal.stability import family
 from thermocal.stability.edf import ONE_SIGMA_CONFIDENCE, confidence_interval
+from thermocal.stability.periodic import PeriodicTerm, shaping_terms
 
 # scipy is imported when first needed (a command that reads the help does not pay for it)
 linalg = LazyModule("scipy.linalg")
@@ -199,6 +201,9 @@ class NoiseTerm:
     quality: str | None = None
     """``"poor"`` when the noise model fits the curve badly (:class:`FitQuality`); the
     value is kept and ``reason`` says why it is doubtful; None otherwise."""
+    tau_range_s: tuple[float, float] | None = None
+    """The τ range [s] the value was read from (the −½ stretch of the angle random walk,
+    the minimum's neighbours of the bias instability); None when not stated."""
 
 
 @dataclass(frozen=True)
@@ -232,6 +237,12 @@ class FitQuality:
             "reason": self.reason,
         }
 
+
+_OTHER_PROCESS: Final = (
+    "(another noise process — flicker of a different kind, a periodic term, a drift or a "
+    "step — or a wrong time base)"
+)
+"""The fit quality's words when nothing names what the noise model misses."""
 
 POOR_CHI2 = 4.0
 """Reduced χ² above which the noise model is reported as a poor description."""
@@ -281,8 +292,7 @@ def fit_quality(tau_s: FloatArray, normalised_residuals: FloatArray, n_active: i
     reason = (
         "the noise model σ² = Σ C_p τ^p does not describe this curve: "
         + "; ".join(reasons)
-        + " (another noise process — flicker of a different kind, a periodic term, a drift "
-        "or a step — or a wrong time base); the noise terms are rough"
+        + f" {_OTHER_PROCESS}; the noise terms are rough"
         if poor
         else None
     )
@@ -325,6 +335,14 @@ class NoiseTerms:
     fit_sigma: FloatArray
     reduced_chi2: float
     quality: FitQuality | None = None
+    bias_minimum: NoiseTerm | None = None
+    """The bias instability at the curve's minimum, always (:func:`bias_at_minimum`);
+    None without three usable points."""
+    shaped_below_s: float | None = None
+    """The points at τ below this [s] lie under the −½ stretch's line beyond their
+    intervals (the sensor's own filter): left out of the fit and the slope lines."""
+    periodic: tuple[PeriodicTerm, ...] = ()
+    """Sinusoids found in the record that shape the curve (:func:`annotate_periodic`)."""
 
     def fit_curve(self, tau_s: npt.ArrayLike) -> FloatArray:
         """Fitted Allan deviation sqrt(Σ C_p τ^p) [unit] at ``tau_s``."""
@@ -849,8 +867,13 @@ def nnls_small(a: FloatArray, b: FloatArray) -> FloatArray:
     return best
 
 
+def _usable(result: AllanResult) -> npt.NDArray[np.bool_]:
+    """The ADEV points noise terms can use: finite, above zero, with degrees of freedom."""
+    return np.asarray(np.isfinite(result.adev) & (result.adev > 0) & (result.edf > 0))
+
+
 def _fit(
-    result: AllanResult, significance: float
+    result: AllanResult, significance: float, ok: npt.NDArray[np.bool_] | None = None
 ) -> tuple[FloatArray, FloatArray, float, list[str | None], FitQuality | None]:
     """Weighted NNLS of σ²(τ) = Σ_{p=−2..2} C_p τ^p (IEEE 952 C.2).
 
@@ -858,9 +881,10 @@ def _fit(
     freedom), iterated three times with the fitted σ² in place of the noisy σ̂²;
     standard errors from the QR factor of the weighted active design, scaled by
     the reduced χ² when it exceeds 1.  Returns C, sd(C), reduced χ², reasons and the
-    fit's quality (:func:`fit_quality`; None without points).
+    fit's quality (:func:`fit_quality`; None without points).  ``ok``: the points
+    used (default :func:`_usable`).
     """
-    ok = np.isfinite(result.adev) & (result.adev > 0) & (result.edf > 0)
+    ok = _usable(result) if ok is None else ok
     tau = result.tau_s[ok]
     s2 = result.avar[ok]
     edf = result.edf[ok]
@@ -988,6 +1012,153 @@ def _read_slope(
     return val, val * float(lo_ratio[best]), val * float(hi_ratio[best]), float(tau[k])
 
 
+_STRETCH_Z: Final = 2.0
+"""A point lies on the −½ stretch when the stretch's line passes within this many of its
+standard deviations, sd(ln σ̂) = 1/√(2·edf) (σ̂²·edf/σ² is χ² with edf degrees of freedom)..."""
+
+_STRETCH_SLACK: Final = math.log(1.01)
+"""... widened by 1 % (neighbouring ADEV points are correlated, the EDF approximate)."""
+
+
+@dataclass(frozen=True)
+class WhiteStretch:
+    """The −½ stretch of an ADEV curve (:func:`white_stretch`).
+
+    ``start``/``stop`` the index range of the points used (into the arrays given);
+    ``intercept`` c of the line ``ln σ = c − ½ ln τ`` (σ(1 s) = e^c, the white-noise
+    coefficient N [unit·√s]); ``shaped_stop`` the leading points ``[0, shaped_stop)`` before
+    the stretch that each lie below its line beyond their intervals (the sensor's own low-pass
+    filter shapes the short τ: a sum of noise terms never lies below one of them), 0 when
+    none.
+    """
+
+    start: int
+    stop: int
+    intercept: float
+    shaped_stop: int
+
+
+def white_stretch(
+    tau_s: npt.ArrayLike,
+    adev: npt.ArrayLike,
+    edf: npt.ArrayLike,
+    allowed: npt.ArrayLike | None = None,
+) -> WhiteStretch | None:
+    """The −½ stretch of an ADEV curve found in the data, not assumed at the shortest τ.
+
+    A run of consecutive points (``adev`` [unit] at ``tau_s`` [s], each with its ``edf``)
+    through which one line of slope −½ passes within each point's interval
+    ``ln σ̂ ± (z/√(2·edf) + 1 %)`` (z = :data:`_STRETCH_Z`; the intersection of the
+    intervals of ``g = ln σ̂ + ½ ln τ`` is not empty).  Of the maximal runs, the stretch
+    is the longest in τ (ln τ_last − ln τ_first) of those of at least three points (else
+    two), the one holding more degrees of freedom Σ edf when two are as long; its line's
+    intercept is the EDF-weighted mean of g over it (IEEE Std 952-1997 C.3: the
+    white-noise coefficient is read on the straight line of slope −½ fitted
+    where the curve has that slope; the local slope of a filtered sensor at short τ,
+    −0.31, −0.42, is not −½ and its points lie below the line).  None without a run of
+    two points.  ``allowed``: the points a run may hold (:func:`noise_terms` passes those
+    whose local slope over τ/4 … 4τ is within ±0.25 of −½, so that the wide intervals
+    of a few long-τ points do not make a stretch of a curve of another slope).
+    """
+    tau = np.asarray(tau_s, dtype=np.float64)
+    ok = np.ones(tau.size, dtype=bool) if allowed is None else np.asarray(allowed, dtype=bool)
+    ld = np.log(np.asarray(adev, dtype=np.float64))
+    w = np.asarray(edf, dtype=np.float64)
+    g = ld + 0.5 * np.log(tau)
+    half = _STRETCH_Z / np.sqrt(2.0 * w) + _STRETCH_SLACK
+    lo, hi = g - half, g + half
+    best: tuple[bool, float, float, int, int] | None = None
+    lt = np.log(tau)
+    b_prev = 0
+    for a in range(tau.size):
+        if b_prev == tau.size:  # a run reached the last point: later ones are its sub-runs
+            break
+        if not ok[a]:
+            continue
+        low, high, b = lo[a], hi[a], a + 1
+        while b < tau.size and ok[b] and max(low, lo[b]) <= min(high, hi[b]):
+            low, high, b = max(low, lo[b]), min(high, hi[b]), b + 1
+        if b <= b_prev or b - a < 2:  # a sub-run of the previous run, or one point
+            continue
+        b_prev = b
+        key = (b - a >= 3, round(float(lt[b - 1] - lt[a]), 9), float(w[a:b].sum()), a, b)
+        if best is None or key[:3] > best[:3]:
+            best = key
+    if best is None:
+        return None
+    a, b = best[3], best[4]
+    c = float(np.average(g[a:b], weights=w[a:b]))
+    shaped = 0  # the leading points that lie below the line beyond their intervals
+    while shaped < a and hi[shaped] < c:
+        shaped += 1
+    return WhiteStretch(a, b, c, shaped)
+
+
+BIAS_MIN_EDF: Final = 5.0
+"""The curve's minimum is sought among the points of at least this many degrees of freedom
+(their ±1σ interval narrower than a factor 1.9): the last points of a record, of one or two
+degrees of freedom, often fall far below the curve by chance."""
+
+
+def bias_at_minimum(
+    tau: FloatArray,
+    dev: FloatArray,
+    lo_ratio: FloatArray,
+    hi_ratio: FloatArray,
+    conv: float,
+    unit: str,
+    label: str,
+    edf: FloatArray | None = None,
+) -> NoiseTerm:
+    """The bias instability at the curve's minimum, always (IEEE Std 952-1997 C.3: the flat
+    minimum of a bias-instability floor is ``0.6643·B``, so ``B = σ_min / 0.6643``), as
+    allan_variance_ros and imu_utils report it.
+
+    ``tau`` [s], ``dev`` [unit] the usable points, ``lo_ratio``/``hi_ratio`` their
+    interval over the deviation; ``conv`` the factor to the term's ``unit``.  The value's
+    interval is the minimum point's (``σ_low/0.6643 … σ_high/0.6643``), ``tau_s`` the τ of
+    the minimum, ``tau_range_s`` its neighbours.  ``quality``: ``good`` when the curve rises
+    beyond both intervals after the minimum; ``rough`` when it does not (the minimum is
+    poorly defined: a flat floor, a noisy tail); ``poor`` when the minimum is the first
+    or the last point (the record's end: σ still falls, B is an upper bound).  ``edf``:
+    the points' degrees of freedom; those below :data:`BIAS_MIN_EDF` are left out (when
+    others remain).
+    """
+    if edf is not None and int(np.count_nonzero(edf >= BIAS_MIN_EDF)) >= 3:
+        keep = np.asarray(edf >= BIAS_MIN_EDF)
+        tau, dev, lo_ratio, hi_ratio = tau[keep], dev[keep], lo_ratio[keep], hi_ratio[keep]
+    k = int(np.argmin(dev))
+    val = float(dev[k]) / BIAS_INSTABILITY_FACTOR
+    lo, hi = val * float(lo_ratio[k]), val * float(hi_ratio[k])
+    rng = (float(tau[max(k - 1, 0)]), float(tau[min(k + 1, tau.size - 1)]))
+    where = f"read at the curve's minimum τ = {tau[k]:.4g} s (σ_min / 0.6643, IEEE 952 C.3)"
+    if k == tau.size - 1:
+        quality, why = (
+            "poor",
+            (
+                f"the minimum is the last point (of at least {BIAS_MIN_EDF:g} degrees of "
+                "freedom), at the record's end: the curve still falls, so this is an upper "
+                "bound; a longer record shows the floor"
+            ),
+        )
+    elif k == 0:
+        quality, why = "poor", "the minimum is the shortest τ: the curve rises from its start"
+    elif bool(np.any(dev[k + 1 :] * lo_ratio[k + 1 :] > dev[k] * hi_ratio[k])):
+        quality, why = "good", ""
+    else:
+        quality, why = (
+            "rough",
+            (
+                "the minimum is poorly defined: no later point rises beyond both intervals "
+                "(a flat floor or a noisy tail)"
+            ),
+        )
+    reason = where + (f"; {quality}: {why}" if why else "")
+    return NoiseTerm(
+        val * conv, unit, reason, lo * conv, hi * conv, float(tau[k]), label, quality, rng
+    )
+
+
 def _fit_terms(
     specs: tuple[tuple[float, str, str], ...],
     scale: float,
@@ -1022,16 +1193,68 @@ def _fit_terms(
     return fit_terms
 
 
+def _read_white(
+    tau: FloatArray,
+    lt: FloatArray,
+    ld: FloatArray,
+    edf: FloatArray,
+    local: FloatArray,
+    lo_ratio: FloatArray,
+    hi_ratio: FloatArray,
+) -> tuple[float, float, float, float, tuple[float, float]] | str:
+    """The angle random walk N on the −½ stretch (:func:`white_stretch`): (value, low, high,
+    τ of the stretch's best-determined point, the stretch's τ range) in native units, or
+    a reason.  The line ``σ = N/√τ`` read at τ = 1 s; the interval spans every point's
+    own reading ``σ̂_i √τ_i`` with its interval over the stretch (where along the stretch
+    N is read is part of the uncertainty); rejected when the line lies more than 25 % above the
+    curve's upper bound at a τ at or beyond the stretch's start (every term lies below the
+    curve; only a sensor's own filter pulls the curve below it, at τ shorter than the
+    stretch)."""
+    st = white_stretch(tau, np.exp(ld), edf, np.abs(local + 0.5) <= _SLOPE_TOLERANCE)
+    if st is None:
+        slopes = np.diff(ld) / np.diff(lt)
+        return (
+            "no region of slope -0.5 in the data: no two neighbouring points lie on one line "
+            f"of slope −½ within their intervals (slopes between points {np.min(slopes):+.2f} "
+            f"… {np.max(slopes):+.2f})"
+        )
+    idx = np.arange(st.start, st.stop)
+    best = int(idx[np.argmax(edf[idx])])
+    line = st.intercept - 0.5 * lt
+    upper = ld + np.log(np.maximum(hi_ratio, 1.0))
+    above = np.flatnonzero(line > upper + _LINE_TOLERANCE)
+    above = above[above >= st.start]
+    if above.size:
+        w = int(above[np.argmax(line[above] - upper[above])])
+        return (
+            f"the slope -0.5 stretch τ = {tau[st.start]:.4g} … {tau[st.stop - 1]:.4g} s is not "
+            f"this noise term: its line would lie {math.exp(line[w] - ld[w]):.3g}× above the "
+            f"measured curve at τ = {tau[w]:.4g} s"
+        )
+    val = math.exp(st.intercept)
+    rng = (float(tau[st.start]), float(tau[st.stop - 1]))
+    g = ld[idx] + 0.5 * lt[idx]  # each point's own reading of N, with its interval
+    lo = math.exp(float(np.min(g + np.log(lo_ratio[idx]))))
+    hi = math.exp(float(np.max(g + np.log(hi_ratio[idx]))))
+    return val, min(lo, val), max(hi, val), float(tau[best]), rng
+
+
+def _at(j: int, tau_k: float) -> str:
+    return f"the slope {TERM_SLOPES[j]:+g} stretch at τ = {tau_k:.4g} s"
+
+
 def _slope_terms(
     result: AllanResult,
     specs: tuple[tuple[float, str, str], ...],
     scale: float,
     fit_reasons: list[str | None],
     poor: bool,
+    ok: npt.NDArray[np.bool_] | None = None,
 ) -> list[NoiseTerm]:
     """The slope-line terms of :func:`noise_terms` (IEEE 952 C.3, read by
-    :func:`_read_slope`; bias instability at the curve's minimum when the curve turns up)."""
-    ok = np.isfinite(result.adev) & (result.adev > 0) & (result.edf > 0)
+    :func:`_read_slope`, the angle random walk by :func:`_read_white`; bias instability at
+    the curve's minimum when the curve turns up); ``ok`` the points used."""
+    ok = _usable(result) if ok is None else ok
     tau = result.tau_s[ok]
     dev = result.adev[ok]
     lo_ratio = result.adev_low[ok] / dev
@@ -1044,13 +1267,26 @@ def _slope_terms(
     lt, ld = np.log(tau), np.log(dev)
     local = np.array([_local_slope(lt, ld, edf, k) for k in range(tau.size)])
     for j, (factor, u, label) in enumerate(specs):
-        term = _read_slope(j, tau, lt, ld, edf, local, lo_ratio, hi_ratio)
+        rng: tuple[float, float] | None = None
+        if j == 1:
+            white = _read_white(tau, lt, ld, edf, local, lo_ratio, hi_ratio)
+            term: tuple[float, float, float, float] | str = (
+                white if isinstance(white, str) else white[:4]
+            )
+            rng = None if isinstance(white, str) else white[4]
+        else:
+            term = _read_slope(j, tau, lt, ld, edf, local, lo_ratio, hi_ratio)
         conv = scale * factor
         k_min = int(np.argmin(dev))
         # a minimum inside the data: the curve rises after it beyond both intervals (a
         # later point's lower bound above the minimum's upper bound), not a noisy tail
         turns_up = 0 < k_min < tau.size - 1 and bool(
             np.any(dev[k_min + 1 :] * lo_ratio[k_min + 1 :] > dev[k_min] * hi_ratio[k_min])
+        )
+        where = (
+            f"the slope {TERM_SLOPES[j]:+g} stretch τ = {rng[0]:.4g} … {rng[1]:.4g} s"
+            if rng is not None
+            else None
         )
         if j == 2 and (isinstance(term, str) or fit_reasons[j] is not None) and turns_up:
             # IEEE 952 C.3: bias instability is the curve's minimum / 0.664, read wherever
@@ -1074,25 +1310,24 @@ def _slope_terms(
             # the slope line stands (IEEE 952 C.3), marked rough: the fit does not find it
             val, lo, hi, tau_k = term
             reason = (
-                f"read from the slope {TERM_SLOPES[j]:+g} stretch at τ = {tau_k:.4g} s; "
-                f"rough: the least-squares fit does not support it ({fit_reasons[j]})"
+                f"read from {where or _at(j, tau_k)}"
+                f"; rough: the least-squares fit does not support it ({fit_reasons[j]})"
             )
             slope_terms.append(
                 NoiseTerm(
                     val * conv, u, reason, lo * conv, hi * conv, tau_k, label,
-                    quality="poor" if poor else "rough",
+                    quality="poor" if poor else "rough", tau_range_s=rng,
                 )
             )  # fmt: skip
         else:
-            conv = scale * factor
             val, lo, hi, tau_k = term
-            note = f"read from the slope {TERM_SLOPES[j]:+g} stretch at τ = {tau_k:.4g} s" + (
+            note = f"read from {where or _at(j, tau_k)}" + (
                 " (the flat minimum / 0.664)" if j == 2 else ""
             )
             slope_terms.append(
                 NoiseTerm(
                     val * conv, u, note if poor else None, lo * conv, hi * conv, tau_k,
-                    label, quality="poor" if poor else None,
+                    label, quality="poor" if poor else None, tau_range_s=rng,
                 )
             )  # fmt: skip
     return slope_terms
@@ -1110,25 +1345,52 @@ def noise_terms(
     Interval: ``C ± z·sd(C)`` (z the normal quantile of ``confidence``), mapped
     through the square root.
 
-    Slope lines (IEEE 952 C.3): for slope s ∈ {−1, −½, 0, +½, +1} the region of
+    Slope lines (IEEE 952 C.3): for slope s ∈ {−1, 0, +½, +1} the region of
     that slope is the run of points whose weighted local slope (ln σ against ln τ
     over τ/4 … 4τ) is within ±0.25 of s and which holds the tangent point τ*
     (the lowest line of slope s touching the curve there).  The line
     ``ln σ = c + s ln τ`` with c the EDF-weighted mean over the run is read at
-    τ = √3 s (Q), 1 s (N), 3 s (K), √2 s (R); B = σ_flat / 0.6643 with σ_flat
-    the weighted mean over τ*/2 … 2τ* (the flat minimum).  A term is reported
+    τ = √3 s (Q), 3 s (K), √2 s (R); B = σ_flat / 0.6643 with σ_flat
+    the weighted mean over τ*/2 … 2τ* (the flat minimum).  The angle random walk N is
+    read on the −½ stretch found in the data (:func:`white_stretch`: the points one line
+    of slope −½ passes through within their intervals), at τ = 1 s; the points at
+    shorter τ that lie below that line (a sensor's own low-pass filter) are left out of
+    the fit and the other slope lines (``shaped_below_s``).  A term is reported
     only where its region exists (at least two points) and the least-squares fit
     also finds it significant; otherwise ``None`` with the reason.  The interval
     applies the chi-square interval of the region's best-determined point.
+
+    ``bias_minimum``: the bias instability at the curve's minimum, always, with its τ,
+    interval and quality (:func:`bias_at_minimum`).
     """
     conf = result.confidence if confidence is None else confidence
     scale, specs = term_units(result.unit)
-    coef, sigma, red_chi2, fit_reasons, quality = _fit(result, significance)
+    ok = _usable(result)
+    shaped_below: float | None = None
+    if int(ok.sum()) >= 3:
+        lt, ld, edf = np.log(result.tau_s[ok]), np.log(result.adev[ok]), result.edf[ok]
+        local = np.array([_local_slope(lt, ld, edf, k) for k in range(lt.size)])
+        st = white_stretch(
+            result.tau_s[ok], result.adev[ok], edf, np.abs(local + 0.5) <= _SLOPE_TOLERANCE
+        )
+        if st is not None and st.shaped_stop:
+            used = np.flatnonzero(ok)
+            ok = ok.copy()
+            ok[used[: st.shaped_stop]] = False
+            shaped_below = float(result.tau_s[used[st.shaped_stop]])
+    coef, sigma, red_chi2, fit_reasons, quality = _fit(result, significance, ok)
     poor = quality is not None and quality.quality == "poor"
     z = float(special.ndtri(0.5 + conf / 2.0))  # normal quantile
 
     fit_terms = _fit_terms(specs, scale, coef, sigma, fit_reasons, quality, z)
-    slope_terms = _slope_terms(result, specs, scale, fit_reasons, poor)
+    slope_terms = _slope_terms(result, specs, scale, fit_reasons, poor, ok)
+    minimum = None
+    if int(ok.sum()) >= 3:
+        dev = result.adev[ok]
+        minimum = bias_at_minimum(
+            result.tau_s[ok], dev, result.adev_low[ok] / dev, result.adev_high[ok] / dev,
+            scale * specs[2][0], specs[2][1], specs[2][2], result.edf[ok],
+        )  # fmt: skip
     return NoiseTerms(
         slope=NoiseTermSet("slope", *slope_terms),
         fit=NoiseTermSet("fit", *fit_terms),
@@ -1136,7 +1398,43 @@ def noise_terms(
         fit_sigma=sigma,
         reduced_chi2=red_chi2,
         quality=quality,
+        bias_minimum=minimum,
+        shaped_below_s=shaped_below,
     )
+
+
+def annotate_periodic(
+    terms: NoiseTerms, result: AllanResult, found: tuple[PeriodicTerm, ...]
+) -> NoiseTerms:
+    """``terms`` with the periodic terms ``found`` in the record
+    (:func:`thermocal.stability.periodic.periodic_terms`) that shape its curve
+    (:func:`~thermocal.stability.periodic.shaping_terms`: ≥ 5 % of the Allan variance at
+    τ = 0.371/f₀) in ``periodic``, and every reason that blamed "another noise process"
+    naming them with their frequency and amplitude instead (IEEE Std 952-1997 C.1.7: a
+    sinusoid's Allan deviation A·sin²(πf₀τ)/(πf₀τ) is not in the noise model)."""
+    shaping = shaping_terms(found, result.tau_s, result.adev)
+    if not shaping:
+        return terms
+    named = (
+        "(" + "; ".join(p.words() for p in shaping) + ": not a term of the noise model; "
+        "remove it — a notch at its frequency — or read the terms away from that τ)"
+    )
+
+    def fix(t: NoiseTerm) -> NoiseTerm:
+        if t.reason is None or _OTHER_PROCESS not in t.reason:
+            return t
+        return dataclasses.replace(t, reason=t.reason.replace(_OTHER_PROCESS, named))
+
+    def fix_set(ts: NoiseTermSet) -> NoiseTermSet:
+        return NoiseTermSet(ts.method, *(fix(t) for t in ts.terms().values()))
+
+    quality = terms.quality
+    if quality is not None and quality.reason is not None:
+        quality = dataclasses.replace(quality, reason=quality.reason.replace(_OTHER_PROCESS, named))
+    return dataclasses.replace(
+        terms, slope=fix_set(terms.slope), fit=fix_set(terms.fit), quality=quality,
+        periodic=shaping,
+    )  # fmt: skip
 
 
 __all__ = [
@@ -1150,7 +1448,10 @@ __all__ = [
     "NoiseTerm",
     "NoiseTermSet",
     "NoiseTerms",
+    "WhiteStretch",
+    "annotate_periodic",
     "averaging_factors",
+    "bias_at_minimum",
     "confidence_interval",
     "dynamic_adev",
     "edf_simple",
@@ -1158,4 +1459,5 @@ __all__ = [
     "noise_terms",
     "overlapping_adev",
     "term_units",
+    "white_stretch",
 ]

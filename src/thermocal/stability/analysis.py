@@ -221,10 +221,14 @@ def _allan_channel(
     """One channel's ADEV, noise terms and dynamic ADEV, with their warnings."""
     from thermocal.stability import allan
     from thermocal.stability import noise_model as nm
+    from thermocal.stability.periodic import periodic_terms
 
     # every figure in the data's own unit (°/s data: ADEV in °/s; INTERFACE common rules)
     values, unit = signal_in_data_unit(rec, name)
     lattice = nm.lattice_step(values)  # before the ADEV overwrites the values
+    segs = rec.segments()
+    longest = max(segs, key=lambda sl: sl.stop - sl.start) if segs else slice(None)
+    found = periodic_terms(values[longest], rec.sample_interval_s, unit)
     res = allan.overlapping_adev(
         values,
         rec.sample_interval_s,
@@ -242,6 +246,7 @@ def _allan_channel(
     noise = allan.noise_terms(res)
     quant = nm.quantization_from_lattice(lattice, rec.sample_interval_s, unit, noise)
     noise = nm.annotate_quantization(noise, quant)
+    noise = allan.annotate_periodic(noise, res, found)
     if noise.quality is not None and noise.quality.quality == "poor":
         warnings.warn(f"{where}: {noise.quality.reason}", ConditioningWarning, stacklevel=1)
     if dynamic_s is None:

@@ -11,7 +11,9 @@ kalibr*, ICRA 2016; the Kalibr wiki "IMU Noise Model")::
 
 * ``σ_n`` noise density [rad/s/√Hz] (gyro) or [m/s²/√Hz] (accelerometer) is the white-noise
   coefficient N of the Allan variance ``σ²(τ) = N²/τ``: the −½ slope line read at τ = 1 s
-  (IEEE 952-1997 C.3; N in (rad/s)·√s = rad/s/√Hz).
+  (IEEE 952-1997 C.3; N in (rad/s)·√s = rad/s/√Hz), fitted on the −½ stretch found in the
+  data (:func:`thermocal.stability.allan.white_stretch`), not at the shortest τ a sensor's
+  own filter shapes.
 * ``σ_b`` random walk [rad/s²/√Hz] or [m/s³/√Hz] is the rate random walk coefficient K of
   ``σ²(τ) = K² τ / 3``: the +½ slope line read at τ = 3 s (K in (rad/s)/√s = rad/s²/√Hz).
 
@@ -44,10 +46,12 @@ from thermocal.stability.allan import (
     AllanResult,
     NoiseTerm,
     NoiseTerms,
+    annotate_periodic,
     noise_terms,
     overlapping_adev,
     term_units,
 )
+from thermocal.stability.periodic import periodic_terms
 
 Sensor = Literal["gyro", "accel"]
 
@@ -98,6 +102,8 @@ class ContinuousTerm:
     read_at_tau_s: float
     quality: str
     reason: str | None
+    tau_range_s: tuple[float, float] | None = None
+    """The τ range [s] the slope line was fitted on (the −½ stretch found in the data)."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -189,6 +195,7 @@ def _choose(
             read_at_tau_s=_READ_AT[kind],
             quality=term.quality or "good",
             reason=term.reason,
+            tau_range_s=term.tau_range_s if method == "slope" else None,
         )
     # not in the data: the largest coefficient the curve allows (every term lies below it)
     ok = np.isfinite(res.adev_high) & (res.adev > 0)
@@ -243,12 +250,16 @@ def axis_noise(
             f"(--{'gyro' if sensor == 'gyro' else 'accel'}-unit)"
         )
     lattice = lattice_step(values)
+    v = np.asarray(values, dtype=np.float64).ravel()
+    longest = max(segments, key=lambda sl: sl.stop - sl.start) if segments else slice(None)
+    found = periodic_terms(v[longest], tau0_s, u)
     res = overlapping_adev(
         values, tau0_s, taus, time_s=time_s, segments=segments, unit=u, confidence=confidence
     )
     terms = noise_terms(res)
     quant = quantization_from_lattice(lattice, tau0_s, u, terms)
     terms = annotate_quantization(terms, quant)
+    terms = annotate_periodic(terms, res, found)
     return AxisNoise(
         name=name,
         sensor=sensor,
@@ -313,7 +324,14 @@ def kalibr_yaml(model: NoiseModel, source: str) -> str:
             t = _term_for(key, ax)
             white = key.endswith("noise_density")
             words = _TERM_WORDS[(ax.sensor, "density" if white else "walk")]
-            if t.method == "slope":
+            if t.method == "slope" and t.tau_range_s is not None:
+                how = (
+                    f"the {_SLOPE['density' if white else 'walk']} slope line of the ADEV "
+                    f"(fitted on its {_SLOPE['density' if white else 'walk']} stretch τ = "
+                    f"{t.tau_range_s[0]:.4g} … {t.tau_range_s[1]:.4g} s) read at τ = "
+                    f"{t.read_at_tau_s:g} s"
+                )
+            elif t.method == "slope":
                 how = (
                     f"the {_SLOPE['density' if white else 'walk']} slope line of the ADEV "
                     f"(touching the curve at τ = {t.tau_s:.4g} s) read at τ = "
@@ -380,6 +398,7 @@ def _term_json(t: NoiseTerm, method: str) -> dict[str, Any]:
         "quality": None if t.value is None else (t.quality or "good"),
         "reason": t.reason,
         "label": t.label,
+        "tau_range_s": list(t.tau_range_s) if t.tau_range_s is not None else None,
     }
 
 
@@ -400,7 +419,17 @@ def _continuous_json(t: ContinuousTerm) -> dict[str, Any]:
         "read_at_tau_s": t.read_at_tau_s,
         "quality": t.quality,
         "reason": t.reason,
+        "tau_range_s": list(t.tau_range_s) if t.tau_range_s is not None else None,
     }
+
+
+def _minimum_json(t: NoiseTerm | None) -> dict[str, Any] | None:
+    """The bias instability at the curve's minimum (always; IEEE 952 C.3)."""
+    if t is None:
+        return None
+    out = _term_json(t, "minimum")
+    out["quality"] = t.quality
+    return out
 
 
 def model_json(model: NoiseModel, source: str) -> dict[str, Any]:
@@ -408,7 +437,9 @@ def model_json(model: NoiseModel, source: str) -> dict[str, Any]:
     axis ``terms`` (every IEEE 952 term in the data's unit: the slope reading where it
     exists, else the fit; ``value``, ``unit``, ``low``, ``high``, ``tau_s``, ``method``,
     ``quality``, ``reason``), ``terms_fit`` (all fitted terms), ``noise_density`` and
-    ``random_walk`` (continuous time, SI), ``output_quantization``
+    ``random_walk`` (continuous time, SI; ``tau_range_s`` the stretch a slope line was
+    fitted on), ``bias_instability_minimum`` (the bias instability at the curve's minimum,
+    always, with ``tau_s``, interval and ``quality``), ``output_quantization``
     (:meth:`OutputQuantization.to_dict`, null when the samples lie on no lattice)."""
     axes: dict[str, Any] = {}
     for ax in model.axes:
@@ -422,6 +453,8 @@ def model_json(model: NoiseModel, source: str) -> dict[str, Any]:
             "output_quantization": ax.quantization.to_dict() if ax.quantization else None,
             "noise_density": _continuous_json(ax.density),
             "random_walk": _continuous_json(ax.walk),
+            "bias_instability_minimum": _minimum_json(ax.terms.bias_minimum),
+            "periodic": [p.to_dict() for p in ax.terms.periodic],
         }
     return {
         "source": source,
@@ -446,8 +479,8 @@ QUANT_MIN_REPEAT: Final = 20
 floating-point data have about as many distinct values as samples."""
 
 QUANT_RTOL: Final = 1e-3
-"""Every sample lies within this fraction of a step of the lattice (unit conversions
-of the stored values leave ~1e-12 of a step; float32 storage ~1e-4)."""
+"""Kept for callers: the former tolerance (every sample within this fraction of a step);
+:func:`lattice_step` uses :data:`QUANT_LEVEL_TOL` and :data:`QUANT_MAX_OFF`."""
 
 _QUANT_PROBE: Final = 200_000
 """Samples (evenly strided) the lattice step is found from before the whole record is checked."""
@@ -540,19 +573,32 @@ class OutputQuantization:
         )
 
 
-def lattice_step(
-    values: npt.ArrayLike, *, rtol: float = QUANT_RTOL
-) -> tuple[float, float, int, int] | None:
-    """The lattice ``offset + k·step`` the finite samples lie on, as (step, offset, levels,
-    finite samples),
-    or None when they lie on none (:data:`QUANT_MIN_LEVELS`, :data:`QUANT_MIN_REPEAT`).
+QUANT_LEVEL_TOL: Final = 0.02
+"""A level lies on the sensor's lattice when within this fraction of a step of it: a storage
+grid up to 25× finer than the step rounds each level by at most half a grid step."""
 
-    The step is found on at most :data:`_QUANT_PROBE` evenly strided samples: the distinct
-    values u sorted, their gaps d, the smallest gap d_min; the step is d_min / j for the
-    smallest j = 1 … 10 that makes every gap an integer multiple within ``rtol`` (a gcd of
-    the gaps with a tolerance; gaps below 1e-9 of the range are rounding within one level);
-    refined as (u_max − u_min) / Σ k.  Then every sample of the
-    record is checked: |(v − offset)/step − round(·)| ≤ ``rtol``.
+QUANT_MAX_OFF: Final = 1e-3
+"""At most this fraction of the samples may lie off the lattice (glitches, outliers)."""
+
+
+def lattice_step(
+    values: npt.ArrayLike, *, rtol: float = QUANT_LEVEL_TOL
+) -> tuple[float, float, int, int] | None:
+    """The sensor's lattice ``offset + k·step`` among the finite samples' distinct levels,
+    as (step, offset, levels, finite samples), or None when they lie on none
+    (:data:`QUANT_MIN_LEVELS`, :data:`QUANT_MIN_REPEAT`).
+
+    The step is the greatest common spacing that explains the levels, robust to a finer
+    storage grid and a few outliers (a pulse-quantised gyro with 77 levels 0.00816 °/s
+    apart stored on a 1.22e-4 °/s grid has step 0.00816, not 1.22e-4): on at most
+    :data:`_QUANT_PROBE` evenly strided samples, the distinct values u with their counts,
+    the first guess the median gap between neighbouring levels among the most-visited
+    ones (adjacent lattice points where the samples are dense), refined by the
+    count-weighted least-squares line ``u = o + step·k`` with k = round((u − o)/step),
+    over ±5, ±20 and then all steps of the most-visited level.  Then every sample of the
+    record is checked: at least 1 − :data:`QUANT_MAX_OFF` of them lie within ``rtol`` of a
+    step of the lattice.  A step of at most :data:`QUANT_MIN_ULPS` storage ulps is the
+    storage's rounding, not the sensor's.
     """
     v = np.asarray(values, dtype=np.float64).ravel()
     if not math.isfinite(float(v.sum())):  # a copy of the finite samples only when needed
@@ -561,45 +607,72 @@ def lattice_step(
     if n < QUANT_MIN_LEVELS * QUANT_MIN_REPEAT:
         return None
     probe = v[:: max(1, n // _QUANT_PROBE)]
-    u = np.unique(probe)
+    u, c = np.unique(probe, return_counts=True)
     if u.size < QUANT_MIN_LEVELS or u.size * QUANT_MIN_REPEAT > probe.size:
         return None
-    d = np.diff(u)
-    # values a few ulps apart are one level (a rate formed as Δangle/τ0 is not exact)
-    d = d[d > _QUANT_MERGE * float(u[-1] - u[0])]
-    if d.size + 1 < QUANT_MIN_LEVELS:
+    guess = _level_lattice(u, c.astype(np.float64), rtol)
+    if guess is None:
         return None
-    d_min = float(d.min())
-    for j in range(1, 11):
-        r = d / (d_min / j)
-        k = np.rint(r)
-        if float(np.max(np.abs(r - k))) <= rtol:
-            break
-    else:
-        return None
-    step = float(u[-1] - u[0]) / float(k.sum())  # the gaps between the extreme levels
-    offset = float(u[0])
+    step, origin = guess
     if step <= QUANT_MIN_ULPS * _storage_ulp(probe, max(abs(float(u[0])), abs(float(u[-1])))):
         return None
     # the whole record, in blocks (no array of n quotients)
+    off = 0
     lo_k, hi_k = math.inf, -math.inf
     for a in range(0, n, 1 << 20):
-        q = (v[a : a + (1 << 20)] - offset) / step
+        q = (v[a : a + (1 << 20)] - origin) / step
         kk = np.rint(q)
-        if float(np.max(np.abs(q - kk))) > rtol:
-            return None
-        lo_k, hi_k = min(lo_k, float(kk.min())), max(hi_k, float(kk.max()))
+        on = np.abs(q - kk) <= rtol
+        off += int(on.size - np.count_nonzero(on))
+        if on.any():
+            lo_k, hi_k = min(lo_k, float(kk[on].min())), max(hi_k, float(kk[on].max()))
+    if off > QUANT_MAX_OFF * n or not math.isfinite(lo_k):
+        return None
     span = int(hi_k - lo_k) + 1
     if span > 1 << 24:  # a lattice of more levels than that is no quantisation to report
         return None
     seen = np.zeros(span, dtype=bool)
     for a in range(0, n, 1 << 20):
-        kk = np.rint((v[a : a + (1 << 20)] - offset) / step) - lo_k
-        seen[kk.astype(np.int64)] = True
+        q = (v[a : a + (1 << 20)] - origin) / step
+        kk = np.rint(q)
+        seen[(kk[np.abs(q - kk) <= rtol] - lo_k).astype(np.int64)] = True
     levels = int(np.count_nonzero(seen))
     if levels < QUANT_MIN_LEVELS or levels * QUANT_MIN_REPEAT > n:
         return None
-    return step, offset, levels, n
+    return step, origin + lo_k * step, levels, n
+
+
+def _level_lattice(
+    u: npt.NDArray[np.float64], c: npt.NDArray[np.float64], rtol: float
+) -> tuple[float, float] | None:
+    """(step, origin) of the lattice the distinct levels ``u`` (visited ``c`` times) lie on,
+    or None (:func:`lattice_step`): the median gap between neighbouring levels among those
+    visited at least as often as the median level, refined by weighted least squares."""
+    top = u[c >= np.median(c)]
+    d = np.diff(top)
+    d = d[d > _QUANT_MERGE * float(u[-1] - u[0])]
+    if d.size == 0:
+        return None
+    step = float(np.median(d))
+    ref = float(u[int(np.argmax(c))])
+    origin = ref
+    for reach in (5.0, 20.0, math.inf):
+        k = np.rint((u - origin) / step)
+        sel = np.abs((u - ref) / step) <= reach + 0.5
+        kk, uu, w = k[sel], u[sel], c[sel]
+        if np.unique(kk).size < 2:
+            return None
+        km = float(np.average(kk, weights=w))
+        um = float(np.average(uu, weights=w))
+        step = float(np.sum(w * (kk - km) * (uu - um)) / np.sum(w * (kk - km) ** 2))
+        if not step > 0:
+            return None
+        origin = um - step * km
+    r = (u - origin) / step
+    on = np.abs(r - np.rint(r)) <= rtol
+    if float(c[on].sum()) < (1.0 - QUANT_MAX_OFF) * float(c.sum()):
+        return None
+    return step, origin
 
 
 def _storage_ulp(probe: npt.NDArray[np.float64], top: float) -> float:
@@ -660,9 +733,10 @@ def quantization_from_lattice(
             else None
         ),
         source=(
-            "the samples lie on a lattice of this step (the gcd of the gaps between the "
-            "distinct sample values, every sample within "
-            f"{QUANT_RTOL:g} step of it); a uniform rounding error has variance step²/12 "
+            "the samples lie on a lattice of this step (the greatest common spacing of the "
+            "distinct sample values, a finer storage grid aside; at least "
+            f"{100 * (1 - QUANT_MAX_OFF):g} % of the samples within {QUANT_LEVEL_TOL:g} "
+            "step of it); a uniform rounding error has variance step²/12 "
             "(IEEE Std 952-1997 Annex C.1)"
         ),
     )  # fmt: skip
@@ -694,6 +768,8 @@ def annotate_quantization(terms: NoiseTerms, quant: OutputQuantization | None) -
 
 __all__ = [
     "KALIBR_KEYS",
+    "QUANT_LEVEL_TOL",
+    "QUANT_MAX_OFF",
     "QUANT_MIN_LEVELS",
     "QUANT_MIN_REPEAT",
     "QUANT_RTOL",

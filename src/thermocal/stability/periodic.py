@@ -1,0 +1,240 @@
+"""Periodic terms of a static record: sinusoids found in its spectrum, named with their
+frequency where the Allan deviation shows them.
+
+Pure maths (numpy; scipy.special imported when first needed; no file I/O).
+
+A sinusoid ``A·sin(2π f₀ t)`` in rate data has the Allan deviation (IEEE Std 952-1997
+Annex C.1.7)::
+
+    σ(τ) = A · sin²(π f₀ τ) / (π f₀ τ)
+
+largest, 0.7246·A, at τ = 0.3710/f₀; the noise model σ² = Σ C_p τ^p has no such bump, so
+its fit is poor there.  The sinusoid is found in Welch's averaged periodogram (P. D. Welch,
+IEEE Trans. Audio Electroacoust. 15(2), 1967; Hann windows, half-overlapping segments):
+a bin whose power density stands above the median of its neighbourhood (the local noise
+floor) beyond the chi-square quantile of the periodogram's degrees of freedom at a 1 %
+family-wise false-alarm probability over the bins (and at least 10×).  Its power is the
+density summed over the peak's bins above the floor, ``P = Σ (S − floor)·Δf``, so
+``A = √(2P)``; its frequency the power-weighted centroid of those bins.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any, Final
+
+import numpy as np
+import numpy.typing as npt
+
+from thermocal._lazy import LazyModule
+
+if TYPE_CHECKING:
+    import scipy.special as _special
+else:
+    _special = LazyModule("scipy.special")
+
+SINE_PEAK_TAU: Final = 0.3710
+"""τ·f₀ at which a sinusoid's Allan deviation A·sin²(πf₀τ)/(πf₀τ) is largest."""
+
+SINE_PEAK_FACTOR: Final = 0.7246
+"""The largest Allan deviation of a sinusoid of amplitude A is 0.7246·A (IEEE 952 C.1.7)."""
+
+PERIODIC_FALSE_ALARM: Final = 0.01
+"""Family-wise probability that noise alone makes a peak of the periodogram."""
+
+PERIODIC_MIN_RATIO: Final = 10.0
+"""A peak stands at least this many times above its local floor."""
+
+PERIODIC_MIN_SHARE: Final = 0.05
+"""A periodic term is named when its ADEV bump holds at least this share of the measured
+Allan variance at τ = 0.371/f₀ (a smaller line does not shape the curve)."""
+
+_MIN_SEGMENTS: Final = 8
+"""Welch segments at least (the floor's estimate needs averages)."""
+
+_FLOOR_BINS: Final = 32
+"""The local floor: the median density over this many bins either side."""
+
+_MAX_SAMPLES: Final = 1 << 23
+"""The periodogram reads at most this many samples (the first): 8.4 million give hundreds of
+segments at the longest segment length, and a day at 1 kHz costs no more than that."""
+
+_PEAK_BINS: Final = 3
+"""Bins either side of a peak's maximum that hold its power (a Hann window's main lobe
+spans ±2 bins)."""
+
+
+@dataclass(frozen=True)
+class PeriodicTerm:
+    """A sinusoid found in the record.
+
+    ``frequency_hz`` f₀ [Hz] and its resolution ``resolution_hz`` (the periodogram's bin);
+    ``amplitude`` A [``unit``]; ``ratio`` the peak's density over the local floor;
+    ``tau_peak_s`` 0.3710/f₀ [s] where its Allan deviation ``adev_peak`` = 0.7246·A
+    [``unit``] is largest; ``share`` that bump's share of the measured Allan variance
+    there (None when not compared).
+    """
+
+    frequency_hz: float
+    resolution_hz: float
+    amplitude: float
+    unit: str
+    ratio: float
+    tau_peak_s: float
+    adev_peak: float
+    share: float | None = None
+
+    def adev(self, tau_s: npt.ArrayLike) -> npt.NDArray[np.float64]:
+        """The sinusoid's Allan deviation A·sin²(πf₀τ)/(πf₀τ) [unit] at ``tau_s`` [s]."""
+        x = math.pi * self.frequency_hz * np.asarray(tau_s, dtype=np.float64)
+        return np.asarray(self.amplitude * np.sin(x) ** 2 / x)
+
+    def words(self) -> str:
+        """The term in words, for reasons and text output."""
+        return (
+            f"a periodic term at {self.frequency_hz:.4g} Hz (± {self.resolution_hz:.2g}), "
+            f"amplitude {self.amplitude:.4g} {self.unit}: its Allan deviation "
+            f"A·sin²(πf₀τ)/(πf₀τ) peaks at {self.adev_peak:.4g} {self.unit} at τ = "
+            f"{self.tau_peak_s:.4g} s (IEEE 952 C.1.7)"
+        )
+
+    def to_dict(self) -> dict[str, Any]:
+        """The JSON object of the term."""
+        return {
+            "frequency_hz": self.frequency_hz,
+            "resolution_hz": self.resolution_hz,
+            "amplitude": self.amplitude,
+            "unit": self.unit,
+            "ratio": self.ratio,
+            "tau_peak_s": self.tau_peak_s,
+            "adev_peak": self.adev_peak,
+            "share": self.share,
+            "source": "Welch periodogram peak above the local floor; Allan deviation "
+            "A·sin²(πf₀τ)/(πf₀τ) (IEEE Std 952-1997 C.1.7)",
+        }
+
+
+def welch(
+    x: npt.NDArray[np.float64], fs: float, seg: int
+) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64], int]:
+    """Welch's one-sided power spectral density [unit²/Hz] of ``x`` sampled at ``fs`` [Hz]:
+    Hann segments of ``seg`` samples overlapping by half, each with its least-squares line
+    removed, ``S = 2 |X|² / (fs Σw²)`` averaged (DC and Nyquist not doubled), as
+    ``scipy.signal.welch(x, fs, "hann", seg, detrend="linear")`` (numpy only: scipy.signal
+    costs a command two seconds of import).  Returns (frequencies, S, segments)."""
+    step = seg // 2
+    n_seg = (x.size - seg) // step + 1
+    w = 0.5 - 0.5 * np.cos(2.0 * math.pi * np.arange(seg) / seg)  # periodic Hann
+    t = np.arange(seg, dtype=np.float64) - (seg - 1) / 2.0
+    tt = float(t @ t)
+    view = np.lib.stride_tricks.sliding_window_view(x, seg)[::step][:n_seg]
+    acc = np.zeros(seg // 2 + 1)
+    for a in range(0, n_seg, 32):
+        block = view[a : a + 32]
+        block = block - block.mean(axis=1, keepdims=True)
+        block = block - np.outer(block @ t / tt, t)
+        acc += np.sum(np.abs(np.fft.rfft(block * w, axis=1)) ** 2, axis=0)
+    psd = acc / n_seg * 2.0 / (fs * float(w @ w))
+    psd[0] /= 2.0
+    if seg % 2 == 0:
+        psd[-1] /= 2.0
+    return np.asarray(np.fft.rfftfreq(seg, 1.0 / fs), dtype=np.float64), psd, n_seg
+
+
+def _running_median(x: npt.NDArray[np.float64], half: int) -> npt.NDArray[np.float64]:
+    """The median of ``x`` over ``[i − half, i + half]`` (clipped at the ends)."""
+    pad = np.pad(x, half, mode="reflect")
+    win = np.lib.stride_tricks.sliding_window_view(pad, 2 * half + 1)
+    return np.asarray(np.median(win, axis=1))
+
+
+def periodic_terms(
+    values: npt.ArrayLike, tau0_s: float, unit: str, *, max_terms: int = 3
+) -> tuple[PeriodicTerm, ...]:
+    """The sinusoids of a rate record ``values`` [``unit``] sampled every ``tau0_s`` [s]
+    (module docstring), strongest first, at most ``max_terms``; () when none stands out or
+    the record is too short for :data:`_MIN_SEGMENTS` segments of 256 samples.
+
+    Gaps are the caller's: pass one contiguous stretch (its first :data:`_MAX_SAMPLES`
+    samples are read).
+    """
+    x = np.asarray(values, dtype=np.float64).ravel()[:_MAX_SAMPLES]
+    x = x[np.isfinite(x)]
+    if x.size < 256 * _MIN_SEGMENTS:
+        return ()
+    fs = 1.0 / tau0_s
+    seg = 1 << math.floor(math.log2(x.size / _MIN_SEGMENTS))
+    seg = min(seg, 1 << 16)
+    f, s, n_seg = welch(x, fs, seg)
+    df = float(f[1] - f[0])
+    dof = max(2.0, 2.0 * n_seg * 0.9)  # Hann, half overlap: ≈ 0.9 of the independent dof
+    floor = _running_median(s, _FLOOR_BINS) / (1.0 - 2.0 / (9.0 * dof)) ** 3  # median→mean
+    usable = np.arange(f.size) > 2 * _PEAK_BINS  # away from DC (drifts, the window's leak)
+    usable &= np.arange(f.size) < f.size - 1
+    n_bins = int(usable.sum())
+    if n_bins < 8:
+        return ()
+    thresh = float(_special.chdtri(dof, PERIODIC_FALSE_ALARM / n_bins)) / dof
+    thresh = max(thresh, PERIODIC_MIN_RATIO)
+    ratio = np.where(usable & (floor > 0), s / np.where(floor > 0, floor, 1.0), 0.0)
+    found: list[PeriodicTerm] = []
+    taken = np.zeros(f.size, dtype=bool)
+    for k in np.argsort(ratio)[::-1]:
+        if ratio[k] < thresh or len(found) >= max_terms:
+            break
+        if taken[k]:
+            continue
+        lo, hi = max(k - _PEAK_BINS, 0), min(k + _PEAK_BINS + 1, f.size)
+        taken[max(k - 2 * _PEAK_BINS, 0) : hi + _PEAK_BINS] = True
+        excess = np.maximum(s[lo:hi] - floor[lo:hi], 0.0)
+        power = float(excess.sum()) * df
+        f0 = float(np.sum(excess * f[lo:hi]) / excess.sum())
+        amp = math.sqrt(2.0 * power)
+        found.append(
+            PeriodicTerm(
+                frequency_hz=f0, resolution_hz=df, amplitude=amp, unit=unit,
+                ratio=float(ratio[k]), tau_peak_s=SINE_PEAK_TAU / f0,
+                adev_peak=SINE_PEAK_FACTOR * amp,
+            )
+        )  # fmt: skip
+    return tuple(found)
+
+
+def shaping_terms(
+    found: tuple[PeriodicTerm, ...], tau_s: npt.ArrayLike, adev: npt.ArrayLike
+) -> tuple[PeriodicTerm, ...]:
+    """The terms of ``found`` whose Allan deviation bump holds at least
+    :data:`PERIODIC_MIN_SHARE` of the measured Allan variance ``adev`` [unit] at the τ
+    [s] nearest (in log) to their ``tau_peak_s``, each with its ``share``."""
+    tau = np.asarray(tau_s, dtype=np.float64)
+    dev = np.asarray(adev, dtype=np.float64)
+    ok = np.isfinite(dev) & (dev > 0)
+    if not ok.any():
+        return ()
+    tau, dev = tau[ok], dev[ok]
+    out = []
+    for p in found:
+        k = int(np.argmin(np.abs(np.log(tau / p.tau_peak_s))))
+        share = float(p.adev(tau[k])[()] ** 2 / dev[k] ** 2)
+        if share >= PERIODIC_MIN_SHARE:
+            out.append(
+                PeriodicTerm(
+                    p.frequency_hz, p.resolution_hz, p.amplitude, p.unit, p.ratio,
+                    p.tau_peak_s, p.adev_peak, min(share, 1.0),
+                )
+            )  # fmt: skip
+    return tuple(out)
+
+
+__all__ = [
+    "PERIODIC_FALSE_ALARM",
+    "PERIODIC_MIN_RATIO",
+    "PERIODIC_MIN_SHARE",
+    "SINE_PEAK_FACTOR",
+    "SINE_PEAK_TAU",
+    "PeriodicTerm",
+    "periodic_terms",
+    "shaping_terms",
+    "welch",
+]
