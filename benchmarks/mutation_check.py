@@ -1103,8 +1103,8 @@ MUTANTS: tuple[Mutant, ...] = (
     Mutant(
         "multipos-gap-factor",
         P + "multipos/gyro.py",
-        "> 1.5 * dt_med)",
-        "> 15.0 * dt_med)",
+        "GAP_FACTOR: float = 1.5",
+        "GAP_FACTOR: float = 15.0",
         MULTI,
         "multi-position: a turn across a gap of 10 samples integrated",
     ),

@@ -30,7 +30,7 @@ import numpy as np
 import numpy.typing as npt
 
 from thermocal import units
-from thermocal.errors import DesignError, ThermocalWarning
+from thermocal.errors import DesignError, ThermocalInputError, ThermocalWarning
 from thermocal.multipos import accel as _accel
 from thermocal.multipos import gyro as _gyro
 from thermocal.multipos.geometry import attitude_along
@@ -174,6 +174,7 @@ def _named_turns(
     face_sigma_rad: dict[str, float],
     where: str,
     sections_from: str,
+    saturated: npt.NDArray[np.bool_] | None = None,
 ) -> list[_gyro.Turn]:
     """Each named turn about the sensor axis of its name (``x_rot``: x), judged first
     (:func:`.gyro.check_turn`), with the calibrated up direction during it and the
@@ -186,8 +187,23 @@ def _named_turns(
     e_a = model.error_matrices(acc.theta)
     var = np.diag(acc.cov)
     out = []
+    dt_med = float(np.median(dt_s))
     for tr in turns:
         j = "xyz".index(tr.name[0])
+        gap = _gyro.turn_gap(dt_s, tr, dt_med)
+        if gap is not None:
+            raise ThermocalInputError(
+                f"{where} {tr.name!r}: a gap in time of {gap[1]:.3g} s after sample {gap[0]} "
+                "inside the turn: the rotation across it is unknown; fix its start and end "
+                f"in {sections_from}, or record the turn again"
+            )
+        if saturated is not None and np.any(saturated[tr.start : tr.end]):
+            i = tr.start + int(np.argmax(saturated[tr.start : tr.end]))
+            raise ThermocalInputError(
+                f"{where} {tr.name!r}: the gyro sits on its rails at sample {i} inside the "
+                "turn: the rotation is unknown; turn more slowly (or at a wider gyro range) "
+                f"and record it again, or leave the turn out of {sections_from}"
+            )
         rot = _gyro.turn_rotation(rate_rad_s, dt_s, bias_rad_s, tr)
         _gyro.check_turn(rot, tr.name, j, f"{where} {tr.name!r}", sections_from)
         c = np.linalg.solve(np.eye(3) + e_a, accel_mg[tr.start : tr.end].mean(axis=0)
@@ -200,9 +216,50 @@ def _named_turns(
     return out
 
 
+def _section_warnings(
+    statics: Sequence[Section],
+    turns: Sequence[Section],
+    has_gyro: bool,
+    where: str,
+    sections_from: str,
+) -> tuple[str, ...]:
+    """Warnings on the sections before any fit (turns named without a gyro, poses not
+    still); the names of the poses not still."""
+    if turns and not has_gyro:
+        warnings.warn(
+            ThermocalWarning(
+                f"{where}: {', '.join(s.name for s in turns)} in {sections_from} are 360° "
+                "turns for the gyro; without its columns (--gyro X,Y,Z) they are not used"
+            ),
+            stacklevel=3,
+        )
+    not_still = tuple(s.name for s in statics if s.still_ratio > 2.0)
+    if not_still:
+        warnings.warn(
+            ThermocalWarning(
+                f"{where}: {len(not_still)} poses are not still (window variance more than "
+                f"twice the quietest): {', '.join(not_still[:8])}"
+                f"{' …' if len(not_still) > 8 else ''}; their means carry the motion"
+            ),
+            stacklevel=3,
+        )
+    return not_still
+
+
 def _warn_implausible(gfit: _gyro.GyroFit, where: str) -> None:
     """A warning when a gyro scale factor or misalignment is beyond
-    :data:`GYRO_E_PLAUSIBLE` (no sensor's: a unit, count scale or pose is wrong)."""
+    :data:`GYRO_E_PLAUSIBLE` (no sensor's: a unit, count scale or pose is wrong), and
+    when the gyro comes from the three turns alone (nothing checks them)."""
+    if gfit.n_motions == 0:
+        warnings.warn(
+            ThermocalWarning(
+                f"{where}: the gyro from the three turns alone (no motion between still "
+                "poses without a gap in time): nothing checks them, a lean of their axes "
+                "is taken for misalignment and σ counts the noise only; record the faces "
+                "and turns in one piece for the motions between them"
+            ),
+            stacklevel=3,
+        )
     th = gfit.theta
     bad = [f"scale factor {ax} {th[3 + i] * units.PPM:+.1%}" for i, ax in enumerate("xyz")
            if abs(th[3 + i] * units.PPM) > GYRO_E_PLAUSIBLE]  # fmt: skip
@@ -255,9 +312,9 @@ def calibrate_session(
     """Calibrate the accelerometer (and gyro) triad of one session (module docstring).
     ``accel_mg`` (n, 3) [mg], ``gyro_rad_s`` (n, 3) [rad/s] or None, ``g_mg`` local
     gravity [mg]; ``sections`` from a POSES file (named ``sections_from`` in messages),
-    else found from the data; ``saturated``
-    (n,) the samples with a gyro axis on its rails (their motions left out of the gyro fit);
-    ``gyro_model`` the elements of the gyro's E fitted (:data:`.gyro.GYRO_MODELS`)."""
+    else found from the data; ``saturated`` (n,) the samples with a gyro axis on its rails
+    (their motions left out of the gyro fit, a turn holding one refused); ``gyro_model`` the
+    elements of the gyro's E fitted (:data:`.gyro.GYRO_MODELS`)."""
     t = np.asarray(time_s, dtype=np.float64)
     a = np.asarray(accel_mg, dtype=np.float64)
     w = None if gyro_rad_s is None else np.asarray(gyro_rad_s, dtype=np.float64)
@@ -265,24 +322,7 @@ def calibrate_session(
         sections = detect_poses(t, a, w, static_s=static_s)
     statics = [s for s in sections if not s.is_turn]
     turns = [s for s in sections if s.is_turn]
-    if turns and w is None:
-        warnings.warn(
-            ThermocalWarning(
-                f"{where}: {', '.join(s.name for s in turns)} in {sections_from} are 360° "
-                "turns for the gyro; without its columns (--gyro X,Y,Z) they are not used"
-            ),
-            stacklevel=2,
-        )
-    not_still = tuple(s.name for s in statics if s.still_ratio > 2.0)
-    if not_still:
-        warnings.warn(
-            ThermocalWarning(
-                f"{where}: {len(not_still)} poses are not still (window variance more than "
-                f"twice the quietest): {', '.join(not_still[:8])}"
-                f"{' …' if len(not_still) > 8 else ''}; their means carry the motion"
-            ),
-            stacklevel=2,
-        )
+    not_still = _section_warnings(statics, turns, w is not None, where, sections_from)
     stats = pose_stats(a, w, statics)
     if len(stats) < 6:
         raise DesignError(
@@ -327,12 +367,13 @@ def calibrate_session(
         dt = np.diff(t)
         dt = np.concatenate([dt, dt[-1:]])
         dir_sig = _direction_sigma(sig, names, acc.method, g_mg)
+        sat = None if saturated is None else np.asarray(saturated, dtype=bool)
         named = _named_turns(turns, w, dt, bias, a, acc, dict(zip(names, dir_sig, strict=True)),
-                             f"{where}: section", sections_from)  # fmt: skip
+                             f"{where}: section", sections_from, sat)  # fmt: skip
         gfit = _gyro.fit_rotations(
             w, dt, [p.section for p in stats], up_of, free, free_cov, bias, bias_cov,
             dir_sig, float(np.sqrt(np.mean(ws**2))), named, latitude_deg=latitude_deg,
-            saturated=None if saturated is None else np.asarray(saturated, dtype=bool),
+            saturated=sat,
             model=gyro_model,
         )  # fmt: skip
         _warn_implausible(gfit, where)

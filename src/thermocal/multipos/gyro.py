@@ -85,6 +85,9 @@ from thermocal.turntable import model
 FloatArray = npt.NDArray[np.float64]
 
 
+GAP_FACTOR: float = 1.5
+"""An interval above this many median intervals is a gap in time: no motion is
+integrated across it, no turn may hold one."""
 TURN_ANGLE_TOLERANCE: float = 0.10
 """A named turn's angle (raw rate, bias removed) may differ from 360° by this fraction;
 more (a quarter turn, two turns, a wrong gyro unit) is refused (:func:`check_turn`).
@@ -113,6 +116,24 @@ class Turn:
     axis_sigma_rad: float
 
 
+def turn_intervals(dt_s: FloatArray, section: Section, dt_med: float) -> FloatArray:
+    """τ [s] of a turn's samples: their forward intervals, the last one the median
+    interval ``dt_med`` when a gap follows the turn (sections recorded apart, imucal's
+    annotated sessions); a gap inside a turn is refused before (:func:`turn_gap`)."""
+    tau: FloatArray = dt_s[section.start : section.end].copy()
+    if tau.size and tau[-1] > GAP_FACTOR * dt_med:
+        tau[-1] = dt_med
+    return tau
+
+
+def turn_gap(dt_s: FloatArray, section: Section, dt_med: float) -> tuple[int, float] | None:
+    """The first gap in time inside a turn (interval above ``GAP_FACTOR × dt_med``): the
+    sample before it and its length [s]; None without one."""
+    inside = dt_s[section.start : section.end - 1]
+    big = np.flatnonzero(inside > GAP_FACTOR * dt_med)
+    return None if big.size == 0 else (section.start + int(big[0]), float(inside[big[0]]))
+
+
 def turn_rotation(
     rate_rad_s: FloatArray, dt_s: FloatArray, bias_rad_s: FloatArray, section: Section
 ) -> FloatArray:
@@ -126,7 +147,7 @@ def turn_rotation(
     rate_rad_s : ndarray, shape (n, 3)
         Gyro rate [rad/s].
     dt_s : ndarray, shape (n,)
-        Each sample's interval τ [s].
+        Each sample's forward interval [s] (τ: :func:`turn_intervals`).
     bias_rad_s : ndarray, shape (3,)
         Gyro bias b [rad/s].
     section : Section
@@ -138,7 +159,8 @@ def turn_rotation(
         The rotation vector [rad], in the gyro's own axes.
     """
     sl = slice(section.start, section.end)
-    out: FloatArray = ((rate_rad_s[sl] - bias_rad_s) * dt_s[sl][:, None]).sum(axis=0)
+    tau = turn_intervals(dt_s, section, float(np.median(dt_s)))
+    out: FloatArray = ((rate_rad_s[sl] - bias_rad_s) * tau[:, None]).sum(axis=0)
     return out
 
 
@@ -288,7 +310,7 @@ def _motions(
     motions: list[_Motion] = []
     for k in range(len(poses) - 1):
         p0, p1 = poses[k], poses[k + 1]
-        if np.any(dt_s[p0.start : p1.end - 1] > 1.5 * dt_med):
+        if np.any(dt_s[p0.start : p1.end - 1] > GAP_FACTOR * dt_med):
             continue  # a gap in time: the rotation across it is unknown
         t_k, t_k1 = p0.n * dt_med, p1.n * dt_med
         t_m = (p1.start - p0.end) * dt_med
@@ -372,7 +394,7 @@ class _Rotations:
         for t_i, tn in enumerate(turns):
             sl = slice(tn.section.start, tn.section.end)
             wc = (rate_rad_s[sl] - b) @ ie_inv.T
-            tau = dt_s[sl][:, None]
+            tau = turn_intervals(dt_s, tn.section, dt_med)[:, None]
             tot = (wc * tau).sum(axis=0)
             sense = 1.0 if float(tot[tn.axis]) >= 0 else -1.0
             t_turn = tn.section.n * dt_med
@@ -577,11 +599,13 @@ def fit_rotations(
     motions = unsaturated(motions, saturated)
     rot = _Rotations(rate_rad_s, dt_s, dt_med, motions, turns, rate_sigma_rad_s,
                      latitude_deg, free=GYRO_MODELS[model])  # fmt: skip
-    if rot.n_rows < len(rot.free) + 3:
+    three_turns = {tn.axis for tn in turns} == {0, 1, 2}
+    if rot.n_rows < len(rot.free) + 3 and not three_turns:
         raise DesignError(
-            f"{len(motions)} motions between static poses: the gyro's scale factors and "
-            "misalignments need rotations about at least two different axes (and a still "
-            "pose before and after each)"
+            f"{len(motions)} motions between static poses (none across a gap in time) and "
+            f"{len(turns)} named turns: the gyro's scale factors and misalignments need "
+            "rotations about at least two different axes with a still pose before and "
+            "after each, or the three turns x_rot, y_rot, z_rot"
         )
     r0, _j, _jb, _a = rot.evaluate(np.zeros((3, 3)), bias_rad_s, up, jac=False)
     e = _solve_error_matrix(rot, bias_rad_s, up, max_iter)
@@ -655,6 +679,7 @@ def _residuals_fixed_att(
 
 
 __all__ = [
+    "GAP_FACTOR",
     "GYRO_MODELS",
     "TURN_ANGLE_TOLERANCE",
     "TURN_AXIS_TOLERANCE_DEG",
@@ -664,5 +689,7 @@ __all__ = [
     "fit_rotations",
     "static_bias",
     "too_few_motions",
+    "turn_gap",
+    "turn_intervals",
     "turn_rotation",
 ]
