@@ -122,9 +122,7 @@ def test_names_with_a_temperature_first_is_not_time(
 
 # --- 2, 3: a sample counter is the time with --rate; multipos takes --rate ---------------
 
-IMUCAL = (
-    Path(__file__).parent / "data" / "imucal_session_head" / "example_ferraris_session_head.csv"
-)
+IMUCAL = Path(__file__).parent / "data" / "imucal_ferraris" / "example_ferraris_session.csv"
 
 
 def test_imucal_counter_is_time_with_rate(capsys: pytest.CaptureFixture[str]) -> None:
@@ -136,8 +134,8 @@ def test_imucal_counter_is_time_with_rate(capsys: pytest.CaptureFixture[str]) ->
     code, out, err = _run(capsys, "inspect", str(IMUCAL), "--rate", "102.4", "--json")
     assert code == 0, err
     d = json.loads(out)
-    assert d["n_samples"] == 1000
-    assert_allclose(d["duration_s"], 999 / 102.4)
+    assert d["n_samples"] == 10376
+    assert_allclose(d["duration_s"], 10375 / 102.4)
     assert d["gaps"] == []
     assert not [w for w in _warnings(err) if "time column" in w], err
     rec = read_recording(IMUCAL, text=_rate(102.4))

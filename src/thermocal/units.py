@@ -398,6 +398,7 @@ def resolve_unit(
     where: str = "",
     option_name: str | None = None,
     ask: str | None = None,
+    implied: str | None = None,
 ) -> ResolvedUnit:
     """The unit of ``column``, resolved once, in INTERFACE.md's order: command-line option
     > the file's own metadata > units in the column name > the units recorded in the model
@@ -406,7 +407,9 @@ def resolve_unit(
     warning naming both (``option_name``: the option as the user wrote it); so does one that
     contradicts the unit written in the column's name (``--time-unit s`` on ``time (ms)``).
     With ``ask`` (an option's name, e.g. ``--accel-unit``) a unit nobody stated is not
-    assumed: a :class:`UnitError` asks for that option.  This is the only place in
+    assumed: a :class:`UnitError` asks for that option.  With ``implied`` (a unit another
+    option implies: raw ``counts`` where ``multipos --accel-scale`` gives one count's size)
+    a unit nobody stated is that one, without a warning.  This is the only place in
     thermocal that chooses a unit nobody stated.
     """
     norm = _normalizer(role)
@@ -440,6 +443,8 @@ def resolve_unit(
         return ResolvedUnit(named, "column name")
     if model:
         return ResolvedUnit(norm(model), "model")
+    if implied:
+        return ResolvedUnit(norm(implied), "option")
     if ask:
         raise UnitError(
             f"{prefix}no unit stated for column {column!r}; give {ask} (or the unit in the "
@@ -510,6 +515,9 @@ class UnitOptions:
     ask: Mapping[str, str] = field(default_factory=dict)
     """Signal column → the option to ask for when nothing states its unit (no default is
     assumed: ``multipos`` asks for its accelerometer's unit rather than assume a rate)."""
+    implied: Mapping[str, str] = field(default_factory=dict)
+    """Signal column → the unit another option implies when nothing states one (``counts``
+    for the columns of a triad given a count scale)."""
 
 
 @dataclass(frozen=True)
@@ -654,6 +662,7 @@ def resolve_inputs(
             default=mod.signal_default,
             where=where,
             ask=opt.ask.get(c),
+            implied=opt.implied.get(c),
         )
         for c in signals
     }

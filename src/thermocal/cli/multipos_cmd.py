@@ -201,8 +201,9 @@ def _human(out: dict[str, Any], a_unit: str, output: Path) -> None:
             table.add_row(f"scale factor {ax}", fmt(d["scale_factor_ppm"][i], 5),
                           fmt(d["scale_factor_ppm_sigma"][i], 3), "ppm")  # fmt: skip
         for i, n in enumerate(d["misalignment_names"]):
+            sig = d["misalignment_arcsec_sigma"][i]  # 0: an element the model holds at 0
             table.add_row(f"misalignment {n}", fmt(d["misalignment_arcsec"][i], 5),
-                          fmt(d["misalignment_arcsec_sigma"][i], 3), "″")  # fmt: skip
+                          fmt(sig, 3) if sig else "held (not fitted)", "″")  # fmt: skip
         stdout.print(table)
     for run in out["runs"]:
         lean = run.get("gyro", {}).get("turn_axis_lean_deg", 0.0)

@@ -165,7 +165,8 @@ def _unit_of(
     scale: tuple[float, str] | None = None,
 ) -> tuple[str, float]:
     """The columns' unit and the factor to it: the option, else the file's (metadata,
-    column name); raw counts need ``scale`` (their unit is then the scale's)."""
+    column name; raw ``counts`` where a ``scale`` is given and nothing states one, as the
+    reader resolves them); raw counts need ``scale`` (their unit is then the scale's)."""
     stated = [c for c in cols if rec.unit_sources.get(c, "default") != "default"]
     found = {option} if option else {rec.units.get(c) or "" for c in stated}
     if not option and len(stated) < 3:
@@ -388,8 +389,10 @@ def _session(
         path, time=opts.time, time_unit=opts.time_unit, signals=[*acc_cols, *(gyr_cols or [])],
         signal_unit=",".join(given) if all(given) else None,  # type: ignore[arg-type]
         temperatures=[temps] if temps else None, text=opts.text,
-        ask_units={**dict.fromkeys(acc_cols, "--accel-unit"),
-                   **dict.fromkeys(gyr_cols or [], "--gyro-unit")},
+        ask_units={**dict.fromkeys([] if opts.accel_scale else acc_cols, "--accel-unit"),
+                   **dict.fromkeys([] if opts.gyro_scale else (gyr_cols or []), "--gyro-unit")},
+        implied_units={**dict.fromkeys(acc_cols if opts.accel_scale else [], "counts"),
+                       **dict.fromkeys((gyr_cols or []) if opts.gyro_scale else [], "counts")},
     )  # fmt: skip
     rec.validate(required=[*acc_cols, *(gyr_cols or []), *([temps] if temps else [])])
     acc, au, a_off = _triad(rec, acc_cols, opts, "accel", path)

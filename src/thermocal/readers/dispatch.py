@@ -435,6 +435,7 @@ def read_recording(
     topic: str | None = None,
     guess_temperatures: bool = False,
     ask_units: dict[str, str] | None = None,
+    implied_units: dict[str, str] | None = None,
 ) -> Recording:
     """Read a CSV, text log or Parquet recording, or a station's recording folder.
 
@@ -463,6 +464,8 @@ def read_recording(
     guess_temperatures : no temperatures given or in a sidecar: those named like one.
     ask_units : signal column → the option a :class:`UnitError` asks for when nothing
         states its unit (:class:`thermocal.units.UnitOptions`; no default is assumed).
+    implied_units : signal column → the unit another option implies when nothing states
+        one (``counts`` for a triad given a count scale), taken without a warning.
 
     Units and temperature conversions are resolved once by
     :func:`thermocal.units.resolve_inputs` (option > file metadata > column name > model
@@ -492,7 +495,7 @@ def read_recording(
     )
     options = units.UnitOptions(  # a counter / rate is in s
         "s" if mode == "counter" else time_unit, signal_unit, temp_unit, temp_conversion,
-        dict(ask_units or {}),
+        dict(ask_units or {}), dict(implied_units or {}),
     )  # fmt: skip
     resolved = _resolve_units(p, info, (time_col, sig_names, tmp_names), options, meta, model)
     n_used = len(names) if keep_other else 1 + len(sig_names) + len(tmp_names)
