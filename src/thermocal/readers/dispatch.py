@@ -448,8 +448,7 @@ def read_recording(
     signals, temperatures : column names with those roles (default: sidecar's).
     signal_unit, temp_unit : units of those columns (override the sidecar); ``signal_unit``
         may be ``U1,…,Un``, one per signal.
-    meta : metadata that overrides the file's (its temperature conversions count as
-        options).
+    meta : metadata that overrides the file's (its temperature conversions count as options).
     keep_other : keep the other numeric columns (non-numeric ones are skipped).
     skipped : if a list is given, the names of skipped non-numeric columns are appended.
     temp_conversion : ``--temp-conversion``, the counts → °C conversion of every
@@ -462,15 +461,13 @@ def read_recording(
         decimal commas are detected without it.
     topic : a PX4 ULog's topic instance, ``NAME[.N]`` (default ``sensor_gyro.0``).
     guess_temperatures : no temperatures given or in a sidecar: those named like one.
-    ask_units : signal column → the option a :class:`UnitError` asks for when nothing
-        states its unit (:class:`thermocal.units.UnitOptions`; no default is assumed).
-    implied_units : signal column → the unit another option implies when nothing states
-        one (``counts`` for a triad given a count scale), taken without a warning.
+    ask_units, implied_units : signal column → the option a :class:`UnitError` asks for,
+        or the unit another option implies (``counts``: a count scale), where nothing
+        states its unit (:class:`thermocal.units.UnitOptions`).
 
     Units and temperature conversions are resolved once by
     :func:`thermocal.units.resolve_inputs` (option > file metadata > column name > model
-    file > a default stated in a warning); the source of each is in
-    ``Recording.unit_sources``.
+    file > a default stated in a warning); each one's source is ``Recording.unit_sources``.
 
     Raises
     ------
