@@ -387,7 +387,7 @@ def _session(
     given = [opts.accel_unit] * 3 + ([opts.gyro_unit] * 3 if gyr_cols else [])
     rec = read_recording(
         path, time=opts.time, time_unit=opts.time_unit, signals=[*acc_cols, *(gyr_cols or [])],
-        signal_unit=",".join(given) if all(given) else None,  # type: ignore[arg-type]
+        signal_unit=",".join(u or "" for u in given) if any(given) else None,
         temperatures=[temps] if temps else None, text=opts.text,
         ask_units={**dict.fromkeys([] if opts.accel_scale else acc_cols, "--accel-unit"),
                    **dict.fromkeys([] if opts.gyro_scale else (gyr_cols or []), "--gyro-unit")},
