@@ -36,3 +36,28 @@ def test_multipos_one_unit_given_asks_for_the_other(tmp_path: Path) -> None:
     code, _, err = _run([*base, "--gyro-unit", "deg/s"])
     assert code == 2
     assert "'acc_x'" in err and "--accel-unit" in err, err
+
+
+def test_multipos_too_few_distinct_poses_names_the_file_and_poses(tmp_path: Path) -> None:
+    """imucal's session without its section list: the detector finds the six faces (6
+    distinct directions of 13 poses).  The refusal said ``error: 6 distinct poses … place
+    the board in more orientations``: no file, and not the way this user already has — the
+    six-face closed form with the faces named in ``--poses``."""
+    code, _, err = _run(["multipos", str(FERRARIS), "-o", str(tmp_path / "c.json"),
+                         "--rate", "102.4", "--accel", "acc_x,acc_y,acc_z",
+                         "--accel-unit", "m/s^2", "--gravity", "9.81"])  # fmt: skip
+    assert code == 2
+    line = [ln for ln in err.splitlines() if ln.startswith("error: ")]
+    assert len(line) == 1, err
+    assert "6 distinct poses" in line[0], err
+    assert str(FERRARIS) in line[0] and "--poses" in line[0], err
+    # a session of one direction is not pointed at the six faces
+    xsens = DATA / "imu_tk_xsens" / "xsens_imu_tk.parquet"
+    code, _, err = _run(["multipos", str(xsens), "-o", str(tmp_path / "x.json"),
+                         "--accel", "acc_x [counts],acc_y [counts],acc_z [counts]",
+                         "--accel-scale", "0.00265,m/s^2", "--accel-offset", "0",
+                         "--gravity", "9.81"])  # fmt: skip
+    assert code == 2 and "1 distinct poses" in err and "--accel-offset" in err, err
+    line = [ln for ln in err.splitlines() if ln.startswith("error: ")]
+    assert len(line) == 1 and "--poses" not in line[0], err
+    assert line[0].count(str(xsens)) == 1, err

@@ -101,19 +101,26 @@ _FREE_FACTOR = np.array([1.0, 1.0, 1.0] + [1e-3 / units.PPM] * 3 + [1e-3 * units
 """θ units per unit of the free parameters (mg; 10⁻³ → ppm; 10⁻³ rad → ″)."""
 
 
-def check_poses(f_mg: FloatArray) -> None:
-    """Refuse poses that cannot determine the nine parameters: fewer than nine distinct
-    gravity directions, or directions all near one plane (a scale factor or a bias along
-    the plane's normal is then unseen)."""
+def distinct_directions(f_mg: FloatArray) -> list[FloatArray]:
+    """The unit gravity directions of the poses ``f_mg`` (n, 3) [mg], each more than
+    :data:`DISTINCT_DEG` from those kept before it (in pose order)."""
     u = f_mg / np.linalg.norm(f_mg, axis=1)[:, None]
     distinct: list[FloatArray] = []
     for v in u:
         if all(float(v @ d) < math.cos(math.radians(DISTINCT_DEG)) for d in distinct):
             distinct.append(v)
+    return distinct
+
+
+def check_poses(f_mg: FloatArray) -> None:
+    """Refuse poses that cannot determine the nine parameters: fewer than nine distinct
+    gravity directions, or directions all near one plane (a scale factor or a bias along
+    the plane's normal is then unseen)."""
+    distinct = distinct_directions(f_mg)
     if len(distinct) < MIN_POSES:
         raise DesignError(
             f"{len(distinct)} distinct poses (gravity directions more than {DISTINCT_DEG:g}° "
-            f"apart) of {len(u)}: the accelerometer's bias, scale factors and misalignments "
+            f"apart) of {len(f_mg)}: the accelerometer's bias, scale factors and misalignments "
             f"need at least {MIN_POSES}; place the board in more orientations"
         )
     w, v = np.linalg.eigh(np.asarray(distinct).T @ np.asarray(distinct) / len(distinct))
@@ -276,6 +283,7 @@ __all__ = [
     "MISFIT_ITERATIONS",
     "AccelFit",
     "check_poses",
+    "distinct_directions",
     "fit_gravity_magnitude",
     "fit_six_faces",
     "misfit_tau",

@@ -420,7 +420,7 @@ def _session(
         if opts.accel_scale is None or "distinct poses" not in str(exc):
             raise
         raise DesignError(
-            f"{path}: {exc}; or, if the raw counts' zero is not 0 (unsigned ADC counts sit "
+            f"{exc}; or, if the raw counts' zero is not 0 (unsigned ADC counts sit "
             "around mid-scale), give it with --accel-offset (e.g. 32768)"
         ) from None
     acc_off_mg = float(units.convert(np.array([a_off]), au, "mg")[0]) if a_off else 0.0
