@@ -1108,6 +1108,7 @@ def compensate_triads(
     chunk_rows: int = DEFAULT_CHUNK_ROWS,
     topic: str | None = None,
     signal_unit: str | None = None,
+    text: TextOptions | None = None,
 ) -> list[TriadCompensation]:
     """Apply triad calibrations (issue 19) to a recording: for each triad and each of its
     axes a column ``<col>_comp = [(I + E(T))⁻¹ (x − b(T))]_axis`` in the column's own unit,
@@ -1117,7 +1118,7 @@ def compensate_triads(
     converted first, ``x = count_scale · N``, and their ``_comp`` columns are in the
     triad's physical unit; raw counts for a triad without a count scale are refused.
     ``signal_unit`` (``--signal-unit``): one unit for every triad column, or one per column
-    in the triads' order.
+    in the triads' order; ``text`` the text-log options (``--rate`` for a log without time).
 
     In chunks of ``chunk_rows`` rows with constant memory, like :func:`compensate_channels`
     (issue 26): the correction is per sample, so each chunk's values equal those of a
@@ -1131,7 +1132,7 @@ def compensate_triads(
     kind_out = file_kind(dst)
     check_not_input(dst, [src])
     _check_chunk_rows(chunk_rows)
-    source = _open_source(src, kind_in, time, None, topic)
+    source = _open_source(src, kind_in, time, text, topic)
     plans = [_triad_plan(tri, source.names, source.available, src) for tri in triads]
     resolved = _resolve_triads(source, plans, time_unit, signal_unit)
     out_info = _triad_output_info(source.info, source.time_col, resolved, plans)
@@ -1436,7 +1437,7 @@ def compensate_calibration_file(
             )
         done = compensate_triads(
             cal.triads, path, out, time=time, time_unit=time_unit, chunk_rows=chunk_rows,
-            topic=topic, signal_unit=signal_unit,
+            topic=topic, signal_unit=signal_unit, text=text,
         )  # fmt: skip
         return CalibrationCompensation(str(model_file), str(out), "triads", tuple(done))
     common: dict[str, Any] = dict(
