@@ -97,3 +97,20 @@ def test_compensate_takes_rate_for_a_triad_calibration(mpu_cal: Path, tmp_path: 
     assert np.array_equal(got["gx"], raw[:, 3])
     assert np.diff(got["time"]) == pytest.approx(0.01)
     assert float(np.sum(got["gx_comp"]) * 0.01) == pytest.approx(90.0, abs=1.0)
+
+
+def test_inspect_does_not_call_a_chamber_setpoint_clipped(tmp_path: Path) -> None:
+    """``thermocal simulate mems-imu`` then ``thermocal inspect`` of it: the chamber's
+    setpoint holds −20 and +50 °C for hours, which the rail detector took for a clipped
+    sensor ("setpoint_c has 14403 samples on its rails … rates and rotations across them
+    are wrong").  Temperatures (by role or by unit) do not clip; the simulator's signals do
+    not either (its truth), so nothing is on a rail.  A raw-count gyro on the int16 rails is
+    still found (the MPU-6050 session, README: gx at rows 3910–3911 and 6662–6671)."""
+    rec = tmp_path / "mems.parquet"
+    assert _run(["simulate", "mems-imu", "-o", str(rec)])[0] == 0
+    code, out, err = _run(["inspect", str(rec), "--json"])
+    assert code == 0, err
+    assert "rails" not in err and "saturated" not in out, err
+    code, out, err = _run(["inspect", str(MPU / "example_data_calibration.csv"), "--rate", "100"])
+    assert code == 0, err
+    assert "column 'gx' has 12 samples on its rails" in out + err, out + err

@@ -304,7 +304,7 @@ def inspect_recording(rec: Recording) -> Inspection:
                     row=first_spike,
                 )
             )
-        if role != "temperature":
+        if role != "temperature" and rec.units.get(name) != "degC":  # a setpoint's holds
             problems.extend(_saturation_problems(name, arr))
         columns[name] = ColumnSummary(
             name=name,
