@@ -1084,6 +1084,14 @@ MUTANTS: tuple[Mutant, ...] = (
         "minimum sought among the last points of one or two degrees of freedom",
     ),
     Mutant(
+        "noise-periodic-stretch-unmasked",
+        P + "stability/allan.py",
+        "        free &= ~(share >= PERIODIC_CLEAN_SHARE)\n",
+        "        pass\n",
+        _t("h38_audit"),
+        "the -1/2 stretch read where a sinusoid holds a third of the Allan variance",
+    ),
+    Mutant(
         "noise-periodic-amplitude",
         P + "stability/periodic.py",
         "amp = math.sqrt(2.0 * power)",

@@ -439,4 +439,5 @@ def allan_of(time_s: FloatArray, x: FloatArray, tau0_s: float, unit: str) -> All
     longest = max(segs, key=lambda sl: sl.stop - sl.start) if segs else slice(None)
     found = periodic_terms(np.asarray(x, dtype=np.float64)[longest], tau0_s, unit)
     res = overlapping_adev(x, tau0_s, "octave", time_s=time_s, unit=unit)
-    return AllanAnalysis(result=res, terms=annotate_periodic(noise_terms(res), res, found))
+    terms = noise_terms(res, periodic=found)
+    return AllanAnalysis(result=res, terms=annotate_periodic(terms, res, found))

@@ -1199,8 +1199,8 @@ def _read_white(
     ld: FloatArray,
     edf: FloatArray,
     local: FloatArray,
-    lo_ratio: FloatArray,
-    hi_ratio: FloatArray,
+    ratios: tuple[FloatArray, FloatArray],
+    allowed: npt.NDArray[np.bool_],
 ) -> tuple[float, float, float, float, tuple[float, float]] | str:
     """The angle random walk N on the −½ stretch (:func:`white_stretch`): (value, low, high,
     τ of the stretch's best-determined point, the stretch's τ range) in native units, or
@@ -1209,8 +1209,10 @@ def _read_white(
     N is read is part of the uncertainty); rejected when the line lies more than 25 % above the
     curve's upper bound at a τ at or beyond the stretch's start (every term lies below the
     curve; only a sensor's own filter pulls the curve below it, at τ shorter than the
-    stretch)."""
-    st = white_stretch(tau, np.exp(ld), edf, np.abs(local + 0.5) <= _SLOPE_TOLERANCE)
+    stretch).  ``ratios`` the points' interval bounds over their value; ``allowed`` the
+    points the stretch may hold (those no sinusoid shapes)."""
+    lo_ratio, hi_ratio = ratios
+    st = white_stretch(tau, np.exp(ld), edf, (np.abs(local + 0.5) <= _SLOPE_TOLERANCE) & allowed)
     if st is None:
         slopes = np.diff(ld) / np.diff(lt)
         return (
@@ -1250,11 +1252,14 @@ def _slope_terms(
     fit_reasons: list[str | None],
     poor: bool,
     ok: npt.NDArray[np.bool_] | None = None,
+    free: npt.NDArray[np.bool_] | None = None,
 ) -> list[NoiseTerm]:
     """The slope-line terms of :func:`noise_terms` (IEEE 952 C.3, read by
     :func:`_read_slope`, the angle random walk by :func:`_read_white`; bias instability at
-    the curve's minimum when the curve turns up); ``ok`` the points used."""
+    the curve's minimum when the curve turns up); ``ok`` the points used, ``free`` those the
+    −½ stretch may hold (:func:`periodic_free`)."""
     ok = _usable(result) if ok is None else ok
+    allowed = np.ones(int(ok.sum()), dtype=bool) if free is None else free[ok]
     tau = result.tau_s[ok]
     dev = result.adev[ok]
     lo_ratio = result.adev_low[ok] / dev
@@ -1269,7 +1274,7 @@ def _slope_terms(
     for j, (factor, u, label) in enumerate(specs):
         rng: tuple[float, float] | None = None
         if j == 1:
-            white = _read_white(tau, lt, ld, edf, local, lo_ratio, hi_ratio)
+            white = _read_white(tau, lt, ld, edf, local, (lo_ratio, hi_ratio), allowed)
             term: tuple[float, float, float, float] | str = (
                 white if isinstance(white, str) else white[:4]
             )
@@ -1333,8 +1338,29 @@ def _slope_terms(
     return slope_terms
 
 
+PERIODIC_CLEAN_SHARE: Final = 0.05
+"""A point of the curve is read for the noise terms only where every sinusoid found holds
+less than this share of its Allan variance (:meth:`PeriodicTerm.adev_bound`)."""
+
+
+def periodic_free(result: AllanResult, periodic: tuple[PeriodicTerm, ...]) -> npt.NDArray[np.bool_]:
+    """The points of ``result`` whose Allan variance the sinusoids ``periodic`` that shape
+    the curve (:func:`~thermocal.stability.periodic.shaping_terms`) hold less than
+    :data:`PERIODIC_CLEAN_SHARE` of, as a boolean mask (all True without one)."""
+    free = np.ones(result.tau_s.size, dtype=bool)
+    for p in shaping_terms(periodic, result.tau_s, result.adev):
+        with np.errstate(invalid="ignore", divide="ignore"):
+            share = p.adev_bound(result.tau_s) ** 2 / result.adev**2
+        free &= ~(share >= PERIODIC_CLEAN_SHARE)
+    return free
+
+
 def noise_terms(
-    result: AllanResult, *, significance: float = 3.0, confidence: float | None = None
+    result: AllanResult,
+    *,
+    significance: float = 3.0,
+    confidence: float | None = None,
+    periodic: tuple[PeriodicTerm, ...] = (),
 ) -> NoiseTerms:
     """IEEE 952 noise terms by slope-line reading and by weighted least squares.
 
@@ -1362,17 +1388,24 @@ def noise_terms(
 
     ``bias_minimum``: the bias instability at the curve's minimum, always, with its τ,
     interval and quality (:func:`bias_at_minimum`).
+
+    ``periodic``: the sinusoids found in the record
+    (:func:`thermocal.stability.periodic.periodic_terms`); the points where one holds
+    :data:`PERIODIC_CLEAN_SHARE` or more of the Allan variance are not read (:func:`periodic_free`:
+    IEEE 952 C.1.7, its bump is no term of the model) for the −½ stretch.
     """
     conf = result.confidence if confidence is None else confidence
     scale, specs = term_units(result.unit)
     ok = _usable(result)
+    free = periodic_free(result, periodic)
     shaped_below: float | None = None
     if int(ok.sum()) >= 3:
         lt, ld, edf = np.log(result.tau_s[ok]), np.log(result.adev[ok]), result.edf[ok]
         local = np.array([_local_slope(lt, ld, edf, k) for k in range(lt.size)])
         st = white_stretch(
-            result.tau_s[ok], result.adev[ok], edf, np.abs(local + 0.5) <= _SLOPE_TOLERANCE
-        )
+            result.tau_s[ok], result.adev[ok], edf,
+            (np.abs(local + 0.5) <= _SLOPE_TOLERANCE) & free[ok],
+        )  # fmt: skip
         if st is not None and st.shaped_stop:
             used = np.flatnonzero(ok)
             ok = ok.copy()
@@ -1383,7 +1416,7 @@ def noise_terms(
     z = float(special.ndtri(0.5 + conf / 2.0))  # normal quantile
 
     fit_terms = _fit_terms(specs, scale, coef, sigma, fit_reasons, quality, z)
-    slope_terms = _slope_terms(result, specs, scale, fit_reasons, poor, ok)
+    slope_terms = _slope_terms(result, specs, scale, fit_reasons, poor, ok, free)
     minimum = None
     if int(ok.sum()) >= 3:
         dev = result.adev[ok]
@@ -1440,6 +1473,7 @@ def annotate_periodic(
 __all__ = [
     "BIAS_INSTABILITY_FACTOR",
     "ONE_SIGMA_CONFIDENCE",
+    "PERIODIC_CLEAN_SHARE",
     "SI_ACCEL_TERMS",
     "TERM_NAMES",
     "AllanResult",
@@ -1458,6 +1492,7 @@ __all__ = [
     "fit_quality",
     "noise_terms",
     "overlapping_adev",
+    "periodic_free",
     "term_units",
     "white_stretch",
 ]

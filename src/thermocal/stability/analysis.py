@@ -243,7 +243,7 @@ def _allan_channel(
         # where the buffer is writeable: windows of phase, found by the floor check)
         overwrite=named_once and dynamic_s is None,
     )
-    noise = allan.noise_terms(res)
+    noise = allan.noise_terms(res, periodic=found)
     quant = nm.quantization_from_lattice(lattice, rec.sample_interval_s, unit, noise)
     noise = nm.annotate_quantization(noise, quant)
     noise = allan.annotate_periodic(noise, res, found)

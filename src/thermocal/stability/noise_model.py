@@ -256,7 +256,7 @@ def axis_noise(
     res = overlapping_adev(
         values, tau0_s, taus, time_s=time_s, segments=segments, unit=u, confidence=confidence
     )
-    terms = noise_terms(res)
+    terms = noise_terms(res, periodic=found)
     quant = quantization_from_lattice(lattice, tau0_s, u, terms)
     terms = annotate_quantization(terms, quant)
     terms = annotate_periodic(terms, res, found)

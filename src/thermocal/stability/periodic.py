@@ -90,6 +90,15 @@ class PeriodicTerm:
         x = math.pi * self.frequency_hz * np.asarray(tau_s, dtype=np.float64)
         return np.asarray(self.amplitude * np.sin(x) ** 2 / x)
 
+    def adev_bound(self, tau_s: npt.ArrayLike) -> npt.NDArray[np.float64]:
+        """The most the sinusoid adds to the Allan deviation [unit] at ``tau_s`` [s]: its
+        own curve A·sin²(πf₀τ)/(πf₀τ) up to its first maximum region (πf₀τ ≤ π/2), its
+        envelope A/(πf₀τ) beyond, where f₀'s resolution leaves the zeros' places unknown."""
+        x = math.pi * self.frequency_hz * np.asarray(tau_s, dtype=np.float64)
+        return np.asarray(
+            np.where(x <= math.pi / 2, self.amplitude * np.sin(x) ** 2 / x, self.amplitude / x)
+        )
+
     def words(self) -> str:
         """The term in words, for reasons and text output."""
         return (
