@@ -141,3 +141,17 @@ def test_white_noise_read_away_from_a_sinusoid(tmp_path: Path) -> None:
     assert arw["unit"] == "ug/sqrt(Hz)"
     assert arw["value"] == pytest.approx(1e3 * n_white, rel=0.02), arw
     assert d["shaped_below_s"] is None  # no filter in this record
+
+
+def test_export_c_of_a_session_without_temperature_invents_none(
+    mpu_cal: Path, tmp_path: Path
+) -> None:
+    """The MPU-6050 session has no temperature column; the report says "calibrated without
+    a temperature column: the parameters apply unchanged at every temperature", but the C
+    header said "calibrated at 25 degC" (the model's placeholder reference, measured by
+    nobody).  It compiles with -Wall -Werror -pedantic either way (tests/test_h38_export_c)."""
+    code, _, err = _run(["export-c", str(mpu_cal), "-o", str(tmp_path / "c")])
+    assert code == 0, err
+    header = (tmp_path / "c" / "mpu.h").read_text(encoding="utf-8")
+    assert "degC" not in header and "calibrated at" not in header, header
+    assert header.count("no temperature column (none measured)") == 2, header

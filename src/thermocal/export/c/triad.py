@@ -103,7 +103,8 @@ def _triad_code(p: str, tri: Any, bias_to_data: float, real: str, ident: str) ->
         + (
             f"T [degC] of {tri.temperature}, clamped to [{m.t_lo_c:g}, {m.t_hi_c:g}]"
             if tri.temperature
-            else f"no temperature column: calibrated at {m.tref_c:g} degC, temp_c has no effect"
+            else "no temperature column (none measured): the parameters apply unchanged at "
+            "every temperature, temp_c has no effect"
             if m.order == 0
             else f"T [degC] (no column named), clamped to [{m.t_lo_c:g}, {m.t_hi_c:g}]"
         )
