@@ -1084,6 +1084,14 @@ MUTANTS: tuple[Mutant, ...] = (
         "minimum sought among the last points of one or two degrees of freedom",
     ),
     Mutant(
+        "multipos-faces-unchecked",
+        P + "multipos/accel.py",
+        "        if ang > FACE_MAX_DEG:\n",
+        "        if ang > 180.0:\n",
+        _t("h38_audit"),
+        "a POSES file of another session turned into a six-face calibration",
+    ),
+    Mutant(
         "noise-periodic-stretch-unmasked",
         P + "stability/allan.py",
         "        free &= ~(share >= PERIODIC_CLEAN_SHARE)\n",

@@ -155,3 +155,21 @@ def test_export_c_of_a_session_without_temperature_invents_none(
     header = (tmp_path / "c" / "mpu.h").read_text(encoding="utf-8")
     assert "degC" not in header and "calibrated at" not in header, header
     assert header.count("no temperature column (none measured)") == 2, header
+
+
+def test_poses_file_of_another_session_is_refused(tmp_path: Path) -> None:
+    """imucal's section list given with the MPU-6050 session (accelerometer only): the six
+    "faces" fall on the table static and the hand-held places, none with its named axis
+    up, yet the six-face closed form wrote a calibration, exit 0, no warning:
+    "gravity-magnitude residual rms 0.252 → 4.09e+03 g".  Refused, naming the faces, the
+    POSES file and what to fix; imucal's own session (tests/test_multipos_imucal.py) still
+    passes, its faces within a few degrees of their axes."""
+    poses = DATA / "imucal_ferraris" / "example_ferraris_session_list.json"
+    out = tmp_path / "c.json"
+    code, _, err = _run(["multipos", str(MPU / "example_data_calibration.csv"), "-o", str(out),
+                         "--accel", "ax,ay,az", "--accel-scale", "0.00006103515625,g",
+                         "--rate", "100", "--gravity", "9.81", "--poses", str(poses)])  # fmt: skip
+    assert code == 2 and not out.exists()
+    line = [ln for ln in err.splitlines() if ln.startswith("error: ")]
+    assert len(line) == 1, err
+    assert "'x_p' 91° off +x" in line[0] and str(poses) in line[0], err

@@ -33,6 +33,7 @@ variances from the pose means' noise.
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any, Final
 
@@ -225,6 +226,31 @@ def fit_gravity_magnitude(f_mg: npt.ArrayLike, sigma_mg: npt.ArrayLike, g_mg: fl
     )
 
 
+FACE_MAX_DEG: Final = 30.0
+"""A face of the six-face form reads gravity within this angle [°] of the axis its name
+puts up (a board laid on a face by hand sits within a few degrees of it)."""
+
+
+def _check_faces(f: dict[str, FloatArray], faces: Sequence[str]) -> None:
+    """Refuse faces whose mean specific force ``f`` [mg] is more than :data:`FACE_MAX_DEG`
+    from the axis their name puts up (``x_p``: +x, ``x_a``: −x …): the closed form would
+    turn any six means into a calibration (a POSES file of another session gave a residual
+    of 4090 g)."""
+    bad = []
+    for n in faces:
+        up = np.zeros(3)
+        up["xyz".index(n[0])] = 1.0 if n.endswith("_p") else -1.0
+        u = f[n] / np.linalg.norm(f[n])
+        ang = math.degrees(math.acos(max(-1.0, min(1.0, float(u @ up)))))
+        if ang > FACE_MAX_DEG:
+            bad.append(f"'{n}' {ang:.0f}° off {'+' if up.sum() > 0 else '−'}{n[0]}")
+    if bad:
+        raise DesignError(
+            f"{len(bad)} of the six faces do not read gravity along the axis their name puts "
+            f"up (more than {FACE_MAX_DEG:g}°): {', '.join(bad)}"
+        )
+
+
 def fit_six_faces(
     faces_mg: dict[str, FloatArray], sigma_mg: dict[str, float], g_mg: float
 ) -> AccelFit:
@@ -236,6 +262,7 @@ def fit_six_faces(
     if missing:
         raise DesignError(f"the six-face calibration needs every face; missing {missing}")
     f = {k: np.asarray(v, dtype=np.float64) for k, v in faces_mg.items()}
+    _check_faces(f, FACES)
     b = sum((f[n] for n in FACES), np.zeros(3)) / 6.0
     var_b = sum(sigma_mg[n] ** 2 for n in FACES) / 36.0
     ie = np.zeros((3, 3))

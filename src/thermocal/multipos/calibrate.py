@@ -336,7 +336,13 @@ def calibrate_session(
     if all(n in names for n in FACES) and len(stats) < _accel.MIN_POSES:
         faces = {n: f[names.index(n)] for n in FACES}
         face_sig = {n: float(sig[names.index(n)]) for n in FACES}
-        acc = _accel.fit_six_faces(faces, face_sig, g_mg)
+        try:
+            acc = _accel.fit_six_faces(faces, face_sig, g_mg)
+        except DesignError as exc:
+            raise DesignError(
+                f"{where}: {exc}; fix their sections in {sections_from} (a POSES file of "
+                "this session?) or the order and signs of the --accel columns"
+            ) from None
         idx: Sequence[int] = tuple(range(12))
         # residuals of the six faces only: map back in pose order
         order = [FACES.index(n) if n in FACES else -1 for n in names]
