@@ -173,3 +173,30 @@ def test_poses_file_of_another_session_is_refused(tmp_path: Path) -> None:
     line = [ln for ln in err.splitlines() if ln.startswith("error: ")]
     assert len(line) == 1, err
     assert "'x_p' 91° off +x" in line[0] and str(poses) in line[0], err
+
+
+def test_validate_names_the_earth_rate_a_fit_kept_in_its_bias(tmp_path: Path) -> None:
+    """``simulate rlg-modelling``/``rlg-validation`` (metadata: latitude 45°, axis up), then
+    ``fit --model poly`` and ``validate``: the fit took nothing off (no --latitude/--axis),
+    validate takes the metadata's earth rate as the zero, so the compensated output reads
+    −Ω_up (−10.64 °/h: 15.041 °/h · sin 45°) and the verdict is "NOT improved" — true, but
+    the warning blamed "another power-on, temperature or sensor?".  It now names the cause
+    and the fit options; with them the same run is improved."""
+    mod, val = tmp_path / "m.parquet", tmp_path / "v.parquet"
+    assert _run(["simulate", "rlg-modelling", "-o", str(mod)])[0] == 0
+    assert _run(["simulate", "rlg-validation", "-o", str(val)])[0] == 0
+    omega_up = 15.041067 * np.sin(np.radians(45.0))  # °/h, the earth rate on the up axis
+    cases = (([], "NOT improved"), (["--latitude", "45", "--axis", "up"], "improved"))
+    for extra, verdict in cases:
+        cal = tmp_path / f"m{len(extra)}.json"
+        assert _run(["fit", str(mod), "-o", str(cal), "--model", "poly", *extra])[0] == 0
+        code, out, err = _run(["validate", str(cal), str(val), "--json"])
+        assert code == 0, err
+        d = json.loads(out)
+        assert d["verdict"].startswith(verdict), d["verdict"]
+        assert d["zero_reference"]["value"] == pytest.approx(omega_up, rel=1e-4)
+        if not extra:
+            assert d["mean_after"] == pytest.approx(-omega_up, rel=0.01)
+            assert "fit --latitude 45 --axis up" in err and "another power-on" not in err, err
+        else:
+            assert "absolute error worse" not in err, err

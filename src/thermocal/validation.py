@@ -61,6 +61,7 @@ import numpy.typing as npt
 
 from thermocal import metrics
 from thermocal.compensate.kernels import (
+    KEPT_IN_BIAS,
     AbsoluteFigures,
     absolute_error_worse,
     absolute_figures,
@@ -428,6 +429,7 @@ def _absolute(
     before: FloatArray,
     after: FloatArray,
     ref: float,
+    ref_what: str,
     where: str,
     display_unit: tuple[str, float],
     note: Callable[[str, type[Warning]], None],
@@ -441,7 +443,8 @@ def _absolute(
         du, k = display_unit
         shown = [AbsoluteFigures(a.mean / k, a.rms_about_zero / k, a.max_abs / k)
                  for a in (abs_b, abs_a)]  # fmt: skip
-        note(absolute_worse_message(where, du, shown[0], shown[1], worse), ThermocalWarning)
+        cause = ref_what.split("; ", 1)[1] if KEPT_IN_BIAS in ref_what else ""
+        note(absolute_worse_message(where, du, shown[0], shown[1], worse, cause), ThermocalWarning)
     return abs_b, abs_a, list(worse)
 
 
@@ -557,7 +560,7 @@ def validate(
     rms_a, ptp_a = run_rms_and_peak_to_peak(t, after, averaging_s, tau0)
     ref, ref_what = zero_reference
     abs_b, abs_a, worse = _absolute(
-        before, after, ref, where, display_unit or (model.signal_unit, 1.0), note
+        before, after, ref, ref_what, where, display_unit or (model.signal_unit, 1.0), note
     )
     return ValidationResult(
         r=r,

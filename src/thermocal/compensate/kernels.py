@@ -28,7 +28,7 @@ import math
 import warnings
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
-from typing import Any, cast
+from typing import Any, Final, cast
 
 import numpy as np
 import numpy.typing as npt
@@ -305,9 +305,15 @@ def absolute_error_worse(
 
 
 def absolute_worse_message(
-    where: str, unit: str, before: AbsoluteFigures, after: AbsoluteFigures, worse: Sequence[str]
+    where: str,
+    unit: str,
+    before: AbsoluteFigures,
+    after: AbsoluteFigures,
+    worse: Sequence[str],
+    cause: str = "",
 ) -> str:
-    """The ``warning:`` text for a compensation that makes the absolute error worse."""
+    """The ``warning:`` text for a compensation that makes the absolute error worse;
+    ``cause`` the known reason (else a model that does not describe this sensor here)."""
     pct = (
         100.0 * (after.rms_about_zero - before.rms_about_zero) / before.rms_about_zero
         if before.rms_about_zero > 0
@@ -317,8 +323,26 @@ def absolute_worse_message(
         f"{where}: the compensation makes the absolute error worse ({', '.join(worse)}): "
         f"mean {before.mean:.4g} → {after.mean:.4g} {unit}, rms about zero "
         f"{before.rms_about_zero:.4g} → {after.rms_about_zero:.4g} {unit} ({pct:+.3g} %), "
-        f"max |error| {before.max_abs:.4g} → {after.max_abs:.4g} {unit}; the model does not "
-        "describe this sensor at these conditions (another power-on, temperature or sensor?)"
+        f"max |error| {before.max_abs:.4g} → {after.max_abs:.4g} {unit}; "
+        + (cause or "the model does not describe this sensor at these conditions (another "
+           "power-on, temperature or sensor?)")
+    )  # fmt: skip
+
+
+KEPT_IN_BIAS: Final = "the model was fitted without removing the earth rate"
+"""Words of :func:`zero_reference` that :func:`absolute_worse_message` gives as the cause."""
+
+
+def _kept_in_bias(model: TemperatureModel, latitude_deg: float, axis: str) -> str:
+    """The words for a model fitted without removing a known input (its file records
+    ``known_input.what == "none"``) compared with the earth rate: it holds that rate in its
+    bias, and the fit option that removes it."""
+    rec = ((getattr(model, "inputs_", {}) or {}).get("known_input")) or {}
+    if not (isinstance(rec, dict) and rec.get("what") == "none"):
+        return ""
+    return (
+        f"; {KEPT_IN_BIAS} (thermocal fit --latitude {latitude_deg:g} --axis {axis}), so its "
+        "compensation takes that rate off as bias"
     )
 
 
@@ -345,6 +369,7 @@ def zero_reference(
         w = units.earth_rate_on_axis_deg_h(meta.latitude_deg, units.parse_axis(meta.axis))
         return float(units.convert(w, "deg/h", mu)), (
             f"the earth rate on axis {meta.axis} at latitude {meta.latitude_deg:g}° (file metadata)"
+            + _kept_in_bias(model, meta.latitude_deg, meta.axis)
         )
     rec = ((getattr(model, "inputs_", {}) or {}).get("known_input")) or {}
     val = rec.get("value") if isinstance(rec, dict) else None
@@ -803,6 +828,7 @@ class ChunkPredictor:
 
 __all__ = [
     "ABSOLUTE_WORSE_TOLERANCE",
+    "KEPT_IN_BIAS",
     "AbsoluteFigures",
     "CalibrationStream",
     "ChunkContext",
