@@ -200,3 +200,14 @@ def test_validate_names_the_earth_rate_a_fit_kept_in_its_bias(tmp_path: Path) ->
             assert "fit --latitude 45 --axis up" in err and "another power-on" not in err, err
         else:
             assert "absolute error worse" not in err, err
+
+
+def test_a_column_named_without_its_unit_is_pointed_to(tmp_path: Path) -> None:
+    """imu_tk's Xsens session names its columns ``acc_x [counts]`` …; a user who types
+    ``--accel acc_x,acc_y,acc_z`` was told only "no column 'acc_x'; available: …"."""
+    xsens = DATA / "imu_tk_xsens" / "xsens_imu_tk.parquet"
+    code, _, err = _run(["multipos", str(xsens), "-o", str(tmp_path / "x.json"),
+                         "--accel", "acc_x,acc_y,acc_z", "--accel-scale", "0.27,mg",
+                         "--accel-offset", "32768", "--gravity", "9.81744"])  # fmt: skip
+    assert code == 2 and err.count("\n") == 1, err
+    assert "no column 'acc_x'" in err and "did you mean 'acc_x [counts]'?" in err, err

@@ -306,6 +306,9 @@ def _roles(
             hint = ""
             if c == time_col and time is None:
                 hint = _time_hint(names)
+            same = [n for n in names if units.strip_unit_from_name(n) == c.strip()]
+            if len(same) == 1 and not hint:  # 'acc_x' for the file's 'acc_x [counts]'
+                hint = f" (did you mean {same[0]!r}? give the name as the file writes it)"
             raise MissingColumnError(
                 f"{p}: no column {short_name(c)}; available: {names_list(names)}{hint}"
             )
