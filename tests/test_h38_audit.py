@@ -211,3 +211,16 @@ def test_a_column_named_without_its_unit_is_pointed_to(tmp_path: Path) -> None:
                          "--accel-offset", "32768", "--gravity", "9.81744"])  # fmt: skip
     assert code == 2 and err.count("\n") == 1, err
     assert "no column 'acc_x'" in err and "did you mean 'acc_x [counts]'?" in err, err
+
+
+def test_a_missing_time_column_points_to_rate(mpu_cal: Path, tmp_path: Path) -> None:
+    """The MPU-6050 logger's files have no time column and a banner ``Fs,100``.  ``inspect``
+    and ``validate`` said "give --rate HZ" without the rate the file states; ``compensate``
+    said only "no time column 'time'; available: …" (no way forward)."""
+    held_out = MPU / "imu_90_x_rot.csv"
+    for args in (["inspect", str(held_out)], ["validate", str(mpu_cal), str(held_out)]):
+        code, _, err = _run(args)
+        assert code == 2, err
+        assert "(the file's banner says 'Fs,100': give --rate 100)" in err, err
+    code, _, err = _run(["compensate", str(mpu_cal), str(held_out), "-o", str(tmp_path / "c.csv")])
+    assert code == 2 and "no time column 'time'" in err and "--rate HZ" in err, err

@@ -92,7 +92,12 @@ from thermocal.readers.common import (
     file_kind,
     thermocal_metadata,
 )
-from thermocal.readers.dispatch import read_log_table, read_recording, read_text_table
+from thermocal.readers.dispatch import (
+    read_log_table,
+    read_recording,
+    read_text_table,
+    time_hint,
+)
 from thermocal.readers.station import is_station_path, station_files, with_sensor
 from thermocal.readers.table import load_sidecar, numeric_column
 from thermocal.readers.text import TextOptions, csv_chunk_options
@@ -679,7 +684,11 @@ def _open_source(
     time_col = time or default_time_column(names, info.get("time"))
     available = ", ".join(repr(c) for c in names)
     if time_col not in names:
-        raise MissingColumnError(f"{src}: no time column {time_col!r}; available: {available}")
+        hint = time_hint(names, (info.get("text_layout") or {}).get("banner") or ())
+        raise MissingColumnError(
+            f"{src}: no time column {time_col!r}; available: {available}"
+            + (hint if time is None else "")
+        )
     return _Source(src, kind_in, names, info, text_table, time_col, available)
 
 

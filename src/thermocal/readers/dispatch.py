@@ -4,6 +4,7 @@
 from __future__ import annotations
 
 import dataclasses
+import re
 import warnings
 from collections.abc import Sequence
 from pathlib import Path
@@ -263,12 +264,25 @@ def _read_other_columns(
         unit_map[c] = units.other_column_unit(c, extra_units.get(c))
 
 
-def _time_hint(names: list[str]) -> str:
+_BANNER_RATE = re.compile(
+    r"^\s*(fs|rate|sample[ _]?rate|sampling[ _]?rate|odr|freq(uency)?)\s*(\[?hz\]?)?\s*[,:=;\t ]"
+    r"\s*([0-9]+(\.[0-9]*)?)\s*(hz)?\s*$",
+    re.IGNORECASE,
+)
+"""A banner line stating the sample rate: ``Fs,100``, ``rate: 50 Hz``, ``ODR=400``."""
+
+
+def time_hint(names: list[str], banner: Sequence[str] = ()) -> str:
     """What to give when no time column is found: ``--time`` or ``--rate``, naming a
-    sample counter (the time with ``--rate``) or a column named like a temperature (not
-    time) among ``names``."""
+    sample counter (the time with ``--rate``), a rate the file's banner states
+    (``banner``: its lines) or a column named like a temperature (not time) among
+    ``names``."""
     counter = counter_column(names)
     temp_like = [n for n in names if named_like_temperature(n)]
+    stated = [(b, m.group(4)) for b in banner if (m := _BANNER_RATE.match(b))]
+    if stated:
+        line, hz = stated[0]
+        return f" (the file's banner says {line.strip()!r}: give --rate {hz})"
     if counter is not None:
         why = f"; {short_name(counter)} is a sample counter: give --rate HZ"
     elif temp_like:
@@ -305,7 +319,7 @@ def _roles(
         if c not in present:
             hint = ""
             if c == time_col and time is None:
-                hint = _time_hint(names)
+                hint = time_hint(names, (info.get("text_layout") or {}).get("banner") or ())
             same = [n for n in names if units.strip_unit_from_name(n) == c.strip()]
             if len(same) == 1 and not hint:  # 'acc_x' for the file's 'acc_x [counts]'
                 hint = f" (did you mean {same[0]!r}? give the name as the file writes it)"

@@ -373,6 +373,7 @@ def read_text(
     report: dict[str, Any] = {
         "text_layout": {
             "banner_lines": len(lay.banner),
+            "banner": [b.strip()[:80] for b in lay.banner[:10]],
             "delimiter": "\t" if lay.delimiter == "\t" else lay.delimiter,
             "decimal": lay.decimal,
             "header": lay.header,
