@@ -5,6 +5,7 @@ the order a user meets it, and holds its fix."""
 from __future__ import annotations
 
 import contextlib
+import hashlib
 import io
 import json
 from pathlib import Path
@@ -224,3 +225,30 @@ def test_a_missing_time_column_points_to_rate(mpu_cal: Path, tmp_path: Path) -> 
         assert "(the file's banner says 'Fs,100': give --rate 100)" in err, err
     code, _, err = _run(["compensate", str(mpu_cal), str(held_out), "-o", str(tmp_path / "c.csv")])
     assert code == 2 and "no time column 'time'" in err and "--rate HZ" in err, err
+
+
+def test_validating_on_the_calibration_session_is_said(mpu_cal: Path, tmp_path: Path) -> None:
+    """A user who validates (and reports) the MPU-6050 calibration on its own session got
+    figures headed "On the independent run … held-out session", no warning: the fit's
+    residuals passed for an independent test.  The calibration now records its sessions'
+    SHA-256 (``triads[].data``, as a model file's ``data``); the held-out file is still
+    "independent"."""
+    own, held = MPU / "example_data_calibration.csv", MPU / "imu_90_x_rot.csv"
+    cal = json.loads(mpu_cal.read_text(encoding="utf-8"))
+    sha = hashlib.sha256(own.read_bytes()).hexdigest()
+    assert all(t["data"] == [{"file": own.name, "sha256": sha}] for t in cal["triads"])
+    for rec, is_own in ((own, True), (held, False)):
+        code, out, err = _run(["validate", str(mpu_cal), str(rec), "--rate", "100", "--json"])
+        assert code == 0, err
+        assert ("the session the calibration was fitted on" in err) is is_own, err
+        val = tmp_path / f"v{is_own}.json"
+        val.write_text(out, encoding="utf-8")
+        html = tmp_path / f"r{is_own}.html"
+        code, _, err = _run(["report", "--model", str(mpu_cal), "--recording", str(rec),
+                             "--rate", "100", "--validation", str(val),
+                             "-o", str(html)])  # fmt: skip
+        assert code == 0, err
+        page = html.read_text(encoding="utf-8")
+        assert ("On the calibration's own session" in page) is is_own
+        assert ("On the independent run" in page) is not is_own
+        assert ("found in the held-out session" in page) is not is_own

@@ -105,6 +105,9 @@ class Triad:
     latitude_deg: float | None = None
     adequacy: dict[str, Any] | None = None
     """The adequacy record of the soaks it was fitted on (:mod:`thermocal.adequacy`)."""
+    data: tuple[dict[str, str], ...] = ()
+    """The session files it was calibrated on, ``{"file": name, "sha256": hash}`` each (as a
+    model file's ``data``): ``validate`` and ``report`` know them when given again."""
     count_scale: float | None = None
     """A triad calibrated on raw counts (``thermocal multipos`` given the count scales, issue 30):
     one count is ``count_scale`` ``unit`` (the datasheet's sensitivity), and ``unit`` is the
@@ -243,6 +246,7 @@ class Calibration:
                     "latitude_deg": t.latitude_deg,
                     "model": t.model.to_dict(),
                     **({"adequacy": t.adequacy} if t.adequacy is not None else {}),
+                    **({"data": [dict(x) for x in t.data]} if t.data else {}),
                     **(
                         {"count_scale": {"value": t.count_scale, "unit": t.unit}}
                         if t.count_scale is not None
@@ -345,6 +349,11 @@ def _triad_from_dict(t: Any, at: str) -> Triad:
         (enc[0], enc[1]),
         None if lat is None else float(lat),
         t["adequacy"] if isinstance(t.get("adequacy"), dict) else None,
+        tuple(
+            {"file": str(x.get("file", "")), "sha256": str(x.get("sha256", ""))}
+            for x in (t.get("data") or [])
+            if isinstance(x, dict)
+        ),
         _count_scale_from_dict(t.get("count_scale"), t["unit"], at),
     )
 

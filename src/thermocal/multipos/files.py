@@ -25,7 +25,7 @@ from thermocal import units
 from thermocal.errors import DesignError, ThermocalInputError, ThermocalWarning, UnitError
 from thermocal.inspection import saturated_mask
 from thermocal.models.calibration import Calibration, Triad
-from thermocal.models.files import save_calibration
+from thermocal.models.files import file_sha256, save_calibration
 from thermocal.multipos.calibrate import METHOD, SessionResult, calibrate_session
 from thermocal.multipos.poses import (
     DRIFT_DEG,
@@ -469,6 +469,8 @@ def _fit_triads(
             Triad(
                 kind, (cols[0], cols[1], cols[2]), unit, opts.temps or "", m,
                 latitude_deg=grav.latitude_deg, count_scale=None if sc is None else sc[0],
+                data=tuple({"file": Path(r.path).name, "sha256": file_sha256(r.path)}
+                           for r in runs),
             )
         )  # fmt: skip
     return triads, models

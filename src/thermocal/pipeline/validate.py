@@ -18,7 +18,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from thermocal.errors import FileFormatError, ThermocalInputError, UnitWarning
+from thermocal.errors import FileFormatError, ThermocalInputError, ThermocalWarning, UnitWarning
 from thermocal.pipeline.options import ValidateOptions
 from thermocal.pipeline.reading import load_recording, split_names, text_options
 from thermocal.readers.common import file_kind
@@ -252,6 +252,22 @@ def _validate_channels(ctx: _Context, cal: Calibration) -> ValidationReport:
     return ValidationReport(ctx.model_file, ctx.file, tuple(per), several=True)
 
 
+def _own_session(cal: Calibration, file: Path) -> None:
+    """A warning when ``file`` is a session the triads were calibrated on (its SHA-256
+    among their ``data``): its figures are the fit's residuals, not an independent test."""
+    from thermocal.models.files import file_sha256
+
+    known = {d.get("sha256") for t in cal.triads for d in t.data}
+    if known and file_sha256(file) in known:
+        warnings.warn(
+            ThermocalWarning(
+                f"{file}: this is the session the calibration was fitted on: its figures are "
+                "the fit's residuals, not an independent test (validate on a held-out session)"
+            ),
+            stacklevel=2,
+        )
+
+
 def _validate_triads(
     cal: Calibration, model_file: Path, file: Path, o: ValidateOptions
 ) -> ValidationReport:
@@ -270,6 +286,7 @@ def _validate_triads(
         text=text_options(o.names, o.rate, o.on_bad_lines, o.delimiter, o.decimal),
         topic=o.topic,
     )
+    _own_session(cal, file)
     if _mp_validate.is_multipos(cal.triads):  # held-out poses (issue 30)
         results: list[Any] = _mp_validate.validate_triads(
             cal.triads, rec, o.latitude, static_s=o.static_s, signal_unit=o.signal_unit

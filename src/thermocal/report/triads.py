@@ -200,6 +200,16 @@ def validation_rows(validation: list[Any] | None) -> tuple[list[dict[str, Any]],
     return summary, per_axis, notes
 
 
+def _own_session(cal: Any, recording_path: str | Path | None) -> bool:
+    """Whether the recording is a session the triads were calibrated on (its SHA-256 among
+    their ``data``)."""
+    from thermocal.models.files import file_sha256
+
+    known = {d.get("sha256") for t in cal.triads for d in t.data}
+    path = Path(recording_path) if recording_path else None
+    return bool(known) and path is not None and path.is_file() and file_sha256(path) in known
+
+
 def build_triad_report(
     cal: Any,
     cal_path: str | Path,
@@ -216,6 +226,7 @@ def build_triad_report(
     from thermocal.report.multipos import pose_section
 
     summary, per_axis, notes = validation_rows(validation)
+    own = _own_session(cal, recording_path)
     html: str = (
         _env()
         .get_template("triads.html.j2")
@@ -231,6 +242,8 @@ def build_triad_report(
             notes=notes,
             recording=str(recording_path) if recording_path else None,
             multipos=pose_section(validation),
+            own_session=own,
+            session_word="calibration" if own else "held-out",
         )
     )
     return html
