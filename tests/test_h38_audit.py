@@ -252,3 +252,15 @@ def test_validating_on_the_calibration_session_is_said(mpu_cal: Path, tmp_path: 
         assert ("On the calibration's own session" in page) is is_own
         assert ("On the independent run" in page) is not is_own
         assert ("found in the held-out session" in page) is not is_own
+
+
+def test_one_signal_unit_for_two_triads_points_to_one_per_column(mpu_cal: Path) -> None:
+    """``validate`` of the MPU-6050 calibration (accelerometer and gyro) with one
+    ``--signal-unit deg/s`` said "the accel triad was calibrated on g data; these columns
+    are in deg/s": no columns, no way forward (and the triad was calibrated on counts)."""
+    code, _, err = _run(["validate", str(mpu_cal), str(MPU / "imu_90_x_rot.csv"), "--rate",
+                         "100", "--signal-unit", "deg/s"])  # fmt: skip
+    assert code == 2
+    (line,) = [ln for ln in err.splitlines() if ln.startswith("error: ")]
+    assert "raw counts of g data" in line and "'ax', 'ay', 'az'" in line, line
+    assert "--signal-unit one unit per triad column" in line, line
