@@ -264,3 +264,33 @@ def test_one_signal_unit_for_two_triads_points_to_one_per_column(mpu_cal: Path) 
     (line,) = [ln for ln in err.splitlines() if ln.startswith("error: ")]
     assert "raw counts of g data" in line and "'ax', 'ay', 'az'" in line, line
     assert "--signal-unit one unit per triad column" in line, line
+
+
+def test_noise_of_a_moving_record_is_warned(tmp_path: Path) -> None:
+    """``thermocal noise`` on imucal's calibration session (six faces and three 360° turns)
+    wrote a Kalibr file with warnings about bounds only, and called the accelerometer's
+    white-noise term the "angle random walk".  The motion is now said (the faces: the
+    accelerometer's direction turns by 90° and more, written in the session list), the term
+    by its accelerometer name; a static record is not warned (the simulated one above)."""
+    base = ["noise", str(FERRARIS), "--rate", "102.4", "--gyro", "gyr_x,gyr_y,gyr_z",
+            "--gyro-unit", "deg/s"]  # fmt: skip
+    code, _, err = _run([*base, "--accel", "acc_x,acc_y,acc_z", "--accel-unit", "m/s^2",
+                         "-o", str(tmp_path / "n.yaml")])  # fmt: skip
+    assert code == 0, err
+    assert "the sensor moves during the record (the accelerometer's direction turns" in err
+    assert "[acc_x]: angle random walk" not in err and "[acc_x]: velocity random walk" in err
+    code, _, err = _run([*base, "--format", "json", "-o", str(tmp_path / "n.json")])
+    assert code == 0, err
+    assert "the sensor moves during the record (the gyro's rate departs" in err, err
+    rng = np.random.default_rng(5)
+    t = np.arange(60_000) / 100.0
+    g = rng.standard_normal((t.size, 3)) * 0.05
+    a = rng.standard_normal((t.size, 3)) * 2.0 + [0.0, 0.0, 1000.0]
+    path = tmp_path / "still.csv"
+    head = "time [s],gx [deg/s],gy [deg/s],gz [deg/s],ax [mg],ay [mg],az [mg]"
+    np.savetxt(path, np.column_stack([t, g, a]), delimiter=",", comments="", header=head)
+    code, _, err = _run(["noise", str(path), "--gyro", "gx [deg/s],gy [deg/s],gz [deg/s]",
+                         "--accel", "ax [mg],ay [mg],az [mg]",
+                         "-o", str(tmp_path / "s.yaml")])  # fmt: skip
+    assert code == 0, err
+    assert "moves" not in err, err

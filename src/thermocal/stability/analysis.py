@@ -20,8 +20,9 @@ from __future__ import annotations
 import math
 import re
 import warnings
+from collections.abc import Sequence
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, Final
 
 from thermocal.errors import ConditioningWarning, ThermocalInputError, UnitWarning
 from thermocal.stability.allan import ONE_SIGMA_CONFIDENCE
@@ -272,6 +273,53 @@ def nonstationary_message(dyn: DynamicAllan, where: str, what: str = "the record
     )
 
 
+STILL_TURN_DEG: Final = 5.0
+"""A noise record whose accelerometer direction (1 s means) turns more than this [°] moved."""
+STILL_RATE_DEG_H: Final = 7200.0
+"""…or, without an accelerometer, whose gyro's 1 s means leave their median by more than
+this [°/h] (2 °/s: a hand's turn, far above any bias change at rest)."""
+
+
+def motion_in(rec: Recording, gyro: Sequence[str], accel: Sequence[str]) -> str | None:
+    """Words for the motion of a record meant to be static, else None: the largest turn of
+    the accelerometer's 1 s mean direction from its median (beyond :data:`STILL_TURN_DEG`;
+    when it reads gravity, above 0.5 g), else the largest departure of the gyro's 1 s mean
+    rate from its median (beyond :data:`STILL_RATE_DEG_H`).  Columns in raw counts without
+    a scale factor are not judged."""
+    import numpy as np
+
+    w = max(1, round(1.0 / rec.sample_interval_s))
+    k = rec.n_samples // w
+
+    def means(cols: Sequence[str], canon: str) -> FloatArray | None:
+        got = [rec.signal(c) for c in cols]
+        if k < 3 or not cols or any(u != canon for _v, u in got):
+            return None
+        x = np.column_stack([v[: k * w] for v, _u in got])
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", RuntimeWarning)  # an all-NaN window
+            m = np.nanmean(x.reshape(k, w, len(cols)), axis=1)
+        return m if int(np.all(np.isfinite(m), axis=1).sum()) >= 3 else None
+
+    a = means(accel, "mg")
+    if a is not None and np.nanmedian(np.linalg.norm(a, axis=1)) > 500.0:
+        u = a / np.linalg.norm(a, axis=1)[:, None]
+        ref = np.nanmedian(u, axis=0)
+        ang = np.degrees(np.arccos(np.clip(u @ (ref / np.linalg.norm(ref)), -1.0, 1.0)))
+        j = int(np.nanargmax(ang))
+        if ang[j] > STILL_TURN_DEG:
+            return f"the accelerometer's direction turns {ang[j]:.3g}° (1 s means, at {j} s)"
+        return None
+    g = means(gyro, "deg/h")
+    if g is None:
+        return None
+    dev = np.linalg.norm(g - np.nanmedian(g, axis=0), axis=1)
+    j = int(np.nanargmax(dev))
+    if dev[j] > STILL_RATE_DEG_H:
+        return f"the gyro's rate departs {dev[j] / 3600.0:.3g} °/s from its median (at {j} s)"
+    return None
+
+
 @dataclass(frozen=True, eq=False)
 class ImuNoise:
     """The result of :func:`imu_noise`: each axis's terms and the estimator noise model."""
@@ -297,6 +345,15 @@ def imu_noise(
     the axis."""
     from thermocal.stability import noise_model as nm
 
+    moved = motion_in(rec, gyro, accel)
+    if moved is not None:
+        warnings.warn(
+            f"{where}: the sensor moves during the record ({moved}): the noise terms need it "
+            "at rest, the Allan deviation of a moving record holds the motion; cut a static "
+            "stretch",
+            ConditioningWarning,
+            stacklevel=1,
+        )
     axes = []
     for name in gyro + accel:
         values, unit = signal_in_data_unit(rec, name)
@@ -312,10 +369,10 @@ def imu_noise(
         confidence=confidence,
     )  # fmt: skip
     for ax in axes:
-        for t in (ax.density, ax.walk):
+        for kind, t in (("density", ax.density), ("walk", ax.walk)):
             if t.method == "bound":
                 warnings.warn(
-                    f"{where} [{ax.name}]: {t.term.replace('_', ' ')}: {t.reason}",
+                    f"{where} [{ax.name}]: {nm.term_words(ax.sensor, kind)}: {t.reason}",
                     ConditioningWarning,
                     stacklevel=1,
                 )

@@ -77,6 +77,14 @@ _TERM_WORDS: Final = {
     ("accel", "density"): "velocity random walk N (white acceleration noise)",
     ("accel", "walk"): "acceleration random walk K",
 }
+
+
+def term_words(sensor: str, kind: str) -> str:
+    """The term in words for a ``sensor`` (gyro, accel) and ``kind`` (density, walk): an
+    accelerometer's white noise is the velocity random walk, not the angle random walk."""
+    return _TERM_WORDS[(sensor, kind)]
+
+
 _READ_AT: Final = {"density": 1.0, "walk": 3.0}
 _SLOPE: Final = {"density": "−½", "walk": "+½"}
 
@@ -786,4 +794,5 @@ __all__ = [
     "noise_model",
     "output_quantization",
     "quantization_from_lattice",
+    "term_words",
 ]
