@@ -294,3 +294,23 @@ def test_noise_of_a_moving_record_is_warned(tmp_path: Path) -> None:
                          "-o", str(tmp_path / "s.yaml")])  # fmt: skip
     assert code == 0, err
     assert "moves" not in err, err
+
+
+def test_known_input_of_a_count_signal_is_in_its_physical_unit(tmp_path: Path) -> None:
+    """``simulate rlg-modelling`` writes RLG counts with a scale factor (4 counts/″);
+    ``fit --latitude 45 --axis up`` takes Ω_up = 15.041067 °/h · sin 45° = 10.6356 °/h off,
+    but the model file recorded it as "10.6356 counts" and the C header said "10.6356
+    counts removed before the fit" (a count is 0.25″, not 1 °/h)."""
+    mod = tmp_path / "m.parquet"
+    assert _run(["simulate", "rlg-modelling", "-o", str(mod)])[0] == 0
+    cal = tmp_path / "m.json"
+    assert _run(["fit", str(mod), "-o", str(cal), "--model", "poly",
+                 "--latitude", "45", "--axis", "up"])[0] == 0  # fmt: skip
+    ki = json.loads(cal.read_text(encoding="utf-8"))["inputs"]["known_input"]
+    omega_up = 15.041067 * np.sin(np.radians(45.0))
+    assert ki["unit"] == "deg/h" and ki["value"] == pytest.approx(omega_up, rel=1e-5), ki
+    code, _, err = _run(["export-c", str(cal), "-o", str(tmp_path / "c")])
+    assert code == 0, err
+    header = (tmp_path / "c" / "m.h").read_text(encoding="utf-8")
+    assert "counts removed before the fit" not in header
+    assert f"{omega_up:.6g}" in header and "deg/h) removed before the fit" in header, header

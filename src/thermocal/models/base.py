@@ -287,6 +287,8 @@ def model_inputs(
     if rec.n_samples > 1:  # sizes the Ṫ buffer of the exported C (export-c)
         out["sample_interval_s"] = float(rec.sample_interval_s)
     canon = canonical_unit(sig_unit) if sig_unit else None
+    if sig_unit == "counts" and rec.meta.scale_factor is not None:  # the fit's values are
+        canon = rec.signal(signal)[1]  # physical (counts / K), and so is the known input
     out["known_input"] = {
         "value": float(known_input),
         "unit": canon,
