@@ -444,14 +444,14 @@ def _rms3(v: FloatArray) -> tuple[float, float, float]:
 def gravity_errors(
     f_before: FloatArray, f_after: FloatArray, sections: Sequence[Section], g: float
 ) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
-    """Per pose: |mean f| − g before and after, and the per-axis error of the mean against
-    g along the after-direction (for the table), all in the unit of ``f``."""
+    """Per pose: |mean f| − g before and after, and that error along each axis,
+    ``(|m| − g)·m/|m|`` (for the table: the axes' rms over poses add in quadrature to the
+    total's, before as after), all in the unit of ``f``."""
     mb = np.asarray([f_before[s.start : s.end].mean(axis=0) for s in sections])
     ma = np.asarray([f_after[s.start : s.end].mean(axis=0) for s in sections])
-    ua = ma / np.linalg.norm(ma, axis=1)[:, None]
-    eb = np.linalg.norm(mb, axis=1) - g
-    ea = np.linalg.norm(ma, axis=1) - g
-    return eb, ea, mb - g * ua, ma - g * ua
+    nb, na = np.linalg.norm(mb, axis=1), np.linalg.norm(ma, axis=1)
+    eb, ea = nb - g, na - g
+    return eb, ea, mb * (eb / nb)[:, None], ma * (ea / na)[:, None]
 
 
 def rotation_errors(
