@@ -331,3 +331,21 @@ def test_accel_per_axis_figures_add_up_to_the_total(mpu_cal: Path) -> None:
             total = tri[f"rms_{when}"]
             axes = np.asarray(tri[f"per_axis_{when}"])
             assert float(np.sqrt(np.sum(axes**2))) == pytest.approx(total, rel=1e-9), tri
+
+
+def test_scale_and_poses_messages_read_as_a_user_needs(tmp_path: Path) -> None:
+    """Two messages a user of the MPU-6050 session meets: ``--accel-scale 1,counts`` said
+    "one count in a accel unit"; imucal's section list on a 30 s cut of the session said
+    "section 'y_p' (2814…3298) is outside the recording's 3000 samples" without asking
+    whether the POSES file is this session's."""
+    cut = tmp_path / "cut.csv"
+    lines = MPU.joinpath("example_data_calibration.csv").read_text(encoding="ascii").splitlines()
+    cut.write_text("\n".join(lines[:3005]) + "\n", encoding="ascii")
+    base = ["multipos", str(cut), "-o", str(tmp_path / "c.json"), "--accel", "ax,ay,az",
+            "--rate", "100", "--gravity", "9.81"]  # fmt: skip
+    code, _, err = _run([*base, "--accel-scale", "1,counts"])
+    assert code == 2 and "one count in an accelerometer unit: mg, g, m/s^2" in err, err
+    poses = DATA / "imucal_ferraris" / "example_ferraris_session_list.json"
+    code, _, err = _run([*base, "--accel-scale", "0.061,mg", "--poses", str(poses)])
+    assert code == 2 and "outside the recording's 3000 samples" in err, err
+    assert "a POSES file of another session?" in err, err

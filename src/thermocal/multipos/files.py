@@ -149,9 +149,9 @@ def count_scale(text: str | None, kind: str) -> tuple[float, str] | None:
         value, unit = math.nan, ""
     if not (math.isfinite(value) and value > 0 and unit and units.signal_kind(unit) == want):
         example = "0.061,mg" if kind == "accel" else "0.00763,deg/s"
+        what = "an accelerometer unit: mg, g, m/s^2" if kind == "accel" else "a rate unit: deg/s"
         raise ThermocalInputError(
-            f"--{kind}-scale takes VALUE,UNIT (one count in a {want} unit, e.g. {example}), "
-            f"got {text!r}"
+            f"--{kind}-scale takes VALUE,UNIT (one count in {what}…; e.g. {example}), got {text!r}"
         )
     return value, unit
 

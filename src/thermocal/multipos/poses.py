@@ -383,7 +383,8 @@ def parse_poses(d: Any, n_samples: int, where: str = "--poses") -> list[Section]
         if not 0 <= s < e <= n_samples:
             raise ThermocalInputError(
                 f"{where}: section {name!r} ({s}…{e}) is outside the recording's "
-                f"{n_samples} samples or empty"
+                f"{n_samples} samples or empty (a POSES file of another session? its "
+                "sections are sample indices of the session file given)"
             )
         out.append(Section(str(name), s, e))
     out.sort(key=lambda sec: sec.start)
