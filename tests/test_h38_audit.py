@@ -349,3 +349,16 @@ def test_scale_and_poses_messages_read_as_a_user_needs(tmp_path: Path) -> None:
     code, _, err = _run([*base, "--accel-scale", "0.061,mg", "--poses", str(poses)])
     assert code == 2 and "outside the recording's 3000 samples" in err, err
     assert "a POSES file of another session?" in err, err
+
+
+def test_multipos_gravity_in_g_is_refused(tmp_path: Path) -> None:
+    """``--gravity 1`` (a user thinking in g) calibrated imucal's session against a 1 m/s²
+    gravity, exit 0, no warning: every scale factor about +8.8e6 ppm (9.81/1 − 1; the residual
+    "8.93 → 0.00114 m/s^2" looked fine).  ``fit --gravity`` already refused it."""
+    poses = DATA / "imucal_ferraris" / "example_ferraris_session_list.json"
+    out = tmp_path / "c.json"
+    code, _, err = _run(["multipos", str(FERRARIS), "-o", str(out), "--rate", "102.4",
+                         "--accel", "acc_x,acc_y,acc_z", "--accel-unit", "m/s^2",
+                         "--poses", str(poses), "--gravity", "1"])  # fmt: skip
+    assert code == 2 and not out.exists(), err
+    assert err.startswith("error: --gravity 1: local gravity in m/s²") and "--latitude" in err

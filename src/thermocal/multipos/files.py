@@ -102,6 +102,11 @@ class MultiposOptions:
             raise ThermocalInputError("--order and --tref need several files and --temps")
         if self.gravity_m_s2 is not None and self.latitude_deg is not None:
             raise ThermocalInputError("give --gravity or --latitude, not both")
+        if self.gravity_m_s2 is not None and not 9.7 <= self.gravity_m_s2 <= 9.9:
+            raise ThermocalInputError(  # '--gravity 1' (in g) scaled every axis by 1/9.8
+                f"--gravity {self.gravity_m_s2:g}: local gravity in m/s² is 9.78-9.83 on the "
+                "earth's surface (1 g = 9.80665 m/s²); give it in m/s², or --latitude DEG"
+            )
         if self.static_s is not None and not (math.isfinite(self.static_s) and self.static_s > 0):
             raise ThermocalInputError(
                 f"--static-s must be a positive number, got {self.static_s!r}"
