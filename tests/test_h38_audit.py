@@ -362,3 +362,16 @@ def test_multipos_gravity_in_g_is_refused(tmp_path: Path) -> None:
                          "--poses", str(poses), "--gravity", "1"])  # fmt: skip
     assert code == 2 and not out.exists(), err
     assert err.startswith("error: --gravity 1: local gravity in m/s²") and "--latitude" in err
+
+
+def test_noise_asks_for_the_unit_it_does_not_know(tmp_path: Path) -> None:
+    """``noise`` on the MPU-6050 logger's bare ``ax,…,gz`` columns warned "no unit stated
+    for the signal column … assuming deg/h (give --signal-unit …)" — an option ``noise``
+    does not have, and deg/h for an accelerometer — then failed with "ax: a accelerometer
+    column in 'deg/h'".  It now asks for the unit by the option it has, as multipos does."""
+    code, _, err = _run(["noise", str(MPU / "imu_90_x_rot.csv"), "--rate", "100",
+                         "--gyro", "gx,gy,gz", "--accel", "ax,ay,az",
+                         "-o", str(tmp_path / "n.yaml")])  # fmt: skip
+    assert code == 2 and "--signal-unit" not in err and "assuming" not in err, err
+    (line,) = [ln for ln in err.splitlines() if ln.startswith("error: ")]
+    assert "no unit stated for column 'gx'; give --gyro-unit" in line, line

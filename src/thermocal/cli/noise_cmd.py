@@ -136,7 +136,9 @@ def noise_cmd(
         signal=",".join(g_names + a_names),
         signal_unit=_unit_list(gyro_unit, accel_unit, len(g_names), len(a_names)),
         keep_other=False,
-    )
+        ask_units={**dict.fromkeys(g_names, "--gyro-unit"),
+                   **dict.fromkeys(a_names, "--accel-unit")},
+    )  # fmt: skip
     res = _analysis.imu_noise(
         rec, g_names, a_names, inflate=inflate, rostopic=rostopic, confidence=confidence,
         where=str(file),

@@ -78,6 +78,7 @@ def load_recording(
     keep_other: bool = True,
     text: TextOptions | None = None,
     topic: str | None = None,
+    ask_units: dict[str, str] | None = None,
 ) -> Recording:
     """Read a recording with the command line's options (options win over the file).
 
@@ -97,6 +98,7 @@ def load_recording(
     temperature conversions as fitted (:meth:`TemperatureModel.input_units`).  Every unit
     is resolved once, by :func:`thermocal.units.resolve_inputs`.  ``text`` (the text-log
     options, :func:`text_options`) and ``topic`` (a ULog topic) choose how the file is read.
+    ``ask_units`` maps a column to the option that states its unit: asked for, not assumed.
     """
     from thermocal import units
     from thermocal.readers.dispatch import read_recording
@@ -124,6 +126,7 @@ def load_recording(
         keep_other=keep_other,
         text=text,
         topic=topic,
+        ask_units=ask_units,
     )
     if model is not None or model_inputs is not None:
         from thermocal.models.base import check_sensor_id

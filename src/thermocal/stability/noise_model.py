@@ -253,7 +253,7 @@ def axis_noise(
     kind_units = units.RATE_UNITS if sensor == "gyro" else units.ACCEL_UNITS
     if u not in kind_units:
         raise ThermocalInputError(
-            f"{name}: a {'gyro' if sensor == 'gyro' else 'accelerometer'} column in {unit!r}; "
+            f"{name}: {'a gyro' if sensor == 'gyro' else 'an accelerometer'} column in {unit!r}; "
             f"the noise model needs one of {', '.join(kind_units)} "
             f"(--{'gyro' if sensor == 'gyro' else 'accel'}-unit)"
         )
