@@ -41,6 +41,7 @@ import numpy as np
 
 from thermocal import units
 from thermocal.compensate.files import compensate_file
+from thermocal.compensate.kernels import zero_reference
 from thermocal.errors import ModelFileError, ThermocalWarning
 from thermocal.export.c import export_c
 from thermocal.models.base import RunData, TemperatureModel
@@ -183,6 +184,7 @@ def _validation_dict(
         validation_ambient=val.temperature_c(AMBIENT),
         averaging_s=cfg.averaging_s,
         settle_s=cfg.settle_s,
+        zero_reference=zero_reference(model, val.meta),  # as thermocal validate
     )
     out = res.to_dict()
     out["model"] = str(model_path)

@@ -24,6 +24,7 @@ import numpy as np
 
 from thermocal import units
 from thermocal.compensate.files import compensate_channels, prepare_run
+from thermocal.compensate.kernels import zero_reference
 from thermocal.errors import ThermocalWarning
 from thermocal.export.c import generate_c_calibration
 from thermocal.models.base import RunData, model_file_dict, model_inputs
@@ -114,7 +115,10 @@ def _validate_channels(
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always", ThermocalWarning)
             mrun = prepare_run(ch.model, val, ch.signal, [TEMP])
-            res = validate(ch.model, mrun.run, mod_air, validation_ambient=val.column(AMBIENT))
+            res = validate(
+                ch.model, mrun.run, mod_air, validation_ambient=val.column(AMBIENT),
+                zero_reference=zero_reference(ch.model, val.meta),  # as thermocal validate
+            )  # fmt: skip
         results[ch.name] = res.in_unit(mrun.data_unit, mrun.factor)
         fit_warnings[ch.name] += [str(w.message) for w in caught]
     return results
