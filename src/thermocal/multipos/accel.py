@@ -104,6 +104,22 @@ _FREE_FACTOR = np.array([1.0, 1.0, 1.0] + [1e-3 / units.PPM] * 3 + [1e-3 * units
 """θ units per unit of the free parameters (mg; 10⁻³ → ppm; 10⁻³ rad → ″)."""
 
 
+def _six_faces_hint(u: FloatArray) -> str:
+    """Where the distinct directions are the six faces (each within ``DISTINCT_DEG`` of a
+    body axis, up and down), the advice that uses them: a POSES file naming them."""
+    if len(u) != 6:
+        return ""
+    near = np.abs(u).max(axis=1) > math.cos(math.radians(DISTINCT_DEG))
+    faces = {(int(np.argmax(np.abs(v))), bool(v[np.argmax(np.abs(v))] > 0)) for v in u}
+    if not near.all() or len(faces) != 6:
+        return ""
+    return (
+        ", or, as they are the six faces (each body axis up and down), name them in a "
+        "--poses file (x_p, x_a, y_p, y_a, z_p, z_a: imucal's section list) for Ferraris's "
+        "six-face closed form"
+    )
+
+
 def check_poses(f_mg: FloatArray) -> None:
     """Refuse poses that cannot determine the nine parameters: fewer than nine distinct
     gravity directions, or directions all near one plane (a scale factor or a bias along
@@ -118,6 +134,7 @@ def check_poses(f_mg: FloatArray) -> None:
             f"{len(distinct)} distinct poses (gravity directions more than {DISTINCT_DEG:g}° "
             f"apart) of {len(u)}: the accelerometer's bias, scale factors and misalignments "
             f"need at least {MIN_POSES}; place the board in more orientations"
+            + _six_faces_hint(np.asarray(distinct))
         )
     w, v = np.linalg.eigh(np.asarray(distinct).T @ np.asarray(distinct) / len(distinct))
     if w[0] < 0.02:
