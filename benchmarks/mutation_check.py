@@ -1205,6 +1205,14 @@ MUTANTS: tuple[Mutant, ...] = (
         "misfit sensor fitted with its white-noise weights (imu_tk's Xsens: 1.09× the residual)",
     ),
     Mutant(
+        "multipos-six-face-bias-noise-only",
+        P + "multipos/accel.py",
+        "np.var(pairs, axis=0, ddof=1) / 3.0",
+        "0.0 * np.var(pairs, axis=0, ddof=1)",
+        ("tests/test_multipos_six_face_sigma.py",),
+        "six-face bias σ from the white noise alone (faces set a degree off: z-rms ≈ 140)",
+    ),
+    Mutant(
         "multipos-offset-ignored",
         P + "multipos/files.py",
         "        return float(given)\n",

@@ -27,7 +27,10 @@ is the one with the white-noise weights, ``misfit_mg`` the ``τ`` added.
 **Six faces** (closed form): with gravity along ±each body axis,
 ``f_{j±} = ±g (I + E) e_j + b``, so ``b = Σ_faces f / 6`` and the column ``j`` of ``I + E``
 is ``(f_{j+} − f_{j−}) / 2g``: all nine elements of E, relative to the faces of the box;
-variances from the pose means' noise.
+variances from the pose means' noise.  Each opposite pair ``(f_{j+} + f_{j−}) / 2`` is an
+estimate of ``b``; a face set down a degree off adds ``g·sin`` of it to the other axes, so the
+bias variance is at least the three pair estimates' sample variance over 3 (on imucal's
+session the noise alone gave a σ sixty times below the pairs' disagreement).
 """
 
 from __future__ import annotations
@@ -113,6 +116,22 @@ def distinct_directions(f_mg: FloatArray) -> list[FloatArray]:
     return distinct
 
 
+def _six_faces_hint(u: FloatArray) -> str:
+    """Where the distinct directions are the six faces (each within ``DISTINCT_DEG`` of a
+    body axis, up and down), the advice that uses them: a POSES file naming them."""
+    if len(u) != 6:
+        return ""
+    near = np.abs(u).max(axis=1) > math.cos(math.radians(DISTINCT_DEG))
+    faces = {(int(np.argmax(np.abs(v))), bool(v[np.argmax(np.abs(v))] > 0)) for v in u}
+    if not near.all() or len(faces) != 6:
+        return ""
+    return (
+        ", or, as they are the six faces (each body axis up and down), name them in a "
+        "--poses file (x_p, x_a, y_p, y_a, z_p, z_a: imucal's section list) for Ferraris's "
+        "six-face closed form"
+    )
+
+
 def check_poses(f_mg: FloatArray) -> None:
     """Refuse poses that cannot determine the nine parameters: fewer than nine distinct
     gravity directions, or directions all near one plane (a scale factor or a bias along
@@ -123,6 +142,7 @@ def check_poses(f_mg: FloatArray) -> None:
             f"{len(distinct)} distinct poses (gravity directions more than {DISTINCT_DEG:g}° "
             f"apart) of {len(f_mg)}: the accelerometer's bias, scale factors and misalignments "
             f"need at least {MIN_POSES}; place the board in more orientations"
+            + _six_faces_hint(np.asarray(distinct))
         )
     w, v = np.linalg.eigh(np.asarray(distinct).T @ np.asarray(distinct) / len(distinct))
     if w[0] < 0.02:
@@ -264,7 +284,10 @@ def fit_six_faces(
     f = {k: np.asarray(v, dtype=np.float64) for k, v in faces_mg.items()}
     _check_faces(f, FACES)
     b = sum((f[n] for n in FACES), np.zeros(3)) / 6.0
-    var_b = sum(sigma_mg[n] ** 2 for n in FACES) / 36.0
+    pairs = np.array([(f[f"{ax}_p"] + f[f"{ax}_a"]) / 2.0 for ax in "xyz"])
+    var_b = np.maximum(  # the noise's, or the three pair estimates' scatter (placement)
+        sum(sigma_mg[n] ** 2 for n in FACES) / 36.0, np.var(pairs, axis=0, ddof=1) / 3.0
+    )
     ie = np.zeros((3, 3))
     var_e = np.zeros(3)
     for j, ax in enumerate("xyz"):
@@ -273,7 +296,7 @@ def fit_six_faces(
     e = ie - np.eye(3)
     theta = model.coeffs_from_error_matrix(e, b)
     sig = np.zeros(12)
-    sig[0:3] = math.sqrt(var_b)
+    sig[0:3] = np.sqrt(var_b)
     sig[3:6] = np.sqrt(var_e) / units.PPM
     for k, n in enumerate(model.MISALIGNMENT_NAMES):
         sig[6 + k] = math.sqrt(var_e[model.MISALIGNMENT_INDEX[n][1]]) * units.RAD_TO_ARCSEC

@@ -352,12 +352,7 @@ def calibrate_session(
             tuple(acc.residuals_mg[o] if o >= 0 else float("nan") for o in order),
         )  # fmt: skip
     else:
-        try:
-            acc = _accel.fit_gravity_magnitude(f, sig, g_mg)
-        except DesignError as exc:  # the file, and the six-face form when it can serve
-            six = " (or, for a six-face session, name the faces x_p … z_a in --poses)"
-            six_ok = len(_accel.distinct_directions(f)) >= 6
-            raise DesignError(f"{where}: {exc}{six if six_ok else ''}") from None
+        acc = _accel.fit_gravity_magnitude(f, sig, g_mg)
         idx = _accel.FREE_INDEX
     temp = None
     if temperature_c is not None:

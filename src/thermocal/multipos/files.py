@@ -422,11 +422,14 @@ def _session(
             gyro_model=opts.gyro_model,
         )  # fmt: skip
     except DesignError as exc:
-        if opts.accel_scale is None or "distinct poses" not in str(exc):
+        if "distinct poses" not in str(exc):
             raise
+        offset = (
+            "; or, if the raw counts' zero is not 0 (unsigned ADC counts sit around "
+            "mid-scale), give it with --accel-offset (e.g. 32768)"
+        )
         raise DesignError(
-            f"{exc}; or, if the raw counts' zero is not 0 (unsigned ADC counts sit "
-            "around mid-scale), give it with --accel-offset (e.g. 32768)"
+            f"{path}: {exc}{offset if opts.accel_scale is not None else ''}"
         ) from None
     acc_off_mg = float(units.convert(np.array([a_off]), au, "mg")[0]) if a_off else 0.0
     g_off_dh = float(units.convert(np.array([g_off]), str(gu), "deg/h")[0]) if g_off else 0.0
