@@ -190,10 +190,11 @@ VALIDATE_MODULES = ["pipeline/validate.py", "pipeline/reading.py", "cli/validate
                     "readers/[!p]*.py",
                     "validation.py", "compensate/kernels.py", "models/base.py",
                     "models/files.py", "models/calibration.py"]  # fmt: skip
-DESCRIBED = {"the known input given (--known-input)", "--encoder-unit"}
+DESCRIBED = {"the known input given (--known-input)", "--encoder-unit", " --axis "}
 """Texts naming a ``fit`` option the model recorded (what it was given), not advice; and the
 unit option of the encoder-angle role (units.py's table of roles), which only ``turntable``
-and triad validation resolve: ``fit`` reads no encoder column."""
+and triad validation resolve: ``fit`` reads no encoder column; and validate's advice to
+refit (``thermocal fit --latitude L --axis A``, compensate/kernels.py), ``fit``'s option."""
 
 
 def advice_problems(text: str, options: dict[str, bool]) -> list[str]:

@@ -108,26 +108,18 @@ def load_recording(
         stated = model.input_units()
     elif model_inputs is not None:
         stated = units.StatedUnits.from_model_inputs(model_inputs)
-    rec = read_recording(
-        path,
-        time=time,
-        time_unit=time_unit,
-        signals=split_names(signal) if signal else None,  # "gx,gy,gz": several channels
-        temperatures=split_names(temps),
-        signal_unit=signal_unit,
-        temp_unit=temp_unit,
-        meta=meta,
-        temp_conversion=(
-            units.temperature_conversion(temp_conversion, "--temp-conversion")
-            if temp_conversion is not None
-            else None
-        ),
-        model=stated,
-        keep_other=keep_other,
-        text=text,
-        topic=topic,
-        ask_units=ask_units,
+    conv = (
+        None
+        if temp_conversion is None
+        else units.temperature_conversion(temp_conversion, "--temp-conversion")
     )
+    rec = read_recording(
+        path, time=time, time_unit=time_unit,
+        signals=split_names(signal) if signal else None,  # "gx,gy,gz": several channels
+        temperatures=split_names(temps), signal_unit=signal_unit, temp_unit=temp_unit,
+        meta=meta, model=stated, keep_other=keep_other, text=text, topic=topic,
+        temp_conversion=conv, ask_units=ask_units,
+    )  # fmt: skip
     if model is not None or model_inputs is not None:
         from thermocal.models.base import check_sensor_id
 
