@@ -67,6 +67,7 @@ NOISE = _t("mutants_maths", "stability_noise_terms", "noise_cmd")
 H38 = _t("noise_terms_h38")
 MULTI = _t("mutants_maths", "multipos")
 STATION = _t("station", "readers_station")
+ST_ATT = _t("tests/attacks/test_station_attacks.py")
 FC = _t("mutants_units", "fc_log_readers", "fc_gates")
 EXPC = _t("export_c", "export_c_edges", "export_c_triads", "export_c_units")
 COMP = _t("mutants_maths", "compensate", "outside_range", "judge_absolute")
@@ -1171,6 +1172,30 @@ MUTANTS: tuple[Mutant, ...] = (
         "if False:",
         STATION,
         "a station folder of a newer format read",
+    ),
+    Mutant(
+        "station-sighup-not-caught",
+        P + "cli/station_cmd.py",
+        'STOP_SIGNALS = ("SIGINT", "SIGTERM", "SIGHUP")',
+        'STOP_SIGNALS = ("SIGINT", "SIGTERM")',
+        ST_ATT,
+        "a hang-up kills the run: chamber left at the program's set-point, open part lost",
+    ),
+    Mutant(
+        "station-log-on-closed-stderr-raises",
+        P + "station/run.py",
+        "            self.broken = say(message)",
+        "            print(message, file=sys.stderr, flush=True)",
+        ST_ATT,
+        "a closed stderr raises BrokenPipeError in the safe stop; the open part never closed",
+    ),
+    Mutant(
+        "station-resume-first-setpoint",
+        P + "station/run.py",
+        'last_sp = float(ev["setpoint_c"])',
+        'last_sp = float(ev["setpoint_c"]) if last_sp is None else last_sp',
+        ST_ATT,
+        "--resume reports the first set-point written, not where a killed run left the chamber",
     ),
     # --- readers: ULog / DataFlash --------------------------------------------------------
     Mutant(

@@ -87,21 +87,53 @@ class Display(Protocol):
     def log(self, message: str) -> None: ...
 
 
+def say(message: str) -> str:
+    """Print ``message`` on stderr; never raises.  Returns ``""``, or why stderr is gone
+    (a closed pipe, a vanished terminal): then file descriptor 2 is pointed at
+    ``os.devnull``, so that no later message (nor Python's flush at exit) raises either."""
+    try:
+        print(message, file=sys.stderr, flush=True)
+    except (OSError, ValueError, AttributeError) as exc:
+        mute_stderr()
+        return f"stderr closed ({type(exc).__name__})"
+    return ""
+
+
+def mute_stderr() -> None:
+    """Point file descriptor 2 (and ``sys.stderr``) at ``os.devnull``."""
+    import contextlib
+    import os
+
+    with contextlib.suppress(OSError, ValueError, AttributeError):
+        fd = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(fd, 2)
+        os.close(fd)
+    with contextlib.suppress(Exception):
+        sys.stderr = open(os.devnull, "w", encoding="utf-8")  # noqa: SIM115 (for the process)
+
+
 class LogDisplay:
-    """Not a terminal: a line per program step and per event on stderr, nothing else."""
+    """Not a terminal: a line per program step and per event on stderr, nothing else.
+    ``broken`` says why stderr is gone (the loop then stops safely: nobody watches)."""
+
+    def __init__(self) -> None:
+        self.broken = ""
 
     def update(self, state: StationState) -> None:
         return None
 
     def log(self, message: str) -> None:
-        print(message, file=sys.stderr, flush=True)
+        if not self.broken:
+            self.broken = say(message)
 
 
 @dataclass(frozen=True)
 class RunResult:
     """What a run did: folder, program span covered [s], parts written, samples per stream,
     bad lines per sensor, how it ended (``"end"``, ``"interrupted"``, ``"chamber"``), the
-    set-points written as ``(program_s, °C)`` and the safe set-point written (or None)."""
+    set-points written as ``(program_s, °C)``, the safe set-point written (or None), the
+    events, why it was interrupted (``"SIGHUP"``, ``"stderr closed (…)"``; ``""``) and, for
+    ``--resume``, how the previous run ended (:func:`previous_run`)."""
 
     out_dir: Path
     program_start_s: float
@@ -113,6 +145,8 @@ class RunResult:
     setpoints: list[tuple[float, float]]
     safe_setpoint_c: float | None
     events: list[dict[str, Any]]
+    stop_reason: str = ""
+    previous: str = ""
 
 
 def _last_program_s(out_dir: Path) -> float:
@@ -159,6 +193,7 @@ class _Loop:
         self.anchors: dict[str, float] = {}
         self.last_time: dict[str, float] = {}
         self.ended = "end"
+        self.stop_reason = ""
         self.safe: float | None = None
         self.sp = math.nan
         self.chamber_c = math.nan
@@ -187,15 +222,24 @@ class _Loop:
         self.t_run = time.time()
         self.next_poll = self.t_run
 
-    def play(self, should_stop: Callable[[], bool] | None) -> None:
+    def _stop_asked(self, should_stop: Callable[[], bool | str] | None) -> str:
+        """Why the run must stop now (``""``: it need not): ``should_stop``'s answer (a
+        string is the reason: a signal's name) or a display whose stderr is gone."""
+        asked = should_stop() if should_stop is not None else False
+        if asked:
+            return asked if isinstance(asked, str) else "asked"
+        return str(getattr(self.disp, "broken", "") or "")
+
+    def play(self, should_stop: Callable[[], bool | str] | None) -> None:
         """The loop: every ``LOOP_S`` at most, the program's step and set-point, the
         chamber's poll, drift, the sensors' lines, part rotation and the display."""
         while True:
             now = time.time()
             p = self.p = self.p0 + (now - self.t_run) * self.time_scale
-            if p >= self.end_s or (should_stop is not None and should_stop()):
+            why = self._stop_asked(should_stop)
+            if p >= self.end_s or why:
                 if p < self.end_s:
-                    self.ended = "interrupted"
+                    self.ended, self.stop_reason = "interrupted", why
                 self.p = min(p, self.end_s)
                 break
             self._program_step(p)
@@ -321,22 +365,28 @@ class _Loop:
 
     def finish(self) -> None:
         """Every way out: the safe set-point, the ports closed, their last lines recorded,
-        the open parts closed, the stop event, the chamber closed."""
+        the open parts closed, the stop event (how the run ended, the chamber's last
+        set-point), the chamber closed.  Each step runs even when one before it failed."""
         rec = self.rec
         self.safe = _safe_stop(self.chamber, self.ch_cfg.safe_setpoint_c, rec, self.disp)
-        for s in self.sensors:
-            s.close()
-        # the last lines that arrived before the ports closed
-        for s in self.sensors:
-            got, bads = s.drain()
-            self.bad[s.cfg.id] += len(bads)
-            rec.bad_lines(s.cfg.id, [(b.host_unix, b.index, b.reason, b.text) for b in bads])
-            self._add_rows(s, got)
-            self.samples[s.cfg.id] += len(got)
-        self.parts += rec.close_parts()
-        rec.event("stop", f"ended: {self.ended}", program_s=self.p, ended=self.ended,
-                  safe_setpoint_c=self.safe)  # fmt: skip
-        self.chamber.close()
+        try:
+            for s in self.sensors:
+                s.close()
+            # the last lines that arrived before the ports closed
+            for s in self.sensors:
+                got, bads = s.drain()
+                self.bad[s.cfg.id] += len(bads)
+                rec.bad_lines(s.cfg.id, [(b.host_unix, b.index, b.reason, b.text) for b in bads])
+                self._add_rows(s, got)
+                self.samples[s.cfg.id] += len(got)
+        finally:
+            self.parts += rec.close_parts()
+            left = self.safe if self.safe is not None else self.sp
+            rec.event("stop", f"ended: {self.ended}" + (f" ({self.stop_reason})" if
+                      self.stop_reason else ""), program_s=self.p, ended=self.ended,
+                      reason=self.stop_reason, safe_setpoint_c=self.safe,
+                      left_at_c=None if left != left else left)  # fmt: skip
+            self.chamber.close()
 
 
 def _open_recorder(
@@ -348,9 +398,9 @@ def _open_recorder(
     resume: bool,
     time_scale: float,
     disp: Display,
-) -> tuple[Recorder, float]:
-    """The recorder of ``out_dir`` and the program time to start at [s] (0, or where a
-    resumed recording ends)."""
+) -> tuple[Recorder, float, str]:
+    """The recorder of ``out_dir``, the program time to start at [s] (0, or where a
+    resumed recording ends) and how the previous run ended (``--resume``)."""
     end_s = float(t_prog[-1])
     p0 = _last_program_s(out_dir) if resume and out_dir.is_dir() else 0.0
     if resume and p0 >= end_s:
@@ -361,13 +411,50 @@ def _open_recorder(
         out_dir, cfg, (list(map(float, t_prog)), list(map(float, c_prog))),
         profile_source=profile_source, time_scale=time_scale, resume=resume,
     )  # fmt: skip
+    n_events = len(rec.doc["events"])
     if rec.removed_tmp:
         rec.event("resume", "removed the part open at the interruption: " + ", ".join(
             rec.removed_tmp))  # fmt: skip
+    previous = ""
     if resume:
+        previous, alarm = previous_run(rec.doc["events"][:n_events])
+        rec.event("resume", previous, program_s=p0)
+        disp.log(("warning: " if alarm else "") + previous)
         rec.event("resume", f"program continues at {p0:.1f} s", program_s=p0)
         disp.log(f"resuming at program time {p0:.1f} s of {end_s:.1f} s")
-    return rec, p0
+    return rec, p0, previous
+
+
+def previous_run(events: list[dict[str, Any]]) -> tuple[str, bool]:
+    """How the last run of a recording ended and where it left the chamber, from its
+    ``station.json`` events, and whether that needs the operator's attention.
+
+    A run that ended writes a ``stop`` event (how it ended, the safe set-point written or
+    not); a run killed (SIGKILL, a power cut, a crash of the interpreter) leaves none: then
+    the chamber still holds the last set-point written (``setpoint`` events) [°C].
+    """
+    last_sp: float | None = None
+    stop: dict[str, Any] | None = None
+    started = False
+    for ev in events:
+        kind = ev.get("kind")
+        if kind == "start":
+            started, stop = True, None
+        elif kind in ("setpoint", "safe") and isinstance(ev.get("setpoint_c"), int | float):
+            last_sp = float(ev["setpoint_c"])
+        elif kind == "stop":
+            stop = ev
+    where = "unknown" if last_sp is None else f"{last_sp:.2f} °C"
+    if stop is None:
+        if not started:
+            return "the last run never started", False
+        return (f"the last run was killed (no stop record: SIGKILL, a power cut or a crash); "
+                f"the chamber was left at {where}, the last set-point written"), True  # fmt: skip
+    how = str(stop.get("ended", "?")) + (f" by {stop['reason']}" if stop.get("reason") else "")
+    if stop.get("safe_setpoint_c") is None:
+        return (f"the last run ended: {how}, WITHOUT the safe set-point; the chamber was "
+                f"left at {where}, the last set-point written"), True  # fmt: skip
+    return f"the last run ended: {how}; the chamber was left at {where} (the safe set-point)", False
 
 
 def run_station(
@@ -380,14 +467,17 @@ def run_station(
     time_scale: float = 1.0,
     display: Display | None = None,
     chamber: Chamber | None = None,
-    should_stop: Callable[[], bool] | None = None,
+    should_stop: Callable[[], bool | str] | None = None,
 ) -> RunResult:
     """Run the program on the station and record everything into ``out_dir``.
 
     Raises :class:`StationStopped` (after the safe set-point and every file are written)
     when the chamber has not answered for ``chamber.timeout_s``; a ``KeyboardInterrupt`` is
-    re-raised after the same safe stop.  ``should_stop`` (tests, a GUI) ends the run early
-    as an interrupt does, without the exception.
+    re-raised after the same safe stop.  ``should_stop`` (signal handlers, tests, a GUI) ends
+    the run early as an interrupt does, without the exception; a string it returns is the
+    reason recorded (``"SIGHUP"``).  A :class:`LogDisplay` whose stderr is gone ends it too.
+    With ``resume``, how the previous run ended and where it left the chamber is logged
+    (``warning:`` when it was killed or left without its safe set-point).
     """
     import numpy as np
 
@@ -400,7 +490,8 @@ def run_station(
     chamber = chamber or make_chamber(ch_cfg, disp.log)
     for c in (*c_prog, ch_cfg.safe_setpoint_c):  # every set-point must fit the register
         _check_setpoint(float(c), ch_cfg)
-    rec, p0 = _open_recorder(cfg, t_prog, c_prog, out_dir, profile_source, resume, time_scale, disp)
+    rec, p0, previous = _open_recorder(cfg, t_prog, c_prog, out_dir, profile_source, resume,
+                                       time_scale, disp)  # fmt: skip
     loop = _Loop(cfg, t_prog, c_prog, p0, time_scale, rec, chamber, disp)
     try:
         loop.start()
@@ -411,7 +502,8 @@ def run_station(
     finally:
         loop.finish()
     return RunResult(out_dir, p0, loop.p, loop.parts, loop.samples, loop.bad, loop.ended,
-                     loop.setpoints, loop.safe, list(rec.doc["events"]))  # fmt: skip
+                     loop.setpoints, loop.safe, list(rec.doc["events"]), loop.stop_reason,
+                     previous)  # fmt: skip
 
 
 def _check_setpoint(c: float, ch: ChamberConfig) -> None:

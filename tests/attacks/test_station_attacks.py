@@ -1,0 +1,200 @@
+"""Issue 39: the station is safe whatever happens to its process, its chamber and its
+folder.  Through the command line, in a real subprocess when a signal is involved, against
+a scripted Modbus TCP server on 127.0.0.1 (:class:`thermocal.station.sim.SimulatedChamber`,
+or a raw socket server sending broken replies) and pseudo-terminals as serial sensors.
+
+Expected values come from outside the station: the set-points the server received, the
+lines the simulated sensor sent, the TOML's numbers.  Every input is hashed before and after.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pyarrow.parquet as pq
+import pytest
+
+pytest.importorskip("pymodbus")
+pytest.importorskip("serial")
+
+from station_toml import sensor_toml
+from thermocal.cli import main
+from thermocal.station.config import parse_station
+from thermocal.station.run import run_station
+from thermocal.station.sim import ChamberModel, SimulatedChamber, SimulatedSerialSensor
+
+SCALE = 0.01
+SRC = str(Path(__file__).resolve().parents[2] / "src")
+HOT = ((0.0, 10.0, 400.0), (25.0, 65.0, 65.0))
+"""A program that goes hot at once and holds: 65 °C is what a dead station leaves."""
+
+
+def _digest(*paths: Path) -> list[str]:
+    return [hashlib.sha256(p.read_bytes()).hexdigest() for p in paths]
+
+
+def _toml(port: int, device: str, part_s: float = 60.0, **extra: object) -> str:
+    ch = "\n".join(f"{k} = {json.dumps(v)}" for k, v in extra.items())
+    return f"""part_s = {part_s}
+[chamber]
+driver = "modbus-tcp"
+host = "127.0.0.1"
+port = {port}
+setpoint_register = 300
+temperature_register = 100
+register_kind = "input"
+scale = {SCALE}
+poll_s = 0.1
+io_timeout_s = 0.3
+safe_setpoint_c = 21.5
+{ch}
+""" + sensor_toml(device)
+
+
+def _profile(tmp: Path, program: tuple[tuple[float, ...], tuple[float, ...]] = HOT) -> Path:
+    p = tmp / "p.csv"
+    p.write_text(
+        "time_s,setpoint_c\n" + "".join(f"{t},{c}\n" for t, c in zip(*program, strict=True))
+    )
+    return p
+
+
+@pytest.fixture
+def rig(tmp_path: Path):  # type: ignore[no-untyped-def]
+    """A chamber server and a 50 Hz gyro on a pseudo-terminal, K = 100."""
+    model = ChamberModel(time_scale=100.0, tau_s=60.0)
+    sim = SimulatedChamber(model=model, scale=SCALE).start()
+    sen = SimulatedSerialSensor(model, rate_hz=50, time_scale=100.0).start()
+    yield {"sim": sim, "sen": sen, "tmp": tmp_path}
+    sen.stop()
+    sim.stop()
+
+
+def _spawn(args: list[str], stdout: int = subprocess.PIPE) -> subprocess.Popen[str]:
+    env = {**os.environ, "PYTHONPATH": SRC}
+    code = "import sys; from thermocal.cli import main; sys.exit(main())"
+    return subprocess.Popen([sys.executable, "-c", code, *args], env=env, text=True,
+                            stdout=stdout, stderr=subprocess.PIPE)  # fmt: skip
+
+
+def _wait(pred, timeout_s: float, what: str) -> None:  # type: ignore[no-untyped-def]
+    end = time.monotonic() + timeout_s
+    while time.monotonic() < end:
+        if pred():
+            return
+        time.sleep(0.02)
+    raise AssertionError(f"timed out waiting for {what}")
+
+
+def _last_kept(out: Path, sent: list[tuple[float, float]]) -> int:
+    """How many lines the sensor had sent when the last recorded one was sent (the
+    recording's last ``(gx, temp)`` found in the lines sent)."""
+    rows: list[tuple[float, float]] = []
+    for p in sorted(out.glob("imu-*.parquet")):
+        t = pq.read_table(p, columns=["gx", "temp"])
+        rows += list(zip(t["gx"].to_pylist(), t["temp"].to_pylist(), strict=True))
+    assert rows, "nothing recorded"
+    return max(i + 1 for i, s in enumerate(sent) if s == rows[-1])
+
+
+def _events(out: Path) -> list[dict]:
+    return json.loads((out / "station.json").read_text())["events"]
+
+
+@pytest.mark.parametrize("sig", ["SIGHUP", "SIGTERM", "SIGINT"])
+def test_signal_writes_safe_setpoint_and_keeps_the_open_part(rig: dict, sig: str) -> None:
+    """part_s = 60: every row of this run is in the part open when the signal comes."""
+    tmp, sim, sen = rig["tmp"], rig["sim"], rig["sen"]
+    toml, prof = tmp / "st.toml", _profile(tmp)
+    toml.write_text(_toml(sim.port, sen.device))
+    before = _digest(toml, prof)
+    out = tmp / "rec"
+    proc = _spawn(["station", "run", str(toml), "--profile", str(prof), "-o", str(out),
+                   "--time-scale", "100"])  # fmt: skip
+    try:
+        _wait(lambda: sim.writes and sim.writes[-1][1] == 65.0, 15, "the hot set-point")
+        time.sleep(0.5)
+        n_sent = len(sen.sent)
+        proc.send_signal(getattr(signal, sig))
+        _o, err = proc.communicate(timeout=15)
+    finally:
+        proc.kill()
+    num = getattr(signal, sig).value
+    assert proc.returncode == 128 + num, err
+    assert sim.writes[-1][1] == pytest.approx(21.5)  # the safe set-point, last
+    assert f"interrupted ({sig})" in err and "--resume" in err
+    # the open part closed: the rows up to the signal kept
+    assert _last_kept(out, sen.sent) >= n_sent - 10
+    stop = _events(out)[-1]
+    assert stop["kind"] == "stop" and stop["reason"] == sig and stop["safe_setpoint_c"] == 21.5
+    assert _digest(toml, prof) == before
+
+    # --resume says how the run ended and where it left the chamber
+    res = run_station(parse_station(toml.read_text()), HOT, out, resume=True,
+                      time_scale=100.0, should_stop=lambda: True)  # fmt: skip
+    assert res.previous == (
+        f"the last run ended: interrupted by {sig}; the chamber was left at 21.50 °C "
+        "(the safe set-point)"
+    )
+
+
+def test_closed_stderr_ends_in_the_safe_stop_and_closed_parts(rig: dict) -> None:
+    """The reader of stderr goes away (a pipe to a dead ``tee``, an ssh session gone): the
+    next message raises BrokenPipeError; the run stops safely, every row kept."""
+    tmp, sim, sen = rig["tmp"], rig["sim"], rig["sen"]
+    steps = (
+        tuple(float(t) for t in range(0, 2001, 20)),
+        tuple(25.0 + (i % 2) * 40.0 for i in range(101)),
+    )
+    toml, prof = tmp / "st.toml", _profile(tmp, steps)  # a step (a stderr line) every 0.2 s
+    toml.write_text(_toml(sim.port, sen.device))
+    out = tmp / "rec"
+    proc = _spawn(["station", "run", str(toml), "--profile", str(prof), "-o", str(out),
+                   "--time-scale", "100"], stdout=subprocess.DEVNULL)  # fmt: skip
+    try:
+        assert proc.stderr is not None
+        _wait(lambda: len(sim.writes) >= 3, 15, "set-points")
+        n_sent = len(sen.sent)
+        proc.stderr.close()
+        proc.wait(timeout=15)
+    finally:
+        proc.kill()
+    assert proc.returncode == 130
+    assert sim.writes[-1][1] == pytest.approx(21.5)
+    assert _last_kept(out, sen.sent) >= n_sent - 10
+    stop = _events(out)[-1]
+    assert stop["kind"] == "stop" and stop["reason"] == "stderr closed (BrokenPipeError)"
+
+
+def test_resume_after_sigkill_says_the_chamber_was_left_hot(
+    rig: dict, capsys: pytest.CaptureFixture[str]
+) -> None:
+    tmp, sim, sen = rig["tmp"], rig["sim"], rig["sen"]
+    toml, prof = tmp / "st.toml", _profile(tmp)
+    toml.write_text(_toml(sim.port, sen.device, part_s=0.3))
+    out = tmp / "rec"
+    proc = _spawn(["station", "run", str(toml), "--profile", str(prof), "-o", str(out),
+                   "--time-scale", "100"])  # fmt: skip
+    try:
+        _wait(lambda: sim.writes and sim.writes[-1][1] == 65.0, 15, "the hot set-point")
+        _wait(lambda: len(list(out.glob("imu-*.parquet"))) >= 2, 15, "closed parts")
+        proc.kill()
+        proc.communicate(timeout=10)
+    finally:
+        proc.kill()
+    assert sim.writes[-1][1] == 65.0  # nobody could write the safe set-point
+    rc = main(["station", "run", str(toml), "--profile", str(prof), "-o", str(out),
+               "--resume", "--time-scale", "400"])  # fmt: skip
+    err = capsys.readouterr().err
+    assert rc == 0, err
+    assert (
+        "warning: the last run was killed (no stop record: SIGKILL, a power cut or a crash); "
+        "the chamber was left at 65.00 °C, the last set-point written"
+    ) in err.splitlines()
