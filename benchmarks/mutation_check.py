@@ -1197,6 +1197,38 @@ MUTANTS: tuple[Mutant, ...] = (
         ST_ATT,
         "--resume reports the first set-point written, not where a killed run left the chamber",
     ),
+    Mutant(
+        "station-reading-range-unchecked",
+        P + "station/chamber.py",
+        "why = self.cfg.out_of_range(value, self.cfg.tolerance_c)",
+        'why = ""',
+        ST_ATT,
+        "a register reading 0x8000 (-3276.8 °C) taken as the chamber's temperature",
+    ),
+    Mutant(
+        "station-program-range-first-only",
+        P + "station/run.py",
+        "for t, c in zip(t_prog, c_prog, strict=True):  # before anything is written",
+        "for t, c in zip(t_prog[:1], c_prog[:1], strict=True):",
+        ST_ATT,
+        "only the program's first set-point checked against the chamber's range",
+    ),
+    Mutant(
+        "station-safe-range-wide",
+        P + "station/config.py",
+        "SAFE_RANGE_C = (0.0, 50.0)",
+        "SAFE_RANGE_C = (0.0, 100.0)",
+        ST_ATT,
+        "a 90 °C safe set-point accepted",
+    ),
+    Mutant(
+        "station-hold-reached-sign",
+        P + "station/run.py",
+        "if not reached and abs(self.chamber_c - sp) <= self.ch_cfg.tolerance_c:",
+        "if not reached and abs(self.chamber_c - sp) >= self.ch_cfg.tolerance_c:",
+        ST_ATT,
+        "a hold counted as reached when the chamber is far from it",
+    ),
     # --- readers: ULog / DataFlash --------------------------------------------------------
     Mutant(
         "ulog-delta-dt-us",

@@ -198,3 +198,117 @@ def test_resume_after_sigkill_says_the_chamber_was_left_hot(
         "warning: the last run was killed (no stop record: SIGKILL, a power cut or a crash); "
         "the chamber was left at 65.00 °C, the last set-point written"
     ) in err.splitlines()
+
+
+# --- item 7: chamber values and set-points against the chamber's range ---------------------
+
+
+def test_a_register_reading_0x8000_is_a_chamber_fault_not_a_temperature(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """0x8000 at 0.1 °C/count, signed: −3276.8 °C, what a controller sends for a broken
+    probe.  ``check`` refuses it; ``run`` treats it as a chamber that does not answer (the
+    safe set-point written, exit 2 after ``timeout_s``), never as a reading."""
+    model = ChamberModel(temperature_c=-3276.8, setpoint_c=-3276.8, tau_s=1e9)
+    sim = SimulatedChamber(model=model, scale=0.1).start()
+    sen = SimulatedSerialSensor(model.advance, rate_hz=50).start()
+    try:
+        toml, prof = tmp_path / "st.toml", _profile(tmp_path)
+        toml.write_text(_toml(sim.port, sen.device, part_s=0.3, timeout_s=0.5).replace(
+            f"scale = {SCALE}", "scale = 0.1"))  # fmt: skip
+        before = _digest(toml, prof)
+        assert main(["station", "check", str(toml), "--listen", "0.3", "--json"]) == 2
+        cap = capsys.readouterr()
+        chamber = json.loads(cap.out)["chamber"]
+        assert chamber["ok"] is False and chamber["temperature_c"] is None
+        last = cap.err.strip().splitlines()[-1]
+        assert last.startswith("error: did not answer: chamber (chamber modbus-tcp 127.0.0.1:")
+        assert "0x8000 = -3276.8 °C is outside the chamber's range -75…180 °C" in last
+
+        out = tmp_path / "rec"
+        rc = main(["station", "run", str(toml), "--profile", str(prof), "-o", str(out),
+                   "--time-scale", "100"])  # fmt: skip
+        err = capsys.readouterr().err
+        assert rc == 2, err
+        assert err.strip().splitlines()[-1].startswith("error: chamber modbus-tcp")
+        assert "-3276.8 °C is outside" in err
+        assert sim.writes[-1][1] == pytest.approx(21.5)
+        for p in out.glob("*-*.parquet"):  # no row claims the fault as a temperature
+            t = pq.read_table(p, columns=["chamber_c"])["chamber_c"].to_pylist()
+            assert all(not (v > -1000) and not (v < -1000) for v in t), p
+        assert _digest(toml, prof) == before
+    finally:
+        sen.stop()
+        sim.stop()
+
+
+@pytest.mark.parametrize(
+    ("program", "extra", "words"),
+    [
+        (((0.0, 10.0, 20.0), (25.0, -300.0, -300.0)), {},
+         "p.csv: set-point at program time 10 s: -300 °C is outside the chamber's range "
+         "-75…180 °C"),
+        (((0.0, 10.0, 20.0), (25.0, 150.0, 150.0)), {"max_c": 120},
+         "p.csv: set-point at program time 10 s: 150 °C is outside the chamber's range -75…120"),
+        (HOT, {"safe_setpoint_c": 200},
+         "safe_setpoint_c = 200 °C is outside the chamber's range -75…180 °C"),
+        (HOT, {"safe_setpoint_c": 90},
+         "safe_setpoint_c = 90 °C is not a safe temperature (0…50 °C)"),
+        (HOT, {"min_c": 50, "max_c": 20}, "min_c must be above -273.15 °C and below max_c"),
+    ],
+)  # fmt: skip
+def test_setpoints_outside_the_chamber_range_are_refused_before_anything_is_written(
+    rig: dict, capsys: pytest.CaptureFixture[str], program: tuple, extra: dict, words: str
+) -> None:
+    tmp, sim, sen = rig["tmp"], rig["sim"], rig["sen"]
+    text = _toml(sim.port, sen.device)
+    if "safe_setpoint_c" in extra:
+        text = text.replace("safe_setpoint_c = 21.5\n", "")
+    toml, prof = tmp / "st.toml", _profile(tmp, program)
+    toml.write_text(text.replace("[chamber]\n", "[chamber]\n" + "".join(
+        f"{k} = {v}\n" for k, v in extra.items())))  # fmt: skip
+    before = _digest(toml, prof)
+    out = tmp / "rec"
+    rc = main(["station", "run", str(toml), "--profile", str(prof), "-o", str(out),
+               "--time-scale", "100"])  # fmt: skip
+    err = capsys.readouterr().err.strip().splitlines()
+    assert rc == 2 and len(err) == 1 and err[0].startswith("error: "), err
+    assert words in err[0] and ("st.toml" in err[0]), err
+    assert sim.writes == [] and not out.exists()
+    assert _digest(toml, prof) == before
+
+
+def test_a_chamber_that_ignores_its_setpoint_is_noticed_in_a_short_hold(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A hold of 290 s at 60 °C, drift_s left at its 1800 s default: the chamber stays at
+    25 °C (τ = 1e9 s); the hold's end says so, once; a chamber that follows says nothing."""
+    k = 1000.0
+    program = ((0.0, 100.0, 110.0, 400.0), (25.0, 25.0, 60.0, 60.0))
+    for tau, warned in ((1e9, True), (1.0, False)):
+        model = ChamberModel(time_scale=k, tau_s=tau)
+        sim = SimulatedChamber(model=model, scale=SCALE).start()
+        sen = SimulatedSerialSensor(model, rate_hz=50, time_scale=k).start()
+        try:
+            toml, prof = tmp_path / "st.toml", _profile(tmp_path, program)
+            toml.write_text(_toml(sim.port, sen.device, part_s=0.3).replace(
+                "poll_s = 0.1", "poll_s = 0.02"))  # fmt: skip
+            out = tmp_path / f"rec{tau:g}"
+            rc = main(["station", "run", str(toml), "--profile", str(prof), "-o", str(out),
+                       "--time-scale", str(k)])  # fmt: skip
+        finally:
+            sen.stop()
+            sim.stop()
+        err = capsys.readouterr().err
+        assert rc == 0, err
+        lines = [ln for ln in err.splitlines() if "in the hold" in ln]
+        if not warned:
+            assert lines == [], err
+            continue
+        assert lines == [
+            "warning: chamber never within tolerance_c = 5 °C of the set-point 60.00 °C in "
+            "the hold at program time 110–400 s (last read 25.00 °C): is it following its "
+            "set-point?"
+        ], err
+        (ev,) = [e for e in _events(out) if e["kind"] == "hold"]
+        assert ev["setpoint_c"] == 60.0 and ev["program_s"] == pytest.approx(400.0)

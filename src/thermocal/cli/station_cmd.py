@@ -166,8 +166,10 @@ def run_cmd(
 ) -> None:
     """Run the chamber program and record every sensor and the chamber into DIR.
 
-    Ctrl-C, an error or the end of the program writes the safe set-point and closes every
-    file; continue an interrupted run with --resume.
+    Ctrl-C, SIGTERM, a hang-up (the terminal or ssh session gone), a closed stderr, an
+    error or the end of the program writes the safe set-point and closes every file;
+    continue an interrupted run with --resume (it says how the last run ended and where it
+    left the chamber).
     """
     cfg = _config.load_station(station)
     prog_t, prog_c = _program.read_program(profile)

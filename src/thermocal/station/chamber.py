@@ -175,9 +175,21 @@ class ModbusChamber:
         return fn
 
     def _read(self, register: int, kind: str) -> float:
+        """One register in °C; a value outside the chamber's range (more than
+        ``tolerance_c`` beyond ``min_c``…``max_c``) is a :class:`ChamberError`: a controller
+        reports a broken probe as 0x8000 (−3276.8 °C at 0.1 °C/count), never a reading."""
         method = "read_input_registers" if kind == "input" else "read_holding_registers"
-        rr = self._call(f"read {kind} register {register}", self._client_method(method), register)
-        return self.map.decode(rr.registers[0])
+        what = f"read {kind} register {register}"
+        rr = self._call(what, self._client_method(method), register)
+        word = rr.registers[0]
+        value = self.map.decode(word)
+        why = self.cfg.out_of_range(value, self.cfg.tolerance_c)
+        if why:
+            raise ChamberError(
+                f"chamber {self.name}: {what}: 0x{int(word) & 0xFFFF:04X} = {why}: a probe "
+                "fault, or check the register, scale and signed of [chamber]"
+            )
+        return value
 
     def read_temperature(self) -> float:
         return self._read(self.map.temperature_register, self.map.register_kind)

@@ -200,6 +200,8 @@ class _Loop:
         self.fail_since: float | None = None
         self.drift_since: float | None = None
         self.drift_reported = False
+        self.hold: tuple[int, float, bool] | None = None
+        self.hold_polls = 0
         self.step = -1
         self.t_run = time.time()
         self.next_poll = self.t_run
@@ -238,9 +240,11 @@ class _Loop:
             p = self.p = self.p0 + (now - self.t_run) * self.time_scale
             why = self._stop_asked(should_stop)
             if p >= self.end_s or why:
+                self.p = min(p, self.end_s)
                 if p < self.end_s:
                     self.ended, self.stop_reason = "interrupted", why
-                self.p = min(p, self.end_s)
+                else:
+                    self._judge_hold()  # the last hold ran to its end
                 break
             self._program_step(p)
             self._chamber(now, p)
@@ -262,12 +266,42 @@ class _Loop:
         t_prog, c_prog = self.t_prog, self.c_prog
         k = int(np.searchsorted(t_prog, p, side="right")) - 1
         if k != self.step:
+            self._judge_hold()
             self.step = k
+            held = k + 1 < len(c_prog) and c_prog[k] == c_prog[k + 1]
+            self.hold = (k, float(c_prog[k]), False) if held else None
             nxt = float(c_prog[min(k + 1, len(c_prog) - 1)])
             msg = (f"step {k + 1}/{self.state.n_steps}: {float(c_prog[k]):.2f} → {nxt:.2f} °C "
                    f"from program time {float(t_prog[k]):.0f} s")  # fmt: skip
             self.disp.log(msg)
             self.rec.event("step", msg, program_s=p, step=k + 1)
+
+    def _judge_hold(self) -> None:
+        """At a hold's end: warn when the chamber, polled during it, never came within
+        ``tolerance_c`` of the hold's set-point (a chamber that ignores its set-point is
+        noticed in every hold, however much shorter than ``drift_s``)."""
+        hold, self.hold = self.hold, None
+        if hold is None or hold[2] or not self.hold_polls:
+            self.hold_polls = 0
+            return
+        k, sp, _ = hold
+        t0, t1 = float(self.t_prog[k]), float(self.t_prog[k + 1])
+        msg = (f"warning: chamber never within tolerance_c = {self.ch_cfg.tolerance_c:g} °C "
+               f"of the set-point {sp:.2f} °C in the hold at program time {t0:.0f}–{t1:.0f} s "
+               f"(last read {self.chamber_c:.2f} °C): is it following its set-point?")  # fmt: skip
+        self.rec.event("hold", msg, program_s=self.p, step=k + 1, setpoint_c=sp)
+        self.disp.log(msg)
+        self.hold_polls = 0
+
+    def _track_hold(self) -> None:
+        """After a poll: note whether the chamber is within ``tolerance_c`` of the hold's
+        set-point [°C]."""
+        if self.hold is None or not math.isfinite(self.chamber_c):
+            return
+        self.hold_polls += 1
+        k, sp, reached = self.hold
+        if not reached and abs(self.chamber_c - sp) <= self.ch_cfg.tolerance_c:
+            self.hold = (k, sp, True)
 
     def _chamber(self, now: float, p: float) -> None:
         """Write the set-point when its register value changes, poll the chamber every
@@ -288,7 +322,9 @@ class _Loop:
                 rec.event("setpoint", f"{target:.3f} °C", program_s=p, setpoint_c=target)
             if now >= self.next_poll:
                 self.next_poll = max(self.next_poll + ch_cfg.poll_s, now)
+                self.chamber_c = math.nan  # unknown until the chamber answers
                 self.chamber_c = self.chamber.read_temperature()
+                self._track_hold()
                 rec.add(CHAMBER_STREAM, {"time": rec.rel(now), "program_s": p,
                                          "setpoint_c": self.sp,
                                          "chamber_c": self.chamber_c})  # fmt: skip
@@ -488,6 +524,13 @@ def run_station(
     c_prog = np.asarray(program[1], dtype=np.float64)
     ch_cfg = cfg.chamber
     chamber = chamber or make_chamber(ch_cfg, disp.log)
+    for t, c in zip(t_prog, c_prog, strict=True):  # before anything is written
+        why = ch_cfg.out_of_range(float(c))
+        if why:
+            raise ThermocalInputError(
+                f"{profile_source or 'the program'}: set-point at program time {t:g} s: {why} "
+                f"in {cfg.source}; fix the program or the chamber's range"
+            )
     for c in (*c_prog, ch_cfg.safe_setpoint_c):  # every set-point must fit the register
         _check_setpoint(float(c), ch_cfg)
     rec, p0, previous = _open_recorder(cfg, t_prog, c_prog, out_dir, profile_source, resume,
