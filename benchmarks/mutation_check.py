@@ -1229,6 +1229,30 @@ MUTANTS: tuple[Mutant, ...] = (
         ST_ATT,
         "a hold counted as reached when the chamber is far from it",
     ),
+    Mutant(
+        "station-reply-function-code-unchecked",
+        P + "station/chamber.py",
+        "if got != code:",
+        "if got is None:",
+        ST_ATT,
+        "a reply to another function code read as the temperature",
+    ),
+    Mutant(
+        "station-lock-shared",
+        P + "station/recorder.py",
+        "fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)",
+        "fcntl.flock(fd, fcntl.LOCK_SH | fcntl.LOCK_NB)",
+        ST_ATT,
+        "two runs write one folder (a shared lock)",
+    ),
+    Mutant(
+        "station-failed-start-kept",
+        P + "station/run.py",
+        "        loop.abandon()\n        raise\n",
+        "        raise\n",
+        ST_ATT,
+        "a failed start leaves station.json: the corrected command is refused",
+    ),
     # --- readers: ULog / DataFlash --------------------------------------------------------
     Mutant(
         "ulog-delta-dt-us",

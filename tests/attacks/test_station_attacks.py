@@ -15,6 +15,7 @@ import os
 import signal
 import subprocess
 import sys
+import threading
 import time
 from pathlib import Path
 
@@ -207,11 +208,12 @@ def test_a_register_reading_0x8000_is_a_chamber_fault_not_a_temperature(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     """0x8000 at 0.1 °C/count, signed: −3276.8 °C, what a controller sends for a broken
-    probe.  ``check`` refuses it; ``run`` treats it as a chamber that does not answer (the
-    safe set-point written, exit 2 after ``timeout_s``), never as a reading."""
+    probe.  ``check`` refuses it; ``run`` does not start on it (nothing written, no folder
+    left); a probe that breaks during the run is a chamber that does not answer (the safe
+    set-point written, exit 2 after ``timeout_s``), never a reading."""
     model = ChamberModel(temperature_c=-3276.8, setpoint_c=-3276.8, tau_s=1e9)
     sim = SimulatedChamber(model=model, scale=0.1).start()
-    sen = SimulatedSerialSensor(model.advance, rate_hz=50).start()
+    sen = SimulatedSerialSensor(lambda: 25.0, rate_hz=50).start()
     try:
         toml, prof = tmp_path / "st.toml", _profile(tmp_path)
         toml.write_text(_toml(sim.port, sen.device, part_s=0.3, timeout_s=0.5).replace(
@@ -226,16 +228,26 @@ def test_a_register_reading_0x8000_is_a_chamber_fault_not_a_temperature(
         assert "0x8000 = -3276.8 °C is outside the chamber's range -75…180 °C" in last
 
         out = tmp_path / "rec"
-        rc = main(["station", "run", str(toml), "--profile", str(prof), "-o", str(out),
-                   "--time-scale", "100"])  # fmt: skip
+        argv = ["station", "run", str(toml), "--profile", str(prof), "-o", str(out),
+                "--time-scale", "100"]  # fmt: skip
+        assert main(argv) == 2
+        err = capsys.readouterr().err.strip().splitlines()
+        assert len(err) == 1 and err[0].startswith("error: chamber modbus-tcp"), err
+        assert "-3276.8 °C is outside" in err[0] and "st.toml" in err[0]
+        assert sim.writes == [] and not out.exists()
+
+        with model.lock:  # the probe works at the start, and breaks 1 s into the run
+            model.temperature_c = model.setpoint_c = 25.0
+        threading.Timer(1.0, lambda: setattr(model, "temperature_c", -3276.8)).start()
+        rc = main(argv)
         err = capsys.readouterr().err
         assert rc == 2, err
         assert err.strip().splitlines()[-1].startswith("error: chamber modbus-tcp")
         assert "-3276.8 °C is outside" in err
         assert sim.writes[-1][1] == pytest.approx(21.5)
-        for p in out.glob("*-*.parquet"):  # no row claims the fault as a temperature
+        for p in out.glob("*-*.parquet"):  # no row holds the fault as a temperature
             t = pq.read_table(p, columns=["chamber_c"])["chamber_c"].to_pylist()
-            assert all(not (v > -1000) and not (v < -1000) for v in t), p
+            assert t and not any(v < -1000 for v in t), p
         assert _digest(toml, prof) == before
     finally:
         sen.stop()
@@ -312,3 +324,142 @@ def test_a_chamber_that_ignores_its_setpoint_is_noticed_in_a_short_hold(
         ], err
         (ev,) = [e for e in _events(out) if e["kind"] == "hold"]
         assert ev["setpoint_c"] == 60.0 and ev["program_s"] == pytest.approx(400.0)
+
+
+# --- item 8: Modbus faults, a failed start, one writer per folder --------------------------
+
+
+class BrokenModbus:
+    """A Modbus TCP server on 127.0.0.1 written here byte by byte (MBAP header, PDU):
+    writes (function 6) are echoed; a read (3 or 4) is answered as ``mode`` says: ``zero``
+    a reply with byte count 0, ``cut`` a frame whose byte count (2) exceeds its data (1
+    byte), ``fc`` the reply of another function code (6), ``ok`` one register = 250."""
+
+    def __init__(self, mode: str) -> None:
+        import socket
+
+        self.mode = mode
+        self.srv = socket.socket()
+        self.srv.bind(("127.0.0.1", 0))
+        self.srv.listen(4)
+        self.srv.settimeout(0.2)
+        self.port = self.srv.getsockname()[1]
+        self.stop = threading.Event()
+        self.writes = 0
+        threading.Thread(target=self._accept, daemon=True).start()
+
+    def _accept(self) -> None:
+        while not self.stop.is_set():
+            try:
+                conn, _ = self.srv.accept()
+            except OSError:
+                continue
+            threading.Thread(target=self._serve, args=(conn,), daemon=True).start()
+
+    def _serve(self, conn) -> None:  # type: ignore[no-untyped-def]
+        import struct
+
+        with conn:
+            while not self.stop.is_set():
+                head = conn.recv(7)
+                if len(head) < 7:
+                    return
+                tid, _pid, length, unit = struct.unpack(">HHHB", head)
+                pdu = conn.recv(length - 1)
+                fc = pdu[0]
+                if fc == 6:
+                    self.writes += 1
+                    body = pdu
+                else:
+                    body = {"zero": bytes([fc, 0]), "cut": bytes([fc, 2, 0x01]),
+                            "fc": bytes([6, 0, 100, 0, 1]), "ok": bytes([fc, 2, 0, 250])}[
+                        self.mode]  # fmt: skip
+                conn.sendall(struct.pack(">HHHB", tid, 0, len(body) + 1, unit) + body)
+
+    def close(self) -> None:
+        self.stop.set()
+        self.srv.close()
+
+
+@pytest.mark.parametrize(
+    ("mode", "words"),
+    [
+        ("zero", "read input register 100: the reply holds 0 registers, not 1"),
+        ("cut", "read input register 100: ModbusIOException"),
+        ("fc", "read input register 100: the reply is for function code 6, not 4"),
+    ],
+)
+def test_modbus_faults_are_one_error_line_naming_the_chamber_and_leave_nothing(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], mode: str, words: str
+) -> None:
+    """``check`` and ``run`` end in exit 2 with one ``error:`` line naming the chamber's
+    address and register (never ``internal: IndexError``, never a value read from a reply
+    to another request, never pymodbus's own log line); the failed start leaves no folder,
+    so the same command on a chamber that answers starts afresh."""
+    server = BrokenModbus(mode)
+    sen = SimulatedSerialSensor(lambda: 25.0, rate_hz=50).start()
+    try:
+        toml, prof = tmp_path / "st.toml", _profile(tmp_path, ((0.0, 30.0), (25.0, 25.0)))
+        toml.write_text(_toml(server.port, sen.device, part_s=0.3))
+        before = _digest(toml, prof)
+        where = f"chamber modbus-tcp 127.0.0.1:{server.port} unit 1: {words}"
+        # in a process of its own: pymodbus's logging reaches the real stderr there
+        proc = _spawn(["station", "check", str(toml), "--listen", "0.3"])
+        _o, text = proc.communicate(timeout=30)
+        err = text.strip().splitlines()
+        assert proc.returncode == 2 and len(err) == 1, err
+        assert err[0].startswith("error: did not answer: chamber (") and where in err[0], err
+
+        out = tmp_path / "rec"
+        argv = ["station", "run", str(toml), "--profile", str(prof), "-o", str(out),
+                "--time-scale", "100"]  # fmt: skip
+        assert main(argv) == 2
+        err = capsys.readouterr().err.strip().splitlines()
+        assert len(err) == 1 and err[0].startswith("error: " + where), err
+        assert str(toml) in err[0] and server.writes == 0
+        assert not out.exists()  # the failed start left nothing
+        assert _digest(toml, prof) == before
+
+        # the corrected command (a chamber that answers) starts, with the same -o
+        sim = SimulatedChamber(scale=SCALE).start()
+        try:
+            toml.write_text(_toml(sim.port, sen.device, part_s=0.3))
+            rc = main(argv)
+            assert rc == 0, capsys.readouterr().err
+        finally:
+            sim.stop()
+        assert json.loads((out / "station.json").read_text())["runs"][0]["resumed"] is False
+    finally:
+        sen.stop()
+        server.close()
+
+
+def test_one_writer_per_folder(rig: dict, capsys: pytest.CaptureFixture[str]) -> None:
+    """A second ``--resume`` while a run writes the folder is refused (exit 2 naming the
+    folder and the writer's process); once that process is gone — even by SIGKILL — the
+    folder is free again."""
+    tmp, sim, sen = rig["tmp"], rig["sim"], rig["sen"]
+    toml, prof = tmp / "st.toml", _profile(tmp)
+    toml.write_text(_toml(sim.port, sen.device, part_s=0.3))
+    out = tmp / "rec"
+    argv = ["station", "run", str(toml), "--profile", str(prof), "-o", str(out),
+            "--time-scale", "100"]  # fmt: skip
+    proc = _spawn(argv)
+    try:
+        _wait(lambda: len(list(out.glob("imu-*.parquet"))) >= 1, 15, "a closed part")
+        n_writes = len(sim.writes)
+        assert main([*argv, "--resume"]) == 2
+        err = capsys.readouterr().err.strip().splitlines()
+        assert err == [
+            f"error: {out}: another station run (process {proc.pid}) is writing this folder; "
+            "wait for it to end, or stop it, before --resume"
+        ]
+        # the refused run wrote nothing to the chamber (the running one goes on)
+        assert all(v in (25.0, 65.0) or 25.0 <= v <= 65.0 for _t, v in sim.writes[n_writes:])
+        assert 21.5 not in [v for _t, v in sim.writes]
+        proc.kill()
+        proc.communicate(timeout=10)
+    finally:
+        proc.kill()
+    rc = main([*argv, "--resume", "--time-scale", "400"])
+    assert rc == 0, capsys.readouterr().err

@@ -59,6 +59,10 @@ STATION_COLUMNS = {
 """The station's own columns and their units."""
 
 
+LOCK_NAME = ".station.lock"
+"""The lock file of a recording folder (its one writer's process id)."""
+
+
 def _fsync_write(path: Path, data: bytes) -> None:
     tmp = path.with_name("." + path.name + ".tmp")
     with open(tmp, "wb") as fh:
@@ -120,7 +124,28 @@ class Recorder:
         self.time_scale = time_scale
         self.streams: dict[str, _Stream] = {}
         self.removed_tmp: list[str] = []
+        self._lock_fd: int | None = None
+        self.created = False
+        try:
+            self._open(out_dir, cfg, program, profile_source, time_scale)
+        except BaseException:
+            self.release()
+            raise
+
+    def _open(
+        self,
+        out_dir: Path,
+        cfg: StationConfig,
+        program: tuple[list[float], list[float]],
+        profile_source: str,
+        time_scale: float,
+    ) -> None:
+        """Lock and load (``--resume``) or create the folder; declare the streams; record
+        the run."""
+        resume = self.resume
         if resume:
+            if out_dir.is_dir():
+                self._lock()
             self.doc = self._load_for_resume(program)
         else:
             if out_dir.exists() and (not out_dir.is_dir() or any(out_dir.iterdir())):
@@ -128,7 +153,12 @@ class Recorder:
                     f"{out_dir}: exists and is not empty; continue it with --resume or name "
                     "another -o"
                 )
+            self.created = not out_dir.exists()
             out_dir.mkdir(parents=True, exist_ok=True)
+            self._lock()
+            if (out_dir / STATION_JSON).exists():  # another run started in between
+                self.release()
+                raise ThermocalInputError(f"{out_dir}: another station run started in it")
             now = time.time()
             self.doc = {
                 "format": STATION_FORMAT,
@@ -153,6 +183,52 @@ class Recorder:
             {"start_unix": time.time(), "time_scale": time_scale, "resumed": resume}
         )
         self.save()
+
+    # --- the folder's one writer ----------------------------------------------------------
+    def _lock(self) -> None:
+        """Hold ``DIR/.station.lock`` (an advisory ``flock``, released by the system when the
+        process ends, even by SIGKILL): a second run on the folder is refused."""
+        try:
+            import fcntl
+        except ImportError:  # no flock on this system: one writer is the operator's care
+            return
+        path = self.dir / LOCK_NAME
+        fd = os.open(path, os.O_RDWR | os.O_CREAT, 0o644)
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except OSError:
+            holder = os.read(fd, 32).decode("ascii", "replace").strip() or "?"
+            os.close(fd)
+            raise ThermocalInputError(
+                f"{self.dir}: another station run (process {holder}) is writing this folder; "
+                "wait for it to end, or stop it, before --resume"
+            ) from None
+        os.ftruncate(fd, 0)
+        os.write(fd, str(os.getpid()).encode())
+        self._lock_fd = fd
+
+    def release(self) -> None:
+        """Let another run write the folder."""
+        if self._lock_fd is not None:
+            os.close(self._lock_fd)
+            self._lock_fd = None
+
+    def discard(self) -> None:
+        """A new recording whose run never started: remove what it wrote (``station.json``,
+        the lock, the folder when this run created it), so the corrected command starts
+        afresh.  A resumed recording is left as it is (``--resume`` accepts it again)."""
+        import contextlib
+
+        if self.resume:
+            self.release()
+            return
+        for name in (STATION_JSON, LOCK_NAME, "." + STATION_JSON + ".tmp"):
+            with contextlib.suppress(FileNotFoundError):
+                (self.dir / name).unlink()
+        self.release()
+        if self.created:
+            with contextlib.suppress(OSError):
+                self.dir.rmdir()
 
     # --- setup ------------------------------------------------------------------------
     def _load_for_resume(self, program: tuple[list[float], list[float]]) -> dict[str, Any]:

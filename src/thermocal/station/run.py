@@ -314,6 +314,7 @@ class _Loop:
         else:
             target = _quantize(float(np.interp(p, self.t_prog, self.c_prog)), ch_cfg.scale,
                                ch_cfg.signed, ch_cfg.driver)  # fmt: skip
+        asked = target != self.sp or now >= self.next_poll
         try:
             if target != self.sp:
                 self.chamber.write_setpoint(target)
@@ -329,7 +330,7 @@ class _Loop:
                                          "setpoint_c": self.sp,
                                          "chamber_c": self.chamber_c})  # fmt: skip
                 self.samples[CHAMBER_STREAM] += 1
-            if self.fail_since is not None:
+            if self.fail_since is not None and asked:  # an answer, not a turn without request
                 rec.event("chamber", "the chamber answers again")
                 self.disp.log("chamber answers again")
                 self.fail_since = None
@@ -398,6 +399,18 @@ class _Loop:
             views.append(SensorView(sid, s.stats.rate_hz(), s.stats.last_values, s.cfg.names,
                                     self.bad[sid], self.samples[sid], silent))  # fmt: skip
         return views
+
+    def abandon(self) -> None:
+        """A start that failed (the chamber or a sensor did not open): close what opened and
+        leave no recording behind (:meth:`Recorder.discard`)."""
+        import contextlib
+
+        for s in self.sensors:
+            with contextlib.suppress(Exception):
+                s.close()
+        with contextlib.suppress(Exception):
+            self.chamber.close()
+        self.rec.discard()
 
     def finish(self) -> None:
         """Every way out: the safe set-point, the ports closed, their last lines recorded,
@@ -538,12 +551,19 @@ def run_station(
     loop = _Loop(cfg, t_prog, c_prog, p0, time_scale, rec, chamber, disp)
     try:
         loop.start()
+    except BaseException:  # nothing was written to the chamber: no safe stop to make
+        loop.abandon()
+        raise
+    try:
         loop.play(should_stop)
     except KeyboardInterrupt:
         loop.ended = "interrupted"
         raise
     finally:
-        loop.finish()
+        try:
+            loop.finish()
+        finally:
+            rec.release()
     return RunResult(out_dir, p0, loop.p, loop.parts, loop.samples, loop.bad, loop.ended,
                      loop.setpoints, loop.safe, list(rec.doc["events"]), loop.stop_reason,
                      previous)  # fmt: skip
