@@ -1253,6 +1253,14 @@ MUTANTS: tuple[Mutant, ...] = (
         ST_ATT,
         "a failed start leaves station.json: the corrected command is refused",
     ),
+    Mutant(
+        "station-resume-units-unchecked",
+        P + "station/recorder.py",
+        'RESUME_SENSOR_KEYS = ("names", "units", "delimiter", "decimal", "rate_hz")',
+        'RESUME_SENSOR_KEYS = ("names", "delimiter", "decimal", "rate_hz")',
+        ST_ATT,
+        "--resume with other units accepted: the folder read in the new unit",
+    ),
     # --- readers: ULog / DataFlash --------------------------------------------------------
     Mutant(
         "ulog-delta-dt-us",

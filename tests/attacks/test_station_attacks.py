@@ -463,3 +463,35 @@ def test_one_writer_per_folder(rig: dict, capsys: pytest.CaptureFixture[str]) ->
         proc.kill()
     rc = main([*argv, "--resume", "--time-scale", "400"])
     assert rc == 0, capsys.readouterr().err
+
+
+@pytest.mark.parametrize(
+    ("old", "new", "words"),
+    [
+        ('units = ["deg/s", "degC"]', 'units = ["rad/s", "degC"]',
+         "sensor 'imu' units was ['deg/s', 'degC'], now ['rad/s', 'degC']"),
+        ("rate_hz = 50", "rate_hz = 100", "sensor 'imu' rate_hz was 50.0, now 100.0"),
+        (f"scale = {SCALE}", "scale = 0.1", f"[chamber] scale was {SCALE}, now 0.1"),
+        ('id = "imu"', 'id = "imu2"', "sensors ['imu'] recorded, ['imu2'] given"),
+    ],
+)  # fmt: skip
+def test_resume_with_other_units_or_options_is_refused(
+    rig: dict, capsys: pytest.CaptureFixture[str], old: str, new: str, words: str
+) -> None:
+    tmp, sim, sen = rig["tmp"], rig["sim"], rig["sen"]
+    toml, prof = tmp / "st.toml", _profile(tmp)
+    toml.write_text(_toml(sim.port, sen.device, part_s=0.3))
+    out = tmp / "rec"
+    run_station(parse_station(toml.read_text()), HOT, out, time_scale=100.0,
+                should_stop=lambda: bool(list(out.glob("imu-*.parquet"))))  # fmt: skip
+    capsys.readouterr()
+    doc = (out / "station.json").read_bytes()
+    toml.write_text(toml.read_text().replace(old, new))
+    n_writes = len(sim.writes)
+    assert main(["station", "run", str(toml), "--profile", str(prof), "-o", str(out),
+                 "--resume", "--time-scale", "400"]) == 2  # fmt: skip
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith(
+        f"error: {out}: --resume with another STATION.toml than the recording's: {words}"
+    ), err
+    assert len(sim.writes) == n_writes and (out / "station.json").read_bytes() == doc

@@ -59,6 +59,12 @@ STATION_COLUMNS = {
 """The station's own columns and their units."""
 
 
+RESUME_SENSOR_KEYS = ("names", "units", "delimiter", "decimal", "rate_hz")
+"""The keys of a ``[[sensor]]`` that ``--resume`` must find unchanged."""
+RESUME_CHAMBER_KEYS = ("setpoint_register", "temperature_register", "register_kind", "scale",
+                       "signed")  # fmt: skip
+"""The keys of ``[chamber]`` that ``--resume`` must find unchanged."""
+
 LOCK_NAME = ".station.lock"
 """The lock file of a recording folder (its one writer's process id)."""
 
@@ -241,6 +247,7 @@ class Recorder:
                 f"{self.dir}: --resume with another program than the recording's "
                 f"({rec.get('source', '?')}); give the same --profile"
             )
+        self._same_setup(doc.get("config"))
         for p in self.dir.glob(".*.parquet.tmp"):  # the part open at the crash
             self.removed_tmp.append(p.name)
             p.unlink()
@@ -248,6 +255,32 @@ class Recorder:
             {"stream": s, "file": p.name} for s, _i, p in closed_parts(self.dir)
         ]
         return doc
+
+    def _same_setup(self, old: Any) -> None:
+        """``--resume`` with the recording's sensors (ids, names, units, rate, separators)
+        and chamber map (registers, scale, sign): the folder is read as one recording, in
+        one set of units, so a difference is refused naming the key and both values."""
+        new = self.cfg.to_dict()
+        old = old if isinstance(old, dict) else {}
+        where = f"{self.dir}: --resume with another STATION.toml than the recording's"
+        old_s = {s.get("id"): s for s in old.get("sensors", []) if isinstance(s, dict)}
+        new_s = {s["id"]: s for s in new["sensors"]}
+        if sorted(map(str, old_s)) != sorted(new_s):
+            raise ThermocalInputError(
+                f"{where}: sensors {sorted(map(str, old_s))} recorded, {sorted(new_s)} given; "
+                "give the same [[sensor]] ids"
+            )
+        pairs = [(f"sensor {sid!r} {k}", old_s[sid].get(k), new_s[sid][k]) for sid in new_s
+                 for k in RESUME_SENSOR_KEYS]  # fmt: skip
+        och = old.get("chamber") if isinstance(old.get("chamber"), dict) else {}
+        pairs += [(f"[chamber] {k}", och.get(k), new["chamber"][k]) for k in RESUME_CHAMBER_KEYS]
+        for key, was_, now_ in pairs:
+            was, now = json.loads(json.dumps(was_)), json.loads(json.dumps(now_))
+            if was != now:
+                raise ThermocalInputError(
+                    f"{where}: {key} was {was!r}, now {now!r} (the folder would be read in "
+                    f"the new setting); give the recording's value or record into another -o"
+                )
 
     def _declare_streams(self) -> None:
         existing = closed_parts(self.dir)
