@@ -1261,6 +1261,30 @@ MUTANTS: tuple[Mutant, ...] = (
         ST_ATT,
         "--resume with other units accepted: the folder read in the new unit",
     ),
+    Mutant(
+        "station-clock-ratio-wide",
+        P + "station/run.py",
+        "CLOCK_RATIO = (0.8, 1.25)",
+        "CLOCK_RATIO = (0.01, 100.0)",
+        ST_ATT,
+        "rate_hz 20× off the sensor's line rate passes the host-clock check",
+    ),
+    Mutant(
+        "station-inf-accepted",
+        P + "station/sensors.py",
+        "if not math.isfinite(value):",
+        "if math.isnan(value):",
+        ST_ATT,
+        "inf and 1e999 lines recorded as good samples",
+    ),
+    Mutant(
+        "station-overlong-line-not-skipped",
+        P + "station/sensors.py",
+        'buf, skipping = b"", True',
+        'buf, skipping = b"", False',
+        ST_ATT,
+        "a 10 MB line kept in bad.txt as 4 KB pieces (every byte)",
+    ),
     # --- readers: ULog / DataFlash --------------------------------------------------------
     Mutant(
         "ulog-delta-dt-us",

@@ -9,6 +9,7 @@ lines the simulated sensor sent, the TOML's numbers.  Every input is hashed befo
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import json
 import os
@@ -495,3 +496,153 @@ def test_resume_with_other_units_or_options_is_refused(
         f"error: {out}: --resume with another STATION.toml than the recording's: {words}"
     ), err
     assert len(sim.writes) == n_writes and (out / "station.json").read_bytes() == doc
+
+
+# --- items 3 and 4: the sensor's time against the host clock; non-finite values -----------
+
+
+@pytest.mark.parametrize(("rate", "ratio"), [(1000, 0.05), (2, 25.0), (50, None)])
+def test_rate_hz_that_disagrees_with_the_host_clock_is_warned_during_the_run(
+    rig: dict, capsys: pytest.CaptureFixture[str], rate: float, ratio: float | None
+) -> None:
+    """The simulated sensor sends 50 lines per host second: ``rate_hz = 1000`` makes the
+    recording's time advance 50/1000 = 0.05× as fast as the host's, ``rate_hz = 2``
+    25×; the right rate says nothing."""
+    tmp, sim, sen = rig["tmp"], rig["sim"], rig["sen"]
+    toml = tmp / "st.toml"
+    toml.write_text(
+        _toml(sim.port, sen.device, part_s=0.5).replace("rate_hz = 50", f"rate_hz = {rate}")
+    )
+    out = tmp / "rec"
+    stop_at = time.monotonic() + 3.0
+    n0 = len(sen.sent)
+    run_station(parse_station(toml.read_text(), str(toml)), HOT, out, time_scale=100.0,
+                should_stop=lambda: time.monotonic() > stop_at)  # fmt: skip
+    err = capsys.readouterr().err
+    lines = [ln for ln in err.splitlines() if "as fast as the host clock" in ln]
+    if ratio is None:
+        assert lines == [], err
+        return
+    # the ratio expected from the lines sent per host second, not from the station's records
+    sent_rate = (len(sen.sent) - n0) / 3.0
+    assert sent_rate == pytest.approx(50, rel=0.1)
+    assert len(lines) == 1 and lines[0].startswith("warning: sensor imu: its time advances "), err
+    (ev,) = [e for e in _events(out) if e["kind"] == "clock"]
+    assert ev["ratio"] == pytest.approx(sent_rate / rate, rel=0.1)
+    assert ev["ratio"] == pytest.approx(ratio, rel=0.1)
+    assert f"rate_hz = {rate} in {toml}" in lines[0]
+
+
+class ScriptedSensor:
+    """A pseudo-terminal sending ``lines`` in a loop at ``rate_hz``; what was sent kept."""
+
+    def __init__(self, lines: list[str], rate_hz: float = 100.0) -> None:
+        import tty
+
+        self.master, self.slave = os.openpty()
+        tty.setraw(self.slave)
+        self.device = os.ttyname(self.slave)
+        os.set_blocking(self.master, False)
+        self.lines, self.rate_hz = lines, rate_hz
+        self.sent: list[str] = []
+        self.stop = threading.Event()
+        self.thread = threading.Thread(target=self._run, daemon=True)
+        self.thread.start()
+
+    def _run(self) -> None:
+        i = 0
+        while not self.stop.wait(1.0 / self.rate_hz):
+            line = self.lines[i % len(self.lines)]
+            try:
+                os.write(self.master, (line + "\r\n").encode())
+            except BlockingIOError:
+                continue
+            except OSError:
+                return
+            self.sent.append(line)
+            i += 1
+
+    def close(self) -> None:
+        self.stop.set()
+        self.thread.join(2)
+        for fd in (self.master, self.slave):
+            with contextlib.suppress(OSError):
+                os.close(fd)
+
+
+def test_nan_inf_and_1e999_lines_are_kept_aside_with_a_warning_during_the_run(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Every 4th line is ``nan``, ``inf`` or ``1e999``: such lines go to imu.bad.txt with a
+    warning while the run goes on; the recording holds only the finite lines and reads."""
+    good = ["0.0500,25.000", "0.0510,25.010", "0.0490,25.020"]
+    lines = [good[0], "nan,25.0", good[1], "0.05,inf", good[2], "1e999,25.0"]
+    model = ChamberModel(time_scale=100.0)
+    sim = SimulatedChamber(model=model, scale=SCALE).start()
+    sen = ScriptedSensor(lines)
+    try:
+        toml = tmp_path / "st.toml"
+        toml.write_text(
+            _toml(sim.port, sen.device, part_s=0.5).replace("rate_hz = 50", "rate_hz = 100")
+        )
+        out = tmp_path / "rec"
+        stop_at = time.monotonic() + 1.5
+        res = run_station(
+            parse_station(toml.read_text(), str(toml)),
+            HOT,
+            out,
+            time_scale=100.0,
+            should_stop=lambda: time.monotonic() > stop_at,
+        )
+    finally:
+        sen.close()
+        sim.stop()
+    err = capsys.readouterr().err
+    warned = [ln for ln in err.splitlines() if "not finite" in ln]
+    assert len(warned) == 1 and warned[0].startswith("warning: sensor imu: line "), err
+    rows = pq.read_table(sorted(out.glob("imu-*.parquet")), columns=["gx", "temp"])
+    got = list(zip(rows["gx"].to_pylist(), rows["temp"].to_pylist(), strict=True))
+    allowed = {tuple(float(x) for x in g.split(",")) for g in good}
+    assert got and set(got) <= allowed  # only the finite lines, as sent
+    bad = (out / "imu.bad.txt").read_text().splitlines()
+    assert {ln.split("\t")[3] for ln in bad} <= {"nan,25.0", "0.05,inf", "1e999,25.0"}
+    assert res.bad_lines["imu"] == len(bad) and abs(len(bad) - len(got)) <= 2
+    assert main(["inspect", str(out), "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["n_samples"] == len(got)
+
+
+def test_a_10_mb_line_is_kept_aside_once_and_cut(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """One 10 MB line between good lines: one bad line of at most 200 characters and a
+    count, not 10 MB in imu.bad.txt; the good lines after it are recorded."""
+    model = ChamberModel(time_scale=100.0)
+    sim = SimulatedChamber(model=model, scale=SCALE).start()
+    sen = ScriptedSensor(["0.0500,25.000"], rate_hz=100)
+    try:
+        toml = tmp_path / "st.toml"
+        toml.write_text(
+            _toml(sim.port, sen.device, part_s=0.5).replace("rate_hz = 50", "rate_hz = 100")
+        )
+        out = tmp_path / "rec"
+        huge = ("1234567890," * 1_000_000).encode()
+
+        def inject() -> None:
+            fd = os.dup(sen.master)
+            os.set_blocking(fd, True)
+            os.write(fd, huge + b"\r\n")
+            os.close(fd)
+
+        threading.Timer(0.3, inject).start()
+        stop_at = time.monotonic() + 3.0
+        run_station(parse_station(toml.read_text(), str(toml)), HOT, out, time_scale=100.0,
+                    should_stop=lambda: time.monotonic() > stop_at)  # fmt: skip
+    finally:
+        sen.close()
+        sim.stop()
+    capsys.readouterr()
+    bad = (out / "imu.bad.txt").read_text().splitlines()
+    assert len(bad) == 1 and (out / "imu.bad.txt").stat().st_size < 1000, bad[:2]
+    assert bad[0].split("\t")[2] == "longer than 4096 bytes"
+    t = pq.read_table(sorted(out.glob("imu-*.parquet")), columns=["host_time"])
+    assert max(t["host_time"].to_pylist()) > 1.5  # lines after the long one recorded

@@ -65,6 +65,9 @@ RESUME_CHAMBER_KEYS = ("setpoint_register", "temperature_register", "register_ki
                        "signed")  # fmt: skip
 """The keys of ``[chamber]`` that ``--resume`` must find unchanged."""
 
+BAD_TEXT_MAX = 200
+"""Characters of a bad line kept in ``SENSOR.bad.txt`` (the rest counted)."""
+
 LOCK_NAME = ".station.lock"
 """The lock file of a recording folder (its one writer's process id)."""
 
@@ -400,6 +403,8 @@ class Recorder:
             return
         with open(self.dir / f"{sensor}.bad.txt", "a", encoding="utf-8") as fh:
             for t, idx, reason, text in rows:
+                if len(text) > BAD_TEXT_MAX:  # a 10 MB line is not kept whole
+                    text = text[:BAD_TEXT_MAX] + f"… ({len(text):,} characters)"
                 fh.write(f"{self.rel(t):.6f}\t{idx}\t{reason}\t{text}\n")
             fh.flush()
             os.fsync(fh.fileno())

@@ -42,6 +42,15 @@ LOOP_S = 0.02
 this often."""
 
 
+CLOCK_CHECK_S = 2.0
+"""Host seconds of lines after which a sensor's time is compared with the host clock [s]."""
+
+CLOCK_RATIO = (0.8, 1.25)
+"""Accepted ratio of a sensor's time to the host clock over :data:`CLOCK_CHECK_S`: wide
+enough for the bursts in which a serial port delivers lines, narrow enough for a rate or a
+time unit off by a factor of 2 or more."""
+
+
 class StationStopped(ThermocalInputError):
     """The run stopped safely because the chamber stopped answering (exit 2)."""
 
@@ -191,6 +200,9 @@ class _Loop:
         self.parts: list[str] = []
         self.stopped = {s.id: False for s in cfg.sensors}
         self.anchors: dict[str, float] = {}
+        self.clock_first: dict[str, tuple[float, float]] = {}
+        self.clock_checked: set[str] = set()
+        self.bad_kinds: set[tuple[str, str]] = set()
         self.last_time: dict[str, float] = {}
         self.ended = "end"
         self.stop_reason = ""
@@ -366,12 +378,58 @@ class _Loop:
 
     def _add_rows(self, s: SerialSensor, got: list[Any]) -> None:
         """The sensor's lines as rows of its stream, with the chamber's state."""
+        row: dict[str, float] = {}
         for smp in got:
             row = _sensor_row(s, smp.host_unix, smp.index, smp.values, self.rec, self.anchors,
                               self.last_time)  # fmt: skip
             program_s = self.p0 + (smp.host_unix - self.t_run) * self.time_scale
             row.update(chamber_c=self.chamber_c, setpoint_c=self.sp, program_s=program_s)
             self.rec.add(s.cfg.id, row)
+        if row:  # from the last line of the first read: lines queued before it share its time
+            self.clock_first.setdefault(s.cfg.id, (row["time"], row["host_time"]))
+            self._check_clock(s, row["time"], row["host_time"])
+
+    def _check_clock(self, s: SerialSensor, t: float, host: float) -> None:
+        """Once per run, after :data:`CLOCK_CHECK_S` of host time: the recording's time
+        (``rate_hz`` or the line's own time field) must advance as the host clock does,
+        ``Δtime / Δhost`` within :data:`CLOCK_RATIO`; else a ``warning:`` (a rate of 1000 Hz
+        declared for a 50 line/s sensor makes every duration 20× too short)."""
+        sid = s.cfg.id
+        t0, h0 = self.clock_first[sid]
+        if sid in self.clock_checked or host - h0 < CLOCK_CHECK_S:
+            return
+        self.clock_checked.add(sid)
+        ratio = (t - t0) / (host - h0)
+        lo, hi = CLOCK_RATIO
+        if lo <= ratio <= hi:
+            return
+        cfg = s.cfg
+        how = (f"rate_hz = {cfg.rate_hz:g}" if cfg.rate_hz is not None else
+               f"its time field {cfg.time_name!r} in "
+               f"{cfg.units[cfg.names.index(cfg.time_name or '')]}")  # fmt: skip
+        msg = (f"warning: sensor {sid}: its time advances {ratio:.3g}× as fast as the host "
+               f"clock over {host - h0:.1f} s ({how} in {self.cfg.source}; the lines arrive at "
+               f"{s.stats.rate_hz():.1f} per s): the recording's time is wrong; stop, fix "
+               "STATION.toml and record again (host_time holds the host's clock)")  # fmt: skip
+        self.rec.event("clock", msg, sensor=sid, ratio=ratio, program_s=self.p)
+        self.disp.log(msg)
+
+    def _warn_bad(self, sid: str, bads: list[Any], p: float) -> None:
+        """A ``warning:`` for the first bad line of each kind (its reason without the
+        numbers and text) per sensor; the rest are counted in ``SENSOR.bad.txt``."""
+        import re
+
+        for b in bads:
+            kind = re.sub(r"\d+", "#", b.reason.split(":")[0])
+            if (sid, kind) in self.bad_kinds:
+                continue
+            self.bad_kinds.add((sid, kind))
+            msg = (
+                f"warning: sensor {sid}: line {b.index} kept aside in {sid}.bad.txt, not "
+                f"recorded ({b.reason}); lines of this kind are only counted from now on"
+            )
+            self.rec.event("bad", msg, sensor=sid, program_s=p)
+            self.disp.log(msg)
 
     def _sensors(self, now: float, p: float) -> list[SensorView]:
         """Drain every sensor's lines into the recorder; report a sensor that stops or
@@ -383,6 +441,7 @@ class _Loop:
             if bads:
                 self.bad[sid] += len(bads)
                 rec.bad_lines(sid, [(b.host_unix, b.index, b.reason, b.text) for b in bads])
+                self._warn_bad(sid, bads, p)
             self._add_rows(s, got)
             self.samples[sid] += len(got)
             silent = (now - (s.stats.last_unix if s.stats.good else self.t_run)
