@@ -1285,6 +1285,14 @@ MUTANTS: tuple[Mutant, ...] = (
         ST_ATT,
         "a 10 MB line kept in bad.txt as 4 KB pieces (every byte)",
     ),
+    Mutant(
+        "station-part-write-error-raw",
+        P + "station/recorder.py",
+        "                self._failed(tmp, exc)\n",
+        "                raise\n",
+        ST_ATT,
+        "a full disk while closing a part: exit 1 without the file's name",
+    ),
     # --- readers: ULog / DataFlash --------------------------------------------------------
     Mutant(
         "ulog-delta-dt-us",

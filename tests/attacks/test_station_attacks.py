@@ -646,3 +646,36 @@ def test_a_10_mb_line_is_kept_aside_once_and_cut(
     assert bad[0].split("\t")[2] == "longer than 4096 bytes"
     t = pq.read_table(sorted(out.glob("imu-*.parquet")), columns=["host_time"])
     assert max(t["host_time"].to_pylist()) > 1.5  # lines after the long one recorded
+
+
+@pytest.mark.parametrize(
+    ("part_s", "file"), [(0.3, "station.json"), (2.0, ".imu-0000.parquet.tmp")]
+)
+def test_a_full_disk_stops_the_run_safely_naming_the_file(
+    rig: dict, part_s: float, file: str
+) -> None:
+    """Files may not grow beyond 6 kB (``RLIMIT_FSIZE``: every write beyond fails with
+    EFBIG, as a full disk fails with ENOSPC): the run stops with the safe set-point, one
+    ``error:`` line naming the file of the recording that could not be written, exit 2."""
+    import resource
+
+    tmp, sim, sen = rig["tmp"], rig["sim"], rig["sen"]
+    toml, prof = tmp / "st.toml", _profile(tmp)
+    toml.write_text(_toml(sim.port, sen.device, part_s=part_s))
+    out = tmp / "rec"
+    env = {**os.environ, "PYTHONPATH": SRC, "PYTHONDONTWRITEBYTECODE": "1"}
+    code = "import sys; from thermocal.cli import main; sys.exit(main())"
+
+    def limit() -> None:
+        resource.setrlimit(resource.RLIMIT_FSIZE, (6000, 6000))
+
+    proc = subprocess.run(
+        [sys.executable, "-c", code, "station", "run", str(toml), "--profile", str(prof),
+         "-o", str(out), "--time-scale", "100"],
+        env=env, text=True, capture_output=True, timeout=60, preexec_fn=limit,
+    )  # fmt: skip
+    err = proc.stderr.strip().splitlines()
+    assert proc.returncode == 2, proc.stderr
+    assert err[-1].startswith(f"error: {out / file}: cannot write (File too large)"), err
+    assert "--resume" in err[-1] and "Traceback" not in proc.stderr
+    assert sim.writes[-1][1] == pytest.approx(21.5)  # the chamber was made safe

@@ -135,6 +135,7 @@ class Recorder:
         self.removed_tmp: list[str] = []
         self._lock_fd: int | None = None
         self.created = False
+        self.write_error = ""
         try:
             self._open(out_dir, cfg, program, profile_source, time_scale)
         except BaseException:
@@ -362,10 +363,14 @@ class Recorder:
             name = part_name(st.name, st.next_index)
             final = self.dir / name
             tmp = self.dir / ("." + name + ".tmp")
-            pq.write_table(table, tmp, write_page_checksum=True)
-            with open(tmp, "rb") as fh:
-                os.fsync(fh.fileno())
-            os.replace(tmp, final)
+            try:
+                pq.write_table(table, tmp, write_page_checksum=True)
+                with open(tmp, "rb") as fh:
+                    os.fsync(fh.fileno())
+                os.replace(tmp, final)
+            except OSError as exc:
+                self._failed(tmp, exc)
+                continue  # already failing: the rows stay in memory, the stop goes on
             self.doc["parts"].append(
                 {
                     "stream": st.name,
@@ -401,16 +406,40 @@ class Recorder:
         """Append bad lines to ``DIR/<sensor>.bad.txt`` (flushed at once)."""
         if not rows:
             return
-        with open(self.dir / f"{sensor}.bad.txt", "a", encoding="utf-8") as fh:
-            for t, idx, reason, text in rows:
-                if len(text) > BAD_TEXT_MAX:  # a 10 MB line is not kept whole
-                    text = text[:BAD_TEXT_MAX] + f"… ({len(text):,} characters)"
-                fh.write(f"{self.rel(t):.6f}\t{idx}\t{reason}\t{text}\n")
-            fh.flush()
-            os.fsync(fh.fileno())
+        path = self.dir / f"{sensor}.bad.txt"
+        try:
+            with open(path, "a", encoding="utf-8") as fh:
+                for t, idx, reason, text in rows:
+                    if len(text) > BAD_TEXT_MAX:  # a 10 MB line is not kept whole
+                        text = text[:BAD_TEXT_MAX] + f"… ({len(text):,} characters)"
+                    fh.write(f"{self.rel(t):.6f}\t{idx}\t{reason}\t{text}\n")
+                fh.flush()
+                os.fsync(fh.fileno())
+        except OSError as exc:
+            self._failed(path, exc)
 
     def save(self) -> None:
-        _fsync_write(self.dir / STATION_JSON, json.dumps(self.doc, indent=1).encode())
+        path = self.dir / STATION_JSON
+        try:
+            _fsync_write(path, json.dumps(self.doc, indent=1).encode())
+        except OSError as exc:
+            self._failed(path, exc)
+
+    def _failed(self, path: Path, exc: OSError) -> None:
+        """A write that failed (a full disk, a file-size limit, a folder gone): the first
+        raises :class:`ThermocalInputError` naming the file, so the run stops safely; later
+        ones, during that safe stop, are ignored (the first error is the one reported)."""
+        if self.write_error:
+            return
+        import re
+
+        code = exc.errno or next(iter(re.findall(r"\[errno (\d+)\]", str(exc))), None)
+        why = os.strerror(int(code)) if code else (str(exc)[:200] or type(exc).__name__)
+        self.write_error = (
+            f"{path}: cannot write ({why}): free space (or fix the folder) and continue "
+            "with --resume; the closed parts are kept"
+        )
+        raise ThermocalInputError(self.write_error) from None
 
 
 __all__ = [
