@@ -18,6 +18,7 @@ import subprocess
 import sys
 import threading
 import time
+from collections.abc import Callable
 from pathlib import Path
 
 import pyarrow.parquet as pq
@@ -536,7 +537,7 @@ def test_rate_hz_that_disagrees_with_the_host_clock_is_warned_during_the_run(
 class ScriptedSensor:
     """A pseudo-terminal sending ``lines`` in a loop at ``rate_hz``; what was sent kept."""
 
-    def __init__(self, lines: list[str], rate_hz: float = 100.0) -> None:
+    def __init__(self, lines: list[str] | Callable[[int], str], rate_hz: float = 100.0) -> None:
         import tty
 
         self.master, self.slave = os.openpty()
@@ -552,7 +553,7 @@ class ScriptedSensor:
     def _run(self) -> None:
         i = 0
         while not self.stop.wait(1.0 / self.rate_hz):
-            line = self.lines[i % len(self.lines)]
+            line = self.lines(i) if callable(self.lines) else self.lines[i % len(self.lines)]
             try:
                 os.write(self.master, (line + "\r\n").encode())
             except BlockingIOError:
@@ -679,3 +680,34 @@ def test_a_full_disk_stops_the_run_safely_naming_the_file(
     assert err[-1].startswith(f"error: {out / file}: cannot write (File too large)"), err
     assert "--resume" in err[-1] and "Traceback" not in proc.stderr
     assert sim.writes[-1][1] == pytest.approx(21.5)  # the chamber was made safe
+
+
+@pytest.mark.parametrize(("unit", "warned"), [("s", True), ("ms", False)])
+def test_a_millisecond_counter_declared_in_seconds_is_warned(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], unit: str, warned: bool
+) -> None:
+    """The lines carry their own time, a counter of milliseconds (10 per line at 100 lines
+    per second): declared in s, the recording's time runs 1000× too fast."""
+    model = ChamberModel(time_scale=100.0)
+    sim = SimulatedChamber(model=model, scale=SCALE).start()
+    sen = ScriptedSensor(lambda i: f"{10 * i},0.05,25.0", rate_hz=100)
+    try:
+        toml = tmp_path / "st.toml"
+        text = _toml(sim.port, sen.device, part_s=0.5)
+        text = text.replace('names = ["gx", "temp"]', 'names = ["time", "gx", "temp"]')
+        text = text.replace('units = ["deg/s", "degC"]', f'units = ["{unit}", "deg/s", "degC"]')
+        toml.write_text(text.replace("rate_hz = 50\n", ""))
+        out = tmp_path / "rec"
+        stop_at = time.monotonic() + 2.8
+        run_station(parse_station(toml.read_text(), str(toml)), HOT, out, time_scale=100.0,
+                    should_stop=lambda: time.monotonic() > stop_at)  # fmt: skip
+    finally:
+        sen.close()
+        sim.stop()
+    lines = [ln for ln in capsys.readouterr().err.splitlines() if "host clock" in ln]
+    if not warned:
+        assert lines == []
+        return
+    assert len(lines) == 1 and "its time field 'time' in s in " in lines[0], lines
+    (ev,) = [e for e in _events(out) if e["kind"] == "clock"]
+    assert ev["ratio"] == pytest.approx(1000.0, rel=0.15)  # 10 ms per line, 100 lines/s
