@@ -1293,6 +1293,14 @@ MUTANTS: tuple[Mutant, ...] = (
         ST_ATT,
         "a full disk while closing a part: exit 1 without the file's name",
     ),
+    Mutant(
+        "station-live-display-hangup-raises",
+        P + "station/display.py",
+        "highlight=False)\n        except (OSError, ValueError) as exc:",
+        "highlight=False)\n        except ValueError as exc:",
+        ST_ATT,
+        "the live display raises on a terminal gone: the safe stop aborted, exit 1",
+    ),
     # --- readers: ULog / DataFlash --------------------------------------------------------
     Mutant(
         "ulog-delta-dt-us",

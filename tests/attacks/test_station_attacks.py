@@ -711,3 +711,43 @@ def test_a_millisecond_counter_declared_in_seconds_is_warned(
     assert len(lines) == 1 and "its time field 'time' in s in " in lines[0], lines
     (ev,) = [e for e in _events(out) if e["kind"] == "clock"]
     assert ev["ratio"] == pytest.approx(1000.0, rel=0.15)  # 10 ms per line, 100 lines/s
+
+
+def test_hangup_of_the_operators_terminal_with_the_live_display(rig: dict) -> None:
+    """stderr is a terminal (a pseudo-terminal: the live display runs); the terminal goes
+    away (its master closed: every write then fails) and SIGHUP comes: the safe set-point,
+    the open part closed, exit 129."""
+    import tty
+
+    tmp, sim, sen = rig["tmp"], rig["sim"], rig["sen"]
+    toml, prof = tmp / "st.toml", _profile(tmp)
+    toml.write_text(_toml(sim.port, sen.device))
+    out = tmp / "rec"
+    master, slave = os.openpty()
+    tty.setraw(slave)
+    env = {**os.environ, "PYTHONPATH": SRC, "COLUMNS": "120"}
+    code = "import sys; from thermocal.cli import main; sys.exit(main())"
+    proc = subprocess.Popen(
+        [sys.executable, "-c", code, "station", "run", str(toml), "--profile", str(prof),
+         "-o", str(out), "--time-scale", "100"],
+        env=env, stdout=subprocess.DEVNULL, stderr=slave, stdin=subprocess.DEVNULL,
+    )  # fmt: skip
+    os.close(slave)
+    try:
+        _wait(lambda: sim.writes and sim.writes[-1][1] == 65.0, 15, "the hot set-point")
+        time.sleep(0.5)
+        seen = b""
+        with contextlib.suppress(OSError):
+            seen = os.read(master, 1 << 16)
+        n_sent = len(sen.sent)
+        os.close(master)  # the terminal is gone
+        proc.send_signal(signal.SIGHUP)
+        proc.wait(timeout=15)
+    finally:
+        proc.kill()
+    assert b"\x1b[" in seen  # it was the live display
+    assert proc.returncode == 129
+    assert sim.writes[-1][1] == pytest.approx(21.5)
+    assert _last_kept(out, sen.sent) >= n_sent - 10
+    stop = _events(out)[-1]
+    assert stop["kind"] == "stop" and stop["reason"] == "SIGHUP"
