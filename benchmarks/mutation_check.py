@@ -1301,6 +1301,14 @@ MUTANTS: tuple[Mutant, ...] = (
         ST_ATT,
         "the live display raises on a terminal gone: the safe stop aborted, exit 1",
     ),
+    Mutant(
+        "station-beyond-any-sensor-signed",
+        P + "station/run.py",
+        "if abs(values[i]) > lim:",
+        "if values[i] > lim:",
+        ST_ATT,
+        "-3e4 deg/s recorded as a sample (only positive values checked)",
+    ),
     # --- readers: ULog / DataFlash --------------------------------------------------------
     Mutant(
         "ulog-delta-dt-us",

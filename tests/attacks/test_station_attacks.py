@@ -751,3 +751,35 @@ def test_hangup_of_the_operators_terminal_with_the_live_display(rig: dict) -> No
     assert _last_kept(out, sen.sent) >= n_sent - 10
     stop = _events(out)[-1]
     assert stop["kind"] == "stop" and stop["reason"] == "SIGHUP"
+
+
+def test_1e300_deg_s_lines_are_kept_aside_with_a_warning(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Every other line reads 1e300 deg/s: beyond any gyro (1e8 deg/h, the limit every
+    command applies to a recording, = 27 778 deg/s); those lines are kept aside with one
+    warning during the run, the others recorded, and the recording reads."""
+    model = ChamberModel(time_scale=100.0)
+    sim = SimulatedChamber(model=model, scale=SCALE).start()
+    sen = ScriptedSensor(["0.0500,25.000", "1e300,25.000", "-3e4,25.000"])
+    try:
+        toml = tmp_path / "st.toml"
+        toml.write_text(
+            _toml(sim.port, sen.device, part_s=0.5).replace("rate_hz = 50", "rate_hz = 100")
+        )
+        out = tmp_path / "rec"
+        stop_at = time.monotonic() + 1.5
+        run_station(parse_station(toml.read_text(), str(toml)), HOT, out, time_scale=100.0,
+                    should_stop=lambda: time.monotonic() > stop_at)  # fmt: skip
+    finally:
+        sen.close()
+        sim.stop()
+    err = capsys.readouterr().err
+    warned = [ln for ln in err.splitlines() if "beyond any sensor" in ln]
+    assert len(warned) == 1 and "(|value| ≤ 27777.8 deg/s)" in warned[0], err
+    gx = pq.read_table(sorted(out.glob("imu-*.parquet")), columns=["gx"])["gx"].to_pylist()
+    assert gx and set(gx) == {0.05}
+    bad = [ln.split("\t")[3] for ln in (out / "imu.bad.txt").read_text().splitlines()]
+    assert set(bad) == {"1e+300,25", "-30000,25"}
+    assert main(["inspect", str(out), "--json"]) == 0
+    capsys.readouterr()

@@ -29,7 +29,7 @@ from thermocal.readers.station import CHAMBER_STREAM, closed_parts
 from thermocal.station.chamber import Chamber, ChamberError, make_chamber
 from thermocal.station.config import ChamberConfig, StationConfig
 from thermocal.station.recorder import Recorder
-from thermocal.station.sensors import SerialSensor
+from thermocal.station.sensors import Bad, SerialSensor
 
 if TYPE_CHECKING:
     import numpy as np
@@ -203,6 +203,7 @@ class _Loop:
         self.clock_first: dict[str, tuple[float, float]] = {}
         self.clock_checked: set[str] = set()
         self.bad_kinds: set[tuple[str, str]] = set()
+        self.limits: dict[str, list[tuple[int, float, str]]] = {}
         self.last_time: dict[str, float] = {}
         self.ended = "end"
         self.stop_reason = ""
@@ -377,8 +378,19 @@ class _Loop:
             self.drift_since, self.drift_reported = None, False
 
     def _add_rows(self, s: SerialSensor, got: list[Any]) -> None:
-        """The sensor's lines as rows of its stream, with the chamber's state."""
+        """The sensor's lines as rows of its stream, with the chamber's state; a line with a
+        value beyond any sensor is kept aside instead (:func:`_beyond_any_sensor`)."""
         row: dict[str, float] = {}
+        limits = self.limits.setdefault(s.cfg.id, _signal_limits(s.cfg))
+        beyond = [(smp, why) for smp in got if (why := _beyond_any_sensor(smp.values, limits))]
+        if beyond:
+            rows = [(b.host_unix, b.index, why, ",".join(f"{v:g}" for v in b.values))
+                    for b, why in beyond]  # fmt: skip
+            self.bad[s.cfg.id] += len(rows)
+            self.rec.bad_lines(s.cfg.id, rows)
+            self._warn_bad(s.cfg.id, [Bad(h, i, t, r) for h, i, r, t in rows], self.p)
+            skip = {id(b) for b, _w in beyond}
+            got = [smp for smp in got if id(smp) not in skip]
         for smp in got:
             row = _sensor_row(s, smp.host_unix, smp.index, smp.values, self.rec, self.anchors,
                               self.last_time)  # fmt: skip
@@ -677,6 +689,37 @@ def _sensor_row(
     row["time"] = t
     row["host_time"] = host
     return row
+
+
+def _signal_limits(cfg: Any) -> list[tuple[int, float, str]]:
+    """``(field index, limit in the field's own unit, unit)`` of each rate or acceleration
+    field: :data:`thermocal.recording.PLAUSIBLE_SIGNAL` (the limit every command applies
+    to a recording) converted to the field's unit."""
+    import numpy as np
+
+    from thermocal import units
+    from thermocal.errors import UnitError
+    from thermocal.recording import PLAUSIBLE_SIGNAL
+
+    out = []
+    for i, u in enumerate(cfg.units):
+        try:
+            kind = units.signal_kind(u)
+        except UnitError:
+            continue
+        if kind in PLAUSIBLE_SIGNAL:
+            one = float(units.to_canonical(np.array([1.0]), u, finite=False)[0][0])
+            out.append((i, PLAUSIBLE_SIGNAL[kind] / one, u))
+    return out
+
+
+def _beyond_any_sensor(values: tuple[float, ...], limits: list[tuple[int, float, str]]) -> str:
+    """Why a line's values cannot come from a sensor (``""``: they can): a rate or an
+    acceleration beyond :data:`thermocal.recording.PLAUSIBLE_SIGNAL` (``1e300 deg/s``)."""
+    for i, lim, u in limits:
+        if abs(values[i]) > lim:
+            return f"beyond any sensor: {values[i]:g} {u} (|value| ≤ {lim:g} {u})"
+    return ""
 
 
 def _safe_stop(chamber: Chamber, safe_c: float, rec: Recorder, disp: Display) -> float | None:
