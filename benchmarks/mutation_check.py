@@ -1309,6 +1309,30 @@ MUTANTS: tuple[Mutant, ...] = (
         ST_ATT,
         "-3e4 deg/s recorded as a sample (only positive values checked)",
     ),
+    Mutant(
+        "station-resume-overwrites-last-part",
+        P + "station/recorder.py",
+        "nxt[s] = max(nxt.get(s, 0), i + 1)",
+        "nxt[s] = max(nxt.get(s, 0), i)",
+        ST_ATT,
+        "--resume writes its first part over the recording's last",
+    ),
+    Mutant(
+        "station-resume-rate-time-from-zero",
+        P + "station/run.py",
+        "anchor = anchors.setdefault(cfg.id, host - index / cfg.rate_hz)",
+        "anchor = anchors.setdefault(cfg.id, -index / cfg.rate_hz)",
+        ST_ATT,
+        "the rate time re-anchored at 0 by each run: time restarts on --resume",
+    ),
+    Mutant(
+        "station-resume-setpoints-unchecked",
+        P + "station/recorder.py",
+        "] != [float(x) for x in program[1]]:",
+        "] != [float(x) for x in program[1]] and False:",
+        ST_ATT,
+        "--resume with other set-points at the same times accepted",
+    ),
     # --- readers: ULog / DataFlash --------------------------------------------------------
     Mutant(
         "ulog-delta-dt-us",

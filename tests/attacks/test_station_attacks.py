@@ -783,3 +783,43 @@ def test_1e300_deg_s_lines_are_kept_aside_with_a_warning(
     assert set(bad) == {"1e+300,25", "-30000,25"}
     assert main(["inspect", str(out), "--json"]) == 0
     capsys.readouterr()
+
+
+def _parts(out: Path) -> dict[str, str]:
+    return {p.name: _digest(p)[0] for p in sorted(out.glob("imu-*.parquet"))}
+
+
+def test_resume_keeps_every_part_continues_time_and_checks_the_setpoints(
+    rig: dict, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Survivors of the last wave: a resume that overwrites the last part, restarts the
+    rate time at 0, or accepts a program whose set-points differ."""
+    tmp, sim, sen = rig["tmp"], rig["sim"], rig["sen"]
+    toml = tmp / "st.toml"
+    toml.write_text(_toml(sim.port, sen.device, part_s=0.3))
+    cfg = parse_station(toml.read_text(), str(toml))
+    out = tmp / "rec"
+    run_station(cfg, HOT, out, time_scale=100.0,
+                should_stop=lambda: len(list(out.glob("imu-*.parquet"))) >= 2)  # fmt: skip
+    first = _parts(out)
+    doc = (out / "station.json").read_bytes()
+    other = _profile(tmp, (HOT[0], (25.0, 70.0, 70.0)))  # same times, other set-points
+    assert main(["station", "run", str(toml), "--profile", str(other), "-o", str(out),
+                 "--resume", "--time-scale", "100"]) == 2  # fmt: skip
+    err = capsys.readouterr().err
+    assert "--resume with another program than the recording's" in err
+    assert (out / "station.json").read_bytes() == doc
+    time.sleep(0.5)
+    stop_at = time.monotonic() + 1.0
+    run_station(cfg, HOT, out, resume=True, time_scale=100.0,
+                should_stop=lambda: time.monotonic() > stop_at)  # fmt: skip
+    capsys.readouterr()
+    after = _parts(out)
+    assert {k: after[k] for k in first} == first and len(after) > len(first)
+    old = pq.read_table([out / n for n in first], columns=["time", "host_time"])
+    new = pq.read_table([out / n for n in after if n not in first], columns=["time", "host_time"])
+    t_old, h_old = old["time"].to_pylist(), old["host_time"].to_pylist()
+    t_new, h_new = new["time"].to_pylist(), new["host_time"].to_pylist()
+    assert t_new[0] > t_old[-1] + 0.4  # the pause of 0.5 s between the runs is in the time
+    # the time continues with the host clock (the lines' own clock at rate_hz = 50)
+    assert (t_new[0] - t_old[-1]) == pytest.approx(h_new[0] - h_old[-1], abs=0.1)
