@@ -1333,6 +1333,14 @@ MUTANTS: tuple[Mutant, ...] = (
         ST_ATT,
         "--resume with other set-points at the same times accepted",
     ),
+    Mutant(
+        "station-no-stderr-prints-on-stdout",
+        P + "station/run.py",
+        '    if sys.stderr is None:\n        return ""\n',
+        "",
+        ST_ATT,
+        "started with 2>&-, the run's messages land in the --json output on stdout",
+    ),
     # --- readers: ULog / DataFlash --------------------------------------------------------
     Mutant(
         "ulog-delta-dt-us",

@@ -823,3 +823,24 @@ def test_resume_keeps_every_part_continues_time_and_checks_the_setpoints(
     assert t_new[0] > t_old[-1] + 0.4  # the pause of 0.5 s between the runs is in the time
     # the time continues with the host clock (the lines' own clock at rate_hz = 50)
     assert (t_new[0] - t_old[-1]) == pytest.approx(h_new[0] - h_old[-1], abs=0.1)
+
+
+def test_started_without_stderr_the_json_on_stdout_stays_clean(rig: dict) -> None:
+    """``2>&-``: Python starts with ``sys.stderr = None`` and ``print(file=None)`` writes to
+    stdout; the run's messages must not land in the ``--json`` output."""
+    tmp, sim, sen = rig["tmp"], rig["sim"], rig["sen"]
+    toml, prof = tmp / "st.toml", _profile(tmp, ((0.0, 10.0, 100.0), (25.0, 30.0, 30.0)))
+    toml.write_text(_toml(sim.port, sen.device, part_s=0.3))
+    out = tmp / "rec"
+    env = {**os.environ, "PYTHONPATH": SRC}
+    code = "import sys; from thermocal.cli import main; sys.exit(main())"
+    proc = subprocess.run(
+        [sys.executable, "-c", code, "station", "run", str(toml), "--profile", str(prof),
+         "-o", str(out), "--time-scale", "100", "--json"],
+        env=env, text=True, stdout=subprocess.PIPE, timeout=60,
+        preexec_fn=lambda: os.close(2),
+    )  # fmt: skip
+    assert proc.returncode == 0, proc.stdout
+    res = json.loads(proc.stdout)  # one JSON object, nothing else
+    assert res["ended"] == "end" and res["safe_setpoint_c"] == 21.5
+    assert sim.writes[-1][1] == pytest.approx(21.5)

@@ -173,7 +173,7 @@ def run_cmd(
     """
     cfg = _config.load_station(station)
     prog_t, prog_c = _program.read_program(profile)
-    live = sys.stderr.isatty() and not as_json
+    live = sys.stderr is not None and sys.stderr.isatty() and not as_json  # None: 2>&-
     disp = _display.RichDisplay() if live else _run.LogDisplay()
     flag = _StopFlag()
     try:

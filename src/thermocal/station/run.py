@@ -99,7 +99,11 @@ class Display(Protocol):
 def say(message: str) -> str:
     """Print ``message`` on stderr; never raises.  Returns ``""``, or why stderr is gone
     (a closed pipe, a vanished terminal): then file descriptor 2 is pointed at
-    ``os.devnull``, so that no later message (nor Python's flush at exit) raises either."""
+    ``os.devnull``, so that no later message (nor Python's flush at exit) raises either.
+    Started without a stderr (``2>&-``: ``sys.stderr`` is None) nothing is printed (never
+    on stdout, where ``--json`` writes) and ``""`` is returned: nobody was watching."""
+    if sys.stderr is None:
+        return ""
     try:
         print(message, file=sys.stderr, flush=True)
     except (OSError, ValueError, AttributeError) as exc:
