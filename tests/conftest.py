@@ -29,3 +29,14 @@ def rng():  # type: ignore[no-untyped-def]
     import numpy as np
 
     return np.random.default_rng(12345)
+
+
+@pytest.fixture(autouse=True)
+def _fresh_consoles() -> None:
+    """Each test's CLI run builds its consoles anew, as a new process does: their width is
+    decided on first use (``COLUMNS``, a terminal or not), so a console kept from an earlier
+    test would carry that test's ``COLUMNS`` into this one (an order-dependent failure)."""
+    from thermocal.cli import common
+
+    for console in (common.stdout, common.stderr):
+        console._console = None  # type: ignore[attr-defined]

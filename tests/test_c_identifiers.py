@@ -129,7 +129,8 @@ def test_collisions_after_mapping_are_refused_naming_both() -> None:
         ("C:\\data\\", "C:\\data\\x5c"),  # a trailing backslash would splice the next line
         ("x\\  ", "x\\x5c  "),  # also before trailing spaces (gcc splices those too)
         ("a ??/", "a ? ?/ "),  # a trigraph (??/ is a backslash in C99); the end padded
-        ("20 °C", "20 \\u00b0C"),
+        ("20 °C", "20 degC"),  # thermocal's own symbols in ASCII (issue 38)
+        ("é ω", "\\u00e9 omega"),
         ("\U0001f600", "\\U0001f600"),
         ("plain text", "plain text"),
     ],

@@ -56,7 +56,8 @@ def test_inspect_reports_data_problems(tmp_path: Path, capsys: pytest.CaptureFix
     # like a linter: every finding printed, then exit 2 because the time is unusable
     assert code == 2
     assert [ln for ln in err.strip().splitlines() if not ln.startswith("warning: ")] == [
-        f"error: {path}: duplicate timestamp 1.0 at row 2 (1 duplicates in all)"
+        f"error: {path}: duplicate timestamp 1.0 at row 2 (1 duplicates in all; host "
+        "timestamps? give --rate HZ to take the samples at the sensor's nominal rate)"
     ]
     d = json.loads(out)
     kinds = {p["kind"]: p for p in d["problems"]}

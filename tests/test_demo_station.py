@@ -8,9 +8,12 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from thermocal.cli import main
+from thermocal.demo.station import MODELLING, VALIDATION
+from thermocal.readers.dispatch import read_recording
 
 pytest.importorskip("pymodbus")
 pytest.importorskip("serial")
@@ -32,6 +35,17 @@ def test_demo_station_records_fits_validates_and_exports(
     assert (out / "modelling" / "station.json").is_file()
     assert (out / "validation" / "station.json").is_file()
     assert sorted(p.suffix for p in (out / "c").iterdir()) == [".c", ".h"]
+    # issue 38: the demo's validation passes thermocal's weak-correlation rule (r < 0.4),
+    # r computed here with numpy on the recorded histories (common elapsed-time base)
+    assert "not weakly correlated" not in capsys.readouterr().err
+    recs = [read_recording(out / n, temperatures=["temp"]) for n in ("modelling", "validation")]
+    span = min(float(r.time_s[-1] - r.time_s[0]) for r in recs)
+    base = np.linspace(0.0, span, 2000)
+    h = [np.interp(base, r.time_s - r.time_s[0], r.column("temp")) for r in recs]
+    assert abs(float(np.corrcoef(h[0], h[1])[0, 1])) < 0.4
+    prog = np.linspace(0.0, min(MODELLING[0][-1], VALIDATION[0][-1]), 2000)  # program time [s]
+    sp = [np.interp(prog, *p) for p in (MODELLING, VALIDATION)]
+    assert abs(float(np.corrcoef(sp[0], sp[1])[0, 1])) < 0.4
 
 
 @pytest.mark.parametrize(

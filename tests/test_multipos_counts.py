@@ -102,3 +102,33 @@ def test_counts_without_a_scale_refused(files: dict[str, Any]) -> None:
                           str(d / "x.json")])  # fmt: skip
     assert code == 2 and "--accel-scale takes VALUE,UNIT" in err, err
     assert not (d / "x.json").exists()
+
+
+def test_a_count_scale_implies_counts_for_bare_columns(files: dict[str, Any]) -> None:
+    """A logger's raw columns name no unit (``ax``, as the MPU-6050 sketches write them):
+    ``--accel-scale``/``--gyro-scale`` say they are counts, so the run needs no
+    ``--accel-unit`` (it asked for one, issue 38) and equals the one of the same counts
+    with ``[LSB]`` in their names, without a word about an assumed unit."""
+    d = files["dir"]
+    raw = pd.read_csv(d / "raw.csv")
+    raw.columns = [c.split(" [")[0] for c in raw.columns]
+    raw.to_csv(d / "bare.csv", index=False)
+    scales = ["--accel-scale", f"{1000.0 / ACC_LSB_PER_G!r},mg",
+              "--gyro-scale", f"{1.0 / GYR_LSB_PER_DPS!r},deg/s", "--latitude", "45"]  # fmt: skip
+    code, out, err = _run(["multipos", str(d / "bare.csv"), "--accel", "acc_x,acc_y,acc_z",
+                           "--gyro", "gyr_x,gyr_y,gyr_z", *scales, "-o", str(d / "bare.json"),
+                           "--json"])  # fmt: skip
+    assert code == 0, err
+    assert "signal column" not in err and "assuming deg/h" not in err, err
+    b = json.loads(out)
+    code, out, err = _run(["multipos", str(d / "raw.csv"), "--accel", _cols("acc", "LSB"),
+                           "--gyro", _cols("gyr", "LSB"), *scales, "-o", str(d / "r.json"),
+                           "--json"])  # fmt: skip
+    assert code == 0, err
+    r = json.loads(out)
+    for kind in ("accel", "gyro"):
+        for k in ("bias", "scale_factor_ppm", "misalignment_arcsec"):
+            np.testing.assert_allclose(b[kind][k], r[kind][k], rtol=1e-9, atol=1e-9)
+    code, _o, err = _run(["multipos", str(d / "bare.csv"), "--accel", "acc_x,acc_y,acc_z",
+                          "--latitude", "45", "-o", str(d / "x.json")])  # fmt: skip
+    assert code == 2 and "give --accel-unit" in err.splitlines()[-1], err

@@ -9,6 +9,7 @@ families); the demo test (tests/test_demo.py) renders the full workflow.
 from __future__ import annotations
 
 import base64
+import dataclasses
 import html
 import json
 import math
@@ -468,14 +469,21 @@ def test_report_drift_angle_and_flags(case: dict[str, Any]) -> None:
     t1 = np.clip(val.column("T1"), *case["model"]["range"]["temperature_c"]["T1"])
     after = gyro - (coef[0] + coef[1] * t1)
     # before: b0 = the mean over the first 10 % of the run (a stated reference, not the
-    # run's own mean); after: the compensated rate with nothing removed (issue 25 item 6)
+    # run's own mean, issue 25 item 6); after: like with like (issue 38), the compensated
+    # rate's own mean over the same window; and both with nothing removed
     rel = val.time_s - val.time_s[0]
-    b0 = float(np.mean(gyro[rel <= 0.1 * rel[-1]]))
-    theta_before = _drift_reference(val.time_s, gyro, b0)
-    theta_after = _drift_reference(val.time_s, after, 0.0)
+    win = rel <= 0.1 * rel[-1]
+    theta_before = _drift_reference(val.time_s, gyro, float(np.mean(gyro[win])))
+    theta_after = _drift_reference(val.time_s, after, float(np.mean(after[win])))
     # the report's drift angle (thermocal.metrics) equals scipy's trapezoid integral
     check_number(tags, "fom.before.drift_angle_max", float(np.max(np.abs(theta_before))), rel=1e-9)
     check_number(tags, "fom.after.drift_angle_max", float(np.max(np.abs(theta_after))), rel=1e-9)
+    raw_b = float(np.max(np.abs(_drift_reference(val.time_s, gyro, 0.0))))
+    raw_a = float(np.max(np.abs(_drift_reference(val.time_s, after, 0.0))))
+    check_number(tags, "fom.before.drift_angle_raw_max", raw_b, rel=1e-9)
+    check_number(tags, "fom.after.drift_angle_raw_max", raw_a, rel=1e-9)
+    check_number(tags, "fom.before.drift_angle_raw_max_deg", raw_b, rel=1e-9)  # the cards
+    check_number(tags, "summary.drift_angle_raw_improvement_pct", 100 * (1 - raw_a / raw_b))
     k_b = int(np.argmax(np.abs(theta_before)))
     check_number(tags, "fom.before.drift_angle_max_time_h", float(rel[k_b]) / 3600.0, rel=1e-9)
     # compensation removes the temperature drift: the drift angle shrinks a lot
@@ -487,6 +495,59 @@ def test_report_drift_angle_and_flags(case: dict[str, Any]) -> None:
     )
     if not weak:
         assert 'data-kind="correlation"' in case["html"]
+
+
+def _card(text: str, label: str) -> str:
+    """The HTML of the summary card titled ``label``."""
+    i = text.index(f'<div class="label">{label}</div>')
+    return text[i : text.index('<div class="card', i) if '<div class="card' in text[i:] else None]
+
+
+def test_report_drift_cards_compare_like_with_like(case: dict[str, Any]) -> None:
+    """Issue 38: a validation run 3 °/h off the model's constant (another turn-on) read
+    "largest drift angle 17.8° → 413°, not improved": a bias-removed before against a raw
+    after.  Each card now compares one definition, before and after (scipy here)."""
+    val: Recording = case["val"]
+    gyro = val.column("gyro") + 3.0
+    shifted = dataclasses.replace(val, columns={**val.columns, "gyro": gyro})
+    text = build_report(ReportInputs(models=(ModelEntry("linear", case["model"], None),),
+                                     recording=shifted))  # fmt: skip
+    coef = [c["value"] for c in case["model"]["coefficients"]]
+    t1 = np.clip(val.column("T1"), *case["model"]["range"]["temperature_c"]["T1"])
+    after = gyro - (coef[0] + coef[1] * t1)
+    rel = val.time_s - val.time_s[0]
+    win = rel <= 0.1 * rel[-1]
+
+    def peak(x: FloatArray, b0: float) -> float:
+        return float(np.max(np.abs(_drift_reference(val.time_s, x, b0))))
+
+    start = _card(text, "Largest drift angle, start bias removed")
+    tags = tagged_numbers(start)
+    b, a = peak(gyro, float(np.mean(gyro[win]))), peak(after, float(np.mean(after[win])))
+    check_number(tags, "fom.before.drift_angle_max_deg", b, rel=1e-9)
+    check_number(tags, "fom.after.drift_angle_max_deg", a, rel=1e-9)
+    assert a < 0.2 * b and 'badge pass">improved<' in start and "same for the compensated" in start
+    raw = _card(text, "Largest drift angle, no bias removed")
+    tags = tagged_numbers(raw)
+    check_number(tags, "fom.before.drift_angle_raw_max_deg", peak(gyro, 0.0), rel=1e-9)
+    check_number(tags, "fom.after.drift_angle_raw_max_deg", peak(after, 0.0), rel=1e-9)
+    assert "θ = ∫ (ω − Ω) dt, before and after" in html.unescape(raw)
+
+
+def test_report_equal_figures_say_no_change(case: dict[str, Any]) -> None:
+    """Issue 38: "Peak-to-peak −1.06e-13 %" — equal figures (to rounding) are "no change"."""
+    v = dict(case["validation"], peak_to_peak_after=1.5012345 * (1 + 1e-15))
+    v.pop("improvement_pct", None)
+    text = build_report(ReportInputs(models=(ModelEntry("linear", case["model"], v),),
+                                     recording=case["val"]))  # fmt: skip
+    card = _card(text, "Peak-to-peak bias")
+    assert ">no change<" in card and "e-13" not in card and "%" not in card
+    assert 'badge fail">no change<' in card  # no change is not an improvement
+    assert tagged_numbers(card)["validation.linear.peak_to_peak_improvement_pct"][0] == "0.0"
+    # every card states its definition, the same before and after (averaging_s = 100 s)
+    assert "max − min of the run's 100 s averages, before and after" in html.unescape(card)
+    stab = _card(text, "Bias stability")
+    assert "std of the 100 s averages within each hold stage" in stab
 
 
 def test_report_warns_on_extrapolation_and_conditioning(case: dict[str, Any]) -> None:

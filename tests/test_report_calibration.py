@@ -152,3 +152,42 @@ def test_calibration_report_renders_in_headless_chromium(
                          "--validation", str(files["dir"] / "v.json"), "-o", str(out)])  # fmt: skip
     assert status == 0, text
     check_rendered(run_chromium(out, tmp_path), n_figures_min=2)
+
+
+def test_calibration_report_absolute_error_gaps_and_warnings_once(
+    files: dict[str, Any], tmp_path: Path
+) -> None:
+    """Issue 38: the multi-channel report showed only the scatter about the mean where the
+    validation has the error against the reference falling; called a record of mostly gaps
+    "N h, n samples every τ0 s"; and printed every warning twice.  Figures computed here."""
+    d, v = files["dir"], json.loads(json.dumps(files["v"]))
+    shared = "the validation run was recorded on another day (a test warning)"
+    for n in NAMES:
+        v["channels"][n]["warnings"] = [*v["channels"][n].get("warnings", []), shared]
+    (tmp_path / "v.json").write_text(json.dumps(v))
+    frame = pd.read_csv(files["val"])
+    keep = (np.arange(len(frame)) // 50) % 10 == 0  # blocks of 50 samples, 9 of 10 dropped
+    frame[keep].to_csv(tmp_path / "gapped.csv", index=False)
+    (tmp_path / "gapped.csv.meta.json").write_text((d / "val-named.csv.meta.json").read_text())
+    out = tmp_path / "r.html"
+    status, text = _run(["report", "--model", str(files["cal"]), "--recording",
+                         str(tmp_path / "gapped.csv"), "--validation", str(tmp_path / "v.json"),
+                         "-o", str(out)])  # fmt: skip
+    assert status == 0, text
+    html = out.read_text()
+    tags = tagged_numbers(html)
+    for n in NAMES:
+        b, a = (v["channels"][n][f"rms_about_zero_{w}"] for w in ("before", "after"))
+        check_number(tags, f"channels.{n}.validation.rms_about_zero_before", b)
+        check_number(tags, f"channels.{n}.validation.rms_about_zero_after", a)
+        check_number(tags, f"channels.{n}.validation.rms_about_zero_improvement_pct",
+                     100.0 * (1.0 - abs(a) / abs(b)), rel=1e-12)  # fmt: skip
+    t = frame["time"].to_numpy()[keep]
+    tau0 = float(np.median(np.diff(frame["time"])))
+    steps = np.diff(t)
+    gap_s = float(np.sum(steps[steps > 1.5 * tau0] - tau0))
+    check_number(tags, "coverage.gap_h", gap_s / 3600.0, rel=1e-12)
+    check_number(tags, "coverage.covered_h", (t[-1] - t[0] - gap_s) / 3600.0, rel=1e-12)
+    check_number(tags, "coverage.gap_pct", 100.0 * gap_s / (t[-1] - t[0]), rel=1e-12)
+    assert f"{int(np.count_nonzero(steps > 1.5 * tau0))} gap(s)" in html
+    assert html.count(shared) == 1 and "(every channel)" in html

@@ -181,7 +181,8 @@ def test_unit_in_column_name(name: str, role: str, unit: str | None) -> None:
 
 def test_resolution_order() -> None:
     """option > metadata > column name > model > default (INTERFACE.md common rules)."""
-    assert resolve_unit("g [deg/s]", "signal", option="rad/s").source == "option"
+    with pytest.warns(UnitWarning, match="contradicts the column name 'g \\[deg/s\\]'"):
+        assert resolve_unit("g [deg/s]", "signal", option="rad/s").source == "option"
     assert resolve_unit("g [deg/s]", "signal", metadata="deg/h").unit == "deg/h"
     assert resolve_unit("g [deg/s]", "signal", model="deg/h").unit == "deg/s"
     assert resolve_unit("g", "signal", model="mg").unit == "mg"

@@ -19,6 +19,15 @@ r < 0.4."""
 DEFAULT_AVERAGING_S: Final = 100.0
 """Averaging time of the stability figures [s] (SPEC §1: 10 s or 100 s averages)."""
 
+POSE_WINDOW_S: Final = 0.5
+POSE_STILL_THRESHOLD: Final = 5.0
+POSE_MOTION_FRACTION: Final = 0.01
+POSE_DRIFT_DEG: Final = 2.0
+"""``thermocal multipos``'s pose detector (:func:`thermocal.multipos.poses.find_poses`):
+variance window [s], still limit in noise variances and in the motions' variance, the
+largest turn across a pose [°] (``--window-s``, ``--still-threshold``,
+``--motion-fraction``, ``--drift-deg``)."""
+
 DEFAULT_GYRO_COLUMNS: Final = ("gyro_x", "gyro_y", "gyro_z")
 """Gyro columns of a turntable recording (``thermocal turntable --gyro``)."""
 

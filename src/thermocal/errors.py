@@ -57,6 +57,10 @@ class GapWarning(ThermocalWarning):
     """The recording has gaps in time; they are reported, never interpolated."""
 
 
+class TimestampWarning(ThermocalWarning):
+    """The time column's steps jitter (host timestamps): ``--rate`` takes the nominal rate."""
+
+
 class ExtrapolationWarning(ThermocalWarning):
     """A model is evaluated outside the temperature range it was fitted on."""
 

@@ -137,17 +137,31 @@ def c_identifier(
 _TRIGRAPH = re.compile(r"\?\?(?=[=/'()!<>\-])")
 
 
+C_COMMENT_ASCII = {
+    "°": "deg", "″": "arcsec", "′": "arcmin", "µ": "u", "μ": "u", "²": "^2", "³": "^3",
+    "⁻¹": "^-1", "·": "*", "×": "x", "−": "-", "–": "-", "—": "-", "…": "...", "±": "+/-",
+    "≤": "<=", "≥": ">=", "→": "->", "Ṫ": "dT/dt", "τ": "tau", "σ": "sigma", "θ": "theta",
+    "ω": "omega", "Ω": "Omega", "√": "sqrt", "Δ": "d",
+}  # fmt: skip
+"""The symbols of thermocal's own text (units, formulas) spelled in ASCII in generated C
+comments (issue 38: ``48.1\u00b0`` in a header); other non-ASCII is escaped."""
+
+
 def c_comment(text: object) -> str:
     """``text`` made safe inside a ``/* … */`` comment, on one line.
 
-    Control characters (newline, carriage return, tab, NUL, DEL, …) → ``\\xNN``; non-ASCII
+    The symbols of :data:`C_COMMENT_ASCII` → their ASCII spelling (``°`` → ``deg``);
+    control characters (newline, carriage return, tab, NUL, DEL, …) → ``\\xNN``; other non-ASCII
     → ``\\uXXXX`` (``\\UXXXXXXXX`` beyond the BMP); ``??`` → ``? ?`` (no trigraph, §5.2.1.1);
     ``*/`` → ``* /`` and ``/*`` → ``/ *`` until neither is left; a backslash followed only
     by spaces up to the end → ``\\x5c`` (no line splice); a ``*``, ``/`` or ``?`` at either
     end gets a space on that side (so the surrounding text cannot complete one).  Idempotent.
     """
     out: list[str] = []
-    for ch in str(text):
+    text = str(text)
+    for sym, plain in C_COMMENT_ASCII.items():
+        text = text.replace(sym, plain)
+    for ch in text:
         o = ord(ch)
         if o < 0x20 or o == 0x7F:
             out.append(f"\\x{o:02x}")

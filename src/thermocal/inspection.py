@@ -12,6 +12,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
+import numpy.typing as npt
 from numpy.lib.stride_tricks import sliding_window_view
 
 from thermocal.errors import ThermocalInputError
@@ -20,6 +21,7 @@ from thermocal.recording import (
     FloatArray,
     Problem,
     Recording,
+    TimeJitter,
     contiguous_slices,
     find_gaps,
     find_problems,
@@ -31,6 +33,60 @@ from thermocal.recording import (
 SPIKE_THRESHOLD = 8.0
 """Hampel test: a sample further than this many robust σ from its window median is a spike."""
 SPIKE_HALF_WINDOW = 3
+RAIL_VALUES = (-32768.0, 32767.0, 65535.0)
+"""The rails of 16-bit raw counts (int16 and the top of uint16): an integer column's extreme
+on one of them is saturated."""
+RAIL_RUN = 3
+"""Any other column: its extreme held this many samples in a row, far from the bulk."""
+
+
+def _longest_run(m: npt.NDArray[np.bool_]) -> int:
+    if not m.any():
+        return 0
+    e = np.flatnonzero(np.diff(np.concatenate([[0], m.astype(np.int8), [0]])))
+    return int((e[1::2] - e[0::2]).max())
+
+
+RAIL_STEP = 10.0
+"""…entered or left by a step this many times the column's median step (a smooth peak
+of a motion flattens out instead)."""
+
+
+def _runs(m: npt.NDArray[np.bool_]) -> list[tuple[int, int]]:
+    e = np.flatnonzero(np.diff(np.concatenate([[0], m.astype(np.int8), [0]])))
+    return [(int(a), int(b)) for a, b in zip(e[0::2], e[1::2], strict=True)]
+
+
+def saturated_mask(x: npt.ArrayLike) -> npt.NDArray[np.bool_]:
+    """The samples of one column on the sensor's rails (clipped): its maximum or minimum
+    when that is a 16-bit rail of integer counts (:data:`RAIL_VALUES`) held at least twice
+    in a row (a wrapping counter passes it once); else the stretches where the column sits
+    on its maximum or minimum for :data:`RAIL_RUN` samples or more, entered or left by a
+    step :data:`RAIL_STEP` times its median step, more than 0.4 of the range from the
+    median."""
+    a = np.asarray(x, dtype=np.float64)
+    out = np.zeros(a.shape, dtype=bool)
+    fin = a[np.isfinite(a)]
+    if fin.size < 2:
+        return out
+    hi, lo = float(fin.max()), float(fin.min())
+    is_int = bool(np.all(fin == np.round(fin)))
+    med = float(np.median(fin))
+    d = np.abs(np.diff(fin))
+    step = float(np.median(d[d > 0])) if np.any(d > 0) else 0.0
+    for v in {hi, lo}:
+        at = a == v
+        if is_int and v in RAIL_VALUES and _longest_run(at) >= 2:  # a counter passes once
+            out |= at
+            continue
+        if abs(v - med) <= 0.4 * (hi - lo):
+            continue
+        for s0, e0 in _runs(at):
+            jumps = [abs(v - a[s0 - 1])] if s0 > 0 else []
+            jumps += [abs(v - a[e0])] if e0 < a.size else []
+            if e0 - s0 >= RAIL_RUN and max(jumps, default=0.0) > RAIL_STEP * step:
+                out[s0:e0] = True
+    return out
 
 
 @dataclass(frozen=True)
@@ -71,6 +127,8 @@ class Inspection:
     time_ok: bool = True
     """Time is finite and strictly increasing, so duration, rate, gaps and segments mean
     something."""
+    timestamp_jitter: TimeJitter | None = None
+    """The scatter of the time steps (:func:`thermocal.recording.time_jitter`)."""
 
     @property
     def fatal(self) -> list[Problem]:
@@ -92,6 +150,9 @@ class Inspection:
             "problems": [p.to_dict() for p in self.problems],
             "time_ok": self.time_ok,
             "usable": not self.fatal,
+            "timestamp_jitter": (
+                self.timestamp_jitter.to_dict() if self.timestamp_jitter is not None else None
+            ),
         }
 
 
@@ -186,6 +247,28 @@ def _temperature_span_c(rec: Recording, name: str) -> list[float] | None:
     return [ext.lo, ext.hi] if ext is not None else None
 
 
+def _saturation_problems(name: str, arr: FloatArray) -> list[Problem]:
+    """A warning for a signal column with samples on its rails: count, value, first row
+    and the number of stretches."""
+    sat = saturated_mask(arr)
+    n = int(np.count_nonzero(sat))
+    if not n:
+        return []
+    first = int(np.argmax(sat))
+    runs = int(np.count_nonzero(np.diff(np.concatenate([[0], sat.astype(np.int8)])) == 1))
+    vals = ", ".join(f"{v:g}" for v in sorted({float(v) for v in arr[sat]}))
+    return [
+        Problem(
+            "saturated",
+            f"column {name!r} has {n} samples on its rails ({vals}: the sensor clipped) in "
+            f"{runs} stretches, first at row {first}: rates and rotations across them are wrong",
+            severity="warning",
+            column=name,
+            row=first,
+        )
+    ]
+
+
 def inspect_recording(rec: Recording) -> Inspection:
     """Summarise a recording and list its problems (never raises on bad data)."""
     t = rec.time_s
@@ -221,6 +304,8 @@ def inspect_recording(rec: Recording) -> Inspection:
                     row=first_spike,
                 )
             )
+        if role != "temperature":
+            problems.extend(_saturation_problems(name, arr))
         columns[name] = ColumnSummary(
             name=name,
             role=role,
@@ -246,7 +331,18 @@ def inspect_recording(rec: Recording) -> Inspection:
         temperature_span=span,
         problems=problems,
         time_ok=time_ok,
+        timestamp_jitter=rec.time_jitter(),
     )
 
 
-__all__ = ["GAP_FACTOR", "ColumnSummary", "Inspection", "count_spikes", "inspect_recording"]
+__all__ = [
+    "GAP_FACTOR",
+    "RAIL_RUN",
+    "RAIL_STEP",
+    "RAIL_VALUES",
+    "ColumnSummary",
+    "Inspection",
+    "count_spikes",
+    "inspect_recording",
+    "saturated_mask",
+]

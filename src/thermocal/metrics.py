@@ -251,20 +251,53 @@ def bias_stability(
     averaging_s: float | None,
     *,
     time_s: npt.ArrayLike | None = None,
+    where: str | None = None,
+    option: str | None = "--average",
 ) -> float:
     """Bias stability ``Bs = sqrt(Σ (ω̄_k − mean)² / (p − 1))`` [unit] (SPEC §1).
 
     ω̄_k are the p non-overlapping averages over ``averaging_s`` (never across a
     gap, see :func:`block_means`); the averaging time must be reported with the
-    figure.  Needs at least two averages.
+    figure.  Needs at least two averages: else an error naming ``where`` (the file) and
+    ``option`` (the averaging option of the command that asked, ``None`` if it has none).
     """
     means = block_means(rate, tau0_s, averaging_s, time_s=time_s)
     if means.size < 2:
         raise ThermocalInputError(
-            f"bias stability needs at least two {averaging_s} s averages; the record "
-            f"gives {means.size} (shorten --average)"
-        )
+            too_few_averages(
+                where, float(averaging_s or tau0_s), means.size,
+                _longest_stretch_s(time_s, tau0_s, np.size(rate)), option,
+            )
+        )  # fmt: skip
     return float(np.std(means, ddof=1))
+
+
+def _longest_stretch_s(time_s: npt.ArrayLike | None, tau0_s: float, n: int) -> float:
+    """The duration [s] of the longest stretch without a gap (``n·τ0`` without times)."""
+    if time_s is None:
+        return n * tau0_s
+    t = np.asarray(time_s, dtype=np.float64).ravel()
+    return float(max((sl.stop - sl.start) * tau0_s for sl in contiguous_slices(t)))
+
+
+def too_few_averages(
+    where: str | None, averaging_s: float, n_means: int, longest_s: float, option: str | None
+) -> str:
+    """The message of a record that gives fewer than two ``averaging_s`` averages: the file
+    ``where``, and the command's option ``option`` (e.g. ``--average``) with the longest
+    averaging time that gives two averages (half the longest stretch without a gap
+    ``longest_s`` [s]); without an option, the record's length is what falls short."""
+    head = f"{where}: " if where else ""
+    fix = (
+        f"; give {option} {longest_s / 2.0:.3g} or less"
+        if option and longest_s / 2.0 > 0
+        else f"; its longest stretch without a gap is {longest_s:.3g} s: record at least "
+        f"{2.0 * averaging_s:.3g} s"
+    )
+    return (
+        f"{head}bias stability needs at least two {averaging_s:g} s averages; the record "
+        f"gives {n_means}{fix}"
+    )
 
 
 def bias_repeatability(biases: npt.ArrayLike) -> float:
@@ -663,6 +696,7 @@ def compute_metrics(
     min_hold_s: float = 600.0,
     drift_reference_s: tuple[float, float] | None = None,
     drift_bias: float | None = None,
+    average_option: str | None = "--average",
 ) -> MetricsResult:
     """All figures of merit of one signal of a recording (SPEC §1), in the data's own unit
     (:func:`data_unit_of`).
@@ -682,6 +716,8 @@ def compute_metrics(
         first sample]; b0 is the mean of ω − Ω_axis over it (:func:`reference_bias`;
         default the first 10 % of the run).
     drift_bias : b0 given instead [data unit, earth rate already removed].
+    average_option : the option of the asking command that sets ``averaging_s`` (named
+        when the record gives fewer than two averages; ``None``: the command has none).
 
     The drift angle ``θ(t) = ∫ (ω − Ω_axis − b0) dt`` (gyros only) is never taken about
     the same run's mean (that makes θ(t_end) ≈ 0 by construction): b0 is the stated
@@ -701,9 +737,11 @@ def compute_metrics(
     means = block_means(values, tau0, avg, time_s=t)
     if means.size < 2:
         raise ThermocalInputError(
-            f"{rec.name}: bias stability needs at least two {avg:g} s averages; the record "
-            f"gives {means.size} (shorten --average)"
-        )
+            too_few_averages(
+                rec.source or rec.name, avg, means.size,
+                _longest_stretch_s(t, tau0, values.size), average_option,
+            )
+        )  # fmt: skip
     stab = float(np.std(means, ddof=1))
     p2p = float(np.max(means) - np.min(means))
     drift = _drift(t, values, name, unit, earth, drift_reference_s, drift_bias)
@@ -859,4 +897,5 @@ __all__ = [
     "run_repeatability",
     "std_interval",
     "temperature_sensitivity",
+    "too_few_averages",
 ]

@@ -31,6 +31,7 @@ from thermocal.errors import (
     PlausibilityWarning,
     ThermocalInputError,
     TimestampError,
+    TimestampWarning,
     UnitError,
 )
 
@@ -352,6 +353,10 @@ class Recording:
             self._scan = (self.time_s, scan_time(self.time_s))
         return self._scan[1]
 
+    def time_jitter(self) -> TimeJitter | None:
+        """The scatter of the time steps (:func:`time_jitter`): host timestamps."""
+        return time_jitter(self.time_s)
+
     def gaps(self, factor: float = GAP_FACTOR) -> list[Gap]:
         """Gaps in time (see :func:`find_gaps`)."""
         return find_gaps(self.time_s, factor=factor, scan=self.time_scan())
@@ -378,12 +383,15 @@ class Recording:
 
     def validate(self, required: list[str] | None = None) -> None:
         """Raise the first error of :func:`find_problems`; implausible values that are only
-        doubtful are emitted as :class:`PlausibilityWarning` (other warnings, such as
+        doubtful are emitted as :class:`PlausibilityWarning`, timestamp jitter
+        (:func:`time_jitter`) as a :class:`TimestampWarning` (other warnings, such as
         gaps, are reported by the caller)."""
         problems = find_problems(self, required=required)
         for p in problems:
             if p.severity == "warning" and p.kind.startswith("implausible"):
                 warnings.warn(PlausibilityWarning(f"{self.name}: {p.message}"), stacklevel=2)
+            elif p.kind == "timestamp_jitter" and not any(q.severity == "error" for q in problems):
+                warnings.warn(TimestampWarning(f"{self.name}: {p.message}"), stacklevel=2)
         for p in problems:
             if p.severity == "error":
                 cls = {
@@ -509,6 +517,160 @@ def contiguous_slices(
     return [slice(a, b) for a, b in itertools.pairwise(bounds) if b > a]
 
 
+JITTER_RELATIVE = 0.1
+"""Time steps scattered by more than this fraction of their median (half the 5–95 %
+range) are host-timestamp jitter, reported with ``--rate`` as the remedy."""
+JITTER_STEPS = 1 << 20
+"""Steps of the time column (its first) that the jitter is measured on: bounded memory."""
+
+
+@dataclass(frozen=True)
+class TimeJitter:
+    """The scatter of the time steps ``Δt_i = t[i+1] − t[i]`` of a recording's first
+    :data:`JITTER_STEPS` steps (:func:`time_jitter`).
+
+    ``interval_s`` is their median [s]; ``relative`` half their 5–95 % percentile range
+    over the median (``0.3``: the steps scatter ±30 % around it); ``n_same`` the steps of
+    zero length (a burst of samples stamped at the same instant by a host);
+    ``n_steps`` how many steps were measured.
+    """
+
+    interval_s: float
+    relative: float
+    n_same: int
+    n_steps: int
+
+    @property
+    def significant(self) -> bool:
+        """Scatter beyond :data:`JITTER_RELATIVE`, or samples sharing a timestamp."""
+        return self.relative > JITTER_RELATIVE or self.n_same > 0
+
+    def to_dict(self) -> dict[str, Any]:
+        return {**dataclasses.asdict(self), "significant": self.significant}
+
+    def message(self) -> str:
+        """What a ``warning:`` says of it, with the remedy."""
+        same = (
+            f", {self.n_same} samples stamped at the same instant as the one before"
+            if self.n_same
+            else ""
+        )
+        return (
+            f"timestamp jitter: the sample intervals scatter ±{100 * self.relative:.3g} % "
+            f"(5–95 %) around their median {self.interval_s:.6g} s{same} (host timestamps, "
+            "e.g. Bluetooth?); give --rate HZ to take the samples at the sensor's nominal rate"
+        )
+
+
+def time_jitter(time_s: FloatArray) -> TimeJitter | None:
+    """The jitter of a time column's steps (:class:`TimeJitter`), measured on its first
+    :data:`JITTER_STEPS` steps; None for fewer than 3 samples, a time that is not finite,
+    or steps that go backwards (refused elsewhere).
+
+    ``relative = (P95(Δt) − P5(Δt)) / (2 · median(Δt))``: for a regular grid 0; for host
+    timestamps of a Bluetooth link whose latency scatters uniformly over ±30 % of the
+    period, 0.27 (the 5–95 % range of a uniform ±30 % is ±27 %)."""
+    t = time_s[: JITTER_STEPS + 1]
+    if t.size < 3 or not all_finite(t):
+        return None
+    dt = np.diff(t)
+    if bool((dt < 0).any()):
+        return None
+    med = float(np.median(dt))
+    if not med > 0:
+        return TimeJitter(med, math.inf, int(np.count_nonzero(dt == 0)), int(dt.size))
+    p5, p95 = np.percentile(dt, [5.0, 95.0])
+    return TimeJitter(
+        med, float(p95 - p5) / (2.0 * med), int(np.count_nonzero(dt == 0)), int(dt.size)
+    )
+
+
+LOST_SAMPLE_JUMP = 0.5
+"""A rise of the host-latency floor by more than this many nominal periods at one step is
+samples lost there (:func:`nominal_time`)."""
+LATENCY_WINDOW = 32
+"""Samples before a step over which the latency floor before it is taken (:func:`nominal_time`)."""
+
+
+def nominal_time(time_s: FloatArray, rate_hz: float) -> tuple[FloatArray, int]:
+    """Host timestamps replaced by the sensor's nominal grid, and the samples found lost.
+
+    A host stamps each sample at its arrival, ``t_i = T_0 + (i + k_i)/r + ℓ_i`` with the
+    latency ``ℓ_i ≥ 0`` and ``k_i`` the samples lost before sample ``i`` (non-decreasing).
+    In the offsets ``o_i = (t_i − t_0)·r − i`` a burst of late samples only rises above
+    the latency floor; a lost sample lifts the floor by one period.  At each step ``i``
+    the floor after it, the suffix minimum ``m_{i+1} = min_{j>i} o_j``, is compared with
+    the floor before it, ``q_i = min(o_{i−W+1} … o_i)`` (``W`` = :data:`LATENCY_WINDOW`);
+    where ``m_{i+1} − q_i``, less the samples already counted lost within the window,
+    exceeds :data:`LOST_SAMPLE_JUMP`, ``round`` of it is lost there, when sample ``i + 1``
+    itself lies that many periods up (within half that margin): a sample that only came
+    late, just before a loss or at the end, is not taken for the loss.  Within a burst
+    (samples delivered at one instant) next to a loss the stamps cannot tell a late sample
+    before the loss from one after it: such samples may be placed one period off.  A slow
+    drift of the host's clock against the sensor's (``W`` samples of it are far below one
+    period) adds none.  Returns ``t'_i = t_0 + (m_0 + i + k_i)/r`` [s] and the total lost.  The
+    input must be finite, in seconds, with at least 2 samples.
+    """
+    n = int(time_s.size)
+    i = np.arange(n, dtype=np.float64)
+    o = (time_s - time_s[0]) * rate_hz - i
+    m = np.minimum.accumulate(o[::-1])[::-1]
+    w = min(LATENCY_WINDOW, n)
+    padded = np.concatenate([np.full(w - 1, np.inf), o])
+    q = np.lib.stride_tricks.sliding_window_view(padded, w).min(axis=1)  # q[i]: o[i-w+1..i]
+    jump = m[1:] - q[:-1]
+    lost = np.zeros(n, dtype=np.float64)  # lost[i + 1]: samples lost between i and i + 1
+    for j in np.flatnonzero(jump > LOST_SAMPLE_JUMP):
+        earlier = float(lost[max(0, j - w + 2) : j + 1].sum())
+        rise = float(jump[j]) - earlier
+        n_lost = round(rise)
+        # sample j + 1 itself must lie n_lost periods up (not merely late, before the loss)
+        if rise > LOST_SAMPLE_JUMP and o[j + 1] - q[j] - earlier > n_lost - LOST_SAMPLE_JUMP / 2:
+            lost[j + 1] = n_lost
+    k = np.cumsum(lost)
+    out: FloatArray = time_s[0] + (m[0] + i + k) / rate_hz
+    return out, int(k[-1])
+
+
+def _nan_problems(rec: Recording) -> list[Problem]:
+    """NaN, empty or infinite values per column, with the first row: an error in a signal
+    or temperature column, a warning in another."""
+    probs: list[Problem] = []
+    for name, arr in rec.columns.items():
+        nan = ~np.isfinite(arr)
+        n_nan = int(np.count_nonzero(nan))
+        if n_nan:
+            first = int(np.argmax(nan))
+            sev: Literal["error", "warning"] = (
+                "error" if name in rec.signals or name in rec.temperatures else "warning"
+            )
+            probs.append(
+                Problem(
+                    "nan",
+                    f"column {name!r} has {n_nan} NaN/empty/infinite values, first at row {first}",
+                    severity=sev,
+                    column=name,
+                    row=first,
+                )
+            )
+    return probs
+
+
+RATE_HINT = "host timestamps? give --rate HZ to take the samples at the sensor's nominal rate"
+"""What a duplicate timestamp's message says to do."""
+
+
+def _jitter_problems(t: FloatArray, found: list[Problem]) -> list[Problem]:
+    """Timestamp jitter (:func:`time_jitter`) as a warning, unless the time is already
+    refused as not finite or going backwards (``found``)."""
+    if any(p.kind in ("nonfinite_time", "backwards_time") for p in found):
+        return []
+    jit = time_jitter(t)
+    if jit is None or not jit.significant:
+        return []
+    return [Problem("timestamp_jitter", jit.message(), severity="warning", column="time")]
+
+
 def find_problems(rec: Recording, required: list[str] | None = None) -> list[Problem]:
     """Everything wrong with a recording, errors first, without raising.
 
@@ -548,7 +710,7 @@ def find_problems(rec: Recording, required: list[str] | None = None) -> list[Pro
                 Problem(
                     "duplicate_time",
                     f"duplicate timestamp {float(t[dup[0] + 1])!r} at row {dup[0] + 1} "
-                    f"({dup.size} duplicates in all)",
+                    f"({dup.size} duplicates in all; {RATE_HINT})",
                     column="time",
                     row=int(dup[0] + 1),
                 )
@@ -563,23 +725,7 @@ def find_problems(rec: Recording, required: list[str] | None = None) -> list[Pro
                     row=int(back[0] + 1),
                 )
             )
-    for name, arr in rec.columns.items():
-        nan = ~np.isfinite(arr)
-        n_nan = int(np.count_nonzero(nan))
-        if n_nan:
-            first = int(np.argmax(nan))
-            sev: Literal["error", "warning"] = (
-                "error" if name in rec.signals or name in rec.temperatures else "warning"
-            )
-            probs.append(
-                Problem(
-                    "nan",
-                    f"column {name!r} has {n_nan} NaN/empty/infinite values, first at row {first}",
-                    severity=sev,
-                    column=name,
-                    row=first,
-                )
-            )
+    probs.extend(_nan_problems(rec))
     for name in rec.signals:
         u = rec.units.get(name, "")
         if u:
@@ -589,6 +735,7 @@ def find_problems(rec: Recording, required: list[str] | None = None) -> list[Pro
                 probs.append(Problem("unit", f"column {name!r}: {exc}", column=name))
     if t.size < 2:
         probs.append(Problem("too_short", "the recording has fewer than 2 samples"))
+    probs.extend(_jitter_problems(t, probs))
     if not any(p.kind in ("nonfinite_time", "duplicate_time", "backwards_time") for p in probs):
         gaps = rec.gaps()
         if gaps:

@@ -397,25 +397,41 @@ def resolve_unit(
     default: str | None = None,
     where: str = "",
     option_name: str | None = None,
+    ask: str | None = None,
+    implied: str | None = None,
 ) -> ResolvedUnit:
     """The unit of ``column``, resolved once, in INTERFACE.md's order: command-line option
     > the file's own metadata > units in the column name > the units recorded in the model
     file > a default (``default``, else :data:`DEFAULT_UNITS`), the last stated in a
     :class:`UnitWarning`.  An option that contradicts the file's metadata wins, with a
-    warning naming both (``option_name``: the option as the user wrote it).  This is the
-    only place in thermocal that chooses a unit nobody stated.
+    warning naming both (``option_name``: the option as the user wrote it); so does one that
+    contradicts the unit written in the column's name (``--time-unit s`` on ``time (ms)``).
+    With ``ask`` (an option's name, e.g. ``--accel-unit``) a unit nobody stated is not
+    assumed: a :class:`UnitError` asks for that option.  With ``implied`` (a unit another
+    option implies: raw ``counts`` where ``multipos --accel-scale`` gives one count's size)
+    a unit nobody stated is that one, without a warning.  This is the only place in
+    thermocal that chooses a unit nobody stated.
     """
     norm = _normalizer(role)
     prefix = f"{where}: " if where else ""
     meta = norm(metadata) if metadata else None
     if option:
         opt = norm(option)
+        said = option_name or f"{_UNIT_OPTION[role]} {opt}"
         if meta is not None and meta != opt:
-            said = option_name or f"{_UNIT_OPTION[role]} {opt}"
             warnings.warn(
                 UnitWarning(
                     f"{prefix}{said} contradicts the file's metadata, which says column "
                     f"{column!r} is in {meta}; using {opt}"
+                ),
+                stacklevel=2,
+            )
+        named = unit_in_column_name(column, role) if meta is None else None
+        if named is not None and named != opt:
+            warnings.warn(
+                UnitWarning(
+                    f"{prefix}{said} contradicts the column name {column!r}, which says "
+                    f"{named}; using {opt} (drop {_UNIT_OPTION[role]} if the name is right)"
                 ),
                 stacklevel=2,
             )
@@ -427,6 +443,13 @@ def resolve_unit(
         return ResolvedUnit(named, "column name")
     if model:
         return ResolvedUnit(norm(model), "model")
+    if implied:
+        return ResolvedUnit(norm(implied), "option")
+    if ask:
+        raise UnitError(
+            f"{prefix}no unit stated for column {column!r}; give {ask} (or the unit in the "
+            "file's metadata or column name)"
+        )
     chosen = norm(default) if default else DEFAULT_UNITS[role]
     whose = " (the model's unit)" if default else ""
     warnings.warn(
@@ -489,6 +512,12 @@ class UnitOptions:
     signal_unit: str | None = None
     temp_unit: str | None = None
     temp_conversion: TemperatureConversion | None = None
+    ask: Mapping[str, str] = field(default_factory=dict)
+    """Signal column → the option to ask for when nothing states its unit (no default is
+    assumed: ``multipos`` asks for its accelerometer's unit rather than assume a rate)."""
+    implied: Mapping[str, str] = field(default_factory=dict)
+    """Signal column → the unit another option implies when nothing states one (``counts``
+    for the columns of a triad given a count scale)."""
 
 
 @dataclass(frozen=True)
@@ -632,6 +661,8 @@ def resolve_inputs(
             model=mod.columns.get(c),
             default=mod.signal_default,
             where=where,
+            ask=opt.ask.get(c),
+            implied=opt.implied.get(c),
         )
         for c in signals
     }

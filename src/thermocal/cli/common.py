@@ -49,6 +49,11 @@ P = ParamSpec("P")
 R = TypeVar("R")
 
 
+WIDTH_OFF_TERMINAL = 10_000
+"""Columns of the console when the output is not a terminal: wide enough for any table
+(rich tables take their natural width, text is not wrapped: ``soft_wrap``)."""
+
+
 class _LazyConsole:
     """A :class:`rich.console.Console` built on first use (``rich.console`` costs start-up)."""
 
@@ -57,11 +62,22 @@ class _LazyConsole:
         self._console: Console | None = None
 
     def real(self) -> Console:
-        """The console itself (built now if not yet)."""
+        """The console itself (built now if not yet).  Outside a terminal (a pipe, a file)
+        and without ``COLUMNS`` set, it is :data:`WIDTH_OFF_TERMINAL` wide, so that a table
+        wider than 80 columns is printed whole rather than its names cut (issue 38)."""
         if self._console is None:
             from rich.console import Console
 
-            self._console = Console(**self._options)
+            options = dict(self._options)
+            stream = sys.stderr if options.get("stderr") else sys.stdout
+            if "width" not in options and not os.environ.get("COLUMNS"):
+                try:
+                    tty = stream.isatty()
+                except (AttributeError, ValueError):  # a closed or odd stream
+                    tty = False
+                if not tty:
+                    options["width"] = WIDTH_OFF_TERMINAL
+            self._console = Console(**options)
         return self._console
 
     def __getattr__(self, attr: str) -> Any:
@@ -109,7 +125,11 @@ NamesOpt = Annotated[
 ]
 RateOpt = Annotated[
     float | None,
-    typer.Option("--rate", help="Text logs without a time column: sample rate [Hz]."),
+    typer.Option(
+        "--rate",
+        help="Sample rate [Hz]: the time of a log without a time column, of a sample counter "
+        "(n_samples, or --time N), or host timestamps taken at this nominal rate.",
+    ),
 ]
 OnBadLinesOpt = Annotated[
     str,

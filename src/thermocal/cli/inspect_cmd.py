@@ -1,6 +1,5 @@
 """``thermocal inspect FILE``: what is in a recording and what is wrong with it."""
 
-import re
 from typing import TYPE_CHECKING, Annotated
 
 import typer
@@ -48,8 +47,6 @@ else:
     _readers = LazyModule("thermocal.readers")
     _recording = LazyModule("thermocal.recording")
     units = LazyModule("thermocal.units")
-
-_TEMP_NAME = re.compile(r"^(t\d+|t_|temp|tmp)|temperature|°c|degc", re.IGNORECASE)
 
 
 @app.command("inspect")
@@ -103,29 +100,8 @@ def inspect_cmd(
         temp_unit=temp_unit,
         temp_conversion=conv,
         skipped=skipped,
+        guess_temperatures=True,
     )
-    if not rec.temperatures and temps is None:
-        guessed = tuple(c for c in rec.columns if _TEMP_NAME.search(c) and c not in rec.signals)
-        rec.temperatures = guessed
-        # a guessed temperature's unit and conversion go through the one resolver
-        res = units.resolve_inputs(
-            "<time>",
-            [],
-            guessed,
-            options=units.UnitOptions(temp_unit=temp_unit, temp_conversion=conv),
-            file=units.StatedUnits(
-                columns={c: rec.units[c] for c in guessed if rec.units.get(c)},
-                conversions={
-                    c: v for c, v in rec.meta.temperature_conversion.items() if c in guessed
-                },
-            ),
-            where=str(file),
-        )
-        rec.units.update(res.units())
-        rec.unit_sources.update({c: r.source for c, r in res.temperatures.items()})
-        for c, r in res.conversions.items():
-            if r.conversion is not None:
-                rec.meta.temperature_conversion[c] = r.conversion
     result = _inspection.inspect_recording(rec)
     for c in skipped:
         result.problems.append(

@@ -6,15 +6,21 @@ polynomial in T − TREF (:func:`thermocal.turntable.thermal.fit_triad`, the tur
 thermal fit).  Writes a calibration of triads, the file type of ``thermocal turntable``."""
 
 from pathlib import Path
-from typing import TYPE_CHECKING, Annotated
+from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
 
+from thermocal import defaults as _poses
 from thermocal._lazy import LazyModule
 from thermocal.cli.application import app
 from thermocal.cli.common import (
+    DecimalOpt,
+    DelimiterOpt,
     JsonOpt,
+    NamesOpt,
+    OnBadLinesOpt,
     OutOpt,
+    RateOpt,
     TimeOpt,
     TimeUnitOpt,
     emit,
@@ -22,6 +28,7 @@ from thermocal.cli.common import (
     handle_errors,
     split_names,
     stdout,
+    text_options,
 )
 from thermocal.errors import ThermocalInputError
 
@@ -76,8 +83,9 @@ PosesOpt = Annotated[
     Path | None,
     typer.Option(
         "--poses",
-        help='Named sections {"name": {"start": i, "end": j}} by sample index (x_p…z_a '
-        "faces, x_rot… 360° turns) instead of the poses found in the data (one file).",
+        help='Named sections {"name": {"start": i, "end": j}} by sample index, or '
+        "imucal's section list as CSV (x_p…z_a faces, x_rot… 360° turns about that "
+        "axis) instead of the poses found in the data (one file).",
     ),
 ]
 GravityOpt = Annotated[float | None, typer.Option("--gravity", help="Local gravity [m/s²].")]
@@ -105,6 +113,121 @@ GyroScaleOpt = Annotated[
     ),
 ]
 StaticOpt = Annotated[float, typer.Option("--static-s", help="Shortest still pose [s].")]
+WindowOpt = Annotated[float, typer.Option("--window-s", help="Pose detector: variance window [s].")]
+StillThresholdOpt = Annotated[
+    float,
+    typer.Option(
+        "--still-threshold",
+        help="Pose detector: still below this many times the sensor's noise variance…",
+    ),
+]
+MotionFractionOpt = Annotated[
+    float,
+    typer.Option(
+        "--motion-fraction",
+        help="…or below this fraction of the motions' variance (hand-held tremor).",
+    ),
+]
+DriftOpt = Annotated[
+    float,
+    typer.Option("--drift-deg", help="Pose detector: a pose turning more than this [°] is moving."),
+]
+AccelOffsetOpt = Annotated[
+    float | None,
+    typer.Option(
+        "--accel-offset",
+        help="Zero of the accelerometer columns in their unit (32768 for unsigned counts).",
+    ),
+]
+GyroOffsetOpt = Annotated[
+    float | None,
+    typer.Option("--gyro-offset", help="Zero of the gyro columns in their unit."),
+]
+GyroModelOpt = Annotated[
+    str,
+    typer.Option(
+        "--gyro-model",
+        help="Gyro elements fitted: full (3 scale factors, 6 misalignments) or scale (3 "
+        "scale factors, misalignments 0: few motions).",
+    ),
+]
+
+
+def _gyro_misfit(run: dict[str, Any]) -> None:
+    """A line when the motions scatter beyond their noise (reduced χ² above
+    ``1 + 3√(2/ν)``): the gyro's σ are scaled by it."""
+    g = run.get("gyro")
+    if not g or not g["dof"] > 0 or g["reduced_chi2"] is None:
+        return
+    chi2, dof = float(g["reduced_chi2"]), int(g["dof"])
+    if chi2 > 1.0 + 3.0 * (2.0 / dof) ** 0.5:
+        stdout.print(
+            f"{run['input']}: the gyro's {g['n_motions']} motions scatter beyond their noise "
+            f"(reduced χ² {fmt(chi2, 3)} on {dof} degrees of freedom, {g['model']} model): "
+            "its σ are scaled by it"
+        )
+
+
+def _explain(out: dict[str, Any]) -> None:
+    """The pose detector's choice, per file: poses found, the still limit and what set
+    it, the stretches rejected and why."""
+    for d in out.get("pose_detection", []):
+        a = d["accel"]
+        stdout.print(
+            f"{d['input']}: {d['n_poses']} poses (window {fmt(d['window_s'], 3)} s, still "
+            f"for ≥ {fmt(d['static_s'], 3)} s below an accelerometer rms of "
+            f"{fmt(a['still_limit_rms'], 3)} {out['unit']}, set by the "
+            + ("noise" if a["limit_set_by"] == "noise" else "motions")
+            + f": noise {', '.join(fmt(v, 3) for v in a['noise_sigma'])}, motions "
+            f"{fmt(a['motion_rms'], 3)}); {len(d['rejected'])} rejected"
+        )
+        for r in d["rejected"]:
+            stdout.print(f"  rejected {r['start']}…{r['end']}: {r['reason']}")
+
+
+def _human(out: dict[str, Any], a_unit: str, output: Path) -> None:
+    """The calibration's tables and what the run said, for a person."""
+    for kind in ("accel", "gyro"):
+        if kind not in out:
+            continue
+        d = out[kind]
+        table = _rich_table.Table(title=f"{kind} triad ({d['method']})")
+        for col in ("parameter", "value", "σ", "unit"):
+            table.add_column(col)
+        for i, ax in enumerate("xyz"):
+            table.add_row(f"bias {ax}", fmt(d["bias"][i], 5), fmt(d["bias_sigma"][i], 3),
+                          d["bias_unit"])  # fmt: skip
+        for i, ax in enumerate("xyz"):
+            table.add_row(f"scale factor {ax}", fmt(d["scale_factor_ppm"][i], 5),
+                          fmt(d["scale_factor_ppm_sigma"][i], 3), "ppm")  # fmt: skip
+        for i, n in enumerate(d["misalignment_names"]):
+            sig = d["misalignment_arcsec_sigma"][i]  # 0: an element the model holds at 0
+            table.add_row(f"misalignment {n}", fmt(d["misalignment_arcsec"][i], 5),
+                          fmt(sig, 3) if sig else "held (not fitted)", "″")  # fmt: skip
+        stdout.print(table)
+    for run in out["runs"]:
+        lean = run.get("gyro", {}).get("turn_axis_lean_deg", 0.0)
+        if lean > 0:
+            stdout.print(
+                f"{run['input']}: the 360° turns lean {fmt(lean, 2)}° off their axes "
+                "(per component, found in the data): counted in the σ, the misalignments "
+                "rest on the motions between poses"
+            )
+    stdout.print(
+        f"{out['n_poses']} poses; gravity-magnitude residual rms "
+        f"{fmt(out['gravity_residual_rms_before'], 3)} → "
+        f"{fmt(out['gravity_residual_rms_after'], 3)} {a_unit}; written {output}"
+    )
+    for run in out["runs"]:
+        _gyro_misfit(run)
+        if run["accel"].get("misfit"):
+            stdout.print(
+                f"{run['input']}: the poses scatter more than their noise (reduced χ² "
+                f"{fmt(run['accel']['reduced_chi2'], 3)}): each pose's σ inflated by a "
+                f"misfit of {fmt(run['accel']['misfit'], 3)} {a_unit}, so that each "
+                "counts as the misfit says"
+            )
+    _explain(out)
 
 
 @app.command("multipos")
@@ -123,10 +246,22 @@ def multipos_cmd(
     order: OrderOpt = None,
     tref: TrefOpt = None,
     static_s: StaticOpt = 1.0,
+    window_s: WindowOpt = _poses.POSE_WINDOW_S,
+    still_threshold: StillThresholdOpt = _poses.POSE_STILL_THRESHOLD,
+    motion_fraction: MotionFractionOpt = _poses.POSE_MOTION_FRACTION,
+    drift_deg: DriftOpt = _poses.POSE_DRIFT_DEG,
+    accel_offset: AccelOffsetOpt = None,
+    gyro_offset: GyroOffsetOpt = None,
+    gyro_model: GyroModelOpt = "full",
     time: TimeOpt = None,
     time_unit: TimeUnitOpt = None,
     accel_scale: AccelScaleOpt = None,
     gyro_scale: GyroScaleOpt = None,
+    t_names: NamesOpt = None,
+    t_rate: RateOpt = None,
+    t_bad: OnBadLinesOpt = "error",
+    t_delim: DelimiterOpt = None,
+    t_dec: DecimalOpt = None,
     as_json: JsonOpt = False,
 ) -> None:
     """Accelerometer (and gyro) triad bias, scale factors and misalignments from hand-placed
@@ -141,35 +276,14 @@ def multipos_cmd(
         (gyr_cols[0], gyr_cols[1], gyr_cols[2]) if gyr_cols else None,
         accel_unit, gyro_unit, temps, gravity, latitude, order, tref, static_s, time, time_unit,
         _mpf.count_scale(accel_scale, "accel"), _mpf.count_scale(gyro_scale, "gyro"),
+        window_s, still_threshold, motion_fraction, drift_deg, accel_offset, gyro_offset,
+        gyro_model,
+        text=text_options(t_names, t_rate, t_bad, t_delim, t_dec),
     )  # fmt: skip
     res = _mpf.calibrate_files(files, output, opts, poses)
     out, a_unit = res.summary, res.accel_unit
 
-    def human() -> None:
-        for kind in ("accel", "gyro"):
-            if kind not in out:
-                continue
-            d = out[kind]
-            table = _rich_table.Table(title=f"{kind} triad ({d['method']})")
-            for col in ("parameter", "value", "σ", "unit"):
-                table.add_column(col)
-            for i, ax in enumerate("xyz"):
-                table.add_row(f"bias {ax}", fmt(d["bias"][i], 5), fmt(d["bias_sigma"][i], 3),
-                              d["bias_unit"])  # fmt: skip
-            for i, ax in enumerate("xyz"):
-                table.add_row(f"scale factor {ax}", fmt(d["scale_factor_ppm"][i], 5),
-                              fmt(d["scale_factor_ppm_sigma"][i], 3), "ppm")  # fmt: skip
-            for i, n in enumerate(d["misalignment_names"]):
-                table.add_row(f"misalignment {n}", fmt(d["misalignment_arcsec"][i], 5),
-                              fmt(d["misalignment_arcsec_sigma"][i], 3), "″")  # fmt: skip
-            stdout.print(table)
-        stdout.print(
-            f"{out['n_poses']} poses; gravity-magnitude residual rms "
-            f"{fmt(out['gravity_residual_rms_before'], 3)} → "
-            f"{fmt(out['gravity_residual_rms_after'], 3)} {a_unit}; written {output}"
-        )
-
-    emit(out, as_json, human)
+    emit(out, as_json, lambda: _human(out, a_unit, output))
 
 
 __all__ = ["multipos_cmd"]

@@ -53,6 +53,7 @@ file; ``j`` = number of breakpoints ``≤ T``; ``y = intercepts[j] + slopes[j]·
 from __future__ import annotations
 
 import bisect
+import dataclasses
 import math
 import warnings
 from collections.abc import Iterator, Sequence
@@ -63,7 +64,7 @@ import numpy as np
 import numpy.typing as npt
 
 from thermocal._lazy import LazyModule
-from thermocal.adequacy import Needs
+from thermocal.adequacy import AdequacyTest, Needs, samples_test, temperature_tests
 from thermocal.errors import (
     DesignError,
     ModelFileError,
@@ -354,6 +355,63 @@ def choose_breakpoints(
     )
 
 
+def segment_tests(
+    breakpoints_c: FloatArray,
+    xs: Sequence[FloatArray],
+    name: str,
+    lo: float,
+    hi: float,
+    *,
+    given: bool,
+    unit: str = "°C",
+) -> tuple[AdequacyTest, ...]:
+    """Every segment of a fitted piecewise model judged as the line it is, by the common
+    rules of :mod:`thermocal.adequacy` (issue 38: a 0.28 °C segment holding one burst was
+    fitted and exported): its temperature span (≥ ``MIN_SPAN_PER_ORDER_C`` °C for order 1),
+    its distinct temperatures (≥ 2) and its samples per coefficient (≥
+    ``MIN_SAMPLES_PER_COEFFICIENT`` for 2), over the samples of every run in
+    ``[b_j, b_{j+1})`` of the final ``breakpoints_c`` [°C] (``lo``/``hi`` the range's ends).
+    Raw-count temperatures (``unit`` not °C): the span is not judged (as
+    :func:`thermocal.adequacy.temperature_tests`).  Each message names the segment and the
+    option that helps: move or drop a breakpoint
+    (``--breakpoints``, when ``given``) or fewer ``--segments``; a failed span or sample
+    count can be fitted anyway with ``--allow-narrow`` (recorded, and ``export-c`` warns).
+    """
+    edges = [lo, *(float(b) for b in breakpoints_c), hi]
+    n_seg = len(edges) - 1
+    parts: list[list[FloatArray]] = [[] for _ in range(n_seg)]
+    for x in xs:
+        idx = segment_index(np.asarray(breakpoints_c, dtype=np.float64), x)
+        for k in range(n_seg):
+            parts[k].append(x[idx == k])
+    fix = (
+        "move or drop a breakpoint (--breakpoints)"
+        if given
+        else f"ask fewer --segments (--segments {n_seg - 1})"
+        if n_seg > 1
+        else "record a wider sweep"
+    )
+    out: list[AdequacyTest] = []
+    for k in range(n_seg):
+        seg = np.concatenate(parts[k]) if parts[k] else np.zeros(0)
+        label = f"{name} segment {k + 1} of {n_seg} ({edges[k]:.4g}…{edges[k + 1]:.4g} °C)"
+        judged = [
+            samples_test(int(seg.size), 2, label),
+            *(t for t in temperature_tests(seg, label, 1, unit=unit) if t.name != "range_ends"),
+        ]
+        out += [
+            dataclasses.replace(
+                t,
+                name=f"segment_{k + 1}_{t.name}",
+                message=t.message.removesuffix(": record a wider sweep") + f": {fix}",
+            )
+            if t.verdict != "pass"
+            else dataclasses.replace(t, name=f"segment_{k + 1}_{t.name}")
+            for t in judged
+        ]
+    return tuple(out)
+
+
 @dataclass(frozen=True)
 class _Lines:
     """The least-squares lines of the segments: intercepts a_s and slopes k_s [signal unit,
@@ -396,6 +454,9 @@ class PiecewiseModel(TemperatureModel):
     initial_breakpoints_: FloatArray
     column_index_: int
     line_cov_: FloatArray
+    segment_tests_: tuple[AdequacyTest, ...]
+    """Each segment judged after the fit (:func:`segment_tests`); the fit pipeline adds
+    them to the model's adequacy record (refused unless overridden)."""
 
     def __init__(
         self,
@@ -463,7 +524,8 @@ class PiecewiseModel(TemperatureModel):
         every segment checked to hold a line (:meth:`_check_segments`); the lines by
         chunked least squares (:meth:`_solve_lines`); the breakpoints moved to where
         adjacent lines meet (intersect method, :meth:`_intersections`); residuals,
-        their correlation and the statistics (:meth:`_set_fitted`).
+        their correlation and the statistics (:meth:`_set_fitted`); every final segment
+        judged by the common adequacy rules (:func:`segment_tests`, ``segment_tests_``).
         """
         if self.method not in METHODS:
             raise ThermocalInputError(
@@ -486,6 +548,10 @@ class PiecewiseModel(TemperatureModel):
         final, discontinuities = self._intersections(bp, lines, lo, hi)
         self._set_fitted(rl, names, j, xs, ys, bp, final, discontinuities, lines, decision,
                          choice)  # fmt: skip
+        self.segment_tests_ = segment_tests(
+            final, xs, names[j], lo, hi, given=self.breakpoints is not None,
+            unit="°C" if rl[0].temperature_unit == "degC" else str(rl[0].temperature_unit),
+        )  # fmt: skip
         return self
 
     def _initial_breakpoints(

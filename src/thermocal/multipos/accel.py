@@ -12,14 +12,25 @@ of a lower-triangular ``E`` (the accelerometer frame, package docstring) — min
 (scipy.optimize.least_squares, trust-region reflective, from ``p = 0``).  ``σ_k`` is the
 noise of the pose mean along gravity: the white-noise variance of the pose's samples
 (from first differences, ``var(Δx)/2``, which a slow tremor hardly touches) over its
-sample count.  Covariance ``(JᵀJ)⁻¹`` at the solution (J of the weighted residuals), scaled
-by the reduced χ² when that exceeds its 3-σ range ``1 + 3·√(2/(m − 9))`` (the poses scatter
-more than their noise says: tremor, coloured noise, a model that does not fit).
+sample count.
+
+**A misfit sensor.**  When the reduced χ² exceeds its 3-σ range ``1 + 3·√(2/(m − 9))``
+(the poses scatter more than their noise says: tremor, coloured noise, a model that does
+not fit), the white-noise weights would let the longest poses pull the fit.  Each pose's
+σ is then inflated by a misfit ``τ`` common to all poses, ``σ_k² → σ_k² + τ²``, with ``τ``
+such that the reduced χ² of the refitted poses is 1 (the additive-variance estimate of a
+random-effects fit, e.g. Paule & Mandel, J. Res. NBS 87 (1982) 377), repeated to a fixed
+point: when ``τ ≫ σ_k`` every pose counts alike (imu_tk's unweighted cost).
+Covariance ``(JᵀJ)⁻¹`` at the solution (J of the weighted residuals); ``reduced_chi2``
+is the one with the white-noise weights, ``misfit_mg`` the ``τ`` added.
 
 **Six faces** (closed form): with gravity along ±each body axis,
 ``f_{j±} = ±g (I + E) e_j + b``, so ``b = Σ_faces f / 6`` and the column ``j`` of ``I + E``
 is ``(f_{j+} − f_{j−}) / 2g``: all nine elements of E, relative to the faces of the box;
-variances from the pose means' noise.
+variances from the pose means' noise.  Each opposite pair ``(f_{j+} + f_{j−}) / 2`` is an
+estimate of ``b``; a face set down a degree off adds ``g·sin`` of it to the other axes, so the
+bias variance is at least the three pair estimates' sample variance over 3 (on imucal's
+session the noise alone gave a σ sixty times below the pairs' disagreement).
 """
 
 from __future__ import annotations
@@ -60,6 +71,8 @@ class AccelFit:
     n_poses: int
     residuals_mg: tuple[float, ...]
     """Each pose's gravity-magnitude error after calibration [mg]."""
+    misfit_mg: float = 0.0
+    """The misfit τ added in quadrature to each pose's σ [mg] (0: the white-noise weights)."""
 
     @property
     def sigma(self) -> FloatArray:
@@ -91,6 +104,22 @@ _FREE_FACTOR = np.array([1.0, 1.0, 1.0] + [1e-3 / units.PPM] * 3 + [1e-3 * units
 """θ units per unit of the free parameters (mg; 10⁻³ → ppm; 10⁻³ rad → ″)."""
 
 
+def _six_faces_hint(u: FloatArray) -> str:
+    """Where the distinct directions are the six faces (each within ``DISTINCT_DEG`` of a
+    body axis, up and down), the advice that uses them: a POSES file naming them."""
+    if len(u) != 6:
+        return ""
+    near = np.abs(u).max(axis=1) > math.cos(math.radians(DISTINCT_DEG))
+    faces = {(int(np.argmax(np.abs(v))), bool(v[np.argmax(np.abs(v))] > 0)) for v in u}
+    if not near.all() or len(faces) != 6:
+        return ""
+    return (
+        ", or, as they are the six faces (each body axis up and down), name them in a "
+        "--poses file (x_p, x_a, y_p, y_a, z_p, z_a: imucal's section list) for Ferraris's "
+        "six-face closed form"
+    )
+
+
 def check_poses(f_mg: FloatArray) -> None:
     """Refuse poses that cannot determine the nine parameters: fewer than nine distinct
     gravity directions, or directions all near one plane (a scale factor or a bias along
@@ -105,6 +134,7 @@ def check_poses(f_mg: FloatArray) -> None:
             f"{len(distinct)} distinct poses (gravity directions more than {DISTINCT_DEG:g}° "
             f"apart) of {len(u)}: the accelerometer's bias, scale factors and misalignments "
             f"need at least {MIN_POSES}; place the board in more orientations"
+            + _six_faces_hint(np.asarray(distinct))
         )
     w, v = np.linalg.eigh(np.asarray(distinct).T @ np.asarray(distinct) / len(distinct))
     if w[0] < 0.02:
@@ -116,15 +146,13 @@ def check_poses(f_mg: FloatArray) -> None:
         )
 
 
-def fit_gravity_magnitude(f_mg: npt.ArrayLike, sigma_mg: npt.ArrayLike, g_mg: float) -> AccelFit:
-    """The nine parameters from the pose means ``f_mg`` (m, 3) [mg] with their noise along
-    gravity ``sigma_mg`` (m,) [mg] and local gravity ``g_mg`` [mg] (module docstring)."""
-    from scipy.optimize import least_squares
+MISFIT_ITERATIONS: Final = 20
+"""Refits at most, while the misfit τ moves by more than 10⁻⁶ of itself."""
 
-    f = np.asarray(f_mg, dtype=np.float64)
-    sg = np.asarray(sigma_mg, dtype=np.float64)
-    m = f.shape[0]
-    check_poses(f)
+
+def _solve(f: FloatArray, sg: FloatArray, g_mg: float, p0: FloatArray) -> Any:
+    """Least squares of the weighted gravity-magnitude residuals (module docstring)."""
+    from scipy.optimize import least_squares
 
     def resid(p: FloatArray) -> FloatArray:
         b, e = _unpack(p)
@@ -132,8 +160,55 @@ def fit_gravity_magnitude(f_mg: npt.ArrayLike, sigma_mg: npt.ArrayLike, g_mg: fl
         out: FloatArray = (np.linalg.norm(c, axis=1) - g_mg) / sg
         return out
 
-    sol = least_squares(resid, np.zeros(9), method="trf", x_scale="jac", xtol=1e-12,
-                        ftol=1e-12, gtol=1e-12)  # fmt: skip
+    return least_squares(resid, p0, method="trf", x_scale="jac", xtol=1e-12, ftol=1e-12,
+                         gtol=1e-12)  # fmt: skip
+
+
+def misfit_tau(r_mg: FloatArray, sigma_mg: FloatArray, dof: int) -> float:
+    """``τ ≥ 0`` [mg] with ``Σ r_k²/(σ_k² + τ²) = dof`` (0 when already below): the root of
+    a decreasing function, by bisection on ``τ²`` in ``[0, Σ r²/dof]``."""
+    r2 = r_mg**2
+    s2 = sigma_mg**2
+
+    def h(t2: float) -> float:
+        return float(np.sum(r2 / (s2 + t2))) - dof
+
+    if dof <= 0 or h(0.0) <= 0:
+        return 0.0
+    lo, hi = 0.0, float(r2.sum()) / dof
+    for _ in range(200):
+        mid = 0.5 * (lo + hi)
+        if h(mid) > 0:
+            lo = mid
+        else:
+            hi = mid
+        if hi - lo <= 1e-12 * hi:
+            break
+    return math.sqrt(0.5 * (lo + hi))
+
+
+def fit_gravity_magnitude(f_mg: npt.ArrayLike, sigma_mg: npt.ArrayLike, g_mg: float) -> AccelFit:
+    """The nine parameters from the pose means ``f_mg`` (m, 3) [mg] with their noise along
+    gravity ``sigma_mg`` (m,) [mg] and local gravity ``g_mg`` [mg] (module docstring)."""
+    f = np.asarray(f_mg, dtype=np.float64)
+    sg0 = np.asarray(sigma_mg, dtype=np.float64)
+    m = f.shape[0]
+    check_poses(f)
+    dof = m - 9
+    sol = _solve(f, sg0, g_mg, np.zeros(9))
+    r0 = np.asarray(sol.fun)
+    chi2 = float(r0 @ r0) / dof if dof > 0 else float("nan")
+    tau = 0.0
+    sg = sg0
+    if dof > 0 and chi2 > 1.0 + 3.0 * math.sqrt(2.0 / dof):
+        for _ in range(MISFIT_ITERATIONS):
+            new = misfit_tau(np.asarray(sol.fun) * sg, sg0, dof)
+            sg = np.sqrt(sg0**2 + new**2)
+            sol = _solve(f, sg, g_mg, sol.x)
+            done = abs(new - tau) <= 1e-6 * new
+            tau = new
+            if done:
+                break
     jac = np.asarray(sol.jac)
     _u, s_, vt = np.linalg.svd(jac, full_matrices=False)
     if not s_[-1] > 1e-10 * s_[0]:
@@ -143,10 +218,6 @@ def fit_gravity_magnitude(f_mg: npt.ArrayLike, sigma_mg: npt.ArrayLike, g_mg: fl
         )
     cov_p = (vt.T / s_**2) @ vt
     r = np.asarray(sol.fun)
-    dof = m - 9
-    chi2 = float(r @ r) / dof if dof > 0 else float("nan")
-    if dof > 0 and chi2 > 1.0 + 3.0 * math.sqrt(2.0 / dof):
-        cov_p = cov_p * chi2
     theta = np.zeros(12)
     cov = np.zeros((12, 12))
     idx = np.array(FREE_INDEX)
@@ -163,6 +234,7 @@ def fit_gravity_magnitude(f_mg: npt.ArrayLike, sigma_mg: npt.ArrayLike, g_mg: fl
         "gravity-magnitude",
         m,
         tuple(float(v) for v in after),
+        tau,
     )
 
 
@@ -178,7 +250,10 @@ def fit_six_faces(
         raise DesignError(f"the six-face calibration needs every face; missing {missing}")
     f = {k: np.asarray(v, dtype=np.float64) for k, v in faces_mg.items()}
     b = sum((f[n] for n in FACES), np.zeros(3)) / 6.0
-    var_b = sum(sigma_mg[n] ** 2 for n in FACES) / 36.0
+    pairs = np.array([(f[f"{ax}_p"] + f[f"{ax}_a"]) / 2.0 for ax in "xyz"])
+    var_b = np.maximum(  # the noise's, or the three pair estimates' scatter (placement)
+        sum(sigma_mg[n] ** 2 for n in FACES) / 36.0, np.var(pairs, axis=0, ddof=1) / 3.0
+    )
     ie = np.zeros((3, 3))
     var_e = np.zeros(3)
     for j, ax in enumerate("xyz"):
@@ -187,7 +262,7 @@ def fit_six_faces(
     e = ie - np.eye(3)
     theta = model.coeffs_from_error_matrix(e, b)
     sig = np.zeros(12)
-    sig[0:3] = math.sqrt(var_b)
+    sig[0:3] = np.sqrt(var_b)
     sig[3:6] = np.sqrt(var_e) / units.PPM
     for k, n in enumerate(model.MISALIGNMENT_NAMES):
         sig[6 + k] = math.sqrt(var_e[model.MISALIGNMENT_INDEX[n][1]]) * units.RAD_TO_ARCSEC
@@ -221,8 +296,10 @@ def to_dict(fit: AccelFit) -> dict[str, Any]:
 
 __all__ = [
     "FREE_INDEX",
+    "MISFIT_ITERATIONS",
     "AccelFit",
     "check_poses",
     "fit_gravity_magnitude",
     "fit_six_faces",
+    "misfit_tau",
 ]

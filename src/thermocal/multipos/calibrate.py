@@ -5,7 +5,10 @@ calibration on a held-out session.
 force and its noise, the accelerometer triad (:mod:`.accel`: gravity magnitude over ≥ 9
 poses, or the closed form when only the six faces are given), the calibrated up
 direction of each pose, the gyro bias from the statics and its scale factors and
-misalignments from the motions between poses and the 360° turns (:mod:`.gyro`).
+misalignments from the motions between poses and the 360° turns (:mod:`.gyro`), each turn
+about the sensor axis it is named for (``x_rot``: x, whatever pose came before it), judged
+before the fit (:func:`.gyro.check_turn`); a gyro scale factor or misalignment beyond
+:data:`GYRO_E_PLAUSIBLE` is a warning.
 
 :func:`validate_session`: on another session, the poses found the same way and, before
 (raw) and after compensation with a calibration of triads, the gravity-magnitude error
@@ -26,6 +29,7 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
+from thermocal import units
 from thermocal.errors import DesignError, ThermocalInputError, ThermocalWarning
 from thermocal.multipos import accel as _accel
 from thermocal.multipos import gyro as _gyro
@@ -38,6 +42,12 @@ FloatArray = npt.NDArray[np.float64]
 METHOD = "multipos"
 """The ``method`` tag of a triad model made by ``thermocal multipos`` (the turntable's are
 ``"turntable"``): :func:`thermocal.multipos.validate.is_multipos` reads it back."""
+
+
+GYRO_E_PLAUSIBLE = 0.10
+"""A gyro scale factor beyond ±10 % (1e5 ppm) or a misalignment beyond 0.1 rad (20 626″)
+is not a sensor's: a wrong unit, count scale or pose is warned of (the turns' own bound,
+:data:`.gyro.TURN_ANGLE_TOLERANCE`)."""
 
 
 @dataclass(frozen=True)
@@ -154,6 +164,136 @@ def _direction_sigma(
     return out
 
 
+def _named_turns(
+    turns: Sequence[Section],
+    rate_rad_s: FloatArray,
+    dt_s: FloatArray,
+    bias_rad_s: FloatArray,
+    accel_mg: FloatArray,
+    acc: _accel.AccelFit,
+    face_sigma_rad: dict[str, float],
+    where: str,
+    sections_from: str,
+    saturated: npt.NDArray[np.bool_] | None = None,
+) -> list[_gyro.Turn]:
+    """Each named turn about the sensor axis of its name (``x_rot``: x), judged first
+    (:func:`.gyro.check_turn`), with the calibrated up direction during it and the
+    direction noise of that axis across itself [rad]: a hand turns the board about the
+    vertical of the face it lies on (``x_p`` or ``x_a``, by the sign of the up
+    direction's x during the turn), whose calibrated direction is ``e_j`` to within its
+    direction noise ``face_sigma_rad[face]`` (:func:`_direction_sigma`); without that
+    face among the poses, the accelerometer calibration's σ of the two misalignments of
+    column j (the frame is the accelerometer's)."""
+    e_a = model.error_matrices(acc.theta)
+    var = np.diag(acc.cov)
+    out = []
+    dt_med = float(np.median(dt_s))
+    for tr in turns:
+        j = "xyz".index(tr.name[0])
+        gap = _gyro.turn_gap(dt_s, tr, dt_med)
+        if gap is not None:
+            raise ThermocalInputError(
+                f"{where} {tr.name!r}: a gap in time of {gap[1]:.3g} s after sample {gap[0]} "
+                "inside the turn: the rotation across it is unknown; fix its start and end "
+                f"in {sections_from}, or record the turn again"
+            )
+        if saturated is not None and np.any(saturated[tr.start : tr.end]):
+            i = tr.start + int(np.argmax(saturated[tr.start : tr.end]))
+            raise ThermocalInputError(
+                f"{where} {tr.name!r}: the gyro sits on its rails at sample {i} inside the "
+                "turn: the rotation is unknown; turn more slowly (or at a wider gyro range) "
+                f"and record it again, or leave the turn out of {sections_from}"
+            )
+        rot = _gyro.turn_rotation(rate_rad_s, dt_s, bias_rad_s, tr)
+        _gyro.check_turn(rot, tr.name, j, f"{where} {tr.name!r}", sections_from)
+        c = np.linalg.solve(np.eye(3) + e_a, accel_mg[tr.start : tr.end].mean(axis=0)
+                            - acc.theta[0:3])  # fmt: skip
+        col = [6 + k for k, n in enumerate(model.MISALIGNMENT_NAMES)
+               if model.MISALIGNMENT_INDEX[n][1] == j]  # fmt: skip
+        face = f"{'xyz'[j]}_{'p' if c[j] >= 0 else 'a'}"
+        sig = face_sigma_rad.get(face, math.sqrt(float(np.mean(var[col]))) * units.ARCSEC_TO_RAD)
+        out.append(_gyro.Turn(tr, j, c / np.linalg.norm(c), float(sig)))
+    return out
+
+
+def _section_warnings(
+    statics: Sequence[Section],
+    turns: Sequence[Section],
+    has_gyro: bool,
+    where: str,
+    sections_from: str,
+) -> tuple[str, ...]:
+    """Warnings on the sections before any fit (turns named without a gyro, poses not
+    still); the names of the poses not still."""
+    if turns and not has_gyro:
+        warnings.warn(
+            ThermocalWarning(
+                f"{where}: {', '.join(s.name for s in turns)} in {sections_from} are 360° "
+                "turns for the gyro; without its columns (--gyro X,Y,Z) they are not used"
+            ),
+            stacklevel=3,
+        )
+    not_still = tuple(s.name for s in statics if s.still_ratio > 2.0)
+    if not_still:
+        warnings.warn(
+            ThermocalWarning(
+                f"{where}: {len(not_still)} poses are not still (window variance more than "
+                f"twice the quietest): {', '.join(not_still[:8])}"
+                f"{' …' if len(not_still) > 8 else ''}; their means carry the motion"
+            ),
+            stacklevel=3,
+        )
+    return not_still
+
+
+def _warn_implausible(gfit: _gyro.GyroFit, where: str) -> None:
+    """A warning when a gyro scale factor or misalignment is beyond
+    :data:`GYRO_E_PLAUSIBLE` (no sensor's: a unit, count scale or pose is wrong), and
+    when the gyro comes from the three turns alone (nothing checks them)."""
+    if gfit.n_motions == 0:
+        warnings.warn(
+            ThermocalWarning(
+                f"{where}: the gyro from the three turns alone (no motion between still "
+                "poses without a gap in time): nothing checks them, a lean of their axes "
+                "is taken for misalignment and σ counts the noise only; record the faces "
+                "and turns in one piece for the motions between them"
+            ),
+            stacklevel=3,
+        )
+    th = gfit.theta
+    bad = [f"scale factor {ax} {th[3 + i] * units.PPM:+.1%}" for i, ax in enumerate("xyz")
+           if abs(th[3 + i] * units.PPM) > GYRO_E_PLAUSIBLE]  # fmt: skip
+    bad += [f"misalignment {n} {th[6 + k]:+.4g}″" for k, n in enumerate(model.MISALIGNMENT_NAMES)
+            if abs(th[6 + k] * units.ARCSEC_TO_RAD) > GYRO_E_PLAUSIBLE]  # fmt: skip
+    if bad:
+        warnings.warn(
+            ThermocalWarning(
+                f"{where}: gyro {', '.join(bad)}: beyond ±{GYRO_E_PLAUSIBLE:.0%} (0.1 rad), "
+                "no gyro's; check the gyro's unit (--gyro-unit, --gyro-scale) and that the "
+                "poses and turns are what they are named (--poses)"
+            ),
+            stacklevel=3,
+        )
+
+
+def _warn_too_few_motions(gfit: _gyro.GyroFit, where: str) -> None:
+    """A warning when the motions cannot carry the model's elements of E
+    (:func:`.gyro.too_few_motions`), naming the reduced model."""
+    if gfit.model != "full" or not _gyro.too_few_motions(gfit):
+        return
+    worst = float(np.max(gfit.sigma[3:6])) * units.PPM
+    warnings.warn(
+        ThermocalWarning(
+            f"{where}: {gfit.n_motions} motions between poses for the gyro's 9 scale factors "
+            f"and misalignments leave {gfit.dof} degree(s) of freedom, and they misfit their "
+            f"noise (reduced χ² {gfit.reduced_chi2:.3g}): the misfit goes into E (scale "
+            f"factor σ up to {worst:.1%}); fit the 3 scale factors only with "
+            "--gyro-model scale (misalignments held at 0), or record more motions"
+        ),
+        stacklevel=3,
+    )
+
+
 def calibrate_session(
     time_s: npt.ArrayLike,
     accel_mg: npt.ArrayLike,
@@ -165,10 +305,16 @@ def calibrate_session(
     static_s: float = 1.0,
     temperature_c: npt.ArrayLike | None = None,
     where: str = "session",
+    sections_from: str = "the POSES file",
+    saturated: npt.ArrayLike | None = None,
+    gyro_model: str = "full",
 ) -> SessionResult:
     """Calibrate the accelerometer (and gyro) triad of one session (module docstring).
     ``accel_mg`` (n, 3) [mg], ``gyro_rad_s`` (n, 3) [rad/s] or None, ``g_mg`` local
-    gravity [mg]; ``sections`` from a POSES file, else found from the data."""
+    gravity [mg]; ``sections`` from a POSES file (named ``sections_from`` in messages),
+    else found from the data; ``saturated`` (n,) the samples with a gyro axis on its rails
+    (their motions left out of the gyro fit, a turn holding one refused); ``gyro_model`` the
+    elements of the gyro's E fitted (:data:`.gyro.GYRO_MODELS`)."""
     t = np.asarray(time_s, dtype=np.float64)
     a = np.asarray(accel_mg, dtype=np.float64)
     w = None if gyro_rad_s is None else np.asarray(gyro_rad_s, dtype=np.float64)
@@ -176,16 +322,7 @@ def calibrate_session(
         sections = detect_poses(t, a, w, static_s=static_s)
     statics = [s for s in sections if not s.is_turn]
     turns = [s for s in sections if s.is_turn]
-    not_still = tuple(s.name for s in statics if s.still_ratio > 2.0)
-    if not_still:
-        warnings.warn(
-            ThermocalWarning(
-                f"{where}: {len(not_still)} poses are not still (window variance more than "
-                f"twice the quietest): {', '.join(not_still[:8])}"
-                f"{' …' if len(not_still) > 8 else ''}; their means carry the motion"
-            ),
-            stacklevel=2,
-        )
+    not_still = _section_warnings(statics, turns, w is not None, where, sections_from)
     stats = pose_stats(a, w, statics)
     if len(stats) < 6:
         raise DesignError(
@@ -229,20 +366,18 @@ def calibrate_session(
         bias, bias_cov = _gyro.static_bias(wm, n, ws, up, latitude_deg)
         dt = np.diff(t)
         dt = np.concatenate([dt, dt[-1:]])
-        turn_pairs = []
-        for tr in turns:
-            before = [i for i, p in enumerate(stats) if p.section.end <= tr.start]
-            if not before:
-                raise ThermocalInputError(
-                    f"{where}: the turn {tr.name!r} has no still pose before it (its axis is "
-                    "the up direction of that pose)"
-                )
-            turn_pairs.append((tr, before[-1]))
+        dir_sig = _direction_sigma(sig, names, acc.method, g_mg)
+        sat = None if saturated is None else np.asarray(saturated, dtype=bool)
+        named = _named_turns(turns, w, dt, bias, a, acc, dict(zip(names, dir_sig, strict=True)),
+                             f"{where}: section", sections_from, sat)  # fmt: skip
         gfit = _gyro.fit_rotations(
             w, dt, [p.section for p in stats], up_of, free, free_cov, bias, bias_cov,
-            _direction_sigma(sig, names, acc.method, g_mg), float(np.sqrt(np.mean(ws**2))),
-            turn_pairs, latitude_deg=latitude_deg,
+            dir_sig, float(np.sqrt(np.mean(ws**2))), named, latitude_deg=latitude_deg,
+            saturated=sat,
+            model=gyro_model,
         )  # fmt: skip
+        _warn_implausible(gfit, where)
+        _warn_too_few_motions(gfit, where)
     return SessionResult(acc, gfit, tuple(stats), tuple(turns), g_mg, temp, not_still)
 
 

@@ -10,22 +10,35 @@ and go out (file layer, as :mod:`thermocal.compensate.files` for the compensatio
 
 from __future__ import annotations
 
+import itertools
 import json
 import math
+import warnings
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from thermocal import units
-from thermocal.errors import ThermocalInputError, UnitError
+from thermocal.errors import DesignError, ThermocalInputError, ThermocalWarning, UnitError
+from thermocal.inspection import saturated_mask
 from thermocal.models.calibration import Calibration, Triad
 from thermocal.models.files import save_calibration
 from thermocal.multipos.calibrate import METHOD, SessionResult, calibrate_session
-from thermocal.multipos.poses import parse_poses
+from thermocal.multipos.poses import (
+    DRIFT_DEG,
+    MOTION_FRACTION,
+    STILL_THRESHOLD,
+    WINDOW_S,
+    PoseDetection,
+    Section,
+    find_poses,
+    parse_poses,
+)
 from thermocal.readers import read_recording
+from thermocal.readers.text import TextOptions
 from thermocal.recording import Recording
 from thermocal.turntable import thermal
 
@@ -56,9 +69,30 @@ class MultiposOptions:
     accel_scale: tuple[float, str] | None = None
     gyro_scale: tuple[float, str] | None = None
     """Raw-count columns: one count is ``value`` ``unit`` (``--accel-scale 0.061,mg``)."""
+    window_s: float = WINDOW_S
+    still_threshold: float = STILL_THRESHOLD
+    motion_fraction: float = MOTION_FRACTION
+    drift_deg: float = DRIFT_DEG
+    """The pose detector's options (:func:`thermocal.multipos.poses.find_poses`)."""
+    accel_offset: float | None = None
+    gyro_offset: float | None = None
+    """Zero of the columns in their own unit (counts: ``--accel-offset 32768`` for unsigned
+    ADC counts); None: none, or mid-scale found in unsigned counts (a warning)."""
+    gyro_model: str = "full"
+    """The gyro's elements of E fitted (:data:`thermocal.multipos.gyro.GYRO_MODELS`)."""
+    text: TextOptions | None = None
+    """How to read a text log and its time (``--rate HZ``: a sample counter, or samples at
+    the nominal rate; ``--names`` …), as every command reads it."""
 
     def check(self, n_files: int, poses: Path | None) -> None:
         """The options' own consistency (before any file is read)."""
+        if self.gyro_model not in ("full", "scale"):
+            raise ThermocalInputError(f"--gyro-model {self.gyro_model!r}: full or scale")
+        if self.gyro_model != "full" and self.gyro is None:
+            raise ThermocalInputError(
+                f"--gyro-model {self.gyro_model}: no gyro columns to fit; name them with "
+                "--gyro X,Y,Z"
+            )
         if n_files > 1 and self.temps is None:
             raise ThermocalInputError(
                 "several files: name their temperature column with --temps (one file per "
@@ -84,6 +118,10 @@ class SessionRun:
     path: Path
     result: SessionResult
     t_range_c: tuple[float, float] | None
+    detection: PoseDetection | None = None
+    """The pose detector's choice (None with a POSES file)."""
+    offsets: dict[str, float] | None = None
+    """Each triad's zero removed before the directions were judged [its unit]."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -127,7 +165,8 @@ def _unit_of(
     scale: tuple[float, str] | None = None,
 ) -> tuple[str, float]:
     """The columns' unit and the factor to it: the option, else the file's (metadata,
-    column name); raw counts need ``scale`` (their unit is then the scale's)."""
+    column name; raw ``counts`` where a ``scale`` is given and nothing states one, as the
+    reader resolves them); raw counts need ``scale`` (their unit is then the scale's)."""
     stated = [c for c in cols if rec.unit_sources.get(c, "default") != "default"]
     found = {option} if option else {rec.units.get(c) or "" for c in stated}
     if not option and len(stated) < 3:
@@ -157,14 +196,42 @@ def _unit_of(
 
 
 def _read_poses(poses: Path | None) -> dict[str, Any] | None:
-    """The POSES file's JSON object (None without one)."""
+    """The POSES file's JSON object (None without one); a ``.csv`` is imucal's section list
+    as pandas writes it (``section_list.to_csv``: a header ``,start,end`` and one row
+    ``name,i,j`` per section)."""
     if poses is None:
         return None
     try:
-        doc: dict[str, Any] = json.loads(poses.read_text(encoding="utf-8"))
+        text = poses.read_text(encoding="utf-8")
+        if poses.suffix.lower() == ".csv":
+            return _poses_csv(text, poses)
+        doc: dict[str, Any] = json.loads(text)
     except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
         raise ThermocalInputError(f"{poses}: not a readable JSON file ({exc})") from None
     return doc
+
+
+def _poses_csv(text: str, poses: Path) -> dict[str, Any]:
+    """imucal's section list written by pandas as CSV (:func:`_read_poses`)."""
+    import csv
+
+    rows = [r for r in csv.reader(text.splitlines()) if any(c.strip() for c in r)]
+    head = [c.strip() for c in rows[0]] if rows else []
+    if "start" not in head or "end" not in head:
+        raise ThermocalInputError(
+            f"{poses}: a CSV section list needs a header with 'start' and 'end' (and the "
+            "section names in the first column), or give the sections as JSON"
+        )
+    i0, i1 = head.index("start"), head.index("end")
+    out: dict[str, Any] = {}
+    for r in rows[1:]:
+        try:
+            out[r[0].strip()] = {"start": int(r[i0]), "end": int(r[i1])}
+        except (IndexError, ValueError):
+            raise ThermocalInputError(
+                f"{poses}: section row {','.join(r)!r} needs integer start and end"
+            ) from None
+    return out
 
 
 class _Gravity:
@@ -191,6 +258,123 @@ class _Gravity:
             self.g_m_s2 = units.normal_gravity_m_s2(float(lat))
 
 
+MID_SCALE = 32768.0
+"""Mid-scale of unsigned 16-bit ADC counts (imu_tk's Xsens data sit around it)."""
+
+
+def _offset(raw: np.ndarray, given: float | None, unit: str, kind: str, path: Path) -> float:
+    """The triad's zero in its columns' unit: ``--{kind}-offset``, else mid-scale for raw
+    counts that are all in 0…65535 with every column's median in the middle half (unsigned
+    ADC counts, a warning), else 0."""
+    if given is not None:
+        if not math.isfinite(given):
+            raise ThermocalInputError(f"--{kind}-offset must be a finite number, got {given!r}")
+        return float(given)
+    if unit != "counts" or raw.size == 0:
+        return 0.0
+    med = np.median(raw, axis=0)
+    if (
+        float(raw.min()) >= 0
+        and float(raw.max()) <= 65535
+        and np.all(np.abs(med - MID_SCALE) < MID_SCALE / 2)
+    ):
+        warnings.warn(
+            ThermocalWarning(
+                f"{path}: the {kind} columns look like unsigned counts around mid-scale "
+                f"(medians {', '.join(f'{m:.0f}' for m in med)}): {MID_SCALE:.0f} taken as "
+                f"their zero; give --{kind}-offset (0 for none) to say it"
+            ),
+            stacklevel=3,
+        )
+        return MID_SCALE
+    return 0.0
+
+
+def _triad(
+    rec: Recording, cols: list[str], opts: MultiposOptions, kind: str, path: Path
+) -> tuple[np.ndarray, str, float]:
+    """The triad's samples in mg (accel) or rad/s (gyro) with its zero removed, its unit
+    and that zero [its unit]."""
+    scale = opts.accel_scale if kind == "accel" else opts.gyro_scale
+    unit, factor = _unit_of(rec, cols, opts.accel_unit if kind == "accel" else opts.gyro_unit,
+                            kind, path, scale)  # fmt: skip
+    raw = np.column_stack([rec.column(c) for c in cols])
+    col_unit = "counts" if scale is not None else unit
+    off = _offset(raw, opts.accel_offset if kind == "accel" else opts.gyro_offset, col_unit,
+                  kind, path)  # fmt: skip
+    to = "mg" if kind == "accel" else "rad/s"
+    return units.convert((raw - off) * factor, unit, to), unit, off * factor
+
+
+def _with_offsets(res: SessionResult, acc_off_mg: float, gyr_off_deg_h: float) -> SessionResult:
+    """The session's calibration with the zeros put back into the biases (the compensation
+    sees the columns as they are) and into the pose means."""
+    if acc_off_mg == 0.0 and gyr_off_deg_h == 0.0:
+        return res
+    th = res.accel.theta.copy()
+    th[0:3] += acc_off_mg
+    poses = tuple(replace(p, f_mean_mg=p.f_mean_mg + acc_off_mg) for p in res.poses)
+    gyro = res.gyro
+    if gyro is not None:
+        tg = gyro.theta.copy()
+        tg[0:3] += gyr_off_deg_h
+        gyro = replace(gyro, theta=tg)
+    return replace(res, accel=replace(res.accel, theta=th), gyro=gyro, poses=poses)
+
+
+def _detect(t: np.ndarray, acc: np.ndarray, w: np.ndarray | None, opts: MultiposOptions,
+            path: Path) -> PoseDetection:  # fmt: skip
+    """The poses found in the data (:func:`find_poses` with the command's options); fewer
+    than six refused with what was rejected and the options that change it."""
+    det = find_poses(t, acc, w, static_s=opts.static_s, window_s=opts.window_s,
+                     threshold=opts.still_threshold, motion_fraction=opts.motion_fraction,
+                     drift_deg=opts.drift_deg)  # fmt: skip
+    if len(det.poses) < 6:
+        why = "; ".join(f"{r.reason} ({r.start}…{r.end})" for r in det.rejected[:4])
+        raise DesignError(
+            f"{path}: {len(det.poses)} static poses found (the accelerometer triad needs at "
+            f"least 9 distinct ones){'; rejected: ' + why if why else ''}: lower --static-s, "
+            "raise --still-threshold or --motion-fraction, or name the poses with --poses"
+        )
+    return det
+
+
+def _saturation(
+    rec: Recording, cols: list[str], sections: list[Section], path: Path
+) -> np.ndarray | None:
+    """The samples with a gyro column on its rails (:func:`thermocal.inspection.saturated_mask`),
+    None when there are none.  A 360° turn across them is refused; each motion between
+    consecutive static poses across them is named in a warning (the gyro fit leaves it out)."""
+    sat = np.zeros(rec.n_samples, dtype=bool)
+    for c in cols:
+        sat |= saturated_mask(rec.column(c))
+    if not sat.any():
+        return None
+    for sec in sections:
+        if sec.is_turn and sat[sec.start : sec.end].any():
+            k = sec.start + int(np.argmax(sat[sec.start : sec.end]))
+            raise ThermocalInputError(
+                f"{path}: the turn {sec.name!r} has gyro samples on their rails (first at row "
+                f"{k}): its rotation is unknown; record it slower, or with a wider gyro range"
+            )
+    statics = [s for s in sections if not s.is_turn]
+    hit = [
+        f"{a.name} → {b.name} (rows {a.end + int(np.argmax(sat[a.end : b.start]))}…)"
+        for a, b in itertools.pairwise(statics)
+        if sat[a.start : b.end].any()
+    ]
+    if hit:
+        warnings.warn(
+            ThermocalWarning(
+                f"{path}: the gyro is on its rails (clipped) during {len(hit)} motion(s): "
+                f"{', '.join(hit[:6])}{' …' if len(hit) > 6 else ''}; left out of the gyro "
+                "fit (`thermocal inspect` lists the samples)"
+            ),
+            stacklevel=3,
+        )
+    return sat
+
+
 def _session(
     path: Path,
     opts: MultiposOptions,
@@ -204,28 +388,50 @@ def _session(
     rec = read_recording(
         path, time=opts.time, time_unit=opts.time_unit, signals=[*acc_cols, *(gyr_cols or [])],
         signal_unit=",".join(given) if all(given) else None,  # type: ignore[arg-type]
-        temperatures=[temps] if temps else None,
+        temperatures=[temps] if temps else None, text=opts.text,
+        ask_units={**dict.fromkeys([] if opts.accel_scale else acc_cols, "--accel-unit"),
+                   **dict.fromkeys([] if opts.gyro_scale else (gyr_cols or []), "--gyro-unit")},
+        implied_units={**dict.fromkeys(acc_cols if opts.accel_scale else [], "counts"),
+                       **dict.fromkeys((gyr_cols or []) if opts.gyro_scale else [], "counts")},
     )  # fmt: skip
     rec.validate(required=[*acc_cols, *(gyr_cols or []), *([temps] if temps else [])])
-    au, af = _unit_of(rec, acc_cols, opts.accel_unit, "accel", path, opts.accel_scale)
+    acc, au, a_off = _triad(rec, acc_cols, opts, "accel", path)
     grav.update(rec, path)
-    acc = units.convert(np.column_stack([rec.column(c) for c in acc_cols]) * af, au, "mg")
-    w, gu = None, None
+    w, gu, g_off = None, None, 0.0
     if gyr_cols:
-        gu, gf = _unit_of(rec, gyr_cols, opts.gyro_unit, "gyro", path, opts.gyro_scale)
-        w = units.convert(np.column_stack([rec.column(c) for c in gyr_cols]) * gf, gu, "rad/s")
-    sections = None
+        w, gu, g_off = _triad(rec, gyr_cols, opts, "gyro", path)
+    det = None
     if sections_d is not None:
         sections = parse_poses(sections_d, rec.n_samples, str(poses))
+    else:
+        det = _detect(rec.time_s, acc, w, opts, path)
+        sections = list(det.poses)
+    sat = _saturation(rec, gyr_cols, sections, path) if gyr_cols else None
     temp = rec.temperature_c(temps) if temps else None
     assert grav.g_m_s2 is not None
-    res = calibrate_session(
-        rec.time_s, acc, w, g_mg=float(grav.g_m_s2) / 9.80665e-3,
-        latitude_deg=grav.latitude_deg, sections=sections, static_s=opts.static_s,
-        temperature_c=temp, where=str(path),
-    )  # fmt: skip
+    try:
+        res = calibrate_session(
+            rec.time_s, acc, w, g_mg=float(grav.g_m_s2) / 9.80665e-3,
+            latitude_deg=grav.latitude_deg, sections=sections, static_s=opts.static_s,
+            temperature_c=temp, where=str(path), saturated=sat, sections_from=str(poses),
+            gyro_model=opts.gyro_model,
+        )  # fmt: skip
+    except DesignError as exc:
+        if "distinct poses" not in str(exc):
+            raise
+        offset = (
+            "; or, if the raw counts' zero is not 0 (unsigned ADC counts sit around "
+            "mid-scale), give it with --accel-offset (e.g. 32768)"
+        )
+        raise DesignError(
+            f"{path}: {exc}{offset if opts.accel_scale is not None else ''}"
+        ) from None
+    acc_off_mg = float(units.convert(np.array([a_off]), au, "mg")[0]) if a_off else 0.0
+    g_off_dh = float(units.convert(np.array([g_off]), str(gu), "deg/h")[0]) if g_off else 0.0
+    res = _with_offsets(res, acc_off_mg, g_off_dh)
     t_range = (float(np.min(temp)), float(np.max(temp))) if temp is not None else None
-    return SessionRun(path, res, t_range), au, gu
+    offsets = {"accel": a_off, **({"gyro": g_off} if gyr_cols else {})}
+    return SessionRun(path, res, t_range, det, offsets), au, gu
 
 
 def _fit_triads(
@@ -336,7 +542,8 @@ def _summary(
             "temperature_c": r.temperature_c,
             "n_poses": len(r.poses),
             "accel": {**_triad_dict(r.accel.theta, r.accel.sigma, to_a, a_unit),
-                      "method": r.accel.method, "reduced_chi2": r.accel.reduced_chi2},
+                      "method": r.accel.method, "reduced_chi2": r.accel.reduced_chi2,
+                      "misfit": r.accel.misfit_mg * to_a},
             "poses": [
                 {**p, "mean_specific_force": (np.asarray(p["mean_specific_force_mg"])
                                               * to_a).tolist(),
@@ -347,12 +554,19 @@ def _summary(
         }  # fmt: skip
         for p in rd["poses"]:
             del p["mean_specific_force_mg"], p["gravity_residual_mg"]
+        if run.detection is not None:
+            to_gr = float(units.convert(np.array([1.0]), "rad/s", g_unit)[0]) if g_unit else 1.0
+            rd["pose_detection"] = run.detection.to_dict(to_a, to_gr)
+        if run.offsets and any(run.offsets.values()):
+            rd["offset"] = run.offsets
         if r.gyro is not None:
             rd["gyro"] = {**_triad_dict(r.gyro.theta, r.gyro.sigma, to_g, str(g_unit)),
                           "method": "rotations between poses"
                           + (" and 360° turns" if r.gyro.n_turns else ""),
                           "n_motions": r.gyro.n_motions, "n_turns": r.gyro.n_turns,
+                          "model": r.gyro.model, "dof": r.gyro.dof,
                           "reduced_chi2": r.gyro.reduced_chi2,
+                          "turn_axis_lean_deg": math.degrees(r.gyro.turn_axis_lean_rad),
                           "direction_rms_before_deg": math.degrees(
                               r.gyro.direction_rms_before_rad),
                           "direction_rms_after_deg": math.degrees(
@@ -386,6 +600,9 @@ def _summary(
                 for f in m.fits
             }  # fmt: skip
         out[kind] = d
+    out["pose_detection"] = [
+        {"input": rd["input"], **rd["pose_detection"]} for rd in run_dicts if "pose_detection" in rd
+    ]
     out["runs"] = run_dicts
     return out
 

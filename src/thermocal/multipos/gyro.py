@@ -20,6 +20,12 @@ Gauss–Newton: a perturbation ``δE`` turns the total rotation R by
 ``ε = −Rᵀ Σ_t D(t) δE ω_c(t) τ``, so ``∂r/∂E_ij = [p×] Rᵀ Σ_t D(t) e_i ω_cj(t) τ`` with
 ``p = A_{k+1}ᵀ A_k⁻ᵀ u_k``; the attitude is integrated again at each iteration.
 
+**Models** (:data:`GYRO_MODELS`): ``full`` fits the nine elements; ``scale`` the three
+scale factors, the misalignments held at 0, when the motions cannot carry nine
+(:func:`too_few_motions`: fewer redundant rows than elements and a misfit beyond the
+noise; a hand-held MPU-6050 session of tomisuarez2/ImuCalibration, 6 usable motions at
+χ² ≈ 700, gives 7.0° on its held-out 90° turn with nine, 0.90° with three).
+
 Each motion's residual lies in the plane normal to ``u_{k+1}`` and has there, per
 component, the variance ``c_k σ_u,k² + c_k+1 σ_u,k+1² + σ_ω² τ T_eff + V_Ω``: the
 direction noise of the two pose means (``σ_u = σ_f/g``, the pose mean's noise across
@@ -38,29 +44,40 @@ defines ``u`` (``K G C Gᵀ Kᵀ``, ``K = (JᵀJ)⁻¹Jᵀ``).  Rotations all ab
 ``E_g``'s other columns unseen: refused.
 
 **360° turns** (Ferraris et al., Sensors and Actuators A 46, 1995,
-doi:10.1016/0924-4247(94)00969-1): a full turn about the vertical adds
-``Σ ω_c τ − (2π s + Ω sin L T) u = 0`` (``u`` the up direction of the pose before it,
-``s = ±1`` the sense, the vertical earth rate over the turn's duration T known from the
-latitude), three linear rows of the same least squares with the 3×3 covariance
-``σ_ω² τ T I + (c (2π σ_u)² + (Ω cos L T ρ)²/2)(I − u uᵀ)``: angle random walk, the
-direction noise of u (across u only) and the horizontal earth rate, which turns with
-the board and integrates to ``Ω cos L T ρ`` in an unknown horizontal direction, with
-``ρ = |mean_t exp(i ψ(t))|`` from the turn's own heading ``ψ(t) = ∫ ω_c·u dt`` (0 for a
-uniform full turn); without L, ``(Ω T)²/3 I`` for the whole earth rate.  The rows are
-whitened by ``C^(−1/2)``.
+doi:10.1016/0924-4247(94)00969-1; imucal's ``x_rot``, ``y_rot``, ``z_rot``): a turn
+named about the sensor's axis ``e_j`` (j = x, y, z, whatever pose came before it: users
+do the turns after the six faces) adds
+``Σ ω_c τ − 2π s e_j − Ω sin L T u = 0``, three linear rows of the same least squares
+(``s = ±1`` the sense, the sign of ``Σ ω_c τ · e_j``; ``u`` the calibrated up direction
+during the turn, along which the vertical earth rate over its duration T is known from
+the latitude).  The axis is the calibrated frame's, as in Ferraris's and imucal's
+``W_s = (I + E_g) (±360°) I`` (imucal ``K_g R_g = I + E_g``).  The 3×3 covariance is
+``σ_ω² τ T I + (2π σ_a)² (I − e_j e_jᵀ) + (Ω cos L T ρ)²/2 (I − u uᵀ)``: angle random
+walk, the direction noise ``σ_a`` of the axis (across it only: a hand turns the board
+about the vertical of the face it lies on, ``e_j`` to within that face's direction noise
+``σ_u``; without the face, the accelerometer calibration's σ of the misalignments of
+column j) and the horizontal earth rate, which turns with the board and integrates to
+``Ω cos L T ρ`` in an unknown horizontal direction, with ``ρ = |mean_t exp(i ψ(t))|`` from
+the turn's own heading ``ψ(t) = ∫ ω_c·u dt`` (0 for a uniform full turn); without L,
+``(Ω T)²/3 I`` for the whole earth rate.  The rows are whitened by ``C^(−1/2)``.
+A hand's turn leans off its axis: the lean's variance, found in the data when the
+turns disagree with the motions (:func:`_turn_axis_scatter`), is added to the turns'
+covariance.  Before any fit a turn is judged by :func:`check_turn`: its rotation vector (raw rate,
+bias removed) within :data:`TURN_AXIS_TOLERANCE_DEG` of its named axis and its angle
+within :data:`TURN_ANGLE_TOLERANCE` of 360°, else refused.
 """
 
 from __future__ import annotations
 
 import math
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 import numpy.typing as npt
 
 from thermocal import units
-from thermocal.errors import DesignError
+from thermocal.errors import DesignError, ThermocalInputError
 from thermocal.multipos.geometry import attitude_along, skew
 from thermocal.multipos.poses import Section
 from thermocal.turntable import model
@@ -68,11 +85,143 @@ from thermocal.turntable import model
 FloatArray = npt.NDArray[np.float64]
 
 
+GAP_FACTOR: float = 1.5
+"""An interval above this many median intervals is a gap in time: no motion is
+integrated across it, no turn may hold one."""
+TURN_ANGLE_TOLERANCE: float = 0.10
+"""A named turn's angle (raw rate, bias removed) may differ from 360° by this fraction;
+more (a quarter turn, two turns, a wrong gyro unit) is refused (:func:`check_turn`).
+It bounds the scale factor a turn can give to ±10 %."""
+GYRO_MODELS: dict[str, tuple[int, ...]] = {"full": tuple(range(9)), "scale": (0, 4, 8)}
+"""The elements of ``E_g`` (row-major) each gyro model fits: ``full`` all nine (three
+scale factors, six misalignments), ``scale`` the three scale factors only, the
+misalignments held at 0 (the gyro's axes taken as the accelerometer's calibrated axes:
+one chip, one die), for sessions whose motions cannot carry nine (:func:`too_few_motions`)."""
+TURN_AXIS_TOLERANCE_DEG: float = 15.0
+"""A named turn's rotation vector may be this far [°] from its named axis (consumer
+gyro misalignments and a hand's wobble are a few degrees); more is refused: a turn named
+``x_rot`` that turns about y (:func:`check_turn`)."""
+
+
+@dataclass(frozen=True)
+class Turn:
+    """A named 360° turn (module docstring): its ``section``, the sensor axis it is named
+    about (``axis`` 0, 1, 2 for ``x_rot``, ``y_rot``, ``z_rot``), the calibrated unit up
+    direction during it ``up`` (body axes: the vertical earth rate) and the direction
+    noise ``axis_sigma_rad`` [rad] of the axis across itself."""
+
+    section: Section
+    axis: int
+    up: FloatArray
+    axis_sigma_rad: float
+
+
+def turn_intervals(dt_s: FloatArray, section: Section, dt_med: float) -> FloatArray:
+    """τ [s] of a turn's samples: their forward intervals, the last one the median
+    interval ``dt_med`` when a gap follows the turn (sections recorded apart, imucal's
+    annotated sessions); a gap inside a turn is refused before (:func:`turn_gap`)."""
+    tau: FloatArray = dt_s[section.start : section.end].copy()
+    if tau.size and tau[-1] > GAP_FACTOR * dt_med:
+        tau[-1] = dt_med
+    return tau
+
+
+def turn_gap(dt_s: FloatArray, section: Section, dt_med: float) -> tuple[int, float] | None:
+    """The first gap in time inside a turn (interval above ``GAP_FACTOR × dt_med``): the
+    sample before it and its length [s]; None without one."""
+    inside = dt_s[section.start : section.end - 1]
+    big = np.flatnonzero(inside > GAP_FACTOR * dt_med)
+    return None if big.size == 0 else (section.start + int(big[0]), float(inside[big[0]]))
+
+
+def turn_rotation(
+    rate_rad_s: FloatArray, dt_s: FloatArray, bias_rad_s: FloatArray, section: Section
+) -> FloatArray:
+    """The rotation vector of a turn: ``Σ (ω − b) τ`` over its samples.
+
+    The raw rate with the bias removed, integrated as Ferraris et al. (1995,
+    doi:10.1016/0924-4247(94)00969-1) integrate a turn (imucal's ``W_s``, its eq. 13–14).
+
+    Parameters
+    ----------
+    rate_rad_s : ndarray, shape (n, 3)
+        Gyro rate [rad/s].
+    dt_s : ndarray, shape (n,)
+        Each sample's forward interval [s] (τ: :func:`turn_intervals`).
+    bias_rad_s : ndarray, shape (3,)
+        Gyro bias b [rad/s].
+    section : Section
+        The turn's samples.
+
+    Returns
+    -------
+    ndarray, shape (3,)
+        The rotation vector [rad], in the gyro's own axes.
+    """
+    sl = slice(section.start, section.end)
+    tau = turn_intervals(dt_s, section, float(np.median(dt_s)))
+    out: FloatArray = ((rate_rad_s[sl] - bias_rad_s) * tau[:, None]).sum(axis=0)
+    return out
+
+
+def check_turn(
+    rotation_rad: FloatArray, name: str, axis: int, where: str, source: str = "the POSES file"
+) -> None:
+    """Refuse a named turn that is not one full turn about its named axis.
+
+    Ferraris et al. (1995) turn the board once about each sensor axis: the rotation
+    vector ``v`` (:func:`turn_rotation`) must lie within :data:`TURN_AXIS_TOLERANCE_DEG`
+    of ``±e_axis`` (``acos(|v_axis| / |v|)``) and its angle ``|v|`` within
+    :data:`TURN_ANGLE_TOLERANCE` of 2π.
+
+    Parameters
+    ----------
+    rotation_rad : ndarray, shape (3,)
+        The turn's rotation vector [rad].
+    name : str
+        The section's name (``x_rot`` …).
+    axis : int
+        The axis it names (0, 1, 2).
+    where : str
+        The file and section, for the message.
+    source : str
+        The file that named the section (the remedy).
+
+    Raises
+    ------
+    ThermocalInputError
+        One line with the measured rotation vector and what to fix.
+    """
+    v = np.asarray(rotation_rad, dtype=np.float64)
+    ang = float(np.linalg.norm(v))
+    ax = "xyz"[axis]
+    deg = np.degrees(v)
+    shown = f"rotation vector ({deg[0]:+.1f}°, {deg[1]:+.1f}°, {deg[2]:+.1f}°) bias removed"
+    off = math.degrees(math.acos(min(1.0, abs(float(v[axis])) / ang))) if ang > 0 else 90.0
+    if off > TURN_AXIS_TOLERANCE_DEG:
+        most = "xyz"[int(np.argmax(np.abs(v)))]
+        raise ThermocalInputError(
+            f"{where}: the gyro turns {math.degrees(ang):.1f}° mostly about {most} "
+            f"({shown}), {off:.1f}° from the sensor's {ax} axis that {name!r} names, "
+            f"which must hold one full turn about {ax}: fix the section's name or its "
+            f"start and end in {source} (or the order of the --gyro columns)"
+        )
+    if abs(ang / (2.0 * math.pi) - 1.0) > TURN_ANGLE_TOLERANCE:
+        raise ThermocalInputError(
+            f"{where}: the gyro turns {math.degrees(ang):.1f}° about {ax} ({shown}), not "
+            f"one full turn (360° ± {TURN_ANGLE_TOLERANCE:.0%}): fix the section's start "
+            f"and end in {source} to hold exactly one turn, or the gyro's unit "
+            "(--gyro-unit, --gyro-scale)"
+        )
+
+
 @dataclass(frozen=True)
 class GyroFit:
     """θ (12: bias [°/h], scale factors [ppm], misalignments [″]) and its covariance, the
     rms of the motions' gravity-direction residuals before (raw rate, bias removed) and
-    after calibration [rad], the reduced χ² and the number of motions and turns used."""
+    after calibration [rad], the reduced χ² and the number of motions and turns used, and
+    the turns' axis lean found in the data [rad] (sd per component, 0 when not
+    significant: :func:`_turn_axis_scatter`)."""
 
     theta: FloatArray
     cov: FloatArray
@@ -81,6 +230,14 @@ class GyroFit:
     reduced_chi2: float
     n_motions: int
     n_turns: int
+    turn_axis_lean_rad: float = 0.0
+    model: str = "full"
+
+    @property
+    def dof(self) -> int:
+        """The fit's degrees of freedom: two per motion (the residual lies across
+        gravity), three per turn, less the elements of E the model fits."""
+        return 2 * self.n_motions + 3 * self.n_turns - len(GYRO_MODELS[self.model])
 
     @property
     def sigma(self) -> FloatArray:
@@ -127,11 +284,9 @@ def _direction(u0: FloatArray, a0: FloatArray, a1: FloatArray) -> FloatArray:
     return out
 
 
-_Held = tuple[
-    list[tuple[FloatArray, FloatArray]], list[tuple[FloatArray, float, float, FloatArray]]
-]
-"""The attitudes at each motion's ends and each turn's (integrated rate, sense, vertical
-earth-rate angle [rad], whitening matrix)."""
+_Held = tuple[list[tuple[FloatArray, FloatArray]], list[tuple[FloatArray, FloatArray, FloatArray]]]
+"""The attitudes at each motion's ends and each turn's (integrated rate, expected rotation
+vector [rad], whitening matrix)."""
 
 
 def _motions(
@@ -155,7 +310,7 @@ def _motions(
     motions: list[_Motion] = []
     for k in range(len(poses) - 1):
         p0, p1 = poses[k], poses[k + 1]
-        if np.any(dt_s[p0.start : p1.end - 1] > 1.5 * dt_med):
+        if np.any(dt_s[p0.start : p1.end - 1] > GAP_FACTOR * dt_med):
             continue  # a gap in time: the rotation across it is unknown
         t_k, t_k1 = p0.n * dt_med, p1.n * dt_med
         t_m = (p1.start - p0.end) * dt_med
@@ -167,6 +322,15 @@ def _motions(
     return motions
 
 
+def unsaturated(motions: list[_Motion], saturated: npt.NDArray[np.bool_] | None) -> list[_Motion]:
+    """The motions with no sample on the gyro's rails between pose k's start and pose
+    k+1's end (``saturated`` per sample, None: none): the rotation across a clipped rate is
+    unknown, as across a gap in time."""
+    if saturated is None:
+        return motions
+    return [m for m in motions if not np.any(saturated[m.start : m.stop])]
+
+
 @dataclass(frozen=True, eq=False)
 class _Rotations:
     """The whitened residuals of the rotation fit (module docstring) and their Jacobians."""
@@ -175,14 +339,26 @@ class _Rotations:
     dt_s: FloatArray
     dt_med: float
     motions: list[_Motion]
-    turns: Sequence[tuple[Section, int]]
-    dir_sigma_rad: FloatArray
+    turns: Sequence[Turn]
     rate_sigma_rad_s: float
     latitude_deg: float | None
+    tilt_var: float = 0.0
+    """τ²: the variance [rad²] of a turn's axis lean off ``e_j`` per component beyond the
+    face's noise (:func:`_turn_axis_scatter`)."""
+    free: tuple[int, ...] = tuple(range(9))
+    """The elements of E fitted (row-major, :data:`GYRO_MODELS`); the others stay 0."""
 
     @property
     def n_rows(self) -> int:
         return 3 * len(self.motions) + 3 * len(self.turns)
+
+    def across_rows(self) -> FloatArray:
+        """Indices of the turns' across-axis rows (the whitening is diagonal in body axes:
+        row ``axis`` of a turn's three is along it, the other two across)."""
+        n_m = 3 * len(self.motions)
+        out = [n_m + 3 * t_i + k for t_i, tn in enumerate(self.turns) for k in range(3)
+               if k != tn.axis]  # fmt: skip
+        return np.asarray(out, dtype=np.int64)
 
     def evaluate(
         self, e: FloatArray, b: FloatArray, u: FloatArray, jac: bool
@@ -197,7 +373,7 @@ class _Rotations:
         j = np.zeros((n_rows, 9))
         jb = np.zeros((n_rows, 3))
         atts: list[tuple[FloatArray, FloatArray]] = []
-        turn_info: list[tuple[FloatArray, float, float, FloatArray]] = []
+        turn_info: list[tuple[FloatArray, FloatArray, FloatArray]] = []
         for m_i, mo in enumerate(motions):
             sl = slice(mo.start, mo.stop)
             wc = (rate_rad_s[sl] - b) @ ie_inv.T
@@ -215,17 +391,18 @@ class _Rotations:
                 px = skew(p) @ rot.T
                 j[3 * m_i : 3 * m_i + 3] = px @ sij * s
                 jb[3 * m_i : 3 * m_i + 3] = px @ d.sum(axis=0) * dt_med * s
-        for t_i, (sec, k) in enumerate(turns):
-            sl = slice(sec.start, sec.end)
+        for t_i, tn in enumerate(turns):
+            sl = slice(tn.section.start, tn.section.end)
             wc = (rate_rad_s[sl] - b) @ ie_inv.T
-            tau = dt_s[sl][:, None]
+            tau = turn_intervals(dt_s, tn.section, dt_med)[:, None]
             tot = (wc * tau).sum(axis=0)
-            sense = 1.0 if float(tot @ u[k]) >= 0 else -1.0
-            t_turn = sec.n * dt_med
-            vert, w_mat = self._turn_whitening(wc, tau, u[k], t_turn, self.dir_sigma_rad[k])
+            sense = 1.0 if float(tot[tn.axis]) >= 0 else -1.0
+            t_turn = tn.section.n * dt_med
+            vert, w_mat = self._turn_whitening(wc, tau, tn, t_turn)
             row = slice(3 * len(motions) + 3 * t_i, 3 * len(motions) + 3 * t_i + 3)
-            r[row] = w_mat @ (tot - (2.0 * math.pi * sense + vert) * u[k])
-            turn_info.append((tot, sense, vert, w_mat))
+            want = 2.0 * math.pi * sense * np.eye(3)[tn.axis] + vert * tn.up
+            r[row] = w_mat @ (tot - want)
+            turn_info.append((tot, want, w_mat))
             if jac:
                 # ∂/∂E_ij of Σ (I+E)⁻¹ ω' τ ≈ −e_i Σ ω_cj τ ; ∂/∂b ≈ −T I
                 colsum = (wc * tau).sum(axis=0)
@@ -237,13 +414,17 @@ class _Rotations:
         return r, j, jb, (atts, turn_info)
 
     def _turn_whitening(
-        self, wc: FloatArray, tau: FloatArray, u: FloatArray, t_turn: float, dir_sigma: float
+        self, wc: FloatArray, tau: FloatArray, tn: Turn, t_turn: float
     ) -> tuple[float, FloatArray]:
         """The vertical earth rate's angle over a turn [rad] and ``C^(−1/2)`` of the turn's
-        residual covariance (module docstring)."""
+        residual covariance (module docstring), along and across the named axis (the
+        horizontal earth rate, across ``up``, counted across the axis: ``up`` is the axis
+        of a turn on a level table)."""
         om = units.EARTH_RATE_RAD_S
         along = self.rate_sigma_rad_s**2 * self.dt_med * t_turn
-        across = along + (2 * math.pi * dir_sigma) ** 2
+        lean = (2 * math.pi) ** 2 * self.tilt_var
+        across = along + (2 * math.pi * tn.axis_sigma_rad) ** 2 + lean
+        along += 2.0 * (2 * math.pi * self.tilt_var) ** 2
         if self.latitude_deg is None:
             vert = 0.0
             along += (om * t_turn) ** 2 / 3.0
@@ -251,10 +432,10 @@ class _Rotations:
         else:
             lat = math.radians(self.latitude_deg)
             vert = om * math.sin(lat) * t_turn
-            psi = np.cumsum((wc @ u) * tau[:, 0])
+            psi = np.cumsum((wc @ tn.up) * tau[:, 0])
             rho = abs(complex(np.mean(np.exp(1j * psi))))
             across += (om * math.cos(lat) * t_turn * rho) ** 2 / 2.0
-        uu = np.outer(u, u)
+        uu = np.outer(np.eye(3)[tn.axis], np.eye(3)[tn.axis])
         return vert, uu / math.sqrt(along) + (np.eye(3) - uu) / math.sqrt(across)
 
 
@@ -267,13 +448,50 @@ def _solve_error_matrix(
 ) -> FloatArray:
     """Gauss-Newton on E from E = 0 until the largest step is below 1e-10."""
     e = np.zeros((3, 3))
+    free = list(rot.free)
     for _ in range(max_iter):
         r, j, _jb, _atts = rot.evaluate(e, bias_rad_s, up, jac=True)
-        step, *_ = np.linalg.lstsq(j * _SCALE, -r, rcond=None)
-        e = e + (step * _SCALE).reshape(3, 3)
+        step, *_ = np.linalg.lstsq(j[:, free] * _SCALE, -r, rcond=None)
+        full = np.zeros(9)
+        full[free] = step
+        e = e + (full * _SCALE).reshape(3, 3)
         if float(np.max(np.abs(step * _SCALE))) < 1e-10:
             break
     return e
+
+
+def _turn_axis_scatter(
+    rot: _Rotations, e: FloatArray, bias_rad_s: FloatArray, up: FloatArray, max_iter: int
+) -> tuple[_Rotations, FloatArray]:
+    """The turns' axis lean by Helmert's variance-component estimate (Koch, *Parameter
+    Estimation and Hypothesis Testing in Linear Models*, 1999, §3.6): a hand's turn
+    wobbles, its axis leans off ``e_j`` by more than the face's noise, and the
+    misalignments would take that lean as theirs with the turns' small σ.  The lean, of
+    variance τ² per component, adds ``(2π)² τ²`` across the axis and ``2 (2π τ²)²`` along
+    it (``2π (1 − cos θ)`` ≈ ``π θ²``: mean and sd ``2π τ²``).  With the redundancy of the
+    across rows ``r_a = n_a − tr(H_aa)`` (``H`` the hat matrix of the whitened fit) and
+    ``f = e_aᵀe_a / r_a``, ``τ² ← τ² + (f − 1) C_a / (2π)²`` (``C_a`` the rows' mean
+    across variance) and E is fitted again, until f settles (at most 8 times), when the
+    first f exceeds ``1 + 3√(2/r_a)``; the motions then hold what the turns cannot."""
+    rows = rot.across_rows()
+    if rows.size == 0 or not rot.motions:
+        return rot, e
+    for it in range(8):
+        r, j, _jb, (_a, turn_info) = rot.evaluate(e, bias_rad_s, up, jac=True)
+        u_, s_, _vt = np.linalg.svd(j[:, list(rot.free)], full_matrices=False)
+        keep = s_ > 1e-12 * s_[0]
+        hat = np.sum(u_[:, keep] ** 2, axis=1)
+        red = float(rows.size - hat[rows].sum())
+        if red < 0.05:
+            break
+        f = float(r[rows] @ r[rows]) / red
+        if (it == 0 and f <= 1.0 + 3.0 * math.sqrt(2.0 / red)) or abs(f - 1.0) < 0.01:
+            break
+        across = float(np.mean([1.0 / float(np.min(np.diag(w))) ** 2 for *_x, w in turn_info]))
+        tau2 = rot.tilt_var + (f - 1.0) * across / (2 * math.pi) ** 2
+        rot = replace(rot, tilt_var=max(0.0, tau2))
+        e = _solve_error_matrix(rot, bias_rad_s, up, max_iter)
+    return rot, e
 
 
 def _error_matrix_cov(
@@ -298,14 +516,16 @@ def _error_matrix_cov(
     covariance ``I + J_b C_b J_bᵀ + G C_a Gᵀ`` (a bias error known to be there is not
     taken for unmodelled scatter and counted a second time); ``(JᵀJ)⁻¹`` is scaled by it
     only when above ``1 + 3√(2/ν)``."""
-    _u, s_, vt = np.linalg.svd(j * _SCALE, full_matrices=False)
+    free = list(rot.free)
+    _u, s_, vt = np.linalg.svd(j[:, free] * _SCALE, full_matrices=False)
     if not s_[-1] > 1e-6 * s_[0]:
         raise DesignError(
             "the rotations between poses are all about one axis (or too small): the gyro's "
             "scale factors and misalignments of the other axes are unseen; turn the board "
             "about at least two different axes between poses"
         )
-    cov0 = (vt.T / s_**2) @ vt * _SCALE**2  # (JᵀJ)⁻¹ of E's nine elements
+    cov0 = np.zeros((9, 9))  # (JᵀJ)⁻¹ of E's fitted elements, 0 for those held at 0
+    cov0[np.ix_(free, free)] = (vt.T / s_**2) @ vt * _SCALE**2
     gain = cov0 @ j.T  # K = (JᵀJ)⁻¹ Jᵀ (whitened)
     # the accelerometer's uncertainty through u (numerical derivative of the residuals)
     ga = np.zeros((rot.n_rows, accel_free.size))
@@ -313,10 +533,10 @@ def _error_matrix_cov(
         h = max(1e-6, 1e-3 * math.sqrt(max(float(accel_free_cov[q, q]), 0.0)))
         pq = accel_free.copy()
         pq[q] += h
-        r_q = _residuals_fixed_att(rot.motions, rot.turns, held, up_of(pq), r)
+        r_q = _residuals_fixed_att(rot.motions, held, up_of(pq), r)
         ga[:, q] = (r_q - r) / h
     c_sys = jb @ bias_cov @ jb.T + ga @ accel_free_cov @ ga.T
-    dof = (2 * len(rot.motions) + 3 * len(rot.turns)) - 9
+    dof = (2 * len(rot.motions) + 3 * len(rot.turns)) - len(free)
     c_rows = np.eye(rot.n_rows) + c_sys
     chi2 = float(r @ np.linalg.solve(c_rows, r)) / dof if dof > 0 else float("nan")
     cov_p = cov0
@@ -356,31 +576,40 @@ def fit_rotations(
     bias_cov: FloatArray,
     dir_sigma_rad: FloatArray,
     rate_sigma_rad_s: float,
-    turns: Sequence[tuple[Section, int]] = (),
+    turns: Sequence[Turn] = (),
     *,
     latitude_deg: float | None = None,
     max_iter: int = 8,
+    saturated: npt.NDArray[np.bool_] | None = None,
+    model: str = "full",
 ) -> GyroFit:
     """``E_g`` from the motions between consecutive ``poses`` (module docstring).
 
     ``up_of(p)`` gives the poses' calibrated unit up directions (m, 3) for accelerometer
     parameters ``p`` (``accel_free`` at the solution, covariance ``accel_free_cov``);
     ``dir_sigma_rad`` (m,) the noise of each pose's direction; ``turns`` the 360° turns with
-    the index of the pose before each; ``latitude_deg`` (None: unknown) the earth rate's
-    split into the vertical, known, and the horizontal, of unknown heading."""
+    their named axes (:class:`Turn`); ``latitude_deg`` (None: unknown) the earth rate's
+    split into the vertical, known, and the horizontal, of unknown heading; ``model`` the
+    elements of E fitted (:data:`GYRO_MODELS`: ``full`` nine, ``scale`` three)."""
+    if model not in GYRO_MODELS:
+        raise ThermocalInputError(f"gyro model {model!r}: one of {', '.join(GYRO_MODELS)}")
     dt_med = float(np.median(dt_s))
     up = up_of(accel_free)
     motions = _motions(dt_s, poses, dt_med, dir_sigma_rad, rate_sigma_rad_s, latitude_deg)
-    rot = _Rotations(rate_rad_s, dt_s, dt_med, motions, turns, dir_sigma_rad,
-                     rate_sigma_rad_s, latitude_deg)  # fmt: skip
-    if rot.n_rows < 9 + 3:
+    motions = unsaturated(motions, saturated)
+    rot = _Rotations(rate_rad_s, dt_s, dt_med, motions, turns, rate_sigma_rad_s,
+                     latitude_deg, free=GYRO_MODELS[model])  # fmt: skip
+    three_turns = {tn.axis for tn in turns} == {0, 1, 2}
+    if rot.n_rows < len(rot.free) + 3 and not three_turns:
         raise DesignError(
-            f"{len(motions)} motions between static poses: the gyro's scale factors and "
-            "misalignments need rotations about at least two different axes (and a still "
-            "pose before and after each)"
+            f"{len(motions)} motions between static poses (none across a gap in time) and "
+            f"{len(turns)} named turns: the gyro's scale factors and misalignments need "
+            "rotations about at least two different axes with a still pose before and "
+            "after each, or the three turns x_rot, y_rot, z_rot"
         )
     r0, _j, _jb, _a = rot.evaluate(np.zeros((3, 3)), bias_rad_s, up, jac=False)
     e = _solve_error_matrix(rot, bias_rad_s, up, max_iter)
+    rot, e = _turn_axis_scatter(rot, e, bias_rad_s, up, max_iter)
     r, j, jb, held = rot.evaluate(e, bias_rad_s, up, jac=True)
     cov_p, chi2 = _error_matrix_cov(
         rot, r, j, jb, held, up_of, accel_free, accel_free_cov, bias_cov
@@ -398,30 +627,69 @@ def fit_rotations(
         chi2,
         len(motions),
         len(turns),
+        math.sqrt(rot.tilt_var),
+        model,
     )
 
 
+def too_few_motions(fit: GyroFit) -> bool:
+    """Whether the motions cannot carry the model's elements of E: a redundancy
+    (:attr:`GyroFit.dof`) below the number of elements fitted, with a misfit beyond the
+    noise (reduced χ² above ``1 + 3√(2/ν)``, ν the dof).
+
+    A least-squares fit of ``u`` unknowns on ``n`` rows averages an unmodelled error of
+    the rows over their redundancy ``n − u`` only (the hat matrix keeps ``u/n`` of each
+    row's error in the fit, Koch 1999, §3.2): with fewer redundant rows than unknowns, a
+    misfit of the motions (χ² ≫ 1: something the model does not hold) goes mostly into
+    E.  A session of a hand-held consumer IMU (six usable motions for nine elements,
+    reduced χ² 704: tomisuarez2/ImuCalibration's MPU-6050) is one; fitting only the scale
+    factors (``model="scale"``) leaves it nine rows of redundancy.
+
+    Parameters
+    ----------
+    fit : GyroFit
+        The fit to judge.
+
+    Returns
+    -------
+    bool
+        True when the redundancy is below the number of elements fitted and the reduced
+        χ² is significant.
+    """
+    nu = fit.dof
+    if nu <= 0:
+        return True
+    significant = fit.reduced_chi2 > 1.0 + 3.0 * math.sqrt(2.0 / nu)
+    return nu < len(GYRO_MODELS[fit.model]) and significant
+
+
 def _residuals_fixed_att(
-    motions: Sequence[_Motion],
-    turns: Sequence[tuple[Section, int]],
-    held: _Held,
-    u: FloatArray,
-    r_ref: FloatArray,
+    motions: Sequence[_Motion], held: _Held, u: FloatArray, r_ref: FloatArray
 ) -> FloatArray:
-    """The whitened residuals for other up directions ``u``, the attitudes (and the turns'
-    integrated rates) held."""
-    atts, turn_info = held
+    """The whitened residuals for other up directions ``u`` of the poses, the attitudes
+    held (the turns' rows, about the calibrated frame's named axes, do not move with the
+    poses' directions)."""
+    atts, _turn_info = held
     out = r_ref.copy()
     for m_i, mo in enumerate(motions):
         a0, a1 = atts[m_i]
         s = 1.0 / math.sqrt(mo.var)
         out[3 * m_i : 3 * m_i + 3] = (u[mo.pose_k1] - _direction(u[mo.pose_k], a0, a1)) * s
-    for t_i, ((_sec, k), (tot, sense, vert, w_mat)) in enumerate(
-        zip(turns, turn_info, strict=True)
-    ):
-        row = slice(3 * len(motions) + 3 * t_i, 3 * len(motions) + 3 * t_i + 3)
-        out[row] = w_mat @ (tot - (2.0 * math.pi * sense + vert) * u[k])
     return out
 
 
-__all__ = ["GyroFit", "fit_rotations", "static_bias"]
+__all__ = [
+    "GAP_FACTOR",
+    "GYRO_MODELS",
+    "TURN_ANGLE_TOLERANCE",
+    "TURN_AXIS_TOLERANCE_DEG",
+    "GyroFit",
+    "Turn",
+    "check_turn",
+    "fit_rotations",
+    "static_bias",
+    "too_few_motions",
+    "turn_gap",
+    "turn_intervals",
+    "turn_rotation",
+]

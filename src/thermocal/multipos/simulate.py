@@ -129,8 +129,14 @@ FERRARIS_TURNS: dict[str, tuple[str, float]] = {
     "y_a": ("y_rot", -1.0),
     "z_p": ("z_rot", -1.0),
 }
-"""The Ferraris session's 360° turns: after which face, its name, and its sense about the
-local vertical (+1 counter-clockwise seen from above): one of them the other way."""
+"""The Ferraris session's 360° turns: the face the board lies on during it, its name, and
+its sense about the local vertical (+1 counter-clockwise seen from above): one of them
+the other way."""
+
+FERRARIS_ORDERS = ("faces-then-turns", "turn-after-face")
+"""How a Ferraris session is recorded: the six faces, then the three turns, each from
+whatever pose the board is in (imucal's guide, what users record); or each turn right
+after its face."""
 
 
 def face_rotation(face: str, heading_rad: float = 0.0) -> FloatArray:
@@ -159,33 +165,49 @@ def simulate_ferraris(
     dwell_s: float = 5.0,
     move_s: float = 2.0,
     turn_s: float = 6.0,
+    turn_tilt_deg: float = 0.0,
     accel_noise_mg: float = 2.0,
     gyro_noise_deg_s: float = 0.03,
     tremor_deg: float = 0.003,
     latitude_deg: float = 45.0,
+    order: str = "faces-then-turns",
 ) -> dict[str, Any]:
     """A Ferraris session (imucal's form): the six faces ``x_p``, ``y_p``, ``z_p``, ``x_a``,
     ``y_a``, ``z_a`` in that order (no flip to the opposite face: a half turn; random
-    headings, each move between 30° and 150°)
-    and, after the faces of :data:`FERRARIS_TURNS`, a full 360° turn about the vertical
-    over ``turn_s`` with the sense given there.  As :func:`simulate_session`, plus
-    ``sections``: the POSES file's object ``{name: {"start": i, "end": j}}`` (faces and
-    turns)."""
-    order = ("x_p", "y_p", "z_p", "x_a", "y_a", "z_a")  # no face after its opposite
+    headings, each move between 30° and 150°) and the three full 360° turns about the
+    vertical over ``turn_s``, each with the board on the face and in the sense of
+    :data:`FERRARIS_TURNS`.  ``order`` (:data:`FERRARIS_ORDERS`): ``faces-then-turns``
+    (what users record, imucal's guide), the turns after the six faces, ``x_rot``,
+    ``y_rot``, ``z_rot``, each from the pose the board is in: moved onto the turn's face
+    (a new heading), held still ``dwell_s`` (a pose that is no section), turned and moved
+    on; ``turn-after-face``, each turn right after its face.  ``turn_tilt_deg``: each
+    turn's axis tilted from the vertical by that angle about a random horizontal axis
+    (a box not flat against its guide, a hand's wobble).  As
+    :func:`simulate_session`, plus ``sections``: the POSES file's object
+    ``{name: {"start": i, "end": j}}`` (faces and turns); ``poses`` lists every still
+    window (with the faces-then-turns order, the three before the turns too)."""
+    if order not in FERRARIS_ORDERS:
+        raise ValueError(f"order must be one of {FERRARIS_ORDERS}, got {order!r}")
+    faces = ["x_p", "y_p", "z_p", "x_a", "y_a", "z_a"]  # no face after its opposite
+    if order == "faces-then-turns":
+        at = faces + list(FERRARIS_TURNS)  # the turns' faces, in x, y, z order
+        turn_after = {6 + i: sense for i, (_n, sense) in enumerate(FERRARIS_TURNS.values())}
+    else:
+        at = faces
+        turn_after = {faces.index(f): sense for f, (_n, sense) in FERRARIS_TURNS.items()}
     cs: list[FloatArray] = []
-    for f in order:  # headings that keep every move well short of a half turn
+    for f in at:  # headings that keep every move well short of a half turn
         c = face_rotation(f, rng.uniform(0, 2 * math.pi))
         while cs and not 0.5 < np.linalg.norm(matrix_to_rotvec(cs[-1].T @ c)) < 2.6:
             c = face_rotation(f, rng.uniform(0, 2 * math.pi))
         cs.append(c)
-    turn_after = {order.index(f): sense for f, (_n, sense) in FERRARIS_TURNS.items()}
-    spec = _Spec(rate_hz, dwell_s, move_s, tremor_deg, turn_s)
+    spec = _Spec(rate_hz, dwell_s, move_s, tremor_deg, turn_s, turn_tilt_deg)
     w_nb, poses, turns = _body_rates(rng, cs, turn_after, spec)
     out = _measure(rng, cs[0], w_nb, poses, accel_theta, gyro_theta, accel_noise_mg,
                    gyro_noise_deg_s, latitude_deg, rate_hz)  # fmt: skip
-    sections = {f: {"start": a, "end": b} for f, (a, b) in zip(order, poses, strict=True)}
+    sections = {f: {"start": a, "end": b} for f, (a, b) in zip(faces, poses, strict=False)}
     for k, (a, b) in turns.items():
-        sections[FERRARIS_TURNS[order[k]][0]] = {"start": a, "end": b}
+        sections[FERRARIS_TURNS[at[k]][0]] = {"start": a, "end": b}
     out["sections"] = sections
     return out
 
@@ -197,6 +219,7 @@ class _Spec:
     move_s: float
     tremor_deg: float
     turn_s: float
+    turn_tilt_deg: float = 0.0
 
 
 def _body_rates(
@@ -228,6 +251,11 @@ def _body_rates(
         if k in turn_after:
             # a full turn about the vertical: the body axis now up, back to c_now
             up_b = c_now.T @ np.array([0.0, 0.0, 1.0])
+            if spec.turn_tilt_deg:
+                h = rng.normal(size=3)
+                h -= (h @ up_b) * up_b
+                tilt = math.radians(spec.turn_tilt_deg) * h / np.linalg.norm(h)
+                up_b = _rodrigues(tilt) @ up_b
             n_t = round(spec.turn_s * spec.rate_hz)
             s = (1 - np.cos(np.pi * np.arange(n_t + 1) / n_t)) / 2
             rates.append(np.diff(s)[:, None] / dt * (2 * math.pi * turn_after[k]) * up_b)
@@ -383,6 +411,7 @@ def simulate_runs(
 
 
 __all__ = [
+    "FERRARIS_ORDERS",
     "FERRARIS_TURNS",
     "Truth",
     "face_rotation",

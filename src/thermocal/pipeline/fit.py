@@ -248,6 +248,7 @@ def _fit_channels(
             with warnings.catch_warnings(record=True) as caught:
                 warnings.simplefilter("always")
                 p.est.fit(p.runs)
+                _judge_fitted(spec, p)
             p.caught.extend(caught)
     return [(p.sig_name, *_finish_channel(spec, p)) for p in preps]
 
@@ -374,6 +375,24 @@ def _judge_channel(
         rate_interval_s=float(spec.options.get("rate_interval_s") or 60.0),
     )
     return judged.enforce().to_dict()
+
+
+def _judge_fitted(spec: _FitSpec, p: _Prepared) -> None:
+    """What only the fit knows, judged by the same rules (a piecewise model's segments,
+    ``segment_tests_``): refused unless overridden, added to the adequacy record."""
+    tests = tuple(getattr(p.est, "segment_tests_", ()))
+    if not tests:
+        return
+    try:
+        judged = _adequacy.Adequacy(tests, tuple(spec.overrides), p.sig_name).enforce()
+    except ThermocalInputError as exc:  # name the files, as a reader's error does
+        raise ThermocalInputError(f"{', '.join(str(r.name) for r in p.runs)}: {exc}") from None
+    rec = p.est.adequacy_
+    if rec is None:  # judged before the fit: always a record here
+        return
+    rec["tests"] = [*rec["tests"], *(t.to_dict() for t in tests)]
+    if judged.failed and rec["verdict"] == "pass":
+        rec["verdict"] = "overridden"
 
 
 def _finish_channel(

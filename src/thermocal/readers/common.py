@@ -342,12 +342,24 @@ TIME_COLUMN_NAMES = ("time", "t", "timestamp", "elapsed", "elapsed time")
 name (``time``, ``Time (ms)``, ``time_s``, ``timestamp_us``)."""
 
 
+TEMPERATURE_NAME = re.compile(r"^(t\d+|t_|temp|tmp)|temperature|°c|degc", re.IGNORECASE)
+"""Names a temperature column goes by (``T1``, ``t_die``, ``temp``, ``IMU temperature``,
+``chip (°C)``): guessed as temperatures by ``inspect``, never taken for time."""
+
+
+def named_like_temperature(name: str) -> bool:
+    """A column named like a temperature (:data:`TEMPERATURE_NAME`, or a capital ``T``
+    alone: ``t`` is time, ``T`` temperature)."""
+    return name.strip() == "T" or TEMPERATURE_NAME.search(name) is not None
+
+
 def default_time_column(names: Sequence[str], stated: str | None = None) -> str:
     """The time column when ``--time`` is not given: ``stated`` (the sidecar's), else
     ``time`` if present, else the one column whose name, with any unit stripped
     (:func:`thermocal.units.unit_in_column_name`), is one of :data:`TIME_COLUMN_NAMES`.
     Several candidates, or none, give ``"time"`` (and so a missing-column error that
-    lists what is there) rather than a guess.
+    lists what is there) rather than a guess.  A column named like a temperature
+    (:func:`named_like_temperature`: ``T``) is never taken for time.
     """
     if stated:
         return stated
@@ -355,6 +367,8 @@ def default_time_column(names: Sequence[str], stated: str | None = None) -> str:
         return "time"
     found = []
     for c in names:
+        if named_like_temperature(c):
+            continue  # ``T``, ``T1``, ``temp``: a temperature, never time
         base = c.strip()
         unit = units.unit_in_column_name(c, "time")
         if unit is not None:

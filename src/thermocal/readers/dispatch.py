@@ -16,6 +16,7 @@ from thermocal.errors import (
     MissingColumnError,
     NonNumericError,
     ThermocalInputError,
+    TimestampWarning,
     UnitWarning,
 )
 from thermocal.readers.common import (
@@ -26,6 +27,7 @@ from thermocal.readers.common import (
     csv_rows_estimate,
     default_time_column,
     file_kind,
+    named_like_temperature,
     names_list,
     short_name,
     thermocal_metadata,
@@ -33,9 +35,25 @@ from thermocal.readers.common import (
 from thermocal.readers.dataflash import read_dataflash
 from thermocal.readers.station import is_station_path, read_station_table, with_sensor
 from thermocal.readers.table import ParquetColumns, csv_header_names, load_sidecar, numeric_column
-from thermocal.readers.text import TextOptions, head_lines, rate_time, read_text, sniff_text
+from thermocal.readers.text import (
+    TextOptions,
+    counter_column,
+    counter_time,
+    head_lines,
+    rate_time,
+    read_text,
+    sniff_text,
+)
 from thermocal.readers.ulog import read_ulog
-from thermocal.recording import META_FORMAT, META_VERSION, FloatArray, Metadata, Recording
+from thermocal.recording import (
+    META_FORMAT,
+    META_VERSION,
+    FloatArray,
+    Metadata,
+    Recording,
+    all_finite,
+    nominal_time,
+)
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -129,7 +147,9 @@ def read_text_table(
     assert isinstance(obj, pd.DataFrame)
     names = list(obj.columns)
     if text.rate_hz is not None:
-        obj, names, t_col, t_unit = rate_time(p, obj, names, info, time, None, text)
+        obj, names, t_col, t_unit, _mode = rate_time(
+            p, obj, names, info, time, None, text, allow_column=False
+        )
         info["time"], info["time_unit"] = t_col, t_unit
     return obj, info
 
@@ -243,6 +263,21 @@ def _read_other_columns(
         unit_map[c] = units.other_column_unit(c, extra_units.get(c))
 
 
+def _time_hint(names: list[str]) -> str:
+    """What to give when no time column is found: ``--time`` or ``--rate``, naming a
+    sample counter (the time with ``--rate``) or a column named like a temperature (not
+    time) among ``names``."""
+    counter = counter_column(names)
+    temp_like = [n for n in names if named_like_temperature(n)]
+    if counter is not None:
+        why = f"; {short_name(counter)} is a sample counter: give --rate HZ"
+    elif temp_like:
+        why = f"; {short_name(temp_like[0])} is named like a temperature, not time"
+    else:
+        why = ""
+    return f" (name the time column with --time, or give --rate HZ for a log without one{why})"
+
+
 def _roles(
     p: Path,
     names: list[str],
@@ -250,22 +285,27 @@ def _roles(
     time: str | None,
     signals: list[str] | None,
     temperatures: list[str] | None,
+    guess_temperatures: bool = False,
 ) -> tuple[str, list[str], list[str]]:
     """The time, signal and temperature columns: as given, else as the file or its
-    sidecar says; a name the file does not have is refused, listing the available ones."""
+    sidecar says (else, with ``guess_temperatures``, the columns named like temperatures,
+    :func:`~thermocal.readers.common.named_like_temperature`); a name the file does not have is
+    refused, listing the available ones."""
     time_col = time or default_time_column(names, info.get("time"))
     sig_info: dict[str, str] = dict(info.get("signals") or {})
     tmp_info: dict[str, str] = dict(info.get("temperatures") or {})
     sig_names = list(signals) if signals is not None else list(sig_info)
     tmp_names = list(temperatures) if temperatures is not None else list(tmp_info)
+    if guess_temperatures and temperatures is None and not tmp_names:
+        tmp_names = [
+            c for c in names if named_like_temperature(c) and c != time_col and c not in sig_names
+        ]
     present = set(names)
     for c in [time_col, *sig_names, *tmp_names]:
         if c not in present:
-            hint = (
-                " (name the time column with --time, or give --rate HZ for a text log without one)"
-                if c == time_col and time is None
-                else ""
-            )
+            hint = ""
+            if c == time_col and time is None:
+                hint = _time_hint(names)
             raise MissingColumnError(
                 f"{p}: no column {short_name(c)}; available: {names_list(names)}{hint}"
             )
@@ -288,6 +328,82 @@ def _read_columns(
         obj.read_f64([time_col, *named])
     t = numeric_column(obj, time_col, p)
     return t, {c: numeric_column(obj, c, p) for c in named}
+
+
+def _n_rows(p: Path, obj: pd.DataFrame | ParquetColumns, names: list[str]) -> int:
+    """The table's number of rows; a table without columns or rows is refused."""
+    if not names:
+        raise FileFormatError(f"{p}: the file has no columns")
+    n_rows = obj.num_rows if isinstance(obj, ParquetColumns) else len(obj)
+    if n_rows == 0:
+        raise FileFormatError(f"{p}: the file has a header but no data rows")
+    return n_rows
+
+
+def _time_s(
+    p: Path, col: str, t: FloatArray, unit: str, mode: str | None, text: TextOptions | None
+) -> FloatArray:
+    """The time column ``t`` (as read, in ``unit``) in seconds: with ``--rate`` a sample
+    counter's ``n / rate`` (``mode`` ``"counter"``) or host stamps at the nominal rate
+    (``"stamps"``), as :func:`~thermocal.readers.text.rate_time` found them."""
+    rate = text.rate_hz if text is not None else None
+    if mode == "counter" and rate is not None:
+        return counter_time(p, col, t, rate)
+    if unit != "s":
+        t = t * units.TIME_UNITS[unit]
+    if mode == "stamps" and rate is not None:
+        t = _stamps_at_rate(p, col, t, rate)
+    return t
+
+
+STAMPS_RATE_RANGE = (0.8, 3.0)
+"""With ``--rate`` on a file with a time column, the mean step of its stamps must lie
+within these multiples of the nominal period (fewer samples than the rate: some lost;
+more, or far fewer: the wrong rate or time unit)."""
+
+
+STAMPS_RATE_TOLERANCE = 0.005
+"""With ``--rate`` on host timestamps, a rate the stamps' span contradicts by more than
+this fraction (lost samples counted) is stated in a warning: a wrong nominal rate lifts the
+latency floor by a period every few dozen samples, read as samples lost."""
+
+
+def _stamps_at_rate(p: Path, col: str, t: FloatArray, rate_hz: float) -> FloatArray:
+    """``--rate`` on a file whose time column holds host timestamps [s]: the samples at the
+    sensor's nominal rate (:func:`thermocal.recording.nominal_time`, lost samples kept as
+    gaps); refused when the stamps are not finite or their mean step is not near the
+    nominal period (:data:`STAMPS_RATE_RANGE`)."""
+    if t.size < 2:
+        return t
+    if not all_finite(t):
+        raise ThermocalInputError(
+            f"{p}: the time column {col!r} has missing or non-finite values; --rate "
+            f"{rate_hz:g} Hz takes the samples at the nominal rate only from finite stamps"
+        )
+    mean_step = float(t[-1] - t[0]) / (t.size - 1)
+    lo, hi = STAMPS_RATE_RANGE
+    if not lo / rate_hz <= mean_step <= hi / rate_hz:
+        raise ThermocalInputError(
+            f"{p}: --rate {rate_hz:g} Hz given but the file has a time column {col!r} whose "
+            f"samples are {mean_step:.6g} s apart on average ({1.0 / mean_step:.6g} Hz); "
+            "check --rate and --time-unit, or drop --rate"
+            if mean_step > 0
+            else f"{p}: --rate {rate_hz:g} Hz given but the file has a time column {col!r} "
+            "that does not advance; drop --rate"
+        )
+    out, lost = nominal_time(t, rate_hz)
+    seen_hz = (t.size - 1 + lost) / float(t[-1] - t[0])
+    if abs(seen_hz / rate_hz - 1.0) > STAMPS_RATE_TOLERANCE:
+        warnings.warn(
+            TimestampWarning(
+                f"{p}: --rate {rate_hz:g} Hz, but the time column {col!r} spans "
+                f"{float(t[-1] - t[0]):.6g} s for {t.size} samples "
+                f"({(t.size - 1) / float(t[-1] - t[0]):.6g} Hz) and {lost} more would be lost "
+                "at that rate; check --rate (the nominal rate, not a rounded one)"
+            ),
+            stacklevel=3,
+        )
+    return out
 
 
 def _conversions(
@@ -317,6 +433,9 @@ def read_recording(
     model: units.StatedUnits | None = None,
     text: TextOptions | None = None,
     topic: str | None = None,
+    guess_temperatures: bool = False,
+    ask_units: dict[str, str] | None = None,
+    implied_units: dict[str, str] | None = None,
 ) -> Recording:
     """Read a CSV, text log or Parquet recording, or a station's recording folder.
 
@@ -329,8 +448,7 @@ def read_recording(
     signals, temperatures : column names with those roles (default: sidecar's).
     signal_unit, temp_unit : units of those columns (override the sidecar); ``signal_unit``
         may be ``U1,…,Un``, one per signal.
-    meta : metadata that overrides the file's (its temperature conversions count as
-        options).
+    meta : metadata that overrides the file's (its temperature conversions count as options).
     keep_other : keep the other numeric columns (non-numeric ones are skipped).
     skipped : if a list is given, the names of skipped non-numeric columns are appended.
     temp_conversion : ``--temp-conversion``, the counts → °C conversion of every
@@ -342,11 +460,14 @@ def read_recording(
         ``--on-bad-lines``, ``--delimiter``, ``--decimal``); banners, other delimiters and
         decimal commas are detected without it.
     topic : a PX4 ULog's topic instance, ``NAME[.N]`` (default ``sensor_gyro.0``).
+    guess_temperatures : no temperatures given or in a sidecar: those named like one.
+    ask_units, implied_units : signal column → the option a :class:`UnitError` asks for,
+        or the unit another option implies (``counts``: a count scale), where nothing
+        states its unit (:class:`thermocal.units.UnitOptions`).
 
     Units and temperature conversions are resolved once by
     :func:`thermocal.units.resolve_inputs` (option > file metadata > column name > model
-    file > a default stated in a warning); the source of each is in
-    ``Recording.unit_sources``.
+    file > a default stated in a warning); each one's source is ``Recording.unit_sources``.
 
     Raises
     ------
@@ -359,28 +480,24 @@ def read_recording(
     obj, info = _open_table(p, text, topic)
 
     names = list(obj.column_names) if isinstance(obj, ParquetColumns) else list(obj.columns)
+    mode = None  # --rate: "rows", "counter" or "stamps" (rate_time)
     if text is not None and text.rate_hz is not None:
-        obj, names, time, time_unit = rate_time(p, obj, names, info, time, time_unit, text)
-    if not names:
-        raise FileFormatError(f"{p}: the file has no columns")
-    n_rows = obj.num_rows if isinstance(obj, ParquetColumns) else len(obj)
-    if n_rows == 0:
-        raise FileFormatError(f"{p}: the file has a header but no data rows")
+        obj, names, time, time_unit, mode = rate_time(p, obj, names, info, time, time_unit, text)
+    n_rows = _n_rows(p, obj, names)
     md = Metadata.from_dict(dict(info.get("metadata") or {}))
     if meta is not None:
         md = md.merged(meta)
-    time_col, sig_names, tmp_names = _roles(p, names, info, time, signals, temperatures)
-    options = units.UnitOptions(
-        time_unit=time_unit,
-        signal_unit=signal_unit,
-        temp_unit=temp_unit,
-        temp_conversion=temp_conversion,
+    time_col, sig_names, tmp_names = _roles(
+        p, names, info, time, signals, temperatures, guess_temperatures
     )
+    options = units.UnitOptions(  # a counter / rate is in s
+        "s" if mode == "counter" else time_unit, signal_unit, temp_unit, temp_conversion,
+        dict(ask_units or {}), dict(implied_units or {}),
+    )  # fmt: skip
     resolved = _resolve_units(p, info, (time_col, sig_names, tmp_names), options, meta, model)
     n_used = len(names) if keep_other else 1 + len(sig_names) + len(tmp_names)
     t, cols = _read_columns(p, obj, n_rows, n_used, time_col, [*sig_names, *tmp_names])
-    if resolved.time.unit != "s":
-        t = t * units.TIME_UNITS[resolved.time.unit]
+    t = _time_s(p, time_col, t, resolved.time.unit, mode, text)
     unit_map: dict[str, str] = resolved.units()
     md.temperature_conversion = _conversions(md, tmp_names, resolved)
     if keep_other:

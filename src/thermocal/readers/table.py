@@ -199,8 +199,10 @@ def numeric_column(
     bad = conv.isna() & series.notna() & (series.astype(str).str.strip() != "")
     if bad.any():
         row = row_offset + int(np.argmax(bad.to_numpy()))
+        lines = obj.attrs.get("file_lines")  # a text log's lines (banner, comments skipped)
+        line = int(lines[row]) if lines is not None and row < len(lines) else row + 2
         raise NonNumericError(
             f"{p}: non-numeric value {short_name(str(series.iloc[row - row_offset]))} in column "
-            f"{short_name(name)} at row {row} (line {row + 2} of the file)"
+            f"{short_name(name)} at row {row} (line {line} of the file)"
         )
     return conv.to_numpy(dtype=np.float64, na_value=np.nan)

@@ -12,14 +12,16 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from thermocal import units
 from thermocal._lazy import LazyModule
 from thermocal.errors import (
     FileFormatError,
     TextLayoutWarning,
     ThermocalInputError,
 )
-from thermocal.readers.common import check_unique_names
+from thermocal.readers.common import TIME_COLUMN_NAMES, check_unique_names
 from thermocal.readers.table import ParquetColumns
+from thermocal.recording import FloatArray
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -102,6 +104,9 @@ class TextLayout:
     decimal: str
     header: bool
     n_fields: int
+    text_columns: tuple[int, ...] = ()
+    """Positions of the fields that hold text on (nearly) every data line (a MAC address,
+    a device name): kept as text, never parsed as numbers (:data:`TEXT_COLUMN_SHARE`)."""
 
     @property
     def plain(self) -> bool:
@@ -157,26 +162,56 @@ def sniff_text(lines: Sequence[str], opts: TextOptions | None = None) -> TextLay
     counts_d = [len(_split(x, d)) for x in body]
     m = max(set(c for c in counts_d if c >= 2) or {1}, key=counts_d.count)
     decimals = [o.decimal] if o.decimal else ([".", ","] if d != "," else ["."])
+    fields_m = [f for f in (_split(x, d) for x in body) if len(f) == m]
+    texts = {c: _text_positions(fields_m, c) for c in decimals}
 
     def numeric(line: str, dec: str) -> bool:
         f = _split(line, d)
-        return len(f) == m and all(_is_number(x, dec, empty=True) for x in f)
+        tp = texts[dec]
+        return (
+            len(f) == m
+            and len(tp) < m
+            and all(_is_number(x, dec, empty=True) for j, x in enumerate(f) if j not in tp)
+        )
 
-    # the decimal mark under which most lines of m fields are numbers (ties: ".")
-    dec = max(decimals, key=lambda c: (sum(numeric(x, c) for x in body), c == "."))
+    # the decimal mark under which most lines of m fields are numbers, with the fewest
+    # text columns (ties: ".")
+    dec = max(decimals, key=lambda c: (sum(numeric(x, c) for x in body), -len(texts[c]), c == "."))
     for k, line in enumerate(lines):
         if not line.strip() or line.lstrip().startswith("#") or len(_split(line, d)) != m:
             continue
         if numeric(line, dec):
-            return TextLayout(k, _banner(lines[:k]), d, dec, False, m)
+            return TextLayout(k, _banner(lines[:k]), d, dec, False, m, texts[dec])
         names = _split(line, d)
         nxt = next((x for x in lines[k + 1 :] if x.strip()), None)
         is_names = all(f and not _is_number(f, dec) for f in names)
         if is_names and nxt is not None and len(_split(nxt, d)) == m:
-            return TextLayout(k, _banner(lines[:k]), d, dec, True, m)
+            return TextLayout(k, _banner(lines[:k]), d, dec, True, m, texts[dec])
     raise FileFormatError(
         f"no line of {m} numeric fields separated by {d!r} was found (give --delimiter and "
         "--decimal if the log uses others)"
+    )
+
+
+TEXT_COLUMN_SHARE = 0.9
+"""A field that is not a number on at least this share of the lines that hold numbers
+elsewhere is a text column (:func:`_text_positions`)."""
+
+
+def _text_positions(rows: Sequence[Sequence[str]], decimal: str) -> tuple[int, ...]:
+    """The positions of ``rows`` (lines split into fields) that are text columns: among the
+    lines with at least one number, those where the field is not a number on at least
+    :data:`TEXT_COLUMN_SHARE` of them (a MAC address beside the samples).  A header (no
+    number) does not count; a line with a stray word is a mangled line, not a column."""
+    mixed = [f for f in rows if any(_is_number(x, decimal) for x in f)]
+    if not mixed:
+        return ()
+    m = len(mixed[0])
+    return tuple(
+        j
+        for j in range(m)
+        if sum(not _is_number(f[j], decimal, empty=True) for f in mixed)
+        >= TEXT_COLUMN_SHARE * len(mixed)
     )
 
 
@@ -263,10 +298,16 @@ def _column_names(path: Path, head: list[str], lay: TextLayout, o: TextOptions) 
 
 def _data_rows(
     path: Path, encoding: str, lay: TextLayout, n: int, on_bad_lines: str
-) -> tuple[list[list[float]], list[int], list[tuple[int, str]]]:
-    """The data rows as floats, each kept row's place among the data lines, and the
-    mangled lines dropped (line number, text): another number of fields than ``n``, or a
-    non-number, is an error naming the line unless ``on_bad_lines`` is ``"skip"``."""
+) -> tuple[list[list[float]], list[int], list[tuple[int, str]], dict[int, list[str]], list[int]]:
+    """The data rows as floats, each kept row's place among the data lines, the mangled
+    lines dropped (line number, text), the text columns' fields (position → the kept
+    rows' texts; NaN stands in their place among the floats) and each kept row's line in
+    the file (for messages): another number of fields
+    than ``n``, or a non-number outside a text column, is an error naming the line unless
+    ``on_bad_lines`` is ``"skip"``."""
+    tp = set(lay.text_columns)
+    texts: dict[int, list[str]] = {j: [] for j in lay.text_columns}
+    linenos: list[int] = []  # each kept row's line in the file (1-based)
     first_data = lay.skip + (1 if lay.header else 0)  # 0-based line of the first data row
     bad: list[tuple[int, str]] = []
     rows: list[list[float]] = []
@@ -285,9 +326,17 @@ def _data_rows(
                 if len(fields) != n:
                     raise ValueError(f"{len(fields)} fields, {n} expected")
                 rows.append(
-                    [parse_number(f.replace(",", ".") if lay.decimal == "," else f) for f in fields]
+                    [
+                        math.nan
+                        if j in tp
+                        else parse_number(f.replace(",", ".") if lay.decimal == "," else f)
+                        for j, f in enumerate(fields)
+                    ]
                 )
+                for j in tp:
+                    texts[j].append(fields[j])
                 ordinal.append(n_data - 1)
+                linenos.append(lineno)
             except ValueError as exc:
                 if on_bad_lines == "error":
                     raise FileFormatError(
@@ -295,7 +344,7 @@ def _data_rows(
                         "fix it or pass --on-bad-lines skip to drop such lines"
                     ) from None
                 bad.append((lineno, text))
-    return rows, ordinal, bad
+    return rows, ordinal, bad, texts, linenos
 
 
 def read_text(
@@ -312,10 +361,13 @@ def read_text(
     except FileFormatError as exc:
         raise FileFormatError(f"{path}: {exc}") from None
     names = _column_names(path, head, lay, o)
-    rows, ordinal, bad = _data_rows(path, encoding, lay, len(names), o.on_bad_lines)
+    rows, ordinal, bad, texts, linenos = _data_rows(path, encoding, lay, len(names), o.on_bad_lines)
     if not rows:
         raise FileFormatError(f"{path}: the file has a header but no data rows")
     df = pd.DataFrame(np.asarray(rows, dtype=np.float64), columns=names)
+    df.attrs["file_lines"] = np.asarray(linenos, dtype=np.int64)  # for messages
+    for j, values in texts.items():  # kept as text: refused only where a command uses it
+        df[names[j]] = pd.Series(values, dtype=object)
     # --rate: time = data-line number / rate, so a dropped line leaves a gap, not a shift
     df.attrs["row_index"] = np.asarray(ordinal, dtype=np.float64)
     report: dict[str, Any] = {
@@ -354,6 +406,28 @@ def read_text(
     return df, report
 
 
+COUNTER_COLUMN_NAMES = (
+    "n_samples",
+    "samples",
+    "sample",
+    "sample_index",
+    "counter",
+    "count",
+    "index",
+    "idx",
+    "seq",
+    "n",
+)
+"""Names a sample counter goes by (compared without case): with ``--rate`` such a column is
+the time, ``counter / rate`` (imucal's sessions: ``n_samples``)."""
+
+
+def counter_column(names: Sequence[str]) -> str | None:
+    """The one column named like a sample counter (:data:`COUNTER_COLUMN_NAMES`), else None."""
+    found = [c for c in names if c.strip().lower() in COUNTER_COLUMN_NAMES]
+    return found[0] if len(found) == 1 else None
+
+
 def rate_time(
     p: Path,
     obj: Any,
@@ -362,23 +436,44 @@ def rate_time(
     time: str | None,
     time_unit: str | None,
     text: TextOptions,
-) -> tuple[Any, list[str], str, str]:
-    """``--rate``: a file without a time column gets ``time = row / rate`` [s], the row
-    counted among the log's data lines (a mangled line dropped leaves a gap); a file that
-    has a time column is refused (say which to believe)."""
+    *,
+    allow_column: bool = True,
+) -> tuple[Any, list[str], str, str | None, str]:
+    """``--rate``: the time of each sample at the stated rate, and how it is found (the
+    last item): ``"rows"`` — a file without a time column gets ``time = row / rate`` [s],
+    the row counted among the log's data lines (a mangled line dropped leaves a gap);
+    ``"counter"`` — a sample counter (``--time N``, or the one column named like one,
+    :data:`COUNTER_COLUMN_NAMES`) is the time, ``counter / rate`` (:func:`counter_time`);
+    ``"stamps"`` — a time column (host timestamps) is replaced by the nominal grid
+    (:func:`thermocal.recording.nominal_time`).  The last two are read by the caller;
+    without ``allow_column`` (a command that streams the file) a time column is refused."""
     assert text.rate_hz is not None
     named = time or info.get("time")
-    if named and named in names:
-        raise ThermocalInputError(
-            f"{p}: --rate {text.rate_hz:g} Hz given but the file has a time column "
-            f"{named!r}; drop --rate (or name another column with --time)"
-        )
+    if named is None and "time" not in names:
+        named = counter_column(names)
     col = named or "time"
     if col in names:
-        raise ThermocalInputError(
-            f"{p}: --rate {text.rate_hz:g} Hz given but the file has a time column {col!r}; "
-            "drop --rate"
+        is_counter = col.strip().lower() in COUNTER_COLUMN_NAMES or (
+            time is not None
+            and col == time
+            and time_unit is None
+            and col.strip().lower() not in TIME_COLUMN_NAMES
+            and units.unit_in_column_name(col, "time") is None
         )
+        if not allow_column:
+            raise ThermocalInputError(
+                f"{p}: --rate {text.rate_hz:g} Hz given but the file has a time column "
+                f"{col!r}; drop --rate"
+                if not is_counter
+                else f"{p}: this command streams the file and cannot take the sample counter "
+                f"{col!r} as time; add a time column (time = {col} / {text.rate_hz:g} Hz) "
+                "and drop --rate"
+            )
+        if is_counter and time_unit not in (None, "s"):
+            raise ThermocalInputError(
+                f"{p}: --rate {text.rate_hz:g} Hz counts the samples of {col!r}; drop --time-unit"
+            )
+        return obj, names, col, time_unit, "counter" if is_counter else "stamps"
     if isinstance(obj, ParquetColumns):
         raise ThermocalInputError(f"{p}: --rate is for text logs; a Parquet file has its time")
     if time_unit not in (None, "s"):
@@ -388,4 +483,27 @@ def rate_time(
         rows = np.arange(len(obj), dtype=np.float64)
     obj = obj.copy()
     obj.insert(0, col, np.asarray(rows, dtype=np.float64) / float(text.rate_hz))
-    return obj, [col, *names], col, "s"
+    return obj, [col, *names], col, "s", "rows"
+
+
+def counter_time(p: Path, col: str, counts: FloatArray, rate_hz: float) -> FloatArray:
+    """A sample counter's time [s]: ``t = n / rate``.  The counter must hold whole numbers
+    that increase (a skipped number is a gap: samples lost); anything else is refused,
+    naming the first row that is not."""
+    fin = np.isfinite(counts)
+    whole = fin & (counts == np.round(counts))
+    if not bool(whole.all()):
+        row = int(np.argmin(whole))
+        raise ThermocalInputError(
+            f"{p}: --rate {rate_hz:g} Hz takes {col!r} for a sample counter, but row {row} "
+            f"holds {float(counts[row])!r}, not a whole number; name the time column with --time"
+        )
+    steps = np.diff(counts)
+    if steps.size and not bool((steps > 0).all()):
+        row = int(np.argmin(steps > 0)) + 1
+        raise ThermocalInputError(
+            f"{p}: the sample counter {col!r} does not increase at row {row} "
+            f"({counts[row - 1]:g} → {counts[row]:g}): samples repeated or the counter wrapped"
+        )
+    out: FloatArray = counts / float(rate_hz)
+    return out

@@ -14,7 +14,13 @@ import numpy as np
 
 from thermocal import units
 from thermocal.compensate.kernels import unit_factor
-from thermocal.metrics import RATE_ANGLE_UNITS, DriftReference, compute_metrics, drift_angle
+from thermocal.metrics import (
+    RATE_ANGLE_UNITS,
+    DriftReference,
+    compute_metrics,
+    drift_angle,
+    drift_angle_extreme,
+)
 from thermocal.models.base import RunData
 from thermocal.models.registry import model_from_dict
 from thermocal.recording import FloatArray, Metadata, Recording
@@ -150,7 +156,7 @@ class FiguresOfMerit:
     the hold stages (least-squares slope and mean |ΔB/ΔT|) [unit/°C], and the drift
     angle θ(t) = ∫ (ω − Ω − b0) dt [``drift_angle_unit``] (gyros), b0 the constant of
     ``drift_reference``: its curve, end value, largest magnitude and when it is reached
-    [s since the first sample]."""
+    [s since the first sample]; and the largest |θ| with no bias removed (b0 = 0)."""
 
     bias: float
     bias_stability: float
@@ -164,11 +170,19 @@ class FiguresOfMerit:
     drift_angle_max_time_s: float | None = None
     drift_angle_unit: str | None = None
     drift_reference: DriftReference | None = None
+    drift_angle_raw_max: float | None = None
+    """The largest |θ| of ``θ(t) = ∫ (ω − Ω_axis) dt`` [``drift_angle_unit``]: no bias
+    removed (gyros), the figure to compare with another series' of the same definition."""
 
     @property
     def drift_angle_max_deg(self) -> float | None:
         """The largest |drift angle| in degrees [°] (converted from rad for rad/s data)."""
         return _in_degrees(self.drift_angle_max, self.drift_angle_unit)
+
+    @property
+    def drift_angle_raw_max_deg(self) -> float | None:
+        """:attr:`drift_angle_raw_max` in degrees [°]."""
+        return _in_degrees(self.drift_angle_raw_max, self.drift_angle_unit)
 
     @property
     def drift_angle_end_deg(self) -> float | None:
@@ -182,6 +196,87 @@ def _in_degrees(value: float | None, unit: str | None) -> float | None:
     return value * units.RAD_TO_DEG if unit == "rad" else value
 
 
+@dataclass(frozen=True)
+class Coverage:
+    """How much of a run's span its samples cover: ``span_s`` first to last sample [s],
+    ``covered_s`` the span less the gaps [s], ``n_gaps`` and ``gap_s`` their number and
+    total length beyond one sample interval [s] (:func:`coverage_of`)."""
+
+    span_s: float
+    covered_s: float
+    n_gaps: int
+    gap_s: float
+
+    @property
+    def gap_pct(self) -> float:
+        """The gaps' share of the span [%] (0 for a span of 0)."""
+        return 100.0 * self.gap_s / self.span_s if self.span_s > 0 else 0.0
+
+
+def coverage_of(time_s: FloatArray, tau0_s: float) -> Coverage:
+    """The coverage of a run with times ``time_s`` [s] and sample interval ``tau0_s`` [s]:
+    each gap (:func:`thermocal.recording.find_gaps`, a step > 1.5 τ0) counts its length
+    less one τ0 (issue 38: a record 98 % gaps read "1.02 h, 3125 samples every 0.02 s")."""
+    from thermocal.recording import find_gaps
+
+    t = np.asarray(time_s, dtype=np.float64)
+    span = float(t[-1] - t[0]) if t.size else 0.0
+    gaps = find_gaps(t)
+    gap_s = float(sum(g.length_s - tau0_s for g in gaps))
+    return Coverage(span, span - gap_s, len(gaps), gap_s)
+
+
+NICE_AVERAGES_S = (1.0, 2.0, 5.0, 10.0, 20.0, 50.0, 100.0, 200.0, 500.0, 1000.0)
+"""Averaging times [s] a report falls back to, largest first, when the default averaging
+time does not fit the record (:func:`averaging_for`)."""
+MIN_FALLBACK_AVERAGES = 10
+"""Averages a fallback averaging time gives at least (a stated bias stability needs a
+handful of averages; IEEE Std 952 reads the Allan curve up to a tenth of the record)."""
+
+
+def _n_means(slices: list[slice], tau0_s: float, averaging_s: float) -> int:
+    m = max(round(averaging_s / tau0_s), 1)
+    return sum((sl.stop - sl.start) // m for sl in slices)
+
+
+def averaging_for(
+    time_s: FloatArray, wanted_s: float, *, given: bool, where: str | None, option: str | None
+) -> tuple[float, str | None]:
+    """The averaging time [s] of a report's bias stability and peak-to-peak on a record
+    with times ``time_s`` [s], and the note that says why it is not ``wanted_s``.
+
+    ``wanted_s`` when the record gives at least two non-overlapping averages of it (never
+    across a gap, as :func:`thermocal.metrics.block_means`).  Else, when the user ``given``
+    it, an error naming the file ``where`` and the option ``option``
+    (:func:`thermocal.metrics.too_few_averages`); when it is a default, the largest of
+    :data:`NICE_AVERAGES_S` giving at least :data:`MIN_FALLBACK_AVERAGES` averages (the
+    sample interval if none does), stated in the note.
+    """
+    from thermocal.errors import ThermocalInputError
+    from thermocal.metrics import too_few_averages
+    from thermocal.recording import contiguous_slices
+
+    t = np.asarray(time_s, dtype=np.float64)
+    if t.size < 2:
+        return wanted_s, None
+    tau0 = float(np.median(np.diff(t)))
+    slices = contiguous_slices(t)
+    n = _n_means(slices, tau0, wanted_s)
+    if n >= 2:
+        return wanted_s, None
+    longest = max(sl.stop - sl.start for sl in slices) * tau0
+    if given:
+        raise ThermocalInputError(too_few_averages(where, wanted_s, n, longest, option))
+    fits = [a for a in NICE_AVERAGES_S if _n_means(slices, tau0, a) >= MIN_FALLBACK_AVERAGES]
+    chosen = max(fits) if fits else tau0
+    note = (
+        f"Bias stability and peak-to-peak are over {chosen:g} s averages: the record "
+        f"(longest stretch without a gap {longest:.3g} s) gives fewer than two of the "
+        f"default {wanted_s:g} s."
+    )
+    return chosen, note
+
+
 def figures_of_merit(
     time_s: FloatArray,
     x: FloatArray,
@@ -193,6 +288,8 @@ def figures_of_merit(
     temp_c: FloatArray,
     drift_bias: float | None = None,
     drift_reference_s: tuple[float, float] | None = None,
+    where: str | None = None,
+    average_option: str | None = "--average",
 ) -> FiguresOfMerit:
     """Figures of merit of a rate ``x`` [``unit``, known input included] (SPEC §1).
 
@@ -202,7 +299,8 @@ def figures_of_merit(
     gaps) removes a stated constant b0, never the run's own mean: ``drift_bias`` when
     given (0 on a compensated output: the model is what removes the bias), else the mean
     over ``drift_reference_s`` (default the first 10 % of the run,
-    :func:`thermocal.metrics.reference_bias`).
+    :func:`thermocal.metrics.reference_bias`).  ``where`` (the file) and ``average_option``
+    are named when the record gives fewer than two averages.
     """
     rec = Recording.from_arrays(
         time_s,
@@ -211,6 +309,7 @@ def figures_of_merit(
         signal_unit=unit,
         meta=dataclasses.replace(meta, scale_factor=None, scale_factor_unit=None),
     )
+    rec = dataclasses.replace(rec, source=where) if where else rec
     m = compute_metrics(
         rec,
         "signal",
@@ -218,12 +317,15 @@ def figures_of_merit(
         temps=[temp_name],
         drift_bias=drift_bias,
         drift_reference_s=drift_reference_s,
+        average_option=average_option,
     )
     sens = m.temperature_sensitivity
     ang: FloatArray | None = None
+    raw_max: float | None = None
     if m.drift_reference is not None and m.unit in RATE_ANGLE_UNITS:
         per = RATE_ANGLE_UNITS[m.unit][1]
         ang = drift_angle(time_s, x, m.drift_reference.bias + m.earth_rate_removed, time_unit_s=per)
+        raw_max = drift_angle_extreme(time_s, x, m.earth_rate_removed, time_unit_s=per).max_abs
     return FiguresOfMerit(
         bias=m.bias,
         bias_stability=m.bias_stability,
@@ -237,6 +339,7 @@ def figures_of_merit(
         drift_angle_max_time_s=m.drift_angle_max_time_s,
         drift_angle_unit=m.drift_angle_unit,
         drift_reference=m.drift_reference,
+        drift_angle_raw_max=raw_max,
     )
 
 

@@ -201,6 +201,31 @@ def improvement_pct(before: Any, after: Any) -> float | None:
     return 100.0 * (1.0 - a / b)
 
 
+NO_CHANGE_REL = 1e-9
+"""Before and after equal within this fraction of the larger: "no change", not a
+percentage of rounding (issue 38: "Peak-to-peak −1.06e-13 %")."""
+
+
+def no_change(before: Any, after: Any) -> bool:
+    """Whether two figures are equal within :data:`NO_CHANGE_REL` of the larger
+    (``|a − b| ≤ 1e-9 · max(|a|, |b|)``; both zero included)."""
+    if not (_is_number(before) and _is_number(after)):
+        return False
+    b, a = float(before), float(after)
+    return (
+        math.isfinite(a) and math.isfinite(b) and abs(a - b) <= NO_CHANGE_REL * max(abs(a), abs(b))
+    )
+
+
+def change_html(before: Any, after: Any, imp: float | None, key: str | None) -> Markup:
+    """The improvement cell of ``before`` → ``after``: ``no change`` when they are equal
+    (:func:`no_change`; tagged 0), else ``imp`` [%] (:func:`improvement_pct`)."""
+    if no_change(before, after):
+        attrs = f' data-key="{escape(key)}" data-value="0.0"' if key else ""
+        return Markup(f'<span class="num"{attrs}>no change</span>')
+    return num(imp, key, digits=3, unit="%")
+
+
 def unit_label(unit: str) -> str:
     """Pretty unit for display (``deg/h`` → ``°/h``)."""
     return {
@@ -387,7 +412,7 @@ def _validation_rows(entry: ModelEntry, unit: str) -> list[dict[str, Any]]:
                 "unit": u,
                 "before": num(b, f"{key}.{name}_before"),
                 "after": num(a, f"{key}.{name}_after"),
-                "improvement": num(imp, f"{key}.{name}_improvement_pct", digits=3),
+                "improvement": change_html(b, a, imp, f"{key}.{name}_improvement_pct"),
                 "flag": _flag(None if imp is None else imp > 0),
             }
         )
@@ -449,25 +474,28 @@ def _summary(
                 "flag_text": "weakly correlated" if ok else "too correlated",
             }
         )
-    for name, label in (
-        ("bias_stability", "Bias stability"),
-        ("bias_repeatability", "Bias repeatability"),
-        ("peak_to_peak", "Peak-to-peak bias"),
-    ):
+    avg = fmt_num(v.get("averaging_s"))
+    for name, label, definition in (
+        ("bias_stability", "Bias stability",
+         f"std of the {avg} s averages within each hold stage, rms over the stages"),
+        ("bias_repeatability", "Bias repeatability", "std of the hold stages' mean biases"),
+        ("peak_to_peak", "Peak-to-peak bias", f"max − min of the run's {avg} s averages"),
+    ):  # fmt: skip
         b, a = v.get(f"{name}_before"), v.get(f"{name}_after")
         if b is None or a is None:
             continue
         imp = _json_improvement(v, name)
-        ok = None if imp is None else imp > 0
+        same = no_change(b, a)
+        ok = None if imp is None else imp > 0 and not same
         items.append(
             {
                 "label": label,
                 "before": num(b, f"{key}.{name}_before", unit=unit_label(unit)),
                 "after": num(a, f"{key}.{name}_after", unit=unit_label(unit)),
-                "value": num(imp, f"{key}.{name}_improvement_pct", digits=3, unit="%"),
-                "note": "improvement",
+                "value": change_html(b, a, imp, f"{key}.{name}_improvement_pct"),
+                "note": f"improvement; {definition}, before and after (validate)",
                 "flag": _flag(ok),
-                "flag_text": "improved" if ok else "not improved",
+                "flag_text": "no change" if same else "improved" if ok else "not improved",
             }
         )
     b, a = v.get("rms_about_zero_before"), v.get("rms_about_zero_after")
@@ -479,28 +507,47 @@ def _summary(
                 "label": "Error about zero (rms per sample)",
                 "before": num(b, f"{key}.rms_about_zero_before", unit=unit_label(unit)),
                 "after": num(a, f"{key}.rms_about_zero_after", unit=unit_label(unit)),
-                "value": num(imp, f"{key}.rms_about_zero_improvement_pct", digits=3, unit="%"),
-                "note": "improvement",
+                "value": change_html(b, a, imp, f"{key}.rms_about_zero_improvement_pct"),
+                "note": "improvement; rms of (output − reference) per sample, reference "
+                + str((v.get("zero_reference") or {}).get("what") or "0")
+                + ", before and after (validate)",
                 "flag": _flag(not worse),
                 "flag_text": "absolute error worse" if worse else "not worse",
             }
         )
-    if fom_before.drift_angle_max_deg is not None and fom_after.drift_angle_max_deg is not None:
-        imp = improvement_pct(fom_before.drift_angle_max_deg, fom_after.drift_angle_max_deg)
-        ok = None if imp is None else imp > 0
+    items += _drift_cards(fom_before, fom_after)
+    return items
+
+
+def _drift_cards(fom_before: FiguresOfMerit, fom_after: FiguresOfMerit) -> list[dict[str, Any]]:
+    """The drift-angle cards of the summary, each comparing one definition before and
+    after (issue 38): the start bias removed (each series' b0 over the same window, or a
+    given b0 before), and no bias removed.  Improvement ``100·(1 − after/before)``."""
+    items: list[dict[str, Any]] = []
+    ref = drift_reference_words(fom_before.drift_reference)
+    for label, attr, key, note in (
+        ("Largest drift angle, start bias removed", "drift_angle_max_deg", "drift_angle",
+         f"θ = ∫ (ω − Ω − b0) dt, before: {ref}; after: the same for the compensated rate"),
+        ("Largest drift angle, no bias removed", "drift_angle_raw_max_deg", "drift_angle_raw",
+         "θ = ∫ (ω − Ω) dt, before and after"),
+    ):  # fmt: skip
+        b, a = getattr(fom_before, attr), getattr(fom_after, attr)
+        if b is None or a is None:
+            continue
+        imp = improvement_pct(b, a)
+        same = no_change(b, a)
+        ok = None if imp is None else imp > 0 and not same
         items.append(
             {
-                "label": "Largest drift angle",
-                "before": num(fom_before.drift_angle_max_deg, "fom.before.drift_angle_max_deg",
-                              unit="°"),
-                "after": num(fom_after.drift_angle_max_deg, "fom.after.drift_angle_max_deg",
-                             unit="°"),
-                "value": num(imp, "summary.drift_angle_improvement_pct", digits=3, unit="%"),
-                "note": "improvement",
+                "label": label,
+                "before": num(b, f"fom.before.{attr}", unit="°"),
+                "after": num(a, f"fom.after.{attr}", unit="°"),
+                "value": change_html(b, a, imp, f"summary.{key}_improvement_pct"),
+                "note": f"improvement; {note}",
                 "flag": _flag(ok),
-                "flag_text": "improved" if ok else "not improved",
+                "flag_text": "no change" if same else "improved" if ok else "not improved",
             }
-        )  # fmt: skip
+        )
     return items
 
 
@@ -906,8 +953,9 @@ def _analyse(inputs: ReportInputs) -> _Analysis:
         rec.temperature_c(stage_temp) if stage_temp not in temp_names
         else main.temps_c[:, temp_names.index(stage_temp)]
     )  # fmt: skip
-    # drift angle: before about a stated reference constant (the mean over a window at the
-    # start), after with nothing removed but the known input (the model removes the bias)
+    # drift angle, like with like (issue 38): before and after each about its own mean over
+    # the same reference window at the start (a given b0 is the raw sensor's: before only);
+    # and both with no bias removed (FiguresOfMerit.drift_angle_raw_max)
     fom_before, fom_after = (
         figures_of_merit(
             main.time_s,
@@ -919,8 +967,9 @@ def _analyse(inputs: ReportInputs) -> _Analysis:
             temp_c=stage_temp_c,
             drift_bias=drift_bias,
             drift_reference_s=None if drift_bias is not None else inputs.drift_reference_s,
+            where=inputs.recording_path or rec.source,
         )
-        for x, drift_bias in ((main.signal, inputs.drift_bias), (main.after_raw, 0.0))
+        for x, drift_bias in ((main.signal, inputs.drift_bias), (main.after_raw, None))
     )
     allan_before = allan_of(main.time_s, main.before, tau0, unit)
     allan_after = allan_of(main.time_s, main.after, tau0, unit)
@@ -1197,7 +1246,8 @@ def _drift_figure(fs: _FigureSet, an: _Analysis) -> None:
         "Drift angle before and after compensation",
         "Angle error over time, θ(t) = ∫ (ω − Ω − b0) dt: before compensation (red) "
         f"with {drift_reference_words(fom_before.drift_reference)}; after (blue) the "
-        "compensated rate integrated with no bias removed (the model removes it).",
+        "compensated rate with its own b0 over the same window (like with like; the "
+        "figures with no bias removed are in the table of figures of merit).",
     )
 
 
@@ -1265,7 +1315,9 @@ def _fom_rows(an: _Analysis) -> list[dict[str, Any]]:
          f"{unit_label(unit)}/°C", 4),
         ("sensitivity_mean_abs", "Temperature sensitivity, mean |ΔB/ΔT| of adjacent stages",
          f"{unit_label(unit)}/°C", 4),
-        ("drift_angle_max", "Largest |drift angle|",
+        ("drift_angle_max", "Largest |drift angle|, start bias removed (b0)",
+         unit_label(fom_before.drift_angle_unit or ""), 4),
+        ("drift_angle_raw_max", "Largest |drift angle|, no bias removed",
          unit_label(fom_before.drift_angle_unit or ""), 4),
     ):  # fmt: skip
         b = getattr(fom_before, name)
@@ -1278,13 +1330,14 @@ def _fom_rows(an: _Analysis) -> list[dict[str, Any]]:
                 "unit": u,
                 "before": num(b, f"fom.before.{name}", digits),
                 "after": num(a, f"fom.after.{name}", digits),
-                "improvement": num(
-                    improvement_pct(abs(b), abs(a))
-                    if name != "bias" and b is not None and a is not None
-                    else None,
+                "improvement": change_html(
+                    abs(b) if b is not None else None,
+                    abs(a) if a is not None else None,
+                    improvement_pct(abs(b), abs(a)) if b is not None and a is not None else None,
                     None,
-                    3,
-                ),
+                )
+                if name != "bias"
+                else num(None),
             }
         )
 

@@ -39,7 +39,13 @@ from thermocal.models.base import model_file_dict
 from thermocal.models.calibration import Calibration
 from thermocal.readers.common import sha256_of
 from thermocal.recording import Recording
-from thermocal.report.analysis import allan_of, apply_model, shown_figures
+from thermocal.report.analysis import (
+    allan_of,
+    apply_model,
+    averaging_for,
+    coverage_of,
+    shown_figures,
+)
 from thermocal.report.build import (
     ILL_CONDITIONED,
     _b64,
@@ -47,6 +53,7 @@ from thermocal.report.build import (
     _env,
     _range_rows,
     adequacy_rows,
+    change_html,
     improvement_pct,
     unit_label,
 )
@@ -168,6 +175,17 @@ def _channel_notes(
     return msgs
 
 
+def _absolute_change(v: dict[str, Any] | None, key: str) -> Any:
+    """The change of the error against the reference (rms about zero, issue 38: the
+    report showed only the scatter about the mean) as :func:`change_html` shows it, or None
+    without both figures."""
+    b, a = (v or {}).get("rms_about_zero_before"), (v or {}).get("rms_about_zero_after")
+    if b is None or a is None:
+        return None
+    imp = improvement_pct(abs(b), abs(a))
+    return change_html(b, a, imp, f"{key}.validation.rms_about_zero_improvement_pct")
+
+
 def _channel_section(
     inputs: CalibrationReportInputs, name: str, averaging_s: float, tau0: float
 ) -> dict[str, Any]:
@@ -241,6 +259,7 @@ def _channel_section(
             else terms[1].angle_random_walk
         ),
         "validation": v,
+        "absolute_change": _absolute_change(v, key),
         "adequacy": adequacy,
         "verdict_class": vclass,
         "verdict": vtext,
@@ -271,8 +290,12 @@ def build_calibration_report(inputs: CalibrationReportInputs) -> str:
     else:
         default_avg = (inputs.validation or {}).get("averaging_s")
     averaging_s = float(inputs.averaging_s or default_avg or DEFAULT_AVERAGING_S)
+    averaging_s, avg_note = averaging_for(
+        rec.time_s, averaging_s, given=inputs.averaging_s is not None,
+        where=inputs.recording_path or rec.source or rec.name, option="--average",
+    )  # fmt: skip
     # several axes: the earth rate differs per axis, so none is removed (stated below)
-    notes = list(inputs.notes)
+    notes = list(inputs.notes) + ([avg_note] if avg_note else [])
     if rec.meta.latitude_deg is not None and len(names) > 1:
         notes.append(
             "The earth rate is not removed from gyro channels in this report (each axis "
@@ -299,6 +322,10 @@ def build_calibration_report(inputs: CalibrationReportInputs) -> str:
         )
         if path
     ]
+    warned: dict[str, list[str]] = {}  # each warning once, with the channels it concerns
+    for sec in sections:
+        for w in sec["warnings"]:
+            warned.setdefault(w, []).append(sec["name"])
     html: str = (
         _env()
         .get_template("calibration.html.j2")
@@ -314,7 +341,9 @@ def build_calibration_report(inputs: CalibrationReportInputs) -> str:
             averaging_s=averaging_s,
             n_samples=rec.time_s.size,
             duration_h=float(rec.time_s[-1] - rec.time_s[0]) / 3600.0,
+            coverage=coverage_of(rec.time_s, tau0),
             tau0=tau0,
+            warning_list=[(w, chans) for w, chans in warned.items()],
             grid=_b64(grid),
             allan=_b64(allan),
             files=files,

@@ -99,8 +99,14 @@ def _triad_code(p: str, tri: Any, bias_to_data: float, real: str, ident: str) ->
     ]
     about = c_comment(
         f"{tri.name}: out = (I + E(T))^-1 (x - b(T)) in {tri.unit}; columns "
-        f"{', '.join(map(str, tri.columns))}; T [degC] of {tri.temperature}, clamped to "
-        f"[{m.t_lo_c:g}, {m.t_hi_c:g}]"
+        f"{', '.join(map(str, tri.columns))}; "
+        + (
+            f"T [degC] of {tri.temperature}, clamped to [{m.t_lo_c:g}, {m.t_hi_c:g}]"
+            if tri.temperature
+            else f"no temperature column: calibrated at {m.tref_c:g} degC, temp_c has no effect"
+            if m.order == 0
+            else f"T [degC] (no column named), clamped to [{m.t_lo_c:g}, {m.t_hi_c:g}]"
+        )
     )
     decl = f"/* {about} */\n"
     if tri.count_scale is not None:
