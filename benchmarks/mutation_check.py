@@ -1470,6 +1470,14 @@ MUTANTS: tuple[Mutant, ...] = (
         ST_ATT,
         "started with 2>&-, the run's messages land in the --json output on stdout",
     ),
+    Mutant(
+        "station-parts-signal-units-uncompared",
+        P + "readers/station.py",
+        'for role in ("signals", "temperatures", "units"):',
+        'for role in ("temperatures", "units"):',
+        ST_ATT,
+        "parts with deg/s and rad/s concatenated and read in the last part's unit",
+    ),
     # --- readers: ULog / DataFlash --------------------------------------------------------
     Mutant(
         "ulog-delta-dt-us",

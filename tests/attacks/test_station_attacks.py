@@ -844,3 +844,35 @@ def test_started_without_stderr_the_json_on_stdout_stays_clean(rig: dict) -> Non
     res = json.loads(proc.stdout)  # one JSON object, nothing else
     assert res["ended"] == "end" and res["safe_setpoint_c"] == 21.5
     assert sim.writes[-1][1] == pytest.approx(21.5)
+
+
+def test_parts_recorded_in_different_units_are_not_concatenated(
+    rig: dict, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A folder whose second part says rad/s where the first says deg/s (what a --resume
+    with other units wrote before it was refused): every command refuses it, naming the
+    part, the column and both units, instead of reading all of it in one unit."""
+    tmp, sim, sen = rig["tmp"], rig["sim"], rig["sen"]
+    toml = tmp / "st.toml"
+    toml.write_text(_toml(sim.port, sen.device, part_s=0.3))
+    out = tmp / "rec"
+    run_station(parse_station(toml.read_text(), str(toml)), HOT, out, time_scale=100.0,
+                should_stop=lambda: len(list(out.glob("imu-*.parquet"))) >= 3)  # fmt: skip
+    capsys.readouterr()
+    assert main(["inspect", str(out), "--json"]) == 0
+    capsys.readouterr()
+    parts = sorted(out.glob("imu-*.parquet"))
+    t = pq.read_table(parts[-1])
+    key = b"thermocal"
+    meta = dict(t.schema.metadata)
+    (k,) = [k for k in meta if key in k]
+    doc = json.loads(meta[k])
+    assert doc["signals"]["gx"] == "deg/s"
+    doc["signals"]["gx"] = "rad/s"
+    pq.write_table(t.replace_schema_metadata({**meta, k: json.dumps(doc).encode()}), parts[-1])
+    before = _digest(*parts)
+    assert main(["inspect", str(out)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith(f"error: {parts[0]}: column 'gx' is deg/s"), err
+    assert f"rad/s (signals) in {parts[-1].name}" in err[0]
+    assert _digest(*parts) == before
