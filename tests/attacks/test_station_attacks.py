@@ -876,3 +876,24 @@ def test_parts_recorded_in_different_units_are_not_concatenated(
     assert len(err) == 1 and err[0].startswith(f"error: {parts[0]}: column 'gx' is deg/s"), err
     assert f"rad/s (signals) in {parts[-1].name}" in err[0]
     assert _digest(*parts) == before
+
+
+@pytest.mark.parametrize("resume", [False, True])
+def test_a_deeply_nested_station_json_is_refused_in_one_line(
+    rig: dict, capsys: pytest.CaptureFixture[str], resume: bool
+) -> None:
+    """``[`` × 100 000: Python's JSON parser recurses (RecursionError, was exit 1)."""
+    tmp, sim, sen = rig["tmp"], rig["sim"], rig["sen"]
+    out = tmp / "rec"
+    out.mkdir()
+    (out / "station.json").write_text("[" * 100_000 + "]" * 100_000)
+    before = _digest(out / "station.json")
+    toml, prof = tmp / "st.toml", _profile(tmp)
+    toml.write_text(_toml(sim.port, sen.device))
+    argv = (["station", "run", str(toml), "--profile", str(prof), "-o", str(out), "--resume"]
+            if resume else ["inspect", str(out)])  # fmt: skip
+    assert main(argv) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err == [f"error: {out / 'station.json'}: nested too deeply to be a thermocal "
+                   "station file"]  # fmt: skip
+    assert _digest(out / "station.json") == before and sim.writes == []

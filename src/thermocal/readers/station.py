@@ -46,6 +46,8 @@ def read_station_json(out_dir: Path) -> dict[str, Any]:
         doc = json.loads(p.read_text(encoding="utf-8"))
     except (json.JSONDecodeError, UnicodeDecodeError) as exc:
         raise FileFormatError(f"{p}: not valid JSON ({exc})") from None
+    except RecursionError:  # thousands of nested brackets: no station file is built so
+        raise FileFormatError(f"{p}: nested too deeply to be a thermocal station file") from None
     if not isinstance(doc, dict) or doc.get("format") != STATION_FORMAT:
         raise FileFormatError(f"{p}: not a thermocal station file")
     version = doc.get("version", 0)
