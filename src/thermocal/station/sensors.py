@@ -183,13 +183,19 @@ class SerialSensor:
         buf = b""
         skipping = False
         port = self._port
-        while not self._stop.is_set():
+        while True:
+            last = self._stop.is_set()  # stopping: what the port already holds, once
             try:
-                data = port.read(max(1, port.in_waiting))
+                waiting = port.in_waiting
+                data = (
+                    port.read(waiting if last else max(1, waiting)) if waiting or not last else b""
+                )
             except Exception as exc:  # a port that vanished: reported, thread ends
                 self.stats.error = f"{type(exc).__name__}: {exc}"
                 return
             if not data:
+                if last:
+                    return
                 continue
             t = time.time()
             if skipping:  # the rest of an overlong line, up to its end
@@ -204,6 +210,8 @@ class SerialSensor:
                 if len(buf) > MAX_LINE:  # kept aside once (cut), the rest skipped
                     self._line(t, buf[:MAX_LINE], f"longer than {MAX_LINE} bytes")
                     buf, skipping = b"", True
+            if last:
+                return
 
     def drain(self) -> tuple[list[Sample], list[Bad]]:
         """The good and bad lines that arrived since the last call."""
