@@ -33,7 +33,7 @@ def _folder(tmp: Path) -> Path:
     (d / "station.json").write_text(json.dumps(doc), encoding="utf-8")
     for i, start in enumerate((0.0, 3.0)):
         t = pa.table({"time": [start, start + 1.0, start + 2.0], "gx": [i, i + 0.5, i + 1.0]})
-        meta = {"time": "time", "units": {"gx": f"deg/h-{i}"}}  # the last part's wins
+        meta = {"time": "time", "units": {"gx": "deg/h"}, "part": i}  # the last part's wins
         t = t.replace_schema_metadata({META_KEY: json.dumps(meta)})
         pq.write_table(t, d / f"imu1-{i:04d}.parquet")
     pq.write_table(pa.table({"time": [9.0]}), d / ".imu1-0002.parquet.tmp")  # being written
@@ -48,7 +48,7 @@ def test_reader_concatenates_the_closed_parts_in_order(tmp_path: Path) -> None:
     table, meta = read_station(d)  # the only sensor
     np.testing.assert_array_equal(table["time"].to_numpy(), [0, 1, 2, 3, 4, 5])
     np.testing.assert_array_equal(table["gx"].to_numpy(), [0, 0.5, 1, 1, 1.5, 2])
-    assert meta["units"] == {"gx": "deg/h-1"}
+    assert meta["units"] == {"gx": "deg/h"} and meta["part"] == 1
     assert read_station(d / "chamber")[0].num_rows == 1
 
 

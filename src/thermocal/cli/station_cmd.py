@@ -112,8 +112,35 @@ def check_cmd(
         raise typer.Exit(2)
 
 
-def _sigterm(_signum: int, _frame: Any) -> None:
-    raise KeyboardInterrupt
+STOP_SIGNALS = ("SIGINT", "SIGTERM", "SIGHUP")
+"""Signals that end a run with the safe stop (a hang-up: the operator's terminal or ssh
+session went away)."""
+
+
+class _StopFlag:
+    """Signal handlers that only note the signal: the loop sees it within one turn and
+    stops safely; a second signal cannot interrupt the safe stop itself."""
+
+    def __init__(self) -> None:
+        self.signum = 0
+        self._old: dict[int, Any] = {}
+
+    def __enter__(self) -> "_StopFlag":
+        for name in STOP_SIGNALS:
+            if hasattr(signal, name):
+                num = getattr(signal, name)
+                self._old[num] = signal.signal(num, self._note)
+        return self
+
+    def __exit__(self, *_exc: object) -> None:
+        for num, old in self._old.items():
+            signal.signal(num, old)
+
+    def _note(self, signum: int, _frame: Any) -> None:
+        self.signum = self.signum or signum
+
+    def __call__(self) -> str:
+        return signal.Signals(self.signum).name if self.signum else ""
 
 
 @station_app.command("run")
@@ -139,33 +166,39 @@ def run_cmd(
 ) -> None:
     """Run the chamber program and record every sensor and the chamber into DIR.
 
-    Ctrl-C, an error or the end of the program writes the safe set-point and closes every
-    file; continue an interrupted run with --resume.
+    Ctrl-C, SIGTERM, a hang-up (the terminal or ssh session gone), a closed stderr, an
+    error or the end of the program writes the safe set-point and closes every file;
+    continue an interrupted run with --resume (it says how the last run ended and where it
+    left the chamber).
     """
     cfg = _config.load_station(station)
     prog_t, prog_c = _program.read_program(profile)
-    live = sys.stderr.isatty() and not as_json
+    live = sys.stderr is not None and sys.stderr.isatty() and not as_json  # None: 2>&-
     disp = _display.RichDisplay() if live else _run.LogDisplay()
-    if hasattr(signal, "SIGTERM"):
-        signal.signal(signal.SIGTERM, _sigterm)
+    flag = _StopFlag()
     try:
-        res = _run.run_station(
-            cfg, (list(prog_t), list(prog_c)), output, profile_source=str(profile),
-            resume=resume, time_scale=time_scale, display=disp,
-        )  # fmt: skip
+        with flag:
+            res = _run.run_station(
+                cfg, (list(prog_t), list(prog_c)), output, profile_source=str(profile),
+                resume=resume, time_scale=time_scale, display=disp, should_stop=flag,
+            )  # fmt: skip
     except KeyboardInterrupt:
-        if live:
-            disp.close()  # type: ignore[union-attr]
-        print(
-            f"interrupted: safe set-point written as logged above; the closed parts in {output} "
-            "are kept (the part open at the interruption was closed too); continue with "
-            "--resume",
-            file=sys.stderr,
-        )
-        raise typer.Exit(EXIT_INTERRUPTED) from None
+        res = None
     finally:
         if live:
             disp.close()  # type: ignore[union-attr]
+    if res is None or res.ended == "interrupted":
+        why = "" if res is None or not res.stop_reason else f" ({res.stop_reason})"
+        safe = (
+            "safe set-point written as logged above"
+            if res is None or (res.safe_setpoint_c is not None)
+            else "the safe set-point could NOT be written"
+        )
+        _run.say(
+            f"interrupted{why}: {safe}; the closed parts in {output} are kept (the part open "
+            "at the interruption was closed too); continue with --resume"
+        )  # fmt: skip
+        raise typer.Exit(128 + flag.signum if flag.signum else EXIT_INTERRUPTED)
     out = {
         "out_dir": str(res.out_dir),
         "ended": res.ended,

@@ -46,6 +46,8 @@ def read_station_json(out_dir: Path) -> dict[str, Any]:
         doc = json.loads(p.read_text(encoding="utf-8"))
     except (json.JSONDecodeError, UnicodeDecodeError) as exc:
         raise FileFormatError(f"{p}: not valid JSON ({exc})") from None
+    except RecursionError:  # thousands of nested brackets: no station file is built so
+        raise FileFormatError(f"{p}: nested too deeply to be a thermocal station file") from None
     if not isinstance(doc, dict) or doc.get("format") != STATION_FORMAT:
         raise FileFormatError(f"{p}: not a thermocal station file")
     version = doc.get("version", 0)
@@ -170,6 +172,8 @@ def read_station(path: Path) -> tuple[pa.Table, dict[str, Any]]:
                 f"{tables[0].schema.names}"
             )
     meta = thermocal_metadata(tables[-1].schema.metadata, files[-1])
+    for p, t in zip(files[:-1], tables[:-1], strict=True):
+        _same_units(p, thermocal_metadata(t.schema.metadata, p), files[-1], meta)
     try:  # a column stored float32 in one part and float64 in another is widened
         table = pa.concat_tables(
             [t.replace_schema_metadata(None) for t in tables], promote_options="permissive"
@@ -177,6 +181,28 @@ def read_station(path: Path) -> tuple[pa.Table, dict[str, Any]]:
     except (pa.ArrowInvalid, pa.ArrowTypeError) as exc:
         raise FileFormatError(f"{path}: parts whose column types disagree ({exc})") from None
     return table, meta
+
+
+def _same_units(p: Path, m: dict[str, Any], last: Path, m_last: dict[str, Any]) -> None:
+    """Parts of one recording read in one set of units: a column whose unit (or role) in
+    part ``p`` differs from the last part's is refused, naming both."""
+
+    def units_of(md: dict[str, Any]) -> dict[str, str]:
+        out = {"time": str(md.get("time_unit"))}
+        for role in ("signals", "temperatures", "units"):
+            d = md.get(role)
+            out |= {str(k): f"{v} ({role})" for k, v in (d.items() if isinstance(d, dict) else ())}
+        return out
+
+    mine, theirs = units_of(m), units_of(m_last)
+    for col in sorted(set(mine) | set(theirs)):
+        if mine.get(col) != theirs.get(col):
+            raise FileFormatError(
+                f"{p}: column {col!r} is {mine.get(col, 'absent')} here and "
+                f"{theirs.get(col, 'absent')} in {last.name}: the parts were recorded in "
+                "different units; read them apart (copy the parts of one setting to a folder "
+                "of their own)"
+            )
 
 
 def read_station_table(p: Path) -> tuple[pd.DataFrame, dict[str, Any]]:

@@ -15,7 +15,9 @@ in ``STATION.toml``.
 
 from __future__ import annotations
 
+import contextlib
 import inspect
+import logging
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -108,6 +110,35 @@ class ManualChamber:
         return None
 
 
+class _LibraryLog(logging.Handler):
+    """pymodbus's own log records (``Unable to decode frame …``), kept off stderr: the last
+    one is added to the :class:`ChamberError` that follows it."""
+
+    def __init__(self) -> None:
+        super().__init__(logging.DEBUG)
+        self.last = ""
+
+    def emit(self, record: logging.LogRecord) -> None:
+        with contextlib.suppress(Exception):
+            self.last = record.getMessage().strip().splitlines()[0][:200]
+
+    def take(self) -> str:
+        last, self.last = self.last, ""
+        return f" (pymodbus: {last})" if last else ""
+
+
+LIBRARY_LOG = _LibraryLog()
+
+
+def quiet_pymodbus() -> None:
+    """Route the ``pymodbus`` loggers to :data:`LIBRARY_LOG` only (no line on stderr)."""
+    log = logging.getLogger("pymodbus")
+    if LIBRARY_LOG not in log.handlers:
+        log.addHandler(LIBRARY_LOG)
+    log.propagate = False
+    log.setLevel(logging.WARNING)
+
+
 def _unit_keyword(method: Callable[..., Any]) -> str:
     """pymodbus ≥ 3.10 names the slave id ``device_id``; older releases ``slave``."""
     params = inspect.signature(method).parameters
@@ -133,6 +164,7 @@ class ModbusChamber:
 
     def connect(self) -> None:
         client_mod = require("pymodbus.client")
+        quiet_pymodbus()
         if self.cfg.driver == "modbus-tcp":
             self._client = client_mod.ModbusTcpClient(
                 self.cfg.host, port=self.cfg.port, timeout=self.cfg.io_timeout_s, retries=0
@@ -145,28 +177,43 @@ class ModbusChamber:
             )  # fmt: skip
         self._kw = _unit_keyword(self._client.read_holding_registers)
         if not self._client.connect():
-            raise ChamberError(f"chamber {self.name}: cannot connect")
+            raise ChamberError(f"chamber {self.name}: cannot connect{LIBRARY_LOG.take()}")
 
-    def _call(self, what: str, fn: Callable[..., Any], *args: Any) -> Any:
+    def _call(self, what: str, fn: Callable[..., Any], code: int, *args: Any) -> Any:
+        """One request; any failure is a :class:`ChamberError` naming the chamber and the
+        register: no answer, a Modbus exception, a reply pymodbus cannot decode, or a
+        reply to another function code than ``code`` (never a value taken from it)."""
         if self._client is None:
             self.connect()
-        exc_mod = require("pymodbus.exceptions")
+        LIBRARY_LOG.take()
         try:
             rr = fn(*args, **{self._kw: self.cfg.unit})
-        except (exc_mod.ModbusException, OSError) as exc:
-            raise ChamberError(f"chamber {self.name}: {what}: {exc}") from None
+        except Exception as exc:  # a broken frame may surface as anything inside pymodbus
+            raise ChamberError(
+                f"chamber {self.name}: {what}: {type(exc).__name__}: {exc}{LIBRARY_LOG.take()}"
+            ) from None
         if rr is None or rr.isError():
-            raise ChamberError(f"chamber {self.name}: {what}: Modbus error {rr}")
+            raise ChamberError(f"chamber {self.name}: {what}: Modbus error {rr}"
+                               f"{LIBRARY_LOG.take()}")  # fmt: skip
+        got = getattr(rr, "function_code", None)
+        if got != code:
+            raise ChamberError(
+                f"chamber {self.name}: {what}: the reply is for function code {got}, not "
+                f"{code}: not a reply to this request"
+            )
         return rr
 
     def write_setpoint(self, setpoint_c: float) -> None:
         word = self.map.encode(setpoint_c)
-        self._call(
-            f"write set-point to register {self.map.setpoint_register}",
-            self._client_method("write_register"),
-            self.map.setpoint_register,
-            word,
-        )
+        reg = self.map.setpoint_register
+        what = f"write set-point to register {reg}"
+        rr = self._call(what, self._client_method("write_register"), 6, reg, word)
+        echo = (getattr(rr, "address", reg), list(getattr(rr, "registers", [word]) or [word]))
+        if echo != (reg, [word]):
+            raise ChamberError(
+                f"chamber {self.name}: {what}: the reply echoes register {echo[0]} = "
+                f"{echo[1]}, not {reg} = [{word}]"
+            )
 
     def _client_method(self, name: str) -> Callable[..., Any]:
         if self._client is None:
@@ -175,9 +222,27 @@ class ModbusChamber:
         return fn
 
     def _read(self, register: int, kind: str) -> float:
+        """One register in °C; a value outside the chamber's range (more than
+        ``tolerance_c`` beyond ``min_c``…``max_c``) is a :class:`ChamberError`: a controller
+        reports a broken probe as 0x8000 (−3276.8 °C at 0.1 °C/count), never a reading."""
         method = "read_input_registers" if kind == "input" else "read_holding_registers"
-        rr = self._call(f"read {kind} register {register}", self._client_method(method), register)
-        return self.map.decode(rr.registers[0])
+        what = f"read {kind} register {register}"
+        rr = self._call(what, self._client_method(method), 4 if kind == "input" else 3, register)
+        regs = list(getattr(rr, "registers", None) or [])
+        if len(regs) != 1:
+            raise ChamberError(
+                f"chamber {self.name}: {what}: the reply holds {len(regs)} registers, not 1 "
+                "(byte count 0 or a cut frame)"
+            )
+        word = regs[0]
+        value = self.map.decode(word)
+        why = self.cfg.out_of_range(value, self.cfg.tolerance_c)
+        if why:
+            raise ChamberError(
+                f"chamber {self.name}: {what}: 0x{int(word) & 0xFFFF:04X} = {why}: a probe "
+                "fault, or check the register, scale and signed of [chamber]"
+            )
+        return value
 
     def read_temperature(self) -> float:
         return self._read(self.map.temperature_register, self.map.register_kind)

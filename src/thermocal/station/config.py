@@ -33,8 +33,16 @@ Keys beyond the contract (all optional): ``[chamber]`` ``timeout_s`` (a chamber 
 not answer for this long stops the run safely, default 30 s), ``io_timeout_s`` (one
 request, default 1 s), ``tolerance_c`` and ``drift_s`` (a chamber further than
 ``tolerance_c`` from its set-point for ``drift_s`` of program time is reported; defaults
-5 °C, 1800 s); ``[[sensor]]`` ``decimal`` (``.`` or ``,``) and ``stale_s`` (a sensor
-silent this long is reported, default ``max(2 s, 20 / rate_hz)``).
+5 °C, 1800 s; a hold in which the chamber never comes within ``tolerance_c`` is reported
+when it ends, however short), ``min_c`` and ``max_c`` (the chamber's range [°C], default
+−75…180 °C, the span of common climatic test chambers: every program set-point must lie in
+it, and a temperature read outside it by more than ``tolerance_c`` — a register reading
+0x8000, a broken probe — is a chamber fault, never a reading); ``[[sensor]]`` ``decimal``
+(``.`` or ``,``) and ``stale_s`` (a sensor silent this long is reported, default
+``max(2 s, 20 / rate_hz)``).
+
+``safe_setpoint_c`` must lie in the chamber's range and in :data:`SAFE_RANGE_C`: it is
+written whenever the run stops, unattended.
 """
 
 from __future__ import annotations
@@ -54,6 +62,10 @@ DRIVERS = ("modbus-tcp", "modbus-rtu", "none")
 """Chamber drivers: Modbus TCP, Modbus RTU over a serial line, or a chamber run by hand."""
 
 _ID = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_]*$")
+SAFE_RANGE_C = (0.0, 50.0)
+"""Where a safe set-point may lie [°C]: near room temperature, where a chamber left alone
+neither heats its load nor freezes condensation on it."""
+
 TIME_NAMES = ("time",)
 """A sensor field with this name is the line's own time (its unit one of s, ms, us)."""
 
@@ -80,6 +92,17 @@ class ChamberConfig:
     io_timeout_s: float = 1.0
     tolerance_c: float = 5.0
     drift_s: float = 1800.0
+    min_c: float = -75.0
+    max_c: float = 180.0
+
+    def out_of_range(self, temperature_c: float, margin_c: float = 0.0) -> str:
+        """``""`` when ``temperature_c`` [°C] lies in ``min_c − margin_c … max_c +
+        margin_c`` (finite), else why not (for a message)."""
+        lo, hi = self.min_c - margin_c, self.max_c + margin_c
+        if math.isfinite(temperature_c) and lo <= temperature_c <= hi:
+            return ""
+        return (f"{temperature_c:g} °C is outside the chamber's range {self.min_c:g}…"
+                f"{self.max_c:g} °C ([chamber] min_c, max_c)")  # fmt: skip
 
 
 @dataclass(frozen=True)
@@ -215,7 +238,10 @@ def _chamber(t: dict[str, Any], where: str) -> ChamberConfig:
         ),
         tolerance_c=_positive(_take(t, "tolerance_c", float, w, d.tolerance_c), "tolerance_c", w),
         drift_s=_positive(_take(t, "drift_s", float, w, d.drift_s), "drift_s", w),
+        min_c=_take(t, "min_c", float, w, d.min_c),
+        max_c=_take(t, "max_c", float, w, d.max_c),
     )
+    _check_range(c, w)
     if driver != "none":
         for key in ("setpoint_register", "temperature_register"):
             if key not in t:
@@ -228,6 +254,21 @@ def _chamber(t: dict[str, Any], where: str) -> ChamberConfig:
     if driver == "modbus-rtu" and not c.device:
         raise _err(w, "driver modbus-rtu needs device (a serial port) and baud")
     return c
+
+
+def _check_range(c: ChamberConfig, w: str) -> None:
+    """``min_c < max_c``, both above absolute zero; ``safe_setpoint_c`` in the range and in
+    :data:`SAFE_RANGE_C`."""
+    if not -273.15 < c.min_c < c.max_c:
+        raise _err(w, f"min_c must be above -273.15 °C and below max_c, got min_c = "
+                   f"{c.min_c:g}, max_c = {c.max_c:g}")  # fmt: skip
+    why = c.out_of_range(c.safe_setpoint_c)
+    lo, hi = SAFE_RANGE_C
+    if not why and not lo <= c.safe_setpoint_c <= hi:
+        why = f"{c.safe_setpoint_c:g} °C is not a safe temperature ({lo:g}…{hi:g} °C)"
+    if why:
+        raise _err(w, f"safe_setpoint_c = {why}; it is written whenever the run stops, "
+                   "unattended: give one near room temperature")  # fmt: skip
 
 
 def _unit_ok(u: str) -> bool:

@@ -56,19 +56,38 @@ class RichDisplay:
         self.live.start()
         self._last = -1.0e9
         self._open = True
+        self.broken = ""
+        """Why the terminal is gone (a hang-up, a closed pipe); the loop then stops safely."""
+
+    def _gone(self, exc: BaseException) -> None:
+        from thermocal.station.run import mute_stderr
+
+        self.broken = f"stderr closed ({type(exc).__name__})"
+        mute_stderr()
 
     def update(self, state: StationState) -> None:
         import time
 
         now = time.monotonic()  # the loop turns at 50 Hz; the display needs 4
-        if now - self._last >= 1.0 / REFRESH_HZ:
+        if now - self._last >= 1.0 / REFRESH_HZ and not self.broken:
             self._last = now
-            self.live.update(render(state))
+            try:
+                self.live.update(render(state))
+            except (OSError, ValueError) as exc:
+                self._gone(exc)
 
     def log(self, message: str) -> None:
-        self.console.print(message, markup=False, highlight=False)
+        if self.broken:
+            return
+        try:
+            self.console.print(message, markup=False, highlight=False)
+        except (OSError, ValueError) as exc:
+            self._gone(exc)
 
     def close(self) -> None:
         if self._open:
             self._open = False
-            self.live.stop()
+            try:
+                self.live.stop()
+            except (OSError, ValueError) as exc:
+                self._gone(exc)

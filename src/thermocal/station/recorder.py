@@ -59,6 +59,19 @@ STATION_COLUMNS = {
 """The station's own columns and their units."""
 
 
+RESUME_SENSOR_KEYS = ("names", "units", "delimiter", "decimal", "rate_hz")
+"""The keys of a ``[[sensor]]`` that ``--resume`` must find unchanged."""
+RESUME_CHAMBER_KEYS = ("setpoint_register", "temperature_register", "register_kind", "scale",
+                       "signed")  # fmt: skip
+"""The keys of ``[chamber]`` that ``--resume`` must find unchanged."""
+
+BAD_TEXT_MAX = 200
+"""Characters of a bad line kept in ``SENSOR.bad.txt`` (the rest counted)."""
+
+LOCK_NAME = ".station.lock"
+"""The lock file of a recording folder (its one writer's process id)."""
+
+
 def _fsync_write(path: Path, data: bytes) -> None:
     tmp = path.with_name("." + path.name + ".tmp")
     with open(tmp, "wb") as fh:
@@ -120,7 +133,29 @@ class Recorder:
         self.time_scale = time_scale
         self.streams: dict[str, _Stream] = {}
         self.removed_tmp: list[str] = []
+        self._lock_fd: int | None = None
+        self.created = False
+        self.write_error = ""
+        try:
+            self._open(out_dir, cfg, program, profile_source, time_scale)
+        except BaseException:
+            self.release()
+            raise
+
+    def _open(
+        self,
+        out_dir: Path,
+        cfg: StationConfig,
+        program: tuple[list[float], list[float]],
+        profile_source: str,
+        time_scale: float,
+    ) -> None:
+        """Lock and load (``--resume``) or create the folder; declare the streams; record
+        the run."""
+        resume = self.resume
         if resume:
+            if out_dir.is_dir():
+                self._lock()
             self.doc = self._load_for_resume(program)
         else:
             if out_dir.exists() and (not out_dir.is_dir() or any(out_dir.iterdir())):
@@ -128,7 +163,12 @@ class Recorder:
                     f"{out_dir}: exists and is not empty; continue it with --resume or name "
                     "another -o"
                 )
+            self.created = not out_dir.exists()
             out_dir.mkdir(parents=True, exist_ok=True)
+            self._lock()
+            if (out_dir / STATION_JSON).exists():  # another run started in between
+                self.release()
+                raise ThermocalInputError(f"{out_dir}: another station run started in it")
             now = time.time()
             self.doc = {
                 "format": STATION_FORMAT,
@@ -154,6 +194,52 @@ class Recorder:
         )
         self.save()
 
+    # --- the folder's one writer ----------------------------------------------------------
+    def _lock(self) -> None:
+        """Hold ``DIR/.station.lock`` (an advisory ``flock``, released by the system when the
+        process ends, even by SIGKILL): a second run on the folder is refused."""
+        try:
+            import fcntl
+        except ImportError:  # no flock on this system: one writer is the operator's care
+            return
+        path = self.dir / LOCK_NAME
+        fd = os.open(path, os.O_RDWR | os.O_CREAT, 0o644)
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except OSError:
+            holder = os.read(fd, 32).decode("ascii", "replace").strip() or "?"
+            os.close(fd)
+            raise ThermocalInputError(
+                f"{self.dir}: another station run (process {holder}) is writing this folder; "
+                "wait for it to end, or stop it, before --resume"
+            ) from None
+        os.ftruncate(fd, 0)
+        os.write(fd, str(os.getpid()).encode())
+        self._lock_fd = fd
+
+    def release(self) -> None:
+        """Let another run write the folder."""
+        if self._lock_fd is not None:
+            os.close(self._lock_fd)
+            self._lock_fd = None
+
+    def discard(self) -> None:
+        """A new recording whose run never started: remove what it wrote (``station.json``,
+        the lock, the folder when this run created it), so the corrected command starts
+        afresh.  A resumed recording is left as it is (``--resume`` accepts it again)."""
+        import contextlib
+
+        if self.resume:
+            self.release()
+            return
+        for name in (STATION_JSON, LOCK_NAME, "." + STATION_JSON + ".tmp"):
+            with contextlib.suppress(FileNotFoundError):
+                (self.dir / name).unlink()
+        self.release()
+        if self.created:
+            with contextlib.suppress(OSError):
+                self.dir.rmdir()
+
     # --- setup ------------------------------------------------------------------------
     def _load_for_resume(self, program: tuple[list[float], list[float]]) -> dict[str, Any]:
         doc = read_station_json(self.dir)
@@ -165,6 +251,7 @@ class Recorder:
                 f"{self.dir}: --resume with another program than the recording's "
                 f"({rec.get('source', '?')}); give the same --profile"
             )
+        self._same_setup(doc.get("config"))
         for p in self.dir.glob(".*.parquet.tmp"):  # the part open at the crash
             self.removed_tmp.append(p.name)
             p.unlink()
@@ -172,6 +259,32 @@ class Recorder:
             {"stream": s, "file": p.name} for s, _i, p in closed_parts(self.dir)
         ]
         return doc
+
+    def _same_setup(self, old: Any) -> None:
+        """``--resume`` with the recording's sensors (ids, names, units, rate, separators)
+        and chamber map (registers, scale, sign): the folder is read as one recording, in
+        one set of units, so a difference is refused naming the key and both values."""
+        new = self.cfg.to_dict()
+        old = old if isinstance(old, dict) else {}
+        where = f"{self.dir}: --resume with another STATION.toml than the recording's"
+        old_s = {s.get("id"): s for s in old.get("sensors", []) if isinstance(s, dict)}
+        new_s = {s["id"]: s for s in new["sensors"]}
+        if sorted(map(str, old_s)) != sorted(new_s):
+            raise ThermocalInputError(
+                f"{where}: sensors {sorted(map(str, old_s))} recorded, {sorted(new_s)} given; "
+                "give the same [[sensor]] ids"
+            )
+        pairs = [(f"sensor {sid!r} {k}", old_s[sid].get(k), new_s[sid][k]) for sid in new_s
+                 for k in RESUME_SENSOR_KEYS]  # fmt: skip
+        och = old.get("chamber") if isinstance(old.get("chamber"), dict) else {}
+        pairs += [(f"[chamber] {k}", och.get(k), new["chamber"][k]) for k in RESUME_CHAMBER_KEYS]
+        for key, was_, now_ in pairs:
+            was, now = json.loads(json.dumps(was_)), json.loads(json.dumps(now_))
+            if was != now:
+                raise ThermocalInputError(
+                    f"{where}: {key} was {was!r}, now {now!r} (the folder would be read in "
+                    f"the new setting); give the recording's value or record into another -o"
+                )
 
     def _declare_streams(self) -> None:
         existing = closed_parts(self.dir)
@@ -250,10 +363,14 @@ class Recorder:
             name = part_name(st.name, st.next_index)
             final = self.dir / name
             tmp = self.dir / ("." + name + ".tmp")
-            pq.write_table(table, tmp, write_page_checksum=True)
-            with open(tmp, "rb") as fh:
-                os.fsync(fh.fileno())
-            os.replace(tmp, final)
+            try:
+                pq.write_table(table, tmp, write_page_checksum=True)
+                with open(tmp, "rb") as fh:
+                    os.fsync(fh.fileno())
+                os.replace(tmp, final)
+            except OSError as exc:
+                self._failed(tmp, exc)
+                continue  # already failing: the rows stay in memory, the stop goes on
             self.doc["parts"].append(
                 {
                     "stream": st.name,
@@ -289,14 +406,40 @@ class Recorder:
         """Append bad lines to ``DIR/<sensor>.bad.txt`` (flushed at once)."""
         if not rows:
             return
-        with open(self.dir / f"{sensor}.bad.txt", "a", encoding="utf-8") as fh:
-            for t, idx, reason, text in rows:
-                fh.write(f"{self.rel(t):.6f}\t{idx}\t{reason}\t{text}\n")
-            fh.flush()
-            os.fsync(fh.fileno())
+        path = self.dir / f"{sensor}.bad.txt"
+        try:
+            with open(path, "a", encoding="utf-8") as fh:
+                for t, idx, reason, text in rows:
+                    if len(text) > BAD_TEXT_MAX:  # a 10 MB line is not kept whole
+                        text = text[:BAD_TEXT_MAX] + f"… ({len(text):,} characters)"
+                    fh.write(f"{self.rel(t):.6f}\t{idx}\t{reason}\t{text}\n")
+                fh.flush()
+                os.fsync(fh.fileno())
+        except OSError as exc:
+            self._failed(path, exc)
 
     def save(self) -> None:
-        _fsync_write(self.dir / STATION_JSON, json.dumps(self.doc, indent=1).encode())
+        path = self.dir / STATION_JSON
+        try:
+            _fsync_write(path, json.dumps(self.doc, indent=1).encode())
+        except OSError as exc:
+            self._failed(path, exc)
+
+    def _failed(self, path: Path, exc: OSError) -> None:
+        """A write that failed (a full disk, a file-size limit, a folder gone): the first
+        raises :class:`ThermocalInputError` naming the file, so the run stops safely; later
+        ones, during that safe stop, are ignored (the first error is the one reported)."""
+        if self.write_error:
+            return
+        import re
+
+        code = exc.errno or next(iter(re.findall(r"\[errno (\d+)\]", str(exc))), None)
+        why = os.strerror(int(code)) if code else (str(exc)[:200] or type(exc).__name__)
+        self.write_error = (
+            f"{path}: cannot write ({why}): free space (or fix the folder) and continue "
+            "with --resume; the closed parts are kept"
+        )
+        raise ThermocalInputError(self.write_error) from None
 
 
 __all__ = [

@@ -29,7 +29,7 @@ from thermocal.readers.station import CHAMBER_STREAM, closed_parts
 from thermocal.station.chamber import Chamber, ChamberError, make_chamber
 from thermocal.station.config import ChamberConfig, StationConfig
 from thermocal.station.recorder import Recorder
-from thermocal.station.sensors import SerialSensor
+from thermocal.station.sensors import Bad, SerialSensor
 
 if TYPE_CHECKING:
     import numpy as np
@@ -40,6 +40,15 @@ if TYPE_CHECKING:
 LOOP_S = 0.02
 """Longest sleep of the loop [s]: sensor lines are drained and stop requests seen at least
 this often."""
+
+
+CLOCK_CHECK_S = 2.0
+"""Host seconds of lines after which a sensor's time is compared with the host clock [s]."""
+
+CLOCK_RATIO = (0.8, 1.25)
+"""Accepted ratio of a sensor's time to the host clock over :data:`CLOCK_CHECK_S`: wide
+enough for the bursts in which a serial port delivers lines, narrow enough for a rate or a
+time unit off by a factor of 2 or more."""
 
 
 class StationStopped(ThermocalInputError):
@@ -87,21 +96,57 @@ class Display(Protocol):
     def log(self, message: str) -> None: ...
 
 
+def say(message: str) -> str:
+    """Print ``message`` on stderr; never raises.  Returns ``""``, or why stderr is gone
+    (a closed pipe, a vanished terminal): then file descriptor 2 is pointed at
+    ``os.devnull``, so that no later message (nor Python's flush at exit) raises either.
+    Started without a stderr (``2>&-``: ``sys.stderr`` is None) nothing is printed (never
+    on stdout, where ``--json`` writes) and ``""`` is returned: nobody was watching."""
+    if sys.stderr is None:
+        return ""
+    try:
+        print(message, file=sys.stderr, flush=True)
+    except (OSError, ValueError, AttributeError) as exc:
+        mute_stderr()
+        return f"stderr closed ({type(exc).__name__})"
+    return ""
+
+
+def mute_stderr() -> None:
+    """Point file descriptor 2 (and ``sys.stderr``) at ``os.devnull``."""
+    import contextlib
+    import os
+
+    with contextlib.suppress(OSError, ValueError, AttributeError):
+        fd = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(fd, 2)
+        os.close(fd)
+    with contextlib.suppress(Exception):
+        sys.stderr = open(os.devnull, "w", encoding="utf-8")  # noqa: SIM115 (for the process)
+
+
 class LogDisplay:
-    """Not a terminal: a line per program step and per event on stderr, nothing else."""
+    """Not a terminal: a line per program step and per event on stderr, nothing else.
+    ``broken`` says why stderr is gone (the loop then stops safely: nobody watches)."""
+
+    def __init__(self) -> None:
+        self.broken = ""
 
     def update(self, state: StationState) -> None:
         return None
 
     def log(self, message: str) -> None:
-        print(message, file=sys.stderr, flush=True)
+        if not self.broken:
+            self.broken = say(message)
 
 
 @dataclass(frozen=True)
 class RunResult:
     """What a run did: folder, program span covered [s], parts written, samples per stream,
     bad lines per sensor, how it ended (``"end"``, ``"interrupted"``, ``"chamber"``), the
-    set-points written as ``(program_s, °C)`` and the safe set-point written (or None)."""
+    set-points written as ``(program_s, °C)``, the safe set-point written (or None), the
+    events, why it was interrupted (``"SIGHUP"``, ``"stderr closed (…)"``; ``""``) and, for
+    ``--resume``, how the previous run ended (:func:`previous_run`)."""
 
     out_dir: Path
     program_start_s: float
@@ -113,6 +158,8 @@ class RunResult:
     setpoints: list[tuple[float, float]]
     safe_setpoint_c: float | None
     events: list[dict[str, Any]]
+    stop_reason: str = ""
+    previous: str = ""
 
 
 def _last_program_s(out_dir: Path) -> float:
@@ -157,14 +204,21 @@ class _Loop:
         self.parts: list[str] = []
         self.stopped = {s.id: False for s in cfg.sensors}
         self.anchors: dict[str, float] = {}
+        self.clock_first: dict[str, tuple[float, float]] = {}
+        self.clock_checked: set[str] = set()
+        self.bad_kinds: set[tuple[str, str]] = set()
+        self.limits: dict[str, list[tuple[int, float, str]]] = {}
         self.last_time: dict[str, float] = {}
         self.ended = "end"
+        self.stop_reason = ""
         self.safe: float | None = None
         self.sp = math.nan
         self.chamber_c = math.nan
         self.fail_since: float | None = None
         self.drift_since: float | None = None
         self.drift_reported = False
+        self.hold: tuple[int, float, bool] | None = None
+        self.hold_polls = 0
         self.step = -1
         self.t_run = time.time()
         self.next_poll = self.t_run
@@ -187,16 +241,27 @@ class _Loop:
         self.t_run = time.time()
         self.next_poll = self.t_run
 
-    def play(self, should_stop: Callable[[], bool] | None) -> None:
+    def _stop_asked(self, should_stop: Callable[[], bool | str] | None) -> str:
+        """Why the run must stop now (``""``: it need not): ``should_stop``'s answer (a
+        string is the reason: a signal's name) or a display whose stderr is gone."""
+        asked = should_stop() if should_stop is not None else False
+        if asked:
+            return asked if isinstance(asked, str) else "asked"
+        return str(getattr(self.disp, "broken", "") or "")
+
+    def play(self, should_stop: Callable[[], bool | str] | None) -> None:
         """The loop: every ``LOOP_S`` at most, the program's step and set-point, the
         chamber's poll, drift, the sensors' lines, part rotation and the display."""
         while True:
             now = time.time()
             p = self.p = self.p0 + (now - self.t_run) * self.time_scale
-            if p >= self.end_s or (should_stop is not None and should_stop()):
-                if p < self.end_s:
-                    self.ended = "interrupted"
+            why = self._stop_asked(should_stop)
+            if p >= self.end_s or why:
                 self.p = min(p, self.end_s)
+                if p < self.end_s:
+                    self.ended, self.stop_reason = "interrupted", why
+                else:
+                    self._judge_hold()  # the last hold ran to its end
                 break
             self._program_step(p)
             self._chamber(now, p)
@@ -218,12 +283,42 @@ class _Loop:
         t_prog, c_prog = self.t_prog, self.c_prog
         k = int(np.searchsorted(t_prog, p, side="right")) - 1
         if k != self.step:
+            self._judge_hold()
             self.step = k
+            held = k + 1 < len(c_prog) and c_prog[k] == c_prog[k + 1]
+            self.hold = (k, float(c_prog[k]), False) if held else None
             nxt = float(c_prog[min(k + 1, len(c_prog) - 1)])
             msg = (f"step {k + 1}/{self.state.n_steps}: {float(c_prog[k]):.2f} → {nxt:.2f} °C "
                    f"from program time {float(t_prog[k]):.0f} s")  # fmt: skip
             self.disp.log(msg)
             self.rec.event("step", msg, program_s=p, step=k + 1)
+
+    def _judge_hold(self) -> None:
+        """At a hold's end: warn when the chamber, polled during it, never came within
+        ``tolerance_c`` of the hold's set-point (a chamber that ignores its set-point is
+        noticed in every hold, however much shorter than ``drift_s``)."""
+        hold, self.hold = self.hold, None
+        if hold is None or hold[2] or not self.hold_polls:
+            self.hold_polls = 0
+            return
+        k, sp, _ = hold
+        t0, t1 = float(self.t_prog[k]), float(self.t_prog[k + 1])
+        msg = (f"warning: chamber never within tolerance_c = {self.ch_cfg.tolerance_c:g} °C "
+               f"of the set-point {sp:.2f} °C in the hold at program time {t0:.0f}–{t1:.0f} s "
+               f"(last read {self.chamber_c:.2f} °C): is it following its set-point?")  # fmt: skip
+        self.rec.event("hold", msg, program_s=self.p, step=k + 1, setpoint_c=sp)
+        self.disp.log(msg)
+        self.hold_polls = 0
+
+    def _track_hold(self) -> None:
+        """After a poll: note whether the chamber is within ``tolerance_c`` of the hold's
+        set-point [°C]."""
+        if self.hold is None or not math.isfinite(self.chamber_c):
+            return
+        self.hold_polls += 1
+        k, sp, reached = self.hold
+        if not reached and abs(self.chamber_c - sp) <= self.ch_cfg.tolerance_c:
+            self.hold = (k, sp, True)
 
     def _chamber(self, now: float, p: float) -> None:
         """Write the set-point when its register value changes, poll the chamber every
@@ -236,6 +331,7 @@ class _Loop:
         else:
             target = _quantize(float(np.interp(p, self.t_prog, self.c_prog)), ch_cfg.scale,
                                ch_cfg.signed, ch_cfg.driver)  # fmt: skip
+        asked = target != self.sp or now >= self.next_poll
         try:
             if target != self.sp:
                 self.chamber.write_setpoint(target)
@@ -244,12 +340,14 @@ class _Loop:
                 rec.event("setpoint", f"{target:.3f} °C", program_s=p, setpoint_c=target)
             if now >= self.next_poll:
                 self.next_poll = max(self.next_poll + ch_cfg.poll_s, now)
+                self.chamber_c = math.nan  # unknown until the chamber answers
                 self.chamber_c = self.chamber.read_temperature()
+                self._track_hold()
                 rec.add(CHAMBER_STREAM, {"time": rec.rel(now), "program_s": p,
                                          "setpoint_c": self.sp,
                                          "chamber_c": self.chamber_c})  # fmt: skip
                 self.samples[CHAMBER_STREAM] += 1
-            if self.fail_since is not None:
+            if self.fail_since is not None and asked:  # an answer, not a turn without request
                 rec.event("chamber", "the chamber answers again")
                 self.disp.log("chamber answers again")
                 self.fail_since = None
@@ -284,13 +382,70 @@ class _Loop:
             self.drift_since, self.drift_reported = None, False
 
     def _add_rows(self, s: SerialSensor, got: list[Any]) -> None:
-        """The sensor's lines as rows of its stream, with the chamber's state."""
+        """The sensor's lines as rows of its stream, with the chamber's state; a line with a
+        value beyond any sensor is kept aside instead (:func:`_beyond_any_sensor`)."""
+        row: dict[str, float] = {}
+        limits = self.limits.setdefault(s.cfg.id, _signal_limits(s.cfg))
+        beyond = [(smp, why) for smp in got if (why := _beyond_any_sensor(smp.values, limits))]
+        if beyond:
+            rows = [(b.host_unix, b.index, why, ",".join(f"{v:g}" for v in b.values))
+                    for b, why in beyond]  # fmt: skip
+            self.bad[s.cfg.id] += len(rows)
+            self.rec.bad_lines(s.cfg.id, rows)
+            self._warn_bad(s.cfg.id, [Bad(h, i, t, r) for h, i, r, t in rows], self.p)
+            skip = {id(b) for b, _w in beyond}
+            got = [smp for smp in got if id(smp) not in skip]
         for smp in got:
             row = _sensor_row(s, smp.host_unix, smp.index, smp.values, self.rec, self.anchors,
                               self.last_time)  # fmt: skip
             program_s = self.p0 + (smp.host_unix - self.t_run) * self.time_scale
             row.update(chamber_c=self.chamber_c, setpoint_c=self.sp, program_s=program_s)
             self.rec.add(s.cfg.id, row)
+        if row:  # from the last line of the first read: lines queued before it share its time
+            self.clock_first.setdefault(s.cfg.id, (row["time"], row["host_time"]))
+            self._check_clock(s, row["time"], row["host_time"])
+
+    def _check_clock(self, s: SerialSensor, t: float, host: float) -> None:
+        """Once per run, after :data:`CLOCK_CHECK_S` of host time: the recording's time
+        (``rate_hz`` or the line's own time field) must advance as the host clock does,
+        ``Δtime / Δhost`` within :data:`CLOCK_RATIO`; else a ``warning:`` (a rate of 1000 Hz
+        declared for a 50 line/s sensor makes every duration 20× too short)."""
+        sid = s.cfg.id
+        t0, h0 = self.clock_first[sid]
+        if sid in self.clock_checked or host - h0 < CLOCK_CHECK_S:
+            return
+        self.clock_checked.add(sid)
+        ratio = (t - t0) / (host - h0)
+        lo, hi = CLOCK_RATIO
+        if lo <= ratio <= hi:
+            return
+        cfg = s.cfg
+        how = (f"rate_hz = {cfg.rate_hz:g}" if cfg.rate_hz is not None else
+               f"its time field {cfg.time_name!r} in "
+               f"{cfg.units[cfg.names.index(cfg.time_name or '')]}")  # fmt: skip
+        msg = (f"warning: sensor {sid}: its time advances {ratio:.3g}× as fast as the host "
+               f"clock over {host - h0:.1f} s ({how} in {self.cfg.source}; the lines arrive at "
+               f"{s.stats.rate_hz():.1f} per s): the recording's time is wrong; stop, fix "
+               "STATION.toml and record again (host_time holds the host's clock)")  # fmt: skip
+        self.rec.event("clock", msg, sensor=sid, ratio=ratio, program_s=self.p)
+        self.disp.log(msg)
+
+    def _warn_bad(self, sid: str, bads: list[Any], p: float) -> None:
+        """A ``warning:`` for the first bad line of each kind (its reason without the
+        numbers and text) per sensor; the rest are counted in ``SENSOR.bad.txt``."""
+        import re
+
+        for b in bads:
+            kind = re.sub(r"\d+", "#", b.reason.split(":")[0])
+            if (sid, kind) in self.bad_kinds:
+                continue
+            self.bad_kinds.add((sid, kind))
+            msg = (
+                f"warning: sensor {sid}: line {b.index} kept aside in {sid}.bad.txt, not "
+                f"recorded ({b.reason}); lines of this kind are only counted from now on"
+            )
+            self.rec.event("bad", msg, sensor=sid, program_s=p)
+            self.disp.log(msg)
 
     def _sensors(self, now: float, p: float) -> list[SensorView]:
         """Drain every sensor's lines into the recorder; report a sensor that stops or
@@ -302,6 +457,7 @@ class _Loop:
             if bads:
                 self.bad[sid] += len(bads)
                 rec.bad_lines(sid, [(b.host_unix, b.index, b.reason, b.text) for b in bads])
+                self._warn_bad(sid, bads, p)
             self._add_rows(s, got)
             self.samples[sid] += len(got)
             silent = (now - (s.stats.last_unix if s.stats.good else self.t_run)
@@ -319,24 +475,42 @@ class _Loop:
                                     self.bad[sid], self.samples[sid], silent))  # fmt: skip
         return views
 
+    def abandon(self) -> None:
+        """A start that failed (the chamber or a sensor did not open): close what opened and
+        leave no recording behind (:meth:`Recorder.discard`)."""
+        import contextlib
+
+        for s in self.sensors:
+            with contextlib.suppress(Exception):
+                s.close()
+        with contextlib.suppress(Exception):
+            self.chamber.close()
+        self.rec.discard()
+
     def finish(self) -> None:
         """Every way out: the safe set-point, the ports closed, their last lines recorded,
-        the open parts closed, the stop event, the chamber closed."""
+        the open parts closed, the stop event (how the run ended, the chamber's last
+        set-point), the chamber closed.  Each step runs even when one before it failed."""
         rec = self.rec
         self.safe = _safe_stop(self.chamber, self.ch_cfg.safe_setpoint_c, rec, self.disp)
-        for s in self.sensors:
-            s.close()
-        # the last lines that arrived before the ports closed
-        for s in self.sensors:
-            got, bads = s.drain()
-            self.bad[s.cfg.id] += len(bads)
-            rec.bad_lines(s.cfg.id, [(b.host_unix, b.index, b.reason, b.text) for b in bads])
-            self._add_rows(s, got)
-            self.samples[s.cfg.id] += len(got)
-        self.parts += rec.close_parts()
-        rec.event("stop", f"ended: {self.ended}", program_s=self.p, ended=self.ended,
-                  safe_setpoint_c=self.safe)  # fmt: skip
-        self.chamber.close()
+        try:
+            for s in self.sensors:
+                s.close()
+            # the last lines that arrived before the ports closed
+            for s in self.sensors:
+                got, bads = s.drain()
+                self.bad[s.cfg.id] += len(bads)
+                rec.bad_lines(s.cfg.id, [(b.host_unix, b.index, b.reason, b.text) for b in bads])
+                self._add_rows(s, got)
+                self.samples[s.cfg.id] += len(got)
+        finally:
+            self.parts += rec.close_parts()
+            left = self.safe if self.safe is not None else self.sp
+            rec.event("stop", f"ended: {self.ended}" + (f" ({self.stop_reason})" if
+                      self.stop_reason else ""), program_s=self.p, ended=self.ended,
+                      reason=self.stop_reason, safe_setpoint_c=self.safe,
+                      left_at_c=None if left != left else left)  # fmt: skip
+            self.chamber.close()
 
 
 def _open_recorder(
@@ -348,9 +522,9 @@ def _open_recorder(
     resume: bool,
     time_scale: float,
     disp: Display,
-) -> tuple[Recorder, float]:
-    """The recorder of ``out_dir`` and the program time to start at [s] (0, or where a
-    resumed recording ends)."""
+) -> tuple[Recorder, float, str]:
+    """The recorder of ``out_dir``, the program time to start at [s] (0, or where a
+    resumed recording ends) and how the previous run ended (``--resume``)."""
     end_s = float(t_prog[-1])
     p0 = _last_program_s(out_dir) if resume and out_dir.is_dir() else 0.0
     if resume and p0 >= end_s:
@@ -361,13 +535,50 @@ def _open_recorder(
         out_dir, cfg, (list(map(float, t_prog)), list(map(float, c_prog))),
         profile_source=profile_source, time_scale=time_scale, resume=resume,
     )  # fmt: skip
+    n_events = len(rec.doc["events"])
     if rec.removed_tmp:
         rec.event("resume", "removed the part open at the interruption: " + ", ".join(
             rec.removed_tmp))  # fmt: skip
+    previous = ""
     if resume:
+        previous, alarm = previous_run(rec.doc["events"][:n_events])
+        rec.event("resume", previous, program_s=p0)
+        disp.log(("warning: " if alarm else "") + previous)
         rec.event("resume", f"program continues at {p0:.1f} s", program_s=p0)
         disp.log(f"resuming at program time {p0:.1f} s of {end_s:.1f} s")
-    return rec, p0
+    return rec, p0, previous
+
+
+def previous_run(events: list[dict[str, Any]]) -> tuple[str, bool]:
+    """How the last run of a recording ended and where it left the chamber, from its
+    ``station.json`` events, and whether that needs the operator's attention.
+
+    A run that ended writes a ``stop`` event (how it ended, the safe set-point written or
+    not); a run killed (SIGKILL, a power cut, a crash of the interpreter) leaves none: then
+    the chamber still holds the last set-point written (``setpoint`` events) [°C].
+    """
+    last_sp: float | None = None
+    stop: dict[str, Any] | None = None
+    started = False
+    for ev in events:
+        kind = ev.get("kind")
+        if kind == "start":
+            started, stop = True, None
+        elif kind in ("setpoint", "safe") and isinstance(ev.get("setpoint_c"), int | float):
+            last_sp = float(ev["setpoint_c"])
+        elif kind == "stop":
+            stop = ev
+    where = "unknown" if last_sp is None else f"{last_sp:.2f} °C"
+    if stop is None:
+        if not started:
+            return "the last run never started", False
+        return (f"the last run was killed (no stop record: SIGKILL, a power cut or a crash); "
+                f"the chamber was left at {where}, the last set-point written"), True  # fmt: skip
+    how = str(stop.get("ended", "?")) + (f" by {stop['reason']}" if stop.get("reason") else "")
+    if stop.get("safe_setpoint_c") is None:
+        return (f"the last run ended: {how}, WITHOUT the safe set-point; the chamber was "
+                f"left at {where}, the last set-point written"), True  # fmt: skip
+    return f"the last run ended: {how}; the chamber was left at {where} (the safe set-point)", False
 
 
 def run_station(
@@ -380,14 +591,17 @@ def run_station(
     time_scale: float = 1.0,
     display: Display | None = None,
     chamber: Chamber | None = None,
-    should_stop: Callable[[], bool] | None = None,
+    should_stop: Callable[[], bool | str] | None = None,
 ) -> RunResult:
     """Run the program on the station and record everything into ``out_dir``.
 
     Raises :class:`StationStopped` (after the safe set-point and every file are written)
     when the chamber has not answered for ``chamber.timeout_s``; a ``KeyboardInterrupt`` is
-    re-raised after the same safe stop.  ``should_stop`` (tests, a GUI) ends the run early
-    as an interrupt does, without the exception.
+    re-raised after the same safe stop.  ``should_stop`` (signal handlers, tests, a GUI) ends
+    the run early as an interrupt does, without the exception; a string it returns is the
+    reason recorded (``"SIGHUP"``).  A :class:`LogDisplay` whose stderr is gone ends it too.
+    With ``resume``, how the previous run ended and where it left the chamber is logged
+    (``warning:`` when it was killed or left without its safe set-point).
     """
     import numpy as np
 
@@ -398,20 +612,36 @@ def run_station(
     c_prog = np.asarray(program[1], dtype=np.float64)
     ch_cfg = cfg.chamber
     chamber = chamber or make_chamber(ch_cfg, disp.log)
+    for t, c in zip(t_prog, c_prog, strict=True):  # before anything is written
+        why = ch_cfg.out_of_range(float(c))
+        if why:
+            raise ThermocalInputError(
+                f"{profile_source or 'the program'}: set-point at program time {t:g} s: {why} "
+                f"in {cfg.source}; fix the program or the chamber's range"
+            )
     for c in (*c_prog, ch_cfg.safe_setpoint_c):  # every set-point must fit the register
         _check_setpoint(float(c), ch_cfg)
-    rec, p0 = _open_recorder(cfg, t_prog, c_prog, out_dir, profile_source, resume, time_scale, disp)
+    rec, p0, previous = _open_recorder(cfg, t_prog, c_prog, out_dir, profile_source, resume,
+                                       time_scale, disp)  # fmt: skip
     loop = _Loop(cfg, t_prog, c_prog, p0, time_scale, rec, chamber, disp)
     try:
         loop.start()
+    except BaseException:  # nothing was written to the chamber: no safe stop to make
+        loop.abandon()
+        raise
+    try:
         loop.play(should_stop)
     except KeyboardInterrupt:
         loop.ended = "interrupted"
         raise
     finally:
-        loop.finish()
+        try:
+            loop.finish()
+        finally:
+            rec.release()
     return RunResult(out_dir, p0, loop.p, loop.parts, loop.samples, loop.bad, loop.ended,
-                     loop.setpoints, loop.safe, list(rec.doc["events"]))  # fmt: skip
+                     loop.setpoints, loop.safe, list(rec.doc["events"]), loop.stop_reason,
+                     previous)  # fmt: skip
 
 
 def _check_setpoint(c: float, ch: ChamberConfig) -> None:
@@ -463,6 +693,37 @@ def _sensor_row(
     row["time"] = t
     row["host_time"] = host
     return row
+
+
+def _signal_limits(cfg: Any) -> list[tuple[int, float, str]]:
+    """``(field index, limit in the field's own unit, unit)`` of each rate or acceleration
+    field: :data:`thermocal.recording.PLAUSIBLE_SIGNAL` (the limit every command applies
+    to a recording) converted to the field's unit."""
+    import numpy as np
+
+    from thermocal import units
+    from thermocal.errors import UnitError
+    from thermocal.recording import PLAUSIBLE_SIGNAL
+
+    out = []
+    for i, u in enumerate(cfg.units):
+        try:
+            kind = units.signal_kind(u)
+        except UnitError:
+            continue
+        if kind in PLAUSIBLE_SIGNAL:
+            one = float(units.to_canonical(np.array([1.0]), u, finite=False)[0][0])
+            out.append((i, PLAUSIBLE_SIGNAL[kind] / one, u))
+    return out
+
+
+def _beyond_any_sensor(values: tuple[float, ...], limits: list[tuple[int, float, str]]) -> str:
+    """Why a line's values cannot come from a sensor (``""``: they can): a rate or an
+    acceleration beyond :data:`thermocal.recording.PLAUSIBLE_SIGNAL` (``1e300 deg/s``)."""
+    for i, lim, u in limits:
+        if abs(values[i]) > lim:
+            return f"beyond any sensor: {values[i]:g} {u} (|value| ≤ {lim:g} {u})"
+    return ""
 
 
 def _safe_stop(chamber: Chamber, safe_c: float, rec: Recorder, disp: Display) -> float | None:

@@ -6,8 +6,9 @@ lines read in one chunk share it.  A line is parsed with the text-log rules of
 (or the first of ``,`` ``;`` tab blanks that gives one field per name), numbers as a CSV
 reader takes them (:func:`thermocal.readers.text.parse_number`: no digit-group underscores, no
 non-ASCII digits), a decimal comma when the TOML says so.  A line that does not give one
-number per name — a banner, a mangled or cut line — is a *bad line*: counted, kept aside
-with its host time and reason, never merged into the data.  Empty lines are ignored.
+number per name — a banner, a mangled or cut line, a value that is not finite (``nan``,
+``inf``, ``1e999``: never a measurement) — is a *bad line*: counted, kept aside with its host
+time and reason, never merged into the data.  Empty lines are ignored.
 """
 
 from __future__ import annotations
@@ -55,9 +56,12 @@ class LineParser:
             if not text:
                 raise BadLine("empty field")
             try:
-                out.append(parse_number(text))
+                value = parse_number(text)
             except ValueError:
                 raise BadLine(f"not a number: {text[:40]!r}") from None
+            if not math.isfinite(value):  # nan, inf, 1e999, a line glued to the next
+                raise BadLine(f"not finite: {text[:40]!r}")
+            out.append(value)
         return tuple(out)
 
     def parse(self, line: str) -> tuple[float, ...]:
@@ -152,7 +156,7 @@ class SerialSensor:
         )
         self._thread.start()
 
-    def _line(self, t: float, raw: bytes) -> None:
+    def _line(self, t: float, raw: bytes, overlong: str = "") -> None:
         text = raw.decode("utf-8", errors="replace").strip("\r\n\x00 ")
         if not text.strip():
             return
@@ -160,6 +164,8 @@ class SerialSensor:
         idx = st.lines
         st.lines += 1
         try:
+            if overlong:
+                raise BadLine(overlong)
             values = self.parser.parse(text)
         except BadLine as exc:
             st.bad += 1
@@ -175,24 +181,37 @@ class SerialSensor:
 
     def _run(self) -> None:
         buf = b""
+        skipping = False
         port = self._port
-        while not self._stop.is_set():
+        while True:
+            last = self._stop.is_set()  # stopping: what the port already holds, once
             try:
-                data = port.read(max(1, port.in_waiting))
+                waiting = port.in_waiting
+                data = (
+                    port.read(waiting if last else max(1, waiting)) if waiting or not last else b""
+                )
             except Exception as exc:  # a port that vanished: reported, thread ends
                 self.stats.error = f"{type(exc).__name__}: {exc}"
                 return
             if not data:
+                if last:
+                    return
                 continue
             t = time.time()
+            if skipping:  # the rest of an overlong line, up to its end
+                if b"\n" not in data:
+                    continue
+                data, skipping = data.split(b"\n", 1)[1], False
             buf += data
             *lines, buf = buf.split(b"\n")
             with self._lock:
                 for raw in lines:
                     self._line(t, raw)
-                if len(buf) > MAX_LINE:
-                    self._line(t, buf)
-                    buf = b""
+                if len(buf) > MAX_LINE:  # kept aside once (cut), the rest skipped
+                    self._line(t, buf[:MAX_LINE], f"longer than {MAX_LINE} bytes")
+                    buf, skipping = b"", True
+            if last:
+                return
 
     def drain(self) -> tuple[list[Sample], list[Bad]]:
         """The good and bad lines that arrived since the last call."""
