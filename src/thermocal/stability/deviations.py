@@ -171,19 +171,68 @@ def _nested_difference_sum(x: FloatArray, m: int, n_terms: int, d: int) -> float
     return total
 
 
+def _third_differences(x: FloatArray, m: int, a: int, n_b: int, out: FloatArray) -> FloatArray:
+    """t_k = x_{k+3m} − 3x_{k+2m} + 3x_{k+m} − x_k for k in [a, a + n_b), into ``out``."""
+    t = out[:n_b]
+    np.subtract(x[a + 3 * m : a + n_b + 3 * m], x[a : a + n_b], out=t)
+    u = np.subtract(x[a + m : a + n_b + m], x[a + 2 * m : a + n_b + 2 * m])
+    u *= 3.0
+    t += u
+    return t
+
+
+def modified_sum(x: FloatArray, m: int, n_terms: int) -> float:
+    """Σ_{j<n_terms} v_j² of MDEV's inner sums v_j = Σ_{i=j}^{j+m−1} (x_{i+2m} − 2x_{i+m} +
+    x_i) (NIST SP 1065 eq. 14), with no running sum of the phase itself.
+
+    v_0 is summed directly (pairwise); then v_{j+1} = v_j + t_j with t_j = x_{j+3m} −
+    3x_{j+2m} + 3x_{j+m} − x_j (the inner sum slides by one: it gains the second difference
+    at j + m and loses the one at j), a running sum carried from block to block of
+    :data:`_CHUNK` terms.  Every partial sum is a v_j itself, as small as the deviation:
+    rounding grows as ε √N relative, not as ε N² |x| / |v| as a running sum of the phase
+    does (issue 42).  At m = 1, v_j is the second difference itself (no running sum): MDEV
+    is OADEV to the last digit."""
+    if n_terms < 1:
+        return 0.0
+    if m == 1:
+        return _nested_difference_sum(x, 1, n_terms, 2)
+    first = x[2 * m : 3 * m] - 2.0 * x[m : 2 * m]
+    first += x[:m]
+    v = float(np.sum(first))
+    size = min(_CHUNK, n_terms)
+    buf, tmp = np.empty(size), np.empty(size)
+    total = 0.0
+    for a in range(0, n_terms, _CHUNK):
+        n_b = min(a + _CHUNK, n_terms) - a
+        n_t = min(n_b, n_terms - 1 - a)  # t_j exists for j < n_terms − 1
+        w = buf[:n_b]
+        w[0] = v
+        if n_t > 0:
+            t = _third_differences(x, m, a, n_t, tmp)
+            w[1:n_b] = t[: n_b - 1]
+            np.cumsum(w, out=w)
+            if n_t == n_b:  # the next block's first inner sum
+                v = float(w[-1]) + float(t[-1])
+        total += float(w @ w)
+    return total
+
+
 def difference_sums(
     base: Callable[[int], tuple[FloatArray, int, int]],
     m: IntArray,
     taps: tuple[tuple[int, float], ...],
     nested: bool = False,
+    kernel: Callable[[FloatArray, int, int], float] | None = None,
 ) -> FloatArray:
     """:func:`_difference_sum` for each factor m: ``base(m)`` gives (array, offset unit,
     term count) — the phase with m itself, or a decimated phase with 1 — shared between
     :data:`_WORKERS` threads (numpy releases the GIL in its loops; BLAS held to one thread
-    meanwhile)."""
+    meanwhile).  ``kernel(array, step, n_terms)``: another sum than ``taps``' (MDEV's)."""
 
     def one(mm: int) -> float:
         arr, step, n_terms = base(mm)
+        if kernel is not None:
+            return kernel(arr, step, n_terms)
         return _difference_sum(arr, step, n_terms, taps, nested)
 
     ms = [int(v) for v in m.tolist()]
@@ -255,13 +304,9 @@ def _fast_sums(name: str, x: FloatArray, m: IntArray) -> tuple[FloatArray, Float
         d, taps = _OVERLAPPING[name]  # ohdev: nested differences (not mdev's running sum)
         sums = difference_sums(lambda mm: (x, mm, n - d * mm), m, taps, nested=True)
         return sums, (n - d * m).astype(np.float64)
-    if name in ("mdev", "tdev"):  # v_j = s_{j+2m} − 2s_{j+m} + s_j, s_j = c_{j+m} − c_j
-        cs = np.empty(n + 1)  # c: the running sum, once for every m
-        cs[0] = 0.0
-        np.cumsum(x, out=cs[1:])
-        return difference_sums(lambda mm: (cs, mm, n - 3 * mm + 1), m, THIRD), (
-            n - 3 * m + 1
-        ).astype(np.float64)
+    if name in ("mdev", "tdev"):  # inner sums slid along by third differences
+        sums = difference_sums(lambda mm: (x, mm, n - 3 * mm + 1), m, THIRD, kernel=modified_sum)
+        return sums, (n - 3 * m + 1).astype(np.float64)
     # totdev: the series extended by odd reflection at both ends, N − 2 terms centred on it
     ext = np.concatenate([2.0 * x[0] - x[n - 2 : 0 : -1], x, 2.0 * x[-1] - x[-2:0:-1]])
     mid = n - 2
