@@ -171,14 +171,50 @@ def _nested_difference_sum(x: FloatArray, m: int, n_terms: int, d: int) -> float
     return total
 
 
-def _third_differences(x: FloatArray, m: int, a: int, n_b: int, out: FloatArray) -> FloatArray:
-    """t_k = x_{k+3m} − 3x_{k+2m} + 3x_{k+m} − x_k for k in [a, a + n_b), into ``out``."""
-    t = out[:n_b]
-    np.subtract(x[a + 3 * m : a + n_b + 3 * m], x[a : a + n_b], out=t)
-    u = np.subtract(x[a + m : a + n_b + m], x[a + 2 * m : a + n_b + 2 * m])
+def _third_differences(
+    x: FloatArray, m: int, a: int, out: FloatArray, tmp: FloatArray, tmp2: FloatArray
+) -> None:
+    """t_k = x_{k+3m} − 3x_{k+2m} + 3x_{k+m} − x_k for k in [a, a + out.size), into ``out``:
+    below :data:`_CHUNK` / 16 as differences of differences over the block and 2m beyond
+    (three subtractions a term), else from the four taps."""
+    n_b = out.size
+    if 16 * m <= _CHUNK:
+        e1 = tmp[: n_b + 2 * m]
+        np.subtract(x[a + m : a + n_b + 3 * m], x[a : a + n_b + 2 * m], out=e1)
+        e2 = tmp2[: n_b + m]
+        np.subtract(e1[m:], e1[: n_b + m], out=e2)
+        np.subtract(e2[m:], e2[:n_b], out=out)
+        return
+    u = tmp[:n_b]
+    np.subtract(x[a + 3 * m : a + n_b + 3 * m], x[a : a + n_b], out=out)
+    np.subtract(x[a + m : a + n_b + m], x[a + 2 * m : a + n_b + 2 * m], out=u)
     u *= 3.0
-    t += u
-    return t
+    out += u
+
+
+_LANES: Final = 32
+"""Running sums per block of :func:`_prefix_squares` are taken over this many contiguous
+pieces at once, one vector add per step (a scalar running sum waits on each add)."""
+
+
+def _prefix_squares(w: FloatArray, lanes: FloatArray) -> tuple[float, float]:
+    """(Σ_k p_k², p_last) of the running sum p_k = Σ_{i≤k} w_i: the block cut into
+    :data:`_LANES` pieces laid side by side (``lanes``: a buffer of ``w.size``), each
+    piece's running sum taken together step by step, then every piece offset by the totals
+    of the pieces before it."""
+    n = w.size
+    if n % _LANES or n < 4 * _LANES:
+        p = np.cumsum(w)
+        return float(p @ p), float(p[-1])
+    cols = n // _LANES
+    grid = lanes[:n].reshape(_LANES, cols)  # column c: w[c·L : (c + 1)·L]
+    np.copyto(grid, w.reshape(cols, _LANES).T)
+    for i in range(1, _LANES):
+        np.add(grid[i], grid[i - 1], out=grid[i])
+    before = np.cumsum(grid[-1])  # the pieces' totals, summed
+    grid[:, 1:] += before[None, :-1]
+    flat = lanes[:n]
+    return float(flat @ flat), float(grid[-1, -1])
 
 
 def modified_sum(x: FloatArray, m: int, n_terms: int) -> float:
@@ -200,20 +236,19 @@ def modified_sum(x: FloatArray, m: int, n_terms: int) -> float:
     first += x[:m]
     v = float(np.sum(first))
     size = min(_CHUNK, n_terms)
-    buf, tmp = np.empty(size), np.empty(size)
+    extra = 2 * m if 16 * m <= _CHUNK else 0
+    buf, lanes = np.empty(size + 1), np.empty(size)
+    tmp, tmp2 = np.empty(size + extra), np.empty(size + extra)
     total = 0.0
     for a in range(0, n_terms, _CHUNK):
         n_b = min(a + _CHUNK, n_terms) - a
         n_t = min(n_b, n_terms - 1 - a)  # t_j exists for j < n_terms − 1
-        w = buf[:n_b]
-        w[0] = v
-        if n_t > 0:
-            t = _third_differences(x, m, a, n_t, tmp)
-            w[1:n_b] = t[: n_b - 1]
-            np.cumsum(w, out=w)
-            if n_t == n_b:  # the next block's first inner sum
-                v = float(w[-1]) + float(t[-1])
-        total += float(w @ w)
+        buf[0] = v  # then t_a … t_{a+n_t−1}: their running sum is v_a … v_{a+n_t}
+        _third_differences(x, m, a, buf[1 : n_t + 1], tmp, tmp2)
+        sq, last = _prefix_squares(buf[:n_b], lanes)
+        total += sq
+        if n_t == n_b:  # the next block's first inner sum
+            v = last + float(buf[n_b])
     return total
 
 
