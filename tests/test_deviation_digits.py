@@ -134,3 +134,17 @@ def test_mdev_equals_adev_at_m1() -> None:
     res = stability(y, TAU0, ["oadev", "mdev"], np.array([TAU0]))
     mdev, oadev = float(res.curves["mdev"].dev[0]), float(res.curves["oadev"].dev[0])
     assert mdev == pytest.approx(oadev, rel=1e-12, abs=0.0)
+
+
+def test_mdev_any_factor_across_blocks() -> None:
+    """MDEV at factors that are no power of 2, either side of the kernel's switch from
+    nested differences to taps (m = 4096 | 4097) and with terms spanning several blocks:
+    within 1e-9 of exact."""
+    ints = _record(300_000, 5)
+    m = np.array([3, 7, 4095, 4096, 4097, 40_000, 99_999])
+    res = stability(ints.astype(np.float64) / SCALE, TAU0, ["mdev"], m * TAU0)
+    curve = res.curves["mdev"]
+    assert curve.m.tolist() == m.tolist()
+    for mm, dev in zip(curve.m.tolist(), curve.dev.tolist(), strict=True):
+        ref = _reference("mdev", ints, int(mm))
+        assert abs(dev - ref) / ref <= REL, (mm, dev, ref)

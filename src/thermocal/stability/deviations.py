@@ -175,10 +175,10 @@ def _third_differences(
     x: FloatArray, m: int, a: int, out: FloatArray, tmp: FloatArray, tmp2: FloatArray
 ) -> None:
     """t_k = x_{k+3m} − 3x_{k+2m} + 3x_{k+m} − x_k for k in [a, a + out.size), into ``out``:
-    below :data:`_CHUNK` / 16 as differences of differences over the block and 2m beyond
+    below :data:`_MOD_CHUNK` / 16 as differences of differences over the block and 2m beyond
     (three subtractions a term), else from the four taps."""
     n_b = out.size
-    if 16 * m <= _CHUNK:
+    if 16 * m <= _MOD_CHUNK:
         e1 = tmp[: n_b + 2 * m]
         np.subtract(x[a + m : a + n_b + 3 * m], x[a : a + n_b + 2 * m], out=e1)
         e2 = tmp2[: n_b + m]
@@ -192,7 +192,10 @@ def _third_differences(
     out += u
 
 
-_LANES: Final = 32
+_MOD_CHUNK: Final = 1 << 16
+"""Terms per block of :func:`modified_sum` (its five buffers stay in the L2 cache)."""
+
+_LANES: Final = 16
 """Running sums per block of :func:`_prefix_squares` are taken over this many contiguous
 pieces at once, one vector add per step (a scalar running sum waits on each add)."""
 
@@ -224,7 +227,7 @@ def modified_sum(x: FloatArray, m: int, n_terms: int) -> float:
     v_0 is summed directly (pairwise); then v_{j+1} = v_j + t_j with t_j = x_{j+3m} −
     3x_{j+2m} + 3x_{j+m} − x_j (the inner sum slides by one: it gains the second difference
     at j + m and loses the one at j), a running sum carried from block to block of
-    :data:`_CHUNK` terms.  Every partial sum is a v_j itself, as small as the deviation:
+    :data:`_MOD_CHUNK` terms.  Every partial sum is a v_j itself, as small as the deviation:
     rounding grows as ε √N relative, not as ε N² |x| / |v| as a running sum of the phase
     does (issue 42).  At m = 1, v_j is the second difference itself (no running sum): MDEV
     is OADEV to the last digit."""
@@ -235,13 +238,13 @@ def modified_sum(x: FloatArray, m: int, n_terms: int) -> float:
     first = x[2 * m : 3 * m] - 2.0 * x[m : 2 * m]
     first += x[:m]
     v = float(np.sum(first))
-    size = min(_CHUNK, n_terms)
-    extra = 2 * m if 16 * m <= _CHUNK else 0
+    size = min(_MOD_CHUNK, n_terms)
+    extra = 2 * m if 16 * m <= _MOD_CHUNK else 0
     buf, lanes = np.empty(size + 1), np.empty(size)
     tmp, tmp2 = np.empty(size + extra), np.empty(size + extra)
     total = 0.0
-    for a in range(0, n_terms, _CHUNK):
-        n_b = min(a + _CHUNK, n_terms) - a
+    for a in range(0, n_terms, _MOD_CHUNK):
+        n_b = min(a + _MOD_CHUNK, n_terms) - a
         n_t = min(n_b, n_terms - 1 - a)  # t_j exists for j < n_terms − 1
         buf[0] = v  # then t_a … t_{a+n_t−1}: their running sum is v_a … v_{a+n_t}
         _third_differences(x, m, a, buf[1 : n_t + 1], tmp, tmp2)
