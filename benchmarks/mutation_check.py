@@ -826,6 +826,22 @@ MUTANTS: tuple[Mutant, ...] = (
         "mdev evaluated one m beyond the data",
     ),
     Mutant(
+        "stability-mdev-third-difference-taps",
+        P + "stability/deviations.py",
+        "    u *= 3.0\n",
+        "    u *= 2.0\n",
+        _t("deviation_digits"),
+        "MDEV's slide x_{j+3m} − 3x_{j+2m} + 3x_{j+m} − x_j with 2 for 3 (m above 4096)",
+    ),
+    Mutant(
+        "stability-mdev-first-inner-sum",
+        P + "stability/deviations.py",
+        "    v = float(np.sum(first))\n",
+        "    v = float(np.sum(first[1:]))\n",
+        _t("deviation_digits"),
+        "MDEV's first inner sum v_0 one second difference short",
+    ),
+    Mutant(
         "stability-totdev-reflection-sign",
         P + "stability/deviations.py",
         "v = (s[:, : 6 * m] - 2.0 * s[:, m : 7 * m] + s[:, 2 * m : 8 * m]) / m",

@@ -171,19 +171,106 @@ def _nested_difference_sum(x: FloatArray, m: int, n_terms: int, d: int) -> float
     return total
 
 
+def _third_differences(
+    x: FloatArray, m: int, a: int, out: FloatArray, tmp: FloatArray, tmp2: FloatArray
+) -> None:
+    """t_k = x_{k+3m} − 3x_{k+2m} + 3x_{k+m} − x_k for k in [a, a + out.size), into ``out``:
+    below :data:`_MOD_CHUNK` / 16 as differences of differences over the block and 2m beyond
+    (three subtractions a term), else from the four taps."""
+    n_b = out.size
+    if 16 * m <= _MOD_CHUNK:
+        e1 = tmp[: n_b + 2 * m]
+        np.subtract(x[a + m : a + n_b + 3 * m], x[a : a + n_b + 2 * m], out=e1)
+        e2 = tmp2[: n_b + m]
+        np.subtract(e1[m:], e1[: n_b + m], out=e2)
+        np.subtract(e2[m:], e2[:n_b], out=out)
+        return
+    u = tmp[:n_b]
+    np.subtract(x[a + 3 * m : a + n_b + 3 * m], x[a : a + n_b], out=out)
+    np.subtract(x[a + m : a + n_b + m], x[a + 2 * m : a + n_b + 2 * m], out=u)
+    u *= 3.0
+    out += u
+
+
+_MOD_CHUNK: Final = 1 << 16
+"""Terms per block of :func:`modified_sum` (its five buffers stay in the L2 cache)."""
+
+_LANES: Final = 16
+"""Running sums per block of :func:`_prefix_squares` are taken over this many contiguous
+pieces at once, one vector add per step (a scalar running sum waits on each add)."""
+
+
+def _prefix_squares(w: FloatArray, lanes: FloatArray) -> tuple[float, float]:
+    """(Σ_k p_k², p_last) of the running sum p_k = Σ_{i≤k} w_i: the block cut into
+    :data:`_LANES` pieces laid side by side (``lanes``: a buffer of ``w.size``), each
+    piece's running sum taken together step by step, then every piece offset by the totals
+    of the pieces before it."""
+    n = w.size
+    if n % _LANES or n < 4 * _LANES:
+        p = np.cumsum(w)
+        return float(p @ p), float(p[-1])
+    cols = n // _LANES
+    grid = lanes[:n].reshape(_LANES, cols)  # column c: w[c·L : (c + 1)·L]
+    np.copyto(grid, w.reshape(cols, _LANES).T)
+    for i in range(1, _LANES):
+        np.add(grid[i], grid[i - 1], out=grid[i])
+    before = np.cumsum(grid[-1])  # the pieces' totals, summed
+    grid[:, 1:] += before[None, :-1]
+    flat = lanes[:n]
+    return float(flat @ flat), float(grid[-1, -1])
+
+
+def modified_sum(x: FloatArray, m: int, n_terms: int) -> float:
+    """Σ_{j<n_terms} v_j² of MDEV's inner sums v_j = Σ_{i=j}^{j+m−1} (x_{i+2m} − 2x_{i+m} +
+    x_i) (NIST SP 1065 eq. 14), with no running sum of the phase itself.
+
+    v_0 is summed directly (pairwise); then v_{j+1} = v_j + t_j with t_j = x_{j+3m} −
+    3x_{j+2m} + 3x_{j+m} − x_j (the inner sum slides by one: it gains the second difference
+    at j + m and loses the one at j), a running sum carried from block to block of
+    :data:`_MOD_CHUNK` terms.  Every partial sum is a v_j itself, as small as the deviation:
+    rounding grows as ε √N relative, not as ε N² |x| / |v| as a running sum of the phase
+    does (issue 42).  At m = 1, v_j is the second difference itself (no running sum): MDEV
+    is OADEV to the last digit."""
+    if n_terms < 1:
+        return 0.0
+    if m == 1:
+        return _nested_difference_sum(x, 1, n_terms, 2)
+    first = x[2 * m : 3 * m] - 2.0 * x[m : 2 * m]
+    first += x[:m]
+    v = float(np.sum(first))
+    size = min(_MOD_CHUNK, n_terms)
+    extra = 2 * m if 16 * m <= _MOD_CHUNK else 0
+    buf, lanes = np.empty(size + 1), np.empty(size)
+    tmp, tmp2 = np.empty(size + extra), np.empty(size + extra)
+    total = 0.0
+    for a in range(0, n_terms, _MOD_CHUNK):
+        n_b = min(a + _MOD_CHUNK, n_terms) - a
+        n_t = min(n_b, n_terms - 1 - a)  # t_j exists for j < n_terms − 1
+        buf[0] = v  # then t_a … t_{a+n_t−1}: their running sum is v_a … v_{a+n_t}
+        _third_differences(x, m, a, buf[1 : n_t + 1], tmp, tmp2)
+        sq, last = _prefix_squares(buf[:n_b], lanes)
+        total += sq
+        if n_t == n_b:  # the next block's first inner sum
+            v = last + float(buf[n_b])
+    return total
+
+
 def difference_sums(
     base: Callable[[int], tuple[FloatArray, int, int]],
     m: IntArray,
     taps: tuple[tuple[int, float], ...],
     nested: bool = False,
+    kernel: Callable[[FloatArray, int, int], float] | None = None,
 ) -> FloatArray:
     """:func:`_difference_sum` for each factor m: ``base(m)`` gives (array, offset unit,
     term count) — the phase with m itself, or a decimated phase with 1 — shared between
     :data:`_WORKERS` threads (numpy releases the GIL in its loops; BLAS held to one thread
-    meanwhile)."""
+    meanwhile).  ``kernel(array, step, n_terms)``: another sum than ``taps``' (MDEV's)."""
 
     def one(mm: int) -> float:
         arr, step, n_terms = base(mm)
+        if kernel is not None:
+            return kernel(arr, step, n_terms)
         return _difference_sum(arr, step, n_terms, taps, nested)
 
     ms = [int(v) for v in m.tolist()]
@@ -255,13 +342,9 @@ def _fast_sums(name: str, x: FloatArray, m: IntArray) -> tuple[FloatArray, Float
         d, taps = _OVERLAPPING[name]  # ohdev: nested differences (not mdev's running sum)
         sums = difference_sums(lambda mm: (x, mm, n - d * mm), m, taps, nested=True)
         return sums, (n - d * m).astype(np.float64)
-    if name in ("mdev", "tdev"):  # v_j = s_{j+2m} − 2s_{j+m} + s_j, s_j = c_{j+m} − c_j
-        cs = np.empty(n + 1)  # c: the running sum, once for every m
-        cs[0] = 0.0
-        np.cumsum(x, out=cs[1:])
-        return difference_sums(lambda mm: (cs, mm, n - 3 * mm + 1), m, THIRD), (
-            n - 3 * m + 1
-        ).astype(np.float64)
+    if name in ("mdev", "tdev"):  # inner sums slid along by third differences
+        sums = difference_sums(lambda mm: (x, mm, n - 3 * mm + 1), m, THIRD, kernel=modified_sum)
+        return sums, (n - 3 * m + 1).astype(np.float64)
     # totdev: the series extended by odd reflection at both ends, N − 2 terms centred on it
     ext = np.concatenate([2.0 * x[0] - x[n - 2 : 0 : -1], x, 2.0 * x[-1] - x[-2:0:-1]])
     mid = n - 2
