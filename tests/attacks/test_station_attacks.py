@@ -87,11 +87,28 @@ def _spawn(args: list[str], stdout: int = subprocess.PIPE) -> subprocess.Popen[s
                             stdout=stdout, stderr=subprocess.PIPE)  # fmt: skip
 
 
-def _wait(pred, timeout_s: float, what: str) -> None:  # type: ignore[no-untyped-def]
+def _end(proc: subprocess.Popen[str]) -> None:
+    """Kill the child if it still runs and close its pipes (a pipe left to the garbage
+    collector is a ResourceWarning in whatever test runs next)."""
+    proc.kill()
+    proc.wait()
+    for f in (proc.stdout, proc.stderr):
+        if f is not None:
+            with contextlib.suppress(OSError):
+                f.close()
+
+
+def _wait(pred, timeout_s: float, what: str, drain: int | None = None) -> None:  # type: ignore[no-untyped-def]
+    """Poll ``pred`` until true; ``drain``: a pipe's descriptor read meanwhile, so that a
+    child writing to it never blocks on a full pipe (a loaded machine is slow to start it)."""
+    import select
+
     end = time.monotonic() + timeout_s
     while time.monotonic() < end:
         if pred():
             return
+        if drain is not None and select.select([drain], [], [], 0)[0]:
+            os.read(drain, 1 << 16)
         time.sleep(0.02)
     raise AssertionError(f"timed out waiting for {what}")
 
@@ -122,13 +139,13 @@ def test_signal_writes_safe_setpoint_and_keeps_the_open_part(rig: dict, sig: str
     proc = _spawn(["station", "run", str(toml), "--profile", str(prof), "-o", str(out),
                    "--time-scale", "100"])  # fmt: skip
     try:
-        _wait(lambda: sim.writes and sim.writes[-1][1] == 65.0, 15, "the hot set-point")
+        _wait(lambda: sim.writes and sim.writes[-1][1] == 65.0, 60, "the hot set-point")
         time.sleep(0.5)
         n_sent = len(sen.sent)
         proc.send_signal(getattr(signal, sig))
         _o, err = proc.communicate(timeout=15)
     finally:
-        proc.kill()
+        _end(proc)
     num = getattr(signal, sig).value
     assert proc.returncode == 128 + num, err
     assert sim.writes[-1][1] == pytest.approx(21.5)  # the safe set-point, last
@@ -163,12 +180,12 @@ def test_closed_stderr_ends_in_the_safe_stop_and_closed_parts(rig: dict) -> None
                    "--time-scale", "100"], stdout=subprocess.DEVNULL)  # fmt: skip
     try:
         assert proc.stderr is not None
-        _wait(lambda: len(sim.writes) >= 3, 15, "set-points")
+        _wait(lambda: len(sim.writes) >= 3, 60, "set-points", drain=proc.stderr.fileno())
         n_sent = len(sen.sent)
         proc.stderr.close()
         proc.wait(timeout=15)
     finally:
-        proc.kill()
+        _end(proc)
     assert proc.returncode == 130
     assert sim.writes[-1][1] == pytest.approx(21.5)
     assert _last_kept(out, sen.sent) >= n_sent - 10
@@ -186,12 +203,12 @@ def test_resume_after_sigkill_says_the_chamber_was_left_hot(
     proc = _spawn(["station", "run", str(toml), "--profile", str(prof), "-o", str(out),
                    "--time-scale", "100"])  # fmt: skip
     try:
-        _wait(lambda: sim.writes and sim.writes[-1][1] == 65.0, 15, "the hot set-point")
-        _wait(lambda: len(list(out.glob("imu-*.parquet"))) >= 2, 15, "closed parts")
+        _wait(lambda: sim.writes and sim.writes[-1][1] == 65.0, 60, "the hot set-point")
+        _wait(lambda: len(list(out.glob("imu-*.parquet"))) >= 2, 60, "closed parts")
         proc.kill()
         proc.communicate(timeout=10)
     finally:
-        proc.kill()
+        _end(proc)
     assert sim.writes[-1][1] == 65.0  # nobody could write the safe set-point
     rc = main(["station", "run", str(toml), "--profile", str(prof), "-o", str(out),
                "--resume", "--time-scale", "400"])  # fmt: skip
@@ -448,7 +465,7 @@ def test_one_writer_per_folder(rig: dict, capsys: pytest.CaptureFixture[str]) ->
             "--time-scale", "100"]  # fmt: skip
     proc = _spawn(argv)
     try:
-        _wait(lambda: len(list(out.glob("imu-*.parquet"))) >= 1, 15, "a closed part")
+        _wait(lambda: len(list(out.glob("imu-*.parquet"))) >= 1, 60, "a closed part")
         n_writes = len(sim.writes)
         assert main([*argv, "--resume"]) == 2
         err = capsys.readouterr().err.strip().splitlines()
@@ -462,7 +479,7 @@ def test_one_writer_per_folder(rig: dict, capsys: pytest.CaptureFixture[str]) ->
         proc.kill()
         proc.communicate(timeout=10)
     finally:
-        proc.kill()
+        _end(proc)
     rc = main([*argv, "--resume", "--time-scale", "400"])
     assert rc == 0, capsys.readouterr().err
 
@@ -734,7 +751,7 @@ def test_hangup_of_the_operators_terminal_with_the_live_display(rig: dict) -> No
     )  # fmt: skip
     os.close(slave)
     try:
-        _wait(lambda: sim.writes and sim.writes[-1][1] == 65.0, 15, "the hot set-point")
+        _wait(lambda: sim.writes and sim.writes[-1][1] == 65.0, 60, "the hot set-point")
         time.sleep(0.5)
         seen = b""
         with contextlib.suppress(OSError):
@@ -744,7 +761,7 @@ def test_hangup_of_the_operators_terminal_with_the_live_display(rig: dict) -> No
         proc.send_signal(signal.SIGHUP)
         proc.wait(timeout=15)
     finally:
-        proc.kill()
+        _end(proc)
     assert b"\x1b[" in seen  # it was the live display
     assert proc.returncode == 129
     assert sim.writes[-1][1] == pytest.approx(21.5)
