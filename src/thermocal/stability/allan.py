@@ -135,6 +135,21 @@ _WORKERS: Final = max(1, min(2, os.cpu_count() or 1))
 """Threads sharing the averaging factors of one Allan computation."""
 
 
+def _worst_above(
+    line: FloatArray, ld: FloatArray, hi_ratio: FloatArray, start: int = 0
+) -> int | None:
+    """The τ index (from ``start``) where a term's log line rises furthest above the log of
+    the curve's upper confidence bound ``ld + log(hi_ratio)``, beyond
+    :data:`_LINE_TOLERANCE`; None where it never does (every term's line lies below the
+    whole curve, σ² being a sum of positive terms)."""
+    upper = ld + np.log(np.maximum(hi_ratio, 1.0))
+    above = np.flatnonzero(line > upper + _LINE_TOLERANCE)
+    above = above[above >= start]
+    if not above.size:
+        return None
+    return int(above[np.argmax(line[above] - upper[above])])
+
+
 # --- results -------------------------------------------------------------------------
 
 
@@ -996,10 +1011,8 @@ def _read_slope(
     # line above the curve's upper confidence bound anywhere was read off a region that
     # belongs to something else (e.g. the steep fall of a detrended curve's last points).
     line = intercept + s * lt
-    upper = ld + np.log(np.maximum(hi_ratio, 1.0))
-    above = np.flatnonzero(line > upper + _LINE_TOLERANCE)
-    if above.size:
-        w = int(above[np.argmax(line[above] - upper[above])])
+    w = _worst_above(line, ld, hi_ratio)
+    if w is not None:
         return (
             f"the slope {s:+g} region near τ = {tau[k]:.4g} s is not this noise term: its "
             f"line would lie {math.exp(line[w] - ld[w]):.3g}× above the measured curve at "
@@ -1223,11 +1236,8 @@ def _read_white(
     idx = np.arange(st.start, st.stop)
     best = int(idx[np.argmax(edf[idx])])
     line = st.intercept - 0.5 * lt
-    upper = ld + np.log(np.maximum(hi_ratio, 1.0))
-    above = np.flatnonzero(line > upper + _LINE_TOLERANCE)
-    above = above[above >= st.start]
-    if above.size:
-        w = int(above[np.argmax(line[above] - upper[above])])
+    w = _worst_above(line, ld, hi_ratio, st.start)
+    if w is not None:
         return (
             f"the slope -0.5 stretch τ = {tau[st.start]:.4g} … {tau[st.stop - 1]:.4g} s is not "
             f"this noise term: its line would lie {math.exp(line[w] - ld[w]):.3g}× above the "
