@@ -1837,6 +1837,63 @@ MUTANTS: tuple[Mutant, ...] = (
         H38R,
         "a capital T taken for time",
     ),
+    # issue 39 slice h39-names
+    Mutant(
+        "names-trigraph-one-pass",
+        P + "identifiers.py",
+        'while "??" in s:',
+        'if "??" in s:',
+        IDS,
+        "C comments escaped in one pass: '???' keeps a '??' (a trigraph with the next '/')",
+    ),
+    Mutant(
+        "names-splice-hidden-by-blanks",
+        P + "identifiers.py",
+        'r"\\\\(?=[ ]*$)"',
+        'r"\\\\(?=$)"',
+        IDS,
+        "a backslash followed by blanks at a comment's end left: still a line splice for gcc",
+    ),
+    Mutant(
+        "names-backstop-splice-blanks",
+        P + "identifiers.py",
+        'if re.search(r"\\\\[ \\t]*(\\n|$)", text):',
+        'if re.search(r"\\\\(\\n|$)", text):',
+        IDS,
+        "the generated-C backstop misses a backslash + blanks + newline (a splice for gcc)",
+    ),
+    Mutant(
+        "names-backstop-trigraph",
+        P + "identifiers.py",
+        "if _TRIGRAPH.search(text):",
+        "if False:",
+        IDS,
+        "the generated-C backstop lets a trigraph through",
+    ),
+    Mutant(
+        "names-metrics-twice-adjacent",
+        P + "metrics.py",
+        "if lab in labels[:i]:",
+        "if lab in labels[: max(i - 1, 0)]:",
+        METRICS + _t("tests/attacks/test_metrics_attacks.py"),
+        "a path given twice in a row counted twice",
+    ),
+    Mutant(
+        "names-metrics-third-sensor-only",
+        P + "metrics.py",
+        "if sensors and value not in sensors:",
+        "if len(sensors) > 1 and value not in sensors:",
+        METRICS + _t("tests/attacks/test_metrics_attacks.py"),
+        "a second sensor pooled; only a third one noticed",
+    ),
+    Mutant(
+        "names-metrics-copy-by-time",
+        P + "metrics.py",
+        "values = np.ascontiguousarray(rec.columns[n], dtype=np.float64)",
+        "values = np.ascontiguousarray(rec.time_s, dtype=np.float64)",
+        METRICS + _t("tests/attacks/test_metrics_attacks.py"),
+        "copies found by their time axis (a re-stamped copy passes, real runs at 1 Hz refused)",
+    ),
 )
 
 
