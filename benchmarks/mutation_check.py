@@ -76,6 +76,7 @@ GRAV = _t("mutants_maths", "gravity_tilt", "gravity_tref")
 IDS = _t("mutants_maths", "c_identifiers", "tests/attacks/test_generated_code_attacks.py")
 OUTS = _t("faults", "tests/attacks/test_output_attacks.py")
 METRICS = _t("mutants_maths", "metrics", "drift_angle", "metrics_runs")
+NAMES = _t("tests/attacks/test_names_attacks.py")
 
 
 MUTANTS: tuple[Mutant, ...] = (
@@ -1843,7 +1844,7 @@ MUTANTS: tuple[Mutant, ...] = (
         P + "identifiers.py",
         'while "??" in s:',
         'if "??" in s:',
-        IDS,
+        IDS + NAMES,
         "C comments escaped in one pass: '???' keeps a '??' (a trigraph with the next '/')",
     ),
     Mutant(
@@ -1851,7 +1852,7 @@ MUTANTS: tuple[Mutant, ...] = (
         P + "identifiers.py",
         'r"\\\\(?=[ ]*$)"',
         'r"\\\\(?=$)"',
-        IDS,
+        IDS + NAMES,
         "a backslash followed by blanks at a comment's end left: still a line splice for gcc",
     ),
     Mutant(
@@ -1859,7 +1860,7 @@ MUTANTS: tuple[Mutant, ...] = (
         P + "identifiers.py",
         'if re.search(r"\\\\[ \\t]*(\\n|$)", text):',
         'if re.search(r"\\\\(\\n|$)", text):',
-        IDS,
+        IDS + NAMES,
         "the generated-C backstop misses a backslash + blanks + newline (a splice for gcc)",
     ),
     Mutant(
@@ -1867,7 +1868,7 @@ MUTANTS: tuple[Mutant, ...] = (
         P + "identifiers.py",
         "if _TRIGRAPH.search(text):",
         "if False:",
-        IDS,
+        IDS + NAMES,
         "the generated-C backstop lets a trigraph through",
     ),
     Mutant(
@@ -1893,6 +1894,86 @@ MUTANTS: tuple[Mutant, ...] = (
         "values = np.ascontiguousarray(rec.time_s, dtype=np.float64)",
         METRICS + _t("tests/attacks/test_metrics_attacks.py"),
         "copies found by their time axis (a re-stamped copy passes, real runs at 1 Hz refused)",
+    ),
+    Mutant(
+        "names-kalibr-axis-name-raw",
+        P + "stability/noise_model.py",
+        "name = one_line(ax.name)",
+        "name = ax.name",
+        NOISE + NAMES,
+        "Kalibr YAML: an axis name written raw in its comments (a newline starts a key)",
+    ),
+    Mutant(
+        "names-kalibr-source-raw",
+        P + "stability/noise_model.py",
+        "written by thermocal noise from {one_line(source)}",
+        "written by thermocal noise from {source}",
+        NOISE + NAMES,
+        "Kalibr YAML: the input file's name written raw in the header comment",
+    ),
+    Mutant(
+        "names-kalibr-key-twice-accepted",
+        P + "stability/noise_model.py",
+        "        if key in seen:\n",
+        "        if key in seen and False:\n",
+        NOISE + NAMES,
+        "Kalibr backstop: a key written twice accepted (PyYAML keeps the last)",
+    ),
+    Mutant(
+        "names-kalibr-float-loose",
+        P + "stability/noise_model.py",
+        'elif not re.fullmatch(r"[0-9]+\\.[0-9]*(e[+-][0-9]+)?", value):',
+        'elif not re.fullmatch(r"[0-9.e+-]+", value):',
+        NOISE + NAMES,
+        "Kalibr backstop: '1e+16' (text to YAML 1.1) taken for a float",
+    ),
+    Mutant(
+        "names-one-line-keeps-line-separator",
+        P + "identifiers.py",
+        '_LINE_UNSAFE_CATEGORIES = frozenset(("Cc", "Cf", "Zl", "Zp", "Cs", "Co", "Cn"))',
+        '_LINE_UNSAFE_CATEGORIES = frozenset(("Cc", "Cf", "Zp", "Cs", "Co", "Cn"))',
+        IDS + NAMES,
+        "U+2028 (a YAML line break) kept in a one-line name",
+    ),
+    Mutant(
+        "names-noise-rate-floor",
+        P + "stability/noise_model.py",
+        "IMU_RATE_HZ: Final = (10.0, 1.0e5)",
+        "IMU_RATE_HZ: Final = (0.01, 1.0e5)",
+        NOISE + NAMES,
+        "time x1000 (0.1 Hz) not warned: densities 31.6x silently",
+    ),
+    Mutant(
+        "names-noise-gyro-density-ceiling",
+        P + "stability/noise_model.py",
+        'IMU_DENSITY: Final = {"gyro": (1.0e-9, 1.0e-2), "accel": (1.0e-8, 1.0e-1)}',
+        'IMU_DENSITY: Final = {"gyro": (1.0e-9, 1.0), "accel": (1.0e-8, 1.0e-1)}',
+        NOISE + NAMES,
+        "a gyro density no IMU has (0.012 rad/s/sqrt(Hz)) not warned",
+    ),
+    Mutant(
+        "names-noise-accel-overlap-cli",
+        P + "cli/noise_cmd.py",
+        "if n in names[:i] or n in (taken or []):",
+        "if n in names[:i]:",
+        NOISE + NAMES,
+        "--accel naming the gyro's columns not refused by the command",
+    ),
+    Mutant(
+        "names-noise-rostopic-any",
+        P + "stability/noise_model.py",
+        'ROS_NAME: Final = re.compile(r"[A-Za-z~/][A-Za-z0-9_/]*")',
+        'ROS_NAME: Final = re.compile(r"[^\\n]*")',
+        NOISE + NAMES,
+        "any one-line --rostopic accepted (a quote, a space, '#', nothing)",
+    ),
+    Mutant(
+        "names-poses-deep-json",
+        P + "multipos/files.py",
+        "except RecursionError:  # thousands of nested brackets",
+        "except MemoryError:  # thousands of nested brackets",
+        NAMES,
+        "a POSES file nested 100 000 deep: RecursionError, exit 1",
     ),
 )
 

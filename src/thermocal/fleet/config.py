@@ -102,6 +102,8 @@ def load_config(path: str | Path) -> FleetConfig:
         raise ThermocalInputError(f"{p}: no such configuration file") from None
     except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
         raise ThermocalInputError(f"{p}: not a valid TOML file ({exc})") from None
+    except RecursionError:  # thousands of nested brackets
+        raise ThermocalInputError(f"{p}: not a fleet configuration (nested too deeply)") from None
     unknown = sorted(set(doc) - {"fit", "validate", "limits", "unit"})
     if unknown:
         raise ThermocalInputError(

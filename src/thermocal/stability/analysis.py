@@ -366,7 +366,7 @@ def imu_noise(
         )  # fmt: skip
     model = nm.noise_model(
         axes, 1.0 / rec.sample_interval_s, inflate=inflate, rostopic=rostopic,
-        confidence=confidence,
+        confidence=confidence, where=where,
     )  # fmt: skip
     for ax in axes:
         for kind, t in (("density", ax.density), ("walk", ax.walk)):

@@ -354,6 +354,8 @@ def parse_station(text: str, where: str = "STATION.toml") -> StationConfig:
         doc = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise _err(where, f"not valid TOML ({exc})") from None
+    except RecursionError:  # thousands of nested brackets
+        raise _err(where, "not a station configuration (TOML nested too deeply)") from None
     known = {"part_s", "chamber", "sensor"}
     unknown = sorted(set(doc) - known)
     if unknown:
