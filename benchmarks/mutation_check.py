@@ -1975,6 +1975,30 @@ MUTANTS: tuple[Mutant, ...] = (
         NAMES,
         "a POSES file nested 100 000 deep: RecursionError, exit 1",
     ),
+    Mutant(
+        "names-report-mathtext",
+        P + "report/figures.py",
+        'PLAIN_TEXT: Any = {"text.parse_math": False}',
+        'PLAIN_TEXT: Any = {"text.parse_math": True}',
+        NAMES,
+        "report figures parse a column name as TeX ('$\\\\frac$': ValueError, exit 1)",
+    ),
+    Mutant(
+        "names-report-glyph-warning",
+        P + "report/figures.py",
+        'r"Glyph \\d+ .*missing from font"',
+        'r"Glyph never"',
+        NAMES,
+        "matplotlib's missing-glyph warning on a name with NEL: a foreign line (exit 1 -W error)",
+    ),
+    Mutant(
+        "names-allan-plot-mathtext",
+        P + "report/allan_plots.py",
+        "ax.set_title(title, parse_math=False)",
+        "ax.set_title(title)",
+        NAMES,
+        "allan --plot parses the column name in its title as TeX",
+    ),
 )
 
 

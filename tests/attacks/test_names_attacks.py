@@ -467,3 +467,125 @@ def test_deeply_nested_toml_configuration_is_refused_naming_it(
     assert code == 2, err
     assert _error_line(err).startswith(f"error: {cfg}: "), err
     assert not (tmp_path / "out").exists()
+
+
+# --- the sweep: every other generated file a name reaches -----------------------------------
+
+SIGNAL = "g <script>alert(1)</script> \"q\" 'r' `b` $x^2$ %s %n \u2028 */ /* ??/\n# x"
+TEMP = "T1 <b>x</b> $\\frac$ \u0085\r\nz"
+SENSOR = 'SN <script>x</script>\n"1" $\\frac$'
+
+
+def _chamber_run(path: Path, signal: str, temp: str, seed: int) -> Path:
+    """1200 s at 1 Hz, a quadratic temperature dependence, any column names."""
+    n = 1200
+    t = np.arange(n, dtype=np.float64)
+    temp_c = 25.0 + 15.0 * np.sin(2 * np.pi * t / n * 1.3)
+    rng = np.random.default_rng(seed)
+    y = 0.5 + 0.02 * (temp_c - 25.0) + 1e-3 * (temp_c - 20.0) ** 2 + rng.normal(0, 0.01, n)
+    pq.write_table(pa.table({"time": t, temp: temp_c, signal: y}), path)
+    return path
+
+
+def _html_structure(text: str) -> tuple[list[tuple[str, tuple[str, ...]]], list[str]]:
+    """The element tags (with their attribute names) and the text of an HTML page, as a
+    browser's tokenizer sees them (the standard library's ``html.parser``)."""
+    from html.parser import HTMLParser
+
+    tags: list[tuple[str, tuple[str, ...]]] = []
+    data: list[str] = []
+
+    class P(HTMLParser):
+        def handle_starttag(self, tag: str, attrs: list[tuple[str, str | None]]) -> None:
+            tags.append((tag, tuple(sorted(a for a, _ in attrs))))
+
+        def handle_data(self, d: str) -> None:
+            data.append(d)
+
+    P(convert_charrefs=True).feed(text)
+    return tags, data
+
+
+def _report(
+    tmp: Path, capsys: pytest.CaptureFixture[str], signal: str, temp: str, sensor: str
+) -> str:
+    """fit → validate → compensate → report, the order a user runs them; every input
+    hashed before and after; the report's text."""
+    m = _chamber_run(tmp / "m.parquet", signal, temp, 1)
+    v = _chamber_run(tmp / "v.parquet", signal, temp, 2)
+    cal, val, comp, html = (tmp / n for n in ("cal.json", "val.json", "c.csv", "r.html"))
+    before = _digest([m, v])
+    code, _, err = _run(
+        capsys, "fit", str(m), "--model", "poly", "--order", "2", "--signal", signal,
+        "--temps", temp, "--signal-unit", "deg/h", "--temp-unit", "degC", "--time-unit", "s",
+        "-o", str(cal),
+    )  # fmt: skip
+    assert code == 0, err
+    code, out, err = _run(
+        capsys, "validate", str(cal), str(v), "--modeling", str(m), "--time-unit", "s", "--json"
+    )
+    assert code == 0, err
+    val.write_text(out)
+    code, _, err = _run(capsys, "compensate", str(cal), str(v), "-o", str(comp), "--time-unit", "s")
+    assert code == 0, err
+    # CSV: the reader gets back the names as they were
+    import csv
+
+    with comp.open(newline="", encoding="utf-8") as fh:
+        header = next(csv.reader(fh))
+    assert header[0] == "time" and set(header[1:]) >= {temp, signal, f"{signal}_comp"}
+    code, _, err = _run(
+        capsys, "report", "--model", str(cal), "--recording", str(v), "--validation", str(val),
+        "--modeling", str(m), "--time-unit", "s", "--sensor", sensor, "--title", sensor,
+        "-o", str(html),
+    )  # fmt: skip
+    assert code == 0, err
+    assert not any(ln.startswith("error") for ln in err.splitlines())
+    assert _digest([m, v]) == before
+    return html.read_text(encoding="utf-8")
+
+
+def test_hostile_names_leave_reports_csv_and_json_inert(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The same runs under plain and under hostile names (a ``<script>``, quotes, TeX that
+    matplotlib's mathtext refuses, line breaks): the HTML has the same elements and
+    attributes (``html.parser``), the hostile names appear as text, whole; the model file
+    (JSON) and the compensated CSV give the names back as they were."""
+    (tmp_path / "plain").mkdir()
+    (tmp_path / "hostile").mkdir()
+    plain = _report(tmp_path / "plain", capsys, "gx", "T1", "SN1")
+    hostile = _report(tmp_path / "hostile", capsys, SIGNAL, TEMP, SENSOR)
+    p_tags, _ = _html_structure(plain)
+    h_tags, h_data = _html_structure(hostile)
+    assert h_tags == p_tags
+    assert [t for t, _ in h_tags].count("script") == 1  # the page's own load check
+    text = "".join(h_data)
+    assert SIGNAL in text and "<script>x</script>" in text
+    import json
+
+    def strings(x: object) -> list[str]:
+        if isinstance(x, dict):
+            return [s for k, v in x.items() for s in [k, *strings(v)]]
+        if isinstance(x, list):
+            return [s for v in x for s in strings(v)]
+        return [x] if isinstance(x, str) else []
+
+    doc = json.loads((tmp_path / "hostile" / "cal.json").read_text(encoding="utf-8"))
+    assert SIGNAL in strings(doc) and TEMP in strings(doc)
+
+
+def test_tex_in_a_column_name_is_plotted_as_text(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``allan --plot`` and its ``--dynamic`` heat map title the figure with the column:
+    matplotlib's mathtext raised ValueError on ``$\\frac$`` (exit 1)."""
+    data = _chamber_run(tmp_path / "f.parquet", "g $\\frac$", "T1", 3)
+    png = tmp_path / "a.png"
+    code, _, err = _run(
+        capsys, "allan", str(data), "--signal", "g $\\frac$", "--signal-unit", "deg/h",
+        "--time-unit", "s", "--plot", str(png), "--dynamic", "200",
+    )  # fmt: skip
+    assert code == 0, err
+    pngs = sorted(tmp_path.glob("*.png"))
+    assert len(pngs) == 2 and all(p.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" for p in pngs)
