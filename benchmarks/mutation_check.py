@@ -1999,6 +1999,22 @@ MUTANTS: tuple[Mutant, ...] = (
         NAMES,
         "allan --plot parses the column name in its title as TeX",
     ),
+    Mutant(
+        "names-fleet-id-dollar",
+        P + "fleet/config.py",
+        "not _ID.fullmatch(uid):",
+        "not _ID.match(uid):",
+        NAMES,
+        "a fleet unit id 'u1\\n' accepted ('$' matches before a final newline): a folder name",
+    ),
+    Mutant(
+        "names-station-id-dollar",
+        P + "station/config.py",
+        "if not _ID.fullmatch(sid) or sid == CHAMBER_STREAM:",
+        "if not _ID.match(sid) or sid == CHAMBER_STREAM:",
+        NAMES,
+        "a station sensor id 'imu\\n' accepted ('$' matches before a final newline)",
+    ),
 )
 
 

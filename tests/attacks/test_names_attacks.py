@@ -589,3 +589,49 @@ def test_tex_in_a_column_name_is_plotted_as_text(
     assert code == 0, err
     pngs = sorted(tmp_path.glob("*.png"))
     assert len(pngs) == 2 and all(p.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" for p in pngs)
+
+
+@pytest.mark.parametrize("uid", ["u1\n", "u1\n\n", "u1\r", "../u1", "u 1", "u1/..", ""])
+def test_a_fleet_unit_id_that_is_no_directory_name_is_refused(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], uid: str
+) -> None:
+    """A unit's id names its folder (``units/<id>``) and its row in the summary: ``u1⏎``
+    passed ``^[A-Za-z0-9][A-Za-z0-9._-]*$`` (``$`` matches before a final newline) and made
+    a folder whose name holds a newline."""
+    import json
+
+    data = _chamber_run(tmp_path / "m.parquet", "gx", "T1", 1)
+    cfg = tmp_path / "fleet.toml"
+    cfg.write_text(
+        '[fit]\nmodel = "poly"\norder = 2\nsignal = "gx"\ntemps = "T1"\n'
+        'signal-unit = "deg/h"\ntemp-unit = "degC"\ntime-unit = "s"\n'
+        f"[[unit]]\nid = {json.dumps(uid)}\nmodeling = {json.dumps(str(data))}\n"
+    )
+    out = tmp_path / "out"
+    code, _, err = _run(capsys, "fleet", str(cfg), "-o", str(out))
+    assert code == 2, err
+    line = _error_line(err)
+    assert line.startswith(f"error: {cfg}") and repr(uid) in line, line
+    assert not out.exists()
+
+
+@pytest.mark.parametrize("sid", ["imu\n", "imu\r", "im u", "imu-1", ""])
+def test_a_station_sensor_id_that_is_no_stream_name_is_refused(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], sid: str
+) -> None:
+    """A sensor's id names its stream files (``<id>-0000.parquet``) and its entry in
+    ``station.json``; ``imu⏎`` passed ``^[A-Za-z0-9][A-Za-z0-9_]*$`` (``$`` matches before a
+    final newline).  Refused while the configuration is read, before any port is opened."""
+    import json
+
+    cfg = tmp_path / "station.toml"
+    cfg.write_text(
+        'part_s = 0.5\n[chamber]\ndriver = "modbus-tcp"\nhost = "127.0.0.1"\nport = 1\n'
+        "setpoint_register = 300\ntemperature_register = 100\n"
+        f"[[sensor]]\nid = {json.dumps(sid)}\ndevice = {json.dumps(str(tmp_path / 'tty'))}\n"
+        'baud = 115200\nnames = ["gx", "temp"]\nunits = ["deg/s", "degC"]\nrate_hz = 50\n'
+    )
+    code, _, err = _run(capsys, "station", "check", str(cfg))
+    assert code == 2, err
+    line = _error_line(err)
+    assert line.startswith(f"error: {cfg}") and repr(sid) in line, line

@@ -137,7 +137,7 @@ def load_config(path: str | Path) -> FleetConfig:
                 f"{where}: unknown key(s) {', '.join(extra)}; use id, modeling, validation"
             )
         uid = u.get("id")
-        if not isinstance(uid, str) or not _ID.match(uid):
+        if not isinstance(uid, str) or not _ID.fullmatch(uid):  # "$" matches before a "\n"
             raise ThermocalInputError(
                 f"{where}: id must be letters, digits, '.', '_' or '-' (it names a directory), "
                 f"got {uid!r}"

@@ -292,7 +292,7 @@ def _sensor(t: dict[str, Any], where: str, i: int) -> SensorConfig:
     if unknown:
         raise _err(w, f"unknown key {unknown[0]!r}; known: {', '.join(sorted(known))}")
     sid = _take(t, "id", str, w, "")
-    if not _ID.match(sid) or sid == CHAMBER_STREAM:
+    if not _ID.fullmatch(sid) or sid == CHAMBER_STREAM:  # "$" matches before a "\n"
         raise _err(w, f"id must be letters, digits and _ (and not {CHAMBER_STREAM!r}), got {sid!r}")
     w = f"{where} sensor {sid!r}"
     device = _take(t, "device", str, w, "")
