@@ -635,3 +635,60 @@ def test_a_station_sensor_id_that_is_no_stream_name_is_refused(
     assert code == 2, err
     line = _error_line(err)
     assert line.startswith(f"error: {cfg}") and repr(sid) in line, line
+
+
+TRIAD = (
+    "g\n1\t1\tTC_G0_ID\t0\t6\n# x",
+    "g <script> y",
+    "g \u2028INS_TCAL1_ENABLE 0 z",
+    "a\rINS_TCAL1_ENABLE 0 x",
+    'a "q" %s `b` y',
+    "a \x85 # */ z",
+)
+PARAM_LINE = {
+    "px4": re.compile(r"1\t1\t[A-Z][A-Z0-9_]*\t-?[0-9][0-9.e+-]*\t(6|9)"),
+    "ardupilot": re.compile(r"[A-Z][A-Z0-9_]* -?[0-9][0-9.e+-]*"),
+}
+"""A parameter line of QGroundControl's file (vehicle, component, name, value, MAVLink type)
+and of ArduPilot's ``.parm`` (name, value): names are firmware names, never a column's."""
+
+
+@pytest.mark.parametrize("fmt", ["px4", "ardupilot"])
+def test_hostile_channel_names_never_reach_a_parameter_file(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], fmt: str
+) -> None:
+    """A gyro and an accelerometer triad under hostile names, fitted and exported: every
+    line of the file is a comment or a parameter line of the firmware's grammar, and the
+    parameters are those of the same calibration under plain names."""
+    n = 400
+    t = np.arange(n, dtype=float)
+    temp = 10.0 + 30.0 * t / (n - 1)
+    rng = np.random.default_rng(26)
+    values = [c + 0.01 * (temp - 25.0) + rng.normal(0.0, 0.001, n) for c in (0.1, 0.2, 0.3)]
+    values += [c + 0.3 * (temp - 25.0) + rng.normal(0.0, 0.5, n) for c in (5.0, -3.0, 1000.0)]
+    texts = {}
+    for label, names in (("plain", PLAIN), ("hostile", TRIAD)):
+        d = tmp_path / label
+        d.mkdir()
+        pq.write_table(
+            pa.table({"time": t, "T1": temp, **dict(zip(names, values, strict=True))}), d / "r.pq"
+        )
+        code, _, err = _run(
+            capsys, "fit", str(d / "r.pq"), "--model", "poly", "--order", "3", "--signal",
+            ",".join(names), "--signal-unit", "deg/s,deg/s,deg/s,mg,mg,mg", "--time-unit", "s",
+            "--temps", "T1", "--temp-unit", "degC", "--gravity-axis", "+z", "--gravity",
+            "9.80665", "-o", str(d / "cal.json"),
+        )  # fmt: skip
+        assert code == 0, err
+        out = d / "params.txt"
+        code, _, err = _run(
+            capsys, "export-params", str(d / "cal.json"), "--format", fmt, "--gyro",
+            ",".join(names[:3]), "--accel", ",".join(names[3:]), "-o", str(out),
+        )  # fmt: skip
+        assert code == 0, err
+        texts[label] = out.read_text(encoding="utf-8")
+    lines = texts["hostile"].split("\n")
+    assert lines[-1] == "" and not re.search("[\r\x85\u2028\u2029]", texts["hostile"])
+    for ln in lines[:-1]:
+        assert ln.startswith("#") or PARAM_LINE[fmt].fullmatch(ln), ln
+    assert texts["hostile"] == texts["plain"]
