@@ -1882,10 +1882,18 @@ MUTANTS: tuple[Mutant, ...] = (
     Mutant(
         "names-metrics-third-sensor-only",
         P + "metrics.py",
-        "if sensors and value not in sensors:",
-        "if len(sensors) > 1 and value not in sensors:",
+        "if named and value not in named:",
+        "if len(named) > 1 and value not in named:",
         METRICS + _t("tests/attacks/test_metrics_attacks.py"),
         "a second sensor pooled; only a third one noticed",
+    ),
+    Mutant(
+        "names-metrics-unnamed-run-silent",
+        P + "metrics.py",
+        'if "" in sensors and len(sensors) > 1:',
+        'if "" in sensors and len(sensors) > 2:',
+        METRICS + _t("tests/attacks/test_metrics_attacks.py"),
+        "a run naming no sensor pooled with a named sensor's without a warning",
     ),
     Mutant(
         "names-metrics-copy-by-time",

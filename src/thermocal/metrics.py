@@ -19,6 +19,7 @@ import bisect
 import dataclasses
 import hashlib
 import math
+import warnings
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Final, TypeVar
@@ -28,7 +29,7 @@ import numpy.typing as npt
 
 from thermocal import units
 from thermocal._lazy import LazyModule
-from thermocal.errors import MissingValueError, ThermocalInputError
+from thermocal.errors import MissingValueError, PlausibilityWarning, ThermocalInputError
 from thermocal.recording import Recording, contiguous_slices, is_increasing
 
 _Run = TypeVar("_Run")
@@ -870,13 +871,16 @@ def sensor_identity(rec: Recording) -> tuple[str, str] | None:
 
 
 def _same_sensor(rec: Recording, label: str, sensors: dict[str, str]) -> None:
-    """Refuse runs whose metadata name different sensors (``sensors``: value → first run)."""
+    """Refuse runs whose metadata name different sensors (``sensors``: value → first run;
+    a run that names none is kept under ``""``)."""
     ident = sensor_identity(rec)
     if ident is None:
+        sensors.setdefault("", label)
         return
     key, value = ident
-    if sensors and value not in sensors:
-        first_value, first = next(iter(sensors.items()))
+    named = {v: f for v, f in sensors.items() if v}
+    if named and value not in named:
+        first_value, first = next(iter(named.items()))
         raise ThermocalInputError(
             f"{label}: {key} {value!r} is not the sensor of {first} ({first_value!r}): a "
             "turn-on to turn-on repeatability pools power-ons of ONE sensor; give each "
@@ -940,6 +944,14 @@ def power_on_metrics(
         per_run.append({n: options.of(rec, n) for n in these})
     if names is None:
         raise ThermocalInputError("no run to analyse")
+    if "" in sensors and len(sensors) > 1:
+        value, first = next((v, f) for v, f in sensors.items() if v)
+        warnings.warn(
+            f"{sensors['']}: its metadata names no sensor; taken for the sensor of {first} "
+            f"({value!r}) in the repeatability (give only one sensor's power-ons)",
+            PlausibilityWarning,
+            stacklevel=2,
+        )
     labels = [str(r) for r in runs]
     reps = {n: run_repeatability([r[n] for r in per_run], labels) for n in names}
     return PowerOnMetrics(tuple(names), tuple(per_run), reps)

@@ -163,3 +163,20 @@ def test_a_serial_in_the_metadata_extra_pairs_counts_too(
     assert "unit2.csv" in line and "'B12'" in line and "serial" in line, line
     code, out, err = _run(capsys, "metrics", *map(str, files[:2]), "--signal", "gx")
     assert code == 0, err
+
+
+def test_a_run_naming_no_sensor_beside_a_named_one_is_warned(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """One run states SN-1, the other nothing: pooled (they may be one sensor), with a
+    warning naming the file without a sensor; the figure is still numpy's."""
+    a = _power_on(tmp_path / "a.csv", 1, 1.0, sensor_id="SN-1")
+    b = _power_on(tmp_path / "b.csv", 2, 1.3, sensor_id=None)
+    code, out, err = _run(capsys, "metrics", str(a), str(b), "--signal", "gx", "--json")
+    assert code == 0, err
+    warned = [ln for ln in err.splitlines() if "names no sensor" in ln]
+    assert len(warned) == 1 and warned[0].startswith(f"warning: {b}: "), err
+    assert "'SN-1'" in warned[0] and str(a) in warned[0]
+    means = [float(np.mean(np.genfromtxt(f, delimiter=",", names=True)["gx"])) for f in (a, b)]
+    got = json.loads(out)["bias_repeatability"]
+    assert got == pytest.approx(float(np.std(means, ddof=1)), rel=1e-9)
