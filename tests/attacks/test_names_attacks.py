@@ -692,3 +692,19 @@ def test_hostile_channel_names_never_reach_a_parameter_file(
     for ln in lines[:-1]:
         assert ln.startswith("#") or PARAM_LINE[fmt].fullmatch(ln), ln
     assert texts["hostile"] == texts["plain"]
+
+
+def test_hostile_names_in_the_json_noise_model_come_back_whole(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``noise --format json``: every axis under its own name as written in the file."""
+    import json
+
+    data = _imu(tmp_path / "imu.parquet", HOSTILE_A)
+    out = tmp_path / "noise.json"
+    code, _, err = _run(capsys, *_noise(data, out, HOSTILE_A, "--format", "json"))
+    assert code == 0, err
+    doc = json.loads(out.read_text(encoding="utf-8"))
+    assert list(doc["axes"]) == list(HOSTILE_A)
+    assert doc["kalibr_axis"]["gyroscope_noise_density"] in HOSTILE_A[:3]
+    assert doc["kalibr"]["gyroscope_noise_density"] == pytest.approx(max(GYRO_DENSITY), rel=0.15)
