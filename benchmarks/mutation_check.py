@@ -2023,6 +2023,14 @@ MUTANTS: tuple[Mutant, ...] = (
         NAMES,
         "a station sensor id 'imu\\n' accepted ('$' matches before a final newline)",
     ),
+    Mutant(
+        "names-oserror-name-raw",
+        P + "pipeline/messages.py",
+        'return one_line(f"{where}: {exc.strerror or exc}"), True',
+        'return f"{where}: {exc.strerror or exc}", True',
+        NAMES,
+        "a file name with a newline in an OS error: the error spread over two lines",
+    ),
 )
 
 

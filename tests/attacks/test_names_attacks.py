@@ -708,3 +708,21 @@ def test_hostile_names_in_the_json_noise_model_come_back_whole(
     assert list(doc["axes"]) == list(HOSTILE_A)
     assert doc["kalibr_axis"]["gyroscope_noise_density"] in HOSTILE_A[:3]
     assert doc["kalibr"]["gyroscope_noise_density"] == pytest.approx(max(GYRO_DENSITY), rel=0.15)
+
+
+def test_an_output_name_with_a_newline_the_system_refuses_gives_one_error_line(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A name too long for the file system (ENAMETOOLONG, a user's error) holding a newline:
+    the ``error:`` line named it raw and spread over two lines."""
+    data = _chamber_run(tmp_path / "m.parquet", "gx", "T1", 1)
+    out = tmp_path / ("x\ny" + "a" * 300 + ".json")
+    code, _, err = _run(
+        capsys, "fit", str(data), "--model", "poly", "--order", "2", "--signal", "gx",
+        "--temps", "T1", "--signal-unit", "deg/h", "--temp-unit", "degC", "--time-unit", "s",
+        "-o", str(out),
+    )  # fmt: skip
+    assert code == 2, err
+    line = _error_line(err)
+    assert "x ya" in line, line
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["m.parquet"]
