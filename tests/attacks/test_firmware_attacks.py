@@ -397,3 +397,51 @@ def test_triad_px4_values_in_range_are_written(tmp_path: Path) -> None:
     assert p["CAL_ACC0_XSCALE"] == pytest.approx(1.0 / 1.03, rel=1e-9)
     assert p["CAL_ACC0_XOFF"] == pytest.approx(10.0 * 9.80665e-3, rel=1e-9)
     assert p["CAL_ACC0_ID"] == 3604490
+
+
+# --- every parameter against what the firmware documents (What to build 3) ---------------------
+
+
+def _gyro_cal(path: Path, lo: float, hi: float) -> None:
+    """Three gyro channels (°/h), a cubic in T fitted over ``lo``…``hi`` °C."""
+    import warnings
+
+    from thermocal.models.base import RunData
+    from thermocal.models.calibration import Calibration, Channel
+    from thermocal.models.files import save_calibration
+    from thermocal.models.poly import PolyModel
+
+    temp = np.linspace(lo, hi, 400)
+    u = (temp - 35.0) / 40.0
+    chans = []
+    for j, axis in enumerate("xyz"):
+        run = RunData(
+            np.arange(temp.size, dtype=np.float64), temp.reshape(-1, 1),
+            (j + 1) * (40.0 * u + 10.0 * u**3), ("temperature",), name=f"g{axis}",
+            signal_unit="deg/h",
+        )  # fmt: skip
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            model = PolyModel(order=3, per_run_offset=False).fit([run])
+        model.signal_name, model.signal_unit = axis, "deg/h"
+        role = {"kind": "gyro", "axis": axis, "instance": 0}
+        chans.append(Channel(f"g{axis}", axis, "deg/h", model, role))
+    save_calibration(Calibration(chans), path)
+
+
+def test_ins_tcal_tmax_beyond_its_documented_range_is_warned(tmp_path: Path) -> None:
+    """INS_TCALn_TMAX ``@Range: -70 80`` (AP_InertialSensor_tempcal.cpp): a calibration
+    fitted to 95 °C is written (the firmware clamps T to it) with a warning naming it."""
+    cal = tmp_path / "c.json"
+    _gyro_cal(cal, 0.0, 95.0)
+    before = _digest(cal)
+    out = tmp_path / "a.parm"
+    code, _o, err = _run(["export-params", str(cal), "--format", "ardupilot", "-o", str(out)])
+    assert code == 0 and _digest(cal) == before, err
+    w = [x for x in _warnings(err) if "INS_TCAL1_TMAX" in x]
+    assert len(w) == 1 and "= 95.0" in w[0] and "-70…80" in w[0], err
+    assert "INS_TCAL1_TMAX 95.0" in out.read_text()
+    # within the range: no such warning
+    _gyro_cal(cal, 0.0, 70.0)
+    code, _o, err = _run(["export-params", str(cal), "--format", "ardupilot", "-o", str(out)])
+    assert code == 0 and "INS_TCAL1_T" not in err, err

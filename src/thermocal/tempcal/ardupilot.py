@@ -516,7 +516,7 @@ def ardupilot_tempcal(
     hygiene (:func:`ardupilot_raw`); an IMU whose temperature is all 0 or NaN is left out
     with a warning.  ``overrides`` the adequacy checks let through."""
     from thermocal.errors import MissingColumnError
-    from thermocal.export.params import ParamSet
+    from thermocal.export.params import ParamSet, check_documented, check_values
     from thermocal.readers.dataflash import dataflash_table, read_dataflash_log
 
     # DIR may hold the log; the files of the set (replaced by name) may not be it
@@ -543,6 +543,8 @@ def ardupilot_tempcal(
         _baro(run)
         run.gates.extend(step_warnings(run.fits, run.series))
         warn_gates(run.gates)
+        check_values(run.params)
+        check_documented(run.params)
         out_set.commit(calibration_of(run.fits), PARAMS_NAME, run.params.text())
     notes = list(run.params.notes)
     found = [k for k, h in run.hygiene.items() if h["active_tcal_removed"]]
