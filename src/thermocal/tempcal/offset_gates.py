@@ -136,7 +136,8 @@ def screen_baro(where: str, time_s: FloatArray, temp_c: FloatArray, pressure_pa:
     p = np.asarray(pressure_pa, dtype=np.float64).reshape(-1)
     finite = np.isfinite(p) & np.isfinite(np.asarray(temp_c, dtype=np.float64))
     if not finite.any():
-        return Screened(None, f"{where}: field {field!r} has no finite value (all NaN or "
+        name = field if not np.isfinite(p).any() else "temperature (with a finite pressure)"
+        return Screened(None, f"{where}: field {name!r} has no finite value (all NaN or "
                         f"infinite): the barometer is left out, no {params} written",
                         ())  # fmt: skip
     lo, hi = BARO_RANGE_PA
@@ -174,7 +175,8 @@ def screen_mag(where: str, time_s: FloatArray, temp_c: FloatArray, field_gauss: 
     b = np.asarray(field_gauss, dtype=np.float64).reshape(len(temp_c), -1)
     finite = np.all(np.isfinite(b), axis=1) & np.isfinite(np.asarray(temp_c, dtype=np.float64))
     if not finite.any():
-        return Screened(None, f"{where}: fields x, y, z have no finite row (NaN or infinite): "
+        name = "x, y, z" if not np.all(np.isfinite(b), axis=1).any() else "temperature"
+        return Screened(None, f"{where}: field(s) {name}: no finite row (NaN or infinite): "
                         "the magnetometer is left out, no TC_M parameters written", ())  # fmt: skip
     mag = np.full(b.shape[0], np.nan)
     mag[finite] = np.linalg.norm(b[finite], axis=1)
