@@ -1983,6 +1983,14 @@ MUTANTS: tuple[Mutant, ...] = (
         "CAL_ACC scale 2.0 written for PX4 (only its metadata range checked)",
     ),
     Mutant(
+        "fw-gyro-bias-threshold",
+        P + "tempcal/pipeline.py",
+        "if bias[j] <= GYRO_BIAS_MAX_RAD_S and",
+        "if bias[j] <= 10.0 * GYRO_BIAS_MAX_RAD_S and",
+        FW_ATT,
+        "a still gyro reading 0.117 rad/s (deg/s in the rad/s topic) not warned",
+    ),
+    Mutant(
         "fw-documented-range-open",
         P + "export/params.py",
         "if doc.lo <= v <= doc.hi:",

@@ -77,13 +77,15 @@ Gen = Callable[[np.ndarray, np.ndarray, np.random.Generator], np.ndarray]
 
 
 def _ulog(path: Path, *, gyro_scale: float = 1.0, pressure: Gen | None = None,
-          mag: Gen | None = None) -> np.ndarray:  # fmt: skip
-    """A still board's ULog: a gyro (rad/s, × ``gyro_scale``), optionally a barometer and a
-    magnetometer; returns the temperature."""
+          mag: Gen | None = None, gyro_noise: float = 1e-3,
+          gyro_offset: float = 0.0) -> np.ndarray:  # fmt: skip
+    """A still board's ULog: a gyro (rad/s: ``gyro_offset`` + noise ``gyro_noise`` + drift,
+    × ``gyro_scale``), optionally a barometer and a magnetometer; returns the temperature."""
     rng = np.random.default_rng(8)
     t, temp, x = _sweep()
     ts = (1e6 + t * 1e6).astype(np.int64)
-    g = (rng.normal(0, 1e-3, (N, 3)) + np.outer(x, [2e-3, -1e-3, 3e-3])) * gyro_scale
+    g = gyro_offset + rng.normal(0, gyro_noise, (N, 3)) + np.outer(x, [2e-3, -1e-3, 3e-3])
+    g *= gyro_scale
     rows = lambda dev, v: [  # noqa: E731
         (int(s), dev, *np.atleast_1d(r).astype(float), float(c))
         for s, r, c in zip(ts, v, temp, strict=True)
@@ -241,6 +243,20 @@ def test_gyro_in_deg_s_in_the_rad_s_topic_is_warned(tmp_path: Path) -> None:
     got = float(w[0].split("a noise of ")[1].split(" rad/s")[0])
     assert got == pytest.approx(1e-3 * 180.0 / math.pi, rel=0.05)
     assert "TC_G0_X0_0" in p
+
+
+def test_gyro_bias_beyond_att_bias_max_is_warned(tmp_path: Path) -> None:
+    """The audit's case: a gyro logged in deg/s whose bias of 0.117 °/s is read as 0.117
+    rad/s (6.7 °/s), with little noise: PX4's ATT_BIAS_MAX is 0.05 rad/s."""
+    code, err, p, _temp = _px4(tmp_path, gyro_offset=0.117, gyro_noise=1e-4)
+    assert code == 0, err
+    w = [x for x in _warnings(err) if "sensor_gyro.0" in x]
+    assert len(w) == 1 and "median rate of" in w[0] and "ATT_BIAS_MAX" in w[0], err
+    got = float(w[0].split("median rate of ")[1].split(" rad/s")[0])
+    _t, _temp, x = _sweep()
+    want = max(abs(np.median(0.117 + k * x)) for k in (2e-3, -1e-3, 3e-3))
+    assert got == pytest.approx(want, rel=1e-3)
+    assert p["TC_G0_X0_0"] == pytest.approx(0.117, abs=0.01)
 
 
 # --- ArduPilot barometer -----------------------------------------------------------------------
