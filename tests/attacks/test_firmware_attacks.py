@@ -265,7 +265,9 @@ def test_gyro_bias_beyond_att_bias_max_is_warned(tmp_path: Path) -> None:
 Curve = Callable[[np.ndarray], np.ndarray]
 
 
-def _ap_log(path: Path, press_of: Curve, baro_temp_of: Curve = lambda t: t) -> np.ndarray:
+def _ap_log(
+    path: Path, press_of: Curve, baro_temp_of: Curve = lambda t: t, gyro_scale: float = 1.0
+) -> np.ndarray:
     """A DataFlash log: one still IMU (−10…50 °C, test_fc_log_readers.imu_truth) and a
     barometer at ``baro_temp_of(T)`` reading ``press_of(T_baro)`` [Pa]."""
     from dataflash_writer import NEW_IMU_FMT, NEW_IMU_LABELS, PARM_FORMAT, dataflash_log
@@ -277,7 +279,8 @@ def _ap_log(path: Path, press_of: Curve, baro_temp_of: Curve = lambda t: t) -> n
     press = press_of(tb100 / 100.0)
     msgs: list = []
     for i in range(m["temp"].size):
-        msgs.append((100, (int(m["time_us"][i]), 0, *m["gyro_meas"][i], *m["accel_meas"][i],
+        gyro = m["gyro_meas"][i] * gyro_scale
+        msgs.append((100, (int(m["time_us"][i]), 0, *gyro, *m["accel_meas"][i],
                            0, 0, float(m["temp"][i]), 1, 1, 1000, 1000)))  # fmt: skip
         msgs.append((BARO_TYPE, (int(m["time_us"][i]) + 10, 0, 0.0, 0.0, float(press[i]),
                                  int(tb100[i]), 0.0, 0, 0.0, 20.0, 1)))  # fmt: skip
@@ -287,10 +290,10 @@ def _ap_log(path: Path, press_of: Curve, baro_temp_of: Curve = lambda t: t) -> n
 
 
 def _ap(
-    tmp_path: Path, press_of: Curve, baro_temp_of: Curve = lambda t: t
+    tmp_path: Path, press_of: Curve, baro_temp_of: Curve = lambda t: t, gyro_scale: float = 1.0
 ) -> tuple[int, str, dict[str, float]]:
     log = tmp_path / "bench.bin"
-    _ap_log(log, press_of, baro_temp_of)
+    _ap_log(log, press_of, baro_temp_of, gyro_scale)
     before = _digest(log)
     code, _out, err = _run(["ardupilot-tempcal", str(log), "-o", str(tmp_path / "out")])
     assert _digest(log) == before and "Traceback" not in err, err
@@ -302,6 +305,18 @@ def _ap(
                 k, v = line.split()
                 out[k] = float(v)
     return code, err, out
+
+
+def test_ardupilot_gyro_in_deg_s_is_warned(tmp_path: Path) -> None:
+    """IMU.GyrX/Y/Z are rad/s (LogStructure.h); a driver's deg/s (×57.3): warned, as PX4's."""
+    code, err, p = _ap(
+        tmp_path, lambda t: 101325.0 - np.maximum(t - 25.0, 0.0) ** 1.35,
+        gyro_scale=180.0 / math.pi,
+    )  # fmt: skip
+    assert code == 0, err
+    w = [x for x in _warnings(err) if "IMU.0 gyro" in x]
+    assert len(w) == 1 and "deg/s" in w[0], err
+    assert "INS_TCAL1_GYR1_X" in p
 
 
 def test_ardupilot_baro_at_a_limit_is_not_enabled(tmp_path: Path) -> None:
