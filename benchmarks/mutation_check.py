@@ -1991,6 +1991,14 @@ MUTANTS: tuple[Mutant, ...] = (
         "a still gyro reading 0.117 rad/s (deg/s in the rad/s topic) not warned",
     ),
     Mutant(
+        "fw-baro-span-located",
+        P + "tempcal/offset_gates.py",
+        'j = np.searchsorted(tb, tb + CHANGE_WINDOW_S, side="right") - 1',
+        'j = np.searchsorted(tb, tb + 10.0 * CHANGE_WINDOW_S, side="right") - 1',
+        FW_ATT,
+        "the climb's time span said over ten minutes, not where it happened",
+    ),
+    Mutant(
         "fw-documented-range-open",
         P + "export/params.py",
         "if doc.lo <= v <= doc.hi:",

@@ -42,6 +42,8 @@ BARO_RANGE_PA = (30_000.0, 110_000.0)
 BARO_STEP_PA = 100.0
 """Largest departure of a still board's pressure from a smooth curve of its temperature [Pa]
 (:func:`altitude_residual`; about 8 m near sea level)."""
+CHANGE_WINDOW_S = 60.0
+"""The window in which a departure from the smooth curve is located (said, not judged) [s]."""
 SMOOTH_ORDER = 5
 """The order of the smooth curve of the temperature the pressure must follow (PX4's TC_B)."""
 MAG_EARTH_GAUSS = (0.25, 0.65)
@@ -129,6 +131,15 @@ def altitude_residual(temp_c: FloatArray, pressure_pa: FloatArray) -> FloatArray
     return out
 
 
+def _fastest_change(tb: FloatArray, resid: FloatArray) -> tuple[float, float, float]:
+    """(start [s], end [s], change [Pa]) of the :data:`CHANGE_WINDOW_S` window over which
+    the residual of :func:`altitude_residual` changes most: where the board moved."""
+    j = np.searchsorted(tb, tb + CHANGE_WINDOW_S, side="right") - 1
+    change = resid[j] - resid
+    k = int(np.argmax(np.abs(change)))
+    return float(tb[k]), float(tb[j[k]]), float(change[k])
+
+
 def screen_baro(where: str, time_s: FloatArray, temp_c: FloatArray, pressure_pa: FloatArray,
                 dialect: Dialect = Dialect()) -> Screened:  # fmt: skip
     """The barometer gates (module docstring) of ``pressure_pa`` [Pa] over ``time_s`` [s]."""
@@ -157,14 +168,14 @@ def screen_baro(where: str, time_s: FloatArray, temp_c: FloatArray, pressure_pa:
     resid = altitude_residual(mb[:, 1], mb[:, 0])
     k = int(np.argmax(np.abs(resid)))
     if abs(resid[k]) > BARO_STEP_PA:
-        off = np.flatnonzero(np.abs(resid) > 0.5 * BARO_STEP_PA)
+        a, b, change = _fastest_change(tb, resid)
         return Screened(None, (
             f"{where}: the pressure departs by {resid[k]:+.0f} Pa (about "
             f"{-resid[k] / 12.0:+.0f} m of altitude) from a smooth curve of the temperature "
-            f"between {tb[off[0]] - t[0]:.0f} s and {tb[off[-1]] - t[0]:.0f} s of the log (a "
-            f"barometer's thermal drift follows its temperature within {BARO_STEP_PA:g} Pa): "
-            f"the board was carried or flown; the barometer is left out, no {params} written "
-            "— record the sweep with the board at rest"
+            f"(a barometer's thermal drift follows its temperature within {BARO_STEP_PA:g} "
+            f"Pa); it changes fastest between {a - t[0]:.0f} s and {b - t[0]:.0f} s of the log "
+            f"({change:+.0f} Pa): the board was carried or flown; the barometer is left out, "
+            f"no {params} written — record the sweep with the board at rest"
         ), tuple(notes))  # fmt: skip
     return Screened(ok, None, tuple(notes))
 
@@ -215,6 +226,7 @@ __all__ = [
     "ARDUPILOT_BARO",
     "BARO_RANGE_PA",
     "BARO_STEP_PA",
+    "CHANGE_WINDOW_S",
     "MAG_EARTH_GAUSS",
     "MAG_RANGE_GAUSS",
     "MAG_TURN_DEG",
