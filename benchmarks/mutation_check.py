@@ -77,6 +77,14 @@ IDS = _t("mutants_maths", "c_identifiers", "tests/attacks/test_generated_code_at
 OUTS = _t("faults", "tests/attacks/test_output_attacks.py")
 METRICS = _t("mutants_maths", "metrics", "drift_angle", "metrics_runs")
 NAMES = _t("tests/attacks/test_names_attacks.py")
+FW_AP = _t("mutants_firmware", "ardupilot_hygiene", "ardupilot_tclr_range",
+           "ardupilot_param_changes", "fc_reports")  # fmt: skip
+FW_EXPORT = _t("mutants_firmware", "export_params", "tests/attacks/test_export_params_attacks.py",
+               "px4_tempcal")  # fmt: skip
+FW_PX4 = _t("mutants_firmware", "px4_tempcal", "px4_baro_mag", "ardupilot_tempcal")
+FW_ADEQ = _t("mutants_firmware", "adequacy", "export_params", "outside_range")
+FW_ULOG = _t("mutants_firmware", "ulog_fast", "px4_read_once")
+FW_ATT = _t("tests/attacks/test_firmware_attacks.py", "mutants_firmware")
 
 
 MUTANTS: tuple[Mutant, ...] = (
@@ -2030,6 +2038,167 @@ MUTANTS: tuple[Mutant, ...] = (
         'return f"{where}: {exc.strerror or exc}", True',
         NAMES,
         "a file name with a newline in an OS error: the error spread over two lines",
+    ),
+    # issue 39 slice h39-firmware
+    Mutant(
+        "fw-ap-rotation-not-inverted",
+        P + "tempcal/ardupilot.py",
+        "out = out @ ardupilot_rotation(code)  #",
+        "out = out @ ardupilot_rotation(code).T  #",
+        FW_AP,
+        "ArduPilot's AHRS rotation applied again instead of undone",
+    ),
+    Mutant(
+        "fw-ap-pitch-sign",
+        P + "tempcal/ardupilot.py",
+        "ry = np.array([[cp, 0, sp], [0, 1, 0], [-sp, 0, cp]])",
+        "ry = np.array([[cp, 0, -sp], [0, 1, 0], [sp, 0, cp]])",
+        FW_AP,
+        "ArduPilot's pitch matrix with its sign flipped",
+    ),
+    Mutant(
+        "fw-tclr-powers-off-by-one",
+        P + "tempcal/ardupilot.py",
+        "return [[float(x) * 1e6 for x in p[k]] for k in (1, 2, 3)]",
+        "return [[float(x) * 1e6 for x in p[k]] for k in (0, 1, 2)]",
+        FW_AP,
+        "TCLR learned coefficients taken one power too low",
+    ),
+    Mutant(
+        "fw-tclr-no-tref",
+        P + "tempcal/ardupilot.py",
+        "np.vander(np.asarray(temp_c, dtype=np.float64) - AP_TREF_C, 4",
+        "np.vander(np.asarray(temp_c, dtype=np.float64), 4",
+        FW_AP,
+        "TCLR cubic fitted in T, not T - 35",
+    ),
+    Mutant(
+        "fw-ap-caltemp-not-clamped",
+        P + "tempcal/ardupilot.py",
+        "tcal = float(np.clip(self.caltemp_c[kind], self.tmin_c, self.tmax_c))",
+        "tcal = float(self.caltemp_c[kind])",
+        FW_AP,
+        "INS_ACC/GYR CALTEMP not constrained to TMIN..TMAX as correct_sensor does",
+    ),
+    Mutant(
+        "fw-px4-accel-sign",
+        P + "export/params.py",
+        'out.params[f"{p}X{k}_{i}"] = poly.coef[k]',
+        'out.params[f"{p}X{k}_{i}"] = -poly.coef[k] if kind == "accel" else poly.coef[k]',
+        FW_PX4,
+        "PX4 accelerometer cubic written with the wrong sign",
+    ),
+    Mutant(
+        "fw-px4-quartic-accepted",
+        P + "export/params.py",
+        "if power > 3:",
+        "if power > 4:",
+        FW_EXPORT,
+        "a quartic accepted for PX4 (X0..X3 only)",
+    ),
+    Mutant(
+        "fw-any-override-passes",
+        P + "adequacy.py",
+        'if t.get("override") not in overrides or not t.get("override")]',
+        "if not overrides]",
+        FW_ADEQ,
+        "firmware export accepts any override for every failed adequacy test",
+    ),
+    Mutant(
+        "fw-ulog-fast-first-for-last",
+        P + "readers/ulog_fast.py",
+        "first[ids[::-1]] = data_at[::-1]",
+        "first[ids] = data_at",
+        FW_ULOG,
+        "fast ULog reader takes each msg_id's last data message for its first",
+    ),
+    Mutant(
+        "fw-baro-no-upper-bound",
+        P + "tempcal/offset_gates.py",
+        "ok = finite & (p >= lo) & (p <= hi)",
+        "ok = finite & (p >= lo)",
+        FW_ATT,
+        "barometer samples of 3e38 Pa kept",
+    ),
+    Mutant(
+        "fw-baro-altitude-threshold",
+        P + "tempcal/offset_gates.py",
+        "if abs(resid[k]) > BARO_STEP_PA:",
+        "if abs(resid[k]) > 10.0 * BARO_STEP_PA:",
+        FW_ATT,
+        "a climb of 50 m taken for thermal drift",
+    ),
+    Mutant(
+        "fw-mag-turn-threshold",
+        P + "tempcal/offset_gates.py",
+        "off = np.flatnonzero(angle > MAG_TURN_DEG)",
+        "off = np.flatnonzero(angle > 10.0 * MAG_TURN_DEG)",
+        FW_ATT,
+        "a turning vehicle's magnetometer fitted",
+    ),
+    Mutant(
+        "fw-mag-unit-band",
+        P + "tempcal/offset_gates.py",
+        "ok = finite & (mag >= lo) & (mag <= hi)",
+        "ok = finite & (mag >= lo) & (mag <= 100.0 * hi)",
+        FW_ATT,
+        "a magnetometer in µT declared as gauss fitted",
+    ),
+    Mutant(
+        "fw-gyro-noise-sqrt2",
+        P + "tempcal/pipeline.py",
+        "noise = np.std(np.diff(v, axis=0), axis=0) / np.sqrt(2.0)",
+        "noise = np.std(np.diff(v, axis=0), axis=0) * np.sqrt(2.0)",
+        FW_ATT,
+        "gyro white noise from first differences multiplied by sqrt 2",
+    ),
+    Mutant(
+        "fw-ap-baro-enabled-at-limit",
+        P + "tempcal/ardupilot_baro.py",
+        '"TCAL_ENABLED": 0 if self.at_limit else 1,',
+        '"TCAL_ENABLED": 1,',
+        FW_ATT,
+        "TCAL_ENABLED 1 when the exponent is at a limit",
+    ),
+    Mutant(
+        "fw-ap-baro-int8-silent",
+        P + "tempcal/ardupilot_baro.py",
+        "and round(hi) <= INT8_RANGE[1]:",
+        "and round(hi) <= 2 * INT8_RANGE[1]:",
+        FW_ATT,
+        "TCAL_TEMP_MAX clamped to 127 without a word",
+    ),
+    Mutant(
+        "fw-triad-px4-scale-metadata-only",
+        P + "export/triad_params.py",
+        "rng = ARDUPILOT_ACCSCAL_RANGE if scale else ARDUPILOT_ACCOFFS_RANGE_M_S2",
+        "rng = PX4_ACCSCALE_RANGE if scale else ARDUPILOT_ACCOFFS_RANGE_M_S2",
+        FW_ATT,
+        "CAL_ACC scale 2.0 written for PX4 (only its metadata range checked)",
+    ),
+    Mutant(
+        "fw-gyro-bias-threshold",
+        P + "tempcal/pipeline.py",
+        "if bias[j] <= GYRO_BIAS_MAX_RAD_S and",
+        "if bias[j] <= 10.0 * GYRO_BIAS_MAX_RAD_S and",
+        FW_ATT,
+        "a still gyro reading 0.117 rad/s (deg/s in the rad/s topic) not warned",
+    ),
+    Mutant(
+        "fw-baro-span-located",
+        P + "tempcal/offset_gates.py",
+        'j = np.searchsorted(tb, tb + CHANGE_WINDOW_S, side="right") - 1',
+        'j = np.searchsorted(tb, tb + 10.0 * CHANGE_WINDOW_S, side="right") - 1',
+        FW_ATT,
+        "the climb's time span said over ten minutes, not where it happened",
+    ),
+    Mutant(
+        "fw-documented-range-open",
+        P + "export/params.py",
+        "if doc.lo <= v <= doc.hi:",
+        "if doc.lo <= v:",
+        FW_ATT,
+        "INS_TCAL TMAX 95 written without the warning of its documented @Range -70…80",
     ),
 )
 
