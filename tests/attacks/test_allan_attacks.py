@@ -267,3 +267,107 @@ def test_profile_ramp_rate_no_chamber_has_refused(
     code, _out, err = _run(["profile", "fog-slow", "--rate", rate, "-o", str(o)], capsys, tmp_path)
     _refused(code, err, "--rate", "°C/min")
     assert not o.exists()
+
+
+# --- time ×1000 under Ṫ terms (fit) ----------------------------------------------------------
+
+
+def _thermal_run(path: Path, time_factor: float, step_s: float, hours: float) -> Path:
+    """A triangle −20 … 50 °C at 1 °C/min (a chamber's ramp), gz = 0.5 + 0.01 T + 0.2 Ṫ
+    [deg/s, Ṫ in °C/min]; the time column written ×``time_factor``."""
+    t = np.arange(0.0, hours * 3600.0, step_s)
+    period = 2 * 70 * 60.0
+    ph = (t % period) / period
+    temp = np.where(ph < 0.5, -20 + 140 * ph, 50 - 140 * (ph - 0.5))
+    rate = np.where(ph < 0.5, 1.0, -1.0)
+    gz = 0.5 + 0.01 * temp + 0.2 * rate + np.random.default_rng(4).normal(0, 0.001, t.size)
+    return _csv(path, {"time": t * time_factor, "T1": temp, "gz": gz})
+
+
+FIT = ["fit", "--model", "poly", "--terms", "T1,dT1", "--signal", "gz", "--signal-unit",
+       "deg/s", "--temps", "T1", "--temp-unit", "degC"]  # fmt: skip
+
+
+def test_time_in_ms_read_as_s_under_rate_terms(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Milliseconds read as seconds: Ṫ 1000× too small (0.001 °C/min); refused by the Ṫ
+    span, and the warning names the likely cause and --time-unit."""
+    f = _thermal_run(tmp_path / "ms.csv", 1000.0, 10.0, 6.0)
+    out = tmp_path / "m.json"
+    code, _o, err = _run(
+        [FIT[0], str(f), *FIT[1:], "--time-unit", "s", "-o", str(out)], capsys, tmp_path
+    )
+    _refused(code, err, "Ṫ spans")
+    _warned(err, "ms.csv: T1: Ṫ reaches 0.001 °C/min", "ms read as s: 1 °C/min", "--time-unit")
+    assert not out.exists()
+
+
+def test_time_in_s_read_as_ms_under_rate_terms(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Seconds read as milliseconds: Ṫ 1000 °C/min, which no chamber does; the fit runs
+    (its Ṫ coefficient 1000× small: 2e-4 for the 0.2 written here) and says why to doubt it."""
+    f = _thermal_run(tmp_path / "s.csv", 1.0, 10.0, 72.0)
+    out = tmp_path / "m.json"
+    code, _o, err = _run(
+        [FIT[0], str(f), *FIT[1:], "--time-unit", "ms", "--allow-motion", "-o", str(out)],
+        capsys, tmp_path,
+    )  # fmt: skip
+    assert code == 0, err
+    _warned(err, "s.csv: T1: Ṫ reaches 1e+03 °C/min", "s read as ms: 1 °C/min", "--time-unit")
+    assert out.exists()
+
+
+def test_right_time_unit_not_doubted(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    f = _thermal_run(tmp_path / "ok.csv", 1.0, 10.0, 6.0)
+    out = tmp_path / "m.json"
+    code, _o, err = _run(
+        [FIT[0], str(f), *FIT[1:], "--time-unit", "s", "-o", str(out)], capsys, tmp_path
+    )
+    assert code == 0, err
+    assert "Ṫ reaches" not in err and "time unit" not in err, err
+
+
+def test_bias_correct_that_corrects_not_warned(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """White FM with a random walk on top: factor 1 at short τ, Howe's 1/√(1 − a τ/T) at
+    long τ (a = 1/(3 ln 2) flicker FM, 3/4 random-walk FM; T = (N − 1) τ0 with N = 4001
+    phase points): something is corrected, so no warning, and every factor is Howe's."""
+    rng = np.random.default_rng(39)
+    n = 4000
+    y = rng.normal(0, 1, n) + np.cumsum(rng.normal(0, 0.03, n))
+    f = _csv(tmp_path / "rw.csv", {"time_s": np.arange(n, dtype=float), "gz_dph": y})
+    code, out, err = _run(
+        ["allan", str(f), "--signal", "gz_dph", "--deviation", "totdev", "--bias-correct",
+         "--json"], capsys, tmp_path,
+    )  # fmt: skip
+    assert code == 0, err
+    assert "warning:" not in err, err
+    got = json.loads(out)
+    a_of = {-1: 1.0 / (3.0 * np.log(2.0)), -2: 0.75}
+    want = [
+        1.0 / np.sqrt(1.0 - a_of.get(al, 0.0) * tau / (n * 1.0))
+        for al, tau in zip(got["totdev_alpha"], got["tau_s"], strict=True)
+    ]
+    assert got["totdev_bias_factor"] == pytest.approx(want, rel=1e-12)
+    assert 1.0 in got["totdev_bias_factor"] and max(got["totdev_bias_factor"]) > 1.2
+
+
+def test_taus_at_the_record_end_kept(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """τ = 99.9 s is m = 999 = ⌊(N − 1)/2⌋ for N = 2000 samples, the last m with at least
+    two second differences of the N + 1 phase points (three here; m = 1000 leaves one):
+    kept, not warned, its ADEV numpy's (SP 1065 eq. 11)."""
+    f, y = _white(tmp_path)
+    code, out, err = _run(
+        ["allan", str(f), "--signal", "gz_dph", "--taus", "99.9", "--json"], capsys, tmp_path
+    )
+    assert code == 0, err
+    assert "warning:" not in err, err
+    got = json.loads(out)
+    m = 999
+    x = np.concatenate(([0.0], np.cumsum(y)))  # phase in units of τ0
+    d = x[2 * m :] - 2 * x[m:-m] + x[: x.size - 2 * m]
+    assert d.size == 3
+    assert got["adev"] == pytest.approx([np.sqrt(np.mean(d**2) / (2 * m**2))], rel=1e-9)
