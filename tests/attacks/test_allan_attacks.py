@@ -371,3 +371,46 @@ def test_taus_at_the_record_end_kept(tmp_path: Path, capsys: pytest.CaptureFixtu
     d = x[2 * m :] - 2 * x[m:-m] + x[: x.size - 2 * m]
     assert d.size == 3
     assert got["adev"] == pytest.approx([np.sqrt(np.mean(d**2) / (2 * m**2))], rel=1e-9)
+
+
+# --- a flat-lined gyro under fit ----------------------------------------------------------------
+
+
+def _sweep(path: Path, gz: np.ndarray) -> Path:
+    t = np.arange(gz.size) * 10.0
+    temp = 20.0 + 30.0 * np.sin(2 * np.pi * t / (3 * 3600.0))
+    return _csv(path, {"time": t, "T1": temp, "gz": gz})
+
+
+FIT2 = ["--model", "poly", "--order", "2", "--signal", "gz", "--signal-unit", "deg/s",
+        "--temps", "T1", "--temp-unit", "degC", "--time-unit", "s"]  # fmt: skip
+
+
+def test_fit_of_a_stuck_gyro_refused(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    f = _sweep(tmp_path / "stuck.csv", np.full(2160, 0.5))
+    out = tmp_path / "m.json"
+    code, _o, err = _run(["fit", str(f), *FIT2, "-o", str(out)], capsys, tmp_path)
+    _refused(code, err, "stuck.csv", "'gz'", "constant (0.5 in all 2160 samples)", "--signal")
+    assert not out.exists()
+
+
+def test_fit_of_a_two_level_gyro_warned(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    gz = 0.5 + 0.01 * np.random.default_rng(1).integers(0, 2, 2160)
+    f = _sweep(tmp_path / "flat.csv", gz)
+    out = tmp_path / "m.json"
+    code, _o, err = _run(["fit", str(f), *FIT2, "-o", str(out)], capsys, tmp_path)
+    assert code == 0, err
+    _warned(err, "flat.csv: the column 'gz' takes only 2 distinct values", "(0.5, 0.51)")
+    assert out.exists()
+
+
+@pytest.mark.parametrize("taus", ["0,1", "nan", "-1", "inf", ""])
+def test_taus_not_a_time_refused(
+    taus: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    f, _y = _white(tmp_path)
+    code, out, err = _run(
+        ["allan", str(f), "--signal", "gz_dph", "--taus", taus, "--json"], capsys, tmp_path
+    )
+    _refused(code, err, f"--taus {taus!r}", "positive, finite")
+    assert out == ""

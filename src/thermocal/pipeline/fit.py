@@ -278,9 +278,15 @@ def _prepare_channel(
     unit = ""
     sig_name = signal or "signal"
     temp_names: tuple[str, ...] | None = None
+    from thermocal.stability.analysis import check_not_stuck
+
     for path, rec in loaded:
         _values, run_unit = rec.signal(signal)
         sig_name = signal or rec.signals[0]
+        check_not_stuck(
+            rec.column(sig_name), sig_name, str(path), "--signal",
+            "has no thermal behaviour to model (a flat model of a dead channel)",
+        )  # fmt: skip
         if unit and run_unit != unit:
             raise ThermocalInputError(f"{path}: signal unit {run_unit} differs from {unit}")
         unit = run_unit

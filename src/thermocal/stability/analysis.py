@@ -50,11 +50,19 @@ def parse_taus(text: str) -> Any:
     if text in TAU_SETS:
         return text
     try:
-        return [float(v) for v in text.split(",") if v.strip()]
+        taus = [float(v) for v in text.split(",") if v.strip()]
     except ValueError:
         raise ThermocalInputError(
             f"--taus {text!r}: use octave, decade, log or a comma-separated list of τ [s]"
         ) from None
+    bad = [t for t in taus if not (math.isfinite(t) and t > 0)]
+    if bad or not taus:
+        raise ThermocalInputError(
+            f"--taus {text!r}: every τ must be a positive, finite time [s]"
+            + (f" (got {bad[0]:g})" if bad else " (none given)")
+            + "; or use octave, decade, log"
+        )
+    return taus
 
 
 FEW_LEVELS: Final = 3
@@ -62,34 +70,48 @@ FEW_LEVELS: Final = 3
 flagged: a stuck or flat-lined sensor, or an output step far above its noise; its
 deviations describe the steps, not the sensor's noise (a warning)."""
 
+STUCK_MIN_SAMPLES: Final = 10
+"""Fewer finite samples than this are too few to call a channel stuck (the estimators' own
+minimums refuse so short a record, naming why)."""
+
 _LEVEL_PROBE: Final = 100_000
 """Samples probed first for :data:`FEW_LEVELS` (the whole column only when they are few)."""
 
 
-def check_not_stuck(values: FloatArray, name: str, where: str, option: str = "--signal") -> None:
+STUCK_ALLAN: Final = "has no noise to analyse (every deviation 0, no noise type)"
+"""What a constant column means to the deviations (:func:`check_not_stuck`)."""
+
+
+def check_not_stuck(
+    values: FloatArray,
+    name: str,
+    where: str,
+    option: str = "--signal",
+    consequence: str = STUCK_ALLAN,
+) -> None:
     """Refuse a constant column, warn on one with at most :data:`FEW_LEVELS` values.
 
     A constant record has an Allan deviation of 0 at every τ, a zero-width interval and no
     identifiable noise (the B1 ratio and R(n) of NIST SP 1065 §5.6 are 0/0): no sensor at
     rest gives one, a stuck or flat-lined channel does.  ``where`` names the file, ``option``
-    the option that names the column.
+    the option that names the column, ``consequence`` what a constant means to the caller.
 
     Raises
     ------
-    ThermocalInputError : every finite sample equal (and at least one finite sample).
+    ThermocalInputError : every finite sample equal (at least :data:`STUCK_MIN_SAMPLES`).
     """
     import numpy as np
 
     v = np.asarray(values, dtype=np.float64).ravel()
     finite = v if math.isfinite(float(v.sum())) else v[np.isfinite(v)]
-    if finite.size < 2:
+    if finite.size < STUCK_MIN_SAMPLES:
         return
     lo, hi = float(finite.min()), float(finite.max())
     if lo == hi:
         raise ThermocalInputError(
             f"{where}: the column {name!r} is constant ({lo:.6g} in all {finite.size} "
-            "samples): a stuck or flat-lined sensor has no noise to analyse (every deviation "
-            f"0, no noise type); name another column with {option}, or check the sensor"
+            f"samples): a stuck or flat-lined sensor {consequence}; name another column "
+            f"with {option}, or check the sensor"
         )
     probe = np.unique(finite[:_LEVEL_PROBE])
     if probe.size > FEW_LEVELS:
@@ -99,8 +121,12 @@ def check_not_stuck(values: FloatArray, name: str, where: str, option: str = "--
         warnings.warn(
             f"{where}: the column {name!r} takes only {levels.size} distinct values in "
             f"{finite.size} samples ({', '.join(f'{x:.6g}' for x in levels)}): a stuck or "
-            "flat-lined sensor, or an output step far coarser than its noise; the deviations "
-            "describe those steps, not the sensor's noise",
+            "flat-lined sensor, or an output step far coarser than its noise: "
+            + (
+                "the deviations describe those steps, not the sensor's noise"
+                if consequence == STUCK_ALLAN
+                else "a model of it describes those steps"
+            ),
             ConditioningWarning,
             stacklevel=2,
         )
