@@ -90,6 +90,7 @@ H39A = _t(
     "mutants_stability",
 )
 H39A_ATT = _t("tests/attacks/test_allan_attacks.py")
+H39A_EDF = _t("mutants_stability", "total_edf_stable32", "noise_terms_theo1_edf")
 
 
 MUTANTS: tuple[Mutant, ...] = (
@@ -2027,6 +2028,54 @@ MUTANTS: tuple[Mutant, ...] = (
         '(100.0, "ms read as s")',
         H39A_ATT,
         "fit: the ms-read-as-s hint scaled by 100, not 1000",
+    ),
+    Mutant(
+        "h39a-edf-table1-rrfm-typo",
+        P + "stability/edf.py",
+        "(1.489, 0.702)",
+        "(1.498, 0.702)",
+        H39A_EDF,
+        "Greenhall Table 1 (modified, random-run FM, d = 3): a0 1.489 typed 1.498",
+    ),
+    Mutant(
+        "h39a-edf-table2-fpm-typo",
+        P + "stability/edf.py",
+        "(9950.0, 6520.0)",
+        "(9950.0, 6250.0)",
+        H39A_EDF,
+        "Greenhall Table 2 (unmodified, flicker PM, d = 3): a1 6520 typed 6250",
+    ),
+    Mutant(
+        "h39a-edf-table2-fwfm-typo",
+        P + "stability/edf.py",
+        "-3: (None, None, (1.053, 0.553)),",
+        "-3: (None, None, (1.053, 0.535)),",
+        H39A_EDF,
+        "Greenhall Table 2 (unmodified, flicker-walk FM, d = 3): a1 0.553 typed 0.535",
+    ),
+    Mutant(
+        "h39a-edf-theo1-rwfm-typo",
+        P + "stability/edf.py",
+        "8.6 * t * (a - 1.0)",
+        "6.8 * t * (a - 1.0)",
+        H39A_EDF,
+        "Theo1 EDF (random-walk FM): 8.6 typed 6.8",
+    ),
+    Mutant(
+        "h39a-edf-totvar-rwfm-typo",
+        P + "stability/edf.py",
+        "-2: (0.93, 0.36)",
+        "-2: (0.93, 0.63)",
+        H39A_EDF,
+        "SP 1065 Table 7 (totdev, random-walk FM): c 0.36 typed 0.63",
+    ),
+    Mutant(
+        "h39a-rn-theory-white-pm",
+        P + "stability/edf.py",
+        "return 1.0 / m",
+        "return 1.0 / (m + 1)",
+        H39A_EDF,
+        "R(n) of white PM 1/(n + 1), not 1/n",
     ),
 )
 
