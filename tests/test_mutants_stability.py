@@ -230,13 +230,14 @@ def test_rad_per_s_quantization_in_urad() -> None:
 
 
 def test_noise_model_random_walk_is_the_largest_walk() -> None:
-    """Three gyro axes at 100 Hz, 1000 s: gx loud white noise (N = 1e-2 rad/s/√Hz) and a
-    small walk (K = 1e-5 rad/s²/√Hz), gy the reverse (1e-4, 1e-3), gz between (1e-3, 1e-4):
+    """Three gyro axes at 100 Hz, 1000 s: gx loud white noise (N = 1e-3 rad/s/√Hz, inside
+    the densities an IMU can have) and a small walk (K = 1e-6 rad/s²/√Hz), gy the reverse
+    (1e-5, 1e-4), gz between (1e-4, 1e-5):
     Kalibr's density is gx's N, its random walk gy's K (simulator truth)."""
     rng = np.random.default_rng(12)
     fs, n = 100.0, 100_000
     dt = 1.0 / fs
-    truth = {"gx": (1e-2, 1e-5), "gy": (1e-4, 1e-3), "gz": (1e-3, 1e-4)}
+    truth = {"gx": (1e-3, 1e-6), "gy": (1e-5, 1e-4), "gz": (1e-4, 1e-5)}
     axes = []
     for name, (dens, walk) in truth.items():
         v = rng.normal(0.0, dens / math.sqrt(dt), n) + np.cumsum(
@@ -247,5 +248,5 @@ def test_noise_model_random_walk_is_the_largest_walk() -> None:
     k = model.kalibr()
     assert model.chosen["gyroscope_noise_density"].name == "gx"
     assert model.chosen["gyroscope_random_walk"].name == "gy"
-    assert k["gyroscope_noise_density"] == pytest.approx(1e-2, rel=0.05)
-    assert k["gyroscope_random_walk"] == pytest.approx(1e-3, rel=0.15)
+    assert k["gyroscope_noise_density"] == pytest.approx(1e-3, rel=0.05)
+    assert k["gyroscope_random_walk"] == pytest.approx(1e-4, rel=0.15)
