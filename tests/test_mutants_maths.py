@@ -85,7 +85,10 @@ def test_noise_model_bound_and_discrete_conversion_by_hand() -> None:
     ok = np.isfinite(res.adev_high) & (res.adev > 0)
     bound = np.min(res.adev_high[ok] * np.sqrt(3.0 / res.tau_s[ok]))
     assert ax.walk.value == pytest.approx(bound * math.pi / 180.0 / 3600.0, rel=1e-12)
-    text = kalibr_yaml(noise_model([ax], 100.0), "test")
+    # Kalibr's imu.yaml needs both sensors (the writer refuses a file without the
+    # accelerometer keys): a quiet accelerometer axis completes the model
+    acc = axis_noise(rng.normal(0.0, 0.01, 100_000), 0.01, name="az", sensor="accel", unit="m/s^2")
+    text = kalibr_yaml(noise_model([ax, acc], 100.0), "test")
     lines = text.splitlines()
     k = next(i for i, x in enumerate(lines) if x.startswith("gyroscope_noise_density:"))
     sigma_c = float(lines[k].split(":")[1])
