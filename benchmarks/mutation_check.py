@@ -57,6 +57,7 @@ TT_ACCEL = _t("mutants_turntable", "turntable_accel", "turntable_thermal")
 TT_ENC = _t("mutants_turntable", "turntable_encoders", "turntable_kinematics", "turntable_cli")
 TT_CAL = _t("mutants_turntable", "turntable_estimation", "turntable_encoders", "turntable_cli")
 FLEET = _t("fleet_units", "fleet", "fleet_reruns")
+WORK_BOUNDS = ("tests/attacks/test_work_bounds_attacks.py",)
 UNITS = _t("mutants_units", "units", "units_resolver", "units_property", "units_travel")
 H38R = _t("reader_options_h38")
 TEXT = _t("mutants_units", "text_logs", "tests/attacks/test_text_attacks.py")
@@ -1836,6 +1837,47 @@ MUTANTS: tuple[Mutant, ...] = (
         "return TEMPERATURE_NAME",
         H38R,
         "a capital T taken for time",
+    ),
+    # issue 39 slice h39-bounds
+    Mutant(
+        "bounds-work-never-checked",
+        P + "stability/family.py",
+        "if total > max_work:",
+        "if False:",
+        WORK_BOUNDS,
+        "the family's work estimate computed and never compared with the budget",
+    ),
+    Mutant(
+        "bounds-work-total-points",
+        P + "stability/deviations.py",
+        '{"mtotdev": 90.0,',
+        '{"mtotdev": 10.0,',
+        WORK_BOUNDS,
+        "the total family's 9m extended points counted as m",
+    ),
+    Mutant(
+        "bounds-work-subsequences",
+        P + "stability/deviations.py",
+        "subs = np.maximum(pts - 3.0 * big + 1.0, 0.0)",
+        "subs = np.maximum(pts - 3.0 * big, 0.0)",
+        WORK_BOUNDS,
+        "one subsequence per factor left out of the estimate (N − 3m, not N − 3m + 1)",
+    ),
+    Mutant(
+        "bounds-work-theo1-lags",
+        P + "stability/deviations.py",
+        "(even / 2.0) * (n - even)",
+        "even * (n - even)",
+        WORK_BOUNDS,
+        "Theo1's m/2 lags counted as m",
+    ),
+    Mutant(
+        "bounds-work-budget-inclusive",
+        P + "stability/family.py",
+        "if total > max_work:",
+        "if total >= max_work * 0.99:",
+        WORK_BOUNDS,
+        "a request within the budget refused",
     ),
 )
 

@@ -116,6 +116,7 @@ def allan_analysis(
     bias_correct: bool = False,
     noise_type: str | None = None,
     noise_id: str | None = None,
+    max_work: float | None = None,
 ) -> AllanAnalysis:
     """The stability analysis of the channels ``names`` of ``rec`` (module docstring).
 
@@ -129,7 +130,8 @@ def allan_analysis(
     ``noise_id``: the identification's rules, ``thermocal`` (default) or ``stable32`` (the
     family only, :func:`thermocal.stability.family.stability`).  A poor noise-model fit and
     a non-stationary record are :class:`ConditioningWarning` naming ``where`` (and the
-    channel when there are several).
+    channel when there are several).  ``max_work``: the family's operation budget
+    (:func:`thermocal.stability.family.check_work`; None: its default).
     """
     if data_type not in DATA_TYPES:
         raise ThermocalInputError(f"--data-type {data_type!r}: use rate or phase")
@@ -143,7 +145,7 @@ def allan_analysis(
             tuple(names),
             family=_family(
                 rec, names, taus, confidence, deviations, data_type, bias_correct, noise_type,
-                noise_id or "thermocal",
+                noise_id or "thermocal", max_work, where,
             ),
         )  # fmt: skip
     family_only = [
@@ -182,6 +184,8 @@ def _family(
     bias_correct: bool = False,
     noise_type: str | None = None,
     noise_id: str = "thermocal",
+    max_work: float | None = None,
+    where: str = "",
 ) -> dict[str, StabilityResult]:
     """The deviations of every channel (phase data: the column as given, in its own unit)."""
     from thermocal.stability import family
@@ -206,6 +210,7 @@ def _family(
             values, rec.sample_interval_s, devs, taus, data_type=data_type,
             segments=rec.segments(), unit=unit, confidence=confidence, bias_correct=bias_correct,
             alpha=alpha, noise_id=noise_id,
+            where=where, max_work=family.DEFAULT_MAX_WORK if max_work is None else max_work,
         )  # fmt: skip
     return results
 

@@ -1,0 +1,221 @@
+"""Bounded work on inputs of any size (issue 39 item 10, "What to build" 4), through the CLI.
+
+Every attack here is generated in code under ``tmp_path``, run through
+:func:`thermocal.cli.main` with a small budget given by option, every input hashed before
+and after, and guarded by an alarm: a regression to a hang fails the test instead of
+blocking CI.  The outcome is exit 2 with exactly one ``error:`` line naming the file and
+the option that gets the user further, or exit 0 with the right numbers.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import math
+import signal
+from collections.abc import Iterator
+from pathlib import Path
+from types import FrameType
+
+import numpy as np
+import pytest
+
+from thermocal.cli import main
+
+ALARM_S = 20
+
+
+@pytest.fixture(autouse=True)
+def _alarm() -> Iterator[None]:
+    """Each test fails after :data:`ALARM_S` seconds instead of hanging."""
+
+    def ring(_sig: int, _frame: FrameType | None) -> None:
+        raise TimeoutError(f"the command ran beyond {ALARM_S} s (a hang)")
+
+    old = signal.signal(signal.SIGALRM, ring)
+    signal.alarm(ALARM_S)
+    try:
+        yield
+    finally:
+        signal.alarm(0)
+        signal.signal(signal.SIGALRM, old)
+
+
+def _digest(p: Path) -> str:
+    return hashlib.sha256(p.read_bytes()).hexdigest()
+
+
+def _digests(folder: Path) -> dict[Path, str]:
+    return {p: _digest(p) for p in folder.rglob("*") if p.is_file()}
+
+
+def _refused(code: int, err: str, *needles: str) -> str:
+    """Exit 2, no traceback, exactly one ``error:`` line holding every needle; that line."""
+    assert "Traceback" not in err, err
+    lines = [ln for ln in err.splitlines() if ln.strip()]
+    assert code == 2, f"exit {code}; stderr: {err}"
+    errors = [ln for ln in lines if ln.startswith("error: ")]
+    assert len(errors) == 1, err
+    for n in needles:
+        assert n in errors[0], (n, errors[0])
+    return errors[0]
+
+
+def _rate_csv(path: Path, n: int, seed: int = 39) -> np.ndarray:
+    """``n`` white-noise rate samples at 1 Hz in deg/h; returns them."""
+    y = np.random.default_rng(seed).standard_normal(n)
+    rows = "\n".join(f"{i},{v!r}" for i, v in enumerate(y.tolist()))
+    path.write_text("time_s,gyro_x [deg/h]\n" + rows + "\n")
+    return y
+
+
+# --- the total family and Theo1: estimate first, refuse beyond the budget ------------------
+
+
+def _mtot_ops(n_phase: int, ms: list[int]) -> float:
+    """SP 1065 eq. 27: N − 3m + 1 subsequences, each extended to 9m points; about ten
+    arithmetic operations per extended point (detrend, centre, reflect, running sum, block
+    second difference, square)."""
+    return sum(10.0 * 9 * m * (n_phase - 3 * m + 1) for m in ms if n_phase - 3 * m + 1 > 0)
+
+
+def _mtotdev_direct(x: np.ndarray, m: int) -> float:
+    """NIST SP 1065 eq. 27 written out term by term (an independent reference): each
+    3m-point subsequence, its half-mean slope removed, extended by even reflection to 9m
+    points; the modified second differences of its m-point block averages, averaged over
+    the 6m of them; averaged over the subsequences; divided by 2τ² (τ0 = 1)."""
+    n = x.size
+    outer = []
+    for i in range(n - 3 * m + 1):
+        seq = x[i : i + 3 * m].copy()
+        h = 3 * m // 2
+        slope = (seq[3 * m - h :].mean() - seq[:h].mean()) / ((3 * m + 1) // 2)
+        seq = seq - slope * np.arange(3 * m)
+        seq -= seq.mean()
+        ext = np.concatenate([seq[::-1], seq, seq[::-1]])
+        inner = []
+        for j in range(6 * m):
+            a = ext[j : j + m].mean()
+            b = ext[j + m : j + 2 * m].mean()
+            c = ext[j + 2 * m : j + 3 * m].mean()
+            inner.append((a - 2 * b + c) ** 2)
+        outer.append(np.mean(inner))
+    return math.sqrt(np.mean(outer) / (2.0 * m * m))
+
+
+def test_mtotdev_all_taus_refused_up_front_with_its_estimate(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """4000 samples at every τ took 233 s (issue 39 item 10): now refused at once, the
+    estimate in the message equal to SP 1065's count of the terms, the options named."""
+    f = tmp_path / "w.csv"
+    _rate_csv(f, 4000)
+    before = _digests(tmp_path)
+    code = main(["allan", str(f), "--signal", "gyro_x [deg/h]", "--deviation", "mtotdev",
+                 "--taus", "all", "--json"])  # fmt: skip
+    out, err = capsys.readouterr()
+    line = _refused(code, err, str(f), "--taus", "--max-work", "mtotdev")
+    assert out == ""
+    expected = _mtot_ops(4001, list(range(1, 4001 // 3 + 1)))
+    assert f"about {expected:.2g} operations" in line
+    assert _digests(tmp_path) == before
+
+
+def test_the_budget_is_the_option_and_a_raised_budget_gives_sp1065s_numbers(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """60 samples, mtotdev at m = 1…20: refused just below its estimate, computed just at
+    it, and the values those of SP 1065 eq. 27 written out in the test."""
+    f = tmp_path / "w.csv"
+    y = _rate_csv(f, 60)
+    need = _mtot_ops(61, list(range(1, 21)))
+    argv = ["allan", str(f), "--signal", "gyro_x [deg/h]", "--deviation", "mtotdev",
+            "--taus", "all", "--json"]  # fmt: skip
+    code = main([*argv, "--max-work", repr(need * 0.999)])
+    _o, err = capsys.readouterr()
+    _refused(code, err, str(f), "--max-work")
+    code = main([*argv, "--max-work", repr(need * 1.001)])
+    out, err = capsys.readouterr()
+    assert code == 0, err
+    got = json.loads(out)
+    x = np.concatenate([[0.0], np.cumsum(y - y.mean())])
+    ref = [_mtotdev_direct(x, m) for m in range(1, 21)]
+    np.testing.assert_allclose(got["mtotdev"], ref, rtol=1e-9)
+
+
+def test_theo1_and_the_total_family_at_1e5_samples(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """1e5 samples at octave τ: the total family refused up front (its estimate over the
+    default budget of 3e10), naming --max-work; no output, the input unchanged."""
+    f = tmp_path / "big.csv"
+    _rate_csv(f, 100_000)
+    before = _digests(tmp_path)
+    code = main(["allan", str(f), "--signal", "gyro_x [deg/h]", "--deviation",
+                 "mtotdev,htotdev,theo1", "--json"])  # fmt: skip
+    out, err = capsys.readouterr()
+    line = _refused(code, err, str(f), "--max-work", "mtotdev")
+    assert out == ""
+    octave = [2**k for k in range(17) if 2**k <= 100_001 // 3]
+    assert f"mtotdev: {_mtot_ops(100_001, octave):.2g}" in line
+    assert _digests(tmp_path) == before
+
+
+@pytest.mark.parametrize("value", ["0", "-1", "nan"])
+def test_a_budget_that_is_not_positive_is_refused(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], value: str
+) -> None:
+    f = tmp_path / "w.csv"
+    _rate_csv(f, 50)
+    code = main(["allan", str(f), "--signal", "gyro_x [deg/h]", "--deviation", "oadev",
+                 "--max-work", value])  # fmt: skip
+    _o, err = capsys.readouterr()
+    _refused(code, err, "--max-work")
+
+
+def test_theo1_at_every_tau_is_refused_with_eq30s_count(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Theo1 (SP 1065 eq. 30) at every τ of 3000 samples: N − m terms of m/2 lags each for
+    every even m < N; about four operations per (term, lag)."""
+    f = tmp_path / "w.csv"
+    _rate_csv(f, 3000)
+    n = 3001
+    expected = sum(4.0 * (m / 2) * (n - m) for m in range(2, n, 2))
+    code = main(["allan", str(f), "--signal", "gyro_x [deg/h]", "--deviation", "theo1",
+                 "--taus", "all", "--max-work", repr(0.99 * expected)])  # fmt: skip
+    _o, err = capsys.readouterr()
+    line = _refused(code, err, str(f), "--max-work", "--taus all")
+    assert f"(theo1: {expected:.2g})" in line
+
+
+def test_theo1_at_the_records_end_has_an_open_interval_not_an_exit_1(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Theo1's empirical EDF of random-walk FM (as ``--taus all`` identifies it there) at
+    τ ≈ 0.84 of 3000 samples falls to ≈ 0.005 and below: the
+    χ² quantile is 0 and the upper bound unbounded (null in JSON), not a divide-by-zero
+    turned into ``error: internal`` (exit 1).  The value itself is SP 1065 eq. 30 written
+    out in the test."""
+    f = tmp_path / "w.csv"
+    y = _rate_csv(f, 3000)
+    code = main(["allan", str(f), "--signal", "gyro_x [deg/h]", "--deviation", "theo1",
+                 "--taus", "1891.5,1893", "--noise-type", "rwfm", "--json"])  # fmt: skip
+    out, err = capsys.readouterr()
+    assert code == 0, err
+    got = json.loads(out)
+    assert got["theo1_tau_s"] == [1891.5, 1893.0]
+    x = np.concatenate([[0.0], np.cumsum(y - y.mean())])
+    n = x.size
+    ref = []
+    for m in (2522, 2524):
+        h = m // 2
+        s = sum(
+            ((x[i] - x[i - d + h]) + (x[i + m] - x[i + d + h])) ** 2 / (h - d)
+            for i in range(n - m)
+            for d in range(h)
+        )
+        ref.append(math.sqrt(s / (0.75 * m * m * (n - m))))
+    np.testing.assert_allclose(got["theo1"], ref, rtol=1e-9)
+    assert 0 < got["theo1_edf"][0] < 0.01
+    assert got["theo1_high"][0] is None or got["theo1_high"][0] > got["theo1"][0]
