@@ -1879,6 +1879,38 @@ MUTANTS: tuple[Mutant, ...] = (
         WORK_BOUNDS,
         "a request within the budget refused",
     ),
+    Mutant(
+        "bounds-fleet-unit-files-unchecked",
+        P + "fleet/config.py",
+        'refuse_special_input(base / f, f"data file of unit {uid}")',
+        "None",
+        WORK_BOUNDS,
+        "a FIFO as a unit's modelling file reaches the hash and the reader (a hang)",
+    ),
+    Mutant(
+        "bounds-special-input-no-fifo",
+        P + "outputs.py",
+        '(stat.S_ISFIFO, "a FIFO"),',
+        '(stat.S_ISDIR, "a FIFO"),',
+        WORK_BOUNDS,
+        "FIFOs not recognised as special files",
+    ),
+    Mutant(
+        "bounds-compensate-special-unchecked",
+        P + "compensate/files.py",
+        "    refuse_special_input(path)\n    if path.stat().st_size == 0:",
+        "    if path.stat().st_size == 0:",
+        WORK_BOUNDS,
+        "compensate opens a FIFO given as its recording",
+    ),
+    Mutant(
+        "bounds-model-file-special-unchecked",
+        P + "models/filecheck.py",
+        "refuse_special_input(p, what)",
+        "None",
+        WORK_BOUNDS,
+        "a FIFO given as a model file is opened",
+    ),
 )
 
 

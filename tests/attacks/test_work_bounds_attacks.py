@@ -12,6 +12,7 @@ from __future__ import annotations
 import hashlib
 import json
 import math
+import os
 import signal
 from collections.abc import Iterator
 from pathlib import Path
@@ -20,6 +21,7 @@ from types import FrameType
 import numpy as np
 import pytest
 
+from fleet_data import CHANNELS, TEMP, config_text, write_run
 from thermocal.cli import main
 
 ALARM_S = 20
@@ -219,3 +221,83 @@ def test_theo1_at_the_records_end_has_an_open_interval_not_an_exit_1(
     np.testing.assert_allclose(got["theo1"], ref, rtol=1e-9)
     assert 0 < got["theo1_edf"][0] < 0.01
     assert got["theo1_high"][0] is None or got["theo1_high"][0] > got["theo1"][0]
+
+
+# --- special files: refused by stat, never opened ------------------------------------------
+
+
+def _fifo(path: Path) -> Path:
+    os.mkfifo(path)
+    return path
+
+
+def _good_model(tmp: Path, capsys: pytest.CaptureFixture[str]) -> tuple[Path, Path]:
+    """A recording (fleet_data's run) and the model ``fit`` writes of it."""
+    run = tmp / "run.csv"
+    write_run(run, 3)
+    model = tmp / "model.json"
+    code = main(["fit", str(run), "--model", "poly", "--order", "1", "--signal",
+                 next(iter(CHANNELS)), "--temps", TEMP, "-o", str(model)])  # fmt: skip
+    _o, err = capsys.readouterr()
+    assert code == 0, err
+    return run, model
+
+
+def test_a_fifo_as_a_fleet_modelling_file_is_refused_up_front(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The FIFO hung ``fleet`` (its hash opened it, then the reader): now exit 2 naming the
+    FIFO and its unit, nothing written, the other unit's file unchanged."""
+    write_run(tmp_path / "U1.csv", 1)
+    fifo = _fifo(tmp_path / "U2.csv")
+    cfg = tmp_path / "batch.toml"
+    cfg.write_text(config_text({"U1": ("U1.csv", None), "U2": ("U2.csv", None)}))
+    before = {p: _digest(p) for p in (cfg, tmp_path / "U1.csv")}
+    code = main(["fleet", str(cfg), "-o", str(tmp_path / "out"), "--workers", "1"])
+    _o, err = capsys.readouterr()
+    _refused(code, err, str(fifo), "FIFO", "U2")
+    assert not (tmp_path / "out").exists()
+    assert {p: _digest(p) for p in before} == before
+
+
+def test_a_fifo_as_the_fleet_configuration_is_refused(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    fifo = _fifo(tmp_path / "batch.toml")
+    code = main(["fleet", str(fifo), "-o", str(tmp_path / "out")])
+    _o, err = capsys.readouterr()
+    _refused(code, err, str(fifo), "FIFO")
+
+
+@pytest.mark.parametrize("command", ["inspect", "metrics", "allan", "fit"])
+def test_a_fifo_as_a_recording_is_refused(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], command: str
+) -> None:
+    fifo = _fifo(tmp_path / "run.csv")
+    extra = {"fit": ["--model", "poly", "-o", str(tmp_path / "m.json")], "allan": ["--signal", "x"]}
+    code = main([command, str(fifo), *extra.get(command, [])])
+    _o, err = capsys.readouterr()
+    _refused(code, err, str(fifo), "FIFO")
+
+
+def test_a_character_device_as_a_recording_is_refused(
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    """``/dev/zero`` never ends: refused by its mode, not read."""
+    code = main(["inspect", "/dev/zero"])
+    _o, err = capsys.readouterr()
+    _refused(code, err, "/dev/zero", "character device")
+
+
+@pytest.mark.parametrize("which", ["model", "data"])
+def test_compensate_refuses_a_fifo(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], which: str
+) -> None:
+    run, model = _good_model(tmp_path, capsys)
+    fifo = _fifo(tmp_path / ("m.json" if which == "model" else "d.csv"))
+    args = [str(fifo), str(run)] if which == "model" else [str(model), str(fifo)]
+    out = tmp_path / "out.csv"
+    code = main(["compensate", *args, "-o", str(out)])
+    _o, err = capsys.readouterr()
+    _refused(code, err, str(fifo), "FIFO")
+    assert not out.exists()

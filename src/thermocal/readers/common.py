@@ -27,7 +27,7 @@ from thermocal.errors import (
     ThermocalInputError,
     ThermocalWarning,
 )
-from thermocal.outputs import TEMP_SUFFIX
+from thermocal.outputs import TEMP_SUFFIX, refuse_special_input, special_mode
 from thermocal.recording import FloatArray
 
 if TYPE_CHECKING:
@@ -81,6 +81,7 @@ def csv_encoding(path: str | Path, probe_bytes: int = 1 << 16) -> str:
     instrument software write it; a ``°`` in a header is the usual case, stated in a
     warning).  UTF-16/32 (NUL bytes) are refused with the remedy.
     """
+    refuse_special_input(path)
     p = Path(path)
     with open(p, "rb") as fh:
         head = fh.read(probe_bytes)
@@ -426,6 +427,8 @@ def sha256_of(path: str | Path) -> str | None:
     file's provenance uses :func:`thermocal.models.files.file_sha256`, which also reads a
     station folder and lets a read error through."""
     h = hashlib.sha256()
+    if special_mode(Path(path)) is not None:  # a FIFO would block: never opened
+        return None
     try:
         with open(path, "rb") as fh:
             while block := fh.read(1 << 20):

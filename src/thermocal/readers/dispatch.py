@@ -20,6 +20,7 @@ from thermocal.errors import (
     TimestampWarning,
     UnitWarning,
 )
+from thermocal.outputs import refuse_special_input
 from thermocal.readers.common import (
     check_memory,
     check_unique_names,
@@ -494,6 +495,7 @@ def read_recording(
     UnitError : an unknown unit string.
     """
     p = Path(path)
+    refuse_special_input(p)  # a FIFO or device: refused before it is opened
     obj, info = _open_table(p, text, topic)
 
     names = list(obj.column_names) if isinstance(obj, ParquetColumns) else list(obj.columns)
