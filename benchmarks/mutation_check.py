@@ -1911,6 +1911,30 @@ MUTANTS: tuple[Mutant, ...] = (
         WORK_BOUNDS,
         "a FIFO given as a model file is opened",
     ),
+    Mutant(
+        "bounds-line-exact-refused",
+        P + "readers/text.py",
+        'and not (len(line) == limit + 1 and line.endswith("\\n"))',
+        "",
+        WORK_BOUNDS,
+        "a line of exactly the bound (plus its line end) refused",
+    ),
+    Mutant(
+        "bounds-line-data-rows-unbounded",
+        P + "readers/text.py",
+        "while line := bounded_line(fh, path, lineno + 1, limit):",
+        "while line := fh.readline():",
+        WORK_BOUNDS,
+        "the data rows read without the line bound (only the layout lines bounded)",
+    ),
+    Mutant(
+        "bounds-line-head-unbounded",
+        P + "readers/text.py",
+        'return [bounded_line(fh, path, k, limit).rstrip("\\r\\n") for k in',
+        'return [fh.readline().rstrip("\\r\\n") for k in',
+        WORK_BOUNDS,
+        "the layout lines read without the bound (a 10 MB line split field by field)",
+    ),
 )
 
 

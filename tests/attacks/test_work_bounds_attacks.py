@@ -301,3 +301,79 @@ def test_compensate_refuses_a_fifo(
     _o, err = capsys.readouterr()
     _refused(code, err, str(fifo), "FIFO")
     assert not out.exists()
+
+
+# --- line length: a text reader refuses a line beyond its bound, naming it ------------------
+
+
+def _log_with_long_line(path: Path, sep: str, long_at: int, long_chars: int) -> None:
+    """A text log with a header, data lines and at data line ``long_at`` one line of
+    ``long_chars`` characters (fields ``1`` separated by ``sep``)."""
+    rows = [sep.join(["time [s]", "gx [deg/s]", "T1 [degC]"])]
+    for i in range(1, 8):
+        rows.append(sep.join([str(i), "0.5", str(20 + i)]))
+    rows.insert(long_at - 1, (("1" + sep) * (long_chars // 2))[:long_chars])
+    path.write_text("\n".join(rows) + "\n")
+
+
+@pytest.mark.parametrize("sep", [",", ";"])
+@pytest.mark.parametrize("command", ["compensate", "inspect", "fit"])
+def test_a_10mb_line_is_refused_naming_its_line(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], sep: str, command: str
+) -> None:
+    """A 10 MB line of five million fields hung ``compensate`` (the layout detection took
+    it field by field): now exit 2 at once naming the file and line 2."""
+    f = tmp_path / ("log.csv" if sep == "," else "log.txt")
+    _log_with_long_line(f, sep, 2, 10_000_000)
+    argv = {
+        "inspect": ["inspect", str(f)],
+        "fit": ["fit", str(f), "--model", "poly", "-o", str(tmp_path / "m.json")],
+    }.get(command)
+    if argv is None:  # compensate: a good model first
+        (tmp_path / "good").mkdir()
+        _run, model = _good_model(tmp_path / "good", capsys)
+        argv = ["compensate", str(model), str(f), "-o", str(tmp_path / "o.csv")]
+    before = _digests(tmp_path)
+    code = main(argv)
+    _o, err = capsys.readouterr()
+    _refused(code, err, str(f), "line 2 ", "THERMOCAL_MAX_LINE")
+    assert len(err) < 1000  # the line itself is not echoed
+    assert not (tmp_path / "o.csv").exists() and not (tmp_path / "m.json").exists()
+    assert _digests(tmp_path) == before
+
+
+def test_the_line_bound_is_exact_and_set_by_the_environment(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """THERMOCAL_MAX_LINE = 40: a data line of exactly 40 characters (a zero-padded time)
+    is read and its value kept; one of 41 is refused naming line 5."""
+    monkeypatch.setenv("THERMOCAL_MAX_LINE", "40")
+    f = tmp_path / "log.txt"
+    lines = ["time [s];gx [deg/s];T1 [degC]"] + [f"{i};0.5;{20 + i}" for i in range(1, 8)]
+    padded = "4".zfill(40 - len(";0.5;24"))
+    lines[4] = f"{padded};0.5;24"
+    assert len(lines[4]) == 40
+    f.write_text("\n".join(lines) + "\n")
+    code = main(["inspect", str(f), "--json"])
+    out, err = capsys.readouterr()
+    assert code == 0, err
+    assert json.loads(out)["n_samples"] == 7
+    lines[4] = "0" + lines[4]
+    f.write_text("\n".join(lines) + "\n")
+    code = main(["inspect", str(f)])
+    _o, err = capsys.readouterr()
+    _refused(code, err, str(f), "line 5 ", "40 characters")
+
+
+def test_a_long_line_past_the_layout_lines_is_refused_too(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Below the 400 lines the layout is found from: the text reader's own bound (line 450
+    named), not a split into two million fields."""
+    f = tmp_path / "log.txt"
+    rows = ["time [s];gx [deg/s];T1 [degC]"] + [f"{i};0.5;25" for i in range(1, 600)]
+    rows[449] = "1;" * 2_000_000
+    f.write_text("\n".join(rows) + "\n")
+    code = main(["inspect", str(f)])
+    _o, err = capsys.readouterr()
+    _refused(code, err, str(f), "line 450 ", "THERMOCAL_MAX_LINE")
