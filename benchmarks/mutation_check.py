@@ -1935,6 +1935,38 @@ MUTANTS: tuple[Mutant, ...] = (
         WORK_BOUNDS,
         "the layout lines read without the bound (a 10 MB line split field by field)",
     ),
+    Mutant(
+        "bounds-scheduler-port-range",
+        P + "fleet/batch.py",
+        "not 1 <= port <= 65535",
+        "not 0 <= port",
+        WORK_BOUNDS,
+        "a scheduler port beyond 65535 handed to Dask (its ValueError: exit 1)",
+    ),
+    Mutant(
+        "bounds-worker-memory-share",
+        P + "fleet/batch.py",
+        "WORKER_MEMORY_SHARE: Final = 0.5",
+        "WORKER_MEMORY_SHARE: Final = 5.0",
+        WORK_BOUNDS,
+        "a unit allowed more memory than its Dask worker has",
+    ),
+    Mutant(
+        "bounds-killed-worker-stops-batch",
+        P + "fleet/batch.py",
+        "yield lost_unit(task_of[fut.key], exc)",
+        "raise",
+        WORK_BOUNDS,
+        "a worker's death stops the batch, its unit lost and its file never named",
+    ),
+    Mutant(
+        "bounds-memory-budget-ignored",
+        P + "readers/common.py",
+        "return budget if base is None else min(base, budget)",
+        "return base",
+        WORK_BOUNDS,
+        "the worker's memory budget set and never applied",
+    ),
 )
 
 

@@ -14,6 +14,7 @@ import json
 import math
 import os
 import signal
+import sys
 from collections.abc import Iterator
 from pathlib import Path
 from types import FrameType
@@ -377,3 +378,128 @@ def test_a_long_line_past_the_layout_lines_is_refused_too(
     code = main(["inspect", str(f)])
     _o, err = capsys.readouterr()
     _refused(code, err, str(f), "line 450 ", "THERMOCAL_MAX_LINE")
+
+
+# --- fleets: the scheduler's address, a worker's memory, a worker that dies ----------------
+
+
+def _two_units(root: Path) -> Path:
+    write_run(root / "U1.csv", 1)
+    write_run(root / "U2.csv", 2)
+    cfg = root / "batch.toml"
+    cfg.write_text(config_text({"U1": ("U1.csv", None), "U2": ("U2.csv", None)}))
+    return cfg
+
+
+@pytest.mark.parametrize(
+    "address", ["not a url", "tcp://", "foo://host:8786", "inproc://x", "host:99999", "host"]
+)
+def test_a_scheduler_that_is_not_an_address_is_refused(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], address: str
+) -> None:
+    """``--scheduler 'not a url'`` ended in Dask's ValueError, exit 1, with the output
+    folder made: now exit 2 naming --scheduler, nothing written."""
+    pytest.importorskip("distributed")
+    cfg = _two_units(tmp_path)
+    before = _digests(tmp_path)
+    code = main(["fleet", str(cfg), "-o", str(tmp_path / "out"), "--scheduler", address])
+    _o, err = capsys.readouterr()
+    _refused(code, err, "--scheduler", repr(address))
+    assert not (tmp_path / "out").exists()
+    assert _digests(tmp_path) == before
+
+
+class _KilledWorker(Exception):
+    """Dask's own: raised by a future whose task's worker died too often."""
+
+
+_KilledWorker.__module__ = "distributed.scheduler"
+
+
+class _Future:
+    def __init__(self, fn: object, task: object, key: str, kill: bool) -> None:
+        self.fn, self.task, self.key, self.kill = fn, task, key, kill
+
+    def result(self) -> object:
+        if self.kill:
+            raise _KilledWorker(f"Attempted to run task {self.key!r} on 4 different workers")
+        return self.fn(self.task)  # type: ignore[operator]
+
+
+def _fake_distributed(kill_unit: str, memory_limit: float | None = None) -> object:
+    """A stand-in for the ``distributed`` module: a client that runs each task here (the
+    unit ``kill_unit``'s future raises KilledWorker, as when its worker dies), and, with
+    ``memory_limit``, a worker of that memory limit and one thread."""
+    from types import SimpleNamespace
+
+    class Client:
+        def __init__(self, address: str, timeout: float) -> None:
+            self.address = address
+
+        def map(self, fn: object, tasks: list[object], pure: bool, key: list[str]) -> list[_Future]:
+            return [
+                _Future(fn, t, k, kill=t.unit.id == kill_unit)  # type: ignore[attr-defined]
+                for t, k in zip(tasks, key, strict=True)
+            ]
+
+        def close(self) -> None:
+            pass
+
+    def get_worker() -> object:
+        if memory_limit is None:
+            raise ValueError("No worker found")
+        return SimpleNamespace(
+            memory_manager=SimpleNamespace(memory_limit=memory_limit), nthreads=1
+        )
+
+    return SimpleNamespace(Client=Client, as_completed=iter, get_worker=get_worker)
+
+
+def test_a_unit_whose_worker_dies_is_failed_and_its_file_named(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The worker running U2 dies (KilledWorker): U2 is a failed unit whose error names
+    its file (a warning line, the summary, exit 4), U1 is calibrated — not a batch stopped
+    with U2 lost."""
+    import pandas as pd
+
+    monkeypatch.setitem(sys.modules, "distributed", _fake_distributed("U2"))
+    cfg = _two_units(tmp_path)
+    out = tmp_path / "out"
+    code = main(["fleet", str(cfg), "-o", str(out), "--scheduler", "tcp://127.0.0.1:8786"])
+    _o, err = capsys.readouterr()
+    assert code == 4, err
+    assert "Traceback" not in err
+    warn = [ln for ln in err.splitlines() if ln.startswith("warning: unit U2:")]
+    assert len(warn) == 1 and str(tmp_path / "U2.csv") in warn[0] and "died" in warn[0], err
+    rows = pd.read_csv(out / "summary.csv").set_index("id")
+    assert rows.loc["U1", "status"] == "ok"
+    assert rows.loc["U2", "status"] == "failed"
+    assert str(tmp_path / "U2.csv") in rows.loc["U2", "error"]
+
+
+def test_a_unit_on_a_dask_worker_reads_within_the_workers_memory(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A 200 000-row Parquet run needs 200 000 × (5 · 8 + 40) B = 16 MB to read (five
+    columns used; readers.common.check_memory); on a worker of 20 MB (a unit may use half)
+    it is refused naming the file instead of the nanny killing the worker; the small unit
+    beside it is calibrated."""
+    import pandas as pd
+
+    monkeypatch.setitem(sys.modules, "distributed", _fake_distributed("", memory_limit=20e6))
+    cfg = _two_units(tmp_path)
+    big = pd.read_csv(tmp_path / "U2.csv")
+    big = big.loc[np.arange(200_000) % len(big)].reset_index(drop=True)
+    big["time [s]"] = np.arange(len(big), dtype=float)
+    big.to_parquet(tmp_path / "U2.parquet", index=False)
+    cfg.write_text(config_text({"U1": ("U1.csv", None), "U2": ("U2.parquet", None)}))
+    out = tmp_path / "out"
+    code = main(["fleet", str(cfg), "-o", str(out), "--workers", "1"])
+    _o, err = capsys.readouterr()
+    assert code == 4, err
+    rows = pd.read_csv(out / "summary.csv").set_index("id")
+    assert rows.loc["U1", "status"] == "ok"
+    assert rows.loc["U2", "status"] == "failed"
+    assert str(tmp_path / "U2.parquet") in rows.loc["U2", "error"]
+    assert "memory" in rows.loc["U2", "error"]

@@ -4,6 +4,7 @@ the time column's names, and the capture of log libraries' noise."""
 from __future__ import annotations
 
 import contextlib
+import contextvars
 import functools
 import hashlib
 import io
@@ -111,9 +112,37 @@ WORKING_BYTES_PER_ROW = 40
 10⁷ rows, benchmarks/RESULTS.md), rounded up."""
 
 
+_BUDGET: contextvars.ContextVar[int | None] = contextvars.ContextVar(
+    "thermocal_memory_budget", default=None
+)
+
+
+@contextlib.contextmanager
+def memory_budget(limit_bytes: int | None) -> Iterator[None]:
+    """Within the block, :func:`memory_limit_bytes` is at most ``limit_bytes`` (None: no
+    change) in this thread's context: a fleet unit on a Dask worker reads within the
+    worker's own memory limit, not the machine's (issue 39 item 10: a 4 MB Parquet of 3e8
+    rows passed the machine's check and the nanny killed the worker)."""
+    token = _BUDGET.set(limit_bytes)
+    try:
+        yield
+    finally:
+        _BUDGET.reset(token)
+
+
 def memory_limit_bytes() -> int | None:
     """Memory a read may use [bytes]: ``THERMOCAL_MEMORY_LIMIT`` (``2G``, ``512M``, bytes)
-    when set, else 90 % of the kernel's ``MemAvailable``; None where neither is known."""
+    when set, else 90 % of the kernel's ``MemAvailable``; None where neither is known; at
+    most the budget of an enclosing :func:`memory_budget`."""
+    base = _machine_limit_bytes()
+    budget = _BUDGET.get()
+    if budget is None:
+        return base
+    return budget if base is None else min(base, budget)
+
+
+def _machine_limit_bytes() -> int | None:
+    """``THERMOCAL_MEMORY_LIMIT`` or 90 % of ``MemAvailable`` (:func:`memory_limit_bytes`)."""
     env = os.environ.get("THERMOCAL_MEMORY_LIMIT", "").strip()
     if env:
         scale = {"K": 1 << 10, "M": 1 << 20, "G": 1 << 30, "T": 1 << 40}
