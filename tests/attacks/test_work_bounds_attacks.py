@@ -503,3 +503,126 @@ def test_a_unit_on_a_dask_worker_reads_within_the_workers_memory(
     assert rows.loc["U2", "status"] == "failed"
     assert str(tmp_path / "U2.parquet") in rows.loc["U2", "error"]
     assert "memory" in rows.loc["U2", "error"]
+
+
+def test_dasks_log_records_do_not_reach_stderr(
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+    monkeypatch: pytest.MonkeyPatch,
+    caplog: pytest.LogCaptureFixture,
+) -> None:
+    """A lost connection makes Dask's client log its traceback (``distributed.client``,
+    which Dask's configuration gives its own level): none of it is emitted while the batch
+    runs; stderr holds the command's own lines only."""
+    import logging
+
+    fake = _fake_distributed("U2")
+    client_cls = fake.Client  # type: ignore[attr-defined]
+
+    class LoggingClient(client_cls):  # type: ignore[misc,valid-type]
+        def map(self, *args: object, **kwargs: object) -> list[_Future]:
+            for name in ("distributed.client", "distributed.core", "tornado.application"):
+                logging.getLogger(name).error("Traceback (most recent call last): ... lost")
+            return super().map(*args, **kwargs)  # type: ignore[no-any-return]
+
+    fake.Client = LoggingClient  # type: ignore[attr-defined]
+    monkeypatch.setitem(sys.modules, "distributed", fake)
+    own = logging.getLogger("distributed.client")
+    monkeypatch.setattr(own, "level", logging.WARNING)  # as Dask's configuration sets it
+    cfg = _two_units(tmp_path)
+    with caplog.at_level(logging.DEBUG):
+        code = main(["fleet", str(cfg), "-o", str(tmp_path / "out"), "--scheduler",
+                     "tcp://127.0.0.1:8786"])  # fmt: skip
+    _o, err = capsys.readouterr()
+    assert code == 4, err
+    assert [r.name for r in caplog.records if r.name.startswith(("distributed", "tornado"))] == []
+    assert all(ln.startswith(("warning: ", "error: ")) for ln in err.splitlines() if ln), err
+    assert own.level == logging.WARNING  # restored
+
+
+def test_a_dynamic_adev_of_tens_of_thousands_of_windows_is_refused_up_front(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``--dynamic 8`` on 1e5 samples at 1 Hz: windows of 8 samples, 4 apart, so
+    (100 000 − 8) // 4 + 1 = 24 999 windows (≈ 7 minutes): refused at once naming the
+    window count, --dynamic and --max-work; a budget raised past the estimate of a
+    shorter record lets it run."""
+    f = tmp_path / "big.csv"
+    _rate_csv(f, 100_000)
+    code = main(["allan", str(f), "--signal", "gyro_x [deg/h]", "--dynamic", "8"])
+    out, err = capsys.readouterr()
+    _refused(code, err, str(f), "--dynamic 8 s", f"{(100_000 - 8) // 4 + 1} windows", "--max-work")
+    assert out == ""
+    small = tmp_path / "small.csv"
+    _rate_csv(small, 400)
+    windows = (400 - 8) // 4 + 1
+    argv = ["allan", str(small), "--signal", "gyro_x [deg/h]", "--dynamic", "8", "--json"]
+    code = main([*argv, "--max-work", repr(windows * 1.5e7)])
+    _o, err = capsys.readouterr()
+    _refused(code, err, f"{windows} windows")
+    code = main([*argv, "--max-work", repr(windows * 1.6e7)])
+    out, err = capsys.readouterr()
+    assert code == 0, err
+    assert len(json.loads(out)["dynamic"]["t_s"]) == windows
+
+
+# --- memory: the Parquet metadata's row count against half the available memory ------------
+
+
+def _declared_parquet(path: Path, rows: int) -> None:
+    """A small Parquet file (constant columns compress to almost nothing) of ``rows`` rows."""
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    time = pa.array(np.arange(rows, dtype=np.float64))
+    zeros = pa.array(np.zeros(rows))
+    table = pa.table({"time [s]": time, "gx [deg/s]": zeros, "T1 [degC]": zeros})
+    pq.write_table(table, path, compression="zstd")
+
+
+@pytest.mark.parametrize("command", ["inspect", "metrics"])
+def test_a_parquet_declaring_more_rows_than_half_the_memory_is_refused(
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+    monkeypatch: pytest.MonkeyPatch,
+    command: str,
+) -> None:
+    """With 40 MB available, a read may take 20 MB: 400 000 rows of three columns need
+    400 000 × (3 · 8 + 40) B = 25.6 MB (the metadata's row count, before any column is
+    read): refused naming the file and THERMOCAL_MEMORY_LIMIT; raised by it, read."""
+    import thermocal.readers.common as rc
+
+    monkeypatch.delenv("THERMOCAL_MEMORY_LIMIT", raising=False)
+    monkeypatch.setattr(rc, "mem_available_bytes", lambda: 40_000_000)
+    f = tmp_path / "run.parquet"
+    _declared_parquet(f, 400_000)
+    assert f.stat().st_size < 2_000_000
+    before = _digests(tmp_path)
+    extra = ["--signal", "gx [deg/s]", "--temps", "T1 [degC]"] if command == "metrics" else []
+    code = main([command, str(f), *extra])
+    _o, err = capsys.readouterr()
+    _refused(code, err, str(f), "THERMOCAL_MEMORY_LIMIT", "400,000 rows")
+    assert _digests(tmp_path) == before
+    monkeypatch.setenv("THERMOCAL_MEMORY_LIMIT", "200M")
+    code = main([command, str(f), *extra, "--json"])
+    out, err = capsys.readouterr()
+    assert code == 0, err
+    if command == "inspect":
+        assert json.loads(out)["n_samples"] == 400_000
+
+
+@pytest.mark.parametrize("value", ["nan", "inf", "-5", "0", "12Q"])
+def test_a_memory_limit_that_is_not_a_size_is_refused(
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+    monkeypatch: pytest.MonkeyPatch,
+    value: str,
+) -> None:
+    """``THERMOCAL_MEMORY_LIMIT=inf`` ended in OverflowError (exit 1), ``-5`` refused every
+    read with a negative limit: exit 2 naming the variable."""
+    monkeypatch.setenv("THERMOCAL_MEMORY_LIMIT", value)
+    f = tmp_path / "run.parquet"
+    _declared_parquet(f, 100)
+    code = main(["inspect", str(f)])
+    _o, err = capsys.readouterr()
+    _refused(code, err, "THERMOCAL_MEMORY_LIMIT", repr(value))

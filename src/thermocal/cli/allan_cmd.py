@@ -373,9 +373,10 @@ MaxWorkOpt = Annotated[
     float | None,
     typer.Option(
         "--max-work",
-        help="With --deviation: the arithmetic operations the deviations may take "
-        "(default 3e10, about half a minute); a request estimated beyond it is refused "
-        "before it starts (the total family and theo1 grow as N·m per τ).",
+        help="With --deviation or --dynamic: the arithmetic operations the deviations or "
+        "the dynamic ADEV's windows may take (default 3e10, about half a minute); a request "
+        "estimated beyond it is refused before it starts (the total family and theo1 grow "
+        "as N·m per τ).",
     ),
 ]
 

@@ -43,9 +43,11 @@ and ``DIR/fleet.html`` (:mod:`thermocal.fleet.report`).
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import hashlib
 import json
+import logging
 import math
 import os
 import re
@@ -778,27 +780,56 @@ def dask_executor(address: str) -> Executor:
             "--scheduler needs Dask distributed: pip install 'thermocal[fleet]'"
         ) from None
     try:
-        client = distributed.Client(address, timeout=30)
+        with dask_logs_quiet():
+            client = distributed.Client(address, timeout=30)
     except (OSError, TimeoutError, ValueError) as exc:
         msg = " ".join(str(exc).split())
         raise ThermocalInputError(f"--scheduler {address}: cannot connect ({msg})") from None
 
     def run(tasks: list[UnitTask]) -> Iterator[UnitOutcome]:
-        try:
-            keys = [f"thermocal-unit-{t.unit.id}-{secrets.token_hex(4)}" for t in tasks]
-            futures = client.map(run_unit, tasks, pure=False, key=keys)
-            task_of = {f.key: t for f, t in zip(futures, tasks, strict=True)}
-            for fut in distributed.as_completed(futures):
-                try:
-                    yield fut.result()
-                except Exception as exc:
-                    if "distributed" not in type(exc).__module__:
-                        raise
-                    yield lost_unit(task_of[fut.key], exc)
-        finally:
-            client.close()
+        with dask_logs_quiet():
+            yield from _run_on(client, distributed, tasks)
 
     return run
+
+
+@contextlib.contextmanager
+def dask_logs_quiet() -> Iterator[None]:
+    """Dask's loggers (``distributed``, ``tornado``) held silent in this process while the
+    batch talks to the cluster: their records (a lost connection's traceback, a worker's
+    death) went to stderr beside the command's own lines; what they report reaches the
+    user as a failed unit (:func:`lost_unit`) or the batch's ``interrupted`` line."""
+    names = [
+        n
+        for n in ("distributed", "tornado", *logging.root.manager.loggerDict)
+        if n.split(".")[0] in ("distributed", "tornado")
+    ]  # Dask's configuration gives some children their own level (distributed.client)
+    loggers = [logging.getLogger(n) for n in dict.fromkeys(names)]
+    saved = [(lg, lg.level) for lg in loggers]
+    for lg in loggers:
+        lg.setLevel(logging.CRITICAL + 10)
+    try:
+        yield
+    finally:
+        for lg, level in saved:
+            lg.setLevel(level)
+
+
+def _run_on(client: Any, distributed: Any, tasks: list[UnitTask]) -> Iterator[UnitOutcome]:
+    """The units on ``client``'s cluster, as they finish (:func:`dask_executor`)."""
+    try:
+        keys = [f"thermocal-unit-{t.unit.id}-{secrets.token_hex(4)}" for t in tasks]
+        futures = client.map(run_unit, tasks, pure=False, key=keys)
+        task_of = {f.key: t for f, t in zip(futures, tasks, strict=True)}
+        for fut in distributed.as_completed(futures):
+            try:
+                yield fut.result()
+            except Exception as exc:
+                if "distributed" not in type(exc).__module__:
+                    raise
+                yield lost_unit(task_of[fut.key], exc)
+    finally:
+        client.close()
 
 
 def lost_unit(task: UnitTask, exc: BaseException) -> UnitOutcome:

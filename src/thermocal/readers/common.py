@@ -132,8 +132,8 @@ def memory_budget(limit_bytes: int | None) -> Iterator[None]:
 
 def memory_limit_bytes() -> int | None:
     """Memory a read may use [bytes]: ``THERMOCAL_MEMORY_LIMIT`` (``2G``, ``512M``, bytes)
-    when set, else 90 % of the kernel's ``MemAvailable``; None where neither is known; at
-    most the budget of an enclosing :func:`memory_budget`."""
+    when set, else half the kernel's ``MemAvailable`` (:data:`MEMORY_SHARE`); None where
+    neither is known; at most the budget of an enclosing :func:`memory_budget`."""
     base = _machine_limit_bytes()
     budget = _BUDGET.get()
     if budget is None:
@@ -141,25 +141,44 @@ def memory_limit_bytes() -> int | None:
     return budget if base is None else min(base, budget)
 
 
+MEMORY_SHARE = 0.5
+"""Share of the kernel's ``MemAvailable`` one read may take when ``THERMOCAL_MEMORY_LIMIT``
+is not set: half, so that a file whose metadata declare more rows than it can hold (a 4 MB
+Parquet of 3e8 constant rows wanted 19 GB) is refused before the machine swaps or other
+processes are killed (issue 39 item 10; it was 90 %)."""
+
+
 def _machine_limit_bytes() -> int | None:
-    """``THERMOCAL_MEMORY_LIMIT`` or 90 % of ``MemAvailable`` (:func:`memory_limit_bytes`)."""
+    """``THERMOCAL_MEMORY_LIMIT`` or :data:`MEMORY_SHARE` of ``MemAvailable``
+    (:func:`memory_limit_bytes`)."""
     env = os.environ.get("THERMOCAL_MEMORY_LIMIT", "").strip()
     if env:
         scale = {"K": 1 << 10, "M": 1 << 20, "G": 1 << 30, "T": 1 << 40}
         try:
             if env[-1].upper() in scale:
-                return int(float(env[:-1]) * scale[env[-1].upper()])
-            return int(float(env))
-        except ValueError:
+                value = int(float(env[:-1]) * scale[env[-1].upper()])
+            else:
+                value = int(float(env))
+        except (ValueError, OverflowError):  # nan, inf
+            value = 0
+        if value <= 0:
             raise ThermocalInputError(
-                f"THERMOCAL_MEMORY_LIMIT={env!r}: give bytes or a number with K, M, G or T"
-            ) from None
+                f"THERMOCAL_MEMORY_LIMIT={env!r}: give a positive number of bytes, or one "
+                "with K, M, G or T"
+            )
+        return value
+    available = mem_available_bytes()
+    return None if available is None else int(MEMORY_SHARE * available)
+
+
+def mem_available_bytes() -> int | None:
+    """The kernel's ``MemAvailable`` [bytes] (``/proc/meminfo``), None where unknown."""
     try:
         with open("/proc/meminfo", encoding="ascii") as fh:
             for line in fh:
                 if line.startswith("MemAvailable:"):
-                    return int(0.9 * int(line.split()[1]) * 1024)
-    except OSError:
+                    return int(line.split()[1]) * 1024
+    except (OSError, ValueError, IndexError):
         return None
     return None
 

@@ -165,6 +165,14 @@ def allan_analysis(
             f"{', '.join(family_only)}: for the deviation family's intervals; give the "
             "deviations with --deviation (the overlapping ADEV: --deviation oadev)"
         )
+    if dynamic_s is not None:  # the windows counted before any work
+        from thermocal.stability import allan, family
+
+        allan.check_dynamic_work(
+            rec.n_samples, rec.sample_interval_s, dynamic_s,
+            family.DEFAULT_MAX_WORK if max_work is None else max_work,
+            channels=len(names), where=where,
+        )  # fmt: skip
     channels: dict[str, AllanChannel] = {}
     for name in names:  # one read of the file, every channel (INTERFACE: several channels)
         label = where + (f" [{name}]" if len(names) > 1 else "")
