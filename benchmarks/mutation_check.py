@@ -2015,6 +2015,14 @@ MUTANTS: tuple[Mutant, ...] = (
         WORK_BOUNDS,
         "THERMOCAL_MEMORY_LIMIT=0 (or nan, inf) taken as a limit of 0 bytes",
     ),
+    Mutant(
+        "bounds-dataflash-special-unchecked",
+        P + "readers/dataflash.py",
+        'refuse_special_input(p, "DataFlash log")',
+        "None",
+        WORK_BOUNDS,
+        "a FIFO given as a DataFlash log handed to pymavlink (a hang)",
+    ),
 )
 
 

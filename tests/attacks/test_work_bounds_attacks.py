@@ -626,3 +626,18 @@ def test_a_memory_limit_that_is_not_a_size_is_refused(
     code = main(["inspect", str(f)])
     _o, err = capsys.readouterr()
     _refused(code, err, "THERMOCAL_MEMORY_LIMIT", repr(value))
+
+
+@pytest.mark.parametrize(
+    ("command", "name"), [("ardupilot-tempcal", "log.bin"), ("px4-tempcal", "log.ulg")]
+)
+def test_a_fifo_as_a_flight_log_is_refused(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], command: str, name: str
+) -> None:
+    """``ardupilot-tempcal`` on a FIFO hung in pymavlink's open: refused by its mode."""
+    fifo = _fifo(tmp_path / name)
+    out = tmp_path / "out.params"
+    code = main([command, str(fifo), "-o", str(out)])
+    _o, err = capsys.readouterr()
+    _refused(code, err, str(fifo), "FIFO")
+    assert not out.exists()
