@@ -641,3 +641,22 @@ def test_a_fifo_as_a_flight_log_is_refused(
     _o, err = capsys.readouterr()
     _refused(code, err, str(fifo), "FIFO")
     assert not out.exists()
+
+
+def test_a_directory_as_a_fleet_modelling_file_is_refused_up_front(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A plain directory (not a station's recording folder) as U2's file: exit 2 naming it
+    and the unit before anything is written; ``inspect`` on it names it too (it printed
+    ``[Errno 21] Is a directory``)."""
+    write_run(tmp_path / "U1.csv", 1)
+    (tmp_path / "U2.csv").mkdir()
+    cfg = tmp_path / "batch.toml"
+    cfg.write_text(config_text({"U1": ("U1.csv", None), "U2": ("U2.csv", None)}))
+    code = main(["fleet", str(cfg), "-o", str(tmp_path / "out"), "--workers", "1"])
+    _o, err = capsys.readouterr()
+    _refused(code, err, str(tmp_path / "U2.csv"), "U2", "is a directory")
+    assert not (tmp_path / "out").exists()
+    code = main(["inspect", str(tmp_path / "U2.csv")])
+    _o, err = capsys.readouterr()
+    _refused(code, err, str(tmp_path / "U2.csv"), "is a directory", "station")

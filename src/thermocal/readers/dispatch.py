@@ -191,8 +191,15 @@ def _open_table(
     p: Path, text: TextOptions | None, topic: str | None
 ) -> tuple[pd.DataFrame | ParquetColumns, dict[str, Any]]:
     """The table of a file (its extension chooses the reader) or of a station's recording
-    folder (``DIR`` or ``DIR/SENSOR``), and what the file and its sidecar say of it."""
+    folder (``DIR`` or ``DIR/SENSOR``), and what the file and its sidecar say of it.  A
+    FIFO, device or socket is refused before it is opened, a plain directory named."""
+    refuse_special_input(p)
     station = is_station_path(p)  # a station's recording folder, DIR or DIR/SENSOR
+    if p.is_dir() and not station:
+        raise FileFormatError(
+            f"{p}: is a directory, not a recording file (a folder is read only when "
+            "`thermocal station run` wrote it: it holds station.json)"
+        )
     kind = "station" if station else file_kind(p)
     if topic is not None and kind not in ("ulog", "dataflash", "station"):
         raise ThermocalInputError(
@@ -495,7 +502,6 @@ def read_recording(
     UnitError : an unknown unit string.
     """
     p = Path(path)
-    refuse_special_input(p)  # a FIFO or device: refused before it is opened
     obj, info = _open_table(p, text, topic)
 
     names = list(obj.column_names) if isinstance(obj, ParquetColumns) else list(obj.columns)
