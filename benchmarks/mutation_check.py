@@ -2023,6 +2023,46 @@ MUTANTS: tuple[Mutant, ...] = (
         WORK_BOUNDS,
         "a FIFO given as a DataFlash log handed to pymavlink (a hang)",
     ),
+    Mutant(
+        "bounds-columns-unbounded",
+        P + "readers/text.py",
+        "MAX_COLUMNS = 10_000",
+        "MAX_COLUMNS = 10_000_000",
+        WORK_BOUNDS,
+        "a table of 300 000 columns handed to pandas (minutes)",
+    ),
+    Mutant(
+        "bounds-columns-swallowed-read",
+        P + "readers/dispatch.py",
+        "except TooManyColumnsError as exc:",
+        "except ZeroDivisionError as exc:",
+        WORK_BOUNDS,
+        "the column bound's refusal swallowed by the reader (pandas reads it as one column)",
+    ),
+    Mutant(
+        "bounds-columns-swallowed-compensate",
+        P + "readers/text.py",
+        "except TooManyColumnsError as exc:",
+        "except ZeroDivisionError as exc:",
+        WORK_BOUNDS,
+        "the column bound's refusal swallowed by compensate's chunk options",
+    ),
+    Mutant(
+        "bounds-theo1-noise-at-m",
+        P + "stability/family.py",
+        "mm = max(1, round(0.75 * mm))",
+        "mm = max(1, mm)",
+        STAB + _t("noise_terms_theo1_edf", "total_edf_stable32", "noise_id_stable32"),
+        "Theo1's noise identified at m, not at the averaging factor of τ = 0.75 m τ0",
+    ),
+    Mutant(
+        "bounds-hadamard-clipped",
+        P + "stability/family.py",
+        "-2 if dmax == 2 else -4)",
+        "-2)",
+        STAB + _t("total_edf_stable32", "noise_id_stable32", "bias_stable32"),
+        "the Hadamard family's α clipped at −2 (flicker-walk and random-run FM lost)",
+    ),
 )
 
 

@@ -660,3 +660,26 @@ def test_a_directory_as_a_fleet_modelling_file_is_refused_up_front(
     code = main(["inspect", str(tmp_path / "U2.csv")])
     _o, err = capsys.readouterr()
     _refused(code, err, str(tmp_path / "U2.csv"), "is a directory", "station")
+
+
+@pytest.mark.parametrize("sep", [",", ";"])
+@pytest.mark.parametrize("command", ["compensate", "inspect"])
+def test_a_table_of_300_000_columns_is_refused_before_pandas_sees_it(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], sep: str, command: str
+) -> None:
+    """300 000 one-letter columns fit in a 600 kB line (under the line bound); pandas
+    builds an object per column before it reads a row (minutes: compensate did not finish
+    in 60 s): refused naming the file and the count, 300 000 > 10 000."""
+    f = tmp_path / ("wide.csv" if sep == "," else "wide.txt")
+    k = 300_000
+    f.write_text(sep.join(["t"] + ["a"] * (k - 1)) + "\n" + (sep.join(["1"] * k) + "\n") * 2)
+    if command == "compensate":
+        (tmp_path / "good").mkdir()
+        _run, model = _good_model(tmp_path / "good", capsys)
+        argv = ["compensate", str(model), str(f), "-o", str(tmp_path / "o.csv")]
+    else:
+        argv = ["inspect", str(f)]
+    code = main(argv)
+    _o, err = capsys.readouterr()
+    _refused(code, err, str(f), "300,000", "10,000 columns")
+    assert not (tmp_path / "o.csv").exists()

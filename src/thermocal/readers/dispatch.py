@@ -39,6 +39,8 @@ from thermocal.readers.station import is_station_path, read_station_table, with_
 from thermocal.readers.table import ParquetColumns, csv_header_names, load_sidecar, numeric_column
 from thermocal.readers.text import (
     TextOptions,
+    TooManyColumnsError,
+    check_column_count,
     counter_column,
     counter_time,
     head_lines,
@@ -93,6 +95,8 @@ def read_table(
         head = head_lines(path, encoding, "replace")
         try:
             lay = sniff_text(head, text)
+        except TooManyColumnsError as exc:
+            raise FileFormatError(f"{path}: {exc}") from None
         except FileFormatError:
             lay = None  # not numeric text: the CSV reader says what is wrong
         needs_text = text is not None and (
@@ -100,7 +104,9 @@ def read_table(
         )
         if (lay is not None and not lay.plain) or needs_text:
             return read_text(path, encoding, text)
-    check_unique_names(path, csv_header_names(path, encoding))  # before pandas renames
+    header = csv_header_names(path, encoding)
+    check_column_count(path, len(header))  # pandas makes an object per column first
+    check_unique_names(path, header)  # before pandas renames
     try:
         df = pd.read_csv(
             path,

@@ -162,6 +162,11 @@ def sniff_text(lines: Sequence[str], opts: TextOptions | None = None) -> TextLay
     d = best[2]
     counts_d = [len(_split(x, d)) for x in body]
     m = max(set(c for c in counts_d if c >= 2) or {1}, key=counts_d.count)
+    if m > MAX_COLUMNS:  # before any field is parsed: the parse is per field, in Python
+        raise TooManyColumnsError(
+            f"{m:,} fields a line, more than the {MAX_COLUMNS:,} columns a recording may "
+            "have: not a data log (or cut it to the columns you use)"
+        )
     decimals = [o.decimal] if o.decimal else ([".", ","] if d != "," else ["."])
     fields_m = [f for f in (_split(x, d) for x in body) if len(f) == m]
     texts = {c: _text_positions(fields_m, c) for c in decimals}
@@ -230,6 +235,26 @@ line: one 10 MB line split into five million fields hung the layout detection (i
 item 10).  ``THERMOCAL_MAX_LINE`` (characters) raises it."""
 
 
+class TooManyColumnsError(FileFormatError):
+    """A text log whose lines hold more than :data:`MAX_COLUMNS` fields (:func:`sniff_text`):
+    never passed on to pandas, which would take minutes over the columns."""
+
+
+MAX_COLUMNS = 10_000
+"""Most columns a table may have: pandas builds one object per column before it reads a
+row (90 000 columns: 40 s; the 500 000 a 1 MiB line can hold: minutes)."""
+
+
+def check_column_count(path: Path, n_columns: int) -> None:
+    """A :class:`FileFormatError` naming ``path`` when it has more than
+    :data:`MAX_COLUMNS` columns."""
+    if n_columns > MAX_COLUMNS:
+        raise FileFormatError(
+            f"{path}: {n_columns:,} columns, more than the {MAX_COLUMNS:,} a recording may "
+            "have: not a data log (or cut it to the columns you use)"
+        )
+
+
 def max_line_chars() -> int:
     """:data:`MAX_LINE_CHARS`, or ``THERMOCAL_MAX_LINE`` when set (a positive integer)."""
     env = os.environ.get("THERMOCAL_MAX_LINE", "").strip()
@@ -278,8 +303,11 @@ def csv_chunk_options(path: Path, encoding: str) -> dict[str, Any]:
     head = head_lines(path, encoding, "replace")
     try:
         lay = sniff_text(head)
+    except TooManyColumnsError as exc:
+        raise FileFormatError(f"{path}: {exc}") from None
     except FileFormatError:
         return {}  # the CSV reader says what is wrong
+    check_column_count(path, lay.n_fields)
     if lay.plain:
         return {}
     if not lay.header:
@@ -402,6 +430,7 @@ def read_text(
     except FileFormatError as exc:
         raise FileFormatError(f"{path}: {exc}") from None
     names = _column_names(path, head, lay, o)
+    check_column_count(path, len(names))
     rows, ordinal, bad, texts, linenos = _data_rows(path, encoding, lay, len(names), o.on_bad_lines)
     if not rows:
         raise FileFormatError(f"{path}: the file has a header but no data rows")
