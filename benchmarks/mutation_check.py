@@ -2052,7 +2052,7 @@ MUTANTS: tuple[Mutant, ...] = (
         P + "stability/family.py",
         "mm = max(1, round(0.75 * mm))",
         "mm = max(1, mm)",
-        STAB + _t("noise_terms_theo1_edf", "total_edf_stable32", "noise_id_stable32"),
+        (*STAB, *_t("noise_terms_theo1_edf", "noise_id_stable32"), *WORK_BOUNDS),
         "Theo1's noise identified at m, not at the averaging factor of τ = 0.75 m τ0",
     ),
     Mutant(
@@ -2060,7 +2060,7 @@ MUTANTS: tuple[Mutant, ...] = (
         P + "stability/family.py",
         "-2 if dmax == 2 else -4)",
         "-2)",
-        STAB + _t("total_edf_stable32", "noise_id_stable32", "bias_stable32"),
+        (*STAB, *_t("total_edf_stable32", "noise_id_stable32"), *WORK_BOUNDS),
         "the Hadamard family's α clipped at −2 (flicker-walk and random-run FM lost)",
     ),
 )

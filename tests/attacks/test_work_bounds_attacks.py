@@ -683,3 +683,69 @@ def test_a_table_of_300_000_columns_is_refused_before_pandas_sees_it(
     _o, err = capsys.readouterr()
     _refused(code, err, str(f), "300,000", "10,000 columns")
     assert not (tmp_path / "o.csv").exists()
+
+
+# --- survivors of issue 39 in the family: Theo1's noise τ, the Hadamard α range ----------
+
+
+def test_theo1s_noise_is_identified_at_its_own_tau_not_at_m(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Theo1 at factor m averages over τ = 0.75 m τ0 (SP 1065 eq. 30): its EDF's noise is
+    the noise at the factor round(0.75 m).  Phase data of white PM plus a random walk
+    (white FM), whose lag-1 identification changes between factors 12 and 16: at every τ
+    identified by the lag-1 test the α the command reports is the one
+    :func:`thermocal.stability.edf.identify_noise` gives at round(0.75 m) on the phase
+    minus its end-point line (written out here), and at m = 16 that differs from m's."""
+    from thermocal.stability.edf import identify_noise
+
+    rng = np.random.default_rng(7)
+    n = 20_000
+    x = rng.standard_normal(n) + 0.4 * np.cumsum(rng.standard_normal(n))
+    f = tmp_path / "phase.csv"
+    f.write_text(
+        "time_s,phase [s]\n" + "\n".join(f"{i},{v!r}" for i, v in enumerate(x.tolist())) + "\n"
+    )
+    code = main(["allan", str(f), "--signal", "phase [s]", "--data-type", "phase",
+                 "--deviation", "theo1", "--taus", "octave", "--json"])  # fmt: skip
+    out, err = capsys.readouterr()
+    assert code == 0, err
+    got = json.loads(out)
+    k = np.arange(n, dtype=np.float64)
+    xc = x - (x[0] + (x[-1] - x[0]) * k / (n - 1))
+
+    def alpha_at(m: int) -> int:
+        return max(min(identify_noise(xc, m, dmax=2, phase_input=True).alpha, 2), -2)
+
+    ms = [round(t / 0.75) for t in got["theo1_tau_s"]]
+    checked = 0
+    for m, a, how in zip(ms, got["theo1_alpha"], got["theo1_alpha_method"], strict=True):
+        if how == "lag1":
+            assert a == alpha_at(max(1, round(0.75 * m))), (m, a)
+            checked += 1
+    assert checked >= 5
+    assert alpha_at(12) != alpha_at(16)  # the record tells the two factors apart
+
+
+def test_random_run_fm_keeps_its_hadamard_alpha_of_minus_4(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Rate samples integrated twice from white noise are random-run FM, S_y ∝ f⁻⁴ (α = −4,
+    SP 1065 Table 1; the simulator's truth): the Hadamard deviations, defined down to
+    α = −4, identify it so at every τ the lag-1 test reads, not clipped to −2 as the Allan
+    family is."""
+    rng = np.random.default_rng(4)
+    y = np.cumsum(np.cumsum(rng.standard_normal(4096)))
+    f = tmp_path / "rrfm.csv"
+    f.write_text(
+        "time_s,y [deg/h]\n" + "\n".join(f"{i},{v!r}" for i, v in enumerate(y.tolist())) + "\n"
+    )
+    code = main(["allan", str(f), "--signal", "y [deg/h]", "--deviation", "hdev,ohdev",
+                 "--json"])  # fmt: skip
+    out, err = capsys.readouterr()
+    assert code == 0, err
+    got = json.loads(out)
+    for name in ("hdev", "ohdev"):
+        lag1 = [a for a, how in zip(got[f"{name}_alpha"], got[f"{name}_alpha_method"],
+                                    strict=True) if how == "lag1"]  # fmt: skip
+        assert len(lag1) >= 6 and set(lag1) == {-4}, (name, got[f"{name}_alpha"])
