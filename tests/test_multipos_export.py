@@ -154,12 +154,18 @@ def test_scale_outside_ardupilot_range_refused(tmp_path: Path) -> None:
                           str(tmp_path / "a.parm")])  # fmt: skip
     assert code == 2 and "INS_ACCSCAL_X" in err and "0.8…1.2" in err, err
     assert not (tmp_path / "a.parm").exists()
-    # PX4 documents no range: written, the diagonal of (I + E)⁻¹
+    # PX4 too (issue 39 item 9): the same sensor, the same range
+    code, _o, err = _run(["export-params", str(cal), "--format", "px4", "-o",
+                          str(tmp_path / "p.params")])  # fmt: skip
+    assert code == 2 and "CAL_ACC0_XSCALE" in err and "0.8…1.2" in err, err
+    assert not (tmp_path / "p.params").exists()
+    # a 10 % scale error is written: the diagonal of (I + E)⁻¹
+    _constant_cal(cal, 100000.0)
     code, _o, err = _run(["export-params", str(cal), "--format", "px4", "-o",
                           str(tmp_path / "p.params")])  # fmt: skip
     assert code == 0, err
     p = _parse(tmp_path / "p.params", "px4")
-    e = np.diag([0.3, 1e-3, -2e-3])
+    e = np.diag([0.1, 1e-3, -2e-3])
     e[1, 0] = 500.0 * math.pi / 180 / 3600
     inv = np.linalg.inv(np.eye(3) + e)
     got = [p[f"CAL_ACC0_{a}SCALE"] for a in "XYZ"]

@@ -183,6 +183,34 @@ def c_comment(text: object) -> str:
     return s
 
 
+_LINE_UNSAFE_CATEGORIES = frozenset(("Cc", "Cf", "Zl", "Zp", "Cs", "Co", "Cn"))
+"""Unicode categories :func:`one_line` escapes: controls (newline, CR, NUL, NEL U+0085, the
+file/group/record separators Python's ``splitlines`` breaks at), format characters (BOM,
+bidirectional overrides), the line and paragraph separators U+2028/U+2029 (YAML 1.1 §5.4
+line breaks), surrogates, private-use and unassigned code points (PyYAML refuses a file
+holding a character outside YAML's printable set, even in a comment)."""
+
+
+def one_line(text: object) -> str:
+    """``text`` as ONE line of printable text, for a comment or a label in a generated
+    file that is not C (Kalibr's YAML, parameter files, Markdown, logs): every character of
+    :data:`_LINE_UNSAFE_CATEGORIES` → ``\\xNN`` (below U+0100), ``\\uXXXX`` or
+    ``\\UXXXXXXXX``; everything else kept (``°``, ``σ`` are printable).  No reader can then
+    find a line break, so no name can end a comment and start a key (YAML 1.2 §5.4, §6.6:
+    a comment ends at the line break).  Idempotent."""
+    out: list[str] = []
+    for ch in str(text):
+        if unicodedata.category(ch) in _LINE_UNSAFE_CATEGORIES:
+            o = ord(ch)
+            if o < 0x100:
+                out.append(f"\\x{o:02x}")
+            else:
+                out.append(f"\\u{o:04x}" if o <= 0xFFFF else f"\\U{o:08x}")
+        else:
+            out.append(ch)
+    return "".join(out)
+
+
 def c_string(text: object) -> str:
     """A C string literal (with its quotes) holding the UTF-8 bytes of ``text``:
     ``\\`` ``"`` and ``?`` escaped (``\\?``: no trigraph), every byte outside printable ASCII
@@ -294,4 +322,5 @@ __all__ = [
     "c_names",
     "c_string",
     "check_generated_c",
+    "one_line",
 ]

@@ -17,17 +17,19 @@ from __future__ import annotations
 
 import bisect
 import dataclasses
+import hashlib
 import math
+import warnings
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
-from typing import TypeVar
+from typing import Final, TypeVar
 
 import numpy as np
 import numpy.typing as npt
 
 from thermocal import units
 from thermocal._lazy import LazyModule
-from thermocal.errors import MissingValueError, ThermocalInputError
+from thermocal.errors import MissingValueError, PlausibilityWarning, ThermocalInputError
 from thermocal.recording import Recording, contiguous_slices, is_increasing
 
 _Run = TypeVar("_Run")
@@ -840,6 +842,72 @@ class PowerOnMetrics:
     repeatability: dict[str, RunRepeatability]
 
 
+SENSOR_ID_KEYS: Final = ("sensor_id", "serial", "serial_number", "device_id")
+"""Metadata keys that name one physical sensor (:class:`~thermocal.recording.Metadata`'s
+``sensor_id``, or the same in its ``extra`` pairs): runs that state different values are
+different sensors."""
+
+
+def _distinct_runs(labels: list[str]) -> None:
+    """A run named twice would count twice (its bias twice in the repeatability)."""
+    for i, lab in enumerate(labels):
+        if lab in labels[:i]:
+            raise ThermocalInputError(
+                f"{lab}: given twice; each power-on counts once in the turn-on to turn-on "
+                "repeatability (give every run's file once)"
+            )
+
+
+def sensor_identity(rec: Recording) -> tuple[str, str] | None:
+    """The first of :data:`SENSOR_ID_KEYS` a recording's metadata state, with its value as
+    text (None when none is stated)."""
+    if rec.meta.sensor_id not in (None, ""):
+        return "sensor_id", str(rec.meta.sensor_id)
+    for key in SENSOR_ID_KEYS:
+        v = rec.meta.extra.get(key)
+        if v not in (None, ""):
+            return key, str(v)
+    return None
+
+
+def _same_sensor(rec: Recording, label: str, sensors: dict[str, str]) -> None:
+    """Refuse runs whose metadata name different sensors (``sensors``: value → first run;
+    a run that names none is kept under ``""``)."""
+    ident = sensor_identity(rec)
+    if ident is None:
+        sensors.setdefault("", label)
+        return
+    key, value = ident
+    named = {v: f for v, f in sensors.items() if v}
+    if named and value not in named:
+        first_value, first = next(iter(named.items()))
+        raise ThermocalInputError(
+            f"{label}: {key} {value!r} is not the sensor of {first} ({first_value!r}): a "
+            "turn-on to turn-on repeatability pools power-ons of ONE sensor; give each "
+            "sensor's runs in their own metrics command"
+        )
+    sensors.setdefault(value, label)
+
+
+def _not_a_copy(
+    rec: Recording, names: list[str], label: str, seen: dict[str, tuple[str, str]]
+) -> None:
+    """Refuse a run whose samples of a channel equal another run's, bit for bit: two
+    power-ons of a noisy sensor never give the same record, a copied file does (its bias
+    repeats exactly and the repeatability is rounding error, e.g. 6.8e-17 °/h)."""
+    for n in names:
+        values = np.ascontiguousarray(rec.columns[n], dtype=np.float64)
+        digest = hashlib.sha256(values.tobytes()).hexdigest()
+        key = f"{n}:{digest}"
+        if key in seen:
+            raise ThermocalInputError(
+                f"{label}: its {values.size} samples of {n} are those of {seen[key][0]}, bit "
+                "for bit (a copy of one run, not another power-on); give each power-on's "
+                "own file once"
+            )
+        seen[key] = (label, n)
+
+
 def power_on_metrics(
     runs: Sequence[_Run],
     read: Callable[[_Run], Recording],
@@ -849,9 +917,17 @@ def power_on_metrics(
     """Several power-ons of one sensor: ``read(run)`` gives each run's recording (read in
     turn, so the first bad file stops the analysis), the figures of the channels
     ``signals`` (default each file's first signal; every run the same channels), and per
-    channel :func:`run_repeatability` over the runs, labelled ``str(run)``."""
+    channel :func:`run_repeatability` over the runs, labelled ``str(run)``.
+
+    Refused (:class:`ThermocalInputError`, naming the files): a run named twice, a run
+    whose samples of a channel equal another run's bit for bit (a copy), runs whose
+    metadata name different sensors (:data:`SENSOR_ID_KEYS`): each would give a
+    repeatability of one sensor that the data cannot support."""
     per_run: list[dict[str, MetricsResult]] = []
     names: list[str] | None = None
+    _distinct_runs([str(r) for r in runs])
+    seen: dict[str, tuple[str, str]] = {}
+    sensors: dict[str, str] = {}
     for run in runs:
         rec = read(run)
         these = signals or [rec.signals[0]]
@@ -863,15 +939,26 @@ def power_on_metrics(
             raise ThermocalInputError(
                 "earth-rate removal (--latitude/--axis) takes one signal at a time"
             )
+        _same_sensor(rec, str(run), sensors)
+        _not_a_copy(rec, these, str(run), seen)
         per_run.append({n: options.of(rec, n) for n in these})
     if names is None:
         raise ThermocalInputError("no run to analyse")
+    if "" in sensors and len(sensors) > 1:
+        value, first = next((v, f) for v, f in sensors.items() if v)
+        warnings.warn(
+            f"{sensors['']}: its metadata names no sensor; taken for the sensor of {first} "
+            f"({value!r}) in the repeatability (give only one sensor's power-ons)",
+            PlausibilityWarning,
+            stacklevel=2,
+        )
     labels = [str(r) for r in runs]
     reps = {n: run_repeatability([r[n] for r in per_run], labels) for n in names}
     return PowerOnMetrics(tuple(names), tuple(per_run), reps)
 
 
 __all__ = [
+    "SENSOR_ID_KEYS",
     "DriftExtreme",
     "DriftReference",
     "MetricsOptions",
@@ -895,6 +982,7 @@ __all__ = [
     "power_on_metrics",
     "reference_bias",
     "run_repeatability",
+    "sensor_identity",
     "std_interval",
     "temperature_sensitivity",
     "too_few_averages",

@@ -63,6 +63,11 @@ class Hold:
             raise ThermocalInputError(f"hold duration must be ≥ 0 s, got {self.duration_s!r}")
 
 
+RAMP_RATE_RANGE = (1e-4, 1e3)
+"""|ramp rate| [°C/min] a program may ask (issue 39: 1e-300 made a program of 1e302 s and
+exit 1); the fastest thermal-shock chambers move tens of °C/min."""
+
+
 @dataclass(frozen=True)
 class Ramp:
     """Move the set-point linearly to ``target_c`` [°C] at ``|rate_c_per_min|`` [°C/min].
@@ -81,6 +86,12 @@ class Ramp:
         if not (math.isfinite(self.rate_c_per_min) and self.rate_c_per_min != 0):
             raise ThermocalInputError(
                 f"ramp rate must be finite and non-zero, got {self.rate_c_per_min!r} °C/min"
+            )
+        lo, hi = RAMP_RATE_RANGE
+        if not lo <= abs(self.rate_c_per_min) <= hi:
+            raise ThermocalInputError(
+                f"ramp rate {self.rate_c_per_min:g} °C/min (--rate, --cycle-rate, --rates): "
+                f"a chamber ramps at {lo:g} to {hi:g} °C/min; give a rate in that range"
             )
 
 

@@ -28,6 +28,7 @@ from thermocal.cli.common import (
     text_options,
 )
 from thermocal.errors import ThermocalInputError
+from thermocal.identifiers import one_line
 
 if TYPE_CHECKING:
     import rich.table as _rich_table
@@ -42,10 +43,19 @@ else:
     _nm = LazyModule("thermocal.stability.noise_model")
 
 
-def _triad(text: str | None, option: str) -> list[str]:
+def _triad(text: str | None, option: str, taken: list[str] | None = None) -> list[str]:
+    """``--gyro``/``--accel`` as three different columns, none of them in ``taken`` (the
+    other sensor's)."""
     names = (split_names(text) or []) if text else []
     if text is not None and len(names) != 3:
-        raise ThermocalInputError(f"{option} {text!r}: give three columns X,Y,Z")
+        raise ThermocalInputError(f"{option} {one_line(repr(text))}: give three columns X,Y,Z")
+    for i, n in enumerate(names):
+        if n in names[:i] or n in (taken or []):
+            where = "named twice" if n in names[:i] else "also in --gyro"
+            raise ThermocalInputError(
+                f"{option} {one_line(repr(text))}: column {one_line(repr(n))} {where}; "
+                "give the three different columns X,Y,Z of each sensor"
+            )
     return names
 
 
@@ -118,7 +128,7 @@ def noise_cmd(
     if out_format not in ("kalibr", "json"):
         raise ThermocalInputError(f"--format {out_format!r}: use kalibr or json")
     g_names = _triad(gyro, "--gyro")
-    a_names = _triad(accel, "--accel")
+    a_names = _triad(accel, "--accel", g_names)
     if out_format == "kalibr" and not a_names:
         raise ThermocalInputError(
             "--format kalibr: Kalibr's imu.yaml needs the accelerometer too; give --accel X,Y,Z "
@@ -144,7 +154,7 @@ def noise_cmd(
         where=str(file),
     )  # fmt: skip
     if out_format == "kalibr":
-        text = _nm.kalibr_yaml(res.model, file.name)
+        text = _nm.kalibr_yaml(res.model, file.name)  # names escaped, keys checked
     else:
         text = json.dumps(jsonable(_nm.model_json(res.model, file.name)), allow_nan=False, indent=1)
     with _writers.atomic_write(output, "w") as fh:

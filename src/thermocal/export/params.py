@@ -289,6 +289,77 @@ def check_values(ps: ParamSet) -> None:
             )
 
 
+@dataclass(frozen=True)
+class Documented:
+    """What a firmware documents of a parameter: ``pattern`` (a regular expression of the
+    names), the MAVLink type written (6 int, 9 float), the values it takes (``lo``…``hi``),
+    whether a value outside is refused (``hard``: the firmware cannot store or use it) or
+    warned (a ground station's @Range, which the firmware itself does not enforce), and
+    the source."""
+
+    pattern: str
+    type: int
+    lo: float
+    hi: float
+    hard: bool
+    source: str
+
+
+DOCUMENTED = (
+    Documented(r"TC_[GABM]_ENABLE", 6, 0, 1, True,
+               "PX4 TC_G_ENABLE/TC_A_ENABLE/TC_B_ENABLE/TC_M_ENABLE: boolean int32 "
+               "(src/modules/temperature_compensation parameters)"),
+    Documented(r"TC_[GABM][0-3]_ID", 6, INT32_RANGE[0], INT32_RANGE[1], True,
+               "PX4 TC_*<n>_ID: int32 (same parameters)"),
+    Documented(r"INS_TCAL[1-3]_ENABLE", 6, 0, 2, True,
+               "ArduPilot INS_TCALn_ENABLE @Values 0:Disabled,1:Enabled,2:LearnCalibration "
+               "(AP_InertialSensor_tempcal.cpp)"),
+    Documented(r"INS_TCAL[1-3]_T(MIN|MAX)", 9, -70, 80, False,
+               "ArduPilot INS_TCALn_TMIN/TMAX @Range: -70 80 degC "
+               "(AP_InertialSensor_tempcal.cpp; the firmware clamps T to the values written)"),
+    Documented(r"TCAL_ENABLED", 6, 0, 2, True,
+               "ArduPilot TCAL_ENABLED @Values 0:Disabled,1:Enabled,2:EnableAndLearn "
+               "(AP_TempCalibration.cpp)"),
+    Documented(r"TCAL_TEMP_(MIN|MAX)", 6, -128, 127, True,
+               "ArduPilot TCAL_TEMP_MIN/MAX: AP_Int8 (AP_TempCalibration.h)"),
+    Documented(r"TCAL_BARO_EXP", 9, 0, 2, True,
+               "ArduPilot TCAL_BARO_EXP: exp_limit_min 0 … exp_limit_max 2 "
+               "(AP_TempCalibration.h)"),
+)  # fmt: skip
+"""The parameters of :class:`ParamSet` whose type and values the firmwares document
+(:func:`check_documented`); the float parameters without a documented range are checked as
+float32 by :func:`check_values`."""
+
+
+def check_documented(ps: ParamSet) -> None:
+    """Every parameter of ``ps`` against :data:`DOCUMENTED`: a type other than the one
+    documented, or a value outside a ``hard`` range, refused (exit 2) naming the parameter,
+    the value and the source; outside a ground station's @Range: a warning."""
+    import re
+
+    for name, v in ps.params.items():
+        doc = next((d for d in DOCUMENTED if re.fullmatch(d.pattern, name)), None)
+        if doc is None:
+            continue
+        typ = ps.types.get(name, 9)
+        whole = isinstance(v, int) or (math.isfinite(v) and float(v).is_integer())
+        if typ != doc.type or (doc.type == 6 and not whole):
+            raise ThermocalInputError(
+                f"{name} = {_show(v)}: written as type {typ}, documented as "
+                f"{'an integer' if doc.type == 6 else 'a float'} ({doc.source})"
+            )
+        if doc.lo <= v <= doc.hi:
+            continue
+        what = f"{name} = {_show(v)}: outside {doc.lo:g}…{doc.hi:g} ({doc.source})"
+        if doc.hard:
+            raise ThermocalInputError(f"{what}: the firmware would not take it")
+        warnings.warn(
+            f"{what}: a ground station flags it; check the calibration's range",
+            ThermocalWarning,
+            stacklevel=2,
+        )
+
+
 def export_params(
     cal: Calibration,
     fmt: str,
@@ -345,6 +416,7 @@ def export_params(
         else:
             _ardupilot_params(out, kind, polys, instance, lo, hi)
     check_values(out)
+    check_documented(out)
     return out
 
 
@@ -445,11 +517,14 @@ def _ardupilot_params(
 
 __all__ = [
     "ARDUPILOT_TREF_C",
+    "DOCUMENTED",
     "FORMATS",
     "MAX_INSTANCES",
     "AxisPoly",
+    "Documented",
     "ParamSet",
     "axis_poly",
+    "check_documented",
     "check_values",
     "export_params",
     "map_axes",
@@ -506,6 +581,7 @@ def px4_offset_params(
         for k, c in enumerate(axis_coef):
             out.params[f"{p}X{k}" if n_axes == 1 else f"{p}X{k}_{i}"] = float(c)
     check_values(out)
+    check_documented(out)
     return out
 
 

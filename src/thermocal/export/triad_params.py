@@ -48,6 +48,21 @@ ARDUPILOT_ACCSCAL_RANGE = (0.8, 1.2)
 """``INS_ACCSCAL_*`` ``@Range: 0.8 1.2`` (ArduPilot ``AP_InertialSensor_Params.cpp``)."""
 ARDUPILOT_ACCOFFS_RANGE_M_S2 = (-3.5, 3.5)
 """``INS_ACCOFFS_*`` ``@Range: -3.5 3.5`` [m/s/s] (same file)."""
+PX4_ACCSCALE_RANGE = (0.1, 3.0)
+"""``CAL_ACC${i}_XSCALE``/``YSCALE``/``ZSCALE`` ``min: 0.1``, ``max: 3.0`` (PX4-Autopilot
+``src/modules/sensors/module.yaml``, the parameter metadata QGroundControl enforces);
+``CAL_ACC${i}_XOFF`` and ``CAL_GYRO${i}_XOFF`` have no range there."""
+PX4_ID_TYPE = "int32"
+"""``CAL_ACC${i}_ID``, ``CAL_GYRO${i}_ID``: ``type: int32`` (same file)."""
+PLAUSIBLE_NOTE = (
+    "a scale this far from 1 or an offset this large is not a sensor's error but a unit or "
+    "range setting off by that factor: check the multipos --accel-unit/--accel-scale"
+)
+"""Why ArduPilot's @Range (:data:`ARDUPILOT_ACCSCAL_RANGE`, :data:`ARDUPILOT_ACCOFFS_RANGE_M_S2`)
+is applied to PX4's values too: the same physical sensor, a MEMS accelerometer whose
+sensitivity is specified within a few % (e.g. ±2 % initial tolerance, Bosch BMI088, TDK
+ICM-20602 datasheets) and whose zero-g offset within a few hundred mg."""
+INT32_RANGE = (-(2**31), 2**31 - 1)
 
 
 @dataclass(frozen=True)
@@ -150,6 +165,37 @@ def _check_ardupilot(names: Sequence[str], values: Sequence[float], rng: tuple[f
             )
 
 
+def _check_px4_accel(names: Sequence[str], values: Sequence[float], scale: bool) -> None:
+    """PX4's ``CAL_ACC*`` scale within its metadata range (:data:`PX4_ACCSCALE_RANGE`) and,
+    scales and offsets, within what a sensor's error can be (:data:`PLAUSIBLE_NOTE`)."""
+    rng = ARDUPILOT_ACCSCAL_RANGE if scale else ARDUPILOT_ACCOFFS_RANGE_M_S2
+    for n, v in zip(names, values, strict=True):
+        if scale and not PX4_ACCSCALE_RANGE[0] <= v <= PX4_ACCSCALE_RANGE[1]:
+            raise ThermocalInputError(
+                f"{n} = {v:.6g}: outside PX4's range {PX4_ACCSCALE_RANGE[0]:g}…"
+                f"{PX4_ACCSCALE_RANGE[1]:g} (min/max of CAL_ACC${{i}}_XSCALE in PX4's "
+                f"src/modules/sensors/module.yaml); {PLAUSIBLE_NOTE}"
+            )
+        if not rng[0] <= v <= rng[1]:
+            unit = "" if scale else " m/s²"
+            px4 = "PX4's metadata allows 0.1…3.0" if scale else "PX4 documents no range"
+            raise ThermocalInputError(
+                f"{n} = {v:.6g}{unit}: beyond {rng[0]:g}…{rng[1]:g}{unit}, the range ArduPilot "
+                f"documents for the same calibration (@Range in AP_InertialSensor_Params.cpp; "
+                f"{px4}); {PLAUSIBLE_NOTE}"
+            )
+
+
+def _check_device_id(name: str, device_id: int) -> None:
+    """A device id PX4 stores (:data:`PX4_ID_TYPE`)."""
+    if not INT32_RANGE[0] <= device_id <= INT32_RANGE[1]:
+        raise ThermocalInputError(
+            f"--device-id {device_id}: {name} is an int32 ({INT32_RANGE[0]}…{INT32_RANGE[1]}, "
+            "type of CAL_ACC${i}_ID in PX4's src/modules/sensors/module.yaml); give the "
+            "device id PX4 shows for the sensor (a 24-bit bus/address/type code)"
+        )
+
+
 def _lost_notes(t: TriadFirmware) -> list[str]:
     """What the firmware cannot hold of this triad (also warned)."""
     unit = "m/s^2" if t.kind == "accel" else "rad/s"
@@ -224,6 +270,7 @@ def triad_params(
         if fmt == "px4":
             idn = f"CAL_ACC{instance}_ID" if kind == "accel" else f"CAL_GYRO{instance}_ID"
             if device_id is not None:
+                _check_device_id(idn, device_id)
                 params[idn], types[idn] = device_id, 6
             else:
                 warnings.warn(
@@ -232,6 +279,10 @@ def triad_params(
                     ThermocalWarning,
                     stacklevel=2,
                 )
+            if kind == "accel":
+                _check_px4_accel(offs, t.offset, scale=False)
+                assert scales is not None
+                _check_px4_accel(scales, t.scale, scale=True)
         elif kind == "accel":
             _check_ardupilot(offs, t.offset, ARDUPILOT_ACCOFFS_RANGE_M_S2, "m/s/s ")
             assert scales is not None

@@ -351,7 +351,7 @@ def read_unit(out_dir: Path, uid: str) -> dict[str, Any] | None:
     f = unit_dir(out_dir, uid) / UNIT_FILE
     try:
         obj = json.loads(f.read_text(encoding="utf-8"))
-    except (OSError, ValueError):
+    except (OSError, ValueError, RecursionError):  # nested too deeply: redone too
         return None
     return obj if isinstance(obj, dict) and obj.get("format") == UNIT_FORMAT else None
 

@@ -105,6 +105,8 @@ def load_config(path: str | Path) -> FleetConfig:
         raise ThermocalInputError(f"{p}: no such configuration file") from None
     except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
         raise ThermocalInputError(f"{p}: not a valid TOML file ({exc})") from None
+    except RecursionError:  # thousands of nested brackets
+        raise ThermocalInputError(f"{p}: not a fleet configuration (nested too deeply)") from None
     unknown = sorted(set(doc) - {"fit", "validate", "limits", "unit"})
     if unknown:
         raise ThermocalInputError(
@@ -138,7 +140,7 @@ def load_config(path: str | Path) -> FleetConfig:
                 f"{where}: unknown key(s) {', '.join(extra)}; use id, modeling, validation"
             )
         uid = u.get("id")
-        if not isinstance(uid, str) or not _ID.match(uid):
+        if not isinstance(uid, str) or not _ID.fullmatch(uid):  # "$" matches before a "\n"
             raise ThermocalInputError(
                 f"{where}: id must be letters, digits, '.', '_' or '-' (it names a directory), "
                 f"got {uid!r}"

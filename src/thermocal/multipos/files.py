@@ -211,8 +211,10 @@ def _read_poses(poses: Path | None) -> dict[str, Any] | None:
         if poses.suffix.lower() == ".csv":
             return _poses_csv(text, poses)
         doc: dict[str, Any] = json.loads(text)
-    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
+    except (OSError, UnicodeDecodeError, ValueError) as exc:  # a 5000-digit integer too
         raise ThermocalInputError(f"{poses}: not a readable JSON file ({exc})") from None
+    except RecursionError:  # thousands of nested brackets
+        raise ThermocalInputError(f"{poses}: not a POSES file (JSON nested too deeply)") from None
     return doc
 
 

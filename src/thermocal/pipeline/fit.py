@@ -21,6 +21,7 @@ figures (``warnings``).
 from __future__ import annotations
 
 import dataclasses
+import math
 import re
 import warnings
 from collections.abc import Sequence
@@ -32,7 +33,7 @@ import numpy as np
 
 from thermocal import units
 from thermocal.defaults import overrides_of
-from thermocal.errors import ConditioningWarning, ThermocalInputError
+from thermocal.errors import ConditioningWarning, PlausibilityWarning, ThermocalInputError
 from thermocal.pipeline.messages import one_line
 from thermocal.pipeline.options import FitOptions
 from thermocal.pipeline.reading import load_recording, split_floats, split_names, text_options
@@ -277,9 +278,15 @@ def _prepare_channel(
     unit = ""
     sig_name = signal or "signal"
     temp_names: tuple[str, ...] | None = None
+    from thermocal.stability.analysis import check_not_stuck
+
     for path, rec in loaded:
         _values, run_unit = rec.signal(signal)
         sig_name = signal or rec.signals[0]
+        check_not_stuck(
+            rec.column(sig_name), sig_name, str(path), "--signal",
+            "has no thermal behaviour to model (a flat model of a dead channel)",
+        )  # fmt: skip
         if unit and run_unit != unit:
             raise ThermocalInputError(f"{path}: signal unit {run_unit} differs from {unit}")
         unit = run_unit
@@ -320,6 +327,12 @@ def _prepare_channel(
             }
         )
 
+    names = list(runs[0].temp_names) if runs else []
+    rate_names = [n for n in est.data_needs(names, len(runs)).rate if n in names] if runs else []
+    for line in rate_time_doubts(
+        runs, rate_names, float(spec.options.get("rate_interval_s") or 60.0)
+    ):  # before the judgement: its refusal would drop a warning caught with it
+        warnings.warn(line, PlausibilityWarning, stacklevel=1)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         est.adequacy_ = _judge_channel(spec, est, runs, sig_name, first_inputs, unit)
@@ -336,6 +349,68 @@ def _prepare_channel(
         elif known_ids and "sensor_id" not in first_inputs:
             first_inputs["sensor_id"] = known_ids[0]
     return _Prepared(est, runs, first_inputs, provenance, unit, sig_name, list(caught))
+
+
+MAX_CHAMBER_RATE_C_PER_MIN = 20.0
+"""|Ṫ| [°C/min] beyond which no thermal test moves a sensor's temperature (climatic chambers
+ramp at 1–15 °C/min; thermal-shock transfers are not ramps a Ṫ term describes)."""
+
+MIN_RAMP_C_PER_MIN = 0.1
+"""Below this largest |Ṫ| [°C/min] a test fitted with Ṫ terms has no ramp (the same bound as
+:data:`thermocal.adequacy.MIN_RATE_SPAN_C_PER_MIN`)."""
+
+TIME_SCALES = ((1000.0, "ms read as s"), (1.0 / 60.0, "minutes read as s"), (1e-3, "s read as ms"))
+"""Time-unit mistakes the Ṫ check names: the factor Ṫ would change by, and the mistake."""
+
+
+def rate_time_doubts(
+    runs: Sequence[_base.RunData], temp_names: Sequence[str], interval_s: float
+) -> list[str]:
+    """Why the time axis of runs fitted with Ṫ terms (``temp_names``) looks wrong, one line
+    per (run, column): the largest |Ṫ| (the 99th percentile of Ṫ over ``interval_s``,
+    :func:`thermocal.adequacy.temperature_rate_c_per_min`) above
+    :data:`MAX_CHAMBER_RATE_C_PER_MIN` or below :data:`MIN_RAMP_C_PER_MIN` where a time unit
+    1000 or 60 times off (:data:`TIME_SCALES`) would make it a chamber's ramp, or a run
+    shorter than the interval.  A wrong time unit scales the Ṫ coefficients by the same
+    factor (issue 39: time ×1000 under rate terms)."""
+    out: list[str] = []
+    for run in runs:
+        if run.temperature_unit != "degC" or run.time_s.size < 2:
+            continue
+        span_s = float(run.time_s[-1] - run.time_s[0])
+        # Ṫ over the interval, or over 1 % of a record too short for it (a time axis read
+        # 1000× short spans ramps in one interval), never below 3 samples' steps
+        step = float(np.median(np.diff(run.time_s)))
+        delta = max(3.0 * step, min(interval_s, span_s / 100.0))
+        for name in temp_names:
+            j = list(run.temp_names).index(name)
+            where = f"{run.name}: {name}"
+            rates = _adequacy.temperature_rate_c_per_min(run.time_s, run.temps_c[:, j], delta)
+            rates = rates[np.isfinite(rates)]
+            if rates.size == 0:
+                out.append(
+                    f"{where}: the record spans {span_s:.4g} s, too short for Ṫ: is its time "
+                    "unit right? (check --time-unit)"
+                )
+                continue
+            peak = float(np.percentile(np.abs(rates), 99.0))
+            fits = sorted(
+                (
+                    (k, what)
+                    for k, what in TIME_SCALES
+                    if MIN_RAMP_C_PER_MIN <= peak * k <= MAX_CHAMBER_RATE_C_PER_MIN
+                ),
+                key=lambda kw: abs(math.log(peak * kw[0])),  # nearest a 1 °C/min ramp
+            )
+            if peak > MAX_CHAMBER_RATE_C_PER_MIN or (peak < MIN_RAMP_C_PER_MIN and fits):
+                hint = f" ({fits[0][1]}: {peak * fits[0][0]:.3g} °C/min)" if fits else ""
+                out.append(
+                    f"{where}: Ṫ reaches {peak:.3g} °C/min over a record of {span_s:.4g} s; "
+                    f"a chamber ramps at {MIN_RAMP_C_PER_MIN:g}–{MAX_CHAMBER_RATE_C_PER_MIN:g} "
+                    f"°C/min: is the time unit right{hint}? The Ṫ coefficients scale with "
+                    "it (check --time-unit)"
+                )
+    return out
 
 
 def _data_unit(first_inputs: dict[str, Any], sig_name: str, unit: str) -> tuple[str, float]:

@@ -97,7 +97,7 @@ def error_text(exc: Exception) -> tuple[str, bool]:
         return one_line(exc), True
     if isinstance(exc, OSError) and exc.errno in USER_OS_ERRORS:
         where = exc.filename if exc.filename is not None else "output"
-        return f"{where}: {exc.strerror or one_line(exc)}", True
+        return one_line(f"{where}: {exc.strerror or exc}"), True  # a name holding "\n"
     return f"internal: {type(exc).__name__}: {one_line(exc)}", False
 
 

@@ -462,7 +462,7 @@ def thermocal_metadata(kv: Any, where: str | Path) -> dict[str, Any]:
         return {}
     try:
         meta = json.loads(raw.decode("utf-8"))
-    except (json.JSONDecodeError, UnicodeDecodeError):
+    except (ValueError, UnicodeDecodeError, RecursionError):  # nested too deeply too
         raise FileFormatError(f"{where}: corrupt thermocal metadata") from None
     if not isinstance(meta, dict):
         raise FileFormatError(f"{where}: corrupt thermocal metadata (not an object)")

@@ -37,8 +37,10 @@ def load_sidecar(path: Path) -> dict[str, Any]:
         return {}
     try:
         obj = json.loads(side.read_text(encoding="utf-8"))
-    except (json.JSONDecodeError, UnicodeDecodeError) as exc:
+    except (ValueError, UnicodeDecodeError) as exc:  # JSONDecodeError, a 5000-digit integer
         raise FileFormatError(f"{side}: not valid JSON ({exc})") from None
+    except RecursionError:  # thousands of nested brackets
+        raise FileFormatError(f"{side}: not a metadata sidecar (nested too deeply)") from None
     if not isinstance(obj, dict):
         raise FileFormatError(f"{side}: expected a JSON object")
     return obj

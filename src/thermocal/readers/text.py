@@ -33,6 +33,11 @@ else:
 # --- text logs (serial terminals, spreadsheets of other locales) ----------------------------
 
 
+RATE_HZ_RANGE = (1e-6, 1e7)
+"""``--rate`` [Hz]: from one sample in 11.6 days to 10 MHz (beyond any inertial sensor's
+output rate); outside, time = n / rate overflows or collapses (issue 39)."""
+
+
 @dataclass(frozen=True)
 class TextOptions:
     """How to read a text log (INTERFACE.md common rules): ``names`` for a file without a
@@ -54,6 +59,12 @@ class TextOptions:
             )
         if self.rate_hz is not None and not (math.isfinite(self.rate_hz) and self.rate_hz > 0):
             raise ThermocalInputError(f"--rate must be a positive rate [Hz], got {self.rate_hz}")
+        lo, hi = RATE_HZ_RANGE
+        if self.rate_hz is not None and not lo <= self.rate_hz <= hi:
+            raise ThermocalInputError(
+                f"--rate {self.rate_hz:g} Hz: no sensor samples at that rate; give the sample "
+                f"rate from {lo:g} to {hi:g} Hz (one sample a minute: --rate 0.0166667)"
+            )
         if self.decimal not in (None, ".", ","):
             raise ThermocalInputError(f"--decimal must be . or , — got {self.decimal!r}")
         if self.names is not None and len(set(self.names)) != len(self.names):

@@ -11,6 +11,7 @@ from typing import Any
 
 import numpy as np
 
+from thermocal.report.figures import drawing_names
 from thermocal.stability.allan import TERM_NAMES, AllanResult, DynamicAllan, NoiseTerms
 from thermocal.writers import atomic_write_path
 
@@ -65,14 +66,15 @@ def plot_allan(
         ax.grid(True, which="both", alpha=0.3)
         ax.legend(fontsize=7)
         if title:
-            ax.set_title(title)
+            ax.set_title(title, parse_math=False)
         positive = result.adev_low[result.adev_low > 0]
         if positive.size:
             ax.set_ylim(bottom=float(np.min(positive)) / 2.0)
         out = Path(path)
 
         def _write(tmp: Path) -> None:
-            fig.savefig(tmp, format="png")
+            with drawing_names():
+                fig.savefig(tmp, format="png")
 
         atomic_write_path(out, _write)
     finally:
@@ -137,11 +139,12 @@ def plot_dynamic(dyn: DynamicAllan, path: str | Path, *, title: str | None = Non
         ax.set_yscale("log")
         ax.set_xlabel(f"window centre [s] (windows of {dyn.window_s:g} s)")
         ax.set_ylabel("averaging time τ [s]")
-        ax.set_title(title or "dynamic Allan deviation")
+        ax.set_title(title or "dynamic Allan deviation", parse_math=False)
         out = Path(path)
 
         def _write(tmp: Path) -> None:
-            fig.savefig(tmp, format="png")
+            with drawing_names():
+                fig.savefig(tmp, format="png")
 
         atomic_write_path(out, _write)
     finally:

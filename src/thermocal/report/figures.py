@@ -78,6 +78,11 @@ def binned_means(
     return centres, mean, np.sqrt(var / cnt[ok])
 
 
+PLAIN_TEXT: Any = {"text.parse_math": False}
+"""matplotlib settings under which every text of a figure is drawn as written: a column
+named ``T1 $\\frac$`` is a name, not TeX (mathtext raised ValueError: exit 1, issue 39)."""
+
+
 @contextmanager
 def _figure(nrows: int = 1, height_in: float = 3.4, sharex: bool = False) -> Iterator[Any]:
     import matplotlib
@@ -85,21 +90,35 @@ def _figure(nrows: int = 1, height_in: float = 3.4, sharex: bool = False) -> Ite
     matplotlib.use("Agg", force=True)
     from matplotlib.figure import Figure
 
-    fig = Figure(figsize=(FIG_WIDTH_IN, height_in * nrows), dpi=DPI, layout="constrained")
-    axes = fig.subplots(nrows, 1, sharex=sharex, squeeze=False)[:, 0]
-    for ax in axes:
-        ax.grid(True, which="major", color="#dddddd", linewidth=0.6)
-        ax.grid(True, which="minor", color="#f0f0f0", linewidth=0.4)
-        for side in ("top", "right"):
-            ax.spines[side].set_visible(False)
-        ax.tick_params(labelsize=8.5)
-    yield fig, axes
+    with matplotlib.rc_context(PLAIN_TEXT):  # the axes' own label texts are made here
+        fig = Figure(figsize=(FIG_WIDTH_IN, height_in * nrows), dpi=DPI, layout="constrained")
+        axes = fig.subplots(nrows, 1, sharex=sharex, squeeze=False)[:, 0]
+        for ax in axes:
+            ax.grid(True, which="major", color="#dddddd", linewidth=0.6)
+            ax.grid(True, which="minor", color="#f0f0f0", linewidth=0.4)
+            for side in ("top", "right"):
+                ax.spines[side].set_visible(False)
+            ax.tick_params(labelsize=8.5)
+        yield fig, axes
 
 
 def _png(fig: Any) -> bytes:
     buf = io.BytesIO()
-    fig.savefig(buf, format="png", dpi=DPI, facecolor="white")
+    with drawing_names():
+        fig.savefig(buf, format="png", dpi=DPI, facecolor="white")
     return buf.getvalue()
+
+
+@contextmanager
+def drawing_names() -> Iterator[None]:
+    """While a figure is drawn: matplotlib's "Glyph N missing from font" warning not
+    shown (a column name holding NEL, CR or a script the font lacks is drawn as boxes;
+    the warning was a foreign line on stderr, and an error under ``-W error``)."""
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.filterwarnings("ignore", r"Glyph \d+ .*missing from font", UserWarning)
+        yield
 
 
 def _hours(time_s: FloatArray) -> FloatArray:
@@ -368,21 +387,23 @@ def _grid(n: int, panel_height_in: float = 2.7) -> Iterator[Any]:
     height = panel_height_in * rows
     # fixed margins [in] rather than a constrained layout: the layout engine measures every
     # tick label once more per draw (half the cost of a grid, issue 28)
-    fig = Figure(figsize=(FIG_WIDTH_IN * 1.25, height), dpi=DPI)
-    fig.subplots_adjust(left=0.07, right=0.99, bottom=0.55 / height, top=1.0 - 0.3 / height,
-                        wspace=0.28, hspace=0.85 / panel_height_in)  # fmt: skip
-    axes = fig.subplots(rows, cols, squeeze=False).ravel()
-    for ax in axes[n:]:
-        ax.set_visible(False)
-    for ax in axes[:n]:
-        ax.grid(True, which="major", color="#dddddd", linewidth=0.6)
-        for side in ("top", "right"):
-            ax.spines[side].set_visible(False)
-        ax.tick_params(labelsize=7.5)
-    # titles at a fixed height above their panel (no ticks on top): matplotlib's automatic
-    # title placement measures every tick label of the panel at each draw
-    with matplotlib.rc_context({"axes.titley": 1.0}):
-        yield fig, axes[:n]
+    with matplotlib.rc_context(PLAIN_TEXT):  # the axes' own label texts are made here
+        fig = Figure(figsize=(FIG_WIDTH_IN * 1.25, height), dpi=DPI)
+        fig.subplots_adjust(left=0.07, right=0.99, bottom=0.55 / height,
+                            top=1.0 - 0.3 / height, wspace=0.28,
+                            hspace=0.85 / panel_height_in)  # fmt: skip
+        axes = fig.subplots(rows, cols, squeeze=False).ravel()
+        for ax in axes[n:]:
+            ax.set_visible(False)
+        for ax in axes[:n]:
+            ax.grid(True, which="major", color="#dddddd", linewidth=0.6)
+            for side in ("top", "right"):
+                ax.spines[side].set_visible(False)
+            ax.tick_params(labelsize=7.5)
+        # titles at a fixed height above their panel (no ticks on top): matplotlib's
+        # automatic title placement measures every tick label of the panel at each draw
+        with matplotlib.rc_context({"axes.titley": 1.0}):
+            yield fig, axes[:n]
 
 
 def bias_vs_temperature_grid(channels: Sequence[ChannelBias]) -> bytes:

@@ -50,11 +50,149 @@ def parse_taus(text: str) -> Any:
     if text in TAU_SETS:
         return text
     try:
-        return [float(v) for v in text.split(",") if v.strip()]
+        taus = [float(v) for v in text.split(",") if v.strip()]
     except ValueError:
         raise ThermocalInputError(
             f"--taus {text!r}: use octave, decade, log or a comma-separated list of τ [s]"
         ) from None
+    bad = [t for t in taus if not (math.isfinite(t) and t > 0)]
+    if bad or not taus:
+        raise ThermocalInputError(
+            f"--taus {text!r}: every τ must be a positive, finite time [s]"
+            + (f" (got {bad[0]:g})" if bad else " (none given)")
+            + "; or use octave, decade, log"
+        )
+    return taus
+
+
+FEW_LEVELS: Final = 3
+"""A channel whose samples take at most this many distinct values (more than one) is
+flagged: a stuck or flat-lined sensor, or an output step far above its noise; its
+deviations describe the steps, not the sensor's noise (a warning)."""
+
+STUCK_MIN_SAMPLES: Final = 10
+"""Fewer finite samples than this are too few to call a channel stuck (the estimators' own
+minimums refuse so short a record, naming why)."""
+
+_LEVEL_PROBE: Final = 100_000
+"""Samples probed first for :data:`FEW_LEVELS` (the whole column only when they are few)."""
+
+
+STUCK_ALLAN: Final = "has no noise to analyse (every deviation 0, no noise type)"
+"""What a constant column means to the deviations (:func:`check_not_stuck`)."""
+
+
+def check_not_stuck(
+    values: FloatArray,
+    name: str,
+    where: str,
+    option: str = "--signal",
+    consequence: str = STUCK_ALLAN,
+) -> None:
+    """Refuse a constant column, warn on one with at most :data:`FEW_LEVELS` values.
+
+    A constant record has an Allan deviation of 0 at every τ, a zero-width interval and no
+    identifiable noise (the B1 ratio and R(n) of NIST SP 1065 §5.6 are 0/0): no sensor at
+    rest gives one, a stuck or flat-lined channel does.  ``where`` names the file, ``option``
+    the option that names the column, ``consequence`` what a constant means to the caller.
+
+    Raises
+    ------
+    ThermocalInputError : every finite sample equal (at least :data:`STUCK_MIN_SAMPLES`).
+    """
+    import numpy as np
+
+    v = np.asarray(values, dtype=np.float64).ravel()
+    finite = v if math.isfinite(float(v.sum())) else v[np.isfinite(v)]
+    if finite.size < STUCK_MIN_SAMPLES:
+        return
+    lo, hi = float(finite.min()), float(finite.max())
+    if lo == hi:
+        raise ThermocalInputError(
+            f"{where}: the column {name!r} is constant ({lo:.6g} in all {finite.size} "
+            f"samples): a stuck or flat-lined sensor {consequence}; name another column "
+            f"with {option}, or check the sensor"
+        )
+    probe = np.unique(finite[:_LEVEL_PROBE])
+    if probe.size > FEW_LEVELS:
+        return
+    levels = np.unique(finite) if finite.size > _LEVEL_PROBE else probe
+    if levels.size <= FEW_LEVELS:
+        warnings.warn(
+            f"{where}: the column {name!r} takes only {levels.size} distinct values in "
+            f"{finite.size} samples ({', '.join(f'{x:.6g}' for x in levels)}): a stuck or "
+            "flat-lined sensor, or an output step far coarser than its noise: "
+            + (
+                "the deviations describe those steps, not the sensor's noise"
+                if consequence == STUCK_ALLAN
+                else "a model of it describes those steps"
+            ),
+            ConditioningWarning,
+            stacklevel=2,
+        )
+
+
+def _tau_range(name: str, tau0_s: float, n_phase: int) -> tuple[float, float, int]:
+    """The τ [s] a deviation reaches on ``n_phase`` phase points and its largest m
+    (theo1: τ = 0.75 m τ0, m even)."""
+    from thermocal.stability import deviations as dv
+
+    if name == "adev-rate":  # the overlapping ADEV of rate samples (allan.averaging_factors)
+        from thermocal.stability.allan import max_averaging_factor
+
+        m_max = max_averaging_factor(n_phase)
+        return tau0_s, m_max * tau0_s, m_max
+    m_max = dv.max_factor(name, n_phase)
+    if name == "theo1":
+        m_max -= m_max % 2
+        return 1.5 * tau0_s, 0.75 * m_max * tau0_s, m_max
+    return tau0_s, m_max * tau0_s, m_max
+
+
+def check_tau_list(
+    taus: Any, tau0_s: float, n_points: int, names: Sequence[str], where: str, spec: str = ""
+) -> None:
+    """``--taus`` as a list of τ [s]: refuse one whose every τ lies outside what the record
+    reaches (every array would be empty), warn naming the τ left out of a list partly
+    outside.  ``n_points``: the longest gap-free stretch's points as each deviation counts
+    them (phase points; ``"adev-rate"``: rate samples); ``names`` the deviations asked."""
+    import numpy as np
+
+    if isinstance(taus, str):
+        return
+    tau = np.asarray(taus, dtype=np.float64).ravel()
+    if tau.size == 0 or not np.all(np.isfinite(tau)) or np.any(tau <= 0):
+        return  # the estimators refuse it with their own message
+    ranges = {n: _tau_range(n, tau0_s, n_points) for n in names}
+    inside = np.zeros(tau.size, dtype=bool)
+    for n, (_lo, _hi, m_max) in ranges.items():
+        m = 2 * np.round(tau / (1.5 * tau0_s)) if n == "theo1" else np.round(tau / tau0_s)
+        inside |= (m >= (2 if n == "theo1" else 1)) & (m <= m_max)
+    lo = min(r[0] for r in ranges.values())
+    hi = max(r[1] for r in ranges.values())
+    given = spec or ",".join(f"{t:g}" for t in tau)
+    span = (
+        f"the record reaches τ {lo:.6g} … {hi:.6g} s (τ0 = {tau0_s:.6g} s, {n_points} points "
+        "in its longest gap-free stretch)"
+    )
+    if not inside.any():
+        raise ThermocalInputError(
+            f"{where}: --taus {given}: no τ within the record: {span}; give --taus in that "
+            "range, or a named set (octave, decade, log)"
+        )
+    if not inside.all():
+        out = ", ".join(f"{t:g}" for t in tau[~inside])
+        warnings.warn(
+            f"{where}: --taus: τ {out} s left out: {span}",
+            ConditioningWarning,
+            stacklevel=2,
+        )
+
+
+def _longest(rec: Recording) -> int:
+    """Samples in the longest gap-free stretch of ``rec``."""
+    segs = rec.segments()
+    return max((sl.stop - sl.start for sl in segs), default=rec.n_samples)
 
 
 def column_unit(name: str) -> str:
@@ -165,6 +303,7 @@ def allan_analysis(
             f"{', '.join(family_only)}: for the deviation family's intervals; give the "
             "deviations with --deviation (the overlapping ADEV: --deviation oadev)"
         )
+    check_tau_list(taus, rec.sample_interval_s, _longest(rec), ["adev-rate"], where)
     if dynamic_s is not None:  # the windows counted before any work
         from thermocal.stability import allan, family
 
@@ -200,6 +339,8 @@ def _family(
 
     devs = family.parse_deviations(deviations or "oadev")
     alpha = family.parse_noise_type(noise_type, devs)
+    n_phase = _longest(rec) + (1 if data_type == "rate" else 0)
+    check_tau_list(taus, rec.sample_interval_s, n_phase, devs, where)
     results = {}
     for name in names:
         if data_type == "phase":  # the column as given, in its own unit
@@ -214,13 +355,61 @@ def _family(
                 )
         else:
             values, unit = signal_in_data_unit(rec, name)
+        check_not_stuck(values, name, where)
         results[name] = family.stability(
             values, rec.sample_interval_s, devs, taus, data_type=data_type,
             segments=rec.segments(), unit=unit, confidence=confidence, bias_correct=bias_correct,
             alpha=alpha, noise_id=noise_id,
             where=where, max_work=family.DEFAULT_MAX_WORK if max_work is None else max_work,
         )  # fmt: skip
+    _idle_options(results, devs, bias_correct, alpha, where)
     return results
+
+
+BIAS_CORRECTED: Final = ("totdev", "htotdev")
+"""The deviations ``--bias-correct`` multiplies by Stable32's factor (the others: 1)."""
+
+
+def _idle_options(
+    results: dict[str, StabilityResult],
+    devs: list[str],
+    bias_correct: bool,
+    alpha: int | None,
+    where: str,
+) -> None:
+    """A warning naming ``--bias-correct`` or ``--noise-type`` where it changed nothing: no
+    totdev/htotdev asked, a factor of 1 at every τ (Stable32 corrects totdev for flicker and
+    random-walk FM only, htotdev for FM noise from m = 2: :func:`.family.stable32_bias`), or
+    no deviation with an interval (MTIE, TIE rms: :data:`.family.NO_INTERVAL`)."""
+    import numpy as np
+
+    from thermocal.stability.family import NO_INTERVAL
+
+    if bias_correct:
+        corrected = [d for d in devs if d in BIAS_CORRECTED]
+        if not corrected:
+            why = f"it corrects totdev and htotdev only, not {', '.join(devs)}"
+        elif all(
+            r.curves[d].bias is None or bool(np.all(r.curves[d].bias == 1.0))
+            for r in results.values()
+            for d in corrected
+        ):
+            why = (
+                f"the factor is 1 at every τ of {', '.join(corrected)} for the noise "
+                "identified (Stable32 corrects totdev for flicker and random-walk FM, "
+                "htotdev for FM noise from m = 2)"
+            )
+        else:
+            why = ""
+        if why:
+            warnings.warn(f"{where}: --bias-correct changes nothing: {why}", ConditioningWarning, 2)
+    if alpha is not None and all(d in NO_INTERVAL for d in devs):
+        warnings.warn(
+            f"{where}: --noise-type changes nothing: no confidence interval or bias factor "
+            f"uses it ({', '.join(devs)}: none)",
+            ConditioningWarning,
+            2,
+        )
 
 
 def _allan_channel(
@@ -239,6 +428,7 @@ def _allan_channel(
 
     # every figure in the data's own unit (°/s data: ADEV in °/s; INTERFACE common rules)
     values, unit = signal_in_data_unit(rec, name)
+    check_not_stuck(values, name, where)
     lattice = nm.lattice_step(values)  # before the ADEV overwrites the values
     segs = rec.segments()
     longest = max(segs, key=lambda sl: sl.stop - sl.start) if segs else slice(None)
@@ -370,6 +560,7 @@ def imu_noise(
     axes = []
     for name in gyro + accel:
         values, unit = signal_in_data_unit(rec, name)
+        check_not_stuck(values, name, where, "--gyro" if name in gyro else "--accel")
         axes.append(
             nm.axis_noise(
                 values, rec.sample_interval_s, name=name,
@@ -379,7 +570,7 @@ def imu_noise(
         )  # fmt: skip
     model = nm.noise_model(
         axes, 1.0 / rec.sample_interval_s, inflate=inflate, rostopic=rostopic,
-        confidence=confidence,
+        confidence=confidence, where=where,
     )  # fmt: skip
     for ax in axes:
         for kind, t in (("density", ax.density), ("walk", ax.walk)):

@@ -34,6 +34,8 @@ from __future__ import annotations
 import dataclasses
 import json
 import math
+import re
+import warnings
 from dataclasses import dataclass
 from typing import Any, Final, Literal
 
@@ -41,7 +43,8 @@ import numpy as np
 import numpy.typing as npt
 
 from thermocal import units
-from thermocal.errors import ThermocalInputError
+from thermocal.errors import PlausibilityWarning, ThermocalInputError
+from thermocal.identifiers import one_line
 from thermocal.stability.allan import (
     AllanResult,
     NoiseTerm,
@@ -287,10 +290,23 @@ def noise_model(
     inflate: float = 1.0,
     rostopic: str = "/imu0",
     confidence: float = 0.6826894921370859,
+    where: str = "",
 ) -> NoiseModel:
-    """Per sensor the largest density and the largest random walk over its axes."""
+    """Per sensor the largest density and the largest random walk over its axes.
+
+    Refused (:class:`ThermocalInputError`): an axis named twice (``--gyro gx,gx,gx``, or a
+    column in both ``--gyro`` and ``--accel``), a ``rostopic`` that is not a ROS graph
+    resource name (:data:`ROS_NAME`).  A :class:`PlausibilityWarning` (naming ``where``)
+    when the update rate or a density lies outside what an IMU has
+    (:func:`implausible`)."""
     if not (math.isfinite(inflate) and inflate >= 1.0):
         raise ThermocalInputError(f"--inflate {inflate!r}: give a factor ≥ 1 (1: none)")
+    _distinct_axes(axes)
+    if not ROS_NAME.fullmatch(rostopic):
+        raise ThermocalInputError(
+            f"--rostopic {one_line(repr(rostopic))}: not a ROS topic name (a letter, '/' or "
+            "'~', then letters, digits, '_' and '/'; ROS wiki 'Names' 1.1.1), e.g. /imu0"
+        )
     chosen: dict[str, AxisNoise] = {}
     for sensor, prefix in (("gyro", "gyroscope"), ("accel", "accelerometer")):
         mine = [a for a in axes if a.sensor == sensor]
@@ -298,7 +314,68 @@ def noise_model(
             continue
         chosen[f"{prefix}_noise_density"] = max(mine, key=lambda a: a.density.value)
         chosen[f"{prefix}_random_walk"] = max(mine, key=lambda a: a.walk.value)
-    return NoiseModel(tuple(axes), update_rate_hz, inflate, rostopic, confidence, chosen)
+    model = NoiseModel(tuple(axes), update_rate_hz, inflate, rostopic, confidence, chosen)
+    for why in implausible(model):
+        warnings.warn(f"{where}: {why}" if where else why, PlausibilityWarning, stacklevel=2)
+    return model
+
+
+ROS_NAME: Final = re.compile(r"[A-Za-z~/][A-Za-z0-9_/]*")
+"""A ROS graph resource name (ROS wiki "Names" 1.1.1: first character a letter, ``~`` or
+``/``; then letters, digits, ``_`` and ``/``): Kalibr looks the IMU's topic up in the bag
+by this name, so nothing else can be a topic."""
+
+IMU_RATE_HZ: Final = (10.0, 1.0e5)
+"""Update rates [Hz] outside which a noise model for an estimator is doubtful: estimators
+fuse IMUs at 100 Hz to a few kHz (Kalibr's examples 200 Hz; the fastest MEMS outputs
+32 kHz, TDK ICM-42688-P data sheet).  A time column in ms read as s gives 1/1000 of the
+rate, and densities √1000 = 31.6× too large (σ_n = σ √τ0)."""
+
+IMU_DENSITY: Final = {"gyro": (1.0e-9, 1.0e-2), "accel": (1.0e-8, 1.0e-1)}
+"""White-noise densities [rad/s/√Hz; m/s²/√Hz] outside which no IMU lies: gyros from 30×
+below a strategic-grade ring laser gyro (0.0001 °/√h = 2.9e-8 rad/s/√Hz) to 20× above a
+noisy consumer MEMS gyro (L3G4200D data sheet 0.03 °/s/√Hz = 5.2e-4 rad/s/√Hz);
+accelerometers from 1 ng/√Hz (seismic sensors) to 10 mg/√Hz (25× an ADXL345's
+400 µg/√Hz, its data sheet)."""
+
+
+def implausible(model: NoiseModel) -> list[str]:
+    """Why ``model``'s update rate or densities cannot be an IMU's (empty: plausible); the
+    bounds are :data:`IMU_RATE_HZ` and :data:`IMU_DENSITY`, each with its source."""
+    out = []
+    lo, hi = IMU_RATE_HZ
+    rate = model.update_rate_hz
+    if not lo <= rate <= hi:
+        out.append(
+            f"update rate {rate:.6g} Hz (one sample every {1.0 / rate:.6g} s) is outside the "
+            f"{lo:g} Hz … {hi:g} Hz an estimator fuses an IMU at: if the time column is in "
+            "ms or µs, give --time-unit (a time axis ×1000 makes every noise density "
+            "√1000 = 31.6× too large)"
+        )
+    for ax in model.axes:
+        dlo, dhi = IMU_DENSITY[ax.sensor]
+        v = ax.density.value
+        if not dlo <= v <= dhi:
+            out.append(
+                f"{one_line(ax.name)}: noise density {v:.4g} {ax.density.unit} lies outside "
+                f"the {dlo:g} … {dhi:g} of any {ax.sensor} (check the column's unit "
+                f"--{ax.sensor}-unit and the time unit --time-unit)"
+            )
+    return out
+
+
+def _distinct_axes(axes: list[AxisNoise]) -> None:
+    """Each column once: a gyro triad of one column, or accelerometer columns that are the
+    gyro's, would give Kalibr one sensor's noise for another's."""
+    first: dict[str, str] = {}
+    for ax in axes:
+        opt = "--gyro" if ax.sensor == "gyro" else "--accel"
+        if ax.name in first:
+            raise ThermocalInputError(
+                f"{opt} {one_line(repr(ax.name))}: column named twice (also in "
+                f"{first[ax.name]}); give three different columns X,Y,Z for each sensor"
+            )
+        first[ax.name] = opt
 
 
 def _yaml_float(x: float) -> str:
@@ -311,7 +388,7 @@ def kalibr_yaml(model: NoiseModel, source: str) -> str:
     conversion, the axes compared)."""
     dt = 1.0 / model.update_rate_hz
     lines = [
-        f"# IMU noise model for Kalibr, written by thermocal noise from {source}",
+        f"# IMU noise model for Kalibr, written by thermocal noise from {one_line(source)}",
         "# Continuous-time values (Kalibr's convention). Allan analysis: overlapping Allan",
         "# deviation (NIST SP 1065), noise terms by IEEE 952-1997 C.3 slope lines, else the",
         "# weighted least-squares fit (C.2). Kalibr takes one number per sensor: each value",
@@ -355,22 +432,23 @@ def kalibr_yaml(model: NoiseModel, source: str) -> str:
             else:
                 how = f"an UPPER BOUND: {t.reason}"
             others = ", ".join(
-                f"{a.name} {_yaml_float(_term_for(key, a).value)}"
+                f"{one_line(a.name)} {_yaml_float(_term_for(key, a).value)}"
                 for a in model.axes
                 if a.sensor == ax.sensor
             )
-            lines.append(f"# {key} [{t.unit}]: {words} of axis {ax.name}, from {how}.")
+            name = one_line(ax.name)
+            lines.append(f"# {key} [{t.unit}]: {words} of axis {name}, from {how}.")
             lines.append(f"#   quality {t.quality}; axes: {others}.")
             oq = ax.quantization
             if white and oq is not None and oq.kind == "rate":
                 lines.append(
-                    f"#   {ax.name} is quantised at {oq.step:.6g} {oq.unit}: its rounding, "
+                    f"#   {name} is quantised at {oq.step:.6g} {oq.unit}: its rounding, "
                     f"white noise of {oq.white_density:.4g} {oq.white_density_unit}, is "
                     "part of this density."
                 )
             if t.low is not None and t.high is not None:
                 lines.append(
-                    f"#   {model.confidence * 100:.1f} % interval of {ax.name}: "
+                    f"#   {model.confidence * 100:.1f} % interval of {name}: "
                     f"{_yaml_float(t.low)} … {_yaml_float(t.high)} (not inflated)."
                 )
             v = float(values[key])
@@ -387,12 +465,49 @@ def kalibr_yaml(model: NoiseModel, source: str) -> str:
             lines.append(f"{key}: {_yaml_float(v)}")
         elif key == "update_rate":
             lines.append("# update_rate [Hz]: 1 / the recording's sample interval.")
-            lines.append(f"{key}: {float(model.update_rate_hz)!r}")
+            rate = repr(float(model.update_rate_hz))  # 100.0; but 1e+16 is text to YAML 1.1
+            if "." not in rate or "e" in rate:
+                rate = f"{float(model.update_rate_hz):.16e}"
+            lines.append(f"{key}: {rate}")
         else:
             lines.append("# rostopic: the ROS topic of this IMU in your bag (--rostopic).")
             lines.append(f"{key}: {json.dumps(model.rostopic)}")
         lines.append("")
-    return "\n".join(lines)
+    text = "\n".join(lines)
+    check_kalibr_yaml(text)
+    return text
+
+
+def check_kalibr_yaml(text: str) -> None:
+    """Refuse (:class:`ThermocalInputError`) ``imu.yaml`` text a name could have steered:
+    a character a YAML reader takes for a line break or refuses (anything
+    :func:`~thermocal.identifiers.one_line` escapes, other than newline), a line that is
+    neither blank, nor a comment starting in column 1, nor ``key: value`` of a key of
+    :data:`KALIBR_KEYS`, a key written twice (PyYAML keeps the LAST: a second
+    ``gyroscope_noise_density`` would win), a numeric key whose value is not a float, a
+    missing key.  The writer's backstop (YAML 1.2 §6.6 comments, §7.4 flow mappings)."""
+    bad = next((c for c in text if c != "\n" and one_line(c) != c), None)
+    if bad is not None:
+        raise ThermocalInputError(f"Kalibr imu.yaml: character {bad!r} in the text")
+    seen: set[str] = set()
+    for ln in text.split("\n"):
+        if ln == "" or ln.startswith("#"):
+            continue
+        m = re.fullmatch(r"([a-z_]+): (\S.*)", ln)
+        if m is None or m.group(1) not in KALIBR_KEYS:
+            raise ThermocalInputError(f"Kalibr imu.yaml: unexpected line {ln[:80]!r}")
+        key, value = m.groups()
+        if key in seen:
+            raise ThermocalInputError(f"Kalibr imu.yaml: {key} written twice")
+        seen.add(key)
+        if key == "rostopic":
+            if not ROS_NAME.fullmatch(json.loads(value)):
+                raise ThermocalInputError(f"Kalibr imu.yaml: rostopic {value[:80]!r}")
+        elif not re.fullmatch(r"[0-9]+\.[0-9]*(e[+-][0-9]+)?", value):
+            raise ThermocalInputError(f"Kalibr imu.yaml: {key} {value[:80]!r} is not a float")
+    missing = [k for k in KALIBR_KEYS if k not in seen]
+    if missing:
+        raise ThermocalInputError(f"Kalibr imu.yaml: no {', '.join(missing)}")
 
 
 def _term_json(t: NoiseTerm, method: str) -> dict[str, Any]:
@@ -775,12 +890,15 @@ def annotate_quantization(terms: NoiseTerms, quant: OutputQuantization | None) -
 
 
 __all__ = [
+    "IMU_DENSITY",
+    "IMU_RATE_HZ",
     "KALIBR_KEYS",
     "QUANT_LEVEL_TOL",
     "QUANT_MAX_OFF",
     "QUANT_MIN_LEVELS",
     "QUANT_MIN_REPEAT",
     "QUANT_RTOL",
+    "ROS_NAME",
     "SI_UNIT",
     "AxisNoise",
     "ContinuousTerm",
@@ -788,6 +906,8 @@ __all__ = [
     "OutputQuantization",
     "annotate_quantization",
     "axis_noise",
+    "check_kalibr_yaml",
+    "implausible",
     "kalibr_yaml",
     "lattice_step",
     "model_json",

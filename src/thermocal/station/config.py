@@ -292,7 +292,7 @@ def _sensor(t: dict[str, Any], where: str, i: int) -> SensorConfig:
     if unknown:
         raise _err(w, f"unknown key {unknown[0]!r}; known: {', '.join(sorted(known))}")
     sid = _take(t, "id", str, w, "")
-    if not _ID.match(sid) or sid == CHAMBER_STREAM:
+    if not _ID.fullmatch(sid) or sid == CHAMBER_STREAM:  # "$" matches before a "\n"
         raise _err(w, f"id must be letters, digits and _ (and not {CHAMBER_STREAM!r}), got {sid!r}")
     w = f"{where} sensor {sid!r}"
     device = _take(t, "device", str, w, "")
@@ -354,6 +354,8 @@ def parse_station(text: str, where: str = "STATION.toml") -> StationConfig:
         doc = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise _err(where, f"not valid TOML ({exc})") from None
+    except RecursionError:  # thousands of nested brackets
+        raise _err(where, "not a station configuration (TOML nested too deeply)") from None
     known = {"part_s", "chamber", "sensor"}
     unknown = sorted(set(doc) - known)
     if unknown:

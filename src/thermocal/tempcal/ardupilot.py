@@ -43,6 +43,7 @@ from thermocal.tempcal.pipeline import (
     check_output_dir,
     end_warning,
     fit_sensor,
+    gyro_unit_warning,
     require_fields,
     staged_set,
     stall_warning,
@@ -515,7 +516,7 @@ def ardupilot_tempcal(
     hygiene (:func:`ardupilot_raw`); an IMU whose temperature is all 0 or NaN is left out
     with a warning.  ``overrides`` the adequacy checks let through."""
     from thermocal.errors import MissingColumnError
-    from thermocal.export.params import ParamSet
+    from thermocal.export.params import ParamSet, check_documented, check_values
     from thermocal.readers.dataflash import dataflash_table, read_dataflash_log
 
     # DIR may hold the log; the files of the set (replaced by name) may not be it
@@ -542,6 +543,8 @@ def ardupilot_tempcal(
         _baro(run)
         run.gates.extend(step_warnings(run.fits, run.series))
         warn_gates(run.gates)
+        check_values(run.params)
+        check_documented(run.params)
         out_set.commit(calibration_of(run.fits), PARAMS_NAME, run.params.text())
     notes = list(run.params.notes)
     found = [k for k, h in run.hygiene.items() if h["active_tcal_removed"]]
@@ -648,6 +651,9 @@ def _imu(run: _Run, df: Any, inst: int) -> None:
         )
         run.fits.append(fit)
         per_kind.append((fit, sub_rec))
+        if kind == "gyro":
+            vals = np.column_stack([sub_rec.signal(a)[0] for a in AXES])
+            run.gates.append(gyro_unit_warning(f"{run.log}: IMU.{inst} gyro", vals))
         run.series[f"{fit.topic}.{inst}"] = (
             time_s, np.column_stack([sub_rec.signal(a)[0] for a in AXES])
         )  # fmt: skip
@@ -699,7 +705,9 @@ def _baro(run: _Run) -> None:
     except MissingColumnError:
         return  # no barometer in the log
     require_fields(df, ["Press", "Temp"], run.log, "BARO.0")
-    temp_c, press_pa = df["Temp"].to_numpy(), df["Press"].to_numpy()
+    temp_c, press_pa = _baro_screened(run, df)
+    if temp_c is None or press_pa is None:
+        return
     fit = fit_ardupilot_baro(temp_c, press_pa)
     if fit is None:
         run.gates.append(
@@ -712,8 +720,10 @@ def _baro(run: _Run) -> None:
         run.gates.append(
             f"BARO.0: TCAL_BARO_EXP {fit.exponent:g} is at a limit of 0…2: the firmware's "
             "one-parameter correction max(T − 25, 0)^e added to the pressure does not follow "
-            f"this barometer's drift (rms {fit.rms_before_pa:.3g} → {fit.rms_after_pa:.3g} Pa)"
+            f"this barometer's drift (rms {fit.rms_before_pa:.3g} → {fit.rms_after_pa:.3g} Pa); "
+            "written with TCAL_ENABLED 0 (the correction off)"
         )
+    run.gates.append(fit.int8_clamped())
     for name, value in fit.params().items():
         run.params.params[name] = value
         run.params.types[name] = 9 if name == "TCAL_BARO_EXP" else 6
@@ -726,6 +736,26 @@ def _baro(run: _Run) -> None:
             run.dlog.params_at_end(), said,
         ),
     )  # fmt: skip
+
+
+def _baro_screened(run: _Run, df: Any) -> tuple[FloatArray | None, FloatArray | None]:
+    """``BARO.0``'s (temperature [°C], pressure [Pa]) through the barometer gates of
+    :func:`.offset_gates.screen_baro` (ArduPilot logs ``Press`` in Pa, LogStructure.h): the
+    samples set aside said with their count, an implausible barometer left out (None, None)
+    with its sentence."""
+    from thermocal.tempcal.offset_gates import ARDUPILOT_BARO, screen_baro
+
+    temp_c, press_pa = df["Temp"].to_numpy(), df["Press"].to_numpy()
+    time_s = (
+        df["TimeUS"].to_numpy() * 1e-6 if "TimeUS" in df.columns
+        else np.arange(temp_c.size, dtype=np.float64)
+    )  # fmt: skip
+    judged = screen_baro(f"BARO.0 of {run.log}", time_s, temp_c, press_pa, ARDUPILOT_BARO)
+    run.gates.extend(judged.notes)
+    if judged.keep is None:
+        run.gates.append(judged.left_out)
+        return None, None
+    return temp_c[judged.keep], press_pa[judged.keep]
 
 
 def _table(run: _Run, name: str, inst: int) -> tuple[Any, dict[str, Any]]:

@@ -40,6 +40,8 @@ EXP_LIMITS = (0.0, 2.0)
 EXP_STEP = 1e-4
 """The resolution of thermocal's search for the exponent (the firmware's is 0.01)."""
 MIN_BINS_ABOVE = 4
+INT8_RANGE = (-128, 127)
+"""``TCAL_TEMP_MIN``/``TCAL_TEMP_MAX`` are ``AP_Int8`` (AP_TempCalibration.h)."""
 """Fewest temperature bins above :data:`TZERO_C` an exponent is fitted to."""
 
 
@@ -78,14 +80,31 @@ class ArdupilotBaroFit:
     at_limit: bool
 
     def params(self) -> dict[str, float]:
-        """``TCAL_ENABLED`` = 1, ``TCAL_TEMP_MIN``/``MAX`` (int8, rounded), ``TCAL_BARO_EXP``."""
-        lo, hi = (max(-128, min(127, round(v))) for v in self.sweep_c)
+        """``TCAL_ENABLED`` = 1 (0 when the exponent is at a limit: the firmware's model does
+        not follow this barometer, and its correction would add up to ``max(T − 25, 0)²`` Pa
+        — 1225 Pa at 60 °C — or a constant 1 Pa), ``TCAL_TEMP_MIN``/``MAX`` (``AP_Int8`` in
+        AP_TempCalibration.h: rounded and clamped to −128…127, :meth:`int8_clamped` says
+        when), ``TCAL_BARO_EXP``."""
+        lo, hi = (max(INT8_RANGE[0], min(INT8_RANGE[1], round(v))) for v in self.sweep_c)
         return {
-            "TCAL_ENABLED": 1,
+            "TCAL_ENABLED": 0 if self.at_limit else 1,
             "TCAL_TEMP_MIN": lo,
             "TCAL_TEMP_MAX": hi,
             "TCAL_BARO_EXP": self.exponent,
         }
+
+    def int8_clamped(self) -> str | None:
+        """The sentence of a sweep beyond ``TCAL_TEMP_MIN``/``MAX``'s int8 (None: within)."""
+        lo, hi = self.sweep_c
+        if INT8_RANGE[0] <= round(lo) and round(hi) <= INT8_RANGE[1]:
+            return None
+        p = self.params()
+        return (
+            f"BARO.{self.instance}: the sweep {lo:.1f}…{hi:.1f} °C does not fit TCAL_TEMP_MIN/"
+            f"TCAL_TEMP_MAX (int8 in AP_TempCalibration.h, {INT8_RANGE[0]}…{INT8_RANGE[1]}): "
+            f"written as {p['TCAL_TEMP_MIN']:g}…{p['TCAL_TEMP_MAX']:g}; the firmware does not "
+            "clamp its correction to them (informational), but they do not say the sweep"
+        )
 
     def to_dict(self) -> dict[str, Any]:
         """The ``BARO.<n>`` object of ``ardupilot-tempcal --json``."""

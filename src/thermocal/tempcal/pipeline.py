@@ -561,3 +561,38 @@ def end_warning(where: str, what: str, ref_c: float, lo: float, hi: float) -> st
         f"({lo:.1f}…{hi:.1f} °C; within {END_MARGIN_C:g} °C or outside): the cubic is least "
         "determined there and the firmware clamps beyond it"
     )
+
+
+GYRO_BIAS_MAX_RAD_S = 0.05
+"""A still flight-controller gyro's rate beyond this [rad/s] is doubtful: PX4's ``ATT_BIAS_MAX``
+(attitude_estimator_q, "Gyro bias limit", default 0.05 rad/s) — what PX4's estimator takes
+for a gyro bias at most."""
+GYRO_NOISE_MAX_RAD_S = 0.0175
+"""A still flight-controller gyro's sample-to-sample noise beyond 1 °/s rms [rad/s] is
+doubtful: MEMS gyros of flight controllers are specified at 0.004–0.01 °/s/√Hz (InvenSense
+ICM-20602, ICM-42688-P, Bosch BMI088 datasheets), 0.1–0.3 °/s rms over their bandwidth."""
+
+
+def gyro_unit_warning(where: str, vals: FloatArray) -> str | None:
+    """The sentence of a still gyro whose median rate on an axis exceeds
+    :data:`GYRO_BIAS_MAX_RAD_S` or whose white noise (``std(diff(v))/√2`` per axis) exceeds
+    :data:`GYRO_NOISE_MAX_RAD_S`: the deg/s of some drivers logged in a rad/s topic (×57.3);
+    ``vals`` (n, 3) in the canonical unit (°/h); None when plausible."""
+    v = np.asarray(vals, dtype=np.float64) * units.DH_TO_RS  # rad/s
+    bias = np.abs(np.median(v, axis=0))
+    noise = np.std(np.diff(v, axis=0), axis=0) / np.sqrt(2.0) if v.shape[0] > 2 else bias * 0
+    j, k = int(np.argmax(bias)), int(np.argmax(noise))
+    if bias[j] <= GYRO_BIAS_MAX_RAD_S and noise[k] <= GYRO_NOISE_MAX_RAD_S:
+        return None
+    what = (
+        f"a median rate of {bias[j]:.4g} rad/s on {AXES[j]} (PX4's ATT_BIAS_MAX: "
+        f"{GYRO_BIAS_MAX_RAD_S:g})"
+        if bias[j] > GYRO_BIAS_MAX_RAD_S
+        else f"a noise of {noise[k]:.4g} rad/s rms on {AXES[k]} (a flight controller's gyro: "
+        f"≤ {GYRO_NOISE_MAX_RAD_S:g})"
+    )
+    return (
+        f"{where}: the still gyro reads {what}: more than a flight-controller gyro at rest — "
+        "deg/s logged in the rad/s field (×57.3)? The parameters are in the log's unit; "
+        "check the driver before using them"
+    )

@@ -52,6 +52,7 @@ from thermocal.tempcal.pipeline import (
     check_output_dir,
     end_warning,
     fit_sensor,
+    gyro_unit_warning,
     read_sensor_topic,
     report_worker,
     require_fields,
@@ -264,9 +265,11 @@ def _px4_tempcal(
     with staged_set(output, reporter, pool) as out_set:  # moved into place whole, or removed
         for name, inst in topics:
             if name in OFFSET_TOPICS:  # barometers and magnetometers: TC_B / TC_M
-                offset_fits.append(
-                    _offset_instance(log, name, inst, tref_c, overrides, params, out_set, old)
+                ofit = _offset_instance(
+                    log, name, inst, tref_c, overrides, params, out_set, old, gates
                 )
+                if ofit is not None:
+                    offset_fits.append(ofit)
                 continue
             fit, more = _imu_instance(
                 log, name, inst, tref_c, overrides, params, out_set, (series, motions), old
@@ -343,24 +346,34 @@ def _offset_instance(
     params: Any,
     out_set: OutputSet,
     old: _Prior,
-) -> OffsetFit:
-    """A barometer or magnetometer instance: read, fit (:func:`fit_offset_sensor`), its
-    ``TC_B``/``TC_M`` parameters merged into ``params``, its report
-    (:func:`.offset_report.offset_report_request`)."""
+    gates: list[str | None],
+) -> OffsetFit | None:
+    """A barometer or magnetometer instance: read, judged by the gates of
+    :mod:`.offset_gates` (implausible: left out, None, its sentence in ``gates``; odd samples
+    set aside, said in ``gates``), fit (:func:`fit_offset_sensor`), its ``TC_B``/``TC_M``
+    parameters merged into ``params``, its report (:func:`.offset_report.offset_report_request`)."""
     from thermocal.export.params import px4_offset_params
     from thermocal.readers.dispatch import read_log_table
+    from thermocal.tempcal.offset_gates import screen_baro, screen_mag
     from thermocal.tempcal.offset_report import offset_report_request
 
     df, _info = read_log_table(log, f"{name}.{inst}")
     fields = OFFSET_TOPICS[name][1]
     require_fields(df, ["timestamp", "temperature", *fields], log, f"{name}.{inst}")
     ids = df["device_id"].to_numpy() if "device_id" in df.columns else np.zeros(1)
-    temp_c, values = (
-        df["temperature"].to_numpy(),
+    time_s, temp_c, values = (
+        df["timestamp"].to_numpy() * 1e-6, df["temperature"].to_numpy(),
         np.column_stack([df[f].to_numpy() for f in fields]),
-    )
+    )  # fmt: skip
+    screen = screen_baro if name == "sensor_baro" else screen_mag
+    judged = screen(f"{log}: {name}.{inst}", time_s, temp_c, values)
+    gates.extend(judged.notes)
+    if judged.keep is None:
+        gates.append(judged.left_out)
+        return None
+    time_s, temp_c, values = time_s[judged.keep], temp_c[judged.keep], values[judged.keep]
     ofit = fit_offset_sensor(
-        df["timestamp"].to_numpy() * 1e-6, temp_c, values, name, inst,
+        time_s, temp_c, values, name, inst,
         int(np.median(ids)), tref_c=tref_c, overrides=overrides,
     )  # fmt: skip
     ps = px4_offset_params(
@@ -402,6 +415,8 @@ def _imu_instance(
     temp_c = rec.temperature_c("temperature")
     series[where] = (rec.time_s, np.column_stack([rec.signal(a)[0] for a in AXES]))
     gates = [stall_warning(where, rec.time_s, temp_c)]
+    if kind == "gyro":
+        gates.append(gyro_unit_warning(f"{log}: {where}", series[where][1]))
     if tref_c is not None:
         gates.append(end_warning(where, "TREF", tref_c, *fit.sweep_c))
     sub = Calibration(fit.channels)
