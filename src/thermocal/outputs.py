@@ -93,9 +93,15 @@ def special_reason(path: str | Path) -> str | None:
         for root in SPECIAL_ROOTS:
             if hop == root or hop.is_relative_to(root):
                 return f"it is under {root}, not a storage file system"
+    return special_mode(p)
+
+
+def special_mode(p: Path) -> str | None:
+    """``"it is a FIFO"`` (a character or block device, a socket) from ``stat`` alone, or
+    None (a regular file, a directory, nothing there)."""
     try:
         mode = os.stat(p).st_mode
-    except OSError:
+    except (OSError, ValueError):
         return None
     for test, what in (
         (stat.S_ISFIFO, "a FIFO"),
@@ -106,6 +112,19 @@ def special_reason(path: str | Path) -> str | None:
         if test(mode):
             return f"it is {what}"
     return None
+
+
+def refuse_special_input(path: str | Path, what: str = "input file") -> None:
+    """Raise :class:`ThermocalInputError` naming ``path`` when it is a FIFO, a device or a
+    socket (``stat`` only: never opened).  Reading one blocks until a writer comes, or
+    never ends (``/dev/zero``): every reader of a user's path asks here first (issue 39
+    item 10: a FIFO as a fleet's modelling file hung ``fleet``)."""
+    why = special_mode(Path(path))
+    if why is not None:
+        raise ThermocalInputError(
+            f"{path}: {why}, not a regular file: give the {what} itself (a special file "
+            "would block the read or never end)"
+        )
 
 
 def refuse_special(path: str | Path, what: str = "the output") -> None:
@@ -233,7 +252,14 @@ def check_outputs(
         no_stale_input(f)
 
 
-__all__ = ["SPECIAL_ROOTS", "check_outputs", "refuse_special", "special_reason"]
+__all__ = [
+    "SPECIAL_ROOTS",
+    "check_outputs",
+    "refuse_special",
+    "refuse_special_input",
+    "special_mode",
+    "special_reason",
+]
 
 
 def sidecar_path(path: str | Path) -> Path:

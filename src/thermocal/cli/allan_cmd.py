@@ -369,6 +369,18 @@ DynamicOpt = Annotated[
 ]
 
 
+MaxWorkOpt = Annotated[
+    float | None,
+    typer.Option(
+        "--max-work",
+        help="With --deviation or --dynamic: the arithmetic operations the deviations or "
+        "the dynamic ADEV's windows may take (default 3e10, about half a minute); a request "
+        "estimated beyond it is refused before it starts (the total family and theo1 grow "
+        "as N·m per τ).",
+    ),
+]
+
+
 def _check_plot(plot: Path | None, file: Path) -> None:
     """``--plot``: a PNG, SVG or PDF file name that is not the input."""
     if plot is None:
@@ -422,6 +434,7 @@ def allan_cmd(
     bias_correct: BiasCorrectOpt = False,
     noise_type: NoiseTypeOpt = None,
     noise_id: NoiseIdOpt = None,
+    max_work: MaxWorkOpt = None,
     as_json: JsonOpt = False,
 ) -> None:
     """Overlapping Allan deviation with chi-square confidence intervals and the noise
@@ -456,6 +469,7 @@ def allan_cmd(
         rec, split_names(signal) or [rec.signals[0]], taus=tau_spec, confidence=confidence,
         deviations=deviation, data_type=data_type, dynamic_s=dynamic, where=str(file),
         bias_correct=bias_correct, noise_type=noise_type, noise_id=noise_id,
+        max_work=max_work,
     )  # fmt: skip
     if res.is_family:
         _emit_family(file, res, as_json)

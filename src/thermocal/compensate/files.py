@@ -84,7 +84,7 @@ from thermocal.models.base import (
     check_sensor_id,
     outside_range_dict,
 )
-from thermocal.outputs import sidecar_path
+from thermocal.outputs import refuse_special_input, sidecar_path
 from thermocal.readers.common import (
     csv_encoding,
     csv_float_options,
@@ -265,6 +265,7 @@ def _file_info(
         return _station_info(path)
     if not path.exists():
         raise FileFormatError(f"{path}: no such file")
+    refuse_special_input(path)
     if path.stat().st_size == 0:
         raise FileFormatError(f"{path}: the file is empty")
     meta: dict[str, Any] = {}

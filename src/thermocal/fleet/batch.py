@@ -43,14 +43,17 @@ and ``DIR/fleet.html`` (:mod:`thermocal.fleet.report`).
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import hashlib
 import json
+import logging
 import math
 import os
 import re
 import secrets
 import shutil
+import sys
 import tempfile
 import threading
 import time
@@ -58,7 +61,7 @@ import warnings
 from collections.abc import Callable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, TypeVar, cast
+from typing import TYPE_CHECKING, Any, Final, TypeVar, cast
 
 from thermocal.errors import ThermocalInputError, ThermocalWarning
 from thermocal.fleet.config import FleetConfig, Limit, UnitSpec, load_config
@@ -76,7 +79,7 @@ from thermocal.fleet.stats import (
 )
 from thermocal.pipeline.messages import error_text, json_text, jsonable, warning_lines
 from thermocal.pipeline.options import FitOptions, ValidateOptions
-from thermocal.readers.common import sha256_of
+from thermocal.readers.common import memory_budget, sha256_of
 
 if TYPE_CHECKING:
     from multiprocessing.context import BaseContext
@@ -168,7 +171,12 @@ def run_unit(task: UnitTask) -> UnitOutcome:
     t0 = time.perf_counter()
     u = task.unit
     outcome = UnitOutcome(u.id, "failed", worker=f"{os.uname().nodename}:{os.getpid()}")
-    with _CAPTURE_LOCK, threadpool_limits(limits=1), tempfile.TemporaryDirectory() as tmp:
+    with (
+        _CAPTURE_LOCK,
+        threadpool_limits(limits=1),
+        memory_budget(worker_memory_budget()),
+        tempfile.TemporaryDirectory() as tmp,
+    ):
         cal = Path(tmp) / CALIBRATION_FILE
         fitted = _step(outcome, lambda: fit_files([Path(m) for m in u.modeling], task.fit, cal))
         if fitted is not None:
@@ -190,6 +198,30 @@ def run_unit(task: UnitTask) -> UnitOutcome:
                 outcome.error = one_line_error(exc)
     outcome.seconds = time.perf_counter() - t0
     return outcome
+
+
+WORKER_MEMORY_SHARE: Final = 0.5
+"""Share of a Dask worker's memory limit a unit's reads may use (the rest: the fit's own
+arrays, the worker's baseline; the nanny ends a worker at 95 %)."""
+
+
+def worker_memory_budget() -> int | None:
+    """On a Dask worker: :data:`WORKER_MEMORY_SHARE` of its memory limit divided among its
+    threads [bytes] (each runs a unit); elsewhere (or no limit set) None.  Asked of the
+    ``distributed`` module only when it is loaded (a worker has it)."""
+    dist = sys.modules.get("distributed")
+    if dist is None:
+        return None
+    try:
+        worker = dist.get_worker()
+    except (ValueError, AttributeError):
+        return None
+    limit = getattr(getattr(worker, "memory_manager", None), "memory_limit", None)
+    if not limit or not math.isfinite(float(limit)) or float(limit) <= 0:
+        return None
+    threads = getattr(worker, "nthreads", 1)
+    n = threads if isinstance(threads, int) and threads > 0 else 1
+    return int(WORKER_MEMORY_SHARE * float(limit) / n)
 
 
 def _per_channel(
@@ -707,33 +739,114 @@ def _ignore_interrupts() -> None:
     signal.signal(signal.SIGINT, signal.SIG_IGN)
 
 
+SCHEDULER_SCHEMES: Final = ("tcp", "tls", "ws", "wss", "ucx")
+"""The address schemes of a Dask scheduler ``--scheduler`` takes (``tcp`` when none)."""
+
+_ADDRESS = re.compile(
+    r"^(?:(?P<scheme>[a-z]+)://)?(?P<host>\[[0-9A-Fa-f:.]+\]|[^\s:/\[\]]+):(?P<port>\d{1,5})/?$"
+)
+
+
+def check_scheduler(address: str) -> str:
+    """``address`` when it is a scheduler address ``[SCHEME://]HOST:PORT`` (a scheme of
+    :data:`SCHEDULER_SCHEMES`, a port 1–65535), else a :class:`ThermocalInputError` naming
+    ``--scheduler`` (Dask's own parser raised ``ValueError``: exit 1)."""
+    m = _ADDRESS.match(address.strip())
+    port = int(m.group("port")) if m else 0
+    scheme = (m.group("scheme") if m else None) or "tcp"
+    if m is None or not 1 <= port <= 65535 or scheme not in SCHEDULER_SCHEMES:
+        raise ThermocalInputError(
+            f"--scheduler {address!r}: not a scheduler address; give tcp://HOST:PORT (the "
+            f"address `dask scheduler` prints; schemes {', '.join(SCHEDULER_SCHEMES)}, port "
+            "1-65535)"
+        )
+    return address.strip()
+
+
 def dask_executor(address: str) -> Executor:
     """Units on a Dask distributed cluster (``tcp://HOST:PORT``), results as they finish.
     Workers must read the unit's files at the same paths (a shared file system); the
-    results travel back to this process, which writes them."""
+    results travel back to this process, which writes them.  The address is checked
+    (:func:`check_scheduler`) and the connection made here, before the batch writes
+    anything.  A worker that dies running a unit (the nanny ended it: memory, a crash)
+    fails that unit, its files named (:func:`lost_unit`); the others go on."""
     import importlib
 
+    address = check_scheduler(address)
     try:
         distributed: Any = importlib.import_module("distributed")  # untyped: held as Any
     except ImportError:
         raise ThermocalInputError(
             "--scheduler needs Dask distributed: pip install 'thermocal[fleet]'"
         ) from None
+    try:
+        with dask_logs_quiet():
+            client = distributed.Client(address, timeout=30)
+    except (OSError, TimeoutError, ValueError) as exc:
+        msg = " ".join(str(exc).split())
+        raise ThermocalInputError(f"--scheduler {address}: cannot connect ({msg})") from None
 
     def run(tasks: list[UnitTask]) -> Iterator[UnitOutcome]:
-        try:
-            client = distributed.Client(address, timeout=30)
-        except (OSError, TimeoutError) as exc:
-            raise ThermocalInputError(f"--scheduler {address}: cannot connect ({exc})") from None
-        try:
-            keys = [f"thermocal-unit-{t.unit.id}-{secrets.token_hex(4)}" for t in tasks]
-            futures = client.map(run_unit, tasks, pure=False, key=keys)
-            for fut in distributed.as_completed(futures):
-                yield fut.result()
-        finally:
-            client.close()
+        with dask_logs_quiet():
+            yield from _run_on(client, distributed, tasks)
 
     return run
+
+
+@contextlib.contextmanager
+def dask_logs_quiet() -> Iterator[None]:
+    """Dask's loggers (``distributed``, ``tornado``) held silent in this process while the
+    batch talks to the cluster: their records (a lost connection's traceback, a worker's
+    death) went to stderr beside the command's own lines; what they report reaches the
+    user as a failed unit (:func:`lost_unit`) or the batch's ``interrupted`` line."""
+    names = [
+        n
+        for n in ("distributed", "tornado", *logging.root.manager.loggerDict)
+        if n.split(".")[0] in ("distributed", "tornado")
+    ]  # Dask's configuration gives some children their own level (distributed.client)
+    loggers = [logging.getLogger(n) for n in dict.fromkeys(names)]
+    saved = [(lg, lg.level) for lg in loggers]
+    for lg in loggers:
+        lg.setLevel(logging.CRITICAL + 10)
+    try:
+        yield
+    finally:
+        for lg, level in saved:
+            lg.setLevel(level)
+
+
+def _run_on(client: Any, distributed: Any, tasks: list[UnitTask]) -> Iterator[UnitOutcome]:
+    """The units on ``client``'s cluster, as they finish (:func:`dask_executor`)."""
+    try:
+        keys = [f"thermocal-unit-{t.unit.id}-{secrets.token_hex(4)}" for t in tasks]
+        futures = client.map(run_unit, tasks, pure=False, key=keys)
+        task_of = {f.key: t for f, t in zip(futures, tasks, strict=True)}
+        for fut in distributed.as_completed(futures):
+            try:
+                yield fut.result()
+            except Exception as exc:
+                if "distributed" not in type(exc).__module__:
+                    raise
+                yield lost_unit(task_of[fut.key], exc)
+    finally:
+        client.close()
+
+
+def lost_unit(task: UnitTask, exc: BaseException) -> UnitOutcome:
+    """The failed outcome of a unit whose worker died under it (Dask's ``KilledWorker``):
+    the error names the unit's files, the likely cause and the way out."""
+    u = task.unit
+    files = ", ".join((*u.modeling, *((u.validation,) if u.validation else ())))
+    reason = " ".join(str(exc).split())[:200]
+    return UnitOutcome(
+        task.unit.id,
+        "failed",
+        error=(
+            f"the worker running unit {task.unit.id} died while it read or fitted {files} "
+            f"({type(exc).__name__}: {reason}); a file too large for the worker's memory is "
+            "the usual cause: cut it, or give the workers more memory"
+        ),
+    )
 
 
 def run_fleet(

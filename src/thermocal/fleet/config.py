@@ -20,7 +20,9 @@ from typing import Any
 
 from thermocal.errors import ThermocalInputError
 from thermocal.fleet.stats import FIGURES
+from thermocal.outputs import refuse_special_input
 from thermocal.pipeline.options import FitOptions, ValidateOptions, options_from_table
+from thermocal.readers.station import is_station_path
 
 _ID = re.compile(r"^[A-Za-z0-9][A-Za-z0-9._-]{0,127}$")
 
@@ -96,6 +98,7 @@ def load_config(path: str | Path) -> FleetConfig:
     :class:`ThermocalInputError` naming the file and the entry (``thermocal fleet`` exits 2);
     a missing data file is not one: that unit fails and the others go on."""
     p = Path(path)
+    refuse_special_input(p, "configuration file")
     try:
         doc = tomllib.loads(p.read_text(encoding="utf-8"))
     except FileNotFoundError:
@@ -155,6 +158,13 @@ def load_config(path: str | Path) -> FleetConfig:
         val = u.get("validation")
         if val is not None and not isinstance(val, str):
             raise ThermocalInputError(f"{where} ({uid}): validation must be one file")
+        for f in (*mod, *([val] if val is not None else [])):
+            refuse_special_input(base / f, f"data file of unit {uid}")  # a FIFO: a hang
+            if (base / f).is_dir() and not is_station_path(base / f):
+                raise ThermocalInputError(
+                    f"{where} ({uid}): {base / f}: is a directory, not a recording file (a "
+                    "folder is read only when `thermocal station run` wrote it)"
+                )
         units.append(
             UnitSpec(
                 uid,

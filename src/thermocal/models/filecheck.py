@@ -26,6 +26,7 @@ from pathlib import Path
 from typing import Any
 
 from thermocal.errors import ModelFileError
+from thermocal.outputs import refuse_special_input
 
 MAX_FILE_BYTES = 64 * 1024 * 1024
 """Largest model or calibration file read [bytes] (64 MiB)."""
@@ -96,6 +97,7 @@ def read_json(path: str | Path, what: str = "model file") -> Any:
     nesting, finite numbers); :class:`ModelFileError` ``"FILE: KEY.PATH: reason"``
     otherwise."""
     p = Path(path)
+    refuse_special_input(p, what)  # a FIFO would block the read
     try:
         with open(p, "rb") as fh:
             raw = fh.read(MAX_FILE_BYTES + 1)

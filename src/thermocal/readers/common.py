@@ -4,6 +4,7 @@ the time column's names, and the capture of log libraries' noise."""
 from __future__ import annotations
 
 import contextlib
+import contextvars
 import functools
 import hashlib
 import io
@@ -27,7 +28,7 @@ from thermocal.errors import (
     ThermocalInputError,
     ThermocalWarning,
 )
-from thermocal.outputs import TEMP_SUFFIX
+from thermocal.outputs import TEMP_SUFFIX, refuse_special_input, special_mode
 from thermocal.recording import FloatArray
 
 if TYPE_CHECKING:
@@ -81,6 +82,7 @@ def csv_encoding(path: str | Path, probe_bytes: int = 1 << 16) -> str:
     instrument software write it; a ``°`` in a header is the usual case, stated in a
     warning).  UTF-16/32 (NUL bytes) are refused with the remedy.
     """
+    refuse_special_input(path)
     p = Path(path)
     with open(p, "rb") as fh:
         head = fh.read(probe_bytes)
@@ -110,26 +112,73 @@ WORKING_BYTES_PER_ROW = 40
 10⁷ rows, benchmarks/RESULTS.md), rounded up."""
 
 
+_BUDGET: contextvars.ContextVar[int | None] = contextvars.ContextVar(
+    "thermocal_memory_budget", default=None
+)
+
+
+@contextlib.contextmanager
+def memory_budget(limit_bytes: int | None) -> Iterator[None]:
+    """Within the block, :func:`memory_limit_bytes` is at most ``limit_bytes`` (None: no
+    change) in this thread's context: a fleet unit on a Dask worker reads within the
+    worker's own memory limit, not the machine's (issue 39 item 10: a 4 MB Parquet of 3e8
+    rows passed the machine's check and the nanny killed the worker)."""
+    token = _BUDGET.set(limit_bytes)
+    try:
+        yield
+    finally:
+        _BUDGET.reset(token)
+
+
 def memory_limit_bytes() -> int | None:
     """Memory a read may use [bytes]: ``THERMOCAL_MEMORY_LIMIT`` (``2G``, ``512M``, bytes)
-    when set, else 90 % of the kernel's ``MemAvailable``; None where neither is known."""
+    when set, else half the kernel's ``MemAvailable`` (:data:`MEMORY_SHARE`); None where
+    neither is known; at most the budget of an enclosing :func:`memory_budget`."""
+    base = _machine_limit_bytes()
+    budget = _BUDGET.get()
+    if budget is None:
+        return base
+    return budget if base is None else min(base, budget)
+
+
+MEMORY_SHARE = 0.5
+"""Share of the kernel's ``MemAvailable`` one read may take when ``THERMOCAL_MEMORY_LIMIT``
+is not set: half, so that a file whose metadata declare more rows than it can hold (a 4 MB
+Parquet of 3e8 constant rows wanted 19 GB) is refused before the machine swaps or other
+processes are killed (issue 39 item 10; it was 90 %)."""
+
+
+def _machine_limit_bytes() -> int | None:
+    """``THERMOCAL_MEMORY_LIMIT`` or :data:`MEMORY_SHARE` of ``MemAvailable``
+    (:func:`memory_limit_bytes`)."""
     env = os.environ.get("THERMOCAL_MEMORY_LIMIT", "").strip()
     if env:
         scale = {"K": 1 << 10, "M": 1 << 20, "G": 1 << 30, "T": 1 << 40}
         try:
             if env[-1].upper() in scale:
-                return int(float(env[:-1]) * scale[env[-1].upper()])
-            return int(float(env))
-        except ValueError:
+                value = int(float(env[:-1]) * scale[env[-1].upper()])
+            else:
+                value = int(float(env))
+        except (ValueError, OverflowError):  # nan, inf
+            value = 0
+        if value <= 0:
             raise ThermocalInputError(
-                f"THERMOCAL_MEMORY_LIMIT={env!r}: give bytes or a number with K, M, G or T"
-            ) from None
+                f"THERMOCAL_MEMORY_LIMIT={env!r}: give a positive number of bytes, or one "
+                "with K, M, G or T"
+            )
+        return value
+    available = mem_available_bytes()
+    return None if available is None else int(MEMORY_SHARE * available)
+
+
+def mem_available_bytes() -> int | None:
+    """The kernel's ``MemAvailable`` [bytes] (``/proc/meminfo``), None where unknown."""
     try:
         with open("/proc/meminfo", encoding="ascii") as fh:
             for line in fh:
                 if line.startswith("MemAvailable:"):
-                    return int(0.9 * int(line.split()[1]) * 1024)
-    except OSError:
+                    return int(line.split()[1]) * 1024
+    except (OSError, ValueError, IndexError):
         return None
     return None
 
@@ -426,6 +475,8 @@ def sha256_of(path: str | Path) -> str | None:
     file's provenance uses :func:`thermocal.models.files.file_sha256`, which also reads a
     station folder and lets a read error through."""
     h = hashlib.sha256()
+    if special_mode(Path(path)) is not None:  # a FIFO would block: never opened
+        return None
     try:
         with open(path, "rb") as fh:
             while block := fh.read(1 << 20):

@@ -20,6 +20,7 @@ from thermocal.errors import (
     PlausibilityWarning,
     ThermocalInputError,
 )
+from thermocal.outputs import refuse_special_input
 from thermocal.readers.common import (
     DEFAULT_DATAFLASH_TOPIC,
     library_output_captured,
@@ -155,6 +156,7 @@ def read_dataflash_log(path: str | Path, messages: Sequence[str]) -> DataflashLo
     (:data:`READ_BUDGET_S` + :data:`READ_BUDGET_S_PER_MB` per MB): a log pymavlink cannot
     finish is a :class:`FileFormatError`, never a hang."""
     p = Path(path)
+    refuse_special_input(p, "DataFlash log")  # pymavlink would block on a FIFO
     try:
         size_mb = p.stat().st_size / 1e6
     except OSError:

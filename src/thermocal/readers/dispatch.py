@@ -20,6 +20,7 @@ from thermocal.errors import (
     TimestampWarning,
     UnitWarning,
 )
+from thermocal.outputs import refuse_special_input
 from thermocal.readers.common import (
     check_memory,
     check_unique_names,
@@ -38,6 +39,8 @@ from thermocal.readers.station import is_station_path, read_station_table, with_
 from thermocal.readers.table import ParquetColumns, csv_header_names, load_sidecar, numeric_column
 from thermocal.readers.text import (
     TextOptions,
+    TooManyColumnsError,
+    check_column_count,
     counter_column,
     counter_time,
     head_lines,
@@ -92,6 +95,8 @@ def read_table(
         head = head_lines(path, encoding, "replace")
         try:
             lay = sniff_text(head, text)
+        except TooManyColumnsError as exc:
+            raise FileFormatError(f"{path}: {exc}") from None
         except FileFormatError:
             lay = None  # not numeric text: the CSV reader says what is wrong
         needs_text = text is not None and (
@@ -99,7 +104,9 @@ def read_table(
         )
         if (lay is not None and not lay.plain) or needs_text:
             return read_text(path, encoding, text)
-    check_unique_names(path, csv_header_names(path, encoding))  # before pandas renames
+    header = csv_header_names(path, encoding)
+    check_column_count(path, len(header))  # pandas makes an object per column first
+    check_unique_names(path, header)  # before pandas renames
     try:
         df = pd.read_csv(
             path,
@@ -190,8 +197,15 @@ def _open_table(
     p: Path, text: TextOptions | None, topic: str | None
 ) -> tuple[pd.DataFrame | ParquetColumns, dict[str, Any]]:
     """The table of a file (its extension chooses the reader) or of a station's recording
-    folder (``DIR`` or ``DIR/SENSOR``), and what the file and its sidecar say of it."""
+    folder (``DIR`` or ``DIR/SENSOR``), and what the file and its sidecar say of it.  A
+    FIFO, device or socket is refused before it is opened, a plain directory named."""
+    refuse_special_input(p)
     station = is_station_path(p)  # a station's recording folder, DIR or DIR/SENSOR
+    if p.is_dir() and not station:
+        raise FileFormatError(
+            f"{p}: is a directory, not a recording file (a folder is read only when "
+            "`thermocal station run` wrote it: it holds station.json)"
+        )
     kind = "station" if station else file_kind(p)
     if topic is not None and kind not in ("ulog", "dataflash", "station"):
         raise ThermocalInputError(

@@ -13,6 +13,7 @@ from thermocal import defaults
 from thermocal._lazy import LazyModule
 from thermocal.defaults import PROGRAM_SETPOINT, PROGRAM_TIME
 from thermocal.errors import FileFormatError, MissingColumnError, NonNumericError
+from thermocal.outputs import refuse_special_input
 from thermocal.profiles import check_program
 from thermocal.readers.common import csv_float_options, file_kind
 from thermocal.readers.dispatch import read_recording
@@ -34,6 +35,7 @@ def read_program(path: str | Path) -> tuple[FloatArray, FloatArray]:
     p = Path(path)
     if not p.exists():
         raise FileFormatError(f"{p}: no such file")
+    refuse_special_input(p, "program file")
     try:
         df = pd.read_csv(p, skipinitialspace=True, **csv_float_options())
     except (pd.errors.EmptyDataError, pd.errors.ParserError, UnicodeDecodeError) as exc:

@@ -4,11 +4,12 @@ mangled lines counted and kept aside, a time column built from a stated rate."""
 from __future__ import annotations
 
 import math
+import os
 import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import IO, TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -172,13 +173,20 @@ def sniff_text(lines: Sequence[str], opts: TextOptions | None = None) -> TextLay
     d = best[2]
     counts_d = [len(_split(x, d)) for x in body]
     m = max(set(c for c in counts_d if c >= 2) or {1}, key=counts_d.count)
+    if m > MAX_COLUMNS:  # before any field is parsed: the parse is per field, in Python
+        raise TooManyColumnsError(
+            f"{m:,} fields a line, more than the {MAX_COLUMNS:,} columns a recording may "
+            "have: not a data log (or cut it to the columns you use)"
+        )
     decimals = [o.decimal] if o.decimal else ([".", ","] if d != "," else ["."])
     fields_m = [f for f in (_split(x, d) for x in body) if len(f) == m]
     texts = {c: _text_positions(fields_m, c) for c in decimals}
 
+    text_sets = {c: frozenset(v) for c, v in texts.items()}  # membership O(1) per field
+
     def numeric(line: str, dec: str) -> bool:
         f = _split(line, d)
-        tp = texts[dec]
+        tp = text_sets[dec]
         return (
             len(f) == m
             and len(tp) < m
@@ -231,10 +239,65 @@ def _banner(lines: Sequence[str]) -> tuple[str, ...]:
     return tuple(x for x in lines if x.strip() and not x.lstrip().startswith("#"))
 
 
+MAX_LINE_CHARS = 1 << 20
+"""Longest line a text reader takes [characters]: 1 MiB, about 50 000 numeric fields (the
+station cuts a sensor's line at 10 MB).  A longer line is refused naming the file and the
+line: one 10 MB line split into five million fields hung the layout detection (issue 39
+item 10).  ``THERMOCAL_MAX_LINE`` (characters) raises it."""
+
+
+class TooManyColumnsError(FileFormatError):
+    """A text log whose lines hold more than :data:`MAX_COLUMNS` fields (:func:`sniff_text`):
+    never passed on to pandas, which would take minutes over the columns."""
+
+
+MAX_COLUMNS = 10_000
+"""Most columns a table may have: pandas builds one object per column before it reads a
+row (90 000 columns: 40 s; the 500 000 a 1 MiB line can hold: minutes)."""
+
+
+def check_column_count(path: Path, n_columns: int) -> None:
+    """A :class:`FileFormatError` naming ``path`` when it has more than
+    :data:`MAX_COLUMNS` columns."""
+    if n_columns > MAX_COLUMNS:
+        raise FileFormatError(
+            f"{path}: {n_columns:,} columns, more than the {MAX_COLUMNS:,} a recording may "
+            "have: not a data log (or cut it to the columns you use)"
+        )
+
+
+def max_line_chars() -> int:
+    """:data:`MAX_LINE_CHARS`, or ``THERMOCAL_MAX_LINE`` when set (a positive integer)."""
+    env = os.environ.get("THERMOCAL_MAX_LINE", "").strip()
+    if not env:
+        return MAX_LINE_CHARS
+    try:
+        value = int(env)
+    except ValueError:
+        value = 0
+    if value < 1:
+        raise ThermocalInputError(f"THERMOCAL_MAX_LINE={env!r}: give a positive integer")
+    return value
+
+
+def bounded_line(fh: IO[str], path: Path, lineno: int, limit: int) -> str:
+    """The next line of ``fh`` (line end kept; ``""`` at the end) read up to ``limit``
+    characters; a longer one is a :class:`FileFormatError` naming ``path`` and ``lineno``."""
+    line = fh.readline(limit + 1)
+    if len(line) > limit and not (len(line) == limit + 1 and line.endswith("\n")):
+        raise FileFormatError(
+            f"{path}: line {lineno} is longer than {limit:,} characters: not a line of a "
+            "data log (cut the file, or set THERMOCAL_MAX_LINE to read longer lines)"
+        )
+    return line
+
+
 def head_lines(path: Path, encoding: str, errors: str) -> list[str]:
-    """The first :data:`SNIFF_LINES` lines of a text file, line ends removed."""
+    """The first :data:`SNIFF_LINES` lines of a text file, line ends removed (each bounded
+    by :func:`max_line_chars`)."""
+    limit = max_line_chars()
     with open(path, encoding=encoding, errors=errors, newline="") as fh:
-        return [fh.readline().rstrip("\r\n") for _ in range(SNIFF_LINES)]
+        return [bounded_line(fh, path, k, limit).rstrip("\r\n") for k in range(1, SNIFF_LINES + 1)]
 
 
 def delimiter_name(delimiter: str) -> str:
@@ -251,8 +314,11 @@ def csv_chunk_options(path: Path, encoding: str) -> dict[str, Any]:
     head = head_lines(path, encoding, "replace")
     try:
         lay = sniff_text(head)
+    except TooManyColumnsError as exc:
+        raise FileFormatError(f"{path}: {exc}") from None
     except FileFormatError:
         return {}  # the CSV reader says what is wrong
+    check_column_count(path, lay.n_fields)
     if lay.plain:
         return {}
     if not lay.header:
@@ -324,8 +390,11 @@ def _data_rows(
     rows: list[list[float]] = []
     ordinal: list[int] = []  # each kept row's place among the data lines (dropped ones too)
     n_data = 0
+    limit = max_line_chars()
     with open(path, encoding=encoding, errors="strict", newline="") as fh:
-        for lineno, line in enumerate(fh, start=1):
+        lineno = 0
+        while line := bounded_line(fh, path, lineno + 1, limit):
+            lineno += 1
             if lineno <= first_data:
                 continue
             text = line.rstrip("\r\n")
@@ -372,6 +441,7 @@ def read_text(
     except FileFormatError as exc:
         raise FileFormatError(f"{path}: {exc}") from None
     names = _column_names(path, head, lay, o)
+    check_column_count(path, len(names))
     rows, ordinal, bad, texts, linenos = _data_rows(path, encoding, lay, len(names), o.on_bad_lines)
     if not rows:
         raise FileFormatError(f"{path}: the file has a header but no data rows")

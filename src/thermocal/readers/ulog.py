@@ -20,6 +20,7 @@ from thermocal.errors import (
     TextLayoutWarning,
     ThermocalInputError,
 )
+from thermocal.outputs import refuse_special_input
 from thermocal.readers.common import (
     LogDamageWarning,
     TrackedReader,
@@ -128,6 +129,7 @@ def _parse_ulog_file(path: Path, names: list[str] | None) -> _ULogRead:
     ``ULog`` object, its data messages gathered with numpy: 3–5× faster); any log it does
     not take as clean is parsed by pyulog as above.
     """
+    refuse_special_input(path, "ULog")  # pyulog would block on a FIFO
     try:
         from pyulog import ULog
     except ImportError:

@@ -14,6 +14,8 @@ from __future__ import annotations
 import struct
 from pathlib import Path
 
+from thermocal.outputs import refuse_special_input
+
 ULOG_MAGIC = b"ULog\x01\x12\x35"
 HEADER_BYTES = 16
 VALUE_CODES = {"float": "<f", "int32_t": "<i"}
@@ -23,6 +25,7 @@ def ulog_parameters(path: str | Path) -> dict[str, float]:
     """The initial parameters (``P`` messages of the definitions section) of a ULog, name →
     value; {} for a file that is not a ULog or has none (the topic reader says why)."""
     out: dict[str, float] = {}
+    refuse_special_input(path, "ULog")
     with open(path, "rb") as fh:
         if fh.read(HEADER_BYTES)[:7] != ULOG_MAGIC:
             return out

@@ -686,6 +686,48 @@ class DynamicAllan:
         return not self.changes
 
 
+DYNAMIC_WINDOW_WORK: Final = 1.5e7
+"""Operations one window of :func:`dynamic_adev` costs beyond its sums (its ADEV's noise
+identification and intervals: ≈ 15 ms a window measured on one core, at ≈ 1 ns an
+operation, the scale of :func:`thermocal.stability.deviations.work`)."""
+
+
+def check_dynamic_work(
+    n_samples: int,
+    tau0_s: float,
+    window_s: float,
+    max_work: float,
+    *,
+    channels: int = 1,
+    where: str = "",
+) -> float:
+    """Estimated operations of :func:`dynamic_adev` in windows of ``window_s`` [s] (half a
+    window apart) over ``n_samples`` samples every ``tau0_s`` [s], for ``channels``
+    channels: windows × (:data:`DYNAMIC_WINDOW_WORK` + 4 n log2 n) with n samples a
+    window.  Beyond ``max_work`` a :class:`ThermocalInputError` naming ``where``,
+    ``--dynamic`` and ``--max-work`` (a window the dynamic ADEV refuses anyway costs 0
+    here: it says why).  ``--dynamic 8`` on 1e5 samples is 25 000 windows, ≈ 7 minutes."""
+    if not max_work > 0:
+        raise ThermocalInputError(f"--max-work {max_work!r}: give a positive operation count")
+    if not (math.isfinite(window_s) and window_s > 0 and tau0_s > 0):
+        return 0.0
+    n_win = round(window_s / tau0_s)
+    if n_win < 8 or n_win > n_samples // 2:
+        return 0.0
+    step = max(1, round(window_s / 2.0 / tau0_s))
+    windows = (n_samples - n_win) // step + 1
+    work = channels * windows * (DYNAMIC_WINDOW_WORK + 4.0 * n_win * math.log2(n_win))
+    if work > max_work:
+        raise ThermocalInputError(
+            (f"{where}: " if where else "")
+            + f"--dynamic {window_s:g} s on {n_samples} samples makes {windows} windows"
+            + (f" in each of {channels} channels" if channels > 1 else "")
+            + f", about {work:.2g} operations, beyond the budget of {max_work:.2g}; give a "
+            f"longer window, or raise --max-work to {math.ceil(work / 1e9) * 1e9:.3g} to run it"
+        )
+    return work
+
+
 def dynamic_adev(
     rate: npt.ArrayLike,
     tau0_s: float,

@@ -254,6 +254,7 @@ def allan_analysis(
     bias_correct: bool = False,
     noise_type: str | None = None,
     noise_id: str | None = None,
+    max_work: float | None = None,
 ) -> AllanAnalysis:
     """The stability analysis of the channels ``names`` of ``rec`` (module docstring).
 
@@ -267,7 +268,8 @@ def allan_analysis(
     ``noise_id``: the identification's rules, ``thermocal`` (default) or ``stable32`` (the
     family only, :func:`thermocal.stability.family.stability`).  A poor noise-model fit and
     a non-stationary record are :class:`ConditioningWarning` naming ``where`` (and the
-    channel when there are several).
+    channel when there are several).  ``max_work``: the family's operation budget
+    (:func:`thermocal.stability.family.check_work`; None: its default).
     """
     if data_type not in DATA_TYPES:
         raise ThermocalInputError(f"--data-type {data_type!r}: use rate or phase")
@@ -281,7 +283,7 @@ def allan_analysis(
             tuple(names),
             family=_family(
                 rec, names, taus, confidence, deviations, data_type, bias_correct, noise_type,
-                noise_id or "thermocal", where,
+                noise_id or "thermocal", max_work, where,
             ),
         )  # fmt: skip
     family_only = [
@@ -302,6 +304,14 @@ def allan_analysis(
             "deviations with --deviation (the overlapping ADEV: --deviation oadev)"
         )
     check_tau_list(taus, rec.sample_interval_s, _longest(rec), ["adev-rate"], where)
+    if dynamic_s is not None:  # the windows counted before any work
+        from thermocal.stability import allan, family
+
+        allan.check_dynamic_work(
+            rec.n_samples, rec.sample_interval_s, dynamic_s,
+            family.DEFAULT_MAX_WORK if max_work is None else max_work,
+            channels=len(names), where=where,
+        )  # fmt: skip
     channels: dict[str, AllanChannel] = {}
     for name in names:  # one read of the file, every channel (INTERFACE: several channels)
         label = where + (f" [{name}]" if len(names) > 1 else "")
@@ -321,6 +331,7 @@ def _family(
     bias_correct: bool = False,
     noise_type: str | None = None,
     noise_id: str = "thermocal",
+    max_work: float | None = None,
     where: str = "",
 ) -> dict[str, StabilityResult]:
     """The deviations of every channel (phase data: the column as given, in its own unit)."""
@@ -349,6 +360,7 @@ def _family(
             values, rec.sample_interval_s, devs, taus, data_type=data_type,
             segments=rec.segments(), unit=unit, confidence=confidence, bias_correct=bias_correct,
             alpha=alpha, noise_id=noise_id,
+            where=where, max_work=family.DEFAULT_MAX_WORK if max_work is None else max_work,
         )  # fmt: skip
     _idle_options(results, devs, bias_correct, alpha, where)
     return results

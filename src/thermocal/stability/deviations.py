@@ -89,6 +89,45 @@ def max_factor(name: str, n_phase: int) -> int:
     raise ValueError(name)
 
 
+WORK_PER_TERM: Final = {"mtotdev": 90.0, "ttotdev": 90.0, "htotdev": 90.0, "theo1": 4.0}
+"""Arithmetic operations per (subsequence, point) of the O(N·m) kernels: the total family
+handles 9m points per subsequence with about 10 operations each (detrend, centre, reflect,
+running sum, block second difference, square); Theo1 3 subtractions and a multiply-add per
+(i, δ) pair.  Every other deviation: :data:`WORK_PER_POINT` per phase point and factor."""
+
+WORK_PER_POINT: Final = 4.0
+"""Operations per phase point and averaging factor of the O(N) deviations (a difference
+of two to four taps and its square)."""
+
+
+def work(name: str, n_phase: int, m: npt.ArrayLike) -> float:
+    """Estimated arithmetic operations of :func:`segment_sums` for ``name`` on one stretch of
+    ``n_phase`` phase points at the factors ``m`` (those beyond :func:`max_factor` cost
+    nothing).
+
+    * mtotdev, ttotdev: Σ_m 90 m (N − 3m + 1) — N − 3m + 1 subsequences of 9m points
+      (NIST SP 1065 eq. 27);
+    * htotdev: the same on the N − 1 rate points (eq. 29; m = 1 is ohdev);
+    * theo1: Σ_m 4 (m/2)(N − m) over even m — m/2 lags δ per term (eq. 30);
+    * the others: Σ_m 4 N.
+
+    These are the sums the kernels here evaluate, so the estimate is their cost to a
+    constant factor (about 1 ns per operation on one 2020s core)."""
+    mm = np.asarray(m, dtype=np.float64).ravel()
+    mm = mm[(mm >= 1) & (mm <= max_factor(name, n_phase))]
+    n = float(n_phase)
+    if name in ("mtotdev", "ttotdev", "htotdev"):
+        pts = n - 1.0 if name == "htotdev" else n
+        big = mm[mm > 1] if name == "htotdev" else mm
+        ones = float(np.sum(mm == 1)) * WORK_PER_POINT * n if name == "htotdev" else 0.0
+        subs = np.maximum(pts - 3.0 * big + 1.0, 0.0)
+        return float(np.sum(WORK_PER_TERM[name] * big * subs)) + ones
+    if name == "theo1":
+        even = mm[mm % 2 == 0]
+        return float(np.sum(WORK_PER_TERM[name] * (even / 2.0) * (n - even)))
+    return WORK_PER_POINT * n * float(mm.size)
+
+
 _CHUNK: Final = 1 << 17
 """Terms per block of :func:`_difference_sum` (a few cache-sized buffers, reused)."""
 
@@ -611,4 +650,5 @@ __all__ = [
     "pool",
     "segment_sums",
     "theo1_tau",
+    "work",
 ]

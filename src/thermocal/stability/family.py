@@ -497,6 +497,72 @@ def _pooled_edf(name: str, m: IntArray, alphas: IntArray, sizes: list[int]) -> F
     return edf
 
 
+DEFAULT_MAX_WORK: Final = 3e10
+"""Arithmetic operations :func:`stability` takes on before it refuses (``--max-work``):
+about half a minute on one core (:func:`.deviations.work`: ≈ 1 ns per operation)."""
+
+
+def factor_sets(
+    names: list[str], taus: str | npt.ArrayLike, tau0_s: float, n_long: int
+) -> dict[str, IntArray]:
+    """The averaging factors of each deviation for a longest stretch of ``n_long`` phase
+    points: ``""`` the common set (every deviation but theo1, up to the largest
+    :func:`.deviations.max_factor`), theo1 its own even set (:func:`factors`)."""
+    others = [n for n in names if n != "theo1"]
+    top = max(dv.max_factor(n, n_long) for n in others) if others else 1
+    sets = {"": factors(taus, tau0_s, top)}
+    for name in names:
+        sets[name] = (
+            factors(taus, tau0_s, dv.max_factor(name, n_long), theo1=True)
+            if name == "theo1"
+            else sets[""]
+        )
+    return sets
+
+
+def check_work(
+    names: list[str],
+    sets: dict[str, IntArray],
+    sizes: list[int],
+    max_work: float,
+    taus: str | npt.ArrayLike = "",
+    where: str = "",
+) -> float:
+    """The estimated operations of the deviations ``names`` at the factors ``sets``
+    (:func:`factor_sets`) over stretches of ``sizes`` phase points
+    (:func:`.deviations.work`, summed); a :class:`ThermocalInputError` naming ``--taus`` and
+    ``--max-work`` when beyond ``max_work``.  The total family and Theo1 cost O(N·m) per
+    factor (NIST SP 1065 eqs. 27–30), so every τ of a long record grows as N³: the refusal
+    comes before any work, with the estimate and the costliest deviation (``where``: the
+    file, named first)."""
+    if not math.isfinite(max_work) and max_work > 0:
+        return math.nan
+    if not max_work > 0:
+        raise ThermocalInputError(f"--max-work {max_work!r}: give a positive operation count")
+    per = {n: sum(dv.work(n, size, sets[n]) for size in sizes) for n in names}
+    total = sum(per.values())
+    if total > max_work:
+        worst = max(per, key=lambda n: per[n])
+        spec = taus if isinstance(taus, str) else "(the τ list)"
+        fewer = "a shorter τ list" if spec == "octave" else "--taus octave"
+        raise ThermocalInputError(
+            (f"{where}: " if where else "")
+            + f"--deviation {','.join(names)} at --taus {spec} on {sum(sizes)} points needs about "
+            f"{total:.2g} operations ({worst}: {per[worst]:.2g}), beyond the "
+            f"budget of {max_work:.2g}; use {fewer} or fewer deviations, or raise --max-work "
+            f"to {_ceil2(total)} to run it"
+        )
+    return total
+
+
+def _ceil2(x: float) -> str:
+    """``x`` rounded up to two significant digits, as a number the option takes."""
+    if x <= 0:
+        return "0"
+    e = 10.0 ** (math.floor(math.log10(x)) - 1)
+    return f"{math.ceil(x / e) * e:.2g}"
+
+
 def stability(
     values: npt.ArrayLike,
     tau0_s: float,
@@ -510,8 +576,14 @@ def stability(
     alpha: int | None = None,
     bias_correct: bool = False,
     noise_id: str = "thermocal",
+    max_work: float = DEFAULT_MAX_WORK,
+    where: str = "",
 ) -> StabilityResult:
     """Deviations ``names`` of rate or phase data [unit] sampled every ``tau0_s`` [s].
+
+    ``max_work``: the budget of arithmetic operations (:func:`check_work`): a request
+    estimated beyond it is refused before any sum is taken (``where``: the file the
+    refusal names).
 
     ``segments``: the gap-free index ranges (default: one); ``alpha``: force the noise
     exponent of the EDF instead of identifying it; ``noise_id``: the identification's rules,
@@ -531,23 +603,14 @@ def stability(
         if noise_id not in NOISE_IDS:
             raise ThermocalInputError(f"--noise-id {noise_id!r}: use {' or '.join(NOISE_IDS)}")
         record = _new_record(values, tau0_s, data_type, segments, names)
-        n_long = max(record.sizes)
-        m_common = factors(
-            taus,
-            tau0_s,
-            max(dv.max_factor(n, n_long) for n in names if n != "theo1")
-            if any(n != "theo1" for n in names)
-            else 1,
-        )
+        sets = factor_sets(names, taus, tau0_s, max(record.sizes))
+        check_work(names, sets, record.sizes, max_work, taus, where)
+        m_common = sets[""]
         record.set_octave(m_common)
         curves: dict[str, DeviationCurve] = {}
         id_cache: dict[tuple[int, int, ed.IdRules], ed.NoiseId] = {}
         for name in names:
-            m = (
-                factors(taus, tau0_s, dv.max_factor(name, n_long), theo1=True)
-                if name == "theo1"
-                else m_common
-            )
+            m = sets[name]
             dev, cnt = record.sums(name, m)
             alphas, methods = _noise_exponents(
                 name, m, record, alpha, id_cache, noise_id, np.asarray(cnt, dtype=np.float64)
@@ -556,8 +619,9 @@ def stability(
             ok = np.isfinite(edf) & np.isfinite(dev)
             lo = np.full(m.size, np.nan)
             hi = np.full(m.size, np.nan)
-            if ok.any():
-                lo_ok, hi_ok = ed.confidence_interval(dev[ok], edf[ok], confidence)
+            if ok.any():  # an EDF ≪ 1 (Theo1's fit at the record's end): χ² quantile 0, high ∞
+                with np.errstate(divide="ignore"):
+                    lo_ok, hi_ok = ed.confidence_interval(dev[ok], edf[ok], confidence)
                 lo[ok], hi[ok] = lo_ok, hi_ok
             bias = None
             if bias_correct:
