@@ -90,6 +90,7 @@ def test_api_reference_documents_the_entry_points(built: Path) -> None:
         "thermocal.stability.family.stability",
         "thermocal.models.make_model",
         "thermocal.turntable.calibrate",
+        "thermocal.multipos.calibrate.calibrate_session",
         "thermocal.export.params.export_params",
     ):
         assert f'id="{name}"' in text, name
