@@ -20,7 +20,15 @@ import pytest
 
 ROOT = Path(__file__).resolve().parents[2]
 DOCS = ROOT / "docs"
-PAGES = ("index", "getting-started", "tutorials/stability-stable32", "methods", "cli", "api")
+PAGES = (
+    "index",
+    "getting-started",
+    "tutorials/stability-stable32",
+    "tutorials/multipos-imucal",
+    "methods",
+    "cli",
+    "api",
+)
 
 OUTSIDE = re.compile(r"\bSPEC\b|INTERFACE\.md|\.\./shared|\bissues?\s*#?\d+", re.IGNORECASE)
 """What a clone does not have: the project's working notes and its issue numbers."""

@@ -1,14 +1,17 @@
 """The tutorials run as written: every ``console`` and ``python`` block of a tutorial page is
-executed from the repository's root, in order, and what it prints is compared, number by
+executed, in order, in a temporary folder that sees the repository's ``tests/`` as the root
+does (outputs land there, never in the clone), and what it prints is compared, number by
 number, with the ``text`` block that follows it on the page; the numbers are also checked
-against the reference the page quotes (Stable32's printed tables, shipped in
-``tests/data/stable32_phasedat`` from allantools' test data, LGPL-3.0).
+against the reference the page quotes: Stable32's printed tables (``tests/data/
+stable32_phasedat``, from allantools' test data, LGPL-3.0) and imucal 2.6.0's calibration of
+its own example session (``tests/data/imucal_ferraris``, MIT).
 """
 
 from __future__ import annotations
 
 import contextlib
 import io
+import math
 import re
 import shlex
 from pathlib import Path
@@ -62,15 +65,28 @@ def _stable32(name: str) -> np.ndarray:
     return np.array([[float(v) for v in ln.split()] for ln in lines if ln.strip() and ln[0] != "#"])
 
 
-@pytest.fixture(scope="module")
-def stability_page() -> list[tuple[str, str]]:
+def _run_in_scratch(tmp: Path, name: str) -> list[tuple[str, str]]:
+    (tmp / "tests").symlink_to(ROOT / "tests", target_is_directory=True)
     with pytest.MonkeyPatch.context() as mp:
-        mp.chdir(ROOT)
-        return _run_page(TUTORIALS / "stability-stable32.md")
+        mp.chdir(tmp)
+        return _run_page(TUTORIALS / name)
+
+
+@pytest.fixture(scope="module")
+def stability_page(tmp_path_factory: pytest.TempPathFactory) -> list[tuple[str, str]]:
+    return _run_in_scratch(tmp_path_factory.mktemp("stability"), "stability-stable32.md")
+
+
+@pytest.fixture(scope="module")
+def multipos_page(tmp_path_factory: pytest.TempPathFactory) -> list[tuple[str, str]]:
+    return _run_in_scratch(tmp_path_factory.mktemp("multipos"), "multipos-imucal.md")
 
 
 def test_every_tutorial_is_executed_here() -> None:
-    assert sorted(p.name for p in TUTORIALS.glob("*.md")) == ["stability-stable32.md"]
+    assert sorted(p.name for p in TUTORIALS.glob("*.md")) == [
+        "multipos-imucal.md",
+        "stability-stable32.md",
+    ]
 
 
 def test_stability_tutorial_prints_what_the_page_shows(
@@ -103,3 +119,60 @@ def test_stability_tutorial_numbers_are_stable32s(stability_page: list[tuple[str
         np.testing.assert_allclose(mine[:, 1], ref[:, 5], rtol=1e-4)
         np.testing.assert_allclose(mine[:, 2], ref[:, 4], rtol=2e-3)
         np.testing.assert_allclose(mine[:, 3], ref[:, 6], rtol=2e-3)
+
+
+def test_multipos_tutorial_prints_what_the_page_shows(
+    multipos_page: list[tuple[str, str]],
+) -> None:
+    assert len(multipos_page) == 1
+    printed, shown = multipos_page[0]
+    assert _numbers(printed) == _numbers(shown)
+    assert len(_numbers(printed)) >= 48  # 24 parameters, value and σ
+
+
+# imucal 2.6.0's FerrarisCalibration of the same session, K_g·R_g and K_a·R_a (computed in a
+# scratch venv as tests/test_multipos_imucal.py's docstring says; imucal is no dependency)
+IMUCAL_KG_RG = np.array([
+    [1.0279030921108503, -0.00046689722733542574, -0.006590606955485163],
+    [-0.00021830076271155843, 0.982423943314377, -0.0027347345695309115],
+    [0.009697592565938506, 0.0076281835698891395, 0.9982342394732935],
+])  # fmt: skip
+IMUCAL_KA_RA = np.array([
+    [0.9966083432390234, -0.014782310326065154, -0.007457416390046589],
+    [0.008597647264494957, 1.002399044531187, 0.0018480118201669386],
+    [0.01364307550082869, 0.0020504932882582476, 1.0233023499168432],
+])  # fmt: skip
+# thermocal's misalignment ab is the element (row, column) of I + E (turntable.model)
+MISALIGNMENT_RC = {"yx": (0, 1), "zx": (0, 2), "xy": (1, 0), "zy": (1, 2), "xz": (2, 0),
+                   "yz": (2, 1)}  # fmt: skip
+ARCSEC = 180.0 / math.pi * 3600.0
+
+
+def _triad_rows(printed: str, title: str) -> dict[str, tuple[float, float]]:
+    """parameter → (value, σ) of one triad's table."""
+    lines = printed.splitlines()
+    start = next(i for i, ln in enumerate(lines) if ln.startswith(title))
+    rows: dict[str, tuple[float, float]] = {}
+    for ln in lines[start + 4 :]:
+        if not ln.startswith("│"):
+            break
+        name, value, sigma, _ = (c.strip() for c in ln.strip("│").split("│"))
+        rows[name] = (float(value), float(sigma))
+    return rows
+
+
+def test_multipos_tutorial_numbers_are_imucals(multipos_page: list[tuple[str, str]]) -> None:
+    """Accelerometer: scale factors and misalignments equal imucal's to the five digits
+    printed; gyro scale factors within 1σ of imucal's (the page's claims)."""
+    printed = multipos_page[0][0]
+    acc = _triad_rows(printed, "accel triad")
+    gyr = _triad_rows(printed, "gyro triad")
+    for i, axis in enumerate("xyz"):
+        ref_acc = (IMUCAL_KA_RA[i, i] - 1) * 1e6
+        assert acc[f"scale factor {axis}"][0] == pytest.approx(ref_acc, rel=5e-5, abs=0.05)
+        ref_gyr = (IMUCAL_KG_RG[i, i] - 1) * 1e6
+        value, sigma = gyr[f"scale factor {axis}"]
+        assert abs(value - ref_gyr) < sigma, axis
+    for name, (r, c) in MISALIGNMENT_RC.items():
+        ref = IMUCAL_KA_RA[r, c] * ARCSEC
+        assert acc[f"misalignment {name}"][0] == pytest.approx(ref, rel=5e-5, abs=0.01)
