@@ -1,0 +1,205 @@
+"""Hostile ``multipos`` sessions and options (issue 39 item 6 and "What to build" 3), through
+the CLI: a calibration that fails its own checks is not written.
+
+The sessions are the simulator's (:func:`thermocal.multipos.simulate.simulate_runs`), recorded
+as users record them: a Ferraris session (the six faces, then the three 360° turns, its
+POSES file the simulator's sections) and sessions of sixteen hand-held poses at three
+temperatures, written here as CSV (accelerometer in m/s², gyro in °/s, the columns' units
+given on the command line as a user does).  Each attack states a unit, a pose or a TREF that
+is wrong, and must end in exit 2 with exactly one ``error:`` line naming the file or option
+and the option that gets the user further, no output file (nor a temporary one), and every
+input byte for byte unchanged.  The true session, with the right options, is written and its
+scale factors agree with the simulator's truth.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import hashlib
+import io
+import json
+import math
+import re
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+
+from thermocal.cli import main
+from thermocal.multipos.simulate import simulate_runs
+from thermocal.outputs import TEMP_SUFFIX
+
+ACC = "accel_x,accel_y,accel_z"
+GYR = "gyro_x,gyro_y,gyro_z"
+TEMP = "temp [degC]"
+MG_IN_M_S2 = 9.80665e-3  # 1 mg in m/s² (CGPM 1901's standard gravity / 1000)
+
+
+def _write(rec: Any, path: Path, gyro_factor: float = 1.0) -> None:
+    """The simulated recording as a CSV a logger writes (gyro columns × ``gyro_factor``)."""
+    cols = {"time": rec.time_s}
+    for c in ("accel_x", "accel_y", "accel_z"):
+        cols[c] = rec.column(c)
+    for c in ("gyro_x", "gyro_y", "gyro_z"):
+        cols[c] = rec.column(c) * gyro_factor
+    cols[TEMP] = rec.temperature_c("T_imu")
+    lines = [",".join(cols)] + [
+        ",".join(repr(float(v)) for v in row) for row in zip(*cols.values(), strict=True)
+    ]
+    path.write_text("\n".join(lines) + "\n", encoding="ascii")
+
+
+@pytest.fixture(scope="module")
+def sessions(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
+    d = tmp_path_factory.mktemp("multipos-attacks")
+    (rec, truth), = simulate_runs([np.random.default_rng(1), np.random.default_rng(2)],
+                                  held_out=False, turns=True)  # fmt: skip
+    _write(rec, d / "ferraris.csv")
+    (d / "poses.json").write_text(json.dumps(truth["sections"]), encoding="utf-8")
+    runs = simulate_runs([np.random.default_rng(3), np.random.default_rng(4)], runs=3,
+                         held_out=False)  # fmt: skip
+    for i, (r, _t) in enumerate(runs):
+        _write(r, d / f"hand{i}.csv")
+    _write(runs[0][0], d / "hand_rad_s.csv", gyro_factor=math.pi / 180.0)
+    return {"dir": d, "ferraris_truth": truth, "hand_truth": [t for _r, t in runs]}
+
+
+def _run(args: list[str]) -> tuple[int, str, str]:
+    o, e = io.StringIO(), io.StringIO()
+    with contextlib.redirect_stdout(o), contextlib.redirect_stderr(e):
+        code = main(args)
+    return code, o.getvalue(), e.getvalue()
+
+
+def _digest(p: Path) -> str:
+    return hashlib.sha256(p.read_bytes()).hexdigest()
+
+
+def _base(d: Path, *files: str) -> list[str]:
+    return ["multipos", *(str(d / f) for f in files), "--accel", ACC, "--gyro", GYR,
+            "--time", "time", "--time-unit", "s", "--latitude", "45"]  # fmt: skip
+
+
+ATTACKS: dict[str, tuple[tuple[str, ...], list[str], tuple[str, ...]]] = {
+    # name: (files, options, words the error line must hold)
+    "six-faces-mg-on-m/s2": (("ferraris.csv",), ["--poses", "{d}/poses.json",
+                             "--accel-unit", "mg", "--gyro-unit", "deg/s"],
+                             ("ferraris.csv", "--accel-unit", "nothing written")),
+    "poses-mg-on-m/s2": (("hand0.csv",), ["--accel-unit", "mg", "--gyro-unit", "deg/s"],
+                         ("hand0.csv", "--accel-unit", "scale factors")),
+    "poses-g-on-m/s2": (("hand0.csv",), ["--accel-unit", "g", "--gyro-unit", "deg/s"],
+                        ("hand0.csv", "--accel-unit", "scale factors")),
+    "rad/s-gyro-declared-deg/s": (("hand_rad_s.csv",), ["--accel-unit", "m/s^2",
+                                  "--gyro-unit", "deg/s"],
+                                  ("hand_rad_s.csv", "--gyro-unit", "scale factors")),
+    "rad/s-gyro-declared-deg/s-scale-model": (("hand_rad_s.csv",), ["--accel-unit", "m/s^2",
+                                              "--gyro-unit", "deg/s", "--gyro-model", "scale"],
+                                              ("hand_rad_s.csv", "--gyro-unit")),
+    "deg/s-gyro-declared-rad/s": (("hand0.csv",), ["--accel-unit", "m/s^2",
+                                  "--gyro-unit", "rad/s"],
+                                  ("hand0.csv", "gyro fit failed", "--gyro-unit")),
+    "ferraris-deg/s-declared-rad/s": (("ferraris.csv",), ["--poses", "{d}/poses.json",
+                                      "--accel-unit", "m/s^2", "--gyro-unit", "rad/s"],
+                                      ("ferraris.csv", "x_rot", "--gyro-unit")),
+    "tref-1e9": (("hand0.csv", "hand1.csv", "hand2.csv"), ["--temps", TEMP, "--accel-unit",
+                 "m/s^2", "--gyro-unit", "deg/s", "--tref", "1e9"],
+                 ("--tref 1e+09", "leave it out")),
+    "tref-200": (("hand0.csv", "hand1.csv", "hand2.csv"), ["--temps", TEMP, "--accel-unit",
+                 "m/s^2", "--gyro-unit", "deg/s", "--tref", "200"],
+                 ("--tref 200", "far outside")),
+    "tref-nan": (("hand0.csv", "hand1.csv", "hand2.csv"), ["--temps", TEMP, "--accel-unit",
+                 "m/s^2", "--gyro-unit", "deg/s", "--tref", "nan"],
+                 ("--tref nan",)),
+    "gravity-negative": (("hand0.csv",), ["--accel-unit", "m/s^2", "--gyro-unit", "deg/s",
+                         "--gravity", "-9.8"], ("--gravity -9.8",)),
+}  # fmt: skip
+
+
+def _swap_faces(sections: dict[str, Any], a: str, b: str) -> dict[str, Any]:
+    out = dict(sections)
+    out[a], out[b] = sections[b], sections[a]
+    return out
+
+
+@pytest.mark.parametrize("name", list(ATTACKS))
+def test_attack(name: str, sessions: dict[str, Any]) -> None:
+    files, opts, words = ATTACKS[name]
+    d: Path = sessions["dir"]
+    if "--gravity" in opts:  # --gravity and --latitude are exclusive: the user drops one
+        args = [a for a in _base(d, *files) if a not in ("--latitude", "45")]
+    else:
+        args = _base(d, *files)
+    out = d / f"out-{re.sub(r'[^a-z0-9]', '_', name)}.json"
+    before = {p: _digest(p) for p in d.iterdir() if p.is_file()}
+    code, _o, err = _run([*args, *(o.format(d=d) for o in opts), "-o", str(out)])
+    assert "Traceback" not in err
+    lines = [ln for ln in err.splitlines() if ln.strip()]
+    assert code == 2, f"exit {code}; stderr: {err}"
+    errors = [ln for ln in lines if ln.startswith("error: ")]
+    assert len(errors) == 1 and lines[-1] == errors[0], err
+    for w in words:
+        assert w in errors[0], (w, errors[0])
+    assert "internal" not in errors[0]
+    assert not out.exists()
+    assert not list(d.glob(f"*{TEMP_SUFFIX}"))
+    assert {p: _digest(p) for p in before} == before, "an input file changed"
+
+
+def test_mg_on_m_s2_quotes_the_unit_ratio(sessions: dict[str, Any]) -> None:
+    """m/s² read as mg: the six faces' scale factors are ``1 mg/(1 m/s²) − 1`` =
+    9.80665e-3 − 1 = −99.02 % (each within the truth's few thousand ppm): the refusal
+    quotes the figure the unit ratio gives, computed here."""
+    d: Path = sessions["dir"]
+    code, _o, err = _run([*_base(d, "ferraris.csv"), "--poses", str(d / "poses.json"),
+                          "--accel-unit", "mg", "--gyro-unit", "deg/s",
+                          "-o", str(d / "x.json")])  # fmt: skip
+    assert code == 2
+    truth = np.asarray(sessions["ferraris_truth"]["accel_theta"][3:6]) * 1e-6
+    expect = (1.0 + truth) * MG_IN_M_S2 - 1.0  # the true scale times the unit ratio
+    got = [float(v) / 100 for v in re.findall(r"[xyz] ([+-][0-9.]+) %", err)]
+    assert len(got) == 3, err
+    np.testing.assert_allclose(got, expect, atol=6e-5)  # 4 digits: -99.01 %
+
+
+@pytest.mark.parametrize("faces", [("x_p", "x_a"), ("x_p", "y_p"), ("z_p", "z_a")])
+def test_swapped_faces_refused_naming_the_poses_file(
+    faces: tuple[str, str], sessions: dict[str, Any]
+) -> None:
+    """Two faces' sections swapped in the POSES file (issue 39 item 6: −5e5 ppm written):
+    refused naming both faces, how far off their axes they read, and the file."""
+    d: Path = sessions["dir"]
+    poses = d / f"swapped-{'-'.join(faces)}.json"
+    poses.write_text(json.dumps(_swap_faces(sessions["ferraris_truth"]["sections"], *faces)),
+                     encoding="utf-8")  # fmt: skip
+    before = {p: _digest(p) for p in d.iterdir() if p.is_file()}
+    out = d / "swapped.json"
+    code, _o, err = _run([*_base(d, "ferraris.csv"), "--poses", str(poses), "--accel-unit",
+                          "m/s^2", "--gyro-unit", "deg/s", "-o", str(out)])  # fmt: skip
+    assert code == 2, err
+    errors = [ln for ln in err.splitlines() if ln.startswith("error: ")]
+    assert len(errors) == 1, err
+    assert all(f"'{f}'" in errors[0] for f in faces) and str(poses) in errors[0], errors[0]
+    assert not out.exists()
+    assert {p: _digest(p) for p in before} == before
+
+
+def test_the_true_sessions_are_written_and_agree_with_the_truth(sessions: dict[str, Any]) -> None:
+    """The gates do not refuse what is right: the Ferraris session with its units and POSES
+    file is written, every scale factor within 4σ of the simulator's truth, and the gravity
+    residual after calibration far below the one before."""
+    d: Path = sessions["dir"]
+    out = d / "good.json"
+    code, o, err = _run([*_base(d, "ferraris.csv"), "--poses", str(d / "poses.json"),
+                         "--accel-unit", "m/s^2", "--gyro-unit", "deg/s", "-o", str(out),
+                         "--json"])  # fmt: skip
+    assert code == 0, err
+    assert out.exists()
+    doc = json.loads(o)
+    truth = sessions["ferraris_truth"]
+    for kind in ("accel", "gyro"):
+        got = np.asarray(doc[kind]["scale_factor_ppm"])
+        sig = np.asarray(doc[kind]["scale_factor_ppm_sigma"])
+        want = np.asarray(truth[f"{kind}_theta"][3:6])
+        assert np.all(np.abs(got - want) < 4 * sig), (kind, got, want, sig)
+    assert doc["gravity_residual_rms_after"] < 0.01 * doc["gravity_residual_rms_before"]
