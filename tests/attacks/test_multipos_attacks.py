@@ -203,3 +203,87 @@ def test_the_true_sessions_are_written_and_agree_with_the_truth(sessions: dict[s
         want = np.asarray(truth[f"{kind}_theta"][3:6])
         assert np.all(np.abs(got - want) < 4 * sig), (kind, got, want, sig)
     assert doc["gravity_residual_rms_after"] < 0.01 * doc["gravity_residual_rms_before"]
+
+
+# --- the turntable's inner-axis zero (issue 39 "Also": alpha_offset_90 silent) ------------
+
+
+@pytest.fixture(scope="module")
+def turntable_run(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, dict[str, Any]]:
+    """A simulated 16-position run (INTERFACE.md geometry, truth known) as a plain CSV."""
+    from thermocal.turntable import simulate_turntable16
+
+    d = tmp_path_factory.mktemp("tt-attacks")
+    rec, truth = simulate_turntable16(3, rate_hz=5.0)
+    cols = {"time": rec.time_s, **{c: rec.column(c) for c in ("gyro_x", "gyro_y", "gyro_z")},
+            "alpha_deg": rec.column("alpha_deg"), "beta_deg": rec.column("beta_deg")}  # fmt: skip
+    for off in (0.0, 90.0, 3.0, 180.0):
+        c = dict(cols, alpha_deg=np.mod(cols["alpha_deg"] + off, 360.0))
+        lines = [",".join(c)] + [",".join(repr(float(v)) for v in row)
+                                 for row in zip(*c.values(), strict=True)]  # fmt: skip
+        (d / f"a{off:g}.csv").write_text("\n".join(lines) + "\n", encoding="ascii")
+    return d, truth
+
+
+def _tt(d: Path, name: str, *extra: str) -> tuple[int, str, str, Path]:
+    out = d / f"out-{name}.json"
+    code, o, err = _run(["turntable", str(d / name), "-o", str(out), "--latitude", "40",
+                         "--gyro-unit", "deg/s", "--encoder-unit", "deg", "--time-unit", "s",
+                         "--json", *extra])  # fmt: skip
+    return code, o, err, out
+
+
+@pytest.mark.parametrize("off", [90.0, 180.0])
+def test_turntable_inner_axis_off_by_a_quarter_turn_is_refused(
+    off: float, turntable_run: tuple[Path, dict[str, Any]]
+) -> None:
+    """α read 90° (180°) more than the geometry's α: the fit took the rotation itself for
+    the x, y scale factors (−1e6 ppm) and misalignments (±206265″), exit 0, no word.  Now
+    refused naming ``--alpha-offset`` with the offset the simulator was given."""
+    d, _truth = turntable_run
+    name = f"a{off:g}.csv"
+    before = {p: _digest(p) for p in d.iterdir() if p.is_file()}
+    code, _o, err, out = _tt(d, name)
+    assert code == 2, err
+    errors = [ln for ln in err.splitlines() if ln.startswith("error: ")]
+    assert len(errors) == 1 and err.strip().splitlines()[-1] == errors[0], err
+    m = re.search(r"--alpha-offset (\S+) ", errors[0])
+    assert m and abs(float(m.group(1)) - off) < 0.05, errors[0]
+    assert name in errors[0]
+    assert not out.exists()
+    assert {p: _digest(p) for p in before} == before
+
+
+def test_turntable_alpha_offset_declared_gives_the_truth(
+    turntable_run: tuple[Path, dict[str, Any]],
+) -> None:
+    """With ``--alpha-offset 90`` the run off by a quarter turn gives the simulator's truth
+    (every coefficient within 4σ), as the run without offset does."""
+    d, truth = turntable_run
+    for name, extra in (("a0.csv", ()), ("a90.csv", ("--alpha-offset", "90"))):
+        code, o, err, _out = _tt(d, name, *extra)
+        assert code == 0, err
+        doc = json.loads(o)
+        for key in ("bias_deg_h", "scale_factor_ppm", "misalignment_arcsec"):
+            got, sig = np.asarray(doc[key]), np.asarray(doc[key + "_sigma"])
+            assert np.all(np.abs(got - np.asarray(truth[key])) < 4 * sig), (name, key, got)
+
+
+def test_turntable_small_inner_axis_offset_is_warned_with_its_figures(
+    turntable_run: tuple[Path, dict[str, Any]],
+) -> None:
+    """α read 3° more: written (a mounting a few degrees off is a table's), with a warning
+    giving the rotation (3° within 0.05°) and the scale factors' bias ``cos 3° − 1`` =
+    −1371 ppm (computed here), which the fitted x, y scale factors show against the truth."""
+    d, truth = turntable_run
+    code, o, err, out = _tt(d, "a3.csv")
+    assert code == 0 and out.exists(), err
+    warns = [ln for ln in err.splitlines() if ln.startswith("warning: ") and "--alpha-offset" in ln]
+    assert len(warns) == 1, err
+    psi = float(re.search(r"rotation of ([+-][0-9.]+)°", warns[0]).group(1))  # type: ignore[union-attr]
+    assert abs(psi - 3.0) < 0.05, warns[0]
+    bias_ppm = (math.cos(math.radians(3.0)) - 1.0) * 1e6
+    assert f"{bias_ppm:+.3g} ppm" in warns[0], (bias_ppm, warns[0])
+    doc = json.loads(o)
+    sf = np.asarray(doc["scale_factor_ppm"][:2]) - np.asarray(truth["scale_factor_ppm"][:2])
+    np.testing.assert_allclose(sf, bias_ppm, atol=30.0)

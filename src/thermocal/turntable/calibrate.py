@@ -10,6 +10,7 @@ the Cramér–Rao bound of the design (:func:`.model.fisher_information`).
 from __future__ import annotations
 
 import dataclasses
+import math
 import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass, field
@@ -240,6 +241,55 @@ def weak_combinations(
     return tuple(out)
 
 
+AZIMUTH_WARNED_DEG = 1.0
+"""A rotation of the body about the inner axis, relative to the declared geometry (body x
+East at α = 0, INTERFACE.md "Turntable geometry"), beyond this [°] is warned of: the fit
+takes it for the antisymmetric pair of misalignments ``yx = −sin ψ``, ``xy = +sin ψ`` and
+biases both x and y scale factors by ``cos ψ − 1`` (−152 ppm at 1°)."""
+AZIMUTH_REFUSED_DEG = 5.0
+"""Beyond this [°] (scale factors biased by −3800 ppm, misalignments of 18000″) the run is
+refused: the α encoder's zero is not the geometry's (a table whose inner axis reads 90° at
+the body's α = 0 gave scale factors of −1e6 ppm and misalignments of ±206265″, i.e. the
+rotation itself); ``--alpha-offset`` declares it."""
+
+
+def inner_axis_azimuth_deg(theta: npt.ArrayLike) -> float:
+    """The rotation ψ [°] of the body about the inner axis (body z) that a calibration's
+    error matrix holds: ``I + E ≈ R_z(ψ)(I + E')`` with ``E'`` small, so
+    ``ψ = atan2(E₁₀ − E₀₁, 2 + E₀₀ + E₁₁)`` (exact for a pure rotation ``E = R_z(ψ) − I``:
+    ``E₀₀ = E₁₁ = cos ψ − 1``, ``E₁₀ = −E₀₁ = sin ψ``).  Positive: the α encoder reads ψ
+    more than the geometry's α (the body turned by +ψ about z)."""
+    e = model.error_matrices(np.asarray(theta, dtype=np.float64))
+    return float(np.degrees(np.arctan2(e[1, 0] - e[0, 1], 2.0 + e[0, 0] + e[1, 1])))
+
+
+def _check_azimuth(theta: FloatArray, name: str, alpha_column: str) -> str | None:
+    """Refuse a run whose fit holds a rotation about the inner axis beyond
+    :data:`AZIMUTH_REFUSED_DEG` (:func:`inner_axis_azimuth_deg`), naming ``--alpha-offset``;
+    the warning's text beyond :data:`AZIMUTH_WARNED_DEG`, else None."""
+    psi = inner_axis_azimuth_deg(theta)
+    what = (
+        f"the fit holds a rotation of {psi:+.4g}° of the body about the inner axis (z) "
+        f"relative to the geometry (body x East at {alpha_column} = 0): the {alpha_column} "
+        "encoder's zero, or the sensor's mounting, is off by that much"
+    )
+    if abs(psi) > AZIMUTH_REFUSED_DEG:
+        raise ThermocalInputError(
+            f"{name}: {what}; its x and y scale factors "
+            f"({(math.cos(math.radians(psi)) - 1) * 1e6:+.3g} ppm) and misalignments yx, xy "
+            "would be that rotation, not the sensor's; declare it with "
+            f"--alpha-offset {psi:.4g} (the reading at the geometry's α = 0), or re-zero the "
+            "encoder; nothing written"
+        )
+    if abs(psi) > AZIMUTH_WARNED_DEG:
+        return (
+            f"{what}; the x and y scale factors are biased by "
+            f"{(math.cos(math.radians(psi)) - 1) * 1e6:+.3g} ppm and yx, xy hold it; declare "
+            f"it with --alpha-offset {psi:.4g}"
+        )
+    return None
+
+
 def calibrate(
     rec: Recording,
     latitude_deg: float | None = None,
@@ -261,6 +311,7 @@ def calibrate(
     accel_unit: str | None = None,
     gravity_m_s2: float | None = None,
     temperature_column: str | None = None,
+    alpha_offset_deg: float = 0.0,
 ) -> TurntableResult:
     """Calibrate a gyro triad from a 16-position dual-axis turntable run (SPEC §7).
 
@@ -290,6 +341,9 @@ def calibrate(
         (default: WGS-84 normal gravity at the latitude).
     temperature_column : a temperature column [°C] whose mean and span over the run are
         reported (the run's soak temperature).
+    alpha_offset_deg : the α encoder's reading at the geometry's α = 0 [°] (subtracted);
+        a rotation about the inner axis found beyond :data:`AZIMUTH_REFUSED_DEG` is refused,
+        beyond :data:`AZIMUTH_WARNED_DEG` warned of (:func:`inner_axis_azimuth_deg`).
 
     Raises
     ------
@@ -301,7 +355,12 @@ def calibrate(
         temperature_column,
     )  # fmt: skip
     g = _gyro_rad_s(rec, gyro_columns, gyro_unit)
+    if not math.isfinite(alpha_offset_deg):
+        raise ThermocalInputError(
+            f"--alpha-offset must be a finite angle [°], got {alpha_offset_deg}"
+        )
     a_deg = np.unwrap(encoder_deg(rec, alpha_column, encoder_unit), period=360.0)
+    a_deg = a_deg - float(alpha_offset_deg)
     b_deg = np.unwrap(encoder_deg(rec, beta_column, encoder_unit), period=360.0)
     full, motion, seg = _segment(
         rec, g, a_deg, b_deg, lat, alpha_column, beta_column, min_positions, min_dwell_s
@@ -315,6 +374,9 @@ def calibrate(
         m, arw, motion, float(encoder_noise_arcsec), kf_interval_s, move_block_s, prior_sigma
     )
     msgs = list(_diagnostics(est, seg.n_positions))
+    azimuth = _check_azimuth(est.kf.theta, str(rec.name), alpha_column)
+    if azimuth:
+        msgs.append(azimuth)
     acc_est, g_local = None, None
     if accel_columns is not None:
         g_local = (

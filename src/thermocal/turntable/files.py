@@ -57,6 +57,8 @@ class TurntableOptions:
     channels: int = 3
     text: TextOptions | None = None
     topic: str | None = None
+    alpha_offset: float = 0.0
+    """The α encoder's reading at the geometry's α = 0 [°] (``--alpha-offset``)."""
 
 
 def check_order(order: int) -> None:
@@ -116,6 +118,7 @@ def calibrate_run(
         gravity_m_s2=o.gravity,
         temperature_column=o.temps,
         min_positions=min_positions,
+        alpha_offset_deg=o.alpha_offset,
     )
     return rec, res
 
