@@ -1975,6 +1975,30 @@ MUTANTS: tuple[Mutant, ...] = (
         H39MP,
         "turntable: a 3° inner-axis rotation (−1371 ppm on x, y) not warned of",
     ),
+    Mutant(
+        "h39mp-tt-scale-refused",
+        P + "turntable/calibrate.py",
+        "SCALE_FACTOR_REFUSED = 0.5",
+        "SCALE_FACTOR_REFUSED = 500.0",
+        H39MP,
+        "turntable: a °/s gyro declared °/h written (scale factors −99.97 %)",
+    ),
+    Mutant(
+        "h39mp-tt-residual-refused",
+        P + "turntable/calibrate.py",
+        "RESIDUAL_REFUSED = 20.0",
+        "RESIDUAL_REFUSED = 200.0",
+        H39MP,
+        "turntable: a run with the latitude's sign wrong (residuals 138×) written",
+    ),
+    Mutant(
+        "h39mp-tt-azimuth-before-unit",
+        P + "turntable/calibrate.py",
+        "if not abs(k - 1.0) <= SCALE_FACTOR_REFUSED:",
+        "if False:",
+        H39MP,
+        "turntable: a wrong gyro unit blamed on the α encoder's zero",
+    ),
 )
 
 

@@ -287,3 +287,41 @@ def test_turntable_small_inner_axis_offset_is_warned_with_its_figures(
     doc = json.loads(o)
     sf = np.asarray(doc["scale_factor_ppm"][:2]) - np.asarray(truth["scale_factor_ppm"][:2])
     np.testing.assert_allclose(sf, bias_ppm, atol=30.0)
+
+
+@pytest.mark.parametrize(
+    ("name", "extra", "words"),
+    [
+        ("a0.csv", ("--gyro-unit", "deg/h"), ("--gyro-unit", "-99.97 %")),
+        ("a0.csv", ("--gyro-unit", "rad/s"), ("--gyro-unit", "scale factors")),
+        ("a0.csv", ("--latitude", "-40"), ("--latitude", "white-noise level")),
+        ("a0.csv", ("--latitude", "0"), ("--latitude", "white-noise level")),
+        ("a90.csv", ("--gyro-unit", "deg/h"), ("--gyro-unit", "-99.97 %")),
+    ],
+)
+def test_turntable_run_that_fails_its_fit_is_refused(
+    name: str, extra: tuple[str, ...], words: tuple[str, ...],
+    turntable_run: tuple[Path, dict[str, Any]],
+) -> None:  # fmt: skip
+    """A °/s gyro declared °/h (scale factors 1/3600 − 1 = −99.97 %, computed here) or rad/s
+    (+5630 %), and the latitude's wrong sign or 0 (residuals 138× and 73× the white-noise
+    level) were fitted and written, with at most a warning; now refused, nothing written.
+    The unit is named first when the α encoder is also a quarter turn off (the x-y block
+    of ``I + E`` is then 1/3600 of a rotation: the unit, not the rotation, is its scale)."""
+    assert f"{100 * (1 / 3600 - 1):+.4g} %" == "-99.97 %"
+    d, _truth = turntable_run
+    args = list(extra)
+    if "--gyro-unit" not in args:
+        args += ["--gyro-unit", "deg/s"]
+    before = {p: _digest(p) for p in d.iterdir() if p.is_file()}
+    out = d / "refused.json"
+    code, _o, err = _run(["turntable", str(d / name), "-o", str(out), "--encoder-unit", "deg",
+                          "--time-unit", "s", *(["--latitude", "40"] if "--latitude" not in
+                          args else []), *args])  # fmt: skip
+    assert code == 2, err
+    errors = [ln for ln in err.splitlines() if ln.startswith("error: ")]
+    assert len(errors) == 1 and err.strip().splitlines()[-1] == errors[0], err
+    for w in words:
+        assert w in errors[0], (w, errors[0])
+    assert not out.exists()
+    assert {p: _digest(p) for p in before} == before

@@ -266,7 +266,14 @@ def inner_axis_azimuth_deg(theta: npt.ArrayLike) -> float:
 def _check_azimuth(theta: FloatArray, name: str, alpha_column: str) -> str | None:
     """Refuse a run whose fit holds a rotation about the inner axis beyond
     :data:`AZIMUTH_REFUSED_DEG` (:func:`inner_axis_azimuth_deg`), naming ``--alpha-offset``;
-    the warning's text beyond :data:`AZIMUTH_WARNED_DEG`, else None."""
+    the warning's text beyond :data:`AZIMUTH_WARNED_DEG`, else None.  Judged first, when
+    the x-y block of ``I + E`` is ``k·R_z(ψ)`` with ``k`` within :data:`SCALE_FACTOR_REFUSED`
+    of 1 (a quarter turn reads as −100 % scale factors); otherwise a unit is wrong and
+    :func:`_check_fit` says so."""
+    e = model.error_matrices(np.asarray(theta, dtype=np.float64))
+    k = 0.5 * math.hypot(e[1, 0] - e[0, 1], 2.0 + e[0, 0] + e[1, 1])
+    if not abs(k - 1.0) <= SCALE_FACTOR_REFUSED:  # the xy block is k·R_z(ψ): a unit's scale
+        return None  # first (:func:`_check_fit`), ψ is not defined by it
     psi = inner_axis_azimuth_deg(theta)
     what = (
         f"the fit holds a rotation of {psi:+.4g}° of the body about the inner axis (z) "
@@ -288,6 +295,44 @@ def _check_azimuth(theta: FloatArray, name: str, alpha_column: str) -> str | Non
             f"it with --alpha-offset {psi:.4g}"
         )
     return None
+
+
+SCALE_FACTOR_REFUSED = 0.5
+"""A fitted scale factor beyond ±50 % is refused, not written: the columns are not in the
+unit declared (a °/s gyro declared °/h gave −999722 ppm, declared rad/s +5.6e7 ppm)."""
+RESIDUAL_REFUSED = 20.0
+"""Least-squares residuals beyond this many times the white-noise level (χ²/dof beyond
+400) are refused: the encoder angles and the earth rate do not describe the run as the
+geometry says (a latitude of the wrong sign gave 138×, the outer axis's zero a quarter turn
+off 152×; the simulated run 1.03×); between ``1 + 5√(2/dof)`` and this, a warning."""
+
+
+def _check_fit(est: _Estimates, acc: accel_mod.AccelEstimate | None, name: str) -> None:
+    """Refuse a run whose fit fails its own checks, before anything is written: a gyro or
+    accelerometer scale factor beyond :data:`SCALE_FACTOR_REFUSED`, least-squares residuals
+    beyond :data:`RESIDUAL_REFUSED` × the white-noise level."""
+    for kind, theta, opt in (("gyro", est.kf.theta, "--gyro-unit"),
+                             ("accelerometer", None if acc is None else acc.theta,
+                              "--accel-unit")):  # fmt: skip
+        if theta is None:
+            continue
+        sf = np.asarray(theta[3:6]) * 1e-6
+        bad = [f"{ax} {100 * v:+.4g} %" for ax, v in zip("xyz", sf, strict=True)
+               if not abs(v) <= SCALE_FACTOR_REFUSED]  # fmt: skip
+        if bad:
+            raise ThermocalInputError(
+                f"{name}: the {kind}'s scale factors come out {', '.join(bad)} (beyond "
+                f"±{SCALE_FACTOR_REFUSED:.0%}: no sensor's): its columns are not in the unit "
+                f"declared; give the right {opt}; nothing written"
+            )
+    ratio = math.sqrt(est.chi2_per_dof) if est.dof > 0 and est.chi2_per_dof > 0 else 0.0
+    if not ratio <= RESIDUAL_REFUSED:
+        raise ThermocalInputError(
+            f"{name}: the fit failed: least-squares residuals {ratio:.3g}× the white-noise "
+            f"level (at most {RESIDUAL_REFUSED:g}×): the encoder angles and the earth rate do "
+            "not describe the run as the geometry says; check --latitude, the encoder columns "
+            "(--alpha, --beta, --encoder-unit) and their zeros (--alpha-offset); nothing written"
+        )
 
 
 def calibrate(
@@ -374,9 +419,6 @@ def calibrate(
         m, arw, motion, float(encoder_noise_arcsec), kf_interval_s, move_block_s, prior_sigma
     )
     msgs = list(_diagnostics(est, seg.n_positions))
-    azimuth = _check_azimuth(est.kf.theta, str(rec.name), alpha_column)
-    if azimuth:
-        msgs.append(azimuth)
     acc_est, g_local = None, None
     if accel_columns is not None:
         g_local = (
@@ -384,6 +426,10 @@ def calibrate(
         )
         acc_est = _accel_triad(rec, accel_columns, accel_unit, a_deg, b_deg, seg.dwells, g_local)
         msgs.extend(_accel_diagnostics(acc_est))
+    azimuth = _check_azimuth(est.kf.theta, str(rec.name), alpha_column)
+    _check_fit(est, acc_est, str(rec.name))
+    if azimuth:
+        msgs.append(azimuth)
     t_mean, t_span = _soak_temperature(rec, temperature_column)
     for msg in msgs:
         warnings.warn(f"{rec.name}: {msg}", TurntableWarning, stacklevel=2)
