@@ -36,9 +36,10 @@ TEMP = "temp [degC]"
 MG_IN_M_S2 = 9.80665e-3  # 1 mg in m/s² (CGPM 1901's standard gravity / 1000)
 
 
-def _write(rec: Any, path: Path, gyro_factor: float = 1.0) -> None:
-    """The simulated recording as a CSV a logger writes (gyro columns × ``gyro_factor``)."""
-    cols = {"time": rec.time_s}
+def _write(rec: Any, path: Path, gyro_factor: float = 1.0, time_factor: float = 1.0) -> None:
+    """The simulated recording as a CSV a logger writes (gyro columns × ``gyro_factor``,
+    time × ``time_factor``)."""
+    cols = {"time": rec.time_s * time_factor}
     for c in ("accel_x", "accel_y", "accel_z"):
         cols[c] = rec.column(c)
     for c in ("gyro_x", "gyro_y", "gyro_z"):
@@ -62,6 +63,7 @@ def sessions(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
     for i, (r, _t) in enumerate(runs):
         _write(r, d / f"hand{i}.csv")
     _write(runs[0][0], d / "hand_rad_s.csv", gyro_factor=math.pi / 180.0)
+    _write(runs[0][0], d / "hand_ms.csv", time_factor=1000.0)  # a logger's ms, read as s
     return {"dir": d, "ferraris_truth": truth, "hand_truth": [t for _r, t in runs]}
 
 
@@ -102,6 +104,14 @@ ATTACKS: dict[str, tuple[tuple[str, ...], list[str], tuple[str, ...]]] = {
     "ferraris-deg/s-declared-rad/s": (("ferraris.csv",), ["--poses", "{d}/poses.json",
                                       "--accel-unit", "m/s^2", "--gyro-unit", "rad/s"],
                                       ("ferraris.csv", "x_rot", "--gyro-unit")),
+    "accel-x-y-swapped": (("hand0.csv",), ["--accel", "accel_y,accel_x,accel_z",
+                          "--accel-unit", "m/s^2", "--gyro-unit", "deg/s"],
+                          ("hand0.csv", "--accel", "order and signs")),
+    "gyro-x-y-swapped": (("hand0.csv",), ["--gyro", "gyro_y,gyro_x,gyro_z",
+                         "--accel-unit", "m/s^2", "--gyro-unit", "deg/s"],
+                         ("hand0.csv", "--gyro", "order and signs")),
+    "time-ms-declared-s": (("hand_ms.csv",), ["--accel-unit", "m/s^2", "--gyro-unit", "deg/s"],
+                           ("hand_ms.csv", "gyro fit failed", "--time-unit")),
     "tref-1e9": (("hand0.csv", "hand1.csv", "hand2.csv"), ["--temps", TEMP, "--accel-unit",
                  "m/s^2", "--gyro-unit", "deg/s", "--tref", "1e9"],
                  ("--tref 1e+09", "leave it out")),

@@ -108,8 +108,9 @@ def check_gyro_fit(gfit: _gyro.GyroFit, where: str) -> None:
         raise DesignError(
             f"{where}: the gyro's scale factors come out {', '.join(bad)} (beyond "
             f"±{SCALE_FACTOR_REFUSED:.0%}: no gyro's): the columns are not in the unit "
-            "declared; give the right --gyro-unit (or --gyro-scale for raw counts); nothing "
-            "written"
+            "declared, or not in the accelerometer's axes; give the right --gyro-unit (or "
+            "--gyro-scale for raw counts), or the order and signs of the --gyro and --accel "
+            "columns (x, y, z of one right-handed frame); nothing written"
         )
     if gfit.n_motions == 0:
         return
@@ -120,8 +121,10 @@ def check_gyro_fit(gfit: _gyro.GyroFit, where: str) -> None:
             f"{where}: the gyro fit failed: the {gfit.n_motions} motions' direction residual "
             f"rms {before:.3g}° before, {after:.3g}° after calibration (at most "
             f"{GYRO_DIRECTION_REFUSED_DEG:g}°, and below the one before); check the gyro's unit "
-            "(--gyro-unit, --gyro-scale) and that the poses are what they are named "
-            "(--poses); nothing written"
+            "(--gyro-unit, --gyro-scale), the time's (--time-unit, --rate), the order and "
+            "signs of the --gyro and --accel "
+            "columns (x, y, z of one right-handed frame) and that the poses are what they are "
+            "named (--poses); nothing written"
         )
 
 
