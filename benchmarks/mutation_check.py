@@ -1999,6 +1999,14 @@ MUTANTS: tuple[Mutant, ...] = (
         H39MP,
         "turntable: a wrong gyro unit blamed on the α encoder's zero",
     ),
+    Mutant(
+        "h39mp-save-calibration-unchecked",
+        P + "models/files.py",
+        "        calibration_from_dict(json.loads(json.dumps(d)), str(path))",
+        "        pass",
+        H39MP,
+        "a calibration its own reader refuses written by any writer",
+    ),
 )
 
 

@@ -63,6 +63,28 @@ def test_a_calibration_its_reader_refuses_is_not_written(tmp_path: object) -> No
     check_as_read(Calibration([], [Triad("accel", ("ax", "ay", "az"), "mg", "", ok)]), out, "")
 
 
+def test_every_calibration_writer_applies_the_readers_checks(tmp_path: object) -> None:
+    """``save_calibration`` (fit, tempcal, multipos, turntable, the demo all write through
+    it): the condition-20 triad above is refused, nothing written; a TREF 200 °C beyond a
+    25 °C-only range (the reader's margin is 50 °C) too."""
+    from pathlib import Path
+
+    from thermocal.models.calibration import Calibration, Triad
+    from thermocal.models.files import save_calibration
+
+    out = Path(str(tmp_path)) / "cal.json"
+    th = np.zeros(12)
+    th[3] = -0.95e6
+    bad = thermal.constant_triad("accel", 25.0, th, np.eye(12), method="multipos")
+    with pytest.raises(DesignError, match=r"condition number 20.*not written"):
+        save_calibration(Calibration([], [Triad("accel", ("ax", "ay", "az"), "mg", "", bad)]), out)
+    assert not out.exists()
+    far = thermal.constant_triad("accel", 200.0, np.zeros(12), np.eye(12), t_range_c=(25.0, 25.0))
+    with pytest.raises(DesignError, match=r"TREF 200"):
+        save_calibration(Calibration([], [Triad("accel", ("ax", "ay", "az"), "mg", "", far)]), out)
+    assert not out.exists()
+
+
 def _fit(before_mg: float, after_mg: float, sf_ppm: float = 100.0) -> mp_accel.AccelFit:
     th = np.zeros(12)
     th[3:6] = sf_ppm
