@@ -335,3 +335,33 @@ def test_turntable_run_that_fails_its_fit_is_refused(
         assert w in errors[0], (w, errors[0])
     assert not out.exists()
     assert {p: _digest(p) for p in before} == before
+
+
+@pytest.fixture(scope="module")
+def thermal_soak(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """One soak of the simulated turntable-thermal scenario (accelerometer in m/s²)."""
+    d = tmp_path_factory.mktemp("tt-thermal")
+    code, _o, err = _run(["simulate", "turntable-thermal", "-o", str(d / "run.parquet")])
+    assert code == 0, err
+    return d / "run_T+0.parquet"
+
+
+@pytest.mark.parametrize(("unit", "ratio"), [("mg", MG_IN_M_S2), ("g", MG_IN_M_S2 * 1e3)])
+def test_turntable_accelerometer_in_the_wrong_unit_is_refused(
+    unit: str, ratio: float, thermal_soak: Path
+) -> None:
+    """m/s² declared mg (g): the accelerometer's scale factors come out the unit ratio − 1,
+    9.80665e-3 − 1 = −99.02 % (9.80665 − 1 = +880.7 %), computed here, for every axis;
+    refused naming --accel-unit, nothing written (the run was written before)."""
+    d = thermal_soak.parent
+    before = {p: _digest(p) for p in d.iterdir() if p.is_file()}
+    out = d / f"tt-{unit}.json"
+    code, _o, err = _run(["turntable", str(thermal_soak), "-o", str(out), "--accel",
+                          "accel_x,accel_y,accel_z", "--accel-unit", unit])  # fmt: skip
+    assert code == 2, err
+    errors = [ln for ln in err.splitlines() if ln.startswith("error: ")]
+    assert len(errors) == 1 and "--accel-unit" in errors[0], err
+    got = [float(v) / 100 for v in re.findall(r"[xyz] ([+-][0-9.]+) %", errors[0])]
+    np.testing.assert_allclose(got, [ratio - 1.0] * 3, atol=2e-3 * max(1.0, ratio))
+    assert not out.exists()
+    assert {p: _digest(p) for p in before} == before
