@@ -2007,6 +2007,14 @@ MUTANTS: tuple[Mutant, ...] = (
         H39MP,
         "a calibration its own reader refuses written by any writer",
     ),
+    Mutant(
+        "h39mp-validate-triads-unjudged",
+        P + "multipos/validate.py",
+        "        if not v.rms_after <= lim:",
+        "        if not v.rms_after <= 10.0 * lim:",
+        H39MP,
+        "validate: a held-out session read in rad/s for °/s (47° after) shown without a word",
+    ),
 )
 
 

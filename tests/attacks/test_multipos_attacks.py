@@ -365,3 +365,45 @@ def test_turntable_accelerometer_in_the_wrong_unit_is_refused(
     np.testing.assert_allclose(got, [ratio - 1.0] * 3, atol=2e-3 * max(1.0, ratio))
     assert not out.exists()
     assert {p: _digest(p) for p in before} == before
+
+
+# --- validate: a held-out session not read as the calibration was made ---------------------
+
+
+@pytest.fixture(scope="module")
+def hand_calibration(sessions: dict[str, Any]) -> Path:
+    d: Path = sessions["dir"]
+    out = d / "hand-cal.json"
+    code, _o, err = _run([*_base(d, "hand1.csv"), "--accel-unit", "m/s^2", "--gyro-unit",
+                          "deg/s", "-o", str(out)])  # fmt: skip
+    assert code == 0, err
+    return out
+
+
+@pytest.mark.parametrize(
+    ("held_out", "warned"),
+    [("hand0.csv", False), ("hand_rad_s.csv", True), ("hand_ms.csv", True)],
+)
+def test_validate_warns_when_the_session_is_not_read_as_calibrated(
+    held_out: str, warned: bool, sessions: dict[str, Any], hand_calibration: Path
+) -> None:
+    """The same sensor's other session (simulator: same truth) validates with a
+    rotation-angle error of a few degrees after compensation, no warning; its gyro in rad/s
+    (the calibration's °/s) or its time in ms read as s leave 25–50° after, which was shown
+    without a word: now a warning naming the units (exit 0, the figures as measured)."""
+    d: Path = sessions["dir"]
+    before = {p: _digest(p) for p in d.iterdir() if p.is_file()}
+    code, o, err = _run(["validate", str(hand_calibration), str(d / held_out), "--time", "time",
+                         "--time-unit", "s", "--json"])  # fmt: skip
+    assert code == 0, err
+    doc = json.loads(o)
+    gyro = doc["triads"]["gyro"]
+    lines = [ln for ln in err.splitlines() if "rotation-angle error rms" in ln]
+    if warned:
+        assert gyro["rms_after"] > 10.0, gyro
+        assert len(lines) == 1 and lines[0].startswith("warning: "), err
+        assert "--time-unit" in lines[0] and held_out in lines[0]
+    else:
+        assert gyro["rms_after"] < 5.0 and gyro["rms_after"] < gyro["rms_before"], gyro
+        assert not lines, err
+    assert {p: _digest(p) for p in before} == before

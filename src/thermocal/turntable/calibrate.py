@@ -335,6 +335,29 @@ def _check_fit(est: _Estimates, acc: accel_mod.AccelEstimate | None, name: str) 
         )
 
 
+def _encoders(
+    rec: Recording, columns: tuple[str, str], unit: str | None, alpha_offset_deg: float
+) -> tuple[FloatArray, FloatArray]:
+    """The encoder angles α (less ``alpha_offset_deg``) and β [°], unwrapped."""
+    if not math.isfinite(alpha_offset_deg):
+        raise ThermocalInputError(
+            f"--alpha-offset must be a finite angle [°], got {alpha_offset_deg}"
+        )
+    a_deg = np.unwrap(encoder_deg(rec, columns[0], unit), period=360.0) - float(alpha_offset_deg)
+    return a_deg, np.unwrap(encoder_deg(rec, columns[1], unit), period=360.0)
+
+
+def _judge(
+    est: _Estimates, acc: accel_mod.AccelEstimate | None, name: str, alpha_column: str
+) -> list[str]:
+    """The fit judged before anything is written: the rotation about the inner axis first
+    (:func:`_check_azimuth`), then the scale factors and residuals (:func:`_check_fit`);
+    the warning to add, if any."""
+    azimuth = _check_azimuth(est.kf.theta, name, alpha_column)
+    _check_fit(est, acc, name)
+    return [azimuth] if azimuth else []
+
+
 def calibrate(
     rec: Recording,
     latitude_deg: float | None = None,
@@ -386,33 +409,23 @@ def calibrate(
         (default: WGS-84 normal gravity at the latitude).
     temperature_column : a temperature column [°C] whose mean and span over the run are
         reported (the run's soak temperature).
-    alpha_offset_deg : the α encoder's reading at the geometry's α = 0 [°] (subtracted);
-        a rotation about the inner axis found beyond :data:`AZIMUTH_REFUSED_DEG` is refused,
-        beyond :data:`AZIMUTH_WARNED_DEG` warned of (:func:`inner_axis_azimuth_deg`).
+    alpha_offset_deg : the α encoder's reading at the geometry's α = 0 [°] (subtracted).
 
     Raises
     ------
     MissingColumnError, MissingValueError : absent or incomplete columns.
     TurntableScheduleError : fewer positions, dwells shorter than asked, an axis not moving.
+    ThermocalInputError : a fit that fails its own checks (:func:`_judge`).
     """
-    lat = _check_inputs(
-        rec, latitude_deg, channels, gyro_columns, alpha_column, beta_column, accel_columns,
-        temperature_column,
-    )  # fmt: skip
+    lat = _check_inputs(rec, latitude_deg, channels, gyro_columns, alpha_column, beta_column,
+                        accel_columns, temperature_column)  # fmt: skip
     g = _gyro_rad_s(rec, gyro_columns, gyro_unit)
-    if not math.isfinite(alpha_offset_deg):
-        raise ThermocalInputError(
-            f"--alpha-offset must be a finite angle [°], got {alpha_offset_deg}"
-        )
-    a_deg = np.unwrap(encoder_deg(rec, alpha_column, encoder_unit), period=360.0)
-    a_deg = a_deg - float(alpha_offset_deg)
-    b_deg = np.unwrap(encoder_deg(rec, beta_column, encoder_unit), period=360.0)
-    full, motion, seg = _segment(
-        rec, g, a_deg, b_deg, lat, alpha_column, beta_column, min_positions, min_dwell_s
-    )
+    a_deg, b_deg = _encoders(rec, (alpha_column, beta_column), encoder_unit, alpha_offset_deg)
+    full, motion, seg = _segment(rec, g, a_deg, b_deg, lat, alpha_column, beta_column,
+                                 min_positions, min_dwell_s)  # fmt: skip
     noise_source = "dwells" if encoder_noise_arcsec is None else "option"
-    if encoder_noise_arcsec is None:
-        encoder_noise_arcsec = motion.reading_sigma_arcsec
+    encoder_noise_arcsec = motion.reading_sigma_arcsec if encoder_noise_arcsec is None else (
+        encoder_noise_arcsec)  # fmt: skip
     m = full.select_channels(channels)
     arw = _arw_rad_sqrt_s(arw_deg_sqrt_h, g, full.dt_s, seg.dwells)
     est = _estimate(
@@ -421,15 +434,11 @@ def calibrate(
     msgs = list(_diagnostics(est, seg.n_positions))
     acc_est, g_local = None, None
     if accel_columns is not None:
-        g_local = (
-            float(gravity_m_s2) if gravity_m_s2 is not None else units.normal_gravity_m_s2(lat)
-        )
+        g_local = float(gravity_m_s2) if gravity_m_s2 is not None else (
+            units.normal_gravity_m_s2(lat))  # fmt: skip
         acc_est = _accel_triad(rec, accel_columns, accel_unit, a_deg, b_deg, seg.dwells, g_local)
         msgs.extend(_accel_diagnostics(acc_est))
-    azimuth = _check_azimuth(est.kf.theta, str(rec.name), alpha_column)
-    _check_fit(est, acc_est, str(rec.name))
-    if azimuth:
-        msgs.append(azimuth)
+    msgs.extend(_judge(est, acc_est, str(rec.name), alpha_column))
     t_mean, t_span = _soak_temperature(rec, temperature_column)
     for msg in msgs:
         warnings.warn(f"{rec.name}: {msg}", TurntableWarning, stacklevel=2)
