@@ -2015,6 +2015,14 @@ MUTANTS: tuple[Mutant, ...] = (
         H39MP,
         "validate: a held-out session read in rad/s for °/s (47° after) shown without a word",
     ),
+    Mutant(
+        "h39mp-short-named-pose",
+        P + "multipos/calibrate.py",
+        "or t[s.end - 1] - t[s.start] < static_s]",
+        "or t[s.end - 1] - t[s.start] < 0.0]",
+        H39MP,
+        "multipos: a named pose of three samples used without a word",
+    ),
 )
 
 

@@ -407,3 +407,22 @@ def test_validate_warns_when_the_session_is_not_read_as_calibrated(
         assert gyro["rms_after"] < 5.0 and gyro["rms_after"] < gyro["rms_before"], gyro
         assert not lines, err
     assert {p: _digest(p) for p in before} == before
+
+
+def test_a_named_pose_of_three_samples_is_warned_of(sessions: dict[str, Any]) -> None:
+    """A POSES file whose x_p section holds 3 samples (0.02 s at the simulator's 100 Hz):
+    written (still poses, a valid closed form) with a warning naming the pose and its
+    0.02 s against --static-s 1 s."""
+    d: Path = sessions["dir"]
+    sec = dict(sessions["ferraris_truth"]["sections"])
+    sec["x_p"] = {"start": sec["x_p"]["start"], "end": sec["x_p"]["start"] + 3}
+    poses = d / "three-samples.json"
+    poses.write_text(json.dumps(sec), encoding="utf-8")
+    out = d / "three.json"
+    code, _o, err = _run([*_base(d, "ferraris.csv"), "--poses", str(poses), "--accel-unit",
+                          "m/s^2", "--gyro-unit", "deg/s", "-o", str(out)])  # fmt: skip
+    assert code == 0, err
+    assert out.exists()
+    lines = [ln for ln in err.splitlines() if "shorter than --static-s" in ln]
+    assert len(lines) == 1 and lines[0].startswith("warning: "), err
+    assert "x_p (0.02 s)" in lines[0] and "1 poses" in lines[0], lines[0]

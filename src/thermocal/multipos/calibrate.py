@@ -324,6 +324,25 @@ def _section_warnings(
     return not_still
 
 
+def _warn_short(
+    t: FloatArray, statics: Sequence[Section], static_s: float, where: str, sections_from: str
+) -> None:
+    """A warning naming the still poses shorter than ``static_s`` [s] (sections of a POSES
+    file: the detector never returns them): a mean of a few samples carries their noise and
+    σ, from ``var(Δx)/2`` of so few differences, is itself uncertain."""
+    short = [f"{s.name} ({t[s.end - 1] - t[s.start]:.3g} s)" for s in statics
+             if s.end - s.start < 2 or t[s.end - 1] - t[s.start] < static_s]  # fmt: skip
+    if short:
+        warnings.warn(
+            ThermocalWarning(
+                f"{where}: {len(short)} poses in {sections_from} are shorter than --static-s "
+                f"{static_s:g} s: {', '.join(short[:6])}{' …' if len(short) > 6 else ''}; "
+                "their means and noise rest on few samples (check their start and end)"
+            ),
+            stacklevel=3,
+        )
+
+
 def _warn_implausible(gfit: _gyro.GyroFit, where: str) -> None:
     """A warning when a gyro scale factor or misalignment is beyond
     :data:`GYRO_E_PLAUSIBLE` (no sensor's: a unit, count scale or pose is wrong), and
@@ -396,11 +415,14 @@ def calibrate_session(
     t = np.asarray(time_s, dtype=np.float64)
     a = np.asarray(accel_mg, dtype=np.float64)
     w = None if gyro_rad_s is None else np.asarray(gyro_rad_s, dtype=np.float64)
+    given = sections is not None
     if sections is None:
         sections = detect_poses(t, a, w, static_s=static_s)
     statics = [s for s in sections if not s.is_turn]
     turns = [s for s in sections if s.is_turn]
     not_still = _section_warnings(statics, turns, w is not None, where, sections_from)
+    if given:
+        _warn_short(t, statics, static_s, where, sections_from)
     stats = pose_stats(a, w, statics)
     if len(stats) < 6:
         raise DesignError(
