@@ -426,3 +426,28 @@ def test_a_named_pose_of_three_samples_is_warned_of(sessions: dict[str, Any]) ->
     lines = [ln for ln in err.splitlines() if "shorter than --static-s" in ln]
     assert len(lines) == 1 and lines[0].startswith("warning: "), err
     assert "x_p (0.02 s)" in lines[0] and "1 poses" in lines[0], lines[0]
+
+
+@pytest.mark.parametrize(("given", "words"), [("85", "warning: "), ("360", "error: ")])
+def test_turntable_alpha_offset_hint_is_the_total(
+    given: str, words: str, turntable_run: tuple[Path, dict[str, Any]]
+) -> None:
+    """α read 90° more, ``--alpha-offset 85`` given (5° left: warned) or 360 (a full turn:
+    refused): the offset suggested is the total that removes the rotation, 90° ± 0.05
+    (the one the simulator's file was given), not the rotation left; an offset beyond ±360°
+    is refused before anything is read (1e308 gave a foreign RuntimeWarning)."""
+    d, _truth = turntable_run
+    (d / "out-a90.csv.json").unlink(missing_ok=True)
+    code, _o, err, out = _tt(d, "a90.csv", "--alpha-offset", given)
+    lines = [ln for ln in err.splitlines() if "--alpha-offset" in ln]
+    assert len(lines) == 1 and lines[0].startswith(words), err
+    m = re.search(r"--alpha-offset ([-0-9.e+]+)", lines[0])
+    assert m and abs(float(m.group(1)) - 90.0) < 0.05, lines[0]
+    assert (code == 0) == (words == "warning: ") and out.exists() == (code == 0)
+    out.unlink(missing_ok=True)
+    code, _o, err, out = _tt(d, "a90.csv", "--alpha-offset", "1e308")
+    assert (
+        code == 2
+        and err.strip() == "error: --alpha-offset must be an angle within ±360°, got 1e+308"
+    )
+    assert not out.exists()

@@ -263,7 +263,9 @@ def inner_axis_azimuth_deg(theta: npt.ArrayLike) -> float:
     return float(np.degrees(np.arctan2(e[1, 0] - e[0, 1], 2.0 + e[0, 0] + e[1, 1])))
 
 
-def _check_azimuth(theta: FloatArray, name: str, alpha_column: str) -> str | None:
+def _check_azimuth(
+    theta: FloatArray, name: str, alpha_column: str, offset_deg: float = 0.0
+) -> str | None:
     """Refuse a run whose fit holds a rotation about the inner axis beyond
     :data:`AZIMUTH_REFUSED_DEG` (:func:`inner_axis_azimuth_deg`), naming ``--alpha-offset``;
     the warning's text beyond :data:`AZIMUTH_WARNED_DEG`, else None.  Judged first, when
@@ -275,6 +277,7 @@ def _check_azimuth(theta: FloatArray, name: str, alpha_column: str) -> str | Non
     if not abs(k - 1.0) <= SCALE_FACTOR_REFUSED:  # the xy block is k·R_z(ψ): a unit's scale
         return None  # first (:func:`_check_fit`), ψ is not defined by it
     psi = inner_axis_azimuth_deg(theta)
+    total = (offset_deg + psi + 180.0) % 360.0 - 180.0  # the --alpha-offset that removes it
     what = (
         f"the fit holds a rotation of {psi:+.4g}° of the body about the inner axis (z) "
         f"relative to the geometry (body x East at {alpha_column} = 0): the {alpha_column} "
@@ -285,14 +288,14 @@ def _check_azimuth(theta: FloatArray, name: str, alpha_column: str) -> str | Non
             f"{name}: {what}; its x and y scale factors "
             f"({(math.cos(math.radians(psi)) - 1) * 1e6:+.3g} ppm) and misalignments yx, xy "
             "would be that rotation, not the sensor's; declare it with "
-            f"--alpha-offset {psi:.4g} (the reading at the geometry's α = 0), or re-zero the "
+            f"--alpha-offset {total:.4g} (the reading at the geometry's α = 0), or re-zero the "
             "encoder; nothing written"
         )
     if abs(psi) > AZIMUTH_WARNED_DEG:
         return (
             f"{what}; the x and y scale factors are biased by "
             f"{(math.cos(math.radians(psi)) - 1) * 1e6:+.3g} ppm and yx, xy hold it; declare "
-            f"it with --alpha-offset {psi:.4g}"
+            f"it with --alpha-offset {total:.4g}"
         )
     return None
 
@@ -339,21 +342,21 @@ def _encoders(
     rec: Recording, columns: tuple[str, str], unit: str | None, alpha_offset_deg: float
 ) -> tuple[FloatArray, FloatArray]:
     """The encoder angles α (less ``alpha_offset_deg``) and β [°], unwrapped."""
-    if not math.isfinite(alpha_offset_deg):
+    if not abs(alpha_offset_deg) <= 360.0:
         raise ThermocalInputError(
-            f"--alpha-offset must be a finite angle [°], got {alpha_offset_deg}"
+            f"--alpha-offset must be an angle within ±360°, got {alpha_offset_deg:g}"
         )
     a_deg = np.unwrap(encoder_deg(rec, columns[0], unit), period=360.0) - float(alpha_offset_deg)
     return a_deg, np.unwrap(encoder_deg(rec, columns[1], unit), period=360.0)
 
 
 def _judge(
-    est: _Estimates, acc: accel_mod.AccelEstimate | None, name: str, alpha_column: str
+    est: _Estimates, acc: accel_mod.AccelEstimate | None, name: str, alpha: tuple[str, float]
 ) -> list[str]:
     """The fit judged before anything is written: the rotation about the inner axis first
     (:func:`_check_azimuth`), then the scale factors and residuals (:func:`_check_fit`);
     the warning to add, if any."""
-    azimuth = _check_azimuth(est.kf.theta, name, alpha_column)
+    azimuth = _check_azimuth(est.kf.theta, name, alpha[0], alpha[1])
     _check_fit(est, acc, name)
     return [azimuth] if azimuth else []
 
@@ -438,7 +441,7 @@ def calibrate(
             units.normal_gravity_m_s2(lat))  # fmt: skip
         acc_est = _accel_triad(rec, accel_columns, accel_unit, a_deg, b_deg, seg.dwells, g_local)
         msgs.extend(_accel_diagnostics(acc_est))
-    msgs.extend(_judge(est, acc_est, str(rec.name), alpha_column))
+    msgs.extend(_judge(est, acc_est, str(rec.name), (alpha_column, alpha_offset_deg)))
     t_mean, t_span = _soak_temperature(rec, temperature_column)
     for msg in msgs:
         warnings.warn(f"{rec.name}: {msg}", TurntableWarning, stacklevel=2)
