@@ -71,6 +71,14 @@ GyroUnitOpt = Annotated[
     ),
 ]
 AlphaOpt = Annotated[str, typer.Option("--alpha", help="Inner-axis encoder angle column.")]
+AlphaOffsetOpt = Annotated[
+    float,
+    typer.Option(
+        "--alpha-offset",
+        help="The inner-axis encoder's reading [°] where body x points East (the geometry's "
+        "α = 0); subtracted.",
+    ),
+]
 BetaOpt = Annotated[str, typer.Option("--beta", help="Outer-axis encoder angle column.")]
 EncoderUnitOpt = Annotated[
     str | None,
@@ -141,6 +149,7 @@ def turntable_cmd(
     gyro: GyroColsOpt = DEFAULT_GYRO,
     gyro_unit: GyroUnitOpt = None,
     alpha: AlphaOpt = "alpha_deg",
+    alpha_offset: AlphaOffsetOpt = 0.0,
     beta: BetaOpt = "beta_deg",
     encoder_unit: EncoderUnitOpt = None,
     arw: ArwOpt = None,
@@ -178,7 +187,7 @@ def turntable_cmd(
         (accel_cols[0], accel_cols[1], accel_cols[2]) if accel_cols else None,
         temps, latitude, time, time_unit, gyro_unit, accel_unit, gravity, alpha, beta,
         encoder_unit, arw, encoder_noise, min_dwell, channels,
-        text_options(t_names, t_rate, t_bad, t_delim, t_dec), topic,
+        text_options(t_names, t_rate, t_bad, t_delim, t_dec), topic, alpha_offset,
     )  # fmt: skip
     res = _files.turntable_calibration(
         files, output, opts, order=order, tref_c=tref, overrides=overrides_of(allow_narrow, False)

@@ -83,10 +83,20 @@ def model_from_dict(d: dict[str, Any], path: str | Path) -> TemperatureModel:
 
 
 def save_calibration(cal: Calibration, path: str | Path) -> dict[str, Any]:
-    """Write a calibration file (atomically); returns its dict."""
+    """Write a calibration file (atomically); returns its dict.  The file's own reader
+    (:func:`~thermocal.models.calibration.calibration_from_dict`) judges it first: a
+    calibration that reader would refuse is refused here and not written (issue 39)."""
+    import json
+
+    from thermocal.errors import DesignError
+
     if not cal.channels and not cal.triads:
         raise ThermocalInputError("calibration: no channels to write")
     d = cal.to_dict()
+    try:
+        calibration_from_dict(json.loads(json.dumps(d)), str(path))
+    except ThermocalInputError as exc:
+        raise DesignError(f"{exc}; the calibration is not written") from None
     write_json(path, d)
     return d
 

@@ -50,6 +50,84 @@ is not a sensor's: a wrong unit, count scale or pose is warned of (the turns' ow
 :data:`.gyro.TURN_ANGLE_TOLERANCE`)."""
 
 
+SCALE_FACTOR_REFUSED = 0.5
+"""A fitted scale factor beyond ±50 % is refused, not written: the columns are not in the
+unit they are declared in (``--accel-unit mg`` on m/s² data gives −99 %, a gyro in rad/s
+declared °/s +5630 %), or a count scale is wrong by more than a factor 1.5; the fit's
+``I + E`` then only converts units.  Between :data:`GYRO_E_PLAUSIBLE` and this a gyro is
+warned of (a count scale from the wrong range setting can still be compensated)."""
+
+ACCEL_RESIDUAL_REFUSED = 0.05
+"""The accelerometer's gravity-magnitude residual rms after calibration, as a fraction of
+local gravity, beyond which the fit failed (50 mg: a hand-held MPU-6050 leaves 12 mg,
+imucal's session 1.1 mg, a simulated one 0.07 mg); refused, as a residual no smaller than
+before the calibration."""
+
+GYRO_DIRECTION_REFUSED_DEG = 10.0
+"""The rms over motions of the gyro's gravity-direction residual after calibration [°]
+beyond which the fit failed (the public sessions leave 0.6–4.1°, a simulated one 0.03°; a
+°/s gyro declared rad/s leaves 40°); refused, as a residual no smaller than before."""
+
+
+def check_accel_fit(acc: _accel.AccelFit, g_mg: float, where: str) -> None:
+    """Refuse (:class:`~thermocal.errors.DesignError`, exit 2) an accelerometer fit that
+    fails its own checks, before anything is written: a scale factor beyond
+    :data:`SCALE_FACTOR_REFUSED`, a gravity-magnitude residual rms after calibration above
+    :data:`ACCEL_RESIDUAL_REFUSED` × ``g`` or not below the one before (``g_mg`` [mg])."""
+    sf = acc.theta[3:6] * units.PPM
+    bad = [f"{ax} {100 * v:+.4g} %" for ax, v in zip("xyz", sf, strict=True)
+           if not abs(v) <= SCALE_FACTOR_REFUSED]  # fmt: skip
+    if bad:
+        raise DesignError(
+            f"{where}: the accelerometer's scale factors come out {', '.join(bad)} (beyond "
+            f"±{SCALE_FACTOR_REFUSED:.0%}: no sensor's; before calibration the poses read "
+            f"gravity's magnitude {acc.residual_rms_before_mg / g_mg:.3g} g rms off 1 g): "
+            "the columns are not in the unit declared; give the right --accel-unit (or "
+            "--accel-scale for raw counts); nothing written"
+        )
+    before, after = acc.residual_rms_before_mg, acc.residual_rms_after_mg
+    if not (after <= ACCEL_RESIDUAL_REFUSED * g_mg and (after < before or after == 0.0)):
+        raise DesignError(
+            f"{where}: the accelerometer fit failed: gravity-magnitude residual rms "
+            f"{before:.4g} mg before, {after:.4g} mg after calibration (at most "
+            f"{ACCEL_RESIDUAL_REFUSED * g_mg:.4g} mg, and below the one before); check that "
+            "the poses are still and what they are named (--poses), and the accelerometer's "
+            "unit (--accel-unit, --accel-scale); nothing written"
+        )
+
+
+def check_gyro_fit(gfit: _gyro.GyroFit, where: str) -> None:
+    """Refuse (:class:`~thermocal.errors.DesignError`, exit 2) a gyro fit that fails its own
+    checks, before anything is written: a scale factor beyond :data:`SCALE_FACTOR_REFUSED`,
+    or a direction residual rms over the motions after calibration above
+    :data:`GYRO_DIRECTION_REFUSED_DEG` or not below the one before."""
+    sf = gfit.theta[3:6] * units.PPM
+    bad = [f"{ax} {100 * v:+.4g} %" for ax, v in zip("xyz", sf, strict=True)
+           if not abs(v) <= SCALE_FACTOR_REFUSED]  # fmt: skip
+    if bad:
+        raise DesignError(
+            f"{where}: the gyro's scale factors come out {', '.join(bad)} (beyond "
+            f"±{SCALE_FACTOR_REFUSED:.0%}: no gyro's): the columns are not in the unit "
+            "declared, or not in the accelerometer's axes; give the right --gyro-unit (or "
+            "--gyro-scale for raw counts), or the order and signs of the --gyro and --accel "
+            "columns (x, y, z of one right-handed frame); nothing written"
+        )
+    if gfit.n_motions == 0:
+        return
+    before = math.degrees(gfit.direction_rms_before_rad)
+    after = math.degrees(gfit.direction_rms_after_rad)
+    if not (after <= GYRO_DIRECTION_REFUSED_DEG and after < before):
+        raise DesignError(
+            f"{where}: the gyro fit failed: the {gfit.n_motions} motions' direction residual "
+            f"rms {before:.3g}° before, {after:.3g}° after calibration (at most "
+            f"{GYRO_DIRECTION_REFUSED_DEG:g}°, and below the one before); check the gyro's unit "
+            "(--gyro-unit, --gyro-scale), the time's (--time-unit, --rate), the order and "
+            "signs of the --gyro and --accel "
+            "columns (x, y, z of one right-handed frame) and that the poses are what they are "
+            "named (--poses); nothing written"
+        )
+
+
 @dataclass(frozen=True)
 class PoseStats:
     """A static pose: its samples, mean specific force [mg], per-sample white noise σ of
@@ -246,6 +324,25 @@ def _section_warnings(
     return not_still
 
 
+def _warn_short(
+    t: FloatArray, statics: Sequence[Section], static_s: float, where: str, sections_from: str
+) -> None:
+    """A warning naming the still poses shorter than ``static_s`` [s] (sections of a POSES
+    file: the detector never returns them): a mean of a few samples carries their noise and
+    σ, from ``var(Δx)/2`` of so few differences, is itself uncertain."""
+    short = [f"{s.name} ({t[s.end - 1] - t[s.start]:.3g} s)" for s in statics
+             if s.end - s.start < 2 or t[s.end - 1] - t[s.start] < static_s]  # fmt: skip
+    if short:
+        warnings.warn(
+            ThermocalWarning(
+                f"{where}: {len(short)} poses in {sections_from} are shorter than --static-s "
+                f"{static_s:g} s: {', '.join(short[:6])}{' …' if len(short) > 6 else ''}; "
+                "their means and noise rest on few samples (check their start and end)"
+            ),
+            stacklevel=3,
+        )
+
+
 def _warn_implausible(gfit: _gyro.GyroFit, where: str) -> None:
     """A warning when a gyro scale factor or misalignment is beyond
     :data:`GYRO_E_PLAUSIBLE` (no sensor's: a unit, count scale or pose is wrong), and
@@ -318,11 +415,14 @@ def calibrate_session(
     t = np.asarray(time_s, dtype=np.float64)
     a = np.asarray(accel_mg, dtype=np.float64)
     w = None if gyro_rad_s is None else np.asarray(gyro_rad_s, dtype=np.float64)
+    given = sections is not None
     if sections is None:
         sections = detect_poses(t, a, w, static_s=static_s)
     statics = [s for s in sections if not s.is_turn]
     turns = [s for s in sections if s.is_turn]
     not_still = _section_warnings(statics, turns, w is not None, where, sections_from)
+    if given:
+        _warn_short(t, statics, static_s, where, sections_from)
     stats = pose_stats(a, w, statics)
     if len(stats) < 6:
         raise DesignError(
@@ -354,6 +454,7 @@ def calibrate_session(
     else:
         acc = _accel.fit_gravity_magnitude(f, sig, g_mg)
         idx = _accel.FREE_INDEX
+    check_accel_fit(acc, g_mg, where)
     temp = None
     if temperature_c is not None:
         tc = np.asarray(temperature_c, dtype=np.float64)
@@ -382,6 +483,7 @@ def calibrate_session(
             saturated=sat,
             model=gyro_model,
         )  # fmt: skip
+        check_gyro_fit(gfit, where)
         _warn_implausible(gfit, where)
         _warn_too_few_motions(gfit, where)
     return SessionResult(acc, gfit, tuple(stats), tuple(turns), g_mg, temp, not_still)
@@ -470,11 +572,16 @@ def rotation_errors(
 
 
 __all__ = [
+    "ACCEL_RESIDUAL_REFUSED",
+    "GYRO_DIRECTION_REFUSED_DEG",
     "METHOD",
+    "SCALE_FACTOR_REFUSED",
     "MultiposValidation",
     "PoseStats",
     "SessionResult",
     "calibrate_session",
+    "check_accel_fit",
+    "check_gyro_fit",
     "gravity_errors",
     "pose_stats",
     "rotation_errors",

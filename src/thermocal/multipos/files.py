@@ -41,6 +41,7 @@ from thermocal.readers import read_recording
 from thermocal.readers.text import TextOptions
 from thermocal.recording import Recording
 from thermocal.turntable import thermal
+from thermocal.turntable.files import check_as_read
 
 NO_TEMPERATURE_TREF_C = 25.0
 """TREF recorded for a calibration made without a temperature column (it applies
@@ -511,6 +512,9 @@ def calibrate_files(
     g_unit = g_units.pop() if g_units else None
     triads, models = _fit_triads(runs, opts, a_unit, g_unit, grav)
     cal = Calibration([], triads)
+    check_as_read(cal, output, "check the columns' units (--accel-unit, --gyro-unit, "
+                  "--accel-scale, --gyro-scale) and the poses (--poses), or fit a lower "
+                  "--order")  # fmt: skip
     save_calibration(cal, output)
     assert grav.g_m_s2 is not None
     out = _summary(runs, models, a_unit, g_unit, float(grav.g_m_s2))

@@ -22,14 +22,17 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import warnings
 from collections.abc import Mapping, Sequence
 from typing import Any
 
 import numpy as np
 
 from thermocal import units
-from thermocal.errors import ThermocalInputError
+from thermocal.errors import ThermocalInputError, ThermocalWarning
 from thermocal.multipos.calibrate import (
+    ACCEL_RESIDUAL_REFUSED,
+    GYRO_DIRECTION_REFUSED_DEG,
     METHOD,
     MultiposValidation,
     gravity_errors,
@@ -135,11 +138,11 @@ def validate_triads(
     if gyr is None or xg is None or xg_c is None:
         if len(sections) == 1:
             out[0] = dataclasses.replace(out[0], not_judged=ONE_POSE_ACCEL_NOT_JUDGED)
-        return out
+        return _judged(out, g, rec.name)
     if len(sections) == 1:
         out[0] = dataclasses.replace(out[0], not_judged=ONE_POSE_NOT_JUDGED)
-        return [*out, _rate_at_rest(gyr.name, xg, xg_c, sections[0], g_in,
-                                    outside(gyr, temp_of(gyr)))]  # fmt: skip
+        return _judged([*out, _rate_at_rest(gyr.name, xg, xg_c, sections[0], g_in,
+                                            outside(gyr, temp_of(gyr)))], g, rec.name)  # fmt: skip
     dt = np.diff(t)
     dt = np.concatenate([dt, dt[-1:]])
     vb = rotation_errors(xg, dt, xa, sections) * units.RAD_TO_DEG
@@ -152,6 +155,33 @@ def validate_triads(
             input_unit=g_in.data_unit, count_scale=g_in.count_scale, physical_unit=g_in.unit,
         )
     )  # fmt: skip
+    return _judged(out, g, rec.name)
+
+
+def _judged(out: list[MultiposValidation], g: float, name: str) -> list[MultiposValidation]:
+    """A warning for each figure left, after compensation, beyond what the calibration's
+    own fit accepts (:data:`~thermocal.multipos.calibrate.ACCEL_RESIDUAL_REFUSED` × ``g``,
+    :data:`~thermocal.multipos.calibrate.GYRO_DIRECTION_REFUSED_DEG`): the held-out
+    session is not read as the calibration was made (a unit, the time's unit, another
+    sensor); the figures stand as measured.  Returns ``out`` unchanged."""
+    bound = {"gravity-magnitude error": (ACCEL_RESIDUAL_REFUSED * g, "the columns' unit"),
+             "rotation-angle error": (GYRO_DIRECTION_REFUSED_DEG, "the gyro's unit, the "
+                                      "time's (--time-unit, --rate)")}  # fmt: skip
+    for v in out:
+        if v.what not in bound:
+            continue
+        lim, what = bound[v.what]
+        if not v.rms_after <= lim:
+            warnings.warn(
+                ThermocalWarning(
+                    f"{name}: the {v.triad} triad's {v.what} rms is {v.rms_after:.4g} {v.unit} "
+                    f"after compensation ({v.rms_before:.4g} before), beyond the "
+                    f"{lim:.4g} {v.unit} a calibration's own fit accepts: this session is not "
+                    f"read as the calibration was made ({what}, the --signal-unit given) "
+                    "or is another sensor's"
+                ),
+                stacklevel=3,
+            )
     return out
 
 

@@ -10,6 +10,7 @@ the Cramér–Rao bound of the design (:func:`.model.fisher_information`).
 from __future__ import annotations
 
 import dataclasses
+import math
 import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass, field
@@ -240,6 +241,126 @@ def weak_combinations(
     return tuple(out)
 
 
+AZIMUTH_WARNED_DEG = 1.0
+"""A rotation of the body about the inner axis, relative to the declared geometry (body x
+East at α = 0, INTERFACE.md "Turntable geometry"), beyond this [°] is warned of: the fit
+takes it for the antisymmetric pair of misalignments ``yx = −sin ψ``, ``xy = +sin ψ`` and
+biases both x and y scale factors by ``cos ψ − 1`` (−152 ppm at 1°)."""
+AZIMUTH_REFUSED_DEG = 5.0
+"""Beyond this [°] (scale factors biased by −3800 ppm, misalignments of 18000″) the run is
+refused: the α encoder's zero is not the geometry's (a table whose inner axis reads 90° at
+the body's α = 0 gave scale factors of −1e6 ppm and misalignments of ±206265″, i.e. the
+rotation itself); ``--alpha-offset`` declares it."""
+
+
+def inner_axis_azimuth_deg(theta: npt.ArrayLike) -> float:
+    """The rotation ψ [°] of the body about the inner axis (body z) that a calibration's
+    error matrix holds: ``I + E ≈ R_z(ψ)(I + E')`` with ``E'`` small, so
+    ``ψ = atan2(E₁₀ − E₀₁, 2 + E₀₀ + E₁₁)`` (exact for a pure rotation ``E = R_z(ψ) − I``:
+    ``E₀₀ = E₁₁ = cos ψ − 1``, ``E₁₀ = −E₀₁ = sin ψ``).  Positive: the α encoder reads ψ
+    more than the geometry's α (the body turned by +ψ about z)."""
+    e = model.error_matrices(np.asarray(theta, dtype=np.float64))
+    return float(np.degrees(np.arctan2(e[1, 0] - e[0, 1], 2.0 + e[0, 0] + e[1, 1])))
+
+
+def _check_azimuth(
+    theta: FloatArray, name: str, alpha_column: str, offset_deg: float = 0.0
+) -> str | None:
+    """Refuse a run whose fit holds a rotation about the inner axis beyond
+    :data:`AZIMUTH_REFUSED_DEG` (:func:`inner_axis_azimuth_deg`), naming ``--alpha-offset``;
+    the warning's text beyond :data:`AZIMUTH_WARNED_DEG`, else None.  Judged first, when
+    the x-y block of ``I + E`` is ``k·R_z(ψ)`` with ``k`` within :data:`SCALE_FACTOR_REFUSED`
+    of 1 (a quarter turn reads as −100 % scale factors); otherwise a unit is wrong and
+    :func:`_check_fit` says so."""
+    e = model.error_matrices(np.asarray(theta, dtype=np.float64))
+    k = 0.5 * math.hypot(e[1, 0] - e[0, 1], 2.0 + e[0, 0] + e[1, 1])
+    if not abs(k - 1.0) <= SCALE_FACTOR_REFUSED:  # the xy block is k·R_z(ψ): a unit's scale
+        return None  # first (:func:`_check_fit`), ψ is not defined by it
+    psi = inner_axis_azimuth_deg(theta)
+    total = (offset_deg + psi + 180.0) % 360.0 - 180.0  # the --alpha-offset that removes it
+    what = (
+        f"the fit holds a rotation of {psi:+.4g}° of the body about the inner axis (z) "
+        f"relative to the geometry (body x East at {alpha_column} = 0): the {alpha_column} "
+        "encoder's zero, or the sensor's mounting, is off by that much"
+    )
+    if abs(psi) > AZIMUTH_REFUSED_DEG:
+        raise ThermocalInputError(
+            f"{name}: {what}; its x and y scale factors "
+            f"({(math.cos(math.radians(psi)) - 1) * 1e6:+.3g} ppm) and misalignments yx, xy "
+            "would be that rotation, not the sensor's; declare it with "
+            f"--alpha-offset {total:.4g} (the reading at the geometry's α = 0), or re-zero the "
+            "encoder; nothing written"
+        )
+    if abs(psi) > AZIMUTH_WARNED_DEG:
+        return (
+            f"{what}; the x and y scale factors are biased by "
+            f"{(math.cos(math.radians(psi)) - 1) * 1e6:+.3g} ppm and yx, xy hold it; declare "
+            f"it with --alpha-offset {total:.4g}"
+        )
+    return None
+
+
+SCALE_FACTOR_REFUSED = 0.5
+"""A fitted scale factor beyond ±50 % is refused, not written: the columns are not in the
+unit declared (a °/s gyro declared °/h gave −999722 ppm, declared rad/s +5.6e7 ppm)."""
+RESIDUAL_REFUSED = 20.0
+"""Least-squares residuals beyond this many times the white-noise level (χ²/dof beyond
+400) are refused: the encoder angles and the earth rate do not describe the run as the
+geometry says (a latitude of the wrong sign gave 138×, the outer axis's zero a quarter turn
+off 152×; the simulated run 1.03×); between ``1 + 5√(2/dof)`` and this, a warning."""
+
+
+def _check_fit(est: _Estimates, acc: accel_mod.AccelEstimate | None, name: str) -> None:
+    """Refuse a run whose fit fails its own checks, before anything is written: a gyro or
+    accelerometer scale factor beyond :data:`SCALE_FACTOR_REFUSED`, least-squares residuals
+    beyond :data:`RESIDUAL_REFUSED` × the white-noise level."""
+    for kind, theta, opt in (("gyro", est.kf.theta, "--gyro-unit"),
+                             ("accelerometer", None if acc is None else acc.theta,
+                              "--accel-unit")):  # fmt: skip
+        if theta is None:
+            continue
+        sf = np.asarray(theta[3:6]) * 1e-6
+        bad = [f"{ax} {100 * v:+.4g} %" for ax, v in zip("xyz", sf, strict=True)
+               if not abs(v) <= SCALE_FACTOR_REFUSED]  # fmt: skip
+        if bad:
+            raise ThermocalInputError(
+                f"{name}: the {kind}'s scale factors come out {', '.join(bad)} (beyond "
+                f"±{SCALE_FACTOR_REFUSED:.0%}: no sensor's): its columns are not in the unit "
+                f"declared; give the right {opt}; nothing written"
+            )
+    ratio = math.sqrt(est.chi2_per_dof) if est.dof > 0 and est.chi2_per_dof > 0 else 0.0
+    if not ratio <= RESIDUAL_REFUSED:
+        raise ThermocalInputError(
+            f"{name}: the fit failed: least-squares residuals {ratio:.3g}× the white-noise "
+            f"level (at most {RESIDUAL_REFUSED:g}×): the encoder angles and the earth rate do "
+            "not describe the run as the geometry says; check --latitude, the encoder columns "
+            "(--alpha, --beta, --encoder-unit) and their zeros (--alpha-offset); nothing written"
+        )
+
+
+def _encoders(
+    rec: Recording, columns: tuple[str, str], unit: str | None, alpha_offset_deg: float
+) -> tuple[FloatArray, FloatArray]:
+    """The encoder angles α (less ``alpha_offset_deg``) and β [°], unwrapped."""
+    if not abs(alpha_offset_deg) <= 360.0:
+        raise ThermocalInputError(
+            f"--alpha-offset must be an angle within ±360°, got {alpha_offset_deg:g}"
+        )
+    a_deg = np.unwrap(encoder_deg(rec, columns[0], unit), period=360.0) - float(alpha_offset_deg)
+    return a_deg, np.unwrap(encoder_deg(rec, columns[1], unit), period=360.0)
+
+
+def _judge(
+    est: _Estimates, acc: accel_mod.AccelEstimate | None, name: str, alpha: tuple[str, float]
+) -> list[str]:
+    """The fit judged before anything is written: the rotation about the inner axis first
+    (:func:`_check_azimuth`), then the scale factors and residuals (:func:`_check_fit`);
+    the warning to add, if any."""
+    azimuth = _check_azimuth(est.kf.theta, name, alpha[0], alpha[1])
+    _check_fit(est, acc, name)
+    return [azimuth] if azimuth else []
+
+
 def calibrate(
     rec: Recording,
     latitude_deg: float | None = None,
@@ -261,6 +382,7 @@ def calibrate(
     accel_unit: str | None = None,
     gravity_m_s2: float | None = None,
     temperature_column: str | None = None,
+    alpha_offset_deg: float = 0.0,
 ) -> TurntableResult:
     """Calibrate a gyro triad from a 16-position dual-axis turntable run (SPEC §7).
 
@@ -290,25 +412,23 @@ def calibrate(
         (default: WGS-84 normal gravity at the latitude).
     temperature_column : a temperature column [°C] whose mean and span over the run are
         reported (the run's soak temperature).
+    alpha_offset_deg : the α encoder's reading at the geometry's α = 0 [°] (subtracted).
 
     Raises
     ------
     MissingColumnError, MissingValueError : absent or incomplete columns.
     TurntableScheduleError : fewer positions, dwells shorter than asked, an axis not moving.
+    ThermocalInputError : a fit that fails its own checks (:func:`_judge`).
     """
-    lat = _check_inputs(
-        rec, latitude_deg, channels, gyro_columns, alpha_column, beta_column, accel_columns,
-        temperature_column,
-    )  # fmt: skip
+    lat = _check_inputs(rec, latitude_deg, channels, gyro_columns, alpha_column, beta_column,
+                        accel_columns, temperature_column)  # fmt: skip
     g = _gyro_rad_s(rec, gyro_columns, gyro_unit)
-    a_deg = np.unwrap(encoder_deg(rec, alpha_column, encoder_unit), period=360.0)
-    b_deg = np.unwrap(encoder_deg(rec, beta_column, encoder_unit), period=360.0)
-    full, motion, seg = _segment(
-        rec, g, a_deg, b_deg, lat, alpha_column, beta_column, min_positions, min_dwell_s
-    )
+    a_deg, b_deg = _encoders(rec, (alpha_column, beta_column), encoder_unit, alpha_offset_deg)
+    full, motion, seg = _segment(rec, g, a_deg, b_deg, lat, alpha_column, beta_column,
+                                 min_positions, min_dwell_s)  # fmt: skip
     noise_source = "dwells" if encoder_noise_arcsec is None else "option"
-    if encoder_noise_arcsec is None:
-        encoder_noise_arcsec = motion.reading_sigma_arcsec
+    encoder_noise_arcsec = motion.reading_sigma_arcsec if encoder_noise_arcsec is None else (
+        encoder_noise_arcsec)  # fmt: skip
     m = full.select_channels(channels)
     arw = _arw_rad_sqrt_s(arw_deg_sqrt_h, g, full.dt_s, seg.dwells)
     est = _estimate(
@@ -317,11 +437,11 @@ def calibrate(
     msgs = list(_diagnostics(est, seg.n_positions))
     acc_est, g_local = None, None
     if accel_columns is not None:
-        g_local = (
-            float(gravity_m_s2) if gravity_m_s2 is not None else units.normal_gravity_m_s2(lat)
-        )
+        g_local = float(gravity_m_s2) if gravity_m_s2 is not None else (
+            units.normal_gravity_m_s2(lat))  # fmt: skip
         acc_est = _accel_triad(rec, accel_columns, accel_unit, a_deg, b_deg, seg.dwells, g_local)
         msgs.extend(_accel_diagnostics(acc_est))
+    msgs.extend(_judge(est, acc_est, str(rec.name), (alpha_column, alpha_offset_deg)))
     t_mean, t_span = _soak_temperature(rec, temperature_column)
     for msg in msgs:
         warnings.warn(f"{rec.name}: {msg}", TurntableWarning, stacklevel=2)

@@ -57,6 +57,8 @@ class TurntableOptions:
     channels: int = 3
     text: TextOptions | None = None
     topic: str | None = None
+    alpha_offset: float = 0.0
+    """The α encoder's reading at the geometry's α = 0 [°] (``--alpha-offset``)."""
 
 
 def check_order(order: int) -> None:
@@ -116,6 +118,7 @@ def calibrate_run(
         gravity_m_s2=o.gravity,
         temperature_column=o.temps,
         min_positions=min_positions,
+        alpha_offset_deg=o.alpha_offset,
     )
     return rec, res
 
@@ -179,6 +182,24 @@ class ThermalRunsResult:
         if self.accel is not None:
             out["accel"] = triad_summary(self.accel)
         return out
+
+
+def check_as_read(cal: Any, output: Path, hint: str) -> None:
+    """The checks the calibration file's reader applies
+    (:func:`thermocal.models.calibration.calibration_from_dict`: each triad's TREF within
+    its range, a well-conditioned ``I + E(T)`` over it, finite numbers …) applied to ``cal``
+    before it is written to ``output``: a calibration that its own reader would refuse is
+    refused now (:class:`~thermocal.errors.DesignError` naming what failed, ``hint`` the
+    options that get the user further), and nothing is written."""
+    import json
+
+    from thermocal.errors import DesignError, ModelFileError
+    from thermocal.models.calibration import calibration_from_dict
+
+    try:
+        calibration_from_dict(json.loads(json.dumps(cal.to_dict())), str(output))
+    except (ModelFileError, ValueError) as exc:
+        raise DesignError(f"{exc}; not written: {hint}") from None
 
 
 def turntable_calibration(
@@ -261,7 +282,10 @@ def thermal_runs(
         triads.append(
             Triad("accel", opts.accel, str(accel_unit), temps, accel_model, rig, latitude, record)
         )
-    save_calibration(Calibration([], triads), output)
+    cal = Calibration([], triads)
+    check_as_read(cal, output, "check the columns' units (--gyro-unit, --accel-unit) and "
+                  "the runs, or fit a lower --order")  # fmt: skip
+    save_calibration(cal, output)
     return ThermalRunsResult(output, tuple(runs), gyro_model, accel_model, record)
 
 

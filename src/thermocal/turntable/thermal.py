@@ -393,6 +393,24 @@ def check_conditioning(triad: TriadThermal, where: str) -> None:
         )
 
 
+def check_tref(tref_c: float, lo: float, hi: float) -> None:
+    """Refuse (exit 2, naming ``--tref``) a reference temperature [°C] that the calibration
+    file's reader would refuse (:func:`check_triad_dict`: finite, inside the soaks'
+    range ``[lo, hi]`` or within :func:`thermocal.models.checks.range_margin` of it), before
+    anything is fitted or written."""
+    from thermocal.models.checks import range_margin
+
+    margin = range_margin(lo, hi)
+    if not (math.isfinite(tref_c) and lo - margin <= tref_c <= hi + margin):
+        where = "far outside" if math.isfinite(tref_c) else "not a temperature within"
+        raise ThermocalInputError(
+            f"--tref {tref_c:g}: the reference temperature is {where} the soaks' "
+            f"[{lo:.4g}, {hi:.4g}] °C (more than {margin:.4g} °C beyond; a calibration file "
+            f"with it is refused when read); give a --tref within [{lo - margin:.4g}, "
+            f"{hi + margin:.4g}] °C, or leave it out (the middle of the soaks)"
+        )
+
+
 def fit_triad(
     kind: str,
     temps_c: Sequence[float],
@@ -427,6 +445,7 @@ def fit_triad(
             f"the runs' temperatures span {span:.3g} °C: soak them at different temperatures"
         )
     tref = float(0.5 * (t.min() + t.max())) if tref_c is None else float(tref_c)
+    check_tref(tref, float(t.min()), float(t.max()))
     dt = t - tref
     scale = max(float(np.max(np.abs(dt))), 1.0)
     max_order = min(MAX_ORDER, r - 1)
@@ -554,6 +573,7 @@ __all__ = [
     "TriadThermal",
     "TriadValidation",
     "check_conditioning",
+    "check_tref",
     "check_triad_dict",
     "constant_triad",
     "correct",
