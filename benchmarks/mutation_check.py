@@ -76,6 +76,7 @@ GRAV = _t("mutants_maths", "gravity_tilt", "gravity_tref")
 IDS = _t("mutants_maths", "c_identifiers", "tests/attacks/test_generated_code_attacks.py")
 OUTS = _t("faults", "tests/attacks/test_output_attacks.py")
 METRICS = _t("mutants_maths", "metrics", "drift_angle", "metrics_runs")
+ADEQ_H39 = ("tests/test_mutants_adequacy.py", *ADEQ)
 
 
 MUTANTS: tuple[Mutant, ...] = (
@@ -1836,6 +1837,56 @@ MUTANTS: tuple[Mutant, ...] = (
         "return TEMPERATURE_NAME",
         H38R,
         "a capital T taken for time",
+    ),
+    # issue 39 slice h39-station
+    Mutant(
+        "adequacy-h39-any-override-passes",
+        P + "adequacy.py",
+        "t.override is None or t.override not in self.overrides",
+        "t.override is None or not self.overrides",
+        ADEQ_H39,
+        "any override (--allow-motion) passes every adequacy test (a narrow sweep too)",
+    ),
+    Mutant(
+        "adequacy-h39-n-equals-p-overridable",
+        P + "adequacy.py",
+        "if n_samples <= n_coefficients:",
+        "if n_samples < n_coefficients:",
+        ADEQ_H39,
+        "n = p samples (the fit passes through them) refused only unless --allow-narrow",
+    ),
+    Mutant(
+        "adequacy-h39-too-few-bins-overridable",
+        P + "adequacy.py",
+        'verdict, override = "fail", None\n        msg = (\n            f"{name} holds {distinct}',
+        'verdict, override = "fail", ALLOW_NARROW\n'
+        '        msg = (\n            f"{name} holds {distinct}',
+        ADEQ_H39,
+        "fewer distinct temperatures than coefficients fitted with --allow-narrow",
+    ),
+    Mutant(
+        "adequacy-h39-best-stillness",
+        P + "adequacy.py",
+        "return max(tests, key=lambda t: (rank[t.verdict], t.figure or 0.0))",
+        "return min(tests, key=lambda t: (rank[t.verdict], t.figure or 0.0))",
+        ADEQ_H39,
+        "of several runs, the stillest run's verdict recorded (a moving run passes)",
+    ),
+    Mutant(
+        "adequacy-h39-first-run-stillness",
+        P + "adequacy.py",
+        "tests.append(_worst_stillness(per_run))",
+        "tests.append(per_run[0])",
+        ADEQ_H39,
+        "of several runs, only the first run's stillness judged",
+    ),
+    Mutant(
+        "adequacy-h39-stillness-figure-ignored",
+        P + "adequacy.py",
+        "key=lambda t: (rank[t.verdict], t.figure or 0.0))",
+        "key=lambda t: rank[t.verdict])",
+        ADEQ_H39,
+        "of runs with one verdict, the first one's figure kept, not the worst",
     ),
 )
 
