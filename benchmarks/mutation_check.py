@@ -77,6 +77,7 @@ IDS = _t("mutants_maths", "c_identifiers", "tests/attacks/test_generated_code_at
 OUTS = _t("faults", "tests/attacks/test_output_attacks.py")
 METRICS = _t("mutants_maths", "metrics", "drift_angle", "metrics_runs")
 ADEQ_H39 = ("tests/test_mutants_adequacy.py", *ADEQ)
+ST_ATT2 = ("tests/attacks/test_station_attacks_2.py",)
 
 
 MUTANTS: tuple[Mutant, ...] = (
@@ -1887,6 +1888,38 @@ MUTANTS: tuple[Mutant, ...] = (
         "key=lambda t: rank[t.verdict])",
         ADEQ_H39,
         "of runs with one verdict, the first one's figure kept, not the worst",
+    ),
+    Mutant(
+        "station-h39-setpoint-event-every-write",
+        P + "station/run.py",
+        "SETPOINT_EVENT_C = 1.0",
+        "SETPOINT_EVENT_C = 0.0",
+        ST_ATT2,
+        "every set-point of a fine ramp an event: station.json rewritten 10⁵ times a day",
+    ),
+    Mutant(
+        "station-h39-setpoint-event-step-ignored",
+        P + "station/run.py",
+        "if (last is not None and last[2] == self.step and abs(",
+        "if (last is not None and abs(",
+        ST_ATT,
+        "a hold's set-point within 1 °C of the ramp's last not recorded: a kill reports 64.x °C",
+    ),
+    Mutant(
+        "station-h39-program-points-unbounded",
+        P + "station/run.py",
+        "if t_prog.size > MAX_PROGRAM_POINTS:",
+        "if t_prog.size > 100 * MAX_PROGRAM_POINTS:",
+        ST_ATT2,
+        "a program of 10⁶ points run: a 20 MB station.json rewritten at every event",
+    ),
+    Mutant(
+        "station-h39-output-folder-oserror-raw",
+        P + "station/recorder.py",
+        "            except OSError as exc:  # a read-only place, a file in the way, no such mount",
+        "            except ValueError as exc:  # a read-only place",
+        ST_ATT2,
+        "-o on a read-only place: the OS error's text without the option to change",
     ),
 )
 

@@ -164,8 +164,14 @@ class Recorder:
                     "another -o"
                 )
             self.created = not out_dir.exists()
-            out_dir.mkdir(parents=True, exist_ok=True)
-            self._lock()
+            try:
+                out_dir.mkdir(parents=True, exist_ok=True)
+                self._lock()
+            except OSError as exc:  # a read-only place, a file in the way, no such mount
+                raise ThermocalInputError(
+                    f"{out_dir}: cannot create the recording folder "
+                    f"({exc.strerror or type(exc).__name__}); give another -o"
+                ) from None
             if (out_dir / STATION_JSON).exists():  # another run started in between
                 self.release()
                 raise ThermocalInputError(f"{out_dir}: another station run started in it")

@@ -42,6 +42,21 @@ LOOP_S = 0.02
 this often."""
 
 
+MAX_PROGRAM_POINTS = 20_000
+"""Most points a program may hold: ``station.json`` (holding the program) is rewritten and
+flushed at every event; a controller's program holds a few hundred segments, a week at one
+point a minute 10 080 (10⁶ points made each rewrite 20 MB and stalled the loop)."""
+
+SETPOINT_EVENT_C = 1.0
+"""Along a ramp, a ``setpoint`` event (a rewrite of ``station.json``) is recorded when the
+set-point has moved this far from the last one recorded [°C] (or at a new program step, or
+after :data:`SETPOINT_EVENT_S`): a ramp at the register's 0.01 °C resolution writes a new
+set-point at every turn of the loop, 10⁵ a day, and one event each made every rewrite
+megabytes long.  The chamber stream's rows hold every set-point polled."""
+
+SETPOINT_EVENT_S = 60.0
+"""Longest host time between two recorded ``setpoint`` events while the set-point moves [s]."""
+
 CLOCK_CHECK_S = 2.0
 """Host seconds of lines after which a sensor's time is compared with the host clock [s]."""
 
@@ -199,6 +214,7 @@ class _Loop:
         self.sensors = [SerialSensor(s) for s in cfg.sensors]
         self.state = StationState(n_steps=len(t_prog) - 1, end_s=self.end_s, time_scale=time_scale)
         self.setpoints: list[tuple[float, float]] = []
+        self.sp_recorded: tuple[float, float, int] | None = None  # °C, host s, step
         self.samples = {s.id: 0 for s in cfg.sensors} | {CHAMBER_STREAM: 0}
         self.bad = {s.id: 0 for s in cfg.sensors}
         self.parts: list[str] = []
@@ -337,7 +353,7 @@ class _Loop:
                 self.chamber.write_setpoint(target)
                 self.sp = target
                 self.setpoints.append((p, target))
-                rec.event("setpoint", f"{target:.3f} °C", program_s=p, setpoint_c=target)
+                self._record_setpoint(now, p, target)
             if now >= self.next_poll:
                 self.next_poll = max(self.next_poll + ch_cfg.poll_s, now)
                 self.chamber_c = math.nan  # unknown until the chamber answers
@@ -364,6 +380,16 @@ class _Loop:
                     f"continue with --resume"
                 ) from None
             self.next_poll = now + min(ch_cfg.poll_s, 0.5)
+
+    def _record_setpoint(self, now: float, p: float, target: float) -> None:
+        """A ``setpoint`` event for a step's first set-point, and along a ramp every
+        :data:`SETPOINT_EVENT_C` or :data:`SETPOINT_EVENT_S` (not for every write)."""
+        last = self.sp_recorded
+        if (last is not None and last[2] == self.step and abs(target - last[0]) < SETPOINT_EVENT_C
+                and now - last[1] < SETPOINT_EVENT_S):  # fmt: skip
+            return
+        self.sp_recorded = (target, now, self.step)
+        self.rec.event("setpoint", f"{target:.3f} °C", program_s=p, setpoint_c=target)
 
     def _drift(self, p: float) -> None:
         """Warn once when the chamber stays beyond ``tolerance_c`` of its set-point for
@@ -555,7 +581,8 @@ def previous_run(events: list[dict[str, Any]]) -> tuple[str, bool]:
 
     A run that ended writes a ``stop`` event (how it ended, the safe set-point written or
     not); a run killed (SIGKILL, a power cut, a crash of the interpreter) leaves none: then
-    the chamber still holds the last set-point written (``setpoint`` events) [°C].
+    the chamber still holds the last set-point written: the last ``setpoint`` event [°C]
+    (along a ramp, within :data:`SETPOINT_EVENT_C` of it).
     """
     last_sp: float | None = None
     stop: dict[str, Any] | None = None
@@ -573,11 +600,11 @@ def previous_run(events: list[dict[str, Any]]) -> tuple[str, bool]:
         if not started:
             return "the last run never started", False
         return (f"the last run was killed (no stop record: SIGKILL, a power cut or a crash); "
-                f"the chamber was left at {where}, the last set-point written"), True  # fmt: skip
+                f"the chamber was left at {where}, the last set-point recorded"), True  # fmt: skip
     how = str(stop.get("ended", "?")) + (f" by {stop['reason']}" if stop.get("reason") else "")
     if stop.get("safe_setpoint_c") is None:
         return (f"the last run ended: {how}, WITHOUT the safe set-point; the chamber was "
-                f"left at {where}, the last set-point written"), True  # fmt: skip
+                f"left at {where}, the last set-point recorded"), True  # fmt: skip
     return f"the last run ended: {how}; the chamber was left at {where} (the safe set-point)", False
 
 
@@ -611,6 +638,12 @@ def run_station(
     t_prog = np.asarray(program[0], dtype=np.float64)
     c_prog = np.asarray(program[1], dtype=np.float64)
     ch_cfg = cfg.chamber
+    if t_prog.size > MAX_PROGRAM_POINTS:
+        raise ThermocalInputError(
+            f"{profile_source or 'the program'}: {t_prog.size} program points; the station "
+            f"takes at most {MAX_PROGRAM_POINTS} (the set-point is interpolated linearly "
+            "between points: a ramp needs only its two ends); resample the program"
+        )
     chamber = chamber or make_chamber(ch_cfg, disp.log)
     for t, c in zip(t_prog, c_prog, strict=True):  # before anything is written
         why = ch_cfg.out_of_range(float(c))

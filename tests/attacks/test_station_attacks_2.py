@@ -1,0 +1,284 @@
+"""Issue 39, "How it is checked": attacks on the station not seen by the first audit.
+
+Through the command line against a scripted Modbus TCP server on 127.0.0.1 and
+pseudo-terminals (the helpers of :mod:`test_station_attacks`).  Each ends in exit 2 with one
+``error:`` line, or a valid run with a ``warning:``, and the chamber at its safe set-point
+whenever anything was written to it.  Expected values come from outside the station: what
+the server received, what the sensor sent, the program written here.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import socket
+import struct
+import threading
+import time
+from pathlib import Path
+
+import pyarrow.parquet as pq
+import pytest
+
+pytest.importorskip("pymodbus")
+pytest.importorskip("serial")
+
+from test_station_attacks import HOT, SCALE, ScriptedSensor, _digest, _events, _profile, _toml
+
+from thermocal.cli import main
+from thermocal.station.sim import ChamberModel, SimulatedChamber
+
+
+class ScriptedModbus:
+    """A Modbus TCP server written here byte by byte (MBAP header, PDU).  A write
+    (function 6) is echoed and its value kept in :attr:`writes` [°C at :data:`SCALE`]; a
+    read (3 or 4) answers one register = 25 °C.  ``delay_s`` delays every reply;
+    ``exception`` (a Modbus exception code) answers every read with it."""
+
+    def __init__(self, *, delay_s: float = 0.0, exception: int = 0) -> None:
+        self.delay_s, self.exception = delay_s, exception
+        self.srv = socket.socket()
+        self.srv.bind(("127.0.0.1", 0))
+        self.srv.listen(4)
+        self.srv.settimeout(0.2)
+        self.port = self.srv.getsockname()[1]
+        self.stop = threading.Event()
+        self.writes: list[float] = []
+        threading.Thread(target=self._accept, daemon=True).start()
+
+    def _accept(self) -> None:
+        while not self.stop.is_set():
+            try:
+                conn, _ = self.srv.accept()
+            except OSError:
+                continue
+            threading.Thread(target=self._serve, args=(conn,), daemon=True).start()
+
+    def _serve(self, conn: socket.socket) -> None:
+        with conn:
+            while not self.stop.is_set():
+                try:
+                    head = conn.recv(7)
+                    if len(head) < 7:
+                        return
+                    tid, _pid, length, unit = struct.unpack(">HHHB", head)
+                    pdu = conn.recv(length - 1)
+                    fc = pdu[0]
+                    if fc == 6:
+                        word = struct.unpack(">H", pdu[3:5])[0]
+                        self.writes.append((word - 0x10000 if word >= 0x8000 else word) * SCALE)
+                        body = pdu
+                    elif self.exception:
+                        body = bytes([fc | 0x80, self.exception])
+                    else:
+                        body = bytes([fc, 2]) + struct.pack(">H", round(25.0 / SCALE))
+                    time.sleep(self.delay_s)
+                    conn.sendall(struct.pack(">HHHB", tid, 0, len(body) + 1, unit) + body)
+                except OSError:
+                    return
+
+    def close(self) -> None:
+        self.stop.set()
+        self.srv.close()
+
+
+def _run(capsys: pytest.CaptureFixture[str], toml: Path, prof: Path, out: Path,
+         k: float = 100.0) -> tuple[int, list[str]]:  # fmt: skip
+    rc = main(["station", "run", str(toml), "--profile", str(prof), "-o", str(out),
+               "--time-scale", f"{k:g}"])  # fmt: skip
+    return rc, capsys.readouterr().err.strip().splitlines()
+
+
+@pytest.mark.parametrize("exception", [2, 4, 6])
+def test_a_chamber_answering_with_a_modbus_exception_is_one_error_line(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], exception: int
+) -> None:
+    """Illegal data address (2), device failure (4), device busy (6) on every read: the
+    start is refused in one line naming the chamber and the register; nothing written,
+    no folder left."""
+    server = ScriptedModbus(exception=exception)
+    sen = ScriptedSensor(["0.05,25.0"], rate_hz=50)
+    try:
+        toml, prof = tmp_path / "st.toml", _profile(tmp_path)
+        toml.write_text(_toml(server.port, sen.device))
+        before = _digest(toml, prof)
+        out = tmp_path / "rec"
+        rc, err = _run(capsys, toml, prof, out)
+    finally:
+        sen.close()
+        server.close()
+    assert rc == 2 and len(err) == 1, err
+    assert err[0].startswith(f"error: chamber modbus-tcp 127.0.0.1:{server.port} unit 1: "
+                             "read input register 100: Modbus error"), err  # fmt: skip
+    assert str(toml) in err[0]
+    assert server.writes == [] and not out.exists() and _digest(toml, prof) == before
+
+
+def test_a_chamber_slower_than_io_timeout_stops_the_run_safely(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Every reply takes 1 s, io_timeout_s = 0.3 s: the start is refused in one line (no
+    answer in time), nothing written; with io_timeout_s = 2 s the run goes on, slowly,
+    and ends at the safe set-point."""
+    server = ScriptedModbus(delay_s=1.0)
+    sen = ScriptedSensor(["0.05,25.0"], rate_hz=50)
+    try:
+        toml = tmp_path / "st.toml"
+        prof = _profile(tmp_path, ((0.0, 200.0), (25.0, 30.0)))
+        toml.write_text(_toml(server.port, sen.device, part_s=0.5))
+        out = tmp_path / "rec"
+        t0 = time.monotonic()
+        rc, err = _run(capsys, toml, prof, out)
+        assert rc == 2 and len(err) == 1, err
+        assert "read input register 100" in err[0] and str(toml) in err[0], err
+        assert time.monotonic() - t0 < 20 and not out.exists() and server.writes == []
+        toml.write_text(toml.read_text().replace("io_timeout_s = 0.3", "io_timeout_s = 2.0"))
+        rc, err = _run(capsys, toml, prof, out)
+    finally:
+        sen.close()
+        server.close()
+    assert rc == 0, err
+    assert server.writes and server.writes[-1] == pytest.approx(21.5)
+
+
+def test_a_sensor_sending_only_partial_lines_is_reported_and_the_run_ends_safely(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A sensor that sends bytes but never a line end: one warning (the cut line kept
+    aside), the sensor reported as stopped, nothing recorded from it; the run ends at
+    the program's end with the safe set-point."""
+    model = ChamberModel(time_scale=100.0)
+    sim = SimulatedChamber(model=model, scale=SCALE).start()
+    master, slave = os.openpty()
+    import tty
+
+    tty.setraw(slave)
+    device = os.ttyname(slave)
+    stop = threading.Event()
+
+    def feed() -> None:
+        fd = os.dup(master)
+        os.set_blocking(fd, False)
+        while not stop.wait(0.005):
+            try:
+                os.write(fd, b"0.05,25.0")  # never a line end
+            except OSError:
+                continue
+        os.close(fd)
+
+    threading.Thread(target=feed, daemon=True).start()
+    try:
+        toml = tmp_path / "st.toml"
+        prof = _profile(tmp_path, ((0.0, 300.0), (25.0, 25.0)))
+        toml.write_text(_toml(sim.port, device, part_s=0.5))
+        out = tmp_path / "rec"
+        rc, err = _run(capsys, toml, prof, out)
+    finally:
+        stop.set()
+        sim.stop()
+        for fd in (master, slave):
+            os.close(fd)
+    assert rc == 0, err
+    assert any(ln.startswith("warning: sensor imu: line 0 kept aside") and
+               "longer than 4096 bytes" in ln for ln in err), err  # fmt: skip
+    assert any(ln.startswith("warning: sensor imu (") and "stopped" in ln for ln in err), err
+    assert not list(out.glob("imu-*.parquet"))
+    assert sim.writes[-1][1] == pytest.approx(21.5)
+    assert (out / "imu.bad.txt").stat().st_size < 10_000
+
+
+def test_a_program_of_a_million_steps(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """10⁶ program points (a step every second for 11.6 days): refused before anything is
+    written, in one line naming the program and how many points it holds (it was run:
+    ``station.json``, which holds the program, became 20 MB, rewritten at every event,
+    and the loop skipped hundreds of steps between two turns)."""
+    model = ChamberModel(time_scale=100.0)
+    sim = SimulatedChamber(model=model, scale=SCALE).start()
+    sen = ScriptedSensor(["0.05,25.0"], rate_hz=50)
+    try:
+        toml = tmp_path / "st.toml"
+        toml.write_text(_toml(sim.port, sen.device, part_s=0.5))
+        prof = tmp_path / "p.csv"
+        n = 1_000_000
+        prof.write_text("time_s,setpoint_c\n" + "".join(
+            f"{i},{25 + (i % 2) * 10}\n" for i in range(n)))  # fmt: skip
+        before = _digest(toml, prof)
+        out = tmp_path / "rec"
+        t0 = time.monotonic()
+        rc, err = _run(capsys, toml, prof, out, k=1e5)  # run, it would end in 10 s
+        took = time.monotonic() - t0
+    finally:
+        sen.close()
+        sim.stop()
+    assert rc == 2 and len(err) == 1, err
+    assert err[0].startswith(f"error: {prof}: {n} program points; the station takes at most "
+                             "20000"), err  # fmt: skip
+    assert took < 30 and sim.writes == [] and not out.exists()
+    assert _digest(toml, prof) == before
+
+
+@pytest.mark.parametrize("where", ["/proc/thermocal-rec", "afile/rec", "ro/rec"])
+def test_an_output_folder_that_cannot_be_created_is_one_error_line(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], where: str
+) -> None:
+    """``-o`` on a read-only file system (``/proc``), under a file, or in a folder without
+    write permission (not for root): one line naming the folder and ``-o``; nothing
+    written to the chamber, the inputs unchanged."""
+    if where == "ro/rec" and os.geteuid() == 0:
+        pytest.skip("root writes into a folder without write permission")
+    if where.startswith("/proc") and not Path("/proc/self").exists():
+        pytest.skip("no /proc")
+    model = ChamberModel(time_scale=100.0)
+    sim = SimulatedChamber(model=model, scale=SCALE).start()
+    sen = ScriptedSensor(["0.05,25.0"], rate_hz=50)
+    (tmp_path / "afile").write_text("not a folder")
+    ro = tmp_path / "ro"
+    ro.mkdir()
+    ro.chmod(0o555)
+    out = Path(where) if where.startswith("/") else tmp_path / where
+    try:
+        toml, prof = tmp_path / "st.toml", _profile(tmp_path, HOT)
+        toml.write_text(_toml(sim.port, sen.device))
+        before = _digest(toml, prof, tmp_path / "afile")
+        rc, err = _run(capsys, toml, prof, out)
+    finally:
+        ro.chmod(0o755)
+        sen.close()
+        sim.stop()
+    assert rc == 2 and len(err) == 1, err
+    assert err[0].startswith(f"error: {out}: cannot create the recording folder ("), err
+    assert err[0].endswith("); give another -o"), err
+    assert sim.writes == [] and _digest(toml, prof, tmp_path / "afile") == before
+
+
+def test_a_fine_ramp_does_not_rewrite_station_json_for_every_setpoint(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A ramp of 40 °C written at 0.01 °C resolution: the chamber receives a new set-point
+    at every turn of the loop; station.json (rewritten and flushed to disk at each event)
+    must not grow by one event per set-point, or a day's ramps (10⁵ set-points) make every
+    write of it megabytes long and stall the loop."""
+    model = ChamberModel(time_scale=1000.0, tau_s=60.0)
+    sim = SimulatedChamber(model=model, scale=SCALE).start()
+    sen = ScriptedSensor(["0.05,25.0"], rate_hz=50)
+    try:
+        toml = tmp_path / "st.toml"
+        toml.write_text(_toml(sim.port, sen.device, part_s=0.5))
+        prof = _profile(tmp_path, ((0.0, 3000.0), (25.0, 65.0)))
+        out = tmp_path / "rec"
+        rc = main(["station", "run", str(toml), "--profile", str(prof), "-o", str(out),
+                   "--time-scale", "1000"])  # fmt: skip
+        err = capsys.readouterr().err
+    finally:
+        sen.close()
+        sim.stop()
+    assert rc == 0, err
+    ramp = [v for _t, v in sim.writes[:-1]]  # the last: the safe set-point
+    assert len(ramp) > 60, len(ramp)  # the loop wrote a new set-point at most turns
+    recorded = [e for e in _events(out) if e["kind"] == "setpoint"]
+    assert len(recorded) <= 40 / 1.0 + 5, len(recorded)  # at most one per °C of the ramp
+    # the last recorded set-point is within 1 °C of the last one written
+    assert abs(recorded[-1]["setpoint_c"] - ramp[-1]) <= 1.0
+    rows = pq.read_table(sorted(out.glob("chamber-*.parquet")), columns=["setpoint_c"])
+    assert set(rows["setpoint_c"].to_pylist()) <= set(ramp)  # every polled row as written
+    assert json.loads((out / "station.json").read_text())["events"][-1]["kind"] == "stop"
