@@ -1921,6 +1921,22 @@ MUTANTS: tuple[Mutant, ...] = (
         ST_ATT2,
         "-o on a read-only place: the OS error's text without the option to change",
     ),
+    Mutant(
+        "station-h39-wall-clock",
+        P + "station/clock.py",
+        "return _WALL0 + (time.monotonic() - _MONO0)",
+        "return time.time()",
+        ST_ATT2,
+        "the loop timed by the wall clock: a step back of an hour stalls the run an hour",
+    ),
+    Mutant(
+        "station-h39-clock-step-silent",
+        P + "station/run.py",
+        "if abs(jump) <= CLOCK_STEP_S:",
+        "if abs(jump) <= 1e9:",
+        ST_ATT2,
+        "a step of the host's clock not reported",
+    ),
 )
 
 

@@ -282,3 +282,49 @@ def test_a_fine_ramp_does_not_rewrite_station_json_for_every_setpoint(
     rows = pq.read_table(sorted(out.glob("chamber-*.parquet")), columns=["setpoint_c"])
     assert set(rows["setpoint_c"].to_pylist()) <= set(ramp)  # every polled row as written
     assert json.loads((out / "station.json").read_text())["events"][-1]["kind"] == "stop"
+
+
+def test_the_host_clock_stepped_back_an_hour(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """1 s into a run the host's clock is stepped back by an hour (``time.time()`` − 3600 s
+    for every caller in the process: the Modbus library's and the simulator's too).  The
+    run goes on and ends on time (300 s of program at K = 100: 3 s) with one warning
+    naming the step, the safe set-point written, the chamber polled all along and the
+    recording's times increasing (it stalled: the program time went back by 3.6e5 s, no
+    poll, no part, no end for an hour)."""
+    import signal
+
+    model = ChamberModel(time_scale=100.0)
+    sim = SimulatedChamber(model=model, scale=SCALE).start()
+    sen = ScriptedSensor(["0.05,25.0"], rate_hz=50)
+    real = time.time
+    t_step = real() + 1.0
+    monkeypatch.setattr(time, "time", lambda: (lambda t: t - 3600.0 if t >= t_step else t)(real()))
+    guard = threading.Timer(30.0, lambda: os.kill(os.getpid(), signal.SIGINT))  # a stall
+    try:
+        toml = tmp_path / "st.toml"
+        toml.write_text(_toml(sim.port, sen.device, part_s=0.5))
+        prof = _profile(tmp_path, ((0.0, 300.0), (25.0, 30.0)))
+        out = tmp_path / "rec"
+        t0 = time.monotonic()
+        guard.start()
+        rc, err = _run(capsys, toml, prof, out)
+        took = time.monotonic() - t0
+    finally:
+        guard.cancel()
+        monkeypatch.undo()
+        sen.close()
+        sim.stop()
+    assert rc == 0, err
+    assert took < 15, took
+    steps = [ln for ln in err if "clock was stepped" in ln]
+    assert len(steps) == 1 and steps[0].startswith(
+        "warning: the host's clock was stepped by -3600.0 s at program time "
+    ), err
+    assert sim.writes[-1][1] == pytest.approx(21.5)
+    ch = pq.read_table(sorted(out.glob("chamber-*.parquet")), columns=["time"])["time"]
+    assert len(ch) >= 15  # poll_s = 0.1 s over 3 s: polled after the step too
+    for name in ("time", "host_time"):
+        t = pq.read_table(sorted(out.glob("imu-*.parquet")), columns=[name])[name].to_numpy()
+        assert t.size > 100 and (t[1:] > t[:-1]).all() and t[-1] - t[0] < 10, name

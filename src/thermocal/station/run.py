@@ -26,6 +26,7 @@ from typing import TYPE_CHECKING, Any, Protocol
 
 from thermocal.errors import ThermocalInputError
 from thermocal.readers.station import CHAMBER_STREAM, closed_parts
+from thermocal.station import clock
 from thermocal.station.chamber import Chamber, ChamberError, make_chamber
 from thermocal.station.config import ChamberConfig, StationConfig
 from thermocal.station.recorder import Recorder
@@ -56,6 +57,9 @@ megabytes long.  The chamber stream's rows hold every set-point polled."""
 
 SETPOINT_EVENT_S = 60.0
 """Longest host time between two recorded ``setpoint`` events while the set-point moves [s]."""
+
+CLOCK_STEP_S = 1.0
+"""A step of the host's wall clock larger than this between two turns is reported [s]."""
 
 CLOCK_CHECK_S = 2.0
 """Host seconds of lines after which a sensor's time is compared with the host clock [s]."""
@@ -236,9 +240,10 @@ class _Loop:
         self.hold: tuple[int, float, bool] | None = None
         self.hold_polls = 0
         self.step = -1
-        self.t_run = time.time()
+        self.t_run = clock.now()
         self.next_poll = self.t_run
         self.p = p0
+        self.wall_step = clock.wall_step()
 
     def start(self) -> None:
         """Connect the chamber (its first temperature), open and start the sensors."""
@@ -254,7 +259,7 @@ class _Loop:
         self.rec.event("start", f"chamber {self.chamber.name}, sensors " + ", ".join(
             s.cfg.id for s in self.sensors), program_s=self.p0,
             time_scale=self.time_scale)  # fmt: skip
-        self.t_run = time.time()
+        self.t_run = clock.now()
         self.next_poll = self.t_run
 
     def _stop_asked(self, should_stop: Callable[[], bool | str] | None) -> str:
@@ -269,7 +274,8 @@ class _Loop:
         """The loop: every ``LOOP_S`` at most, the program's step and set-point, the
         chamber's poll, drift, the sensors' lines, part rotation and the display."""
         while True:
-            now = time.time()
+            now = clock.now()
+            self._clock_step(p=self.p)
             p = self.p = self.p0 + (now - self.t_run) * self.time_scale
             why = self._stop_asked(should_stop)
             if p >= self.end_s or why:
@@ -291,6 +297,20 @@ class _Loop:
             state.samples, state.parts = sum(self.samples.values()), len(self.parts)
             self.disp.update(state)
             time.sleep(LOOP_S)
+
+    def _clock_step(self, p: float) -> None:
+        """A ``warning:`` when the host's wall clock was stepped by more than
+        :data:`CLOCK_STEP_S` since the last turn: the run goes on by the station's clock
+        (:mod:`thermocal.station.clock`), unmoved."""
+        step = clock.wall_step()
+        jump, self.wall_step = step - self.wall_step, step
+        if abs(jump) <= CLOCK_STEP_S:
+            return
+        msg = (f"warning: the host's clock was stepped by {jump:+.1f} s at program time "
+               f"{p:.1f} s; the station keeps its own clock: the program, the polls and the "
+               "recorded times go on unmoved")  # fmt: skip
+        self.rec.event("clock", msg, step_s=jump, program_s=p)
+        self.disp.log(msg)
 
     def _program_step(self, p: float) -> None:
         """Log and record a new program step when ``p`` [s] enters one."""

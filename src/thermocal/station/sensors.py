@@ -1,6 +1,6 @@
 """Serial sensors: one text line per sample, read by a thread per port (pyserial).
 
-Every line gets the host's wall-clock time [s] (``time.time()``) when its bytes are read;
+Every line gets the host's time [s] (:func:`thermocal.station.clock.now`) when its bytes are read;
 lines read in one chunk share it.  A line is parsed with the text-log rules of
 :mod:`thermocal.readers` (INTERFACE.md common rules): the fields split at the stated delimiter
 (or the first of ``,`` ``;`` tab blanks that gives one field per name), numbers as a CSV
@@ -17,10 +17,10 @@ import collections
 import contextlib
 import math
 import threading
-import time
 from dataclasses import dataclass, field
 from typing import Any
 
+from thermocal.station import clock
 from thermocal.station.config import SensorConfig, require
 
 DELIMITERS = (",", ";", "\t", " ")
@@ -197,7 +197,7 @@ class SerialSensor:
                 if last:
                     return
                 continue
-            t = time.time()
+            t = clock.now()
             if skipping:  # the rest of an overlong line, up to its end
                 if b"\n" not in data:
                     continue
