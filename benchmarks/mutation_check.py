@@ -1902,7 +1902,7 @@ MUTANTS: tuple[Mutant, ...] = (
         P + "station/run.py",
         "if (last is not None and last[2] == self.step and abs(",
         "if (last is not None and abs(",
-        ST_ATT,
+        ST_ATT2,
         "a hold's set-point within 1 °C of the ramp's last not recorded: a kill reports 64.x °C",
     ),
     Mutant(
@@ -1936,6 +1936,14 @@ MUTANTS: tuple[Mutant, ...] = (
         "if abs(jump) <= 1e9:",
         ST_ATT2,
         "a step of the host's clock not reported",
+    ),
+    Mutant(
+        "station-h39-shared-register-accepted",
+        P + "station/config.py",
+        'if c.register_kind == "holding" and c.setpoint_register == c.temperature_register:',
+        "if False:",
+        ST_ATT2,
+        "one holding register for set-point and temperature: the set-point read back as T",
     ),
 )
 

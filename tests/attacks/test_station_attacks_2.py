@@ -23,7 +23,18 @@ import pytest
 pytest.importorskip("pymodbus")
 pytest.importorskip("serial")
 
-from test_station_attacks import HOT, SCALE, ScriptedSensor, _digest, _events, _profile, _toml
+from test_station_attacks import (
+    HOT,
+    SCALE,
+    ScriptedSensor,
+    _digest,
+    _end,
+    _events,
+    _profile,
+    _spawn,
+    _toml,
+    _wait,
+)
 
 from thermocal.cli import main
 from thermocal.station.sim import ChamberModel, SimulatedChamber
@@ -161,7 +172,7 @@ def test_a_sensor_sending_only_partial_lines_is_reported_and_the_run_ends_safely
         os.set_blocking(fd, False)
         while not stop.wait(0.005):
             try:
-                os.write(fd, b"0.05,25.0")  # never a line end
+                os.write(fd, b"0.05,25.0," * 100)  # 1 kB, never a line end
             except OSError:
                 continue
         os.close(fd)
@@ -328,3 +339,78 @@ def test_the_host_clock_stepped_back_an_hour(
     for name in ("time", "host_time"):
         t = pq.read_table(sorted(out.glob("imu-*.parquet")), columns=[name])[name].to_numpy()
         assert t.size > 100 and (t[1:] > t[:-1]).all() and t[-1] - t[0] < 10, name
+
+
+def test_a_kill_during_the_hold_after_a_ramp_reports_the_holds_setpoint(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """25 °C, a step to 64.2 °C, a ramp to 65 °C and a hold; SIGKILL in the hold.  Along
+    a ramp set-points are recorded every 1 °C only (the whole ramp is 0.8 °C), but a new
+    program step's first one always: ``--resume`` says the chamber was left at 65.00 °C,
+    the set-point the server received last (not the ramp's first, 64.2x °C)."""
+    model = ChamberModel(time_scale=1000.0, tau_s=60.0)
+    sim = SimulatedChamber(model=model, scale=SCALE).start()
+    sen = ScriptedSensor(["0.05,25.0"], rate_hz=50)
+    program = ((0.0, 100.0, 101.0, 2000.0, 30000.0), (25.0, 25.0, 64.2, 65.0, 65.0))
+    try:
+        toml, prof = tmp_path / "st.toml", _profile(tmp_path, program)
+        toml.write_text(_toml(sim.port, sen.device, part_s=0.3))
+        out = tmp_path / "rec"
+        proc = _spawn(["station", "run", str(toml), "--profile", str(prof), "-o", str(out),
+                       "--time-scale", "1000"])  # fmt: skip
+        try:
+            _wait(lambda: sim.writes and sim.writes[-1][1] == 65.0, 60, "the hold's set-point")
+            time.sleep(0.3)
+            proc.kill()
+            proc.communicate(timeout=10)
+        finally:
+            _end(proc)
+        last = sim.writes[-1][1]
+        assert last == 65.0 and any(64.2 <= v < 64.5 for _t, v in sim.writes)
+        rc = main(["station", "run", str(toml), "--profile", str(prof), "-o", str(out),
+                   "--resume", "--time-scale", "1e5"])  # fmt: skip
+        err = capsys.readouterr().err.splitlines()
+    finally:
+        sen.close()
+        sim.stop()
+    assert rc == 0, err
+    assert (
+        "warning: the last run was killed (no stop record: SIGKILL, a power cut or a crash); "
+        f"the chamber was left at {last:.2f} °C, the last set-point recorded"
+    ) in err, err
+
+
+@pytest.mark.parametrize(("kind", "refused"), [("holding", True), ("input", False)])
+def test_one_register_for_the_setpoint_and_the_temperature(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], kind: str, refused: bool
+) -> None:
+    """``setpoint_register = temperature_register = 300``, holding: the station would read
+    back its own set-point as the chamber's temperature (a chamber that follows perfectly,
+    whatever it does): ``check`` and ``run`` refuse it in one line naming the file and the
+    register, nothing written.  An input register of the same address is another register
+    (Modbus keeps them apart): accepted."""
+    model = ChamberModel(time_scale=100.0)
+    sim = SimulatedChamber(model=model, scale=SCALE).start()
+    sen = ScriptedSensor(["0.05,25.0"], rate_hz=50)
+    try:
+        toml, prof = tmp_path / "st.toml", _profile(tmp_path, ((0.0, 100.0), (25.0, 25.0)))
+        text = _toml(sim.port, sen.device, part_s=0.5)
+        text = text.replace("temperature_register = 100", "temperature_register = 300")
+        toml.write_text(text.replace('register_kind = "input"', f'register_kind = "{kind}"'))
+        before = _digest(toml, prof)
+        rc_check = main(["station", "check", str(toml), "--listen", "0.3"])
+        check_err = capsys.readouterr().err.strip().splitlines()
+        out = tmp_path / "rec"
+        rc, err = _run(capsys, toml, prof, out)
+    finally:
+        sen.close()
+        sim.stop()
+    assert _digest(toml, prof) == before
+    if not refused:
+        assert rc == 0 and rc_check == 0, (err, check_err)
+        return
+    for code, lines in ((rc_check, check_err), (rc, err)):
+        assert code == 2 and len(lines) == 1, lines
+        words = "setpoint_register and temperature_register are both holding register 300"
+        assert lines[0].startswith(f"error: {toml} [chamber]: {words}"), lines
+    assert sim.writes == [] and not out.exists()

@@ -373,7 +373,7 @@ class _Loop:
                 self.chamber.write_setpoint(target)
                 self.sp = target
                 self.setpoints.append((p, target))
-                self._record_setpoint(now, p, target)
+            self._record_setpoint(now, p)
             if now >= self.next_poll:
                 self.next_poll = max(self.next_poll + ch_cfg.poll_s, now)
                 self.chamber_c = math.nan  # unknown until the chamber answers
@@ -401,10 +401,13 @@ class _Loop:
                 ) from None
             self.next_poll = now + min(ch_cfg.poll_s, 0.5)
 
-    def _record_setpoint(self, now: float, p: float, target: float) -> None:
-        """A ``setpoint`` event for a step's first set-point, and along a ramp every
-        :data:`SETPOINT_EVENT_C` or :data:`SETPOINT_EVENT_S` (not for every write)."""
-        last = self.sp_recorded
+    def _record_setpoint(self, now: float, p: float) -> None:
+        """A ``setpoint`` event for the set-point in force (written) at a program step's
+        first turn, and along a ramp every :data:`SETPOINT_EVENT_C` or
+        :data:`SETPOINT_EVENT_S` (not for every write)."""
+        last, target = self.sp_recorded, self.sp
+        if target != target or (last is not None and last[0] == target):
+            return
         if (last is not None and last[2] == self.step and abs(target - last[0]) < SETPOINT_EVENT_C
                 and now - last[1] < SETPOINT_EVENT_S):  # fmt: skip
             return
