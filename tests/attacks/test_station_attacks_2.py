@@ -414,3 +414,56 @@ def test_one_register_for_the_setpoint_and_the_temperature(
         words = "setpoint_register and temperature_register are both holding register 300"
         assert lines[0].startswith(f"error: {toml} [chamber]: {words}"), lines
     assert sim.writes == [] and not out.exists()
+
+
+def test_a_flooding_sensor_does_not_stall_the_chamber(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A sensor that sends lines as fast as the pseudo-terminal takes them (64 kB chunks
+    of good lines, declared at 50 Hz): the run still ends on time with the safe set-point,
+    the chamber polled all along (poll_s = 0.1 s over 3 s: no gap of 0.3 s; 26 000 lines/s
+    stretched them to 0.5 s, the loop recording every line that came at each turn), and a
+    warning that the lines arrive far faster than ``rate_hz`` (the time is wrong)."""
+    import tty
+
+    model = ChamberModel(time_scale=100.0)
+    sim = SimulatedChamber(model=model, scale=SCALE).start()
+    master, slave = os.openpty()
+    tty.setraw(slave)
+    stop = threading.Event()
+    sent = [0]
+
+    def feed() -> None:
+        chunk = b"0.0500,25.000\r\n" * 4096
+        while not stop.is_set():
+            try:
+                sent[0] += os.write(master, chunk)
+            except BlockingIOError:
+                time.sleep(0.001)
+            except OSError:
+                return
+
+    os.set_blocking(master, False)
+    threading.Thread(target=feed, daemon=True).start()
+    try:
+        toml = tmp_path / "st.toml"
+        prof = _profile(tmp_path, ((0.0, 300.0), (25.0, 30.0)))
+        toml.write_text(_toml(sim.port, os.ttyname(slave), part_s=0.5))
+        out = tmp_path / "rec"
+        t0 = time.monotonic()
+        rc, err = _run(capsys, toml, prof, out)
+        took = time.monotonic() - t0
+    finally:
+        stop.set()
+        time.sleep(0.05)
+        sim.stop()
+        for fd in (master, slave):
+            os.close(fd)
+    assert rc == 0, err
+    assert took < 10, took
+    assert sim.writes[-1][1] == pytest.approx(21.5)
+    ch = pq.read_table(sorted(out.glob("chamber-*.parquet")), columns=["time"])["time"]
+    assert len(ch) >= 20 and float(max(ch.to_numpy()[1:] - ch.to_numpy()[:-1])) < 0.3
+    lines_per_s = sent[0] / 15 / took  # bytes sent / bytes per line / seconds: ≫ 50
+    assert lines_per_s > 1000
+    assert any(ln.startswith("warning: sensor imu: its time advances") for ln in err), err

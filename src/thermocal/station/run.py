@@ -30,7 +30,7 @@ from thermocal.station import clock
 from thermocal.station.chamber import Chamber, ChamberError, make_chamber
 from thermocal.station.config import ChamberConfig, StationConfig
 from thermocal.station.recorder import Recorder
-from thermocal.station.sensors import Bad, SerialSensor
+from thermocal.station.sensors import MAX_BACKLOG, Bad, SerialSensor
 
 if TYPE_CHECKING:
     import numpy as np
@@ -57,6 +57,16 @@ megabytes long.  The chamber stream's rows hold every set-point polled."""
 
 SETPOINT_EVENT_S = 60.0
 """Longest host time between two recorded ``setpoint`` events while the set-point moves [s]."""
+
+ROWS_PER_TURN = 2000
+"""Most lines of one sensor recorded per turn of the loop: a flooding sensor leaves the
+rest for the next turns instead of delaying the chamber's polls and the stop requests
+(26 000 lines/s stretched the polls to 0.5 s; a little more made the turns diverge)."""
+
+SWITCH_S = 0.0005
+"""Python's thread switch interval during a run [s] (default 0.005): the loop's every
+blocking call (a Modbus request, a write) waits up to this long for the interpreter lock
+when a flooding sensor's thread holds it, dozens of times a turn."""
 
 CLOCK_STEP_S = 1.0
 """A step of the host's wall clock larger than this between two turns is reported [s]."""
@@ -223,6 +233,7 @@ class _Loop:
         self.bad = {s.id: 0 for s in cfg.sensors}
         self.parts: list[str] = []
         self.stopped = {s.id: False for s in cfg.sensors}
+        self.dropped_warned: dict[str, bool] = {}
         self.anchors: dict[str, float] = {}
         self.clock_first: dict[str, tuple[float, float]] = {}
         self.clock_checked: set[str] = set()
@@ -502,7 +513,15 @@ class _Loop:
         rec, views = self.rec, []
         for s in self.sensors:
             sid = s.cfg.id
-            got, bads = s.drain()
+            got, bads = s.drain(ROWS_PER_TURN)
+            if s.stats.dropped and not self.dropped_warned.get(sid):
+                self.dropped_warned[sid] = True
+                msg = (f"warning: sensor {sid}: lines arrive faster than the station can record "
+                       f"them ({s.stats.rate_hz():.0f} per s): lines beyond "
+                       f"{MAX_BACKLOG} waiting are dropped and counted; check the sensor's "
+                       "output rate")  # fmt: skip
+                rec.event("sensor", msg, sensor=sid, program_s=p)
+                self.disp.log(msg)
             if bads:
                 self.bad[sid] += len(bads)
                 rec.bad_lines(sid, [(b.host_unix, b.index, b.reason, b.text) for b in bads])
@@ -558,7 +577,8 @@ class _Loop:
             rec.event("stop", f"ended: {self.ended}" + (f" ({self.stop_reason})" if
                       self.stop_reason else ""), program_s=self.p, ended=self.ended,
                       reason=self.stop_reason, safe_setpoint_c=self.safe,
-                      left_at_c=None if left != left else left)  # fmt: skip
+                      left_at_c=None if left != left else left,
+                      dropped={s.cfg.id: s.stats.dropped for s in self.sensors})  # fmt: skip
             self.chamber.close()
 
 
@@ -680,9 +700,12 @@ def run_station(
     rec, p0, previous = _open_recorder(cfg, t_prog, c_prog, out_dir, profile_source, resume,
                                        time_scale, disp)  # fmt: skip
     loop = _Loop(cfg, t_prog, c_prog, p0, time_scale, rec, chamber, disp)
+    switch = sys.getswitchinterval()
+    sys.setswitchinterval(SWITCH_S)  # a busy sensor thread hands the loop the GIL sooner
     try:
         loop.start()
     except BaseException:  # nothing was written to the chamber: no safe stop to make
+        sys.setswitchinterval(switch)
         loop.abandon()
         raise
     try:
@@ -695,6 +718,7 @@ def run_station(
             loop.finish()
         finally:
             rec.release()
+            sys.setswitchinterval(switch)
     return RunResult(out_dir, p0, loop.p, loop.parts, loop.samples, loop.bad, loop.ended,
                      loop.setpoints, loop.safe, list(rec.doc["events"]), loop.stop_reason,
                      previous)  # fmt: skip

@@ -32,6 +32,11 @@ READ_TIMEOUT_S = 0.1
 MAX_LINE = 4096
 """A line longer than this many bytes without an end is cut and kept aside as bad."""
 
+MAX_BACKLOG = 200_000
+"""Most good lines waiting for the station's loop; a sensor flooding faster than the loop
+records lines drops the newer ones beyond, counted (:attr:`SensorStats.dropped`), so that
+neither memory nor the loop's turns grow without bound."""
+
 
 class BadLine(ValueError):
     """A line that does not give one number per name."""
@@ -91,6 +96,7 @@ class SensorStats:
     last_values: tuple[float, ...] = ()
     first_line: str = ""
     error: str = ""
+    dropped: int = 0
     recent: collections.deque[float] = field(default_factory=lambda: collections.deque(maxlen=200))
 
     def rate_hz(self) -> float:
@@ -171,6 +177,9 @@ class SerialSensor:
             st.bad += 1
             self._bad.append(Bad(t, idx, text, str(exc)))
             return
+        if len(self._samples) >= MAX_BACKLOG:  # the loop cannot keep up: counted, not kept
+            st.dropped += 1
+            return
         st.good += 1
         st.last_unix = t
         st.last_values = values
@@ -213,11 +222,15 @@ class SerialSensor:
             if last:
                 return
 
-    def drain(self) -> tuple[list[Sample], list[Bad]]:
-        """The good and bad lines that arrived since the last call."""
+    def drain(self, most: int | None = None) -> tuple[list[Sample], list[Bad]]:
+        """The good lines that arrived since the last call (the ``most`` oldest of them; the
+        rest wait for the next call) and the bad ones."""
         with self._lock:
-            s, b = self._samples, self._bad
-            self._samples, self._bad = [], []
+            if most is None or len(self._samples) <= most:
+                s, self._samples = self._samples, []
+            else:
+                s, self._samples = self._samples[:most], self._samples[most:]
+            b, self._bad = self._bad, []
         return s, b
 
     def close(self) -> None:
