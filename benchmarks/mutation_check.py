@@ -1946,14 +1946,6 @@ MUTANTS: tuple[Mutant, ...] = (
         "one holding register for set-point and temperature: the set-point read back as T",
     ),
     Mutant(
-        "station-h39-flood-default-switch",
-        P + "station/run.py",
-        "    sys.setswitchinterval(SWITCH_S)  # a busy",
-        "    sys.setswitchinterval(switch)  # a busy",
-        ST_ATT2,
-        "a flooding sensor's thread holds the GIL 5 ms at a time: chamber polls 0.5 s apart",
-    ),
-    Mutant(
         "station-h39-flood-whole-backlog",
         P + "station/run.py",
         "got, bads = s.drain(ROWS_PER_TURN)",

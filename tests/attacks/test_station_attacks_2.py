@@ -421,8 +421,9 @@ def test_a_flooding_sensor_does_not_stall_the_chamber(
 ) -> None:
     """A sensor that sends lines as fast as the pseudo-terminal takes them (64 kB chunks
     of good lines, declared at 50 Hz): the run still ends on time with the safe set-point,
-    the chamber polled all along (poll_s = 0.1 s over 3 s: no gap of 0.3 s; 26 000 lines/s
-    stretched them to 0.5 s, the loop recording every line that came at each turn), and a
+    the chamber polled all along (poll_s = 0.1 s over 3 s: 20 polls, no gap of 0.45 s;
+    26 000 lines/s gave 11 polls up to 0.51 s apart, the loop recording every line that came
+    at each turn), and a
     warning that the lines arrive far faster than ``rate_hz`` (the time is wrong)."""
     import tty
 
@@ -463,7 +464,8 @@ def test_a_flooding_sensor_does_not_stall_the_chamber(
     assert took < 10, took
     assert sim.writes[-1][1] == pytest.approx(21.5)
     ch = pq.read_table(sorted(out.glob("chamber-*.parquet")), columns=["time"])["time"]
-    assert len(ch) >= 20 and float(max(ch.to_numpy()[1:] - ch.to_numpy()[:-1])) < 0.3
+    # measured at load average 6-7: 25-28 polls, gaps 0.24-0.39 s (before: 11, 0.51 s)
+    assert len(ch) >= 20 and float(max(ch.to_numpy()[1:] - ch.to_numpy()[:-1])) < 0.45
     lines_per_s = sent[0] / 15 / took  # bytes sent / bytes per line / seconds: ≫ 50
     assert lines_per_s > 1000
     assert any(ln.startswith("warning: sensor imu: its time advances") for ln in err), err
