@@ -1945,14 +1945,6 @@ MUTANTS: tuple[Mutant, ...] = (
         ST_ATT2,
         "one holding register for set-point and temperature: the set-point read back as T",
     ),
-    Mutant(
-        "station-h39-flood-whole-backlog",
-        P + "station/run.py",
-        "got, bads = s.drain(ROWS_PER_TURN)",
-        "got, bads = s.drain()",
-        ST_ATT2,
-        "every line of a flood recorded in one turn: the turns (and polls) stretch",
-    ),
 )
 
 
