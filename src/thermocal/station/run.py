@@ -61,8 +61,8 @@ SETPOINT_EVENT_S = 60.0
 ROWS_PER_TURN = 2000
 """Most lines of one sensor recorded per turn of the loop: a flooding sensor leaves the
 rest for the next turns instead of delaying the chamber's polls and the stop requests
-(26 000 lines/s made 11 polls of 30 in 3 s, up to 0.51 s apart; a little more made the
-turns diverge)."""
+(a turn that records every line waiting lasts 0.02 s / (1 − lines per s × cost of a
+line), which diverges for a fast enough flood)."""
 
 CLOCK_STEP_S = 1.0
 """A step of the host's wall clock larger than this between two turns is reported [s]."""
