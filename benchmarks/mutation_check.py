@@ -102,6 +102,8 @@ H39A = _t(
 H39A_ATT = _t("tests/attacks/test_allan_attacks.py")
 H39A_EDF = _t("mutants_stability", "total_edf_stable32", "noise_terms_theo1_edf")
 H39MP = _t("mutants_multipos", "tests/attacks/test_multipos_attacks.py")
+ADEQ_H39 = ("tests/test_mutants_adequacy.py", *ADEQ)
+ST_ATT2 = ("tests/attacks/test_station_attacks_2.py",)
 
 
 MUTANTS: tuple[Mutant, ...] = (
@@ -2851,6 +2853,112 @@ MUTANTS: tuple[Mutant, ...] = (
         "or t[s.end - 1] - t[s.start] < 0.0]",
         H39MP,
         "multipos: a named pose of three samples used without a word",
+    ),
+    # issue 39 slice h39-station
+    Mutant(
+        "adequacy-h39-any-override-passes",
+        P + "adequacy.py",
+        "t.override is None or t.override not in self.overrides",
+        "t.override is None or not self.overrides",
+        ADEQ_H39,
+        "any override (--allow-motion) passes every adequacy test (a narrow sweep too)",
+    ),
+    Mutant(
+        "adequacy-h39-n-equals-p-overridable",
+        P + "adequacy.py",
+        "if n_samples <= n_coefficients:",
+        "if n_samples < n_coefficients:",
+        ADEQ_H39,
+        "n = p samples (the fit passes through them) refused only unless --allow-narrow",
+    ),
+    Mutant(
+        "adequacy-h39-too-few-bins-overridable",
+        P + "adequacy.py",
+        'verdict, override = "fail", None\n        msg = (\n            f"{name} holds {distinct}',
+        'verdict, override = "fail", ALLOW_NARROW\n'
+        '        msg = (\n            f"{name} holds {distinct}',
+        ADEQ_H39,
+        "fewer distinct temperatures than coefficients fitted with --allow-narrow",
+    ),
+    Mutant(
+        "adequacy-h39-best-stillness",
+        P + "adequacy.py",
+        "return max(tests, key=lambda t: (rank[t.verdict], t.figure or 0.0))",
+        "return min(tests, key=lambda t: (rank[t.verdict], t.figure or 0.0))",
+        ADEQ_H39,
+        "of several runs, the stillest run's verdict recorded (a moving run passes)",
+    ),
+    Mutant(
+        "adequacy-h39-first-run-stillness",
+        P + "adequacy.py",
+        "tests.append(_worst_stillness(per_run))",
+        "tests.append(per_run[0])",
+        ADEQ_H39,
+        "of several runs, only the first run's stillness judged",
+    ),
+    Mutant(
+        "adequacy-h39-stillness-figure-ignored",
+        P + "adequacy.py",
+        "key=lambda t: (rank[t.verdict], t.figure or 0.0))",
+        "key=lambda t: rank[t.verdict])",
+        ADEQ_H39,
+        "of runs with one verdict, the first one's figure kept, not the worst",
+    ),
+    Mutant(
+        "station-h39-setpoint-event-every-write",
+        P + "station/run.py",
+        "SETPOINT_EVENT_C = 1.0",
+        "SETPOINT_EVENT_C = 0.0",
+        ST_ATT2,
+        "every set-point of a fine ramp an event: station.json rewritten 10⁵ times a day",
+    ),
+    Mutant(
+        "station-h39-setpoint-event-step-ignored",
+        P + "station/run.py",
+        "if (last is not None and last[2] == self.step and abs(",
+        "if (last is not None and abs(",
+        ST_ATT2,
+        "a hold's set-point within 1 °C of the ramp's last not recorded: a kill reports 64.x °C",
+    ),
+    Mutant(
+        "station-h39-program-points-unbounded",
+        P + "station/run.py",
+        "if t_prog.size > MAX_PROGRAM_POINTS:",
+        "if t_prog.size > 100 * MAX_PROGRAM_POINTS:",
+        ST_ATT2,
+        "a program of 10⁶ points run: a 20 MB station.json rewritten at every event",
+    ),
+    Mutant(
+        "station-h39-output-folder-oserror-raw",
+        P + "station/recorder.py",
+        "            except OSError as exc:  # a read-only place, a file in the way, no such mount",
+        "            except ValueError as exc:  # a read-only place",
+        ST_ATT2,
+        "-o on a read-only place: the OS error's text without the option to change",
+    ),
+    Mutant(
+        "station-h39-wall-clock",
+        P + "station/clock.py",
+        "return _WALL0 + (time.monotonic() - _MONO0)",
+        "return time.time()",
+        ST_ATT2,
+        "the loop timed by the wall clock: a step back of an hour stalls the run an hour",
+    ),
+    Mutant(
+        "station-h39-clock-step-silent",
+        P + "station/run.py",
+        "if abs(jump) <= CLOCK_STEP_S:",
+        "if abs(jump) <= 1e9:",
+        ST_ATT2,
+        "a step of the host's clock not reported",
+    ),
+    Mutant(
+        "station-h39-shared-register-accepted",
+        P + "station/config.py",
+        'if c.register_kind == "holding" and c.setpoint_register == c.temperature_register:',
+        "if False:",
+        ST_ATT2,
+        "one holding register for set-point and temperature: the set-point read back as T",
     ),
 )
 

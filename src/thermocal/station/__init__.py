@@ -12,7 +12,9 @@ run       the program loop: set-points, polling, stale sensors, the safe set-poi
 sim       a simulated chamber (a pymodbus server with first-order dynamics) and simulated
           serial sensors on pseudo-terminals, for tests, rehearsals and the demo.
 
-Units: temperatures [°C], times [s]; host time is the wall clock (``time.time()``) of the
-station PC, stored relative to the recording's start time (``station.json``).
+Units: temperatures [°C], times [s]; host time is the station PC's clock
+(:func:`thermocal.station.clock.now`: the wall clock at the start plus the monotonic time
+since, unmoved by a step of the host's clock), stored relative to the recording's start
+time (``station.json``).
 pymodbus and pyserial are an optional extra: ``pip install 'thermocal[station]'``.
 """

@@ -251,6 +251,11 @@ def _chamber(t: dict[str, Any], where: str) -> ChamberConfig:
                 raise _err(w, f"{key} must be a register address 0..65535")
         if not 0 <= c.unit <= 247:
             raise _err(w, f"unit (slave id) must be 0..247, got {c.unit}")
+        if c.register_kind == "holding" and c.setpoint_register == c.temperature_register:
+            raise _err(w, f"setpoint_register and temperature_register are both holding "
+                       f"register {c.setpoint_register}: the station would read its own "
+                       "set-point back as the chamber's temperature; give the process value's "
+                       "register from the controller's manual")  # fmt: skip
     if driver == "modbus-rtu" and not c.device:
         raise _err(w, "driver modbus-rtu needs device (a serial port) and baud")
     return c

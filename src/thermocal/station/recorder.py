@@ -29,7 +29,6 @@ from __future__ import annotations
 import datetime as _dt
 import json
 import os
-import time
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -47,6 +46,7 @@ from thermocal.readers.station import (
     read_station_json,
     station_files,
 )
+from thermocal.station import clock
 from thermocal.station.config import StationConfig
 
 STATION_COLUMNS = {
@@ -164,12 +164,18 @@ class Recorder:
                     "another -o"
                 )
             self.created = not out_dir.exists()
-            out_dir.mkdir(parents=True, exist_ok=True)
-            self._lock()
+            try:
+                out_dir.mkdir(parents=True, exist_ok=True)
+                self._lock()
+            except OSError as exc:  # a read-only place, a file in the way, no such mount
+                raise ThermocalInputError(
+                    f"{out_dir}: cannot create the recording folder "
+                    f"({exc.strerror or type(exc).__name__}); give another -o"
+                ) from None
             if (out_dir / STATION_JSON).exists():  # another run started in between
                 self.release()
                 raise ThermocalInputError(f"{out_dir}: another station run started in it")
-            now = time.time()
+            now = clock.now()
             self.doc = {
                 "format": STATION_FORMAT,
                 "version": STATION_VERSION,
@@ -188,9 +194,9 @@ class Recorder:
             }
         self.start_unix = float(self.doc["start_unix"])
         self._declare_streams()
-        self.part_started = time.time()
+        self.part_started = clock.now()
         self.doc["runs"].append(
-            {"start_unix": time.time(), "time_scale": time_scale, "resumed": resume}
+            {"start_unix": clock.now(), "time_scale": time_scale, "resumed": resume}
         )
         self.save()
 
@@ -385,7 +391,7 @@ class Recorder:
             st.next_index += 1
             st.rows = 0
             st.data = {c: [] for c in st.columns}
-        self.part_started = time.time()
+        self.part_started = clock.now()
         if written:
             self.save()
         return written
@@ -396,7 +402,7 @@ class Recorder:
         return []
 
     def event(self, kind: str, message: str, **fields: Any) -> None:
-        now = time.time()
+        now = clock.now()
         self.doc["events"].append(
             {"time": self.rel(now), "kind": kind, "message": message, **fields}
         )

@@ -26,10 +26,11 @@ from typing import TYPE_CHECKING, Any, Protocol
 
 from thermocal.errors import ThermocalInputError
 from thermocal.readers.station import CHAMBER_STREAM, closed_parts
+from thermocal.station import clock
 from thermocal.station.chamber import Chamber, ChamberError, make_chamber
 from thermocal.station.config import ChamberConfig, StationConfig
 from thermocal.station.recorder import Recorder
-from thermocal.station.sensors import Bad, SerialSensor
+from thermocal.station.sensors import MAX_BACKLOG, Bad, SerialSensor
 
 if TYPE_CHECKING:
     import numpy as np
@@ -41,6 +42,30 @@ LOOP_S = 0.02
 """Longest sleep of the loop [s]: sensor lines are drained and stop requests seen at least
 this often."""
 
+
+MAX_PROGRAM_POINTS = 20_000
+"""Most points a program may hold: ``station.json`` (holding the program) is rewritten and
+flushed at every event; a controller's program holds a few hundred segments, a week at one
+point a minute 10 080 (10⁶ points made each rewrite 20 MB and stalled the loop)."""
+
+SETPOINT_EVENT_C = 1.0
+"""Along a ramp, a ``setpoint`` event (a rewrite of ``station.json``) is recorded when the
+set-point has moved this far from the last one recorded [°C] (or at a new program step, or
+after :data:`SETPOINT_EVENT_S`): a ramp at the register's 0.01 °C resolution writes a new
+set-point at every turn of the loop, 10⁵ a day, and one event each made every rewrite
+megabytes long.  The chamber stream's rows hold every set-point polled."""
+
+SETPOINT_EVENT_S = 60.0
+"""Longest host time between two recorded ``setpoint`` events while the set-point moves [s]."""
+
+ROWS_PER_TURN = 2000
+"""Most lines of one sensor recorded per turn of the loop: a flooding sensor leaves the
+rest for the next turns instead of delaying the chamber's polls and the stop requests
+(a turn that records every line waiting lasts 0.02 s / (1 − lines per s × cost of a
+line), which diverges for a fast enough flood)."""
+
+CLOCK_STEP_S = 1.0
+"""A step of the host's wall clock larger than this between two turns is reported [s]."""
 
 CLOCK_CHECK_S = 2.0
 """Host seconds of lines after which a sensor's time is compared with the host clock [s]."""
@@ -199,10 +224,12 @@ class _Loop:
         self.sensors = [SerialSensor(s) for s in cfg.sensors]
         self.state = StationState(n_steps=len(t_prog) - 1, end_s=self.end_s, time_scale=time_scale)
         self.setpoints: list[tuple[float, float]] = []
+        self.sp_recorded: tuple[float, float, int] | None = None  # °C, host s, step
         self.samples = {s.id: 0 for s in cfg.sensors} | {CHAMBER_STREAM: 0}
         self.bad = {s.id: 0 for s in cfg.sensors}
         self.parts: list[str] = []
         self.stopped = {s.id: False for s in cfg.sensors}
+        self.dropped_warned: dict[str, bool] = {}
         self.anchors: dict[str, float] = {}
         self.clock_first: dict[str, tuple[float, float]] = {}
         self.clock_checked: set[str] = set()
@@ -220,9 +247,10 @@ class _Loop:
         self.hold: tuple[int, float, bool] | None = None
         self.hold_polls = 0
         self.step = -1
-        self.t_run = time.time()
+        self.t_run = clock.now()
         self.next_poll = self.t_run
         self.p = p0
+        self.wall_step = clock.wall_step()
 
     def start(self) -> None:
         """Connect the chamber (its first temperature), open and start the sensors."""
@@ -238,7 +266,7 @@ class _Loop:
         self.rec.event("start", f"chamber {self.chamber.name}, sensors " + ", ".join(
             s.cfg.id for s in self.sensors), program_s=self.p0,
             time_scale=self.time_scale)  # fmt: skip
-        self.t_run = time.time()
+        self.t_run = clock.now()
         self.next_poll = self.t_run
 
     def _stop_asked(self, should_stop: Callable[[], bool | str] | None) -> str:
@@ -253,7 +281,8 @@ class _Loop:
         """The loop: every ``LOOP_S`` at most, the program's step and set-point, the
         chamber's poll, drift, the sensors' lines, part rotation and the display."""
         while True:
-            now = time.time()
+            now = clock.now()
+            self._clock_step(p=self.p)
             p = self.p = self.p0 + (now - self.t_run) * self.time_scale
             why = self._stop_asked(should_stop)
             if p >= self.end_s or why:
@@ -275,6 +304,20 @@ class _Loop:
             state.samples, state.parts = sum(self.samples.values()), len(self.parts)
             self.disp.update(state)
             time.sleep(LOOP_S)
+
+    def _clock_step(self, p: float) -> None:
+        """A ``warning:`` when the host's wall clock was stepped by more than
+        :data:`CLOCK_STEP_S` since the last turn: the run goes on by the station's clock
+        (:mod:`thermocal.station.clock`), unmoved."""
+        step = clock.wall_step()
+        jump, self.wall_step = step - self.wall_step, step
+        if abs(jump) <= CLOCK_STEP_S:
+            return
+        msg = (f"warning: the host's clock was stepped by {jump:+.1f} s at program time "
+               f"{p:.1f} s; the station keeps its own clock: the program, the polls and the "
+               "recorded times go on unmoved")  # fmt: skip
+        self.rec.event("clock", msg, step_s=jump, program_s=p)
+        self.disp.log(msg)
 
     def _program_step(self, p: float) -> None:
         """Log and record a new program step when ``p`` [s] enters one."""
@@ -337,7 +380,7 @@ class _Loop:
                 self.chamber.write_setpoint(target)
                 self.sp = target
                 self.setpoints.append((p, target))
-                rec.event("setpoint", f"{target:.3f} °C", program_s=p, setpoint_c=target)
+            self._record_setpoint(now, p)
             if now >= self.next_poll:
                 self.next_poll = max(self.next_poll + ch_cfg.poll_s, now)
                 self.chamber_c = math.nan  # unknown until the chamber answers
@@ -364,6 +407,19 @@ class _Loop:
                     f"continue with --resume"
                 ) from None
             self.next_poll = now + min(ch_cfg.poll_s, 0.5)
+
+    def _record_setpoint(self, now: float, p: float) -> None:
+        """A ``setpoint`` event for the set-point in force (written) at a program step's
+        first turn, and along a ramp every :data:`SETPOINT_EVENT_C` or
+        :data:`SETPOINT_EVENT_S` (not for every write)."""
+        last, target = self.sp_recorded, self.sp
+        if target != target or (last is not None and last[0] == target):
+            return
+        if (last is not None and last[2] == self.step and abs(target - last[0]) < SETPOINT_EVENT_C
+                and now - last[1] < SETPOINT_EVENT_S):  # fmt: skip
+            return
+        self.sp_recorded = (target, now, self.step)
+        self.rec.event("setpoint", f"{target:.3f} °C", program_s=p, setpoint_c=target)
 
     def _drift(self, p: float) -> None:
         """Warn once when the chamber stays beyond ``tolerance_c`` of its set-point for
@@ -453,7 +509,15 @@ class _Loop:
         rec, views = self.rec, []
         for s in self.sensors:
             sid = s.cfg.id
-            got, bads = s.drain()
+            got, bads = s.drain(ROWS_PER_TURN)
+            if s.stats.dropped and not self.dropped_warned.get(sid):
+                self.dropped_warned[sid] = True
+                msg = (f"warning: sensor {sid}: lines arrive faster than the station can record "
+                       f"them ({s.stats.rate_hz():.0f} per s): lines beyond "
+                       f"{MAX_BACKLOG} waiting are dropped and counted; check the sensor's "
+                       "output rate")  # fmt: skip
+                rec.event("sensor", msg, sensor=sid, program_s=p)
+                self.disp.log(msg)
             if bads:
                 self.bad[sid] += len(bads)
                 rec.bad_lines(sid, [(b.host_unix, b.index, b.reason, b.text) for b in bads])
@@ -509,7 +573,8 @@ class _Loop:
             rec.event("stop", f"ended: {self.ended}" + (f" ({self.stop_reason})" if
                       self.stop_reason else ""), program_s=self.p, ended=self.ended,
                       reason=self.stop_reason, safe_setpoint_c=self.safe,
-                      left_at_c=None if left != left else left)  # fmt: skip
+                      left_at_c=None if left != left else left,
+                      dropped={s.cfg.id: s.stats.dropped for s in self.sensors})  # fmt: skip
             self.chamber.close()
 
 
@@ -555,7 +620,8 @@ def previous_run(events: list[dict[str, Any]]) -> tuple[str, bool]:
 
     A run that ended writes a ``stop`` event (how it ended, the safe set-point written or
     not); a run killed (SIGKILL, a power cut, a crash of the interpreter) leaves none: then
-    the chamber still holds the last set-point written (``setpoint`` events) [°C].
+    the chamber still holds the last set-point written: the last ``setpoint`` event [°C]
+    (along a ramp, within :data:`SETPOINT_EVENT_C` of it).
     """
     last_sp: float | None = None
     stop: dict[str, Any] | None = None
@@ -573,11 +639,11 @@ def previous_run(events: list[dict[str, Any]]) -> tuple[str, bool]:
         if not started:
             return "the last run never started", False
         return (f"the last run was killed (no stop record: SIGKILL, a power cut or a crash); "
-                f"the chamber was left at {where}, the last set-point written"), True  # fmt: skip
+                f"the chamber was left at {where}, the last set-point recorded"), True  # fmt: skip
     how = str(stop.get("ended", "?")) + (f" by {stop['reason']}" if stop.get("reason") else "")
     if stop.get("safe_setpoint_c") is None:
         return (f"the last run ended: {how}, WITHOUT the safe set-point; the chamber was "
-                f"left at {where}, the last set-point written"), True  # fmt: skip
+                f"left at {where}, the last set-point recorded"), True  # fmt: skip
     return f"the last run ended: {how}; the chamber was left at {where} (the safe set-point)", False
 
 
@@ -611,6 +677,12 @@ def run_station(
     t_prog = np.asarray(program[0], dtype=np.float64)
     c_prog = np.asarray(program[1], dtype=np.float64)
     ch_cfg = cfg.chamber
+    if t_prog.size > MAX_PROGRAM_POINTS:
+        raise ThermocalInputError(
+            f"{profile_source or 'the program'}: {t_prog.size} program points; the station "
+            f"takes at most {MAX_PROGRAM_POINTS} (the set-point is interpolated linearly "
+            "between points: a ramp needs only its two ends); resample the program"
+        )
     chamber = chamber or make_chamber(ch_cfg, disp.log)
     for t, c in zip(t_prog, c_prog, strict=True):  # before anything is written
         why = ch_cfg.out_of_range(float(c))

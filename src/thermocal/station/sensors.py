@@ -1,6 +1,6 @@
 """Serial sensors: one text line per sample, read by a thread per port (pyserial).
 
-Every line gets the host's wall-clock time [s] (``time.time()``) when its bytes are read;
+Every line gets the host's time [s] (:func:`thermocal.station.clock.now`) when its bytes are read;
 lines read in one chunk share it.  A line is parsed with the text-log rules of
 :mod:`thermocal.readers` (INTERFACE.md common rules): the fields split at the stated delimiter
 (or the first of ``,`` ``;`` tab blanks that gives one field per name), numbers as a CSV
@@ -17,10 +17,10 @@ import collections
 import contextlib
 import math
 import threading
-import time
 from dataclasses import dataclass, field
 from typing import Any
 
+from thermocal.station import clock
 from thermocal.station.config import SensorConfig, require
 
 DELIMITERS = (",", ";", "\t", " ")
@@ -31,6 +31,11 @@ READ_TIMEOUT_S = 0.1
 
 MAX_LINE = 4096
 """A line longer than this many bytes without an end is cut and kept aside as bad."""
+
+MAX_BACKLOG = 200_000
+"""Most good lines waiting for the station's loop; a sensor flooding faster than the loop
+records lines drops the newer ones beyond, counted (:attr:`SensorStats.dropped`), so that
+neither memory nor the loop's turns grow without bound."""
 
 
 class BadLine(ValueError):
@@ -91,6 +96,7 @@ class SensorStats:
     last_values: tuple[float, ...] = ()
     first_line: str = ""
     error: str = ""
+    dropped: int = 0
     recent: collections.deque[float] = field(default_factory=lambda: collections.deque(maxlen=200))
 
     def rate_hz(self) -> float:
@@ -171,6 +177,9 @@ class SerialSensor:
             st.bad += 1
             self._bad.append(Bad(t, idx, text, str(exc)))
             return
+        if len(self._samples) >= MAX_BACKLOG:  # the loop cannot keep up: counted, not kept
+            st.dropped += 1
+            return
         st.good += 1
         st.last_unix = t
         st.last_values = values
@@ -197,7 +206,7 @@ class SerialSensor:
                 if last:
                     return
                 continue
-            t = time.time()
+            t = clock.now()
             if skipping:  # the rest of an overlong line, up to its end
                 if b"\n" not in data:
                     continue
@@ -213,11 +222,15 @@ class SerialSensor:
             if last:
                 return
 
-    def drain(self) -> tuple[list[Sample], list[Bad]]:
-        """The good and bad lines that arrived since the last call."""
+    def drain(self, most: int | None = None) -> tuple[list[Sample], list[Bad]]:
+        """The good lines that arrived since the last call (the ``most`` oldest of them; the
+        rest wait for the next call) and the bad ones."""
         with self._lock:
-            s, b = self._samples, self._bad
-            self._samples, self._bad = [], []
+            if most is None or len(self._samples) <= most:
+                s, self._samples = self._samples, []
+            else:
+                s, self._samples = self._samples[:most], self._samples[most:]
+            b, self._bad = self._bad, []
         return s, b
 
     def close(self) -> None:
