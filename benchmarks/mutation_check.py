@@ -2235,6 +2235,14 @@ MUTANTS: tuple[Mutant, ...] = (
         "fit --rate-interval 0 refused for a 'Ṫ span' instead of naming the option",
     ),
     Mutant(
+        "audit-fit-run-twice",
+        P + "pipeline/fit.py",
+        "        if digest in seen:\n",
+        "        if str(path) in seen:\n",
+        AUDIT,
+        "fit a.csv a.csv (or a copy) counts one run twice, exit 0",
+    ),
+    Mutant(
         "audit-c-float-max",
         P + "export/c/core.py",
         'if self.real == "float" and abs(x) > FLT_MAX:',

@@ -547,6 +547,21 @@ def model_options(o: FitOptions) -> dict[str, Any]:
     }
 
 
+def _distinct_runs(paths: Sequence[Path]) -> None:
+    """Refuse a run given twice, by name or as a byte-for-byte copy (the same SHA-256): it
+    would count twice, its samples weighing double and the standard errors shrunk by √2
+    (issue 39 audit: ``fit a.csv a.csv`` wrote ``n_runs`` 2, exit 0)."""
+    seen: dict[str, Path] = {}
+    for path in paths:
+        digest = _files.file_sha256(path)
+        if digest in seen:
+            raise ThermocalInputError(
+                f"{path}: the same bytes as {seen[digest]} (a file given twice, or a copy): "
+                "each run counts once in a fit; give every run's file once"
+            )
+        seen[digest] = path
+
+
 def _check_numbers(o: FitOptions) -> None:
     """Refuse the numeric options no fit can use, naming the option (issue 39 audit): a
     latitude outside ±90° (the earth rate Ω·sin φ of a latitude of 200° is that of −20°),
@@ -631,6 +646,7 @@ def fit_files(paths: Sequence[Path], options: FitOptions, output: Path) -> FitRe
         raise ThermocalInputError(
             f"--tref applies to the poly family (coefficients about TREF), not {o.model!r}"
         )
+    _distinct_runs([path for path, _rec in loaded])
     spec = _FitSpec(o.model, family_options, o.temps, o.latitude, o.axis, o.known_input,
                     o.target, o.gravity_axis, g_local, o.tref,
                     _gravity.triad_gravity(loaded, names, o.gravity_axis, g_local),
