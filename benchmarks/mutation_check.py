@@ -104,6 +104,7 @@ H39A_EDF = _t("mutants_stability", "total_edf_stable32", "noise_terms_theo1_edf"
 H39MP = _t("mutants_multipos", "tests/attacks/test_multipos_attacks.py")
 ADEQ_H39 = ("tests/test_mutants_adequacy.py", *ADEQ)
 ST_ATT2 = ("tests/attacks/test_station_attacks_2.py",)
+AUDIT = _t("tests/attacks/test_audit39_attacks.py")
 
 
 MUTANTS: tuple[Mutant, ...] = (
@@ -2959,6 +2960,103 @@ MUTANTS: tuple[Mutant, ...] = (
         "if False:",
         ST_ATT2,
         "one holding register for set-point and temperature: the set-point read back as T",
+    ),
+    # issue 39 slice h39-audit
+    Mutant(
+        "audit-fit-latitude-open",
+        P + "pipeline/fit.py",
+        "if o.latitude is not None and not -90.0 <= o.latitude <= 90.0:",
+        "if o.latitude is not None and not -90.0 <= o.latitude:",
+        AUDIT,
+        "fit --latitude 200 accepted: the earth rate of another latitude removed silently",
+    ),
+    Mutant(
+        "audit-fit-rcond-negative",
+        P + "pipeline/fit.py",
+        "if value is not None and not (np.isfinite(value) and value >= 0.0):",
+        "if value is not None and not (np.isfinite(value) and value >= -1.0):",
+        AUDIT,
+        "fit --rcond -1 accepted: the SVD truncation silently switched off",
+    ),
+    Mutant(
+        "audit-fit-breakpoints-empty",
+        P + "pipeline/fit.py",
+        'if o.breakpoints is not None and not split_floats(o.breakpoints, "--breakpoints"):',
+        'if o.breakpoints is not None and split_floats(o.breakpoints, "--breakpoints") is None:',
+        AUDIT,
+        "fit --model piecewise --breakpoints , writes a one-line model",
+    ),
+    Mutant(
+        "audit-fit-rate-interval-zero",
+        P + "pipeline/fit.py",
+        "(np.isfinite(o.rate_interval) and o.rate_interval > 0)",
+        "(np.isfinite(o.rate_interval) and o.rate_interval >= 0)",
+        AUDIT,
+        "fit --rate-interval 0 refused for a 'Ṫ span' instead of naming the option",
+    ),
+    Mutant(
+        "audit-fit-run-twice",
+        P + "pipeline/fit.py",
+        "        if digest in seen:\n",
+        "        if str(path) in seen:\n",
+        AUDIT,
+        "fit a.csv a.csv (or a copy) counts one run twice, exit 0",
+    ),
+    Mutant(
+        "audit-c-float-max",
+        P + "export/c/core.py",
+        'if self.real == "float" and abs(x) > FLT_MAX:',
+        'if self.real == "float" and abs(x) > 10.0 * FLT_MAX:',
+        AUDIT,
+        "export-c --float of a -1e39 constant: exit 1 from the compiler, files left",
+    ),
+    Mutant(
+        "audit-c-float-tiny-kept",
+        P + "export/c/core.py",
+        'if self.real == "float" and abs(x) < FLT_MIN:',
+        'if self.real == "float" and abs(x) < 0.0:',
+        AUDIT,
+        "export-c --float writes 1e-50f: the compiler's truncation warning fails the build",
+    ),
+    Mutant(
+        "audit-c-float-overflow-unsaid",
+        P + "export/c/files.py",
+        "if not math.isfinite(err.max_abs):",
+        'if err.max_abs > float("inf"):',
+        AUDIT,
+        "export-c --float whose float build gives inf: exit 0, the error shown as '—'",
+    ),
+    Mutant(
+        "audit-sim-budget-in-seconds",
+        P + "simulate/scenarios.py",
+        "check_sample_budget(duration_s * rate_hz + 1,",
+        "check_sample_budget(duration_s + 1,",
+        AUDIT,
+        "the sample budget counts seconds, not samples: --rate-hz 1e9 reaches MemoryError",
+    ),
+    Mutant(
+        "audit-sim-budget-one-run",
+        P + "simulate/scenarios.py",
+        "check_sample_budget(float(runs) * n_run,",
+        "check_sample_budget(n_run,",
+        AUDIT,
+        "--runs 1e6 judged as one run: a million generators spawned (hang)",
+    ),
+    Mutant(
+        "audit-program-absolute-zero",
+        P + "profiles.py",
+        "cold = np.flatnonzero(c < ABSOLUTE_ZERO_C)",
+        "cold = np.flatnonzero(c < 2.0 * ABSOLUTE_ZERO_C)",
+        AUDIT,
+        "a chamber program step to -300 °C simulated",
+    ),
+    Mutant(
+        "audit-demo-seed-negative",
+        P + "cli/demo_cmd.py",
+        "if seed < 0:",
+        "if seed < -10:",
+        AUDIT,
+        "demo --seed -5: exit 1 from numpy with a half-made folder",
     ),
 )
 

@@ -472,9 +472,13 @@ def builtin_profile(name: str, **params: Any) -> Profile:
 # --- program files -------------------------------------------------------------------------------
 
 
+ABSOLUTE_ZERO_C = -273.15
+"""Absolute zero [°C] (0 K; the kelvin's definition, SI Brochure 9th ed. §2.3.1)."""
+
+
 def check_program(time_s: npt.ArrayLike, setpoint_c: npt.ArrayLike, what: str = "program") -> None:
     """Raise :class:`ThermocalInputError` unless time is finite and strictly increasing and
-    the set-points are finite, with at least two points."""
+    the set-points are finite and not below absolute zero, with at least two points."""
     t = np.asarray(time_s, dtype=np.float64)
     c = np.asarray(setpoint_c, dtype=np.float64)
     if t.ndim != 1 or t.shape != c.shape:
@@ -489,6 +493,12 @@ def check_program(time_s: npt.ArrayLike, setpoint_c: npt.ArrayLike, what: str = 
         raise TimestampError(
             f"{what}: time must increase strictly; row {back[0] + 1} ({float(t[back[0] + 1])!r}) "
             f"follows {float(t[back[0]])!r}"
+        )
+    cold = np.flatnonzero(c < ABSOLUTE_ZERO_C)
+    if cold.size:
+        raise ThermocalInputError(
+            f"{what}: set-point {float(c[cold[0]])!r} °C at row {cold[0]} is below absolute "
+            f"zero ({ABSOLUTE_ZERO_C} °C): a set-point is a temperature in °C"
         )
 
 

@@ -73,18 +73,18 @@ def demo_cmd(
     With ``--imu``: the same for a six-channel MEMS IMU, into one calibration file.  With
     ``--station``: record a simulated chamber and serial IMU through the test station first.
     """
-    if imu and station:
-        from thermocal.errors import ThermocalInputError
+    from thermocal.errors import ThermocalInputError
 
+    if imu and station:
         raise ThermocalInputError("--imu and --station are two demos: give one")
+    if seed < 0:  # numpy's SeedSequence takes none (was exit 1 with a half-made folder)
+        raise ThermocalInputError(f"--seed must be a non-negative integer, got {seed}")
     if imu and output == Path("thermocal-demo"):
         output = Path("thermocal-imu-demo")
     if station and output == Path("thermocal-demo"):
         output = Path("thermocal-station-demo")
     check_outputs([], [], dirs=[output])  # no FIFO, device, /proc… (the demo reads no file)
     if output.exists() and not output.is_dir():
-        from thermocal.errors import ThermocalInputError
-
         raise ThermocalInputError(f"{output}: exists and is not a directory")
     if imu:
         _imu_demo(output, seed, quick, as_json)

@@ -622,6 +622,47 @@ def model_options(o: FitOptions) -> dict[str, Any]:
     }
 
 
+def _distinct_runs(paths: Sequence[Path]) -> None:
+    """Refuse a run given twice, by name or as a byte-for-byte copy (the same SHA-256): it
+    would count twice, its samples weighing double and the standard errors shrunk by √2
+    (issue 39 audit: ``fit a.csv a.csv`` wrote ``n_runs`` 2, exit 0)."""
+    seen: dict[str, Path] = {}
+    for path in paths:
+        digest = _files.file_sha256(path)
+        if digest in seen:
+            raise ThermocalInputError(
+                f"{path}: the same bytes as {seen[digest]} (a file given twice, or a copy): "
+                "each run counts once in a fit; give every run's file once"
+            )
+        seen[digest] = path
+
+
+def _check_numbers(o: FitOptions) -> None:
+    """Refuse the numeric options no fit can use, naming the option (issue 39 audit): a
+    latitude outside ±90° (the earth rate Ω·sin φ of a latitude of 200° is that of −20°),
+    NaN or infinite ``--ridge``/``--known-input``, a ``--rate-interval`` ≤ 0, a negative or
+    NaN ``--rcond``/``--noise-threshold`` (they silently switched the SVD truncation
+    off), and ``--breakpoints`` holding no number (a piecewise fit without breakpoints
+    is one straight line)."""
+    if o.latitude is not None and not -90.0 <= o.latitude <= 90.0:
+        raise ThermocalInputError(f"--latitude must be within ±90°, got {o.latitude}")
+    for opt, value in {"--ridge": o.ridge, "--known-input": o.known_input}.items():
+        if value is not None and not np.isfinite(value):
+            raise ThermocalInputError(f"{opt} must be a finite number, got {value}")
+    if o.rate_interval is not None and not (np.isfinite(o.rate_interval) and o.rate_interval > 0):
+        raise ThermocalInputError(
+            f"--rate-interval must be a finite number of seconds > 0, got {o.rate_interval}"
+        )
+    for opt, value in {"--rcond": o.rcond, "--noise-threshold": o.noise_threshold}.items():
+        if value is not None and not (np.isfinite(value) and value >= 0.0):
+            raise ThermocalInputError(f"{opt} must be a finite number ≥ 0, got {value}")
+    if o.breakpoints is not None and not split_floats(o.breakpoints, "--breakpoints"):
+        raise ThermocalInputError(
+            f"--breakpoints {o.breakpoints!r} holds no temperature: give them as 25,30 [°C], "
+            "or --segments N to choose them from the data"
+        )
+
+
 def _check_options(paths: Sequence[Path], o: FitOptions, output: Path) -> dict[str, Any]:
     """Everything refused before a file is read: target, ceilings, output name, family
     options; returns the family options (:func:`model_options`)."""
@@ -633,6 +674,7 @@ def _check_options(paths: Sequence[Path], o: FitOptions, output: Path) -> dict[s
     _writers.check_not_input(output, list(paths))
     if output.suffix.lower() not in (".json", ""):
         raise ThermocalInputError(f"{output}: the model file is JSON; use a .json name")
+    _check_numbers(o)
     options = model_options(o)
     if o.select_method not in ("bic", "holdout"):
         raise ThermocalInputError(
@@ -679,6 +721,7 @@ def fit_files(paths: Sequence[Path], options: FitOptions, output: Path) -> FitRe
         raise ThermocalInputError(
             f"--tref applies to the poly family (coefficients about TREF), not {o.model!r}"
         )
+    _distinct_runs([path for path, _rec in loaded])
     spec = _FitSpec(o.model, family_options, o.temps, o.latitude, o.axis, o.known_input,
                     o.target, o.gravity_axis, g_local, o.tref,
                     _gravity.triad_gravity(loaded, names, o.gravity_axis, g_local),

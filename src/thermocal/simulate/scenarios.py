@@ -75,10 +75,27 @@ def _program(profile: ProfileInput, default: str) -> tuple[ProgramArrays, list[S
     return (t, c), find_holds(t, c)
 
 
+MAX_SAMPLES = 20_000_000
+"""The most samples one simulated file holds (duration × rate, summed over the files of
+one call): 2e7 samples, about 1.6 GB of float64 over the ~10 arrays a scenario builds
+(the built-in programs at their own rates hold ≤ 2.4e5).  More is refused before any
+array is allocated (issue 39 audit: ``--rate-hz 1e9`` asked for 1.66 PiB, exit 1)."""
+
+
+def check_sample_budget(n: float, what: str) -> None:
+    """Refuse ``n`` samples above :data:`MAX_SAMPLES`, saying what to lower."""
+    if not n <= MAX_SAMPLES:
+        raise ThermocalInputError(
+            f"{what}: {n:.3g} samples to simulate, above the limit of {MAX_SAMPLES:.3g}: "
+            "lower --rate-hz, or shorten the chamber program (--profile, --record-s, --runs)"
+        )
+
+
 def _time_grid(duration_s: float, rate_hz: float) -> FloatArray:
     if not (math.isfinite(rate_hz) and rate_hz > 0):
         raise ThermocalInputError(f"rate_hz must be > 0, got {rate_hz!r}")
     dt = 1.0 / rate_hz
+    check_sample_budget(duration_s * rate_hz + 1, f"{duration_s:g} s at {rate_hz:g} Hz")
     n = math.floor(duration_s / dt + 1e-9) + 1
     if n < 2:
         raise ThermocalInputError("the chamber program is shorter than two samples")
@@ -388,6 +405,8 @@ def scenario_accel_full_range(
     program, stages = _program(profile, "accel-full-range")
     stages = [dataclasses.replace(s, label=s.label.removeprefix("run1/")) for s in stages]
     hz = rate_hz or p.rate_hz
+    n_run = float(program[0][-1]) * float(hz) + 1
+    check_sample_budget(float(runs) * n_run, f"{int(runs)} runs of {n_run:.3g} samples")
     rngs = scenario_rng("accel-full-range", seed, int(runs) + 1)
     curves = p.curves or (p.bias_model,)
     assign = rngs[-1].permutation(np.resize(np.arange(len(curves)), int(runs)))

@@ -24,6 +24,11 @@ from thermocal.identifiers import (
 from thermocal.recording import GAP_FACTOR, FloatArray
 
 REAL_TYPES = ("double", "float")
+FLT_MAX = float(np.finfo(np.float32).max)
+"""The largest finite IEEE-754 binary32 value, C's ``FLT_MAX`` (3.4028235e38)."""
+FLT_MIN = float(np.finfo(np.float32).tiny)
+"""The smallest normal IEEE-754 binary32 value, C's ``FLT_MIN`` (1.1754944e-38); a float
+literal below it is written as 0."""
 
 
 # --- the generated module -------------------------------------------------------------------
@@ -150,6 +155,13 @@ class ExportContext:
         """A C literal of the real type (17 significant digits, ``f`` suffix for float)."""
         if not math.isfinite(x):
             raise ModelFileError(f"non-finite coefficient {x!r} cannot be exported")
+        if self.real == "float" and abs(x) > FLT_MAX:
+            raise ModelFileError(
+                f"the constant {float(x)!r} is beyond a C float's largest value FLT_MAX = "
+                f"{FLT_MAX:.8g} (C11 §5.2.4.2.2): export it without --float (in double)"
+            )
+        if self.real == "float" and abs(x) < FLT_MIN:
+            x = 0.0  # below FLT_MIN: what a float holds of it is 0 (no truncation warning)
         s = repr(float(x))
         if "e" not in s and "." not in s and "inf" not in s:
             s += ".0"

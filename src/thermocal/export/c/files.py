@@ -3,6 +3,7 @@
 
 from __future__ import annotations
 
+import math
 import warnings
 from dataclasses import dataclass
 from pathlib import Path
@@ -134,6 +135,14 @@ def export_c_file(
             err = measure_float_error(
                 d, prefix=ex.prefix, sample_interval_s=sample_interval_s, unit=unit
             )
+            if not math.isfinite(err.max_abs):  # inf − inf or inf − x: the float build overflowed
+                warnings.warn(
+                    f"{path}: the float build's output is not finite where double's is (a "
+                    "result beyond FLT_MAX 3.4028235e+38 over the calibrated range): these "
+                    "float functions are wrong; export without --float (in double)",
+                    ThermocalWarning,
+                    stacklevel=2,
+                )
     return ExportCResult("model", ex, tuple(paths), float_error=err)
 
 
