@@ -8,6 +8,8 @@ samples with (IEEE Std 952-1997 Annex C formulas, evaluated here independently).
 
 from __future__ import annotations
 
+import contextlib
+import io
 import json
 import math
 import re
@@ -20,6 +22,8 @@ import numpy as np
 import pandas as pd
 import pytest
 from tests.docs.test_tutorials import TUTORIALS, _numbers, _run_in_scratch
+
+from thermocal.cli import main
 
 Pages = tuple[list[tuple[str, str]], Path]
 
@@ -81,6 +85,13 @@ def test_chamber_fit_leaves_the_simulated_noise(chamber: Pages) -> None:
     sigma = _noise_sigma(truth)
     assert sigma == pytest.approx(0.0574, abs=5e-5)
     assert rms == pytest.approx(sigma, rel=0.02)
+    # the page's "its T1 coefficient is 0.013 °/h/°C with the gradient term, the fit's
+    # 0.001": the truth's linear T1 term plus every gradient g·(T1 − Tj), and the fit's
+    bias = truth["preset"]["bias_model"]
+    t1 = bias["poly"][0][0] + sum(g for i, _, g in bias["gradient"] if i == 0)
+    t1 -= sum(g for _, j, g in bias["gradient"] if j == 0)
+    assert t1 == pytest.approx(0.013)
+    assert _row(pairs[2][0], "(T1-TREF)  ")[0] == pytest.approx(0.001, abs=1e-4)
 
 
 def test_chamber_validation_figures_match_the_truth(chamber: Pages) -> None:
@@ -112,6 +123,21 @@ def test_chamber_model_follows_the_true_bias_on_the_validation_run(chamber: Page
     assert float(np.std(err)) == pytest.approx(0.0009, abs=5e-5)
     left = d["gyro_comp"].to_numpy() * per_count - (d["truth_rate"] - d["truth_bias"]).to_numpy()
     assert float(np.std(left)) == pytest.approx(_noise_sigma(truth), rel=0.02)
+
+
+def test_chamber_rate_terms_add_little_on_this_sensor(chamber: Pages, tmp_path: Path) -> None:
+    """The page's claim: the same fit without the dT terms follows truth_bias on the
+    validation run about as closely (0.0009 °/h rms)."""
+    _, tmp = chamber
+    model, comp = tmp_path / "no_rate.json", tmp_path / "no_rate.csv"
+    fit = ["fit", str(tmp / "mod.csv"), "--model", "poly", "--terms", "T1,T1^2,T1^3,T2,T3,T3^2,T4"]
+    with contextlib.redirect_stdout(io.StringIO()):
+        assert main([*fit, "--latitude", "45", "--axis", "up", "-o", str(model)]) == 0
+        assert main(["compensate", str(model), str(tmp / "val.csv"), "-o", str(comp)]) == 0
+    d = pd.read_csv(comp)
+    per_count = _deg_per_h_per_count(_truth(tmp, "val_truth.json"))
+    err = d["gyro_model"].to_numpy() * per_count - d["truth_bias"].to_numpy()
+    assert float(np.std(err)) == pytest.approx(0.0009, abs=5e-5)
 
 
 C_MAIN = r"""
@@ -235,10 +261,13 @@ def test_noise_kalibr_file_is_continuous_time_si(noise: Pages) -> None:
     assert values["update_rate"] == 100.0
     assert (tmp / "imu.yaml").is_file()
     python = pairs[3][0]
+    page = (TUTORIALS / "noise-for-estimator.md").read_text(encoding="utf-8")
     n = values["gyroscope_noise_density"]
     assert f"= {n * 180 / math.pi * 60:.4g} °/√h" in python
+    # Kalibr's discrete values at Δt = 0.01 s: σ_c/√Δt (white), σ_c·√Δt (walk)
+    assert f"{n / 0.1 * 1e3:.3g}·10⁻³ rad/s per sample" in page
+    assert f"{values['gyroscope_random_walk'] * 0.1 * 1e7:.2g}·10⁻⁷ rad/s per step" in page
     assert math.isclose(GYRO_N * 60, 0.36)  # 1 °/s/√Hz = 60 °/√h
-    page = (TUTORIALS / "noise-for-estimator.md").read_text(encoding="utf-8")
     assert f"{DEG / 60 * 1e4:.4g}·10⁻⁴ rad/s/√Hz" in page  # 2.909
     assert f"{DEG / 3600 / 60 * 1e8:.3g}·10⁻⁸ rad/s²/√Hz" in page  # 8.08
     assert f"{9.80665e-6 * 1e6:.4g}·10⁻⁶ m/s²/√Hz" in page  # 9.807
