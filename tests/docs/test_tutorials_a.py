@@ -71,7 +71,7 @@ def _noise_sigma(truth: dict[str, Any]) -> float:
 
 def test_chamber_tutorial_prints_what_the_page_shows(chamber: Pages) -> None:
     pairs, _ = chamber
-    assert len(pairs) == 6
+    assert len(pairs) == 7
     for printed, shown in pairs:
         assert _numbers(printed) == _numbers(shown)
 
@@ -123,6 +123,25 @@ def test_chamber_model_follows_the_true_bias_on_the_validation_run(chamber: Page
     assert float(np.std(err)) == pytest.approx(0.0009, abs=5e-5)
     left = d["gyro_comp"].to_numpy() * per_count - (d["truth_rate"] - d["truth_bias"]).to_numpy()
     assert float(np.std(left)) == pytest.approx(_noise_sigma(truth), rel=0.02)
+
+
+OMEGA_E = 7.292115e-5  # earth rotation rate [rad/s], WGS-84 (NIMA TR8350.2)
+
+
+def test_chamber_failed_check_is_the_earth_rate(chamber: Pages) -> None:
+    """Without --latitude/--axis the model's constant holds Ω sin φ (φ = 45°, up axis), and
+    validate says NOT improved with the compensated mean at −Ω sin φ (+ the small offset
+    of the good model)."""
+    pairs, _ = chamber
+    earth = math.degrees(OMEGA_E) * 3600.0 * math.sin(math.radians(45.0))  # °/h
+    good = _row(pairs[2][0], "const")[0]
+    bad_fit, bad_validate = pairs[6][0].split("validation of poly model", 1)
+    assert _row(bad_fit, "const")[0] - good == pytest.approx(earth, abs=2e-4)
+    assert "verdict: NOT improved" in bad_validate
+    assert "--latitude 45 --axis up" in bad_validate
+    _before, after, _ = _row(bad_validate, "mean (about zero)")
+    good_after = _row(pairs[3][0], "mean (about zero)")[1]
+    assert after == pytest.approx(good_after - earth, abs=0.01)
 
 
 def test_chamber_rate_terms_add_little_on_this_sensor(chamber: Pages, tmp_path: Path) -> None:
