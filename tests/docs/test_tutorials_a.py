@@ -265,6 +265,11 @@ def test_noise_terms_hold_the_simulated_truth(noise: Pages) -> None:
             assert _holds(ax["B"], floor), name
     # the random walk: ax and ay hold it, az does not (the page says so); Kalibr's axis does
     assert [_holds(axes[a]["K"], ACCEL_K) for a in ("ax", "ay", "az")] == [True, True, False]
+    # a bound rests on the interval's upper end: at 95 % above the command line's 68.3 %
+    cli = {ln.split("│")[1].strip(): _numbers(ln.split("│")[3])[0]
+           for ln in noise[0][1][0].splitlines() if ln.startswith("│ g")}  # fmt: skip
+    assert cli["gx"] == 6.711e-06 and axes["gx"]["K"][0] == 9.04e-06  # the page's figures
+    assert all(axes[g]["K"][0] > cli[g] for g in ("gx", "gy", "gz"))
     kalibr_axis = max(("ax", "ay", "az"), key=lambda a: axes[a]["K"][0])
     assert _holds(axes[kalibr_axis]["K"], ACCEL_K)
 
