@@ -155,6 +155,19 @@ def test_fc_tutorial_prints_what_the_page_shows(fc_page: tuple[Path, Page]) -> N
         assert printed.strip() == shown.strip()
 
 
+def test_fc_holdout_is_the_noise_of_the_bins(fc_page: tuple[Path, Page]) -> None:
+    """The gyro's hold-out rms per axis is the noise of a bin's median: 0.001 rad/s per sample
+    (make_fc_logs.py) over 3000/121 samples a bin, ×1.25 (a median's efficiency) ≈ 52 °/h."""
+    _, page = fc_page
+    expected = 0.001 * 180 / math.pi * 3600 / math.sqrt(3000 / 121) * 1.25
+    for printed in (page[0][0], page[2][0]):
+        row = next(ln for ln in printed.splitlines() if "deg/h" in ln and "│" in ln)
+        values = [float(v) for v in row.split("│")[-2].split("deg/h")[0].split("/")]
+        assert len(values) == 3
+        for v in values:
+            assert 0.8 * expected < v < 1.25 * expected, (v, expected)
+
+
 def _px4_params(path: Path) -> dict[str, float]:
     out = {}
     for line in path.read_text().splitlines():
