@@ -84,7 +84,9 @@ def multipos_page(tmp_path_factory: pytest.TempPathFactory) -> list[tuple[str, s
 
 def test_every_tutorial_is_executed_here() -> None:
     assert sorted(p.name for p in TUTORIALS.glob("*.md")) == [
+        "fc-params.md",  # tests/docs/test_tutorials_b.py
         "multipos-imucal.md",
+        "production-batch.md",  # tests/docs/test_tutorials_b.py
         "stability-stable32.md",
     ]
 
