@@ -84,8 +84,10 @@ def multipos_page(tmp_path_factory: pytest.TempPathFactory) -> list[tuple[str, s
 
 def test_every_tutorial_is_executed_here() -> None:
     assert sorted(p.name for p in TUTORIALS.glob("*.md")) == [
+        "chamber-to-c.md",  # tests/docs/test_tutorials_a.py
         "fc-params.md",  # tests/docs/test_tutorials_b.py
         "multipos-imucal.md",
+        "noise-for-estimator.md",  # tests/docs/test_tutorials_a.py
         "production-batch.md",  # tests/docs/test_tutorials_b.py
         "stability-stable32.md",
     ]

@@ -21,7 +21,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 import pytest
-from tests.docs.test_tutorials import TUTORIALS, _numbers, _run_in_scratch
+from test_tutorials import TUTORIALS, _numbers, _run_in_scratch
 
 from thermocal.cli import main
 
