@@ -307,8 +307,8 @@ def test_a_register_reading_0x8000_is_a_chamber_fault_not_a_temperature(
 @pytest.mark.parametrize(
     ("program", "extra", "words"),
     [
-        (((0.0, 10.0, 20.0), (25.0, -300.0, -300.0)), {},
-         "p.csv: set-point at program time 10 s: -300 °C is outside the chamber's range "
+        (((0.0, 10.0, 20.0), (25.0, -100.0, -100.0)), {},
+         "p.csv: set-point at program time 10 s: -100 °C is outside the chamber's range "
          "-75…180 °C"),
         (((0.0, 10.0, 20.0), (25.0, 150.0, 150.0)), {"max_c": 120},
          "p.csv: set-point at program time 10 s: 150 °C is outside the chamber's range -75…120"),

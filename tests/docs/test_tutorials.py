@@ -65,9 +65,22 @@ def _stable32(name: str) -> np.ndarray:
     return np.array([[float(v) for v in ln.split()] for ln in lines if ln.strip() and ln[0] != "#"])
 
 
+def fresh_cli(mp: pytest.MonkeyPatch) -> None:
+    """The page runs as in a new shell: no ``COLUMNS`` left by an earlier test and the
+    CLI's consoles built anew (a module fixture runs before the autouse console reset of
+    ``tests/conftest.py``, so in a parallel run a console of another test's width printed
+    the page's tables cut short)."""
+    from thermocal.cli import common
+
+    mp.delenv("COLUMNS", raising=False)
+    for console in (common.stdout, common.stderr):
+        mp.setattr(console, "_console", None)
+
+
 def _run_in_scratch(tmp: Path, name: str) -> list[tuple[str, str]]:
     (tmp / "tests").symlink_to(ROOT / "tests", target_is_directory=True)
     with pytest.MonkeyPatch.context() as mp:
+        fresh_cli(mp)
         mp.chdir(tmp)
         return _run_page(TUTORIALS / name)
 

@@ -23,7 +23,7 @@ from types import ModuleType
 import numpy as np
 import pandas as pd
 import pytest
-from test_tutorials import BLOCK, ROOT, TUTORIALS, _numbers
+from test_tutorials import BLOCK, ROOT, TUTORIALS, _numbers, fresh_cli
 
 from thermocal.cli import main
 
@@ -67,6 +67,7 @@ def _run_page(page: Path, here: Path) -> Page:
 
 def _in_scratch(tmp: Path, name: str) -> Page:
     with pytest.MonkeyPatch.context() as mp:
+        fresh_cli(mp)
         mp.chdir(tmp)
         return _run_page(TUTORIALS / name, tmp)
 
