@@ -90,6 +90,7 @@ from thermocal.readers.common import (
     csv_float_options,
     default_time_column,
     file_kind,
+    names_list,
     thermocal_metadata,
 )
 from thermocal.readers.dispatch import (
@@ -683,7 +684,7 @@ def _open_source(
         text_table, text_info = read_text_table(src, text, time)
     names, info, _ = _file_info(src, kind_in, text_table, text_info)
     time_col = time or default_time_column(names, info.get("time"))
-    available = ", ".join(repr(c) for c in names)
+    available = names_list(names)  # the first 20 and how many more (10 000 columns: one line)
     if time_col not in names:
         hint = time_hint(names, (info.get("text_layout") or {}).get("banner") or ())
         raise MissingColumnError(
