@@ -84,7 +84,7 @@ from thermocal.models.base import (
     check_sensor_id,
     outside_range_dict,
 )
-from thermocal.outputs import refuse_special_input, sidecar_path
+from thermocal.outputs import refuse_special_input, sidecar_path, warn_formula_names
 from thermocal.readers.common import (
     csv_encoding,
     csv_float_options,
@@ -634,6 +634,7 @@ def compensate_channels(
         )
     t_unit = plans[0].time_unit
     out_info = _output_info(source.info, source.time_col, t_unit, plans)
+    warn_formula_names(dst, source.names)  # every output column begins as an input's name
     state = _PassState()
     run = _ChannelPass(source, plans, _evaluation_groups(plans), units.TIME_UNITS[t_unit],
                        chunk_rows, on_progress, state)  # fmt: skip
@@ -1147,6 +1148,7 @@ def compensate_triads(
     plans = [_triad_plan(tri, source.names, source.available, src) for tri in triads]
     resolved = _resolve_triads(source, plans, time_unit, signal_unit)
     out_info = _triad_output_info(source.info, source.time_col, resolved, plans)
+    warn_formula_names(dst, source.names)
     state = _PassState()
     atomic_write_path(
         dst, lambda tmp: _write_triads(tmp, source, kind_out, out_info, plans, resolved,

@@ -640,7 +640,15 @@ def summary_rows(
 
 
 def write_summary(rows: Sequence[Mapping[str, Any]], out_dir: Path) -> tuple[Path, Path]:
-    """``summary.csv`` and ``summary.parquet`` (atomic writes), columns in first-seen order."""
+    """``summary.csv`` and ``summary.parquet`` (atomic writes), columns in first-seen order.
+
+    ``summary.csv`` is a table for spreadsheets: a text cell or a column name beginning
+    with ``=``, ``+``, ``-``, ``@``, TAB or CR (a unit id, a channel name, an error) is
+    written with a ``'`` in front, so that the spreadsheet shows it instead of running it
+    as a formula (OWASP, "CSV Injection",
+    https://owasp.org/www-community/attacks/CSV_Injection;
+    :func:`thermocal.outputs.neutralise_cell`); numbers stay numbers.
+    ``summary.parquet`` keeps every name and text exactly."""
     import pandas as pd
 
     from thermocal.writers import atomic_write, atomic_write_path
@@ -655,9 +663,22 @@ def write_summary(rows: Sequence[Mapping[str, Any]], out_dir: Path) -> tuple[Pat
     df["pass"] = df["pass"].astype("boolean")
     csv_path, pq_path = out_dir / "summary.csv", out_dir / "summary.parquet"
     with atomic_write(csv_path, "w") as fh:
-        df.to_csv(fh, index=False)
+        _for_spreadsheets(df).to_csv(fh, index=False)
     atomic_write_path(pq_path, lambda tmp: df.to_parquet(tmp, index=False))
     return csv_path, pq_path
+
+
+def _for_spreadsheets(df: Any) -> Any:
+    """A copy of ``df`` whose text cells and column names cannot run as spreadsheet
+    formulas (:func:`thermocal.outputs.neutralise_cell`; numbers and booleans untouched)."""
+    from thermocal.outputs import neutralise_cell
+
+    out = df.copy()
+    for c in out.columns:
+        if out[c].dtype == object:
+            out[c] = out[c].map(neutralise_cell)
+    out.columns = [neutralise_cell(c) for c in out.columns]
+    return out
 
 
 Executor = Callable[[list[UnitTask]], Iterator[UnitOutcome]]
