@@ -205,3 +205,141 @@ def test_compensate_missing_signal_lists_20_columns_and_how_many_more(
     assert "'col00018'" not in line and len(line) < 2000
     assert not out.exists()
     assert _digests(tmp_path) == before
+
+
+# --- 1. names that a spreadsheet runs as formulas (OWASP "CSV Injection") -------------
+
+INJECTED = "=1+2"  # a formula a spreadsheet would compute (3)
+
+
+def _injected_run(path: Path, name: str = INJECTED) -> tuple[np.ndarray, np.ndarray]:
+    """400 s at 1 Hz, 10 → 40 °C, a gyro column ``name`` in deg/s (0.5 + 0.01·(T − 25) +
+    a wobble): returns (temperature, signal) as the file holds them."""
+    n = 400
+    t = np.arange(n, dtype=float)
+    temp = np.linspace(10.0, 40.0, n)
+    pd.DataFrame(
+        {"time": t, name: 0.5 + 0.01 * (temp - 25.0) + 0.001 * np.sin(t), "T": temp}
+    ).to_csv(path, index=False)
+    back = pd.read_csv(path)
+    return back["T"].to_numpy(), back[name].to_numpy()
+
+
+def test_compensate_csv_keeps_a_formula_name_and_warns(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """compensate's CSV is data for a program: the column name round-trips exactly, and one
+    ``warning:`` names the output, the column and the risk; the compensated values are the
+    residual of a straight line fitted here with numpy."""
+    temp, sig = _injected_run(tmp_path / "d.csv")
+    model = tmp_path / "m.json"
+    code = main(["fit", str(tmp_path / "d.csv"), "--model", "poly", "--order", "1",
+                 "--signal", INJECTED, "--signal-unit", "deg/s", "--time-unit", "s",
+                 "--temps", "T", "--temp-unit", "degC", "-o", str(model)])  # fmt: skip
+    assert code == 0, capsys.readouterr().err
+    capsys.readouterr()
+    before = _digests(tmp_path)
+    out = tmp_path / "out.csv"
+    code = main(["compensate", str(model), str(tmp_path / "d.csv"), "-o", str(out)])
+    _o, err = capsys.readouterr()
+    assert code == 0, err
+    warn = [ln for ln in err.splitlines() if ln.startswith("warning:")]
+    assert len(warn) == 1, err
+    assert str(out) in warn[0] and repr(INJECTED) in warn[0] and "CSV Injection" in warn[0]
+    assert {p: h for p, h in _digests(tmp_path).items() if p in before} == before
+    df = pd.read_csv(out)
+    assert list(df.columns) == ["time", INJECTED, "T", INJECTED + "_model", INJECTED + "_comp"]
+    ref = sig - np.polyval(np.polyfit(temp, sig, 1), temp)
+    np.testing.assert_allclose(df[INJECTED + "_comp"], ref, rtol=0, atol=1e-9)
+
+
+def test_compensate_parquet_with_a_formula_name_says_nothing(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The warning is about spreadsheets opening a CSV: a Parquet output gets none."""
+    _injected_run(tmp_path / "d.csv")
+    model = tmp_path / "m.json"
+    assert main(["fit", str(tmp_path / "d.csv"), "--model", "poly", "--order", "1",
+                 "--signal", INJECTED, "--signal-unit", "deg/s", "--time-unit", "s",
+                 "--temps", "T", "--temp-unit", "degC", "-o", str(model)]) == 0  # fmt: skip
+    capsys.readouterr()
+    out = tmp_path / "out.parquet"
+    code = main(["compensate", str(model), str(tmp_path / "d.csv"), "-o", str(out)])
+    _o, err = capsys.readouterr()
+    assert code == 0 and "warning:" not in err, err
+
+
+@pytest.mark.parametrize("first", ["=", "+", "-", "@"])  # a TAB is stripped by the reader
+def test_fleet_summary_csv_neutralises_formula_names(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], first: str
+) -> None:
+    """fleet's summary.csv is a table for spreadsheets: a channel name beginning with a
+    formula trigger is written with a ``'`` in front (OWASP's mitigation); numbers stay
+    numbers; summary.parquet keeps the name exactly."""
+    import csv
+
+    name = first + "SUM(A1)"
+    for k in (1, 2):
+        _injected_run(tmp_path / f"U{k}.csv", name)
+    cfg = tmp_path / "batch.toml"
+    cfg.write_text(
+        '[fit]\nmodel = "poly"\norder = 1\nsignal = ["'
+        + name.replace("\t", "\\t")
+        + '"]\ntemps = "T"\nsignal_unit = "deg/s"\n\n'
+        + "".join(f'[[unit]]\nid = "U{k}"\nmodeling = ["U{k}.csv"]\n\n' for k in (1, 2))
+    )
+    before = _digests(tmp_path)
+    out = tmp_path / "out"
+    code = main(["fleet", str(cfg), "-o", str(out), "--workers", "1"])
+    _o, err = capsys.readouterr()
+    assert code == 0, err
+    assert {p: h for p, h in _digests(tmp_path).items() if p in before} == before
+    with open(out / "summary.csv", newline="", encoding="utf-8") as fh:
+        cells = [c for row in csv.reader(fh) for c in row]
+    assert "'" + name + ".unit" in cells
+    for c in cells:  # a cell a spreadsheet would run is a number, never a text
+        if c[:1] in ("=", "+", "-", "@", "\t", "\r"):
+            float(c)
+    pq_cols = pd.read_parquet(out / "summary.parquet").columns
+    assert name + ".unit" in pq_cols
+
+
+# --- 5. values declared as counts that are not counts ---------------------------------
+
+
+def _adev_tau0(y: np.ndarray) -> float:
+    """The overlapping Allan deviation at τ = τ0 written here: √(½ ⟨(ȳ₂ − ȳ₁)²⟩)."""
+    return float(np.sqrt(0.5 * np.mean(np.diff(y) ** 2)))
+
+
+@pytest.mark.parametrize("integers", [False, True])
+def test_allan_counts_that_are_not_integers_warn(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], integers: bool
+) -> None:
+    """``--signal-unit counts`` on a column of fractions (0.01 σ white noise, physical
+    values) gave an ADEV in "counts" without a word; now one warning names the column,
+    --signal-unit and the metadata's scale_factor.  Integer counts: no warning.  Both:
+    the ADEV at τ0 is the one computed here."""
+    import json
+
+    rng = np.random.default_rng(5)
+    n = 2000
+    y = rng.normal(0.0, 30.0, n).round() if integers else rng.normal(0.0, 0.01, n)
+    pd.DataFrame({"time": np.arange(n) / 100.0, "g": y}).to_csv(tmp_path / "c.csv", index=False)
+    before = _digests(tmp_path)
+    code = main(["allan", str(tmp_path / "c.csv"), "--signal", "g", "--signal-unit", "counts",
+                 "--time-unit", "s", "--json"])  # fmt: skip
+    out, err = capsys.readouterr()
+    assert code == 0, err
+    warn = [ln for ln in err.splitlines() if ln.startswith("warning:")]
+    if integers:
+        assert not warn, err
+    else:
+        assert len(warn) == 1, err
+        for needle in ("'g'", "counts", "not integers", "--signal-unit", "scale_factor"):
+            assert needle in warn[0], (needle, warn[0])
+    assert _digests(tmp_path) == before
+    d = json.loads(out)
+    d = d.get("g", d)
+    assert d["tau_s"][0] == pytest.approx(0.01) and d["unit"] == "counts"
+    assert d["adev"][0] == pytest.approx(_adev_tau0(y), rel=1e-9)
