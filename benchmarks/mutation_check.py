@@ -2950,6 +2950,14 @@ MUTANTS: tuple[Mutant, ...] = (
         H39L,
         "integer counts warned as fractions",
     ),
+    Mutant(
+        "h39left-signal-error-every-column",
+        P + "pipeline/reading.py",
+        '            + (names_list(names) or "see thermocal inspect FILE")',
+        '            + (", ".join(repr(c) for c in names) or "see thermocal inspect FILE")',
+        H39L,
+        "allan/fit/noise: 'name the signal column' lists 10 000 names on one line",
+    ),
 )
 
 

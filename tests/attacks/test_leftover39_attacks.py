@@ -343,3 +343,19 @@ def test_allan_counts_that_are_not_integers_warn(
     d = d.get("g", d)
     assert d["tau_s"][0] == pytest.approx(0.01) and d["unit"] == "counts"
     assert d["adev"][0] == pytest.approx(_adev_tau0(y), rel=1e-9)
+
+
+def test_allan_without_signal_lists_20_columns_and_how_many_more(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The same list in every command's "name the signal column with --signal" error."""
+    wide = tmp_path / "wide.csv"
+    names = ["time"] + [f"col{k:05d}" for k in range(9999)]
+    rows = "\n".join(",".join([str(r)] + ["1"] * 9999) for r in range(3))
+    wide.write_text(",".join(names) + "\n" + rows + "\n")
+    before = _digests(tmp_path)
+    code = main(["allan", str(wide), "--time-unit", "s"])
+    _o, err = capsys.readouterr()
+    line = _refused(code, err, "--signal", "'col00019'", "(9,979 more)")
+    assert "'col00020'" not in line and len(line) < 2000
+    assert _digests(tmp_path) == before
