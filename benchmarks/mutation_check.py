@@ -105,6 +105,7 @@ H39MP = _t("mutants_multipos", "tests/attacks/test_multipos_attacks.py")
 ADEQ_H39 = ("tests/test_mutants_adequacy.py", *ADEQ)
 ST_ATT2 = ("tests/attacks/test_station_attacks_2.py",)
 AUDIT = _t("tests/attacks/test_audit39_attacks.py")
+H39L = _t("tests/attacks/test_leftover39_attacks.py")
 
 
 MUTANTS: tuple[Mutant, ...] = (
@@ -3057,6 +3058,111 @@ MUTANTS: tuple[Mutant, ...] = (
         "if seed < -10:",
         AUDIT,
         "demo --seed -5: exit 1 from numpy with a half-made folder",
+    ),
+    # issue 39 slice h39-left
+    Mutant(
+        "h39left-confidence-floor-zero",
+        P + "stability/edf.py",
+        "    if not CONFIDENCE_MIN <= c <= CONFIDENCE_MAX:",
+        "    if not 0.0 < c < 1.0:",
+        H39L,
+        "--confidence 1e-300 accepted: an interval of zero width beside the estimate",
+    ),
+    Mutant(
+        "h39left-confidence-unchecked-noise",
+        P + "stability/analysis.py",
+        "    check_confidence(confidence)\n    moved = motion_in(rec, gyro, accel)",
+        "    moved = motion_in(rec, gyro, accel)",
+        H39L,
+        "noise --confidence 1e-300 accepted",
+    ),
+    Mutant(
+        "h39left-station-fifo-no-such-file",
+        P + "station/config.py",
+        '    refuse_special_input(p, "station file (STATION.toml)")',
+        "    pass",
+        H39L,
+        "station check FIFO: 'no such file'",
+    ),
+    Mutant(
+        "h39left-port-fifo-passes",
+        P + "station/config.py",
+        '    if why is not None and why != "it is a character device":',
+        "    if False:",
+        H39L,
+        "a FIFO as a sensor port: pyserial's 'Inappropriate ioctl'",
+    ),
+    Mutant(
+        "h39left-dead-worker-stops-batch",
+        P + "fleet/batch.py",
+        "        return lost_unit(task, exc)",
+        "        raise",
+        H39L,
+        "a local worker's death stops the batch, its unit unnamed",
+    ),
+    Mutant(
+        "h39left-compensate-every-column",
+        P + "compensate/files.py",
+        "    available = names_list(names)",
+        '    available = ", ".join(repr(c) for c in names)',
+        H39L,
+        "compensate's error lists 10 000 column names on one line",
+    ),
+    Mutant(
+        "h39left-summary-csv-formula",
+        P + "fleet/batch.py",
+        "        _for_spreadsheets(df).to_csv(fh, index=False)",
+        "        df.to_csv(fh, index=False)",
+        H39L,
+        "fleet summary.csv: a channel name '=1+2' runs as a formula",
+    ),
+    Mutant(
+        "h39left-formula-trigger-minus-dropped",
+        P + "outputs.py",
+        'FORMULA_TRIGGERS: tuple[str, ...] = ("=", "+", "-", "@", "\\t", "\\r")',
+        'FORMULA_TRIGGERS: tuple[str, ...] = ("=", "+", "@", "\\t", "\\r")',
+        H39L,
+        "a name beginning with '-' left as a formula",
+    ),
+    Mutant(
+        "h39left-summary-header-not-neutralised",
+        P + "fleet/batch.py",
+        "    out.columns = [neutralise_cell(c) for c in out.columns]",
+        "    out.columns = list(out.columns)",
+        H39L,
+        "summary.csv: a channel's column name '=1+2.unit' runs as a formula",
+    ),
+    Mutant(
+        "h39left-compensate-formula-silent",
+        P + "compensate/files.py",
+        "    warn_formula_names(dst, source.names)  # every output column",
+        "    pass  # every output column",
+        H39L,
+        "compensate CSV: a formula name written without a word",
+    ),
+    Mutant(
+        "h39left-counts-share-never",
+        P + "recording.py",
+        "    if first is None or fractional < NON_INTEGER_COUNTS_SHARE * finite:",
+        "    if first is None or fractional <= finite:",
+        H39L,
+        "values declared as counts that are fractions: silent",
+    ),
+    Mutant(
+        "h39left-counts-integers-warn",
+        P + "recording.py",
+        "        frac = ok & (part != np.round(part))",
+        "        frac = ok",
+        H39L,
+        "integer counts warned as fractions",
+    ),
+    Mutant(
+        "h39left-signal-error-every-column",
+        P + "pipeline/reading.py",
+        '            + (names_list(names) or "see thermocal inspect FILE")',
+        '            + (", ".join(repr(c) for c in names) or "see thermocal inspect FILE")',
+        H39L,
+        "allan/fit/noise: 'name the signal column' lists 10 000 names on one line",
     ),
 )
 

@@ -252,13 +252,62 @@ def check_outputs(
         no_stale_input(f)
 
 
+FORMULA_TRIGGERS: tuple[str, ...] = ("=", "+", "-", "@", "\t", "\r")
+"""First characters that make a spreadsheet (Excel, LibreOffice Calc, Google Sheets) read
+a CSV cell as a formula: OWASP, "CSV Injection"
+(https://owasp.org/www-community/attacks/CSV_Injection) and ASVS 5.0 requirement 1.2.10
+list ``=``, ``+``, ``-``, ``@``, TAB and CR."""
+
+
+def formula_risk(value: object) -> bool:
+    """True when ``value`` is a string whose first character is in
+    :data:`FORMULA_TRIGGERS` (a spreadsheet would run it as a formula)."""
+    return isinstance(value, str) and value[:1] in FORMULA_TRIGGERS
+
+
+def neutralise_cell(value: object) -> object:
+    """``value`` with a ``'`` in front when :func:`formula_risk` (OWASP's mitigation: the
+    spreadsheet shows the text, the apostrophe is its "text" marker); anything else, numbers
+    included, unchanged.  For tables meant for spreadsheets only: a program reading the
+    file sees the apostrophe."""
+    return "'" + value if isinstance(value, str) and formula_risk(value) else value
+
+
+def warn_formula_names(path: str | Path, names: Iterable[str], what: str = "column") -> None:
+    """Warn (:class:`~thermocal.errors.ThermocalWarning`) when ``path`` is a CSV and one of
+    ``names`` begins with a formula trigger (:func:`formula_risk`): the name is written as
+    it is, since a program reading the file must find it again, but a spreadsheet opening
+    the CSV would run it (OWASP "CSV Injection")."""
+    import warnings
+
+    from thermocal.errors import ThermocalWarning
+
+    if Path(path).suffix.lower() != ".csv":
+        return
+    risky = [n for n in names if formula_risk(n)]
+    if risky:
+        more = f" (and {len(risky) - 1} more)" if len(risky) > 1 else ""
+        warnings.warn(
+            f"{path}: {what} {risky[0]!r}{more} begins with {risky[0][0]!r}: a spreadsheet "
+            'opening this CSV runs it as a formula (OWASP "CSV Injection"); kept as it is '
+            "for programs reading the file: rename it before opening the CSV in a spreadsheet, "
+            "or write Parquet",
+            ThermocalWarning,
+            stacklevel=2,
+        )
+
+
 __all__ = [
+    "FORMULA_TRIGGERS",
     "SPECIAL_ROOTS",
     "check_outputs",
+    "formula_risk",
+    "neutralise_cell",
     "refuse_special",
     "refuse_special_input",
     "special_mode",
     "special_reason",
+    "warn_formula_names",
 ]
 
 

@@ -768,6 +768,10 @@ PLAUSIBLE_SIGNAL = {"rate": 1e8, "accel": 1e7}
 PLAUSIBLE_COUNTS = 2.0**64
 """Largest |value| of a raw count column without a scale factor: no ADC or pulse counter
 has more than 64 bits (and float64 is exact for integers only up to 2⁵³)."""
+NON_INTEGER_COUNTS_SHARE = 0.1
+"""A column declared in raw counts of which at least this share of the finite values is
+not an integer is reported (a warning, issue 39: "values declared as counts"): an ADC or
+a pulse counter outputs integers; fractions mean physical values or averaged counts."""
 
 
 def _physical_of_counts(
@@ -1014,6 +1018,45 @@ def _signal_problems(rec: Recording, name: str) -> list[Problem]:
     return probs
 
 
+def _count_problems(rec: Recording, name: str) -> list[Problem]:
+    """A warning when the signal ``name`` is declared in raw counts and at least
+    :data:`NON_INTEGER_COUNTS_SHARE` of its finite values are not integers (blocks of
+    :data:`DIFF_BLOCK` rows)."""
+    arr, unit = rec.columns.get(name), rec.units.get(name)
+    if arr is None or not unit:
+        return []
+    try:
+        if units.signal_kind(unit) != "raw":
+            return []
+    except UnitError:
+        return []
+    finite = fractional = 0
+    first: int | None = None
+    for a0 in range(0, arr.size, DIFF_BLOCK):
+        part = arr[a0 : a0 + DIFF_BLOCK]
+        ok = np.isfinite(part)
+        frac = ok & (part != np.round(part))
+        finite += int(ok.sum())
+        fractional += int(frac.sum())
+        if first is None and frac.any():
+            first = a0 + int(np.argmax(frac))
+    if first is None or fractional < NON_INTEGER_COUNTS_SHARE * finite:
+        return []
+    return [
+        Problem(
+            "implausible_counts",
+            f"signal column {name!r} is declared in counts, but {fractional:,} of its "
+            f"{finite:,} values are not integers (row {first}: {float(arr[first]):.6g}): a "
+            "count is an integer; physical values need their unit (--signal-unit deg/s, mg, "
+            "…), averaged counts one count's size (scale_factor and scale_factor_unit in the "
+            "file's metadata, FILE.meta.json)",
+            severity="warning",
+            column=name,
+            row=first,
+        )
+    ]
+
+
 def plausibility_problems(rec: Recording) -> list[Problem]:
     """Values no sensor or chamber produces, named by column, value and row (issue 14).
 
@@ -1037,6 +1080,7 @@ def plausibility_problems(rec: Recording) -> list[Problem]:
         probs.extend(_temperature_problems(rec, name))
     for name in rec.signals:
         probs.extend(_signal_problems(rec, name))
+        probs.extend(_count_problems(rec, name))
     probs.extend(_accelerometer_magnitude_problems(rec))
     probs.extend(_sample_interval_problems(rec))
     return probs

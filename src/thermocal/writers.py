@@ -25,7 +25,13 @@ from thermocal.defaults import PROGRAM_SETPOINT, PROGRAM_TIME
 from thermocal.errors import (
     ThermocalInputError,
 )
-from thermocal.outputs import TEMP_SUFFIX, check_outputs, refuse_special, sidecar_path
+from thermocal.outputs import (
+    TEMP_SUFFIX,
+    check_outputs,
+    refuse_special,
+    sidecar_path,
+    warn_formula_names,
+)
 from thermocal.readers.common import file_kind
 from thermocal.readers.dispatch import recording_info
 from thermocal.recording import META_KEY, FloatArray, Recording
@@ -288,6 +294,7 @@ def write_recording(
         if sidecar:
             write_json(sidecar_path(p), info)
     else:
+        warn_formula_names(p, data)  # kept exactly: a program reads the names back
         table = pa.table(data)
         opts = pacsv.WriteOptions(include_header=True, quoting_style="needed")
         atomic_write_path(p, lambda tmp: pacsv.write_csv(table, tmp, write_options=opts))

@@ -84,12 +84,13 @@ from thermocal.models.base import (
     check_sensor_id,
     outside_range_dict,
 )
-from thermocal.outputs import refuse_special_input, sidecar_path
+from thermocal.outputs import refuse_special_input, sidecar_path, warn_formula_names
 from thermocal.readers.common import (
     csv_encoding,
     csv_float_options,
     default_time_column,
     file_kind,
+    names_list,
     thermocal_metadata,
 )
 from thermocal.readers.dispatch import (
@@ -633,6 +634,7 @@ def compensate_channels(
         )
     t_unit = plans[0].time_unit
     out_info = _output_info(source.info, source.time_col, t_unit, plans)
+    warn_formula_names(dst, source.names)  # every output column begins as an input's name
     state = _PassState()
     run = _ChannelPass(source, plans, _evaluation_groups(plans), units.TIME_UNITS[t_unit],
                        chunk_rows, on_progress, state)  # fmt: skip
@@ -683,7 +685,7 @@ def _open_source(
         text_table, text_info = read_text_table(src, text, time)
     names, info, _ = _file_info(src, kind_in, text_table, text_info)
     time_col = time or default_time_column(names, info.get("time"))
-    available = ", ".join(repr(c) for c in names)
+    available = names_list(names)  # the first 20 and how many more (10 000 columns: one line)
     if time_col not in names:
         hint = time_hint(names, (info.get("text_layout") or {}).get("banner") or ())
         raise MissingColumnError(
@@ -1146,6 +1148,7 @@ def compensate_triads(
     plans = [_triad_plan(tri, source.names, source.available, src) for tri in triads]
     resolved = _resolve_triads(source, plans, time_unit, signal_unit)
     out_info = _triad_output_info(source.info, source.time_col, resolved, plans)
+    warn_formula_names(dst, source.names)
     state = _PassState()
     atomic_write_path(
         dst, lambda tmp: _write_triads(tmp, source, kind_out, out_info, plans, resolved,

@@ -58,7 +58,7 @@ import tempfile
 import threading
 import time
 import warnings
-from collections.abc import Callable, Iterator, Mapping, Sequence
+from collections.abc import Callable, Generator, Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Final, TypeVar, cast
@@ -640,7 +640,15 @@ def summary_rows(
 
 
 def write_summary(rows: Sequence[Mapping[str, Any]], out_dir: Path) -> tuple[Path, Path]:
-    """``summary.csv`` and ``summary.parquet`` (atomic writes), columns in first-seen order."""
+    """``summary.csv`` and ``summary.parquet`` (atomic writes), columns in first-seen order.
+
+    ``summary.csv`` is a table for spreadsheets: a text cell or a column name beginning
+    with ``=``, ``+``, ``-``, ``@``, TAB or CR (a unit id, a channel name, an error) is
+    written with a ``'`` in front, so that the spreadsheet shows it instead of running it
+    as a formula (OWASP, "CSV Injection",
+    https://owasp.org/www-community/attacks/CSV_Injection;
+    :func:`thermocal.outputs.neutralise_cell`); numbers stay numbers.
+    ``summary.parquet`` keeps every name and text exactly."""
     import pandas as pd
 
     from thermocal.writers import atomic_write, atomic_write_path
@@ -655,9 +663,22 @@ def write_summary(rows: Sequence[Mapping[str, Any]], out_dir: Path) -> tuple[Pat
     df["pass"] = df["pass"].astype("boolean")
     csv_path, pq_path = out_dir / "summary.csv", out_dir / "summary.parquet"
     with atomic_write(csv_path, "w") as fh:
-        df.to_csv(fh, index=False)
+        _for_spreadsheets(df).to_csv(fh, index=False)
     atomic_write_path(pq_path, lambda tmp: df.to_parquet(tmp, index=False))
     return csv_path, pq_path
+
+
+def _for_spreadsheets(df: Any) -> Any:
+    """A copy of ``df`` whose text cells and column names cannot run as spreadsheet
+    formulas (:func:`thermocal.outputs.neutralise_cell`; numbers and booleans untouched)."""
+    from thermocal.outputs import neutralise_cell
+
+    out = df.copy()
+    for c in out.columns:
+        if out[c].dtype == object:
+            out[c] = out[c].map(neutralise_cell)
+    out.columns = [neutralise_cell(c) for c in out.columns]
+    return out
 
 
 Executor = Callable[[list[UnitTask]], Iterator[UnitOutcome]]
@@ -698,38 +719,96 @@ class _OwnedSpawnContext:
                 proc.terminate()
 
 
-def local_executor(workers: int) -> Executor:
+def local_executor(
+    workers: int, unit_fn: Callable[[UnitTask], UnitOutcome] | None = None
+) -> Executor:
     """Units in this process (one worker) or in ``workers`` local processes, results as
-    they finish."""
+    they finish.  A worker process that dies (the kernel's OOM killer, a crash in a native
+    library) breaks the pool: the units it may have held (the first ``workers + 1``
+    unfinished ones in submission order: the pool queues at most one call beyond its
+    workers) are rerun one by one, each alone in a fresh process, and the one that kills
+    its process again is a failed unit whose error names it and its files
+    (:func:`lost_unit`, as on Dask); the rest go on in a fresh pool.  ``unit_fn``: what a
+    worker runs per unit (default :func:`run_unit`; a module-level function, it is
+    pickled)."""
+    fn = run_unit if unit_fn is None else unit_fn
 
     def run(tasks: list[UnitTask]) -> Iterator[UnitOutcome]:
         if workers <= 1:
             for t in tasks:
-                yield run_unit(t)
+                yield fn(t)
             return
-        from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
-
-        ctx = _OwnedSpawnContext()
-        pool = ProcessPoolExecutor(
-            max_workers=workers,
-            mp_context=cast("BaseContext", ctx),  # a spawn context by delegation
-            initializer=_ignore_interrupts,
-        )
-        pending = {pool.submit(run_unit, t) for t in tasks}
-        try:
-            while pending:
-                done, pending = wait(pending, return_when=FIRST_COMPLETED)
-                for fut in done:
-                    yield fut.result()
-        except BaseException:
-            # Ctrl-C (or a failure): the units running are abandoned, not waited for; they
-            # were never written, so a rerun does them
-            pool.shutdown(wait=False, cancel_futures=True)
-            ctx.terminate()
-            raise
-        pool.shutdown(wait=True)
+        left = list(tasks)
+        while left:
+            left = yield from _pool_round(left, workers, fn)
 
     return run
+
+
+def _pool(workers: int) -> tuple[Any, Any]:
+    from concurrent.futures import ProcessPoolExecutor
+
+    ctx = _OwnedSpawnContext()
+    pool = ProcessPoolExecutor(
+        max_workers=workers,
+        mp_context=cast("BaseContext", ctx),  # a spawn context by delegation
+        initializer=_ignore_interrupts,
+    )
+    return ctx, pool
+
+
+def _pool_round(
+    tasks: list[UnitTask], workers: int, fn: Callable[[UnitTask], UnitOutcome]
+) -> Generator[UnitOutcome, None, list[UnitTask]]:
+    """Run ``tasks`` in one pool of ``workers`` processes; when a worker dies, settle the
+    units it may have held alone (:func:`_alone`) and return those never started."""
+    from concurrent.futures import FIRST_COMPLETED, wait
+    from concurrent.futures.process import BrokenProcessPool
+
+    ctx, pool = _pool(workers)
+    task_of = {pool.submit(fn, t): t for t in tasks}
+    pending, finished, broken = set(task_of), set(), False
+    try:
+        while pending and not broken:
+            done, pending = wait(pending, return_when=FIRST_COMPLETED)
+            for fut in done:
+                try:
+                    outcome = fut.result()
+                except BrokenProcessPool:
+                    broken = True
+                    continue
+                finished.add(task_of[fut].unit.id)
+                yield outcome
+    except BaseException:
+        # Ctrl-C (or a failure): the units running are abandoned, not waited for; they
+        # were never written, so a rerun does them
+        pool.shutdown(wait=False, cancel_futures=True)
+        ctx.terminate()
+        raise
+    if not broken:
+        pool.shutdown(wait=True)
+        return []
+    pool.shutdown(wait=False, cancel_futures=True)
+    ctx.terminate()
+    unfinished = [t for t in task_of.values() if t.unit.id not in finished]
+    for t in unfinished[: workers + 1]:
+        yield _alone(t, fn)
+    return unfinished[workers + 1 :]
+
+
+def _alone(task: UnitTask, fn: Callable[[UnitTask], UnitOutcome]) -> UnitOutcome:
+    """``task`` alone in a fresh worker process: its outcome, or :func:`lost_unit` when it
+    kills that process too."""
+    from concurrent.futures.process import BrokenProcessPool
+
+    ctx, pool = _pool(1)
+    try:
+        return cast("UnitOutcome", pool.submit(fn, task).result())
+    except BrokenProcessPool as exc:
+        return lost_unit(task, exc)
+    finally:
+        pool.shutdown(wait=False, cancel_futures=True)
+        ctx.terminate()
 
 
 def _ignore_interrupts() -> None:

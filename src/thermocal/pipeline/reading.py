@@ -135,9 +135,11 @@ def load_recording(
                 names = list(again.columns)
             except Exception:  # the listing is a courtesy; the error stands as it is
                 names = []
+        from thermocal.readers.common import names_list
+
         raise ThermocalInputError(
             f"{path}: name the signal column with --signal; available: "
-            + (", ".join(repr(c) for c in names) or "see thermocal inspect FILE")
+            + (names_list(names) or "see thermocal inspect FILE")  # 20 and how many more
         )
     if check:
         rec.validate()

@@ -26,6 +26,7 @@ from typing import TYPE_CHECKING, Any, Final
 
 from thermocal.errors import ConditioningWarning, ThermocalInputError, UnitWarning
 from thermocal.stability.allan import ONE_SIGMA_CONFIDENCE
+from thermocal.stability.edf import check_confidence
 
 if TYPE_CHECKING:
     import numpy as np
@@ -271,6 +272,7 @@ def allan_analysis(
     channel when there are several).  ``max_work``: the family's operation budget
     (:func:`thermocal.stability.family.check_work`; None: its default).
     """
+    check_confidence(confidence)
     if data_type not in DATA_TYPES:
         raise ThermocalInputError(f"--data-type {data_type!r}: use rate or phase")
     if dynamic_s is not None and (deviations is not None or data_type == "phase"):
@@ -548,6 +550,7 @@ def imu_noise(
     the axis."""
     from thermocal.stability import noise_model as nm
 
+    check_confidence(confidence)
     moved = motion_in(rec, gyro, accel)
     if moved is not None:
         warnings.warn(

@@ -797,6 +797,44 @@ def _b1_identify(
     return NoiseId(_MU_TO_ALPHA[chosen], float("nan"), "b1", 0)
 
 
+CONFIDENCE_MIN: Final = 0.5
+"""The smallest confidence level accepted: below it the interval no longer brackets the
+median of the chi-square law, so it need not contain the estimate itself (at c → 0 both
+bounds collapse onto ``σ̂ √(ν / χ²_{0.5}(ν))``, beside σ̂)."""
+CONFIDENCE_MAX: Final = 1.0 - 1e-9
+"""The largest confidence level accepted: beyond it ``(1 − c)/2`` < 5e-10 and the chi-square
+quantiles of a few degrees of freedom run to 0 or to the double range (an interval of
+``[0, ∞)`` printed as numbers)."""
+
+
+def check_confidence(confidence: float, option: str = "--confidence") -> float:
+    """Return ``confidence`` when ``CONFIDENCE_MIN ≤ c ≤ CONFIDENCE_MAX``, else raise
+    :class:`ThermocalInputError` naming ``option`` and the value (issue 39: 1e-300 gave an
+    interval of zero width beside the estimate; NaN, 0 and 1 were refused without the
+    option's name).
+
+    Parameters
+    ----------
+    confidence : float
+        Confidence level of a two-sided chi-square interval (dimensionless, e.g. 0.683 for
+        one sigma, NIST SP 1065 eq. 45).
+    option : str
+        The option's name shown in the error.
+
+    Returns
+    -------
+    float
+        ``confidence`` unchanged.
+    """
+    c = float(confidence)
+    if not CONFIDENCE_MIN <= c <= CONFIDENCE_MAX:
+        raise ThermocalInputError(
+            f"{option} {confidence!r}: give a confidence level between {CONFIDENCE_MIN} and "
+            f"{CONFIDENCE_MAX!r} (0.6827 is one sigma, 0.95 two)"
+        )
+    return c
+
+
 def confidence_interval(
     adev: npt.ArrayLike, edf: npt.ArrayLike, confidence: float = ONE_SIGMA_CONFIDENCE
 ) -> tuple[FloatArray, FloatArray]:

@@ -24,7 +24,7 @@ from dataclasses import dataclass
 from typing import Any, Protocol
 
 from thermocal.errors import ThermocalError, ThermocalInputError
-from thermocal.station.config import ChamberConfig, require
+from thermocal.station.config import ChamberConfig, check_port, require
 
 
 class ChamberError(ThermocalError):
@@ -171,6 +171,7 @@ class ModbusChamber:
             )
         else:
             require("serial")
+            check_port(self.cfg.device, f"chamber {self.name}")
             self._client = client_mod.ModbusSerialClient(
                 self.cfg.device, baudrate=self.cfg.baud, timeout=self.cfg.io_timeout_s,
                 retries=0,

@@ -56,6 +56,7 @@ from typing import Any
 
 from thermocal import units
 from thermocal.errors import ThermocalInputError
+from thermocal.outputs import refuse_special_input, special_mode
 from thermocal.readers.station import CHAMBER_STREAM  # the reader owns the stream name
 
 DRIVERS = ("modbus-tcp", "modbus-rtu", "none")
@@ -383,6 +384,7 @@ def parse_station(text: str, where: str = "STATION.toml") -> StationConfig:
 def load_station(path: str | Path) -> StationConfig:
     """Read and check ``STATION.toml`` (:func:`parse_station`)."""
     p = Path(path)
+    refuse_special_input(p, "station file (STATION.toml)")  # a FIFO is no "no such file"
     if not p.is_file():
         raise ThermocalInputError(f"{p}: no such file")
     try:
@@ -390,6 +392,18 @@ def load_station(path: str | Path) -> StationConfig:
     except UnicodeDecodeError:
         raise ThermocalInputError(f"{p}: not UTF-8 text") from None
     return parse_station(text, str(p))
+
+
+def check_port(device: str, who: str) -> None:
+    """Refuse a serial ``device`` that is a FIFO, a socket or a block device (``stat``
+    only, never opened; issue 39): pyserial would answer "Inappropriate ioctl for device".
+    A character device (``/dev/ttyUSB0``, a pty) and a pyserial URL pass."""
+    why = special_mode(Path(device))
+    if why is not None and why != "it is a character device":
+        raise ThermocalInputError(
+            f"{who}: {device}: {why}, not a serial port: give the port's device "
+            "(/dev/ttyUSB0, /dev/ttyACM0, a pty) or a pyserial URL"
+        )
 
 
 def require(module: str) -> Any:

@@ -21,7 +21,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from thermocal.station import clock
-from thermocal.station.config import SensorConfig, require
+from thermocal.station.config import SensorConfig, check_port, require
 
 DELIMITERS = (",", ";", "\t", " ")
 """Delimiters tried, in order, when the TOML gives none (those of the text-log reader)."""
@@ -143,6 +143,7 @@ class SerialSensor:
     def open(self) -> None:
         """Open the port (:class:`thermocal.errors.ThermocalInputError` naming it if not)."""
         serial = require("serial")
+        check_port(self.cfg.device, f"sensor {self.cfg.id}")
         try:
             self._port = serial.serial_for_url(
                 self.cfg.device, baudrate=self.cfg.baud, timeout=READ_TIMEOUT_S
