@@ -102,6 +102,7 @@ H39A = _t(
 H39A_ATT = _t("tests/attacks/test_allan_attacks.py")
 H39A_EDF = _t("mutants_stability", "total_edf_stable32", "noise_terms_theo1_edf")
 H39MP = _t("mutants_multipos", "tests/attacks/test_multipos_attacks.py")
+DIGITS = _t("deviation_digits")
 
 
 MUTANTS: tuple[Mutant, ...] = (
@@ -2851,6 +2852,47 @@ MUTANTS: tuple[Mutant, ...] = (
         "or t[s.end - 1] - t[s.start] < 0.0]",
         H39MP,
         "multipos: a named pose of three samples used without a word",
+    ),
+    # issue 42 slice h42-speed
+    Mutant(
+        "h42s-lane-offset-dropped",
+        P + "stability/deviations.py",
+        "        off += v  # v_j = off_c + t[i, c]",
+        "        off *= 1.0  # v_j = off_c + t[i, c]",
+        DIGITS,
+        "MDEV lanes: each column's inner sums without the running offset (v_a + column totals)",
+    ),
+    Mutant(
+        "h42s-lane-cross-term-halved",
+        P + "stability/deviations.py",
+        "+ 2.0 * float(ones @ (t @ off))",
+        "+ float(ones @ (t @ off))",
+        DIGITS,
+        "MDEV lanes: Σ (off + t)² expanded with the cross term once, not twice",
+    ),
+    Mutant(
+        "h42s-lane-tail-double-counted",
+        P + "stability/deviations.py",
+        "_modified_tail(x, m, n_terms, a, v_a) - v_a * v_a",
+        "_modified_tail(x, m, n_terms, a, v_a) - 0.0 * v_a",
+        DIGITS,
+        "MDEV: the inner sum where the lane blocks stop counted twice (lanes and tail)",
+    ),
+    Mutant(
+        "h42s-doubling-one-short",
+        P + "stability/deviations.py",
+        "        while k < m:  # d[i]",
+        "        while k < m // 2:  # d[i]",
+        DIGITS,
+        "MDEV at m = 2, 4, 8: window sums of m/2 second differences, not m",
+    ),
+    Mutant(
+        "h42s-total-raw-phase",
+        P + "stability/family.py",
+        'raw = name in ("mtie", "tierms")\n',
+        'raw = name in ("mtie", "tierms", "mtotdev", "ttotdev", "htotdev", "theo1")\n',
+        DIGITS,
+        "the total family and Theo1 on the phase before its end-point line is removed",
     ),
 )
 
