@@ -2887,12 +2887,12 @@ MUTANTS: tuple[Mutant, ...] = (
         "MDEV at m = 2, 4, 8: window sums of m/2 second differences, not m",
     ),
     Mutant(
-        "h42s-total-raw-phase",
-        P + "stability/family.py",
-        'raw = name in ("mtie", "tierms")\n',
-        'raw = name in ("mtie", "tierms", "mtotdev", "ttotdev", "htotdev", "theo1")\n',
+        "h42s-phase-mean-kept",
+        P + "stability/deviations.py",
+        "    np.subtract(values, offset, out=x[1:])",
+        "    np.subtract(values, 0.0, out=x[1:])",
         DIGITS,
-        "the total family and Theo1 on the phase before its end-point line is removed",
+        "rate → phase without the mean removed: the phase's running sum carries the 1e6 °/h",
     ),
 )
 

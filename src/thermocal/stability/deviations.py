@@ -340,11 +340,19 @@ _LANE_CHUNK: Final = 1 << 18
 def lane_layout(x: FloatArray) -> FloatArray:
     """x as a (:data:`_LANES`, ⌈N / L⌉) array: row i, column c holds x_{cL+i} (zero past the
     end).  A shift of the index by m = kL is a shift of k columns, the same in every row: the
-    third differences of :func:`_lane_modified_sum` come out already laid in lanes."""
+    third differences of :func:`_lane_modified_sum` come out already laid in lanes.  Copied
+    in blocks of 1024 columns (a transposed copy of the whole is ≈ 5× slower)."""
     cols = -(-x.size // _LANES)
-    flat = np.zeros(cols * _LANES)
-    flat[: x.size] = x
-    return np.ascontiguousarray(flat.reshape(cols, _LANES).T)
+    full = x.size // _LANES
+    out = np.zeros((_LANES, cols))
+    src = x[: full * _LANES].reshape(full, _LANES)
+    for a in range(0, full, 1024):
+        b = min(a + 1024, full)
+        np.copyto(out[:, a:b], src[a:b].T)
+    rest = x.size - full * _LANES
+    if rest:
+        out[:rest, full] = x[full * _LANES :]
+    return out
 
 
 def _lane_modified_sum(
