@@ -485,10 +485,15 @@ def _fast_sums(name: str, x: FloatArray, m: IntArray) -> tuple[FloatArray, Float
         return sums, (n - d * m).astype(np.float64)
     if name in ("mdev", "tdev"):  # inner sums slid along by third differences
         big = bool(np.any((m % _LANES == 0) & (n - 3 * m > _LANE_CHUNK)))
-        lane = lane_layout(x) if big else None
+        # the lane layout made by one thread while the other takes the small m (submitted
+        # before the sums: first in the queue, so a sum waiting on it never blocks it)
+        lane = _pool().submit(lane_layout, x) if big and _WORKERS > 1 else None
+        ready = lane_layout(x) if big and lane is None else None
 
         def mod(arr: FloatArray, step: int, n_terms: int) -> float:
-            return modified_sum(arr, step, n_terms, lane)
+            if lane is not None and step % _LANES == 0:
+                return modified_sum(arr, step, n_terms, lane.result())
+            return modified_sum(arr, step, n_terms, ready)
 
         sums = difference_sums(lambda mm: (x, mm, n - 3 * mm + 1), m, THIRD, kernel=mod)
         return sums, (n - 3 * m + 1).astype(np.float64)
