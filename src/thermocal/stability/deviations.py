@@ -360,40 +360,83 @@ def _lane_modified_sum(
 ) -> tuple[float, int, float]:
     """(Σ_{0≤j≤a} v_j², a, v_a) of :func:`modified_sum` for m a multiple of :data:`_LANES`
     over whole blocks of :data:`_LANE_CHUNK` terms (a: where they stop), from the phase in
-    :func:`lane_layout`: per block the third differences t_{a+cL+i} at [i, c] (column shifts
-    of m / L), summed down the rows (each column a run of L consecutive t), the columns'
-    totals summed along and added with v_a to every column: v_{a+1} … v_{a+B} in place."""
-    k = m // _LANES
-    cb = _LANE_CHUNK // _LANES
-    nested = 2 * k <= cb
-    t = np.empty((_LANES, cb))
-    e1 = np.empty((_LANES, cb + 2 * k)) if nested else np.empty((_LANES, cb))
-    e2 = np.empty((_LANES, cb + k)) if nested else e1
+    :func:`lane_layout` (:func:`_lane_block` per block)."""
+    bufs = _LaneBuffers(m // _LANES)
     total, a = v * v, 0
-    ones = np.ones(_LANES)
     while a + _LANE_CHUNK <= n_terms - 1:  # t_j for j < n_terms − 1
-        s = a // _LANES
-        if nested:
-            np.subtract(lane[:, s + k : s + cb + 3 * k], lane[:, s : s + cb + 2 * k], out=e1)
-            np.subtract(e1[:, k:], e1[:, : cb + k], out=e2)
-            np.subtract(e2[:, k:], e2[:, :cb], out=t)
-        else:
-            np.subtract(lane[:, s + 3 * k : s + cb + 3 * k], lane[:, s : s + cb], out=t)
-            np.subtract(lane[:, s + k : s + cb + k], lane[:, s + 2 * k : s + cb + 2 * k], out=e1)
-            e1 *= 3.0
-            t += e1
-        for i in range(1, _LANES):
-            np.add(t[i], t[i - 1], out=t[i])
-        off = np.cumsum(t[-1])  # v_{a+(c+1)L} − v_a
-        v_next = v + float(off[-1])
-        off[1:] = off[:-1]
-        off[0] = 0.0
-        off += v  # v_j = off_c + t[i, c]: Σ v² = Σ t² + 2 Σ_c off_c Σ_i t[i, c] + L Σ off²
-        flat = t.reshape(-1)
-        total += float(flat @ flat) + 2.0 * float(ones @ (t @ off)) + _LANES * float(off @ off)
+        sq, v = _lane_block(lane, m // _LANES, a // _LANES, v, bufs)
+        total += sq
         a += _LANE_CHUNK
-        v = v_next
     return total, a, v
+
+
+class _LaneBuffers:
+    """Work arrays of :func:`_lane_block` for column shifts up to ``k``."""
+
+    def __init__(self, k: int) -> None:
+        cb = _LANE_CHUNK // _LANES
+        self.nested = 2 * k <= cb
+        self.t = np.empty((_LANES, cb))
+        self.e1 = np.empty((_LANES, cb + 2 * k)) if self.nested else np.empty((_LANES, cb))
+        self.e2 = np.empty((_LANES, cb + k)) if self.nested else self.e1
+        self.ones = np.ones(_LANES)
+
+
+def _lane_block(
+    lane: FloatArray, k: int, s: int, v: float, bufs: _LaneBuffers
+) -> tuple[float, float]:
+    """(Σ v_j², v_{a+B}) over j = a + 1 … a + B (a = s L, B = :data:`_LANE_CHUNK`) given
+    v = v_a, m = kL: the third differences t_{a+cL+i} at [i, c] (column shifts of k), summed
+    down the rows (each column a run of L consecutive t), the columns' totals summed along
+    and added with v_a: v_{a+cL+i+1} = off_c + t[i, c]."""
+    cb = _LANE_CHUNK // _LANES
+    t, e1 = bufs.t, bufs.e1
+    if 2 * k <= cb:
+        e1, e2 = e1[:, : cb + 2 * k], bufs.e2[:, : cb + k]
+        np.subtract(lane[:, s + k : s + cb + 3 * k], lane[:, s : s + cb + 2 * k], out=e1)
+        np.subtract(e1[:, k:], e1[:, : cb + k], out=e2)
+        np.subtract(e2[:, k:], e2[:, :cb], out=t)
+    else:
+        np.subtract(lane[:, s + 3 * k : s + cb + 3 * k], lane[:, s : s + cb], out=t)
+        np.subtract(lane[:, s + k : s + cb + k], lane[:, s + 2 * k : s + cb + 2 * k], out=e1)
+        e1 *= 3.0
+        t += e1
+    for i in range(1, _LANES):
+        np.add(t[i], t[i - 1], out=t[i])
+    off = np.cumsum(t[-1])  # v_{a+(c+1)L} − v_a
+    v_next = v + float(off[-1])
+    off[1:] = off[:-1]
+    off[0] = 0.0
+    off += v  # v_j = off_c + t[i, c]: Σ v² = Σ t² + 2 Σ_c off_c Σ_i t[i, c] + L Σ off²
+    flat = t.reshape(-1)
+    sq = float(flat @ flat) + 2.0 * float(bufs.ones @ (t @ off)) + _LANES * float(off @ off)
+    return sq, v_next
+
+
+def lane_group_sums(x: FloatArray, lane: FloatArray, ms: list[int]) -> list[float]:
+    """:func:`modified_sum` for several m (multiples of :data:`_LANES`, m/L ≤ half a block,
+    N − 3m > :data:`_LANE_CHUNK`) in ONE pass over the lane layout: each block of phase is
+    read from memory once for all of them (the sums are bound by memory, not arithmetic)."""
+    n = x.size
+    ks = [mm // _LANES for mm in ms]
+    n_terms = [n - 3 * mm + 1 for mm in ms]
+    vs, totals = [], []
+    for mm in ms:
+        first = x[2 * mm : 3 * mm] - 2.0 * x[mm : 2 * mm]
+        first += x[:mm]
+        vs.append(float(np.sum(first)))
+        totals.append(vs[-1] * vs[-1])
+    bufs = _LaneBuffers(max(ks))
+    ends = [(nt - 1) // _LANE_CHUNK * _LANE_CHUNK for nt in n_terms]
+    for a in range(0, max(ends), _LANE_CHUNK):
+        for i, k in enumerate(ks):
+            if a < ends[i]:
+                sq, vs[i] = _lane_block(lane, k, a // _LANES, vs[i], bufs)
+                totals[i] += sq
+    return [
+        tot + _modified_tail(x, mm, nt, e, v) - v * v
+        for tot, mm, nt, e, v in zip(totals, ms, n_terms, ends, vs, strict=True)
+    ]
 
 
 def difference_sums(
@@ -469,6 +512,34 @@ _OVERLAPPING: Final = {"oadev": (2, SECOND), "ohdev": (3, THIRD), "tierms": (1, 
 """Differences taken and taps of the overlapping deviations of :func:`_fast_sums`."""
 
 
+def _modified_sums(x: FloatArray, m: IntArray) -> FloatArray:
+    """:func:`modified_sum` per m: the m of :func:`lane_group_sums` in two groups (one per
+    thread, each one pass over the phase), the lane layout made by a pool thread first (first
+    in the queue: a sum waiting on it never blocks it), the other m by :func:`difference_sums`."""
+    n = x.size
+    lanes = (m % _LANES == 0) & (n - 3 * m > _LANE_CHUNK)
+    grouped = lanes & (2 * (m // _LANES) <= _LANE_CHUNK // _LANES)
+    out = np.zeros(m.size)
+    with threadpool_limits(limits=1, user_api="blas"):
+        lane = _pool().submit(lane_layout, x) if np.any(lanes) else None
+        idx = np.flatnonzero(grouped)
+        jobs = [
+            (part, _pool().submit(lambda g: lane_group_sums(x, lane.result(), g), m[part].tolist()))
+            for part in (idx[0::2], idx[1::2])
+            if part.size and lane is not None
+        ]
+
+        def mod(arr: FloatArray, step: int, n_terms: int) -> float:
+            ready = lane.result() if lane is not None and step % _LANES == 0 else None
+            return modified_sum(arr, step, n_terms, ready)
+
+        rest = np.flatnonzero(~grouped)
+        out[rest] = difference_sums(lambda mm: (x, mm, n - 3 * mm + 1), m[rest], THIRD, kernel=mod)
+        for part, job in jobs:
+            out[part] = job.result()
+    return out
+
+
 def _fast_sums(name: str, x: FloatArray, m: IntArray) -> tuple[FloatArray, FloatArray]:
     """(Σ of squared differences, terms) per valid m of the finite-difference deviations
     (:data:`_FAST`), through :func:`difference_sums`."""
@@ -484,19 +555,7 @@ def _fast_sums(name: str, x: FloatArray, m: IntArray) -> tuple[FloatArray, Float
         sums = difference_sums(lambda mm: (x, mm, n - d * mm), m, taps, nested=True)
         return sums, (n - d * m).astype(np.float64)
     if name in ("mdev", "tdev"):  # inner sums slid along by third differences
-        big = bool(np.any((m % _LANES == 0) & (n - 3 * m > _LANE_CHUNK)))
-        # the lane layout made by one thread while the other takes the small m (submitted
-        # before the sums: first in the queue, so a sum waiting on it never blocks it)
-        lane = _pool().submit(lane_layout, x) if big and _WORKERS > 1 else None
-        ready = lane_layout(x) if big and lane is None else None
-
-        def mod(arr: FloatArray, step: int, n_terms: int) -> float:
-            if lane is not None and step % _LANES == 0:
-                return modified_sum(arr, step, n_terms, lane.result())
-            return modified_sum(arr, step, n_terms, ready)
-
-        sums = difference_sums(lambda mm: (x, mm, n - 3 * mm + 1), m, THIRD, kernel=mod)
-        return sums, (n - 3 * m + 1).astype(np.float64)
+        return _modified_sums(x, m), (n - 3 * m + 1).astype(np.float64)
     # totdev: the series extended by odd reflection at both ends, N − 2 terms centred on it
     ext = np.concatenate([2.0 * x[0] - x[n - 2 : 0 : -1], x, 2.0 * x[-1] - x[-2:0:-1]])
     mid = n - 2
