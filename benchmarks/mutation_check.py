@@ -106,6 +106,7 @@ ADEQ_H39 = ("tests/test_mutants_adequacy.py", *ADEQ)
 ST_ATT2 = ("tests/attacks/test_station_attacks_2.py",)
 AUDIT = _t("tests/attacks/test_audit39_attacks.py")
 H39L = _t("tests/attacks/test_leftover39_attacks.py")
+DIGITS = _t("deviation_digits")
 
 
 MUTANTS: tuple[Mutant, ...] = (
@@ -3163,6 +3164,47 @@ MUTANTS: tuple[Mutant, ...] = (
         '            + (", ".join(repr(c) for c in names) or "see thermocal inspect FILE")',
         H39L,
         "allan/fit/noise: 'name the signal column' lists 10 000 names on one line",
+    ),
+    # issue 42 slice h42-speed
+    Mutant(
+        "h42s-lane-offset-dropped",
+        P + "stability/deviations.py",
+        "    off += v  # v_j = off_c + t[i, c]",
+        "    off *= 1.0  # v_j = off_c + t[i, c]",
+        DIGITS,
+        "MDEV lanes: each column's inner sums without the running offset (v_a + column totals)",
+    ),
+    Mutant(
+        "h42s-lane-cross-term-halved",
+        P + "stability/deviations.py",
+        "+ 2.0 * float(bufs.ones @ (t @ off))",
+        "+ float(bufs.ones @ (t @ off))",
+        DIGITS,
+        "MDEV lanes: Σ (off + t)² expanded with the cross term once, not twice",
+    ),
+    Mutant(
+        "h42s-lane-tail-double-counted",
+        P + "stability/deviations.py",
+        "tot + _modified_tail(x, mm, nt, e, v) - v * v",
+        "tot + _modified_tail(x, mm, nt, e, v) - 0.0 * v",
+        DIGITS,
+        "MDEV: the inner sum where the lane blocks stop counted twice (lanes and tail)",
+    ),
+    Mutant(
+        "h42s-doubling-one-short",
+        P + "stability/deviations.py",
+        "        while k < m:  # d[i]",
+        "        while k < m // 2:  # d[i]",
+        DIGITS,
+        "MDEV at m = 2, 4, 8: window sums of m/2 second differences, not m",
+    ),
+    Mutant(
+        "h42s-phase-mean-kept",
+        P + "stability/deviations.py",
+        "    np.subtract(values, offset, out=x[1:])",
+        "    np.subtract(values, 0.0, out=x[1:])",
+        DIGITS,
+        "rate → phase without the mean removed: the phase's running sum carries the 1e6 °/h",
     ),
 )
 

@@ -148,3 +148,87 @@ def test_mdev_any_factor_across_blocks() -> None:
     for mm, dev in zip(curve.m.tolist(), curve.dev.tolist(), strict=True):
         ref = _reference("mdev", ints, int(mm))
         assert abs(dev - ref) / ref <= REL, (mm, dev, ref)
+
+
+# The total family and Theo1 (issue 42): their kernels are O(N·m) per τ, so the records are
+# short (N ≈ 3e3–1e4) but carry the same 1e6 °/h offset.  The reference evaluates NIST SP
+# 1065 eqs. 27–30 directly in numpy float64 on the record with its offset removed EXACTLY
+# (J_i = I_i − 1e6·SCALE, integers): every one of these deviations cancels a constant rate
+# (a phase line) — MTOT/HTOT remove each subsequence's own line, Theo1's taps sum to zero —
+# so the offset-free record has the same deviations, and its phase X_k = Σ_{i<k} J_i is an
+# exact integer of at most ~1e9, whose float64 sums keep ~1e-15 of their digits.
+OFFSET = 1_000_000 * SCALE
+"""The 1e6 °/h offset in integer units (exactly representable)."""
+
+
+def _half_mean_detrended(seg: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]:
+    """Rows of ``seg`` (3m points each) less their line through the means of the first and
+    last ⌊3m/2⌋ points (SP 1065 §5.2.8: the half-average slope; for odd 3m the middle point
+    is in neither half), the slope per point being the difference of the half means over
+    the distance between the halves' centres."""
+    p = seg.shape[1]
+    h = p // 2
+    first, last = seg[:, :h].mean(axis=1), seg[:, p - h :].mean(axis=1)
+    slope = (last - first) / (p - h)  # centres (h − 1)/2 and (2p − h − 1)/2 apart: p − h
+    return np.asarray(seg - slope[:, None] * np.arange(p)[None, :])
+
+
+def _tot_reference(z: npt.NDArray[np.float64], m: int) -> float:
+    """Σ_n (1/6m) Σ_{i<6m} (Σ_{k=i}^{i+m−1} x#_{k+2m} − 2x#_{k+m} + x#_k)² / m² over the
+    N − 3m + 1 subsequences of 3m points of ``z``, each detrended (half means) and extended
+    by uninverted even reflection to 9m points x# (SP 1065 eqs. 27 and 29)."""
+    seg = _half_mean_detrended(np.lib.stride_tricks.sliding_window_view(z, 3 * m))
+    ext = np.concatenate([seg[:, ::-1], seg, seg[:, ::-1]], axis=1)  # 9m points
+    d2 = ext[:, 2 * m :] - 2.0 * ext[:, m : 8 * m] + ext[:, : 7 * m]  # 7m second differences
+    c = np.zeros((d2.shape[0], d2.shape[1] + 1))
+    np.cumsum(d2, axis=1, out=c[:, 1:])  # of detrended differences: small, no cancellation
+    inner = (c[:, m : 7 * m] - c[:, : 6 * m]) / m  # i = 0 … 6m − 1
+    return float(np.sum(inner * inner)) / (6.0 * m)
+
+
+def _total_reference(name: str, ints: I64, m: int) -> float:
+    """mtotdev, ttotdev, htotdev or theo1 of y = ints / SCALE [°/h] every TAU0 at factor m,
+    by SP 1065's definitions on the offset-free record (see OFFSET)."""
+    j = ints - OFFSET
+    x = np.zeros(j.size + 1, dtype=np.int64)
+    np.cumsum(j, out=x[1:])
+    xf = x.astype(np.float64)  # phase in units of TAU0 / SCALE, exact
+    unit, tau = TAU0 / SCALE, m * TAU0
+    n = xf.size
+    if name in ("mtotdev", "ttotdev"):  # eq. 27 (ttotdev: eq. 28, τ²/3 of it)
+        var = _tot_reference(xf, m) * unit**2 / (2.0 * tau * tau * (n - 3 * m + 1))
+        return math.sqrt(var * tau * tau / 3.0) if name == "ttotdev" else math.sqrt(var)
+    if name == "htotdev":  # eq. 29 on the rate; m = 1 is ohdev (Stable32's convention)
+        yf = j.astype(np.float64)  # rate in units of 1 / SCALE
+        if m == 1:
+            t = xf[3:] - 3.0 * xf[2:-1] + 3.0 * xf[1:-2] - xf[:-3]
+            return math.sqrt(float(t @ t) / (6.0 * t.size)) * unit / tau
+        var = _tot_reference(yf, m) / (6.0 * (yf.size - 3 * m + 1))
+        return math.sqrt(var) / SCALE
+    if name == "theo1":  # eq. 30, m even, τ = 0.75 m τ0
+        h, k = m // 2, n - m
+        total = 0.0
+        for dl in range(h):
+            i = np.arange(k)
+            v = (xf[i] - xf[i - dl + h]) + (xf[i + m] - xf[i + dl + h])
+            total += float(v @ v) / (h - dl)
+        return math.sqrt(total / (0.75 * k)) * unit / tau
+    raise ValueError(name)
+
+
+@pytest.mark.parametrize(
+    ("names", "n"), [(("mtotdev", "ttotdev"), 3000), (("htotdev",), 3000), (("theo1",), 10_000)]
+)
+def test_total_family_and_theo1_keep_their_digits(names: tuple[str, ...], n: int) -> None:
+    """MTOT, TTOT, HTOT and Theo1 of a record of 1e6 °/h + random walk + white noise within
+    1e-9 of SP 1065's definition evaluated on the offset-free record, at every octave τ."""
+    ints = _record(n, 6)
+    res = stability(ints.astype(np.float64) / SCALE, TAU0, list(names), "octave")
+    for name in names:
+        curve = res.curves[name]
+        ok = curve.n_terms > 0
+        assert np.count_nonzero(ok) >= 5, name
+        for m, dev in zip(curve.m[ok].tolist(), curve.dev[ok].tolist(), strict=True):
+            ref = _total_reference(name, ints, int(m))
+            rel = abs(dev - ref) / ref
+            assert rel <= REL, f"{name} m={m}: {dev!r} vs {ref!r} (rel {rel:.2e})"
