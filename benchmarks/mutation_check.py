@@ -3058,6 +3058,23 @@ MUTANTS: tuple[Mutant, ...] = (
         AUDIT,
         "demo --seed -5: exit 1 from numpy with a half-made folder",
     ),
+    # issue 39 lead: the triad simulators' sample budget
+    Mutant(
+        "lead-turntable-sim-budget-off",
+        P + "turntable/simulate.py",
+        "if not wanted <= MAX_SIMULATED_SAMPLES:",
+        "if wanted < 0:",
+        AUDIT,
+        "simulate turntable-16 --rate-hz 1e12 allocates unchecked: MemoryError, exit 1",
+    ),
+    Mutant(
+        "lead-multipos-sim-budget-off",
+        P + "multipos/simulate.py",
+        "if not wanted <= MAX_SIMULATED_SAMPLES:",
+        "if wanted < 0:",
+        AUDIT,
+        "simulate multipos --rate-hz 1e12 allocates unchecked: MemoryError, exit 1",
+    ),
 )
 
 
