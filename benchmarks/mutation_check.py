@@ -3206,6 +3206,23 @@ MUTANTS: tuple[Mutant, ...] = (
         DIGITS,
         "rate → phase without the mean removed: the phase's running sum carries the 1e6 °/h",
     ),
+    # issue 39 lead: the triad simulators' sample budget
+    Mutant(
+        "lead-turntable-sim-budget-off",
+        P + "turntable/simulate.py",
+        "if not wanted <= MAX_SIMULATED_SAMPLES:",
+        "if wanted < 0:",
+        AUDIT,
+        "simulate turntable-16 --rate-hz 1e12 allocates unchecked: MemoryError, exit 1",
+    ),
+    Mutant(
+        "lead-multipos-sim-budget-off",
+        P + "multipos/simulate.py",
+        "if not wanted <= MAX_SIMULATED_SAMPLES:",
+        "if wanted < 0:",
+        AUDIT,
+        "simulate multipos --rate-hz 1e12 allocates unchecked: MemoryError, exit 1",
+    ),
 )
 
 

@@ -63,3 +63,12 @@ ALLOW_MOTION: Final = "--allow-motion"
 def overrides_of(allow_narrow: bool, allow_motion: bool) -> tuple[str, ...]:
     """The adequacy overrides a command was given (:mod:`thermocal.adequacy`)."""
     return tuple(o for o, on in ((ALLOW_NARROW, allow_narrow), (ALLOW_MOTION, allow_motion)) if on)
+
+
+MAX_SIMULATED_SAMPLES: Final = 20_000_000
+"""The most samples one call of a simulator makes (duration × rate, summed over the files
+it writes): 2e7 samples, about 1.6 GB of float64 over the ~10 arrays a scenario builds
+(the built-in programs at their own rates hold ≤ 2.4e5).  More is refused before any
+array is allocated: ``simulate --rate-hz 1e9`` asked for 1.66 PiB and ended in a
+MemoryError.  Shared by the chamber scenarios, the turntable and the multi-position
+simulators."""

@@ -584,13 +584,7 @@ def test_attack(attack: Attack, tmp_path: Path, capsys: pytest.CaptureFixture[st
         attack.check(tmp_path, err)
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="turntable/multipos simulators (the multipos/turntable "
-    "slice's files) allocate duration × rate samples unchecked: MemoryError, "
-    "exit 1 (issue 39 audit)",
-)
-@pytest.mark.parametrize("scenario", ["turntable-16", "multipos"])
+@pytest.mark.parametrize("scenario", ["turntable-16", "turntable-thermal", "multipos"])
 def test_the_triad_simulators_refuse_an_absurd_rate(
     scenario: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
@@ -599,4 +593,7 @@ def test_the_triad_simulators_refuse_an_absurd_rate(
         code = main(["simulate", scenario, "-o", str(tmp_path / "s"), "--rate-hz", "1e12"])
     err = capsys.readouterr().err
     assert code == 2, err[-500:]
-    assert err.strip().splitlines()[-1].startswith("error: ") and "--rate-hz" in err
+    lines = err.strip().splitlines()
+    assert lines[-1].startswith("error: ") and "--rate-hz" in lines[-1], err[-500:]
+    assert sum(ln.startswith("error: ") for ln in lines) == 1, err[-500:]
+    assert not (tmp_path / "s").exists(), "a simulation folder was left"

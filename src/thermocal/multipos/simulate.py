@@ -23,6 +23,8 @@ import numpy as np
 import numpy.typing as npt
 
 from thermocal import units
+from thermocal.defaults import MAX_SIMULATED_SAMPLES
+from thermocal.errors import ThermocalInputError
 from thermocal.multipos.geometry import attitude_along, matrix_to_rotvec
 from thermocal.turntable import model
 
@@ -232,6 +234,15 @@ def _body_rates(
     next), with a 360° turn about the vertical after pose k of sense ``turn_after[k]``;
     the still windows and the turns' sample ranges."""
     dt = 1.0 / spec.rate_hz
+    # the most samples the loop below can make (dwell and move drawn up to 1.3×)
+    wanted = spec.rate_hz * (
+        len(cs) * 1.3 * (spec.dwell_s + spec.move_s) + len(turn_after) * spec.turn_s
+    )
+    if not wanted <= MAX_SIMULATED_SAMPLES:
+        raise ThermocalInputError(
+            f"rate_hz {spec.rate_hz:g}: up to {wanted:.3g} samples for {len(cs)} poses, "
+            f"above the limit of {MAX_SIMULATED_SAMPLES:.3g}: lower --rate-hz"
+        )
     rates = []
     poses = []
     turns = {}

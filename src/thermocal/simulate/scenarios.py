@@ -16,6 +16,7 @@ import numpy as np
 import numpy.typing as npt
 
 from thermocal import units
+from thermocal.defaults import MAX_SIMULATED_SAMPLES
 from thermocal.errors import ThermocalInputError
 from thermocal.profiles import (
     POWER_ON_LABEL,
@@ -75,11 +76,8 @@ def _program(profile: ProfileInput, default: str) -> tuple[ProgramArrays, list[S
     return (t, c), find_holds(t, c)
 
 
-MAX_SAMPLES = 20_000_000
-"""The most samples one simulated file holds (duration × rate, summed over the files of
-one call): 2e7 samples, about 1.6 GB of float64 over the ~10 arrays a scenario builds
-(the built-in programs at their own rates hold ≤ 2.4e5).  More is refused before any
-array is allocated (issue 39 audit: ``--rate-hz 1e9`` asked for 1.66 PiB, exit 1)."""
+MAX_SAMPLES = MAX_SIMULATED_SAMPLES
+"""See :data:`thermocal.defaults.MAX_SIMULATED_SAMPLES`."""
 
 
 def check_sample_budget(n: float, what: str) -> None:

@@ -21,6 +21,8 @@ import numpy as np
 import numpy.typing as npt
 
 from thermocal import units
+from thermocal.defaults import MAX_SIMULATED_SAMPLES
+from thermocal.errors import ThermocalInputError
 from thermocal.recording import Metadata, Recording
 from thermocal.turntable import kinematics, model
 from thermocal.turntable.schedule import POSITIONS_16, build_schedule
@@ -93,6 +95,12 @@ def _sampled_motion(
     """Samples of a schedule at ``rate_hz``: (n, time [s], α [°], β [°], the mean true body
     rate over each interval ending at sample i [rad/s], row 0 at rest)."""
     tau = 1.0 / rate_hz
+    wanted = sched.duration_s * rate_hz + 1.0
+    if not wanted <= MAX_SIMULATED_SAMPLES:
+        raise ThermocalInputError(
+            f"rate_hz {rate_hz:g}: {wanted:.3g} samples over the {sched.duration_s:g} s "
+            f"schedule, above the limit of {MAX_SIMULATED_SAMPLES:.3g}: lower --rate-hz"
+        )
     n = int(np.floor(sched.duration_s * rate_hz)) + 1
     t = np.arange(n, dtype=np.float64) * tau
     a_deg, b_deg = sched.angles_at(t)
