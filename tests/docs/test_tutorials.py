@@ -168,7 +168,7 @@ ARCSEC = 180.0 / math.pi * 3600.0
 def _triad_rows(printed: str, title: str) -> dict[str, tuple[float, float]]:
     """parameter → (value, σ) of one triad's table."""
     lines = printed.splitlines()
-    start = next(i for i, ln in enumerate(lines) if ln.startswith(title))
+    start = next(i for i, ln in enumerate(lines) if ln.lstrip().startswith(title))
     rows: dict[str, tuple[float, float]] = {}
     for ln in lines[start + 4 :]:
         if not ln.startswith("│"):

@@ -117,7 +117,9 @@ def drawing_names() -> Iterator[None]:
     import warnings
 
     with warnings.catch_warnings():
-        warnings.filterwarnings("ignore", r"Glyph \d+ .*missing from font", UserWarning)
+        # matplotlib ≥ 3.9: "… missing from font(s) …"; 3.8 (the floor): "… missing from
+        # current font."
+        warnings.filterwarnings("ignore", r"Glyph \d+ .*missing from", UserWarning)
         yield
 
 
