@@ -2249,7 +2249,7 @@ MUTANTS: tuple[Mutant, ...] = (
     Mutant(
         "names-report-glyph-warning",
         P + "report/figures.py",
-        'r"Glyph \\d+ .*missing from font"',
+        'r"Glyph \\d+ .*missing from"',
         'r"Glyph never"',
         NAMES,
         "matplotlib's missing-glyph warning on a name with NEL: a foreign line (exit 1 -W error)",
@@ -2747,9 +2747,9 @@ MUTANTS: tuple[Mutant, ...] = (
     ),
     Mutant(
         "h39mp-scale-factor-refused",
-        P + "multipos/calibrate.py",
-        "SCALE_FACTOR_REFUSED = 0.5",
-        "SCALE_FACTOR_REFUSED = 50.0",
+        P + "turntable/model.py",
+        "SCALE_FACTOR_REFUSED: Final = 0.5",
+        "SCALE_FACTOR_REFUSED: Final = 50.0",
         H39MP,
         "multipos: --accel-unit mg on m/s² data written (scale factors −99 %)",
     ),
@@ -2812,8 +2812,8 @@ MUTANTS: tuple[Mutant, ...] = (
     Mutant(
         "h39mp-tt-scale-refused",
         P + "turntable/calibrate.py",
-        "SCALE_FACTOR_REFUSED = 0.5",
-        "SCALE_FACTOR_REFUSED = 500.0",
+        "bad = model.scale_factors_beyond(theta)",
+        "bad = []",
         H39MP,
         "turntable: a °/s gyro declared °/h written (scale factors −99.97 %)",
     ),

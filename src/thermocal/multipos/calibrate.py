@@ -36,6 +36,7 @@ from thermocal.multipos import gyro as _gyro
 from thermocal.multipos.geometry import attitude_along
 from thermocal.multipos.poses import FACES, Section, detect_poses
 from thermocal.turntable import model
+from thermocal.turntable.model import SCALE_FACTOR_REFUSED
 
 FloatArray = npt.NDArray[np.float64]
 
@@ -49,13 +50,6 @@ GYRO_E_PLAUSIBLE = 0.10
 is not a sensor's: a wrong unit, count scale or pose is warned of (the turns' own bound,
 :data:`.gyro.TURN_ANGLE_TOLERANCE`)."""
 
-
-SCALE_FACTOR_REFUSED = 0.5
-"""A fitted scale factor beyond ±50 % is refused, not written: the columns are not in the
-unit they are declared in (``--accel-unit mg`` on m/s² data gives −99 %, a gyro in rad/s
-declared °/s +5630 %), or a count scale is wrong by more than a factor 1.5; the fit's
-``I + E`` then only converts units.  Between :data:`GYRO_E_PLAUSIBLE` and this a gyro is
-warned of (a count scale from the wrong range setting can still be compensated)."""
 
 ACCEL_RESIDUAL_REFUSED = 0.05
 """The accelerometer's gravity-magnitude residual rms after calibration, as a fraction of
@@ -74,9 +68,7 @@ def check_accel_fit(acc: _accel.AccelFit, g_mg: float, where: str) -> None:
     fails its own checks, before anything is written: a scale factor beyond
     :data:`SCALE_FACTOR_REFUSED`, a gravity-magnitude residual rms after calibration above
     :data:`ACCEL_RESIDUAL_REFUSED` × ``g`` or not below the one before (``g_mg`` [mg])."""
-    sf = acc.theta[3:6] * units.PPM
-    bad = [f"{ax} {100 * v:+.4g} %" for ax, v in zip("xyz", sf, strict=True)
-           if not abs(v) <= SCALE_FACTOR_REFUSED]  # fmt: skip
+    bad = model.scale_factors_beyond(acc.theta)
     if bad:
         raise DesignError(
             f"{where}: the accelerometer's scale factors come out {', '.join(bad)} (beyond "
@@ -101,9 +93,7 @@ def check_gyro_fit(gfit: _gyro.GyroFit, where: str) -> None:
     checks, before anything is written: a scale factor beyond :data:`SCALE_FACTOR_REFUSED`,
     or a direction residual rms over the motions after calibration above
     :data:`GYRO_DIRECTION_REFUSED_DEG` or not below the one before."""
-    sf = gfit.theta[3:6] * units.PPM
-    bad = [f"{ax} {100 * v:+.4g} %" for ax, v in zip("xyz", sf, strict=True)
-           if not abs(v) <= SCALE_FACTOR_REFUSED]  # fmt: skip
+    bad = model.scale_factors_beyond(gfit.theta)
     if bad:
         raise DesignError(
             f"{where}: the gyro's scale factors come out {', '.join(bad)} (beyond "

@@ -25,6 +25,7 @@ from thermocal.errors import MissingValueError, ThermocalInputError, UnitError
 from thermocal.recording import Recording
 from thermocal.turntable import accel as accel_mod
 from thermocal.turntable import estimate_ls, kalman, model, schedule
+from thermocal.turntable.model import SCALE_FACTOR_REFUSED
 from thermocal.turntable.schedule import TurntableWarning
 
 FloatArray = npt.NDArray[np.float64]
@@ -300,9 +301,6 @@ def _check_azimuth(
     return None
 
 
-SCALE_FACTOR_REFUSED = 0.5
-"""A fitted scale factor beyond ±50 % is refused, not written: the columns are not in the
-unit declared (a °/s gyro declared °/h gave −999722 ppm, declared rad/s +5.6e7 ppm)."""
 RESIDUAL_REFUSED = 20.0
 """Least-squares residuals beyond this many times the white-noise level (χ²/dof beyond
 400) are refused: the encoder angles and the earth rate do not describe the run as the
@@ -319,9 +317,7 @@ def _check_fit(est: _Estimates, acc: accel_mod.AccelEstimate | None, name: str) 
                               "--accel-unit")):  # fmt: skip
         if theta is None:
             continue
-        sf = np.asarray(theta[3:6]) * 1e-6
-        bad = [f"{ax} {100 * v:+.4g} %" for ax, v in zip("xyz", sf, strict=True)
-               if not abs(v) <= SCALE_FACTOR_REFUSED]  # fmt: skip
+        bad = model.scale_factors_beyond(theta)
         if bad:
             raise ThermocalInputError(
                 f"{name}: the {kind}'s scale factors come out {', '.join(bad)} (beyond "

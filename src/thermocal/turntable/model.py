@@ -74,6 +74,28 @@ import numpy.typing as npt
 from thermocal import units
 from thermocal.turntable import kinematics
 
+SCALE_FACTOR_REFUSED: Final = 0.5
+"""A fitted scale factor beyond ±50 % is refused, not written, by the turntable and the
+multi-position calibrations alike: the columns are not in the unit they are declared in (a
+°/s gyro declared °/h gave −999722 ppm, declared rad/s +5.6e7 ppm; ``--accel-unit mg`` on
+m/s² data −99 %), or a count scale is wrong by more than a factor 1.5."""
+
+
+def scale_factors_beyond(theta: npt.ArrayLike) -> list[str]:
+    """``"x +5630 %"`` for each scale factor of a triad's parameters beyond
+    ±:data:`SCALE_FACTOR_REFUSED` (empty: all within).
+
+    Parameters
+    ----------
+    theta : array_like
+        The triad's parameter vector in this module's layout: ``theta[3:6]`` are the x, y,
+        z scale factors [ppm].
+    """
+    sf = np.asarray(theta, dtype=np.float64)[3:6] * units.PPM
+    return [f"{ax} {100 * v:+.4g} %" for ax, v in zip("xyz", sf, strict=True)
+            if not abs(v) <= SCALE_FACTOR_REFUSED]  # fmt: skip
+
+
 FloatArray = npt.NDArray[np.float64]
 
 COEFF_NAMES: Final = (
