@@ -17,6 +17,44 @@ class ThermocalInputError(ThermocalError, ValueError):
     """Bad input: a file, column, value, option or unit the user supplied is wrong."""
 
 
+class ParameterError(ThermocalInputError):
+    """A bad value of one parameter of a library call.
+
+    The message names the parameter as the library spells it (``rate_hz``); the command
+    line shows the same message with its option in that place (``--rate``), through
+    :meth:`named`.  Write ``{name}`` in ``message`` where the name goes.
+
+    Parameters
+    ----------
+    parameter : str
+        The keyword or field name, as in the signature (``"rate_hz"``).
+    message : str
+        The message with ``{name}`` where the parameter's name goes, e.g.
+        ``"{name} must be a positive rate [Hz], got 0"``.
+
+    Examples
+    --------
+    >>> err = ParameterError("rate_hz", "{name} must be positive, got -1")
+    >>> str(err)
+    'rate_hz must be positive, got -1'
+    >>> err.named("--rate")
+    '--rate must be positive, got -1'
+    """
+
+    def __init__(self, parameter: str, message: str) -> None:
+        self.parameter = parameter
+        self.template = message
+        super().__init__(message.replace("{name}", parameter))
+
+    def named(self, name: str) -> str:
+        """The message with ``name`` (an option, ``--rate``) for the parameter."""
+        return self.template.replace("{name}", name)
+
+    def __reduce__(self) -> tuple[type[ParameterError], tuple[str, str]]:
+        # picklable across processes (the fleet's workers)
+        return (type(self), (self.parameter, self.template))
+
+
 class FileFormatError(ThermocalInputError):
     """The file is not a readable CSV or Parquet file, or is empty."""
 

@@ -15,7 +15,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from thermocal._lazy import LazyModule
-from thermocal.errors import ThermocalInputError, ThermocalWarning
+from thermocal.errors import ParameterError, ThermocalInputError, ThermocalWarning
 
 if TYPE_CHECKING:
     import numpy as np
@@ -89,10 +89,29 @@ USER_OS_ERRORS: frozenset[int] = frozenset(
 """OS errors a user causes (exit 2 with ``error:``), as opposed to bugs (exit 1)."""
 
 
+OPTION_OF: dict[str, str] = {
+    "rate_hz": "--rate",
+    "signals": "--signal",
+    "temperatures": "--temps",
+}
+"""Library parameters whose command-line option is not the parameter's name with dashes
+(``time_unit`` → ``--time-unit`` needs no entry)."""
+
+
+def option_name(parameter: str) -> str:
+    """The command-line option of a library parameter: :data:`OPTION_OF`, else the name with
+    dashes (``rate_interval`` → ``--rate-interval``)."""
+    return OPTION_OF.get(parameter, "--" + parameter.replace("_", "-"))
+
+
 def error_text(exc: Exception) -> tuple[str, bool]:
     """The text of the ``error:`` line the command line prints for ``exc`` and whether it is
     the user's (exit 2: bad input, a missing file, permissions, a full disk) rather than
-    thermocal's own failure (exit 1, ``internal: TYPE: message``)."""
+    thermocal's own failure (exit 1, ``internal: TYPE: message``).  A
+    :class:`~thermocal.errors.ParameterError` names the option (:func:`option_name`) where the
+    library names its parameter."""
+    if isinstance(exc, ParameterError):
+        return one_line(exc.named(option_name(exc.parameter))), True
     if isinstance(exc, ThermocalInputError | FileNotFoundError | IsADirectoryError):
         return one_line(exc), True
     if isinstance(exc, OSError) and exc.errno in USER_OS_ERRORS:
@@ -102,10 +121,12 @@ def error_text(exc: Exception) -> tuple[str, bool]:
 
 
 __all__ = [
+    "OPTION_OF",
     "USER_OS_ERRORS",
     "error_text",
     "json_text",
     "jsonable",
     "one_line",
+    "option_name",
     "warning_lines",
 ]

@@ -1,0 +1,157 @@
+"""How a file is read: one frozen object for every reading path of the library.
+
+:class:`ReadOptions` carries what a user states about a recording — its columns, their units,
+the raw-count temperature conversion, the log topic and how a text log is laid out.  Every
+call that reads a file takes one (``read=ReadOptions(...)``); the command line builds it from
+its options (``--time``, ``--signal``, ``--temps``, ``--rate``, …).  What is not stated is
+read from the file (sidecar, Parquet metadata, column names), as :mod:`thermocal.units`
+resolves it.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from collections.abc import Iterable
+from dataclasses import dataclass
+from typing import Any, Literal
+
+from thermocal.errors import ParameterError
+from thermocal.units import TemperatureConversion, temperature_conversion
+
+RATE_HZ_RANGE: tuple[float, float] = (1e-6, 1e7)
+"""Sample rates [Hz] a sensor log can have (one sample in 11.6 days to 10 MHz)."""
+
+
+def _names(value: str | Iterable[str] | None, parameter: str) -> tuple[str, ...] | None:
+    """``"a, b"`` or ``["a", "b"]`` → ``("a", "b")``; None stays None."""
+    if value is None:
+        return None
+    items = value.split(",") if isinstance(value, str) else list(value)
+    out: list[str] = []
+    for item in items:
+        if not isinstance(item, str):
+            raise ParameterError(parameter, f"{{name}} holds column names, got {item!r}")
+        if item.strip():
+            out.append(item.strip())
+    return tuple(out)
+
+
+@dataclass(frozen=True)
+class ReadOptions:
+    """How to read a recording; every field left ``None`` is taken from the file.
+
+    Parameters
+    ----------
+    time : str, optional
+        Name of the time column.  Default: the file's, or a column named like time.
+    time_unit : str, optional
+        Unit of the time column (``"s"``, ``"ms"``, ``"us"``, ``"ns"``, ``"min"``, ``"h"``).
+    signals : tuple of str, optional
+        Signal columns, in order; the first is the primary signal.  A comma-separated
+        string (``"gx,gy,gz"``) or a list is accepted and stored as a tuple.
+    temperatures : tuple of str, optional
+        Temperature columns, as ``signals``.
+    signal_unit : str, optional
+        Unit of the signal columns (``"deg/h"``, ``"deg/s"``, ``"rad/s"``, ``"mg"``,
+        ``"m/s^2"``, ``"g"``, ``"counts"``, …).
+    temp_unit : str, optional
+        Unit of the temperature columns (``"degC"``, ``"K"``, ``"degF"``, ``"counts"``).
+    temp_conversion : TemperatureConversion, optional
+        Raw ADC counts → °C, :math:`T = g\\,v + o` (gain :math:`g` [°C/count], offset
+        :math:`o` [°C]); the text ``"GAIN,OFFSET[,int16]"`` or a tuple is accepted.
+    topic : str, optional
+        Flight-controller log topic or message (``"sensor_gyro"``, ``"sensor_gyro:1"``,
+        ``"IMU[0]"``).
+    names : tuple of str, optional
+        Column names of a text log without a header row.
+    rate_hz : float, optional
+        Sample rate [Hz] of a log without a time column: :math:`t_k = k / f`.
+    on_bad_lines : {"error", "skip"}
+        A mangled line of a text log is an error naming it (default) or is dropped and
+        counted.
+    delimiter : str, optional
+        Field separator of a text log (detected when None: ``,`` ``;`` tab or blanks).
+    decimal : {".", ","}, optional
+        Decimal mark of a text log (detected when None).
+
+    Raises
+    ------
+    thermocal.errors.ParameterError
+        A value no file can have, naming the field (``rate_hz``, ``on_bad_lines``, …).
+
+    Examples
+    --------
+    >>> from thermocal.readers.options import ReadOptions
+    >>> ReadOptions(signals="gx, gy", rate_hz=100.0).signals
+    ('gx', 'gy')
+    >>> ReadOptions(rate_hz=-1.0)
+    Traceback (most recent call last):
+    ...
+    thermocal.errors.ParameterError: rate_hz must be a positive rate [Hz], got -1.0
+    """
+
+    time: str | None = None
+    time_unit: str | None = None
+    signals: tuple[str, ...] | None = None
+    temperatures: tuple[str, ...] | None = None
+    signal_unit: str | None = None
+    temp_unit: str | None = None
+    temp_conversion: TemperatureConversion | None = None
+    topic: str | None = None
+    names: tuple[str, ...] | None = None
+    rate_hz: float | None = None
+    on_bad_lines: Literal["error", "skip"] = "error"
+    delimiter: str | None = None
+    decimal: Literal[".", ","] | None = None
+
+    def __post_init__(self) -> None:
+        set_ = object.__setattr__  # frozen: normalise in place once
+        for field in ("signals", "temperatures", "names"):
+            set_(self, field, _names(getattr(self, field), field))
+        if self.temp_conversion is not None:
+            set_(
+                self,
+                "temp_conversion",
+                temperature_conversion(self.temp_conversion, "temp_conversion"),
+            )
+        if self.on_bad_lines not in ("error", "skip"):
+            raise ParameterError(
+                "on_bad_lines", f"{{name}} must be error or skip, got {self.on_bad_lines!r}"
+            )
+        if self.rate_hz is not None:
+            rate = self.rate_hz
+            if not (isinstance(rate, int | float) and math.isfinite(rate) and rate > 0):
+                raise ParameterError(
+                    "rate_hz", f"{{name}} must be a positive rate [Hz], got {rate}"
+                )
+            lo, hi = RATE_HZ_RANGE
+            if not lo <= rate <= hi:
+                raise ParameterError(
+                    "rate_hz",
+                    f"{{name}} {rate:g} Hz: no sensor samples at that rate; give the sample "
+                    f"rate from {lo:g} to {hi:g} Hz (one sample a minute: 0.0166667)",
+                )
+        if self.decimal not in (None, ".", ","):
+            raise ParameterError("decimal", f"{{name}} must be . or , — got {self.decimal!r}")
+        if self.names is not None and len(set(self.names)) != len(self.names):
+            raise ParameterError("names", f"{{name}} repeats a name: {list(self.names)}")
+
+    def replace(self, **changes: Any) -> ReadOptions:
+        """A copy with ``changes`` (field = value), checked as a new object is."""
+        return dataclasses.replace(self, **changes)
+
+    @property
+    def text_layout_given(self) -> bool:
+        """Whether any text-log field (``names``, ``rate_hz``, ``on_bad_lines``,
+        ``delimiter``, ``decimal``) differs from its default."""
+        return (
+            self.names is not None
+            or self.rate_hz is not None
+            or self.on_bad_lines != "error"
+            or bool(self.delimiter)
+            or self.decimal is not None
+        )
+
+
+__all__ = ["RATE_HZ_RANGE", "ReadOptions"]
