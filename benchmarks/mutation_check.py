@@ -1262,7 +1262,7 @@ MUTANTS: tuple[Mutant, ...] = (
     ),
     Mutant(
         "multipos-offset-ignored",
-        P + "multipos/files.py",
+        P + "pipeline/multipos.py",
         "        return float(given)\n",
         "        return 0.0\n",
         ("tests/test_multipos_real_sessions.py",),
@@ -1302,7 +1302,7 @@ MUTANTS: tuple[Mutant, ...] = (
     ),
     Mutant(
         "multipos-offset-not-in-bias",
-        P + "multipos/files.py",
+        P + "pipeline/multipos.py",
         "    if acc_off_mg == 0.0 and gyr_off_deg_h == 0.0:",
         "    if True:",
         ("tests/test_multipos_real_sessions.py",),
@@ -2232,7 +2232,7 @@ MUTANTS: tuple[Mutant, ...] = (
     ),
     Mutant(
         "names-poses-deep-json",
-        P + "multipos/files.py",
+        P + "pipeline/multipos.py",
         "except RecursionError:  # thousands of nested brackets",
         "except MemoryError:  # thousands of nested brackets",
         NAMES,
@@ -2779,7 +2779,7 @@ MUTANTS: tuple[Mutant, ...] = (
     ),
     Mutant(
         "h39mp-check-as-read-skipped",
-        P + "turntable/files.py",
+        P + "pipeline/turntable.py",
         "        calibration_from_dict(json.loads(json.dumps(cal.to_dict())), str(output))",
         "        pass",
         H39MP,

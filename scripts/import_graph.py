@@ -33,7 +33,7 @@ LAYERS: dict[str, int] = {
     # 3 files: reading, writing, model files, the drivers that stream files
     "readers": 3, "writers": 3, "models.files": 3, "models.filecheck": 3, "compensate.files": 3,
     "validation": 3, "export": 3, "tempcal": 3,
-    "station": 3, "pipeline": 3, "turntable.files": 3, "multipos.files": 3,
+    "station": 3, "pipeline": 3,
     # 4 presentation and batch drivers
     "report": 4, "fleet": 4, "demo": 4,
     # 5 the command line

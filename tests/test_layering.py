@@ -52,12 +52,9 @@ MATHS_PACKAGES = (
 MODEL_FILE_MODULES = (
     "thermocal.models.files",
     "thermocal.models.filecheck",
-    "thermocal.turntable.files",
-    "thermocal.multipos.files",
 )
 """The file-layer edges inside maths packages (ARCHITECTURE.md): the model files' readers and
-writers, and the turntable's and multipos' drivers that read recordings and save
-calibrations.  (``models.schema`` and ``models.calibration`` check and build dicts, no I/O:
+writers.  (``models.schema`` and ``models.calibration`` check and build dicts, no I/O:
 maths.)"""
 FACADES: tuple[str, ...] = ()
 """Packages whose ``__init__`` hands out file functions on first use: checked at import only.
@@ -71,8 +68,6 @@ FILE_LAYER = (
     "thermocal.writers",
     "thermocal.models.files",
     "thermocal.models.filecheck",
-    "thermocal.turntable.files",
-    "thermocal.multipos.files",
     "thermocal.compensate.files",
     "thermocal.pipeline",
     "thermocal.tempcal",

@@ -1,4 +1,4 @@
-"""``thermocal multipos``'s library function :func:`thermocal.multipos.files.calibrate_files`
+"""``thermocal multipos``'s library function :func:`thermocal.pipeline.multipos.calibrate_files`
 without the command line (issue 27): a simulated session with known truth, its options
 checked before any file is read, the calibration it saves."""
 
@@ -11,7 +11,7 @@ import pytest
 
 from thermocal.errors import ThermocalInputError
 from thermocal.models.files import load_calibration
-from thermocal.multipos.files import MultiposOptions, calibrate_files
+from thermocal.pipeline.multipos import MultiposOptions, calibrate_files
 from thermocal.simulate import SimulateOptions, simulate_scenario
 from thermocal.writers import write_recording
 

@@ -46,7 +46,7 @@ def test_a_calibration_its_reader_refuses_is_not_written(tmp_path: object) -> No
     from pathlib import Path
 
     from thermocal.models.calibration import Calibration, Triad
-    from thermocal.turntable.files import check_as_read
+    from thermocal.pipeline.turntable import check_as_read
 
     th = np.zeros(12)
     th[3] = -0.95e6  # ppm

@@ -1,4 +1,4 @@
-"""``thermocal turntable`` as a library call (:mod:`thermocal.turntable.files`), without the
+"""``thermocal turntable`` as a library call (:mod:`thermocal.pipeline.turntable`), without the
 command line (issue 27)."""
 
 from __future__ import annotations
@@ -10,14 +10,14 @@ import numpy as np
 import pytest
 
 from thermocal.errors import ThermocalInputError
-from thermocal.readers.dispatch import read_recording
-from thermocal.turntable import calibrate, simulate_turntable16
-from thermocal.turntable.files import (
+from thermocal.pipeline.turntable import (
     SingleRunResult,
     TurntableOptions,
     check_order,
     turntable_calibration,
 )
+from thermocal.readers.dispatch import read_recording
+from thermocal.turntable import calibrate, simulate_turntable16
 from thermocal.writers import write_recording
 
 GYRO = ("gyro_x", "gyro_y", "gyro_z")

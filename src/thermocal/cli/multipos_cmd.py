@@ -35,12 +35,12 @@ from thermocal.errors import ThermocalInputError
 if TYPE_CHECKING:
     import rich.table as _rich_table
 
-    import thermocal.multipos.files as _mpf
+    import thermocal.pipeline.multipos as _mpf
     import thermocal.writers as _writers
 else:
     _rich_table = LazyModule("rich.table")
     _writers = LazyModule("thermocal.writers")
-    _mpf = LazyModule("thermocal.multipos.files")
+    _mpf = LazyModule("thermocal.pipeline.multipos")
 
 
 def _three(text: str | None, option: str) -> list[str] | None:

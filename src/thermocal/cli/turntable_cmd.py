@@ -3,7 +3,7 @@
 error models over temperature from runs at several soaks (issue 19), written as a
 calibration that ``compensate`` applies.
 
-The library does the work (:func:`thermocal.turntable.files.turntable_calibration`); this
+The library does the work (:func:`thermocal.pipeline.turntable.turntable_calibration`); this
 module parses the options and prints the result."""
 
 from pathlib import Path
@@ -39,12 +39,12 @@ from thermocal.errors import ThermocalInputError
 if TYPE_CHECKING:
     import rich.table as _rich_table
 
-    import thermocal.turntable.files as _files
+    import thermocal.pipeline.turntable as _files
     import thermocal.turntable.model as _model
     import thermocal.writers as _writers
 else:
     _rich_table = LazyModule("rich.table")
-    _files = LazyModule("thermocal.turntable.files")
+    _files = LazyModule("thermocal.pipeline.turntable")
     _model = LazyModule("thermocal.turntable.model")
     _writers = LazyModule("thermocal.writers")
 

@@ -23,6 +23,6 @@ Modules: :mod:`.poses` (static poses, the POSES file), :mod:`.accel` (accelerome
 the gravity magnitude, six-face closed form), :mod:`.gyro` (gyro from the rotations
 between poses and from 360° turns), :mod:`.calibrate` (one session end to end, its
 validation), :mod:`.simulate` (sessions with known truth): pure maths on numpy arrays, no
-I/O.  :mod:`.files` is the file edge ``thermocal multipos`` calls: it reads the sessions,
-fits in temperature and saves the calibration.
+I/O.  :mod:`thermocal.pipeline.multipos` is the file driver ``thermocal multipos`` calls: it
+reads the sessions, fits in temperature and saves the calibration.
 """

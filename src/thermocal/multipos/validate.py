@@ -69,7 +69,7 @@ def triad_columns(
     return x, inp
 
 
-def validate_triads(
+def validate_held_out_session(
     triads: Sequence[Any],
     rec: Any,
     latitude_deg: float | None = None,
@@ -259,4 +259,4 @@ def is_multipos(triads: Sequence[Any]) -> bool:
     return any(getattr(t.model, "method", "turntable") == METHOD for t in triads)
 
 
-__all__ = ["is_multipos", "validate_triads"]
+__all__ = ["is_multipos", "triad_columns", "validate_held_out_session"]

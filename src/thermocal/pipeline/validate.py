@@ -276,7 +276,7 @@ def _validate_triads(
     outside its calibrated temperature range."""
     from thermocal.compensate.files import read_for_triads
     from thermocal.multipos import validate as _mp_validate
-    from thermocal.turntable.calibrate import validate_triads
+    from thermocal.turntable.calibrate import validate_turntable_run
 
     rec = read_for_triads(
         file,
@@ -288,11 +288,11 @@ def _validate_triads(
     )
     _own_session(cal, file)
     if _mp_validate.is_multipos(cal.triads):  # held-out poses (issue 30)
-        results: list[Any] = _mp_validate.validate_triads(
+        results: list[Any] = _mp_validate.validate_held_out_session(
             cal.triads, rec, o.latitude, static_s=o.static_s, signal_unit=o.signal_unit
         )
     else:
-        results = validate_triads(cal.triads, rec, o.latitude)
+        results = validate_turntable_run(cal.triads, rec, o.latitude)
     for r in results:
         if r.outside_range_fraction > 0:
             warnings.warn(

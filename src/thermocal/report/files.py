@@ -215,7 +215,7 @@ def _triad_report(
     from thermocal.compensate.files import read_for_triads
     from thermocal.multipos import validate as _mp_validate
     from thermocal.report.triads import write_triad_report
-    from thermocal.turntable.calibrate import validate_triads
+    from thermocal.turntable.calibrate import validate_turntable_run
 
     rec = read_for_triads(
         recording,
@@ -226,11 +226,11 @@ def _triad_report(
         topic=opts.topic,
     )
     if _mp_validate.is_multipos(cal.triads):  # held-out poses (issue 30)
-        results: list[Any] = _mp_validate.validate_triads(
+        results: list[Any] = _mp_validate.validate_held_out_session(
             cal.triads, rec, latitude_deg, signal_unit=opts.signal_unit
         )
     else:
-        results = validate_triads(cal.triads, rec, latitude_deg)
+        results = validate_turntable_run(cal.triads, rec, latitude_deg)
     path = write_triad_report(output, cal, cal_path, results, recording, title=title, sensor=sensor)
     return ReportResult(Path(path), "triads")
 

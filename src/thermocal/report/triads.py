@@ -2,10 +2,10 @@
 in the calibration's own units (a bias in the triad's unit, °/s for a °/s calibration; scale
 factors [ppm], misalignments [″]) with their σ, and, on an independent run, the figures
 before and after compensation: a turntable run's dwell-mean and move-angle errors
-(:func:`thermocal.turntable.calibrate.validate_triads`) or a multipos held-out session's
-gravity-magnitude and rotation-angle errors (:func:`thermocal.multipos.validate.
-validate_triads`), first as the absolute figures (rms over poses or motions, before → after,
-the change in %), then per axis.
+(:func:`thermocal.turntable.calibrate.validate_turntable_run`) or a multipos held-out
+session's gravity-magnitude and rotation-angle errors
+(:func:`thermocal.multipos.validate.validate_held_out_session`), first as the absolute
+figures (rms over poses or motions, before → after, the change in %), then per axis.
 
 Against temperature only what was measured against it: a triad calibrated over several
 temperatures (``multipos --temps`` with a file per temperature, or a turntable over

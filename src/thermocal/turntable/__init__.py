@@ -4,8 +4,8 @@ Modules: :mod:`.kinematics` (frames, eq. (1)–(3)), :mod:`.schedule` (16 positi
 design checks), :mod:`.model` (error model, measurement model, Cramér–Rao bound),
 :mod:`.simulate` (``turntable-16`` scenario), :mod:`.estimate_ls` (batch least
 squares), :mod:`.kalman` (14/15-state filter), :mod:`.calibrate` (the pipeline),
-:mod:`.thermal` (every parameter over temperature), :mod:`.files` (the command at the file
-layer's edge: runs read, calibrated, written; imported by nothing in the maths).
+:mod:`.thermal` (every parameter over temperature).  The command's file driver (runs read,
+calibrated, written) is :mod:`thermocal.pipeline.turntable`.
 """
 
 from __future__ import annotations

@@ -702,7 +702,7 @@ def estimate_from(theta: FloatArray, cov: FloatArray) -> Estimate:
     return Estimate(theta=np.asarray(theta, dtype=np.float64), cov=np.asarray(cov))
 
 
-def validate_triads(
+def validate_turntable_run(
     triads: Sequence[Any],
     rec: Recording,
     latitude_deg: float | None = None,

@@ -37,11 +37,11 @@ from thermocal.multipos.poses import (
     find_poses,
     parse_poses,
 )
+from thermocal.pipeline.turntable import check_as_read
 from thermocal.readers import read_recording
 from thermocal.readers.text import TextOptions
 from thermocal.recording import Recording
 from thermocal.turntable import thermal
-from thermocal.turntable.files import check_as_read
 
 NO_TEMPERATURE_TREF_C = 25.0
 """TREF recorded for a calibration made without a temperature column (it applies
