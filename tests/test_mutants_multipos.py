@@ -16,6 +16,7 @@ import pytest
 from thermocal.errors import DesignError, ThermocalInputError
 from thermocal.multipos import accel as mp_accel
 from thermocal.multipos.calibrate import check_accel_fit
+from thermocal.pipeline.messages import error_text
 from thermocal.turntable import thermal
 
 MG = 9.80665e-3  # 1 mg [m/s²]
@@ -28,15 +29,17 @@ ARCSEC = math.pi / 180.0 / 3600.0
 def test_a_tref_the_reader_refuses_is_refused_before_the_fit() -> None:
     """The reader accepts a TREF within the soaks' range or ``max(span, 50 °C)`` of it
     (:func:`thermocal.models.checks.range_margin`); soaks at −10, 20, 50 °C: span 60, so
-    −70 … 110 °C.  110 is fitted, 110.5 refused naming --tref (the issue's 1e9 too)."""
+    −70 … 110 °C.  110 is fitted, 110.5 refused naming
+    ``tref_c`` (``--tref`` on the command line; 1e9 too)."""
     temps = [-10.0, 20.0, 50.0]
     th = np.zeros((3, 12))
     sg = np.ones((3, 12))
     assert thermal.fit_triad("accel", temps, th, sg, tref_c=110.0).tref_c == 110.0
     assert thermal.fit_triad("accel", temps, th, sg, tref_c=-70.0).tref_c == -70.0
     for bad in (110.5, -70.5, 1e9, float("nan")):
-        with pytest.raises(ThermocalInputError, match=r"--tref"):
+        with pytest.raises(ThermocalInputError, match=r"^tref_c ") as err:
             thermal.fit_triad("accel", temps, th, sg, tref_c=bad)
+        assert error_text(err.value)[0].startswith("--tref ")  # the command line's option
 
 
 def test_a_calibration_its_reader_refuses_is_not_written(tmp_path: object) -> None:

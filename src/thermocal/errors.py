@@ -8,6 +8,8 @@ turns these into exit status 2 and a one-line ``error: ...`` on stderr
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 
 class ThermocalError(Exception):
     """Base class of thermocal's own exceptions."""
@@ -31,6 +33,10 @@ class ParameterError(ThermocalInputError):
     message : str
         The message with ``{name}`` where the parameter's name goes, e.g.
         ``"{name} must be a positive rate [Hz], got 0"``.
+    others : tuple of str, optional
+        Other parameters the message names, each written ``{parameter}`` in ``message``
+        (``"{name} applies with {gravity_axis} only"``); shown as their own names, or as
+        the options :meth:`named` is given a mapping for.
 
     Examples
     --------
@@ -39,20 +45,31 @@ class ParameterError(ThermocalInputError):
     'rate_hz must be positive, got -1'
     >>> err.named("--rate")
     '--rate must be positive, got -1'
+    >>> msg = "{name} applies with {gravity_axis} only"
+    >>> two = ParameterError("gravity", msg, ("gravity_axis",))
+    >>> str(two)
+    'gravity applies with gravity_axis only'
+    >>> two.named("--gravity", lambda p: "--" + p.replace("_", "-"))
+    '--gravity applies with --gravity-axis only'
     """
 
-    def __init__(self, parameter: str, message: str) -> None:
+    def __init__(self, parameter: str, message: str, others: tuple[str, ...] = ()) -> None:
         self.parameter = parameter
         self.template = message
-        super().__init__(message.replace("{name}", parameter))
+        self.others = tuple(others)
+        super().__init__(self.named(parameter))
 
-    def named(self, name: str) -> str:
-        """The message with ``name`` (an option, ``--rate``) for the parameter."""
-        return self.template.replace("{name}", name)
+    def named(self, name: str, other: Callable[[str], str] | None = None) -> str:
+        """The message with ``name`` (an option, ``--rate``) for the parameter, and
+        ``other(p)`` for each of :attr:`others` (their own names without ``other``)."""
+        text = self.template.replace("{name}", name)
+        for p in self.others:
+            text = text.replace("{" + p + "}", other(p) if other is not None else p)
+        return text
 
-    def __reduce__(self) -> tuple[type[ParameterError], tuple[str, str]]:
+    def __reduce__(self) -> tuple[type[ParameterError], tuple[str, str, tuple[str, ...]]]:
         # picklable across processes (the fleet's workers)
-        return (type(self), (self.parameter, self.template))
+        return (type(self), (self.parameter, self.template, self.others))
 
 
 class FileFormatError(ThermocalInputError):

@@ -46,7 +46,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from thermocal import units
-from thermocal.errors import ThermocalInputError, ThermocalWarning
+from thermocal.errors import ParameterError, ThermocalInputError, ThermocalWarning
 
 if TYPE_CHECKING:
     from thermocal.recording import FloatArray, Recording
@@ -130,13 +130,16 @@ def local_gravity_m_s2(
     gravity, stated in a warning.  None without ``--gravity-axis``."""
     if gravity_axis is None:
         if gravity is not None:
-            raise ThermocalInputError("--gravity applies with --gravity-axis only")
+            raise ParameterError(
+                "gravity", "{name} applies with {gravity_axis} only", ("gravity_axis",)
+            )
         return None
     units.parse_gravity_axis(gravity_axis)  # refuse a bad axis before reading
     if gravity is not None:
         if not 9.7 <= gravity <= 9.9:
-            raise ThermocalInputError(
-                f"--gravity {gravity:g}: local gravity on the earth's surface is 9.78-9.83 m/s²"
+            raise ParameterError(
+                "gravity",
+                f"{{name}} {gravity:g}: local gravity on the earth's surface is 9.78-9.83 m/s²",
             )
         return float(gravity)
     if latitude is not None:

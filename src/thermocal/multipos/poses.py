@@ -44,7 +44,7 @@ import numpy as np
 import numpy.typing as npt
 
 from thermocal import defaults
-from thermocal.errors import ThermocalInputError
+from thermocal.errors import ParameterError, ThermocalInputError
 
 FloatArray = npt.NDArray[np.float64]
 
@@ -279,14 +279,14 @@ def find_poses(
     *,
     static_s: float = 1.0,
     window_s: float = WINDOW_S,
-    threshold: float = STILL_THRESHOLD,
+    still_threshold: float = STILL_THRESHOLD,
     motion_fraction: float = MOTION_FRACTION,
     drift_deg: float = DRIFT_DEG,
 ) -> PoseDetection:
     """Static poses found from the data, with the stretches rejected and why (module
     docstring).  ``accel`` (n, 3) in any unit with its offset removed (directions are
     judged on it), ``gyro`` (n, 3) or None; ``static_s`` [s] the shortest pose,
-    ``window_s`` [s] the variance window, ``threshold`` the still limit in multiples of the
+    ``window_s`` [s] the variance window, ``still_threshold`` the still limit in multiples of the
     noise floor, ``motion_fraction`` the still limit as a fraction of the motions'
     variance, ``drift_deg`` [°] the largest turn of the gravity direction across a pose."""
     t = np.asarray(time_s, dtype=np.float64)
@@ -294,12 +294,15 @@ def find_poses(
     n = t.size
     if n < 10:
         raise ThermocalInputError(f"{n} samples: too short for a multi-position session")
-    for name, val in (("--static-s", static_s), ("--window-s", window_s),
-                      ("--still-threshold", threshold), ("--drift-deg", drift_deg)):  # fmt: skip
+    threshold = still_threshold
+    for name, val in (("static_s", static_s), ("window_s", window_s),
+                      ("still_threshold", threshold), ("drift_deg", drift_deg)):  # fmt: skip
         if not (math.isfinite(val) and val > 0):
-            raise ThermocalInputError(f"{name} must be a positive number, got {val!r}")
+            raise ParameterError(name, f"{{name}} must be a positive number, got {val!r}")
     if not (math.isfinite(motion_fraction) and 0 <= motion_fraction < 1):
-        raise ThermocalInputError(f"--motion-fraction must be in [0, 1), got {motion_fraction!r}")
+        raise ParameterError(
+            "motion_fraction", f"{{name}} must be in [0, 1), got {motion_fraction!r}"
+        )
     dt = float(np.median(np.diff(t)))
     w = min(max(5, round(window_s / dt)), max(2, n // 4))
     va = _axis_variances(a, w)
@@ -330,11 +333,11 @@ def detect_poses(
     *,
     static_s: float = 1.0,
     window_s: float = WINDOW_S,
-    threshold: float = STILL_THRESHOLD,
+    still_threshold: float = STILL_THRESHOLD,
 ) -> list[Section]:
     """The poses of :func:`find_poses` (its defaults otherwise)."""
     det = find_poses(time_s, accel, gyro, static_s=static_s, window_s=window_s,
-                     threshold=threshold)  # fmt: skip
+                     still_threshold=still_threshold)  # fmt: skip
     return list(det.poses)
 
 

@@ -29,7 +29,7 @@ from typing import Any
 import numpy as np
 
 from thermocal import units
-from thermocal.errors import ThermocalInputError, ThermocalWarning
+from thermocal.errors import ParameterError, ThermocalInputError, ThermocalWarning
 from thermocal.multipos.calibrate import (
     ACCEL_RESIDUAL_REFUSED,
     GYRO_DIRECTION_REFUSED_DEG,
@@ -83,8 +83,9 @@ def validate_held_out_session(
     from thermocal.turntable import thermal
 
     if not (math.isfinite(static_s) and static_s > 0):
-        raise ThermocalInputError(
-            f"{rec.name}: --static-s must be a positive number of seconds, got {static_s!r}"
+        raise ParameterError(
+            "static_s",
+            f"{rec.name}: {{name}} must be a positive number of seconds, got {static_s!r}",
         )
     by = {t.model.kind: t for t in triads}
     acc = by.get("accel")
@@ -99,7 +100,7 @@ def validate_held_out_session(
     g_m_s2 = acc.model.gravity_m_s2
     if g_m_s2 is None:
         if lat is None:
-            raise ThermocalInputError(f"{rec.name}: give the latitude (--latitude DEG)")
+            raise ParameterError("latitude_deg", f"{rec.name}: give the latitude ({{name}} DEG)")
         g_m_s2 = units.normal_gravity_m_s2(float(lat))
     t = rec.time_s
     unit_opts = units.per_signal_option(signal_unit, [c for tr in triads for c in tr.columns])

@@ -93,6 +93,9 @@ OPTION_OF: dict[str, str] = {
     "rate_hz": "--rate",
     "signals": "--signal",
     "temperatures": "--temps",
+    "latitude_deg": "--latitude",
+    "alpha_offset_deg": "--alpha-offset",
+    "tref_c": "--tref",
 }
 """Library parameters whose command-line option is not the parameter's name with dashes
 (``time_unit`` → ``--time-unit`` needs no entry)."""
@@ -111,7 +114,7 @@ def error_text(exc: Exception) -> tuple[str, bool]:
     :class:`~thermocal.errors.ParameterError` names the option (:func:`option_name`) where the
     library names its parameter."""
     if isinstance(exc, ParameterError):
-        return one_line(exc.named(option_name(exc.parameter))), True
+        return one_line(exc.named(option_name(exc.parameter), option_name)), True
     if isinstance(exc, ThermocalInputError | FileNotFoundError | IsADirectoryError):
         return one_line(exc), True
     if isinstance(exc, OSError) and exc.errno in USER_OS_ERRORS:

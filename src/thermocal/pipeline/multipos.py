@@ -335,7 +335,7 @@ def _detect(t: np.ndarray, acc: np.ndarray, w: np.ndarray | None, opts: Multipos
     """The poses found in the data (:func:`find_poses` with the command's options); fewer
     than six refused with what was rejected and the options that change it."""
     det = find_poses(t, acc, w, static_s=opts.static_s, window_s=opts.window_s,
-                     threshold=opts.still_threshold, motion_fraction=opts.motion_fraction,
+                     still_threshold=opts.still_threshold, motion_fraction=opts.motion_fraction,
                      drift_deg=opts.drift_deg)  # fmt: skip
     if len(det.poses) < 6:
         why = "; ".join(f"{r.reason} ({r.start}…{r.end})" for r in det.rejected[:4])

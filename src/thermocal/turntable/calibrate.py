@@ -21,7 +21,7 @@ import numpy.typing as npt
 
 from thermocal import units
 from thermocal.defaults import DEFAULT_GYRO_COLUMNS as DEFAULT_GYRO_COLUMNS
-from thermocal.errors import MissingValueError, ThermocalInputError, UnitError
+from thermocal.errors import MissingValueError, ParameterError, ThermocalInputError, UnitError
 from thermocal.recording import Recording
 from thermocal.turntable import accel as accel_mod
 from thermocal.turntable import estimate_ls, kalman, model, schedule
@@ -339,8 +339,8 @@ def _encoders(
 ) -> tuple[FloatArray, FloatArray]:
     """The encoder angles α (less ``alpha_offset_deg``) and β [°], unwrapped."""
     if not abs(alpha_offset_deg) <= 360.0:
-        raise ThermocalInputError(
-            f"--alpha-offset must be an angle within ±360°, got {alpha_offset_deg:g}"
+        raise ParameterError(
+            "alpha_offset_deg", f"{{name}} must be an angle within ±360°, got {alpha_offset_deg:g}"
         )
     a_deg = np.unwrap(encoder_deg(rec, columns[0], unit), period=360.0) - float(alpha_offset_deg)
     return a_deg, np.unwrap(encoder_deg(rec, columns[1], unit), period=360.0)
@@ -542,7 +542,7 @@ def _check_inputs(
         raise ThermocalInputError(f"channels must be 2 or 3, got {channels}")
     lat = latitude_deg if latitude_deg is not None else rec.meta.latitude_deg
     if lat is None:
-        raise ThermocalInputError(f"{rec.name}: give the latitude (--latitude DEG)")
+        raise ParameterError("latitude_deg", f"{rec.name}: give the latitude ({{name}} DEG)")
     if not -90.0 <= lat <= 90.0:
         raise ThermocalInputError(f"latitude {lat} is outside [-90, 90]°")
     cols = [*gyro_columns, alpha_column, beta_column]
@@ -728,7 +728,7 @@ def validate_turntable_run(
         None,
     )
     if lat is None:
-        raise ThermocalInputError(f"{rec.name}: give the latitude (--latitude DEG)")
+        raise ParameterError("latitude_deg", f"{rec.name}: give the latitude ({{name}} DEG)")
     cols = [alpha_column, beta_column]
     for tri in triads:
         cols += [*tri.columns, tri.temperature]

@@ -29,7 +29,7 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
-from thermocal.errors import DesignError, ModelFileError, ThermocalInputError
+from thermocal.errors import DesignError, ModelFileError, ParameterError, ThermocalInputError
 from thermocal.turntable import model
 
 FloatArray = npt.NDArray[np.float64]
@@ -403,11 +403,12 @@ def check_tref(tref_c: float, lo: float, hi: float) -> None:
     margin = range_margin(lo, hi)
     if not (math.isfinite(tref_c) and lo - margin <= tref_c <= hi + margin):
         where = "far outside" if math.isfinite(tref_c) else "not a temperature within"
-        raise ThermocalInputError(
-            f"--tref {tref_c:g}: the reference temperature is {where} the soaks' "
+        raise ParameterError(
+            "tref_c",
+            f"{{name}} {tref_c:g}: the reference temperature is {where} the soaks' "
             f"[{lo:.4g}, {hi:.4g}] °C (more than {margin:.4g} °C beyond; a calibration file "
-            f"with it is refused when read); give a --tref within [{lo - margin:.4g}, "
-            f"{hi + margin:.4g}] °C, or leave it out (the middle of the soaks)"
+            f"with it is refused when read); give a {{name}} within [{lo - margin:.4g}, "
+            f"{hi + margin:.4g}] °C, or leave it out (the middle of the soaks)",
         )
 
 
