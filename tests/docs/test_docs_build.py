@@ -25,6 +25,7 @@ PAGES = (
     "getting-started",
     "tutorials/stability-stable32",
     "tutorials/multipos-imucal",
+    "tutorials/notebook-multipos",
     "tutorials/chamber-to-c",
     "tutorials/noise-for-estimator",
     "tutorials/fc-params",

@@ -90,6 +90,34 @@ class AccelFit:
         out = np.linalg.solve(np.eye(3) + self.error_matrix, (f - self.theta[0:3]).T).T
         return np.asarray(out, dtype=np.float64)
 
+    def to_dict(self) -> dict[str, Any]:
+        """The fit as plain JSON types: biases [mg], scale-factor errors [ppm] and
+        misalignments [″] (:data:`thermocal.turntable.model.MISALIGNMENT_NAMES` order) with
+        their σ, the error matrix ``E``, the residuals [mg], the method and the poses."""
+        s = self.sigma
+        return {
+            "bias_mg": self.theta[0:3].tolist(),
+            "bias_mg_sigma": s[0:3].tolist(),
+            "scale_factor_ppm": self.theta[3:6].tolist(),
+            "scale_factor_ppm_sigma": s[3:6].tolist(),
+            "misalignment_arcsec": self.theta[6:12].tolist(),
+            "misalignment_arcsec_sigma": s[6:12].tolist(),
+            "misalignment_names": list(model.MISALIGNMENT_NAMES),
+            "error_matrix": self.error_matrix.tolist(),
+            "residual_rms_before_mg": self.residual_rms_before_mg,
+            "residual_rms_after_mg": self.residual_rms_after_mg,
+            "reduced_chi2": self.reduced_chi2,
+            "method": self.method,
+            "n_poses": self.n_poses,
+            "residuals_mg": list(self.residuals_mg),
+            "misfit_mg": self.misfit_mg,
+        }
+
+    def table(self) -> list[dict[str, Any]]:
+        """The twelve coefficients as rows (:func:`thermocal.turntable.model.
+        coefficient_rows`, bias in mg)."""
+        return model.coefficient_rows(self.theta, self.sigma, "mg", "accel")
+
 
 def _unpack(p: FloatArray) -> tuple[FloatArray, FloatArray]:
     """(b [mg], E) from the nine free parameters (E entries in 10⁻³)."""

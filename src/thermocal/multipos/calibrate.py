@@ -172,6 +172,28 @@ class SessionResult:
     temperature_c: float | None
     not_still: tuple[str, ...] = field(default=())
 
+    def to_dict(self) -> dict[str, Any]:
+        """The session's calibration as plain JSON types: ``accel`` and ``gyro``
+        (:meth:`AccelFit.to_dict <thermocal.multipos.accel.AccelFit.to_dict>`,
+        :meth:`GyroFit.to_dict <thermocal.multipos.gyro.GyroFit.to_dict>`, None without a
+        gyro), ``g_mg`` [mg], ``temperature_c`` [°C], ``poses`` (:meth:`poses_dict`),
+        ``turns`` (name, start, end) and ``not_still``."""
+        return {
+            "accel": self.accel.to_dict(),
+            "gyro": None if self.gyro is None else self.gyro.to_dict(),
+            "g_mg": self.g_mg,
+            "temperature_c": self.temperature_c,
+            "poses": self.poses_dict(),
+            "turns": [{"name": s.name, "start": s.start, "end": s.end} for s in self.turns],
+            "not_still": list(self.not_still),
+        }
+
+    def table(self) -> list[dict[str, Any]]:
+        """Every coefficient of the session as rows (triad, parameter, value, sigma,
+        unit): the accelerometer's (bias in mg) then the gyro's (bias in °/h);
+        ``pandas.DataFrame(result.table())`` makes it a table."""
+        return self.accel.table() + ([] if self.gyro is None else self.gyro.table())
+
     def poses_dict(self) -> list[dict[str, Any]]:
         return [
             {

@@ -72,6 +72,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
+from typing import Any
 
 import numpy as np
 import numpy.typing as npt
@@ -243,6 +244,39 @@ class GyroFit:
     def sigma(self) -> FloatArray:
         out: FloatArray = np.sqrt(np.maximum(np.diag(self.cov), 0.0))
         return out
+
+    @property
+    def error_matrix(self) -> FloatArray:
+        """``E`` of ``ω_meas = (I + E) ω + b`` (3×3, dimensionless)."""
+        return model.error_matrices(self.theta)
+
+    def to_dict(self) -> dict[str, Any]:
+        """The fit as plain JSON types: biases [°/h], scale-factor errors [ppm] and
+        misalignments [″] (:data:`thermocal.turntable.model.MISALIGNMENT_NAMES` order) with
+        their σ, the error matrix ``E``, the direction residuals [°] and what was used."""
+        s = self.sigma
+        return {
+            "bias_deg_h": self.theta[0:3].tolist(),
+            "bias_deg_h_sigma": s[0:3].tolist(),
+            "scale_factor_ppm": self.theta[3:6].tolist(),
+            "scale_factor_ppm_sigma": s[3:6].tolist(),
+            "misalignment_arcsec": self.theta[6:12].tolist(),
+            "misalignment_arcsec_sigma": s[6:12].tolist(),
+            "misalignment_names": list(model.MISALIGNMENT_NAMES),
+            "error_matrix": self.error_matrix.tolist(),
+            "direction_rms_before_deg": math.degrees(self.direction_rms_before_rad),
+            "direction_rms_after_deg": math.degrees(self.direction_rms_after_rad),
+            "reduced_chi2": self.reduced_chi2,
+            "n_motions": self.n_motions,
+            "n_turns": self.n_turns,
+            "turn_axis_lean_deg": math.degrees(self.turn_axis_lean_rad),
+            "model": self.model,
+        }
+
+    def table(self) -> list[dict[str, Any]]:
+        """The twelve coefficients as rows (:func:`thermocal.turntable.model.
+        coefficient_rows`, bias in °/h)."""
+        return model.coefficient_rows(self.theta, self.sigma, "deg/h", "gyro")
 
 
 def static_bias(

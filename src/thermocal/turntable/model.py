@@ -66,7 +66,7 @@ Unobservable combinations and the constraints taken
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Final
+from typing import Any, Final
 
 import numpy as np
 import numpy.typing as npt
@@ -113,6 +113,43 @@ COEFF_NAMES: Final = (
     "yz",
 )
 """Names of θ, in order."""
+
+
+def coefficient_rows(
+    theta: npt.ArrayLike, sigma: npt.ArrayLike, bias_unit: str, triad: str
+) -> list[dict[str, Any]]:
+    """The twelve coefficients of a triad as table rows.
+
+    Parameters
+    ----------
+    theta, sigma : array_like, shape (12,)
+        The coefficients in :data:`COEFF_NAMES` order and their standard deviations: bias
+        [``bias_unit``], scale-factor errors [ppm], misalignments [″].
+    bias_unit : str
+        The unit of the three biases (``"mg"``, ``"deg/h"``).
+    triad : str
+        The triad's name, repeated in each row (``"accel"``, ``"gyro"``).
+
+    Returns
+    -------
+    list of dict
+        One row per coefficient: ``triad``, ``parameter`` (:data:`COEFF_NAMES`), ``value``,
+        ``sigma`` and ``unit``; ``pandas.DataFrame(rows)`` makes it a table.
+
+    Examples
+    --------
+    >>> rows = coefficient_rows(np.arange(12.0), np.ones(12), "mg", "accel")
+    >>> rows[4]
+    {'triad': 'accel', 'parameter': 'sf_y', 'value': 4.0, 'sigma': 1.0, 'unit': 'ppm'}
+    """
+    th = np.asarray(theta, dtype=np.float64).reshape(N_COEFFS)
+    sg = np.asarray(sigma, dtype=np.float64).reshape(N_COEFFS)
+    unit = (bias_unit,) * 3 + ("ppm",) * 3 + ("arcsec",) * 6
+    return [
+        {"triad": triad, "parameter": n, "value": float(v), "sigma": float(e), "unit": u}
+        for n, v, e, u in zip(COEFF_NAMES, th, sg, unit, strict=True)
+    ]
+
 
 MISALIGNMENT_NAMES: Final = ("yx", "zx", "xy", "zy", "xz", "yz")
 MISALIGNMENT_INDEX: Final[dict[str, tuple[int, int]]] = {
