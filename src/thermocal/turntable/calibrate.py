@@ -457,6 +457,105 @@ def calibrate(
     )  # fmt: skip
 
 
+def calibrate_arrays(
+    time_s: npt.ArrayLike,
+    gyro: npt.ArrayLike,
+    alpha: npt.ArrayLike,
+    beta: npt.ArrayLike,
+    latitude_deg: float,
+    *,
+    gyro_unit: str = "deg/s",
+    encoder_unit: str = "deg",
+    accel: npt.ArrayLike | None = None,
+    accel_unit: str = "m/s^2",
+    temperature_c: npt.ArrayLike | None = None,
+    **options: Any,
+) -> TurntableResult:
+    """Calibrate a gyro triad from arrays of a 16-position dual-axis turntable run.
+
+    The arrays are put in a :class:`~thermocal.recording.Recording` and handed to
+    :func:`calibrate`, which does the work; use it for what a file holds.
+
+    Parameters
+    ----------
+    time_s : array_like, shape (n,)
+        Sample times [s].
+    gyro : array_like, shape (n, 3)
+        The x, y, z gyro outputs, each the mean rate over the interval ending at its
+        sample [``gyro_unit``].
+    alpha, beta : array_like, shape (n,)
+        Inner- and outer-axis encoder angles at the sample times [``encoder_unit``],
+        wrapped or not.
+    latitude_deg : float
+        Site latitude [°]: the earth rate's input.
+    gyro_unit : str, optional
+        Unit of ``gyro`` (``"deg/s"``, ``"deg/h"``, ``"rad/s"``).
+    encoder_unit : str, optional
+        Unit of the encoder angles (``"deg"`` or ``"rad"``).
+    accel : array_like, shape (n, 3), optional
+        An accelerometer triad on the same table [``accel_unit``], calibrated from the
+        dwells' gravity.
+    accel_unit : str, optional
+        Unit of ``accel`` (``"m/s^2"``, ``"mg"``, ``"g"``).
+    temperature_c : array_like, shape (n,), optional
+        A temperature [°C] whose mean and span over the run are reported.
+    **options
+        Any keyword of :func:`calibrate` (``min_dwell_s``, ``channels``, ``gravity_m_s2``,
+        ``alpha_offset_deg`` …).
+
+    Returns
+    -------
+    TurntableResult
+        The Kalman-filter estimate, the least-squares cross-check and the design's
+        Cramér–Rao bound (:meth:`TurntableResult.to_dict`).
+
+    Raises
+    ------
+    thermocal.errors.ThermocalInputError
+        Arrays of different lengths, a run that is not a 16-position schedule, a fit that
+        fails its own checks.
+
+    Examples
+    --------
+    >>> from thermocal.turntable import calibrate_arrays, simulate_turntable16
+    >>> rec, truth = simulate_turntable16(0, rate_hz=10.0, dwell_s=20.0)
+    >>> gyro = np.column_stack([rec.column(c) for c in ("gyro_x", "gyro_y", "gyro_z")])
+    >>> res = calibrate_arrays(rec.time_s, gyro, rec.column("alpha_deg"),
+    ...                        rec.column("beta_deg"), 40.0, min_dwell_s=10.0)
+    >>> truth["scale_factor_ppm"]
+    [45.0, -80.0, 25.0]
+    >>> err = res.kalman.theta[3:6] - truth["scale_factor_ppm"]
+    >>> bool(np.all(abs(err) < 3 * res.kalman.sigma[3:6]))
+    True
+    """
+    g = np.asarray(gyro, dtype=np.float64)
+    if g.ndim != 2 or g.shape[1] != 3:
+        raise ParameterError("gyro", f"{{name}} must be an (n, 3) array, got shape {g.shape}")
+    signals: dict[str, npt.ArrayLike] = {f"gyro_{ax}": g[:, i] for i, ax in enumerate("xyz")}
+    unit_of = dict.fromkeys(signals, gyro_unit)
+    if accel is not None:
+        a = np.asarray(accel, dtype=np.float64)
+        if a.shape != g.shape:
+            raise ParameterError("accel", f"{{name}} must have the shape of gyro {g.shape}")
+        signals.update({f"accel_{ax}": a[:, i] for i, ax in enumerate("xyz")})
+        unit_of.update(dict.fromkeys(("accel_x", "accel_y", "accel_z"), accel_unit))
+    temps = None if temperature_c is None else {"temperature_c": temperature_c}
+    rec = Recording.from_arrays(
+        time_s, signals, temps, signal_unit=unit_of,
+        other={"alpha": alpha, "beta": beta},
+        other_units={"alpha": encoder_unit, "beta": encoder_unit},
+    )  # fmt: skip
+    return calibrate(
+        rec, latitude_deg, gyro_columns=("gyro_x", "gyro_y", "gyro_z"),
+        alpha_column="alpha", beta_column="beta", gyro_unit=gyro_unit,
+        encoder_unit=encoder_unit,
+        accel_columns=None if accel is None else ("accel_x", "accel_y", "accel_z"),
+        accel_unit=None if accel is None else accel_unit,
+        temperature_column=None if temperature_c is None else "temperature_c",
+        **options,
+    )  # fmt: skip
+
+
 def _segment(
     rec: Recording,
     g: FloatArray,
