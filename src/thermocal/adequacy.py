@@ -42,8 +42,9 @@ The tests (figures over every run of a channel together):
     The firmware's own minimum sweep (ArduPilot's learning requires
     :data:`ARDUPILOT_MIN_SPAN_C` °C).
 
-Sources: SPEC §3–§4 (the chamber program must cover the operating range with soaks and
-ramps; the temperature-rate terms need ramps of both signs), IEEE Std 952-2020 Annex C
+Sources: the temperature-characteristic calibration test plan (the chamber program must
+cover the operating range with soaks and ramps; the temperature-rate terms need ramps of
+both signs), IEEE Std 952-2020 Annex C
 (thermal tests at stabilised and ramped temperatures), ArduPilot's ``TCal`` learning
 (``AP_InertialSensor_tempcal.cpp``: a 10 °C minimum span), PX4's
 ``process_sensor_caldata.py`` (binned cubic per axis).

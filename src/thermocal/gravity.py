@@ -1,4 +1,4 @@
-"""Gravity as a known input of static accelerometers (issue 15; issue 25 item 3).
+"""Gravity as a known input of static accelerometers.
 
 A static accelerometer triad reads the specific force of gravity plus its bias:
 ``f = g·u + b(T)`` [mg], ``u`` the unit vector of "up" in the body frame, ``g`` the local

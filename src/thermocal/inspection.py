@@ -109,7 +109,7 @@ class ColumnSummary:
 
 @dataclass(frozen=True)
 class Inspection:
-    """Summary of a recording (INTERFACE.md ``inspect --json`` keys)."""
+    """Summary of a recording (the keys of ``inspect --json``)."""
 
     file: str
     n_samples: int
@@ -157,7 +157,7 @@ class Inspection:
 
 
 SPIKE_CHUNK = 1 << 18
-"""Window centres per chunk of the Hampel test's running median (issue 26: the medians
+"""Window centres per chunk of the Hampel test's running median (the medians
 of one chunk at a time, ≈ 2 MB each, instead of two arrays as long as the column)."""
 
 SPIKE_BLOCK = 1 << 15

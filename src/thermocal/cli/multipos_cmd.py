@@ -1,6 +1,6 @@
 """``thermocal multipos FILE... --accel X,Y,Z [--gyro X,Y,Z] -o CAL.json``: accelerometer
 and gyro triads calibrated without a turntable, from hand-placed static poses and the
-rotations between them (issue 30; INTERFACE.md "Calibration without a turntable").  With
+rotations between them (Tedaldi et al. 2014, Ferraris et al. 1995).  With
 several files at several temperatures and ``--temps``, every parameter becomes a
 polynomial in T − TREF (:func:`thermocal.turntable.thermal.fit_triad`, the turntable's own
 thermal fit).  Writes a calibration of triads, the file type of ``thermocal turntable``."""

@@ -1,6 +1,6 @@
-"""``thermocal turntable FILE -o RESULT.json``: gyro-triad calibration (SPEC §7);
+"""``thermocal turntable FILE -o RESULT.json``: gyro-triad calibration (CN104880182);
 ``thermocal turntable FILE... --temps COL [--accel X,Y,Z] -o CAL.json``: both triads'
-error models over temperature from runs at several soaks (issue 19), written as a
+error models over temperature from runs at several soaks, written as a
 calibration that ``compensate`` applies.
 
 The library does the work (:func:`thermocal.pipeline.turntable.turntable_calibration`); this
@@ -102,7 +102,9 @@ EncoderNoiseOpt = Annotated[
 MinDwellOpt = Annotated[float, typer.Option("--min-dwell", help="Shortest dwell accepted [s].")]
 ChannelsOpt = Annotated[
     int,
-    typer.Option("--channels", help="3: Δα, Δβ, Δγ (15 states); 2: the SPEC's Δα, Δβ (14 states)."),
+    typer.Option(
+        "--channels", help="3: Δα, Δβ, Δγ (15 states); 2: the source's Δα, Δβ (14 states)."
+    ),
 ]
 SoakTempsOpt = Annotated[
     str | None,

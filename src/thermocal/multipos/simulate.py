@@ -1,4 +1,4 @@
-"""Hand-placed multi-position sessions with known truth (issue 30).
+"""Hand-placed multi-position sessions with known truth.
 
 Poses: ``n_poses`` orientations drawn uniformly on SO(3) (a board put down by hand in
 random orientations), each held ``dwell_s`` (± 30 %) with a small tremor (a rotation of

@@ -1,4 +1,4 @@
-"""A calibration of triads judged on a held-out multi-position session (issue 30).
+"""A calibration of triads judged on a held-out multi-position session.
 
 The poses are found in the held-out session as in calibration (:func:`.poses.detect_poses`
 on the raw data).  Accelerometer: per pose, ``|mean f| − g`` before (raw) and after

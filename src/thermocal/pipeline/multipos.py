@@ -133,7 +133,7 @@ class SessionRun:
 @dataclass(frozen=True, eq=False)
 class MultiposResult:
     """The result of :func:`calibrate_files`: the calibration written, the ``--json`` object
-    (INTERFACE.md; ``output`` the file written) and the accelerometer's unit."""
+    (``output`` the file written) and the accelerometer's unit."""
 
     calibration: Calibration
     summary: dict[str, Any]
@@ -541,7 +541,7 @@ def _triad_dict(theta: Any, sigma: Any, bias_factor: float, bias_unit: str) -> d
 def _summary(
     runs: list[SessionRun], models: dict[str, Any], a_unit: str, g_unit: str | None, g_m_s2: float
 ) -> dict[str, Any]:
-    """The ``--json`` object (INTERFACE.md): each triad at TREF in the data's units, the
+    """The ``--json`` object: each triad at TREF in the data's units, the
     poses, the gravity residuals in the accelerometer's unit, and each run's figures."""
     to_a = float(units.convert(np.array([1.0]), "mg", a_unit)[0])
     to_g = float(units.convert(np.array([1.0]), "deg/h", g_unit)[0]) if g_unit else 1.0

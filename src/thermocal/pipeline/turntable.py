@@ -1,8 +1,8 @@
 """The turntable at the file layer's edge: ``thermocal turntable FILE...`` as one library call.
 
 One run (:func:`turntable_calibration` with one file): the gyro triad's bias, scale factor
-and misalignment (SPEC §7, :func:`thermocal.turntable.calibrate.calibrate`), written as the
-result JSON.  Several runs at soak temperatures (issue 19): each run calibrated alone, then
+and misalignment (:func:`thermocal.turntable.calibrate.calibrate`), written as the
+result JSON.  Several runs at soak temperatures: each run calibrated alone, then
 every parameter of each triad as a polynomial in temperature
 (:func:`thermocal.turntable.thermal.fit_triad`), judged first
 (:mod:`thermocal.adequacy`) and written as a calibration of triads that ``compensate``
@@ -80,7 +80,7 @@ def check_order(order: int) -> None:
 def read_run(path: Path, o: TurntableOptions) -> Recording:
     """Read one run (:func:`thermocal.readers.read_recording`).  The gyro columns' unit goes
     through the shared resolver: --gyro-unit > file metadata > unit in the column name > °/s
-    (INTERFACE: gyro_z in °/s), the last stated in a warning."""
+    (gyro_z in °/s), the last stated in a warning."""
     from thermocal.readers.dispatch import read_recording
 
     return read_recording(
@@ -133,14 +133,14 @@ class SingleRunResult:
     result: TurntableResult
 
     def to_dict(self) -> dict[str, Any]:
-        """The result JSON (INTERFACE.md), with ``input``."""
+        """The result JSON, with ``input``."""
         out: dict[str, Any] = self.result.to_dict()
         out["input"] = str(self.input)
         return out
 
 
 def triad_summary(tri: _thermal.TriadThermal) -> dict[str, object]:
-    """The JSON of one triad's temperature model (INTERFACE.md: tref_c, order, coefficients
+    """The JSON of one triad's temperature model (tref_c, order, coefficients
     with _sigma, loto_rms)."""
     return {
         "tref_c": tri.tref_c,
@@ -171,7 +171,7 @@ class ThermalRunsResult:
     adequacy: dict[str, Any]
 
     def to_dict(self) -> dict[str, Any]:
-        """The JSON of ``turntable --temps`` with several runs (INTERFACE.md)."""
+        """The JSON of ``turntable --temps`` with several runs."""
         out: dict[str, Any] = {
             "output": str(self.output),
             "format": "thermocal-calibration",

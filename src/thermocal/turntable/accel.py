@@ -1,5 +1,5 @@
-"""Accelerometer triad from the dwells of a dual-axis turntable run (issue 19; SPEC §7
-geometry, INTERFACE.md "Turntable geometry").
+"""Accelerometer triad from the dwells of a dual-axis turntable run (the geometry of
+:mod:`.kinematics`).
 
 Model: ``f_meas = (I + E_a) f_true + b_a + noise``, with ``f_true`` the specific force of a
 sensor at rest, gravity's reaction pointing up: ``f_true_b = C_nᵇ (0, 0, g)`` in the body
@@ -10,7 +10,7 @@ Each dwell's mean specific force gives three equations; axis ``i`` alone reads
 ``f_i − f_true,i = Σ_j E_ij f_true,j + b_i``: four unknowns per axis, linear, solved by
 weighted least squares over the dwells (weights: samples per dwell, the mean of ``n``
 samples having variance σ²/n), through an SVD of the scaled design (no normal equations).
-The per-axis residual variance gives the covariance.  Sixteen positions (SPEC §7) put
+The per-axis residual variance gives the covariance.  Sixteen positions put
 gravity along ± every body axis and between them: every element of ``E_a`` is seen.
 
 Units out (θ, 12, the order of the gyro's :mod:`.model`): bias [mg] (1 mg = 9.80665·10⁻³

@@ -1,4 +1,4 @@
-"""Turntable calibration of a gyro triad: the pipeline (SPEC §7).
+"""Turntable calibration of a gyro triad: the pipeline (CN104880182).
 
 :func:`calibrate` reads the gyro and encoder columns of a recording, checks the
 design (16 positions, dwells, both axes moving), estimates the angle random walk
@@ -46,7 +46,7 @@ CONSTRAINTS = (
     {
         "combination": "outer-axis encoder zero offset / base levelling and north alignment",
         "status": "seen only through the earth rate; not estimated",
-        "handling": "constraint: zero (SPEC §7 levelled, aligned base)",
+        "handling": "constraint: zero (a levelled, north-aligned base)",
     },
 )
 
@@ -87,7 +87,8 @@ def _coeff_dict(theta: FloatArray, sigma: FloatArray, cov: FloatArray | None) ->
 class TurntableResult:
     """Result of :func:`calibrate`.
 
-    ``kalman`` is the reported estimate (SPEC §7), ``least_squares`` the cross-check,
+    ``kalman`` is the reported estimate (the source's filter), ``least_squares`` the
+    cross-check,
     ``crb`` the Cramér–Rao bound σ of each coefficient for this design and noise (12,
     units of :mod:`.model`), ``agreement`` the largest |θ_KF − θ_LS| / σ_LS,
     ``weak_combinations`` the poorly determined directions found in the design,
@@ -127,7 +128,7 @@ class TurntableResult:
     """Its range over the run (max − min) [°C]: a soak that drifts during the run."""
 
     def to_dict(self) -> dict[str, Any]:
-        """JSON-ready dict with the INTERFACE.md keys (from the Kalman filter)."""
+        """JSON-ready dict of the result file's keys (from the Kalman filter)."""
         out: dict[str, Any] = {"format": RESULT_FORMAT, "version": RESULT_VERSION}
         out.update(self.kalman.to_dict())
         out["misalignment_names"] = list(model.MISALIGNMENT_NAMES)
@@ -244,7 +245,7 @@ def weak_combinations(
 
 AZIMUTH_WARNED_DEG = 1.0
 """A rotation of the body about the inner axis, relative to the declared geometry (body x
-East at α = 0, INTERFACE.md "Turntable geometry"), beyond this [°] is warned of: the fit
+East at α = 0, :mod:`.kinematics`), beyond this [°] is warned of: the fit
 takes it for the antisymmetric pair of misalignments ``yx = −sin ψ``, ``xy = +sin ψ`` and
 biases both x and y scale factors by ``cos ψ − 1`` (−152 ppm at 1°)."""
 AZIMUTH_REFUSED_DEG = 5.0
@@ -380,7 +381,7 @@ def calibrate(
     temperature_column: str | None = None,
     alpha_offset_deg: float = 0.0,
 ) -> TurntableResult:
-    """Calibrate a gyro triad from a 16-position dual-axis turntable run (SPEC §7).
+    """Calibrate a gyro triad from a 16-position dual-axis turntable run (CN104880182).
 
     Parameters
     ----------
@@ -397,7 +398,7 @@ def calibrate(
     encoder_noise_arcsec : white noise σ of the encoder readings [″]; estimated from the
         readings at rest (jitter, or quantisation q/√12) when None
         (:func:`.schedule.detect_motion`).
-    channels : 3 (Δα, Δβ, Δγ; 15-state filter) or 2 (the SPEC's Δα, Δβ; 14 states).
+    channels : 3 (Δα, Δβ, Δγ; 15-state filter) or 2 (the source's Δα, Δβ; 14 states).
     min_positions, min_dwell_s : design checks (:func:`.schedule.check_design`).
     move_block_s : least squares: rotations cut into increments of at most this [s].
     kf_interval_s : filter measurement interval [s] (at rest and while rotating).
@@ -763,7 +764,7 @@ def _diagnostics(est: _Estimates, n_positions: int) -> tuple[str, ...]:
         msgs.append(f"weakly observable combination: {w['combination']}")
     if n_positions < len(schedule.POSITIONS_16):
         msgs.append(
-            f"{n_positions} positions held, not the {len(schedule.POSITIONS_16)} of SPEC §7: "
+            f"{n_positions} positions held, not the {len(schedule.POSITIONS_16)} of the schedule: "
             "estimated with what is there (the σ say how well)"
         )
     return tuple(msgs)
@@ -810,7 +811,7 @@ def validate_turntable_run(
     alpha_column: str | None = None,
     beta_column: str | None = None,
 ) -> list[Any]:
-    """Judge a calibration of triads (issue 19) on an independent 16-position run: the
+    """Judge a calibration of triads on an independent 16-position run: the
     reference of every sample from the encoder angles (true body rate ``ω_ib^b``, eq. (2),
     over each interval; specific force ``C_nᵇ (0, 0, g)`` at rest), the dwells and moves
     from the encoders (:func:`.schedule.detect_motion`), and per triad the dwell-mean and

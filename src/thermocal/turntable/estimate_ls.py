@@ -1,4 +1,5 @@
-"""Batch least squares for the turntable calibration (SPEC §7, "(our reading)" cross-check).
+"""Batch least squares for the turntable calibration (our cross-check of
+the source's filter).
 
 The data are cut into blocks of sample intervals: each dwell is one block (its
 angle increments are the static averages projected on the gimbal axes, times the

@@ -1,8 +1,8 @@
-"""The 14-state Kalman filter of SPEC §7 (CN104880182, seed 002, claim 4).
+"""The 14-state Kalman filter of the dual-axis turntable source document (CN104880182, claim 4).
 
 State ``x = [θ (12), Δα, Δβ[, Δγ]]``: the twelve coefficients of :mod:`.model` as
 random constants ([°/h], [ppm], [arcsec]) and the gyro-integrated gimbal angles minus
-the encoder angles [arcsec] — 14 states as in the SPEC, or 15 with the rotation Δγ
+the encoder angles [arcsec] — 14 states as in the source, or 15 with the rotation Δγ
 about the third axis e_⊥ = e_z × e_E^b whose true value is zero (our reading; see
 :mod:`.model`).  Over a block of sample intervals the angle errors grow by
 the gyro errors projected on each gimbal axis (model eq. (4) summed over the block;

@@ -1,4 +1,4 @@
-"""Kinematics of the dual-axis turntable (SPEC §7; INTERFACE.md "Turntable geometry").
+"""Kinematics of the dual-axis turntable (CN104880182).
 
 Frames (pyins-style names: ``mat_nb`` takes body vectors to the base frame n):
 
@@ -25,7 +25,7 @@ the gyro outputs as, eq. (3)::
     α̇ = e_z · (ω_ib^b − C_n^b ω_ie^n),      β̇ = e_E^b(α) · (ω_ib^b − C_n^b ω_ie^n)
 
 which is how the gyro-integrated gimbal angles of the 14-state filter are formed.
-Source: CN104880182 (seed 002) kinematic equations, rewritten for this geometry.
+Source: CN104880182's kinematic equations, rewritten for this geometry.
 """
 
 from __future__ import annotations

@@ -1,12 +1,12 @@
 """Gyro-triad error model of the turntable calibration and its linear measurement model.
 
-Error model (SPEC §7, INTERFACE.md)::
+Error model (the dual-axis turntable source document, CN104880182)::
 
     ω_meas = (I + E) ω_true + b + n,      Δω = ω_meas − ω_true = b + E ω_true + n
 
 with ``b`` the biases δD0 [°/h], ``diag(E)`` the scale-factor errors δK [ppm] and
-the off-diagonal of ``E`` the six misalignments δE [arcsec].  The SPEC's names
-``δE_ab`` follow the source's filter rows (CN104880182, seed 002): ``δE_ab`` is the
+the off-diagonal of ``E`` the six misalignments δE [arcsec].  The source's names
+``δE_ab`` follow its filter rows (CN104880182, claim 4): ``δE_ab`` is the
 sensitivity of gyro *b* to a rate about axis *a*, i.e. ``E[b, a]``:
 
 =======  =============  =================================
@@ -24,7 +24,7 @@ The coefficient vector θ (12) is, in this order and in these units::
 
     [b_x, b_y, b_z [°/h], k_x, k_y, k_z [ppm], yx, zx, xy, zy, xz, yz [arcsec]]
 
-Measurement model (SPEC §7): over a sample interval i of length τ_i the
+Measurement model (CN104880182): over a sample interval i of length τ_i the
 gyro-integrated gimbal angles minus the encoder angle changes are, eq. (4)::
 
     y_α,i = e_z · (g_i τ_i − C_n^b ω_ie^n τ_i) − Δα_enc,i       = h_α,i θ + w_α,i
@@ -40,13 +40,13 @@ angle increments; the filter's Δα, Δβ, Δγ are their running sums.
 
 The third channel (our reading): ``e_⊥^b = e_z × e_E^b = (sin α, cos α, 0)`` is the
 body direction perpendicular to both gimbal axes; the mechanism cannot turn about it,
-so the gyro-integrated rotation about it, Δγ, has true value zero.  The SPEC's
+so the gyro-integrated rotation about it, Δγ, has true value zero.  The source's
 filter measures Δα, Δβ only; then, because every outer-axis move of the 16-position
 sequence happens at α ∈ {0°, 90°, 180°, 270°} (where ``e_E^bᵀ E e_E^b`` has no xy
 term), the two xy misalignments are seen only through the earth rate (σ ≈ 100″).
 Δγ sees them during every outer-axis move (``e_⊥ᵀ E e_E^b`` = ``yx`` at α = 0,
 ``−xy`` at α = 90°).  ``channels=3`` (default) uses Δα, Δβ, Δγ; ``channels=2`` is
-the SPEC's 14-state form.
+the source's 14-state form.
 
 Unobservable combinations and the constraints taken
 ---------------------------------------------------
@@ -59,7 +59,7 @@ Unobservable combinations and the constraints taken
   ``inner_axis_azimuth_arcsec``.
 * A zero offset of the outer-axis encoder, or a base not levelled and aligned,
   rotates the earth-rate input only; it is not estimated (**constraint**: zero, as
-  SPEC §7 prescribes a levelled, aligned base).  Its effect is of the order of
+  the source prescribes a levelled, aligned base).  Its effect is of the order of
   Ω × offset on the static readings.
 """
 
@@ -160,7 +160,7 @@ MISALIGNMENT_INDEX: Final[dict[str, tuple[int, int]]] = {
     "xz": (2, 0),
     "yz": (2, 1),
 }
-"""SPEC name → (row, column) of the error matrix E."""
+"""Misalignment name → (row, column) of the error matrix E."""
 
 N_COEFFS: Final = 12
 I_YX: Final = 6
@@ -240,7 +240,7 @@ class IntervalModel:
         return int(self.y_arcsec.shape[1])
 
     def select_channels(self, n_channels: int) -> IntervalModel:
-        """The first ``n_channels`` channels (2: the SPEC's Δα, Δβ; 3: with Δγ)."""
+        """The first ``n_channels`` channels (2: the source's Δα, Δβ; 3: with Δγ)."""
         if n_channels not in (2, 3):
             raise ValueError("n_channels must be 2 or 3")
         return IntervalModel(

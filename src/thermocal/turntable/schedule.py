@@ -1,7 +1,7 @@
-"""The 16-position schedule of SPEC §7 and its recognition in recorded encoder angles.
+"""The 16-position schedule of CN104880182 and its recognition in recorded encoder angles.
 
 Positions (α, β) relative to the starting angles (α0, β0), in the source's order
-(CN104880182, seed 002, claim 3)::
+(CN104880182, claim 3)::
 
     (0,0) (90,0) (180,0) (270,0) (0,180) (90,180) (180,180) (270,180)
     (90,90) (270,90) (0,90) (180,90) (270,270) (90,270) (180,270) (0,270)
@@ -43,7 +43,7 @@ POSITIONS_16: Final = (
     (180.0, 270.0),
     (0.0, 270.0),
 )
-"""The sixteen (α − α0, β − β0) positions of SPEC §7 [°]."""
+"""The sixteen (α − α0, β − β0) positions of the source document [°]."""
 
 
 class TurntableScheduleError(DesignError):
@@ -100,7 +100,7 @@ def build_schedule(
     settle_s: float = 1.0,
     positions_deg: tuple[tuple[float, float], ...] = POSITIONS_16,
 ) -> Schedule:
-    """The SPEC §7 schedule: dwell ``dwell_s`` at each position, single-axis moves at
+    """The sixteen-position schedule: dwell ``dwell_s`` at each position, single-axis moves at
     ``move_rate_deg_s`` (α first, then β, ``settle_s`` between them)."""
     if dwell_s <= 0 or move_rate_deg_s <= 0 or settle_s < 0:
         raise DesignError("dwell, move rate must be positive and settle non-negative")
@@ -234,7 +234,7 @@ def _quantum(readings_deg: FloatArray, max_values: int = 100_000) -> float:
 
 def detect_motion(time_s: FloatArray, alpha_deg: FloatArray, beta_deg: FloatArray) -> Motion:
     """Classify each sample interval as moving or at rest, robustly to encoder jitter and
-    quantisation (issue 12: a per-sample rate threshold is crossed by a few arcseconds of
+    quantisation (a per-sample rate threshold is crossed by a few arcseconds of
     jitter at 100–200 Hz).
 
     1. Noise: σ from the median absolute deviation of second differences of the unwrapped
@@ -396,7 +396,7 @@ def check_design(
     if seg.n_positions < min_positions:
         raise TurntableScheduleError(
             f"{name}: only {seg.n_positions} distinct positions held (need "
-            f"{min_positions}, SPEC §7 sixteen-position sequence)"
+            f"{min_positions}, the sixteen-position sequence)"
         )
     short = [d for d in seg.dwells if d.duration_s < min_dwell_s - dwell_tolerance_s]
     if short:

@@ -1,7 +1,7 @@
 """Simulator of the ``turntable-16`` scenario: a gyro triad on the dual-axis turntable.
 
-The trajectory is :func:`thermocal.turntable.schedule.build_schedule` (SPEC §7);
-the body rates follow kinematics eq. (2); the gyros read (INTERFACE.md)::
+The trajectory is :func:`thermocal.turntable.schedule.build_schedule` ;
+the body rates follow kinematics eq. (2); the gyros read::
 
     g_i = (I + E) ω̄_true,i + b + n_i,      n_i ~ N(0, N² / τ)
 
@@ -38,7 +38,8 @@ BETA_COLUMN = "beta_deg"
 class TurntableTruth:
     """The simulated triad's errors, as applied to the true rates.
 
-    ``misalignment_arcsec`` in the SPEC order (yx, zx, xy, zy, xz, yz), mapping to
+    ``misalignment_arcsec`` in the order of :data:`.model.MISALIGNMENT_NAMES` (yx, zx, xy,
+    zy, xz, yz), mapping to
     ``E[0,1], E[0,2], E[1,0], E[1,2], E[2,0], E[2,1]`` (see :mod:`.model`).  The
     default is a navigation-grade triad whose xy misalignments have an antisymmetric
     part of 20″ (a rotation of the triad about the inner axis relative to the
@@ -131,7 +132,7 @@ def simulate_turntable16(
     beta0_deg: float = 0.0,
     positions_deg: tuple[tuple[float, float], ...] = POSITIONS_16,
 ) -> tuple[Recording, dict[str, Any]]:
-    """Simulate a 16-position turntable run (SPEC §7) with known truth.
+    """Simulate a 16-position turntable run with known truth.
 
     Returns the recording (``time`` [s], ``gyro_x/y/z`` [°/s, mean rate over the
     interval ending at each sample], ``alpha_deg``/``beta_deg`` [°, encoder angles
@@ -199,7 +200,7 @@ def simulate_turntable16(
     return rec, truth_dict
 
 
-# --- several soaks: the error model over temperature (issue 19) -------------------------
+# --- several soaks: the error model over temperature ------------------------------------
 
 THERMAL_TREF_C = 20.0
 """Reference temperature of the thermal truth's polynomials [°C]."""

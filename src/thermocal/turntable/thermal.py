@@ -1,4 +1,4 @@
-"""A triad's error model over temperature from turntable runs at several soaks (issue 19).
+"""A triad's error model over temperature from turntable runs at several soaks.
 
 Each run gives θ (12: bias, scale factors, misalignments) with standard errors at its
 soak temperature T_r.  Each parameter becomes a polynomial in ``T − TREF``:
@@ -142,7 +142,7 @@ class TriadThermal:
     runs: tuple[tuple[float, tuple[float, ...], tuple[float, ...]], ...] = ()
     """Each run's (temperature [°C], θ, σ) the polynomials were fitted to (for reports)."""
     method: str = "turntable"
-    """How the runs were calibrated: ``turntable`` or ``multipos`` (issue 30)."""
+    """How the runs were calibrated: ``turntable`` or ``multipos``."""
     gravity_m_s2: float | None = None
     """Local gravity the runs were calibrated with (multipos), for a later validation."""
 
@@ -428,7 +428,7 @@ def fit_triad(
     ``thetas``/``sigmas`` (R, 12) per run in the units of :data:`UNITS`; ``tref_c``
     defaults to the middle of the soak range; ``order`` to the LOTO choice.  A parameter
     whose σ is zero in every run is one held by a constraint (the multi-position
-    accelerometer's upper misalignments, issue 30): fitted unweighted.  ``method`` and
+    accelerometer's upper misalignments): fitted unweighted.  ``method`` and
     ``gravity_m_s2`` are recorded with the model."""
     if kind not in UNITS:
         raise ThermocalInputError(f"triad kind must be gyro or accel, got {kind!r}")
