@@ -248,10 +248,11 @@ def triad_gravity(
         m = [_finite_mean(rec.signal(chans[a])[0], path, chans[a]) for a in AXES]
         up = m[AXES.index(letter)]
         if abs(up - sign * g_mg) > GRAVITY_TOLERANCE_MG:
-            raise ThermocalInputError(
-                f"{path}: --gravity-axis {gravity_axis}: {chans[letter]} should read about "
+            raise ParameterError(
+                "gravity_axis",
+                f"{path}: {{name}} {gravity_axis}: {chans[letter]} should read about "
                 f"{sign * g_mg:+.1f} mg but reads {up:.1f} mg on average; is {gravity_axis} "
-                "the axis pointing up, and the unit right?"
+                "the axis pointing up, and the unit right?",
             )
         mag = math.sqrt(sum(v * v for v in m))
         if abs(mag - g_mg) > GRAVITY_TOLERANCE_MG:
@@ -320,18 +321,21 @@ def channel_gravity(
 
     letter = (guess_role(name, unit) or {}).get("axis")
     if letter is None:
-        raise ThermocalInputError(
-            f"--gravity-axis {gravity_axis}: channel {name!r} names no axis (x, y or z "
-            "as its last letter); fit it with --known-input instead"
+        raise ParameterError(
+            "gravity_axis",
+            f"{{name}} {gravity_axis}: channel {name!r} names no axis (x, y or z "
+            "as its last letter); fit it with {known_input} instead",
+            ("known_input",),
         )
     mean = _finite_mean(values_mg, path, name)
     g_mg = units.gravity_on_axis_mg(letter, gravity_axis, g_m_s2)
     off = mean - g_mg
     if g_mg != 0.0 and abs(off) > GRAVITY_TOLERANCE_MG:
-        raise ThermocalInputError(
-            f"{path}: --gravity-axis {gravity_axis}: {name} should read about "
+        raise ParameterError(
+            "gravity_axis",
+            f"{path}: {{name}} {gravity_axis}: {name} should read about "
             f"{g_mg:+.1f} mg but reads {mean:.1f} mg on average; is {gravity_axis} the "
-            "axis pointing up, and the unit right?"
+            "axis pointing up, and the unit right?",
         )
     if g_mg == 0.0 and abs(off) > GRAVITY_TOLERANCE_MG:
         tilt = math.degrees(math.asin(min(1.0, abs(mean) / 1000.0)))

@@ -43,3 +43,35 @@ def test_gravity_accepted_and_latitude_gives_normal_gravity() -> None:
     s2 = 0.5  # sin²(45°)
     want = ge * (1 + k * s2) / (1 - e2 * s2) ** 0.5
     assert local_gravity_m_s2("+z", None, 45.0) == pytest.approx(want, abs=1e-6)
+
+
+def test_a_channel_without_an_axis_letter_names_gravity_axis_and_known_input() -> None:
+    """``channel_gravity`` of an accelerometer channel named ``acc`` (no x, y or z at its
+    end) with an up axis: the refusal names both parameters, the command line's options."""
+    import numpy as np
+
+    from thermocal.gravity import channel_gravity
+
+    with pytest.raises(ParameterError) as err:
+        channel_gravity(None, 0, "run.csv", "acc", "mg", np.full(10, 1000.0), "+z", 9.81)
+    assert str(err.value) == (
+        "gravity_axis +z: channel 'acc' names no axis (x, y or z as its last letter); "
+        "fit it with known_input instead"
+    )
+    assert error_text(err.value)[0] == (
+        "--gravity-axis +z: channel 'acc' names no axis (x, y or z as its last letter); "
+        "fit it with --known-input instead"
+    )
+
+
+def test_an_up_axis_reading_off_gravity_names_gravity_axis() -> None:
+    """az reads 0 mg where +z up means +1000.0 mg (g = 9.80665 m/s²): refused."""
+    import numpy as np
+
+    from thermocal.gravity import channel_gravity
+
+    with pytest.raises(ParameterError) as err:
+        channel_gravity(None, 0, "run.csv", "az", "mg", np.zeros(10), "+z", 9.80665)
+    text, users = error_text(err.value)
+    assert users and text.startswith("run.csv: --gravity-axis +z: az should read about +1000.0")
+    assert str(err.value).startswith("run.csv: gravity_axis +z: az should read about +1000.0")
