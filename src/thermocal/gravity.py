@@ -125,9 +125,49 @@ class TriadGravity:
 def local_gravity_m_s2(
     gravity_axis: str | None, gravity: float | None, latitude: float | None
 ) -> float | None:
-    """The local gravity [m/s²] for ``--gravity-axis``: ``--gravity``, else WGS-84 normal
-    gravity at ``--latitude`` (:func:`thermocal.units.normal_gravity_m_s2`), else standard
-    gravity, stated in a warning.  None without ``--gravity-axis``."""
+    """The local gravity [m/s²] used with an up axis.
+
+    Parameters
+    ----------
+    gravity_axis : str or None
+        The sensor axis pointing up (``"+z"``, ``"-x"`` …); None: no gravity input.
+    gravity : float or None
+        Local gravity [m/s²], within 9.7-9.9.
+    latitude : float or None
+        Site latitude [°], for WGS-84 normal gravity when ``gravity`` is not given.
+
+    Returns
+    -------
+    float or None
+        ``gravity``, else normal gravity at ``latitude``, else standard gravity
+        9.80665 m/s² (with a warning); None without ``gravity_axis``.
+
+    Raises
+    ------
+    thermocal.errors.ParameterError
+        ``gravity`` without ``gravity_axis``, or off the earth's 9.78-9.83 m/s².
+
+    Notes
+    -----
+    WGS-84 normal gravity (Somigliana's formula, NIMA TR8350.2 eq. 4-1 [1]_):
+
+    .. math::
+
+        \\gamma(\\varphi) = \\gamma_e \\frac{1 + k \\sin^2\\varphi}
+        {\\sqrt{1 - e^2 \\sin^2\\varphi}}
+
+    References
+    ----------
+    .. [1] NIMA TR8350.2, "Department of Defense World Geodetic System 1984, its
+       definition and relationships with local geodetic systems", 3rd ed., 2000.
+
+    Examples
+    --------
+    >>> round(local_gravity_m_s2("+z", None, 45.0), 5)
+    9.8062
+    >>> local_gravity_m_s2(None, None, 45.0) is None
+    True
+    """
     if gravity_axis is None:
         if gravity is not None:
             raise ParameterError(

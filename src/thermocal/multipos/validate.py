@@ -77,9 +77,51 @@ def validate_held_out_session(
     static_s: float = 1.0,
     signal_unit: str | None = None,
 ) -> list[MultiposValidation]:
-    """Held-out figures of each triad (module docstring); ``signal_unit`` (``--signal-unit``):
-    one unit for every triad column, or one per column in the triads' order, as
-    ``compensate`` takes it."""
+    """A multi-position calibration of triads judged on a held-out session.
+
+    Parameters
+    ----------
+    triads : sequence of Triad
+        The calibration's triads (:class:`thermocal.models.calibration.Triad`), one of them
+        an accelerometer (it gives the poses' up directions).
+    rec : Recording
+        The held-out session, with the triads' columns.
+    latitude_deg : float, optional
+        Site latitude [°] for normal gravity when the calibration recorded no ``g``
+        (default: the recording's, then the calibration's).
+    static_s : float, optional
+        The shortest still pose [s].
+    signal_unit : str, optional
+        One unit for every triad column, or one per column in the triads' order
+        (comma-separated as ``compensate`` takes it).
+
+    Returns
+    -------
+    list of MultiposValidation
+        Per triad, before (raw) and after compensation: the rms over poses of the
+        gravity-magnitude error [accelerometer unit], or over motions of the rotation-angle
+        error [°] (module docstring).
+
+    Raises
+    ------
+    thermocal.errors.ParameterError
+        ``static_s`` not positive, no latitude where one is needed.
+    thermocal.errors.ThermocalInputError
+        No accelerometer triad, no still pose in the session.
+
+    Notes
+    -----
+    Per pose the gravity-magnitude error :math:`\\lVert \\bar f_k \\rVert - g` with
+    :math:`f = (I + E(T))^{-1}(f_\\mathrm{meas} - b(T))` after compensation; per motion
+    between poses the angle between the next pose's up direction and the previous one's
+    carried over by the integrated rate (Tedaldi et al. 2014 [1]_, the gyro cost).
+
+    References
+    ----------
+    .. [1] D. Tedaldi, A. Pretto and E. Menegatti, "A robust and easy to implement method
+       for IMU calibration without external equipments", Proc. IEEE ICRA 2014,
+       pp. 3042-3049, doi:10.1109/ICRA.2014.6907297.
+    """
     from thermocal.turntable import thermal
 
     if not (math.isfinite(static_s) and static_s > 0):
