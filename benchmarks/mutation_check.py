@@ -1164,6 +1164,39 @@ MUTANTS: tuple[Mutant, ...] = (
         "one glitch off the lattice hides the sensor's quantisation",
     ),
     # --- multipos ------------------------------------------------------------------------
+    # the triads' calibration from arrays, and errors that name parameters
+    Mutant(
+        "i40c-tt-arrays-gyro-unit-ignored",
+        P + "turntable/calibrate.py",
+        'alpha_column="alpha", beta_column="beta", gyro_unit=gyro_unit,',
+        'alpha_column="alpha", beta_column="beta", gyro_unit="deg/s",',
+        ("tests/turntable/test_turntable_calibrate_arrays.py",),
+        "calibrate_arrays with rad/s arrays read them as °/s",
+    ),
+    Mutant(
+        "i40c-tt-arrays-encoders-swapped",
+        P + "turntable/calibrate.py",
+        'other={"alpha": alpha, "beta": beta},',
+        'other={"alpha": beta, "beta": alpha},',
+        ("tests/turntable/test_turntable_calibrate_arrays.py",),
+        "calibrate_arrays takes the outer encoder for the inner one",
+    ),
+    Mutant(
+        "i40c-coefficient-rows-units",
+        P + "turntable/model.py",
+        'unit = (bias_unit,) * 3 + ("ppm",) * 3 + ("arcsec",) * 6',
+        'unit = (bias_unit,) * 3 + ("arcsec",) * 3 + ("ppm",) * 6',
+        ("tests/docs/test_tutorial_notebook_multipos.py",),
+        "a triad's table shows scale factors in ″ and misalignments in ppm",
+    ),
+    Mutant(
+        "i40c-parameter-error-others-unnamed",
+        P + "errors.py",
+        'text = text.replace("{" + p + "}", other(p) if other is not None else p)',
+        'text = text.replace("{" + p + "}", p)',
+        ("tests/core/test_gravity_parameters.py", "tests/test_gravity_tref.py"),
+        "--gravity without --gravity-axis: the command line names gravity_axis, no option",
+    ),
     Mutant(
         "multipos-gap-factor",
         P + "multipos/gyro.py",

@@ -64,10 +64,12 @@ def test_the_page_prints_what_it_shows(cells: list[tuple[str, str]]) -> None:
 
 
 def _rows(printed: str) -> dict[tuple[str, str], tuple[float, float]]:
-    """(triad, parameter) → (value, σ) of the calibration block's lines."""
+    """(triad, parameter) → (value, σ) of the calibration block's lines; each line's unit
+    is checked: ppm for a scale factor, arcsec for a misalignment."""
     out = {}
     for line in printed.splitlines()[1:]:
-        triad, name, value, _pm, sigma = line.split()
+        triad, name, value, _pm, sigma, unit = line.split()
+        assert unit == ("ppm" if name.startswith("sf_") else "arcsec"), line
         out[(triad, name)] = (float(value), float(sigma))
     return out
 
