@@ -173,12 +173,52 @@ def count_spikes(
 ) -> tuple[int, int | None]:
     """Count spikes with a Hampel test per contiguous segment.
 
-    A sample is a spike when ``|x_i − med_i| > threshold · 1.4826 · MAD_i`` where
-    ``med_i`` and ``MAD_i`` are the median and median absolute deviation of the
-    window ``i ± half_window`` (Hampel 1974; Pearson 2002).  Windows whose MAD is
-    zero use the segment's global MAD of first differences (a floor of σ, so only the
-    samples farther than ``threshold`` floors from their window's median need their
-    window's MAD).  Returns the count and the first spike's row.
+    Parameters
+    ----------
+    time_s : ndarray, shape (n,)
+        Sample times [s] (the test runs on each gap-free segment).
+    x : ndarray, shape (n,)
+        The column, in any unit.
+    threshold : float, optional
+        The test's threshold in robust standard deviations.
+    half_window : int, optional
+        Half the window [samples].
+
+    Returns
+    -------
+    count : int
+        The spike samples.
+    first : int or None
+        The first spike's row.
+
+    Notes
+    -----
+    A sample is a spike when
+
+    .. math::
+
+        |x_i - \\mathrm{med}_i| > t \\cdot 1.4826 \\cdot \\mathrm{MAD}_i
+
+    with :math:`\\mathrm{med}_i` and :math:`\\mathrm{MAD}_i` the median and median
+    absolute deviation of the window ``i ± half_window`` (Hampel 1974 [1]_; Pearson 2002
+    [2]_).  Windows whose MAD is zero use the segment's global MAD of first differences (a
+    floor of σ, so only the samples farther than ``threshold`` floors from their window's
+    median need their window's MAD).
+
+    References
+    ----------
+    .. [1] F. R. Hampel, "The influence curve and its role in robust estimation", Journal
+       of the American Statistical Association 69(346), 1974, pp. 383-393.
+    .. [2] R. K. Pearson, "Outliers in process modeling and identification", IEEE
+       Transactions on Control Systems Technology 10(1), 2002, pp. 55-63.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> x = np.random.default_rng(0).normal(0.0, 1.0, 300)
+    >>> x[[50, 200]] += 40.0
+    >>> count_spikes(np.arange(300.0), x)
+    (2, 50)
     """
     n_total = 0
     first: int | None = None
@@ -270,7 +310,37 @@ def _saturation_problems(name: str, arr: FloatArray) -> list[Problem]:
 
 
 def inspect_recording(rec: Recording) -> Inspection:
-    """Summarise a recording and list its problems (never raises on bad data)."""
+    """What is in a recording and what is wrong with it.
+
+    Parameters
+    ----------
+    rec : Recording
+        The recording, as read.
+
+    Returns
+    -------
+    Inspection
+        Samples, duration [s], sample rate [Hz], gaps, per-column summaries (spikes,
+        rails, non-finite values), each temperature's span [°C], the timestamps' jitter and
+        every problem found with its severity; never raises on bad data.
+
+    Notes
+    -----
+    Spikes by the Hampel test (:func:`count_spikes`), clipped samples by
+    :func:`saturated_mask`, gaps where a step exceeds :data:`GAP_FACTOR` times the
+    median interval.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from thermocal.recording import Recording
+    >>> x = np.random.default_rng(0).normal(0.0, 1.0, 500)
+    >>> x[100] = 50.0
+    >>> rec = Recording.from_arrays(np.arange(500) * 0.01, {"gz": x}, signal_unit="deg/h")
+    >>> ins = inspect_recording(rec)
+    >>> ins.n_samples, round(ins.sample_rate_hz), ins.columns["gz"].n_spikes
+    (500, 100, 1)
+    """
     t = rec.time_s
     problems = find_problems(rec)
     time_ok = not any(

@@ -224,8 +224,46 @@ def misfit_tau(r_mg: FloatArray, sigma_mg: FloatArray, dof: int) -> float:
 
 
 def fit_gravity_magnitude(f_mg: npt.ArrayLike, sigma_mg: npt.ArrayLike, g_mg: float) -> AccelFit:
-    """The nine parameters from the pose means ``f_mg`` (m, 3) [mg] with their noise along
-    gravity ``sigma_mg`` (m,) [mg] and local gravity ``g_mg`` [mg] (module docstring)."""
+    """The accelerometer triad's nine free parameters from the gravity magnitude.
+
+    Parameters
+    ----------
+    f_mg : array_like, shape (m, 3)
+        The mean specific force of each still pose [mg], at least nine distinct poses.
+    sigma_mg : array_like, shape (m,)
+        The noise of each pose mean along gravity [mg].
+    g_mg : float
+        Local gravity [mg].
+
+    Returns
+    -------
+    AccelFit
+        θ (12: bias [mg], scale factors [ppm], misalignments [″]; ``yx = zx = zy = 0``, the
+        body frame being the accelerometer frame), its covariance and the residuals.
+
+    Raises
+    ------
+    thermocal.errors.DesignError
+        Fewer than nine distinct poses (:func:`check_poses`).
+
+    Notes
+    -----
+    Weighted least squares (Tedaldi et al. 2014 [1]_, eqs. 9-10) on
+
+    .. math::
+
+        r_k = \\frac{\\lVert (I + E)^{-1} (\\bar f_k - b) \\rVert - g}
+        {\\sqrt{\\sigma_k^2 + \\tau^2}}
+
+    with ``τ`` a misfit added in quadrature when the reduced χ² is beyond its 3σ band
+    (the poses scatter beyond their noise: a hand's placement, a board's flex).
+
+    References
+    ----------
+    .. [1] D. Tedaldi, A. Pretto and E. Menegatti, "A robust and easy to implement method
+       for IMU calibration without external equipments", Proc. IEEE ICRA 2014,
+       pp. 3042-3049, doi:10.1109/ICRA.2014.6907297.
+    """
     f = np.asarray(f_mg, dtype=np.float64)
     sg0 = np.asarray(sigma_mg, dtype=np.float64)
     m = f.shape[0]
@@ -302,8 +340,55 @@ def _check_faces(f: dict[str, FloatArray], faces: Sequence[str]) -> None:
 def fit_six_faces(
     faces_mg: dict[str, FloatArray], sigma_mg: dict[str, float], g_mg: float
 ) -> AccelFit:
-    """Closed form from the six named faces (module docstring): ``faces_mg`` maps
-    ``x_p``…``z_a`` to the pose mean [mg], ``sigma_mg`` to its per-axis noise [mg]."""
+    """The accelerometer triad in closed form from the six named faces.
+
+    Parameters
+    ----------
+    faces_mg : dict of str to array_like
+        ``x_p`` … ``z_a`` (that axis up, then down) → the face's mean specific force (3,)
+        [mg].
+    sigma_mg : dict of str to float
+        Each face → the per-axis noise of its mean [mg].
+    g_mg : float
+        Local gravity [mg].
+
+    Returns
+    -------
+    AccelFit
+        θ (12: bias [mg], scale factors [ppm], misalignments [″], all six: ``E`` refers
+        to the faces of the box), its covariance and each face's gravity residual.
+
+    Raises
+    ------
+    thermocal.errors.DesignError
+        A face missing, or a face whose gravity is not along the axis its name says.
+
+    Notes
+    -----
+    Ferraris et al. (1995) [1]_: the bias is the mean of the six faces and column ``j`` of
+    ``I + E`` half the difference of the faces ``j+`` and ``j−`` over ``g``:
+
+    .. math::
+
+        b = \\frac{1}{6} \\sum_{\\text{faces}} \\bar f, \\qquad
+        (I + E)\\, e_j = \\frac{\\bar f_{j+} - \\bar f_{j-}}{2 g}
+
+    References
+    ----------
+    .. [1] F. Ferraris, U. Grimaldi and M. Parvis, "Procedure for effortless in-field
+       calibration of three-axis rate gyros and accelerometers", Sensors and Materials
+       7(5), 1995, pp. 311-330.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> k = np.diag([1.01, 0.99, 1.0])  # +1 % x, -1 % y scale factors
+    >>> faces = {f"{a}_{s}": k @ (sg * 1000.0 * np.eye(3)[i])
+    ...          for i, a in enumerate("xyz") for s, sg in (("p", 1), ("a", -1))}
+    >>> fit = fit_six_faces(faces, dict.fromkeys(faces, 0.1), 1000.0)
+    >>> [round(float(v)) for v in fit.theta[3:6]]
+    [10000, -10000, 0]
+    """
     from thermocal.multipos.poses import FACES
 
     missing = [n for n in FACES if n not in faces_mg]
