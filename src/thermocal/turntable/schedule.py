@@ -100,8 +100,42 @@ def build_schedule(
     settle_s: float = 1.0,
     positions_deg: tuple[tuple[float, float], ...] = POSITIONS_16,
 ) -> Schedule:
-    """The sixteen-position schedule: dwell ``dwell_s`` at each position, single-axis moves at
-    ``move_rate_deg_s`` (α first, then β, ``settle_s`` between them)."""
+    """The sixteen-position schedule of the dual-axis turntable source document [1]_.
+
+    Parameters
+    ----------
+    alpha0_deg, beta0_deg : float, optional
+        The inner- and outer-axis starting angles [°].
+    dwell_s : float, optional
+        The dwell at each position [s].
+    move_rate_deg_s : float, optional
+        The rate of the single-axis moves [°/s] (α first, then β).
+    settle_s : float, optional
+        The pause between the α and the β move [s].
+    positions_deg : tuple of (float, float), optional
+        The (α − α0, β − β0) positions [°] (default: :data:`POSITIONS_16`).
+
+    Returns
+    -------
+    Schedule
+        The angle knots against time and the dwell windows.
+
+    Raises
+    ------
+    thermocal.errors.DesignError
+        A dwell or move rate not positive, a negative settle.
+
+    References
+    ----------
+    .. [1] *A method for separating the combined error coefficients of a ring-laser gyro
+       triad based on dual-axis rotation*, Chinese invention patent CN104880182, claim 3.
+
+    Examples
+    --------
+    >>> s = build_schedule(dwell_s=10.0)
+    >>> s.dwell_windows_s.shape
+    (16, 2)
+    """
     if dwell_s <= 0 or move_rate_deg_s <= 0 or settle_s < 0:
         raise DesignError("dwell, move rate must be positive and settle non-negative")
     t = 0.0
