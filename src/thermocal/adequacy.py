@@ -715,58 +715,29 @@ def judge(
     Parameters
     ----------
     needs : Needs
-        The model's polynomial order in T per temperature column, its number of
-        coefficients and the columns whose rate of change it fits.
-    runs_time_s : sequence of ndarray
-        Each run's sample times [s].
-    runs_temps : sequence of ndarray
-        Each run's temperatures, shape (n, k), columns in ``temp_names`` order
-        [``temperature_unit``].
+        The model's order in T per temperature column, its coefficients, its Ṫ columns.
+    runs_time_s, runs_temps : sequence of ndarray
+        Each run's times [s] and temperatures (n, k) in ``temp_names`` order.
     temp_names : sequence of str
         The temperature columns' names.
     signals : sequence of ndarray, optional
-        Each run's signal in the canonical unit of ``kind`` (°/h, mg), for the stillness
-        test.
+        Each run's signal in the canonical unit of ``kind`` (°/h, mg), for the stillness test.
     kind : {"gyro", "accel"}, optional
         The signal's kind.
-    name : str, optional
-        The channel's name in the record and messages.
-    temperature_unit : str, optional
-        Unit of the temperatures as messages show it.
+    name, temperature_unit, unit : str, optional
+        The channel, and the units as messages show them.
     unit_factor : float, optional
         Multiplies a figure in the canonical unit into the data's own unit.
-    unit : str, optional
-        The data's own unit, as messages show it.
     overrides : iterable of str, optional
         The refusals the user allowed (:data:`ALLOW_NARROW`, :data:`ALLOW_MOTION`).
     rate_interval_s : float, optional
-        The backward difference interval of the temperature rate [s].
+        Δ of the backward difference Ṫ = 60 (T(t) − T(t − Δ)) / Δ [°C/min] [s].
 
     Returns
     -------
     Adequacy
         Every test (samples, span, distinct temperatures, ends, rate, stillness) with its
-        verdict, and the overrides.
-
-    Notes
-    -----
-    A polynomial of order ``p`` in T needs at least ``p + 1`` distinct temperatures over a
-    span that covers the operating range, and rate-of-change terms need ramps of both
-    signs (the temperature-characteristic calibration test plan; IEEE Std 952 [1]_,
-    thermal tests at stabilised and ramped temperatures).  The temperature rate is the
-    backward difference
-
-    .. math::
-
-        \\dot T_i = 60\\, \\frac{T_i - T(t_i - \\Delta)}{\\Delta} \\quad
-        [\\mathrm{°C/min}]
-
-    with :math:`\\Delta` = ``rate_interval_s``.
-
-    References
-    ----------
-    .. [1] IEEE Std 952-1997 (R2008), "IEEE Standard Specification Format Guide and Test
-       Procedure for Single-Axis Interferometric Fiber Optic Gyros", IEEE, 1998.
+        verdict, and the overrides (sources: module docstring).
 
     Examples
     --------

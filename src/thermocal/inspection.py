@@ -175,12 +175,10 @@ def count_spikes(
 
     Parameters
     ----------
-    time_s : ndarray, shape (n,)
-        Sample times [s] (the test runs on each gap-free segment).
-    x : ndarray, shape (n,)
-        The column, in any unit.
+    time_s, x : ndarray, shape (n,)
+        Sample times [s] (the test runs on each gap-free segment) and the column.
     threshold : float, optional
-        The test's threshold in robust standard deviations.
+        The threshold ``t`` in robust standard deviations.
     half_window : int, optional
         Half the window [samples].
 
@@ -193,24 +191,10 @@ def count_spikes(
 
     Notes
     -----
-    A sample is a spike when
-
-    .. math::
-
-        |x_i - \\mathrm{med}_i| > t \\cdot 1.4826 \\cdot \\mathrm{MAD}_i
-
-    with :math:`\\mathrm{med}_i` and :math:`\\mathrm{MAD}_i` the median and median
-    absolute deviation of the window ``i ± half_window`` (Hampel 1974 [1]_; Pearson 2002
-    [2]_).  Windows whose MAD is zero use the segment's global MAD of first differences (a
-    floor of σ, so only the samples farther than ``threshold`` floors from their window's
-    median need their window's MAD).
-
-    References
-    ----------
-    .. [1] F. R. Hampel, "The influence curve and its role in robust estimation", Journal
-       of the American Statistical Association 69(346), 1974, pp. 383-393.
-    .. [2] R. K. Pearson, "Outliers in process modeling and identification", IEEE
-       Transactions on Control Systems Technology 10(1), 2002, pp. 55-63.
+    A spike: :math:`|x_i - \\mathrm{med}_i| > t \\cdot 1.4826 \\cdot \\mathrm{MAD}_i` over the
+    window ``i ± half_window`` (F. R. Hampel, JASA 69(346), 1974; R. K. Pearson, IEEE Trans.
+    Control Systems Technology 10(1), 2002).  A window whose MAD is zero uses the segment's
+    MAD of first differences as a floor.
 
     Examples
     --------

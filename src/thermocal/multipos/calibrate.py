@@ -420,99 +420,11 @@ def calibrate_session(
 ) -> SessionResult:
     """Calibrate the accelerometer (and gyro) triad of one multi-position session.
 
-    The static poses (given, or found by :func:`.poses.detect_poses`), each pose's mean
-    specific force and its noise, the accelerometer triad (gravity magnitude over at least
-    nine poses, or the six faces' closed form when only they are named), the calibrated up
-    direction of each pose, then the gyro bias from the poses at rest and its scale factors
-    and misalignments from the motions between poses and the named 360° turns.
-
-    Parameters
-    ----------
-    time_s : array_like, shape (n,)
-        Sample times [s].
-    accel_mg : array_like, shape (n, 3)
-        Specific force of the x, y, z accelerometers [mg].
-    gyro_rad_s : array_like, shape (n, 3), or None
-        Rates of the x, y, z gyros [rad/s]; None calibrates the accelerometer alone.
-    g_mg : float
-        Local gravity [mg] (1 mg = 9.80665e-3 m/s²).
-    latitude_deg : float, optional
-        Site latitude [°]: the earth rate is taken off the gyro bias (None: not taken off,
-        as imucal does).
-    sections : sequence of Section, optional
-        The poses and turns by sample index (:func:`.poses.parse_poses`); None finds the
-        poses from the data.
-    static_s : float, optional
-        The shortest still pose [s].
-    temperature_c : array_like, shape (n,), optional
-        Temperature [°C]; its mean over the poses is reported.
-    where, sections_from : str, optional
-        The session and the source of ``sections``, as messages name them.
-    saturated : array_like of bool, shape (n,), optional
-        Samples with a gyro axis on its rails: their motions are left out of the gyro fit,
-        a turn holding one is refused.
-    gyro_model : {"full", "scale"}, optional
-        The elements of the gyro's ``E`` fitted (:data:`.gyro.GYRO_MODELS`).
-
-    Returns
-    -------
-    SessionResult
-        The accelerometer fit (:class:`~thermocal.multipos.accel.AccelFit`), the gyro fit
-        (:class:`~thermocal.multipos.gyro.GyroFit`, None without a gyro), the poses and
-        turns used; ``to_dict()`` and ``table()`` give them as data.
-
-    Raises
-    ------
-    thermocal.errors.DesignError
-        Fewer than six poses, faces that are not the faces they are named, a fit that
-        fails its own checks (scale factors beyond ±50 %, residuals no smaller than before).
-    thermocal.errors.ParameterError
-        A detection parameter out of its range (:func:`.poses.find_poses`).
-
-    Notes
-    -----
-    The accelerometer minimises the gravity-magnitude misfit over the poses ``k``
-    (Tedaldi et al. 2014 [1]_, eqs. 9-10) with the body frame the accelerometer frame
-    (``E_a`` lower triangular):
-
-    .. math::
-
-        \\min_{b_a, E_a} \\sum_k \\left(\\frac{\\lVert (I + E_a)^{-1}
-        (\\bar f_k - b_a) \\rVert - g}{\\sigma_k}\\right)^2
-
-    With the six faces named and fewer than nine poses, the closed form of Ferraris et
-    al. (1995) [2]_: ``b_a`` the mean of the six face means and column ``j`` of
-    ``I + E_a`` half the difference of the faces ``j+`` and ``j−`` over ``g``.  The gyro's
-    ``E_g`` makes the rotation integrated over each motion carry the first pose's up
-    direction onto the next's, and each named turn one full turn about its axis.
-
-    References
-    ----------
-    .. [1] D. Tedaldi, A. Pretto and E. Menegatti, "A robust and easy to implement method
-       for IMU calibration without external equipments", Proc. IEEE ICRA 2014,
-       pp. 3042-3049, doi:10.1109/ICRA.2014.6907297.
-    .. [2] F. Ferraris, U. Grimaldi and M. Parvis, "Procedure for effortless in-field
-       calibration of three-axis rate gyros and accelerometers", Sensors and Materials
-       7(5), 1995, pp. 311-330.
-
-    Examples
-    --------
-    Six faces held still, accelerometer only, with a +2 % x scale factor and a 30 mg
-    y bias:
-
-    >>> import numpy as np
-    >>> from thermocal.multipos import Section, calibrate_session
-    >>> faces = np.array([[1, 0, 0], [-1, 0, 0], [0, 1, 0], [0, -1, 0], [0, 0, 1],
-    ...                   [0, 0, -1]]) * 1000.0
-    >>> f = np.repeat(faces, 200, axis=0) * [1.02, 1.0, 1.0] + [0.0, 30.0, 0.0]
-    >>> f = f + np.random.default_rng(0).normal(0.0, 0.5, f.shape)
-    >>> names = ["x_p", "x_a", "y_p", "y_a", "z_p", "z_a"]
-    >>> secs = [Section(n, 200 * i, 200 * i + 200) for i, n in enumerate(names)]
-    >>> res = calibrate_session(np.arange(1200) / 100.0, f, None, g_mg=1000.0,
-    ...                         sections=secs)
-    >>> res.accel.method, round(float(res.accel.theta[3]), -2), round(float(res.accel.theta[1]), 1)
-    ('six-face', 20000.0, 30.0)
-    """
+    ``accel_mg`` (n, 3) [mg], ``gyro_rad_s`` (n, 3) [rad/s] or None, ``g_mg`` local gravity
+    [mg], ``latitude_deg`` [°] (the earth rate off the gyro bias); ``sections`` given
+    (:func:`.poses.parse_poses`) or found; ``saturated`` (n,) samples on a gyro's rails;
+    ``gyro_model`` the gyro's E (:data:`.gyro.GYRO_MODELS`).  Returns a :class:`SessionResult`;
+    the model, its formulas and sources and an example are in :mod:`thermocal.multipos`."""
     t = np.asarray(time_s, dtype=np.float64)
     a = np.asarray(accel_mg, dtype=np.float64)
     w = None if gyro_rad_s is None else np.asarray(gyro_rad_s, dtype=np.float64)

@@ -289,16 +289,13 @@ def find_poses(
     ----------
     time_s : array_like, shape (n,)
         Sample times [s], at least 10 samples.
-    accel : array_like, shape (n, 3)
-        Accelerometer samples in any unit (directions are judged on them).
-    gyro : array_like, shape (n, 3), optional
-        Gyro samples in any unit; when given, a still sample is still for both sensors.
-    static_s : float, optional
-        The shortest pose [s].
-    window_s : float, optional
-        The moving-variance window [s].
+    accel, gyro : array_like, shape (n, 3)
+        Accelerometer samples in any unit (directions are judged on them); gyro samples in
+        any unit or None (when given, a still sample is still for both sensors).
+    static_s, window_s : float, optional
+        The shortest pose and the moving-variance window [s].
     still_threshold : float, optional
-        The still limit in multiples of the noise floor (dimensionless).
+        The still limit in multiples of the noise floor.
     motion_fraction : float, optional
         The still limit as a fraction of the motions' variance, in [0, 1).
     drift_deg : float, optional
@@ -307,50 +304,29 @@ def find_poses(
     Returns
     -------
     PoseDetection
-        The poses (:class:`Section`), the stretches rejected (too short, moving, tremor)
-        and each sensor's noise floor and still limit.
+        The poses (:class:`Section`), the stretches rejected (too short, moving, tremor) and
+        each sensor's noise floor and still limit.
 
     Raises
     ------
     thermocal.errors.ParameterError
         A parameter out of its range (named as in this signature).
-    thermocal.errors.ThermocalInputError
-        Fewer than 10 samples.
 
     Notes
     -----
-    With ``v_j`` the centred moving variance of axis ``j`` over ``w`` samples, ``σ_j²`` its
-    noise floor (the 10th percentile of ``v_j`` over the 10 % point of
-    ``χ²_{w−1}/(w−1)``) and ``m`` the 90th percentile of ``Σ_j v_j`` (the motions), a
-    sample is still where, for each sensor,
-
-    .. math::
-
-        \\sum_j v_j < \\max\\left(t \\sum_j \\sigma_j^2,\\; f\\, m\\right)
-
-    with ``t`` = ``still_threshold`` and ``f`` = ``motion_fraction`` (module docstring).
-    The static-detector idea, a variance threshold relative to the sensor's own noise, is
-    that of Tedaldi et al. (2014) [1]_.
-
-    References
-    ----------
-    .. [1] D. Tedaldi, A. Pretto and E. Menegatti, "A robust and easy to implement method
-       for IMU calibration without external equipments", Proc. IEEE ICRA 2014,
-       pp. 3042-3049, doi:10.1109/ICRA.2014.6907297.
+    A sample is still where, for each sensor, :math:`\\sum_j v_j < \\max(t \\sum_j
+    \\sigma_j^2,\\ f m)`: ``v_j`` the moving variance of axis ``j``, ``σ_j²`` its noise
+    floor, ``m`` the motions' variance, ``t`` = ``still_threshold``, ``f`` =
+    ``motion_fraction`` (module docstring; the static detector of Tedaldi et al. 2014).
 
     Examples
     --------
-    Two still stretches of 3 s with a 2 s move between them:
-
     >>> import numpy as np
     >>> rng = np.random.default_rng(0)
     >>> t = np.arange(800) / 100.0
     >>> a = np.tile([0.0, 0.0, 1000.0], (800, 1)) + rng.normal(0.0, 1.0, (800, 3))
     >>> a[300:500] += 300.0 * np.sin(np.linspace(0, np.pi, 200))[:, None]
-    >>> det = find_poses(t, a)
-    >>> [(p.start < 300, p.end <= 310, p.n > 250) for p in det.poses][0]
-    (True, True, True)
-    >>> len(det.poses)
+    >>> len(find_poses(t, a).poses)
     2
     """
     t = np.asarray(time_s, dtype=np.float64)

@@ -79,49 +79,14 @@ def validate_held_out_session(
 ) -> list[MultiposValidation]:
     """A multi-position calibration of triads judged on a held-out session.
 
-    Parameters
-    ----------
-    triads : sequence of Triad
-        The calibration's triads (:class:`thermocal.models.calibration.Triad`), one of them
-        an accelerometer (it gives the poses' up directions).
-    rec : Recording
-        The held-out session, with the triads' columns.
-    latitude_deg : float, optional
-        Site latitude [°] for normal gravity when the calibration recorded no ``g``
-        (default: the recording's, then the calibration's).
-    static_s : float, optional
-        The shortest still pose [s].
-    signal_unit : str, optional
-        One unit for every triad column, or one per column in the triads' order
-        (comma-separated as ``compensate`` takes it).
-
-    Returns
-    -------
-    list of MultiposValidation
-        Per triad, before (raw) and after compensation: the rms over poses of the
-        gravity-magnitude error [accelerometer unit], or over motions of the rotation-angle
-        error [°] (module docstring).
-
-    Raises
-    ------
-    thermocal.errors.ParameterError
-        ``static_s`` not positive, no latitude where one is needed.
-    thermocal.errors.ThermocalInputError
-        No accelerometer triad, no still pose in the session.
-
-    Notes
-    -----
-    Per pose the gravity-magnitude error :math:`\\lVert \\bar f_k \\rVert - g` with
-    :math:`f = (I + E(T))^{-1}(f_\\mathrm{meas} - b(T))` after compensation; per motion
-    between poses the angle between the next pose's up direction and the previous one's
-    carried over by the integrated rate (Tedaldi et al. 2014 [1]_, the gyro cost).
-
-    References
-    ----------
-    .. [1] D. Tedaldi, A. Pretto and E. Menegatti, "A robust and easy to implement method
-       for IMU calibration without external equipments", Proc. IEEE ICRA 2014,
-       pp. 3042-3049, doi:10.1109/ICRA.2014.6907297.
-    """
+    ``triads`` the calibration's (one an accelerometer: it gives the poses' up directions),
+    ``rec`` the session, ``latitude_deg`` [°] for normal gravity when the calibration recorded
+    none, ``static_s`` [s] the shortest pose, ``signal_unit`` one unit for every triad column
+    or one per column (comma-separated, as ``compensate`` takes it).  Returns one
+    :class:`MultiposValidation` per triad: before and after compensation, the gravity-magnitude
+    error over poses and the rotation-angle error over motions (module docstring; Tedaldi et
+    al. 2014).  Raises :class:`~thermocal.errors.ParameterError` for a ``static_s`` not
+    positive or a missing latitude."""
     from thermocal.turntable import thermal
 
     if not (math.isfinite(static_s) and static_s > 0):

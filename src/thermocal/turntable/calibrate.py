@@ -381,88 +381,41 @@ def calibrate(
     temperature_column: str | None = None,
     alpha_offset_deg: float = 0.0,
 ) -> TurntableResult:
-    """Calibrate a gyro triad from a 16-position dual-axis turntable run.
+    """Calibrate a gyro triad from a 16-position dual-axis turntable run (CN104880182).
 
     Parameters
     ----------
     rec : Recording
         Time [s], gyro mean rates over the interval ending at each sample, encoder angles
-        α, β at the sample times [° or rad] (wrapped or not).
+        α, β at the sample times [° or rad], wrapped or not.
     latitude_deg : float, optional
-        Site latitude L [°] (default: the recording's metadata).
-    gyro_columns, alpha_column, beta_column : str
-        Column names.
-    gyro_unit : str, optional
-        Unit of the gyro columns (default: the recording's; none known is refused).
-    encoder_unit : str, optional
-        ``"deg"`` or ``"rad"`` (default: the recording's metadata, else the unit in the
-        column name, else ° with a warning: :func:`thermocal.units.resolve_unit`).
-    arw_deg_sqrt_h : float or sequence of float, optional
-        Angle random walk [°/√h], scalar or per axis; estimated from the dwells when None.
-    encoder_noise_arcsec : float, optional
-        White-noise σ of the encoder readings [″]; estimated from the readings at rest
-        (jitter, or quantisation q/√12) when None (:func:`.schedule.detect_motion`).
+        Site latitude [°] (default: the recording's metadata).
+    gyro_columns, alpha_column, beta_column, accel_columns, temperature_column : str
+        Column names (``accel_columns``: an accelerometer triad from the dwells' gravity,
+        :mod:`.accel`; ``temperature_column``: its mean and span over the run [°C]).
+    gyro_unit, encoder_unit, accel_unit : str, optional
+        Units (default: the recording's; an encoder without one is taken in ° with a warning).
+    arw_deg_sqrt_h, encoder_noise_arcsec : float, optional
+        Angle random walk [°/√h] and encoder noise σ [″]; estimated from the dwells if None.
     channels : {3, 2}
         3: Δα, Δβ, Δγ (15-state filter); 2: the source's Δα, Δβ (14 states).
-    min_positions : int
-        Positions the run must hold (:func:`.schedule.check_design`).
-    min_dwell_s : float
-        The shortest dwell [s].
-    move_block_s : float
-        Least squares: rotations cut into increments of at most this [s].
-    kf_interval_s : float
-        Filter measurement interval [s] (at rest and while rotating).
+    min_positions, min_dwell_s, move_block_s, kf_interval_s : int or float
+        Design checks (positions, the shortest dwell [s]), the least-squares block and the
+        filter's measurement interval [s].
     prior_sigma : tuple of float
         The filter's initial σ of bias [°/h], scale factor [ppm], misalignment [″].
-    accel_columns : sequence of str, optional
-        The accelerometer triad's columns (x, y, z), estimated from the mean specific
-        force of each dwell (:mod:`.accel`).
-    accel_unit : str, optional
-        Their unit (default: the recording's; none known is refused).
-    gravity_m_s2 : float, optional
-        Local gravity [m/s²] (default: WGS-84 normal gravity at the latitude).
-    temperature_column : str, optional
-        A temperature column [°C] whose mean and span over the run are reported.
-    alpha_offset_deg : float
-        The α encoder's reading at the geometry's α = 0 [°] (subtracted), within ±360°.
+    gravity_m_s2, alpha_offset_deg : float, optional
+        Local gravity [m/s²] (default: WGS-84 normal); the α encoder's reading at α = 0 [°].
 
     Returns
     -------
     TurntableResult
-        The Kalman-filter estimate (reported), the least-squares cross-check, the
-        design's Cramér–Rao bound and the diagnostics; :meth:`TurntableResult.to_dict`.
+        The Kalman estimate, the least-squares cross-check and the Cramér–Rao bound.
 
     Raises
     ------
-    thermocal.errors.MissingColumnError, thermocal.errors.MissingValueError
-        Absent or incomplete columns.
-    TurntableScheduleError
-        Fewer positions, dwells shorter than asked, an axis not moving.
-    thermocal.errors.ParameterError
-        No latitude known, an ``alpha_offset_deg`` beyond ±360°.
     thermocal.errors.ThermocalInputError
-        A fit that fails its own checks (:func:`_judge`).
-
-    Notes
-    -----
-    The error model :math:`\\omega_\\mathrm{meas} = (I + E)\\,\\omega_\\mathrm{true} + b + n`
-    (:mod:`.model`); the 14-state filter and the sixteen positions are those of the
-    dual-axis turntable source document [1]_, the terms those of IEEE Std 952 [2]_.
-
-    References
-    ----------
-    .. [1] *A method for separating the combined error coefficients of a ring-laser gyro
-       triad based on dual-axis rotation*, Chinese invention patent CN104880182.
-    .. [2] IEEE Std 952-1997 (R2008), "IEEE Standard Specification Format Guide and Test
-       Procedure for Single-Axis Interferometric Fiber Optic Gyros", IEEE, 1998.
-
-    Examples
-    --------
-    >>> from thermocal.turntable import calibrate, simulate_turntable16
-    >>> rec, truth = simulate_turntable16(1, rate_hz=10.0, dwell_s=20.0)
-    >>> res = calibrate(rec, 40.0, min_dwell_s=10.0)
-    >>> res.n_positions, res.n_states
-    (16, 15)
+        Missing columns, a schedule not held, a fit that fails its own checks.
     """
     lat = _check_inputs(rec, latitude_deg, channels, gyro_columns, alpha_column, beta_column,
                         accel_columns, temperature_column)  # fmt: skip
@@ -861,10 +814,10 @@ def validate_turntable_run(
     """A turntable calibration of triads judged on an independent 16-position run.
 
     The reference of every sample comes from the encoder angles (the true body rate
-    ``ω_ib^b`` over each interval, :func:`.kinematics.omega_ib_b`; the specific force
-    ``C_nᵇ (0, 0, g)`` at rest), the dwells and moves from the encoders
-    (:func:`.schedule.detect_motion`); per triad the dwell-mean and move-angle errors
-    before and after compensation (:func:`thermocal.turntable.thermal.validate_triad`).
+    ``ω_ib^b = C_nᵇ ω_ie^n + ω_nb^b(α, β, α̇, β̇)`` over each interval,
+    :func:`.kinematics.omega_ib_b`; the specific force ``C_nᵇ (0, 0, g)`` at rest); per triad
+    the dwell-mean and move-angle errors before and after compensation
+    (:func:`thermocal.turntable.thermal.validate_triad`).
 
     Parameters
     ----------
@@ -872,40 +825,16 @@ def validate_turntable_run(
         The calibration's triads (:class:`thermocal.models.calibration.Triad`).
     rec : Recording
         The independent run: time, the triads' columns and temperatures, the encoders.
-    latitude_deg : float, optional
-        Site latitude [°] (default: the recording's metadata, then the calibration's).
-    gravity_m_s2 : float, optional
-        Local gravity [m/s²] (default: WGS-84 normal gravity at the latitude).
+    latitude_deg, gravity_m_s2 : float, optional
+        Site latitude [°] (default: the recording's, then the calibration's) and local
+        gravity [m/s²] (default: WGS-84 normal gravity there).
     alpha_column, beta_column : str, optional
         The encoder columns (default: the calibration runs').
 
     Returns
     -------
-    list
-        One :class:`thermocal.turntable.thermal.TriadValidation` per triad.
-
-    Raises
-    ------
-    thermocal.errors.ParameterError
-        No latitude known.
-    thermocal.errors.ThermocalInputError
-        Missing or non-finite columns, fewer than two dwells.
-
-    Notes
-    -----
-    The true body rate of the dual-axis table at latitude :math:`L` (earth rate
-    :math:`\\Omega`), from the encoder angles (CN104880182 [1]_):
-
-    .. math::
-
-        \\omega_{ib}^b = C_n^b\\, \\omega_{ie}^n + \\omega_{nb}^b(\\alpha, \\beta,
-        \\dot\\alpha, \\dot\\beta), \\qquad
-        \\omega_{ie}^n = (0,\\ \\Omega\\cos L,\\ \\Omega\\sin L)
-
-    References
-    ----------
-    .. [1] *A method for separating the combined error coefficients of a ring-laser gyro
-       triad based on dual-axis rotation*, Chinese invention patent CN104880182.
+    list of TriadValidation
+        One per triad (:class:`thermocal.turntable.thermal.TriadValidation`).
     """
     from thermocal.turntable import kinematics, thermal
 

@@ -432,61 +432,25 @@ def fit_triad(
     temps_c : sequence of float
         Each run's soak temperature [°C].
     thetas, sigmas : array_like, shape (R, 12)
-        Each run's θ and its σ in the units of :data:`UNITS` (bias [°/h or mg], scale
-        factors [ppm], misalignments [″]).  A parameter whose σ is zero in every run is
-        one held by a constraint (the multi-position accelerometer's upper
-        misalignments): fitted unweighted.
+        Each run's θ and its σ in the units of :data:`UNITS`; a parameter whose σ is zero in
+        every run (held by a constraint) is fitted unweighted.
     tref_c : float, optional
-        The reference temperature [°C] (default: the middle of the soak range), within
-        the soaks' range or its reader's margin of it.
+        The reference temperature [°C] (default: the middle of the soaks).
     order : int, optional
-        The polynomial order (default: chosen per parameter by the leave-one-temperature-
-        out error).
-    method : str, optional
-        How the runs were calibrated (``"turntable"`` or ``"multipos"``), recorded.
-    gravity_m_s2 : float, optional
-        The local gravity the accelerometer was calibrated with [m/s²], recorded.
+        The polynomial order (default: chosen per parameter by the LOTO error).
+    method, gravity_m_s2 : str, float, optional
+        How the runs were calibrated and the accelerometer's gravity [m/s²], recorded.
 
     Returns
     -------
     TriadThermal
-        The coefficients of each parameter's polynomial with their σ, the order and the
-        LOTO rms of each; ``theta_at(T)`` evaluates it (clamped to the soaks' range).
+        Each parameter's polynomial :math:`\\theta_k(T) = \\sum_p c_{kp} (T - T_\\mathrm{ref})^p`
+        with its σ, order and LOTO rms (module docstring).
 
     Raises
     ------
     thermocal.errors.ParameterError
         A ``tref_c`` the calibration file's reader would refuse.
-    thermocal.errors.ThermocalInputError
-        An unknown kind, arrays of the wrong shape.
-
-    Notes
-    -----
-    Each parameter is a polynomial in :math:`T - T_\\mathrm{ref}` fitted by weighted least
-    squares (weights :math:`1/\\sigma_{rk}^2`), its σ scaled by the reduced χ² when that
-    exceeds 1 (module docstring):
-
-    .. math::
-
-        \\theta_k(T) = \\sum_{p=0}^{P} c_{kp} (T - T_\\mathrm{ref})^p
-
-    The error model at each temperature is that of the turntable source document [1]_.
-
-    References
-    ----------
-    .. [1] *A method for separating the combined error coefficients of a ring-laser gyro
-       triad based on dual-axis rotation*, Chinese invention patent CN104880182.
-
-    Examples
-    --------
-    A gyro x bias of 10 + 0.5 (T − 20) °/h measured at three soaks:
-
-    >>> import numpy as np
-    >>> th = np.zeros((3, 12))
-    >>> th[:, 0] = [0.0, 10.0, 20.0]
-    >>> fit = fit_triad("gyro", [0.0, 20.0, 40.0], th, np.ones((3, 12)), tref_c=20.0, order=1)
-    >>> [round(float(v), 3) for v in fit.theta_at(30.0)[:2]]
-    [15.0, 0.0]
     """
     if kind not in UNITS:
         raise ThermocalInputError(f"triad kind must be gyro or accel, got {kind!r}")
