@@ -403,46 +403,10 @@ def _warn_too_few_motions(gfit: _gyro.GyroFit, where: str) -> None:
     )
 
 
-def calibrate_session(
-    time_s: npt.ArrayLike,
-    accel_mg: npt.ArrayLike,
-    gyro_rad_s: npt.ArrayLike | None,
-    *,
-    g_mg: float,
-    latitude_deg: float | None = None,
-    sections: Sequence[Section] | None = None,
-    static_s: float = 1.0,
-    temperature_c: npt.ArrayLike | None = None,
-    where: str = "session",
-    sections_from: str = "the POSES file",
-    saturated: npt.ArrayLike | None = None,
-    gyro_model: str = "full",
-) -> SessionResult:
-    """Calibrate the accelerometer (and gyro) triad of one multi-position session.
-
-    ``accel_mg`` (n, 3) [mg], ``gyro_rad_s`` (n, 3) [rad/s] or None, ``g_mg`` local gravity
-    [mg], ``latitude_deg`` [°] (the earth rate off the gyro bias); ``sections`` given
-    (:func:`.poses.parse_poses`) or found; ``saturated`` (n,) samples on a gyro's rails;
-    ``gyro_model`` the gyro's E (:data:`.gyro.GYRO_MODELS`).  Returns a :class:`SessionResult`;
-    the model, its formulas and sources and an example are in :mod:`thermocal.multipos`."""
-    t = np.asarray(time_s, dtype=np.float64)
-    a = np.asarray(accel_mg, dtype=np.float64)
-    w = None if gyro_rad_s is None else np.asarray(gyro_rad_s, dtype=np.float64)
-    given = sections is not None
-    if sections is None:
-        sections = detect_poses(t, a, w, static_s=static_s)
-    statics = [s for s in sections if not s.is_turn]
-    turns = [s for s in sections if s.is_turn]
-    not_still = _section_warnings(statics, turns, w is not None, where, sections_from)
-    if given:
-        _warn_short(t, statics, static_s, where, sections_from)
-    stats = pose_stats(a, w, statics)
-    if len(stats) < 6:
-        raise DesignError(
-            f"{where}: {len(stats)} static poses found (still for at least {static_s:g} s): "
-            f"the accelerometer triad needs at least {_accel.MIN_POSES} distinct poses "
-            "(6 with the six faces named in --poses)"
-        )
+def _accel_fit(
+    stats: Sequence[PoseStats], g_mg: float, where: str, sections_from: str
+) -> tuple[_accel.AccelFit, Sequence[int]]:
+    """The accelerometer fit of :func:`calibrate_session` and the indices of θ it frees."""
     f = np.asarray([p.f_mean_mg for p in stats])
     sig = np.asarray([p.mean_sigma_mg for p in stats])
     names = [p.section.name for p in stats]
@@ -468,37 +432,142 @@ def calibrate_session(
         acc = _accel.fit_gravity_magnitude(f, sig, g_mg)
         idx = _accel.FREE_INDEX
     check_accel_fit(acc, g_mg, where)
+    return acc, idx
+
+
+def _gyro_fit(
+    t: FloatArray, a: FloatArray, w: FloatArray, stats: Sequence[PoseStats],
+    turns: Sequence[Section], acc: _accel.AccelFit, idx: Sequence[int], g_mg: float,
+    latitude_deg: float | None, sat: npt.NDArray[np.bool_] | None, gyro_model: str,
+    where: str, sections_from: str,
+) -> _gyro.GyroFit:  # fmt: skip
+    """The gyro fit of :func:`calibrate_session`, on the accelerometer's up directions."""
+    f = np.asarray([p.f_mean_mg for p in stats])
+    sig = np.asarray([p.mean_sigma_mg for p in stats])
+    names = [p.section.name for p in stats]
+    held = np.array([acc.method == "six-face" and n in FACES for n in names])
+    up_of = _up_function(acc.theta, idx, f, held)
+    free = acc.theta[np.asarray(idx)]
+    free_cov = acc.cov[np.ix_(np.asarray(idx), np.asarray(idx))]
+    up = up_of(free)
+    n = np.asarray([p.section.n for p in stats], dtype=np.float64)
+    wm = np.asarray([p.w_mean_rad_s for p in stats])
+    ws = np.sqrt(np.average(np.asarray([p.w_sigma_rad_s for p in stats]) ** 2, axis=0,
+                            weights=n))  # fmt: skip
+    bias, bias_cov = _gyro.static_bias(wm, n, ws, up, latitude_deg)
+    dt = np.diff(t)
+    dt = np.concatenate([dt, dt[-1:]])
+    dir_sig = _direction_sigma(sig, names, acc.method, g_mg)
+    named = _named_turns(turns, w, dt, bias, a, acc, dict(zip(names, dir_sig, strict=True)),
+                         f"{where}: section", sections_from, sat)  # fmt: skip
+    gfit = _gyro.fit_rotations(
+        w, dt, [p.section for p in stats], up_of, free, free_cov, bias, bias_cov,
+        dir_sig, float(np.sqrt(np.mean(ws**2))), named, latitude_deg=latitude_deg,
+        saturated=sat,
+        model=gyro_model,
+    )  # fmt: skip
+    check_gyro_fit(gfit, where)
+    _warn_implausible(gfit, where)
+    _warn_too_few_motions(gfit, where)
+    return gfit
+
+
+def calibrate_session(
+    time_s: npt.ArrayLike,
+    accel_mg: npt.ArrayLike,
+    gyro_rad_s: npt.ArrayLike | None,
+    *,
+    g_mg: float,
+    latitude_deg: float | None = None,
+    sections: Sequence[Section] | None = None,
+    static_s: float = 1.0,
+    temperature_c: npt.ArrayLike | None = None,
+    where: str = "session",
+    sections_from: str = "the POSES file",
+    saturated: npt.ArrayLike | None = None,
+    gyro_model: str = "full",
+) -> SessionResult:
+    """Calibrate the accelerometer (and gyro) triad of one multi-position session.
+
+    Parameters
+    ----------
+    time_s, accel_mg, gyro_rad_s : array_like, shapes (n,), (n, 3), (n, 3) or None
+        Sample times [s], specific force [mg] and rates [rad/s] (None: accelerometer only).
+    g_mg, latitude_deg : float
+        Local gravity [mg]; site latitude [°], the earth rate taken off the gyro bias (None:
+        not taken off, as imucal does).
+    sections : sequence of Section, optional
+        Poses and turns by sample (:func:`.poses.parse_poses`); None finds the poses.
+    static_s : float, optional
+        The shortest still pose [s].
+    temperature_c, saturated : array_like, shape (n,), optional
+        Temperature [°C] (its mean over the poses reported); samples with a gyro on its
+        rails (their motions left out, a turn holding one refused).
+    where, sections_from : str, optional
+        The session and the source of ``sections``, as messages name them.
+    gyro_model : {"full", "scale"}, optional
+        The elements of the gyro's ``E`` fitted (:data:`.gyro.GYRO_MODELS`).
+
+    Returns
+    -------
+    SessionResult
+        The accelerometer and gyro fits, the poses and turns; ``to_dict()``, ``table()``.
+
+    Raises
+    ------
+    thermocal.errors.DesignError
+        Fewer than six poses, faces not what they are named, a fit failing its checks.
+
+    Notes
+    -----
+    The accelerometer minimises :math:`\\sum_k (\\lVert (I + E_a)^{-1} (\\bar f_k - b_a)
+    \\rVert - g)^2 / \\sigma_k^2` over the poses (Tedaldi et al. 2014, eqs. 9-10), or, with
+    the six faces named, Ferraris et al. (1995)'s closed form; the gyro's ``E_g`` makes the
+    rotation integrated over each motion carry one pose's up direction onto the next's
+    (:mod:`thermocal.multipos`: the model and its sources).
+
+    Examples
+    --------
+    Six faces, accelerometer only, with a +2 % x scale factor and a 30 mg y bias:
+
+    >>> import numpy as np
+    >>> from thermocal.multipos import FACES, Section, calibrate_session
+    >>> rng = np.random.default_rng(0)
+    >>> f = np.repeat(np.vstack([np.eye(3), -np.eye(3)])[[0, 3, 1, 4, 2, 5]] * 1000.0, 200, 0)
+    >>> f = f * [1.02, 1.0, 1.0] + [0.0, 30.0, 0.0] + rng.normal(0, 0.5, f.shape)
+    >>> secs = [Section(n, 200 * i, 200 * i + 200) for i, n in enumerate(FACES)]
+    >>> res = calibrate_session(np.arange(1200) / 100.0, f, None, g_mg=1000.0, sections=secs)
+    >>> res.accel.method, round(float(res.accel.theta[3]), -2), round(float(res.accel.theta[1]), 1)
+    ('six-face', 20000.0, 30.0)
+    """
+    t = np.asarray(time_s, dtype=np.float64)
+    a = np.asarray(accel_mg, dtype=np.float64)
+    w = None if gyro_rad_s is None else np.asarray(gyro_rad_s, dtype=np.float64)
+    given = sections is not None
+    if sections is None:
+        sections = detect_poses(t, a, w, static_s=static_s)
+    statics = [s for s in sections if not s.is_turn]
+    turns = [s for s in sections if s.is_turn]
+    not_still = _section_warnings(statics, turns, w is not None, where, sections_from)
+    if given:
+        _warn_short(t, statics, static_s, where, sections_from)
+    stats = pose_stats(a, w, statics)
+    if len(stats) < 6:
+        raise DesignError(
+            f"{where}: {len(stats)} static poses found (still for at least {static_s:g} s): "
+            f"the accelerometer triad needs at least {_accel.MIN_POSES} distinct poses "
+            "(6 with the six faces named in --poses)"
+        )
+    acc, idx = _accel_fit(stats, g_mg, where, sections_from)
     temp = None
     if temperature_c is not None:
         tc = np.asarray(temperature_c, dtype=np.float64)
         temp = float(np.nanmean(np.concatenate([tc[s.start : s.end] for s in statics])))
     gfit = None
     if w is not None:
-        held = np.array([acc.method == "six-face" and n in FACES for n in names])
-        up_of = _up_function(acc.theta, idx, f, held)
-        free = acc.theta[np.asarray(idx)]
-        free_cov = acc.cov[np.ix_(np.asarray(idx), np.asarray(idx))]
-        up = up_of(free)
-        n = np.asarray([p.section.n for p in stats], dtype=np.float64)
-        wm = np.asarray([p.w_mean_rad_s for p in stats])
-        ws = np.sqrt(np.average(np.asarray([p.w_sigma_rad_s for p in stats]) ** 2, axis=0,
-                                weights=n))  # fmt: skip
-        bias, bias_cov = _gyro.static_bias(wm, n, ws, up, latitude_deg)
-        dt = np.diff(t)
-        dt = np.concatenate([dt, dt[-1:]])
-        dir_sig = _direction_sigma(sig, names, acc.method, g_mg)
         sat = None if saturated is None else np.asarray(saturated, dtype=bool)
-        named = _named_turns(turns, w, dt, bias, a, acc, dict(zip(names, dir_sig, strict=True)),
-                             f"{where}: section", sections_from, sat)  # fmt: skip
-        gfit = _gyro.fit_rotations(
-            w, dt, [p.section for p in stats], up_of, free, free_cov, bias, bias_cov,
-            dir_sig, float(np.sqrt(np.mean(ws**2))), named, latitude_deg=latitude_deg,
-            saturated=sat,
-            model=gyro_model,
-        )  # fmt: skip
-        check_gyro_fit(gfit, where)
-        _warn_implausible(gfit, where)
-        _warn_too_few_motions(gfit, where)
+        gfit = _gyro_fit(t, a, w, stats, turns, acc, idx, g_mg, latitude_deg, sat,
+                         gyro_model, where, sections_from)  # fmt: skip
     return SessionResult(acc, gfit, tuple(stats), tuple(turns), g_mg, temp, not_still)
 
 
