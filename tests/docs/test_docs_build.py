@@ -31,6 +31,7 @@ PAGES = (
     "tutorials/production-batch",
     "methods",
     "cli",
+    "json",
     "api",
 )
 
