@@ -103,6 +103,7 @@ def test_every_tutorial_is_executed_here() -> None:
         "noise-for-estimator.md",  # tests/docs/test_tutorials_a.py
         "production-batch.md",  # tests/docs/test_tutorials_b.py
         "stability-stable32.md",
+        "station.md",  # tests/docs/test_tutorial_station.py
     ]
 
 
