@@ -31,6 +31,7 @@ PAGES = (
     "tutorials/production-batch",
     "tutorials/station",
     "methods",
+    "gallery",
     "cli",
     "json",
     "api",
@@ -132,6 +133,17 @@ def test_api_reference_documents_the_entry_points(built: Path) -> None:
         "thermocal.export.params.export_params",
     ):
         assert f'id="{name}"' in text, name
+
+
+def test_gallery_embeds_every_figure_it_names(built: Path) -> None:
+    page = (DOCS / "gallery.md").read_text(encoding="utf-8")
+    names = re.findall(r"^```\{thermocal-figure\} (\S+)$", page, re.MULTILINE)
+    text = (built / "gallery.html").read_text(encoding="utf-8")
+    assert len(names) >= 18
+    for name in names:
+        figure = re.search(rf'<figure[^>]* id="gallery-{re.escape(name)}">\s*<img [^>]*>', text)
+        assert figure is not None, name
+        assert 'src="data:image/png;base64,' in figure.group(0), name
 
 
 def test_cli_reference_is_in_the_site(built: Path) -> None:
