@@ -53,9 +53,28 @@ def _split(key: str) -> Path_:
     return tuple(s for part in key.split(".") for s in re.split(r"(\[\])", part) if s)
 
 
+DEVIATIONS = "adev|oadev|mdev|tdev|hdev|ohdev|totdev|mtotdev|ttotdev|htotdev|theo1|mtie|tierms"
+"""``allan --deviation``'s names (its help lists them): ``<deviation>`` stands for these only."""
+
+
+def _segment(pattern: str) -> re.Pattern[str]:
+    """A documented segment as a regex: ``<deviation>`` one of :data:`DEVIATIONS`, any other
+    ``<name>`` any key; ``<deviation>_tau_s`` a prefix with a fixed rest."""
+    parts = re.split(r"(<[^>]+>)", pattern)
+    return re.compile(
+        "".join(
+            (f"(?:{DEVIATIONS})" if p == "<deviation>" else r".+")
+            if p.startswith("<")
+            else re.escape(p)
+            for p in parts
+        )
+    )
+
+
 def _matches(pattern: Path_, path: Path_) -> bool:
     return len(pattern) == len(path) and all(
-        p == s or (p.startswith("<") and s != "[]") for p, s in zip(pattern, path, strict=True)
+        s != "[]" and _segment(p).fullmatch(s) is not None if p != "[]" else s == "[]"
+        for p, s in zip(pattern, path, strict=True)
     )
 
 
@@ -170,9 +189,28 @@ def _chamber_runs(t: Path) -> list[tuple[str, Any]]:
         ("profile design-validation",
          _run(["profile", "design-validation", mod, "-o", str(t / "design.csv")])),
     ]  # fmt: skip
+    runs += _imu_runs(t)
     for name in ("rlg-modelling", "rlg-validation", "fog-slow", "mems-warmup", "accel-full-range"):
         runs.append(("profile NAME", _run(["profile", name, "-o", str(t / f"{name}.csv")])))
     return runs
+
+
+def _imu_runs(t: Path) -> list[tuple[str, Any]]:
+    """Several signals at once (a six-channel calibration) and the deviation family."""
+    mod, val, cal = str(t / "imu-mod.parquet"), str(t / "imu-val.parquet"), str(t / "imu.json")
+    _run(["simulate", "mems-imu", "-o", mod, "--seed", "1"])
+    _run(["simulate", "mems-imu", "--run", "validation", "-o", val, "--seed", "1"])
+    return [
+        ("fit", _run(["fit", mod, "--model", "poly", "--order", "3",
+                      "--signal", "gx,gy,gz,ax,ay,az", "--temps", "T_die",
+                      "--gravity-axis", "+z", "--latitude", "45", "-o", cal])),
+        ("validate", _run(["validate", cal, val, "--modeling", mod, "--ambient", "T_chamber"])),
+        ("compensate", _run(["compensate", cal, val, "-o", str(t / "imu-comp.parquet")])),
+        ("export-c", _run(["export-c", cal, "-o", str(t / "imu-c")])),
+        ("metrics", _run(["metrics", val, "--signal", "gx,gy,gz"])),
+        ("allan", _run(["allan", val, "--signal", "gx,gy"])),
+        ("allan", _run(["allan", val, "--signal", "gx", "--deviation", "mdev,hdev"])),
+    ]  # fmt: skip
 
 
 def _other_runs(t: Path) -> list[tuple[str, Any]]:
