@@ -196,10 +196,16 @@ def _chamber_runs(t: Path) -> list[tuple[str, Any]]:
 
 
 def _imu_runs(t: Path) -> list[tuple[str, Any]]:
-    """Several signals at once (a six-channel calibration) and the deviation family."""
+    """Several signals at once (a six-channel calibration), the deviation family, the dynamic
+    ADEV and several power-ons of one sensor."""
     mod, val, cal = str(t / "imu-mod.parquet"), str(t / "imu-val.parquet"), str(t / "imu.json")
     _run(["simulate", "mems-imu", "-o", mod, "--seed", "1"])
     _run(["simulate", "mems-imu", "--run", "validation", "-o", val, "--seed", "1"])
+    runs = []  # three power-ons of a MEMS gyro at +20 °C
+    for seed in (1, 2, 3):
+        _run(["simulate", "mems-warmup", "-o", str(t / f"w{seed}.csv"), "--seed", str(seed),
+              "--record-s", "360"])  # fmt: skip
+        runs.append(str(t / f"w{seed}_T+20.csv"))
     return [
         ("fit", _run(["fit", mod, "--model", "poly", "--order", "3",
                       "--signal", "gx,gy,gz,ax,ay,az", "--temps", "T_die",
@@ -210,6 +216,8 @@ def _imu_runs(t: Path) -> list[tuple[str, Any]]:
         ("metrics", _run(["metrics", val, "--signal", "gx,gy,gz"])),
         ("allan", _run(["allan", val, "--signal", "gx,gy"])),
         ("allan", _run(["allan", val, "--signal", "gx", "--deviation", "mdev,hdev"])),
+        ("allan", _run(["allan", val, "--signal", "gx", "--dynamic", "20000"])),
+        ("metrics", _run(["metrics", *runs, "--signal", "gyro"])),
     ]  # fmt: skip
 
 
