@@ -28,14 +28,39 @@ Truth = dict[str, Any]
 
 @dataclass(frozen=True)
 class NoiseParams:
-    """Noise terms of a sensor output, in its unit ``u`` (°/h or mg).
+    r"""Noise terms of a sensor output, in its unit ``u`` (°/h or mg).
 
-    white_density : N [u·√s] = [u/√Hz], two-sided PSD N² (angle / velocity random walk;
-        a gyro ARW of N' [°/√h] is N = 60·N' [°/h·√s]); Allan ``σ²(τ) = N²/τ``.
-    bias_instability : B [u], flicker PSD ``B²/(2πf)``; Allan plateau ``0.664 B``.
-    rate_random_walk : K [u/√s]; Allan ``σ²(τ) = K² τ/3``.
-    rate_ramp : R [u/s]; Allan ``σ²(τ) = R² τ²/2``.
-    resolution : output LSB [u] (0: none); pulse outputs are quantized by K instead.
+    Parameters
+    ----------
+    white_density : float
+        N [u·√s] = [u/√Hz], two-sided PSD N² (angle or velocity random walk; a gyro ARW of
+        N' [°/√h] is N = 60·N' [°/h·√s]).
+    bias_instability : float
+        B [u], flicker noise of PSD B²/(2πf).
+    rate_random_walk : float
+        K [u/√s].
+    rate_ramp : float
+        R [u/s].
+    resolution : float
+        Output LSB [u] (0: none); pulse outputs are quantized by the scale factor instead.
+
+    Notes
+    -----
+    The Allan variance of each term, as IEEE Std 952-1997 Annex C gives it:
+
+    .. math::
+
+        \sigma^2(\tau) = \frac{N^2}{\tau} + \frac{2\ln 2}{\pi}B^2
+        + \frac{K^2\tau}{3} + \frac{R^2\tau^2}{2},
+
+    so that the flicker plateau is :math:`\sqrt{2\ln 2/\pi}\,B \approx 0.664\,B`.
+
+    References
+    ----------
+    IEEE Std 952-1997, *IEEE Standard Specification Format Guide and Test Procedure for
+    Single-Axis Interferometric Fiber Optic Gyros*, Annex C.
+
+    W. J. Riley, *Handbook of Frequency Stability Analysis*, NIST SP 1065, 2008.
     """
 
     white_density: float = 0.0
