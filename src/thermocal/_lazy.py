@@ -1,4 +1,4 @@
-"""A module imported on first attribute access (start-up, issue 17): heavy libraries a module
+"""A module imported on first attribute access (start-up time): heavy libraries a module
 needs only inside some functions (scipy.stats for confidence intervals) stay out of the
 import of the module itself."""
 
@@ -24,7 +24,7 @@ class LazyModule:
 
 
 def prefetch(*names: str) -> None:
-    """Import modules in a background thread while the caller reads its file (issue 17).
+    """Import modules in a background thread while the caller reads its file.
 
     A command that will need, say, :mod:`scipy.special` after reading a large file starts
     its import first: the file reader and numpy release the GIL, so most of the import's

@@ -1,4 +1,4 @@
-"""The one gate between names from files or options and generated code (issue 26, item 3).
+"""The one gate between names from files or options and generated code.
 
 A column, channel, temperature or triad name, a ``--name`` prefix or a string field of a
 model file can hold anything: ``*/``, a newline followed by ``#error``, a backslash that
@@ -144,7 +144,7 @@ C_COMMENT_ASCII = {
     "ω": "omega", "Ω": "Omega", "√": "sqrt", "Δ": "d",
 }  # fmt: skip
 """The symbols of thermocal's own text (units, formulas) spelled in ASCII in generated C
-comments (issue 38: ``48.1\u00b0`` in a header); other non-ASCII is escaped."""
+comments (``48.1\u00b0`` would reach a header as a non-ASCII byte); other non-ASCII is escaped."""
 
 
 def c_comment(text: object) -> str:

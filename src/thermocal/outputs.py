@@ -1,5 +1,5 @@
 """Where a command may write: the one gate every output passes before anything is written
-(issue 26 item 1; INTERFACE.md common rules, "nothing is ever written over an input file").
+(the common rule of the command line: nothing is ever written over an input file).
 
 :func:`check_outputs` refuses (:class:`~thermocal.errors.ThermocalInputError`, exit 2, one
 ``error:`` line naming the output and the input) when
@@ -117,8 +117,8 @@ def special_mode(p: Path) -> str | None:
 def refuse_special_input(path: str | Path, what: str = "input file") -> None:
     """Raise :class:`ThermocalInputError` naming ``path`` when it is a FIFO, a device or a
     socket (``stat`` only: never opened).  Reading one blocks until a writer comes, or
-    never ends (``/dev/zero``): every reader of a user's path asks here first (issue 39
-    item 10: a FIFO as a fleet's modelling file hung ``fleet``)."""
+    never ends (``/dev/zero``): every reader of a user's path asks here first (a FIFO given as a
+    fleet's modelling file would hang ``thermocal fleet``)."""
     why = special_mode(Path(path))
     if why is not None:
         raise ThermocalInputError(

@@ -1,6 +1,6 @@
 """Shared pieces of the command line: reading options, error handling, output.
 
-INTERFACE.md common rules implemented here:
+The common rules of the command line, implemented here:
 
 * ``--json`` prints one JSON object on stdout and nothing else there
   (:func:`emit`); NaN and infinities become ``null``.
@@ -64,7 +64,7 @@ class _LazyConsole:
     def real(self) -> Console:
         """The console itself (built now if not yet).  Outside a terminal (a pipe, a file)
         and without ``COLUMNS`` set, it is :data:`WIDTH_OFF_TERMINAL` wide, so that a table
-        wider than 80 columns is printed whole rather than its names cut (issue 38)."""
+        wider than 80 columns is printed whole rather than its names cut."""
         if self._console is None:
             from rich.console import Console
 
@@ -94,7 +94,7 @@ stderr: Console = _LazyConsole(stderr=True, soft_wrap=True)  # type: ignore[assi
 
 # --- reusable option types ----------------------------------------------------------
 # Defaults are given where a command uses an alias (``time_unit: TimeUnitOpt = "s"``);
-# each command keeps the defaults INTERFACE.md documents for it.
+# each command keeps the defaults its help documents.
 
 FileArg = Annotated[Path, typer.Argument(help="Recording (CSV or Parquet).", show_default=False)]
 ModelArg = Annotated[
@@ -233,7 +233,7 @@ def parse_temp_conversion(text: str) -> units.TemperatureConversion:
 
 
 def handle_errors(fn: Callable[P, R]) -> Callable[P, R]:
-    """Map exceptions to INTERFACE.md exit statuses.
+    """Map exceptions to the exit statuses of the command line.
 
     :class:`ThermocalInputError` (and ``FileNotFoundError``) → ``error: ...``, exit 2.
     Anything else → ``error: internal: ...``, exit 1 (traceback only when the

@@ -1,6 +1,6 @@
 """``thermocal demo --imu``: the multi-channel workflow on a simulated six-axis MEMS IMU.
 
-Steps (issue 15): simulate the ``mems-imu`` scenario's modelling run and its weakly
+Steps: simulate the ``mems-imu`` scenario's modelling run and its weakly
 correlated validation run (the same unit, :func:`thermocal.simulate.scenario_mems_imu`);
 fit one cubic per channel on the die temperature into a calibration; validate every
 channel on the validation run (r against the modelling run's chamber air, figures before

@@ -1,4 +1,4 @@
-"""The whole station chain on one machine, no hardware (issue 31, item 6)::
+"""The whole station chain on one machine, no hardware::
 
     python -m thermocal.demo.station -o station-demo [--time-scale 200]
 
@@ -21,8 +21,8 @@ from pathlib import Path
 
 MODELLING = ([0.0, 300.0, 900.0, 1500.0, 2400.0, 3000.0], [25.0, 25.0, -10.0, -10.0, 70.0, 70.0])
 VALIDATION = ([0.0, 300.0, 900.0, 1500.0, 2100.0, 3000.0], [25.0, 45.0, 45.0, 0.0, 0.0, 60.0])
-"""Weakly correlated with :data:`MODELLING` (SPEC §5, r < 0.4): r = 0.15 between the two
-programs, 0.06 between their histories through the chamber's 120 s lag (issue 38: the earlier
+"""Weakly correlated with :data:`MODELLING` (r < 0.4): r = 0.15 between the two
+programs, 0.06 between their histories through the chamber's 120 s lag (the earlier
 25 → 60 → 0 → 40 °C program gave r = 0.49 and failed the demo's own validation), inside the
 modelled −10…70 °C."""
 

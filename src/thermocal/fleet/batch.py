@@ -1,5 +1,4 @@
-"""Production batches: one calibration per unit of a fleet (issue 18; INTERFACE.md "Fleet
-configuration").
+"""Production batches: one calibration per unit of a fleet.
 
 A TOML configuration names the ``thermocal fit`` options once (``[fit]``, by their long names
 without dashes), optional ``thermocal validate`` options (``[validate]``), optional pass/fail
@@ -94,7 +93,7 @@ CALIBRATION_FILE = "calibration.json"
 VALIDATION_FILE = "validation.json"
 
 EXIT_SOME_FAILED = 4
-"""Exit status of ``thermocal fleet`` when some unit failed (INTERFACE.md)."""
+"""Exit status of ``thermocal fleet`` when some unit failed."""
 
 
 # --- configuration ------------------------------------------------------------------------

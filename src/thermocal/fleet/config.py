@@ -1,4 +1,4 @@
-"""A fleet configuration (INTERFACE.md "Fleet configuration"): the TOML file read and
+"""A fleet configuration : the TOML file read and
 checked (:func:`load_config`).
 
 ``[fit]`` names the ``thermocal fit`` options once, by their long names without dashes,

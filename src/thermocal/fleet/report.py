@@ -1,4 +1,4 @@
-"""``DIR/fleet.html``: the report of a production batch (issue 18).
+"""``DIR/fleet.html``: the report of a production batch.
 
 Yield (calibrated, passed, failed), the distribution of each channel's residual figures and
 fitted coefficients across the units (each coefficient as a robust z-score, so that terms of

@@ -1,4 +1,4 @@
-"""The fleet's figures and their statistics across units (issue 18): the figure names a unit
+"""The fleet's figures and their statistics across units: the figure names a unit
 records, the unit a channel's figures are shown in, robust z-scores and outliers.  Shared by
 the batch driver (:mod:`thermocal.fleet.batch`) and its report (:mod:`thermocal.fleet.report`)."""
 

@@ -1,4 +1,4 @@
-"""The numbers of a report (SPEC §1, §5): a model applied to a run (bias before, model,
+"""The numbers of a report: a model applied to a run (bias before, model,
 after, each in the data's unit), figures of merit and Allan deviation with noise terms.
 
 Pure: no files, no plotting (:mod:`thermocal.report.build` renders them)."""
@@ -90,7 +90,7 @@ def in_data_unit(sig: RunSignals, unit: str, k: float) -> RunSignals:
 
 def known_input_of(rec: Recording, unit: str) -> float:
     """Earth rate seen by the sensitive axis [°/h] when the metadata gives latitude and
-    axis (SPEC §1: B0 = mean − Ω_axis), else 0 (accelerometers: 0)."""
+    axis (B0 = mean − Ω_axis, IEEE Std 952-1997), else 0 (accelerometers: 0)."""
     if unit != "deg/h" or rec.meta.latitude_deg is None or rec.meta.axis is None:
         return 0.0
     return float(
@@ -149,7 +149,7 @@ def apply_model(model_dict: dict[str, Any], rec: Recording, signal: str | None) 
 
 @dataclass(frozen=True)
 class FiguresOfMerit:
-    """SPEC §1 figures of a whole run [signal unit], from
+    """The figures of merit of a whole run [signal unit], from
     :func:`thermocal.metrics.compute_metrics` (the numbers of ``thermocal metrics``):
     bias B0 (earth rate removed when latitude and axis are known), bias stability
     and peak-to-peak over ``averaging_s`` averages, temperature sensitivity over
@@ -216,7 +216,7 @@ class Coverage:
 def coverage_of(time_s: FloatArray, tau0_s: float) -> Coverage:
     """The coverage of a run with times ``time_s`` [s] and sample interval ``tau0_s`` [s]:
     each gap (:func:`thermocal.recording.find_gaps`, a step > 1.5 τ0) counts its length
-    less one τ0 (issue 38: a record 98 % gaps read "1.02 h, 3125 samples every 0.02 s")."""
+    less one τ0 (a record 98 % gaps is not "1.02 h" of data)."""
     from thermocal.recording import find_gaps
 
     t = np.asarray(time_s, dtype=np.float64)
@@ -291,7 +291,7 @@ def figures_of_merit(
     where: str | None = None,
     average_option: str | None = "--average",
 ) -> FiguresOfMerit:
-    """Figures of merit of a rate ``x`` [``unit``, known input included] (SPEC §1).
+    """Figures of merit of a rate ``x`` [``unit``, known input included].
 
     Runs :func:`thermocal.metrics.compute_metrics` on a recording of ``x`` with
     ``temp_c`` as the hold-stage temperature.  The drift angle
@@ -359,8 +359,8 @@ def shown_figures(
     deviation of the ``averaging_s`` block means, never across a gap; the slope of the hold
     stages' mean biases, pooled by set-point within 0.5 °C, against their temperatures),
     with the gaps, the sample interval and the hold stages found once for all the series
-    (they depend on the time and temperature only; issue 28: the report of a long log
-    found them dozens of times).  With an earth rate to remove (a latitude or axis in
+    (they depend on the time and temperature only).  With an earth rate to remove (a latitude or
+    axis in
     ``meta``), or fewer than two averages (its error), :func:`figures_of_merit` per series."""
     from thermocal.metrics import block_means, data_unit_of, temperature_sensitivity
     from thermocal.preprocess import segment_holds
@@ -430,7 +430,8 @@ class AllanAnalysis:
 def allan_of(time_s: FloatArray, x: FloatArray, tau0_s: float, unit: str) -> AllanAnalysis:
     """Overlapping Allan deviation (octave τ, ±1σ confidence intervals, split at gaps) and
     the IEEE Std 952 noise terms, by :func:`thermocal.stability.allan.overlapping_adev` and
-    :func:`thermocal.stability.allan.noise_terms` (NIST SP 1065 eq. 11; SPEC §1), with the
+    :func:`thermocal.stability.allan.noise_terms` (NIST SP 1065 eq. 11; IEEE Std 952-1997 Annex
+    C), with the
     periodic terms of the longest gap-free stretch that shape the curve named
     (:func:`thermocal.stability.allan.annotate_periodic`)."""
     from thermocal.recording import contiguous_slices

@@ -1,7 +1,8 @@
 """Build the self-contained HTML report of a temperature-compensation workflow.
 
-The report gathers, for one sensor, what an engineer sends a customer (SPEC
-§1, §4a–§5, §8): test conditions and data provenance, the chamber profile and
+The report gathers, for one sensor, what an engineer sends a customer (the
+ring-laser-gyro method's figures, model and validation): test conditions and data provenance,
+the chamber profile and
 temperature channels, the bias against time and temperature before and after
 compensation, the validation table on a weakly correlated test (r, stages,
 stability, repeatability, improvement), Allan deviation before and after with
@@ -203,7 +204,7 @@ def improvement_pct(before: Any, after: Any) -> float | None:
 
 NO_CHANGE_REL = 1e-9
 """Before and after equal within this fraction of the larger: "no change", not a
-percentage of rounding (issue 38: "Peak-to-peak −1.06e-13 %")."""
+percentage of rounding (not "Peak-to-peak −1.06e-13 %")."""
 
 
 def no_change(before: Any, after: Any) -> bool:
@@ -499,7 +500,7 @@ def _summary(
             }
         )
     b, a = v.get("rms_about_zero_before"), v.get("rms_about_zero_after")
-    if b is not None and a is not None:  # what the user sees (issue 25): worse fails
+    if b is not None and a is not None:  # what the user sees: worse fails
         worse = bool(v.get("absolute_error_worse"))
         imp = improvement_pct(float(b), float(a))
         items.append(
@@ -521,7 +522,7 @@ def _summary(
 
 def _drift_cards(fom_before: FiguresOfMerit, fom_after: FiguresOfMerit) -> list[dict[str, Any]]:
     """The drift-angle cards of the summary, each comparing one definition before and
-    after (issue 38): the start bias removed (each series' b0 over the same window, or a
+    after: the start bias removed (each series' b0 over the same window, or a
     given b0 before), and no bias removed.  Improvement ``100·(1 − after/before)``."""
     items: list[dict[str, Any]] = []
     ref = drift_reference_words(fom_before.drift_reference)
@@ -869,7 +870,7 @@ def _env() -> Any:
 @dataclass(frozen=True)
 class _Analysis:
     """The numbers behind the report: each model applied to the validation run, and the
-    primary model's figures of merit and Allan deviation before and after (SPEC §1)."""
+    primary model's figures of merit and Allan deviation before and after."""
 
     primary: ModelEntry
     signal: str | None
@@ -937,7 +938,7 @@ def _analyse(inputs: ReportInputs) -> _Analysis:
     role = recording_role(inputs, rec_sha)
     sig_col = signal if signal in rec.columns else (rec.signals[0] if rec.signals else None)
     _, canon = rec.signal(sig_col)
-    # every figure in the data's own unit (the column's unit as given, issue 25)
+    # every figure in the data's own unit (the column's unit as given)
     unit, k = data_unit_of(rec, sig_col or "", canon)
     applied = {
         e.label: in_data_unit(apply_model(e.model, rec, signal), unit, k) for e in inputs.models
@@ -953,7 +954,7 @@ def _analyse(inputs: ReportInputs) -> _Analysis:
         rec.temperature_c(stage_temp) if stage_temp not in temp_names
         else main.temps_c[:, temp_names.index(stage_temp)]
     )  # fmt: skip
-    # drift angle, like with like (issue 38): before and after each about its own mean over
+    # drift angle, like with like: before and after each about its own mean over
     # the same reference window at the start (a given b0 is the raw sensor's: before only);
     # and both with no bias removed (FiguresOfMerit.drift_angle_raw_max)
     fom_before, fom_after = (
@@ -1285,7 +1286,7 @@ def _noise_rows(an: _Analysis) -> list[dict[str, Any]]:
                     }
                 )
         noise_rows.append({"label": label, "unit": unit_label(term_unit), "cells": cells})
-        if key == "bias_instability":  # IEEE 952 C.3: always at the minimum (issue 38)
+        if key == "bias_instability":  # IEEE Std 952-1997 Annex C: always at the minimum
             mins = [al.terms.bias_minimum for al in (allan_before, allan_after)]
             cells = []
             for when, m in zip(("before", "after"), mins, strict=True):
@@ -1301,7 +1302,7 @@ def _noise_rows(an: _Analysis) -> list[dict[str, Any]]:
 
 
 def _fom_rows(an: _Analysis) -> list[dict[str, Any]]:
-    """SPEC §1 figures of merit before and after, with the improvement."""
+    """The figures of merit before and after, with the improvement."""
     unit, averaging_s, stage_temp = an.unit, an.averaging_s, an.stage_temp
     fom_before, fom_after = an.fom_before, an.fom_after
     fom_rows = []
@@ -1401,7 +1402,7 @@ def _validation_tables(inputs: ReportInputs, unit: str) -> list[dict[str, Any]]:
 
 def _overall(primary: ModelEntry, summary: list[dict[str, Any]]) -> str:
     """The verdict: only from a validation result that was given, and PASS only when its
-    correlation check is among the passed ones (issue 13 item 6)."""
+    correlation check is among the passed ones."""
     flags = [s["flag"] for s in summary]
     if not primary.validation:
         return "na"
@@ -1415,7 +1416,7 @@ def _overall(primary: ModelEntry, summary: list[dict[str, Any]]) -> str:
 def build_report(inputs: ReportInputs) -> str:
     """The report as one self-contained HTML document (str).
 
-    Steps: apply each model to the validation run and compute the primary model's SPEC §1
+    Steps: apply each model to the validation run and compute the primary model's
     figures of merit and Allan deviation before and after (:func:`_analyse`); figures
     (:func:`_report_figures`); tables from the figures and the model and validation JSON
     (:func:`_noise_rows`, :func:`_fom_rows`, :func:`_comparison_rows`,

@@ -80,7 +80,7 @@ def binned_means(
 
 PLAIN_TEXT: Any = {"text.parse_math": False}
 """matplotlib settings under which every text of a figure is drawn as written: a column
-named ``T1 $\\frac$`` is a name, not TeX (mathtext raised ValueError: exit 1, issue 39)."""
+named ``T1 $\\frac$`` is a name, not TeX (mathtext would raise ValueError)."""
 
 
 @contextmanager
@@ -388,7 +388,7 @@ def _grid(n: int, panel_height_in: float = 2.7) -> Iterator[Any]:
     rows = (n + cols - 1) // cols
     height = panel_height_in * rows
     # fixed margins [in] rather than a constrained layout: the layout engine measures every
-    # tick label once more per draw (half the cost of a grid, issue 28)
+    # tick label once more per draw (half the cost of a grid)
     with matplotlib.rc_context(PLAIN_TEXT):  # the axes' own label texts are made here
         fig = Figure(figsize=(FIG_WIDTH_IN * 1.25, height), dpi=DPI)
         fig.subplots_adjust(left=0.07, right=0.99, bottom=0.55 / height,

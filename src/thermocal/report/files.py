@@ -225,7 +225,7 @@ def _triad_report(
         text=opts.text,
         topic=opts.topic,
     )
-    if _mp_validate.is_multipos(cal.triads):  # held-out poses (issue 30)
+    if _mp_validate.is_multipos(cal.triads):  # held-out poses
         results: list[Any] = _mp_validate.validate_triads(
             cal.triads, rec, latitude_deg, signal_unit=opts.signal_unit
         )
@@ -252,7 +252,7 @@ def _models_report(
     dynamic_s: float | None = None,
 ) -> ReportResult:
     """Model files reported and compared: both runs read with the same options (what they
-    warn shown in the report too, issue 25)."""
+    warn shown in the report too)."""
     from thermocal.models.files import load_model_dict
     from thermocal.report.build import ModelEntry, ReportInputs, write_report
 
@@ -277,7 +277,7 @@ def _models_report(
             for c in e.model.get("temperatures") or []:
                 if c not in temp_cols:
                     temp_cols.append(str(c))
-        # what thermocal warns while reading the runs goes into the report too (issue 25)
+        # what thermocal warns while reading the runs goes into the report too
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")
             val_rec = read_run(recording, sig, temp_cols, fitted, opts)

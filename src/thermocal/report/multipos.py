@@ -1,4 +1,4 @@
-"""The multi-position part of a triad report (issue 30): the held-out session's poses on
+"""The multi-position part of a triad report: the held-out session's poses on
 the sphere and the gravity-magnitude residual of each.
 
 Each still pose's compensated mean specific force, normalised, is the gravity ("up")
@@ -6,8 +6,8 @@ direction in body axes: a point on the unit sphere.  The sphere is drawn as its 
 hemispheres, ``z ≥ 0`` seen from +z and ``z < 0`` seen from −z, each in the orthographic
 projection ``(u_x, u_y)`` (the unit disc), each point coloured by its residual
 ``|mean f| − g`` after compensation and numbered as in the table.  Poses spread over both
-hemispheres are what the gravity-magnitude fit needs (INTERFACE.md: ≥ 9 distinct poses,
-not in one plane).  matplotlib is imported here only.
+hemispheres are what the gravity-magnitude fit needs (at least 9 distinct poses, not in one
+plane; Tedaldi et al. 2014).  matplotlib is imported here only.
 """
 
 from __future__ import annotations

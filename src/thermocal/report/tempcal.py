@@ -1,4 +1,4 @@
-"""Report content of the flight-controller calibrations (issue 28, items 2 and 3).
+"""Report content of the flight-controller calibrations.
 
 :func:`comparison_html`: the coefficients active in the log against the new ones, a table
 (per parameter old, new, difference) and a figure (the correction of each set over the
@@ -74,7 +74,7 @@ def comparison_html(cmp: CoefficientComparison) -> str:
     )
 
 
-# --- barometers and magnetometers (issue 28, item 3) -------------------------------------
+# --- barometers and magnetometers -------------------------------------------------------
 
 
 def offset_residual_figure(req: OffsetReportRequest) -> bytes:
@@ -156,7 +156,7 @@ def write_offset_report(path: str | Path, req: OffsetReportRequest) -> Path:
     return write_html(path, build_offset_report(req))
 
 
-# --- ArduPilot's barometer: TCAL_BARO_EXP (issue 28, item 3) ----------------------------
+# --- ArduPilot's barometer: TCAL_BARO_EXP --------------------------------------------------
 
 
 def ardupilot_baro_figures(req: ArdupilotBaroReportRequest) -> tuple[bytes, bytes]:

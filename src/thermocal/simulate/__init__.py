@@ -1,4 +1,4 @@
-"""Sensor and chamber simulator with known truth (SPEC §2, §6).
+"""Sensor and chamber simulator with known truth.
 
 Chain of the simulation (every stage a pure function on arrays):
 
@@ -14,7 +14,7 @@ Chain of the simulation (every stage a pure function on arrays):
    first-order recursion run by :func:`scipy.signal.lfilter`.  The node
    temperatures are the sensor's temperature channels ``T1..T4``; their exact
    derivatives give the temperature rates.
-3. **Sensor** (:func:`simulate_sensor`): SPEC §2 error model
+3. **Sensor** (:func:`simulate_sensor`): the error model
    ``F = (1 + δK(T)) · (ω_in + B0 + D + E(T, Ṫ, ∇T)) + noise`` where ``B0`` is the
    constant bias, ``D`` the turn-on offset (random per run: repeatability), ``E``
    the temperature-induced bias (:class:`BiasModel`: polynomial, rate,
@@ -22,7 +22,7 @@ Chain of the simulation (every stage a pure function on arrays):
    scale-factor temperature coefficient; noise (:func:`simulate_noise`): angle
    random walk, bias instability (flicker, PSD ``B²/(2πf)``), rate random walk,
    rate ramp (IEEE Std 952-1997 Annex C) and quantization — pulse counts with
-   scale factor K for ring-laser gyros (SPEC §1), output resolution otherwise.
+   scale factor K for ring-laser gyros, output resolution otherwise.
 
 Truth columns (all scenarios):
 

@@ -1,5 +1,5 @@
 """The temperature-induced bias of a simulated sensor: polynomial, piecewise,
-warm-up and hysteresis terms (SPEC §7).
+warm-up and hysteresis terms.
 
 Part of :mod:`thermocal.simulate`."""
 
@@ -23,7 +23,8 @@ Truth = dict[str, Any]
 
 @dataclass(frozen=True)
 class PiecewiseTerm:
-    """Continuous piecewise-linear bias in ``T_sensor`` (seed 001), zero at ``t_ref``.
+    """Continuous piecewise-linear bias in ``T_sensor`` (*Design and engineering implementation
+    of a fibre-optic-gyro line-of-sight stabilisation system*), zero at ``t_ref``.
 
     ``b(T) = s_0 (T − T_ref) + Σ_j (s_{j+1} − s_j) w ln(1 + e^{(T − c_j)/w})`` − its
     value at T_ref: slopes ``slopes`` [unit/°C] between breakpoints ``breakpoints_c``,
@@ -55,7 +56,8 @@ class PiecewiseTerm:
 
 @dataclass(frozen=True)
 class WarmupTerm:
-    """Warm-up bias (seed 003, SPEC §4c): ``Σ_{j≥1} a_j(T0) ΔT^j``, ``ΔT = T − T0``,
+    """Warm-up bias (*Temperature-characteristic calibration test plan*): ``Σ_{j≥1} a_j(T0)
+    ΔT^j``, ``ΔT = T − T0``,
     ``a_j(T0) = b_j0 + b_j1 T0 + b_j2 T0²``; ``coefficients[j−1] = (b_j0, b_j1, b_j2)``;
     ``start`` = ``(c0, c1, c2)`` gives the power-on bias ``c0 + c1 T0 + c2 T0²``.
     T0 is the sensor temperature at power-on [°C]."""
@@ -101,12 +103,13 @@ def play_operator(x: FloatArray, width: float, p0: float | None = None) -> Float
 
 @dataclass(frozen=True)
 class BiasModel:
-    """Temperature-induced bias ``E`` of SPEC §2 [unit of the sensor: °/h or mg].
+    """Temperature-induced bias ``E`` [unit of the sensor: °/h or mg].
 
     ``E = Σ_k Σ_j poly[k][j−1] (T_k − T_ref)^j + Σ_k rate[k] Ṫ_k
     + Σ_k coupling[k] (T_k − T_ref) Ṫ_k + Σ g (T_i − T_j)`` (+ piecewise, warm-up,
     hysteresis terms), with ``Ṫ`` in [°C/min].  Every polynomial, rate, coupling
-    and gradient term lies in the span of the seed-000 37-term model (SPEC §4a).
+    and gradient term lies in the span of the 37-term model of *A modelling and validation
+    method for the temperature compensation model of a ring-laser gyroscope*.
     """
 
     t_ref_c: float = 20.0

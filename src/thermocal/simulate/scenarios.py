@@ -176,8 +176,8 @@ def _truth(
             ),
             "time_constants_s": [float(v) for v in thermal.time_constants_s],
             "stages": [s.to_dict() for s in stages],
-            "truth_bias_definition": "temperature-induced bias E (SPEC §2); see "
-            "thermocal.simulate module docstring",
+            "truth_bias_definition": "temperature-induced bias E (constant bias, turn-on "
+            "offset and input excluded); see thermocal.simulate module docstring",
             **extra,
         }
     )
@@ -258,7 +258,8 @@ def scenario_rlg_modelling(
     axis: str = "up",
     preset: str = "rlg",
 ) -> ScenarioResult:
-    """Seed-000 modelling run of the ``rlg`` preset over the ``rlg-modelling`` profile
+    """Modelling run (*A modelling and validation method for the temperature compensation model
+    of a ring-laser gyroscope*) of the ``rlg`` preset over the ``rlg-modelling`` profile
     (≈ 65 h at 1 Hz by default); powered on at t = 0, soaked at the start temperature."""
     return _single_gyro_scenario(
         "rlg-modelling", seed, profile, rate_hz, latitude_deg, axis, preset, warmed_up=False
@@ -274,7 +275,8 @@ def scenario_rlg_validation(
     axis: str = "up",
     preset: str = "rlg",
 ) -> ScenarioResult:
-    """Seed-000 validation run (holds, weakly correlated with ``rlg-modelling``), same
+    """Validation run of the ring-laser-gyro method (holds, weakly correlated with
+    ``rlg-modelling``), same
     sensor as :func:`scenario_rlg_modelling`, another turn-on and noise."""
     return _single_gyro_scenario(
         "rlg-validation", seed, profile, rate_hz, latitude_deg, axis, preset, warmed_up=False
@@ -290,7 +292,8 @@ def scenario_fog_slow(
     axis: str = "up",
     preset: str = "fog",
 ) -> ScenarioResult:
-    """Seed-001 slow drift over 15–42 °C of a warmed-up ``fog`` (piecewise bias)."""
+    """Slow drift (*Design and engineering implementation of a fibre-optic-gyro line-of-sight
+    stabilisation system*, chapter 3) over 15–42 °C of a warmed-up ``fog`` (piecewise bias)."""
     return _single_gyro_scenario(
         "fog-slow", seed, profile, rate_hz, latitude_deg, axis, preset, warmed_up=True
     )
@@ -328,7 +331,8 @@ def scenario_mems_warmup(
     axis: str = "up",
     preset: str = "mems-gyro",
 ) -> ScenarioResult:
-    """Seed-003 warm-ups: one file per start temperature (label ``T+25`` …).
+    """Power-on warm-ups (*Temperature-characteristic calibration test plan*): one file per
+    start temperature (label ``T+25`` …).
 
     Each file starts at power-on (t = 0) with the unit soaked at the chamber air
     temperature and lasts the power-on hold (``record_s`` ≥ 360 s for program
@@ -336,7 +340,9 @@ def scenario_mems_warmup(
     coefficients ``a_j(T0)`` and ``start_bias``.
     """
     if record_s < 360:
-        raise ThermocalInputError(f"record_s must be ≥ 360 s (seed 003), got {record_s}")
+        raise ThermocalInputError(
+            f"record_s must be ≥ 360 s (the warm-up test plan's record), got {record_s}"
+        )
     p = get_preset(preset)
     program, wins = _power_on_windows(profile, record_s)
     hz = rate_hz or p.rate_hz
@@ -382,7 +388,8 @@ def scenario_accel_full_range(
     orientation: str = "horizontal",
     preset: str = "accel",
 ) -> ScenarioResult:
-    """Seed-004 full-range runs: one file per run (label ``run1`` …).
+    """Full-range runs (*Adaptive accelerometer temperature compensation method for inertial
+    navigation*): one file per run (label ``run1`` …).
 
     The program (default ``accel-full-range`` with one repetition) is one run,
     repeated ``runs`` times with a power-on at the start of each.  Each run's bias
@@ -427,7 +434,7 @@ def scenario_accel_full_range(
 
 
 def scenario_turntable16(seed: int, profile: ProfileInput = None, **opts: Any) -> ScenarioResult:
-    """The 16-position turntable run (SPEC §7), delegated to
+    """The 16-position dual-axis turntable run (CN104880182), delegated to
     :func:`thermocal.turntable.simulate.simulate_turntable16` (imported lazily)."""
     if profile is not None:
         raise ThermocalInputError("the turntable-16 scenario takes no chamber profile")
@@ -466,7 +473,7 @@ def scenario_turntable_thermal(
 ) -> ScenarioResult:
     """16-position runs of a gyro and an accelerometer triad at several soak temperatures
     and a held-out run at an unseen one, every parameter a known polynomial in temperature
-    (:func:`thermocal.turntable.simulate.simulate_turntable_thermal`, issue 19)."""
+    (:func:`thermocal.turntable.simulate.simulate_turntable_thermal`)."""
     if profile is not None:
         raise ThermocalInputError("the turntable-thermal scenario takes no chamber profile")
     from thermocal.turntable.simulate import simulate_turntable_thermal
@@ -480,7 +487,7 @@ def scenario_turntable_thermal(
 
 def scenario_multipos(seed: int, profile: ProfileInput = None, **opts: Any) -> ScenarioResult:
     """Hand-placed multi-position sessions of an IMU with known bias, scale factors and
-    misalignments and their temperature trends (issue 30;
+    misalignments and their temperature trends (
     :func:`thermocal.multipos.simulate.simulate_runs`; ``runs`` sessions at temperatures
     over −10…+50 °C, one at 25 °C by default)."""
     if profile is not None:
@@ -523,7 +530,7 @@ def scenario_mems_imu(
     gravity_axis: str = "az",
     preset: str = "mems-gyro",
 ) -> ScenarioResult:
-    """A six-axis MEMS IMU in a chamber (issue 15): three gyros [°/s], three
+    """A six-axis MEMS IMU in a chamber: three gyros [°/s], three
     accelerometers [mg], one die temperature ``T_die`` (the first node of the preset's
     thermal network, so it lags the chamber air) and the air ``T_chamber``.
 

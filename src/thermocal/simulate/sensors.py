@@ -37,9 +37,10 @@ class SensorPreset:
     """A simulated sensor: thermal network, error model and noise.
 
     ``unit`` is the physical unit of truth and noise (``deg/h`` or ``mg``);
-    ``output`` is ``pulses`` (integrating counts with scale factor K, SPEC §1) or
+    ``output`` is ``pulses`` (integrating counts with scale factor K) or
     ``value`` (the physical unit).  ``curves`` are the characteristic curves
-    (seed 004) of accelerometers; a run picks one.
+    (*Adaptive accelerometer temperature compensation method for inertial navigation*) of
+    accelerometers; a run picks one.
     """
 
     name: str
@@ -104,7 +105,7 @@ FOG = SensorPreset(
     name="fog",
     kind="gyro",
     description="tactical-grade fibre-optic gyro, rate output [°/h], bias piecewise linear "
-    "in the coil temperature T1 with corners near 23.6 and 30 °C (seed 001)",
+    "in the coil temperature T1 with corners near 23.6 and 30 °C (fibre-optic-gyro thesis)",
     unit="deg/h",
     output="value",
     bias_constant=0.3,
@@ -131,7 +132,7 @@ MEMS_GYRO = SensorPreset(
     name="mems-gyro",
     kind="gyro",
     description="industrial MEMS gyro, rate output [°/h], strong self-heating warm-up "
-    "(T1 die, T2 board, T3 case, T4 fixture); warm-up bias per seed 003",
+    "(T1 die, T2 board, T3 case, T4 fixture); warm-up bias per the MEMS test plan",
     unit="deg/h",
     output="value",
     bias_constant=0.0,
@@ -161,7 +162,7 @@ ACCEL = SensorPreset(
     name="accel",
     kind="accel",
     description="navigation/tactical accelerometer, output [mg], bias vs T1 in one of "
-    "three characteristic curves per run (seed 004)",
+    "three characteristic curves per run (adaptive accelerometer method)",
     unit="mg",
     output="value",
     bias_constant=0.0,
@@ -230,7 +231,7 @@ def simulate_sensor(
     turn_on_offset: float | None = None,
     power_on_s: float = 0.0,
 ) -> SensorOutput:
-    """Sensor output for a thermal history (SPEC §2).
+    """Sensor output for a thermal history.
 
     ``F = (1 + δK(T1)) (ω_in + B0 + D + E) + noise`` with ``δK = tc·1e-6·(T1 − T_ref)``,
     ``D ~ N(0, turn_on_sigma²)`` unless given, ``E`` from ``bias_model`` (default:

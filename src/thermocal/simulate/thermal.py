@@ -1,4 +1,4 @@
-"""The chamber air and the thermal network of the sensor (SPEC §7).
+"""The chamber air and the thermal network of the sensor.
 
 Part of :mod:`thermocal.simulate`."""
 
@@ -151,8 +151,8 @@ def chamber_air(
 
 @dataclass(frozen=True)
 class ThermalNetwork:
-    """Lumped thermal network of a sensor (SPEC §2: several sensors at places with
-    different lags, so that gradients exist).
+    """Lumped thermal network of a sensor (several temperature sensors at places with
+    different lags, so that gradients exist, as in the ring-laser-gyro method).
 
     names : node (temperature channel) names; capacitance_j_per_k : C_i [J/K];
     to_air_w_per_k : conductance of each node to the chamber air [W/K];

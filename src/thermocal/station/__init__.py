@@ -1,4 +1,4 @@
-"""The test station (INTERFACE.md, "Test station"; issue 31): drive a climatic chamber over
+"""The test station: drive a climatic chamber over
 Modbus, record serial sensors with host time stamps, and keep the recording crash-safe.
 
 Modules

@@ -1,5 +1,5 @@
-"""``STATION.toml``: the chamber and the sensors of a test station (INTERFACE.md, "Test
-station").  Every key is checked here; an error names the file and the key.
+"""``STATION.toml``: the chamber and the sensors of a test station.  Every key is checked here;
+an error names the file and the key.
 
 Example::
 
@@ -396,7 +396,7 @@ def load_station(path: str | Path) -> StationConfig:
 
 def check_port(device: str, who: str) -> None:
     """Refuse a serial ``device`` that is a FIFO, a socket or a block device (``stat``
-    only, never opened; issue 39): pyserial would answer "Inappropriate ioctl for device".
+    only, never opened): pyserial would answer "Inappropriate ioctl for device".
     A character device (``/dev/ttyUSB0``, a pty) and a pyserial URL pass."""
     why = special_mode(Path(device))
     if why is not None and why != "it is a character device":

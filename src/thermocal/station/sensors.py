@@ -2,7 +2,7 @@
 
 Every line gets the host's time [s] (:func:`thermocal.station.clock.now`) when its bytes are read;
 lines read in one chunk share it.  A line is parsed with the text-log rules of
-:mod:`thermocal.readers` (INTERFACE.md common rules): the fields split at the stated delimiter
+:mod:`thermocal.readers`: the fields split at the stated delimiter
 (or the first of ``,`` ``;`` tab blanks that gives one field per name), numbers as a CSV
 reader takes them (:func:`thermocal.readers.text.parse_number`: no digit-group underscores, no
 non-ASCII digits), a decimal comma when the TOML says so.  A line that does not give one
