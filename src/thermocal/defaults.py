@@ -64,7 +64,25 @@ ALLOW_MOTION: Final = "--allow-motion"
 
 
 def overrides_of(allow_narrow: bool, allow_motion: bool) -> tuple[str, ...]:
-    """The adequacy overrides a command was given (:mod:`thermocal.adequacy`)."""
+    """The adequacy overrides a command was given (:mod:`thermocal.adequacy`).
+
+    Parameters
+    ----------
+    allow_narrow : bool
+        Whether the sweep's adequacy tests were overridden (``--allow-narrow``).
+    allow_motion : bool
+        Whether the stillness test was overridden (``--allow-motion``).
+
+    Returns
+    -------
+    tuple of str
+        The options given, in that order.
+
+    Examples
+    --------
+    >>> overrides_of(True, False)
+    ('--allow-narrow',)
+    """
     return tuple(o for o, on in ((ALLOW_NARROW, allow_narrow), (ALLOW_MOTION, allow_motion)) if on)
 
 

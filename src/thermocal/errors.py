@@ -47,7 +47,17 @@ class ParameterError(ThermocalInputError):
         super().__init__(message.replace("{name}", parameter))
 
     def named(self, name: str) -> str:
-        """The message with ``name`` (an option, ``--rate``) for the parameter."""
+        """The message with ``name`` (an option, ``--rate``) for the parameter.
+
+        Parameters
+        ----------
+        name : str
+            What to show for the parameter (``--rate``).
+
+        Returns
+        -------
+        str
+        """
         return self.template.replace("{name}", name)
 
     def __reduce__(self) -> tuple[type[ParameterError], tuple[str, str]]:

@@ -117,6 +117,16 @@ def main(argv: list[str] | None = None) -> int:
 
     Usage errors (unknown option, missing argument) print one ``error: ...`` line
     on stderr and return 2, as the common rules of the command line ask.
+
+    Parameters
+    ----------
+    argv : list of str, optional
+        The arguments (default ``sys.argv[1:]``).
+
+    Returns
+    -------
+    int
+        The exit status.
     """
     args = list(sys.argv[1:] if argv is None else argv)
     _register(_modules_for(args))

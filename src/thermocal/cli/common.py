@@ -225,7 +225,22 @@ OutOpt = Annotated[Path, typer.Option("-o", "--output", help="Output file.")]
 
 def parse_temp_conversion(text: str) -> units.TemperatureConversion:
     """``"0.0625,-50"`` → gain [°C/count] 0.0625, offset [°C] −50; ``"0.0625,-50,int16"``
-    for signed 16-bit counts stored unsigned (:class:`thermocal.units.TemperatureConversion`)."""
+    for signed 16-bit counts stored unsigned (:class:`thermocal.units.TemperatureConversion`).
+
+    Parameters
+    ----------
+    text : str
+        The option's text.
+
+    Returns
+    -------
+    TemperatureConversion
+
+    Raises
+    ------
+    ThermocalInputError
+        Not ``GAIN,OFFSET[,int16]`` with finite numbers.
+    """
     return units.temperature_conversion(text, "--temp-conversion")
 
 
@@ -239,6 +254,17 @@ def handle_errors(fn: Callable[P, R]) -> Callable[P, R]:
     Anything else → ``error: internal: ...``, exit 1 (traceback only when the
     environment variable ``THERMOCAL_DEBUG`` is set).  thermocal warnings are
     printed as one ``warning: ...`` line each on stderr.
+
+    Parameters
+    ----------
+    fn : callable
+        The command's function.
+
+    Returns
+    -------
+    callable
+        ``fn`` wrapped: exit 2 with one ``error:`` line for the user's errors, 1 for thermocal's
+        own.
     """
 
     @functools.wraps(fn)
@@ -276,7 +302,17 @@ def _show_warnings(caught: list[warnings.WarningMessage]) -> None:
 
 
 def emit(obj: Any, as_json: bool, human: Callable[[], None] | None = None) -> None:
-    """Print ``obj`` as one JSON object (``--json``) or call ``human`` for rich output."""
+    """Print ``obj`` as one JSON object (``--json``) or call ``human`` for rich output.
+
+    Parameters
+    ----------
+    obj : object
+        What to print.
+    as_json : bool
+        Print JSON instead of text.
+    human : callable, optional
+        Prints the human output.
+    """
     if as_json:
         sys.stdout.write(json.dumps(jsonable(obj), allow_nan=False) + "\n")
         sys.stdout.flush()
@@ -287,7 +323,19 @@ def emit(obj: Any, as_json: bool, human: Callable[[], None] | None = None) -> No
 
 
 def fmt(x: float | None, digits: int = 4) -> str:
-    """Number for a human table: ``—`` for None/NaN."""
+    """Number for a human table: ``—`` for None/NaN.
+
+    Parameters
+    ----------
+    x : float or None
+        The number.
+    digits : int
+        Significant digits.
+
+    Returns
+    -------
+    str
+    """
     if x is None or (isinstance(x, float) and not math.isfinite(x)):
         return "—"
     return f"{x:.{digits}g}"
@@ -298,6 +346,18 @@ def progress(description: str, total: float | None = None) -> Iterator[Callable[
     """A progress bar on a terminal (stderr), silent otherwise.
 
     Yields ``advance(amount)``.
+
+    Parameters
+    ----------
+    description : str
+        The bar's label.
+    total : float, optional
+        The total (None: no percentage).
+
+    Returns
+    -------
+    contextmanager
+        Yields a function that advances the bar.
     """
     if not sys.stderr.isatty():
         yield lambda _amount: None

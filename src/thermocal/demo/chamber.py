@@ -351,14 +351,25 @@ def run_demo(
     config: DemoConfig | None = None,
     progress: Callable[[str], None] | None = None,
 ) -> DemoResult:
-    """Run the chamber workflow (module docstring) and write everything into ``out_dir``.
+    """Run the chamber workflow (module docstring) and write everything into ``out_dir``:
+    ``report.html``; ``models/seed37.json``, ``models/selected.json``; ``validation/*.json``;
+    ``c/*.h``, ``c/*.c``; ``data/rlg-modelling.parquet``, ``data/rlg-validation.parquet``
+    (+ ``*.truth.json``), ``data/rlg-validation-compensated.parquet``; ``profiles/*.csv``.
 
-    Files: ``report.html``; ``models/seed37.json``, ``models/selected.json``;
-    ``validation/*.json``; ``c/*.h``, ``c/*.c``; ``data/rlg-modelling.parquet``,
-    ``data/rlg-validation.parquet`` (+ ``*.truth.json``), the compensated
-    validation run ``data/rlg-validation-compensated.parquet``; the chamber
-    programs ``profiles/*.csv``.  ``progress(step)`` is called after each of
-    :data:`DEMO_STEPS`.
+    Parameters
+    ----------
+    out_dir : str or pathlib.Path
+        The folder written.
+    seed : int
+        The seed; the same seed gives the same output.
+    config : DemoConfig, optional
+        Sizes and rates of the demonstration.
+    progress : callable, optional
+        Called with the name of each of :data:`DEMO_STEPS` once done.
+
+    Returns
+    -------
+    DemoResult
     """
     cfg = config or DemoConfig()
     out = Path(out_dir)

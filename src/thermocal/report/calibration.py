@@ -271,7 +271,18 @@ def _channel_section(
 
 
 def build_calibration_report(inputs: CalibrationReportInputs) -> str:
-    """The calibration report as one self-contained HTML document (module docstring)."""
+    """The calibration report as one self-contained HTML document (module docstring).
+
+    Parameters
+    ----------
+    inputs : CalibrationReportInputs
+        The calibration, the validation run and the optional ``validate --json`` output.
+
+    Returns
+    -------
+    str
+        The HTML document.
+    """
     from thermocal import __version__
     from thermocal.report import figures as F
 
@@ -356,7 +367,19 @@ def build_calibration_report(inputs: CalibrationReportInputs) -> str:
 
 
 def write_calibration_report(path: str | Path, inputs: CalibrationReportInputs) -> Path:
-    """Build the calibration report and write it atomically to ``path``; returns the path."""
+    """Build the calibration report and write it atomically to ``path``; returns the path.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        The HTML file.
+    inputs : CalibrationReportInputs
+        As :func:`build_calibration_report`.
+
+    Returns
+    -------
+    pathlib.Path
+    """
     return write_html(path, build_calibration_report(inputs))
 
 

@@ -67,10 +67,21 @@ class WarmupTerm:
     start: tuple[float, float, float] = (0.0, 0.0, 0.0)
 
     def a(self, t0_c: float) -> list[float]:
-        """Coefficients a_j(T0) [unit/°C^j], j = 1..order."""
+        """Coefficients a_j(T0) [unit/°C^j], j = 1..order.
+
+        Parameters
+        ----------
+        t0_c : float
+            Sensor temperature at power-on T0 [°C].
+
+        Returns
+        -------
+        list of float
+        """
         return [b0 + b1 * t0_c + b2 * t0_c**2 for b0, b1, b2 in self.coefficients]
 
     def start_bias(self, t0_c: float) -> float:
+        """The power-on bias c0 + c1 T0 + c2 T0² [unit of the sensor] at T0 = ``t0_c`` [°C]."""
         c0, c1, c2 = self.start
         return c0 + c1 * t0_c + c2 * t0_c**2
 
@@ -87,7 +98,37 @@ class HysteresisTerm:
 
 
 def play_operator(x: FloatArray, width: float, p0: float | None = None) -> FloatArray:
-    """Play (backlash) operator: ``p_i = clip(p_{i−1}, x_i − w/2, x_i + w/2)``."""
+    """Play (backlash) operator: ``p_i = clip(p_{i−1}, x_i − w/2, x_i + w/2)``.
+
+    Parameters
+    ----------
+    x : numpy.ndarray
+        The input (a temperature history) [°C].
+    width : float
+        The play's width w [°C].
+    p0 : float, optional
+        The initial state (default ``x[0]``).
+
+    Returns
+    -------
+    numpy.ndarray
+        The operator's output, same shape as ``x``.
+
+    Notes
+    -----
+    The play (backlash) operator of hysteresis models: it follows the input only once the input
+    has moved w/2 beyond it.
+
+    References
+    ----------
+    M. A. Krasnosel'skii and A. V. Pokrovskii, *Systems with Hysteresis*, Springer, 1989.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> play_operator(np.array([0.0, 1.0, 2.0, 1.5, 0.0]), 1.0).tolist()
+    [0.0, 0.5, 1.5, 1.5, 0.5]
+    """
     half = width / 2.0
     out = np.empty_like(x)
     p = float(x[0]) if p0 is None else p0
@@ -130,7 +171,24 @@ class BiasModel:
         power_on_index: int = 0,
     ) -> FloatArray:
         """E at every sample: ``temps_c`` and ``rates_c_per_min`` are (n, k); ``t0_c`` the
-        node temperatures at power-on (warm-up term; before ``power_on_index`` it is 0)."""
+        node temperatures at power-on (warm-up term; before ``power_on_index`` it is 0).
+
+        Parameters
+        ----------
+        temps_c : numpy.ndarray
+            Node temperatures (n, k) [°C].
+        rates_c_per_min : numpy.ndarray
+            Their rates (n, k) [°C/min].
+        t0_c : numpy.ndarray, optional
+            Node temperatures at power-on (k,) [°C].
+        power_on_index : int
+            Sample of the power-on.
+
+        Returns
+        -------
+        numpy.ndarray
+            E (n,) [unit of the sensor].
+        """
         n = temps_c.shape[0]
         out = np.full(n, float(self.offset))
         xk = np.empty(n)

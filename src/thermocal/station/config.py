@@ -355,7 +355,46 @@ def _sensor(t: dict[str, Any], where: str, i: int) -> SensorConfig:
 
 
 def parse_station(text: str, where: str = "STATION.toml") -> StationConfig:
-    """Parse and check the text of a ``STATION.toml``."""
+    """Parse and check the text of a ``STATION.toml``.
+
+    Parameters
+    ----------
+    text : str
+        The file's text.
+    where : str
+        How messages name the file.
+
+    Returns
+    -------
+    StationConfig
+
+    Raises
+    ------
+    ThermocalInputError
+        Not TOML, an unknown or missing key, a value out of its range, a preset the map
+        contradicts; the message names the file and the key.
+
+    Examples
+    --------
+    A Eurotherm 2000 series controller by its preset (set-point register 24, process value
+    register 1, from the maker's communications handbook) and one serial IMU at 100 Hz:
+
+    >>> cfg = parse_station('''
+    ... [chamber]
+    ... driver = "modbus-tcp"
+    ... host = "192.168.0.10"
+    ... preset = "eurotherm-2000"
+    ... scale = 0.1
+    ... [[sensor]]
+    ... id = "imu"
+    ... device = "/dev/ttyUSB0"
+    ... names = ["gyro_x", "temp"]
+    ... units = ["deg/s", "degC"]
+    ... rate_hz = 100
+    ... ''')
+    >>> cfg.chamber.setpoint_register, cfg.chamber.temperature_register, cfg.sensors[0].id
+    (24, 1, 'imu')
+    """
     try:
         doc = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
@@ -382,7 +421,22 @@ def parse_station(text: str, where: str = "STATION.toml") -> StationConfig:
 
 
 def load_station(path: str | Path) -> StationConfig:
-    """Read and check ``STATION.toml`` (:func:`parse_station`)."""
+    """Read and check ``STATION.toml`` (:func:`parse_station`).
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        The ``STATION.toml``.
+
+    Returns
+    -------
+    StationConfig
+
+    Raises
+    ------
+    ThermocalInputError
+        The file is missing, special or not UTF-8, or :func:`parse_station` refuses it.
+    """
     p = Path(path)
     refuse_special_input(p, "station file (STATION.toml)")  # a FIFO is no "no such file"
     if not p.is_file():

@@ -66,6 +66,7 @@ class RichDisplay:
         mute_stderr()
 
     def update(self, state: StationState) -> None:
+        """Redraw the live display with ``state``."""
         import time
 
         now = time.monotonic()  # the loop turns at 50 Hz; the display needs 4
@@ -77,6 +78,7 @@ class RichDisplay:
                 self._gone(exc)
 
     def log(self, message: str) -> None:
+        """Print ``message`` above the live display."""
         if self.broken:
             return
         try:
@@ -85,6 +87,7 @@ class RichDisplay:
             self._gone(exc)
 
     def close(self) -> None:
+        """Stop the live display."""
         if self._open:
             self._open = False
             try:

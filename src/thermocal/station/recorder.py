@@ -82,6 +82,7 @@ def _fsync_write(path: Path, data: bytes) -> None:
 
 
 def part_name(stream: str, index: int) -> str:
+    """The file name of part ``index`` of ``stream`` (``chamber-0001.parquet``)."""
     return f"{stream}-{index:04d}.parquet"
 
 
@@ -315,6 +316,7 @@ class Recorder:
         return unix - self.start_unix
 
     def add(self, stream: str, row: dict[str, float]) -> None:
+        """Buffer one sample ``row`` of ``stream`` (written when its part closes)."""
         st = self.streams[stream]
         for c in st.columns:
             st.data[c].append(float(row.get(c, float("nan"))))
@@ -397,11 +399,14 @@ class Recorder:
         return written
 
     def maybe_rotate(self, now_unix: float) -> list[str]:
+        """Close the open parts when they are ``part_s`` old at host time ``now_unix`` [s];
+        return the names closed."""
         if now_unix - self.part_started >= self.cfg.part_s:
             return self.close_parts()
         return []
 
     def event(self, kind: str, message: str, **fields: Any) -> None:
+        """Record an event (``kind``, ``message`` and its fields) in ``station.json``."""
         now = clock.now()
         self.doc["events"].append(
             {"time": self.rel(now), "kind": kind, "message": message, **fields}
@@ -425,6 +430,7 @@ class Recorder:
             self._failed(path, exc)
 
     def save(self) -> None:
+        """Write ``station.json`` atomically."""
         path = self.dir / STATION_JSON
         try:
             _fsync_write(path, json.dumps(self.doc, indent=1).encode())

@@ -116,9 +116,11 @@ class StationState:
 
 
 class Display(Protocol):
-    def update(self, state: StationState) -> None: ...
+    def update(self, state: StationState) -> None:
+        """Show ``state``."""
 
-    def log(self, message: str) -> None: ...
+    def log(self, message: str) -> None:
+        """Show one message."""
 
 
 def say(message: str) -> str:
@@ -158,9 +160,11 @@ class LogDisplay:
         self.broken = ""
 
     def update(self, state: StationState) -> None:
+        """Nothing: a log display prints messages only."""
         return None
 
     def log(self, message: str) -> None:
+        """Print ``message`` on stderr."""
         if not self.broken:
             self.broken = say(message)
 
@@ -668,6 +672,37 @@ def run_station(
     reason recorded (``"SIGHUP"``).  A :class:`LogDisplay` whose stderr is gone ends it too.
     With ``resume``, how the previous run ended and where it left the chamber is logged
     (``warning:`` when it was killed or left without its safe set-point).
+
+    Parameters
+    ----------
+    cfg : StationConfig
+        The station (:func:`thermocal.station.config.load_station`).
+    program : tuple of (list of float, list of float)
+        The chamber program: times [s] and set-points [°C], linear between points.
+    out_dir : pathlib.Path
+        The recording folder.
+    profile_source : str
+        How messages name the program (its file).
+    resume : bool
+        Continue a recording in ``out_dir`` where it stopped.
+    time_scale : float
+        Program seconds per wall-clock second (rehearsals with a simulated chamber).
+    display : Display, optional
+        Where the state is shown (default :class:`LogDisplay`).
+    chamber : Chamber, optional
+        The chamber driver (default from ``cfg``).
+    should_stop : callable, optional
+        Polled by the loop; true or a reason string ends the run as an interrupt does.
+
+    Returns
+    -------
+    RunResult
+
+    Raises
+    ------
+    ThermocalInputError
+        A set-point outside the chamber's range or register, too many program points, a bad
+        ``time_scale`` (before anything is written).
     """
     import numpy as np
 

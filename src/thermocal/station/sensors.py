@@ -156,6 +156,7 @@ class SerialSensor:
             ) from None
 
     def start(self) -> None:
+        """Open the port and start the reading thread."""
         if self._port is None:
             self.open()
         self._thread = threading.Thread(
@@ -235,6 +236,7 @@ class SerialSensor:
         return s, b
 
     def close(self) -> None:
+        """Stop the reading thread and close the port."""
         self._stop.set()
         if self._thread is not None:
             self._thread.join(timeout=2.0)

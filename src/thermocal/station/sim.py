@@ -148,6 +148,8 @@ class SimulatedChamber:
         await self._server.serving
 
     def start(self, timeout_s: float = 10.0) -> SimulatedChamber:
+        """Start the Modbus server in a thread; return self once it answers (within
+        ``timeout_s``)."""
         self._thread.start()
         if not self._ready.wait(timeout_s):
             raise TimeoutError("simulated chamber did not start")
@@ -261,13 +263,16 @@ class SimulatedSerialSensor:
                 self.sent.append((float(f"{gx:.6f}"), float(f"{self.die_c:.3f}")))
 
     def start(self) -> SimulatedSerialSensor:
+        """Open the pseudo-terminal and start sending lines; return self."""
         self._thread.start()
         return self
 
     def silence(self) -> None:
+        """Stop sending lines, keeping the port open (a sensor gone quiet)."""
         self._silent.set()
 
     def stop(self) -> None:
+        """Stop sending and close the pseudo-terminal."""
         self._stop.set()
         self._thread.join(5.0)
         for fd in (self.master, self._slave):
