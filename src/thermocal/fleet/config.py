@@ -74,7 +74,17 @@ class Limit:
     channel: str | None = None
 
     def check(self, value: float | None) -> bool:
-        """Whether ``value`` (finite) meets the limit; a missing or non-finite value fails."""
+        """Whether ``value`` (finite) meets the limit; a missing or non-finite value fails.
+
+        Parameters
+        ----------
+        value : float or None
+            The figure.
+
+        Returns
+        -------
+        bool
+        """
         if value is None or not math.isfinite(value):
             return False
         return value <= self.value if self.bound == "max" else value >= self.value

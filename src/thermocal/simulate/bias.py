@@ -81,7 +81,17 @@ class WarmupTerm:
         return [b0 + b1 * t0_c + b2 * t0_c**2 for b0, b1, b2 in self.coefficients]
 
     def start_bias(self, t0_c: float) -> float:
-        """The power-on bias c0 + c1 T0 + c2 T0² [unit of the sensor] at T0 = ``t0_c`` [°C]."""
+        """The power-on bias c0 + c1 T0 + c2 T0² [unit of the sensor] at T0 = ``t0_c`` [°C].
+
+        Parameters
+        ----------
+        t0_c : float
+            Sensor temperature at power-on T0 [°C].
+
+        Returns
+        -------
+        float
+        """
         c0, c1, c2 = self.start
         return c0 + c1 * t0_c + c2 * t0_c**2
 

@@ -91,6 +91,7 @@ class SensorPreset:
     curves: tuple[BiasModel, ...] = ()
 
     def to_dict(self) -> dict[str, Any]:
+        """The preset as plain JSON data (written in the truth file)."""
         d = _plain_dict(dataclasses.asdict(self))
         d["network"] = self.network.to_dict()
         return d

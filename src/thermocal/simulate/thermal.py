@@ -242,6 +242,7 @@ class ThermalNetwork:
 
     @property
     def n_nodes(self) -> int:
+        """Number of nodes k."""
         return len(self.names)
 
     def conductance_matrix(self) -> FloatArray:
@@ -282,6 +283,7 @@ class ThermalNetwork:
         )
 
     def to_dict(self) -> dict[str, Any]:
+        """The network as plain JSON data, with its time constants and steady rise."""
         d = dataclasses.asdict(self)
         d["time_constants_s"] = [float(v) for v in self.time_constants_s()]
         d["steady_rise_c"] = [float(v) for v in self.steady_rise_c()]

@@ -80,6 +80,16 @@ class RegisterMap:
         ------
         ThermocalInputError
             The temperature does not fit the register at this scale.
+
+        Parameters
+        ----------
+        temperature_c : float
+            The temperature [°C].
+
+        Returns
+        -------
+        int
+            The word, 0…65535.
         """
         ratio = temperature_c / self.scale  # inf for a tiny scale: refused, not rounded
         lo, hi = (-32768, 32767) if self.signed else (0, 65535)
@@ -93,7 +103,18 @@ class RegisterMap:
         return counts & 0xFFFF
 
     def decode(self, word: int) -> float:
-        """The unsigned 16-bit word read from a register → °C."""
+        """The unsigned 16-bit word read from a register → °C.
+
+        Parameters
+        ----------
+        word : int
+            The unsigned 16-bit word read.
+
+        Returns
+        -------
+        float
+            The temperature [°C].
+        """
         w = int(word) & 0xFFFF
         if self.signed and w >= 0x8000:
             w -= 0x10000
@@ -109,7 +130,13 @@ class Chamber(Protocol):
         """Open the connection; :class:`ChamberError` when the chamber does not answer."""
 
     def write_setpoint(self, setpoint_c: float) -> None:
-        """Write the set-point [°C]."""
+        """Write the set-point [°C].
+
+        Parameters
+        ----------
+        setpoint_c : float
+            The set-point [°C].
+        """
 
     def read_temperature(self) -> float:
         """The chamber's temperature [°C] (NaN when unknown)."""
@@ -136,7 +163,13 @@ class ManualChamber:
         return None
 
     def write_setpoint(self, setpoint_c: float) -> None:
-        """The step's goal, shown once per program step (the loop asks no more often)."""
+        """The step's goal, shown once per program step (the loop asks no more often).
+
+        Parameters
+        ----------
+        setpoint_c : float
+            The set-point [°C].
+        """
         self._setpoint = setpoint_c
         self._show(f"operator: set the chamber to {setpoint_c:.2f} °C")
 
@@ -263,7 +296,13 @@ class ModbusChamber:
         return rr
 
     def write_setpoint(self, setpoint_c: float) -> None:
-        """Write the set-point [°C] to the set-point register (Write Single Register)."""
+        """Write the set-point [°C] to the set-point register (Write Single Register).
+
+        Parameters
+        ----------
+        setpoint_c : float
+            The set-point [°C].
+        """
         word = self.map.encode(setpoint_c)
         reg = self.map.setpoint_register
         what = f"write set-point to register {reg}"

@@ -98,7 +98,19 @@ class ChamberConfig:
 
     def out_of_range(self, temperature_c: float, margin_c: float = 0.0) -> str:
         """``""`` when ``temperature_c`` [°C] lies in ``min_c − margin_c … max_c +
-        margin_c`` (finite), else why not (for a message)."""
+        margin_c`` (finite), else why not (for a message).
+
+        Parameters
+        ----------
+        temperature_c : float
+            A temperature [°C].
+        margin_c : float
+            Margin beyond the range [°C].
+
+        Returns
+        -------
+        str
+        """
         lo, hi = self.min_c - margin_c, self.max_c + margin_c
         if math.isfinite(temperature_c) and lo <= temperature_c <= hi:
             return ""
@@ -451,7 +463,20 @@ def load_station(path: str | Path) -> StationConfig:
 def check_port(device: str, who: str) -> None:
     """Refuse a serial ``device`` that is a FIFO, a socket or a block device (``stat``
     only, never opened): pyserial would answer "Inappropriate ioctl for device".
-    A character device (``/dev/ttyUSB0``, a pty) and a pyserial URL pass."""
+    A character device (``/dev/ttyUSB0``, a pty) and a pyserial URL pass.
+
+    Parameters
+    ----------
+    device : str
+        The serial device or pyserial URL.
+    who : str
+        How the message names its owner (``[chamber]``, ``[[sensor]] imu``).
+
+    Raises
+    ------
+    ThermocalInputError
+        A FIFO, a socket or a block device.
+    """
     why = special_mode(Path(device))
     if why is not None and why != "it is a character device":
         raise ThermocalInputError(
@@ -462,7 +487,22 @@ def check_port(device: str, who: str) -> None:
 
 def require(module: str) -> Any:
     """Import an optional library of the station, or a one-line input error saying what to
-    install (exit 2 on the command line)."""
+    install (exit 2 on the command line).
+
+    Parameters
+    ----------
+    module : str
+        The module's name.
+
+    Returns
+    -------
+    module
+
+    Raises
+    ------
+    ThermocalInputError
+        Not installed: the message says ``pip install 'thermocal[station]'``.
+    """
     import importlib
 
     try:

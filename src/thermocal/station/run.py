@@ -116,11 +116,25 @@ class StationState:
 
 
 class Display(Protocol):
+    """Where a run shows its state and messages (a live table or log lines)."""
+
     def update(self, state: StationState) -> None:
-        """Show ``state``."""
+        """Show ``state``.
+
+        Parameters
+        ----------
+        state : StationState
+            The station's state.
+        """
 
     def log(self, message: str) -> None:
-        """Show one message."""
+        """Show one message.
+
+        Parameters
+        ----------
+        message : str
+            The text.
+        """
 
 
 def say(message: str) -> str:
@@ -128,7 +142,18 @@ def say(message: str) -> str:
     (a closed pipe, a vanished terminal): then file descriptor 2 is pointed at
     ``os.devnull``, so that no later message (nor Python's flush at exit) raises either.
     Started without a stderr (``2>&-``: ``sys.stderr`` is None) nothing is printed (never
-    on stdout, where ``--json`` writes) and ``""`` is returned: nobody was watching."""
+    on stdout, where ``--json`` writes) and ``""`` is returned: nobody was watching.
+
+    Parameters
+    ----------
+    message : str
+        The text.
+
+    Returns
+    -------
+    str
+        ``""``, or why stderr is gone.
+    """
     if sys.stderr is None:
         return ""
     try:
@@ -160,11 +185,23 @@ class LogDisplay:
         self.broken = ""
 
     def update(self, state: StationState) -> None:
-        """Nothing: a log display prints messages only."""
+        """Nothing: a log display prints messages only.
+
+        Parameters
+        ----------
+        state : StationState
+            The station's state.
+        """
         return None
 
     def log(self, message: str) -> None:
-        """Print ``message`` on stderr."""
+        """Print ``message`` on stderr.
+
+        Parameters
+        ----------
+        message : str
+            The text.
+        """
         if not self.broken:
             self.broken = say(message)
 
@@ -626,6 +663,16 @@ def previous_run(events: list[dict[str, Any]]) -> tuple[str, bool]:
     not); a run killed (SIGKILL, a power cut, a crash of the interpreter) leaves none: then
     the chamber still holds the last set-point written: the last ``setpoint`` event [°C]
     (along a ramp, within :data:`SETPOINT_EVENT_C` of it).
+
+    Parameters
+    ----------
+    events : list of dict
+        The events of ``station.json``.
+
+    Returns
+    -------
+    tuple of (str, bool)
+        How it ended, and whether that needs the operator's attention.
     """
     last_sp: float | None = None
     stop: dict[str, Any] | None = None

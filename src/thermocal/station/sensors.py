@@ -70,7 +70,22 @@ class LineParser:
         return tuple(out)
 
     def parse(self, line: str) -> tuple[float, ...]:
-        """The line's numbers, or :class:`BadLine` saying why not."""
+        """The line's numbers, or :class:`BadLine` saying why not.
+
+        Parameters
+        ----------
+        line : str
+            One line of the sensor, without its end.
+
+        Returns
+        -------
+        tuple of float
+
+        Raises
+        ------
+        BadLine
+            Why the line is not a sample.
+        """
         delims = (self.delimiter,) if self.delimiter else DELIMITERS
         reason = ""
         for d in delims:
@@ -226,7 +241,17 @@ class SerialSensor:
 
     def drain(self, most: int | None = None) -> tuple[list[Sample], list[Bad]]:
         """The good lines that arrived since the last call (the ``most`` oldest of them; the
-        rest wait for the next call) and the bad ones."""
+        rest wait for the next call) and the bad ones.
+
+        Parameters
+        ----------
+        most : int, optional
+            Take at most this many good lines.
+
+        Returns
+        -------
+        tuple of (list of Sample, list of Bad)
+        """
         with self._lock:
             if most is None or len(self._samples) <= most:
                 s, self._samples = self._samples, []
