@@ -1,4 +1,4 @@
-"""HTML report of a calibration of triads (issues 19, 30, 38): for each triad its parameters
+"""HTML report of a calibration of triads: for each triad its parameters
 in the calibration's own units (a bias in the triad's unit, °/s for a °/s calibration; scale
 factors [ppm], misalignments [″]) with their σ, and, on an independent run, the figures
 before and after compensation: a turntable run's dwell-mean and move-angle errors
