@@ -2,8 +2,8 @@
 
 Every problem with the user's input is a :class:`ThermocalInputError` (or a
 subclass) whose message names the file, column or row at fault.  The command line
-turns these into exit status 2 and a one-line ``error: ...`` on stderr
-(INTERFACE.md, "Common rules").
+turns these into exit status 2 and a one-line ``error: ...`` on stderr (the common rules
+of the command line); anything else is an internal failure, exit status 1.
 """
 
 from __future__ import annotations
@@ -47,7 +47,17 @@ class ParameterError(ThermocalInputError):
         super().__init__(message.replace("{name}", parameter))
 
     def named(self, name: str) -> str:
-        """The message with ``name`` (an option, ``--rate``) for the parameter."""
+        """The message with ``name`` (an option, ``--rate``) for the parameter.
+
+        Parameters
+        ----------
+        name : str
+            What to show for the parameter (``--rate``).
+
+        Returns
+        -------
+        str
+        """
         return self.template.replace("{name}", name)
 
     def __reduce__(self) -> tuple[type[ParameterError], tuple[str, str]]:
