@@ -16,6 +16,7 @@ import json
 import math
 import os
 import sys
+import typing
 import warnings
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
@@ -281,7 +282,7 @@ def handle_errors(fn: Callable[P, R]) -> Callable[P, R]:
                 raise typer.Exit(report_interrupted()) from None
             except Exception as exc:  # the mapping the fleet uses too (error_text)
                 _show_warnings(caught)
-                text, users = error_text(exc)
+                text, users = error_text(exc, _command_options(fn))
                 if not users and os.environ.get("THERMOCAL_DEBUG"):
                     raise
                 print(f"error: {text}", file=sys.stderr)
@@ -290,6 +291,23 @@ def handle_errors(fn: Callable[P, R]) -> Callable[P, R]:
         return result
 
     return wrapper
+
+
+def _command_options(fn: Callable[..., Any]) -> dict[str, str]:
+    """``{parameter: option}`` of a command function (``rate_hz`` → ``--rate-hz`` for
+    ``simulate``), read from its ``Annotated[..., typer.Option("--name")]`` declarations;
+    empty when they cannot be read."""
+    try:
+        hints = typing.get_type_hints(fn, include_extras=True)
+    except Exception:  # a courtesy for the message: never fails the error path
+        return {}
+    out: dict[str, str] = {}
+    for name, hint in hints.items():
+        for info in getattr(hint, "__metadata__", ()):
+            decls = [d for d in getattr(info, "param_decls", None) or () if d.startswith("--")]
+            if isinstance(info, typer.models.OptionInfo):
+                out[name] = decls[0] if decls else "--" + name.replace("_", "-")
+    return out
 
 
 def _show_warnings(caught: list[warnings.WarningMessage]) -> None:
