@@ -76,7 +76,7 @@ _FIELDS = "uint64_t timestamp;uint32_t device_id;float x;float y;float z;float t
 
 def _ulog(topics: list[tuple[str, int, np.ndarray]]) -> bytes:
     """(name, instance, records of :data:`_REC`) → a ULog file: header, flag bits, format,
-    add-logged and data messages (the layout of tests/ulog_writer.py, vectorised)."""
+    add-logged and data messages (the layout of tests/helpers/ulog_writer.py, vectorised)."""
     import struct
 
     out = bytearray(b"ULog\x01\x12\x35\x01" + struct.pack("<Q", 0))

@@ -47,45 +47,82 @@ class Mutant:
     what: str
 
 
+_TEST_FILES = {p.name: p.relative_to(ROOT).as_posix() for p in (ROOT / "tests").rglob("test_*.py")}
+"""Every test file by its basename (basenames are unique across the tests tree)."""
+
+
 def _t(*names: str) -> tuple[str, ...]:
-    return tuple(n if "/" in n else f"tests/test_{n}.py" for n in names)
+    """Test files by module name, wherever they sit in the tests tree (``units`` gives
+    ``tests/core/test_units.py``); a name with a ``/`` is a path and is kept as it is."""
+    return tuple(
+        n if "/" in n else _TEST_FILES.get(f"test_{n}.py", f"tests/test_{n}.py") for n in names
+    )
 
 
 P = "src/thermocal/"
-TT_THERMAL = _t("mutants_turntable", "turntable_thermal", "turntable_thermal_cli")
-TT_ACCEL = _t("mutants_turntable", "turntable_accel", "turntable_thermal")
-TT_ENC = _t("mutants_turntable", "turntable_encoders", "turntable_kinematics", "turntable_cli")
-TT_CAL = _t("mutants_turntable", "turntable_estimation", "turntable_encoders", "turntable_cli")
+# Files split by the module they guard (each group: the files one earlier file became).
+MATHS = _t("adequacy_by_hand", "stability_by_hand", "kernels_by_hand", "preprocess_by_hand",
+           "gravity_by_hand", "identifiers_by_hand")  # fmt: skip
+FIRMWARE = _t("ardupilot_by_hand", "px4_accel_by_hand", "params_by_hand", "ulog_subscriptions")
+MULTIPOS_BY_HAND = _t("calibration_checks", "multipos_by_hand", "gravity_placements",
+                      "validation_by_hand")  # fmt: skip
+H38_AUDIT = _t("multipos_messages", "validate_messages", "compensate_rate", "inspection_setpoints",
+               "noise_messages", "export_c_messages", "demo_validations")  # fmt: skip
+LEFTOVER39 = _t("allan_option_attacks", "station_fifo_attacks", "fleet_worker_attacks",
+                "compensate_column_attacks")  # fmt: skip
+TT_THERMAL = _t("turntable_by_hand", "turntable_thermal", "turntable_thermal_cli")
+TT_ACCEL = _t("turntable_by_hand", "turntable_accel", "turntable_thermal")
+TT_ENC = _t("turntable_by_hand", "turntable_encoders", "turntable_kinematics", "turntable_cli")
+TT_CAL = _t("turntable_by_hand", "turntable_estimation", "turntable_encoders", "turntable_cli")
 FLEET = _t("fleet_units", "fleet", "fleet_reruns")
-WORK_BOUNDS = ("tests/attacks/test_work_bounds_attacks.py",)
-UNITS = _t("mutants_units", "units", "units_resolver", "units_property", "units_travel")
-H38R = _t("reader_options_h38")
-TEXT = _t("mutants_units", "text_logs", "tests/attacks/test_text_attacks.py")
-PARAMS = _t("mutants_export", "export_params", "tests/attacks/test_export_params_attacks.py")
-PX4 = _t("mutants_export", "px4_tempcal", "px4_baro_mag", "ardupilot_tempcal")
-ADEQ = _t("mutants_maths", "adequacy", "fc_gates")
-STAB = _t("mutants_maths", "stability_reference", "allan", "allan_references")
-NOISE = _t("mutants_maths", "stability_noise_terms", "noise_cmd")
-H38 = _t("noise_terms_h38")
-MULTI = _t("mutants_maths", "multipos")
+WORK_BOUNDS = ("tests/cli/test_work_bounds_attacks.py",)
+UNITS = _t(
+    "units_by_hand",
+    "text_by_hand",
+    "ulog_vehicle_imu",
+    "units",
+    "units_resolver",
+    "units_property",
+    "units_travel",
+)
+H38R = _t("reader_options")
+TEXT = _t(
+    "units_by_hand",
+    "text_by_hand",
+    "ulog_vehicle_imu",
+    "text_logs",
+    "tests/readers/test_text_attacks.py",
+)
+PARAMS = _t(
+    "params_ranges",
+    "tempcal_by_hand",
+    "export_params",
+    "tests/export/test_export_params_attacks.py",
+)
+PX4 = _t("params_ranges", "tempcal_by_hand", "px4_tempcal", "px4_baro_mag", "ardupilot_tempcal")
+ADEQ = _t(*MATHS, "adequacy", "fc_gates")
+STAB = _t(*MATHS, "stability_reference", "allan", "allan_references")
+NOISE = _t(*MATHS, "stability_noise_terms", "noise_cmd")
+H38 = _t("noise_terms_real_sensors")
+MULTI = _t(*MATHS, "multipos")
 STATION = _t("station", "readers_station")
-ST_ATT = _t("tests/attacks/test_station_attacks.py")
-FC = _t("mutants_units", "fc_log_readers", "fc_gates")
+ST_ATT = _t("tests/station/test_station_attacks.py")
+FC = _t("units_by_hand", "text_by_hand", "ulog_vehicle_imu", "fc_log_readers", "fc_gates")
 EXPC = _t("export_c", "export_c_edges", "export_c_triads", "export_c_units")
-COMP = _t("mutants_maths", "compensate", "outside_range", "judge_absolute")
-GRAV = _t("mutants_maths", "gravity_tilt", "gravity_tref")
-IDS = _t("mutants_maths", "c_identifiers", "tests/attacks/test_generated_code_attacks.py")
-OUTS = _t("faults", "tests/attacks/test_output_attacks.py")
-METRICS = _t("mutants_maths", "metrics", "drift_angle", "metrics_runs")
-NAMES = _t("tests/attacks/test_names_attacks.py")
-FW_AP = _t("mutants_firmware", "ardupilot_hygiene", "ardupilot_tclr_range",
+COMP = _t(*MATHS, "compensate", "outside_range", "judge_absolute")
+GRAV = _t(*MATHS, "gravity_tilt", "gravity_tref")
+IDS = _t(*MATHS, "c_identifiers", "tests/export/test_generated_code_attacks.py")
+OUTS = _t("faults", "tests/core/test_output_attacks.py")
+METRICS = _t(*MATHS, "metrics", "drift_angle", "metrics_runs")
+NAMES = _t("tests/core/test_names_attacks.py")
+FW_AP = _t(*FIRMWARE, "ardupilot_hygiene", "ardupilot_tclr_range",
            "ardupilot_param_changes", "fc_reports")  # fmt: skip
-FW_EXPORT = _t("mutants_firmware", "export_params", "tests/attacks/test_export_params_attacks.py",
+FW_EXPORT = _t(*FIRMWARE, "export_params", "tests/export/test_export_params_attacks.py",
                "px4_tempcal")  # fmt: skip
-FW_PX4 = _t("mutants_firmware", "px4_tempcal", "px4_baro_mag", "ardupilot_tempcal")
-FW_ADEQ = _t("mutants_firmware", "adequacy", "export_params", "outside_range")
-FW_ULOG = _t("mutants_firmware", "ulog_fast", "px4_read_once")
-FW_ATT = _t("tests/attacks/test_firmware_attacks.py", "mutants_firmware")
+FW_PX4 = _t(*FIRMWARE, "px4_tempcal", "px4_baro_mag", "ardupilot_tempcal")
+FW_ADEQ = _t(*FIRMWARE, "adequacy", "export_params", "outside_range")
+FW_ULOG = _t(*FIRMWARE, "ulog_fast", "tempcal_pipeline_reads")
+FW_ATT = _t("tests/tempcal/test_firmware_attacks.py", *FIRMWARE)
 H39A = _t(
     "stability_reference",
     "allan",
@@ -97,15 +134,15 @@ H39A = _t(
     "total_edf_stable32",
     "noise_type",
     "stability_noise_terms",
-    "mutants_stability",
+    "stability_tables",
 )
-H39A_ATT = _t("tests/attacks/test_allan_attacks.py")
-H39A_EDF = _t("mutants_stability", "total_edf_stable32", "noise_terms_theo1_edf")
-H39MP = _t("mutants_multipos", "tests/attacks/test_multipos_attacks.py")
-ADEQ_H39 = ("tests/test_mutants_adequacy.py", *ADEQ)
-ST_ATT2 = ("tests/attacks/test_station_attacks_2.py",)
-AUDIT = _t("tests/attacks/test_audit39_attacks.py")
-H39L = _t("tests/attacks/test_leftover39_attacks.py")
+H39A_ATT = _t("tests/stability/test_allan_attacks.py")
+H39A_EDF = _t("stability_tables", "total_edf_stable32", "noise_terms_theo1_edf")
+H39MP = _t(*MULTIPOS_BY_HAND, "tests/multipos/test_multipos_attacks.py")
+ADEQ_H39 = (*_t("adequacy_overrides"), *ADEQ)
+ST_ATT2 = ("tests/station/test_station_run_attacks.py",)
+AUDIT = _t("tests/cli/test_cli_surface_attacks.py", "tests/simulate/test_simulate_rate_attacks.py")
+H39L = _t(*LEFTOVER39)
 DIGITS = _t("deviation_digits")
 
 
@@ -276,7 +313,7 @@ MUTANTS: tuple[Mutant, ...] = (
         P + "models/poly.py",
         '        same_length(state, path, "coef", len(state["terms"]), "one per term")\n',
         "",
-        _t("tests/attacks/test_attacks.py"),
+        _t("tests/cli/test_cli_attacks.py"),
         "model file with fewer coefficients than terms accepted",
     ),
     Mutant(
@@ -1136,7 +1173,7 @@ MUTANTS: tuple[Mutant, ...] = (
         P + "multipos/accel.py",
         "        if ang > FACE_MAX_DEG:\n",
         "        if ang > 180.0:\n",
-        _t("h38_audit"),
+        _t(*H38_AUDIT),
         "a POSES file of another session turned into a six-face calibration",
     ),
     Mutant(
@@ -1144,7 +1181,7 @@ MUTANTS: tuple[Mutant, ...] = (
         P + "stability/allan.py",
         "        free &= ~(share >= PERIODIC_CLEAN_SHARE)\n",
         "        pass\n",
-        _t("h38_audit"),
+        _t(*H38_AUDIT),
         "the -1/2 stretch read where a sinusoid holds a third of the Allan variance",
     ),
     Mutant(
@@ -1194,7 +1231,7 @@ MUTANTS: tuple[Mutant, ...] = (
         P + "errors.py",
         'text = text.replace("{" + p + "}", other(p) if other is not None else p)',
         'text = text.replace("{" + p + "}", p)',
-        ("tests/core/test_gravity_parameters.py", "tests/test_gravity_tref.py"),
+        ("tests/core/test_gravity_parameters.py", "tests/core/test_gravity_tref.py"),
         "--gravity without --gravity-axis: the command line names gravity_axis, no option",
     ),
     Mutant(
@@ -1218,7 +1255,7 @@ MUTANTS: tuple[Mutant, ...] = (
         P + "multipos/calibrate.py",
         'j = "xyz".index(tr.name[0])',
         "j = 2",
-        (*MULTI, "tests/test_multipos_imucal.py"),
+        (*MULTI, "tests/multipos/test_multipos_imucal.py"),
         "multi-position: every named turn taken about z (issue 38's bug: the last face's axis)",
     ),
     Mutant(
@@ -1226,7 +1263,7 @@ MUTANTS: tuple[Mutant, ...] = (
         P + "multipos/gyro.py",
         "if off > TURN_AXIS_TOLERANCE_DEG:",
         "if off > 180.0:",
-        (*MULTI, "tests/test_multipos_imucal.py"),
+        (*MULTI, "tests/multipos/test_multipos_imucal.py"),
         "multi-position: a turn about another axis than its name accepted",
     ),
     Mutant(
@@ -1234,7 +1271,7 @@ MUTANTS: tuple[Mutant, ...] = (
         P + "multipos/gyro.py",
         "if abs(ang / (2.0 * math.pi) - 1.0) > TURN_ANGLE_TOLERANCE:",
         "if abs(ang / (2.0 * math.pi) - 1.0) > 0.6:",
-        (*MULTI, "tests/test_multipos_imucal.py"),
+        (*MULTI, "tests/multipos/test_multipos_imucal.py"),
         "multi-position: half a turn taken for a full one",
     ),
     Mutant(
@@ -1242,7 +1279,7 @@ MUTANTS: tuple[Mutant, ...] = (
         P + "multipos/gyro.py",
         "rot, e = _turn_axis_scatter(rot, e, bias_rad_s, up, max_iter)",
         "rot, e = rot, e",
-        (*MULTI, "tests/test_multipos_sigma.py", "tests/test_multipos_imucal.py"),
+        (*MULTI, "tests/multipos/test_multipos_sigma.py", "tests/multipos/test_multipos_imucal.py"),
         "multi-position: a hand's turn taken exactly about its axis (misalignment σ 5× small)",
     ),
     Mutant(
@@ -1250,7 +1287,7 @@ MUTANTS: tuple[Mutant, ...] = (
         P + "multipos/calibrate.py",
         "if abs(th[3 + i] * units.PPM) > GYRO_E_PLAUSIBLE]",
         "if abs(th[3 + i] * units.PPM) > 1.0]",
-        (*MULTI, "tests/test_multipos_imucal.py"),
+        (*MULTI, "tests/multipos/test_multipos_imucal.py"),
         "multi-position: a gyro scale factor of +25 % not warned of",
     ),
     Mutant(
@@ -1266,7 +1303,7 @@ MUTANTS: tuple[Mutant, ...] = (
         P + "multipos/gyro.py",
         "c_sys = jb @ bias_cov @ jb.T + ga @ accel_free_cov @ ga.T",
         "c_sys = ga @ accel_free_cov @ ga.T",
-        (*MULTI, "tests/test_multipos_sigma.py"),
+        (*MULTI, "tests/multipos/test_multipos_sigma.py"),
         "gyro scale σ without the bias uncertainty",
     ),
     Mutant(
@@ -1274,7 +1311,7 @@ MUTANTS: tuple[Mutant, ...] = (
         P + "multipos/poses.py",
         "by_motion = motion_fraction * motion",
         "by_motion = 0.0 * motion",
-        ("tests/test_multipos_real_sessions.py",),
+        ("tests/multipos/test_multipos_real_sessions.py",),
         "pose detector: the still limit from the noise alone (hand-held poses lost: 4 of 10)",
     ),
     Mutant(
@@ -1282,7 +1319,7 @@ MUTANTS: tuple[Mutant, ...] = (
         P + "multipos/accel.py",
         "for _ in range(MISFIT_ITERATIONS):",
         "for _ in range(0):",
-        ("tests/test_multipos_real_sessions.py",),
+        ("tests/multipos/test_multipos_real_sessions.py",),
         "misfit sensor fitted with its white-noise weights (imu_tk's Xsens: 1.09× the residual)",
     ),
     Mutant(
@@ -1290,7 +1327,7 @@ MUTANTS: tuple[Mutant, ...] = (
         P + "multipos/accel.py",
         "np.var(pairs, axis=0, ddof=1) / 3.0",
         "0.0 * np.var(pairs, axis=0, ddof=1)",
-        ("tests/test_multipos_six_face_sigma.py",),
+        ("tests/multipos/test_multipos_six_face_sigma.py",),
         "six-face bias σ from the white noise alone (faces set a degree off: z-rms ≈ 140)",
     ),
     Mutant(
@@ -1298,7 +1335,7 @@ MUTANTS: tuple[Mutant, ...] = (
         P + "pipeline/multipos.py",
         "        return float(given)\n",
         "        return 0.0\n",
-        ("tests/test_multipos_real_sessions.py",),
+        ("tests/multipos/test_multipos_real_sessions.py",),
         "--accel-offset/--gyro-offset ignored (unsigned counts: 1 distinct pose)",
     ),
     Mutant(
@@ -1306,7 +1343,7 @@ MUTANTS: tuple[Mutant, ...] = (
         P + "multipos/gyro.py",
         "motions = unsaturated(motions, saturated)",
         "motions = unsaturated(motions, None)",
-        ("tests/test_multipos_real_sessions.py",),
+        ("tests/multipos/test_multipos_real_sessions.py",),
         "motions across clipped gyro samples integrated into the gyro fit",
     ),
     Mutant(
@@ -1314,7 +1351,7 @@ MUTANTS: tuple[Mutant, ...] = (
         P + "inspection.py",
         "            problems.extend(_saturation_problems(name, arr))",
         "            pass",
-        ("tests/test_multipos_real_sessions.py",),
+        ("tests/multipos/test_multipos_real_sessions.py",),
         "inspect says nothing of samples on the int16 rails",
     ),
     Mutant(
@@ -1322,7 +1359,7 @@ MUTANTS: tuple[Mutant, ...] = (
         P + "multipos/poses.py",
         "        if turn > drift_deg:",
         "        if turn > 1e9 * drift_deg:",
-        ("tests/test_multipos_real_sessions.py",),
+        ("tests/multipos/test_multipos_real_sessions.py",),
         "pose detector: a slow 10° turn taken as a pose",
     ),
     Mutant(
@@ -1330,7 +1367,7 @@ MUTANTS: tuple[Mutant, ...] = (
         P + "multipos/poses.py",
         "    rejected += _tremor(ratio, poses, rejected, min_n)",
         "    rejected += _tremor(ratio, poses, rejected, min_n)[:0]",
-        ("tests/test_multipos_real_sessions.py",),
+        ("tests/multipos/test_multipos_real_sessions.py",),
         "pose detector: stretches lost to tremor not reported",
     ),
     Mutant(
@@ -1338,7 +1375,7 @@ MUTANTS: tuple[Mutant, ...] = (
         P + "pipeline/multipos.py",
         "    if acc_off_mg == 0.0 and gyr_off_deg_h == 0.0:",
         "    if True:",
-        ("tests/test_multipos_real_sessions.py",),
+        ("tests/multipos/test_multipos_real_sessions.py",),
         "--accel-offset removed before the fit but not put back into the biases",
     ),
     Mutant(
@@ -1346,7 +1383,7 @@ MUTANTS: tuple[Mutant, ...] = (
         P + "multipos/gyro.py",
         '"scale": (0, 4, 8)}',
         '"scale": tuple(range(9))}',
-        ("tests/test_multipos_real_sessions.py",),
+        ("tests/multipos/test_multipos_real_sessions.py",),
         "--gyro-model scale fits the misalignments too (MPU held-out turn 6.96°)",
     ),
     Mutant(
@@ -1354,7 +1391,7 @@ MUTANTS: tuple[Mutant, ...] = (
         P + "multipos/gyro.py",
         "return nu < len(GYRO_MODELS[fit.model]) and significant",
         "return nu < 3 and significant",
-        ("tests/test_multipos_real_sessions.py",),
+        ("tests/multipos/test_multipos_real_sessions.py",),
         "6 motions for 9 gyro elements (3 dof, χ² 704) not warned of",
     ),
     # --- station -----------------------------------------------------------------------------
@@ -1769,7 +1806,7 @@ MUTANTS: tuple[Mutant, ...] = (
         P + "preprocess.py",
         'lo = np.searchsorted(ts, ti - interval_s / 2.0, side="left")',
         'lo = np.searchsorted(ts, ti - interval_s, side="left")',
-        _t("mutants_maths", "preprocess"),
+        _t(*MATHS, "preprocess"),
         "centred Ṫ over 1.5 Δ",
     ),
     # issue 38, reports and messages (h38-reports)
@@ -1778,7 +1815,7 @@ MUTANTS: tuple[Mutant, ...] = (
         P + "report/analysis.py",
         ">= MIN_FALLBACK_AVERAGES]",
         ">= 2]",
-        _t("h38_messages"),
+        _t("tempcal_averages", "metrics_averages"),
         "a short record's fallback averaging time gives only two averages",
     ),
     Mutant(
@@ -1786,7 +1823,7 @@ MUTANTS: tuple[Mutant, ...] = (
         P + "metrics.py",
         "{option} {longest_s / 2.0:.3g} or less",
         "{option} {longest_s:.3g} or less",
-        _t("h38_messages"),
+        _t("tempcal_averages", "metrics_averages"),
         "the advised --average is the whole record (one average), not half",
     ),
     Mutant(
@@ -1794,7 +1831,7 @@ MUTANTS: tuple[Mutant, ...] = (
         P + "export/c/core.py",
         "units.convert([value], unit, su)",
         "units.convert([value], su, unit)",
-        _t("h38_export_c"),
+        _t("export_c_readable"),
         "the header's known input converted the wrong way (deg/h shown as deg/s)",
     ),
     Mutant(
@@ -1818,7 +1855,7 @@ MUTANTS: tuple[Mutant, ...] = (
         P + "models/piecewise.py",
         "parts[k].append(x[idx == k])",
         "parts[k].append(x[idx == 0])",
-        _t("h38_piecewise"),
+        _t("piecewise_segments"),
         "every segment judged on the first segment's samples",
     ),
     Mutant(
@@ -1826,7 +1863,7 @@ MUTANTS: tuple[Mutant, ...] = (
         P + "models/piecewise.py",
         "given=self.breakpoints is not None,",
         "given=False,",
-        _t("h38_piecewise"),
+        _t("piecewise_segments"),
         "breakpoints given, the refusal advises --segments instead of moving them",
     ),
     Mutant(
@@ -2164,7 +2201,7 @@ MUTANTS: tuple[Mutant, ...] = (
         P + "metrics.py",
         "if lab in labels[:i]:",
         "if lab in labels[: max(i - 1, 0)]:",
-        METRICS + _t("tests/attacks/test_metrics_attacks.py"),
+        METRICS + _t("tests/core/test_metrics_attacks.py"),
         "a path given twice in a row counted twice",
     ),
     Mutant(
@@ -2172,7 +2209,7 @@ MUTANTS: tuple[Mutant, ...] = (
         P + "metrics.py",
         "if named and value not in named:",
         "if len(named) > 1 and value not in named:",
-        METRICS + _t("tests/attacks/test_metrics_attacks.py"),
+        METRICS + _t("tests/core/test_metrics_attacks.py"),
         "a second sensor pooled; only a third one noticed",
     ),
     Mutant(
@@ -2180,7 +2217,7 @@ MUTANTS: tuple[Mutant, ...] = (
         P + "metrics.py",
         'if "" in sensors and len(sensors) > 1:',
         'if "" in sensors and len(sensors) > 2:',
-        METRICS + _t("tests/attacks/test_metrics_attacks.py"),
+        METRICS + _t("tests/core/test_metrics_attacks.py"),
         "a run naming no sensor pooled with a named sensor's without a warning",
     ),
     Mutant(
@@ -2188,7 +2225,7 @@ MUTANTS: tuple[Mutant, ...] = (
         P + "metrics.py",
         "values = np.ascontiguousarray(rec.columns[n], dtype=np.float64)",
         "values = np.ascontiguousarray(rec.time_s, dtype=np.float64)",
-        METRICS + _t("tests/attacks/test_metrics_attacks.py"),
+        METRICS + _t("tests/core/test_metrics_attacks.py"),
         "copies found by their time axis (a re-stamped copy passes, real runs at 1 Hz refused)",
     ),
     Mutant(
@@ -2751,7 +2788,7 @@ MUTANTS: tuple[Mutant, ...] = (
         P + "validation.py",
         "run.temps_c[:, 0]",
         "run.temps_c[:, -1]",
-        (*H39MP, "tests/test_validation.py"),
+        (*H39MP, "tests/core/test_validation.py"),
         "validate: the ambient taken from the last temperature column",
     ),
     Mutant(
@@ -2759,7 +2796,7 @@ MUTANTS: tuple[Mutant, ...] = (
         P + "validation.py",
         "zero_reference=self.zero_reference / factor,",
         "zero_reference=self.zero_reference,",
-        (*H39MP, "tests/test_validation.py", "tests/test_triad_validate_counts.py"),
+        (*H39MP, "tests/core/test_validation.py", "tests/pipeline/test_triad_validate_counts.py"),
         "validate: the zero reference left in the model's unit when shown in the data's",
     ),
     Mutant(
@@ -2767,7 +2804,7 @@ MUTANTS: tuple[Mutant, ...] = (
         P + "validation.py",
         '"bias_stability_before", "bias_stability_after")',
         '"bias_stability_before", "bias_stability_after")[:2]',
-        (*H39MP, "tests/test_validation.py", "tests/test_triad_validate_counts.py"),
+        (*H39MP, "tests/core/test_validation.py", "tests/pipeline/test_triad_validate_counts.py"),
         "validate: each stage's bias stability left in the model's unit",
     ),
     Mutant(
@@ -2775,7 +2812,7 @@ MUTANTS: tuple[Mutant, ...] = (
         P + "validation.py",
         "if self.r is not None and not self.weakly_correlated:",
         "if False:",
-        (*H39MP, "tests/test_validation.py"),
+        (*H39MP, "tests/core/test_validation.py"),
         "validate: a run that repeats the modelling run judged improved",
     ),
     Mutant(

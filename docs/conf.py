@@ -30,11 +30,12 @@ extensions = [
     "numpydoc",
     "myst_parser",
     "thermocal_cli",
+    "thermocal_gallery",
 ]
 
 source_suffix = {".rst": "restructuredtext", ".md": "markdown"}
 root_doc = "index"
-exclude_patterns = ["_build", "README.md", "Thumbs.db", ".DS_Store"]
+exclude_patterns = ["_build", "_ext", "README.md", "Thumbs.db", ".DS_Store"]
 
 # Markdown pages: $$ … $$ and $ … $ maths, ::: fences for directives
 myst_enable_extensions = ["dollarmath", "colon_fence", "deflist"]

@@ -1,4 +1,4 @@
-"""A module imported on first attribute access (start-up, issue 17): heavy libraries a module
+"""A module imported on first attribute access (start-up time): heavy libraries a module
 needs only inside some functions (scipy.stats for confidence intervals) stay out of the
 import of the module itself."""
 
@@ -10,7 +10,19 @@ from typing import Any
 
 
 class LazyModule:
-    """``LazyModule("scipy.stats").chi2`` imports :mod:`scipy.stats` on that first access."""
+    """``LazyModule("scipy.stats").chi2`` imports :mod:`scipy.stats` on that first access.
+
+    Parameters
+    ----------
+    name : str
+        The module's dotted name (``"scipy.stats"``).
+
+    Examples
+    --------
+    >>> json = LazyModule("json")
+    >>> json.dumps([1, 2])
+    '[1, 2]'
+    """
 
     def __init__(self, name: str) -> None:
         self._name = name
@@ -24,7 +36,7 @@ class LazyModule:
 
 
 def prefetch(*names: str) -> None:
-    """Import modules in a background thread while the caller reads its file (issue 17).
+    """Import modules in a background thread while the caller reads its file.
 
     A command that will need, say, :mod:`scipy.special` after reading a large file starts
     its import first: the file reader and numpy release the GIL, so most of the import's
@@ -32,6 +44,12 @@ def prefetch(*names: str) -> None:
     ``import`` of the same module in the main thread wait for this one, never run it twice.
     The thread is not a daemon: an interpreter exiting early waits for it (a daemon killed
     in the middle of an import can crash the interpreter's shutdown).
+
+    Parameters
+    ----------
+    *names : str
+        Dotted names of the modules to import, in that order; an import that fails stops
+        the thread silently (the main thread meets the error again when it imports).
     """
     import threading
 

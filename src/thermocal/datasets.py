@@ -26,13 +26,38 @@ else:
     pd = LazyModule("pandas")
 
 EXAMPLES = {"tvac": "tvac_bursts.csv"}
+"""Name of each shipped example → its file in ``thermocal/data``."""
 TVAC_COUNTS_GAIN_C = 0.0625
+"""Gain of the ``tvac`` temperature counts [°C/count]."""
 TVAC_COUNTS_OFFSET_C = -50.0
+"""Offset of the ``tvac`` temperature counts [°C]: ``T = 0.0625·counts − 50``."""
 TVAC_SPIKE_ROWS = (1_337, 4_020, 5_555)
+"""Rows of the ``tvac`` log that hold a +30 °/h spike."""
 
 
 def example_path(name: str) -> Path:
-    """Path of a shipped example recording (``tvac``)."""
+    """Path of a shipped example recording (``tvac``).
+
+    Parameters
+    ----------
+    name : str
+        The example's name, a key of :data:`EXAMPLES`.
+
+    Returns
+    -------
+    pathlib.Path
+        The file inside the installed package.
+
+    Raises
+    ------
+    KeyError
+        ``name`` is not a shipped example (the message lists them).
+
+    Examples
+    --------
+    >>> example_path("tvac").name
+    'tvac_bursts.csv'
+    """
     if name not in EXAMPLES:
         raise KeyError(f"unknown example {name!r}; known: {', '.join(EXAMPLES)}")
     return Path(str(resources.files("thermocal") / "data" / EXAMPLES[name]))
@@ -45,6 +70,24 @@ def make_tvac_log(seed: int = 7) -> pd.DataFrame:
     sensor temperature falls from +25 °C towards −10 °C with a 40-minute time
     constant; the gyro reads 0.5 °/h + 0.01 °/h/°C·(T − 25) + white noise
     (0.05 °/h rms); three spikes of +30 °/h.
+
+    Parameters
+    ----------
+    seed : int
+        Seed of :func:`numpy.random.default_rng`; 7 gives the shipped file.
+
+    Returns
+    -------
+    pandas.DataFrame
+        6000 rows: ``time_ms`` [ms], ``gyro deg/h`` [°/h], ``temp_counts`` [counts].
+
+    Examples
+    --------
+    >>> df = make_tvac_log()
+    >>> df.shape
+    (6000, 3)
+    >>> float(df["temp_counts"].iloc[0]) * TVAC_COUNTS_GAIN_C + TVAC_COUNTS_OFFSET_C  # [°C]
+    25.0
     """
     rng = np.random.default_rng(seed)
     starts_s = np.arange(24) * 300.0 + rng.uniform(-5.0, 5.0, 24)

@@ -1,6 +1,6 @@
 """Defaults and names the command line shows in its help, kept free of numpy.
 
-``thermocal --help`` registers every command without importing the maths (issue 17): the
+``thermocal --help`` registers every command without importing the maths: the
 values a command's help or defaults show live here, and the modules that use them import them
 from here (one definition each)."""
 
@@ -13,11 +13,14 @@ DEFAULT_CHUNK_ROWS: Final = 500_000
 for a 37-term polynomial)."""
 
 WEAK_CORRELATION_LIMIT: Final = 0.4
-"""Seed 000 / SPEC §5: a validation test is weakly correlated with the modelling test when
-r < 0.4."""
+"""A validation test is weakly correlated with the modelling test when the correlation
+coefficient of their temperature histories is r < 0.4 (*A modelling and validation method for
+the temperature compensation model of a ring-laser gyroscope*, a Chinese invention patent
+published 2017)."""
 
 DEFAULT_AVERAGING_S: Final = 100.0
-"""Averaging time of the stability figures [s] (SPEC §1: 10 s or 100 s averages)."""
+"""Averaging time of the stability figures [s] (10 s or 100 s averages, as the ring-laser-gyro
+and fibre-optic-gyro test methods state bias stability)."""
 
 POSE_WINDOW_S: Final = 0.5
 POSE_STILL_THRESHOLD: Final = 5.0
@@ -61,7 +64,25 @@ ALLOW_MOTION: Final = "--allow-motion"
 
 
 def overrides_of(allow_narrow: bool, allow_motion: bool) -> tuple[str, ...]:
-    """The adequacy overrides a command was given (:mod:`thermocal.adequacy`)."""
+    """The adequacy overrides a command was given (:mod:`thermocal.adequacy`).
+
+    Parameters
+    ----------
+    allow_narrow : bool
+        Whether the sweep's adequacy tests were overridden (``--allow-narrow``).
+    allow_motion : bool
+        Whether the stillness test was overridden (``--allow-motion``).
+
+    Returns
+    -------
+    tuple of str
+        The options given, in that order.
+
+    Examples
+    --------
+    >>> overrides_of(True, False)
+    ('--allow-narrow',)
+    """
     return tuple(o for o, on in ((ALLOW_NARROW, allow_narrow), (ALLOW_MOTION, allow_motion)) if on)
 
 

@@ -2,8 +2,8 @@
 
 Every problem with the user's input is a :class:`ThermocalInputError` (or a
 subclass) whose message names the file, column or row at fault.  The command line
-turns these into exit status 2 and a one-line ``error: ...`` on stderr
-(INTERFACE.md, "Common rules").
+turns these into exit status 2 and a one-line ``error: ...`` on stderr (the common rules
+of the command line); anything else is an internal failure, exit status 1.
 """
 
 from __future__ import annotations
@@ -60,8 +60,20 @@ class ParameterError(ThermocalInputError):
         super().__init__(self.named(parameter))
 
     def named(self, name: str, other: Callable[[str], str] | None = None) -> str:
-        """The message with ``name`` (an option, ``--rate``) for the parameter, and
-        ``other(p)`` for each of :attr:`others` (their own names without ``other``)."""
+        """The message with ``name`` (an option, ``--rate``) for the parameter.
+
+        Parameters
+        ----------
+        name : str
+            What to show for the parameter (``--rate``).
+        other : callable, optional
+            What to show for each of :attr:`others` (``other(p)``; their own names
+            without it).
+
+        Returns
+        -------
+        str
+        """
         text = self.template.replace("{name}", name)
         for p in self.others:
             text = text.replace("{" + p + "}", other(p) if other is not None else p)

@@ -1,4 +1,4 @@
-"""The one gate between names from files or options and generated code (issue 26, item 3).
+"""The one gate between names from files or options and generated code.
 
 A column, channel, temperature or triad name, a ``--name`` prefix or a string field of a
 model file can hold anything: ``*/``, a newline followed by ``#error``, a backslash that
@@ -104,6 +104,46 @@ def c_identifier(
     ``used`` maps the identifiers given out so far to their originals (updated): a second
     original mapping to an identifier already taken is a :class:`ThermocalInputError`
     naming both (``what`` says what they are: channel, triad, …).
+
+    Parameters
+    ----------
+    name : str
+        Any string: a column, channel, triad or model name, a prefix.
+    used : MutableMapping[str, str], optional
+        The identifiers given out so far, mapped to their originals; updated.
+    what : str
+        What the names are, for the message (``"channel"``, ``"triad"``).
+    max_len : int
+        Longest identifier returned [characters].
+
+    Returns
+    -------
+    str
+        The identifier.
+
+    Raises
+    ------
+    ThermocalInputError
+        With ``used``: another original already maps to the same identifier (the message names
+        both and says how to rename).
+
+    References
+    ----------
+    ISO/IEC 9899:1999, *Programming languages — C*, §5.2.4.1 (63 significant initial
+    characters), §6.4.1 (keywords), §7.1.3
+    (reserved identifiers).
+
+    Examples
+    --------
+    >>> c_identifier("rlg poly-v2"), c_identifier("2nd axis"), c_identifier("int")
+    ('rlg_poly_v2', 'm_2nd_axis', 'c_int')
+    >>> used = {}
+    >>> c_identifier("T-1", used, what="channel")
+    't_1'
+    >>> c_identifier("T 1", used, what="channel")
+    Traceback (most recent call last):
+    ...
+    thermocal.errors.ThermocalInputError: channels 'T-1' and 'T 1' both become ...
     """
     text = unicodedata.normalize("NFKD", str(name))
     parts: list[str] = []
@@ -144,7 +184,7 @@ C_COMMENT_ASCII = {
     "ω": "omega", "Ω": "Omega", "√": "sqrt", "Δ": "d",
 }  # fmt: skip
 """The symbols of thermocal's own text (units, formulas) spelled in ASCII in generated C
-comments (issue 38: ``48.1\u00b0`` in a header); other non-ASCII is escaped."""
+comments (``48.1\u00b0`` would reach a header as a non-ASCII byte); other non-ASCII is escaped."""
 
 
 def c_comment(text: object) -> str:
@@ -156,6 +196,26 @@ def c_comment(text: object) -> str:
     ``*/`` → ``* /`` and ``/*`` → ``/ *`` until neither is left; a backslash followed only
     by spaces up to the end → ``\\x5c`` (no line splice); a ``*``, ``/`` or ``?`` at either
     end gets a space on that side (so the surrounding text cannot complete one).  Idempotent.
+
+    Parameters
+    ----------
+    text : object
+        Any value; ``str(text)`` is made safe.
+
+    Returns
+    -------
+    str
+        Printable ASCII that cannot end, open or splice a comment.
+
+    References
+    ----------
+    ISO/IEC 9899:1999, *Programming languages — C*, §5.1.1.2 (line splicing), §5.2.1.1
+    (trigraphs), §6.4.9 (comments).
+
+    Examples
+    --------
+    >>> c_comment("48.1 °C */ #error")
+    '48.1 degC * / #error'
     """
     out: list[str] = []
     text = str(text)
@@ -197,7 +257,28 @@ def one_line(text: object) -> str:
     :data:`_LINE_UNSAFE_CATEGORIES` → ``\\xNN`` (below U+0100), ``\\uXXXX`` or
     ``\\UXXXXXXXX``; everything else kept (``°``, ``σ`` are printable).  No reader can then
     find a line break, so no name can end a comment and start a key (YAML 1.2 §5.4, §6.6:
-    a comment ends at the line break).  Idempotent."""
+    a comment ends at the line break).  Idempotent.
+
+    Parameters
+    ----------
+    text : object
+        Any value; ``str(text)`` is escaped.
+
+    Returns
+    -------
+    str
+        One line of printable text.
+
+    References
+    ----------
+    *YAML Ain't Markup Language (YAML) Version 1.2*, §5.4 (line break characters), §6.6
+    (comments).
+
+    Examples
+    --------
+    >>> print(one_line("gyro x" + chr(10) + "#error"))
+    gyro x\\x0a#error
+    """
     out: list[str] = []
     for ch in str(text):
         if unicodedata.category(ch) in _LINE_UNSAFE_CATEGORIES:
@@ -214,7 +295,28 @@ def one_line(text: object) -> str:
 def c_string(text: object) -> str:
     """A C string literal (with its quotes) holding the UTF-8 bytes of ``text``:
     ``\\`` ``"`` and ``?`` escaped (``\\?``: no trigraph), every byte outside printable ASCII
-    as a three-digit octal escape (``°`` → ``\\302\\260``)."""
+    as a three-digit octal escape (``°`` → ``\\302\\260``).
+
+    Parameters
+    ----------
+    text : object
+        Any value; the UTF-8 bytes of ``str(text)`` are written.
+
+    Returns
+    -------
+    str
+        The literal, quotes included.
+
+    References
+    ----------
+    ISO/IEC 9899:1999, *Programming languages — C*, §6.4.5 (string literals), §6.4.4.4 (octal
+    escape sequences).
+
+    Examples
+    --------
+    >>> print(c_string('say "hi"??'))
+    "say \\"hi\\"\\?\\?"
+    """
     out = ['"']
     for b in str(text).encode("utf-8", "surrogatepass"):
         ch = chr(b)
@@ -242,7 +344,25 @@ def c_code_only(text: str, *, keep_literals: bool = False) -> str:
     literal by ``""`` (kept as written with ``keep_literals``; newlines kept), for checks on
     the code itself; a
     :class:`ThermocalInputError` when a comment or literal is not closed or a comment holds
-    ``/*``."""
+    ``/*``.
+
+    Parameters
+    ----------
+    text : str
+        C source text.
+    keep_literals : bool
+        Keep string and character literals as written instead of ``""``.
+
+    Returns
+    -------
+    str
+        The code with comments blanked.
+
+    Raises
+    ------
+    ThermocalInputError
+        A comment or literal is not closed, or a comment holds ``/*``.
+    """
     out: list[str] = []
     i, n = 0, len(text)
     while i < n:
@@ -281,7 +401,32 @@ def check_generated_c(text: str, what: str = "generated C") -> None:
     character outside printable ASCII and newline, a trigraph, a line splice (backslash
     before a newline, §5.1.1.2), an open comment or literal, ``/*`` inside a comment, or a
     preprocessor line other than those the generators write (``#ifndef NAME``, ``#define
-    NAME …``, ``#endif``, ``#include "name.h"``)."""
+    NAME …``, ``#endif``, ``#include "name.h"``).
+
+    Parameters
+    ----------
+    text : str
+        The whole generated file.
+    what : str
+        How the message names it (the file's name).
+
+    Raises
+    ------
+    ThermocalInputError
+        The text breaks one of the rules above; the message says which.
+
+    References
+    ----------
+    ISO/IEC 9899:1999, *Programming languages — C*, §5.1.1.2, §5.2.1.1, §6.4.9, §6.10.
+
+    Examples
+    --------
+    >>> check_generated_c("int x = 1; /* fine */")
+    >>> check_generated_c("int x = 1; /* a */ */", what="gyro.c")
+    Traceback (most recent call last):
+    ...
+    thermocal.errors.ThermocalInputError: gyro.c: '*/' outside a comment
+    """
     bad = next((c for c in text if not (" " <= c <= "~" or c == "\n")), None)
     if bad is not None:
         raise ThermocalInputError(f"{what}: character {bad!r} outside printable ASCII")
@@ -301,7 +446,25 @@ def check_generated_c(text: str, what: str = "generated C") -> None:
 def c_names(text: str, prefix: str) -> set[str]:
     """Identifiers of C ``text`` (outside comments and literals) that begin with
     ``prefix + '_'`` in either case: the names a generated module declares under its
-    prefix."""
+    prefix.
+
+    Parameters
+    ----------
+    text : str
+        C source text.
+    prefix : str
+        The module's prefix, without the trailing ``_``.
+
+    Returns
+    -------
+    set of str
+        The identifiers found, as written.
+
+    Examples
+    --------
+    >>> sorted(c_names("float gyro_x(float t); /* gyro_y */ int other;", "GYRO"))
+    ['gyro_x']
+    """
     lo = prefix.lower() + "_"
     return {
         w

@@ -1,5 +1,5 @@
 """Where a command may write: the one gate every output passes before anything is written
-(issue 26 item 1; INTERFACE.md common rules, "nothing is ever written over an input file").
+(the common rule of the command line: nothing is ever written over an input file).
 
 :func:`check_outputs` refuses (:class:`~thermocal.errors.ThermocalInputError`, exit 2, one
 ``error:`` line naming the output and the input) when
@@ -85,9 +85,28 @@ def _link_chain(path: Path) -> list[Path]:
 
 
 def special_reason(path: str | Path) -> str | None:
-    """Why ``path`` is no place for an output (it, or a link it leads through, lies under
-    :data:`SPECIAL_ROOTS`, or it is a FIFO, a device or a socket), or None.  Only
-    ``stat`` and ``readlink`` are used: a FIFO is never opened."""
+    """Why ``path`` is no place for an output, or None.
+
+    Only ``stat`` and ``readlink`` are used: a FIFO is never opened.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        The output's path, existing or not.
+
+    Returns
+    -------
+    str or None
+        ``"it is under /dev, not a storage file system"`` when the path, or a link it leads
+        through, lies under :data:`SPECIAL_ROOTS`; ``"it is a FIFO"`` (a character or
+        block device, a socket) from :func:`special_mode`; None for a regular file, a
+        directory or nothing there.
+
+    Examples
+    --------
+    >>> special_reason("/dev/null")
+    'it is under /dev, not a storage file system'
+    """
     p = Path(path)
     for hop in _link_chain(p):
         for root in SPECIAL_ROOTS:
@@ -97,8 +116,19 @@ def special_reason(path: str | Path) -> str | None:
 
 
 def special_mode(p: Path) -> str | None:
-    """``"it is a FIFO"`` (a character or block device, a socket) from ``stat`` alone, or
-    None (a regular file, a directory, nothing there)."""
+    """What kind of special file ``p`` is, from ``stat`` alone (never opened).
+
+    Parameters
+    ----------
+    p : pathlib.Path
+        The path to look at.
+
+    Returns
+    -------
+    str or None
+        ``"it is a FIFO"``, ``"it is a character device"``, ``"it is a block device"`` or
+        ``"it is a socket"``; None for a regular file, a directory or nothing there.
+    """
     try:
         mode = os.stat(p).st_mode
     except (OSError, ValueError):
@@ -115,10 +145,24 @@ def special_mode(p: Path) -> str | None:
 
 
 def refuse_special_input(path: str | Path, what: str = "input file") -> None:
-    """Raise :class:`ThermocalInputError` naming ``path`` when it is a FIFO, a device or a
-    socket (``stat`` only: never opened).  Reading one blocks until a writer comes, or
-    never ends (``/dev/zero``): every reader of a user's path asks here first (issue 39
-    item 10: a FIFO as a fleet's modelling file hung ``fleet``)."""
+    """Refuse an input that is a FIFO, a device or a socket (``stat`` only: never opened).
+
+    Reading one blocks until a writer comes, or never ends (``/dev/zero``): every reader of
+    a user's path asks here first (a FIFO given as a fleet's modelling file would hang
+    ``thermocal fleet``).
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        The input's path.
+    what : str
+        How the message names the input (``"input file"``).
+
+    Raises
+    ------
+    ThermocalInputError
+        ``path`` is a special file; the message names it.
+    """
     why = special_mode(Path(path))
     if why is not None:
         raise ThermocalInputError(
@@ -128,7 +172,20 @@ def refuse_special_input(path: str | Path, what: str = "input file") -> None:
 
 
 def refuse_special(path: str | Path, what: str = "the output") -> None:
-    """Raise when ``path`` is a special file (:func:`special_reason`)."""
+    """Refuse to write an output onto a special file (:func:`special_reason`).
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        The output's path.
+    what : str
+        How the message names the output (``"the output"``).
+
+    Raises
+    ------
+    ThermocalInputError
+        ``path`` is, or leads through a link to, a special file.
+    """
     why = special_reason(path)
     if why is not None:
         raise ThermocalInputError(f"{path}: refusing to write {what} there: {why}")
@@ -182,12 +239,35 @@ def check_outputs(
     replaced: Iterable[str | Path] = (),
     what: str = "the output",
 ) -> None:
-    """Refuse a run, before anything is written, whose outputs would write, replace or
-    delete one of its ``inputs`` or land on a special file (module docstring).
+    """Refuse outputs that would write, replace or delete an input, or land on a special file.
 
-    ``outputs``: files the command writes (replacing any file of that name); ``dirs``:
-    folders it creates or writes files into; ``replaced``: folders it replaces or deletes
-    (they may hold no input).  ``what`` names the outputs in the message."""
+    Parameters
+    ----------
+    outputs, inputs : iterable of str or pathlib.Path
+        Files the run writes (replacing any of that name); files and station folders it reads.
+    dirs, replaced : iterable of str or pathlib.Path
+        Folders the run writes files into (they may hold inputs); folders it replaces or
+        deletes (they may hold no input).
+    what : str
+        How the message names the outputs.
+
+    Raises
+    ------
+    ThermocalInputError
+        A rule is broken; the message names the output and the input.
+
+    Examples
+    --------
+    >>> import pathlib, tempfile
+    >>> with tempfile.TemporaryDirectory() as tmp:
+    ...     run = pathlib.Path(tmp, "run.csv")
+    ...     check_outputs([pathlib.Path(tmp, "out.csv")], [run])  # a new file: passes
+    ...     try:
+    ...         check_outputs([run], [run])
+    ...     except ThermocalInputError as err:
+    ...         print(str(err).replace(tmp, "TMP"))
+    TMP/run.csv: refusing to write over the input file TMP/run.csv
+    """
     ins = _inputs(inputs)
     by_inode: dict[tuple[int, int] | None, _Input] = {
         i.inode: i for i in ins if i.inode is not None
@@ -260,24 +340,76 @@ list ``=``, ``+``, ``-``, ``@``, TAB and CR."""
 
 
 def formula_risk(value: object) -> bool:
-    """True when ``value`` is a string whose first character is in
-    :data:`FORMULA_TRIGGERS` (a spreadsheet would run it as a formula)."""
+    """Whether a spreadsheet would run ``value`` as a formula.
+
+    Parameters
+    ----------
+    value : object
+        A cell or a column name.
+
+    Returns
+    -------
+    bool
+        True when ``value`` is a string whose first character is in
+        :data:`FORMULA_TRIGGERS`.
+
+    References
+    ----------
+    OWASP, "CSV Injection", https://owasp.org/www-community/attacks/CSV_Injection.
+
+    Examples
+    --------
+    >>> formula_risk("=1+1"), formula_risk("gyro_x"), formula_risk(-1.5)
+    (True, False, False)
+    """
     return isinstance(value, str) and value[:1] in FORMULA_TRIGGERS
 
 
 def neutralise_cell(value: object) -> object:
-    """``value`` with a ``'`` in front when :func:`formula_risk` (OWASP's mitigation: the
-    spreadsheet shows the text, the apostrophe is its "text" marker); anything else, numbers
-    included, unchanged.  For tables meant for spreadsheets only: a program reading the
-    file sees the apostrophe."""
+    """A cell made safe for a spreadsheet: a ``'`` in front when :func:`formula_risk`.
+
+    OWASP's mitigation: the spreadsheet shows the text, the apostrophe is its "text"
+    marker.  For tables meant for spreadsheets only: a program reading the file sees the
+    apostrophe.
+
+    Parameters
+    ----------
+    value : object
+        A cell.
+
+    Returns
+    -------
+    object
+        ``"'" + value`` for a risky string; anything else, numbers included, unchanged.
+
+    Examples
+    --------
+    >>> neutralise_cell("@SUM(A1)"), neutralise_cell(3.0)
+    ("'@SUM(A1)", 3.0)
+    """
     return "'" + value if isinstance(value, str) and formula_risk(value) else value
 
 
 def warn_formula_names(path: str | Path, names: Iterable[str], what: str = "column") -> None:
-    """Warn (:class:`~thermocal.errors.ThermocalWarning`) when ``path`` is a CSV and one of
-    ``names`` begins with a formula trigger (:func:`formula_risk`): the name is written as
-    it is, since a program reading the file must find it again, but a spreadsheet opening
-    the CSV would run it (OWASP "CSV Injection")."""
+    """Warn when a CSV output will hold a name a spreadsheet would run as a formula.
+
+    The name is written as it is, since a program reading the file must find it again, but
+    a spreadsheet opening the CSV would run it (OWASP "CSV Injection").
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        The output; only a ``.csv`` is concerned.
+    names : iterable of str
+        The column (or other) names written into it.
+    what : str
+        How the warning names them (``"column"``).
+
+    Warns
+    -----
+    ThermocalWarning
+        One of ``names`` begins with a character of :data:`FORMULA_TRIGGERS`.
+    """
     import warnings
 
     from thermocal.errors import ThermocalWarning
@@ -312,7 +444,23 @@ __all__ = [
 
 
 def sidecar_path(path: str | Path) -> Path:
-    """``FILE.meta.json`` beside ``FILE``."""
+    """The metadata sidecar of a recording: ``FILE.meta.json`` beside ``FILE``.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        The recording.
+
+    Returns
+    -------
+    pathlib.Path
+        The sidecar's path (it may not exist).
+
+    Examples
+    --------
+    >>> sidecar_path("runs/a.csv").as_posix()
+    'runs/a.csv.meta.json'
+    """
     p = Path(path)
     return p.with_name(p.name + ".meta.json")
 

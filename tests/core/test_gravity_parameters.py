@@ -1,6 +1,6 @@
 """The gravity of ``fit --gravity-axis`` as a library call: its refusals name the library's
 parameters (``gravity``, ``gravity_axis``); the command line shows its options in their place
-(``tests/test_gravity_tref.py`` checks the command line's texts)."""
+(``tests/core/test_gravity_tref.py`` checks the command line's texts)."""
 
 from __future__ import annotations
 

@@ -3,7 +3,7 @@ in order in ONE namespace (as a notebook runs its cells), in a temporary folder 
 repository's ``tests/`` as the root does; what each prints is compared number by number with
 the ``text`` block after it, and the calibration it prints with imucal 2.6.0's calibration of
 the same session (``tests/data/imucal_ferraris``, MIT; the reference numbers are those of
-``tests/test_multipos_imucal.py``, computed with imucal in a scratch venv; imucal is no
+``tests/multipos/test_multipos_imucal.py``, computed with imucal in a scratch venv; imucal is no
 dependency of thermocal).
 """
 
@@ -15,20 +15,13 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from test_tutorials import (
-    ARCSEC,
-    BLOCK,
-    IMUCAL_KA_RA,
-    IMUCAL_KG_RG,
-    MISALIGNMENT_RC,
-    ROOT,
-    TUTORIALS,
-    _numbers,
-)
+
+from test_tutorials import ARCSEC, IMUCAL_KA_RA, IMUCAL_KG_RG, MISALIGNMENT_RC
+from tutorial_pages import BLOCK, ROOT, TUTORIALS, _numbers
 
 PAGE = TUTORIALS / "notebook-multipos.md"
 
-# imucal 2.6.0's b_g of the same session [deg/s] (tests/test_multipos_imucal.py)
+# imucal 2.6.0's b_g of the same session [deg/s] (tests/multipos/test_multipos_imucal.py)
 IMUCAL_B_G = np.array([-0.5996686296674446, -0.36984313466306884, 0.0587739354671091])
 
 

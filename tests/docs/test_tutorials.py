@@ -9,80 +9,20 @@ its own example session (``tests/data/imucal_ferraris``, MIT).
 
 from __future__ import annotations
 
-import contextlib
-import io
 import math
-import re
-import shlex
-from pathlib import Path
 
 import numpy as np
 import pytest
 
-from thermocal.cli import main
+from tutorial_pages import ROOT, TUTORIALS, _numbers, _run_in_scratch
 
-ROOT = Path(__file__).resolve().parents[2]
-TUTORIALS = ROOT / "docs" / "tutorials"
 STABLE32 = ROOT / "tests" / "data" / "stable32_phasedat"
-NUMBER = re.compile(r"[-+]?\d+(?:\.\d+)?(?:e[-+]?\d+)?")
-BLOCK = re.compile(r"^```(\w+)\n(.*?)^```$", re.MULTILINE | re.DOTALL)
-
-
-def _run_block(lang: str, body: str) -> str:
-    """What a ``console`` block's ``$ thermocal …`` lines or a ``python`` block print."""
-    out = io.StringIO()
-    if lang == "python":
-        with contextlib.redirect_stdout(out):
-            exec(compile(body, "tutorial", "exec"), {})
-        return out.getvalue()
-    for line in body.splitlines():
-        assert line.startswith("$ thermocal "), line
-        err = io.StringIO()
-        with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
-            code = main(shlex.split(line[len("$ thermocal ") :]))
-        assert code == 0, err.getvalue()
-    return out.getvalue()
-
-
-def _run_page(page: Path) -> list[tuple[str, str]]:
-    """(printed, shown) for every executable block of the page, in order."""
-    blocks = [(m.group(1), m.group(2)) for m in BLOCK.finditer(page.read_text(encoding="utf-8"))]
-    pairs = []
-    for i, (lang, body) in enumerate(blocks):
-        if lang in ("console", "python"):
-            shown = next(b for la, b in blocks[i + 1 :] if la == "text")
-            pairs.append((_run_block(lang, body), shown))
-    return pairs
-
-
-def _numbers(text: str) -> list[float]:
-    return [float(v) for v in NUMBER.findall(text)]
 
 
 def _stable32(name: str) -> np.ndarray:
     """Stable32's printed rows: AF, τ, terms, α, low, deviation, high."""
     lines = (STABLE32 / name).read_text(encoding="latin-1").splitlines()
     return np.array([[float(v) for v in ln.split()] for ln in lines if ln.strip() and ln[0] != "#"])
-
-
-def fresh_cli(mp: pytest.MonkeyPatch) -> None:
-    """The page runs as in a new shell: no ``COLUMNS`` left by an earlier test and the
-    CLI's consoles built anew (a module fixture runs before the autouse console reset of
-    ``tests/conftest.py``, so in a parallel run a console of another test's width printed
-    the page's tables cut short)."""
-    from thermocal.cli import common
-
-    mp.delenv("COLUMNS", raising=False)
-    for console in (common.stdout, common.stderr):
-        mp.setattr(console, "_console", None)
-
-
-def _run_in_scratch(tmp: Path, name: str) -> list[tuple[str, str]]:
-    (tmp / "tests").symlink_to(ROOT / "tests", target_is_directory=True)
-    with pytest.MonkeyPatch.context() as mp:
-        fresh_cli(mp)
-        mp.chdir(tmp)
-        return _run_page(TUTORIALS / name)
 
 
 @pytest.fixture(scope="module")
@@ -104,6 +44,7 @@ def test_every_tutorial_is_executed_here() -> None:
         "notebook-multipos.md",  # tests/docs/test_tutorial_notebook_multipos.py
         "production-batch.md",  # tests/docs/test_tutorials_b.py
         "stability-stable32.md",
+        "station.md",  # tests/docs/test_tutorial_station.py
     ]
 
 
@@ -118,7 +59,7 @@ def test_stability_tutorial_prints_what_the_page_shows(
 
 def test_stability_tutorial_numbers_are_stable32s(stability_page: list[tuple[str, str]]) -> None:
     """Values to Stable32's five printed digits, bounds to 2e-3 (its EDF rounding), terms and
-    α exactly: the tolerances of tests/test_stability_reference.py."""
+    α exactly: the tolerances of tests/stability/test_stability_reference.py."""
     table = [_numbers(line) for line in stability_page[0][0].splitlines() if line.startswith("│")]
     got = np.array(table)  # τ, oadev, low, high, edf, α, terms
     ref = _stable32("phase_dat_oadev_octave.txt")
@@ -149,7 +90,7 @@ def test_multipos_tutorial_prints_what_the_page_shows(
 
 
 # imucal 2.6.0's FerrarisCalibration of the same session, K_g·R_g and K_a·R_a (computed in a
-# scratch venv as tests/test_multipos_imucal.py's docstring says; imucal is no dependency)
+# scratch venv as tests/multipos/test_multipos_imucal.py's docstring says; imucal is no dependency)
 IMUCAL_KG_RG = np.array([
     [1.0279030921108503, -0.00046689722733542574, -0.006590606955485163],
     [-0.00021830076271155843, 0.982423943314377, -0.0027347345695309115],

@@ -21,9 +21,9 @@ from typing import Any
 import numpy as np
 import pandas as pd
 import pytest
-from test_tutorials import TUTORIALS, _numbers, _run_in_scratch
 
 from thermocal.cli import main
+from tutorial_pages import TUTORIALS, _numbers, _run_in_scratch
 
 Pages = tuple[list[tuple[str, str]], Path]
 

@@ -23,9 +23,9 @@ from types import ModuleType
 import numpy as np
 import pandas as pd
 import pytest
-from test_tutorials import BLOCK, ROOT, TUTORIALS, _numbers, fresh_cli
 
 from thermocal.cli import main
+from tutorial_pages import BLOCK, ROOT, TUTORIALS, _numbers, fresh_cli
 
 Page = list[tuple[str, str, list[int]]]
 

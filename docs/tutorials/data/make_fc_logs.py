@@ -4,9 +4,9 @@ ULog: ``sensor_gyro`` and ``sensor_accel``, instance 0) and ``sweep.bin`` (ArduP
 known cubic gyro and accelerometer biases, white noise and a few spikes.
 
 Deterministic (NumPy's PCG64, seed 40): rerunning it rewrites the same bytes, which the test
-suite checks.  The file writers are the test suite's own (``tests/ulog_writer.py``, from the
-ULog format description at docs.px4.io; ``tests/dataflash_writer.py``, from ArduPilot's
-LogStructure.h), so the logs are not made by the library that reads them.
+suite checks.  The file writers are the test suite's own (``tests/helpers/ulog_writer.py``,
+from the ULog format description at docs.px4.io; ``tests/helpers/dataflash_writer.py``, from
+ArduPilot's LogStructure.h), so the logs are not made by the library that reads them.
 
 Run from the repository's root: ``python docs/tutorials/data/make_fc_logs.py``.
 """
@@ -19,7 +19,7 @@ from pathlib import Path
 import numpy as np
 
 HERE = Path(__file__).resolve().parent
-sys.path.insert(0, str(HERE.parents[2] / "tests"))
+sys.path.insert(0, str(HERE.parents[2] / "tests" / "helpers"))
 
 from dataflash_writer import imu_log  # noqa: E402
 from ulog_writer import SENSOR_FIELDS, ulog_bytes  # noqa: E402

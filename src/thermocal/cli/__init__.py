@@ -1,9 +1,9 @@
-"""thermocal's command line (INTERFACE.md).
+"""thermocal's command line.
 
 Each command lives in its own module under :mod:`thermocal.cli` and registers on
 :data:`thermocal.cli.application.app`; :func:`main` is the console entry point.  A run imports only
 the module of the command it runs (:data:`COMMANDS`), so ``thermocal --version`` and
-``import thermocal.cli`` load neither pandas, pyarrow, scipy nor matplotlib (issue 17).
+``import thermocal.cli`` load neither pandas, pyarrow, scipy nor matplotlib.
 ``--help`` and an unknown command register every command module; those import only typer,
 the option declarations (:mod:`thermocal.cli.common`) and :mod:`thermocal.defaults` at their
 top, and the maths through :class:`thermocal._lazy.LazyModule` when a command runs, so the
@@ -116,7 +116,17 @@ def main(argv: list[str] | None = None) -> int:
     """Run the command line; returns the exit status (0 ok, 2 bad input, 1 internal).
 
     Usage errors (unknown option, missing argument) print one ``error: ...`` line
-    on stderr and return 2, as INTERFACE.md asks.
+    on stderr and return 2, as the common rules of the command line ask.
+
+    Parameters
+    ----------
+    argv : list of str, optional
+        The arguments (default ``sys.argv[1:]``).
+
+    Returns
+    -------
+    int
+        The exit status.
     """
     args = list(sys.argv[1:] if argv is None else argv)
     _register(_modules_for(args))

@@ -1,6 +1,6 @@
 """Shared pieces of the command line: reading options, error handling, output.
 
-INTERFACE.md common rules implemented here:
+The common rules of the command line, implemented here:
 
 * ``--json`` prints one JSON object on stdout and nothing else there
   (:func:`emit`); NaN and infinities become ``null``.
@@ -16,6 +16,7 @@ import json
 import math
 import os
 import sys
+import typing
 import warnings
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
@@ -64,7 +65,7 @@ class _LazyConsole:
     def real(self) -> Console:
         """The console itself (built now if not yet).  Outside a terminal (a pipe, a file)
         and without ``COLUMNS`` set, it is :data:`WIDTH_OFF_TERMINAL` wide, so that a table
-        wider than 80 columns is printed whole rather than its names cut (issue 38)."""
+        wider than 80 columns is printed whole rather than its names cut."""
         if self._console is None:
             from rich.console import Console
 
@@ -94,7 +95,7 @@ stderr: Console = _LazyConsole(stderr=True, soft_wrap=True)  # type: ignore[assi
 
 # --- reusable option types ----------------------------------------------------------
 # Defaults are given where a command uses an alias (``time_unit: TimeUnitOpt = "s"``);
-# each command keeps the defaults INTERFACE.md documents for it.
+# each command keeps the defaults its help documents.
 
 FileArg = Annotated[Path, typer.Argument(help="Recording (CSV or Parquet).", show_default=False)]
 ModelArg = Annotated[
@@ -225,7 +226,22 @@ OutOpt = Annotated[Path, typer.Option("-o", "--output", help="Output file.")]
 
 def parse_temp_conversion(text: str) -> units.TemperatureConversion:
     """``"0.0625,-50"`` → gain [°C/count] 0.0625, offset [°C] −50; ``"0.0625,-50,int16"``
-    for signed 16-bit counts stored unsigned (:class:`thermocal.units.TemperatureConversion`)."""
+    for signed 16-bit counts stored unsigned (:class:`thermocal.units.TemperatureConversion`).
+
+    Parameters
+    ----------
+    text : str
+        The option's text.
+
+    Returns
+    -------
+    TemperatureConversion
+
+    Raises
+    ------
+    ThermocalInputError
+        Not ``GAIN,OFFSET[,int16]`` with finite numbers.
+    """
     return units.temperature_conversion(text, "--temp-conversion")
 
 
@@ -233,12 +249,23 @@ def parse_temp_conversion(text: str) -> units.TemperatureConversion:
 
 
 def handle_errors(fn: Callable[P, R]) -> Callable[P, R]:
-    """Map exceptions to INTERFACE.md exit statuses.
+    """Map exceptions to the exit statuses of the command line.
 
     :class:`ThermocalInputError` (and ``FileNotFoundError``) → ``error: ...``, exit 2.
     Anything else → ``error: internal: ...``, exit 1 (traceback only when the
     environment variable ``THERMOCAL_DEBUG`` is set).  thermocal warnings are
     printed as one ``warning: ...`` line each on stderr.
+
+    Parameters
+    ----------
+    fn : callable
+        The command's function.
+
+    Returns
+    -------
+    callable
+        ``fn`` wrapped: exit 2 with one ``error:`` line for the user's errors, 1 for thermocal's
+        own.
     """
 
     @functools.wraps(fn)
@@ -255,7 +282,7 @@ def handle_errors(fn: Callable[P, R]) -> Callable[P, R]:
                 raise typer.Exit(report_interrupted()) from None
             except Exception as exc:  # the mapping the fleet uses too (error_text)
                 _show_warnings(caught)
-                text, users = error_text(exc)
+                text, users = error_text(exc, _command_options(fn))
                 if not users and os.environ.get("THERMOCAL_DEBUG"):
                     raise
                 print(f"error: {text}", file=sys.stderr)
@@ -264,6 +291,23 @@ def handle_errors(fn: Callable[P, R]) -> Callable[P, R]:
         return result
 
     return wrapper
+
+
+def _command_options(fn: Callable[..., Any]) -> dict[str, str]:
+    """``{parameter: option}`` of a command function (``rate_hz`` → ``--rate-hz`` for
+    ``simulate``), read from its ``Annotated[..., typer.Option("--name")]`` declarations;
+    empty when they cannot be read."""
+    try:
+        hints = typing.get_type_hints(fn, include_extras=True)
+    except Exception:  # a courtesy for the message: never fails the error path
+        return {}
+    out: dict[str, str] = {}
+    for name, hint in hints.items():
+        for info in getattr(hint, "__metadata__", ()):
+            decls = [d for d in getattr(info, "param_decls", None) or () if d.startswith("--")]
+            if isinstance(info, typer.models.OptionInfo):
+                out[name] = decls[0] if decls else "--" + name.replace("_", "-")
+    return out
 
 
 def _show_warnings(caught: list[warnings.WarningMessage]) -> None:
@@ -276,7 +320,17 @@ def _show_warnings(caught: list[warnings.WarningMessage]) -> None:
 
 
 def emit(obj: Any, as_json: bool, human: Callable[[], None] | None = None) -> None:
-    """Print ``obj`` as one JSON object (``--json``) or call ``human`` for rich output."""
+    """Print ``obj`` as one JSON object (``--json``) or call ``human`` for rich output.
+
+    Parameters
+    ----------
+    obj : object
+        What to print.
+    as_json : bool
+        Print JSON instead of text.
+    human : callable, optional
+        Prints the human output.
+    """
     if as_json:
         sys.stdout.write(json.dumps(jsonable(obj), allow_nan=False) + "\n")
         sys.stdout.flush()
@@ -287,7 +341,19 @@ def emit(obj: Any, as_json: bool, human: Callable[[], None] | None = None) -> No
 
 
 def fmt(x: float | None, digits: int = 4) -> str:
-    """Number for a human table: ``—`` for None/NaN."""
+    """Number for a human table: ``—`` for None/NaN.
+
+    Parameters
+    ----------
+    x : float or None
+        The number.
+    digits : int
+        Significant digits.
+
+    Returns
+    -------
+    str
+    """
     if x is None or (isinstance(x, float) and not math.isfinite(x)):
         return "—"
     return f"{x:.{digits}g}"
@@ -298,6 +364,18 @@ def progress(description: str, total: float | None = None) -> Iterator[Callable[
     """A progress bar on a terminal (stderr), silent otherwise.
 
     Yields ``advance(amount)``.
+
+    Parameters
+    ----------
+    description : str
+        The bar's label.
+    total : float, optional
+        The total (None: no percentage).
+
+    Returns
+    -------
+    contextmanager
+        Yields a function that advances the bar.
     """
     if not sys.stderr.isatty():
         yield lambda _amount: None

@@ -1,6 +1,5 @@
 """``thermocal fleet CONFIG.toml -o DIR [--workers N] [--scheduler ADDRESS] [--force]``:
-one calibration per unit of a production batch (:mod:`thermocal.fleet.batch`; INTERFACE.md
-"Fleet configuration").
+one calibration per unit of a production batch (:mod:`thermocal.fleet.batch`).
 
 Exit status 0 when every unit was calibrated, 4 when some failed (each recorded with its
 error; the others went on), 2 for a bad configuration.

@@ -1,4 +1,4 @@
-"""Ctrl-C on the command line (INTERFACE.md: exit 130 saying what was kept)."""
+"""Ctrl-C on the command line (exit status 130, saying what was kept)."""
 
 from __future__ import annotations
 

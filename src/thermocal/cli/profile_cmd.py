@@ -4,7 +4,7 @@
   (``rlg-modelling``, ``rlg-validation``, ``fog-slow``, ``mems-warmup``,
   ``accel-full-range``) writes the chamber program ``time_s, setpoint_c``.
 * ``thermocal profile correlate A B [--column C] [--json]``: r and
-  ``weakly_correlated`` of two temperature histories (SPEC §5).
+  ``weakly_correlated`` of two temperature histories (r < 0.4).
 * ``thermocal profile design-validation MODEL -o VAL.csv --seed N``, or
   ``thermocal profile rlg-validation --against MODEL --seed N``: a hold profile
   over the modelling range with |r| below the limit.
@@ -148,7 +148,7 @@ def rlg_modelling_cmd(
     dt: DtOpt = 60.0,
     as_json: JsonOpt = False,
 ) -> None:
-    """Seed-000 modelling test: cycles between −20 and +50 °C, then ±2…±0.1 °C/min cycles."""
+    """Ring-laser-gyro modelling test: cycles between −20 and +50 °C, then ±2…±0.1 °C/min cycles."""
     params = _clean(
         {
             "low_c": low,
@@ -189,7 +189,7 @@ def rlg_validation_cmd(
     dt: DtOpt = 60.0,
     as_json: JsonOpt = False,
 ) -> None:
-    """Seed-000 validation test: holds at several temperatures (or designed with --against)."""
+    """Ring-laser-gyro validation test: temperature holds (or designed with --against)."""
     if against is not None:
         if holds is not None:
             raise ThermocalInputError("give either --holds or --against, not both")
@@ -219,7 +219,7 @@ def fog_slow_cmd(
     dt: DtOpt = 60.0,
     as_json: JsonOpt = False,
 ) -> None:
-    """Seed-001 slow drift over 15–42 °C."""
+    """Fibre-optic-gyro slow drift over 15–42 °C."""
     params = _clean(
         {
             "low_c": low,
@@ -250,7 +250,7 @@ def mems_warmup_cmd(
     dt: DtOpt = 60.0,
     as_json: JsonOpt = False,
 ) -> None:
-    """Seed-003 power-on warm-ups at several start temperatures."""
+    """MEMS power-on warm-ups at several start temperatures."""
     params = _clean(
         {
             "start_temps_c": split_floats(starts, "--starts"),
@@ -282,7 +282,7 @@ def accel_full_range_cmd(
     dt: DtOpt = 60.0,
     as_json: JsonOpt = False,
 ) -> None:
-    """Seed-004 full range: −40 °C soak 2 h, 2 °C/min to +60 °C, soak 2 h; points every 5 °C."""
+    """Accelerometer full range: −40 °C 2 h, 2 °C/min to +60 °C, 2 h; points every 5 °C."""
     params = _clean(
         {
             "low_c": low,

@@ -1,4 +1,4 @@
-"""``thermocal station check|run``: the test station (INTERFACE.md, "Test station").
+"""``thermocal station check|run``: the test station.
 
 Thin: parse, call :func:`thermocal.station.check.check_station` or
 :func:`thermocal.station.run.run_station`, print.  pymodbus and pyserial are imported when a

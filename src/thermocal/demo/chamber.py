@@ -1,18 +1,21 @@
-"""The whole chamber workflow of SPEC §4a–§5 on built-in simulated data (``thermocal demo``).
+"""The whole chamber workflow (model, validation, compensation, C) on built-in simulated data
+(``thermocal demo``).
 
 :func:`run_demo` plays what a test lab does with a ring-laser gyro that has four
-temperature sensors (seed 000):
+temperature sensors, as *A modelling and validation method for the temperature compensation
+model of a ring-laser gyroscope*
+(a Chinese invention patent, 2017) describes:
 
-1. **Profiles** — a shortened seed-000 modelling profile (a −20…+50 °C cycle
+1. **Profiles** — a shortened modelling profile of the patent (a −20…+50 °C cycle
    and ramps at ±2, ±1, ±0.5 °C/min; :func:`thermocal.profiles.rlg_modelling`)
    and a validation hold profile designed to be weakly correlated with it
-   (:func:`thermocal.profiles.design_validation_profile`, r < 0.4, SPEC §5).
+   (:func:`thermocal.profiles.design_validation_profile`, r < 0.4).
 2. **Simulation** — both runs of the ``rlg`` preset at 1 Hz
    (:mod:`thermocal.simulate`, scenarios ``rlg-modelling`` and
    ``rlg-validation``; separate turn-ons and noise), written as Parquet with
    their truth JSON.
-3. **Fit** — the seed's 37-term model (per sensor T, T², T³, Ṫ, Ṫ², Ṫ³, TṪ,
-   (TṪ)², (TṪ)³ and a constant; SPEC §4a) and a term-selected model of the same
+3. **Fit** — the patent's 37-term model (per sensor T, T², T³, Ṫ, Ṫ², Ṫ³, TṪ,
+   (TṪ)², (TṪ)³ and a constant) and a term-selected model of the same
    family, both saved as model files.
 4. **Validation** of both on the validation run (:func:`thermocal.validation.validate`:
    r of the chamber temperatures, hold-stage bias stability and repeatability
@@ -154,7 +157,7 @@ class DemoResult:
 
 
 def _fit_poly(run: RunData, cfg: DemoConfig, *, select: bool) -> TemperatureModel:
-    """The seed's 37-term polynomial (SPEC §4a), optionally with term selection."""
+    """The ring-laser-gyro patent's 37-term polynomial, optionally with term selection."""
     params: dict[str, Any] = {"terms": "seed000", "rate_interval_s": cfg.rate_interval_s}
     if select:
         params["select"] = "bic"
@@ -348,14 +351,25 @@ def run_demo(
     config: DemoConfig | None = None,
     progress: Callable[[str], None] | None = None,
 ) -> DemoResult:
-    """Run the chamber workflow (module docstring) and write everything into ``out_dir``.
+    """Run the chamber workflow (module docstring) and write everything into ``out_dir``:
+    ``report.html``; ``models/seed37.json``, ``models/selected.json``; ``validation/*.json``;
+    ``c/*.h``, ``c/*.c``; ``data/rlg-modelling.parquet``, ``data/rlg-validation.parquet``
+    (+ ``*.truth.json``), ``data/rlg-validation-compensated.parquet``; ``profiles/*.csv``.
 
-    Files: ``report.html``; ``models/seed37.json``, ``models/selected.json``;
-    ``validation/*.json``; ``c/*.h``, ``c/*.c``; ``data/rlg-modelling.parquet``,
-    ``data/rlg-validation.parquet`` (+ ``*.truth.json``), the compensated
-    validation run ``data/rlg-validation-compensated.parquet``; the chamber
-    programs ``profiles/*.csv``.  ``progress(step)`` is called after each of
-    :data:`DEMO_STEPS`.
+    Parameters
+    ----------
+    out_dir : str or pathlib.Path
+        The folder written.
+    seed : int
+        The seed; the same seed gives the same output.
+    config : DemoConfig, optional
+        Sizes and rates of the demonstration.
+    progress : callable, optional
+        Called with the name of each of :data:`DEMO_STEPS` once done.
+
+    Returns
+    -------
+    DemoResult
     """
     cfg = config or DemoConfig()
     out = Path(out_dir)
@@ -432,8 +446,9 @@ def run_demo(
 
 
 def _demo_profiles(out: Path, cfg: DemoConfig, seed: int, written: list[Path]) -> tuple[Any, Any]:
-    """The modelling profile (a shortened seed-000 cycle) and a validation profile designed
-    to be weakly correlated with it (SPEC §5), written as chamber programs."""
+    """The modelling profile (a shortened cycle of the ring-laser-gyro patent) and a validation
+    profile designed
+    to be weakly correlated with it (r < 0.4), written as chamber programs."""
     prof_m = rlg_modelling(
         low_c=cfg.low_c,
         high_c=cfg.high_c,
@@ -477,12 +492,12 @@ def _demo_notes(cfg: DemoConfig, seed: int, mod: Any, primary: str) -> tuple[str
         f"Simulated data (thermocal.simulate, preset rlg, seed {seed}): a navigation-grade "
         "ring-laser gyro with four temperature sensors (T1 block, T2 discharge, T3 mount, "
         f"T4 case), sampled at {cfg.rate_hz:g} Hz, sensitive axis up at latitude "
-        f"{mod.meta.latitude_deg:g}°. Modelling run: shortened seed-000 profile "
+        f"{mod.meta.latitude_deg:g}°. Modelling run: shortened ring-laser-gyro patent profile "
         f"({cfg.low_c:g}…{cfg.high_c:g} °C cycle, ramps at ±"
         + ", ±".join(f"{r:g}" for r in cfg.rates_c_per_min)
         + " °C/min). Validation run: hold profile designed by thermocal to be weakly "
-        "correlated with the modelling run (SPEC §5).",
-        f"Models: 'seed37' is the seed's 37-term polynomial (SPEC §4a); 'selected' the same "
+        "correlated with the modelling run (r < 0.4).",
+        f"Models: 'seed37' is the ring-laser-gyro patent's 37-term polynomial; 'selected' the same "
         f"family with term selection (BIC). The model with the smaller rms of the "
         f"compensated validation run ('{primary}') is reported in detail and was used for "
         "the compensated file.",

@@ -1,6 +1,6 @@
 """``thermocal demo --imu``: the multi-channel workflow on a simulated six-axis MEMS IMU.
 
-Steps (issue 15): simulate the ``mems-imu`` scenario's modelling run and its weakly
+Steps: simulate the ``mems-imu`` scenario's modelling run and its weakly
 correlated validation run (the same unit, :func:`thermocal.simulate.scenario_mems_imu`);
 fit one cubic per channel on the die temperature into a calibration; validate every
 channel on the validation run (r against the modelling run's chamber air, figures before
@@ -151,6 +151,20 @@ def _summary(
     )
 
 
+def _simulate(out: Path, seed: int, rate_hz: float, files: list[Path]) -> tuple[Any, Any]:
+    """The modelling and validation runs of the ``mems-imu`` scenario, written with the truth."""
+    ((mod, truth),) = SCENARIOS["mems-imu"](seed, rate_hz=rate_hz)
+    ((val, _),) = SCENARIOS["mems-imu"](seed, run="validation", rate_hz=rate_hz)
+    for name, rec in (("imu-modelling", mod), ("imu-validation", val)):
+        p = out / "data" / f"{name}.parquet"
+        write_recording(rec, p)
+        files.append(p)
+    truth_path = out / "data" / "imu.truth.json"
+    write_json(truth_path, truth)
+    files.append(truth_path)
+    return mod, val
+
+
 def run_imu_demo(
     out_dir: str | Path = "thermocal-imu-demo",
     *,
@@ -158,7 +172,23 @@ def run_imu_demo(
     rate_hz: float = 1.0,
     progress: Callable[[str], None] | None = None,
 ) -> ImuDemoResult:
-    """Run the six-channel workflow (module docstring) into ``out_dir``."""
+    """Run the six-channel workflow (module docstring) into ``out_dir``.
+
+    Parameters
+    ----------
+    out_dir : str or pathlib.Path
+        The folder written.
+    seed : int
+        The seed; the same seed gives the same output.
+    rate_hz : float
+        Sample rate [Hz].
+    progress : callable, optional
+        Called with each step's name.
+
+    Returns
+    -------
+    ImuDemoResult
+    """
     out = Path(out_dir)
     for sub in ("data", "models", "c"):
         (out / sub).mkdir(parents=True, exist_ok=True)
@@ -169,16 +199,7 @@ def run_imu_demo(
         if progress is not None:
             progress(name)
 
-    # 1. simulate
-    ((mod, truth),) = SCENARIOS["mems-imu"](seed, rate_hz=rate_hz)
-    ((val, _),) = SCENARIOS["mems-imu"](seed, run="validation", rate_hz=rate_hz)
-    for name, rec in (("imu-modelling", mod), ("imu-validation", val)):
-        p = out / "data" / f"{name}.parquet"
-        write_recording(rec, p)
-        files.append(p)
-    truth_path = out / "data" / "imu.truth.json"
-    write_json(truth_path, truth)
-    files.append(truth_path)
+    mod, val = _simulate(out, seed, rate_hz, files)  # 1. simulate
     step(IMU_STEPS[0])
 
     # 2. fit: one cubic per channel on the die temperature

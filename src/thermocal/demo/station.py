@@ -1,4 +1,4 @@
-"""The whole station chain on one machine, no hardware (issue 31, item 6)::
+"""The whole station chain on one machine, no hardware::
 
     python -m thermocal.demo.station -o station-demo [--time-scale 200]
 
@@ -21,8 +21,8 @@ from pathlib import Path
 
 MODELLING = ([0.0, 300.0, 900.0, 1500.0, 2400.0, 3000.0], [25.0, 25.0, -10.0, -10.0, 70.0, 70.0])
 VALIDATION = ([0.0, 300.0, 900.0, 1500.0, 2100.0, 3000.0], [25.0, 45.0, 45.0, 0.0, 0.0, 60.0])
-"""Weakly correlated with :data:`MODELLING` (SPEC §5, r < 0.4): r = 0.15 between the two
-programs, 0.06 between their histories through the chamber's 120 s lag (issue 38: the earlier
+"""Weakly correlated with :data:`MODELLING` (r < 0.4): r = 0.15 between the two
+programs, 0.06 between their histories through the chamber's 120 s lag (the earlier
 25 → 60 → 0 → 40 °C program gave r = 0.49 and failed the demo's own validation), inside the
 modelled −10…70 °C."""
 
@@ -54,7 +54,20 @@ def run_demo(out: Path, time_scale: float = 200.0) -> dict[str, object]:
     The library calls behind ``thermocal station run``, ``fit``, ``validate`` and
     ``export-c`` (:func:`thermocal.station.run.run_station`,
     :func:`thermocal.pipeline.fit.fit_files`, :func:`thermocal.pipeline.validate.validate_files`,
-    :func:`thermocal.export.c.files.export_c_file`), in the order a user runs the commands."""
+    :func:`thermocal.export.c.files.export_c_file`), in the order a user runs the commands.
+
+    Parameters
+    ----------
+    out : pathlib.Path
+        The folder written.
+    time_scale : float
+        Program seconds per wall-clock second.
+
+    Returns
+    -------
+    dict
+        The paths written and the fitted slopes.
+    """
     from thermocal.errors import ThermocalInputError
     from thermocal.export.c.files import export_c_file
     from thermocal.pipeline.fit import fit_files
@@ -108,6 +121,19 @@ def run_demo(out: Path, time_scale: float = 200.0) -> dict[str, object]:
 
 
 def cli(argv: list[str] | None = None) -> int:
+    """``python -m thermocal.demo.station``: parse ``-o`` and ``--time-scale``, run, print the
+    summary.
+
+    Parameters
+    ----------
+    argv : list of str, optional
+        The arguments (default ``sys.argv[1:]``).
+
+    Returns
+    -------
+    int
+        The exit status.
+    """
     ap = argparse.ArgumentParser(prog="python -m thermocal.demo.station", description=__doc__)
     ap.add_argument("-o", "--output", type=Path, default=Path("station-demo"))
     ap.add_argument("--time-scale", type=float, default=200.0)

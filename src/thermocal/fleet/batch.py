@@ -1,5 +1,4 @@
-"""Production batches: one calibration per unit of a fleet (issue 18; INTERFACE.md "Fleet
-configuration").
+"""Production batches: one calibration per unit of a fleet.
 
 A TOML configuration names the ``thermocal fit`` options once (``[fit]``, by their long names
 without dashes), optional ``thermocal validate`` options (``[validate]``), optional pass/fail
@@ -94,7 +93,7 @@ CALIBRATION_FILE = "calibration.json"
 VALIDATION_FILE = "validation.json"
 
 EXIT_SOME_FAILED = 4
-"""Exit status of ``thermocal fleet`` when some unit failed (INTERFACE.md)."""
+"""Exit status of ``thermocal fleet`` when some unit failed."""
 
 
 # --- configuration ------------------------------------------------------------------------
@@ -162,7 +161,19 @@ def run_unit(task: UnitTask) -> UnitOutcome:
     modelling files, then :func:`thermocal.pipeline.validate.validate_files` on its
     validation file (``modeling``: its first modelling file) if it has one.  Never raises
     for the unit's own faults (a missing or corrupt file, a singular design): they make a
-    failed outcome whose error names the file, as the command would print it."""
+    failed outcome whose error names the file, as the command would print it.
+
+    Parameters
+    ----------
+    task : UnitTask
+        The unit and the fit and validation options.
+
+    Returns
+    -------
+    UnitOutcome
+        ``status`` ``"ok"`` or ``"failed"`` with the command's ``error:`` text; never raises
+        for the unit's own fault.
+    """
     from threadpoolctl import threadpool_limits
 
     from thermocal.pipeline.fit import fit_files
@@ -238,6 +249,17 @@ def _per_channel(
 
 
 def one_line_error(exc: BaseException) -> str:
+    """The ``error:`` text of ``exc`` on one line, as the command line prints it.
+
+    Parameters
+    ----------
+    exc : BaseException
+        The exception.
+
+    Returns
+    -------
+    str
+    """
     return " ".join(str(exc).split())
 
 
@@ -252,7 +274,20 @@ def channel_figures(
 
     The fit's figures are read from the file through the model loader (checksum verified),
     in the model's unit, and multiplied by the factor of :func:`shown_unit`; validation
-    figures come in the unit that ``validate`` names and are converted the same way."""
+    figures come in the unit that ``validate`` names and are converted the same way.
+
+    Parameters
+    ----------
+    calibration : str or pathlib.Path
+        The unit's calibration or model file.
+    validation : mapping, optional
+        Its ``thermocal validate --json`` result.
+
+    Returns
+    -------
+    dict of str to dict
+        Per channel its figures and ``unit``.
+    """
     from thermocal.models.files import load_calibration
 
     cal = load_calibration(calibration)
@@ -298,12 +333,43 @@ def channel_figures(
 
 
 def unit_figures(outcome: UnitOutcome) -> dict[str, dict[str, Any]]:
-    """Per channel figures of an outcome, in each channel's data unit (:func:`channel_figures`)."""
+    """Per channel figures of an outcome, in each channel's data unit (:func:`channel_figures`).
+
+    Parameters
+    ----------
+    outcome : UnitOutcome
+        What the worker handed back.
+
+    Returns
+    -------
+    dict of str to dict
+    """
     return outcome.figures
 
 
 def judge(figures: Mapping[str, Mapping[str, Any]], limits: Sequence[Limit]) -> list[str]:
-    """The limits a unit fails (empty: it passes)."""
+    """The limits a unit fails (empty: it passes).
+
+    Parameters
+    ----------
+    figures : mapping of str to mapping
+        Per channel its figures in its data unit (:func:`channel_figures`), with ``"unit"``.
+    limits : sequence of Limit
+        The ``[limits]`` of the configuration.
+
+    Returns
+    -------
+    list of str
+        One line per limit failed, naming the channel, the figure, its value and unit.
+
+    Examples
+    --------
+    >>> from thermocal.fleet.config import Limit
+    >>> judge({"gyro": {"rms_after": 0.2, "unit": "deg/s"}}, [Limit("rms_after", "max", 0.15)])
+    ['gyro.rms_after = 0.2 deg/s fails rms_after ≤ 0.15']
+    >>> judge({"gyro": {"rms_after": 0.1, "unit": "deg/s"}}, [Limit("rms_after", "max", 0.15)])
+    []
+    """
     failed: list[str] = []
     for lim in limits:
         names = [lim.channel] if lim.channel else list(figures)
@@ -327,9 +393,21 @@ def judge(figures: Mapping[str, Mapping[str, Any]], limits: Sequence[Limit]) -> 
 
 @dataclass(frozen=True)
 class FleetResult:
-    """What :func:`run_fleet` did: units run now, skipped (done before and still right),
-    failed, the units redone with why (``{id: reason}``), and the summary rows of every
-    unit of the configuration."""
+    """What :func:`run_fleet` did.
+
+    Parameters
+    ----------
+    ran, skipped, failed : tuple of str
+        Unit ids run now, skipped (done before and still right), and failed.
+    rows : tuple of dict
+        The summary rows of every unit of the configuration.
+    summary_csv, summary_parquet, html : pathlib.Path
+        The files written.
+    interrupted : str, optional
+        Why the batch stopped early (a worker died, the cluster went away).
+    redone : mapping of str to str
+        The units redone in this run and why.
+    """
 
     ran: tuple[str, ...]
     skipped: tuple[str, ...]
@@ -343,11 +421,36 @@ class FleetResult:
 
 
 def unit_dir(out_dir: Path, uid: str) -> Path:
+    """The folder of unit ``uid``: ``DIR/units/<id>``.
+
+    Parameters
+    ----------
+    out_dir : pathlib.Path
+        The batch's output folder.
+    uid : str
+        The unit's id.
+
+    Returns
+    -------
+    pathlib.Path
+    """
     return out_dir / "units" / uid
 
 
 def read_unit(out_dir: Path, uid: str) -> dict[str, Any] | None:
-    """A unit's ``unit.json`` (None when absent or unreadable: not done)."""
+    """A unit's ``unit.json`` (None when absent or unreadable: not done).
+
+    Parameters
+    ----------
+    out_dir : pathlib.Path
+        The batch's output folder.
+    uid : str
+        The unit's id.
+
+    Returns
+    -------
+    dict or None
+    """
     f = unit_dir(out_dir, uid) / UNIT_FILE
     try:
         obj = json.loads(f.read_text(encoding="utf-8"))
@@ -361,7 +464,17 @@ def read_unit(out_dir: Path, uid: str) -> dict[str, Any] | None:
 
 def unit_input_paths(u: UnitSpec) -> list[str]:
     """The files a unit reads: its modelling files, its validation file, and the
-    ``FILE.meta.json`` sidecar of each where one exists (it sets units and conversions)."""
+    ``FILE.meta.json`` sidecar of each where one exists (it sets units and conversions).
+
+    Parameters
+    ----------
+    u : UnitSpec
+        The unit.
+
+    Returns
+    -------
+    list of str
+    """
     from thermocal.outputs import sidecar_path
 
     out: list[str] = []
@@ -374,7 +487,18 @@ def unit_input_paths(u: UnitSpec) -> list[str]:
 
 
 def unit_inputs(u: UnitSpec) -> dict[str, str | None]:
-    """``{path: sha256}`` of :func:`unit_input_paths` (recorded in ``unit.json``)."""
+    """``{path: sha256}`` of :func:`unit_input_paths` (recorded in ``unit.json``).
+
+    Parameters
+    ----------
+    u : UnitSpec
+        The unit.
+
+    Returns
+    -------
+    dict of str to str or None
+        SHA-256 of each input (None when it cannot be read).
+    """
     return {f: sha256_of(f) for f in unit_input_paths(u)}
 
 
@@ -382,7 +506,19 @@ def unit_options(config: FleetConfig, u: UnitSpec) -> dict[str, Any]:
     """The options as they apply to a unit: ``fit`` (``[fit]`` as arguments), ``validate``
     (``[validate]``, only for a unit with a validation run) and ``limits``
     (``[channel, figure, bound, value]``; every limit applies to every unit: a channel
-    limit on a unit without the channel fails it)."""
+    limit on a unit without the channel fails it).
+
+    Parameters
+    ----------
+    config : FleetConfig
+        The batch.
+    u : UnitSpec
+        The unit.
+
+    Returns
+    -------
+    dict
+    """
     return {
         "fit": list(config.fit_args),
         "validate": list(config.validate_args) if u.validation is not None else [],
@@ -399,7 +535,20 @@ def _version() -> str:
 def verify_unit_folder(folder: Path, rec: Mapping[str, Any]) -> list[str]:
     """What is wrong with a unit's folder (empty: it verifies): every file ``unit.json``
     lists is present with its recorded SHA-256, and ``calibration.json`` loads through the
-    model loader (format, version, checksum)."""
+    model loader (format, version, checksum).
+
+    Parameters
+    ----------
+    folder : pathlib.Path
+        The unit's folder.
+    rec : mapping
+        Its ``unit.json``.
+
+    Returns
+    -------
+    list of str
+        What is wrong (empty: it verifies).
+    """
     from thermocal.models.files import load_calibration
 
     problems: list[str] = []
@@ -426,7 +575,24 @@ def stale_reasons(
     out_dir: Path, config: FleetConfig, u: UnitSpec, inputs: Mapping[str, str | None]
 ) -> list[str] | None:
     """Why a unit must be (re)done: None for a unit never run (no folder), ``[]`` for one
-    done and still right, else the reasons (module docstring)."""
+    done and still right, else the reasons (module docstring).
+
+    Parameters
+    ----------
+    out_dir : pathlib.Path
+        The batch's output folder.
+    config : FleetConfig
+        The batch.
+    u : UnitSpec
+        The unit.
+    inputs : mapping of str to str or None
+        SHA-256 of the unit's inputs now.
+
+    Returns
+    -------
+    list of str or None
+        None: never run; empty: done and still right; else why it must be redone.
+    """
     folder = unit_dir(out_dir, u.id)
     rec = read_unit(out_dir, u.id)
     if rec is None:
@@ -462,7 +628,17 @@ def stale_reasons(
 
 
 def config_inputs(config: FleetConfig) -> list[str]:
-    """Every file the batch reads: the configuration and each unit's inputs."""
+    """Every file the batch reads: the configuration and each unit's inputs.
+
+    Parameters
+    ----------
+    config : FleetConfig
+        The batch.
+
+    Returns
+    -------
+    list of str
+    """
     out = [str(config.path)]
     for u in config.units:
         out += unit_input_paths(u)
@@ -480,7 +656,20 @@ def check_outputs(config: FleetConfig, out_dir: str | Path) -> None:
     ``DIR/fleet.html`` (and their stale temporaries), ``DIR/units`` and, for every unit,
     ``DIR/units/<id>`` (replaced when the unit is redone) and the temporary folders of
     interrupted runs (deleted).  The rules are those of every command, one gate:
-    :func:`thermocal.outputs.check_outputs`."""
+    :func:`thermocal.outputs.check_outputs`.
+
+    Parameters
+    ----------
+    config : FleetConfig
+        The batch.
+    out_dir : str or pathlib.Path
+        The batch's output folder.
+
+    Raises
+    ------
+    ThermocalInputError
+        An output would write over, replace or delete an input.
+    """
     from thermocal.outputs import check_outputs as gate
 
     out = Path(out_dir)
@@ -519,7 +708,22 @@ def write_unit(out_dir: Path, outcome: UnitOutcome, record: dict[str, Any]) -> P
     """Write a unit's files into a temporary directory, ``unit.json`` last (with each
     file's SHA-256), and rename it into place (an older directory of the unit is moved
     aside first and removed after): ``units/<id>/`` is complete or absent, whenever the run
-    stops."""
+    stops.
+
+    Parameters
+    ----------
+    out_dir : pathlib.Path
+        The batch's output folder.
+    outcome : UnitOutcome
+        What the worker handed back.
+    record : dict
+        The unit's ``unit.json`` record.
+
+    Returns
+    -------
+    pathlib.Path
+        The unit's folder.
+    """
     units_dir = out_dir / "units"
     units_dir.mkdir(parents=True, exist_ok=True)
     tag = secrets.token_hex(4)
@@ -568,7 +772,23 @@ def unit_record(
     """The content of ``unit.json``: status, error, warnings, figures per channel (in each
     channel's data unit), pass/fail against the limits, what the unit was made from
     (``inputs`` with their SHA-256, ``options``, ``thermocal_version``), why it was redone,
-    and timing.  :func:`write_unit` adds ``files`` (name → SHA-256)."""
+    and timing.  :func:`write_unit` adds ``files`` (name → SHA-256).
+
+    Parameters
+    ----------
+    outcome : UnitOutcome
+        What the worker handed back.
+    config : FleetConfig
+        The batch.
+    inputs : mapping, optional
+        SHA-256 of the unit's inputs.
+    redone_because : str, optional
+        Why the unit was redone.
+
+    Returns
+    -------
+    dict
+    """
     spec = next((u for u in config.units if u.id == outcome.id), None)
     figures = unit_figures(outcome) if outcome.status == "ok" else {}
     reasons = judge(figures, config.limits) if outcome.status == "ok" else []
@@ -608,7 +828,23 @@ def summary_rows(
 ) -> list[dict[str, Any]]:
     """One row per unit of the configuration, from the units' ``unit.json`` (a unit with
     none, or found stale and not redone (``stale``: an interrupted run): ``status``
-    ``pending``); ``redone``: the reason a unit was redone in this run."""
+    ``pending``); ``redone``: the reason a unit was redone in this run.
+
+    Parameters
+    ----------
+    config : FleetConfig
+        The batch.
+    out_dir : pathlib.Path
+        The batch's output folder.
+    redone : mapping, optional
+        Units redone in this run and why.
+    stale : mapping, optional
+        Units found stale and not redone (pending).
+
+    Returns
+    -------
+    list of dict
+    """
     rows: list[dict[str, Any]] = []
     redone = redone or {}
     stale = stale or {}
@@ -648,7 +884,20 @@ def write_summary(rows: Sequence[Mapping[str, Any]], out_dir: Path) -> tuple[Pat
     as a formula (OWASP, "CSV Injection",
     https://owasp.org/www-community/attacks/CSV_Injection;
     :func:`thermocal.outputs.neutralise_cell`); numbers stay numbers.
-    ``summary.parquet`` keeps every name and text exactly."""
+    ``summary.parquet`` keeps every name and text exactly.
+
+    Parameters
+    ----------
+    rows : sequence of mapping
+        The rows (:func:`summary_rows`).
+    out_dir : pathlib.Path
+        The batch's output folder.
+
+    Returns
+    -------
+    tuple of pathlib.Path
+        ``summary.csv`` and ``summary.parquet``.
+    """
     import pandas as pd
 
     from thermocal.writers import atomic_write, atomic_write_path
@@ -730,7 +979,20 @@ def local_executor(
     its process again is a failed unit whose error names it and its files
     (:func:`lost_unit`, as on Dask); the rest go on in a fresh pool.  ``unit_fn``: what a
     worker runs per unit (default :func:`run_unit`; a module-level function, it is
-    pickled)."""
+    pickled).
+
+    Parameters
+    ----------
+    workers : int
+        Worker processes.
+    unit_fn : callable, optional
+        Runs one unit (default :func:`run_unit`).
+
+    Returns
+    -------
+    callable
+        Maps the tasks to their outcomes, as they finish.
+    """
     fn = run_unit if unit_fn is None else unit_fn
 
     def run(tasks: list[UnitTask]) -> Iterator[UnitOutcome]:
@@ -829,7 +1091,22 @@ _ADDRESS = re.compile(
 def check_scheduler(address: str) -> str:
     """``address`` when it is a scheduler address ``[SCHEME://]HOST:PORT`` (a scheme of
     :data:`SCHEDULER_SCHEMES`, a port 1–65535), else a :class:`ThermocalInputError` naming
-    ``--scheduler`` (Dask's own parser raised ``ValueError``: exit 1)."""
+    ``--scheduler`` (Dask's own parser raised ``ValueError``: exit 1).
+
+    Parameters
+    ----------
+    address : str
+        A Dask scheduler's address (``tcp://host:8786``).
+
+    Returns
+    -------
+    str
+
+    Raises
+    ------
+    ThermocalInputError
+        Not ``[SCHEME://]HOST:PORT``.
+    """
     m = _ADDRESS.match(address.strip())
     port = int(m.group("port")) if m else 0
     scheme = (m.group("scheme") if m else None) or "tcp"
@@ -848,7 +1125,23 @@ def dask_executor(address: str) -> Executor:
     results travel back to this process, which writes them.  The address is checked
     (:func:`check_scheduler`) and the connection made here, before the batch writes
     anything.  A worker that dies running a unit (the nanny ended it: memory, a crash)
-    fails that unit, its files named (:func:`lost_unit`); the others go on."""
+    fails that unit, its files named (:func:`lost_unit`); the others go on.
+
+    Parameters
+    ----------
+    address : str
+        A Dask scheduler's address (``tcp://host:8786``).
+
+    Returns
+    -------
+    callable
+        Maps the tasks to their outcomes, as they finish.
+
+    Raises
+    ------
+    ThermocalInputError
+        Dask is not installed, the address is not a scheduler's, or it cannot be reached.
+    """
     import importlib
 
     address = check_scheduler(address)
@@ -913,7 +1206,20 @@ def _run_on(client: Any, distributed: Any, tasks: list[UnitTask]) -> Iterator[Un
 
 def lost_unit(task: UnitTask, exc: BaseException) -> UnitOutcome:
     """The failed outcome of a unit whose worker died under it (Dask's ``KilledWorker``):
-    the error names the unit's files, the likely cause and the way out."""
+    the error names the unit's files, the likely cause and the way out.
+
+    Parameters
+    ----------
+    task : UnitTask
+        The unit and its options.
+    exc : BaseException
+        The exception.
+
+    Returns
+    -------
+    UnitOutcome
+        ``status`` ``"failed"`` with the reason.
+    """
     u = task.unit
     files = ", ".join((*u.modeling, *((u.validation,) if u.validation else ())))
     reason = " ".join(str(exc).split())[:200]
@@ -939,12 +1245,37 @@ def run_fleet(
     executor: Executor | None = None,
 ) -> FleetResult:
     """Calibrate every unit not yet done or no longer right (all with ``force``), write
-    each as it finishes, then the summary and ``fleet.html`` (module docstring).  Refused
-    before anything is written when an output path is, or holds, an input
-    (:func:`check_outputs`).  ``on_unit`` is called after each unit is written (progress).
-    A unit's fault never stops the others; an interrupted batch (Ctrl-C, a worker that
-    died) keeps every unit written so far, writes the summary and re-raises
-    (``KeyboardInterrupt``) or reports it in ``interrupted``."""
+    each as it finishes, then the summary and ``fleet.html`` (module docstring).  A unit's
+    fault never stops the others; an interrupted batch (Ctrl-C, a worker that died) keeps
+    every unit written so far, writes the summary and re-raises (``KeyboardInterrupt``) or
+    reports it in ``interrupted``.
+
+    Parameters
+    ----------
+    config : FleetConfig
+        The batch (:func:`thermocal.fleet.config.load_config`).
+    out_dir : str or pathlib.Path
+        The folder: ``units/<id>/``, ``summary.csv``, ``summary.parquet``, ``fleet.html``.
+    workers : int
+        Local worker processes (1: in this process).
+    scheduler : str, optional
+        Address of a Dask scheduler (``tcp://host:8786``) instead of local processes.
+    force : bool
+        Redo every unit, even those done and still right.
+    on_unit, executor : callable, optional
+        Called with each :class:`UnitOutcome` once written (progress); runs the tasks
+        instead of the local or Dask executor (tests).
+
+    Returns
+    -------
+    FleetResult
+
+    Raises
+    ------
+    ThermocalInputError
+        An output is, or holds, an input (:func:`check_outputs`, before anything is
+        written); the scheduler's address is not one.
+    """
     out = Path(out_dir)
     check_outputs(config, out)
     run = executor or (dask_executor(scheduler) if scheduler else local_executor(workers))

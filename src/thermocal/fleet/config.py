@@ -1,4 +1,4 @@
-"""A fleet configuration (INTERFACE.md "Fleet configuration"): the TOML file read and
+"""A fleet configuration : the TOML file read and
 checked (:func:`load_config`).
 
 ``[fit]`` names the ``thermocal fit`` options once, by their long names without dashes,
@@ -29,8 +29,17 @@ _ID = re.compile(r"^[A-Za-z0-9][A-Za-z0-9._-]{0,127}$")
 
 @dataclass(frozen=True)
 class UnitSpec:
-    """One device of the batch: its id, modelling files and optional validation file
-    (absolute paths)."""
+    """One device of the batch.
+
+    Parameters
+    ----------
+    id : str
+        The unit's id (letters, digits, ``.``, ``_``, ``-``; a folder name).
+    modeling : tuple of str
+        Its modelling files (absolute paths).
+    validation : str, optional
+        Its validation file (absolute path).
+    """
 
     id: str
     modeling: tuple[str, ...]
@@ -39,8 +48,25 @@ class UnitSpec:
 
 @dataclass(frozen=True)
 class Limit:
-    """A pass/fail threshold on a figure: ``figure ≤ value`` (``max``) or ``≥`` (``min``),
-    for every channel or for the one named (the figure in that channel's data unit)."""
+    """A pass/fail threshold on a figure, for every channel or for the one named.
+
+    Parameters
+    ----------
+    figure : str
+        A figure of :data:`thermocal.fleet.stats.FIGURES` (``"rms_after"``).
+    bound : {"max", "min"}
+        ``figure ≤ value`` or ``figure ≥ value``.
+    value : float
+        The threshold, in the channel's data unit.
+    channel : str, optional
+        The channel it applies to (None: every channel).
+
+    Examples
+    --------
+    >>> lim = Limit("rms_after", "max", 0.15, channel="gyro_x")
+    >>> lim.label, lim.check(0.1), lim.check(0.2), lim.check(float("nan"))
+    ('gyro_x.rms_after ≤ 0.15', True, False, False)
+    """
 
     figure: str
     bound: str
@@ -48,19 +74,43 @@ class Limit:
     channel: str | None = None
 
     def check(self, value: float | None) -> bool:
+        """Whether ``value`` (finite) meets the limit; a missing or non-finite value fails.
+
+        Parameters
+        ----------
+        value : float or None
+            The figure.
+
+        Returns
+        -------
+        bool
+        """
         if value is None or not math.isfinite(value):
             return False
         return value <= self.value if self.bound == "max" else value >= self.value
 
     @property
     def label(self) -> str:
+        """The limit as the report and the messages write it (``gyro.rms_after ≤ 0.15``)."""
         where = f"{self.channel}." if self.channel else ""
         return f"{where}{self.figure} {'≤' if self.bound == 'max' else '≥'} {self.value:g}"
 
 
 @dataclass(frozen=True)
 class FleetConfig:
-    """A parsed fleet configuration (:func:`load_config`)."""
+    """A parsed fleet configuration (:func:`load_config`).
+
+    Parameters
+    ----------
+    path : pathlib.Path
+        The TOML file.
+    fit_args, validate_args : tuple of str
+        The ``[fit]`` and ``[validate]`` tables as command-line arguments.
+    limits : tuple of Limit
+        The ``[limits]``.
+    units : tuple of UnitSpec
+        The ``[[unit]]`` entries.
+    """
 
     path: Path
     fit_args: tuple[str, ...]
@@ -96,7 +146,23 @@ def _limits(table: Mapping[str, Any], where: str, channel: str | None = None) ->
 def load_config(path: str | Path) -> FleetConfig:
     """Read and check a fleet configuration (module docstring).  Every error is a
     :class:`ThermocalInputError` naming the file and the entry (``thermocal fleet`` exits 2);
-    a missing data file is not one: that unit fails and the others go on."""
+    a missing data file is not one: that unit fails and the others go on.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        The TOML file.
+
+    Returns
+    -------
+    FleetConfig
+
+    Raises
+    ------
+    ThermocalInputError
+        The file is missing, special, not TOML, or holds an unknown table, key, option or
+        limit, a bad unit id or a unit without modelling files.
+    """
     p = Path(path)
     refuse_special_input(p, "configuration file")
     try:

@@ -1,4 +1,4 @@
-"""``DIR/fleet.html``: the report of a production batch (issue 18).
+"""``DIR/fleet.html``: the report of a production batch.
 
 Yield (calibrated, passed, failed), the distribution of each channel's residual figures and
 fitted coefficients across the units (each coefficient as a robust z-score, so that terms of
@@ -88,7 +88,22 @@ def build_fleet_report(
 ) -> str:
     """The batch report as one HTML document (module docstring); every figure in its
     channel's data unit, as ``unit.json`` holds it; ``redone``: the units redone in this
-    run and why."""
+    run and why.
+
+    Parameters
+    ----------
+    config : FleetConfig
+        The batch.
+    records : mapping of str to mapping or None
+        Each unit's ``unit.json`` by id (None: not done).
+    redone : mapping of str to str, optional
+        The units redone in this run and why.
+
+    Returns
+    -------
+    str
+        The self-contained HTML document.
+    """
     from thermocal import __version__
     from thermocal.report.build import _env
 
@@ -170,7 +185,20 @@ def write_fleet_report(
     records: Mapping[str, Mapping[str, Any] | None],
     redone: Mapping[str, str] | None = None,
 ) -> Path:
-    """Build the batch report and write it atomically; returns the path."""
+    """Build the batch report and write it atomically; returns the path.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        The HTML file to write.
+    config, records, redone
+        As :func:`build_fleet_report`.
+
+    Returns
+    -------
+    pathlib.Path
+        The path written.
+    """
     return write_html(path, build_fleet_report(config, records, redone))
 
 

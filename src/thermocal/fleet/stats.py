@@ -1,4 +1,4 @@
-"""The fleet's figures and their statistics across units (issue 18): the figure names a unit
+"""The fleet's figures and their statistics across units: the figure names a unit
 records, the unit a channel's figures are shown in, robust z-scores and outliers.  Shared by
 the batch driver (:mod:`thermocal.fleet.batch`) and its report (:mod:`thermocal.fleet.report`)."""
 
@@ -38,7 +38,26 @@ def shown_unit(model_unit: str, data_unit: str) -> tuple[str, float]:
     model's unit to it: ``(data_unit, f)`` with ``x[data_unit] = f · x[model_unit]``
     (:func:`thermocal.units.convert`, e.g. 1/3600 from °/h to °/s) when both are physical
     units of one kind; otherwise (raw counts, made physical by a scale factor) the model's
-    own unit and 1."""
+    own unit and 1.
+
+    Parameters
+    ----------
+    model_unit : str
+        The unit of the channel's model (``"deg/h"``).
+    data_unit : str
+        The unit of the channel's data column (``"deg/s"``).
+
+    Returns
+    -------
+    tuple of (str, float)
+        The shown unit and the factor from the model's unit to it.
+
+    Examples
+    --------
+    >>> unit, f = shown_unit("deg/h", "deg/s")
+    >>> unit, f * 3600
+    ('deg/s', 1.0)
+    """
     from thermocal import units
     from thermocal.errors import UnitError
 
@@ -52,15 +71,70 @@ def shown_unit(model_unit: str, data_unit: str) -> tuple[str, float]:
 def convert_unit_label(unit: str, model_unit: str, shown: str) -> str | None:
     """``deg/h/degC^2`` → ``deg/s/degC^2``: the unit of a coefficient proportional to the
     signal (its unit starts with the model's signal unit) in the shown unit; None when the
-    coefficient is not in the signal's unit (a breakpoint in °C, a time constant)."""
+    coefficient is not in the signal's unit (a breakpoint in °C, a time constant).
+
+    Parameters
+    ----------
+    unit : str
+        The coefficient's unit.
+    model_unit : str
+        The model's signal unit.
+    shown : str
+        The unit the signal is shown in.
+
+    Returns
+    -------
+    str or None
+
+    Examples
+    --------
+    >>> convert_unit_label("deg/h/degC^2", "deg/h", "deg/s")
+    'deg/s/degC^2'
+    >>> convert_unit_label("degC", "deg/h", "deg/s") is None
+    True
+    """
     if unit == model_unit or unit.startswith(model_unit + "/"):
         return shown + unit[len(model_unit) :]
     return None
 
 
 def robust_z(values: Iterable[float]) -> list[float]:
-    """Modified z-scores ``0.6745 (x − median) / MAD`` (Iglewicz & Hoaglin, 1993; |z| > 3.5
-    marks an outlier); NaN where the MAD is zero or the value missing."""
+    r"""Modified z-scores of a figure across the units of a batch.
+
+    Parameters
+    ----------
+    values : iterable of float
+        The figure of each unit (NaN or inf: missing).
+
+    Returns
+    -------
+    list of float
+        One score per value; NaN where the value is missing, or everywhere when fewer
+        than three values are finite or the MAD is zero.
+
+    Notes
+    -----
+    .. math::
+
+        z_i = \frac{0.6745\,(x_i - \tilde x)}{\operatorname{MAD}}, \qquad
+        \operatorname{MAD} = \operatorname{median}_j |x_j - \tilde x| ,
+
+    with :math:`\tilde x` the median of the finite values; :math:`|z| >` :data:`OUTLIER_Z`
+    (3.5) marks an outlier.  0.6745 is the 0.75 quantile of the standard normal
+    distribution, so that :math:`z` is a standard score for normal data.
+
+    References
+    ----------
+    B. Iglewicz and D. C. Hoaglin, *How to Detect and Handle Outliers*, ASQC Basic
+    References in Quality Control vol. 16, ASQC Quality Press, 1993.
+
+    Examples
+    --------
+    Median 3, MAD 1 (worked out by hand), so the scores are 0.6745 (x − 3):
+
+    >>> [round(z, 3) for z in robust_z([1, 2, 3, 4, 100])]
+    [-1.349, -0.674, 0.0, 0.674, 65.427]
+    """
     import numpy as np
 
     x = np.asarray(list(values), dtype=np.float64)
@@ -82,7 +156,23 @@ def common_unit(figs: Sequence[Mapping[str, Any]]) -> tuple[str, list[float]]:
     """The unit most of a channel's units are shown in, and per record the factor taking
     its signal figures there (NaN where it cannot be converted: left out of comparisons
     across units).  A batch whose files give one channel in different units is compared in
-    one unit."""
+    one unit.
+
+    Parameters
+    ----------
+    figs : sequence of mapping
+        One channel's figures per unit, each with its ``"unit"``.
+
+    Returns
+    -------
+    tuple of (str, list of float)
+        The common unit and one factor per record.
+
+    Examples
+    --------
+    >>> common_unit([{"unit": "deg/h"}, {"unit": "deg/h"}, {"unit": "deg/s"}])
+    ('deg/h', [1.0, 1.0, 3600.0])
+    """
     from collections import Counter
 
     names = [str(f.get("unit") or "") for f in figs]
@@ -109,7 +199,19 @@ HISTOGRAM_FIGURES = {"rms_residual": "fit rms residual", "rms_after": "validatio
 def channel_series(figs: Sequence[Mapping[str, Any]]) -> tuple[str, dict[str, list[float]]]:
     """A channel's figures and coefficients across units, each in one unit
     (:func:`common_unit`): ``(unit, {what: values})``, ``what`` a figure name or
-    ``coefficient <term>``."""
+    ``coefficient <term>``.
+
+    Parameters
+    ----------
+    figs : sequence of mapping
+        One channel's figures per unit (``thermocal fit --json`` and ``validate --json``
+        figures, ``coefficients`` and ``coefficient_units``).
+
+    Returns
+    -------
+    tuple of (str, dict)
+        The common unit and each series (NaN where a unit lacks the value).
+    """
     unit, factors = common_unit(figs)
     series: dict[str, list[float]] = {}
     for n in SERIES_FIGURES:
@@ -126,7 +228,22 @@ def channel_series(figs: Sequence[Mapping[str, Any]]) -> tuple[str, dict[str, li
 
 
 def coefficient_unit(figs: Sequence[Mapping[str, Any]], term: str, unit: str) -> str:
-    """The unit of a coefficient across units, in the channel's common ``unit``."""
+    """The unit of a coefficient across units, in the channel's common ``unit``.
+
+    Parameters
+    ----------
+    figs : sequence of mapping
+        One channel's figures per unit.
+    term : str
+        The coefficient's term name.
+    unit : str
+        The channel's common unit.
+
+    Returns
+    -------
+    str
+        The unit label, or ``""`` when no record gives one.
+    """
     for f in figs:
         cu = (f.get("coefficient_units") or {}).get(term)
         if cu:
@@ -138,7 +255,31 @@ def coefficient_unit(figs: Sequence[Mapping[str, Any]], term: str, unit: str) ->
 def outliers(records: Mapping[str, Mapping[str, Any] | None]) -> list[dict[str, Any]]:
     """Units whose figure or coefficient is a robust outlier among the ok units, per
     channel: ``{"id", "channel", "what", "value", "unit", "z"}`` (the value in the
-    channel's common data unit, :func:`channel_series`), largest |z| first."""
+    channel's common data unit, :func:`channel_series`), largest |z| first.
+
+    Parameters
+    ----------
+    records : mapping of str to mapping or None
+        Each unit's summary record by unit id (``status`` and ``channels``); units that did
+        not finish (``status`` other than ``"ok"``) are left out.
+
+    Returns
+    -------
+    list of dict
+        One entry per outlying value, largest |z| first.
+
+    Examples
+    --------
+    Six gyros, one of them with a validation rms five times the others'.  Median 0.105, MAD
+    0.01 (by hand), so z = 0.6745 × 0.395 / 0.01 = 26.6:
+
+    >>> rms = [0.10, 0.11, 0.09, 0.10, 0.12, 0.5]
+    >>> records = {f"u{i}": {"status": "ok", "channels": {"gyro": {"unit": "deg/h",
+    ...                                                             "rms_after": v}}}
+    ...            for i, v in enumerate(rms)}
+    >>> [(o["id"], o["what"], round(o["z"], 1)) for o in outliers(records)]
+    [('u5', 'rms_after', 26.6)]
+    """
     ok = {k: v for k, v in records.items() if v and v.get("status") == "ok"}
     found: list[dict[str, Any]] = []
     channels = sorted({ch for v in ok.values() for ch in (v.get("channels") or {})})

@@ -10,7 +10,7 @@ import errno
 import json
 import math
 import warnings
-from collections.abc import Iterable
+from collections.abc import Iterable, Mapping
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -101,20 +101,43 @@ OPTION_OF: dict[str, str] = {
 (``time_unit`` → ``--time-unit`` needs no entry)."""
 
 
-def option_name(parameter: str) -> str:
-    """The command-line option of a library parameter: :data:`OPTION_OF`, else the name with
-    dashes (``rate_interval`` → ``--rate-interval``)."""
+def option_name(parameter: str, options: Mapping[str, str] | None = None) -> str:
+    """The command-line option of a library parameter.
+
+    Parameters
+    ----------
+    parameter : str
+        The library's parameter name (``"rate_interval"``).
+    options : mapping, optional
+        ``{parameter: option}`` of the running command (its own spelling wins: ``simulate``
+        takes ``--rate-hz`` where ``fit`` takes ``--rate``).
+
+    Returns
+    -------
+    str
+        ``options[parameter]``, else :data:`OPTION_OF`, else the name with dashes.
+
+    Examples
+    --------
+    >>> option_name("rate_interval")
+    '--rate-interval'
+    >>> option_name("rate_hz"), option_name("rate_hz", {"rate_hz": "--rate-hz"})
+    ('--rate', '--rate-hz')
+    """
+    if options and parameter in options:
+        return options[parameter]
     return OPTION_OF.get(parameter, "--" + parameter.replace("_", "-"))
 
 
-def error_text(exc: Exception) -> tuple[str, bool]:
+def error_text(exc: Exception, options: Mapping[str, str] | None = None) -> tuple[str, bool]:
     """The text of the ``error:`` line the command line prints for ``exc`` and whether it is
     the user's (exit 2: bad input, a missing file, permissions, a full disk) rather than
     thermocal's own failure (exit 1, ``internal: TYPE: message``).  A
     :class:`~thermocal.errors.ParameterError` names the option (:func:`option_name`) where the
     library names its parameter."""
     if isinstance(exc, ParameterError):
-        return one_line(exc.named(option_name(exc.parameter), option_name)), True
+        text = exc.named(option_name(exc.parameter, options), lambda p: option_name(p, options))
+        return one_line(text), True
     if isinstance(exc, ThermocalInputError | FileNotFoundError | IsADirectoryError):
         return one_line(exc), True
     if isinstance(exc, OSError) and exc.errno in USER_OS_ERRORS:

@@ -1,4 +1,4 @@
-"""HTML report of a temperature-compensation workflow (SPEC §1, §4a–§5, §8).
+"""HTML report of a temperature-compensation workflow: model, validation and figures of merit.
 
 :func:`build_report` turns :class:`ReportInputs` (model files, validation
 results, recordings) into one self-contained HTML document; :func:`write_report`

@@ -26,7 +26,24 @@ def plot_allan(
     """Write a PNG: σ(τ) with its confidence bars, the fitted model and each
     significant fitted term (IEEE 952 slope lines), the −½ stretch's line over the τ it was
     fitted on and the curve's minimum (bias instability, IEEE 952 C.3).  Written
-    atomically."""
+    atomically.
+
+    Parameters
+    ----------
+    result : AllanResult
+        The deviation (:func:`thermocal.stability.allan.overlapping_adev`).
+    noise : NoiseTerms, optional
+        The noise terms drawn as their lines.
+    path : str or pathlib.Path
+        The file to write.
+    title : str, optional
+        The figure's title.
+
+    Returns
+    -------
+    pathlib.Path
+        The path written.
+    """
     import matplotlib
 
     matplotlib.use("Agg")
@@ -116,7 +133,22 @@ def _mark_readings(ax: Any, result: AllanResult, noise: NoiseTerms) -> None:
 def plot_dynamic(dyn: DynamicAllan, path: str | Path, *, title: str | None = None) -> Path:
     """Write a heat map of the dynamic Allan deviation: window centre [s] across, τ [s]
     up (log), log10 ADEV [unit] as colour; windows where the curve departs from the whole
-    record's are outlined.  Written atomically."""
+    record's are outlined.  Written atomically.
+
+    Parameters
+    ----------
+    dyn : DynamicAllan
+        The dynamic Allan deviation.
+    path : str or pathlib.Path
+        The file to write.
+    title : str, optional
+        The figure's title.
+
+    Returns
+    -------
+    pathlib.Path
+        The path written.
+    """
     import matplotlib
 
     matplotlib.use("Agg")

@@ -1,4 +1,4 @@
-"""The numbers of a report (SPEC §1, §5): a model applied to a run (bias before, model,
+"""The numbers of a report: a model applied to a run (bias before, model,
 after, each in the data's unit), figures of merit and Allan deviation with noise terms.
 
 Pure: no files, no plotting (:mod:`thermocal.report.build` renders them)."""
@@ -74,7 +74,22 @@ class RunSignals:
 
 def in_data_unit(sig: RunSignals, unit: str, k: float) -> RunSignals:
     """``sig`` (canonical unit) in the data's own ``unit``: every series and the known input
-    divided by ``k`` (``value[canonical] = k · value[data]``)."""
+    divided by ``k`` (``value[canonical] = k · value[data]``).
+
+    Parameters
+    ----------
+    sig : RunSignals
+        The model applied to a run.
+    unit : str
+        The data's unit (``"deg/h"``, ``"mg"``).
+    k : float
+        Factor from the model's unit to the data's.
+
+    Returns
+    -------
+    RunSignals
+        The same signals times ``k``, labelled ``unit``.
+    """
     if k == 1.0 and unit == sig.unit:
         return sig
     return dataclasses.replace(
@@ -90,7 +105,24 @@ def in_data_unit(sig: RunSignals, unit: str, k: float) -> RunSignals:
 
 def known_input_of(rec: Recording, unit: str) -> float:
     """Earth rate seen by the sensitive axis [°/h] when the metadata gives latitude and
-    axis (SPEC §1: B0 = mean − Ω_axis), else 0 (accelerometers: 0)."""
+    axis (B0 = mean − Ω_axis, IEEE Std 952-1997), else 0 (accelerometers: 0).
+
+    Parameters
+    ----------
+    rec : Recording
+        The recording.
+    unit : str
+        The data's unit (``"deg/h"``, ``"mg"``).
+
+    Returns
+    -------
+    float
+        Ω sin(latitude) for an up axis, Ω cos(latitude) for north, 0 for east [°/h]; 0 when unknown.
+
+    References
+    ----------
+    IEEE Std 952-1997, Annex C (the earth rate seen by the sensitive axis).
+    """
     if unit != "deg/h" or rec.meta.latitude_deg is None or rec.meta.axis is None:
         return 0.0
     return float(
@@ -104,6 +136,25 @@ def apply_model(model_dict: dict[str, Any], rec: Recording, signal: str | None) 
     ``after = before − model(T, Ṫ)``; the model is evaluated on the fitted range
     (clamped, as in compensation); :class:`~thermocal.errors.ExtrapolationWarning`
     messages are collected, not raised.
+
+    Parameters
+    ----------
+    model_dict : dict
+        The content of a model file.
+    rec : Recording
+        The recording.
+    signal : str, optional
+        The signal column (default: the model's).
+
+    Returns
+    -------
+    RunSignals
+        Bias before, model, bias after, each in the data's unit.
+
+    Raises
+    ------
+    ThermocalInputError
+        The recording lacks a column the model needs.
     """
     model = model_from_dict(model_dict)
     sig_name = signal or (model_dict.get("signal") or {}).get("name")
@@ -149,7 +200,7 @@ def apply_model(model_dict: dict[str, Any], rec: Recording, signal: str | None) 
 
 @dataclass(frozen=True)
 class FiguresOfMerit:
-    """SPEC §1 figures of a whole run [signal unit], from
+    """The figures of merit of a whole run [signal unit], from
     :func:`thermocal.metrics.compute_metrics` (the numbers of ``thermocal metrics``):
     bias B0 (earth rate removed when latitude and axis are known), bias stability
     and peak-to-peak over ``averaging_s`` averages, temperature sensitivity over
@@ -216,7 +267,28 @@ class Coverage:
 def coverage_of(time_s: FloatArray, tau0_s: float) -> Coverage:
     """The coverage of a run with times ``time_s`` [s] and sample interval ``tau0_s`` [s]:
     each gap (:func:`thermocal.recording.find_gaps`, a step > 1.5 τ0) counts its length
-    less one τ0 (issue 38: a record 98 % gaps read "1.02 h, 3125 samples every 0.02 s")."""
+    less one τ0 (a record 98 % gaps is not "1.02 h" of data).
+
+    Parameters
+    ----------
+    time_s : numpy.ndarray
+        Time [s].
+    tau0_s : float
+        Sample interval τ0 [s].
+
+    Returns
+    -------
+    Coverage
+
+    Examples
+    --------
+    Samples every second at 0…9 s and 100…109 s: one step of 91 s, a gap of 91 − 1 = 90 s:
+
+    >>> import numpy as np
+    >>> t = np.concatenate([np.arange(0.0, 10.0), np.arange(100.0, 110.0)])
+    >>> round(coverage_of(t, 1.0).gap_s, 1)
+    90.0
+    """
     from thermocal.recording import find_gaps
 
     t = np.asarray(time_s, dtype=np.float64)
@@ -251,6 +323,24 @@ def averaging_for(
     (:func:`thermocal.metrics.too_few_averages`); when it is a default, the largest of
     :data:`NICE_AVERAGES_S` giving at least :data:`MIN_FALLBACK_AVERAGES` averages (the
     sample interval if none does), stated in the note.
+
+    Parameters
+    ----------
+    time_s : numpy.ndarray
+        Time [s].
+    wanted_s : float
+        The averaging time asked for [s].
+    given : bool
+        Whether the user gave it (else a default).
+    where : str, optional
+        How a warning names the run.
+    option : str, optional
+        The option that sets it, for the warning.
+
+    Returns
+    -------
+    tuple of (float, str or None)
+        The averaging time used [s] and, when it differs from the one asked for, why.
     """
     from thermocal.errors import ThermocalInputError
     from thermocal.metrics import too_few_averages
@@ -291,7 +381,7 @@ def figures_of_merit(
     where: str | None = None,
     average_option: str | None = "--average",
 ) -> FiguresOfMerit:
-    """Figures of merit of a rate ``x`` [``unit``, known input included] (SPEC §1).
+    """Figures of merit of a rate ``x`` [``unit``, known input included].
 
     Runs :func:`thermocal.metrics.compute_metrics` on a recording of ``x`` with
     ``temp_c`` as the hold-stage temperature.  The drift angle
@@ -301,6 +391,41 @@ def figures_of_merit(
     over ``drift_reference_s`` (default the first 10 % of the run,
     :func:`thermocal.metrics.reference_bias`).  ``where`` (the file) and ``average_option``
     are named when the record gives fewer than two averages.
+
+    Parameters
+    ----------
+    time_s : numpy.ndarray
+        Time [s].
+    x : numpy.ndarray
+        The signal [``unit``].
+    unit : str
+        The data's unit (``"deg/h"``, ``"mg"``).
+    averaging_s : float
+        Averaging time of bias stability and peak-to-peak [s].
+    meta : Metadata
+        The recording's metadata.
+    temp_name : str
+        The temperature channel's name.
+    temp_c : numpy.ndarray
+        Its values [°C] (hold stages).
+    drift_bias : float, optional
+        b0 of the drift angle [``unit``].
+    drift_reference_s : tuple of float, optional
+        Window whose mean is b0 [s since the first sample].
+    where : str, optional
+        How warnings name the run.
+    average_option : str, optional
+        The option that sets the averaging time, for warnings.
+
+    Returns
+    -------
+    FiguresOfMerit
+
+    References
+    ----------
+    IEEE Std 952-1997 and IEEE Std 1431-2004 (bias, bias stability); *A modelling and
+    validation method for the temperature compensation model of a ring-laser gyroscope*
+    (bias stability and repeatability over temperature holds).
     """
     rec = Recording.from_arrays(
         time_s,
@@ -359,9 +484,32 @@ def shown_figures(
     deviation of the ``averaging_s`` block means, never across a gap; the slope of the hold
     stages' mean biases, pooled by set-point within 0.5 °C, against their temperatures),
     with the gaps, the sample interval and the hold stages found once for all the series
-    (they depend on the time and temperature only; issue 28: the report of a long log
-    found them dozens of times).  With an earth rate to remove (a latitude or axis in
-    ``meta``), or fewer than two averages (its error), :func:`figures_of_merit` per series."""
+    (they depend on the time and temperature only).  With an earth rate to remove (a latitude or
+    axis in
+    ``meta``), or fewer than two averages (its error), :func:`figures_of_merit` per series.
+
+    Parameters
+    ----------
+    time_s : numpy.ndarray
+        Time [s].
+    series : tuple of numpy.ndarray
+        Signals of the same run [``unit``].
+    unit : str
+        The data's unit (``"deg/h"``, ``"mg"``).
+    averaging_s : float
+        Averaging time [s].
+    meta : Metadata
+        The recording's metadata.
+    temp_name : str
+        The temperature channel's name.
+    temp_c : numpy.ndarray
+        Its values [°C].
+
+    Returns
+    -------
+    list of (float or None, float or None)
+        Per series its bias stability and temperature sensitivity.
+    """
     from thermocal.metrics import block_means, data_unit_of, temperature_sensitivity
     from thermocal.preprocess import segment_holds
     from thermocal.recording import contiguous_slices
@@ -430,9 +578,31 @@ class AllanAnalysis:
 def allan_of(time_s: FloatArray, x: FloatArray, tau0_s: float, unit: str) -> AllanAnalysis:
     """Overlapping Allan deviation (octave τ, ±1σ confidence intervals, split at gaps) and
     the IEEE Std 952 noise terms, by :func:`thermocal.stability.allan.overlapping_adev` and
-    :func:`thermocal.stability.allan.noise_terms` (NIST SP 1065 eq. 11; SPEC §1), with the
+    :func:`thermocal.stability.allan.noise_terms` (NIST SP 1065 eq. 11; IEEE Std 952-1997 Annex
+    C), with the
     periodic terms of the longest gap-free stretch that shape the curve named
-    (:func:`thermocal.stability.allan.annotate_periodic`)."""
+    (:func:`thermocal.stability.allan.annotate_periodic`).
+
+    Parameters
+    ----------
+    time_s : numpy.ndarray
+        Time [s].
+    x : numpy.ndarray
+        The signal [``unit``].
+    tau0_s : float
+        Sample interval τ0 [s].
+    unit : str
+        The data's unit (``"deg/h"``, ``"mg"``).
+
+    Returns
+    -------
+    AllanAnalysis
+
+    References
+    ----------
+    IEEE Std 952-1997, Annex C; W. J. Riley, *Handbook of Frequency Stability Analysis*,
+    NIST SP 1065, 2008.
+    """
     from thermocal.recording import contiguous_slices
 
     segs = contiguous_slices(np.asarray(time_s, dtype=np.float64))

@@ -1,7 +1,8 @@
 """Build the self-contained HTML report of a temperature-compensation workflow.
 
-The report gathers, for one sensor, what an engineer sends a customer (SPEC
-§1, §4a–§5, §8): test conditions and data provenance, the chamber profile and
+The report gathers, for one sensor, what an engineer sends a customer (the
+ring-laser-gyro method's figures, model and validation): test conditions and data provenance,
+the chamber profile and
 temperature channels, the bias against time and temperature before and after
 compensation, the validation table on a weakly correlated test (r, stages,
 stability, repeatability, improvement), Allan deviation before and after with
@@ -90,11 +91,17 @@ words of :func:`thermocal.models.base.condition_wording`."""
 class ModelEntry:
     """One fitted model in the report.
 
-    ``model`` is the content of a model file (as written by
-    :func:`thermocal.models.save_model`), ``validation`` the JSON object of
-    ``thermocal validate --json`` for that model on the validation run (or
-    ``None``), ``label`` a short name shown in tables, ``path`` the model file
-    (provenance).
+    Parameters
+    ----------
+    label : str
+        A short name shown in tables.
+    model : dict
+        The content of a model file (as :func:`thermocal.save_model` writes it).
+    validation : dict, optional
+        The JSON object of ``thermocal validate --json`` for that model on the validation
+        run.
+    path : str, optional
+        The model file (provenance).
     """
 
     label: str
@@ -107,21 +114,38 @@ class ModelEntry:
 class ReportInputs:
     """Everything :func:`build_report` needs.
 
-    Attributes
+    Parameters
     ----------
-    models : fitted models; the first is the primary model, shown in detail
-        (figures, coefficients); every model appears in the comparison table.
-    recording : the validation run (the model is applied to it).
-    modeling : the modelling run, if available (profile and fit figures).
-    signal : signal column of the recordings (default: the model's signal name).
-    recording_path, modeling_path : files the runs were read from (provenance,
-        SHA-256 shown).
-    title, sensor : headline texts.
-    warnings : extra warning lines to show (e.g. caught while fitting).
-    notes : free text paragraphs under "Test conditions".
-    files : other produced files (label, path) listed in the provenance table.
-    generated_by : the command that made the report.
-    averaging_s : averaging time of the computed figures [s] (``--average``).
+    models : tuple of ModelEntry
+        Fitted models; the first is the primary model, shown in detail (figures,
+        coefficients); every model appears in the comparison table.
+    recording : Recording
+        The validation run (the models are applied to it).
+    modeling : Recording, optional
+        The modelling run (profile and fit figures).
+    signal : str, optional
+        Signal column of the recordings (default: the model's signal name).
+    recording_path, modeling_path : str, optional
+        Files the runs were read from (provenance, SHA-256 shown).
+    title, sensor : str
+        Headline texts.
+    warnings : tuple of str
+        Extra warning lines to show (e.g. caught while fitting).
+    notes : tuple of str
+        Free text paragraphs under "Test conditions".
+    files : tuple of (str, str)
+        Other produced files (label, path) listed in the provenance table.
+    generated_by : str
+        The command that made the report.
+    averaging_s : float, optional
+        Averaging time of the computed figures [s] (``--average``).
+    drift_reference_s : tuple of float, optional
+        Window [s since the first sample] whose mean is the drift angle's b0 before
+        compensation.
+    drift_bias : float, optional
+        That b0 [the data's unit] instead of a window.
+    dynamic_s : float, optional
+        Window [s] of the dynamic Allan deviation of the compensated output.
     """
 
     models: tuple[ModelEntry, ...]
@@ -160,6 +184,22 @@ def fmt_num(value: Any, digits: int = 4) -> str:
 
     Integers are shown whole.  Very large or small magnitudes use an exponent
     (``1.234e-05``).
+
+    Parameters
+    ----------
+    value : object
+        A number, a bool, None or NaN.
+    digits : int
+        Significant digits.
+
+    Returns
+    -------
+    str
+
+    Examples
+    --------
+    >>> fmt_num(0.123456), fmt_num(1.5e-5), fmt_num(7), fmt_num(float("nan"))
+    ('0.1235', '1.500e-05', '7', '—')
     """
     if value is None or isinstance(value, bool):
         return "—" if value is None else ("yes" if value else "no")
@@ -177,7 +217,23 @@ def fmt_num(value: Any, digits: int = 4) -> str:
 
 
 def num(value: Any, key: str | None = None, digits: int = 4, unit: str = "") -> Markup:
-    """HTML for a number; with ``key`` tagged ``data-key``/``data-value`` (full precision)."""
+    """HTML for a number; with ``key`` tagged ``data-key``/``data-value`` (full precision).
+
+    Parameters
+    ----------
+    value : object
+        The number.
+    key : str, optional
+        The key tagged on the element (tests and scrapers read it).
+    digits : int
+        Significant digits shown.
+    unit : str
+        Unit shown after it.
+
+    Returns
+    -------
+    markupsafe.Markup
+    """
     text = fmt_num(value, digits)
     attrs = ""
     if key is not None:
@@ -192,7 +248,23 @@ def _is_number(v: Any) -> TypeGuard[float | int]:
 
 
 def improvement_pct(before: Any, after: Any) -> float | None:
-    """Improvement ``100 · (1 − after/before)`` [%] (None when not computable)."""
+    """Improvement ``100 · (1 − after/before)`` [%] (None when not computable).
+
+    Parameters
+    ----------
+    before, after : float
+        A figure before and after compensation (same unit).
+
+    Returns
+    -------
+    float or None
+        The improvement [%]; None when either is missing or not finite, or ``before`` is 0.
+
+    Examples
+    --------
+    >>> improvement_pct(2.0, 0.5), improvement_pct(0.0, 1.0)
+    (75.0, None)
+    """
     if not (_is_number(before) and _is_number(after)):
         return None
     b, a = float(before), float(after)
@@ -203,12 +275,29 @@ def improvement_pct(before: Any, after: Any) -> float | None:
 
 NO_CHANGE_REL = 1e-9
 """Before and after equal within this fraction of the larger: "no change", not a
-percentage of rounding (issue 38: "Peak-to-peak −1.06e-13 %")."""
+percentage of rounding (not "Peak-to-peak −1.06e-13 %")."""
 
 
 def no_change(before: Any, after: Any) -> bool:
     """Whether two figures are equal within :data:`NO_CHANGE_REL` of the larger
-    (``|a − b| ≤ 1e-9 · max(|a|, |b|)``; both zero included)."""
+    (``|a − b| ≤ 1e-9 · max(|a|, |b|)``; both zero included).
+
+    Parameters
+    ----------
+    before : float
+        The figure before.
+    after : float
+        The figure after.
+
+    Returns
+    -------
+    bool
+
+    Examples
+    --------
+    >>> no_change(1.0, 1.0 + 1e-12), no_change(1.0, 0.99)
+    (True, False)
+    """
     if not (_is_number(before) and _is_number(after)):
         return False
     b, a = float(before), float(after)
@@ -219,7 +308,23 @@ def no_change(before: Any, after: Any) -> bool:
 
 def change_html(before: Any, after: Any, imp: float | None, key: str | None) -> Markup:
     """The improvement cell of ``before`` → ``after``: ``no change`` when they are equal
-    (:func:`no_change`; tagged 0), else ``imp`` [%] (:func:`improvement_pct`)."""
+    (:func:`no_change`; tagged 0), else ``imp`` [%] (:func:`improvement_pct`).
+
+    Parameters
+    ----------
+    before : float
+        The figure before.
+    after : float
+        The figure after.
+    imp : float or None
+        The improvement [%] (:func:`improvement_pct`).
+    key : str or None
+        The key tagged on the element.
+
+    Returns
+    -------
+    markupsafe.Markup
+    """
     if no_change(before, after):
         attrs = f' data-key="{escape(key)}" data-value="0.0"' if key else ""
         return Markup(f'<span class="num"{attrs}>no change</span>')
@@ -227,7 +332,23 @@ def change_html(before: Any, after: Any, imp: float | None, key: str | None) -> 
 
 
 def unit_label(unit: str) -> str:
-    """Pretty unit for display (``deg/h`` → ``°/h``)."""
+    """Pretty unit for display (``deg/h`` → ``°/h``).
+
+    Parameters
+    ----------
+    unit : str
+        The data's unit (``"deg/h"``, ``"mg"``).
+
+    Returns
+    -------
+    str
+        The unit as printed (``°/h``, ``mg``, ``°C``).
+
+    Examples
+    --------
+    >>> unit_label("deg/h")
+    '°/h'
+    """
     return {
         "deg/h": "°/h",
         "deg/s": "°/s",
@@ -260,7 +381,18 @@ GAP_SHARE_WARN = 0.10
 
 
 def gap_share(rec: Recording) -> tuple[int, float, float]:
-    """(number of gaps, their total length [s], their share of the time span)."""
+    """(number of gaps, their total length [s], their share of the time span).
+
+    Parameters
+    ----------
+    rec : Recording
+        The recording.
+
+    Returns
+    -------
+    tuple of (int, float, float)
+        Number of gaps, their total [s] and share of the span [%].
+    """
     gaps = rec.gaps()
     total = float(sum(g.length_s for g in gaps))
     span = rec.duration_s
@@ -270,7 +402,22 @@ def gap_share(rec: Recording) -> tuple[int, float, float]:
 def conversions_of(rec: Recording, signal: str | None, shown_unit: str) -> list[str]:
     """Every conversion applied to a run, in words: the time column's unit, the signal's
     unit as given (and where it came from) and the unit the report shows, a scale factor K
-    of raw counts, each raw-count temperature's ``T = gain·counts + offset``."""
+    of raw counts, each raw-count temperature's ``T = gain·counts + offset``.
+
+    Parameters
+    ----------
+    rec : Recording
+        The recording.
+    signal : str, optional
+        The signal column (default: the model's).
+    shown_unit : str
+        The unit the report shows.
+
+    Returns
+    -------
+    list of str
+        One line per conversion applied when the run was read.
+    """
     src = rec.unit_sources
     out = [
         f"time: column in {rec.time_unit}"
@@ -499,7 +646,7 @@ def _summary(
             }
         )
     b, a = v.get("rms_about_zero_before"), v.get("rms_about_zero_after")
-    if b is not None and a is not None:  # what the user sees (issue 25): worse fails
+    if b is not None and a is not None:  # what the user sees: worse fails
         worse = bool(v.get("absolute_error_worse"))
         imp = improvement_pct(float(b), float(a))
         items.append(
@@ -521,7 +668,7 @@ def _summary(
 
 def _drift_cards(fom_before: FiguresOfMerit, fom_after: FiguresOfMerit) -> list[dict[str, Any]]:
     """The drift-angle cards of the summary, each comparing one definition before and
-    after (issue 38): the start bias removed (each series' b0 over the same window, or a
+    after: the start bias removed (each series' b0 over the same window, or a
     given b0 before), and no bias removed.  Improvement ``100·(1 − after/before)``."""
     items: list[dict[str, Any]] = []
     ref = drift_reference_words(fom_before.drift_reference)
@@ -553,7 +700,20 @@ def _drift_cards(fom_before: FiguresOfMerit, fom_after: FiguresOfMerit) -> list[
 
 def model_factor(model: dict[str, Any], unit: str | None) -> tuple[str, float]:
     """(the model's signal unit, k) with ``value[model unit] = k · value[unit]``; k = 1 when
-    ``unit`` is not given, equal, or of another kind (counts)."""
+    ``unit`` is not given, equal, or of another kind (counts).
+
+    Parameters
+    ----------
+    model : dict
+        The content of a model file.
+    unit : str or None
+        The data's unit.
+
+    Returns
+    -------
+    tuple of (str, float)
+        The shown unit and the factor from the model's unit.
+    """
     mu = str((model.get("signal") or {}).get("unit") or "")
     if not mu:
         return mu, 1.0
@@ -731,7 +891,21 @@ def _adequacy_of(entry: ModelEntry) -> dict[str, Any] | None:
 
 def adequacy_rows(ad: Any, key: str, label: str) -> dict[str, Any] | None:
     """``{"label", "verdict", "overrides", "tests": [{name, figure, threshold, unit,
-    verdict, override, message}]}`` from an ``adequacy`` record; None when there is none."""
+    verdict, override, message}]}`` from an ``adequacy`` record; None when there is none.
+
+    Parameters
+    ----------
+    ad : dict
+        The model file's adequacy record.
+    key : str
+        The row's key.
+    label : str
+        The row's label.
+
+    Returns
+    -------
+    dict or None
+    """
     if not isinstance(ad, dict):
         return None
     tests = []
@@ -869,7 +1043,7 @@ def _env() -> Any:
 @dataclass(frozen=True)
 class _Analysis:
     """The numbers behind the report: each model applied to the validation run, and the
-    primary model's figures of merit and Allan deviation before and after (SPEC §1)."""
+    primary model's figures of merit and Allan deviation before and after."""
 
     primary: ModelEntry
     signal: str | None
@@ -908,7 +1082,20 @@ class _Analysis:
 def recording_role(inputs: ReportInputs, sha256: str | None) -> str:
     """What the recording is to the models: ``"modelling"`` when one of them was fitted on
     it (its SHA-256, else its file name, among the model files' ``data``), else
-    ``"validation"`` when a validation result was given, else ``"test"``."""
+    ``"validation"`` when a validation result was given, else ``"test"``.
+
+    Parameters
+    ----------
+    inputs : ReportInputs
+        The report's inputs.
+    sha256 : str or None
+        The recording's checksum.
+
+    Returns
+    -------
+    str
+        ``"validation"`` or ``"modelling"`` (a model applied to its own modelling run).
+    """
     name = Path(inputs.recording_path).name if inputs.recording_path else None
     for e in inputs.models:
         for d in e.model.get("data") or []:
@@ -937,7 +1124,7 @@ def _analyse(inputs: ReportInputs) -> _Analysis:
     role = recording_role(inputs, rec_sha)
     sig_col = signal if signal in rec.columns else (rec.signals[0] if rec.signals else None)
     _, canon = rec.signal(sig_col)
-    # every figure in the data's own unit (the column's unit as given, issue 25)
+    # every figure in the data's own unit (the column's unit as given)
     unit, k = data_unit_of(rec, sig_col or "", canon)
     applied = {
         e.label: in_data_unit(apply_model(e.model, rec, signal), unit, k) for e in inputs.models
@@ -953,7 +1140,7 @@ def _analyse(inputs: ReportInputs) -> _Analysis:
         rec.temperature_c(stage_temp) if stage_temp not in temp_names
         else main.temps_c[:, temp_names.index(stage_temp)]
     )  # fmt: skip
-    # drift angle, like with like (issue 38): before and after each about its own mean over
+    # drift angle, like with like: before and after each about its own mean over
     # the same reference window at the start (a given b0 is the raw sensor's: before only);
     # and both with no bias removed (FiguresOfMerit.drift_angle_raw_max)
     fom_before, fom_after = (
@@ -1253,7 +1440,17 @@ def _drift_figure(fs: _FigureSet, an: _Analysis) -> None:
 
 def drift_reference_words(ref: Any) -> str:
     """How the constant b0 of the drift angle was chosen, in words (a
-    :class:`~thermocal.metrics.DriftReference` or None)."""
+    :class:`~thermocal.metrics.DriftReference` or None).
+
+    Parameters
+    ----------
+    ref : object
+        The drift angle's reference (a window or a b0).
+
+    Returns
+    -------
+    str
+    """
     if ref is None:
         return "no bias removed"
     b0 = f"{fmt_num(ref.bias, 5)} {unit_label(ref.unit)}"
@@ -1285,7 +1482,7 @@ def _noise_rows(an: _Analysis) -> list[dict[str, Any]]:
                     }
                 )
         noise_rows.append({"label": label, "unit": unit_label(term_unit), "cells": cells})
-        if key == "bias_instability":  # IEEE 952 C.3: always at the minimum (issue 38)
+        if key == "bias_instability":  # IEEE Std 952-1997 Annex C: always at the minimum
             mins = [al.terms.bias_minimum for al in (allan_before, allan_after)]
             cells = []
             for when, m in zip(("before", "after"), mins, strict=True):
@@ -1301,7 +1498,7 @@ def _noise_rows(an: _Analysis) -> list[dict[str, Any]]:
 
 
 def _fom_rows(an: _Analysis) -> list[dict[str, Any]]:
-    """SPEC §1 figures of merit before and after, with the improvement."""
+    """The figures of merit before and after, with the improvement."""
     unit, averaging_s, stage_temp = an.unit, an.averaging_s, an.stage_temp
     fom_before, fom_after = an.fom_before, an.fom_after
     fom_rows = []
@@ -1401,7 +1598,7 @@ def _validation_tables(inputs: ReportInputs, unit: str) -> list[dict[str, Any]]:
 
 def _overall(primary: ModelEntry, summary: list[dict[str, Any]]) -> str:
     """The verdict: only from a validation result that was given, and PASS only when its
-    correlation check is among the passed ones (issue 13 item 6)."""
+    correlation check is among the passed ones."""
     flags = [s["flag"] for s in summary]
     if not primary.validation:
         return "na"
@@ -1415,12 +1612,27 @@ def _overall(primary: ModelEntry, summary: list[dict[str, Any]]) -> str:
 def build_report(inputs: ReportInputs) -> str:
     """The report as one self-contained HTML document (str).
 
-    Steps: apply each model to the validation run and compute the primary model's SPEC §1
+    Steps: apply each model to the validation run and compute the primary model's
     figures of merit and Allan deviation before and after (:func:`_analyse`); figures
     (:func:`_report_figures`); tables from the figures and the model and validation JSON
     (:func:`_noise_rows`, :func:`_fom_rows`, :func:`_comparison_rows`,
     :func:`_validation_tables`); warnings; the verdict (:func:`_overall`); render
     ``templates/report.html.j2``.
+
+    Parameters
+    ----------
+    inputs : ReportInputs
+        The models, their validation results and the runs.
+
+    Returns
+    -------
+    str
+        The HTML document; every figure in the data's own unit.
+
+    Warns
+    -----
+    ThermocalWarning
+        What the analysis warns (gaps, extrapolation, …), also shown in the report.
     """
     from thermocal import __version__
 
@@ -1488,7 +1700,19 @@ def build_report(inputs: ReportInputs) -> str:
 
 
 def write_report(path: str | Path, inputs: ReportInputs) -> Path:
-    """Build the report and write it atomically to ``path`` (UTF-8); returns the path."""
+    """Build the report and write it atomically to ``path`` (UTF-8); returns the path.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        The HTML file.
+    inputs : ReportInputs
+        As :func:`build_report`.
+
+    Returns
+    -------
+    pathlib.Path
+    """
     return write_html(path, build_report(inputs))
 
 

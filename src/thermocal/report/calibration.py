@@ -1,4 +1,4 @@
-"""HTML report of a calibration: several channels in one document (issue 15).
+"""HTML report of a calibration: several channels in one document.
 
 :func:`build_calibration_report` applies every channel's model to the validation run
 (:func:`thermocal.report.build.apply_model`, each channel in its data column's unit) and
@@ -6,7 +6,7 @@ shows, for 1 to ~18 channels:
 
 1. a per-channel summary table — role, unit, family, coefficients, fitted temperature
    range, fit residual, condition number; temperature sensitivity (least-squares slope
-   over the hold stages, SPEC §1) and bias stability before → after, computed here from
+   over the hold stages) and bias stability before → after, computed here from
    the recording with :func:`thermocal.metrics.compute_metrics`; the validation figures
    (r, rms before → after) and one verdict per channel when ``thermocal validate --json``
    output is given (no verdict without it);
@@ -176,8 +176,8 @@ def _channel_notes(
 
 
 def _absolute_change(v: dict[str, Any] | None, key: str) -> Any:
-    """The change of the error against the reference (rms about zero, issue 38: the
-    report showed only the scatter about the mean) as :func:`change_html` shows it, or None
+    """The change of the error against the reference (rms about zero, beside the
+    scatter about the mean) as :func:`change_html` shows it, or None
     without both figures."""
     b, a = (v or {}).get("rms_about_zero_before"), (v or {}).get("rms_about_zero_after")
     if b is None or a is None:
@@ -250,7 +250,7 @@ def _channel_section(
         "stability_improvement": improvement_pct(
             fom[0]["bias_stability"], fom[1]["bias_stability"]
         ),
-        # IEEE 952 C.3: B at the curve's minimum, always (issue 38), N on the −½ stretch
+        # IEEE Std 952-1997 Annex C: B at the curve's minimum, always; N on the −½ stretch
         "bi_before": allan[0].terms.bias_minimum or terms[0].bias_instability,
         "bi_after": allan[1].terms.bias_minimum or terms[1].bias_instability,
         "rw_after": (
@@ -271,7 +271,18 @@ def _channel_section(
 
 
 def build_calibration_report(inputs: CalibrationReportInputs) -> str:
-    """The calibration report as one self-contained HTML document (module docstring)."""
+    """The calibration report as one self-contained HTML document (module docstring).
+
+    Parameters
+    ----------
+    inputs : CalibrationReportInputs
+        The calibration, the validation run and the optional ``validate --json`` output.
+
+    Returns
+    -------
+    str
+        The HTML document.
+    """
     from thermocal import __version__
     from thermocal.report import figures as F
 
@@ -356,7 +367,19 @@ def build_calibration_report(inputs: CalibrationReportInputs) -> str:
 
 
 def write_calibration_report(path: str | Path, inputs: CalibrationReportInputs) -> Path:
-    """Build the calibration report and write it atomically to ``path``; returns the path."""
+    """Build the calibration report and write it atomically to ``path``; returns the path.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        The HTML file.
+    inputs : CalibrationReportInputs
+        As :func:`build_calibration_report`.
+
+    Returns
+    -------
+    pathlib.Path
+    """
     return write_html(path, build_calibration_report(inputs))
 
 

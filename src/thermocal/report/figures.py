@@ -42,6 +42,21 @@ def decimate_for_plot(
 
     Block length ``m = max(block, ceil(n / max_points))``; the trailing partial
     block is averaged on its own.  With ``m = 1`` the arrays are returned unchanged.
+
+    Parameters
+    ----------
+    x : array_like
+        The abscissa.
+    max_points : int
+        Most points drawn.
+    block : int
+        Samples already averaged per point.
+    *ys : array_like
+        The ordinates.
+
+    Returns
+    -------
+    tuple of numpy.ndarray
     """
     arrays = [np.asarray(a, dtype=np.float64) for a in (x, *ys)]
     n = arrays[0].size
@@ -63,7 +78,24 @@ def binned_means(
     x: npt.ArrayLike, y: npt.ArrayLike, n_bins: int = 40, min_count: int = 30
 ) -> tuple[FloatArray, FloatArray, FloatArray]:
     """Means of ``y`` in ``n_bins`` equal-width bins of ``x``: (bin centre, mean, standard
-    error of the mean), bins with fewer than ``min_count`` samples left out."""
+    error of the mean), bins with fewer than ``min_count`` samples left out.
+
+    Parameters
+    ----------
+    x : array_like
+        The abscissa (a temperature).
+    y : array_like
+        The values.
+    n_bins : int
+        Number of bins.
+    min_count : int
+        Fewest samples a bin needs.
+
+    Returns
+    -------
+    tuple of numpy.ndarray
+        Bin centres, means and counts.
+    """
     xa = np.asarray(x, dtype=np.float64)
     ya = np.asarray(y, dtype=np.float64)
     edges = np.linspace(float(xa.min()), float(xa.max()), n_bins + 1)
@@ -80,7 +112,7 @@ def binned_means(
 
 PLAIN_TEXT: Any = {"text.parse_math": False}
 """matplotlib settings under which every text of a figure is drawn as written: a column
-named ``T1 $\\frac$`` is a name, not TeX (mathtext raised ValueError: exit 1, issue 39)."""
+named ``T1 $\\frac$`` is a name, not TeX (mathtext would raise ValueError)."""
 
 
 @contextmanager
@@ -144,7 +176,18 @@ class TemperaturePanel:
 
 
 def temperature_profile(panels: Sequence[TemperaturePanel]) -> bytes:
-    """Chamber profile and temperature channels of each run against time [h]."""
+    """Chamber profile and temperature channels of each run against time [h].
+
+    Parameters
+    ----------
+    panels : sequence of TemperaturePanel
+        One panel per run.
+
+    Returns
+    -------
+    bytes
+        The figure as PNG.
+    """
     with _figure(len(panels), height_in=3.0) as (fig, axes):
         for ax, p in zip(axes, panels, strict=True):
             t = np.asarray(p.time_s, dtype=np.float64)
@@ -177,6 +220,30 @@ def bias_vs_time(
     ``stages`` are (start_s, stop_s) of the temperature holds used for the
     stability and repeatability figures.  When ``temperature`` is given it is
     drawn on a right-hand axis.
+
+    Parameters
+    ----------
+    time_s : numpy.ndarray
+        Time [s].
+    before : numpy.ndarray
+        Bias before compensation [``unit``].
+    after : numpy.ndarray
+        After [``unit``].
+    unit : str
+        The data's unit.
+    stages : sequence of (float, float)
+        Hold stages [s].
+    temperature : numpy.ndarray, optional
+        A temperature drawn on a second axis [°C].
+    temperature_label : str
+        Its name.
+    block : int
+        Samples averaged per point.
+
+    Returns
+    -------
+    bytes
+        The figure as PNG.
     """
     t = np.asarray(time_s, dtype=np.float64)
     with _figure(1, height_in=3.6) as (fig, axes):
@@ -213,7 +280,28 @@ def bias_vs_temperature(
     block: int = 1,
 ) -> bytes:
     """Bias before and after compensation against a temperature channel [°C]: averages
-    over ``block`` samples (faint dots) and means in 40 temperature bins (lines)."""
+    over ``block`` samples (faint dots) and means in 40 temperature bins (lines).
+
+    Parameters
+    ----------
+    temperature_c : numpy.ndarray
+        Temperature [°C].
+    before : numpy.ndarray
+        Bias before [``unit``].
+    after : numpy.ndarray
+        After [``unit``].
+    unit : str
+        The data's unit.
+    temperature_label : str
+        Its name.
+    block : int
+        Samples averaged per point.
+
+    Returns
+    -------
+    bytes
+        The figure as PNG.
+    """
     x = np.asarray(temperature_c, dtype=np.float64)
     with _figure(1, height_in=3.6) as (fig, axes):
         ax = axes[0]
@@ -251,14 +339,35 @@ class AllanCurve:
 
 
 def say_why_empty(ax: Any, reason: str) -> None:
-    """Write in an empty panel why it is empty (a blank figure never goes out unexplained)."""
+    """Write in an empty panel why it is empty (a blank figure never goes out unexplained).
+
+    Parameters
+    ----------
+    ax : matplotlib.axes.Axes
+        The axes.
+    reason : str
+        Why it is empty.
+    """
     ax.text(0.5, 0.5, reason, ha="center", va="center", wrap=True, fontsize=9,
             color="#5b6773", transform=ax.transAxes)  # fmt: skip
 
 
 def allan_deviation(curves: Sequence[AllanCurve], *, unit: str) -> bytes:
     """Log-log Allan deviation σ(τ) with confidence intervals as error bars; a curve with no
-    positive point is named in the panel with the reason."""
+    positive point is named in the panel with the reason.
+
+    Parameters
+    ----------
+    curves : sequence of AllanCurve
+        The curves.
+    unit : str
+        The data's unit.
+
+    Returns
+    -------
+    bytes
+        The figure as PNG.
+    """
     colors = (BEFORE_COLOR, AFTER_COLOR, "#27ae60", "#8e44ad")
     with _figure(1, height_in=4.0) as (fig, axes):
         ax = axes[0]
@@ -308,7 +417,24 @@ def drift_angle(
     unit: str = "°",
 ) -> bytes:
     """Drift angle [``unit``] (integral of the rate less a stated constant bias) before and
-    after compensation, against time [h]."""
+    after compensation, against time [h].
+
+    Parameters
+    ----------
+    time_s : numpy.ndarray
+        Time [s].
+    before_deg : numpy.ndarray
+        Drift angle before [``unit``].
+    after_deg : numpy.ndarray
+        After [``unit``].
+    unit : str
+        The angle's unit.
+
+    Returns
+    -------
+    bytes
+        The figure as PNG.
+    """
     t = np.asarray(time_s, dtype=np.float64)
     with _figure(1, height_in=3.4) as (fig, axes):
         ax = axes[0]
@@ -330,7 +456,26 @@ def model_fit(
     unit: str,
     block: int = 1,
 ) -> bytes:
-    """Modelling run: measured bias, model output and residual against time [h]."""
+    """Modelling run: measured bias, model output and residual against time [h].
+
+    Parameters
+    ----------
+    time_s : numpy.ndarray
+        Time [s].
+    measured : numpy.ndarray
+        The output [``unit``].
+    modelled : numpy.ndarray
+        The model [``unit``].
+    unit : str
+        The data's unit.
+    block : int
+        Samples averaged per point.
+
+    Returns
+    -------
+    bytes
+        The figure as PNG.
+    """
     t = np.asarray(time_s, dtype=np.float64)
     with _figure(2, height_in=2.6, sharex=True) as (fig, axes):
         th, ym, yf = decimate_for_plot(_hours(t), measured, modelled, block=block)
@@ -388,7 +533,7 @@ def _grid(n: int, panel_height_in: float = 2.7) -> Iterator[Any]:
     rows = (n + cols - 1) // cols
     height = panel_height_in * rows
     # fixed margins [in] rather than a constrained layout: the layout engine measures every
-    # tick label once more per draw (half the cost of a grid, issue 28)
+    # tick label once more per draw (half the cost of a grid)
     with matplotlib.rc_context(PLAIN_TEXT):  # the axes' own label texts are made here
         fig = Figure(figsize=(FIG_WIDTH_IN * 1.25, height), dpi=DPI)
         fig.subplots_adjust(left=0.07, right=0.99, bottom=0.55 / height,
@@ -411,7 +556,18 @@ def _grid(n: int, panel_height_in: float = 2.7) -> Iterator[Any]:
 def bias_vs_temperature_grid(channels: Sequence[ChannelBias]) -> bytes:
     """One panel per channel: bias before and after compensation [its unit] against its
     temperature [°C], both centred on their means (faint dots: block means; lines: means
-    in 30 temperature bins)."""
+    in 30 temperature bins).
+
+    Parameters
+    ----------
+    channels : sequence of ChannelBias
+        One panel per channel.
+
+    Returns
+    -------
+    bytes
+        The figure as PNG.
+    """
     with _grid(len(channels)) as (fig, axes):
         for ax, ch in zip(axes, channels, strict=True):
             b = ch.before - float(np.mean(ch.before))
@@ -443,7 +599,18 @@ def _few_minor_ticks(ax: Any) -> None:
 
 def allan_grid(curves: Sequence[tuple[str, str, Sequence[AllanCurve]]]) -> bytes:
     """One log-log panel per channel ``(name, unit, curves)``: Allan deviation before and
-    after compensation with its confidence intervals."""
+    after compensation with its confidence intervals.
+
+    Parameters
+    ----------
+    curves : sequence of (str, str, sequence of AllanCurve)
+        Per channel its name, unit and curves.
+
+    Returns
+    -------
+    bytes
+        The figure as PNG.
+    """
     colors = (BEFORE_COLOR, AFTER_COLOR)
     with _grid(len(curves)) as (fig, axes):
         for ax, (name, unit, cs) in zip(axes, curves, strict=True):

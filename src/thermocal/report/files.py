@@ -42,7 +42,24 @@ def _no_progress(
 
 def read_validation_json(path: Path, *, channels: bool = False) -> dict[str, Any]:
     """A validation result file (``thermocal validate --json`` output) as a dict; with
-    ``channels`` also the several-channel form ``{"channels": {NAME: {…}}}``."""
+    ``channels`` also the several-channel form ``{"channels": {NAME: {…}}}``.
+
+    Parameters
+    ----------
+    path : pathlib.Path
+        The ``thermocal validate --json`` output.
+    channels : bool
+        Expect a calibration's per-channel result.
+
+    Returns
+    -------
+    dict
+
+    Raises
+    ------
+    ThermocalInputError
+        Not a validation result.
+    """
     try:
         obj = json.loads(path.read_text(encoding="utf-8"))
     except FileNotFoundError:
@@ -84,7 +101,30 @@ def read_run(
     model file's ``inputs`` filling in what the options and the file leave unstated
     (:func:`thermocal.units.resolve_inputs`); the sensor id compared with the model's; a
     signal required; time finite and increasing, no NaN (:meth:`Recording.validate`),
-    gaps reported in one :class:`GapWarning`."""
+    gaps reported in one :class:`GapWarning`.
+
+    Parameters
+    ----------
+    path : pathlib.Path
+        The recording.
+    signals : str
+        The signal column(s).
+    temps : sequence of str
+        The temperature columns.
+    model_inputs : dict
+        The model file's ``inputs``.
+    opts : ReadOptions
+        How the report's recordings are read.
+
+    Returns
+    -------
+    Recording
+
+    Raises
+    ------
+    ThermocalInputError
+        A missing column, a unit that cannot be resolved, a sensor id that differs.
+    """
     from thermocal.pipeline.reading import load_recording
 
     return load_recording(
@@ -111,6 +151,19 @@ class ReportResult:
     kind: str
 
 
+def _check_counts(
+    models: Sequence[Path], validations: Sequence[Path], labels: Sequence[str]
+) -> None:
+    """One ``--validation`` file and one ``--label`` per ``--model`` file, when given."""
+    if validations and len(validations) != len(models):
+        raise ThermocalInputError(
+            f"{len(validations)} --validation files for {len(models)} --model files; "
+            "give one validation per model, in the same order"
+        )
+    if labels and len(labels) != len(models):
+        raise ThermocalInputError(f"{len(labels)} --label values for {len(models)} --model files")
+
+
 def make_report(
     models: Sequence[Path],
     recording: Path,
@@ -130,31 +183,44 @@ def make_report(
 ) -> ReportResult:
     """``thermocal report``: a self-contained HTML report written atomically to ``output``.
 
-    A calibration of triads (the first model file) is judged on ``recording``
-    (held-out poses of a multi-position calibration, else the turntable's validation;
-    ``latitude_deg`` [°] default the file's metadata) and reported
-    (:func:`thermocal.report.triads.write_triad_report`); a calibration of several
-    channels (or several named in ``signal``) gets the calibration report
-    (:func:`thermocal.report.calibration.write_calibration_report`); model files are
-    reported and compared (:func:`thermocal.report.write_report`; one ``validations``
-    file and one label per model, in the same order).  ``progress`` draws the steps.
-    ``dynamic_s``: window [s] of the dynamic Allan deviation of the compensated output
-    (model reports only; :attr:`thermocal.report.build.ReportInputs.dynamic_s`).
-    Input errors (:class:`ThermocalInputError`): counts that do not match, the output
-    being an input, a calibration of channels given with other models.
+    Parameters
+    ----------
+    models : sequence of pathlib.Path
+        Model files, compared (:func:`thermocal.report.write_report`); or one calibration:
+        of triads, judged on ``recording`` (held-out poses, else the turntable's validation;
+        :func:`thermocal.report.triads.write_triad_report`), or of several channels
+        (:func:`thermocal.report.calibration.write_calibration_report`).
+    recording, modeling : pathlib.Path
+        The validation run and, optionally, the modelling run.
+    output : pathlib.Path
+        The HTML file to write.
+    validations, labels : sequence
+        ``thermocal validate --json`` results and labels, one per model, in its order.
+    signal, title, sensor : str, optional
+        The signal column(s) and the headline texts.
+    averaging_s, latitude_deg, dynamic_s : float, optional
+        Averaging time of the stability figures [s]; latitude [°] of a triad's validation
+        (default the file's metadata); window of the dynamic Allan deviation [s].
+    read : ReadOptions, optional
+        How the recordings are read.
+    progress : callable, optional
+        Draws the steps.
+
+    Returns
+    -------
+    ReportResult
+
+    Raises
+    ------
+    ThermocalInputError
+        Counts that do not match, the output an input, channels given with other models.
     """
     from thermocal.models.files import load_calibration
     from thermocal.writers import check_not_input
 
     opts = read or ReadOptions()
     bar = progress or _no_progress
-    if validations and len(validations) != len(models):
-        raise ThermocalInputError(
-            f"{len(validations)} --validation files for {len(models)} --model files; "
-            "give one validation per model, in the same order"
-        )
-    if labels and len(labels) != len(models):
-        raise ThermocalInputError(f"{len(labels)} --label values for {len(models)} --model files")
+    _check_counts(models, validations, labels)
     inputs_files: list[str | Path] = [*models, *validations, recording]
     if modeling is not None:
         inputs_files.append(modeling)
@@ -225,7 +291,7 @@ def _triad_report(
         text=opts.text,
         topic=opts.topic,
     )
-    if _mp_validate.is_multipos(cal.triads):  # held-out poses (issue 30)
+    if _mp_validate.is_multipos(cal.triads):  # held-out poses
         results: list[Any] = _mp_validate.validate_held_out_session(
             cal.triads, rec, latitude_deg, signal_unit=opts.signal_unit
         )
@@ -252,7 +318,7 @@ def _models_report(
     dynamic_s: float | None = None,
 ) -> ReportResult:
     """Model files reported and compared: both runs read with the same options (what they
-    warn shown in the report too, issue 25)."""
+    warn shown in the report too)."""
     from thermocal.models.files import load_model_dict
     from thermocal.report.build import ModelEntry, ReportInputs, write_report
 
@@ -277,7 +343,7 @@ def _models_report(
             for c in e.model.get("temperatures") or []:
                 if c not in temp_cols:
                     temp_cols.append(str(c))
-        # what thermocal warns while reading the runs goes into the report too (issue 25)
+        # what thermocal warns while reading the runs goes into the report too
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")
             val_rec = read_run(recording, sig, temp_cols, fitted, opts)

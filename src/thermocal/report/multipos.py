@@ -1,4 +1,4 @@
-"""The multi-position part of a triad report (issue 30): the held-out session's poses on
+"""The multi-position part of a triad report: the held-out session's poses on
 the sphere and the gravity-magnitude residual of each.
 
 Each still pose's compensated mean specific force, normalised, is the gravity ("up")
@@ -6,8 +6,8 @@ direction in body axes: a point on the unit sphere.  The sphere is drawn as its 
 hemispheres, ``z ≥ 0`` seen from +z and ``z < 0`` seen from −z, each in the orthographic
 projection ``(u_x, u_y)`` (the unit disc), each point coloured by its residual
 ``|mean f| − g`` after compensation and numbered as in the table.  Poses spread over both
-hemispheres are what the gravity-magnitude fit needs (INTERFACE.md: ≥ 9 distinct poses,
-not in one plane).  matplotlib is imported here only.
+hemispheres are what the gravity-magnitude fit needs (at least 9 distinct poses, not in one
+plane; Tedaldi et al. 2014).  matplotlib is imported here only.
 """
 
 from __future__ import annotations
@@ -27,7 +27,22 @@ def _png_b64(fig: Any) -> str:
 
 def sphere_figure(up: Any, residual: Any, unit: str) -> str:
     """The poses' up directions ``up`` (m, 3) on the two hemispheres, coloured by
-    ``residual`` (m,) [``unit``] (module docstring); a PNG data URI."""
+    ``residual`` (m,) [``unit``] (module docstring); a PNG data URI.
+
+    Parameters
+    ----------
+    up : numpy.ndarray
+        Unit gravity directions in body axes (n, 3).
+    residual : numpy.ndarray
+        Gravity-magnitude residuals (n,) [``unit``].
+    unit : str
+        The data's unit (``"deg/h"``, ``"mg"``).
+
+    Returns
+    -------
+    str
+        The figure as a PNG data URI.
+    """
     import matplotlib
 
     matplotlib.use("Agg", force=True)
@@ -71,7 +86,18 @@ def pose_section(validation: Sequence[Any] | None) -> dict[str, Any] | None:
     """The report's poses section from the held-out validation
     (:class:`thermocal.multipos.calibrate.MultiposValidation` with ``per_pose``), None
     when there is none: the figure and the table rows (pose, samples, direction,
-    residual before and after, in the accelerometer's unit)."""
+    residual before and after, in the accelerometer's unit).
+
+    Parameters
+    ----------
+    validation : sequence, optional
+        The held-out validation results.
+
+    Returns
+    -------
+    dict or None
+        The section's context, or None without held-out poses.
+    """
     val = next((v for v in validation or () if getattr(v, "per_pose", ())), None)
     if val is None:
         return None

@@ -1,4 +1,4 @@
-"""Report content of the flight-controller calibrations (issue 28, items 2 and 3).
+"""Report content of the flight-controller calibrations.
 
 :func:`comparison_html`: the coefficients active in the log against the new ones, a table
 (per parameter old, new, difference) and a figure (the correction of each set over the
@@ -29,7 +29,18 @@ NEW_COLOR = "#1f6fb2"
 
 def comparison_figure(cmp: CoefficientComparison) -> bytes:
     """One panel per axis: the old and the new correction [cmp.unit] against the
-    temperature [°C] over the calibrated range (PNG)."""
+    temperature [°C] over the calibrated range (PNG).
+
+    Parameters
+    ----------
+    cmp : CoefficientComparison
+        The coefficients of two calibrations.
+
+    Returns
+    -------
+    bytes
+        The figure as PNG.
+    """
     from thermocal.report.figures import _figure, _png
 
     t = np.asarray(cmp.temp_c)
@@ -47,7 +58,18 @@ def comparison_figure(cmp: CoefficientComparison) -> bytes:
 
 def comparison_html(cmp: CoefficientComparison) -> str:
     """The section ``#<cmp.anchor>`` of a report: table and figure of :func:`comparison_figure`
-    (each number also in ``data-old``/``data-new``/``data-difference`` at full precision)."""
+    (each number also in ``data-old``/``data-new``/``data-difference`` at full precision).
+
+    Parameters
+    ----------
+    cmp : CoefficientComparison
+        The coefficients of two calibrations.
+
+    Returns
+    -------
+    str
+        An HTML fragment.
+    """
     from markupsafe import escape
 
     rows = "\n".join(
@@ -74,13 +96,24 @@ def comparison_html(cmp: CoefficientComparison) -> str:
     )
 
 
-# --- barometers and magnetometers (issue 28, item 3) -------------------------------------
+# --- barometers and magnetometers -------------------------------------------------------
 
 
 def offset_residual_figure(req: OffsetReportRequest) -> bytes:
     """One panel per axis: the residual before (samples relative to their median) and after
     the firmware's correction [unit] against the temperature [°C]; the samples (block means,
-    in time order) light, the bin medians dark (PNG)."""
+    in time order) light, the bin medians dark (PNG).
+
+    Parameters
+    ----------
+    req
+        What the report shows.
+
+    Returns
+    -------
+    bytes
+        The figure as PNG.
+    """
     from thermocal.report.figures import _figure, _png, decimate_for_plot
 
     unit = unit_label(req.fit.unit)
@@ -101,7 +134,18 @@ def offset_residual_figure(req: OffsetReportRequest) -> bytes:
 
 def offset_holdout_figure(req: OffsetReportRequest) -> bytes:
     """One panel per axis: the odd temperature bins' residual [unit] to the polynomial
-    fitted to the even bins only, with its rms (the fit's hold-out rms) (PNG)."""
+    fitted to the even bins only, with its rms (the fit's hold-out rms) (PNG).
+
+    Parameters
+    ----------
+    req
+        What the report shows.
+
+    Returns
+    -------
+    bytes
+        The figure as PNG.
+    """
     from thermocal.report.figures import _figure, _png
 
     unit = unit_label(req.fit.unit)
@@ -120,7 +164,18 @@ def offset_holdout_figure(req: OffsetReportRequest) -> bytes:
 def build_offset_report(req: OffsetReportRequest) -> str:
     """The HTML report of one barometer or magnetometer calibration: its parameters, the
     residual before/after against the temperature and the held-out bins
-    (:func:`offset_residual_figure`, :func:`offset_holdout_figure`)."""
+    (:func:`offset_residual_figure`, :func:`offset_holdout_figure`).
+
+    Parameters
+    ----------
+    req
+        What the report shows.
+
+    Returns
+    -------
+    str
+        The self-contained HTML document.
+    """
     import datetime as _dt
 
     from thermocal import __version__
@@ -150,19 +205,43 @@ def build_offset_report(req: OffsetReportRequest) -> str:
 
 
 def write_offset_report(path: str | Path, req: OffsetReportRequest) -> Path:
-    """:func:`build_offset_report` written atomically to ``path``."""
+    """:func:`build_offset_report` written atomically to ``path``.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        The file to write.
+    req
+        What the report shows.
+
+    Returns
+    -------
+    pathlib.Path
+        The path written.
+    """
     from thermocal.writers import write_html
 
     return write_html(path, build_offset_report(req))
 
 
-# --- ArduPilot's barometer: TCAL_BARO_EXP (issue 28, item 3) ----------------------------
+# --- ArduPilot's barometer: TCAL_BARO_EXP --------------------------------------------------
 
 
 def ardupilot_baro_figures(req: ArdupilotBaroReportRequest) -> tuple[bytes, bytes]:
     """(the pressure residual before and after the firmware's correction ``max(T − 25, 0)^e``
     [Pa] against the temperature [°C], samples light and bin means dark; the odd bins'
-    residual [Pa] to the exponent fitted to the even bins) as PNGs."""
+    residual [Pa] to the exponent fitted to the even bins) as PNGs.
+
+    Parameters
+    ----------
+    req
+        What the report shows.
+
+    Returns
+    -------
+    tuple of bytes
+        Two PNG figures.
+    """
     from thermocal.report.figures import _figure, _png, decimate_for_plot
 
     with _figure(1, height_in=2.8) as (fig, axes):
@@ -193,7 +272,18 @@ def build_ardupilot_baro_report(req: ArdupilotBaroReportRequest) -> str:
     """The HTML report of ArduPilot's barometer calibration: the parameters
     ``TCAL_ENABLED``/``TEMP_MIN``/``TEMP_MAX``/``BARO_EXP`` (the log's beside the new), the
     rms before/after, the residual figure, the held-out bins, the warnings
-    (:func:`ardupilot_baro_figures`)."""
+    (:func:`ardupilot_baro_figures`).
+
+    Parameters
+    ----------
+    req
+        What the report shows.
+
+    Returns
+    -------
+    str
+        The self-contained HTML document.
+    """
     import datetime as _dt
 
     from thermocal import __version__
@@ -217,7 +307,20 @@ def build_ardupilot_baro_report(req: ArdupilotBaroReportRequest) -> str:
 
 
 def write_ardupilot_baro_report(path: str | Path, req: ArdupilotBaroReportRequest) -> Path:
-    """:func:`build_ardupilot_baro_report` written atomically to ``path``."""
+    """:func:`build_ardupilot_baro_report` written atomically to ``path``.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        The file to write.
+    req
+        What the report shows.
+
+    Returns
+    -------
+    pathlib.Path
+        The path written.
+    """
     from thermocal.writers import write_html
 
     return write_html(path, build_ardupilot_baro_report(req))

@@ -1,4 +1,4 @@
-"""HTML report of a calibration of triads (issues 19, 30, 38): for each triad its parameters
+"""HTML report of a calibration of triads: for each triad its parameters
 in the calibration's own units (a bias in the triad's unit, °/s for a °/s calibration; scale
 factors [ppm], misalignments [″]) with their σ, and, on an independent run, the figures
 before and after compensation: a turntable run's dwell-mean and move-angle errors
@@ -37,7 +37,18 @@ def _b64(png: bytes) -> str:
 
 def display_factors(tri: Any) -> list[tuple[float, str]]:
     """Per parameter of ``tri``'s model, the factor and unit it is shown in: a bias
-    (stored in °/h or mg) in the triad's own unit (``Triad.unit``), the others as stored."""
+    (stored in °/h or mg) in the triad's own unit (``Triad.unit``), the others as stored.
+
+    Parameters
+    ----------
+    tri
+        The triad calibration.
+
+    Returns
+    -------
+    list of (float, str)
+        Per axis the factor to the shown unit and the unit.
+    """
     out = []
     for f in tri.model.fits:
         if f.name.startswith("bias") and f.unit != tri.unit:
@@ -49,7 +60,18 @@ def display_factors(tri: Any) -> list[tuple[float, str]]:
 
 def run_temperatures(tri: Any) -> list[float]:
     """The distinct temperatures [°C] the triad was calibrated at (none without a
-    temperature column: the TREF recorded then is no measurement)."""
+    temperature column: the TREF recorded then is no measurement).
+
+    Parameters
+    ----------
+    tri
+        The triad calibration.
+
+    Returns
+    -------
+    list of float
+        The runs' temperatures [°C].
+    """
     if not tri.temperature:
         return []
     return sorted({round(float(r[0]), 6) for r in tri.model.runs})
@@ -184,7 +206,17 @@ def _summary_of(r: Any) -> list[dict[str, Any]]:
 
 def validation_rows(validation: list[Any] | None) -> tuple[list[dict[str, Any]], ...]:
     """The validation's absolute figures (one row per figure: n, before, after, change in %
-    and unit), its per-axis rows, and what it could not judge."""
+    and unit), its per-axis rows, and what it could not judge.
+
+    Parameters
+    ----------
+    validation : sequence, optional
+        The held-out validation results.
+
+    Returns
+    -------
+    tuple of list of dict
+    """
     summary: list[dict[str, Any]] = []
     per_axis: list[dict[str, Any]] = []
     notes: list[dict[str, Any]] = []
@@ -220,7 +252,28 @@ def build_triad_report(
     sensor: str | None = None,
 ) -> str:
     """The report's HTML (module docstring); ``title`` default "Triad calibration —
-    <file name>", ``sensor`` the sensor's name or serial number shown under it."""
+    <file name>", ``sensor`` the sensor's name or serial number shown under it.
+
+    Parameters
+    ----------
+    cal : Calibration
+        The triad calibration.
+    cal_path : str or pathlib.Path
+        Its file (provenance).
+    validation : sequence, optional
+        The held-out validation results.
+    recording_path : str or pathlib.Path, optional
+        The validation run (provenance).
+    title : str, optional
+        The headline.
+    sensor : str, optional
+        The sensor's name.
+
+    Returns
+    -------
+    str
+        The self-contained HTML document.
+    """
     from thermocal import __version__
     from thermocal.report.build import _env
     from thermocal.report.multipos import pose_section
@@ -250,7 +303,22 @@ def build_triad_report(
 
 
 def write_triad_report(path: str | Path, *args: Any, **kwargs: Any) -> Path:
-    """Write :func:`build_triad_report`'s HTML to ``path`` (a temporary, then renamed)."""
+    """Write :func:`build_triad_report`'s HTML to ``path`` (a temporary, then renamed).
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        The file to write.
+    *args
+        As :func:`build_triad_report`.
+    **kwargs
+        As :func:`build_triad_report`.
+
+    Returns
+    -------
+    pathlib.Path
+        The path written.
+    """
     return write_html(path, build_triad_report(*args, **kwargs))
 
 

@@ -1,4 +1,4 @@
-"""Sensor and chamber simulator with known truth (SPEC §2, §6).
+"""Sensor and chamber simulator with known truth.
 
 Chain of the simulation (every stage a pure function on arrays):
 
@@ -14,7 +14,7 @@ Chain of the simulation (every stage a pure function on arrays):
    first-order recursion run by :func:`scipy.signal.lfilter`.  The node
    temperatures are the sensor's temperature channels ``T1..T4``; their exact
    derivatives give the temperature rates.
-3. **Sensor** (:func:`simulate_sensor`): SPEC §2 error model
+3. **Sensor** (:func:`simulate_sensor`): the error model
    ``F = (1 + δK(T)) · (ω_in + B0 + D + E(T, Ṫ, ∇T)) + noise`` where ``B0`` is the
    constant bias, ``D`` the turn-on offset (random per run: repeatability), ``E``
    the temperature-induced bias (:class:`BiasModel`: polynomial, rate,
@@ -22,7 +22,7 @@ Chain of the simulation (every stage a pure function on arrays):
    scale-factor temperature coefficient; noise (:func:`simulate_noise`): angle
    random walk, bias instability (flicker, PSD ``B²/(2πf)``), rate random walk,
    rate ramp (IEEE Std 952-1997 Annex C) and quantization — pulse counts with
-   scale factor K for ring-laser gyros (SPEC §1), output resolution otherwise.
+   scale factor K for ring-laser gyros, output resolution otherwise.
 
 Truth columns (all scenarios):
 
@@ -44,140 +44,102 @@ from an explicit :class:`numpy.random.Generator`; scenarios derive it from
 from __future__ import annotations
 
 from thermocal.simulate.bias import (
-    BiasModel as BiasModel,
+    BiasModel,
+    HysteresisTerm,
+    PiecewiseTerm,
+    WarmupTerm,
+    play_operator,
 )
-from thermocal.simulate.bias import (
-    HysteresisTerm as HysteresisTerm,
-)
-from thermocal.simulate.bias import (
-    PiecewiseTerm as PiecewiseTerm,
-)
-from thermocal.simulate.bias import (
-    WarmupTerm as WarmupTerm,
-)
-from thermocal.simulate.bias import (
-    play_operator as play_operator,
-)
-from thermocal.simulate.noise import (
-    FLICKER_MAX_RATE_HZ as FLICKER_MAX_RATE_HZ,
-)
-from thermocal.simulate.noise import (
-    NoiseParams as NoiseParams,
-)
-from thermocal.simulate.noise import (
-    flicker_noise as flicker_noise,
-)
-from thermocal.simulate.noise import (
-    simulate_noise as simulate_noise,
-)
+from thermocal.simulate.noise import FLICKER_MAX_RATE_HZ, NoiseParams, flicker_noise, simulate_noise
 from thermocal.simulate.scenarios import (
-    DEFAULT_LATITUDE_DEG as DEFAULT_LATITUDE_DEG,
-)
-from thermocal.simulate.scenarios import (
-    IMU_BIAS_SPAN as IMU_BIAS_SPAN,
-)
-from thermocal.simulate.scenarios import (
-    IMU_CHANNELS as IMU_CHANNELS,
-)
-from thermocal.simulate.scenarios import (
-    IMU_NOISE as IMU_NOISE,
-)
-from thermocal.simulate.scenarios import (
-    ORIENTATIONS as ORIENTATIONS,
-)
-from thermocal.simulate.scenarios import (
-    SCENARIOS as SCENARIOS,
-)
-from thermocal.simulate.scenarios import (
-    TRUTH_FORMAT as TRUTH_FORMAT,
-)
-from thermocal.simulate.scenarios import (
-    TRUTH_VERSION as TRUTH_VERSION,
-)
-from thermocal.simulate.scenarios import (
-    ScenarioFn as ScenarioFn,
-)
-from thermocal.simulate.scenarios import (
-    SimulateOptions as SimulateOptions,
-)
-from thermocal.simulate.scenarios import (
-    Simulation as Simulation,
-)
-from thermocal.simulate.scenarios import (
-    run_scenario as run_scenario,
-)
-from thermocal.simulate.scenarios import (
-    scenario_accel_full_range as scenario_accel_full_range,
-)
-from thermocal.simulate.scenarios import (
-    scenario_fog_slow as scenario_fog_slow,
-)
-from thermocal.simulate.scenarios import (
-    scenario_mems_imu as scenario_mems_imu,
-)
-from thermocal.simulate.scenarios import (
-    scenario_mems_warmup as scenario_mems_warmup,
-)
-from thermocal.simulate.scenarios import (
-    scenario_rlg_modelling as scenario_rlg_modelling,
-)
-from thermocal.simulate.scenarios import (
-    scenario_rlg_validation as scenario_rlg_validation,
-)
-from thermocal.simulate.scenarios import (
-    scenario_rng as scenario_rng,
-)
-from thermocal.simulate.scenarios import (
-    scenario_turntable16 as scenario_turntable16,
-)
-from thermocal.simulate.scenarios import (
-    simulate_scenario as simulate_scenario,
+    DEFAULT_LATITUDE_DEG,
+    IMU_BIAS_SPAN,
+    IMU_CHANNELS,
+    IMU_NOISE,
+    ORIENTATIONS,
+    SCENARIOS,
+    TRUTH_FORMAT,
+    TRUTH_VERSION,
+    ScenarioFn,
+    SimulateOptions,
+    Simulation,
+    run_scenario,
+    scenario_accel_full_range,
+    scenario_fog_slow,
+    scenario_mems_imu,
+    scenario_mems_warmup,
+    scenario_rlg_modelling,
+    scenario_rlg_validation,
+    scenario_rng,
+    scenario_turntable16,
+    simulate_scenario,
 )
 from thermocal.simulate.sensors import (
-    ACCEL as ACCEL,
-)
-from thermocal.simulate.sensors import (
-    FOG as FOG,
-)
-from thermocal.simulate.sensors import (
-    MEMS_GYRO as MEMS_GYRO,
-)
-from thermocal.simulate.sensors import (
-    PRESETS as PRESETS,
-)
-from thermocal.simulate.sensors import (
-    RLG as RLG,
-)
-from thermocal.simulate.sensors import (
-    SensorOutput as SensorOutput,
-)
-from thermocal.simulate.sensors import (
-    SensorPreset as SensorPreset,
-)
-from thermocal.simulate.sensors import (
-    get_preset as get_preset,
-)
-from thermocal.simulate.sensors import (
-    simulate_sensor as simulate_sensor,
+    ACCEL,
+    FOG,
+    MEMS_GYRO,
+    PRESETS,
+    RLG,
+    SensorOutput,
+    SensorPreset,
+    get_preset,
+    simulate_sensor,
 )
 from thermocal.simulate.thermal import (
-    ChamberModel as ChamberModel,
+    ChamberModel,
+    ThermalNetwork,
+    ThermalResult,
+    chamber_air,
+    simulate_nodes,
+    simulate_thermal,
+    uniform_step,
 )
-from thermocal.simulate.thermal import (
-    ThermalNetwork as ThermalNetwork,
-)
-from thermocal.simulate.thermal import (
-    ThermalResult as ThermalResult,
-)
-from thermocal.simulate.thermal import (
-    chamber_air as chamber_air,
-)
-from thermocal.simulate.thermal import (
-    simulate_nodes as simulate_nodes,
-)
-from thermocal.simulate.thermal import (
-    simulate_thermal as simulate_thermal,
-)
-from thermocal.simulate.thermal import (
-    uniform_step as uniform_step,
-)
+
+__all__ = [
+    "ACCEL",
+    "DEFAULT_LATITUDE_DEG",
+    "FLICKER_MAX_RATE_HZ",
+    "FOG",
+    "IMU_BIAS_SPAN",
+    "IMU_CHANNELS",
+    "IMU_NOISE",
+    "MEMS_GYRO",
+    "ORIENTATIONS",
+    "PRESETS",
+    "RLG",
+    "SCENARIOS",
+    "TRUTH_FORMAT",
+    "TRUTH_VERSION",
+    "BiasModel",
+    "ChamberModel",
+    "HysteresisTerm",
+    "NoiseParams",
+    "PiecewiseTerm",
+    "ScenarioFn",
+    "SensorOutput",
+    "SensorPreset",
+    "SimulateOptions",
+    "Simulation",
+    "ThermalNetwork",
+    "ThermalResult",
+    "WarmupTerm",
+    "chamber_air",
+    "flicker_noise",
+    "get_preset",
+    "play_operator",
+    "run_scenario",
+    "scenario_accel_full_range",
+    "scenario_fog_slow",
+    "scenario_mems_imu",
+    "scenario_mems_warmup",
+    "scenario_rlg_modelling",
+    "scenario_rlg_validation",
+    "scenario_rng",
+    "scenario_turntable16",
+    "simulate_nodes",
+    "simulate_noise",
+    "simulate_scenario",
+    "simulate_sensor",
+    "simulate_thermal",
+    "uniform_step",
+]

@@ -1,5 +1,5 @@
 """The temperature-induced bias of a simulated sensor: polynomial, piecewise,
-warm-up and hysteresis terms (SPEC §7).
+warm-up and hysteresis terms.
 
 Part of :mod:`thermocal.simulate`."""
 
@@ -23,7 +23,8 @@ Truth = dict[str, Any]
 
 @dataclass(frozen=True)
 class PiecewiseTerm:
-    """Continuous piecewise-linear bias in ``T_sensor`` (seed 001), zero at ``t_ref``.
+    """Continuous piecewise-linear bias in ``T_sensor`` (*Design and engineering implementation
+    of a fibre-optic-gyro line-of-sight stabilisation system*), zero at ``t_ref``.
 
     ``b(T) = s_0 (T − T_ref) + Σ_j (s_{j+1} − s_j) w ln(1 + e^{(T − c_j)/w})`` − its
     value at T_ref: slopes ``slopes`` [unit/°C] between breakpoints ``breakpoints_c``,
@@ -55,7 +56,8 @@ class PiecewiseTerm:
 
 @dataclass(frozen=True)
 class WarmupTerm:
-    """Warm-up bias (seed 003, SPEC §4c): ``Σ_{j≥1} a_j(T0) ΔT^j``, ``ΔT = T − T0``,
+    """Warm-up bias (*Temperature-characteristic calibration test plan*): ``Σ_{j≥1} a_j(T0)
+    ΔT^j``, ``ΔT = T − T0``,
     ``a_j(T0) = b_j0 + b_j1 T0 + b_j2 T0²``; ``coefficients[j−1] = (b_j0, b_j1, b_j2)``;
     ``start`` = ``(c0, c1, c2)`` gives the power-on bias ``c0 + c1 T0 + c2 T0²``.
     T0 is the sensor temperature at power-on [°C]."""
@@ -65,10 +67,31 @@ class WarmupTerm:
     start: tuple[float, float, float] = (0.0, 0.0, 0.0)
 
     def a(self, t0_c: float) -> list[float]:
-        """Coefficients a_j(T0) [unit/°C^j], j = 1..order."""
+        """Coefficients a_j(T0) [unit/°C^j], j = 1..order.
+
+        Parameters
+        ----------
+        t0_c : float
+            Sensor temperature at power-on T0 [°C].
+
+        Returns
+        -------
+        list of float
+        """
         return [b0 + b1 * t0_c + b2 * t0_c**2 for b0, b1, b2 in self.coefficients]
 
     def start_bias(self, t0_c: float) -> float:
+        """The power-on bias c0 + c1 T0 + c2 T0² [unit of the sensor] at T0 = ``t0_c`` [°C].
+
+        Parameters
+        ----------
+        t0_c : float
+            Sensor temperature at power-on T0 [°C].
+
+        Returns
+        -------
+        float
+        """
         c0, c1, c2 = self.start
         return c0 + c1 * t0_c + c2 * t0_c**2
 
@@ -85,7 +108,37 @@ class HysteresisTerm:
 
 
 def play_operator(x: FloatArray, width: float, p0: float | None = None) -> FloatArray:
-    """Play (backlash) operator: ``p_i = clip(p_{i−1}, x_i − w/2, x_i + w/2)``."""
+    """Play (backlash) operator: ``p_i = clip(p_{i−1}, x_i − w/2, x_i + w/2)``.
+
+    Parameters
+    ----------
+    x : numpy.ndarray
+        The input (a temperature history) [°C].
+    width : float
+        The play's width w [°C].
+    p0 : float, optional
+        The initial state (default ``x[0]``).
+
+    Returns
+    -------
+    numpy.ndarray
+        The operator's output, same shape as ``x``.
+
+    Notes
+    -----
+    The play (backlash) operator of hysteresis models: it follows the input only once the input
+    has moved w/2 beyond it.
+
+    References
+    ----------
+    M. A. Krasnosel'skii and A. V. Pokrovskii, *Systems with Hysteresis*, Springer, 1989.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> play_operator(np.array([0.0, 1.0, 2.0, 1.5, 0.0]), 1.0).tolist()
+    [0.0, 0.5, 1.5, 1.5, 0.5]
+    """
     half = width / 2.0
     out = np.empty_like(x)
     p = float(x[0]) if p0 is None else p0
@@ -101,12 +154,13 @@ def play_operator(x: FloatArray, width: float, p0: float | None = None) -> Float
 
 @dataclass(frozen=True)
 class BiasModel:
-    """Temperature-induced bias ``E`` of SPEC §2 [unit of the sensor: °/h or mg].
+    """Temperature-induced bias ``E`` [unit of the sensor: °/h or mg].
 
     ``E = Σ_k Σ_j poly[k][j−1] (T_k − T_ref)^j + Σ_k rate[k] Ṫ_k
     + Σ_k coupling[k] (T_k − T_ref) Ṫ_k + Σ g (T_i − T_j)`` (+ piecewise, warm-up,
     hysteresis terms), with ``Ṫ`` in [°C/min].  Every polynomial, rate, coupling
-    and gradient term lies in the span of the seed-000 37-term model (SPEC §4a).
+    and gradient term lies in the span of the 37-term model of *A modelling and validation
+    method for the temperature compensation model of a ring-laser gyroscope*.
     """
 
     t_ref_c: float = 20.0
@@ -127,7 +181,24 @@ class BiasModel:
         power_on_index: int = 0,
     ) -> FloatArray:
         """E at every sample: ``temps_c`` and ``rates_c_per_min`` are (n, k); ``t0_c`` the
-        node temperatures at power-on (warm-up term; before ``power_on_index`` it is 0)."""
+        node temperatures at power-on (warm-up term; before ``power_on_index`` it is 0).
+
+        Parameters
+        ----------
+        temps_c : numpy.ndarray
+            Node temperatures (n, k) [°C].
+        rates_c_per_min : numpy.ndarray
+            Their rates (n, k) [°C/min].
+        t0_c : numpy.ndarray, optional
+            Node temperatures at power-on (k,) [°C].
+        power_on_index : int
+            Sample of the power-on.
+
+        Returns
+        -------
+        numpy.ndarray
+            E (n,) [unit of the sensor].
+        """
         n = temps_c.shape[0]
         out = np.full(n, float(self.offset))
         xk = np.empty(n)

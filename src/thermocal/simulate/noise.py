@@ -28,14 +28,39 @@ Truth = dict[str, Any]
 
 @dataclass(frozen=True)
 class NoiseParams:
-    """Noise terms of a sensor output, in its unit ``u`` (°/h or mg).
+    r"""Noise terms of a sensor output, in its unit ``u`` (°/h or mg).
 
-    white_density : N [u·√s] = [u/√Hz], two-sided PSD N² (angle / velocity random walk;
-        a gyro ARW of N' [°/√h] is N = 60·N' [°/h·√s]); Allan ``σ²(τ) = N²/τ``.
-    bias_instability : B [u], flicker PSD ``B²/(2πf)``; Allan plateau ``0.664 B``.
-    rate_random_walk : K [u/√s]; Allan ``σ²(τ) = K² τ/3``.
-    rate_ramp : R [u/s]; Allan ``σ²(τ) = R² τ²/2``.
-    resolution : output LSB [u] (0: none); pulse outputs are quantized by K instead.
+    Parameters
+    ----------
+    white_density : float
+        N [u·√s] = [u/√Hz], two-sided PSD N² (angle or velocity random walk; a gyro ARW of
+        N' [°/√h] is N = 60·N' [°/h·√s]).
+    bias_instability : float
+        B [u], flicker noise of PSD B²/(2πf).
+    rate_random_walk : float
+        K [u/√s].
+    rate_ramp : float
+        R [u/s].
+    resolution : float
+        Output LSB [u] (0: none); pulse outputs are quantized by the scale factor instead.
+
+    Notes
+    -----
+    The Allan variance of each term, as IEEE Std 952-1997 Annex C gives it:
+
+    .. math::
+
+        \sigma^2(\tau) = \frac{N^2}{\tau} + \frac{2\ln 2}{\pi}B^2
+        + \frac{K^2\tau}{3} + \frac{R^2\tau^2}{2},
+
+    so that the flicker plateau is :math:`\sqrt{2\ln 2/\pi}\,B \approx 0.664\,B`.
+
+    References
+    ----------
+    IEEE Std 952-1997, *IEEE Standard Specification Format Guide and Test Procedure for
+    Single-Axis Interferometric Fiber Optic Gyros*, Annex C.
+
+    W. J. Riley, *Handbook of Frequency Stability Analysis*, NIST SP 1065, 2008.
     """
 
     white_density: float = 0.0
@@ -46,10 +71,43 @@ class NoiseParams:
 
 
 def flicker_noise(n: int, dt_s: float, b: float, rng: np.random.Generator) -> FloatArray:
-    """Flicker (1/f) noise with two-sided PSD ``S(f) = B²/(2πf)`` (IEEE 952 bias instability).
+    r"""Flicker (1/f) noise of two-sided PSD ``S(f) = B²/(2πf)`` (IEEE 952 bias instability).
 
-    Spectral synthesis: ``X_k = sqrt(N f_s S(f_k)/2)·(a + ib)``, a, b ~ N(0, 1),
-    ``x = irfft(X)`` (so ``E|X_k|² = N f_s S(f_k)``); the DC bin is zero.
+    Parameters
+    ----------
+    n : int
+        Number of samples.
+    dt_s : float
+        Sample interval τ0 [s].
+    b : float
+        Bias instability coefficient B [unit of the output].
+    rng : numpy.random.Generator
+        The source of the random numbers.
+
+    Returns
+    -------
+    numpy.ndarray
+        The noise (n,) [unit of B].
+
+    Notes
+    -----
+    Spectral synthesis on the FFT grid :math:`f_k`:
+
+    .. math::
+
+        X_k = \sqrt{N f_s S(f_k)/2}\,(a_k + i b_k),\quad a_k, b_k \sim N(0, 1),
+        \qquad x = \mathrm{irfft}(X),
+
+    so that :math:`E|X_k|^2 = N f_s S(f_k)`; the DC bin is zero.  Its Allan deviation is
+    flat at :math:`\sqrt{2\ln 2/\pi}\,B \approx 0.664\,B`.
+
+    References
+    ----------
+    IEEE Std 952-1997, *IEEE Standard Specification Format Guide and Test Procedure for
+    Single-Axis Interferometric Fiber Optic Gyros*, Annex C.
+
+    W. J. Riley, *Handbook of Frequency Stability Analysis*, NIST Special Publication 1065,
+    2008.
     """
     if b == 0.0 or n == 0:
         return np.zeros(n)
@@ -74,10 +132,56 @@ FLICKER_MAX_RATE_HZ = 10.0
 
 
 def simulate_noise(n: int, dt_s: float, noise: NoiseParams, rng: np.random.Generator) -> FloatArray:
-    """Sum of white (N/√τ0 per sample), flicker (:func:`flicker_noise`, at most at
-    :data:`FLICKER_MAX_RATE_HZ`), rate random walk (cumulative sum of N(0, K² τ0)) and
-    rate ramp (R·t) noise, n samples at τ0 = dt_s.
-    Samples are mean rates over each interval (IEEE Std 952 Annex C)."""
+    r"""The noise of a sensor output: white, flicker, rate random walk and rate ramp.
+
+    White noise of standard deviation N/√τ0 per sample, flicker (:func:`flicker_noise`,
+    synthesised at most at :data:`FLICKER_MAX_RATE_HZ`), rate random walk (cumulative
+    sum of N(0, K² τ0)) and rate ramp (R·t).  Samples are mean rates over each interval.
+
+    Parameters
+    ----------
+    n : int
+        Number of samples.
+    dt_s : float
+        Sample interval τ0 [s].
+    noise : NoiseParams
+        The noise terms N, B, K, R.
+    rng : numpy.random.Generator
+        The source of the random numbers.
+
+    Returns
+    -------
+    numpy.ndarray
+        The noise (n,) [unit of the terms].
+
+    Notes
+    -----
+    The Allan variance of the sum is that of IEEE Std 952-1997 Annex C,
+
+    .. math::
+
+        \sigma^2(\tau) = \frac{N^2}{\tau} + \frac{2\ln 2}{\pi}B^2
+        + \frac{K^2\tau}{3} + \frac{R^2\tau^2}{2} .
+
+    References
+    ----------
+    IEEE Std 952-1997, *IEEE Standard Specification Format Guide and Test Procedure for
+    Single-Axis Interferometric Fiber Optic Gyros*, Annex C.
+
+    W. J. Riley, *Handbook of Frequency Stability Analysis*, NIST Special Publication 1065,
+    2008.
+
+    Examples
+    --------
+    White noise of N = 0.1 [unit·√s] at τ0 = 0.01 s has a standard deviation
+    N/√τ0 = 1 per sample:
+
+    >>> import numpy as np
+    >>> y = simulate_noise(200_000, 0.01, NoiseParams(white_density=0.1),
+    ...                    np.random.default_rng(0))
+    >>> round(float(y.std()), 2)
+    1.0
+    """
     if noise.white_density:
         out = rng.standard_normal(n)
         out *= noise.white_density / math.sqrt(dt_s)

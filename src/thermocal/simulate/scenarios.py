@@ -57,7 +57,33 @@ TRUTH_VERSION = 1
 
 
 def scenario_rng(scenario: str, seed: int, n: int) -> list[np.random.Generator]:
-    """``n`` independent generators from ``SeedSequence([seed, crc32(scenario)])``."""
+    """``n`` independent generators from ``SeedSequence([seed, crc32(scenario)])``.
+
+    Parameters
+    ----------
+    scenario : str
+        The scenario's name.
+    seed : int
+        The seed; the same seed gives the same output.
+    n : int
+        Number of generators.
+
+    Returns
+    -------
+    list of numpy.random.Generator
+
+    Raises
+    ------
+    ThermocalInputError
+        ``seed`` is not a non-negative integer.
+
+    Examples
+    --------
+    >>> a, = scenario_rng("fog-slow", 0, 1)
+    >>> b, = scenario_rng("fog-slow", 0, 1)
+    >>> bool(a.normal() == b.normal())
+    True
+    """
     if int(seed) != seed or seed < 0:
         raise ThermocalInputError(f"seed must be a non-negative integer, got {seed!r}")
     ss = np.random.SeedSequence([int(seed), zlib.crc32(scenario.encode())])
@@ -81,7 +107,20 @@ MAX_SAMPLES = MAX_SIMULATED_SAMPLES
 
 
 def check_sample_budget(n: float, what: str) -> None:
-    """Refuse ``n`` samples above :data:`MAX_SAMPLES`, saying what to lower."""
+    """Refuse ``n`` samples above :data:`MAX_SAMPLES`, saying what to lower.
+
+    Parameters
+    ----------
+    n : float
+        Samples the call would make.
+    what : str
+        How the message names the call.
+
+    Raises
+    ------
+    ThermocalInputError
+        ``n`` is above :data:`MAX_SAMPLES`.
+    """
     if not n <= MAX_SAMPLES:
         raise ThermocalInputError(
             f"{what}: {n:.3g} samples to simulate, above the limit of {MAX_SAMPLES:.3g}: "
@@ -176,8 +215,8 @@ def _truth(
             ),
             "time_constants_s": [float(v) for v in thermal.time_constants_s],
             "stages": [s.to_dict() for s in stages],
-            "truth_bias_definition": "temperature-induced bias E (SPEC §2); see "
-            "thermocal.simulate module docstring",
+            "truth_bias_definition": "temperature-induced bias E (constant bias, turn-on "
+            "offset and input excluded); see thermocal.simulate module docstring",
             **extra,
         }
     )
@@ -258,8 +297,35 @@ def scenario_rlg_modelling(
     axis: str = "up",
     preset: str = "rlg",
 ) -> ScenarioResult:
-    """Seed-000 modelling run of the ``rlg`` preset over the ``rlg-modelling`` profile
-    (≈ 65 h at 1 Hz by default); powered on at t = 0, soaked at the start temperature."""
+    """Modelling run (*A modelling and validation method for the temperature compensation model
+    of a ring-laser gyroscope*) of the ``rlg`` preset over the ``rlg-modelling`` profile
+    (≈ 65 h at 1 Hz by default); powered on at t = 0, soaked at the start temperature.
+
+    Parameters
+    ----------
+    seed : int
+        The seed; the same seed gives the same output.
+    profile : str, tuple of numpy.ndarray or None
+        The chamber program (a built-in name or ``(time_s, setpoint_c)``); None: the scenario's own.
+    rate_hz : float, optional
+        Sample rate [Hz] (default: the preset's).
+    latitude_deg : float
+        Latitude [°] (the earth rate on the sensitive axis).
+    axis : str
+        Sensitive axis (``"up"``, ``"north"``, …).
+    preset : str
+        The sensor preset (:data:`thermocal.simulate.PRESETS`).
+
+    Returns
+    -------
+    list of (Recording, dict)
+        Each recording with its truth.
+
+    Raises
+    ------
+    ThermocalInputError
+        A bad option, a program the chamber cannot follow, or more samples than the budget.
+    """
     return _single_gyro_scenario(
         "rlg-modelling", seed, profile, rate_hz, latitude_deg, axis, preset, warmed_up=False
     )
@@ -274,8 +340,35 @@ def scenario_rlg_validation(
     axis: str = "up",
     preset: str = "rlg",
 ) -> ScenarioResult:
-    """Seed-000 validation run (holds, weakly correlated with ``rlg-modelling``), same
-    sensor as :func:`scenario_rlg_modelling`, another turn-on and noise."""
+    """Validation run of the ring-laser-gyro method (holds, weakly correlated with
+    ``rlg-modelling``), same
+    sensor as :func:`scenario_rlg_modelling`, another turn-on and noise.
+
+    Parameters
+    ----------
+    seed : int
+        The seed; the same seed gives the same output.
+    profile : str, tuple of numpy.ndarray or None
+        The chamber program (a built-in name or ``(time_s, setpoint_c)``); None: the scenario's own.
+    rate_hz : float, optional
+        Sample rate [Hz] (default: the preset's).
+    latitude_deg : float
+        Latitude [°] (the earth rate on the sensitive axis).
+    axis : str
+        Sensitive axis (``"up"``, ``"north"``, …).
+    preset : str
+        The sensor preset (:data:`thermocal.simulate.PRESETS`).
+
+    Returns
+    -------
+    list of (Recording, dict)
+        Each recording with its truth.
+
+    Raises
+    ------
+    ThermocalInputError
+        A bad option, a program the chamber cannot follow, or more samples than the budget.
+    """
     return _single_gyro_scenario(
         "rlg-validation", seed, profile, rate_hz, latitude_deg, axis, preset, warmed_up=False
     )
@@ -290,7 +383,34 @@ def scenario_fog_slow(
     axis: str = "up",
     preset: str = "fog",
 ) -> ScenarioResult:
-    """Seed-001 slow drift over 15–42 °C of a warmed-up ``fog`` (piecewise bias)."""
+    """Slow drift (*Design and engineering implementation of a fibre-optic-gyro line-of-sight
+    stabilisation system*, chapter 3) over 15–42 °C of a warmed-up ``fog`` (piecewise bias).
+
+    Parameters
+    ----------
+    seed : int
+        The seed; the same seed gives the same output.
+    profile : str, tuple of numpy.ndarray or None
+        The chamber program (a built-in name or ``(time_s, setpoint_c)``); None: the scenario's own.
+    rate_hz : float, optional
+        Sample rate [Hz] (default: the preset's).
+    latitude_deg : float
+        Latitude [°] (the earth rate on the sensitive axis).
+    axis : str
+        Sensitive axis (``"up"``, ``"north"``, …).
+    preset : str
+        The sensor preset (:data:`thermocal.simulate.PRESETS`).
+
+    Returns
+    -------
+    list of (Recording, dict)
+        Each recording with its truth.
+
+    Raises
+    ------
+    ThermocalInputError
+        A bad option, a program the chamber cannot follow, or more samples than the budget.
+    """
     return _single_gyro_scenario(
         "fog-slow", seed, profile, rate_hz, latitude_deg, axis, preset, warmed_up=True
     )
@@ -328,15 +448,45 @@ def scenario_mems_warmup(
     axis: str = "up",
     preset: str = "mems-gyro",
 ) -> ScenarioResult:
-    """Seed-003 warm-ups: one file per start temperature (label ``T+25`` …).
+    """Power-on warm-ups (*Temperature-characteristic calibration test plan*): one file per
+    start temperature (label ``T+25`` …).
 
     Each file starts at power-on (t = 0) with the unit soaked at the chamber air
     temperature and lasts the power-on hold (``record_s`` ≥ 360 s for program
     files).  Truth: ``start_temperature_c`` (T0 = T1 at power-on), the warm-up
     coefficients ``a_j(T0)`` and ``start_bias``.
+
+    Parameters
+    ----------
+    seed : int
+        The seed; the same seed gives the same output.
+    profile : str, tuple of numpy.ndarray or None
+        The chamber program (a built-in name or ``(time_s, setpoint_c)``); None: the scenario's own.
+    rate_hz : float, optional
+        Sample rate [Hz] (default: the preset's).
+    record_s : float
+        Record per power-on [s], at least 360.
+    latitude_deg : float
+        Latitude [°] (the earth rate on the sensitive axis).
+    axis : str
+        Sensitive axis (``"up"``, ``"north"``, …).
+    preset : str
+        The sensor preset (:data:`thermocal.simulate.PRESETS`).
+
+    Returns
+    -------
+    list of (Recording, dict)
+        Each recording with its truth.
+
+    Raises
+    ------
+    ThermocalInputError
+        A bad option, a program the chamber cannot follow, or more samples than the budget.
     """
     if record_s < 360:
-        raise ThermocalInputError(f"record_s must be ≥ 360 s (seed 003), got {record_s}")
+        raise ThermocalInputError(
+            f"record_s must be ≥ 360 s (the warm-up test plan's record), got {record_s}"
+        )
     p = get_preset(preset)
     program, wins = _power_on_windows(profile, record_s)
     hz = rate_hz or p.rate_hz
@@ -382,7 +532,8 @@ def scenario_accel_full_range(
     orientation: str = "horizontal",
     preset: str = "accel",
 ) -> ScenarioResult:
-    """Seed-004 full-range runs: one file per run (label ``run1`` …).
+    """Full-range runs (*Adaptive accelerometer temperature compensation method for inertial
+    navigation*): one file per run (label ``run1`` …).
 
     The program (default ``accel-full-range`` with one repetition) is one run,
     repeated ``runs`` times with a power-on at the start of each.  Each run's bias
@@ -390,6 +541,31 @@ def scenario_accel_full_range(
     shuffled balanced cycle over the preset's curves, plus the turn-on offset.
     The input is gravity on the sensitive axis (``orientation``: horizontal 0 g,
     up +1 g, down −1 g) in [mg].
+
+    Parameters
+    ----------
+    seed : int
+        The seed; the same seed gives the same output.
+    profile : str, tuple of numpy.ndarray or None
+        The chamber program (a built-in name or ``(time_s, setpoint_c)``); None: the scenario's own.
+    runs : int
+        Number of runs (one power-on each).
+    rate_hz : float, optional
+        Sample rate [Hz] (default: the preset's).
+    orientation : str
+        ``"horizontal"``, ``"up"`` or ``"down"`` (gravity on the sensitive axis).
+    preset : str
+        The sensor preset (:data:`thermocal.simulate.PRESETS`).
+
+    Returns
+    -------
+    list of (Recording, dict)
+        Each recording with its truth.
+
+    Raises
+    ------
+    ThermocalInputError
+        A bad option, a program the chamber cannot follow, or more samples than the budget.
     """
     p = get_preset(preset)
     if orientation not in ORIENTATIONS:
@@ -427,8 +603,28 @@ def scenario_accel_full_range(
 
 
 def scenario_turntable16(seed: int, profile: ProfileInput = None, **opts: Any) -> ScenarioResult:
-    """The 16-position turntable run (SPEC §7), delegated to
-    :func:`thermocal.turntable.simulate.simulate_turntable16` (imported lazily)."""
+    """The 16-position dual-axis turntable run (CN104880182), delegated to
+    :func:`thermocal.turntable.simulate.simulate_turntable16` (imported lazily).
+
+    Parameters
+    ----------
+    seed : int
+        The seed; the same seed gives the same output.
+    profile : None
+        Must be None (no chamber program).
+    **opts
+        Options of the delegated simulator.
+
+    Returns
+    -------
+    list of (Recording, dict)
+        Each recording with its truth.
+
+    Raises
+    ------
+    ThermocalInputError
+        A bad option, a program the chamber cannot follow, or more samples than the budget.
+    """
     if profile is not None:
         raise ThermocalInputError("the turntable-16 scenario takes no chamber profile")
     from thermocal.turntable.simulate import simulate_turntable16
@@ -466,7 +662,27 @@ def scenario_turntable_thermal(
 ) -> ScenarioResult:
     """16-position runs of a gyro and an accelerometer triad at several soak temperatures
     and a held-out run at an unseen one, every parameter a known polynomial in temperature
-    (:func:`thermocal.turntable.simulate.simulate_turntable_thermal`, issue 19)."""
+    (:func:`thermocal.turntable.simulate.simulate_turntable_thermal`).
+
+    Parameters
+    ----------
+    seed : int
+        The seed; the same seed gives the same output.
+    profile : None
+        Must be None (no chamber program).
+    **opts
+        Options of the delegated simulator.
+
+    Returns
+    -------
+    list of (Recording, dict)
+        Each recording with its truth.
+
+    Raises
+    ------
+    ThermocalInputError
+        A bad option, a program the chamber cannot follow, or more samples than the budget.
+    """
     if profile is not None:
         raise ThermocalInputError("the turntable-thermal scenario takes no chamber profile")
     from thermocal.turntable.simulate import simulate_turntable_thermal
@@ -480,9 +696,29 @@ def scenario_turntable_thermal(
 
 def scenario_multipos(seed: int, profile: ProfileInput = None, **opts: Any) -> ScenarioResult:
     """Hand-placed multi-position sessions of an IMU with known bias, scale factors and
-    misalignments and their temperature trends (issue 30;
+    misalignments and their temperature trends (
     :func:`thermocal.multipos.simulate.simulate_runs`; ``runs`` sessions at temperatures
-    over −10…+50 °C, one at 25 °C by default)."""
+    over −10…+50 °C, one at 25 °C by default).
+
+    Parameters
+    ----------
+    seed : int
+        The seed; the same seed gives the same output.
+    profile : None
+        Must be None (no chamber program).
+    **opts
+        Options of the delegated simulator.
+
+    Returns
+    -------
+    list of (Recording, dict)
+        Each recording with its truth.
+
+    Raises
+    ------
+    ThermocalInputError
+        A bad option, a program the chamber cannot follow, or more samples than the budget.
+    """
     if profile is not None:
         raise ThermocalInputError("the multipos scenario takes no chamber profile")
     from thermocal.multipos.simulate import simulate_runs
@@ -523,17 +759,32 @@ def scenario_mems_imu(
     gravity_axis: str = "az",
     preset: str = "mems-gyro",
 ) -> ScenarioResult:
-    """A six-axis MEMS IMU in a chamber (issue 15): three gyros [°/s], three
-    accelerometers [mg], one die temperature ``T_die`` (the first node of the preset's
-    thermal network, so it lags the chamber air) and the air ``T_chamber``.
+    """A six-axis MEMS IMU in a chamber: gyros [°/s], accelerometers [mg], the die
+    temperature ``T_die`` (lagging the air) and the air ``T_chamber``.  Each channel's bias
+    is a cubic ``Σ_j c_j x^j``, ``x = (T_die − 25)/40``, coefficients drawn within
+    :data:`IMU_BIAS_SPAN`; gravity +1000 mg on ``gravity_axis``; white noise
+    :data:`IMU_NOISE`.  Truth: ``channels`` and ``truth_<name>`` columns (the bias alone).
 
-    Each channel's temperature-induced bias is a cubic in the die temperature,
-    ``b(T) = Σ_j c_j x^j`` with ``x = (T − 25)/40`` and coefficients drawn (per seed) within
-    :data:`IMU_BIAS_SPAN`; gravity (+1000 mg) is on ``gravity_axis``; white noise
-    :data:`IMU_NOISE`. ``run`` ``"modelling"`` uses the soak-and-ramp program of
-    ``rlg-modelling``, ``"validation"`` the weakly correlated ``rlg-validation`` program
-    (the same unit: the same coefficients). Truth: ``channels`` {name: {unit, coefficients,
-    gravity_mg}} and ``truth_<name>`` columns (the temperature-induced bias alone).
+    Parameters
+    ----------
+    seed : int
+        The seed: the same seed gives the same unit (the same coefficients).
+    profile : str, tuple of numpy.ndarray or None
+        The chamber program; None: ``rlg-modelling`` or ``rlg-validation``, as ``run`` says.
+    run, gravity_axis, preset : str
+        ``"modelling"`` or ``"validation"``; the accelerometer channel that sees +1000 mg;
+        the sensor preset whose thermal network is used.
+    rate_hz : float
+        Sample rate [Hz].
+
+    Returns
+    -------
+    list of (Recording, dict)
+
+    Raises
+    ------
+    ThermocalInputError
+        A bad option, or more samples than the budget.
     """
     if run not in ("modelling", "validation"):
         raise ThermocalInputError(f"run must be modelling or validation, got {run!r}")
@@ -619,7 +870,30 @@ SCENARIOS: dict[str, ScenarioFn] = {
 def run_scenario(
     name: str, seed: int = 0, profile: ProfileInput = None, **opts: Any
 ) -> ScenarioResult:
-    """Run a scenario by name; unknown names and options raise :class:`ThermocalInputError`."""
+    """Run a scenario by name.
+
+    Parameters
+    ----------
+    name : str
+        A key of :data:`SCENARIOS`.
+    seed : int
+        The seed; the same seed gives the same recordings.
+    profile : str, tuple of numpy.ndarray or None
+        The chamber program (a built-in name or ``(time_s, setpoint_c)``); None: the
+        scenario's own.
+    **opts
+        The scenario's options (``rate_hz``, ``latitude_deg``, ``runs``, …).
+
+    Returns
+    -------
+    list of (Recording, dict)
+        Each recording with its truth.
+
+    Raises
+    ------
+    ThermocalInputError
+        An unknown scenario or option.
+    """
     try:
         fn = SCENARIOS[name]
     except KeyError:
@@ -636,9 +910,32 @@ def run_scenario(
 
 @dataclass(frozen=True)
 class SimulateOptions:
-    """The options ``thermocal simulate`` passes to a scenario (None: the scenario's
-    default): sample rate [Hz], latitude [°] and sensitive axis, number of runs,
-    orientation, record per power-on [s] and run (modelling or validation)."""
+    """The options of a scenario (None: the scenario's default).
+
+    Parameters
+    ----------
+    rate_hz : float, optional
+        Sample rate [Hz].
+    latitude_deg : float, optional
+        Latitude [°], within ±90.
+    axis : str, optional
+        Sensitive axis of a single gyro (``"up"``, ``"north"``, …).
+    runs : int, optional
+        Number of runs.
+    orientation : str, optional
+        Accelerometer orientation (``"horizontal"``, ``"up"``, ``"down"``).
+    record_s : float, optional
+        Record per power-on [s].
+    run : str, optional
+        ``"modelling"`` or ``"validation"`` (multi-channel scenarios).
+    turns : bool, optional
+        Multi-position sessions with the six named faces and 360° turns.
+
+    Raises
+    ------
+    ThermocalInputError
+        A rate that is not positive or a latitude beyond ±90°.
+    """
 
     rate_hz: float | None = None
     latitude_deg: float | None = None
@@ -675,7 +972,19 @@ class Simulation:
 
     def truth_document(self, files: Sequence[str], profile: str | None) -> dict[str, Any]:
         """The ``--truth`` JSON: format, version, scenario, seed, profile and per recording
-        its truth with ``file`` the path it was written to."""
+        its truth with ``file`` the path it was written to.
+
+        Parameters
+        ----------
+        files : sequence of str
+            The path each recording was written to.
+        profile : str, optional
+            The profile's name or file.
+
+        Returns
+        -------
+        dict
+        """
         return {
             "format": TRUTH_FORMAT,
             "version": TRUTH_VERSION,
@@ -689,7 +998,37 @@ class Simulation:
 def simulate_scenario(
     scenario: str, seed: int, profile: ProfileInput, options: SimulateOptions
 ) -> Simulation:
-    """Run the scenario (:func:`run_scenario`) with ``options`` and label its recordings."""
+    """Run a scenario with its options and label its recordings.
+
+    Parameters
+    ----------
+    scenario : str
+        A key of :data:`SCENARIOS`.
+    seed : int
+        The seed.
+    profile : str, tuple of numpy.ndarray or None
+        The chamber program, or None for the scenario's own.
+    options : SimulateOptions
+        The options.
+
+    Returns
+    -------
+    Simulation
+
+    Raises
+    ------
+    ThermocalInputError
+        An unknown scenario, an option it does not take, or a run over the sample budget.
+
+    Examples
+    --------
+    Power-on warm-ups of a MEMS gyro at seven start temperatures; each truth records the
+    warm-up coefficients the recording was made with:
+
+    >>> sim = simulate_scenario("mems-warmup", 0, None, SimulateOptions())
+    >>> sim.labels
+    ('T-40', 'T-20', 'T+0', 'T+20', 'T+40', 'T+60', 'T+80')
+    """
     results = run_scenario(scenario, seed, profile, **options.given())
     labels = [str(t.get("label", "")) for _, t in results]
     if len(set(labels)) != len(labels):

@@ -1,4 +1,4 @@
-"""The chamber air and the thermal network of the sensor (SPEC §7).
+"""The chamber air and the thermal network of the sensor.
 
 Part of :mod:`thermocal.simulate`."""
 
@@ -54,8 +54,17 @@ def _plain(obj: Any) -> Any:
 
 @dataclass(frozen=True)
 class ChamberModel:
-    """A temperature chamber: set-point slew limit [°C/min] and air lag τ [s]
-    (``0`` for no lag, ``inf`` rate for no limit)."""
+    """A temperature chamber: its set-point slew limit and air lag.
+
+    Parameters
+    ----------
+    max_rate_c_per_min : float
+        Slew limit of the set-point [°C/min] (``inf``: no limit).
+    air_time_constant_s : float
+        Lag τ of the air behind the limited set-point [s] (0: no lag).
+    internal_step_s : float
+        Step of the internal grid the chamber is simulated on [s].
+    """
 
     max_rate_c_per_min: float = 3.0
     air_time_constant_s: float = 120.0
@@ -128,6 +137,37 @@ def chamber_air(
     lagged by ``τ_air dA/dt = S_lim − A`` (exact first-order-hold discretisation),
     starting in equilibrium; then interpolated to ``time_s``.
     Returns ``(setpoint_c, air_c)``.
+
+    Parameters
+    ----------
+    time_s : numpy.ndarray
+        Elapsed program time [s].
+    program_time_s, program_setpoint_c : numpy.ndarray
+        The chamber program: times [s] and set-points [°C].
+    chamber : ChamberModel, optional
+        The chamber (default :class:`ChamberModel`).
+
+    Returns
+    -------
+    tuple of numpy.ndarray
+        ``(setpoint_c, air_c)`` at ``time_s`` [°C].
+
+    Raises
+    ------
+    ThermocalInputError
+        A program whose times do not increase or whose values are not finite.
+
+    Examples
+    --------
+    A 10 °C step: the default slew limit of 3 °C/min turns it into a 200 s ramp, which the
+    air follows with its 120 s lag; at 600 s the air lacks
+    6 (1 − e^(−200/120)) e^(−400/120) = 0.17 °C (worked out by hand from the two stages):
+
+    >>> import numpy as np
+    >>> sp, air = chamber_air(np.array([0.0, 600.0, 3600.0]), np.array([0.0, 1.0]),
+    ...                       np.array([20.0, 30.0]))
+    >>> sp.round(1).tolist(), air.round(1).tolist()
+    ([20.0, 30.0, 30.0], [20.0, 29.8, 30.0])
     """
     ch = chamber or ChamberModel()
     check_program(program_time_s, program_setpoint_c, "chamber program")
@@ -151,13 +191,36 @@ def chamber_air(
 
 @dataclass(frozen=True)
 class ThermalNetwork:
-    """Lumped thermal network of a sensor (SPEC §2: several sensors at places with
-    different lags, so that gradients exist).
+    r"""Lumped thermal network of a sensor (several temperature sensors at places with
+    different lags, so that gradients exist, as in the ring-laser-gyro method).
 
-    names : node (temperature channel) names; capacitance_j_per_k : C_i [J/K];
-    to_air_w_per_k : conductance of each node to the chamber air [W/K];
-    links : ``(i, j, G_ij)`` conductances between nodes [W/K];
-    power_w : self-heating power of each node after power-on [W].
+    Parameters
+    ----------
+    names : tuple of str
+        Node (temperature channel) names.
+    capacitance_j_per_k : tuple of float
+        Heat capacity C_i of each node [J/K].
+    to_air_w_per_k : tuple of float
+        Conductance of each node to the chamber air [W/K].
+    links : tuple of (int, int, float)
+        ``(i, j, G_ij)``: conductances between nodes [W/K].
+    power_w : tuple of float
+        Self-heating power of each node after power-on [W].
+
+    Raises
+    ------
+    ThermocalInputError
+        The tuples differ in length, a capacity is not positive, or no node couples to
+        the air.
+
+    Notes
+    -----
+    .. math::
+
+        C\,\frac{\mathrm dT}{\mathrm dt} = -(L + \operatorname{diag}(g_{air}))\,T
+        + g_{air}\,A(t) + P\,H(t - t_{on})
+
+    with :math:`L` the Laplacian of the links and :math:`A` the chamber air.
     """
 
     names: tuple[str, ...]
@@ -179,6 +242,7 @@ class ThermalNetwork:
 
     @property
     def n_nodes(self) -> int:
+        """Number of nodes k."""
         return len(self.names)
 
     def conductance_matrix(self) -> FloatArray:
@@ -219,6 +283,7 @@ class ThermalNetwork:
         )
 
     def to_dict(self) -> dict[str, Any]:
+        """The network as plain JSON data, with its time constants and steady rise."""
         d = dataclasses.asdict(self)
         d["time_constants_s"] = [float(v) for v in self.time_constants_s()]
         d["steady_rise_c"] = [float(v) for v in self.steady_rise_c()]
@@ -230,7 +295,25 @@ _CHUNK = 1 << 15
 
 
 def uniform_step(time_s: FloatArray, what: str = "time") -> float:
-    """The constant sample interval [s] of a uniform time grid (relative tolerance 1e-6)."""
+    """The constant sample interval of a uniform time grid (relative tolerance 1e-6).
+
+    Parameters
+    ----------
+    time_s : numpy.ndarray
+        The grid [s].
+    what : str
+        How the message names it.
+
+    Returns
+    -------
+    float
+        The step [s].
+
+    Raises
+    ------
+    ThermocalInputError
+        Fewer than two samples, or a grid that is not uniform and increasing.
+    """
     if time_s.size < 2:
         raise ThermocalInputError(f"{what}: needs at least two samples")
     d = np.diff(time_s)
@@ -258,6 +341,26 @@ def simulate_nodes(
     recursion and the power-step response ``w_P/λ (1 − e^{−λ(t − t_on)})``; ``T = M z``.
     ``dt_s`` is the grid step when already checked by the caller.
     Returns ``(temperatures (n, k), rates_c_per_min (n, k))``, column-contiguous.
+
+    Parameters
+    ----------
+    time_s : numpy.ndarray
+        Uniform time grid (n,) [s].
+    air_c : numpy.ndarray
+        Chamber air (n,) [°C].
+    network : ThermalNetwork
+        The sensor's network (k nodes).
+    power_on_s : float or None
+        Power-on time [s]; None: never powered.
+    warmed_up : bool
+        Start in the powered steady state.
+    dt_s : float, optional
+        The grid step [s], when the caller has checked it.
+
+    Returns
+    -------
+    tuple of numpy.ndarray
+        ``(temperatures (n, k) [°C], rates (n, k) [°C/min])``.
     """
     h = uniform_step(time_s) if dt_s is None else float(dt_s)
     lam, m, w_air, w_pow = network.modes()
@@ -301,8 +404,25 @@ def simulate_nodes(
 
 @dataclass(frozen=True)
 class ThermalResult:
-    """Output of :func:`simulate_thermal`: time [s], set-point and chamber air [°C],
-    node temperatures (n, k) [°C] and their exact rates (n, k) [°C/min]."""
+    """Output of :func:`simulate_thermal`.
+
+    Parameters
+    ----------
+    time_s : numpy.ndarray
+        Time (n,) [s].
+    setpoint_c, air_c : numpy.ndarray
+        Chamber set-point and air (n,) [°C].
+    temperatures_c : numpy.ndarray
+        Node temperatures (n, k) [°C].
+    rates_c_per_min : numpy.ndarray
+        Their exact rates (n, k) [°C/min].
+    names : tuple of str
+        The node names.
+    time_constants_s : numpy.ndarray
+        The network's time constants, longest first [s].
+    dt_s : float
+        The sample interval [s] (NaN: computed from ``time_s``).
+    """
 
     time_s: FloatArray
     setpoint_c: FloatArray
@@ -330,7 +450,36 @@ def simulate_thermal(
     warmed_up: bool = False,
 ) -> ThermalResult:
     """Chamber set-point → chamber air (:func:`chamber_air`) → sensor node temperatures
-    (:func:`simulate_nodes`).  ``time_s`` is elapsed program time on a uniform grid."""
+    (:func:`simulate_nodes`).  ``time_s`` is elapsed program time on a uniform grid.
+
+    Parameters
+    ----------
+    time_s : numpy.ndarray
+        Elapsed program time on a uniform grid [s].
+    program_time_s, program_setpoint_c : numpy.ndarray
+        The chamber program: times [s] and set-points [°C].
+    network : ThermalNetwork
+        The sensor's network.
+    chamber : ChamberModel, optional
+        The chamber (default :class:`ChamberModel`).
+    power_on_s : float or None
+        Power-on time [s]; None: never powered.
+    warmed_up : bool
+        Start in the powered steady state.
+
+    Returns
+    -------
+    ThermalResult
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from thermocal.simulate import FOG
+    >>> th = simulate_thermal(np.arange(0.0, 7200.0, 10.0), np.array([0.0, 600.0]),
+    ...                       np.array([20.0, 20.0]), FOG.network, warmed_up=True)
+    >>> bool(np.allclose(th.temperatures_c[-1] - 20.0, FOG.network.steady_rise_c(), atol=1e-6))
+    True
+    """
     t = np.asarray(time_s, dtype=np.float64)
     sp, air = chamber_air(
         t,

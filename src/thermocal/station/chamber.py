@@ -36,7 +36,35 @@ class RegisterMap:
     """How a temperature is held in one 16-bit register.
 
     ``counts = round(T / scale)``; signed registers hold −32768…32767 as two's complement
-    (``u = counts mod 2¹⁶``), unsigned ones 0…65535.  ``scale`` [°C per count].
+    (``u = counts mod 2¹⁶``), unsigned ones 0…65535.
+
+    Parameters
+    ----------
+    setpoint_register : int
+        Address of the holding register the set-point is written to.
+    temperature_register : int
+        Address of the register the chamber's temperature (process value) is read from.
+    register_kind : {"holding", "input"}
+        The temperature register's kind.
+    scale : float
+        Resolution [°C per count] (0.1 for a controller showing one decimal place).
+    signed : bool
+        Two's-complement counts.
+
+    References
+    ----------
+    Modbus Organization, *MODBUS Application Protocol Specification V1.1b3*, 2012
+    (function codes 0x03 Read Holding Registers, 0x04 Read Input Registers, 0x06 Write
+    Single Register).
+
+    Eurotherm, *2000 Series Communications Handbook*, HA026230 (scaled integers at the
+    configured resolution).
+
+    Examples
+    --------
+    >>> m = RegisterMap(setpoint_register=24, temperature_register=1, scale=0.1)
+    >>> m.encode(-12.5), m.decode(65411)
+    (65411, -12.5)
     """
 
     setpoint_register: int
@@ -46,7 +74,23 @@ class RegisterMap:
     signed: bool = True
 
     def encode(self, temperature_c: float) -> int:
-        """°C → the unsigned 16-bit word written to the register."""
+        """°C → the unsigned 16-bit word written to the register.
+
+        Raises
+        ------
+        ThermocalInputError
+            The temperature does not fit the register at this scale.
+
+        Parameters
+        ----------
+        temperature_c : float
+            The temperature [°C].
+
+        Returns
+        -------
+        int
+            The word, 0…65535.
+        """
         ratio = temperature_c / self.scale  # inf for a tiny scale: refused, not rounded
         lo, hi = (-32768, 32767) if self.signed else (0, 65535)
         counts = round(ratio) if math.isfinite(ratio) else None
@@ -59,7 +103,18 @@ class RegisterMap:
         return counts & 0xFFFF
 
     def decode(self, word: int) -> float:
-        """The unsigned 16-bit word read from a register → °C."""
+        """The unsigned 16-bit word read from a register → °C.
+
+        Parameters
+        ----------
+        word : int
+            The unsigned 16-bit word read.
+
+        Returns
+        -------
+        float
+            The temperature [°C].
+        """
         w = int(word) & 0xFFFF
         if self.signed and w >= 0x8000:
             w -= 0x10000
@@ -71,15 +126,26 @@ class Chamber(Protocol):
 
     name: str
 
-    def connect(self) -> None: ...
+    def connect(self) -> None:
+        """Open the connection; :class:`ChamberError` when the chamber does not answer."""
 
-    def write_setpoint(self, setpoint_c: float) -> None: ...
+    def write_setpoint(self, setpoint_c: float) -> None:
+        """Write the set-point [°C].
 
-    def read_temperature(self) -> float: ...
+        Parameters
+        ----------
+        setpoint_c : float
+            The set-point [°C].
+        """
 
-    def read_setpoint(self) -> float: ...
+    def read_temperature(self) -> float:
+        """The chamber's temperature [°C] (NaN when unknown)."""
 
-    def close(self) -> None: ...
+    def read_setpoint(self) -> float:
+        """The set-point the controller holds [°C] (NaN when unknown)."""
+
+    def close(self) -> None:
+        """Close the connection (never raises)."""
 
 
 class ManualChamber:
@@ -93,20 +159,30 @@ class ManualChamber:
         self._setpoint = math.nan
 
     def connect(self) -> None:
+        """Nothing to open: the operator runs the chamber."""
         return None
 
     def write_setpoint(self, setpoint_c: float) -> None:
-        """The step's goal, shown once per program step (the loop asks no more often)."""
+        """The step's goal, shown once per program step (the loop asks no more often).
+
+        Parameters
+        ----------
+        setpoint_c : float
+            The set-point [°C].
+        """
         self._setpoint = setpoint_c
         self._show(f"operator: set the chamber to {setpoint_c:.2f} °C")
 
     def read_temperature(self) -> float:
+        """NaN: a chamber run by hand reports no temperature."""
         return math.nan
 
     def read_setpoint(self) -> float:
+        """The last set-point shown to the operator [°C] (NaN before the first)."""
         return self._setpoint
 
     def close(self) -> None:
+        """Nothing to close."""
         return None
 
 
@@ -146,9 +222,23 @@ def _unit_keyword(method: Callable[..., Any]) -> str:
 
 
 class ModbusChamber:
-    """A controller on Modbus TCP or RTU (pymodbus).  Every request either returns or raises
-    :class:`ChamberError` within ``io_timeout_s`` (no retries: the station's own loop retries
-    at its poll interval and stops after ``timeout_s``)."""
+    """A controller on Modbus TCP or RTU (pymodbus).
+
+    Every request either returns or raises :class:`ChamberError` within ``io_timeout_s`` (no
+    retries: the station's own loop retries at its poll interval and stops after
+    ``timeout_s``).
+
+    Parameters
+    ----------
+    cfg : ChamberConfig
+        The ``[chamber]`` table (driver, address, register map).
+
+    References
+    ----------
+    Modbus Organization, *MODBUS Application Protocol Specification V1.1b3*, 2012
+    (function codes 0x03 Read Holding Registers, 0x04 Read Input Registers, 0x06 Write
+    Single Register).
+    """
 
     def __init__(self, cfg: ChamberConfig) -> None:
         self.cfg = cfg
@@ -163,6 +253,7 @@ class ModbusChamber:
         self._client: Any = None
 
     def connect(self) -> None:
+        """Open the Modbus connection; :class:`ChamberError` when it cannot be opened."""
         client_mod = require("pymodbus.client")
         quiet_pymodbus()
         if self.cfg.driver == "modbus-tcp":
@@ -205,6 +296,13 @@ class ModbusChamber:
         return rr
 
     def write_setpoint(self, setpoint_c: float) -> None:
+        """Write the set-point [°C] to the set-point register (Write Single Register).
+
+        Parameters
+        ----------
+        setpoint_c : float
+            The set-point [°C].
+        """
         word = self.map.encode(setpoint_c)
         reg = self.map.setpoint_register
         what = f"write set-point to register {reg}"
@@ -246,19 +344,35 @@ class ModbusChamber:
         return value
 
     def read_temperature(self) -> float:
+        """Read the temperature register [°C]."""
         return self._read(self.map.temperature_register, self.map.register_kind)
 
     def read_setpoint(self) -> float:
+        """Read the set-point register back [°C]."""
         return self._read(self.map.setpoint_register, "holding")
 
     def close(self) -> None:
+        """Close the connection (never raises)."""
         if self._client is not None:
             self._client.close()
             self._client = None
 
 
 def make_chamber(cfg: ChamberConfig, show: Callable[[str], None] | None = None) -> Chamber:
-    """The driver named by ``cfg.driver`` (not yet connected)."""
+    """The driver named by ``cfg.driver`` (not yet connected).
+
+    Parameters
+    ----------
+    cfg : ChamberConfig
+        The ``[chamber]`` table.
+    show : callable, optional
+        How a chamber run by hand shows the operator each new set-point.
+
+    Returns
+    -------
+    Chamber
+        :class:`ManualChamber` for ``driver = "none"``, else :class:`ModbusChamber`.
+    """
     if cfg.driver == "none":
         return ManualChamber(show)
     return ModbusChamber(cfg)

@@ -48,7 +48,25 @@ class StationCheck:
 
 def check_station(cfg: StationConfig, listen_s: float = 3.0) -> StationCheck:
     """Connect to the chamber (read its temperature and set-point) and listen to every
-    sensor for up to ``listen_s`` seconds [s] (less once each has sent 20 good lines)."""
+    sensor for up to ``listen_s`` seconds [s] (less once each has sent 20 good lines).
+
+    Parameters
+    ----------
+    cfg : StationConfig
+        The station.
+    listen_s : float
+        The longest time to listen to each sensor [s].
+
+    Returns
+    -------
+    StationCheck
+        The chamber's answer and each sensor's; nothing is recorded.
+
+    Raises
+    ------
+    ThermocalInputError
+        ``listen_s`` is not positive.
+    """
     if not listen_s > 0:
         raise ThermocalInputError(f"--listen must be > 0 s, got {listen_s}")
     chamber = make_chamber(cfg.chamber)

@@ -1,5 +1,5 @@
-"""``STATION.toml``: the chamber and the sensors of a test station (INTERFACE.md, "Test
-station").  Every key is checked here; an error names the file and the key.
+"""``STATION.toml``: the chamber and the sensors of a test station.  Every key is checked here;
+an error names the file and the key.
 
 Example::
 
@@ -98,7 +98,19 @@ class ChamberConfig:
 
     def out_of_range(self, temperature_c: float, margin_c: float = 0.0) -> str:
         """``""`` when ``temperature_c`` [°C] lies in ``min_c − margin_c … max_c +
-        margin_c`` (finite), else why not (for a message)."""
+        margin_c`` (finite), else why not (for a message).
+
+        Parameters
+        ----------
+        temperature_c : float
+            A temperature [°C].
+        margin_c : float
+            Margin beyond the range [°C].
+
+        Returns
+        -------
+        str
+        """
         lo, hi = self.min_c - margin_c, self.max_c + margin_c
         if math.isfinite(temperature_c) and lo <= temperature_c <= hi:
             return ""
@@ -355,7 +367,46 @@ def _sensor(t: dict[str, Any], where: str, i: int) -> SensorConfig:
 
 
 def parse_station(text: str, where: str = "STATION.toml") -> StationConfig:
-    """Parse and check the text of a ``STATION.toml``."""
+    """Parse and check the text of a ``STATION.toml``.
+
+    Parameters
+    ----------
+    text : str
+        The file's text.
+    where : str
+        How messages name the file.
+
+    Returns
+    -------
+    StationConfig
+
+    Raises
+    ------
+    ThermocalInputError
+        Not TOML, an unknown or missing key, a value out of its range, a preset the map
+        contradicts; the message names the file and the key.
+
+    Examples
+    --------
+    A Eurotherm 2000 series controller by its preset (set-point register 24, process value
+    register 1, from the maker's communications handbook) and one serial IMU at 100 Hz:
+
+    >>> cfg = parse_station('''
+    ... [chamber]
+    ... driver = "modbus-tcp"
+    ... host = "192.168.0.10"
+    ... preset = "eurotherm-2000"
+    ... scale = 0.1
+    ... [[sensor]]
+    ... id = "imu"
+    ... device = "/dev/ttyUSB0"
+    ... names = ["gyro_x", "temp"]
+    ... units = ["deg/s", "degC"]
+    ... rate_hz = 100
+    ... ''')
+    >>> cfg.chamber.setpoint_register, cfg.chamber.temperature_register, cfg.sensors[0].id
+    (24, 1, 'imu')
+    """
     try:
         doc = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
@@ -382,7 +433,22 @@ def parse_station(text: str, where: str = "STATION.toml") -> StationConfig:
 
 
 def load_station(path: str | Path) -> StationConfig:
-    """Read and check ``STATION.toml`` (:func:`parse_station`)."""
+    """Read and check ``STATION.toml`` (:func:`parse_station`).
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        The ``STATION.toml``.
+
+    Returns
+    -------
+    StationConfig
+
+    Raises
+    ------
+    ThermocalInputError
+        The file is missing, special or not UTF-8, or :func:`parse_station` refuses it.
+    """
     p = Path(path)
     refuse_special_input(p, "station file (STATION.toml)")  # a FIFO is no "no such file"
     if not p.is_file():
@@ -396,8 +462,21 @@ def load_station(path: str | Path) -> StationConfig:
 
 def check_port(device: str, who: str) -> None:
     """Refuse a serial ``device`` that is a FIFO, a socket or a block device (``stat``
-    only, never opened; issue 39): pyserial would answer "Inappropriate ioctl for device".
-    A character device (``/dev/ttyUSB0``, a pty) and a pyserial URL pass."""
+    only, never opened): pyserial would answer "Inappropriate ioctl for device".
+    A character device (``/dev/ttyUSB0``, a pty) and a pyserial URL pass.
+
+    Parameters
+    ----------
+    device : str
+        The serial device or pyserial URL.
+    who : str
+        How the message names its owner (``[chamber]``, ``[[sensor]] imu``).
+
+    Raises
+    ------
+    ThermocalInputError
+        A FIFO, a socket or a block device.
+    """
     why = special_mode(Path(device))
     if why is not None and why != "it is a character device":
         raise ThermocalInputError(
@@ -408,7 +487,22 @@ def check_port(device: str, who: str) -> None:
 
 def require(module: str) -> Any:
     """Import an optional library of the station, or a one-line input error saying what to
-    install (exit 2 on the command line)."""
+    install (exit 2 on the command line).
+
+    Parameters
+    ----------
+    module : str
+        The module's name.
+
+    Returns
+    -------
+    module
+
+    Raises
+    ------
+    ThermocalInputError
+        Not installed: the message says ``pip install 'thermocal[station]'``.
+    """
     import importlib
 
     try:

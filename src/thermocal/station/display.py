@@ -23,7 +23,17 @@ def _hms(s: float) -> str:
 
 
 def render(state: StationState) -> Any:
-    """The display as a rich renderable."""
+    """The display as a rich renderable.
+
+    Parameters
+    ----------
+    state : StationState
+        The station's state.
+
+    Returns
+    -------
+    rich renderable
+    """
     from rich.console import Group
     from rich.table import Table
 
@@ -66,6 +76,13 @@ class RichDisplay:
         mute_stderr()
 
     def update(self, state: StationState) -> None:
+        """Redraw the live display with ``state``.
+
+        Parameters
+        ----------
+        state : StationState
+            The station's state.
+        """
         import time
 
         now = time.monotonic()  # the loop turns at 50 Hz; the display needs 4
@@ -77,6 +94,13 @@ class RichDisplay:
                 self._gone(exc)
 
     def log(self, message: str) -> None:
+        """Print ``message`` above the live display.
+
+        Parameters
+        ----------
+        message : str
+            The text.
+        """
         if self.broken:
             return
         try:
@@ -85,6 +109,7 @@ class RichDisplay:
             self._gone(exc)
 
     def close(self) -> None:
+        """Stop the live display."""
         if self._open:
             self._open = False
             try:

@@ -21,8 +21,25 @@ from dataclasses import dataclass
 
 @dataclass(frozen=True)
 class ControllerPreset:
-    """A controller's register map: the set-point register written, the temperature
-    (process value) register read, its kind, signed 16-bit counts; ``source`` the manual."""
+    """A controller's register map, as its maker's manual gives it.
+
+    Parameters
+    ----------
+    name : str
+        The preset's name (``[chamber] preset``).
+    setpoint_register : int
+        The set-point register written.
+    temperature_register : int
+        The temperature (process value) register read.
+    register_kind : str
+        ``"holding"`` or ``"input"``.
+    signed : bool
+        Signed 16-bit counts.
+    source : str
+        The manual the map was read in.
+    note : str
+        What the controller must be set to for the map to hold.
+    """
 
     name: str
     setpoint_register: int

@@ -82,6 +82,19 @@ def _fsync_write(path: Path, data: bytes) -> None:
 
 
 def part_name(stream: str, index: int) -> str:
+    """The file name of part ``index`` of ``stream`` (``chamber-0001.parquet``).
+
+    Parameters
+    ----------
+    stream : str
+        The stream (``chamber`` or a sensor id).
+    index : int
+        The part's number.
+
+    Returns
+    -------
+    str
+    """
     return f"{stream}-{index:04d}.parquet"
 
 
@@ -311,10 +324,30 @@ class Recorder:
 
     # --- rows, parts, events ---------------------------------------------------------------
     def rel(self, unix: float) -> float:
-        """Host wall-clock time → seconds since the recording's start."""
+        """Host wall-clock time → seconds since the recording's start.
+
+        Parameters
+        ----------
+        unix : float
+            Host time [s since 1970].
+
+        Returns
+        -------
+        float
+            Seconds since the start [s].
+        """
         return unix - self.start_unix
 
     def add(self, stream: str, row: dict[str, float]) -> None:
+        """Buffer one sample ``row`` of ``stream`` (written when its part closes).
+
+        Parameters
+        ----------
+        stream : str
+            The stream (``chamber`` or a sensor id).
+        row : dict
+            One sample's fields.
+        """
         st = self.streams[stream]
         for c in st.columns:
             st.data[c].append(float(row.get(c, float("nan"))))
@@ -397,11 +430,34 @@ class Recorder:
         return written
 
     def maybe_rotate(self, now_unix: float) -> list[str]:
+        """Close the open parts when they are ``part_s`` old at host time ``now_unix`` [s];
+        return the names closed.
+
+        Parameters
+        ----------
+        now_unix : float
+            Host time now [s since 1970].
+
+        Returns
+        -------
+        list of str
+        """
         if now_unix - self.part_started >= self.cfg.part_s:
             return self.close_parts()
         return []
 
     def event(self, kind: str, message: str, **fields: Any) -> None:
+        """Record an event (``kind``, ``message`` and its fields) in ``station.json``.
+
+        Parameters
+        ----------
+        kind : str
+            The event's kind.
+        message : str
+            The text.
+        **fields
+            The event's other fields.
+        """
         now = clock.now()
         self.doc["events"].append(
             {"time": self.rel(now), "kind": kind, "message": message, **fields}
@@ -409,7 +465,15 @@ class Recorder:
         self.save()
 
     def bad_lines(self, sensor: str, rows: list[tuple[float, int, str, str]]) -> None:
-        """Append bad lines to ``DIR/<sensor>.bad.txt`` (flushed at once)."""
+        """Append bad lines to ``DIR/<sensor>.bad.txt`` (flushed at once).
+
+        Parameters
+        ----------
+        sensor : str
+            The sensor's id.
+        rows : list of (float, int, str, str)
+            Host time [s], line number, the line and why it is bad.
+        """
         if not rows:
             return
         path = self.dir / f"{sensor}.bad.txt"
@@ -425,6 +489,7 @@ class Recorder:
             self._failed(path, exc)
 
     def save(self) -> None:
+        """Write ``station.json`` atomically."""
         path = self.dir / STATION_JSON
         try:
             _fsync_write(path, json.dumps(self.doc, indent=1).encode())

@@ -116,9 +116,25 @@ class StationState:
 
 
 class Display(Protocol):
-    def update(self, state: StationState) -> None: ...
+    """Where a run shows its state and messages (a live table or log lines)."""
 
-    def log(self, message: str) -> None: ...
+    def update(self, state: StationState) -> None:
+        """Show ``state``.
+
+        Parameters
+        ----------
+        state : StationState
+            The station's state.
+        """
+
+    def log(self, message: str) -> None:
+        """Show one message.
+
+        Parameters
+        ----------
+        message : str
+            The text.
+        """
 
 
 def say(message: str) -> str:
@@ -126,7 +142,18 @@ def say(message: str) -> str:
     (a closed pipe, a vanished terminal): then file descriptor 2 is pointed at
     ``os.devnull``, so that no later message (nor Python's flush at exit) raises either.
     Started without a stderr (``2>&-``: ``sys.stderr`` is None) nothing is printed (never
-    on stdout, where ``--json`` writes) and ``""`` is returned: nobody was watching."""
+    on stdout, where ``--json`` writes) and ``""`` is returned: nobody was watching.
+
+    Parameters
+    ----------
+    message : str
+        The text.
+
+    Returns
+    -------
+    str
+        ``""``, or why stderr is gone.
+    """
     if sys.stderr is None:
         return ""
     try:
@@ -158,9 +185,23 @@ class LogDisplay:
         self.broken = ""
 
     def update(self, state: StationState) -> None:
+        """Nothing: a log display prints messages only.
+
+        Parameters
+        ----------
+        state : StationState
+            The station's state.
+        """
         return None
 
     def log(self, message: str) -> None:
+        """Print ``message`` on stderr.
+
+        Parameters
+        ----------
+        message : str
+            The text.
+        """
         if not self.broken:
             self.broken = say(message)
 
@@ -622,6 +663,16 @@ def previous_run(events: list[dict[str, Any]]) -> tuple[str, bool]:
     not); a run killed (SIGKILL, a power cut, a crash of the interpreter) leaves none: then
     the chamber still holds the last set-point written: the last ``setpoint`` event [°C]
     (along a ramp, within :data:`SETPOINT_EVENT_C` of it).
+
+    Parameters
+    ----------
+    events : list of dict
+        The events of ``station.json``.
+
+    Returns
+    -------
+    tuple of (str, bool)
+        How it ended, and whether that needs the operator's attention.
     """
     last_sp: float | None = None
     stop: dict[str, Any] | None = None
@@ -668,6 +719,37 @@ def run_station(
     reason recorded (``"SIGHUP"``).  A :class:`LogDisplay` whose stderr is gone ends it too.
     With ``resume``, how the previous run ended and where it left the chamber is logged
     (``warning:`` when it was killed or left without its safe set-point).
+
+    Parameters
+    ----------
+    cfg : StationConfig
+        The station (:func:`thermocal.station.config.load_station`).
+    program : tuple of (list of float, list of float)
+        The chamber program: times [s] and set-points [°C], linear between points.
+    out_dir : pathlib.Path
+        The recording folder.
+    profile_source : str
+        How messages name the program (its file).
+    resume : bool
+        Continue a recording in ``out_dir`` where it stopped.
+    time_scale : float
+        Program seconds per wall-clock second (rehearsals with a simulated chamber).
+    display : Display, optional
+        Where the state is shown (default :class:`LogDisplay`).
+    chamber : Chamber, optional
+        The chamber driver (default from ``cfg``).
+    should_stop : callable, optional
+        Polled by the loop; true or a reason string ends the run as an interrupt does.
+
+    Returns
+    -------
+    RunResult
+
+    Raises
+    ------
+    ThermocalInputError
+        A set-point outside the chamber's range or register, too many program points, a bad
+        ``time_scale`` (before anything is written).
     """
     import numpy as np
 

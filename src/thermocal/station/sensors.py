@@ -2,7 +2,7 @@
 
 Every line gets the host's time [s] (:func:`thermocal.station.clock.now`) when its bytes are read;
 lines read in one chunk share it.  A line is parsed with the text-log rules of
-:mod:`thermocal.readers` (INTERFACE.md common rules): the fields split at the stated delimiter
+:mod:`thermocal.readers`: the fields split at the stated delimiter
 (or the first of ``,`` ``;`` tab blanks that gives one field per name), numbers as a CSV
 reader takes them (:func:`thermocal.readers.text.parse_number`: no digit-group underscores, no
 non-ASCII digits), a decimal comma when the TOML says so.  A line that does not give one
@@ -70,7 +70,22 @@ class LineParser:
         return tuple(out)
 
     def parse(self, line: str) -> tuple[float, ...]:
-        """The line's numbers, or :class:`BadLine` saying why not."""
+        """The line's numbers, or :class:`BadLine` saying why not.
+
+        Parameters
+        ----------
+        line : str
+            One line of the sensor, without its end.
+
+        Returns
+        -------
+        tuple of float
+
+        Raises
+        ------
+        BadLine
+            Why the line is not a sample.
+        """
         delims = (self.delimiter,) if self.delimiter else DELIMITERS
         reason = ""
         for d in delims:
@@ -156,6 +171,7 @@ class SerialSensor:
             ) from None
 
     def start(self) -> None:
+        """Open the port and start the reading thread."""
         if self._port is None:
             self.open()
         self._thread = threading.Thread(
@@ -225,7 +241,17 @@ class SerialSensor:
 
     def drain(self, most: int | None = None) -> tuple[list[Sample], list[Bad]]:
         """The good lines that arrived since the last call (the ``most`` oldest of them; the
-        rest wait for the next call) and the bad ones."""
+        rest wait for the next call) and the bad ones.
+
+        Parameters
+        ----------
+        most : int, optional
+            Take at most this many good lines.
+
+        Returns
+        -------
+        tuple of (list of Sample, list of Bad)
+        """
         with self._lock:
             if most is None or len(self._samples) <= most:
                 s, self._samples = self._samples, []
@@ -235,6 +261,7 @@ class SerialSensor:
         return s, b
 
     def close(self) -> None:
+        """Stop the reading thread and close the port."""
         self._stop.set()
         if self._thread is not None:
             self._thread.join(timeout=2.0)

@@ -44,7 +44,18 @@ class ChamberModel:
     lock: threading.Lock = field(default_factory=threading.Lock)
 
     def advance(self, now: float | None = None) -> float:
-        """Integrate to ``now`` (host [s]); return the temperature [°C]."""
+        """Integrate to ``now`` (host [s]); return the temperature [°C].
+
+        Parameters
+        ----------
+        now : float, optional
+            Host time [s] (default now).
+
+        Returns
+        -------
+        float
+            The temperature [°C].
+        """
         with self.lock:
             now = time.time() if now is None else now
             dt = max(0.0, now - self.last_unix) * self.time_scale
@@ -148,6 +159,23 @@ class SimulatedChamber:
         await self._server.serving
 
     def start(self, timeout_s: float = 10.0) -> SimulatedChamber:
+        """Start the Modbus server in a thread; return self once it answers (within
+        ``timeout_s``).
+
+        Parameters
+        ----------
+        timeout_s : float
+            Longest wait for the server [s].
+
+        Returns
+        -------
+        SimulatedChamber
+
+        Raises
+        ------
+        TimeoutError
+            The server did not start in time.
+        """
         self._thread.start()
         if not self._ready.wait(timeout_s):
             raise TimeoutError("simulated chamber did not start")
@@ -156,7 +184,13 @@ class SimulatedChamber:
         return self
 
     def stop(self, timeout_s: float = 5.0) -> None:
-        """Shut the server down (its port closes: the chamber stops answering)."""
+        """Shut the server down (its port closes: the chamber stops answering).
+
+        Parameters
+        ----------
+        timeout_s : float
+            Longest wait for the server to stop [s].
+        """
         if self._loop is not None and self._server is not None and self._thread.is_alive():
             fut = asyncio.run_coroutine_threadsafe(self._server.shutdown(), self._loop)
             with contextlib.suppress(Exception):  # already closing
@@ -261,13 +295,16 @@ class SimulatedSerialSensor:
                 self.sent.append((float(f"{gx:.6f}"), float(f"{self.die_c:.3f}")))
 
     def start(self) -> SimulatedSerialSensor:
+        """Open the pseudo-terminal and start sending lines; return self."""
         self._thread.start()
         return self
 
     def silence(self) -> None:
+        """Stop sending lines, keeping the port open (a sensor gone quiet)."""
         self._silent.set()
 
     def stop(self) -> None:
+        """Stop sending and close the pseudo-terminal."""
         self._stop.set()
         self._thread.join(5.0)
         for fd in (self.master, self._slave):
