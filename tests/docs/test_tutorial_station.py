@@ -22,9 +22,9 @@ from pathlib import Path
 from typing import Any
 
 import pytest
-from test_tutorials import BLOCK, TUTORIALS, fresh_cli
 
 from thermocal.cli import main
+from tutorial_pages import BLOCK, TUTORIALS, fresh_cli
 
 pytest.importorskip("pymodbus")
 pytest.importorskip("serial")
