@@ -687,9 +687,9 @@ MUTANTS: tuple[Mutant, ...] = (
     ),
     Mutant(
         "params-ardupilot-tref",
-        P + "export/params.py",
-        "ARDUPILOT_TREF_C = 35.0",
-        "ARDUPILOT_TREF_C = 25.0",
+        P + "firmware/formats.py",
+        "AP_TREF_C = 35.0",
+        "AP_TREF_C = 25.0",
         PARAMS,
         "ArduPilot's polynomial about 25 °C (the firmware's is 35 °C)",
     ),
@@ -744,10 +744,10 @@ MUTANTS: tuple[Mutant, ...] = (
     # --- px4 / ardupilot tempcal --------------------------------------------------------
     Mutant(
         "px4-baro-holdout-on-training",
-        P + "tempcal/px4.py",
-        "held = np.polynomial.polynomial.polyfit(x[even], v_med[even, j], order)",
-        "held = np.polynomial.polynomial.polyfit(x, v_med[:, j], order)",
-        PX4,
+        P + "firmware/px4.py",
+        "held = poly.polyfit(x[even], v_med[even], order)",
+        "held = poly.polyfit(x, v_med, order)",
+        (*PX4, "tests/firmware/test_firmware_px4.py"),
         "baro/mag hold-out fitted on every bin",
     ),
     Mutant(
@@ -760,7 +760,7 @@ MUTANTS: tuple[Mutant, ...] = (
     ),
     Mutant(
         "px4-bin-median-to-mean",
-        P + "tempcal/binning.py",
+        P + "firmware/binning.py",
         "[np.median(values[order[a:b]], axis=0)",
         "[np.mean(values[order[a:b]], axis=0)",
         PX4,
@@ -768,10 +768,10 @@ MUTANTS: tuple[Mutant, ...] = (
     ),
     Mutant(
         "px4-baro-tref-low-end",
-        P + "tempcal/px4.py",
-        "tref = 0.5 * (lo + hi) if tref_c is None else float(tref_c)\n    x = t_med - tref",
-        "tref = lo if tref_c is None else float(tref_c)\n    x = t_med - tref",
-        PX4,
+        P + "firmware/px4.py",
+        "tref = 0.5 * (lo + hi) if tref_c is None else float(tref_c)",
+        "tref = lo if tref_c is None else float(tref_c)",
+        (*PX4, "tests/firmware/test_firmware_px4.py"),
         "baro/mag TREF at the low end",
     ),
     Mutant(
@@ -2297,7 +2297,7 @@ MUTANTS: tuple[Mutant, ...] = (
     ),
     Mutant(
         "fw-ap-pitch-sign",
-        P + "tempcal/ardupilot.py",
+        P + "firmware/ardupilot.py",
         "ry = np.array([[cp, 0, sp], [0, 1, 0], [-sp, 0, cp]])",
         "ry = np.array([[cp, 0, -sp], [0, 1, 0], [sp, 0, cp]])",
         FW_AP,
@@ -2305,7 +2305,7 @@ MUTANTS: tuple[Mutant, ...] = (
     ),
     Mutant(
         "fw-tclr-powers-off-by-one",
-        P + "tempcal/ardupilot.py",
+        P + "firmware/ardupilot.py",
         "return [[float(x) * 1e6 for x in p[k]] for k in (1, 2, 3)]",
         "return [[float(x) * 1e6 for x in p[k]] for k in (0, 1, 2)]",
         FW_AP,
@@ -2313,7 +2313,7 @@ MUTANTS: tuple[Mutant, ...] = (
     ),
     Mutant(
         "fw-tclr-no-tref",
-        P + "tempcal/ardupilot.py",
+        P + "firmware/ardupilot.py",
         "np.vander(np.asarray(temp_c, dtype=np.float64) - AP_TREF_C, 4",
         "np.vander(np.asarray(temp_c, dtype=np.float64), 4",
         FW_AP,

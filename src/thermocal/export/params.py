@@ -34,8 +34,8 @@ its definition.  The notes say so; a model fitted without ``--gravity-axis`` is 
 warned.
 
 Refused (issue 26): a channel given twice or to both triads, a channel of the other kind,
-an instance the firmware does not have (:data:`MAX_INSTANCES`), and any parameter that is
-not a finite float32 (or, for the int32 ``ID``, outside int32).
+an instance the firmware does not have (:data:`thermocal.firmware.formats.FORMATS`), and
+any parameter that is not a finite float32 (or, for the int32 ``ID``, outside int32).
 """
 
 from __future__ import annotations
@@ -51,25 +51,13 @@ import numpy as np
 
 from thermocal import units
 from thermocal.errors import ThermocalInputError, ThermocalWarning
+from thermocal.firmware.formats import ARDUPILOT_SCALE, FORMATS
 from thermocal.models.base import TemperatureModel
 from thermocal.models.calibration import Calibration
 
-FORMATS = ("px4", "ardupilot")
-ARDUPILOT_TREF_C = 35.0
-"""ArduPilot's fixed reference of the temperature polynomial [°C]
-(AP_InertialSensor_tempcal: ``TEMP_REFERENCE``)."""
-ARDUPILOT_SCALE = 1.0e-6
-"""ArduPilot stores ``c_k`` scaled: the firmware multiplies the polynomial by 1e-6."""
 ARDUPILOT_MIN_SPAN_C = 10.0
 """ArduPilot's learning needs a sweep of at least 10 °C (tempcal_IMU.py's minimum)."""
 AXES = ("x", "y", "z")
-MAX_INSTANCES = {"px4": 4, "ardupilot": 3}
-"""Sensor instances each firmware has thermal-calibration parameters for.  PX4:
-``GYRO_COUNT_MAX = ACCEL_COUNT_MAX = 4`` with ``static_assert``s that the ``TC_G0…TC_G3`` /
-``TC_A0…TC_A3`` parameters match (PX4-Autopilot
-``src/modules/temperature_compensation/TemperatureCompensation.h``).  ArduPilot:
-``INS_TCAL1_…INS_TCAL3_`` (``AP_SUBGROUPINFO(tcal_old_param[0..2], "_TCAL1_"…"_TCAL3_")``
-in ``libraries/AP_InertialSensor/AP_InertialSensor.cpp``, the first three IMUs)."""
 FLOAT32_MAX = float(np.finfo(np.float32).max)
 """Largest finite float32 (≈ 3.4028235e38): the firmware stores parameters as 32-bit floats."""
 INT32_RANGE = (-(2**31), 2**31 - 1)
@@ -376,9 +364,9 @@ def export_params(
     calibration's recorded sensor id when numeric, else 0 with a warning)."""
     if fmt not in FORMATS:
         raise ThermocalInputError(f"--format must be one of {', '.join(FORMATS)}, got {fmt!r}")
-    n_max = MAX_INSTANCES[fmt]
+    n_max = FORMATS[fmt].max_instances
     if not 0 <= instance < n_max:
-        have = "TC_G0…TC_G3 and TC_A0…TC_A3" if fmt == "px4" else "INS_TCAL1…INS_TCAL3"
+        have = FORMATS[fmt].instances
         raise ThermocalInputError(
             f"--instance {instance}: {fmt} has {have}, instances 0…{n_max - 1}"
         )
@@ -395,7 +383,7 @@ def export_params(
         if fmt == "px4":
             tref = 0.5 * (lo + hi) if tref_c is None else float(tref_c)
         else:
-            tref = ARDUPILOT_TREF_C
+            tref = float(FORMATS[fmt].tref_c or 0.0)
             if hi - lo < ARDUPILOT_MIN_SPAN_C:
                 warnings.warn(
                     f"{kind}: the fitted range {lo:.1f}…{hi:.1f} °C spans less than "
@@ -516,10 +504,7 @@ def _ardupilot_params(
 
 
 __all__ = [
-    "ARDUPILOT_TREF_C",
     "DOCUMENTED",
-    "FORMATS",
-    "MAX_INSTANCES",
     "AxisPoly",
     "Documented",
     "ParamSet",
@@ -531,16 +516,10 @@ __all__ = [
 ]
 
 
-PX4_OFFSET_SENSORS = {"baro": ("B", 5, 1), "mag": ("M", 3, 3)}
-"""PX4's other thermally compensated sensors: parameter letter, polynomial order, axes.
-PX4-Autopilot parameter reference (``src/modules/temperature_compensation``):
-``TC_B<n>_ID``, ``_TMIN``, ``_TMAX``, ``_TREF``, ``_X0``…``_X5`` ("Barometer offset
-temperature ^k polynomial coefficient", in Pa as ``sensor_baro.pressure``) for n = 0…3 and
-``TC_B_ENABLE``; ``TC_M<n>_ID``, ``_TMIN``, ``_TMAX``, ``_TREF``, ``_X<k>_<axis>``, k = 0…3
-("Magnetometer offset temperature ^k polynomial coefficient", in gauss as ``sensor_mag``)
-for n = 0…3 and ``TC_M_ENABLE`` (PX4 v1.15 and later).  The firmware subtracts
-``Σ X_k·dT^k`` with ``dT = clamp(T, TMIN, TMAX) − TREF`` from the measurement."""
-PX4_OFFSET_INSTANCES = 4
+PX4_OFFSET_KINDS = ("baro", "mag")
+"""PX4's thermally compensated sensors besides the IMU (their parameters:
+:data:`thermocal.firmware.formats.FORMATS`).  The firmware subtracts ``Σ X_k·dT^k`` with
+``dT = clamp(T, TMIN, TMAX) − TREF`` from the measurement."""
 
 
 def px4_offset_params(
@@ -554,15 +533,15 @@ def px4_offset_params(
 ) -> ParamSet:
     """PX4 ``TC_B<n>_*`` (``kind`` "baro", ``coefficients`` [[X0…X5]]) or ``TC_M<n>_*``
     ("mag", [[X0…X3] per axis x, y, z]): polynomial in ``T − TREF`` [firmware unit: Pa,
-    gauss], (:data:`PX4_OFFSET_SENSORS`); refused for an instance PX4 has no parameters
-    for, or a value that is not a finite float32."""
-    if kind not in PX4_OFFSET_SENSORS:
+    gauss], (:data:`thermocal.firmware.formats.FORMATS`); refused for an instance PX4 has
+    no parameters for, or a value that is not a finite float32."""
+    if kind not in PX4_OFFSET_KINDS:
         raise ThermocalInputError(f"no PX4 thermal parameters for a {kind!r} sensor")
-    letter, order, n_axes = PX4_OFFSET_SENSORS[kind]
-    if not 0 <= instance < PX4_OFFSET_INSTANCES:
+    sensor, n_max = FORMATS["px4"].sensors[kind], FORMATS["px4"].max_instances
+    letter, order, n_axes = sensor.tag, sensor.order, sensor.n_axes
+    if not 0 <= instance < n_max:
         raise ThermocalInputError(
-            f"PX4 has TC_{letter}0…TC_{letter}{PX4_OFFSET_INSTANCES - 1}; {kind} instance "
-            f"{instance} has none"
+            f"PX4 has TC_{letter}0…TC_{letter}{n_max - 1}; {kind} instance {instance} has none"
         )
     if len(coefficients) != n_axes or any(len(c) != order + 1 for c in coefficients):
         raise ThermocalInputError(

@@ -39,11 +39,9 @@ import numpy as np
 
 from thermocal import units
 from thermocal.errors import ThermocalInputError, ThermocalWarning
+from thermocal.firmware.formats import FORMATS
 from thermocal.models.calibration import Calibration, Triad
 
-MAX_INSTANCES = {"px4": 4, "ardupilot": 3}
-"""PX4 ``CAL_ACC0…CAL_ACC3`` / ``CAL_GYRO0…CAL_GYRO3``; ArduPilot ``INS_ACC*``,
-``INS_ACC2*``, ``INS_ACC3*`` (three IMUs)."""
 ARDUPILOT_ACCSCAL_RANGE = (0.8, 1.2)
 """``INS_ACCSCAL_*`` ``@Range: 0.8 1.2`` (ArduPilot ``AP_InertialSensor_Params.cpp``)."""
 ARDUPILOT_ACCOFFS_RANGE_M_S2 = (-3.5, 3.5)
@@ -240,12 +238,13 @@ def triad_params(
     """The firmware parameters of the calibration's ``accel`` and ``gyro`` triads (module
     docstring); warns what the firmware cannot hold, refuses a value outside ArduPilot's
     range or an instance the firmware does not have."""
-    if fmt not in MAX_INSTANCES:
+    if fmt not in FORMATS:
         raise ThermocalInputError(f"--format must be px4 or ardupilot, got {fmt!r}")
-    if not 0 <= instance < MAX_INSTANCES[fmt]:
+    n_max = FORMATS[fmt].max_instances  # PX4 CAL_ACC0…3 / CAL_GYRO0…3; ArduPilot three IMUs
+    if not 0 <= instance < n_max:
         have = "CAL_ACC0…CAL_ACC3" if fmt == "px4" else "INS_ACC, INS_ACC2, INS_ACC3"
         raise ThermocalInputError(
-            f"--instance {instance}: {fmt} has {have}, instances 0…{MAX_INSTANCES[fmt] - 1}"
+            f"--instance {instance}: {fmt} has {have}, instances 0…{n_max - 1}"
         )
     triads = {t.name: t for t in cal.triads if t.name in ("accel", "gyro")}
     if not triads:
@@ -322,7 +321,6 @@ def as_dict(tp: TriadParams) -> dict[str, Any]:
 __all__ = [
     "ARDUPILOT_ACCOFFS_RANGE_M_S2",
     "ARDUPILOT_ACCSCAL_RANGE",
-    "MAX_INSTANCES",
     "TriadFirmware",
     "TriadParams",
     "as_dict",

@@ -19,8 +19,8 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from thermocal.firmware.binning import even_odd_split, temperature_bins
 from thermocal.recording import FloatArray
-from thermocal.tempcal.binning import even_odd_split, temperature_bins
 
 if TYPE_CHECKING:
     from thermocal.tempcal.compare import CoefficientComparison

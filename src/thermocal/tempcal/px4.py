@@ -10,7 +10,7 @@ relative to their median because gravity is in the data) and writes ``TC_*`` par
 thermocal does the same with three differences (each stated in the summary):
 
 * **equal weight across the temperature range**: the samples are first reduced to the
-  median of each temperature bin (:func:`thermocal.tempcal.binning.temperature_bins`), so a
+  median of each temperature bin (:func:`thermocal.firmware.binning.temperature_bins`), so a
   slow end of the sweep does not outweigh a fast middle — PX4 bins the temperature for the
   same reason;
 * **robust to spikes**: the bin statistic is the median, not the mean;
@@ -35,12 +35,13 @@ from typing import Any
 import numpy as np
 
 from thermocal import adequacy
-from thermocal.errors import ThermocalInputError
+from thermocal.errors import ParameterError, ThermocalInputError
+from thermocal.firmware.formats import FORMATS
+from thermocal.firmware.px4 import px4_coefficients
 from thermocal.models.calibration import Calibration
 from thermocal.outputs import check_outputs
 from thermocal.readers.ulog_params import ulog_parameters
 from thermocal.recording import FloatArray
-from thermocal.tempcal.binning import BIN_WIDTH_C, MIN_BINS, temperature_bins
 from thermocal.tempcal.compare import CoefficientComparison, px4_comparison
 from thermocal.tempcal.pipeline import (
     AXES,
@@ -83,7 +84,7 @@ def log_topics(path: Path) -> list[tuple[str, int]]:
 OFFSET_TOPICS = {"sensor_baro": ("baro", ("pressure",), "Pa"), "sensor_mag": ("mag", AXES, "gauss")}
 """PX4 topics calibrated as offsets in the firmware's unit (uORB ``SensorBaro.msg`` pressure
 [Pa], ``SensorMag.msg`` x, y, z [gauss]) with the polynomial order of their parameters
-(:data:`thermocal.export.params.PX4_OFFSET_SENSORS`: 5 for TC_B, 3 for TC_M)."""
+(:data:`thermocal.firmware.formats.FORMATS`: 5 for TC_B, 3 for TC_M)."""
 
 
 @dataclass(frozen=True)
@@ -119,19 +120,16 @@ def fit_offset_sensor(
     tref_c: float | None = None,
     overrides: tuple[str, ...] = (),
 ) -> OffsetFit:
-    """Judge (:func:`thermocal.adequacy.judge`: sweep, bins, ends), bin (medians of
-    :data:`BIN_WIDTH_C` bins, equal weight across the range, robust to spikes), judge on
-    held-out bins (a polynomial fitted to the even bins, its rms on the odd ones) and fit a
-    polynomial of PX4's order in ``T − TREF`` (TREF mid-range unless given) to every bin.
+    """Judge (:func:`thermocal.adequacy.judge`: sweep, bins, ends), then fit PX4's
+    polynomial (:func:`thermocal.firmware.px4.px4_coefficients`: medians of 0.5 °C bins,
+    equal weight across the range, robust to spikes; judged on held-out bins; a polynomial
+    of PX4's order in ``T − TREF``, TREF mid-range unless given, fitted to every bin).
     ``values`` (n, axes) in the topic's unit (:data:`OFFSET_TOPICS`)."""
-    from thermocal.export.params import PX4_OFFSET_SENSORS
-
     kind, fields, unit = OFFSET_TOPICS[topic]
-    order = PX4_OFFSET_SENSORS[kind][1]
+    order = FORMATS["px4"].sensors[kind].order
     where = f"{topic}.{instance}"
     vals = np.asarray(values, dtype=np.float64).reshape(len(temp_c), -1)
     temp = np.asarray(temp_c, dtype=np.float64)
-    lo, hi = float(np.min(temp)), float(np.max(temp))
     tname = f"{where} temperature"
     record = (
         adequacy.judge(
@@ -141,29 +139,17 @@ def fit_offset_sensor(
         .enforce()
         .to_dict()
     )  # fmt: skip
-    rel = vals - np.median(vals, axis=0)
-    _c, t_med, v_med = temperature_bins(temp, rel)
-    need = max(MIN_BINS, 2 * (order + 1))
-    if t_med.size < need:
-        raise ThermocalInputError(
-            f"{where}: the temperature covers {t_med.size} bins of {BIN_WIDTH_C:g} °C; a "
-            f"polynomial of order {order} needs at least {need}: record a wider sweep"
-        )
-    tref = 0.5 * (lo + hi) if tref_c is None else float(tref_c)
-    x = t_med - tref
-    even, odd = np.arange(0, x.size, 2), np.arange(1, x.size, 2)
-    coefs, rms = [], {}
+    try:
+        fit = px4_coefficients(temp, vals, kind=kind, tref_c=tref_c)
+    except ParameterError as exc:
+        if exc.parameter != "temperature_c":
+            raise
+        raise ThermocalInputError(f"{where}: {exc.named('the temperature')}") from None
     names = fields if len(fields) > 1 else ("pressure",)
-    for j, name in enumerate(names):
-        held = np.polynomial.polynomial.polyfit(x[even], v_med[even, j], order)
-        pred = np.polynomial.polynomial.polyval(x[odd], held)
-        rms[name] = float(np.sqrt(np.mean((v_med[odd, j] - pred) ** 2)))
-        coefs.append(
-            tuple(float(c) for c in np.polynomial.polynomial.polyfit(x, v_med[:, j], order))
-        )
     return OffsetFit(
-        topic, kind, instance, device_id, unit, (lo, hi), tref, int(temp.size), int(t_med.size),
-        order, tuple(coefs), rms, record,
+        topic, kind, instance, device_id, unit, (fit.tmin_c, fit.tmax_c), fit.tref_c,
+        fit.n_samples, fit.n_bins, order, fit.coefficients,
+        dict(zip(names, fit.holdout_rms, strict=True)), record,
     )  # fmt: skip
 
 
@@ -453,8 +439,6 @@ def _imu_instance(
 
 
 __all__ = [
-    "BIN_WIDTH_C",
-    "MIN_BINS",
     "OFFSET_TOPICS",
     "TOPICS",
     "OffsetFit",
@@ -463,5 +447,4 @@ __all__ = [
     "log_topics",
     "offset_summary",
     "px4_tempcal",
-    "temperature_bins",
 ]
