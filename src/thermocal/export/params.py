@@ -1,5 +1,5 @@
-"""Firmware thermal-calibration parameters from a calibration (issue 16; INTERFACE.md
-"Firmware parameter formats").
+"""Firmware thermal-calibration parameters from a calibration: the parameter
+files of the firmwares' thermal compensation.
 
 * **PX4** (``TemperatureCompensation``): per sensor instance ``n`` and axis ``i``,
   ``offset_i = X0_i + X1_i·dT + X2_i·dT² + X3_i·dT³`` with
@@ -33,7 +33,7 @@ relative to the run's median; the absolute offset is the accelerometer calibrati
 its definition.  The notes say so; a model fitted without ``--gravity-axis`` is also
 warned.
 
-Refused (issue 26): a channel given twice or to both triads, a channel of the other kind,
+Refused: a channel given twice or to both triads, a channel of the other kind,
 an instance the firmware does not have (:data:`thermocal.firmware.formats.FORMATS`), and
 any parameter that is not a finite float32 (or, for the int32 ``ID``, outside int32).
 """
@@ -574,7 +574,7 @@ class ParamsFileResult:
     params: ParamSet
 
     def to_dict(self) -> dict[str, Any]:
-        """The ``thermocal export-params --json`` object (INTERFACE.md)."""
+        """The ``thermocal export-params --json`` object."""
         return {
             "output": self.output,
             "format": self.format,
@@ -611,7 +611,7 @@ def export_params_file(
 
     check_not_input(output, [calibration])
     cal = load_calibration(calibration)
-    if not cal.channels and cal.triads:  # issue 30: a calibration of triads
+    if not cal.channels and cal.triads:  # a calibration of triads
         if tref_c is not None:
             raise ThermocalInputError(
                 "--tref is for thermal parameters; a triad's values are taken at its own TREF"

@@ -1,5 +1,5 @@
-"""Firmware sensor-calibration parameters from a calibration of triads (issue 30;
-INTERFACE.md "Calibration without a turntable"): ``thermocal export-params`` of what
+"""Firmware sensor-calibration parameters from a calibration of triads:
+``thermocal export-params`` of what
 ``thermocal multipos`` (or ``turntable``) wrote.
 
 The triad model (:mod:`thermocal.turntable.model`) is ``x = (I + E) x_true + b``, so the
@@ -78,7 +78,7 @@ class TriadFirmware:
     temperature_dependent: bool
     tref_c: float
     count_scale: tuple[float, str] | None = None
-    """A triad calibrated on raw counts: one count is ``value`` ``unit`` (issue 30)."""
+    """A triad calibrated on raw counts: one count is ``value`` ``unit``."""
 
 
 def triad_firmware(triad: Triad) -> TriadFirmware:

@@ -11,10 +11,10 @@ correction curve (:func:`ardupilot_poly_curve`), the firmware's learning fit
 
 References
 ----------
-.. [1] ArduPilot, ``libraries/AP_InertialSensor/AP_InertialSensor_tempcal.cpp``,
-   https://github.com/ArduPilot/ardupilot/blob/master/libraries/AP_InertialSensor/AP_InertialSensor_tempcal.cpp
-.. [2] ArduPilot, ``libraries/AP_Math/polyfit.h`` and ``libraries/AP_Math/rotations.h``,
-   https://github.com/ArduPilot/ardupilot/tree/master/libraries/AP_Math
+* ArduPilot, ``libraries/AP_InertialSensor/AP_InertialSensor_tempcal.cpp``,
+  https://github.com/ArduPilot/ardupilot/blob/master/libraries/AP_InertialSensor/AP_InertialSensor_tempcal.cpp
+* ArduPilot, ``libraries/AP_Math/polyfit.h`` and ``libraries/AP_Math/rotations.h``,
+  https://github.com/ArduPilot/ardupilot/tree/master/libraries/AP_Math
 """
 
 from __future__ import annotations
@@ -235,8 +235,8 @@ def ardupilot_coefficients(
 
     References
     ----------
-    .. [1] ArduPilot, ``libraries/AP_InertialSensor/AP_InertialSensor_tempcal.cpp``
-       (``Learn::save_calibration``, ``correct_sensor``).
+    * ArduPilot, ``libraries/AP_InertialSensor/AP_InertialSensor_tempcal.cpp``
+      (``Learn::save_calibration``, ``correct_sensor``).
 
     Examples
     --------

@@ -8,12 +8,12 @@ and the file a ground station loads.  ``thermocal export-params``, ``px4-tempcal
 
 References
 ----------
-.. [1] PX4-Autopilot, ``src/modules/temperature_compensation/TemperatureCompensation.cpp``
-   and ``TemperatureCompensation.h``, https://github.com/PX4/PX4-Autopilot
-.. [2] PX4-Autopilot, ``Tools/process_sensor_caldata.py``,
-   https://github.com/PX4/PX4-Autopilot/blob/main/Tools/process_sensor_caldata.py
-.. [3] ArduPilot, ``libraries/AP_InertialSensor/AP_InertialSensor_tempcal.cpp``,
-   https://github.com/ArduPilot/ardupilot
+* PX4-Autopilot, ``src/modules/temperature_compensation/TemperatureCompensation.cpp``
+  and ``TemperatureCompensation.h``, https://github.com/PX4/PX4-Autopilot
+* PX4-Autopilot, ``Tools/process_sensor_caldata.py``,
+  https://github.com/PX4/PX4-Autopilot/blob/main/Tools/process_sensor_caldata.py
+* ArduPilot, ``libraries/AP_InertialSensor/AP_InertialSensor_tempcal.cpp``,
+  https://github.com/ArduPilot/ardupilot
 """
 
 from __future__ import annotations

@@ -9,11 +9,11 @@ the ``TC_*`` parameters.  No file is read or written here.
 
 References
 ----------
-.. [1] PX4-Autopilot, ``Tools/process_sensor_caldata.py``,
-   https://github.com/PX4/PX4-Autopilot/blob/main/Tools/process_sensor_caldata.py
-.. [2] PX4-Autopilot, ``src/modules/temperature_compensation/TemperatureCompensation.cpp``,
-   https://github.com/PX4/PX4-Autopilot/tree/main/src/modules/temperature_compensation
-.. [3] PX4 User Guide, "Thermal Compensation", https://docs.px4.io/main/en/advanced_config/sensor_thermal_calibration.html
+* PX4-Autopilot, ``Tools/process_sensor_caldata.py``,
+  https://github.com/PX4/PX4-Autopilot/blob/main/Tools/process_sensor_caldata.py
+* PX4-Autopilot, ``src/modules/temperature_compensation/TemperatureCompensation.cpp``,
+  https://github.com/PX4/PX4-Autopilot/tree/main/src/modules/temperature_compensation
+* PX4 User Guide, "Thermal Compensation", https://docs.px4.io/main/en/advanced_config/sensor_thermal_calibration.html
 """
 
 from __future__ import annotations
@@ -276,8 +276,8 @@ def px4_coefficients(
 
     References
     ----------
-    .. [1] PX4-Autopilot, ``Tools/process_sensor_caldata.py``.
-    .. [2] PX4-Autopilot, ``src/modules/temperature_compensation/TemperatureCompensation.cpp``.
+    * PX4-Autopilot, ``Tools/process_sensor_caldata.py``.
+    * PX4-Autopilot, ``src/modules/temperature_compensation/TemperatureCompensation.cpp``.
 
     Examples
     --------

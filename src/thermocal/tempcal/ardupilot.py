@@ -71,7 +71,7 @@ BARO_REPORT = "report_BARO_0.html"
 """The report of the first barometer's ``TCAL_BARO_EXP``."""
 
 
-# --- ArduPilot log hygiene (issue 28, item 4) ---------------------------------------------
+# --- ArduPilot log hygiene ---------------------------------------------------------------
 
 
 @dataclass(frozen=True)
@@ -387,7 +387,7 @@ class ArdupilotTempcalResult:
         return [k for k, h in self.hygiene.items() if h["active_tcal_removed"]]
 
     def to_dict(self) -> dict[str, Any]:
-        """The JSON of ``ardupilot-tempcal --json`` (INTERFACE.md)."""
+        """The JSON of ``ardupilot-tempcal --json``."""
         return {
             "log": str(self.log),
             "params": str(self.params_path),

@@ -1,4 +1,4 @@
-"""ArduPilot's barometer temperature calibration (issue 28, item 3): ``TCAL_BARO_EXP``.
+"""ArduPilot's barometer temperature calibration ``TCAL_BARO_EXP``.
 
 ArduPilot's ``AP_TempCalibration`` (libraries/AP_TempCalibration/AP_TempCalibration.cpp,
 .h) documents four parameters: ``TCAL_ENABLED`` (0 disabled, 1 use, 2 learn and use),

@@ -1,4 +1,4 @@
-"""What the report of a barometer or magnetometer calibration shows (issue 28, item 3).
+"""What the report of a barometer or magnetometer calibration shows.
 
 PX4's ``TC_B<n>``/``TC_M<n>`` are polynomials of the offset in ``T − TREF`` [Pa, gauss]
 (:func:`thermocal.tempcal.px4.fit_offset_sensor`).  :func:`offset_report_request` computes,

@@ -457,7 +457,7 @@ def staged_set(output: Path, reporter: Reporter | None, pool: Any = None) -> Ite
     out.close()
 
 
-# --- gates (issue 28, item 5): doubtful, named in a warning --------------------------------
+# --- gates: doubtful, named in a warning ---------------------------------------------------
 
 STALL_S = 600.0
 """A sweep that does not rise by :data:`STALL_RISE_C` for this long has stopped rising

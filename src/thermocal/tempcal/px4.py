@@ -1,4 +1,4 @@
-"""PX4's whole thermal calibration from one ULog (issue 16): ``thermocal px4-tempcal``.
+"""PX4's whole thermal calibration from one ULog: ``thermocal px4-tempcal``.
 
 The PX4 dialect of the one pipeline (:mod:`thermocal.tempcal.pipeline`): the topics
 ``sensor_gyro``/``sensor_accel`` (and ``sensor_baro``/``sensor_mag`` as offsets), the ``TC_*``
@@ -79,7 +79,7 @@ def log_topics(path: Path) -> list[tuple[str, int]]:
     return ulog_sensor_instances(path, (*TOPICS, *OFFSET_TOPICS))
 
 
-# --- barometers and magnetometers (issue 28, item 3) -------------------------------------
+# --- barometers and magnetometers --------------------------------------------------------
 
 OFFSET_TOPICS = {"sensor_baro": ("baro", ("pressure",), "Pa"), "sensor_mag": ("mag", AXES, "gauss")}
 """PX4 topics calibrated as offsets in the firmware's unit (uORB ``SensorBaro.msg`` pressure
@@ -180,7 +180,7 @@ class Px4TempcalResult:
     """Per sensor, the log's ``TC_*`` for its device against the new ones."""
 
     def to_dict(self) -> dict[str, Any]:
-        """The JSON of ``px4-tempcal --json`` (INTERFACE.md)."""
+        """The JSON of ``px4-tempcal --json``."""
         return {
             "log": str(self.log),
             "params": str(self.params_path),
