@@ -30,7 +30,7 @@ from thermocal.firmware.ardupilot import (
     ardupilot_rotation,
     tclr_learned,
 )
-from thermocal.firmware.formats import AP_TREF_C
+from thermocal.firmware.formats import AP_TREF_C, FORMATS
 from thermocal.models.calibration import Calibration
 from thermocal.outputs import check_outputs
 from thermocal.recording import FloatArray, Recording
@@ -60,8 +60,6 @@ from thermocal.tempcal.pipeline import (
     warn_gates,
 )
 
-PARAMS_NAME = "ardupilot.parm"
-"""The parameter file of the set (Mission Planner's ``.parm``, ``INS_TCAL*``)."""
 MAX_IMUS = 3
 """ArduPilot logs up to three IMUs (``IMU``, instances 0…2)."""
 KINDS = (("gyro", "Gyr", "rad/s"), ("accel", "Acc", "m/s^2"))
@@ -450,7 +448,7 @@ def ardupilot_tempcal(
     from thermocal.readers.dataflash import dataflash_table, read_dataflash_log
 
     # DIR may hold the log; the files of the set (replaced by name) may not be it
-    names = ["calibration.json", PARAMS_NAME]
+    names = ["calibration.json", FORMATS["ardupilot"].params_file]
     names += [f"report_IMU_{i}_{k}.html" for i in range(MAX_IMUS) for k in ("gyro", "accel")]
     names.append(BARO_REPORT)
     check_outputs([output / n for n in names], [log], dirs=[output])
@@ -475,7 +473,9 @@ def ardupilot_tempcal(
         warn_gates(run.gates)
         check_values(run.params)
         check_documented(run.params)
-        out_set.commit(calibration_of(run.fits), PARAMS_NAME, run.params.text())
+        out_set.commit(
+            calibration_of(run.fits), FORMATS["ardupilot"].params_file, run.params.text()
+        )
     notes = list(run.params.notes)
     found = [k for k, h in run.hygiene.items() if h["active_tcal_removed"]]
     if found:
@@ -504,7 +504,8 @@ def ardupilot_tempcal(
             "were rotated back to the sensor frame before fitting"
         )
     return ArdupilotTempcalResult(
-        log, output / PARAMS_NAME, output / "calibration.json", tuple(out_set.reports),
+        log, output / FORMATS["ardupilot"].params_file, output / "calibration.json",
+        tuple(out_set.reports),
         tuple(run.fits), tuple(notes), run.orientation, run.hygiene, run.previous,
         run.learning, run.baro, run.rotated, _changes_said(run),
     )  # fmt: skip

@@ -65,8 +65,6 @@ from thermocal.tempcal.pipeline import (
 )
 
 TOPICS = ("sensor_gyro", "sensor_accel")
-PARAMS_NAME = "px4.params"
-"""The parameter file of the set (QGroundControl's format, ``TC_*``)."""
 
 
 def log_topics(path: Path) -> list[tuple[str, int]]:
@@ -217,7 +215,9 @@ def px4_tempcal(
     # DIR may hold the log; the files of the set (replaced by name) may not be it
     from thermocal.readers.ulog import parsed_once
 
-    check_outputs([output / "calibration.json", output / PARAMS_NAME], [log], dirs=[output])
+    check_outputs(
+        [output / "calibration.json", output / FORMATS["px4"].params_file], [log], dirs=[output]
+    )
     check_output_dir(output)
     with (
         report_worker(reporter, log) as pool,  # starts while the log is read
@@ -266,14 +266,15 @@ def _px4_tempcal(
         warn_gates(gates)
         if not fits:
             raise ThermocalInputError(f"{log}: {NO_SENSOR}")
-        out_set.commit(calibration_of(fits), PARAMS_NAME, params.text())
+        out_set.commit(calibration_of(fits), FORMATS["px4"].params_file, params.text())
     if any(f.kind == "accel" for f in fits):
         params.notes.append(
             "accelerometers: offsets relative to mid-range (gravity is in the data), as PX4's "
             "own script does"
         )
     return Px4TempcalResult(
-        log, output / PARAMS_NAME, output / "calibration.json", tuple(out_set.reports),
+        log, output / FORMATS["px4"].params_file, output / "calibration.json",
+        tuple(out_set.reports),
         tuple(fits), tuple(offset_fits), tuple(params.notes), old.found,
     )  # fmt: skip
 
