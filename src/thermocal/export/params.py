@@ -50,7 +50,7 @@ from typing import Any
 import numpy as np
 
 from thermocal import units
-from thermocal.errors import ThermocalInputError, ThermocalWarning
+from thermocal.errors import ParameterError, ThermocalInputError, ThermocalWarning
 from thermocal.firmware.formats import ARDUPILOT_SCALE, FORMATS
 from thermocal.models.base import TemperatureModel
 from thermocal.models.calibration import Calibration
@@ -200,27 +200,30 @@ def map_axes(
     for kind, given in (("gyro", gyro), ("accel", accel)):
         if given:
             if len(given) != 3:
-                raise ThermocalInputError(f"--{kind} takes three channels, x,y,z; got {given}")
+                raise ParameterError(kind, f"{{name}} takes three channels, x,y,z; got {given}")
             twice = sorted({c for c in given if list(given).count(c) > 1})
             if twice:
-                raise ThermocalInputError(
-                    f"--{kind} {','.join(given)}: channel {', '.join(map(repr, twice))} given "
-                    "for more than one axis; each axis takes its own channel"
+                raise ParameterError(
+                    kind,
+                    f"{{name}} {','.join(given)}: channel {', '.join(map(repr, twice))} given "
+                    "for more than one axis; each axis takes its own channel",
                 )
             missing = [c for c in given if c not in cal.names]
             if missing:
-                raise ThermocalInputError(
-                    f"--{kind}: no channel {', '.join(map(repr, missing))} in the calibration "
-                    f"({', '.join(cal.names)})"
+                raise ParameterError(
+                    kind,
+                    f"{{name}}: no channel {', '.join(map(repr, missing))} in the calibration "
+                    f"({', '.join(cal.names)})",
                 )
             for c in given:
                 ch = cal.channel(c)
                 role = ch.role or guess_role(c, ch.model.signal_unit) or {}
                 if role.get("kind") not in (None, kind):
                     art = {"gyro": "a gyro", "accel": "an accel"}
-                    raise ThermocalInputError(
-                        f"--{kind} {','.join(given)}: channel {c!r} is {art[role['kind']]} "
-                        f"({ch.model.signal_unit}), not {art[kind]}"
+                    raise ParameterError(
+                        kind,
+                        f"{{name}} {','.join(given)}: channel {c!r} is {art[role['kind']]} "
+                        f"({ch.model.signal_unit}), not {art[kind]}",
                     )
             out[kind] = dict(zip(AXES, given, strict=True))
             continue
@@ -230,9 +233,10 @@ def map_axes(
             if (ch.role or {}).get("kind") == kind and (ch.role or {}).get("axis") in AXES
         }
         if found and set(found) != set(AXES):
-            raise ThermocalInputError(
+            raise ParameterError(
+                kind,
                 f"the calibration has {kind} axes {sorted(found)} only; the firmware takes a "
-                f"triad: give --{kind} X,Y,Z"
+                "triad: give {name} X,Y,Z",
             )
         if found:
             out[kind] = {a: found[a] for a in AXES}
@@ -363,15 +367,15 @@ def export_params(
     of the fitted range; ``device_id``: ``{"gyro": id, "accel": id}`` (default the
     calibration's recorded sensor id when numeric, else 0 with a warning)."""
     if fmt not in FORMATS:
-        raise ThermocalInputError(f"--format must be one of {', '.join(FORMATS)}, got {fmt!r}")
+        raise ParameterError("format", f"{{name}} must be one of {', '.join(FORMATS)}, got {fmt!r}")
     n_max = FORMATS[fmt].max_instances
     if not 0 <= instance < n_max:
         have = FORMATS[fmt].instances
-        raise ThermocalInputError(
-            f"--instance {instance}: {fmt} has {have}, instances 0…{n_max - 1}"
+        raise ParameterError(
+            "instance", f"{{name}} {instance}: {fmt} has {have}, instances 0…{n_max - 1}"
         )
     if tref_c is not None and not math.isfinite(tref_c):
-        raise ThermocalInputError(f"--tref {tref_c}: not a finite temperature")
+        raise ParameterError("tref_c", f"{{name}} {tref_c}: not a finite temperature")
     triads = map_axes(cal, gyro, accel)
     out = ParamSet(fmt)
     for kind, chans in triads.items():
@@ -451,9 +455,10 @@ def _device_id(cal: Calibration, kind: str, given: Mapping[str, int] | None) -> 
         text = str(sid) if sid is not None else ""
         if text.isascii() and text.isdigit():
             if len(text) > 10:  # beyond any int32; check_values would refuse it
-                raise ThermocalInputError(
+                raise ParameterError(
+                    "device_id",
                     f"{kind}: the recorded sensor id ({len(text)} digits) is not a device id "
-                    "the firmware can store (int32): give --device-id"
+                    "the firmware can store (int32): give {name}",
                 )
             return int(text)
     warnings.warn(
@@ -613,8 +618,9 @@ def export_params_file(
     cal = load_calibration(calibration)
     if not cal.channels and cal.triads:  # a calibration of triads
         if tref_c is not None:
-            raise ThermocalInputError(
-                "--tref is for thermal parameters; a triad's values are taken at its own TREF"
+            raise ParameterError(
+                "tref_c",
+                "{name} is for thermal parameters; a triad's values are taken at its own TREF",
             )
         return _triad_params_file(cal, calibration, fmt, output, gyro, accel, instance,
                                   device_id)  # fmt: skip

@@ -38,7 +38,7 @@ from typing import Any
 import numpy as np
 
 from thermocal import units
-from thermocal.errors import ThermocalInputError, ThermocalWarning
+from thermocal.errors import ParameterError, ThermocalInputError, ThermocalWarning
 from thermocal.firmware.formats import FORMATS
 from thermocal.models.calibration import Calibration, Triad
 
@@ -187,10 +187,11 @@ def _check_px4_accel(names: Sequence[str], values: Sequence[float], scale: bool)
 def _check_device_id(name: str, device_id: int) -> None:
     """A device id PX4 stores (:data:`PX4_ID_TYPE`)."""
     if not INT32_RANGE[0] <= device_id <= INT32_RANGE[1]:
-        raise ThermocalInputError(
-            f"--device-id {device_id}: {name} is an int32 ({INT32_RANGE[0]}…{INT32_RANGE[1]}, "
+        raise ParameterError(
+            "device_id",
+            f"{{name}} {device_id}: {name} is an int32 ({INT32_RANGE[0]}…{INT32_RANGE[1]}, "
             "type of CAL_ACC${i}_ID in PX4's src/modules/sensors/module.yaml); give the "
-            "device id PX4 shows for the sensor (a 24-bit bus/address/type code)"
+            "device id PX4 shows for the sensor (a 24-bit bus/address/type code)",
         )
 
 
@@ -239,12 +240,12 @@ def triad_params(
     docstring); warns what the firmware cannot hold, refuses a value outside ArduPilot's
     range or an instance the firmware does not have."""
     if fmt not in FORMATS:
-        raise ThermocalInputError(f"--format must be px4 or ardupilot, got {fmt!r}")
+        raise ParameterError("format", f"{{name}} must be px4 or ardupilot, got {fmt!r}")
     n_max = FORMATS[fmt].max_instances  # PX4 CAL_ACC0…3 / CAL_GYRO0…3; ArduPilot three IMUs
     if not 0 <= instance < n_max:
         have = "CAL_ACC0…CAL_ACC3" if fmt == "px4" else "INS_ACC, INS_ACC2, INS_ACC3"
-        raise ThermocalInputError(
-            f"--instance {instance}: {fmt} has {have}, instances 0…{n_max - 1}"
+        raise ParameterError(
+            "instance", f"{{name}} {instance}: {fmt} has {have}, instances 0…{n_max - 1}"
         )
     triads = {t.name: t for t in cal.triads if t.name in ("accel", "gyro")}
     if not triads:

@@ -93,6 +93,7 @@ OPTION_OF: dict[str, str] = {
     "rate_hz": "--rate",
     "signals": "--signal",
     "temperatures": "--temps",
+    "tref_c": "--tref",
 }
 """Library parameters whose command-line option is not the parameter's name with dashes
 (``time_unit`` → ``--time-unit`` needs no entry)."""
