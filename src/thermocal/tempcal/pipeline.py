@@ -236,15 +236,6 @@ def require_fields(df: Any, names: Sequence[str], log: Path, where: str) -> None
         )
 
 
-def read_sensor_topic(log: Path, topic: str) -> Recording:
-    """One ULog topic instance (``NAME.N``) as a recording of x, y, z and ``temperature``
-    (:func:`thermocal.readers.read_recording`), checked (finite, increasing time) and its
-    gaps stated in one :class:`GapWarning`."""
-    from thermocal.pipeline.reading import load_recording
-
-    return load_recording(log, signal="x,y,z", temps="temperature", topic=topic)
-
-
 # --- the output set ------------------------------------------------------------------------
 
 

@@ -40,9 +40,9 @@ from thermocal.firmware.formats import FORMATS
 from thermocal.firmware.px4 import px4_coefficients
 from thermocal.models.calibration import Calibration
 from thermocal.outputs import check_outputs
-from thermocal.readers.ulog_params import ulog_parameters
 from thermocal.recording import FloatArray
 from thermocal.tempcal.compare import CoefficientComparison, px4_comparison
+from thermocal.tempcal.flightlog import FlightLog, open_px4_log
 from thermocal.tempcal.pipeline import (
     AXES,
     OutputSet,
@@ -54,7 +54,6 @@ from thermocal.tempcal.pipeline import (
     end_warning,
     fit_sensor,
     gyro_unit_warning,
-    read_sensor_topic,
     report_worker,
     require_fields,
     staged_set,
@@ -65,16 +64,6 @@ from thermocal.tempcal.pipeline import (
 )
 
 TOPICS = ("sensor_gyro", "sensor_accel")
-
-
-def log_topics(path: Path) -> list[tuple[str, int]]:
-    """The ``sensor_gyro``/``sensor_accel``/``sensor_baro``/``sensor_mag`` instances of a ULog
-    that carry a temperature
-    (:func:`thermocal.readers.ulog.ulog_sensor_instances`: an unreadable log is refused, damage and
-    every instance left out are said in warnings)."""
-    from thermocal.readers.ulog import ulog_sensor_instances
-
-    return ulog_sensor_instances(path, (*TOPICS, *OFFSET_TOPICS))
 
 
 # --- barometers and magnetometers --------------------------------------------------------
@@ -209,25 +198,24 @@ def px4_tempcal(
     written).  Each IMU instance goes through the pipeline (:func:`.pipeline.fit_sensor`: a
     cubic per axis about ``tref_c`` [°C], mid-range unless given); barometers and
     magnetometers are offsets (:func:`fit_offset_sensor`).  ``overrides`` the adequacy
-    checks let through (``narrow``, ``motion``).  The log is parsed once
-    (:func:`thermocal.readers.ulog.parsed_once`) for every topic read."""
+    checks let through (``narrow``, ``motion``).  The log is read once into a
+    :class:`~thermocal.tempcal.flightlog.FlightLog` (:func:`.flightlog.open_px4_log`) that
+    every step takes its data from."""
 
     # DIR may hold the log; the files of the set (replaced by name) may not be it
-    from thermocal.readers.ulog import parsed_once
-
     check_outputs(
         [output / "calibration.json", output / FORMATS["px4"].params_file], [log], dirs=[output]
     )
     check_output_dir(output)
     with (
         report_worker(reporter, log) as pool,  # starts while the log is read
-        parsed_once(log, (*TOPICS, *OFFSET_TOPICS)),  # the log is parsed once
+        open_px4_log(log, (*TOPICS, *OFFSET_TOPICS)) as flight,  # the log is parsed once
     ):
-        return _px4_tempcal(log, output, tref_c, overrides, reporter, pool)
+        return _px4_tempcal(flight, output, tref_c, overrides, reporter, pool)
 
 
 def _px4_tempcal(
-    log: Path,
+    flight: FlightLog,
     output: Path,
     tref_c: float | None,
     overrides: tuple[str, ...],
@@ -237,7 +225,7 @@ def _px4_tempcal(
     """:func:`px4_tempcal` after its output checks (``pool``: the report worker)."""
     from thermocal.export.params import ParamSet
 
-    topics = log_topics(log)
+    log, topics = flight.path, flight.instances
     if not topics:
         raise ThermocalInputError(f"{log}: {NO_SENSOR}")
     check_outputs([output / f"report_{n}_{i}.html" for n, i in topics], [log], dirs=[output])
@@ -247,18 +235,18 @@ def _px4_tempcal(
     series: dict[str, tuple[FloatArray, FloatArray]] = {}
     motions: dict[str, adequacy.Motion] = {}
     params = ParamSet("px4")
-    old = _Prior(_tc_in_force(log, params.notes), {})  # the TC_* the log was recorded with
+    old = _Prior(_tc_in_force(flight, params.notes), {})  # the TC_* the log was recorded with
     with staged_set(output, reporter, pool) as out_set:  # moved into place whole, or removed
         for name, inst in topics:
             if name in OFFSET_TOPICS:  # barometers and magnetometers: TC_B / TC_M
                 ofit = _offset_instance(
-                    log, name, inst, tref_c, overrides, params, out_set, old, gates
+                    flight, name, inst, tref_c, overrides, params, out_set, old, gates
                 )
                 if ofit is not None:
                     offset_fits.append(ofit)
                 continue
             fit, more = _imu_instance(
-                log, name, inst, tref_c, overrides, params, out_set, (series, motions), old
+                flight, name, inst, tref_c, overrides, params, out_set, (series, motions), old
             )
             fits.append(fit)
             gates.extend(more)
@@ -279,19 +267,17 @@ def _px4_tempcal(
     )  # fmt: skip
 
 
-def _tc_in_force(log: Path, notes: list[str]) -> dict[str, float]:
+def _tc_in_force(flight: FlightLog, notes: list[str]) -> dict[str, float]:
     """The log's parameters the new ``TC_*`` are compared with: the initial ones
-    (:func:`thermocal.readers.ulog_params.ulog_parameters`) updated by every ``TC_*`` changed
-    during the recording (:func:`thermocal.readers.ulog.ulog_parameter_changes`), i.e. those
+    (``flight.parameters``) updated by every ``TC_*`` changed during the recording
+    (``flight.parameter_changes``), i.e. those
     in force at the end of the log, the board's calibration the new one replaces.  PX4 logs
     ``sensor_gyro``/``_accel``/``_baro``/``_mag`` before its temperature compensation
     (applied downstream, sensors/vehicle_imu), so such a change leaves the data as they are;
     each is said in ``notes`` (name, old → new, log time) with the values compared."""
-    from thermocal.readers.ulog import ulog_parameter_changes
-
-    params = ulog_parameters(log)
+    params = dict(flight.parameters)
     said: list[str] = []
-    for t, name, value in ulog_parameter_changes(log, (*TOPICS, *OFFSET_TOPICS)):
+    for t, name, value in flight.parameter_changes:
         before = params.get(name)
         if name.startswith("TC_") and before is not None and before != value:
             said.append(f"{name} {before:g} → {value:g} at log time {t:.3f} s")
@@ -307,7 +293,7 @@ def _tc_in_force(log: Path, notes: list[str]) -> dict[str, float]:
 
 @dataclass(frozen=True)
 class _Prior:
-    """The log's parameters (:func:`thermocal.readers.ulog_params.ulog_parameters`) and,
+    """The log's parameters (:attr:`.flightlog.FlightLog.parameters`) and,
     per sensor, its ``TC_*`` compared with the new ones (:func:`.compare.px4_comparison`)."""
 
     params: dict[str, float]
@@ -325,7 +311,7 @@ class _Prior:
 
 
 def _offset_instance(
-    log: Path,
+    flight: FlightLog,
     name: str,
     inst: int,
     tref_c: float | None,
@@ -340,11 +326,11 @@ def _offset_instance(
     set aside, said in ``gates``), fit (:func:`fit_offset_sensor`), its ``TC_B``/``TC_M``
     parameters merged into ``params``, its report (:func:`.offset_report.offset_report_request`)."""
     from thermocal.export.params import px4_offset_params
-    from thermocal.readers.dispatch import read_log_table
     from thermocal.tempcal.offset_gates import screen_baro, screen_mag
     from thermocal.tempcal.offset_report import offset_report_request
 
-    df, _info = read_log_table(log, f"{name}.{inst}")
+    log = flight.path
+    df, _info = flight.table(f"{name}.{inst}")
     fields = OFFSET_TOPICS[name][1]
     require_fields(df, ["timestamp", "temperature", *fields], log, f"{name}.{inst}")
     ids = df["device_id"].to_numpy() if "device_id" in df.columns else np.zeros(1)
@@ -378,7 +364,7 @@ def _offset_instance(
 
 
 def _imu_instance(
-    log: Path,
+    flight: FlightLog,
     name: str,
     inst: int,
     tref_c: float | None,
@@ -396,7 +382,8 @@ def _imu_instance(
 
     kind = "gyro" if name == "sensor_gyro" else "accel"
     where = f"{name}.{inst}"
-    rec = read_sensor_topic(log, where)
+    log = flight.path
+    rec = flight.recording(where)
     series, motions = found
     fit = fit_sensor(rec, name, kind, inst, overrides=overrides, motions=motions)
     temp_c = rec.temperature_c("temperature")
@@ -445,7 +432,6 @@ __all__ = [
     "OffsetFit",
     "Px4TempcalResult",
     "fit_offset_sensor",
-    "log_topics",
     "offset_summary",
     "px4_tempcal",
 ]
