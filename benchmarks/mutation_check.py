@@ -3223,6 +3223,39 @@ MUTANTS: tuple[Mutant, ...] = (
         AUDIT,
         "simulate multipos --rate-hz 1e12 allocates unchecked: MemoryError, exit 1",
     ),
+    # the firmware maths as pure functions (thermocal.firmware)
+    Mutant(
+        "fw-px4-gyro-relative",
+        P + "firmware/px4.py",
+        'relative = kind != "gyro"',
+        'relative = kind != "baro"',
+        ("tests/firmware/test_firmware_px4.py", "tests/docs/test_tutorial_notebook_px4.py"),
+        "PX4 gyro offsets taken relative to their median (PX4's script fits them absolute)",
+    ),
+    Mutant(
+        "fw-px4-offset-not-clamped",
+        P + "firmware/px4.py",
+        "np.float64).ravel(), self.tmin_c, self.tmax_c)",
+        "np.float64).ravel(), -np.inf, np.inf)",
+        ("tests/firmware/test_firmware_px4.py",),
+        "the firmware's offset evaluated beyond TMIN..TMAX (PX4 clamps)",
+    ),
+    Mutant(
+        "fw-ap-correction-not-relative",
+        P + "firmware/ardupilot.py",
+        "return curve(t) - curve(np.array([float(caltemp_c)]))",
+        "return curve(t)",
+        ("tests/firmware/test_firmware_ardupilot.py",),
+        "ArduPilot's correction without its calibration-temperature term",
+    ),
+    Mutant(
+        "fw-binned-min-bins",
+        P + "firmware/px4.py",
+        "need = max(MIN_BINS, 2 * (order + 1))",
+        "need = order + 1",
+        ("tests/firmware/test_firmware_px4.py", "tests/test_px4_baro_mag.py"),
+        "a polynomial fitted to as few bins as it has coefficients",
+    ),
 )
 
 

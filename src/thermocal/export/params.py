@@ -362,20 +362,55 @@ def export_params(
     device_id: Mapping[str, int] | None = None,
     tref_c: float | None = None,
 ) -> ParamSet:
-    """The parameters of ``fmt`` for the calibration's gyro and accelerometer triads
-    (module docstring).  ``tref_c`` (PX4): the reference temperature, default the middle
-    of the fitted range; ``device_id``: ``{"gyro": id, "accel": id}`` (default the
-    calibration's recorded sensor id when numeric, else 0 with a warning)."""
-    if fmt not in FORMATS:
-        raise ParameterError("format", f"{{name}} must be one of {', '.join(FORMATS)}, got {fmt!r}")
-    n_max = FORMATS[fmt].max_instances
-    if not 0 <= instance < n_max:
-        have = FORMATS[fmt].instances
-        raise ParameterError(
-            "instance", f"{{name}} {instance}: {fmt} has {have}, instances 0…{n_max - 1}"
-        )
-    if tref_c is not None and not math.isfinite(tref_c):
-        raise ParameterError("tref_c", f"{{name}} {tref_c}: not a finite temperature")
+    """The firmware parameters of a calibration's gyro and accelerometer triads.
+
+    Parameters
+    ----------
+    cal : Calibration
+        Channels fitted with the ``poly`` family, order ≤ 3, on one temperature in °C.
+    fmt : {"px4", "ardupilot"}
+        The dialect (:data:`thermocal.firmware.formats.FORMATS`).
+    gyro, accel : sequence of str, optional
+        The channels of each triad in x, y, z order; default the channels' roles.
+    instance : int
+        The sensor instance (PX4 0…3: ``TC_G0``…; ArduPilot 0…2: ``INS_TCAL1``…).
+    device_id : Mapping[str, int], optional
+        PX4 device id per kind, ``{"gyro": id, "accel": id}``; default the calibration's
+        recorded sensor id when numeric, else 0 with a warning.
+    tref_c : float, optional
+        PX4's ``TREF`` [°C]; default the middle of the fitted range (ArduPilot's is 35 °C).
+
+    Returns
+    -------
+    ParamSet
+        Name → value and MAVLink type of every parameter, the polynomials per axis in the
+        firmware's unit (rad/s, m/s²), the notes of the file.
+
+    Raises
+    ------
+    thermocal.errors.ParameterError
+        ``fmt``, ``instance``, ``tref_c``, ``gyro``/``accel`` or ``device_id`` the firmware
+        cannot take (the parameter is named).
+    thermocal.errors.ThermocalInputError
+        A channel the firmware cannot express (another family, Ṫ or several temperatures,
+        a power above 3), ranges that do not overlap, a value that is not a finite float32.
+
+    Notes
+    -----
+    Each channel's polynomial is re-expanded exactly about the reference temperature and
+    converted from the model's unit (°/h, mg) to the firmware's.  PX4 subtracts
+    :math:`\\sum_{k=0}^{3} X_k\\,\\Delta T^k`,
+    :math:`\\Delta T = \\operatorname{clamp}(T, T_\\mathrm{min}, T_\\mathrm{max}) -
+    T_\\mathrm{ref}`; ArduPilot stores :math:`c_k = b_k \\cdot 10^6`, k = 1…3, of the
+    polynomial about 35 °C (no constant).  Accelerometer offsets are relative (module
+    docstring).
+
+    References
+    ----------
+    * PX4-Autopilot, ``src/modules/temperature_compensation/TemperatureCompensation.cpp``.
+    * ArduPilot, ``libraries/AP_InertialSensor/AP_InertialSensor_tempcal.cpp``.
+    """
+    _check_arguments(fmt, instance, tref_c)
     triads = map_axes(cal, gyro, accel)
     out = ParamSet(fmt)
     for kind, chans in triads.items():
@@ -410,6 +445,20 @@ def export_params(
     check_values(out)
     check_documented(out)
     return out
+
+
+def _check_arguments(fmt: str, instance: int, tref_c: float | None) -> None:
+    """Refuse a dialect, an instance or a TREF :func:`export_params` cannot take."""
+    if fmt not in FORMATS:
+        raise ParameterError("format", f"{{name}} must be one of {', '.join(FORMATS)}, got {fmt!r}")
+    n_max = FORMATS[fmt].max_instances
+    if not 0 <= instance < n_max:
+        have = FORMATS[fmt].instances
+        raise ParameterError(
+            "instance", f"{{name}} {instance}: {fmt} has {have}, instances 0…{n_max - 1}"
+        )
+    if tref_c is not None and not math.isfinite(tref_c):
+        raise ParameterError("tref_c", f"{{name}} {tref_c}: not a finite temperature")
 
 
 def _accel_notes(
@@ -605,11 +654,37 @@ def export_params_file(
     tref_c: float | None = None,
     device_id: int | None = None,
 ) -> ParamsFileResult:
-    """``thermocal export-params``: a calibration (or model) file's firmware parameters
-    (:func:`export_params`) written atomically to ``output`` (never one of the inputs),
-    once the data behind it are known to support the fit
-    (:func:`thermocal.export.checks.check_firmware_adequacy`, ArduPilot's minimum sweep
-    too).  ``device_id``: the PX4 device id of both the gyro and the accelerometer."""
+    """A calibration (or model) file's firmware parameters, written to a parameter file.
+
+    Parameters
+    ----------
+    calibration : str or Path
+        The calibration or model file (``thermocal fit``, ``multipos``, ``turntable``).
+    fmt : {"px4", "ardupilot"}
+        The dialect (:data:`thermocal.firmware.formats.FORMATS`).
+    output : str or Path
+        The parameter file, written atomically (never one of the inputs).
+    gyro, accel : sequence of str, optional
+        The channels of each triad in x, y, z order; default the channels' roles.
+    instance : int
+        The sensor instance the parameters are for.
+    tref_c : float, optional
+        PX4's ``TREF`` [°C]; default the middle of the fitted range.
+    device_id : int, optional
+        The PX4 device id of both the gyro and the accelerometer.
+
+    Returns
+    -------
+    ParamsFileResult
+        The file written, its dialect and the parameters (:class:`ParamSet`).
+
+    Raises
+    ------
+    thermocal.errors.ThermocalInputError
+        What :func:`export_params` refuses, and data behind the calibration that do not
+        support the fit (:func:`thermocal.export.checks.check_firmware_adequacy`,
+        ArduPilot's 10 °C sweep too).
+    """
     from thermocal.export.checks import check_firmware_adequacy
     from thermocal.models.files import load_calibration
     from thermocal.writers import atomic_write, check_not_input

@@ -436,13 +436,51 @@ class _Run:
 def ardupilot_tempcal(
     log: Path, output: Path, *, overrides: tuple[str, ...] = (), reporter: Reporter | None = None
 ) -> ArdupilotTempcalResult:
-    """ArduPilot's thermal calibration of every IMU of a DataFlash log, written to the
-    directory ``output`` as one set: ``calibration.json``, ``ardupilot.parm``
-    (``INS_TCAL<n>_*``) and ``report_IMU_<n>_<kind>.html`` per sensor (written by
-    ``reporter``; none: not written).  Each IMU's gyro and accelerometer go through the
-    pipeline (:func:`.pipeline.fit_sensor` with ArduPilot's minimum sweep) after the log's
-    hygiene (:func:`ardupilot_raw`); an IMU whose temperature is all 0 or NaN is left out
-    with a warning.  ``overrides`` the adequacy checks let through."""
+    """ArduPilot's thermal calibration of every IMU of a DataFlash log, written as one set.
+
+    Parameters
+    ----------
+    log : Path
+        An ArduPilot DataFlash log (``.bin``) with ``IMU`` messages over a temperature sweep.
+    output : Path
+        The directory of the set: ``calibration.json``, ``ardupilot.parm``
+        (``INS_TCAL<n>_*``), ``report_IMU_<n>_<kind>.html`` per sensor and the first
+        barometer's ``TCAL_BARO_EXP`` report; built beside it and moved into place whole.
+    overrides : tuple of str
+        Adequacy checks let through (``"narrow"``, ``"motion"``).
+    reporter : callable, optional
+        Writes one report (the presentation layer's); None: no report written.
+
+    Returns
+    -------
+    ArdupilotTempcalResult
+        The files written, each sensor's fit, the log's hygiene (rotation undone, an active
+        ``INS_TCAL`` removed), the previous and the firmware-learned coefficients compared.
+
+    Raises
+    ------
+    thermocal.errors.ThermocalInputError
+        An unreadable log, no IMU with a usable temperature, a sweep narrower than
+        ArduPilot's 10 °C or otherwise inadequate unless overridden, a board rotation that
+        cannot be undone, an output that is the log or not a directory.
+
+    Notes
+    -----
+    Each IMU's gyro and accelerometer go through the pipeline (:func:`.pipeline.fit_sensor`
+    with ArduPilot's minimum sweep) after the log's hygiene (:func:`ardupilot_raw`); an IMU
+    whose temperature is all 0 or NaN is left out with a warning.  The firmware subtracts
+
+    .. math::
+
+        p(\\operatorname{clamp}(T) - 35) - p(T_\\mathrm{cal} - 35), \\qquad
+        p(t) = (c_1 + (c_2 + c_3 t)\\,t)\\,t \\cdot 10^{-6} .
+
+    References
+    ----------
+    * ArduPilot, ``libraries/AP_InertialSensor/AP_InertialSensor_tempcal.cpp``,
+      https://github.com/ArduPilot/ardupilot/blob/master/libraries/AP_InertialSensor/AP_InertialSensor_tempcal.cpp
+    * ArduPilot, ``libraries/AP_TempCalibration/AP_TempCalibration.cpp`` (the barometer).
+    """
     from thermocal.errors import MissingColumnError
     from thermocal.export.params import ParamSet, check_documented, check_values
     from thermocal.readers.dataflash import dataflash_table, read_dataflash_log
@@ -476,6 +514,19 @@ def ardupilot_tempcal(
         out_set.commit(
             calibration_of(run.fits), FORMATS["ardupilot"].params_file, run.params.text()
         )
+    notes = _run_notes(run)
+    return ArdupilotTempcalResult(
+        log, output / FORMATS["ardupilot"].params_file, output / "calibration.json",
+        tuple(out_set.reports),
+        tuple(run.fits), tuple(notes), run.orientation, run.hygiene, run.previous,
+        run.learning, run.baro, run.rotated, _changes_said(run),
+    )  # fmt: skip
+
+
+def _run_notes(run: _Run) -> list[str]:
+    """The notes of an :func:`ardupilot_tempcal` run: the parameter file's, the log's
+    hygiene (an active ``INS_TCAL`` removed, a rotation undone), the firmware's learning
+    found, the barometer's exponent and the parameter changes during the recording."""
     notes = list(run.params.notes)
     found = [k for k, h in run.hygiene.items() if h["active_tcal_removed"]]
     if found:
@@ -503,12 +554,7 @@ def ardupilot_tempcal(
             f"AHRS_ORIENTATION {run.orientation} ({AP_ROTATIONS[run.orientation]}): the data "
             "were rotated back to the sensor frame before fitting"
         )
-    return ArdupilotTempcalResult(
-        log, output / FORMATS["ardupilot"].params_file, output / "calibration.json",
-        tuple(out_set.reports),
-        tuple(run.fits), tuple(notes), run.orientation, run.hygiene, run.previous,
-        run.learning, run.baro, run.rotated, _changes_said(run),
-    )  # fmt: skip
+    return notes
 
 
 def _changes_said(run: _Run) -> tuple[dict[str, Any], ...]:

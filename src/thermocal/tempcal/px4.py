@@ -192,15 +192,56 @@ def px4_tempcal(
     overrides: tuple[str, ...] = (),
     reporter: Reporter | None = None,
 ) -> Px4TempcalResult:
-    """PX4's thermal calibration of every sensor instance of a ULog, written to the
-    directory ``output`` as one set: ``calibration.json``, ``px4.params`` (``TC_*``) and
-    ``report_<topic>_<n>.html`` per IMU instance (written by ``reporter``; none: not
-    written).  Each IMU instance goes through the pipeline (:func:`.pipeline.fit_sensor`: a
-    cubic per axis about ``tref_c`` [°C], mid-range unless given); barometers and
-    magnetometers are offsets (:func:`fit_offset_sensor`).  ``overrides`` the adequacy
-    checks let through (``narrow``, ``motion``).  The log is read once into a
-    :class:`~thermocal.tempcal.flightlog.FlightLog` (:func:`.flightlog.open_px4_log`) that
-    every step takes its data from."""
+    """PX4's thermal calibration of every sensor instance of a ULog, written as one set.
+
+    Parameters
+    ----------
+    log : Path
+        A PX4 ULog recorded with the thermal-calibration logging profile (``sensor_gyro``,
+        ``sensor_accel``, ``sensor_baro``, ``sensor_mag`` with their temperatures).
+    output : Path
+        The directory of the set: ``calibration.json``, ``px4.params`` (``TC_*``) and
+        ``report_<topic>_<n>.html`` per instance; built beside it and moved into place whole.
+    tref_c : float, optional
+        ``TREF`` of every polynomial [°C]; default the middle of each instance's range.
+    overrides : tuple of str
+        Adequacy checks let through (``"narrow"``, ``"motion"``).
+    reporter : callable, optional
+        Writes one report (the presentation layer's); None: no report written.
+
+    Returns
+    -------
+    Px4TempcalResult
+        The files written, each instance's fit and hold-out rms, the notes of the
+        parameter file, the log's previous ``TC_*`` compared with the new ones.
+
+    Raises
+    ------
+    thermocal.errors.ThermocalInputError
+        An unreadable log, no sensor with a temperature, data that cannot support the fit
+        (sweep, bins, motion) unless overridden, an output that is the log or not a
+        directory.
+
+    Notes
+    -----
+    The log is read once into a :class:`~thermocal.tempcal.flightlog.FlightLog`.  Each IMU
+    instance goes through the pipeline (:func:`.pipeline.fit_sensor`: a cubic per axis in
+    the temperature, fitted to the medians of 0.5 °C bins); barometers and magnetometers
+    are offsets (:func:`fit_offset_sensor`, :func:`thermocal.firmware.px4.px4_coefficients`).
+    The firmware subtracts, per axis,
+
+    .. math::
+
+        o(T) = \\sum_{k=0}^{n} X_k\\,(\\operatorname{clamp}(T, T_\\mathrm{min},
+        T_\\mathrm{max}) - T_\\mathrm{ref})^k .
+
+    References
+    ----------
+    * PX4-Autopilot, ``Tools/process_sensor_caldata.py``,
+      https://github.com/PX4/PX4-Autopilot/blob/main/Tools/process_sensor_caldata.py
+    * PX4-Autopilot, ``src/modules/temperature_compensation/TemperatureCompensation.cpp``,
+      https://github.com/PX4/PX4-Autopilot/tree/main/src/modules/temperature_compensation
+    """
 
     # DIR may hold the log; the files of the set (replaced by name) may not be it
     check_outputs(
