@@ -51,7 +51,7 @@ import numpy as np
 
 from thermocal import units
 from thermocal.errors import ParameterError, ThermocalInputError, ThermocalWarning
-from thermocal.firmware.formats import ARDUPILOT_SCALE, FORMATS
+from thermocal.firmware.formats import ARDUPILOT_SCALE, FORMATS, INT32_RANGE
 from thermocal.models.base import TemperatureModel
 from thermocal.models.calibration import Calibration
 
@@ -60,7 +60,6 @@ ARDUPILOT_MIN_SPAN_C = 10.0
 AXES = ("x", "y", "z")
 FLOAT32_MAX = float(np.finfo(np.float32).max)
 """Largest finite float32 (≈ 3.4028235e38): the firmware stores parameters as 32-bit floats."""
-INT32_RANGE = (-(2**31), 2**31 - 1)
 
 
 @dataclass(frozen=True)
@@ -281,56 +280,16 @@ def check_values(ps: ParamSet) -> None:
             )
 
 
-@dataclass(frozen=True)
-class Documented:
-    """What a firmware documents of a parameter: ``pattern`` (a regular expression of the
-    names), the MAVLink type written (6 int, 9 float), the values it takes (``lo``…``hi``),
-    whether a value outside is refused (``hard``: the firmware cannot store or use it) or
-    warned (a ground station's @Range, which the firmware itself does not enforce), and
-    the source."""
-
-    pattern: str
-    type: int
-    lo: float
-    hi: float
-    hard: bool
-    source: str
-
-
-DOCUMENTED = (
-    Documented(r"TC_[GABM]_ENABLE", 6, 0, 1, True,
-               "PX4 TC_G_ENABLE/TC_A_ENABLE/TC_B_ENABLE/TC_M_ENABLE: boolean int32 "
-               "(src/modules/temperature_compensation parameters)"),
-    Documented(r"TC_[GABM][0-3]_ID", 6, INT32_RANGE[0], INT32_RANGE[1], True,
-               "PX4 TC_*<n>_ID: int32 (same parameters)"),
-    Documented(r"INS_TCAL[1-3]_ENABLE", 6, 0, 2, True,
-               "ArduPilot INS_TCALn_ENABLE @Values 0:Disabled,1:Enabled,2:LearnCalibration "
-               "(AP_InertialSensor_tempcal.cpp)"),
-    Documented(r"INS_TCAL[1-3]_T(MIN|MAX)", 9, -70, 80, False,
-               "ArduPilot INS_TCALn_TMIN/TMAX @Range: -70 80 degC "
-               "(AP_InertialSensor_tempcal.cpp; the firmware clamps T to the values written)"),
-    Documented(r"TCAL_ENABLED", 6, 0, 2, True,
-               "ArduPilot TCAL_ENABLED @Values 0:Disabled,1:Enabled,2:EnableAndLearn "
-               "(AP_TempCalibration.cpp)"),
-    Documented(r"TCAL_TEMP_(MIN|MAX)", 6, -128, 127, True,
-               "ArduPilot TCAL_TEMP_MIN/MAX: AP_Int8 (AP_TempCalibration.h)"),
-    Documented(r"TCAL_BARO_EXP", 9, 0, 2, True,
-               "ArduPilot TCAL_BARO_EXP: exp_limit_min 0 … exp_limit_max 2 "
-               "(AP_TempCalibration.h)"),
-)  # fmt: skip
-"""The parameters of :class:`ParamSet` whose type and values the firmwares document
-(:func:`check_documented`); the float parameters without a documented range are checked as
-float32 by :func:`check_values`."""
-
-
 def check_documented(ps: ParamSet) -> None:
-    """Every parameter of ``ps`` against :data:`DOCUMENTED`: a type other than the one
+    """Every parameter of ``ps`` against what the firmwares document of it
+    (``documented`` of :data:`thermocal.firmware.formats.FORMATS`): a type other than the one
     documented, or a value outside a ``hard`` range, refused (exit 2) naming the parameter,
     the value and the source; outside a ground station's @Range: a warning."""
     import re
 
     for name, v in ps.params.items():
-        doc = next((d for d in DOCUMENTED if re.fullmatch(d.pattern, name)), None)
+        documented = (d for f in FORMATS.values() for d in f.documented)
+        doc = next((d for d in documented if re.fullmatch(d.pattern, name)), None)
         if doc is None:
             continue
         typ = ps.types.get(name, 9)
@@ -558,9 +517,7 @@ def _ardupilot_params(
 
 
 __all__ = [
-    "DOCUMENTED",
     "AxisPoly",
-    "Documented",
     "ParamSet",
     "axis_poly",
     "check_documented",

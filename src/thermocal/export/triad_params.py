@@ -39,7 +39,7 @@ import numpy as np
 
 from thermocal import units
 from thermocal.errors import ParameterError, ThermocalInputError, ThermocalWarning
-from thermocal.firmware.formats import FORMATS
+from thermocal.firmware.formats import FORMATS, INT32_RANGE
 from thermocal.models.calibration import Calibration, Triad
 
 ARDUPILOT_ACCSCAL_RANGE = (0.8, 1.2)
@@ -60,7 +60,6 @@ PLAUSIBLE_NOTE = (
 is applied to PX4's values too: the same physical sensor, a MEMS accelerometer whose
 sensitivity is specified within a few % (e.g. ±2 % initial tolerance, Bosch BMI088, TDK
 ICM-20602 datasheets) and whose zero-g offset within a few hundred mg."""
-INT32_RANGE = (-(2**31), 2**31 - 1)
 
 
 @dataclass(frozen=True)

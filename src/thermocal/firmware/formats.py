@@ -26,6 +26,35 @@ AP_TREF_C = 35.0
 (``AP_InertialSensor_tempcal.cpp``: ``TEMP_REFERENCE``)."""
 ARDUPILOT_SCALE = 1.0e-6
 """ArduPilot stores its coefficients ``c_k`` scaled: the firmware multiplies them by 1e-6."""
+INT32_RANGE = (-(2**31), 2**31 - 1)
+"""The values of a firmware's int32 parameter (MAVLink type 6)."""
+
+
+@dataclass(frozen=True)
+class Documented:
+    """What a firmware documents of a parameter.
+
+    Parameters
+    ----------
+    pattern : str
+        A regular expression of the parameter names.
+    type : int
+        The MAVLink type written (6 int32, 9 float).
+    lo, hi : float
+        The values it takes [the parameter's unit].
+    hard : bool
+        A value outside is refused (the firmware cannot store or use it); else warned (a
+        ground station's @Range, which the firmware itself does not enforce).
+    source : str
+        Where the firmware documents it.
+    """
+
+    pattern: str
+    type: int
+    lo: float
+    hi: float
+    hard: bool
+    source: str
 
 
 @dataclass(frozen=True)
@@ -80,6 +109,9 @@ class FirmwareFormat:
         The sensors it compensates, by kind.
     source : str
         The firmware source file that applies the parameters.
+    documented : tuple of Documented
+        The parameters whose type and values the firmware documents (checked before a
+        parameter file is written).
     """
 
     name: str
@@ -91,6 +123,7 @@ class FirmwareFormat:
     scale: float
     sensors: Mapping[str, SensorParams] = field(default_factory=dict)
     source: str = ""
+    documented: tuple[Documented, ...] = ()
 
 
 FORMATS: dict[str, FirmwareFormat] = {
@@ -104,6 +137,13 @@ FORMATS: dict[str, FirmwareFormat] = {
             "mag": SensorParams("mag", "M", 3, 3, "gauss"),
         },
         "src/modules/temperature_compensation/TemperatureCompensation.cpp",
+        (
+            Documented(r"TC_[GABM]_ENABLE", 6, 0, 1, True,
+                       "PX4 TC_G_ENABLE/TC_A_ENABLE/TC_B_ENABLE/TC_M_ENABLE: boolean int32 "
+                       "(src/modules/temperature_compensation parameters)"),
+            Documented(r"TC_[GABM][0-3]_ID", 6, INT32_RANGE[0], INT32_RANGE[1], True,
+                       "PX4 TC_*<n>_ID: int32 (same parameters)"),
+        ),
     ),
     "ardupilot": FirmwareFormat(
         "ardupilot", "Mission Planner parameter file (INS_TCAL*)", "ardupilot.parm", 3,
@@ -113,6 +153,23 @@ FORMATS: dict[str, FirmwareFormat] = {
             "accel": SensorParams("accel", "ACC", 3, 3, "m/s^2"),
         },
         "libraries/AP_InertialSensor/AP_InertialSensor_tempcal.cpp",
+        (
+            Documented(r"INS_TCAL[1-3]_ENABLE", 6, 0, 2, True,
+                       "ArduPilot INS_TCALn_ENABLE @Values 0:Disabled,1:Enabled,2:LearnCalibration "
+                       "(AP_InertialSensor_tempcal.cpp)"),
+            Documented(r"INS_TCAL[1-3]_T(MIN|MAX)", 9, -70, 80, False,
+                       "ArduPilot INS_TCALn_TMIN/TMAX @Range: -70 80 degC "
+                       "(AP_InertialSensor_tempcal.cpp; the firmware clamps T to the values "
+                       "written)"),
+            Documented(r"TCAL_ENABLED", 6, 0, 2, True,
+                       "ArduPilot TCAL_ENABLED @Values 0:Disabled,1:Enabled,2:EnableAndLearn "
+                       "(AP_TempCalibration.cpp)"),
+            Documented(r"TCAL_TEMP_(MIN|MAX)", 6, -128, 127, True,
+                       "ArduPilot TCAL_TEMP_MIN/MAX: AP_Int8 (AP_TempCalibration.h)"),
+            Documented(r"TCAL_BARO_EXP", 9, 0, 2, True,
+                       "ArduPilot TCAL_BARO_EXP: exp_limit_min 0 … exp_limit_max 2 "
+                       "(AP_TempCalibration.h)"),
+        ),
     ),
 }  # fmt: skip
 """The firmware dialects by name.  PX4: ``GYRO_COUNT_MAX = ACCEL_COUNT_MAX = 4`` with
@@ -162,6 +219,8 @@ __all__ = [
     "AP_TREF_C",
     "ARDUPILOT_SCALE",
     "FORMATS",
+    "INT32_RANGE",
+    "Documented",
     "FirmwareFormat",
     "SensorParams",
     "firmware_format",
