@@ -542,10 +542,47 @@ def px4_offset_params(
     tref_c: float,
     coefficients: Sequence[Sequence[float]],
 ) -> ParamSet:
-    """PX4 ``TC_B<n>_*`` (``kind`` "baro", ``coefficients`` [[X0…X5]]) or ``TC_M<n>_*``
-    ("mag", [[X0…X3] per axis x, y, z]): polynomial in ``T − TREF`` [firmware unit: Pa,
-    gauss], (:data:`thermocal.firmware.formats.FORMATS`); refused for an instance PX4 has
-    no parameters for, or a value that is not a finite float32."""
+    """PX4's barometer (``TC_B<n>_*``) or magnetometer (``TC_M<n>_*``) parameters.
+
+    Parameters
+    ----------
+    kind : {"baro", "mag"}
+        The sensor.
+    instance : int
+        Its instance, 0…3.
+    device_id : int
+        PX4's device id of the sensor.
+    tmin_c, tmax_c, tref_c : float
+        ``TMIN``, ``TMAX``, ``TREF`` [°C].
+    coefficients : sequence of sequence of float
+        ``[[X0…X5]]`` for the barometer [Pa], ``[[X0…X3]]`` per axis x, y, z for the
+        magnetometer [gauss]: the polynomial in ``T − TREF``
+        (:data:`thermocal.firmware.formats.FORMATS`).
+
+    Returns
+    -------
+    ParamSet
+        The parameters, checked.
+
+    Raises
+    ------
+    thermocal.errors.ThermocalInputError
+        A sensor or an instance PX4 has no parameters for, coefficients of the wrong shape,
+        a value that is not a finite float32.
+
+    Notes
+    -----
+    The firmware subtracts :math:`\\sum_k X_k\\,\\Delta T^k`,
+    :math:`\\Delta T = \\operatorname{clamp}(T, T_\\mathrm{min}, T_\\mathrm{max}) -
+    T_\\mathrm{ref}`, from the measurement (PX4-Autopilot
+    ``src/modules/temperature_compensation/TemperatureCompensation.cpp``).
+
+    Examples
+    --------
+    >>> ps = px4_offset_params("baro", 0, 7, 10.0, 50.0, 30.0, [[1.5, -2.0, 0, 0, 0, 0]])
+    >>> ps.params["TC_B0_X1"], ps.params["TC_B0_TREF"], ps.params["TC_B_ENABLE"]
+    (-2.0, 30.0, 1)
+    """
     if kind not in PX4_OFFSET_KINDS:
         raise ThermocalInputError(f"no PX4 thermal parameters for a {kind!r} sensor")
     sensor, n_max = FORMATS["px4"].sensors[kind], FORMATS["px4"].max_instances
