@@ -271,8 +271,11 @@ def px4_coefficients(
         o(T) = \\sum_{k=0}^{n} X_k\\,(\\operatorname{clamp}(T, T_\\mathrm{min},
         T_\\mathrm{max}) - T_\\mathrm{ref})^k .
 
-    ``thermocal px4-tempcal`` writes accelerometer offsets relative to the fitted value at
-    mid-range instead of the median; the two differ by a constant only.
+    ``thermocal px4-tempcal`` fits the same bins with the same cubic, but takes ``TMIN`` and
+    ``TMAX`` at the median temperatures of the first and last bins (the fitted range, a
+    fraction of a bin inside the recorded extremes) and writes accelerometer offsets that
+    are zero at mid-range instead of relative to the median: with its ``TREF`` given as
+    ``tref_c``, the coefficients here are its own, the accelerometer's ``X0`` aside.
 
     References
     ----------
