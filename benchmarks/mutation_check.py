@@ -724,9 +724,9 @@ MUTANTS: tuple[Mutant, ...] = (
     ),
     Mutant(
         "params-ardupilot-tref",
-        P + "export/params.py",
-        "ARDUPILOT_TREF_C = 35.0",
-        "ARDUPILOT_TREF_C = 25.0",
+        P + "firmware/formats.py",
+        "AP_TREF_C = 35.0",
+        "AP_TREF_C = 25.0",
         PARAMS,
         "ArduPilot's polynomial about 25 °C (the firmware's is 35 °C)",
     ),
@@ -781,10 +781,10 @@ MUTANTS: tuple[Mutant, ...] = (
     # --- px4 / ardupilot tempcal --------------------------------------------------------
     Mutant(
         "px4-baro-holdout-on-training",
-        P + "tempcal/px4.py",
-        "held = np.polynomial.polynomial.polyfit(x[even], v_med[even, j], order)",
-        "held = np.polynomial.polynomial.polyfit(x, v_med[:, j], order)",
-        PX4,
+        P + "firmware/px4.py",
+        "held = poly.polyfit(x[even], v_med[even], order)",
+        "held = poly.polyfit(x, v_med, order)",
+        (*PX4, "tests/firmware/test_firmware_px4.py"),
         "baro/mag hold-out fitted on every bin",
     ),
     Mutant(
@@ -797,7 +797,7 @@ MUTANTS: tuple[Mutant, ...] = (
     ),
     Mutant(
         "px4-bin-median-to-mean",
-        P + "tempcal/binning.py",
+        P + "firmware/binning.py",
         "[np.median(values[order[a:b]], axis=0)",
         "[np.mean(values[order[a:b]], axis=0)",
         PX4,
@@ -805,10 +805,10 @@ MUTANTS: tuple[Mutant, ...] = (
     ),
     Mutant(
         "px4-baro-tref-low-end",
-        P + "tempcal/px4.py",
-        "tref = 0.5 * (lo + hi) if tref_c is None else float(tref_c)\n    x = t_med - tref",
-        "tref = lo if tref_c is None else float(tref_c)\n    x = t_med - tref",
-        PX4,
+        P + "firmware/px4.py",
+        "tref = 0.5 * (lo + hi) if tref_c is None else float(tref_c)",
+        "tref = lo if tref_c is None else float(tref_c)",
+        (*PX4, "tests/firmware/test_firmware_px4.py"),
         "baro/mag TREF at the low end",
     ),
     Mutant(
@@ -2367,7 +2367,7 @@ MUTANTS: tuple[Mutant, ...] = (
     ),
     Mutant(
         "fw-ap-pitch-sign",
-        P + "tempcal/ardupilot.py",
+        P + "firmware/ardupilot.py",
         "ry = np.array([[cp, 0, sp], [0, 1, 0], [-sp, 0, cp]])",
         "ry = np.array([[cp, 0, -sp], [0, 1, 0], [sp, 0, cp]])",
         FW_AP,
@@ -2375,7 +2375,7 @@ MUTANTS: tuple[Mutant, ...] = (
     ),
     Mutant(
         "fw-tclr-powers-off-by-one",
-        P + "tempcal/ardupilot.py",
+        P + "firmware/ardupilot.py",
         "return [[float(x) * 1e6 for x in p[k]] for k in (1, 2, 3)]",
         "return [[float(x) * 1e6 for x in p[k]] for k in (0, 1, 2)]",
         FW_AP,
@@ -2383,7 +2383,7 @@ MUTANTS: tuple[Mutant, ...] = (
     ),
     Mutant(
         "fw-tclr-no-tref",
-        P + "tempcal/ardupilot.py",
+        P + "firmware/ardupilot.py",
         "np.vander(np.asarray(temp_c, dtype=np.float64) - AP_TREF_C, 4",
         "np.vander(np.asarray(temp_c, dtype=np.float64), 4",
         FW_AP,
@@ -3292,6 +3292,39 @@ MUTANTS: tuple[Mutant, ...] = (
         "if wanted < 0:",
         AUDIT,
         "simulate multipos --rate-hz 1e12 allocates unchecked: MemoryError, exit 1",
+    ),
+    # the firmware maths as pure functions (thermocal.firmware)
+    Mutant(
+        "fw-px4-gyro-relative",
+        P + "firmware/px4.py",
+        'relative = kind != "gyro"',
+        'relative = kind != "baro"',
+        ("tests/firmware/test_firmware_px4.py", "tests/docs/test_tutorial_notebook_px4.py"),
+        "PX4 gyro offsets taken relative to their median (PX4's script fits them absolute)",
+    ),
+    Mutant(
+        "fw-px4-offset-not-clamped",
+        P + "firmware/px4.py",
+        "np.float64).ravel(), self.tmin_c, self.tmax_c)",
+        "np.float64).ravel(), -np.inf, np.inf)",
+        ("tests/firmware/test_firmware_px4.py",),
+        "the firmware's offset evaluated beyond TMIN..TMAX (PX4 clamps)",
+    ),
+    Mutant(
+        "fw-ap-correction-not-relative",
+        P + "firmware/ardupilot.py",
+        "return curve(t) - curve(np.array([float(caltemp_c)]))",
+        "return curve(t)",
+        ("tests/firmware/test_firmware_ardupilot.py",),
+        "ArduPilot's correction without its calibration-temperature term",
+    ),
+    Mutant(
+        "fw-binned-min-bins",
+        P + "firmware/px4.py",
+        "need = max(MIN_BINS, 2 * (order + 1))",
+        "need = order + 1",
+        ("tests/firmware/test_firmware_px4.py", "tests/test_px4_baro_mag.py"),
+        "a polynomial fitted to as few bins as it has coefficients",
     ),
 )
 

@@ -29,6 +29,7 @@ PAGES = (
     "tutorials/chamber-to-c",
     "tutorials/noise-for-estimator",
     "tutorials/fc-params",
+    "tutorials/notebook-px4",
     "tutorials/production-batch",
     "tutorials/station",
     "methods",

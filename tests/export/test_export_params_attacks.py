@@ -5,7 +5,7 @@ once from a recording generated here; each attack runs ``export-params`` on it (
 edited in code, its checksums recomputed as anyone can) and must end in exit 2 with one
 ``error:`` line naming the option, channel or parameter, no output file, and every input
 byte for byte unchanged.  The firmware limits the attacks probe are cited in
-:data:`thermocal.export.params.MAX_INSTANCES` (PX4 ``TC_G0…3``/``TC_A0…3``, ArduPilot
+:data:`thermocal.firmware.formats.FORMATS` (PX4 ``TC_G0…3``/``TC_A0…3``, ArduPilot
 ``INS_TCAL1…3``) and :data:`thermocal.export.params.FLOAT32_MAX`.
 """
 

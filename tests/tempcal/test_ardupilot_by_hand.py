@@ -41,7 +41,7 @@ FIRMWARE_ROTATIONS = {
 
 @pytest.mark.parametrize("code", sorted(FIRMWARE_ROTATIONS))
 def test_ardupilot_rotation_is_the_firmwares(code: int) -> None:
-    from thermocal.tempcal.ardupilot import ardupilot_rotation
+    from thermocal.firmware.ardupilot import ardupilot_rotation
 
     v = [0.3, -1.7, 2.9]
     got = ardupilot_rotation(code) @ np.array(v)
@@ -68,7 +68,7 @@ def test_tclr_learned_is_the_firmwares_polyfit_in_t_minus_35() -> None:
     """``st.pfit.update(tdiff = T − TEMP_REFERENCE (35), sum)``, then
     ``coefficients[k] = p[2-k] * SCALE_FACTOR (1e6)``: c1…c3 are the t, t², t³ terms of the
     least-squares cubic in T − 35 (numpy's polyfit here, highest power first)."""
-    from thermocal.tempcal.ardupilot import tclr_learned
+    from thermocal.firmware.ardupilot import tclr_learned
 
     rng = np.random.default_rng(5)
     temp = np.linspace(12.0, 61.0, 40)

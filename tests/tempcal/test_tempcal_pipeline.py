@@ -9,8 +9,8 @@ import numpy as np
 import pytest
 
 from dataflash_writer import imu_log
+from thermocal.firmware.binning import temperature_bins
 from thermocal.tempcal.ardupilot import ardupilot_tempcal
-from thermocal.tempcal.binning import temperature_bins
 from thermocal.tempcal.pipeline import ReportRequest, holdout_rms
 from thermocal.tempcal.px4 import px4_tempcal
 from ulog_writer import SENSOR_FIELDS, ulog_bytes

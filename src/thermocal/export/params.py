@@ -1,5 +1,5 @@
-"""Firmware thermal-calibration parameters from a calibration (issue 16; INTERFACE.md
-"Firmware parameter formats").
+"""Firmware thermal-calibration parameters from a calibration: the parameter
+files of the firmwares' thermal compensation.
 
 * **PX4** (``TemperatureCompensation``): per sensor instance ``n`` and axis ``i``,
   ``offset_i = X0_i + X1_i·dT + X2_i·dT² + X3_i·dT³`` with
@@ -33,9 +33,9 @@ relative to the run's median; the absolute offset is the accelerometer calibrati
 its definition.  The notes say so; a model fitted without ``--gravity-axis`` is also
 warned.
 
-Refused (issue 26): a channel given twice or to both triads, a channel of the other kind,
-an instance the firmware does not have (:data:`MAX_INSTANCES`), and any parameter that is
-not a finite float32 (or, for the int32 ``ID``, outside int32).
+Refused: a channel given twice or to both triads, a channel of the other kind,
+an instance the firmware does not have (:data:`thermocal.firmware.formats.FORMATS`), and
+any parameter that is not a finite float32 (or, for the int32 ``ID``, outside int32).
 """
 
 from __future__ import annotations
@@ -50,29 +50,16 @@ from typing import Any
 import numpy as np
 
 from thermocal import units
-from thermocal.errors import ThermocalInputError, ThermocalWarning
+from thermocal.errors import ParameterError, ThermocalInputError, ThermocalWarning
+from thermocal.firmware.formats import ARDUPILOT_SCALE, FORMATS, INT32_RANGE
 from thermocal.models.base import TemperatureModel
 from thermocal.models.calibration import Calibration
 
-FORMATS = ("px4", "ardupilot")
-ARDUPILOT_TREF_C = 35.0
-"""ArduPilot's fixed reference of the temperature polynomial [°C]
-(AP_InertialSensor_tempcal: ``TEMP_REFERENCE``)."""
-ARDUPILOT_SCALE = 1.0e-6
-"""ArduPilot stores ``c_k`` scaled: the firmware multiplies the polynomial by 1e-6."""
 ARDUPILOT_MIN_SPAN_C = 10.0
 """ArduPilot's learning needs a sweep of at least 10 °C (tempcal_IMU.py's minimum)."""
 AXES = ("x", "y", "z")
-MAX_INSTANCES = {"px4": 4, "ardupilot": 3}
-"""Sensor instances each firmware has thermal-calibration parameters for.  PX4:
-``GYRO_COUNT_MAX = ACCEL_COUNT_MAX = 4`` with ``static_assert``s that the ``TC_G0…TC_G3`` /
-``TC_A0…TC_A3`` parameters match (PX4-Autopilot
-``src/modules/temperature_compensation/TemperatureCompensation.h``).  ArduPilot:
-``INS_TCAL1_…INS_TCAL3_`` (``AP_SUBGROUPINFO(tcal_old_param[0..2], "_TCAL1_"…"_TCAL3_")``
-in ``libraries/AP_InertialSensor/AP_InertialSensor.cpp``, the first three IMUs)."""
 FLOAT32_MAX = float(np.finfo(np.float32).max)
 """Largest finite float32 (≈ 3.4028235e38): the firmware stores parameters as 32-bit floats."""
-INT32_RANGE = (-(2**31), 2**31 - 1)
 
 
 @dataclass(frozen=True)
@@ -212,27 +199,30 @@ def map_axes(
     for kind, given in (("gyro", gyro), ("accel", accel)):
         if given:
             if len(given) != 3:
-                raise ThermocalInputError(f"--{kind} takes three channels, x,y,z; got {given}")
+                raise ParameterError(kind, f"{{name}} takes three channels, x,y,z; got {given}")
             twice = sorted({c for c in given if list(given).count(c) > 1})
             if twice:
-                raise ThermocalInputError(
-                    f"--{kind} {','.join(given)}: channel {', '.join(map(repr, twice))} given "
-                    "for more than one axis; each axis takes its own channel"
+                raise ParameterError(
+                    kind,
+                    f"{{name}} {','.join(given)}: channel {', '.join(map(repr, twice))} given "
+                    "for more than one axis; each axis takes its own channel",
                 )
             missing = [c for c in given if c not in cal.names]
             if missing:
-                raise ThermocalInputError(
-                    f"--{kind}: no channel {', '.join(map(repr, missing))} in the calibration "
-                    f"({', '.join(cal.names)})"
+                raise ParameterError(
+                    kind,
+                    f"{{name}}: no channel {', '.join(map(repr, missing))} in the calibration "
+                    f"({', '.join(cal.names)})",
                 )
             for c in given:
                 ch = cal.channel(c)
                 role = ch.role or guess_role(c, ch.model.signal_unit) or {}
                 if role.get("kind") not in (None, kind):
                     art = {"gyro": "a gyro", "accel": "an accel"}
-                    raise ThermocalInputError(
-                        f"--{kind} {','.join(given)}: channel {c!r} is {art[role['kind']]} "
-                        f"({ch.model.signal_unit}), not {art[kind]}"
+                    raise ParameterError(
+                        kind,
+                        f"{{name}} {','.join(given)}: channel {c!r} is {art[role['kind']]} "
+                        f"({ch.model.signal_unit}), not {art[kind]}",
                     )
             out[kind] = dict(zip(AXES, given, strict=True))
             continue
@@ -242,9 +232,10 @@ def map_axes(
             if (ch.role or {}).get("kind") == kind and (ch.role or {}).get("axis") in AXES
         }
         if found and set(found) != set(AXES):
-            raise ThermocalInputError(
+            raise ParameterError(
+                kind,
                 f"the calibration has {kind} axes {sorted(found)} only; the firmware takes a "
-                f"triad: give --{kind} X,Y,Z"
+                "triad: give {name} X,Y,Z",
             )
         if found:
             out[kind] = {a: found[a] for a in AXES}
@@ -289,56 +280,16 @@ def check_values(ps: ParamSet) -> None:
             )
 
 
-@dataclass(frozen=True)
-class Documented:
-    """What a firmware documents of a parameter: ``pattern`` (a regular expression of the
-    names), the MAVLink type written (6 int, 9 float), the values it takes (``lo``…``hi``),
-    whether a value outside is refused (``hard``: the firmware cannot store or use it) or
-    warned (a ground station's @Range, which the firmware itself does not enforce), and
-    the source."""
-
-    pattern: str
-    type: int
-    lo: float
-    hi: float
-    hard: bool
-    source: str
-
-
-DOCUMENTED = (
-    Documented(r"TC_[GABM]_ENABLE", 6, 0, 1, True,
-               "PX4 TC_G_ENABLE/TC_A_ENABLE/TC_B_ENABLE/TC_M_ENABLE: boolean int32 "
-               "(src/modules/temperature_compensation parameters)"),
-    Documented(r"TC_[GABM][0-3]_ID", 6, INT32_RANGE[0], INT32_RANGE[1], True,
-               "PX4 TC_*<n>_ID: int32 (same parameters)"),
-    Documented(r"INS_TCAL[1-3]_ENABLE", 6, 0, 2, True,
-               "ArduPilot INS_TCALn_ENABLE @Values 0:Disabled,1:Enabled,2:LearnCalibration "
-               "(AP_InertialSensor_tempcal.cpp)"),
-    Documented(r"INS_TCAL[1-3]_T(MIN|MAX)", 9, -70, 80, False,
-               "ArduPilot INS_TCALn_TMIN/TMAX @Range: -70 80 degC "
-               "(AP_InertialSensor_tempcal.cpp; the firmware clamps T to the values written)"),
-    Documented(r"TCAL_ENABLED", 6, 0, 2, True,
-               "ArduPilot TCAL_ENABLED @Values 0:Disabled,1:Enabled,2:EnableAndLearn "
-               "(AP_TempCalibration.cpp)"),
-    Documented(r"TCAL_TEMP_(MIN|MAX)", 6, -128, 127, True,
-               "ArduPilot TCAL_TEMP_MIN/MAX: AP_Int8 (AP_TempCalibration.h)"),
-    Documented(r"TCAL_BARO_EXP", 9, 0, 2, True,
-               "ArduPilot TCAL_BARO_EXP: exp_limit_min 0 … exp_limit_max 2 "
-               "(AP_TempCalibration.h)"),
-)  # fmt: skip
-"""The parameters of :class:`ParamSet` whose type and values the firmwares document
-(:func:`check_documented`); the float parameters without a documented range are checked as
-float32 by :func:`check_values`."""
-
-
 def check_documented(ps: ParamSet) -> None:
-    """Every parameter of ``ps`` against :data:`DOCUMENTED`: a type other than the one
+    """Every parameter of ``ps`` against what the firmwares document of it
+    (``documented`` of :data:`thermocal.firmware.formats.FORMATS`): a type other than the one
     documented, or a value outside a ``hard`` range, refused (exit 2) naming the parameter,
     the value and the source; outside a ground station's @Range: a warning."""
     import re
 
     for name, v in ps.params.items():
-        doc = next((d for d in DOCUMENTED if re.fullmatch(d.pattern, name)), None)
+        documented = (d for f in FORMATS.values() for d in f.documented)
+        doc = next((d for d in documented if re.fullmatch(d.pattern, name)), None)
         if doc is None:
             continue
         typ = ps.types.get(name, 9)
@@ -370,20 +321,55 @@ def export_params(
     device_id: Mapping[str, int] | None = None,
     tref_c: float | None = None,
 ) -> ParamSet:
-    """The parameters of ``fmt`` for the calibration's gyro and accelerometer triads
-    (module docstring).  ``tref_c`` (PX4): the reference temperature, default the middle
-    of the fitted range; ``device_id``: ``{"gyro": id, "accel": id}`` (default the
-    calibration's recorded sensor id when numeric, else 0 with a warning)."""
-    if fmt not in FORMATS:
-        raise ThermocalInputError(f"--format must be one of {', '.join(FORMATS)}, got {fmt!r}")
-    n_max = MAX_INSTANCES[fmt]
-    if not 0 <= instance < n_max:
-        have = "TC_G0…TC_G3 and TC_A0…TC_A3" if fmt == "px4" else "INS_TCAL1…INS_TCAL3"
-        raise ThermocalInputError(
-            f"--instance {instance}: {fmt} has {have}, instances 0…{n_max - 1}"
-        )
-    if tref_c is not None and not math.isfinite(tref_c):
-        raise ThermocalInputError(f"--tref {tref_c}: not a finite temperature")
+    """The firmware parameters of a calibration's gyro and accelerometer triads.
+
+    Parameters
+    ----------
+    cal : Calibration
+        Channels fitted with the ``poly`` family, order ≤ 3, on one temperature in °C.
+    fmt : {"px4", "ardupilot"}
+        The dialect (:data:`thermocal.firmware.formats.FORMATS`).
+    gyro, accel : sequence of str, optional
+        The channels of each triad in x, y, z order; default the channels' roles.
+    instance : int
+        The sensor instance (PX4 0…3: ``TC_G0``…; ArduPilot 0…2: ``INS_TCAL1``…).
+    device_id : Mapping[str, int], optional
+        PX4 device id per kind, ``{"gyro": id, "accel": id}``; default the calibration's
+        recorded sensor id when numeric, else 0 with a warning.
+    tref_c : float, optional
+        PX4's ``TREF`` [°C]; default the middle of the fitted range (ArduPilot's is 35 °C).
+
+    Returns
+    -------
+    ParamSet
+        Name → value and MAVLink type of every parameter, the polynomials per axis in the
+        firmware's unit (rad/s, m/s²), the notes of the file.
+
+    Raises
+    ------
+    thermocal.errors.ParameterError
+        ``fmt``, ``instance``, ``tref_c``, ``gyro``/``accel`` or ``device_id`` the firmware
+        cannot take (the parameter is named).
+    thermocal.errors.ThermocalInputError
+        A channel the firmware cannot express (another family, Ṫ or several temperatures,
+        a power above 3), ranges that do not overlap, a value that is not a finite float32.
+
+    Notes
+    -----
+    Each channel's polynomial is re-expanded exactly about the reference temperature and
+    converted from the model's unit (°/h, mg) to the firmware's.  PX4 subtracts
+    :math:`\\sum_{k=0}^{3} X_k\\,\\Delta T^k`,
+    :math:`\\Delta T = \\operatorname{clamp}(T, T_\\mathrm{min}, T_\\mathrm{max}) -
+    T_\\mathrm{ref}`; ArduPilot stores :math:`c_k = b_k \\cdot 10^6`, k = 1…3, of the
+    polynomial about 35 °C (no constant).  Accelerometer offsets are relative (module
+    docstring).
+
+    References
+    ----------
+    * PX4-Autopilot, ``src/modules/temperature_compensation/TemperatureCompensation.cpp``.
+    * ArduPilot, ``libraries/AP_InertialSensor/AP_InertialSensor_tempcal.cpp``.
+    """
+    _check_arguments(fmt, instance, tref_c)
     triads = map_axes(cal, gyro, accel)
     out = ParamSet(fmt)
     for kind, chans in triads.items():
@@ -395,7 +381,7 @@ def export_params(
         if fmt == "px4":
             tref = 0.5 * (lo + hi) if tref_c is None else float(tref_c)
         else:
-            tref = ARDUPILOT_TREF_C
+            tref = float(FORMATS[fmt].tref_c or 0.0)
             if hi - lo < ARDUPILOT_MIN_SPAN_C:
                 warnings.warn(
                     f"{kind}: the fitted range {lo:.1f}…{hi:.1f} °C spans less than "
@@ -418,6 +404,20 @@ def export_params(
     check_values(out)
     check_documented(out)
     return out
+
+
+def _check_arguments(fmt: str, instance: int, tref_c: float | None) -> None:
+    """Refuse a dialect, an instance or a TREF :func:`export_params` cannot take."""
+    if fmt not in FORMATS:
+        raise ParameterError("format", f"{{name}} must be one of {', '.join(FORMATS)}, got {fmt!r}")
+    n_max = FORMATS[fmt].max_instances
+    if not 0 <= instance < n_max:
+        have = FORMATS[fmt].instances
+        raise ParameterError(
+            "instance", f"{{name}} {instance}: {fmt} has {have}, instances 0…{n_max - 1}"
+        )
+    if tref_c is not None and not math.isfinite(tref_c):
+        raise ParameterError("tref_c", f"{{name}} {tref_c}: not a finite temperature")
 
 
 def _accel_notes(
@@ -463,9 +463,10 @@ def _device_id(cal: Calibration, kind: str, given: Mapping[str, int] | None) -> 
         text = str(sid) if sid is not None else ""
         if text.isascii() and text.isdigit():
             if len(text) > 10:  # beyond any int32; check_values would refuse it
-                raise ThermocalInputError(
+                raise ParameterError(
+                    "device_id",
                     f"{kind}: the recorded sensor id ({len(text)} digits) is not a device id "
-                    "the firmware can store (int32): give --device-id"
+                    "the firmware can store (int32): give {name}",
                 )
             return int(text)
     warnings.warn(
@@ -516,12 +517,7 @@ def _ardupilot_params(
 
 
 __all__ = [
-    "ARDUPILOT_TREF_C",
-    "DOCUMENTED",
-    "FORMATS",
-    "MAX_INSTANCES",
     "AxisPoly",
-    "Documented",
     "ParamSet",
     "axis_poly",
     "check_documented",
@@ -531,16 +527,10 @@ __all__ = [
 ]
 
 
-PX4_OFFSET_SENSORS = {"baro": ("B", 5, 1), "mag": ("M", 3, 3)}
-"""PX4's other thermally compensated sensors: parameter letter, polynomial order, axes.
-PX4-Autopilot parameter reference (``src/modules/temperature_compensation``):
-``TC_B<n>_ID``, ``_TMIN``, ``_TMAX``, ``_TREF``, ``_X0``…``_X5`` ("Barometer offset
-temperature ^k polynomial coefficient", in Pa as ``sensor_baro.pressure``) for n = 0…3 and
-``TC_B_ENABLE``; ``TC_M<n>_ID``, ``_TMIN``, ``_TMAX``, ``_TREF``, ``_X<k>_<axis>``, k = 0…3
-("Magnetometer offset temperature ^k polynomial coefficient", in gauss as ``sensor_mag``)
-for n = 0…3 and ``TC_M_ENABLE`` (PX4 v1.15 and later).  The firmware subtracts
-``Σ X_k·dT^k`` with ``dT = clamp(T, TMIN, TMAX) − TREF`` from the measurement."""
-PX4_OFFSET_INSTANCES = 4
+PX4_OFFSET_KINDS = ("baro", "mag")
+"""PX4's thermally compensated sensors besides the IMU (their parameters:
+:data:`thermocal.firmware.formats.FORMATS`).  The firmware subtracts ``Σ X_k·dT^k`` with
+``dT = clamp(T, TMIN, TMAX) − TREF`` from the measurement."""
 
 
 def px4_offset_params(
@@ -552,17 +542,54 @@ def px4_offset_params(
     tref_c: float,
     coefficients: Sequence[Sequence[float]],
 ) -> ParamSet:
-    """PX4 ``TC_B<n>_*`` (``kind`` "baro", ``coefficients`` [[X0…X5]]) or ``TC_M<n>_*``
-    ("mag", [[X0…X3] per axis x, y, z]): polynomial in ``T − TREF`` [firmware unit: Pa,
-    gauss], (:data:`PX4_OFFSET_SENSORS`); refused for an instance PX4 has no parameters
-    for, or a value that is not a finite float32."""
-    if kind not in PX4_OFFSET_SENSORS:
+    """PX4's barometer (``TC_B<n>_*``) or magnetometer (``TC_M<n>_*``) parameters.
+
+    Parameters
+    ----------
+    kind : {"baro", "mag"}
+        The sensor.
+    instance : int
+        Its instance, 0…3.
+    device_id : int
+        PX4's device id of the sensor.
+    tmin_c, tmax_c, tref_c : float
+        ``TMIN``, ``TMAX``, ``TREF`` [°C].
+    coefficients : sequence of sequence of float
+        ``[[X0…X5]]`` for the barometer [Pa], ``[[X0…X3]]`` per axis x, y, z for the
+        magnetometer [gauss]: the polynomial in ``T − TREF``
+        (:data:`thermocal.firmware.formats.FORMATS`).
+
+    Returns
+    -------
+    ParamSet
+        The parameters, checked.
+
+    Raises
+    ------
+    thermocal.errors.ThermocalInputError
+        A sensor or an instance PX4 has no parameters for, coefficients of the wrong shape,
+        a value that is not a finite float32.
+
+    Notes
+    -----
+    The firmware subtracts :math:`\\sum_k X_k\\,\\Delta T^k`,
+    :math:`\\Delta T = \\operatorname{clamp}(T, T_\\mathrm{min}, T_\\mathrm{max}) -
+    T_\\mathrm{ref}`, from the measurement (PX4-Autopilot
+    ``src/modules/temperature_compensation/TemperatureCompensation.cpp``).
+
+    Examples
+    --------
+    >>> ps = px4_offset_params("baro", 0, 7, 10.0, 50.0, 30.0, [[1.5, -2.0, 0, 0, 0, 0]])
+    >>> ps.params["TC_B0_X1"], ps.params["TC_B0_TREF"], ps.params["TC_B_ENABLE"]
+    (-2.0, 30.0, 1)
+    """
+    if kind not in PX4_OFFSET_KINDS:
         raise ThermocalInputError(f"no PX4 thermal parameters for a {kind!r} sensor")
-    letter, order, n_axes = PX4_OFFSET_SENSORS[kind]
-    if not 0 <= instance < PX4_OFFSET_INSTANCES:
+    sensor, n_max = FORMATS["px4"].sensors[kind], FORMATS["px4"].max_instances
+    letter, order, n_axes = sensor.tag, sensor.order, sensor.n_axes
+    if not 0 <= instance < n_max:
         raise ThermocalInputError(
-            f"PX4 has TC_{letter}0…TC_{letter}{PX4_OFFSET_INSTANCES - 1}; {kind} instance "
-            f"{instance} has none"
+            f"PX4 has TC_{letter}0…TC_{letter}{n_max - 1}; {kind} instance {instance} has none"
         )
     if len(coefficients) != n_axes or any(len(c) != order + 1 for c in coefficients):
         raise ThermocalInputError(
@@ -595,7 +622,7 @@ class ParamsFileResult:
     params: ParamSet
 
     def to_dict(self) -> dict[str, Any]:
-        """The ``thermocal export-params --json`` object (INTERFACE.md)."""
+        """The ``thermocal export-params --json`` object."""
         return {
             "output": self.output,
             "format": self.format,
@@ -621,21 +648,48 @@ def export_params_file(
     tref_c: float | None = None,
     device_id: int | None = None,
 ) -> ParamsFileResult:
-    """``thermocal export-params``: a calibration (or model) file's firmware parameters
-    (:func:`export_params`) written atomically to ``output`` (never one of the inputs),
-    once the data behind it are known to support the fit
-    (:func:`thermocal.export.checks.check_firmware_adequacy`, ArduPilot's minimum sweep
-    too).  ``device_id``: the PX4 device id of both the gyro and the accelerometer."""
+    """A calibration (or model) file's firmware parameters, written to a parameter file.
+
+    Parameters
+    ----------
+    calibration : str or Path
+        The calibration or model file (``thermocal fit``, ``multipos``, ``turntable``).
+    fmt : {"px4", "ardupilot"}
+        The dialect (:data:`thermocal.firmware.formats.FORMATS`).
+    output : str or Path
+        The parameter file, written atomically (never one of the inputs).
+    gyro, accel : sequence of str, optional
+        The channels of each triad in x, y, z order; default the channels' roles.
+    instance : int
+        The sensor instance the parameters are for.
+    tref_c : float, optional
+        PX4's ``TREF`` [°C]; default the middle of the fitted range.
+    device_id : int, optional
+        The PX4 device id of both the gyro and the accelerometer.
+
+    Returns
+    -------
+    ParamsFileResult
+        The file written, its dialect and the parameters (:class:`ParamSet`).
+
+    Raises
+    ------
+    thermocal.errors.ThermocalInputError
+        What :func:`export_params` refuses, and data behind the calibration that do not
+        support the fit (:func:`thermocal.export.checks.check_firmware_adequacy`,
+        ArduPilot's 10 °C sweep too).
+    """
     from thermocal.export.checks import check_firmware_adequacy
     from thermocal.models.files import load_calibration
     from thermocal.writers import atomic_write, check_not_input
 
     check_not_input(output, [calibration])
     cal = load_calibration(calibration)
-    if not cal.channels and cal.triads:  # issue 30: a calibration of triads
+    if not cal.channels and cal.triads:  # a calibration of triads
         if tref_c is not None:
-            raise ThermocalInputError(
-                "--tref is for thermal parameters; a triad's values are taken at its own TREF"
+            raise ParameterError(
+                "tref_c",
+                "{name} is for thermal parameters; a triad's values are taken at its own TREF",
             )
         return _triad_params_file(cal, calibration, fmt, output, gyro, accel, instance,
                                   device_id)  # fmt: skip

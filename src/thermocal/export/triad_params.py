@@ -1,5 +1,5 @@
-"""Firmware sensor-calibration parameters from a calibration of triads (issue 30;
-INTERFACE.md "Calibration without a turntable"): ``thermocal export-params`` of what
+"""Firmware sensor-calibration parameters from a calibration of triads:
+``thermocal export-params`` of what
 ``thermocal multipos`` (or ``turntable``) wrote.
 
 The triad model (:mod:`thermocal.turntable.model`) is ``x = (I + E) x_true + b``, so the
@@ -38,12 +38,10 @@ from typing import Any
 import numpy as np
 
 from thermocal import units
-from thermocal.errors import ThermocalInputError, ThermocalWarning
+from thermocal.errors import ParameterError, ThermocalInputError, ThermocalWarning
+from thermocal.firmware.formats import FORMATS, INT32_RANGE
 from thermocal.models.calibration import Calibration, Triad
 
-MAX_INSTANCES = {"px4": 4, "ardupilot": 3}
-"""PX4 ``CAL_ACC0…CAL_ACC3`` / ``CAL_GYRO0…CAL_GYRO3``; ArduPilot ``INS_ACC*``,
-``INS_ACC2*``, ``INS_ACC3*`` (three IMUs)."""
 ARDUPILOT_ACCSCAL_RANGE = (0.8, 1.2)
 """``INS_ACCSCAL_*`` ``@Range: 0.8 1.2`` (ArduPilot ``AP_InertialSensor_Params.cpp``)."""
 ARDUPILOT_ACCOFFS_RANGE_M_S2 = (-3.5, 3.5)
@@ -62,7 +60,6 @@ PLAUSIBLE_NOTE = (
 is applied to PX4's values too: the same physical sensor, a MEMS accelerometer whose
 sensitivity is specified within a few % (e.g. ±2 % initial tolerance, Bosch BMI088, TDK
 ICM-20602 datasheets) and whose zero-g offset within a few hundred mg."""
-INT32_RANGE = (-(2**31), 2**31 - 1)
 
 
 @dataclass(frozen=True)
@@ -80,7 +77,7 @@ class TriadFirmware:
     temperature_dependent: bool
     tref_c: float
     count_scale: tuple[float, str] | None = None
-    """A triad calibrated on raw counts: one count is ``value`` ``unit`` (issue 30)."""
+    """A triad calibrated on raw counts: one count is ``value`` ``unit``."""
 
 
 def triad_firmware(triad: Triad) -> TriadFirmware:
@@ -189,10 +186,11 @@ def _check_px4_accel(names: Sequence[str], values: Sequence[float], scale: bool)
 def _check_device_id(name: str, device_id: int) -> None:
     """A device id PX4 stores (:data:`PX4_ID_TYPE`)."""
     if not INT32_RANGE[0] <= device_id <= INT32_RANGE[1]:
-        raise ThermocalInputError(
-            f"--device-id {device_id}: {name} is an int32 ({INT32_RANGE[0]}…{INT32_RANGE[1]}, "
+        raise ParameterError(
+            "device_id",
+            f"{{name}} {device_id}: {name} is an int32 ({INT32_RANGE[0]}…{INT32_RANGE[1]}, "
             "type of CAL_ACC${i}_ID in PX4's src/modules/sensors/module.yaml); give the "
-            "device id PX4 shows for the sensor (a 24-bit bus/address/type code)"
+            "device id PX4 shows for the sensor (a 24-bit bus/address/type code)",
         )
 
 
@@ -240,12 +238,13 @@ def triad_params(
     """The firmware parameters of the calibration's ``accel`` and ``gyro`` triads (module
     docstring); warns what the firmware cannot hold, refuses a value outside ArduPilot's
     range or an instance the firmware does not have."""
-    if fmt not in MAX_INSTANCES:
-        raise ThermocalInputError(f"--format must be px4 or ardupilot, got {fmt!r}")
-    if not 0 <= instance < MAX_INSTANCES[fmt]:
+    if fmt not in FORMATS:
+        raise ParameterError("format", f"{{name}} must be px4 or ardupilot, got {fmt!r}")
+    n_max = FORMATS[fmt].max_instances  # PX4 CAL_ACC0…3 / CAL_GYRO0…3; ArduPilot three IMUs
+    if not 0 <= instance < n_max:
         have = "CAL_ACC0…CAL_ACC3" if fmt == "px4" else "INS_ACC, INS_ACC2, INS_ACC3"
-        raise ThermocalInputError(
-            f"--instance {instance}: {fmt} has {have}, instances 0…{MAX_INSTANCES[fmt] - 1}"
+        raise ParameterError(
+            "instance", f"{{name}} {instance}: {fmt} has {have}, instances 0…{n_max - 1}"
         )
     triads = {t.name: t for t in cal.triads if t.name in ("accel", "gyro")}
     if not triads:
@@ -322,7 +321,6 @@ def as_dict(tp: TriadParams) -> dict[str, Any]:
 __all__ = [
     "ARDUPILOT_ACCOFFS_RANGE_M_S2",
     "ARDUPILOT_ACCSCAL_RANGE",
-    "MAX_INSTANCES",
     "TriadFirmware",
     "TriadParams",
     "as_dict",

@@ -23,6 +23,14 @@ from typing import Any
 import numpy as np
 
 from thermocal.errors import ThermocalInputError
+from thermocal.firmware.ardupilot import (
+    AP_CURVE_FORMULA,
+    AP_ROTATIONS,
+    ardupilot_poly_curve,
+    ardupilot_rotation,
+    tclr_learned,
+)
+from thermocal.firmware.formats import AP_TREF_C, FORMATS
 from thermocal.models.calibration import Calibration
 from thermocal.outputs import check_outputs
 from thermocal.recording import FloatArray, Recording
@@ -52,8 +60,6 @@ from thermocal.tempcal.pipeline import (
     warn_gates,
 )
 
-PARAMS_NAME = "ardupilot.parm"
-"""The parameter file of the set (Mission Planner's ``.parm``, ``INS_TCAL*``)."""
 MAX_IMUS = 3
 """ArduPilot logs up to three IMUs (``IMU``, instances 0…2)."""
 KINDS = (("gyro", "Gyr", "rad/s"), ("accel", "Acc", "m/s^2"))
@@ -63,54 +69,7 @@ BARO_REPORT = "report_BARO_0.html"
 """The report of the first barometer's ``TCAL_BARO_EXP``."""
 
 
-# --- ArduPilot log hygiene (issue 28, item 4) ---------------------------------------------
-
-AP_ROTATIONS: dict[int, str] = {
-    0: "NONE", 1: "YAW_45", 2: "YAW_90", 3: "YAW_135", 4: "YAW_180", 5: "YAW_225",
-    6: "YAW_270", 7: "YAW_315", 8: "ROLL_180", 9: "ROLL_180_YAW_45", 10: "ROLL_180_YAW_90",
-    11: "ROLL_180_YAW_135", 12: "PITCH_180", 13: "ROLL_180_YAW_225", 14: "ROLL_180_YAW_270",
-    15: "ROLL_180_YAW_315", 16: "ROLL_90", 17: "ROLL_90_YAW_45", 18: "ROLL_90_YAW_90",
-    19: "ROLL_90_YAW_135", 20: "ROLL_270", 21: "ROLL_270_YAW_45", 22: "ROLL_270_YAW_90",
-    23: "ROLL_270_YAW_135", 24: "PITCH_90", 25: "PITCH_270", 26: "PITCH_180_YAW_90",
-    27: "PITCH_180_YAW_270", 28: "ROLL_90_PITCH_90", 29: "ROLL_180_PITCH_90",
-    30: "ROLL_270_PITCH_90", 31: "ROLL_90_PITCH_180", 32: "ROLL_270_PITCH_180",
-    33: "ROLL_90_PITCH_270", 34: "ROLL_180_PITCH_270", 35: "ROLL_270_PITCH_270",
-    36: "ROLL_90_PITCH_180_YAW_90", 37: "ROLL_90_YAW_270", 39: "PITCH_315",
-    40: "ROLL_90_PITCH_315", 41: "PITCH_7", 42: "ROLL_45", 43: "ROLL_315",
-}  # fmt: skip
-"""ArduPilot's ``enum Rotation`` (``libraries/AP_Math/rotations.h``), the board orientations
-``AHRS_ORIENTATION`` takes, by value; 38 (``ROLL_90_PITCH_68_YAW_293``) and 100 (custom) are
-not implemented and refused by name."""
-AP_REFUSED_ROTATIONS = {38: "ROLL_90_PITCH_68_YAW_293", 100: "CUSTOM"}
-
-
-def ardupilot_rotation(code: int) -> FloatArray:
-    """The matrix ``R`` of ArduPilot rotation ``code``: ``Vector3::rotate`` gives ``R·v``
-    with ``R = Rz(yaw)·Ry(pitch)·Rx(roll)`` for ``ROTATION_ROLL_r_PITCH_p_YAW_y`` (checked
-    against rotations.cpp: YAW_90 is (x, y) → (−y, x), ROLL_90 is (y, z) → (−z, y), PITCH_90
-    is (x, z) → (z, −x))."""
-    if code not in AP_ROTATIONS:
-        name = AP_REFUSED_ROTATIONS.get(code, "unknown")
-        raise ThermocalInputError(
-            f"AHRS_ORIENTATION {code} ({name}) is not implemented: the data cannot be rotated "
-            "back to the sensor frame; calibrate from a log recorded with AHRS_ORIENTATION 0"
-        )
-    angles = {"ROLL": 0.0, "PITCH": 0.0, "YAW": 0.0}
-    parts = AP_ROTATIONS[code].split("_")
-    for axis, deg in zip(parts[::2], parts[1::2], strict=True):
-        angles[axis] = math.radians(float(deg))
-    cr, sr = math.cos(angles["ROLL"]), math.sin(angles["ROLL"])
-    cp, sp = math.cos(angles["PITCH"]), math.sin(angles["PITCH"])
-    cy, sy = math.cos(angles["YAW"]), math.sin(angles["YAW"])
-    rx = np.array([[1, 0, 0], [0, cr, -sr], [0, sr, cr]])
-    ry = np.array([[cp, 0, sp], [0, 1, 0], [-sp, 0, cp]])
-    rz = np.array([[cy, -sy, 0], [sy, cy, 0], [0, 0, 1]])
-    r: FloatArray = np.round(rz @ ry @ rx, 12).astype(np.float64)
-    return r
-
-
-AP_TREF_C = 35.0
-"""ArduPilot's ``TEMP_REFERENCE`` (AP_InertialSensor_tempcal.cpp)."""
+# --- ArduPilot log hygiene ---------------------------------------------------------------
 
 
 @dataclass(frozen=True)
@@ -139,27 +98,6 @@ class ActiveTcal:
         t = np.clip(np.asarray(temp_c, dtype=np.float64), self.tmin_c, self.tmax_c)
         tcal = float(np.clip(self.caltemp_c[kind], self.tmin_c, self.tmax_c))
         return poly(t - AP_TREF_C) - poly(np.array([tcal - AP_TREF_C]))
-
-
-AP_CURVE_FORMULA = (
-    "poly(clamp(T, TMIN, TMAX) − 35 °C), poly(t) = (c1 + (c2 + c3·t)·t)·t·1e-6 "
-    "(AP_InertialSensor_tempcal.cpp correct_sensor, without its constant CALTEMP term)"
-)
-
-
-def ardupilot_poly_curve(
-    coef: Sequence[Sequence[float]], tmin_c: float, tmax_c: float
-) -> Callable[[FloatArray], FloatArray]:
-    """The temperature-dependent part of ArduPilot's correction for stored coefficients
-    ``coef[k-1][axis]`` (×1e6): :data:`AP_CURVE_FORMULA`, (n, 3) [rad/s or m/s²]."""
-    c = np.asarray(coef, dtype=np.float64)
-
-    def curve(temp_c: FloatArray) -> FloatArray:
-        t = (np.clip(np.asarray(temp_c, dtype=np.float64), tmin_c, tmax_c) - AP_TREF_C)[:, None]
-        out: FloatArray = (c[0] + (c[1] + c[2] * t) * t) * t * 1e-6
-        return out
-
-    return curve
 
 
 def ardupilot_comparison(
@@ -331,16 +269,6 @@ def tclr_points(
     return temp, xyz
 
 
-def tclr_learned(temp_c: FloatArray, xyz: FloatArray) -> list[list[float]]:
-    """The coefficients the firmware learns from its ``TCLR`` points: its ``PolyFit<4>``
-    (AP_Math/polyfit.h) is the least-squares cubic with constant of X, Y, Z in ``T − 35``,
-    ``p0 + p1·t + p2·t² + p3·t³``; ``save_calibration`` stores ``c_k = p_k·1e6``,
-    k = 1…3 (the constant dropped).  Returns ``c[k-1][axis]`` as stored."""
-    v = np.vander(np.asarray(temp_c, dtype=np.float64) - AP_TREF_C, 4, increasing=True)
-    p, *_ = np.linalg.lstsq(v, np.asarray(xyz, dtype=np.float64), rcond=None)
-    return [[float(x) * 1e6 for x in p[k]] for k in (1, 2, 3)]
-
-
 @dataclass(frozen=True)
 class TclrRange:
     """The range ``TMIN…TMAX`` [°C] the firmware saves with its learned coefficients of one
@@ -457,7 +385,7 @@ class ArdupilotTempcalResult:
         return [k for k, h in self.hygiene.items() if h["active_tcal_removed"]]
 
     def to_dict(self) -> dict[str, Any]:
-        """The JSON of ``ardupilot-tempcal --json`` (INTERFACE.md)."""
+        """The JSON of ``ardupilot-tempcal --json``."""
         return {
             "log": str(self.log),
             "params": str(self.params_path),
@@ -508,19 +436,57 @@ class _Run:
 def ardupilot_tempcal(
     log: Path, output: Path, *, overrides: tuple[str, ...] = (), reporter: Reporter | None = None
 ) -> ArdupilotTempcalResult:
-    """ArduPilot's thermal calibration of every IMU of a DataFlash log, written to the
-    directory ``output`` as one set: ``calibration.json``, ``ardupilot.parm``
-    (``INS_TCAL<n>_*``) and ``report_IMU_<n>_<kind>.html`` per sensor (written by
-    ``reporter``; none: not written).  Each IMU's gyro and accelerometer go through the
-    pipeline (:func:`.pipeline.fit_sensor` with ArduPilot's minimum sweep) after the log's
-    hygiene (:func:`ardupilot_raw`); an IMU whose temperature is all 0 or NaN is left out
-    with a warning.  ``overrides`` the adequacy checks let through."""
+    """ArduPilot's thermal calibration of every IMU of a DataFlash log, written as one set.
+
+    Parameters
+    ----------
+    log : Path
+        An ArduPilot DataFlash log (``.bin``) with ``IMU`` messages over a temperature sweep.
+    output : Path
+        The directory of the set: ``calibration.json``, ``ardupilot.parm``
+        (``INS_TCAL<n>_*``), ``report_IMU_<n>_<kind>.html`` per sensor and the first
+        barometer's ``TCAL_BARO_EXP`` report; built beside it and moved into place whole.
+    overrides : tuple of str
+        Adequacy checks let through (``"narrow"``, ``"motion"``).
+    reporter : callable, optional
+        Writes one report (the presentation layer's); None: no report written.
+
+    Returns
+    -------
+    ArdupilotTempcalResult
+        The files written, each sensor's fit, the log's hygiene (rotation undone, an active
+        ``INS_TCAL`` removed), the previous and the firmware-learned coefficients compared.
+
+    Raises
+    ------
+    thermocal.errors.ThermocalInputError
+        An unreadable log, no IMU with a usable temperature, a sweep narrower than
+        ArduPilot's 10 °C or otherwise inadequate unless overridden, a board rotation that
+        cannot be undone, an output that is the log or not a directory.
+
+    Notes
+    -----
+    Each IMU's gyro and accelerometer go through the pipeline (:func:`.pipeline.fit_sensor`
+    with ArduPilot's minimum sweep) after the log's hygiene (:func:`ardupilot_raw`); an IMU
+    whose temperature is all 0 or NaN is left out with a warning.  The firmware subtracts
+
+    .. math::
+
+        p(\\operatorname{clamp}(T) - 35) - p(T_\\mathrm{cal} - 35), \\qquad
+        p(t) = (c_1 + (c_2 + c_3 t)\\,t)\\,t \\cdot 10^{-6} .
+
+    References
+    ----------
+    * ArduPilot, ``libraries/AP_InertialSensor/AP_InertialSensor_tempcal.cpp``,
+      https://github.com/ArduPilot/ardupilot/blob/master/libraries/AP_InertialSensor/AP_InertialSensor_tempcal.cpp
+    * ArduPilot, ``libraries/AP_TempCalibration/AP_TempCalibration.cpp`` (the barometer).
+    """
     from thermocal.errors import MissingColumnError
     from thermocal.export.params import ParamSet, check_documented, check_values
     from thermocal.readers.dataflash import dataflash_table, read_dataflash_log
 
     # DIR may hold the log; the files of the set (replaced by name) may not be it
-    names = ["calibration.json", PARAMS_NAME]
+    names = ["calibration.json", FORMATS["ardupilot"].params_file]
     names += [f"report_IMU_{i}_{k}.html" for i in range(MAX_IMUS) for k in ("gyro", "accel")]
     names.append(BARO_REPORT)
     check_outputs([output / n for n in names], [log], dirs=[output])
@@ -545,7 +511,22 @@ def ardupilot_tempcal(
         warn_gates(run.gates)
         check_values(run.params)
         check_documented(run.params)
-        out_set.commit(calibration_of(run.fits), PARAMS_NAME, run.params.text())
+        out_set.commit(
+            calibration_of(run.fits), FORMATS["ardupilot"].params_file, run.params.text()
+        )
+    notes = _run_notes(run)
+    return ArdupilotTempcalResult(
+        log, output / FORMATS["ardupilot"].params_file, output / "calibration.json",
+        tuple(out_set.reports),
+        tuple(run.fits), tuple(notes), run.orientation, run.hygiene, run.previous,
+        run.learning, run.baro, run.rotated, _changes_said(run),
+    )  # fmt: skip
+
+
+def _run_notes(run: _Run) -> list[str]:
+    """The notes of an :func:`ardupilot_tempcal` run: the parameter file's, the log's
+    hygiene (an active ``INS_TCAL`` removed, a rotation undone), the firmware's learning
+    found, the barometer's exponent and the parameter changes during the recording."""
     notes = list(run.params.notes)
     found = [k for k, h in run.hygiene.items() if h["active_tcal_removed"]]
     if found:
@@ -573,11 +554,7 @@ def ardupilot_tempcal(
             f"AHRS_ORIENTATION {run.orientation} ({AP_ROTATIONS[run.orientation]}): the data "
             "were rotated back to the sensor frame before fitting"
         )
-    return ArdupilotTempcalResult(
-        log, output / PARAMS_NAME, output / "calibration.json", tuple(out_set.reports),
-        tuple(run.fits), tuple(notes), run.orientation, run.hygiene, run.previous,
-        run.learning, run.baro, run.rotated, _changes_said(run),
-    )  # fmt: skip
+    return notes
 
 
 def _changes_said(run: _Run) -> tuple[dict[str, Any], ...]:
@@ -823,18 +800,14 @@ def _hygiene_and_gates(run: _Run, inst: int, ps: Any, prev_params: Mapping[str, 
 
 
 __all__ = [
-    "AP_ROTATIONS",
-    "AP_TREF_C",
     "ActiveTcal",
     "ArdupilotTempcalResult",
     "ardupilot_active",
     "ardupilot_raw",
     "ardupilot_raw_intervals",
-    "ardupilot_rotation",
     "ardupilot_tempcal",
     "imu_hygiene_params",
     "param_intervals",
-    "tclr_learned",
     "tclr_points",
     "tclr_range",
 ]

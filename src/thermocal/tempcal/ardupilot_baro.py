@@ -1,4 +1,4 @@
-"""ArduPilot's barometer temperature calibration (issue 28, item 3): ``TCAL_BARO_EXP``.
+"""ArduPilot's barometer temperature calibration ``TCAL_BARO_EXP``.
 
 ArduPilot's ``AP_TempCalibration`` (libraries/AP_TempCalibration/AP_TempCalibration.cpp,
 .h) documents four parameters: ``TCAL_ENABLED`` (0 disabled, 1 use, 2 learn and use),
@@ -14,7 +14,7 @@ while still, by minimising the spread of the corrected pressure over 0.25 °C bi
 to the first bin, in steps of 0.01.
 
 thermocal fits the same ``e`` from the log: the pressure reduced to the medians of
-:data:`~thermocal.tempcal.binning.BIN_WIDTH_C` temperature bins (robust to spikes, equal
+:data:`~thermocal.firmware.binning.BIN_WIDTH_C` temperature bins (robust to spikes, equal
 weight across the range), ``e`` the value in [0, 2] (resolution :data:`EXP_STEP`) that
 minimises the variance of ``P_bin + max(T_bin − 25, 0)^e`` about its mean; judged on
 held-out bins (``e`` fitted to the even bins, the rms of the corrected odd bins about the even
@@ -30,8 +30,8 @@ from typing import Any
 
 import numpy as np
 
+from thermocal.firmware.binning import even_odd_split, temperature_bins
 from thermocal.recording import FloatArray
-from thermocal.tempcal.binning import even_odd_split, temperature_bins
 
 TZERO_C = 25.0
 """``AP_TempCalibration::Tzero``: the temperature at which the correction starts [°C]."""

@@ -1,4 +1,4 @@
-"""The coefficients a log was recorded with against the new ones (issue 28, item 2).
+"""The coefficients a log was recorded with against the new ones.
 
 A flight controller's log carries the thermal calibration that was active while it was
 recorded (ArduPilot's ``INS_TCAL<n>_*`` in its ``PARM`` messages).  A

@@ -1,5 +1,5 @@
-"""Gates of PX4's barometers and magnetometers before their ``TC_B``/``TC_M`` fit (issue 39,
-item 2): what no barometer on Earth and no still magnetometer reads is named and the sensor
+"""Gates of PX4's barometers and magnetometers before their ``TC_B``/``TC_M`` fit: what no
+barometer on Earth and no still magnetometer reads is named and the sensor
 left out (no ``TC_B<n>``/``TC_M<n>`` written, the IMU calibrations kept), or the odd samples
 set aside with their count — never fitted.
 

@@ -1,4 +1,4 @@
-"""What the report of a barometer or magnetometer calibration shows (issue 28, item 3).
+"""What the report of a barometer or magnetometer calibration shows.
 
 PX4's ``TC_B<n>``/``TC_M<n>`` are polynomials of the offset in ``T − TREF`` [Pa, gauss]
 (:func:`thermocal.tempcal.px4.fit_offset_sensor`).  :func:`offset_report_request` computes,
@@ -19,8 +19,8 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from thermocal.firmware.binning import even_odd_split, temperature_bins
 from thermocal.recording import FloatArray
-from thermocal.tempcal.binning import even_odd_split, temperature_bins
 
 if TYPE_CHECKING:
     from thermocal.tempcal.compare import CoefficientComparison

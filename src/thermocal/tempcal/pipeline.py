@@ -32,12 +32,12 @@ import numpy.typing as npt
 
 from thermocal import adequacy, units
 from thermocal.errors import ThermocalInputError, ThermocalWarning
+from thermocal.firmware.binning import BIN_WIDTH_C, MIN_BINS, even_odd_split, temperature_bins
 from thermocal.models.base import RunData, model_inputs
 from thermocal.models.calibration import Calibration, Channel
 from thermocal.models.poly import PolyModel
 from thermocal.recording import FloatArray, Recording
 from thermocal.tempcal.ardupilot_baro import ArdupilotBaroReportRequest
-from thermocal.tempcal.binning import BIN_WIDTH_C, MIN_BINS, even_odd_split, temperature_bins
 from thermocal.tempcal.compare import CoefficientComparison
 from thermocal.tempcal.offset_report import OffsetReportRequest
 
@@ -234,15 +234,6 @@ def require_fields(df: Any, names: Sequence[str], log: Path, where: str) -> None
             f"{log}: {where} lacks the field(s) {', '.join(missing)} (a damaged format "
             "definition?); it has: " + ", ".join(map(str, list(df.columns)[:20]))
         )
-
-
-def read_sensor_topic(log: Path, topic: str) -> Recording:
-    """One ULog topic instance (``NAME.N``) as a recording of x, y, z and ``temperature``
-    (:func:`thermocal.readers.read_recording`), checked (finite, increasing time) and its
-    gaps stated in one :class:`GapWarning`."""
-    from thermocal.pipeline.reading import load_recording
-
-    return load_recording(log, signal="x,y,z", temps="temperature", topic=topic)
 
 
 # --- the output set ------------------------------------------------------------------------
@@ -457,7 +448,7 @@ def staged_set(output: Path, reporter: Reporter | None, pool: Any = None) -> Ite
     out.close()
 
 
-# --- gates (issue 28, item 5): doubtful, named in a warning --------------------------------
+# --- gates: doubtful, named in a warning ---------------------------------------------------
 
 STALL_S = 600.0
 """A sweep that does not rise by :data:`STALL_RISE_C` for this long has stopped rising

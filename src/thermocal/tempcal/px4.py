@@ -1,4 +1,4 @@
-"""PX4's whole thermal calibration from one ULog (issue 16): ``thermocal px4-tempcal``.
+"""PX4's whole thermal calibration from one ULog: ``thermocal px4-tempcal``.
 
 The PX4 dialect of the one pipeline (:mod:`thermocal.tempcal.pipeline`): the topics
 ``sensor_gyro``/``sensor_accel`` (and ``sensor_baro``/``sensor_mag`` as offsets), the ``TC_*``
@@ -10,7 +10,7 @@ relative to their median because gravity is in the data) and writes ``TC_*`` par
 thermocal does the same with three differences (each stated in the summary):
 
 * **equal weight across the temperature range**: the samples are first reduced to the
-  median of each temperature bin (:func:`thermocal.tempcal.binning.temperature_bins`), so a
+  median of each temperature bin (:func:`thermocal.firmware.binning.temperature_bins`), so a
   slow end of the sweep does not outweigh a fast middle — PX4 bins the temperature for the
   same reason;
 * **robust to spikes**: the bin statistic is the median, not the mean;
@@ -35,13 +35,14 @@ from typing import Any
 import numpy as np
 
 from thermocal import adequacy
-from thermocal.errors import ThermocalInputError
+from thermocal.errors import ParameterError, ThermocalInputError
+from thermocal.firmware.formats import FORMATS
+from thermocal.firmware.px4 import px4_coefficients
 from thermocal.models.calibration import Calibration
 from thermocal.outputs import check_outputs
-from thermocal.readers.ulog_params import ulog_parameters
 from thermocal.recording import FloatArray
-from thermocal.tempcal.binning import BIN_WIDTH_C, MIN_BINS, temperature_bins
 from thermocal.tempcal.compare import CoefficientComparison, px4_comparison
+from thermocal.tempcal.flightlog import FlightLog, open_px4_log
 from thermocal.tempcal.pipeline import (
     AXES,
     OutputSet,
@@ -53,7 +54,6 @@ from thermocal.tempcal.pipeline import (
     end_warning,
     fit_sensor,
     gyro_unit_warning,
-    read_sensor_topic,
     report_worker,
     require_fields,
     staged_set,
@@ -64,26 +64,14 @@ from thermocal.tempcal.pipeline import (
 )
 
 TOPICS = ("sensor_gyro", "sensor_accel")
-PARAMS_NAME = "px4.params"
-"""The parameter file of the set (QGroundControl's format, ``TC_*``)."""
 
 
-def log_topics(path: Path) -> list[tuple[str, int]]:
-    """The ``sensor_gyro``/``sensor_accel``/``sensor_baro``/``sensor_mag`` instances of a ULog
-    that carry a temperature
-    (:func:`thermocal.readers.ulog.ulog_sensor_instances`: an unreadable log is refused, damage and
-    every instance left out are said in warnings)."""
-    from thermocal.readers.ulog import ulog_sensor_instances
-
-    return ulog_sensor_instances(path, (*TOPICS, *OFFSET_TOPICS))
-
-
-# --- barometers and magnetometers (issue 28, item 3) -------------------------------------
+# --- barometers and magnetometers --------------------------------------------------------
 
 OFFSET_TOPICS = {"sensor_baro": ("baro", ("pressure",), "Pa"), "sensor_mag": ("mag", AXES, "gauss")}
 """PX4 topics calibrated as offsets in the firmware's unit (uORB ``SensorBaro.msg`` pressure
 [Pa], ``SensorMag.msg`` x, y, z [gauss]) with the polynomial order of their parameters
-(:data:`thermocal.export.params.PX4_OFFSET_SENSORS`: 5 for TC_B, 3 for TC_M)."""
+(:data:`thermocal.firmware.formats.FORMATS`: 5 for TC_B, 3 for TC_M)."""
 
 
 @dataclass(frozen=True)
@@ -119,19 +107,16 @@ def fit_offset_sensor(
     tref_c: float | None = None,
     overrides: tuple[str, ...] = (),
 ) -> OffsetFit:
-    """Judge (:func:`thermocal.adequacy.judge`: sweep, bins, ends), bin (medians of
-    :data:`BIN_WIDTH_C` bins, equal weight across the range, robust to spikes), judge on
-    held-out bins (a polynomial fitted to the even bins, its rms on the odd ones) and fit a
-    polynomial of PX4's order in ``T − TREF`` (TREF mid-range unless given) to every bin.
+    """Judge (:func:`thermocal.adequacy.judge`: sweep, bins, ends), then fit PX4's
+    polynomial (:func:`thermocal.firmware.px4.px4_coefficients`: medians of 0.5 °C bins,
+    equal weight across the range, robust to spikes; judged on held-out bins; a polynomial
+    of PX4's order in ``T − TREF``, TREF mid-range unless given, fitted to every bin).
     ``values`` (n, axes) in the topic's unit (:data:`OFFSET_TOPICS`)."""
-    from thermocal.export.params import PX4_OFFSET_SENSORS
-
     kind, fields, unit = OFFSET_TOPICS[topic]
-    order = PX4_OFFSET_SENSORS[kind][1]
+    order = FORMATS["px4"].sensors[kind].order
     where = f"{topic}.{instance}"
     vals = np.asarray(values, dtype=np.float64).reshape(len(temp_c), -1)
     temp = np.asarray(temp_c, dtype=np.float64)
-    lo, hi = float(np.min(temp)), float(np.max(temp))
     tname = f"{where} temperature"
     record = (
         adequacy.judge(
@@ -141,29 +126,17 @@ def fit_offset_sensor(
         .enforce()
         .to_dict()
     )  # fmt: skip
-    rel = vals - np.median(vals, axis=0)
-    _c, t_med, v_med = temperature_bins(temp, rel)
-    need = max(MIN_BINS, 2 * (order + 1))
-    if t_med.size < need:
-        raise ThermocalInputError(
-            f"{where}: the temperature covers {t_med.size} bins of {BIN_WIDTH_C:g} °C; a "
-            f"polynomial of order {order} needs at least {need}: record a wider sweep"
-        )
-    tref = 0.5 * (lo + hi) if tref_c is None else float(tref_c)
-    x = t_med - tref
-    even, odd = np.arange(0, x.size, 2), np.arange(1, x.size, 2)
-    coefs, rms = [], {}
+    try:
+        fit = px4_coefficients(temp, vals, kind=kind, tref_c=tref_c)
+    except ParameterError as exc:
+        if exc.parameter != "temperature_c":
+            raise
+        raise ThermocalInputError(f"{where}: {exc.named('the temperature')}") from None
     names = fields if len(fields) > 1 else ("pressure",)
-    for j, name in enumerate(names):
-        held = np.polynomial.polynomial.polyfit(x[even], v_med[even, j], order)
-        pred = np.polynomial.polynomial.polyval(x[odd], held)
-        rms[name] = float(np.sqrt(np.mean((v_med[odd, j] - pred) ** 2)))
-        coefs.append(
-            tuple(float(c) for c in np.polynomial.polynomial.polyfit(x, v_med[:, j], order))
-        )
     return OffsetFit(
-        topic, kind, instance, device_id, unit, (lo, hi), tref, int(temp.size), int(t_med.size),
-        order, tuple(coefs), rms, record,
+        topic, kind, instance, device_id, unit, (fit.tmin_c, fit.tmax_c), fit.tref_c,
+        fit.n_samples, fit.n_bins, order, fit.coefficients,
+        dict(zip(names, fit.holdout_rms, strict=True)), record,
     )  # fmt: skip
 
 
@@ -194,7 +167,7 @@ class Px4TempcalResult:
     """Per sensor, the log's ``TC_*`` for its device against the new ones."""
 
     def to_dict(self) -> dict[str, Any]:
-        """The JSON of ``px4-tempcal --json`` (INTERFACE.md)."""
+        """The JSON of ``px4-tempcal --json``."""
         return {
             "log": str(self.log),
             "params": str(self.params_path),
@@ -219,29 +192,71 @@ def px4_tempcal(
     overrides: tuple[str, ...] = (),
     reporter: Reporter | None = None,
 ) -> Px4TempcalResult:
-    """PX4's thermal calibration of every sensor instance of a ULog, written to the
-    directory ``output`` as one set: ``calibration.json``, ``px4.params`` (``TC_*``) and
-    ``report_<topic>_<n>.html`` per IMU instance (written by ``reporter``; none: not
-    written).  Each IMU instance goes through the pipeline (:func:`.pipeline.fit_sensor`: a
-    cubic per axis about ``tref_c`` [°C], mid-range unless given); barometers and
-    magnetometers are offsets (:func:`fit_offset_sensor`).  ``overrides`` the adequacy
-    checks let through (``narrow``, ``motion``).  The log is parsed once
-    (:func:`thermocal.readers.ulog.parsed_once`) for every topic read."""
+    """PX4's thermal calibration of every sensor instance of a ULog, written as one set.
+
+    Parameters
+    ----------
+    log : Path
+        A PX4 ULog recorded with the thermal-calibration logging profile (``sensor_gyro``,
+        ``sensor_accel``, ``sensor_baro``, ``sensor_mag`` with their temperatures).
+    output : Path
+        The directory of the set: ``calibration.json``, ``px4.params`` (``TC_*``) and
+        ``report_<topic>_<n>.html`` per instance; built beside it and moved into place whole.
+    tref_c : float, optional
+        ``TREF`` of every polynomial [°C]; default the middle of each instance's range.
+    overrides : tuple of str
+        Adequacy checks let through (``"narrow"``, ``"motion"``).
+    reporter : callable, optional
+        Writes one report (the presentation layer's); None: no report written.
+
+    Returns
+    -------
+    Px4TempcalResult
+        The files written, each instance's fit and hold-out rms, the notes of the
+        parameter file, the log's previous ``TC_*`` compared with the new ones.
+
+    Raises
+    ------
+    thermocal.errors.ThermocalInputError
+        An unreadable log, no sensor with a temperature, data that cannot support the fit
+        (sweep, bins, motion) unless overridden, an output that is the log or not a
+        directory.
+
+    Notes
+    -----
+    The log is read once into a :class:`~thermocal.tempcal.flightlog.FlightLog`.  Each IMU
+    instance goes through the pipeline (:func:`.pipeline.fit_sensor`: a cubic per axis in
+    the temperature, fitted to the medians of 0.5 °C bins); barometers and magnetometers
+    are offsets (:func:`fit_offset_sensor`, :func:`thermocal.firmware.px4.px4_coefficients`).
+    The firmware subtracts, per axis,
+
+    .. math::
+
+        o(T) = \\sum_{k=0}^{n} X_k\\,(\\operatorname{clamp}(T, T_\\mathrm{min},
+        T_\\mathrm{max}) - T_\\mathrm{ref})^k .
+
+    References
+    ----------
+    * PX4-Autopilot, ``Tools/process_sensor_caldata.py``,
+      https://github.com/PX4/PX4-Autopilot/blob/main/Tools/process_sensor_caldata.py
+    * PX4-Autopilot, ``src/modules/temperature_compensation/TemperatureCompensation.cpp``,
+      https://github.com/PX4/PX4-Autopilot/tree/main/src/modules/temperature_compensation
+    """
 
     # DIR may hold the log; the files of the set (replaced by name) may not be it
-    from thermocal.readers.ulog import parsed_once
-
-    check_outputs([output / "calibration.json", output / PARAMS_NAME], [log], dirs=[output])
+    check_outputs(
+        [output / "calibration.json", output / FORMATS["px4"].params_file], [log], dirs=[output]
+    )
     check_output_dir(output)
     with (
         report_worker(reporter, log) as pool,  # starts while the log is read
-        parsed_once(log, (*TOPICS, *OFFSET_TOPICS)),  # the log is parsed once
+        open_px4_log(log, (*TOPICS, *OFFSET_TOPICS)) as flight,  # the log is parsed once
     ):
-        return _px4_tempcal(log, output, tref_c, overrides, reporter, pool)
+        return _px4_tempcal(flight, output, tref_c, overrides, reporter, pool)
 
 
 def _px4_tempcal(
-    log: Path,
+    flight: FlightLog,
     output: Path,
     tref_c: float | None,
     overrides: tuple[str, ...],
@@ -251,7 +266,7 @@ def _px4_tempcal(
     """:func:`px4_tempcal` after its output checks (``pool``: the report worker)."""
     from thermocal.export.params import ParamSet
 
-    topics = log_topics(log)
+    log, topics = flight.path, flight.instances
     if not topics:
         raise ThermocalInputError(f"{log}: {NO_SENSOR}")
     check_outputs([output / f"report_{n}_{i}.html" for n, i in topics], [log], dirs=[output])
@@ -261,18 +276,18 @@ def _px4_tempcal(
     series: dict[str, tuple[FloatArray, FloatArray]] = {}
     motions: dict[str, adequacy.Motion] = {}
     params = ParamSet("px4")
-    old = _Prior(_tc_in_force(log, params.notes), {})  # the TC_* the log was recorded with
+    old = _Prior(_tc_in_force(flight, params.notes), {})  # the TC_* the log was recorded with
     with staged_set(output, reporter, pool) as out_set:  # moved into place whole, or removed
         for name, inst in topics:
             if name in OFFSET_TOPICS:  # barometers and magnetometers: TC_B / TC_M
                 ofit = _offset_instance(
-                    log, name, inst, tref_c, overrides, params, out_set, old, gates
+                    flight, name, inst, tref_c, overrides, params, out_set, old, gates
                 )
                 if ofit is not None:
                     offset_fits.append(ofit)
                 continue
             fit, more = _imu_instance(
-                log, name, inst, tref_c, overrides, params, out_set, (series, motions), old
+                flight, name, inst, tref_c, overrides, params, out_set, (series, motions), old
             )
             fits.append(fit)
             gates.extend(more)
@@ -280,31 +295,30 @@ def _px4_tempcal(
         warn_gates(gates)
         if not fits:
             raise ThermocalInputError(f"{log}: {NO_SENSOR}")
-        out_set.commit(calibration_of(fits), PARAMS_NAME, params.text())
+        out_set.commit(calibration_of(fits), FORMATS["px4"].params_file, params.text())
     if any(f.kind == "accel" for f in fits):
         params.notes.append(
             "accelerometers: offsets relative to mid-range (gravity is in the data), as PX4's "
             "own script does"
         )
     return Px4TempcalResult(
-        log, output / PARAMS_NAME, output / "calibration.json", tuple(out_set.reports),
+        log, output / FORMATS["px4"].params_file, output / "calibration.json",
+        tuple(out_set.reports),
         tuple(fits), tuple(offset_fits), tuple(params.notes), old.found,
     )  # fmt: skip
 
 
-def _tc_in_force(log: Path, notes: list[str]) -> dict[str, float]:
+def _tc_in_force(flight: FlightLog, notes: list[str]) -> dict[str, float]:
     """The log's parameters the new ``TC_*`` are compared with: the initial ones
-    (:func:`thermocal.readers.ulog_params.ulog_parameters`) updated by every ``TC_*`` changed
-    during the recording (:func:`thermocal.readers.ulog.ulog_parameter_changes`), i.e. those
+    (``flight.parameters``) updated by every ``TC_*`` changed during the recording
+    (``flight.parameter_changes``), i.e. those
     in force at the end of the log, the board's calibration the new one replaces.  PX4 logs
     ``sensor_gyro``/``_accel``/``_baro``/``_mag`` before its temperature compensation
     (applied downstream, sensors/vehicle_imu), so such a change leaves the data as they are;
     each is said in ``notes`` (name, old → new, log time) with the values compared."""
-    from thermocal.readers.ulog import ulog_parameter_changes
-
-    params = ulog_parameters(log)
+    params = dict(flight.parameters)
     said: list[str] = []
-    for t, name, value in ulog_parameter_changes(log, (*TOPICS, *OFFSET_TOPICS)):
+    for t, name, value in flight.parameter_changes:
         before = params.get(name)
         if name.startswith("TC_") and before is not None and before != value:
             said.append(f"{name} {before:g} → {value:g} at log time {t:.3f} s")
@@ -320,7 +334,7 @@ def _tc_in_force(log: Path, notes: list[str]) -> dict[str, float]:
 
 @dataclass(frozen=True)
 class _Prior:
-    """The log's parameters (:func:`thermocal.readers.ulog_params.ulog_parameters`) and,
+    """The log's parameters (:attr:`.flightlog.FlightLog.parameters`) and,
     per sensor, its ``TC_*`` compared with the new ones (:func:`.compare.px4_comparison`)."""
 
     params: dict[str, float]
@@ -338,7 +352,7 @@ class _Prior:
 
 
 def _offset_instance(
-    log: Path,
+    flight: FlightLog,
     name: str,
     inst: int,
     tref_c: float | None,
@@ -353,11 +367,11 @@ def _offset_instance(
     set aside, said in ``gates``), fit (:func:`fit_offset_sensor`), its ``TC_B``/``TC_M``
     parameters merged into ``params``, its report (:func:`.offset_report.offset_report_request`)."""
     from thermocal.export.params import px4_offset_params
-    from thermocal.readers.dispatch import read_log_table
     from thermocal.tempcal.offset_gates import screen_baro, screen_mag
     from thermocal.tempcal.offset_report import offset_report_request
 
-    df, _info = read_log_table(log, f"{name}.{inst}")
+    log = flight.path
+    df, _info = flight.table(f"{name}.{inst}")
     fields = OFFSET_TOPICS[name][1]
     require_fields(df, ["timestamp", "temperature", *fields], log, f"{name}.{inst}")
     ids = df["device_id"].to_numpy() if "device_id" in df.columns else np.zeros(1)
@@ -391,7 +405,7 @@ def _offset_instance(
 
 
 def _imu_instance(
-    log: Path,
+    flight: FlightLog,
     name: str,
     inst: int,
     tref_c: float | None,
@@ -409,7 +423,8 @@ def _imu_instance(
 
     kind = "gyro" if name == "sensor_gyro" else "accel"
     where = f"{name}.{inst}"
-    rec = read_sensor_topic(log, where)
+    log = flight.path
+    rec = flight.recording(where)
     series, motions = found
     fit = fit_sensor(rec, name, kind, inst, overrides=overrides, motions=motions)
     temp_c = rec.temperature_c("temperature")
@@ -453,15 +468,11 @@ def _imu_instance(
 
 
 __all__ = [
-    "BIN_WIDTH_C",
-    "MIN_BINS",
     "OFFSET_TOPICS",
     "TOPICS",
     "OffsetFit",
     "Px4TempcalResult",
     "fit_offset_sensor",
-    "log_topics",
     "offset_summary",
     "px4_tempcal",
-    "temperature_bins",
 ]

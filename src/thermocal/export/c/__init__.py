@@ -1,4 +1,4 @@
-"""Plain C99 code computing a model's correction sample by sample (SPEC §8).
+"""Plain C99 code computing a model's correction sample by sample.
 
 "Coefficients solidified in the IMU software": :func:`generate_c` turns a model
 file's dict (:func:`thermocal.models.files.load_model_dict`) into a header and a
@@ -35,7 +35,7 @@ fields of a model file) and may hold anything: every one reaches the C through t
 names that meet after mapping refused; comment text by
 :func:`~thermocal.identifiers.c_comment`; string literals by
 :func:`~thermocal.identifiers.c_string`), and every module is checked by
-:func:`~thermocal.identifiers.check_generated_c` before it is written (issue 26).
+:func:`~thermocal.identifiers.check_generated_c` before it is written.
 
 The arithmetic follows the family's ``ModelStream`` operation by operation, so
 the double build agrees with the Python streaming compensator to rounding

@@ -1,5 +1,5 @@
 """C code of the ``bank`` family (:mod:`thermocal.export.c`): the bank of models
-chosen at power-on (SPEC §4d)."""
+chosen at power-on."""
 
 from __future__ import annotations
 
@@ -12,7 +12,7 @@ from thermocal.export.c.core import (
 
 
 def generate(ctx: ExportContext) -> FamilyCode:
-    """Model bank (SPEC §4d, models/bank.py ``BankStream``): every piecewise-linear model
+    """Model bank (models/bank.py ``BankStream``): every piecewise-linear model
     evaluated at the clamped T; during ``t − t_first < startup_s`` the residual sums
     ``Σ (y − f_m)`` pick ``argmin_m |Σ_m/N|``; then the choice is frozen."""
     st = ctx.model["state"]
@@ -32,7 +32,7 @@ def generate(ctx: ExportContext) -> FamilyCode:
         update=_update(ctx),
         defines=[f"#define {P}_N_MODELS {m}"],
         notes=[
-            "Model bank (SPEC 4d): one piecewise-linear model per characteristic curve,",
+            "Model bank: one piecewise-linear model per characteristic curve,",
             f"selected during the first {float(st['startup_s']):g} s after power-on by the",
             "smallest |mean(signal - known_input - model)|; pass the raw signal to update.",
         ],

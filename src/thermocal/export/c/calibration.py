@@ -41,7 +41,7 @@ def generate_c_calibration(
     real: str = "double",
     sample_interval_s: float | None = None,
 ) -> CExport:
-    """One C99 header and source for a whole calibration (issue 15).
+    """One C99 header and source for a whole calibration.
 
     ``channels``: ``(name, model dict, unit)`` per channel (unit None: the channel's data
     unit as fitted, :func:`c_signal_unit`). Each channel is the same code as its own

@@ -573,7 +573,7 @@ def _indent(text: str, n: int = 4) -> str:
 
 
 def _rate_buffer_code(ctx: ExportContext) -> tuple[list[str], str, str]:
-    """State fields, init and update code of the backward-difference Ṫ (SPEC §3, seed 000):
+    """State fields, init and update code of the backward-difference Ṫ:
     a ring buffer of the raw temperatures of the last Δt of the current contiguous
     segment; ``Ṫ = (T − T_lo)/(t − t_lo)·60`` [°C/min] with ``t_lo`` the oldest buffered
     time ≥ t − Δt, 0 at a segment's first sample; a step > GAP_FACTOR·τ clears the buffer.

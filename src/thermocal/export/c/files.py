@@ -32,7 +32,7 @@ class ExportCResult:
     float_error: FloatError | None = None
 
     def to_dict(self) -> dict[str, Any]:
-        """The ``thermocal export-c --json`` object (INTERFACE.md)."""
+        """The ``thermocal export-c --json`` object."""
         ex, files = self.export, [str(p) for p in self.files]
         if self.kind == "triads":
             return {

@@ -1,5 +1,5 @@
 """C code of the ``piecewise`` family (:mod:`thermocal.export.c`): piecewise-linear
-segments (SPEC §4b)."""
+segments."""
 
 from __future__ import annotations
 
@@ -14,7 +14,7 @@ from thermocal.identifiers import c_comment
 
 
 def generate(ctx: ExportContext) -> FamilyCode:
-    """Piecewise-linear model (SPEC §4b, models/piecewise.py eq. 1 and ``PiecewiseStream``):
+    """Piecewise-linear model (models/piecewise.py eq. 1 and ``PiecewiseStream``):
 
     ``T = clamp(T_in)`` to the fitted range; ``j`` = number of breakpoints ``≤ T``;
     ``y = intercepts[j] + slopes[j]·T``.  Both methods (``intersect``, ``continuous``)
@@ -87,7 +87,7 @@ def generate(ctx: ExportContext) -> FamilyCode:
             f"#define {P}_TEMP_INDEX {k} /* temps_c[] entry the model uses ({c_comment(used)}) */",
         ],
         notes=[
-            f"Piecewise-linear model (SPEC 4b, {method} method) in {used} [{ctx.tu}]:",
+            f"Piecewise-linear model ({method} method) in {used} [{ctx.tu}]:",
             "y = A[j] + S[j] T, j = number of breakpoints <= T; T clamped to the fitted range.",
             "Memoryless; call init once before use.",
         ],

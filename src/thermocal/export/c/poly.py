@@ -1,4 +1,4 @@
-"""C code of the ``poly`` family (:mod:`thermocal.export.c`): the polynomial of SPEC §4a
+"""C code of the ``poly`` family (:mod:`thermocal.export.c`): the polynomial model
 with its Ṫ buffer, as models/poly.py streams it."""
 
 from __future__ import annotations
@@ -20,7 +20,7 @@ from thermocal.recording import FloatArray
 N_ACCUMULATORS = 4
 """Partial sums of the terms in the generated C (term i goes to sum i mod 4; the sums are
 added pairwise at the end): four chains of additions run side by side, where one would
-wait on each addition's latency (18.6 → 30+ M samples/s at -O2, issue 17)."""
+wait on each addition's latency (18.6 → 30+ M samples/s at -O2)."""
 
 
 @dataclass(frozen=True)
@@ -132,7 +132,7 @@ def _data(ctx: ExportContext, plan: _PolyPlan) -> list[str]:
 
 
 def generate(ctx: ExportContext) -> FamilyCode:
-    """Polynomial model (SPEC §4a, models/poly.py docstring steps 1–4 and ``PolyStream``):
+    """Polynomial model (models/poly.py docstring steps 1–4 and ``PolyStream``):
     Ṫ from the raw temperatures, clamp T and Ṫ (rate sensors) to the fitted ranges,
     ``u = (T − c_T)/s_T``, ``v = (Ṫ − c_R)/s_R``, ``w = (T·Ṫ − c_W)/s_W``,
     ``y = Σ_j coef_j u^a v^b w^c + constant`` (powers by repeated multiplication; the sum
@@ -142,7 +142,7 @@ def generate(ctx: ExportContext) -> FamilyCode:
     data = _data(ctx, plan)
     defines = [f"#define {P}_N_TERMS {len(plan.terms)}"]
     notes = [
-        f"Polynomial model (SPEC 4a): {len(plan.terms)} terms + constant in the centred and scaled",
+        f"Polynomial model: {len(plan.terms)} terms + constant in the centred and scaled",
         "base variables u = (T - c_T)/s_T, v = (dT - c_R)/s_R, w = (T dT - c_W)/s_W",
         f"(dT = backward difference over the rate interval, {ctx.tu}/min). Inputs are clamped",
         "to the fitted temperature (and rate) range. Call init at power-on.",
@@ -195,7 +195,7 @@ def _update_head(ctx: ExportContext, plan: _PolyPlan) -> tuple[list[str], int]:
     P, r = ctx.P, ctx.r
     upd = [f"{r} T[{P}_N_TEMPS];"] if plan.needs_t else []
     # independent partial sums: one running sum would chain every term's addition on the
-    # last (its latency, not the arithmetic, bounding the speed; issue 17)
+    # last (its latency, not the arithmetic, bounding the speed)
     n_acc = max(1, min(N_ACCUMULATORS, len(plan.terms)))
     upd += [
         f"{r} " + ", ".join(f"acc{k} = {ctx.lit(0.0)}" for k in range(n_acc)) + ";",

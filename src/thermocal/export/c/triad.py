@@ -1,4 +1,4 @@
-"""Plain C99 for a calibration of triads (issue 19): per triad one function
+"""Plain C99 for a calibration of triads: per triad one function
 
     void <p>_<triad>_correct(double temp_c, const <real> x[3], <real> out[3]);
 
@@ -8,7 +8,7 @@ calibrated range, every parameter a polynomial in ``T − TREF`` (Horner), ``E``
 determinant (no allocation, no library call; ``I + E`` is within 10⁻³ of the identity, so
 the determinant is near 1).  Matches :func:`thermocal.turntable.thermal.correct`.
 
-A triad calibrated on raw counts (``multipos --accel-scale/--gyro-scale``, issue 30) takes
+A triad calibrated on raw counts (``multipos --accel-scale/--gyro-scale``) takes
 ``x`` in its physical unit all the same; the header defines the count scale
 ``<P>_<TRIAD>_COUNT_SCALE`` (one count in that unit) and states the conversion
 ``x = <P>_<TRIAD>_COUNT_SCALE · counts`` that the caller applies to the raw registers first,

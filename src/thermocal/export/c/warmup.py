@@ -1,5 +1,5 @@
 """C code of the ``warmup`` family (:mod:`thermocal.export.c`): warm-up models indexed
-by the start temperature (SPEC §4c)."""
+by the start temperature."""
 
 from __future__ import annotations
 
@@ -13,7 +13,7 @@ from thermocal.identifiers import c_comment
 
 
 def generate(ctx: ExportContext) -> FamilyCode:
-    """Warm-up model (SPEC §4c, models/warmup.py ``WarmupStream``):
+    """Warm-up model (models/warmup.py ``WarmupStream``):
 
     T = clamp(T_in); during ``t − t_first < W``: T0 = running mean of T; then frozen;
     a_j = Σ_k b_jk clamp(T0)^k (Horner), ΔF = Σ_j a_j (T − T0)^j (Horner).
@@ -84,7 +84,7 @@ return acc;
         update=update,
         defines=[f"#define {P}_ORDER {nj - 1}", f"#define {P}_T0_ORDER {nk - 1}"],
         notes=[
-            "Warm-up model (SPEC 4c): dF = sum_j a_j(T0) dT^j, a_j(T0) = sum_k b_jk T0^k,",
+            "Warm-up model: dF = sum_j a_j(T0) dT^j, a_j(T0) = sum_k b_jk T0^k,",
             f"T0 = running mean of the temperature over the first {window:g} s after power-on.",
             "Call init at power-on.",
         ],
