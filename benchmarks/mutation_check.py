@@ -3323,7 +3323,7 @@ MUTANTS: tuple[Mutant, ...] = (
         P + "firmware/px4.py",
         "need = max(MIN_BINS, 2 * (order + 1))",
         "need = order + 1",
-        ("tests/firmware/test_firmware_px4.py", "tests/test_px4_baro_mag.py"),
+        ("tests/firmware/test_firmware_px4.py", "tests/tempcal/test_px4_baro_mag.py"),
         "a polynomial fitted to as few bins as it has coefficients",
     ),
 )
