@@ -73,7 +73,7 @@ FILE_LAYER = (
     "thermocal.models.filecheck",
     "thermocal.turntable.files",
     "thermocal.multipos.files",
-    "thermocal.compensate.files",
+    "thermocal.pipeline.compensate",
     "thermocal.pipeline",
     "thermocal.tempcal",
     "thermocal.export",
@@ -92,7 +92,7 @@ LIGHT_FORBIDDEN = (
     "pyarrow",
     "thermocal.readers",
     "thermocal.writers",
-    "thermocal.compensate.files",
+    "thermocal.pipeline.compensate",
     "thermocal.models.files",
 )
 

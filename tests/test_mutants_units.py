@@ -16,7 +16,8 @@ import pytest
 
 from thermocal import units
 from thermocal.errors import FileFormatError
-from thermocal.readers.text import TextOptions, parse_number, read_text, sniff_text
+from thermocal.readers.options import ReadOptions
+from thermocal.readers.text import parse_number, read_text, sniff_text
 
 ARCSEC_PER_RAD = 180.0 / math.pi * 3600.0  # 206 264.806…
 
@@ -108,8 +109,8 @@ def test_a_row_with_too_many_fields_is_a_bad_line(tmp_path: Path) -> None:
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # the layout and the skipped line are stated
         with pytest.raises(FileFormatError, match="line 4"):
-            read_text(f, "utf-8", TextOptions())
-        df, _info = read_text(f, "utf-8", TextOptions(on_bad_lines="skip"))
+            read_text(f, "utf-8", ReadOptions())
+        df, _info = read_text(f, "utf-8", ReadOptions(on_bad_lines="skip"))
     assert df.shape == (2, 3)
     assert list(df["t"]) == [0.0, 2.0]
 
@@ -118,7 +119,8 @@ def test_ulog_vehicle_imu_integrals_become_rates(tmp_path: Path) -> None:
     """PX4's ``vehicle_imu`` logs Δθ [rad] and Δv [m/s] over Δt [µs]: the reader's rates
     are Δθ/Δt [rad/s] and Δv/Δt [m/s²] with Δt in seconds (mutant ulog-delta-dt-us reads
     Δt in ms: rates 1000× too small).  Written with the test's own ULog writer."""
-    from thermocal.readers.dispatch import read_log_table
+    from thermocal.readers.dispatch import read_whole_table
+    from thermocal.readers.options import ReadOptions
     from ulog_writer import ulog_bytes
 
     fields = [("uint64_t", "timestamp"), ("float[3]", "delta_angle"),
@@ -134,7 +136,7 @@ def test_ulog_vehicle_imu_integrals_become_rates(tmp_path: Path) -> None:
     log.write_bytes(ulog_bytes([("vehicle_imu", 0, fields, rows)]))
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        df, info = read_log_table(log, "vehicle_imu")
+        df, info = read_whole_table(log, ReadOptions(topic="vehicle_imu"))
     for i in range(3):
         np.testing.assert_allclose(df[f"gyro_rad_s[{i}]"], w[i], rtol=1e-6, atol=1e-9)
         np.testing.assert_allclose(df[f"accel_m_s2[{i}]"], a[i], rtol=1e-6, atol=1e-9)

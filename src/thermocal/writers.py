@@ -32,8 +32,8 @@ from thermocal.outputs import (
     sidecar_path,
     warn_formula_names,
 )
-from thermocal.readers.common import file_kind
 from thermocal.readers.dispatch import recording_info
+from thermocal.readers.formats import file_kind
 from thermocal.recording import META_KEY, FloatArray, Recording
 
 if TYPE_CHECKING:
@@ -265,7 +265,7 @@ def write_json(path: str | Path, obj: Any) -> None:
 def check_not_input(out: str | Path, inputs: list[str | Path]) -> None:
     """Refuse to write ``out`` over one of the inputs or an input's sidecar
     ``FILE.meta.json``, or onto a special file (the one gate,
-    :func:`thermocal.outputs.check_outputs`; INTERFACE.md common rules)."""
+    :func:`thermocal.outputs.check_outputs`; an input is never overwritten)."""
     check_outputs([out], inputs)
 
 

@@ -15,9 +15,10 @@ from thermocal.defaults import PROGRAM_SETPOINT, PROGRAM_TIME
 from thermocal.errors import FileFormatError, MissingColumnError, NonNumericError
 from thermocal.outputs import refuse_special_input
 from thermocal.profiles import check_program
-from thermocal.readers.common import csv_float_options, file_kind
+from thermocal.readers.common import csv_float_options
 from thermocal.readers.dispatch import read_recording
-from thermocal.readers.text import TextOptions
+from thermocal.readers.formats import file_kind
+from thermocal.readers.options import ReadOptions
 from thermocal.recording import FloatArray
 
 if TYPE_CHECKING:
@@ -64,15 +65,13 @@ def read_program(path: str | Path) -> tuple[FloatArray, FloatArray]:
 def read_history(
     path: Path,
     column: str | None = None,
-    *,
-    text: TextOptions | None = None,
-    topic: str | None = None,
+    read: ReadOptions | None = None,
 ) -> tuple[FloatArray, FloatArray, str]:
     """A temperature history ``(time_s, temperature_c, column)`` from a chamber program CSV
     (``time_s, setpoint_c``; its set-point unless ``column`` is another of its columns) or a
     recording (``column``, default its first temperature column, else ``setpoint_c``), read
-    by :func:`thermocal.readers.read_recording` with the text-log options ``text`` and the
-    log topic ``topic`` as every command reads a recording."""
+    by :func:`thermocal.readers.read_recording` with ``read`` (a text log's layout, a log's
+    topic) as every command reads a recording."""
     if not path.exists():
         raise FileFormatError(f"{path}: no such file")
     time_col: str | None = None
@@ -87,7 +86,8 @@ def read_history(
             return t, c, defaults.PROGRAM_SETPOINT
         if defaults.PROGRAM_TIME in header and "time" not in header:
             time_col = defaults.PROGRAM_TIME
-    rec = read_recording(path, time=time_col, text=text, topic=topic)
+    r = read or ReadOptions()
+    rec = read_recording(path, r.replace(time=time_col) if time_col is not None else r)
     if column is None:
         if rec.temperatures:
             column = rec.temperatures[0]

@@ -240,9 +240,12 @@ def read_sensor_topic(log: Path, topic: str) -> Recording:
     """One ULog topic instance (``NAME.N``) as a recording of x, y, z and ``temperature``
     (:func:`thermocal.readers.read_recording`), checked (finite, increasing time) and its
     gaps stated in one :class:`GapWarning`."""
-    from thermocal.pipeline.reading import load_recording
+    from thermocal.pipeline.reading import check_recording
+    from thermocal.readers.dispatch import read_recording
+    from thermocal.readers.options import ReadOptions
 
-    return load_recording(log, signal="x,y,z", temps="temperature", topic=topic)
+    read = ReadOptions(signals=("x", "y", "z"), temperatures=("temperature",), topic=topic)
+    return check_recording(read_recording(log, read), read)
 
 
 # --- the output set ------------------------------------------------------------------------

@@ -353,11 +353,12 @@ def _offset_instance(
     set aside, said in ``gates``), fit (:func:`fit_offset_sensor`), its ``TC_B``/``TC_M``
     parameters merged into ``params``, its report (:func:`.offset_report.offset_report_request`)."""
     from thermocal.export.params import px4_offset_params
-    from thermocal.readers.dispatch import read_log_table
+    from thermocal.readers.dispatch import read_whole_table
+    from thermocal.readers.options import ReadOptions
     from thermocal.tempcal.offset_gates import screen_baro, screen_mag
     from thermocal.tempcal.offset_report import offset_report_request
 
-    df, _info = read_log_table(log, f"{name}.{inst}")
+    df, _info = read_whole_table(log, ReadOptions(topic=f"{name}.{inst}"))
     fields = OFFSET_TOPICS[name][1]
     require_fields(df, ["timestamp", "temperature", *fields], log, f"{name}.{inst}")
     ids = df["device_id"].to_numpy() if "device_id" in df.columns else np.zeros(1)

@@ -1,8 +1,8 @@
-"""Compensation of files with a fitted model (SPEC §4, §8); the maths (in memory, in
-chunks, live) is :mod:`thermocal.compensate.kernels`, re-exported here.
+"""Compensation of files with a fitted model; the maths (in memory, in chunks, live) is
+:mod:`thermocal.compensate.kernels`.
 
 A model gives the temperature-induced part of the signal, ``ŷ = model(T, Ṫ, …)``;
-the compensated output is ``F' = F − ŷ`` (SPEC §4c: "output F' = F − ΔF").
+the compensated output is ``F' = F − ŷ`` (output F' = F − ΔF).
 
 Three ways to apply a model, all giving the same numbers:
 
@@ -30,12 +30,9 @@ column's own unit.  A model and data of different kinds (°/h against mg) is a
 
 from __future__ import annotations
 
-import contextlib
 import dataclasses
 import json
 import math
-import signal
-import threading
 import warnings
 from collections.abc import Callable, Iterator, Sequence
 from concurrent.futures import Future, ThreadPoolExecutor
@@ -47,61 +44,40 @@ import numpy as np
 
 from thermocal import units
 from thermocal._lazy import LazyModule
-from thermocal.compensate.kernels import (  # the maths, re-exported
+from thermocal.compensate.kernels import (
     AbsoluteFigures,
-    CalibrationStream,
     ChunkPredictor,
-    Compensation,
-    ModelRun,
-    StreamingCompensator,
     absolute_error_worse,
     absolute_worse_message,
     check_signal_kind,
-    chunk_context,
-    compensate_run,
     model_scale_factor,
-    prepare_run,
     temperature_inputs,
     unit_factor,
     zero_reference,
 )
-from thermocal.defaults import DEFAULT_CHUNK_ROWS as DEFAULT_CHUNK_ROWS
+from thermocal.defaults import DEFAULT_CHUNK_ROWS
 from thermocal.errors import (
     ExtrapolationWarning,
     FileFormatError,
     MissingColumnError,
     MissingValueError,
     PlausibilityWarning,
-    TextLayoutWarning,
     ThermocalInputError,
     ThermocalWarning,
     TimestampError,
     UnitError,
 )
 from thermocal.models.base import (
-    ChunkContext,
     TemperatureModel,
     check_sensor_id,
     outside_range_dict,
 )
 from thermocal.outputs import refuse_special_input, sidecar_path, warn_formula_names
-from thermocal.readers.common import (
-    csv_encoding,
-    csv_float_options,
-    default_time_column,
-    file_kind,
-    names_list,
-    thermocal_metadata,
-)
-from thermocal.readers.dispatch import (
-    read_log_table,
-    read_recording,
-    read_text_table,
-    time_hint,
-)
-from thermocal.readers.station import is_station_path, station_files, with_sensor
+from thermocal.readers.common import default_time_column, names_list
+from thermocal.readers.dispatch import read_recording, read_whole_table, time_hint
+from thermocal.readers.formats import FileFormat, file_kind, format_of
+from thermocal.readers.options import ReadOptions
 from thermocal.readers.table import load_sidecar, numeric_column
-from thermocal.readers.text import TextOptions, csv_chunk_options
 from thermocal.recording import (
     ABSOLUTE_ZERO_C,
     FEW_SAMPLES,
@@ -129,41 +105,6 @@ else:
 
 MODEL_SUFFIX = "_model"
 COMP_SUFFIX = "_comp"
-
-
-# --- files ---------------------------------------------------------------------------------
-
-
-@dataclass
-class _CtrlC:
-    seen: bool = False
-
-
-@contextlib.contextmanager
-def _ctrl_c_noted() -> Iterator[_CtrlC]:
-    """Note a Ctrl-C (SIGINT) while pandas' C parser reads a CSV file: it turns the
-    KeyboardInterrupt raised inside its ``read`` into a ParserError ("Calling read(nbytes)
-    on source failed"), which would read as a damaged file.  The handler notes it and
-    raises KeyboardInterrupt as Python's default does; installed only where a handler can
-    be (the main thread) and where SIGINT is not ignored (fleet workers)."""
-    note = _CtrlC()
-    if threading.current_thread() is not threading.main_thread():
-        yield note
-        return
-    before = signal.getsignal(signal.SIGINT)
-    if before is not signal.default_int_handler:
-        yield note
-        return
-
-    def handler(signum: int, frame: Any) -> None:
-        note.seen = True
-        signal.default_int_handler(signum, frame)
-
-    signal.signal(signal.SIGINT, handler)
-    try:
-        yield note
-    finally:
-        signal.signal(signal.SIGINT, before)
 
 
 @dataclass(frozen=True)
@@ -252,124 +193,29 @@ class _RunningMoments:
         )
 
 
-def _file_info(
-    path: Path,
-    kind: str,
-    table: pd.DataFrame | None = None,
-    table_info: dict[str, Any] | None = None,
-) -> tuple[list[str], dict[str, Any], int | None]:
-    """Column names, thermocal metadata (sidecar over Parquet key-value) and row count
-    (``table``: a text log already read whole, with its metadata)."""
-    if table is not None:
-        return [str(c) for c in table.columns], dict(table_info or {}), len(table)
-    if kind == "station":
-        return _station_info(path)
-    if not path.exists():
-        raise FileFormatError(f"{path}: no such file")
-    refuse_special_input(path)
-    if path.stat().st_size == 0:
-        raise FileFormatError(f"{path}: the file is empty")
-    meta: dict[str, Any] = {}
-    n_rows: int | None = None
-    if kind == "parquet":
-        try:
-            pf = pq.ParquetFile(path)
-        except (pa.ArrowInvalid, OSError) as exc:
-            raise FileFormatError(f"{path}: not a readable Parquet file ({exc})") from None
-        names = list(pf.schema_arrow.names)
-        n_rows = int(pf.metadata.num_rows)
-        meta = thermocal_metadata(pf.schema_arrow.metadata, path)
-    else:
-        enc = csv_encoding(path)
-        opts = csv_chunk_options(path, enc)
-        try:
-            head = pd.read_csv(path, nrows=0, skipinitialspace=True, encoding=enc, **opts)
-        except (pd.errors.ParserError, pd.errors.EmptyDataError, UnicodeDecodeError) as exc:
-            msg = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
-            raise FileFormatError(f"{path}: not a readable CSV file ({msg})") from None
-        names = [str(c).strip() for c in head.columns]
-    meta = {**meta, **load_sidecar(path)}
-    return names, meta, n_rows
-
-
-def _station_info(path: Path) -> tuple[list[str], dict[str, Any], int | None]:
-    """Columns, metadata (the last closed part's, as :func:`read_station` reads it) and row
-    count of a station recording ``DIR/SENSOR`` (its closed Parquet parts, in order)."""
-    files = station_files(path)
-    names: list[str] | None = None
-    n_rows, meta = 0, {}
-    for f in files:
-        try:
-            pf = pq.ParquetFile(f)
-        except (pa.ArrowInvalid, OSError) as exc:
-            raise FileFormatError(f"{f}: not a readable Parquet part ({exc})") from None
-        these = list(pf.schema_arrow.names)
-        if names is not None and these != names:
-            raise FileFormatError(f"{f}: columns {these} differ from the first part's {names}")
-        names = these
-        n_rows += int(pf.metadata.num_rows)
-        meta = thermocal_metadata(pf.schema_arrow.metadata, f)
-    return names or [], meta, n_rows
-
-
-def _input_kind(src: Path, topic: str | None) -> tuple[Path, str, str | None]:
-    """``(path, kind, topic)`` of an input: a station recording folder (``DIR``, ``DIR/ID``,
-    or ``DIR`` with ``--sensor ID``) is read part after part as kind ``"station"`` (its path
-    ``DIR/ID``; INTERFACE.md: every command reads DIR as one recording); any other file by
-    its extension, with ``topic`` for a flight-controller log."""
-    if is_station_path(src):
-        return with_sensor(src, topic), "station", None
-    return src, file_kind(src), topic
-
-
-def _iter_chunks(
-    path: Path, kind: str, chunk_rows: int, table: pd.DataFrame | None = None
-) -> Iterator[pd.DataFrame | pa.RecordBatch]:
-    """Chunks of the file; a read or parse failure mid-file is a :class:`FileFormatError`
-    naming the file (Parquet pages are checked against their checksums).  ``table``: a
-    text log read whole (text options), sliced."""
-    if table is not None:
-        for a in range(0, len(table), chunk_rows):
-            yield table.iloc[a : a + chunk_rows].reset_index(drop=True)
-        return
-    if kind == "station":  # the closed parts in order, each in chunks (constant memory)
-        for f in station_files(path):
-            yield from _iter_chunks(f, "parquet", chunk_rows)
-        return
-    if kind == "parquet":
-        try:
-            # a buffered stream without pre-buffering: with the defaults the reader's
-            # allocations grow with the file (≈ 20 B/row); this way they stay at ≈ 1 MB
-            pf = pq.ParquetFile(
-                path, page_checksum_verification=True, buffer_size=1 << 20, pre_buffer=False
-            )
-            yield from pf.iter_batches(batch_size=chunk_rows)
-        except (pa.ArrowInvalid, OSError) as exc:
-            raise FileFormatError(f"{path}: not a readable Parquet file ({exc})") from None
-    else:
-        enc = csv_encoding(path)
-        with warnings.catch_warnings():  # _file_info stated the layout already
-            warnings.simplefilter("ignore", TextLayoutWarning)
-            opts = csv_chunk_options(path, enc)
-        reader = pd.read_csv(
-            path,
-            chunksize=chunk_rows,
-            skipinitialspace=True,
-            low_memory=False,
-            encoding=enc,
-            **csv_float_options(),
-            **opts,
+def _source_format(path: str | Path, read: ReadOptions) -> tuple[Path, FileFormat, ReadOptions]:
+    """The input of a chunked pass, its registered format and how to read it: a format that
+    cannot be read in chunks is refused naming the file, its format and what to do; a
+    station folder's sensor (``DIR`` with ``--sensor ID``) is read as ``DIR/ID``."""
+    src = Path(path)
+    fmt = format_of(src)
+    if fmt.chunks == "none":
+        raise FileFormatError(
+            f"{src}: {fmt.title} ({fmt.name} format) cannot be read in chunks, which "
+            "compensate needs; write it as CSV or Parquet first (thermocal.read_recording, "
+            "then thermocal.write_recording)"
         )
-        try:
-            with reader, _ctrl_c_noted() as ctrl_c:
-                for df in reader:
-                    df.columns = [str(c).strip() for c in df.columns]
-                    yield df
-        except (pd.errors.ParserError, UnicodeDecodeError) as exc:
-            if ctrl_c.seen:  # Ctrl-C inside pandas' read: the C parser reports a read failure
-                raise KeyboardInterrupt from None
-            msg = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
-            raise FileFormatError(f"{path}: not a readable CSV file ({msg})") from None
+    if fmt.locate is not None:
+        return fmt.locate(src, read.topic), fmt, read.replace(topic=None)
+    if read.topic is not None and "topic" not in fmt.options:
+        raise ThermocalInputError(f"{src}: --topic is for flight-controller logs (.ulg, .bin)")
+    return src, fmt, read
+
+
+def _slices(table: pd.DataFrame, chunk_rows: int) -> Iterator[pd.DataFrame]:
+    """A table read whole, ``chunk_rows`` rows at a time."""
+    for a in range(0, len(table), chunk_rows):
+        yield table.iloc[a : a + chunk_rows].reset_index(drop=True)
 
 
 def _check_plausible(
@@ -492,21 +338,15 @@ def compensate_file(
     model: TemperatureModel,
     path: str | Path,
     out: str | Path,
+    read: ReadOptions | None = None,
     *,
     signal: str | None = None,
-    time: str | None = None,
-    time_unit: str | None = None,
-    signal_unit: str | None = None,
-    temp_unit: str | None = None,
     chunk_rows: int = DEFAULT_CHUNK_ROWS,
     extrapolate: bool = False,
     known_input: float = 0.0,
     on_progress: Callable[[int], None] | None = None,
-    temperature_conversion: units.TemperatureConversion | tuple[float, float] | None = None,
-    text: TextOptions | None = None,
-    topic: str | None = None,
 ) -> CompensateFileResult:
-    """Compensate a CSV/Parquet file into ``out`` with constant memory.
+    """Compensate a recording file into ``out`` with constant memory.
 
     ``out`` keeps every input column and adds ``<signal>_model`` (ŷ) and
     ``<signal>_comp`` (``F − ŷ``), both in the data column's unit.  The signal
@@ -520,13 +360,16 @@ def compensate_file(
 
     Chunks are predicted with their context (:class:`ChunkPredictor`), so the
     result equals an in-memory ``predict`` of the whole file.  ``known_input``
-    [model unit] is what :class:`StreamingCompensator` says.  ``temperature_conversion``
-    ``(gain, offset[, "int16"])`` converts raw-count temperatures
-    (``T = gain·counts + offset``), overriding the file's metadata.
-    One channel of :func:`compensate_channels`.
+    [model unit] is what :class:`StreamingCompensator` says.  ``read``
+    (:class:`~thermocal.readers.options.ReadOptions`) says how the file is read: its time
+    column and units, ``temp_conversion`` ``(gain, offset[, "int16"])`` for raw-count
+    temperatures (``T = gain·counts + offset``, over the file's metadata), a log's topic, a
+    text log's layout.  One channel of :func:`compensate_channels`.
 
     Raises
     ------
+    FileFormatError : no registered format reads the file, or its format cannot be read in
+        chunks.
     MissingColumnError : the signal, time or a model temperature column is absent
         (the missing and the available columns are named).
     UnitError : the model's and the data's signal units differ in kind; temperatures in
@@ -538,18 +381,12 @@ def compensate_file(
         [(sig, model)],
         path,
         out,
-        time=time,
-        time_unit=time_unit,
-        signal_unit=signal_unit,
-        temp_unit=temp_unit,
+        read,
         chunk_rows=chunk_rows,
         extrapolate=extrapolate,
         known_input=known_input,
         on_progress=on_progress,
-        temperature_conversion=temperature_conversion,
         signal_given=signal is not None,
-        text=text,
-        topic=topic,
     )[0]
 
 
@@ -579,28 +416,22 @@ def compensate_channels(
     channels: Sequence[tuple[str, TemperatureModel]],
     path: str | Path,
     out: str | Path,
+    read: ReadOptions | None = None,
     *,
-    time: str | None = None,
-    time_unit: str | None = None,
-    signal_unit: str | None = None,
-    temp_unit: str | None = None,
     chunk_rows: int = DEFAULT_CHUNK_ROWS,
     extrapolate: bool = False,
     known_input: float = 0.0,
     on_progress: Callable[[int], None] | None = None,
-    temperature_conversion: units.TemperatureConversion | tuple[float, float] | None = None,
     signal_given: bool = True,
-    text: TextOptions | None = None,
-    topic: str | None = None,
 ) -> list[CompensateFileResult]:
     """Compensate several channels ``(signal column, model)`` of one file in one chunked
-    pass with constant memory (issue 15): every chunk is read once, its time checked
+    pass with constant memory: every chunk is read once, its time checked
     once, each distinct temperature input converted once, and every channel adds its
     ``<signal>_model`` and ``<signal>_comp`` in its own data column's unit (see
-    :func:`compensate_file` for the rules of one channel). ``signal_unit`` is one unit
+    :func:`compensate_file` for the rules of one channel). ``read.signal_unit`` is one unit
     for all or one per channel (``"deg/s,deg/s,deg/s,mg,mg,mg"``).
     """
-    src, kind_in, topic = _input_kind(Path(path), topic)
+    src, fmt, r = _source_format(path, read or ReadOptions())
     dst = Path(out)
     kind_out = file_kind(dst)
     check_not_input(dst, [src])
@@ -610,16 +441,13 @@ def compensate_channels(
     sig_list = [c for c, _m in channels]
     if len(set(sig_list)) != len(sig_list):
         raise ThermocalInputError(f"a signal column appears twice: {sig_list}")
-    source = _open_source(src, kind_in, time, text, topic)
-    sig_opts = units.per_signal_option(signal_unit, sig_list)
-    conv_opt = (
-        units.temperature_conversion(temperature_conversion, "--temp-conversion")
-        if temperature_conversion is not None
-        else None
-    )
+    source = _open_source(src, fmt, r)
+    sig_opts = units.per_signal_option(r.signal_unit, sig_list)
     ctx = _FileContext(src, source.names, source.info, source.time_col, source.available,
                        signal_given)  # fmt: skip
-    opts = units.UnitOptions(time_unit=time_unit, temp_unit=temp_unit, temp_conversion=conv_opt)
+    opts = units.UnitOptions(
+        time_unit=r.time_unit, temp_unit=r.temp_unit, temp_conversion=r.temp_conversion
+    )
     plans = [
         _channel_plan(ctx, sig_name, model, sig_opts[sig_name], opts,
                       extrapolate=extrapolate, known_input=known_input,
@@ -654,12 +482,12 @@ def _check_chunk_rows(chunk_rows: int) -> None:
 
 @dataclass(frozen=True)
 class _Source:
-    """The input of a chunked pass: its path and kind, its columns and metadata, the table
-    of a log read whole (ULog, DataFlash, a text log with options; None: read in chunks)
-    and the time column, checked present."""
+    """The input of a chunked pass: its path and format, its columns and metadata, the table
+    of a file read whole (a log, a plugin's format, a text log with layout options; None:
+    read a chunk at a time) and the time column, checked present."""
 
     src: Path
-    kind: str
+    fmt: FileFormat
     names: list[str]
     info: dict[str, Any]
     table: pd.DataFrame | None
@@ -668,22 +496,37 @@ class _Source:
 
     def chunks(self, chunk_rows: int) -> Iterator[pd.DataFrame | pa.RecordBatch]:
         """The file's rows, ``chunk_rows`` at a time."""
-        return _iter_chunks(self.src, self.kind, chunk_rows, self.table)
+        if self.table is not None:
+            return _slices(self.table, chunk_rows)
+        assert self.fmt.stream is not None
+        return self.fmt.stream(self.src, chunk_rows)
 
 
-def _open_source(
-    src: Path, kind_in: str, time: str | None, text: TextOptions | None, topic: str | None
-) -> _Source:
-    """The input's columns and metadata (flight-controller logs and text logs with options
-    read whole first) and its time column (``time``, else the metadata's or the default);
-    :class:`MissingColumnError` naming the available columns when it is absent."""
-    text_table: pd.DataFrame | None = None
-    text_info: dict[str, Any] | None = None
-    if kind_in in ("ulog", "dataflash"):  # flight-controller logs: read whole, then chunked
-        text_table, text_info = read_log_table(src, topic)
-    elif text is not None:
-        text_table, text_info = read_text_table(src, text, time)
-    names, info, _ = _file_info(src, kind_in, text_table, text_info)
+def _head(src: Path, fmt: FileFormat) -> tuple[list[str], dict[str, Any]]:
+    """Column names and metadata (sidecar over the file's) of a format read a chunk at a
+    time, without reading its rows; a missing, special or empty file is refused."""
+    if fmt.sniff is None or not fmt.sniff(src):
+        if not src.exists():
+            raise FileFormatError(f"{src}: no such file")
+        refuse_special_input(src)
+        if src.stat().st_size == 0:
+            raise FileFormatError(f"{src}: the file is empty")
+    assert fmt.head is not None
+    names, meta, _n_rows = fmt.head(src)
+    return names, {**meta, **load_sidecar(src)}
+
+
+def _open_source(src: Path, fmt: FileFormat, read: ReadOptions) -> _Source:
+    """The input's columns and metadata (a format read whole, or a text log with layout
+    options, read first) and its time column (``read.time``, else the metadata's or the
+    default); :class:`MissingColumnError` naming the available columns when it is absent."""
+    table: pd.DataFrame | None = None
+    if fmt.chunks == "whole" or read.text_layout_given:
+        table, info = read_whole_table(src, read)
+        names = [str(c) for c in table.columns]
+    else:
+        names, info = _head(src, fmt)
+    time = read.time
     time_col = time or default_time_column(names, info.get("time"))
     available = names_list(names)  # the first 20 and how many more (10 000 columns: one line)
     if time_col not in names:
@@ -692,7 +535,7 @@ def _open_source(
             f"{src}: no time column {time_col!r}; available: {available}"
             + (hint if time is None else "")
         )
-    return _Source(src, kind_in, names, info, text_table, time_col, available)
+    return _Source(src, fmt, names, info, table, time_col, available)
 
 
 @dataclass
@@ -1048,27 +891,15 @@ def _evaluation_groups(plans: Sequence[_ChannelPlan]) -> list[list[_ChannelPlan]
 
 __all__ = [
     "COMP_SUFFIX",
-    "DEFAULT_CHUNK_ROWS",
     "MODEL_SUFFIX",
     "CalibrationCompensation",
-    "CalibrationStream",
-    "ChunkContext",
-    "ChunkPredictor",
     "CompensateFileResult",
-    "Compensation",
-    "ModelRun",
-    "StreamingCompensator",
-    "check_signal_kind",
-    "chunk_context",
+    "TriadCompensation",
     "compensate_calibration_file",
     "compensate_channels",
     "compensate_file",
-    "compensate_run",
-    "model_scale_factor",
-    "prepare_run",
-    "temperature_inputs",
-    "unit_factor",
-    "zero_reference",
+    "compensate_triads",
+    "read_for_triads",
 ]
 
 
@@ -1094,59 +925,56 @@ class TriadCompensation:
 def read_for_triads(
     path: str | Path,
     triads: Sequence[Any],
-    *,
-    time: str | None = None,
-    time_unit: str | None = None,
-    text: TextOptions | None = None,
-    topic: str | None = None,
+    read: ReadOptions | None = None,
 ) -> Recording:
     """A recording read for triad calibrations: their temperature columns as temperatures,
     so that their units go through the resolver (option > metadata > column name); the
-    triads' own columns keep the unit their metadata or name states.  ``text`` and ``topic``:
-    the text-log options and log topic every command reads a recording with."""
+    triads' own columns keep the unit their metadata or name states.  ``read``: how every
+    command reads a recording (its time column and unit, a text log's layout, a topic)."""
     temps = list(dict.fromkeys(t.temperature for t in triads if t.temperature))
+    r = read or ReadOptions()
     return read_recording(
-        path, time=time, time_unit=time_unit, temperatures=temps, text=text, topic=topic
-    )
+        path,
+        ReadOptions(time=r.time, time_unit=r.time_unit, temperatures=tuple(temps), topic=r.topic,
+                    names=r.names, rate_hz=r.rate_hz, on_bad_lines=r.on_bad_lines,
+                    delimiter=r.delimiter, decimal=r.decimal),
+    )  # fmt: skip
 
 
 def compensate_triads(
     triads: Sequence[Any],
     path: str | Path,
     out: str | Path,
+    read: ReadOptions | None = None,
     *,
-    time: str | None = None,
-    time_unit: str | None = None,
     chunk_rows: int = DEFAULT_CHUNK_ROWS,
-    topic: str | None = None,
-    signal_unit: str | None = None,
-    text: TextOptions | None = None,
 ) -> list[TriadCompensation]:
-    """Apply triad calibrations (issue 19) to a recording: for each triad and each of its
+    """Apply triad calibrations to a recording: for each triad and each of its
     axes a column ``<col>_comp = [(I + E(T))⁻¹ (x − b(T))]_axis`` in the column's own unit,
     ``T`` the triad's temperature column at each sample (clamped to the calibrated range,
     with a warning when samples leave it; :func:`thermocal.turntable.thermal.correct`).
-    Raw-count columns of a triad calibrated on counts (``Triad.count_scale``, issue 30) are
+    Raw-count columns of a triad calibrated on counts (``Triad.count_scale``) are
     converted first, ``x = count_scale · N``, and their ``_comp`` columns are in the
     triad's physical unit; raw counts for a triad without a count scale are refused.
-    ``signal_unit`` (``--signal-unit``): one unit for every triad column, or one per column
-    in the triads' order; ``text`` the text-log options (``--rate`` for a log without time).
+    ``read.signal_unit``: one unit for every triad column, or one per column in the triads'
+    order; ``read`` also carries the time column and unit, a topic and a text log's layout
+    (``rate_hz`` for a log without time).
 
-    In chunks of ``chunk_rows`` rows with constant memory, like :func:`compensate_channels`
-    (issue 26): the correction is per sample, so each chunk's values equal those of a
-    whole-file pass; every input column is kept as it is and the output is written chunk
-    by chunk to a temporary name, renamed when complete.  Units: option > the file's
+    In chunks of ``chunk_rows`` rows with constant memory, like :func:`compensate_channels`:
+    the correction is per sample, so each chunk's values equal those of a whole-file pass;
+    every input column is kept as it is and the output is written chunk by chunk to a
+    temporary name, renamed when complete.  Units: option > the file's
     metadata > a unit in the column name > the unit the triad was calibrated on
     (:func:`thermocal.units.resolve_inputs`).
     """
-    src, kind_in, topic = _input_kind(Path(path), topic)
+    src, fmt, r = _source_format(path, read or ReadOptions())
     dst = Path(out)
     kind_out = file_kind(dst)
     check_not_input(dst, [src])
     _check_chunk_rows(chunk_rows)
-    source = _open_source(src, kind_in, time, text, topic)
+    source = _open_source(src, fmt, r)
     plans = [_triad_plan(tri, source.names, source.available, src) for tri in triads]
-    resolved = _resolve_triads(source, plans, time_unit, signal_unit)
+    resolved = _resolve_triads(source, plans, r.time_unit, r.signal_unit)
     out_info = _triad_output_info(source.info, source.time_col, resolved, plans)
     warn_formula_names(dst, source.names)
     state = _PassState()
@@ -1382,7 +1210,7 @@ class CalibrationCompensation:
     """``(channel name, model family, result)``; one entry for ``single``."""
 
     def to_dict(self) -> dict[str, Any]:
-        """The ``thermocal compensate --json`` object (INTERFACE.md)."""
+        """The ``thermocal compensate --json`` object."""
         if self.kind == "triads":
             return {"model": self.model_file, "output": self.output,
                     "triads": [d.to_dict() for d in self.triads]}  # fmt: skip
@@ -1407,19 +1235,13 @@ def compensate_calibration_file(
     model_file: str | Path,
     path: str | Path,
     out: str | Path,
+    read: ReadOptions | None = None,
     *,
     signal: str | None = None,
-    time: str | None = None,
-    time_unit: str | None = None,
-    signal_unit: str | None = None,
-    temp_unit: str | None = None,
-    temp_conversion: str | None = None,
     chunk_rows: int = DEFAULT_CHUNK_ROWS,
     extrapolate: bool = False,
     known_input: float = 0.0,
     on_progress: Callable[[int], None] | None = None,
-    text: TextOptions | None = None,
-    topic: str | None = None,
 ) -> CalibrationCompensation:
     """``thermocal compensate``: apply a model or calibration file to a recording.
 
@@ -1427,8 +1249,8 @@ def compensate_calibration_file(
     triads is applied by :func:`compensate_triads`; one channel (a model file) by
     :func:`compensate_file` (``signal``: its column, default the model's); several
     channels (those named in ``signal``, ``"gx,gy"``, default all) in one pass by
-    :func:`compensate_channels`.  ``temp_conversion`` is ``"GAIN,OFFSET[,int16]"``
-    (:func:`thermocal.units.temperature_conversion`).  A calibration with both triads and
+    :func:`compensate_channels`.  ``read`` says how the recording is read
+    (:class:`~thermocal.readers.options.ReadOptions`).  A calibration with both triads and
     channels is refused (:class:`ThermocalInputError`).
     """
     from thermocal.models.files import load_calibration
@@ -1437,36 +1259,27 @@ def compensate_calibration_file(
     if file_kind(Path(out)) == "csv":  # the CSV's sidecar must not land on an input either
         check_not_input(sidecar_path(out), [path, model_file])
     cal = load_calibration(model_file)  # a model file is a calibration of one channel
-    conv = (
-        units.temperature_conversion(temp_conversion, "--temp-conversion")
-        if temp_conversion is not None
-        else None
-    )
     if cal.triads:
         if cal.channels:
             raise ThermocalInputError(
                 f"{model_file}: a calibration with both triads and single channels is not "
                 "applied yet; split it"
             )
-        done = compensate_triads(
-            cal.triads, path, out, time=time, time_unit=time_unit, chunk_rows=chunk_rows,
-            topic=topic, signal_unit=signal_unit, text=text,
-        )  # fmt: skip
+        done = compensate_triads(cal.triads, path, out, read, chunk_rows=chunk_rows)
         return CalibrationCompensation(str(model_file), str(out), "triads", tuple(done))
     common: dict[str, Any] = dict(
-        time=time, time_unit=time_unit, signal_unit=signal_unit, temp_unit=temp_unit,
-        temperature_conversion=conv, chunk_rows=chunk_rows, extrapolate=extrapolate,
-        known_input=known_input, on_progress=on_progress, text=text, topic=topic,
+        chunk_rows=chunk_rows, extrapolate=extrapolate, known_input=known_input,
+        on_progress=on_progress,
     )  # fmt: skip
     if len(cal.channels) == 1:
         ch = cal.channels[0]
-        res = compensate_file(ch.model, path, out, signal=signal, **common)
+        res = compensate_file(ch.model, path, out, read, signal=signal, **common)
         return CalibrationCompensation(
             str(model_file), str(out), "single", channels=((ch.name, ch.model.family, res),)
         )
     chosen = _split_names(signal) or cal.names
     models = [(cal.channel(n).signal, cal.channel(n).model) for n in chosen]
-    results = compensate_channels(models, path, out, **common)
+    results = compensate_channels(models, path, out, read, **common)
     return CalibrationCompensation(
         str(model_file),
         str(out),
