@@ -3247,6 +3247,14 @@ MUTANTS: tuple[Mutant, ...] = (
         ("tests/readers/test_format_plugin.py",),
         "a plugin's format (read whole) streamed as if it had chunk readers",
     ),
+    Mutant(
+        "writers-read-only-format-written-as-csv",
+        P + "writers.py",
+        "    if kind not in RECORDING_WRITERS:",
+        "    if False:",
+        ("tests/readers/test_readers_writers_registry.py",),
+        "a recording written as CSV under a .ulg or .bin name",
+    ),
 )
 
 

@@ -91,7 +91,7 @@ from thermocal.recording import (
     Recording,
     median_interval,
 )
-from thermocal.writers import atomic_write_path, check_not_input, write_json
+from thermocal.writers import atomic_write_path, check_not_input, write_json, written_format
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -433,7 +433,7 @@ def compensate_channels(
     """
     src, fmt, r = _source_format(path, read or ReadOptions())
     dst = Path(out)
-    kind_out = file_kind(dst)
+    kind_out = written_format(dst)
     check_not_input(dst, [src])
     _check_chunk_rows(chunk_rows)
     if not channels:
@@ -969,7 +969,7 @@ def compensate_triads(
     """
     src, fmt, r = _source_format(path, read or ReadOptions())
     dst = Path(out)
-    kind_out = file_kind(dst)
+    kind_out = written_format(dst)
     check_not_input(dst, [src])
     _check_chunk_rows(chunk_rows)
     source = _open_source(src, fmt, r)
