@@ -282,56 +282,76 @@ def _append_columns(
     return out
 
 
-class _Writer:
-    """Writes chunks to a CSV or Parquet file (format by extension of the output)."""
+class _ParquetChunks:
+    """Writes chunks to a Parquet file, the metadata in its key-value store."""
 
-    def __init__(self, tmp: Path, kind: str, info: dict[str, Any]) -> None:
+    sidecar = False
+    """Whether the output's metadata also goes to a ``FILE.meta.json`` sidecar."""
+
+    def __init__(self, tmp: Path, info: dict[str, Any]) -> None:
         self.tmp = tmp
-        self.kind = kind
         self.info = info
         self._pq: pq.ParquetWriter | None = None
         self._schema: pa.Schema | None = None
-        self._fh: Any = None
-        self._first = True
 
     def write(self, chunk: pd.DataFrame | pa.RecordBatch) -> None:
-        if self.kind == "parquet":
-            if isinstance(chunk, pd.DataFrame):
-                df = chunk.copy()
-                for c in df.columns:
-                    dtype = df[c].dtype
-                    if pd.api.types.is_bool_dtype(dtype):
-                        continue
-                    if pd.api.types.is_numeric_dtype(dtype):
-                        df[c] = df[c].astype(np.float64)
-                    else:
-                        df[c] = df[c].astype("string")
-                table = pa.Table.from_pandas(df, preserve_index=False)
-            else:
-                table = pa.Table.from_batches([chunk])
-            if self._pq is None:
-                meta = dict(table.schema.metadata or {})
-                meta.pop(b"pandas", None)
-                meta[META_KEY.encode()] = json.dumps(self.info).encode("utf-8")
-                self._schema = table.schema.with_metadata(meta)
-                # dictionary encoding of float columns costs 3x the write time and rarely
-                # shrinks measured data; keep it for the others (ids, counts, text)
-                dict_cols = [f.name for f in self._schema if not pa.types.is_floating(f.type)]
-                self._pq = pq.ParquetWriter(self.tmp, self._schema, use_dictionary=dict_cols)
-            assert self._schema is not None
-            self._pq.write_table(table.cast(self._schema))
+        if isinstance(chunk, pd.DataFrame):
+            df = chunk.copy()
+            for c in df.columns:
+                dtype = df[c].dtype
+                if pd.api.types.is_bool_dtype(dtype):
+                    continue
+                if pd.api.types.is_numeric_dtype(dtype):
+                    df[c] = df[c].astype(np.float64)
+                else:
+                    df[c] = df[c].astype("string")
+            table = pa.Table.from_pandas(df, preserve_index=False)
         else:
-            df = chunk.to_pandas() if isinstance(chunk, pa.RecordBatch) else chunk
-            if self._fh is None:
-                self._fh = open(self.tmp, "w", encoding="utf-8", newline="")  # noqa: SIM115
-            df.to_csv(self._fh, index=False, header=self._first, lineterminator="\n")
-            self._first = False
+            table = pa.Table.from_batches([chunk])
+        if self._pq is None:
+            meta = dict(table.schema.metadata or {})
+            meta.pop(b"pandas", None)
+            meta[META_KEY.encode()] = json.dumps(self.info).encode("utf-8")
+            self._schema = table.schema.with_metadata(meta)
+            # dictionary encoding of float columns costs 3x the write time and rarely
+            # shrinks measured data; keep it for the others (ids, counts, text)
+            dict_cols = [f.name for f in self._schema if not pa.types.is_floating(f.type)]
+            self._pq = pq.ParquetWriter(self.tmp, self._schema, use_dictionary=dict_cols)
+        assert self._schema is not None
+        self._pq.write_table(table.cast(self._schema))
 
     def close(self) -> None:
         if self._pq is not None:
             self._pq.close()
+
+
+class _CsvChunks:
+    """Writes chunks to a CSV file (its metadata goes to the sidecar)."""
+
+    sidecar = True
+
+    def __init__(self, tmp: Path, info: dict[str, Any]) -> None:
+        self.tmp = tmp
+        self._fh: Any = None
+        self._first = True
+
+    def write(self, chunk: pd.DataFrame | pa.RecordBatch) -> None:
+        df = chunk.to_pandas() if isinstance(chunk, pa.RecordBatch) else chunk
+        if self._fh is None:
+            self._fh = open(self.tmp, "w", encoding="utf-8", newline="")  # noqa: SIM115
+        df.to_csv(self._fh, index=False, header=self._first, lineterminator="\n")
+        self._first = False
+
+    def close(self) -> None:
         if self._fh is not None:
             self._fh.close()
+
+
+_CHUNK_WRITERS: dict[str, type[_ParquetChunks] | type[_CsvChunks]] = {
+    "parquet": _ParquetChunks,
+    "csv": _CsvChunks,
+}
+"""The chunked writer of each output format :func:`thermocal.writers.written_format` names."""
 
 
 def compensate_file(
@@ -467,7 +487,7 @@ def compensate_channels(
     run = _ChannelPass(source, plans, _evaluation_groups(plans), units.TIME_UNITS[t_unit],
                        chunk_rows, on_progress, state)  # fmt: skip
     atomic_write_path(dst, lambda tmp: run.write(tmp, kind_out, out_info))
-    if kind_out == "csv":
+    if _CHUNK_WRITERS[kind_out].sidecar:
         write_json(sidecar_path(dst), out_info)
     for plan in plans:
         plan.predictor.finish()
@@ -575,7 +595,7 @@ class _ChannelPass:
         a second thread while this one is computed (pyarrow and numpy release the GIL);
         one chunk in flight, errors re-raised here."""
         src, state = self.source.src, self.state
-        w = _Writer(tmp, kind_out, out_info)
+        w = _CHUNK_WRITERS[kind_out](tmp, out_info)
         pool = ThreadPoolExecutor(max_workers=1, thread_name_prefix="thermocal-write")
         pending: Future[None] | None = None
         try:
@@ -982,7 +1002,7 @@ def compensate_triads(
         dst, lambda tmp: _write_triads(tmp, source, kind_out, out_info, plans, resolved,
                                        chunk_rows, state)
     )  # fmt: skip
-    if kind_out == "csv":
+    if _CHUNK_WRITERS[kind_out].sidecar:
         write_json(sidecar_path(dst), out_info)
     results = []
     for p in plans:
@@ -1058,7 +1078,7 @@ def _write_triads(
     src = source.src
     t_factor = units.TIME_UNITS[resolved.time.unit]
     temp_names = _triad_temperatures(plans)
-    w = _Writer(tmp, kind_out, out_info)
+    w = _CHUNK_WRITERS[kind_out](tmp, out_info)
     try:
         for chunk in source.chunks(chunk_rows):
             row0 = state.rows
