@@ -363,9 +363,27 @@ def write_recording(
 
 
 def write_program(path: str | Path, time_s: npt.ArrayLike, setpoint_c: npt.ArrayLike) -> Path:
-    """Write a chamber program CSV with columns ``time_s, setpoint_c`` (atomic; checked by
-    :func:`thermocal.profiles.check_program`; read back by
-    :func:`thermocal.readers.program.read_program`)."""
+    """Write a chamber program CSV with columns ``time_s, setpoint_c``, atomically.
+
+    Parameters
+    ----------
+    path : str or Path
+        The output, ``*.csv``.
+    time_s : array_like
+        Times [s], increasing.
+    setpoint_c : array_like
+        Set-points [°C], one per time.
+
+    Returns
+    -------
+    Path
+        The file written (read back by :func:`thermocal.readers.program.read_program`).
+
+    Raises
+    ------
+    thermocal.errors.ThermocalInputError
+        Not a ``.csv`` name, or a program :func:`thermocal.profiles.check_program` refuses.
+    """
     from thermocal.profiles import check_program
 
     t = np.asarray(time_s, dtype=np.float64)

@@ -369,32 +369,75 @@ def compensate_file(
     """Compensate a recording file into ``out`` with constant memory.
 
     ``out`` keeps every input column and adds ``<signal>_model`` (ŷ) and
-    ``<signal>_comp`` (``F − ŷ``), both in the data column's unit.  The signal
-    column is the model's ``signal_name`` unless ``signal`` is given; the
-    temperature columns are the model's.  Units and temperature conversions are resolved
-    once (:func:`thermocal.units.resolve_inputs`): options, then the file's sidecar or
-    Parquet metadata, the unit in the column name, what the model file recorded of its
-    inputs (:meth:`TemperatureModel.input_units`), else a default stated in a warning.
-    The output is written to a temporary name and renamed when complete
-    (:func:`thermocal.writers.atomic_write_path`); ``out`` may not be ``path``.
+    ``<signal>_comp`` (``F − ŷ``), both in the data column's unit.  One channel of
+    :func:`compensate_channels`.
 
-    Chunks are predicted with their context (:class:`ChunkPredictor`), so the
-    result equals an in-memory ``predict`` of the whole file.  ``known_input``
-    [model unit] is what :class:`StreamingCompensator` says.  ``read``
-    (:class:`~thermocal.readers.options.ReadOptions`) says how the file is read: its time
-    column and units, ``temp_conversion`` ``(gain, offset[, "int16"])`` for raw-count
-    temperatures (``T = gain·counts + offset``, over the file's metadata), a log's topic, a
-    text log's layout.  One channel of :func:`compensate_channels`.
+    Parameters
+    ----------
+    model : TemperatureModel
+        A fitted model; its temperature columns are read from the file.
+    path : str or Path
+        The recording, in any registered format that can be read in chunks
+        (:mod:`thermocal.readers.formats`).
+    out : str or Path
+        The output, CSV (with its ``FILE.meta.json`` sidecar) or Parquet; written to a
+        temporary name and renamed when complete.  It may not be ``path``.
+    read : ReadOptions, optional
+        How the file is read (:class:`~thermocal.readers.options.ReadOptions`): time column
+        and units, ``temp_conversion`` for raw-count temperatures (over the file's
+        metadata), a log's topic, a text log's layout.
+    signal : str, optional
+        The signal column (default: the model's ``signal_name``).
+    chunk_rows : int
+        Rows read and written at a time (at least 2).
+    extrapolate : bool
+        Allow temperatures outside the fitted range (a warning instead of an error).
+    known_input : float
+        Known input [model unit] (earth rate, a gravity component) removed from what the
+        model sees (a bank's start-up selection).
+    on_progress : callable, optional
+        Called with the number of rows done after each chunk.
+
+    Returns
+    -------
+    CompensateFileResult
+        Rows, chunks, the added columns and their unit, and the figures before and after
+        (rms about the mean, mean, rms and largest error about the ideal output).
 
     Raises
     ------
-    FileFormatError : no registered format reads the file, or its format cannot be read in
-        chunks.
-    MissingColumnError : the signal, time or a model temperature column is absent
-        (the missing and the available columns are named).
-    UnitError : the model's and the data's signal units differ in kind; temperatures in
-        raw counts without a conversion for a °C model, or in °C for a counts model.
-    TimestampError, MissingValueError : time not increasing, NaN in a used column.
+    thermocal.errors.FileFormatError
+        No registered format reads the file, or its format cannot be read in chunks.
+    thermocal.errors.MissingColumnError
+        The signal, time or a model temperature column is absent (the missing and the
+        available columns are named).
+    thermocal.errors.UnitError
+        The model's and the data's signal units differ in kind; temperatures in raw counts
+        without a conversion for a °C model, or in °C for a counts model.
+    thermocal.errors.TimestampError
+        Time not increasing.
+    thermocal.errors.MissingValueError
+        NaN in a used column.
+
+    Notes
+    -----
+    The model gives the temperature-induced part of the output, the compensated output is
+
+    .. math:: F'_k = F_k - \\hat y(T_k, \\dot T_k, \\ldots)
+
+    Units and temperature conversions are resolved once
+    (:func:`thermocal.units.resolve_inputs`): ``read``, then the file's sidecar or Parquet
+    metadata, the unit in the column name, what the model file recorded of its inputs
+    (:meth:`TemperatureModel.input_units`), else a default stated in a warning.  Chunks
+    are predicted with their context (:class:`~thermocal.compensate.kernels.ChunkPredictor`:
+    the samples since power-on and the last Δt seconds of the rate buffer), so the result
+    equals an in-memory ``predict`` of the whole file.
+
+    References
+    ----------
+    *A modelling and validation method for the temperature compensation model of a
+    ring-laser gyroscope*, Chinese invention patent, published 2017 (the compensated output
+    :math:`F' = F - \\hat y`); the References of ``docs/methods.md``.
     """
     sig = signal or model.signal_name
     return compensate_channels(
@@ -444,12 +487,36 @@ def compensate_channels(
     on_progress: Callable[[int], None] | None = None,
     signal_given: bool = True,
 ) -> list[CompensateFileResult]:
-    """Compensate several channels ``(signal column, model)`` of one file in one chunked
-    pass with constant memory: every chunk is read once, its time checked
-    once, each distinct temperature input converted once, and every channel adds its
-    ``<signal>_model`` and ``<signal>_comp`` in its own data column's unit (see
-    :func:`compensate_file` for the rules of one channel). ``read.signal_unit`` is one unit
-    for all or one per channel (``"deg/s,deg/s,deg/s,mg,mg,mg"``).
+    """Compensate several channels of one file in one chunked pass with constant memory.
+
+    Every chunk is read once, its time checked once, each distinct temperature input
+    converted once, and every channel adds its ``<signal>_model`` and ``<signal>_comp`` in
+    its own data column's unit (:func:`compensate_file` gives the rules of one channel).
+
+    Parameters
+    ----------
+    channels : sequence of (str, TemperatureModel)
+        ``(signal column, fitted model)`` pairs, each column once.
+    path, out : str or Path
+        The recording and the output (as :func:`compensate_file`).
+    read : ReadOptions, optional
+        How the file is read; ``read.signal_unit`` is one unit for all channels or one per
+        channel (``"deg/s,deg/s,deg/s,mg,mg,mg"``).
+    chunk_rows, extrapolate, known_input, on_progress
+        As :func:`compensate_file`.
+    signal_given : bool
+        Whether the signal columns were named by the user (a missing one is then said as
+        theirs, not the model's).
+
+    Returns
+    -------
+    list of CompensateFileResult
+        One per channel, in ``channels``' order.
+
+    Raises
+    ------
+    thermocal.errors.ThermocalInputError
+        No channel, a column twice, or any error of :func:`compensate_file`.
     """
     src, fmt, r = _source_format(path, read or ReadOptions())
     dst = Path(out)
@@ -947,10 +1014,24 @@ def read_for_triads(
     triads: Sequence[Any],
     read: ReadOptions | None = None,
 ) -> Recording:
-    """A recording read for triad calibrations: their temperature columns as temperatures,
-    so that their units go through the resolver (option > metadata > column name); the
-    triads' own columns keep the unit their metadata or name states.  ``read``: how every
-    command reads a recording (its time column and unit, a text log's layout, a topic)."""
+    """A recording read for triad calibrations.
+
+    Parameters
+    ----------
+    path : str or Path
+        The recording.
+    triads : sequence of Triad
+        The calibration's triads; their temperature columns are read as temperatures, so
+        that their units go through the resolver (option > metadata > column name); the
+        triads' own columns keep the unit their metadata or name states.
+    read : ReadOptions, optional
+        How the file is read: its time column and unit, a text log's layout, a topic
+        (its column roles are the triads').
+
+    Returns
+    -------
+    Recording
+    """
     temps = list(dict.fromkeys(t.temperature for t in triads if t.temperature))
     r = read or ReadOptions()
     return read_recording(
@@ -969,10 +1050,42 @@ def compensate_triads(
     *,
     chunk_rows: int = DEFAULT_CHUNK_ROWS,
 ) -> list[TriadCompensation]:
-    """Apply triad calibrations to a recording: for each triad and each of its
-    axes a column ``<col>_comp = [(I + E(T))⁻¹ (x − b(T))]_axis`` in the column's own unit,
-    ``T`` the triad's temperature column at each sample (clamped to the calibrated range,
-    with a warning when samples leave it; :func:`thermocal.turntable.thermal.correct`).
+    """Apply triad calibrations to a recording, in chunks with constant memory.
+
+    Parameters
+    ----------
+    triads : sequence of Triad
+        The calibration's triads.
+    path, out : str or Path
+        The recording and the output (as :func:`compensate_file`).
+    read : ReadOptions, optional
+        How the file is read (see below for ``signal_unit``).
+    chunk_rows : int
+        Rows read and written at a time (at least 2).
+
+    Returns
+    -------
+    list of TriadCompensation
+        One per triad: its columns, the added ones, their unit, the share of samples
+        outside the calibrated temperature range.
+
+    Raises
+    ------
+    thermocal.errors.MissingColumnError
+        A triad's column absent from the file.
+    thermocal.errors.UnitError
+        Raw-count temperatures without a conversion, or raw counts for a triad calibrated
+        without a count scale.
+
+    Notes
+    -----
+    For each triad and each of its axes a column
+
+    .. math:: x^{comp} = \\left[(I + E(T))^{-1} (x - b(T))\\right]_{axis}
+
+    in the column's own unit, ``T`` the triad's temperature column at each sample (clamped
+    to the calibrated range, with a warning when samples leave it;
+    :func:`thermocal.turntable.thermal.correct`).
     Raw-count columns of a triad calibrated on counts (``Triad.count_scale``) are
     converted first, ``x = count_scale · N``, and their ``_comp`` columns are in the
     triad's physical unit; raw counts for a triad without a count scale are refused.
@@ -1263,15 +1376,38 @@ def compensate_calibration_file(
     known_input: float = 0.0,
     on_progress: Callable[[int], None] | None = None,
 ) -> CalibrationCompensation:
-    """``thermocal compensate``: apply a model or calibration file to a recording.
+    """Apply a model or calibration file to a recording (``thermocal compensate``).
 
-    ``out`` may be neither input (nor, for a CSV, may its sidecar).  A calibration of
-    triads is applied by :func:`compensate_triads`; one channel (a model file) by
-    :func:`compensate_file` (``signal``: its column, default the model's); several
-    channels (those named in ``signal``, ``"gx,gy"``, default all) in one pass by
-    :func:`compensate_channels`.  ``read`` says how the recording is read
-    (:class:`~thermocal.readers.options.ReadOptions`).  A calibration with both triads and
-    channels is refused (:class:`ThermocalInputError`).
+    A calibration of triads is applied by :func:`compensate_triads`; one channel (a model
+    file) by :func:`compensate_file`; several channels in one pass by
+    :func:`compensate_channels`.
+
+    Parameters
+    ----------
+    model_file : str or Path
+        A model file or a calibration file.
+    path : str or Path
+        The recording.
+    out : str or Path
+        The output; it may be neither input (nor, for a CSV, may its sidecar).
+    read : ReadOptions, optional
+        How the recording is read (:class:`~thermocal.readers.options.ReadOptions`).
+    signal : str, optional
+        One channel: its column (default the model's); several: the channels to apply,
+        ``"gx,gy"`` (default all).
+    chunk_rows, extrapolate, known_input, on_progress
+        As :func:`compensate_file`.
+
+    Returns
+    -------
+    CalibrationCompensation
+        What was applied (``triads``, ``single`` or ``channels``) and each result.
+
+    Raises
+    ------
+    thermocal.errors.ThermocalInputError
+        A calibration with both triads and channels, an output on an input, or any error
+        of :func:`compensate_file` and :func:`compensate_triads`.
     """
     from thermocal.models.files import load_calibration
 

@@ -102,11 +102,21 @@ def read_options(
 
 
 def read_options_of(o: Any) -> ReadOptions:
-    """The :class:`~thermocal.readers.options.ReadOptions` of a command's options object
-    (``FitOptions``, ``ValidateOptions``): its ``time``, ``time_unit``, ``signal``,
-    ``temps``, ``signal_unit``, ``temp_unit``, ``temp_conversion``, ``topic`` and text-log
-    fields (``names``, ``rate``, ``on_bad_lines``, ``delimiter``, ``decimal``), those it
-    has, through :func:`read_options`."""
+    """The :class:`~thermocal.readers.options.ReadOptions` of a command's options object.
+
+    Parameters
+    ----------
+    o : object
+        ``FitOptions``, ``ValidateOptions`` or any object with (some of) the fields
+        ``time``, ``time_unit``, ``signal``, ``temps``, ``signal_unit``, ``temp_unit``,
+        ``temp_conversion``, ``topic``, ``names``, ``rate``, ``on_bad_lines``,
+        ``delimiter``, ``decimal`` (the options' strings).
+
+    Returns
+    -------
+    ReadOptions
+        As :func:`read_options` builds it from those fields.
+    """
     fields = ("time", "time_unit", "signal", "temps", "signal_unit", "temp_unit",
               "temp_conversion", "topic", "names", "rate", "delimiter", "decimal")  # fmt: skip
     given = {f: getattr(o, f) for f in fields if getattr(o, f, None) is not None}

@@ -410,8 +410,31 @@ DEFAULT_DATAFLASH_TOPIC = "IMU.0"
 
 
 def parse_topic(topic: str | None, default: str = DEFAULT_ULOG_TOPIC) -> tuple[str, int]:
-    """``NAME[.N]`` → (name, instance) of a flight-controller log's topic (a ULog topic or a
-    DataFlash message); ``default`` when ``topic`` is None."""
+    """The name and instance of a flight-controller log's topic.
+
+    Parameters
+    ----------
+    topic : str, optional
+        ``NAME[.N]``: a ULog topic or a DataFlash message and its instance.
+    default : str
+        The topic when ``topic`` is None.
+
+    Returns
+    -------
+    tuple
+        ``(name, instance)``, the instance 0 when none is given.
+
+    Raises
+    ------
+    thermocal.errors.ThermocalInputError
+        Not ``NAME`` or ``NAME.N``.
+
+    Examples
+    --------
+    >>> from thermocal.readers.common import parse_topic
+    >>> parse_topic("sensor_accel.1"), parse_topic(None, "IMU")
+    (('sensor_accel', 1), ('IMU', 0))
+    """
     text = (topic or default).strip()
     name, _, inst = text.partition(".")
     if not name or (inst and not inst.isdigit()):

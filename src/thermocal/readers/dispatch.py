@@ -576,7 +576,22 @@ def _table_recording(
 
 
 def recording_info(rec: Recording, time: str = "time") -> dict[str, Any]:
-    """The metadata object written beside (or into) a recording file."""
+    """The metadata object written beside (or into) a recording file.
+
+    Parameters
+    ----------
+    rec : Recording
+        The recording written.
+    time : str
+        Name of its time column in the file (written in [s]).
+
+    Returns
+    -------
+    dict
+        ``format``, ``version``, ``time``, ``time_unit``, the signal and temperature
+        columns with their units, the other columns' units and the metadata, as a CSV's
+        ``FILE.meta.json`` sidecar or a Parquet file's key-value store holds it.
+    """
     return {
         "format": META_FORMAT,
         "version": META_VERSION,

@@ -30,8 +30,22 @@ else:
 def read_program(path: str | Path) -> tuple[FloatArray, FloatArray]:
     """Read a chamber program CSV (columns ``time_s`` and ``setpoint_c``).
 
-    Raises :class:`FileFormatError`, :class:`MissingColumnError`,
-    :class:`NonNumericError` or :class:`TimestampError` naming the file.
+    Parameters
+    ----------
+    path : str or Path
+        The program, as :func:`thermocal.writers.write_program` writes it.
+
+    Returns
+    -------
+    tuple of ndarray
+        ``(time_s, setpoint_c)``: the times [s] and set-points [°C].
+
+    Raises
+    ------
+    thermocal.errors.FileFormatError, thermocal.errors.MissingColumnError
+        Not a readable CSV, or a column missing (named).
+    thermocal.errors.NonNumericError, thermocal.errors.TimestampError
+        A cell not a number, or times not increasing (file, row and column named).
     """
     p = Path(path)
     if not p.exists():
@@ -67,11 +81,32 @@ def read_history(
     column: str | None = None,
     read: ReadOptions | None = None,
 ) -> tuple[FloatArray, FloatArray, str]:
-    """A temperature history ``(time_s, temperature_c, column)`` from a chamber program CSV
-    (``time_s, setpoint_c``; its set-point unless ``column`` is another of its columns) or a
-    recording (``column``, default its first temperature column, else ``setpoint_c``), read
-    by :func:`thermocal.readers.read_recording` with ``read`` (a text log's layout, a log's
-    topic) as every command reads a recording."""
+    """A temperature history from a chamber program or a recording.
+
+    Parameters
+    ----------
+    path : Path
+        A chamber program CSV (``time_s, setpoint_c``) or a recording in any registered
+        format.
+    column : str, optional
+        The column: a program's set-point unless another of its columns is named; a
+        recording's first temperature column, else ``setpoint_c``.
+    read : ReadOptions, optional
+        How a recording is read (a text log's layout, a log's topic), as every command
+        reads one (:func:`thermocal.readers.read_recording`).
+
+    Returns
+    -------
+    tuple
+        ``(time_s, temperature_c, column)``: times [s], temperatures [°C] and the column.
+
+    Raises
+    ------
+    thermocal.errors.FileFormatError
+        No such file, or one no registered format reads.
+    thermocal.errors.MissingColumnError
+        No temperature column known (the available ones are listed).
+    """
     if not path.exists():
         raise FileFormatError(f"{path}: no such file")
     time_col: str | None = None
