@@ -33,9 +33,10 @@ import pandas as pd
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from bench_fit import make_data
-from thermocal.compensate.files import compensate_channels
 from thermocal.models.base import RunData
 from thermocal.models.poly import PolyModel, fit_shared
+from thermocal.pipeline.compensate import compensate_channels
+from thermocal.readers.options import ReadOptions
 
 NAMES = ("g1", "g2", "g3", "g4", "g5", "g6")
 
@@ -96,8 +97,12 @@ def main(argv: list[str] | None = None) -> int:
             out = Path(tmp) / "out.parquet"
             one = [(NAMES[0], models[0])]
             six = list(zip(NAMES, models, strict=True))
-            f_one = timed(lambda: compensate_channels(one, src, out, signal_unit="deg/h"), 2)
-            f_six = timed(lambda: compensate_channels(six, src, out, signal_unit="deg/h"), 2)
+            f_one = timed(
+                lambda: compensate_channels(one, src, out, ReadOptions(signal_unit="deg/h")), 2
+            )
+            f_six = timed(
+                lambda: compensate_channels(six, src, out, ReadOptions(signal_unit="deg/h")), 2
+            )
             print(f"compensate file, one channel   {f_one:.2f} s")
             print(f"compensate file, six channels  {f_six:.2f} s   ratio {f_six / f_one:.2f} "
                   "(target ≤ 2)")  # fmt: skip

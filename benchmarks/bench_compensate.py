@@ -26,11 +26,12 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from thermocal.compensate.files import StreamingCompensator, compensate_file, compensate_run
+from thermocal.compensate.kernels import StreamingCompensator, compensate_run
 from thermocal.export.c import exercise_inputs, find_compiler, generate_c
 from thermocal.models.base import RunData
 from thermocal.models.files import load_model_dict, save_model
 from thermocal.models.registry import make_model
+from thermocal.pipeline.compensate import compensate_file
 from thermocal.simulate import SCENARIOS
 
 TEMPS = ["T1", "T2", "T3", "T4"]

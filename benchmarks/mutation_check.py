@@ -262,7 +262,7 @@ MUTANTS: tuple[Mutant, ...] = (
     ),
     Mutant(
         "compensate-unit-factor-inverted",
-        P + "compensate/files.py",
+        P + "pipeline/compensate.py",
         "y_data = y_model / plan.factor",
         "y_data = y_model * plan.factor",
         _t("compensate"),
@@ -318,7 +318,7 @@ MUTANTS: tuple[Mutant, ...] = (
     ),
     Mutant(
         "io-temporary-readable",
-        P + "readers/common.py",
+        P + "readers/formats.py",
         "    if name.endswith(TEMP_SUFFIX):\n",
         "    if False:\n",
         _t("faults"),
@@ -1098,7 +1098,7 @@ MUTANTS: tuple[Mutant, ...] = (
     Mutant(
         "reading-signal-message-lists-nothing",
         P + "pipeline/reading.py",
-        "        if not names and not keep_other:",
+        "        if not names:  # only the named columns were read: list them all",
         "        if False:",
         _t("text_single_column"),
         "the --signal message lists no columns when only the named ones were read",
@@ -1997,9 +1997,9 @@ MUTANTS: tuple[Mutant, ...] = (
     ),
     Mutant(
         "bounds-compensate-special-unchecked",
-        P + "compensate/files.py",
-        "    refuse_special_input(path)\n    if path.stat().st_size == 0:",
-        "    if path.stat().st_size == 0:",
+        P + "pipeline/compensate.py",
+        "        refuse_special_input(src)\n        if src.stat().st_size == 0:",
+        "        if src.stat().st_size == 0:",
         WORK_BOUNDS,
         "compensate opens a FIFO given as its recording",
     ),
@@ -2133,7 +2133,7 @@ MUTANTS: tuple[Mutant, ...] = (
     ),
     Mutant(
         "bounds-columns-swallowed-read",
-        P + "readers/dispatch.py",
+        P + "readers/formats.py",
         "except TooManyColumnsError as exc:",
         "except ZeroDivisionError as exc:",
         WORK_BOUNDS,
@@ -2664,9 +2664,9 @@ MUTANTS: tuple[Mutant, ...] = (
     ),
     Mutant(
         "h39a-rate-floor-gone",
-        P + "readers/text.py",
-        "RATE_HZ_RANGE = (1e-6, 1e7)",
-        "RATE_HZ_RANGE = (1e-320, 1e7)",
+        P + "readers/options.py",
+        "RATE_HZ_RANGE: tuple[float, float] = (1e-6, 1e7)",
+        "RATE_HZ_RANGE: tuple[float, float] = (1e-320, 1e7)",
         H39A_ATT,
         "--rate 1e-300 accepted (time = n / rate overflows: exit 1)",
     ),
@@ -3173,7 +3173,7 @@ MUTANTS: tuple[Mutant, ...] = (
     ),
     Mutant(
         "h39left-compensate-every-column",
-        P + "compensate/files.py",
+        P + "pipeline/compensate.py",
         "    available = names_list(names)",
         '    available = ", ".join(repr(c) for c in names)',
         H39L,
@@ -3205,7 +3205,7 @@ MUTANTS: tuple[Mutant, ...] = (
     ),
     Mutant(
         "h39left-compensate-formula-silent",
-        P + "compensate/files.py",
+        P + "pipeline/compensate.py",
         "    warn_formula_names(dst, source.names)  # every output column",
         "    pass  # every output column",
         H39L,
@@ -3325,6 +3325,38 @@ MUTANTS: tuple[Mutant, ...] = (
         "need = order + 1",
         ("tests/firmware/test_firmware_px4.py", "tests/tempcal/test_px4_baro_mag.py"),
         "a polynomial fitted to as few bins as it has coefficients",
+    ),
+    Mutant(
+        "formats-unknown-suffix-read-as-csv",
+        P + "readers/formats.py",
+        "        raise FileFormatError(_unknown_format_message(path))\n    return best[1]",
+        "        return BUILT_IN[-1]\n    return best[1]",
+        ("tests/readers/test_readers_formats.py",),
+        "a file no registered format reads is read as CSV",
+    ),
+    Mutant(
+        "compensate-unchunkable-format-read",
+        P + "pipeline/compensate.py",
+        'if fmt.chunks == "none":',
+        'if fmt.chunks == "never":',
+        ("tests/readers/test_format_plugin.py",),
+        "compensate goes through a format declared unreadable in chunks (exit 1, not 2)",
+    ),
+    Mutant(
+        "compensate-whole-format-streamed",
+        P + "pipeline/compensate.py",
+        'if fmt.chunks == "whole" or read.text_layout_given:',
+        "if read.text_layout_given:",
+        ("tests/readers/test_format_plugin.py",),
+        "a plugin's format (read whole) streamed as if it had chunk readers",
+    ),
+    Mutant(
+        "writers-read-only-format-written-as-csv",
+        P + "writers.py",
+        "    if kind not in RECORDING_WRITERS:",
+        "    if False:",
+        ("tests/readers/test_readers_writers_registry.py",),
+        "a recording written as CSV under a .ulg or .bin name",
     ),
 )
 

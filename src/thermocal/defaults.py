@@ -9,8 +9,8 @@ from __future__ import annotations
 from typing import Final
 
 DEFAULT_CHUNK_ROWS: Final = 500_000
-"""Rows per chunk of :func:`thermocal.compensate.files.compensate_file` (≈ 100 MB of working memory
-for a 37-term polynomial)."""
+"""Rows per chunk of :func:`thermocal.pipeline.compensate.compensate_file` (≈ 100 MB of working
+memory for a 37-term polynomial)."""
 
 WEAK_CORRELATION_LIMIT: Final = 0.4
 """A validation test is weakly correlated with the modelling test when the correlation

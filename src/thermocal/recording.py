@@ -55,7 +55,7 @@ class Metadata:
     ----------
     sample_interval_s : nominal sample interval τ [s]; the median interval of
         the time column when not given.
-    scale_factor : scale factor K of a raw-count output (SPEC §1).
+    scale_factor : scale factor K of a raw-count output.
     scale_factor_unit : unit of K, a key of :data:`thermocal.units.SCALE_FACTOR_UNITS`.
     latitude_deg : test-site latitude φ [°], for earth-rate removal.
     axis : sensitive-axis direction in local ENU (``"up"``, ``"north"``, ``"e,n,u"``).
@@ -276,7 +276,7 @@ class Recording:
         """A signal in its canonical unit ([°/h] or [mg]) with that unit.
 
         Raw ``counts`` are converted with the metadata's scale factor K when one
-        is given (SPEC §1), otherwise returned as counts.
+        is given, otherwise returned as counts.
         """
         name = self._default(name, self.signals, "signal")
         values = self.column(name)
@@ -451,7 +451,7 @@ def scan_time(time_s: FloatArray) -> TimeScan:
     """Scan a time column once, block by block (:func:`time_steps`, bounded memory): finite
     or not, smallest and largest step, duplicates, backward steps and the interval
     (:class:`TimeScan`).  The exact median is computed only when the grid is not regular
-    (issue 17: the checks of a 10⁸-row file took six differences and four medians)."""
+    (the checks of a 10⁸-row file otherwise take six differences and four medians)."""
     n = int(time_s.size)
     empty = np.zeros(0, dtype=np.intp)
     nan = float("nan")
@@ -770,7 +770,7 @@ PLAUSIBLE_COUNTS = 2.0**64
 has more than 64 bits (and float64 is exact for integers only up to 2⁵³)."""
 NON_INTEGER_COUNTS_SHARE = 0.1
 """A column declared in raw counts of which at least this share of the finite values is
-not an integer is reported (a warning, issue 39: "values declared as counts"): an ADC or
+not an integer is reported (a warning: values declared as counts): an ADC or
 a pulse counter outputs integers; fractions mean physical values or averaged counts."""
 
 
@@ -1058,7 +1058,7 @@ def _count_problems(rec: Recording, name: str) -> list[Problem]:
 
 
 def plausibility_problems(rec: Recording) -> list[Problem]:
-    """Values no sensor or chamber produces, named by column, value and row (issue 14).
+    """Values no sensor or chamber produces, named by column, value and row .
 
     Temperatures (in °C, after a counts conversion where one is given): below absolute
     zero is an error; outside −100…+200 °C a warning (with the likely cause: kelvin,
@@ -1088,7 +1088,7 @@ def plausibility_problems(rec: Recording) -> list[Problem]:
 
 STATIC_G_MG = (800.0, 1200.0)
 """A static accelerometer triad reads |a| ≈ 1 g; its median magnitude outside this band
-[mg] points to a wrong range setting or unit (issue 13 plausibility)."""
+[mg] points to a wrong range setting or unit (a plausibility check)."""
 SINGLE_AXIS_MAX_MG = 1500.0
 """A static single-axis accelerometer reads within ±1 g; a median |a| beyond this [mg]."""
 

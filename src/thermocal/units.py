@@ -4,7 +4,7 @@ Every quantity in thermocal carries its unit in its name (``rate_c_per_min``,
 ``bias_deg_h``), in its docstring (``[°/h]``) or in a unit field.  Conversions
 are the named constants below; code never writes a bare ``3600`` or ``9.80665``.
 
-Signal unit strings accepted on the command line and in files (INTERFACE.md):
+Signal unit strings accepted on the command line and in files:
 
 ========  ==========================  =========
 string    meaning                     kind
@@ -25,7 +25,7 @@ stored unsigned).
 
 The one resolver (:func:`resolve_inputs`, per column :func:`resolve_unit` and
 :func:`resolve_temperature_conversion`) chooses every unit and conversion of a recording,
-once, in INTERFACE.md's order: command-line option > the file's own metadata > a unit in
+once, in this order: command-line option > the file's own metadata > a unit in
 the column name > what the model file recorded > a default stated in a
 :class:`~thermocal.errors.UnitWarning`.  Nothing else in thermocal chooses a unit.
 
@@ -305,7 +305,7 @@ DEFAULT_UNITS: Final[dict[str, str]] = {
     "angle": "deg",
 }
 """What a column is taken to be in when nothing states its unit — always said in a
-``warning:`` line (INTERFACE.md common rules), never assumed silently."""
+``warning:`` line, never assumed silently."""
 
 _UNIT_OPTION: Final[dict[str, str]] = {
     "time": "--time-unit",
@@ -422,7 +422,7 @@ def resolve_unit(
     ask: str | None = None,
     implied: str | None = None,
 ) -> ResolvedUnit:
-    """The unit of ``column``, resolved once, in INTERFACE.md's order: command-line option
+    """The unit of ``column``, resolved once, in this order: command-line option
     > the file's own metadata > units in the column name > the units recorded in the model
     file > a default (``default``, else :data:`DEFAULT_UNITS`), the last stated in a
     :class:`UnitWarning`.  An option that contradicts the file's metadata wins, with a
@@ -655,7 +655,7 @@ def resolve_inputs(
     where: str = "",
 ) -> ResolvedInputs:
     """Resolve, once, the time unit, every signal's and temperature's unit and every
-    temperature's raw-count conversion of a recording (INTERFACE.md common rules):
+    temperature's raw-count conversion of a recording:
     command-line option > the file's own metadata > units written in the column name >
     the units recorded in the model file > a default stated in a :class:`UnitWarning`.
 
@@ -846,8 +846,8 @@ def earth_rate_on_axis_deg_h(latitude_deg: float, axis_enu: npt.ArrayLike) -> fl
     """Earth rate seen by a sensitive axis [°/h].
 
     The earth-rate vector in local East-North-Up is ``Ω (0, cos φ, sin φ)``
-    (SPEC §1, §7); the axis reads its projection ``Ω_axis = Ω u·(0, cos φ, sin φ)``
-    for a unit vector ``u`` (normalised here).  For a vertical axis this is ``Ω sin φ``.
+    (φ the latitude); the axis reads its projection ``Ω_axis = Ω u·(0, cos φ, sin φ)`` for a
+    unit vector ``u`` (normalised here).  For a vertical axis this is ``Ω sin φ``.
     """
     u = np.asarray(axis_enu, dtype=np.float64).reshape(3)
     norm = float(np.linalg.norm(u))
@@ -947,12 +947,12 @@ def gravity_on_axis_mg(channel_axis: str, gravity_axis: str, gravity_m_s2: float
 
 DEFAULT_SCALE_FACTOR_UNIT: Final = "counts/arcsec"
 """Unit of a scale factor K given without one: pulses per arcsec, the seed's ring-laser
-gyro (SPEC §1), stated in a :class:`UnitWarning` wherever it is used."""
+gyro, stated in a :class:`UnitWarning` wherever it is used."""
 
 
 def scale_factor_unit_or_default(unit: str | None, where: str = "") -> str:
     """The scale factor's unit, or :data:`DEFAULT_SCALE_FACTOR_UNIT` stated in a
-    :class:`UnitWarning` (no silent default, issue 13)."""
+    :class:`UnitWarning` (no silent default)."""
     if unit:
         return unit
     prefix = f"{where}: " if where else ""
@@ -979,7 +979,7 @@ SCALE_FACTOR_UNITS: Final[dict[str, tuple[bool, float, str]]] = {
 }
 """Units of a scale factor K and how counts become a physical signal.
 
-Integrating outputs (ring-laser and fibre-optic gyro pulse counts, SPEC §1):
+Integrating outputs (ring-laser and fibre-optic gyro pulse counts):
 ``rate = N / (τ K)`` with τ the sample interval [s], e.g. K in pulses per arcsec
 gives [arcsec/s] = [°/h].  Non-integrating outputs (MEMS LSB): ``value = N / K``.
 """
@@ -997,7 +997,7 @@ def counts_to_physical(
 ) -> tuple[npt.NDArray[np.float64], str]:
     """Convert raw counts to the canonical unit ([°/h] or [mg]) with scale factor K.
 
-    SPEC §1: ``ω = N / (τ K)`` for pulse (integrating) outputs, ``N / K`` otherwise.
+    ``ω = N / (τ K)`` for pulse (integrating) outputs, ``N / K`` otherwise.
     Returns the converted array and the canonical unit string.  A finite count that
     overflows on conversion (1e300 counts with a small K) is a :class:`UnitError` naming
     ``where`` and its row (:func:`refuse_overflow`) unless ``finite=False``.
@@ -1046,8 +1046,8 @@ class ShownUnit:
 
 
 def shown_unit(model_unit: str, data_unit: str | None) -> ShownUnit:
-    """The data's own unit for figures computed in ``model_unit`` (INTERFACE.md: every
-    figure in the data's own unit).
+    """The data's own unit for figures computed in ``model_unit`` (every
+    figure is shown in the data's own unit).
 
     ``data_unit`` (the column's unit as given: option, file metadata or column name) is
     kept as written when it is a physical unit of the model unit's kind (°/s data of a

@@ -9,7 +9,7 @@ not a copy of the modelling test's:
    validation test is *weakly correlated* when ``r < 0.4``.  A test that is not
    gets a :class:`~thermocal.errors.CorrelationWarning`, not a refusal.
 2. **Compensation**: ``F' = F − ŷ(T, Ṫ, …)`` with the model
-   (:func:`thermocal.compensate.files.compensate_run`).
+   (:func:`thermocal.compensate.kernels.compensate_run`).
 3. **Hold stages**: the temperature-hold stages of the validation run are cut
    out (:func:`thermocal.preprocess.segment_holds` on the ambient column) and,
    before and after compensation, within each stage s:
@@ -207,7 +207,7 @@ class ValidationResult:
 
     def in_unit(self, unit: str, factor: float) -> ValidationResult:
         """The same result with every signal figure in ``unit``, where ``value[self.unit]
-        = factor · value[unit]`` (e.g. the data's own unit, :class:`thermocal.compensate.files.
+        = factor · value[unit]`` (e.g. the data's own unit, :class:`thermocal.compensate.kernels.
         ModelRun`); improvements, r and the stage layout are unchanged."""
         if factor == 1.0 and unit == self.unit:
             return self

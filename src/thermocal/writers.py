@@ -23,6 +23,7 @@ import numpy.typing as npt
 from thermocal._lazy import LazyModule
 from thermocal.defaults import PROGRAM_SETPOINT, PROGRAM_TIME
 from thermocal.errors import (
+    FileFormatError,
     ThermocalInputError,
 )
 from thermocal.outputs import (
@@ -32,8 +33,8 @@ from thermocal.outputs import (
     sidecar_path,
     warn_formula_names,
 )
-from thermocal.readers.common import file_kind
 from thermocal.readers.dispatch import recording_info
+from thermocal.readers.formats import file_kind, format_named
 from thermocal.recording import META_KEY, FloatArray, Recording
 
 if TYPE_CHECKING:
@@ -265,8 +266,54 @@ def write_json(path: str | Path, obj: Any) -> None:
 def check_not_input(out: str | Path, inputs: list[str | Path]) -> None:
     """Refuse to write ``out`` over one of the inputs or an input's sidecar
     ``FILE.meta.json``, or onto a special file (the one gate,
-    :func:`thermocal.outputs.check_outputs`; INTERFACE.md common rules)."""
+    :func:`thermocal.outputs.check_outputs`; an input is never overwritten)."""
     check_outputs([out], inputs)
+
+
+def _write_parquet(p: Path, data: dict[str, FloatArray], info: dict[str, Any],
+                   sidecar: bool | None) -> None:  # fmt: skip
+    """A Parquet recording: the metadata in its key-value store (and a sidecar if asked)."""
+    table = pa.table(data)
+    table = table.replace_schema_metadata({META_KEY: json.dumps(info)})
+    atomic_write_path(p, lambda tmp: pq.write_table(table, tmp, write_page_checksum=True))
+    if sidecar:
+        write_json(sidecar_path(p), info)
+
+
+def _write_csv(p: Path, data: dict[str, FloatArray], info: dict[str, Any],
+               sidecar: bool | None) -> None:  # fmt: skip
+    """A CSV recording (Arrow's writer: shortest exact numbers) and its sidecar."""
+    warn_formula_names(p, data)  # kept exactly: a program reads the names back
+    table = pa.table(data)
+    opts = pacsv.WriteOptions(include_header=True, quoting_style="needed")
+    atomic_write_path(p, lambda tmp: pacsv.write_csv(table, tmp, write_options=opts))
+    if sidecar is None or sidecar:
+        write_json(sidecar_path(p), info)
+
+
+RecordingWriter = Callable[[Path, dict[str, FloatArray], dict[str, Any], bool | None], None]
+"""``write(path, columns, metadata, sidecar)``: a recording's columns written atomically."""
+
+RECORDING_WRITERS: dict[str, RecordingWriter] = {"parquet": _write_parquet, "csv": _write_csv}
+"""The registered formats (:mod:`thermocal.readers.formats`) a recording is written in."""
+
+
+def written_format(path: Path) -> str:
+    """The name of the format an output recording is written in (a key of
+    :data:`RECORDING_WRITERS`), by its suffix.
+
+    Raises
+    ------
+    thermocal.errors.FileFormatError
+        A suffix no format has, or a format thermocal reads but does not write.
+    """
+    kind = file_kind(path)
+    if kind not in RECORDING_WRITERS:
+        raise FileFormatError(
+            f"{path}: thermocal reads {format_named(kind).title} but writes recordings as CSV "
+            "or Parquet; name the output *.csv or *.parquet"
+        )
+    return kind
 
 
 def write_recording(
@@ -278,35 +325,65 @@ def write_recording(
     their key-value metadata (and a sidecar only if ``sidecar=True``).
     Time is written in [s].  CSV numbers are written by Arrow's writer in their
     shortest exact form, so a CSV round-trip reproduces every float64 bit.
+
+    Parameters
+    ----------
+    rec : Recording
+        What to write.
+    path : str or Path
+        The output; its registered format (:func:`thermocal.readers.formats.file_kind`)
+        chooses the writer in :data:`RECORDING_WRITERS`.
+    time : str
+        Name of the time column written [s].
+    sidecar : bool, optional
+        Write ``FILE.meta.json`` (default: for CSV only).
+
+    Returns
+    -------
+    Path
+        The file written.
+
+    Raises
+    ------
+    thermocal.errors.FileFormatError
+        A suffix no format has, or a format thermocal reads but does not write.
+    thermocal.errors.ThermocalInputError
+        A column named like the time column.
     """
     p = Path(path)
-    kind = file_kind(p)
+    writer = RECORDING_WRITERS[written_format(p)]
     info = recording_info(rec, time=time)
     data: dict[str, FloatArray] = {time: rec.time_s}
     for c, v in rec.columns.items():
         if c == time:
             raise ThermocalInputError(f"column name {c!r} clashes with the time column")
         data[c] = v
-    if kind == "parquet":
-        table = pa.table(data)
-        table = table.replace_schema_metadata({META_KEY: json.dumps(info)})
-        atomic_write_path(p, lambda tmp: pq.write_table(table, tmp, write_page_checksum=True))
-        if sidecar:
-            write_json(sidecar_path(p), info)
-    else:
-        warn_formula_names(p, data)  # kept exactly: a program reads the names back
-        table = pa.table(data)
-        opts = pacsv.WriteOptions(include_header=True, quoting_style="needed")
-        atomic_write_path(p, lambda tmp: pacsv.write_csv(table, tmp, write_options=opts))
-        if sidecar is None or sidecar:
-            write_json(sidecar_path(p), info)
+    writer(p, data, info, sidecar)
     return p
 
 
 def write_program(path: str | Path, time_s: npt.ArrayLike, setpoint_c: npt.ArrayLike) -> Path:
-    """Write a chamber program CSV with columns ``time_s, setpoint_c`` (atomic; checked by
-    :func:`thermocal.profiles.check_program`; read back by
-    :func:`thermocal.readers.program.read_program`)."""
+    """Write a chamber program CSV with columns ``time_s, setpoint_c``, atomically.
+
+    Parameters
+    ----------
+    path : str or Path
+        The output, ``*.csv``.
+    time_s : array_like
+        Times [s], increasing.
+    setpoint_c : array_like
+        Set-points [°C], one per time.
+
+    Returns
+    -------
+    Path
+        The file written (read back by :func:`thermocal.readers.program.read_program`).
+
+    Raises
+    ------
+    thermocal.errors.ThermocalInputError
+        Not a ``.csv`` name, or a program :func:`thermocal.profiles.check_program` refuses.
+    """
     from thermocal.profiles import check_program
 
     t = np.asarray(time_s, dtype=np.float64)

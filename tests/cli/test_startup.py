@@ -106,7 +106,7 @@ def test_help_resolves_every_command_without_the_maths() -> None:
 def test_the_help_names_are_the_libraries_names() -> None:
     """The values the help shows (thermocal.defaults) are the ones the maths uses."""
     from thermocal import defaults, profiles, validation
-    from thermocal.compensate import files as compensate
+    from thermocal.pipeline import compensate
     from thermocal.simulate import SCENARIOS
     from thermocal.turntable.calibrate import DEFAULT_GYRO_COLUMNS
 

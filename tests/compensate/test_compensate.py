@@ -23,11 +23,9 @@ import pyarrow.parquet as pq
 import pytest
 
 from thermocal import units
-from thermocal.compensate.files import (
-    ChunkContext,
+from thermocal.compensate.kernels import (
     ChunkPredictor,
     StreamingCompensator,
-    compensate_file,
     compensate_run,
     unit_factor,
 )
@@ -38,10 +36,19 @@ from thermocal.errors import (
     TimestampError,
     UnitError,
 )
-from thermocal.models.base import Coefficient, FitStats, ModelStream, RunData, TemperatureModel
+from thermocal.models.base import (
+    ChunkContext,
+    Coefficient,
+    FitStats,
+    ModelStream,
+    RunData,
+    TemperatureModel,
+)
 from thermocal.models.registry import MODEL_REGISTRY, make_model
+from thermocal.pipeline.compensate import compensate_file
 from thermocal.preprocess import temperature_rate
 from thermocal.readers.common import csv_float_options
+from thermocal.readers.options import ReadOptions
 from thermocal.recording import GAP_FACTOR, FloatArray
 
 # --- a toy model with a rate buffer and a start-up state ------------------------------------
@@ -265,7 +272,7 @@ def test_compensate_file_chunked_equals_in_memory(
     src = tmp_path / "in.csv"
     _write_csv(src, run)
     out = tmp_path / f"out.{out_ext}"
-    res = compensate_file(m, src, out, chunk_rows=333, time_unit="s")
+    res = compensate_file(m, src, out, ReadOptions(time_unit="s"), chunk_rows=333)
     assert res.n_rows == run.n_samples
     assert res.n_chunks == math.ceil(run.n_samples / 333)
     assert not res.streamed
@@ -308,7 +315,9 @@ def test_compensate_file_streams_unknown_family_parquet_in(tmp_path: Path) -> No
     )
     src = tmp_path / "in.parquet"
     df.to_parquet(src)
-    res = compensate_file(m, src, tmp_path / "o.parquet", chunk_rows=100, time_unit="s")
+    res = compensate_file(
+        m, src, tmp_path / "o.parquet", ReadOptions(time_unit="s"), chunk_rows=100
+    )
     assert res.streamed
     got = pq.read_table(tmp_path / "o.parquet").to_pandas()
     np.testing.assert_allclose(got["gyro_comp"], compensate_run(m, run).corrected, rtol=1e-12)
@@ -327,7 +336,7 @@ def test_compensate_file_converts_units(tmp_path: Path) -> None:
     )
     src = tmp_path / "in.csv"
     _write_csv(src, ds, unit="deg/s", extra=False)
-    compensate_file(m, src, tmp_path / "o.csv", time_unit="s")
+    compensate_file(m, src, tmp_path / "o.csv", ReadOptions(time_unit="s"))
     got = pd.read_csv(tmp_path / "o.csv")
     exp = compensate_run(m, run)
     np.testing.assert_allclose(got["gyro_model"], exp.model_value * units.DH_TO_DS, rtol=1e-12)
@@ -340,7 +349,7 @@ def test_unit_mismatch_names_both(tmp_path: Path) -> None:
     src = tmp_path / "in.csv"
     _write_csv(src, run, unit="mg", extra=False)
     with pytest.raises(UnitError, match=r"'deg/h'.*'mg'"):
-        compensate_file(m, src, tmp_path / "o.csv", time_unit="s")
+        compensate_file(m, src, tmp_path / "o.csv", ReadOptions(time_unit="s"))
     assert not (tmp_path / "o.csv").exists()
     assert unit_factor("rad/s", "deg/h") == pytest.approx(units.RS_TO_DH, rel=1e-15)
 
@@ -352,7 +361,7 @@ def test_missing_temperature_column_names_missing_and_available(tmp_path: Path) 
     src = tmp_path / "in.csv"
     _write_csv(src, run, extra=False)
     with pytest.raises(MissingColumnError, match=r"'Tcase'.*available: 'time', 'gyro', 'T1', 'T2'"):
-        compensate_file(m, src, tmp_path / "o.csv", time_unit="s")
+        compensate_file(m, src, tmp_path / "o.csv", ReadOptions(time_unit="s"))
 
 
 def test_never_writes_over_input(tmp_path: Path) -> None:
@@ -373,7 +382,7 @@ def test_one_extrapolation_warning_for_the_file(tmp_path: Path) -> None:
     src = tmp_path / "in.csv"
     _write_csv(src, run, extra=False)
     with pytest.warns(ExtrapolationWarning, match=f"{n_out} samples outside") as rec:
-        compensate_file(m, src, tmp_path / "o.csv", chunk_rows=50, time_unit="s")
+        compensate_file(m, src, tmp_path / "o.csv", ReadOptions(time_unit="s"), chunk_rows=50)
     assert len([w for w in rec if issubclass(w.category, ExtrapolationWarning)]) == 1
 
 
@@ -485,9 +494,13 @@ def test_every_family_chunked_file_equals_in_memory(
     pd.DataFrame(cols).to_parquet(src)
     with pytest.warns(ExtrapolationWarning):
         res = compensate_file(
-            m, src, tmp_path / "out.csv", chunk_rows=333, known_input=run.known_input,
-            time_unit="s",
-        )  # fmt: skip
+            m,
+            src,
+            tmp_path / "out.csv",
+            ReadOptions(time_unit="s"),
+            chunk_rows=333,
+            known_input=run.known_input,
+        )
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", ExtrapolationWarning)
         batch = compensate_run(m, run)

@@ -19,7 +19,7 @@ import pandas as pd
 import pyarrow.parquet as pq
 import pytest
 
-import thermocal.compensate.files as compensate_mod
+import thermocal.pipeline.compensate as compensate_mod
 import thermocal.readers.dispatch as io_mod
 from thermocal.cli import main
 from thermocal.models.files import load_calibration

@@ -68,7 +68,6 @@ FILE_LAYER = (
     "thermocal.writers",
     "thermocal.models.files",
     "thermocal.models.filecheck",
-    "thermocal.compensate.files",
     "thermocal.pipeline",
     "thermocal.tempcal",
     "thermocal.export",
@@ -87,7 +86,7 @@ LIGHT_FORBIDDEN = (
     "pyarrow",
     "thermocal.readers",
     "thermocal.writers",
-    "thermocal.compensate.files",
+    "thermocal.pipeline.compensate",
     "thermocal.models.files",
 )
 

@@ -14,6 +14,7 @@ import pytest
 from thermocal.cli import main
 from thermocal.demo.station import MODELLING, VALIDATION
 from thermocal.readers.dispatch import read_recording
+from thermocal.readers.options import ReadOptions
 
 pytest.importorskip("pymodbus")
 pytest.importorskip("serial")
@@ -38,7 +39,10 @@ def test_demo_station_records_fits_validates_and_exports(
     # issue 38: the demo's validation passes thermocal's weak-correlation rule (r < 0.4),
     # r computed here with numpy on the recorded histories (common elapsed-time base)
     assert "not weakly correlated" not in capsys.readouterr().err
-    recs = [read_recording(out / n, temperatures=["temp"]) for n in ("modelling", "validation")]
+    recs = [
+        read_recording(out / n, ReadOptions(temperatures=["temp"]))
+        for n in ("modelling", "validation")
+    ]
     span = min(float(r.time_s[-1] - r.time_s[0]) for r in recs)
     base = np.linspace(0.0, span, 2000)
     h = [np.interp(base, r.time_s - r.time_s[0], r.column("temp")) for r in recs]

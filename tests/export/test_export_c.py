@@ -18,7 +18,7 @@ import numpy as np
 import pytest
 
 from thermocal.cli import main
-from thermocal.compensate.files import StreamingCompensator
+from thermocal.compensate.kernels import StreamingCompensator
 from thermocal.errors import ModelFileError
 from thermocal.export.c import (
     c_harness,

@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from thermocal.compensate.files import StreamingCompensator
+from thermocal.compensate.kernels import StreamingCompensator
 from thermocal.export.c import compile_harness, find_compiler, generate_c, run_harness
 from thermocal.models.base import RunData
 from thermocal.models.files import load_model, load_model_dict, save_model

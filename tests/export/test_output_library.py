@@ -11,7 +11,6 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from thermocal.compensate.files import CalibrationCompensation, compensate_calibration_file
 from thermocal.errors import ThermocalInputError
 from thermocal.export.c import generate_c, generate_c_calibration
 from thermocal.export.c.files import ExportCResult, export_c_file
@@ -19,6 +18,8 @@ from thermocal.models.base import RunData, model_file_dict
 from thermocal.models.calibration import Calibration, Channel
 from thermocal.models.files import save_calibration, save_model
 from thermocal.models.registry import make_model
+from thermocal.pipeline.compensate import CalibrationCompensation, compensate_calibration_file
+from thermocal.readers.options import ReadOptions
 
 N = 4000
 SLOPES = {"gx": 0.02, "gy": -0.05}
@@ -63,8 +64,8 @@ def test_compensate_calibration_file_two_channels_in_one_pass(tmp_path: Path) ->
     cal_path = tmp_path / "cal.json"
     save_calibration(cal, cal_path)
     out = tmp_path / "out.csv"
-    run = _quiet(compensate_calibration_file, cal_path, src, out, time_unit="s",
-                 signal_unit="deg/h", temp_unit="degC", chunk_rows=777)  # fmt: skip
+    read = ReadOptions(time_unit="s", signal_unit="deg/h", temp_unit="degC")
+    run = _quiet(compensate_calibration_file, cal_path, src, out, read, chunk_rows=777)
     assert isinstance(run, CalibrationCompensation) and run.kind == "channels"
     got = pd.read_csv(out)
     for k, ((name, family, res), slope) in enumerate(
@@ -89,8 +90,8 @@ def test_compensate_calibration_file_one_model_and_its_refusals(tmp_path: Path) 
     ch = _channel(df, "gy")
     model_path = tmp_path / "m.json"
     save_model(ch.model, model_path)
-    run = _quiet(compensate_calibration_file, model_path, src, tmp_path / "o.parquet",
-                 time_unit="s", signal_unit="deg/h", temp_unit="degC")  # fmt: skip
+    read = ReadOptions(time_unit="s", signal_unit="deg/h", temp_unit="degC")
+    run = _quiet(compensate_calibration_file, model_path, src, tmp_path / "o.parquet", read)
     assert run.kind == "single"
     d = run.to_dict()
     assert d["model"] == str(model_path) and d["family"] == "poly" and d["signal"] == "gy"

@@ -13,7 +13,7 @@ import pandas as pd
 import pytest
 
 from thermocal.cli import main
-from thermocal.compensate.files import CalibrationStream
+from thermocal.compensate.kernels import CalibrationStream
 from thermocal.errors import ThermocalInputError
 from thermocal.models.files import load_calibration
 from thermocal.simulate import IMU_CHANNELS, SCENARIOS

@@ -108,7 +108,7 @@ def no_reading(monkeypatch: pytest.MonkeyPatch) -> None:
     def refuse(*_a: object, **_k: object) -> None:
         raise AssertionError("a data file was read before the option was checked")
 
-    monkeypatch.setattr(fit_cmd, "load_recording", refuse)
+    monkeypatch.setattr(fit_cmd, "check_recording", refuse)
     monkeypatch.setattr(io_mod, "read_recording", refuse)
 
 

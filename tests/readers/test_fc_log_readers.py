@@ -31,6 +31,7 @@ from fc_logs import imu_truth, parm_file
 from thermocal.cli import main
 from thermocal.errors import UnitWarning
 from thermocal.readers.dispatch import read_recording
+from thermocal.readers.options import ReadOptions
 from ulog_writer import ulog_bytes
 
 
@@ -92,8 +93,9 @@ def test_older_layout_reads_with_the_firmware_units(tmp_path: Path, two_imus: li
     log = tmp_path / "copter36.bin"
     log.write_bytes(old_layout(two_imus))
     with pytest.warns(UnitWarning, match="EG|ErrG") as said:
-        rec = read_recording(log, signals=["GyrX", "AccZ", "ErrG"], temperatures=["Temp"],
-                             topic="IMU.1")  # fmt: skip
+        rec = read_recording(
+            log, ReadOptions(signals=["GyrX", "AccZ", "ErrG"], temperatures=["Temp"], topic="IMU.1")
+        )
     assert len(said) == 1 and "counts" in str(said[0].message)
     assert rec.units["GyrX"] == "rad/s" and rec.units["AccZ"] == "m/s^2"
     assert rec.units["Temp"] == "degC" and rec.units["ErrG"] == "counts"

@@ -16,6 +16,7 @@ from numpy.testing import assert_allclose
 from thermocal.cli import main
 from thermocal.errors import TextLayoutWarning, UnitError, UnitWarning
 from thermocal.readers import read_recording
+from thermocal.readers.options import ReadOptions
 
 
 def _run(capsys: pytest.CaptureFixture[str], *args: str) -> tuple[int, str, str]:
@@ -84,7 +85,9 @@ def test_time_unit_contradicting_the_column_name_is_said(
     ]
     assert_allclose(json.loads(out)["sample_rate_hz"], 0.1)  # as the option says
     with pytest.warns(UnitWarning, match="contradicts the column name 'time \\(ms\\)'"):
-        rec = read_recording(path, time_unit="s", signals=["gyro"], signal_unit="deg/h")
+        rec = read_recording(
+            path, ReadOptions(time_unit="s", signals=["gyro"], signal_unit="deg/h")
+        )
     assert_allclose(rec.time_s[1], 10.0)
 
 
@@ -104,13 +107,12 @@ def test_names_with_a_temperature_first_is_not_time(
         "temperature, not time)"
     )
     from thermocal.errors import MissingColumnError
-    from thermocal.readers.text import TextOptions
 
     with (
         pytest.warns(TextLayoutWarning, match="blank-separated"),
         pytest.raises(MissingColumnError, match="'T' is named like a temperature, not time"),
     ):
-        read_recording(path, text=TextOptions(names=("T", "ax", "ay", "az")))
+        read_recording(path, ReadOptions(names=("T", "ax", "ay", "az")))
     code, out, err = _run(
         capsys, "inspect", str(path), "--names", "T,ax,ay,az", "--rate", "50", "--json"
     )
@@ -138,15 +140,14 @@ def test_imucal_counter_is_time_with_rate(capsys: pytest.CaptureFixture[str]) ->
     assert_allclose(d["duration_s"], 10375 / 102.4)
     assert d["gaps"] == []
     assert not [w for w in _warnings(err) if "time column" in w], err
-    rec = read_recording(IMUCAL, text=_rate(102.4))
+    rec = read_recording(IMUCAL, _rate(102.4))
     counts = np.loadtxt(IMUCAL, delimiter=",", skiprows=1, usecols=0)
     assert_allclose(rec.time_s, counts / 102.4, rtol=0, atol=1e-12)
 
 
 def _rate(hz: float) -> object:
-    from thermocal.readers.text import TextOptions
 
-    return TextOptions(rate_hz=hz)
+    return ReadOptions(rate_hz=hz)
 
 
 def test_counter_gaps_are_gaps(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
@@ -208,7 +209,7 @@ def test_multipos_asks_for_the_accel_unit(
     )
     with pytest.raises(UnitError, match="give --accel-unit"):
         read_recording(
-            IMUCAL, text=_rate(102.4), signals=["acc_x"], ask_units={"acc_x": "--accel-unit"}
+            IMUCAL, _rate(102.4).replace(signals=["acc_x"]), ask_units={"acc_x": "--accel-unit"}
         )
 
 
@@ -271,7 +272,7 @@ def test_jitter_is_said_and_rate_takes_the_nominal_grid(
         (2296, 0.02),
     ]
     rec = read_recording(
-        path, text=_rate(100.0), time_unit="s", signals=["gx"], signal_unit="deg/s"
+        path, _rate(100.0).replace(time_unit="s", signals=["gx"], signal_unit="deg/s")
     )
     assert_allclose(rec.time_s - rec.time_s[0], truth - truth[0], rtol=0, atol=1e-9)
 
@@ -281,7 +282,7 @@ def test_jitter_without_bursts_is_a_warning_of_every_command(tmp_path: Path) -> 
 
     path = tmp_path / "bt.csv"
     _bluetooth(path, [], bursts=False)
-    rec = read_recording(path, time_unit="s", signals=["gx"], signal_unit="deg/s")
+    rec = read_recording(path, ReadOptions(time_unit="s", signals=["gx"], signal_unit="deg/s"))
     with pytest.warns(TimestampWarning, match=r"scatter ±\d+(\.\d+)? % .* give --rate HZ"):
         rec.validate()
     jit = rec.time_jitter()
@@ -294,7 +295,7 @@ def test_rate_on_exact_stamps_recovers_whole_lost_periods(tmp_path: Path) -> Non
     path = tmp_path / "bt.csv"
     truth = _bluetooth(path, [700, 1500, 1501, 2300], ms=False)
     rec = read_recording(
-        path, text=_rate(100.0), time_unit="s", signals=["gx"], signal_unit="deg/s"
+        path, _rate(100.0).replace(time_unit="s", signals=["gx"], signal_unit="deg/s")
     )
     assert_allclose(rec.time_s - rec.time_s[0], truth - truth[0], rtol=0, atol=1e-9)
 
@@ -352,7 +353,9 @@ def test_a_text_column_not_used_is_read_past(
     assert [p["column"] for p in d["problems"] if p["kind"] == "non_numeric"] == ["mac"]
     skipped: list[str] = []
     with pytest.warns(TextLayoutWarning):  # the banner and the layout are stated
-        rec = read_recording(path, time_unit="s", signals=["ax"], signal_unit="g", skipped=skipped)
+        rec = read_recording(
+            path, ReadOptions(time_unit="s", signals=["ax"], signal_unit="g"), skipped=skipped
+        )
     assert_allclose(rec.columns["ax"], ax)
     assert skipped == ["mac"]
     # a used column that holds text: exit 2 naming the column and the file
@@ -374,7 +377,7 @@ def test_a_stray_word_is_still_a_mangled_line(tmp_path: Path) -> None:
     lines[10] = "9;oops"
     path.write_text("\n".join(lines) + "\n")
     with pytest.raises(FileFormatError, match="line 11 is not a data row"):
-        read_recording(path, time_unit="s", signals=["g"], signal_unit="deg/h")
+        read_recording(path, ReadOptions(time_unit="s", signals=["g"], signal_unit="deg/h"))
 
 
 READING_COMMANDS = (
@@ -476,8 +479,8 @@ def test_rate_the_stamps_contradict_is_said(tmp_path: Path) -> None:
     with pytest.warns(
         TimestampWarning, match=r"--rate 102\.4 Hz, but .* \((99\.9\d*|100) Hz\) and 9\d more"
     ):
-        read_recording(path, text=_rate(102.4), time_unit="s", signals=["gx"], signal_unit="g")
+        read_recording(path, _rate(102.4).replace(time_unit="s", signals=["gx"], signal_unit="g"))
     with warnings.catch_warnings():
         warnings.simplefilter("error", TimestampWarning)
         warnings.simplefilter("error", GapWarning)
-        read_recording(path, text=_rate(100.0), time_unit="s", signals=["gx"], signal_unit="g")
+        read_recording(path, _rate(100.0).replace(time_unit="s", signals=["gx"], signal_unit="g"))

@@ -10,7 +10,8 @@ from pathlib import Path
 import pytest
 
 from thermocal.errors import FileFormatError
-from thermocal.readers.text import TextOptions, parse_number, read_text, sniff_text
+from thermocal.readers.options import ReadOptions
+from thermocal.readers.text import parse_number, read_text, sniff_text
 
 
 def test_a_row_with_an_empty_field_is_data_not_a_banner() -> None:
@@ -50,7 +51,7 @@ def test_a_row_with_too_many_fields_is_a_bad_line(tmp_path: Path) -> None:
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # the layout and the skipped line are stated
         with pytest.raises(FileFormatError, match="line 4"):
-            read_text(f, "utf-8", TextOptions())
-        df, _info = read_text(f, "utf-8", TextOptions(on_bad_lines="skip"))
+            read_text(f, "utf-8", ReadOptions())
+        df, _info = read_text(f, "utf-8", ReadOptions(on_bad_lines="skip"))
     assert df.shape == (2, 3)
     assert list(df["t"]) == [0.0, 2.0]

@@ -17,7 +17,8 @@ import pytest
 from thermocal.cli import main
 from thermocal.errors import TextLayoutWarning
 from thermocal.readers.dispatch import read_recording
-from thermocal.readers.text import TextOptions, sniff_text
+from thermocal.readers.options import ReadOptions
+from thermocal.readers.text import sniff_text
 
 BANNER = [
     "=~=~=~=~=~=~=~=~=~=~=~= PuTTY log 2026.11.20 10:15:03 =~=~=~=~=~=~=~=~=~=~=~=",
@@ -85,9 +86,18 @@ def test_skip_drops_and_reports_mangled_lines_and_keeps_time(
     assert "3 mangled line(s) dropped (--on-bad-lines skip): line(s) 504, 904, 1204" in err
     # time = data-line number / rate: the dropped lines leave gaps, the rest keep their time
     with pytest.warns(TextLayoutWarning):
-        rec = read_recording(path, signals=["gx"], temperatures=["T"], signal_unit="deg/h",
-                             temp_unit="degC", text=TextOptions(names=("gx", "gy", "gz", "T"),
-                             rate_hz=RATE_HZ, on_bad_lines="skip"))  # fmt: skip
+        rec = read_recording(
+            path,
+            ReadOptions(
+                signals=["gx"],
+                temperatures=["T"],
+                signal_unit="deg/h",
+                temp_unit="degC",
+                names=("gx", "gy", "gz", "T"),
+                rate_hz=RATE_HZ,
+                on_bad_lines="skip",
+            ),
+        )
     keep = np.setdiff1d(np.arange(N), [500, 900, 1200])  # the three mangled lines
     np.testing.assert_array_equal(rec.time_s, keep / RATE_HZ)
     # every value kept is the one written on its line (6 decimals)

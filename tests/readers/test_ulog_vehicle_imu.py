@@ -14,7 +14,8 @@ def test_ulog_vehicle_imu_integrals_become_rates(tmp_path: Path) -> None:
     """PX4's ``vehicle_imu`` logs Δθ [rad] and Δv [m/s] over Δt [µs]: the reader's rates
     are Δθ/Δt [rad/s] and Δv/Δt [m/s²] with Δt in seconds (mutant ulog-delta-dt-us reads
     Δt in ms: rates 1000× too small).  Written with the test's own ULog writer."""
-    from thermocal.readers.dispatch import read_log_table
+    from thermocal.readers.dispatch import read_whole_table
+    from thermocal.readers.options import ReadOptions
     from ulog_writer import ulog_bytes
 
     fields = [("uint64_t", "timestamp"), ("float[3]", "delta_angle"),
@@ -30,7 +31,7 @@ def test_ulog_vehicle_imu_integrals_become_rates(tmp_path: Path) -> None:
     log.write_bytes(ulog_bytes([("vehicle_imu", 0, fields, rows)]))
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        df, info = read_log_table(log, "vehicle_imu")
+        df, info = read_whole_table(log, ReadOptions(topic="vehicle_imu"))
     for i in range(3):
         np.testing.assert_allclose(df[f"gyro_rad_s[{i}]"], w[i], rtol=1e-6, atol=1e-9)
         np.testing.assert_allclose(df[f"accel_m_s2[{i}]"], a[i], rtol=1e-6, atol=1e-9)

@@ -15,8 +15,8 @@ import pytest
 
 from thermocal.cli import main
 from thermocal.errors import TextLayoutWarning
-from thermocal.readers.text import TextOptions
-from thermocal.report.files import ReadOptions, make_report
+from thermocal.readers.options import ReadOptions
+from thermocal.report.files import make_report
 
 BANNER = [
     "=~=~=~=~=~=~=~=~=~=~=~= PuTTY log 2026.11.20 10:15:03 =~=~=~=~=~=~=~=~=~=~=~=",
@@ -97,7 +97,7 @@ def test_make_report_reads_the_modelling_log_with_the_text_options(
     logs: tuple[Path, Path, Path, np.ndarray], tmp_path: Path
 ) -> None:
     model, mod, val, data = logs
-    read = ReadOptions(text=TextOptions(names=tuple(NAMES.split(",")), rate_hz=RATE_HZ))
+    read = ReadOptions(names=tuple(NAMES.split(",")), rate_hz=RATE_HZ)
     with warnings.catch_warnings(record=True) as caught:  # how each log was read, said
         warnings.simplefilter("always")
         res = make_report([model], val, tmp_path / "r.html", modeling=mod, averaging_s=1.0,

@@ -20,6 +20,7 @@ import pandas as pd
 import pytest
 
 from thermocal.cli import main
+from thermocal.readers.options import ReadOptions
 
 GAIN, OFFSET = 0.01, -40.0
 N = 6000
@@ -177,9 +178,16 @@ def test_one_finding_from_several_sources_is_shown_once(work: Path) -> None:
     validation = {"warnings": [msg, f"hot.csv: {msg}"]}
     from thermocal.units import TemperatureConversion
 
-    rec = read_recording(work / "mod.csv", time="time (ms)", signals=["gz [deg/s]"],
-                         temperatures=["T1"], temp_unit="counts",
-                         temp_conversion=TemperatureConversion(GAIN, OFFSET))  # fmt: skip
+    rec = read_recording(
+        work / "mod.csv",
+        ReadOptions(
+            time="time (ms)",
+            signals=["gz [deg/s]"],
+            temperatures=["T1"],
+            temp_unit="counts",
+            temp_conversion=TemperatureConversion(GAIN, OFFSET),
+        ),
+    )
     inputs = ReportInputs(
         models=(ModelEntry("m", model, validation),),
         recording=rec,

@@ -20,6 +20,7 @@ import pytest
 from dataflash_writer import imu_log
 from thermocal.cli import main
 from thermocal.readers.dispatch import read_recording
+from thermocal.readers.options import ReadOptions
 
 G0 = 9.80665
 
@@ -46,7 +47,9 @@ def test_dataflash_reads_back_values_and_units(tmp_path: Path) -> None:
              30.0 + 0.05 * i) for i in range(60)]  # fmt: skip
     path = tmp_path / "imu.bin"
     path.write_bytes(imu_log(rows))
-    rec = read_recording(path, signals=["GyrX", "AccZ"], temperatures=["T"], topic="IMU.1")
+    rec = read_recording(
+        path, ReadOptions(signals=["GyrX", "AccZ"], temperatures=["T"], topic="IMU.1")
+    )
     mine = [r for r in rows if r[1] == 1]
     np.testing.assert_allclose(rec.time_s, [r[0] * 1e-6 for r in mine], rtol=0, atol=1e-9)
     np.testing.assert_allclose(rec.column("GyrX"), [r[2] for r in mine], rtol=1e-6)
@@ -54,7 +57,7 @@ def test_dataflash_reads_back_values_and_units(tmp_path: Path) -> None:
     assert rec.units["T"] == "degC"
     np.testing.assert_allclose(rec.column("T"), [r[10] for r in mine], rtol=1e-6)
     with pytest.raises(Exception, match="no IMU messages of instance 2"):
-        read_recording(path, signals=["GyrX"], temperatures=["T"], topic="IMU.2")
+        read_recording(path, ReadOptions(signals=["GyrX"], temperatures=["T"], topic="IMU.2"))
 
 
 def test_ardupilot_correction_removes_95_percent(tmp_path: Path) -> None:

@@ -18,6 +18,7 @@ import numpy as np
 import pytest
 
 from thermocal.cli import main
+from thermocal.readers.options import ReadOptions
 from ulog_writer import SENSOR_FIELDS, ulog_bytes
 
 G0 = 9.80665
@@ -203,7 +204,7 @@ def test_the_holdout_is_held_out(sweep: dict) -> None:
     from thermocal.readers.dispatch import read_recording
 
     log = sweep["dir"].parent / "sweep.ulg"
-    rec = read_recording(log, topic="sensor_gyro.0")
+    rec = read_recording(log, ReadOptions(topic="sensor_gyro.0"))
     temp = rec.column("temperature")
     lo = math.floor(float(temp.min()) / 0.5) * 0.5
     idx = np.floor((temp - lo) / 0.5).astype(int)

@@ -17,6 +17,7 @@ from thermocal.pipeline.turntable import (
     turntable_calibration,
 )
 from thermocal.readers.dispatch import read_recording
+from thermocal.readers.options import ReadOptions
 from thermocal.turntable import calibrate, simulate_turntable16
 from thermocal.writers import write_recording
 
@@ -30,7 +31,7 @@ def test_one_run_is_calibrated_and_written(tmp_path: Path) -> None:
     out = tmp_path / "res.json"
     res = turntable_calibration([path], out, TurntableOptions(GYRO, latitude=40.0))
     assert isinstance(res, SingleRunResult)
-    direct = calibrate(read_recording(path, signals=list(GYRO)), 40.0)
+    direct = calibrate(read_recording(path, ReadOptions(signals=list(GYRO))), 40.0)
     np.testing.assert_array_equal(res.result.kalman.theta, direct.kalman.theta)
     saved = json.loads(out.read_text())
     assert saved["input"] == str(path) and saved["bias_deg_h"] == res.to_dict()["bias_deg_h"]

@@ -25,20 +25,21 @@ from thermocal.cli.common import (
     TimeOpt,
     TimeUnitOpt,
     TopicOpt,
+    check_recording,
     emit,
     fmt,
     handle_errors,
     jsonable,
-    load_recording,
+    read_options,
     split_names,
     stdout,
-    text_options,
 )
 from thermocal.errors import ThermocalInputError, UnitWarning
 
 if TYPE_CHECKING:
     import rich.table as _rich_table
 
+    import thermocal.readers as _readers
     import thermocal.stability.allan as _allan
     import thermocal.stability.analysis as _analysis
     import thermocal.stability.family as _family
@@ -47,6 +48,7 @@ if TYPE_CHECKING:
 else:
     _rich_table = LazyModule("rich.table")
     _writers = LazyModule("thermocal.writers")
+    _readers = LazyModule("thermocal.readers")
     _analysis = LazyModule("thermocal.stability.analysis")
     _family = LazyModule("thermocal.stability.family")
 
@@ -450,19 +452,15 @@ def allan_cmd(
             warnings.filterwarnings(
                 "ignore", ".*no unit stated for the signal column", category=UnitWarning
             )
-        rec = load_recording(
-            file,
-            text=text_options(t_names, t_rate, t_bad, t_delim, t_dec),
-            topic=topic,
-            time=time,
-            time_unit=time_unit,
-            signal=signal,
+        read = read_options(
+            time=time, time_unit=time_unit, signal=signal,
             temps=temps if temps is not None else "",  # no temperature column is read
-            signal_unit=signal_unit,
-            temp_unit=temp_unit,
-            temp_conversion=temp_conversion,
-            keep_other=False,  # the Allan deviation uses the time and the signal only
-        )
+            signal_unit=signal_unit, temp_unit=temp_unit, temp_conversion=temp_conversion,
+            topic=topic, names=t_names, rate=t_rate, on_bad_lines=t_bad, delimiter=t_delim,
+            decimal=t_dec,
+        )  # fmt: skip
+        # the Allan deviation uses the time and the signal only
+        rec = check_recording(_readers.read_recording(file, read, keep_other=False), read)
     _check_plot(plot, file)
     tau_spec = _analysis.parse_taus(taus)
     res = _analysis.allan_analysis(

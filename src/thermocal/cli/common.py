@@ -31,10 +31,10 @@ from thermocal.errors import ThermocalWarning
 from thermocal.pipeline.messages import error_text, warning_lines
 from thermocal.pipeline.messages import jsonable as jsonable
 from thermocal.pipeline.messages import one_line as one_line
-from thermocal.pipeline.reading import load_recording as load_recording
+from thermocal.pipeline.reading import check_recording as check_recording
+from thermocal.pipeline.reading import read_options as read_options
 from thermocal.pipeline.reading import split_floats as split_floats
 from thermocal.pipeline.reading import split_names as split_names
-from thermocal.pipeline.reading import text_options as text_options
 
 if TYPE_CHECKING:
     import numpy as np

@@ -2,7 +2,7 @@
 
 OUT keeps every input column and adds ``<signal>_model`` and ``<signal>_comp``
 (INTERFACE.md).  Files of any size are processed in chunks with constant memory
-(:func:`thermocal.compensate.files.compensate_file`).
+(:func:`thermocal.pipeline.compensate.compensate_file`).
 """
 
 from pathlib import Path
@@ -35,17 +35,17 @@ from thermocal.cli.common import (
     fmt,
     handle_errors,
     progress,
+    read_options,
     stdout,
-    text_options,
 )
 
 if TYPE_CHECKING:
     import rich.table as _rich_table
 
-    import thermocal.compensate.files as _compensate
+    import thermocal.pipeline.compensate as _compensate
 else:
     _rich_table = LazyModule("rich.table")
-    _compensate = LazyModule("thermocal.compensate.files")
+    _compensate = LazyModule("thermocal.pipeline.compensate")
 
 
 @app.command("compensate")
@@ -82,12 +82,14 @@ def compensate_cmd(
 ) -> None:
     """Apply MODEL to FILE; OUT gets every input column plus <signal>_model and <signal>_comp."""
     with progress("compensating") as advance:
+        read = read_options(
+            time=time, time_unit=time_unit, signal_unit=signal_unit, temp_unit=temp_unit,
+            temp_conversion=temp_conversion, topic=topic, names=t_names, rate=t_rate,
+            on_bad_lines=t_bad, delimiter=t_delim, decimal=t_dec,
+        )  # fmt: skip
         run = _compensate.compensate_calibration_file(
-            model_file, file, output, signal=signal, time=time, time_unit=time_unit,
-            signal_unit=signal_unit, temp_unit=temp_unit, temp_conversion=temp_conversion,
-            chunk_rows=chunk_rows, extrapolate=extrapolate, known_input=known_input,
-            on_progress=advance, text=text_options(t_names, t_rate, t_bad, t_delim, t_dec),
-            topic=topic,
+            model_file, file, output, read, signal=signal, chunk_rows=chunk_rows,
+            extrapolate=extrapolate, known_input=known_input, on_progress=advance,
         )  # fmt: skip
     show = {"triads": _show_triads, "single": _show_single, "channels": _show_channels}
     emit(run.to_dict(), as_json, lambda: show[run.kind](run, file))

@@ -25,10 +25,8 @@ from thermocal.cli.common import (
     fmt,
     handle_errors,
     one_line,
-    parse_temp_conversion,
-    split_names,
+    read_options,
     stdout,
-    text_options,
 )
 from thermocal.errors import ThermocalInputError
 
@@ -87,18 +85,14 @@ def inspect_cmd(
     --strict, warnings count too.
     """
     skipped: list[str] = []
-    conv = parse_temp_conversion(temp_conversion) if temp_conversion is not None else None
+    read = read_options(
+        time=time, time_unit=time_unit, signal=signal, temps=temps, signal_unit=signal_unit,
+        temp_unit=temp_unit, temp_conversion=temp_conversion, topic=topic, names=t_names,
+        rate=t_rate, on_bad_lines=t_bad, delimiter=t_delim, decimal=t_dec,
+    )  # fmt: skip
     rec = _readers.read_recording(
         file,
-        text=text_options(t_names, t_rate, t_bad, t_delim, t_dec),
-        topic=topic,
-        time=time,
-        time_unit=time_unit,
-        signals=split_names(signal),
-        temperatures=split_names(temps),
-        signal_unit=signal_unit,
-        temp_unit=temp_unit,
-        temp_conversion=conv,
+        read,
         skipped=skipped,
         guess_temperatures=True,
     )

@@ -26,14 +26,14 @@ from thermocal.cli.common import (
     TimeOpt,
     TimeUnitOpt,
     TopicOpt,
+    check_recording,
     emit,
     fmt,
     handle_errors,
     jsonable,
-    load_recording,
+    read_options,
     split_names,
     stdout,
-    text_options,
 )
 from thermocal.errors import ThermocalInputError
 
@@ -41,11 +41,13 @@ if TYPE_CHECKING:
     import rich.table as _rich_table
 
     import thermocal.metrics as _metrics
+    import thermocal.readers as _readers
     from thermocal.metrics import MetricsResult
     from thermocal.recording import Recording
 else:
     _rich_table = LazyModule("rich.table")
     _metrics = LazyModule("thermocal.metrics")
+    _readers = LazyModule("thermocal.readers")
 
 
 def metrics_json(res: "_metrics.MetricsResult") -> dict[str, Any]:
@@ -147,19 +149,14 @@ def metrics_cmd(
     the run biases with its 68.3 % chi-square interval)."""
 
     def read(file: Path) -> "Recording":
-        return load_recording(
-            file,
-            text=text_options(t_names, t_rate, t_bad, t_delim, t_dec),
-            topic=topic,
-            time=time,
-            time_unit=time_unit,
-            signal=signal,
-            temps=temps,
-            signal_unit=signal_unit,
-            temp_unit=temp_unit,
-            temp_conversion=temp_conversion,
-            keep_other=False,  # metrics use the signal and the temperatures only
-        )
+        r = read_options(
+            time=time, time_unit=time_unit, signal=signal, temps=temps,
+            signal_unit=signal_unit, temp_unit=temp_unit, temp_conversion=temp_conversion,
+            topic=topic, names=t_names, rate=t_rate, on_bad_lines=t_bad, delimiter=t_delim,
+            decimal=t_dec,
+        )  # fmt: skip
+        # metrics use the signal and the temperatures only
+        return check_recording(_readers.read_recording(file, r, keep_other=False), r)
 
     def options() -> "_metrics.MetricsOptions":
         t_names_ = split_names(temps)

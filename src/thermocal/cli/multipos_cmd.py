@@ -26,9 +26,9 @@ from thermocal.cli.common import (
     emit,
     fmt,
     handle_errors,
+    read_options,
     split_names,
     stdout,
-    text_options,
 )
 from thermocal.errors import ThermocalInputError
 
@@ -278,7 +278,9 @@ def multipos_cmd(
         _mpf.count_scale(accel_scale, "accel"), _mpf.count_scale(gyro_scale, "gyro"),
         window_s, still_threshold, motion_fraction, drift_deg, accel_offset, gyro_offset,
         gyro_model,
-        text=text_options(t_names, t_rate, t_bad, t_delim, t_dec),
+        read=read_options(
+            names=t_names, rate=t_rate, on_bad_lines=t_bad, delimiter=t_delim, decimal=t_dec
+        ),
     )  # fmt: skip
     res = _mpf.calibrate_files(files, output, opts, poses)
     out, a_unit = res.summary, res.accel_unit

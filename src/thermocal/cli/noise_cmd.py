@@ -19,13 +19,13 @@ from thermocal.cli.common import (
     TimeOpt,
     TimeUnitOpt,
     TopicOpt,
+    check_recording,
     fmt,
     handle_errors,
     jsonable,
-    load_recording,
+    read_options,
     split_names,
     stdout,
-    text_options,
 )
 from thermocal.errors import ThermocalInputError
 from thermocal.identifiers import one_line
@@ -33,12 +33,14 @@ from thermocal.identifiers import one_line
 if TYPE_CHECKING:
     import rich.table as _rich_table
 
+    import thermocal.readers as _readers
     import thermocal.stability.analysis as _analysis
     import thermocal.stability.noise_model as _nm
     import thermocal.writers as _writers
 else:
     _rich_table = LazyModule("rich.table")
     _writers = LazyModule("thermocal.writers")
+    _readers = LazyModule("thermocal.readers")
     _analysis = LazyModule("thermocal.stability.analysis")
     _nm = LazyModule("thermocal.stability.noise_model")
 
@@ -137,18 +139,20 @@ def noise_cmd(
     _writers.check_not_input(output, [file])
     if output.is_dir():
         raise ThermocalInputError(f"{output}: is a directory, expected a file name")
-    rec = load_recording(
-        file,
-        text=text_options(t_names, t_rate, t_bad, t_delim, t_dec),
-        topic=topic,
-        time=time,
-        time_unit=time_unit,
-        signal=",".join(g_names + a_names),
+    read = read_options(
+        time=time, time_unit=time_unit, signal=",".join(g_names + a_names),
         signal_unit=_unit_list(gyro_unit, accel_unit, len(g_names), len(a_names)),
+        topic=topic, names=t_names, rate=t_rate, on_bad_lines=t_bad, delimiter=t_delim,
+            decimal=t_dec,
+    )  # fmt: skip
+    rec = _readers.read_recording(
+        file,
+        read,
         keep_other=False,
         ask_units={**dict.fromkeys(g_names, "--gyro-unit"),
                    **dict.fromkeys(a_names, "--accel-unit")},
     )  # fmt: skip
+    check_recording(rec, read)
     res = _analysis.imu_noise(
         rec, g_names, a_names, inflate=inflate, rostopic=rostopic, confidence=confidence,
         where=str(file),

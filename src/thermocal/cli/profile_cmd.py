@@ -29,9 +29,9 @@ from thermocal.cli.common import (
     TopicOpt,
     emit,
     handle_errors,
+    read_options,
     split_floats,
     stdout,
-    text_options,
 )
 from thermocal.cli.common import RateOpt as TextRateOpt
 from thermocal.errors import ThermocalInputError
@@ -320,11 +320,16 @@ def correlate_cmd(
     as_json: JsonOpt = False,
 ) -> None:
     """r = Cov(X, Y)/(σX σY) of two temperature histories on a common elapsed-time base."""
-    text = text_options(t_names, t_rate, t_bad, t_delim, t_dec)
-    ta, xa, ca = _program.read_history(file_a, column, text=text, topic=topic)
-    tb, xb, cb = _program.read_history(
-        file_b, column_b if column_b is not None else column, text=text, topic=topic
+    read = read_options(
+        topic=topic,
+        names=t_names,
+        rate=t_rate,
+        on_bad_lines=t_bad,
+        delimiter=t_delim,
+        decimal=t_dec,
     )
+    ta, xa, ca = _program.read_history(file_a, column, read)
+    tb, xb, cb = _program.read_history(file_b, column_b if column_b is not None else column, read)
     res = _profiles.correlate(ta, xa, tb, xb, r_limit=limit, n_points=points)
     out = {
         "r": res.r,

@@ -31,8 +31,8 @@ from thermocal.cli.common import (
     TurntableLatitudeOpt,
     handle_errors,
     progress,
+    read_options,
     stderr,
-    text_options,
 )
 
 if TYPE_CHECKING:
@@ -119,10 +119,10 @@ def report_cmd(
 
         if any(p is not None and p.is_dir() and is_station_path(p) for p in (recording, modeling)):
             topic = sensor
-    read = _report_files.ReadOptions(
+    read = read_options(
         time=time, time_unit=time_unit, signal_unit=signal_unit, temp_unit=temp_unit,
-        temp_conversion=temp_conversion,
-        text=text_options(t_names, t_rate, t_bad, t_delim, t_dec), topic=topic,
+        temp_conversion=temp_conversion, topic=topic, names=t_names, rate=t_rate,
+        on_bad_lines=t_bad, delimiter=t_delim, decimal=t_dec,
     )  # fmt: skip
     res = _report_files.make_report(
         model, recording, output, validations=list(validation or []), modeling=modeling,

@@ -29,9 +29,9 @@ from thermocal.cli.common import (
     emit,
     fmt,
     handle_errors,
+    read_options,
     split_names,
     stdout,
-    text_options,
 )
 from thermocal.defaults import overrides_of
 from thermocal.errors import ThermocalInputError
@@ -189,7 +189,11 @@ def turntable_cmd(
         (accel_cols[0], accel_cols[1], accel_cols[2]) if accel_cols else None,
         temps, latitude, time, time_unit, gyro_unit, accel_unit, gravity, alpha, beta,
         encoder_unit, arw, encoder_noise, min_dwell, channels,
-        text_options(t_names, t_rate, t_bad, t_delim, t_dec), topic, alpha_offset,
+        read_options(
+            names=t_names, rate=t_rate, on_bad_lines=t_bad, delimiter=t_delim, decimal=t_dec
+        ),
+        topic,
+        alpha_offset,
     )  # fmt: skip
     res = _files.turntable_calibration(
         files, output, opts, order=order, tref_c=tref, overrides=overrides_of(allow_narrow, False)

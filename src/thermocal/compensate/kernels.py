@@ -1,5 +1,5 @@
 """Compensation with a fitted model, in memory and live (SPEC §4, §8): the maths of
-:mod:`thermocal.compensate.files` without files (issue 15: the maths imports no I/O).
+:mod:`thermocal.pipeline.compensate` without files (issue 15: the maths imports no I/O).
 
 A model gives the temperature-induced part of the signal, ``ŷ = model(T, Ṫ, …)``; the
 compensated output is ``F' = F − ŷ`` (SPEC §4c: "output F' = F − ΔF").
@@ -197,7 +197,7 @@ def prepare_run(
     """The recording's signal and temperatures as the model takes them (validate, report).
 
     ``rec`` should be read with the model's recorded units as fallbacks
-    (``load_recording(..., model=model)``).  A signal of another kind than the model's is
+    (``read_recording(..., model=model)``).  A signal of another kind than the model's is
     refused (:func:`check_signal_kind`); raw-count temperatures are converted, or kept as
     counts for a model fitted in counts (a mismatch is refused).  ``known_input`` is in
     the data's unit.

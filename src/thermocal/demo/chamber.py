@@ -21,7 +21,7 @@ model of a ring-laser gyroscope*
    r of the chamber temperatures, hold-stage bias stability and repeatability
    before and after), saved as the JSON of ``thermocal validate --json``.
 5. **Compensation** of the validation file with the reported model
-   (:func:`thermocal.compensate.files.compensate_file`).
+   (:func:`thermocal.pipeline.compensate.compensate_file`).
 6. **C export** of both models (:func:`thermocal.export.c.export_c`).
 7. **Report** — ``report.html`` (:func:`thermocal.report.write_report`) with the
    figures of merit and Allan deviation before and after compensation.
@@ -43,13 +43,13 @@ from typing import Any
 import numpy as np
 
 from thermocal import units
-from thermocal.compensate.files import compensate_file
 from thermocal.compensate.kernels import zero_reference
 from thermocal.errors import ModelFileError, ThermocalWarning
 from thermocal.export.c import export_c
 from thermocal.models.base import RunData, TemperatureModel
 from thermocal.models.files import save_model
 from thermocal.models.registry import make_model
+from thermocal.pipeline.compensate import compensate_file
 from thermocal.profiles import design_validation_profile, rlg_modelling
 from thermocal.recording import Recording
 from thermocal.report import ModelEntry, ReportInputs, write_report

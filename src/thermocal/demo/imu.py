@@ -23,14 +23,14 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from thermocal import units
-from thermocal.compensate.files import compensate_channels, prepare_run
-from thermocal.compensate.kernels import zero_reference
+from thermocal.compensate.kernels import prepare_run, zero_reference
 from thermocal.errors import ThermocalWarning
 from thermocal.export.c import generate_c_calibration
 from thermocal.models.base import RunData, model_file_dict, model_inputs
 from thermocal.models.calibration import Calibration, Channel, guess_role
 from thermocal.models.files import save_calibration
 from thermocal.models.poly import PolyModel
+from thermocal.pipeline.compensate import compensate_channels
 from thermocal.report.calibration import CalibrationReportInputs, write_calibration_report
 from thermocal.simulate import IMU_CHANNELS, SCENARIOS
 from thermocal.validation import validate

@@ -3,12 +3,14 @@
 options    :class:`FitOptions`, :class:`ValidateOptions`: one field per option of ``thermocal
            fit`` / ``thermocal validate`` (same names, dashes as underscores), built from the
            command line or from a fleet configuration's ``[fit]``/``[validate]`` tables
-reading    :func:`load_recording`: a data file read with the commands' options (text-log
-           options, ``--topic``, units as a model file states them)
+reading    :func:`read_options` / :func:`read_options_of`: the commands' options as one
+           ``ReadOptions``; :func:`check_recording`: what a command needs of a recording
 fit        :func:`fit_files` → :class:`FitResult`: a model (one channel) or a calibration
            (several) fitted on recordings and saved
 validate   :func:`validate_files` → :class:`ValidationReport`: a model or calibration judged on
            an independent recording (:func:`thermocal.validation.validate`)
+compensate :func:`compensate_calibration_file`: a model or calibration applied to a recording
+           in chunks with constant memory
 messages   JSON-ready values and warning lines as the command line prints them
 
 Nothing heavy is imported here: ``thermocal fit --help`` loads not even numpy.

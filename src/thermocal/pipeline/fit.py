@@ -9,7 +9,8 @@ checksums.  The family is looked up in the registry
 (:func:`thermocal.models.registry.get_model_class`)
 and built from the options by its one option parser (:meth:`TemperatureModel.from_cli_options`,
 :func:`model_options` gives the keys).  Every file is read once, through
-:func:`thermocal.pipeline.reading.load_recording` with the text-log options and ``topic``.
+:func:`thermocal.readers.read_recording` with one ``ReadOptions``
+(:func:`thermocal.pipeline.reading.read_options_of`).
 
 The data are judged before the fit (:func:`thermocal.adequacy.judge`: refused when they cannot
 support the model, unless overridden); the earth rate seen by a gyro's axis (``latitude``,
@@ -36,7 +37,7 @@ from thermocal.defaults import overrides_of
 from thermocal.errors import ConditioningWarning, PlausibilityWarning, ThermocalInputError
 from thermocal.pipeline.messages import one_line
 from thermocal.pipeline.options import FitOptions
-from thermocal.pipeline.reading import load_recording, split_floats, split_names, text_options
+from thermocal.pipeline.reading import check_recording, read_options_of, split_floats, split_names
 from thermocal.readers.station import station_sensor_paths
 
 if TYPE_CHECKING:
@@ -698,23 +699,11 @@ def fit_files(paths: Sequence[Path], options: FitOptions, output: Path) -> FitRe
     family_options = _check_options(paths, o, output)
     names = split_names(o.signal) or []
     g_local = _local_gravity(o.gravity_axis, o.gravity, o.latitude)
-    text = text_options(o.names, o.rate, o.on_bad_lines, o.delimiter, o.decimal)
+    from thermocal.readers.dispatch import read_recording
+
+    read = read_options_of(o)
     loaded = [
-        (
-            path,
-            load_recording(
-                path,
-                time=o.time,
-                time_unit=o.time_unit,
-                signal=o.signal,
-                temps=o.temps,
-                signal_unit=o.signal_unit,
-                temp_unit=o.temp_unit,
-                temp_conversion=o.temp_conversion,
-                text=text,
-                topic=o.topic,
-            ),
-        )
+        (path, check_recording(read_recording(path, read), read))
         for path in station_sensor_paths(paths, o.topic)
     ]
     if o.tref is not None and o.model != "poly":

@@ -5,7 +5,7 @@ temperature over several sessions (:func:`thermocal.turntable.thermal.fit_triad`
 turntable's own thermal fit) and save the calibration of triads.
 
 The maths of :mod:`thermocal.multipos` reads no file; this module is where files come in
-and go out (file layer, as :mod:`thermocal.compensate.files` for the compensation kernels).
+and go out (file layer, as :mod:`thermocal.pipeline.compensate` for the compensation kernels).
 """
 
 from __future__ import annotations
@@ -39,7 +39,7 @@ from thermocal.multipos.poses import (
 )
 from thermocal.pipeline.turntable import check_as_read
 from thermocal.readers import read_recording
-from thermocal.readers.text import TextOptions
+from thermocal.readers.options import ReadOptions
 from thermocal.recording import Recording
 from thermocal.turntable import thermal
 
@@ -81,9 +81,10 @@ class MultiposOptions:
     ADC counts); None: none, or mid-scale found in unsigned counts (a warning)."""
     gyro_model: str = "full"
     """The gyro's elements of E fitted (:data:`thermocal.multipos.gyro.GYRO_MODELS`)."""
-    text: TextOptions | None = None
-    """How to read a text log and its time (``--rate HZ``: a sample counter, or samples at
-    the nominal rate; ``--names`` …), as every command reads it."""
+    read: ReadOptions | None = None
+    """How to read a text log and its time (``rate_hz``: a sample counter, or samples at
+    the nominal rate; ``names`` …), as every command reads it; its columns and units are
+    those named above."""
 
     def check(self, n_files: int, poses: Path | None) -> None:
         """The options' own consistency (before any file is read)."""
@@ -393,10 +394,15 @@ def _session(
     """Read and calibrate one session file; its accelerometer and gyro units."""
     acc_cols, gyr_cols, temps = list(opts.accel), list(opts.gyro or []) or None, opts.temps
     given = [opts.accel_unit] * 3 + ([opts.gyro_unit] * 3 if gyr_cols else [])
-    rec = read_recording(
-        path, time=opts.time, time_unit=opts.time_unit, signals=[*acc_cols, *(gyr_cols or [])],
+    read = (opts.read or ReadOptions()).replace(
+        time=opts.time,
+        time_unit=opts.time_unit,
+        signals=(*acc_cols, *(gyr_cols or [])),
         signal_unit=",".join(u or "" for u in given) if any(given) else None,
-        temperatures=[temps] if temps else None, text=opts.text,
+        temperatures=(temps,) if temps else None,
+    )
+    rec = read_recording(
+        path, read,
         ask_units={**dict.fromkeys([] if opts.accel_scale else acc_cols, "--accel-unit"),
                    **dict.fromkeys([] if opts.gyro_scale else (gyr_cols or []), "--gyro-unit")},
         implied_units={**dict.fromkeys(acc_cols if opts.accel_scale else [], "counts"),

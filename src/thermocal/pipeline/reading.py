@@ -1,6 +1,7 @@
-"""A data file read with the options of the commands (options win over the file): the one
-reading path of ``fit`` and ``validate`` (their main files and ``validate --modeling``),
-through :func:`thermocal.readers.dispatch.read_recording`."""
+"""How the commands read a data file: their options (strings) become one
+:class:`~thermocal.readers.options.ReadOptions` (:func:`read_options`, :func:`read_options_of`),
+the file is read by :func:`thermocal.readers.read_recording`, and what a command needs of the
+recording is checked in a second step (:func:`check_recording`)."""
 
 from __future__ import annotations
 
@@ -11,9 +12,8 @@ from typing import TYPE_CHECKING, Any
 from thermocal.errors import GapWarning, ThermocalInputError
 
 if TYPE_CHECKING:
-    from thermocal.models.base import TemperatureModel
-    from thermocal.readers.text import TextOptions
-    from thermocal.recording import Metadata, Recording
+    from thermocal.readers.options import ReadOptions
+    from thermocal.recording import Recording
 
 
 def split_names(text: str | None) -> list[str] | None:
@@ -38,30 +38,7 @@ def split_floats(text: str | None, what: str) -> list[float] | None:
         ) from None
 
 
-def text_options(
-    names: str | None,
-    rate: float | None,
-    on_bad_lines: str,
-    delimiter: str | None,
-    decimal: str | None,
-) -> TextOptions | None:
-    """The text-log options ``--names a,b,c``, ``--rate HZ``, ``--on-bad-lines``,
-    ``--delimiter``, ``--decimal`` (None when none is given)."""
-    from thermocal.readers.text import TextOptions
-
-    if names is None and rate is None and on_bad_lines == "error" and not delimiter and not decimal:
-        return None
-    return TextOptions(
-        names=tuple(split_names(names) or []) if names is not None else None,
-        rate_hz=rate,
-        on_bad_lines=on_bad_lines,
-        delimiter=delimiter,
-        decimal=decimal,
-    )
-
-
-def load_recording(
-    path: Path,
+def read_options(
     *,
     time: str | None = None,
     time_unit: str | None = None,
@@ -69,79 +46,128 @@ def load_recording(
     temps: str | None = None,
     signal_unit: str | None = None,
     temp_unit: str | None = None,
-    meta: Metadata | None = None,
-    require_signal: bool = True,
-    check: bool = True,
     temp_conversion: str | None = None,
-    model_inputs: dict[str, Any] | None = None,
-    model: TemperatureModel | None = None,
-    keep_other: bool = True,
-    text: TextOptions | None = None,
     topic: str | None = None,
-    ask_units: dict[str, str] | None = None,
-) -> Recording:
-    """Read a recording with the command line's options (options win over the file).
+    names: str | None = None,
+    rate: float | None = None,
+    on_bad_lines: str = "error",
+    delimiter: str | None = None,
+    decimal: str | None = None,
+) -> ReadOptions:
+    """The :class:`~thermocal.readers.options.ReadOptions` of the command-line options that
+    say how a file is read.
 
-    ``keep_other=False`` reads only the time, signal and temperature columns (8 bytes a
-    row less for every other column, for commands that use no other).
+    Parameters
+    ----------
+    time, time_unit, signal_unit, temp_unit, topic, delimiter, decimal : str, optional
+        ``--time``, ``--time-unit``, ``--signal-unit``, ``--temp-unit``, ``--topic``,
+        ``--delimiter``, ``--decimal`` as given.
+    signal, temps, names : str, optional
+        ``--signal``, ``--temps``, ``--names``: comma-separated column names (an empty
+        ``--signal`` is none given; an empty ``--temps`` states there is none).
+    temp_conversion : str, optional
+        ``--temp-conversion GAIN,OFFSET[,int16]``: raw counts → °C.
+    rate : float, optional
+        ``--rate`` [Hz].
+    on_bad_lines : str
+        ``--on-bad-lines``: ``error`` or ``skip``.
 
-    A signal named with ``--signal`` becomes the first signal; without it the
-    file's sidecar roles are used.  With ``require_signal`` a recording with no
-    signal at all is an input error.  With ``check`` (INTERFACE.md common rules)
-    the time column must be finite and strictly increasing and the signal and
-    temperature columns free of NaN (:meth:`Recording.validate`, an input error
-    naming the file, column and row); gaps are allowed and reported as one
-    :class:`GapWarning`.  ``temp_conversion`` (``"GAIN,OFFSET[,int16]"``) sets the raw-count
-    conversion ``T[°C] = GAIN·counts + OFFSET`` of every temperature column.
-    ``model`` (a fitted model; or ``model_inputs``, a model file's ``inputs``) fills in
-    what the options and the file leave unstated: the time unit, column units and
-    temperature conversions as fitted (:meth:`TemperatureModel.input_units`).  Every unit
-    is resolved once, by :func:`thermocal.units.resolve_inputs`.  ``text`` (the text-log
-    options, :func:`text_options`) and ``topic`` (a ULog topic) choose how the file is read.
-    ``ask_units`` maps a column to the option that states its unit: asked for, not assumed.
+    Returns
+    -------
+    ReadOptions
+
+    Raises
+    ------
+    thermocal.errors.UnitError
+        ``temp_conversion`` is not ``GAIN,OFFSET[,int16]`` (named ``--temp-conversion``).
+    thermocal.errors.ParameterError
+        A value no file can have, naming the :class:`ReadOptions` field.
     """
     from thermocal import units
-    from thermocal.readers.dispatch import read_recording
+    from thermocal.readers.options import ReadOptions
 
-    stated: units.StatedUnits | None = None
-    if model is not None:
-        stated = model.input_units()
-    elif model_inputs is not None:
-        stated = units.StatedUnits.from_model_inputs(model_inputs)
     conv = (
         None
         if temp_conversion is None
         else units.temperature_conversion(temp_conversion, "--temp-conversion")
     )
-    rec = read_recording(
-        path, time=time, time_unit=time_unit,
-        signals=split_names(signal) if signal else None,  # "gx,gy,gz": several channels
-        temperatures=split_names(temps), signal_unit=signal_unit, temp_unit=temp_unit,
-        meta=meta, model=stated, keep_other=keep_other, text=text, topic=topic,
-        temp_conversion=conv, ask_units=ask_units,
+    return ReadOptions(
+        time=time, time_unit=time_unit,
+        signals=tuple(split_names(signal) or ()) if signal else None,
+        temperatures=tuple(split_names(temps) or ()) if temps is not None else None,
+        signal_unit=signal_unit, temp_unit=temp_unit, temp_conversion=conv, topic=topic,
+        names=names, rate_hz=rate, on_bad_lines=on_bad_lines,  # type: ignore[arg-type]
+        delimiter=delimiter, decimal=decimal,  # type: ignore[arg-type]
     )  # fmt: skip
-    if model is not None or model_inputs is not None:
-        from thermocal.models.base import check_sensor_id
 
-        fitted = getattr(model, "inputs_", None) if model is not None else model_inputs
-        check_sensor_id(fitted, rec.meta.sensor_id, str(path))
+
+def read_options_of(o: Any) -> ReadOptions:
+    """The :class:`~thermocal.readers.options.ReadOptions` of a command's options object.
+
+    Parameters
+    ----------
+    o : object
+        ``FitOptions``, ``ValidateOptions`` or any object with (some of) the fields
+        ``time``, ``time_unit``, ``signal``, ``temps``, ``signal_unit``, ``temp_unit``,
+        ``temp_conversion``, ``topic``, ``names``, ``rate``, ``on_bad_lines``,
+        ``delimiter``, ``decimal`` (the options' strings).
+
+    Returns
+    -------
+    ReadOptions
+        As :func:`read_options` builds it from those fields.
+    """
+    fields = ("time", "time_unit", "signal", "temps", "signal_unit", "temp_unit",
+              "temp_conversion", "topic", "names", "rate", "delimiter", "decimal")  # fmt: skip
+    given = {f: getattr(o, f) for f in fields if getattr(o, f, None) is not None}
+    return read_options(on_bad_lines=getattr(o, "on_bad_lines", "error"), **given)
+
+
+def check_recording(
+    rec: Recording,
+    read: ReadOptions | None = None,
+    *,
+    require_signal: bool = True,
+    validate: bool = True,
+) -> Recording:
+    """What a command needs of a recording it has read: a signal, time and values it can use.
+
+    Parameters
+    ----------
+    rec : Recording
+        As :func:`thermocal.readers.read_recording` read it (``rec.source``: its file).
+    read : ReadOptions, optional
+        How it was read (to list the file's columns when no signal is named).
+    require_signal : bool
+        A recording with no signal at all is an input error naming ``--signal`` and the
+        available columns.
+    validate : bool
+        The time column must be finite and strictly increasing and the signal and
+        temperature columns free of NaN (:meth:`Recording.validate`, an input error naming
+        the file, column and row); gaps are allowed and said in one :class:`GapWarning`.
+
+    Returns
+    -------
+    Recording
+        ``rec`` itself.
+
+    Raises
+    ------
+    thermocal.errors.ThermocalInputError
+        No signal (with ``require_signal``), or time or values unusable (with ``validate``).
+    """
+    path = Path(rec.source or "recording")
     if require_signal and not rec.signals:
         names = list(rec.columns)
-        if not names and not keep_other:  # only the named columns were read: list them all
-            try:
-                with warnings.catch_warnings():  # said once already, by the first read
-                    warnings.simplefilter("ignore")
-                    again = read_recording(path, time=time, text=text, topic=topic)
-                names = list(again.columns)
-            except Exception:  # the listing is a courtesy; the error stands as it is
-                names = []
+        if not names:  # only the named columns were read: list them all
+            names = _all_columns(path, read)
         from thermocal.readers.common import names_list
 
         raise ThermocalInputError(
             f"{path}: name the signal column with --signal; available: "
             + (names_list(names) or "see thermocal inspect FILE")  # 20 and how many more
         )
-    if check:
+    if validate:
         rec.validate()
         gaps = rec.gaps()
         if gaps:
@@ -156,4 +182,31 @@ def load_recording(
     return rec
 
 
-__all__ = ["load_recording", "split_floats", "split_names", "text_options"]
+def _all_columns(path: Path, read: ReadOptions | None) -> list[str]:
+    """Every column of the file, read again with its time column and layout (a courtesy
+    listing: empty when that read fails)."""
+    from thermocal.readers.dispatch import read_recording
+    from thermocal.readers.options import ReadOptions
+
+    r = read or ReadOptions()
+    try:
+        with warnings.catch_warnings():  # said once already, by the first read
+            warnings.simplefilter("ignore")
+            again = read_recording(
+                path,
+                ReadOptions(time=r.time, topic=r.topic, names=r.names, rate_hz=r.rate_hz,
+                            on_bad_lines=r.on_bad_lines, delimiter=r.delimiter,
+                            decimal=r.decimal),
+            )  # fmt: skip
+        return list(again.columns)
+    except Exception:  # the listing is a courtesy; the error stands as it is
+        return []
+
+
+__all__ = [
+    "check_recording",
+    "read_options",
+    "read_options_of",
+    "split_floats",
+    "split_names",
+]

@@ -21,7 +21,7 @@ import numpy as np
 
 from thermocal import adequacy, units
 from thermocal.errors import ThermocalInputError
-from thermocal.readers.text import TextOptions
+from thermocal.readers.options import ReadOptions
 from thermocal.recording import Recording
 from thermocal.turntable import thermal as _thermal
 from thermocal.turntable.calibrate import TurntableResult, calibrate
@@ -55,7 +55,8 @@ class TurntableOptions:
     encoder_noise: float | None = None
     min_dwell: float = 60.0
     channels: int = 3
-    text: TextOptions | None = None
+    read: ReadOptions | None = None
+    """A text log's layout (``names``, ``rate_hz``, …); the columns are those named above."""
     topic: str | None = None
     alpha_offset: float = 0.0
     """The α encoder's reading at the geometry's α = 0 [°] (``--alpha-offset``)."""
@@ -83,17 +84,15 @@ def read_run(path: Path, o: TurntableOptions) -> Recording:
     (gyro_z in °/s), the last stated in a warning."""
     from thermocal.readers.dispatch import read_recording
 
-    return read_recording(
-        path,
+    read = (o.read or ReadOptions()).replace(
         time=o.time,
         time_unit=o.time_unit,
-        signals=list(o.gyro),
+        signals=tuple(o.gyro),
         signal_unit=o.gyro_unit,
-        temperatures=[o.temps] if o.temps else None,
-        model=units.StatedUnits(signal_default="deg/s"),
-        text=o.text,
+        temperatures=(o.temps,) if o.temps else None,
         topic=o.topic,
     )
+    return read_recording(path, read, model=units.StatedUnits(signal_default="deg/s"))
 
 
 def calibrate_run(

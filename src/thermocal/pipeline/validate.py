@@ -4,8 +4,8 @@
 ``r`` compares the ``ambient`` column of the modelling and validation runs (default: the
 model's first temperature column).  The modelling run is ``options.modeling``, else the model
 file's recorded data file if it still exists (:func:`modeling_file`); otherwise ``r`` is null,
-with a warning.  Both files are read through :func:`thermocal.pipeline.reading.load_recording`
-with the same options (time, units, temperature conversion and the text-log options: a
+with a warning.  Both files are read through :func:`thermocal.readers.read_recording`
+with the same ReadOptions (time, units, temperature conversion and the text-log options: a
 headerless serial log as the modelling run needs ``names`` as much as the validated one).
 A calibration of triads (``thermocal turntable``, ``thermocal multipos``) is judged on a
 turntable or multi-position run instead (dwell-mean and move-angle errors, held-out poses).
@@ -20,13 +20,13 @@ from typing import TYPE_CHECKING, Any
 
 from thermocal.errors import FileFormatError, ThermocalInputError, ThermocalWarning, UnitWarning
 from thermocal.pipeline.options import ValidateOptions
-from thermocal.pipeline.reading import load_recording, split_names, text_options
-from thermocal.readers.common import file_kind
+from thermocal.pipeline.reading import check_recording, read_options_of, split_names
+from thermocal.readers.formats import file_kind, format_named
 
 if TYPE_CHECKING:
     from thermocal.models.base import TemperatureModel
     from thermocal.models.calibration import Calibration
-    from thermocal.readers.text import TextOptions
+    from thermocal.readers.options import ReadOptions
     from thermocal.recording import FloatArray, Recording
     from thermocal.validation import ValidationResult
 
@@ -113,7 +113,7 @@ class _Context:
     model_file: Path
     file: Path
     o: ValidateOptions
-    text: TextOptions | None
+    read: ReadOptions
     modeling: dict[Path, Recording]
 
 
@@ -130,19 +130,13 @@ def _modeling_ambient(
         return None, None
     mrec = ctx.modeling.get(mod_path)
     if mrec is None or amb not in mrec.columns:
-        mrec = load_recording(
-            mod_path,
-            time=o.time,
-            time_unit=o.time_unit,
-            temps=amb,
-            temp_unit=o.temp_unit,
-            temp_conversion=o.temp_conversion,
-            model=model,
-            require_signal=False,
-            check=False,
-            text=ctx.text,
+        from thermocal.readers.dispatch import read_recording
+
+        read = ctx.read.replace(
+            signals=None, temperatures=(amb,), signal_unit=None,
             topic=o.topic if _is_log(mod_path) else None,
-        )
+        )  # fmt: skip
+        mrec = read_recording(mod_path, read, model=model)
         for prob in recording.find_problems(mrec, required=[amb]):
             if prob.severity == "error" and (prob.column in (None, "time", amb)):
                 raise ThermocalInputError(f"{mod_path}: {prob.message}")
@@ -154,7 +148,7 @@ def _is_log(path: Path) -> bool:
     """A flight-controller log (``.ulg``, ``.bin``), which ``--topic`` applies to; a station
     folder, a CSV or Parquet file is not (and a name no reader accepts is said by the reader)."""
     try:
-        return file_kind(path) in ("ulog", "dataflash")
+        return "topic" in format_named(file_kind(path)).options
     except FileFormatError:
         return False
 
@@ -165,26 +159,17 @@ def _validate_channel(
     """Validate one model on its signal column; (result, --json object).  ``rec``: the
     file already read (several channels: once for all of them)."""
     from thermocal import validation
-    from thermocal.compensate import files as compensate
+    from thermocal.compensate import kernels as compensate
 
     o = ctx.o
     temps = list(model.temp_names_)
     amb = o.ambient or temps[0]
     read_temps = temps if amb in temps else [*temps, amb]
     if rec is None:
-        rec = load_recording(
-            ctx.file,
-            time=o.time,
-            time_unit=o.time_unit,
-            signal=sig,
-            temps=",".join(read_temps),
-            signal_unit=o.signal_unit,
-            temp_unit=o.temp_unit,
-            temp_conversion=o.temp_conversion,
-            model=model,
-            text=ctx.text,
-            topic=o.topic,
-        )
+        from thermocal.readers.dispatch import read_recording
+
+        read = ctx.read.replace(signals=(sig,), temperatures=tuple(read_temps))
+        rec = check_recording(read_recording(ctx.file, read, model=model), read)
     # the data in the model's units (kinds checked); figures go back to the data's unit
     prepared = compensate.prepare_run(model, rec, sig, temps)
     counts = prepared.data_unit == "counts"  # raw counts: figures in K's physical unit
@@ -231,18 +216,13 @@ def _validate_channels(ctx: _Context, cal: Calibration) -> ValidationReport:
     read_temps = temperatures_of(cal, chosen)
     if o.ambient and o.ambient not in read_temps:
         read_temps.append(o.ambient)
-    rec_all = load_recording(
-        ctx.file,
-        time=o.time,
-        time_unit=o.time_unit,
-        signal=",".join(cal.channel(n).signal for n in chosen),
-        temps=",".join(read_temps),
-        signal_unit=o.signal_unit,
-        temp_unit=o.temp_unit,
-        temp_conversion=o.temp_conversion,
-        model_inputs=merged_inputs(cal, chosen),
-        text=ctx.text,
-        topic=o.topic,
+    from thermocal.readers.dispatch import read_recording
+
+    read = ctx.read.replace(
+        signals=tuple(cal.channel(n).signal for n in chosen), temperatures=tuple(read_temps)
+    )
+    rec_all = check_recording(
+        read_recording(ctx.file, read, model=merged_inputs(cal, chosen)), read
     )
     per = []
     for n in chosen:
@@ -274,18 +254,11 @@ def _validate_triads(
     """A calibration of triads judged on a turntable run (issue 19), or on held-out poses
     of a multi-position calibration (issue 30); a warning per triad for the share of samples
     outside its calibrated temperature range."""
-    from thermocal.compensate.files import read_for_triads
     from thermocal.multipos import validate as _mp_validate
+    from thermocal.pipeline.compensate import read_for_triads
     from thermocal.turntable.calibrate import validate_turntable_run
 
-    rec = read_for_triads(
-        file,
-        cal.triads,
-        time=o.time,
-        time_unit=o.time_unit,
-        text=text_options(o.names, o.rate, o.on_bad_lines, o.delimiter, o.decimal),
-        topic=o.topic,
-    )
+    rec = read_for_triads(file, cal.triads, read_options_of(o))
     _own_session(cal, file)
     if _mp_validate.is_multipos(cal.triads):  # held-out poses (issue 30)
         results: list[Any] = _mp_validate.validate_held_out_session(
@@ -318,8 +291,7 @@ def validate_files(
     pre = load_calibration(calibration)
     if pre.triads and not pre.channels:
         return _validate_triads(pre, calibration, file, o)
-    text = text_options(o.names, o.rate, o.on_bad_lines, o.delimiter, o.decimal)
-    ctx = _Context(calibration, file, o, text, {})
+    ctx = _Context(calibration, file, o, read_options_of(o), {})
     cal = load_calibration(calibration)  # a model file is a calibration of one channel
     cal.require_channels("validate")
     if len(cal.channels) > 1:

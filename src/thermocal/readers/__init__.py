@@ -1,4 +1,4 @@
-"""Readers: one module per file format, one entry (:func:`read_recording`) for all of them.
+"""Readers: one module per file format, one registry of formats, one reading call.
 
 =====================  ==========================================================
 module                 format
@@ -8,44 +8,49 @@ module                 format
 ``ulog``               PX4 ULog, by topic and instance
 ``dataflash``          ArduPilot DataFlash ``.bin``, by message
 ``station``            the folder ``thermocal station run`` writes
-``dispatch``           :func:`read_recording`: the format chosen by the file
+``chunks``             the formats read a chunk at a time (CSV, Parquet, station)
+``formats``            the file-format registry (:class:`FileFormat`, entry points)
+``options``            :class:`ReadOptions`, how a file is read
+``dispatch``           :func:`read_recording`: the format looked up in the registry
 =====================  ==========================================================
 
-Public entry points: :func:`read_recording` (every format, one set of options) and
-:func:`recording_info` (what a file says of its columns, without reading them); for commands
-that go through a file in chunks, :func:`read_log_table` (a flight-controller log's topic)
-and :func:`read_text_table` (a text log read with its options); the flight-controller logs
-themselves: :func:`ulog_sensor_instances`, :func:`read_dataflash_log`,
-:func:`dataflash_table`, and :func:`parse_topic` for ``--topic``.
+Public entry points: :func:`read_recording` (every format, one :class:`ReadOptions`),
+:func:`recording_info` (the metadata object written beside a recording),
+:func:`read_whole_table` (a file read whole as one table, for commands that then go through
+it in chunks), :func:`format_of` and :class:`FileFormat` (the registry); the
+flight-controller logs themselves: :func:`ulog_sensor_instances`,
+:func:`read_dataflash_log`, :func:`dataflash_table`, and :func:`parse_topic` for a topic.
 """
 
 from thermocal.readers.common import (
     DEFAULT_DATAFLASH_TOPIC,
     DEFAULT_ULOG_TOPIC,
-    file_kind,
     parse_topic,
 )
 from thermocal.readers.dataflash import dataflash_table, read_dataflash_log
-from thermocal.readers.dispatch import (
-    read_log_table,
-    read_recording,
-    read_text_table,
-    recording_info,
+from thermocal.readers.dispatch import read_recording, read_whole_table, recording_info
+from thermocal.readers.formats import (
+    FileFormat,
+    file_kind,
+    format_of,
+    registered_formats,
 )
-from thermocal.readers.text import TextOptions
+from thermocal.readers.options import ReadOptions
 from thermocal.readers.ulog import ulog_sensor_instances
 
 __all__ = [
     "DEFAULT_DATAFLASH_TOPIC",
     "DEFAULT_ULOG_TOPIC",
-    "TextOptions",
+    "FileFormat",
+    "ReadOptions",
     "dataflash_table",
     "file_kind",
+    "format_of",
     "parse_topic",
     "read_dataflash_log",
-    "read_log_table",
     "read_recording",
-    "read_text_table",
+    "read_whole_table",
     "recording_info",
+    "registered_formats",
     "ulog_sensor_instances",
 ]

@@ -1,4 +1,4 @@
-"""What every reader shares: formats by suffix, encodings, memory checks, numeric columns,
+"""What every reader shares: encodings, memory checks, numeric columns,
 the time column's names, and the capture of log libraries' noise."""
 
 from __future__ import annotations
@@ -28,7 +28,7 @@ from thermocal.errors import (
     ThermocalInputError,
     ThermocalWarning,
 )
-from thermocal.outputs import TEMP_SUFFIX, refuse_special_input, special_mode
+from thermocal.outputs import refuse_special_input, special_mode
 from thermocal.recording import FloatArray
 
 if TYPE_CHECKING:
@@ -43,37 +43,9 @@ else:
 def csv_float_options() -> dict[str, Any]:
     """``pandas.read_csv`` options that parse every decimal to the nearest float64 (pandas < 3's
     default parser can be one ulp off; pandas 3 is exact by default and deprecates the option).
-    A function so that importing this module does not import pandas (issue 17)."""
+    A function so that importing this module does not import pandas."""
     major = int(pd.__version__.split(".")[0])
     return {"float_precision": "round_trip"} if major < 3 else {}
-
-
-CSV_SUFFIXES = (".csv", ".txt", ".csv.gz", ".log", ".tsv", ".dat")
-PARQUET_SUFFIXES = (".parquet", ".pq")
-ULOG_SUFFIXES = (".ulg",)
-DATAFLASH_SUFFIXES = (".bin",)
-
-
-def file_kind(path: str | Path) -> str:
-    """``'csv'`` or ``'parquet'`` from the extension, else :class:`FileFormatError`."""
-    name = str(path).lower()
-    if name.endswith(TEMP_SUFFIX):
-        raise FileFormatError(
-            f"{path}: an unfinished output of an interrupted thermocal run, not a result; "
-            "delete it (the next run to the same output removes it)"
-        )
-    if name.endswith(PARQUET_SUFFIXES):
-        return "parquet"
-    if name.endswith(ULOG_SUFFIXES):
-        return "ulog"
-    if name.endswith(DATAFLASH_SUFFIXES):
-        return "dataflash"
-    if name.endswith(CSV_SUFFIXES):
-        return "csv"
-    raise FileFormatError(
-        f"{path}: not a CSV or Parquet file (expected extension .csv, or .txt, .log, .tsv, "
-        ".dat for a text log, .parquet, .ulg for a PX4 log or .bin for an ArduPilot log)"
-    )
 
 
 def csv_encoding(path: str | Path, probe_bytes: int = 1 << 16) -> str:
@@ -121,8 +93,8 @@ _BUDGET: contextvars.ContextVar[int | None] = contextvars.ContextVar(
 def memory_budget(limit_bytes: int | None) -> Iterator[None]:
     """Within the block, :func:`memory_limit_bytes` is at most ``limit_bytes`` (None: no
     change) in this thread's context: a fleet unit on a Dask worker reads within the
-    worker's own memory limit, not the machine's (issue 39 item 10: a 4 MB Parquet of 3e8
-    rows passed the machine's check and the nanny killed the worker)."""
+    worker's own memory limit, not the machine's (a 4 MB Parquet of 3e8
+    rows passes the machine's check and the worker's nanny kills it)."""
     token = _BUDGET.set(limit_bytes)
     try:
         yield
@@ -145,7 +117,7 @@ MEMORY_SHARE = 0.5
 """Share of the kernel's ``MemAvailable`` one read may take when ``THERMOCAL_MEMORY_LIMIT``
 is not set: half, so that a file whose metadata declare more rows than it can hold (a 4 MB
 Parquet of 3e8 constant rows wanted 19 GB) is refused before the machine swaps or other
-processes are killed (issue 39 item 10; it was 90 %)."""
+processes are killed (it was 90 %)."""
 
 
 def _machine_limit_bytes() -> int | None:
@@ -184,7 +156,7 @@ def mem_available_bytes() -> int | None:
 
 
 def check_memory(path: Path, n_rows: int, n_columns: int, *, estimated: bool = False) -> None:
-    """Refuse up front a read that would not fit in memory (issue 14).
+    """Refuse up front a read that would not fit in memory .
 
     Needed ≈ ``n_rows · (8 · n_columns + 40)`` bytes (the float64 columns plus the
     commands' working memory); compared with :func:`memory_limit_bytes`. The error gives
@@ -438,8 +410,31 @@ DEFAULT_DATAFLASH_TOPIC = "IMU.0"
 
 
 def parse_topic(topic: str | None, default: str = DEFAULT_ULOG_TOPIC) -> tuple[str, int]:
-    """``NAME[.N]`` → (name, instance) of a flight-controller log's topic (a ULog topic or a
-    DataFlash message); ``default`` when ``topic`` is None."""
+    """The name and instance of a flight-controller log's topic.
+
+    Parameters
+    ----------
+    topic : str, optional
+        ``NAME[.N]``: a ULog topic or a DataFlash message and its instance.
+    default : str
+        The topic when ``topic`` is None.
+
+    Returns
+    -------
+    tuple
+        ``(name, instance)``, the instance 0 when none is given.
+
+    Raises
+    ------
+    thermocal.errors.ThermocalInputError
+        Not ``NAME`` or ``NAME.N``.
+
+    Examples
+    --------
+    >>> from thermocal.readers.common import parse_topic
+    >>> parse_topic("sensor_accel.1"), parse_topic(None, "IMU")
+    (('sensor_accel', 1), ('IMU', 0))
+    """
     text = (topic or default).strip()
     name, _, inst = text.partition(".")
     if not name or (inst and not inst.isdigit()):

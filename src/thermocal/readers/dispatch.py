@@ -1,12 +1,13 @@
-"""One entry for every file a command takes: :func:`read_recording` dispatches by format
-(CSV/Parquet, text log, ULog, DataFlash, station folder) and returns a :class:`Recording`."""
+"""One entry for every file a command takes: :func:`read_recording` looks the file's format
+up in the registry (:mod:`thermocal.readers.formats`: CSV/Parquet, text log, ULog,
+DataFlash, station folder, plugins) and returns a :class:`Recording`."""
 
 from __future__ import annotations
 
 import dataclasses
 import re
 import warnings
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -23,32 +24,16 @@ from thermocal.errors import (
 from thermocal.outputs import refuse_special_input
 from thermocal.readers.common import (
     check_memory,
-    check_unique_names,
-    csv_encoding,
-    csv_float_options,
-    csv_rows_estimate,
     default_time_column,
-    file_kind,
     named_like_temperature,
     names_list,
     short_name,
-    thermocal_metadata,
 )
-from thermocal.readers.dataflash import read_dataflash
-from thermocal.readers.station import is_station_path, read_station_table, with_sensor
-from thermocal.readers.table import ParquetColumns, csv_header_names, load_sidecar, numeric_column
-from thermocal.readers.text import (
-    TextOptions,
-    TooManyColumnsError,
-    check_column_count,
-    counter_column,
-    counter_time,
-    head_lines,
-    rate_time,
-    read_text,
-    sniff_text,
-)
-from thermocal.readers.ulog import read_ulog
+from thermocal.readers.formats import TEXT_FIELDS, FileFormat, format_of
+from thermocal.readers.options import ReadOptions
+from thermocal.readers.station import is_station_path
+from thermocal.readers.table import ParquetColumns, load_sidecar, numeric_column
+from thermocal.readers.text import counter_column, counter_time, rate_time
 from thermocal.recording import (
     META_FORMAT,
     META_VERSION,
@@ -61,102 +46,90 @@ from thermocal.recording import (
 
 if TYPE_CHECKING:
     import pandas as pd
-    import pyarrow as pa
-    import pyarrow.parquet as pq
+
+    from thermocal.models.base import TemperatureModel
 else:
     pd = LazyModule("pandas")
-    pa = LazyModule("pyarrow")
-    pq = LazyModule("pyarrow.parquet")
 
 
-def read_table(
-    path: Path, kind: str, text: TextOptions | None = None, topic: str | None = None
-) -> tuple[pd.DataFrame | ParquetColumns, dict[str, Any]]:
+def _checked_file(path: Path) -> None:
+    """A file that exists and holds something."""
     if not path.exists():
         raise FileFormatError(f"{path}: no such file")
     if path.stat().st_size == 0:
         raise FileFormatError(f"{path}: the file is empty")
-    if kind == "ulog":
-        return read_ulog(path, topic)
-    if kind == "dataflash":
-        return read_dataflash(path, topic)
-    if kind == "parquet":
-        try:
-            table = ParquetColumns(pq.ParquetFile(path, page_checksum_verification=True))
-        except (pa.ArrowInvalid, OSError) as exc:
-            raise FileFormatError(f"{path}: not a readable Parquet file ({exc})") from None
-        check_unique_names(path, table.column_names)
-        return table, thermocal_metadata(table.metadata, path)
-    encoding = csv_encoding(path)
-    # pandas holds every column of a CSV (and its parser about as much again)
-    rows_est, cols_est = csv_rows_estimate(path)
-    check_memory(path, rows_est, 2 * cols_est, estimated=True)
-    if not path.name.lower().endswith(".gz"):
-        head = head_lines(path, encoding, "replace")
-        try:
-            lay = sniff_text(head, text)
-        except TooManyColumnsError as exc:
-            raise FileFormatError(f"{path}: {exc}") from None
-        except FileFormatError:
-            lay = None  # not numeric text: the CSV reader says what is wrong
-        needs_text = text is not None and (
-            text.names is not None or text.on_bad_lines == "skip" or text.delimiter or text.decimal
-        )
-        if (lay is not None and not lay.plain) or needs_text:
-            return read_text(path, encoding, text)
-    header = csv_header_names(path, encoding)
-    check_column_count(path, len(header))  # pandas makes an object per column first
-    check_unique_names(path, header)  # before pandas renames
-    try:
-        df = pd.read_csv(
-            path,
-            skipinitialspace=True,
-            comment=None,
-            low_memory=False,
-            **csv_float_options(),
-            encoding=encoding,
-        )
-    except pd.errors.EmptyDataError:
-        raise FileFormatError(f"{path}: the file is empty (no header)") from None
-    except (pd.errors.ParserError, UnicodeDecodeError) as exc:
-        msg = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
-        raise FileFormatError(f"{path}: not a readable CSV file ({msg})") from None
-    df.columns = [str(c).strip() for c in df.columns]
-    check_unique_names(path, list(df.columns))  # ``a`` and ``a `` are one name stripped
-    return df, {}
 
 
-def read_log_table(path: str | Path, topic: str | None) -> tuple[pd.DataFrame, dict[str, Any]]:
-    """One topic instance of a flight-controller log (.ulg, .bin) as a table and its
-    metadata (for commands that go through it in chunks: compensate)."""
+def read_table(
+    path: Path, read: ReadOptions, fmt: FileFormat | None = None
+) -> tuple[pd.DataFrame | ParquetColumns, dict[str, Any]]:
+    """The table of a file and what the file itself says of it, by its registered reader.
+
+    Parameters
+    ----------
+    path : Path
+        The file, or a station's recording folder.
+    read : ReadOptions
+        How to read it (its topic, a text log's layout).
+    fmt : FileFormat, optional
+        Its format, when known (default: :func:`~thermocal.readers.formats.format_of`).
+
+    Returns
+    -------
+    tuple
+        ``(table, metadata)``: a ``pandas.DataFrame`` (or the lazy Parquet table) and the
+        file's own metadata (units, roles), before its sidecar.
+
+    Raises
+    ------
+    thermocal.errors.FileFormatError
+        No such file, an empty one, or one its format's reader cannot read.
+    """
+    fmt = fmt or format_of(path)
+    if fmt.sniff is None or not fmt.sniff(path):  # a folder a format recognises is no file
+        _checked_file(path)
+    return fmt.read(path, read)
+
+
+def read_whole_table(path: str | Path, read: ReadOptions) -> tuple[pd.DataFrame, dict[str, Any]]:
+    """A file read whole as one table with its metadata and sidecar, for a command that then
+    goes through it in chunks (compensate): a flight-controller log's topic, a plugin's
+    format, or a text log read with its layout options (``names``, ``rate_hz`` — a ``time``
+    column added —, ``on_bad_lines``, ``delimiter``, ``decimal``).
+
+    Parameters
+    ----------
+    path : str or Path
+        The file.
+    read : ReadOptions
+        How to read it.
+
+    Returns
+    -------
+    tuple
+        ``(table, metadata)``, the sidecar's metadata over the file's.
+
+    Raises
+    ------
+    thermocal.errors.ThermocalInputError
+        A field of ``read`` that does not apply to the file's format (named by its option).
+    """
     p = Path(path)
-    kind = file_kind(p)
-    if kind not in ("ulog", "dataflash"):
+    fmt = format_of(p)
+    if read.topic is not None and "topic" not in fmt.options:
         raise ThermocalInputError(f"{p}: --topic is for flight-controller logs (.ulg, .bin)")
-    obj, info = read_table(p, kind, None, topic)
-    assert isinstance(obj, pd.DataFrame)
-    return obj, info
-
-
-def read_text_table(
-    path: str | Path, text: TextOptions, time: str | None = None
-) -> tuple[pd.DataFrame, dict[str, Any]]:
-    """A text log read whole with ``text`` (names, rate, bad lines, delimiter, decimal):
-    the table (a ``time`` column added for ``--rate``) and its sidecar metadata — for
-    commands that then go through it in chunks (compensate).  Text logs are small; the
-    memory check still applies."""
-    p = Path(path)
-    if file_kind(p) != "csv":
+    if read.text_layout_given and not fmt.options >= TEXT_FIELDS:
         raise ThermocalInputError(
             f"{p}: --names, --rate, --on-bad-lines, --delimiter and --decimal are for text logs"
         )
-    obj, file_meta = read_table(p, "csv", text)
+    obj, file_meta = read_table(p, read, fmt)
     info: dict[str, Any] = {**file_meta, **load_sidecar(p)}
-    assert isinstance(obj, pd.DataFrame)
+    if not isinstance(obj, pd.DataFrame):
+        raise FileFormatError(f"{p}: {fmt.title} ({fmt.name}) is not read whole as one table")
     names = list(obj.columns)
-    if text.rate_hz is not None:
+    if read.rate_hz is not None:
         obj, names, t_col, t_unit, _mode = rate_time(
-            p, obj, names, info, time, None, text, allow_column=False
+            p, obj, names, info, read.time, None, read, allow_column=False
         )
         info["time"], info["time_unit"] = t_col, t_unit
     return obj, info
@@ -172,7 +145,7 @@ def _fc_log_unknown_units(
     """A flight-controller log's field whose unit neither the firmware's message definition
     known here (:data:`PX4_UNITS`, :data:`ARDUPILOT_UNITS`), nor ``--signal-unit``, the column
     name or the model states is read as raw values (``counts``, not converted) with a
-    :class:`~thermocal.errors.UnitWarning` — never guessed as °/h (issue 28)."""
+    :class:`~thermocal.errors.UnitWarning` — never guessed as °/h."""
     if option:
         return
     known: dict[str, str] = info.setdefault("units", {})
@@ -193,30 +166,23 @@ def _fc_log_unknown_units(
         )
 
 
-def _open_table(
-    p: Path, text: TextOptions | None, topic: str | None
-) -> tuple[pd.DataFrame | ParquetColumns, dict[str, Any]]:
-    """The table of a file (its extension chooses the reader) or of a station's recording
-    folder (``DIR`` or ``DIR/SENSOR``), and what the file and its sidecar say of it.  A
-    FIFO, device or socket is refused before it is opened, a plain directory named."""
+def _open_table(p: Path, read: ReadOptions) -> tuple[pd.DataFrame | ParquetColumns, dict[str, Any]]:
+    """The table of a file (its registered format chooses the reader) or of a station's
+    recording folder (``DIR`` or ``DIR/SENSOR``), and what the file and its sidecar say of
+    it.  A FIFO, device or socket is refused before it is opened, a plain directory named."""
     refuse_special_input(p)
-    station = is_station_path(p)  # a station's recording folder, DIR or DIR/SENSOR
-    if p.is_dir() and not station:
+    fmt = format_of(p) if not p.is_dir() or is_station_path(p) else None
+    if fmt is None:
         raise FileFormatError(
             f"{p}: is a directory, not a recording file (a folder is read only when "
             "`thermocal station run` wrote it: it holds station.json)"
         )
-    kind = "station" if station else file_kind(p)
-    if topic is not None and kind not in ("ulog", "dataflash", "station"):
+    if read.topic is not None and "topic" not in fmt.options:
         raise ThermocalInputError(
             f"{p}: --topic/--sensor is for flight-controller logs (.ulg, .bin) and station "
             "recordings"
         )
-    obj: pd.DataFrame | ParquetColumns
-    if station:  # --sensor ID (the same option as --topic) picks DIR/ID
-        obj, file_meta = read_station_table(with_sensor(p, topic))
-    else:
-        obj, file_meta = read_table(p, kind, text, topic)
+    obj, file_meta = read_table(p, read, fmt)
     side = load_sidecar(p)
     info: dict[str, Any] = {**file_meta, **side}
     return obj, info
@@ -311,8 +277,8 @@ def _roles(
     names: list[str],
     info: dict[str, Any],
     time: str | None,
-    signals: list[str] | None,
-    temperatures: list[str] | None,
+    signals: Sequence[str] | None,
+    temperatures: Sequence[str] | None,
     guess_temperatures: bool = False,
 ) -> tuple[str, list[str], list[str]]:
     """The time, signal and temperature columns: as given, else as the file or its
@@ -372,12 +338,12 @@ def _n_rows(p: Path, obj: pd.DataFrame | ParquetColumns, names: list[str]) -> in
 
 
 def _time_s(
-    p: Path, col: str, t: FloatArray, unit: str, mode: str | None, text: TextOptions | None
+    p: Path, col: str, t: FloatArray, unit: str, mode: str | None, text: ReadOptions
 ) -> FloatArray:
     """The time column ``t`` (as read, in ``unit``) in seconds: with ``--rate`` a sample
     counter's ``n / rate`` (``mode`` ``"counter"``) or host stamps at the nominal rate
     (``"stamps"``), as :func:`~thermocal.readers.text.rate_time` found them."""
-    rate = text.rate_hz if text is not None else None
+    rate = text.rate_hz
     if mode == "counter" and rate is not None:
         return counter_time(p, col, t, rate)
     if unit != "s":
@@ -448,94 +414,154 @@ def _conversions(
     }
 
 
+def _stated_by_model(
+    model: TemperatureModel | units.StatedUnits | Mapping[str, Any] | None,
+) -> tuple[units.StatedUnits | None, Mapping[str, Any] | None]:
+    """What a model states of its inputs (units, conversions) and its record of them (the
+    sensor id it was fitted on): from a fitted model, a model file's ``inputs`` or the
+    stated units alone."""
+    if model is None or isinstance(model, units.StatedUnits):
+        return model, None
+    if isinstance(model, Mapping):
+        return units.StatedUnits.from_model_inputs(dict(model)), model
+    return model.input_units(), getattr(model, "inputs_", None)
+
+
 def read_recording(
     path: str | Path,
+    read: ReadOptions | None = None,
     *,
-    time: str | None = None,
-    time_unit: str | None = None,
-    signals: list[str] | None = None,
-    temperatures: list[str] | None = None,
-    signal_unit: str | None = None,
-    temp_unit: str | None = None,
     meta: Metadata | None = None,
     keep_other: bool = True,
     skipped: list[str] | None = None,
-    temp_conversion: units.TemperatureConversion | None = None,
-    model: units.StatedUnits | None = None,
-    text: TextOptions | None = None,
-    topic: str | None = None,
+    model: TemperatureModel | units.StatedUnits | Mapping[str, Any] | None = None,
     guess_temperatures: bool = False,
     ask_units: dict[str, str] | None = None,
     implied_units: dict[str, str] | None = None,
 ) -> Recording:
-    """Read a CSV, text log or Parquet recording, or a station's recording folder.
+    """Read a recording from any registered file format into a :class:`Recording`.
+
+    The format is looked up in the file-format registry
+    (:func:`thermocal.readers.formats.format_of`: CSV and text logs, Parquet, PX4 ULog,
+    ArduPilot DataFlash, a station's recording folder, and installed plugins).  Units and
+    temperature conversions are resolved once by :func:`thermocal.units.resolve_inputs`
+    (``read`` > file metadata > column name > ``model`` > a default stated in a warning);
+    each one's source is ``Recording.unit_sources``.  Time is converted to seconds,
+    temperatures stay in their unit with the conversion to °C recorded.
 
     Parameters
     ----------
-    path : the file; its extension chooses the format.  A folder written by ``thermocal
-        station run`` is read as one recording (``DIR``, or ``DIR/SENSOR`` of several).
-    time : name of the time column (default: sidecar's, else ``"time"``).
-    time_unit : ``s``, ``ms`` or ``us``; converted to [s].
-    signals, temperatures : column names with those roles (default: sidecar's).
-    signal_unit, temp_unit : units of those columns (override the sidecar); ``signal_unit``
-        may be ``U1,…,Un``, one per signal.
-    meta : metadata that overrides the file's (its temperature conversions count as options).
-    keep_other : keep the other numeric columns (non-numeric ones are skipped).
-    skipped : if a list is given, the names of skipped non-numeric columns are appended.
-    temp_conversion : ``--temp-conversion``, the counts → °C conversion of every
-        temperature column (which it says are raw counts).
-    model : the units a model file recorded of its inputs
-        (:meth:`thermocal.units.StatedUnits.from_model_inputs`): used where the option,
-        the file and the column name are silent.
-    text : how to read a text log (:class:`TextOptions`: ``--names``, ``--rate``,
-        ``--on-bad-lines``, ``--delimiter``, ``--decimal``); banners, other delimiters and
-        decimal commas are detected without it.
-    topic : a PX4 ULog's topic instance, ``NAME[.N]`` (default ``sensor_gyro.0``).
-    guess_temperatures : no temperatures given or in a sidecar: those named like one.
-    ask_units, implied_units : signal column → the option a :class:`UnitError` asks for,
-        or the unit another option implies (``counts``: a count scale), where nothing
-        states its unit (:class:`thermocal.units.UnitOptions`).
+    path : str or Path
+        The file.  A folder written by ``thermocal station run`` is read as one recording
+        (``DIR``, or ``DIR/SENSOR`` of several).
+    read : ReadOptions, optional
+        How to read it: columns and their roles, units, a raw-count temperature conversion,
+        a log's topic, a text log's layout (:class:`~thermocal.readers.options.ReadOptions`).
+        Default: everything from the file.
+    meta : Metadata, optional
+        Metadata that overrides the file's (its temperature conversions count as options).
+    keep_other : bool
+        Keep the other numeric columns (non-numeric ones are skipped).
+    skipped : list of str, optional
+        When given, the names of skipped non-numeric columns are appended.
+    model : TemperatureModel, StatedUnits or mapping, optional
+        A fitted model, a model file's ``inputs`` record or the units a model file states
+        (:meth:`thermocal.units.StatedUnits.from_model_inputs`): used where ``read``, the
+        file and the column name are silent; a model's sensor id must match the file's.
+    guess_temperatures : bool
+        No temperatures given or in a sidecar: those named like one.
+    ask_units, implied_units : dict, optional
+        Signal column → the option a :class:`~thermocal.errors.UnitError` asks for, or the
+        unit another option implies (``counts``: a count scale), where nothing states its
+        unit (:class:`thermocal.units.UnitOptions`).
 
-    Units and temperature conversions are resolved once by
-    :func:`thermocal.units.resolve_inputs` (option > file metadata > column name > model
-    file > a default stated in a warning); each one's source is ``Recording.unit_sources``.
+    Returns
+    -------
+    Recording
+        Time [s], the columns as float64, their units and roles, the metadata.
 
     Raises
     ------
-    FileFormatError : not CSV/Parquet, unreadable or empty.
-    MissingColumnError : a named column is absent (the available ones are listed).
-    NonNumericError : a non-numeric cell in a named column (row and column named).
-    UnitError : an unknown unit string.
+    thermocal.errors.FileFormatError
+        No registered format reads it, or it is unreadable or empty.
+    thermocal.errors.MissingColumnError
+        A named column is absent (the available ones are listed).
+    thermocal.errors.NonNumericError
+        A non-numeric cell in a named column (row and column named).
+    thermocal.errors.UnitError
+        An unknown unit string.
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> from thermocal.readers import ReadOptions, read_recording
+    >>> d = pathlib.Path(tempfile.mkdtemp())
+    >>> _ = (d / "run.csv").write_text("t_ms,gx,T\\n0,0.5,20.0\\n10,0.25,20.5\\n20,0.5,21.0\\n")
+    >>> rec = read_recording(
+    ...     d / "run.csv",
+    ...     ReadOptions(time="t_ms", time_unit="ms", signals="gx", temperatures="T",
+    ...                 signal_unit="deg/s", temp_unit="degC"),
+    ... )
+    >>> rec.time_s.tolist(), rec.units["gx"], rec.temperature_c("T").tolist()
+    ([0.0, 0.01, 0.02], 'deg/s', [20.0, 20.5, 21.0])
     """
     p = Path(path)
-    obj, info = _open_table(p, text, topic)
+    r = read or ReadOptions()
+    obj, info = _open_table(p, r)
+    stated, fitted = _stated_by_model(model)
+    units_of = units.UnitOptions(  # the options' own; a rate's counter is in s (below)
+        r.time_unit, r.signal_unit, r.temp_unit, r.temp_conversion,
+        dict(ask_units or {}), dict(implied_units or {}),
+    )  # fmt: skip
+    rec = _table_recording(
+        p, obj, info, r, units_of, meta=meta, keep_other=keep_other, skipped=skipped,
+        stated=stated, guess_temperatures=guess_temperatures,
+    )  # fmt: skip
+    if fitted is not None:
+        from thermocal.models.base import check_sensor_id
 
+        check_sensor_id(fitted, rec.meta.sensor_id, str(p))
+    return rec
+
+
+def _table_recording(
+    p: Path,
+    obj: pd.DataFrame | ParquetColumns,
+    info: dict[str, Any],
+    r: ReadOptions,
+    options: units.UnitOptions,
+    *,
+    meta: Metadata | None,
+    keep_other: bool,
+    skipped: list[str] | None,
+    stated: units.StatedUnits | None,
+    guess_temperatures: bool,
+) -> Recording:
+    """The :class:`Recording` of a table read from ``p``: roles, units resolved once, time in
+    seconds (a rate's rows, counter or stamps), the other numeric columns kept."""
     names = list(obj.column_names) if isinstance(obj, ParquetColumns) else list(obj.columns)
-    mode = None  # --rate: "rows", "counter" or "stamps" (rate_time)
-    if text is not None and text.rate_hz is not None:
-        obj, names, time, time_unit, mode = rate_time(p, obj, names, info, time, time_unit, text)
+    time, time_unit = r.time, r.time_unit
+    mode = None  # rate_hz: "rows", "counter" or "stamps" (rate_time)
+    if r.rate_hz is not None:
+        obj, names, time, time_unit, mode = rate_time(p, obj, names, info, time, time_unit, r)
     n_rows = _n_rows(p, obj, names)
     md = Metadata.from_dict(dict(info.get("metadata") or {}))
     if meta is not None:
         md = md.merged(meta)
     time_col, sig_names, tmp_names = _roles(
-        p, names, info, time, signals, temperatures, guess_temperatures
+        p, names, info, time, r.signals, r.temperatures, guess_temperatures
     )
-    options = units.UnitOptions(  # a counter / rate is in s
-        "s" if mode == "counter" else time_unit, signal_unit, temp_unit, temp_conversion,
-        dict(ask_units or {}), dict(implied_units or {}),
-    )  # fmt: skip
-    resolved = _resolve_units(p, info, (time_col, sig_names, tmp_names), options, meta, model)
+    options = dataclasses.replace(options, time_unit="s" if mode == "counter" else time_unit)
+    resolved = _resolve_units(p, info, (time_col, sig_names, tmp_names), options, meta, stated)
     n_used = len(names) if keep_other else 1 + len(sig_names) + len(tmp_names)
     t, cols = _read_columns(p, obj, n_rows, n_used, time_col, [*sig_names, *tmp_names])
-    t = _time_s(p, time_col, t, resolved.time.unit, mode, text)
+    t = _time_s(p, time_col, t, resolved.time.unit, mode, r)
     unit_map: dict[str, str] = resolved.units()
     md.temperature_conversion = _conversions(md, tmp_names, resolved)
     if keep_other:
         _read_other_columns(
             p, obj, [c for c in names if c != time_col], cols, unit_map, info, skipped
         )
-
     return Recording(
         time_s=t,
         columns=cols,
@@ -550,7 +576,22 @@ def read_recording(
 
 
 def recording_info(rec: Recording, time: str = "time") -> dict[str, Any]:
-    """The metadata object written beside (or into) a recording file."""
+    """The metadata object written beside (or into) a recording file.
+
+    Parameters
+    ----------
+    rec : Recording
+        The recording written.
+    time : str
+        Name of its time column in the file (written in [s]).
+
+    Returns
+    -------
+    dict
+        ``format``, ``version``, ``time``, ``time_unit``, the signal and temperature
+        columns with their units, the other columns' units and the metadata, as a CSV's
+        ``FILE.meta.json`` sidecar or a Parquet file's key-value store holds it.
+    """
     return {
         "format": META_FORMAT,
         "version": META_VERSION,

@@ -20,7 +20,8 @@ from thermocal.errors import ParameterError
 from thermocal.units import TemperatureConversion, temperature_conversion
 
 RATE_HZ_RANGE: tuple[float, float] = (1e-6, 1e7)
-"""Sample rates [Hz] a sensor log can have (one sample in 11.6 days to 10 MHz)."""
+"""Sample rates [Hz] a sensor log can have: from one sample in 11.6 days to 10 MHz (beyond
+any inertial sensor's output rate); outside, time = n / rate overflows or collapses."""
 
 
 def _names(value: str | Iterable[str] | None, parameter: str) -> tuple[str, ...] | None:
@@ -130,7 +131,7 @@ class ReadOptions:
                 raise ParameterError(
                     "rate_hz",
                     f"{{name}} {rate:g} Hz: no sensor samples at that rate; give the sample "
-                    f"rate from {lo:g} to {hi:g} Hz (one sample a minute: 0.0166667)",
+                    f"rate from {lo:g} to {hi:g} Hz (one sample a minute: {{name}} 0.0166667)",
                 )
         if self.decimal not in (None, ".", ","):
             raise ParameterError("decimal", f"{{name}} must be . or , — got {self.decimal!r}")

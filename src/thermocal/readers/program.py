@@ -15,9 +15,10 @@ from thermocal.defaults import PROGRAM_SETPOINT, PROGRAM_TIME
 from thermocal.errors import FileFormatError, MissingColumnError, NonNumericError
 from thermocal.outputs import refuse_special_input
 from thermocal.profiles import check_program
-from thermocal.readers.common import csv_float_options, file_kind
+from thermocal.readers.common import csv_float_options
 from thermocal.readers.dispatch import read_recording
-from thermocal.readers.text import TextOptions
+from thermocal.readers.formats import file_kind
+from thermocal.readers.options import ReadOptions
 from thermocal.recording import FloatArray
 
 if TYPE_CHECKING:
@@ -29,8 +30,22 @@ else:
 def read_program(path: str | Path) -> tuple[FloatArray, FloatArray]:
     """Read a chamber program CSV (columns ``time_s`` and ``setpoint_c``).
 
-    Raises :class:`FileFormatError`, :class:`MissingColumnError`,
-    :class:`NonNumericError` or :class:`TimestampError` naming the file.
+    Parameters
+    ----------
+    path : str or Path
+        The program, as :func:`thermocal.writers.write_program` writes it.
+
+    Returns
+    -------
+    tuple of ndarray
+        ``(time_s, setpoint_c)``: the times [s] and set-points [°C].
+
+    Raises
+    ------
+    thermocal.errors.FileFormatError, thermocal.errors.MissingColumnError
+        Not a readable CSV, or a column missing (named).
+    thermocal.errors.NonNumericError, thermocal.errors.TimestampError
+        A cell not a number, or times not increasing (file, row and column named).
     """
     p = Path(path)
     if not p.exists():
@@ -64,15 +79,34 @@ def read_program(path: str | Path) -> tuple[FloatArray, FloatArray]:
 def read_history(
     path: Path,
     column: str | None = None,
-    *,
-    text: TextOptions | None = None,
-    topic: str | None = None,
+    read: ReadOptions | None = None,
 ) -> tuple[FloatArray, FloatArray, str]:
-    """A temperature history ``(time_s, temperature_c, column)`` from a chamber program CSV
-    (``time_s, setpoint_c``; its set-point unless ``column`` is another of its columns) or a
-    recording (``column``, default its first temperature column, else ``setpoint_c``), read
-    by :func:`thermocal.readers.read_recording` with the text-log options ``text`` and the
-    log topic ``topic`` as every command reads a recording."""
+    """A temperature history from a chamber program or a recording.
+
+    Parameters
+    ----------
+    path : Path
+        A chamber program CSV (``time_s, setpoint_c``) or a recording in any registered
+        format.
+    column : str, optional
+        The column: a program's set-point unless another of its columns is named; a
+        recording's first temperature column, else ``setpoint_c``.
+    read : ReadOptions, optional
+        How a recording is read (a text log's layout, a log's topic), as every command
+        reads one (:func:`thermocal.readers.read_recording`).
+
+    Returns
+    -------
+    tuple
+        ``(time_s, temperature_c, column)``: times [s], temperatures [°C] and the column.
+
+    Raises
+    ------
+    thermocal.errors.FileFormatError
+        No such file, or one no registered format reads.
+    thermocal.errors.MissingColumnError
+        No temperature column known (the available ones are listed).
+    """
     if not path.exists():
         raise FileFormatError(f"{path}: no such file")
     time_col: str | None = None
@@ -87,7 +121,8 @@ def read_history(
             return t, c, defaults.PROGRAM_SETPOINT
         if defaults.PROGRAM_TIME in header and "time" not in header:
             time_col = defaults.PROGRAM_TIME
-    rec = read_recording(path, time=time_col, text=text, topic=topic)
+    r = read or ReadOptions()
+    rec = read_recording(path, r.replace(time=time_col) if time_col is not None else r)
     if column is None:
         if rec.temperatures:
             column = rec.temperatures[0]

@@ -114,8 +114,8 @@ def _stream_of(path: Path) -> tuple[Path, str]:
 
 
 def with_sensor(path: Path, sensor: str | None) -> Path:
-    """``DIR/SENSOR`` for ``--sensor SENSOR`` (INTERFACE.md, test station: "every command reads
-    DIR as one recording, --sensor ID when there are several").  ``path`` is ``DIR`` or
+    """``DIR/SENSOR`` for ``--sensor SENSOR`` (every command reads
+    DIR as one recording, with --sensor ID when there are several).  ``path`` is ``DIR`` or
     ``DIR/ID``; without ``sensor`` it is returned as it is.  A sensor the recording does not
     have, or ``DIR/A`` with ``--sensor B``, is a :class:`FileFormatError` naming the sensors."""
     if sensor is None:

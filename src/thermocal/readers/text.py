@@ -21,6 +21,7 @@ from thermocal.errors import (
     ThermocalInputError,
 )
 from thermocal.readers.common import TIME_COLUMN_NAMES, check_unique_names
+from thermocal.readers.options import ReadOptions
 from thermocal.readers.table import ParquetColumns
 from thermocal.recording import FloatArray
 
@@ -31,44 +32,6 @@ else:
 
 
 # --- text logs (serial terminals, spreadsheets of other locales) ----------------------------
-
-
-RATE_HZ_RANGE = (1e-6, 1e7)
-"""``--rate`` [Hz]: from one sample in 11.6 days to 10 MHz (beyond any inertial sensor's
-output rate); outside, time = n / rate overflows or collapses (issue 39)."""
-
-
-@dataclass(frozen=True)
-class TextOptions:
-    """How to read a text log (INTERFACE.md common rules): ``names`` for a file without a
-    header row; ``rate_hz`` for a file without a time column (time = row / rate);
-    ``on_bad_lines`` ``"error"`` (default: the first mangled line is named) or ``"skip"``
-    (mangled lines dropped, how many reported); ``delimiter`` and ``decimal`` (detected when
-    None: ``,`` ``;`` tab or blanks; ``.`` or ``,``)."""
-
-    names: tuple[str, ...] | None = None
-    rate_hz: float | None = None
-    on_bad_lines: str = "error"
-    delimiter: str | None = None
-    decimal: str | None = None
-
-    def __post_init__(self) -> None:
-        if self.on_bad_lines not in ("error", "skip"):
-            raise ThermocalInputError(
-                f"--on-bad-lines must be error or skip, got {self.on_bad_lines!r}"
-            )
-        if self.rate_hz is not None and not (math.isfinite(self.rate_hz) and self.rate_hz > 0):
-            raise ThermocalInputError(f"--rate must be a positive rate [Hz], got {self.rate_hz}")
-        lo, hi = RATE_HZ_RANGE
-        if self.rate_hz is not None and not lo <= self.rate_hz <= hi:
-            raise ThermocalInputError(
-                f"--rate {self.rate_hz:g} Hz: no sensor samples at that rate; give the sample "
-                f"rate from {lo:g} to {hi:g} Hz (one sample a minute: --rate 0.0166667)"
-            )
-        if self.decimal not in (None, ".", ","):
-            raise ThermocalInputError(f"--decimal must be . or , — got {self.decimal!r}")
-        if self.names is not None and len(set(self.names)) != len(self.names):
-            raise ThermocalInputError(f"--names repeats a name: {list(self.names)}")
 
 
 SNIFF_LINES = 400
@@ -126,7 +89,7 @@ class TextLayout:
         return self.skip == 0 and self.delimiter == "," and self.decimal == "." and self.header
 
 
-def sniff_text(lines: Sequence[str], opts: TextOptions | None = None) -> TextLayout:
+def sniff_text(lines: Sequence[str], opts: ReadOptions | None = None) -> TextLayout:
     """The layout of a text log from its first lines.
 
     For each candidate delimiter (``, ; tab blanks``, or the one given) the modal number of
@@ -140,7 +103,7 @@ def sniff_text(lines: Sequence[str], opts: TextOptions | None = None) -> TextLay
     lines, for ``--on-bad-lines``.  The decimal mark is ``,`` when the delimiter is not a
     comma and the data parse with ``,`` but not with ``.``.
     """
-    o = opts or TextOptions()
+    o = opts or ReadOptions()
     delims = [o.delimiter] if o.delimiter else list(_DELIMS)
     delims = ["\t" if d == "\\t" else d for d in delims]
     body = [x for x in lines if x.strip() and not x.lstrip().startswith("#")]
@@ -242,8 +205,8 @@ def _banner(lines: Sequence[str]) -> tuple[str, ...]:
 MAX_LINE_CHARS = 1 << 20
 """Longest line a text reader takes [characters]: 1 MiB, about 50 000 numeric fields (the
 station cuts a sensor's line at 10 MB).  A longer line is refused naming the file and the
-line: one 10 MB line split into five million fields hung the layout detection (issue 39
-item 10).  ``THERMOCAL_MAX_LINE`` (characters) raises it."""
+line: one 10 MB line split into five million fields hung the layout detection.
+``THERMOCAL_MAX_LINE`` (characters) raises it."""
 
 
 class TooManyColumnsError(FileFormatError):
@@ -342,7 +305,7 @@ def csv_chunk_options(path: Path, encoding: str) -> dict[str, Any]:
     }
 
 
-def _column_names(path: Path, head: list[str], lay: TextLayout, o: TextOptions) -> list[str]:
+def _column_names(path: Path, head: list[str], lay: TextLayout, o: ReadOptions) -> list[str]:
     """The header row's names, or ``--names`` for a file without one (refused with a
     header, or when their number is not the number of fields)."""
     if lay.header:
@@ -428,13 +391,13 @@ def _data_rows(
 
 
 def read_text(
-    path: Path, encoding: str, opts: TextOptions | None
+    path: Path, encoding: str, opts: ReadOptions | None
 ) -> tuple[pd.DataFrame, dict[str, Any]]:
     """A text log as a DataFrame of floats: banner skipped, delimiter and decimal mark
     detected (or given), header taken from ``--names`` when the file has none, mangled
     lines (another number of fields, a non-number) refused naming the first or, with
     ``on_bad_lines="skip"``, dropped and counted.  Warnings say what was skipped."""
-    o = opts or TextOptions()
+    o = opts or ReadOptions()
     head = head_lines(path, encoding, "strict")
     try:
         lay = sniff_text(head, o)
@@ -517,7 +480,7 @@ def rate_time(
     info: dict[str, Any],
     time: str | None,
     time_unit: str | None,
-    text: TextOptions,
+    text: ReadOptions,
     *,
     allow_column: bool = True,
 ) -> tuple[Any, list[str], str, str | None, str]:

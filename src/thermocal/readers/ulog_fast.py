@@ -1,5 +1,5 @@
 """A fast reader of a clean PX4 ULog's data messages, giving the same ``pyulog.ULog`` object
-as pyulog's own parse (issue 28: pyulog's per-message Python loop took ≈ 2 s of a 50 MB log).
+as pyulog's own parse (pyulog's per-message Python loop takes ≈ 2 s of a 50 MB log).
 
 ULog file format (docs.px4.io, "ULog File Format"): a 16-byte header, then messages of
 ``uint16 msg_size, uint8 msg_type`` and ``msg_size`` bytes of payload.  The definitions

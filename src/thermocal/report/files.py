@@ -24,7 +24,7 @@ if TYPE_CHECKING:
     from contextlib import AbstractContextManager
 
     from thermocal.models.calibration import Calibration
-    from thermocal.readers.text import TextOptions
+    from thermocal.readers.options import ReadOptions
     from thermocal.recording import Recording
 
     Progress = Callable[[str, float | None], AbstractContextManager[Callable[[float], None]]]
@@ -78,21 +78,6 @@ def read_validation_json(path: Path, *, channels: bool = False) -> dict[str, Any
     return obj
 
 
-@dataclass(frozen=True)
-class ReadOptions:
-    """How the report's recordings are read: the command line's column, unit and text-log
-    options (:func:`thermocal.readers.read_recording`), the same for every recording."""
-
-    time: str | None = None
-    time_unit: str | None = None
-    signal_unit: str | None = None
-    temp_unit: str | None = None
-    temp_conversion: str | None = None
-    """``"GAIN,OFFSET[,int16]"`` (:func:`thermocal.units.temperature_conversion`)."""
-    text: TextOptions | None = None
-    topic: str | None = None
-
-
 def read_run(
     path: Path, signals: str, temps: Sequence[str], model_inputs: dict[str, Any], opts: ReadOptions
 ) -> Recording:
@@ -125,21 +110,11 @@ def read_run(
     ThermocalInputError
         A missing column, a unit that cannot be resolved, a sensor id that differs.
     """
-    from thermocal.pipeline.reading import load_recording
+    from thermocal.pipeline.reading import check_recording
+    from thermocal.readers.dispatch import read_recording
 
-    return load_recording(
-        path,
-        time=opts.time,
-        time_unit=opts.time_unit,
-        signal=signals or None,
-        temps=",".join(temps) if temps else None,
-        signal_unit=opts.signal_unit,
-        temp_unit=opts.temp_unit,
-        temp_conversion=opts.temp_conversion,
-        model_inputs=model_inputs,
-        text=opts.text,
-        topic=opts.topic,
-    )
+    read = opts.replace(signals=signals or None, temperatures=tuple(temps) if temps else None)
+    return check_recording(read_recording(path, read, model=model_inputs), read)
 
 
 @dataclass(frozen=True)
@@ -216,6 +191,7 @@ def make_report(
         Counts that do not match, the output an input, channels given with other models.
     """
     from thermocal.models.files import load_calibration
+    from thermocal.readers.options import ReadOptions
     from thermocal.writers import check_not_input
 
     opts = read or ReadOptions()
@@ -278,19 +254,12 @@ def _triad_report(
 ) -> ReportResult:
     """A calibration of triads judged on ``recording`` and reported (``title`` None: the
     triad report's own)."""
-    from thermocal.compensate.files import read_for_triads
     from thermocal.multipos import validate as _mp_validate
+    from thermocal.pipeline.compensate import read_for_triads
     from thermocal.report.triads import write_triad_report
     from thermocal.turntable.calibrate import validate_turntable_run
 
-    rec = read_for_triads(
-        recording,
-        cal.triads,
-        time=opts.time,
-        time_unit=opts.time_unit,
-        text=opts.text,
-        topic=opts.topic,
-    )
+    rec = read_for_triads(recording, cal.triads, opts)
     if _mp_validate.is_multipos(cal.triads):  # held-out poses
         results: list[Any] = _mp_validate.validate_held_out_session(
             cal.triads, rec, latitude_deg, signal_unit=opts.signal_unit

@@ -55,16 +55,20 @@ class FlightLog:
         """One IMU topic instance (``NAME.N``) as a recording of x, y, z and
         ``temperature`` in the canonical units, checked (finite, increasing time), its gaps
         said in one warning; served from the log's one parse."""
-        from thermocal.pipeline.reading import load_recording
+        from thermocal.pipeline.reading import check_recording
+        from thermocal.readers.dispatch import read_recording
+        from thermocal.readers.options import ReadOptions
 
-        return load_recording(self.path, signal="x,y,z", temps="temperature", topic=topic)
+        read = ReadOptions(signals=("x", "y", "z"), temperatures=("temperature",), topic=topic)
+        return check_recording(read_recording(self.path, read), read)
 
     def table(self, topic: str) -> tuple[pd.DataFrame, dict[str, Any]]:
         """One topic instance (``NAME.N``) as a table of its fields (PX4's units) and its
         metadata; served from the log's one parse."""
-        from thermocal.readers.dispatch import read_log_table
+        from thermocal.readers.dispatch import read_whole_table
+        from thermocal.readers.options import ReadOptions
 
-        return read_log_table(self.path, topic)
+        return read_whole_table(self.path, ReadOptions(topic=topic))
 
 
 @contextlib.contextmanager

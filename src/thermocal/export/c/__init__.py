@@ -25,7 +25,7 @@ source file with
   fitted on converted counts also gets ``<p>_temps_from_counts``.  ``init`` is a power-on (it
   forgets every state); ``sample_interval_s`` is the nominal sample interval τ:
   a time step longer than ``GAP_FACTOR`` (1.5) × τ resets the rate estimate, as
-  in :class:`thermocal.compensate.files.StreamingCompensator`;
+  in :class:`thermocal.compensate.kernels.StreamingCompensator`;
 * a comment block with the model file's identity (family, format version,
   thermocal version, checksum, signal, temperatures, data files).
 

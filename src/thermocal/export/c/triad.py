@@ -12,7 +12,7 @@ A triad calibrated on raw counts (``multipos --accel-scale/--gyro-scale``) takes
 ``x`` in its physical unit all the same; the header defines the count scale
 ``<P>_<TRIAD>_COUNT_SCALE`` (one count in that unit) and states the conversion
 ``x = <P>_<TRIAD>_COUNT_SCALE · counts`` that the caller applies to the raw registers first,
-as :func:`thermocal.compensate.files.compensate_triads` does.
+as :func:`thermocal.pipeline.compensate.compensate_triads` does.
 """
 
 from __future__ import annotations

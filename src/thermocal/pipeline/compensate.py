@@ -1,8 +1,8 @@
-"""Compensation of files with a fitted model (SPEC §4, §8); the maths (in memory, in
-chunks, live) is :mod:`thermocal.compensate.kernels`, re-exported here.
+"""Compensation of files with a fitted model; the maths (in memory, in chunks, live) is
+:mod:`thermocal.compensate.kernels`.
 
 A model gives the temperature-induced part of the signal, ``ŷ = model(T, Ṫ, …)``;
-the compensated output is ``F' = F − ŷ`` (SPEC §4c: "output F' = F − ΔF").
+the compensated output is ``F' = F − ŷ`` (output F' = F − ΔF).
 
 Three ways to apply a model, all giving the same numbers:
 
@@ -30,12 +30,9 @@ column's own unit.  A model and data of different kinds (°/h against mg) is a
 
 from __future__ import annotations
 
-import contextlib
 import dataclasses
 import json
 import math
-import signal
-import threading
 import warnings
 from collections.abc import Callable, Iterator, Sequence
 from concurrent.futures import Future, ThreadPoolExecutor
@@ -47,61 +44,40 @@ import numpy as np
 
 from thermocal import units
 from thermocal._lazy import LazyModule
-from thermocal.compensate.kernels import (  # the maths, re-exported
+from thermocal.compensate.kernels import (
     AbsoluteFigures,
-    CalibrationStream,
     ChunkPredictor,
-    Compensation,
-    ModelRun,
-    StreamingCompensator,
     absolute_error_worse,
     absolute_worse_message,
     check_signal_kind,
-    chunk_context,
-    compensate_run,
     model_scale_factor,
-    prepare_run,
     temperature_inputs,
     unit_factor,
     zero_reference,
 )
-from thermocal.defaults import DEFAULT_CHUNK_ROWS as DEFAULT_CHUNK_ROWS
+from thermocal.defaults import DEFAULT_CHUNK_ROWS
 from thermocal.errors import (
     ExtrapolationWarning,
     FileFormatError,
     MissingColumnError,
     MissingValueError,
     PlausibilityWarning,
-    TextLayoutWarning,
     ThermocalInputError,
     ThermocalWarning,
     TimestampError,
     UnitError,
 )
 from thermocal.models.base import (
-    ChunkContext,
     TemperatureModel,
     check_sensor_id,
     outside_range_dict,
 )
 from thermocal.outputs import refuse_special_input, sidecar_path, warn_formula_names
-from thermocal.readers.common import (
-    csv_encoding,
-    csv_float_options,
-    default_time_column,
-    file_kind,
-    names_list,
-    thermocal_metadata,
-)
-from thermocal.readers.dispatch import (
-    read_log_table,
-    read_recording,
-    read_text_table,
-    time_hint,
-)
-from thermocal.readers.station import is_station_path, station_files, with_sensor
+from thermocal.readers.common import default_time_column, names_list
+from thermocal.readers.dispatch import read_recording, read_whole_table, time_hint
+from thermocal.readers.formats import FileFormat, file_kind, format_of
+from thermocal.readers.options import ReadOptions
 from thermocal.readers.table import load_sidecar, numeric_column
-from thermocal.readers.text import TextOptions, csv_chunk_options
 from thermocal.recording import (
     ABSOLUTE_ZERO_C,
     FEW_SAMPLES,
@@ -115,7 +91,7 @@ from thermocal.recording import (
     Recording,
     median_interval,
 )
-from thermocal.writers import atomic_write_path, check_not_input, write_json
+from thermocal.writers import atomic_write_path, check_not_input, write_json, written_format
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -129,41 +105,6 @@ else:
 
 MODEL_SUFFIX = "_model"
 COMP_SUFFIX = "_comp"
-
-
-# --- files ---------------------------------------------------------------------------------
-
-
-@dataclass
-class _CtrlC:
-    seen: bool = False
-
-
-@contextlib.contextmanager
-def _ctrl_c_noted() -> Iterator[_CtrlC]:
-    """Note a Ctrl-C (SIGINT) while pandas' C parser reads a CSV file: it turns the
-    KeyboardInterrupt raised inside its ``read`` into a ParserError ("Calling read(nbytes)
-    on source failed"), which would read as a damaged file.  The handler notes it and
-    raises KeyboardInterrupt as Python's default does; installed only where a handler can
-    be (the main thread) and where SIGINT is not ignored (fleet workers)."""
-    note = _CtrlC()
-    if threading.current_thread() is not threading.main_thread():
-        yield note
-        return
-    before = signal.getsignal(signal.SIGINT)
-    if before is not signal.default_int_handler:
-        yield note
-        return
-
-    def handler(signum: int, frame: Any) -> None:
-        note.seen = True
-        signal.default_int_handler(signum, frame)
-
-    signal.signal(signal.SIGINT, handler)
-    try:
-        yield note
-    finally:
-        signal.signal(signal.SIGINT, before)
 
 
 @dataclass(frozen=True)
@@ -252,124 +193,29 @@ class _RunningMoments:
         )
 
 
-def _file_info(
-    path: Path,
-    kind: str,
-    table: pd.DataFrame | None = None,
-    table_info: dict[str, Any] | None = None,
-) -> tuple[list[str], dict[str, Any], int | None]:
-    """Column names, thermocal metadata (sidecar over Parquet key-value) and row count
-    (``table``: a text log already read whole, with its metadata)."""
-    if table is not None:
-        return [str(c) for c in table.columns], dict(table_info or {}), len(table)
-    if kind == "station":
-        return _station_info(path)
-    if not path.exists():
-        raise FileFormatError(f"{path}: no such file")
-    refuse_special_input(path)
-    if path.stat().st_size == 0:
-        raise FileFormatError(f"{path}: the file is empty")
-    meta: dict[str, Any] = {}
-    n_rows: int | None = None
-    if kind == "parquet":
-        try:
-            pf = pq.ParquetFile(path)
-        except (pa.ArrowInvalid, OSError) as exc:
-            raise FileFormatError(f"{path}: not a readable Parquet file ({exc})") from None
-        names = list(pf.schema_arrow.names)
-        n_rows = int(pf.metadata.num_rows)
-        meta = thermocal_metadata(pf.schema_arrow.metadata, path)
-    else:
-        enc = csv_encoding(path)
-        opts = csv_chunk_options(path, enc)
-        try:
-            head = pd.read_csv(path, nrows=0, skipinitialspace=True, encoding=enc, **opts)
-        except (pd.errors.ParserError, pd.errors.EmptyDataError, UnicodeDecodeError) as exc:
-            msg = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
-            raise FileFormatError(f"{path}: not a readable CSV file ({msg})") from None
-        names = [str(c).strip() for c in head.columns]
-    meta = {**meta, **load_sidecar(path)}
-    return names, meta, n_rows
-
-
-def _station_info(path: Path) -> tuple[list[str], dict[str, Any], int | None]:
-    """Columns, metadata (the last closed part's, as :func:`read_station` reads it) and row
-    count of a station recording ``DIR/SENSOR`` (its closed Parquet parts, in order)."""
-    files = station_files(path)
-    names: list[str] | None = None
-    n_rows, meta = 0, {}
-    for f in files:
-        try:
-            pf = pq.ParquetFile(f)
-        except (pa.ArrowInvalid, OSError) as exc:
-            raise FileFormatError(f"{f}: not a readable Parquet part ({exc})") from None
-        these = list(pf.schema_arrow.names)
-        if names is not None and these != names:
-            raise FileFormatError(f"{f}: columns {these} differ from the first part's {names}")
-        names = these
-        n_rows += int(pf.metadata.num_rows)
-        meta = thermocal_metadata(pf.schema_arrow.metadata, f)
-    return names or [], meta, n_rows
-
-
-def _input_kind(src: Path, topic: str | None) -> tuple[Path, str, str | None]:
-    """``(path, kind, topic)`` of an input: a station recording folder (``DIR``, ``DIR/ID``,
-    or ``DIR`` with ``--sensor ID``) is read part after part as kind ``"station"`` (its path
-    ``DIR/ID``; INTERFACE.md: every command reads DIR as one recording); any other file by
-    its extension, with ``topic`` for a flight-controller log."""
-    if is_station_path(src):
-        return with_sensor(src, topic), "station", None
-    return src, file_kind(src), topic
-
-
-def _iter_chunks(
-    path: Path, kind: str, chunk_rows: int, table: pd.DataFrame | None = None
-) -> Iterator[pd.DataFrame | pa.RecordBatch]:
-    """Chunks of the file; a read or parse failure mid-file is a :class:`FileFormatError`
-    naming the file (Parquet pages are checked against their checksums).  ``table``: a
-    text log read whole (text options), sliced."""
-    if table is not None:
-        for a in range(0, len(table), chunk_rows):
-            yield table.iloc[a : a + chunk_rows].reset_index(drop=True)
-        return
-    if kind == "station":  # the closed parts in order, each in chunks (constant memory)
-        for f in station_files(path):
-            yield from _iter_chunks(f, "parquet", chunk_rows)
-        return
-    if kind == "parquet":
-        try:
-            # a buffered stream without pre-buffering: with the defaults the reader's
-            # allocations grow with the file (≈ 20 B/row); this way they stay at ≈ 1 MB
-            pf = pq.ParquetFile(
-                path, page_checksum_verification=True, buffer_size=1 << 20, pre_buffer=False
-            )
-            yield from pf.iter_batches(batch_size=chunk_rows)
-        except (pa.ArrowInvalid, OSError) as exc:
-            raise FileFormatError(f"{path}: not a readable Parquet file ({exc})") from None
-    else:
-        enc = csv_encoding(path)
-        with warnings.catch_warnings():  # _file_info stated the layout already
-            warnings.simplefilter("ignore", TextLayoutWarning)
-            opts = csv_chunk_options(path, enc)
-        reader = pd.read_csv(
-            path,
-            chunksize=chunk_rows,
-            skipinitialspace=True,
-            low_memory=False,
-            encoding=enc,
-            **csv_float_options(),
-            **opts,
+def _source_format(path: str | Path, read: ReadOptions) -> tuple[Path, FileFormat, ReadOptions]:
+    """The input of a chunked pass, its registered format and how to read it: a format that
+    cannot be read in chunks is refused naming the file, its format and what to do; a
+    station folder's sensor (``DIR`` with ``--sensor ID``) is read as ``DIR/ID``."""
+    src = Path(path)
+    fmt = format_of(src)
+    if fmt.chunks == "none":
+        raise FileFormatError(
+            f"{src}: {fmt.title} ({fmt.name} format) cannot be read in chunks, which "
+            "compensate needs; write it as CSV or Parquet first (thermocal.read_recording, "
+            "then thermocal.write_recording)"
         )
-        try:
-            with reader, _ctrl_c_noted() as ctrl_c:
-                for df in reader:
-                    df.columns = [str(c).strip() for c in df.columns]
-                    yield df
-        except (pd.errors.ParserError, UnicodeDecodeError) as exc:
-            if ctrl_c.seen:  # Ctrl-C inside pandas' read: the C parser reports a read failure
-                raise KeyboardInterrupt from None
-            msg = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
-            raise FileFormatError(f"{path}: not a readable CSV file ({msg})") from None
+    if fmt.locate is not None:
+        return fmt.locate(src, read.topic), fmt, read.replace(topic=None)
+    if read.topic is not None and "topic" not in fmt.options:
+        raise ThermocalInputError(f"{src}: --topic is for flight-controller logs (.ulg, .bin)")
+    return src, fmt, read
+
+
+def _slices(table: pd.DataFrame, chunk_rows: int) -> Iterator[pd.DataFrame]:
+    """A table read whole, ``chunk_rows`` rows at a time."""
+    for a in range(0, len(table), chunk_rows):
+        yield table.iloc[a : a + chunk_rows].reset_index(drop=True)
 
 
 def _check_plausible(
@@ -436,120 +282,174 @@ def _append_columns(
     return out
 
 
-class _Writer:
-    """Writes chunks to a CSV or Parquet file (format by extension of the output)."""
+class _ParquetChunks:
+    """Writes chunks to a Parquet file, the metadata in its key-value store."""
 
-    def __init__(self, tmp: Path, kind: str, info: dict[str, Any]) -> None:
+    sidecar = False
+    """Whether the output's metadata also goes to a ``FILE.meta.json`` sidecar."""
+
+    def __init__(self, tmp: Path, info: dict[str, Any]) -> None:
         self.tmp = tmp
-        self.kind = kind
         self.info = info
         self._pq: pq.ParquetWriter | None = None
         self._schema: pa.Schema | None = None
-        self._fh: Any = None
-        self._first = True
 
     def write(self, chunk: pd.DataFrame | pa.RecordBatch) -> None:
-        if self.kind == "parquet":
-            if isinstance(chunk, pd.DataFrame):
-                df = chunk.copy()
-                for c in df.columns:
-                    dtype = df[c].dtype
-                    if pd.api.types.is_bool_dtype(dtype):
-                        continue
-                    if pd.api.types.is_numeric_dtype(dtype):
-                        df[c] = df[c].astype(np.float64)
-                    else:
-                        df[c] = df[c].astype("string")
-                table = pa.Table.from_pandas(df, preserve_index=False)
-            else:
-                table = pa.Table.from_batches([chunk])
-            if self._pq is None:
-                meta = dict(table.schema.metadata or {})
-                meta.pop(b"pandas", None)
-                meta[META_KEY.encode()] = json.dumps(self.info).encode("utf-8")
-                self._schema = table.schema.with_metadata(meta)
-                # dictionary encoding of float columns costs 3x the write time and rarely
-                # shrinks measured data; keep it for the others (ids, counts, text)
-                dict_cols = [f.name for f in self._schema if not pa.types.is_floating(f.type)]
-                self._pq = pq.ParquetWriter(self.tmp, self._schema, use_dictionary=dict_cols)
-            assert self._schema is not None
-            self._pq.write_table(table.cast(self._schema))
+        if isinstance(chunk, pd.DataFrame):
+            df = chunk.copy()
+            for c in df.columns:
+                dtype = df[c].dtype
+                if pd.api.types.is_bool_dtype(dtype):
+                    continue
+                if pd.api.types.is_numeric_dtype(dtype):
+                    df[c] = df[c].astype(np.float64)
+                else:
+                    df[c] = df[c].astype("string")
+            table = pa.Table.from_pandas(df, preserve_index=False)
         else:
-            df = chunk.to_pandas() if isinstance(chunk, pa.RecordBatch) else chunk
-            if self._fh is None:
-                self._fh = open(self.tmp, "w", encoding="utf-8", newline="")  # noqa: SIM115
-            df.to_csv(self._fh, index=False, header=self._first, lineterminator="\n")
-            self._first = False
+            table = pa.Table.from_batches([chunk])
+        if self._pq is None:
+            meta = dict(table.schema.metadata or {})
+            meta.pop(b"pandas", None)
+            meta[META_KEY.encode()] = json.dumps(self.info).encode("utf-8")
+            self._schema = table.schema.with_metadata(meta)
+            # dictionary encoding of float columns costs 3x the write time and rarely
+            # shrinks measured data; keep it for the others (ids, counts, text)
+            dict_cols = [f.name for f in self._schema if not pa.types.is_floating(f.type)]
+            self._pq = pq.ParquetWriter(self.tmp, self._schema, use_dictionary=dict_cols)
+        assert self._schema is not None
+        self._pq.write_table(table.cast(self._schema))
 
     def close(self) -> None:
         if self._pq is not None:
             self._pq.close()
+
+
+class _CsvChunks:
+    """Writes chunks to a CSV file (its metadata goes to the sidecar)."""
+
+    sidecar = True
+
+    def __init__(self, tmp: Path, info: dict[str, Any]) -> None:
+        self.tmp = tmp
+        self._fh: Any = None
+        self._first = True
+
+    def write(self, chunk: pd.DataFrame | pa.RecordBatch) -> None:
+        df = chunk.to_pandas() if isinstance(chunk, pa.RecordBatch) else chunk
+        if self._fh is None:
+            self._fh = open(self.tmp, "w", encoding="utf-8", newline="")  # noqa: SIM115
+        df.to_csv(self._fh, index=False, header=self._first, lineterminator="\n")
+        self._first = False
+
+    def close(self) -> None:
         if self._fh is not None:
             self._fh.close()
+
+
+_CHUNK_WRITERS: dict[str, type[_ParquetChunks] | type[_CsvChunks]] = {
+    "parquet": _ParquetChunks,
+    "csv": _CsvChunks,
+}
+"""The chunked writer of each output format :func:`thermocal.writers.written_format` names."""
 
 
 def compensate_file(
     model: TemperatureModel,
     path: str | Path,
     out: str | Path,
+    read: ReadOptions | None = None,
     *,
     signal: str | None = None,
-    time: str | None = None,
-    time_unit: str | None = None,
-    signal_unit: str | None = None,
-    temp_unit: str | None = None,
     chunk_rows: int = DEFAULT_CHUNK_ROWS,
     extrapolate: bool = False,
     known_input: float = 0.0,
     on_progress: Callable[[int], None] | None = None,
-    temperature_conversion: units.TemperatureConversion | tuple[float, float] | None = None,
-    text: TextOptions | None = None,
-    topic: str | None = None,
 ) -> CompensateFileResult:
-    """Compensate a CSV/Parquet file into ``out`` with constant memory.
+    """Compensate a recording file into ``out`` with constant memory.
 
     ``out`` keeps every input column and adds ``<signal>_model`` (ŷ) and
-    ``<signal>_comp`` (``F − ŷ``), both in the data column's unit.  The signal
-    column is the model's ``signal_name`` unless ``signal`` is given; the
-    temperature columns are the model's.  Units and temperature conversions are resolved
-    once (:func:`thermocal.units.resolve_inputs`): options, then the file's sidecar or
-    Parquet metadata, the unit in the column name, what the model file recorded of its
-    inputs (:meth:`TemperatureModel.input_units`), else a default stated in a warning.
-    The output is written to a temporary name and renamed when complete
-    (:func:`thermocal.writers.atomic_write_path`); ``out`` may not be ``path``.
+    ``<signal>_comp`` (``F − ŷ``), both in the data column's unit.  One channel of
+    :func:`compensate_channels`.
 
-    Chunks are predicted with their context (:class:`ChunkPredictor`), so the
-    result equals an in-memory ``predict`` of the whole file.  ``known_input``
-    [model unit] is what :class:`StreamingCompensator` says.  ``temperature_conversion``
-    ``(gain, offset[, "int16"])`` converts raw-count temperatures
-    (``T = gain·counts + offset``), overriding the file's metadata.
-    One channel of :func:`compensate_channels`.
+    Parameters
+    ----------
+    model : TemperatureModel
+        A fitted model; its temperature columns are read from the file.
+    path : str or Path
+        The recording, in any registered format that can be read in chunks
+        (:mod:`thermocal.readers.formats`).
+    out : str or Path
+        The output, CSV (with its ``FILE.meta.json`` sidecar) or Parquet; written to a
+        temporary name and renamed when complete.  It may not be ``path``.
+    read : ReadOptions, optional
+        How the file is read (:class:`~thermocal.readers.options.ReadOptions`): time column
+        and units, ``temp_conversion`` for raw-count temperatures (over the file's
+        metadata), a log's topic, a text log's layout.
+    signal : str, optional
+        The signal column (default: the model's ``signal_name``).
+    chunk_rows : int
+        Rows read and written at a time (at least 2).
+    extrapolate : bool
+        Allow temperatures outside the fitted range (a warning instead of an error).
+    known_input : float
+        Known input [model unit] (earth rate, a gravity component) removed from what the
+        model sees (a bank's start-up selection).
+    on_progress : callable, optional
+        Called with the number of rows done after each chunk.
+
+    Returns
+    -------
+    CompensateFileResult
+        Rows, chunks, the added columns and their unit, and the figures before and after
+        (rms about the mean, mean, rms and largest error about the ideal output).
 
     Raises
     ------
-    MissingColumnError : the signal, time or a model temperature column is absent
-        (the missing and the available columns are named).
-    UnitError : the model's and the data's signal units differ in kind; temperatures in
-        raw counts without a conversion for a °C model, or in °C for a counts model.
-    TimestampError, MissingValueError : time not increasing, NaN in a used column.
+    thermocal.errors.FileFormatError
+        No registered format reads the file, or its format cannot be read in chunks.
+    thermocal.errors.MissingColumnError
+        The signal, time or a model temperature column is absent (the missing and the
+        available columns are named).
+    thermocal.errors.UnitError
+        The model's and the data's signal units differ in kind; temperatures in raw counts
+        without a conversion for a °C model, or in °C for a counts model.
+    thermocal.errors.TimestampError
+        Time not increasing.
+    thermocal.errors.MissingValueError
+        NaN in a used column.
+
+    Notes
+    -----
+    The model gives the temperature-induced part of the output, the compensated output is
+
+    .. math:: F'_k = F_k - \\hat y(T_k, \\dot T_k, \\ldots)
+
+    Units and temperature conversions are resolved once
+    (:func:`thermocal.units.resolve_inputs`): ``read``, then the file's sidecar or Parquet
+    metadata, the unit in the column name, what the model file recorded of its inputs
+    (:meth:`TemperatureModel.input_units`), else a default stated in a warning.  Chunks
+    are predicted with their context (:class:`~thermocal.compensate.kernels.ChunkPredictor`:
+    the samples since power-on and the last Δt seconds of the rate buffer), so the result
+    equals an in-memory ``predict`` of the whole file.
+
+    References
+    ----------
+    *A modelling and validation method for the temperature compensation model of a
+    ring-laser gyroscope*, Chinese invention patent, published 2017 (the compensated output
+    :math:`F' = F - \\hat y`); the References of ``docs/methods.md``.
     """
     sig = signal or model.signal_name
     return compensate_channels(
         [(sig, model)],
         path,
         out,
-        time=time,
-        time_unit=time_unit,
-        signal_unit=signal_unit,
-        temp_unit=temp_unit,
+        read,
         chunk_rows=chunk_rows,
         extrapolate=extrapolate,
         known_input=known_input,
         on_progress=on_progress,
-        temperature_conversion=temperature_conversion,
         signal_given=signal is not None,
-        text=text,
-        topic=topic,
     )[0]
 
 
@@ -579,30 +479,48 @@ def compensate_channels(
     channels: Sequence[tuple[str, TemperatureModel]],
     path: str | Path,
     out: str | Path,
+    read: ReadOptions | None = None,
     *,
-    time: str | None = None,
-    time_unit: str | None = None,
-    signal_unit: str | None = None,
-    temp_unit: str | None = None,
     chunk_rows: int = DEFAULT_CHUNK_ROWS,
     extrapolate: bool = False,
     known_input: float = 0.0,
     on_progress: Callable[[int], None] | None = None,
-    temperature_conversion: units.TemperatureConversion | tuple[float, float] | None = None,
     signal_given: bool = True,
-    text: TextOptions | None = None,
-    topic: str | None = None,
 ) -> list[CompensateFileResult]:
-    """Compensate several channels ``(signal column, model)`` of one file in one chunked
-    pass with constant memory (issue 15): every chunk is read once, its time checked
-    once, each distinct temperature input converted once, and every channel adds its
-    ``<signal>_model`` and ``<signal>_comp`` in its own data column's unit (see
-    :func:`compensate_file` for the rules of one channel). ``signal_unit`` is one unit
-    for all or one per channel (``"deg/s,deg/s,deg/s,mg,mg,mg"``).
+    """Compensate several channels of one file in one chunked pass with constant memory.
+
+    Every chunk is read once, its time checked once, each distinct temperature input
+    converted once, and every channel adds its ``<signal>_model`` and ``<signal>_comp`` in
+    its own data column's unit (:func:`compensate_file` gives the rules of one channel).
+
+    Parameters
+    ----------
+    channels : sequence of (str, TemperatureModel)
+        ``(signal column, fitted model)`` pairs, each column once.
+    path, out : str or Path
+        The recording and the output (as :func:`compensate_file`).
+    read : ReadOptions, optional
+        How the file is read; ``read.signal_unit`` is one unit for all channels or one per
+        channel (``"deg/s,deg/s,deg/s,mg,mg,mg"``).
+    chunk_rows, extrapolate, known_input, on_progress
+        As :func:`compensate_file`.
+    signal_given : bool
+        Whether the signal columns were named by the user (a missing one is then said as
+        theirs, not the model's).
+
+    Returns
+    -------
+    list of CompensateFileResult
+        One per channel, in ``channels``' order.
+
+    Raises
+    ------
+    thermocal.errors.ThermocalInputError
+        No channel, a column twice, or any error of :func:`compensate_file`.
     """
-    src, kind_in, topic = _input_kind(Path(path), topic)
+    src, fmt, r = _source_format(path, read or ReadOptions())
     dst = Path(out)
-    kind_out = file_kind(dst)
+    kind_out = written_format(dst)
     check_not_input(dst, [src])
     _check_chunk_rows(chunk_rows)
     if not channels:
@@ -610,16 +528,13 @@ def compensate_channels(
     sig_list = [c for c, _m in channels]
     if len(set(sig_list)) != len(sig_list):
         raise ThermocalInputError(f"a signal column appears twice: {sig_list}")
-    source = _open_source(src, kind_in, time, text, topic)
-    sig_opts = units.per_signal_option(signal_unit, sig_list)
-    conv_opt = (
-        units.temperature_conversion(temperature_conversion, "--temp-conversion")
-        if temperature_conversion is not None
-        else None
-    )
+    source = _open_source(src, fmt, r)
+    sig_opts = units.per_signal_option(r.signal_unit, sig_list)
     ctx = _FileContext(src, source.names, source.info, source.time_col, source.available,
                        signal_given)  # fmt: skip
-    opts = units.UnitOptions(time_unit=time_unit, temp_unit=temp_unit, temp_conversion=conv_opt)
+    opts = units.UnitOptions(
+        time_unit=r.time_unit, temp_unit=r.temp_unit, temp_conversion=r.temp_conversion
+    )
     plans = [
         _channel_plan(ctx, sig_name, model, sig_opts[sig_name], opts,
                       extrapolate=extrapolate, known_input=known_input,
@@ -639,7 +554,7 @@ def compensate_channels(
     run = _ChannelPass(source, plans, _evaluation_groups(plans), units.TIME_UNITS[t_unit],
                        chunk_rows, on_progress, state)  # fmt: skip
     atomic_write_path(dst, lambda tmp: run.write(tmp, kind_out, out_info))
-    if kind_out == "csv":
+    if _CHUNK_WRITERS[kind_out].sidecar:
         write_json(sidecar_path(dst), out_info)
     for plan in plans:
         plan.predictor.finish()
@@ -654,12 +569,12 @@ def _check_chunk_rows(chunk_rows: int) -> None:
 
 @dataclass(frozen=True)
 class _Source:
-    """The input of a chunked pass: its path and kind, its columns and metadata, the table
-    of a log read whole (ULog, DataFlash, a text log with options; None: read in chunks)
-    and the time column, checked present."""
+    """The input of a chunked pass: its path and format, its columns and metadata, the table
+    of a file read whole (a log, a plugin's format, a text log with layout options; None:
+    read a chunk at a time) and the time column, checked present."""
 
     src: Path
-    kind: str
+    fmt: FileFormat
     names: list[str]
     info: dict[str, Any]
     table: pd.DataFrame | None
@@ -668,22 +583,37 @@ class _Source:
 
     def chunks(self, chunk_rows: int) -> Iterator[pd.DataFrame | pa.RecordBatch]:
         """The file's rows, ``chunk_rows`` at a time."""
-        return _iter_chunks(self.src, self.kind, chunk_rows, self.table)
+        if self.table is not None:
+            return _slices(self.table, chunk_rows)
+        assert self.fmt.stream is not None
+        return self.fmt.stream(self.src, chunk_rows)
 
 
-def _open_source(
-    src: Path, kind_in: str, time: str | None, text: TextOptions | None, topic: str | None
-) -> _Source:
-    """The input's columns and metadata (flight-controller logs and text logs with options
-    read whole first) and its time column (``time``, else the metadata's or the default);
-    :class:`MissingColumnError` naming the available columns when it is absent."""
-    text_table: pd.DataFrame | None = None
-    text_info: dict[str, Any] | None = None
-    if kind_in in ("ulog", "dataflash"):  # flight-controller logs: read whole, then chunked
-        text_table, text_info = read_log_table(src, topic)
-    elif text is not None:
-        text_table, text_info = read_text_table(src, text, time)
-    names, info, _ = _file_info(src, kind_in, text_table, text_info)
+def _head(src: Path, fmt: FileFormat) -> tuple[list[str], dict[str, Any]]:
+    """Column names and metadata (sidecar over the file's) of a format read a chunk at a
+    time, without reading its rows; a missing, special or empty file is refused."""
+    if fmt.sniff is None or not fmt.sniff(src):
+        if not src.exists():
+            raise FileFormatError(f"{src}: no such file")
+        refuse_special_input(src)
+        if src.stat().st_size == 0:
+            raise FileFormatError(f"{src}: the file is empty")
+    assert fmt.head is not None
+    names, meta, _n_rows = fmt.head(src)
+    return names, {**meta, **load_sidecar(src)}
+
+
+def _open_source(src: Path, fmt: FileFormat, read: ReadOptions) -> _Source:
+    """The input's columns and metadata (a format read whole, or a text log with layout
+    options, read first) and its time column (``read.time``, else the metadata's or the
+    default); :class:`MissingColumnError` naming the available columns when it is absent."""
+    table: pd.DataFrame | None = None
+    if fmt.chunks == "whole" or read.text_layout_given:
+        table, info = read_whole_table(src, read)
+        names = [str(c) for c in table.columns]
+    else:
+        names, info = _head(src, fmt)
+    time = read.time
     time_col = time or default_time_column(names, info.get("time"))
     available = names_list(names)  # the first 20 and how many more (10 000 columns: one line)
     if time_col not in names:
@@ -692,7 +622,7 @@ def _open_source(
             f"{src}: no time column {time_col!r}; available: {available}"
             + (hint if time is None else "")
         )
-    return _Source(src, kind_in, names, info, text_table, time_col, available)
+    return _Source(src, fmt, names, info, table, time_col, available)
 
 
 @dataclass
@@ -732,7 +662,7 @@ class _ChannelPass:
         a second thread while this one is computed (pyarrow and numpy release the GIL);
         one chunk in flight, errors re-raised here."""
         src, state = self.source.src, self.state
-        w = _Writer(tmp, kind_out, out_info)
+        w = _CHUNK_WRITERS[kind_out](tmp, out_info)
         pool = ThreadPoolExecutor(max_workers=1, thread_name_prefix="thermocal-write")
         pending: Future[None] | None = None
         try:
@@ -1048,27 +978,15 @@ def _evaluation_groups(plans: Sequence[_ChannelPlan]) -> list[list[_ChannelPlan]
 
 __all__ = [
     "COMP_SUFFIX",
-    "DEFAULT_CHUNK_ROWS",
     "MODEL_SUFFIX",
     "CalibrationCompensation",
-    "CalibrationStream",
-    "ChunkContext",
-    "ChunkPredictor",
     "CompensateFileResult",
-    "Compensation",
-    "ModelRun",
-    "StreamingCompensator",
-    "check_signal_kind",
-    "chunk_context",
+    "TriadCompensation",
     "compensate_calibration_file",
     "compensate_channels",
     "compensate_file",
-    "compensate_run",
-    "model_scale_factor",
-    "prepare_run",
-    "temperature_inputs",
-    "unit_factor",
-    "zero_reference",
+    "compensate_triads",
+    "read_for_triads",
 ]
 
 
@@ -1094,59 +1012,102 @@ class TriadCompensation:
 def read_for_triads(
     path: str | Path,
     triads: Sequence[Any],
-    *,
-    time: str | None = None,
-    time_unit: str | None = None,
-    text: TextOptions | None = None,
-    topic: str | None = None,
+    read: ReadOptions | None = None,
 ) -> Recording:
-    """A recording read for triad calibrations: their temperature columns as temperatures,
-    so that their units go through the resolver (option > metadata > column name); the
-    triads' own columns keep the unit their metadata or name states.  ``text`` and ``topic``:
-    the text-log options and log topic every command reads a recording with."""
+    """A recording read for triad calibrations.
+
+    Parameters
+    ----------
+    path : str or Path
+        The recording.
+    triads : sequence of Triad
+        The calibration's triads; their temperature columns are read as temperatures, so
+        that their units go through the resolver (option > metadata > column name); the
+        triads' own columns keep the unit their metadata or name states.
+    read : ReadOptions, optional
+        How the file is read: its time column and unit, a text log's layout, a topic
+        (its column roles are the triads').
+
+    Returns
+    -------
+    Recording
+    """
     temps = list(dict.fromkeys(t.temperature for t in triads if t.temperature))
+    r = read or ReadOptions()
     return read_recording(
-        path, time=time, time_unit=time_unit, temperatures=temps, text=text, topic=topic
-    )
+        path,
+        ReadOptions(time=r.time, time_unit=r.time_unit, temperatures=tuple(temps), topic=r.topic,
+                    names=r.names, rate_hz=r.rate_hz, on_bad_lines=r.on_bad_lines,
+                    delimiter=r.delimiter, decimal=r.decimal),
+    )  # fmt: skip
 
 
 def compensate_triads(
     triads: Sequence[Any],
     path: str | Path,
     out: str | Path,
+    read: ReadOptions | None = None,
     *,
-    time: str | None = None,
-    time_unit: str | None = None,
     chunk_rows: int = DEFAULT_CHUNK_ROWS,
-    topic: str | None = None,
-    signal_unit: str | None = None,
-    text: TextOptions | None = None,
 ) -> list[TriadCompensation]:
-    """Apply triad calibrations (issue 19) to a recording: for each triad and each of its
-    axes a column ``<col>_comp = [(I + E(T))⁻¹ (x − b(T))]_axis`` in the column's own unit,
-    ``T`` the triad's temperature column at each sample (clamped to the calibrated range,
-    with a warning when samples leave it; :func:`thermocal.turntable.thermal.correct`).
-    Raw-count columns of a triad calibrated on counts (``Triad.count_scale``, issue 30) are
+    """Apply triad calibrations to a recording, in chunks with constant memory.
+
+    Parameters
+    ----------
+    triads : sequence of Triad
+        The calibration's triads.
+    path, out : str or Path
+        The recording and the output (as :func:`compensate_file`).
+    read : ReadOptions, optional
+        How the file is read (see below for ``signal_unit``).
+    chunk_rows : int
+        Rows read and written at a time (at least 2).
+
+    Returns
+    -------
+    list of TriadCompensation
+        One per triad: its columns, the added ones, their unit, the share of samples
+        outside the calibrated temperature range.
+
+    Raises
+    ------
+    thermocal.errors.MissingColumnError
+        A triad's column absent from the file.
+    thermocal.errors.UnitError
+        Raw-count temperatures without a conversion, or raw counts for a triad calibrated
+        without a count scale.
+
+    Notes
+    -----
+    For each triad and each of its axes a column
+
+    .. math:: x^{comp} = \\left[(I + E(T))^{-1} (x - b(T))\\right]_{axis}
+
+    in the column's own unit, ``T`` the triad's temperature column at each sample (clamped
+    to the calibrated range, with a warning when samples leave it;
+    :func:`thermocal.turntable.thermal.correct`).
+    Raw-count columns of a triad calibrated on counts (``Triad.count_scale``) are
     converted first, ``x = count_scale · N``, and their ``_comp`` columns are in the
     triad's physical unit; raw counts for a triad without a count scale are refused.
-    ``signal_unit`` (``--signal-unit``): one unit for every triad column, or one per column
-    in the triads' order; ``text`` the text-log options (``--rate`` for a log without time).
+    ``read.signal_unit``: one unit for every triad column, or one per column in the triads'
+    order; ``read`` also carries the time column and unit, a topic and a text log's layout
+    (``rate_hz`` for a log without time).
 
-    In chunks of ``chunk_rows`` rows with constant memory, like :func:`compensate_channels`
-    (issue 26): the correction is per sample, so each chunk's values equal those of a
-    whole-file pass; every input column is kept as it is and the output is written chunk
-    by chunk to a temporary name, renamed when complete.  Units: option > the file's
+    In chunks of ``chunk_rows`` rows with constant memory, like :func:`compensate_channels`:
+    the correction is per sample, so each chunk's values equal those of a whole-file pass;
+    every input column is kept as it is and the output is written chunk by chunk to a
+    temporary name, renamed when complete.  Units: option > the file's
     metadata > a unit in the column name > the unit the triad was calibrated on
     (:func:`thermocal.units.resolve_inputs`).
     """
-    src, kind_in, topic = _input_kind(Path(path), topic)
+    src, fmt, r = _source_format(path, read or ReadOptions())
     dst = Path(out)
-    kind_out = file_kind(dst)
+    kind_out = written_format(dst)
     check_not_input(dst, [src])
     _check_chunk_rows(chunk_rows)
-    source = _open_source(src, kind_in, time, text, topic)
+    source = _open_source(src, fmt, r)
     plans = [_triad_plan(tri, source.names, source.available, src) for tri in triads]
-    resolved = _resolve_triads(source, plans, time_unit, signal_unit)
+    resolved = _resolve_triads(source, plans, r.time_unit, r.signal_unit)
     out_info = _triad_output_info(source.info, source.time_col, resolved, plans)
     warn_formula_names(dst, source.names)
     state = _PassState()
@@ -1154,7 +1115,7 @@ def compensate_triads(
         dst, lambda tmp: _write_triads(tmp, source, kind_out, out_info, plans, resolved,
                                        chunk_rows, state)
     )  # fmt: skip
-    if kind_out == "csv":
+    if _CHUNK_WRITERS[kind_out].sidecar:
         write_json(sidecar_path(dst), out_info)
     results = []
     for p in plans:
@@ -1230,7 +1191,7 @@ def _write_triads(
     src = source.src
     t_factor = units.TIME_UNITS[resolved.time.unit]
     temp_names = _triad_temperatures(plans)
-    w = _Writer(tmp, kind_out, out_info)
+    w = _CHUNK_WRITERS[kind_out](tmp, out_info)
     try:
         for chunk in source.chunks(chunk_rows):
             row0 = state.rows
@@ -1382,7 +1343,7 @@ class CalibrationCompensation:
     """``(channel name, model family, result)``; one entry for ``single``."""
 
     def to_dict(self) -> dict[str, Any]:
-        """The ``thermocal compensate --json`` object (INTERFACE.md)."""
+        """The ``thermocal compensate --json`` object."""
         if self.kind == "triads":
             return {"model": self.model_file, "output": self.output,
                     "triads": [d.to_dict() for d in self.triads]}  # fmt: skip
@@ -1407,29 +1368,46 @@ def compensate_calibration_file(
     model_file: str | Path,
     path: str | Path,
     out: str | Path,
+    read: ReadOptions | None = None,
     *,
     signal: str | None = None,
-    time: str | None = None,
-    time_unit: str | None = None,
-    signal_unit: str | None = None,
-    temp_unit: str | None = None,
-    temp_conversion: str | None = None,
     chunk_rows: int = DEFAULT_CHUNK_ROWS,
     extrapolate: bool = False,
     known_input: float = 0.0,
     on_progress: Callable[[int], None] | None = None,
-    text: TextOptions | None = None,
-    topic: str | None = None,
 ) -> CalibrationCompensation:
-    """``thermocal compensate``: apply a model or calibration file to a recording.
+    """Apply a model or calibration file to a recording (``thermocal compensate``).
 
-    ``out`` may be neither input (nor, for a CSV, may its sidecar).  A calibration of
-    triads is applied by :func:`compensate_triads`; one channel (a model file) by
-    :func:`compensate_file` (``signal``: its column, default the model's); several
-    channels (those named in ``signal``, ``"gx,gy"``, default all) in one pass by
-    :func:`compensate_channels`.  ``temp_conversion`` is ``"GAIN,OFFSET[,int16]"``
-    (:func:`thermocal.units.temperature_conversion`).  A calibration with both triads and
-    channels is refused (:class:`ThermocalInputError`).
+    A calibration of triads is applied by :func:`compensate_triads`; one channel (a model
+    file) by :func:`compensate_file`; several channels in one pass by
+    :func:`compensate_channels`.
+
+    Parameters
+    ----------
+    model_file : str or Path
+        A model file or a calibration file.
+    path : str or Path
+        The recording.
+    out : str or Path
+        The output; it may be neither input (nor, for a CSV, may its sidecar).
+    read : ReadOptions, optional
+        How the recording is read (:class:`~thermocal.readers.options.ReadOptions`).
+    signal : str, optional
+        One channel: its column (default the model's); several: the channels to apply,
+        ``"gx,gy"`` (default all).
+    chunk_rows, extrapolate, known_input, on_progress
+        As :func:`compensate_file`.
+
+    Returns
+    -------
+    CalibrationCompensation
+        What was applied (``triads``, ``single`` or ``channels``) and each result.
+
+    Raises
+    ------
+    thermocal.errors.ThermocalInputError
+        A calibration with both triads and channels, an output on an input, or any error
+        of :func:`compensate_file` and :func:`compensate_triads`.
     """
     from thermocal.models.files import load_calibration
 
@@ -1437,36 +1415,27 @@ def compensate_calibration_file(
     if file_kind(Path(out)) == "csv":  # the CSV's sidecar must not land on an input either
         check_not_input(sidecar_path(out), [path, model_file])
     cal = load_calibration(model_file)  # a model file is a calibration of one channel
-    conv = (
-        units.temperature_conversion(temp_conversion, "--temp-conversion")
-        if temp_conversion is not None
-        else None
-    )
     if cal.triads:
         if cal.channels:
             raise ThermocalInputError(
                 f"{model_file}: a calibration with both triads and single channels is not "
                 "applied yet; split it"
             )
-        done = compensate_triads(
-            cal.triads, path, out, time=time, time_unit=time_unit, chunk_rows=chunk_rows,
-            topic=topic, signal_unit=signal_unit, text=text,
-        )  # fmt: skip
+        done = compensate_triads(cal.triads, path, out, read, chunk_rows=chunk_rows)
         return CalibrationCompensation(str(model_file), str(out), "triads", tuple(done))
     common: dict[str, Any] = dict(
-        time=time, time_unit=time_unit, signal_unit=signal_unit, temp_unit=temp_unit,
-        temperature_conversion=conv, chunk_rows=chunk_rows, extrapolate=extrapolate,
-        known_input=known_input, on_progress=on_progress, text=text, topic=topic,
+        chunk_rows=chunk_rows, extrapolate=extrapolate, known_input=known_input,
+        on_progress=on_progress,
     )  # fmt: skip
     if len(cal.channels) == 1:
         ch = cal.channels[0]
-        res = compensate_file(ch.model, path, out, signal=signal, **common)
+        res = compensate_file(ch.model, path, out, read, signal=signal, **common)
         return CalibrationCompensation(
             str(model_file), str(out), "single", channels=((ch.name, ch.model.family, res),)
         )
     chosen = _split_names(signal) or cal.names
     models = [(cal.channel(n).signal, cal.channel(n).model) for n in chosen]
-    results = compensate_channels(models, path, out, **common)
+    results = compensate_channels(models, path, out, read, **common)
     return CalibrationCompensation(
         str(model_file),
         str(out),
