@@ -176,10 +176,8 @@ def make_report(
     averaging_s, latitude_deg, dynamic_s : float, optional
         Averaging time of the stability figures [s]; latitude [°] of a triad's validation
         (default the file's metadata); window of the dynamic Allan deviation [s].
-    read : ReadOptions, optional
-        How the recordings are read.
-    progress : callable, optional
-        Draws the steps.
+    read, progress : ReadOptions, callable, optional
+        How the recordings are read; what draws the steps.
 
     Returns
     -------
