@@ -2587,8 +2587,8 @@ MUTANTS: tuple[Mutant, ...] = (
     Mutant(
         "h39a-idle-noise-type-any",
         P + "stability/analysis.py",
-        "all(d in NO_INTERVAL for d in devs)",
-        "any(d in NO_INTERVAL for d in devs)",
+        "all(no_interval(d) is not None for d in devs)",
+        "any(no_interval(d) is not None for d in devs)",
         H39A_ATT,
         "--noise-type called idle when one deviation (MTIE) has no interval",
     ),

@@ -81,8 +81,8 @@ def family_json(res: "_family.StabilityResult") -> dict[str, Any]:
         out[f"{name}_n"] = c.n_terms
         out[f"{name}_tau_s"] = c.tau_s
         out[f"{name}_unit"] = c.unit
-        out[f"{name}_interval"] = _family.NO_INTERVAL.get(
-            name, f"chi-square, {100 * res.confidence:.1f} %, {_family.edf_source(name)}"
+        out[f"{name}_interval"] = _family.no_interval(name) or (
+            f"chi-square, {100 * res.confidence:.1f} %, {_family.edf_source(name)}"
         )
         if c.bias is not None:
             out[f"{name}_bias_factor"] = c.bias
@@ -104,8 +104,9 @@ def _family_human(file: Path, res: "_family.StabilityResult") -> None:
                 str(int(c.n_terms[i])),
             )  # fmt: skip
         stdout.print(t)
-        if name in _family.NO_INTERVAL:
-            stdout.print(f"{name}: interval {_family.NO_INTERVAL[name]}")
+        why = _family.no_interval(name)
+        if why is not None:
+            stdout.print(f"{name}: interval {why}")
 
 
 def _terms_json(terms: dict[str, Any], method: str) -> dict[str, Any]:

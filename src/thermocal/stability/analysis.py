@@ -136,14 +136,14 @@ def check_not_stuck(
 def _tau_range(name: str, tau0_s: float, n_phase: int) -> tuple[float, float, int]:
     """The τ [s] a deviation reaches on ``n_phase`` phase points and its largest m
     (theo1: τ = 0.75 m τ0, m even)."""
-    from thermocal.stability import deviations as dv
+    from thermocal.stability import registry
 
     if name == "adev-rate":  # the overlapping ADEV of rate samples (allan.averaging_factors)
         from thermocal.stability.allan import max_averaging_factor
 
         m_max = max_averaging_factor(n_phase)
         return tau0_s, m_max * tau0_s, m_max
-    m_max = dv.max_factor(name, n_phase)
+    m_max = registry.get(name).max_factor(n_phase)
     if name == "theo1":
         m_max -= m_max % 2
         return 1.5 * tau0_s, 0.75 * m_max * tau0_s, m_max
@@ -382,10 +382,10 @@ def _idle_options(
     """A warning naming ``--bias-correct`` or ``--noise-type`` where it changed nothing: no
     totdev/htotdev asked, a factor of 1 at every τ (Stable32 corrects totdev for flicker and
     random-walk FM only, htotdev for FM noise from m = 2: :func:`.family.stable32_bias`), or
-    no deviation with an interval (MTIE, TIE rms: :data:`.family.NO_INTERVAL`)."""
+    no deviation with an interval (MTIE, TIE rms: :func:`.family.no_interval`)."""
     import numpy as np
 
-    from thermocal.stability.family import NO_INTERVAL
+    from thermocal.stability.family import no_interval
 
     if bias_correct:
         corrected = [d for d in devs if d in BIAS_CORRECTED]
@@ -405,7 +405,7 @@ def _idle_options(
             why = ""
         if why:
             warnings.warn(f"{where}: --bias-correct changes nothing: {why}", ConditioningWarning, 2)
-    if alpha is not None and all(d in NO_INTERVAL for d in devs):
+    if alpha is not None and all(no_interval(d) is not None for d in devs):
         warnings.warn(
             f"{where}: --noise-type changes nothing: no confidence interval or bias factor "
             f"uses it ({', '.join(devs)}: none)",

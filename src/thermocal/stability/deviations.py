@@ -48,26 +48,6 @@ ndimage = LazyModule("scipy.ndimage")
 FloatArray = npt.NDArray[np.float64]
 IntArray = npt.NDArray[np.int64]
 
-DEVIATIONS: Final = (
-    "oadev",
-    "adev",
-    "mdev",
-    "tdev",
-    "hdev",
-    "ohdev",
-    "totdev",
-    "mtotdev",
-    "ttotdev",
-    "htotdev",
-    "theo1",
-    "mtie",
-    "tierms",
-)
-"""Names accepted by ``--deviation``, as in NIST SP 1065 / allantools / Stable32."""
-
-TIME_DEVIATIONS: Final = frozenset({"tdev", "ttotdev", "mtie", "tierms"})
-"""Deviations in phase units (unit·s for rate data) rather than in rate units."""
-
 _BLOCK: Final = 1 << 22
 """Elements per block of the O(N·m) kernels (mtotdev, htotdev, theo1)."""
 
@@ -812,8 +792,6 @@ def centred(x: FloatArray, *, inplace: bool = False) -> FloatArray:
 
 
 __all__ = [
-    "DEVIATIONS",
-    "TIME_DEVIATIONS",
     "as_phase",
     "centred",
     "max_factor",

@@ -16,7 +16,7 @@ mtotdev, ttotdev           SP 1065 Table 8
 htotdev                    SP 1065 §5.2.14 (α = 0, −1, −2), else as ohdev; m = 1 as ohdev
 theo1                      Howe's empirical fits (:func:`.edf.edf_theo1`), α identified
                            at the averaging factor of τ = 0.75 m τ0
-mtie, tierms               none (NaN; JSON ``<name>_interval`` says why: NO_INTERVAL)
+mtie, tierms               none (NaN; JSON ``<name>_interval`` says why: :func:`no_interval`)
 =========================  =========================================================
 
 The EDFs of gap-separated stretches add (independent estimates).
@@ -32,47 +32,30 @@ import numpy as np
 import numpy.typing as npt
 from threadpoolctl import threadpool_limits
 
-from thermocal.errors import MissingValueError, ThermocalInputError
+from thermocal.errors import MissingValueError, ParameterError, ThermocalInputError
 from thermocal.stability import deviations as dv
 from thermocal.stability import edf as ed
+from thermocal.stability import registry
 
 FloatArray = npt.NDArray[np.float64]
 IntArray = npt.NDArray[np.int64]
 
-HADAMARD = frozenset({"hdev", "ohdev", "htotdev"})
 TOTAL = frozenset({"totdev", "mtotdev", "ttotdev", "htotdev"})
 NOISE_IDS: Final = ("thermocal", "stable32")
 """Noise-identification rules (:func:`stability`): thermocal's (B1 against Barnes' theory at
 the number of averages, bounded by the shorter τ's α) or Stable32's."""
 
-NO_INTERVAL: dict[str, str] = {
-    "mtie": "none: MTIE is a maximum over windows, not a variance; no chi-square EDF applies "
-    "and neither NIST SP 1065 nor Stable32 gives it an interval",
-    "tierms": "none: NIST SP 1065 gives TIE rms no EDF",
-}
-"""The deviations whose ``low``/``high`` are NaN, and why (``<name>_interval`` in JSON)."""
+
+def no_interval(name: str) -> str | None:
+    """Why the deviation ``name`` has no interval (its ``low``/``high`` are NaN;
+    ``<name>_interval`` in JSON), or None when it has one."""
+    dev = registry.get(name)
+    return dev.interval if dev.edf is None else None
 
 
 def edf_source(name: str) -> str:
     """Where a deviation's EDF comes from, as the ``<name>_interval`` text states it."""
-    if name == "theo1":
-        return (
-            "Howe's empirical Theo1 EDF (its random-walk FM fit is far too small, the "
-            "interval too wide, beyond τ ≈ 0.2 of the record)"
-        )
-    if name in ("mtotdev", "ttotdev"):
-        return (
-            "Stable32's MTOT EDF (Greenhall's modified-Allan EDF below m = 10, a line in N/m "
-            "above, read from Stable32's bounds)"
-        )
-    if name == "htotdev":
-        return (
-            "SP 1065 Htot EDF from m = 16, Stable32's rule (the simple EDF + 2) below m = 16 "
-            "and at phase noise"
-        )
-    if name == "totdev":
-        return "SP 1065 TOTVAR EDF, Stable32's phase-noise rule (simple EDF + 2)"
-    return "Greenhall/SP 1065 EDF"
+    return registry.get(name).interval
 
 
 @dataclass(frozen=True, eq=False)
@@ -150,13 +133,13 @@ def stable32_bias(name: str, alpha: int, m: int, n_phase: int) -> float:
 
 
 def parse_deviations(spec: str) -> list[str]:
-    """``"oadev,mdev"`` → names, checked against :data:`.deviations.DEVIATIONS`."""
+    """``"oadev,mdev"`` → names, checked against the registry (:func:`.registry.names`)."""
     names = [s.strip().lower() for s in spec.split(",") if s.strip()]
-    bad = [n for n in names if n not in dv.DEVIATIONS]
+    bad = [n for n in names if n not in registry.names()]
     if bad or not names:
         raise ThermocalInputError(
             f"--deviation {spec!r}: unknown {', '.join(bad) or 'empty list'}; use "
-            + ", ".join(dv.DEVIATIONS)
+            + ", ".join(registry.names())
         )
     return list(dict.fromkeys(names))
 
@@ -182,7 +165,7 @@ def parse_noise_type(spec: str | None, names: list[str]) -> int | None:
         raise ThermocalInputError(
             f"--noise-type {spec!r}: use auto, {', '.join(NOISE_TYPES)} or α from -4 to 2"
         )
-    not_h = [n for n in names if n not in HADAMARD and n not in ("mtie", "tierms")]
+    not_h = [n for n in names if not registry.get(n).hadamard and registry.get(n).edf is not None]
     if alpha < -2 and not_h:
         raise ThermocalInputError(
             f"--noise-type {spec!r} (α = {alpha}) is defined for the Hadamard deviations "
@@ -226,28 +209,14 @@ def factors(
 
 
 def _edf(name: str, alpha: int, m: int, n_phase: int) -> float:
+    """The registered EDF of ``name`` (:mod:`.registry`); NaN where it has none."""
+    edf = registry.get(name).edf
+    if edf is None:
+        return float("nan")
     try:
-        if name == "adev":
-            return ed.greenhall_edf(alpha, 2, m, n_phase, overlapping=False, modified=False)
-        if name == "oadev":
-            return ed.greenhall_edf(alpha, 2, m, n_phase, overlapping=True, modified=False)
-        if name in ("mdev", "tdev"):
-            return ed.greenhall_edf(alpha, 2, m, n_phase, overlapping=True, modified=True)
-        if name == "hdev":
-            return ed.greenhall_edf(alpha, 3, m, n_phase, overlapping=False, modified=False)
-        if name == "ohdev":
-            return ed.greenhall_edf(alpha, 3, m, n_phase, overlapping=True, modified=False)
-        if name == "totdev":
-            return ed.edf_totdev(n_phase, m, alpha)
-        if name in ("mtotdev", "ttotdev"):
-            return ed.edf_mtotdev(n_phase, m, alpha)
-        if name == "htotdev":
-            return ed.edf_htotdev(n_phase, m, alpha)
-        if name == "theo1":
-            return ed.edf_theo1(n_phase, m, alpha)
+        return edf(alpha, m, n_phase)
     except ValueError:
         return float("nan")
-    return float("nan")
 
 
 def _stretches(
@@ -330,7 +299,7 @@ class _Record:
         shift by a constant; for phase data the frequency offset is gone before the lag-1
         test, which removes nothing else (:func:`.edf.identify_noise`)."""
         if self._centred is None:
-            raw = any(n in ("mtie", "tierms") for n in self.names)
+            raw = any(registry.get(n).raw_phase for n in self.names)
             self._centred = [dv.centred(x, inplace=not raw) for x in self.phases()]
         return self._centred
 
@@ -367,9 +336,9 @@ class _Record:
         if name in ("adev", "hdev") and self.m_max:
             parts = [dv.octave_sums(name, self.levels(i), m) for i in range(len(self.kept))]
         else:
-            raw = name in ("mtie", "tierms")
+            dev = registry.get(name)
             parts = [
-                dv.segment_sums(name, xr if raw else xc, self.tau0_s, m)
+                dev.sums(xr if dev.raw_phase else xc, self.tau0_s, m)
                 for xr, xc in zip(self.phases(), self.centred(), strict=True)
             ]
         return dv.pool(name, parts, m.size)
@@ -437,7 +406,7 @@ def _noise_exponents(
     column), down to 6 averages for the total family and 10 for ADEV and HDEV, never
     bounded by the shorter τ's α; the lag-1 method on rate averages with their mean removed
     (not their line) and r1 normalised as Stable32's (:class:`thermocal.stability.edf.IdRules`)."""
-    dmax = 3 if name in HADAMARD else 2
+    dmax = 3 if registry.get(name).hadamard else 2
     stable32 = noise_id == "stable32"
     b1_min = ed.MIN_B1_GROUPS
     if stable32 and name in TOTAL:
@@ -490,7 +459,7 @@ def _pooled_edf(name: str, m: IntArray, alphas: IntArray, sizes: list[int]) -> F
     edf = np.zeros(m.size)
     for n_phase in sizes:
         for i, mm in enumerate(m.tolist()):
-            if mm <= dv.max_factor(name, n_phase):
+            if mm <= registry.get(name).max_factor(n_phase):
                 e = _edf(name, int(alphas[i]), int(mm), n_phase)
                 edf[i] += e if math.isfinite(e) and e > 0 else 0.0
     edf[edf <= 0] = np.nan
@@ -509,11 +478,11 @@ def factor_sets(
     points: ``""`` the common set (every deviation but theo1, up to the largest
     :func:`.deviations.max_factor`), theo1 its own even set (:func:`factors`)."""
     others = [n for n in names if n != "theo1"]
-    top = max(dv.max_factor(n, n_long) for n in others) if others else 1
+    top = max(registry.get(n).max_factor(n_long) for n in others) if others else 1
     sets = {"": factors(taus, tau0_s, top)}
     for name in names:
         sets[name] = (
-            factors(taus, tau0_s, dv.max_factor(name, n_long), theo1=True)
+            factors(taus, tau0_s, registry.get(name).max_factor(n_long), theo1=True)
             if name == "theo1"
             else sets[""]
         )
@@ -539,7 +508,7 @@ def check_work(
         return math.nan
     if not max_work > 0:
         raise ThermocalInputError(f"--max-work {max_work!r}: give a positive operation count")
-    per = {n: sum(dv.work(n, size, sets[n]) for size in sizes) for n in names}
+    per = {n: sum(registry.get(n).estimated_work(size, sets[n]) for size in sizes) for n in names}
     total = sum(per.values())
     if total > max_work:
         worst = max(per, key=lambda n: per[n])
@@ -602,6 +571,13 @@ def stability(
             raise ThermocalInputError(f"--data-type {data_type!r}: use rate or phase")
         if noise_id not in NOISE_IDS:
             raise ThermocalInputError(f"--noise-id {noise_id!r}: use {' or '.join(NOISE_IDS)}")
+        for name in names:
+            if data_type not in registry.get(name).data_types:
+                raise ParameterError(
+                    "data_type",
+                    f"{{name}} {data_type!r}: {name} takes "
+                    + " or ".join(registry.get(name).data_types),
+                )
         record = _new_record(values, tau0_s, data_type, segments, names)
         sets = factor_sets(names, taus, tau0_s, max(record.sizes))
         check_work(names, sets, record.sizes, max_work, taus, where)
@@ -656,5 +632,5 @@ def _unit(name: str, unit: str, data_type: str) -> str:
     if not unit:
         return ""
     if data_type == "rate":
-        return f"{unit}*s" if name in dv.TIME_DEVIATIONS else unit
-    return unit if name in dv.TIME_DEVIATIONS else f"{unit}/s"
+        return f"{unit}*s" if registry.get(name).time_deviation else unit
+    return unit if registry.get(name).time_deviation else f"{unit}/s"
