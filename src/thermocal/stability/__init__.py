@@ -1,5 +1,5 @@
-"""Frequency-stability analysis of arrays: the NIST SP 1065 deviation family with
-confidence intervals, and the IEEE Std 952 noise terms.
+"""Frequency-stability analysis of arrays: the NIST SP 1065 deviation family [1]_ with
+confidence intervals, and the IEEE Std 952 noise terms [2]_.
 
 The public calls take a numpy array and a sample rate (as ``allantools.oadev(y, rate=…)``):
 

@@ -3,7 +3,8 @@
 The calls a notebook user makes with an array of rate (or phase) samples and a sample rate,
 in the manner of allantools (``allantools.oadev(y, rate=…, data_type="freq", taus=…)``):
 :func:`deviation` (any registered deviation, :mod:`.registry`), one function per deviation
-(:func:`oadev`, :func:`mdev`, …) and :func:`allan_noise` (the noise terms).  Each returns a
+(:func:`oadev`, :func:`mdev`, …: NIST SP 1065 [1]_, intervals from Greenhall and Riley's
+EDF [3]_) and :func:`allan_noise` (the IEEE 952 noise terms [2]_).  Each returns a
 frozen result with ``to_dict()`` and ``to_frame()``.  The recording-based analysis
 (:func:`thermocal.stability.analysis.allan_analysis`, ``thermocal allan``) computes the same
 numbers through the same functions.

@@ -4,7 +4,8 @@ Each entry (:class:`Deviation`) names the deviation, its sums over one gap-free 
 phase, its largest averaging factor, its equivalent degrees of freedom, the data types it
 takes and its Stable32 name.  The command line (``thermocal allan --deviation``), the
 library (:func:`thermocal.stability.family.stability`, :func:`thermocal.stability.deviation`)
-and the report read this table; a new deviation is one :func:`register` call.
+and the report read this table; a new deviation is one :func:`register` call.  The built-in
+entries are NIST SP 1065's deviations [1]_ with Greenhall and Riley's EDF [2]_.
 
 References
 ----------
