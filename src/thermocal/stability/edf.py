@@ -809,9 +809,8 @@ quantiles of a few degrees of freedom run to 0 or to the double range (an interv
 
 def check_confidence(confidence: float, option: str = "--confidence") -> float:
     """Return ``confidence`` when ``CONFIDENCE_MIN ≤ c ≤ CONFIDENCE_MAX``, else raise
-    :class:`ThermocalInputError` naming ``option`` and the value (issue 39: 1e-300 gave an
-    interval of zero width beside the estimate; NaN, 0 and 1 were refused without the
-    option's name).
+    :class:`ThermocalInputError` naming ``option`` and the value (a confidence of 1e-300
+    would give an interval of zero width beside the estimate).
 
     Parameters
     ----------

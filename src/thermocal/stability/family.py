@@ -442,7 +442,7 @@ def _noise_exponents(
         if not stable32 and nid.method == "b1" and i > 0 and alphas[i] > alphas[i - 1]:
             # B1 from 8–29 averages misreads random-walk FM as flicker or white FM in ≈ 40 %
             # of records (α read higher than at the shorter τ, where power-law noise can only
-            # steepen): the shorter τ's α is kept (Monte-Carlo coverage, issue 29 item 3).
+            # steepen): the shorter τ's α is kept (Monte-Carlo coverage).
             # A phase-noise reading split by R(n) (``b1-rn``) is no such misreading (B1 of
             # random-walk FM is ≈ N/2, of PM ≈ 2/3) and stands, as in Stable32 (Sr87 m = 100,
             # PHASE.DAT m = 100: flicker PM after white FM)

@@ -592,7 +592,7 @@ def model_json(model: NoiseModel, source: str) -> dict[str, Any]:
     }
 
 
-# --- output quantisation (issue 29 item 2) ---------------------------------------------------
+# --- output quantisation --------------------------------------------------------------------------
 
 QUANT_MIN_LEVELS: Final = 3
 """Distinct output levels a quantised record must show (two levels give no lattice)."""
