@@ -24,7 +24,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any, Final
 
-from thermocal.errors import ConditioningWarning, ThermocalInputError, UnitWarning
+from thermocal.errors import ConditioningWarning, ParameterError, ThermocalInputError, UnitWarning
 from thermocal.stability.allan import ONE_SIGMA_CONFIDENCE
 from thermocal.stability.edf import check_confidence
 
@@ -39,31 +39,8 @@ if TYPE_CHECKING:
 
     FloatArray = npt.NDArray[np.float64]
 
-TAU_SETS = ("octave", "decade", "log", "all")
-"""The named τ sets of ``--taus`` (else a list of τ [s])."""
-
 DATA_TYPES = ("rate", "phase")
 """``--data-type``: rate data (a rate column) or phase data (an integrated quantity)."""
-
-
-def parse_taus(text: str) -> Any:
-    """``--taus``: a named set (:data:`TAU_SETS`) as given, else a list of τ [s]."""
-    if text in TAU_SETS:
-        return text
-    try:
-        taus = [float(v) for v in text.split(",") if v.strip()]
-    except ValueError:
-        raise ThermocalInputError(
-            f"--taus {text!r}: use octave, decade, log or a comma-separated list of τ [s]"
-        ) from None
-    bad = [t for t in taus if not (math.isfinite(t) and t > 0)]
-    if bad or not taus:
-        raise ThermocalInputError(
-            f"--taus {text!r}: every τ must be a positive, finite time [s]"
-            + (f" (got {bad[0]:g})" if bad else " (none given)")
-            + "; or use octave, decade, log"
-        )
-    return taus
 
 
 FEW_LEVELS: Final = 3
@@ -248,24 +225,24 @@ def allan_analysis(
     *,
     taus: Any = "octave",
     confidence: float = ONE_SIGMA_CONFIDENCE,
-    deviations: str | None = None,
+    deviations: Sequence[str] | None = None,
     data_type: str = "rate",
     dynamic_s: float | None = None,
     where: str = "",
     bias_correct: bool = False,
-    noise_type: str | None = None,
+    noise_type: int | None = None,
     noise_id: str | None = None,
     max_work: float | None = None,
 ) -> AllanAnalysis:
     """The stability analysis of the channels ``names`` of ``rec`` (module docstring).
 
-    ``taus``: a named τ set or a list of τ [s] (:func:`parse_taus`); ``deviations``: the
-    comma-separated deviations of :func:`thermocal.stability.family.parse_deviations`
-    (then, or with ``data_type="phase"``, the family replaces the ADEV and noise terms);
+    ``taus``: a named τ set (``octave``, ``decade``, ``log``, ``all``) or a list of τ [s];
+    ``deviations``: registered deviation names (:func:`thermocal.stability.registry.names`;
+    then, or with ``data_type="phase"``, the family replaces the ADEV and noise terms);
     ``dynamic_s``: the dynamic ADEV's window [s] (rate data, ADEV only); ``bias_correct``:
     Stable32's bias correction of totdev and htotdev (the family only); ``noise_type``: the
-    power-law noise the intervals and bias factors assume at every τ instead of the one
-    identified (:func:`thermocal.stability.family.parse_noise_type`; the family only);
+    power-law exponent α the intervals and bias factors assume at every τ instead of the one
+    identified (−4…2, below −2 the Hadamard deviations only; the family only);
     ``noise_id``: the identification's rules, ``thermocal`` (default) or ``stable32`` (the
     family only, :func:`thermocal.stability.family.stability`).  A poor noise-model fit and
     a non-stationary record are :class:`ConditioningWarning` naming ``where`` (and the
@@ -274,7 +251,7 @@ def allan_analysis(
     """
     check_confidence(confidence)
     if data_type not in DATA_TYPES:
-        raise ThermocalInputError(f"--data-type {data_type!r}: use rate or phase")
+        raise ParameterError("data_type", f"{{name}} {data_type!r}: use rate or phase")
     if dynamic_s is not None and (deviations is not None or data_type == "phase"):
         raise ThermocalInputError(
             "--dynamic computes the overlapping ADEV of rate data; run it without --deviation "
@@ -292,10 +269,7 @@ def allan_analysis(
         opt
         for opt, given in (
             ("--bias-correct (totdev, htotdev)", bias_correct),
-            (
-                "--noise-type",
-                noise_type is not None and noise_type.strip().lower() not in ("", "auto"),
-            ),
+            ("--noise-type", noise_type is not None),
             ("--noise-id", noise_id is not None),
         )
         if given
@@ -328,10 +302,10 @@ def _family(
     names: list[str],
     taus: Any,
     confidence: float,
-    deviations: str | None,
+    deviations: Sequence[str] | None,
     data_type: str,
     bias_correct: bool = False,
-    noise_type: str | None = None,
+    noise_type: int | None = None,
     noise_id: str = "thermocal",
     max_work: float | None = None,
     where: str = "",
@@ -339,8 +313,8 @@ def _family(
     """The deviations of every channel (phase data: the column as given, in its own unit)."""
     from thermocal.stability import family
 
-    devs = family.parse_deviations(deviations or "oadev")
-    alpha = family.parse_noise_type(noise_type, devs)
+    devs = list(dict.fromkeys(deviations or ["oadev"]))
+    alpha = family.check_noise_type(noise_type, devs)
     n_phase = _longest(rec) + (1 if data_type == "rate" else 0)
     check_tau_list(taus, rec.sample_interval_s, n_phase, devs, where)
     results = {}
@@ -588,7 +562,6 @@ def imu_noise(
 
 __all__ = [
     "DATA_TYPES",
-    "TAU_SETS",
     "AllanAnalysis",
     "AllanChannel",
     "ImuNoise",
@@ -596,6 +569,5 @@ __all__ = [
     "column_unit",
     "imu_noise",
     "nonstationary_message",
-    "parse_taus",
     "signal_in_data_unit",
 ]

@@ -25,6 +25,7 @@ The EDFs of gap-separated stretches add (independent estimates).
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass, field, replace
 from typing import Final
 
@@ -132,46 +133,45 @@ def stable32_bias(name: str, alpha: int, m: int, n_phase: int) -> float:
     return 1.0
 
 
-def parse_deviations(spec: str) -> list[str]:
-    """``"oadev,mdev"`` → names, checked against the registry (:func:`.registry.names`)."""
-    names = [s.strip().lower() for s in spec.split(",") if s.strip()]
-    bad = [n for n in names if n not in registry.names()]
-    if bad or not names:
-        raise ThermocalInputError(
-            f"--deviation {spec!r}: unknown {', '.join(bad) or 'empty list'}; use "
-            + ", ".join(registry.names())
-        )
-    return list(dict.fromkeys(names))
-
-
 NOISE_TYPES: Final = {"wpm": 2, "fpm": 1, "wfm": 0, "ffm": -1, "rwfm": -2, "fwfm": -3, "rrfm": -4}
 """Power-law noise names → α (S_y(f) ∝ f^α; NIST SP 1065 Table 1): white and flicker PM,
 white, flicker and random-walk FM, flicker-walk and random-run FM (Hadamard family only)."""
 
 
-def parse_noise_type(spec: str | None, names: list[str]) -> int | None:
-    """``--noise-type``: ``auto`` (None: identified per τ), a name of :data:`NOISE_TYPES`
-    or α itself (−4…2).  Stable32's noise-type setting: the EDF and the bias corrections
-    use this α at every τ.  α < −2 only for the Hadamard family (hdev, ohdev, htotdev):
-    the Allan-family EDF (Greenhall & Riley 2003) needs α + 2d > 1, d = 2."""
-    if spec is None or spec.strip().lower() in ("", "auto"):
+def check_noise_type(alpha: int | None, names: Sequence[str]) -> int | None:
+    """The power-law exponent α the EDF and bias factors assume at every τ (Stable32's noise
+    type setting), checked for the deviations ``names``.
+
+    Parameters
+    ----------
+    alpha : int or None
+        α (S_y(f) ∝ f^α, NIST SP 1065 Table 1) from −4 to 2; None: identified per τ.
+    names : sequence of str
+        The deviations it is for.
+
+    Returns
+    -------
+    int or None
+        ``alpha``.
+
+    Raises
+    ------
+    ParameterError
+        α outside −4…2, or below −2 for a deviation outside the Hadamard family: the
+        Allan-family EDF (Greenhall & Riley 2003) needs α + 2d > 1 with d = 2.
+    """
+    if alpha is None:
         return None
-    key = spec.strip().lower()
-    try:
-        alpha = NOISE_TYPES[key] if key in NOISE_TYPES else int(key)
-    except ValueError:
-        alpha = 99
-    if not -4 <= alpha <= 2:
-        raise ThermocalInputError(
-            f"--noise-type {spec!r}: use auto, {', '.join(NOISE_TYPES)} or α from -4 to 2"
-        )
+    if isinstance(alpha, bool) or not isinstance(alpha, int | np.integer) or not -4 <= alpha <= 2:
+        raise ParameterError("noise_type", f"{{name}} {alpha!r}: give α from -4 to 2 or None")
     not_h = [n for n in names if not registry.get(n).hadamard and registry.get(n).edf is not None]
     if alpha < -2 and not_h:
-        raise ThermocalInputError(
-            f"--noise-type {spec!r} (α = {alpha}) is defined for the Hadamard deviations "
-            f"(hdev, ohdev, htotdev) only, not {', '.join(not_h)}"
+        raise ParameterError(
+            "noise_type",
+            f"{{name}} α = {alpha} is defined for the Hadamard deviations (hdev, ohdev, "
+            f"htotdev) only, not {', '.join(not_h)}",
         )
-    return alpha
+    return int(alpha)
 
 
 def factors(
@@ -507,7 +507,7 @@ def check_work(
     if not math.isfinite(max_work) and max_work > 0:
         return math.nan
     if not max_work > 0:
-        raise ThermocalInputError(f"--max-work {max_work!r}: give a positive operation count")
+        raise ParameterError("max_work", f"{{name}} {max_work!r}: give a positive operation count")
     per = {n: sum(registry.get(n).estimated_work(size, sets[n]) for size in sizes) for n in names}
     total = sum(per.values())
     if total > max_work:
@@ -567,10 +567,10 @@ def stability(
     O(n) for all τ, no phase array); the same numbers as the phase-difference path.
     """
     with threadpool_limits(limits=1, user_api="blas"):  # many short dots: BLAS threads wait
-        if data_type not in ("rate", "phase"):
-            raise ThermocalInputError(f"--data-type {data_type!r}: use rate or phase")
+        if data_type not in registry.DATA_TYPES:
+            raise ParameterError("data_type", f"{{name}} {data_type!r}: use rate or phase")
         if noise_id not in NOISE_IDS:
-            raise ThermocalInputError(f"--noise-id {noise_id!r}: use {' or '.join(NOISE_IDS)}")
+            raise ParameterError("noise_id", f"{{name}} {noise_id!r}: use {' or '.join(NOISE_IDS)}")
         for name in names:
             if data_type not in registry.get(name).data_types:
                 raise ParameterError(
