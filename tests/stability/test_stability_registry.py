@@ -15,7 +15,7 @@ from scipy import stats
 
 from thermocal import stability
 from thermocal.cli import main
-from thermocal.errors import ParameterError
+from thermocal.errors import ParameterError, ThermocalInputError
 from thermocal.stability import registry
 
 
@@ -100,3 +100,13 @@ def test_an_unknown_or_taken_name_is_refused_naming_the_parameter() -> None:
         stability.deviation("nodev", np.zeros(10), rate_hz=1.0)
     with pytest.raises(ParameterError, match="'oadev' is registered already"):
         registry.register(registry.get("oadev"))
+
+
+def test_a_toy_deviation_without_a_work_estimate_costs_four_operations_a_point(
+    toy: registry.Deviation,
+) -> None:
+    """Every factor of m = 1 … 2000 on 4001 phase points: 4 · 4001 · 2000 = 3.2e7 operations."""
+    assert toy.estimated_work(4001, np.arange(1, 2001)) == 4.0 * 4001 * 2000
+    y = np.random.default_rng(9).normal(size=4000)
+    with pytest.raises(ThermocalInputError, match=r"needs about 3\.2e\+07 operations"):
+        stability.deviation("toystd", y, rate_hz=1.0, taus="all", max_work=1e7)
