@@ -63,13 +63,33 @@ def edf_source(name: str) -> str:
 class DeviationCurve:
     """One deviation against τ.
 
-    ``tau_s`` [s] (theo1: 0.75 m τ0), ``m`` averaging factors, ``dev`` [``unit``],
-    ``low``/``high`` its interval (NaN where none), ``edf``, ``n_terms``, ``alpha`` the noise
-    exponent used for the EDF, ``alpha_method`` per τ: ``lag1``, ``b1``, ``b1-rn`` (B1 read
-    phase noise, R(n) split white from flicker PM), ``b1-previous`` (B1 read a higher α than
-    the shorter τ's, which is kept), ``previous`` (too few averages), ``given``; ``bias``
-    the factor ``dev``, ``low`` and ``high`` were multiplied by (:func:`stable32_bias`; None
-    when no correction was asked).
+    Parameters
+    ----------
+    name : str
+        The deviation.
+    tau_s : numpy.ndarray
+        Averaging times τ [s] (theo1: 0.75 m τ0).
+    m : numpy.ndarray
+        Averaging factors.
+    dev : numpy.ndarray
+        The deviation [``unit``].
+    low, high : numpy.ndarray
+        Its interval [``unit``] (NaN where none).
+    edf : numpy.ndarray
+        Equivalent degrees of freedom.
+    n_terms : numpy.ndarray
+        Terms behind each point.
+    alpha : numpy.ndarray
+        The power-law noise exponent used for the EDF.
+    alpha_method : tuple of str
+        Per τ: ``lag1``, ``b1``, ``b1-rn`` (B1 read phase noise, R(n) split white from
+        flicker PM), ``b1-previous`` (B1 read a higher α than the shorter τ's, which is
+        kept), ``previous`` (too few averages), ``given``.
+    unit : str
+        Unit of ``dev``.
+    bias : numpy.ndarray or None
+        The factor ``dev``, ``low`` and ``high`` were multiplied by (:func:`stable32_bias`;
+        None when no correction was asked).
     """
 
     name: str
@@ -88,8 +108,33 @@ class DeviationCurve:
 
 @dataclass(frozen=True, eq=False)
 class StabilityResult:
-    """Deviations of one record: ``curves`` by name, the common ``tau_s``/``m`` (theo1 has its
-    own), ``tau0_s``, ``data_type``, ``confidence``, ``n_segments``, ``n_points``."""
+    """Deviations of one record (:func:`stability`).
+
+    Parameters
+    ----------
+    curves : dict of str to DeviationCurve
+        One curve per deviation, in the order asked.
+    tau_s : numpy.ndarray
+        The common averaging times [s] (theo1 has its own).
+    m : numpy.ndarray
+        The common averaging factors.
+    tau0_s : float
+        Sample interval [s].
+    data_type : str
+        ``rate`` or ``phase``.
+    confidence : float
+        Confidence level of the intervals.
+    n_segments : int
+        Gap-free stretches used.
+    n_points : int
+        Phase points over the stretches.
+    unit : str
+        Unit of the data.
+    notes : tuple of str
+        Remarks on the analysis.
+    noise_id : str
+        The identification rules used (``thermocal`` or ``stable32``).
+    """
 
     curves: dict[str, DeviationCurve]
     tau_s: FloatArray
@@ -532,6 +577,60 @@ def _ceil2(x: float) -> str:
     return f"{math.ceil(x / e) * e:.2g}"
 
 
+def _check_request(names: list[str], data_type: str, noise_id: str) -> None:
+    """The data type and the identification rules checked for the deviations ``names``."""
+    if data_type not in registry.DATA_TYPES:
+        raise ParameterError("data_type", f"{{name}} {data_type!r}: use rate or phase")
+    if noise_id not in NOISE_IDS:
+        raise ParameterError("noise_id", f"{{name}} {noise_id!r}: use {' or '.join(NOISE_IDS)}")
+    for name in names:
+        if data_type not in registry.get(name).data_types:
+            raise ParameterError(
+                "data_type",
+                f"{{name}} {data_type!r}: {name} takes "
+                + " or ".join(registry.get(name).data_types),
+            )
+
+
+def _curve(
+    name: str,
+    m: IntArray,
+    record: _Record,
+    alpha: int | None,
+    id_cache: dict[tuple[int, int, ed.IdRules], ed.NoiseId],
+    noise_id: str,
+    confidence: float,
+    bias_correct: bool,
+    unit: str,
+) -> DeviationCurve:
+    """One deviation of the record at the factors ``m``, with its interval (:func:`stability`)."""
+    dev, cnt = record.sums(name, m)
+    alphas, methods = _noise_exponents(
+        name, m, record, alpha, id_cache, noise_id, np.asarray(cnt, dtype=np.float64)
+    )
+    edf = _pooled_edf(name, m, alphas, record.sizes)
+    ok = np.isfinite(edf) & np.isfinite(dev)
+    lo = np.full(m.size, np.nan)
+    hi = np.full(m.size, np.nan)
+    if ok.any():  # an EDF ≪ 1 (Theo1's fit at the record's end): χ² quantile 0, high ∞
+        with np.errstate(divide="ignore"):
+            lo_ok, hi_ok = ed.confidence_interval(dev[ok], edf[ok], confidence)
+        lo[ok], hi[ok] = lo_ok, hi_ok
+    bias = None
+    if bias_correct:
+        n_rec = sum(record.sizes) - len(record.sizes) + 1
+        bias = np.array(
+            [stable32_bias(name, int(a), int(mm), n_rec) for a, mm in zip(alphas, m, strict=True)]
+        )
+        dev, lo, hi = dev * bias, lo * bias, hi * bias
+    tau0_s, data_type = record.tau0_s, record.data_type
+    tau = dv.theo1_tau(m, tau0_s) if name == "theo1" else m * float(tau0_s)
+    return DeviationCurve(
+        name, np.asarray(tau, dtype=np.float64), m, dev, lo, hi, edf, cnt, alphas,
+        methods, _unit(name, unit, data_type), bias,
+    )  # fmt: skip
+
+
 def stability(
     values: npt.ArrayLike,
     tau0_s: float,
@@ -548,84 +647,89 @@ def stability(
     max_work: float = DEFAULT_MAX_WORK,
     where: str = "",
 ) -> StabilityResult:
-    """Deviations ``names`` of rate or phase data [unit] sampled every ``tau0_s`` [s].
+    r"""Several deviations of one record of rate or phase data, with chi-square intervals.
 
-    ``max_work``: the budget of arithmetic operations (:func:`check_work`): a request
-    estimated beyond it is refused before any sum is taken (``where``: the file the
-    refusal names).
+    Parameters
+    ----------
+    values : array_like
+        Rate samples [unit] (each the mean over τ0) or phase points [unit].
+    tau0_s : float
+        Sample interval τ0 [s].
+    names : list of str
+        Registered deviations (:func:`thermocal.stability.registry.names`).
+    taus : {"octave", "decade", "log", "all"} or array_like
+        A named τ set or averaging times τ [s].
+    data_type : {"rate", "phase"}
+        What ``values`` are: rate data give deviations in ``unit``, time deviations in
+        ``unit*s``; phase data deviations in ``unit/s``, time deviations in ``unit``.
+    segments : list of slice, optional
+        The gap-free index ranges (default: one), pooled; their EDFs add.
+    unit : str
+        Unit of ``values``.
+    confidence : float
+        Confidence level of the intervals (default 0.683, ±1σ).
+    alpha : int, optional
+        The noise exponent α of the EDF at every τ instead of the identified one.
+    bias_correct : bool
+        Multiply totdev and htotdev by Stable32's bias factor (:func:`stable32_bias`).
+    noise_id : {"thermocal", "stable32"}
+        The identification's rules (:func:`_noise_exponents`).
+    max_work : float
+        Arithmetic operations allowed before the request is refused (:func:`check_work`).
+    where : str
+        The file the refusals name.
 
-    ``segments``: the gap-free index ranges (default: one); ``alpha``: force the noise
-    exponent of the EDF instead of identifying it; ``noise_id``: the identification's rules,
-    ``thermocal`` or ``stable32`` (:func:`_noise_exponents`); ``bias_correct``: totdev and htotdev
-    (value and interval) multiplied by Stable32's bias factor (:func:`stable32_bias`, with
-    the record length summed over the stretches).  Rate data give deviations in ``unit``
-    and time deviations (tdev, ttotdev, mtie, tierms) in ``unit*s``; phase data give
-    deviations in ``unit/s`` and time deviations in ``unit``.
+    Returns
+    -------
+    StabilityResult
+        One :class:`DeviationCurve` per name.
 
-    Rate data at octave τ (every m a power of 2): adev and hdev and the noise identification
-    come from each stretch's octave pyramid of block sums (:func:`.deviations.octave_levels`,
-    O(n) for all τ, no phase array); the same numbers as the phase-difference path.
+    Raises
+    ------
+    thermocal.errors.ThermocalInputError
+        An unknown data type, too few points, a bad τ list, work beyond ``max_work``.
+
+    Notes
+    -----
+    Each deviation is its NIST SP 1065 sum over the phase (:mod:`.deviations`); the interval
+    (SP 1065 eq. 45) is
+
+    .. math:: \left[\hat\sigma\sqrt{\nu/\chi^2_{(1+p)/2}(\nu)},\;
+              \hat\sigma\sqrt{\nu/\chi^2_{(1-p)/2}(\nu)}\right]
+
+    with ν the deviation's EDF for the noise identified per τ (lag-1 autocorrelation,
+    Riley & Greenhall 2004; B1 ratio where few averages remain).
+
+    References
+    ----------
+    .. [1] W. J. Riley, "Handbook of Frequency Stability Analysis", NIST SP 1065, 2008.
+    .. [2] C. A. Greenhall and W. J. Riley, "Uncertainty of stability variances based on
+       finite differences", Proc. 35th PTTI Meeting, 2003.
+
+    Examples
+    --------
+    >>> y = np.random.default_rng(0).normal(0.0, 1.0, 10_000)
+    >>> r = stability(y, 1.0, ["oadev", "mdev"], [1.0, 10.0])
+    >>> [round(float(v), 2) for v in r.curves["oadev"].dev]
+    [1.0, 0.32]
     """
     with threadpool_limits(limits=1, user_api="blas"):  # many short dots: BLAS threads wait
-        if data_type not in registry.DATA_TYPES:
-            raise ParameterError("data_type", f"{{name}} {data_type!r}: use rate or phase")
-        if noise_id not in NOISE_IDS:
-            raise ParameterError("noise_id", f"{{name}} {noise_id!r}: use {' or '.join(NOISE_IDS)}")
-        for name in names:
-            if data_type not in registry.get(name).data_types:
-                raise ParameterError(
-                    "data_type",
-                    f"{{name}} {data_type!r}: {name} takes "
-                    + " or ".join(registry.get(name).data_types),
-                )
+        _check_request(names, data_type, noise_id)
         record = _new_record(values, tau0_s, data_type, segments, names)
         sets = factor_sets(names, taus, tau0_s, max(record.sizes))
         check_work(names, sets, record.sizes, max_work, taus, where)
         m_common = sets[""]
         record.set_octave(m_common)
-        curves: dict[str, DeviationCurve] = {}
         id_cache: dict[tuple[int, int, ed.IdRules], ed.NoiseId] = {}
-        for name in names:
-            m = sets[name]
-            dev, cnt = record.sums(name, m)
-            alphas, methods = _noise_exponents(
-                name, m, record, alpha, id_cache, noise_id, np.asarray(cnt, dtype=np.float64)
-            )
-            edf = _pooled_edf(name, m, alphas, record.sizes)
-            ok = np.isfinite(edf) & np.isfinite(dev)
-            lo = np.full(m.size, np.nan)
-            hi = np.full(m.size, np.nan)
-            if ok.any():  # an EDF ≪ 1 (Theo1's fit at the record's end): χ² quantile 0, high ∞
-                with np.errstate(divide="ignore"):
-                    lo_ok, hi_ok = ed.confidence_interval(dev[ok], edf[ok], confidence)
-                lo[ok], hi[ok] = lo_ok, hi_ok
-            bias = None
-            if bias_correct:
-                n_rec = sum(record.sizes) - len(record.sizes) + 1
-                bias = np.array(
-                    [
-                        stable32_bias(name, int(a), int(mm), n_rec)
-                        for a, mm in zip(alphas, m, strict=True)
-                    ]
-                )
-                dev, lo, hi = dev * bias, lo * bias, hi * bias
-            tau = dv.theo1_tau(m, tau0_s) if name == "theo1" else m * float(tau0_s)
-            curves[name] = DeviationCurve(
-                name, np.asarray(tau, dtype=np.float64), m, dev, lo, hi, edf, cnt, alphas,
-                methods, _unit(name, unit, data_type), bias,
-            )  # fmt: skip
+        curves = {
+            n: _curve(n, sets[n], record, alpha, id_cache, noise_id, confidence, bias_correct, unit)
+            for n in names
+        }
         return StabilityResult(
-            curves=curves,
-            tau_s=np.asarray(m_common * float(tau0_s), dtype=np.float64),
-            m=m_common,
-            tau0_s=float(tau0_s),
-            data_type=data_type,
-            confidence=float(confidence),
-            n_segments=len(record.kept),
-            n_points=int(sum(record.sizes)),
-            unit=unit,
-            noise_id=noise_id,
-        )
+            curves, np.asarray(m_common * float(tau0_s), dtype=np.float64), m_common,
+            float(tau0_s), data_type, float(confidence), len(record.kept),
+            int(sum(record.sizes)), unit, noise_id=noise_id,
+        )  # fmt: skip
 
 
 def _unit(name: str, unit: str, data_type: str) -> str:
