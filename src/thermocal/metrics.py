@@ -192,10 +192,37 @@ def block_means(
     *,
     time_s: npt.ArrayLike | None = None,
 ) -> FloatArray:
-    """Non-overlapping means of ``m = round(averaging_s/τ0)`` samples, never across a gap.
+    r"""Non-overlapping means of ``m = round(averaging_s/τ0)`` samples, never across a gap.
 
-    Incomplete blocks at the end of each contiguous stretch are dropped.
-    ``averaging_s=None`` returns the samples themselves.
+    Parameters
+    ----------
+    values : array_like
+        Samples [unit].
+    tau0_s : float
+        Sample interval τ0 [s].
+    averaging_s : float or None
+        Averaging time [s]; None: the samples themselves.
+    time_s : array_like, optional
+        Sample times [s]: the record is cut at gaps and each stretch averaged alone.
+
+    Returns
+    -------
+    numpy.ndarray
+        The block means [unit]; an incomplete block at a stretch's end is dropped.
+
+    Raises
+    ------
+    thermocal.errors.ThermocalInputError
+        ``time_s`` and ``values`` of different lengths, a bad averaging time.
+
+    Notes
+    -----
+    .. math:: \bar\omega_k = \frac{1}{m}\sum_{i=km}^{km+m-1} \omega_i
+
+    Examples
+    --------
+    >>> block_means([1.0, 3.0, 5.0, 7.0, 9.0], 1.0, 2.0).tolist()
+    [2.0, 6.0]
     """
     y = _as_1d(values, "signal")
     m = _samples_per_average(tau0_s, averaging_s)
@@ -219,10 +246,36 @@ def block_means(
 
 
 def bias(rate: npt.ArrayLike, *, earth_rate_deg_h: float = 0.0) -> float:
-    """Bias ``B0 = mean(ω) − Ω_axis`` [°/h].
+    r"""Bias: the mean rate less the earth rate the sensitive axis sees.
 
-    ``earth_rate_deg_h`` is the earth rate seen by the sensitive axis
-    (:func:`thermocal.units.earth_rate_on_axis_deg_h`), 0 for accelerometers.
+    Parameters
+    ----------
+    rate : array_like
+        Rate samples ω_i [°/h] (any unit, with ``earth_rate_deg_h`` in the same).
+    earth_rate_deg_h : float
+        The earth rate on the sensitive axis Ω_axis [°/h]
+        (:func:`thermocal.units.earth_rate_on_axis_deg_h`); 0 for accelerometers.
+
+    Returns
+    -------
+    float
+        B0 [°/h].
+
+    Notes
+    -----
+    .. math:: B_0 = \frac{1}{n}\sum_i \omega_i - \Omega_{axis}
+
+    (IEEE Std 952-1997 and IEEE Std 1431-2004 define the bias as the average output over
+    a specified time that has no correlation with the input rotation.)
+
+    References
+    ----------
+    .. [1] IEEE Std 952-1997; IEEE Std 1431-2004.
+
+    Examples
+    --------
+    >>> bias([10.0, 12.0, 14.0], earth_rate_deg_h=2.0)
+    10.0
     """
     return float(np.mean(_as_1d(rate, "rate"))) - float(earth_rate_deg_h)
 
@@ -256,12 +309,43 @@ def bias_stability(
     where: str | None = None,
     option: str | None = "--average",
 ) -> float:
-    """Bias stability ``Bs = sqrt(Σ (ω̄_k − mean)² / (p − 1))`` [unit].
+    r"""Bias stability: the standard deviation of the averages over ``averaging_s``.
 
-    ω̄_k are the p non-overlapping averages over ``averaging_s`` (never across a
-    gap, see :func:`block_means`); the averaging time must be reported with the
-    figure.  Needs at least two averages: else an error naming ``where`` (the file) and
-    ``option`` (the averaging option of the command that asked, ``None`` if it has none).
+    Parameters
+    ----------
+    rate : array_like
+        Rate samples [unit].
+    tau0_s : float
+        Sample interval τ0 [s].
+    averaging_s : float or None
+        Averaging time [s] (report it with the figure); None: the samples.
+    time_s : array_like, optional
+        Sample times [s]; no average spans a gap (:func:`block_means`).
+    where : str, optional
+        The file a refusal names.
+    option : str or None
+        The averaging option of the command that asked (None if it has none).
+
+    Returns
+    -------
+    float
+        Bs [unit].
+
+    Raises
+    ------
+    thermocal.errors.ThermocalInputError
+        Fewer than two averages.
+
+    Notes
+    -----
+    With the p block means :math:`\bar\omega_k` (:func:`block_means`):
+
+    .. math:: B_s = \sqrt{\frac{1}{p-1}\sum_{k=1}^{p}(\bar\omega_k - \bar\omega)^2}
+
+    Examples
+    --------
+    >>> round(bias_stability([1.0, 3.0, 5.0, 7.0, 9.0, 11.0], 1.0, 2.0), 3)
+    4.0
     """
     means = block_means(rate, tau0_s, averaging_s, time_s=time_s)
     if means.size < 2:
@@ -303,8 +387,32 @@ def too_few_averages(
 
 
 def bias_repeatability(biases: npt.ArrayLike) -> float:
-    """Bias repeatability ``Br = sqrt(Σ (B0_i − mean)² / (p − 1))`` over p runs or
-    hold stages [unit].  Needs p ≥ 2."""
+    r"""Bias repeatability: the standard deviation of the biases of p runs or hold stages.
+
+    Parameters
+    ----------
+    biases : array_like
+        The p biases B0_i [unit].
+
+    Returns
+    -------
+    float
+        Br [unit].
+
+    Raises
+    ------
+    thermocal.errors.ThermocalInputError
+        Fewer than two biases.
+
+    Notes
+    -----
+    .. math:: B_r = \sqrt{\frac{1}{p-1}\sum_{i=1}^{p}(B_{0,i} - \bar B_0)^2}
+
+    Examples
+    --------
+    >>> bias_repeatability([1.0, 2.0, 3.0])
+    1.0
+    """
     b = _as_1d(biases, "biases")
     if b.size < 2:
         raise ThermocalInputError(f"bias repeatability needs at least two biases, got {b.size}")
@@ -331,10 +439,45 @@ class RunRepeatability:
 
 
 def std_interval(s: float, n: int, confidence: float = ONE_SIGMA) -> tuple[float, float]:
-    """Chi-square interval of a standard deviation ``s`` of ``n`` normal samples.
+    r"""Chi-square interval of a standard deviation ``s`` of ``n`` normal samples.
 
-    ``ν = n − 1``: ``σ ∈ [s √(ν / χ²_{(1+c)/2}(ν)), s √(ν / χ²_{(1−c)/2}(ν))]`` (e.g. NIST/
-    SEMATECH e-Handbook of Statistical Methods §7.2.3; NIST SP 1065 eq. 45 for deviations).
+    Parameters
+    ----------
+    s : float
+        The sample standard deviation [unit].
+    n : int
+        The number of samples.
+    confidence : float
+        Confidence level c, in (0, 1) (default ±1σ).
+
+    Returns
+    -------
+    low, high : float
+        The bounds [unit].
+
+    Raises
+    ------
+    thermocal.errors.ThermocalInputError
+        ``n`` < 2 or ``confidence`` outside (0, 1).
+
+    Notes
+    -----
+    With ν = n − 1 (NIST SP 1065 eq. 45, as for a deviation with ν degrees of freedom):
+
+    .. math:: \sigma \in \left[ s\sqrt{\nu/\chi^2_{(1+c)/2}(\nu)},\;
+              s\sqrt{\nu/\chi^2_{(1-c)/2}(\nu)} \right]
+
+    References
+    ----------
+    .. [1] W. J. Riley, "Handbook of Frequency Stability Analysis", NIST SP 1065, 2008.
+
+    Examples
+    --------
+    Ten samples at 95 %: the chi-square quantiles of 9 degrees of freedom are 19.02 and
+    2.70.
+
+    >>> [round(v, 3) for v in std_interval(1.0, 10, 0.95)]
+    [0.688, 1.826]
     """
     if n < 2:
         raise ThermocalInputError(f"a standard deviation needs at least two values, got {n}")
@@ -376,12 +519,41 @@ def run_repeatability(
 def temperature_sensitivity(
     temps_c: npt.ArrayLike, biases: npt.ArrayLike, *, unit: str = "deg/h"
 ) -> TemperatureSensitivity:
-    """Bias temperature sensitivity [unit/°C] (thermocal's reading).
+    r"""Bias temperature sensitivity [unit/°C], two ways.
 
-    With the points sorted by temperature: ``mean_abs_adjacent = mean_i
-    |(B_{i+1} − B_i)/(T_{i+1} − T_i)|`` and ``ls_slope`` = slope of the
-    least-squares line ``B = a + b T`` (``numpy.linalg.lstsq``).
-    Needs two or more points at distinct temperatures.
+    Parameters
+    ----------
+    temps_c : array_like
+        Temperatures T_i [°C] of the points (two or more, distinct).
+    biases : array_like
+        The biases B_i [unit] at those temperatures.
+    unit : str
+        Unit of ``biases``.
+
+    Returns
+    -------
+    TemperatureSensitivity
+        ``mean_abs_adjacent`` and ``ls_slope`` [unit/°C], the sorted points.
+
+    Raises
+    ------
+    thermocal.errors.ThermocalInputError
+        Fewer than two points, two at the same temperature, lengths that differ.
+
+    Notes
+    -----
+    With the points sorted by temperature (thermocal's reading: both figures, named),
+
+    .. math:: S_{adj} = \frac{1}{n-1}\sum_{i=1}^{n-1}
+              \left|\frac{B_{i+1}-B_i}{T_{i+1}-T_i}\right|
+
+    and ``ls_slope`` the slope b of the least-squares line B = a + b T.
+
+    Examples
+    --------
+    >>> s = temperature_sensitivity([20.0, 30.0, 40.0], [1.0, 2.0, 2.5])
+    >>> round(s.mean_abs_adjacent, 3), round(s.ls_slope, 3)
+    (0.075, 0.075)
     """
     T = _as_1d(temps_c, "temperatures")
     B = _as_1d(biases, "biases")
@@ -431,13 +603,41 @@ def drift_angle(
     *,
     time_unit_s: float = units.SECONDS_PER_HOUR,
 ) -> FloatArray:
-    """Drift angle ``θ(t) = ∫ (ω − b0) dt`` [angle unit of ω] (the FOG thesis).
+    r"""Drift angle: the integral of the rate less its bias (the FOG thesis).
 
-    Cumulative trapezoid rule: ``θ_k = θ_{k−1} + ½(e_k + e_{k−1})(t_k − t_{k−1})
-    / time_unit_s`` with ``e = ω − b0`` and t [s]; θ_0 = 0.  ``time_unit_s`` is the
-    number of seconds in the rate's time unit (3600 for [°/h] → θ in [°]; 1 for [°/s] or
-    [rad/s]).  Across a gap (see :func:`thermocal.recording.find_gaps`) nothing is
-    integrated (θ is held).
+    Parameters
+    ----------
+    time_s : array_like
+        Sample times t_k [s].
+    rate : array_like
+        Rate samples ω_k [angle unit per time unit].
+    bias : float
+        The bias b0 removed [the rate's unit].
+    time_unit_s : float
+        Seconds in the rate's time unit (3600 for [°/h] → θ in [°]; 1 for [°/s]).
+
+    Returns
+    -------
+    numpy.ndarray
+        θ_k [angle unit], θ_0 = 0; held across a gap
+        (:func:`thermocal.recording.find_gaps`).
+
+    Raises
+    ------
+    thermocal.errors.ThermocalInputError
+        Lengths that differ.
+
+    Notes
+    -----
+    Cumulative trapezoid rule with :math:`e_k = \omega_k - b_0`:
+
+    .. math:: \theta_k = \theta_{k-1} + \tfrac12 (e_k + e_{k-1})
+              \frac{t_k - t_{k-1}}{\text{time\_unit\_s}}
+
+    Examples
+    --------
+    >>> drift_angle([0.0, 3600.0, 7200.0], [2.0, 2.0, 4.0], 1.0).tolist()
+    [0.0, 1.0, 3.0]
     """
     t = _as_1d(time_s, "time")
     e = _as_1d(rate, "rate") - float(bias)

@@ -142,8 +142,32 @@ def block_average(
 
 
 def lowpass_time_constant_s(bandwidth_hz: float) -> float:
-    """``T_f = 1/(2π f_c)`` [s] of a first-order low-pass with bandwidth ``f_c`` [Hz]
-    (0.04 Hz → T_f ≈ 3.98 s)."""
+    r"""The time constant of a first-order low-pass of a given bandwidth.
+
+    Parameters
+    ----------
+    bandwidth_hz : float
+        The −3 dB bandwidth f_c [Hz].
+
+    Returns
+    -------
+    float
+        T_f [s].
+
+    Raises
+    ------
+    thermocal.errors.ThermocalInputError
+        A bandwidth that is not positive.
+
+    Notes
+    -----
+    .. math:: T_f = \frac{1}{2\pi f_c}
+
+    Examples
+    --------
+    >>> round(lowpass_time_constant_s(0.04), 2)
+    3.98
+    """
     if not bandwidth_hz > 0:
         raise ThermocalInputError(f"bandwidth must be positive, got {bandwidth_hz}")
     return 1.0 / (2.0 * math.pi * bandwidth_hz)
@@ -157,16 +181,40 @@ def lowpass_first_order(
     time_constant_s: float | None = None,
     initial: Literal["first", "zero"] = "first",
 ) -> FloatArray:
-    """First-order low-pass ``H(s) = 1/(T_f s + 1)`` (the FOG thesis's "inertia link").
+    r"""First-order low-pass ``H(s) = 1/(T_f s + 1)`` (the FOG thesis's "inertia link").
 
-    Exact zero-order-hold discretisation at the sample period τ::
+    Parameters
+    ----------
+    x : array_like
+        The samples [any unit].
+    period_s : float
+        Sample period τ [s].
+    bandwidth_hz : float, optional
+        Bandwidth f_c [Hz] (T_f = 1/(2π f_c)); give it or ``time_constant_s``.
+    time_constant_s : float, optional
+        Time constant T_f [s].
+    initial : {"first", "zero"}
+        Start at rest at ``x[0]`` (``y[0] = x[0]``) or from 0.
 
-        a = exp(−τ/T_f),   y[k] = a·y[k−1] + (1 − a)·x[k−1]
+    Returns
+    -------
+    numpy.ndarray
+        The filtered samples y [the unit of ``x``].
 
-    so that a unit step applied at k = 0 gives ``y[k] = 1 − exp(−kτ/T_f)`` exactly
-    (``1 − e⁻¹`` at t = T_f).  ``initial="first"`` starts at rest at ``x[0]``
-    (``y[0] = x[0]``), ``"zero"`` starts from 0.  Give either ``bandwidth_hz``
-    (``T_f = 1/(2π f_c)``) or ``time_constant_s``.
+    Notes
+    -----
+    Exact zero-order-hold discretisation at the sample period τ:
+
+    .. math:: a = e^{-\tau/T_f}, \qquad y_k = a\,y_{k-1} + (1-a)\,x_{k-1},
+
+    so that a unit step applied at k = 0 gives :math:`y_k = 1 - e^{-k\tau/T_f}` exactly
+    (1 − e⁻¹ at t = T_f).
+
+    Examples
+    --------
+    >>> y = lowpass_first_order([1.0] * 3, 1.0, time_constant_s=1.0, initial="zero")
+    >>> [round(v, 4) for v in y.tolist()]
+    [0.0, 0.6321, 0.8647]
     """
     arr = _as_f64(x, "x")
     if (bandwidth_hz is None) == (time_constant_s is None):
@@ -362,11 +410,35 @@ def temperature_rate(
     *,
     gap_factor: float = GAP_FACTOR,
 ) -> FloatArray:
-    """Temperature rate Ṫ [°C/min] over an interval Δt [s], never across a gap.
+    r"""Temperature rate Ṫ [°C/min] over an interval Δt [s], never across a gap.
 
-    The RLG patent: ``Ṫ(t) = (T(t+Δt) − T(t)) / Δt``.  Three forms:
+    Parameters
+    ----------
+    time_s : array_like
+        Sample times [s].
+    temp_c : array_like
+        Temperatures [°C].
+    interval_s : float
+        The interval Δt [s].
+    method : {"backward", "forward", "centred"}
+        Where the difference is assigned (below).
+    gap_factor : float
+        A step longer than this many median steps is a gap.
 
-    * ``"forward"`` — the seed's formula at time t: partner sample j is the first
+    Returns
+    -------
+    numpy.ndarray
+        Ṫ [°C/min] per sample.
+
+    Notes
+    -----
+    The RLG patent:
+
+    .. math:: \dot T(t) = \frac{T(t+\Delta t) - T(t)}{\Delta t}
+
+    Three forms:
+
+    * ``"forward"`` — the patent's formula at time t: partner sample j is the first
       with ``t_j ≥ t_i + Δt``;
     * ``"backward"`` — the same difference assigned to the end of the interval,
       ``Ṫ(t) = (T(t) − T(t−Δt))/Δt``: causal, so firmware and the streaming
