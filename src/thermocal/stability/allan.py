@@ -586,34 +586,63 @@ def overlapping_adev(
     alpha: int | None = None,
     overwrite: bool = False,
 ) -> AllanResult:
-    """Overlapping Allan deviation of rate data (NIST SP 1065 eq. 11, IEEE 952 C.1).
+    r"""Overlapping Allan deviation of rate data with chi-square intervals.
 
     Parameters
     ----------
-    rate : rate samples y_i [unit], each the mean over its interval τ0.
-    tau0_s : sample interval τ0 [s].
-    taus : ``"octave"``, ``"decade"``, ``"log"`` or averaging times [s]
-        (see :func:`averaging_factors`).
-    time_s : sample times [s]; when given the data are split at gaps
-        (:func:`thermocal.recording.contiguous_slices`), each segment is
-        processed alone (no difference spans a gap) and the per-τ sums of squares
-        are pooled: ``σ² = Σ_s S_s / (2 m² Σ_s L_s)`` (variances weighted by term
-        counts L_s); the EDFs add.
-    segments : the gap-free index ranges of ``time_s`` when the caller has them already
-        (:meth:`thermocal.recording.Recording.segments`, computed once per recording).
-    unit : unit string of ``rate`` (reported, and used by :func:`noise_terms`).
-    confidence : confidence level of ``adev_low``/``adev_high`` (default ±1σ).
-    alpha : force the noise exponent of the EDF (default: identified per τ; α, the
-        method per τ and the EDF from :func:`thermocal.stability.family.oadev_edf`,
-        Greenhall's EDF summed over the segments).
-    overwrite : the phase may be accumulated in ``rate``'s own buffer (a writeable
-        float64 array the caller no longer needs: its values are destroyed), so that the
-        computation holds no array per sample beyond the data.
+    rate : array_like
+        Rate samples y_i [unit], each the mean over its interval τ0.
+    tau0_s : float
+        Sample interval τ0 [s].
+    taus : {"octave", "decade", "log"} or array_like
+        A named set or averaging times [s] (:func:`averaging_factors`).
+    time_s : array_like, optional
+        Sample times [s]: the data are split at gaps, each segment processed alone and
+        the per-τ sums of squares pooled, :math:`\sigma^2 = \sum_s S_s / (2 m^2 \sum_s
+        L_s)`; the EDFs add.
+    segments : list of slice, optional
+        The gap-free index ranges, when the caller has them.
+    unit : str
+        Unit of ``rate`` (reported, and used by :func:`noise_terms`).
+    confidence : float
+        Confidence level of ``adev_low``/``adev_high`` (default ±1σ).
+    alpha : int, optional
+        The noise exponent of the EDF at every τ (default: identified per τ,
+        :func:`thermocal.stability.family.oadev_edf`).
+    overwrite : bool
+        The phase may be accumulated in ``rate``'s own buffer (a writeable float64 array
+        the caller no longer needs: its values are destroyed).
+
+    Returns
+    -------
+    AllanResult
+        τ, the deviation, its interval, EDF and noise exponent per τ.
 
     Raises
     ------
-    MissingValueError : NaN or infinite rate samples.
-    ThermocalInputError : too few samples, bad τ0 or τ list, mismatched time.
+    thermocal.errors.MissingValueError
+        NaN or infinite rate samples.
+    thermocal.errors.ThermocalInputError
+        Too few samples, a bad τ0 or τ list, mismatched time.
+
+    Notes
+    -----
+    NIST SP 1065 eq. 11 (IEEE Std 952-1997 C.1) on the phase :math:`x_k = \tau_0
+    \sum_{i<k} (y_i - \bar y)`:
+
+    .. math:: \sigma^2(\tau) = \frac{1}{2\tau^2(N-2m)}\sum_{k=0}^{N-2m-1}
+              (x_{k+2m} - 2x_{k+m} + x_k)^2
+
+    References
+    ----------
+    .. [1] W. J. Riley, "Handbook of Frequency Stability Analysis", NIST SP 1065, 2008.
+
+    Examples
+    --------
+    >>> y = np.random.default_rng(0).normal(0.0, 3.0, 20_000)
+    >>> r = overlapping_adev(y, 0.1, [0.1, 1.0], unit="deg/h")
+    >>> [round(float(v), 2) for v in r.adev]
+    [2.99, 0.94]
     """
     y, overwrite = _checked_rate(rate, tau0_s, overwrite)
     slices = _gap_free_slices(y, time_s, segments)
@@ -633,21 +662,9 @@ def overlapping_adev(
     tau = np.asarray(m * float(tau0_s), dtype=np.float64)
     lo, hi = confidence_interval(adev, edf, confidence)
     return AllanResult(
-        tau_s=tau,
-        m=m,
-        adev=adev,
-        adev_low=np.asarray(lo, dtype=np.float64),
-        adev_high=np.asarray(hi, dtype=np.float64),
-        n_terms=n_terms,
-        edf=edf,
-        alpha=alphas,
-        unit=unit,
-        confidence=float(confidence),
-        tau0_s=float(tau0_s),
-        n_samples=used,
-        n_segments=segs,
-        alpha_method=methods,
-    )
+        tau, m, adev, np.asarray(lo, dtype=np.float64), np.asarray(hi, dtype=np.float64),
+        n_terms, edf, alphas, unit, float(confidence), float(tau0_s), used, segs, methods,
+    )  # fmt: skip
 
 
 # --- dynamic Allan deviation ---------------------------------------------------------
@@ -1412,7 +1429,31 @@ def noise_terms(
     confidence: float | None = None,
     periodic: tuple[PeriodicTerm, ...] = (),
 ) -> NoiseTerms:
-    """IEEE 952 noise terms by slope-line reading and by weighted least squares.
+    r"""IEEE 952 noise terms by slope-line reading and by weighted least squares.
+
+    Parameters
+    ----------
+    result : AllanResult
+        The overlapping Allan deviation (:func:`overlapping_adev`).
+    significance : float
+        Standard errors a fitted coefficient must reach to be reported.
+    confidence : float, optional
+        Confidence level of the terms' intervals (default: the result's).
+    periodic : tuple of PeriodicTerm
+        Sinusoids found in the record (:func:`thermocal.stability.periodic.periodic_terms`):
+        the points where one holds :data:`PERIODIC_CLEAN_SHARE` or more of the Allan
+        variance are not read for the −½ stretch (IEEE 952 C.1.7, :func:`periodic_free`).
+
+    Returns
+    -------
+    NoiseTerms
+        The five terms by both methods, the fit and its quality, and the bias instability
+        at the curve's minimum (:func:`bias_at_minimum`).
+
+    Notes
+    -----
+    .. math:: \sigma^2(\tau) = \frac{3Q^2}{\tau^2} + \frac{N^2}{\tau}
+              + \frac{2\ln 2}{\pi}B^2 + \frac{K^2\tau}{3} + \frac{R^2\tau^2}{2}
 
     Fit (IEEE 952 C.2): ``σ²(τ) = Σ_{p=−2..2} C_p τ^p`` by weighted NNLS
     (see :func:`_fit`); ``Q = √(C₋₂/3)``, ``N = √C₋₁``, ``B = √(C₀ π/(2 ln 2))``,
@@ -1436,13 +1477,9 @@ def noise_terms(
     also finds it significant; otherwise ``None`` with the reason.  The interval
     applies the chi-square interval of the region's best-determined point.
 
-    ``bias_minimum``: the bias instability at the curve's minimum, always, with its τ,
-    interval and quality (:func:`bias_at_minimum`).
-
-    ``periodic``: the sinusoids found in the record
-    (:func:`thermocal.stability.periodic.periodic_terms`); the points where one holds
-    :data:`PERIODIC_CLEAN_SHARE` or more of the Allan variance are not read (:func:`periodic_free`:
-    IEEE 952 C.1.7, its bump is no term of the model) for the −½ stretch.
+    References
+    ----------
+    .. [1] IEEE Std 952-1997, Annex C.
     """
     conf = result.confidence if confidence is None else confidence
     scale, specs = term_units(result.unit)
