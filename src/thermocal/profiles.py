@@ -598,9 +598,33 @@ def common_base(
 
 
 def pearson_r(x: FloatArray, y: FloatArray) -> float:
-    """``r = Cov(X, Y) / (σ_X σ_Y)`` (the RLG patent; population moments, so the n cancels).
+    r"""Pearson's correlation coefficient of two equally long histories (the RLG patent).
 
-    Raises :class:`ThermocalInputError` when either history is constant (r undefined).
+    Parameters
+    ----------
+    x, y : numpy.ndarray
+        The two histories [°C], on one time base.
+
+    Returns
+    -------
+    float
+        r in [−1, 1].
+
+    Raises
+    ------
+    thermocal.errors.ThermocalInputError
+        Either history is constant (r undefined).
+
+    Notes
+    -----
+    .. math:: r = \frac{\mathrm{Cov}(X, Y)}{\sigma_X \sigma_Y}
+              = \frac{\sum (x_i - \bar x)(y_i - \bar y)}
+                     {\sqrt{\sum (x_i - \bar x)^2 \sum (y_i - \bar y)^2}}
+
+    Examples
+    --------
+    >>> round(pearson_r(np.array([1.0, 2.0, 3.0, 4.0]), np.array([2.0, 1.0, 4.0, 3.0])), 3)
+    0.6
     """
     dx = x - x.mean()
     dy = y - y.mean()

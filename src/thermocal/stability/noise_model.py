@@ -292,20 +292,57 @@ def noise_model(
     confidence: float = 0.6826894921370859,
     where: str = "",
 ) -> NoiseModel:
-    """Per sensor the largest density and the largest random walk over its axes.
+    """The noise model of an IMU for an estimator: per sensor the largest white-noise
+    density and the largest random walk over its axes (Kalibr's ``imu.yaml`` convention).
 
-    Refused (:class:`ThermocalInputError`): an axis named twice (``--gyro gx,gx,gx``, or a
-    column in both ``--gyro`` and ``--accel``), a ``rostopic`` that is not a ROS graph
-    resource name (:data:`ROS_NAME`).  A :class:`PlausibilityWarning` (naming ``where``)
-    when the update rate or a density lies outside what an IMU has
-    (:func:`implausible`)."""
+    Parameters
+    ----------
+    axes : list of AxisNoise
+        Each axis's continuous-time terms (:func:`axis_noise`).
+    update_rate_hz : float
+        The IMU's sample rate [Hz].
+    inflate : float
+        Factor ≥ 1 every noise value is multiplied by (unmodelled effects; 1: none).
+    rostopic : str
+        The IMU's ROS topic (a ROS graph resource name, :data:`ROS_NAME`).
+    confidence : float
+        Confidence level of the intervals reported.
+    where : str
+        The file the warnings name.
+
+    Returns
+    -------
+    NoiseModel
+        The chosen axis per Kalibr key, and every axis.
+
+    Raises
+    ------
+    thermocal.errors.ThermocalInputError
+        ``inflate`` below 1, ``rostopic`` not a ROS name, an axis named twice.
+
+    Warns
+    -----
+    PlausibilityWarning
+        An update rate or a density outside what an IMU has (:func:`implausible`).
+
+    Notes
+    -----
+    A white-noise density σ_c [unit/√Hz] is the angle (velocity) random walk N, the −½
+    line read at τ = 1 s; a random walk σ_c [unit/s/√Hz] is the rate random walk K, the
+    +½ line read at τ = 3 s (IEEE Std 952-1997 Annex C: σ² = N²/τ + K²τ/3).  Their
+    discrete-time values at the step Δt are σ_c/√Δt and σ_c √Δt.
+
+    References
+    ----------
+    .. [1] IEEE Std 952-1997, Annex C.
+    """
     if not (math.isfinite(inflate) and inflate >= 1.0):
         raise ThermocalInputError(f"--inflate {inflate!r}: give a factor ≥ 1 (1: none)")
     _distinct_axes(axes)
     if not ROS_NAME.fullmatch(rostopic):
         raise ThermocalInputError(
             f"--rostopic {one_line(repr(rostopic))}: not a ROS topic name (a letter, '/' or "
-            "'~', then letters, digits, '_' and '/'; ROS wiki 'Names' 1.1.1), e.g. /imu0"
+            "'~', then letters, digits, '_' and '/'; ROS wiki 'Names' 1.1.1), e.g. /imu0",
         )
     chosen: dict[str, AxisNoise] = {}
     for sensor, prefix in (("gyro", "gyroscope"), ("accel", "accelerometer")):
