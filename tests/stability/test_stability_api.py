@@ -94,6 +94,8 @@ def test_allan_noise_recovers_the_simulated_arw_and_rrw() -> None:
         (lambda: stability.oadev(np.ones(100), 1.0, taus=[1.0, -1.0]), "taus: averaging"),
         (lambda: stability.oadev(np.ones(100), 1.0, data_type="time"), "data_type 'time'"),
         (lambda: stability.allan_noise(np.ones(100), 1.0, taus="all"), "taus 'all'"),
+        (lambda: stability.oadev(np.ones((100, 3)), 1.0), r"y must be one-dim.*\(100, 3\)"),
+        (lambda: stability.allan_noise(np.ones((3, 100)), 1.0), r"y must be one-dim.*\(3, 100\)"),
     ],
 )
 def test_bad_parameters_are_refused_by_name(call, message) -> None:  # type: ignore[no-untyped-def]

@@ -162,6 +162,16 @@ def _tau_spec(taus: TauSet | npt.ArrayLike) -> str | FloatArray:
     return tau
 
 
+def _samples(y: npt.ArrayLike) -> FloatArray:
+    """``y`` as a float array of one axis (a table of several axes is refused, not flattened)."""
+    values = np.asarray(y, dtype=np.float64)
+    if values.ndim != 1:
+        raise ParameterError(
+            "y", f"{{name}} must be one-dimensional (one axis), got shape {values.shape}"
+        )
+    return values
+
+
 def _data_type(data_type: DataType) -> str:
     """``freq`` and ``rate`` → ``rate``; ``phase`` as given."""
     if data_type in ("freq", "rate"):
@@ -257,7 +267,7 @@ def deviation(
     if noise_type is not None and noise_type not in range(-4 if dev.hadamard else -2, 3):
         raise ParameterError("noise_type", f"{{name}} {noise_type!r}: α outside {name}'s range")
     res = family.stability(
-        np.asarray(y, dtype=np.float64), _tau0(rate_hz), [dev.name], _tau_spec(taus),
+        _samples(y), _tau0(rate_hz), [dev.name], _tau_spec(taus),
         data_type=kind, unit=unit, confidence=confidence, alpha=noise_type,
         bias_correct=bias_correct, max_work=max_work,
     )  # fmt: skip
@@ -544,8 +554,7 @@ def allan_noise(
     spec = _tau_spec(taus)
     if spec == "all":
         raise ParameterError("taus", "{name} 'all': use octave, decade, log or τ [s]")
-    values = np.asarray(y, dtype=np.float64)
-    res = allan.overlapping_adev(values, tau0, spec, unit=unit, confidence=confidence)
+    res = allan.overlapping_adev(_samples(y), tau0, spec, unit=unit, confidence=confidence)
     return AllanNoise(res, allan.noise_terms(res))
 
 
