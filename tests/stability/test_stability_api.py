@@ -108,3 +108,14 @@ def test_a_noise_type_beyond_the_deviation_is_refused() -> None:
     assert stability.hdev(y, 1.0, noise_type=-4).alpha.tolist() == [-4] * 9
     with pytest.raises(ParameterError, match="noise_type -3: α outside oadev's range"):
         stability.oadev(y, 1.0, noise_type=-3)
+
+
+def test_the_array_functions_below_the_api_refuse_a_table_too() -> None:
+    from thermocal.stability.allan import overlapping_adev
+    from thermocal.stability.family import stability as family_stability
+
+    table = np.ones((50, 3))
+    with pytest.raises(ParameterError, match=r"rate must be one-dim.*\(50, 3\)"):
+        overlapping_adev(table, 1.0)
+    with pytest.raises(ParameterError, match=r"values must be one-dim.*\(50, 3\)"):
+        family_stability(table, 1.0, ["oadev"])

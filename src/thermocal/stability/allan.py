@@ -80,7 +80,7 @@ from threadpoolctl import threadpool_limits
 
 from thermocal import units
 from thermocal._lazy import LazyModule
-from thermocal.errors import MissingValueError, ThermocalInputError
+from thermocal.errors import MissingValueError, ParameterError, ThermocalInputError
 from thermocal.recording import contiguous_slices
 from thermocal.stability import family
 from thermocal.stability.edf import ONE_SIGMA_CONFIDENCE, confidence_interval
@@ -520,7 +520,9 @@ def _checked_rate(rate: npt.ArrayLike, tau0_s: float, overwrite: bool) -> tuple[
     """The rate as a 1-D float64 array (the caller's own buffer when it is one, then
     ``overwrite`` may stand) after checking τ0 and that every sample is finite."""
     own = isinstance(rate, np.ndarray) and rate.dtype == np.float64 and rate.ndim == 1
-    y = cast(FloatArray, rate) if own else np.asarray(rate, dtype=np.float64).ravel()
+    y = cast(FloatArray, rate) if own else np.asarray(rate, dtype=np.float64)
+    if y.ndim != 1:  # a table of axes flattened into one record: a silent wrong number
+        raise ParameterError("rate", f"{{name}} must be one-dimensional, got shape {y.shape}")
     if not (math.isfinite(tau0_s) and tau0_s > 0):
         raise ThermocalInputError(f"sample interval τ0 must be positive, got {tau0_s!r}")
     with np.errstate(over="ignore", invalid="ignore"):

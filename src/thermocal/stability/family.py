@@ -269,7 +269,9 @@ def _stretches(
 ) -> tuple[FloatArray, list[slice], float]:
     """The checked samples, the gap-free stretches giving at least 3 phase points and the
     samples' sum."""
-    y = np.asarray(values, dtype=np.float64).ravel()
+    y = np.asarray(values, dtype=np.float64)
+    if y.ndim != 1:  # a table of axes flattened into one record: a silent wrong number
+        raise ParameterError("values", f"{{name}} must be one-dimensional, got shape {y.shape}")
     if not (math.isfinite(tau0_s) and tau0_s > 0):
         raise ThermocalInputError(f"sample interval τ0 must be positive, got {tau0_s!r}")
     # a NaN or ±inf sample makes the sum non-finite (the sum alone overflowing is rare):
