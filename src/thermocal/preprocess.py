@@ -96,10 +96,29 @@ def block_average(
 ) -> BlockAverage:
     """Average ``values`` over consecutive blocks of ``block_s`` seconds, never across a gap.
 
-    Blocks start at each contiguous segment's first sample; a block holds the
-    samples with ``t0 + k·block_s ≤ t < t0 + (k+1)·block_s``.  Blocks with fewer
-    than ``min_fill`` × the nominal sample count (the end of a segment) are dropped.
-    ``values`` may be 1-D or (n_samples, n_channels).
+    Parameters
+    ----------
+    time_s : array_like
+        Sample times [s].
+    values : array_like
+        Samples [any unit], 1-D or (n_samples, n_channels).
+    block_s : float
+        Block length [s].
+    min_fill : float
+        Fraction of the nominal sample count a block must hold to be kept.
+    gap_factor : float
+        A step longer than this many median steps is a gap.
+
+    Returns
+    -------
+    BlockAverage
+        The block times and means.
+
+    Notes
+    -----
+    Blocks start at each contiguous segment's first sample; a block holds the samples
+    with ``t0 + k·block_s ≤ t < t0 + (k+1)·block_s``; the short block at a segment's end
+    is dropped.
     """
     t = _as_f64(time_s, "time_s")
     v = np.asarray(values, dtype=np.float64)
@@ -611,10 +630,38 @@ def spectrum(
     segment_length: int | None = None,
     gap_factor: float = GAP_FACTOR,
 ) -> Spectrum:
-    """Welch PSD of a signal (scipy.signal.welch, Hann window, 50 % overlap, linear detrend).
+    """Welch power spectral density of a signal on its longest gap-free segment.
 
-    Computed on the longest contiguous segment (a :class:`GapWarning` says so when
-    the recording has gaps).  The temperature drift lives below ~0.04 Hz.
+    Parameters
+    ----------
+    time_s : array_like
+        Sample times [s].
+    x : array_like
+        Samples [unit].
+    segment_length : int, optional
+        Samples per Welch segment (default: scipy's).
+    gap_factor : float
+        A step longer than this many median steps is a gap.
+
+    Returns
+    -------
+    Spectrum
+        Frequencies [Hz] and the one-sided PSD [unit²/Hz].
+
+    Warns
+    -----
+    GapWarning
+        The recording has gaps (only the longest segment is used).
+
+    Notes
+    -----
+    ``scipy.signal.welch``: Hann window, 50 % overlap, linear detrend (Welch 1967).  The
+    temperature drift lives below ~0.04 Hz.
+
+    References
+    ----------
+    .. [1] P. D. Welch, "The use of fast Fourier transform for the estimation of power
+       spectra", IEEE Trans. Audio and Electroacoustics 15(2), 1967.
     """
     t = _as_f64(time_s, "time_s")
     arr = _as_f64(x, "x")

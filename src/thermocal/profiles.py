@@ -649,10 +649,42 @@ def correlate(
 ) -> CorrelationResult:
     """Correlation of two temperature histories (the RLG patent).
 
-    ``r = Cov(X, Y) / (σ_X σ_Y)`` with X, Y the two histories on the common
-    elapsed-time base of :func:`common_base` (non-finite samples dropped).
-    ``weakly_correlated`` is ``r < r_limit`` as the seed states it (a strongly
-    *negative* r also passes; :func:`design_validation_profile` aims at ``|r|``).
+    Parameters
+    ----------
+    time_a, temp_a : array_like
+        Times [s] and temperatures [°C] of the first history (e.g. the modelling test).
+    time_b, temp_b : array_like
+        Times [s] and temperatures [°C] of the second (e.g. the validation test).
+    r_limit : float
+        ``weakly_correlated`` is r < r_limit.
+    n_points : int
+        Points of the common elapsed-time base.
+
+    Returns
+    -------
+    CorrelationResult
+        r, whether the histories are weakly correlated, the common base's size and length.
+
+    Raises
+    ------
+    thermocal.errors.ThermocalInputError
+        A history that is constant on the common base (r undefined), or too short.
+
+    Notes
+    -----
+    :func:`pearson_r` of X, Y, the two histories on the common elapsed-time base of
+    :func:`common_base` (non-finite samples dropped).  ``weakly_correlated`` is
+    r < r_limit as the RLG patent states it (a strongly *negative* r also passes;
+    :func:`design_validation_profile` aims at ``|r|``).
+
+    Examples
+    --------
+    A sine and a cosine over one whole period are uncorrelated:
+
+    >>> t = np.arange(0.0, 3600.0, 10.0)
+    >>> res = correlate(t, np.sin(2 * np.pi * t / 3600), t, np.cos(2 * np.pi * t / 3600))
+    >>> round(res.r, 2) == 0.0, res.weakly_correlated
+    (True, True)
     """
     base, x, y = common_base(time_a, temp_a, time_b, temp_b, n_points)
     r = pearson_r(x, y)

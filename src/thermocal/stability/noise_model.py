@@ -249,8 +249,46 @@ def axis_noise(
     confidence: float = 0.6826894921370859,
     taus: Any = "octave",
 ) -> AxisNoise:
-    """Allan analysis (:func:`thermocal.stability.allan.overlapping_adev`, :func:`noise_terms`)
-    of one axis in the data's unit ``unit`` and its continuous-time density and random walk in SI.
+    """The noise of one IMU axis: its Allan analysis in the data's unit and its
+    continuous-time white-noise density and random walk in SI.
+
+    Parameters
+    ----------
+    values : array_like
+        Rate samples of the axis [``unit``] (a gyro's angular rate or an accelerometer's
+        specific force).
+    tau0_s : float
+        Sample interval τ0 [s].
+    name : str
+        The axis (its column).
+    sensor : {"gyro", "accel"}
+        What the axis measures.
+    unit : str
+        Unit of ``values`` (a rate or acceleration unit).
+    segments : list of slice, optional
+        The gap-free index ranges.
+    time_s : array_like, optional
+        Sample times [s] (the record is split at gaps).
+    confidence : float
+        Confidence level of the intervals.
+    taus : {"octave", "decade", "log"} or array_like
+        The τ set of the Allan deviation.
+
+    Returns
+    -------
+    AxisNoise
+        The Allan deviation and terms (:func:`thermocal.stability.allan.overlapping_adev`,
+        :func:`thermocal.stability.allan.noise_terms`), the density [rad/s/√Hz or
+        m/s²/√Hz] and random walk [rad/s²/√Hz or m/s³/√Hz], the output quantisation found.
+
+    Raises
+    ------
+    thermocal.errors.ThermocalInputError
+        A unit that is not the sensor's.
+
+    References
+    ----------
+    .. [1] IEEE Std 952-1997, Annex C.
     """
     u = units.normalize_signal_unit(unit)
     kind_units = units.RATE_UNITS if sensor == "gyro" else units.ACCEL_UNITS
