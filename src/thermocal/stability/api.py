@@ -278,10 +278,10 @@ def deviation(
     )  # fmt: skip
 
 
-Deviation = Callable[..., DeviationResult]
+_DeviationFunction = Callable[..., DeviationResult]
 
 
-def _one(name: str, formula: str, words: str) -> Deviation:
+def _one(name: str, formula: str, words: str) -> _DeviationFunction:
     """The function of one built-in deviation: :func:`deviation` with ``name`` fixed."""
 
     def func(
