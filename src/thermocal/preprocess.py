@@ -1,14 +1,14 @@
-"""Pre-processing of recordings (SPEC §3): pure numpy functions on arrays.
+"""Pre-processing of recordings: pure numpy functions on arrays.
 
 * :func:`sum_decimate`, :func:`mean_decimate` — sum raw counts to a lower rate
-  (seed 001: 100 Hz summed to 1 Hz) or average.
+  (the FOG thesis: 100 Hz summed to 1 Hz) or average.
 * :func:`block_average` — averages over blocks of a stated time, never across a gap.
 * :func:`lowpass_first_order` — the "inertia link" ``H(s) = 1/(T_f s + 1)``,
   discretised exactly (zero-order hold) at the sample period.
 * :func:`temperature_rate` — ``Ṫ = (T(t+Δt) − T(t))/Δt`` [°C/min], forward,
   backward (causal) or centred, never across a gap.
 * :func:`segment_holds` — split a run into temperature holds and ramps.
-* :func:`remove_startup_offset` — subtract the turn-on bias (seed 001).
+* :func:`remove_startup_offset` — subtract the turn-on bias (the FOG thesis).
 * :func:`spectrum` — Welch power spectral density of the static output.
 
 Gaps are found by :func:`thermocal.recording.find_gaps` (a step longer than
@@ -54,7 +54,7 @@ def _as_f64(x: npt.ArrayLike, name: str) -> FloatArray:
 def sum_decimate(x: npt.ArrayLike, factor: int) -> FloatArray:
     """Sum consecutive blocks of ``factor`` samples: ``y_j = Σ_{i=jm}^{jm+m-1} x_i``.
 
-    Used for pulse counts (SPEC §3: 100 Hz counts summed to 1 Hz).  A trailing
+    Used for pulse counts (100 Hz counts summed to 1 Hz).  A trailing
     partial block is dropped.  No gap check: use :func:`block_average` on
     recordings with gaps.
     """
@@ -96,10 +96,29 @@ def block_average(
 ) -> BlockAverage:
     """Average ``values`` over consecutive blocks of ``block_s`` seconds, never across a gap.
 
-    Blocks start at each contiguous segment's first sample; a block holds the
-    samples with ``t0 + k·block_s ≤ t < t0 + (k+1)·block_s``.  Blocks with fewer
-    than ``min_fill`` × the nominal sample count (the end of a segment) are dropped.
-    ``values`` may be 1-D or (n_samples, n_channels).
+    Parameters
+    ----------
+    time_s : array_like
+        Sample times [s].
+    values : array_like
+        Samples [any unit], 1-D or (n_samples, n_channels).
+    block_s : float
+        Block length [s].
+    min_fill : float
+        Fraction of the nominal sample count a block must hold to be kept.
+    gap_factor : float
+        A step longer than this many median steps is a gap.
+
+    Returns
+    -------
+    BlockAverage
+        The block times and means.
+
+    Notes
+    -----
+    Blocks start at each contiguous segment's first sample; a block holds the samples
+    with ``t0 + k·block_s ≤ t < t0 + (k+1)·block_s``; the short block at a segment's end
+    is dropped.
     """
     t = _as_f64(time_s, "time_s")
     v = np.asarray(values, dtype=np.float64)
@@ -142,8 +161,32 @@ def block_average(
 
 
 def lowpass_time_constant_s(bandwidth_hz: float) -> float:
-    """``T_f = 1/(2π f_c)`` [s] of a first-order low-pass with bandwidth ``f_c`` [Hz]
-    (SPEC §3: 0.04 Hz → T_f ≈ 3.98 s)."""
+    r"""The time constant of a first-order low-pass of a given bandwidth.
+
+    Parameters
+    ----------
+    bandwidth_hz : float
+        The −3 dB bandwidth f_c [Hz].
+
+    Returns
+    -------
+    float
+        T_f [s].
+
+    Raises
+    ------
+    thermocal.errors.ThermocalInputError
+        A bandwidth that is not positive.
+
+    Notes
+    -----
+    .. math:: T_f = \frac{1}{2\pi f_c}
+
+    Examples
+    --------
+    >>> round(lowpass_time_constant_s(0.04), 2)
+    3.98
+    """
     if not bandwidth_hz > 0:
         raise ThermocalInputError(f"bandwidth must be positive, got {bandwidth_hz}")
     return 1.0 / (2.0 * math.pi * bandwidth_hz)
@@ -157,16 +200,40 @@ def lowpass_first_order(
     time_constant_s: float | None = None,
     initial: Literal["first", "zero"] = "first",
 ) -> FloatArray:
-    """First-order low-pass ``H(s) = 1/(T_f s + 1)`` (SPEC §3, seed 001 "inertia link").
+    r"""First-order low-pass ``H(s) = 1/(T_f s + 1)`` (the FOG thesis's "inertia link").
 
-    Exact zero-order-hold discretisation at the sample period τ::
+    Parameters
+    ----------
+    x : array_like
+        The samples [any unit].
+    period_s : float
+        Sample period τ [s].
+    bandwidth_hz : float, optional
+        Bandwidth f_c [Hz] (T_f = 1/(2π f_c)); give it or ``time_constant_s``.
+    time_constant_s : float, optional
+        Time constant T_f [s].
+    initial : {"first", "zero"}
+        Start at rest at ``x[0]`` (``y[0] = x[0]``) or from 0.
 
-        a = exp(−τ/T_f),   y[k] = a·y[k−1] + (1 − a)·x[k−1]
+    Returns
+    -------
+    numpy.ndarray
+        The filtered samples y [the unit of ``x``].
 
-    so that a unit step applied at k = 0 gives ``y[k] = 1 − exp(−kτ/T_f)`` exactly
-    (``1 − e⁻¹`` at t = T_f).  ``initial="first"`` starts at rest at ``x[0]``
-    (``y[0] = x[0]``), ``"zero"`` starts from 0.  Give either ``bandwidth_hz``
-    (``T_f = 1/(2π f_c)``) or ``time_constant_s``.
+    Notes
+    -----
+    Exact zero-order-hold discretisation at the sample period τ:
+
+    .. math:: a = e^{-\tau/T_f}, \qquad y_k = a\,y_{k-1} + (1-a)\,x_{k-1},
+
+    so that a unit step applied at k = 0 gives :math:`y_k = 1 - e^{-k\tau/T_f}` exactly
+    (1 − e⁻¹ at t = T_f).
+
+    Examples
+    --------
+    >>> y = lowpass_first_order([1.0] * 3, 1.0, time_constant_s=1.0, initial="zero")
+    >>> [round(v, 4) for v in y.tolist()]
+    [0.0, 0.6321, 0.8647]
     """
     arr = _as_f64(x, "x")
     if (bandwidth_hz is None) == (time_constant_s is None):
@@ -269,8 +336,8 @@ def segment_rates(
 ) -> FloatArray:
     """Ṫ [°C/min] at ``rows`` of one contiguous segment (times ``ts``, temps ``Ts`` (n, k)).
 
-    The same arithmetic as :func:`thermocal.preprocess.temperature_rate`
-    (SPEC §3): partner samples ``lo``/``hi`` inside the segment (backward: the
+    The same arithmetic as :func:`thermocal.preprocess.temperature_rate`:
+    partner samples ``lo``/``hi`` inside the segment (backward: the
     first ``t_j ≥ t_i − Δt`` and i; forward: i and the first ``t_j ≥ t_i + Δt``;
     centred: ±Δt/2), ``Ṫ = (T_hi − T_lo)/(t_hi − t_lo)·60``, 0 when the span
     is 0.  Works on a block of rows so that long runs need no full-size temporaries;
@@ -362,11 +429,35 @@ def temperature_rate(
     *,
     gap_factor: float = GAP_FACTOR,
 ) -> FloatArray:
-    """Temperature rate Ṫ [°C/min] over an interval Δt [s], never across a gap.
+    r"""Temperature rate Ṫ [°C/min] over an interval Δt [s], never across a gap.
 
-    SPEC §3 (seed 000): ``Ṫ(t) = (T(t+Δt) − T(t)) / Δt``.  Three forms:
+    Parameters
+    ----------
+    time_s : array_like
+        Sample times [s].
+    temp_c : array_like
+        Temperatures [°C].
+    interval_s : float
+        The interval Δt [s].
+    method : {"backward", "forward", "centred"}
+        Where the difference is assigned (below).
+    gap_factor : float
+        A step longer than this many median steps is a gap.
 
-    * ``"forward"`` — the seed's formula at time t: partner sample j is the first
+    Returns
+    -------
+    numpy.ndarray
+        Ṫ [°C/min] per sample.
+
+    Notes
+    -----
+    The RLG patent:
+
+    .. math:: \dot T(t) = \frac{T(t+\Delta t) - T(t)}{\Delta t}
+
+    Three forms:
+
+    * ``"forward"`` — the patent's formula at time t: partner sample j is the first
       with ``t_j ≥ t_i + Δt``;
     * ``"backward"`` — the same difference assigned to the end of the interval,
       ``Ṫ(t) = (T(t) − T(t−Δt))/Δt``: causal, so firmware and the streaming
@@ -387,7 +478,7 @@ def temperature_rate(
         raise ThermocalInputError(f"unknown rate method {method!r}; use one of {RATE_METHODS}")
     if not interval_s > 0:
         raise ThermocalInputError(f"rate interval must be positive, got {interval_s}")
-    # one implementation of Ṫ for the whole package (issue 15): the block form the models
+    # one implementation of Ṫ for the whole package: the block form the models
     # use, on one column
     out: FloatArray = temperature_rates(t, T, interval_s, method, gap_factor=gap_factor)
     return out
@@ -447,7 +538,7 @@ def segment_holds(
     if not rate_interval_s > 0:
         raise ThermocalInputError(f"rate interval must be positive, got {rate_interval_s}")
     # |Ṫ| < threshold block by block (the centred Ṫ of temperature_rate, bit for bit):
-    # one byte a sample, no full-length Ṫ (issue 26)
+    # one byte a sample, no full-length Ṫ
     is_hold = np.full(t.size, rate_threshold_c_per_min > 0.0)  # rows of no segment: Ṫ = 0
     T2 = T.reshape(-1, 1)
     for sl in gap_free_slices(t, gap_factor):
@@ -510,7 +601,7 @@ def segment_holds(
 def remove_startup_offset(
     time_s: npt.ArrayLike, x: npt.ArrayLike, window_s: float
 ) -> tuple[FloatArray, float]:
-    """Subtract the turn-on offset: the mean of the first ``window_s`` seconds (seed 001).
+    """Subtract the turn-on offset: the mean of the first ``window_s`` seconds (the FOG thesis).
 
     Returns ``(x − offset, offset)``.
     """
@@ -539,10 +630,38 @@ def spectrum(
     segment_length: int | None = None,
     gap_factor: float = GAP_FACTOR,
 ) -> Spectrum:
-    """Welch PSD of a signal (scipy.signal.welch, Hann window, 50 % overlap, linear detrend).
+    """Welch power spectral density of a signal on its longest gap-free segment.
 
-    Computed on the longest contiguous segment (a :class:`GapWarning` says so when
-    the recording has gaps).  SPEC §3: the temperature drift lives below ~0.04 Hz.
+    Parameters
+    ----------
+    time_s : array_like
+        Sample times [s].
+    x : array_like
+        Samples [unit].
+    segment_length : int, optional
+        Samples per Welch segment (default: scipy's).
+    gap_factor : float
+        A step longer than this many median steps is a gap.
+
+    Returns
+    -------
+    Spectrum
+        Frequencies [Hz] and the one-sided PSD [unit²/Hz].
+
+    Warns
+    -----
+    GapWarning
+        The recording has gaps (only the longest segment is used).
+
+    Notes
+    -----
+    ``scipy.signal.welch``: Hann window, 50 % overlap, linear detrend (Welch 1967).  The
+    temperature drift lives below ~0.04 Hz.
+
+    References
+    ----------
+    .. [1] P. D. Welch, "The use of fast Fourier transform for the estimation of power
+       spectra", IEEE Trans. Audio and Electroacoustics 15(2), 1967.
     """
     t = _as_f64(time_s, "time_s")
     arr = _as_f64(x, "x")

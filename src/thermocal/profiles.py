@@ -1,6 +1,6 @@
 """Chamber test profiles, their correlation, and the weakly-correlated validation design.
 
-A :class:`Profile` is a start temperature and a list of segments (SPEC §6):
+A :class:`Profile` is a start temperature and a list of segments:
 
 * :class:`Hold` — keep the set-point for ``duration_s`` [s];
 * :class:`Ramp` — move the set-point to ``target_c`` [°C] at ``rate_c_per_min`` [°C/min];
@@ -13,11 +13,15 @@ two columns ``time_s, setpoint_c`` (:meth:`Profile.program`,
 Ramps therefore have exactly their rate and holds exactly their duration.
 
 The built-in profiles (:data:`PROFILE_NAMES`, :func:`builtin_profile`) follow the
-seeds: ``rlg-modelling`` and ``rlg-validation`` (seed 000), ``fog-slow`` (seed 001),
-``mems-warmup`` (seed 003), ``accel-full-range`` (seed 004).
+source documents: ``rlg-modelling`` and ``rlg-validation`` the RLG patent (*A modelling and
+validation method for the temperature compensation model of a ring-laser gyroscope*),
+``fog-slow`` the FOG thesis (*Design and engineering implementation of a fibre-optic-gyro
+line-of-sight stabilisation system*, chapter 3), ``mems-warmup`` the MEMS test plan
+(*Temperature-characteristic calibration test plan*), ``accel-full-range`` the accelerometer
+patent (*Adaptive accelerometer temperature compensation method for inertial navigation*).
 
-:func:`correlate` is the seed-000 weak-correlation test ``r = Cov(X, Y)/(σ_X σ_Y)``
-(SPEC §5) on a common elapsed-time base, and :func:`design_validation_profile`
+:func:`correlate` is the RLG patent's weak-correlation test ``r = Cov(X, Y)/(σ_X σ_Y)``
+on a common elapsed-time base, and :func:`design_validation_profile`
 searches (seeded) for a hold profile over the same temperature range with ``|r|``
 below the limit.
 """
@@ -64,7 +68,7 @@ class Hold:
 
 
 RAMP_RATE_RANGE = (1e-4, 1e3)
-"""|ramp rate| [°C/min] a program may ask (issue 39: 1e-300 made a program of 1e302 s and
+"""|ramp rate| [°C/min] a program may ask (1e-300 would make a program of 1e302 s and
 exit 1); the fastest thermal-shock chambers move tens of °C/min."""
 
 
@@ -246,7 +250,7 @@ class Profile:
         ]
 
 
-# --- built-in profiles (seed 000, 001, 003, 004) -------------------------------------------------
+# --- built-in profiles (the source documents) -----------------------------------------------------
 
 
 def rlg_modelling(
@@ -260,7 +264,7 @@ def rlg_modelling(
     rates_c_per_min: Sequence[float] = (2.0, 1.0, 0.5, 0.2, 0.1),
     rate_hold_s: float = 1800.0,
 ) -> Profile:
-    """Seed-000 modelling test (SPEC §6): cycles between ``low_c`` and ``high_c``, then
+    """The modelling test of the RLG patent: cycles between ``low_c`` and ``high_c``, then
     cycles with ramps of ±2, ±1, ±0.5, ±0.2 and ±0.1 °C/min.
 
     Part 1 (label ``temperature-cycle``): ``n_temperature_cycles`` × (ramp to
@@ -308,7 +312,7 @@ def rlg_validation(
     rate_c_per_min: float = 1.0,
     start_c: float = 20.0,
 ) -> Profile:
-    """Seed-000 validation test (SPEC §5, §6): holds at several temperatures.
+    """The validation test of the RLG patent: holds at several temperatures.
 
     From ``start_c``, for each temperature: ramp at ``rate_c_per_min``, hold
     ``hold_s`` (one value or one per hold; label ``hold {T:+g}``); then ramp back
@@ -339,7 +343,7 @@ def fog_slow(
     hold_s: float = 3600.0,
     n_cycles: int = 1,
 ) -> Profile:
-    """Seed-001 slow drift over 15–42 °C: hold at ``low_c``, then ``n_cycles`` × (ramp
+    """The FOG thesis's slow drift over 15–42 °C: hold at ``low_c``, then ``n_cycles`` × (ramp
     to ``high_c`` at ``rate_c_per_min``, hold, ramp to ``low_c``, hold); ≈ 12 h by default."""
     if not low_c < high_c:
         raise ThermocalInputError(f"low_c ({low_c}) must be below high_c ({high_c})")
@@ -375,14 +379,16 @@ def mems_warmup(
     transition_rate_c_per_min: float = 2.0,
     start_c: float = 20.0,
 ) -> Profile:
-    """Seed-003 warm-ups at several start temperatures (SPEC §4c, §6).
+    """Warm-ups at several start temperatures (the MEMS test plan).
 
     For each start temperature T0: ramp to T0, soak ``soak_s`` unpowered (label
     ``soak T0``), then hold ``record_s`` ≥ 6 min with the unit powered (label
     ``power-on T{T0:+g}``, see :func:`power_on_label`).
     """
     if record_s < 360:
-        raise ThermocalInputError(f"record_s must be ≥ 360 s (6 min, seed 003), got {record_s}")
+        raise ThermocalInputError(
+            f"record_s must be ≥ 360 s (6 min, the MEMS test plan), got {record_s}"
+        )
     segs: list[Segment] = []
     for t0 in start_temps_c:
         segs += [
@@ -410,7 +416,7 @@ def accel_full_range(
     start_c: float = 20.0,
     startup_s: float = 600.0,
 ) -> Profile:
-    """Seed-004 full-range test (SPEC §4d), repeated ``repeats`` times (one run each).
+    """The full-range test of the accelerometer patent, repeated ``repeats`` times (one run each).
 
     Each run (labels ``run{i}/...``): ``startup`` hold at ``start_c`` (power-on),
     cool to ``low_c`` and soak ``soak_s`` (``soak-low``), ramp at ``rate_c_per_min``
@@ -533,7 +539,7 @@ def find_holds(
     return stages
 
 
-# --- correlation (seed 000, SPEC §5) -------------------------------------------------------------
+# --- correlation (the RLG patent) -----------------------------------------------------------------
 
 
 @dataclass(frozen=True)
@@ -541,7 +547,7 @@ class CorrelationResult:
     """Correlation of two temperature histories on a common elapsed-time base.
 
     r : Pearson coefficient ``Cov(X, Y)/(σ_X σ_Y)``; weakly_correlated : ``r < r_limit``
-    (seed 000 literally; see :func:`correlate`); n : number of common points;
+    (the RLG patent literally; see :func:`correlate`); n : number of common points;
     duration_s : length of the common base [s]; r_limit : the limit used.
     """
 
@@ -573,7 +579,7 @@ def common_base(
     temp_b: npt.ArrayLike,
     n_points: int = DEFAULT_CORRELATION_POINTS,
 ) -> tuple[FloatArray, FloatArray, FloatArray]:
-    """Resample two histories on a common elapsed-time base (SPEC §5, our reading).
+    """Resample two histories on a common elapsed-time base (thermocal's reading).
 
     Both are timed from their own first sample; the base is ``n_points`` uniform
     times over the overlap ``[0, min(duration_a, duration_b)]``; values are linearly
@@ -592,9 +598,33 @@ def common_base(
 
 
 def pearson_r(x: FloatArray, y: FloatArray) -> float:
-    """``r = Cov(X, Y) / (σ_X σ_Y)`` (seed 000; population moments, so the n cancels).
+    r"""Pearson's correlation coefficient of two equally long histories (the RLG patent).
 
-    Raises :class:`ThermocalInputError` when either history is constant (r undefined).
+    Parameters
+    ----------
+    x, y : numpy.ndarray
+        The two histories [°C], on one time base.
+
+    Returns
+    -------
+    float
+        r in [−1, 1].
+
+    Raises
+    ------
+    thermocal.errors.ThermocalInputError
+        Either history is constant (r undefined).
+
+    Notes
+    -----
+    .. math:: r = \frac{\mathrm{Cov}(X, Y)}{\sigma_X \sigma_Y}
+              = \frac{\sum (x_i - \bar x)(y_i - \bar y)}
+                     {\sqrt{\sum (x_i - \bar x)^2 \sum (y_i - \bar y)^2}}
+
+    Examples
+    --------
+    >>> round(pearson_r(np.array([1.0, 2.0, 3.0, 4.0]), np.array([2.0, 1.0, 4.0, 3.0])), 3)
+    0.6
     """
     dx = x - x.mean()
     dy = y - y.mean()
@@ -617,12 +647,44 @@ def correlate(
     r_limit: float = WEAK_CORRELATION_LIMIT,
     n_points: int = DEFAULT_CORRELATION_POINTS,
 ) -> CorrelationResult:
-    """Correlation of two temperature histories (seed 000, SPEC §5).
+    """Correlation of two temperature histories (the RLG patent).
 
-    ``r = Cov(X, Y) / (σ_X σ_Y)`` with X, Y the two histories on the common
-    elapsed-time base of :func:`common_base` (non-finite samples dropped).
-    ``weakly_correlated`` is ``r < r_limit`` as the seed states it (a strongly
-    *negative* r also passes; :func:`design_validation_profile` aims at ``|r|``).
+    Parameters
+    ----------
+    time_a, temp_a : array_like
+        Times [s] and temperatures [°C] of the first history (e.g. the modelling test).
+    time_b, temp_b : array_like
+        Times [s] and temperatures [°C] of the second (e.g. the validation test).
+    r_limit : float
+        ``weakly_correlated`` is r < r_limit.
+    n_points : int
+        Points of the common elapsed-time base.
+
+    Returns
+    -------
+    CorrelationResult
+        r, whether the histories are weakly correlated, the common base's size and length.
+
+    Raises
+    ------
+    thermocal.errors.ThermocalInputError
+        A history that is constant on the common base (r undefined), or too short.
+
+    Notes
+    -----
+    :func:`pearson_r` of X, Y, the two histories on the common elapsed-time base of
+    :func:`common_base` (non-finite samples dropped).  ``weakly_correlated`` is
+    r < r_limit as the RLG patent states it (a strongly *negative* r also passes;
+    :func:`design_validation_profile` aims at ``|r|``).
+
+    Examples
+    --------
+    A sine and a cosine over one whole period are uncorrelated:
+
+    >>> t = np.arange(0.0, 3600.0, 10.0)
+    >>> res = correlate(t, np.sin(2 * np.pi * t / 3600), t, np.cos(2 * np.pi * t / 3600))
+    >>> round(res.r, 2) == 0.0, res.weakly_correlated
+    (True, True)
     """
     base, x, y = common_base(time_a, temp_a, time_b, temp_b, n_points)
     r = pearson_r(x, y)
@@ -644,7 +706,7 @@ def design_validation_profile(
     n_candidates: int = 400,
     n_points: int = 2000,
 ) -> Profile:
-    """Design a hold profile weakly correlated with a modelling test (SPEC §5, our reading).
+    """Design a hold profile weakly correlated with a modelling test (thermocal's reading).
 
     The hold temperatures are ``n_holds`` evenly spaced values over the modelling
     range ``[min, max]`` (so the validation covers the same range; default: one

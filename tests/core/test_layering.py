@@ -166,6 +166,18 @@ def _resolve(name: str, known: dict[str, tuple[Path, bool]]) -> str:
     return name
 
 
+def _to_frame_nodes(tree: ast.AST) -> set[int]:
+    """The nodes inside a ``def to_frame`` method: its ``import pandas`` builds the table the
+    user asked for from arrays (no file is read); the fresh-interpreter check still holds
+    (importing the module loads no pandas)."""
+    return {
+        id(n)
+        for f in ast.walk(tree)
+        if isinstance(f, ast.FunctionDef) and f.name == "to_frame"
+        for n in ast.walk(f)
+    }
+
+
 @cache
 def import_graph() -> dict[str, Module]:
     """Every module of the package with its imports (see the module docstring)."""
@@ -174,9 +186,13 @@ def import_graph() -> dict[str, Module]:
     for name, (path, is_package) in known.items():
         mod = Module(name, path, is_package)
         package = name if is_package else name.rpartition(".")[0]
-        for node in _nodes(ast.parse(path.read_text(encoding="utf-8"))):
+        tree = ast.parse(path.read_text(encoding="utf-8"))
+        frames = _to_frame_nodes(tree)
+        for node in _nodes(tree):
             if isinstance(node, ast.Import):
                 for a in node.names:
+                    if id(node) in frames and a.name == "pandas":
+                        continue  # a result's to_frame(): the table the user asked for
                     mod.imports.append(Import(node.lineno, _resolve(a.name, known), (), a.asname))
             elif isinstance(node, ast.ImportFrom):
                 base = node.module or ""

@@ -21,12 +21,13 @@ NUMBER = re.compile(r"[-+]?\d+(?:\.\d+)?(?:e[-+]?\d+)?")
 BLOCK = re.compile(r"^```(\w+)\n(.*?)^```$", re.MULTILINE | re.DOTALL)
 
 
-def _run_block(lang: str, body: str) -> str:
-    """What a ``console`` block's ``$ thermocal …`` lines or a ``python`` block print."""
+def _run_block(lang: str, body: str, namespace: dict[str, object] | None = None) -> str:
+    """What a ``console`` block's ``$ thermocal …`` lines or a ``python`` block print (the
+    page's python blocks share ``namespace``, as a notebook's cells do)."""
     out = io.StringIO()
     if lang == "python":
         with contextlib.redirect_stdout(out):
-            exec(compile(body, "tutorial", "exec"), {})
+            exec(compile(body, "tutorial", "exec"), {} if namespace is None else namespace)
         return out.getvalue()
     for line in body.splitlines():
         assert line.startswith("$ thermocal "), line
@@ -41,10 +42,11 @@ def _run_page(page: Path) -> list[tuple[str, str]]:
     """(printed, shown) for every executable block of the page, in order."""
     blocks = [(m.group(1), m.group(2)) for m in BLOCK.finditer(page.read_text(encoding="utf-8"))]
     pairs = []
+    namespace: dict[str, object] = {}
     for i, (lang, body) in enumerate(blocks):
         if lang in ("console", "python"):
             shown = next(b for la, b in blocks[i + 1 :] if la == "text")
-            pairs.append((_run_block(lang, body), shown))
+            pairs.append((_run_block(lang, body, namespace), shown))
     return pairs
 
 

@@ -13,6 +13,7 @@ import numpy as np
 import pytest
 from scipy import stats
 
+from thermocal.cli.allan_cmd import parse_taus
 from thermocal.errors import ConditioningWarning, ThermocalInputError
 from thermocal.metrics import MetricsOptions, channel_metrics, power_on_metrics
 from thermocal.recording import Recording
@@ -21,7 +22,6 @@ from thermocal.stability.analysis import (
     allan_analysis,
     column_unit,
     imu_noise,
-    parse_taus,
 )
 
 
@@ -81,7 +81,7 @@ def test_allan_analysis_reports_in_the_columns_own_unit() -> None:
 def test_allan_analysis_family_gives_the_deviations_asked() -> None:
     rec = _rate_recording()
     y = rec.column("gy").copy()
-    res = allan_analysis(rec, ["gy"], taus=[1.0, 4.0], deviations="adev,oadev")
+    res = allan_analysis(rec, ["gy"], taus=[1.0, 4.0], deviations=["adev", "oadev"])
     assert res.is_family and not res.channels
     fam = res.family["gy"]
     np.testing.assert_allclose(
@@ -97,7 +97,7 @@ def test_allan_analysis_checks_its_options() -> None:
     with pytest.raises(ThermocalInputError, match="use rate or phase"):
         allan_analysis(rec, ["gx"], data_type="angle")
     with pytest.raises(ThermocalInputError, match="--dynamic computes"):
-        allan_analysis(rec, ["gx"], deviations="mdev", dynamic_s=100.0)
+        allan_analysis(rec, ["gx"], deviations=["mdev"], dynamic_s=100.0)
     assert parse_taus("decade") == "decade"
     assert parse_taus("1, 10,100") == [1.0, 10.0, 100.0]
     with pytest.raises(ThermocalInputError, match="--taus"):

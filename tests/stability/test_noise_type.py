@@ -15,7 +15,8 @@ import numpy as np
 import pytest
 
 from stable32_phasedat import allan_refuses, phase_csv, rows, run_allan
-from thermocal.stability.family import NOISE_TYPES, parse_noise_type
+from thermocal.cli.allan_cmd import parse_noise_type
+from thermocal.stability.family import NOISE_TYPES
 
 
 def test_white_pm_htotdev_equals_stable32s_forced_run(

@@ -42,8 +42,10 @@ if TYPE_CHECKING:
     import thermocal.readers as _readers
     import thermocal.stability.allan as _allan
     import thermocal.stability.analysis as _analysis
+    import thermocal.stability.api as _api
     import thermocal.stability.family as _family
     import thermocal.stability.noise_model as _nm
+    import thermocal.stability.registry as _registry
     import thermocal.writers as _writers
 else:
     _rich_table = LazyModule("rich.table")
@@ -51,6 +53,74 @@ else:
     _readers = LazyModule("thermocal.readers")
     _analysis = LazyModule("thermocal.stability.analysis")
     _family = LazyModule("thermocal.stability.family")
+    _registry = LazyModule("thermocal.stability.registry")
+    _api = LazyModule("thermocal.stability.api")
+
+
+def parse_taus(text: str) -> str | list[float]:
+    """``--taus``: a named set (:data:`thermocal.stability.api.TAU_SETS`) as given, else a
+    list of τ [s]."""
+    if text in _api.TAU_SETS:
+        return text
+    try:
+        taus = [float(v) for v in text.split(",") if v.strip()]
+    except ValueError:
+        raise ThermocalInputError(
+            f"--taus {text!r}: use octave, decade, log or a comma-separated list of τ [s]"
+        ) from None
+    bad = [t for t in taus if not (math.isfinite(t) and t > 0)]
+    if bad or not taus:
+        raise ThermocalInputError(
+            f"--taus {text!r}: every τ must be a positive, finite time [s]"
+            + (f" (got {bad[0]:g})" if bad else " (none given)")
+            + "; or use octave, decade, log"
+        )
+    return taus
+
+
+def parse_deviations(spec: str) -> list[str]:
+    """``--deviation "oadev,mdev"`` → names, checked against the deviation registry."""
+    known = _registry.names()
+    names = [s.strip().lower() for s in spec.split(",") if s.strip()]
+    bad = [n for n in names if n not in known]
+    if bad or not names:
+        raise ThermocalInputError(
+            f"--deviation {spec!r}: unknown {', '.join(bad) or 'empty list'}; use "
+            + ", ".join(known)
+        )
+    return list(dict.fromkeys(names))
+
+
+def parse_noise_type(spec: str | None, names: list[str]) -> int | None:
+    """``--noise-type``: ``auto`` (None: identified per τ), a name of
+    :data:`thermocal.stability.family.NOISE_TYPES` or α itself (−4…2).  α < −2 only for the
+    Hadamard family (hdev, ohdev, htotdev)."""
+    if spec is None or spec.strip().lower() in ("", "auto"):
+        return None
+    key = spec.strip().lower()
+    try:
+        alpha = _family.NOISE_TYPES[key] if key in _family.NOISE_TYPES else int(key)
+    except ValueError:
+        alpha = 99
+    if not -4 <= alpha <= 2:
+        raise ThermocalInputError(
+            f"--noise-type {spec!r}: use auto, {', '.join(_family.NOISE_TYPES)} or α from -4 to 2"
+        )
+    not_h = [n for n in names if not _registry.get(n).hadamard and _registry.get(n).edf is not None]
+    if alpha < -2 and not_h:
+        raise ThermocalInputError(
+            f"--noise-type {spec!r} (α = {alpha}) is defined for the Hadamard deviations "
+            f"(hdev, ohdev, htotdev) only, not {', '.join(not_h)}"
+        )
+    return alpha
+
+
+def _noise_type(spec: str | None, devs: list[str] | None, data_type: str) -> int | None:
+    """α of ``--noise-type`` for the deviation family (``--deviation`` or phase data); for the
+    default overlapping ADEV any α given (0) so that the library refuses the option there."""
+    if devs is not None or data_type == "phase":
+        return parse_noise_type(spec, devs or ["oadev"])
+    return None if spec is None or spec.strip().lower() in ("", "auto") else 0
 
 
 def family_json(res: "_family.StabilityResult") -> dict[str, Any]:
@@ -83,8 +153,8 @@ def family_json(res: "_family.StabilityResult") -> dict[str, Any]:
         out[f"{name}_n"] = c.n_terms
         out[f"{name}_tau_s"] = c.tau_s
         out[f"{name}_unit"] = c.unit
-        out[f"{name}_interval"] = _family.NO_INTERVAL.get(
-            name, f"chi-square, {100 * res.confidence:.1f} %, {_family.edf_source(name)}"
+        out[f"{name}_interval"] = _family.no_interval(name) or (
+            f"chi-square, {100 * res.confidence:.1f} %, {_family.edf_source(name)}"
         )
         if c.bias is not None:
             out[f"{name}_bias_factor"] = c.bias
@@ -106,8 +176,9 @@ def _family_human(file: Path, res: "_family.StabilityResult") -> None:
                 str(int(c.n_terms[i])),
             )  # fmt: skip
         stdout.print(t)
-        if name in _family.NO_INTERVAL:
-            stdout.print(f"{name}: interval {_family.NO_INTERVAL[name]}")
+        why = _family.no_interval(name)
+        if why is not None:
+            stdout.print(f"{name}: interval {why}")
 
 
 def _terms_json(terms: dict[str, Any], method: str) -> dict[str, Any]:
@@ -462,11 +533,13 @@ def allan_cmd(
         # the Allan deviation uses the time and the signal only
         rec = check_recording(_readers.read_recording(file, read, keep_other=False), read)
     _check_plot(plot, file)
-    tau_spec = _analysis.parse_taus(taus)
+    tau_spec = parse_taus(taus)
+    devs = parse_deviations(deviation) if deviation is not None else None
     res = _analysis.allan_analysis(
         rec, split_names(signal) or [rec.signals[0]], taus=tau_spec, confidence=confidence,
-        deviations=deviation, data_type=data_type, dynamic_s=dynamic, where=str(file),
-        bias_correct=bias_correct, noise_type=noise_type, noise_id=noise_id,
+        deviations=devs, data_type=data_type, dynamic_s=dynamic, where=str(file),
+        bias_correct=bias_correct, noise_type=_noise_type(noise_type, devs, data_type),
+        noise_id=noise_id,
         max_work=max_work,
     )  # fmt: skip
     if res.is_family:

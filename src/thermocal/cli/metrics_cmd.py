@@ -1,5 +1,5 @@
 """``thermocal metrics FILE``: bias, bias stability, peak-to-peak, drift angle,
-repeatability and temperature sensitivity of one signal (SPEC §1)."""
+repeatability and temperature sensitivity of one signal."""
 
 from collections.abc import Callable
 from pathlib import Path
@@ -51,7 +51,7 @@ else:
 
 
 def metrics_json(res: "_metrics.MetricsResult") -> dict[str, Any]:
-    """The ``--json`` object of ``thermocal metrics`` (INTERFACE.md keys first); every rate
+    """The ``--json`` object of ``thermocal metrics`` (the documented keys first); every rate
     figure in ``unit`` (the data's own unit), angles in ``drift_angle_unit``."""
     d: dict[str, Any] = jsonable(res)
     ts = res.temperature_sensitivity

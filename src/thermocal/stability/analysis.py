@@ -24,7 +24,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any, Final
 
-from thermocal.errors import ConditioningWarning, ThermocalInputError, UnitWarning
+from thermocal.errors import ConditioningWarning, ParameterError, ThermocalInputError, UnitWarning
 from thermocal.stability.allan import ONE_SIGMA_CONFIDENCE
 from thermocal.stability.edf import check_confidence
 
@@ -39,31 +39,8 @@ if TYPE_CHECKING:
 
     FloatArray = npt.NDArray[np.float64]
 
-TAU_SETS = ("octave", "decade", "log", "all")
-"""The named τ sets of ``--taus`` (else a list of τ [s])."""
-
 DATA_TYPES = ("rate", "phase")
 """``--data-type``: rate data (a rate column) or phase data (an integrated quantity)."""
-
-
-def parse_taus(text: str) -> Any:
-    """``--taus``: a named set (:data:`TAU_SETS`) as given, else a list of τ [s]."""
-    if text in TAU_SETS:
-        return text
-    try:
-        taus = [float(v) for v in text.split(",") if v.strip()]
-    except ValueError:
-        raise ThermocalInputError(
-            f"--taus {text!r}: use octave, decade, log or a comma-separated list of τ [s]"
-        ) from None
-    bad = [t for t in taus if not (math.isfinite(t) and t > 0)]
-    if bad or not taus:
-        raise ThermocalInputError(
-            f"--taus {text!r}: every τ must be a positive, finite time [s]"
-            + (f" (got {bad[0]:g})" if bad else " (none given)")
-            + "; or use octave, decade, log"
-        )
-    return taus
 
 
 FEW_LEVELS: Final = 3
@@ -136,14 +113,14 @@ def check_not_stuck(
 def _tau_range(name: str, tau0_s: float, n_phase: int) -> tuple[float, float, int]:
     """The τ [s] a deviation reaches on ``n_phase`` phase points and its largest m
     (theo1: τ = 0.75 m τ0, m even)."""
-    from thermocal.stability import deviations as dv
+    from thermocal.stability import registry
 
     if name == "adev-rate":  # the overlapping ADEV of rate samples (allan.averaging_factors)
         from thermocal.stability.allan import max_averaging_factor
 
         m_max = max_averaging_factor(n_phase)
         return tau0_s, m_max * tau0_s, m_max
-    m_max = dv.max_factor(name, n_phase)
+    m_max = registry.get(name).max_factor(n_phase)
     if name == "theo1":
         m_max -= m_max % 2
         return 1.5 * tau0_s, 0.75 * m_max * tau0_s, m_max
@@ -248,24 +225,24 @@ def allan_analysis(
     *,
     taus: Any = "octave",
     confidence: float = ONE_SIGMA_CONFIDENCE,
-    deviations: str | None = None,
+    deviations: Sequence[str] | None = None,
     data_type: str = "rate",
     dynamic_s: float | None = None,
     where: str = "",
     bias_correct: bool = False,
-    noise_type: str | None = None,
+    noise_type: int | None = None,
     noise_id: str | None = None,
     max_work: float | None = None,
 ) -> AllanAnalysis:
     """The stability analysis of the channels ``names`` of ``rec`` (module docstring).
 
-    ``taus``: a named τ set or a list of τ [s] (:func:`parse_taus`); ``deviations``: the
-    comma-separated deviations of :func:`thermocal.stability.family.parse_deviations`
-    (then, or with ``data_type="phase"``, the family replaces the ADEV and noise terms);
+    ``taus``: a named τ set (``octave``, ``decade``, ``log``, ``all``) or a list of τ [s];
+    ``deviations``: registered deviation names (:func:`thermocal.stability.registry.names`;
+    then, or with ``data_type="phase"``, the family replaces the ADEV and noise terms);
     ``dynamic_s``: the dynamic ADEV's window [s] (rate data, ADEV only); ``bias_correct``:
     Stable32's bias correction of totdev and htotdev (the family only); ``noise_type``: the
-    power-law noise the intervals and bias factors assume at every τ instead of the one
-    identified (:func:`thermocal.stability.family.parse_noise_type`; the family only);
+    power-law exponent α the intervals and bias factors assume at every τ instead of the one
+    identified (−4…2, below −2 the Hadamard deviations only; the family only);
     ``noise_id``: the identification's rules, ``thermocal`` (default) or ``stable32`` (the
     family only, :func:`thermocal.stability.family.stability`).  A poor noise-model fit and
     a non-stationary record are :class:`ConditioningWarning` naming ``where`` (and the
@@ -274,7 +251,7 @@ def allan_analysis(
     """
     check_confidence(confidence)
     if data_type not in DATA_TYPES:
-        raise ThermocalInputError(f"--data-type {data_type!r}: use rate or phase")
+        raise ParameterError("data_type", f"{{name}} {data_type!r}: use rate or phase")
     if dynamic_s is not None and (deviations is not None or data_type == "phase"):
         raise ThermocalInputError(
             "--dynamic computes the overlapping ADEV of rate data; run it without --deviation "
@@ -292,10 +269,7 @@ def allan_analysis(
         opt
         for opt, given in (
             ("--bias-correct (totdev, htotdev)", bias_correct),
-            (
-                "--noise-type",
-                noise_type is not None and noise_type.strip().lower() not in ("", "auto"),
-            ),
+            ("--noise-type", noise_type is not None),
             ("--noise-id", noise_id is not None),
         )
         if given
@@ -315,7 +289,7 @@ def allan_analysis(
             channels=len(names), where=where,
         )  # fmt: skip
     channels: dict[str, AllanChannel] = {}
-    for name in names:  # one read of the file, every channel (INTERFACE: several channels)
+    for name in names:  # one read of the file, every channel
         label = where + (f" [{name}]" if len(names) > 1 else "")
         channels[name] = _allan_channel(
             rec, name, taus, confidence, dynamic_s, names.count(name) == 1, label
@@ -328,10 +302,10 @@ def _family(
     names: list[str],
     taus: Any,
     confidence: float,
-    deviations: str | None,
+    deviations: Sequence[str] | None,
     data_type: str,
     bias_correct: bool = False,
-    noise_type: str | None = None,
+    noise_type: int | None = None,
     noise_id: str = "thermocal",
     max_work: float | None = None,
     where: str = "",
@@ -339,8 +313,8 @@ def _family(
     """The deviations of every channel (phase data: the column as given, in its own unit)."""
     from thermocal.stability import family
 
-    devs = family.parse_deviations(deviations or "oadev")
-    alpha = family.parse_noise_type(noise_type, devs)
+    devs = list(dict.fromkeys(deviations or ["oadev"]))
+    alpha = family.check_noise_type(noise_type, devs)
     n_phase = _longest(rec) + (1 if data_type == "rate" else 0)
     check_tau_list(taus, rec.sample_interval_s, n_phase, devs, where)
     results = {}
@@ -382,10 +356,10 @@ def _idle_options(
     """A warning naming ``--bias-correct`` or ``--noise-type`` where it changed nothing: no
     totdev/htotdev asked, a factor of 1 at every τ (Stable32 corrects totdev for flicker and
     random-walk FM only, htotdev for FM noise from m = 2: :func:`.family.stable32_bias`), or
-    no deviation with an interval (MTIE, TIE rms: :data:`.family.NO_INTERVAL`)."""
+    no deviation with an interval (MTIE, TIE rms: :func:`.family.no_interval`)."""
     import numpy as np
 
-    from thermocal.stability.family import NO_INTERVAL
+    from thermocal.stability.family import no_interval
 
     if bias_correct:
         corrected = [d for d in devs if d in BIAS_CORRECTED]
@@ -405,7 +379,7 @@ def _idle_options(
             why = ""
         if why:
             warnings.warn(f"{where}: --bias-correct changes nothing: {why}", ConditioningWarning, 2)
-    if alpha is not None and all(d in NO_INTERVAL for d in devs):
+    if alpha is not None and all(no_interval(d) is not None for d in devs):
         warnings.warn(
             f"{where}: --noise-type changes nothing: no confidence interval or bias factor "
             f"uses it ({', '.join(devs)}: none)",
@@ -428,7 +402,7 @@ def _allan_channel(
     from thermocal.stability import noise_model as nm
     from thermocal.stability.periodic import periodic_terms
 
-    # every figure in the data's own unit (°/s data: ADEV in °/s; INTERFACE common rules)
+    # every figure in the data's own unit (°/s data: ADEV in °/s)
     values, unit = signal_in_data_unit(rec, name)
     check_not_stuck(values, name, where)
     lattice = nm.lattice_step(values)  # before the ADEV overwrites the values
@@ -588,7 +562,6 @@ def imu_noise(
 
 __all__ = [
     "DATA_TYPES",
-    "TAU_SETS",
     "AllanAnalysis",
     "AllanChannel",
     "ImuNoise",
@@ -596,6 +569,5 @@ __all__ = [
     "column_unit",
     "imu_noise",
     "nonstationary_message",
-    "parse_taus",
     "signal_in_data_unit",
 ]

@@ -48,26 +48,6 @@ ndimage = LazyModule("scipy.ndimage")
 FloatArray = npt.NDArray[np.float64]
 IntArray = npt.NDArray[np.int64]
 
-DEVIATIONS: Final = (
-    "oadev",
-    "adev",
-    "mdev",
-    "tdev",
-    "hdev",
-    "ohdev",
-    "totdev",
-    "mtotdev",
-    "ttotdev",
-    "htotdev",
-    "theo1",
-    "mtie",
-    "tierms",
-)
-"""Names accepted by ``--deviation``, as in NIST SP 1065 / allantools / Stable32."""
-
-TIME_DEVIATIONS: Final = frozenset({"tdev", "ttotdev", "mtie", "tierms"})
-"""Deviations in phase units (unit·s for rate data) rather than in rate units."""
-
 _BLOCK: Final = 1 << 22
 """Elements per block of the O(N·m) kernels (mtotdev, htotdev, theo1)."""
 
@@ -268,7 +248,7 @@ def modified_sum(x: FloatArray, m: int, n_terms: int, lane: FloatArray | None = 
     at j + m and loses the one at j), a running sum carried from block to block of
     :data:`_MOD_CHUNK` terms.  Every partial sum is a v_j itself, as small as the deviation:
     rounding grows as ε √N relative, not as ε N² |x| / |v| as a running sum of the phase
-    does (issue 42).  At m = 1, v_j is the second difference itself (no running sum): MDEV
+    does.  At m = 1, v_j is the second difference itself (no running sum): MDEV
     is OADEV to the last digit; at m = 2, 4, 8 the window sums of the second differences
     are taken by doubling (pairwise, log₂ m adds a term).  ``lane``: x in the layout of
     :func:`lane_layout`, for m a multiple of :data:`_LANES` (:func:`_lane_modified_sum`)."""
@@ -812,8 +792,6 @@ def centred(x: FloatArray, *, inplace: bool = False) -> FloatArray:
 
 
 __all__ = [
-    "DEVIATIONS",
-    "TIME_DEVIATIONS",
     "as_phase",
     "centred",
     "max_factor",

@@ -167,12 +167,56 @@ def _basic_sum(j: int, m_terms: float, s: float, f: float, alpha: int, d: int) -
 def greenhall_edf(
     alpha: int, d: int, m: int, n_phase: int, *, overlapping: bool, modified: bool
 ) -> float:
-    """EDF of a finite-difference variance (Greenhall & Riley 2003, eqs. 11–13, Tables 1–3).
+    r"""Equivalent degrees of freedom of a finite-difference variance.
 
-    ``d`` = 2 for the Allan family (ADEV, OADEV, MDEV, TDEV), 3 for Hadamard (HDEV, OHDEV);
-    ``overlapping``: stride S = m (else 1); ``modified``: filter factor F = 1 (else m).
-    Needs α + 2d > 1.  L = m/F + m d phase points per term, M = 1 + ⌊S(N − L)/m⌋ terms,
-    J = min(M, (d+1)S), r = M/S.  Returns NaN when N < L (no term).
+    Parameters
+    ----------
+    alpha : int
+        Power-law noise exponent α (S_y(f) ∝ f^α); needs α + 2d > 1.
+    d : int
+        Order of the phase difference: 2 for the Allan family (ADEV, OADEV, MDEV, TDEV),
+        3 for the Hadamard family (HDEV, OHDEV).
+    m : int
+        Averaging factor (τ = m τ0).
+    n_phase : int
+        Phase points N.
+    overlapping : bool
+        Stride S = 1 (every start), else S = m.
+    modified : bool
+        Filter factor F = 1 (MDEV, TDEV), else F = m.
+
+    Returns
+    -------
+    float
+        The EDF ν; NaN when N < L (no term).
+
+    Raises
+    ------
+    ValueError
+        α + 2d ≤ 1 (the variance does not converge).
+
+    Notes
+    -----
+    The EDF of a variance estimate V is the ν of the chi-square law with its mean and
+    variance,
+
+    .. math:: \nu = \frac{2\,(\mathrm{E}\,V)^2}{\mathrm{Var}\,V},
+
+    evaluated by Greenhall & Riley's algorithm (eqs. 11–13, Tables 1–3) with L = m/F + m d
+    phase points per term, M = 1 + ⌊S(N − L)/m⌋ terms, J = min(M, (d+1)S) and r = M/S.
+
+    References
+    ----------
+    .. [1] C. A. Greenhall and W. J. Riley, "Uncertainty of stability variances based on
+       finite differences", Proc. 35th PTTI Meeting, 2003.
+
+    Examples
+    --------
+    White FM, overlapping Allan variance of 1001 phase points at m = 1 (Stable32 prints
+    782 for its record PHASE.DAT there):
+
+    >>> round(greenhall_edf(0, 2, 1, 1001, overlapping=True, modified=False), 1)
+    782.0
     """
     f = 1.0 if modified else float(m)
     s = float(m) if overlapping else 1.0
@@ -213,6 +257,11 @@ def greenhall_edf(
                 float(_sz(np.zeros(1), math.inf, alpha, d)[0]) ** 2 * J_MAX
             )
         return 1.0 / inv
+    return _pm_edf(alpha, d, m, j, big_m, s, r)
+
+
+def _pm_edf(alpha: int, d: int, m: int, j: float, big_m: float, s: float, r: float) -> float:
+    """Greenhall & Riley's EDF of an unmodified variance at phase noise (cases 3 and 4)."""
     if alpha == 1:  # case 3: unmodified, flicker PM
         if j <= J_MAX:
             inv = _basic_sum(int(j), big_m, s, float(m), 1, d) / (
@@ -325,8 +374,45 @@ def edf_stable32_simple(n_phase: int, m: int, alpha: int) -> float:
 
 
 def edf_totdev(n_phase: int, m: int, alpha: int) -> float:
-    """Total variance EDF, SP 1065 Table 7: ``b·(N/m) − c`` for α = 0, −1, −2; phase
-    noise (α > 0): :func:`edf_stable32_simple`, as Stable32."""
+    r"""Equivalent degrees of freedom of the total variance.
+
+    Parameters
+    ----------
+    n_phase : int
+        Phase points N.
+    m : int
+        Averaging factor.
+    alpha : int
+        Power-law noise exponent α.
+
+    Returns
+    -------
+    float
+        The EDF ν.
+
+    Notes
+    -----
+    NIST SP 1065 Table 7 for white, flicker and random-walk FM (α = 0, −1, −2; b = 1.50,
+    1.17, 0.93 and c = 0, 0.22, 0.36):
+
+    .. math:: \nu = b\,\frac{N}{m} - c
+
+    Phase noise (α > 0): :func:`edf_stable32_simple`, as Stable32; α < −2: Greenhall's
+    overlapping Allan EDF at α = −2.
+
+    References
+    ----------
+    .. [1] W. J. Riley, "Handbook of Frequency Stability Analysis", NIST SP 1065, 2008.
+    .. [2] D. A. Howe, "The total deviation approach to long-term characterization of
+       frequency stability", IEEE Trans. UFFC 47(5), 2000.
+
+    Examples
+    --------
+    White FM, 1001 phase points, m = 10: 1.5 · 100.1 = 150.15.
+
+    >>> round(edf_totdev(1001, 10, 0), 2)
+    150.15
+    """
     if alpha in _TOT:
         b, c = _TOT[alpha]
         return b * n_phase / m - c
@@ -809,9 +895,8 @@ quantiles of a few degrees of freedom run to 0 or to the double range (an interv
 
 def check_confidence(confidence: float, option: str = "--confidence") -> float:
     """Return ``confidence`` when ``CONFIDENCE_MIN ≤ c ≤ CONFIDENCE_MAX``, else raise
-    :class:`ThermocalInputError` naming ``option`` and the value (issue 39: 1e-300 gave an
-    interval of zero width beside the estimate; NaN, 0 and 1 were refused without the
-    option's name).
+    :class:`ThermocalInputError` naming ``option`` and the value (a confidence of 1e-300
+    would give an interval of zero width beside the estimate).
 
     Parameters
     ----------
@@ -838,9 +923,47 @@ def check_confidence(confidence: float, option: str = "--confidence") -> float:
 def confidence_interval(
     adev: npt.ArrayLike, edf: npt.ArrayLike, confidence: float = ONE_SIGMA_CONFIDENCE
 ) -> tuple[FloatArray, FloatArray]:
-    """Chi-square confidence interval of a deviation (NIST SP 1065 eq. 45).
+    r"""Chi-square confidence interval of a deviation.
 
-    ``σ_low = σ̂ √(edf / χ²_{(1+c)/2}(edf))``, ``σ_high = σ̂ √(edf / χ²_{(1−c)/2}(edf))``.
+    Parameters
+    ----------
+    adev : array_like
+        The deviations σ̂ [any unit].
+    edf : array_like
+        Their equivalent degrees of freedom ν.
+    confidence : float
+        Confidence level p, in (0, 1) (default 0.683, ±1σ).
+
+    Returns
+    -------
+    low, high : numpy.ndarray
+        The bounds [the unit of ``adev``].
+
+    Raises
+    ------
+    thermocal.errors.ThermocalInputError
+        ``confidence`` outside (0, 1).
+
+    Notes
+    -----
+    NIST SP 1065 eq. 45:
+
+    .. math::
+
+        \sigma_{low} = \hat\sigma \sqrt{\nu / \chi^2_{(1+p)/2}(\nu)}, \qquad
+        \sigma_{high} = \hat\sigma \sqrt{\nu / \chi^2_{(1-p)/2}(\nu)}
+
+    References
+    ----------
+    .. [1] W. J. Riley, "Handbook of Frequency Stability Analysis", NIST SP 1065, 2008.
+
+    Examples
+    --------
+    ν = 100 at 95 %: √(100/129.56) and √(100/74.22), the chi-square quantiles of any table:
+
+    >>> lo, hi = confidence_interval([1.0], [100.0], 0.95)
+    >>> round(float(lo[0]), 3), round(float(hi[0]), 3)
+    (0.879, 1.161)
     """
     if not 0.0 < confidence < 1.0:
         raise ThermocalInputError(f"confidence must be in (0, 1), got {confidence!r}")

@@ -16,7 +16,7 @@ mtotdev, ttotdev           SP 1065 Table 8
 htotdev                    SP 1065 §5.2.14 (α = 0, −1, −2), else as ohdev; m = 1 as ohdev
 theo1                      Howe's empirical fits (:func:`.edf.edf_theo1`), α identified
                            at the averaging factor of τ = 0.75 m τ0
-mtie, tierms               none (NaN; JSON ``<name>_interval`` says why: NO_INTERVAL)
+mtie, tierms               none (NaN; JSON ``<name>_interval`` says why: :func:`no_interval`)
 =========================  =========================================================
 
 The EDFs of gap-separated stretches add (independent estimates).
@@ -25,6 +25,7 @@ The EDFs of gap-separated stretches add (independent estimates).
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass, field, replace
 from typing import Final
 
@@ -32,60 +33,63 @@ import numpy as np
 import numpy.typing as npt
 from threadpoolctl import threadpool_limits
 
-from thermocal.errors import MissingValueError, ThermocalInputError
+from thermocal.errors import MissingValueError, ParameterError, ThermocalInputError
 from thermocal.stability import deviations as dv
 from thermocal.stability import edf as ed
+from thermocal.stability import registry
 
 FloatArray = npt.NDArray[np.float64]
 IntArray = npt.NDArray[np.int64]
 
-HADAMARD = frozenset({"hdev", "ohdev", "htotdev"})
 TOTAL = frozenset({"totdev", "mtotdev", "ttotdev", "htotdev"})
 NOISE_IDS: Final = ("thermocal", "stable32")
 """Noise-identification rules (:func:`stability`): thermocal's (B1 against Barnes' theory at
 the number of averages, bounded by the shorter τ's α) or Stable32's."""
 
-NO_INTERVAL: dict[str, str] = {
-    "mtie": "none: MTIE is a maximum over windows, not a variance; no chi-square EDF applies "
-    "and neither NIST SP 1065 nor Stable32 gives it an interval",
-    "tierms": "none: NIST SP 1065 gives TIE rms no EDF",
-}
-"""The deviations whose ``low``/``high`` are NaN, and why (``<name>_interval`` in JSON)."""
+
+def no_interval(name: str) -> str | None:
+    """Why the deviation ``name`` has no interval (its ``low``/``high`` are NaN;
+    ``<name>_interval`` in JSON), or None when it has one."""
+    dev = registry.get(name)
+    return dev.interval if dev.edf is None else None
 
 
 def edf_source(name: str) -> str:
     """Where a deviation's EDF comes from, as the ``<name>_interval`` text states it."""
-    if name == "theo1":
-        return (
-            "Howe's empirical Theo1 EDF (its random-walk FM fit is far too small, the "
-            "interval too wide, beyond τ ≈ 0.2 of the record)"
-        )
-    if name in ("mtotdev", "ttotdev"):
-        return (
-            "Stable32's MTOT EDF (Greenhall's modified-Allan EDF below m = 10, a line in N/m "
-            "above, read from Stable32's bounds)"
-        )
-    if name == "htotdev":
-        return (
-            "SP 1065 Htot EDF from m = 16, Stable32's rule (the simple EDF + 2) below m = 16 "
-            "and at phase noise"
-        )
-    if name == "totdev":
-        return "SP 1065 TOTVAR EDF, Stable32's phase-noise rule (simple EDF + 2)"
-    return "Greenhall/SP 1065 EDF"
+    return registry.get(name).interval
 
 
 @dataclass(frozen=True, eq=False)
 class DeviationCurve:
     """One deviation against τ.
 
-    ``tau_s`` [s] (theo1: 0.75 m τ0), ``m`` averaging factors, ``dev`` [``unit``],
-    ``low``/``high`` its interval (NaN where none), ``edf``, ``n_terms``, ``alpha`` the noise
-    exponent used for the EDF, ``alpha_method`` per τ: ``lag1``, ``b1``, ``b1-rn`` (B1 read
-    phase noise, R(n) split white from flicker PM), ``b1-previous`` (B1 read a higher α than
-    the shorter τ's, which is kept), ``previous`` (too few averages), ``given``; ``bias``
-    the factor ``dev``, ``low`` and ``high`` were multiplied by (:func:`stable32_bias`; None
-    when no correction was asked).
+    Parameters
+    ----------
+    name : str
+        The deviation.
+    tau_s : numpy.ndarray
+        Averaging times τ [s] (theo1: 0.75 m τ0).
+    m : numpy.ndarray
+        Averaging factors.
+    dev : numpy.ndarray
+        The deviation [``unit``].
+    low, high : numpy.ndarray
+        Its interval [``unit``] (NaN where none).
+    edf : numpy.ndarray
+        Equivalent degrees of freedom.
+    n_terms : numpy.ndarray
+        Terms behind each point.
+    alpha : numpy.ndarray
+        The power-law noise exponent used for the EDF.
+    alpha_method : tuple of str
+        Per τ: ``lag1``, ``b1``, ``b1-rn`` (B1 read phase noise, R(n) split white from
+        flicker PM), ``b1-previous`` (B1 read a higher α than the shorter τ's, which is
+        kept), ``previous`` (too few averages), ``given``.
+    unit : str
+        Unit of ``dev``.
+    bias : numpy.ndarray or None
+        The factor ``dev``, ``low`` and ``high`` were multiplied by (:func:`stable32_bias`;
+        None when no correction was asked).
     """
 
     name: str
@@ -104,8 +108,33 @@ class DeviationCurve:
 
 @dataclass(frozen=True, eq=False)
 class StabilityResult:
-    """Deviations of one record: ``curves`` by name, the common ``tau_s``/``m`` (theo1 has its
-    own), ``tau0_s``, ``data_type``, ``confidence``, ``n_segments``, ``n_points``."""
+    """Deviations of one record (:func:`stability`).
+
+    Parameters
+    ----------
+    curves : dict of str to DeviationCurve
+        One curve per deviation, in the order asked.
+    tau_s : numpy.ndarray
+        The common averaging times [s] (theo1 has its own).
+    m : numpy.ndarray
+        The common averaging factors.
+    tau0_s : float
+        Sample interval [s].
+    data_type : str
+        ``rate`` or ``phase``.
+    confidence : float
+        Confidence level of the intervals.
+    n_segments : int
+        Gap-free stretches used.
+    n_points : int
+        Phase points over the stretches.
+    unit : str
+        Unit of the data.
+    notes : tuple of str
+        Remarks on the analysis.
+    noise_id : str
+        The identification rules used (``thermocal`` or ``stable32``).
+    """
 
     curves: dict[str, DeviationCurve]
     tau_s: FloatArray
@@ -149,46 +178,45 @@ def stable32_bias(name: str, alpha: int, m: int, n_phase: int) -> float:
     return 1.0
 
 
-def parse_deviations(spec: str) -> list[str]:
-    """``"oadev,mdev"`` → names, checked against :data:`.deviations.DEVIATIONS`."""
-    names = [s.strip().lower() for s in spec.split(",") if s.strip()]
-    bad = [n for n in names if n not in dv.DEVIATIONS]
-    if bad or not names:
-        raise ThermocalInputError(
-            f"--deviation {spec!r}: unknown {', '.join(bad) or 'empty list'}; use "
-            + ", ".join(dv.DEVIATIONS)
-        )
-    return list(dict.fromkeys(names))
-
-
 NOISE_TYPES: Final = {"wpm": 2, "fpm": 1, "wfm": 0, "ffm": -1, "rwfm": -2, "fwfm": -3, "rrfm": -4}
 """Power-law noise names → α (S_y(f) ∝ f^α; NIST SP 1065 Table 1): white and flicker PM,
 white, flicker and random-walk FM, flicker-walk and random-run FM (Hadamard family only)."""
 
 
-def parse_noise_type(spec: str | None, names: list[str]) -> int | None:
-    """``--noise-type``: ``auto`` (None: identified per τ), a name of :data:`NOISE_TYPES`
-    or α itself (−4…2).  Stable32's noise-type setting: the EDF and the bias corrections
-    use this α at every τ.  α < −2 only for the Hadamard family (hdev, ohdev, htotdev):
-    the Allan-family EDF (Greenhall & Riley 2003) needs α + 2d > 1, d = 2."""
-    if spec is None or spec.strip().lower() in ("", "auto"):
+def check_noise_type(alpha: int | None, names: Sequence[str]) -> int | None:
+    """The power-law exponent α the EDF and bias factors assume at every τ (Stable32's noise
+    type setting), checked for the deviations ``names``.
+
+    Parameters
+    ----------
+    alpha : int or None
+        α (S_y(f) ∝ f^α, NIST SP 1065 Table 1) from −4 to 2; None: identified per τ.
+    names : sequence of str
+        The deviations it is for.
+
+    Returns
+    -------
+    int or None
+        ``alpha``.
+
+    Raises
+    ------
+    ParameterError
+        α outside −4…2, or below −2 for a deviation outside the Hadamard family: the
+        Allan-family EDF (Greenhall & Riley 2003) needs α + 2d > 1 with d = 2.
+    """
+    if alpha is None:
         return None
-    key = spec.strip().lower()
-    try:
-        alpha = NOISE_TYPES[key] if key in NOISE_TYPES else int(key)
-    except ValueError:
-        alpha = 99
-    if not -4 <= alpha <= 2:
-        raise ThermocalInputError(
-            f"--noise-type {spec!r}: use auto, {', '.join(NOISE_TYPES)} or α from -4 to 2"
-        )
-    not_h = [n for n in names if n not in HADAMARD and n not in ("mtie", "tierms")]
+    if isinstance(alpha, bool) or not isinstance(alpha, int | np.integer) or not -4 <= alpha <= 2:
+        raise ParameterError("noise_type", f"{{name}} {alpha!r}: give α from -4 to 2 or None")
+    not_h = [n for n in names if not registry.get(n).hadamard and registry.get(n).edf is not None]
     if alpha < -2 and not_h:
-        raise ThermocalInputError(
-            f"--noise-type {spec!r} (α = {alpha}) is defined for the Hadamard deviations "
-            f"(hdev, ohdev, htotdev) only, not {', '.join(not_h)}"
+        raise ParameterError(
+            "noise_type",
+            f"{{name}} α = {alpha} is defined for the Hadamard deviations (hdev, ohdev, "
+            f"htotdev) only, not {', '.join(not_h)}",
         )
-    return alpha
+    return int(alpha)
 
 
 def factors(
@@ -226,28 +254,14 @@ def factors(
 
 
 def _edf(name: str, alpha: int, m: int, n_phase: int) -> float:
+    """The registered EDF of ``name`` (:mod:`.registry`); NaN where it has none."""
+    edf = registry.get(name).edf
+    if edf is None:
+        return float("nan")
     try:
-        if name == "adev":
-            return ed.greenhall_edf(alpha, 2, m, n_phase, overlapping=False, modified=False)
-        if name == "oadev":
-            return ed.greenhall_edf(alpha, 2, m, n_phase, overlapping=True, modified=False)
-        if name in ("mdev", "tdev"):
-            return ed.greenhall_edf(alpha, 2, m, n_phase, overlapping=True, modified=True)
-        if name == "hdev":
-            return ed.greenhall_edf(alpha, 3, m, n_phase, overlapping=False, modified=False)
-        if name == "ohdev":
-            return ed.greenhall_edf(alpha, 3, m, n_phase, overlapping=True, modified=False)
-        if name == "totdev":
-            return ed.edf_totdev(n_phase, m, alpha)
-        if name in ("mtotdev", "ttotdev"):
-            return ed.edf_mtotdev(n_phase, m, alpha)
-        if name == "htotdev":
-            return ed.edf_htotdev(n_phase, m, alpha)
-        if name == "theo1":
-            return ed.edf_theo1(n_phase, m, alpha)
+        return edf(alpha, m, n_phase)
     except ValueError:
         return float("nan")
-    return float("nan")
 
 
 def _stretches(
@@ -255,7 +269,9 @@ def _stretches(
 ) -> tuple[FloatArray, list[slice], float]:
     """The checked samples, the gap-free stretches giving at least 3 phase points and the
     samples' sum."""
-    y = np.asarray(values, dtype=np.float64).ravel()
+    y = np.asarray(values, dtype=np.float64)
+    if y.ndim != 1:  # a table of axes flattened into one record: a silent wrong number
+        raise ParameterError("values", f"{{name}} must be one-dimensional, got shape {y.shape}")
     if not (math.isfinite(tau0_s) and tau0_s > 0):
         raise ThermocalInputError(f"sample interval τ0 must be positive, got {tau0_s!r}")
     # a NaN or ±inf sample makes the sum non-finite (the sum alone overflowing is rare):
@@ -330,7 +346,7 @@ class _Record:
         shift by a constant; for phase data the frequency offset is gone before the lag-1
         test, which removes nothing else (:func:`.edf.identify_noise`)."""
         if self._centred is None:
-            raw = any(n in ("mtie", "tierms") for n in self.names)
+            raw = any(registry.get(n).raw_phase for n in self.names)
             self._centred = [dv.centred(x, inplace=not raw) for x in self.phases()]
         return self._centred
 
@@ -367,9 +383,9 @@ class _Record:
         if name in ("adev", "hdev") and self.m_max:
             parts = [dv.octave_sums(name, self.levels(i), m) for i in range(len(self.kept))]
         else:
-            raw = name in ("mtie", "tierms")
+            dev = registry.get(name)
             parts = [
-                dv.segment_sums(name, xr if raw else xc, self.tau0_s, m)
+                dev.sums(xr if dev.raw_phase else xc, self.tau0_s, m)
                 for xr, xc in zip(self.phases(), self.centred(), strict=True)
             ]
         return dv.pool(name, parts, m.size)
@@ -437,7 +453,7 @@ def _noise_exponents(
     column), down to 6 averages for the total family and 10 for ADEV and HDEV, never
     bounded by the shorter τ's α; the lag-1 method on rate averages with their mean removed
     (not their line) and r1 normalised as Stable32's (:class:`thermocal.stability.edf.IdRules`)."""
-    dmax = 3 if name in HADAMARD else 2
+    dmax = 3 if registry.get(name).hadamard else 2
     stable32 = noise_id == "stable32"
     b1_min = ed.MIN_B1_GROUPS
     if stable32 and name in TOTAL:
@@ -473,7 +489,7 @@ def _noise_exponents(
         if not stable32 and nid.method == "b1" and i > 0 and alphas[i] > alphas[i - 1]:
             # B1 from 8–29 averages misreads random-walk FM as flicker or white FM in ≈ 40 %
             # of records (α read higher than at the shorter τ, where power-law noise can only
-            # steepen): the shorter τ's α is kept (Monte-Carlo coverage, issue 29 item 3).
+            # steepen): the shorter τ's α is kept (Monte-Carlo coverage).
             # A phase-noise reading split by R(n) (``b1-rn``) is no such misreading (B1 of
             # random-walk FM is ≈ N/2, of PM ≈ 2/3) and stands, as in Stable32 (Sr87 m = 100,
             # PHASE.DAT m = 100: flicker PM after white FM)
@@ -490,7 +506,7 @@ def _pooled_edf(name: str, m: IntArray, alphas: IntArray, sizes: list[int]) -> F
     edf = np.zeros(m.size)
     for n_phase in sizes:
         for i, mm in enumerate(m.tolist()):
-            if mm <= dv.max_factor(name, n_phase):
+            if mm <= registry.get(name).max_factor(n_phase):
                 e = _edf(name, int(alphas[i]), int(mm), n_phase)
                 edf[i] += e if math.isfinite(e) and e > 0 else 0.0
     edf[edf <= 0] = np.nan
@@ -509,11 +525,11 @@ def factor_sets(
     points: ``""`` the common set (every deviation but theo1, up to the largest
     :func:`.deviations.max_factor`), theo1 its own even set (:func:`factors`)."""
     others = [n for n in names if n != "theo1"]
-    top = max(dv.max_factor(n, n_long) for n in others) if others else 1
+    top = max(registry.get(n).max_factor(n_long) for n in others) if others else 1
     sets = {"": factors(taus, tau0_s, top)}
     for name in names:
         sets[name] = (
-            factors(taus, tau0_s, dv.max_factor(name, n_long), theo1=True)
+            factors(taus, tau0_s, registry.get(name).max_factor(n_long), theo1=True)
             if name == "theo1"
             else sets[""]
         )
@@ -538,8 +554,8 @@ def check_work(
     if not math.isfinite(max_work) and max_work > 0:
         return math.nan
     if not max_work > 0:
-        raise ThermocalInputError(f"--max-work {max_work!r}: give a positive operation count")
-    per = {n: sum(dv.work(n, size, sets[n]) for size in sizes) for n in names}
+        raise ParameterError("max_work", f"{{name}} {max_work!r}: give a positive operation count")
+    per = {n: sum(registry.get(n).estimated_work(size, sets[n]) for size in sizes) for n in names}
     total = sum(per.values())
     if total > max_work:
         worst = max(per, key=lambda n: per[n])
@@ -563,6 +579,60 @@ def _ceil2(x: float) -> str:
     return f"{math.ceil(x / e) * e:.2g}"
 
 
+def _check_request(names: list[str], data_type: str, noise_id: str) -> None:
+    """The data type and the identification rules checked for the deviations ``names``."""
+    if data_type not in registry.DATA_TYPES:
+        raise ParameterError("data_type", f"{{name}} {data_type!r}: use rate or phase")
+    if noise_id not in NOISE_IDS:
+        raise ParameterError("noise_id", f"{{name}} {noise_id!r}: use {' or '.join(NOISE_IDS)}")
+    for name in names:
+        if data_type not in registry.get(name).data_types:
+            raise ParameterError(
+                "data_type",
+                f"{{name}} {data_type!r}: {name} takes "
+                + " or ".join(registry.get(name).data_types),
+            )
+
+
+def _curve(
+    name: str,
+    m: IntArray,
+    record: _Record,
+    alpha: int | None,
+    id_cache: dict[tuple[int, int, ed.IdRules], ed.NoiseId],
+    noise_id: str,
+    confidence: float,
+    bias_correct: bool,
+    unit: str,
+) -> DeviationCurve:
+    """One deviation of the record at the factors ``m``, with its interval (:func:`stability`)."""
+    dev, cnt = record.sums(name, m)
+    alphas, methods = _noise_exponents(
+        name, m, record, alpha, id_cache, noise_id, np.asarray(cnt, dtype=np.float64)
+    )
+    edf = _pooled_edf(name, m, alphas, record.sizes)
+    ok = np.isfinite(edf) & np.isfinite(dev)
+    lo = np.full(m.size, np.nan)
+    hi = np.full(m.size, np.nan)
+    if ok.any():  # an EDF ≪ 1 (Theo1's fit at the record's end): χ² quantile 0, high ∞
+        with np.errstate(divide="ignore"):
+            lo_ok, hi_ok = ed.confidence_interval(dev[ok], edf[ok], confidence)
+        lo[ok], hi[ok] = lo_ok, hi_ok
+    bias = None
+    if bias_correct:
+        n_rec = sum(record.sizes) - len(record.sizes) + 1
+        bias = np.array(
+            [stable32_bias(name, int(a), int(mm), n_rec) for a, mm in zip(alphas, m, strict=True)]
+        )
+        dev, lo, hi = dev * bias, lo * bias, hi * bias
+    tau0_s, data_type = record.tau0_s, record.data_type
+    tau = dv.theo1_tau(m, tau0_s) if name == "theo1" else m * float(tau0_s)
+    return DeviationCurve(
+        name, np.asarray(tau, dtype=np.float64), m, dev, lo, hi, edf, cnt, alphas,
+        methods, _unit(name, unit, data_type), bias,
+    )  # fmt: skip
+
+
 def stability(
     values: npt.ArrayLike,
     tau0_s: float,
@@ -579,82 +649,94 @@ def stability(
     max_work: float = DEFAULT_MAX_WORK,
     where: str = "",
 ) -> StabilityResult:
-    """Deviations ``names`` of rate or phase data [unit] sampled every ``tau0_s`` [s].
+    r"""Several deviations of one record of rate or phase data, with chi-square intervals.
 
-    ``max_work``: the budget of arithmetic operations (:func:`check_work`): a request
-    estimated beyond it is refused before any sum is taken (``where``: the file the
-    refusal names).
+    Parameters
+    ----------
+    values : array_like
+        Rate samples [unit] (each the mean over τ0) or phase points [unit].
+    tau0_s : float
+        Sample interval τ0 [s].
+    names : list of str
+        Registered deviations (:func:`thermocal.stability.registry.names`).
+    taus : {"octave", "decade", "log", "all"} or array_like
+        A named τ set or averaging times τ [s].
+    data_type : {"rate", "phase"}
+        What ``values`` are: rate data give deviations in ``unit``, time deviations in
+        ``unit*s``; phase data deviations in ``unit/s``, time deviations in ``unit``.
+    segments : list of slice, optional
+        The gap-free index ranges (default: one), pooled; their EDFs add.
+    unit : str
+        Unit of ``values``.
+    confidence : float
+        Confidence level of the intervals (default 0.683, ±1σ).
+    alpha : int, optional
+        The noise exponent α of the EDF at every τ instead of the identified one.
+    bias_correct : bool
+        Multiply totdev and htotdev by Stable32's bias factor (:func:`stable32_bias`).
+    noise_id : {"thermocal", "stable32"}
+        The identification's rules (:func:`_noise_exponents`).
+    max_work : float
+        Arithmetic operations allowed before the request is refused (:func:`check_work`).
+    where : str
+        The file the refusals name.
 
-    ``segments``: the gap-free index ranges (default: one); ``alpha``: force the noise
-    exponent of the EDF instead of identifying it; ``noise_id``: the identification's rules,
-    ``thermocal`` or ``stable32`` (:func:`_noise_exponents`); ``bias_correct``: totdev and htotdev
-    (value and interval) multiplied by Stable32's bias factor (:func:`stable32_bias`, with
-    the record length summed over the stretches).  Rate data give deviations in ``unit``
-    and time deviations (tdev, ttotdev, mtie, tierms) in ``unit*s``; phase data give
-    deviations in ``unit/s`` and time deviations in ``unit``.
+    Returns
+    -------
+    StabilityResult
+        One :class:`DeviationCurve` per name.
 
-    Rate data at octave τ (every m a power of 2): adev and hdev and the noise identification
-    come from each stretch's octave pyramid of block sums (:func:`.deviations.octave_levels`,
-    O(n) for all τ, no phase array); the same numbers as the phase-difference path.
+    Raises
+    ------
+    thermocal.errors.ThermocalInputError
+        An unknown data type, too few points, a bad τ list, work beyond ``max_work``.
+
+    Notes
+    -----
+    Each deviation is its NIST SP 1065 sum over the phase (:mod:`.deviations`); the interval
+    (SP 1065 eq. 45) is
+
+    .. math:: \left[\hat\sigma\sqrt{\nu/\chi^2_{(1+p)/2}(\nu)},\;
+              \hat\sigma\sqrt{\nu/\chi^2_{(1-p)/2}(\nu)}\right]
+
+    with ν the deviation's EDF for the noise identified per τ (lag-1 autocorrelation,
+    Riley & Greenhall 2004; B1 ratio where few averages remain).
+
+    References
+    ----------
+    .. [1] W. J. Riley, "Handbook of Frequency Stability Analysis", NIST SP 1065, 2008.
+    .. [2] C. A. Greenhall and W. J. Riley, "Uncertainty of stability variances based on
+       finite differences", Proc. 35th PTTI Meeting, 2003.
+
+    Examples
+    --------
+    >>> y = np.random.default_rng(0).normal(0.0, 1.0, 10_000)
+    >>> r = stability(y, 1.0, ["oadev", "mdev"], [1.0, 10.0])
+    >>> [round(float(v), 2) for v in r.curves["oadev"].dev]
+    [1.0, 0.32]
     """
     with threadpool_limits(limits=1, user_api="blas"):  # many short dots: BLAS threads wait
-        if data_type not in ("rate", "phase"):
-            raise ThermocalInputError(f"--data-type {data_type!r}: use rate or phase")
-        if noise_id not in NOISE_IDS:
-            raise ThermocalInputError(f"--noise-id {noise_id!r}: use {' or '.join(NOISE_IDS)}")
+        _check_request(names, data_type, noise_id)
         record = _new_record(values, tau0_s, data_type, segments, names)
         sets = factor_sets(names, taus, tau0_s, max(record.sizes))
         check_work(names, sets, record.sizes, max_work, taus, where)
         m_common = sets[""]
         record.set_octave(m_common)
-        curves: dict[str, DeviationCurve] = {}
         id_cache: dict[tuple[int, int, ed.IdRules], ed.NoiseId] = {}
-        for name in names:
-            m = sets[name]
-            dev, cnt = record.sums(name, m)
-            alphas, methods = _noise_exponents(
-                name, m, record, alpha, id_cache, noise_id, np.asarray(cnt, dtype=np.float64)
-            )
-            edf = _pooled_edf(name, m, alphas, record.sizes)
-            ok = np.isfinite(edf) & np.isfinite(dev)
-            lo = np.full(m.size, np.nan)
-            hi = np.full(m.size, np.nan)
-            if ok.any():  # an EDF ≪ 1 (Theo1's fit at the record's end): χ² quantile 0, high ∞
-                with np.errstate(divide="ignore"):
-                    lo_ok, hi_ok = ed.confidence_interval(dev[ok], edf[ok], confidence)
-                lo[ok], hi[ok] = lo_ok, hi_ok
-            bias = None
-            if bias_correct:
-                n_rec = sum(record.sizes) - len(record.sizes) + 1
-                bias = np.array(
-                    [
-                        stable32_bias(name, int(a), int(mm), n_rec)
-                        for a, mm in zip(alphas, m, strict=True)
-                    ]
-                )
-                dev, lo, hi = dev * bias, lo * bias, hi * bias
-            tau = dv.theo1_tau(m, tau0_s) if name == "theo1" else m * float(tau0_s)
-            curves[name] = DeviationCurve(
-                name, np.asarray(tau, dtype=np.float64), m, dev, lo, hi, edf, cnt, alphas,
-                methods, _unit(name, unit, data_type), bias,
-            )  # fmt: skip
+        curves = {
+            n: _curve(n, sets[n], record, alpha, id_cache, noise_id, confidence, bias_correct, unit)
+            for n in names
+        }
         return StabilityResult(
-            curves=curves,
-            tau_s=np.asarray(m_common * float(tau0_s), dtype=np.float64),
-            m=m_common,
-            tau0_s=float(tau0_s),
-            data_type=data_type,
-            confidence=float(confidence),
-            n_segments=len(record.kept),
-            n_points=int(sum(record.sizes)),
-            unit=unit,
-            noise_id=noise_id,
-        )
+            curves, np.asarray(m_common * float(tau0_s), dtype=np.float64), m_common,
+            float(tau0_s), data_type, float(confidence), len(record.kept),
+            int(sum(record.sizes)), unit, noise_id=noise_id,
+        )  # fmt: skip
 
 
 def _unit(name: str, unit: str, data_type: str) -> str:
     if not unit:
         return ""
     if data_type == "rate":
-        return f"{unit}*s" if name in dv.TIME_DEVIATIONS else unit
-    return unit if name in dv.TIME_DEVIATIONS else f"{unit}/s"
+        return f"{unit}*s" if registry.get(name).time_deviation else unit
+    return unit if registry.get(name).time_deviation else f"{unit}/s"

@@ -249,8 +249,46 @@ def axis_noise(
     confidence: float = 0.6826894921370859,
     taus: Any = "octave",
 ) -> AxisNoise:
-    """Allan analysis (:func:`thermocal.stability.allan.overlapping_adev`, :func:`noise_terms`)
-    of one axis in the data's unit ``unit`` and its continuous-time density and random walk in SI.
+    """The noise of one IMU axis: its Allan analysis in the data's unit and its
+    continuous-time white-noise density and random walk in SI.
+
+    Parameters
+    ----------
+    values : array_like
+        Rate samples of the axis [``unit``] (a gyro's angular rate or an accelerometer's
+        specific force).
+    tau0_s : float
+        Sample interval τ0 [s].
+    name : str
+        The axis (its column).
+    sensor : {"gyro", "accel"}
+        What the axis measures.
+    unit : str
+        Unit of ``values`` (a rate or acceleration unit).
+    segments : list of slice, optional
+        The gap-free index ranges.
+    time_s : array_like, optional
+        Sample times [s] (the record is split at gaps).
+    confidence : float
+        Confidence level of the intervals.
+    taus : {"octave", "decade", "log"} or array_like
+        The τ set of the Allan deviation.
+
+    Returns
+    -------
+    AxisNoise
+        The Allan deviation and terms (:func:`thermocal.stability.allan.overlapping_adev`,
+        :func:`thermocal.stability.allan.noise_terms`), the density [rad/s/√Hz or
+        m/s²/√Hz] and random walk [rad/s²/√Hz or m/s³/√Hz], the output quantisation found.
+
+    Raises
+    ------
+    thermocal.errors.ThermocalInputError
+        A unit that is not the sensor's.
+
+    References
+    ----------
+    .. [1] IEEE Std 952-1997, Annex C.
     """
     u = units.normalize_signal_unit(unit)
     kind_units = units.RATE_UNITS if sensor == "gyro" else units.ACCEL_UNITS
@@ -292,20 +330,57 @@ def noise_model(
     confidence: float = 0.6826894921370859,
     where: str = "",
 ) -> NoiseModel:
-    """Per sensor the largest density and the largest random walk over its axes.
+    """The noise model of an IMU for an estimator: per sensor the largest white-noise
+    density and the largest random walk over its axes (Kalibr's ``imu.yaml`` convention).
 
-    Refused (:class:`ThermocalInputError`): an axis named twice (``--gyro gx,gx,gx``, or a
-    column in both ``--gyro`` and ``--accel``), a ``rostopic`` that is not a ROS graph
-    resource name (:data:`ROS_NAME`).  A :class:`PlausibilityWarning` (naming ``where``)
-    when the update rate or a density lies outside what an IMU has
-    (:func:`implausible`)."""
+    Parameters
+    ----------
+    axes : list of AxisNoise
+        Each axis's continuous-time terms (:func:`axis_noise`).
+    update_rate_hz : float
+        The IMU's sample rate [Hz].
+    inflate : float
+        Factor ≥ 1 every noise value is multiplied by (unmodelled effects; 1: none).
+    rostopic : str
+        The IMU's ROS topic (a ROS graph resource name, :data:`ROS_NAME`).
+    confidence : float
+        Confidence level of the intervals reported.
+    where : str
+        The file the warnings name.
+
+    Returns
+    -------
+    NoiseModel
+        The chosen axis per Kalibr key, and every axis.
+
+    Raises
+    ------
+    thermocal.errors.ThermocalInputError
+        ``inflate`` below 1, ``rostopic`` not a ROS name, an axis named twice.
+
+    Warns
+    -----
+    PlausibilityWarning
+        An update rate or a density outside what an IMU has (:func:`implausible`).
+
+    Notes
+    -----
+    A white-noise density σ_c [unit/√Hz] is the angle (velocity) random walk N, the −½
+    line read at τ = 1 s; a random walk σ_c [unit/s/√Hz] is the rate random walk K, the
+    +½ line read at τ = 3 s (IEEE Std 952-1997 Annex C: σ² = N²/τ + K²τ/3).  Their
+    discrete-time values at the step Δt are σ_c/√Δt and σ_c √Δt.
+
+    References
+    ----------
+    .. [1] IEEE Std 952-1997, Annex C.
+    """
     if not (math.isfinite(inflate) and inflate >= 1.0):
         raise ThermocalInputError(f"--inflate {inflate!r}: give a factor ≥ 1 (1: none)")
     _distinct_axes(axes)
     if not ROS_NAME.fullmatch(rostopic):
         raise ThermocalInputError(
             f"--rostopic {one_line(repr(rostopic))}: not a ROS topic name (a letter, '/' or "
-            "'~', then letters, digits, '_' and '/'; ROS wiki 'Names' 1.1.1), e.g. /imu0"
+            "'~', then letters, digits, '_' and '/'; ROS wiki 'Names' 1.1.1), e.g. /imu0",
         )
     chosen: dict[str, AxisNoise] = {}
     for sensor, prefix in (("gyro", "gyroscope"), ("accel", "accelerometer")):
@@ -592,7 +667,7 @@ def model_json(model: NoiseModel, source: str) -> dict[str, Any]:
     }
 
 
-# --- output quantisation (issue 29 item 2) ---------------------------------------------------
+# --- output quantisation --------------------------------------------------------------------------
 
 QUANT_MIN_LEVELS: Final = 3
 """Distinct output levels a quantised record must show (two levels give no lattice)."""
