@@ -223,7 +223,7 @@ def test_registry_and_bad_params():
         with pytest.raises(ThermocalInputError):
             PolyModel(**kw).fit([run])  # type: ignore[arg-type]
     with pytest.raises(ThermocalInputError, match="does not apply"):
-        PolyModel.from_cli_options({"breakpoints": [25.0]})
+        PolyModel.from_options({"breakpoints": [25.0]})
 
 
 # --- truth recovery on the simulator (SPEC §4a, seed 000) -----------------------------------

@@ -227,7 +227,7 @@ def test_model_file_round_trip(fitted: WarmupModel, tmp_path) -> None:
 
 def test_registry_and_cli_options() -> None:
     assert get_model_class("warmup") is WarmupModel
-    m = WarmupModel.from_cli_options(
+    m = WarmupModel.from_options(
         {
             "start_window_s": 5.0,
             "order": 3,
@@ -239,7 +239,7 @@ def test_registry_and_cli_options() -> None:
     assert (m.start_window_s, m.order, m.t0_order) == (5.0, 3, 2)
     # an option warmup does not take is refused (no longer dropped silently)
     with pytest.raises(ThermocalInputError, match="segments does not apply to model 'warmup'"):
-        WarmupModel.from_cli_options({"segments": 3})
+        WarmupModel.from_options({"segments": 3})
 
 
 # --- range and bad input -----------------------------------------------------------------------

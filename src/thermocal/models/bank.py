@@ -87,6 +87,7 @@ from thermocal.errors import (
     ModelFileError,
     ThermocalInputError,
 )
+from thermocal.families import BANK, FamilyDeclaration
 from thermocal.models.base import (
     ChunkContext,
     ClampOnce,
@@ -248,8 +249,7 @@ class BankModel(TemperatureModel):
     error_metric : ``"max"`` or ``"rms"`` of model − characteristic line.
     """
 
-    family: ClassVar[str] = "bank"
-    C_GENERATOR: ClassVar[str | None] = "thermocal.export.c.bank"
+    declaration: ClassVar[FamilyDeclaration] = BANK
     uses_rate: ClassVar[bool] = False
 
     breakpoints_: list[FloatArray]

@@ -78,6 +78,7 @@ from thermocal.errors import (
     UnitError,
     UnitWarning,
 )
+from thermocal.families import FamilyDeclaration
 from thermocal.recording import FloatArray, Recording
 from thermocal.units import (
     DEFAULT_UNITS,
@@ -521,6 +522,10 @@ class TemperatureModel(ABC):
         """Every family's ``fit`` records the units of its runs (signal, temperature) —
         the model learns its inputs without each family having to."""
         super().__init_subclass__(**kwargs)
+        decl = cls.__dict__.get("declaration")
+        if decl is not None:  # the name and the C generator are the declaration's
+            cls.family = decl.name
+            cls.C_GENERATOR = decl.c_generator
         fit = cls.__dict__.get("fit")
         if fit is None or getattr(fit, "_records_units", False):
             return
@@ -595,27 +600,41 @@ class TemperatureModel(ABC):
 
     C_GENERATOR: ClassVar[str | None] = None
     """The module of :mod:`thermocal.export.c` whose ``generate(ctx)`` writes this family's
-    C code (imported only by ``export-c``); None: no C export."""
+    C code (imported only by ``export-c``); None: no C export.  Set from
+    :attr:`declaration`."""
 
-    CLI_KEYS: ClassVar[Mapping[str, str] | None] = None
-    """``thermocal fit`` option key → constructor parameter; None (every family of the
-    registry): the constructor's own parameter names.  The one option parser,
-    :meth:`from_cli_options`, refuses the rest."""
-
-    @classmethod
-    def cli_keys(cls) -> dict[str, str]:
-        """``thermocal fit`` option key → constructor parameter: :attr:`CLI_KEYS`, else the
-        constructor's own parameter names, in its order."""
-        if cls.CLI_KEYS is not None:
-            return dict(cls.CLI_KEYS)
-        return {p: p for p in cls._param_names()}
+    declaration: ClassVar[FamilyDeclaration]
+    """What the family declares of itself (:class:`~thermocal.families.FamilyDeclaration`):
+    its name, fit options with bounds, data needs, C generator and firmware formats."""
 
     @classmethod
-    def from_cli_options(cls, options: Mapping[str, Any]) -> Self:
-        """Build from the ``thermocal fit`` option dict: ``None`` values are options not
-        given; a given option the family does not take is an input error naming it and
-        the options the family does take (the same rule for every family)."""
-        keys = cls.cli_keys()
+    def from_options(cls, options: Mapping[str, Any]) -> Self:
+        """Build from fit options ``{constructor parameter: value}``, each checked against
+        the family's declared option (type and bounds).
+
+        ``None`` values are options not given; a given option the family does not declare
+        is refused, naming it and the options the family takes (the same rule for every
+        family).
+
+        Parameters
+        ----------
+        options : mapping of str to object
+            Constructor parameters as declared (``{"order": 2, "rate_interval_s": 60.0}``).
+
+        Returns
+        -------
+        TemperatureModel
+            The unfitted model.
+
+        Raises
+        ------
+        thermocal.errors.ThermocalInputError
+            An option the family does not take.
+        thermocal.errors.ParameterError
+            A value of the wrong type or out of its declared bounds, naming the parameter.
+        """
+        decl = cls.declaration
+        keys = [o.name for o in decl.options]
         given = {k: v for k, v in options.items() if v is not None}
         unknown = [k for k in given if k not in keys]
         if unknown:
@@ -624,7 +643,7 @@ class TemperatureModel(ABC):
                 f"option{'s' if len(unknown) > 1 else ''} {', '.join(unknown)} {verb} not apply "
                 f"to model {cls.family!r} (it takes: {', '.join(keys)})"
             )
-        return cls(**{keys[k]: v for k, v in given.items()})
+        return cls(**{k: decl.option(k).check(v) for k, v in given.items()})
 
     def chunk_context(self) -> ChunkContext:
         """The context a chunk needs (:class:`ChunkContext`); the default — all history —

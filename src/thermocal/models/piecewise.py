@@ -71,6 +71,7 @@ from thermocal.errors import (
     ThermocalInputError,
     ThermocalWarning,
 )
+from thermocal.families import PIECEWISE, FamilyDeclaration
 from thermocal.models.base import (
     ChunkContext,
     ClampOnce,
@@ -443,8 +444,7 @@ class PiecewiseModel(TemperatureModel):
         overlap in temperature (:func:`thermocal.models.poly.decide_run_offsets`).
     """
 
-    family: ClassVar[str] = "piecewise"
-    C_GENERATOR: ClassVar[str | None] = "thermocal.export.c.piecewise"
+    declaration: ClassVar[FamilyDeclaration] = PIECEWISE
     uses_rate: ClassVar[bool] = False
 
     breakpoints_: FloatArray

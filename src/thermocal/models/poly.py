@@ -102,6 +102,7 @@ import numpy as np
 
 from thermocal.adequacy import Needs
 from thermocal.errors import ExtrapolationWarning, ModelFileError, ThermocalInputError
+from thermocal.families import POLY, FamilyDeclaration
 from thermocal.models.base import (
     ChunkContext,
     Coefficient,
@@ -216,8 +217,7 @@ class PolyModel(PolyBase):
     noise_threshold : a component below ``rcond`` is kept when ``|uᵢᵀz| > k σ̂`` (None: never).
     """
 
-    family: ClassVar[str] = "poly"
-    C_GENERATOR: ClassVar[str | None] = "thermocal.export.c.poly"
+    declaration: ClassVar[FamilyDeclaration] = POLY
     uses_rate: ClassVar[bool] = True
 
     # -- construction from the command line --

@@ -81,6 +81,7 @@ from thermocal.errors import (
     ModelFileError,
     ThermocalInputError,
 )
+from thermocal.families import WARMUP, FamilyDeclaration
 from thermocal.models.base import (
     ChunkContext,
     Coefficient,
@@ -302,8 +303,7 @@ class WarmupModel(TemperatureModel):
         those offsets as in stage 2.  (``two_stage`` always has a free a0 per run.)
     """
 
-    family: ClassVar[str] = "warmup"
-    C_GENERATOR: ClassVar[str | None] = "thermocal.export.c.warmup"
+    declaration: ClassVar[FamilyDeclaration] = WARMUP
     uses_rate: ClassVar[bool] = False
 
     b_: FloatArray

@@ -7,8 +7,8 @@ Fits one model (one channel) or a calibration of several channels on one or seve
 :func:`thermocal.models.files.save_calibration`) with the data files' names and SHA-256
 checksums.  The family is looked up in the registry
 (:func:`thermocal.models.registry.get_model_class`)
-and built from the options by its one option parser (:meth:`TemperatureModel.from_cli_options`,
-:func:`model_options` gives the keys).  Every file is read once, through
+and built from its declared options (``FitOptions.params``) by its one option parser
+(:meth:`TemperatureModel.from_options`).  Every file is read once, through
 :func:`thermocal.pipeline.reading.load_recording` with the text-log options and ``topic``.
 
 The data are judged before the fit (:func:`thermocal.adequacy.judge`: refused when they cannot
@@ -24,7 +24,7 @@ import dataclasses
 import math
 import re
 import warnings
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, cast
@@ -33,10 +33,16 @@ import numpy as np
 
 from thermocal import units
 from thermocal.defaults import overrides_of
-from thermocal.errors import ConditioningWarning, PlausibilityWarning, ThermocalInputError
+from thermocal.errors import (
+    ConditioningWarning,
+    ParameterError,
+    PlausibilityWarning,
+    ThermocalInputError,
+)
+from thermocal.families import MAX_ORDER, MAX_TERMS
 from thermocal.pipeline.messages import one_line
 from thermocal.pipeline.options import FitOptions
-from thermocal.pipeline.reading import load_recording, split_floats, split_names, text_options
+from thermocal.pipeline.reading import load_recording, split_names, text_options
 from thermocal.readers.station import station_sensor_paths
 
 if TYPE_CHECKING:
@@ -70,65 +76,31 @@ def run_temp_names(rec: _recording.Recording, temps: str | None) -> list[str]:
     return split_names(temps) or list(rec.temperatures)
 
 
-MAX_ORDER = 10
-"""Hard ceiling of ``--order`` (poly: powers of each temperature; warmup: order in ΔT) and
-``--t0-order`` (warmup).  A temperature polynomial of order 10 over a −40…85 °C range
-already has a condition number near 1e9 on scaled variables (each further power loses about
-one digit of the fit's 16); calibration practice (IEEE Std 952/1293, the PX4 and ArduPilot
-thermal calibrations: order 3) stays well below.  The data limit (more coefficients than
-samples or distinct temperatures) is checked once the data are read (``thermocal.adequacy``);
-this ceiling is checked before anything is read or allocated, so that an order of 10²⁰ —
-which typer parses as a Python int — never becomes a list of 10²⁰ terms."""
-
-MAX_TERMS = 200
-"""Hard ceiling of the number of terms in ``--terms`` (poly).  The seed set ``seed000`` has
-9 terms per temperature sensor (37 with four sensors and the constant); 200 terms is five times
-that, and a design matrix of 200 float64 columns costs 1.6 kB per sample (16 GB at 10⁷
-samples), beyond any machine the fit is meant for."""
-
-MAX_SEGMENTS = 100
-"""Hard ceiling of ``--segments`` (piecewise): each segment adds two coefficients and
-needs its own temperature span; 100 segments over a −40…85 °C range is 1.25 °C each, below
-which a segment fits the noise of one soak rather than a temperature effect."""
-
-
-def check_ceilings(
-    order: int | None, t0_order: int | None, segments: int | None, terms: str | None
-) -> None:
-    """Refuse (:class:`ThermocalInputError`, exit 2) an order or term count beyond the hard
-    ceilings :data:`MAX_ORDER`, :data:`MAX_TERMS`, :data:`MAX_SEGMENTS`, before any data is
-    read.  The value is checked, not only its type: typer parses any integer literal."""
-    for option, value, lo, hi in (
-        ("--order", order, 1, MAX_ORDER),
-        ("--t0-order", t0_order, 0, MAX_ORDER),
-        ("--segments", segments, 1, MAX_SEGMENTS),
-    ):
-        if value is not None and not lo <= value <= hi:
-            shown = (
-                str(value)
-                if len(str(value)) <= 24
-                else f"{str(value)[:20]}… ({len(str(value))} digits)"
+def check_terms(terms: str | None) -> None:
+    """Refuse (:class:`~thermocal.errors.ParameterError`, exit 2) a poly term list beyond the
+    hard ceilings: more than :data:`~thermocal.families.MAX_TERMS` terms or a power above
+    :data:`~thermocal.families.MAX_ORDER`, before any data is read (the value is checked,
+    not only its type: an integer literal of any length parses)."""
+    if terms is None:
+        return
+    n = terms.count(",") + 1
+    if n > MAX_TERMS:
+        raise ParameterError("terms", f"{{name}} lists {n} terms; at most {MAX_TERMS} are accepted")
+    for power in _POWER.findall(terms):
+        if len(power) > 3 or int(power) > MAX_ORDER:
+            raise ParameterError(
+                "terms", f"{{name}}: power {power[:20]} is above the ceiling {MAX_ORDER}"
             )
-            raise ThermocalInputError(f"{option} must be between {lo} and {hi}, got {shown}")
-    if terms is not None:
-        n = terms.count(",") + 1
-        if n > MAX_TERMS:
-            raise ThermocalInputError(f"--terms lists {n} terms; at most {MAX_TERMS} are accepted")
-        for power in _POWER.findall(terms):
-            if len(power) > 3 or int(power) > MAX_ORDER:
-                raise ThermocalInputError(
-                    f"--terms: power {power[:20]} is above the ceiling {MAX_ORDER}"
-                )
 
 
 _POWER = re.compile(r"\^\s*(\d+)")
 
 
-def build_model(family: str, options: dict[str, Any]) -> _base.TemperatureModel:
-    """Instantiate a registered family from the CLI option dict by its one option parser
-    (:meth:`TemperatureModel.from_cli_options`: an option the family does not take is
-    refused, for every family)."""
-    return _registry.get_model_class(family).from_cli_options(options)
+def build_model(family: str, options: Mapping[str, Any]) -> _base.TemperatureModel:
+    """Instantiate a registered family from its fit options ``{parameter: value}`` by its
+    one option parser (:meth:`TemperatureModel.from_options`: an option the family does
+    not take is refused, for every family; each value checked against its declaration)."""
+    return _registry.get_model_class(family).from_options(options)
 
 
 def earth_rate_known_input(
@@ -594,34 +566,6 @@ class FitResult:
         }
 
 
-def model_options(o: FitOptions) -> dict[str, Any]:
-    """The family options of ``o`` as :meth:`TemperatureModel.from_cli_options` takes them
-    (keys: ``terms``, ``order``, ``rate_interval_s``, ``rate_method``, ``select`` (the
-    criterion, or None), ``ridge``, ``rcond``, ``solver``, ``noise_threshold``,
-    ``breakpoints`` [°C], ``segments``, ``method``, ``start_window_s``, ``t0_order``,
-    ``deviation``, ``tolerance``, ``startup_s``, ``per_run_offset``)."""
-    return {
-        "terms": o.terms,
-        "order": o.order,
-        "rate_interval_s": o.rate_interval,
-        "rate_method": o.rate_method,
-        "select": o.select_method if o.select else None,
-        "ridge": o.ridge,
-        "rcond": o.rcond,
-        "solver": o.solver,
-        "noise_threshold": o.noise_threshold,
-        "breakpoints": split_floats(o.breakpoints, "--breakpoints"),
-        "segments": o.segments,
-        "method": o.method,
-        "start_window_s": o.start_window,
-        "t0_order": o.t0_order,
-        "deviation": o.deviation,
-        "tolerance": o.tolerance,
-        "startup_s": o.startup_s,
-        "per_run_offset": o.per_run_offset,
-    }
-
-
 def _distinct_runs(paths: Sequence[Path]) -> None:
     """Refuse a run given twice, by name or as a byte-for-byte copy (the same SHA-256): it
     would count twice, its samples weighing double and the standard errors shrunk by √2
@@ -638,48 +582,29 @@ def _distinct_runs(paths: Sequence[Path]) -> None:
 
 
 def _check_numbers(o: FitOptions) -> None:
-    """Refuse the numeric options no fit can use, naming the option (issue 39 audit): a
-    latitude outside ±90° (the earth rate Ω·sin φ of a latitude of 200° is that of −20°),
-    NaN or infinite ``--ridge``/``--known-input``, a ``--rate-interval`` ≤ 0, a negative or
-    NaN ``--rcond``/``--noise-threshold`` (they silently switched the SVD truncation
-    off), and ``--breakpoints`` holding no number (a piecewise fit without breakpoints
-    is one straight line)."""
+    """Refuse the numeric options no fit can use, naming the option: a latitude outside
+    ±90° (the earth rate Ω·sin φ of a latitude of 200° is that of −20°) and a NaN or
+    infinite ``known_input``.  The family's own options are checked by their declarations
+    (:meth:`thermocal.families.FamilyOption.check`)."""
     if o.latitude is not None and not -90.0 <= o.latitude <= 90.0:
         raise ThermocalInputError(f"--latitude must be within ±90°, got {o.latitude}")
-    for opt, value in {"--ridge": o.ridge, "--known-input": o.known_input}.items():
-        if value is not None and not np.isfinite(value):
-            raise ThermocalInputError(f"{opt} must be a finite number, got {value}")
-    if o.rate_interval is not None and not (np.isfinite(o.rate_interval) and o.rate_interval > 0):
-        raise ThermocalInputError(
-            f"--rate-interval must be a finite number of seconds > 0, got {o.rate_interval}"
-        )
-    for opt, value in {"--rcond": o.rcond, "--noise-threshold": o.noise_threshold}.items():
-        if value is not None and not (np.isfinite(value) and value >= 0.0):
-            raise ThermocalInputError(f"{opt} must be a finite number ≥ 0, got {value}")
-    if o.breakpoints is not None and not split_floats(o.breakpoints, "--breakpoints"):
-        raise ThermocalInputError(
-            f"--breakpoints {o.breakpoints!r} holds no temperature: give them as 25,30 [°C], "
-            "or --segments N to choose them from the data"
-        )
+    if o.known_input is not None and not np.isfinite(o.known_input):
+        raise ThermocalInputError(f"--known-input must be a finite number, got {o.known_input}")
 
 
 def _check_options(paths: Sequence[Path], o: FitOptions, output: Path) -> dict[str, Any]:
     """Everything refused before a file is read: target, ceilings, output name, family
-    options; returns the family options (:func:`model_options`)."""
+    options; returns the family options (``o.params``)."""
     if o.target not in TARGETS:
         raise ThermocalInputError(f"--target must be bias or scale_factor, got {o.target!r}")
-    check_ceilings(o.order, o.t0_order, o.segments, o.terms)
+    options = dict(o.params)
+    check_terms(options.get("terms"))
     if not paths:
         raise ThermocalInputError("give at least one data file")
     _writers.check_not_input(output, list(paths))
     if output.suffix.lower() not in (".json", ""):
         raise ThermocalInputError(f"{output}: the model file is JSON; use a .json name")
     _check_numbers(o)
-    options = model_options(o)
-    if o.select_method not in ("bic", "holdout"):
-        raise ThermocalInputError(
-            f"--select-method must be bic or holdout, got {o.select_method!r}"
-        )
     build_model(o.model, options)  # refuse options that do not apply before reading
     if len(split_names(o.signal) or []) > 1 and o.axis is not None:
         raise ThermocalInputError(
@@ -750,13 +675,9 @@ def fit_files(paths: Sequence[Path], options: FitOptions, output: Path) -> FitRe
 
 
 __all__ = [
-    "MAX_ORDER",
-    "MAX_SEGMENTS",
-    "MAX_TERMS",
     "FitResult",
     "FittedChannel",
     "build_model",
-    "check_ceilings",
+    "check_terms",
     "fit_files",
-    "model_options",
 ]

@@ -93,6 +93,9 @@ OPTION_OF: dict[str, str] = {
     "rate_hz": "--rate",
     "signals": "--signal",
     "temperatures": "--temps",
+    "rate_interval_s": "--rate-interval",
+    "start_window_s": "--start-window",
+    "select": "--select-method",
 }
 """Library parameters whose command-line option is not the parameter's name with dashes
 (``time_unit`` → ``--time-unit`` needs no entry)."""
