@@ -1935,7 +1935,7 @@ MUTANTS: tuple[Mutant, ...] = (
     ),
     Mutant(
         "bounds-model-file-special-unchecked",
-        P + "models/filecheck.py",
+        P + "pipeline/model_filecheck.py",
         "refuse_special_input(p, what)",
         "None",
         WORK_BOUNDS,
@@ -2835,7 +2835,7 @@ MUTANTS: tuple[Mutant, ...] = (
     ),
     Mutant(
         "h39mp-save-calibration-unchecked",
-        P + "models/files.py",
+        P + "pipeline/model_file.py",
         "        calibration_from_dict(json.loads(json.dumps(d)), str(path))",
         "        pass",
         H39MP,

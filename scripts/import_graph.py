@@ -31,7 +31,7 @@ LAYERS: dict[str, int] = {
     "stability": 2, "models": 2, "compensate.kernels": 2, "simulate": 2, "turntable": 2,
     "multipos": 2, "datasets": 2, "compensate": 2,
     # 3 files: reading, writing, model files, the drivers that stream files
-    "readers": 3, "writers": 3, "models.files": 3, "models.filecheck": 3, "compensate.files": 3,
+    "readers": 3, "writers": 3, "compensate.files": 3,
     "validation": 3, "export": 3, "tempcal": 3,
     "station": 3, "pipeline": 3, "turntable.files": 3, "multipos.files": 3,
     # 4 presentation and batch drivers

@@ -11,11 +11,11 @@ import pytest
 
 from thermocal.cli import main
 from thermocal.errors import ThermocalInputError
-from thermocal.models.files import load_model
 from thermocal.models.piecewise import PiecewiseModel
 from thermocal.models.poly import PolyModel
 from thermocal.models.registry import MODEL_REGISTRY
 from thermocal.pipeline.fit import build_model
+from thermocal.pipeline.model_file import load_model
 from thermocal.recording import Recording
 from thermocal.writers import write_recording
 

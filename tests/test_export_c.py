@@ -29,8 +29,8 @@ from thermocal.export.c import (
     run_harness,
 )
 from thermocal.models.base import RunData, TemperatureModel
-from thermocal.models.files import load_model, load_model_dict, save_model
 from thermocal.models.registry import MODEL_REGISTRY, make_model
+from thermocal.pipeline.model_file import load_model, load_model_dict, save_model
 from thermocal.simulate import SCENARIOS
 
 N_SAMPLES = 100_000

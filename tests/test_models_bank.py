@@ -19,7 +19,7 @@ from thermocal.models.bank import (
     pwl_evaluate,
 )
 from thermocal.models.base import ModelStream, RunData
-from thermocal.models.files import load_model, save_model
+from thermocal.pipeline.model_file import load_model, save_model
 from thermocal.simulate import SCENARIOS
 
 OFFSETS = (0.0, 1.5, -2.0)

@@ -18,8 +18,8 @@ from thermocal.errors import (
     ThermocalWarning,
 )
 from thermocal.models import RunData, get_model_class
-from thermocal.models.files import load_model, save_model
 from thermocal.models.piecewise import PiecewiseModel, evaluate_lines
+from thermocal.pipeline.model_file import load_model, save_model
 from thermocal.simulate import SCENARIOS
 
 BPS = np.array([23.6, 30.0])

@@ -10,8 +10,8 @@ import numpy as np
 import pytest
 
 from thermocal.errors import ThermocalInputError
-from thermocal.models.files import load_calibration
 from thermocal.multipos.files import MultiposOptions, calibrate_files
+from thermocal.pipeline.model_file import load_calibration
 from thermocal.simulate import SimulateOptions, simulate_scenario
 from thermocal.writers import write_recording
 

@@ -17,8 +17,8 @@ from thermocal.export.c import generate_c, generate_c_calibration
 from thermocal.export.c.files import ExportCResult, export_c_file
 from thermocal.models.base import RunData, model_file_dict
 from thermocal.models.calibration import Calibration, Channel
-from thermocal.models.files import save_calibration, save_model
 from thermocal.models.registry import make_model
+from thermocal.pipeline.model_file import save_calibration, save_model
 
 N = 4000
 SLOPES = {"gx": 0.02, "gy": -0.05}

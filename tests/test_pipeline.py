@@ -201,7 +201,7 @@ FIT_MODULES = ["pipeline/fit.py", "pipeline/reading.py", "cli/fit_cmd.py", "adeq
 VALIDATE_MODULES = ["pipeline/validate.py", "pipeline/reading.py", "cli/validate_cmd.py",
                     "readers/[!p]*.py",
                     "validation.py", "compensate/kernels.py", "models/base.py",
-                    "models/files.py", "models/calibration.py"]  # fmt: skip
+                    "pipeline/model_file.py", "models/calibration.py"]  # fmt: skip
 DESCRIBED = {"the known input given (--known-input)", "--encoder-unit", " --axis "}
 """Texts naming a ``fit`` option the model recorded (what it was given), not advice; and the
 unit option of the encoder-angle role (units.py's table of roles), which only ``turntable``

@@ -28,8 +28,8 @@ from scipy.signal import lfilter
 
 from thermocal.errors import ThermocalInputError
 from thermocal.models.base import Coefficient, FitStats, ModelStream, RunData, TemperatureModel
-from thermocal.models.files import save_model
 from thermocal.models.registry import MODEL_REGISTRY
+from thermocal.pipeline.model_file import save_model
 from thermocal.recording import FloatArray, Metadata, Recording
 from thermocal.report import (
     ModelEntry,
@@ -671,7 +671,7 @@ def test_apply_model_uses_the_fit_provenance_for_the_earth_rate(
     """A model fitted with the earth rate removed (``--latitude/--axis``) and one fitted on
     the raw output both give the same bias after compensation in the report."""
     from thermocal.cli import main
-    from thermocal.models.files import load_model_dict
+    from thermocal.pipeline.model_file import load_model_dict
     from thermocal.report.build import apply_model, known_input_of
 
     n = 4000

@@ -21,7 +21,7 @@ from typing import TYPE_CHECKING, Any
 from thermocal._version import __version__
 
 if TYPE_CHECKING:
-    from thermocal.models.files import load_calibration, load_model, save_model
+    from thermocal.pipeline.model_file import load_calibration, load_model, save_model
     from thermocal.readers.dispatch import read_recording
     from thermocal.recording import Metadata, Recording
     from thermocal.writers import write_recording
@@ -41,9 +41,9 @@ def __getattr__(name: str) -> Any:
 
         return writers.write_recording
     if name in ("load_model", "save_model", "load_calibration"):
-        from thermocal.models import files
+        from thermocal.pipeline import model_file
 
-        return getattr(files, name)
+        return getattr(model_file, name)
     if name in ("Metadata", "Recording"):  # numpy: imported on first use too
         from thermocal import recording
 

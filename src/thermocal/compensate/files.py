@@ -1431,7 +1431,7 @@ def compensate_calibration_file(
     (:func:`thermocal.units.temperature_conversion`).  A calibration with both triads and
     channels is refused (:class:`ThermocalInputError`).
     """
-    from thermocal.models.files import load_calibration
+    from thermocal.pipeline.model_file import load_calibration
 
     check_not_input(out, [path, model_file])
     if file_kind(Path(out)) == "csv":  # the CSV's sidecar must not land on an input either

@@ -627,7 +627,7 @@ def export_params_file(
     (:func:`thermocal.export.checks.check_firmware_adequacy`, ArduPilot's minimum sweep
     too).  ``device_id``: the PX4 device id of both the gyro and the accelerometer."""
     from thermocal.export.checks import check_firmware_adequacy
-    from thermocal.models.files import load_calibration
+    from thermocal.pipeline.model_file import load_calibration
     from thermocal.writers import atomic_write, check_not_input
 
     check_not_input(output, [calibration])

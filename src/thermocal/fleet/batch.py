@@ -253,7 +253,7 @@ def channel_figures(
     The fit's figures are read from the file through the model loader (checksum verified),
     in the model's unit, and multiplied by the factor of :func:`shown_unit`; validation
     figures come in the unit that ``validate`` names and are converted the same way."""
-    from thermocal.models.files import load_calibration
+    from thermocal.pipeline.model_file import load_calibration
 
     cal = load_calibration(calibration)
     vals = _per_channel(validation, cal.names)
@@ -400,7 +400,7 @@ def verify_unit_folder(folder: Path, rec: Mapping[str, Any]) -> list[str]:
     """What is wrong with a unit's folder (empty: it verifies): every file ``unit.json``
     lists is present with its recorded SHA-256, and ``calibration.json`` loads through the
     model loader (format, version, checksum)."""
-    from thermocal.models.files import load_calibration
+    from thermocal.pipeline.model_file import load_calibration
 
     problems: list[str] = []
     files = rec.get("files")

@@ -3,8 +3,8 @@
 Fits one model (one channel) or a calibration of several channels on one or several runs
 (several files = several runs, each with its own turn-on offset unless
 ``per_run_offset=False``) and writes the self-describing model file
-(:func:`thermocal.models.files.save_model`; several channels:
-:func:`thermocal.models.files.save_calibration`) with the data files' names and SHA-256
+(:func:`thermocal.pipeline.model_file.save_model`; several channels:
+:func:`thermocal.pipeline.model_file.save_calibration`) with the data files' names and SHA-256
 checksums.  The family is looked up in the registry
 (:func:`thermocal.models.registry.get_model_class`)
 and built from its declared options (``FitOptions.params``) by its one option parser
@@ -50,9 +50,9 @@ if TYPE_CHECKING:
     import thermocal.gravity as _gravity
     import thermocal.models.base as _base
     import thermocal.models.calibration as _calibration
-    import thermocal.models.files as _files
     import thermocal.models.poly as _poly
     import thermocal.models.registry as _registry
+    import thermocal.pipeline.model_file as _files
     import thermocal.recording as _recording
     import thermocal.writers as _writers
 else:
@@ -63,7 +63,7 @@ else:
     _base = LazyModule("thermocal.models.base")
     _registry = LazyModule("thermocal.models.registry")
     _calibration = LazyModule("thermocal.models.calibration")
-    _files = LazyModule("thermocal.models.files")
+    _files = LazyModule("thermocal.pipeline.model_file")
     _poly = LazyModule("thermocal.models.poly")
     _gravity = LazyModule("thermocal.gravity")
     _recording = LazyModule("thermocal.recording")

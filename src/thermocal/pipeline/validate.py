@@ -255,7 +255,7 @@ def _validate_channels(ctx: _Context, cal: Calibration) -> ValidationReport:
 def _own_session(cal: Calibration, file: Path) -> None:
     """A warning when ``file`` is a session the triads were calibrated on (its SHA-256
     among their ``data``): its figures are the fit's residuals, not an independent test."""
-    from thermocal.models.files import file_sha256
+    from thermocal.pipeline.model_file import file_sha256
 
     known = {d.get("sha256") for t in cal.triads for d in t.data}
     if known and file_sha256(file) in known:
@@ -312,7 +312,7 @@ def validate_files(
     docstring): correlation r, bias stability and repeatability over the hold stages, rms and
     peak-to-peak, before and after compensation, in the data's own unit
     (:func:`thermocal.validation.validate`); triads: dwell-mean and move-angle errors."""
-    from thermocal.models.files import load_calibration
+    from thermocal.pipeline.model_file import load_calibration
 
     o = options if options is not None else ValidateOptions()
     pre = load_calibration(calibration)

@@ -143,7 +143,7 @@ def make_report(
     Input errors (:class:`ThermocalInputError`): counts that do not match, the output
     being an input, a calibration of channels given with other models.
     """
-    from thermocal.models.files import load_calibration
+    from thermocal.pipeline.model_file import load_calibration
     from thermocal.writers import check_not_input
 
     opts = read or ReadOptions()
@@ -253,7 +253,7 @@ def _models_report(
 ) -> ReportResult:
     """Model files reported and compared: both runs read with the same options (what they
     warn shown in the report too, issue 25)."""
-    from thermocal.models.files import load_model_dict
+    from thermocal.pipeline.model_file import load_model_dict
     from thermocal.report.build import ModelEntry, ReportInputs, write_report
 
     with bar("building report", 3) as advance:

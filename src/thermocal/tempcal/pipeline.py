@@ -371,7 +371,7 @@ class OutputSet:
     def commit(self, calibration: Calibration, params_name: str, params_text: str) -> None:
         """Write the reports left (:meth:`finish_reports`), ``calibration.json`` and the
         parameter file, then move the set into place."""
-        from thermocal.models.files import save_calibration
+        from thermocal.pipeline.model_file import save_calibration
         from thermocal.writers import atomic_write, commit_directory
 
         self.finish_reports()

@@ -1,4 +1,4 @@
-"""Model and calibration files: the file edge of :mod:`thermocal.models` (issue 15).
+"""Model and calibration files: the file edge of :mod:`thermocal.models`, in the workflow layer.
 
 The maths modules (:mod:`thermocal.models.base`, the families, :mod:`thermocal.models.
 calibration`) build and check plain dicts (:func:`~thermocal.models.base.model_file_dict`,
@@ -27,8 +27,8 @@ from thermocal.models.calibration import (
     guess_role,
     is_calibration,
 )
-from thermocal.models.filecheck import read_json
 from thermocal.models.schema import verify_model_dict
+from thermocal.pipeline.model_filecheck import read_json
 from thermocal.writers import write_json
 
 

@@ -1,4 +1,4 @@
-"""Reading a model or calibration file's JSON within stated bounds (issue 26).
+"""Reading a model or calibration file's JSON within stated bounds.
 
 A model file is read before anything else looks at it, and refused (:class:`ModelFileError`,
 exit 2, naming the file and the key path) when:
