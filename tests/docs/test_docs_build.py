@@ -29,6 +29,7 @@ PAGES = (
     "tutorials/noise-for-estimator",
     "tutorials/fc-params",
     "tutorials/production-batch",
+    "tutorials/notebook-poly",
     "methods",
     "cli",
     "api",

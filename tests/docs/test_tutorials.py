@@ -101,6 +101,7 @@ def test_every_tutorial_is_executed_here() -> None:
         "fc-params.md",  # tests/docs/test_tutorials_b.py
         "multipos-imucal.md",
         "noise-for-estimator.md",  # tests/docs/test_tutorials_a.py
+        "notebook-poly.md",  # tests/docs/test_tutorial_notebook_poly.py
         "production-batch.md",  # tests/docs/test_tutorials_b.py
         "stability-stable32.md",
     ]
