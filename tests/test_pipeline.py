@@ -17,6 +17,7 @@ import pytest
 
 from thermocal.cli import main
 from thermocal.pipeline.fit import fit_files
+from thermocal.pipeline.messages import option_name
 from thermocal.pipeline.options import (
     ALIASES,
     FitOptions,
@@ -51,7 +52,11 @@ def test_fit_files_recovers_the_bias_and_slope(tmp_path: Path) -> None:
     3 standard errors of a straight-line fit to white noise (σ/√n and σ/(√n·std T))."""
     _write(tmp_path / "mod.csv", RAMP, 1)
     opts = FitOptions(
-        model="poly", params={"order": 1}, signal="gyro [deg/h]", temps="T1 [degC]", tref=25.0
+        model="poly",
+        params={"order": 1},
+        signals=("gyro [deg/h]",),
+        temperatures=("T1 [degC]",),
+        tref=25.0,
     )
     res = fit_files([tmp_path / "mod.csv"], opts, tmp_path / "m.json")
     assert not res.calibration and res.output.is_file()
@@ -84,7 +89,11 @@ def test_validate_files_figures_against_a_hand_computation(tmp_path: Path) -> No
     _write(tmp_path / "mod.csv", RAMP, 1)
     val = _write(tmp_path / "val.csv", SINE, 2)
     opts = FitOptions(
-        model="poly", params={"order": 1}, signal="gyro [deg/h]", temps="T1 [degC]", tref=25.0
+        model="poly",
+        params={"order": 1},
+        signals=("gyro [deg/h]",),
+        temperatures=("T1 [degC]",),
+        tref=25.0,
     )
     fit = fit_files([tmp_path / "mod.csv"], opts, tmp_path / "m.json")
     coefs = {c["name"]: c["value"] for c in fit.channels[0].figures["tref"]["coefficients"]}
@@ -166,7 +175,8 @@ def _long_options(name: str) -> dict[str, bool]:
 
 @pytest.mark.parametrize(("command", "cls"), [("fit", FitOptions), ("validate", ValidateOptions)])
 def test_the_options_dataclass_is_the_command(command: str, cls: type) -> None:
-    fields = {"--" + f.name.replace("_", "-") for f in dataclasses.fields(cls)} - {"--params"}
+    # each field is its option (option_name: signals is --signal, rate_hz is --rate)
+    fields = {option_name(f.name) for f in dataclasses.fields(cls)} - {"--params"}
     if command == "fit":  # the families' declared options, and none besides
         fields |= {"--" + name for name in family_option_kinds()}
     aliases = {"--" + a for a in ALIASES.get(command, {})}
@@ -178,7 +188,7 @@ def test_a_table_gives_the_options_and_the_arguments() -> None:
     table = {"model": "poly", "order": 2, "signal": ["gx", "gy"], "select": True, "ridge": 0.5}
     opts, args = options_from_table("fit", table, "cfg [fit]")
     assert opts == FitOptions(
-        model="poly", params={"order": 2, "select": "bic", "ridge": 0.5}, signal="gx,gy"
+        model="poly", params={"order": 2, "select": "bic", "ridge": 0.5}, signals=("gx", "gy")
     )
     assert args == ["--model", "poly", "--order", "2", "--signal", "gx,gy", "--select",
                     "--ridge", "0.5"]  # fmt: skip
@@ -272,7 +282,9 @@ def test_the_fleet_figures_are_what_fit_and_validate_give(tmp_path: Path) -> Non
 
     _write(tmp_path / "mod.csv", RAMP, 1)
     _write(tmp_path / "val.csv", SINE, 2)
-    opts = FitOptions(model="poly", params={"order": 1}, signal="gyro [deg/h]", temps="T1 [degC]")
+    opts = FitOptions(
+        model="poly", params={"order": 1}, signals=("gyro [deg/h]",), temperatures=("T1 [degC]",)
+    )
     fit = fit_files([tmp_path / "mod.csv"], opts, tmp_path / "m.json")
     with pytest.warns(UserWarning, match="temperature-hold stage"):
         rep = validate_files(tmp_path / "m.json", tmp_path / "val.csv")

@@ -42,7 +42,7 @@ def _annotations() -> dict[str, Any]:
 
 def test_every_family_option_is_a_fit_option_of_its_type_and_nothing_else_is() -> None:
     params, types = _fit_params(), _annotations()
-    common = {"--" + f.name.replace("_", "-") for f in dataclasses.fields(FitOptions)}
+    common = {option_name(f.name) for f in dataclasses.fields(FitOptions)}
     common = (common - {"--params"}) | {"--output", "--json"}
     declared: set[str] = set()
     for decl in BUILTIN_FAMILIES:

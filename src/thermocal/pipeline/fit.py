@@ -42,7 +42,7 @@ from thermocal.errors import (
 from thermocal.families import MAX_ORDER, MAX_TERMS
 from thermocal.pipeline.messages import one_line
 from thermocal.pipeline.options import FitOptions
-from thermocal.pipeline.reading import load_recording, split_names, text_options
+from thermocal.pipeline.reading import load_recording, text_options
 from thermocal.readers.station import station_sensor_paths
 
 if TYPE_CHECKING:
@@ -68,12 +68,10 @@ else:
     _gravity = LazyModule("thermocal.gravity")
     _recording = LazyModule("thermocal.recording")
 
-TARGETS = ("bias", "scale_factor")
 
-
-def run_temp_names(rec: _recording.Recording, temps: str | None) -> list[str]:
-    """The temperature columns a fit uses: ``--temps`` or the file's."""
-    return split_names(temps) or list(rec.temperatures)
+def run_temp_names(rec: _recording.Recording, temps: Sequence[str] | None) -> list[str]:
+    """The temperature columns a fit uses: those named, or the file's."""
+    return list(temps or ()) or list(rec.temperatures)
 
 
 def check_terms(terms: str | None) -> None:
@@ -147,7 +145,7 @@ class _FitSpec:
 
     family: str
     options: dict[str, Any]
-    temps: str | None
+    temps: tuple[str, ...] | None
     latitude: float | None
     axis: str | None
     known_input: float | None
@@ -277,7 +275,7 @@ def _prepare_channel(
             if g_in.record is not None:  # export-params reads whether it was measured
                 first_inputs["known_input"]["gravity"] = g_in.record
         run = _base.RunData.from_recording(
-            rec, signal, split_names(temps), known_input=ki, temperature_unit="auto"
+            rec, signal, list(temps) if temps else None, known_input=ki, temperature_unit="auto"
         )
         run = dataclasses.replace(run, name=path.name)
         if temp_names is None:
@@ -593,10 +591,8 @@ def _check_numbers(o: FitOptions) -> None:
 
 
 def _check_options(paths: Sequence[Path], o: FitOptions, output: Path) -> dict[str, Any]:
-    """Everything refused before a file is read: target, ceilings, output name, family
-    options; returns the family options (``o.params``)."""
-    if o.target not in TARGETS:
-        raise ThermocalInputError(f"--target must be bias or scale_factor, got {o.target!r}")
+    """Everything refused before a file is read: ceilings, output name, family options;
+    returns the family options (``o.params``)."""
     options = dict(o.params)
     check_terms(options.get("terms"))
     if not paths:
@@ -606,7 +602,7 @@ def _check_options(paths: Sequence[Path], o: FitOptions, output: Path) -> dict[s
         raise ThermocalInputError(f"{output}: the model file is JSON; use a .json name")
     _check_numbers(o)
     build_model(o.model, options)  # refuse options that do not apply before reading
-    if len(split_names(o.signal) or []) > 1 and o.axis is not None:
+    if len(o.signals or ()) > 1 and o.axis is not None:
         raise ThermocalInputError(
             "earth-rate removal (--axis) takes one signal at a time: each gyro's sensitive "
             "axis points elsewhere; fit the gyros one by one with their --axis, or leave the "
@@ -615,44 +611,39 @@ def _check_options(paths: Sequence[Path], o: FitOptions, output: Path) -> dict[s
     return options
 
 
+def _read(path: Path, o: FitOptions) -> _recording.Recording:
+    """One run's file, read with the fit's reading fields."""
+    joined = {k: ",".join(v) if v else None for k, v in (("signal", o.signals),
+              ("temps", o.temperatures), ("names", o.names))}  # fmt: skip
+    return load_recording(
+        path, time=o.time, time_unit=o.time_unit, signal=joined["signal"],
+        temps=joined["temps"], signal_unit=o.signal_unit, temp_unit=o.temp_unit,
+        temp_conversion=cast(Any, o.temp_conversion),  # the reader takes the parsed form too
+        text=text_options(joined["names"], o.rate_hz, o.on_bad_lines, o.delimiter, o.decimal),
+        topic=o.topic,
+    )  # fmt: skip
+
+
 def fit_files(paths: Sequence[Path], options: FitOptions, output: Path) -> FitResult:
     """Fit ``options.model`` on the recordings ``paths`` (one run each) and save it to
     ``output`` (module docstring).  Options are checked before any file is read
     (:class:`ThermocalInputError`); each file is read once with every channel's column."""
     o = options
     family_options = _check_options(paths, o, output)
-    names = split_names(o.signal) or []
+    names = list(o.signals or ())
     g_local = _local_gravity(o.gravity_axis, o.gravity, o.latitude)
-    text = text_options(o.names, o.rate, o.on_bad_lines, o.delimiter, o.decimal)
-    loaded = [
-        (
-            path,
-            load_recording(
-                path,
-                time=o.time,
-                time_unit=o.time_unit,
-                signal=o.signal,
-                temps=o.temps,
-                signal_unit=o.signal_unit,
-                temp_unit=o.temp_unit,
-                temp_conversion=o.temp_conversion,
-                text=text,
-                topic=o.topic,
-            ),
-        )
-        for path in station_sensor_paths(paths, o.topic)
-    ]
+    loaded = [(path, _read(path, o)) for path in station_sensor_paths(paths, o.topic)]
     if o.tref is not None and o.model != "poly":
         raise ThermocalInputError(
             f"--tref applies to the poly family (coefficients about TREF), not {o.model!r}"
         )
     _distinct_runs([path for path, _rec in loaded])
-    spec = _FitSpec(o.model, family_options, o.temps, o.latitude, o.axis, o.known_input,
+    spec = _FitSpec(o.model, family_options, o.temperatures, o.latitude, o.axis, o.known_input,
                     o.target, o.gravity_axis, g_local, o.tref,
                     _gravity.triad_gravity(loaded, names, o.gravity_axis, g_local),
                     overrides_of(o.allow_narrow, o.allow_motion))  # fmt: skip
     if len(names) <= 1:
-        est, result, n_runs = _fit_channel(spec, loaded, o.signal)
+        est, result, n_runs = _fit_channel(spec, loaded, names[0] if names else None)
         _files.save_model(est, output)
         result["output"] = str(output)
         return FitResult(output, (FittedChannel(est.signal_name, est, result, n_runs),), False)

@@ -14,37 +14,112 @@ from __future__ import annotations
 
 import dataclasses
 import typing
-from collections.abc import Mapping
+from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, TypeVar
+from typing import TYPE_CHECKING, Any, Literal, TypeVar
 
 from thermocal.defaults import DEFAULT_AVERAGING_S
-from thermocal.errors import ThermocalInputError
+from thermocal.errors import ParameterError, ThermocalInputError, UnitError
 from thermocal.families import FamilyOption, fit_option_table
+from thermocal.pipeline.messages import option_name
+
+if TYPE_CHECKING:  # numpy and the readers: imported when used (``fit --help`` loads neither)
+    from thermocal.readers.options import ReadOptions
+    from thermocal.units import TemperatureConversion
+
+TARGETS = ("bias", "scale_factor")
+"""What a fit's model describes."""
+
+
+def _names(value: str | Iterable[str] | None, parameter: str) -> tuple[str, ...] | None:
+    """``"a, b"`` or ``["a", "b"]`` → ``("a", "b")``; None or no name → None."""
+    if value is None:
+        return None
+    items = value.split(",") if isinstance(value, str) else list(value)
+    if not all(isinstance(v, str) for v in items):
+        raise ParameterError(parameter, f"{{name}} holds column names, got {value!r}")
+    return tuple(v.strip() for v in items if v.strip()) or None
 
 
 @dataclass(frozen=True)
 class FitOptions:
     """The options of a fit (:func:`thermocal.pipeline.fit.fit_files`, ``thermocal fit``).
 
-    ``model`` names the family and ``params`` holds its options by constructor parameter,
-    as the family declares them (:class:`thermocal.families.FamilyOption`:
-    ``{"order": 2, "rate_interval_s": 60.0}``, ``{"breakpoints": (25.0, 30.0)}``); each
-    is checked against its declared type and bounds before a file is read.  The other
-    fields apply to every family, and how the files are read.
+    Parameters
+    ----------
+    model : str
+        The family (``"poly"``, ``"piecewise"``, ``"warmup"``, ``"bank"`` or a plugin's).
+    params : mapping of str to object
+        The family's options by constructor parameter, as the family declares them
+        (:class:`thermocal.families.FamilyOption`: ``{"order": 2, "rate_interval_s": 60.0}``,
+        ``{"breakpoints": (25.0, 30.0)}``); each is checked against its declared type and
+        bounds before a file is read.
+    signals : tuple of str, optional
+        The signal columns; several make a calibration of one model per channel.  A
+        comma-separated text is accepted and stored as a tuple.
+    temperatures : tuple of str, optional
+        The temperature columns (default: the file's), as ``signals``.
+    time, time_unit, signal_unit, temp_unit : str, optional
+        The time column and the units of the columns (default: the file's).
+    temp_conversion : TemperatureConversion, optional
+        Raw counts → °C, :math:`T = g\\,v + o` (the text ``"GAIN,OFFSET[,int16]"`` is
+        accepted).
+    target : {"bias", "scale_factor"}
+        What the model describes.
+    latitude : float, optional
+        Test-site latitude [°]; with ``axis``, the earth rate seen by a gyro's axis is a
+        known input.
+    axis : str, optional
+        A gyro's sensitive axis (``"up"``, ``"north"``, … or ``"e,n,u"``).
+    known_input : float, optional
+        Any other known input, in the canonical signal unit ([°/h] or [mg]).
+    gravity_axis : str, optional
+        Accelerometers: the body axis pointing up (``"+z"``); its gravity is a known input.
+    gravity : float, optional
+        Local gravity [m/s²] (default: WGS-84 normal gravity at ``latitude``).
+    tref : float, optional
+        poly: also give the coefficients about this reference temperature [°C].
+    allow_narrow, allow_motion : bool
+        Fit even where the data fail the adequacy tests (with a warning recorded).
+    names : tuple of str, optional
+        Column names of a text log without a header row.
+    topic : str, optional
+        Flight-controller log topic, or a station recording's sensor.
+    rate_hz : float, optional
+        Sample rate [Hz] of a log without a time column.
+    on_bad_lines : {"error", "skip"}
+        A mangled line of a text log: an error naming it, or dropped and counted.
+    delimiter : str, optional
+        Field separator of a text log (detected when None).
+    decimal : {".", ","}, optional
+        Decimal mark of a text log (detected when None).
+
+    Raises
+    ------
+    thermocal.errors.ParameterError
+        A target, column list or temperature conversion no fit can use, naming the field.
+
+    Examples
+    --------
+    >>> from thermocal.pipeline.options import FitOptions
+    >>> o = FitOptions("poly", {"order": 2}, signals="gx, gy", temperatures=["T1"])
+    >>> o.signals, o.temperatures
+    (('gx', 'gy'), ('T1',))
+    >>> o.read_options.signals
+    ('gx', 'gy')
     """
 
     model: str
     params: Mapping[str, Any] = dataclasses.field(default_factory=dict)
-    signal: str | None = None
-    temps: str | None = None
+    signals: tuple[str, ...] | None = None
+    temperatures: tuple[str, ...] | None = None
     time: str | None = None
     time_unit: str | None = None
     signal_unit: str | None = None
     temp_unit: str | None = None
-    temp_conversion: str | None = None
-    target: str = "bias"
+    temp_conversion: TemperatureConversion | None = None
+    target: Literal["bias", "scale_factor"] = "bias"
     latitude: float | None = None
     axis: str | None = None
     known_input: float | None = None
@@ -54,12 +129,28 @@ class FitOptions:
     allow_narrow: bool = False
     allow_motion: bool = False
     # how the files are read (text logs, ULog)
-    names: str | None = None
+    names: tuple[str, ...] | None = None
     topic: str | None = None
-    rate: float | None = None
-    on_bad_lines: str = "error"
+    rate_hz: float | None = None
+    on_bad_lines: Literal["error", "skip"] = "error"
     delimiter: str | None = None
-    decimal: str | None = None
+    decimal: Literal[".", ","] | None = None
+
+    def __post_init__(self) -> None:
+        set_ = object.__setattr__  # frozen: normalise in place once
+        for field in ("signals", "temperatures", "names"):
+            set_(self, field, _names(getattr(self, field), field))
+        if self.temp_conversion is not None:
+            set_(self, "temp_conversion", _conversion(self.temp_conversion))
+        if self.target not in TARGETS:
+            raise ParameterError(
+                "target", f"{{name}} must be bias or scale_factor, got {self.target!r}"
+            )
+
+    @property
+    def read_options(self) -> ReadOptions:
+        """How the files are read (:class:`thermocal.readers.options.ReadOptions`)."""
+        return _read_options(self)
 
 
 @dataclass(frozen=True)
@@ -91,6 +182,42 @@ class ValidateOptions:
     latitude: float | None = None
     static_s: float = 1.0
 
+    @property
+    def read_options(self) -> ReadOptions:
+        """How the files are read (:class:`thermocal.readers.options.ReadOptions`; the
+        signal column named, the temperatures the file's)."""
+        return _read_options(self)
+
+
+def _conversion(value: object) -> TemperatureConversion:
+    """A temperature conversion from its text or tuple, refused naming ``temp_conversion``."""
+    from thermocal.units import temperature_conversion
+
+    try:
+        return temperature_conversion(value, "{name}")
+    except UnitError as exc:
+        raise ParameterError("temp_conversion", str(exc)) from None
+
+
+def _read_options(o: FitOptions | ValidateOptions) -> ReadOptions:
+    """The :class:`ReadOptions` of a fit's or a validation's reading fields."""
+    from thermocal.readers.options import ReadOptions
+
+    signals: Any  # ReadOptions takes a column list's text too (a validation's fields)
+    names: Any
+    if isinstance(o, FitOptions):
+        signals, temperatures, names, rate = o.signals, o.temperatures, o.names, o.rate_hz
+    else:
+        signals, temperatures, names, rate = o.signal, None, o.names, o.rate
+    conversion: Any = o.temp_conversion
+    return ReadOptions(
+        time=o.time, time_unit=o.time_unit, signals=signals, temperatures=temperatures,
+        signal_unit=o.signal_unit, temp_unit=o.temp_unit, temp_conversion=conversion,
+        topic=o.topic, names=names, rate_hz=rate,
+        on_bad_lines=o.on_bad_lines,  # type: ignore[arg-type]
+        delimiter=o.delimiter, decimal=o.decimal,  # type: ignore[arg-type]
+    )  # fmt: skip
+
 
 ALIASES: dict[str, dict[str, str]] = {
     "fit": {"sensor": "topic"},
@@ -110,14 +237,16 @@ O = TypeVar("O", FitOptions, ValidateOptions)
 def option_kinds(cls: type[Any]) -> dict[str, str]:
     """``{option name: "flag" | "int" | "float" | "str" | "path"}`` of an options dataclass
     (option names with dashes)."""
-    hints = typing.get_type_hints(cls)
+    from thermocal.units import TemperatureConversion
+
+    hints = typing.get_type_hints(cls, localns={"TemperatureConversion": TemperatureConversion})
     out: dict[str, str] = {}
     for f in dataclasses.fields(cls):
         if f.name == "params":  # the family's options: :func:`family_option_kinds`
             continue
         args = set(typing.get_args(hints[f.name])) - {type(None)} or {hints[f.name]}
         kind = next(iter(args))
-        name = f.name.replace("_", "-")
+        name = option_name(f.name)[2:]
         out[name] = {bool: "flag", int: "int", float: "float", Path: "path"}.get(kind, "str")
     return out
 
@@ -157,9 +286,15 @@ def family_params(values: Mapping[str, Any]) -> dict[str, Any]:
 
 
 def options_of(cls: type[O], values: Mapping[str, Any]) -> O:
-    """The options dataclass from a mapping holding at least its fields (a command's
-    parameters, named as the fields)."""
-    return cls(**{f.name: values[f.name] for f in dataclasses.fields(cls) if f.name in values})
+    """The options dataclass from a command's parameters, named as its options without
+    dashes (``signal`` gives the field ``signals``, ``rate`` the field ``rate_hz``:
+    :func:`thermocal.pipeline.messages.option_name`)."""
+    out: dict[str, Any] = {}
+    for f in dataclasses.fields(cls):
+        key = option_name(f.name)[2:].replace("-", "_")
+        if key in values:
+            out[f.name] = values[key]
+    return cls(**out)
 
 
 def _table_text(key: str, value: Any, where: str) -> str:
@@ -219,6 +354,7 @@ def options_from_table(command: str, table: Mapping[str, Any], where: str) -> tu
     family option (``per_run_offset``) set to false is ``--no-per-run-offset``."""
     cls = OPTIONS[command]
     kinds = _table_kinds(command)
+    fields = {option_name(f.name)[2:]: f.name for f in dataclasses.fields(cls)}
     aliases = ALIASES.get(command, {})
     known = {n: n for n in kinds if n.replace("-", "_") not in NOT_IN_TABLES}
     known |= {a: t for a, t in aliases.items()}
@@ -231,7 +367,7 @@ def options_from_table(command: str, table: Mapping[str, Any], where: str) -> tu
                 f"{where}: {key!r} is not an option of thermocal {command}; it takes "
                 + ", ".join(sorted(known))
             )
-        field = known[name].replace("-", "_")
+        field = fields.get(known[name], known[name].replace("-", "_"))
         kind = kinds[known[name]]
         if kind in ("flag", "tristate"):
             flag_args, values[field] = _table_flag(name, kind, value, where)
@@ -247,7 +383,7 @@ def options_from_table(command: str, table: Mapping[str, Any], where: str) -> tu
     ]
     for f in required:
         if f not in values:
-            raise ThermocalInputError(f"{where}: Missing option '--{f.replace('_', '-')}'.")
+            raise ThermocalInputError(f"{where}: Missing option '{option_name(f)}'.")
     if command == "fit":
         own = {f.name for f in dataclasses.fields(cls)}
         values = {k: v for k, v in values.items() if k in own} | {"params": family_params(values)}
