@@ -34,8 +34,8 @@ import pandas as pd
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from bench_fit import make_data
 from thermocal.compensate.files import compensate_channels
-from thermocal.models.base import RunData
 from thermocal.models.poly import PolyModel, fit_shared
+from thermocal.models.rundata import RunData
 
 NAMES = ("g1", "g2", "g3", "g4", "g5", "g6")
 

@@ -28,8 +28,8 @@ import pandas as pd
 
 from thermocal.compensate.files import StreamingCompensator, compensate_file, compensate_run
 from thermocal.export.c import exercise_inputs, find_compiler, generate_c
-from thermocal.models.base import RunData
 from thermocal.models.registry import make_model
+from thermocal.models.rundata import RunData
 from thermocal.pipeline.model_file import load_model_dict, save_model
 from thermocal.simulate import SCENARIOS
 

@@ -148,7 +148,7 @@ def test_corrupt_calibration_is_refused_naming_the_channel(
     imu: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     from thermocal.errors import ModelFileError
-    from thermocal.models.base import checksum
+    from thermocal.models.format import checksum
     from thermocal.pipeline.model_file import load_calibration
 
     cal_path = tmp_path / "cal.json"

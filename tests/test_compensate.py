@@ -38,8 +38,10 @@ from thermocal.errors import (
     TimestampError,
     UnitError,
 )
-from thermocal.models.base import Coefficient, FitStats, ModelStream, RunData, TemperatureModel
+from thermocal.models.base import ModelStream, TemperatureModel
 from thermocal.models.registry import MODEL_REGISTRY, make_model
+from thermocal.models.results import Coefficient, FitStats
+from thermocal.models.rundata import RunData
 from thermocal.preprocess import temperature_rate
 from thermocal.readers.common import csv_float_options
 from thermocal.recording import GAP_FACTOR, FloatArray

@@ -18,7 +18,8 @@ from thermocal.models.bank import (
     hat_basis,
     pwl_evaluate,
 )
-from thermocal.models.base import ModelStream, RunData
+from thermocal.models.base import ModelStream
+from thermocal.models.rundata import RunData
 from thermocal.pipeline.model_file import load_model, save_model
 from thermocal.simulate import SCENARIOS
 

@@ -10,7 +10,8 @@ import pytest
 
 from thermocal.errors import DesignError, ExtrapolationWarning, ThermocalInputError
 from thermocal.models import get_model_class
-from thermocal.models.base import ModelStream, RunData
+from thermocal.models.base import ModelStream
+from thermocal.models.rundata import RunData
 from thermocal.models.warmup import WarmupModel, running_start_mean
 from thermocal.pipeline.model_file import load_model, save_model
 

@@ -27,8 +27,10 @@ from numpy.testing import assert_allclose
 from scipy.signal import lfilter
 
 from thermocal.errors import ThermocalInputError
-from thermocal.models.base import Coefficient, FitStats, ModelStream, RunData, TemperatureModel
+from thermocal.models.base import ModelStream, TemperatureModel
 from thermocal.models.registry import MODEL_REGISTRY
+from thermocal.models.results import Coefficient, FitStats
+from thermocal.models.rundata import RunData
 from thermocal.pipeline.model_file import save_model
 from thermocal.recording import FloatArray, Metadata, Recording
 from thermocal.report import (

@@ -19,8 +19,10 @@ import pytest
 
 from thermocal.cli import main
 from thermocal.errors import CorrelationWarning, ExtrapolationWarning, ThermocalWarning
-from thermocal.models.base import Coefficient, FitStats, ModelStream, RunData, TemperatureModel
+from thermocal.models.base import ModelStream, TemperatureModel
 from thermocal.models.registry import MODEL_REGISTRY, make_model
+from thermocal.models.results import Coefficient, FitStats
+from thermocal.models.rundata import RunData
 from thermocal.pipeline.model_file import save_model
 from thermocal.profiles import common_base
 from thermocal.recording import FloatArray, Recording

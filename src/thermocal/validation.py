@@ -41,7 +41,7 @@ not a copy of the modelling test's:
    constant offset the model adds (a model fitted at 13 °C applied at 47 °C).
 7. **Applicability**: the share of samples outside the model's calibrated temperature
    range (and Ṫ range, and time since power-on for warm-up models) and how far
-   (:class:`~thermocal.models.base.RangeExcess`), one warning for the run.
+   (:class:`~thermocal.models.ranges.RangeExcess`), one warning for the run.
 
 All figures are in the model's signal unit ([°/h] or [mg]); :meth:`ValidationResult.in_unit`
 gives them in the data's own unit (``thermocal validate`` does).
@@ -77,15 +77,15 @@ from thermocal.errors import (
     ThermocalWarning,
     TimestampError,
 )
-from thermocal.models.base import (
+from thermocal.models.base import TemperatureModel
+from thermocal.models.ranges import (
     RANGE_WARNING_PATTERNS,
     RangeExcess,
-    RunData,
-    TemperatureModel,
     outside_range,
     outside_range_dict,
     outside_range_message,
 )
+from thermocal.models.rundata import RunData
 from thermocal.preprocess import segment_holds
 from thermocal.profiles import correlate
 from thermocal.recording import FloatArray, median_interval

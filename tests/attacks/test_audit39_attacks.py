@@ -34,7 +34,7 @@ import numpy as np
 import pytest
 
 from thermocal.cli import main
-from thermocal.models.base import checksum
+from thermocal.models.format import checksum
 from thermocal.outputs import TEMP_SUFFIX
 
 sys.path.insert(0, str(Path(__file__).parent.parent))

@@ -437,9 +437,9 @@ def _gyro_cal(path: Path, lo: float, hi: float) -> None:
     """Three gyro channels (°/h), a cubic in T fitted over ``lo``…``hi`` °C."""
     import warnings
 
-    from thermocal.models.base import RunData
     from thermocal.models.calibration import Calibration, Channel
     from thermocal.models.poly import PolyModel
+    from thermocal.models.rundata import RunData
     from thermocal.pipeline.model_file import save_calibration
 
     temp = np.linspace(lo, hi, 400)

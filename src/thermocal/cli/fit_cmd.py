@@ -71,10 +71,12 @@ if TYPE_CHECKING:
     import rich.table as _rich_table
 
     import thermocal.models.base as _base
+    import thermocal.models.results as _results
     import thermocal.pipeline.fit as _fit
 else:
     _rich_table = LazyModule("rich.table")
     _base = LazyModule("thermocal.models.base")
+    _results = LazyModule("thermocal.models.results")
     _fit = LazyModule("thermocal.pipeline.fit")
 
 FilesArg = Annotated[
@@ -246,7 +248,7 @@ def _human_single(
     tab.add_row("runs / samples", f"{n_runs} / {st.n_samples}")
     tab.add_row("coefficients", str(st.n_coefficients))
     tab.add_row(f"rms residual [{unit}]", fmt(result["rms_residual"]))
-    wording = _base.condition_wording(kappa)
+    wording = _results.condition_wording(kappa)
     tab.add_row("condition number", f"{fmt(st.condition_number)} ({wording})")
     if corr:
         tab.add_row(

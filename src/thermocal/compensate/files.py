@@ -78,12 +78,9 @@ from thermocal.errors import (
     TimestampError,
     UnitError,
 )
-from thermocal.models.base import (
-    ChunkContext,
-    TemperatureModel,
-    check_sensor_id,
-    outside_range_dict,
-)
+from thermocal.models.base import ChunkContext, TemperatureModel
+from thermocal.models.ranges import outside_range_dict
+from thermocal.models.rundata import check_sensor_id
 from thermocal.outputs import refuse_special_input, sidecar_path, warn_formula_names
 from thermocal.readers.common import (
     csv_encoding,
@@ -202,7 +199,7 @@ class CompensateFileResult:
     """The compensation raised the rms about zero or the max |error| by more than 1 %."""
     outside_range: dict[str, Any] = field(default_factory=dict)
     """How far the file leaves the model's calibrated ranges, per input
-    (:func:`~thermocal.models.base.outside_range_dict`)."""
+    (:func:`~thermocal.models.ranges.outside_range_dict`)."""
     outside_calibrated_range: bool = False
 
     def to_dict(self) -> dict[str, Any]:

@@ -41,15 +41,9 @@ from thermocal.errors import (
     UnitError,
     UnitWarning,
 )
-from thermocal.models.base import (
-    ChunkContext,
-    ModelStream,
-    RangeExcess,
-    RangeTally,
-    RunData,
-    TemperatureModel,
-    outside_range_message,
-)
+from thermocal.models.base import ChunkContext, ModelStream, TemperatureModel
+from thermocal.models.ranges import RangeExcess, RangeTally, outside_range_message
+from thermocal.models.rundata import RunData
 from thermocal.recording import GAP_FACTOR, FloatArray, Metadata, Recording, median_interval
 
 # --- unit handling ------------------------------------------------------------------------
@@ -809,7 +803,7 @@ class ChunkPredictor:
     def finish(self) -> None:
         """Issue one :class:`ExtrapolationWarning` for the whole file when samples left the
         calibrated ranges (temperature, Ṫ, time since power-on), saying for what share of
-        the samples and how far (:func:`~thermocal.models.base.outside_range_message`)."""
+        the samples and how far (:func:`~thermocal.models.ranges.outside_range_message`)."""
         self.warn_outside()
 
     @property

@@ -27,9 +27,10 @@ from thermocal.compensate.files import compensate_channels, prepare_run
 from thermocal.compensate.kernels import zero_reference
 from thermocal.errors import ThermocalWarning
 from thermocal.export.c import generate_c_calibration
-from thermocal.models.base import RunData, model_file_dict, model_inputs
 from thermocal.models.calibration import Calibration, Channel, guess_role
+from thermocal.models.format import model_file_dict
 from thermocal.models.poly import PolyModel
+from thermocal.models.rundata import RunData, model_inputs
 from thermocal.pipeline.model_file import save_calibration
 from thermocal.report.calibration import CalibrationReportInputs, write_calibration_report
 from thermocal.simulate import IMU_CHANNELS, SCENARIOS

@@ -6,13 +6,7 @@ The families are listed once, in :data:`thermocal.models.registry.MODEL_REGISTRY
 
 from __future__ import annotations
 
-from thermocal.models.base import (
-    Coefficient,
-    FitStats,
-    ModelStream,
-    RunData,
-    TemperatureModel,
-)
+from thermocal.models.base import ModelStream, TemperatureModel
 from thermocal.models.registry import (
     MODEL_REGISTRY,
     get_model_class,
@@ -20,6 +14,8 @@ from thermocal.models.registry import (
     model_from_dict,
     register,
 )
+from thermocal.models.results import Coefficient, FitStats
+from thermocal.models.rundata import RunData
 
 __all__ = [
     "MODEL_REGISTRY",

@@ -91,10 +91,7 @@ from thermocal.families import BANK, FamilyDeclaration
 from thermocal.models.base import (
     ChunkContext,
     ClampOnce,
-    Coefficient,
-    FitStats,
     ModelStream,
-    RunData,
     TemperatureModel,
     stream_channel,
 )
@@ -108,6 +105,8 @@ from thermocal.models.checks import (
     sensor_param,
     string,
 )
+from thermocal.models.results import Coefficient, FitStats
+from thermocal.models.rundata import RunData
 from thermocal.models.warmup import CONDITION_WARN, channel_index, lstsq_svd, single_channel
 from thermocal.preprocess import segment_holds
 from thermocal.recording import FloatArray

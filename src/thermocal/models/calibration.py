@@ -33,11 +33,8 @@ from typing import Any
 import numpy as np
 
 from thermocal.errors import ModelFileError, ThermocalInputError
-from thermocal.models.base import (
-    TemperatureModel,
-    checksum,
-    model_file_dict,
-)
+from thermocal.models.base import TemperatureModel
+from thermocal.models.format import checksum, model_file_dict
 from thermocal.models.registry import model_from_dict
 from thermocal.models.schema import verify_model_dict
 

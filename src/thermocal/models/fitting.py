@@ -12,11 +12,9 @@ from typing import Any
 import numpy as np
 
 from thermocal.errors import ConditioningWarning, ExtrapolationWarning, ThermocalInputError
-from thermocal.models.base import (
-    FitStats,
-    RunData,
-    TemperatureModel,
-)
+from thermocal.models.base import TemperatureModel
+from thermocal.models.results import FitStats
+from thermocal.models.rundata import RunData
 from thermocal.models.terms import (
     CHUNK_ROWS,
 )

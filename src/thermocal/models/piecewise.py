@@ -75,10 +75,7 @@ from thermocal.families import PIECEWISE, FamilyDeclaration
 from thermocal.models.base import (
     ChunkContext,
     ClampOnce,
-    Coefficient,
-    FitStats,
     ModelStream,
-    RunData,
     TemperatureModel,
     stream_channel,
 )
@@ -99,6 +96,8 @@ from thermocal.models.fitting import (
     record_ranges,
 )
 from thermocal.models.residuals import MAX_SAMPLES_PER_SERIES, residual_correlation
+from thermocal.models.results import Coefficient, FitStats
+from thermocal.models.rundata import RunData
 from thermocal.models.terms import CHUNK_ROWS, Chunk, LstsqSolution, accumulate_r, solve_r
 from thermocal.recording import FloatArray
 

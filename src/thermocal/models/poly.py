@@ -103,12 +103,7 @@ import numpy as np
 from thermocal.adequacy import Needs
 from thermocal.errors import ExtrapolationWarning, ModelFileError, ThermocalInputError
 from thermocal.families import POLY, FamilyDeclaration
-from thermocal.models.base import (
-    ChunkContext,
-    Coefficient,
-    ModelStream,
-    RunData,
-)
+from thermocal.models.base import ChunkContext, ModelStream
 from thermocal.models.checks import (
     boolean,
     fields,
@@ -173,6 +168,8 @@ from thermocal.models.poly_types import PolyBase
 from thermocal.models.poly_types import (
     build_plan as build_plan,
 )
+from thermocal.models.results import Coefficient
+from thermocal.models.rundata import RunData
 from thermocal.models.terms import (
     BaseScaling,
     Term,

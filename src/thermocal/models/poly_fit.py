@@ -13,10 +13,6 @@ import numpy as np
 from threadpoolctl import threadpool_limits
 
 from thermocal.errors import ConditioningWarning, ThermocalInputError
-from thermocal.models.base import (
-    FitStats,
-    RunData,
-)
 from thermocal.models.fitting import (
     SHORT_RATE_WARN_SHARE,
     Block,
@@ -29,6 +25,8 @@ from thermocal.models.fitting import (
 )
 from thermocal.models.poly_types import PolyBase
 from thermocal.models.residuals import MAX_SAMPLES_PER_SERIES, residual_correlation
+from thermocal.models.results import FitStats
+from thermocal.models.rundata import RunData
 from thermocal.models.terms import (
     BaseScaling,
     Chunk,

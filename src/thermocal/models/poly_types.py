@@ -17,8 +17,9 @@ import numpy as np
 import numpy.typing as npt
 
 from thermocal.errors import ThermocalInputError
-from thermocal.models.base import RunData, TemperatureModel
+from thermocal.models.base import TemperatureModel
 from thermocal.models.fitting import Block
+from thermocal.models.rundata import RunData
 from thermocal.models.terms import BaseScaling, Term, segment_rates, temperature_rates
 from thermocal.preprocess import RATE_METHODS
 from thermocal.recording import FloatArray

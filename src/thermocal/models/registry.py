@@ -37,7 +37,8 @@ from thermocal.families import (
     ENTRY_POINT_GROUP,
     FamilyDeclaration,
 )
-from thermocal.models.base import TemperatureModel, check_model_header
+from thermocal.models.base import TemperatureModel
+from thermocal.models.format import check_model_header
 
 
 def _load_class(path: str) -> Any:

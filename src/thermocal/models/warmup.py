@@ -82,14 +82,7 @@ from thermocal.errors import (
     ThermocalInputError,
 )
 from thermocal.families import WARMUP, FamilyDeclaration
-from thermocal.models.base import (
-    ChunkContext,
-    Coefficient,
-    FitStats,
-    ModelStream,
-    RunData,
-    TemperatureModel,
-)
+from thermocal.models.base import ChunkContext, ModelStream, TemperatureModel
 from thermocal.models.checks import (
     fields,
     integer,
@@ -100,6 +93,8 @@ from thermocal.models.checks import (
     sensor_param,
     string,
 )
+from thermocal.models.results import Coefficient, FitStats
+from thermocal.models.rundata import RunData
 from thermocal.recording import FloatArray
 
 DISTINCT_T0_C = 1.0

@@ -52,6 +52,8 @@ if TYPE_CHECKING:
     import thermocal.models.calibration as _calibration
     import thermocal.models.poly as _poly
     import thermocal.models.registry as _registry
+    import thermocal.models.results as _results
+    import thermocal.models.rundata as _rundata
     import thermocal.pipeline.model_file as _files
     import thermocal.recording as _recording
     import thermocal.writers as _writers
@@ -61,6 +63,8 @@ else:
     _adequacy = LazyModule("thermocal.adequacy")
     _writers = LazyModule("thermocal.writers")
     _base = LazyModule("thermocal.models.base")
+    _results = LazyModule("thermocal.models.results")
+    _rundata = LazyModule("thermocal.models.rundata")
     _registry = LazyModule("thermocal.models.registry")
     _calibration = LazyModule("thermocal.models.calibration")
     _files = LazyModule("thermocal.pipeline.model_file")
@@ -182,7 +186,7 @@ class _Prepared:
     """One channel ready to fit: its model, runs and provenance, and the warnings so far."""
 
     est: _base.TemperatureModel
-    runs: list[_base.RunData]
+    runs: list[_rundata.RunData]
     first_inputs: dict[str, Any]
     provenance: list[dict[str, Any]]
     unit: str
@@ -241,7 +245,7 @@ def _prepare_channel(
     """One channel's runs with their known inputs, its model object and provenance."""
     est = build_model(spec.family, spec.options)
     temps, latitude, axis, known_input = spec.temps, spec.latitude, spec.axis, spec.known_input
-    runs: list[_base.RunData] = []
+    runs: list[_rundata.RunData] = []
     first_inputs: dict[str, Any] = {}
     provenance: list[dict[str, Any]] = []
     sensor_ids: list[str | None] = []
@@ -268,13 +272,13 @@ def _prepare_channel(
         if known_input is not None:
             ki += known_input
         if not runs:  # the model learns how its inputs were written (model file "inputs")
-            first_inputs = _base.model_inputs(
+            first_inputs = _rundata.model_inputs(
                 rec, sig_name, run_temp_names(rec, temps), known_input=ki,
                 known_input_what=known_input_what(earth_lat, axis, known_input, g_in.what),
             )  # fmt: skip
             if g_in.record is not None:  # export-params reads whether it was measured
                 first_inputs["known_input"]["gravity"] = g_in.record
-        run = _base.RunData.from_recording(
+        run = _rundata.RunData.from_recording(
             rec, signal, list(temps) if temps else None, known_input=ki, temperature_unit="auto"
         )
         run = dataclasses.replace(run, name=path.name)
@@ -334,7 +338,7 @@ TIME_SCALES = ((1000.0, "ms read as s"), (1.0 / 60.0, "minutes read as s"), (1e-
 
 
 def rate_time_doubts(
-    runs: Sequence[_base.RunData], temp_names: Sequence[str], interval_s: float
+    runs: Sequence[_rundata.RunData], temp_names: Sequence[str], interval_s: float
 ) -> list[str]:
     """Why the time axis of runs fitted with Ṫ terms (``temp_names``) looks wrong, one line
     per (run, column): the largest |Ṫ| (the 99th percentile of Ṫ over ``interval_s``,
@@ -394,7 +398,7 @@ def _data_unit(first_inputs: dict[str, Any], sig_name: str, unit: str) -> tuple[
 def _judge_channel(
     spec: _FitSpec,
     est: _base.TemperatureModel,
-    runs: list[_base.RunData],
+    runs: list[_rundata.RunData],
     sig_name: str,
     first_inputs: dict[str, Any],
     unit: str,
@@ -492,7 +496,7 @@ def _finish_channel(
         "rms_residual": st.rms_residual * to_given,  # in the data's own unit (``unit``)
         "rms_residual_model_unit": st.rms_residual,
         "condition_number": st.condition_number,
-        "condition": _base.condition_wording(kappa),
+        "condition": _results.condition_wording(kappa),
         "temperature_range": trange,
         "rate_range": rrange,
         "n_samples": st.n_samples,

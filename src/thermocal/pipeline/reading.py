@@ -121,7 +121,7 @@ def load_recording(
         temp_conversion=conv, ask_units=ask_units,
     )  # fmt: skip
     if model is not None or model_inputs is not None:
-        from thermocal.models.base import check_sensor_id
+        from thermocal.models.rundata import check_sensor_id
 
         fitted = getattr(model, "inputs_", None) if model is not None else model_inputs
         check_sensor_id(fitted, rec.meta.sensor_id, str(path))

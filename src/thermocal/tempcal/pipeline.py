@@ -32,9 +32,9 @@ import numpy.typing as npt
 
 from thermocal import adequacy, units
 from thermocal.errors import ThermocalInputError, ThermocalWarning
-from thermocal.models.base import RunData, model_inputs
 from thermocal.models.calibration import Calibration, Channel
 from thermocal.models.poly import PolyModel
+from thermocal.models.rundata import RunData, model_inputs
 from thermocal.recording import FloatArray, Recording
 from thermocal.tempcal.ardupilot_baro import ArdupilotBaroReportRequest
 from thermocal.tempcal.binning import BIN_WIDTH_C, MIN_BINS, even_odd_split, temperature_bins

@@ -202,7 +202,7 @@ def _export_calibration(
     its data's unit (``unit`` applies one unit to every channel, or one per channel); or
     the module of its triads."""
     from thermocal import units
-    from thermocal.models.base import model_file_dict
+    from thermocal.models.format import model_file_dict
     from thermocal.pipeline.model_file import load_calibration
 
     cal = load_calibration(path)
