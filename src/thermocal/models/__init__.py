@@ -1,7 +1,10 @@
-"""Temperature-compensation model families (SPEC §4) behind one contract.
+"""Temperature-compensation model families behind one contract.
 
 The families are listed once, in :data:`thermocal.models.registry.MODEL_REGISTRY`:
-``poly`` (SPEC §4a), ``piecewise`` (§4b), ``warmup`` (§4c) and ``bank`` (§4d).
+``poly`` ([Seed-RLG]), ``piecewise`` ([Seed-FOG]), ``warmup`` ([Seed-Plan]) and ``bank``
+([Seed-Accel]); the sources are listed in the References of the methods chapter
+(``docs/methods.md``).  Each family declares its options, data needs and firmware support
+(:mod:`thermocal.families`).
 """
 
 from __future__ import annotations

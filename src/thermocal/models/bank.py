@@ -1,4 +1,4 @@
-"""Adaptive model bank chosen at power-on (SPEC §4d, seed 004, accelerometers).
+"""Adaptive model bank chosen at power-on ([Seed-Accel], accelerometers).
 
 Run-to-run repeatability is poor, so one model does not fit every turn-on.  The
 bank holds one continuous piecewise-linear model of the output against one
@@ -130,7 +130,7 @@ def pwl_evaluate(breakpoints_c: FloatArray, values: FloatArray, temp_c: FloatArr
         f(T) = v_j + (v_{j+1} − v_j)/(x_{j+1} − x_j) · (T − x_j),   x_j ≤ T < x_{j+1}
 
     with the end segments extended linearly outside ``[x_0, x_K]`` (callers clamp
-    first when they do not want to extrapolate).  SPEC §4b/§4d.
+    first when they do not want to extrapolate).  [Seed-FOG], [Seed-Accel].
     """
     x = breakpoints_c
     j = np.clip(np.searchsorted(x, temp_c, side="right") - 1, 0, x.size - 2)
@@ -232,7 +232,7 @@ def _selection(dev: FloatArray, n: int, complete: bool) -> Selection:
 
 class BankModel(TemperatureModel):
     """Bank of piecewise-linear models, one per characteristic curve, chosen at
-    power-on (SPEC §4d, seed 004).
+    power-on ([Seed-Accel]).
 
     Parameters
     ----------
@@ -310,7 +310,7 @@ class BankModel(TemperatureModel):
     # -- fit --
     def fit(self, runs: Sequence[RunData]) -> Self:
         """Group the runs into characteristic curves, fit a piecewise-linear model
-        per group and keep those within ``tolerance`` (SPEC §4d steps 1–3)."""
+        per group and keep those within ``tolerance`` ([Seed-Accel], steps 1–3)."""
         self._check_params()
         if not runs:
             raise ThermocalInputError("bank: no runs to fit")
@@ -546,7 +546,7 @@ class BankModel(TemperatureModel):
         return dev, choice, m
 
     def select(self, run: RunData, *, extrapolate: bool = False) -> Selection:
-        """The model chosen for a power-on from its start-up window (SPEC §4d step 4);
+        """The model chosen for a power-on from its start-up window ([Seed-Accel], step 4);
         also stored in ``selection_``."""
         temp = self._prepare(run, extrapolate)
         f = self._model_matrix(temp[: self._startup_count(run)])

@@ -1,14 +1,14 @@
 """The contract every temperature-compensation model follows, and its file format.
 
-Estimator contract (STYLE.md, after scikit-learn): ``__init__`` only stores its
+Estimator contract (after scikit-learn): ``__init__`` only stores its
 keyword arguments; ``fit(runs)`` validates, learns values whose names end in
 ``_`` and returns ``self``; ``predict(run)`` returns the temperature-induced
-signal (bias, or scale-factor error, SPEC §4e) in the signal's canonical unit;
+signal (bias, or scale-factor error, [Seed-RLG]) in the signal's canonical unit;
 ``get_params()`` returns the constructor arguments.  The families are listed by name in
-the one registry, :data:`thermocal.models.registry.MODEL_REGISTRY` (STYLE rule 8), which
+the one registry, :data:`thermocal.models.registry.MODEL_REGISTRY`, which
 sits above them: this module knows no family.
 
-A model file is a self-describing, versioned JSON object (SPEC §8)::
+A model file is a self-describing, versioned JSON object::
 
     {
       "format": "thermocal-model", "format_version": 3,

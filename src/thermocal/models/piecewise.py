@@ -1,4 +1,4 @@
-"""Piecewise-linear temperature model (SPEC §4b, seed 001, fibre-optic gyro).
+"""Piecewise-linear temperature model ([Seed-FOG], fibre-optic gyro).
 
 For a warmed-up sensor and slow temperature change (no rate terms) the
 temperature-induced signal is a piecewise-linear function of one temperature T
@@ -300,7 +300,7 @@ def choose_breakpoints(
     *,
     per_run_offset: bool = True,
 ) -> BreakpointChoice:
-    """Breakpoints of at most ``n_segments`` segments chosen from the data (SPEC §4b,
+    """Breakpoints of at most ``n_segments`` segments chosen from the data ([Seed-FOG],
     our reading: "a continuous piecewise-linear fit with breakpoints chosen by the data").
 
     The data are reduced to per-run temperature bins (mean T, mean y, count; N_BINS bins
@@ -366,7 +366,7 @@ def segment_tests(
     unit: str = "°C",
 ) -> tuple[AdequacyTest, ...]:
     """Every segment of a fitted piecewise model judged as the line it is, by the common
-    rules of :mod:`thermocal.adequacy` (issue 38: a 0.28 °C segment holding one burst was
+    rules of :mod:`thermocal.adequacy` (a 0.28 °C segment holding one burst was
     fitted and exported): its temperature span (≥ ``MIN_SPAN_PER_ORDER_C`` °C for order 1),
     its distinct temperatures (≥ 2) and its samples per coefficient (≥
     ``MIN_SAMPLES_PER_COEFFICIENT`` for 2), over the samples of every run in
@@ -429,7 +429,7 @@ class _Lines:
 
 
 class PiecewiseModel(TemperatureModel):
-    """Piecewise-linear model in one temperature (SPEC §4b); see the module docstring.
+    """Piecewise-linear model in one temperature ([Seed-FOG]); see the module docstring.
 
     Parameters
     ----------

@@ -1,7 +1,7 @@
-"""Multi-sensor polynomial model with rate and coupling terms (SPEC §4a, seed 000).
+"""Multi-sensor polynomial model with rate and coupling terms ([Seed-RLG]).
 
 The temperature-induced signal (bias [°/h] or [mg], or scale-factor error,
-SPEC §4e) is
+[Seed-RLG]) is
 
 .. math::
 
@@ -196,7 +196,7 @@ STATE_LAYOUT = "thermocal-poly-1"
 
 
 class PolyModel(PolyBase):
-    """Polynomial in T, Ṫ and TṪ of several sensors (SPEC §4a); see the module docstring.
+    """Polynomial in T, Ṫ and TṪ of several sensors ([Seed-RLG]); see the module docstring.
 
     Parameters
     ----------
@@ -298,7 +298,7 @@ class PolyModel(PolyBase):
     def coefficients_about(self, tref_c: float) -> list[Coefficient]:
         """Raw-monomial coefficients about a reference temperature: the same model written
         in ``dT_k = T_k − TREF`` (the convention of PX4's and ArduPilot's thermal
-        calibrations, INTERFACE.md "export-params"), with standard errors.
+        calibrations, ``thermocal export-params``), with standard errors.
 
         Each monomial ``T_k^P Ṫ_k^Q = ((T_k − TREF) + TREF)^P Ṫ_k^Q`` expands binomially
         into ``Σ_j C(P, j) TREF^(P−j) dT_k^j Ṫ_k^Q``; with ``S`` that linear map,

@@ -1,4 +1,4 @@
-"""The polynomial model's types that its fitting and its evaluation share (SPEC §4a).
+"""The polynomial model's types that its fitting and its evaluation share ([Seed-RLG]).
 
 :mod:`thermocal.models.poly_fit` and :mod:`thermocal.models.poly_eval` work on
 :class:`PolyBase` (parameters, fitted values, Ṫ, the evaluation plan); the model itself,

@@ -71,7 +71,7 @@ CONDITION_WORDS: tuple[tuple[float, str], ...] = (
 
 
 def condition_wording(kappa: float | None) -> str:
-    """Words for a condition number κ that match the number (issue 13 item 9).
+    """Words for a condition number κ that match the number.
 
     κ ≤ 1e3 well conditioned; ≤ 1e6 moderately (about log₁₀κ of the data's digits are
     lost: the coefficients' standard errors are inflated by collinear terms); ≤ 1e10

@@ -234,7 +234,7 @@ def check_sensor_id(
 ) -> None:
     """:class:`ExtrapolationWarning` when the data's sensor id (metadata ``sensor_id``)
     differs from the one the model was fitted on (model file ``inputs.sensor_id``):
-    a compensation model belongs to one sensor (issue 14). Silent when either is unknown."""
+    a compensation model belongs to one sensor. Silent when either is unknown."""
     fitted = (model_inputs or {}).get("sensor_id")
     if not fitted or not data_sensor_id or str(fitted) == str(data_sensor_id):
         return

@@ -1,4 +1,4 @@
-"""Warm-up (self-heating) model with start-temperature dependence (SPEC §4c, seed 003).
+"""Warm-up (self-heating) model with start-temperature dependence ([Seed-Plan]).
 
 For a sensor used minutes after power-on.  Each run is one power-on.  With
 ``T`` the temperature of one channel [°C] and ``F`` the output (known input
@@ -24,7 +24,7 @@ do exactly this, so they agree to the last bit.  A gap in time does not restart
 the window (the window is measured in time from the first sample; only
 ``ModelStream.reset()`` — a new power-on — does).
 
-Fitting (least squares, SVD; SPEC "our reading"): ΔT is scaled by its largest
+Fitting (least squares, SVD; our reading of [Seed-Plan]): ΔT is scaled by its largest
 absolute value and T0 centred and scaled, the solution is then converted back
 to the physical ``b``.  ``method="two_stage"`` is the seed's procedure (a_j per
 run, then a_j against T0); ``method="joint"`` fits ``ΔF = Σ_j Σ_k b_jk T0^k ΔT^j``
@@ -237,7 +237,7 @@ def _window_count(time_s: FloatArray, window_s: float) -> int:
 
 def running_start_mean(time_s: FloatArray, x: FloatArray, window_s: float) -> FloatArray:
     """Causal start value of every sample: the running mean over the start window,
-    frozen once the window is full (SPEC §4c, MODELS_COMMON causality rule)::
+    frozen once the window is full ([Seed-Plan]; causal)::
 
         x0_i = (1/(i+1)) Σ_{k≤i} x_k   for i < m,     x0_i = x0_{m−1}   for i ≥ m
 
@@ -280,7 +280,7 @@ class _ScaledFit:
 
 class WarmupModel(TemperatureModel):
     """Two-stage warm-up model ``ΔF = Σ_j a_j(T0) ΔT^j``, ``a_j(T0) = Σ_k b_jk T0^k``
-    (SPEC §4c, seed 003).
+    ([Seed-Plan]).
 
     Parameters
     ----------
@@ -367,7 +367,7 @@ class WarmupModel(TemperatureModel):
 
     # -- fit --
     def fit(self, runs: Sequence[RunData]) -> Self:
-        """Fit the b matrix to several power-on runs (SPEC §4c).
+        """Fit the b matrix to several power-on runs ([Seed-Plan]).
 
         Stage 1 (per run, post-window samples): ``ΔF = Σ_j a_j ΔT^j`` by least
         squares.  Stage 2: ``a_j = Σ_k b_jk T0^k`` over the runs by least squares
@@ -663,7 +663,7 @@ class WarmupModel(TemperatureModel):
 
     def check_duration(self, elapsed_s: float) -> None:
         """:class:`ExtrapolationWarning` when a record runs longer after power-on than any
-        fitted run (issue 14: a model fitted on 900 s power-ons applied to 21 h): the
+        fitted run (a model fitted on 900 s power-ons applied to 21 h): the
         warm-up polynomial in ΔT says nothing about the time beyond."""
         rng = self.duration_range_s_
         if rng is None or not elapsed_s > self.DURATION_MARGIN * rng[1]:
@@ -758,7 +758,7 @@ class WarmupModel(TemperatureModel):
         self.sensor_name_ = str(state["sensor_name"])
         lo, hi = state["t0_range_c"]
         self.t0_range_ = (float(lo), float(hi))
-        dur = state.get("duration_range_s")  # absent in files before issue 14
+        dur = state.get("duration_range_s")  # absent in older files
         self.duration_range_s_ = None if dur is None else (float(dur[0]), float(dur[1]))
         self.start_temps_ = np.array(state.get("start_temps_c", []), dtype=np.float64)
         self.start_outputs_ = np.array(state.get("start_outputs", []), dtype=np.float64)

@@ -1,4 +1,4 @@
-"""Fitting a compensation model on recordings: :func:`fit_files` (``thermocal fit``; SPEC §4).
+"""Fitting a compensation model on recordings: :func:`fit_files` (``thermocal fit``).
 
 Fits one model (one channel) or a calibration of several channels on one or several runs
 (several files = several runs, each with its own turn-on offset unless
@@ -111,7 +111,7 @@ def earth_rate_known_input(
     """Earth rate seen by the sensitive axis [°/h], as a known input of a gyro run.
 
     ``Ω_axis = Ω u·(0, cos φ, sin φ)`` for the unit axis ``u`` in East-North-Up
-    (SPEC §1, :func:`thermocal.units.earth_rate_on_axis_deg_h`); 0 without
+    (IEEE Std 952-1997, :func:`thermocal.units.earth_rate_on_axis_deg_h`); 0 without
     ``--latitude``/``--axis``.  Both options are needed together and
     the signal (canonical unit ``unit``) must be a rate: otherwise an input error naming
     ``where`` (the file).
@@ -346,7 +346,7 @@ def rate_time_doubts(
     :data:`MAX_CHAMBER_RATE_C_PER_MIN` or below :data:`MIN_RAMP_C_PER_MIN` where a time unit
     1000 or 60 times off (:data:`TIME_SCALES`) would make it a chamber's ramp, or a run
     shorter than the interval.  A wrong time unit scales the Ṫ coefficients by the same
-    factor (issue 39: time ×1000 under rate terms)."""
+    factor (time ×1000 under rate terms)."""
     out: list[str] = []
     for run in runs:
         if run.temperature_unit != "degC" or run.time_s.size < 2:
@@ -531,8 +531,8 @@ def _finish_channel(
 
 @dataclass(frozen=True)
 class FittedChannel:
-    """One channel fitted by :func:`fit_files`: its model, its ``--json`` figures (INTERFACE.md
-    ``fit`` keys; ``rms_residual`` in the data's own unit) and the number of runs."""
+    """One channel fitted by :func:`fit_files`: its model, its ``--json`` figures (the
+    ``fit --json`` keys; ``rms_residual`` in the data's own unit) and the number of runs."""
 
     name: str
     model: _base.TemperatureModel
@@ -571,7 +571,7 @@ class FitResult:
 def _distinct_runs(paths: Sequence[Path]) -> None:
     """Refuse a run given twice, by name or as a byte-for-byte copy (the same SHA-256): it
     would count twice, its samples weighing double and the standard errors shrunk by √2
-    (issue 39 audit: ``fit a.csv a.csv`` wrote ``n_runs`` 2, exit 0)."""
+    (``fit a.csv a.csv`` counted two runs)."""
     seen: dict[str, Path] = {}
     for path in paths:
         digest = _files.file_sha256(path)

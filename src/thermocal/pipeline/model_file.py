@@ -82,7 +82,7 @@ def model_from_dict(d: dict[str, Any], path: str | Path) -> TemperatureModel:
 def save_calibration(cal: Calibration, path: str | Path) -> dict[str, Any]:
     """Write a calibration file (atomically); returns its dict.  The file's own reader
     (:func:`~thermocal.models.calibration.calibration_from_dict`) judges it first: a
-    calibration that reader would refuse is refused here and not written (issue 39)."""
+    calibration that reader would refuse is refused here and not written."""
     import json
 
     from thermocal.errors import DesignError

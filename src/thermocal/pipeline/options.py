@@ -155,7 +155,7 @@ class FitOptions:
 
 @dataclass(frozen=True)
 class ValidateOptions:
-    """``thermocal validate`` (INTERFACE.md; :func:`thermocal.pipeline.validate.validate_files`).
+    """``thermocal validate`` (:func:`thermocal.pipeline.validate.validate_files`).
     The text-log options (``names``, ``rate``, ``on_bad_lines``, ``delimiter``, ``decimal``)
     apply to the validated file and to the ``modeling`` file alike; the log ``topic`` to each
     of them that is a flight-controller log (a CSV modelling run of a logged test)."""

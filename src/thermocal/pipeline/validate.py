@@ -1,5 +1,5 @@
 """Judging a model or calibration on an independent recording: :func:`validate_files`
-(``thermocal validate``; SPEC §5, :func:`thermocal.validation.validate`).
+(``thermocal validate``; [Seed-RLG], :func:`thermocal.validation.validate`).
 
 ``r`` compares the ``ambient`` column of the modelling and validation runs (default: the
 model's first temperature column).  The modelling run is ``options.modeling``, else the model
@@ -217,7 +217,7 @@ def _validate_channel(
 
 def _validate_channels(ctx: _Context, cal: Calibration) -> ValidationReport:
     """A calibration of several channels: the file read once with every chosen channel's
-    column (issue 15), each channel judged on it."""
+    column, each channel judged on it."""
     from thermocal.models.calibration import merged_inputs, temperatures_of
 
     o = ctx.o
@@ -271,8 +271,8 @@ def _own_session(cal: Calibration, file: Path) -> None:
 def _validate_triads(
     cal: Calibration, model_file: Path, file: Path, o: ValidateOptions
 ) -> ValidationReport:
-    """A calibration of triads judged on a turntable run (issue 19), or on held-out poses
-    of a multi-position calibration (issue 30); a warning per triad for the share of samples
+    """A calibration of triads judged on a turntable run, or on held-out poses
+    of a multi-position calibration; a warning per triad for the share of samples
     outside its calibrated temperature range."""
     from thermocal.compensate.files import read_for_triads
     from thermocal.multipos import validate as _mp_validate
@@ -287,7 +287,7 @@ def _validate_triads(
         topic=o.topic,
     )
     _own_session(cal, file)
-    if _mp_validate.is_multipos(cal.triads):  # held-out poses (issue 30)
+    if _mp_validate.is_multipos(cal.triads):  # held-out poses
         results: list[Any] = _mp_validate.validate_triads(
             cal.triads, rec, o.latitude, static_s=o.static_s, signal_unit=o.signal_unit
         )
