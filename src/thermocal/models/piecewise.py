@@ -441,6 +441,36 @@ class PiecewiseModel(TemperatureModel):
     temperature : name or 0-based index of the temperature column (default the first).
     per_run_offset : per-run offsets as nuisance parameters; None (default) when the runs
         overlap in temperature (:func:`thermocal.models.poly.decide_run_offsets`).
+
+    Notes
+    -----
+    With breakpoints :math:`\\beta_1 < \\dots < \\beta_{S-1}` in one temperature, each
+    segment :math:`j` is a line fitted by least squares on its own data,
+
+    .. math::
+
+        \\hat y(T) = a_j + s_j T, \\qquad \\beta_{j-1} \\le T < \\beta_j ,
+
+    and with ``method="intersect"`` each breakpoint moves to the intersection of the two
+    adjacent lines, which makes the model continuous.
+
+    References
+    ----------
+    .. [1] *Design and engineering implementation of a fibre-optic-gyro line-of-sight
+       stabilisation system*, master's thesis, chapter 3 (docs/methods.md, Seed-FOG).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from thermocal.models import RunData
+    >>> from thermocal.models.piecewise import PiecewiseModel
+    >>> t = np.arange(0.0, 3600.0, 10.0)
+    >>> temp = 25.0 + 15.0 * np.sin(2 * np.pi * t / 3600.0)
+    >>> y = np.where(temp < 25.0, 1.0 + 0.01 * (temp - 25.0), 1.0 + 0.03 * (temp - 25.0))
+    >>> model = PiecewiseModel(breakpoints=[25.0]).fit([RunData(t, temp[:, None], y, ("T1",))])
+    >>> at = RunData(np.arange(3.0), np.array([[15.0], [25.0], [35.0]]), None, ("T1",))
+    >>> [round(float(v), 4) for v in model.predict(at)]
+    [0.9, 1.0, 1.3]
     """
 
     declaration: ClassVar[FamilyDeclaration] = PIECEWISE

@@ -212,6 +212,42 @@ class PolyModel(PolyBase):
         (default) when the runs overlap in temperature (:func:`decide_run_offsets`).
     solver : ``"auto"`` (Gram when well conditioned, else chunked QR), ``"qr"``, ``"gram"``.
     noise_threshold : a component below ``rcond`` is kept when ``|uᵢᵀz| > k σ̂`` (None: never).
+
+    Notes
+    -----
+    For temperature sensors :math:`k` with temperature :math:`T_k` and rate
+    :math:`\\dot T_k` (the backward difference over ``rate_interval_s``), the model is
+    a constant plus the chosen terms, fitted by least squares:
+
+    .. math::
+
+        \\hat y = c_0 + \\sum_k \\sum_{p} a_{kp} T_k^p + b_{kp} \\dot T_k^p
+                 + d_{kp} (T_k \\dot T_k)^p
+
+    and the compensated output is :math:`F' = F - \\hat y`.
+
+    References
+    ----------
+    .. [1] *A modelling and validation method for the temperature compensation model of a
+       ring-laser gyroscope*, Chinese invention patent, 2017 (docs/methods.md,
+       Seed-RLG).
+    .. [2] IEEE Std 952-1997, *IEEE Standard Specification Format Guide and Test Procedure
+       for Single-Axis Interferometric Fiber Optic Gyros* (the temperature-sensitivity
+       terms of the model equation).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from thermocal.models import RunData
+    >>> from thermocal.models.poly import PolyModel
+    >>> t = np.arange(0.0, 3600.0, 10.0)
+    >>> temp = 25.0 + 15.0 * np.sin(2 * np.pi * t / 3600.0)
+    >>> run = RunData(t, temp[:, None], 0.5 + 0.02 * temp, ("T1",))
+    >>> model = PolyModel(order=1).fit([run])
+    >>> [(c.name, round(c.value, 4)) for c in model.coefficients()]
+    [('const', 0.5), ('T1', 0.02)]
+    >>> round(float(model.predict(run)[0]), 4)
+    1.0
     """
 
     declaration: ClassVar[FamilyDeclaration] = POLY

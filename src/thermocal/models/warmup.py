@@ -296,6 +296,41 @@ class WarmupModel(TemperatureModel):
     per_run_offset : ``joint`` only: a free a0 per run (nuisance parameters, so the
         noise of each run's F0 does not bias the ΔT terms), then ``a0(T0)`` fitted to
         those offsets as in stage 2.  (``two_stage`` always has a free a0 per run.)
+
+    Notes
+    -----
+    With :math:`T_0` and :math:`F_0` the means of the first ``start_window_s`` seconds of a
+    power-on and :math:`\\Delta T = T - T_0`, the drift of the output is
+
+    .. math::
+
+        \\Delta F = \\sum_{j=0}^{n} \\Bigl(\\sum_{k=0}^{m} b_{jk} T_0^k\\Bigr)
+                   \\Delta T^j ,
+
+    :math:`n` = ``order``, :math:`m` = ``t0_order``, fitted over several power-ons at
+    different start temperatures.
+
+    References
+    ----------
+    .. [1] *Temperature-characteristic calibration test plan* (a MEMS sensor's power-on
+       warm-up tests and model; docs/methods.md, Seed-Plan).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from thermocal.models import RunData
+    >>> from thermocal.models.warmup import WarmupModel
+    >>> runs = []
+    >>> for t0 in (10.0, 25.0, 40.0):
+    ...     t = np.arange(0.0, 900.0, 1.0)
+    ...     temp = t0 + 8.0 * (1.0 - np.exp(-t / 300.0))
+    ...     drift = 0.1 + (0.02 + 0.001 * t0) * (temp - t0)
+    ...     runs.append(RunData(t, temp[:, None], drift, ("T1",)))
+    >>> model = WarmupModel(order=1, t0_order=1).fit(runs)
+    >>> {c.name: round(c.value, 5) for c in model.coefficients()}["b11"]
+    0.001
+    >>> round(float(model.predict(runs[1])[-1]), 3)
+    0.342
     """
 
     declaration: ClassVar[FamilyDeclaration] = WARMUP
