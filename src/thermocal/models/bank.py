@@ -246,6 +246,44 @@ class BankModel(TemperatureModel):
     grid_step_c : bin width of the curves compared in the clustering [°C].
     hold_min_s : shortest constant-temperature hold used as a characteristic point [s].
     error_metric : ``"max"`` or ``"rms"`` of model − characteristic line.
+
+    Notes
+    -----
+    Each model :math:`f_m` of the bank is a continuous piecewise-linear function of one
+    temperature; at power-on the model whose mean residual over the start-up samples is
+    smallest is chosen,
+
+    .. math::
+
+        D_m(N) = \\Bigl| \\frac{1}{N} \\sum_{i<N} \\bigl(y_i - f_m(T_i)\\bigr) \\Bigr| ,
+        \\qquad \\hat m = \\arg\\min_m D_m ,
+
+    and the compensated output is :math:`F' = F - f_{\\hat m}(T)`.
+
+    References
+    ----------
+    .. [1] *Adaptive accelerometer temperature compensation method for inertial
+       navigation*, Chinese invention patent, published 2020 (docs/methods.md,
+       Seed-Accel).
+
+    Examples
+    --------
+    Four runs over −20…60 °C on two characteristic curves 3 mg apart; a power-on that
+    reads 3.5 mg at 25 °C picks the second curve (3.025 + 0.02 · 25 mg):
+
+    >>> import numpy as np
+    >>> from thermocal.models import RunData
+    >>> from thermocal.models.bank import BankModel
+    >>> t = np.arange(0.0, 6000.0, 10.0)
+    >>> temp = np.clip(-20.0 + t / 60.0, -20.0, 60.0)
+    >>> runs = [RunData(t, temp[:, None], c + 0.02 * temp, ("T1",))
+    ...         for c in (0.0, 0.05, 3.0, 3.05)]
+    >>> model = BankModel(deviation=1.0, tolerance=0.2).fit(runs)
+    >>> len(model.values_)
+    2
+    >>> on = RunData(np.arange(60.0), np.full((60, 1), 25.0), np.full(60, 3.5), ("T1",))
+    >>> round(float(model.predict(on)[-1]), 3)
+    3.525
     """
 
     declaration: ClassVar[FamilyDeclaration] = BANK
