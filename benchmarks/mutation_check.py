@@ -177,7 +177,7 @@ MUTANTS: tuple[Mutant, ...] = (
     ),
     Mutant(
         "piecewise-no-width-rule-no-bic",
-        P + "models/piecewise.py",
+        P + "models/breakpoints.py",
         "chosen = int(np.argmin(bic)) + 1\n",
         "chosen = len(fits)\n",
         _t("models_piecewise", "cli_contract"),
@@ -1782,7 +1782,7 @@ MUTANTS: tuple[Mutant, ...] = (
     ),
     Mutant(
         "piecewise-segments-judged-on-the-first",
-        P + "models/piecewise.py",
+        P + "models/breakpoints.py",
         "parts[k].append(x[idx == k])",
         "parts[k].append(x[idx == 0])",
         _t("h38_piecewise"),
