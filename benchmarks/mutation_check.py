@@ -265,7 +265,7 @@ MUTANTS: tuple[Mutant, ...] = (
     ),
     Mutant(
         "warmup-window-cumsum-off-by-one",
-        P + "models/warmup.py",
+        P + "models/numerics.py",
         "np.cumsum(x[:m]) / np.arange(1, m + 1, dtype=np.float64)",
         "np.cumsum(x[:m]) / np.arange(2, m + 2, dtype=np.float64)",
         _t("models_warmup"),

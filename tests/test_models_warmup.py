@@ -11,8 +11,9 @@ import pytest
 from thermocal.errors import DesignError, ExtrapolationWarning, ThermocalInputError
 from thermocal.models import get_model_class
 from thermocal.models.base import ModelStream
+from thermocal.models.numerics import running_start_mean
 from thermocal.models.rundata import RunData
-from thermocal.models.warmup import WarmupModel, running_start_mean
+from thermocal.models.warmup import WarmupModel
 from thermocal.pipeline.model_file import load_model, save_model
 
 # true b (rows: ΔT^0..ΔT^2, columns: T0^0..T0^2), a0 ≡ 0 [°/h, °/h/°C, ...]

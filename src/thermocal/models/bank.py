@@ -105,9 +105,10 @@ from thermocal.models.checks import (
     sensor_param,
     string,
 )
+from thermocal.models.numerics import channel_index, lstsq_svd, single_channel
 from thermocal.models.results import Coefficient, FitStats
 from thermocal.models.rundata import RunData
-from thermocal.models.warmup import CONDITION_WARN, channel_index, lstsq_svd, single_channel
+from thermocal.models.warmup import CONDITION_WARN
 from thermocal.preprocess import segment_holds
 from thermocal.recording import FloatArray
 
