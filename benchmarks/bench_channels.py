@@ -33,8 +33,8 @@ import pandas as pd
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from bench_fit import make_data
-from thermocal.models.base import RunData
 from thermocal.models.poly import PolyModel, fit_shared
+from thermocal.models.rundata import RunData
 from thermocal.pipeline.compensate import compensate_channels
 from thermocal.readers.options import ReadOptions
 

@@ -28,10 +28,10 @@ import pandas as pd
 
 from thermocal.compensate.kernels import StreamingCompensator, compensate_run
 from thermocal.export.c import exercise_inputs, find_compiler, generate_c
-from thermocal.models.base import RunData
-from thermocal.models.files import load_model_dict, save_model
 from thermocal.models.registry import make_model
+from thermocal.models.rundata import RunData
 from thermocal.pipeline.compensate import compensate_file
+from thermocal.pipeline.model_file import load_model_dict, save_model
 from thermocal.simulate import SCENARIOS
 
 TEMPS = ["T1", "T2", "T3", "T4"]

@@ -67,7 +67,7 @@ from threadpoolctl import threadpool_limits
 from thermocal.readers.dispatch import read_recording
 from thermocal.models.base import RunData
 from thermocal.models.registry import make_model
-from thermocal.models.files import save_model
+from thermocal.pipeline.model_file import save_model
 cfg = Path({str(cfg)!r}); out = Path({str(out)!r}); out.mkdir(parents=True, exist_ok=True)
 doc = tomllib.loads(cfg.read_text())
 t0 = time.perf_counter()

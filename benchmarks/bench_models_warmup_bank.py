@@ -21,7 +21,7 @@ import time
 import numpy as np
 
 from thermocal.models.bank import BankModel
-from thermocal.models.base import RunData
+from thermocal.models.rundata import RunData
 from thermocal.models.warmup import WarmupModel
 from thermocal.simulate import SCENARIOS
 

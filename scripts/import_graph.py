@@ -25,13 +25,13 @@ ROOT = Path(__file__).resolve().parents[1] / "src" / "thermocal"
 LAYERS: dict[str, int] = {
     # 1 core: the glossary, the types, the gates
     "_lazy": 1, "_version": 1, "errors": 1, "defaults": 1, "units": 1, "identifiers": 1, "outputs": 1,
-    "recording": 1,
+    "recording": 1, "families": 1,
     # 2 maths: pure functions on arrays
     "preprocess": 2, "metrics": 2, "profiles": 2, "inspection": 2, "adequacy": 2, "gravity": 2,
     "stability": 2, "models": 2, "compensate.kernels": 2, "simulate": 2, "turntable": 2,
     "multipos": 2, "datasets": 2, "compensate": 2, "firmware": 2,
     # 3 files: reading, writing, model files, the drivers that stream files
-    "readers": 3, "writers": 3, "models.files": 3, "models.filecheck": 3,
+    "readers": 3, "writers": 3,
     "validation": 3, "export": 3, "tempcal": 3,
     "station": 3, "pipeline": 3,
     # 4 presentation and batch drivers

@@ -55,7 +55,7 @@ from thermocal._version import __version__
 if TYPE_CHECKING:
     from thermocal import export, metrics, models, multipos, simulate, stability, turntable
     from thermocal.errors import ParameterError, ThermocalInputError
-    from thermocal.models.files import load_calibration, load_model, save_model
+    from thermocal.pipeline.model_file import load_calibration, load_model, save_model
     from thermocal.readers.dispatch import read_recording
     from thermocal.readers.options import ReadOptions
     from thermocal.recording import Metadata, Recording
@@ -88,9 +88,9 @@ def _home(name: str) -> ModuleType:
 
         return writers
     if name in _MODEL_FILES:
-        from thermocal.models import files
+        from thermocal.pipeline import model_file
 
-        return files
+        return model_file
     if name in _ERRORS:
         from thermocal import errors
 

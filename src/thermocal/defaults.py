@@ -47,11 +47,6 @@ SCENARIO_NAMES: Final = (
 )
 """The simulator's scenarios (:data:`thermocal.simulate.SCENARIOS`, a test checks they agree)."""
 
-MODEL_FAMILIES: Final = ("poly", "piecewise", "warmup", "bank")
-"""The model families by name, in the order ``thermocal fit --help`` lists them: the keys of
-:data:`thermocal.models.registry.MODEL_REGISTRY`, which is built from this tuple and refuses
-to load when a family class and its name are not both here."""
-
 PROGRAM_TIME: Final = "time_s"
 PROGRAM_SETPOINT: Final = "setpoint_c"
 """Columns of a chamber program CSV (:func:`thermocal.readers.program.read_program`)."""

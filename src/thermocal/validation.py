@@ -1,4 +1,4 @@
-"""Validating a compensation model on a weakly correlated test (SPEC §5, seed 000).
+"""Validating a compensation model on a weakly correlated test ([Seed-RLG]).
 
 A model is judged on a test it was not fitted to, whose temperature history is
 not a copy of the modelling test's:
@@ -14,10 +14,10 @@ not a copy of the modelling test's:
    out (:func:`thermocal.preprocess.segment_holds` on the ambient column) and,
    before and after compensation, within each stage s:
 
-   * bias ``B0_s = mean(F)`` over the stage (SPEC §1);
+   * bias ``B0_s = mean(F)`` over the stage (IEEE Std 952-1997);
    * bias stability ``Bs_s = sqrt(Σ (F̄_j − mean F̄)²/(q − 1))`` of the q averages
      ``F̄_j`` over complete blocks of ``round(averaging_s/τ0)`` samples from the
-     stage's first sample (:func:`thermocal.metrics.block_means`; SPEC §1);
+     stage's first sample (:func:`thermocal.metrics.block_means`; IEEE Std 952-1997);
 
    and across the p stages:
 
@@ -25,13 +25,13 @@ not a copy of the modelling test's:
      (our choice: the rms is the stability a user sees over a typical stage and
      is not pulled down by short, quiet stages as a median would be; p' counts
      the stages with ≥ 2 complete blocks);
-   * ``bias_repeatability Br = sqrt(Σ (B0_s − mean B0)²/(p − 1))`` (SPEC §1).
+   * ``bias_repeatability Br = sqrt(Σ (B0_s − mean B0)²/(p − 1))`` (IEEE Std 952-1997).
 
 4. **Whole run**: on the averages over ``averaging_s`` of the whole run (never
    across a gap), after removing their mean, ``rms = sqrt(mean(F̄_j − mean F̄)²)``
    and ``peak_to_peak = max F̄_j − min F̄_j``.
 5. ``improvement_pct[x] = 100 (x_before − x_after)/x_before`` for each figure.
-6. **What the user sees** (issue 25): per sample, about the level an ideal sensor would
+6. **What the user sees**: per sample, about the level an ideal sensor would
    give (``K``, :func:`thermocal.compensate.kernels.zero_reference`: the known input — earth rate,
    gravity — or 0), ``mean = mean(F − K)``, ``rms_about_zero = sqrt(mean((F − K)²))`` and
    ``max_abs = max |F − K|``, before and after (:class:`~thermocal.compensate.kernels.
@@ -41,7 +41,7 @@ not a copy of the modelling test's:
    constant offset the model adds (a model fitted at 13 °C applied at 47 °C).
 7. **Applicability**: the share of samples outside the model's calibrated temperature
    range (and Ṫ range, and time since power-on for warm-up models) and how far
-   (:class:`~thermocal.models.base.RangeExcess`), one warning for the run.
+   (:class:`~thermocal.models.ranges.RangeExcess`), one warning for the run.
 
 All figures are in the model's signal unit ([°/h] or [mg]); :meth:`ValidationResult.in_unit`
 gives them in the data's own unit (``thermocal validate`` does).
@@ -77,15 +77,15 @@ from thermocal.errors import (
     ThermocalWarning,
     TimestampError,
 )
-from thermocal.models.base import (
+from thermocal.models.base import TemperatureModel
+from thermocal.models.ranges import (
     RANGE_WARNING_PATTERNS,
     RangeExcess,
-    RunData,
-    TemperatureModel,
     outside_range,
     outside_range_dict,
     outside_range_message,
 )
+from thermocal.models.rundata import RunData
 from thermocal.preprocess import segment_holds
 from thermocal.profiles import correlate
 from thermocal.recording import FloatArray, median_interval
@@ -118,7 +118,7 @@ class StageFigures:
 
 @dataclass(frozen=True)
 class ValidationResult:
-    """Result of :func:`validate`; :meth:`to_dict` gives the ``--json`` keys of INTERFACE.md.
+    """Result of :func:`validate`; :meth:`to_dict` gives ``thermocal validate --json``'s keys.
 
     ``r`` and ``weakly_correlated`` are ``None`` when no modelling history was given.
     """
@@ -177,7 +177,7 @@ class ValidationResult:
     @property
     def verdict(self) -> str:
         """One word on the model for this run: ``"NOT weakly correlated"`` when r says the
-        validation run repeats the modelling run (SPEC §5: then it proves nothing), else
+        validation run repeats the modelling run ([Seed-RLG]: then it proves nothing), else
         ``"NOT improved (absolute error worse)"`` when the compensation makes the error
         about zero worse (:attr:`absolute_error_worse`), else ``"improved"``/``"NOT
         improved"`` by the rms of the bias before and after; ``"—"`` when the rms cannot be
@@ -298,12 +298,13 @@ def block_means(time_s: FloatArray, x: FloatArray, averaging_s: float, tau0_s: f
 
 
 def stability_of_means(means: FloatArray) -> float:
-    """``sqrt(Σ (x̄_j − mean x̄)²/(m − 1))`` (SPEC §1 Bs); NaN for fewer than 2 averages."""
+    """``sqrt(Σ (x̄_j − mean x̄)²/(m − 1))`` (IEEE Std 952-1997, bias stability); NaN for
+    fewer than 2 averages."""
     return float(np.std(means, ddof=1)) if means.size >= 2 else float("nan")
 
 
 def repeatability(biases: npt.ArrayLike) -> float:
-    """``Br = sqrt(Σ_{i=1..p} (B0_i − mean B0)²/(p − 1))`` (SPEC §1); NaN for p < 2."""
+    """``Br = sqrt(Σ_{i=1..p} (B0_i − mean B0)²/(p − 1))`` (IEEE Std 952-1997); NaN for p < 2."""
     b = np.asarray(biases, dtype=np.float64)
     return metrics.bias_repeatability(b) if b.size >= 2 else float("nan")
 
@@ -319,7 +320,7 @@ def run_rms_and_peak_to_peak(
     time_s: FloatArray, x: FloatArray, averaging_s: float, tau0_s: float
 ) -> tuple[float, float]:
     """Whole-run ``rms = sqrt(mean((x̄_j − mean x̄)²))`` and ``max x̄_j − min x̄_j`` of the
-    averages over ``averaging_s`` (SPEC §1 peak-to-peak; mean removed)."""
+    averages over ``averaging_s`` (peak-to-peak; mean removed)."""
     m = block_means(time_s, x, averaging_s, tau0_s)
     if m.size == 0:
         return float("nan"), float("nan")
@@ -504,7 +505,7 @@ def validate(
     zero_reference: tuple[float, str] = (0.0, "0"),
     display_unit: tuple[str, float] | None = None,
 ) -> ValidationResult:
-    """Judge ``model`` on an independent test (SPEC §5; the module docstring gives the formulas).
+    """Judge ``model`` on an independent test ([Seed-RLG]; the module docstring gives the formulas).
 
     Parameters
     ----------

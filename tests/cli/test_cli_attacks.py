@@ -226,7 +226,7 @@ def _corrupt_models(good: dict[str, object]) -> list[tuple[str, bytes, str]]:
         return json.dumps(d).encode()
 
     def with_checksum(d: dict[str, object]) -> bytes:
-        from thermocal.models.base import checksum
+        from thermocal.models.format import checksum
 
         d = dict(d)
         d.pop("checksum", None)

@@ -11,11 +11,11 @@ import pytest
 
 from thermocal.cli import main
 from thermocal.errors import ThermocalInputError
-from thermocal.models.files import load_model
 from thermocal.models.piecewise import PiecewiseModel
 from thermocal.models.poly import PolyModel
 from thermocal.models.registry import MODEL_REGISTRY
 from thermocal.pipeline.fit import build_model
+from thermocal.pipeline.model_file import load_model
 from thermocal.recording import Recording
 from thermocal.writers import write_recording
 
@@ -129,12 +129,11 @@ def test_never_writes_over_input(tmp_path, capsys):
 
 
 def test_dispatch_through_registry(monkeypatch):
-    """A family registered without its own option table gets its constructor arguments;
+    """A family registered without its own declaration takes its parent's declared options;
     every family refuses an option it does not take (one parser for all)."""
 
     class Plain(PiecewiseModel):
         family = "plain-test"
-        CLI_KEYS = None
 
     monkeypatch.setitem(MODEL_REGISTRY, "plain-test", Plain)
     m = build_model("plain-test", {"segments": 2, "method": None})

@@ -33,7 +33,7 @@ import pytest
 
 from dataflash_writer import imu_log
 from thermocal.cli import main
-from thermocal.models.base import checksum
+from thermocal.models.format import checksum
 from thermocal.outputs import TEMP_SUFFIX
 from ulog_writer import SENSOR_FIELDS, ulog_bytes
 
@@ -326,7 +326,7 @@ ATTACKS: list[Attack] = [
        "--axis", "up"), D, "--latitude", "vague"),
     _r("fit/tref-inf", (*FIT, "--model", "poly", "--order", "2", "--tref", "inf"), D, "TREF"),
     _r("fit/warmup-start-window-nan", (*FIT, "--model", "warmup", "--start-window", "nan"), D,
-       "start_window_s"),
+       "--start-window"),  # the option, no longer the constructor's parameter name
     _r("fit/bank-tolerance-nan", (*FIT, "--model", "bank", "--tolerance", "nan"), D,
        "tolerance"),
     _r("fit/gravity-nan", ("fit", "{d}/d.csv", "-o", "{d}/m.json", "--model", "poly", "--signal",

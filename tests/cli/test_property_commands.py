@@ -350,7 +350,7 @@ def edited_calibrations(draw: st.DrawFn, raw: bytes) -> bytes:
     recomputed, as anyone can), or its channels cut."""
     import json
 
-    from thermocal.models.base import checksum
+    from thermocal.models.format import checksum
 
     cal = json.loads(raw)
     kind = draw(st.sampled_from(["as-fitted", "as-fitted", "coef", "drop-channels", "roles"]))

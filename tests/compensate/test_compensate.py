@@ -36,15 +36,10 @@ from thermocal.errors import (
     TimestampError,
     UnitError,
 )
-from thermocal.models.base import (
-    ChunkContext,
-    Coefficient,
-    FitStats,
-    ModelStream,
-    RunData,
-    TemperatureModel,
-)
+from thermocal.models.base import ChunkContext, ModelStream, TemperatureModel
 from thermocal.models.registry import MODEL_REGISTRY, make_model
+from thermocal.models.results import Coefficient, FitStats
+from thermocal.models.rundata import RunData
 from thermocal.pipeline.compensate import compensate_file
 from thermocal.preprocess import temperature_rate
 from thermocal.readers.common import csv_float_options

@@ -22,7 +22,7 @@ import pytest
 import thermocal.pipeline.compensate as compensate_mod
 import thermocal.readers.dispatch as io_mod
 from thermocal.cli import main
-from thermocal.models.files import load_calibration
+from thermocal.pipeline.model_file import load_calibration
 from thermocal.readers.dispatch import read_recording
 from thermocal.turntable import thermal
 from thermocal.turntable.simulate import simulate_turntable_thermal

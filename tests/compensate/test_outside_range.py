@@ -16,7 +16,7 @@ import pytest
 from thermocal.cli import main
 from thermocal.compensate.kernels import StreamingCompensator
 from thermocal.errors import ExtrapolationWarning
-from thermocal.models.files import load_model
+from thermocal.pipeline.model_file import load_model
 
 SIG = "gx [deg/s]"
 N = 3600

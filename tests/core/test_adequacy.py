@@ -17,7 +17,7 @@ from typer.testing import CliRunner
 
 from thermocal.adequacy import Needs, judge, stillness, stillness_test
 from thermocal.cli import app
-from thermocal.models.base import checksum
+from thermocal.models.format import checksum
 
 
 def _cli(*argv: str) -> tuple[int, str]:

@@ -26,9 +26,9 @@ DEFINED_IN = {
     "read_recording": "thermocal.readers.dispatch",
     "write_recording": "thermocal.writers",
     "ReadOptions": "thermocal.readers.options",
-    "load_model": "thermocal.models.files",
-    "save_model": "thermocal.models.files",
-    "load_calibration": "thermocal.models.files",
+    "load_model": "thermocal.pipeline.model_file",
+    "save_model": "thermocal.pipeline.model_file",
+    "load_calibration": "thermocal.pipeline.model_file",
     "ParameterError": "thermocal.errors",
     "ThermocalInputError": "thermocal.errors",
 }

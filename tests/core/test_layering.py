@@ -49,25 +49,23 @@ MATHS_PACKAGES = (
     "thermocal.multipos",
 )
 """Every module of these packages is maths, except :data:`MODEL_FILE_MODULES`."""
-MODEL_FILE_MODULES = (
-    "thermocal.models.files",
-    "thermocal.models.filecheck",
-)
-"""The file-layer edges inside maths packages (ARCHITECTURE.md): the model files' readers and
-writers.  (``models.schema`` and ``models.calibration`` check and build dicts, no I/O:
+MODEL_FILE_MODULES = ()
+"""The file-layer edges inside maths packages (ARCHITECTURE.md): none — the model file, the
+turntable's and multipos' drivers and the chunked compensation live in ``pipeline/``.
+(``models.schema`` and ``models.calibration`` check and build dicts, no I/O:
 maths.)"""
 FACADES: tuple[str, ...] = ()
 """Packages whose ``__init__`` hands out file functions on first use: checked at import only.
 None today: ``thermocal.models`` no longer re-exports ``load_model`` (import it from
-``thermocal.models.files``)."""
+``thermocal.pipeline.model_file``)."""
 
 FILE_LAYER = (
     "pandas",
     "pyarrow",
     "thermocal.readers",
     "thermocal.writers",
-    "thermocal.models.files",
-    "thermocal.models.filecheck",
+    "thermocal.pipeline.model_file",
+    "thermocal.pipeline.model_filecheck",
     "thermocal.pipeline",
     "thermocal.tempcal",
     "thermocal.export",
@@ -87,7 +85,7 @@ LIGHT_FORBIDDEN = (
     "thermocal.readers",
     "thermocal.writers",
     "thermocal.pipeline.compensate",
-    "thermocal.models.files",
+    "thermocal.pipeline.model_file",
 )
 
 CLI = "thermocal.cli"
@@ -295,7 +293,7 @@ def test_the_graph_sees_every_kind_of_import() -> None:
     ``TYPE_CHECKING`` imports are not (checked on modules whose imports are known)."""
     edges = _edges(import_graph())
     assert "thermocal.readers.dispatch" in edges["thermocal"]  # inside __getattr__
-    assert "thermocal.models.files" in edges["thermocal.pipeline.validate"]  # in a function
+    assert "thermocal.pipeline.model_file" in edges["thermocal.pipeline.validate"]  # in a function
     graph = import_graph()
     assert "pandas" in {i.target for i in graph["thermocal.readers.common"].imports}  # Lazy
     assert len(edges) == len(list(SRC.rglob("*.py")))
@@ -318,7 +316,7 @@ def test_a_circle_is_found() -> None:
 def test_the_maths_list_is_the_layout() -> None:
     mods = maths_modules()
     assert "thermocal.models.poly" in mods and "thermocal.turntable.thermal" in mods
-    assert "thermocal.models.files" not in mods and len(mods) > 40
+    assert "thermocal.pipeline.model_file" not in mods and len(mods) > 40
 
 
 @pytest.mark.parametrize("module", maths_modules())
@@ -341,11 +339,11 @@ def test_maths_module_loads_no_file_layer(module: str) -> None:
 
 
 def test_the_file_functions_are_still_reachable_from_the_package() -> None:
-    import thermocal.models.files
+    import thermocal.pipeline.model_file
 
     assert callable(thermocal.read_recording) and callable(thermocal.write_recording)
-    assert thermocal.load_model is thermocal.models.files.load_model
-    assert thermocal.save_model is thermocal.models.files.save_model
+    assert thermocal.load_model is thermocal.pipeline.model_file.load_model
+    assert thermocal.save_model is thermocal.pipeline.model_file.save_model
     with pytest.raises(AttributeError):
         _ = thermocal.no_such_thing
 

@@ -369,7 +369,7 @@ def test_model_files_of_format_version_1_still_load(
 ) -> None:
     """An older model file (no ``inputs``): what it did not record is unknown, so the data's
     unstated units fall to the stated default — the model's own unit, said in a warning."""
-    from thermocal.models.base import checksum
+    from thermocal.models.format import checksum
 
     df = _gyro_deg_s()
     src = tmp_path / "run.csv"

@@ -19,9 +19,11 @@ import pytest
 
 from thermocal.cli import main
 from thermocal.errors import CorrelationWarning, ExtrapolationWarning, ThermocalWarning
-from thermocal.models.base import Coefficient, FitStats, ModelStream, RunData, TemperatureModel
-from thermocal.models.files import save_model
+from thermocal.models.base import ModelStream, TemperatureModel
 from thermocal.models.registry import MODEL_REGISTRY, make_model
+from thermocal.models.results import Coefficient, FitStats
+from thermocal.models.rundata import RunData
+from thermocal.pipeline.model_file import save_model
 from thermocal.profiles import common_base
 from thermocal.recording import FloatArray, Recording
 from thermocal.simulate import SCENARIOS
@@ -414,7 +416,7 @@ def test_cli_compensate_end_to_end(
     # the file holds pulse counts (K = 4 counts/arcsec, τ = 1 s): the model columns are in
     # counts too, and gyro_comp = gyro − gyro_model
     np.testing.assert_allclose(got["gyro_comp"], got["gyro"] - got["gyro_model"], rtol=1e-12)
-    from thermocal.models.files import load_model
+    from thermocal.pipeline.model_file import load_model
 
     model = load_model(cli_files["model"])
     rec = Recording.from_arrays(

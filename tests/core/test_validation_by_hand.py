@@ -35,7 +35,7 @@ def test_the_ambient_is_the_first_temperature_column() -> None:
     first column: four holds (the profile's), and r equals numpy's Pearson r of the first
     column against the modelling history on their common time base, computed here."""
     from test_validation import _profile
-    from thermocal.models.base import RunData
+    from thermocal.models.rundata import RunData
     from thermocal.profiles import common_base
     from thermocal.validation import validate
 

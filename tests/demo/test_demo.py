@@ -22,7 +22,7 @@ from report_checks import (
 from thermocal.cli import main
 from thermocal.demo.chamber import DEMO_STEPS, QUICK, run_demo
 from thermocal.models import RunData
-from thermocal.models.files import load_model, load_model_dict
+from thermocal.pipeline.model_file import load_model, load_model_dict
 from thermocal.readers.dispatch import read_recording
 
 DEMO_BUDGET_S = 60.0

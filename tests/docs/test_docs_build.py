@@ -33,6 +33,7 @@ PAGES = (
     "tutorials/notebook-px4",
     "tutorials/production-batch",
     "tutorials/station",
+    "tutorials/notebook-poly",
     "methods",
     "gallery",
     "cli",

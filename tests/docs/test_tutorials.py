@@ -44,6 +44,7 @@ def test_every_tutorial_is_executed_here() -> None:
         "notebook-multipos.md",  # tests/docs/test_tutorial_notebook_multipos.py
         "notebook-px4.md",  # tests/docs/test_tutorial_notebook_px4.py
         "notebook-allan.md",  # tests/docs/test_tutorial_notebook_allan.py
+        "notebook-poly.md",  # tests/docs/test_tutorial_notebook_poly.py
         "production-batch.md",  # tests/docs/test_tutorials_b.py
         "stability-stable32.md",
         "station.md",  # tests/docs/test_tutorial_station.py

@@ -28,9 +28,10 @@ from thermocal.export.c import (
     generate_c,
     run_harness,
 )
-from thermocal.models.base import RunData, TemperatureModel
-from thermocal.models.files import load_model, load_model_dict, save_model
+from thermocal.models.base import TemperatureModel
 from thermocal.models.registry import MODEL_REGISTRY, make_model
+from thermocal.models.rundata import RunData
+from thermocal.pipeline.model_file import load_model, load_model_dict, save_model
 from thermocal.simulate import SCENARIOS
 
 N_SAMPLES = 100_000

@@ -12,9 +12,9 @@ import pytest
 
 from thermocal.compensate.kernels import StreamingCompensator
 from thermocal.export.c import compile_harness, find_compiler, generate_c, run_harness
-from thermocal.models.base import RunData
-from thermocal.models.files import load_model, load_model_dict, save_model
 from thermocal.models.registry import make_model
+from thermocal.models.rundata import RunData
+from thermocal.pipeline.model_file import load_model, load_model_dict, save_model
 
 pytestmark = pytest.mark.skipif(find_compiler() is None, reason="no C compiler")
 

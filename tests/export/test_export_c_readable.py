@@ -24,7 +24,7 @@ from thermocal.export.c import compile_harness, generate_c, run_harness
 from thermocal.export.c.harness import CFLAGS, find_compiler
 from thermocal.export.c.triad import generate_c_triads
 from thermocal.models.calibration import Triad
-from thermocal.models.files import load_model_dict
+from thermocal.pipeline.model_file import load_model_dict
 from thermocal.turntable import thermal
 
 needs_cc = pytest.mark.skipif(find_compiler() is None, reason="no C compiler")

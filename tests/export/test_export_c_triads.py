@@ -15,7 +15,7 @@ from thermocal.cli import main
 from thermocal.export.c.harness import find_compiler
 from thermocal.export.c.triad import generate_c_triads
 from thermocal.models.calibration import Calibration, Triad
-from thermocal.models.files import save_calibration
+from thermocal.pipeline.model_file import save_calibration
 from thermocal.turntable import thermal
 
 SOAKS = np.array([-40.0, -20.0, 0.0, 20.0, 40.0, 60.0])

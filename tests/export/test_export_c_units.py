@@ -18,8 +18,8 @@ import pytest
 from thermocal import units
 from thermocal.cli import main
 from thermocal.export.c import compile_harness, generate_c, run_harness
-from thermocal.models.base import checksum
-from thermocal.models.files import load_model_dict
+from thermocal.models.format import checksum
+from thermocal.pipeline.model_file import load_model_dict
 
 needs_cc = pytest.mark.skipif(
     not any(shutil.which(c) for c in ("cc", "gcc", "clang")), reason="no C compiler"

@@ -25,7 +25,7 @@ import numpy as np
 import pytest
 
 from thermocal.cli import main
-from thermocal.models.base import checksum
+from thermocal.models.format import checksum
 from thermocal.outputs import TEMP_SUFFIX
 
 GYROS, ACCELS = ("gx", "gy", "gz"), ("ax", "ay", "az")

@@ -344,7 +344,7 @@ def test_hostile_triad_names_give_inert_c_equal_to_python(
 ) -> None:
     """The triads renamed in the calibration file (a file anyone can write): the keyword
     ``int`` and a 300-character name ending in ``*/⏎#error INJECTED``."""
-    from thermocal.models.files import load_calibration, save_calibration
+    from thermocal.pipeline.model_file import load_calibration, save_calibration
 
     cal = load_calibration(triad_runs["cal"])  # type: ignore[arg-type]
     long = "w" * 300 + " */\n#error INJECTED\n"
@@ -369,7 +369,7 @@ def test_hostile_triad_names_give_inert_c_equal_to_python(
 def test_triad_names_that_meet_in_c_are_refused(
     tmp_path: Path, capsys: pytest.CaptureFixture[str], triad_runs: dict[str, object]
 ) -> None:
-    from thermocal.models.files import load_calibration, save_calibration
+    from thermocal.pipeline.model_file import load_calibration, save_calibration
 
     cal = load_calibration(triad_runs["cal"])  # type: ignore[arg-type]
     cal.triads = [

@@ -29,8 +29,8 @@ import pytest
 
 from thermocal.cli import main
 from thermocal.models.calibration import Calibration, Triad
-from thermocal.models.files import save_calibration
 from thermocal.multipos.simulate import simulate_session
+from thermocal.pipeline.model_file import save_calibration
 from thermocal.turntable import thermal
 
 MG = 9.80665e-3  # m/s² per mg

@@ -14,11 +14,12 @@ import pytest
 from thermocal.errors import ThermocalInputError
 from thermocal.export.c import generate_c, generate_c_calibration
 from thermocal.export.c.files import ExportCResult, export_c_file
-from thermocal.models.base import RunData, model_file_dict
 from thermocal.models.calibration import Calibration, Channel
-from thermocal.models.files import save_calibration, save_model
+from thermocal.models.format import model_file_dict
 from thermocal.models.registry import make_model
+from thermocal.models.rundata import RunData
 from thermocal.pipeline.compensate import CalibrationCompensation, compensate_calibration_file
+from thermocal.pipeline.model_file import save_calibration, save_model
 from thermocal.readers.options import ReadOptions
 
 N = 4000

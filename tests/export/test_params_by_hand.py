@@ -14,9 +14,9 @@ from thermocal.errors import ThermocalInputError
 
 def _channels(order: int) -> object:
     """Three gyro channels (°/h): a polynomial of ``order`` in T fitted to a quartic drift."""
-    from thermocal.models.base import RunData
     from thermocal.models.calibration import Calibration, Channel
     from thermocal.models.poly import PolyModel
+    from thermocal.models.rundata import RunData
 
     temp = np.linspace(-10.0, 60.0, 400)
     u = (temp - 25.0) / 35.0

@@ -14,7 +14,7 @@ import pytest
 
 from thermocal.cli import main
 from thermocal.export.params import export_params
-from thermocal.models.files import load_calibration
+from thermocal.pipeline.model_file import load_calibration
 from thermocal.simulate import SCENARIOS
 from thermocal.writers import write_recording
 

@@ -119,7 +119,7 @@ def _edit_coefficient(cal_path: Path, fix_checksums: bool) -> None:
     """Change the first channel's constant in a calibration file by 1 (a corruption), and
     with ``fix_checksums`` recompute the model's and the calibration's checksums (an edit
     that the file's own check cannot see)."""
-    from thermocal.models.base import checksum
+    from thermocal.models.format import checksum
 
     d = json.loads(cal_path.read_text(encoding="utf-8"))
     model = d["channels"][0]["model"]

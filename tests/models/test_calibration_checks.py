@@ -60,7 +60,7 @@ def test_every_calibration_writer_applies_the_readers_checks(tmp_path: object) -
     from pathlib import Path
 
     from thermocal.models.calibration import Calibration, Triad
-    from thermocal.models.files import save_calibration
+    from thermocal.pipeline.model_file import save_calibration
 
     out = Path(str(tmp_path)) / "cal.json"
     th = np.zeros(12)

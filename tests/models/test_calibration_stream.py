@@ -15,7 +15,7 @@ import pytest
 from thermocal.cli import main
 from thermocal.compensate.kernels import CalibrationStream
 from thermocal.errors import ThermocalInputError
-from thermocal.models.files import load_calibration
+from thermocal.pipeline.model_file import load_calibration
 from thermocal.simulate import IMU_CHANNELS, SCENARIOS
 from thermocal.writers import write_recording
 

@@ -102,7 +102,7 @@ def test_allan_plots_one_file_per_channel(
 def test_fit_several_channels_writes_a_calibration_equal_to_single_fits(
     imu: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    from thermocal.models.files import load_calibration, load_model
+    from thermocal.pipeline.model_file import load_calibration, load_model
 
     cal_path = tmp_path / "cal.json"
     res = _json(
@@ -133,7 +133,7 @@ def test_fit_several_channels_writes_a_calibration_equal_to_single_fits(
 def test_a_single_model_file_loads_as_a_one_channel_calibration(
     imu: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    from thermocal.models.files import load_calibration
+    from thermocal.pipeline.model_file import load_calibration
 
     one = tmp_path / "gx.json"
     _json(
@@ -148,8 +148,8 @@ def test_corrupt_calibration_is_refused_naming_the_channel(
     imu: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     from thermocal.errors import ModelFileError
-    from thermocal.models.base import checksum
-    from thermocal.models.files import load_calibration
+    from thermocal.models.format import checksum
+    from thermocal.pipeline.model_file import load_calibration
 
     cal_path = tmp_path / "cal.json"
     _json(
@@ -284,7 +284,7 @@ def test_calibration_c_compiles_strict_and_matches_python(
     if cc is None:
         pytest.skip("no C compiler on this machine")
     from thermocal.models.calibration import Calibration, Channel
-    from thermocal.models.files import load_model, save_calibration
+    from thermocal.pipeline.model_file import load_model, save_calibration
 
     models = {}
     for name, unit in zip(CHANNELS, UNITS, strict=True):

@@ -10,8 +10,8 @@ import numpy as np
 import pytest
 
 from thermocal.errors import ExtrapolationWarning, ThermocalInputError
-from thermocal.models.base import RunData
 from thermocal.models.poly import PolyModel, fit_shared
+from thermocal.models.rundata import RunData
 
 
 def _runs(seed: int, n: int = 6000) -> list[RunData]:

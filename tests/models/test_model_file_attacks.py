@@ -32,7 +32,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from thermocal.cli import main
-from thermocal.defaults import MODEL_FAMILIES
+from thermocal.families import MODEL_FAMILIES
 
 COMMANDS: dict[str, list[str]] = {
     "compensate": ["compensate", "{m}", "{d}", "-o", "{o}/comp.csv"],
@@ -42,7 +42,7 @@ COMMANDS: dict[str, list[str]] = {
     "report": ["report", "--model", "{m}", "--recording", "{d}", "-o", "{o}/report.html"],
 }
 KINDS = (*MODEL_FAMILIES, "calibration", "triads")
-"""Every registered model family (thermocal.defaults.MODEL_FAMILIES), and the calibrations."""
+"""Every registered model family (thermocal.families.MODEL_FAMILIES), and the calibrations."""
 
 UNITS = ["--time-unit", "s", "--temp-unit", "degC"]
 

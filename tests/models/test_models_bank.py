@@ -18,8 +18,9 @@ from thermocal.models.bank import (
     hat_basis,
     pwl_evaluate,
 )
-from thermocal.models.base import ModelStream, RunData
-from thermocal.models.files import load_model, save_model
+from thermocal.models.base import ModelStream
+from thermocal.models.rundata import RunData
+from thermocal.pipeline.model_file import load_model, save_model
 from thermocal.simulate import SCENARIOS
 
 OFFSETS = (0.0, 1.5, -2.0)
@@ -292,7 +293,7 @@ def test_model_file_round_trip(synthetic: BankModel, tmp_path) -> None:
 
 def test_registry_and_cli_options() -> None:
     assert get_model_class("bank") is BankModel
-    m = BankModel.from_cli_options(
+    m = BankModel.from_options(
         {
             "deviation": 0.5,
             "tolerance": None,
@@ -303,7 +304,7 @@ def test_registry_and_cli_options() -> None:
     assert (m.deviation, m.tolerance, m.startup_s) == (0.5, 0.2, 10)
     # the bank has no per-run offsets: the option is refused, not dropped silently
     with pytest.raises(ThermocalInputError, match="per_run_offset does not apply"):
-        BankModel.from_cli_options({"per_run_offset": True})
+        BankModel.from_options({"per_run_offset": True})
 
 
 # --- range and bad input ------------------------------------------------------------------------

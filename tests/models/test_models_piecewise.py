@@ -18,8 +18,9 @@ from thermocal.errors import (
     ThermocalWarning,
 )
 from thermocal.models import RunData, get_model_class
-from thermocal.models.files import load_model, save_model
-from thermocal.models.piecewise import PiecewiseModel, evaluate_lines
+from thermocal.models.breakpoints import evaluate_lines
+from thermocal.models.piecewise import PiecewiseModel
+from thermocal.pipeline.model_file import load_model, save_model
 from thermocal.simulate import SCENARIOS
 
 BPS = np.array([23.6, 30.0])

@@ -13,7 +13,6 @@ from numpy.testing import assert_allclose, assert_array_equal
 from thermocal import simulate
 from thermocal.errors import DesignError, ExtrapolationWarning, ThermocalInputError
 from thermocal.models import RunData, get_model_class
-from thermocal.models.files import load_model, save_model
 from thermocal.models.poly import PolyModel
 from thermocal.models.terms import (
     Term,
@@ -24,6 +23,7 @@ from thermocal.models.terms import (
     temperature_rates,
     term_features,
 )
+from thermocal.pipeline.model_file import load_model, save_model
 from thermocal.preprocess import block_average, temperature_rate
 from thermocal.recording import contiguous_slices
 
@@ -223,7 +223,7 @@ def test_registry_and_bad_params():
         with pytest.raises(ThermocalInputError):
             PolyModel(**kw).fit([run])  # type: ignore[arg-type]
     with pytest.raises(ThermocalInputError, match="does not apply"):
-        PolyModel.from_cli_options({"breakpoints": [25.0]})
+        PolyModel.from_options({"breakpoints": [25.0]})
 
 
 # --- truth recovery on the simulator (SPEC §4a, seed 000) -----------------------------------

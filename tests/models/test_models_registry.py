@@ -3,16 +3,19 @@ derived from :data:`thermocal.models.registry.MODEL_REGISTRY`."""
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 import pytest
 
-from thermocal.defaults import MODEL_FAMILIES
 from thermocal.errors import ModelFileError
+from thermocal.families import BUILTIN_FAMILIES, MODEL_FAMILIES, POLY
 from thermocal.models import registry
 from thermocal.models.bank import BankModel
-from thermocal.models.base import RunData, checksum, model_file_dict
+from thermocal.models.format import checksum, model_file_dict
 from thermocal.models.piecewise import PiecewiseModel
 from thermocal.models.poly import PolyModel
+from thermocal.models.rundata import RunData
 from thermocal.models.schema import verify_model_dict
 from thermocal.models.warmup import WarmupModel
 
@@ -40,21 +43,22 @@ def test_a_family_record_is_what_its_class_declares() -> None:
     poly = registry.family("poly")
     assert poly.model_class is PolyModel and poly.c_generator == "thermocal.export.c.poly"
     # the fit options are the constructor's parameters, in its order
-    assert list(poly.options) == [
+    assert [o.name for o in poly.declaration.options] == [
         "terms", "order", "rate_interval_s", "rate_method", "select", "ridge", "rcond",
         "per_run_offset", "solver", "noise_threshold",
     ]  # fmt: skip
-    assert all(k == v for k, v in poly.options.items())
+    assert poly.declaration is POLY is PolyModel.declaration
     assert [f.name for f in registry.families()] == list(MODEL_FAMILIES)
     with pytest.raises(ModelFileError, match="unknown model family 'nope'; known: bank, piecewise"):
         registry.family("nope")
 
 
 def test_names_and_classes_cannot_drift_apart() -> None:
-    with pytest.raises(ImportError, match=r"differ from defaults\.MODEL_FAMILIES"):
-        registry._registry((PolyModel, PiecewiseModel, WarmupModel))
-    with pytest.raises(ImportError, match=r"differ from defaults\.MODEL_FAMILIES"):
-        registry._registry((PolyModel, PolyModel, PiecewiseModel, WarmupModel, BankModel))
+    assert registry._registry(BUILTIN_FAMILIES) == registry.MODEL_REGISTRY
+    # a declaration whose class carries another one stops the import
+    moved = dataclasses.replace(POLY, model_class="thermocal.models.piecewise:PiecewiseModel")
+    with pytest.raises(ImportError, match="does not carry the declaration of family 'poly'"):
+        registry._registry((moved, *BUILTIN_FAMILIES[1:]))
 
 
 def test_model_from_dict_dispatches_by_family_and_refuses_unknown_ones() -> None:

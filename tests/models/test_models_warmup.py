@@ -10,9 +10,11 @@ import pytest
 
 from thermocal.errors import DesignError, ExtrapolationWarning, ThermocalInputError
 from thermocal.models import get_model_class
-from thermocal.models.base import ModelStream, RunData
-from thermocal.models.files import load_model, save_model
-from thermocal.models.warmup import WarmupModel, running_start_mean
+from thermocal.models.base import ModelStream
+from thermocal.models.numerics import running_start_mean
+from thermocal.models.rundata import RunData
+from thermocal.models.warmup import WarmupModel
+from thermocal.pipeline.model_file import load_model, save_model
 
 # true b (rows: ΔT^0..ΔT^2, columns: T0^0..T0^2), a0 ≡ 0 [°/h, °/h/°C, ...]
 B_TRUE = np.array(
@@ -227,7 +229,7 @@ def test_model_file_round_trip(fitted: WarmupModel, tmp_path) -> None:
 
 def test_registry_and_cli_options() -> None:
     assert get_model_class("warmup") is WarmupModel
-    m = WarmupModel.from_cli_options(
+    m = WarmupModel.from_options(
         {
             "start_window_s": 5.0,
             "order": 3,
@@ -239,7 +241,7 @@ def test_registry_and_cli_options() -> None:
     assert (m.start_window_s, m.order, m.t0_order) == (5.0, 3, 2)
     # an option warmup does not take is refused (no longer dropped silently)
     with pytest.raises(ThermocalInputError, match="segments does not apply to model 'warmup'"):
-        WarmupModel.from_cli_options({"segments": 3})
+        WarmupModel.from_options({"segments": 3})
 
 
 # --- range and bad input -----------------------------------------------------------------------

@@ -19,8 +19,8 @@ import pandas as pd
 import pytest
 
 from thermocal.cli import main
-from thermocal.models.base import RunData
 from thermocal.models.piecewise import PiecewiseModel
+from thermocal.models.rundata import RunData
 from thermocal.recording import Recording
 
 BURST_SPAN_C = 0.28

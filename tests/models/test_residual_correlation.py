@@ -97,7 +97,7 @@ def test_reported_slope_error_matches_its_spread_on_ar1_residuals(model: str) ->
     ],
 )
 def test_condition_wording_matches_the_number(kappa: float | None, words: str) -> None:
-    from thermocal.models.base import condition_wording
+    from thermocal.models.results import condition_wording
 
     assert condition_wording(kappa) == words
 

@@ -48,7 +48,7 @@ def counts_cal(tmp_path_factory: pytest.TempPathFactory) -> Path:
 def _tampered(src: Path, dst: Path, change: Any, *, resum: bool = True) -> Path:
     """``src`` changed by ``change(doc)``, its checksum recomputed (a deliberate edit) unless
     ``resum`` is False (a file edited by hand)."""
-    from thermocal.models.base import checksum
+    from thermocal.models.format import checksum
 
     doc = json.loads(src.read_text())
     change(doc)

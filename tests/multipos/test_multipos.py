@@ -30,9 +30,9 @@ from scipy.optimize import least_squares
 
 from thermocal.cli import main
 from thermocal.export.c.harness import find_compiler
-from thermocal.models.files import load_calibration
 from thermocal.multipos.calibrate import SessionResult, calibrate_session
 from thermocal.multipos.simulate import random_truth, simulate_session
+from thermocal.pipeline.model_file import load_calibration
 from thermocal.turntable import thermal
 
 MG = 9.80665e-3

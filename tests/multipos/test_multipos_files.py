@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from thermocal.errors import ThermocalInputError
-from thermocal.models.files import load_calibration
+from thermocal.pipeline.model_file import load_calibration
 from thermocal.pipeline.multipos import MultiposOptions, calibrate_files
 from thermocal.simulate import SimulateOptions, simulate_scenario
 from thermocal.writers import write_recording

@@ -27,7 +27,7 @@ import pandas as pd
 import pytest
 
 from thermocal.cli import main
-from thermocal.models.base import checksum
+from thermocal.models.format import checksum
 from thermocal.multipos.simulate import simulate_session
 
 ACC_LSB_PER_G = 8192.0  # ±4 g range

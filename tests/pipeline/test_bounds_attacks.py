@@ -128,8 +128,13 @@ def test_fit_refuses_an_order_or_term_count_beyond_the_ceiling_before_reading(
 def test_fit_accepts_the_ceiling_itself(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     """Order 10 passes the ceiling (the data then decide): the check does not refuse the
     limit it names."""
-    fit_cmd.check_ceilings(10, 10, 100, ",".join(["T1"] * 200))
-    fit_cmd.check_ceilings(None, 0, 1, "T1^10")
+    fit_cmd.check_terms(",".join(["T1"] * 200))
+    fit_cmd.check_terms("T1^10")
+    limits = (("poly", "order", 10), ("warmup", "order", 10), ("warmup", "t0_order", 10),
+              ("warmup", "t0_order", 0), ("piecewise", "segments", 100),
+              ("piecewise", "segments", 1))  # fmt: skip
+    for family, name, value in limits:
+        assert fit_cmd.build_model(family, {name: value}).get_params()[name] == value
 
 
 def test_turntable_refuses_an_order_beyond_the_ceiling_before_reading(

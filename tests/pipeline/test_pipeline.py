@@ -17,10 +17,12 @@ import pytest
 
 from thermocal.cli import main
 from thermocal.pipeline.fit import fit_files
+from thermocal.pipeline.messages import option_name
 from thermocal.pipeline.options import (
     ALIASES,
     FitOptions,
     ValidateOptions,
+    family_option_kinds,
     options_from_table,
 )
 from thermocal.pipeline.validate import validate_files
@@ -49,7 +51,13 @@ def test_fit_files_recovers_the_bias_and_slope(tmp_path: Path) -> None:
     """Order 1 about TREF = 25 °C: the constant is the bias and the T1 term the slope, within
     3 standard errors of a straight-line fit to white noise (σ/√n and σ/(√n·std T))."""
     _write(tmp_path / "mod.csv", RAMP, 1)
-    opts = FitOptions(model="poly", order=1, signal="gyro [deg/h]", temps="T1 [degC]", tref=25.0)
+    opts = FitOptions(
+        model="poly",
+        params={"order": 1},
+        signals=("gyro [deg/h]",),
+        temperatures=("T1 [degC]",),
+        tref=25.0,
+    )
     res = fit_files([tmp_path / "mod.csv"], opts, tmp_path / "m.json")
     assert not res.calibration and res.output.is_file()
     fig = res.channels[0].figures
@@ -66,9 +74,12 @@ def test_fit_files_recovers_the_bias_and_slope(tmp_path: Path) -> None:
 def test_fit_files_refuses_options_before_reading(tmp_path: Path) -> None:
     from thermocal.errors import ThermocalInputError
 
-    with pytest.raises(ThermocalInputError, match="--order must be between 1 and 10"):
+    # the library names its parameter; the command line shows --order in its place
+    with pytest.raises(ThermocalInputError, match=r"^order must be between 1 and 10"):
         fit_files(
-            [tmp_path / "nothing.csv"], FitOptions(model="poly", order=11), tmp_path / "m.json"
+            [tmp_path / "nothing.csv"],
+            FitOptions(model="poly", params={"order": 11}),
+            tmp_path / "m.json",
         )
 
 
@@ -77,7 +88,13 @@ def test_validate_files_figures_against_a_hand_computation(tmp_path: Path) -> No
     ``rms_after`` that of the signal minus the model, here computed with the fitted slope."""
     _write(tmp_path / "mod.csv", RAMP, 1)
     val = _write(tmp_path / "val.csv", SINE, 2)
-    opts = FitOptions(model="poly", order=1, signal="gyro [deg/h]", temps="T1 [degC]", tref=25.0)
+    opts = FitOptions(
+        model="poly",
+        params={"order": 1},
+        signals=("gyro [deg/h]",),
+        temperatures=("T1 [degC]",),
+        tref=25.0,
+    )
     fit = fit_files([tmp_path / "mod.csv"], opts, tmp_path / "m.json")
     coefs = {c["name"]: c["value"] for c in fit.channels[0].figures["tref"]["coefficients"]}
     with pytest.warns(UserWarning, match="temperature-hold stage"):  # none in a sine
@@ -158,7 +175,10 @@ def _long_options(name: str) -> dict[str, bool]:
 
 @pytest.mark.parametrize(("command", "cls"), [("fit", FitOptions), ("validate", ValidateOptions)])
 def test_the_options_dataclass_is_the_command(command: str, cls: type) -> None:
-    fields = {"--" + f.name.replace("_", "-") for f in dataclasses.fields(cls)}
+    # each field is its option (option_name: signals is --signal, rate_hz is --rate)
+    fields = {option_name(f.name) for f in dataclasses.fields(cls)} - {"--params"}
+    if command == "fit":  # the families' declared options, and none besides
+        fields |= {"--" + name for name in family_option_kinds()}
     aliases = {"--" + a for a in ALIASES.get(command, {})}
     opts = set(_long_options(command)) - {"--output", "--json", "--help", "--no-per-run-offset"}
     assert fields | aliases == opts
@@ -167,7 +187,9 @@ def test_the_options_dataclass_is_the_command(command: str, cls: type) -> None:
 def test_a_table_gives_the_options_and_the_arguments() -> None:
     table = {"model": "poly", "order": 2, "signal": ["gx", "gy"], "select": True, "ridge": 0.5}
     opts, args = options_from_table("fit", table, "cfg [fit]")
-    assert opts == FitOptions(model="poly", order=2, signal="gx,gy", select=True, ridge=0.5)
+    assert opts == FitOptions(
+        model="poly", params={"order": 2, "select": "bic", "ridge": 0.5}, signals=("gx", "gy")
+    )
     assert args == ["--model", "poly", "--order", "2", "--signal", "gx,gy", "--select",
                     "--ridge", "0.5"]  # fmt: skip
     v, _ = options_from_table("validate", {"average": 30}, "cfg [validate]")
@@ -189,7 +211,7 @@ FIT_MODULES = ["pipeline/fit.py", "pipeline/reading.py", "cli/fit_cmd.py", "adeq
 VALIDATE_MODULES = ["pipeline/validate.py", "pipeline/reading.py", "cli/validate_cmd.py",
                     "readers/[!p]*.py",
                     "validation.py", "compensate/kernels.py", "models/base.py",
-                    "models/files.py", "models/calibration.py"]  # fmt: skip
+                    "pipeline/model_file.py", "models/calibration.py"]  # fmt: skip
 DESCRIBED = {"the known input given (--known-input)", "--encoder-unit", " --axis "}
 """Texts naming a ``fit`` option the model recorded (what it was given), not advice; and the
 unit option of the encoder-angle role (units.py's table of roles), which only ``turntable``
@@ -260,7 +282,9 @@ def test_the_fleet_figures_are_what_fit_and_validate_give(tmp_path: Path) -> Non
 
     _write(tmp_path / "mod.csv", RAMP, 1)
     _write(tmp_path / "val.csv", SINE, 2)
-    opts = FitOptions(model="poly", order=1, signal="gyro [deg/h]", temps="T1 [degC]")
+    opts = FitOptions(
+        model="poly", params={"order": 1}, signals=("gyro [deg/h]",), temperatures=("T1 [degC]",)
+    )
     fit = fit_files([tmp_path / "mod.csv"], opts, tmp_path / "m.json")
     with pytest.warns(UserWarning, match="temperature-hold stage"):
         rep = validate_files(tmp_path / "m.json", tmp_path / "val.csv")

@@ -97,7 +97,7 @@ FILE_LAYER = [
     "pyarrow",
     "thermocal.readers",
     "thermocal.writers",
-    "thermocal.models.files",
+    "thermocal.pipeline.model_file",
 ]
 
 

@@ -32,9 +32,11 @@ from report_checks import (
     tagged_numbers,
 )
 from thermocal.errors import ThermocalInputError
-from thermocal.models.base import Coefficient, FitStats, ModelStream, RunData, TemperatureModel
-from thermocal.models.files import save_model
+from thermocal.models.base import ModelStream, TemperatureModel
 from thermocal.models.registry import MODEL_REGISTRY
+from thermocal.models.results import Coefficient, FitStats
+from thermocal.models.rundata import RunData
+from thermocal.pipeline.model_file import save_model
 from thermocal.recording import FloatArray, Metadata, Recording
 from thermocal.report import (
     ModelEntry,
@@ -519,7 +521,7 @@ def test_apply_model_uses_the_fit_provenance_for_the_earth_rate(
     """A model fitted with the earth rate removed (``--latitude/--axis``) and one fitted on
     the raw output both give the same bias after compensation in the report."""
     from thermocal.cli import main
-    from thermocal.models.files import load_model_dict
+    from thermocal.pipeline.model_file import load_model_dict
     from thermocal.report.build import apply_model, known_input_of
 
     n = 4000

@@ -132,7 +132,7 @@ def test_conversions_and_units_are_stated(work: Path) -> None:
 
 
 def _with_adequacy(work: Path, verdict: str, overrides: list[str]) -> Path:
-    from thermocal.models.base import checksum
+    from thermocal.models.format import checksum
 
     m: dict[str, Any] = json.loads((work / "m.json").read_text())
     m["adequacy"] = {

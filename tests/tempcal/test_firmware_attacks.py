@@ -369,7 +369,7 @@ def _triad_cal(path: Path, scale: float, offset_mg: float) -> None:
     """An accelerometer triad whose firmware scale is ``scale`` (the model's
     ``1 + s = 1/scale``) and x offset ``offset_mg``."""
     from thermocal.models.calibration import Calibration, Triad
-    from thermocal.models.files import save_calibration
+    from thermocal.pipeline.model_file import save_calibration
     from thermocal.turntable import thermal
 
     th = np.zeros(12)
@@ -437,10 +437,10 @@ def _gyro_cal(path: Path, lo: float, hi: float) -> None:
     """Three gyro channels (°/h), a cubic in T fitted over ``lo``…``hi`` °C."""
     import warnings
 
-    from thermocal.models.base import RunData
     from thermocal.models.calibration import Calibration, Channel
-    from thermocal.models.files import save_calibration
     from thermocal.models.poly import PolyModel
+    from thermocal.models.rundata import RunData
+    from thermocal.pipeline.model_file import save_calibration
 
     temp = np.linspace(lo, hi, 400)
     u = (temp - 35.0) / 40.0

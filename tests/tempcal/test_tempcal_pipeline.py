@@ -66,7 +66,7 @@ def test_px4_tempcal_library_call(tmp_path: Path) -> None:
     # the gyro's x bias: 0.002 + 0.004·(T − 20)/30 rad/s; at TREF (mid-range 20 °C) 0.002
     gx = next(ch for ch in res.fits[1].channels if ch.name == "g0_x")
     run_t = np.array([[20.0], [50.0]])
-    from thermocal.models.base import RunData
+    from thermocal.models.rundata import RunData
 
     pred = gx.model.predict(RunData(np.arange(2.0), run_t, None, ("temperature",)))
     np.testing.assert_allclose(pred, np.array([0.002, 0.006]) * 180 / np.pi * 3600, rtol=2e-3)

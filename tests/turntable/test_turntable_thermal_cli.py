@@ -207,7 +207,7 @@ def test_bias_only_and_single_temperature_do_much_worse(workflow: dict) -> None:
     raw_a = np.column_stack([rec.column(c) for c in A_COLS])
     ours = _dwell_rms(comp[[f"{c}_comp" for c in A_COLS]].to_numpy(), f_true, dwells) / MG
     # bias-only: the calibrated bias polynomials, no scale factor or misalignment
-    from thermocal.models.files import load_calibration
+    from thermocal.pipeline.model_file import load_calibration
 
     tri = load_calibration(workflow["cal"]).triads[1].model  # type: ignore[arg-type]
     bias_only = raw_a - tri.theta_at(temp)[:, 0:3] * MG

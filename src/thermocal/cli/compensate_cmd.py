@@ -1,7 +1,7 @@
 """``thermocal compensate MODEL.json FILE -o OUT``: apply a fitted model to a recording.
 
 OUT keeps every input column and adds ``<signal>_model`` and ``<signal>_comp``
-(INTERFACE.md).  Files of any size are processed in chunks with constant memory
+Files of any size are processed in chunks with constant memory
 (:func:`thermocal.pipeline.compensate.compensate_file`).
 """
 

@@ -1,41 +1,20 @@
 """``thermocal fit FILE... --model NAME --signal COL --temps COLS -o MODEL.json``.
 
-The command parses its options into :class:`thermocal.pipeline.options.FitOptions` (one field
-per option), calls :func:`thermocal.pipeline.fit.fit_files` and prints the result.
+The command parses its options into :class:`thermocal.pipeline.options.FitOptions`, calls
+:func:`thermocal.pipeline.fit.fit_files` and prints the result.
 
-Fits a compensation model (SPEC §4) on one or several runs (several FILEs =
-several runs, each with its own turn-on offset unless ``--no-per-run-offset``)
-and writes the self-describing model file (:func:`thermocal.models.files.save_model`)
-with the data files' names and SHA-256 checksums.
+Fits a compensation model on one or several runs (several FILEs = several runs, each with
+its own turn-on offset unless ``--no-per-run-offset``) and writes the self-describing model
+file with the data files' names and SHA-256 checksums.
 
-The family is looked up in the registry (:func:`thermocal.models.registry.get_model_class`).
-The command collects the model options the user gave into one dict and calls
-``cls.from_cli_options(options)``, the one option parser of every family
-restricted to its constructor parameters.  Only options given on the command
-line are in the dict (no ``None`` values).  Keys:
-
-==================  =======================  ==================================================
-key                 option                   meaning (families)
-==================  =======================  ==================================================
-``terms``           ``--terms``              ``seed000`` or ``"T1,T1^2,dT1,T1*dT1,..."`` (poly)
-``order``           ``--order N``            plain polynomial order (poly); order in ΔT (warmup)
-``rate_interval_s`` ``--rate-interval S``    Δt of Ṫ [s] (poly)
-``rate_method``     ``--rate-method``        backward | forward | centred (poly)
-``select``          ``--select [--select-method bic|holdout]``  term selection (poly)
-``ridge``           ``--ridge ALPHA``        ridge α on unit-RMS terms (poly)
-``rcond``           ``--rcond R``            SVD truncation threshold (poly)
-``solver``          ``--solver``             auto | qr | gram (poly)
-``noise_threshold`` ``--noise-threshold K``  keep truncated components above K σ̂ (poly)
-``breakpoints``     ``--breakpoints 25,30``  list of float [°C] (piecewise)
-``segments``        ``--segments N``         segments, breakpoints from data (piecewise)
-``method``          ``--method``             intersect | continuous (piecewise); warmup's own
-``start_window_s``  ``--start-window S``     F0/T0 averaging window [s] (warmup)
-``t0_order``        ``--t0-order M``         coefficient order in T0 (warmup)
-``deviation``       ``--deviation``          distinct-curve threshold, signal unit (bank)
-``tolerance``       ``--tolerance``          model acceptance, signal unit (bank)
-``startup_s``       ``--startup-s``          start-up smoothing window [s] (bank)
-``per_run_offset``  ``--[no-]per-run-offset``  per-run turn-on offsets (all that support it)
-==================  =======================  ==================================================
+The options of the model families are not written here: one typer option is made for each
+option the built-in families declare (:func:`thermocal.families.fit_option_table`; an
+option several families share, such as ``--order``, once, its help naming each family's
+meaning), and the values given go to ``FitOptions.params`` by constructor parameter
+(:func:`thermocal.pipeline.options.family_params`: ``--rate-interval`` →
+``rate_interval_s``, ``--select --select-method holdout`` → ``select="holdout"``,
+``--breakpoints 25,30`` → ``(25.0, 30.0)``).  The family checks them against its
+declaration and refuses an option it does not take.
 
 ``--target bias|scale_factor`` and the signal's name and unit are recorded in
 the model file.  ``--latitude DEG --axis up`` removes the earth rate seen by
@@ -50,6 +29,8 @@ model's canonical ``model_unit``), ``condition_number``, ``temperature_range`` (
 fit statistics), ``coefficients`` and ``warnings``.
 """
 
+import dataclasses
+import inspect
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated, Any
 
@@ -79,19 +60,23 @@ from thermocal.cli.common import (
     emit,
     fmt,
     handle_errors,
+    split_floats,
     stdout,
 )
-from thermocal.defaults import MODEL_FAMILIES
-from thermocal.pipeline.options import FitOptions, options_of
+from thermocal.errors import ThermocalInputError
+from thermocal.families import MODEL_FAMILIES, FamilyOption, fit_option_table
+from thermocal.pipeline.options import FitOptions, family_params, options_of
 
 if TYPE_CHECKING:
     import rich.table as _rich_table
 
     import thermocal.models.base as _base
+    import thermocal.models.results as _results
     import thermocal.pipeline.fit as _fit
 else:
     _rich_table = LazyModule("rich.table")
     _base = LazyModule("thermocal.models.base")
+    _results = LazyModule("thermocal.models.results")
     _fit = LazyModule("thermocal.pipeline.fit")
 
 FilesArg = Annotated[
@@ -100,88 +85,14 @@ FilesArg = Annotated[
 ]
 
 FamilyOpt = Annotated[
-    str, typer.Option("--model", help=f"Model family: {', '.join(MODEL_FAMILIES)}.")
+    str,
+    typer.Option(
+        "--model",
+        help=f"Model family: {', '.join(MODEL_FAMILIES)}, or one a plugin package installs.",
+    ),
 ]
 
 OutputOpt = Annotated[Path, typer.Option("-o", "--output", help="Model file to write (JSON).")]
-
-TermsOpt = Annotated[
-    str | None, typer.Option("--terms", help='poly: "seed000" or "T1,T1^2,dT1,T1*dT1,...".')
-]
-
-OrderOpt = Annotated[
-    int | None,
-    typer.Option("--order", help="poly: plain polynomial order; warmup: order in ΔT."),
-]
-
-RateIntervalOpt = Annotated[
-    float | None, typer.Option("--rate-interval", help="poly: Δt of Ṫ [s] (default 60).")
-]
-
-RateMethodOpt = Annotated[
-    str | None, typer.Option("--rate-method", help="poly: backward | forward | centred.")
-]
-
-SelectOpt = Annotated[bool, typer.Option("--select", help="poly: stepwise term selection.")]
-
-SelectMethodOpt = Annotated[
-    str, typer.Option("--select-method", help="poly: selection criterion bic | holdout.")
-]
-
-RidgeOpt = Annotated[float | None, typer.Option("--ridge", help="poly: ridge α.")]
-
-RcondOpt = Annotated[
-    float | None, typer.Option("--rcond", help="poly: SVD truncation (default 1e-3).")
-]
-
-SolverOpt = Annotated[str | None, typer.Option("--solver", help="poly: auto | qr | gram.")]
-
-NoiseThresholdOpt = Annotated[
-    float | None,
-    typer.Option(
-        "--noise-threshold", help="poly: keep truncated SVD components above K σ (default 10)."
-    ),
-]
-
-BreakpointsOpt = Annotated[
-    str | None, typer.Option("--breakpoints", help="piecewise: breakpoints [°C], e.g. 25,30.")
-]
-
-SegmentsOpt = Annotated[
-    int | None, typer.Option("--segments", help="piecewise: N segments chosen from the data.")
-]
-
-MethodOpt = Annotated[
-    str | None, typer.Option("--method", help="piecewise: intersect | continuous.")
-]
-
-StartWindowOpt = Annotated[
-    float | None, typer.Option("--start-window", help="warmup: F0/T0 window [s].")
-]
-
-T0OrderOpt = Annotated[
-    int | None, typer.Option("--t0-order", help="warmup: coefficient order in T0.")
-]
-
-DeviationOpt = Annotated[
-    float | None, typer.Option("--deviation", help="bank: distinct-curve threshold.")
-]
-
-ToleranceOpt = Annotated[
-    float | None, typer.Option("--tolerance", help="bank: model acceptance tolerance.")
-]
-
-StartupSOpt = Annotated[
-    float | None, typer.Option("--startup-s", help="bank: start-up window [s].")
-]
-
-PerRunOffsetOpt = Annotated[
-    bool | None,
-    typer.Option(
-        "--per-run-offset/--no-per-run-offset",
-        help="Estimate one turn-on offset per run (nuisance parameters).",
-    ),
-]
 
 TargetOpt = Annotated[
     str, typer.Option("--target", help="What the model describes: bias | scale_factor.")
@@ -220,62 +131,105 @@ TrefOpt = Annotated[
 ]
 
 
-@app.command("fit")
-@handle_errors
-def fit_cmd(
-    files: FilesArg,
-    model: FamilyOpt,
-    output: OutputOpt,
-    signal: SignalOpt = None,
-    temps: TempsOpt = None,
-    time: TimeOpt = None,
-    time_unit: TimeUnitOpt = None,
-    signal_unit: SignalUnitOpt = None,
-    temp_unit: TempUnitOpt = None,
-    temp_conversion: TempConversionOpt = None,
-    terms: TermsOpt = None,
-    order: OrderOpt = None,
-    rate_interval: RateIntervalOpt = None,
-    rate_method: RateMethodOpt = None,
-    select: SelectOpt = False,
-    select_method: SelectMethodOpt = "bic",
-    ridge: RidgeOpt = None,
-    rcond: RcondOpt = None,
-    solver: SolverOpt = None,
-    noise_threshold: NoiseThresholdOpt = None,
-    breakpoints: BreakpointsOpt = None,
-    segments: SegmentsOpt = None,
-    method: MethodOpt = None,
-    start_window: StartWindowOpt = None,
-    t0_order: T0OrderOpt = None,
-    deviation: DeviationOpt = None,
-    tolerance: ToleranceOpt = None,
-    startup_s: StartupSOpt = None,
-    per_run_offset: PerRunOffsetOpt = None,
-    target: TargetOpt = "bias",
-    latitude: LatitudeOpt = None,
-    axis: AxisOpt = None,
-    known_input: KnownInputOpt = None,
-    gravity_axis: GravityAxisOpt = None,
-    gravity: GravityOpt = None,
-    tref: TrefOpt = None,
-    allow_narrow: AllowNarrowOpt = False,
-    allow_motion: AllowMotionOpt = False,
-    names: NamesOpt = None,
-    topic: TopicOpt = None,
-    rate: RateOpt = None,
-    on_bad_lines: OnBadLinesOpt = "error",
-    delimiter: DelimiterOpt = None,
-    decimal: DecimalOpt = None,
-    as_json: JsonOpt = False,
-) -> None:
+_FAMILY_FIELDS = fit_option_table()
+"""The family options of ``fit``, by option name without dashes: built from the families'
+declarations (:mod:`thermocal.families`), not written here."""
+
+
+def _family_help(decls: list[tuple[str, FamilyOption]]) -> str:
+    """One help text for an option several families may share: ``poly: …; warmup: ….``
+    (families giving the same text named together)."""
+    by_text: dict[str, list[str]] = {}
+    for fam, o in decls:
+        by_text.setdefault(o.help, []).append(fam)
+    return "; ".join(f"{', '.join(fams)}: {text}" for text, fams in by_text.items()) + "."
+
+
+def _negated(cli: str) -> str:
+    """The negative of a yes/no option (``--per-run-offset`` → its ``no-`` form)."""
+    return "-" * 2 + "no-" + cli[2:]
+
+
+def _family_parameters() -> list[inspect.Parameter]:
+    """One typer option per family option of :data:`_FAMILY_FIELDS` (a switch: its flag
+    and its choice; a yes/no: ``--NAME/--no-NAME``; numbers as numbers; a list of numbers
+    as text, parsed by :func:`_family_values`)."""
+    out: list[inspect.Parameter] = []
+
+    def add(name: str, kind: type[Any] | Any, option: Any, default: Any) -> None:
+        out.append(inspect.Parameter(name, KW, annotation=Annotated[kind, option], default=default))
+
+    for field, decls in _FAMILY_FIELDS.items():
+        first, cli, text = decls[0][1], decls[0][1].cli, _family_help(decls)
+        if first.switch:
+            add(field, bool, typer.Option(cli, help=text), False)
+            switch = "--" + first.switch.replace("_", "-")
+            choice = f"{' | '.join(first.choices)} (with {cli})."
+            add(first.switch, str, typer.Option(switch, help=choice), first.choices[0])
+        elif first.kind == "bool":
+            add(field, bool | None, typer.Option(f"{cli}/{_negated(cli)}", help=text), None)
+        else:
+            kind = {"int": int, "float": float}.get(first.kind, str)
+            add(field, kind | None, typer.Option(cli, help=text), None)
+    return out
+
+
+def _family_values(values: dict[str, Any]) -> dict[str, Any]:
+    """The family options given on the command line as the families declare them: a list
+    of numbers (``--breakpoints 25,30``) parsed into a tuple of floats [°C]."""
+    out = dict(values)
+    for field, decls in _FAMILY_FIELDS.items():
+        text = values.get(field)
+        if decls[0][1].kind == "floats" and text is not None:
+            numbers = split_floats(text, decls[0][1].cli) or []
+            if not numbers:
+                raise ThermocalInputError(
+                    f"{decls[0][1].cli} {text!r} holds no number: give them as 25,30, or "
+                    "--segments N to choose them from the data"
+                )
+            out[field] = tuple(numbers)
+    return out
+
+
+def fit_cmd(**values: Any) -> None:
     """Fit a temperature-compensation model on one or several runs and save it."""
-    result = _fit.fit_files(files, options_of(FitOptions, locals()), output)
+    files, output, as_json = values.pop("files"), values.pop("output"), values.pop("as_json")
+    values = _family_values(values)
+    options = options_of(FitOptions, values)
+    options = dataclasses.replace(options, params=family_params(values))
+    result = _fit.fit_files(files, options, output)
     if result.calibration:
         emit(result.to_dict(), as_json, lambda: _human_channels(result.channels, output))
         return
     ch = result.channels[0]
     emit(result.to_dict(), as_json, lambda: _human_single(ch.model, ch.figures, ch.n_runs, output))
+
+
+KW = inspect.Parameter.KEYWORD_ONLY
+_EMPTY = inspect.Parameter.empty
+_COMMON_FIRST = (
+    ("files", FilesArg, _EMPTY), ("model", FamilyOpt, _EMPTY), ("output", OutputOpt, _EMPTY),
+    ("signal", SignalOpt, None), ("temps", TempsOpt, None), ("time", TimeOpt, None),
+    ("time_unit", TimeUnitOpt, None), ("signal_unit", SignalUnitOpt, None),
+    ("temp_unit", TempUnitOpt, None), ("temp_conversion", TempConversionOpt, None),
+)  # fmt: skip
+_COMMON_LAST = (
+    ("target", TargetOpt, "bias"), ("latitude", LatitudeOpt, None), ("axis", AxisOpt, None),
+    ("known_input", KnownInputOpt, None), ("gravity_axis", GravityAxisOpt, None),
+    ("gravity", GravityOpt, None), ("tref", TrefOpt, None),
+    ("allow_narrow", AllowNarrowOpt, False), ("allow_motion", AllowMotionOpt, False),
+    ("names", NamesOpt, None), ("topic", TopicOpt, None), ("rate", RateOpt, None),
+    ("on_bad_lines", OnBadLinesOpt, "error"), ("delimiter", DelimiterOpt, None),
+    ("decimal", DecimalOpt, None), ("as_json", JsonOpt, False),
+)  # fmt: skip
+"""The options of ``fit`` every family shares, around the families' own."""
+
+fit_cmd.__signature__ = inspect.Signature(  # type: ignore[attr-defined]
+    [inspect.Parameter(n, KW, annotation=a, default=d) for n, a, d in _COMMON_FIRST]
+    + _family_parameters()
+    + [inspect.Parameter(n, KW, annotation=a, default=d) for n, a, d in _COMMON_LAST]
+)
+app.command("fit")(handle_errors(fit_cmd))
 
 
 def _human_single(
@@ -294,7 +248,7 @@ def _human_single(
     tab.add_row("runs / samples", f"{n_runs} / {st.n_samples}")
     tab.add_row("coefficients", str(st.n_coefficients))
     tab.add_row(f"rms residual [{unit}]", fmt(result["rms_residual"]))
-    wording = _base.condition_wording(kappa)
+    wording = _results.condition_wording(kappa)
     tab.add_row("condition number", f"{fmt(st.condition_number)} ({wording})")
     if corr:
         tab.add_row(

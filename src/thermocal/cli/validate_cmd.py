@@ -1,6 +1,6 @@
 """``thermocal validate MODEL.json FILE [--modeling FILE] [--ambient COL]``.
 
-Judges a model on an independent, weakly correlated test (SPEC §5,
+Judges a model on an independent, weakly correlated test ([Seed-RLG],
 :func:`thermocal.validation.validate`).  ``r`` compares the ``--ambient`` column
 of the modelling and validation runs (default: the model's first temperature
 column).  Without ``--modeling`` the model file's recorded data file is used if

@@ -1,8 +1,8 @@
-"""Compensation with a fitted model, in memory and live (SPEC §4, §8): the maths of
-:mod:`thermocal.pipeline.compensate` without files (issue 15: the maths imports no I/O).
+"""Compensation with a fitted model, in memory and live ([Seed-RLG]): the maths of
+:mod:`thermocal.pipeline.compensate` without files (the maths imports no I/O).
 
 A model gives the temperature-induced part of the signal, ``ŷ = model(T, Ṫ, …)``; the
-compensated output is ``F' = F − ŷ`` (SPEC §4c: "output F' = F − ΔF").
+compensated output is ``F' = F − ŷ`` ([Seed-Plan]: "output F' = F − ΔF").
 
 * :func:`compensate_run` — in memory, ``model.predict(run)`` on a whole run.
 * :class:`ChunkPredictor` — a long run chunk by chunk with the *context* the model needs
@@ -41,15 +41,9 @@ from thermocal.errors import (
     UnitError,
     UnitWarning,
 )
-from thermocal.models.base import (
-    ChunkContext,
-    ModelStream,
-    RangeExcess,
-    RangeTally,
-    RunData,
-    TemperatureModel,
-    outside_range_message,
-)
+from thermocal.models.base import ChunkContext, ModelStream, TemperatureModel
+from thermocal.models.ranges import RangeExcess, RangeTally, outside_range_message
+from thermocal.models.rundata import RunData
 from thermocal.recording import GAP_FACTOR, FloatArray, Metadata, Recording, median_interval
 
 # --- unit handling ------------------------------------------------------------------------
@@ -66,7 +60,8 @@ def unit_factor(
     """Factor ``f`` with ``value[model unit] = f · value[data unit]`` (all units are linear).
 
     Raw ``counts`` data are turned into a physical unit with the metadata's scale
-    factor K (SPEC §1: ``ω = N/(τK)`` or ``N/K``, :func:`thermocal.units.counts_to_physical`).
+    factor K (IEEE Std 952-1997: ``ω = N/(τK)`` or ``N/K``,
+    :func:`thermocal.units.counts_to_physical`).
 
     Raises
     ------
@@ -238,7 +233,7 @@ class Compensation:
 def compensate_run(
     model: TemperatureModel, run: RunData, *, extrapolate: bool = False
 ) -> Compensation:
-    """Apply a model to a whole run in memory: ``F' = F − ŷ(T, Ṫ, …)`` (SPEC §4).
+    """Apply a model to a whole run in memory: ``F' = F − ŷ(T, Ṫ, …)``.
 
     ``run.signal`` must be in the model's unit.  ``known_input`` is not removed:
     the compensated output still contains the true input (earth rate, gravity).
@@ -353,7 +348,7 @@ def zero_reference(
     "zero" of the absolute figures (:class:`AbsoluteFigures`).
 
     In order: ``known_input`` when given (non-zero); for a gyro, the earth rate on the
-    sensitive axis when the data's metadata give latitude and axis (SPEC §1,
+    sensitive axis when the data's metadata give latitude and axis (IEEE Std 952-1997,
     :func:`thermocal.units.earth_rate_on_axis_deg_h`); the known input the model file
     recorded of its fit (``inputs.known_input``, assumed the same on this run); else 0.
     """
@@ -534,7 +529,7 @@ class StreamingCompensator:
 
 
 class CalibrationStream:
-    """Compensate every channel of a calibration sample by sample (live data, issue 15).
+    """Compensate every channel of a calibration sample by sample (live data).
 
     One :class:`StreamingCompensator` per channel (each keeps its own rate buffer and
     power-on state), fed from one sample of the whole IMU: the time [s], the
@@ -809,7 +804,7 @@ class ChunkPredictor:
     def finish(self) -> None:
         """Issue one :class:`ExtrapolationWarning` for the whole file when samples left the
         calibrated ranges (temperature, Ṫ, time since power-on), saying for what share of
-        the samples and how far (:func:`~thermocal.models.base.outside_range_message`)."""
+        the samples and how far (:func:`~thermocal.models.ranges.outside_range_message`)."""
         self.warn_outside()
 
     @property

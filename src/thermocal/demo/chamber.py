@@ -46,10 +46,11 @@ from thermocal import units
 from thermocal.compensate.kernels import zero_reference
 from thermocal.errors import ModelFileError, ThermocalWarning
 from thermocal.export.c import export_c
-from thermocal.models.base import RunData, TemperatureModel
-from thermocal.models.files import save_model
+from thermocal.models.base import TemperatureModel
 from thermocal.models.registry import make_model
+from thermocal.models.rundata import RunData
 from thermocal.pipeline.compensate import compensate_file
+from thermocal.pipeline.model_file import save_model
 from thermocal.profiles import design_validation_profile, rlg_modelling
 from thermocal.recording import Recording
 from thermocal.report import ModelEntry, ReportInputs, write_report

@@ -26,11 +26,12 @@ from thermocal import units
 from thermocal.compensate.kernels import prepare_run, zero_reference
 from thermocal.errors import ThermocalWarning
 from thermocal.export.c import generate_c_calibration
-from thermocal.models.base import RunData, model_file_dict, model_inputs
 from thermocal.models.calibration import Calibration, Channel, guess_role
-from thermocal.models.files import save_calibration
+from thermocal.models.format import model_file_dict
 from thermocal.models.poly import PolyModel
+from thermocal.models.rundata import RunData, model_inputs
 from thermocal.pipeline.compensate import compensate_channels
+from thermocal.pipeline.model_file import save_calibration
 from thermocal.report.calibration import CalibrationReportInputs, write_calibration_report
 from thermocal.simulate import IMU_CHANNELS, SCENARIOS
 from thermocal.validation import validate

@@ -105,7 +105,9 @@ def run_demo(out: Path, time_scale: float = 200.0) -> dict[str, object]:
     finally:
         sensor.stop()
         sim.stop()
-    fit_opts = FitOptions(model="poly", order=1, signal="gx", temps="temp")
+    fit_opts = FitOptions(
+        model="poly", params={"order": 1}, signals=("gx",), temperatures=("temp",)
+    )
     fit_files([out / "modelling"], fit_opts, out / "model.json")
     validate_files(
         out / "model.json", out / "validation", ValidateOptions(modeling=out / "modelling")

@@ -680,7 +680,7 @@ def export_params_file(
         ArduPilot's 10 °C sweep too).
     """
     from thermocal.export.checks import check_firmware_adequacy
-    from thermocal.models.files import load_calibration
+    from thermocal.pipeline.model_file import load_calibration
     from thermocal.writers import atomic_write, check_not_input
 
     check_not_input(output, [calibration])

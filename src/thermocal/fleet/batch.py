@@ -288,7 +288,7 @@ def channel_figures(
     dict of str to dict
         Per channel its figures and ``unit``.
     """
-    from thermocal.models.files import load_calibration
+    from thermocal.pipeline.model_file import load_calibration
 
     cal = load_calibration(calibration)
     vals = _per_channel(validation, cal.names)
@@ -549,7 +549,7 @@ def verify_unit_folder(folder: Path, rec: Mapping[str, Any]) -> list[str]:
     list of str
         What is wrong (empty: it verifies).
     """
-    from thermocal.models.files import load_calibration
+    from thermocal.pipeline.model_file import load_calibration
 
     problems: list[str] = []
     files = rec.get("files")

@@ -1,4 +1,4 @@
-"""Adaptive model bank chosen at power-on (SPEC §4d, seed 004, accelerometers).
+"""Adaptive model bank chosen at power-on ([Seed-Accel], accelerometers).
 
 Run-to-run repeatability is poor, so one model does not fit every turn-on.  The
 bank holds one continuous piecewise-linear model of the output against one
@@ -87,13 +87,11 @@ from thermocal.errors import (
     ModelFileError,
     ThermocalInputError,
 )
+from thermocal.families import BANK, FamilyDeclaration
 from thermocal.models.base import (
     ChunkContext,
     ClampOnce,
-    Coefficient,
-    FitStats,
     ModelStream,
-    RunData,
     TemperatureModel,
     stream_channel,
 )
@@ -107,7 +105,10 @@ from thermocal.models.checks import (
     sensor_param,
     string,
 )
-from thermocal.models.warmup import CONDITION_WARN, channel_index, lstsq_svd, single_channel
+from thermocal.models.numerics import channel_index, lstsq_svd, single_channel
+from thermocal.models.results import Coefficient, FitStats
+from thermocal.models.rundata import RunData
+from thermocal.models.warmup import CONDITION_WARN
 from thermocal.preprocess import segment_holds
 from thermocal.recording import FloatArray
 
@@ -130,7 +131,7 @@ def pwl_evaluate(breakpoints_c: FloatArray, values: FloatArray, temp_c: FloatArr
         f(T) = v_j + (v_{j+1} − v_j)/(x_{j+1} − x_j) · (T − x_j),   x_j ≤ T < x_{j+1}
 
     with the end segments extended linearly outside ``[x_0, x_K]`` (callers clamp
-    first when they do not want to extrapolate).  SPEC §4b/§4d.
+    first when they do not want to extrapolate).  [Seed-FOG], [Seed-Accel].
     """
     x = breakpoints_c
     j = np.clip(np.searchsorted(x, temp_c, side="right") - 1, 0, x.size - 2)
@@ -232,7 +233,7 @@ def _selection(dev: FloatArray, n: int, complete: bool) -> Selection:
 
 class BankModel(TemperatureModel):
     """Bank of piecewise-linear models, one per characteristic curve, chosen at
-    power-on (SPEC §4d, seed 004).
+    power-on ([Seed-Accel]).
 
     Parameters
     ----------
@@ -246,10 +247,47 @@ class BankModel(TemperatureModel):
     grid_step_c : bin width of the curves compared in the clustering [°C].
     hold_min_s : shortest constant-temperature hold used as a characteristic point [s].
     error_metric : ``"max"`` or ``"rms"`` of model − characteristic line.
+
+    Notes
+    -----
+    Each model :math:`f_m` of the bank is a continuous piecewise-linear function of one
+    temperature; at power-on the model whose mean residual over the start-up samples is
+    smallest is chosen,
+
+    .. math::
+
+        D_m(N) = \\Bigl| \\frac{1}{N} \\sum_{i<N} \\bigl(y_i - f_m(T_i)\\bigr) \\Bigr| ,
+        \\qquad \\hat m = \\arg\\min_m D_m ,
+
+    and the compensated output is :math:`F' = F - f_{\\hat m}(T)`.
+
+    References
+    ----------
+    .. [1] *Adaptive accelerometer temperature compensation method for inertial
+       navigation*, Chinese invention patent, published 2020 (docs/methods.md,
+       Seed-Accel).
+
+    Examples
+    --------
+    Four runs over −20…60 °C on two characteristic curves 3 mg apart; a power-on that
+    reads 3.5 mg at 25 °C picks the second curve (3.025 + 0.02 · 25 mg):
+
+    >>> import numpy as np
+    >>> from thermocal.models import RunData
+    >>> from thermocal.models.bank import BankModel
+    >>> t = np.arange(0.0, 6000.0, 10.0)
+    >>> temp = np.clip(-20.0 + t / 60.0, -20.0, 60.0)
+    >>> runs = [RunData(t, temp[:, None], c + 0.02 * temp, ("T1",))
+    ...         for c in (0.0, 0.05, 3.0, 3.05)]
+    >>> model = BankModel(deviation=1.0, tolerance=0.2).fit(runs)
+    >>> len(model.values_)
+    2
+    >>> on = RunData(np.arange(60.0), np.full((60, 1), 25.0), np.full(60, 3.5), ("T1",))
+    >>> round(float(model.predict(on)[-1]), 3)
+    3.525
     """
 
-    family: ClassVar[str] = "bank"
-    C_GENERATOR: ClassVar[str | None] = "thermocal.export.c.bank"
+    declaration: ClassVar[FamilyDeclaration] = BANK
     uses_rate: ClassVar[bool] = False
 
     breakpoints_: list[FloatArray]
@@ -311,7 +349,7 @@ class BankModel(TemperatureModel):
     # -- fit --
     def fit(self, runs: Sequence[RunData]) -> Self:
         """Group the runs into characteristic curves, fit a piecewise-linear model
-        per group and keep those within ``tolerance`` (SPEC §4d steps 1–3)."""
+        per group and keep those within ``tolerance`` ([Seed-Accel], steps 1–3)."""
         self._check_params()
         if not runs:
             raise ThermocalInputError("bank: no runs to fit")
@@ -547,7 +585,7 @@ class BankModel(TemperatureModel):
         return dev, choice, m
 
     def select(self, run: RunData, *, extrapolate: bool = False) -> Selection:
-        """The model chosen for a power-on from its start-up window (SPEC §4d step 4);
+        """The model chosen for a power-on from its start-up window ([Seed-Accel], step 4);
         also stored in ``selection_``."""
         temp = self._prepare(run, extrapolate)
         f = self._model_matrix(temp[: self._startup_count(run)])

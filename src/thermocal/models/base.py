@@ -1,14 +1,14 @@
 """The contract every temperature-compensation model follows, and its file format.
 
-Estimator contract (STYLE.md, after scikit-learn): ``__init__`` only stores its
+Estimator contract (after scikit-learn): ``__init__`` only stores its
 keyword arguments; ``fit(runs)`` validates, learns values whose names end in
 ``_`` and returns ``self``; ``predict(run)`` returns the temperature-induced
-signal (bias, or scale-factor error, SPEC §4e) in the signal's canonical unit;
+signal (bias, or scale-factor error, [Seed-RLG]) in the signal's canonical unit;
 ``get_params()`` returns the constructor arguments.  The families are listed by name in
-the one registry, :data:`thermocal.models.registry.MODEL_REGISTRY` (STYLE rule 8), which
+the one registry, :data:`thermocal.models.registry.MODEL_REGISTRY`, which
 sits above them: this module knows no family.
 
-A model file is a self-describing, versioned JSON object (SPEC §8)::
+A model file is a self-describing, versioned JSON object::
 
     {
       "format": "thermocal-model", "format_version": 3,
@@ -57,340 +57,33 @@ from __future__ import annotations
 import copy
 import datetime as _dt
 import functools
-import hashlib
 import inspect
-import json
-import math
 import warnings
 from abc import ABC, abstractmethod
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, field
-from typing import Any, ClassVar, Literal, Self
+from dataclasses import dataclass
+from typing import Any, ClassVar, Self
 
 import numpy as np
 
 from thermocal.adequacy import Needs
 from thermocal.errors import (
-    DesignError,
     ExtrapolationWarning,
     ModelFileError,
     ThermocalInputError,
-    UnitError,
-    UnitWarning,
 )
-from thermocal.recording import FloatArray, Recording
+from thermocal.families import FamilyDeclaration
+from thermocal.models.format import MODEL_FORMAT, MODEL_FORMAT_VERSION, _jsonify, check_model_header
+from thermocal.models.results import Coefficient, FitStats
+from thermocal.models.rundata import RunData, _run_units
+from thermocal.recording import FloatArray
 from thermocal.units import (
     DEFAULT_UNITS,
     LEGACY_TEMPERATURE_UNIT,
     StatedUnits,
-    canonical_unit,
     normalize_signal_unit,
     normalize_temperature_unit,
 )
-
-MODEL_FORMAT = "thermocal-model"
-MODEL_FORMAT_VERSION = 3
-
-
-# --- input data ------------------------------------------------------------------------
-
-
-@dataclass(frozen=True)
-class RunData:
-    """One run (one power-on) as a model sees it.
-
-    Attributes
-    ----------
-    time_s : sample times [s], shape (n,).
-    temps_c : temperatures [°C] (raw counts when ``temperature_unit`` is ``counts``),
-        shape (n, k), columns in ``temp_names`` order.
-    signal : sensor output in its canonical unit ([°/h] or [mg]), shape (n,),
-        or ``None`` when only predicting from temperatures.
-    temp_names : names of the temperature columns.
-    name : where the run came from (file name), for messages and provenance.
-    known_input : the known input to remove before fitting (earth rate [°/h],
-        gravity component [mg]); subtracted from ``signal`` by :meth:`target`.
-    signal_unit : the canonical unit of ``signal`` (``deg/h``, ``mg`` or ``counts``) when
-        known (:meth:`from_recording` sets it); a model fitted on the run records it.
-    temperature_unit : ``degC``, or ``counts`` for raw-count temperatures used without a
-        conversion (a model fitted on them is in counts).
-    """
-
-    time_s: FloatArray
-    temps_c: FloatArray
-    signal: FloatArray | None = None
-    temp_names: tuple[str, ...] = ()
-    name: str = ""
-    known_input: float = 0.0
-    extra: dict[str, Any] = field(default_factory=dict)
-    signal_unit: str | None = None
-    temperature_unit: str = "degC"
-
-    def __post_init__(self) -> None:
-        n = self.time_s.shape[0]
-        if self.temps_c.ndim != 2 or self.temps_c.shape[0] != n:
-            raise ThermocalInputError(
-                f"{self.name or 'run'}: temperatures must be (n_samples, n_sensors); got "
-                f"{self.temps_c.shape} for {n} samples"
-            )
-        if self.signal is not None and self.signal.shape != (n,):
-            raise ThermocalInputError(
-                f"{self.name or 'run'}: signal has {self.signal.shape[0]} samples, time has {n}"
-            )
-
-    @property
-    def n_samples(self) -> int:
-        return int(self.time_s.shape[0])
-
-    def target(self) -> FloatArray:
-        """The signal minus the known input: what a model is fitted to."""
-        if self.signal is None:
-            raise ThermocalInputError(f"{self.name or 'run'}: no signal to fit")
-        return self.signal - self.known_input
-
-    @classmethod
-    def from_recording(
-        cls,
-        rec: Recording,
-        signal: str | None = None,
-        temps: Sequence[str] | None = None,
-        *,
-        known_input: float = 0.0,
-        require_signal: bool = True,
-        temperature_unit: Literal["degC", "counts", "auto"] = "degC",
-    ) -> RunData:
-        """Pull the time, temperatures and signal (canonical unit) out of a recording.
-
-        ``temperature_unit``: ``degC`` (raw counts converted, a counts column without a
-        conversion is an error); ``counts`` (the raw counts as stored, for a model fitted
-        in counts; a °C column is an error); ``auto`` (fit): ``counts`` when every used
-        temperature is in raw counts with no conversion stated, else ``degC``.
-        NaN in the used columns is an input error (never silently dropped).
-        """
-        names = tuple(temps) if temps else rec.temperatures
-        if not names:
-            raise ThermocalInputError(
-                f"{rec.name}: no temperature columns named; available: "
-                + ", ".join(repr(c) for c in rec.columns)
-            )
-        t_unit = temperature_unit
-        if t_unit == "auto":
-            t_unit = _auto_temperature_unit(rec, names)
-        if t_unit == "counts":
-            temps_c = np.column_stack([rec.temperature_counts(n) for n in names])
-        else:
-            temps_c = rec.temperatures_c(names)
-        sig: FloatArray | None = None
-        sig_unit: str | None = None
-        if require_signal or signal is not None or rec.signals:
-            try:
-                sig, sig_unit = rec.signal(signal)
-            except ThermocalInputError:
-                if require_signal:
-                    raise
-        for label, arr in [("time", rec.time_s), ("temperatures", temps_c)] + (
-            [("signal", sig)] if sig is not None else []
-        ):
-            bad = ~np.isfinite(arr)
-            if bad.any():
-                row = int(np.argwhere(bad)[0][0])
-                raise ThermocalInputError(
-                    f"{rec.name}: {label} has {int(bad.sum())} NaN/non-finite values "
-                    f"(first at row {row}); clean or cut the data first"
-                )
-        return cls(
-            time_s=rec.time_s,
-            temps_c=temps_c,
-            signal=sig,
-            temp_names=names,
-            name=rec.source or rec.meta.run_id or "",
-            known_input=known_input,
-            signal_unit=sig_unit,
-            temperature_unit=t_unit,
-        )
-
-
-def _auto_temperature_unit(rec: Recording, names: Sequence[str]) -> Literal["degC", "counts"]:
-    """``counts`` when every temperature column is in raw counts with no conversion (a
-    model in counts), ``degC`` when none is; a mix is an input error naming the columns."""
-    raw = [
-        n
-        for n in names
-        if rec.units.get(n) == "counts" and n not in rec.meta.temperature_conversion
-    ]
-    if not raw:
-        return "degC"
-    if len(raw) < len(names):
-        raise UnitError(
-            f"{rec.name}: temperature column(s) {', '.join(map(repr, raw))} are raw counts "
-            "without a conversion, the others are in °C; a model takes one temperature "
-            "unit: give --temp-conversion GAIN,OFFSET[,int16] for the counts"
-        )
-    warnings.warn(
-        UnitWarning(
-            f"{rec.name}: temperature column(s) {', '.join(map(repr, raw))} are raw counts "
-            "and no conversion to °C is given: the model is fitted in counts (its ranges and "
-            "coefficients are per count) and applies to raw-count data only"
-        ),
-        stacklevel=3,
-    )
-    return "counts"
-
-
-def _run_units(runs: Sequence[RunData]) -> tuple[str | None, str]:
-    """(canonical signal unit or None, temperature unit) shared by ``runs``; runs that
-    disagree are an input error naming both."""
-    sig = {r.signal_unit for r in runs if r.signal_unit}
-    if len(sig) > 1:
-        raise UnitError(f"the runs' signals are in different units: {', '.join(sorted(sig))}")
-    temp = {r.temperature_unit for r in runs}
-    if len(temp) > 1:
-        raise UnitError(
-            "some runs give temperatures in °C and some in raw counts without a conversion; "
-            "give --temp-conversion for the counts"
-        )
-    return (next(iter(sig)) if sig else None), (next(iter(temp)) if temp else "degC")
-
-
-def model_inputs(
-    rec: Recording,
-    signal: str,
-    temps: Sequence[str],
-    *,
-    known_input: float = 0.0,
-    known_input_what: str | None = None,
-) -> dict[str, Any]:
-    """What a model file records of how its fitted data were written (``inputs``): the
-    time unit, the signal's and temperatures' units as given (e.g. ``deg/s``, ``counts``)
-    and where each was stated, the raw-count temperature conversions, the scale factor of
-    a raw-count signal, and the known input removed (value in the canonical unit and what
-    it is).  ``rec`` is a recording read by :func:`thermocal.readers.dispatch.read_recording`."""
-    used = [signal, *temps]
-    out: dict[str, Any] = {
-        "time_unit": rec.time_unit,
-        "units": {c: rec.units[c] for c in used if rec.units.get(c)},
-        "unit_sources": {c: s for c, s in rec.unit_sources.items() if c in used or c == "<time>"},
-        "temperature_conversion": {
-            c: list(rec.meta.temperature_conversion[c].to_json())
-            for c in temps
-            if c in rec.meta.temperature_conversion and rec.units.get(c) == "counts"
-        },
-    }
-    sig_unit = rec.units.get(signal)
-    if sig_unit == "counts" and rec.meta.scale_factor is not None:
-        out["scale_factor"] = {
-            "value": rec.meta.scale_factor,
-            "unit": rec.meta.scale_factor_unit,
-        }
-    if rec.meta.sensor_id:
-        out["sensor_id"] = str(rec.meta.sensor_id)
-    if rec.n_samples > 1:  # sizes the Ṫ buffer of the exported C (export-c)
-        out["sample_interval_s"] = float(rec.sample_interval_s)
-    canon = canonical_unit(sig_unit) if sig_unit else None
-    if sig_unit == "counts" and rec.meta.scale_factor is not None:  # the fit's values are
-        canon = rec.signal(signal)[1]  # physical (counts / K), and so is the known input
-    out["known_input"] = {
-        "value": float(known_input),
-        "unit": canon,
-        "what": known_input_what or ("none" if known_input == 0.0 else "given"),
-    }
-    return out
-
-
-def check_sensor_id(
-    model_inputs: Mapping[str, Any] | None, data_sensor_id: Any, where: str
-) -> None:
-    """:class:`ExtrapolationWarning` when the data's sensor id (metadata ``sensor_id``)
-    differs from the one the model was fitted on (model file ``inputs.sensor_id``):
-    a compensation model belongs to one sensor (issue 14). Silent when either is unknown."""
-    fitted = (model_inputs or {}).get("sensor_id")
-    if not fitted or not data_sensor_id or str(fitted) == str(data_sensor_id):
-        return
-    warnings.warn(
-        f"{where}: the data come from sensor {str(data_sensor_id)!r} but the model was fitted "
-        f"on sensor {str(fitted)!r}; a compensation model belongs to one sensor",
-        ExtrapolationWarning,
-        stacklevel=2,
-    )
-
-
-# --- fitted coefficients and statistics ----------------------------------------------------
-
-
-@dataclass(frozen=True)
-class Coefficient:
-    """A learned coefficient, in physical (unscaled) units, with its standard error."""
-
-    name: str
-    value: float
-    stderr: float | None = None
-    unit: str = ""
-
-    def to_dict(self) -> dict[str, Any]:
-        d: dict[str, Any] = {"name": self.name, "value": self.value}
-        # a standard error that cannot be estimated (no residual degrees of freedom) is
-        # left out — "not estimable" — rather than written as a non-JSON NaN
-        if self.stderr is not None and math.isfinite(self.stderr):
-            d["stderr"] = self.stderr
-        if self.unit:
-            d["unit"] = self.unit
-        return d
-
-
-@dataclass(frozen=True)
-class FitStats:
-    """Fit statistics reported with every model.
-
-    ``rms_residual`` in the signal unit; ``condition_number`` of the scaled
-    design (2-norm, from the SVD); ``dof`` residual degrees of freedom.
-    """
-
-    n_samples: int
-    n_coefficients: int
-    rms_residual: float
-    condition_number: float | None = None
-    r_squared: float | None = None
-    dof: int | None = None
-    extra: dict[str, Any] = field(default_factory=dict)
-
-    def to_dict(self) -> dict[str, Any]:
-        d: dict[str, Any] = {
-            "n_samples": self.n_samples,
-            "n_coefficients": self.n_coefficients,
-            "rms_residual": self.rms_residual,
-            "condition_number": self.condition_number,
-            "r_squared": self.r_squared,
-            "dof": self.dof,
-        }
-        d.update(self.extra)
-        return d
-
-
-CONDITION_WORDS: tuple[tuple[float, str], ...] = (
-    (1e3, "well conditioned"),
-    (1e6, "moderately conditioned"),
-    (1e10, "ill-conditioned"),
-    (math.inf, "near singular"),
-)
-"""Upper bounds of the 2-norm condition number κ of the scaled design and their words."""
-
-
-def condition_wording(kappa: float | None) -> str:
-    """Words for a condition number κ that match the number (issue 13 item 9).
-
-    κ ≤ 1e3 well conditioned; ≤ 1e6 moderately (about log₁₀κ of the data's digits are
-    lost: the coefficients' standard errors are inflated by collinear terms); ≤ 1e10
-    ill-conditioned (individual coefficients are not meaningful, only the prediction);
-    beyond, near singular. Least squares loses ≈ log₁₀ κ significant digits (Golub & Van
-    Loan, *Matrix Computations*, 4th ed., §5.3.8).
-    """
-    if kappa is None or not math.isfinite(kappa):
-        return "condition unknown"
-    words = next(w for bound, w in CONDITION_WORDS if kappa <= bound)
-    if kappa <= 1e3:
-        return words
-    return f"{words}: about {math.log10(kappa):.0f} of the data's digits lost"
-
 
 # --- helpers for single-temperature streams --------------------------------------------------
 
@@ -521,6 +214,10 @@ class TemperatureModel(ABC):
         """Every family's ``fit`` records the units of its runs (signal, temperature) —
         the model learns its inputs without each family having to."""
         super().__init_subclass__(**kwargs)
+        decl = cls.__dict__.get("declaration")
+        if decl is not None:  # the name and the C generator are the declaration's
+            cls.family = decl.name
+            cls.C_GENERATOR = decl.c_generator
         fit = cls.__dict__.get("fit")
         if fit is None or getattr(fit, "_records_units", False):
             return
@@ -595,27 +292,41 @@ class TemperatureModel(ABC):
 
     C_GENERATOR: ClassVar[str | None] = None
     """The module of :mod:`thermocal.export.c` whose ``generate(ctx)`` writes this family's
-    C code (imported only by ``export-c``); None: no C export."""
+    C code (imported only by ``export-c``); None: no C export.  Set from
+    :attr:`declaration`."""
 
-    CLI_KEYS: ClassVar[Mapping[str, str] | None] = None
-    """``thermocal fit`` option key → constructor parameter; None (every family of the
-    registry): the constructor's own parameter names.  The one option parser,
-    :meth:`from_cli_options`, refuses the rest."""
-
-    @classmethod
-    def cli_keys(cls) -> dict[str, str]:
-        """``thermocal fit`` option key → constructor parameter: :attr:`CLI_KEYS`, else the
-        constructor's own parameter names, in its order."""
-        if cls.CLI_KEYS is not None:
-            return dict(cls.CLI_KEYS)
-        return {p: p for p in cls._param_names()}
+    declaration: ClassVar[FamilyDeclaration]
+    """What the family declares of itself (:class:`~thermocal.families.FamilyDeclaration`):
+    its name, fit options with bounds, data needs, C generator and firmware formats."""
 
     @classmethod
-    def from_cli_options(cls, options: Mapping[str, Any]) -> Self:
-        """Build from the ``thermocal fit`` option dict: ``None`` values are options not
-        given; a given option the family does not take is an input error naming it and
-        the options the family does take (the same rule for every family)."""
-        keys = cls.cli_keys()
+    def from_options(cls, options: Mapping[str, Any]) -> Self:
+        """Build from fit options ``{constructor parameter: value}``, each checked against
+        the family's declared option (type and bounds).
+
+        ``None`` values are options not given; a given option the family does not declare
+        is refused, naming it and the options the family takes (the same rule for every
+        family).
+
+        Parameters
+        ----------
+        options : mapping of str to object
+            Constructor parameters as declared (``{"order": 2, "rate_interval_s": 60.0}``).
+
+        Returns
+        -------
+        TemperatureModel
+            The unfitted model.
+
+        Raises
+        ------
+        thermocal.errors.ThermocalInputError
+            An option the family does not take.
+        thermocal.errors.ParameterError
+            A value of the wrong type or out of its declared bounds, naming the parameter.
+        """
+        decl = cls.declaration
+        keys = [o.name for o in decl.options]
         given = {k: v for k, v in options.items() if v is not None}
         unknown = [k for k in given if k not in keys]
         if unknown:
@@ -624,7 +335,7 @@ class TemperatureModel(ABC):
                 f"option{'s' if len(unknown) > 1 else ''} {', '.join(unknown)} {verb} not apply "
                 f"to model {cls.family!r} (it takes: {', '.join(keys)})"
             )
-        return cls(**{keys[k]: v for k, v in given.items()})
+        return cls(**{k: decl.option(k).check(v) for k, v in given.items()})
 
     def chunk_context(self) -> ChunkContext:
         """The context a chunk needs (:class:`ChunkContext`); the default — all history —
@@ -843,319 +554,3 @@ class TemperatureModel(ABC):
         # files before format version 3 were always fitted in °C (and say so)
         model.temperature_unit = normalize_temperature_unit(str(tu or LEGACY_TEMPERATURE_UNIT))
         return model
-
-
-# --- file I/O ------------------------------------------------------------------------------
-
-
-def _jsonify(obj: Any) -> Any:
-    if isinstance(obj, dict):
-        return {str(k): _jsonify(v) for k, v in obj.items()}
-    if isinstance(obj, list | tuple):
-        return [_jsonify(v) for v in obj]
-    if isinstance(obj, np.ndarray):
-        return _jsonify(obj.tolist())
-    if isinstance(obj, np.generic):
-        return _jsonify(obj.item())
-    if isinstance(obj, float) and not np.isfinite(obj):
-        return None
-    return obj
-
-
-def _canonical(d: dict[str, Any]) -> bytes:
-    return json.dumps(
-        {k: v for k, v in d.items() if k != "checksum"},
-        sort_keys=True,
-        separators=(",", ":"),
-        ensure_ascii=True,
-        allow_nan=False,
-    ).encode("ascii")
-
-
-def checksum(d: dict[str, Any]) -> str:
-    """SHA-256 of the canonical JSON of a model dict (``checksum`` key excluded)."""
-    return hashlib.sha256(_canonical(d)).hexdigest()
-
-
-def check_model_header(d: Any) -> None:
-    """Refuse foreign, newer or unknown model dicts with a clear :class:`ModelFileError`."""
-    if not isinstance(d, dict) or d.get("format") != MODEL_FORMAT:
-        raise ModelFileError("not a thermocal model file (missing 'format': 'thermocal-model')")
-    ver = d.get("format_version")
-    if not isinstance(ver, int):
-        raise ModelFileError("model file has no integer format_version")
-    if ver > MODEL_FORMAT_VERSION:
-        raise ModelFileError(
-            f"model file format version {ver} is newer than this thermocal supports "
-            f"({MODEL_FORMAT_VERSION}); upgrade thermocal"
-        )
-    for key in ("family", "params", "state", "temperatures", "range", "fit"):
-        if key not in d:
-            raise ModelFileError(f"model file is missing the {key!r} section")
-
-
-def _nonfinite_fields(obj: Any, path: str = "") -> list[str]:
-    """Dotted paths of the NaN/inf floats inside a JSON-like structure."""
-    if isinstance(obj, dict):
-        return [p for k, v in obj.items() for p in _nonfinite_fields(v, f"{path}.{k}")]
-    if isinstance(obj, (list, tuple)):
-        return [p for i, v in enumerate(obj) for p in _nonfinite_fields(v, f"{path}[{i}]")]
-    if isinstance(obj, float) and not math.isfinite(obj):
-        return [path.lstrip(".")]
-    return []
-
-
-def model_file_dict(model: TemperatureModel) -> dict[str, Any]:
-    """The model file's dict (:meth:`TemperatureModel.to_dict` with its checksum); a
-    non-finite number anywhere is refused with :class:`DesignError` naming the field."""
-    d = model.to_dict()
-    bad = _nonfinite_fields(d)
-    if bad:
-        raise DesignError(
-            f"the fitted model holds non-finite numbers ({', '.join(bad[:5])}): the data do "
-            "not determine it (too few samples or a degenerate design); nothing written"
-        )
-    d["checksum"] = checksum(d)
-    return d
-
-
-# --- applicability: how far a run leaves the calibrated ranges --------------------------------
-
-RANGE_WARNING_PATTERNS: tuple[str, ...] = (
-    r".*samples outside the model's temperature range",
-    r"temperature rate outside the model's fitted range",
-    r"warmup: the record runs",
-)
-"""The per-call range warnings of the families' ``predict`` (temperature, Ṫ, time since
-power-on) that one :func:`outside_range_message` per channel replaces where a whole run
-or file is applied (compensate, validate): pass them to ``warnings.filterwarnings``."""
-
-_SUFFIX = {"°C": "c", "°C/min": "c_per_min", "s": "s", "counts": "counts",
-           "counts/min": "counts_per_min"}  # fmt: skip
-
-
-@dataclass(frozen=True)
-class RangeExcess:
-    """How far one input of a model left the range it was calibrated over.
-
-    ``quantity``: ``temperature`` [°C], ``temperature_rate`` (Ṫ [°C/min], models with rate
-    terms) or ``time_since_power_on`` [s] (warm-up models: the time since the record's first
-    sample against the longest fitted power-on); ``counts``/``counts/min`` for a model in raw
-    counts.  A sample is outside when any checked column is below its calibrated minimum or
-    above its maximum; ``beyond[col]`` is the largest distance ``max(lo − x, x − hi, 0)``
-    over the samples [unit]; ``seen[col]`` the range met and ``fitted[col]`` the calibrated
-    one.
-    """
-
-    quantity: str
-    unit: str
-    n_samples: int
-    n_outside: int
-    beyond: dict[str, float]
-    seen: dict[str, tuple[float, float]]
-    fitted: dict[str, tuple[float, float]]
-
-    @property
-    def share(self) -> float:
-        """Fraction of the samples outside (0…1)."""
-        return self.n_outside / self.n_samples if self.n_samples else 0.0
-
-    @property
-    def max_beyond(self) -> float:
-        """The largest distance outside over every column [unit]."""
-        return max(self.beyond.values(), default=0.0)
-
-    def to_dict(self) -> dict[str, Any]:
-        """``share`` (0…1), ``share_pct``, ``n_outside``, ``n_samples``, ``max_beyond_<unit>``
-        (``_c``, ``_c_per_min``, ``_s``), ``unit``, and per column ``seen``/``range``/``beyond``."""
-        return {
-            "share": self.share,
-            "share_pct": 100.0 * self.share,
-            "n_outside": self.n_outside,
-            "n_samples": self.n_samples,
-            f"max_beyond_{_SUFFIX.get(self.unit, 'value')}": self.max_beyond,
-            "unit": self.unit,
-            "columns": {
-                c: {"seen": list(self.seen[c]), "range": list(self.fitted[c]),
-                    "beyond": self.beyond[c]}
-                for c in self.fitted
-            },
-        }  # fmt: skip
-
-    def describe(self) -> str:
-        """One phrase: share, how far, and the columns that left their range."""
-        what = {"temperature": "temperature", "temperature_rate": "Ṫ",
-                "time_since_power_on": "time after power-on"}[self.quantity]  # fmt: skip
-        cols = ", ".join(
-            f"{c} met {self.seen[c][0]:.4g}…{self.seen[c][1]:.4g} {self.unit}, calibrated "
-            f"{self.fitted[c][0]:.4g}…{self.fitted[c][1]:.4g} {self.unit}"
-            for c in self.fitted
-            if self.beyond[c] > 0
-        )
-        return (
-            f"{what}: {self.n_outside} samples outside ({100.0 * self.share:.3g} % of "
-            f"{self.n_samples}), up to {self.max_beyond:.3g} {self.unit} beyond ({cols})"
-        )
-
-
-class RangeTally:
-    """Accumulates, chunk by chunk, how far a run leaves a model's calibrated ranges.
-
-    Feed the samples in order with :meth:`add` (time [s], temperatures (n, k) in the
-    model's temperature unit, columns in ``temp_names_`` order); :meth:`result` gives one
-    :class:`RangeExcess` per checked input.  Ṫ is the model's own (``model.rates``: its
-    Δt and difference form, never across a gap) computed with the last ``2Δt`` of the
-    previous chunks as history, so chunked and whole-run figures agree for the causal
-    backward form; the time since power-on counts from the first sample added.
-    """
-
-    def __init__(self, model: TemperatureModel) -> None:
-        model.check_fitted()
-        self.model = model
-        self.names = tuple(model.temp_names_)
-        self._lo = np.asarray(model.temp_range_, dtype=np.float64)[:, 0]
-        self._hi = np.asarray(model.temp_range_, dtype=np.float64)[:, 1]
-        tu = "°C" if model.temperature_unit == "degC" else model.temperature_unit
-        self._tu = tu
-        self.n = 0
-        self._t_out = 0
-        self._t_min = np.full(self._lo.size, np.inf)
-        self._t_max = np.full(self._lo.size, -np.inf)
-        # Ṫ: the sensors whose rate a term uses (poly), with the model's rate definition
-        rr = getattr(model, "rate_range_", None)
-        self._rate_cols: list[int] = []
-        if rr is not None and bool(getattr(model, "model_uses_rate", False)):
-            self._rate_cols = [int(j) for j in model._rate_sensors()]  # type: ignore[attr-defined]
-            self._r_lo = np.asarray(rr, dtype=np.float64)[:, 0]
-            self._r_hi = np.asarray(rr, dtype=np.float64)[:, 1]
-            self._r_min = np.full(self._lo.size, np.inf)
-            self._r_max = np.full(self._lo.size, -np.inf)
-            self._r_out = 0
-            self._hist_s = 2.0 * float(getattr(model, "rate_interval_s", 60.0))
-            self._tail_t: FloatArray = np.zeros(0)
-            self._tail_T: FloatArray = np.zeros((0, self._lo.size))
-        # time since power-on: warm-up models record their fitted power-on durations
-        dur = getattr(model, "duration_range_s_", None)
-        self._dur: tuple[float, float] | None = (
-            None if dur is None else (float(dur[0]), float(dur[1]))
-        )
-        self._t0: float | None = None
-        self._e_max = -np.inf
-        self._e_out = 0
-
-    def add(self, time_s: FloatArray, temps_c: FloatArray) -> None:
-        """The next samples of the run (in time order)."""
-        t = np.asarray(time_s, dtype=np.float64).reshape(-1)
-        T = np.asarray(temps_c, dtype=np.float64).reshape(t.size, -1)
-        if t.size == 0:
-            return
-        self.n += int(t.size)
-        temps = T
-        out = (temps < self._lo) | (temps > self._hi)
-        self._t_out += int(np.count_nonzero(out.any(axis=1)))
-        self._t_min = np.minimum(self._t_min, T.min(axis=0))
-        self._t_max = np.maximum(self._t_max, T.max(axis=0))
-        if self._rate_cols:
-            m = self._tail_t.size
-            ct = np.concatenate([self._tail_t, t])
-            cT = np.concatenate([self._tail_T, T])
-            r = np.asarray(self.model.rates(ct, cT), dtype=np.float64)[m:]  # type: ignore[attr-defined]
-            j = self._rate_cols
-            rj = r[:, j]
-            self._r_out += int(
-                np.count_nonzero(((rj < self._r_lo[j]) | (rj > self._r_hi[j])).any(axis=1))
-            )
-            self._r_min[j] = np.minimum(self._r_min[j], rj.min(axis=0))
-            self._r_max[j] = np.maximum(self._r_max[j], rj.max(axis=0))
-            keep = ct >= ct[-1] - self._hist_s
-            self._tail_t, self._tail_T = ct[keep].copy(), cT[keep].copy()
-        if self._dur is not None:
-            if self._t0 is None:
-                self._t0 = float(t[0])
-            e = t - self._t0
-            self._e_max = max(self._e_max, float(e[-1]))
-            self._e_out += int(np.count_nonzero(e > self._dur[1]))
-
-    def result(self) -> tuple[RangeExcess, ...]:
-        """One :class:`RangeExcess` per checked input (temperature always; Ṫ for models
-        with rate terms; time since power-on for warm-up models); empty before any sample."""
-        if self.n == 0:
-            return ()
-
-        def excess(
-            quantity: str, unit: str, n_out: int, cols: Sequence[int],
-            mn: FloatArray, mx: FloatArray, lo: FloatArray, hi: FloatArray,
-        ) -> RangeExcess:  # fmt: skip
-            names = [self.names[i] for i in cols]
-            return RangeExcess(
-                quantity=quantity,
-                unit=unit,
-                n_samples=self.n,
-                n_outside=n_out,
-                beyond={
-                    n: float(max(lo[i] - mn[i], mx[i] - hi[i], 0.0))
-                    for n, i in zip(names, cols, strict=True)
-                },
-                seen={n: (float(mn[i]), float(mx[i])) for n, i in zip(names, cols, strict=True)},
-                fitted={n: (float(lo[i]), float(hi[i])) for n, i in zip(names, cols, strict=True)},
-            )
-
-        all_cols = list(range(self._lo.size))
-        out = [
-            excess("temperature", self._tu, self._t_out, all_cols,
-                   self._t_min, self._t_max, self._lo, self._hi)
-        ]  # fmt: skip
-        if self._rate_cols:
-            out.append(
-                excess("temperature_rate", f"{self._tu}/min", self._r_out, self._rate_cols,
-                       self._r_min, self._r_max, self._r_lo, self._r_hi)
-            )  # fmt: skip
-        if self._dur is not None:
-            lo, hi = self._dur
-            out.append(
-                RangeExcess(
-                    quantity="time_since_power_on",
-                    unit="s",
-                    n_samples=self.n,
-                    n_outside=self._e_out,
-                    beyond={"power-on": max(self._e_max - hi, 0.0)},
-                    seen={"power-on": (0.0, self._e_max)},
-                    fitted={"power-on": (lo, hi)},
-                )
-            )
-        return tuple(out)
-
-
-def outside_range(model: TemperatureModel, time_s: FloatArray, temps_c: FloatArray) -> tuple[
-    RangeExcess, ...
-]:  # fmt: skip
-    """How far one whole run (time [s], temperatures (n, k)) leaves ``model``'s calibrated
-    ranges (:class:`RangeTally` fed once)."""
-    tally = RangeTally(model)
-    tally.add(time_s, temps_c)
-    return tally.result()
-
-
-def outside_range_message(
-    excess: Sequence[RangeExcess], where: str, *, extrapolate: bool
-) -> str | None:
-    """The one warning for a channel applied outside its calibrated range (None when every
-    sample is inside): each input that left, with its share of samples and how far."""
-    bad = [e for e in excess if e.n_outside > 0]
-    if not bad:
-        return None
-    action = (
-        "the model is extrapolated there"
-        if extrapolate
-        else "the model's inputs are held at the calibrated range there"
-    )
-    return (
-        f"{where}: the model is applied outside its calibrated range: "
-        + "; ".join(e.describe() for e in bad)
-        + f"; {action}"
-    )
-
-
-def outside_range_dict(excess: Sequence[RangeExcess]) -> dict[str, Any]:
-    """``{quantity: RangeExcess.to_dict()}`` of every checked input (JSON ``outside_range``)."""
-    return {e.quantity: e.to_dict() for e in excess}

@@ -1,4 +1,4 @@
-"""A calibration: several named channels, each with its own fitted model (issue 15).
+"""A calibration: several named channels, each with its own fitted model.
 
 A real IMU has three gyros and three accelerometers; a calibration keeps one model per
 channel (any family), with the channel's signal column, its unit as given and an optional
@@ -33,18 +33,15 @@ from typing import Any
 import numpy as np
 
 from thermocal.errors import ModelFileError, ThermocalInputError
-from thermocal.models.base import (
-    TemperatureModel,
-    checksum,
-    model_file_dict,
-)
+from thermocal.models.base import TemperatureModel
+from thermocal.models.format import checksum, model_file_dict
 from thermocal.models.registry import model_from_dict
 from thermocal.models.schema import verify_model_dict
 
 CALIBRATION_FORMAT = "thermocal-calibration"
 CALIBRATION_FORMAT_VERSION = 2
-"""The newest version this thermocal reads.  Version 2 added a triad's ``count_scale``
-(issue 30); a file is written as version 1 unless one of its triads has one, so a file
+"""The newest version this thermocal reads.  Version 2 added a triad's ``count_scale``;
+a file is written as version 1 unless one of its triads has one, so a file
 without it is what it was, and a thermocal that knows only version 1 refuses a file whose
 counts it could not convert rather than apply it to the wrong unit."""
 COUNT_SCALE_FORMAT_VERSION = 2
@@ -86,10 +83,10 @@ class Channel:
 
 @dataclass
 class Triad:
-    """A sensor triad whose error model couples its three axes (issue 19): ``name``
+    """A sensor triad whose error model couples its three axes: ``name``
     (``gyro``/``accel``), the three ``columns`` (x, y, z) it reads, their ``unit`` as given,
     the ``temperature`` column whose value indexes the model (``""`` for a model calibrated
-    at one temperature and read without one, issue 30), and the ``model`` itself
+    at one temperature and read without one), and the ``model`` itself
     (:class:`thermocal.turntable.thermal.TriadThermal`: bias, scale factors and
     misalignments as polynomials in temperature).  Applied as
     ``x_c = (I + E(T))⁻¹ (x − b(T))`` per sample (``<col>_comp``).  ``encoders`` (α, β
@@ -109,7 +106,7 @@ class Triad:
     """The session files it was calibrated on, ``{"file": name, "sha256": hash}`` each (as a
     model file's ``data``): ``validate`` and ``report`` know them when given again."""
     count_scale: float | None = None
-    """A triad calibrated on raw counts (``thermocal multipos`` given the count scales, issue 30):
+    """A triad calibrated on raw counts (``thermocal multipos`` given the count scales):
     one count is ``count_scale`` ``unit`` (the datasheet's sensitivity), and ``unit`` is the
     physical unit the parameters and the compensated columns are in.  Compensation converts
     raw-count columns first, ``x [unit] = count_scale · N``; None: the triad was calibrated on

@@ -12,11 +12,9 @@ from typing import Any
 import numpy as np
 
 from thermocal.errors import ConditioningWarning, ExtrapolationWarning, ThermocalInputError
-from thermocal.models.base import (
-    FitStats,
-    RunData,
-    TemperatureModel,
-)
+from thermocal.models.base import TemperatureModel
+from thermocal.models.results import FitStats
+from thermocal.models.rundata import RunData
 from thermocal.models.terms import (
     CHUNK_ROWS,
 )
@@ -57,7 +55,7 @@ first temperature column) share at least this fraction of the narrower range."""
 
 @dataclass(frozen=True)
 class OffsetDecision:
-    """Whether per-run turn-on offsets are estimated, and why (issue 13, honest statistics).
+    """Whether per-run turn-on offsets are estimated, and why.
 
     A per-run offset is a free constant per run. Offsets and the temperature function are
     only separable where runs cover common temperatures: two runs at separate temperatures
@@ -250,7 +248,7 @@ def short_rate_share(time_s: FloatArray, interval_s: float, method: str) -> tupl
     ends one), so near a segment's start (backward), end (forward) or either (centred)
     the difference covers less than Δt; a segment shorter than Δt — a 5 s burst logged
     every 5 min — has *only* such samples, and its Ṫ is temperature noise divided by a
-    fraction of a second (issue 13 item 8). Returns (count, number of segments).
+    fraction of a second. Returns (count, number of segments).
     """
     half = SHORT_RATE_SPAN_FRACTION * interval_s
     count = 0

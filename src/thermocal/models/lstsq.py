@@ -1,5 +1,5 @@
-"""Least squares in chunks (SPEC §4a numerics): designs reduced to triangular factors by
-Gram/Cholesky or Householder QR, solved by the SVD of the column-equilibrated factor with
+"""Least squares in chunks (the polynomial model's numerics): designs reduced to triangular
+factors by Gram/Cholesky or Householder QR, solved by the SVD of the column-equilibrated factor with
 condition numbers and standard errors, and forward term selection (BIC or hold-out).
 
 Used by the polynomial and piecewise families (:mod:`thermocal.models.poly_fit`,
@@ -17,7 +17,7 @@ import numpy.typing as npt
 
 from thermocal._lazy import LazyModule
 from thermocal.errors import DesignError, ThermocalInputError
-from thermocal.preprocess import (  # Ṫ has one implementation, in preprocess (issue 15)
+from thermocal.preprocess import (  # Ṫ has one implementation, in preprocess
     RATE_BLOCK_ROWS as RATE_BLOCK_ROWS,
 )
 from thermocal.preprocess import (
@@ -60,7 +60,7 @@ SINGULAR_RCOND = 1.0e-11
 Chunk = tuple[FloatArray, int, int]
 """``(A, group, fold)`` of one block of c rows: ``A`` (c, p + 1 + t), Fortran order, holds
 ``[F | 1 | Y]`` (the p features, a column of ones, the t ≥ 1 targets: several channels
-sharing one design, issue 15)."""
+sharing one design)."""
 
 
 @dataclass(frozen=True)
@@ -495,7 +495,7 @@ def forward_select(
     names: Sequence[str],
     method: Literal["bic", "holdout"] = "bic",
 ) -> Selection:
-    """Forward stepwise term selection (SPEC §4a: by information criterion or validation error).
+    """Forward stepwise term selection (by information criterion or validation error).
 
     Starting from the ``required`` columns (constant / per-run offsets), add at
     each step the candidate that lowers the score most; stop when none lowers

@@ -1,7 +1,7 @@
-"""Multi-sensor polynomial model with rate and coupling terms (SPEC §4a, seed 000).
+"""Multi-sensor polynomial model with rate and coupling terms ([Seed-RLG]).
 
 The temperature-induced signal (bias [°/h] or [mg], or scale-factor error,
-SPEC §4e) is
+[Seed-RLG]) is
 
 .. math::
 
@@ -102,12 +102,8 @@ import numpy as np
 
 from thermocal.adequacy import Needs
 from thermocal.errors import ExtrapolationWarning, ModelFileError, ThermocalInputError
-from thermocal.models.base import (
-    ChunkContext,
-    Coefficient,
-    ModelStream,
-    RunData,
-)
+from thermocal.families import POLY, FamilyDeclaration
+from thermocal.models.base import ChunkContext, ModelStream
 from thermocal.models.checks import (
     boolean,
     fields,
@@ -172,6 +168,8 @@ from thermocal.models.poly_types import PolyBase
 from thermocal.models.poly_types import (
     build_plan as build_plan,
 )
+from thermocal.models.results import Coefficient
+from thermocal.models.rundata import RunData
 from thermocal.models.terms import (
     BaseScaling,
     Term,
@@ -198,7 +196,7 @@ STATE_LAYOUT = "thermocal-poly-1"
 
 
 class PolyModel(PolyBase):
-    """Polynomial in T, Ṫ and TṪ of several sensors (SPEC §4a); see the module docstring.
+    """Polynomial in T, Ṫ and TṪ of several sensors ([Seed-RLG]); see the module docstring.
 
     Parameters
     ----------
@@ -214,10 +212,45 @@ class PolyModel(PolyBase):
         (default) when the runs overlap in temperature (:func:`decide_run_offsets`).
     solver : ``"auto"`` (Gram when well conditioned, else chunked QR), ``"qr"``, ``"gram"``.
     noise_threshold : a component below ``rcond`` is kept when ``|uᵢᵀz| > k σ̂`` (None: never).
+
+    Notes
+    -----
+    For temperature sensors :math:`k` with temperature :math:`T_k` and rate
+    :math:`\\dot T_k` (the backward difference over ``rate_interval_s``), the model is
+    a constant plus the chosen terms, fitted by least squares:
+
+    .. math::
+
+        \\hat y = c_0 + \\sum_k \\sum_{p} a_{kp} T_k^p + b_{kp} \\dot T_k^p
+                 + d_{kp} (T_k \\dot T_k)^p
+
+    and the compensated output is :math:`F' = F - \\hat y`.
+
+    References
+    ----------
+    .. [1] *A modelling and validation method for the temperature compensation model of a
+       ring-laser gyroscope*, Chinese invention patent, 2017 (docs/methods.md,
+       Seed-RLG).
+    .. [2] IEEE Std 952-1997, *IEEE Standard Specification Format Guide and Test Procedure
+       for Single-Axis Interferometric Fiber Optic Gyros* (the temperature-sensitivity
+       terms of the model equation).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from thermocal.models import RunData
+    >>> from thermocal.models.poly import PolyModel
+    >>> t = np.arange(0.0, 3600.0, 10.0)
+    >>> temp = 25.0 + 15.0 * np.sin(2 * np.pi * t / 3600.0)
+    >>> run = RunData(t, temp[:, None], 0.5 + 0.02 * temp, ("T1",))
+    >>> model = PolyModel(order=1).fit([run])
+    >>> [(c.name, round(c.value, 4)) for c in model.coefficients()]
+    [('const', 0.5), ('T1', 0.02)]
+    >>> round(float(model.predict(run)[0]), 4)
+    1.0
     """
 
-    family: ClassVar[str] = "poly"
-    C_GENERATOR: ClassVar[str | None] = "thermocal.export.c.poly"
+    declaration: ClassVar[FamilyDeclaration] = POLY
     uses_rate: ClassVar[bool] = True
 
     # -- construction from the command line --
@@ -301,7 +334,7 @@ class PolyModel(PolyBase):
     def coefficients_about(self, tref_c: float) -> list[Coefficient]:
         """Raw-monomial coefficients about a reference temperature: the same model written
         in ``dT_k = T_k − TREF`` (the convention of PX4's and ArduPilot's thermal
-        calibrations, INTERFACE.md "export-params"), with standard errors.
+        calibrations, ``thermocal export-params``), with standard errors.
 
         Each monomial ``T_k^P Ṫ_k^Q = ((T_k − TREF) + TREF)^P Ṫ_k^Q`` expands binomially
         into ``Σ_j C(P, j) TREF^(P−j) dT_k^j Ṫ_k^Q``; with ``S`` that linear map,

@@ -13,11 +13,9 @@ import numpy as np
 import numpy.typing as npt
 
 from thermocal.errors import ExtrapolationWarning
-from thermocal.models.base import (
-    RunData,
-)
 from thermocal.models.fitting import warn_rate_range
 from thermocal.models.poly_types import EvalPlan, PolyBase
+from thermocal.models.rundata import RunData
 from thermocal.models.terms import (
     backward_partners,
     gap_free_slices,

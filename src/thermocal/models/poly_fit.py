@@ -1,5 +1,5 @@
-"""Fitting :class:`~thermocal.models.poly.PolyModel` (SPEC §4a), one channel or several
-sharing one design (issue 15): :func:`fit_shared` and its steps."""
+"""Fitting :class:`~thermocal.models.poly.PolyModel` ([Seed-RLG]), one channel or several
+sharing one design: :func:`fit_shared` and its steps."""
 
 from __future__ import annotations
 
@@ -13,10 +13,6 @@ import numpy as np
 from threadpoolctl import threadpool_limits
 
 from thermocal.errors import ConditioningWarning, ThermocalInputError
-from thermocal.models.base import (
-    FitStats,
-    RunData,
-)
 from thermocal.models.fitting import (
     SHORT_RATE_WARN_SHARE,
     Block,
@@ -29,6 +25,8 @@ from thermocal.models.fitting import (
 )
 from thermocal.models.poly_types import PolyBase
 from thermocal.models.residuals import MAX_SAMPLES_PER_SERIES, residual_correlation
+from thermocal.models.results import FitStats
+from thermocal.models.rundata import RunData
 from thermocal.models.terms import (
     BaseScaling,
     Chunk,
@@ -62,7 +60,7 @@ def _same_inputs(a: RunData, b: RunData) -> bool:
 
 
 def fit_shared(models: Sequence[PolyBase], runs_by_model: Sequence[Sequence[RunData]]) -> None:
-    """Fit several channels that share one design (issue 15): the same parameters and the
+    """Fit several channels that share one design: the same parameters and the
     same runs' times and temperatures, each with its own signal and known input.
 
     The work that depends on the temperatures alone — Ṫ, the base-variable scaling, the
@@ -81,7 +79,7 @@ def fit_shared(models: Sequence[PolyBase], runs_by_model: Sequence[Sequence[RunD
     """
     head, rls = _shared_runs(models, runs_by_model)
     # BLAS on one thread: the blocks are small (≤ 32 768 × ~40), where threads oversubscribe
-    # and triple the wall time on a loaded machine (issue 17); the same numbers either way
+    # and triple the wall time on a loaded machine; the same numbers either way
     with threadpool_limits(limits=1, user_api="blas"):
         design = _shared_design(head, rls[0])
         dp = _DesignPass(design, rls)

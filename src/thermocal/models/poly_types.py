@@ -1,4 +1,4 @@
-"""The polynomial model's types that its fitting and its evaluation share (SPEC §4a).
+"""The polynomial model's types that its fitting and its evaluation share ([Seed-RLG]).
 
 :mod:`thermocal.models.poly_fit` and :mod:`thermocal.models.poly_eval` work on
 :class:`PolyBase` (parameters, fitted values, Ṫ, the evaluation plan); the model itself,
@@ -17,8 +17,9 @@ import numpy as np
 import numpy.typing as npt
 
 from thermocal.errors import ThermocalInputError
-from thermocal.models.base import RunData, TemperatureModel
+from thermocal.models.base import TemperatureModel
 from thermocal.models.fitting import Block
+from thermocal.models.rundata import RunData
 from thermocal.models.terms import BaseScaling, Term, segment_rates, temperature_rates
 from thermocal.preprocess import RATE_METHODS
 from thermocal.recording import FloatArray

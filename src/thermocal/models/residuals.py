@@ -1,4 +1,4 @@
-"""Standard errors that hold on coloured residuals (issue 13, honest statistics).
+"""Standard errors that hold on coloured residuals.
 
 Chamber residuals are never white: unmodelled slow drift, hysteresis and the sensor's
 own flicker noise make neighbouring samples alike. Ordinary least-squares standard

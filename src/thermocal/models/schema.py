@@ -6,7 +6,7 @@ bad field (``state.coef[2]: expected a finite number, got 'a'``), never turned i
 ``KeyError``, a silent NaN or a shape mismatch deep in a kernel.
 
 The checks are structural (types, shapes, finite values, known units, ordered ranges);
-the checksum (:func:`thermocal.models.base.checksum`) separately proves the file is the
+the checksum (:func:`thermocal.models.format.checksum`) separately proves the file is the
 one thermocal wrote.  Unknown extra keys are allowed (newer writers may add fields).
 Each family's ``state`` layout is documented in its module, which checks it
 (``check_state``, made of :mod:`thermocal.models.checks`); this module checks the common
@@ -19,7 +19,6 @@ from typing import Any
 
 from thermocal import units
 from thermocal.errors import ModelFileError
-from thermocal.models.base import check_model_header, checksum
 from thermocal.models.checks import (
     Check,
     boolean,
@@ -34,6 +33,7 @@ from thermocal.models.checks import (
     range_margin,
     string,
 )
+from thermocal.models.format import check_model_header, checksum
 from thermocal.models.poly import MAX_TERM_POWER
 from thermocal.models.registry import get_model_class
 

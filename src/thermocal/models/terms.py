@@ -2,7 +2,7 @@
 
 Three parts, all pure numpy/scipy:
 
-1. **Terms** (SPEC §4a, seed 000).  A term belongs to one temperature sensor k
+1. **Terms** ([Seed-RLG]).  A term belongs to one temperature sensor k
    and is the product of powers of three *base variables* of that sensor,
 
    .. math::
@@ -107,7 +107,7 @@ from thermocal.models.lstsq import (
 from thermocal.models.lstsq import (
     subset_rss as subset_rss,
 )
-from thermocal.preprocess import (  # Ṫ has one implementation, in preprocess (issue 15)
+from thermocal.preprocess import (  # Ṫ has one implementation, in preprocess
     RATE_BLOCK_ROWS as RATE_BLOCK_ROWS,
 )
 from thermocal.preprocess import (
@@ -203,7 +203,7 @@ class Term:
 
 
 def seed000_terms(n_sensors: int) -> list[Term]:
-    """The seed-000 term set (SPEC §4a): per sensor T, T², T³, Ṫ, Ṫ², Ṫ³, TṪ, (TṪ)², (TṪ)³.
+    """The term set ([Seed-RLG]): per sensor T, T², T³, Ṫ, Ṫ², Ṫ³, TṪ, (TṪ)², (TṪ)³.
 
     With the implicit constant: ``9·n_sensors + 1`` coefficients (37 for 4 sensors).
     """

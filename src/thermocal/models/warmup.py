@@ -1,4 +1,4 @@
-"""Warm-up (self-heating) model with start-temperature dependence (SPEC §4c, seed 003).
+"""Warm-up (self-heating) model with start-temperature dependence ([Seed-Plan]).
 
 For a sensor used minutes after power-on.  Each run is one power-on.  With
 ``T`` the temperature of one channel [°C] and ``F`` the output (known input
@@ -24,7 +24,7 @@ do exactly this, so they agree to the last bit.  A gap in time does not restart
 the window (the window is measured in time from the first sample; only
 ``ModelStream.reset()`` — a new power-on — does).
 
-Fitting (least squares, SVD; SPEC "our reading"): ΔT is scaled by its largest
+Fitting (least squares, SVD; our reading of [Seed-Plan]): ΔT is scaled by its largest
 absolute value and T0 centred and scaled, the solution is then converted back
 to the physical ``b``.  ``method="two_stage"`` is the seed's procedure (a_j per
 run, then a_j against T0); ``method="joint"`` fits ``ΔF = Σ_j Σ_k b_jk T0^k ΔT^j``
@@ -71,7 +71,6 @@ from typing import Any, ClassVar, Self
 
 import numpy as np
 import numpy.typing as npt
-from numpy.polynomial import polynomial as npoly
 
 from thermocal.adequacy import Needs
 from thermocal.errors import (
@@ -81,14 +80,8 @@ from thermocal.errors import (
     ModelFileError,
     ThermocalInputError,
 )
-from thermocal.models.base import (
-    ChunkContext,
-    Coefficient,
-    FitStats,
-    ModelStream,
-    RunData,
-    TemperatureModel,
-)
+from thermocal.families import WARMUP, FamilyDeclaration
+from thermocal.models.base import ChunkContext, ModelStream, TemperatureModel
 from thermocal.models.checks import (
     fields,
     integer,
@@ -99,6 +92,18 @@ from thermocal.models.checks import (
     sensor_param,
     string,
 )
+from thermocal.models.numerics import (
+    _clamp_range,
+    _poly_shift_matrix,
+    _window_count,
+    channel_index,
+    horner,
+    lstsq_svd,
+    running_start_mean,
+    single_channel,
+)
+from thermocal.models.results import Coefficient, FitStats
+from thermocal.models.rundata import RunData
 from thermocal.recording import FloatArray
 
 DISTINCT_T0_C = 1.0
@@ -107,163 +112,8 @@ DISTINCT_T0_C = 1.0
 CONDITION_WARN = 1e10
 """A scaled design with a 2-norm condition number above this gets a ConditioningWarning."""
 
-RANK_RTOL = 1e-12
-"""Singular values below ``RANK_RTOL × s_max`` make a design singular (DesignError)."""
 
 METHODS = ("two_stage", "joint")
-
-
-# --- shared numerical helpers (also used by the bank family) ------------------------------
-
-
-@dataclasses.dataclass(frozen=True)
-class LstsqResult:
-    """Solution of ``min ‖X c − y‖₂`` by SVD.
-
-    ``coef`` (p,) or (p, q); ``cov_unit`` = (XᵀX)⁻¹ = V S⁻² Vᵀ (from the SVD, no
-    explicit inverse of XᵀX), multiply by s² for the covariance; ``sigma2`` the
-    residual variance s² = ‖r‖²/(n − p) per column (NaN when n = p);
-    ``condition_number`` = s_max/s_min; ``rank``; ``singular`` the indices of the
-    columns most involved in the null space (empty when full rank).
-    """
-
-    coef: FloatArray
-    cov_unit: FloatArray
-    sigma2: FloatArray
-    condition_number: float
-    rank: int
-    dof: int
-    null_columns: tuple[int, ...]
-
-
-def lstsq_svd(x: FloatArray, y: FloatArray) -> LstsqResult:
-    """Least squares ``c = V S⁻¹ Uᵀ y`` through the thin SVD ``X = U S Vᵀ``.
-
-    Covariance of the coefficients ``cov = s² V S⁻² Vᵀ`` with
-    ``s² = ‖y − Xc‖²/(n − p)`` (Golub & Van Loan, *Matrix Computations*, §5.5).
-    A rank-deficient design is not solved: ``rank < p`` and ``null_columns``
-    tell the caller which terms to name in its :class:`DesignError`.
-    """
-    n, p = x.shape
-    u, s, vt = np.linalg.svd(x, full_matrices=False)
-    smax = float(s[0]) if s.size else 0.0
-    tol = RANK_RTOL * smax
-    rank = int(np.count_nonzero(s > tol)) if smax > 0 else 0
-    if rank < p:
-        # columns with the largest weight in the weakest right singular vectors
-        weak = vt[rank:] if rank < vt.shape[0] else vt[-1:]
-        w = np.abs(weak).max(axis=0)
-        null = tuple(int(i) for i in np.flatnonzero(w > 0.1 * w.max()))
-        nan = np.full((p, *y.shape[1:]), np.nan)
-        return LstsqResult(
-            nan, np.full((p, p), np.nan), np.full(y.shape[1:], np.nan), math.inf, rank, n - p, null
-        )
-    uty = u.T @ y
-    coef = vt.T @ (uty / s[:, None] if y.ndim == 2 else uty / s)
-    resid = y - x @ coef
-    dof = n - p
-    sigma2 = (
-        np.asarray(np.sum(resid**2, axis=0) / dof, dtype=np.float64)
-        if dof > 0
-        else np.full(y.shape[1:], np.nan)
-    )
-    vs = vt.T / s
-    cov_unit = vs @ vs.T
-    return LstsqResult(
-        np.asarray(coef, dtype=np.float64),
-        np.asarray(cov_unit, dtype=np.float64),
-        sigma2,
-        smax / float(s[-1]),
-        rank,
-        dof,
-        (),
-    )
-
-
-def channel_index(family: str, run: RunData, sensor: int, fitted_name: str | None = None) -> int:
-    """Column of ``run.temps_c`` a single-channel model uses.
-
-    The fitted channel's name when the run has it, else the only column, else
-    column ``sensor`` (0 = the first named temperature channel).
-    """
-    k = run.temps_c.shape[1]
-    if fitted_name is not None:
-        if fitted_name in run.temp_names:
-            return run.temp_names.index(fitted_name)
-        if k == 1:
-            return 0
-    if not 0 <= sensor < k:
-        names = ", ".join(run.temp_names) or f"{k} unnamed"
-        raise ThermocalInputError(
-            f"{family}: temperature channel index sensor={sensor} does not exist in "
-            f"{run.name or 'run'} (channels: {names})"
-        )
-    return sensor
-
-
-def single_channel(run: RunData, col: int) -> RunData:
-    """A copy of ``run`` holding only temperature column ``col``."""
-    name = run.temp_names[col] if col < len(run.temp_names) else f"T{col + 1}"
-    return dataclasses.replace(run, temps_c=run.temps_c[:, [col]], temp_names=(name,))
-
-
-def horner(coef: FloatArray, x: FloatArray) -> FloatArray:
-    """``Σ_k coef[k] x^k`` by Horner's rule (same operations for arrays and scalars)."""
-    out = np.full_like(x, coef[-1])
-    for c in coef[-2::-1]:
-        out = out * x + c
-    return out
-
-
-def _clamp_range(
-    values: FloatArray, lo: float, hi: float, what: str, *, extrapolate: bool
-) -> FloatArray:
-    below = values < lo
-    above = values > hi
-    if below.any() or above.any():
-        n = int(np.count_nonzero(below | above))
-        action = "extrapolating" if extrapolate else "clamped to the fitted range"
-        warnings.warn(
-            f"{n} samples with {what} {float(values.min()):.2f}…{float(values.max()):.2f} °C "
-            f"outside the fitted {lo:.2f}…{hi:.2f} °C; {action}",
-            ExtrapolationWarning,
-            stacklevel=4,
-        )
-        if not extrapolate:
-            return np.clip(values, lo, hi)
-    return values
-
-
-def _window_count(time_s: FloatArray, window_s: float) -> int:
-    """Number of samples in the start window ``t − t_first < window_s`` (≥ 1)."""
-    return max(1, int(np.count_nonzero(time_s - time_s[0] < window_s)))
-
-
-def running_start_mean(time_s: FloatArray, x: FloatArray, window_s: float) -> FloatArray:
-    """Causal start value of every sample: the running mean over the start window,
-    frozen once the window is full (SPEC §4c, MODELS_COMMON causality rule)::
-
-        x0_i = (1/(i+1)) Σ_{k≤i} x_k   for i < m,     x0_i = x0_{m−1}   for i ≥ m
-
-    with m the number of samples with ``t − t_first < window_s``.  The sums are
-    sequential (``np.cumsum``), as in the streaming twin.
-    """
-    m = _window_count(time_s, window_s)
-    cs = np.cumsum(x[:m]) / np.arange(1, m + 1, dtype=np.float64)
-    out = np.empty_like(x)
-    out[:m] = cs
-    out[m:] = cs[-1]
-    return out
-
-
-def _poly_shift_matrix(mu: float, sigma: float, n: int) -> FloatArray:
-    """M with ``Σ_k c_k ((x − μ)/σ)^k = Σ_k (M c)_k x^k`` (binomial expansion)."""
-    m = np.zeros((n, n))
-    base = np.array([-mu / sigma, 1.0 / sigma])
-    for k in range(n):
-        pk = npoly.polypow(base, k) if k else np.array([1.0])
-        m[: pk.size, k] = pk
-    return m
 
 
 # --- the model ------------------------------------------------------------------------------
@@ -284,7 +134,7 @@ class _ScaledFit:
 
 class WarmupModel(TemperatureModel):
     """Two-stage warm-up model ``ΔF = Σ_j a_j(T0) ΔT^j``, ``a_j(T0) = Σ_k b_jk T0^k``
-    (SPEC §4c, seed 003).
+    ([Seed-Plan]).
 
     Parameters
     ----------
@@ -300,10 +150,44 @@ class WarmupModel(TemperatureModel):
     per_run_offset : ``joint`` only: a free a0 per run (nuisance parameters, so the
         noise of each run's F0 does not bias the ΔT terms), then ``a0(T0)`` fitted to
         those offsets as in stage 2.  (``two_stage`` always has a free a0 per run.)
+
+    Notes
+    -----
+    With :math:`T_0` and :math:`F_0` the means of the first ``start_window_s`` seconds of a
+    power-on and :math:`\\Delta T = T - T_0`, the drift of the output is
+
+    .. math::
+
+        \\Delta F = \\sum_{j=0}^{n} \\Bigl(\\sum_{k=0}^{m} b_{jk} T_0^k\\Bigr)
+                   \\Delta T^j ,
+
+    :math:`n` = ``order``, :math:`m` = ``t0_order``, fitted over several power-ons at
+    different start temperatures.
+
+    References
+    ----------
+    .. [1] *Temperature-characteristic calibration test plan* (a MEMS sensor's power-on
+       warm-up tests and model; docs/methods.md, Seed-Plan).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from thermocal.models import RunData
+    >>> from thermocal.models.warmup import WarmupModel
+    >>> runs = []
+    >>> for t0 in (10.0, 25.0, 40.0):
+    ...     t = np.arange(0.0, 900.0, 1.0)
+    ...     temp = t0 + 8.0 * (1.0 - np.exp(-t / 300.0))
+    ...     drift = 0.1 + (0.02 + 0.001 * t0) * (temp - t0)
+    ...     runs.append(RunData(t, temp[:, None], drift, ("T1",)))
+    >>> model = WarmupModel(order=1, t0_order=1).fit(runs)
+    >>> {c.name: round(c.value, 5) for c in model.coefficients()}["b11"]
+    0.001
+    >>> round(float(model.predict(runs[1])[-1]), 3)
+    0.342
     """
 
-    family: ClassVar[str] = "warmup"
-    C_GENERATOR: ClassVar[str | None] = "thermocal.export.c.warmup"
+    declaration: ClassVar[FamilyDeclaration] = WARMUP
     uses_rate: ClassVar[bool] = False
 
     b_: FloatArray
@@ -372,7 +256,7 @@ class WarmupModel(TemperatureModel):
 
     # -- fit --
     def fit(self, runs: Sequence[RunData]) -> Self:
-        """Fit the b matrix to several power-on runs (SPEC §4c).
+        """Fit the b matrix to several power-on runs ([Seed-Plan]).
 
         Stage 1 (per run, post-window samples): ``ΔF = Σ_j a_j ΔT^j`` by least
         squares.  Stage 2: ``a_j = Σ_k b_jk T0^k`` over the runs by least squares
@@ -668,7 +552,7 @@ class WarmupModel(TemperatureModel):
 
     def check_duration(self, elapsed_s: float) -> None:
         """:class:`ExtrapolationWarning` when a record runs longer after power-on than any
-        fitted run (issue 14: a model fitted on 900 s power-ons applied to 21 h): the
+        fitted run (a model fitted on 900 s power-ons applied to 21 h): the
         warm-up polynomial in ΔT says nothing about the time beyond."""
         rng = self.duration_range_s_
         if rng is None or not elapsed_s > self.DURATION_MARGIN * rng[1]:
@@ -763,7 +647,7 @@ class WarmupModel(TemperatureModel):
         self.sensor_name_ = str(state["sensor_name"])
         lo, hi = state["t0_range_c"]
         self.t0_range_ = (float(lo), float(hi))
-        dur = state.get("duration_range_s")  # absent in files before issue 14
+        dur = state.get("duration_range_s")  # absent in older files
         self.duration_range_s_ = None if dur is None else (float(dur[0]), float(dur[1]))
         self.start_temps_ = np.array(state.get("start_temps_c", []), dtype=np.float64)
         self.start_outputs_ = np.array(state.get("start_outputs", []), dtype=np.float64)

@@ -1,8 +1,9 @@
 """The fit → validate path as library functions (layer 3, the file layer).
 
-options    :class:`FitOptions`, :class:`ValidateOptions`: one field per option of ``thermocal
-           fit`` / ``thermocal validate`` (same names, dashes as underscores), built from the
-           command line or from a fleet configuration's ``[fit]``/``[validate]`` tables
+options    :class:`FitOptions`, :class:`ValidateOptions`: typed fields, one per option of
+           ``thermocal fit`` / ``thermocal validate`` (a fit's family options in ``params``),
+           built from the command line or from a fleet configuration's ``[fit]``/``[validate]``
+           tables; ``read_options`` gives how the files are read
 reading    :func:`read_options` / :func:`read_options_of`: the commands' options as one
            ``ReadOptions``; :func:`check_recording`: what a command needs of a recording
 fit        :func:`fit_files` → :class:`FitResult`: a model (one channel) or a calibration

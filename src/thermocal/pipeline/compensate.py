@@ -67,11 +67,9 @@ from thermocal.errors import (
     TimestampError,
     UnitError,
 )
-from thermocal.models.base import (
-    TemperatureModel,
-    check_sensor_id,
-    outside_range_dict,
-)
+from thermocal.models.base import TemperatureModel
+from thermocal.models.ranges import outside_range_dict
+from thermocal.models.rundata import check_sensor_id
 from thermocal.outputs import refuse_special_input, sidecar_path, warn_formula_names
 from thermocal.readers.common import default_time_column, names_list
 from thermocal.readers.dispatch import read_recording, read_whole_table, time_hint
@@ -143,7 +141,7 @@ class CompensateFileResult:
     """The compensation raised the rms about zero or the max |error| by more than 1 %."""
     outside_range: dict[str, Any] = field(default_factory=dict)
     """How far the file leaves the model's calibrated ranges, per input
-    (:func:`~thermocal.models.base.outside_range_dict`)."""
+    (:func:`~thermocal.models.ranges.outside_range_dict`)."""
     outside_calibrated_range: bool = False
 
     def to_dict(self) -> dict[str, Any]:
@@ -1409,7 +1407,7 @@ def compensate_calibration_file(
         A calibration with both triads and channels, an output on an input, or any error
         of :func:`compensate_file` and :func:`compensate_triads`.
     """
-    from thermocal.models.files import load_calibration
+    from thermocal.pipeline.model_file import load_calibration
 
     check_not_input(out, [path, model_file])
     if file_kind(Path(out)) == "csv":  # the CSV's sidecar must not land on an input either

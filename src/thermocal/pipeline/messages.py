@@ -96,6 +96,9 @@ OPTION_OF: dict[str, str] = {
     "latitude_deg": "--latitude",
     "alpha_offset_deg": "--alpha-offset",
     "tref_c": "--tref",
+    "rate_interval_s": "--rate-interval",
+    "start_window_s": "--start-window",
+    "select": "--select-method",
 }
 """Library parameters whose command-line option is not the parameter's name with dashes
 (``time_unit`` → ``--time-unit`` needs no entry)."""

@@ -25,7 +25,6 @@ from thermocal import units
 from thermocal.errors import DesignError, ThermocalInputError, ThermocalWarning, UnitError
 from thermocal.inspection import saturated_mask
 from thermocal.models.calibration import Calibration, Triad
-from thermocal.models.files import file_sha256, save_calibration
 from thermocal.multipos.calibrate import METHOD, SessionResult, calibrate_session
 from thermocal.multipos.poses import (
     DRIFT_DEG,
@@ -37,6 +36,7 @@ from thermocal.multipos.poses import (
     find_poses,
     parse_poses,
 )
+from thermocal.pipeline.model_file import file_sha256, save_calibration
 from thermocal.pipeline.turntable import check_as_read
 from thermocal.readers import read_recording
 from thermocal.readers.options import ReadOptions

@@ -1,63 +1,125 @@
 """The options of ``thermocal fit`` and ``thermocal validate`` as frozen dataclasses.
 
 One field per long option of the command, named as the option without its dashes
-(``--rate-interval`` → ``rate_interval``), with the command's default: the command line
-builds them from its parameters, a fleet configuration from its ``[fit]``/``[validate]``
-tables (:func:`options_from_table`), and a test checks that the fields and the command's
-options are the same set.  What the command takes besides (its files, ``-o``, ``--json``)
-is not an option here.
+(``--time-unit`` → ``time_unit``), with the command's default; a fit's family options are
+one field, ``params`` (constructor parameter → value, as the family declares them in
+:mod:`thermocal.families`).  The command line builds them from its parameters, a fleet
+configuration from its ``[fit]``/``[validate]`` tables (:func:`options_from_table`), and a
+test checks that the fields, the families' declared options and the command's options are
+the same set.  What the command takes besides (its files, ``-o``, ``--json``) is not an
+option here.
 """
 
 from __future__ import annotations
 
 import dataclasses
 import typing
-from collections.abc import Mapping
+from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, TypeVar
+from typing import TYPE_CHECKING, Any, Literal, TypeVar
 
 from thermocal.defaults import DEFAULT_AVERAGING_S
-from thermocal.errors import ThermocalInputError
+from thermocal.errors import ParameterError, ThermocalInputError, UnitError
+from thermocal.families import FamilyOption, fit_option_table
+from thermocal.pipeline.messages import option_name
+
+if TYPE_CHECKING:  # numpy and the readers: imported when used (``fit --help`` loads neither)
+    from thermocal.readers.options import ReadOptions
+    from thermocal.units import TemperatureConversion
+
+TARGETS = ("bias", "scale_factor")
+"""What a fit's model describes."""
+
+
+def _names(value: str | Iterable[str] | None, parameter: str) -> tuple[str, ...] | None:
+    """``"a, b"`` or ``["a", "b"]`` → ``("a", "b")``; None or no name → None."""
+    if value is None:
+        return None
+    items = value.split(",") if isinstance(value, str) else list(value)
+    if not all(isinstance(v, str) for v in items):
+        raise ParameterError(parameter, f"{{name}} holds column names, got {value!r}")
+    return tuple(v.strip() for v in items if v.strip()) or None
 
 
 @dataclass(frozen=True)
 class FitOptions:
-    """``thermocal fit`` (INTERFACE.md; :func:`thermocal.pipeline.fit.fit_files`)."""
+    """The options of a fit (:func:`thermocal.pipeline.fit.fit_files`, ``thermocal fit``).
+
+    Parameters
+    ----------
+    model : str
+        The family (``"poly"``, ``"piecewise"``, ``"warmup"``, ``"bank"`` or a plugin's).
+    params : mapping of str to object
+        The family's options by constructor parameter, as the family declares them
+        (:class:`thermocal.families.FamilyOption`: ``{"order": 2, "rate_interval_s": 60.0}``,
+        ``{"breakpoints": (25.0, 30.0)}``); each is checked against its declared type and
+        bounds before a file is read.
+    signals : tuple of str, optional
+        The signal columns; several make a calibration of one model per channel.  A
+        comma-separated text is accepted and stored as a tuple.
+    temperatures : tuple of str, optional
+        The temperature columns (default: the file's), as ``signals``.
+    time, time_unit, signal_unit, temp_unit : str, optional
+        The time column and the units of the columns (default: the file's).
+    temp_conversion : TemperatureConversion, optional
+        Raw counts → °C, :math:`T = g\\,v + o` (the text ``"GAIN,OFFSET[,int16]"`` is
+        accepted).
+    target : {"bias", "scale_factor"}
+        What the model describes.
+    latitude : float, optional
+        Test-site latitude [°]; with ``axis``, the earth rate seen by a gyro's axis is a
+        known input.
+    axis : str, optional
+        A gyro's sensitive axis (``"up"``, ``"north"``, … or ``"e,n,u"``).
+    known_input : float, optional
+        Any other known input, in the canonical signal unit ([°/h] or [mg]).
+    gravity_axis : str, optional
+        Accelerometers: the body axis pointing up (``"+z"``); its gravity is a known input.
+    gravity : float, optional
+        Local gravity [m/s²] (default: WGS-84 normal gravity at ``latitude``).
+    tref : float, optional
+        poly: also give the coefficients about this reference temperature [°C].
+    allow_narrow, allow_motion : bool
+        Fit even where the data fail the adequacy tests (with a warning recorded).
+    names : tuple of str, optional
+        Column names of a text log without a header row.
+    topic : str, optional
+        Flight-controller log topic, or a station recording's sensor.
+    rate_hz : float, optional
+        Sample rate [Hz] of a log without a time column.
+    on_bad_lines : {"error", "skip"}
+        A mangled line of a text log: an error naming it, or dropped and counted.
+    delimiter : str, optional
+        Field separator of a text log (detected when None).
+    decimal : {".", ","}, optional
+        Decimal mark of a text log (detected when None).
+
+    Raises
+    ------
+    thermocal.errors.ParameterError
+        A target, column list or temperature conversion no fit can use, naming the field.
+
+    Examples
+    --------
+    >>> from thermocal.pipeline.options import FitOptions
+    >>> o = FitOptions("poly", {"order": 2}, signals="gx, gy", temperatures=["T1"])
+    >>> o.signals, o.temperatures
+    (('gx', 'gy'), ('T1',))
+    >>> o.read_options.signals
+    ('gx', 'gy')
+    """
 
     model: str
-    signal: str | None = None
-    temps: str | None = None
+    params: Mapping[str, Any] = dataclasses.field(default_factory=dict)
+    signals: tuple[str, ...] | None = None
+    temperatures: tuple[str, ...] | None = None
     time: str | None = None
     time_unit: str | None = None
     signal_unit: str | None = None
     temp_unit: str | None = None
-    temp_conversion: str | None = None
-    # poly
-    terms: str | None = None
-    order: int | None = None
-    rate_interval: float | None = None
-    rate_method: str | None = None
-    select: bool = False
-    select_method: str = "bic"
-    ridge: float | None = None
-    rcond: float | None = None
-    solver: str | None = None
-    noise_threshold: float | None = None
-    # piecewise
-    breakpoints: str | None = None
-    segments: int | None = None
-    method: str | None = None
-    # warmup
-    start_window: float | None = None
-    t0_order: int | None = None
-    # bank
-    deviation: float | None = None
-    tolerance: float | None = None
-    startup_s: float | None = None
-    # every family
-    per_run_offset: bool | None = None
-    target: str = "bias"
+    temp_conversion: TemperatureConversion | None = None
+    target: Literal["bias", "scale_factor"] = "bias"
     latitude: float | None = None
     axis: str | None = None
     known_input: float | None = None
@@ -67,17 +129,33 @@ class FitOptions:
     allow_narrow: bool = False
     allow_motion: bool = False
     # how the files are read (text logs, ULog)
-    names: str | None = None
+    names: tuple[str, ...] | None = None
     topic: str | None = None
-    rate: float | None = None
-    on_bad_lines: str = "error"
+    rate_hz: float | None = None
+    on_bad_lines: Literal["error", "skip"] = "error"
     delimiter: str | None = None
-    decimal: str | None = None
+    decimal: Literal[".", ","] | None = None
+
+    def __post_init__(self) -> None:
+        set_ = object.__setattr__  # frozen: normalise in place once
+        for field in ("signals", "temperatures", "names"):
+            set_(self, field, _names(getattr(self, field), field))
+        if self.temp_conversion is not None:
+            set_(self, "temp_conversion", _conversion(self.temp_conversion))
+        if self.target not in TARGETS:
+            raise ParameterError(
+                "target", f"{{name}} must be bias or scale_factor, got {self.target!r}"
+            )
+
+    @property
+    def read_options(self) -> ReadOptions:
+        """How the files are read (:class:`thermocal.readers.options.ReadOptions`)."""
+        return _read_options(self)
 
 
 @dataclass(frozen=True)
 class ValidateOptions:
-    """``thermocal validate`` (INTERFACE.md; :func:`thermocal.pipeline.validate.validate_files`).
+    """``thermocal validate`` (:func:`thermocal.pipeline.validate.validate_files`).
     The text-log options (``names``, ``rate``, ``on_bad_lines``, ``delimiter``, ``decimal``)
     apply to the validated file and to the ``modeling`` file alike; the log ``topic`` to each
     of them that is a flight-controller log (a CSV modelling run of a logged test)."""
@@ -104,6 +182,42 @@ class ValidateOptions:
     latitude: float | None = None
     static_s: float = 1.0
 
+    @property
+    def read_options(self) -> ReadOptions:
+        """How the files are read (:class:`thermocal.readers.options.ReadOptions`; the
+        signal column named, the temperatures the file's)."""
+        return _read_options(self)
+
+
+def _conversion(value: object) -> TemperatureConversion:
+    """A temperature conversion from its text or tuple, refused naming ``temp_conversion``."""
+    from thermocal.units import temperature_conversion
+
+    try:
+        return temperature_conversion(value, "{name}")
+    except UnitError as exc:
+        raise ParameterError("temp_conversion", str(exc)) from None
+
+
+def _read_options(o: FitOptions | ValidateOptions) -> ReadOptions:
+    """The :class:`ReadOptions` of a fit's or a validation's reading fields."""
+    from thermocal.readers.options import ReadOptions
+
+    signals: Any  # ReadOptions takes a column list's text too (a validation's fields)
+    names: Any
+    if isinstance(o, FitOptions):
+        signals, temperatures, names, rate = o.signals, o.temperatures, o.names, o.rate_hz
+    else:
+        signals, temperatures, names, rate = o.signal, None, o.names, o.rate
+    conversion: Any = o.temp_conversion
+    return ReadOptions(
+        time=o.time, time_unit=o.time_unit, signals=signals, temperatures=temperatures,
+        signal_unit=o.signal_unit, temp_unit=o.temp_unit, temp_conversion=conversion,
+        topic=o.topic, names=names, rate_hz=rate,
+        on_bad_lines=o.on_bad_lines,  # type: ignore[arg-type]
+        delimiter=o.delimiter, decimal=o.decimal,  # type: ignore[arg-type]
+    )  # fmt: skip
+
 
 ALIASES: dict[str, dict[str, str]] = {
     "fit": {"sensor": "topic"},
@@ -111,7 +225,7 @@ ALIASES: dict[str, dict[str, str]] = {
 }
 """Second names of an option (``--average`` is ``--averaging``), per command."""
 
-NOT_IN_TABLES = frozenset({"modeling"})
+NOT_IN_TABLES = frozenset({"modeling", "params"})
 """Options a fleet sets itself (the unit's own modelling file)."""
 
 OPTIONS: dict[str, type[Any]] = {"fit": FitOptions, "validate": ValidateOptions}
@@ -123,20 +237,64 @@ O = TypeVar("O", FitOptions, ValidateOptions)
 def option_kinds(cls: type[Any]) -> dict[str, str]:
     """``{option name: "flag" | "int" | "float" | "str" | "path"}`` of an options dataclass
     (option names with dashes)."""
-    hints = typing.get_type_hints(cls)
+    from thermocal.units import TemperatureConversion
+
+    hints = typing.get_type_hints(cls, localns={"TemperatureConversion": TemperatureConversion})
     out: dict[str, str] = {}
     for f in dataclasses.fields(cls):
+        if f.name == "params":  # the family's options: :func:`family_option_kinds`
+            continue
         args = set(typing.get_args(hints[f.name])) - {type(None)} or {hints[f.name]}
         kind = next(iter(args))
-        name = f.name.replace("_", "-")
+        name = option_name(f.name)[2:]
         out[name] = {bool: "flag", int: "int", float: "float", Path: "path"}.get(kind, "str")
     return out
 
 
+def family_option_kinds() -> dict[str, tuple[str, tuple[FamilyOption, ...]]]:
+    """``{option name: (kind, the declared options it gives)}`` of the built-in families'
+    fit options (option names with dashes; :func:`thermocal.families.fit_option_table`).
+    A choice with a switch is two options: the flag ``select`` and its ``select-method``."""
+    out: dict[str, tuple[str, tuple[FamilyOption, ...]]] = {}
+    for name, decls in fit_option_table().items():
+        opts = tuple(o for _fam, o in decls)
+        first = opts[0]
+        dashed = name.replace("_", "-")
+        if first.switch:
+            out[dashed] = ("flag", opts)
+            out[first.switch.replace("_", "-")] = ("str", opts)
+        else:
+            out[dashed] = ({"bool": "tristate"}.get(first.kind, first.kind), opts)
+    return out
+
+
+def family_params(values: Mapping[str, Any]) -> dict[str, Any]:
+    """The family options (constructor parameters) of the command-line values ``values``
+    (named as the options without dashes, ``rate_interval``, ``select``,
+    ``select_method``): ``{parameter: value}`` for the options given (not None; a flag
+    given).  An option the chosen family does not take is kept: the family refuses it."""
+    params: dict[str, Any] = {}
+    for name, decls in fit_option_table().items():
+        first = decls[0][1]
+        value = values.get(name)
+        if first.switch:
+            if value:
+                params[first.name] = values.get(first.switch) or first.choices[0]
+        elif value is not None:
+            params[first.name] = value
+    return params
+
+
 def options_of(cls: type[O], values: Mapping[str, Any]) -> O:
-    """The options dataclass from a mapping holding at least its fields (a command's
-    parameters, named as the fields)."""
-    return cls(**{f.name: values[f.name] for f in dataclasses.fields(cls) if f.name in values})
+    """The options dataclass from a command's parameters, named as its options without
+    dashes (``signal`` gives the field ``signals``, ``rate`` the field ``rate_hz``:
+    :func:`thermocal.pipeline.messages.option_name`)."""
+    out: dict[str, Any] = {}
+    for f in dataclasses.fields(cls):
+        key = option_name(f.name)[2:].replace("-", "_")
+        if key in values:
+            out[f.name] = values[key]
+    return cls(**out)
 
 
 def _table_text(key: str, value: Any, where: str) -> str:
@@ -158,12 +316,32 @@ def _parse(kind: str, name: str, text: str, where: str) -> Any:
             return int(text)
         if kind == "float":
             return float(text)
+        if kind == "floats":
+            return tuple(float(v) for v in text.split(","))
     except ValueError:
-        what = "integer" if kind == "int" else "float"
+        what = {"int": "integer", "float": "float"}.get(kind, "list of numbers")
         raise ThermocalInputError(
             f"{where}: Invalid value for '--{name}': {text!r} is not a valid {what}."
         ) from None
     return Path(text) if kind == "path" else text
+
+
+def _table_kinds(command: str) -> dict[str, str]:
+    """``{option name: kind}`` a table of ``command`` takes (the family options of ``fit``
+    included)."""
+    kinds = option_kinds(OPTIONS[command])
+    if command == "fit":
+        kinds |= {n: kind for n, (kind, _opts) in family_option_kinds().items()}
+    return kinds
+
+
+def _table_flag(name: str, kind: str, value: Any, where: str) -> tuple[list[str], bool]:
+    """A flag's command-line arguments and value (``tristate``: false is ``--no-NAME``)."""
+    if not isinstance(value, bool):
+        raise ThermocalInputError(f"{where}: {name} is a flag: write true or false")
+    if kind == "tristate":
+        return [f"--{name}" if value else f"--no-{name}"], value
+    return ([f"--{name}"] if value else []), value
 
 
 def options_from_table(command: str, table: Mapping[str, Any], where: str) -> tuple[Any, list[str]]:
@@ -172,9 +350,11 @@ def options_from_table(command: str, table: Mapping[str, Any], where: str) -> tu
     as command-line arguments (``["--model", "poly", "--order", "2", "--signal", "gx,gy",
     "--select"]``, recorded with each unit).  An unknown option, a value of the wrong shape
     or type, or a missing required option is a :class:`ThermocalInputError` naming it
-    (``where``: the file and table).  A flag set to false is left at its default."""
+    (``where``: the file and table).  A flag set to false is left at its default; a yes/no
+    family option (``per_run_offset``) set to false is ``--no-per-run-offset``."""
     cls = OPTIONS[command]
-    kinds = option_kinds(cls)
+    kinds = _table_kinds(command)
+    fields = {option_name(f.name)[2:]: f.name for f in dataclasses.fields(cls)}
     aliases = ALIASES.get(command, {})
     known = {n: n for n in kinds if n.replace("-", "_") not in NOT_IN_TABLES}
     known |= {a: t for a, t in aliases.items()}
@@ -187,22 +367,26 @@ def options_from_table(command: str, table: Mapping[str, Any], where: str) -> tu
                 f"{where}: {key!r} is not an option of thermocal {command}; it takes "
                 + ", ".join(sorted(known))
             )
-        field = known[name].replace("-", "_")
+        field = fields.get(known[name], known[name].replace("-", "_"))
         kind = kinds[known[name]]
-        if kind == "flag":
-            if not isinstance(value, bool):
-                raise ThermocalInputError(f"{where}: {key} is a flag: write true or false")
-            if value:
-                args.append(f"--{name}")
-                values[field] = True
+        if kind in ("flag", "tristate"):
+            flag_args, values[field] = _table_flag(name, kind, value, where)
+            args += flag_args
             continue
         text = _table_text(str(key), value, where)
         args += [f"--{name}", text]
         values[field] = _parse(kind, name, text, where)
-    required = [f.name for f in dataclasses.fields(cls) if f.default is dataclasses.MISSING]
+    required = [
+        f.name
+        for f in dataclasses.fields(cls)
+        if f.default is dataclasses.MISSING and f.default_factory is dataclasses.MISSING
+    ]
     for f in required:
         if f not in values:
-            raise ThermocalInputError(f"{where}: Missing option '--{f.replace('_', '-')}'.")
+            raise ThermocalInputError(f"{where}: Missing option '{option_name(f)}'.")
+    if command == "fit":
+        own = {f.name for f in dataclasses.fields(cls)}
+        values = {k: v for k, v in values.items() if k in own} | {"params": family_params(values)}
     return cls(**values), args
 
 
@@ -211,6 +395,8 @@ __all__ = [
     "OPTIONS",
     "FitOptions",
     "ValidateOptions",
+    "family_option_kinds",
+    "family_params",
     "option_kinds",
     "options_from_table",
     "options_of",

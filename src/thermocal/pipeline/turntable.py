@@ -248,7 +248,7 @@ def thermal_runs(
     soak temperatures are judged first (:func:`thermocal.adequacy.temperature_tests`: span
     and distinct soaks for the order asked, 1 when the order is chosen per parameter)."""
     from thermocal.models.calibration import Calibration, Triad
-    from thermocal.models.files import save_calibration
+    from thermocal.pipeline.model_file import save_calibration
 
     if output.suffix.lower() != ".json":
         raise ThermocalInputError(f"{output}: the calibration is JSON; use a .json name")

@@ -1,5 +1,5 @@
 """Judging a model or calibration on an independent recording: :func:`validate_files`
-(``thermocal validate``; SPEC §5, :func:`thermocal.validation.validate`).
+(``thermocal validate``; [Seed-RLG], :func:`thermocal.validation.validate`).
 
 ``r`` compares the ``ambient`` column of the modelling and validation runs (default: the
 model's first temperature column).  The modelling run is ``options.modeling``, else the model
@@ -202,7 +202,7 @@ def _validate_channel(
 
 def _validate_channels(ctx: _Context, cal: Calibration) -> ValidationReport:
     """A calibration of several channels: the file read once with every chosen channel's
-    column (issue 15), each channel judged on it."""
+    column, each channel judged on it."""
     from thermocal.models.calibration import merged_inputs, temperatures_of
 
     o = ctx.o
@@ -235,7 +235,7 @@ def _validate_channels(ctx: _Context, cal: Calibration) -> ValidationReport:
 def _own_session(cal: Calibration, file: Path) -> None:
     """A warning when ``file`` is a session the triads were calibrated on (its SHA-256
     among their ``data``): its figures are the fit's residuals, not an independent test."""
-    from thermocal.models.files import file_sha256
+    from thermocal.pipeline.model_file import file_sha256
 
     known = {d.get("sha256") for t in cal.triads for d in t.data}
     if known and file_sha256(file) in known:
@@ -251,8 +251,8 @@ def _own_session(cal: Calibration, file: Path) -> None:
 def _validate_triads(
     cal: Calibration, model_file: Path, file: Path, o: ValidateOptions
 ) -> ValidationReport:
-    """A calibration of triads judged on a turntable run (issue 19), or on held-out poses
-    of a multi-position calibration (issue 30); a warning per triad for the share of samples
+    """A calibration of triads judged on a turntable run, or on held-out poses
+    of a multi-position calibration; a warning per triad for the share of samples
     outside its calibrated temperature range."""
     from thermocal.multipos import validate as _mp_validate
     from thermocal.pipeline.compensate import read_for_triads
@@ -285,7 +285,7 @@ def validate_files(
     docstring): correlation r, bias stability and repeatability over the hold stages, rms and
     peak-to-peak, before and after compensation, in the data's own unit
     (:func:`thermocal.validation.validate`); triads: dwell-mean and move-angle errors."""
-    from thermocal.models.files import load_calibration
+    from thermocal.pipeline.model_file import load_calibration
 
     o = options if options is not None else ValidateOptions()
     pre = load_calibration(calibration)

@@ -467,7 +467,7 @@ def thermocal_metadata(kv: Any, where: str | Path) -> dict[str, Any]:
 def sha256_of(path: str | Path) -> str | None:
     """SHA-256 of a file's content, read in 1 MiB blocks; None when it cannot be read (a
     report states it unknown; the fleet redoes a unit whose input is missing).  A model
-    file's provenance uses :func:`thermocal.models.files.file_sha256`, which also reads a
+    file's provenance uses :func:`thermocal.pipeline.model_file.file_sha256`, which also reads a
     station folder and lets a read error through."""
     h = hashlib.sha256()
     if special_mode(Path(path)) is not None:  # a FIFO would block: never opened

@@ -518,7 +518,7 @@ def read_recording(
         stated=stated, guess_temperatures=guess_temperatures,
     )  # fmt: skip
     if fitted is not None:
-        from thermocal.models.base import check_sensor_id
+        from thermocal.models.rundata import check_sensor_id
 
         check_sensor_id(fitted, rec.meta.sensor_id, str(p))
     return rec

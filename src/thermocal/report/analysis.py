@@ -21,8 +21,8 @@ from thermocal.metrics import (
     drift_angle,
     drift_angle_extreme,
 )
-from thermocal.models.base import RunData
 from thermocal.models.registry import model_from_dict
+from thermocal.models.rundata import RunData
 from thermocal.recording import FloatArray, Metadata, Recording
 from thermocal.stability.allan import (
     AllanResult,
@@ -35,7 +35,7 @@ from thermocal.stability.periodic import periodic_terms
 
 ILL_CONDITIONED = 1.0e6
 """Condition number (scaled design) above which the report warns: ill-conditioned in the
-words of :func:`thermocal.models.base.condition_wording`."""
+words of :func:`thermocal.models.results.condition_wording`."""
 
 
 # --- analysis of the runs --------------------------------------------------------------------

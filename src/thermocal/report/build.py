@@ -41,7 +41,7 @@ from thermocal import units
 from thermocal.defaults import DEFAULT_AVERAGING_S, WEAK_CORRELATION_LIMIT
 from thermocal.errors import ThermocalInputError, ThermocalWarning
 from thermocal.metrics import data_unit_of
-from thermocal.models.base import condition_wording
+from thermocal.models.results import condition_wording
 from thermocal.readers.common import sha256_of
 from thermocal.recording import Recording
 from thermocal.report.analysis import (
@@ -81,7 +81,7 @@ from thermocal.writers import write_html
 
 ILL_CONDITIONED = 1.0e6
 """Condition number (scaled design) above which the report warns: ill-conditioned in the
-words of :func:`thermocal.models.base.condition_wording`."""
+words of :func:`thermocal.models.results.condition_wording`."""
 
 
 # --- inputs ------------------------------------------------------------------------------

@@ -35,8 +35,8 @@ from typing import Any
 from thermocal.compensate.kernels import unit_factor
 from thermocal.defaults import DEFAULT_AVERAGING_S
 from thermocal.errors import ThermocalInputError
-from thermocal.models.base import model_file_dict
 from thermocal.models.calibration import Calibration
+from thermocal.models.format import model_file_dict
 from thermocal.readers.common import sha256_of
 from thermocal.recording import Recording
 from thermocal.report.analysis import (

@@ -188,7 +188,7 @@ def make_report(
     ThermocalInputError
         Counts that do not match, the output an input, channels given with other models.
     """
-    from thermocal.models.files import load_calibration
+    from thermocal.pipeline.model_file import load_calibration
     from thermocal.readers.options import ReadOptions
     from thermocal.writers import check_not_input
 
@@ -286,7 +286,7 @@ def _models_report(
 ) -> ReportResult:
     """Model files reported and compared: both runs read with the same options (what they
     warn shown in the report too)."""
-    from thermocal.models.files import load_model_dict
+    from thermocal.pipeline.model_file import load_model_dict
     from thermocal.report.build import ModelEntry, ReportInputs, write_report
 
     with bar("building report", 3) as advance:

@@ -235,7 +235,7 @@ def validation_rows(validation: list[Any] | None) -> tuple[list[dict[str, Any]],
 def _own_session(cal: Any, recording_path: str | Path | None) -> bool:
     """Whether the recording is a session the triads were calibrated on (its SHA-256 among
     their ``data``)."""
-    from thermocal.models.files import file_sha256
+    from thermocal.pipeline.model_file import file_sha256
 
     known = {d.get("sha256") for t in cal.triads for d in t.data}
     path = Path(recording_path) if recording_path else None

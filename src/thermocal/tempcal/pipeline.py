@@ -33,9 +33,9 @@ import numpy.typing as npt
 from thermocal import adequacy, units
 from thermocal.errors import ThermocalInputError, ThermocalWarning
 from thermocal.firmware.binning import BIN_WIDTH_C, MIN_BINS, even_odd_split, temperature_bins
-from thermocal.models.base import RunData, model_inputs
 from thermocal.models.calibration import Calibration, Channel
 from thermocal.models.poly import PolyModel
+from thermocal.models.rundata import RunData, model_inputs
 from thermocal.recording import FloatArray, Recording
 from thermocal.tempcal.ardupilot_baro import ArdupilotBaroReportRequest
 from thermocal.tempcal.compare import CoefficientComparison
@@ -362,7 +362,7 @@ class OutputSet:
     def commit(self, calibration: Calibration, params_name: str, params_text: str) -> None:
         """Write the reports left (:meth:`finish_reports`), ``calibration.json`` and the
         parameter file, then move the set into place."""
-        from thermocal.models.files import save_calibration
+        from thermocal.pipeline.model_file import save_calibration
         from thermocal.writers import atomic_write, commit_directory
 
         self.finish_reports()

@@ -1,7 +1,7 @@
 """Plain C99 code computing a model's correction sample by sample.
 
 "Coefficients solidified in the IMU software": :func:`generate_c` turns a model
-file's dict (:func:`thermocal.models.files.load_model_dict`) into a header and a
+file's dict (:func:`thermocal.pipeline.model_file.load_model_dict`) into a header and a
 source file with
 
 * no dynamic allocation, no library beyond ``<math.h>``-free C99 (``<stddef.h>``);

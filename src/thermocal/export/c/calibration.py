@@ -245,7 +245,7 @@ def export_c(
 ) -> tuple[CExport, list[Path]]:
     """Read and verify a model file, generate its C module and write it into ``out_dir``
     (``unit``: the functions' signal unit, :func:`c_signal_unit`)."""
-    from thermocal.models.files import load_model_dict
+    from thermocal.pipeline.model_file import load_model_dict
 
     d = load_model_dict(model_path)
     ex = generate_c(

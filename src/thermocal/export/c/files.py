@@ -73,7 +73,7 @@ def _read_json(path: Path) -> object:
     """The file's JSON, or None when it is not JSON within the model files' bounds (the
     model loader then says why)."""
     from thermocal.errors import ModelFileError
-    from thermocal.models.filecheck import read_json
+    from thermocal.pipeline.model_filecheck import read_json
 
     try:
         return read_json(path)
@@ -112,7 +112,7 @@ def export_c_file(
     if is_calibration(_read_json(path)):
         return _export_calibration(path, out_dir, name, real, sample_interval_s, unit)
     from thermocal.adequacy import check_for_firmware
-    from thermocal.models.files import load_model_dict
+    from thermocal.pipeline.model_file import load_model_dict
 
     d = load_model_dict(path)
     check_for_firmware(d.get("adequacy"), str(path))
@@ -202,8 +202,8 @@ def _export_calibration(
     its data's unit (``unit`` applies one unit to every channel, or one per channel); or
     the module of its triads."""
     from thermocal import units
-    from thermocal.models.base import model_file_dict
-    from thermocal.models.files import load_calibration
+    from thermocal.models.format import model_file_dict
+    from thermocal.pipeline.model_file import load_calibration
 
     cal = load_calibration(path)
     check_firmware_adequacy(cal, path, None)

@@ -1,7 +1,7 @@
-"""Model and calibration files: the file edge of :mod:`thermocal.models` (issue 15).
+"""Model and calibration files: the file edge of :mod:`thermocal.models`, in the workflow layer.
 
 The maths modules (:mod:`thermocal.models.base`, the families, :mod:`thermocal.models.
-calibration`) build and check plain dicts (:func:`~thermocal.models.base.model_file_dict`,
+calibration`) build and check plain dicts (:func:`~thermocal.models.format.model_file_dict`,
 :func:`~thermocal.models.schema.verify_model_dict`, :meth:`Calibration.to_dict`,
 :func:`~thermocal.models.calibration.calibration_from_dict`) and import no I/O; reading and
 writing the files (atomically, :func:`thermocal.writers.write_json`) happens here.
@@ -15,11 +15,7 @@ from typing import Any
 
 from thermocal.errors import ModelFileError, ThermocalInputError
 from thermocal.models import registry
-from thermocal.models.base import (
-    MODEL_FORMAT,
-    TemperatureModel,
-    model_file_dict,
-)
+from thermocal.models.base import TemperatureModel
 from thermocal.models.calibration import (
     Calibration,
     Channel,
@@ -27,8 +23,9 @@ from thermocal.models.calibration import (
     guess_role,
     is_calibration,
 )
-from thermocal.models.filecheck import read_json
+from thermocal.models.format import MODEL_FORMAT, model_file_dict
 from thermocal.models.schema import verify_model_dict
+from thermocal.pipeline.model_filecheck import read_json
 from thermocal.writers import write_json
 
 
@@ -85,7 +82,7 @@ def model_from_dict(d: dict[str, Any], path: str | Path) -> TemperatureModel:
 def save_calibration(cal: Calibration, path: str | Path) -> dict[str, Any]:
     """Write a calibration file (atomically); returns its dict.  The file's own reader
     (:func:`~thermocal.models.calibration.calibration_from_dict`) judges it first: a
-    calibration that reader would refuse is refused here and not written (issue 39)."""
+    calibration that reader would refuse is refused here and not written."""
     import json
 
     from thermocal.errors import DesignError

@@ -1,4 +1,4 @@
-"""Reading a model or calibration file's JSON within stated bounds (issue 26).
+"""Reading a model or calibration file's JSON within stated bounds.
 
 A model file is read before anything else looks at it, and refused (:class:`ModelFileError`,
 exit 2, naming the file and the key path) when:
@@ -12,7 +12,7 @@ exit 2, naming the file and the key path) when:
   (``1e309``), or an integer beyond ±2⁵³ (the largest exactly representable in a double;
   a 5000-digit integer is refused before Python converts it).
 
-The checksum a model file carries (:func:`thermocal.models.base.checksum`) is computed
+The checksum a model file carries (:func:`thermocal.models.format.checksum`) is computed
 afterwards: it guards against accidents (a truncated copy, a hand edit, a bit flip), not
 against tampering — anyone can recompute it — which is why the content itself is checked
 (:mod:`thermocal.models.schema`, :meth:`thermocal.turntable.thermal.TriadThermal.from_dict`).
