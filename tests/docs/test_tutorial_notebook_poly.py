@@ -17,7 +17,7 @@ from typing import Any
 import numpy as np
 import pytest
 
-from test_tutorials import BLOCK, TUTORIALS, _numbers
+from tutorial_pages import BLOCK, TUTORIALS, _numbers
 
 PAGE = TUTORIALS / "notebook-poly.md"
 SIGMA = 0.05  # [°/h] the page's white noise

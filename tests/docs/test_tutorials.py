@@ -41,10 +41,10 @@ def test_every_tutorial_is_executed_here() -> None:
         "fc-params.md",  # tests/docs/test_tutorials_b.py
         "multipos-imucal.md",
         "noise-for-estimator.md",  # tests/docs/test_tutorials_a.py
-        "notebook-multipos.md",  # tests/docs/test_tutorial_notebook_multipos.py
-        "notebook-px4.md",  # tests/docs/test_tutorial_notebook_px4.py
         "notebook-allan.md",  # tests/docs/test_tutorial_notebook_allan.py
+        "notebook-multipos.md",  # tests/docs/test_tutorial_notebook_multipos.py
         "notebook-poly.md",  # tests/docs/test_tutorial_notebook_poly.py
+        "notebook-px4.md",  # tests/docs/test_tutorial_notebook_px4.py
         "production-batch.md",  # tests/docs/test_tutorials_b.py
         "stability-stable32.md",
         "station.md",  # tests/docs/test_tutorial_station.py
