@@ -216,8 +216,8 @@ def accumulate_targets(
     n_folds: int = 1,
     solver: Literal["auto", "qr", "gram"] = "auto",
 ) -> list[Reduced]:
-    """:func:`accumulate_r` for ``n_targets`` targets sharing one design (several channels,
-    issue 15): one :class:`Reduced` per target, each computed by the very operations a
+    """:func:`accumulate_r` for ``n_targets`` targets sharing one design (several channels):
+    one :class:`Reduced` per target, each computed by the very operations a
     single target gets, so each equals its own one-target reduction bit for bit.
 
     Shared: the features of every chunk (built once by ``make_chunks``), the Gram matrix

@@ -260,7 +260,7 @@ def _validate_triads(
 
     rec = read_for_triads(file, cal.triads, read_options_of(o))
     _own_session(cal, file)
-    if _mp_validate.is_multipos(cal.triads):  # held-out poses (issue 30)
+    if _mp_validate.is_multipos(cal.triads):  # held-out poses
         results: list[Any] = _mp_validate.validate_held_out_session(
             cal.triads, rec, o.latitude, static_s=o.static_s, signal_unit=o.signal_unit
         )
