@@ -118,6 +118,12 @@ class AccelFit:
         coefficient_rows`, bias in mg)."""
         return model.coefficient_rows(self.theta, self.sigma, "mg", "accel")
 
+    def to_frame(self) -> Any:
+        """:meth:`table` as a pandas DataFrame (pandas must be installed)."""
+        import pandas
+
+        return pandas.DataFrame(self.table())
+
 
 def _unpack(p: FloatArray) -> tuple[FloatArray, FloatArray]:
     """(b [mg], E) from the nine free parameters (E entries in 10⁻³)."""

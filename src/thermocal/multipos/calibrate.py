@@ -194,6 +194,12 @@ class SessionResult:
         ``pandas.DataFrame(result.table())`` makes it a table."""
         return self.accel.table() + ([] if self.gyro is None else self.gyro.table())
 
+    def to_frame(self) -> Any:
+        """:meth:`table` as a pandas DataFrame (pandas must be installed)."""
+        import pandas
+
+        return pandas.DataFrame(self.table())
+
     def poses_dict(self) -> list[dict[str, Any]]:
         return [
             {

@@ -278,6 +278,12 @@ class GyroFit:
         coefficient_rows`, bias in °/h)."""
         return model.coefficient_rows(self.theta, self.sigma, "deg/h", "gyro")
 
+    def to_frame(self) -> Any:
+        """:meth:`table` as a pandas DataFrame (pandas must be installed)."""
+        import pandas
+
+        return pandas.DataFrame(self.table())
+
 
 def static_bias(
     rate_means_rad_s: FloatArray,
