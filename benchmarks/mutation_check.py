@@ -1331,6 +1331,14 @@ MUTANTS: tuple[Mutant, ...] = (
         "six-face bias σ from the white noise alone (faces set a degree off: z-rms ≈ 140)",
     ),
     Mutant(
+        "multipos-scatter-two-sigma",
+        P + "multipos/gyro.py",
+        "return reduced_chi2 > 1.0 + 3.0 * math.sqrt(2.0 / dof)",
+        "return reduced_chi2 > 1.0 + 2.0 * math.sqrt(2.0 / dof)",
+        ("tests/pipeline/test_pipeline_multipos.py",),
+        "a gyro fit called scattered at two standard deviations of its reduced chi2, not three",
+    ),
+    Mutant(
         "multipos-offset-ignored",
         P + "pipeline/multipos.py",
         "        return float(given)\n",
@@ -1389,8 +1397,8 @@ MUTANTS: tuple[Mutant, ...] = (
     Mutant(
         "multipos-too-few-motions-redundancy",
         P + "multipos/gyro.py",
-        "return nu < len(GYRO_MODELS[fit.model]) and significant",
-        "return nu < 3 and significant",
+        "return nu < len(GYRO_MODELS[fit.model]) and scatter_beyond_noise(",
+        "return nu < 3 and scatter_beyond_noise(",
         ("tests/multipos/test_multipos_real_sessions.py",),
         "6 motions for 9 gyro elements (3 dof, χ² 704) not warned of",
     ),
