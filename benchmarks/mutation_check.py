@@ -1331,6 +1331,14 @@ MUTANTS: tuple[Mutant, ...] = (
         "six-face bias σ from the white noise alone (faces set a degree off: z-rms ≈ 140)",
     ),
     Mutant(
+        "validate-about-zero-signed",
+        P + "validation.py",
+        "return 100.0 * (abs(before) - abs(after)) / abs(before)",
+        "return 100.0 * (before - abs(after)) / abs(before)",
+        ("tests/core/test_validation_about_zero.py",),
+        "a mean of -4 moved to 2 shown as a 150 % improvement about zero",
+    ),
+    Mutant(
         "multipos-scatter-two-sigma",
         P + "multipos/gyro.py",
         "return reduced_chi2 > 1.0 + 3.0 * math.sqrt(2.0 / dof)",
