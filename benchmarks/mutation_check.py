@@ -1331,6 +1331,14 @@ MUTANTS: tuple[Mutant, ...] = (
         "six-face bias σ from the white noise alone (faces set a degree off: z-rms ≈ 140)",
     ),
     Mutant(
+        "fit-weak-coefficient-one-sigma",
+        P + "models/results.py",
+        "return not (ratio is None or ratio >= DISTINCT_T)",
+        "return not (ratio is None or ratio >= 0.5 * DISTINCT_T)",
+        ("tests/models/test_results_coefficient.py",),
+        "a coefficient 1.5 standard errors from zero called distinct from zero",
+    ),
+    Mutant(
         "validate-about-zero-signed",
         P + "validation.py",
         "return 100.0 * (abs(before) - abs(after)) / abs(before)",
