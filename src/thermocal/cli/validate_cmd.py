@@ -1,6 +1,7 @@
 """``thermocal validate MODEL.json FILE [--modeling FILE] [--ambient COL]``.
 
-Judges a model on an independent, weakly correlated test ([Seed-RLG],
+Judges a model on an independent, weakly correlated test (*A modelling and validation
+method for the temperature compensation model of a ring-laser gyroscope*, 2017;
 :func:`thermocal.validation.validate`).  ``r`` compares the ``--ambient`` column
 of the modelling and validation runs (default: the model's first temperature
 column).  Without ``--modeling`` the model file's recorded data file is used if
