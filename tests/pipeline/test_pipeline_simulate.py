@@ -48,3 +48,24 @@ def test_bad_format_names_the_parameter_and_the_option(
     err = capsys.readouterr().err
     assert code == 2
     assert err.strip() == "error: --format must be csv or parquet, got 'xml'"
+
+
+@pytest.mark.parametrize(
+    ("kw", "lib", "opts", "cli"),
+    [
+        ({"rate_hz": 0.0}, "rate_hz must be a positive number, got 0.0",
+         ["--rate-hz", "0"], "--rate-hz must be a positive number, got 0.0"),
+        ({"latitude_deg": 100.0}, "latitude_deg must be within ±90°, got 100.0",
+         ["--latitude", "100"], "--latitude must be within ±90°, got 100.0"),
+    ],
+)  # fmt: skip
+def test_options_name_the_parameter_and_the_cli_the_option(
+    kw: dict[str, float], lib: str, opts: list[str], cli: str, tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+) -> None:  # fmt: skip
+    with pytest.raises(ParameterError) as e:
+        SimulateOptions(**kw)
+    assert str(e.value) == lib
+    code = main(["simulate", "fog-slow", "-o", str(tmp_path / "x.csv"), *opts])
+    assert code == 2
+    assert capsys.readouterr().err.strip() == f"error: {cli}"
