@@ -331,6 +331,45 @@ def run_rms_and_peak_to_peak(
 # --- validation -----------------------------------------------------------------------------
 
 
+def improvement_about_zero_pct(before: float | None, after: float | None) -> float | None:
+    r"""Improvement of a figure about zero (a mean, an rms about zero, a largest error),
+    judged on its magnitude [%].
+
+    Parameters
+    ----------
+    before, after : float or None
+        The figure before and after compensation (same unit; signed for a mean).
+
+    Returns
+    -------
+    float or None
+        :math:`100\,(|b| - |a|)/|b|`; None when ``before`` is 0 or missing or ``after``
+        is missing.
+
+    Notes
+    -----
+    A compensation that moves the mean from +3 to −1 improved it by 67 %: the sign of a
+    mean about zero is not an error of its own.
+
+    .. math::
+
+        I = 100\,\frac{|b| - |a|}{|b|}
+
+    References
+    ----------
+    IEEE Std 1431-2004, IEEE Standard Specification Format Guide and Test Procedure for
+    Coriolis Vibratory Gyros (bias and its temperature sensitivity).
+
+    Examples
+    --------
+    >>> improvement_about_zero_pct(3.0, -1.0), improvement_about_zero_pct(0.0, 1.0)
+    (66.66666666666667, None)
+    """
+    if not before or after is None:
+        return None
+    return 100.0 * (abs(before) - abs(after)) / abs(before)
+
+
 def _correlation(
     modeling_ambient: tuple[npt.ArrayLike, npt.ArrayLike] | None,
     t: FloatArray,
@@ -595,6 +634,7 @@ __all__ = [
     "StageFigures",
     "ValidationResult",
     "block_means",
+    "improvement_about_zero_pct",
     "repeatability",
     "rms_over_stages",
     "run_rms_and_peak_to_peak",

@@ -14,10 +14,10 @@ import pytest
 
 import thermocal.tempcal.pipeline as pipeline
 from thermocal import adequacy
-from thermocal.cli.tempcal_cmd import write_report
 from thermocal.errors import ThermocalWarning
 from thermocal.recording import Metadata
 from thermocal.report.analysis import figures_of_merit, shown_figures
+from thermocal.report.sensor import write_sensor_report
 from thermocal.tempcal.px4 import px4_tempcal
 from ulog_writer import SENSOR_FIELDS, ulog_bytes
 
@@ -65,7 +65,7 @@ def test_stillness_is_computed_once_per_sensor(
 def _warning_reporter(path: Path, request: Any) -> None:
     """A reporter that says something (module level: sent to the worker by reference)."""
     warnings.warn(ThermocalWarning(f"report {path.name} says hello"), stacklevel=1)
-    write_report(path, request)
+    write_sensor_report(path, request)
 
 
 def _reports(out: Path) -> dict[str, str]:

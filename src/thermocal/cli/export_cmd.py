@@ -128,9 +128,9 @@ def export_params_cmd(
     def human() -> None:
         stdout.print(f"wrote {output}: {len(res.params.params)} {fmt} parameters")
         for a in res.params.axes:
-            unit = "rad/s" if a.kind == "gyro" else "m/s^2"
             stdout.print(
-                f"  {a.kind} {a.axis} <- {a.channel}: offset at TREF {fmt_c(a.coef[0])} {unit}"
+                f"  {a.kind} {a.axis} <- {a.channel}: offset at TREF {fmt_c(a.coef[0])} "
+                f"{res.unit_of(a.kind)}"
             )
         for n in res.params.notes:
             stdout.print(n)
@@ -139,4 +139,5 @@ def export_params_cmd(
 
 
 def fmt_c(v: float) -> str:
+    """A coefficient in four significant digits."""
     return f"{v:.4g}"

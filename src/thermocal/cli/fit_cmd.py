@@ -270,10 +270,10 @@ def _human_single(
     weak = 0
     ctab.add_column("unit")
     for c in est.coefficients():
-        ratio = abs(c.value) / c.stderr if c.stderr else None
-        flag = "" if ratio is None or ratio >= 2.0 else " *"
+        flag = " *" if c.indistinct_from_zero else ""
         weak += bool(flag)
-        ctab.add_row(c.name, fmt(c.value, 6), fmt(c.stderr, 3), f"{fmt(ratio, 2)}{flag}", c.unit)
+        ctab.add_row(c.name, fmt(c.value, 6), fmt(c.stderr, 3), f"{fmt(c.t_ratio, 2)}{flag}",
+                     c.unit)  # fmt: skip
     stdout.print(ctab)
     if "tref" in result:
         ttab = _rich_table.Table(title=f"coefficients about TREF = {result['tref']['tref_c']:g} °C")
@@ -284,8 +284,8 @@ def _human_single(
         stdout.print(ttab)
     if weak:
         stdout.print(
-            f"* {weak} coefficient(s) within 2 standard errors of 0: not distinct from "
-            "zero on these data (consider --select or fewer terms)"
+            f"* {weak} coefficient(s) within {_results.DISTINCT_T:g} standard errors of 0: not "
+            "distinct from zero on these data (consider --select or fewer terms)"
         )
 
 

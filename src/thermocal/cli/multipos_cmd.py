@@ -5,6 +5,7 @@ several files at several temperatures and ``--temps``, every parameter becomes a
 polynomial in T − TREF (:func:`thermocal.turntable.thermal.fit_triad`, the turntable's own
 thermal fit).  Writes a calibration of triads, the file type of ``thermocal turntable``."""
 
+import math
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated, Any
 
@@ -30,17 +31,41 @@ from thermocal.cli.common import (
     split_names,
     stdout,
 )
-from thermocal.errors import ThermocalInputError
+from thermocal.errors import ThermocalInputError, UnitError
 
 if TYPE_CHECKING:
     import rich.table as _rich_table
 
+    import thermocal.multipos.gyro as _gyro
     import thermocal.pipeline.multipos as _mpf
-    import thermocal.writers as _writers
+    import thermocal.units as units
 else:
     _rich_table = LazyModule("rich.table")
-    _writers = LazyModule("thermocal.writers")
+    _gyro = LazyModule("thermocal.multipos.gyro")
     _mpf = LazyModule("thermocal.pipeline.multipos")
+    units = LazyModule("thermocal.units")
+
+
+def _count_scale(text: str | None, kind: str) -> tuple[float, str] | None:
+    """``--accel-scale``/``--gyro-scale VALUE,UNIT``: one raw count is ``VALUE`` ``UNIT``
+    (a datasheet's sensitivity, e.g. ``0.061,mg`` or ``0.00763,deg/s``), a positive
+    finite number and a unit of the triad's kind."""
+    if text is None:
+        return None
+    parts = [p.strip() for p in text.split(",")]
+    want = "accel" if kind == "accel" else "rate"
+    try:
+        value = float(parts[0])
+        unit = str(units.normalize_signal_unit(parts[1])) if len(parts) == 2 else ""
+    except (ValueError, UnitError):
+        value, unit = math.nan, ""
+    if not (math.isfinite(value) and value > 0 and unit and units.signal_kind(unit) == want):
+        example = "0.061,mg" if kind == "accel" else "0.00763,deg/s"
+        what = "an accelerometer unit: mg, g, m/s^2" if kind == "accel" else "a rate unit: deg/s"
+        raise ThermocalInputError(
+            f"--{kind}-scale takes VALUE,UNIT (one count in {what}…; e.g. {example}), got {text!r}"
+        )
+    return value, unit
 
 
 def _three(text: str | None, option: str) -> list[str] | None:
@@ -154,13 +179,13 @@ GyroModelOpt = Annotated[
 
 
 def _gyro_misfit(run: dict[str, Any]) -> None:
-    """A line when the motions scatter beyond their noise (reduced χ² above
-    ``1 + 3√(2/ν)``): the gyro's σ are scaled by it."""
+    """A line when the motions scatter beyond their noise
+    (:func:`thermocal.multipos.gyro.scatter_beyond_noise`): the gyro's σ are scaled by it."""
     g = run.get("gyro")
     if not g or not g["dof"] > 0 or g["reduced_chi2"] is None:
         return
     chi2, dof = float(g["reduced_chi2"]), int(g["dof"])
-    if chi2 > 1.0 + 3.0 * (2.0 / dof) ** 0.5:
+    if _gyro.scatter_beyond_noise(chi2, dof):
         stdout.print(
             f"{run['input']}: the gyro's {g['n_motions']} motions scatter beyond their noise "
             f"(reduced χ² {fmt(chi2, 3)} on {dof} degrees of freedom, {g['model']} model): "
@@ -266,16 +291,13 @@ def multipos_cmd(
 ) -> None:
     """Accelerometer (and gyro) triad bias, scale factors and misalignments from hand-placed
     poses, without a turntable (Tedaldi et al. 2014; Ferraris et al. 1995)."""
-    _writers.check_not_input(output, [*files, *([poses] if poses else [])])
-    if output.suffix.lower() != ".json":
-        raise ThermocalInputError(f"{output}: the calibration is JSON; use a .json name")
     acc_cols = _three(accel, "--accel") or []
     gyr_cols = _three(gyro, "--gyro")
     opts = _mpf.MultiposOptions(
         (acc_cols[0], acc_cols[1], acc_cols[2]),
         (gyr_cols[0], gyr_cols[1], gyr_cols[2]) if gyr_cols else None,
         accel_unit, gyro_unit, temps, gravity, latitude, order, tref, static_s, time, time_unit,
-        _mpf.count_scale(accel_scale, "accel"), _mpf.count_scale(gyro_scale, "gyro"),
+        _count_scale(accel_scale, "accel"), _count_scale(gyro_scale, "gyro"),
         window_s, still_threshold, motion_fraction, drift_deg, accel_offset, gyro_offset,
         gyro_model,
         read=read_options(
@@ -283,9 +305,8 @@ def multipos_cmd(
         ),
     )  # fmt: skip
     res = _mpf.calibrate_files(files, output, opts, poses)
-    out, a_unit = res.summary, res.accel_unit
-
-    emit(out, as_json, lambda: _human(out, a_unit, output))
+    out = res.to_dict()
+    emit(out, as_json, lambda: _human(out, res.accel_unit, output))
 
 
 __all__ = ["multipos_cmd"]

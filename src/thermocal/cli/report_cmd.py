@@ -114,11 +114,6 @@ def report_cmd(
     Every model given is shown (fit, range of validity, coefficients); a PASS/ATTENTION
     verdict is stated only from a validation result given with --validation.
     """
-    if topic is None and sensor is not None:  # a station folder's sensor is the report's
-        from thermocal.readers.station import is_station_path
-
-        if any(p is not None and p.is_dir() and is_station_path(p) for p in (recording, modeling)):
-            topic = sensor
     read = read_options(
         time=time, time_unit=time_unit, signal_unit=signal_unit, temp_unit=temp_unit,
         temp_conversion=temp_conversion, topic=topic, names=t_names, rate=t_rate,

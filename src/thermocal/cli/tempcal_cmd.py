@@ -4,7 +4,7 @@ a flight controller's thermal calibration from one log.
 The library does the work (:func:`thermocal.tempcal.px4.px4_tempcal`,
 :func:`thermocal.tempcal.ardupilot.ardupilot_tempcal`, one pipeline:
 :mod:`thermocal.tempcal.pipeline`); this module parses the options, gives the report writer
-(:func:`thermocal.report.calibration.write_calibration_report`) and prints the result.
+(:func:`thermocal.report.sensor.write_sensor_report`) and prints the result.
 """
 
 from pathlib import Path
@@ -29,59 +29,12 @@ if TYPE_CHECKING:
     import rich.table as _rich_table
 
     from thermocal.tempcal.ardupilot import ArdupilotTempcalResult
-    from thermocal.tempcal.pipeline import AnyReportRequest, SensorFit
+    from thermocal.tempcal.pipeline import SensorFit
     from thermocal.tempcal.px4 import OffsetFit, Px4TempcalResult
 else:
     _rich_table = LazyModule("rich.table")
 
 OutDirOpt = Annotated[Path, typer.Option("-o", "--output", help="Directory to write.")]
-
-
-def write_report(path: Path, req: "AnyReportRequest") -> None:
-    """One sensor's HTML report (:func:`thermocal.report.calibration.write_calibration_report`;
-    a barometer's or magnetometer's: :func:`thermocal.report.tempcal.write_offset_report`;
-    ArduPilot's ``TCAL_BARO_EXP``: :func:`thermocal.report.tempcal.write_ardupilot_baro_report`)."""
-    from thermocal.report.calibration import CalibrationReportInputs, write_calibration_report
-    from thermocal.report.tempcal import comparison_html, write_offset_report
-    from thermocal.tempcal.ardupilot_baro import ArdupilotBaroReportRequest
-    from thermocal.tempcal.offset_report import OffsetReportRequest
-
-    if isinstance(req, OffsetReportRequest):
-        write_offset_report(path, req)
-        return
-    if isinstance(req, ArdupilotBaroReportRequest):  # TCAL_BARO_EXP
-        from thermocal.report.tempcal import write_ardupilot_baro_report
-
-        write_ardupilot_baro_report(path, req)
-        return
-
-    write_calibration_report(
-        path,
-        CalibrationReportInputs(
-            calibration=req.calibration, recording=req.recording,
-            recording_path=req.recording_path, title=req.title, sensor=req.sensor,
-            generated_by=req.generated_by, extra=req.extra, notes=req.notes,
-            appendix=tuple(
-                comparison_html(c) for c in (req.previous, req.firmware_learning) if c is not None
-            ),
-        ),
-    )  # fmt: skip
-
-
-def _warm_reports() -> None:
-    """What the first report costs beyond its own work (the report modules imported, a
-    log-axis figure drawn: fonts and tick labels), paid by the report worker while the log
-    is read (:func:`thermocal.tempcal.pipeline.report_worker`)."""
-    import numpy as np
-
-    from thermocal.report import calibration as _calibration  # noqa: F401
-    from thermocal.report import figures as F
-
-    tau = np.logspace(-2, 3, 12)
-    F.allan_grid([("x", "unit", [F.AllanCurve("before", tau, 1.0 / tau, None, None)])] * 3)
-
-
-write_report.warm = _warm_reports  # type: ignore[attr-defined]
 
 
 @app.command("px4-tempcal")
@@ -100,11 +53,12 @@ def px4_tempcal_cmd(
     """Fit every gyro and accelerometer instance of a PX4 log as PX4 would (a cubic per axis
     about TREF), robust to spikes, with equal weight across the temperature range and
     judged on held-out data; write the TC_* parameters, the calibration and reports."""
+    from thermocal.report.sensor import write_sensor_report
     from thermocal.tempcal.px4 import px4_tempcal
 
     res = px4_tempcal(
         log, output, tref_c=tref, overrides=overrides_of(allow_narrow, allow_motion),
-        reporter=write_report,
+        reporter=write_sensor_report,
     )  # fmt: skip
     emit(res.to_dict(), as_json, lambda: _print_px4(res))
 
@@ -138,11 +92,13 @@ def ardupilot_tempcal_cmd(
     """ArduPilot's thermal calibration from one DataFlash log: every IMU instance's gyro
     and accelerometer fitted as in px4-tempcal, written as INS_TCAL* (.parm), a calibration
     and reports (the polynomial about 35 °C without constant, as the firmware takes it)."""
+    from thermocal.report.sensor import write_sensor_report
     from thermocal.tempcal.ardupilot import ardupilot_tempcal
 
     res = ardupilot_tempcal(
-        log, output, overrides=overrides_of(allow_narrow, allow_motion), reporter=write_report
-    )
+        log, output, overrides=overrides_of(allow_narrow, allow_motion),
+        reporter=write_sensor_report,
+    )  # fmt: skip
     emit(res.to_dict(), as_json, lambda: _print_ardupilot(res))
 
 

@@ -1,6 +1,7 @@
 """``thermocal validate MODEL.json FILE [--modeling FILE] [--ambient COL]``.
 
-Judges a model on an independent, weakly correlated test ([Seed-RLG],
+Judges a model on an independent, weakly correlated test (*A modelling and validation
+method for the temperature compensation model of a ring-laser gyroscope*, 2017;
 :func:`thermocal.validation.validate`).  ``r`` compares the ``--ambient`` column
 of the modelling and validation runs (default: the model's first temperature
 column).  Without ``--modeling`` the model file's recorded data file is used if
@@ -49,8 +50,10 @@ if TYPE_CHECKING:
     import rich.table as _rich_table
 
     import thermocal.pipeline.validate as _validate
+    import thermocal.validation as _validation
 else:
     _rich_table = LazyModule("rich.table")
+    _validation = LazyModule("thermocal.validation")
     _validate = LazyModule("thermocal.pipeline.validate")
 
 ModelingOpt = Annotated[
@@ -150,7 +153,7 @@ def _human_single(report: "_validate.ValidationReport") -> None:
         ("max_abs", "max |error|"),
     ):
         b, a = out[f"{key}_before"], out[f"{key}_after"]
-        pct = 100.0 * (abs(b) - abs(a)) / abs(b) if b and a is not None else None
+        pct = _validation.improvement_about_zero_pct(b, a)
         table.add_row(
             label, fmt(b), fmt(a), "—" if pct is None else f"{pct:.1f} %"
         )  # fmt: skip

@@ -621,6 +621,21 @@ class ParamsFileResult:
     format: str
     params: ParamSet
 
+    def unit_of(self, kind: str) -> str:
+        """The unit of the offsets the firmware subtracts for a sensor.
+
+        Parameters
+        ----------
+        kind : str
+            ``"gyro"`` or ``"accel"``.
+
+        Returns
+        -------
+        str
+            ``"rad/s"`` or ``"m/s^2"`` (:data:`thermocal.firmware.formats.FORMATS`).
+        """
+        return FORMATS[self.format].sensors[kind].unit
+
     def to_dict(self) -> dict[str, Any]:
         """The ``thermocal export-params --json`` object."""
         return {

@@ -11,6 +11,9 @@ from typing import Any
 
 # --- fitted coefficients and statistics ----------------------------------------------------
 
+DISTINCT_T = 2.0
+"""A coefficient within this many standard errors of zero is not distinct from zero."""
+
 
 @dataclass(frozen=True)
 class Coefficient:
@@ -20,6 +23,54 @@ class Coefficient:
     value: float
     stderr: float | None = None
     unit: str = ""
+
+    @property
+    def t_ratio(self) -> float | None:
+        r"""The coefficient over its standard error, :math:`|v|/s` (None without a standard
+        error or with a zero one).
+
+        Returns
+        -------
+        float or None
+            The magnitude in standard errors [dimensionless].
+
+        Examples
+        --------
+        >>> round(Coefficient("c1", -0.5, 0.25).t_ratio, 3)
+        2.0
+        """
+        return abs(self.value) / self.stderr if self.stderr else None
+
+    @property
+    def indistinct_from_zero(self) -> bool:
+        r"""Whether the coefficient lies within :data:`DISTINCT_T` standard errors of zero:
+        not distinct from zero on the data it was fitted on.
+
+        Returns
+        -------
+        bool
+            True when :math:`|v|/s <` :data:`DISTINCT_T` (a NaN ratio included); False
+            without a standard error.
+
+        Notes
+        -----
+        Two standard errors is the 95 % two-sided bound of a normal estimate (1.96 σ).
+
+        References
+        ----------
+        IEEE Std 952-1997, IEEE Standard Specification Format Guide and Test Procedure for
+        Single-Axis Interferometric Fiber Optic Gyros, Annex C (least-squares model
+        fitting of test data).
+
+        Examples
+        --------
+        >>> Coefficient("c1", 0.3, 0.2).indistinct_from_zero
+        True
+        >>> Coefficient("c1", 3.0, 0.2).indistinct_from_zero
+        False
+        """
+        ratio = self.t_ratio
+        return not (ratio is None or ratio >= DISTINCT_T)
 
     def to_dict(self) -> dict[str, Any]:
         d: dict[str, Any] = {"name": self.name, "value": self.value}

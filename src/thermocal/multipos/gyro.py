@@ -672,6 +672,47 @@ def fit_rotations(
     )
 
 
+def scatter_beyond_noise(reduced_chi2: float, dof: int) -> bool:
+    r"""Whether a fit's residuals scatter beyond their noise: a reduced χ² more than three
+    of its standard deviations above 1.
+
+    Parameters
+    ----------
+    reduced_chi2 : float
+        The fit's χ² divided by its degrees of freedom [dimensionless].
+    dof : int
+        The degrees of freedom ν (positive).
+
+    Returns
+    -------
+    bool
+        True when :math:`\chi^2_\nu > 1 + 3\sqrt{2/\nu}`.
+
+    Notes
+    -----
+    With normal residuals of the stated σ, :math:`\nu\chi^2_\nu` follows a χ² law of ν
+    degrees of freedom (mean ν, variance 2ν): :math:`\chi^2_\nu` has mean 1 and standard
+    deviation :math:`\sqrt{2/\nu}`.
+
+    .. math::
+
+        \chi^2_\nu > 1 + 3\sqrt{2/\nu}
+
+    References
+    ----------
+    Tedaldi, D., Pretto, A., Menegatti, E. (2014). A robust and easy to implement method
+    for IMU calibration without external equipments. ICRA 2014, 3042-3049.
+
+    Examples
+    --------
+    >>> scatter_beyond_noise(1.5, 100), scatter_beyond_noise(704.0, 3)
+    (True, True)
+    >>> scatter_beyond_noise(1.2, 100)
+    False
+    """
+    return reduced_chi2 > 1.0 + 3.0 * math.sqrt(2.0 / dof)
+
+
 def too_few_motions(fit: GyroFit) -> bool:
     """Whether the motions cannot carry the model's elements of E: a redundancy
     (:attr:`GyroFit.dof`) below the number of elements fitted, with a misfit beyond the
@@ -699,8 +740,7 @@ def too_few_motions(fit: GyroFit) -> bool:
     nu = fit.dof
     if nu <= 0:
         return True
-    significant = fit.reduced_chi2 > 1.0 + 3.0 * math.sqrt(2.0 / nu)
-    return nu < len(GYRO_MODELS[fit.model]) and significant
+    return nu < len(GYRO_MODELS[fit.model]) and scatter_beyond_noise(fit.reduced_chi2, nu)
 
 
 def _residuals_fixed_att(
@@ -727,6 +767,7 @@ __all__ = [
     "Turn",
     "check_turn",
     "fit_rotations",
+    "scatter_beyond_noise",
     "static_bias",
     "too_few_motions",
     "turn_gap",

@@ -99,6 +99,7 @@ OPTION_OF: dict[str, str] = {
     "rate_interval_s": "--rate-interval",
     "start_window_s": "--start-window",
     "select": "--select-method",
+    "file_format": "--format",
 }
 """Library parameters whose command-line option is not the parameter's name with dashes
 (``time_unit`` → ``--time-unit`` needs no entry)."""

@@ -10,6 +10,7 @@ and go out (file layer, as :mod:`thermocal.pipeline.compensate` for the compensa
 
 from __future__ import annotations
 
+import copy
 import itertools
 import json
 import math
@@ -22,7 +23,7 @@ from typing import Any
 import numpy as np
 
 from thermocal import units
-from thermocal.errors import DesignError, ThermocalInputError, ThermocalWarning, UnitError
+from thermocal.errors import DesignError, ThermocalInputError, ThermocalWarning
 from thermocal.inspection import saturated_mask
 from thermocal.models.calibration import Calibration, Triad
 from thermocal.multipos.calibrate import METHOD, SessionResult, calibrate_session
@@ -42,6 +43,7 @@ from thermocal.readers import read_recording
 from thermocal.readers.options import ReadOptions
 from thermocal.recording import Recording
 from thermocal.turntable import thermal
+from thermocal.writers import check_not_input
 
 NO_TEMPERATURE_TREF_C = 25.0
 """TREF recorded for a calibration made without a temperature column (it applies
@@ -140,27 +142,18 @@ class MultiposResult:
     summary: dict[str, Any]
     accel_unit: str
 
+    def to_dict(self) -> dict[str, Any]:
+        """The result as ``thermocal multipos --json`` prints it.
 
-def count_scale(text: str | None, kind: str) -> tuple[float, str] | None:
-    """``--accel-scale``/``--gyro-scale VALUE,UNIT``: one raw count is ``VALUE`` ``UNIT``
-    (a datasheet's sensitivity, e.g. ``0.061,mg`` or ``0.00763,deg/s``), a positive
-    finite number and a unit of the triad's kind."""
-    if text is None:
-        return None
-    parts = [p.strip() for p in text.split(",")]
-    want = "accel" if kind == "accel" else "rate"
-    try:
-        value = float(parts[0])
-        unit = str(units.normalize_signal_unit(parts[1])) if len(parts) == 2 else ""
-    except (ValueError, UnitError):
-        value, unit = math.nan, ""
-    if not (math.isfinite(value) and value > 0 and unit and units.signal_kind(unit) == want):
-        example = "0.061,mg" if kind == "accel" else "0.00763,deg/s"
-        what = "an accelerometer unit: mg, g, m/s^2" if kind == "accel" else "a rate unit: deg/s"
-        raise ThermocalInputError(
-            f"--{kind}-scale takes VALUE,UNIT (one count in {what}…; e.g. {example}), got {text!r}"
-        )
-    return value, unit
+        Returns
+        -------
+        dict
+            Each triad at TREF in the data's units (bias, scale factors [ppm],
+            misalignments [″] with their σ), the poses, the gravity-magnitude residuals
+            before and after in the accelerometer's unit, each run's figures and the pose
+            detector's choice, and ``output``, the calibration file written.
+        """
+        return copy.deepcopy(self.summary)
 
 
 def _unit_of(
@@ -499,6 +492,9 @@ def calibrate_files(
     """Calibrate the sessions ``files`` (one per temperature; ``poses`` the named sections
     of a single file) and write the calibration of triads to ``output`` (module
     docstring).  Every file's columns must be in one unit per triad."""
+    check_not_input(output, [*files, *([poses] if poses else [])])
+    if output.suffix.lower() != ".json":
+        raise ThermocalInputError(f"{output}: the calibration is JSON; use a .json name")
     opts.check(len(files), poses)
     sections_d = _read_poses(poses)
     runs: list[SessionRun] = []
@@ -632,5 +628,4 @@ __all__ = [
     "MultiposResult",
     "SessionRun",
     "calibrate_files",
-    "count_scale",
 ]

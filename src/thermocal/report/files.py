@@ -13,7 +13,7 @@ import contextlib
 import json
 import warnings
 from collections.abc import Callable, Iterator, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -139,6 +139,20 @@ def _check_counts(
         raise ThermocalInputError(f"{len(labels)} --label values for {len(models)} --model files")
 
 
+def _station_topic(
+    read: ReadOptions, sensor: str | None, paths: Sequence[Path | None]
+) -> ReadOptions:
+    """A station folder's sensor is the report's: ``sensor`` read as the topic when no topic
+    is given and a recording is a station folder."""
+    if read.topic is not None or sensor is None:
+        return read
+    from thermocal.readers.station import is_station_path
+
+    if any(p is not None and p.is_dir() and is_station_path(p) for p in paths):
+        return replace(read, topic=sensor)
+    return read
+
+
 def make_report(
     models: Sequence[Path],
     recording: Path,
@@ -172,7 +186,8 @@ def make_report(
     validations, labels : sequence
         ``thermocal validate --json`` results and labels, one per model, in its order.
     signal, title, sensor : str, optional
-        The signal column(s) and the headline texts.
+        The signal column(s) and the headline texts; with a station folder and no
+        ``read.topic``, ``sensor`` is also the sensor read.
     averaging_s, latitude_deg, dynamic_s : float, optional
         Averaging time of the stability figures [s]; latitude [°] of a triad's validation
         (default the file's metadata); window of the dynamic Allan deviation [s].
@@ -192,7 +207,7 @@ def make_report(
     from thermocal.readers.options import ReadOptions
     from thermocal.writers import check_not_input
 
-    opts = read or ReadOptions()
+    opts = _station_topic(read or ReadOptions(), sensor, (recording, modeling))
     bar = progress or _no_progress
     _check_counts(models, validations, labels)
     inputs_files: list[str | Path] = [*models, *validations, recording]

@@ -17,7 +17,7 @@ import numpy.typing as npt
 
 from thermocal import units
 from thermocal.defaults import MAX_SIMULATED_SAMPLES
-from thermocal.errors import ThermocalInputError
+from thermocal.errors import ParameterError, ThermocalInputError
 from thermocal.profiles import (
     POWER_ON_LABEL,
     Profile,
@@ -933,8 +933,9 @@ class SimulateOptions:
 
     Raises
     ------
-    ThermocalInputError
-        A rate that is not positive or a latitude beyond ±90°.
+    thermocal.errors.ParameterError
+        A rate that is not positive (``rate_hz``) or a latitude beyond ±90°
+        (``latitude_deg``).
     """
 
     rate_hz: float | None = None
@@ -950,9 +951,9 @@ class SimulateOptions:
     def __post_init__(self) -> None:
         rate, lat = self.rate_hz, self.latitude_deg
         if rate is not None and not (math.isfinite(rate) and rate > 0):
-            raise ThermocalInputError(f"--rate-hz must be a positive number, got {rate!r}")
+            raise ParameterError("rate_hz", f"{{name}} must be a positive number, got {rate!r}")
         if lat is not None and not (math.isfinite(lat) and abs(lat) <= 90.0):
-            raise ThermocalInputError(f"--latitude must be within ±90°, got {lat!r}")
+            raise ParameterError("latitude_deg", f"{{name}} must be within ±90°, got {lat!r}")
 
     def given(self) -> dict[str, Any]:
         """The options given, as the scenario's keyword arguments."""

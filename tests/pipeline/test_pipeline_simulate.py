@@ -1,0 +1,71 @@
+"""``thermocal.pipeline.simulate``: the library call behind ``thermocal simulate``; its
+``to_dict()`` is what ``--json`` prints."""
+
+from __future__ import annotations
+
+import json
+import shutil
+from pathlib import Path
+
+import pytest
+
+from thermocal.cli import main
+from thermocal.errors import ParameterError
+from thermocal.pipeline.simulate import simulate_files, simulation_paths
+from thermocal.readers.dispatch import read_recording
+from thermocal.simulate import SimulateOptions
+
+
+def test_to_dict_is_what_the_cli_prints(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    out, truth = tmp_path / "runs", tmp_path / "truth.json"
+    args = ["simulate", "accel-full-range", "-o", str(out), "--runs", "2", "--seed", "3"]
+    assert main([*args, "--truth", str(truth), "--json"]) == 0
+    printed = json.loads(capsys.readouterr().out)
+    shutil.rmtree(out)
+    truth.unlink()
+    res = simulate_files(
+        "accel-full-range", out, seed=3, truth=truth, options=SimulateOptions(runs=2)
+    )
+    assert res.to_dict() == printed
+    # the counts are the files' rows, read back by the reader
+    # what was asked, independently of the code under test
+    assert printed["scenario"] == "accel-full-range"
+    assert printed["seed"] == 3
+    assert printed["truth"] == str(truth)
+    assert len(printed["files"]) == 2
+    assert all(Path(f).parent == out and f.endswith(".csv") for f in printed["files"])
+    for f, n in zip(printed["files"], printed["n_samples"], strict=True):
+        assert read_recording(f).n_samples == n
+    assert json.loads(truth.read_text())["seed"] == 3
+
+
+def test_bad_format_names_the_parameter_and_the_option(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    with pytest.raises(ParameterError, match=r"^file_format must be csv or parquet"):
+        simulation_paths(tmp_path / "d", "fog-slow", ["a", "b"], "xml")
+    code = main(["simulate", "mems-warmup", "-o", str(tmp_path / "d"), "--format", "xml"])
+    err = capsys.readouterr().err
+    assert code == 2
+    assert err.strip() == "error: --format must be csv or parquet, got 'xml'"
+
+
+@pytest.mark.parametrize(
+    ("kw", "lib", "opts", "cli"),
+    [
+        ({"rate_hz": 0.0}, "rate_hz must be a positive number, got 0.0",
+         ["--rate-hz", "0"], "--rate-hz must be a positive number, got 0.0"),
+        ({"latitude_deg": 100.0}, "latitude_deg must be within ±90°, got 100.0",
+         ["--latitude", "100"], "--latitude must be within ±90°, got 100.0"),
+    ],
+)  # fmt: skip
+def test_options_name_the_parameter_and_the_cli_the_option(
+    kw: dict[str, float], lib: str, opts: list[str], cli: str, tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+) -> None:  # fmt: skip
+    with pytest.raises(ParameterError) as e:
+        SimulateOptions(**kw)
+    assert str(e.value) == lib
+    code = main(["simulate", "fog-slow", "-o", str(tmp_path / "x.csv"), *opts])
+    assert code == 2
+    assert capsys.readouterr().err.strip() == f"error: {cli}"
