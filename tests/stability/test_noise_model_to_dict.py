@@ -29,8 +29,8 @@ def test_noise_model_to_dict_is_the_json_file(tmp_path: Path) -> None:
     rng = np.random.default_rng(0)
     n = 60_000
     data = {"time [s]": np.arange(n) * DT_S}
-    for c, d in zip(COLS, DENSITY, strict=True):
-        data[c] = rng.normal(0.0, d / math.sqrt(DT_S), n)  # discrete σ = σ_c/√Δt
+    for c, sigma in zip(COLS, DENSITY, strict=True):
+        data[c] = rng.normal(0.0, sigma / math.sqrt(DT_S), n)  # discrete σ = σ_c/√Δt
     path = tmp_path / "imu.csv"
     pd.DataFrame(data).to_csv(path, index=False, float_format="%.9g")
     out = tmp_path / "noise.json"
