@@ -8,6 +8,7 @@ range and NaN count, temperature span, spikes (Hampel test) and the problems of
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -293,13 +294,17 @@ def _saturation_problems(name: str, arr: FloatArray) -> list[Problem]:
     ]
 
 
-def inspect_recording(rec: Recording) -> Inspection:
+def inspect_recording(rec: Recording, skipped: Sequence[str] = ()) -> Inspection:
     """What is in a recording and what is wrong with it.
 
     Parameters
     ----------
     rec : Recording
         The recording, as read.
+    skipped : sequence of str
+        Columns the reader skipped because they hold non-numeric values (the ``skipped``
+        list of :func:`thermocal.readers.read_recording`): each one a ``non_numeric``
+        warning, after the other problems.
 
     Returns
     -------
@@ -383,10 +388,23 @@ def inspect_recording(rec: Recording) -> Inspection:
         n_segments=(len(gaps) + 1 if t.size else 0) if time_ok else None,
         columns=columns,
         temperature_span=span,
-        problems=problems,
+        problems=problems + _skipped_problems(skipped),
         time_ok=time_ok,
         timestamp_jitter=rec.time_jitter(),
     )
+
+
+def _skipped_problems(skipped: Sequence[str]) -> list[Problem]:
+    """A ``non_numeric`` warning per column the reader skipped."""
+    return [
+        Problem(
+            "non_numeric",
+            f"column {c!r} holds non-numeric values and was skipped",
+            severity="warning",
+            column=c,
+        )
+        for c in skipped
+    ]
 
 
 __all__ = [

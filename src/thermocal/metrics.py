@@ -22,7 +22,7 @@ import math
 import warnings
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
-from typing import Final, TypeVar
+from typing import Any, Final, TypeVar
 
 import numpy as np
 import numpy.typing as npt
@@ -158,6 +158,58 @@ class MetricsResult:
     drift_angle_max: float | None = None
     drift_angle_max_time_s: float | None = None
     drift_reference: DriftReference | None = None
+
+    def to_dict(self) -> dict[str, Any]:
+        """The figures as plain Python values: the object ``thermocal metrics --json``
+        prints for one channel (NaN where it prints null).
+
+        Returns
+        -------
+        dict
+            ``bias``, ``bias_stability``, ``averaging_s`` [s], ``peak_to_peak``, ``unit``
+            (every rate figure in it), ``temperature_sensitivity`` (its fields, or None),
+            ``bias_repeatability``, ``drift_angle_max``, ``drift_angle_max_time_s`` [s],
+            ``drift_angle``, ``drift_angle_unit``, ``drift_reference`` (its fields, or
+            None), ``earth_rate_removed``, ``n_stages``, ``stages`` (each hold stage's
+            fields), ``n_samples``, ``n_segments``, ``n_averages``, ``duration_s`` [s] and
+            ``signal``.
+
+        References
+        ----------
+        IEEE Std 952-1997, IEEE Std 1431-2004 (the figures' definitions).
+        """
+        ts = self.temperature_sensitivity
+        return {
+            "bias": self.bias,
+            "bias_stability": self.bias_stability,
+            "averaging_s": self.averaging_s,
+            "peak_to_peak": self.peak_to_peak,
+            "unit": self.unit,
+            "temperature_sensitivity": None if ts is None else _plain(ts),
+            "bias_repeatability": self.bias_repeatability,
+            "drift_angle_max": self.drift_angle_max,
+            "drift_angle_max_time_s": self.drift_angle_max_time_s,
+            "drift_angle": self.drift_angle,
+            "drift_angle_unit": self.drift_angle_unit,
+            "drift_reference": _plain(self.drift_reference),
+            "earth_rate_removed": self.earth_rate_removed,
+            "n_stages": len(self.stages),
+            "stages": _plain(self.stages),
+            "n_samples": self.n_samples,
+            "n_segments": self.n_segments,
+            "n_averages": self.n_averages,
+            "duration_s": self.duration_s,
+            "signal": self.signal,
+        }
+
+
+def _plain(obj: Any) -> Any:
+    """A result's value as plain Python: dataclasses as dicts, tuples as lists."""
+    if dataclasses.is_dataclass(obj) and not isinstance(obj, type):
+        return {f.name: _plain(getattr(obj, f.name)) for f in dataclasses.fields(obj)}
+    if isinstance(obj, list | tuple):
+        return [_plain(v) for v in obj]
+    return obj
 
 
 # --- helpers ---------------------------------------------------------------------------
@@ -436,6 +488,40 @@ class RunRepeatability:
     bias_repeatability_high: float
     confidence: float
     unit: str
+
+    def to_dict(self) -> dict[str, Any]:
+        """The repeatability as plain Python values: the object ``thermocal metrics FILE
+        FILE… --json`` prints for one channel (NaN where it prints null).
+
+        Returns
+        -------
+        dict
+            ``runs`` (each run's :meth:`MetricsResult.to_dict` with ``file`` first),
+            ``n_runs``, ``bias`` (the mean run bias), ``bias_stability`` (the largest
+            in-run one), ``averaging_s`` [s], ``bias_repeatability`` (the sample standard
+            deviation of the run biases) with ``bias_repeatability_low``/``_high`` (its
+            chi-square interval), ``bias_repeatability_kind``, ``confidence`` and ``unit``.
+
+        References
+        ----------
+        IEEE Std 952-1997 (turn-on to turn-on bias repeatability).
+        """
+        return {
+            "runs": [
+                {"file": f, **r.to_dict()} for f, r in zip(self.files, self.runs, strict=True)
+            ],
+            "n_runs": len(self.runs),
+            "bias": self.bias_mean,
+            "bias_stability": max(r.bias_stability for r in self.runs),
+            "averaging_s": self.runs[0].averaging_s,
+            "bias_repeatability": self.bias_repeatability,
+            "bias_repeatability_low": self.bias_repeatability_low,
+            "bias_repeatability_high": self.bias_repeatability_high,
+            "bias_repeatability_kind": "turn-on to turn-on (sample standard deviation "
+            "of the run biases)",
+            "confidence": self.confidence,
+            "unit": self.unit,
+        }
 
 
 def std_interval(s: float, n: int, confidence: float = ONE_SIGMA) -> tuple[float, float]:

@@ -557,6 +557,62 @@ class CorrelationResult:
     duration_s: float = float("nan")
     r_limit: float = WEAK_CORRELATION_LIMIT
 
+    def to_dict(self) -> dict[str, Any]:
+        """The result as plain Python values, as ``thermocal profile correlate --json``
+        prints it (before the columns' names): ``r``, ``weakly_correlated``, ``r_limit``,
+        ``n`` and ``duration_s`` [s]."""
+        return {
+            "r": self.r,
+            "weakly_correlated": self.weakly_correlated,
+            "r_limit": self.r_limit,
+            "n": self.n,
+            "duration_s": self.duration_s,
+        }
+
+
+def program_summary(
+    profile: Profile, time_s: npt.ArrayLike, setpoint_c: npt.ArrayLike, file: str
+) -> dict[str, Any]:
+    """What ``thermocal profile NAME --json`` prints of a written chamber program.
+
+    Parameters
+    ----------
+    profile : Profile
+        The profile the program samples.
+    time_s : array_like
+        The program's times [s] (:meth:`Profile.program`).
+    setpoint_c : array_like
+        Its set-points [°C].
+    file : str
+        Where the program was written.
+
+    Returns
+    -------
+    dict
+        ``profile`` (its name), ``file``, ``n_points``, ``duration_s`` [s] (the last
+        time), ``min_c``/``max_c`` [°C] (the set-points' range) and ``params`` (the
+        profile's parameters).
+
+    Examples
+    --------
+    >>> prof = builtin_profile("rlg-validation")
+    >>> t, c = prof.program(None)
+    >>> s = program_summary(prof, t, c, "val.csv")
+    >>> s["n_points"] == t.size, s["min_c"] == float(c.min())
+    (True, True)
+    """
+    t = np.asarray(time_s, dtype=np.float64)
+    c = np.asarray(setpoint_c, dtype=np.float64)
+    return {
+        "profile": profile.name,
+        "file": file,
+        "n_points": int(t.size),
+        "duration_s": float(t[-1]),
+        "min_c": float(np.min(c)),
+        "max_c": float(np.max(c)),
+        "params": profile.params,
+    }
+
 
 def _clean_history(t: npt.ArrayLike, y: npt.ArrayLike, what: str) -> tuple[FloatArray, FloatArray]:
     ta = np.asarray(t, dtype=np.float64).ravel()

@@ -4,7 +4,7 @@ IEEE 952 noise terms by slope lines and by least squares."""
 import math
 import warnings
 from pathlib import Path
-from typing import TYPE_CHECKING, Annotated, Any
+from typing import TYPE_CHECKING, Annotated
 
 import typer
 
@@ -29,7 +29,6 @@ from thermocal.cli.common import (
     emit,
     fmt,
     handle_errors,
-    jsonable,
     read_options,
     split_names,
     stdout,
@@ -44,7 +43,6 @@ if TYPE_CHECKING:
     import thermocal.stability.analysis as _analysis
     import thermocal.stability.api as _api
     import thermocal.stability.family as _family
-    import thermocal.stability.noise_model as _nm
     import thermocal.stability.registry as _registry
     import thermocal.writers as _writers
 else:
@@ -123,44 +121,6 @@ def _noise_type(spec: str | None, devs: list[str] | None, data_type: str) -> int
     return None if spec is None or spec.strip().lower() in ("", "auto") else 0
 
 
-def family_json(res: "_family.StabilityResult") -> dict[str, Any]:
-    """The ``--json`` object of ``allan --deviation``: ``tau_s`` and per deviation NAME the
-    keys NAME, NAME_low, NAME_high, NAME_edf, NAME_alpha, NAME_n, NAME_tau_s, NAME_unit and
-    NAME_interval (how the interval was found, or "none: why" where low/high are null),
-    NAME_bias_factor with ``--bias-correct`` (the factor NAME, low and high carry);
-    ``alpha`` the noise identified per ``tau_s`` (first Allan-family deviation)."""
-    out: dict[str, Any] = {
-        "tau_s": res.tau_s,
-        "data_type": res.data_type,
-        "confidence": res.confidence,
-        "tau0_s": res.tau0_s,
-        "n_segments": res.n_segments,
-        "deviations": list(res.curves),
-        "noise_id": res.noise_id,
-    }
-    alpha_src = next(
-        (c for c in res.curves.values() if c.name not in ("theo1", "hdev", "ohdev", "htotdev")),
-        next(iter(res.curves.values())),
-    )
-    out["alpha"] = alpha_src.alpha if alpha_src.name != "theo1" else None
-    for name, c in res.curves.items():
-        out[name] = c.dev
-        out[f"{name}_low"] = c.low
-        out[f"{name}_high"] = c.high
-        out[f"{name}_edf"] = c.edf
-        out[f"{name}_alpha"] = c.alpha
-        out[f"{name}_alpha_method"] = list(c.alpha_method)
-        out[f"{name}_n"] = c.n_terms
-        out[f"{name}_tau_s"] = c.tau_s
-        out[f"{name}_unit"] = c.unit
-        out[f"{name}_interval"] = _family.no_interval(name) or (
-            f"chi-square, {100 * res.confidence:.1f} %, {_family.edf_source(name)}"
-        )
-        if c.bias is not None:
-            out[f"{name}_bias_factor"] = c.bias
-    return dict(jsonable(out))
-
-
 def _family_human(file: Path, res: "_family.StabilityResult") -> None:
     for name, c in res.curves.items():
         corrected = ", bias-corrected as Stable32" if c.bias is not None else ""
@@ -181,46 +141,6 @@ def _family_human(file: Path, res: "_family.StabilityResult") -> None:
             stdout.print(f"{name}: interval {why}")
 
 
-def _terms_json(terms: dict[str, Any], method: str) -> dict[str, Any]:
-    """Each noise term's JSON object; ``method`` how it was read, the same word ``noise
-    --format json`` gives (``slope``: the IEEE 952 slope line, ``fit``: the weighted
-    least-squares fit; :attr:`thermocal.stability.allan.NoiseTermSet.method`)."""
-    return {
-        name: {
-            "value": t.value,
-            "unit": t.unit,
-            "reason": t.reason,
-            "low": t.low,
-            "high": t.high,
-            "tau_s": t.tau_s,
-            "label": t.label,
-            "quality": t.quality,
-            "method": method,
-            "tau_range_s": list(t.tau_range_s) if t.tau_range_s is not None else None,
-        }
-        for name, t in terms.items()
-    }
-
-
-def minimum_json(t: "_allan.NoiseTerm | None") -> dict[str, Any] | None:
-    """``bias_instability_minimum``: the bias instability at the curve's minimum (IEEE 952
-    C.3, σ_min/0.6643), always given: ``value``, ``unit``, ``low``/``high`` (the minimum
-    point's interval / 0.6643), ``tau_s`` (the minimum), ``quality`` (good, rough: poorly
-    defined, poor: at the record's end, an upper bound) and ``reason``."""
-    if t is None:
-        return None
-    return {
-        "value": t.value,
-        "unit": t.unit,
-        "low": t.low,
-        "high": t.high,
-        "tau_s": t.tau_s,
-        "quality": t.quality,
-        "reason": t.reason,
-        "method": "minimum",
-    }
-
-
 def minimum_cell(t: "_allan.NoiseTerm | None") -> str:
     """The bias instability at the minimum in one table cell: value, unit, τ, quality."""
     if t is None or t.value is None:
@@ -238,82 +158,13 @@ def minimum_line(t: "_allan.NoiseTerm | None") -> str | None:
     )
 
 
-def dynamic_json(dyn: "_allan.DynamicAllan") -> dict[str, Any]:
-    """``dynamic``: ``window_s``, ``step_s``, ``t_s`` (window centres), ``tau_s``, ``adev``
-    (windows × τ, null where a window is too short), ``adev_low``/``adev_high``,
-    ``stationary``, ``changes`` and the test's ``test_confidence``."""
-    return {
-        "window_s": dyn.window_s,
-        "step_s": dyn.step_s,
-        "t_s": dyn.t_s,
-        "tau_s": dyn.tau_s,
-        "adev": dyn.adev,
-        "adev_low": dyn.adev_low,
-        "adev_high": dyn.adev_high,
-        "unit": dyn.unit,
-        "stationary": dyn.stationary,
-        "changes": list(dyn.changes),
-        "test_confidence": dyn.test_confidence,
-    }
-
-
-def allan_json(
-    res: "_allan.AllanResult",
-    noise: "_allan.NoiseTerms",
-    dyn: "_allan.DynamicAllan | None" = None,
-    quant: "_nm.OutputQuantization | None" = None,
-) -> dict[str, Any]:
-    """The ``--json`` object of ``thermocal allan``: ``noise`` holds the fit-method
-    terms, ``noise_slope`` the slope-line terms (each value or null with a reason);
-    ``output_quantization`` the quantisation step found in the samples (value, unit,
-    source, the noise it makes; null when they lie on no lattice); ``dynamic`` with
-    ``--dynamic``; ``interval`` how ``adev_low``/``adev_high`` were found (Greenhall's EDF
-    with α identified per τ, ``alpha_method``: the implementation of ``--deviation
-    oadev``)."""
-    out: dict[str, Any] = {
-        "tau_s": res.tau_s,
-        "adev": res.adev,
-        "adev_low": res.adev_low,
-        "adev_high": res.adev_high,
-        "unit": res.unit,
-        "n_terms": res.n_terms,
-        "edf": res.edf,
-        "alpha": res.alpha,
-        "alpha_method": list(res.alpha_method),
-        "interval": f"chi-square, {100 * res.confidence:.1f} %, "
-        + _family.edf_source("oadev")
-        + ", α identified per τ (as --deviation oadev)",
-        "confidence": res.confidence,
-        "tau0_s": res.tau0_s,
-        "n_samples": res.n_samples,
-        "n_segments": res.n_segments,
-        "noise": _terms_json(noise.fit.terms(), noise.fit.method),
-        "noise_method": "weighted non-negative least squares (IEEE 952 C.2)",
-        "noise_slope": _terms_json(noise.slope.terms(), noise.slope.method),
-        "noise_slope_method": "slope lines (IEEE 952 C.3)",
-        "fit_coefficients": noise.fit_coefficients,
-        "fit_reduced_chi2": noise.reduced_chi2,
-        "fit_quality": noise.quality.to_dict() if noise.quality is not None else None,
-        "output_quantization": quant.to_dict() if quant is not None else None,
-        "bias_instability_minimum": minimum_json(noise.bias_minimum),
-        "shaped_below_s": noise.shaped_below_s,
-        "periodic": [p.to_dict() for p in noise.periodic],
-    }
-    if dyn is not None:
-        out["dynamic"] = dynamic_json(dyn)
-    return dict(jsonable(out))
-
-
 def _emit_channels(
-    file: Path,
-    analyses: "dict[str, tuple[_allan.AllanResult, _allan.NoiseTerms]]",
-    as_json: bool,
-    plot: Path | None,
-    dynamics: "dict[str, _allan.DynamicAllan]",
-    quants: "dict[str, _nm.OutputQuantization | None] | None" = None,
+    file: Path, analysis: "_analysis.AllanAnalysis", as_json: bool, plot: Path | None
 ) -> None:
     """Several channels: ``{"channels": {NAME: {…}}}`` or one noise-term table with a
     column per channel (the ADEV points are in the JSON and the plots)."""
+    analyses = {n: (c.adev, c.noise) for n, c in analysis.channels.items()}
+    quants = {n: c.quantization for n, c in analysis.channels.items()}
 
     def human() -> None:
         t = _rich_table.Table(title=f"{file} — noise terms (least-squares fit), per channel")
@@ -351,7 +202,7 @@ def _emit_channels(
             ],
         )
         stdout.print(t)
-        for name, oq in (quants or {}).items():
+        for name, oq in quants.items():
             if oq is not None:
                 stdout.print(f"{name}: {oq.line()}")
         for name, (_r, n) in analyses.items():
@@ -360,16 +211,7 @@ def _emit_channels(
         if plot is not None:
             stdout.print(f"plots written to {plot.stem}_<channel>{plot.suffix} in {plot.parent}")
 
-    emit(
-        {
-            "channels": {
-                name: allan_json(r, n, dynamics.get(name), (quants or {}).get(name))
-                for name, (r, n) in analyses.items()
-            }
-        },
-        as_json,
-        human,
-    )
+    emit({"channels": {n: c.to_dict() for n, c in analysis.channels.items()}}, as_json, human)
 
 
 def _stretch_cell(t: "_allan.NoiseTerm") -> str:
@@ -554,14 +396,14 @@ def _emit_family(file: Path, res: "_analysis.AllanAnalysis", as_json: bool) -> N
     """``--deviation`` or phase data: one channel's object, or ``{"channels": …}``."""
     if len(res.names) == 1:
         one = res.family[res.names[0]]
-        emit(family_json(one), as_json, lambda: _family_human(file, one))
+        emit(one.to_dict(), as_json, lambda: _family_human(file, one))
         return
 
     def human_all() -> None:
         for r in res.family.values():
             _family_human(file, r)
 
-    emit({"channels": {n: family_json(r) for n, r in res.family.items()}}, as_json, human_all)
+    emit({"channels": {n: r.to_dict() for n, r in res.family.items()}}, as_json, human_all)
 
 
 def _emit_allan(
@@ -569,11 +411,8 @@ def _emit_allan(
 ) -> None:
     """The ADEV table and the noise terms of one channel (several: :func:`_emit_channels`)."""
     names = analysis.names
-    dynamics = {n: c.dynamic for n, c in analysis.channels.items() if c.dynamic is not None}
     if len(names) > 1:
-        pairs = {n: (c.adev, c.noise) for n, c in analysis.channels.items()}
-        quants = {n: c.quantization for n, c in analysis.channels.items()}
-        _emit_channels(file, pairs, as_json, plot, dynamics, quants)
+        _emit_channels(file, analysis, as_json, plot)
         return
     ch = analysis.channels[names[0]]
     res, noise = ch.adev, ch.noise
@@ -643,4 +482,4 @@ def _emit_allan(
         if plot is not None:
             stdout.print(f"plot written to {plot}")
 
-    emit(allan_json(res, noise, ch.dynamic, ch.quantization), as_json, human)
+    emit(ch.to_dict(), as_json, human)

@@ -36,14 +36,12 @@ if TYPE_CHECKING:
 
     import thermocal.inspection as _inspection
     import thermocal.readers as _readers
-    import thermocal.recording as _recording
     from thermocal import units
 else:
     _markup = LazyModule("rich.markup")
     _rich_table = LazyModule("rich.table")
     _inspection = LazyModule("thermocal.inspection")
     _readers = LazyModule("thermocal.readers")
-    _recording = LazyModule("thermocal.recording")
     units = LazyModule("thermocal.units")
 
 
@@ -96,16 +94,7 @@ def inspect_cmd(
         skipped=skipped,
         guess_temperatures=True,
     )
-    result = _inspection.inspect_recording(rec)
-    for c in skipped:
-        result.problems.append(
-            _recording.Problem(
-                "non_numeric",
-                f"column {c!r} holds non-numeric values and was skipped",
-                severity="warning",
-                column=c,
-            )
-        )
+    result = _inspection.inspect_recording(rec, skipped)
     emit(result.to_dict(), as_json, lambda: _print_human(result))
     # raised as input errors, so that the common handler prints the warnings first and
     # the one error: line last (exit 2)

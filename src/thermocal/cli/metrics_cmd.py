@@ -3,7 +3,7 @@ repeatability and temperature sensitivity of one signal."""
 
 from collections.abc import Callable
 from pathlib import Path
-from typing import TYPE_CHECKING, Annotated, Any
+from typing import TYPE_CHECKING, Annotated
 
 import typer
 
@@ -30,7 +30,6 @@ from thermocal.cli.common import (
     emit,
     fmt,
     handle_errors,
-    jsonable,
     read_options,
     split_names,
     stdout,
@@ -48,35 +47,6 @@ else:
     _rich_table = LazyModule("rich.table")
     _metrics = LazyModule("thermocal.metrics")
     _readers = LazyModule("thermocal.readers")
-
-
-def metrics_json(res: "_metrics.MetricsResult") -> dict[str, Any]:
-    """The ``--json`` object of ``thermocal metrics`` (the documented keys first); every rate
-    figure in ``unit`` (the data's own unit), angles in ``drift_angle_unit``."""
-    d: dict[str, Any] = jsonable(res)
-    ts = res.temperature_sensitivity
-    return {
-        "bias": res.bias,
-        "bias_stability": res.bias_stability,
-        "averaging_s": res.averaging_s,
-        "peak_to_peak": res.peak_to_peak,
-        "unit": res.unit,
-        "temperature_sensitivity": None if ts is None else d["temperature_sensitivity"],
-        "bias_repeatability": res.bias_repeatability,
-        "drift_angle_max": res.drift_angle_max,
-        "drift_angle_max_time_s": res.drift_angle_max_time_s,
-        "drift_angle": res.drift_angle,
-        "drift_angle_unit": res.drift_angle_unit,
-        "drift_reference": d["drift_reference"],
-        "earth_rate_removed": res.earth_rate_removed,
-        "n_stages": len(res.stages),
-        "stages": d["stages"],
-        "n_samples": res.n_samples,
-        "n_segments": res.n_segments,
-        "n_averages": res.n_averages,
-        "duration_s": res.duration_s,
-        "signal": res.signal,
-    }
 
 
 MetricsFilesArg = Annotated[
@@ -243,9 +213,9 @@ def _emit_metrics(file: Path, results: "dict[str, MetricsResult]", as_json: bool
             stdout.print(f"drift angle: {_reference_words(ref)}")
 
     if len(results) == 1:
-        emit(metrics_json(first_result(results)), as_json, human)
+        emit(next(iter(results.values())).to_dict(), as_json, human)
     else:
-        emit({"channels": {n: metrics_json(r) for n, r in results.items()}}, as_json, human)
+        emit({"channels": {n: r.to_dict() for n, r in results.items()}}, as_json, human)
 
 
 def _parse_window(text: str | None) -> tuple[float, float] | None:
@@ -275,11 +245,6 @@ def _reference_words(ref: "_metrics.DriftReference") -> str:
     return f"θ(t) = ∫ (ω − Ω − b0) dt with the given b0 = {fmt(ref.bias, 6)} {ref.unit}"
 
 
-def first_result(results: "dict[str, _metrics.MetricsResult]") -> "_metrics.MetricsResult":
-    """The only result of a one-channel run."""
-    return next(iter(results.values()))
-
-
 def _emit_runs(res: "_metrics.PowerOnMetrics", as_json: bool) -> None:
     """``metrics FILE FILE...``: every file one power-on; per channel ``runs`` (each run's
     figures, as one file's JSON plus ``file``), ``bias`` the mean run bias,
@@ -287,29 +252,6 @@ def _emit_runs(res: "_metrics.PowerOnMetrics", as_json: bool) -> None:
     to turn-on: sample standard deviation of the run biases) with
     ``bias_repeatability_low``/``_high`` (68.3 % chi-square interval), all in ``unit``."""
     names, reps = list(res.names), res.repeatability
-
-    def one(rep: "_metrics.RunRepeatability") -> dict[str, Any]:
-        return dict(
-            jsonable(
-                {
-                    "runs": [
-                        {"file": f, **metrics_json(r)}
-                        for f, r in zip(rep.files, rep.runs, strict=True)
-                    ],
-                    "n_runs": len(rep.runs),
-                    "bias": rep.bias_mean,
-                    "bias_stability": max(r.bias_stability for r in rep.runs),
-                    "averaging_s": rep.runs[0].averaging_s,
-                    "bias_repeatability": rep.bias_repeatability,
-                    "bias_repeatability_low": rep.bias_repeatability_low,
-                    "bias_repeatability_high": rep.bias_repeatability_high,
-                    "bias_repeatability_kind": "turn-on to turn-on (sample standard deviation "
-                    "of the run biases)",
-                    "confidence": rep.confidence,
-                    "unit": rep.unit,
-                }
-            )
-        )
 
     def human() -> None:
         for name, rep in reps.items():
@@ -327,6 +269,6 @@ def _emit_runs(res: "_metrics.PowerOnMetrics", as_json: bool) -> None:
             )
 
     if len(names) == 1:
-        emit(one(reps[names[0]]), as_json, human)
+        emit(reps[names[0]].to_dict(), as_json, human)
     else:
-        emit({"channels": {n: one(r) for n, r in reps.items()}}, as_json, human)
+        emit({"channels": {n: r.to_dict() for n, r in reps.items()}}, as_json, human)

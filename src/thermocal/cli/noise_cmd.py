@@ -160,7 +160,7 @@ def noise_cmd(
     if out_format == "kalibr":
         text = _nm.kalibr_yaml(res.model, file.name)  # names escaped, keys checked
     else:
-        text = json.dumps(jsonable(_nm.model_json(res.model, file.name)), allow_nan=False, indent=1)
+        text = json.dumps(jsonable(res.model.to_dict(file.name)), allow_nan=False, indent=1)
     with _writers.atomic_write(output, "w") as fh:
         fh.write(text + ("" if text.endswith("\n") else "\n"))
 

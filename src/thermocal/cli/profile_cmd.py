@@ -98,18 +98,8 @@ def _write_profile(
         raise ThermocalInputError(f"--dt must be ≥ 0 s (0: corner points only), got {dt:g}")
     t, c = prof.program(dt if dt > 0 else None)
     _writers.write_program(output, t, c)
-    summary = {
-        "profile": prof.name,
-        "file": str(output),
-        "n_points": int(t.size),
-        "duration_s": float(t[-1]),
-        "min_c": float(np.min(c)),
-        "max_c": float(np.max(c)),
-        "params": prof.params,
-        **extra,
-    }
     emit(
-        summary,
+        {**_profiles.program_summary(prof, t, c, str(output)), **extra},
         as_json,
         lambda: stdout.print(
             f"{prof.name}: {t.size} points, {t[-1] / 3600:.2f} h, "
@@ -331,17 +321,8 @@ def correlate_cmd(
     ta, xa, ca = _program.read_history(file_a, column, read)
     tb, xb, cb = _program.read_history(file_b, column_b if column_b is not None else column, read)
     res = _profiles.correlate(ta, xa, tb, xb, r_limit=limit, n_points=points)
-    out = {
-        "r": res.r,
-        "weakly_correlated": res.weakly_correlated,
-        "r_limit": res.r_limit,
-        "n": res.n,
-        "duration_s": res.duration_s,
-        "column_a": ca,
-        "column_b": cb,
-    }
     emit(
-        out,
+        {**res.to_dict(), "column_a": ca, "column_b": cb},
         as_json,
         lambda: stdout.print(
             f"r = {res.r:.4f} over {res.duration_s / 3600:.2f} h ({res.n} points): "

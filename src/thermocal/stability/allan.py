@@ -328,6 +328,62 @@ class NoiseTermSet:
         """Terms by JSON key, in order."""
         return {name: getattr(self, name) for name in TERM_NAMES}
 
+    def to_dict(self) -> dict[str, dict[str, Any]]:
+        """Each term's object as ``thermocal allan --json`` prints it under ``noise`` (fit)
+        or ``noise_slope`` (slope lines): ``value``, ``unit``, ``reason``, ``low``,
+        ``high``, ``tau_s``, ``label``, ``quality``, ``method`` (this set's, the word
+        ``noise --format json`` gives) and ``tau_range_s``."""
+        return {
+            name: {
+                "value": t.value,
+                "unit": t.unit,
+                "reason": t.reason,
+                "low": t.low,
+                "high": t.high,
+                "tau_s": t.tau_s,
+                "label": t.label,
+                "quality": t.quality,
+                "method": self.method,
+                "tau_range_s": list(t.tau_range_s) if t.tau_range_s is not None else None,
+            }
+            for name, t in self.terms().items()
+        }
+
+
+def minimum_dict(t: NoiseTerm | None) -> dict[str, Any] | None:
+    """The bias instability at the curve's minimum (:func:`bias_at_minimum`) as
+    ``thermocal allan --json`` prints it under ``bias_instability_minimum``.
+
+    Parameters
+    ----------
+    t : NoiseTerm or None
+        :attr:`NoiseTerms.bias_minimum`.
+
+    Returns
+    -------
+    dict or None
+        ``value`` (σ_min/0.6643), ``unit``, ``low``/``high`` (the minimum point's interval
+        / 0.6643), ``tau_s`` (the minimum), ``quality`` (good; rough: poorly defined; poor:
+        at the record's end, an upper bound), ``reason`` and ``method`` ("minimum"); None
+        without a minimum.
+
+    References
+    ----------
+    IEEE Std 952-1997, annex C.3 (the bias instability read at the flat of the curve).
+    """
+    if t is None:
+        return None
+    return {
+        "value": t.value,
+        "unit": t.unit,
+        "low": t.low,
+        "high": t.high,
+        "tau_s": t.tau_s,
+        "quality": t.quality,
+        "reason": t.reason,
+        "method": "minimum",
+    }
+
 
 @dataclass(frozen=True, eq=False)
 class NoiseTerms:
@@ -702,6 +758,25 @@ class DynamicAllan:
     @property
     def stationary(self) -> bool:
         return not self.changes
+
+    def to_dict(self) -> dict[str, Any]:
+        """The object ``thermocal allan --dynamic --json`` prints under ``dynamic``:
+        ``window_s``, ``step_s``, ``t_s`` (window centres), ``tau_s``, ``adev`` (windows ×
+        τ, NaN where a window is too short), ``adev_low``/``adev_high``, ``unit``,
+        ``stationary``, ``changes`` and ``test_confidence``."""
+        return {
+            "window_s": self.window_s,
+            "step_s": self.step_s,
+            "t_s": self.t_s.tolist(),
+            "tau_s": self.tau_s.tolist(),
+            "adev": self.adev.tolist(),
+            "adev_low": self.adev_low.tolist(),
+            "adev_high": self.adev_high.tolist(),
+            "unit": self.unit,
+            "stationary": self.stationary,
+            "changes": [dict(c) for c in self.changes],
+            "test_confidence": self.test_confidence,
+        }
 
 
 DYNAMIC_WINDOW_WORK: Final = 1.5e7

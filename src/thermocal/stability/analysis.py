@@ -202,6 +202,63 @@ class AllanChannel:
     dynamic: DynamicAllan | None = None
     quantization: OutputQuantization | None = None
 
+    def to_dict(self) -> dict[str, Any]:
+        """The channel as plain Python values: the object ``thermocal allan --json`` prints
+        (NaN where it prints null).
+
+        Returns
+        -------
+        dict
+            The curve (``tau_s``, ``adev``, ``adev_low``/``adev_high``, ``unit``,
+            ``n_terms``, ``edf``, ``alpha``, ``alpha_method``, ``interval``: how the
+            interval was found), ``noise`` (the least-squares terms,
+            :meth:`thermocal.stability.allan.NoiseTermSet.to_dict`), ``noise_slope`` (the
+            slope-line terms), ``fit_coefficients``, ``fit_reduced_chi2``, ``fit_quality``,
+            ``output_quantization`` (None when the samples lie on no lattice),
+            ``bias_instability_minimum``, ``shaped_below_s``, ``periodic`` and, with a
+            dynamic ADEV, ``dynamic``.
+
+        References
+        ----------
+        IEEE Std 952-1997, annex C (C.2: the least-squares fit; C.3: the slope lines).
+        """
+        from thermocal.stability.allan import minimum_dict
+        from thermocal.stability.family import edf_source
+
+        res, noise, quant = self.adev, self.noise, self.quantization
+        out: dict[str, Any] = {
+            "tau_s": res.tau_s.tolist(),
+            "adev": res.adev.tolist(),
+            "adev_low": res.adev_low.tolist(),
+            "adev_high": res.adev_high.tolist(),
+            "unit": res.unit,
+            "n_terms": res.n_terms.tolist(),
+            "edf": res.edf.tolist(),
+            "alpha": res.alpha.tolist(),
+            "alpha_method": list(res.alpha_method),
+            "interval": f"chi-square, {100 * res.confidence:.1f} %, "
+            + edf_source("oadev")
+            + ", α identified per τ (as --deviation oadev)",
+            "confidence": res.confidence,
+            "tau0_s": res.tau0_s,
+            "n_samples": res.n_samples,
+            "n_segments": res.n_segments,
+            "noise": noise.fit.to_dict(),
+            "noise_method": "weighted non-negative least squares (IEEE 952 C.2)",
+            "noise_slope": noise.slope.to_dict(),
+            "noise_slope_method": "slope lines (IEEE 952 C.3)",
+            "fit_coefficients": noise.fit_coefficients.tolist(),
+            "fit_reduced_chi2": noise.reduced_chi2,
+            "fit_quality": noise.quality.to_dict() if noise.quality is not None else None,
+            "output_quantization": quant.to_dict() if quant is not None else None,
+            "bias_instability_minimum": minimum_dict(noise.bias_minimum),
+            "shaped_below_s": noise.shaped_below_s,
+            "periodic": [p.to_dict() for p in noise.periodic],
+        }
+        if self.dynamic is not None:
+            out["dynamic"] = self.dynamic.to_dict()
+        return out
+
 
 @dataclass(frozen=True, eq=False)
 class AllanAnalysis:

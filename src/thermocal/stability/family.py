@@ -27,7 +27,7 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field, replace
-from typing import Final
+from typing import Any, Final
 
 import numpy as np
 import numpy.typing as npt
@@ -147,6 +147,56 @@ class StabilityResult:
     unit: str
     notes: tuple[str, ...] = field(default=())
     noise_id: str = "thermocal"
+
+    def to_dict(self) -> dict[str, Any]:
+        """The result as plain Python values: the object ``thermocal allan --deviation
+        --json`` prints (NaN where it prints null).
+
+        Returns
+        -------
+        dict
+            ``tau_s``, ``data_type``, ``confidence``, ``tau0_s``, ``n_segments``,
+            ``deviations`` (the names), ``noise_id``, ``alpha`` (the noise identified per
+            ``tau_s`` by the first Allan-family deviation; None for theo1 alone) and per
+            deviation NAME the keys NAME, NAME_low, NAME_high, NAME_edf, NAME_alpha,
+            NAME_alpha_method, NAME_n, NAME_tau_s, NAME_unit, NAME_interval (how the
+            interval was found, or "none: why") and, when a bias correction was asked,
+            NAME_bias_factor.
+        """
+        out: dict[str, Any] = {
+            "tau_s": self.tau_s.tolist(),
+            "data_type": self.data_type,
+            "confidence": self.confidence,
+            "tau0_s": self.tau0_s,
+            "n_segments": self.n_segments,
+            "deviations": list(self.curves),
+            "noise_id": self.noise_id,
+        }
+        alpha_src = next(
+            (c for c in self.curves.values() if c.name not in _NOT_ALPHA_SOURCES),
+            next(iter(self.curves.values())),
+        )
+        out["alpha"] = alpha_src.alpha.tolist() if alpha_src.name != "theo1" else None
+        for name, c in self.curves.items():
+            out[name] = c.dev.tolist()
+            out[f"{name}_low"] = c.low.tolist()
+            out[f"{name}_high"] = c.high.tolist()
+            out[f"{name}_edf"] = c.edf.tolist()
+            out[f"{name}_alpha"] = c.alpha.tolist()
+            out[f"{name}_alpha_method"] = list(c.alpha_method)
+            out[f"{name}_n"] = c.n_terms.tolist()
+            out[f"{name}_tau_s"] = c.tau_s.tolist()
+            out[f"{name}_unit"] = c.unit
+            out[f"{name}_interval"] = no_interval(name) or (
+                f"chi-square, {100 * self.confidence:.1f} %, {edf_source(name)}"
+            )
+            if c.bias is not None:
+                out[f"{name}_bias_factor"] = c.bias.tolist()
+        return out
+
+
+_NOT_ALPHA_SOURCES: Final = ("theo1", "hdev", "ohdev", "htotdev")
+"""Deviations whose α column does not stand for the record's noise in ``alpha``."""
 
 
 _TOTVAR_BIAS: Final = {-1: 1.0 / (3.0 * math.log(2.0)), -2: 0.75}

@@ -161,6 +161,60 @@ class NoiseModel:
         out["rostopic"] = self.rostopic
         return {k: out[k] for k in KALIBR_KEYS if k in out}
 
+    def to_dict(self, source: str) -> dict[str, Any]:
+        """The noise model as plain Python values: the file ``thermocal noise --format
+        json`` writes (NaN where it writes null).
+
+        Parameters
+        ----------
+        source : str
+            The recording's name, stated in the file.
+
+        Returns
+        -------
+        dict
+            ``kalibr`` (the values and the axis each came from: ``kalibr_axis``), and per
+            axis ``terms`` (every IEEE 952 term in the data's unit: the slope reading where
+            it exists, else the fit; ``value``, ``unit``, ``low``, ``high``, ``tau_s``,
+            ``method``, ``quality``, ``reason``), ``terms_fit`` (all fitted terms),
+            ``noise_density`` and ``random_walk`` (continuous time, SI; ``tau_range_s`` the
+            stretch a slope line was fitted on), ``bias_instability_minimum`` (the bias
+            instability at the curve's minimum, always, with ``tau_s``, interval and
+            ``quality``), ``output_quantization`` (:meth:`OutputQuantization.to_dict`, None
+            when the samples lie on no lattice).
+
+        References
+        ----------
+        IEEE Std 952-1997, annex C (the terms); Kalibr's ``imu.yaml`` (continuous-time
+        noise densities and random walks).
+        """
+        axes: dict[str, Any] = {}
+        for ax in self.axes:
+            slope, fit = ax.terms.slope.terms(), ax.terms.fit.terms()
+            axes[ax.name] = {
+                "sensor": ax.sensor,
+                "unit": ax.unit,
+                "terms": {k: _best(slope[k], fit[k]) for k in slope},
+                "terms_fit": {k: _term_json(fit[k], "fit") for k in fit},
+                "fit_quality": ax.terms.quality.to_dict() if ax.terms.quality else None,
+                "output_quantization": ax.quantization.to_dict() if ax.quantization else None,
+                "noise_density": _continuous_json(ax.density),
+                "random_walk": _continuous_json(ax.walk),
+                "bias_instability_minimum": _minimum_json(ax.terms.bias_minimum),
+                "periodic": [p.to_dict() for p in ax.terms.periodic],
+            }
+        return {
+            "source": source,
+            "kalibr": self.kalibr(),
+            "kalibr_axis": {k: a.name for k, a in self.chosen.items()},
+            "kalibr_rule": "per sensor the largest value over its axes",
+            "inflate": self.inflate,
+            "update_rate_hz": self.update_rate_hz,
+            "confidence": self.confidence,
+            "discrete_time": "white noise σ_d = σ_c / √Δt; random walk σ_d = σ_c · √Δt",
+            "axes": axes,
+        }
+
 
 def _term_for(key: str, ax: AxisNoise) -> ContinuousTerm:
     return ax.density if key.endswith("noise_density") else ax.walk
@@ -630,43 +684,6 @@ def _minimum_json(t: NoiseTerm | None) -> dict[str, Any] | None:
     return out
 
 
-def model_json(model: NoiseModel, source: str) -> dict[str, Any]:
-    """The JSON noise model: ``kalibr`` (the values and the axis each came from), and per
-    axis ``terms`` (every IEEE 952 term in the data's unit: the slope reading where it
-    exists, else the fit; ``value``, ``unit``, ``low``, ``high``, ``tau_s``, ``method``,
-    ``quality``, ``reason``), ``terms_fit`` (all fitted terms), ``noise_density`` and
-    ``random_walk`` (continuous time, SI; ``tau_range_s`` the stretch a slope line was
-    fitted on), ``bias_instability_minimum`` (the bias instability at the curve's minimum,
-    always, with ``tau_s``, interval and ``quality``), ``output_quantization``
-    (:meth:`OutputQuantization.to_dict`, null when the samples lie on no lattice)."""
-    axes: dict[str, Any] = {}
-    for ax in model.axes:
-        slope, fit = ax.terms.slope.terms(), ax.terms.fit.terms()
-        axes[ax.name] = {
-            "sensor": ax.sensor,
-            "unit": ax.unit,
-            "terms": {k: _best(slope[k], fit[k]) for k in slope},
-            "terms_fit": {k: _term_json(fit[k], "fit") for k in fit},
-            "fit_quality": ax.terms.quality.to_dict() if ax.terms.quality else None,
-            "output_quantization": ax.quantization.to_dict() if ax.quantization else None,
-            "noise_density": _continuous_json(ax.density),
-            "random_walk": _continuous_json(ax.walk),
-            "bias_instability_minimum": _minimum_json(ax.terms.bias_minimum),
-            "periodic": [p.to_dict() for p in ax.terms.periodic],
-        }
-    return {
-        "source": source,
-        "kalibr": model.kalibr(),
-        "kalibr_axis": {k: a.name for k, a in model.chosen.items()},
-        "kalibr_rule": "per sensor the largest value over its axes",
-        "inflate": model.inflate,
-        "update_rate_hz": model.update_rate_hz,
-        "confidence": model.confidence,
-        "discrete_time": "white noise σ_d = σ_c / √Δt; random walk σ_d = σ_c · √Δt",
-        "axes": axes,
-    }
-
-
 # --- output quantisation --------------------------------------------------------------------------
 
 QUANT_MIN_LEVELS: Final = 3
@@ -985,7 +1002,6 @@ __all__ = [
     "implausible",
     "kalibr_yaml",
     "lattice_step",
-    "model_json",
     "noise_model",
     "output_quantization",
     "quantization_from_lattice",
