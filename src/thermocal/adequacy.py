@@ -131,6 +131,8 @@ class AdequacyTest:
     message: str
 
     def to_dict(self) -> dict[str, Any]:
+        """JSON-ready dict (non-finite figures → None)."""
+
         def num(v: float | None) -> float | None:
             return None if v is None or not math.isfinite(v) else float(v)
 
@@ -165,6 +167,7 @@ class Adequacy:
 
     @property
     def failed(self) -> tuple[AdequacyTest, ...]:
+        """The tests whose verdict is ``"fail"``."""
         return tuple(t for t in self.tests if t.verdict == "fail")
 
     @property
@@ -176,11 +179,14 @@ class Adequacy:
 
     @property
     def verdict(self) -> str:
+        """``"fail"`` when a failure is not overridden, ``"overridden"`` when every failure
+        is, else ``"pass"``."""
         if self.refused:
             return "fail"
         return "overridden" if self.failed else "pass"
 
     def to_dict(self) -> dict[str, Any]:
+        """JSON-ready dict: the verdict, the overrides and every test."""
         return {
             "verdict": self.verdict,
             "overrides": list(self.overrides),

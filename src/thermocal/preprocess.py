@@ -695,10 +695,12 @@ class Segment:
 
     @property
     def slice(self) -> slice:
+        """``slice(start, stop)`` of the segment's samples."""
         return slice(self.start, self.stop)
 
     @property
     def duration_s(self) -> float:
+        """Time from the segment's first to its last sample [s]."""
         return self.stop_s - self.start_s
 
 

@@ -194,6 +194,7 @@ class Problem:
     row: int | None = None
 
     def to_dict(self) -> dict[str, Any]:
+        """JSON-ready dict of the set fields."""
         return {k: v for k, v in dataclasses.asdict(self).items() if v is not None}
 
 
@@ -331,10 +332,12 @@ class Recording:
 
     @property
     def n_samples(self) -> int:
+        """Number of samples."""
         return int(self.time_s.size)
 
     @property
     def duration_s(self) -> float:
+        """Time from the first to the last sample [s] (0 for fewer than 2 samples)."""
         return float(self.time_s[-1] - self.time_s[0]) if self.time_s.size > 1 else 0.0
 
     @property
@@ -347,11 +350,13 @@ class Recording:
 
     @property
     def sample_rate_hz(self) -> float:
+        """Nominal sample rate 1/τ [Hz] (NaN when τ is not positive)."""
         tau = self.sample_interval_s
         return 1.0 / tau if tau > 0 else float("nan")
 
     @property
     def name(self) -> str:
+        """The source file, else the run id, else ``"<recording>"``, for messages."""
         return self.source or self.meta.run_id or "<recording>"
 
     def column(self, name: str) -> FloatArray:
@@ -873,6 +878,7 @@ class TimeJitter:
         return self.relative > JITTER_RELATIVE or self.n_same > 0
 
     def to_dict(self) -> dict[str, Any]:
+        """JSON-ready dict of the fields and :attr:`significant`."""
         return {**dataclasses.asdict(self), "significant": self.significant}
 
     def message(self) -> str:

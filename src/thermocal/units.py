@@ -358,6 +358,7 @@ class TemperatureConversion(NamedTuple):
         return out
 
     def to_json(self) -> list[float | str]:
+        """The file form ``[gain, offset]`` or ``[gain, offset, "int16"]``."""
         out: list[float | str] = [float(self.gain), float(self.offset)]
         if self.encoding != "plain":
             out.append(self.encoding)

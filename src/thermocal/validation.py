@@ -108,9 +108,11 @@ class StageFigures:
 
     @property
     def duration_s(self) -> float:
+        """Length of the stage [s]."""
         return self.stop_s - self.start_s
 
     def to_dict(self) -> dict[str, Any]:
+        """JSON-ready dict of the stage's figures."""
         d = {k: getattr(self, k) for k in self.__dataclass_fields__}
         d["duration_s"] = self.duration_s
         return d
