@@ -558,8 +558,9 @@ def firmware_test(span_c: float, firmware: str, minimum_c: float) -> AdequacyTes
 
     References
     ----------
-    - ArduPilot, ``libraries/AP_InertialSensor/AP_InertialSensor_tempcal.cpp``
-      (temperature-calibration learning needs a sweep of at least 10 °C).
+    - ArduPilot, ``libraries/AP_InertialSensor/AP_InertialSensor_tempcal.cpp``:
+      ``TEMP_RANGE_MIN`` = 10 [°C], and ``INS_TCALn_TMAX`` "must be at least 10
+      degrees above TMIN".
     """
     ok = span_c >= minimum_c
     return AdequacyTest(
