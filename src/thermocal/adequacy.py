@@ -102,9 +102,25 @@ DEG_H_PER_DEG_S = 3600.0
 
 @dataclass(frozen=True)
 class AdequacyTest:
-    """One test: its figure and threshold (in ``unit``), verdict ``pass`` | ``warn`` |
-    ``fail`` | ``n/a``, the option that overrides a failure (None: it cannot be
-    overridden) and a one-line message."""
+    """One adequacy test: its figure, threshold, verdict and message.
+
+    Attributes
+    ----------
+    name : str
+        The test (``"temperature_span"``, ``"stillness"`` …; module docstring).
+    figure : float or None
+        What the data offer [``unit``]; None when not judged.
+    threshold : float or None
+        What the model needs [``unit``].
+    unit : str
+        Unit of ``figure`` and ``threshold`` (``"°C"``, ``"°C/min"``, ``"%"`` …).
+    verdict : str
+        ``"pass"``, ``"warn"``, ``"fail"`` or ``"n/a"``.
+    override : str or None
+        The option that overrides a failure; None: it cannot be overridden.
+    message : str
+        One line for the user.
+    """
 
     name: str
     figure: float | None
@@ -115,6 +131,8 @@ class AdequacyTest:
     message: str
 
     def to_dict(self) -> dict[str, Any]:
+        """JSON-ready dict (non-finite figures → None)."""
+
         def num(v: float | None) -> float | None:
             return None if v is None or not math.isfinite(v) else float(v)
 
@@ -131,7 +149,17 @@ class AdequacyTest:
 
 @dataclass(frozen=True)
 class Adequacy:
-    """The record of every test and the overrides the user gave."""
+    """The record of every adequacy test of a fit and the overrides the user gave.
+
+    Attributes
+    ----------
+    tests : tuple of AdequacyTest
+        Every test, in order.
+    overrides : tuple of str
+        The refusals the user allowed (:data:`ALLOW_NARROW`, :data:`ALLOW_MOTION`).
+    subject : str
+        What was judged (a channel or a command), for messages.
+    """
 
     tests: tuple[AdequacyTest, ...]
     overrides: tuple[str, ...] = ()
@@ -139,6 +167,7 @@ class Adequacy:
 
     @property
     def failed(self) -> tuple[AdequacyTest, ...]:
+        """The tests whose verdict is ``"fail"``."""
         return tuple(t for t in self.tests if t.verdict == "fail")
 
     @property
@@ -150,11 +179,14 @@ class Adequacy:
 
     @property
     def verdict(self) -> str:
+        """``"fail"`` when a failure is not overridden, ``"overridden"`` when every failure
+        is, else ``"pass"``."""
         if self.refused:
             return "fail"
         return "overridden" if self.failed else "pass"
 
     def to_dict(self) -> dict[str, Any]:
+        """JSON-ready dict: the verdict, the overrides and every test."""
         return {
             "verdict": self.verdict,
             "overrides": list(self.overrides),
@@ -162,12 +194,38 @@ class Adequacy:
         }
 
     def merged(self, other: Adequacy) -> Adequacy:
+        """The record of both fits' tests (this record's overrides and subject).
+
+        Parameters
+        ----------
+        other : Adequacy
+            Another record whose tests are appended.
+
+        Returns
+        -------
+        Adequacy
+        """
         return Adequacy((*self.tests, *other.tests), self.overrides, self.subject)
 
     def enforce(self) -> Adequacy:
-        """Refuse (:class:`ThermocalInputError`, exit 2) what is not supported and not
-        overridden, naming every missing thing; warn for overridden failures and for
-        ``warn`` verdicts.  Returns ``self``."""
+        """Refuse what is not supported and not overridden; warn for the rest.
+
+        Returns
+        -------
+        Adequacy
+            ``self``.
+
+        Raises
+        ------
+        ThermocalInputError
+            A failed test that no given override allows, naming every missing thing
+            and the options that would allow it.
+
+        Warns
+        -----
+        ThermocalWarning
+            For each overridden failure and each ``warn`` verdict.
+        """
         refused = self.refused
         if refused:
             hints = sorted({t.override for t in refused if t.override})
@@ -193,7 +251,18 @@ class Adequacy:
 
 
 def from_dict(d: Any) -> dict[str, Any] | None:
-    """A stored record, checked for shape (None when absent or malformed)."""
+    """A stored adequacy record, checked for shape.
+
+    Parameters
+    ----------
+    d : object
+        The ``adequacy`` value of a model file.
+
+    Returns
+    -------
+    dict or None
+        ``d`` when it is a dict with a ``tests`` list; None when absent or malformed.
+    """
     if not isinstance(d, dict) or not isinstance(d.get("tests"), list):
         return None
     return d
@@ -216,7 +285,28 @@ def _span(temps: FloatArray, *, finite_scratch: bool = False) -> tuple[float, fl
 
 
 def samples_test(n_samples: int, n_coefficients: int, name: str = "") -> AdequacyTest:
-    """n / p against :data:`MIN_SAMPLES_PER_COEFFICIENT` (n ≤ p: refused outright)."""
+    """Samples per fitted coefficient against :data:`MIN_SAMPLES_PER_COEFFICIENT`.
+
+    Parameters
+    ----------
+    n_samples : int
+        Samples n of the fit (all runs).
+    n_coefficients : int
+        Coefficients p of the model.
+    name : str, optional
+        The channel, for the message (default none).
+
+    Returns
+    -------
+    AdequacyTest
+        ``samples_per_coefficient`` with figure n / p; fails (overridable with
+        :data:`ALLOW_NARROW`) below the minimum and without override when n ≤ p.
+
+    Examples
+    --------
+    >>> samples_test(100, 4).verdict, samples_test(4, 4).override is None
+    ('pass', True)
+    """
     ratio = n_samples / max(n_coefficients, 1)
     if n_samples <= n_coefficients:
         return AdequacyTest(
@@ -243,11 +333,66 @@ def samples_test(n_samples: int, n_coefficients: int, name: str = "") -> Adequac
     )
 
 
+def _distinct_bins(t: FloatArray, lo: float, hi: float, width: float, per_bin: int) -> int:
+    """Occupied bins of ``width`` [°C] from ``lo`` to ``hi`` holding ≥ ``per_bin`` samples."""
+    span = hi - lo if t.size else 0.0
+    if t.size and span > 0:
+        counts = np.zeros(0, dtype=np.intp)
+        for a in range(0, t.size, 1 << 18):  # in blocks: the bin counts add up
+            tb = t[a : a + (1 << 18)]
+            idx = np.clip(np.floor((tb - lo) / width).astype(np.int64), 0, None)
+            c = np.bincount(idx[(tb >= lo) & (tb <= hi)])
+            if c.size > counts.size:
+                c[: counts.size] += counts
+                counts = c
+            else:
+                counts[: c.size] += c
+        return int(np.count_nonzero(counts >= per_bin))
+    return 1 if t.size else 0
+
+
+def _range_ends_test(t: FloatArray, lo: float, hi: float, name: str) -> AdequacyTest:
+    """The share of samples [%] in the lowest and highest tenth of ``lo…hi`` (the smaller)."""
+    span = hi - lo
+    low = float(np.count_nonzero(t <= lo + END_FRACTION * span)) / t.size * 100.0
+    high = float(np.count_nonzero(t >= hi - END_FRACTION * span)) / t.size * 100.0
+    share = min(low, high)
+    end = "lowest" if low <= high else "highest"
+    return AdequacyTest(
+        "range_ends",
+        share,
+        MIN_END_SHARE_PCT,
+        "%",
+        "pass" if share >= MIN_END_SHARE_PCT else "warn",
+        None,
+        f"{name}: the {end} tenth of the range holds {share:.2g} % of the samples: "
+        "the model's end there rests on few samples (soak longer at the ends)",
+    )
+
+
 def temperature_tests(
     temps: FloatArray, name: str, order: int, *, unit: str = "°C"
 ) -> list[AdequacyTest]:
-    """Span, distinct temperatures and coverage of the ends of one temperature column
-    (all runs together) for a polynomial of ``order`` in it."""
+    """Span, distinct temperatures and coverage of the ends of one temperature column.
+
+    Parameters
+    ----------
+    temps : numpy.ndarray
+        The column's temperatures over all runs together [°C].
+    name : str
+        The column, for messages.
+    order : int
+        The model's polynomial order in this column.
+    unit : str, optional
+        Unit of ``temps``; anything but ``"°C"`` (raw counts) is not judged.
+
+    Returns
+    -------
+    list of AdequacyTest
+        ``temperature_span`` (0.1–99.9 percentile span against
+        :data:`MIN_SPAN_PER_ORDER_C` × order), ``distinct_temperatures`` (occupied bins
+        against order + 1) and ``range_ends`` (share in the lowest and highest tenth).
+    """
     if unit != "°C":
         return [
             AdequacyTest(
@@ -283,20 +428,7 @@ def temperature_tests(
     ]
     width = max(span / N_SPAN_BINS, MIN_BIN_WIDTH_C)
     per_bin = max(1, min(MIN_SAMPLES_PER_BIN, t.size // (3 * N_SPAN_BINS)))
-    if t.size and span > 0:
-        counts = np.zeros(0, dtype=np.intp)
-        for a in range(0, t.size, 1 << 18):  # in blocks: the bin counts add up
-            tb = t[a : a + (1 << 18)]
-            idx = np.clip(np.floor((tb - lo) / width).astype(np.int64), 0, None)
-            c = np.bincount(idx[(tb >= lo) & (tb <= hi)])
-            if c.size > counts.size:
-                c[: counts.size] += counts
-                counts = c
-            else:
-                counts[: c.size] += c
-        distinct = int(np.count_nonzero(counts >= per_bin))
-    else:
-        distinct = 1 if t.size else 0
+    distinct = _distinct_bins(t, lo, hi, width, per_bin)
     if distinct < order + 1:
         verdict, override = "fail", None
         msg = (
@@ -325,30 +457,42 @@ def temperature_tests(
         )
     )
     if t.size and span > 0:
-        low = float(np.count_nonzero(t <= lo + END_FRACTION * span)) / t.size * 100.0
-        high = float(np.count_nonzero(t >= hi - END_FRACTION * span)) / t.size * 100.0
-        share = min(low, high)
-        end = "lowest" if low <= high else "highest"
-        out.append(
-            AdequacyTest(
-                "range_ends",
-                share,
-                MIN_END_SHARE_PCT,
-                "%",
-                "pass" if share >= MIN_END_SHARE_PCT else "warn",
-                None,
-                f"{name}: the {end} tenth of the range holds {share:.2g} % of the samples: "
-                "the model's end there rests on few samples (soak longer at the ends)",
-            )
-        )
+        out.append(_range_ends_test(t, lo, hi, name))
     return out
 
 
 def temperature_rate_c_per_min(
     time_s: FloatArray, temps: FloatArray, interval_s: float = RATE_INTERVAL_S
 ) -> FloatArray:
-    """Ṫ = (T(t) − T(t − Δ)) / Δ × 60 [°C/min] with Δ = ``interval_s`` (samples closer than
-    Δ to the start are left out)."""
+    r"""Temperature rate by a backward difference over ``interval_s``.
+
+    Parameters
+    ----------
+    time_s : numpy.ndarray
+        Sample times [s], increasing.
+    temps : numpy.ndarray
+        Temperatures [°C].
+    interval_s : float, optional
+        Δ of the difference [s] (default :data:`RATE_INTERVAL_S`).
+
+    Returns
+    -------
+    numpy.ndarray
+        Ṫ [°C/min] for the samples at least Δ after the start.
+
+    Notes
+    -----
+    .. math:: \dot T(t) = 60\,\frac{T(t) - T(t - \Delta)}{\Delta}
+
+    with :math:`T(t-\Delta)` interpolated linearly.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> t = np.arange(0.0, 600.0, 1.0)
+    >>> round(float(temperature_rate_c_per_min(t, 0.01 * t, 60.0)[0]), 3)
+    0.6
+    """
     if time_s.size < 2:
         return np.empty(0)
     keep = time_s >= time_s[0] + interval_s
@@ -359,7 +503,21 @@ def temperature_rate_c_per_min(
 
 
 def rate_test(rates_c_per_min: FloatArray, name: str) -> AdequacyTest:
-    """The Ṫ span (1–99 percentiles) against :data:`MIN_RATE_SPAN_C_PER_MIN`."""
+    """The span of the temperature rate against :data:`MIN_RATE_SPAN_C_PER_MIN`.
+
+    Parameters
+    ----------
+    rates_c_per_min : numpy.ndarray
+        Ṫ [°C/min] (:func:`temperature_rate_c_per_min`); non-finite values skipped.
+    name : str
+        The temperature column, for the message.
+
+    Returns
+    -------
+    AdequacyTest
+        ``rate_range`` with the 1–99 percentile span [°C/min]; fails (overridable
+        with :data:`ALLOW_NARROW`) below the minimum.
+    """
     r = rates_c_per_min[np.isfinite(rates_c_per_min)]
     if r.size == 0:
         span, lo, hi = 0.0, math.nan, math.nan
@@ -380,6 +538,30 @@ def rate_test(rates_c_per_min: FloatArray, name: str) -> AdequacyTest:
 
 
 def firmware_test(span_c: float, firmware: str, minimum_c: float) -> AdequacyTest:
+    """The sweep against a firmware's minimum temperature span.
+
+    Parameters
+    ----------
+    span_c : float
+        The sweep's span [°C].
+    firmware : str
+        The firmware's name, for the message (``"ArduPilot"`` …).
+    minimum_c : float
+        The smallest span that firmware's calibration accepts [°C]
+        (e.g. :data:`ARDUPILOT_MIN_SPAN_C`).
+
+    Returns
+    -------
+    AdequacyTest
+        ``firmware_minimum``; fails (overridable with :data:`ALLOW_NARROW`) below
+        ``minimum_c``.
+
+    References
+    ----------
+    - ArduPilot, ``libraries/AP_InertialSensor/AP_InertialSensor_tempcal.cpp``:
+      ``TEMP_RANGE_MIN`` = 10 [°C], and ``INS_TCALn_TMAX`` "must be at least 10
+      degrees above TMIN".
+    """
     ok = span_c >= minimum_c
     return AdequacyTest(
         "firmware_minimum",
@@ -395,10 +577,24 @@ def firmware_test(span_c: float, firmware: str, minimum_c: float) -> AdequacyTes
 
 @dataclass(frozen=True)
 class Motion:
-    """What :func:`stillness` found: the share of moving time, the largest departure [the
-    given unit], the threshold used, the bumps (start, end [s], peak) and the steps (time
-    [s], size [the given unit], the angle between the levels before and after [°] or None
-    without a level to measure it by), and the median level (its norm)."""
+    """What :func:`stillness` found.
+
+    Attributes
+    ----------
+    share : float
+        Share of the time moving [-].
+    peak : float
+        Largest departure from the running median [the given unit].
+    threshold : float
+        The threshold used [the given unit].
+    episodes : list of (float, float, float)
+        The bumps: start [s], end [s], peak [the given unit].
+    rotating : float or None
+        The median level's norm [the given unit] (a gyro turning), None without one.
+    steps : list of (float, float, float or None)
+        The steps: time [s], size [the given unit], angle between the levels before
+        and after [°] (None without a level to measure it by).
+    """
 
     share: float
     peak: float
@@ -532,8 +728,51 @@ def stillness_remembered() -> Iterator[None]:
 def stillness(
     time_s: npt.ArrayLike, values: npt.ArrayLike, floor: float, *, k_sigma: float = STILL_K_SIGMA
 ) -> Motion:
-    """Tell motion from thermal drift (the formula and its source: :func:`_stillness`);
-    remembered within :func:`stillness_remembered`."""
+    r"""Tell motion from thermal drift in a channel or a triad.
+
+    Blocks of ``max(1 s, 10 samples)``; each block's median :math:`m_b` (a vector
+    for a triad) is compared with :math:`M_b`, the median of the block medians within
+    ±w/2 (w = :data:`STILL_WINDOW_S`): slow thermal drift follows it, a bump or a turn
+    does not.  Remembered within :func:`stillness_remembered`.
+
+    Parameters
+    ----------
+    time_s : array_like
+        Sample times [s].
+    values : array_like
+        The signal, shape ``(n,)`` or ``(n, m)`` for a triad [unit of ``floor``,
+        e.g. °/h or mg].
+    floor : float
+        Absolute threshold [unit of ``values``] (:data:`MOTION_FLOOR_DEG_S`,
+        :data:`MOTION_FLOOR_MG` in the canonical unit).
+    k_sigma : float, optional
+        Threshold in units of the sensor's noise (default :data:`STILL_K_SIGMA`).
+
+    Returns
+    -------
+    Motion
+
+    Notes
+    -----
+    A block is moving when a bump or a step exceeds the threshold:
+
+    .. math::
+        |m_b - M_b| \;\text{or}\; 2\,|M_b - (B_b + A_b)/2|
+        > \max\!\left(\mathrm{floor},\; 1.25\,k\,\sigma_w/\sqrt{n_b}\right)
+
+    with :math:`B_b`, :math:`A_b` the medians over w/2 before and after the block,
+    :math:`\sigma_w` the sensor's own noise (robust scatter about the block medians)
+    and :math:`n_b` the samples per block (the median of n white samples scatters
+    1.25 σ/√n).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> t = np.arange(0.0, 600.0, 0.1)
+    >>> x = np.random.default_rng(0).normal(0.0, 1.0, t.size)
+    >>> stillness(t, x, 5.0).share
+    0.0
+    """
     memo = _STILL_MEMO.get()
     if memo is None:
         return _stillness(time_s, values, floor, k_sigma=k_sigma)
@@ -619,12 +858,32 @@ def stillness_test(
     unit_factor: float = 1.0,
     unit: str | None = None,
 ) -> AdequacyTest:
-    """:func:`stillness` of a gyro (``values`` [°/h]) or accelerometer ([mg]) channel or
-    triad, as a test; ``unit_factor``/``unit`` express the figures in the data's unit
-    (figure × unit_factor).  Refused (``--allow-motion``): moving more than
-    :data:`MAX_MOVING_SHARE` of the time, a gyro turning at more than
-    :data:`ROTATING_DEG_S`, an accelerometer whose level stepped (the board was
-    re-oriented: gravity moved between the axes).  Warned: shorter bumps, a gyro's step."""
+    """:func:`stillness` of a gyro or accelerometer channel or triad, as a test.
+
+    Refused (:data:`ALLOW_MOTION`): moving more than :data:`MAX_MOVING_SHARE` of the
+    time, a gyro turning at more than :data:`ROTATING_DEG_S`, an accelerometer whose
+    level stepped (the board was re-oriented).  Warned: shorter bumps, a gyro's step.
+
+    Parameters
+    ----------
+    time_s : array_like
+        Sample times [s].
+    values : array_like
+        The signal [°/h for a gyro, mg for an accelerometer].
+    kind : str
+        ``"gyro"`` or ``"accel"``; anything else is not judged (``n/a``).
+    name : str
+        The channel, for messages.
+    unit_factor : float, optional
+        Multiplies a figure in the canonical unit into the data's unit (default 1).
+    unit : str, optional
+        The data's unit as messages show it (default the canonical one).
+
+    Returns
+    -------
+    AdequacyTest
+        ``stillness`` with the share of moving time [%].
+    """
     if kind not in ("gyro", "accel"):
         return AdequacyTest(
             "stillness", None, None, "", "n/a", None,
@@ -686,9 +945,17 @@ def stillness_test(
 
 @dataclass(frozen=True)
 class Needs:
-    """What a model asks of the data: its polynomial order in T per temperature column
-    (0: the column is not used in T), the number of coefficients and whether Ṫ terms
-    are fitted (per column)."""
+    """What a model asks of the data.
+
+    Attributes
+    ----------
+    order : dict of str to int
+        Polynomial order in T per temperature column (0: not used in T).
+    n_coefficients : int
+        Number of fitted coefficients.
+    rate : tuple of str
+        The temperature columns whose Ṫ terms are fitted.
+    """
 
     order: dict[str, int]
     n_coefficients: int
@@ -794,10 +1061,26 @@ def _worst_stillness(tests: list[AdequacyTest]) -> AdequacyTest:
 
 
 def check_for_firmware(record: Any, where: str) -> None:
-    """Refuse (exit 2) firmware output from a model whose adequacy failed without an
-    override at fit time, naming the failed test; warn when it was overridden; say nothing
-    for a model that passed.  A model file without a record (written before the check
-    existed) gets a warning."""
+    """Refuse firmware output from a model whose adequacy failed without an override.
+
+    Parameters
+    ----------
+    record : object
+        The model file's ``adequacy`` record (:meth:`Adequacy.to_dict`).
+    where : str
+        The model file, named in messages.
+
+    Raises
+    ------
+    ThermocalInputError
+        A test failed at fit time without an override (exit 2, naming the test).
+
+    Warns
+    -----
+    ThermocalWarning
+        A failure was overridden, or the model carries no record (written before
+        the check existed).
+    """
     rec = from_dict(record)
     if rec is None:
         warnings.warn(

@@ -65,12 +65,18 @@ AXES = ("x", "y", "z")
 
 @dataclass(frozen=True)
 class GravityInput:
-    """The gravity one accelerometer channel reads in one run, as a known input.
+    r"""The gravity one accelerometer channel reads in one run, as a known input.
 
-    ``value_mg``: ``g·u_i`` [mg] (0 for a gyro or without ``--gravity-axis``); ``what``:
-    the words of the model's known-input record (None when there is no gravity);
-    ``record``: the model's ``inputs.known_input.gravity`` (up axis, g [m/s²], the
-    direction when measured and ``direction_measured``), None without gravity."""
+    Attributes
+    ----------
+    value_mg : float
+        :math:`g\,u_i` [mg]; 0 for a gyro or without an up axis.
+    what : str or None
+        The words of the model's known-input record; None when there is no gravity.
+    record : dict or None
+        The model's ``inputs.known_input.gravity`` (up axis, g [m/s²], the direction
+        when measured and ``direction_measured``); None without gravity.
+    """
 
     value_mg: float
     what: str | None = None
@@ -81,9 +87,21 @@ class GravityInput:
 class TriadGravity:
     """Gravity of one accelerometer triad over the runs of a fit.
 
-    ``channels``: axis letter → channel name; ``run_direction``: per run, the unit vector
-    ``u`` of its placement (x, y, z); ``placement``: per run, its placement's index;
-    ``g_mg``: local gravity [mg]; ``gravity_axis``: the nominal up axis (``"+z"``…)."""
+    Attributes
+    ----------
+    channels : dict of str to str
+        Axis letter → channel name.
+    run_direction : tuple of tuple of float
+        Per run, the unit vector ``u`` of its placement (x, y, z) [-].
+    placement : tuple of int
+        Per run, its placement's index.
+    g_mg : float
+        Local gravity [mg].
+    g_m_s2 : float
+        Local gravity [m/s²].
+    gravity_axis : str
+        The nominal up axis (``"+z"``, ``"-x"`` …).
+    """
 
     channels: dict[str, str]
     run_direction: tuple[tuple[float, float, float], ...]
@@ -93,7 +111,20 @@ class TriadGravity:
     gravity_axis: str
 
     def known_input(self, run: int, name: str) -> GravityInput:
-        """Channel ``name``'s known input in run ``run``: ``g·u_i`` [mg], with its record."""
+        r"""Channel ``name``'s known input in run ``run``.
+
+        Parameters
+        ----------
+        run : int
+            Index of the run in the fit.
+        name : str
+            Channel name, one of :attr:`channels`.
+
+        Returns
+        -------
+        GravityInput
+            :math:`g\,u_i` [mg], with its words and record.
+        """
         axis = next(a for a, n in self.channels.items() if n == name)
         u = self.run_direction[run]
         i = AXES.index(axis)
@@ -194,13 +225,56 @@ def local_gravity_m_s2(
 
 
 def nominal_up(gravity_axis: str) -> tuple[float, float, float]:
-    """The unit vector of the nominal up axis (``"+z"`` → (0, 0, 1))."""
+    """The unit vector of the nominal up axis.
+
+    Parameters
+    ----------
+    gravity_axis : str
+        The sensor axis pointing up: a sign and a letter (``"+z"``, ``"-x"`` …).
+
+    Returns
+    -------
+    tuple of float
+        ``(x, y, z)`` unit vector [-].
+
+    Raises
+    ------
+    ParameterError
+        ``gravity_axis`` is not a sign and one of x, y, z.
+
+    Examples
+    --------
+    >>> nominal_up("-x")
+    (-1.0, 0.0, 0.0)
+    """
     letter, sign = units.parse_gravity_axis(gravity_axis)
     return tuple(sign if a == letter else 0.0 for a in AXES)  # type: ignore[return-value]
 
 
 def tilt_deg(u: Sequence[float], gravity_axis: str) -> float:
-    """Angle [°] between the direction ``u`` and the nominal up axis: ``acos(u·e)``."""
+    r"""Angle between a direction and the nominal up axis.
+
+    Parameters
+    ----------
+    u : sequence of float
+        Unit vector ``(x, y, z)`` of the measured gravity direction [-].
+    gravity_axis : str
+        The nominal up axis (``"+z"`` …).
+
+    Returns
+    -------
+    float
+        Tilt [°].
+
+    Notes
+    -----
+    .. math:: \theta = \arccos(\mathbf u \cdot \mathbf e_{up})
+
+    Examples
+    --------
+    >>> round(tilt_deg((0.0, 0.1045, 0.9945), "+z"), 1)
+    6.0
+    """
     e = nominal_up(gravity_axis)
     c = float(np.dot(np.asarray(u, dtype=np.float64), e))
     return math.degrees(math.acos(max(-1.0, min(1.0, c))))
@@ -209,12 +283,39 @@ def tilt_deg(u: Sequence[float], gravity_axis: str) -> float:
 def group_placements(
     means_mg: Sequence[Sequence[float]], tolerance_deg: float = PLACEMENT_TOLERANCE_DEG
 ) -> tuple[tuple[tuple[float, float, float], ...], tuple[int, ...]]:
-    """Per run, the unit gravity direction of its placement and the placement's index.
+    r"""Per run, the unit gravity direction of its placement and the placement's index.
 
-    ``means_mg``: each run's mean specific force (x, y, z) [mg].  Runs are taken in order;
-    a run joins the first placement whose direction (that of the mean of its runs' mean
-    vectors) is within ``tolerance_deg`` of the run's own ``f̄_r / |f̄_r|``, else starts
-    a new one.  The directions are those of the final placements (module docstring)."""
+    Runs are taken in order; a run joins the first placement whose direction (that
+    of the mean of its runs' mean vectors) is within ``tolerance_deg`` of the run's
+    own direction, else it starts a new one.  The directions returned are those of
+    the final placements.
+
+    Parameters
+    ----------
+    means_mg : sequence of sequence of float
+        Each run's mean specific force ``(x, y, z)`` [mg].
+    tolerance_deg : float, optional
+        Largest angle between a run and its placement [°] (default
+        :data:`PLACEMENT_TOLERANCE_DEG`, 5°).
+
+    Returns
+    -------
+    directions : tuple of tuple of float
+        Per run, the unit vector of its placement [-].
+    placement : tuple of int
+        Per run, the index of its placement.
+
+    Notes
+    -----
+    .. math:: \mathbf d_r = \bar{\mathbf f}_r / |\bar{\mathbf f}_r|, \quad
+        \mathbf d_r \cdot \mathbf u_P \ge \cos(\mathrm{tolerance})
+
+    Examples
+    --------
+    >>> dirs, place = group_placements([(0, 0, 1000), (0, 0, 1001), (1000, 0, 0)])
+    >>> place
+    (0, 0, 1)
+    """
     vecs = [np.asarray(m, dtype=np.float64) for m in means_mg]
     members: list[list[int]] = []
     cos_tol = math.cos(math.radians(tolerance_deg))
@@ -239,9 +340,22 @@ def group_placements(
 
 
 def accel_triad(names: Sequence[str | None], unit_of: Mapping[str, str]) -> dict[str, str] | None:
-    """Axis → channel of the accelerometer triad among the fitted channels ``names`` (by
-    unit kind and the trailing axis letter, :func:`thermocal.models.calibration.guess_role`);
-    None unless exactly one channel per axis x, y, z."""
+    """Axis → channel of the accelerometer triad among the fitted channels.
+
+    Parameters
+    ----------
+    names : sequence of str or None
+        The fitted channels (None entries are skipped).
+    unit_of : mapping of str to str
+        Channel name → its unit; the kind is read from the unit and the axis from the
+        trailing letter (:func:`thermocal.models.calibration.guess_role`).
+
+    Returns
+    -------
+    dict of str to str or None
+        ``{"x": name, "y": name, "z": name}``; None unless exactly one accelerometer
+        channel per axis.
+    """
     from thermocal.models.calibration import guess_role
 
     found: dict[str, list[str]] = {a: [] for a in AXES}
@@ -269,11 +383,42 @@ def triad_gravity(
     gravity_axis: str | None,
     g_m_s2: float | None,
 ) -> TriadGravity | None:
-    """The measured gravity of the accelerometer triad among ``names`` over the runs
-    ``loaded`` (path, recording), or None without ``--gravity-axis`` or without a full
-    triad.  Each run is checked: the up axis within :data:`GRAVITY_TOLERANCE_MG` of ±g
-    (else an input error: the wrong axis or unit), the magnitude within it of g (else a
-    warning: a bias of that size along gravity is doubtful)."""
+    r"""The measured gravity of the accelerometer triad over the runs of a fit.
+
+    Each run is checked: the up axis within :data:`GRAVITY_TOLERANCE_MG` of ±g (else
+    an error: the wrong axis or unit), the magnitude within it of g (else a warning:
+    a bias of that size along gravity is doubtful).
+
+    Parameters
+    ----------
+    loaded : sequence of (Path, Recording)
+        The runs of the fit, with their paths.
+    names : sequence of str or None
+        The fitted channels.
+    gravity_axis : str or None
+        The sensor axis pointing up (``"+z"`` …); None: no gravity.
+    g_m_s2 : float or None
+        Local gravity [m/s²] (:func:`local_gravity_m_s2`).
+
+    Returns
+    -------
+    TriadGravity or None
+        None without ``gravity_axis`` or without a full triad.
+
+    Raises
+    ------
+    ParameterError
+        (``gravity_axis``) the up axis's mean is more than 100 mg from ±g.
+    ThermocalInputError
+        A triad channel has no finite value.
+
+    Notes
+    -----
+    .. math:: \mathbf u = \bar{\mathbf f} / |\bar{\mathbf f}|, \quad g_{mg} = 1000\,g / g_0
+
+    with :math:`g_0` = 9.80665 m/s² and one :math:`\mathbf u` per placement
+    (:func:`group_placements`).
+    """
     if gravity_axis is None or g_m_s2 is None or not loaded:
         return None
     first = loaded[0][1]
@@ -321,6 +466,32 @@ def triad_gravity(
     return TriadGravity(dict(chans), dirs, place, g_mg, g_m_s2, gravity_axis)
 
 
+def _warn_lone_channel(
+    path: Path | str, name: str, mean: float, g_mg: float, gravity_axis: str, run: int
+) -> None:
+    """Warnings of a channel fitted without its triad: tilt of a horizontal axis, no direction."""
+    off = mean - g_mg
+    if g_mg == 0.0 and abs(off) > GRAVITY_TOLERANCE_MG:
+        tilt = math.degrees(math.asin(min(1.0, abs(mean) / 1000.0)))
+        warnings.warn(
+            f"{path}: {name} is horizontal with {gravity_axis} up but reads {mean:.1f} "
+            f"mg (a tilt of about {tilt:.0f}°): its share of gravity stays in the model's "
+            "constant",
+            ThermocalWarning,
+            stacklevel=3,
+        )
+    if run == 0:
+        warnings.warn(
+            f"--gravity-axis {gravity_axis}: {name} is fitted without the other axes of its "
+            "accelerometer triad, so the gravity direction is unknown: its known input "
+            f"assumes {gravity_axis} exactly up ({g_mg:+.1f} mg) and a tilt's share of gravity "
+            "stays in the model's constant; export-params writes no absolute accelerometer "
+            "offset from it (fit x, y and z together to measure the direction)",
+            ThermocalWarning,
+            stacklevel=3,
+        )
+
+
 def channel_gravity(
     triad: TriadGravity | None,
     run: int,
@@ -331,17 +502,40 @@ def channel_gravity(
     gravity_axis: str | None,
     g_m_s2: float | None,
 ) -> GravityInput:
-    """The gravity channel ``name`` (canonical unit ``unit``) reads in run ``run`` [mg].
+    r"""The gravity a channel reads in one run [mg], as a known input.
 
-    * not an accelerometer: 0;
-    * without ``--gravity-axis``: 0, with a warning when its mean exceeds
-      :data:`NO_GRAVITY_MG` (the model's constant would hold gravity and compensation
-      take it out);
-    * a channel of the measured ``triad``: ``g·u_i`` (:class:`TriadGravity`);
-    * otherwise the direction is unknown: ``±g`` on the nominal up axis (within
-      :data:`GRAVITY_TOLERANCE_MG`, else an input error), 0 on the others (a mean beyond
-      the tolerance is warned as a tilt), and a warning in the first run that the
-      direction could not be measured."""
+    Not an accelerometer: 0.  Without an up axis: 0 (with a warning when its mean
+    exceeds :data:`NO_GRAVITY_MG`).  A channel of the measured ``triad``:
+    :math:`g\,u_i`.  Otherwise ±g on the nominal up axis and 0 on the others, with a
+    warning that the direction is not measured.
+
+    Parameters
+    ----------
+    triad : TriadGravity or None
+        The measured triad (:func:`triad_gravity`).
+    run : int
+        Index of the run.
+    path : Path or str
+        The run's file, named in messages.
+    name, unit : str
+        Channel name and its canonical unit.
+    values_mg : numpy.ndarray
+        The channel's samples [mg].
+    gravity_axis : str or None
+        The sensor axis pointing up; None: no gravity.
+    g_m_s2 : float or None
+        Local gravity [m/s²].
+
+    Returns
+    -------
+    GravityInput
+
+    Raises
+    ------
+    ParameterError
+        (``gravity_axis``) a channel naming no axis, or an up axis more than 100 mg
+        from ±g.
+    """
     if units.signal_kind(unit) != "accel":
         return GravityInput(0.0)
     if gravity_axis is None or g_m_s2 is None:
@@ -377,25 +571,7 @@ def channel_gravity(
             f"{g_mg:+.1f} mg but reads {mean:.1f} mg on average; is {gravity_axis} the "
             "axis pointing up, and the unit right?",
         )
-    if g_mg == 0.0 and abs(off) > GRAVITY_TOLERANCE_MG:
-        tilt = math.degrees(math.asin(min(1.0, abs(mean) / 1000.0)))
-        warnings.warn(
-            f"{path}: {name} is horizontal with {gravity_axis} up but reads {mean:.1f} "
-            f"mg (a tilt of about {tilt:.0f}°): its share of gravity stays in the model's "
-            "constant",
-            ThermocalWarning,
-            stacklevel=2,
-        )
-    if run == 0:
-        warnings.warn(
-            f"--gravity-axis {gravity_axis}: {name} is fitted without the other axes of its "
-            "accelerometer triad, so the gravity direction is unknown: its known input "
-            f"assumes {gravity_axis} exactly up ({g_mg:+.1f} mg) and a tilt's share of gravity "
-            "stays in the model's constant; export-params writes no absolute accelerometer "
-            "offset from it (fit x, y and z together to measure the direction)",
-            ThermocalWarning,
-            stacklevel=2,
-        )
+    _warn_lone_channel(path, name, mean, g_mg, gravity_axis, run)
     what = (
         f"gravity {g_mg:+.6g} mg ({gravity_axis} up, g = {g_m_s2:.7g} m/s²; direction not "
         "measured: a tilt's share of gravity is in the constant)"

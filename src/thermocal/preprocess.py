@@ -52,11 +52,42 @@ def _as_f64(x: npt.ArrayLike, name: str) -> FloatArray:
 
 
 def sum_decimate(x: npt.ArrayLike, factor: int) -> FloatArray:
-    """Sum consecutive blocks of ``factor`` samples: ``y_j = Σ_{i=jm}^{jm+m-1} x_i``.
+    r"""Sum consecutive blocks of ``factor`` samples.
 
-    Used for pulse counts (100 Hz counts summed to 1 Hz).  A trailing
-    partial block is dropped.  No gap check: use :func:`block_average` on
-    recordings with gaps.
+    Used for pulse counts (100 Hz counts summed to 1 Hz, as in the fibre-optic-gyro
+    thesis).  A trailing partial block is dropped.  No gap check: use
+    :func:`block_average` on recordings with gaps.
+
+    Parameters
+    ----------
+    x : array_like
+        Samples, one-dimensional [any unit, e.g. counts].
+    factor : int
+        Samples per block m (≥ 1).
+
+    Returns
+    -------
+    numpy.ndarray
+        Block sums, ``len(x) // factor`` of them [unit of ``x``].
+
+    Raises
+    ------
+    ThermocalInputError
+        ``factor`` below 1, or ``x`` not one-dimensional.
+
+    Notes
+    -----
+    .. math:: y_j = \sum_{i=jm}^{jm+m-1} x_i
+
+    References
+    ----------
+    - *Design and engineering implementation of a fibre-optic-gyro line-of-sight
+      stabilisation system*, master's thesis, chapter 3 "Fibre-optic gyroscope".
+
+    Examples
+    --------
+    >>> sum_decimate([1, 2, 3, 4, 5], 2)
+    array([3., 7.])
     """
     arr = _as_f64(x, "x")
     if factor < 1:
@@ -67,7 +98,30 @@ def sum_decimate(x: npt.ArrayLike, factor: int) -> FloatArray:
 
 
 def mean_decimate(x: npt.ArrayLike, factor: int) -> FloatArray:
-    """Mean of consecutive blocks of ``factor`` samples (trailing partial block dropped)."""
+    r"""Mean of consecutive blocks of ``factor`` samples (trailing partial block dropped).
+
+    Parameters
+    ----------
+    x : array_like
+        Samples, one-dimensional [any unit].
+    factor : int
+        Samples per block m (≥ 1).
+
+    Returns
+    -------
+    numpy.ndarray
+        Block means :math:`\frac{1}{m}\sum_{i=jm}^{jm+m-1} x_i` [unit of ``x``].
+
+    Raises
+    ------
+    ThermocalInputError
+        ``factor`` below 1, or ``x`` not one-dimensional.
+
+    Examples
+    --------
+    >>> mean_decimate([1, 2, 3, 4, 5], 2)
+    array([1.5, 3.5])
+    """
     return sum_decimate(x, factor) / factor
 
 
@@ -259,8 +313,25 @@ RATE_BLOCK_ROWS = 32768
 
 
 def step_range(time_s: FloatArray) -> tuple[float, float]:
-    """Smallest and largest time step ``min/max(t_{i+1} − t_i)`` [s] (NaN-free input;
-    ``(inf, -inf)`` for fewer than 2 samples), reduced in cache-sized blocks."""
+    r"""Smallest and largest time step, reduced in cache-sized blocks.
+
+    Parameters
+    ----------
+    time_s : numpy.ndarray
+        Sample times [s], NaN-free.
+
+    Returns
+    -------
+    tuple of float
+        :math:`(\min_i (t_{i+1} - t_i), \max_i (t_{i+1} - t_i))` [s];
+        ``(inf, -inf)`` for fewer than 2 samples.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> step_range(np.array([0.0, 1.0, 3.0]))
+    (1.0, 2.0)
+    """
     n = int(time_s.size)
     lo, hi = math.inf, -math.inf
     if n < 2:
@@ -280,14 +351,26 @@ def gap_free_slices(
     gap_factor: float = GAP_FACTOR,
     steps: tuple[float, float] | None = None,
 ) -> list[slice]:
-    """Contiguous index ranges between gaps: the same slices as
-    :func:`thermocal.recording.contiguous_slices` (a step longer than ``gap_factor`` ×
-    the median step is a gap), with an exact shortcut for gap-free data.
+    """Contiguous index ranges between gaps, with an exact shortcut for gap-free data.
 
-    When every step is positive and ``max(dt) ≤ gap_factor · min(dt)``, no step can
-    exceed ``gap_factor`` × the median (``median ≥ min``), so the whole run is one
-    slice without computing the median; otherwise the general function is used.
-    ``steps``: :func:`step_range` of ``time_s`` when already known.
+    The same slices as :func:`thermocal.recording.contiguous_slices` (a step longer
+    than ``gap_factor`` × the median step is a gap).  When every step is positive and
+    ``max(dt) ≤ gap_factor · min(dt)``, no step can exceed ``gap_factor`` × the median
+    (``median ≥ min``), so the whole run is one slice without computing the median.
+
+    Parameters
+    ----------
+    time_s : numpy.ndarray
+        Sample times [s].
+    gap_factor : float, optional
+        A step longer than this many median steps is a gap (default ``GAP_FACTOR``, 1.5).
+    steps : tuple of float, optional
+        :func:`step_range` of ``time_s`` when already known [s].
+
+    Returns
+    -------
+    list of slice
+        The contiguous segments, in order.
     """
     n = int(time_s.size)
     if n < 3:
@@ -301,15 +384,32 @@ def gap_free_slices(
 def backward_partners(
     time_s: FloatArray, s0: int, a: int, b: int, interval_s: float, *, increasing: bool = False
 ) -> int | npt.NDArray[np.intp]:
-    """Partner samples of the causal rate for rows ``a … b−1`` of the segment starting at ``s0``.
+    r"""Partner samples of the causal rate for rows ``a … b−1`` of a segment.
 
-    ``lo_i`` = the first row ``j ≥ s0`` with ``t_j ≥ t_i − Δt``
-    (``searchsorted(..., side="left")``, as :func:`thermocal.preprocess.temperature_rate`).
-    Returns an ``int`` L when ``lo_i = i − L`` for every row, with ``t_{lo_i} < t_i``
-    (checked exactly: ``t_{i−L} ≥ t_i − Δt > t_{i−L−1}``, ``i − L − 1 ≥ s0``) — the
-    usual case of regular sampling, where the partner values are a slice; else the
-    array of absolute indices ``lo_i``.  ``increasing=True`` tells that the times are
-    known to increase strictly (then ``t_{i−L} < t_i`` needs no check).
+    :math:`lo_i` is the first row :math:`j \ge s_0` with :math:`t_j \ge t_i - \Delta t`
+    (``searchsorted(..., side="left")``, as :func:`temperature_rate`).
+
+    Parameters
+    ----------
+    time_s : numpy.ndarray
+        Sample times [s].
+    s0 : int
+        First row of the contiguous segment.
+    a, b : int
+        The rows ``a … b−1`` whose partners are wanted.
+    interval_s : float
+        Δt [s].
+    increasing : bool, optional
+        The times are known to increase strictly (then :math:`t_{i-L} < t_i` needs
+        no check); default False.
+
+    Returns
+    -------
+    int or numpy.ndarray
+        An ``int`` L when :math:`lo_i = i - L` for every row (checked exactly:
+        :math:`t_{i-L} \ge t_i - \Delta t > t_{i-L-1}`, :math:`i - L - 1 \ge s_0`) — the
+        usual case of regular sampling, where the partner values are a slice; else the
+        array of absolute indices :math:`lo_i`.
     """
     x0 = float(time_s[a]) - interval_s
     lo_a = s0 + int(np.searchsorted(time_s[s0 : a + 1], x0, side="left"))
@@ -334,15 +434,39 @@ def segment_rates(
     interval_s: float,
     method: str = "backward",
 ) -> FloatArray:
-    """Ṫ [°C/min] at ``rows`` of one contiguous segment (times ``ts``, temps ``Ts`` (n, k)).
+    r"""Temperature rate at some rows of one contiguous segment.
 
-    The same arithmetic as :func:`thermocal.preprocess.temperature_rate`:
-    partner samples ``lo``/``hi`` inside the segment (backward: the
-    first ``t_j ≥ t_i − Δt`` and i; forward: i and the first ``t_j ≥ t_i + Δt``;
-    centred: ±Δt/2), ``Ṫ = (T_hi − T_lo)/(t_hi − t_lo)·60``, 0 when the span
-    is 0.  Works on a block of rows so that long runs need no full-size temporaries;
-    a backward block of consecutive rows uses :func:`backward_partners` (slices
-    instead of gathers on regular sampling).  Returns (len(rows), k), Fortran order.
+    The same arithmetic as :func:`temperature_rate`: partner samples lo/hi inside the
+    segment (backward: the first :math:`t_j \ge t_i - \Delta t` and i; forward: i and
+    the first :math:`t_j \ge t_i + \Delta t`; centred: ±Δt/2), 0 when the span is 0.
+    Works on a block of rows so that long runs need no full-size temporaries.
+
+    Parameters
+    ----------
+    ts : numpy.ndarray
+        The segment's times [s], shape ``(n,)``.
+    Ts : numpy.ndarray
+        The segment's temperatures [°C], shape ``(n, k)``.
+    rows : numpy.ndarray of int
+        The rows (within the segment) whose rate is wanted.
+    interval_s : float
+        Δt [s].
+    method : str, optional
+        ``"backward"`` (default), ``"forward"`` or ``"centred"``.
+
+    Returns
+    -------
+    numpy.ndarray
+        Ṫ [°C/min], shape ``(len(rows), k)``, Fortran order.
+
+    Raises
+    ------
+    ThermocalInputError
+        An unknown ``method``.
+
+    Notes
+    -----
+    .. math:: \dot T_i = 60\,\frac{T_{hi} - T_{lo}}{t_{hi} - t_{lo}}
     """
     n = ts.size
     i = np.asarray(rows, dtype=np.intp)
@@ -391,11 +515,28 @@ def temperature_rates(
     *,
     gap_factor: float = GAP_FACTOR,
 ) -> FloatArray:
-    """Ṫ of every column [°C/min], never across a gap (:func:`segment_rates` per segment,
-    in blocks of :data:`RATE_BLOCK_ROWS` rows).
+    """Temperature rate of every column, never across a gap.
 
-    Equal, bit for bit, to :func:`thermocal.preprocess.temperature_rate` applied column
-    by column.  ``temps_c`` may be 1-D (one column; a 1-D result).
+    :func:`segment_rates` per contiguous segment, in blocks of :data:`RATE_BLOCK_ROWS`
+    rows; equal, bit for bit, to :func:`temperature_rate` applied column by column.
+
+    Parameters
+    ----------
+    time_s : numpy.ndarray
+        Sample times [s].
+    temps_c : numpy.ndarray
+        Temperatures [°C], shape ``(n, k)`` or ``(n,)`` (then a 1-D result).
+    interval_s : float
+        Δt [s].
+    method : str, optional
+        ``"backward"`` (default), ``"forward"`` or ``"centred"``.
+    gap_factor : float, optional
+        A step longer than this many median steps is a gap (default 1.5).
+
+    Returns
+    -------
+    numpy.ndarray
+        Ṫ [°C/min], the shape of ``temps_c``.
     """
     T = np.asarray(temps_c, dtype=np.float64)
     one_d = T.ndim == 1
@@ -413,7 +554,28 @@ def temperature_rates(
 def backward_rates(
     time_s: FloatArray, temps_c: FloatArray, interval_s: float, *, gap_factor: float = GAP_FACTOR
 ) -> FloatArray:
-    """Causal rate ``Ṫ(t) = (T(t) − T(t−Δt))/Δt`` [°C/min] of every column (see above)."""
+    r"""Causal temperature rate of every column.
+
+    Parameters
+    ----------
+    time_s : numpy.ndarray
+        Sample times [s].
+    temps_c : numpy.ndarray
+        Temperatures [°C], shape ``(n, k)`` or ``(n,)``.
+    interval_s : float
+        Δt [s].
+    gap_factor : float, optional
+        A step longer than this many median steps is a gap (default 1.5).
+
+    Returns
+    -------
+    numpy.ndarray
+        Ṫ [°C/min], the shape of ``temps_c``.
+
+    Notes
+    -----
+    .. math:: \dot T(t) = 60\,\frac{T(t) - T(t - \Delta t)}{\Delta t}
+    """
     return temperature_rates(time_s, temps_c, interval_s, "backward", gap_factor=gap_factor)
 
 
@@ -449,9 +611,15 @@ def temperature_rate(
     numpy.ndarray
         Ṫ [°C/min] per sample.
 
+    Raises
+    ------
+    ThermocalInputError
+        ``time_s`` and ``temp_c`` differ in length, an unknown ``method``, or
+        ``interval_s`` not positive.
+
     Notes
     -----
-    The RLG patent:
+    The forward difference of the ring-laser-gyro modelling method:
 
     .. math:: \dot T(t) = \frac{T(t+\Delta t) - T(t)}{\Delta t}
 
@@ -469,6 +637,18 @@ def temperature_rate(
     shorter interval, divided by its own length); with no partner (a one-sample
     segment) Ṫ = 0.  The difference is always divided by the actual time between
     the two samples, so ``Ṫ`` of a ramp at r °C/min is exactly r.
+
+    References
+    ----------
+    - *A modelling and validation method for the temperature compensation model of a
+      ring-laser gyroscope*, Chinese invention patent, 2017 (the temperature rate).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> t = np.arange(0.0, 600.0, 1.0)
+    >>> round(float(temperature_rate(t, 20.0 + t / 120.0)[-1]), 3)
+    0.5
     """
     t = _as_f64(time_s, "time_s")
     T = _as_f64(temp_c, "temp_c")
@@ -491,9 +671,18 @@ def temperature_rate(
 class Segment:
     """A stretch of a run: a temperature ``"hold"`` or a ``"ramp"``.
 
-    ``start``/``stop`` are sample indices (``slice(start, stop)``), ``start_s``/
-    ``stop_s`` times [s], ``mean_temp_c`` the mean temperature [°C] and
-    ``rate_c_per_min`` the mean temperature rate [°C/min] over the segment.
+    Attributes
+    ----------
+    kind : {"hold", "ramp"}
+        What the stretch is.
+    start, stop : int
+        Sample indices (``slice(start, stop)``).
+    start_s, stop_s : float
+        Times of the first and last sample [s].
+    mean_temp_c : float
+        Mean temperature [°C].
+    rate_c_per_min : float
+        Mean temperature rate over the segment [°C/min].
     """
 
     kind: Literal["hold", "ramp"]
@@ -506,48 +695,24 @@ class Segment:
 
     @property
     def slice(self) -> slice:
+        """``slice(start, stop)`` of the segment's samples."""
         return slice(self.start, self.stop)
 
     @property
     def duration_s(self) -> float:
+        """Time from the segment's first to its last sample [s]."""
         return self.stop_s - self.start_s
 
 
-def segment_holds(
-    time_s: npt.ArrayLike,
-    temp_c: npt.ArrayLike,
-    *,
-    rate_threshold_c_per_min: float = 0.05,
-    min_duration_s: float = 600.0,
-    rate_interval_s: float = 60.0,
-    settle_s: float = 0.0,
-    gap_factor: float = GAP_FACTOR,
+def _label_segments(
+    t: FloatArray,
+    T: FloatArray,
+    is_hold: npt.NDArray[np.bool_],
+    settle_s: float,
+    min_duration_s: float,
+    gap_factor: float,
 ) -> list[Segment]:
-    """Split a run into temperature holds and ramps from the temperature rate.
-
-    A sample belongs to a hold when the centred rate over ``rate_interval_s``
-    satisfies ``|Ṫ| < rate_threshold_c_per_min``; runs of such samples lasting at
-    least ``min_duration_s`` are holds (their first ``settle_s`` seconds are
-    given to the preceding ramp), everything else is ramp.  Segments never span
-    a gap.
-    """
-    t = _as_f64(time_s, "time_s")
-    T = _as_f64(temp_c, "temp_c")
-    if t.size != T.size:
-        raise ThermocalInputError("time_s and temp_c have different lengths")
-    if not rate_interval_s > 0:
-        raise ThermocalInputError(f"rate interval must be positive, got {rate_interval_s}")
-    # |Ṫ| < threshold block by block (the centred Ṫ of temperature_rate, bit for bit):
-    # one byte a sample, no full-length Ṫ
-    is_hold = np.full(t.size, rate_threshold_c_per_min > 0.0)  # rows of no segment: Ṫ = 0
-    T2 = T.reshape(-1, 1)
-    for sl in gap_free_slices(t, gap_factor):
-        s0, s1 = int(sl.start), int(sl.stop)
-        ts, Ts = t[s0:s1], T2[s0:s1]
-        for a in range(0, s1 - s0, RATE_BLOCK_ROWS):
-            b = min(s1 - s0, a + RATE_BLOCK_ROWS)
-            r = segment_rates(ts, Ts, np.arange(a, b), rate_interval_s, "centred")[:, 0]
-            np.less(np.abs(r), rate_threshold_c_per_min, out=is_hold[s0 + a : s0 + b])
+    """The holds and ramps of :func:`segment_holds` from the per-sample hold mask."""
     segs: list[Segment] = []
     for sl in contiguous_slices(t, gap_factor):
         base = int(sl.start)
@@ -595,15 +760,121 @@ def segment_holds(
     return segs
 
 
+def segment_holds(
+    time_s: npt.ArrayLike,
+    temp_c: npt.ArrayLike,
+    *,
+    rate_threshold_c_per_min: float = 0.05,
+    min_duration_s: float = 600.0,
+    rate_interval_s: float = 60.0,
+    settle_s: float = 0.0,
+    gap_factor: float = GAP_FACTOR,
+) -> list[Segment]:
+    r"""Split a run into temperature holds and ramps from the temperature rate.
+
+    A sample belongs to a hold when the centred rate over ``rate_interval_s``
+    satisfies :math:`|\dot T| <` ``rate_threshold_c_per_min``; runs of such samples
+    lasting at least ``min_duration_s`` are holds (their first ``settle_s`` seconds
+    are given to the preceding ramp), everything else is ramp.  Segments never span
+    a gap.
+
+    Parameters
+    ----------
+    time_s : array_like
+        Sample times [s].
+    temp_c : array_like
+        Temperatures [°C].
+    rate_threshold_c_per_min : float, optional
+        Largest |Ṫ| of a hold [°C/min] (default 0.05).
+    min_duration_s : float, optional
+        Shortest hold [s] (default 600).
+    rate_interval_s : float, optional
+        Δt of the centred rate [s] (default 60).
+    settle_s : float, optional
+        Start of each hold given to the ramp before it [s] (default 0).
+    gap_factor : float, optional
+        A step longer than this many median steps is a gap (default 1.5).
+
+    Returns
+    -------
+    list of Segment
+        Holds and ramps in time order.
+
+    Raises
+    ------
+    ThermocalInputError
+        Lengths differ, or ``rate_interval_s`` not positive.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> t = np.arange(0.0, 3600.0, 1.0)
+    >>> T = np.where(t < 1200, 20.0, np.minimum(20.0 + (t - 1200) / 60.0, 30.0))
+    >>> [s.kind for s in segment_holds(t, T)]
+    ['hold', 'ramp', 'hold']
+    """
+    t = _as_f64(time_s, "time_s")
+    T = _as_f64(temp_c, "temp_c")
+    if t.size != T.size:
+        raise ThermocalInputError("time_s and temp_c have different lengths")
+    if not rate_interval_s > 0:
+        raise ThermocalInputError(f"rate interval must be positive, got {rate_interval_s}")
+    # |Ṫ| < threshold block by block (the centred Ṫ of temperature_rate, bit for bit):
+    # one byte a sample, no full-length Ṫ
+    is_hold = np.full(t.size, rate_threshold_c_per_min > 0.0)  # rows of no segment: Ṫ = 0
+    T2 = T.reshape(-1, 1)
+    for sl in gap_free_slices(t, gap_factor):
+        s0, s1 = int(sl.start), int(sl.stop)
+        ts, Ts = t[s0:s1], T2[s0:s1]
+        for a in range(0, s1 - s0, RATE_BLOCK_ROWS):
+            b = min(s1 - s0, a + RATE_BLOCK_ROWS)
+            r = segment_rates(ts, Ts, np.arange(a, b), rate_interval_s, "centred")[:, 0]
+            np.less(np.abs(r), rate_threshold_c_per_min, out=is_hold[s0 + a : s0 + b])
+    return _label_segments(t, T, is_hold, settle_s, min_duration_s, gap_factor)
+
+
 # --- offsets and spectrum ---------------------------------------------------------------
 
 
 def remove_startup_offset(
     time_s: npt.ArrayLike, x: npt.ArrayLike, window_s: float
 ) -> tuple[FloatArray, float]:
-    """Subtract the turn-on offset: the mean of the first ``window_s`` seconds (the FOG thesis).
+    r"""Subtract the turn-on offset: the mean of the first ``window_s`` seconds.
 
-    Returns ``(x − offset, offset)``.
+    Parameters
+    ----------
+    time_s : array_like
+        Sample times [s].
+    x : array_like
+        The signal [its unit].
+    window_s : float
+        Length of the start-up window [s] (at least one sample is used).
+
+    Returns
+    -------
+    tuple of (numpy.ndarray, float)
+        ``(x − offset, offset)`` [unit of ``x``].
+
+    Raises
+    ------
+    ThermocalInputError
+        An empty signal.
+
+    Notes
+    -----
+    .. math:: b_0 = \frac{1}{n}\sum_{t_i < t_0 + w} x_i
+
+    References
+    ----------
+    - *Design and engineering implementation of a fibre-optic-gyro line-of-sight
+      stabilisation system*, master's thesis, chapter 3 "Fibre-optic gyroscope".
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> y, b0 = remove_startup_offset(np.arange(10.0), np.arange(10.0) + 5.0, 3.0)
+    >>> b0
+    6.0
     """
     t = _as_f64(time_s, "time_s")
     arr = _as_f64(x, "x")
@@ -616,7 +887,17 @@ def remove_startup_offset(
 
 @dataclass(frozen=True)
 class Spectrum:
-    """One-sided power spectral density: ``frequency_hz`` and ``psd`` [unit²/Hz]."""
+    """One-sided power spectral density.
+
+    Attributes
+    ----------
+    frequency_hz : numpy.ndarray
+        Frequencies [Hz].
+    psd : numpy.ndarray
+        Power spectral density [unit²/Hz].
+    segment_length : int
+        Samples per Welch segment.
+    """
 
     frequency_hz: FloatArray
     psd: FloatArray
@@ -660,8 +941,9 @@ def spectrum(
 
     References
     ----------
-    .. [1] P. D. Welch, "The use of fast Fourier transform for the estimation of power
-       spectra", IEEE Trans. Audio and Electroacoustics 15(2), 1967.
+    - P. D. Welch, "The use of fast Fourier transform for the estimation of power
+      spectra: a method based on time averaging over short, modified periodograms",
+      IEEE Transactions on Audio and Electroacoustics 15(2), pp. 70-73, 1967.
     """
     t = _as_f64(time_s, "time_s")
     arr = _as_f64(x, "x")

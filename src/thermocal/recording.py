@@ -53,18 +53,25 @@ class Metadata:
 
     Attributes
     ----------
-    sample_interval_s : nominal sample interval τ [s]; the median interval of
-        the time column when not given.
-    scale_factor : scale factor K of a raw-count output.
-    scale_factor_unit : unit of K, a key of :data:`thermocal.units.SCALE_FACTOR_UNITS`.
-    latitude_deg : test-site latitude φ [°], for earth-rate removal.
-    axis : sensitive-axis direction in local ENU (``"up"``, ``"north"``, ``"e,n,u"``).
-    sensor_id, run_id, notes : free text.
-    temperature_conversion : per temperature column a
-        :class:`~thermocal.units.TemperatureConversion` ``(gain, offset[, "int16"])`` with
+    sample_interval_s : float or None
+        Nominal sample interval τ [s]; the median interval of the time column when
+        not given.
+    scale_factor : float or None
+        Scale factor K of a raw-count output [``scale_factor_unit``].
+    scale_factor_unit : str or None
+        Unit of K, a key of :data:`thermocal.units.SCALE_FACTOR_UNITS`.
+    latitude_deg : float or None
+        Test-site latitude φ [°], for earth-rate removal.
+    axis : str or None
+        Sensitive-axis direction in local ENU (``"up"``, ``"north"``, ``"e,n,u"``).
+    sensor_id, run_id, notes : str or None
+        Free text.
+    temperature_conversion : dict of str to TemperatureConversion
+        Per temperature column ``(gain, offset[, "int16"])`` with
         ``T[°C] = gain · counts + offset`` for raw ADC temperatures (``int16``: signed
         16-bit counts stored unsigned).
-    extra : any other key-value pairs (kept through read/write round-trips).
+    extra : dict
+        Any other key-value pairs (kept through read/write round-trips).
     """
 
     sample_interval_s: float | None = None
@@ -92,7 +99,28 @@ class Metadata:
 
     @classmethod
     def from_dict(cls, d: dict[str, Any]) -> Metadata:
-        """Inverse of :meth:`to_dict`; unknown keys go to ``extra``."""
+        """Inverse of :meth:`to_dict`; unknown keys go to ``extra``.
+
+        Parameters
+        ----------
+        d : dict
+            A metadata mapping (a sidecar ``FILE.meta.json`` or a file's key-value store).
+
+        Returns
+        -------
+        Metadata
+
+        Raises
+        ------
+        ThermocalInputError
+            A malformed ``temperature_conversion`` entry.
+
+        Examples
+        --------
+        >>> m = Metadata.from_dict({"sample_interval_s": 0.01, "site": "lab 2"})
+        >>> m.sample_interval_s, m.extra
+        (0.01, {'site': 'lab 2'})
+        """
         known = {f.name for f in dataclasses.fields(cls)}
         kwargs: dict[str, Any] = {}
         extra = dict(d.get("extra", {}))
@@ -114,7 +142,17 @@ class Metadata:
         return cls(**kwargs, extra=extra)
 
     def merged(self, other: Metadata) -> Metadata:
-        """A copy of ``self`` with every field that ``other`` sets taken from ``other``."""
+        """A copy of ``self`` with every field that ``other`` sets taken from ``other``.
+
+        Parameters
+        ----------
+        other : Metadata
+            Metadata whose set fields win (dicts are merged key by key).
+
+        Returns
+        -------
+        Metadata
+        """
         out = dataclasses.replace(self)
         for f in dataclasses.fields(other):
             v = getattr(other, f.name)
@@ -156,6 +194,7 @@ class Problem:
     row: int | None = None
 
     def to_dict(self) -> dict[str, Any]:
+        """JSON-ready dict of the set fields."""
         return {k: v for k, v in dataclasses.asdict(self).items() if v is not None}
 
 
@@ -165,13 +204,25 @@ class Recording:
 
     Attributes
     ----------
-    time_s : sample times [s], float64, strictly increasing once validated.
-    columns : every non-time column as float64 arrays, by name.
-    units : unit string of each column (``""`` if unknown).
-    signals : names of the sensor-output columns (roles).
-    temperatures : names of the temperature columns (roles).
-    meta : :class:`Metadata`.
-    source : the file it was read from, if any.
+    time_s : numpy.ndarray
+        Sample times [s], float64, strictly increasing once validated.
+    columns : dict of str to numpy.ndarray
+        Every non-time column as float64 arrays, by name.
+    units : dict of str to str
+        Unit string of each column (``""`` if unknown).
+    signals : tuple of str
+        Names of the sensor-output columns (roles).
+    temperatures : tuple of str
+        Names of the temperature columns (roles).
+    meta : Metadata
+        What the test is.
+    source : str or None
+        The file it was read from, if any.
+    time_unit : str
+        Unit the file's time column was written in (``time_s`` is always in seconds).
+    unit_sources : dict of str to str
+        Where each column's unit came from (``option``, ``metadata``, ``column name``,
+        ``model`` or ``default``; ``"<time>"`` for the time column).
     """
 
     time_s: FloatArray
@@ -205,7 +256,49 @@ class Recording:
         other_units: dict[str, str] | None = None,
         meta: Metadata | None = None,
     ) -> Recording:
-        """Build a recording from arrays (all the same length)."""
+        """Build a recording from arrays, all the same length.
+
+        Parameters
+        ----------
+        time_s : array_like
+            Sample times [s].
+        signals : dict of str to array_like, optional
+            Sensor-output columns by name [``signal_unit``].
+        temperatures : dict of str to array_like, optional
+            Temperature columns by name [``temperature_unit``].
+        signal_unit : str or dict of str to str, optional
+            Unit of every signal, or per signal (default ``"deg/h"``).
+        temperature_unit : str, optional
+            Unit of the temperatures (default ``"degC"``; ``"counts"`` for raw ADC values).
+        other : dict of str to array_like, optional
+            Further columns without a role.
+        other_units : dict of str to str, optional
+            Their units (default ``""``, unknown).
+        meta : Metadata, optional
+            The recording's metadata (default empty).
+
+        Returns
+        -------
+        Recording
+
+        Raises
+        ------
+        ThermocalInputError
+            A column whose length differs from ``time_s``'s.
+        UnitError
+            An unknown unit.
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> t = np.arange(0.0, 10.0, 0.5)
+        >>> rec = Recording.from_arrays(t, {"gx": np.zeros(t.size)}, {"T": 25.0 + 0 * t},
+        ...                             signal_unit="deg/s")
+        >>> rec.n_samples, rec.sample_rate_hz, round(float(rec.signal("gx")[0][0]), 3)
+        (20, 2.0, 0.0)
+        >>> rec.signal("gx")[1]
+        'deg/h'
+        """
         t = np.asarray(time_s, dtype=np.float64)
         cols: dict[str, FloatArray] = {}
         unit_map: dict[str, str] = {}
@@ -239,10 +332,12 @@ class Recording:
 
     @property
     def n_samples(self) -> int:
+        """Number of samples."""
         return int(self.time_s.size)
 
     @property
     def duration_s(self) -> float:
+        """Time from the first to the last sample [s] (0 for fewer than 2 samples)."""
         return float(self.time_s[-1] - self.time_s[0]) if self.time_s.size > 1 else 0.0
 
     @property
@@ -255,15 +350,33 @@ class Recording:
 
     @property
     def sample_rate_hz(self) -> float:
+        """Nominal sample rate 1/τ [Hz] (NaN when τ is not positive)."""
         tau = self.sample_interval_s
         return 1.0 / tau if tau > 0 else float("nan")
 
     @property
     def name(self) -> str:
+        """The source file, else the run id, else ``"<recording>"``, for messages."""
         return self.source or self.meta.run_id or "<recording>"
 
     def column(self, name: str) -> FloatArray:
-        """A column by name; :class:`MissingColumnError` lists the available ones."""
+        """A column by name, as stored.
+
+        Parameters
+        ----------
+        name : str
+            The column.
+
+        Returns
+        -------
+        numpy.ndarray
+            Its values [its unit, :attr:`units`].
+
+        Raises
+        ------
+        MissingColumnError
+            No such column (the message lists the available ones).
+        """
         try:
             return self.columns[name]
         except KeyError:
@@ -275,8 +388,27 @@ class Recording:
     def signal(self, name: str | None = None) -> tuple[FloatArray, str]:
         """A signal in its canonical unit ([°/h] or [mg]) with that unit.
 
-        Raw ``counts`` are converted with the metadata's scale factor K when one
-        is given, otherwise returned as counts.
+        Raw ``counts`` are converted with the metadata's scale factor K when one is
+        given, otherwise returned as counts.
+
+        Parameters
+        ----------
+        name : str, optional
+            The signal column (default the first signal).
+
+        Returns
+        -------
+        values : numpy.ndarray
+            The signal [``unit``].
+        unit : str
+            ``"deg/h"``, ``"mg"`` or ``"counts"``.
+
+        Raises
+        ------
+        MissingColumnError
+            No such column, or no signal column at all.
+        UnitError
+            No unit is known for the column.
         """
         name = self._default(name, self.signals, "signal")
         values = self.column(name)
@@ -294,9 +426,29 @@ class Recording:
         return units.to_canonical(values, unit, f"{self.name}: signal column {name!r}")
 
     def temperature_c(self, name: str | None = None) -> FloatArray:
-        """A temperature column in [°C], converting raw counts with the metadata's
-        ``temperature_conversion`` (``T = gain·counts + offset``, int16 counts first made
-        signed)."""
+        r"""A temperature column in [°C].
+
+        Raw counts are converted with the metadata's ``temperature_conversion``
+        (:math:`T = \mathrm{gain}\cdot\mathrm{counts} + \mathrm{offset}`, int16 counts first
+        made signed).
+
+        Parameters
+        ----------
+        name : str, optional
+            The temperature column (default the first).
+
+        Returns
+        -------
+        numpy.ndarray
+            Temperatures [°C].
+
+        Raises
+        ------
+        MissingColumnError
+            No such column.
+        UnitError
+            No unit known, or raw counts without a conversion.
+        """
         name = self._default(name, self.temperatures, "temperature")
         values = self.column(name)
         unit = self.units.get(name)
@@ -314,8 +466,23 @@ class Recording:
         return units.temperature_conversion(conv).to_celsius(values, f"{self.name}: {name!r}")
 
     def temperature_counts(self, name: str) -> FloatArray:
-        """A raw-count temperature column as stored [counts], for models fitted in counts
-        (no conversion); a column in °C is a :class:`UnitError`."""
+        """A raw-count temperature column as stored, for models fitted in counts.
+
+        Parameters
+        ----------
+        name : str
+            The temperature column.
+
+        Returns
+        -------
+        numpy.ndarray
+            The column [counts], not converted.
+
+        Raises
+        ------
+        UnitError
+            The column is not in counts (e.g. in °C).
+        """
         unit = self.units.get(name)
         if not unit or units.normalize_temperature_unit(unit) != "counts":
             raise UnitError(
@@ -326,7 +493,25 @@ class Recording:
         return self.column(name)
 
     def temperatures_c(self, names: list[str] | tuple[str, ...] | None = None) -> FloatArray:
-        """Temperatures as an (n_samples, n_sensors) array [°C]."""
+        """Temperatures as an ``(n_samples, n_sensors)`` array [°C].
+
+        Parameters
+        ----------
+        names : sequence of str, optional
+            The columns, in order (default every temperature column).
+
+        Returns
+        -------
+        numpy.ndarray
+            Temperatures [°C]; a view of the column when there is one.
+
+        Raises
+        ------
+        MissingColumnError
+            No temperature column named.
+        UnitError
+            A column in counts without a conversion.
+        """
         names = tuple(names) if names is not None else self.temperatures
         if not names:
             raise MissingColumnError(f"{self.name}: no temperature columns named")
@@ -358,15 +543,45 @@ class Recording:
         return time_jitter(self.time_s)
 
     def gaps(self, factor: float = GAP_FACTOR) -> list[Gap]:
-        """Gaps in time (see :func:`find_gaps`)."""
+        """Gaps in time (:func:`find_gaps`).
+
+        Parameters
+        ----------
+        factor : float, optional
+            A step longer than this many nominal steps is a gap (default ``GAP_FACTOR``, 1.5).
+
+        Returns
+        -------
+        list of Gap
+        """
         return find_gaps(self.time_s, factor=factor, scan=self.time_scan())
 
     def segments(self, factor: float = GAP_FACTOR) -> list[slice]:
-        """Contiguous (gap-free) index ranges."""
+        """Contiguous (gap-free) index ranges (:func:`contiguous_slices`).
+
+        Parameters
+        ----------
+        factor : float, optional
+            A step longer than this many nominal steps is a gap (default 1.5).
+
+        Returns
+        -------
+        list of slice
+        """
         return contiguous_slices(self.time_s, factor=factor, scan=self.time_scan())
 
     def select(self, index: slice | npt.NDArray[np.bool_] | npt.NDArray[np.intp]) -> Recording:
-        """A recording of the selected rows (metadata and roles kept)."""
+        """A recording of the selected rows (metadata and roles kept).
+
+        Parameters
+        ----------
+        index : slice or numpy.ndarray of bool or int
+            The rows.
+
+        Returns
+        -------
+        Recording
+        """
         return dataclasses.replace(
             self,
             time_s=self.time_s[index],
@@ -374,7 +589,19 @@ class Recording:
         )
 
     def with_columns(self, new: dict[str, FloatArray], new_units: dict[str, str]) -> Recording:
-        """A copy with extra (or replaced) columns; roles unchanged."""
+        """A copy with extra (or replaced) columns; roles unchanged.
+
+        Parameters
+        ----------
+        new : dict of str to numpy.ndarray
+            The columns to add or replace.
+        new_units : dict of str to str
+            Their units.
+
+        Returns
+        -------
+        Recording
+        """
         cols = dict(self.columns)
         cols.update(new)
         u = dict(self.units)
@@ -382,10 +609,28 @@ class Recording:
         return dataclasses.replace(self, columns=cols, units=u)
 
     def validate(self, required: list[str] | None = None) -> None:
-        """Raise the first error of :func:`find_problems`; implausible values that are only
-        doubtful are emitted as :class:`PlausibilityWarning`, timestamp jitter
-        (:func:`time_jitter`) as a :class:`TimestampWarning` (other warnings, such as
-        gaps, are reported by the caller)."""
+        """Raise the first error of :func:`find_problems`, warn for the doubtful.
+
+        Implausible values that are only doubtful are emitted as
+        :class:`PlausibilityWarning`, timestamp jitter (:func:`time_jitter`) as a
+        :class:`TimestampWarning`; other warnings, such as gaps, are reported by the caller.
+
+        Parameters
+        ----------
+        required : list of str, optional
+            Columns that must be present.
+
+        Raises
+        ------
+        MissingColumnError
+            A required column is missing.
+        MissingValueError
+            NaN or empty values in a signal or temperature column.
+        TimestampError
+            Duplicate, backward or non-finite times.
+        ThermocalInputError
+            Any other error of :func:`find_problems`.
+        """
         problems = find_problems(self, required=required)
         for p in problems:
             if p.severity == "warning" and p.kind.startswith("implausible"):
@@ -412,8 +657,22 @@ DIFF_BLOCK = 1 << 18
 
 
 def time_steps(time_s: FloatArray, block: int = DIFF_BLOCK) -> Iterator[tuple[int, FloatArray]]:
-    """``(offset, Δt)`` blocks of the time steps ``t[i+1] − t[i]``, ``i = offset …``,
-    each at most ``block`` long: scans a long time column in constant extra memory."""
+    r"""Blocks of the time steps, in constant extra memory.
+
+    Parameters
+    ----------
+    time_s : numpy.ndarray
+        Sample times [s].
+    block : int, optional
+        Largest block length (default :data:`DIFF_BLOCK`).
+
+    Yields
+    ------
+    offset : int
+        Index i of the block's first step.
+    steps : numpy.ndarray
+        :math:`\Delta t_i = t_{i+1} - t_i` [s] for the block.
+    """
     n = int(time_s.size) - 1
     for a in range(0, max(n, 0), block):
         b = min(n, a + block)
@@ -448,10 +707,29 @@ class TimeScan:
 
 
 def scan_time(time_s: FloatArray) -> TimeScan:
-    """Scan a time column once, block by block (:func:`time_steps`, bounded memory): finite
-    or not, smallest and largest step, duplicates, backward steps and the interval
-    (:class:`TimeScan`).  The exact median is computed only when the grid is not regular
-    (the checks of a 10⁸-row file otherwise take six differences and four medians)."""
+    """Scan a time column once, block by block, with bounded memory.
+
+    Finds whether it is finite, its smallest and largest step, duplicates, backward
+    steps and the nominal interval (:class:`TimeScan`).  The exact median is computed
+    only when the grid is not regular (the checks of a 10⁸-row file otherwise take six
+    differences and four medians).
+
+    Parameters
+    ----------
+    time_s : numpy.ndarray
+        Sample times [s].
+
+    Returns
+    -------
+    TimeScan
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> sc = scan_time(np.array([0.0, 0.1, 0.2, 0.2, 0.4]))
+    >>> round(sc.interval_s, 3), sc.duplicate_rows.tolist()
+    (0.1, [2])
+    """
     n = int(time_s.size)
     empty = np.zeros(0, dtype=np.intp)
     nan = float("nan")
@@ -479,19 +757,53 @@ def scan_time(time_s: FloatArray) -> TimeScan:
 
 
 def median_interval(time_s: FloatArray) -> float:
-    """Nominal time step [s]: the median step, or the mean step on a regular grid where the
-    two agree to the rounding of the stamps (:func:`scan_time`); NaN for fewer than 2
-    samples."""
+    """Nominal time step: the median step, or the mean step on a regular grid.
+
+    On a regular grid the two agree to the rounding of the stamps (:func:`scan_time`).
+
+    Parameters
+    ----------
+    time_s : numpy.ndarray
+        Sample times [s].
+
+    Returns
+    -------
+    float
+        The nominal step [s]; NaN for fewer than 2 samples.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> median_interval(np.array([0.0, 1.0, 2.0, 5.0]))
+    1.0
+    """
     return scan_time(time_s).interval_s
 
 
 def find_gaps(
     time_s: FloatArray, factor: float = GAP_FACTOR, scan: TimeScan | None = None
 ) -> list[Gap]:
-    """Gaps: steps longer than ``factor`` × the nominal step (:func:`scan_time`; ``scan``
-    if the caller has it already).
+    """Gaps: steps longer than ``factor`` × the nominal step.
 
-    Returns one :class:`Gap` per gap, ``start_s`` measured from the first sample.
+    Parameters
+    ----------
+    time_s : numpy.ndarray
+        Sample times [s].
+    factor : float, optional
+        Gap threshold in nominal steps (default ``GAP_FACTOR``, 1.5).
+    scan : TimeScan, optional
+        :func:`scan_time` of ``time_s`` when the caller has it already.
+
+    Returns
+    -------
+    list of Gap
+        One per gap, ``start_s`` measured from the first sample [s].
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> find_gaps(np.array([0.0, 1.0, 2.0, 5.0, 6.0]))
+    [Gap(index=2, start_s=2.0, length_s=3.0)]
     """
     if time_s.size < 3:
         return []
@@ -511,7 +823,27 @@ def find_gaps(
 def contiguous_slices(
     time_s: FloatArray, factor: float = GAP_FACTOR, scan: TimeScan | None = None
 ) -> list[slice]:
-    """Index ranges between gaps (one slice for a gap-free recording)."""
+    """Index ranges between gaps (one slice for a gap-free recording).
+
+    Parameters
+    ----------
+    time_s : numpy.ndarray
+        Sample times [s].
+    factor : float, optional
+        Gap threshold in nominal steps (default 1.5).
+    scan : TimeScan, optional
+        :func:`scan_time` of ``time_s`` when known.
+
+    Returns
+    -------
+    list of slice
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> contiguous_slices(np.array([0.0, 1.0, 2.0, 5.0, 6.0]))
+    [slice(0, 3, None), slice(3, 5, None)]
+    """
     gaps = find_gaps(time_s, factor, scan)
     bounds = [0] + [g.index + 1 for g in gaps] + [int(time_s.size)]
     return [slice(a, b) for a, b in itertools.pairwise(bounds) if b > a]
@@ -546,6 +878,7 @@ class TimeJitter:
         return self.relative > JITTER_RELATIVE or self.n_same > 0
 
     def to_dict(self) -> dict[str, Any]:
+        """JSON-ready dict of the fields and :attr:`significant`."""
         return {**dataclasses.asdict(self), "significant": self.significant}
 
     def message(self) -> str:
@@ -563,13 +896,27 @@ class TimeJitter:
 
 
 def time_jitter(time_s: FloatArray) -> TimeJitter | None:
-    """The jitter of a time column's steps (:class:`TimeJitter`), measured on its first
-    :data:`JITTER_STEPS` steps; None for fewer than 3 samples, a time that is not finite,
-    or steps that go backwards (refused elsewhere).
+    r"""The jitter of a time column's steps, measured on its first :data:`JITTER_STEPS` steps.
 
-    ``relative = (P95(Δt) − P5(Δt)) / (2 · median(Δt))``: for a regular grid 0; for host
-    timestamps of a Bluetooth link whose latency scatters uniformly over ±30 % of the
-    period, 0.27 (the 5–95 % range of a uniform ±30 % is ±27 %)."""
+    Parameters
+    ----------
+    time_s : numpy.ndarray
+        Sample times [s].
+
+    Returns
+    -------
+    TimeJitter or None
+        None for fewer than 3 samples, a time that is not finite, or steps that go
+        backwards (refused elsewhere).
+
+    Notes
+    -----
+    .. math::
+        \mathrm{relative} = \frac{P_{95}(\Delta t) - P_{5}(\Delta t)}{2\,\mathrm{median}(\Delta t)}
+
+    0 for a regular grid; 0.27 for host timestamps of a link whose latency scatters
+    uniformly over ±30 % of the period (the 5–95 % range of a uniform ±30 % is ±27 %).
+    """
     t = time_s[: JITTER_STEPS + 1]
     if t.size < 3 or not all_finite(t):
         return None
@@ -593,23 +940,41 @@ LATENCY_WINDOW = 32
 
 
 def nominal_time(time_s: FloatArray, rate_hz: float) -> tuple[FloatArray, int]:
-    """Host timestamps replaced by the sensor's nominal grid, and the samples found lost.
+    r"""Host timestamps replaced by the sensor's nominal grid, and the samples found lost.
 
-    A host stamps each sample at its arrival, ``t_i = T_0 + (i + k_i)/r + ℓ_i`` with the
-    latency ``ℓ_i ≥ 0`` and ``k_i`` the samples lost before sample ``i`` (non-decreasing).
-    In the offsets ``o_i = (t_i − t_0)·r − i`` a burst of late samples only rises above
-    the latency floor; a lost sample lifts the floor by one period.  At each step ``i``
-    the floor after it, the suffix minimum ``m_{i+1} = min_{j>i} o_j``, is compared with
-    the floor before it, ``q_i = min(o_{i−W+1} … o_i)`` (``W`` = :data:`LATENCY_WINDOW`);
-    where ``m_{i+1} − q_i``, less the samples already counted lost within the window,
-    exceeds :data:`LOST_SAMPLE_JUMP`, ``round`` of it is lost there, when sample ``i + 1``
-    itself lies that many periods up (within half that margin): a sample that only came
-    late, just before a loss or at the end, is not taken for the loss.  Within a burst
-    (samples delivered at one instant) next to a loss the stamps cannot tell a late sample
-    before the loss from one after it: such samples may be placed one period off.  A slow
-    drift of the host's clock against the sensor's (``W`` samples of it are far below one
-    period) adds none.  Returns ``t'_i = t_0 + (m_0 + i + k_i)/r`` [s] and the total lost.  The
-    input must be finite, in seconds, with at least 2 samples.
+    A host stamps each sample at its arrival, :math:`t_i = T_0 + (i + k_i)/r + \ell_i`
+    with the latency :math:`\ell_i \ge 0` and :math:`k_i` the samples lost before sample
+    i (non-decreasing).  In the offsets :math:`o_i = (t_i - t_0) r - i` a burst of late
+    samples only rises above the latency floor; a lost sample lifts the floor by one
+    period.  At each step i the floor after it, :math:`m_{i+1} = \min_{j>i} o_j`, is
+    compared with the floor before it, :math:`q_i = \min(o_{i-W+1} \ldots o_i)`
+    (W = :data:`LATENCY_WINDOW`); where :math:`m_{i+1} - q_i`, less the samples already
+    counted lost within the window, exceeds :data:`LOST_SAMPLE_JUMP`, its rounding is
+    lost there, when sample i + 1 itself lies that many periods up (within half that
+    margin).  Within a burst next to a loss a sample may be placed one period off; a
+    slow drift of the host's clock adds none.
+
+    Parameters
+    ----------
+    time_s : numpy.ndarray
+        Host timestamps [s], finite, at least 2.
+    rate_hz : float
+        The sensor's nominal sample rate r [Hz].
+
+    Returns
+    -------
+    time_s : numpy.ndarray
+        :math:`t'_i = t_0 + (m_0 + i + k_i)/r` [s].
+    n_lost : int
+        Total samples found lost.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> t = np.array([0.0, 0.01, 0.02, 0.04, 0.05]) + np.array([0, 3, 0, 2, 0]) * 1e-3
+    >>> new, lost = nominal_time(t, 100.0)
+    >>> np.round(new, 3).tolist(), lost
+    ([0.0, 0.01, 0.02, 0.04, 0.05], 1)
     """
     n = int(time_s.size)
     i = np.arange(n, dtype=np.float64)
@@ -674,9 +1039,20 @@ def _jitter_problems(t: FloatArray, found: list[Problem]) -> list[Problem]:
 def find_problems(rec: Recording, required: list[str] | None = None) -> list[Problem]:
     """Everything wrong with a recording, errors first, without raising.
 
-    Checks: required columns present; time finite, strictly increasing (duplicate
-    and backwards steps named by row); NaN counts per column with the first row;
-    gaps (warning); unknown unit strings; fewer than 2 samples.
+    Checks: required columns present; time finite, strictly increasing (duplicate and
+    backwards steps named by row); NaN counts per column with the first row; gaps
+    (warning); unknown unit strings; fewer than 2 samples.
+
+    Parameters
+    ----------
+    rec : Recording
+        The recording.
+    required : list of str, optional
+        Columns that must be present.
+
+    Returns
+    -------
+    list of Problem
     """
     probs: list[Problem] = []
     for name in required or []:
@@ -814,17 +1190,40 @@ MEDIAN_BLOCK = 1 << 18
 def median_in_blocks(
     values: Callable[[int, int], FloatArray], n: int, block: int = MEDIAN_BLOCK
 ) -> float:
-    """``np.median`` of ``n`` values that ``values(a, b)`` computes block by block (rows
-    a … b − 1), exactly (the same bits), with memory of a few blocks instead of the
-    whole array.
+    """The exact median of ``n`` values computed block by block, in bounded memory.
 
-    Selection by bracketing (Floyd & Rivest 1975, "Expected time bounds for selection"):
-    a strided sample of ≈ 65 536 values gives bounds ``lo ≤ hi`` around its median; one
-    pass counts the values below ``lo`` and keeps those within ``[lo, hi]``; when the
-    middle order statistic(s) ``(n − 1)//2`` and ``n//2`` fall among the kept ones they
-    are selected there (``np.partition``), their mean is the median as ``np.median``
-    forms it.  Otherwise the bracket is widened (three tries), and at last the whole
-    array is built.  NaN-free values are assumed (the caller checks).
+    Selection by bracketing: a strided sample of ≈ 65 536 values gives bounds
+    ``lo ≤ hi`` around its median; one pass counts the values below ``lo`` and keeps
+    those within ``[lo, hi]``; when the middle order statistic(s) ``(n − 1)//2`` and
+    ``n//2`` fall among the kept ones they are selected there (``np.partition``), their
+    mean is the median as ``np.median`` forms it (the same bits).  Otherwise the bracket
+    is widened (three tries), and at last the whole array is built.
+
+    Parameters
+    ----------
+    values : callable
+        ``values(a, b)`` returns rows ``a … b − 1`` (NaN-free; the caller checks).
+    n : int
+        Number of values.
+    block : int, optional
+        Rows per block (default :data:`MEDIAN_BLOCK`).
+
+    Returns
+    -------
+    float
+        ``np.median`` of the n values [their unit].
+
+    References
+    ----------
+    - R. W. Floyd and R. L. Rivest, "Expected time bounds for selection",
+      Communications of the ACM 18(3), pp. 165-172, 1975.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> x = np.arange(11.0)
+    >>> median_in_blocks(lambda a, b: x[a:b], 11, block=2)
+    5.0
     """
     if n <= 4 * block:
         return float(np.median(values(0, n), overwrite_input=True))
@@ -859,8 +1258,26 @@ def median_in_blocks(
 
 
 def all_finite(arr: npt.NDArray[np.float64]) -> bool:
-    """Every element finite, without a mask as long as the array on the usual path: the
-    sum is finite exactly when every element is (or it overflowed: then the mask)."""
+    """Every element finite, without a full-size mask on the usual path.
+
+    The sum is finite exactly when every element is (or it overflowed: then the mask).
+
+    Parameters
+    ----------
+    arr : numpy.ndarray
+        Values.
+
+    Returns
+    -------
+    bool
+        True for an empty array.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> all_finite(np.array([1.0, np.nan])), all_finite(np.array([1e308, 1e308]))
+    (False, True)
+    """
     if arr.size == 0:
         return True
     with np.errstate(over="ignore", invalid="ignore"):
@@ -870,7 +1287,19 @@ def all_finite(arr: npt.NDArray[np.float64]) -> bool:
 
 
 def is_increasing(t: FloatArray, block: int = DIFF_BLOCK) -> bool:
-    """``t`` strictly increasing, checked in blocks (a few bytes a row of one block)."""
+    """Whether ``t`` is strictly increasing, checked in blocks.
+
+    Parameters
+    ----------
+    t : numpy.ndarray
+        Sample times [s].
+    block : int, optional
+        Rows per block (default :data:`DIFF_BLOCK`).
+
+    Returns
+    -------
+    bool
+    """
     for a in range(0, max(t.size - 1, 0), block):
         if not bool(np.all(np.diff(t[a : a + block + 1]) > 0)):
             return False
@@ -878,9 +1307,22 @@ def is_increasing(t: FloatArray, block: int = DIFF_BLOCK) -> bool:
 
 
 def finite_extrema(arr: FloatArray, block: int = DIFF_BLOCK) -> Extrema | None:
-    """:class:`Extrema` of the finite values of ``arr`` (None when there is none),
-    scanned in blocks of ``block`` rows: a few bytes of working memory per row of a
-    block, none per row of the column."""
+    """:class:`Extrema` of the finite values of an array, scanned in blocks.
+
+    A few bytes of working memory per row of a block, none per row of the column.
+
+    Parameters
+    ----------
+    arr : numpy.ndarray
+        Values [any unit].
+    block : int, optional
+        Rows per block (default :data:`DIFF_BLOCK`).
+
+    Returns
+    -------
+    Extrema or None
+        None when there is no finite value.
+    """
     best: list[Any] = [math.inf, -1, -math.inf, -1, 0]
     for a in range(0, arr.size, block):
         part = arr[a : a + block]
@@ -1058,12 +1500,21 @@ def _count_problems(rec: Recording, name: str) -> list[Problem]:
 
 
 def plausibility_problems(rec: Recording) -> list[Problem]:
-    """Values no sensor or chamber produces, named by column, value and row .
+    """Values no sensor or chamber produces, named by column, value and row.
 
-    Temperatures (in °C, after a counts conversion where one is given): below absolute
-    zero is an error; outside −100…+200 °C a warning (with the likely cause: kelvin,
-    raw ADC counts).  Signals, converted to their canonical unit: a magnitude beyond
-    :data:`PLAUSIBLE_SIGNAL`, or one that overflows on conversion, is an error.
+    Temperatures (in °C, after a counts conversion where one is given): below
+    absolute zero is an error; outside −100…+200 °C a warning (with the likely cause:
+    kelvin, raw ADC counts).  Signals, converted to their canonical unit: a magnitude
+    beyond :data:`PLAUSIBLE_SIGNAL`, or one that overflows on conversion, is an error.
+
+    Parameters
+    ----------
+    rec : Recording
+        The recording.
+
+    Returns
+    -------
+    list of Problem
     """
     probs: list[Problem] = []
     n = rec.n_samples

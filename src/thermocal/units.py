@@ -154,7 +154,28 @@ _ANGLE_ALIASES: Final = {
 
 
 def normalize_signal_unit(unit: str) -> str:
-    """Return the canonical spelling of a signal unit, or raise :class:`UnitError`."""
+    """The canonical spelling of a signal unit.
+
+    Parameters
+    ----------
+    unit : str
+        A rate, acceleration or raw unit, or an alias (``"°/s"``, ``"dps"`` …).
+
+    Returns
+    -------
+    str
+        A key of :data:`SIGNAL_UNITS` (``"deg/s"``, ``"mg"``, ``"counts"`` …).
+
+    Raises
+    ------
+    UnitError
+        An unknown unit (the message lists the known ones).
+
+    Examples
+    --------
+    >>> normalize_signal_unit("deg/s")
+    'deg/s'
+    """
     u = unit.strip()
     if u in SIGNAL_UNITS:
         return u
@@ -165,7 +186,23 @@ def normalize_signal_unit(unit: str) -> str:
 
 
 def normalize_angle_unit(unit: str) -> str:
-    """Return ``'deg'`` or ``'rad'`` (an encoder angle's unit), or raise :class:`UnitError`."""
+    """The canonical spelling of an encoder angle's unit.
+
+    Parameters
+    ----------
+    unit : str
+        ``"deg"``, ``"rad"`` or an alias (``"°"``, ``"degrees"``, ``"radians"``).
+
+    Returns
+    -------
+    str
+        ``"deg"`` or ``"rad"``.
+
+    Raises
+    ------
+    UnitError
+        An unknown unit.
+    """
     u = unit.strip().lower()
     alias = u if u in ANGLE_UNITS else _ANGLE_ALIASES.get(u)
     if alias is None:
@@ -174,7 +211,30 @@ def normalize_angle_unit(unit: str) -> str:
 
 
 def angle_to_deg(values: npt.ArrayLike, unit: str) -> npt.NDArray[np.float64]:
-    """An angle in ``unit`` (:data:`ANGLE_UNITS`) in [°]: ``θ[°] = θ[unit] · factor``."""
+    r"""An angle in degrees.
+
+    Parameters
+    ----------
+    values : array_like
+        Angles [``unit``].
+    unit : str
+        A unit of :data:`ANGLE_UNITS` or an alias.
+
+    Returns
+    -------
+    numpy.ndarray
+        :math:`\theta[°] = \theta[\mathrm{unit}] \cdot \mathrm{factor}` [°].
+
+    Raises
+    ------
+    UnitError
+        An unknown unit.
+
+    Examples
+    --------
+    >>> round(float(angle_to_deg(3.141592653589793, "rad")[()]), 6)
+    180.0
+    """
     out: npt.NDArray[np.float64] = (
         np.asarray(values, dtype=np.float64) * ANGLE_UNITS[normalize_angle_unit(unit)]
     )
@@ -182,7 +242,23 @@ def angle_to_deg(values: npt.ArrayLike, unit: str) -> npt.NDArray[np.float64]:
 
 
 def normalize_temperature_unit(unit: str) -> str:
-    """Return ``'degC'`` or ``'counts'``, or raise :class:`UnitError`."""
+    """The canonical spelling of a temperature unit.
+
+    Parameters
+    ----------
+    unit : str
+        ``"degC"``, ``"counts"`` or an alias (``"°C"``, ``"C"`` …).
+
+    Returns
+    -------
+    str
+        ``"degC"`` or ``"counts"``.
+
+    Raises
+    ------
+    UnitError
+        An unknown unit.
+    """
     alias = _TEMP_ALIASES.get(unit.strip().lower())
     if alias is None:
         raise UnitError(
@@ -192,7 +268,23 @@ def normalize_temperature_unit(unit: str) -> str:
 
 
 def normalize_time_unit(unit: str) -> str:
-    """Return ``'s'``, ``'ms'`` or ``'us'``, or raise :class:`UnitError`."""
+    """The canonical spelling of a time unit.
+
+    Parameters
+    ----------
+    unit : str
+        ``"s"``, ``"ms"``, ``"us"`` (``"µs"`` accepted).
+
+    Returns
+    -------
+    str
+        A key of :data:`TIME_UNITS`.
+
+    Raises
+    ------
+    UnitError
+        An unknown unit.
+    """
     u = unit.strip().lower().replace("µ", "u")
     if u in TIME_UNITS:
         return u
@@ -224,8 +316,32 @@ class TemperatureConversion(NamedTuple):
     encoding: str = "plain"
 
     def to_celsius(self, counts: npt.ArrayLike, where: str = "") -> npt.NDArray[np.float64]:
-        """Temperatures [°C] of raw counts (an ``int16`` count outside −32768…65535 is a
-        :class:`UnitError` naming ``where``)."""
+        r"""Temperatures of raw counts.
+
+        Parameters
+        ----------
+        counts : array_like
+            Raw counts as stored [counts].
+        where : str, optional
+            The column, named in messages.
+
+        Returns
+        -------
+        numpy.ndarray
+            :math:`T = \mathrm{gain}\cdot v + \mathrm{offset}` [°C].
+
+        Raises
+        ------
+        UnitError
+            An ``int16`` count outside −32768…65535, or a value that overflows.
+
+        Examples
+        --------
+        >>> TemperatureConversion(0.0625, -50.0).to_celsius([800.0]).tolist()
+        [0.0]
+        >>> TemperatureConversion(0.01, 0.0, "int16").to_celsius([65436.0]).tolist()
+        [-1.0]
+        """
         v = np.asarray(counts, dtype=np.float64)
         if self.encoding == "int16":
             bad = np.isfinite(v) & ((v < -INT16_SIGN_BIT) | (v >= UINT16_MODULUS))
@@ -242,6 +358,7 @@ class TemperatureConversion(NamedTuple):
         return out
 
     def to_json(self) -> list[float | str]:
+        """The file form ``[gain, offset]`` or ``[gain, offset, "int16"]``."""
         out: list[float | str] = [float(self.gain), float(self.offset)]
         if self.encoding != "plain":
             out.append(self.encoding)
@@ -257,9 +374,31 @@ class TemperatureConversion(NamedTuple):
 def temperature_conversion(
     value: object, what: str = "temperature conversion"
 ) -> TemperatureConversion:
-    """A :class:`TemperatureConversion` from ``(gain, offset[, encoding])`` (tuple, list, the
-    file form) or the text ``"GAIN,OFFSET[,int16]"``; a :class:`UnitError` naming ``what``
-    when it is neither, or the gain is zero or not finite."""
+    """A :class:`TemperatureConversion` from its file form or its text.
+
+    Parameters
+    ----------
+    value : object
+        ``(gain, offset[, encoding])`` as a tuple or list (the file form), a
+        :class:`TemperatureConversion`, or the text ``"GAIN,OFFSET[,int16]"``;
+        gain [°C/count], offset [°C].
+    what : str, optional
+        What is being read, named in messages.
+
+    Returns
+    -------
+    TemperatureConversion
+
+    Raises
+    ------
+    UnitError
+        Neither form, an unknown encoding, or a gain that is zero or not finite.
+
+    Examples
+    --------
+    >>> temperature_conversion("0.0625,-50,int16")
+    TemperatureConversion(gain=0.0625, offset=-50.0, encoding='int16')
+    """
     if isinstance(value, TemperatureConversion):
         return value
     parts: list[Any]
@@ -360,8 +499,25 @@ def unit_in_column_name(name: str, role: UnitRole) -> str | None:
 
     Recognised: a trailing bracket (``time (ms)``, ``gx [deg/s]``, ``temp [°C]``) and a
     last word after a space or underscore (``gyrox rad/s``, ``time_ms``,
-    ``temp_counts``), when that word is a unit of the column's role (time, signal or
-    temperature).  A name that is only a unit (``g``) or has no unit (``T1``) gives None.
+    ``temp_counts``), when that word is a unit of the column's role.  A name that is
+    only a unit (``g``) or has no unit (``T1``) gives None.
+
+    Parameters
+    ----------
+    name : str
+        The column name.
+    role : {"time", "signal", "temperature", "angle"}
+        The column's role; only that role's units are recognised.
+
+    Returns
+    -------
+    str or None
+        The canonical unit.
+
+    Examples
+    --------
+    >>> unit_in_column_name("gx [deg/s]", "signal"), unit_in_column_name("T1", "temperature")
+    ('deg/s', None)
     """
     norm = _normalizer(role)
     text = name.strip()
@@ -379,18 +535,48 @@ def unit_in_column_name(name: str, role: UnitRole) -> str | None:
 
 
 def other_column_unit(column: str, metadata: str | None) -> str:
-    """The unit of a column outside the signal and temperature roles (an accelerometer triad
-    read beside the gyros, an auxiliary channel): the file's metadata, else a signal unit
-    written in the column's name (rate, acceleration, raw), else ``""`` — the resolver's
-    order without its last step: nothing is assumed for such a column."""
+    """The unit of a column outside the signal and temperature roles.
+
+    An accelerometer triad read beside the gyros, an auxiliary channel: the file's
+    metadata, else a signal unit written in the column's name, else ``""`` — nothing is
+    assumed for such a column.
+
+    Parameters
+    ----------
+    column : str
+        The column name.
+    metadata : str or None
+        The unit the file's metadata states.
+
+    Returns
+    -------
+    str
+        The unit, or ``""`` when none is stated.
+    """
     if metadata:
         return metadata
     return unit_in_column_name(column, "signal") or ""
 
 
 def strip_unit_from_name(name: str) -> str:
-    """The column name without a trailing unit written in brackets or as its last word
-    (``time (ms)`` → ``time``, ``time_s`` → ``time``); unchanged when there is none."""
+    """The column name without a trailing unit.
+
+    Parameters
+    ----------
+    name : str
+        The column name (``time (ms)``, ``time_s``).
+
+    Returns
+    -------
+    str
+        The name without a unit written in brackets or as its last word; unchanged
+        when there is none.
+
+    Examples
+    --------
+    >>> strip_unit_from_name("time (ms)"), strip_unit_from_name("time_s")
+    ('time', 'time')
+    """
     text = name.strip()
     m = _bracket_unit(text)
     if m and text[: m[0]].strip():
@@ -403,7 +589,15 @@ def strip_unit_from_name(name: str) -> str:
 
 @dataclass(frozen=True)
 class ResolvedUnit:
-    """A column's unit and where it came from (``option`` … ``default``)."""
+    """A column's unit and where it came from.
+
+    Attributes
+    ----------
+    unit : str
+        The canonical unit.
+    source : {"option", "metadata", "column name", "model", "default"}
+        Where it came from.
+    """
 
     unit: str
     source: UnitSource
@@ -422,17 +616,40 @@ def resolve_unit(
     ask: str | None = None,
     implied: str | None = None,
 ) -> ResolvedUnit:
-    """The unit of ``column``, resolved once, in this order: command-line option
-    > the file's own metadata > units in the column name > the units recorded in the model
-    file > a default (``default``, else :data:`DEFAULT_UNITS`), the last stated in a
-    :class:`UnitWarning`.  An option that contradicts the file's metadata wins, with a
-    warning naming both (``option_name``: the option as the user wrote it); so does one that
-    contradicts the unit written in the column's name (``--time-unit s`` on ``time (ms)``).
-    With ``ask`` (an option's name, e.g. ``--accel-unit``) a unit nobody stated is not
-    assumed: a :class:`UnitError` asks for that option.  With ``implied`` (a unit another
-    option implies: raw ``counts`` where ``multipos --accel-scale`` gives one count's size)
-    a unit nobody stated is that one, without a warning.  This is the only place in
-    thermocal that chooses a unit nobody stated.
+    """The unit of a column, resolved once; the only place that chooses an unstated unit.
+
+    Order: option > the file's own metadata > the unit in the column name > the unit
+    recorded in the model file > ``default`` (else :data:`DEFAULT_UNITS`), the last
+    stated in a :class:`UnitWarning`.  An option that contradicts the metadata or the
+    column name wins, with a warning naming both.
+
+    Parameters
+    ----------
+    column : str
+        The column name.
+    role : {"time", "signal", "temperature", "angle"}
+        The column's role.
+    option, metadata, model, default : str, optional
+        The unit the command line, the file's metadata, the model file and the caller
+        state (None: not stated).
+    where : str, optional
+        The file, named in messages.
+    option_name : str, optional
+        The option as the user wrote it, for messages.
+    ask : str, optional
+        An option's name: a unit nobody stated is refused, asking for it.
+    implied : str, optional
+        A unit another option implies (raw ``counts`` with a count scale), taken
+        without a warning when nobody states one.
+
+    Returns
+    -------
+    ResolvedUnit
+
+    Raises
+    ------
+    UnitError
+        An unknown unit, or no unit stated with ``ask``.
     """
     norm = _normalizer(role)
     prefix = f"{where}: " if where else ""
@@ -486,8 +703,15 @@ def resolve_unit(
 
 @dataclass(frozen=True)
 class ResolvedConversion:
-    """The raw-count conversion of a temperature column and where it came from (``none``:
-    no conversion is stated anywhere)."""
+    """The raw-count conversion of a temperature column and where it came from.
+
+    Attributes
+    ----------
+    conversion : TemperatureConversion or None
+        The conversion; None when none is stated anywhere.
+    source : {"option", "metadata", "model", "none"}
+        Where it came from.
+    """
 
     conversion: TemperatureConversion | None
     source: ConversionSource
@@ -501,9 +725,25 @@ def resolve_temperature_conversion(
     model: TemperatureConversion | None = None,
     where: str = "",
 ) -> ResolvedConversion:
-    """The counts → °C conversion of a raw-count temperature column: ``--temp-conversion``
-    > the file's metadata > the conversion recorded in the model file > none.  An option
-    that contradicts the file's metadata wins, with a :class:`UnitWarning` naming both."""
+    """The counts → °C conversion of a raw-count temperature column.
+
+    Order: option > the file's metadata > the conversion recorded in the model file >
+    none.  An option that contradicts the file's metadata wins, with a
+    :class:`UnitWarning` naming both.
+
+    Parameters
+    ----------
+    column : str
+        The temperature column.
+    option, metadata, model : TemperatureConversion, optional
+        The conversion the command line, the file's metadata and the model file state.
+    where : str, optional
+        The file, named in messages.
+
+    Returns
+    -------
+    ResolvedConversion
+    """
     if option is not None:
         if metadata is not None and tuple(metadata) != tuple(option):
             warnings.warn(
@@ -526,8 +766,18 @@ def resolve_temperature_conversion(
 class UnitOptions:
     """What the command line says about units (``None``: the option was not given).
 
-    ``signal_unit`` is one unit for every signal or ``U1,…,Un``, one per signal;
-    ``temp_conversion`` applies to every temperature column and implies raw counts.
+    Attributes
+    ----------
+    time_unit, temp_unit : str or None
+        Unit of the time column and of every temperature column.
+    signal_unit : str or None
+        One unit for every signal, or ``U1,…,Un``, one per signal.
+    temp_conversion : TemperatureConversion or None
+        Applies to every temperature column and implies raw counts.
+    ask : mapping of str to str
+        Signal column → the option to ask for when nothing states its unit.
+    implied : mapping of str to str
+        Signal column → the unit another option implies when nothing states one.
     """
 
     time_unit: str | None = None
@@ -544,13 +794,22 @@ class UnitOptions:
 
 @dataclass(frozen=True)
 class StatedUnits:
-    """Units a source states about columns: a data file's own metadata (sidecar or Parquet
-    key-value, :meth:`from_file_info`) or a model file's record of its inputs
-    (:meth:`from_model_inputs`).
+    """Units a source states about columns.
 
-    ``signal_default`` (models only) is the model's canonical signal unit: the default,
-    stated in a warning, for data whose signal unit nothing states (older model files that
-    did not record the unit as given).
+    A data file's own metadata (sidecar or Parquet key-value, :meth:`from_file_info`)
+    or a model file's record of its inputs (:meth:`from_model_inputs`).
+
+    Attributes
+    ----------
+    time_unit : str or None
+        Unit of the time column.
+    columns : mapping of str to str
+        Column → unit.
+    conversions : mapping of str to TemperatureConversion
+        Temperature column → raw-count conversion.
+    signal_default : str or None
+        Models only: the model's canonical signal unit, the stated default for data
+        whose signal unit nothing states (older model files).
     """
 
     time_unit: str | None = None
@@ -560,8 +819,25 @@ class StatedUnits:
 
     @classmethod
     def from_file_info(cls, info: Mapping[str, Any], where: str = "") -> StatedUnits:
-        """From a recording's metadata object (``time_unit``, ``signals``, ``temperatures``,
-        ``units``, ``metadata.temperature_conversion``; see :mod:`thermocal.readers`)."""
+        """The units a recording's metadata object states.
+
+        Parameters
+        ----------
+        info : mapping
+            ``time_unit``, ``signals``, ``temperatures``, ``units`` and
+            ``metadata.temperature_conversion`` (see :mod:`thermocal.readers`).
+        where : str, optional
+            The file, named in messages.
+
+        Returns
+        -------
+        StatedUnits
+
+        Raises
+        ------
+        UnitError
+            A malformed temperature conversion.
+        """
         cols: dict[str, str] = {}
         for key in ("units", "temperatures", "signals"):  # later keys win
             part = info.get(key) or {}
@@ -580,8 +856,20 @@ class StatedUnits:
     def from_model_inputs(
         cls, inputs: Mapping[str, Any], *, signal_default: str | None = None
     ) -> StatedUnits:
-        """From a model file's ``inputs`` (format version ≥ 2; empty for older files, whose
-        units are then unknown and fall to the stated default)."""
+        """The units a model file's ``inputs`` record states.
+
+        Parameters
+        ----------
+        inputs : mapping
+            The model's ``inputs`` (format version ≥ 2; empty for older files, whose units
+            then fall to the stated default).
+        signal_default : str, optional
+            The model's canonical signal unit.
+
+        Returns
+        -------
+        StatedUnits
+        """
         units_ = inputs.get("units") or {}
         conv = {
             str(k): temperature_conversion(v, f"model inputs: temperature_conversion of {k!r}")
@@ -598,8 +886,17 @@ class StatedUnits:
 
 @dataclass(frozen=True)
 class ResolvedInputs:
-    """Every unit of a recording's used columns, each with its source, and the raw-count
-    conversion of every temperature column (:func:`resolve_inputs`)."""
+    """Every unit of a recording's used columns, each with its source.
+
+    Attributes
+    ----------
+    time : ResolvedUnit
+        The time column's unit.
+    signals, temperatures : mapping of str to ResolvedUnit
+        Each signal's and temperature's unit.
+    conversions : mapping of str to ResolvedConversion
+        Each temperature column's raw-count conversion.
+    """
 
     time: ResolvedUnit
     signals: Mapping[str, ResolvedUnit]
@@ -626,7 +923,25 @@ class ResolvedInputs:
 
 
 def per_signal_option(option: str | None, signals: Sequence[str]) -> dict[str, str | None]:
-    """``--signal-unit``: one unit for every signal, or one per signal (comma-separated)."""
+    """One unit for every signal, or one per signal (comma-separated).
+
+    Parameters
+    ----------
+    option : str or None
+        ``"U"`` or ``"U1,…,Un"``.
+    signals : sequence of str
+        The signal columns.
+
+    Returns
+    -------
+    dict of str to str or None
+        Signal → its unit (None when ``option`` is not given).
+
+    Raises
+    ------
+    UnitError
+        A number of units that is neither 1 nor the number of signals.
+    """
     return _per_signal(option, signals)
 
 
@@ -654,13 +969,34 @@ def resolve_inputs(
     model: StatedUnits | None = None,
     where: str = "",
 ) -> ResolvedInputs:
-    """Resolve, once, the time unit, every signal's and temperature's unit and every
-    temperature's raw-count conversion of a recording:
-    command-line option > the file's own metadata > units written in the column name >
-    the units recorded in the model file > a default stated in a :class:`UnitWarning`.
+    """Resolve, once, every unit and raw-count conversion of a recording's used columns.
 
-    ``--temp-conversion`` says the temperatures are raw counts (with ``--temp-unit degC``
-    it is a contradiction, refused).  Pure: no file is read here.
+    Order: option > the file's own metadata > units written in the column name > the
+    units recorded in the model file > a default stated in a :class:`UnitWarning`
+    (:func:`resolve_unit`).  A temperature conversion says the temperatures are raw
+    counts.  Pure: no file is read here.
+
+    Parameters
+    ----------
+    time_column : str
+        The time column.
+    signals, temperatures : sequence of str
+        The signal and temperature columns.
+    options : UnitOptions, optional
+        What the command line says.
+    file, model : StatedUnits, optional
+        What the data file's metadata and the model file state.
+    where : str, optional
+        The file, named in messages.
+
+    Returns
+    -------
+    ResolvedInputs
+
+    Raises
+    ------
+    UnitError
+        An unknown unit, or a conversion given with temperatures stated in °C.
     """
     opt = options or UnitOptions()
     fil = file or StatedUnits()
@@ -723,7 +1059,28 @@ def resolve_inputs(
 
 
 def signal_kind(unit: str) -> SignalKind:
-    """Kind of a signal unit: ``'rate'`` (gyro), ``'accel'`` or ``'raw'``."""
+    """Kind of a signal unit.
+
+    Parameters
+    ----------
+    unit : str
+        A signal unit or alias.
+
+    Returns
+    -------
+    str
+        ``"rate"`` (gyro), ``"accel"`` or ``"raw"``.
+
+    Raises
+    ------
+    UnitError
+        An unknown unit.
+
+    Examples
+    --------
+    >>> signal_kind("deg/s"), signal_kind("g"), signal_kind("counts")
+    ('rate', 'accel', 'raw')
+    """
     u = normalize_signal_unit(unit)
     if u in RATE_UNITS:
         return "rate"
@@ -748,17 +1105,31 @@ def refuse_overflow(
     where: str = "",
     first_row: int = 0,
 ) -> None:
-    """Refuse (:class:`UnitError`, exit 2) a conversion that made a finite value
-    non-finite (a float64 overflow: |x| > 1.8e308), naming ``where`` (the column), the
-    first such row (``first_row`` + index, rows of a 2-D array by its first axis) and the
-    value before and after.
+    """Refuse a conversion that made a finite value non-finite.
 
-    Cheap on the usual path: the sum of ``out`` is finite exactly when every element is
-    (an infinite or NaN term makes it non-finite; a finite overflow of the sum sends it to
-    the block scan, which then finds nothing); no copy is made.  Only when it is not are
-    ``out`` and ``values`` scanned, in blocks of :data:`OVERFLOW_SCAN_BLOCK`, for a
-    non-finite output whose input was finite (a NaN or infinity already in the data is
-    not the conversion's doing and is left to the callers' gap handling)."""
+    Cheap on the usual path: the sum of ``out`` is finite exactly when every element
+    is; no copy is made.  Only when it is not are ``out`` and ``values`` scanned, in
+    blocks of :data:`OVERFLOW_SCAN_BLOCK`, for a non-finite output whose input was
+    finite (a NaN or infinity already in the data is left to the callers).
+
+    Parameters
+    ----------
+    out : numpy.ndarray
+        The converted values.
+    values : numpy.ndarray
+        The values before conversion (broadcast to ``out``'s shape).
+    what : str
+        The conversion, for the message (``"deg/s → deg/h"``).
+    where : str, optional
+        The column, named in the message.
+    first_row : int, optional
+        Row number of ``out``'s first row (rows of a 2-D array by its first axis).
+
+    Raises
+    ------
+    ConversionOverflowError
+        A float64 overflow (|x| > 1.8e308): names the row and the value before and after.
+    """
     flat = out.reshape(-1)
     if flat.size == 0:
         return
@@ -782,10 +1153,23 @@ def refuse_overflow(
 
 
 def canonical_unit(unit: str) -> str:
-    """The unit figures of merit are reported in: [°/h] for rates, [mg] for accelerations.
+    """The unit figures of merit are reported in.
 
-    Raw counts stay ``'counts'`` unless a scale factor converts them (see
-    :func:`to_canonical`).
+    Parameters
+    ----------
+    unit : str
+        A signal unit.
+
+    Returns
+    -------
+    str
+        ``"deg/h"`` for rates, ``"mg"`` for accelerations, ``"counts"`` for raw counts
+        (unless a scale factor converts them, :func:`counts_to_physical`).
+
+    Examples
+    --------
+    >>> canonical_unit("rad/s"), canonical_unit("m/s^2")
+    ('deg/h', 'mg')
     """
     kind = signal_kind(unit)
     return {"rate": "deg/h", "accel": "mg", "raw": "counts"}[kind]
@@ -801,11 +1185,40 @@ def to_canonical(
 ) -> tuple[npt.NDArray[np.float64], str]:
     """Convert a signal to its canonical unit ([°/h] for rates, [mg] for accelerations).
 
-    Returns the converted float64 array and the canonical unit string. Data already in
-    the canonical unit come back as they are (no copy, no memory per row): treat the
-    result as read-only.  A finite value that overflows on conversion is a
-    :class:`UnitError` naming ``where`` and its row (:func:`refuse_overflow`) unless
-    ``finite=False`` (callers that report such values themselves).
+    Data already in the canonical unit come back as they are (no copy): treat the
+    result as read-only.
+
+    Parameters
+    ----------
+    values : array_like
+        The signal [``unit``].
+    unit : str
+        Its unit.
+    where : str, optional
+        The column, named in messages.
+    first_row : int, optional
+        Row number of the first value, for messages.
+    finite : bool, optional
+        Refuse a finite value that overflows (default True; False for callers that
+        report such values themselves).
+
+    Returns
+    -------
+    values : numpy.ndarray
+        The converted signal.
+    unit : str
+        ``"deg/h"``, ``"mg"`` or ``"counts"``.
+
+    Raises
+    ------
+    UnitError
+        An unknown unit, or an overflow (:func:`refuse_overflow`).
+
+    Examples
+    --------
+    >>> x, u = to_canonical([1.0], "deg/s")
+    >>> x.tolist(), u
+    ([3600.0], 'deg/h')
     """
     u = normalize_signal_unit(unit)
     arr = np.asarray(values, dtype=np.float64)
@@ -823,8 +1236,32 @@ def to_canonical(
 def convert(
     values: npt.ArrayLike, from_unit: str, to_unit: str, where: str = ""
 ) -> npt.NDArray[np.float64]:
-    """Convert between two signal units of the same kind (rate↔rate, accel↔accel); a finite
-    value that overflows is a :class:`UnitError` naming ``where`` (:func:`refuse_overflow`)."""
+    """Convert between two signal units of the same kind (rate↔rate, accel↔accel).
+
+    Parameters
+    ----------
+    values : array_like
+        The signal [``from_unit``].
+    from_unit, to_unit : str
+        The units.
+    where : str, optional
+        The column, named in messages.
+
+    Returns
+    -------
+    numpy.ndarray
+        The signal [``to_unit``] (a copy).
+
+    Raises
+    ------
+    UnitError
+        An unknown unit, units of different kinds, or an overflow.
+
+    Examples
+    --------
+    >>> convert([1000.0], "mg", "g").tolist()
+    [1.0]
+    """
     f = normalize_signal_unit(from_unit)
     t = normalize_signal_unit(to_unit)
     arr = np.asarray(values, dtype=np.float64)
@@ -843,11 +1280,40 @@ def convert(
 
 
 def earth_rate_on_axis_deg_h(latitude_deg: float, axis_enu: npt.ArrayLike) -> float:
-    """Earth rate seen by a sensitive axis [°/h].
+    r"""Earth rate seen by a sensitive axis.
 
-    The earth-rate vector in local East-North-Up is ``Ω (0, cos φ, sin φ)``
-    (φ the latitude); the axis reads its projection ``Ω_axis = Ω u·(0, cos φ, sin φ)`` for a
-    unit vector ``u`` (normalised here).  For a vertical axis this is ``Ω sin φ``.
+    Parameters
+    ----------
+    latitude_deg : float
+        Site latitude φ [°].
+    axis_enu : array_like
+        Direction of the sensitive axis in local East-North-Up (normalised here).
+
+    Returns
+    -------
+    float
+        The earth-rate component along the axis [°/h].
+
+    Raises
+    ------
+    UnitError
+        A zero direction vector.
+
+    Notes
+    -----
+    .. math:: \Omega_{axis} = \Omega\,\mathbf u \cdot (0, \cos\varphi, \sin\varphi)
+
+    with Ω the earth rate (:data:`EARTH_RATE_DEG_H`); for a vertical axis
+    :math:`\Omega \sin\varphi`.
+
+    References
+    ----------
+    - IEEE Std 952-1997, earth rate as an input of a stationary gyro.
+
+    Examples
+    --------
+    >>> round(earth_rate_on_axis_deg_h(90.0, (0, 0, 1)), 3)
+    15.041
     """
     u = np.asarray(axis_enu, dtype=np.float64).reshape(3)
     norm = float(np.linalg.norm(u))
@@ -870,7 +1336,29 @@ AXIS_NAMES: Final[dict[str, tuple[float, float, float]]] = {
 
 
 def parse_axis(axis: str | npt.ArrayLike) -> npt.NDArray[np.float64]:
-    """Axis name (``up``, ``north``, …) or ``"e,n,u"`` triple → unit vector in ENU."""
+    """A sensitive-axis direction as a unit vector in East-North-Up.
+
+    Parameters
+    ----------
+    axis : str or array_like
+        A name of :data:`AXIS_NAMES` (``"up"``, ``"north"`` …), the text ``"e,n,u"``,
+        or three components.
+
+    Returns
+    -------
+    numpy.ndarray
+        Unit vector ``(e, n, u)`` [-].
+
+    Raises
+    ------
+    UnitError
+        An unknown name, not three components, or a zero vector.
+
+    Examples
+    --------
+    >>> parse_axis("north").tolist(), parse_axis("3,0,4").tolist()
+    ([0.0, 1.0, 0.0], [0.6, 0.0, 0.8])
+    """
     if isinstance(axis, str):
         key = axis.strip().lower()
         if key in AXIS_NAMES:
@@ -902,11 +1390,40 @@ WGS84_E2: Final = 0.00669437999013
 
 
 def normal_gravity_m_s2(latitude_deg: float) -> float:
-    """WGS-84 normal gravity on the ellipsoid at geodetic latitude φ [m/s²].
+    r"""WGS 84 normal gravity on the ellipsoid at geodetic latitude φ.
 
-    Somigliana's closed formula (NIMA TR8350.2, eq. 4-1):
-    ``γ(φ) = γe (1 + k sin²φ) / sqrt(1 − e² sin²φ)``; 9.7803 at the equator, 9.8322 at
-    the poles.  Height above the ellipsoid is neglected (−3.1e-6 m/s² per metre).
+    Height above the ellipsoid is neglected (−3.1e-6 m/s² per metre).
+
+    Parameters
+    ----------
+    latitude_deg : float
+        Geodetic latitude φ [°], within ±90.
+
+    Returns
+    -------
+    float
+        Normal gravity γ [m/s²]: 9.7803 at the equator, 9.8322 at the poles.
+
+    Raises
+    ------
+    UnitError
+        A latitude outside ±90°.
+
+    Notes
+    -----
+    Somigliana's closed formula:
+
+    .. math:: \gamma(\varphi) = \gamma_e \frac{1 + k \sin^2\varphi}{\sqrt{1 - e^2 \sin^2\varphi}}
+
+    References
+    ----------
+    - NIMA TR8350.2, *Department of Defense World Geodetic System 1984: its definition
+      and relationships with local geodetic systems*, 3rd ed., 2000, eq. 4-1.
+
+    Examples
+    --------
+    >>> round(normal_gravity_m_s2(0.0), 4), round(normal_gravity_m_s2(90.0), 4)
+    (9.7803, 9.8322)
     """
     if not -90.0 <= latitude_deg <= 90.0:
         raise UnitError(f"latitude must be within ±90°, got {latitude_deg}")
@@ -919,8 +1436,30 @@ def normal_gravity_m_s2(latitude_deg: float) -> float:
 
 
 def parse_gravity_axis(text: str) -> tuple[str, float]:
-    """The body axis pointing up in a static run, ``"+z"``/``"-x"``/``"z"`` →
-    (``"z"``, +1.0): the axis letter and the sign of the specific force it reads."""
+    """The body axis pointing up in a static run.
+
+    Parameters
+    ----------
+    text : str
+        ``"+z"``, ``"-x"``, ``"z"`` …
+
+    Returns
+    -------
+    letter : str
+        ``"x"``, ``"y"`` or ``"z"``.
+    sign : float
+        +1.0 or −1.0: the sign of the specific force the axis reads.
+
+    Raises
+    ------
+    UnitError
+        Not a sign and one of x, y, z.
+
+    Examples
+    --------
+    >>> parse_gravity_axis("-x")
+    ('x', -1.0)
+    """
     key = text.strip().lower().replace(" ", "")
     sign = -1.0 if key.startswith("-") else 1.0
     letter = key.lstrip("+-")
@@ -933,10 +1472,28 @@ def parse_gravity_axis(text: str) -> tuple[str, float]:
 
 
 def gravity_on_axis_mg(channel_axis: str, gravity_axis: str, gravity_m_s2: float) -> float:
-    """Specific force of gravity read by a static accelerometer along ``channel_axis``
-    (``"x"``, ``"y"``, ``"z"``) when ``gravity_axis`` (``"+z"``…) points up [mg]:
-    ``±1000 · g / g0`` on the up axis, 0 on the others (g0 = 9.80665 m/s², the unit
-    of ``g`` and ``mg``)."""
+    r"""Specific force of gravity read by a static accelerometer along one axis.
+
+    Parameters
+    ----------
+    channel_axis : str
+        The accelerometer's axis, ``"x"``, ``"y"`` or ``"z"``.
+    gravity_axis : str
+        The axis pointing up (``"+z"`` …).
+    gravity_m_s2 : float
+        Local gravity g [m/s²].
+
+    Returns
+    -------
+    float
+        :math:`\pm 1000\,g/g_0` on the up axis, 0 on the others [mg], with
+        :math:`g_0` = 9.80665 m/s² (the unit of ``g`` and ``mg``).
+
+    Examples
+    --------
+    >>> gravity_on_axis_mg("z", "-z", 9.80665)
+    -1000.0
+    """
     letter, sign = parse_gravity_axis(gravity_axis)
     if channel_axis != letter:
         return 0.0
@@ -951,8 +1508,25 @@ gyro, stated in a :class:`UnitWarning` wherever it is used."""
 
 
 def scale_factor_unit_or_default(unit: str | None, where: str = "") -> str:
-    """The scale factor's unit, or :data:`DEFAULT_SCALE_FACTOR_UNIT` stated in a
-    :class:`UnitWarning` (no silent default)."""
+    """The scale factor's unit, or the default stated in a warning.
+
+    Parameters
+    ----------
+    unit : str or None
+        The unit the metadata states.
+    where : str, optional
+        The file, named in the warning.
+
+    Returns
+    -------
+    str
+        ``unit``, else :data:`DEFAULT_SCALE_FACTOR_UNIT` (no silent default).
+
+    Warns
+    -----
+    UnitWarning
+        No unit stated.
+    """
     if unit:
         return unit
     prefix = f"{where}: " if where else ""
@@ -995,12 +1569,52 @@ def counts_to_physical(
     *,
     finite: bool = True,
 ) -> tuple[npt.NDArray[np.float64], str]:
-    """Convert raw counts to the canonical unit ([°/h] or [mg]) with scale factor K.
+    r"""Convert raw counts to the canonical unit ([°/h] or [mg]) with scale factor K.
 
-    ``ω = N / (τ K)`` for pulse (integrating) outputs, ``N / K`` otherwise.
-    Returns the converted array and the canonical unit string.  A finite count that
-    overflows on conversion (1e300 counts with a small K) is a :class:`UnitError` naming
-    ``where`` and its row (:func:`refuse_overflow`) unless ``finite=False``.
+    Parameters
+    ----------
+    counts : array_like
+        Raw counts N per sample [counts].
+    scale_factor : float
+        Scale factor K [``scale_factor_unit``], finite and non-zero.
+    scale_factor_unit : str
+        A key of :data:`SCALE_FACTOR_UNITS` (``"counts/arcsec"``, ``"counts/g"`` …).
+    interval_s : float
+        Sample interval τ [s] (integrating outputs only).
+    where : str, optional
+        The column, named in messages.
+    first_row : int, optional
+        Row number of the first count, for messages.
+    finite : bool, optional
+        Refuse a finite count that overflows (default True).
+
+    Returns
+    -------
+    values : numpy.ndarray
+        The signal in its canonical unit.
+    unit : str
+        ``"deg/h"`` or ``"mg"``.
+
+    Raises
+    ------
+    UnitError
+        An unknown unit, K zero or not finite, τ not positive for a pulse output,
+        or an overflow.
+
+    Notes
+    -----
+    .. math:: \omega = \frac{N}{\tau K} \;\text{(pulse, integrating outputs)}, \qquad
+        \omega = \frac{N}{K} \;\text{(otherwise)}
+
+    References
+    ----------
+    - IEEE Std 952-1997, scale factor of a fibre-optic gyro's pulse output.
+
+    Examples
+    --------
+    >>> x, u = counts_to_physical([10.0], 10.0, "counts/arcsec", 1.0)
+    >>> x.tolist(), u
+    ([1.0], 'deg/h')
     """
     if scale_factor_unit not in SCALE_FACTOR_UNITS:
         raise UnitError(
@@ -1035,10 +1649,18 @@ def counts_to_physical(
 
 @dataclass(frozen=True)
 class ShownUnit:
-    """The unit a channel's figures are shown to the user in, and the factors between it
-    and the unit the model works in: ``x[unit] = to_shown · x[model_unit]`` and
-    ``x[model_unit] = to_model · x[unit]`` (both from :func:`convert`, so each is exact
-    for its own direction)."""
+    """The unit a channel's figures are shown in, and the factors to the model's unit.
+
+    Attributes
+    ----------
+    unit : str
+        The unit shown to the user.
+    to_shown : float
+        ``x[unit] = to_shown · x[model_unit]``.
+    to_model : float
+        ``x[model_unit] = to_model · x[unit]`` (both from :func:`convert`, each exact
+        for its own direction).
+    """
 
     unit: str
     to_shown: float
@@ -1046,13 +1668,29 @@ class ShownUnit:
 
 
 def shown_unit(model_unit: str, data_unit: str | None) -> ShownUnit:
-    """The data's own unit for figures computed in ``model_unit`` (every
-    figure is shown in the data's own unit).
+    """The data's own unit for figures computed in the model's unit.
 
-    ``data_unit`` (the column's unit as given: option, file metadata or column name) is
-    kept as written when it is a physical unit of the model unit's kind (°/s data of a
-    model in °/h: factor 1/3600).  Raw counts made physical by a scale factor, an unknown
-    or missing unit, or another kind keep the model's unit, with factors 1.
+    ``data_unit`` is kept as written when it is a physical unit of the model unit's
+    kind (°/s data of a model in °/h: factor 1/3600).  Raw counts made physical by a
+    scale factor, an unknown or missing unit, or another kind keep the model's unit,
+    with factors 1.
+
+    Parameters
+    ----------
+    model_unit : str
+        The unit the model works in.
+    data_unit : str or None
+        The column's unit as given (option, file metadata or column name).
+
+    Returns
+    -------
+    ShownUnit
+
+    Examples
+    --------
+    >>> s = shown_unit("deg/h", "deg/s")
+    >>> s.unit, round(s.to_shown * 3600, 9)
+    ('deg/s', 1.0)
     """
     same = ShownUnit(model_unit, 1.0, 1.0)
     if not data_unit:

@@ -108,9 +108,11 @@ class StageFigures:
 
     @property
     def duration_s(self) -> float:
+        """Length of the stage [s]."""
         return self.stop_s - self.start_s
 
     def to_dict(self) -> dict[str, Any]:
+        """JSON-ready dict of the stage's figures."""
         d = {k: getattr(self, k) for k in self.__dataclass_fields__}
         d["duration_s"] = self.duration_s
         return d
@@ -177,7 +179,7 @@ class ValidationResult:
     @property
     def verdict(self) -> str:
         """One word on the model for this run: ``"NOT weakly correlated"`` when r says the
-        validation run repeats the modelling run ([Seed-RLG]: then it proves nothing), else
+        validation run repeats the modelling run (then it proves nothing), else
         ``"NOT improved (absolute error worse)"`` when the compensation makes the error
         about zero worse (:attr:`absolute_error_worse`), else ``"improved"``/``"NOT
         improved"`` by the rms of the bias before and after; ``"—"`` when the rms cannot be
@@ -206,9 +208,24 @@ class ValidationResult:
         return f"{self.verdict}; outside the calibrated range ({what})"
 
     def in_unit(self, unit: str, factor: float) -> ValidationResult:
-        """The same result with every signal figure in ``unit``, where ``value[self.unit]
-        = factor · value[unit]`` (e.g. the data's own unit, :class:`thermocal.compensate.kernels.
-        ModelRun`); improvements, r and the stage layout are unchanged."""
+        """The same result with every signal figure expressed in another unit.
+
+        Parameters
+        ----------
+        unit : str
+            Name of the new unit (e.g. the data's own unit, ``"deg/h"``).
+        factor : float
+            Conversion factor [unit of ``self`` per ``unit``], so that
+            ``value[self.unit] = factor · value[unit]``; ``1.0`` with the same unit
+            returns ``self``.
+
+        Returns
+        -------
+        ValidationResult
+            Copy whose bias stability, repeatability, rms, peak-to-peak, stage biases,
+            absolute figures and zero reference are divided by ``factor``; improvements,
+            correlation ``r`` and the stage layout are unchanged.
+        """
         if factor == 1.0 and unit == self.unit:
             return self
         keys = [
@@ -292,25 +309,107 @@ class ValidationResult:
 
 
 def block_means(time_s: FloatArray, x: FloatArray, averaging_s: float, tau0_s: float) -> FloatArray:
-    """Averages of ``x`` over complete consecutive blocks of ``m = round(averaging_s/τ0)``
-    samples from the first sample, never across a gap (:func:`thermocal.metrics.block_means`)."""
+    """Averages of a signal over complete consecutive blocks, never across a gap.
+
+    Parameters
+    ----------
+    time_s : numpy.ndarray
+        Sample times [s].
+    x : numpy.ndarray
+        Signal [its unit].
+    averaging_s : float
+        Averaging time τ [s].
+    tau0_s : float
+        Sample interval τ0 [s]; blocks hold ``m = round(averaging_s / tau0_s)``
+        samples counted from the first sample.
+
+    Returns
+    -------
+    numpy.ndarray
+        One average per complete block [unit of ``x``]
+        (see :func:`thermocal.metrics.block_means`).
+
+    References
+    ----------
+    - IEEE Std 952-1997, Annex C (averages over the sample time τ).
+    """
     return metrics.block_means(x, tau0_s, averaging_s, time_s=time_s)
 
 
 def stability_of_means(means: FloatArray) -> float:
-    """``sqrt(Σ (x̄_j − mean x̄)²/(m − 1))`` (IEEE Std 952-1997, bias stability); NaN for
-    fewer than 2 averages."""
+    r"""Bias stability: sample standard deviation of the block averages.
+
+    Parameters
+    ----------
+    means : numpy.ndarray
+        Block averages :math:`\bar x_j` [signal unit].
+
+    Returns
+    -------
+    float
+        Bias stability [signal unit]; NaN for fewer than 2 averages.
+
+    Notes
+    -----
+    .. math:: B_s = \sqrt{\frac{1}{m-1}\sum_{j=1}^{m}(\bar x_j - \langle \bar x\rangle)^2}
+
+    References
+    ----------
+    - IEEE Std 952-1997, IEEE Standard Specification Format Guide and Test Procedure
+      for Single-Axis Interferometric Fiber Optic Gyros, bias instability/stability.
+    """
     return float(np.std(means, ddof=1)) if means.size >= 2 else float("nan")
 
 
 def repeatability(biases: npt.ArrayLike) -> float:
-    """``Br = sqrt(Σ_{i=1..p} (B0_i − mean B0)²/(p − 1))`` (IEEE Std 952-1997); NaN for p < 2."""
+    r"""Bias repeatability: sample standard deviation of the biases of ``p`` runs.
+
+    Parameters
+    ----------
+    biases : array_like
+        Bias :math:`B_{0,i}` of each run or stage [signal unit].
+
+    Returns
+    -------
+    float
+        Bias repeatability [signal unit]; NaN for fewer than 2 biases.
+
+    Notes
+    -----
+    .. math:: B_r = \sqrt{\frac{1}{p-1}\sum_{i=1}^{p}(B_{0,i} - \langle B_0\rangle)^2}
+
+    References
+    ----------
+    - IEEE Std 952-1997, bias repeatability.
+
+    Examples
+    --------
+    >>> round(repeatability([1.0, 2.0, 3.0]), 3)
+    1.0
+    """
     b = np.asarray(biases, dtype=np.float64)
     return metrics.bias_repeatability(b) if b.size >= 2 else float("nan")
 
 
 def rms_over_stages(values: npt.ArrayLike) -> float:
-    """``sqrt((1/p') Σ v_s²)`` over the finite values (NaN when none)."""
+    r"""Root mean square over stages of a per-stage figure, ignoring NaN.
+
+    Parameters
+    ----------
+    values : array_like
+        One figure per stage [signal unit]; non-finite values are skipped.
+
+    Returns
+    -------
+    float
+        :math:`\sqrt{\frac{1}{p'}\sum_s v_s^2}` over the ``p'`` finite values
+        [signal unit]; NaN when none is finite.
+
+    Examples
+    --------
+    >>> round(rms_over_stages([3.0, 4.0, float("nan")]), 3)
+    3.536
+    """
     v = np.asarray(values, dtype=np.float64)
     v = v[np.isfinite(v)]
     return float(np.sqrt(np.mean(v * v))) if v.size else float("nan")
@@ -319,8 +418,31 @@ def rms_over_stages(values: npt.ArrayLike) -> float:
 def run_rms_and_peak_to_peak(
     time_s: FloatArray, x: FloatArray, averaging_s: float, tau0_s: float
 ) -> tuple[float, float]:
-    """Whole-run ``rms = sqrt(mean((x̄_j − mean x̄)²))`` and ``max x̄_j − min x̄_j`` of the
-    averages over ``averaging_s`` (peak-to-peak; mean removed)."""
+    r"""Whole-run rms and peak-to-peak of the averages over ``averaging_s``.
+
+    Parameters
+    ----------
+    time_s : numpy.ndarray
+        Sample times [s].
+    x : numpy.ndarray
+        Signal [its unit].
+    averaging_s : float
+        Averaging time τ [s].
+    tau0_s : float
+        Sample interval τ0 [s].
+
+    Returns
+    -------
+    tuple of float
+        ``(rms, peak_to_peak)`` [unit of ``x``]: rms of the block averages about
+        their mean and ``max − min`` of the averages; ``(nan, nan)`` when the run
+        is shorter than one block.
+
+    Notes
+    -----
+    .. math:: \mathrm{rms} = \sqrt{\frac{1}{m}\sum_j(\bar x_j - \langle\bar x\rangle)^2},
+        \quad \mathrm{p2p} = \max_j \bar x_j - \min_j \bar x_j
+    """
     m = block_means(time_s, x, averaging_s, tau0_s)
     if m.size == 0:
         return float("nan"), float("nan")
@@ -529,56 +651,25 @@ def _inputs(
     return t, amb, run.signal
 
 
-def validate(
+def _validate(
     model: TemperatureModel,
     run_validation: RunData,
-    modeling_ambient: tuple[npt.ArrayLike, npt.ArrayLike] | None = None,
-    *,
-    validation_ambient: npt.ArrayLike | None = None,
-    averaging_s: float = DEFAULT_AVERAGING_S,
-    r_limit: float = WEAK_CORRELATION_LIMIT,
-    rate_threshold_c_per_min: float = 0.05,
-    min_stage_s: float = 600.0,
-    settle_s: float = 0.0,
-    extrapolate: bool = False,
-    zero_reference: tuple[float, str] = (0.0, "0"),
-    display_unit: tuple[str, float] | None = None,
+    modeling_ambient: tuple[npt.ArrayLike, npt.ArrayLike] | None,
+    validation_ambient: npt.ArrayLike | None,
+    averaging_s: float,
+    r_limit: float,
+    holds: tuple[float, float, float],
+    extrapolate: bool,
+    zero_reference: tuple[float, str],
+    display_unit: tuple[str, float] | None,
 ) -> ValidationResult:
-    """Judge ``model`` on an independent test ([Seed-RLG]; the module docstring gives the formulas).
-
-    Parameters
-    ----------
-    model : a fitted model; figures are in ``model.signal_unit``.
-    run_validation : the validation run (signal in the model's unit).
-    modeling_ambient : ``(time_s, temp_c)`` of the modelling test's ambient temperature,
-        or ``None`` (then ``r`` is ``None`` and a :class:`CorrelationWarning` says so).
-    validation_ambient : the validation test's ambient temperature [°C], shape (n,);
-        default: the run's first temperature column.
-    averaging_s : averaging time of the stability, rms and peak-to-peak figures [s].
-    rate_threshold_c_per_min, min_stage_s, settle_s : hold detection
-        (:func:`thermocal.preprocess.segment_holds` on the ambient temperature).
-    extrapolate : evaluate the model outside its fitted range instead of clamping.
-    zero_reference : ``(K, what)``, the level an ideal sensor would output on this run
-        [model unit] (:func:`thermocal.compensate.kernels.zero_reference`): the "zero" of the
-        absolute figures.
-    display_unit : ``(unit, factor)`` with ``value[model unit] = factor · value[unit]``:
-        the unit the warning texts state figures in (the data's own); default the model's.
-
-    Warns
-    -----
-    CorrelationWarning : the validation test is not weakly correlated (``r ≥ r_limit``),
-        or no modelling history was given.
-    ThermocalWarning : fewer than two hold stages (repeatability undefined); the
-        compensation makes the absolute error worse.
-    ExtrapolationWarning : samples outside the model's calibrated ranges (one warning:
-        share and distance per input; replaces the model's own range warnings).
-    """
+    """The work of :func:`validate` (``holds`` = rate threshold, minimum stage, settle)."""
     t, amb, before = _inputs(run_validation, validation_ambient, averaging_s)
     notes: list[str] = []
 
     def note(msg: str, cat: type[Warning]) -> None:
         notes.append(msg)
-        warnings.warn(msg, cat, stacklevel=3)
+        warnings.warn(msg, cat, stacklevel=4)
 
     # 1. correlation of the ambient histories
     r, weak = _correlation(modeling_ambient, t, amb, r_limit, note)
@@ -591,10 +682,8 @@ def validate(
         raise ThermocalInputError("the validation run needs at least two increasing times")
 
     # 3. hold stages
-    stages = _stages(
-        t, amb, before, after, averaging_s, tau0, (rate_threshold_c_per_min, min_stage_s, settle_s)
-    )
-    _stage_notes(stages, averaging_s, rate_threshold_c_per_min, min_stage_s, note)
+    stages = _stages(t, amb, before, after, averaging_s, tau0, holds)
+    _stage_notes(stages, averaging_s, holds[0], holds[1], note)
 
     rms_b, ptp_b = run_rms_and_peak_to_peak(t, before, averaging_s, tau0)
     rms_a, ptp_a = run_rms_and_peak_to_peak(t, after, averaging_s, tau0)
@@ -626,6 +715,107 @@ def validate(
         zero_reference_what=ref_what,
         absolute_worse=tuple(worse),
         outside_range=excess,
+    )
+
+
+def validate(
+    model: TemperatureModel,
+    run_validation: RunData,
+    modeling_ambient: tuple[npt.ArrayLike, npt.ArrayLike] | None = None,
+    *,
+    validation_ambient: npt.ArrayLike | None = None,
+    averaging_s: float = DEFAULT_AVERAGING_S,
+    r_limit: float = WEAK_CORRELATION_LIMIT,
+    rate_threshold_c_per_min: float = 0.05,
+    min_stage_s: float = 600.0,
+    settle_s: float = 0.0,
+    extrapolate: bool = False,
+    zero_reference: tuple[float, str] = (0.0, "0"),
+    display_unit: tuple[str, float] | None = None,
+) -> ValidationResult:
+    r"""Judge a compensation model on an independent, weakly correlated test.
+
+    Parameters
+    ----------
+    model : TemperatureModel
+        A fitted model; every figure is in ``model.signal_unit``.
+    run_validation : RunData
+        The validation run (signal in the model's unit, times [s], temperatures [°C]).
+    modeling_ambient : tuple of array_like, optional
+        ``(time_s, temp_c)`` of the modelling test's ambient temperature [s, °C];
+        ``None`` (default) leaves ``r`` undefined and a :class:`CorrelationWarning` says so.
+    validation_ambient : array_like, optional
+        The validation test's ambient temperature [°C], shape ``(n,)``; default the
+        run's first temperature column.
+    averaging_s : float, optional
+        Averaging time τ of the stability, rms and peak-to-peak figures [s]
+        (default ``DEFAULT_AVERAGING_S``).
+    r_limit : float, optional
+        Correlation below which the test is weakly correlated [-] (default 0.4).
+    rate_threshold_c_per_min : float, optional
+        Hold detection: largest temperature rate of a hold [°C/min] (default 0.05).
+    min_stage_s : float, optional
+        Hold detection: shortest hold kept [s] (default 600).
+    settle_s : float, optional
+        Hold detection: time dropped at the start of each hold [s] (default 0);
+        see :func:`thermocal.preprocess.segment_holds`.
+    extrapolate : bool, optional
+        Evaluate the model outside its fitted range instead of clamping (default False).
+    zero_reference : tuple of (float, str), optional
+        ``(K, what)``: the level an ideal sensor would output on this run [model unit]
+        and its description (:func:`thermocal.compensate.kernels.zero_reference`);
+        default ``(0.0, "0")``.
+    display_unit : tuple of (str, float), optional
+        ``(unit, factor)`` with ``value[model unit] = factor · value[unit]``: the unit
+        the warning texts state figures in; default the model's.
+
+    Returns
+    -------
+    ValidationResult
+        Per-stage and whole-run figures before/after compensation, and the verdict.
+
+    Raises
+    ------
+    ThermocalInputError
+        ``averaging_s`` ≤ 0, ambient and run lengths differ, < 2 increasing times.
+
+    Warns
+    -----
+    CorrelationWarning
+        Not weakly correlated (``r ≥ r_limit``), or no modelling history given.
+    ThermocalWarning
+        Fewer than two hold stages; the absolute error made worse.
+    ExtrapolationWarning
+        Samples outside the model's calibrated ranges (share and distance per input).
+
+    Notes
+    -----
+    Ambient correlation, compensated signal, per-stage stability of q block averages,
+
+    .. math::
+        r = \frac{\mathrm{Cov}(X, Y)}{\sigma_X \sigma_Y}, \quad
+        F' = F - \hat y(T, \dot T, \ldots), \quad
+        B_{s} = \sqrt{\frac{1}{q-1}\sum_j (\bar F_j - \langle \bar F\rangle)^2}
+
+    then across stages :func:`rms_over_stages` and :func:`repeatability`.
+
+    References
+    ----------
+    - *A modelling and validation method for the temperature compensation model of a
+      ring-laser gyroscope*, Chinese invention patent, 2017 (r < 0.4).
+    - IEEE Std 952-1997, bias, bias stability and bias repeatability.
+    """
+    return _validate(
+        model,
+        run_validation,
+        modeling_ambient,
+        validation_ambient,
+        averaging_s,
+        r_limit,
+        (rate_threshold_c_per_min, min_stage_s, settle_s),
+        extrapolate,
+        zero_reference,
+        display_unit,
     )
 
 

@@ -100,9 +100,19 @@ def _pid_alive(pid: int) -> bool:
 def remove_stale_temporaries(target: str | Path) -> list[Path]:
     """Remove the temporaries of ``target`` left by writers that no longer run.
 
-    A temporary is ``.NAME.<pid>.<random>.thermocal-partial`` (:data:`TEMP_SUFFIX`); it is
-    stale when no process ``pid`` exists (a writer killed by SIGKILL or a power cut).
-    Temporaries of live writers are left alone.  Returns the removed paths.
+    A temporary is ``.NAME.<pid>.<random>.thermocal-partial`` (:data:`TEMP_SUFFIX`);
+    it is stale when no process ``pid`` exists (a writer killed by SIGKILL or a power
+    cut).  Temporaries of live writers are left alone.
+
+    Parameters
+    ----------
+    target : str or Path
+        The output whose stale temporaries are removed.
+
+    Returns
+    -------
+    list of Path
+        The removed temporaries.
     """
     t = Path(target)
     removed: list[Path] = []
@@ -167,16 +177,56 @@ def _temporary_for(path: str | Path) -> Iterator[tuple[Path, Path]]:
 def atomic_write(path: str | Path, mode: str = "wb") -> Iterator[Any]:
     """Open a temporary file beside ``path``; rename it over ``path`` on success.
 
-    On any exception the temporary file is removed and ``path`` is untouched.  Writers
-    of the same output are serialised; temporaries carry :data:`TEMP_SUFFIX`.
+    On any exception the temporary file is removed and ``path`` is untouched.
+    Writers of the same output are serialised; temporaries carry :data:`TEMP_SUFFIX`.
+
+    Parameters
+    ----------
+    path : str or Path
+        The output file.
+    mode : str, optional
+        Mode of :func:`open` (default ``"wb"``).
+
+    Yields
+    ------
+    file object
+        The open temporary file.
+
+    Raises
+    ------
+    ThermocalInputError
+        The output cannot be written (permissions, full disk …); nothing was written.
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> out = pathlib.Path(tempfile.mkdtemp()) / "a.txt"
+    >>> with atomic_write(out, "w") as fh:
+    ...     _ = fh.write("ok")
+    >>> out.read_text()
+    'ok'
     """
     with _temporary_for(path) as (_target, tmp), open(tmp, mode) as fh:
         yield fh
 
 
 def atomic_write_path(path: str | Path, writer: Callable[[Path], None]) -> None:
-    """Call ``writer(tmp_path)`` then rename ``tmp_path`` over ``path`` (for libraries
-    that want a path, not a file object)."""
+    """Call ``writer(tmp_path)``, then rename ``tmp_path`` over ``path``.
+
+    For libraries that want a path, not a file object (Arrow, matplotlib).
+
+    Parameters
+    ----------
+    path : str or Path
+        The output file.
+    writer : callable
+        ``writer(tmp_path)`` writes the whole output to ``tmp_path``.
+
+    Raises
+    ------
+    ThermocalInputError
+        The output cannot be written; nothing was written.
+    """
     with _temporary_for(path) as (_target, tmp):
         tmp.touch(mode=0o600)
         writer(tmp)
@@ -197,11 +247,28 @@ def _remove_stale_staging(target: Path) -> None:
 
 
 def staging_directory(target: str | Path) -> Path:
-    """A new empty directory beside ``target``, ``.NAME.<pid>.<random>.thermocal-partial``,
-    in which a command builds a set of outputs (calibration, parameters, reports) that must
-    appear whole or not at all; :func:`commit_directory` moves it into place,
-    :func:`discard_staging` removes it on failure, and the next
-    run to the same target removes those of runs that died."""
+    """A new empty directory beside ``target`` for a set of outputs that appear whole or not at all.
+
+    The directory is ``.NAME.<pid>.<random>.thermocal-partial``; a command builds its
+    outputs (calibration, parameters, reports) in it, :func:`commit_directory` moves it
+    into place, :func:`discard_staging` removes it on failure, and the next run to the
+    same target removes those of runs that died.
+
+    Parameters
+    ----------
+    target : str or Path
+        The output directory.
+
+    Returns
+    -------
+    Path
+        The staging directory.
+
+    Raises
+    ------
+    ThermocalInputError
+        ``target`` exists and is not a directory, or its parent is not a directory.
+    """
     t = Path(target)
     refuse_special(t)
     if t.exists() and not t.is_dir():
@@ -220,10 +287,19 @@ def staging_directory(target: str | Path) -> Path:
 
 
 def commit_directory(stage: Path, target: str | Path) -> None:
-    """Move a complete output set from ``stage`` into ``target``: one rename when ``target``
-    does not exist or is an empty directory (atomic); otherwise each file replaces its
-    namesake in ``target`` (``os.replace``, atomic per file; other files of ``target`` are
-    left alone), then ``stage`` is removed."""
+    """Move a complete output set from ``stage`` into ``target``.
+
+    One rename when ``target`` does not exist or is an empty directory (atomic);
+    otherwise each file replaces its namesake in ``target`` (``os.replace``, atomic per
+    file; other files of ``target`` are left alone), then ``stage`` is removed.
+
+    Parameters
+    ----------
+    stage : Path
+        The staging directory (:func:`staging_directory`).
+    target : str or Path
+        The output directory.
+    """
     t = Path(target)
     with _output_lock(t):
         empty = t.is_dir() and not t.is_symlink() and not any(t.iterdir())
@@ -250,23 +326,66 @@ def discard_staging() -> None:
 
 
 def write_html(path: str | Path, html: str) -> Path:
-    """Write an HTML page (a report) atomically as UTF-8; returns the path."""
+    """Write an HTML page (a report) atomically as UTF-8.
+
+    Parameters
+    ----------
+    path : str or Path
+        The output file.
+    html : str
+        The page.
+
+    Returns
+    -------
+    Path
+        ``path``.
+    """
     with atomic_write(path, "wb") as fh:
         fh.write(html.encode("utf-8"))
     return Path(path)
 
 
 def write_json(path: str | Path, obj: Any) -> None:
-    """Write JSON atomically (indent 2, UTF-8)."""
+    r"""Write JSON atomically (indent 2, UTF-8, a final newline).
+
+    Parameters
+    ----------
+    path : str or Path
+        The output file.
+    obj : object
+        A JSON-serialisable object; NaN and infinities are refused (``ValueError``).
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> out = pathlib.Path(tempfile.mkdtemp()) / "a.json"
+    >>> write_json(out, {"bias": 1.5})
+    >>> out.read_text()
+    '{\n  "bias": 1.5\n}\n'
+    """
     text = json.dumps(obj, indent=2, ensure_ascii=False, allow_nan=False)
     with atomic_write(path, "w") as fh:
         fh.write(text + "\n")
 
 
 def check_not_input(out: str | Path, inputs: list[str | Path]) -> None:
-    """Refuse to write ``out`` over one of the inputs or an input's sidecar
-    ``FILE.meta.json``, or onto a special file (the one gate,
-    :func:`thermocal.outputs.check_outputs`; an input is never overwritten)."""
+    """Refuse to write ``out`` over an input, an input's sidecar or a special file.
+
+    The one gate is :func:`thermocal.outputs.check_outputs`; an input is never
+    overwritten.
+
+    Parameters
+    ----------
+    out : str or Path
+        The output file.
+    inputs : list of str or Path
+        The input files (each ``FILE.meta.json`` sidecar is protected too).
+
+    Raises
+    ------
+    ThermocalInputError
+        ``out`` is one of the inputs, an input's sidecar or a special file.
+    """
     check_outputs([out], inputs)
 
 
@@ -299,13 +418,28 @@ RECORDING_WRITERS: dict[str, RecordingWriter] = {"parquet": _write_parquet, "csv
 
 
 def written_format(path: Path) -> str:
-    """The name of the format an output recording is written in (a key of
-    :data:`RECORDING_WRITERS`), by its suffix.
+    """The name of the format an output recording is written in, by its suffix.
+
+    Parameters
+    ----------
+    path : Path
+        The output recording.
+
+    Returns
+    -------
+    str
+        A key of :data:`RECORDING_WRITERS` (``"csv"`` or ``"parquet"``).
 
     Raises
     ------
     thermocal.errors.FileFormatError
         A suffix no format has, or a format thermocal reads but does not write.
+
+    Examples
+    --------
+    >>> from pathlib import Path
+    >>> written_format(Path("out.parquet"))
+    'parquet'
     """
     kind = file_kind(path)
     if kind not in RECORDING_WRITERS:
