@@ -154,7 +154,32 @@ def _time_budget(seconds: float) -> Iterator[None]:
 def read_dataflash_log(path: str | Path, messages: Sequence[str]) -> DataflashLog:
     """Read an ArduPilot DataFlash log (:func:`_read_dataflash_log`) within a time budget
     (:data:`READ_BUDGET_S` + :data:`READ_BUDGET_S_PER_MB` per MB): a log pymavlink cannot
-    finish is a :class:`FileFormatError`, never a hang."""
+    finish is a :class:`FileFormatError`, never a hang.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        The DataFlash ``.bin`` log.
+    messages : sequence of str
+        Message names to keep (``IMU``, ``TCLR``, …).
+
+    Returns
+    -------
+    DataflashLog
+        The kept messages' rows, the names seen and notes on damage.
+
+    Raises
+    ------
+    FileFormatError
+        A log pymavlink cannot read, or cannot finish within the time budget.
+    ThermocalInputError
+        A special file (FIFO, device), or pymavlink not installed.
+
+    References
+    ----------
+    - ArduPilot, *Onboard (DataFlash) log messages* and ``libraries/AP_Logger``
+      (``FMT``/``FMTU``/``UNIT``/``MULT`` messages), ardupilot.org.
+    """
     p = Path(path)
     refuse_special_input(p, "DataFlash log")  # pymavlink would block on a FIFO
     try:
@@ -291,7 +316,32 @@ def dataflash_table(
     """Instance ``inst`` of message ``name`` from a :func:`read_dataflash_log` pass, as a
     table with the firmware's units (:data:`ARDUPILOT_UNITS`).  Both layouts: the instance
     field ``I`` (newer firmware) or, for ``IMU.1``/``IMU.2``, the older messages
-    ``IMU2``/``IMU3`` without it; ``T`` or ``Temp`` the temperature."""
+    ``IMU2``/``IMU3`` without it; ``T`` or ``Temp`` the temperature.
+
+    Parameters
+    ----------
+    log : DataflashLog
+        A :func:`read_dataflash_log` pass.
+    path : pathlib.Path
+        The log, named in errors.
+    name : str
+        Message name (``IMU``).
+    inst : int
+        Instance (0-based).
+
+    Returns
+    -------
+    tuple of (pandas.DataFrame, dict)
+        The fields as float64 columns, and what the reader found (time column ``TimeUS``
+        [µs], units, message).
+
+    Raises
+    ------
+    MissingColumnError
+        No such message instance in the log (the message lists those it has).
+    FileFormatError
+        Messages without ``TimeUS`` (a damaged format definition).
+    """
     legacy = f"{name}{inst + 1}" if inst > 0 else None  # IMU2 = IMU.1 in older logs
     rows = [r for r in log.rows.get(name, []) if int(r.get("I", 0)) == inst]
     source = name
@@ -331,7 +381,32 @@ def read_dataflash(path: Path, topic: str | None) -> tuple[pd.DataFrame, dict[st
     table: the message's fields as columns, ``TimeUS`` [µs] the time, the firmware's units
     (:data:`ARDUPILOT_UNITS`, whether or not the log carries unit messages).  Older logs
     name their second and third IMU ``IMU2``/``IMU3`` (no ``I`` field): ``IMU.1`` reads
-    ``IMU2`` (:func:`dataflash_table`).  The log is read once (:func:`read_dataflash_log`)."""
+    ``IMU2`` (:func:`dataflash_table`).  The log is read once (:func:`read_dataflash_log`).
+
+    Parameters
+    ----------
+    path : pathlib.Path
+        The DataFlash ``.bin`` log.
+    topic : str or None
+        ``NAME`` or ``NAME.INSTANCE``; ``None``: the default message (``IMU.0``).
+
+    Returns
+    -------
+    tuple of (pandas.DataFrame, dict)
+        As :func:`dataflash_table`.
+
+    Raises
+    ------
+    FileFormatError
+        An unreadable log.
+    MissingColumnError
+        No such message instance.
+
+    References
+    ----------
+    - ArduPilot, *Onboard (DataFlash) log messages* and ``libraries/AP_Logger``
+      (``FMT``/``FMTU``/``UNIT``/``MULT`` messages), ardupilot.org.
+    """
     name, inst = parse_topic(topic, DEFAULT_DATAFLASH_TOPIC)
     wanted = [name] + ([f"{name}{inst + 1}"] if inst > 0 else [])
     log = read_dataflash_log(path, wanted)
