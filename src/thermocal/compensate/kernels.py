@@ -265,6 +265,15 @@ class ModelRun:
     ``model.temperature_unit``); ``data_unit`` is the data column's own unit and
     ``factor`` takes values from it to the model's unit: ``value[model] = factor ·
     value[data]``; :meth:`to_data_unit` brings model values (ŷ, residuals, figures) back.
+
+    Attributes
+    ----------
+    run : RunData
+        The run in the model's units.
+    data_unit : str
+        The data column's own signal unit.
+    factor : float
+        ``value[model unit] = factor · value[data unit]``.
     """
 
     run: RunData
@@ -355,6 +364,13 @@ class Compensation:
     """Result of :func:`compensate_run`.
 
     ``model_value`` ŷ and ``corrected`` ``F' = F − ŷ`` [model signal unit], shape (n,).
+
+    Attributes
+    ----------
+    model_value : numpy.ndarray
+        ŷ, the temperature-induced part [model signal unit].
+    corrected : numpy.ndarray
+        ``F − ŷ`` [model signal unit].
     """
 
     model_value: FloatArray

@@ -43,7 +43,13 @@ else:
 def csv_float_options() -> dict[str, Any]:
     """``pandas.read_csv`` options that parse every decimal to the nearest float64 (pandas < 3's
     default parser can be one ulp off; pandas 3 is exact by default and deprecates the option).
-    A function so that importing this module does not import pandas."""
+    A function so that importing this module does not import pandas.
+
+    Returns
+    -------
+    dict
+        ``{"float_precision": "round_trip"}`` under pandas < 3, else ``{}``.
+    """
     major = int(pd.__version__.split(".")[0])
     return {"float_precision": "round_trip"} if major < 3 else {}
 
@@ -143,7 +149,18 @@ def memory_budget(limit_bytes: int | None) -> Iterator[None]:
 def memory_limit_bytes() -> int | None:
     """Memory a read may use [bytes]: ``THERMOCAL_MEMORY_LIMIT`` (``2G``, ``512M``, bytes)
     when set, else half the kernel's ``MemAvailable`` (:data:`MEMORY_SHARE`); None where
-    neither is known; at most the budget of an enclosing :func:`memory_budget`."""
+    neither is known; at most the budget of an enclosing :func:`memory_budget`.
+
+    Returns
+    -------
+    int or None
+        The limit [bytes], or ``None`` when unknown.
+
+    Raises
+    ------
+    ThermocalInputError
+        ``THERMOCAL_MEMORY_LIMIT`` set to something that is not a size.
+    """
     base = _machine_limit_bytes()
     budget = _BUDGET.get()
     if budget is None:
@@ -182,7 +199,13 @@ def _machine_limit_bytes() -> int | None:
 
 
 def mem_available_bytes() -> int | None:
-    """The kernel's ``MemAvailable`` [bytes] (``/proc/meminfo``), None where unknown."""
+    """The kernel's ``MemAvailable`` [bytes] (``/proc/meminfo``), None where unknown.
+
+    Returns
+    -------
+    int or None
+        Available memory [bytes], or ``None`` off Linux or when unreadable.
+    """
     try:
         with open("/proc/meminfo", encoding="ascii") as fh:
             for line in fh:
@@ -449,7 +472,13 @@ class TrackedReader(io.BufferedReader):
     def short_read(self) -> bool:
         """The last read came back short (some bytes, fewer than asked): a short read can
         only be the last read with data (the file ends there), so it is the last read when
-        nothing was read after it (the position is still where it left off)."""
+        nothing was read after it (the position is still where it left off).
+
+        Returns
+        -------
+        bool
+            Whether the file ended inside the last read (a cut file).
+        """
         end = self.stopped_at if self.closed else self.tell()
         return self._short_at is not None and self._short_at == end and not self._empty_after
 

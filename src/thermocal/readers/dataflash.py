@@ -77,7 +77,19 @@ logging fills its last page; pymavlink ignores up to this many, DFReader.py)."""
 class ParamChange:
     """A parameter set again later in a DataFlash log with another value: a ``PARM`` message
     (``TimeUS`` [µs] → ``time_s`` [s], the log's clock) whose value differs from the value of
-    that name in force before it (``old``)."""
+    that name in force before it (``old``).
+
+    Attributes
+    ----------
+    time_s : float
+        When the new value was set, on the log's clock [s].
+    name : str
+        The parameter's name.
+    old : float
+        The value in force before.
+    new : float
+        The value set.
+    """
 
     time_s: float
     name: str
@@ -85,6 +97,13 @@ class ParamChange:
     new: float
 
     def to_dict(self) -> dict[str, float | str]:
+        """The change as a JSON-ready mapping.
+
+        Returns
+        -------
+        dict
+            ``time_s`` [s], ``name``, ``old`` and ``new``.
+        """
         return {"time_s": self.time_s, "name": self.name, "old": self.old, "new": self.new}
 
 
@@ -94,7 +113,21 @@ class DataflashLog:
     fields), every message type seen, the parameters (``params``: the first value of each
     name, the parameters the recording started with; ``param_changes``: every later ``PARM``
     that changed a value, in log order) and the sentences on what was lost
-    (:func:`_dataflash_loss`)."""
+    (:func:`_dataflash_loss`).
+
+    Attributes
+    ----------
+    rows : dict of str to list of dict
+        Per wanted message type, its messages' numeric fields.
+    names_seen : frozenset of str
+        Every message type in the log.
+    params : dict of str to float
+        The first value of each parameter.
+    notes : tuple of str
+        What was lost to damage.
+    param_changes : tuple of ParamChange
+        Later changes of a parameter's value, in log order.
+    """
 
     rows: dict[str, list[dict[str, float]]]
     names_seen: frozenset[str]
@@ -103,7 +136,13 @@ class DataflashLog:
     param_changes: tuple[ParamChange, ...] = ()
 
     def params_at_end(self) -> dict[str, float]:
-        """The parameters in force at the end of the log (initial values and every change)."""
+        """The parameters in force at the end of the log (initial values and every change).
+
+        Returns
+        -------
+        dict of str to float
+            Parameter name → the last value set.
+        """
         out = dict(self.params)
         for c in self.param_changes:
             out[c.name] = c.new

@@ -288,7 +288,18 @@ def check_column_count(path: Path, n_columns: int) -> None:
 
 
 def max_line_chars() -> int:
-    """:data:`MAX_LINE_CHARS`, or ``THERMOCAL_MAX_LINE`` when set (a positive integer)."""
+    """:data:`MAX_LINE_CHARS`, or ``THERMOCAL_MAX_LINE`` when set (a positive integer).
+
+    Returns
+    -------
+    int
+        The longest line a text reader accepts [characters].
+
+    Raises
+    ------
+    ThermocalInputError
+        ``THERMOCAL_MAX_LINE`` set to something other than a positive integer.
+    """
     env = os.environ.get("THERMOCAL_MAX_LINE", "").strip()
     if not env:
         return MAX_LINE_CHARS
