@@ -216,7 +216,7 @@ def read_dataflash_log(path: str | Path, messages: Sequence[str]) -> DataflashLo
 
     References
     ----------
-    - ArduPilot, *Onboard (DataFlash) log messages* and ``libraries/AP_Logger``
+    - ArduPilot, *Onboard Message Log Messages* and ``libraries/AP_Logger``
       (``FMT``/``FMTU``/``UNIT``/``MULT`` messages), ardupilot.org.
     """
     p = Path(path)
@@ -443,7 +443,7 @@ def read_dataflash(path: Path, topic: str | None) -> tuple[pd.DataFrame, dict[st
 
     References
     ----------
-    - ArduPilot, *Onboard (DataFlash) log messages* and ``libraries/AP_Logger``
+    - ArduPilot, *Onboard Message Log Messages* and ``libraries/AP_Logger``
       (``FMT``/``FMTU``/``UNIT``/``MULT`` messages), ardupilot.org.
     """
     name, inst = parse_topic(topic, DEFAULT_DATAFLASH_TOPIC)
