@@ -387,7 +387,7 @@ class LibraryNoise:
         return len(text)
 
     def flush(self) -> None:
-        pass
+        """Nothing to flush (the file-like protocol)."""
 
     def _count(self, line: str) -> None:
         line = line.strip()
@@ -400,6 +400,7 @@ class LibraryNoise:
         self.kinds[kind] = self.kinds.get(kind, 0) + 1
 
     def close(self) -> None:
+        """Count the last, unfinished line."""
         if self._part:
             self._count(self._part)
             self._part = ""
@@ -506,6 +507,7 @@ class TrackedReader(io.BufferedReader):
     _empty_after = False
 
     def close(self) -> None:
+        """Close the file, noting where reading stopped (:attr:`stopped_at`)."""
         if self.stopped_at is None and not self.closed:
             self.stopped_at = self.tell()
         super().close()
