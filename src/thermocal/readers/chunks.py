@@ -215,7 +215,7 @@ def station_chunks(path: Path, chunk_rows: int) -> Iterator[pa.RecordBatch]:
 
 
 def csv_chunks(path: Path, chunk_rows: int) -> Iterator[pd.DataFrame]:
-    """The rows of a CSV or text log, ``chunk_rows`` at a time, in its detected layout; a
+    r"""The rows of a CSV or text log, ``chunk_rows`` at a time, in its detected layout; a
     parse failure mid-file is a :class:`~thermocal.errors.FileFormatError` naming the file
     (a Ctrl-C inside pandas' parser stays a KeyboardInterrupt).
 
@@ -237,6 +237,17 @@ def csv_chunks(path: Path, chunk_rows: int) -> Iterator[pd.DataFrame]:
         A line that cannot be parsed, or text that cannot be decoded.
     ThermocalInputError
         A text log without a header row.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> from thermocal.readers.chunks import csv_chunks
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     p = Path(d, "run.csv")
+    ...     _ = p.write_text("time, T1, gyro\n0,25.0,1.5\n1,25.1,1.6\n2,25.2,1.7\n")
+    ...     [(list(c.columns), len(c)) for c in csv_chunks(p, 2)]
+    [(['time', 'T1', 'gyro'], 2), (['time', 'T1', 'gyro'], 1)]
     """
     enc = csv_encoding(path)
     with warnings.catch_warnings():  # csv_head stated the layout already
