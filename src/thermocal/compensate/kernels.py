@@ -57,16 +57,55 @@ def unit_factor(
     sample_interval_s: float | None = None,
     where: str = "",
 ) -> float:
-    """Factor ``f`` with ``value[model unit] = f · value[data unit]`` (all units are linear).
+    r"""Factor ``f`` with ``value[model unit] = f · value[data unit]`` (all units are linear).
 
     Raw ``counts`` data are turned into a physical unit with the metadata's scale
     factor K (IEEE Std 952-1997: ``ω = N/(τK)`` or ``N/K``,
     :func:`thermocal.units.counts_to_physical`).
 
+    Parameters
+    ----------
+    data_unit : str
+        Unit of the data's signal column (e.g. ``"deg/h"``, ``"mg"``, ``"counts"``).
+    model_unit : str
+        The model's signal unit (``model.signal_unit``).
+    meta : Metadata, optional
+        The recording's metadata; its scale factor K converts raw ``counts``
+        (default ``None``: no conversion of counts possible).
+    sample_interval_s : float, optional
+        Sample interval τ [s] for a scale factor per pulse; default the metadata's
+        ``sample_interval_s``, else 1 s.
+    where : str, optional
+        Name put in front of an error message (the file); default ``""``.
+
+    Returns
+    -------
+    float
+        The factor f [model unit / data unit]; 1.0 for equal units.
+
     Raises
     ------
-    UnitError : the two units measure different kinds of quantity (the message names
-        both), or counts cannot be converted because no scale factor is given.
+    UnitError
+        The two units measure different kinds of quantity (the message names both),
+        or counts cannot be converted because no scale factor is given.
+
+    Notes
+    -----
+    .. math:: y_{\mathrm{model}} = f\,y_{\mathrm{data}},
+              \qquad \omega = \frac{N}{\tau K}
+
+    References
+    ----------
+    - IEEE Std 952-1997, *IEEE Standard Specification Format Guide and Test Procedure
+      for Single-Axis Interferometric Fiber Optic Gyros* (scale factor K).
+
+    Examples
+    --------
+    >>> from thermocal.compensate.kernels import unit_factor
+    >>> round(unit_factor("deg/s", "deg/h"), 3)
+    3600.0
+    >>> unit_factor("mg", "mg")
+    1.0
     """
     du = units.normalize_signal_unit(data_unit)
     mu = units.normalize_signal_unit(model_unit)
@@ -96,9 +135,26 @@ def unit_factor(
 
 
 def check_signal_kind(data_unit: str, model_unit: str, where: str = "") -> None:
-    """Refuse data whose signal is of another kind than the model's (a rate against an
-    acceleration), naming both, before anything is computed or written.  Raw ``counts``
-    data pass here (their scale factor decides, :func:`unit_factor`)."""
+    """Refuse data whose signal is of another kind than the model's.
+
+    A rate against an acceleration is refused, naming both, before anything is computed
+    or written.  Raw ``counts`` data pass here (their scale factor decides,
+    :func:`unit_factor`).
+
+    Parameters
+    ----------
+    data_unit : str
+        Unit of the data's signal column.
+    model_unit : str
+        The model's signal unit.
+    where : str, optional
+        Name put in front of the error message (the file); default ``""``.
+
+    Raises
+    ------
+    UnitError
+        The data's unit is of another kind than the model's (and not raw counts).
+    """
     du = units.normalize_signal_unit(data_unit)
     mu = units.normalize_signal_unit(model_unit)
     kd, km = units.signal_kind(du), units.signal_kind(mu)
@@ -111,8 +167,24 @@ def check_signal_kind(data_unit: str, model_unit: str, where: str = "") -> None:
 
 
 def model_scale_factor(model: TemperatureModel, meta: Metadata) -> Metadata:
-    """``meta`` with the scale factor K of a raw-count signal taken from the model file's
-    ``inputs`` when the data's metadata gives none (the resolution order: file > model)."""
+    """``meta`` with the scale factor K taken from the model when the data give none.
+
+    The scale factor of a raw-count signal comes from the model file's ``inputs`` when
+    the data's metadata gives none (the resolution order: file > model).
+
+    Parameters
+    ----------
+    model : TemperatureModel
+        A fitted model (its ``inputs_`` record of the fit's scale factor).
+    meta : Metadata
+        The data's metadata; updated in place when it has no scale factor.
+
+    Returns
+    -------
+    Metadata
+        ``meta`` itself, with ``scale_factor`` [counts per unit] and its unit set when
+        the model recorded one and the data did not.
+    """
     sf = (getattr(model, "inputs_", {}) or {}).get("scale_factor")
     if meta.scale_factor is None and isinstance(sf, dict) and sf.get("value") is not None:
         meta.scale_factor = float(sf["value"])
@@ -127,8 +199,31 @@ def temperature_inputs(
     counts → °C conversion, or ``None`` (the values as they are: °C for a °C model, raw
     counts for a model fitted in counts).
 
-    Raises :class:`UnitError` for raw counts without any conversion (option, file or
-    model) under a °C model, and for °C data under a counts model."""
+    Parameters
+    ----------
+    model : TemperatureModel
+        A fitted model (``temperature_unit`` is ``"°C"`` or ``"counts"``).
+    resolved : thermocal.units.ResolvedInputs
+        The data's temperature columns with their units and conversions.
+    where : str, optional
+        Name put in front of a message (the file); default ``""``.
+
+    Returns
+    -------
+    dict of str to TemperatureConversion or None
+        Per temperature column, the counts → °C conversion to apply, or ``None``.
+
+    Raises
+    ------
+    UnitError
+        Raw counts without any conversion (option, file or model) under a °C model, or
+        °C data under a counts model.
+
+    Warns
+    -----
+    UnitWarning
+        A conversion given as an option for a model fitted in raw counts (not used).
+    """
     prefix = f"{where}: " if where else ""
     out: dict[str, units.TemperatureConversion | None] = {}
     for c, r in resolved.temperatures.items():
@@ -170,6 +265,15 @@ class ModelRun:
     ``model.temperature_unit``); ``data_unit`` is the data column's own unit and
     ``factor`` takes values from it to the model's unit: ``value[model] = factor ·
     value[data]``; :meth:`to_data_unit` brings model values (ŷ, residuals, figures) back.
+
+    Attributes
+    ----------
+    run : RunData
+        The run in the model's units.
+    data_unit : str
+        The data column's own signal unit.
+    factor : float
+        ``value[model unit] = factor · value[data unit]``.
     """
 
     run: RunData
@@ -177,7 +281,18 @@ class ModelRun:
     factor: float
 
     def to_data_unit(self, values: npt.ArrayLike) -> FloatArray:
-        """Model-unit values [model unit] → the data's unit."""
+        """Model-unit values → the data's unit.
+
+        Parameters
+        ----------
+        values : array_like
+            Values in the model's signal unit (ŷ, residuals, figures).
+
+        Returns
+        -------
+        numpy.ndarray
+            ``values / factor`` [data unit], float64.
+        """
         return np.asarray(values, dtype=np.float64) / self.factor
 
 
@@ -194,8 +309,33 @@ def prepare_run(
     ``rec`` should be read with the model's recorded units as fallbacks
     (``read_recording(..., model=model)``).  A signal of another kind than the model's is
     refused (:func:`check_signal_kind`); raw-count temperatures are converted, or kept as
-    counts for a model fitted in counts (a mismatch is refused).  ``known_input`` is in
-    the data's unit.
+    counts for a model fitted in counts (a mismatch is refused).
+
+    Parameters
+    ----------
+    model : TemperatureModel
+        A fitted model.
+    rec : Recording
+        The recording to prepare.
+    signal : str, optional
+        Signal column; default the model's ``signal_name``.
+    temps : sequence of str, optional
+        Temperature columns; default the model's ``temp_names_``.
+    known_input : float, optional
+        The true input during the run (earth rate, gravity component) [data unit];
+        default 0.
+
+    Returns
+    -------
+    ModelRun
+        The run in the model's units with the data unit and the factor between them.
+
+    Raises
+    ------
+    UnitError
+        The signal is of another kind than the model's, or counts cannot be converted.
+    ThermocalInputError
+        A signal or temperature column is missing from the recording.
     """
     sig = signal or model.signal_name
     names = tuple(temps) if temps else tuple(model.temp_names_)
@@ -224,6 +364,13 @@ class Compensation:
     """Result of :func:`compensate_run`.
 
     ``model_value`` ŷ and ``corrected`` ``F' = F − ŷ`` [model signal unit], shape (n,).
+
+    Attributes
+    ----------
+    model_value : numpy.ndarray
+        ŷ, the temperature-induced part [model signal unit].
+    corrected : numpy.ndarray
+        ``F − ŷ`` [model signal unit].
     """
 
     model_value: FloatArray
@@ -233,10 +380,53 @@ class Compensation:
 def compensate_run(
     model: TemperatureModel, run: RunData, *, extrapolate: bool = False
 ) -> Compensation:
-    """Apply a model to a whole run in memory: ``F' = F − ŷ(T, Ṫ, …)``.
+    r"""Apply a model to a whole run in memory: ``F' = F − ŷ(T, Ṫ, …)``.
 
     ``run.signal`` must be in the model's unit.  ``known_input`` is not removed:
     the compensated output still contains the true input (earth rate, gravity).
+
+    Parameters
+    ----------
+    model : TemperatureModel
+        A fitted model.
+    run : RunData
+        Time [s], temperatures [°C or counts, as the model] and signal [model unit].
+    extrapolate : bool, optional
+        Allow prediction outside the calibrated ranges (see the family's
+        ``predict``); default ``False``.
+
+    Returns
+    -------
+    Compensation
+        ŷ and ``F − ŷ`` [model signal unit], shape (n,).
+
+    Raises
+    ------
+    ThermocalInputError
+        The run has no signal.
+
+    Notes
+    -----
+    .. math:: F'_i = F_i - \hat y(T_i, \dot T_i, \ldots)
+
+    References
+    ----------
+    - *Temperature-characteristic calibration test plan* (output ``F' = F − ΔF``).
+    - *A modelling and validation method for the temperature compensation model of a
+      ring-laser gyroscope*, Chinese invention patent, 2017.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from thermocal.models import RunData
+    >>> from thermocal.models.poly import PolyModel
+    >>> from thermocal.compensate.kernels import compensate_run
+    >>> t = np.arange(0.0, 3600.0, 10.0)
+    >>> temp = 25.0 + 15.0 * np.sin(2 * np.pi * t / 3600.0)
+    >>> run = RunData(t, temp[:, None], 0.5 + 0.02 * temp, ("T1",))
+    >>> out = compensate_run(PolyModel(order=1).fit([run]), run)
+    >>> round(float(np.max(np.abs(out.corrected))), 6)
+    0.0
     """
     if run.signal is None:
         raise ThermocalInputError(f"{run.name or 'run'}: no signal to compensate")
@@ -258,7 +448,17 @@ class AbsoluteFigures:
     sensor would give (the reference K: 0, or the known input — earth rate, gravity):
     ``mean = mean(x − K)``, ``rms_about_zero = sqrt(mean((x − K)²)) = sqrt(σ² + mean²)``
     (σ the rms about the mean) and ``max_abs = max |x − K|`` [unit of x].  Unlike the
-    figures about the mean, these see a constant offset the model adds or leaves."""
+    figures about the mean, these see a constant offset the model adds or leaves.
+
+    Attributes
+    ----------
+    mean : float
+        ``mean(x − K)`` [unit of x].
+    rms_about_zero : float
+        ``sqrt(mean((x − K)²))`` [unit of x].
+    max_abs : float
+        ``max |x − K|`` [unit of x].
+    """
 
     mean: float
     rms_about_zero: float
@@ -266,7 +466,32 @@ class AbsoluteFigures:
 
 
 def absolute_figures(x: npt.ArrayLike, reference: float = 0.0) -> AbsoluteFigures:
-    """:class:`AbsoluteFigures` of the samples ``x`` about ``reference`` (same unit)."""
+    r""":class:`AbsoluteFigures` of the samples ``x`` about ``reference`` (same unit).
+
+    Parameters
+    ----------
+    x : array_like
+        The output samples [any unit].
+    reference : float, optional
+        The level K an ideal sensor would output [unit of x]; default 0.
+
+    Returns
+    -------
+    AbsoluteFigures
+        Mean, rms about K and largest |x − K| [unit of x]; NaN for no sample.
+
+    Notes
+    -----
+    .. math:: \mathrm{rms}_0 = \sqrt{\frac{1}{n}\sum_i (x_i - K)^2}
+              = \sqrt{\sigma^2 + \bar e^{\,2}}
+
+    Examples
+    --------
+    >>> from thermocal.compensate.kernels import absolute_figures
+    >>> f = absolute_figures([1.0, -1.0, 3.0], reference=1.0)
+    >>> round(f.mean, 3), round(f.rms_about_zero, 3), f.max_abs
+    (0.0, 1.633, 2.0)
+    """
     e = np.asarray(x, dtype=np.float64) - float(reference)
     if e.size == 0:
         return AbsoluteFigures(float("nan"), float("nan"), float("nan"))
@@ -278,10 +503,29 @@ def absolute_figures(x: npt.ArrayLike, reference: float = 0.0) -> AbsoluteFigure
 def absolute_error_worse(
     before: AbsoluteFigures, after: AbsoluteFigures, tolerance: float = ABSOLUTE_WORSE_TOLERANCE
 ) -> list[str]:
-    """The absolute figures the compensation made worse: ``"rms about zero"`` when
+    r"""The absolute figures the compensation made worse: ``"rms about zero"`` when
     ``after > (1 + tolerance) · before``; ``"max |error|"`` likewise, counted only when the
     rms about zero did not improve as well (a larger single extreme while the rms about
-    zero falls is a noise sample, not a worse output); empty when none."""
+    zero falls is a noise sample, not a worse output); empty when none.
+
+    Parameters
+    ----------
+    before, after : AbsoluteFigures
+        Figures of the raw and of the compensated output [same unit].
+    tolerance : float, optional
+        Allowed relative increase [fraction]; default
+        :data:`ABSOLUTE_WORSE_TOLERANCE` (0.01).
+
+    Returns
+    -------
+    list of str
+        ``"rms about zero"`` and/or ``"max |error|"``; empty when neither is worse.
+
+    Notes
+    -----
+    .. math:: \mathrm{rms}_0^{\mathrm{after}} > (1 + \mathrm{tol})\,
+              \mathrm{rms}_0^{\mathrm{before}}
+    """
     out = []
     b, a = before.rms_about_zero, after.rms_about_zero
     finite = math.isfinite(a) and math.isfinite(b)
@@ -307,8 +551,26 @@ def absolute_worse_message(
     worse: Sequence[str],
     cause: str = "",
 ) -> str:
-    """The ``warning:`` text for a compensation that makes the absolute error worse;
-    ``cause`` the known reason (else a model that does not describe this sensor here)."""
+    """The ``warning:`` text for a compensation that makes the absolute error worse.
+
+    Parameters
+    ----------
+    where : str
+        The file or channel named first.
+    unit : str
+        Unit of the figures.
+    before, after : AbsoluteFigures
+        Figures of the raw and of the compensated output [unit].
+    worse : sequence of str
+        What got worse (:func:`absolute_error_worse`).
+    cause : str, optional
+        The known reason; default: a model that does not describe this sensor here.
+
+    Returns
+    -------
+    str
+        One line: the figures before → after and the cause.
+    """
     pct = (
         100.0 * (after.rms_about_zero - before.rms_about_zero) / before.rms_about_zero
         if before.rms_about_zero > 0
@@ -344,13 +606,40 @@ def _kept_in_bias(model: TemperatureModel, latitude_deg: float, axis: str) -> st
 def zero_reference(
     model: TemperatureModel, meta: Metadata | None, known_input: float = 0.0
 ) -> tuple[float, str]:
-    """The level an ideal sensor would output on this run [model unit] and what it is: the
+    r"""The level an ideal sensor would output on this run [model unit] and what it is: the
     "zero" of the absolute figures (:class:`AbsoluteFigures`).
 
     In order: ``known_input`` when given (non-zero); for a gyro, the earth rate on the
     sensitive axis when the data's metadata give latitude and axis (IEEE Std 952-1997,
     :func:`thermocal.units.earth_rate_on_axis_deg_h`); the known input the model file
     recorded of its fit (``inputs.known_input``, assumed the same on this run); else 0.
+
+    Parameters
+    ----------
+    model : TemperatureModel
+        A fitted model (its signal unit and the known input of its fit).
+    meta : Metadata or None
+        The data's metadata (latitude [°] and sensitive axis).
+    known_input : float, optional
+        The known input given by the user [model unit]; default 0 (none).
+
+    Returns
+    -------
+    tuple of (float, str)
+        The reference level [model unit] and the words saying where it comes from.
+
+    Notes
+    -----
+    The earth rate on an axis at latitude φ, with Ω = 15.041 °/h:
+
+    .. math:: \Omega_{\mathrm{axis}} = \Omega\,\mathbf{u}\cdot(0, \cos\varphi, \sin\varphi)
+
+    with **u** the unit sensitive axis in local East-North-Up.
+
+    References
+    ----------
+    - IEEE Std 952-1997, *IEEE Standard Specification Format Guide and Test Procedure
+      for Single-Axis Interferometric Fiber Optic Gyros* (earth-rate input).
     """
     if known_input:
         return float(known_input), "the known input given (--known-input)"
@@ -394,6 +683,39 @@ class StreamingCompensator:
 
     The outputs equal :func:`compensate_run` to 1e-12 (relative) on the same data,
     start-up included, when ``sample_interval_s`` is the run's median interval.
+
+    Parameters
+    ----------
+    model : TemperatureModel
+        A fitted model.
+    sample_interval_s : float
+        Nominal sample interval [s] (positive, finite).
+    extrapolate : bool, optional
+        Passed to the family's stream; default ``False``.
+    known_input : float, optional
+        The true input (earth rate [°/h], gravity component [mg]) [model unit];
+        default 0.
+
+    Raises
+    ------
+    ThermocalInputError
+        ``sample_interval_s`` not positive and finite; mixing :meth:`update` and
+        :meth:`update_block` between resets.
+    TimestampError
+        Time that does not increase strictly.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from thermocal.models import RunData
+    >>> from thermocal.models.poly import PolyModel
+    >>> from thermocal.compensate.kernels import StreamingCompensator
+    >>> t = np.arange(0.0, 3600.0, 10.0)
+    >>> temp = 25.0 + 15.0 * np.sin(2 * np.pi * t / 3600.0)
+    >>> model = PolyModel(order=1).fit([RunData(t, temp[:, None], 0.5 + 0.02 * temp, ("T1",))])
+    >>> comp = StreamingCompensator(model, 10.0)
+    >>> round(comp.update(0.0, [30.0], 1.2), 6)
+    0.1
 
     Two ways to feed it (not to be mixed between two resets):
 
@@ -439,8 +761,27 @@ class StreamingCompensator:
         self._mode = mode
 
     def update(self, time_s: float, temps_c: npt.ArrayLike, signal: float) -> float:
-        """Corrected output ``F − ŷ`` of one sample: time [s], temperatures (k,) [°C],
-        raw signal F [model unit]."""
+        """Corrected output ``F − ŷ`` of one sample.
+
+        Parameters
+        ----------
+        time_s : float
+            Time [s], strictly after the previous sample's.
+        temps_c : array_like
+            Temperatures (k,) [°C, or counts for a counts model].
+        signal : float
+            Raw signal F [model unit].
+
+        Returns
+        -------
+        float
+            ``F − ŷ`` [model unit].
+
+        Raises
+        ------
+        TimestampError
+            Time not after the previous sample's.
+        """
         t = float(time_s)
         if self._last_t is not None and not t > self._last_t:
             raise TimestampError(
@@ -480,6 +821,27 @@ class StreamingCompensator:
         one :class:`ExtrapolationWarning` per stream, at the first block with samples outside
         a calibrated range (temperature, Ṫ, time since power-on; :attr:`outside_range`
         gives the share and distance over every block fed since).
+
+        Parameters
+        ----------
+        time_s : array_like
+            Times (n,) [s], strictly increasing and after the previous block's.
+        temps_c : array_like
+            Temperatures (n,) or (n, k) [°C].
+        signal : array_like
+            Raw signal (n,) [model unit].
+
+        Returns
+        -------
+        Compensation
+            ŷ and ``F − ŷ`` (n,) [model unit].
+
+        Raises
+        ------
+        ThermocalInputError
+            Arrays of different lengths; mixing with :meth:`update` before a reset.
+        TimestampError
+            Time that does not increase.
         """
         t = np.asarray(time_s, dtype=np.float64).reshape(-1)
         T = np.asarray(temps_c, dtype=np.float64)
@@ -514,7 +876,22 @@ class StreamingCompensator:
     def process(
         self, time_s: npt.ArrayLike, temps_c: npt.ArrayLike, signal: npt.ArrayLike
     ) -> Compensation:
-        """Feed arrays sample by sample (state carried on from earlier calls)."""
+        """Feed arrays sample by sample (state carried on from earlier calls).
+
+        Parameters
+        ----------
+        time_s : array_like
+            Times (n,) [s], strictly increasing.
+        temps_c : array_like
+            Temperatures (n,) or (n, k) [°C].
+        signal : array_like
+            Raw signal (n,) [model unit].
+
+        Returns
+        -------
+        Compensation
+            ŷ and ``F − ŷ`` (n,) [model unit].
+        """
         t = np.asarray(time_s, dtype=np.float64)
         T = np.asarray(temps_c, dtype=np.float64)
         if T.ndim == 1:
@@ -540,8 +917,22 @@ class CalibrationStream:
     outputs ``F − ŷ`` in the same units.  Equal to :func:`compensate_channels` on the
     same samples (tested to 1e-9 relative).
 
-    ``channels``: a :class:`~thermocal.models.calibration.Calibration` or ``(name,
-    model, data unit)`` triples.
+    Parameters
+    ----------
+    channels : Calibration or iterable of (str, TemperatureModel, str)
+        A :class:`~thermocal.models.calibration.Calibration` or ``(name, model, data
+        unit)`` triples.
+    sample_interval_s : float
+        Nominal sample interval [s].
+    extrapolate : bool, optional
+        Passed to every channel's stream; default ``False``.
+
+    Raises
+    ------
+    ThermocalInputError
+        No channel.
+    UnitError
+        A channel's data unit of another kind than its model's.
     """
 
     def __init__(
@@ -602,8 +993,28 @@ class CalibrationStream:
         return arr
 
     def update(self, time_s: float, temps_c: Any, raw: npt.ArrayLike) -> FloatArray:
-        """Corrected outputs (N,) of one sample [each channel's data unit]; ``temps_c``:
-        (k,) in :attr:`temperature_names` order, or a mapping name → °C."""
+        """Corrected outputs (N,) of one sample [each channel's data unit].
+
+        Parameters
+        ----------
+        time_s : float
+            Time [s], strictly increasing.
+        temps_c : array_like or mapping of str to float
+            (k,) temperatures [°C] in :attr:`temperature_names` order, or a mapping
+            name → °C.
+        raw : array_like
+            (N,) raw outputs in :attr:`names` order [each channel's data unit].
+
+        Returns
+        -------
+        numpy.ndarray
+            (N,) corrected outputs ``F − ŷ`` [each channel's data unit].
+
+        Raises
+        ------
+        ThermocalInputError
+            A temperature missing or the wrong number of values.
+        """
         T = self._temps(temps_c)
         f = self._raw(raw)
         out = np.empty(len(self.names))
@@ -615,8 +1026,23 @@ class CalibrationStream:
     def update_block(
         self, time_s: npt.ArrayLike, temps_c: npt.ArrayLike, raw: npt.ArrayLike
     ) -> tuple[FloatArray, FloatArray]:
-        """A block of samples: ``temps_c`` (n, k), ``raw`` (n, N) → (model values,
-        corrected outputs), both (n, N) in each channel's data unit."""
+        """Compensate a block of samples of every channel.
+
+        Parameters
+        ----------
+        time_s : array_like
+            Times (n,) [s], strictly increasing.
+        temps_c : array_like
+            (n, k) temperatures [°C] in :attr:`temperature_names` order.
+        raw : array_like
+            (n, N) raw outputs [each channel's data unit].
+
+        Returns
+        -------
+        tuple of numpy.ndarray
+            (model values ŷ, corrected outputs ``F − ŷ``), both (n, N) in each
+            channel's data unit.
+        """
         t = np.asarray(time_s, dtype=np.float64).reshape(-1)
         T = self._temps(np.asarray(temps_c, dtype=np.float64).reshape(t.size, -1))
         f = self._raw(np.asarray(raw, dtype=np.float64).reshape(t.size, -1))
@@ -637,8 +1063,19 @@ class CalibrationStream:
 
 
 def chunk_context(model: TemperatureModel) -> ChunkContext:
-    """The :class:`ChunkContext` the model's family declares
-    (:meth:`TemperatureModel.chunk_context`; ``None`` fields: stream instead)."""
+    """The :class:`ChunkContext` the model's family declares.
+
+    Parameters
+    ----------
+    model : TemperatureModel
+        A fitted model (:meth:`TemperatureModel.chunk_context`).
+
+    Returns
+    -------
+    ChunkContext
+        Head and tail spans [s]; ``None`` fields (an infinite head included): stream
+        sample by sample instead.
+    """
     ctx = model.chunk_context()
     if ctx.head_s is not None and not math.isfinite(ctx.head_s):
         return ChunkContext(head_s=None, tail_s=ctx.tail_s)
@@ -654,6 +1091,19 @@ class ChunkPredictor:
     chunk.  When head and tail meet they are one contiguous stretch; otherwise
     the jump in time between them is a gap, which the model treats like any gap.
     Families without a finite context are streamed sample by sample.
+
+    Parameters
+    ----------
+    model : TemperatureModel
+        A fitted model.
+    extrapolate : bool, optional
+        Passed to ``predict``; default ``False``.
+    name : str, optional
+        Name of the data in the warning; default ``""`` (``"data"``).
+    known_input : float, optional
+        The true input [model unit]; default 0.
+    sample_interval_s : float, optional
+        Sample interval [s]; default the first chunk's median interval.
     """
 
     MARGIN_SAMPLES = 4
@@ -689,10 +1139,26 @@ class ChunkPredictor:
 
     @property
     def streams(self) -> bool:
+        """Whether the model is streamed sample by sample (no finite context)."""
         return self.context.head_s is None or self.context.tail_s is None
 
     def predict(self, time_s: FloatArray, temps_c: FloatArray, signal: FloatArray) -> FloatArray:
-        """ŷ for the next chunk of rows (in order) [model unit]."""
+        """ŷ for the next chunk of rows (in order).
+
+        Parameters
+        ----------
+        time_s : numpy.ndarray
+            Times (n,) [s], after the previous chunk's.
+        temps_c : numpy.ndarray
+            Temperatures (n, k) [°C].
+        signal : numpy.ndarray
+            Raw signal (n,) [model unit].
+
+        Returns
+        -------
+        numpy.ndarray
+            ŷ (n,) [model unit], equal to a whole-run ``predict`` on these rows.
+        """
         n = time_s.size
         if n == 0:
             return np.zeros(0)
@@ -710,7 +1176,24 @@ class ChunkPredictor:
     ) -> list[FloatArray]:
         """ŷ of this predictor's model and of each follower's (several channels whose
         ``poly`` models share one evaluation, :func:`thermocal.models.poly.predict_many`):
-        the context is carried once, here; the followers' counts follow."""
+        the context is carried once, here; the followers' counts follow.
+
+        Parameters
+        ----------
+        time_s : numpy.ndarray
+            Times (n,) [s].
+        temps_c : numpy.ndarray
+            Temperatures (n, k) [°C].
+        signal : numpy.ndarray
+            Raw signal (n,) [model unit].
+        followers : sequence of ChunkPredictor
+            Predictors whose models are evaluated together with this one.
+
+        Returns
+        -------
+        list of numpy.ndarray
+            ŷ (n,) of this model then of each follower [each model's unit].
+        """
         n = time_s.size
         if n == 0:
             return [np.zeros(0) for _ in range(1 + len(followers))]

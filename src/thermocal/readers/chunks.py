@@ -99,6 +99,16 @@ def csv_head(path: Path) -> Head:
 def parquet_head(path: Path) -> Head:
     """The column names, thermocal key-value metadata and number of rows of a Parquet file.
 
+    Parameters
+    ----------
+    path : pathlib.Path
+        The Parquet file.
+
+    Returns
+    -------
+    Head
+        ``(column names, thermocal metadata dict, number of rows)``.
+
     Raises
     ------
     thermocal.errors.FileFormatError
@@ -116,6 +126,16 @@ def station_head(path: Path) -> Head:
     """Columns, metadata (the last closed part's, as
     :func:`~thermocal.readers.station.read_station` reads it) and row count of a station
     recording ``DIR/SENSOR`` (its closed Parquet parts, in order).
+
+    Parameters
+    ----------
+    path : pathlib.Path
+        ``DIR`` or ``DIR/SENSOR``.
+
+    Returns
+    -------
+    Head
+        ``(column names, thermocal metadata dict, number of rows)`` over every part.
 
     Raises
     ------
@@ -140,7 +160,25 @@ def station_head(path: Path) -> Head:
 
 def parquet_chunks(path: Path, chunk_rows: int) -> Iterator[pa.RecordBatch]:
     """The rows of a Parquet file, ``chunk_rows`` at a time, its pages checked against their
-    checksums; a read failure mid-file is a :class:`~thermocal.errors.FileFormatError`."""
+    checksums; a read failure mid-file is a :class:`~thermocal.errors.FileFormatError`.
+
+    Parameters
+    ----------
+    path : pathlib.Path
+        The Parquet file.
+    chunk_rows : int
+        Rows per chunk.
+
+    Yields
+    ------
+    pyarrow.RecordBatch
+        Up to ``chunk_rows`` rows each.
+
+    Raises
+    ------
+    FileFormatError
+        An unreadable file or a page whose checksum fails.
+    """
     try:
         # a buffered stream without pre-buffering: with the defaults the reader's
         # allocations grow with the file (≈ 20 B/row); this way they stay at ≈ 1 MB
@@ -153,15 +191,64 @@ def parquet_chunks(path: Path, chunk_rows: int) -> Iterator[pa.RecordBatch]:
 
 
 def station_chunks(path: Path, chunk_rows: int) -> Iterator[pa.RecordBatch]:
-    """The closed parts of a station recording in order, each in chunks (constant memory)."""
+    """The closed parts of a station recording in order, each in chunks (constant memory).
+
+    Parameters
+    ----------
+    path : pathlib.Path
+        ``DIR`` or ``DIR/SENSOR``.
+    chunk_rows : int
+        Rows per chunk.
+
+    Yields
+    ------
+    pyarrow.RecordBatch
+        Up to ``chunk_rows`` rows each.
+
+    Raises
+    ------
+    FileFormatError
+        No closed part, or an unreadable part.
+    """
     for f in station_files(path):
         yield from parquet_chunks(f, chunk_rows)
 
 
 def csv_chunks(path: Path, chunk_rows: int) -> Iterator[pd.DataFrame]:
-    """The rows of a CSV or text log, ``chunk_rows`` at a time, in its detected layout; a
+    r"""The rows of a CSV or text log, ``chunk_rows`` at a time, in its detected layout; a
     parse failure mid-file is a :class:`~thermocal.errors.FileFormatError` naming the file
-    (a Ctrl-C inside pandas' parser stays a KeyboardInterrupt)."""
+    (a Ctrl-C inside pandas' parser stays a KeyboardInterrupt).
+
+    Parameters
+    ----------
+    path : pathlib.Path
+        The CSV or text log (``.gz`` allowed).
+    chunk_rows : int
+        Rows per chunk.
+
+    Yields
+    ------
+    pandas.DataFrame
+        Up to ``chunk_rows`` rows each, column names stripped of blanks.
+
+    Raises
+    ------
+    FileFormatError
+        A line that cannot be parsed, or text that cannot be decoded.
+    ThermocalInputError
+        A text log without a header row.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> from thermocal.readers.chunks import csv_chunks
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     p = Path(d, "run.csv")
+    ...     _ = p.write_text("time, T1, gyro\n0,25.0,1.5\n1,25.1,1.6\n2,25.2,1.7\n")
+    ...     [(list(c.columns), len(c)) for c in csv_chunks(p, 2)]
+    [(['time', 'T1', 'gyro'], 2), (['time', 'T1', 'gyro'], 1)]
+    """
     enc = csv_encoding(path)
     with warnings.catch_warnings():  # csv_head stated the layout already
         warnings.simplefilter("ignore", TextLayoutWarning)

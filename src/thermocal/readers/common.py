@@ -43,7 +43,13 @@ else:
 def csv_float_options() -> dict[str, Any]:
     """``pandas.read_csv`` options that parse every decimal to the nearest float64 (pandas < 3's
     default parser can be one ulp off; pandas 3 is exact by default and deprecates the option).
-    A function so that importing this module does not import pandas."""
+    A function so that importing this module does not import pandas.
+
+    Returns
+    -------
+    dict
+        ``{"float_precision": "round_trip"}`` under pandas < 3, else ``{}``.
+    """
     major = int(pd.__version__.split(".")[0])
     return {"float_precision": "round_trip"} if major < 3 else {}
 
@@ -53,6 +59,34 @@ def csv_encoding(path: str | Path, probe_bytes: int = 1 << 16) -> str:
     mark) when its start decodes as UTF-8, else ``latin-1`` (Western lab PCs and
     instrument software write it; a ``°`` in a header is the usual case, stated in a
     warning).  UTF-16/32 (NUL bytes) are refused with the remedy.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        The CSV file.
+    probe_bytes : int, optional
+        How many bytes of the start are decoded [bytes]; default 65 536.
+
+    Returns
+    -------
+    str
+        ``"utf-8-sig"`` or ``"latin-1"``.
+
+    Raises
+    ------
+    FileFormatError
+        UTF-16/32 text (NUL bytes).
+    ThermocalInputError
+        A special file (FIFO, device) instead of a regular file.
+
+    Warns
+    -----
+    TextEncodingWarning
+        The start is not UTF-8: read as Latin-1.
+
+    References
+    ----------
+    - RFC 4180, *Common Format and MIME Type for Comma-Separated Values (CSV) Files*, 2005.
     """
     refuse_special_input(path)
     p = Path(path)
@@ -94,7 +128,17 @@ def memory_budget(limit_bytes: int | None) -> Iterator[None]:
     """Within the block, :func:`memory_limit_bytes` is at most ``limit_bytes`` (None: no
     change) in this thread's context: a fleet unit on a Dask worker reads within the
     worker's own memory limit, not the machine's (a 4 MB Parquet of 3e8
-    rows passes the machine's check and the worker's nanny kills it)."""
+    rows passes the machine's check and the worker's nanny kills it).
+
+    Parameters
+    ----------
+    limit_bytes : int or None
+        The memory limit within the block [bytes]; ``None`` leaves the limit unchanged.
+
+    Yields
+    ------
+    None
+    """
     token = _BUDGET.set(limit_bytes)
     try:
         yield
@@ -105,7 +149,18 @@ def memory_budget(limit_bytes: int | None) -> Iterator[None]:
 def memory_limit_bytes() -> int | None:
     """Memory a read may use [bytes]: ``THERMOCAL_MEMORY_LIMIT`` (``2G``, ``512M``, bytes)
     when set, else half the kernel's ``MemAvailable`` (:data:`MEMORY_SHARE`); None where
-    neither is known; at most the budget of an enclosing :func:`memory_budget`."""
+    neither is known; at most the budget of an enclosing :func:`memory_budget`.
+
+    Returns
+    -------
+    int or None
+        The limit [bytes], or ``None`` when unknown.
+
+    Raises
+    ------
+    ThermocalInputError
+        ``THERMOCAL_MEMORY_LIMIT`` set to something that is not a size.
+    """
     base = _machine_limit_bytes()
     budget = _BUDGET.get()
     if budget is None:
@@ -144,7 +199,13 @@ def _machine_limit_bytes() -> int | None:
 
 
 def mem_available_bytes() -> int | None:
-    """The kernel's ``MemAvailable`` [bytes] (``/proc/meminfo``), None where unknown."""
+    """The kernel's ``MemAvailable`` [bytes] (``/proc/meminfo``), None where unknown.
+
+    Returns
+    -------
+    int or None
+        Available memory [bytes], or ``None`` off Linux or when unreadable.
+    """
     try:
         with open("/proc/meminfo", encoding="ascii") as fh:
             for line in fh:
@@ -156,11 +217,31 @@ def mem_available_bytes() -> int | None:
 
 
 def check_memory(path: Path, n_rows: int, n_columns: int, *, estimated: bool = False) -> None:
-    """Refuse up front a read that would not fit in memory .
+    r"""Refuse up front a read that would not fit in memory.
 
     Needed ≈ ``n_rows · (8 · n_columns + 40)`` bytes (the float64 columns plus the
     commands' working memory); compared with :func:`memory_limit_bytes`. The error gives
     both figures and the ways out (cut the file; ``compensate`` streams it).
+
+    Parameters
+    ----------
+    path : pathlib.Path
+        The file named in the error.
+    n_rows : int
+        Rows to read.
+    n_columns : int
+        Numeric columns to read.
+    estimated : bool, optional
+        Whether ``n_rows`` is an estimate (the message says "about"); default ``False``.
+
+    Raises
+    ------
+    ThermocalInputError
+        The read needs more memory than :func:`memory_limit_bytes`.
+
+    Notes
+    -----
+    .. math:: \mathrm{need} = n_{\mathrm{rows}}\,(8\,n_{\mathrm{columns}} + 40)\ \mathrm{bytes}
     """
     limit = memory_limit_bytes()
     need = n_rows * (BYTES_PER_VALUE * n_columns + WORKING_BYTES_PER_ROW)
@@ -176,7 +257,21 @@ def check_memory(path: Path, n_rows: int, n_columns: int, *, estimated: bool = F
 
 
 def csv_rows_estimate(path: Path, probe_bytes: int = 1 << 16) -> tuple[int, int]:
-    """(rows, columns) of a CSV estimated from its size and its first lines."""
+    """(rows, columns) of a CSV estimated from its size and its first lines.
+
+    Parameters
+    ----------
+    path : pathlib.Path
+        The CSV file.
+    probe_bytes : int, optional
+        How many bytes of the start are looked at [bytes]; default 65 536.
+
+    Returns
+    -------
+    tuple of (int, int)
+        Estimated rows (file size / mean line length of the probe) and columns (the
+        header's separators + 1).
+    """
     size = path.stat().st_size
     with open(path, "rb") as fh:
         head = fh.read(probe_bytes)
@@ -191,19 +286,58 @@ def csv_rows_estimate(path: Path, probe_bytes: int = 1 << 16) -> tuple[int, int]
 
 def short_name(name: str, limit: int = 60) -> str:
     """``repr`` of a column name for a message, cut to ``limit`` characters (a header of
-    megabytes must not become a message of megabytes)."""
+    megabytes must not become a message of megabytes).
+
+    Parameters
+    ----------
+    name : str
+        A column name.
+    limit : int, optional
+        Characters kept; default 60.
+
+    Returns
+    -------
+    str
+        The ``repr``, cut with its full length stated.
+    """
     return repr(name) if len(name) <= limit else repr(name[:limit]) + f"… ({len(name):,} chars)"
 
 
 def names_list(names: Sequence[str], limit: int = 20) -> str:
-    """Column names for a message: the first ``limit``, each cut (:func:`short_name`)."""
+    """Column names for a message: the first ``limit``, each cut (:func:`short_name`).
+
+    Parameters
+    ----------
+    names : sequence of str
+        Column names.
+    limit : int, optional
+        Names shown; default 20.
+
+    Returns
+    -------
+    str
+        Comma-separated names, with how many more there are.
+    """
     shown = ", ".join(short_name(c) for c in names[:limit])
     return shown + (f", … ({len(names) - limit:,} more)" if len(names) > limit else "")
 
 
 def check_unique_names(path: str | Path, names: Sequence[str]) -> None:
     """Refuse a header that names a column twice (compared after stripping blanks): which
-    of the two a command would read is a guess (:class:`FileFormatError` naming it)."""
+    of the two a command would read is a guess (:class:`FileFormatError` naming it).
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        The file named in the error.
+    names : sequence of str
+        The header's column names.
+
+    Raises
+    ------
+    FileFormatError
+        A name that appears twice (blank names excepted).
+    """
     seen: dict[str, int] = {}
     for k, raw in enumerate(names):
         name = str(raw).strip()
@@ -233,6 +367,18 @@ class LibraryNoise:
         self._part = ""
 
     def write(self, text: str) -> int:
+        """Count the lines of ``text`` (the file-like protocol of :data:`sys.stdout`).
+
+        Parameters
+        ----------
+        text : str
+            Text a library printed.
+
+        Returns
+        -------
+        int
+            ``len(text)``, as :meth:`io.TextIOBase.write` returns.
+        """
         self._part += text
         if "\n" in self._part:
             *done, self._part = self._part.split("\n")
@@ -241,7 +387,7 @@ class LibraryNoise:
         return len(text)
 
     def flush(self) -> None:
-        pass
+        """Nothing to flush (the file-like protocol)."""
 
     def _count(self, line: str) -> None:
         line = line.strip()
@@ -254,12 +400,25 @@ class LibraryNoise:
         self.kinds[kind] = self.kinds.get(kind, 0) + 1
 
     def close(self) -> None:
+        """Count the last, unfinished line."""
         if self._part:
             self._count(self._part)
             self._part = ""
 
     def summary(self, library: str) -> str:
-        """``pymavlink printed 143 652 line(s): 143 650 × 'bad header # at #', …`` or ``""``."""
+        """``pymavlink printed 143 652 line(s): 143 650 × 'bad header # at #', …`` or ``""``.
+
+        Parameters
+        ----------
+        library : str
+            The library's name (``pymavlink``, ``pyulog``).
+
+        Returns
+        -------
+        str
+            One line naming the three most frequent kinds of line, or ``""`` when nothing
+            was printed.
+        """
         if not self.lines:
             return ""
         top = sorted(self.kinds.items(), key=lambda kv: -kv[1])[:3]
@@ -314,11 +473,29 @@ class TrackedReader(io.BufferedReader):
     def short_read(self) -> bool:
         """The last read came back short (some bytes, fewer than asked): a short read can
         only be the last read with data (the file ends there), so it is the last read when
-        nothing was read after it (the position is still where it left off)."""
+        nothing was read after it (the position is still where it left off).
+
+        Returns
+        -------
+        bool
+            Whether the file ended inside the last read (a cut file).
+        """
         end = self.stopped_at if self.closed else self.tell()
         return self._short_at is not None and self._short_at == end and not self._empty_after
 
     def read(self, size: int | None = -1) -> bytes:
+        """Read like :meth:`io.BufferedReader.read`, noting a short read (a cut file).
+
+        Parameters
+        ----------
+        size : int or None, optional
+            Bytes to read; ``-1`` or ``None``: to the end.
+
+        Returns
+        -------
+        bytes
+            The bytes read (fewer than ``size`` only at the end of the file).
+        """
         data = _BUFFERED_READ(self, size)
         if size is None or len(data) != size:  # rare: only at the end of the file
             if data and size is not None and size > 0:
@@ -330,6 +507,7 @@ class TrackedReader(io.BufferedReader):
     _empty_after = False
 
     def close(self) -> None:
+        """Close the file, noting where reading stopped (:attr:`stopped_at`)."""
         if self.stopped_at is None and not self.closed:
             self.stopped_at = self.tell()
         super().close()
@@ -339,6 +517,20 @@ _BUFFERED_READ = io.BufferedReader.read
 
 
 def warn_damage(path: Path, notes: Sequence[str]) -> None:
+    """Warn once that a log is damaged, listing what was found.
+
+    Parameters
+    ----------
+    path : pathlib.Path
+        The log named in the warning.
+    notes : sequence of str
+        What is damaged; no warning when empty.
+
+    Warns
+    -----
+    LogDamageWarning
+        When ``notes`` is not empty.
+    """
     if notes:
         warnings.warn(
             LogDamageWarning(f"{path}: the log is damaged: " + "; ".join(notes)), stacklevel=3
@@ -347,7 +539,18 @@ def warn_damage(path: Path, notes: Sequence[str]) -> None:
 
 def arrow_chunk_f64(chunk: pa.Array) -> FloatArray:
     """A numeric Arrow array as float64, nulls as NaN, without pandas: ``to_numpy`` with
-    copies allowed goes through pyarrow's pandas shim and imports pandas (0.3 s)."""
+    copies allowed goes through pyarrow's pandas shim and imports pandas (0.3 s).
+
+    Parameters
+    ----------
+    chunk : pyarrow.Array
+        A numeric Arrow array (any integer or float type).
+
+    Returns
+    -------
+    numpy.ndarray
+        float64 values, NaN where the array is null.
+    """
     if not pa.types.is_float64(chunk.type):
         chunk = chunk.cast(pa.float64())
     if chunk.null_count:
@@ -370,7 +573,24 @@ TEMPERATURE_NAME = re.compile(r"^(t\d+|t_|temp|tmp)|temperature|°c|degc", re.IG
 
 def named_like_temperature(name: str) -> bool:
     """A column named like a temperature (:data:`TEMPERATURE_NAME`, or a capital ``T``
-    alone: ``t`` is time, ``T`` temperature)."""
+    alone: ``t`` is time, ``T`` temperature).
+
+    Parameters
+    ----------
+    name : str
+        A column name.
+
+    Returns
+    -------
+    bool
+        Whether the name reads as a temperature.
+
+    Examples
+    --------
+    >>> from thermocal.readers.common import named_like_temperature
+    >>> [named_like_temperature(c) for c in ("T", "temp_gyro", "t")]
+    [True, True, False]
+    """
     return name.strip() == "T" or TEMPERATURE_NAME.search(name) is not None
 
 
@@ -381,6 +601,26 @@ def default_time_column(names: Sequence[str], stated: str | None = None) -> str:
     Several candidates, or none, give ``"time"`` (and so a missing-column error that
     lists what is there) rather than a guess.  A column named like a temperature
     (:func:`named_like_temperature`: ``T``) is never taken for time.
+
+    Parameters
+    ----------
+    names : sequence of str
+        The file's column names.
+    stated : str, optional
+        The time column a sidecar states; default ``None``.
+
+    Returns
+    -------
+    str
+        The time column's name (``"time"`` when none or several candidates).
+
+    Examples
+    --------
+    >>> from thermocal.readers.common import default_time_column
+    >>> default_time_column(["T1", "Time (ms)", "gyro"])
+    'Time (ms)'
+    >>> default_time_column(["T", "gyro"])
+    'time'
     """
     if stated:
         return stated
@@ -447,7 +687,25 @@ def parse_topic(topic: str | None, default: str = DEFAULT_ULOG_TOPIC) -> tuple[s
 def thermocal_metadata(kv: Any, where: str | Path) -> dict[str, Any]:
     """The thermocal metadata object (JSON under :data:`thermocal.recording.META_KEY`) of a
     Parquet file's key-value map ``kv`` (None or without the key: ``{}``); anything that is
-    not a JSON object is a :class:`FileFormatError` naming ``where``."""
+    not a JSON object is a :class:`FileFormatError` naming ``where``.
+
+    Parameters
+    ----------
+    kv : mapping of bytes to bytes or None
+        A Parquet file's key-value metadata.
+    where : str or pathlib.Path
+        The file named in the error.
+
+    Returns
+    -------
+    dict
+        The metadata object; ``{}`` when there is none.
+
+    Raises
+    ------
+    FileFormatError
+        The metadata is not a JSON object.
+    """
     import json
 
     from thermocal.recording import META_KEY
@@ -468,7 +726,22 @@ def sha256_of(path: str | Path) -> str | None:
     """SHA-256 of a file's content, read in 1 MiB blocks; None when it cannot be read (a
     report states it unknown; the fleet redoes a unit whose input is missing).  A model
     file's provenance uses :func:`thermocal.pipeline.model_file.file_sha256`, which also reads a
-    station folder and lets a read error through."""
+    station folder and lets a read error through.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        The file.
+
+    Returns
+    -------
+    str or None
+        The hexadecimal SHA-256 digest, or ``None`` when unreadable or special.
+
+    References
+    ----------
+    - NIST FIPS 180-4, *Secure Hash Standard (SHS)*, 2015.
+    """
     h = hashlib.sha256()
     if special_mode(Path(path)) is not None:  # a FIFO would block: never opened
         return None

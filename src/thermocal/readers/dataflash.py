@@ -77,7 +77,19 @@ logging fills its last page; pymavlink ignores up to this many, DFReader.py)."""
 class ParamChange:
     """A parameter set again later in a DataFlash log with another value: a ``PARM`` message
     (``TimeUS`` [µs] → ``time_s`` [s], the log's clock) whose value differs from the value of
-    that name in force before it (``old``)."""
+    that name in force before it (``old``).
+
+    Attributes
+    ----------
+    time_s : float
+        When the new value was set, on the log's clock [s].
+    name : str
+        The parameter's name.
+    old : float
+        The value in force before.
+    new : float
+        The value set.
+    """
 
     time_s: float
     name: str
@@ -85,6 +97,13 @@ class ParamChange:
     new: float
 
     def to_dict(self) -> dict[str, float | str]:
+        """The change as a JSON-ready mapping.
+
+        Returns
+        -------
+        dict
+            ``time_s`` [s], ``name``, ``old`` and ``new``.
+        """
         return {"time_s": self.time_s, "name": self.name, "old": self.old, "new": self.new}
 
 
@@ -94,7 +113,21 @@ class DataflashLog:
     fields), every message type seen, the parameters (``params``: the first value of each
     name, the parameters the recording started with; ``param_changes``: every later ``PARM``
     that changed a value, in log order) and the sentences on what was lost
-    (:func:`_dataflash_loss`)."""
+    (:func:`_dataflash_loss`).
+
+    Attributes
+    ----------
+    rows : dict of str to list of dict
+        Per wanted message type, its messages' numeric fields.
+    names_seen : frozenset of str
+        Every message type in the log.
+    params : dict of str to float
+        The first value of each parameter.
+    notes : tuple of str
+        What was lost to damage.
+    param_changes : tuple of ParamChange
+        Later changes of a parameter's value, in log order.
+    """
 
     rows: dict[str, list[dict[str, float]]]
     names_seen: frozenset[str]
@@ -103,7 +136,13 @@ class DataflashLog:
     param_changes: tuple[ParamChange, ...] = ()
 
     def params_at_end(self) -> dict[str, float]:
-        """The parameters in force at the end of the log (initial values and every change)."""
+        """The parameters in force at the end of the log (initial values and every change).
+
+        Returns
+        -------
+        dict of str to float
+            Parameter name → the last value set.
+        """
         out = dict(self.params)
         for c in self.param_changes:
             out[c.name] = c.new
@@ -154,7 +193,32 @@ def _time_budget(seconds: float) -> Iterator[None]:
 def read_dataflash_log(path: str | Path, messages: Sequence[str]) -> DataflashLog:
     """Read an ArduPilot DataFlash log (:func:`_read_dataflash_log`) within a time budget
     (:data:`READ_BUDGET_S` + :data:`READ_BUDGET_S_PER_MB` per MB): a log pymavlink cannot
-    finish is a :class:`FileFormatError`, never a hang."""
+    finish is a :class:`FileFormatError`, never a hang.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        The DataFlash ``.bin`` log.
+    messages : sequence of str
+        Message names to keep (``IMU``, ``TCLR``, …).
+
+    Returns
+    -------
+    DataflashLog
+        The kept messages' rows, the names seen and notes on damage.
+
+    Raises
+    ------
+    FileFormatError
+        A log pymavlink cannot read, or cannot finish within the time budget.
+    ThermocalInputError
+        A special file (FIFO, device), or pymavlink not installed.
+
+    References
+    ----------
+    - ArduPilot, *Onboard Message Log Messages* and ``libraries/AP_Logger``
+      (``FMT``/``FMTU``/``UNIT``/``MULT`` messages), ardupilot.org.
+    """
     p = Path(path)
     refuse_special_input(p, "DataFlash log")  # pymavlink would block on a FIFO
     try:
@@ -291,7 +355,32 @@ def dataflash_table(
     """Instance ``inst`` of message ``name`` from a :func:`read_dataflash_log` pass, as a
     table with the firmware's units (:data:`ARDUPILOT_UNITS`).  Both layouts: the instance
     field ``I`` (newer firmware) or, for ``IMU.1``/``IMU.2``, the older messages
-    ``IMU2``/``IMU3`` without it; ``T`` or ``Temp`` the temperature."""
+    ``IMU2``/``IMU3`` without it; ``T`` or ``Temp`` the temperature.
+
+    Parameters
+    ----------
+    log : DataflashLog
+        A :func:`read_dataflash_log` pass.
+    path : pathlib.Path
+        The log, named in errors.
+    name : str
+        Message name (``IMU``).
+    inst : int
+        Instance (0-based).
+
+    Returns
+    -------
+    tuple of (pandas.DataFrame, dict)
+        The fields as float64 columns, and what the reader found (time column ``TimeUS``
+        [µs], units, message).
+
+    Raises
+    ------
+    MissingColumnError
+        No such message instance in the log (the message lists those it has).
+    FileFormatError
+        Messages without ``TimeUS`` (a damaged format definition).
+    """
     legacy = f"{name}{inst + 1}" if inst > 0 else None  # IMU2 = IMU.1 in older logs
     rows = [r for r in log.rows.get(name, []) if int(r.get("I", 0)) == inst]
     source = name
@@ -331,7 +420,32 @@ def read_dataflash(path: Path, topic: str | None) -> tuple[pd.DataFrame, dict[st
     table: the message's fields as columns, ``TimeUS`` [µs] the time, the firmware's units
     (:data:`ARDUPILOT_UNITS`, whether or not the log carries unit messages).  Older logs
     name their second and third IMU ``IMU2``/``IMU3`` (no ``I`` field): ``IMU.1`` reads
-    ``IMU2`` (:func:`dataflash_table`).  The log is read once (:func:`read_dataflash_log`)."""
+    ``IMU2`` (:func:`dataflash_table`).  The log is read once (:func:`read_dataflash_log`).
+
+    Parameters
+    ----------
+    path : pathlib.Path
+        The DataFlash ``.bin`` log.
+    topic : str or None
+        ``NAME`` or ``NAME.INSTANCE``; ``None``: the default message (``IMU.0``).
+
+    Returns
+    -------
+    tuple of (pandas.DataFrame, dict)
+        As :func:`dataflash_table`.
+
+    Raises
+    ------
+    FileFormatError
+        An unreadable log.
+    MissingColumnError
+        No such message instance.
+
+    References
+    ----------
+    - ArduPilot, *Onboard Message Log Messages* and ``libraries/AP_Logger``
+      (``FMT``/``FMTU``/``UNIT``/``MULT`` messages), ardupilot.org.
+    """
     name, inst = parse_topic(topic, DEFAULT_DATAFLASH_TOPIC)
     wanted = [name] + ([f"{name}{inst + 1}"] if inst > 0 else [])
     log = read_dataflash_log(path, wanted)

@@ -256,7 +256,26 @@ def time_hint(names: list[str], banner: Sequence[str] = ()) -> str:
     """What to give when no time column is found: ``--time`` or ``--rate``, naming a
     sample counter (the time with ``--rate``), a rate the file's banner states
     (``banner``: its lines) or a column named like a temperature (not time) among
-    ``names``."""
+    ``names``.
+
+    Parameters
+    ----------
+    names : list of str
+        The file's column names.
+    banner : sequence of str, optional
+        The banner lines skipped before the data; default none.
+
+    Returns
+    -------
+    str
+        A parenthesised hint, beginning with a blank, to end an error message.
+
+    Examples
+    --------
+    >>> from thermocal.readers.dispatch import time_hint
+    >>> time_hint(["n", "gyro"], ["rate: 50 Hz"])
+    " (the file's banner says 'rate: 50 Hz': give --rate 50)"
+    """
     counter = counter_column(names)
     temp_like = [n for n in names if named_like_temperature(n)]
     stated = [(b, m.group(4)) for b in banner if (m := _BANNER_RATE.match(b))]

@@ -320,6 +320,16 @@ def registered_formats() -> tuple[FileFormat, ...]:
 def format_named(name: str) -> FileFormat:
     """The registered format called ``name``.
 
+    Parameters
+    ----------
+    name : str
+        The format's registered name (``"csv"``, ``"parquet"``, ``"ulog"``, …).
+
+    Returns
+    -------
+    FileFormat
+        Its registry entry.
+
     Raises
     ------
     thermocal.errors.ParameterError
@@ -354,6 +364,7 @@ def format_of(path: str | Path) -> FileFormat:
     Returns
     -------
     FileFormat
+        The registry entry that reads the file.
 
     Raises
     ------
@@ -394,7 +405,22 @@ def _by_suffix(path: str | Path) -> FileFormat:
 
 def file_kind(path: str | Path) -> str:
     """The name of a file's format by its suffix alone (``"csv"``, ``"parquet"``, ``"ulog"``,
-    ``"dataflash"`` or a plugin's); :class:`~thermocal.errors.FileFormatError` otherwise.
+    ``"dataflash"`` or a plugin's).
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        The file.
+
+    Returns
+    -------
+    str
+        The registered format's name.
+
+    Raises
+    ------
+    thermocal.errors.FileFormatError
+        No registered format has the file's suffix, or the file is an unfinished output.
 
     Examples
     --------

@@ -139,7 +139,23 @@ class ReadOptions:
             raise ParameterError("names", f"{{name}} repeats a name: {list(self.names)}")
 
     def replace(self, **changes: Any) -> ReadOptions:
-        """A copy with ``changes`` (field = value), checked as a new object is."""
+        """A copy with ``changes`` (field = value), checked as a new object is.
+
+        Parameters
+        ----------
+        **changes
+            Field names and their new values.
+
+        Returns
+        -------
+        ReadOptions
+            The new options.
+
+        Raises
+        ------
+        thermocal.errors.ParameterError
+            A new value out of its bounds (as in the constructor).
+        """
         return dataclasses.replace(self, **changes)
 
     @property

@@ -29,7 +29,20 @@ CHAMBER_STREAM = "chamber"
 
 
 def closed_parts(out_dir: Path, stream: str | None = None) -> list[tuple[str, int, Path]]:
-    """Closed parts in ``out_dir`` as ``(stream, index, path)``, in stream and index order."""
+    """Closed parts in ``out_dir`` as ``(stream, index, path)``, in stream and index order.
+
+    Parameters
+    ----------
+    out_dir : pathlib.Path
+        The station folder.
+    stream : str, optional
+        Only this stream's parts (a sensor id or ``chamber``); default all.
+
+    Returns
+    -------
+    list of (str, int, pathlib.Path)
+        Stream, part index and path of each closed part.
+    """
     out = []
     for p in out_dir.iterdir():
         m = PART_RE.match(p.name)
@@ -39,6 +52,24 @@ def closed_parts(out_dir: Path, stream: str | None = None) -> list[tuple[str, in
 
 
 def read_station_json(out_dir: Path) -> dict[str, Any]:
+    """Read and check a folder's ``station.json``.
+
+    Parameters
+    ----------
+    out_dir : pathlib.Path
+        The station folder.
+
+    Returns
+    -------
+    dict
+        The station file's object (format, version, sensors).
+
+    Raises
+    ------
+    FileFormatError
+        No ``station.json``, invalid JSON, not a thermocal station file, a version that is
+        not an integer or newer than this thermocal's, or bad sensor ids.
+    """
     p = out_dir / STATION_JSON
     if not p.is_file():
         raise FileFormatError(f"{out_dir}: not a station recording (no {STATION_JSON})")
@@ -60,7 +91,18 @@ def read_station_json(out_dir: Path) -> dict[str, Any]:
 
 
 def is_station_path(path: Path) -> bool:
-    """``DIR`` or ``DIR/SENSOR`` of a station recording."""
+    """``DIR`` or ``DIR/SENSOR`` of a station recording.
+
+    Parameters
+    ----------
+    path : pathlib.Path
+        A path given by the user.
+
+    Returns
+    -------
+    bool
+        Whether it is a station folder, or a sensor inside one.
+    """
     if path.is_dir():
         return (path / STATION_JSON).is_file()
     return not path.exists() and (path.parent / STATION_JSON).is_file()
@@ -88,7 +130,18 @@ def _checked_sensor_ids(doc: dict[str, Any], where: Path) -> list[str]:
 
 
 def sensor_ids(doc: dict[str, Any]) -> list[str]:
-    """The sensor ids of a station file read by :func:`read_station_json` (checked there)."""
+    """The sensor ids of a station file read by :func:`read_station_json` (checked there).
+
+    Parameters
+    ----------
+    doc : dict
+        The station file's object.
+
+    Returns
+    -------
+    list of str
+        The sensor ids, in the file's order.
+    """
     return _checked_sensor_ids(doc, Path(STATION_JSON))
 
 
@@ -117,7 +170,25 @@ def with_sensor(path: Path, sensor: str | None) -> Path:
     """``DIR/SENSOR`` for ``--sensor SENSOR`` (every command reads
     DIR as one recording, with --sensor ID when there are several).  ``path`` is ``DIR`` or
     ``DIR/ID``; without ``sensor`` it is returned as it is.  A sensor the recording does not
-    have, or ``DIR/A`` with ``--sensor B``, is a :class:`FileFormatError` naming the sensors."""
+    have, or ``DIR/A`` with ``--sensor B``, is a :class:`FileFormatError` naming the sensors.
+
+    Parameters
+    ----------
+    path : pathlib.Path
+        ``DIR`` or ``DIR/ID``.
+    sensor : str or None
+        The sensor id chosen by the user.
+
+    Returns
+    -------
+    pathlib.Path
+        ``DIR/SENSOR`` (or ``path`` unchanged without ``sensor``).
+
+    Raises
+    ------
+    FileFormatError
+        A sensor the recording does not have, or two different sensors named.
+    """
     if sensor is None:
         return path
     if not path.is_dir():
@@ -137,12 +208,46 @@ def with_sensor(path: Path, sensor: str | None) -> Path:
 
 def station_sensor_paths(paths: Sequence[Path], sensor: str | None) -> list[Path]:
     """``paths`` with every station folder given as ``DIR`` turned into ``DIR/SENSOR``
-    (:func:`with_sensor`): what provenance records and hashes.  Other files are unchanged."""
+    (:func:`with_sensor`): what provenance records and hashes.  Other files are unchanged.
+
+    Parameters
+    ----------
+    paths : sequence of pathlib.Path
+        Paths given by the user.
+    sensor : str or None
+        The sensor id chosen by the user.
+
+    Returns
+    -------
+    list of pathlib.Path
+        The paths with each station folder narrowed to its sensor.
+
+    Raises
+    ------
+    FileFormatError
+        As :func:`with_sensor`.
+    """
     return [with_sensor(p, sensor) if is_station_path(p) else p for p in paths]
 
 
 def station_files(path: Path) -> list[Path]:
-    """The closed parts of ``DIR`` or ``DIR/SENSOR``, in order (the recording's content)."""
+    """The closed parts of ``DIR`` or ``DIR/SENSOR``, in order (the recording's content).
+
+    Parameters
+    ----------
+    path : pathlib.Path
+        ``DIR`` or ``DIR/SENSOR``.
+
+    Returns
+    -------
+    list of pathlib.Path
+        The closed Parquet parts, in index order.
+
+    Raises
+    ------
+    FileFormatError
+        No closed part of the stream yet (or not a station folder).
+    """
     out_dir, stream = _stream_of(path)
     parts = closed_parts(out_dir, stream)
     if not parts:
@@ -154,7 +259,24 @@ def read_station(path: Path) -> tuple[pa.Table, dict[str, Any]]:
     """A station recording as one table: ``DIR`` (its only sensor) or ``DIR/SENSOR`` (one
     of several, or ``DIR/chamber``).  The closed parts are concatenated in order; the
     metadata object is the last part's.  Raises :class:`FileFormatError` naming what is
-    missing."""
+    missing.
+
+    Parameters
+    ----------
+    path : pathlib.Path
+        ``DIR`` or ``DIR/SENSOR``.
+
+    Returns
+    -------
+    tuple of (pyarrow.Table, dict)
+        The concatenated parts and the last part's thermocal metadata.
+
+    Raises
+    ------
+    FileFormatError
+        Not a station recording, no closed part, a corrupt part, or parts whose columns
+        or units differ.
+    """
     import pyarrow as pa
     import pyarrow.parquet as pq
 
@@ -206,7 +328,23 @@ def _same_units(p: Path, m: dict[str, Any], last: Path, m_last: dict[str, Any]) 
 
 
 def read_station_table(p: Path) -> tuple[pd.DataFrame, dict[str, Any]]:
-    """The closed Parquet parts of a station recording as one table (:func:`read_station`)."""
+    """The closed Parquet parts of a station recording as one table (:func:`read_station`).
+
+    Parameters
+    ----------
+    p : pathlib.Path
+        ``DIR`` or ``DIR/SENSOR``.
+
+    Returns
+    -------
+    tuple of (pandas.DataFrame, dict)
+        The data and the last part's thermocal metadata.
+
+    Raises
+    ------
+    FileFormatError
+        As :func:`read_station`.
+    """
     table, meta = read_station(p)
     return table.to_pandas(), meta
 

@@ -32,6 +32,23 @@ else:
 
 
 def load_sidecar(path: Path) -> dict[str, Any]:
+    """The metadata sidecar of a CSV file (``FILE.meta.json``), or ``{}`` when there is none.
+
+    Parameters
+    ----------
+    path : pathlib.Path
+        The data file (not the sidecar).
+
+    Returns
+    -------
+    dict
+        The sidecar's object (units, scale factor, time column, …).
+
+    Raises
+    ------
+    FileFormatError
+        A sidecar that is not valid JSON or not a JSON object.
+    """
     side = sidecar_path(path)
     if not side.exists():
         return {}
@@ -48,7 +65,22 @@ def load_sidecar(path: Path) -> dict[str, Any]:
 
 class ParquetColumns:
     """Columns of a Parquet file read one at a time, so that peak memory stays near
-    the size of the float64 arrays handed back (not the Arrow table plus its copy)."""
+    the size of the float64 arrays handed back (not the Arrow table plus its copy).
+
+    Parameters
+    ----------
+    pf : pyarrow.parquet.ParquetFile
+        The open Parquet file.
+
+    Attributes
+    ----------
+    column_names : list of str
+        The file's column names.
+    num_rows : int
+        Its number of rows.
+    metadata : dict of bytes to bytes
+        Its key-value metadata.
+    """
 
     def __init__(self, pf: pq.ParquetFile) -> None:
         self._pf = pf
@@ -62,7 +94,13 @@ class ParquetColumns:
         """Read the integer and floating-point columns among ``names`` together, one row
         group at a time (pyarrow decodes the columns of a row group on several threads);
         :meth:`column_f64` then hands each one over.  Peak memory: the results plus one
-        row group of these columns."""
+        row group of these columns.
+
+        Parameters
+        ----------
+        names : sequence of str
+            The columns wanted; non-numeric ones are left to :meth:`column`.
+        """
         schema = self._pf.schema_arrow
         todo = [
             n
@@ -95,13 +133,36 @@ class ParquetColumns:
             self._read.update(out)
 
     def column(self, name: str) -> pa.ChunkedArray:
+        """One column as Arrow, read whole.
+
+        Parameters
+        ----------
+        name : str
+            The column's name.
+
+        Returns
+        -------
+        pyarrow.ChunkedArray
+            The column.
+        """
         col: pa.ChunkedArray = self._pf.read(columns=[name], use_threads=True).column(0)
         return col
 
     def column_f64(self, name: str) -> FloatArray | None:
         """A numeric column as float64, read one row group at a time into the result, so
         that the only memory beyond the result is one row group of one column (None for a
-        column that is not integer or floating point: the caller reads it whole)."""
+        column that is not integer or floating point: the caller reads it whole).
+
+        Parameters
+        ----------
+        name : str
+            The column's name.
+
+        Returns
+        -------
+        numpy.ndarray or None
+            float64 values (nulls as NaN), or ``None`` for a non-numeric column.
+        """
         if name in self._read:  # read with others by :meth:`read_f64`
             return self._read.pop(name)
         field_type = self._pf.schema_arrow.field(name).type
@@ -124,7 +185,20 @@ class ParquetColumns:
 def csv_header_names(path: Path, encoding: str) -> list[str]:
     """The names of a comma CSV's header line as written (pandas renames a repeated name
     ``a.1``, so repeats are looked for here).  One pass over the line: linear in its
-    length.  Empty for a header the ``csv`` module cannot split (the reader then says)."""
+    length.  Empty for a header the ``csv`` module cannot split (the reader then says).
+
+    Parameters
+    ----------
+    path : pathlib.Path
+        The CSV file (``.gz`` allowed).
+    encoding : str
+        Its encoding.
+
+    Returns
+    -------
+    list of str
+        The header's names, as written.
+    """
     opener: Callable[..., Any] = open
     if path.name.lower().endswith(".gz"):
         import gzip
@@ -146,7 +220,27 @@ def csv_header_names(path: Path, encoding: str) -> list[str]:
 
 
 def arrow_to_f64(col: pa.ChunkedArray | pa.Array, name: str, path: Path) -> FloatArray:
-    """An Arrow column as float64 (copied chunk by chunk into one array)."""
+    """An Arrow column as float64 (copied chunk by chunk into one array).
+
+    Parameters
+    ----------
+    col : pyarrow.ChunkedArray or pyarrow.Array
+        The column (integer, float, boolean or decimal).
+    name : str
+        Its name, for the error.
+    path : pathlib.Path
+        The file, for the error.
+
+    Returns
+    -------
+    numpy.ndarray
+        float64 values, nulls as NaN.
+
+    Raises
+    ------
+    NonNumericError
+        A column of another type (text, dates).
+    """
     if not (pa.types.is_integer(col.type) or pa.types.is_floating(col.type)):
         if pa.types.is_boolean(col.type) or pa.types.is_decimal(col.type):
             return np.asarray(col.to_numpy(zero_copy_only=False), dtype=np.float64)
@@ -181,6 +275,36 @@ def numeric_column(
     Missing cells become NaN.  A cell that is not a number raises
     :class:`NonNumericError` naming the column and the row (``row_offset`` is the
     file row of the chunk's first row, for chunked readers).
+
+    Parameters
+    ----------
+    obj : pandas.DataFrame or pyarrow.RecordBatch or ParquetColumns
+        The table (or chunk).
+    name : str
+        The column's name.
+    path : str or pathlib.Path
+        The file, named in errors.
+    row_offset : int, optional
+        File row of ``obj``'s first row; default 0.
+
+    Returns
+    -------
+    numpy.ndarray
+        float64 values (n,).
+
+    Raises
+    ------
+    NonNumericError
+        A cell that is not a number (names the column, row and line).
+    FileFormatError
+        A Parquet column that cannot be read.
+
+    Examples
+    --------
+    >>> import pandas as pd
+    >>> from thermocal.readers.table import numeric_column
+    >>> numeric_column(pd.DataFrame({"g": ["1.5", "", "2"]}), "g", "run.csv").tolist()
+    [1.5, nan, 2.0]
     """
     p = Path(path)
     if isinstance(obj, ParquetColumns):

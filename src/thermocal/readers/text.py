@@ -48,7 +48,29 @@ def parse_number(field: str) -> float:
     """A text field as a float, as a CSV reader takes it: ASCII digits, sign, ``.``,
     exponent, or ``nan``/``inf``.  Python's :func:`float` also accepts digit-group
     underscores (``0_5`` → 5.0) and non-ASCII digits (``١٢``); those are malformed numbers
-    here (``ValueError``), so a mangled line is a bad line, not a silent value."""
+    here (``ValueError``), so a mangled line is a bad line, not a silent value.
+
+    Parameters
+    ----------
+    field : str
+        One field of a text line.
+
+    Returns
+    -------
+    float
+        The number.
+
+    Raises
+    ------
+    ValueError
+        A malformed number (underscores, non-ASCII digits, any other text).
+
+    Examples
+    --------
+    >>> from thermocal.readers.text import parse_number
+    >>> parse_number(" -1.5e-3 ")
+    -0.0015
+    """
     if "_" in field or not field.isascii():
         raise ValueError(f"malformed number {field.strip()[:40]!r}")
     return float(field)
@@ -89,24 +111,8 @@ class TextLayout:
         return self.skip == 0 and self.delimiter == "," and self.decimal == "." and self.header
 
 
-def sniff_text(lines: Sequence[str], opts: ReadOptions | None = None) -> TextLayout:
-    """The layout of a text log from its first lines.
-
-    For each candidate delimiter (``, ; tab blanks``, or the one given) the modal number of
-    fields m (≥ 2) of the non-empty, non-``#`` lines; the delimiter whose modal count
-    covers most lines wins (ties: in that order).  Where no line has two fields and most
-    lines are one number, one column (m = 1: Stable32's phase/frequency files).  The data
-    start at the first line with m fields that is numeric (empty fields allowed: missing
-    values), or that names the columns (no field a number) and is followed by a line of m
-    fields (the header); the lines before are skipped, those but ``#`` comments as a
-    banner (a terminal's, a logger's).  Lines further down that do not fit are mangled
-    lines, for ``--on-bad-lines``.  The decimal mark is ``,`` when the delimiter is not a
-    comma and the data parse with ``,`` but not with ``.``.
-    """
-    o = opts or ReadOptions()
-    delims = [o.delimiter] if o.delimiter else list(_DELIMS)
-    delims = ["\t" if d == "\\t" else d for d in delims]
-    body = [x for x in lines if x.strip() and not x.lstrip().startswith("#")]
+def _best_delimiter(body: Sequence[str], delims: Sequence[str]) -> tuple[int, int, str] | None:
+    """(-lines covered by the modal field count, order, delimiter) of the best delimiter."""
     best: tuple[int, int, str] | None = None  # (-covered, order, delimiter)
     for order, d in enumerate(delims):
         counts = [len(_split(x, d)) for x in body]
@@ -117,6 +123,45 @@ def sniff_text(lines: Sequence[str], opts: ReadOptions | None = None) -> TextLay
         key = (-good.count(m), order, d)
         if best is None or key < best:
             best = key
+    return best
+
+
+def sniff_text(lines: Sequence[str], opts: ReadOptions | None = None) -> TextLayout:
+    """The layout of a text log from its first lines.
+
+    For each candidate delimiter (``, ; tab blanks``, or the one given) the modal number of
+    fields m (≥ 2) of the non-empty, non-``#`` lines; the delimiter whose modal count covers
+    most lines wins (ties: in that order). Where no line has two fields and most lines are
+    one number, one column (m = 1: Stable32's phase/frequency files). The data start at the
+    first line with m fields that is numeric (empty fields: missing values), or that names
+    the columns (no field a number) and is followed by a line of m fields (the header); the
+    lines before are skipped, those but ``#`` comments as a banner (a terminal's, a
+    logger's). Lines further down that do not fit are mangled lines, for ``--on-bad-lines``.
+    The decimal mark is ``,`` when the delimiter is not a comma and the data parse with
+    ``,`` but not with ``.``.
+
+    Parameters
+    ----------
+    lines : sequence of str
+        The file's first lines, line ends removed.
+    opts : ReadOptions, optional
+        How the file is read (a given delimiter); default :class:`ReadOptions`.
+
+    Returns
+    -------
+    TextLayout
+        Delimiter, decimal mark, lines to skip, header and number of fields.
+
+    Raises
+    ------
+    FileFormatError
+        No layout found; ``TooManyColumnsError`` (a subclass) for too many columns.
+    """
+    o = opts or ReadOptions()
+    delims = [o.delimiter] if o.delimiter else list(_DELIMS)
+    delims = ["\t" if d == "\\t" else d for d in delims]
+    body = [x for x in lines if x.strip() and not x.lstrip().startswith("#")]
+    best = _best_delimiter(body, delims)
     if best is None:
         # one value a line (Stable32's phase and frequency files, a logger's single column):
         # one column when most lines are one number each
@@ -221,7 +266,20 @@ row (90 000 columns: 40 s; the 500 000 a 1 MiB line can hold: minutes)."""
 
 def check_column_count(path: Path, n_columns: int) -> None:
     """A :class:`FileFormatError` naming ``path`` when it has more than
-    :data:`MAX_COLUMNS` columns."""
+    :data:`MAX_COLUMNS` columns.
+
+    Parameters
+    ----------
+    path : pathlib.Path
+        The file named in the error.
+    n_columns : int
+        The file's number of columns.
+
+    Raises
+    ------
+    FileFormatError
+        More than :data:`MAX_COLUMNS` columns.
+    """
     if n_columns > MAX_COLUMNS:
         raise FileFormatError(
             f"{path}: {n_columns:,} columns, more than the {MAX_COLUMNS:,} a recording may "
@@ -230,7 +288,18 @@ def check_column_count(path: Path, n_columns: int) -> None:
 
 
 def max_line_chars() -> int:
-    """:data:`MAX_LINE_CHARS`, or ``THERMOCAL_MAX_LINE`` when set (a positive integer)."""
+    """:data:`MAX_LINE_CHARS`, or ``THERMOCAL_MAX_LINE`` when set (a positive integer).
+
+    Returns
+    -------
+    int
+        The longest line a text reader accepts [characters].
+
+    Raises
+    ------
+    ThermocalInputError
+        ``THERMOCAL_MAX_LINE`` set to something other than a positive integer.
+    """
     env = os.environ.get("THERMOCAL_MAX_LINE", "").strip()
     if not env:
         return MAX_LINE_CHARS
@@ -245,7 +314,29 @@ def max_line_chars() -> int:
 
 def bounded_line(fh: IO[str], path: Path, lineno: int, limit: int) -> str:
     """The next line of ``fh`` (line end kept; ``""`` at the end) read up to ``limit``
-    characters; a longer one is a :class:`FileFormatError` naming ``path`` and ``lineno``."""
+    characters; a longer one is a :class:`FileFormatError` naming ``path`` and ``lineno``.
+
+    Parameters
+    ----------
+    fh : file-like of str
+        The open text file.
+    path : pathlib.Path
+        The file named in the error.
+    lineno : int
+        The line's number (1-based), named in the error.
+    limit : int
+        Longest line accepted [characters].
+
+    Returns
+    -------
+    str
+        The line, its end kept; ``""`` at the end of the file.
+
+    Raises
+    ------
+    FileFormatError
+        A line longer than ``limit``.
+    """
     line = fh.readline(limit + 1)
     if len(line) > limit and not (len(line) == limit + 1 and line.endswith("\n")):
         raise FileFormatError(
@@ -257,21 +348,78 @@ def bounded_line(fh: IO[str], path: Path, lineno: int, limit: int) -> str:
 
 def head_lines(path: Path, encoding: str, errors: str) -> list[str]:
     """The first :data:`SNIFF_LINES` lines of a text file, line ends removed (each bounded
-    by :func:`max_line_chars`)."""
+    by :func:`max_line_chars`).
+
+    Parameters
+    ----------
+    path : pathlib.Path
+        The text file.
+    encoding : str
+        Its encoding (:func:`~thermocal.readers.common.csv_encoding`).
+    errors : str
+        How decoding errors are handled (``"strict"``, ``"replace"``).
+
+    Returns
+    -------
+    list of str
+        Up to :data:`SNIFF_LINES` lines.
+
+    Raises
+    ------
+    FileFormatError
+        A line longer than :func:`max_line_chars`.
+    """
     limit = max_line_chars()
     with open(path, encoding=encoding, errors=errors, newline="") as fh:
         return [bounded_line(fh, path, k, limit).rstrip("\r\n") for k in range(1, SNIFF_LINES + 1)]
 
 
 def delimiter_name(delimiter: str) -> str:
-    """How a warning names a delimiter: ``tab``, ``blank`` or the quoted character."""
+    """How a warning names a delimiter: ``tab``, ``blank`` or the quoted character.
+
+    Parameters
+    ----------
+    delimiter : str
+        The delimiter.
+
+    Returns
+    -------
+    str
+        ``"tab"``, ``"blank"`` or the quoted character.
+    """
     return {"\t": "tab", " ": "blank"}.get(delimiter, repr(delimiter))
 
 
 def csv_chunk_options(path: Path, encoding: str) -> dict[str, Any]:
     """``pandas.read_csv`` options for reading a text file in chunks (compensate): the
     detected delimiter, decimal mark and banner lines to skip, stated in a warning when
-    not a plain comma CSV; a file without a header row is refused (name the columns)."""
+    not a plain comma CSV; a file without a header row is refused (name the columns).
+
+    Parameters
+    ----------
+    path : pathlib.Path
+        The text file.
+    encoding : str
+        Its encoding.
+
+    Returns
+    -------
+    dict
+        Keyword options for :func:`pandas.read_csv` (``sep``, ``decimal``, ``skiprows``);
+        ``{}`` for a plain comma CSV or a gzip file.
+
+    Raises
+    ------
+    FileFormatError
+        Too many columns.
+    ThermocalInputError
+        A file without a header row.
+
+    Warns
+    -----
+    TextLayoutWarning
+        A layout other than a plain comma CSV.
+    """
     if path.name.lower().endswith(".gz"):
         return {}
     head = head_lines(path, encoding, "replace")
@@ -396,7 +544,33 @@ def read_text(
     """A text log as a DataFrame of floats: banner skipped, delimiter and decimal mark
     detected (or given), header taken from ``--names`` when the file has none, mangled
     lines (another number of fields, a non-number) refused naming the first or, with
-    ``on_bad_lines="skip"``, dropped and counted.  Warnings say what was skipped."""
+    ``on_bad_lines="skip"``, dropped and counted.  Warnings say what was skipped.
+
+    Parameters
+    ----------
+    path : pathlib.Path
+        The text file.
+    encoding : str
+        Its encoding.
+    opts : ReadOptions or None
+        How the file is read (delimiter, names, bad lines); ``None``: the defaults.
+
+    Returns
+    -------
+    tuple of (pandas.DataFrame, dict)
+        The data as float64 columns, and what was found (layout, lines skipped).
+
+    Raises
+    ------
+    FileFormatError
+        No layout, no data row, a mangled line (unless ``on_bad_lines="skip"``), too many
+        columns or too long a line.
+
+    Warns
+    -----
+    TextLayoutWarning
+        Lines skipped or dropped, a layout other than a plain comma CSV.
+    """
     o = opts or ReadOptions()
     head = head_lines(path, encoding, "strict")
     try:
@@ -468,7 +642,18 @@ the time, ``counter / rate`` (imucal's sessions: ``n_samples``)."""
 
 
 def counter_column(names: Sequence[str]) -> str | None:
-    """The one column named like a sample counter (:data:`COUNTER_COLUMN_NAMES`), else None."""
+    """The one column named like a sample counter (:data:`COUNTER_COLUMN_NAMES`), else None.
+
+    Parameters
+    ----------
+    names : sequence of str
+        Column names.
+
+    Returns
+    -------
+    str or None
+        The counter column's name; ``None`` for none or several.
+    """
     found = [c for c in names if c.strip().lower() in COUNTER_COLUMN_NAMES]
     return found[0] if len(found) == 1 else None
 
@@ -484,14 +669,49 @@ def rate_time(
     *,
     allow_column: bool = True,
 ) -> tuple[Any, list[str], str, str | None, str]:
-    """``--rate``: the time of each sample at the stated rate, and how it is found (the
+    r"""``--rate``: the time of each sample at the stated rate, and how it is found (the
     last item): ``"rows"`` — a file without a time column gets ``time = row / rate`` [s],
     the row counted among the log's data lines (a mangled line dropped leaves a gap);
     ``"counter"`` — a sample counter (``--time N``, or the one column named like one,
     :data:`COUNTER_COLUMN_NAMES`) is the time, ``counter / rate`` (:func:`counter_time`);
     ``"stamps"`` — a time column (host timestamps) is replaced by the nominal grid
     (:func:`thermocal.recording.nominal_time`).  The last two are read by the caller;
-    without ``allow_column`` (a command that streams the file) a time column is refused."""
+    without ``allow_column`` (a command that streams the file) a time column is refused.
+
+    Parameters
+    ----------
+    p : pathlib.Path
+        The file, named in messages.
+    obj : pandas.DataFrame or pyarrow.Table
+        The data read so far.
+    names : list of str
+        Its column names.
+    info : dict
+        What the reader found (a stated time column).
+    time : str or None
+        The time (or counter) column given by the user.
+    time_unit : str or None
+        The unit of that column.
+    text : ReadOptions
+        How the file is read; ``rate_hz`` [Hz] must be set.
+    allow_column : bool, optional
+        Whether a time column may be replaced by the nominal grid; default ``True``.
+
+    Returns
+    -------
+    tuple
+        ``(obj, names, time column, time unit, how)`` with ``how`` one of ``"rows"``,
+        ``"counter"``, ``"stamps"``.
+
+    Raises
+    ------
+    ThermocalInputError
+        A time column where none is allowed, or a named column that is missing.
+
+    Notes
+    -----
+    .. math:: t_i = \frac{i}{f_s}\ \mathrm{[s]}, \qquad f_s = \texttt{rate\_hz}
+    """
     assert text.rate_hz is not None
     named = time or info.get("time")
     if named is None and "time" not in names:
@@ -532,9 +752,43 @@ def rate_time(
 
 
 def counter_time(p: Path, col: str, counts: FloatArray, rate_hz: float) -> FloatArray:
-    """A sample counter's time [s]: ``t = n / rate``.  The counter must hold whole numbers
+    r"""A sample counter's time [s]: ``t = n / rate``.  The counter must hold whole numbers
     that increase (a skipped number is a gap: samples lost); anything else is refused,
-    naming the first row that is not."""
+    naming the first row that is not.
+
+    Parameters
+    ----------
+    p : pathlib.Path
+        The file, named in the error.
+    col : str
+        The counter column's name.
+    counts : numpy.ndarray
+        The counter's values.
+    rate_hz : float
+        The sample rate [Hz].
+
+    Returns
+    -------
+    numpy.ndarray
+        Time [s], ``counts / rate_hz``.
+
+    Raises
+    ------
+    ThermocalInputError
+        A value that is not a whole number, or a counter that does not increase.
+
+    Notes
+    -----
+    .. math:: t_i = \frac{n_i}{f_s}
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from pathlib import Path
+    >>> from thermocal.readers.text import counter_time
+    >>> counter_time(Path("log.txt"), "n", np.array([10.0, 11.0, 13.0]), 100.0).tolist()
+    [0.1, 0.11, 0.13]
+    """
     fin = np.isfinite(counts)
     whole = fin & (counts == np.round(counts))
     if not bool(whole.all()):

@@ -93,7 +93,19 @@ def parsed_once(path: str | Path, names: Sequence[str]) -> Iterator[None]:
     topic) is served from ONE pyulog parse of those topics, made at the first read: a
     command that takes several topics of one log reads the file once.  What is read, and
     every warning said, is the same as without the block (the parse is the same, only
-    shared)."""
+    shared).
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        The ULog file.
+    names : sequence of str
+        The topics the commands within the block read.
+
+    Yields
+    ------
+    None
+    """
     cache: _Cache = {(Path(path).resolve(), tuple(sorted(set(names)))): None}  # parsed lazily
     token = _PARSED.set(cache)
     try:
@@ -198,7 +210,25 @@ def ulog_parameter_changes(
     pyulog's ``changed_parameters``, timed by the last data message before it), in log
     order, from the parse of ``topics`` (:func:`_parse_ulog`: within :func:`parsed_once`,
     no second read).  Values equal to those already in force are kept; the caller
-    compares."""
+    compares.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        The ULog file.
+    topics : sequence of str
+        The topics parsed with it (shares the parse).
+
+    Returns
+    -------
+    list of (float, str, float)
+        Time [s], parameter name and value of each change, in log order.
+
+    References
+    ----------
+    - PX4 Autopilot, *ULog File Format*, PX4 User Guide (docs.px4.io,
+      ``dev_log/ulog_file_format``).
+    """
     read = _parse_ulog(Path(path), list(topics))
     return [(float(t) * 1e-6, str(n), float(v)) for t, n, v in read.ulog.changed_parameters]
 
@@ -206,7 +236,25 @@ def ulog_parameter_changes(
 def ulog_sensor_instances(path: str | Path, topics: Sequence[str]) -> list[tuple[str, int]]:
     """The instances of ``topics`` in a ULog that carry a temperature, sorted; every instance
     left out (no ``temperature`` field, or one that is all 0 or NaN: no sensor behind it) is
-    named in a warning, and damage to the log is said (:func:`_parse_ulog`)."""
+    named in a warning, and damage to the log is said (:func:`_parse_ulog`).
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        The ULog file.
+    topics : sequence of str
+        Topic names (``sensor_gyro``, ``sensor_accel``, …).
+
+    Returns
+    -------
+    list of (str, int)
+        ``(topic, multi_id)`` of each instance with a usable temperature, sorted.
+
+    Warns
+    -----
+    LogDamageWarning
+        Instances left out, or damage to the log.
+    """
     p = Path(path)
     read = _parse_ulog(p, list(topics))
     warn_damage(p, read.notes)
@@ -238,7 +286,40 @@ def read_ulog(path: Path, topic: str | None) -> tuple[pd.DataFrame, dict[str, An
     """One topic instance of a PX4 ULog as a table: its fields as columns, ``timestamp``
     [µs] the time, PX4's units for the known topics, the median ``device_id`` as the
     sensor id.  Damage to the log is said in a warning with what was lost
-    (:func:`_parse_ulog`).  Needs ``pyulog`` (``pip install 'thermocal[logs]'``)."""
+    (:func:`_parse_ulog`).  Needs ``pyulog`` (``pip install 'thermocal[logs]'``).
+
+    Parameters
+    ----------
+    path : pathlib.Path
+        The ULog file.
+    topic : str or None
+        ``NAME`` or ``NAME.INSTANCE`` (default instance 0); ``None``: the default topic.
+
+    Returns
+    -------
+    tuple of (pandas.DataFrame, dict)
+        The topic's fields as float64 columns, and what the reader found (time column
+        and its unit, column units, sensor id).
+
+    Raises
+    ------
+    MissingColumnError
+        No such topic instance in the log (the message lists those it has).
+    FileFormatError
+        A missing, empty or unreadable ULog file.
+    ThermocalInputError
+        ``pyulog`` is not installed (``pip install 'thermocal[logs]'``).
+
+    Warns
+    -----
+    LogDamageWarning
+        Damage to the log and the messages lost.
+
+    References
+    ----------
+    - PX4 Autopilot, *ULog File Format*, PX4 User Guide (docs.px4.io,
+      ``dev_log/ulog_file_format``).
+    """
     name, inst = parse_topic(topic)
     read = _parse_ulog(path, [name])
     found = [d for d in read.ulog.data_list if d.name == name and d.multi_id == inst]

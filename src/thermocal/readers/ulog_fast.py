@@ -50,7 +50,33 @@ an unknown message's payload for it)."""
 def message_offsets(buf: bytes | mmap.mmap, start: int) -> tuple[np.ndarray, int]:
     """Offsets (int64) of the messages of ``buf`` from ``start`` (``uint16`` size, ``uint8``
     type, payload) and the position after the last one (``len(buf)`` for a chain that ends
-    exactly at the end of the file)."""
+    exactly at the end of the file).
+
+    Parameters
+    ----------
+    buf : bytes or mmap.mmap
+        The whole file.
+    start : int
+        Byte offset of the first message (the end of the definitions section).
+
+    Returns
+    -------
+    tuple of (numpy.ndarray, int)
+        The messages' byte offsets and the byte position after the last message.
+
+    Examples
+    --------
+    >>> from thermocal.readers.ulog_fast import message_offsets
+    >>> buf = bytes([2, 0, ord("D"), 7, 7, 0, 0, ord("S")])
+    >>> offsets, end = message_offsets(buf, 0)
+    >>> offsets.tolist(), end
+    ([0, 5], 8)
+
+    References
+    ----------
+    - PX4 Autopilot, *ULog File Format*, PX4 User Guide (docs.px4.io,
+      ``dev_log/ulog_file_format``).
+    """
     unpack = _HEADER.unpack_from
     out = array("q")  # compact and faster to append to than a list
     add = out.append
@@ -80,7 +106,25 @@ def _rows(buf: mmap.mmap, at: np.ndarray, itemsize: int) -> np.ndarray:
 def fast_ulog(path: Path, names: Sequence[str] | None) -> Any | None:
     """The ``pyulog.ULog`` of ``path`` with the topics ``names`` (all when None), equal to
     ``ULog(path, message_name_filter_list=names)``, or None when the log is not clean (see
-    the module's docstring): the caller then parses it with pyulog."""
+    the module's docstring): the caller then parses it with pyulog.
+
+    Parameters
+    ----------
+    path : pathlib.Path
+        The ULog file.
+    names : sequence of str or None
+        Topics to keep; ``None``: all.
+
+    Returns
+    -------
+    pyulog.ULog or None
+        The parsed log, or ``None`` when the log is damaged or has no data section.
+
+    References
+    ----------
+    - PX4 Autopilot, *ULog File Format*, PX4 User Guide (docs.px4.io,
+      ``dev_log/ulog_file_format``).
+    """
     from pyulog import ULog
 
     fh = TrackedReader(path)  # pyulog closes it where its definitions parse stopped

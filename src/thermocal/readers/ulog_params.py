@@ -23,7 +23,28 @@ VALUE_CODES = {"float": "<f", "int32_t": "<i"}
 
 def ulog_parameters(path: str | Path) -> dict[str, float]:
     """The initial parameters (``P`` messages of the definitions section) of a ULog, name →
-    value; {} for a file that is not a ULog or has none (the topic reader says why)."""
+    value; {} for a file that is not a ULog or has none (the topic reader says why).
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        The ULog file.
+
+    Returns
+    -------
+    dict of str to float
+        Parameter name → value (``int32_t`` and ``float`` parameters).
+
+    Raises
+    ------
+    ThermocalInputError
+        A special file (FIFO, device) instead of a regular file.
+
+    References
+    ----------
+    - PX4 Autopilot, *ULog File Format*, PX4 User Guide (docs.px4.io,
+      ``dev_log/ulog_file_format``).
+    """
     out: dict[str, float] = {}
     refuse_special_input(path, "ULog")
     with open(path, "rb") as fh:
