@@ -212,7 +212,7 @@ def test_simulate_scenario_labels_and_truth_document() -> None:
     assert opts.given() == {"rate_hz": 0.01, "runs": 2}
     with pytest.raises(ThermocalInputError, match="^rate_hz must be a positive number"):
         SimulateOptions(rate_hz=0.0)
-    with pytest.raises(ThermocalInputError, match="--latitude"):
+    with pytest.raises(ThermocalInputError, match="^latitude_deg "):
         SimulateOptions(latitude_deg=91.0)
 
 
