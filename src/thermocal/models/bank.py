@@ -326,6 +326,7 @@ class Selection:
     complete: bool
 
     def to_dict(self) -> dict[str, Any]:
+        """JSON form of the selection."""
         return {
             "index": self.index,
             "deviations": list(self.deviations),
@@ -832,6 +833,7 @@ class BankModel(TemperatureModel):
         return BankStream(self, extrapolate=extrapolate, known_input=known_input)
 
     def coefficients(self) -> list[Coefficient]:
+        """Each model's value at each breakpoint [signal unit], with standard errors."""
         self.check_fitted()
         out = []
         for m, (b, v, se) in enumerate(
@@ -955,6 +957,7 @@ class BankStream(ModelStream):
         self.reset()
 
     def reset(self) -> None:
+        """Forget everything (a new power-on): the start-up selection starts again."""
         n = len(self._vs)
         self._t_first: float | None = None
         self._sums = [0.0] * n
@@ -966,6 +969,7 @@ class BankStream(ModelStream):
 
     @property
     def selection(self) -> Selection:
+        """The current :class:`Selection`."""
         return _selection(np.array(self._dev, dtype=np.float64), self._count, self._frozen)
 
     def _value(self, m: int, temp: float) -> float:

@@ -77,6 +77,7 @@ class BreakpointChoice:
         return self.chosen < self.requested
 
     def to_dict(self) -> dict[str, Any]:
+        """JSON form of the choice."""
         return {
             "method": "BIC of the continuous fit on temperature-binned means",
             "segments_requested": self.requested,

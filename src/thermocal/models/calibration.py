@@ -327,6 +327,7 @@ class Calibration:
 
     @property
     def names(self) -> list[str]:
+        """Names of the channels, in order."""
         return [c.name for c in self.channels]
 
     def channel(self, name: str) -> Channel:

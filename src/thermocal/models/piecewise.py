@@ -719,6 +719,7 @@ class PiecewiseStream(ModelStream):
         self.reset()
 
     def reset(self) -> None:
+        """Forget everything (a new power-on)."""
         self._clamp.warned = False
 
     def update(self, time_s: float, temps_c: FloatArray, signal: float | None = None) -> float:

@@ -550,6 +550,7 @@ class PolyModel(PolyBase):
             raise ThermocalInputError("poly model state: coefficient and term counts differ")
 
     def to_dict(self) -> dict[str, Any]:
+        """The model file's content (without checksum); ``rate`` is null when no term uses Ṫ."""
         d = super().to_dict()
         if not self.model_uses_rate:
             d["rate"] = None
@@ -616,6 +617,7 @@ class PolyStream(ModelStream):
         self.reset()
 
     def reset(self) -> None:
+        """Forget everything (a new power-on): the Ṫ history restarts."""
         self._times: deque[float] = deque()
         self._hist: deque[list[float]] = deque()
         self._last_t: float | None = None

@@ -655,6 +655,7 @@ class WarmupModel(TemperatureModel):
         return out[0] if x.ndim == 0 else out
 
     def coefficients(self) -> list[Coefficient]:
+        """The b matrix ``b_jk`` [signal unit / °C^(j+k)], with standard errors."""
         self.check_fitted()
         out = []
         unit = self.signal_unit
@@ -790,6 +791,7 @@ class WarmupStream(ModelStream):
         self.reset()
 
     def reset(self) -> None:
+        """Forget everything (a new power-on): T0 is captured again."""
         self._t_first: float | None = None
         self._sum = 0.0
         self._count = 0
