@@ -242,8 +242,9 @@ class TemperatureModel(ABC):
 
     References
     ----------
-    - Pedregosa, F. et al. (2011). Scikit-learn: Machine Learning in Python. JMLR 12,
-      2825–2830 (the estimator contract ``fit``/``predict``/``get_params``).
+    - Buitinck, L. et al. (2013). API design for machine learning software: experiences
+      from the scikit-learn project. ECML PKDD Workshop on Languages for Data Mining and
+      Machine Learning, 108–122 (the estimator contract ``fit``/``predict``/``get_params``).
     - IEEE Std 1431-2004, IEEE Standard Specification Format Guide and Test Procedure
       for Coriolis Vibratory Gyros (temperature sensitivity of bias and scale factor).
 
