@@ -33,20 +33,29 @@ class RunData:
 
     Attributes
     ----------
-    time_s : sample times [s], shape (n,).
-    temps_c : temperatures [°C] (raw counts when ``temperature_unit`` is ``counts``),
-        shape (n, k), columns in ``temp_names`` order.
-    signal : sensor output in its canonical unit ([°/h] or [mg]), shape (n,),
-        or ``None`` when only predicting from temperatures.
-    temp_names : names of the temperature columns.
-    name : where the run came from (file name), for messages and provenance.
-    known_input : the known input to remove before fitting (earth rate [°/h],
-        gravity component [mg]); subtracted from ``signal`` by :meth:`target`.
-    signal_unit : the canonical unit of ``signal`` (``deg/h``, ``mg`` or ``counts``) when
-        known (:meth:`from_recording` sets it); a model fitted on the run records it.
-    temperature_unit : ``degC``, or ``counts`` for raw-count temperatures used without a
+    time_s : numpy.ndarray
+        Sample times, shape (n,) [s].
+    temps_c : numpy.ndarray
+        Temperatures, shape (n, k) [°C] (raw counts when ``temperature_unit`` is
+        ``counts``), columns in ``temp_names`` order.
+    signal : numpy.ndarray or None
+        Sensor output in its canonical unit, shape (n,) [°/h] or [mg]; None (default) when
+        only predicting from temperatures.
+    temp_names : tuple of str
+        Names of the temperature columns (default empty).
+    name : str
+        Where the run came from (file name), for messages and provenance.
+    known_input : float
+        The known input to remove before fitting (earth rate [°/h], gravity component
+        [mg]); subtracted from ``signal`` by :meth:`target`.  Default 0.
+    extra : dict
+        Family-specific per-run values (default empty).
+    signal_unit : str or None
+        The canonical unit of ``signal`` (``deg/h``, ``mg`` or ``counts``) when known
+        (:meth:`from_recording` sets it); a model fitted on the run records it.
+    temperature_unit : str
+        ``degC`` (default), or ``counts`` for raw-count temperatures used without a
         conversion (a model fitted on them is in counts).
-    extra : dict of family-specific per-run values (default empty).
 
     Raises
     ------
