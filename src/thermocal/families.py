@@ -107,6 +107,16 @@ class FamilyOption:
         """``value`` checked against the option's type and bounds, as the constructor takes
         it (a tuple of floats for ``"floats"``).
 
+        Parameters
+        ----------
+        value : object
+            The value given.
+
+        Returns
+        -------
+        object
+            The value as the constructor takes it.
+
         Raises
         ------
         thermocal.errors.ParameterError
@@ -191,7 +201,17 @@ class FamilyDeclaration:
     firmware: tuple[str, ...] = ()
 
     def option(self, name: str) -> FamilyOption:
-        """The declared option of constructor parameter ``name`` (KeyError when none)."""
+        """The declared option of constructor parameter ``name`` (KeyError when none).
+
+        Parameters
+        ----------
+        name : str
+            Constructor parameter.
+
+        Returns
+        -------
+        FamilyOption
+        """
         for o in self.options:
             if o.name == name:
                 return o
@@ -312,7 +332,22 @@ def fit_option_table(
 ) -> dict[str, list[tuple[str, FamilyOption]]]:
     """Every fit option of ``declarations`` by command-line field (``rate_interval``), with
     the families declaring it: ``{field: [(family, option), ...]}``, in declaration order.
-    The command line makes one option of each field; its help names each family's meaning."""
+    The command line makes one option of each field; its help names each family's meaning.
+
+    Parameters
+    ----------
+    declarations : tuple of FamilyDeclaration, optional
+        Default :data:`BUILTIN_FAMILIES`.
+
+    Returns
+    -------
+    dict of str to list of tuple
+
+    Examples
+    --------
+    >>> list(fit_option_table())[:4]
+    ['terms', 'order', 'rate_interval', 'rate_method']
+    """
     table: dict[str, list[tuple[str, FamilyOption]]] = {}
     for decl in declarations:
         for o in decl.options:

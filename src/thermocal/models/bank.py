@@ -131,7 +131,35 @@ def pwl_evaluate(breakpoints_c: FloatArray, values: FloatArray, temp_c: FloatArr
         f(T) = v_j + (v_{j+1} − v_j)/(x_{j+1} − x_j) · (T − x_j),   x_j ≤ T < x_{j+1}
 
     with the end segments extended linearly outside ``[x_0, x_K]`` (callers clamp
-    first when they do not want to extrapolate).  [Seed-FOG], [Seed-Accel].
+    first when they do not want to extrapolate).
+
+    Parameters
+    ----------
+    breakpoints_c : numpy.ndarray
+        Ascending breakpoints x_0 … x_K [°C].
+    values : numpy.ndarray
+        Value at each breakpoint [signal unit].
+    temp_c : numpy.ndarray
+        Temperatures T [°C].
+
+    Returns
+    -------
+    numpy.ndarray
+        f(T) [signal unit], the shape of ``temp_c``.
+
+    References
+    ----------
+    - *Design and engineering implementation of a fibre-optic-gyro line-of-sight
+      stabilisation system*, master's thesis, chapter 3 "Fibre-optic gyroscope".
+    - *Adaptive accelerometer temperature compensation method for inertial navigation*,
+      Chinese invention patent, filed 2019-10-29, published 2020-02-21.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> pwl_evaluate(np.array([0.0, 10.0, 20.0]), np.array([0.0, 1.0, 3.0]),
+    ...              np.array([5.0, 15.0, 25.0])).tolist()
+    [0.5, 2.0, 4.0]
     """
     x = breakpoints_c
     j = np.clip(np.searchsorted(x, temp_c, side="right") - 1, 0, x.size - 2)
@@ -143,7 +171,26 @@ def pwl_evaluate(breakpoints_c: FloatArray, values: FloatArray, temp_c: FloatArr
 def hat_basis(breakpoints_c: FloatArray, temp_c: FloatArray) -> FloatArray:
     """Design matrix (n, K+1) of the continuous piecewise-linear hat functions:
     column j is 1 at x_j, 0 at the other breakpoints, linear between (so the
-    least-squares coefficients are the values at the breakpoints)."""
+    least-squares coefficients are the values at the breakpoints).
+
+    Parameters
+    ----------
+    breakpoints_c : numpy.ndarray
+        Ascending breakpoints, shape (K+1,) [°C].
+    temp_c : numpy.ndarray
+        Temperatures, shape (n,) [°C] (clamped to the breakpoints' range).
+
+    Returns
+    -------
+    numpy.ndarray
+        Shape (n, K+1); each row sums to 1.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> hat_basis(np.array([0.0, 10.0, 20.0]), np.array([5.0])).tolist()
+    [[0.5, 0.5, 0.0]]
+    """
     x = breakpoints_c
     t = np.clip(temp_c, x[0], x[-1])
     j = np.clip(np.searchsorted(x, t, side="right") - 1, 0, x.size - 2)
@@ -159,7 +206,26 @@ def binned_curve(
     temp_c: FloatArray, y: FloatArray, edges_c: FloatArray
 ) -> tuple[FloatArray, FloatArray, FloatArray]:
     """Bin means of ``y`` and ``T`` on temperature bins ``edges_c``: returns
-    ``(mean_y, mean_T, count)`` per bin (NaN for an empty bin)."""
+    ``(mean_y, mean_T, count)`` per bin (NaN for an empty bin).
+
+    Parameters
+    ----------
+    temp_c : numpy.ndarray
+        Temperatures, shape (n,) [°C].
+    y : numpy.ndarray
+        Output, shape (n,) [signal unit].
+    edges_c : numpy.ndarray
+        Bin edges [°C], ascending.
+
+    Returns
+    -------
+    mean_y : numpy.ndarray
+        Bin means of y [signal unit].
+    mean_T : numpy.ndarray
+        Bin means of T [°C].
+    count : numpy.ndarray
+        Samples per bin.
+    """
     nb = edges_c.size - 1
     idx = np.clip(np.searchsorted(edges_c, temp_c, side="right") - 1, 0, nb - 1)
     cnt = np.bincount(idx, minlength=nb).astype(np.float64)
@@ -171,7 +237,22 @@ def binned_curve(
 
 def curve_distance(curves: FloatArray) -> FloatArray:
     """Pairwise max-deviation ``d_ij = max_b |c_i(b) − c_j(b)|`` over the bins where
-    both runs have data (inf when they share none)."""
+    both runs have data (inf when they share none).
+
+    Parameters
+    ----------
+    curves : numpy.ndarray
+        Binned curves, shape (runs, bins) [signal unit], NaN where empty.
+
+    Returns
+    -------
+    numpy.ndarray
+        Distance matrix (runs, runs) [signal unit].
+
+    Notes
+    -----
+    .. math:: d_{ij} = \\max_b |c_i(b) - c_j(b)|
+    """
     diff = np.abs(curves[:, None, :] - curves[None, :, :])
     both = np.isfinite(diff)
     d = np.where(both, diff, -np.inf).max(axis=2)
@@ -182,7 +263,32 @@ def curve_distance(curves: FloatArray) -> FloatArray:
 
 def cluster_runs(distance: FloatArray, threshold: float) -> list[list[int]]:
     """Complete-linkage agglomerative clustering: every pair inside a group is
-    within ``threshold``.  Groups are ordered by their first run."""
+    within ``threshold``.  Groups are ordered by their first run.
+
+    Parameters
+    ----------
+    distance : numpy.ndarray
+        Distance matrix (:func:`curve_distance`) [signal unit].
+    threshold : float
+        Largest distance inside a group [signal unit] (1 mg in the source document).
+
+    Returns
+    -------
+    list of list of int
+        Run indices per group.
+
+    References
+    ----------
+    - *Adaptive accelerometer temperature compensation method for inertial navigation*,
+      Chinese invention patent, filed 2019-10-29, published 2020-02-21.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> d = np.array([[0.0, 0.1, 3.0], [0.1, 0.0, 3.1], [3.0, 3.1, 0.0]])
+    >>> cluster_runs(d, 1.0)
+    [[0, 1], [2]]
+    """
     n = distance.shape[0]
     if n == 1:
         return [[0]]
@@ -199,10 +305,18 @@ def cluster_runs(distance: FloatArray, threshold: float) -> list[list[int]]:
 class Selection:
     """The model chosen at power-on.
 
-    ``index`` of the chosen model in the bank; ``deviations`` D_m of every model
-    [signal unit]; ``margin`` runner-up − best deviation (inf with one model);
-    ``n_samples`` start-up samples used; ``complete`` True once the start-up
-    window (``startup_s``) was full.
+    Attributes
+    ----------
+    index : int
+        Index of the chosen model in the bank.
+    deviations : tuple of float
+        D_m of every model [signal unit].
+    margin : float
+        Runner-up − best deviation [signal unit] (inf with one model).
+    n_samples : int
+        Start-up samples used.
+    complete : bool
+        True once the start-up window (``startup_s``) was full.
     """
 
     index: int
@@ -212,6 +326,7 @@ class Selection:
     complete: bool
 
     def to_dict(self) -> dict[str, Any]:
+        """JSON form of the selection."""
         return {
             "index": self.index,
             "deviations": list(self.deviations),
@@ -320,7 +435,19 @@ class BankModel(TemperatureModel):
         self.error_metric = error_metric
 
     def data_needs(self, temp_names: Sequence[str], n_runs: int) -> Needs:
-        """Each curve of the bank is judged as a line in its column."""
+        """Each curve of the bank is judged as a line in its column.
+
+        Parameters
+        ----------
+        temp_names : sequence of str
+            The temperature columns.
+        n_runs : int
+            Number of runs.
+
+        Returns
+        -------
+        thermocal.adequacy.Needs
+        """
         j = self.sensor if 0 <= self.sensor < len(temp_names) else 0
         return Needs({temp_names[j]: 1} if temp_names else {}, 2)
 
@@ -349,7 +476,23 @@ class BankModel(TemperatureModel):
     # -- fit --
     def fit(self, runs: Sequence[RunData]) -> Self:
         """Group the runs into characteristic curves, fit a piecewise-linear model
-        per group and keep those within ``tolerance`` ([Seed-Accel], steps 1–3)."""
+        per group and keep those within ``tolerance`` ([Seed-Accel], steps 1–3).
+
+        Parameters
+        ----------
+        runs : sequence of RunData
+            Power-ons with signal [signal unit, mg for accelerometers] over a common range.
+
+        Returns
+        -------
+        BankModel
+            ``self``, fitted.
+
+        Raises
+        ------
+        thermocal.errors.DesignError
+            Runs over different temperature ranges, or no curve within ``tolerance``.
+        """
         self._check_params()
         if not runs:
             raise ThermocalInputError("bank: no runs to fit")
@@ -413,6 +556,32 @@ class BankModel(TemperatureModel):
                 ConditioningWarning,
                 stacklevel=2,
             )
+        self._store(
+            one,
+            groups,
+            labels,
+            dist,
+            (kept_b, kept_v, kept_se),
+            info,
+            rejected,
+            (cond, resid_sq, n_res),
+        )
+        return self
+
+    def _store(
+        self,
+        one: list[RunData],
+        groups: list[list[int]],
+        labels: list[str],
+        dist: FloatArray,
+        kept: tuple[list[FloatArray], list[FloatArray], list[FloatArray | None]],
+        info: list[dict[str, Any]],
+        rejected: list[dict[str, Any]],
+        fit: tuple[float, float, int],
+    ) -> None:
+        """Set the learned values and the fit statistics of :meth:`fit`."""
+        kept_b, kept_v, kept_se = kept
+        cond, resid_sq, n_res = fit
         self.breakpoints_ = kept_b
         self.values_ = kept_v
         self.stderr_ = kept_se
@@ -441,7 +610,6 @@ class BankModel(TemperatureModel):
                 },
             ),
         )
-        return self
 
     def _common_range(self, temps: list[FloatArray], labels: list[str]) -> tuple[float, float]:
         """The temperature range every run covers (to within two grid steps) [°C]; runs
@@ -586,7 +754,24 @@ class BankModel(TemperatureModel):
 
     def select(self, run: RunData, *, extrapolate: bool = False) -> Selection:
         """The model chosen for a power-on from its start-up window ([Seed-Accel], step 4);
-        also stored in ``selection_``."""
+        also stored in ``selection_``.
+
+        Parameters
+        ----------
+        run : RunData
+            The power-on, with its signal.
+        extrapolate : bool, optional
+            Default False (clamp temperatures to the fitted range).
+
+        Returns
+        -------
+        Selection
+
+        Notes
+        -----
+        .. math:: D_m(N) = \\Big|\\frac{1}{N}\\sum_{i<N} (y_i - f_m(T_i))\\Big|,
+                  \\qquad m^* = \\arg\\min_m D_m
+        """
         temp = self._prepare(run, extrapolate)
         f = self._model_matrix(temp[: self._startup_count(run)])
         dev, _choice, m = self._run_selection(run, f)
@@ -595,7 +780,25 @@ class BankModel(TemperatureModel):
 
     def predict(self, run: RunData, *, extrapolate: bool = False) -> FloatArray:
         """Output of the selected model at every sample [signal unit]: running
-        selection during the start-up window, frozen after it."""
+        selection during the start-up window, frozen after it.
+
+        Parameters
+        ----------
+        run : RunData
+            The power-on, with its signal (the selection needs it).
+        extrapolate : bool, optional
+            Default False.
+
+        Returns
+        -------
+        numpy.ndarray
+            Shape (n,) [signal unit].
+
+        Raises
+        ------
+        thermocal.errors.ThermocalInputError
+            The run has no signal.
+        """
         temp = self._prepare(run, extrapolate)
         f = self._model_matrix(temp[: self._startup_count(run)])  # every model, start-up only
         dev, choice, m = self._run_selection(run, f)
@@ -611,11 +814,26 @@ class BankModel(TemperatureModel):
     ) -> ModelStream:
         """Sample-by-sample twin of :meth:`predict`; ``known_input`` (e.g. the gravity
         component [mg]) is subtracted from the raw signal before the selection, like
-        :meth:`RunData.target`."""
+        :meth:`RunData.target`.
+
+        Parameters
+        ----------
+        sample_interval_s : float
+            Nominal sample interval [s].
+        extrapolate : bool, optional
+            Default False.
+        known_input : float, optional
+            Known input [signal unit].  Default 0.
+
+        Returns
+        -------
+        BankStream
+        """
         self.check_fitted()
         return BankStream(self, extrapolate=extrapolate, known_input=known_input)
 
     def coefficients(self) -> list[Coefficient]:
+        """Each model's value at each breakpoint [signal unit], with standard errors."""
         self.check_fitted()
         out = []
         for m, (b, v, se) in enumerate(
@@ -635,7 +853,20 @@ class BankModel(TemperatureModel):
     @classmethod
     def check_state(cls, d: dict[str, Any], root: str = "") -> None:
         """The ``state`` section of a bank model file: one or more models of at least two
-        ascending breakpoints with a value each; ``params.sensor`` one of the inputs."""
+        ascending breakpoints with a value each; ``params.sensor`` one of the inputs.
+
+        Parameters
+        ----------
+        d : dict
+            The model file's content.
+        root : str, optional
+            Key path prefix.  Default ``""``.
+
+        Raises
+        ------
+        thermocal.errors.ModelFileError
+            A bad state, naming the key path.
+        """
         sensor_param(d, root)
         state, path = d["state"], key_path(root, "state")
         fields(
@@ -700,6 +931,15 @@ class BankStream(ModelStream):
     channels (``sensor`` picks).  ``signal`` (raw; ``known_input`` is subtracted) is
     required during the start-up window.  ``selection`` is the current :class:`Selection`.
     Warns once per stream when a temperature leaves the fitted range.
+
+    Parameters
+    ----------
+    model : BankModel
+        The fitted bank.
+    extrapolate : bool, optional
+        Default False.
+    known_input : float, optional
+        Known input subtracted from the signal [signal unit].  Default 0.
     """
 
     def __init__(
@@ -717,6 +957,7 @@ class BankStream(ModelStream):
         self.reset()
 
     def reset(self) -> None:
+        """Forget everything (a new power-on): the start-up selection starts again."""
         n = len(self._vs)
         self._t_first: float | None = None
         self._sums = [0.0] * n
@@ -728,6 +969,7 @@ class BankStream(ModelStream):
 
     @property
     def selection(self) -> Selection:
+        """The current :class:`Selection`."""
         return _selection(np.array(self._dev, dtype=np.float64), self._count, self._frozen)
 
     def _value(self, m: int, temp: float) -> float:
@@ -738,6 +980,27 @@ class BankStream(ModelStream):
         return v[j] + slope * (temp - x[j])
 
     def update(self, time_s: float, temps_c: FloatArray, signal: float | None = None) -> float:
+        """Model value for one sample (see :meth:`ModelStream.update`).
+
+        Parameters
+        ----------
+        time_s : float
+            Sample time [s].
+        temps_c : numpy.ndarray
+            Temperatures [°C].
+        signal : float, optional
+            Raw signal [signal unit]; required during the start-up window.
+
+        Returns
+        -------
+        float
+            The selected model's value [signal unit].
+
+        Raises
+        ------
+        thermocal.errors.ThermocalInputError
+            No signal during the start-up window.
+        """
         temp = self._clamp(stream_channel(temps_c, self._col))
         t = float(time_s)
         if self._t_first is None:

@@ -89,8 +89,26 @@ from thermocal.units import (
 
 
 def stream_channel(temps_c: FloatArray | float, column: int) -> float:
-    """The model's temperature [°C] from one sample's ``temps_c``: the only value, or
-    the value at ``column`` when every fitted column is given."""
+    """The model's temperature [°C] from one sample's ``temps_c``.
+
+    Parameters
+    ----------
+    temps_c : numpy.ndarray or float
+        One sample's temperatures [°C]: a single value, or one per fitted column.
+    column : int
+        Index of the model's column among the fitted columns.
+
+    Returns
+    -------
+    float
+        The only value, or the value at ``column`` when every fitted column is given [°C].
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> stream_channel(25.0, 1), stream_channel(np.array([20.0, 30.0]), 1)
+    (25.0, 30.0)
+    """
     if type(temps_c) is np.ndarray and temps_c.dtype == np.float64 and temps_c.ndim == 1:
         arr = temps_c
     else:
@@ -100,7 +118,22 @@ def stream_channel(temps_c: FloatArray | float, column: int) -> float:
 
 class ClampOnce:
     """Clamp one temperature to the fitted range ``[lo, hi]`` [°C] sample by sample, with
-    one :class:`ExtrapolationWarning` per stream (``extrapolate=True``: warn, keep T)."""
+    one :class:`ExtrapolationWarning` per stream (``extrapolate=True``: warn, keep T).
+
+    Parameters
+    ----------
+    lo, hi : float
+        The fitted temperature range [°C] (or [counts] for a model in counts).
+    extrapolate : bool
+        True: keep a temperature outside the range (and warn once); False: clamp it.
+
+    Notes
+    -----
+    .. math:: T_\\mathrm{used} = \\min(\\max(T, T_\\mathrm{lo}), T_\\mathrm{hi})
+
+    the clamping PX4 (``TemperatureCompensation.cpp``) and ArduPilot
+    (``AP_InertialSensor_tempcal.cpp``) apply outside the calibrated range.
+    """
 
     __slots__ = ("extrapolate", "hi", "lo", "warned")
 
@@ -145,7 +178,23 @@ class ModelStream(ABC):
 
     @abstractmethod
     def update(self, time_s: float, temps_c: FloatArray, signal: float | None = None) -> float:
-        """Model value for one sample: time [s], temperatures (k,) [°C], raw signal."""
+        """Model value for one sample.
+
+        Parameters
+        ----------
+        time_s : float
+            Sample time [s].
+        temps_c : numpy.ndarray
+            The sample's temperatures, shape (k,) [°C].
+        signal : float, optional
+            The raw signal in the model's unit ([°/h] or [mg]); only the warm-up
+            family's start-up state uses it.  Default None.
+
+        Returns
+        -------
+        float
+            The temperature-induced signal for this sample [model's signal unit].
+        """
 
     @abstractmethod
     def reset(self) -> None:
@@ -157,10 +206,14 @@ class ChunkContext:
     """What a chunk of a long run must be predicted together with to reproduce a
     whole-run predict (declared by each family, :meth:`TemperatureModel.chunk_context`).
 
-    ``head_s`` — seconds from the first sample whose samples fix the start-up state
-    (the warm-up window of T0/F0, the bank's selection window); ``tail_s`` — seconds of
-    history before the chunk (the Ṫ interval Δt).  ``None`` for either means the
-    family needs all history (then a file is streamed sample by sample).
+    Attributes
+    ----------
+    head_s : float or None
+        Seconds [s] from the first sample whose samples fix the start-up state (the
+        warm-up window of T0/F0, the bank's selection window); None: all history.
+    tail_s : float or None
+        Seconds [s] of history before the chunk (the Ṫ interval Δt); None: all history
+        (then a file is streamed sample by sample).
     """
 
     head_s: float | None
@@ -174,9 +227,40 @@ class TemperatureModel(ABC):
     ``_state`` / ``_set_state`` (the learned values as JSON-ready dicts), and
     ``coefficients()``.  Learned attributes end in ``_`` and exist only after fit.
 
-    Common learned attributes set by :meth:`_record_common` during ``fit``:
-    ``temp_names_``, ``temp_range_`` (k×2 [°C]), ``rate_range_`` (k×2 [°C/min] or
-    None), ``stats_`` (:class:`FitStats`), ``data_`` (provenance list).
+    Attributes
+    ----------
+    temp_names_ : tuple of str
+        Names of the fitted temperature columns (learned).
+    temp_range_ : numpy.ndarray
+        Fitted temperature range per column, shape (k, 2) [°C] (learned).
+    rate_range_ : numpy.ndarray or None
+        Fitted Ṫ range per column, shape (k, 2) [°C/min]; None for models without Ṫ.
+    stats_ : FitStats
+        Fit statistics (learned).
+    data_ : list of dict
+        Provenance of the fitted runs (file name, sample count).
+
+    References
+    ----------
+    - Buitinck, L. et al. (2013). API design for machine learning software: experiences
+      from the scikit-learn project. ECML PKDD Workshop on Languages for Data Mining and
+      Machine Learning, 108–122 (the estimator contract ``fit``/``predict``/``get_params``).
+    - IEEE Std 1431-2004, IEEE Standard Specification Format Guide and Test Procedure
+      for Coriolis Vibratory Gyros (temperature sensitivity of bias and scale factor).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from thermocal.models import RunData
+    >>> from thermocal.models.poly import PolyModel
+    >>> t = np.arange(0.0, 600.0, 1.0)
+    >>> temp = 20.0 + t / 60.0
+    >>> run = RunData(t, temp[:, None], 3.0 - 0.1 * temp, ("T1",))
+    >>> model = PolyModel(order=1).fit([run])
+    >>> model.is_fitted, model.temp_names_, [round(float(v), 3) for v in model.temp_range_[0]]
+    (True, ('T1',), [20.0, 29.983])
+    >>> round(float(model.residuals(run).std()), 9)
+    0.0
     """
 
     family: ClassVar[str] = ""
@@ -249,21 +333,77 @@ class TemperatureModel(ABC):
     def data_needs(self, temp_names: Sequence[str], n_runs: int) -> Needs:
         """What this model asks of the data before it is fitted (its polynomial order in
         each temperature column, coefficient count, Ṫ columns), for
-        :func:`thermocal.adequacy.judge`.  Default: a line in the first column."""
+        :func:`thermocal.adequacy.judge`.  Default: a line in the first column.
+
+        Parameters
+        ----------
+        temp_names : sequence of str
+            The temperature columns the model will be fitted on.
+        n_runs : int
+            Number of runs it will be fitted on.
+
+        Returns
+        -------
+        thermocal.adequacy.Needs
+            Polynomial order per column and coefficient count.
+        """
         return Needs({temp_names[0]: 1} if temp_names else {}, 2)
 
     # -- estimator contract --
     @abstractmethod
     def fit(self, runs: Sequence[RunData]) -> Self:
-        """Learn from one or several runs; returns ``self``."""
+        """Learn from one or several runs.
+
+        Parameters
+        ----------
+        runs : sequence of RunData
+            The runs (power-ons) to fit, each with a signal.
+
+        Returns
+        -------
+        TemperatureModel
+            ``self``, fitted.
+
+        Raises
+        ------
+        thermocal.errors.ThermocalInputError
+            Runs without a signal, too few samples, or parameters the data cannot support.
+        """
 
     @abstractmethod
     def predict(self, run: RunData, *, extrapolate: bool = False) -> FloatArray:
-        """Temperature-induced signal for each sample of ``run`` [signal unit]."""
+        """Temperature-induced signal for each sample of ``run``.
+
+        Parameters
+        ----------
+        run : RunData
+            Times [s] and temperatures [°C] (signal not needed).
+        extrapolate : bool, optional
+            False (default): temperatures outside the fitted range are clamped, with an
+            :class:`~thermocal.errors.ExtrapolationWarning`; True: used as they are.
+
+        Returns
+        -------
+        numpy.ndarray
+            Model value per sample, shape (n,) [model's signal unit, °/h or mg].
+        """
 
     @abstractmethod
     def stream(self, sample_interval_s: float, *, extrapolate: bool = False) -> ModelStream:
-        """A :class:`ModelStream` computing :meth:`predict` sample by sample."""
+        """A :class:`ModelStream` computing :meth:`predict` sample by sample.
+
+        Parameters
+        ----------
+        sample_interval_s : float
+            Nominal sample interval [s] (a step longer than ``GAP_FACTOR`` times it is a
+            gap that resets the Ṫ estimate).
+        extrapolate : bool, optional
+            As in :meth:`predict`.  Default False.
+
+        Returns
+        -------
+        ModelStream
+        """
 
     @abstractmethod
     def coefficients(self) -> list[Coefficient]:
@@ -283,7 +423,20 @@ class TemperatureModel(ABC):
         :meth:`_state` writes) once the common sections passed
         (:func:`thermocal.models.schema.check_model_dict`); raise
         :class:`~thermocal.errors.ModelFileError` naming the key path, prefixed by ``root``.
-        The default checks nothing: a family's own module states its layout."""
+        The default checks nothing: a family's own module states its layout.
+
+        Parameters
+        ----------
+        d : dict
+            The ``state`` section.
+        root : str, optional
+            Key path prefix for messages.  Default ``""``.
+
+        Raises
+        ------
+        thermocal.errors.ModelFileError
+            A key of the state missing or of the wrong type or shape.
+        """
 
     @classmethod
     def _param_names(cls) -> list[str]:
@@ -347,6 +500,23 @@ class TemperatureModel(ABC):
         return {p: copy.deepcopy(getattr(self, p)) for p in self._param_names()}
 
     def set_params(self, **params: Any) -> Self:
+        """Set constructor arguments (estimator contract); returns ``self``.
+
+        Parameters
+        ----------
+        **params
+            Constructor arguments by name.
+
+        Returns
+        -------
+        TemperatureModel
+            ``self``.
+
+        Raises
+        ------
+        thermocal.errors.ThermocalInputError
+            A name the family's constructor does not take.
+        """
         for k, v in params.items():
             if k not in self._param_names():
                 raise ThermocalInputError(f"{self.family}: unknown parameter {k!r}")
@@ -359,9 +529,11 @@ class TemperatureModel(ABC):
 
     @property
     def is_fitted(self) -> bool:
+        """True once :meth:`fit` (or :meth:`from_dict`) set the learned values."""
         return hasattr(self, "stats_")
 
     def check_fitted(self) -> None:
+        """Raise :class:`~thermocal.errors.ThermocalInputError` when the model is not fitted."""
         if not self.is_fitted:
             raise ThermocalInputError(f"{self.family} model is not fitted yet")
 
@@ -370,11 +542,32 @@ class TemperatureModel(ABC):
 
         No limit by default; a warm-up model (fitted on power-ons of a few minutes)
         overrides it with an :class:`ExtrapolationWarning`.
+
+        Parameters
+        ----------
+        elapsed_s : float
+            Time since the record's first sample [s].
         """
         del elapsed_s
 
     def residuals(self, run: RunData) -> FloatArray:
-        """``target − predict`` of a run (signal unit)."""
+        """``target − predict`` of a run.
+
+        Parameters
+        ----------
+        run : RunData
+            A run with a signal.
+
+        Returns
+        -------
+        numpy.ndarray
+            Residual per sample, shape (n,) [model's signal unit]; the model is evaluated
+            with ``extrapolate=True``.
+
+        Notes
+        -----
+        .. math:: e_i = (y_i - y_\\mathrm{known}) - \\hat f(T_i, \\dot T_i)
+        """
         return run.target() - self.predict(run, extrapolate=True)
 
     # -- helpers for subclasses --
@@ -408,6 +601,23 @@ class TemperatureModel(ABC):
 
         With ``extrapolate=True`` the temperatures are returned as they are, with an
         :class:`ExtrapolationWarning` if they leave the range.
+
+        Parameters
+        ----------
+        temps_c : numpy.ndarray
+            Temperatures, shape (n, k) [°C].
+        extrapolate : bool, optional
+            Keep out-of-range temperatures (and warn).  Default False.
+
+        Returns
+        -------
+        numpy.ndarray
+            The temperatures clipped to ``temp_range_`` column by column [°C].
+
+        References
+        ----------
+        - PX4 ``src/modules/temperature_compensation/TemperatureCompensation.cpp``.
+        - ArduPilot ``libraries/AP_InertialSensor/AP_InertialSensor_tempcal.cpp``.
         """
         lo = self.temp_range_[:, 0]
         hi = self.temp_range_[:, 1]
@@ -435,7 +645,18 @@ class TemperatureModel(ABC):
 
     # -- files --
     def to_dict(self) -> dict[str, Any]:
-        """The model file's content (without checksum)."""
+        """The model file's content (without checksum).
+
+        Returns
+        -------
+        dict
+            JSON-ready content in the layout of the module docstring.
+
+        Raises
+        ------
+        thermocal.errors.ThermocalInputError
+            The model is not fitted.
+        """
         from thermocal._version import __version__
 
         self.check_fitted()
@@ -508,7 +729,23 @@ class TemperatureModel(ABC):
     def from_dict(cls, d: dict[str, Any]) -> Self:
         """Rebuild a fitted model of this family from :meth:`to_dict` output (checks the
         format and that the dict is of this family).  A dict of any registered family:
-        :func:`thermocal.models.registry.model_from_dict`."""
+        :func:`thermocal.models.registry.model_from_dict`.
+
+        Parameters
+        ----------
+        d : dict
+            A model file's content (:meth:`to_dict`).
+
+        Returns
+        -------
+        TemperatureModel
+            The fitted model.
+
+        Raises
+        ------
+        thermocal.errors.ModelFileError
+            Wrong format tag, a newer format version, or a dict of another family.
+        """
         check_model_header(d)
         if not cls.family or str(d["family"]) != cls.family:
             raise ModelFileError(

@@ -50,6 +50,19 @@ class BreakpointChoice:
     k segments (on the temperature-binned data; lower is better); ``supported`` the
     largest k whose segments can all meet the minimum width, sample and distinct-
     temperature rules; ``chosen`` the k kept.
+
+    Attributes
+    ----------
+    breakpoints_c : list of float
+        The chosen breakpoints [°C].
+    requested : int
+        Segments asked for.
+    supported : int
+        Most segments the rules allow.
+    chosen : int
+        Segments kept.
+    bic : list of float
+        BIC per segment count.
     """
 
     breakpoints_c: list[float]
@@ -60,9 +73,11 @@ class BreakpointChoice:
 
     @property
     def reduced(self) -> bool:
+        """True when fewer segments were kept than asked for."""
         return self.chosen < self.requested
 
     def to_dict(self) -> dict[str, Any]:
+        """JSON form of the choice."""
         return {
             "method": "BIC of the continuous fit on temperature-binned means",
             "segments_requested": self.requested,
@@ -76,7 +91,19 @@ class BreakpointChoice:
 
 
 def segment_index(breakpoints: FloatArray, temp_c: FloatArray) -> npt.NDArray[np.intp]:
-    """Segment of each temperature: the number of breakpoints ``≤ T`` (eq. 1)."""
+    """Segment of each temperature: the number of breakpoints ``≤ T`` (eq. 1).
+
+    Parameters
+    ----------
+    breakpoints : numpy.ndarray
+        Ascending breakpoints [°C].
+    temp_c : numpy.ndarray
+        Temperatures [°C].
+
+    Returns
+    -------
+    numpy.ndarray of int
+    """
     idx: npt.NDArray[np.intp] = np.searchsorted(breakpoints, temp_c, side="right")
     return idx
 
@@ -84,7 +111,36 @@ def segment_index(breakpoints: FloatArray, temp_c: FloatArray) -> npt.NDArray[np
 def evaluate_lines(
     breakpoints: FloatArray, intercepts: FloatArray, slopes: FloatArray, temp_c: FloatArray
 ) -> FloatArray:
-    """``y = a_j + s_j T`` with j from :func:`segment_index` (eq. 1)."""
+    """``y = a_j + s_j T`` with j from :func:`segment_index` (eq. 1).
+
+    Parameters
+    ----------
+    breakpoints : numpy.ndarray
+        Ascending breakpoints (K,) [°C].
+    intercepts : numpy.ndarray
+        a_j per segment (K+1,) [signal unit].
+    slopes : numpy.ndarray
+        s_j per segment (K+1,) [signal unit/°C].
+    temp_c : numpy.ndarray
+        Temperatures [°C].
+
+    Returns
+    -------
+    numpy.ndarray
+        y [signal unit].
+
+    References
+    ----------
+    - *Design and engineering implementation of a fibre-optic-gyro line-of-sight
+      stabilisation system*, master's thesis, chapter 3 "Fibre-optic gyroscope".
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> t = np.array([20.0, 30.0, 40.0])
+    >>> evaluate_lines(np.array([30.0]), np.array([1.0, -2.0]), np.array([0.1, 0.2]), t).tolist()
+    [3.0, 4.0, 6.0]
+    """
     j = np.searchsorted(breakpoints, temp_c, side="right")
     out: FloatArray = intercepts[j] + slopes[j] * temp_c
     return out
@@ -240,6 +296,19 @@ def choose_breakpoints(
     levels, the slope, and a slope change and a location per breakpoint): a breakpoint
     is kept only when the data warrant it.  Binning averages the within-bin noise, so
     coloured chamber noise inflates the criterion less than it would per sample.
+
+    Parameters
+    ----------
+    temps, ys : sequence of numpy.ndarray
+        Temperatures [°C] and targets [signal unit] per run.
+    n_segments : int
+        Most segments.
+    per_run_offset : bool, optional
+        One level per run (default True).
+
+    Returns
+    -------
+    BreakpointChoice
     """
     if n_segments < 1:
         raise ThermocalInputError(f"number of segments must be ≥ 1, got {n_segments}")
@@ -298,6 +367,25 @@ def segment_tests(
     option that helps: move or drop a breakpoint
     (``--breakpoints``, when ``given``) or fewer ``--segments``; a failed span or sample
     count can be fitted anyway with ``--allow-narrow`` (recorded, and ``export-c`` warns).
+
+    Parameters
+    ----------
+    breakpoints_c : numpy.ndarray
+        Final breakpoints [°C].
+    xs : sequence of numpy.ndarray
+        Temperatures per run [°C].
+    name : str
+        The temperature column.
+    lo, hi : float
+        The range's ends [°C].
+    given : bool
+        Breakpoints given by the user.
+    unit : str, optional
+        Temperature unit.  Default ``"°C"``.
+
+    Returns
+    -------
+    tuple of thermocal.adequacy.AdequacyTest
     """
     edges = [lo, *(float(b) for b in breakpoints_c), hi]
     n_seg = len(edges) - 1

@@ -52,7 +52,25 @@ ROLE_KINDS = ("gyro", "accel")
 
 def guess_role(name: str, unit: str) -> dict[str, Any] | None:
     """A channel's role from its unit kind and a trailing axis letter of its name
-    (``gx`` → gyro x, ``acc_z`` → accel z); None when the unit is raw counts."""
+    (``gx`` → gyro x, ``acc_z`` → accel z); None when the unit is raw counts.
+
+    Parameters
+    ----------
+    name : str
+        The column name.
+    unit : str
+        Its unit as given (e.g. ``deg/s``, ``g``, ``counts``).
+
+    Returns
+    -------
+    dict or None
+        ``{"kind": "gyro"|"accel", "axis": "x"|"y"|"z"}`` (axis when the name ends in one).
+
+    Examples
+    --------
+    >>> guess_role("gx", "deg/s"), guess_role("acc_z", "g"), guess_role("t", "counts")
+    ({'kind': 'gyro', 'axis': 'x'}, {'kind': 'accel', 'axis': 'z'}, None)
+    """
     from thermocal import units
     from thermocal.errors import UnitError
 
@@ -72,7 +90,21 @@ def guess_role(name: str, unit: str) -> dict[str, Any] | None:
 @dataclass
 class Channel:
     """One channel: ``name`` (unique in the calibration), the ``signal`` column it reads,
-    the ``unit`` of that column as given, an optional ``role`` and its fitted ``model``."""
+    the ``unit`` of that column as given, an optional ``role`` and its fitted ``model``.
+
+    Attributes
+    ----------
+    name : str
+        Channel name, unique in the calibration.
+    signal : str
+        The signal column it reads.
+    unit : str
+        That column's unit as given (e.g. ``deg/s``).
+    model : TemperatureModel
+        The fitted model.
+    role : dict or None
+        ``{"kind": ..., "axis": ...}`` (:func:`guess_role`), default None.
+    """
 
     name: str
     signal: str
@@ -91,7 +123,36 @@ class Triad:
     misalignments as polynomials in temperature).  Applied as
     ``x_c = (I + E(T))⁻¹ (x − b(T))`` per sample (``<col>_comp``).  ``encoders`` (α, β
     columns) and ``latitude_deg`` are those of the calibration runs: a later command on a run
-    of the same rig (validate, report) needs none of them repeated."""
+    of the same rig (validate, report) needs none of them repeated.
+
+    Attributes
+    ----------
+    name : str
+        ``gyro`` or ``accel``.
+    columns : tuple of str
+        The x, y, z columns.
+    unit : str
+        Their unit as given (physical unit of the parameters).
+    temperature : str
+        The temperature column ([°C]), ``""`` for a single-temperature model.
+    model : thermocal.turntable.thermal.TriadThermal
+        Bias, scale factors and misalignments as polynomials in temperature.
+    encoders : tuple of str
+        The α, β encoder columns [°] (default ``("alpha_deg", "beta_deg")``).
+    latitude_deg : float or None
+        Latitude of the calibration runs [°].
+
+    Notes
+    -----
+    .. math:: x_c = (I + E(T))^{-1} (x - b(T))
+
+    References
+    ----------
+    - IEEE Std 1554-2005, IEEE Recommended Practice for Inertial Sensor Test Equipment,
+      Instrumentation, Data Acquisition, and Analysis.
+    - Tedaldi, D., Pretto, A. & Menegatti, E. (2014). A robust and easy to implement method
+      for IMU calibration without external equipments. ICRA 2014, 3042–3049.
+    """
 
     name: str
     columns: tuple[str, str, str]
@@ -114,7 +175,12 @@ class Triad:
 
     def calibrated_unit(self) -> str:
         """The unit of the columns the triad was calibrated on: raw counts for a triad with
-        a count scale, else its unit (the unit of a column that states none)."""
+        a count scale, else its unit (the unit of a column that states none).
+
+        Returns
+        -------
+        str
+        """
         return "counts" if self.count_scale is not None else self.unit
 
     def input_in(self, data_units: Collection[str], where: str) -> TriadInput:
@@ -122,6 +188,17 @@ class Triad:
         its model: raw counts of a triad with a count scale become ``count_scale · N`` in
         ``unit``; data in ``unit``'s kind are taken as they are.  The one path shared by
         ``compensate`` and ``validate`` (and the report).
+
+        Parameters
+        ----------
+        data_units : collection of str
+            The units the three columns were read in.
+        where : str
+            The data's name, for messages.
+
+        Returns
+        -------
+        TriadInput
 
         Raises
         ------
@@ -165,7 +242,19 @@ class TriadInput:
     read in (``data_unit``), the physical ``unit`` of their values and of the compensated
     output, the ``count_scale`` applied to raw counts (one count is ``count_scale`` ``unit``;
     None for columns already in a physical unit) and ``to_data``, the factor from the
-    model's bias unit (°/h for a gyro, mg for an accelerometer) to ``unit``."""
+    model's bias unit (°/h for a gyro, mg for an accelerometer) to ``unit``.
+
+    Attributes
+    ----------
+    data_unit : str
+        The unit the columns were read in.
+    unit : str
+        Physical unit of the values and of the compensated output.
+    count_scale : float or None
+        [unit per count] for raw counts; None for physical columns.
+    to_data : float
+        Factor from the model's bias unit ([°/h] or [mg]) to ``unit``.
+    """
 
     data_unit: str
     unit: str
@@ -174,7 +263,18 @@ class TriadInput:
 
     def physical(self, x: Any) -> Any:
         """The values ``x`` (raw counts or already physical) in ``unit``:
-        ``x_phys = count_scale · N`` for raw counts, else ``x`` unchanged."""
+        ``x_phys = count_scale · N`` for raw counts, else ``x`` unchanged.
+
+        Parameters
+        ----------
+        x : float or numpy.ndarray
+            Values in ``data_unit``.
+
+        Returns
+        -------
+        float or numpy.ndarray
+            Values in ``unit``.
+        """
         if self.count_scale is None:
             return x
         with np.errstate(over="ignore"):  # an overflow is refused by the caller
@@ -183,7 +283,20 @@ class TriadInput:
 
 @dataclass
 class Calibration:
-    """Several channels, each with its model, and triads (module docstring)."""
+    """Several channels, each with its model, and triads (module docstring).
+
+    Attributes
+    ----------
+    channels : list of Channel
+        Default empty.
+    triads : list of Triad
+        Default empty.
+
+    Raises
+    ------
+    thermocal.errors.ThermocalInputError
+        Two channels or triads share a name.
+    """
 
     channels: list[Channel] = field(default_factory=list)
     triads: list[Triad] = field(default_factory=list)
@@ -194,7 +307,18 @@ class Calibration:
             raise ThermocalInputError(f"calibration: channel names must be unique, got {names}")
 
     def require_channels(self, what: str) -> None:
-        """Refuse a calibration of triads only for a command that handles channels only."""
+        """Refuse a calibration of triads only for a command that handles channels only.
+
+        Parameters
+        ----------
+        what : str
+            The command, for the message.
+
+        Raises
+        ------
+        thermocal.errors.ThermocalInputError
+            The calibration has no channel.
+        """
         if not self.channels:
             raise ThermocalInputError(
                 f"this calibration holds triads ({', '.join(t.name for t in self.triads)}) and no "
@@ -203,9 +327,26 @@ class Calibration:
 
     @property
     def names(self) -> list[str]:
+        """Names of the channels, in order."""
         return [c.name for c in self.channels]
 
     def channel(self, name: str) -> Channel:
+        """The channel called ``name``.
+
+        Parameters
+        ----------
+        name : str
+            The channel name.
+
+        Returns
+        -------
+        Channel
+
+        Raises
+        ------
+        thermocal.errors.ThermocalInputError
+            No such channel (the message lists the names).
+        """
         for c in self.channels:
             if c.name == name:
                 return c
@@ -260,11 +401,39 @@ class Calibration:
 
 
 def is_calibration(d: Any) -> bool:
+    """True when ``d`` is a calibration file's dict (its ``format`` tag), not a model file.
+
+    Parameters
+    ----------
+    d : object
+        A parsed JSON document.
+
+    Returns
+    -------
+    bool
+    """
     return isinstance(d, dict) and d.get("format") == CALIBRATION_FORMAT
 
 
 def calibration_from_dict(d: dict[str, Any], where: str) -> Calibration:
-    """Verify (format, version, checksums, each model's schema) and build."""
+    """Verify (format, version, checksums, each model's schema) and build.
+
+    Parameters
+    ----------
+    d : dict
+        The calibration file's content.
+    where : str
+        The file's name, for messages.
+
+    Returns
+    -------
+    Calibration
+
+    Raises
+    ------
+    thermocal.errors.ModelFileError
+        Wrong format or version, a checksum mismatch, or a model that fails its schema.
+    """
     ver = d.get("format_version")
     if not isinstance(ver, int):
         raise ModelFileError(f"{where}: calibration file has no integer format_version")
@@ -380,7 +549,19 @@ def _count_scale_from_dict(cs: Any, unit: str, at: str) -> float | None:
 
 
 def temperatures_of(cal: Calibration, names: Sequence[str] | None = None) -> list[str]:
-    """Every temperature input of the chosen channels, in first-seen order."""
+    """Every temperature input of the chosen channels, in first-seen order.
+
+    Parameters
+    ----------
+    cal : Calibration
+        The calibration.
+    names : sequence of str, optional
+        Channels to use; None (default): all.
+
+    Returns
+    -------
+    list of str
+    """
     out: list[str] = []
     for n in names or cal.names:
         for t in cal.channel(n).model.temp_names_:
@@ -393,7 +574,20 @@ def merged_inputs(cal: Calibration, names: Sequence[str] | None = None) -> dict[
     """The chosen channels' recorded inputs (units, conversions, time unit) merged into one
     model-file ``inputs`` object, to read a recording once for all of them; the first
     channel's wins where two disagree (each channel's unit is checked again when its model
-    is applied)."""
+    is applied).
+
+    Parameters
+    ----------
+    cal : Calibration
+        The calibration.
+    names : sequence of str, optional
+        Channels to use; None (default): all.
+
+    Returns
+    -------
+    dict
+        One model-file ``inputs`` object.
+    """
     out: dict[str, Any] = {}
     units_: dict[str, Any] = {}
     conv: dict[str, Any] = {}

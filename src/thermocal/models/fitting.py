@@ -25,7 +25,24 @@ HOLDOUT_BLOCKS = 10
 
 
 def check_runs(runs: Sequence[RunData], family: str) -> list[RunData]:
-    """Common input checks: at least one run, a signal, the same temperature columns."""
+    """Common input checks: at least one run, a signal, the same temperature columns.
+
+    Parameters
+    ----------
+    runs : sequence of RunData
+        The runs to fit.
+    family : str
+        The family's name, for messages.
+
+    Returns
+    -------
+    list of RunData
+
+    Raises
+    ------
+    thermocal.errors.ThermocalInputError
+        No run, a run without signal, or runs with different temperature columns.
+    """
     rl = list(runs)
     if not rl:
         raise ThermocalInputError(f"{family}: no runs to fit")
@@ -64,9 +81,20 @@ class OffsetDecision:
     °/h/°C). The runs form a graph (edge = overlap ≥ :data:`OFFSET_OVERLAP_FRACTION` of
     the narrower central range); offsets are separable when the graph is connected.
 
-    ``used`` offsets estimated; ``requested`` the setting (None = automatic);
-    ``connected`` the overlap graph is connected; ``groups`` run names per connected
-    group; ``ranges_c`` central range per run [°C]; ``reason`` one line for the user.
+    Attributes
+    ----------
+    used : bool
+        Offsets estimated.
+    requested : bool or None
+        The setting (None = automatic).
+    connected : bool
+        The overlap graph is connected.
+    groups : list of list of str
+        Run names per connected group.
+    ranges_c : list of tuple of float
+        Central range per run [°C].
+    reason : str
+        One line for the user.
     """
 
     used: bool
@@ -96,6 +124,23 @@ def run_overlap_groups(
     Runs i and j are linked when ``overlap(i, j) ≥ fraction × min(width_i, width_j)`` with
     ``overlap = min(hi) − max(lo)`` (> 0); a run of (near) zero width — a hold — is linked
     to a run whose range contains its temperature. Groups by union–find.
+
+    Parameters
+    ----------
+    ranges_c : sequence of tuple of float
+        (lo, hi) per run [°C].
+    fraction : float, optional
+        Overlap share of the narrower range.  Default :data:`OFFSET_OVERLAP_FRACTION`.
+
+    Returns
+    -------
+    list of list of int
+        Run indices per connected group.
+
+    Examples
+    --------
+    >>> run_overlap_groups([(20.0, 40.0), (30.0, 50.0), (60.0, 80.0)])
+    [[0, 1], [2]]
     """
     n = len(ranges_c)
     parent = list(range(n))
@@ -131,6 +176,21 @@ def decide_run_offsets(
     warning when the graph is not connected (the slope then rests on within-run
     variation only). False: pooled. One run: nothing to decide.
     ``column`` the temperature column whose ranges are compared.
+
+    Parameters
+    ----------
+    requested : bool or None
+        The setting (None: automatic).
+    runs : sequence of RunData
+        The runs.
+    family : str
+        The family's name, for messages.
+    column : int, optional
+        Temperature column compared.  Default 0.
+
+    Returns
+    -------
+    OffsetDecision
     """
     names = [r.name or f"run {i + 1}" for i, r in enumerate(runs)]
     ranges = [
@@ -191,7 +251,21 @@ def warn_rate_range(
     *,
     extrapolate: bool,
 ) -> None:
-    """:class:`ExtrapolationWarning` when Ṫ of a used sensor left the fitted rate range."""
+    """:class:`ExtrapolationWarning` when Ṫ of a used sensor left the fitted rate range.
+
+    Parameters
+    ----------
+    seen_lo, seen_hi : numpy.ndarray
+        Ṫ range met per sensor [°C/min].
+    rate_range : numpy.ndarray
+        Fitted Ṫ range (k, 2) [°C/min].
+    names : sequence of str
+        Sensor names.
+    used : sequence of int
+        Sensors whose terms use Ṫ.
+    extrapolate : bool
+        Wording of the warning (extrapolating or clamped).
+    """
     lo, hi = rate_range[:, 0], rate_range[:, 1]
     bad = [j for j in used if seen_lo[j] < lo[j] or seen_hi[j] > hi[j]]
     if bad:
@@ -216,6 +290,19 @@ def run_blocks(time_s: FloatArray, n_folds: int = 1, chunk: int = CHUNK_ROWS) ->
 
     With ``n_folds == 2`` the run is cut into :data:`HOLDOUT_BLOCKS` equal parts
     by sample index and the odd parts form fold 1 (blocked hold-out).
+
+    Parameters
+    ----------
+    time_s : numpy.ndarray
+        Sample times [s].
+    n_folds : int, optional
+        1 or 2.  Default 1.
+    chunk : int, optional
+        Most rows per block.  Default :data:`CHUNK_ROWS`.
+
+    Returns
+    -------
+    list of Block
     """
     n = int(time_s.size)
     if n_folds == 1:
@@ -248,7 +335,23 @@ def short_rate_share(time_s: FloatArray, interval_s: float, method: str) -> tupl
     ends one), so near a segment's start (backward), end (forward) or either (centred)
     the difference covers less than Δt; a segment shorter than Δt — a 5 s burst logged
     every 5 min — has *only* such samples, and its Ṫ is temperature noise divided by a
-    fraction of a second. Returns (count, number of segments).
+    fraction of a second.
+
+    Parameters
+    ----------
+    time_s : numpy.ndarray
+        Sample times [s].
+    interval_s : float
+        Ṫ interval Δt [s].
+    method : str
+        ``backward``, ``forward`` or ``centred``.
+
+    Returns
+    -------
+    count : int
+        Samples whose Ṫ spans less than Δt/2.
+    n_segments : int
+        Contiguous segments.
     """
     half = SHORT_RATE_SPAN_FRACTION * interval_s
     count = 0
@@ -281,6 +384,19 @@ def record_ranges(
 
     ``rate_bounds`` / ``temp_bounds`` = (per-run minima, per-run maxima) of Ṫ / T,
     shape (n_runs, k); the temperature bounds are computed here when not given.
+
+    Parameters
+    ----------
+    model : TemperatureModel
+        The model being fitted.
+    runs : sequence of RunData
+        Its runs.
+    stats : FitStats
+        The fit statistics.
+    rate_bounds : tuple of numpy.ndarray or None
+        Per-run Ṫ minima and maxima [°C/min].
+    temp_bounds : tuple of numpy.ndarray, optional
+        Per-run T minima and maxima [°C].
     """
     if temp_bounds is None:
         lo_t = np.array([[r.temps_c[:, j].min() for j in range(r.temps_c.shape[1])] for r in runs])

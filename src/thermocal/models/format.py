@@ -53,12 +53,38 @@ def _canonical(d: dict[str, Any]) -> bytes:
 
 
 def checksum(d: dict[str, Any]) -> str:
-    """SHA-256 of the canonical JSON of a model dict (``checksum`` key excluded)."""
+    """SHA-256 of the canonical JSON of a model dict (``checksum`` key excluded).
+
+    Parameters
+    ----------
+    d : dict
+        A model (or calibration) file's content.
+
+    Returns
+    -------
+    str
+        64 hexadecimal digits.
+
+    References
+    ----------
+    - FIPS PUB 180-4 (2015), Secure Hash Standard.
+    """
     return hashlib.sha256(_canonical(d)).hexdigest()
 
 
 def check_model_header(d: Any) -> None:
-    """Refuse foreign, newer or unknown model dicts with a clear :class:`ModelFileError`."""
+    """Refuse foreign, newer or unknown model dicts with a clear :class:`ModelFileError`.
+
+    Parameters
+    ----------
+    d : object
+        A parsed JSON document.
+
+    Raises
+    ------
+    thermocal.errors.ModelFileError
+        Not a thermocal model, a newer format version, or a missing section.
+    """
     if not isinstance(d, dict) or d.get("format") != MODEL_FORMAT:
         raise ModelFileError("not a thermocal model file (missing 'format': 'thermocal-model')")
     ver = d.get("format_version")
@@ -87,7 +113,23 @@ def _nonfinite_fields(obj: Any, path: str = "") -> list[str]:
 
 def model_file_dict(model: TemperatureModel) -> dict[str, Any]:
     """The model file's dict (:meth:`TemperatureModel.to_dict` with its checksum); a
-    non-finite number anywhere is refused with :class:`DesignError` naming the field."""
+    non-finite number anywhere is refused with :class:`DesignError` naming the field.
+
+    Parameters
+    ----------
+    model : TemperatureModel
+        A fitted model.
+
+    Returns
+    -------
+    dict
+        The content with its ``checksum``.
+
+    Raises
+    ------
+    thermocal.errors.DesignError
+        A non-finite number in the content.
+    """
     d = model.to_dict()
     bad = _nonfinite_fields(d)
     if bad:

@@ -67,9 +67,15 @@ sharing one design)."""
 class Reduced:
     """A design reduced to triangular form, per fold.
 
-    ``r_aug[f]`` is the (q+t)×(q+t) upper-triangular factor of ``[F | Z | Y]``
-    for fold f (q = p features + m groups, t targets, usually 1); ``n[f]`` its row count;
-    ``solver`` ``"qr"`` or ``"gram"``.
+    Attributes
+    ----------
+    r_aug : list of numpy.ndarray
+        Per fold f, the (q+t)×(q+t) upper-triangular factor of ``[F | Z | Y]`` (q = p
+        features + m groups, t targets, usually 1).
+    n : list of int
+        Row count per fold.
+    solver : str
+        ``"qr"`` or ``"gram"``.
     """
 
     r_aug: list[FloatArray]
@@ -84,6 +90,7 @@ class Reduced:
 
     @property
     def n_total(self) -> int:
+        """Rows over all folds."""
         return int(sum(self.n))
 
 
@@ -203,6 +210,33 @@ def accumulate_r(
     when the Gram path is abandoned for the QR path).  ``"auto"``: Gram path,
     kept when every fold's Cholesky succeeds and the column-equilibrated design
     has κ ≤ :data:`GRAM_MAX_COND`, else the chunked Householder QR.
+
+    Parameters
+    ----------
+    make_chunks : callable
+        Returns an iterator of :data:`Chunk` ``(A, group, fold)``.
+    p : int
+        Number of feature columns.
+    m : int
+        Number of groups (per-run offsets).
+    n_folds : int, optional
+        Folds (2 for a hold-out selection).  Default 1.
+    solver : {"auto", "qr", "gram"}, optional
+        Default ``"auto"``.
+
+    Returns
+    -------
+    Reduced
+
+    Notes
+    -----
+    Gram path: :math:`A^\\top A = R^\\top R` (Cholesky); QR path: :math:`A = QR`
+    (Householder), both giving the same R up to rounding.
+
+    References
+    ----------
+    - Golub, G. H. & Van Loan, C. F. (2013). *Matrix Computations*, 4th ed., Johns Hopkins
+      University Press, §5.3 (the full-rank least-squares problem).
     """
     return accumulate_targets(make_chunks, p, m, 1, n_folds=n_folds, solver=solver)[0]
 
@@ -224,6 +258,24 @@ def accumulate_targets(
     of ``[F | 1]`` (BLAS ``dsyrk``) and the Gram/QR decision; per target: ``[F | 1]ᵀ y`` and
     ``yᵀy`` (Gram path) or the Householder update (QR path, used for ill-conditioned
     designs).
+
+    Parameters
+    ----------
+    make_chunks : callable
+        Returns an iterator of :data:`Chunk` with ``n_targets`` target columns.
+    p, m : int
+        Feature columns and groups.
+    n_targets : int
+        Targets t sharing the design.
+    n_folds : int, optional
+        Default 1.
+    solver : {"auto", "qr", "gram"}, optional
+        Default ``"auto"``.
+
+    Returns
+    -------
+    list of Reduced
+        One per target.
     """
     if solver not in ("auto", "qr", "gram"):
         raise ThermocalInputError(f"unknown solver {solver!r}; use auto, qr or gram")
@@ -249,14 +301,48 @@ def accumulate_targets(
 
 
 def column_scales(r: FloatArray) -> FloatArray:
-    """Column 2-norms of the design from its R factor (‖A e_j‖ = ‖R e_j‖)."""
+    """Column 2-norms of the design from its R factor (‖A e_j‖ = ‖R e_j‖).
+
+    Parameters
+    ----------
+    r : numpy.ndarray
+        Upper-triangular R of the design A, shape (q, q).
+
+    Returns
+    -------
+    numpy.ndarray
+        :math:`\\lVert A e_j \\rVert_2` per column, shape (q,); 1 for a zero column.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> a = np.random.default_rng(0).random((20, 2))
+    >>> r = np.linalg.qr(a, mode="r")
+    >>> bool(np.allclose(column_scales(r), np.linalg.norm(a, axis=0)))
+    True
+    """
     s = np.sqrt(np.sum(r * r, axis=0))
     out: FloatArray = np.where(s > 0, s, 1.0)
     return out
 
 
 def scaled_condition(r: FloatArray) -> float:
-    """2-norm condition number of the column-equilibrated design (from its R factor)."""
+    """2-norm condition number of the column-equilibrated design (from its R factor).
+
+    Parameters
+    ----------
+    r : numpy.ndarray
+        Upper-triangular R of the design, shape (q, q).
+
+    Returns
+    -------
+    float
+        :math:`\\kappa_2(A D) = s_\\max / s_\\min`, D the column scaling to unit norm.
+
+    References
+    ----------
+    - Golub, G. H. & Van Loan, C. F. (2013). *Matrix Computations*, 4th ed., §2.6.2, §5.3.8.
+    """
     rs = r / column_scales(r)[None, :]
     sv = np.linalg.svd(rs, compute_uv=False)
     if sv.size == 0 or sv[-1] <= 0:
@@ -268,10 +354,43 @@ def scaled_condition(r: FloatArray) -> float:
 class LstsqSolution:
     """Solution of a column-scaled least-squares problem from its R factor.
 
-    ``coef`` (q,) and ``cov`` (q, q) in the original column units; ``rss`` the
-    residual sum of squares (ridge and truncation included); ``dof`` = n − rank;
-    ``condition_number`` of the equilibrated design; ``rank`` singular values
-    kept; ``singular_values`` of the equilibrated R (descending).
+    Attributes
+    ----------
+    coef : numpy.ndarray
+        Coefficients (q,) in the original column units.
+    cov : numpy.ndarray
+        Their covariance (q, q).
+    rss : float
+        Residual sum of squares (ridge and truncation included) [target unit²].
+    n : int
+        Rows.
+    dof : int
+        n − rank.
+    condition_number : float
+        κ₂ of the equilibrated design.
+    rank : int
+        Singular values kept.
+    n_truncated : int
+        Singular values dropped.
+    singular_values : numpy.ndarray
+        Of the equilibrated R, descending.
+    extra : dict
+        Solver details.
+
+    Examples
+    --------
+    A line fitted from the R factor agrees with :func:`numpy.linalg.lstsq`:
+
+    >>> import numpy as np
+    >>> rng = np.random.default_rng(0)
+    >>> x = rng.random(200)
+    >>> a = np.column_stack([x, np.ones_like(x)])
+    >>> y = 2.0 * x + 0.5 + 0.01 * rng.standard_normal(200)
+    >>> sol = solve_r(np.linalg.qr(np.column_stack([a, y]), mode="r"), 200, ["x", "const"])
+    >>> np.round(sol.coef, 3).tolist(), sol.dof
+    ([1.997, 0.5], 198)
+    >>> np.round(np.linalg.lstsq(a, y, rcond=None)[0], 3).tolist()
+    [1.997, 0.5]
     """
 
     coef: FloatArray
@@ -287,13 +406,29 @@ class LstsqSolution:
 
     @property
     def sigma2(self) -> float:
+        """Residual variance :math:`\\hat\\sigma^2 = \\mathrm{RSS}/\\mathrm{dof}` (NaN at dof 0)."""
         return self.rss / self.dof if self.dof > 0 else math.nan
 
 
 def singular_error(
     r: FloatArray, names: Sequence[str], *, rcond: float = SINGULAR_RCOND
 ) -> DesignError | None:
-    """A :class:`DesignError` naming the columns of a (near-)singular design, or None."""
+    """A :class:`DesignError` naming the columns of a (near-)singular design, or None.
+
+    Parameters
+    ----------
+    r : numpy.ndarray
+        Upper-triangular R of the design, shape (q, q).
+    names : sequence of str
+        Column names.
+    rcond : float, optional
+        Singular when :math:`s_\\min < \\mathrm{rcond}\\, s_\\max`.  Default
+        :data:`SINGULAR_RCOND`.
+
+    Returns
+    -------
+    thermocal.errors.DesignError or None
+    """
     q = r.shape[1]
     if q == 0:
         return None
@@ -390,17 +525,29 @@ def solve_r(
 
         γ_P = Σ_{kept i} v_i c_i s_i/(s_i² + nα),     γ_U = R11⁻¹ (z1 − R12 γ_P)
 
-    (ridge α ≥ 0 shrinks only the P coefficients; Golub & Van Loan §6.1.4).
-    Component i is kept when ``s_i > rcond · s_max`` (truncated SVD) or, with
-    ``noise_threshold`` k, when ``|c_i| > k σ̂`` — its share of the data stands
-    out of the noise (σ̂² = RSS/(n − q) of the full fit; a discrete Picard
-    rule, Hansen, *Rank-Deficient and Discrete Ill-Posed Problems*, SIAM 1998,
-    §3.2).  ``β = D γ``; ``cov(β) = σ² D L Lᵀ D`` with L
-    the linear map from ``[z1; z2]`` to γ (triangular solves, no inverse of
-    AᵀA).  Residuals are assumed white; with coloured noise the standard
-    errors are optimistic.  A design with ``s_min < 1e-11 s_max`` raises
-    :class:`DesignError` naming the dependent columns.  ``columns`` restricts
-    the problem to a subset (in that order).
+    (ridge α ≥ 0 shrinks only the P coefficients; Golub & Van Loan §6.1.4).  Component i
+    is kept when ``s_i > rcond · s_max`` (truncated SVD) or, with ``noise_threshold`` k,
+    when ``|c_i| > k σ̂`` — its share of the data stands out of the noise (σ̂² = RSS/(n − q)
+    of the full fit; a discrete Picard rule, Hansen, *Rank-Deficient and Discrete
+    Ill-Posed Problems*, SIAM 1998, §3.2).  ``β = D γ``; ``cov(β) = σ² D L Lᵀ D`` with L
+    the linear map from ``[z1; z2]`` to γ (triangular solves, no inverse of AᵀA).
+    Residuals are assumed white; with coloured noise the standard errors are optimistic.
+
+    Parameters
+    ----------
+    r_aug, n, names : numpy.ndarray, int, sequence of str
+        R factor of ``[A | y]`` (q+1, q+1), rows of A, column names (for messages).
+    penalised, ridge, rcond, noise_threshold, columns : optional
+        P-column mask, α ≥ 0, truncation ratio, k, column subset (in that order).
+
+    Returns
+    -------
+    LstsqSolution
+
+    Raises
+    ------
+    thermocal.errors.DesignError
+        ``s_min < 1e-11 s_max``, naming the dependent columns.
     """
     q = r_aug.shape[1] - 1
     cols = list(range(q)) if columns is None else list(columns)
@@ -463,6 +610,20 @@ def subset_rss(r_aug: FloatArray, columns: Sequence[int]) -> tuple[float, FloatA
 
     ``‖y − A_S β‖² = ‖r_y − R_S β‖²`` where ``r_y`` is the last column of
     ``R_aug`` (Q orthogonal); solved by lstsq on the small matrix.
+
+    Parameters
+    ----------
+    r_aug : numpy.ndarray
+        R factor of ``[A | y]``, shape (q+1, q+1).
+    columns : sequence of int
+        The subset S.
+
+    Returns
+    -------
+    rss : float
+        Residual sum of squares [target unit²].
+    beta : numpy.ndarray
+        Coefficients of the columns of S.
     """
     q = r_aug.shape[1] - 1
     R = r_aug[:, list(columns)]
@@ -473,7 +634,22 @@ def subset_rss(r_aug: FloatArray, columns: Sequence[int]) -> tuple[float, FloatA
 
 
 def holdout_rss(r_aug_hold: FloatArray, columns: Sequence[int], beta: FloatArray) -> float:
-    """``‖y_h − A_h,S β‖²`` of a held-out fold from its R factor."""
+    """``‖y_h − A_h,S β‖²`` of a held-out fold from its R factor.
+
+    Parameters
+    ----------
+    r_aug_hold : numpy.ndarray
+        R factor of the held-out fold's ``[A | y]``.
+    columns : sequence of int
+        The subset S.
+    beta : numpy.ndarray
+        Coefficients fitted on the other fold.
+
+    Returns
+    -------
+    float
+        Held-out residual sum of squares [target unit²].
+    """
     q = r_aug_hold.shape[1] - 1
     res = r_aug_hold[:, q] - r_aug_hold[:, list(columns)] @ beta
     return float(res @ res)
@@ -481,7 +657,17 @@ def holdout_rss(r_aug_hold: FloatArray, columns: Sequence[int], beta: FloatArray
 
 @dataclass(frozen=True)
 class Selection:
-    """Result of forward stepwise selection: kept columns in the order added, and the path."""
+    """Result of forward stepwise selection: kept columns in the order added, and the path.
+
+    Attributes
+    ----------
+    kept : list of int
+        Columns kept, in the order added.
+    path : list of dict
+        Each step's column and score.
+    method : str
+        ``"bic"`` or ``"holdout"``.
+    """
 
     kept: list[int]
     path: list[dict[str, Any]]
@@ -502,6 +688,32 @@ def forward_select(
     it.  ``"bic"``: ``n ln(RSS/n) + k ln n`` on all data (Schwarz 1978,
     doi:10.1214/aos/1176344136); ``"holdout"``: RSS on fold 1 of a fit on fold 0
     (blocked hold-out; ``red`` must have two folds).
+
+    Parameters
+    ----------
+    red : Reduced
+        The reduced design (two folds for ``"holdout"``).
+    candidates : sequence of int
+        Columns that may be added.
+    required : sequence of int
+        Columns always kept.
+    names : sequence of str
+        Column names.
+    method : {"bic", "holdout"}, optional
+        Default ``"bic"``.
+
+    Returns
+    -------
+    Selection
+
+    Notes
+    -----
+    .. math:: \\mathrm{BIC} = n \\ln(\\mathrm{RSS}/n) + k \\ln n
+
+    References
+    ----------
+    - Schwarz, G. (1978). Estimating the dimension of a model. *Annals of Statistics*
+      6(2), 461–464, doi:10.1214/aos/1176344136.
     """
     kept: list[int] = list(required)
     remaining = [c for c in candidates if c not in kept]

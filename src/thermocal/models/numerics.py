@@ -34,8 +34,23 @@ class LstsqResult:
     ``coef`` (p,) or (p, q); ``cov_unit`` = (XᵀX)⁻¹ = V S⁻² Vᵀ (from the SVD, no
     explicit inverse of XᵀX), multiply by s² for the covariance; ``sigma2`` the
     residual variance s² = ‖r‖²/(n − p) per column (NaN when n = p);
-    ``condition_number`` = s_max/s_min; ``rank``; ``singular`` the indices of the
-    columns most involved in the null space (empty when full rank).
+    Attributes
+    ----------
+    coef : numpy.ndarray
+        Coefficients (p,) or (p, q).
+    cov_unit : numpy.ndarray
+        :math:`(X^\\top X)^{-1} = V S^{-2} V^\\top` (from the SVD, no explicit inverse);
+        multiply by s² for the covariance.
+    sigma2 : numpy.ndarray
+        Residual variance :math:`s^2 = \\lVert r\\rVert^2/(n - p)` per column (NaN when n = p).
+    condition_number : float
+        :math:`s_\\max / s_\\min`.
+    rank : int
+        Numerical rank.
+    dof : int
+        n − p.
+    null_columns : tuple of int
+        Columns most involved in the null space (empty when full rank).
     """
 
     coef: FloatArray
@@ -54,6 +69,34 @@ def lstsq_svd(x: FloatArray, y: FloatArray) -> LstsqResult:
     ``s² = ‖y − Xc‖²/(n − p)`` (Golub & Van Loan, *Matrix Computations*, §5.5).
     A rank-deficient design is not solved: ``rank < p`` and ``null_columns``
     tell the caller which terms to name in its :class:`DesignError`.
+
+    Parameters
+    ----------
+    x : numpy.ndarray
+        Design X, shape (n, p).
+    y : numpy.ndarray
+        Targets, shape (n,) or (n, q).
+
+    Returns
+    -------
+    LstsqResult
+
+    Notes
+    -----
+    .. math:: c = V S^{-1} U^\\top y, \\qquad \\mathrm{cov}(c) = s^2 V S^{-2} V^\\top
+
+    References
+    ----------
+    - Golub, G. H. & Van Loan, C. F. (2013). *Matrix Computations*, 4th ed., Johns Hopkins
+      University Press, §5.5.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> x = np.column_stack([np.ones(5), np.arange(5.0)])
+    >>> res = lstsq_svd(x, 1.0 + 2.0 * np.arange(5.0))
+    >>> np.round(res.coef, 6).tolist(), res.rank, res.dof
+    ([1.0, 2.0], 2, 3)
     """
     n, p = x.shape
     u, s, vt = np.linalg.svd(x, full_matrices=False)
@@ -96,6 +139,26 @@ def channel_index(family: str, run: RunData, sensor: int, fitted_name: str | Non
 
     The fitted channel's name when the run has it, else the only column, else
     column ``sensor`` (0 = the first named temperature channel).
+
+    Parameters
+    ----------
+    family : str
+        The family's name, for messages.
+    run : RunData
+        The run.
+    sensor : int
+        0-based column index used when the name does not decide.
+    fitted_name : str, optional
+        The fitted channel's name.
+
+    Returns
+    -------
+    int
+
+    Raises
+    ------
+    thermocal.errors.ThermocalInputError
+        ``sensor`` beyond the run's temperature columns.
     """
     k = run.temps_c.shape[1]
     if fitted_name is not None:
@@ -113,13 +176,47 @@ def channel_index(family: str, run: RunData, sensor: int, fitted_name: str | Non
 
 
 def single_channel(run: RunData, col: int) -> RunData:
-    """A copy of ``run`` holding only temperature column ``col``."""
+    """A copy of ``run`` holding only temperature column ``col``.
+
+    Parameters
+    ----------
+    run : RunData
+        The run.
+    col : int
+        The column to keep.
+
+    Returns
+    -------
+    RunData
+    """
     name = run.temp_names[col] if col < len(run.temp_names) else f"T{col + 1}"
     return dataclasses.replace(run, temps_c=run.temps_c[:, [col]], temp_names=(name,))
 
 
 def horner(coef: FloatArray, x: FloatArray) -> FloatArray:
-    """``Σ_k coef[k] x^k`` by Horner's rule (same operations for arrays and scalars)."""
+    """``Σ_k coef[k] x^k`` by Horner's rule (same operations for arrays and scalars).
+
+    Parameters
+    ----------
+    coef : numpy.ndarray
+        Coefficients, lowest power first.
+    x : numpy.ndarray or float
+        Where to evaluate.
+
+    Returns
+    -------
+    numpy.ndarray or float
+
+    Notes
+    -----
+    .. math:: p(x) = c_0 + x (c_1 + x (c_2 + \\dots))
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> horner(np.array([1.0, 2.0, 3.0]), np.array([0.0, 1.0, 2.0])).tolist()
+    [1.0, 6.0, 17.0]
+    """
     out = np.full_like(x, coef[-1])
     for c in coef[-2::-1]:
         out = out * x + c
@@ -158,6 +255,31 @@ def running_start_mean(time_s: FloatArray, x: FloatArray, window_s: float) -> Fl
 
     with m the number of samples with ``t − t_first < window_s``.  The sums are
     sequential (``np.cumsum``), as in the streaming twin.
+
+    Parameters
+    ----------
+    time_s : numpy.ndarray
+        Sample times [s].
+    x : numpy.ndarray
+        Values (temperature [°C] or output [signal unit]).
+    window_s : float
+        Start window [s].
+
+    Returns
+    -------
+    numpy.ndarray
+        x0 per sample, the unit of ``x``.
+
+    References
+    ----------
+    - *Temperature-characteristic calibration test plan* (a MEMS sensor's power-on warm-up
+      tests and model).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> running_start_mean(np.arange(5.0), np.array([1.0, 3.0, 5.0, 7.0, 9.0]), 2.0).tolist()
+    [1.0, 2.0, 2.0, 2.0, 2.0]
     """
     m = _window_count(time_s, window_s)
     cs = np.cumsum(x[:m]) / np.arange(1, m + 1, dtype=np.float64)

@@ -198,7 +198,19 @@ class PiecewiseModel(TemperatureModel):
     # -- helpers --
     def data_needs(self, temp_names: Sequence[str], n_runs: int) -> Needs:
         """Judged as a line in the model's column (each segment's own data are checked by
-        the fit); S + 1 coefficients for S given segments, plus per-run offsets."""
+        the fit); S + 1 coefficients for S given segments, plus per-run offsets.
+
+        Parameters
+        ----------
+        temp_names : sequence of str
+            The temperature columns.
+        n_runs : int
+            Number of runs.
+
+        Returns
+        -------
+        thermocal.adequacy.Needs
+        """
         j = self._column(temp_names, len(temp_names)) if temp_names else 0
         # breakpoints chosen from the data (segments=N) are fewer where the data are short
         s = len(self.breakpoints) + 1 if self.breakpoints else 1
@@ -245,6 +257,21 @@ class PiecewiseModel(TemperatureModel):
         adjacent lines meet (intersect method, :meth:`_intersections`); residuals,
         their correlation and the statistics (:meth:`_set_fitted`); every final segment
         judged by the common adequacy rules (:func:`segment_tests`, ``segment_tests_``).
+
+        Parameters
+        ----------
+        runs : sequence of RunData
+            Runs with times [s], temperatures [°C] and signal [°/h or mg].
+
+        Returns
+        -------
+        PiecewiseModel
+            ``self``, fitted.
+
+        Raises
+        ------
+        thermocal.errors.DesignError
+            The data cannot determine the model (rank, ranges, segments).
         """
         if self.method not in METHODS:
             raise ThermocalInputError(
@@ -537,14 +564,39 @@ class PiecewiseModel(TemperatureModel):
         self.data_ = [{"file": r.name, "n_samples": r.n_samples} for r in rl]
 
     def predict(self, run: RunData, *, extrapolate: bool = False) -> FloatArray:
-        """Eq. (1) for every sample of ``run`` [signal unit]; T clamped to the fitted range."""
+        """Eq. (1) for every sample of ``run`` [signal unit]; T clamped to the fitted range.
+
+        Parameters
+        ----------
+        run : RunData
+            Times [s] and temperatures [°C].
+        extrapolate : bool, optional
+            False (default): temperatures clamped to the fitted range, with a warning.
+
+        Returns
+        -------
+        numpy.ndarray
+            Shape (n,) [signal unit].
+        """
         self.check_fitted()
         x = self._pick(run)
         xc = self.clamp(x[:, None], extrapolate=extrapolate)[:, 0]
         return evaluate_lines(self.breakpoints_, self.intercepts_, self.slopes_, xc)
 
     def stream(self, sample_interval_s: float, *, extrapolate: bool = False) -> PiecewiseStream:
-        """Sample-by-sample twin of :meth:`predict` (memoryless)."""
+        """Sample-by-sample twin of :meth:`predict` (memoryless).
+
+        Parameters
+        ----------
+        sample_interval_s : float
+            Nominal sample interval [s].
+        extrapolate : bool, optional
+            Default False.
+
+        Returns
+        -------
+        PiecewiseStream
+        """
         self.check_fitted()
         return PiecewiseStream(self, extrapolate=extrapolate)
 
@@ -577,7 +629,20 @@ class PiecewiseModel(TemperatureModel):
     @classmethod
     def check_state(cls, d: dict[str, Any], root: str = "") -> None:
         """The ``state`` section of a piecewise model file: ascending breakpoints, one
-        intercept and slope per segment, its column one of the inputs."""
+        intercept and slope per segment, its column one of the inputs.
+
+        Parameters
+        ----------
+        d : dict
+            The model file's content.
+        root : str, optional
+            Key path prefix.  Default ``""``.
+
+        Raises
+        ------
+        thermocal.errors.ModelFileError
+            A bad state, naming the key path.
+        """
         state, path, n_temps = d["state"], key_path(root, "state"), len(d["temperatures"])
         fields(
             {"breakpoints": ascending, "intercepts": list_of(number), "slopes": list_of(number)},
@@ -633,6 +698,13 @@ class PiecewiseStream(ModelStream):
     ``temps_c`` may hold only the model's temperature or every fitted column
     (then the model's ``column_index`` is used).  Warns once per stream when a
     sample leaves the fitted range.
+
+    Parameters
+    ----------
+    model : PiecewiseModel
+        The fitted model.
+    extrapolate : bool
+        Keep out-of-range temperatures (and warn).
     """
 
     def __init__(self, model: PiecewiseModel, *, extrapolate: bool) -> None:
@@ -647,9 +719,26 @@ class PiecewiseStream(ModelStream):
         self.reset()
 
     def reset(self) -> None:
+        """Forget everything (a new power-on)."""
         self._clamp.warned = False
 
     def update(self, time_s: float, temps_c: FloatArray, signal: float | None = None) -> float:
+        """Model value for one sample (see :meth:`ModelStream.update`).
+
+        Parameters
+        ----------
+        time_s : float
+            Sample time [s].
+        temps_c : numpy.ndarray
+            Temperatures [°C].
+        signal : float, optional
+            Not used.
+
+        Returns
+        -------
+        float
+            [signal unit].
+        """
         x = self._clamp(stream_channel(temps_c, self._col))
         j = bisect.bisect_right(self._bps, x)
         return self._inter[j] + self._slopes[j] * x

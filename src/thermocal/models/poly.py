@@ -266,13 +266,40 @@ class PolyModel(PolyBase):
         Works through each run in blocks of :data:`~thermocal.models.terms.CHUNK_ROWS`
         samples (Ṫ, features and the reduction per block), so memory stays at the
         input arrays plus a few MB.  :func:`fit_shared` fits several channels at once.
+
+        Parameters
+        ----------
+        runs : sequence of RunData
+            Runs with times [s], temperatures [°C] and signal [°/h or mg].
+
+        Returns
+        -------
+        PolyModel
+            ``self``, fitted.
+
+        Raises
+        ------
+        thermocal.errors.DesignError
+            The data cannot determine the model (rank, ranges, segments).
         """
         fit_shared([self], [runs])
         return self
 
     def data_needs(self, temp_names: Sequence[str], n_runs: int) -> Needs:
         """Order in T per column (T and T·Ṫ powers), the terms plus the constant and the
-        per-run offsets, and the columns with Ṫ terms."""
+        per-run offsets, and the columns with Ṫ terms.
+
+        Parameters
+        ----------
+        temp_names : sequence of str
+            The temperature columns.
+        n_runs : int
+            Number of runs.
+
+        Returns
+        -------
+        thermocal.adequacy.Needs
+        """
         terms = parse_terms(self.terms, len(temp_names), self.order)
         order = {n: 0 for n in temp_names}
         for t in terms:
@@ -296,11 +323,35 @@ class PolyModel(PolyBase):
         Evaluated in blocks of :data:`PREDICT_BLOCK_ROWS` rows (Ṫ partners found per
         block by :func:`~thermocal.models.terms.backward_partners`; Horner's rule per
         sensor, :class:`EvalPlan`); the same numbers as :class:`PolyStream`.
+
+        Parameters
+        ----------
+        run : RunData
+            Times [s] and temperatures [°C].
+        extrapolate : bool, optional
+            False (default): temperatures clamped to the fitted range, with a warning.
+
+        Returns
+        -------
+        numpy.ndarray
+            Shape (n,) [signal unit].
         """
         return evaluate([self], run, extrapolate=extrapolate)[0]
 
     def stream(self, sample_interval_s: float, *, extrapolate: bool = False) -> PolyStream:
-        """Sample-by-sample twin of :meth:`predict` (needs the backward rate form)."""
+        """Sample-by-sample twin of :meth:`predict` (needs the backward rate form).
+
+        Parameters
+        ----------
+        sample_interval_s : float
+            Nominal sample interval [s].
+        extrapolate : bool, optional
+            Default False.
+
+        Returns
+        -------
+        PolyStream
+        """
         self.check_fitted()
         if self.model_uses_rate and self.rate_method != "backward":
             raise ThermocalInputError(
@@ -341,6 +392,25 @@ class PolyModel(PolyBase):
         ``b = S a`` and ``cov b = S cov a Sᵀ``.  Names use ``dT1`` for ``T1 − TREF``…
         (rates keep ``Ṫ``, written ``rate1``).  Only the constant and the
         polynomial terms change; the model's values do not.
+
+        Parameters
+        ----------
+        tref_c : float
+            Reference temperature TREF [°C].
+
+        Returns
+        -------
+        list of Coefficient
+
+        Notes
+        -----
+        .. math:: T^P = \\sum_{j=0}^{P} \\binom{P}{j} T_\\mathrm{ref}^{P-j} (T - T_\\mathrm{ref})^j,
+                  \\qquad \\mathrm{cov}\\, b = S\\, \\mathrm{cov}\\, a\\, S^\\top
+
+        References
+        ----------
+        - PX4 ``Tools/process_sensor_caldata.py`` and ArduPilot
+          ``AP_InertialSensor_tempcal.cpp`` (polynomials in T − TREF).
         """
         self.check_fitted()
         if not math.isfinite(tref_c):
@@ -386,7 +456,20 @@ class PolyModel(PolyBase):
     def check_state(cls, d: dict[str, Any], root: str = "") -> None:
         """The ``state`` section of a poly model file (:meth:`_state`'s layout): centres and
         scales per base variable (scales not 0), terms of powers 0…:data:`MAX_TERM_POWER` on
-        known sensors, one coefficient per term; a used centre in or near its fitted range."""
+        known sensors, one coefficient per term; a used centre in or near its fitted range.
+
+        Parameters
+        ----------
+        d : dict
+            The model file's content.
+        root : str, optional
+            Key path prefix.  Default ``""``.
+
+        Raises
+        ------
+        thermocal.errors.ModelFileError
+            A bad state, naming the key path.
+        """
         state, path, n_temps = d["state"], key_path(root, "state"), len(d["temperatures"])
         fields(
             {
@@ -467,6 +550,7 @@ class PolyModel(PolyBase):
             raise ThermocalInputError("poly model state: coefficient and term counts differ")
 
     def to_dict(self) -> dict[str, Any]:
+        """The model file's content (without checksum); ``rate`` is null when no term uses Ṫ."""
         d = super().to_dict()
         if not self.model_uses_rate:
             d["rate"] = None
@@ -493,6 +577,20 @@ class PolyStream(ModelStream):
     ``GAP_FACTOR × sample_interval_s`` starts a new segment (rate restarts from 0).
     Warns once per stream (per kind: temperature, rate) when a sample leaves the
     fitted range.
+
+    Parameters
+    ----------
+    model : PolyModel
+        The fitted model.
+    sample_interval_s : float
+        Nominal sample interval [s].
+    extrapolate : bool
+        Keep out-of-range inputs (and warn).
+
+    Raises
+    ------
+    thermocal.errors.ThermocalInputError
+        A sample interval that is not positive.
     """
 
     def __init__(self, model: PolyModel, sample_interval_s: float, *, extrapolate: bool) -> None:
@@ -519,6 +617,7 @@ class PolyStream(ModelStream):
         self.reset()
 
     def reset(self) -> None:
+        """Forget everything (a new power-on): the Ṫ history restarts."""
         self._times: deque[float] = deque()
         self._hist: deque[list[float]] = deque()
         self._last_t: float | None = None
@@ -532,6 +631,22 @@ class PolyStream(ModelStream):
         )
 
     def update(self, time_s: float, temps_c: FloatArray, signal: float | None = None) -> float:
+        """Model value for one sample (see :meth:`ModelStream.update`).
+
+        Parameters
+        ----------
+        time_s : float
+            Sample time [s].
+        temps_c : numpy.ndarray
+            Temperatures [°C].
+        signal : float, optional
+            Not used.
+
+        Returns
+        -------
+        float
+            [signal unit].
+        """
         t = float(time_s)
         if type(temps_c) is np.ndarray and temps_c.dtype == np.float64 and temps_c.ndim == 1:
             row: list[float] = temps_c.tolist()

@@ -356,7 +356,21 @@ def warn_temperature_range(
     extrapolate: bool,
 ) -> None:
     """The :class:`ExtrapolationWarning` of :meth:`TemperatureModel.clamp` (same text)
-    from the ranges met: ``n`` samples outside, per column seen and fitted range."""
+    from the ranges met: ``n`` samples outside, per column seen and fitted range.
+
+    Parameters
+    ----------
+    seen_min, seen_max : numpy.ndarray
+        Range met per column [°C].
+    temp_range : numpy.ndarray
+        Fitted range (k, 2) [°C].
+    names : sequence of str
+        Column names.
+    n_outside : int
+        Samples outside.
+    extrapolate : bool
+        Wording (extrapolating or clamped).
+    """
     lo, hi = temp_range[:, 0], temp_range[:, 1]
     bad = [i for i in range(lo.size) if seen_min[i] < lo[i] or seen_max[i] > hi[i]]
     if not bad:
@@ -377,7 +391,17 @@ def evaluation_key(model: PolyBase) -> tuple[Any, ...]:
     """What decides how a fitted model's inputs are turned into its centred variables
     (steps 1–3 of the module docstring) and the shape of step 4: models with equal keys
     (channels fitted together by :func:`fit_shared`, unless term selection differs) can
-    be evaluated together by :func:`predict_many`."""
+    be evaluated together by :func:`predict_many`.
+
+    Parameters
+    ----------
+    model : PolyBase
+        A fitted polynomial model.
+
+    Returns
+    -------
+    tuple
+    """
     model.check_fitted()
     plan = model._plan()
     rr = model.rate_range_
@@ -404,7 +428,22 @@ def predict_many(
     Ṫ and centred variables once, then each model's polynomial (step 4) on a copy of
     them — the same operations as each model alone, so each result equals its own
     :meth:`~PolyModel.predict` bit for bit.  Models whose :func:`evaluation_key` differs
-    are evaluated one by one.  Range warnings are issued once (the ranges are shared)."""
+    are evaluated one by one.  Range warnings are issued once (the ranges are shared).
+
+    Parameters
+    ----------
+    models : sequence of PolyBase
+        Fitted models.
+    run : RunData
+        Times [s] and temperatures [°C].
+    extrapolate : bool, optional
+        Default False.
+
+    Returns
+    -------
+    list of numpy.ndarray
+        One (n,) array per model [signal unit].
+    """
     if not models:
         return []
     head = models[0]
@@ -419,7 +458,22 @@ def evaluate(
 ) -> list[FloatArray]:
     """Steps 1–4 for models of one :func:`evaluation_key` (one model: :meth:`PolyModel.
     predict`): the inputs, Ṫ and centred variables once, each model's polynomial, and the
-    range warnings once (the ranges are shared)."""
+    range warnings once (the ranges are shared).
+
+    Parameters
+    ----------
+    models : sequence of PolyBase
+        Fitted models of one :func:`evaluation_key`.
+    run : RunData
+        Times [s] and temperatures [°C].
+    extrapolate : bool, optional
+        Default False.
+
+    Returns
+    -------
+    list of numpy.ndarray
+        One (n,) array per model [signal unit].
+    """
     head = models[0]
     head.check_fitted()
     head._check_temps(run)

@@ -76,6 +76,18 @@ def fit_shared(models: Sequence[PolyBase], runs_by_model: Sequence[Sequence[RunD
     :func:`~thermocal.models.terms.accumulate_targets`); per channel the selection and
     solution (:func:`_solve_channel`); a second pass for the residuals; per channel the
     covariance and statistics (:func:`_finish_channel`).
+
+    Parameters
+    ----------
+    models : sequence of PolyBase
+        Unfitted models with equal parameters (fitted in place).
+    runs_by_model : sequence of sequence of RunData
+        Each model's runs (same times and temperatures, own signal).
+
+    Raises
+    ------
+    thermocal.errors.ThermocalInputError
+        The channels' runs do not share their times, temperatures or parameters.
     """
     head, rls = _shared_runs(models, runs_by_model)
     # BLAS on one thread: the blocks are small (≤ 32 768 × ~40), where threads oversubscribe

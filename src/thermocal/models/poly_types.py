@@ -73,6 +73,13 @@ class EvalPlan:
     folded them into the coefficients (``centred[kind]`` False: no subtraction);
     ``mixed``: (row, coefficient, factor kinds); ``rate_sensors``: the columns whose Ṫ
     a term uses; ``py_rows``: the stream form.
+
+    Attributes
+    ----------
+    constant : float
+        The constant [signal unit].
+    sensors, kinds, horner, centres, centred, mixed, rate_sensors, py_rows
+        As described above.
     """
 
     constant: float
@@ -94,7 +101,13 @@ def build_plan(
     mixed term ``u^a v^b w^c`` gets ``coef / (s_T^a s_R^b s_W^c)``.  When no mixed term
     uses it and every sensor's ``|c| ≤ s``, the centre of Ṫ (of T·Ṫ) is folded in by the
     binomial re-expansion ``Σ_p a_p (x − c)^p = Σ_j b_j x^j`` (the ``b_0`` join the
-    constant), which saves a pass and loses no accuracy."""
+    constant), which saves a pass and loses no accuracy.
+
+    Parameters
+    ----------
+    terms, scaling, coef, constant : list of Term, BaseScaling, numpy.ndarray, float
+        The fitted terms, their scaling, coefficients and constant [signal unit].
+    """
     sensors = tuple(sorted({t.sensor for t in terms}))
     row_of = {s: i for i, s in enumerate(sensors)}
     centre_of = {
@@ -184,7 +197,31 @@ def build_plan(
 class PolyBase(TemperatureModel):
     """The parameters and fitted values of :class:`~thermocal.models.poly.PolyModel` (its
     docstring lists them) and what fitting and evaluation ask of them: the parameter
-    check, Ṫ and the evaluation plan."""
+    check, Ṫ and the evaluation plan.
+
+    Parameters
+    ----------
+    terms : str or list of str or None
+        Term list (``"seed000"`` default) or None with ``order``.
+    order : int, optional
+        Plain polynomial order in T.
+    rate_interval_s : float
+        Ṫ interval Δt [s] (default 60).
+    rate_method : str
+        ``backward`` (default), ``forward`` or ``centred``.
+    select : str, optional
+        Term selection: ``bic`` or ``holdout``.
+    ridge : float
+        Ridge α ≥ 0 (default 0).
+    rcond : float, optional
+        Truncation ratio of singular values.
+    per_run_offset : bool, optional
+        Per-run offsets (None: decided from the runs' overlap).
+    solver : str
+        ``auto`` (default), ``qr`` or ``gram``.
+    noise_threshold : float, optional
+        k of the discrete Picard rule.
+    """
 
     terms_: list[Term]
     scaling_: BaseScaling
@@ -256,7 +293,25 @@ class PolyBase(TemperatureModel):
         return out
 
     def rates(self, time_s: FloatArray, temps_c: FloatArray) -> FloatArray:
-        """Ṫ of every temperature column [°C/min] with the model's rate form and Δt."""
+        """Ṫ of every temperature column [°C/min] with the model's rate form and Δt.
+
+        Parameters
+        ----------
+        time_s : numpy.ndarray
+            Sample times (n,) [s].
+        temps_c : numpy.ndarray
+            Temperatures (n, k) [°C].
+
+        Returns
+        -------
+        numpy.ndarray
+            Ṫ (n, k) [°C/min].
+
+        Notes
+        -----
+        .. math:: \\dot T_i = 60\\, \\frac{T_i - T_j}{t_i - t_j}, \\qquad
+                  t_j = \\min\\{t : t \\ge t_i - \\Delta t\\} \\text{ (backward)}
+        """
         return temperature_rates(time_s, temps_c, float(self.rate_interval_s), self.rate_method)
 
     def _plan(self) -> EvalPlan:

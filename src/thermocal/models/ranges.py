@@ -42,6 +42,19 @@ class RangeExcess:
     above its maximum; ``beyond[col]`` is the largest distance ``max(lo − x, x − hi, 0)``
     over the samples [unit]; ``seen[col]`` the range met and ``fitted[col]`` the calibrated
     one.
+
+    Attributes
+    ----------
+    quantity : str
+        ``temperature``, ``temperature_rate`` or ``time_since_power_on``.
+    unit : str
+        [°C], [°C/min], [s], or counts.
+    n_samples, n_outside : int
+        Samples checked and samples outside.
+    beyond : dict of str to float
+        Largest distance outside per column [unit].
+    seen, fitted : dict of str to tuple of float
+        Range met and calibrated range per column [unit].
     """
 
     quantity: str
@@ -104,6 +117,16 @@ class RangeTally:
     Δt and difference form, never across a gap) computed with the last ``2Δt`` of the
     previous chunks as history, so chunked and whole-run figures agree for the causal
     backward form; the time since power-on counts from the first sample added.
+
+    Parameters
+    ----------
+    model : TemperatureModel
+        A fitted model.
+
+    Raises
+    ------
+    thermocal.errors.ThermocalInputError
+        The model is not fitted.
     """
 
     def __init__(self, model: TemperatureModel) -> None:
@@ -141,7 +164,15 @@ class RangeTally:
         self._e_out = 0
 
     def add(self, time_s: FloatArray, temps_c: FloatArray) -> None:
-        """The next samples of the run (in time order)."""
+        """The next samples of the run (in time order).
+
+        Parameters
+        ----------
+        time_s : numpy.ndarray
+            Sample times (n,) [s].
+        temps_c : numpy.ndarray
+            Temperatures (n, k) in the model's temperature unit.
+        """
         t = np.asarray(time_s, dtype=np.float64).reshape(-1)
         T = np.asarray(temps_c, dtype=np.float64).reshape(t.size, -1)
         if t.size == 0:
@@ -227,7 +258,26 @@ def outside_range(model: TemperatureModel, time_s: FloatArray, temps_c: FloatArr
     RangeExcess, ...
 ]:  # fmt: skip
     """How far one whole run (time [s], temperatures (n, k)) leaves ``model``'s calibrated
-    ranges (:class:`RangeTally` fed once)."""
+    ranges (:class:`RangeTally` fed once).
+
+    Parameters
+    ----------
+    model : TemperatureModel
+        A fitted model.
+    time_s : numpy.ndarray
+        Sample times (n,) [s].
+    temps_c : numpy.ndarray
+        Temperatures (n, k) [°C].
+
+    Returns
+    -------
+    tuple of RangeExcess
+        One per checked input.
+
+    Notes
+    -----
+    .. math:: \\mathrm{beyond} = \\max_i \\max(lo - x_i,\\; x_i - hi,\\; 0)
+    """
     tally = RangeTally(model)
     tally.add(time_s, temps_c)
     return tally.result()
@@ -237,7 +287,21 @@ def outside_range_message(
     excess: Sequence[RangeExcess], where: str, *, extrapolate: bool
 ) -> str | None:
     """The one warning for a channel applied outside its calibrated range (None when every
-    sample is inside): each input that left, with its share of samples and how far."""
+    sample is inside): each input that left, with its share of samples and how far.
+
+    Parameters
+    ----------
+    excess : sequence of RangeExcess
+        From :func:`outside_range`.
+    where : str
+        The data's name.
+    extrapolate : bool
+        Wording (extrapolating or clamped).
+
+    Returns
+    -------
+    str or None
+    """
     bad = [e for e in excess if e.n_outside > 0]
     if not bad:
         return None
@@ -254,5 +318,15 @@ def outside_range_message(
 
 
 def outside_range_dict(excess: Sequence[RangeExcess]) -> dict[str, Any]:
-    """``{quantity: RangeExcess.to_dict()}`` of every checked input (JSON ``outside_range``)."""
+    """``{quantity: RangeExcess.to_dict()}`` of every checked input (JSON ``outside_range``).
+
+    Parameters
+    ----------
+    excess : sequence of RangeExcess
+        From :func:`outside_range`.
+
+    Returns
+    -------
+    dict
+    """
     return {e.quantity: e.to_dict() for e in excess}

@@ -83,7 +83,18 @@ def load_plugins(group: str = ENTRY_POINT_GROUP) -> list[str]:
     """Register the families of the entry points of ``group``; returns their names.
 
     A plugin that cannot be imported or is not a family is skipped with one
-    :class:`~thermocal.errors.ThermocalWarning` naming it and why."""
+    :class:`~thermocal.errors.ThermocalWarning` naming it and why.
+
+    Parameters
+    ----------
+    group : str, optional
+        The entry-point group.  Default :data:`ENTRY_POINT_GROUP`.
+
+    Returns
+    -------
+    list of str
+        Names of the families registered.
+    """
     added: list[str] = []
     for ep in importlib.metadata.entry_points(group=group):
         try:
@@ -112,7 +123,17 @@ M = TypeVar("M", bound=type[TemperatureModel])
 @dataclass(frozen=True)
 class Family:
     """What the registry knows of one family: its name, its class and the declaration the
-    class carries (options, data needs, C generator, firmware)."""
+    class carries (options, data needs, C generator, firmware).
+
+    Attributes
+    ----------
+    name : str
+        The family's name.
+    model_class : type
+        Its :class:`~thermocal.models.base.TemperatureModel` subclass.
+    declaration : FamilyDeclaration
+        What the class declares of itself.
+    """
 
     name: str
     model_class: type[TemperatureModel]
@@ -135,7 +156,27 @@ def register(cls: M) -> M:
 
 
 def get_model_class(family: str) -> type[TemperatureModel]:
-    """The class of a registered family, or :class:`ModelFileError` naming the known ones."""
+    """The class of a registered family, or :class:`ModelFileError` naming the known ones.
+
+    Parameters
+    ----------
+    family : str
+        The family's name.
+
+    Returns
+    -------
+    type
+
+    Raises
+    ------
+    thermocal.errors.ModelFileError
+        An unknown family.
+
+    Examples
+    --------
+    >>> get_model_class("poly").__name__
+    'PolyModel'
+    """
     try:
         return MODEL_REGISTRY[family]
     except KeyError:
@@ -145,7 +186,27 @@ def get_model_class(family: str) -> type[TemperatureModel]:
 
 
 def family(name: str) -> Family:
-    """The registry's record of one family (:class:`ModelFileError` when unknown)."""
+    """The registry's record of one family (:class:`ModelFileError` when unknown).
+
+    Parameters
+    ----------
+    name : str
+        The family's name.
+
+    Returns
+    -------
+    Family
+
+    Raises
+    ------
+    thermocal.errors.ModelFileError
+        An unknown family.
+
+    Examples
+    --------
+    >>> family("poly").c_generator
+    'thermocal.export.c.poly'
+    """
     cls = get_model_class(name)
     return Family(name, cls, cls.declaration)
 
@@ -156,14 +217,48 @@ def families() -> tuple[Family, ...]:
 
 
 def make_model(family: str, **params: Any) -> TemperatureModel:
-    """Instantiate a registered family with parameters."""
+    """Instantiate a registered family with parameters.
+
+    Parameters
+    ----------
+    family : str
+        The family's name.
+    **params
+        Constructor arguments.
+
+    Returns
+    -------
+    TemperatureModel
+        The unfitted model.
+
+    Raises
+    ------
+    thermocal.errors.ModelFileError
+        An unknown family.
+    """
     return get_model_class(family)(**params)
 
 
 def model_from_dict(d: dict[str, Any]) -> TemperatureModel:
     """Rebuild a fitted model of any registered family from its
     :meth:`~thermocal.models.base.TemperatureModel.to_dict` output (checks the format, then
-    looks the family up: an unknown one is refused, naming the known ones)."""
+    looks the family up: an unknown one is refused, naming the known ones).
+
+    Parameters
+    ----------
+    d : dict
+        A model file's content.
+
+    Returns
+    -------
+    TemperatureModel
+        The fitted model.
+
+    Raises
+    ------
+    thermocal.errors.ModelFileError
+        A bad header or an unknown family.
+    """
     check_model_header(d)
     return get_model_class(str(d["family"])).from_dict(d)
 

@@ -43,10 +43,21 @@ FEW_EFFECTIVE_SAMPLES = 30.0
 class ResidualCorrelation:
     """Integrated autocorrelation time of the residuals.
 
-    ``tau`` τ [samples] (≥ 1); ``n`` samples; ``n_eff`` = n/τ; ``window`` Sokal's M
-    [samples]; ``lag1`` the lag-one autocorrelation; ``converged`` the window rule was met
-    before the series ran out (otherwise τ is a lower bound: the residuals hold a
-    component as slow as the record).
+    Attributes
+    ----------
+    tau : float
+        τ [samples] (≥ 1).
+    n : int
+        Samples.
+    n_eff : float
+        n/τ.
+    window : int
+        Sokal's window M [samples].
+    lag1 : float
+        Lag-one autocorrelation.
+    converged : bool
+        The window rule was met before the series ran out (otherwise τ is a lower bound:
+        the residuals hold a component as slow as the record).
     """
 
     tau: float
@@ -141,6 +152,42 @@ def residual_correlation(
     3.19): white residuals then give the OLS standard errors exactly rather than a random
     few per cent more. Residuals
     below 1e-9 of ``data_rms`` (an exact fit: rounding noise) also give τ = 1.
+
+    Parameters
+    ----------
+    series : sequence of numpy.ndarray
+        Residuals per run [signal unit].
+    data_rms : float, optional
+        RMS of the data [signal unit], for the exact-fit rule.
+    c : float, optional
+        Sokal's window constant.  Default :data:`SOKAL_C` (5).
+
+    Returns
+    -------
+    ResidualCorrelation
+
+    Notes
+    -----
+    .. math:: \\tau = 1 + 2 \\sum_{k=1}^{M} \\rho_k
+
+    References
+    ----------
+    - Sokal, A. D. (1997). Monte Carlo methods in statistical mechanics: foundations and
+      new algorithms. In *Functional Integration* (Cargèse 1996), NATO ASI Series B 361,
+      Plenum, 131–192, §3.
+
+    Examples
+    --------
+    AR(1) residuals of lag-one correlation 0.9 (τ = (1 + ρ)/(1 − ρ) = 19 in theory):
+
+    >>> import numpy as np
+    >>> e = np.random.default_rng(0).standard_normal(2000)
+    >>> x = np.zeros(2000)
+    >>> for i in range(1, 2000):
+    ...     x[i] = 0.9 * x[i - 1] + e[i]
+    >>> r = residual_correlation([x])
+    >>> round(r.tau, 1), round(r.lag1, 2)
+    (22.6, 0.9)
     """
     pieces = [np.asarray(s, dtype=np.float64)[:MAX_SAMPLES_PER_SERIES] for s in series]
     pieces = [p[np.isfinite(p)] for p in pieces]

@@ -17,7 +17,24 @@ DISTINCT_T = 2.0
 
 @dataclass(frozen=True)
 class Coefficient:
-    """A learned coefficient, in physical (unscaled) units, with its standard error."""
+    """A learned coefficient, in physical (unscaled) units, with its standard error.
+
+    Attributes
+    ----------
+    name : str
+        Term name (e.g. ``"T1"``, ``"T1^2"``, ``"const"``).
+    value : float
+        Value [signal unit per unit of the term, e.g. (°/h)/°C].
+    stderr : float or None
+        Standard error [same unit]; None or NaN: not estimable.
+    unit : str
+        Unit text (default ``""``).
+
+    Examples
+    --------
+    >>> Coefficient("T1", 0.02, float("nan"), "deg/h/degC").to_dict()
+    {'name': 'T1', 'value': 0.02, 'unit': 'deg/h/degC'}
+    """
 
     name: str
     value: float
@@ -73,6 +90,7 @@ class Coefficient:
         return not (ratio is None or ratio >= DISTINCT_T)
 
     def to_dict(self) -> dict[str, Any]:
+        """JSON-ready dict; a non-finite standard error is left out."""
         d: dict[str, Any] = {"name": self.name, "value": self.value}
         # a standard error that cannot be estimated (no residual degrees of freedom) is
         # left out — "not estimable" — rather than written as a non-JSON NaN
@@ -87,8 +105,22 @@ class Coefficient:
 class FitStats:
     """Fit statistics reported with every model.
 
-    ``rms_residual`` in the signal unit; ``condition_number`` of the scaled
-    design (2-norm, from the SVD); ``dof`` residual degrees of freedom.
+    Attributes
+    ----------
+    n_samples : int
+        Samples fitted.
+    n_coefficients : int
+        Coefficients learned.
+    rms_residual : float
+        RMS of the residuals [signal unit].
+    condition_number : float or None
+        2-norm condition number κ of the scaled design (ratio of extreme singular values).
+    r_squared : float or None
+        Coefficient of determination :math:`1 - \\mathrm{RSS}/\\mathrm{TSS}`.
+    dof : int or None
+        Residual degrees of freedom n − p.
+    extra : dict
+        Family-specific statistics, written to the model file's ``fit`` section.
     """
 
     n_samples: int
@@ -100,6 +132,7 @@ class FitStats:
     extra: dict[str, Any] = field(default_factory=dict)
 
     def to_dict(self) -> dict[str, Any]:
+        """JSON-ready dict (``extra`` merged in)."""
         d: dict[str, Any] = {
             "n_samples": self.n_samples,
             "n_coefficients": self.n_coefficients,
@@ -129,6 +162,26 @@ def condition_wording(kappa: float | None) -> str:
     ill-conditioned (individual coefficients are not meaningful, only the prediction);
     beyond, near singular. Least squares loses ≈ log₁₀ κ significant digits (Golub & Van
     Loan, *Matrix Computations*, 4th ed., §5.3.8).
+
+    Parameters
+    ----------
+    kappa : float or None
+        The 2-norm condition number κ (dimensionless); None or non-finite: unknown.
+
+    Returns
+    -------
+    str
+        The words.
+
+    References
+    ----------
+    - Golub, G. H. & Van Loan, C. F. (2013). *Matrix Computations*, 4th ed., Johns Hopkins
+      University Press, §5.3.8.
+
+    Examples
+    --------
+    >>> condition_wording(12.0), condition_wording(3e7)
+    ('well conditioned', "ill-conditioned: about 7 of the data's digits lost")
     """
     if kappa is None or not math.isfinite(kappa):
         return "condition unknown"

@@ -33,19 +33,42 @@ class RunData:
 
     Attributes
     ----------
-    time_s : sample times [s], shape (n,).
-    temps_c : temperatures [°C] (raw counts when ``temperature_unit`` is ``counts``),
-        shape (n, k), columns in ``temp_names`` order.
-    signal : sensor output in its canonical unit ([°/h] or [mg]), shape (n,),
-        or ``None`` when only predicting from temperatures.
-    temp_names : names of the temperature columns.
-    name : where the run came from (file name), for messages and provenance.
-    known_input : the known input to remove before fitting (earth rate [°/h],
-        gravity component [mg]); subtracted from ``signal`` by :meth:`target`.
-    signal_unit : the canonical unit of ``signal`` (``deg/h``, ``mg`` or ``counts``) when
-        known (:meth:`from_recording` sets it); a model fitted on the run records it.
-    temperature_unit : ``degC``, or ``counts`` for raw-count temperatures used without a
+    time_s : numpy.ndarray
+        Sample times, shape (n,) [s].
+    temps_c : numpy.ndarray
+        Temperatures, shape (n, k) [°C] (raw counts when ``temperature_unit`` is
+        ``counts``), columns in ``temp_names`` order.
+    signal : numpy.ndarray or None
+        Sensor output in its canonical unit, shape (n,) [°/h] or [mg]; None (default) when
+        only predicting from temperatures.
+    temp_names : tuple of str
+        Names of the temperature columns (default empty).
+    name : str
+        Where the run came from (file name), for messages and provenance.
+    known_input : float
+        The known input to remove before fitting (earth rate [°/h], gravity component
+        [mg]); subtracted from ``signal`` by :meth:`target`.  Default 0.
+    extra : dict
+        Family-specific per-run values (default empty).
+    signal_unit : str or None
+        The canonical unit of ``signal`` (``deg/h``, ``mg`` or ``counts``) when known
+        (:meth:`from_recording` sets it); a model fitted on the run records it.
+    temperature_unit : str
+        ``degC`` (default), or ``counts`` for raw-count temperatures used without a
         conversion (a model fitted on them is in counts).
+
+    Raises
+    ------
+    thermocal.errors.ThermocalInputError
+        ``temps_c`` not of shape (n, k), or ``signal`` not of length n.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> t = np.arange(5.0)
+    >>> run = RunData(t, (20.0 + t)[:, None], np.full(5, 3.0), ("T1",), known_input=1.0)
+    >>> run.n_samples, run.target().tolist()
+    (5, [2.0, 2.0, 2.0, 2.0, 2.0])
     """
 
     time_s: FloatArray
@@ -72,10 +95,22 @@ class RunData:
 
     @property
     def n_samples(self) -> int:
+        """Number of samples n."""
         return int(self.time_s.shape[0])
 
     def target(self) -> FloatArray:
-        """The signal minus the known input: what a model is fitted to."""
+        """The signal minus the known input: what a model is fitted to.
+
+        Returns
+        -------
+        numpy.ndarray
+            :math:`y_i - y_\\mathrm{known}`, shape (n,) [signal unit].
+
+        Raises
+        ------
+        thermocal.errors.ThermocalInputError
+            The run has no signal.
+        """
         if self.signal is None:
             raise ThermocalInputError(f"{self.name or 'run'}: no signal to fit")
         return self.signal - self.known_input
@@ -98,6 +133,32 @@ class RunData:
         in counts; a °C column is an error); ``auto`` (fit): ``counts`` when every used
         temperature is in raw counts with no conversion stated, else ``degC``.
         NaN in the used columns is an input error (never silently dropped).
+
+        Parameters
+        ----------
+        rec : thermocal.recording.Recording
+            The recording as read.
+        signal : str, optional
+            Signal column; None (default): the recording's only signal.
+        temps : sequence of str, optional
+            Temperature columns; None (default): every temperature column.
+        known_input : float, optional
+            Known input to remove [canonical signal unit: °/h or mg].  Default 0.
+        require_signal : bool, optional
+            True (default): a recording without the signal is an error.
+        temperature_unit : {"degC", "counts", "auto"}, optional
+            Default ``"degC"``.
+
+        Returns
+        -------
+        RunData
+
+        Raises
+        ------
+        thermocal.errors.ThermocalInputError
+            No temperature column, no signal (when required), or non-finite values.
+        thermocal.errors.UnitError
+            A temperature column whose unit does not fit ``temperature_unit``.
         """
         names = tuple(temps) if temps else rec.temperatures
         if not names:
@@ -196,7 +257,26 @@ def model_inputs(
     time unit, the signal's and temperatures' units as given (e.g. ``deg/s``, ``counts``)
     and where each was stated, the raw-count temperature conversions, the scale factor of
     a raw-count signal, and the known input removed (value in the canonical unit and what
-    it is).  ``rec`` is a recording read by :func:`thermocal.readers.dispatch.read_recording`."""
+    it is).  ``rec`` is a recording read by :func:`thermocal.readers.dispatch.read_recording`.
+
+    Parameters
+    ----------
+    rec : thermocal.recording.Recording
+        The recording the model is fitted on.
+    signal : str
+        The signal column.
+    temps : sequence of str
+        The temperature columns.
+    known_input : float, optional
+        Known input removed [canonical signal unit].  Default 0.
+    known_input_what : str, optional
+        What the known input is (e.g. ``"earth rate"``); None: ``"none"`` or ``"given"``.
+
+    Returns
+    -------
+    dict
+        The ``inputs`` section of the model file.
+    """
     used = [signal, *temps]
     out: dict[str, Any] = {
         "time_unit": rec.time_unit,
@@ -234,7 +314,17 @@ def check_sensor_id(
 ) -> None:
     """:class:`ExtrapolationWarning` when the data's sensor id (metadata ``sensor_id``)
     differs from the one the model was fitted on (model file ``inputs.sensor_id``):
-    a compensation model belongs to one sensor. Silent when either is unknown."""
+    a compensation model belongs to one sensor. Silent when either is unknown.
+
+    Parameters
+    ----------
+    model_inputs : mapping or None
+        The model file's ``inputs`` section.
+    data_sensor_id : object
+        The data's ``sensor_id`` metadata, or None.
+    where : str
+        The data's name, for the message.
+    """
     fitted = (model_inputs or {}).get("sensor_id")
     if not fitted or not data_sensor_id or str(fitted) == str(data_sensor_id):
         return

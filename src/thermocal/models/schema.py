@@ -70,7 +70,22 @@ def _null(value: Any, path: str) -> None:
 def check_params(params: dict[str, Any], family_class: type, path: str) -> None:
     """Each constructor argument in ``params`` of the type its annotation states (an
     integer where the family takes ``int``, a finite number for ``float``...); an argument
-    the family does not take is refused by name."""
+    the family does not take is refused by name.
+
+    Parameters
+    ----------
+    params : dict
+        The ``params`` section.
+    family_class : type
+        The family's class.
+    path : str
+        Key path of the section.
+
+    Raises
+    ------
+    thermocal.errors.ModelFileError
+        A value of the wrong type, or an argument the family does not take.
+    """
     import inspect
 
     sig = inspect.signature(family_class.__init__)  # type: ignore[misc]
@@ -168,6 +183,18 @@ def check_model_dict(d: dict[str, Any], root: str = "") -> None:
     (:meth:`~thermocal.models.base.TemperatureModel.check_state`: a poly model's centres
     lie in or near the fitted range, :func:`near_range`).
     Units are checked against thermocal's glossary.
+
+    Parameters
+    ----------
+    d : dict
+        The model file's content.
+    root : str, optional
+        Key path prefix.  Default ``""``.
+
+    Raises
+    ------
+    thermocal.errors.ModelFileError
+        A section missing or of the wrong type or shape, naming the key path.
     """
     fields(
         {
@@ -215,7 +242,27 @@ def verify_model_dict(d: Any, where: str, root: str = "") -> dict[str, Any]:
     path, prefixed by ``root`` (``channels[0].model`` in a calibration).
 
     The checksum guards against accidents (truncation, a hand edit, a bit flip), not
-    against tampering: anyone can recompute it, so the content is checked as well."""
+    against tampering: anyone can recompute it, so the content is checked as well.
+
+    Parameters
+    ----------
+    d : object
+        The parsed JSON document.
+    where : str
+        The file's name, for messages.
+    root : str, optional
+        Key path prefix.  Default ``""``.
+
+    Returns
+    -------
+    dict
+        ``d``, verified.
+
+    Raises
+    ------
+    thermocal.errors.ModelFileError
+        Wrong header, a checksum mismatch, or a schema error.
+    """
     at = f"{where}: {root}" if root else where
     try:
         check_model_header(d)

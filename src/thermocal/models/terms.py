@@ -139,7 +139,33 @@ CHUNK_ROWS = 32768
 
 @dataclass(frozen=True, order=True)
 class Term:
-    """One regression term ``u_k^a · v_k^b · w_k^c`` of sensor ``sensor`` (0-based), eq. (1)."""
+    """One regression term ``u_k^a · v_k^b · w_k^c`` of sensor ``sensor`` (0-based), eq. (1).
+
+    Attributes
+    ----------
+    sensor : int
+        0-based index of the temperature sensor k.
+    t_power : int
+        Power a of the scaled temperature u (default 0).
+    rate_power : int
+        Power b of the scaled rate v (default 0).
+    coupling_power : int
+        Power c of the scaled coupling w = TṪ (default 0).
+
+    Raises
+    ------
+    thermocal.errors.ThermocalInputError
+        A negative power or sensor, or all powers zero (the constant is implicit).
+
+    Notes
+    -----
+    .. math:: \\mathrm{term} = u_k^a\\, v_k^b\\, w_k^c
+
+    References
+    ----------
+    - *A modelling and validation method for the temperature compensation model of a
+      ring-laser gyroscope*, Chinese invention patent, published 2017.
+    """
 
     sensor: int
     t_power: int = 0
@@ -156,6 +182,7 @@ class Term:
 
     @property
     def uses_rate(self) -> bool:
+        """True when the term needs Ṫ (a rate or coupling power)."""
         return self.rate_power > 0 or self.coupling_power > 0
 
     @property
@@ -184,6 +211,7 @@ class Term:
         return "*".join(parts)
 
     def to_dict(self) -> dict[str, Any]:
+        """JSON-ready dict: name, sensor and the three powers."""
         return {
             "name": self.name,
             "sensor": self.sensor,
@@ -194,6 +222,17 @@ class Term:
 
     @classmethod
     def from_dict(cls, d: dict[str, Any]) -> Term:
+        """Inverse of :meth:`to_dict`.
+
+        Parameters
+        ----------
+        d : dict
+            ``sensor``, ``t_power``, ``rate_power``, ``coupling_power``.
+
+        Returns
+        -------
+        Term
+        """
         return cls(
             sensor=int(d["sensor"]),
             t_power=int(d.get("t_power", 0)),
@@ -206,6 +245,26 @@ def seed000_terms(n_sensors: int) -> list[Term]:
     """The term set ([Seed-RLG]): per sensor T, T², T³, Ṫ, Ṫ², Ṫ³, TṪ, (TṪ)², (TṪ)³.
 
     With the implicit constant: ``9·n_sensors + 1`` coefficients (37 for 4 sensors).
+
+    Parameters
+    ----------
+    n_sensors : int
+        Number of temperature sensors k.
+
+    Returns
+    -------
+    list of Term
+        ``9·n_sensors`` terms.
+
+    References
+    ----------
+    - *A modelling and validation method for the temperature compensation model of a
+      ring-laser gyroscope*, Chinese invention patent, published 2017.
+
+    Examples
+    --------
+    >>> len(seed000_terms(4)) + 1
+    37
     """
     out: list[Term] = []
     for k in range(n_sensors):
@@ -216,7 +275,29 @@ def seed000_terms(n_sensors: int) -> list[Term]:
 
 
 def polynomial_terms(n_sensors: int, order: int) -> list[Term]:
-    """Plain polynomial in the temperatures: per sensor T, T², …, T^order (no rate terms)."""
+    """Plain polynomial in the temperatures: per sensor T, T², …, T^order (no rate terms).
+
+    Parameters
+    ----------
+    n_sensors : int
+        Number of temperature sensors.
+    order : int
+        Polynomial order (≥ 1).
+
+    Returns
+    -------
+    list of Term
+
+    Raises
+    ------
+    thermocal.errors.ThermocalInputError
+        ``order`` below 1.
+
+    Examples
+    --------
+    >>> [t.name for t in polynomial_terms(2, 2)]
+    ['T1', 'T1^2', 'T2', 'T2^2']
+    """
     if order < 1:
         raise ThermocalInputError(f"polynomial order must be ≥ 1, got {order}")
     return [Term(k, t_power=p) for k in range(n_sensors) for p in range(1, order + 1)]
@@ -281,8 +362,27 @@ def _parse_monomial(text: str, whole: str) -> dict[tuple[int, str], int]:
 def parse_term(text: str, n_sensors: int) -> Term | None:
     """Read one term (``"T1^2"``, ``"dT2"``, ``"T1*dT1"``, ``"(T3*dT3)^2"``); None for a constant.
 
-    Raises :class:`ThermocalInputError` for cross-sensor products, unknown
-    factors and sensors beyond ``n_sensors``.
+    Parameters
+    ----------
+    text : str
+        The term's text.
+    n_sensors : int
+        Number of temperature sensors (``T<k>`` must have k ≤ n_sensors).
+
+    Returns
+    -------
+    Term or None
+        The term; None for a constant.
+
+    Raises
+    ------
+    thermocal.errors.ThermocalInputError
+        Cross-sensor products, unknown factors and sensors beyond ``n_sensors``.
+
+    Examples
+    --------
+    >>> parse_term("T1*dT1", 1)
+    Term(sensor=0, t_power=0, rate_power=0, coupling_power=1)
     """
     whole = text.strip()
     exps = _parse_monomial(whole, whole)
@@ -312,8 +412,29 @@ def parse_terms(
 ) -> list[Term]:
     """Term list from a ``--terms`` value, or a plain polynomial from ``order``.
 
-    ``spec``: ``"seed000"`` (default when both are None), a comma-separated
-    string or a list of term texts.  Duplicates are an input error.
+    Parameters
+    ----------
+    spec : str or sequence of str or None
+        ``"seed000"`` (default when both are None), a comma-separated string or a list of
+        term texts.
+    n_sensors : int
+        Number of temperature sensors.
+    order : int, optional
+        Order of a plain polynomial (:func:`polynomial_terms`) when ``spec`` is None.
+
+    Returns
+    -------
+    list of Term
+
+    Raises
+    ------
+    thermocal.errors.ThermocalInputError
+        A duplicate or unreadable term.
+
+    Examples
+    --------
+    >>> [t.name for t in parse_terms("T1,T1^2,dT1,(T1*dT1)^2", 1)]
+    ['T1', 'T1^2', 'dT1', '(T1*dT1)^2']
     """
     if n_sensors < 1:
         raise ThermocalInputError("the polynomial model needs at least one temperature column")
@@ -346,9 +467,16 @@ def parse_terms(
 class BaseScaling:
     """Centres and scales of the base variables of eq. (1), per sensor.
 
-    ``t_center``/``t_scale`` [°C], ``rate_center``/``rate_scale`` [°C/min],
-    ``coupling_center``/``coupling_scale`` [°C²/min]; arrays of length k.
     Unused base variables have centre 0 and scale 1.
+
+    Attributes
+    ----------
+    t_center, t_scale : numpy.ndarray
+        Centre and scale of T per sensor, shape (k,) [°C].
+    rate_center, rate_scale : numpy.ndarray
+        Centre and scale of Ṫ per sensor, shape (k,) [°C/min].
+    coupling_center, coupling_scale : numpy.ndarray
+        Centre and scale of TṪ per sensor, shape (k,) [°C²/min].
     """
 
     t_center: FloatArray
@@ -359,6 +487,17 @@ class BaseScaling:
     coupling_scale: FloatArray
 
     def to_list(self, names: Sequence[str]) -> list[dict[str, Any]]:
+        """One JSON-ready dict per sensor.
+
+        Parameters
+        ----------
+        names : sequence of str
+            The sensors' column names.
+
+        Returns
+        -------
+        list of dict
+        """
         return [
             {
                 "name": names[k] if k < len(names) else f"T{k + 1}",
@@ -374,6 +513,18 @@ class BaseScaling:
 
     @classmethod
     def from_list(cls, items: Sequence[dict[str, Any]]) -> BaseScaling:
+        """Inverse of :meth:`to_list`.
+
+        Parameters
+        ----------
+        items : sequence of dict
+            One dict per sensor.
+
+        Returns
+        -------
+        BaseScaling
+        """
+
         def col(key: str) -> FloatArray:
             return np.array([float(d[key]) for d in items], dtype=np.float64)
 
@@ -392,8 +543,27 @@ def fit_base_scaling(
 ) -> BaseScaling:
     """Means and standard deviations of T, Ṫ, TṪ over all runs, for the sensors the terms use.
 
-    A base variable that the terms need but that does not vary raises
-    :class:`DesignError` naming the terms.
+    Parameters
+    ----------
+    temps : sequence of numpy.ndarray
+        Temperatures per run, each (n_r, k) [°C].
+    rates : sequence of numpy.ndarray or None
+        Ṫ per run, each (n_r, k) [°C/min]; needed when a term uses Ṫ.
+    terms : sequence of Term
+        The model's terms.
+
+    Returns
+    -------
+    BaseScaling
+
+    Raises
+    ------
+    thermocal.errors.DesignError
+        A base variable the terms need does not vary, naming the terms.
+
+    Notes
+    -----
+    .. math:: c = \\frac{1}{N}\\sum_i x_i, \\qquad s = \\sqrt{\\frac{1}{N}\\sum_i (x_i - c)^2}
     """
     k = temps[0].shape[1]
     tc, ts = np.zeros(k), np.ones(k)
@@ -458,6 +628,33 @@ def term_features(
     term uses Ṫ).  ``out`` may be a preallocated (n, n_terms) array (Fortran
     order is fastest).  Powers are built by repeated multiplication
     (``x³ = x²·x``), the same arithmetic for any block length.
+
+    Parameters
+    ----------
+    terms : sequence of Term
+        The terms.
+    scaling : BaseScaling
+        Centres and scales (:func:`fit_base_scaling`).
+    temps_c : numpy.ndarray
+        Temperatures (n, k) [°C].
+    rates_c_per_min : numpy.ndarray or None
+        Ṫ (n, k) [°C/min], needed when a term uses Ṫ.
+    out : numpy.ndarray, optional
+        Preallocated (n, n_terms) result.
+
+    Returns
+    -------
+    numpy.ndarray
+        The design columns, shape (n, n_terms) (dimensionless).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> temps = 20.0 + 10.0 * np.random.default_rng(0).random((50, 1))
+    >>> terms = parse_terms("T1,T1^2", 1)
+    >>> features = term_features(terms, fit_base_scaling([temps], None, terms), temps, None)
+    >>> features.shape, np.round(features.mean(axis=0), 6).tolist()
+    ((50, 2), [0.0, 1.0])
     """
     n = temps_c.shape[0]
     if out is None:
@@ -526,6 +723,25 @@ def raw_expansion(
     (``P = i + l``, ``Q = j + l`` for ``T^i Ṫ^j (TṪ)^l``).  Returns the list of
     monomials ``(sensor, P, Q)`` (``(-1, 0, 0)`` = constant, first) and the
     matrix M with ``raw = M @ [constant, term coefficients...]``.
+
+    Parameters
+    ----------
+    terms : sequence of Term
+        The terms.
+    scaling : BaseScaling
+        Their centres and scales.
+
+    Returns
+    -------
+    monomials : list of tuple of int
+        ``(sensor, P, Q)`` per raw monomial, the constant ``(-1, 0, 0)`` first.
+    M : numpy.ndarray
+        Shape (n_monomials, 1 + n_terms).
+
+    Notes
+    -----
+    .. math:: \\left(\\frac{x - c}{s}\\right)^p
+              = \\sum_{i=0}^{p} \\binom{p}{i} \\frac{x^i (-c)^{p-i}}{s^p}
     """
     keys: list[tuple[int, int, int]] = [(-1, 0, 0)]
     index: dict[tuple[int, int, int], int] = {(-1, 0, 0): 0}
@@ -564,7 +780,22 @@ def raw_expansion(
 
 
 def monomial_name(key: tuple[int, int, int]) -> str:
-    """Name of a raw monomial ``T_k^P Ṫ_k^Q``: ``const``, ``T1^2``, ``(T1*dT1)^2``, ``T1^2*dT1``."""
+    """Name of a raw monomial ``T_k^P Ṫ_k^Q``: ``const``, ``T1^2``, ``(T1*dT1)^2``, ``T1^2*dT1``.
+
+    Parameters
+    ----------
+    key : tuple of int
+        ``(sensor, P, Q)``; sensor −1 is the constant.
+
+    Returns
+    -------
+    str
+
+    Examples
+    --------
+    >>> monomial_name((-1, 0, 0)), monomial_name((0, 2, 1))
+    ('const', 'T1^2*dT1')
+    """
     k, P, Q = key
     if k < 0:
         return "const"

@@ -220,7 +220,19 @@ class WarmupModel(TemperatureModel):
     def data_needs(self, temp_names: Sequence[str], n_runs: int) -> Needs:
         """Judged in its column as a line (the ΔT polynomial of each run rests on the
         warm-up itself, the T0 dependence on the runs' start temperatures), with
-        (order + 1)(t0_order + 1) coefficients."""
+        (order + 1)(t0_order + 1) coefficients.
+
+        Parameters
+        ----------
+        temp_names : sequence of str
+            The temperature columns.
+        n_runs : int
+            Number of runs.
+
+        Returns
+        -------
+        thermocal.adequacy.Needs
+        """
         j = self.sensor if 0 <= self.sensor < len(temp_names) else 0
         n = (self.order + 1) * (self.t0_order + 1)
         return Needs({temp_names[j]: 1} if temp_names else {}, n)
@@ -264,6 +276,21 @@ class WarmupModel(TemperatureModel):
         post-window changes (:meth:`_start_values`), the distinct start temperatures,
         the scaled fit (:meth:`_fit_two_stage` or :meth:`_fit_joint`), the physical b
         with standard errors and the statistics (:meth:`_set_fitted`).
+
+        Parameters
+        ----------
+        runs : sequence of RunData
+            Runs with times [s], temperatures [°C] and signal [°/h or mg].
+
+        Returns
+        -------
+        WarmupModel
+            ``self``, fitted.
+
+        Raises
+        ------
+        thermocal.errors.DesignError
+            The data cannot determine the model (rank, ranges, segments).
         """
         self._check_params()
         if not runs:
@@ -534,7 +561,20 @@ class WarmupModel(TemperatureModel):
 
     def predict(self, run: RunData, *, extrapolate: bool = False) -> FloatArray:
         """ΔF of every sample: ``Σ_j a_j(T0_i) (T_i − T0_i)^j`` with the causal T0_i
-        (running mean over the start window, then frozen) [signal unit]."""
+        (running mean over the start window, then frozen) [signal unit].
+
+        Parameters
+        ----------
+        run : RunData
+            Times [s] and temperatures [°C].
+        extrapolate : bool, optional
+            False (default): temperatures clamped to the fitted range, with a warning.
+
+        Returns
+        -------
+        numpy.ndarray
+            Shape (n,) [signal unit].
+        """
         temp = self.clamp(self._prepare(run)[:, None], extrapolate=extrapolate)[:, 0]
         self.check_duration(float(run.time_s[-1] - run.time_s[0]) if run.n_samples else 0.0)
         t0 = running_start_mean(run.time_s, temp, float(self.start_window_s))
@@ -553,7 +593,13 @@ class WarmupModel(TemperatureModel):
     def check_duration(self, elapsed_s: float) -> None:
         """:class:`ExtrapolationWarning` when a record runs longer after power-on than any
         fitted run (a model fitted on 900 s power-ons applied to 21 h): the
-        warm-up polynomial in ΔT says nothing about the time beyond."""
+        warm-up polynomial in ΔT says nothing about the time beyond.
+
+        Parameters
+        ----------
+        elapsed_s : float
+            Time since the record's first sample [s].
+        """
         rng = self.duration_range_s_
         if rng is None or not elapsed_s > self.DURATION_MARGIN * rng[1]:
             return
@@ -567,13 +613,40 @@ class WarmupModel(TemperatureModel):
         )
 
     def stream(self, sample_interval_s: float, *, extrapolate: bool = False) -> ModelStream:
-        """Sample-by-sample twin of :meth:`predict` (T0 captured at power-on)."""
+        """Sample-by-sample twin of :meth:`predict` (T0 captured at power-on).
+
+        Parameters
+        ----------
+        sample_interval_s : float
+            Nominal sample interval [s].
+        extrapolate : bool, optional
+            Default False.
+
+        Returns
+        -------
+        WarmupStream
+        """
         self.check_fitted()
         return WarmupStream(self, extrapolate=extrapolate)
 
     def a_of_t0(self, t0_c: float | npt.ArrayLike) -> FloatArray:
         """Coefficients ``a_j(T0) = Σ_k b_jk T0^k`` for start temperature(s) T0 [°C];
-        shape (order+1,) or (n, order+1)."""
+        shape (order+1,) or (n, order+1).
+
+        Parameters
+        ----------
+        t0_c : float or array_like
+            Start temperature(s) T0 [°C].
+
+        Returns
+        -------
+        numpy.ndarray
+            a_j [signal unit / °C^j].
+
+        Notes
+        -----
+        .. math:: a_j(T_0) = \\sum_k b_{jk} T_0^k
+        """
         self.check_fitted()
         x = np.asarray(t0_c, dtype=np.float64)
         out = np.stack(
@@ -582,6 +655,7 @@ class WarmupModel(TemperatureModel):
         return out[0] if x.ndim == 0 else out
 
     def coefficients(self) -> list[Coefficient]:
+        """The b matrix ``b_jk`` [signal unit / °C^(j+k)], with standard errors."""
         self.check_fitted()
         out = []
         unit = self.signal_unit
@@ -601,7 +675,20 @@ class WarmupModel(TemperatureModel):
     @classmethod
     def check_state(cls, d: dict[str, Any], root: str = "") -> None:
         """The ``state`` section of a warmup model file: ``b`` of (order + 1) × (t0_order +
-        1) (or without the constant row) finite numbers; ``params.sensor`` one of the inputs."""
+        1) (or without the constant row) finite numbers; ``params.sensor`` one of the inputs.
+
+        Parameters
+        ----------
+        d : dict
+            The model file's content.
+        root : str, optional
+            Key path prefix.  Default ``""``.
+
+        Raises
+        ------
+        thermocal.errors.ModelFileError
+            A bad state, naming the key path.
+        """
         sensor_param(d, root)
         state, path = d["state"], key_path(root, "state")
         fields(
@@ -681,6 +768,13 @@ class WarmupStream(ModelStream):
     ``temps_c`` holds either one value (the model's channel) or the channels of the
     fitted runs (``sensor`` picks); the signal is not used.  Warns once per stream (per
     kind: temperature, start temperature) when a value leaves the fitted range.
+
+    Parameters
+    ----------
+    model : WarmupModel
+        The fitted model.
+    extrapolate : bool, optional
+        Default False.
     """
 
     def __init__(self, model: WarmupModel, *, extrapolate: bool = False) -> None:
@@ -697,6 +791,7 @@ class WarmupStream(ModelStream):
         self.reset()
 
     def reset(self) -> None:
+        """Forget everything (a new power-on): T0 is captured again."""
         self._t_first: float | None = None
         self._sum = 0.0
         self._count = 0
@@ -732,6 +827,22 @@ class WarmupStream(ModelStream):
         return [_horner_py(bj, t0c) for bj in self._b]
 
     def update(self, time_s: float, temps_c: FloatArray, signal: float | None = None) -> float:
+        """Model value for one sample (see :meth:`ModelStream.update`).
+
+        Parameters
+        ----------
+        time_s : float
+            Sample time [s].
+        temps_c : numpy.ndarray
+            Temperatures [°C].
+        signal : float, optional
+            Not used.
+
+        Returns
+        -------
+        float
+            [signal unit].
+        """
         if type(temps_c) is np.ndarray and temps_c.dtype == np.float64 and temps_c.ndim == 1:
             arr = temps_c
         else:
