@@ -210,9 +210,9 @@ def test_simulate_scenario_labels_and_truth_document() -> None:
     assert doc["scenario"] == "accel-full-range" and doc["seed"] == 4
     assert [f["file"] for f in doc["files"]] == ["x.csv", "y.csv"]
     assert opts.given() == {"rate_hz": 0.01, "runs": 2}
-    with pytest.raises(ThermocalInputError, match="^rate_hz must be a positive number"):
+    with pytest.raises(ThermocalInputError, match=r"^rate_hz must be a positive number"):
         SimulateOptions(rate_hz=0.0)
-    with pytest.raises(ThermocalInputError, match="^latitude_deg "):
+    with pytest.raises(ThermocalInputError, match=r"^latitude_deg "):
         SimulateOptions(latitude_deg=91.0)
 
 
