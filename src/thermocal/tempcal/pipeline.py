@@ -79,8 +79,45 @@ def _cubic(t: FloatArray, y: FloatArray, unit: str, name: str) -> PolyModel:
 
 
 def holdout_rms(t_med: FloatArray, v_med: FloatArray, unit: str, name: str) -> float:
-    """The rms [unit] on the odd bins of a cubic fitted to the even bins only
-    (:func:`.binning.even_odd_split`): ``sqrt(mean((v_odd − p_even(T_odd))²))``."""
+    r"""The rms of a cubic fitted to the even temperature bins, evaluated on the odd ones.
+
+    Parameters
+    ----------
+    t_med : numpy.ndarray
+        Bin median temperatures, ascending [°C].
+    v_med : numpy.ndarray
+        Bin median values of one axis, same length [``unit``].
+    unit : str
+        Unit of ``v_med`` (canonical: ``°/h`` or ``mg``).
+    name : str
+        Name given to the fitted channel.
+
+    Returns
+    -------
+    float
+        Hold-out rms [``unit``].
+
+    Notes
+    -----
+    With :math:`p_{even}` the cubic least-squares fit to the even bins
+    (:func:`thermocal.firmware.binning.even_odd_split`):
+
+    .. math:: \mathrm{rms} = \sqrt{\tfrac{1}{n_{odd}} \sum_{i \in odd}
+       \left(v_i - p_{even}(T_i)\right)^2}
+
+    References
+    ----------
+    - G. H. Golub and C. F. Van Loan, *Matrix Computations*, 4th ed., Johns Hopkins
+      University Press, 2013 (linear least squares).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> t = np.linspace(20.0, 60.0, 81)
+    >>> v = 5.0 + 0.2 * t - 0.001 * t**2
+    >>> round(holdout_rms(t, v, "°/h", "g0_x"), 6)
+    0.0
+    """
     even, odd = even_odd_split(t_med.size)
     held = _cubic(t_med[even], v_med[even], unit, name)
     run_odd = RunData(
@@ -100,9 +137,41 @@ def judge_sensor(
     overrides: tuple[str, ...],
     firmware: str,
 ) -> dict[str, Any]:
-    """Step 1: :func:`thermocal.adequacy.judge` of one instance (a cubic: 3 in the
-    temperature, 4 bins; stillness of ``vals`` in the canonical unit), with ArduPilot's
-    minimum sweep for ``firmware="ardupilot"``; refuses (exit 2) what is not overridden."""
+    """Judge one sensor instance's data before anything is fitted.
+
+    :func:`thermocal.adequacy.judge` for a cubic (3 in the temperature, 4 bins; stillness of
+    ``vals``), with ArduPilot's minimum sweep added when ``firmware="ardupilot"``.
+
+    Parameters
+    ----------
+    rec : thermocal.recording.Recording
+        The instance's recording (time [s], temperature [°C], axes x, y, z).
+    where : str
+        Name of the instance in messages (``TOPIC.N``).
+    kind : str
+        ``"gyro"`` or ``"accel"``.
+    vals : numpy.ndarray
+        Shape (n, 3): the three axes in the canonical unit [°/h or mg].
+    overrides : tuple of str
+        Names of the adequacy tests the user accepts anyway.
+    firmware : str
+        ``"px4"`` or ``"ardupilot"`` (the latter adds the 10 °C minimum sweep).
+
+    Returns
+    -------
+    dict
+        The adequacy record (:meth:`thermocal.adequacy.Adequacy.to_dict`).
+
+    Raises
+    ------
+    ThermocalInputError
+        When a test fails and is not in ``overrides`` (a sweep too short, a sensor moving).
+
+    References
+    ----------
+    - ArduPilot ``libraries/AP_InertialSensor/AP_InertialSensor_tempcal.cpp`` (minimum
+      learning range).
+    """
     temp = rec.temperature_c("temperature")
     unit = rec.signal(AXES[0])[1]
     shown = units.shown_unit(unit, rec.units.get(AXES[0], unit))
@@ -132,17 +201,41 @@ def judge_sensor(
 
 
 def motion_floor(kind: str) -> float:
-    """The smallest departure :func:`thermocal.adequacy.stillness` calls motion, in the
-    canonical unit of ``kind`` (°/h for a gyro, mg for an accelerometer)."""
+    """The smallest departure :func:`thermocal.adequacy.stillness` calls motion.
+
+    Parameters
+    ----------
+    kind : str
+        ``"gyro"`` or anything else (an accelerometer).
+
+    Returns
+    -------
+    float
+        The floor in the canonical unit of ``kind`` [°/h for a gyro, mg for an accelerometer].
+    """
     if kind == "gyro":
         return adequacy.MOTION_FLOOR_DEG_S * adequacy.DEG_H_PER_DEG_S
     return adequacy.MOTION_FLOOR_MG
 
 
 def still_mask(time_s: FloatArray, motion: adequacy.Motion) -> npt.NDArray[np.bool_]:
-    """The samples outside every bump :func:`thermocal.adequacy.stillness` found (each
-    episode ``[start, end]`` [s] widened by :data:`adequacy.STILL_BLOCK_S` on both sides:
-    the block edges are where a bump begins and ends, not where it is over)."""
+    """The samples outside every bump :func:`thermocal.adequacy.stillness` found.
+
+    Each episode ``[start, end]`` is widened by :data:`thermocal.adequacy.STILL_BLOCK_S` on
+    both sides (the block edges are where a bump begins and ends, not where it is over).
+
+    Parameters
+    ----------
+    time_s : numpy.ndarray
+        Sample times, ascending [s].
+    motion : thermocal.adequacy.Motion
+        The stillness result (its ``episodes``: start [s], end [s], peak).
+
+    Returns
+    -------
+    numpy.ndarray of bool
+        True for the samples kept (still), same length as ``time_s``.
+    """
     keep = np.ones(time_s.size, dtype=bool)
     pad = adequacy.STILL_BLOCK_S
     for start, end, _peak in motion.episodes:
@@ -161,13 +254,55 @@ def fit_sensor(
     firmware: str = "px4",
     motions: dict[str, adequacy.Motion] | None = None,
 ) -> SensorFit:
-    """Judge the log (:func:`judge_sensor`), leave out the bumps (the board handled,
-    knocked: :func:`thermocal.adequacy.stillness`'s episodes, :func:`still_mask`; a bump
-    fills whole temperature bins where the sweep is fast, and no statistic of the bin can
-    tell it from the bias), then bin (:func:`.binning.temperature_bins`), judge on held-out
-    bins (:func:`holdout_rms`) and fit one sensor instance's three axes (a cubic in T per
-    axis, to every bin).  ``motions`` (when given) gets the stillness result under
-    ``TOPIC.N`` (for :func:`step_warnings`, not computed twice)."""
+    """Judge, clean, bin and fit one sensor instance's three axes (a cubic in T per axis).
+
+    Judge the log (:func:`judge_sensor`), leave out the bumps (the board handled, knocked:
+    :func:`thermocal.adequacy.stillness`'s episodes, :func:`still_mask`; a bump fills whole
+    temperature bins where the sweep is fast, and no statistic of the bin can tell it from the
+    bias), bin (:func:`thermocal.firmware.binning.temperature_bins`), judge on held-out bins
+    (:func:`holdout_rms`) and fit a cubic per axis to every bin.
+
+    Parameters
+    ----------
+    rec : thermocal.recording.Recording
+        The instance's recording: time [s], ``temperature`` [°C], axes x, y, z.
+    topic : str
+        Topic (PX4) or message (ArduPilot) name, used in channel and message names.
+    kind : str
+        ``"gyro"`` or ``"accel"``.
+    instance : int
+        Sensor instance number (0, 1, …).
+    overrides : tuple of str, optional
+        Adequacy tests the user accepts anyway (default none).
+    firmware : str, optional
+        ``"px4"`` (default) or ``"ardupilot"`` (adds its 10 °C minimum sweep).
+    motions : dict, optional
+        When given, receives the stillness result under ``TOPIC.N`` (for
+        :func:`step_warnings`, not computed twice).
+
+    Returns
+    -------
+    SensorFit
+        Sweep [°C], sample and bin counts, hold-out rms per axis [°/h or mg] and the three
+        fitted channels.
+
+    Raises
+    ------
+    ThermocalInputError
+        When the data are judged inadequate (not overridden), or the temperature covers fewer
+        than :data:`thermocal.firmware.binning.MIN_BINS` bins.
+
+    Notes
+    -----
+    Per axis, the least-squares cubic of the bin medians :math:`(T_k, v_k)`:
+
+    .. math:: v(T) = c_0 + c_1 T + c_2 T^2 + c_3 T^3
+
+    References
+    ----------
+    - PX4 ``Tools/process_sensor_caldata.py`` (cubic fit of bias against temperature).
+    - ArduPilot ``libraries/AP_InertialSensor/AP_InertialSensor_tempcal.cpp``.
+    """
     temp = rec.temperature_c("temperature")
     lo, hi = float(np.min(temp)), float(np.max(temp))
     where = f"{topic}.{instance}"
@@ -210,12 +345,35 @@ def fit_sensor(
 
 
 def calibration_of(fits: Sequence[SensorFit]) -> Calibration:
-    """Every fitted channel of ``fits`` as one calibration."""
+    """Every fitted channel of ``fits`` as one calibration.
+
+    Parameters
+    ----------
+    fits : sequence of SensorFit
+        The fitted sensor instances.
+
+    Returns
+    -------
+    thermocal.models.calibration.Calibration
+        Their channels, in order.
+    """
     return Calibration([ch for f in fits for ch in f.channels])
 
 
 def summary(fits: Sequence[SensorFit]) -> dict[str, Any]:
-    """The JSON summary: per sensor the sweep, bins and hold-out rms per axis."""
+    """The JSON summary: per sensor the sweep, bins and hold-out rms per axis.
+
+    Parameters
+    ----------
+    fits : sequence of SensorFit
+        The fitted sensor instances.
+
+    Returns
+    -------
+    dict
+        ``TOPIC.N`` → the fields of :class:`SensorFit` without the channels, plus
+        ``holdout_rms_unit`` (°/h or mg).
+    """
     return {
         f"{f.topic}.{f.instance}": {
             **{k: v for k, v in dataclasses.asdict(f).items() if k != "channels"},
@@ -226,8 +384,24 @@ def summary(fits: Sequence[SensorFit]) -> dict[str, Any]:
 
 
 def require_fields(df: Any, names: Sequence[str], log: Path, where: str) -> None:
-    """Refuse (exit 2) a topic or message missing fields the calibration reads (a damaged
-    format definition renames them), naming them."""
+    """Refuse a topic or message that lacks fields the calibration reads, naming them.
+
+    Parameters
+    ----------
+    df : pandas.DataFrame
+        The topic's or message's table.
+    names : sequence of str
+        Fields the calibration reads.
+    log : pathlib.Path
+        The log file (named in the error).
+    where : str
+        The topic or message (named in the error).
+
+    Raises
+    ------
+    ThermocalInputError
+        When a field is missing (a damaged format definition renames them).
+    """
     missing = [n for n in names if n not in df.columns]
     if missing:
         raise ThermocalInputError(
@@ -314,8 +488,17 @@ class OutputSet:
     _pending: list[tuple[Any, Path, AnyReportRequest]] = field(default_factory=list)
 
     def report(self, name: str, request: AnyReportRequest) -> None:
-        """Write the report ``name`` into the stage (when a reporter is given): here, or
-        in the worker process (the class docstring)."""
+        """Write the report ``name`` into the stage (when a reporter is given).
+
+        Built here, or in the worker process for a large recording (the class docstring).
+
+        Parameters
+        ----------
+        name : str
+            File name of the report inside the output directory.
+        request : AnyReportRequest
+            What the report is built from.
+        """
         path = self.output / name
         self.reports.append(path)
         if self.reporter is None:
@@ -360,8 +543,17 @@ class OutputSet:
             self._pool = None
 
     def commit(self, calibration: Calibration, params_name: str, params_text: str) -> None:
-        """Write the reports left (:meth:`finish_reports`), ``calibration.json`` and the
-        parameter file, then move the set into place."""
+        """Write the reports left, ``calibration.json`` and the parameter file, then move the set.
+
+        Parameters
+        ----------
+        calibration : thermocal.models.calibration.Calibration
+            The calibration written as ``calibration.json``.
+        params_name : str
+            File name of the firmware parameter file.
+        params_text : str
+            Its content.
+        """
         from thermocal.pipeline.model_file import save_calibration
         from thermocal.writers import atomic_write, commit_directory
 
@@ -397,10 +589,25 @@ def _warm_job(reporter: Reporter) -> None:
 
 @contextlib.contextmanager
 def report_worker(reporter: Reporter | None, log: Path) -> Iterator[Any]:
-    """The report worker of :class:`OutputSet` started before a large log
-    (:data:`PARALLEL_MIN_BYTES`) is read, so that its start and the reporter's ``warm()``
-    (imports, fonts: a second or so) overlap the reading; None when the reports are built
-    here (:func:`report_workers`, a small log).  Stopped at the end of the block."""
+    """Start the report worker of :class:`OutputSet` before a large log is read.
+
+    For a log of at least :data:`PARALLEL_MIN_BYTES`, so that the worker's start and the
+    reporter's ``warm()`` (imports, fonts: a second or so) overlap the reading.  Stopped at
+    the end of the block.
+
+    Parameters
+    ----------
+    reporter : Reporter or None
+        Writes one report; None: no reports, no worker.
+    log : pathlib.Path
+        The log about to be read (its size decides).
+
+    Yields
+    ------
+    concurrent.futures.ProcessPoolExecutor or None
+        The worker, or None when the reports are built here (:func:`report_workers`, a small
+        log).
+    """
     pool = None
     try:
         big = log.stat().st_size >= PARALLEL_MIN_BYTES
@@ -424,17 +631,44 @@ def report_workers() -> int:
 
 
 def check_output_dir(output: Path) -> None:
-    """Refuse (exit 2) an output that exists and is not a directory."""
+    """Refuse an output that exists and is not a directory.
+
+    Parameters
+    ----------
+    output : pathlib.Path
+        The output directory asked for.
+
+    Raises
+    ------
+    ThermocalInputError
+        When ``output`` exists and is not a directory.
+    """
     if output.exists() and not output.is_dir():
         raise ThermocalInputError(f"{output}: exists and is not a directory")
 
 
 @contextlib.contextmanager
 def staged_set(output: Path, reporter: Reporter | None, pool: Any = None) -> Iterator[OutputSet]:
-    """A new staging directory for ``output`` (:func:`thermocal.writers.staging_directory`);
-    on any failure — a later sensor's error, Ctrl-C — it is removed
-    (:func:`thermocal.writers.discard_staging`), so that no part of the set is left.
-    ``pool``: the report worker already started (:func:`report_worker`)."""
+    """A new staging directory for ``output``, removed on any failure.
+
+    :func:`thermocal.writers.staging_directory`; on any failure — a later sensor's error,
+    Ctrl-C — it is removed (:func:`thermocal.writers.discard_staging`), so that no part of the
+    set is left.
+
+    Parameters
+    ----------
+    output : pathlib.Path
+        The output directory the set is moved to by :meth:`OutputSet.commit`.
+    reporter : Reporter or None
+        Writes one report; None: none written.
+    pool : concurrent.futures.ProcessPoolExecutor, optional
+        The report worker already started (:func:`report_worker`); default none.
+
+    Yields
+    ------
+    OutputSet
+        The set being built.
+    """
     from thermocal.writers import discard_staging, staging_directory
 
     out = OutputSet(output, staging_directory(output), reporter, workers=report_workers())
@@ -464,17 +698,58 @@ class GateWarning(ThermocalWarning):
 
 
 def warn_gates(gates: Sequence[str | None]) -> None:
-    """Each gate's sentence as a :class:`GateWarning` (None: the gate passed)."""
+    """Say each gate's sentence as a :class:`GateWarning`.
+
+    Parameters
+    ----------
+    gates : sequence of str or None
+        Each gate's sentence; None: the gate passed.
+    """
     for msg in gates:
         if msg:
             warnings.warn(GateWarning(msg), stacklevel=2)
 
 
 def sweep_stall(time_s: FloatArray, temp_c: FloatArray) -> tuple[float, float, float]:
-    """(longest time without a :data:`STALL_RISE_C` rise of the running maximum [s], the
-    temperature it stalled at [°C], the time it began [s from the log's start]).  A rise:
-    the running maximum enters the next 0.5 °C step above the first temperature; the
-    stretch after the last rise counts too (a sweep that ends on a plateau)."""
+    r"""The longest stretch without a :data:`STALL_RISE_C` rise of the temperature.
+
+    A rise: the running maximum enters the next 0.5 °C step above the first temperature; the
+    stretch after the last rise counts too (a sweep that ends on a plateau).
+
+    Parameters
+    ----------
+    time_s : numpy.ndarray
+        Sample times, ascending [s].
+    temp_c : numpy.ndarray
+        Temperatures, same length [°C].
+
+    Returns
+    -------
+    tuple of float
+        (longest time without a rise [s], the temperature it stalled at [°C], the time it
+        began [s from the log's start]).
+
+    Notes
+    -----
+    With :math:`\Delta = 0.5` °C, the level of sample :math:`i` is
+
+    .. math:: \ell_i = \left\lfloor \frac{\max_{j \le i} T_j - T_0}{\Delta} \right\rfloor
+
+    and a rise is a sample where :math:`\ell` increases.
+
+    References
+    ----------
+    - ArduPilot ``libraries/AP_InertialSensor/AP_InertialSensor_tempcal.cpp``
+      (``CAL_TIMEOUT_MS`` = 600 s without a 0.5 °C rise ends the learning).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> t = np.arange(0.0, 3000.0, 10.0)
+    >>> temp = np.minimum(20.0 + t / 60.0, 40.0)  # 1 °C/min to 40 °C at 1200 s, then flat to 2990 s
+    >>> [round(x, 1) for x in sweep_stall(t, temp)]
+    [1790.0, 40.0, 1200.0]
+    """
     t = np.asarray(time_s, dtype=np.float64)
     temp = np.asarray(temp_c, dtype=np.float64)
     if t.size < 2:
@@ -488,7 +763,27 @@ def sweep_stall(time_s: FloatArray, temp_c: FloatArray) -> tuple[float, float, f
 
 
 def stall_warning(where: str, time_s: FloatArray, temp_c: FloatArray) -> str | None:
-    """The sentence of a sweep that stops rising for more than :data:`STALL_S`, or None."""
+    """The sentence of a sweep that stops rising for more than :data:`STALL_S`, or None.
+
+    Parameters
+    ----------
+    where : str
+        Name of the sensor in the sentence.
+    time_s : numpy.ndarray
+        Sample times [s].
+    temp_c : numpy.ndarray
+        Temperatures [°C].
+
+    Returns
+    -------
+    str or None
+        The warning sentence, or None when the sweep never stalls longer (:func:`sweep_stall`).
+
+    References
+    ----------
+    - ArduPilot ``libraries/AP_InertialSensor/AP_InertialSensor_tempcal.cpp``
+      (``CAL_TIMEOUT_MS``).
+    """
     gap, at_c, start = sweep_stall(time_s, temp_c)
     if gap <= STALL_S:
         return None
@@ -504,11 +799,26 @@ def step_warnings(
     series: Mapping[str, tuple[FloatArray, FloatArray]],
     motions: Mapping[str, adequacy.Motion] | None = None,
 ) -> list[str]:
-    """A step-like bias on one instance of a multi-IMU board:
-    :func:`thermocal.adequacy.stillness` of every instance of a kind (``series``: name →
-    (time [s], values in the canonical unit), or its result already in ``motions``); a step
-    on one instance not seen on another within the stillness window is a bias jump of that
-    sensor, not the board moving (which every instance would see)."""
+    """A step-like bias on one instance of a multi-IMU board.
+
+    :func:`thermocal.adequacy.stillness` of every instance of a kind; a step on one instance
+    not seen on another within the stillness window is a bias jump of that sensor, not the
+    board moving (which every instance would see).
+
+    Parameters
+    ----------
+    fits : sequence of SensorFit
+        The fitted instances (grouped by kind; a kind with one instance is skipped).
+    series : mapping
+        ``TOPIC.N`` → (time [s], values (n, 3) in the canonical unit [°/h or mg]).
+    motions : mapping, optional
+        ``TOPIC.N`` → stillness result already computed (:func:`fit_sensor`'s ``motions``).
+
+    Returns
+    -------
+    list of str
+        One sentence per instance with a step of its own.
+    """
     out: list[str] = []
     by_kind: dict[str, list[SensorFit]] = {}
     for f in fits:
@@ -543,8 +853,34 @@ def step_warnings(
 
 
 def end_warning(where: str, what: str, ref_c: float, lo: float, hi: float) -> str | None:
-    """``what`` (a reference temperature) within :data:`END_MARGIN_C` of, or outside, the
-    calibrated range [lo, hi] °C: the firmware clamps there, the cubic is least known."""
+    """The sentence of a reference temperature near or beyond an end of the calibrated range.
+
+    Within :data:`END_MARGIN_C` of, or outside, ``[lo, hi]``: the firmware clamps there and the
+    cubic is least known.
+
+    Parameters
+    ----------
+    where : str
+        Name of the sensor in the sentence.
+    what : str
+        What the temperature is (e.g. ``"the reference temperature"``).
+    ref_c : float
+        The reference temperature [°C].
+    lo, hi : float
+        The calibrated range [°C].
+
+    Returns
+    -------
+    str or None
+        The sentence, or None when ``lo + 2 <= ref_c <= hi - 2``.
+
+    Examples
+    --------
+    >>> end_warning("g0", "TREF", 25.0, 10.0, 60.0) is None
+    True
+    >>> end_warning("g0", "TREF", 59.0, 10.0, 60.0) is None
+    False
+    """
     if lo + END_MARGIN_C <= ref_c <= hi - END_MARGIN_C:
         return None
     return (
@@ -565,10 +901,32 @@ ICM-20602, ICM-42688-P, Bosch BMI088 datasheets), 0.1–0.3 °/s rms over their 
 
 
 def gyro_unit_warning(where: str, vals: FloatArray) -> str | None:
-    """The sentence of a still gyro whose median rate on an axis exceeds
-    :data:`GYRO_BIAS_MAX_RAD_S` or whose white noise (``std(diff(v))/√2`` per axis) exceeds
-    :data:`GYRO_NOISE_MAX_RAD_S`: the deg/s of some drivers logged in a rad/s topic (×57.3);
-    ``vals`` (n, 3) in the canonical unit (°/h); None when plausible."""
+    r"""The sentence of a still gyro whose rates look like deg/s logged in a rad/s field.
+
+    Parameters
+    ----------
+    where : str
+        Name of the sensor in the sentence.
+    vals : numpy.ndarray
+        Shape (n, 3): the still gyro in the canonical unit [°/h].
+
+    Returns
+    -------
+    str or None
+        The sentence when an axis's median rate exceeds :data:`GYRO_BIAS_MAX_RAD_S` or its
+        white noise exceeds :data:`GYRO_NOISE_MAX_RAD_S`; None when plausible.
+
+    Notes
+    -----
+    Per axis, in rad/s, the bias and the white noise from first differences:
+
+    .. math:: b = |\operatorname{median}(v)|, \qquad
+       \sigma = \frac{\operatorname{std}(v_{i+1} - v_i)}{\sqrt{2}}
+
+    References
+    ----------
+    - PX4 ``ATT_BIAS_MAX`` (attitude_estimator_q, default 0.05 rad/s).
+    """
     v = np.asarray(vals, dtype=np.float64) * units.DH_TO_RS  # rad/s
     bias = np.abs(np.median(v, axis=0))
     noise = np.std(np.diff(v, axis=0), axis=0) / np.sqrt(2.0) if v.shape[0] > 2 else bias * 0
