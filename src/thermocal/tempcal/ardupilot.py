@@ -85,9 +85,42 @@ class ActiveTcal:
     caltemp_c: dict[str, float]
 
     def correction(self, kind: str, temp_c: FloatArray) -> FloatArray:
-        """What the firmware subtracted (AP_InertialSensor_tempcal.cpp ``correct_sensor``):
-        ``poly(clamp(T) − 35) − poly(clamp(T_cal) − 35)``, ``poly(t) = (c1 + (c2 + c3·t)·t)·t
-        ·1e-6``, (n, 3) [rad/s or m/s²]."""
+        r"""What the firmware subtracted from the logged data at temperatures ``temp_c``.
+
+        Parameters
+        ----------
+        kind : str
+            ``"gyro"`` or ``"accel"``.
+        temp_c : numpy.ndarray
+            IMU temperatures, shape (n,) [°C].
+
+        Returns
+        -------
+        numpy.ndarray
+            Shape (n, 3), x, y, z [rad/s for a gyro, m/s² for an accelerometer].
+
+        Notes
+        -----
+        With :math:`T` and :math:`T_{cal}` clamped to ``[tmin_c, tmax_c]`` and
+        :math:`T_{ref} = 35` °C:
+
+        .. math:: \Delta(T) = p(T - T_{ref}) - p(T_{cal} - T_{ref}), \qquad
+           p(t) = (c_1 + (c_2 + c_3 t)\,t)\,t \cdot 10^{-6}
+
+        References
+        ----------
+        - ArduPilot ``libraries/AP_InertialSensor/AP_InertialSensor_tempcal.cpp``
+          (``correct_sensor``).
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> p = {"INS_TCAL1_ENABLE": 1, "INS_TCAL1_GYR1_X": 100.0, "INS_TCAL1_TMIN": 0.0,
+        ...      "INS_TCAL1_TMAX": 70.0, "INS_GYR1_CALTEMP": 35.0}
+        >>> active = ardupilot_active(p, 0)
+        >>> [round(float(x), 6) for x in active.correction("gyro", np.array([45.0]))[0]]
+        [0.001, 0.0, 0.0]
+        """
         c = np.asarray(self.coefficients[kind], dtype=np.float64)
 
         def poly(t: FloatArray) -> FloatArray:
@@ -104,9 +137,32 @@ def ardupilot_comparison(
     active: ActiveTcal, new_params: Mapping[str, float], kind: str, unit: str,
     sweep_c: tuple[float, float],
 ) -> CoefficientComparison:  # fmt: skip
-    """IMU ``active.instance``'s ``kind`` coefficients active in the log against the new
-    ``INS_TCAL<n>_*`` (``new_params``): each parameter old → new, and both corrections
-    (:func:`ardupilot_poly_curve`, each clamped to its own TMIN…TMAX) over ``sweep_c``."""
+    """The coefficients active in the log against the new ``INS_TCAL<n>_*`` of one sensor.
+
+    Parameters
+    ----------
+    active : ActiveTcal
+        The calibration active in the log (IMU ``active.instance``).
+    new_params : mapping of str to float
+        The new parameters (``INS_TCAL<n>_*``; coefficients as stored, ×1e-6 in use).
+    kind : str
+        ``"gyro"`` or ``"accel"``.
+    unit : str
+        Unit of the corrections shown (``rad/s`` or ``m/s^2``).
+    sweep_c : tuple of float
+        The temperature sweep ``(lo, hi)`` over which both corrections are drawn [°C].
+
+    Returns
+    -------
+    thermocal.tempcal.compare.CoefficientComparison
+        Each parameter old → new, and both corrections
+        (:func:`thermocal.firmware.ardupilot.ardupilot_poly_curve`, each clamped to its own
+        TMIN…TMAX) over ``sweep_c``.
+
+    References
+    ----------
+    - ArduPilot ``libraries/AP_InertialSensor/AP_InertialSensor_tempcal.cpp``.
+    """
     n = active.instance + 1
     tag = "GYR" if kind == "gyro" else "ACC"
     names = [[f"INS_TCAL{n}_{tag}{k}_{a}" for a in "XYZ"] for k in (1, 2, 3)]
@@ -127,8 +183,27 @@ def ardupilot_comparison(
 
 
 def ardupilot_active(params: dict[str, float], instance: int) -> ActiveTcal | None:
-    """The active temperature calibration of IMU ``instance`` in a log's ``PARM`` values
-    (``INS_TCAL<n>_ENABLE`` = 1, n = instance + 1), or None."""
+    """The active temperature calibration of IMU ``instance`` in a log's ``PARM`` values.
+
+    Active when ``INS_TCAL<n>_ENABLE`` = 1 (n = instance + 1).  Missing coefficients are 0,
+    a missing range 0…70 °C, a missing or unset ``CALTEMP`` (NaN or ≤ -100) 35 °C.
+
+    Parameters
+    ----------
+    params : dict of str to float
+        The log's parameter values.
+    instance : int
+        IMU instance (0, 1, 2).
+
+    Returns
+    -------
+    ActiveTcal or None
+        The calibration, or None when not enabled.
+
+    References
+    ----------
+    - ArduPilot ``libraries/AP_InertialSensor/AP_InertialSensor_tempcal.cpp``.
+    """
     n = instance + 1
     if int(params.get(f"INS_TCAL{n}_ENABLE", 0)) != 1:
         return None
@@ -149,10 +224,52 @@ def ardupilot_active(params: dict[str, float], instance: int) -> ActiveTcal | No
 def ardupilot_raw(
     params: dict[str, float], instance: int, kind: str, temp_c: FloatArray, xyz: FloatArray
 ) -> tuple[FloatArray, ActiveTcal | None, int]:
-    """Logged IMU data back to the raw sensor frame as ArduPilot's firmware produced them:
-    the logged vector is ``R·(v − correction)`` (the temperature correction in the sensor
-    frame, then the board's rotation ``AHRS_ORIENTATION``), so ``v = Rᵀ·logged +
-    correction``.  Returns (v, the active calibration or None, the orientation code)."""
+    r"""Logged IMU data back to the raw sensor frame, as ArduPilot's firmware produced them.
+
+    Parameters
+    ----------
+    params : dict of str to float
+        The parameters in force (``AHRS_ORIENTATION``, ``INS_TCAL<n>_*``, ``CALTEMP``).
+    instance : int
+        IMU instance (0, 1, 2).
+    kind : str
+        ``"gyro"`` or ``"accel"``.
+    temp_c : numpy.ndarray
+        IMU temperatures, shape (n,) [°C].
+    xyz : numpy.ndarray
+        Logged vectors, shape (n, 3) [rad/s or m/s²].
+
+    Returns
+    -------
+    tuple
+        (raw vectors (n, 3) [rad/s or m/s²], the active calibration or None, the orientation
+        code).
+
+    Raises
+    ------
+    ThermocalInputError
+        When ``AHRS_ORIENTATION`` is not an integer.
+
+    Notes
+    -----
+    The logged vector is the board rotation :math:`R` (``AHRS_ORIENTATION``) of the sensor
+    vector less the temperature correction :math:`\Delta(T)` (:meth:`ActiveTcal.correction`):
+
+    .. math:: \ell = R\,(v - \Delta(T)) \quad\Longrightarrow\quad v = R^\mathsf{T} \ell + \Delta(T)
+
+    References
+    ----------
+    - ArduPilot ``libraries/AP_InertialSensor/AP_InertialSensor_tempcal.cpp``
+      (``correct_sensor``) and ``libraries/AP_Math/rotations.h``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> v, active, code = ardupilot_raw({"AHRS_ORIENTATION": 0}, 0, "gyro",
+    ...                                  np.array([30.0]), np.array([[0.1, 0.2, 0.3]]))
+    >>> v.tolist(), active, code
+    ([[0.1, 0.2, 0.3]], None, 0)
+    """
     value = params.get("AHRS_ORIENTATION", 0)
     if not (math.isfinite(value) and float(value).is_integer()):
         raise ThermocalInputError(  # int(2.5) would rotate by YAW_90 without a word
@@ -170,9 +287,21 @@ def ardupilot_raw(
 
 
 def imu_hygiene_params(name: str, instance: int) -> bool:
-    """Whether parameter ``name`` changes what the firmware did to IMU ``instance``'s logged
-    data: ``AHRS_ORIENTATION``, ``INS_TCAL<n>_*``, ``INS_ACC<n>_CALTEMP``,
-    ``INS_GYR<n>_CALTEMP`` (n = instance + 1)."""
+    """Whether parameter ``name`` changes what the firmware did to IMU ``instance``'s data.
+
+    Parameters
+    ----------
+    name : str
+        A parameter name.
+    instance : int
+        IMU instance (0, 1, 2); n = instance + 1 in the names.
+
+    Returns
+    -------
+    bool
+        True for ``AHRS_ORIENTATION``, ``INS_TCAL<n>_*``, ``INS_ACC<n>_CALTEMP`` and
+        ``INS_GYR<n>_CALTEMP``.
+    """
     n = instance + 1
     return name == "AHRS_ORIENTATION" or name.startswith(f"INS_TCAL{n}_") or name in (
         f"INS_ACC{n}_CALTEMP", f"INS_GYR{n}_CALTEMP",
@@ -197,12 +326,36 @@ a whole INS_TCAL set replaced twice (2 × 22 values) is named in full."""
 def param_intervals(
     initial: Mapping[str, float], changes: Sequence[Any], relevant: Callable[[str], bool]
 ) -> tuple[list[ParamInterval], list[Any]]:
-    """The log cut where a ``relevant`` parameter changed (``changes``: the reader's
-    :class:`~thermocal.readers.dataflash.ParamChange`, in log order), each piece with the
-    values in force; and those changes.  ArduPilot reads ``INS_TCAL*``, its ``CALTEMP`` and
-    ``AHRS_ORIENTATION`` live (AP_InertialSensor_tempcal.cpp ``correct_sensor`` reads the
-    parameters at each sample), so a sample logged at ``t`` was corrected with the values set
-    last before ``t``."""
+    """The log cut where a relevant parameter changed, each piece with the values in force.
+
+    ArduPilot reads ``INS_TCAL*``, its ``CALTEMP`` and ``AHRS_ORIENTATION`` live
+    (``correct_sensor`` reads the parameters at each sample), so a sample logged at ``t`` was
+    corrected with the values set last before ``t``.
+
+    Parameters
+    ----------
+    initial : mapping of str to float
+        The parameter values at the start of the log.
+    changes : sequence of thermocal.readers.dataflash.ParamChange
+        The parameter changes, in log order (time [s], name, old, new).
+    relevant : callable
+        ``relevant(name)``: whether a change cuts the log (:func:`imu_hygiene_params`).
+
+    Returns
+    -------
+    tuple
+        (the intervals ``[start_s, end_s)`` [s] with their parameters, the relevant changes).
+
+    Raises
+    ------
+    ThermocalInputError
+        When a relevant parameter (other than a ``CALTEMP``) is set to a value that is not a
+        number.
+
+    References
+    ----------
+    - ArduPilot ``libraries/AP_InertialSensor/AP_InertialSensor_tempcal.cpp``.
+    """
     cur = dict(initial)
     out: list[ParamInterval] = []
     used = [c for c in changes if relevant(c.name)]
@@ -226,9 +379,34 @@ def ardupilot_raw_intervals(
     intervals: Sequence[ParamInterval], instance: int, kind: str, time_s: FloatArray,
     temp_c: FloatArray, xyz: FloatArray,
 ) -> tuple[FloatArray, list[ActiveTcal | None], list[int]]:  # fmt: skip
-    """:func:`ardupilot_raw` per interval of the log: each sample undone with the parameters
-    in force when it was recorded (:func:`param_intervals`).  Returns (v, per interval the
-    active calibration or None, per interval the orientation code)."""
+    """:func:`ardupilot_raw` per interval: each sample undone with the parameters then in force.
+
+    Parameters
+    ----------
+    intervals : sequence of ParamInterval
+        The intervals of :func:`param_intervals`, in time order.
+    instance : int
+        IMU instance (0, 1, 2).
+    kind : str
+        ``"gyro"`` or ``"accel"``.
+    time_s : numpy.ndarray
+        Sample times (n,) [s, the log's clock].
+    temp_c : numpy.ndarray
+        IMU temperatures (n,) [°C].
+    xyz : numpy.ndarray
+        Logged vectors (n, 3) [rad/s or m/s²].
+
+    Returns
+    -------
+    tuple
+        (raw vectors (n, 3), per interval the active calibration or None, per interval the
+        orientation code).
+
+    Raises
+    ------
+    ThermocalInputError
+        When an interval's ``AHRS_ORIENTATION`` is not an integer.
+    """
     out = np.asarray(xyz, dtype=np.float64).copy()
     actives: list[ActiveTcal | None] = []
     codes: list[int] = []
@@ -261,7 +439,27 @@ mean, or rad/s], logged while ``INS_TCAL<n>_ENABLE`` = 2 (learning)."""
 def tclr_points(
     rows: Sequence[Mapping[str, float]], instance: int, kind: str
 ) -> tuple[FloatArray, FloatArray]:
-    """(Temp [°C], X/Y/Z (n, 3)) of the ``TCLR`` messages of IMU ``instance``'s ``kind``."""
+    """The ``TCLR`` points of IMU ``instance``'s ``kind``.
+
+    Parameters
+    ----------
+    rows : sequence of mapping
+        The log's ``TCLR`` messages (fields ``I``, ``SType``, ``Temp``, ``X``, ``Y``, ``Z``).
+    instance : int
+        IMU instance (0, 1, 2).
+    kind : str
+        ``"gyro"`` (SType 1) or ``"accel"`` (SType 0).
+
+    Returns
+    -------
+    tuple of numpy.ndarray
+        (``Temp`` (n,) [°C], ``X``/``Y``/``Z`` (n, 3) [rad/s or m/s²]).
+
+    References
+    ----------
+    - ArduPilot ``libraries/AP_InertialSensor/AP_InertialSensor_tempcal.cpp``
+      (``Learn::add_sample``).
+    """
     st = TCLR_STYPES[kind]
     sel = [r for r in rows if int(r.get("I", 0)) == instance and int(r.get("SType", -1)) == st]
     temp = np.array([r["Temp"] for r in sel], dtype=np.float64)
@@ -283,17 +481,38 @@ def tclr_range(
     rows: Sequence[Mapping[str, float]], instance: int, changes: Sequence[Any],
     imu_time_s: FloatArray, imu_temp_c: FloatArray,
 ) -> TclrRange | None:  # fmt: skip
-    """IMU ``instance``'s learned range as the firmware defines it
-    (AP_InertialSensor_tempcal.cpp ``Learn::save_calibration``: ``temp_min = start_temp``,
-    ``temp_max = temperature``): ``start_temp`` is the mid temperature ``T`` of the
-    accelerometer's first window (``add_sample``, ``si == 0``: its first ``TCLR`` with
-    SType 0), the same for the gyro; ``temperature`` is the (filtered) temperature when the
-    last window closed.  In order of preference: the ``INS_TCAL<n>_TMIN/TMAX`` the firmware
-    saved during the log (``changes``, :class:`~thermocal.readers.dataflash.ParamChange`, set
-    at or after the instance's first ``TCLR``: exact); else TMIN from the first accelerometer
-    window and TMAX the IMU temperature (``imu_temp_c`` over ``imu_time_s`` [s]) at the last
-    ``TCLR``'s ``TimeUS``; else (times outside the IMU's) the highest window temperature, a
-    lower bound.  None without ``TCLR`` of this IMU."""
+    """IMU ``instance``'s learned range as the firmware defines it.
+
+    ``Learn::save_calibration`` saves ``temp_min = start_temp``, ``temp_max = temperature``:
+    ``start_temp`` is the mid temperature of the accelerometer's first window (its first
+    ``TCLR`` with SType 0), ``temperature`` the (filtered) temperature when the last window
+    closed.  In order of preference: the ``INS_TCAL<n>_TMIN/TMAX`` the firmware saved during
+    the log (set at or after the instance's first ``TCLR``: exact); else TMIN from the first
+    accelerometer window and TMAX the IMU temperature at the last ``TCLR``'s ``TimeUS``; else
+    (times outside the IMU's) the highest window temperature, a lower bound.
+
+    Parameters
+    ----------
+    rows : sequence of mapping
+        The log's ``TCLR`` messages.
+    instance : int
+        IMU instance (0, 1, 2).
+    changes : sequence of thermocal.readers.dataflash.ParamChange
+        The log's parameter changes (time [s], name, old, new).
+    imu_time_s : numpy.ndarray
+        The IMU's sample times [s].
+    imu_temp_c : numpy.ndarray
+        The IMU's temperatures [°C].
+
+    Returns
+    -------
+    TclrRange or None
+        TMIN, TMAX [°C] and how they were found; None without ``TCLR`` of this IMU.
+
+    References
+    ----------
+    - ArduPilot ``libraries/AP_InertialSensor/AP_InertialSensor_tempcal.cpp``.
+    """
     mine = [r for r in rows if int(r.get("I", 0)) == instance and "Temp" in r]
     if not mine:
         return None
@@ -324,10 +543,37 @@ def tclr_comparison(
     rows: Sequence[Mapping[str, float]], instance: int, kind: str, unit: str,
     new_params: Mapping[str, float], sweep_c: tuple[float, float], learned_range: TclrRange,
 ) -> CoefficientComparison | None:  # fmt: skip
-    """The firmware's learned coefficients of IMU ``instance``'s ``kind`` (:func:`tclr_learned`
-    of its ``TCLR`` points, valid over the IMU's learned range ``learned_range``,
-    :func:`tclr_range`) against thermocal's ``new_params``; None with fewer than 4 points at
-    distinct temperatures (no cubic)."""
+    """The firmware's learned coefficients of one sensor against thermocal's.
+
+    Parameters
+    ----------
+    rows : sequence of mapping
+        The log's ``TCLR`` messages.
+    instance : int
+        IMU instance (0, 1, 2).
+    kind : str
+        ``"gyro"`` or ``"accel"``.
+    unit : str
+        Unit of the corrections shown (``rad/s`` or ``m/s^2``).
+    new_params : mapping of str to float
+        thermocal's ``INS_TCAL<n>_*``.
+    sweep_c : tuple of float
+        The temperature sweep ``(lo, hi)`` [°C].
+    learned_range : TclrRange
+        The IMU's learned range (:func:`tclr_range`) [°C].
+
+    Returns
+    -------
+    thermocal.tempcal.compare.CoefficientComparison or None
+        The comparison (:func:`thermocal.firmware.ardupilot.tclr_learned` of the ``TCLR``
+        points: a least-squares cubic in T − 35 °C); None with fewer than 4 points at distinct
+        temperatures (no cubic).
+
+    References
+    ----------
+    - ArduPilot ``libraries/AP_InertialSensor/AP_InertialSensor_tempcal.cpp``
+      (``Learn::finish_calibration``).
+    """
     temp, xyz = tclr_points(rows, instance, kind)
     if np.unique(temp).size < 4:
         return None
