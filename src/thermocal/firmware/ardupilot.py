@@ -55,10 +55,43 @@ AP_REFUSED_ROTATIONS = {38: "ROLL_90_PITCH_68_YAW_293", 100: "CUSTOM"}
 
 
 def ardupilot_rotation(code: int) -> FloatArray:
-    """The matrix ``R`` of ArduPilot rotation ``code``: ``Vector3::rotate`` gives ``R·v``
-    with ``R = Rz(yaw)·Ry(pitch)·Rx(roll)`` for ``ROTATION_ROLL_r_PITCH_p_YAW_y`` (checked
-    against rotations.cpp: YAW_90 is (x, y) → (−y, x), ROLL_90 is (y, z) → (−z, y), PITCH_90
-    is (x, z) → (z, −x))."""
+    r"""The matrix of ArduPilot board rotation ``code`` (``AHRS_ORIENTATION``).
+
+    Parameters
+    ----------
+    code : int
+        A value of ArduPilot's ``enum Rotation`` (:data:`AP_ROTATIONS`).
+
+    Returns
+    -------
+    numpy.ndarray
+        The 3×3 matrix :math:`R` with ``Vector3::rotate`` giving :math:`R v`.
+
+    Raises
+    ------
+    ThermocalInputError
+        When ``code`` is not implemented (38, 100 custom, or unknown).
+
+    Notes
+    -----
+    For ``ROTATION_ROLL_r_PITCH_p_YAW_y``:
+
+    .. math:: R = R_z(y)\,R_y(p)\,R_x(r)
+
+    checked against ``rotations.cpp``: YAW_90 is (x, y) → (−y, x), ROLL_90 is (y, z) → (−z, y),
+    PITCH_90 is (x, z) → (z, −x).
+
+    References
+    ----------
+    - ArduPilot ``libraries/AP_Math/rotations.h`` and ``libraries/AP_Math/vector3.cpp``
+      (``Vector3::rotate``).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> (ardupilot_rotation(2) @ np.array([1.0, 0.0, 0.0])).round(3).tolist()
+    [0.0, 1.0, 0.0]
+    """
     if code not in AP_ROTATIONS:
         name = AP_REFUSED_ROTATIONS.get(code, "unknown")
         raise ThermocalInputError(
@@ -88,8 +121,39 @@ AP_CURVE_FORMULA = (
 def ardupilot_poly_curve(
     coef: Sequence[Sequence[float]], tmin_c: float, tmax_c: float
 ) -> Callable[[FloatArray], FloatArray]:
-    """The temperature-dependent part of ArduPilot's correction for stored coefficients
-    ``coef[k-1][axis]`` (×1e6): :data:`AP_CURVE_FORMULA`, (n, 3) [rad/s or m/s²]."""
+    r"""The temperature-dependent part of ArduPilot's correction for stored coefficients.
+
+    Parameters
+    ----------
+    coef : sequence of sequence of float
+        ``coef[k - 1][axis]`` = :math:`c_k` as stored (×1e6), k = 1…3, axes x, y, z.
+    tmin_c, tmax_c : float
+        The calibrated range ``INS_TCAL<n>_TMIN``/``_TMAX`` [°C].
+
+    Returns
+    -------
+    callable
+        ``curve(temp_c)``: temperatures (n,) [°C] → correction (n, 3) [rad/s or m/s²].
+
+    Notes
+    -----
+    :data:`AP_CURVE_FORMULA`:
+
+    .. math:: p(t) = (c_1 + (c_2 + c_3 t)\,t)\,t \cdot 10^{-6}, \qquad
+       t = \operatorname{clamp}(T, T_{min}, T_{max}) - 35
+
+    References
+    ----------
+    - ArduPilot ``libraries/AP_InertialSensor/AP_InertialSensor_tempcal.cpp``
+      (``correct_sensor``).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> curve = ardupilot_poly_curve([[100.0, 0, 0], [0, 0, 0], [0, 0, 0]], 20.0, 50.0)
+    >>> [round(float(x), 6) for x in curve(np.array([45.0, 60.0]))[:, 0]]
+    [0.001, 0.0015]
+    """
     c = np.asarray(coef, dtype=np.float64)
 
     def curve(temp_c: FloatArray) -> FloatArray:
@@ -101,10 +165,42 @@ def ardupilot_poly_curve(
 
 
 def tclr_learned(temp_c: FloatArray, xyz: FloatArray) -> list[list[float]]:
-    """The coefficients the firmware learns from its ``TCLR`` points: its ``PolyFit<4>``
-    (AP_Math/polyfit.h) is the least-squares cubic with constant of X, Y, Z in ``T − 35``,
-    ``p0 + p1·t + p2·t² + p3·t³``; ``save_calibration`` stores ``c_k = p_k·1e6``,
-    k = 1…3 (the constant dropped).  Returns ``c[k-1][axis]`` as stored."""
+    r"""The coefficients the firmware learns from its ``TCLR`` points.
+
+    Parameters
+    ----------
+    temp_c : numpy.ndarray
+        The points' temperatures (n,) [°C], at least 4 distinct.
+    xyz : numpy.ndarray
+        The points' X, Y, Z (n, 3) [rad/s or m/s²].
+
+    Returns
+    -------
+    list of list of float
+        ``c[k - 1][axis]`` as stored (×1e6), k = 1…3 (the constant dropped).
+
+    Notes
+    -----
+    The firmware's ``PolyFit<4>`` is the least-squares cubic with constant, per axis, in
+    :math:`t = T - 35`:
+
+    .. math:: \min_p \sum_i \left(v_i - \sum_{k=0}^{3} p_k t_i^k\right)^2, \qquad
+       c_k = 10^6\,p_k,\; k = 1 \ldots 3
+
+    References
+    ----------
+    - ArduPilot ``libraries/AP_Math/polyfit.h`` and
+      ``libraries/AP_InertialSensor/AP_InertialSensor_tempcal.cpp`` (``save_calibration``).
+    - G. H. Golub and C. F. Van Loan, *Matrix Computations*, 4th ed., 2013 (least squares).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> t = np.linspace(20.0, 60.0, 9)
+    >>> v = np.column_stack([2e-6 * (t - 35.0), 0 * t, 0 * t])
+    >>> [round(x, 6) for x in tclr_learned(t, v)[0]]
+    [2.0, 0.0, 0.0]
+    """
     v = np.vander(np.asarray(temp_c, dtype=np.float64) - AP_TREF_C, 4, increasing=True)
     p, *_ = np.linalg.lstsq(v, np.asarray(xyz, dtype=np.float64), rcond=None)
     return [[float(x) * 1e6 for x in p[k]] for k in (1, 2, 3)]
@@ -150,8 +246,32 @@ class ArdupilotFit:
     n_bins: int
 
     def correction(self, temperature_c: npt.ArrayLike, caltemp_c: float = AP_TREF_C) -> FloatArray:
-        """What the firmware subtracts at ``temperature_c`` [°C] for a sensor calibrated at
-        ``caltemp_c`` [°C], shape (n, 3) [rad/s or m/s²] (temperatures clamped to the range)."""
+        r"""What the firmware subtracts at ``temperature_c``, calibrated at ``caltemp_c``.
+
+        Parameters
+        ----------
+        temperature_c : array_like
+            Temperatures [°C] (clamped to ``tmin_c…tmax_c``).
+        caltemp_c : float, optional
+            ``INS_ACC<n>_CALTEMP``/``INS_GYR<n>_CALTEMP`` [°C]; default 35.
+
+        Returns
+        -------
+        numpy.ndarray
+            Shape (n, 3) [rad/s or m/s²].
+
+        Notes
+        -----
+        .. math:: \Delta(T) = p(\operatorname{clamp}(T) - 35)
+           - p(\operatorname{clamp}(T_{cal}) - 35)
+
+        with :math:`p` of :func:`ardupilot_poly_curve`.
+
+        References
+        ----------
+        - ArduPilot ``libraries/AP_InertialSensor/AP_InertialSensor_tempcal.cpp``
+          (``correct_sensor``).
+        """
         curve = ardupilot_poly_curve(self.coefficients, self.tmin_c, self.tmax_c)
         t = np.asarray(temperature_c, dtype=np.float64).ravel()
         return curve(t) - curve(np.array([float(caltemp_c)]))

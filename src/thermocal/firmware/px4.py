@@ -81,8 +81,27 @@ class Px4Fit:
     relative: bool
 
     def offset(self, temperature_c: npt.ArrayLike) -> FloatArray:
-        """The offset the firmware subtracts at ``temperature_c`` [°C], shape (n, axes)
-        [firmware unit]; the temperature is clamped to ``TMIN…TMAX`` as the firmware does."""
+        r"""The offset the firmware subtracts at ``temperature_c``.
+
+        Parameters
+        ----------
+        temperature_c : array_like
+            Temperatures [°C], clamped to ``TMIN…TMAX`` as the firmware does.
+
+        Returns
+        -------
+        numpy.ndarray
+            Shape (n, axes) [firmware unit].
+
+        Notes
+        -----
+        .. math:: o_i(T) = \sum_{k=0}^{n} X_{k,i}\,\Delta T^k, \qquad
+           \Delta T = \operatorname{clamp}(T, T_{min}, T_{max}) - T_{ref}
+
+        References
+        ----------
+        - PX4 ``src/modules/sensors/temperature_compensation/TemperatureCompensation.cpp``.
+        """
         t = np.clip(np.asarray(temperature_c, dtype=np.float64).ravel(), self.tmin_c, self.tmax_c)
         c = np.asarray(self.coefficients, dtype=np.float64)  # (axes, order + 1)
         out = np.asarray(np.polynomial.polynomial.polyval(t - self.tref_c, c.T), np.float64)
