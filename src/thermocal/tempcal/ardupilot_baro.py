@@ -46,15 +46,64 @@ INT8_RANGE = (-128, 127)
 
 
 def baro_correction(temp_c: FloatArray, exponent: float) -> FloatArray:
-    """The firmware's correction ``max(T − 25, 0)^e`` [Pa], added to the pressure
-    (``AP_TempCalibration::calculate_correction``)."""
+    r"""The firmware's barometer correction, added to the pressure.
+
+    Parameters
+    ----------
+    temp_c : numpy.ndarray
+        Barometer temperatures [°C].
+    exponent : float
+        ``TCAL_BARO_EXP`` (dimensionless).
+
+    Returns
+    -------
+    numpy.ndarray
+        The correction [Pa], same shape as ``temp_c``.
+
+    Notes
+    -----
+    .. math:: \Delta p(T) = \max(T - 25, 0)^{e}
+
+    References
+    ----------
+    - ArduPilot ``libraries/AP_TempCalibration/AP_TempCalibration.cpp``
+      (``calculate_correction``).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> baro_correction(np.array([20.0, 29.0]), 1.5).tolist()
+    [0.0, 8.0]
+    """
     out: FloatArray = np.maximum(np.asarray(temp_c, dtype=np.float64) - TZERO_C, 0.0) ** exponent
     return out
 
 
 def best_exponent(temp_c: FloatArray, press_pa: FloatArray) -> tuple[float, float]:
-    """(the exponent in :data:`EXP_LIMITS` minimising the variance of ``press_pa +``
-    :func:`baro_correction` about its mean, that mean [Pa]), on a grid of :data:`EXP_STEP`."""
+    r"""The exponent that makes the corrected pressure the flattest.
+
+    Parameters
+    ----------
+    temp_c : numpy.ndarray
+        Temperatures [°C] (bin medians or samples).
+    press_pa : numpy.ndarray
+        Pressures, same length [Pa].
+
+    Returns
+    -------
+    tuple of float
+        (the exponent in :data:`EXP_LIMITS` on a grid of :data:`EXP_STEP`, the mean corrected
+        pressure [Pa]).
+
+    Notes
+    -----
+    .. math:: \hat e = \arg\min_{e} \operatorname{var}\left(p_i + \max(T_i - 25, 0)^{e}\right)
+
+    References
+    ----------
+    - ArduPilot ``libraries/AP_TempCalibration/AP_TempCalibration.cpp`` (its learning
+      searches the exponent the same way, in steps of 0.01).
+    """
     grid = np.arange(EXP_LIMITS[0], EXP_LIMITS[1] + EXP_STEP / 2, EXP_STEP)
     dt = np.maximum(np.asarray(temp_c, dtype=np.float64) - TZERO_C, 0.0)
     corrected = np.asarray(press_pa, dtype=np.float64)[None, :] + dt[None, :] ** grid[:, None]
@@ -114,9 +163,27 @@ class ArdupilotBaroFit:
 def fit_ardupilot_baro(
     temp_c: FloatArray, press_pa: FloatArray, instance: int = 0
 ) -> ArdupilotBaroFit | None:
-    """The firmware's exponent fitted to a log's barometer (module docstring); None when
-    fewer than :data:`MIN_BINS_ABOVE` temperature bins lie above 25 °C (the correction is
-    zero below)."""
+    """The firmware's exponent ``TCAL_BARO_EXP`` fitted to a log's barometer.
+
+    Parameters
+    ----------
+    temp_c : numpy.ndarray
+        Barometer temperatures [°C] (non-finite samples dropped).
+    press_pa : numpy.ndarray
+        Pressures as logged (uncorrected), same length [Pa].
+    instance : int, optional
+        Barometer instance (default 0; the firmware corrects instance 0 only).
+
+    Returns
+    -------
+    ArdupilotBaroFit or None
+        The fit, or None when fewer than :data:`MIN_BINS_ABOVE` temperature bins lie above
+        25 °C (the correction is zero below).
+
+    References
+    ----------
+    - ArduPilot ``libraries/AP_TempCalibration/AP_TempCalibration.cpp``.
+    """
     temp = np.asarray(temp_c, dtype=np.float64)
     press = np.asarray(press_pa, dtype=np.float64)
     ok = np.isfinite(temp) & np.isfinite(press)
@@ -174,10 +241,30 @@ def baro_report_request(
     fit: ArdupilotBaroFit, temp_c: FloatArray, press_pa: FloatArray, log_path: str,
     generated_by: str, log_params: Mapping[str, float], said: tuple[str, ...] = (),
 ) -> ArdupilotBaroReportRequest:  # fmt: skip
-    """The report's numbers (:class:`ArdupilotBaroReportRequest`) of ``fit`` on the log's
-    barometer samples (``temp_c`` [°C], ``press_pa`` [Pa] as logged: ``BARO.Press`` is
-    uncorrected); ``log_params`` the log's parameters (their ``TCAL_*`` are shown beside the
-    new ones)."""
+    """The numbers of the barometer report of ``fit`` on the log's samples.
+
+    Parameters
+    ----------
+    fit : ArdupilotBaroFit
+        The fitted exponent.
+    temp_c : numpy.ndarray
+        Barometer temperatures [°C].
+    press_pa : numpy.ndarray
+        Pressures as logged (``BARO.Press`` is uncorrected) [Pa].
+    log_path : str
+        The log, named in the report.
+    generated_by : str
+        The command line that made the report.
+    log_params : mapping of str to float
+        The log's parameters (their ``TCAL_*`` shown beside the new ones).
+    said : tuple of str, optional
+        Warnings already said, repeated in the report.
+
+    Returns
+    -------
+    ArdupilotBaroReportRequest
+        What the report is built from.
+    """
     temp = np.asarray(temp_c, dtype=np.float64)
     press = np.asarray(press_pa, dtype=np.float64)
     ok = np.isfinite(temp) & np.isfinite(press)

@@ -83,10 +83,33 @@ def compare_coefficients(
     axes: Sequence[str] = ("x", "y", "z"),
     **labels: str,
 ) -> CoefficientComparison:
-    """The comparison of one sensor: ``old``/``new`` map temperatures (n,) [°C] to the
-    correction (n, axes) [``unit``]; evaluated at :data:`CURVE_POINTS` temperatures over
-    ``range_c`` (the new calibration's range); ``labels``: the naming fields of
-    :class:`CoefficientComparison` (``old_key``, ``title``, …)."""
+    """The comparison of one sensor's old and new temperature corrections.
+
+    Parameters
+    ----------
+    sensor : str
+        Name of the sensor (e.g. ``"IMU.0 gyro"``).
+    unit : str
+        Unit of the corrections (e.g. ``rad/s``).
+    parameters : sequence of tuple
+        (parameter name, old value, new value).
+    range_c : tuple of float
+        Temperature range ``(lo, hi)`` the curves are evaluated over [°C] (the new
+        calibration's).
+    old, new : callable
+        Temperatures (n,) [°C] → correction (n, axes) [``unit``].
+    formula : str
+        The correction's formula, shown in the report.
+    axes : sequence of str, optional
+        Axis names (default x, y, z).
+    **labels : str
+        The naming fields of :class:`CoefficientComparison` (``old_key``, ``title``, …).
+
+    Returns
+    -------
+    CoefficientComparison
+        Both curves at :data:`CURVE_POINTS` temperatures and the parameter table.
+    """
     t = np.linspace(range_c[0], range_c[1], CURVE_POINTS)
     o, n = np.asarray(old(t)).reshape(t.size, -1), np.asarray(new(t)).reshape(t.size, -1)
     return CoefficientComparison(
@@ -118,8 +141,35 @@ PX4_CURVE_FORMULA = (
 def px4_poly_curve(
     params: Mapping[str, float], prefix: str, order: int, suffixes: Sequence[str]
 ) -> Callable[[FloatArray], FloatArray]:
-    """PX4's offset of the parameters ``<prefix>X<k><suffix>`` (:data:`PX4_CURVE_FORMULA`),
-    (n, axes) [the sensor's unit]."""
+    r"""PX4's offset for the parameters ``<prefix>X<k><suffix>``.
+
+    Parameters
+    ----------
+    params : mapping of str to float
+        PX4 parameters holding ``<prefix>TMIN``, ``TMAX``, ``TREF`` [°C] and ``X<k><suffix>``.
+    prefix : str
+        E.g. ``"TC_G0_"``.
+    order : int
+        Polynomial order (3, or 5 for the barometer).
+    suffixes : sequence of str
+        Axis suffixes (``"_0"``, ``"_1"``, ``"_2"``; ``""`` for the barometer).
+
+    Returns
+    -------
+    callable
+        Temperatures (n,) [°C] → offset (n, axes) [the sensor's unit].
+
+    Notes
+    -----
+    :data:`PX4_CURVE_FORMULA`:
+
+    .. math:: o(T) = \sum_{k=0}^{n} X_k \left(\operatorname{clamp}(T, T_{min}, T_{max})
+       - T_{ref}\right)^k
+
+    References
+    ----------
+    - PX4 ``src/modules/sensors/temperature_compensation/TemperatureCompensation.cpp``.
+    """
     lo, hi, tref = (params[prefix + k] for k in ("TMIN", "TMAX", "TREF"))
     c = np.array([[params[f"{prefix}X{k}{s}"] for s in suffixes] for k in range(order + 1)])
 
@@ -135,10 +185,38 @@ def px4_comparison(
     old: Mapping[str, float], new: Mapping[str, float], kind: str, instance: int,
     device_id: int, unit: str, range_c: tuple[float, float],
 ) -> CoefficientComparison | None:  # fmt: skip
-    """The ``TC_*`` of the sensor with ``device_id`` in the log's parameters ``old`` (the
-    calibration index ``m`` whose ``TC_<letter><m>_ID`` is it: PX4 matches by device id, not
-    by instance) against the new ``TC_<letter><instance>_*``; None when the log has none for
-    this device (or its device id is 0, unknown)."""
+    """The ``TC_*`` active in the log for a device against the new ones.
+
+    PX4 matches the calibration to a sensor by device id, not by instance: the calibration
+    index ``m`` whose ``TC_<letter><m>_ID`` is ``device_id`` is compared with the new
+    ``TC_<letter><instance>_*``.
+
+    Parameters
+    ----------
+    old : mapping of str to float
+        The log's parameters.
+    new : mapping of str to float
+        The new parameters.
+    kind : str
+        ``"gyro"``, ``"accel"``, ``"baro"`` or ``"mag"``.
+    instance : int
+        The new calibration's instance (0…3).
+    device_id : int
+        PX4's device id of the sensor (0: unknown).
+    unit : str
+        Unit of the offsets.
+    range_c : tuple of float
+        Temperature range of the curves [°C].
+
+    Returns
+    -------
+    CoefficientComparison or None
+        None when the log has no calibration for this device (or ``device_id`` is 0).
+
+    References
+    ----------
+    - PX4 ``src/modules/sensors/temperature_compensation/TemperatureCompensation.cpp``.
+    """
     letter, order, suffixes, axes = PX4_TC[kind]
     m = next(
         (
