@@ -52,9 +52,24 @@ class FlightLog:
     parameter_changes: tuple[tuple[float, str, float], ...]
 
     def recording(self, topic: str) -> Recording:
-        """One IMU topic instance (``NAME.N``) as a recording of x, y, z and
-        ``temperature`` in the canonical units, checked (finite, increasing time), its gaps
-        said in one warning; served from the log's one parse."""
+        """One IMU topic instance as a checked recording, served from the log's one parse.
+
+        Parameters
+        ----------
+        topic : str
+            The topic instance, ``NAME.N``.
+
+        Returns
+        -------
+        thermocal.recording.Recording
+            x, y, z and ``temperature`` in the canonical units (°/h or mg; °C), checked (finite,
+            increasing time), its gaps said in one warning.
+
+        Raises
+        ------
+        ThermocalInputError
+            When the topic is missing or its data are unusable.
+        """
         from thermocal.pipeline.reading import check_recording
         from thermocal.readers.dispatch import read_recording
         from thermocal.readers.options import ReadOptions
@@ -63,8 +78,18 @@ class FlightLog:
         return check_recording(read_recording(self.path, read), read)
 
     def table(self, topic: str) -> tuple[pd.DataFrame, dict[str, Any]]:
-        """One topic instance (``NAME.N``) as a table of its fields (PX4's units) and its
-        metadata; served from the log's one parse."""
+        """One topic instance as a table of its fields, served from the log's one parse.
+
+        Parameters
+        ----------
+        topic : str
+            The topic instance, ``NAME.N``.
+
+        Returns
+        -------
+        tuple
+            (the fields as a pandas.DataFrame in PX4's units, the topic's metadata).
+        """
         from thermocal.readers.dispatch import read_whole_table
         from thermocal.readers.options import ReadOptions
 

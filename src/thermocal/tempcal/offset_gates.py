@@ -118,9 +118,42 @@ ARDUPILOT_BARO = Dialect("Press", "ArduPilot logs Pa (LogStructure.h BARO)", "TC
 
 
 def altitude_residual(temp_c: FloatArray, pressure_pa: FloatArray) -> FloatArray:
-    """``pressure_pa`` minus its least-squares polynomial of order :data:`SMOOTH_ORDER` in the
-    temperature (PX4's own order for ``TC_B``, normalised to −1…1 over the sweep) [Pa]: what
-    the temperature does not explain — a climb, a descent, the board carried."""
+    r"""The pressure minus its least-squares polynomial in the temperature: what the temperature
+    does not explain (a climb, a descent, the board carried).
+
+    Parameters
+    ----------
+    temp_c : numpy.ndarray
+        Temperatures [°C].
+    pressure_pa : numpy.ndarray
+        Pressures, same length [Pa].
+
+    Returns
+    -------
+    numpy.ndarray
+        The residual [Pa], same length.
+
+    Notes
+    -----
+    With :math:`x` the temperature normalised to −1…1 over the sweep and :math:`n` =
+    :data:`SMOOTH_ORDER` (PX4's own order for ``TC_B``, fewer with fewer distinct
+    temperatures):
+
+    .. math:: r_i = p_i - \sum_{k=0}^{n} \hat a_k x_i^k, \qquad
+       \hat a = \arg\min_a \sum_i \Big(p_i - \sum_k a_k x_i^k\Big)^2
+
+    References
+    ----------
+    - PX4 ``Tools/process_sensor_caldata.py`` (the barometer's polynomial order).
+    - G. H. Golub and C. F. Van Loan, *Matrix Computations*, 4th ed., 2013 (least squares).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> t = np.linspace(20.0, 60.0, 50)
+    >>> float(np.max(np.abs(altitude_residual(t, 101325.0 + 3.0 * t)))) < 1e-6
+    True
+    """
     t = np.asarray(temp_c, dtype=np.float64)
     half = max(0.5 * float(np.ptp(t)), 1e-9)
     x = (t - 0.5 * (float(np.max(t)) + float(np.min(t)))) / half
@@ -142,7 +175,27 @@ def _fastest_change(tb: FloatArray, resid: FloatArray) -> tuple[float, float, fl
 
 def screen_baro(where: str, time_s: FloatArray, temp_c: FloatArray, pressure_pa: FloatArray,
                 dialect: Dialect = Dialect()) -> Screened:  # fmt: skip
-    """The barometer gates (module docstring) of ``pressure_pa`` [Pa] over ``time_s`` [s]."""
+    """The barometer gates (module docstring) of one barometer's samples.
+
+    Parameters
+    ----------
+    where : str
+        Name of the barometer in messages.
+    time_s : numpy.ndarray
+        Sample times [s].
+    temp_c : numpy.ndarray
+        Temperatures [°C].
+    pressure_pa : numpy.ndarray
+        Pressures [Pa].
+    dialect : Dialect, optional
+        How the firmware names the field and its parameters (default PX4's).
+
+    Returns
+    -------
+    Screened
+        The samples kept (None: the barometer is left out), the sentence saying why it is
+        left out, and notes on samples set aside.
+    """
     field, params = dialect.field, dialect.params
     p = np.asarray(pressure_pa, dtype=np.float64).reshape(-1)
     finite = np.isfinite(p) & np.isfinite(np.asarray(temp_c, dtype=np.float64))
@@ -182,7 +235,25 @@ def screen_baro(where: str, time_s: FloatArray, temp_c: FloatArray, pressure_pa:
 
 def screen_mag(where: str, time_s: FloatArray, temp_c: FloatArray, field_gauss: FloatArray
                ) -> Screened:  # fmt: skip
-    """The magnetometer gates (module docstring) of ``field_gauss`` (n, 3) [gauss]."""
+    """The magnetometer gates (module docstring) of one magnetometer's samples.
+
+    Parameters
+    ----------
+    where : str
+        Name of the magnetometer in messages.
+    time_s : numpy.ndarray
+        Sample times [s].
+    temp_c : numpy.ndarray
+        Temperatures [°C].
+    field_gauss : numpy.ndarray
+        Field (n, 3) [gauss].
+
+    Returns
+    -------
+    Screened
+        The samples kept (None: the magnetometer is left out), the sentence saying why, and
+        notes on samples set aside.
+    """
     b = np.asarray(field_gauss, dtype=np.float64).reshape(len(temp_c), -1)
     finite = np.all(np.isfinite(b), axis=1) & np.isfinite(np.asarray(temp_c, dtype=np.float64))
     if not finite.any():

@@ -51,8 +51,29 @@ class OffsetReportRequest:
 
 
 def firmware_offset(fit: OffsetFit, temp_c: FloatArray) -> FloatArray:
-    """PX4's offset of ``fit`` at ``temp_c``: ``Σ_k X_k·(clamp(T, TMIN, TMAX) − TREF)^k``
-    per axis, (n, axes) [``fit.unit``] (TMIN/TMAX: the fit's sweep)."""
+    r"""PX4's offset of ``fit`` at ``temp_c`` (TMIN/TMAX: the fit's sweep).
+
+    Parameters
+    ----------
+    fit : thermocal.tempcal.px4.OffsetFit
+        A barometer's or magnetometer's fit.
+    temp_c : numpy.ndarray
+        Temperatures (n,) [°C].
+
+    Returns
+    -------
+    numpy.ndarray
+        Shape (n, axes) [``fit.unit``].
+
+    Notes
+    -----
+    .. math:: o_i(T) = \sum_{k} X_{k,i} \left(\operatorname{clamp}(T, T_{min}, T_{max})
+       - T_{ref}\right)^k
+
+    References
+    ----------
+    - PX4 ``src/modules/sensors/temperature_compensation/TemperatureCompensation.cpp``.
+    """
     x = np.clip(np.asarray(temp_c, dtype=np.float64), *fit.sweep_c) - fit.tref_c
     cols = [np.polynomial.polynomial.polyval(x, np.asarray(c)) for c in fit.coefficients]
     out: FloatArray = np.column_stack(cols)
@@ -67,8 +88,28 @@ def offset_report_request(
     generated_by: str,
     previous: CoefficientComparison | None = None,
 ) -> OffsetReportRequest:
-    """The numbers of one barometer's or magnetometer's report (module docstring);
-    ``values`` (n, axes) [``fit.unit``] as logged."""
+    """The numbers of one barometer's or magnetometer's report (module docstring).
+
+    Parameters
+    ----------
+    fit : thermocal.tempcal.px4.OffsetFit
+        The sensor's fit.
+    temp_c : numpy.ndarray
+        Temperatures (n,) [°C].
+    values : numpy.ndarray
+        The sensor's values (n, axes) as logged [``fit.unit``].
+    log_path : str
+        The log, named in the report.
+    generated_by : str
+        The command line that made the report.
+    previous : CoefficientComparison, optional
+        The log's ``TC_*`` for this device against the new ones (default none).
+
+    Returns
+    -------
+    OffsetReportRequest
+        What the report is built from.
+    """
     temp = np.asarray(temp_c, dtype=np.float64)
     vals = np.asarray(values, dtype=np.float64).reshape(temp.size, -1)
     before = vals - np.median(vals, axis=0)

@@ -107,11 +107,54 @@ def fit_offset_sensor(
     tref_c: float | None = None,
     overrides: tuple[str, ...] = (),
 ) -> OffsetFit:
-    """Judge (:func:`thermocal.adequacy.judge`: sweep, bins, ends), then fit PX4's
-    polynomial (:func:`thermocal.firmware.px4.px4_coefficients`: medians of 0.5 °C bins,
-    equal weight across the range, robust to spikes; judged on held-out bins; a polynomial
-    of PX4's order in ``T − TREF``, TREF mid-range unless given, fitted to every bin).
-    ``values`` (n, axes) in the topic's unit (:data:`OFFSET_TOPICS`)."""
+    r"""Judge, then fit PX4's polynomial to one barometer or magnetometer.
+
+    Judged by :func:`thermocal.adequacy.judge` (sweep, bins, ends), then fitted by
+    :func:`thermocal.firmware.px4.px4_coefficients` (medians of 0.5 °C bins, equal weight
+    across the range, robust to spikes; judged on held-out bins; a polynomial of PX4's order in
+    ``T − TREF``, fitted to every bin).
+
+    Parameters
+    ----------
+    time_s : numpy.ndarray
+        Sample times [s].
+    temp_c : numpy.ndarray
+        Temperatures [°C].
+    values : numpy.ndarray
+        Values (n, axes) in the topic's unit (:data:`OFFSET_TOPICS`: Pa or gauss).
+    topic : str
+        The ULog topic (a key of :data:`OFFSET_TOPICS`).
+    instance : int
+        Topic instance.
+    device_id : int
+        PX4's device id of the sensor.
+    tref_c : float, optional
+        ``TC_*_TREF`` [°C]; default mid-range.
+    overrides : tuple of str, optional
+        Adequacy tests the user accepts anyway.
+
+    Returns
+    -------
+    OffsetFit
+        Sweep and TREF [°C], counts, coefficients ``X_k`` [unit/°C^k], hold-out rms per axis.
+
+    Raises
+    ------
+    ThermocalInputError
+        When the data are judged inadequate (not overridden) or the temperature cannot carry
+        the polynomial.
+
+    Notes
+    -----
+    Per axis, least squares over the bin medians :math:`(T_j, v_j)`:
+
+    .. math:: \min_X \sum_j \Big(v_j - \sum_{k=0}^{n} X_k (T_j - T_{ref})^k\Big)^2
+
+    References
+    ----------
+    - PX4 ``Tools/process_sensor_caldata.py`` and
+      ``src/modules/sensors/temperature_compensation/TemperatureCompensation.cpp``.
+    """
     kind, fields, unit = OFFSET_TOPICS[topic]
     order = FORMATS["px4"].sensors[kind].order
     where = f"{topic}.{instance}"
@@ -141,7 +184,18 @@ def fit_offset_sensor(
 
 
 def offset_summary(fits: Sequence[OffsetFit]) -> dict[str, Any]:
-    """The JSON summary of the barometers and magnetometers (as :func:`summary`)."""
+    """The JSON summary of the barometers and magnetometers.
+
+    Parameters
+    ----------
+    fits : sequence of OffsetFit
+        The fitted sensors.
+
+    Returns
+    -------
+    dict
+        ``TOPIC.N`` → the fields of :class:`OffsetFit` plus ``holdout_rms_unit``.
+    """
     return {
         f"{f.topic}.{f.instance}": {**dataclasses.asdict(f), "holdout_rms_unit": f.unit}
         for f in fits
