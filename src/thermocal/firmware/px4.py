@@ -68,6 +68,10 @@ class Px4Fit:
         \\Delta T = \\operatorname{clamp}(T, T_\\mathrm{min}, T_\\mathrm{max}) - T_\\mathrm{ref}
 
     (``TemperatureCompensation::apply``).
+
+    References
+    ----------
+    - PX4 ``src/modules/sensors/temperature_compensation/TemperatureCompensation.cpp``.
     """
 
     kind: str
@@ -219,6 +223,11 @@ def binned_polynomial(
     coefficients minimise :math:`\\sum_b (\\tilde v_b - \\sum_k c_k (\\tilde T_b -
     T_\\mathrm{ref})^k)^2` (``numpy.polynomial.polynomial.polyfit``), as PX4's script fits
     its bin means with ``numpy.polyfit``.
+
+    References
+    ----------
+    - PX4 ``Tools/process_sensor_caldata.py`` (binned polynomial fit).
+    - G. H. Golub and C. F. Van Loan, *Matrix Computations*, 4th ed., 2013 (least squares).
     """
     temp, vals = _checked(temperature_c, values)
     _c, t_med, v_med = temperature_bins(temp, vals, bin_width_c)

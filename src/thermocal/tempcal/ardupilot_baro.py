@@ -116,7 +116,12 @@ class ArdupilotBaroFit:
     """``TCAL_BARO_EXP`` of barometer ``instance`` (the firmware corrects instance 0 only):
     the sweep [°C], samples and bins, the exponent, the rms of the bin medians about their
     mean before and after the correction [Pa], the hold-out rms [Pa], whether the exponent
-    is at a limit of :data:`EXP_LIMITS` (the model does not fit this barometer)."""
+    is at a limit of :data:`EXP_LIMITS` (the model does not fit this barometer).
+
+    References
+    ----------
+    - ArduPilot ``libraries/AP_TempCalibration/AP_TempCalibration.cpp``.
+    """
 
     instance: int
     sweep_c: tuple[float, float]
