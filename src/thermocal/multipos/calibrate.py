@@ -54,7 +54,7 @@ is not a sensor's: a wrong unit, count scale or pose is warned of (the turns' ow
 ACCEL_RESIDUAL_REFUSED = 0.05
 """The accelerometer's gravity-magnitude residual rms after calibration, as a fraction of
 local gravity, beyond which the fit failed (50 mg: a hand-held MPU-6050 leaves 12 mg,
-imucal's session 1.1 mg, a simulated one 0.07 mg); refused, as a residual no smaller than
+imucal's example recording 1.1 mg, a simulated one 0.07 mg); refused, as a residual no smaller than
 before the calibration."""
 
 GYRO_DIRECTION_REFUSED_DEG = 10.0
