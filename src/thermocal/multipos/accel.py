@@ -85,7 +85,18 @@ class AccelFit:
         return model.error_matrices(self.theta)
 
     def correct(self, f_mg: npt.ArrayLike) -> FloatArray:
-        """``(I + E)⁻¹ (f − b)`` [mg] of specific forces (…, 3) [mg]."""
+        """``(I + E)⁻¹ (f − b)`` [mg] of specific forces (…, 3) [mg].
+
+        Parameters
+        ----------
+        f_mg : array_like, shape (..., 3)
+            Raw specific force [mg].
+
+        Returns
+        -------
+        numpy.ndarray, shape (..., 3)
+            Compensated specific force [mg].
+        """
         f = np.asarray(f_mg, dtype=np.float64)
         out = np.linalg.solve(np.eye(3) + self.error_matrix, (f - self.theta[0:3]).T).T
         return np.asarray(out, dtype=np.float64)
@@ -141,7 +152,24 @@ _FREE_FACTOR = np.array([1.0, 1.0, 1.0] + [1e-3 / units.PPM] * 3 + [1e-3 * units
 
 def distinct_directions(f_mg: FloatArray) -> list[FloatArray]:
     """The unit gravity directions of the poses ``f_mg`` (n, 3) [mg], each more than
-    :data:`DISTINCT_DEG` from those kept before it (in pose order)."""
+    :data:`DISTINCT_DEG` from those kept before it (in pose order).
+
+    Parameters
+    ----------
+    f_mg : numpy.ndarray, shape (n, 3)
+        The poses' mean specific force [mg].
+
+    Returns
+    -------
+    list of numpy.ndarray, shape (3,)
+        The distinct unit directions.
+
+    Examples
+    --------
+    >>> f = np.array([[0, 0, 1000.0], [0, 1.0, 1000.0], [1000.0, 0, 0]])
+    >>> len(distinct_directions(f))
+    2
+    """
     u = f_mg / np.linalg.norm(f_mg, axis=1)[:, None]
     distinct: list[FloatArray] = []
     for v in u:
@@ -169,7 +197,18 @@ def _six_faces_hint(u: FloatArray) -> str:
 def check_poses(f_mg: FloatArray) -> None:
     """Refuse poses that cannot determine the nine parameters: fewer than nine distinct
     gravity directions, or directions all near one plane (a scale factor or a bias along
-    the plane's normal is then unseen)."""
+    the plane's normal is then unseen).
+
+    Parameters
+    ----------
+    f_mg : numpy.ndarray, shape (n, 3)
+        The poses' mean specific force [mg].
+
+    Raises
+    ------
+    thermocal.errors.DesignError
+        Too few distinct directions, or all near one plane.
+    """
     distinct = distinct_directions(f_mg)
     if len(distinct) < MIN_POSES:
         raise DesignError(
@@ -208,7 +247,31 @@ def _solve(f: FloatArray, sg: FloatArray, g_mg: float, p0: FloatArray) -> Any:
 
 def misfit_tau(r_mg: FloatArray, sigma_mg: FloatArray, dof: int) -> float:
     """``τ ≥ 0`` [mg] with ``Σ r_k²/(σ_k² + τ²) = dof`` (0 when already below): the root of
-    a decreasing function, by bisection on ``τ²`` in ``[0, Σ r²/dof]``."""
+    a decreasing function, by bisection on ``τ²`` in ``[0, Σ r²/dof]``.
+
+    Parameters
+    ----------
+    r_mg : numpy.ndarray
+        Residuals [mg].
+    sigma_mg : numpy.ndarray
+        Their σ [mg].
+    dof : int
+        Degrees of freedom.
+
+    Returns
+    -------
+    float
+        τ [mg].
+
+    Notes
+    -----
+    .. math:: \\sum_k \\frac{r_k^2}{\\sigma_k^2 + \\tau^2} = \\mathrm{dof}
+
+    Examples
+    --------
+    >>> round(misfit_tau(np.full(4, 5.0), np.full(4, 3.0), 4), 3)  # √(25 − 9)
+    4.0
+    """
     r2 = r_mg**2
     s2 = sigma_mg**2
 
@@ -435,6 +498,7 @@ def fit_six_faces(
 
 
 def to_dict(fit: AccelFit) -> dict[str, Any]:
+    """An accelerometer fit as a JSON-ready dict (biases [mg], ppm, arcsec, with σ)."""
     s = fit.sigma
     return {
         "method": fit.method,

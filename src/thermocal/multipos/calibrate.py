@@ -54,7 +54,7 @@ is not a sensor's: a wrong unit, count scale or pose is warned of (the turns' ow
 ACCEL_RESIDUAL_REFUSED = 0.05
 """The accelerometer's gravity-magnitude residual rms after calibration, as a fraction of
 local gravity, beyond which the fit failed (50 mg: a hand-held MPU-6050 leaves 12 mg,
-imucal's session 1.1 mg, a simulated one 0.07 mg); refused, as a residual no smaller than
+imucal's example recording 1.1 mg, a simulated one 0.07 mg); refused, as a residual no smaller than
 before the calibration."""
 
 GYRO_DIRECTION_REFUSED_DEG = 10.0
@@ -67,7 +67,22 @@ def check_accel_fit(acc: _accel.AccelFit, g_mg: float, where: str) -> None:
     """Refuse (:class:`~thermocal.errors.DesignError`, exit 2) an accelerometer fit that
     fails its own checks, before anything is written: a scale factor beyond
     :data:`SCALE_FACTOR_REFUSED`, a gravity-magnitude residual rms after calibration above
-    :data:`ACCEL_RESIDUAL_REFUSED` × ``g`` or not below the one before (``g_mg`` [mg])."""
+    :data:`ACCEL_RESIDUAL_REFUSED` × ``g`` or not below the one before (``g_mg`` [mg]).
+
+    Parameters
+    ----------
+    acc : AccelFit
+        The accelerometer fit.
+    g_mg : float
+        Local gravity [mg] (1000 mg = 1 g).
+    where : str
+        The session's name in the message.
+
+    Raises
+    ------
+    thermocal.errors.DesignError
+        A scale factor beyond ±50 %, or a residual too large or not reduced.
+    """
     bad = model.scale_factors_beyond(acc.theta)
     if bad:
         raise DesignError(
@@ -92,7 +107,20 @@ def check_gyro_fit(gfit: _gyro.GyroFit, where: str) -> None:
     """Refuse (:class:`~thermocal.errors.DesignError`, exit 2) a gyro fit that fails its own
     checks, before anything is written: a scale factor beyond :data:`SCALE_FACTOR_REFUSED`,
     or a direction residual rms over the motions after calibration above
-    :data:`GYRO_DIRECTION_REFUSED_DEG` or not below the one before."""
+    :data:`GYRO_DIRECTION_REFUSED_DEG` or not below the one before.
+
+    Parameters
+    ----------
+    gfit : GyroFit
+        The gyro fit.
+    where : str
+        The session's name in the message.
+
+    Raises
+    ------
+    thermocal.errors.DesignError
+        A scale factor beyond ±50 %, or a direction residual [°] too large or not reduced.
+    """
     bad = model.scale_factors_beyond(gfit.theta)
     if bad:
         raise DesignError(
@@ -144,6 +172,35 @@ def _white_sigma(x: FloatArray) -> FloatArray:
 def pose_stats(
     accel_mg: FloatArray, gyro_rad_s: FloatArray | None, sections: Sequence[Section]
 ) -> list[PoseStats]:
+    """Mean and white-noise σ of each static pose.
+
+    Parameters
+    ----------
+    accel_mg : numpy.ndarray, shape (n, 3)
+        Specific force [mg].
+    gyro_rad_s : numpy.ndarray, shape (n, 3), optional
+        Rates [rad/s].
+    sections : sequence of Section
+        The static poses.
+
+    Returns
+    -------
+    list of PoseStats
+
+    Notes
+    -----
+    The per-sample white-noise σ from first differences:
+
+    .. math:: \\sigma^2 = \\tfrac12 \\langle (x_{i+1} - x_i)^2 \\rangle
+
+    Examples
+    --------
+    >>> from thermocal.multipos.poses import Section
+    >>> f = np.random.default_rng(0).normal(0.0, 2.0, (20000, 3)) + [0.0, 0.0, 1000.0]
+    >>> st = pose_stats(f, None, [Section("pose_1", 0, 20000)])[0]
+    >>> round(float(st.f_mean_mg[2])), [round(float(v), 1) for v in st.f_sigma_mg]
+    (1000, [2.0, 2.0, 2.0])
+    """
     out = []
     for s in sections:
         f = accel_mg[s.start : s.end]
@@ -631,7 +688,33 @@ def gravity_errors(
 ) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
     """Per pose: |mean f| − g before and after, and that error along each axis,
     ``(|m| − g)·m/|m|`` (for the table: the axes' rms over poses add in quadrature to the
-    total's, before as after), all in the unit of ``f``."""
+    total's, before as after), all in the unit of ``f``.
+
+    Parameters
+    ----------
+    f_before, f_after : numpy.ndarray, shape (n, 3)
+        Specific force before and after calibration [any unit, e.g. mg].
+    sections : sequence of Section
+        The static poses.
+    g : float
+        Local gravity in the same unit.
+
+    Returns
+    -------
+    err_before, err_after : numpy.ndarray, shape (P,)
+        :math:`|\\bar f| - g` per pose.
+    axes_before, axes_after : numpy.ndarray, shape (P, 3)
+        That error along each axis.
+
+    Notes
+    -----
+    .. math:: e = |m| - g, \\qquad e_\\mathrm{axes} = e \\, m / |m|
+
+    References
+    ----------
+    - D. Tedaldi, A. Pretto and E. Menegatti, "A robust and easy to implement method for
+      IMU calibration without external equipments", Proc. IEEE ICRA 2014, 3042–3049.
+    """
     mb = np.asarray([f_before[s.start : s.end].mean(axis=0) for s in sections])
     ma = np.asarray([f_after[s.start : s.end].mean(axis=0) for s in sections])
     nb, na = np.linalg.norm(mb, axis=1), np.linalg.norm(ma, axis=1)
@@ -644,7 +727,33 @@ def rotation_errors(
 ) -> FloatArray:
     """Per motion between consecutive poses, the direction error vector
     ``u_{k+1} × (A_{k+1}ᵀ A_k⁻ᵀ u_k)`` [rad] (its norm is the rotation-angle error),
-    ``f`` the specific force that gives the up directions."""
+    ``f`` the specific force that gives the up directions.
+
+    Parameters
+    ----------
+    rate_rad_s : numpy.ndarray, shape (n, 3)
+        Calibrated body rates [rad/s].
+    dt_s : numpy.ndarray, shape (n,)
+        Sample intervals [s].
+    f : numpy.ndarray, shape (n, 3)
+        Specific force [any unit].
+    sections : sequence of Section
+        The static poses, in time order.
+
+    Returns
+    -------
+    numpy.ndarray, shape (P − 1, 3)
+        Direction error per motion [rad].
+
+    Notes
+    -----
+    .. math:: \\varepsilon_k = u_{k+1} \\times (A_{k+1}^\\mathsf{T} A_k^{-\\mathsf{T}} u_k)
+
+    References
+    ----------
+    - D. Tedaldi, A. Pretto and E. Menegatti, "A robust and easy to implement method for
+      IMU calibration without external equipments", Proc. IEEE ICRA 2014, 3042–3049.
+    """
     out = []
     for p0, p1 in itertools.pairwise(sections):
         sl = slice(p0.start, p1.end)

@@ -120,7 +120,22 @@ class Turn:
 def turn_intervals(dt_s: FloatArray, section: Section, dt_med: float) -> FloatArray:
     """τ [s] of a turn's samples: their forward intervals, the last one the median
     interval ``dt_med`` when a gap follows the turn (sections recorded apart, imucal's
-    annotated sessions); a gap inside a turn is refused before (:func:`turn_gap`)."""
+    annotated sessions); a gap inside a turn is refused before (:func:`turn_gap`).
+
+    Parameters
+    ----------
+    dt_s : numpy.ndarray, shape (n,)
+        Sample intervals [s].
+    section : Section
+        The turn's samples.
+    dt_med : float
+        The median interval [s].
+
+    Returns
+    -------
+    numpy.ndarray
+        τ of each of the turn's samples [s].
+    """
     tau: FloatArray = dt_s[section.start : section.end].copy()
     if tau.size and tau[-1] > GAP_FACTOR * dt_med:
         tau[-1] = dt_med
@@ -129,7 +144,22 @@ def turn_intervals(dt_s: FloatArray, section: Section, dt_med: float) -> FloatAr
 
 def turn_gap(dt_s: FloatArray, section: Section, dt_med: float) -> tuple[int, float] | None:
     """The first gap in time inside a turn (interval above ``GAP_FACTOR × dt_med``): the
-    sample before it and its length [s]; None without one."""
+    sample before it and its length [s]; None without one.
+
+    Parameters
+    ----------
+    dt_s : numpy.ndarray, shape (n,)
+        Sample intervals [s].
+    section : Section
+        The turn's samples.
+    dt_med : float
+        The median interval [s].
+
+    Returns
+    -------
+    tuple of (int, float) or None
+        Index of the sample before the gap and the gap's length [s].
+    """
     inside = dt_s[section.start : section.end - 1]
     big = np.flatnonzero(inside > GAP_FACTOR * dt_med)
     return None if big.size == 0 else (section.start + int(big[0]), float(inside[big[0]]))
@@ -294,7 +324,32 @@ def static_bias(
 ) -> tuple[FloatArray, FloatArray]:
     """Gyro bias [rad/s] and its covariance from the static poses (module docstring):
     ``rate_means`` (m, 3), ``n_samples`` (m,), per-sample white noise σ (3,), ``up`` (m, 3)
-    unit up directions in body axes."""
+    unit up directions in body axes.
+
+    Parameters
+    ----------
+    rate_means_rad_s : numpy.ndarray, shape (m, 3)
+        Mean rate of each static pose [rad/s].
+    n_samples : numpy.ndarray, shape (m,)
+        Samples per pose.
+    rate_sigma_rad_s : numpy.ndarray, shape (3,)
+        Per-sample white-noise σ [rad/s].
+    up : numpy.ndarray, shape (m, 3)
+        Unit up direction of each pose in body axes.
+    latitude_deg : float or None
+        Latitude [°] for the earth rate's vertical component; None: not removed.
+
+    Returns
+    -------
+    bias, cov : numpy.ndarray
+        Bias (3,) [rad/s] and its covariance (3, 3) [rad²/s²].
+
+    References
+    ----------
+    - F. Ferraris, U. Grimaldi and M. Parvis, "Procedure for effortless in-field
+      calibration of three-axis rate gyros and accelerometers", *Sensors and Materials*
+      7(5), 311–330, 1995.
+    """
     w = n_samples / n_samples.sum()
     om = units.EARTH_RATE_RAD_S
     b = (w[:, None] * rate_means_rad_s).sum(axis=0)
@@ -365,7 +420,20 @@ def _motions(
 def unsaturated(motions: list[_Motion], saturated: npt.NDArray[np.bool_] | None) -> list[_Motion]:
     """The motions with no sample on the gyro's rails between pose k's start and pose
     k+1's end (``saturated`` per sample, None: none): the rotation across a clipped rate is
-    unknown, as across a gap in time."""
+    unknown, as across a gap in time.
+
+    Parameters
+    ----------
+    motions : list of _Motion
+        The motions between poses.
+    saturated : numpy.ndarray of bool, shape (n,), optional
+        Per sample, a rate on the rails.
+
+    Returns
+    -------
+    list of _Motion
+        The motions with no saturated sample.
+    """
     if saturated is None:
         return motions
     return [m for m in motions if not np.any(saturated[m.start : m.stop])]

@@ -36,7 +36,15 @@ TREF_TRUTH_C = 25.0
 
 @dataclass(frozen=True)
 class Truth:
-    """True θ of both triads at a temperature (units of :mod:`thermocal.turntable.thermal`)."""
+    """True θ of both triads at a temperature (units of :mod:`thermocal.turntable.thermal`).
+
+    Attributes
+    ----------
+    accel : numpy.ndarray, shape (12,)
+        Accelerometer θ: biases [mg], scale factors [ppm], misalignments [arcsec].
+    gyro : numpy.ndarray, shape (12,)
+        Gyro θ: biases [°/h], scale factors [ppm], misalignments [arcsec].
+    """
 
     accel: FloatArray
     gyro: FloatArray
@@ -44,7 +52,24 @@ class Truth:
 
 def random_truth(rng: np.random.Generator) -> tuple[Truth, Truth]:
     """θ₀ and the slope θ₁ [per °C] of a consumer MEMS IMU.  Accelerometer misalignments
-    lower triangular (the accelerometer frame is the body frame)."""
+    lower triangular (the accelerometer frame is the body frame).
+
+    Parameters
+    ----------
+    rng : numpy.random.Generator
+        The random source.
+
+    Returns
+    -------
+    theta0, theta1 : Truth
+        θ at 25 °C and its slope per °C (units of :class:`Truth`, per °C for the slope).
+
+    Examples
+    --------
+    >>> t0, t1 = random_truth(np.random.default_rng(0))
+    >>> t0.gyro.shape, bool(abs(t0.accel[0]) <= 40), float(t1.gyro[6])
+    ((12,), True, 0.0)
+    """
     a0 = np.zeros(12)
     a0[0:3] = rng.uniform(-40, 40, 3)  # mg
     a0[3:6] = rng.uniform(-8000, 8000, 3)  # ppm
@@ -90,7 +115,47 @@ def simulate_session(
 ) -> dict[str, Any]:
     """One session (module docstring): ``time_s``, ``accel_mg`` (n, 3), ``gyro_deg_s``
     (n, 3), the true ``attitude`` (n, 3, 3, body → local), ``poses`` (start, end) of the
-    still windows and ``g_m_s2``."""
+    still windows and ``g_m_s2``.
+
+    Parameters
+    ----------
+    rng : numpy.random.Generator
+        The random source (poses, durations, noise).
+    accel_theta, gyro_theta : numpy.ndarray, shape (12,)
+        True θ of the accelerometer (mg, ppm, arcsec) and the gyro (°/h, ppm, arcsec).
+    n_poses : int, default 16
+        Number of still poses, drawn uniformly on SO(3).
+    rate_hz : float, default 100.0
+        Sample rate [Hz].
+    dwell_s, move_s : float, default 5.0, 2.0
+        Mean still time per pose and mean move time [s] (each ± 30 %).
+    accel_noise_mg, gyro_noise_deg_s : float, default 2.0, 0.03
+        White-noise σ per sample [mg], [°/s].
+    tremor_deg : float, default 0.003
+        Amplitude of the hand's tremor while still [°].
+    latitude_deg : float, default 45.0
+        Latitude for the earth rate [°].
+    max_angle_deg : float, default 170.0
+        Largest rotation between consecutive poses [°] (the smallest is 30°).
+
+    Returns
+    -------
+    dict
+        ``time_s`` [s], ``accel_mg`` [mg], ``gyro_deg_s`` [°/s], ``attitude``, ``poses``
+        (sample index pairs), ``g_m_s2`` [m/s²].
+
+    References
+    ----------
+    - D. Tedaldi, A. Pretto and E. Menegatti, "A robust and easy to implement method for
+      IMU calibration without external equipments", Proc. IEEE ICRA 2014, 3042–3049.
+
+    Examples
+    --------
+    >>> th = np.zeros(12)
+    >>> s = simulate_session(np.random.default_rng(0), th, th, n_poses=4, rate_hz=20.0)
+    >>> len(s["poses"]), s["accel_mg"].shape[1]
+    (4, 3)
+    """
     cs = [_random_rotation(rng)]
     while len(cs) < n_poses:
         c = _random_rotation(rng)
@@ -119,7 +184,32 @@ def simulate_attitudes(
 ) -> dict[str, Any]:
     """A session through the given still ``attitudes`` (body → local ENU rotations, each
     move shorter than a half turn), as :func:`simulate_session` (which draws them at
-    random): for a held-out turn of a known angle."""
+    random): for a held-out turn of a known angle.
+
+    Parameters
+    ----------
+    rng : numpy.random.Generator
+        The random source (durations, tremor, noise).
+    attitudes : list of numpy.ndarray, shape (3, 3)
+        The still poses, body → local ENU.
+    accel_theta, gyro_theta : numpy.ndarray, shape (12,)
+        True θ of the accelerometer (mg, ppm, arcsec) and the gyro (°/h, ppm, arcsec).
+    rate_hz : float, default 100.0
+        Sample rate [Hz].
+    dwell_s, move_s : float, default 5.0, 2.0
+        Mean still time per pose and mean move time [s] (each ± 30 %).
+    accel_noise_mg, gyro_noise_deg_s : float, default 2.0, 0.03
+        White-noise σ per sample [mg], [°/s].
+    tremor_deg : float, default 0.003
+        Amplitude of the hand's tremor while still [°].
+    latitude_deg : float, default 45.0
+        Latitude for the earth rate [°].
+
+    Returns
+    -------
+    dict
+        As :func:`simulate_session`.
+    """
     spec = _Spec(rate_hz, dwell_s, move_s, tremor_deg, 6.0)
     w_nb, poses, _turns = _body_rates(rng, attitudes, {}, spec)
     return _measure(rng, attitudes[0], w_nb, poses, accel_theta, gyro_theta,
@@ -143,7 +233,32 @@ after its face."""
 
 def face_rotation(face: str, heading_rad: float = 0.0) -> FloatArray:
     """Body → local (ENU) rotation of a face (``x_p``: body x up, ``x_a``: body x down…),
-    turned by ``heading_rad`` about the vertical."""
+    turned by ``heading_rad`` about the vertical.
+
+    Parameters
+    ----------
+    face : str
+        ``x_p``, ``x_a``, ``y_p``, ``y_a``, ``z_p`` or ``z_a`` (the body axis pointing up,
+        ``_p``, or down, ``_a``).
+    heading_rad : float, default 0.0
+        Turn about the local vertical [rad].
+
+    Returns
+    -------
+    numpy.ndarray, shape (3, 3)
+        The rotation matrix C_b^n.
+
+    References
+    ----------
+    - F. Ferraris, U. Grimaldi and M. Parvis, "Procedure for effortless in-field
+      calibration of three-axis rate gyros and accelerometers", *Sensors and Materials*
+      7(5), 311–330, 1995.
+
+    Examples
+    --------
+    >>> (face_rotation("x_p") @ [1.0, 0.0, 0.0]).round(3).tolist()  # body x up
+    [0.0, 0.0, 1.0]
+    """
     from thermocal.multipos.geometry import rotvec_to_matrix
 
     axis = np.eye(3)["xyz".index(face[0])] * (1.0 if face.endswith("_p") else -1.0)
@@ -187,7 +302,47 @@ def simulate_ferraris(
     (a box not flat against its guide, a hand's wobble).  As
     :func:`simulate_session`, plus ``sections``: the POSES file's object
     ``{name: {"start": i, "end": j}}`` (faces and turns); ``poses`` lists every still
-    window (with the faces-then-turns order, the three before the turns too)."""
+    window (with the faces-then-turns order, the three before the turns too).
+
+    Parameters
+    ----------
+    rng : numpy.random.Generator
+        The random source.
+    accel_theta, gyro_theta : numpy.ndarray, shape (12,)
+        True θ of the accelerometer (mg, ppm, arcsec) and the gyro (°/h, ppm, arcsec).
+    turn_s : float, default 6.0
+        Duration of each 360° turn [s].
+    turn_tilt_deg : float, default 0.0
+        Tilt of each turn's axis from the vertical [°].
+    order : {"faces-then-turns", "turn-after-face"}
+        The recording order.
+    rate_hz : float, default 100.0
+        Sample rate [Hz].
+    dwell_s, move_s : float, default 5.0, 2.0
+        Mean still time per pose and mean move time [s] (each ± 30 %).
+    accel_noise_mg, gyro_noise_deg_s : float, default 2.0, 0.03
+        White-noise σ per sample [mg], [°/s].
+    tremor_deg : float, default 0.003
+        Amplitude of the hand's tremor while still [°].
+    latitude_deg : float, default 45.0
+        Latitude for the earth rate [°].
+
+    Returns
+    -------
+    dict
+        As :func:`simulate_session`, plus ``sections``.
+
+    Raises
+    ------
+    ValueError
+        ``order`` not in :data:`FERRARIS_ORDERS`.
+
+    References
+    ----------
+    - F. Ferraris, U. Grimaldi and M. Parvis, "Procedure for effortless in-field
+      calibration of three-axis rate gyros and accelerometers", *Sensors and Materials*
+      7(5), 311–330, 1995.
+    """
     if order not in FERRARIS_ORDERS:
         raise ValueError(f"order must be one of {FERRARIS_ORDERS}, got {order!r}")
     faces = ["x_p", "y_p", "z_p", "x_a", "y_a", "z_a"]  # no face after its opposite
@@ -342,6 +497,25 @@ GYRO_COLUMNS = ("gyro_x", "gyro_y", "gyro_z")
 TEMPERATURE_COLUMN = "T_imu"
 
 
+def _recording(
+    s: dict[str, Any], tc: float, rate_hz: float, latitude_deg: float
+) -> tuple[Any, FloatArray]:
+    """One simulated session as a Recording (m/s², °/s, drifting ``T_imu``) and its temperature."""
+    from thermocal.recording import Metadata, Recording
+
+    n = s["time_s"].size
+    temp = tc + 0.2 * np.sin(np.linspace(0, np.pi, n))
+    acc = s["accel_mg"] * MG_M_S2
+    sig = {c: acc[:, k] for k, c in enumerate(ACCEL_COLUMNS)}
+    sig |= {c: s["gyro_deg_s"][:, k] for k, c in enumerate(GYRO_COLUMNS)}
+    unit = {c: "m/s^2" for c in ACCEL_COLUMNS} | {c: "deg/s" for c in GYRO_COLUMNS}
+    rec = Recording.from_arrays(
+        s["time_s"], sig, {TEMPERATURE_COLUMN: temp}, signal_unit=unit,
+        meta=Metadata(latitude_deg=latitude_deg, sample_interval_s=1.0 / rate_hz),
+    )  # fmt: skip
+    return rec, temp
+
+
 def simulate_runs(
     seed_rngs: list[np.random.Generator],
     *,
@@ -361,9 +535,33 @@ def simulate_runs(
     ``held-out``, at the first temperature (several runs: midway between the first two),
     for validation.  With ``turns`` every session but the held-out one is a Ferraris
     session (:func:`simulate_ferraris`: the six faces and three 360° turns, one the other
-    way), its truth carrying ``sections``, the POSES file's object for ``--poses``."""
-    from thermocal.recording import Metadata, Recording
+    way), its truth carrying ``sections``, the POSES file's object for ``--poses``.
 
+    Parameters
+    ----------
+    seed_rngs : list of numpy.random.Generator
+        Two generators: the truth's and the sessions'.
+    runs : int, default 1
+        Number of sessions (temperatures) besides the held-out one.
+    rate_hz, latitude_deg : float, default 100.0, 45.0
+        Sample rate [Hz] and latitude [°].
+    n_poses : int, default 16
+        Poses per random session.
+    temperatures_c : tuple of float, optional
+        The sessions' temperatures [°C] (default as above).
+    held_out, turns : bool, default True, False
+        Add the held-out session; record Ferraris sessions.
+
+    Returns
+    -------
+    list of (Recording, dict)
+        Each session and its truth.
+
+    Raises
+    ------
+    ValueError
+        ``runs`` below 1.
+    """
     if runs < 1:
         raise ValueError("runs must be at least 1")
     truth0, slope = random_truth(seed_rngs[0])
@@ -384,16 +582,7 @@ def simulate_runs(
         else:
             s = simulate_session(rng, ta, tg, n_poses=n_poses, rate_hz=rate_hz,
                                  latitude_deg=latitude_deg)  # fmt: skip
-        n = s["time_s"].size
-        temp = tc + 0.2 * np.sin(np.linspace(0, np.pi, n))
-        acc = s["accel_mg"] * MG_M_S2
-        sig = {c: acc[:, k] for k, c in enumerate(ACCEL_COLUMNS)}
-        sig |= {c: s["gyro_deg_s"][:, k] for k, c in enumerate(GYRO_COLUMNS)}
-        unit = {c: "m/s^2" for c in ACCEL_COLUMNS} | {c: "deg/s" for c in GYRO_COLUMNS}
-        rec = Recording.from_arrays(
-            s["time_s"], sig, {TEMPERATURE_COLUMN: temp}, signal_unit=unit,
-            meta=Metadata(latitude_deg=latitude_deg, sample_interval_s=1.0 / rate_hz),
-        )  # fmt: skip
+        rec, temp = _recording(s, tc, rate_hz, latitude_deg)
         label = "held-out" if is_held else f"T{tc:+.0f}"
         out.append(
             (

@@ -200,7 +200,45 @@ def estimate_arw(
 ) -> FloatArray:
     """Angle random walk of each gyro [rad/√s] from the scatter at rest:
     ``N² = τ · Σ_d Σ_i (g_i − ḡ_d)² / Σ_d (n_d − 1)`` over the dwells (white rate noise
-    of the mean rate over τ has variance N²/τ; IEEE Std 952 annex C)."""
+    of the mean rate over τ has variance N²/τ; IEEE Std 952 annex C).
+
+    Parameters
+    ----------
+    gyro_rad_s : numpy.ndarray, shape (n, 3)
+        Gyro mean rates per interval [rad/s] (row 0 unused).
+    dt_s : numpy.ndarray, shape (n − 1,)
+        Interval lengths τ [s].
+    dwells : sequence of Dwell
+        The dwells (:func:`.schedule.segment`).
+
+    Returns
+    -------
+    numpy.ndarray, shape (3,)
+        N of each gyro [rad/√s].
+
+    Raises
+    ------
+    thermocal.errors.ThermocalInputError
+        No dwell of two samples or more.
+
+    Notes
+    -----
+    .. math:: N^2 = \\tau \\, \\frac{\\sum_d \\sum_i (g_i - \\bar g_d)^2}{\\sum_d (n_d - 1)}
+
+    References
+    ----------
+    - IEEE Std 952-1997, *IEEE Standard Specification Format Guide and Test Procedure for
+      Single-Axis Interferometric Fiber Optic Gyros*, Annex C.
+
+    Examples
+    --------
+    >>> from thermocal.turntable.schedule import Dwell
+    >>> rng = np.random.default_rng(0)
+    >>> g = rng.normal(0.0, 1e-3 / np.sqrt(0.01), (100001, 3))  # N = 1e-3 rad/√s at 100 Hz
+    >>> d = Dwell(0, 100000, 0.0, 1000.0, 0.0, 0.0)
+    >>> [round(float(v) * 1e3, 2) for v in estimate_arw(g, np.full(100000, 0.01), [d])]
+    [1.0, 1.0, 1.0]
+    """
     ss = np.zeros(3)
     dof = 0
     tau = []
@@ -226,7 +264,25 @@ def weak_combinations(
     The earth rate gives about ``info_static / static_fraction`` over the whole run
     (``static_fraction`` the share of time at rest); a coefficient whose total
     information (diagonal) is less than ``ratio`` times that owes nothing to the
-    rotations.  Static data alone separate such terms only to hundreds of ppm or ″."""
+    rotations.  Static data alone separate such terms only to hundreds of ppm or ″.
+
+    Parameters
+    ----------
+    info : numpy.ndarray, shape (12, 12)
+        Fisher information of θ from the whole run [1/unit²].
+    info_static : numpy.ndarray, shape (12, 12)
+        The same from the dwells only.
+    static_fraction : float
+        Share of the run's time at rest (0…1).
+    ratio : float, default 10.0
+        Least gain of the whole run over the earth rate alone.
+
+    Returns
+    -------
+    tuple of dict
+        One entry per weak coefficient: ``combination``, ``status``,
+        ``information_over_earth_rate_only``.
+    """
     out = []
     earth = np.diag(info_static) / max(static_fraction, 1e-12)
     d_all = np.diag(info)
@@ -260,7 +316,30 @@ def inner_axis_azimuth_deg(theta: npt.ArrayLike) -> float:
     error matrix holds: ``I + E ≈ R_z(ψ)(I + E')`` with ``E'`` small, so
     ``ψ = atan2(E₁₀ − E₀₁, 2 + E₀₀ + E₁₁)`` (exact for a pure rotation ``E = R_z(ψ) − I``:
     ``E₀₀ = E₁₁ = cos ψ − 1``, ``E₁₀ = −E₀₁ = sin ψ``).  Positive: the α encoder reads ψ
-    more than the geometry's α (the body turned by +ψ about z)."""
+    more than the geometry's α (the body turned by +ψ about z).
+
+    Parameters
+    ----------
+    theta : array_like, shape (12,)
+        θ (scale factors [ppm], misalignments [arcsec]).
+
+    Returns
+    -------
+    float
+        ψ [°].
+
+    Notes
+    -----
+    .. math:: \\psi = \\operatorname{atan2}(E_{10} - E_{01},\\ 2 + E_{00} + E_{11})
+
+    Examples
+    --------
+    >>> from thermocal.turntable.model import coeffs_from_error_matrix
+    >>> c, s_ = np.cos(np.radians(2.0)), np.sin(np.radians(2.0))
+    >>> e = np.array([[c - 1, -s_, 0], [s_, c - 1, 0], [0, 0, 0]])
+    >>> round(inner_axis_azimuth_deg(coeffs_from_error_matrix(e, np.zeros(3))), 6)
+    2.0
+    """
     e = model.error_matrices(np.asarray(theta, dtype=np.float64))
     return float(np.degrees(np.arctan2(e[1, 0] - e[0, 1], 2.0 + e[0, 0] + e[1, 1])))
 
@@ -665,7 +744,27 @@ def encoder_deg(rec: Recording, column: str, unit: str | None = None) -> FloatAr
     """An encoder angle column in [°]: its unit resolved like every column's
     (:func:`thermocal.units.resolve_unit`, role ``angle``: ``unit`` (``--encoder-unit``) >
     the file's metadata > the unit in the column's name > ° with a warning), then
-    ``θ[°] = θ[unit] · ANGLE_UNITS[unit]``."""
+    ``θ[°] = θ[unit] · ANGLE_UNITS[unit]``.
+
+    Parameters
+    ----------
+    rec : Recording
+        The turntable run.
+    column : str
+        The encoder column's name.
+    unit : str, optional
+        Its unit (``deg``, ``rad``, ``arcsec``…), overriding the file's.
+
+    Returns
+    -------
+    numpy.ndarray, shape (n,)
+        The angle [°].
+
+    Raises
+    ------
+    thermocal.errors.ThermocalInputError
+        An unknown unit.
+    """
     resolved = units.resolve_unit(
         column, "angle", option=unit, metadata=rec.units.get(column) or None, where=rec.name
     )
@@ -798,7 +897,19 @@ def _accel_triad(
 
 
 def estimate_from(theta: FloatArray, cov: FloatArray) -> Estimate:
-    """Wrap θ and its covariance."""
+    """Wrap θ and its covariance.
+
+    Parameters
+    ----------
+    theta : numpy.ndarray, shape (12,)
+        θ (biases, ppm, arcsec).
+    cov : numpy.ndarray, shape (12, 12)
+        Its covariance [units²].
+
+    Returns
+    -------
+    Estimate
+    """
     return Estimate(theta=np.asarray(theta, dtype=np.float64), cov=np.asarray(cov))
 
 

@@ -42,7 +42,33 @@ def kf_predict(
     x: FloatArray, p: FloatArray, g: FloatArray, q_delta: FloatArray
 ) -> tuple[FloatArray, FloatArray]:
     """Propagate over one block: ``x ← Φ x``, ``P ← Φ P Φᵀ + Q`` with
-    ``Φ = [[I, 0], [G, I]]`` and ``Q = blockdiag(0₁₂, q_delta)``."""
+    ``Φ = [[I, 0], [G, I]]`` and ``Q = blockdiag(0₁₂, q_delta)``.
+
+    Parameters
+    ----------
+    x : numpy.ndarray, shape (12 + k,)
+        State: θ (biases [°/h], ppm, arcsec) and the k angle increments Δ [arcsec].
+    p : numpy.ndarray, shape (12 + k, 12 + k)
+        Its covariance.
+    g : numpy.ndarray, shape (k, 12)
+        The block's regressors G [arcsec per unit of θ].
+    q_delta : numpy.ndarray, shape (k, k)
+        The block's noise covariance of Δ [arcsec²].
+
+    Returns
+    -------
+    x, p : numpy.ndarray
+        The propagated state and covariance.
+
+    Notes
+    -----
+    .. math:: x \\leftarrow \\Phi x, \\quad P \\leftarrow \\Phi P \\Phi^\\mathsf{T} + Q
+
+    References
+    ----------
+    - R. E. Kalman, "A new approach to linear filtering and prediction problems", *Trans.
+      ASME J. Basic Engineering* 82(1), 35–45, 1960.
+    """
     phi = np.eye(x.size)
     phi[N_COEFFS:, :N_COEFFS] = g
     x_new = phi @ x
@@ -54,7 +80,41 @@ def kf_predict(
 def kf_update(
     x: FloatArray, p: FloatArray, z: FloatArray, h: FloatArray, r: FloatArray
 ) -> tuple[FloatArray, FloatArray, FloatArray]:
-    """Joseph-form measurement update; returns ``(x⁺, P⁺, innovation)``."""
+    """Joseph-form measurement update; returns ``(x⁺, P⁺, innovation)``.
+
+    Parameters
+    ----------
+    x, p : numpy.ndarray
+        Prior state (n,) and covariance (n, n).
+    z : numpy.ndarray, shape (k,)
+        The measurement [arcsec].
+    h : numpy.ndarray, shape (k, n)
+        Measurement matrix.
+    r : numpy.ndarray, shape (k, k)
+        Measurement noise covariance [arcsec²].
+
+    Returns
+    -------
+    x, p, innovation : numpy.ndarray
+        Posterior state and covariance, and ``z − H x`` [arcsec].
+
+    Notes
+    -----
+    .. math:: K = P H^\\mathsf{T} (H P H^\\mathsf{T} + R)^{-1}, \\quad
+              P^+ = (I - K H) P (I - K H)^\\mathsf{T} + K R K^\\mathsf{T}
+
+    References
+    ----------
+    - R. E. Kalman, "A new approach to linear filtering and prediction problems", *Trans.
+      ASME J. Basic Engineering* 82(1), 35–45, 1960.
+
+    Examples
+    --------
+    >>> x, p = np.zeros(1), np.eye(1) * 4.0
+    >>> x1, p1, _ = kf_update(x, p, np.array([1.0]), np.eye(1), np.eye(1))
+    >>> round(float(x1[0]), 3), round(float(p1[0, 0]), 3)  # K = 4/5
+    (0.8, 0.8)
+    """
     innov = z - h @ x
     s = h @ p @ h.T + r
     k = np.linalg.solve(s, h @ p).T  # K = P Hᵀ S⁻¹ (S symmetric)
@@ -66,7 +126,17 @@ def kf_update(
 
 
 def kf_restart(p: FloatArray, x: FloatArray, r: FloatArray) -> None:
-    """Reset Δ (in place) at the start of an integration: zero, covariance R."""
+    """Reset Δ (in place) at the start of an integration: zero, covariance R.
+
+    Parameters
+    ----------
+    p : numpy.ndarray, shape (12 + k, 12 + k)
+        Covariance, modified in place.
+    x : numpy.ndarray, shape (12 + k,)
+        State, modified in place.
+    r : numpy.ndarray, shape (k, k)
+        Covariance of the restarted Δ [arcsec²].
+    """
     x[N_COEFFS:] = 0.0
     p[N_COEFFS:, :] = 0.0
     p[:, N_COEFFS:] = 0.0
@@ -109,7 +179,29 @@ def run_filter(
 ) -> KalmanEstimate:
     """Run the 14-state filter over the blocks (a measurement at each block end).
 
-    ``prior_sigma`` (12) is the initial σ of the coefficients (random constants)."""
+    Parameters
+    ----------
+    blocks : Blocks
+        The summed measurement blocks.
+    prior_sigma : array_like, shape (12,)
+        Initial σ of the coefficients (random constants) [°/h, ppm, arcsec].
+    prior_mean : array_like, shape (12,), optional
+        Initial mean (default zero).
+    encoder_noise_arcsec : float, default 0.0
+        White noise of the encoder angles [arcsec].
+
+    Returns
+    -------
+    KalmanEstimate
+
+    References
+    ----------
+    - R. E. Kalman, "A new approach to linear filtering and prediction problems", *Trans.
+      ASME J. Basic Engineering* 82(1), 35–45, 1960.
+    - *A method for separating the combined error coefficients of a ring-laser gyro triad
+      based on dual-axis rotation*, Chinese invention patent CN104880182 (the 14-state
+      filter).
+    """
     ps = np.asarray(prior_sigma, dtype=np.float64).reshape(N_COEFFS)
     nc = blocks.n_channels
     n_states = N_COEFFS + nc

@@ -90,6 +90,16 @@ def scale_factors_beyond(theta: npt.ArrayLike) -> list[str]:
     theta : array_like
         The triad's parameter vector in this module's layout: ``theta[3:6]`` are the x, y,
         z scale factors [ppm].
+
+    Returns
+    -------
+    list of str
+        One ``"axis ±percent %"`` entry per scale factor beyond the limit (empty: none).
+
+    Examples
+    --------
+    >>> scale_factors_beyond([0, 0, 0, 1e3, 6e5, -2e3] + [0] * 6)
+    ['y +60 %']
     """
     sf = np.asarray(theta, dtype=np.float64)[3:6] * units.PPM
     return [f"{ax} {100 * v:+.4g} %" for ax, v in zip("xyz", sf, strict=True)
@@ -168,7 +178,31 @@ I_XY: Final = 8
 
 
 def coeffs_from_error_matrix(error_matrix: npt.ArrayLike, bias_deg_h: npt.ArrayLike) -> FloatArray:
-    """θ (12) from the error matrix E (dimensionless) and the biases b [°/h]."""
+    """The coefficient vector θ from the error matrix and the biases.
+
+    Parameters
+    ----------
+    error_matrix : array_like, shape (3, 3)
+        E (dimensionless): scale-factor errors on the diagonal, misalignments off it [rad].
+    bias_deg_h : array_like, shape (3,)
+        The biases b [°/h].
+
+    Returns
+    -------
+    numpy.ndarray, shape (12,)
+        θ: biases [°/h], scale factors [ppm], misalignments [arcsec] (:data:`COEFF_NAMES`).
+
+    References
+    ----------
+    - *A method for separating the combined error coefficients of a ring-laser gyro triad
+      based on dual-axis rotation*, Chinese invention patent CN104880182, claim 4.
+
+    Examples
+    --------
+    >>> e = np.diag([1e-6, 2e-6, 0.0])
+    >>> coeffs_from_error_matrix(e, [1.0, 2.0, 3.0])[:6].round(3).tolist()
+    [1.0, 2.0, 3.0, 1.0, 2.0, 0.0]
+    """
     e = np.asarray(error_matrix, dtype=np.float64).reshape(3, 3)
     b = np.asarray(bias_deg_h, dtype=np.float64).reshape(3)
     mis = [e[MISALIGNMENT_INDEX[n]] * units.RAD_TO_ARCSEC for n in MISALIGNMENT_NAMES]
@@ -178,7 +212,28 @@ def coeffs_from_error_matrix(error_matrix: npt.ArrayLike, bias_deg_h: npt.ArrayL
 def error_matrices(theta: npt.ArrayLike) -> FloatArray:
     """E (…, 3, 3) from θ (…, 12), stacked or not: ``E_ii = θ_{3+i}`` [ppm] · 10⁻⁶ and the
     misalignments θ_6… [″] in radians at :data:`MISALIGNMENT_INDEX` (the biases θ_0…2 are
-    not part of E; any bias unit, gyro or accelerometer)."""
+    not part of E; any bias unit, gyro or accelerometer).
+
+    Parameters
+    ----------
+    theta : array_like, shape (..., 12)
+        θ: biases, scale factors [ppm], misalignments [arcsec].
+
+    Returns
+    -------
+    numpy.ndarray, shape (..., 3, 3)
+        E (dimensionless).
+
+    Notes
+    -----
+    .. math:: E_{ii} = 10^{-6}\\,\\theta_{3+i}, \\quad
+              E_{rc} = \\theta_{6+k}\\,\\pi / (180 \\cdot 3600)
+
+    References
+    ----------
+    - *A method for separating the combined error coefficients of a ring-laser gyro triad
+      based on dual-axis rotation*, Chinese invention patent CN104880182.
+    """
     th = np.asarray(theta, dtype=np.float64)
     e = np.zeros((*th.shape[:-1], 3, 3))
     for i in range(3):
@@ -190,7 +245,20 @@ def error_matrices(theta: npt.ArrayLike) -> FloatArray:
 
 
 def error_matrix_from_coeffs(theta: npt.ArrayLike) -> tuple[FloatArray, FloatArray]:
-    """(E, b [°/h]) from θ (inverse of :func:`coeffs_from_error_matrix`)."""
+    """The error matrix and biases from θ (inverse of :func:`coeffs_from_error_matrix`).
+
+    Parameters
+    ----------
+    theta : array_like, shape (12,)
+        θ: biases [°/h], scale factors [ppm], misalignments [arcsec].
+
+    Returns
+    -------
+    E : numpy.ndarray, shape (3, 3)
+        Error matrix (dimensionless).
+    b : numpy.ndarray, shape (3,)
+        Biases [°/h].
+    """
     th = np.asarray(theta, dtype=np.float64).reshape(N_COEFFS)
     return error_matrices(th), th[0:3].copy()
 
@@ -199,7 +267,34 @@ def inner_axis_azimuth(
     theta: npt.ArrayLike, cov: npt.ArrayLike | None = None
 ) -> tuple[float, float]:
     """Antisymmetric xy part ``a = (yx − xy)/2`` [arcsec] — the triad's rotation about
-    the inner axis relative to the encoder zero — and its σ (NaN without ``cov``)."""
+    the inner axis relative to the encoder zero — and its σ (NaN without ``cov``).
+
+    Parameters
+    ----------
+    theta : array_like, shape (12,)
+        θ (misalignments [arcsec] at indices 6…11).
+    cov : array_like, shape (12, 12), optional
+        θ's covariance [units²].
+
+    Returns
+    -------
+    a : float
+        The antisymmetric part [arcsec].
+    sigma : float
+        Its standard deviation [arcsec]; NaN without ``cov``.
+
+    Notes
+    -----
+    .. math:: a = (\\theta_\\mathrm{yx} - \\theta_\\mathrm{xy})/2, \\quad
+              \\sigma_a^2 = w^\\mathsf{T} C w, \\ w = \\tfrac12(e_\\mathrm{yx} - e_\\mathrm{xy})
+
+    Examples
+    --------
+    >>> th = np.zeros(12)
+    >>> th[6], th[8] = 10.0, -10.0
+    >>> inner_axis_azimuth(th, np.eye(12))[0], round(inner_axis_azimuth(th, np.eye(12))[1], 3)
+    (10.0, 0.707)
+    """
     th = np.asarray(theta, dtype=np.float64)
     w = np.zeros(N_COEFFS)
     w[I_YX], w[I_XY] = 0.5, -0.5
@@ -215,7 +310,12 @@ CHANNEL_NAMES: Final = ("alpha", "beta", "gamma")
 
 @dataclass(frozen=True)
 class IntervalModel:
-    """Per-sample-interval measurement model, eq. (4).
+    """Per-sample-interval measurement model of the dual-axis turntable, eq. (4).
+
+    References
+    ----------
+    - *A method for separating the combined error coefficients of a ring-laser gyro triad
+      based on dual-axis rotation*, Chinese invention patent CN104880182, eq. (4).
 
     Attributes
     ----------
@@ -237,10 +337,26 @@ class IntervalModel:
 
     @property
     def n_channels(self) -> int:
+        """Number of channels k (2: Δα, Δβ; 3: with Δγ)."""
         return int(self.y_arcsec.shape[1])
 
     def select_channels(self, n_channels: int) -> IntervalModel:
-        """The first ``n_channels`` channels (2: the source's Δα, Δβ; 3: with Δγ)."""
+        """The first ``n_channels`` channels (2: the source's Δα, Δβ; 3: with Δγ).
+
+        Parameters
+        ----------
+        n_channels : {2, 3}
+            Number of channels kept.
+
+        Returns
+        -------
+        IntervalModel
+
+        Raises
+        ------
+        ValueError
+            ``n_channels`` not 2 or 3.
+        """
         if n_channels not in (2, 3):
             raise ValueError("n_channels must be 2 or 3")
         return IntervalModel(
@@ -254,7 +370,26 @@ class IntervalModel:
 
     def channel_cov(self, arw_rad_sqrt_s: npt.ArrayLike) -> FloatArray:
         """White-noise covariance of each interval's channels [arcsec²], (m, k, k):
-        ``cov(w_c, w_d) = Σ_j p_cj p_dj N_j² τ``."""
+        ``cov(w_c, w_d) = Σ_j p_cj p_dj N_j² τ``.
+
+        Parameters
+        ----------
+        arw_rad_sqrt_s : array_like, shape (3,) or scalar
+            Angle random walk N_j of each gyro [rad/√s].
+
+        Returns
+        -------
+        numpy.ndarray, shape (m, k, k)
+            Covariance [arcsec²].
+
+        Notes
+        -----
+        .. math:: \\operatorname{cov}(w_c, w_d) = \\sum_j p_{cj}\\, p_{dj}\\, N_j^2\\, \\tau
+
+        References
+        ----------
+        - IEEE Std 952-1997, Annex C (angle random walk N).
+        """
         n2 = (np.asarray(arw_rad_sqrt_s, dtype=np.float64) * units.RAD_TO_ARCSEC) ** 2
         n2 = n2 * np.ones(3)
         out: FloatArray = np.einsum("mcj,mdj,j->mcd", self.proj, self.proj, n2)
@@ -276,16 +411,37 @@ def interval_model(
 
     Parameters
     ----------
-    time_s : sample times [s], (n,).
-    gyro_rad_s : gyro mean rates over the interval ending at each sample [rad/s], (n, 3);
-        the first row (an interval before the first encoder reading) is not used.
-    alpha_rad, beta_rad : unwrapped encoder angles at the sample times [rad], (n,).
-    latitude_deg : latitude L [°].
-    gap_factor : an interval longer than this × the median is a gap (invalid).
-    move_threshold_rad_s : an interval is "moving" if an encoder rate exceeds this.
+    time_s : array_like, shape (n,)
+        Sample times [s].
+    gyro_rad_s : array_like, shape (n, 3)
+        Gyro mean rates over the interval ending at each sample [rad/s]; the first row
+        (an interval before the first encoder reading) is not used.
+    alpha_rad, beta_rad : array_like, shape (n,)
+        Unwrapped encoder angles at the sample times [rad].
+    latitude_deg : float
+        Latitude L [°].
+    gap_factor : float, default 1.5
+        An interval longer than this × the median is a gap (invalid).
+    move_threshold_rad_s : float, default 1e-3
+        An interval is "moving" if an encoder rate exceeds this [rad/s].
 
+    Returns
+    -------
+    IntervalModel
+        m = n − 1 intervals, three channels.
+
+    Notes
+    -----
     The earth rate and e_E^b, e_⊥^b are evaluated at the interval's mid angles; the
-    true increments φ = ω_true τ come from the encoders (kinematics eq. (2)).
+    true increments φ = ω_true τ come from the encoders (kinematics eq. (2)):
+
+    .. math:: y_{c,i} = p_c \\cdot (g_i \\tau_i - C_n^b \\omega_{ie}^n \\tau_i)
+              - \\Delta\\mathrm{enc}_{c,i} = h_{c,i}\\,\\theta + w_{c,i}
+
+    References
+    ----------
+    - *A method for separating the combined error coefficients of a ring-laser gyro triad
+      based on dual-axis rotation*, Chinese invention patent CN104880182, eq. (4).
     """
     t = np.asarray(time_s, dtype=np.float64)
     g = np.asarray(gyro_rad_s, dtype=np.float64)
@@ -324,7 +480,25 @@ def interval_model(
 
 def whitened_regressors(model: IntervalModel, arw_rad_sqrt_s: npt.ArrayLike) -> FloatArray:
     """``L_i⁻¹ h_i`` for every interval, (m, k, 12), with ``L_i`` the Cholesky factor of
-    the interval's channel covariance (invalid intervals are zero)."""
+    the interval's channel covariance (invalid intervals are zero).
+
+    Parameters
+    ----------
+    model : IntervalModel
+        The measurement model.
+    arw_rad_sqrt_s : array_like, shape (3,) or scalar
+        Angle random walk of each gyro [rad/√s].
+
+    Returns
+    -------
+    numpy.ndarray, shape (m, k, 12)
+        Whitened regressors [1/unit of θ].
+
+    References
+    ----------
+    - G. H. Golub and C. F. Van Loan, *Matrix Computations*, 4th ed., 2013 (Cholesky
+      factorisation, generalised least squares).
+    """
     cov = model.channel_cov(arw_rad_sqrt_s)
     cov[~model.valid] = np.eye(model.n_channels)
     low = np.linalg.cholesky(cov)
@@ -347,7 +521,33 @@ def fisher_information(
 
     Its inverse is the Cramér–Rao bound of the design (Kay, *Fundamentals of
     Statistical Signal Processing I*, 1993, §3.7, linear Gaussian model).  With the
-    three channels it is the bound for the whole gyro record."""
+    three channels it is the bound for the whole gyro record.
+
+    Parameters
+    ----------
+    model : IntervalModel
+        The measurement model.
+    arw_rad_sqrt_s : array_like, shape (3,) or scalar
+        Angle random walk of each gyro [rad/√s].
+    mask : numpy.ndarray of bool, shape (m,), optional
+        Intervals to include (with the valid ones).
+    whitened : numpy.ndarray, optional
+        :func:`whitened_regressors` computed before.
+
+    Returns
+    -------
+    numpy.ndarray, shape (12, 12)
+        J [1/unit²].
+
+    Notes
+    -----
+    .. math:: J = \\sum_i h_i^\\mathsf{T} C_i^{-1} h_i
+
+    References
+    ----------
+    - S. M. Kay, *Fundamentals of Statistical Signal Processing, Vol. I: Estimation
+      Theory*, Prentice Hall, 1993, §3.7.
+    """
     hw = whitened if whitened is not None else whitened_regressors(model, arw_rad_sqrt_s)
     sel = model.valid if mask is None else model.valid & mask
     hv2 = hw[sel].reshape(-1, N_COEFFS)

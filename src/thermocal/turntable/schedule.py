@@ -74,10 +74,28 @@ class Schedule:
 
     @property
     def duration_s(self) -> float:
+        """Length of the trajectory [s] (time of the last knot)."""
         return float(self.time_s[-1])
 
     def angles_at(self, t_s: npt.ArrayLike) -> tuple[FloatArray, FloatArray]:
-        """Unwrapped (α, β) [°] at times ``t_s`` (linear interpolation of the knots)."""
+        """Unwrapped (α, β) at times ``t_s`` (linear interpolation of the knots).
+
+        Parameters
+        ----------
+        t_s : array_like
+            Times [s].
+
+        Returns
+        -------
+        alpha_deg, beta_deg : numpy.ndarray
+            Inner and outer gimbal angles [°], unwrapped.
+
+        Examples
+        --------
+        >>> sch = build_schedule(dwell_s=60.0, move_rate_deg_s=10.0)
+        >>> [round(float(v), 3) for v in sch.angles_at(30.0)]  # first dwell: (0, 0)
+        [0.0, 0.0]
+        """
         t = np.asarray(t_s, dtype=np.float64)
         return (
             np.interp(t, self.time_s, self.alpha_deg),
@@ -283,6 +301,24 @@ def detect_motion(time_s: FloatArray, alpha_deg: FloatArray, beta_deg: FloatArra
        stay within ``tol`` of the run's median, so a dwell keeps its full length.
 
     An interval is moving unless both of its samples belong to the same rest run.
+
+    Parameters
+    ----------
+    time_s : numpy.ndarray, shape (n,)
+        Sample times [s].
+    alpha_deg, beta_deg : numpy.ndarray, shape (n,)
+        Unwrapped encoder angles [°].
+
+    Returns
+    -------
+    Motion
+        ``moving`` per interval (n − 1), the rest jitter [arcsec], the reading grid [°]
+        and the tolerance band [°].
+
+    References
+    ----------
+    - F. R. Hampel, "The influence curve and its role in robust estimation", *J. Amer.
+      Statist. Assoc.* 69(346), 383–393, 1974 (the MAD scale 1.4826).
     """
     from scipy.ndimage import maximum_filter1d, minimum_filter1d
 
@@ -338,7 +374,23 @@ def detect_motion(time_s: FloatArray, alpha_deg: FloatArray, beta_deg: FloatArra
 
 
 def runs(mask: npt.NDArray[np.bool_]) -> list[tuple[int, int]]:
-    """Maximal runs ``[start, stop)`` where ``mask`` is true."""
+    """Maximal runs ``[start, stop)`` where ``mask`` is true.
+
+    Parameters
+    ----------
+    mask : numpy.ndarray of bool
+        The flags.
+
+    Returns
+    -------
+    list of tuple of int
+        ``(start, stop)`` index pairs, in order.
+
+    Examples
+    --------
+    >>> runs(np.array([True, True, False, True]))
+    [(0, 2), (3, 4)]
+    """
     m = np.concatenate([[False], np.asarray(mask, dtype=bool), [False]])
     d = np.diff(m.astype(np.int8))
     starts = np.flatnonzero(d == 1)
@@ -358,7 +410,24 @@ def segment(
 ) -> Segmentation:
     """Find the dwells (static runs ≥ ``pause_s``) and count distinct positions.
 
-    ``moving`` and ``valid`` are per sample interval (length n − 1)."""
+    Parameters
+    ----------
+    time_s : numpy.ndarray, shape (n,)
+        Sample times [s].
+    alpha_deg, beta_deg : numpy.ndarray, shape (n,)
+        Unwrapped encoder angles [°].
+    moving, valid : numpy.ndarray of bool, shape (n − 1,)
+        Per sample interval: moving (:func:`detect_motion`) and not spanning a time gap.
+    pause_s : float, default 10.0
+        Shortest static run counted as a dwell [s].
+    position_tol_deg : float, default 0.5
+        Two dwells within this angle on both axes are one position [°].
+
+    Returns
+    -------
+    Segmentation
+        The dwells, the number of distinct positions and each axis's travel [°].
+    """
     # static runs; runs at one position separated only by gaps in time are one dwell
     merged: list[list[float]] = []  # [start, stop, duration, alpha, beta]
     for a, b in runs(~moving & valid):
@@ -417,7 +486,35 @@ def check_design(
 
     Checks: each axis travels at least ``min_travel_deg`` (rotations are what make
     scale factors and misalignments observable); at least ``min_positions``
-    distinct positions; every dwell at least ``min_dwell_s − dwell_tolerance_s``."""
+    distinct positions; every dwell at least ``min_dwell_s − dwell_tolerance_s``.
+
+    Parameters
+    ----------
+    seg : Segmentation
+        The recognised dwells (:func:`segment`).
+    name : str
+        The recording's name in messages (e.g. the file).
+    alpha_col, beta_col : str
+        The encoder columns' names, in messages.
+    min_positions : int, default 16
+        Distinct positions needed.
+    min_dwell_s : float, default 60.0
+        Shortest dwell asked [s].
+    dwell_tolerance_s : float, default 0.0
+        Allowance below ``min_dwell_s`` [s].
+    min_travel_deg : float, default 45.0
+        Least total travel of each axis [°].
+
+    Raises
+    ------
+    TurntableScheduleError
+        An axis that never moves, too few positions, or a dwell too short.
+
+    References
+    ----------
+    - *A method for separating the combined error coefficients of a ring-laser gyro triad
+      based on dual-axis rotation*, Chinese invention patent CN104880182, claim 3.
+    """
     for col, travel, what in (
         (alpha_col, seg.alpha_travel_deg, "inner"),
         (beta_col, seg.beta_travel_deg, "outer"),
@@ -443,7 +540,17 @@ def check_design(
 
 
 def warn_gaps(name: str, time_s: FloatArray, valid: npt.NDArray[np.bool_]) -> None:
-    """Warn (``GapWarning``) about time gaps: they split the angle integration."""
+    """Warn (``GapWarning``) about time gaps: they split the angle integration.
+
+    Parameters
+    ----------
+    name : str
+        The recording's name in the message.
+    time_s : numpy.ndarray, shape (n,)
+        Sample times [s].
+    valid : numpy.ndarray of bool, shape (n − 1,)
+        False for an interval that spans a gap.
+    """
     bad = np.flatnonzero(~valid)
     if bad.size:
         i = int(bad[0])

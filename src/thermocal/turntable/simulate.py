@@ -65,7 +65,17 @@ class TurntableTruth:
     @classmethod
     def random(cls, seed: int) -> TurntableTruth:
         """A random navigation-grade triad: biases 0.01–0.05 °/h, scale-factor
-        errors 10–100 ppm, misalignments 5–60″ (random signs)."""
+        errors 10–100 ppm, misalignments 5–60″ (random signs).
+
+        Parameters
+        ----------
+        seed : int
+            Seed of :func:`numpy.random.default_rng`.
+
+        Returns
+        -------
+        TurntableTruth
+        """
         rng = np.random.default_rng(seed)
 
         def draw(lo: float, hi: float, n: int) -> list[float]:
@@ -243,7 +253,25 @@ ACCEL_THERMAL_TRUTH: dict[str, tuple[tuple[float, ...], ...]] = {
 
 
 def thermal_theta(spec: dict[str, tuple[tuple[float, ...], ...]], temp_c: Any) -> FloatArray:
-    """θ (…, 12) of a thermal truth at temperatures [°C] (polynomials in T − TREF)."""
+    """θ (…, 12) of a thermal truth at temperatures [°C] (polynomials in T − TREF).
+
+    Parameters
+    ----------
+    spec : dict
+        ``bias``, ``scale_factor``, ``misalignment``: per parameter, the coefficients of
+        ascending powers of ``T − THERMAL_TREF_C`` [°/h, ppm, arcsec per °C^p].
+    temp_c : array_like
+        Temperatures [°C].
+
+    Returns
+    -------
+    numpy.ndarray, shape (..., 12)
+        θ (biases [°/h], scale factors [ppm], misalignments [arcsec]).
+
+    Notes
+    -----
+    .. math:: \\theta_k(T) = \\sum_p c_{kp} (T - T_\\mathrm{ref})^p
+    """
     d = np.asarray(temp_c, dtype=np.float64) - THERMAL_TREF_C
     cols = [
         np.polynomial.polynomial.polyval(d, np.asarray(c))

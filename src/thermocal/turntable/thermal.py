@@ -55,8 +55,23 @@ TRIAD_VERSION = 1
 
 @dataclass(frozen=True)
 class ParameterFit:
-    """One parameter's polynomial in ``T − TREF`` (``coef`` ascending powers, its
-    covariance), the LOTO rms [parameter unit] and the reduced χ² of the fit."""
+    """One parameter's polynomial in temperature, with its covariance and fit figures.
+
+    Attributes
+    ----------
+    name : str
+        The parameter's name (one of :data:`PARAMETER_NAMES`).
+    unit : str
+        Its unit: °/h or mg (bias), ppm (scale factor), arcsec (misalignment).
+    coef : numpy.ndarray, shape (P + 1,)
+        Coefficients of ascending powers of ``T − TREF`` [unit / °C^p].
+    cov : numpy.ndarray, shape (P + 1, P + 1)
+        Their covariance [unit² / °C^(p+q)].
+    loto_rms : float
+        Leave-one-temperature-out rms prediction error [unit]; NaN when not computable.
+    reduced_chi2 : float
+        Reduced χ² of the weighted fit (dimensionless); NaN with no degree of freedom.
+    """
 
     name: str
     unit: str
@@ -67,6 +82,7 @@ class ParameterFit:
 
     @property
     def sigma(self) -> FloatArray:
+        """Standard errors of :attr:`coef` (square root of the covariance's diagonal)."""
         out: FloatArray = np.sqrt(np.maximum(np.diag(self.cov), 0.0))
         return out
 
@@ -130,7 +146,38 @@ def _loto(dt: FloatArray, v: FloatArray, w: FloatArray, order: int, scale: float
 
 @dataclass(frozen=True)
 class TriadThermal:
-    """A triad's twelve parameters as polynomials in temperature (module docstring)."""
+    """A triad's twelve error parameters as polynomials in temperature.
+
+    Attributes
+    ----------
+    kind : {"gyro", "accel"}
+        The triad's kind.
+    tref_c : float
+        Reference temperature TREF [°C].
+    order : int
+        The highest polynomial order among the parameters (0…3).
+    t_lo_c, t_hi_c : float
+        The calibrated temperature range [°C]; evaluation is clamped to it.
+    fits : tuple of ParameterFit
+        The twelve parameters in the order of :data:`PARAMETER_NAMES`.
+    soak_temperatures_c : tuple of float
+        The runs' soak temperatures [°C].
+
+    Notes
+    -----
+    Each parameter is
+
+    .. math:: \\theta_k(T) = \\sum_{p=0}^{P} c_{kp}\\,(T - T_\\mathrm{ref})^p,
+
+    evaluated at ``clip(T, t_lo_c, t_hi_c)``.
+
+    References
+    ----------
+    - *A method for separating the combined error coefficients of a ring-laser gyro triad
+      based on dual-axis rotation*, Chinese invention patent CN104880182.
+    - IEEE Std 1431-2004, *IEEE Standard Specification Format Guide and Test Procedure for
+      Coriolis Vibratory Gyros* (temperature sensitivity of bias and scale factor).
+    """
 
     kind: str
     tref_c: float
@@ -147,8 +194,23 @@ class TriadThermal:
     """Local gravity the runs were calibrated with (multipos), for a later validation."""
 
     def sigma_at(self, temp_c: npt.ArrayLike) -> FloatArray:
-        """Standard error (…, 12) of each fitted parameter at temperatures (clamped):
-        ``σ(T)² = vᵀ C v``, ``v = (1, ΔT, ΔT², …)``."""
+        """Standard error of each fitted parameter at temperatures (clamped to the range).
+
+        Parameters
+        ----------
+        temp_c : array_like
+            Temperatures [°C], any shape (…).
+
+        Returns
+        -------
+        numpy.ndarray, shape (…, 12)
+            σ of each parameter [its unit].
+
+        Notes
+        -----
+        .. math:: \\sigma_k(T)^2 = v^\\mathsf{T} C_k v, \\quad
+                  v = (1, \\Delta T, \\Delta T^2, \\dots), \\quad \\Delta T = T - T_\\mathrm{ref}
+        """
         t = np.clip(np.asarray(temp_c, dtype=np.float64), self.t_lo_c, self.t_hi_c)
         dt = t - self.tref_c
         cols = []
@@ -159,7 +221,31 @@ class TriadThermal:
         return out
 
     def theta_at(self, temp_c: npt.ArrayLike) -> FloatArray:
-        """θ (n, 12) at temperatures clamped to the calibrated range."""
+        """The twelve parameters θ at temperatures clamped to the calibrated range.
+
+        Parameters
+        ----------
+        temp_c : array_like
+            Temperatures [°C], any shape (…).
+
+        Returns
+        -------
+        numpy.ndarray, shape (…, 12)
+            θ in the units of :data:`UNITS` (°/h or mg, ppm, arcsec).
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> from thermocal.turntable.thermal import fit_triad
+        >>> temps = [0.0, 20.0, 40.0]
+        >>> thetas = np.zeros((3, 12))
+        >>> thetas[:, 0] = [1.0, 3.0, 5.0]  # bias_x [°/h], 0.1 °/h per °C
+        >>> tri = fit_triad("gyro", temps, thetas, np.ones((3, 12)), order=1)
+        >>> round(float(tri.theta_at(30.0)[0]), 3)
+        4.0
+        >>> round(float(tri.theta_at(60.0)[0]), 3)  # clamped to 40 °C
+        5.0
+        """
         t = np.clip(np.asarray(temp_c, dtype=np.float64), self.t_lo_c, self.t_hi_c)
         dt = t - self.tref_c
         out: FloatArray = np.stack(
@@ -168,6 +254,7 @@ class TriadThermal:
         return out
 
     def to_dict(self) -> dict[str, Any]:
+        """The file form (JSON-ready dict) that :meth:`from_dict` reads back."""
         return {
             "format": TRIAD_FORMAT,
             "version": TRIAD_VERSION,
@@ -198,9 +285,25 @@ class TriadThermal:
 
     @classmethod
     def from_dict(cls, d: Any, where: str = "triad") -> TriadThermal:
-        """The file form (:meth:`to_dict`) back, checked before use (:func:`check_triad_dict`:
-        types, shapes, finite numbers, TREF, a well-conditioned ``I + E(T)``); ``where``
-        prefixes the key path in errors (``FILE: triads[0].model``)."""
+        """Read the file form (:meth:`to_dict`) back, checked before use.
+
+        Parameters
+        ----------
+        d : Any
+            The parsed JSON object.
+        where : str, default "triad"
+            Prefix of the key path in errors (e.g. ``FILE: triads[0].model``).
+
+        Returns
+        -------
+        TriadThermal
+
+        Raises
+        ------
+        thermocal.errors.ModelFileError
+            Wrong types, shapes or non-finite numbers (:func:`check_triad_dict`), or an
+            ill-conditioned ``I + E(T)`` (:func:`check_conditioning`).
+        """
         check_triad_dict(d, where)
         fits = tuple(
             ParameterFit(
@@ -273,8 +376,11 @@ def _numbers(v: Any, path: str, n: int | None = None, *, min_len: int = 0) -> No
 
 
 def check_triad_dict(d: Any, where: str) -> None:
-    """Check a triad model's file form before anything uses it; :class:`ModelFileError`
-    naming the key path (``where`` + ``.parameters[0].coefficients``) otherwise.
+    """Check a triad model's file form before anything uses it.
+
+    Parameters: ``d`` the parsed JSON object; ``where`` the key-path prefix in errors.
+    Raises :class:`~thermocal.errors.ModelFileError` naming the key path (``where`` +
+    ``.parameters[0].coefficients``).
 
     Checked: the format tag and version, ``kind`` (gyro/accel), ``order`` (0…3), a finite
     ``tref_c`` inside or near (:func:`thermocal.models.schema.near_range`) a finite
@@ -360,7 +466,30 @@ def check_conditioning(triad: TriadThermal, where: str) -> None:
     it, so no other temperature is ever used) and the soaks; the condition number
     (2-norm, ratio of extreme singular values) must be at most :data:`MAX_CONDITION` and
     the determinant keep one sign (a sign change is a singular point between two grid
-    temperatures)."""
+    temperatures).
+
+    Parameters
+    ----------
+    triad : TriadThermal
+        The model to check.
+    where : str
+        Key-path prefix in the error message.
+
+    Raises
+    ------
+    thermocal.errors.ModelFileError
+        ``I + E(T)`` not finite, with condition number above :data:`MAX_CONDITION`, or
+        with a determinant that changes sign over the range.
+
+    Notes
+    -----
+    .. math:: \\kappa(T) = \\sigma_\\max(I + E(T)) / \\sigma_\\min(I + E(T)) \\le 10
+
+    References
+    ----------
+    - G. H. Golub and C. F. Van Loan, *Matrix Computations*, 4th ed., 2013 (§2.6, the
+      condition number of a linear system).
+    """
     grid = np.linspace(triad.t_lo_c, triad.t_hi_c, CONDITION_GRID)
     _, e = error_terms(triad, grid)
     m = e + np.eye(3)[None, :, :]
@@ -397,7 +526,20 @@ def check_tref(tref_c: float, lo: float, hi: float) -> None:
     """Refuse (exit 2, naming ``--tref``) a reference temperature [°C] that the calibration
     file's reader would refuse (:func:`check_triad_dict`: finite, inside the soaks'
     range ``[lo, hi]`` or within :func:`thermocal.models.checks.range_margin` of it), before
-    anything is fitted or written."""
+    anything is fitted or written.
+
+    Parameters
+    ----------
+    tref_c : float
+        Reference temperature [°C].
+    lo, hi : float
+        The soaks' temperature range [°C].
+
+    Raises
+    ------
+    thermocal.errors.ParameterError
+        ``tref_c`` not finite or farther than the margin outside ``[lo, hi]``.
+    """
     from thermocal.models.checks import range_margin
 
     margin = range_margin(lo, hi)
@@ -410,6 +552,40 @@ def check_tref(tref_c: float, lo: float, hi: float) -> None:
             f"with it is refused when read); give a {{name}} within [{lo - margin:.4g}, "
             f"{hi + margin:.4g}] °C, or leave it out (the middle of the soaks)",
         )
+
+
+def _fit_inputs(
+    kind: str,
+    temps_c: Sequence[float],
+    thetas: npt.ArrayLike,
+    sigmas: npt.ArrayLike,
+    tref_c: float | None,
+    order: int | None,
+) -> tuple[FloatArray, FloatArray, FloatArray, float]:
+    """:func:`fit_triad`'s inputs checked, as arrays, with TREF [°C]."""
+    if kind not in UNITS:
+        raise ThermocalInputError(f"triad kind must be gyro or accel, got {kind!r}")
+    t = np.asarray(temps_c, dtype=np.float64)
+    th = np.asarray(thetas, dtype=np.float64)
+    sg = np.asarray(sigmas, dtype=np.float64)
+    r = t.size
+    if th.shape != (r, 12) or sg.shape != (r, 12):
+        raise ThermocalInputError("thetas and sigmas must be (runs, 12)")
+    if r < 2:
+        raise DesignError("a temperature model needs runs at two soak temperatures at least")
+    span = float(t.max() - t.min())
+    if not span > 0.5:
+        raise DesignError(
+            f"the runs' temperatures span {span:.3g} °C: soak them at different temperatures"
+        )
+    tref = float(0.5 * (t.min() + t.max())) if tref_c is None else float(tref_c)
+    check_tref(tref, float(t.min()), float(t.max()))
+    max_order = min(MAX_ORDER, r - 1)
+    if order is not None and not 0 <= order <= max_order:
+        raise DesignError(
+            f"order {order} needs at least {order + 1} soak temperatures; the runs give {r}"
+        )
+    return t, th, sg, tref
 
 
 def fit_triad(
@@ -451,31 +627,37 @@ def fit_triad(
     ------
     thermocal.errors.ParameterError
         A ``tref_c`` the calibration file's reader would refuse.
+    thermocal.errors.ThermocalInputError
+        ``kind`` not gyro/accel, or ``thetas``/``sigmas`` not of shape (R, 12).
+    thermocal.errors.DesignError
+        Fewer than two soaks, soaks within 0.5 °C, or an ``order`` the soaks cannot support.
+
+    Notes
+    -----
+    Weighted least squares with weights :math:`w_r = 1/\\sigma_{rk}^2`; the covariance
+    :math:`(A^\\mathsf{T} W A)^{-1}` is scaled by the reduced χ² when it exceeds 1.
+
+    References
+    ----------
+    - G. H. Golub and C. F. Van Loan, *Matrix Computations*, 4th ed., 2013 (weighted least
+      squares by the SVD).
+    - *A method for separating the combined error coefficients of a ring-laser gyro triad
+      based on dual-axis rotation*, Chinese invention patent CN104880182.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> temps = [-10.0, 25.0, 60.0]
+    >>> thetas = np.zeros((3, 12))
+    >>> thetas[:, 3] = [100.0, 135.0, 170.0]  # scale_factor_x [ppm]: 1 ppm/°C
+    >>> tri = fit_triad("gyro", temps, thetas, np.ones((3, 12)), order=1)
+    >>> round(float(tri.fits[3].coef[1]), 3), tri.tref_c
+    (1.0, 25.0)
     """
-    if kind not in UNITS:
-        raise ThermocalInputError(f"triad kind must be gyro or accel, got {kind!r}")
-    t = np.asarray(temps_c, dtype=np.float64)
-    th = np.asarray(thetas, dtype=np.float64)
-    sg = np.asarray(sigmas, dtype=np.float64)
+    t, th, sg, tref = _fit_inputs(kind, temps_c, thetas, sigmas, tref_c, order)
     r = t.size
-    if th.shape != (r, 12) or sg.shape != (r, 12):
-        raise ThermocalInputError("thetas and sigmas must be (runs, 12)")
-    if r < 2:
-        raise DesignError("a temperature model needs runs at two soak temperatures at least")
-    span = float(t.max() - t.min())
-    if not span > 0.5:
-        raise DesignError(
-            f"the runs' temperatures span {span:.3g} °C: soak them at different temperatures"
-        )
-    tref = float(0.5 * (t.min() + t.max())) if tref_c is None else float(tref_c)
-    check_tref(tref, float(t.min()), float(t.max()))
     dt = t - tref
     scale = max(float(np.max(np.abs(dt))), 1.0)
-    max_order = min(MAX_ORDER, r - 1)
-    if order is not None and not 0 <= order <= max_order:
-        raise DesignError(
-            f"order {order} needs at least {order + 1} soak temperatures; the runs give {r}"
-        )
     fits = []
     for k in range(12):
         sg_k = sg[:, k]
@@ -520,8 +702,35 @@ def constant_triad(
     """A triad calibrated at one temperature: every parameter a constant (order 0), the
     calibrated range ``t_range_c`` (the temperatures the run saw; default that temperature
     alone; the model is applied unchanged at any temperature, with the usual warning
-    outside it).  ``theta``
-    (12) and its covariance in the units of :data:`UNITS`."""
+    outside it).
+
+    Parameters
+    ----------
+    kind : {"gyro", "accel"}
+        The triad's kind.
+    temp_c : float
+        The run's temperature [°C], also TREF.
+    theta : array_like, shape (12,)
+        The parameters in the units of :data:`UNITS` (°/h or mg, ppm, arcsec).
+    cov : array_like, shape (12, 12)
+        Their covariance [units²].
+    t_range_c : tuple of float, optional
+        The calibrated range [°C] (default: ``temp_c`` alone).
+    method : str, default "turntable"
+        How the run was calibrated (``turntable`` or ``multipos``), recorded.
+    gravity_m_s2 : float, optional
+        Local gravity used [m/s²], recorded.
+
+    Returns
+    -------
+    TriadThermal
+        Order 0 in every parameter.
+
+    Raises
+    ------
+    thermocal.errors.ThermocalInputError
+        ``kind`` not gyro/accel.
+    """
     if kind not in UNITS:
         raise ThermocalInputError(f"triad kind must be gyro or accel, got {kind!r}")
     th = np.asarray(theta, dtype=np.float64).reshape(12)
@@ -542,7 +751,23 @@ def constant_triad(
 
 
 def error_terms(triad: TriadThermal, temp_c: npt.ArrayLike) -> tuple[FloatArray, FloatArray]:
-    """``(b(T) (n, 3) in the bias unit, E(T) (n, 3, 3))`` at each temperature."""
+    """Bias vector and error matrix of a triad at each temperature.
+
+    Parameters
+    ----------
+    triad : TriadThermal
+        The model.
+    temp_c : array_like, shape (n,)
+        Temperatures [°C] (clamped to the calibrated range).
+
+    Returns
+    -------
+    b : numpy.ndarray, shape (n, 3)
+        Bias b(T) [°/h or mg].
+    E : numpy.ndarray, shape (n, 3, 3)
+        Scale-factor and misalignment matrix E(T) (dimensionless), see
+        :func:`thermocal.turntable.model.error_matrices`.
+    """
     th = np.atleast_2d(triad.theta_at(temp_c))
     b: FloatArray = th[:, 0:3]
     return b, model.error_matrices(th)
@@ -556,7 +781,35 @@ def solve3(m: FloatArray, r: FloatArray) -> FloatArray:
     """``m⁻¹ r`` for stacks of 3×3 matrices ``m`` (n, 3, 3) and vectors ``r`` (n, 3), by the
     adjugate over the determinant (Cramer's rule; ``I + E`` is within 10⁻³ of the identity,
     so the determinant is near 1 and the formula exact to rounding) — vectorised, where a
-    LAPACK call per 3×3 matrix would cost microseconds each."""
+    LAPACK call per 3×3 matrix would cost microseconds each.
+
+    Parameters
+    ----------
+    m : numpy.ndarray, shape (n, 3, 3)
+        Matrices.
+    r : numpy.ndarray, shape (n, 3)
+        Right-hand sides.
+
+    Returns
+    -------
+    numpy.ndarray, shape (n, 3)
+        ``m⁻¹ r`` per row.
+
+    Notes
+    -----
+    .. math:: m^{-1} r = \\operatorname{adj}(m)\\, r / \\det m
+
+    References
+    ----------
+    - G. H. Golub and C. F. Van Loan, *Matrix Computations*, 4th ed., 2013.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> m = np.array([[[2.0, 0, 0], [0, 4.0, 0], [0, 0, 1.0]]])
+    >>> solve3(m, np.array([[2.0, 2.0, 3.0]])).round(3).tolist()
+    [[1.0, 0.5, 3.0]]
+    """
     a, b, c = m[:, 0, 0], m[:, 0, 1], m[:, 0, 2]
     d, e, f = m[:, 1, 0], m[:, 1, 1], m[:, 1, 2]
     g, h, i = m[:, 2, 0], m[:, 2, 1], m[:, 2, 2]
@@ -575,7 +828,40 @@ def correct(
 ) -> FloatArray:
     """``x_c = (I + E(T))⁻¹ (x − b(T))`` per sample; ``x`` (n, 3) in the data's unit,
     ``bias_to_data`` the factor from the triad's bias unit (°/h or mg) to it.  Computed in
-    blocks of :data:`CORRECT_BLOCK` samples (:func:`solve3` for the 3×3 solves)."""
+    blocks of :data:`CORRECT_BLOCK` samples (:func:`solve3` for the 3×3 solves).
+
+    Parameters
+    ----------
+    triad : TriadThermal
+        The model.
+    x : array_like, shape (n, 3)
+        Raw samples [data unit, e.g. °/s or m/s²].
+    temp_c : array_like, shape (n,) or scalar
+        Each sample's temperature [°C].
+    bias_to_data : float
+        Factor from the triad's bias unit (°/h or mg) to the data's unit.
+
+    Returns
+    -------
+    numpy.ndarray, shape (n, 3)
+        Compensated samples [data unit].
+
+    Notes
+    -----
+    .. math:: x_c = (I + E(T))^{-1}\\,(x - b(T))
+
+    References
+    ----------
+    - *A method for separating the combined error coefficients of a ring-laser gyro triad
+      based on dual-axis rotation*, Chinese invention patent CN104880182.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> tri = constant_triad("gyro", 25.0, [3600.0, 0, 0] + [0.0] * 9, np.eye(12))
+    >>> correct(tri, [[2.0, 0.0, 0.0]], 25.0, 1 / 3600).round(3).tolist()  # °/s
+    [[1.0, 0.0, 0.0]]
+    """
     xs = np.asarray(x, dtype=np.float64)
     tc = np.broadcast_to(np.asarray(temp_c, dtype=np.float64), xs.shape[:1])
     out = np.empty_like(xs)
@@ -612,7 +898,25 @@ class TriadValidation:
     """How a triad calibration does on an independent turntable run (:func:`validate_triad`):
     per axis, before (raw) and after (compensated), the rms over the dwells of the dwell-mean
     error against the reference the encoders give (earth rate or gravity in body axes) and,
-    for gyros, the rms over the moves of the angle error accumulated during each move."""
+    for gyros, the rms over the moves of the angle error accumulated during each move.
+
+    Attributes
+    ----------
+    triad : str
+        The triad's name.
+    unit : str
+        Unit of the dwell figures (°/h or mg).
+    dwell_rms_before, dwell_rms_after : tuple of float
+        Per-axis rms of the dwell-mean error [unit], raw and compensated.
+    move_angle_rms_before_arcsec, move_angle_rms_after_arcsec : tuple of float or None
+        Per-axis rms of the move-angle error [arcsec] (gyros with two dwells or more).
+    n_dwells : int
+        Number of dwells.
+    temperature_c : tuple of float
+        Lowest and highest sample temperature [°C].
+    outside_range_fraction : float
+        Fraction of samples outside the calibrated range (0…1).
+    """
 
     triad: str
     unit: str
@@ -625,6 +929,7 @@ class TriadValidation:
     outside_range_fraction: float
 
     def to_dict(self) -> dict[str, Any]:
+        """The fields as a JSON-ready dict."""
         from dataclasses import asdict
 
         return asdict(self)
@@ -658,7 +963,45 @@ def validate_triad(
     same unit; the true body rate or specific force from the encoder angles) over the
     ``dwells`` (interval indexing of :mod:`.schedule`) and, for a gyro triad, over the moves
     between them (angle = Σ rate·Δt).  Figures in ``figure_unit`` (data unit ×
-    ``figure_unit_factor``: °/h or mg)."""
+    ``figure_unit_factor``: °/h or mg).
+
+    Parameters
+    ----------
+    triad : TriadThermal
+        The calibration to validate.
+    kind_unit : str
+        The data's unit (recorded by the caller; not used in the arithmetic).
+    x, reference : numpy.ndarray, shape (n, 3)
+        Raw samples and the encoder-derived truth [data unit].
+    temp_c : numpy.ndarray, shape (n,)
+        Each sample's temperature [°C].
+    dwells : sequence of slice-like
+        The dwells (``start``/``stop`` into the interval indexing of :mod:`.schedule`).
+    bias_to_data : float
+        Factor from the triad's bias unit to the data's unit.
+    dt_s : float
+        Sample interval [s].
+    name : str
+        The triad's name in the result.
+    figure_unit_factor : float
+        Factor from the data's unit to ``figure_unit``.
+    figure_unit : str
+        Unit of the dwell figures (°/h or mg).
+
+    Returns
+    -------
+    TriadValidation
+
+    Notes
+    -----
+    .. math:: e_\\mathrm{dwell} = \\sqrt{\\tfrac{1}{D}\\sum_d (\\bar x_d - \\bar r_d)^2}, \\quad
+              \\Delta\\theta_\\mathrm{move} = \\sum (x - r)\\,\\Delta t
+
+    References
+    ----------
+    - *A method for separating the combined error coefficients of a ring-laser gyro triad
+      based on dual-axis rotation*, Chinese invention patent CN104880182.
+    """
     xc = correct(triad, x, temp_c, bias_to_data)
 
     def dwell_rms(v: FloatArray) -> tuple[float, float, float]:
