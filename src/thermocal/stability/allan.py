@@ -412,6 +412,17 @@ class NoiseTerms:
     fit_sigma : standard errors of ``fit_coefficients`` (NaN where C = 0).
     reduced_chi2 : weighted residual sum of squares / (points − active terms).
     quality : how well the noise model describes the curve (:class:`FitQuality`).
+
+    Examples
+    --------
+    White rate noise of 3 °/h per sample at 10 Hz: N = 3·√0.1 / 60 = 0.0158 °/√h.
+
+    >>> import numpy as np
+    >>> y = np.random.default_rng(0).normal(0.0, 3.0, 20_000)
+    >>> terms = noise_terms(overlapping_adev(y, 0.1, unit="deg/h"))
+    >>> arw = terms.slope.angle_random_walk
+    >>> print(f"{arw.value:.3g} {arw.unit}")
+    0.0158 deg/sqrt(h)
     """
 
     slope: NoiseTermSet

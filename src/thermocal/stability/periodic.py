@@ -236,6 +236,15 @@ def periodic_terms(
     -------
     tuple of PeriodicTerm
         The sinusoids, strongest first.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> t = np.arange(20_000) * 0.1
+    >>> y = np.random.default_rng(0).normal(0.0, 1.0, t.size) + 5.0 * np.sin(np.pi * t)
+    >>> (p,) = periodic_terms(y, 0.1, "deg/h")
+    >>> print(f"{p.frequency_hz:.3g} Hz, {p.amplitude:.3g} {p.unit}")
+    0.5 Hz, 5 deg/h
     """
     x = np.asarray(values, dtype=np.float64).ravel()[:_MAX_SAMPLES]
     x = x[np.isfinite(x)]

@@ -180,6 +180,11 @@ def get(name: str) -> Deviation:
     ------
     ParameterError
         ``name`` is not registered (the message lists the names).
+
+    Examples
+    --------
+    >>> get("mdev").reference
+    'NIST SP 1065 eq. 14'
     """
     try:
         return _TABLE[name]
