@@ -440,6 +440,18 @@ def noise_model(
     References
     ----------
     .. [1] IEEE Std 952-1997, Annex C.
+
+    Examples
+    --------
+    White gyro noise of 0.01 rad/s per sample at 100 Hz: density 0.01·√0.01 = 0.001 rad/s/√Hz.
+
+    >>> import numpy as np
+    >>> y = np.random.default_rng(0).normal(0.0, 0.01, 4_000)
+    >>> ax = axis_noise(y, 0.01, name="gx", sensor="gyro", unit="rad/s")
+    >>> print(f"{ax.density.value:.3g} {ax.density.unit}")
+    0.000998 rad/s/sqrt(Hz)
+    >>> sorted(noise_model([ax], 100.0).chosen)
+    ['gyroscope_noise_density', 'gyroscope_random_walk']
     """
     if not (math.isfinite(inflate) and inflate >= 1.0):
         raise ThermocalInputError(f"--inflate {inflate!r}: give a factor ≥ 1 (1: none)")
