@@ -859,6 +859,18 @@ def identify_noise(
     ----------
     - Riley & Greenhall 2004 (lag-1 autocorrelation).
     - Barnes, J. A. (1969), NBS Technical Note 375 (bias functions B1 and B2).
+
+    Examples
+    --------
+    White FM (α = 0) and random-walk FM (α = −2) rate, as phase points:
+
+    >>> import numpy as np
+    >>> w = np.random.default_rng(0).normal(size=4000)
+    >>> identify_noise(np.r_[0.0, np.cumsum(w)], 4, dmax=2, phase_input=False).alpha
+    0
+    >>> rw = np.cumsum(w)
+    >>> identify_noise(np.r_[0.0, np.cumsum(rw)], 4, dmax=2, phase_input=False).alpha
+    -2
     """
     nb = (x.size - 1) // m  # m-averages of the rate: (x_{(k+1)m} − x_{km}) / m
     ym = np.diff(x[: nb * m + 1 : m]) if nb else x[:0].copy()
