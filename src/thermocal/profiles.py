@@ -134,6 +134,7 @@ class Piece:
 
     @property
     def duration_s(self) -> float:
+        """Duration of the stage [s]."""
         return self.end_s - self.start_s
 
     @property
@@ -153,6 +154,7 @@ class Stage:
     label: str = ""
 
     def to_dict(self) -> dict[str, Any]:
+        """The stage as a JSON-ready dict (times [s], set-point [°C])."""
         return {
             "label": self.label,
             "start_s": float(self.start_s),

@@ -242,6 +242,7 @@ class FitQuality:
     reason: str | None
 
     def to_dict(self) -> dict[str, Any]:
+        """The fit quality as a JSON-ready dict (misfit runs as dicts)."""
         return {
             "reduced_chi2": self.reduced_chi2,
             "dof": self.dof,
@@ -878,6 +879,7 @@ class DynamicAllan:
 
     @property
     def stationary(self) -> bool:
+        """True when no (window, τ) cell differs from the whole record's ADEV."""
         return not self.changes
 
     def to_dict(self) -> dict[str, Any]:
