@@ -340,11 +340,37 @@ def bias_from_counts(
     scale_factor_unit: str = "counts/arcsec",
     earth_rate_deg_h: float = 0.0,
 ) -> float:
-    """Bias from raw pulse counts: ``B0 = (1/(τK)) · mean(N_i) − Ω_axis`` [°/h].
+    r"""Bias from raw pulse counts: ``B0 = (1/(τK)) · mean(N_i) − Ω_axis`` [°/h].
 
     ``scale_factor`` K in ``scale_factor_unit`` (see
     :data:`thermocal.units.SCALE_FACTOR_UNITS`; the default pulses per arcsec
     gives [arcsec/s] = [°/h]), ``tau_s`` the sample interval τ [s].
+
+    Parameters
+    ----------
+    counts : array_like
+        Pulse counts N_i per sample interval [counts].
+    scale_factor : float
+        Scale factor K [``scale_factor_unit``].
+    tau_s : float
+        Sample interval τ [s].
+    scale_factor_unit : str, optional
+        Unit of K (default ``"counts/arcsec"``).
+    earth_rate_deg_h : float, optional
+        Earth-rate component Ω_axis along the sensitive axis [°/h] (default 0).
+
+    Returns
+    -------
+    float
+        Bias B0 [°/h].
+
+    Notes
+    -----
+    .. math:: B_0 = \frac{1}{\tau K} \overline{N_i} - \Omega_{axis}
+
+    References
+    ----------
+    - IEEE Std 952-1997; IEEE Std 1431-2004 (bias as the average output).
     """
     rate, _unit = units.counts_to_physical(
         _as_1d(counts, "counts"), scale_factor, scale_factor_unit, tau_s
@@ -424,7 +450,26 @@ def too_few_averages(
     """The message of a record that gives fewer than two ``averaging_s`` averages: the file
     ``where``, and the command's option ``option`` (e.g. ``--average``) with the longest
     averaging time that gives two averages (half the longest stretch without a gap
-    ``longest_s`` [s]); without an option, the record's length is what falls short."""
+    ``longest_s`` [s]); without an option, the record's length is what falls short.
+
+    Parameters
+    ----------
+    where : str or None
+        File named in the message.
+    averaging_s : float
+        Averaging time asked [s].
+    n_means : int
+        Number of averages it gives.
+    longest_s : float
+        Longest gap-free stretch [s].
+    option : str or None
+        Command option to name.
+
+    Returns
+    -------
+    str
+        The message.
+    """
     head = f"{where}: " if where else ""
     fix = (
         f"; give {option} {longest_s / 2.0:.3g} or less"
@@ -579,10 +624,38 @@ def std_interval(s: float, n: int, confidence: float = ONE_SIGMA) -> tuple[float
 def run_repeatability(
     runs: list[MetricsResult], files: list[str], confidence: float = ONE_SIGMA
 ) -> RunRepeatability:
-    """Turn-on to turn-on bias repeatability of several runs of one signal (separate
+    r"""Turn-on to turn-on bias repeatability of several runs of one signal (separate
     power-ons): ``Br = sqrt(Σ (B_i − B̄)² / (p − 1))`` over the p run biases
     (:func:`bias_repeatability`) with its chi-square interval (:func:`std_interval`).
-    Every run must be in one unit."""
+    Every run must be in one unit.
+
+    Parameters
+    ----------
+    runs : list of MetricsResult
+        Figures of each run, in one unit.
+    files : list of str
+        Files of the runs.
+    confidence : float, optional
+        Confidence level of the interval (default one sigma, 0.683).
+
+    Returns
+    -------
+    RunRepeatability
+        Repeatability Br [unit] and its interval.
+
+    Raises
+    ------
+    ThermocalInputError
+        Fewer than two runs, or runs in different units.
+
+    Notes
+    -----
+    .. math:: B_r = \sqrt{\textstyle\sum_i (B_i - \bar B)^2 / (p - 1)}
+
+    References
+    ----------
+    - IEEE Std 952-1997 (turn-on to turn-on bias repeatability).
+    """
     if len(runs) < 2:
         raise ThermocalInputError(f"turn-on repeatability needs at least two runs, got {len(runs)}")
     unit = runs[0].unit
@@ -674,8 +747,29 @@ def peak_to_peak(
     *,
     time_s: npt.ArrayLike | None = None,
 ) -> float:
-    """Peak-to-peak variation ``max(ω̄_k) − min(ω̄_k)`` of the averages over
-    ``averaging_s`` [unit] (blocks as in :func:`block_means`)."""
+    r"""Peak-to-peak variation ``max(ω̄_k) − min(ω̄_k)`` of the averages over
+    ``averaging_s`` [unit] (blocks as in :func:`block_means`).
+
+    Parameters
+    ----------
+    rate : array_like
+        Rate samples [unit].
+    tau0_s : float
+        Sample interval [s].
+    averaging_s : float or None
+        Averaging time [s]; None: the samples themselves.
+    time_s : array_like, optional
+        Sample times [s] (gaps split the blocks).
+
+    Returns
+    -------
+    float
+        Peak-to-peak variation [unit].
+
+    Notes
+    -----
+    .. math:: \max_k \bar\omega_k - \min_k \bar\omega_k
+    """
     means = block_means(rate, tau0_s, averaging_s, time_s=time_s)
     if means.size == 0:
         raise ThermocalInputError(f"the record is shorter than one {averaging_s} s average")
@@ -749,7 +843,28 @@ def drift_angle_extreme(
     """End value and largest magnitude of :func:`drift_angle` (the same trapezoids,
     nothing integrated across a gap), block by block without the full-length curve.
 
-    ``max_abs = max_k |θ_k|`` at ``max_time_s = t_k − t_0`` (the first such sample)."""
+    ``max_abs = max_k |θ_k|`` at ``max_time_s = t_k − t_0`` (the first such sample).
+
+    Parameters
+    ----------
+    time_s : array_like
+        Sample times [s].
+    rate : array_like
+        Rate samples [unit/time unit].
+    bias : float
+        Constant b0 removed [unit/time unit].
+    time_unit_s : float, optional
+        Seconds per time unit of the rate (default 3600: a rate per hour).
+    unit : str, optional
+        Angle unit (default ``"deg"``).
+    block : int, optional
+        Samples per block (default 2**18).
+
+    Returns
+    -------
+    DriftExtreme
+        End value and largest magnitude of the drift angle [unit] and its time [s].
+    """
     t = _as_1d(time_s, "time")
     r = _as_1d(rate, "rate")
     if t.shape != r.shape:
@@ -774,8 +889,29 @@ def drift_angle_extreme(
 def drift_angle_total(
     time_s: npt.ArrayLike, rate_deg_h: npt.ArrayLike, bias_deg_h: float, block: int = 1 << 18
 ) -> float:
-    """The end value θ(t_end) of :func:`drift_angle` [°] for a rate in [°/h], summed block
-    by block (the same trapezoids, nothing integrated across a gap) without the curve."""
+    r"""The end value θ(t_end) of :func:`drift_angle` [°] for a rate in [°/h], summed block
+    by block (the same trapezoids, nothing integrated across a gap) without the curve.
+
+    Parameters
+    ----------
+    time_s : array_like
+        Sample times [s].
+    rate_deg_h : array_like
+        Rate [°/h].
+    bias_deg_h : float
+        Constant b0 removed [°/h].
+    block : int, optional
+        Samples per block (default 2**18).
+
+    Returns
+    -------
+    float
+        Drift angle at the end θ(t_end) [°].
+
+    Notes
+    -----
+    .. math:: \theta(t) = \int_{t_0}^{t} (\omega - b_0)\, dt
+    """
     return drift_angle_extreme(time_s, rate_deg_h, bias_deg_h, block=block).end
 
 
@@ -793,6 +929,29 @@ def reference_bias(
     :data:`DEFAULT_DRIFT_REFERENCE_FRACTION` of the run's duration.  ``earth_rate`` Ω_axis
     and ``rate`` in ``unit``.  A window holding no sample is a
     :class:`~thermocal.errors.ThermocalInputError`.
+
+    Parameters
+    ----------
+    time_s : array_like
+        Sample times [s].
+    rate : array_like
+        Rate samples [``unit``].
+    window_s : tuple of float, optional
+        Reference window (start, end) [s since the first sample].
+    earth_rate : float, optional
+        Earth-rate component Ω_axis [``unit``] (default 0).
+    unit : str, optional
+        Rate unit (default ``"deg/h"``).
+
+    Returns
+    -------
+    DriftReference
+        The constant b0 [``unit``] and its window.
+
+    Raises
+    ------
+    ThermocalInputError
+        When the window holds no sample.
     """
     t = _as_1d(time_s, "time")
     r = _as_1d(rate, "rate")
@@ -840,7 +999,26 @@ def hold_stages(
     min_duration_s: float = 600.0,
 ) -> tuple[Stage, ...]:
     """Temperature-hold stages (:func:`thermocal.preprocess.segment_holds`) with the
-    mean temperature and mean signal of each."""
+    mean temperature and mean signal of each.
+
+    Parameters
+    ----------
+    time_s : numpy.ndarray
+        Sample times [s].
+    temp_c : numpy.ndarray
+        Temperatures [°C].
+    values : numpy.ndarray
+        Signal samples [unit].
+    rate_threshold_c_per_min : float, optional
+        Largest temperature rate of a hold [°C/min] (default 0.05).
+    min_duration_s : float, optional
+        Shortest hold [s] (default 600).
+
+    Returns
+    -------
+    tuple of Stage
+        One stage per hold.
+    """
     from thermocal.preprocess import segment_holds
 
     segs = segment_holds(
@@ -869,6 +1047,20 @@ def data_unit_of(rec: Recording, name: str, canonical: str) -> tuple[str, float]
     The column's own unit as given (``deg/s`` stays ``deg/s``); raw counts are shown in
     the unit :meth:`Recording.signal` gave them (``canonical``: [°/h] or [mg] when a scale
     factor K converted them, else ``counts``), so k = 1.
+
+    Parameters
+    ----------
+    rec : Recording
+        The recording.
+    name : str
+        Signal name.
+    canonical : str
+        Unit :meth:`Recording.signal` gave the signal.
+
+    Returns
+    -------
+    tuple of (str, float)
+        The shown unit and the factor k.
     """
     given = rec.units.get(name)
     shown = units.shown_unit(canonical, units.normalize_signal_unit(given) if given else None)
@@ -1089,7 +1281,20 @@ class MetricsOptions:
         return self.latitude_deg is not None or self.axis is not None
 
     def of(self, rec: Recording, name: str) -> MetricsResult:
-        """:func:`compute_metrics` of the signal ``name`` of ``rec`` with these options."""
+        """:func:`compute_metrics` of the signal ``name`` of ``rec`` with these options.
+
+        Parameters
+        ----------
+        rec : Recording
+            The recording.
+        name : str
+            Signal name.
+
+        Returns
+        -------
+        MetricsResult
+            The signal's figures of merit.
+        """
         return compute_metrics(
             rec,
             name,
@@ -1109,7 +1314,22 @@ def channel_metrics(
 ) -> dict[str, MetricsResult]:
     """The figures of every channel ``names`` of one recording (one read of the file,
     several channels).  Earth-rate removal takes one channel: each channel's
-    sensitive axis points elsewhere."""
+    sensitive axis points elsewhere.
+
+    Parameters
+    ----------
+    rec : Recording
+        The recording.
+    names : list of str
+        Signal names.
+    options : MetricsOptions
+        How the figures are computed.
+
+    Returns
+    -------
+    dict of str to MetricsResult
+        Figures per channel.
+    """
     if len(names) > 1 and options.removes_earth_rate:
         raise ThermocalInputError(
             "earth-rate removal (--latitude/--axis) takes one signal at a time: each channel's "
@@ -1146,7 +1366,18 @@ def _distinct_runs(labels: list[str]) -> None:
 
 def sensor_identity(rec: Recording) -> tuple[str, str] | None:
     """The first of :data:`SENSOR_ID_KEYS` a recording's metadata state, with its value as
-    text (None when none is stated)."""
+    text (None when none is stated).
+
+    Parameters
+    ----------
+    rec : Recording
+        The recording.
+
+    Returns
+    -------
+    tuple of (str, str) or None
+        The metadata key and its value.
+    """
     if rec.meta.sensor_id not in (None, ""):
         return "sensor_id", str(rec.meta.sensor_id)
     for key in SENSOR_ID_KEYS:
@@ -1208,7 +1439,29 @@ def power_on_metrics(
     Refused (:class:`ThermocalInputError`, naming the files): a run named twice, a run
     whose samples of a channel equal another run's bit for bit (a copy), runs whose
     metadata name different sensors (:data:`SENSOR_ID_KEYS`): each would give a
-    repeatability of one sensor that the data cannot support."""
+    repeatability of one sensor that the data cannot support.
+
+    Parameters
+    ----------
+    runs : sequence
+        The runs (files).
+    read : callable
+        ``read(run)`` → Recording.
+    signals : list of str or None
+        Channels (default each file's first signal).
+    options : MetricsOptions
+        How the figures are computed.
+
+    Returns
+    -------
+    PowerOnMetrics
+        Figures per run and repeatability per channel.
+
+    Raises
+    ------
+    ThermocalInputError
+        A run named twice, a copied run, or runs of different sensors.
+    """
     per_run: list[dict[str, MetricsResult]] = []
     names: list[str] | None = None
     _distinct_runs([str(r) for r in runs])

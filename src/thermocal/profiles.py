@@ -134,6 +134,7 @@ class Piece:
 
     @property
     def duration_s(self) -> float:
+        """Duration of the stage [s]."""
         return self.end_s - self.start_s
 
     @property
@@ -153,6 +154,7 @@ class Stage:
     label: str = ""
 
     def to_dict(self) -> dict[str, Any]:
+        """The stage as a JSON-ready dict (times [s], set-point [°C])."""
         return {
             "label": self.label,
             "start_s": float(self.start_s),
@@ -225,6 +227,16 @@ class Profile:
         end point is appended when it is not on the grid); with ``None`` only the
         corner points are returned.  Linear interpolation of either reproduces the
         profile exactly at the returned times.
+
+        Parameters
+        ----------
+        dt_s : float or None, optional
+            Sampling interval [s] (default 60); None: corner points only.
+
+        Returns
+        -------
+        tuple of numpy.ndarray
+            Times [s] and set-points [°C].
         """
         tk, ck = self.knots()
         if dt_s is None:
@@ -239,7 +251,18 @@ class Profile:
         return t, np.interp(t, tk, ck)
 
     def setpoint_at(self, time_s: npt.ArrayLike) -> FloatArray:
-        """Set-point [°C] at the given elapsed times [s] (held at the ends)."""
+        """Set-point [°C] at the given elapsed times [s] (held at the ends).
+
+        Parameters
+        ----------
+        time_s : array_like
+            Elapsed times [s].
+
+        Returns
+        -------
+        numpy.ndarray
+            Set-points [°C].
+        """
         tk, ck = self.knots()
         return np.interp(np.asarray(time_s, dtype=np.float64), tk, ck)
 
@@ -367,7 +390,18 @@ POWER_ON_LABEL = "power-on"
 
 
 def power_on_label(start_c: float) -> str:
-    """``'power-on T+25'`` — the label of a power-on hold at ``start_c``."""
+    """``'power-on T+25'`` — the label of a power-on hold at ``start_c``.
+
+    Parameters
+    ----------
+    start_c : float
+        Temperature of the power-on hold [°C].
+
+    Returns
+    -------
+    str
+        The label.
+    """
     return f"{POWER_ON_LABEL} T{start_c:+g}"
 
 
@@ -461,6 +495,31 @@ def builtin_profile(name: str, **params: Any) -> Profile:
     """A built-in profile by name (:data:`PROFILE_NAMES`) with keyword parameters.
 
     Raises :class:`ThermocalInputError` for an unknown name or parameter.
+
+    Parameters
+    ----------
+    name : str
+        Profile name (:data:`PROFILE_NAMES`).
+    **params
+        The profile's keyword parameters (temperatures [°C], durations [s], rates [°C/min]).
+
+    Returns
+    -------
+    Profile
+        The profile.
+
+    Raises
+    ------
+    ThermocalInputError
+        An unknown name or parameter.
+
+    Examples
+    --------
+    >>> from thermocal.profiles import PROFILE_NAMES, builtin_profile
+    >>> p = builtin_profile(PROFILE_NAMES[0])
+    >>> t, sp = p.program(None)
+    >>> bool(t[0] == 0.0 and len(t) == len(sp))
+    True
     """
     try:
         builder = PROFILE_BUILDERS[name]
@@ -484,7 +543,22 @@ ABSOLUTE_ZERO_C = -273.15
 
 def check_program(time_s: npt.ArrayLike, setpoint_c: npt.ArrayLike, what: str = "program") -> None:
     """Raise :class:`ThermocalInputError` unless time is finite and strictly increasing and
-    the set-points are finite and not below absolute zero, with at least two points."""
+    the set-points are finite and not below absolute zero, with at least two points.
+
+    Parameters
+    ----------
+    time_s : array_like
+        Times [s].
+    setpoint_c : array_like
+        Set-points [°C].
+    what : str, optional
+        What the message names (default ``"program"``).
+
+    Raises
+    ------
+    ThermocalInputError
+        On any of the faults above.
+    """
     t = np.asarray(time_s, dtype=np.float64)
     c = np.asarray(setpoint_c, dtype=np.float64)
     if t.ndim != 1 or t.shape != c.shape:
@@ -518,6 +592,28 @@ def find_holds(
 
     A stage is a maximal run of consecutive points whose set-point stays within
     ``tol_c`` of its first value; the program is linear between points.
+
+    Parameters
+    ----------
+    time_s : array_like
+        Program times [s].
+    setpoint_c : array_like
+        Set-points [°C].
+    min_duration_s : float, optional
+        Shortest hold [s] (default 600).
+    tol_c : float, optional
+        Set-point tolerance [°C] (default 1e-6).
+
+    Returns
+    -------
+    list of Stage
+        The holds.
+
+    Examples
+    --------
+    >>> from thermocal.profiles import find_holds
+    >>> [(s.start_s, s.end_s) for s in find_holds([0, 600, 1200, 1800], [25, 25, 40, 40])]
+    [(0.0, 600.0), (1200.0, 1800.0)]
     """
     t = np.asarray(time_s, dtype=np.float64)
     c = np.asarray(setpoint_c, dtype=np.float64)
@@ -641,6 +737,20 @@ def common_base(
     times over the overlap ``[0, min(duration_a, duration_b)]``; values are linearly
     interpolated (a chamber program is linear between its points).  Returns
     ``(elapsed_s, x, y)``.
+
+    Parameters
+    ----------
+    time_a, temp_a : array_like
+        Times [s] and temperatures [°C] of the first history.
+    time_b, temp_b : array_like
+        Times [s] and temperatures [°C] of the second history.
+    n_points : int, optional
+        Points of the common base (default :data:`DEFAULT_CORRELATION_POINTS`).
+
+    Returns
+    -------
+    tuple of numpy.ndarray
+        Elapsed times [s] and the two resampled histories [°C].
     """
     ta, xa = _clean_history(time_a, temp_a, "history A")
     tb, xb = _clean_history(time_b, temp_b, "history B")
@@ -773,6 +883,33 @@ def design_validation_profile(
     ``rate_c_per_min`` from and back to the modelling start temperature.
 
     Raises :class:`DesignError` when no candidate reaches ``|r| < r_limit``.
+
+    Parameters
+    ----------
+    model_time_s, model_setpoint_c : array_like
+        The modelling test's times [s] and set-points [°C].
+    seed : int
+        Seed of the random generator.
+    r_limit : float, optional
+        Largest accepted ``|r|`` (default :data:`WEAK_CORRELATION_LIMIT`).
+    n_holds : int, optional
+        Number of holds (default one per 10 °C, at least 4).
+    hold_s : float, optional
+        Mean hold duration [s] (default 7200).
+    rate_c_per_min : float, optional
+        Ramp rate [°C/min] (default 1).
+    n_candidates, n_points : int, optional
+        Random candidates (default 400) and correlation points (default 2000).
+
+    Returns
+    -------
+    Profile
+        The validation profile.
+
+    Raises
+    ------
+    DesignError
+        When no candidate reaches ``|r| < r_limit``.
     """
     tm = np.asarray(model_time_s, dtype=np.float64)
     cm = np.asarray(model_setpoint_c, dtype=np.float64)

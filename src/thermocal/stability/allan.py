@@ -242,6 +242,7 @@ class FitQuality:
     reason: str | None
 
     def to_dict(self) -> dict[str, Any]:
+        """The fit quality as a JSON-ready dict (misfit runs as dicts)."""
         return {
             "reduced_chi2": self.reduced_chi2,
             "dof": self.dof,
@@ -267,7 +268,22 @@ MISFIT_SIGMA = 1.5
 
 
 def fit_quality(tau_s: FloatArray, normalised_residuals: FloatArray, n_active: int) -> FitQuality:
-    """:class:`FitQuality` from the fit's residuals ``(σ²_fit − σ̂²)/sd(σ̂²)`` per point."""
+    """:class:`FitQuality` from the fit's residuals ``(σ²_fit − σ̂²)/sd(σ̂²)`` per point.
+
+    Parameters
+    ----------
+    tau_s : numpy.ndarray
+        Averaging times of the fitted points [s].
+    normalised_residuals : numpy.ndarray
+        Residual of each point over the standard deviation of its Allan variance [1].
+    n_active : int
+        Number of noise terms with a positive coefficient.
+
+    Returns
+    -------
+    FitQuality
+        Reduced chi-square and the runs of same-sign misfits.
+    """
     r = np.asarray(normalised_residuals, dtype=np.float64)
     dof = max(int(r.size) - int(n_active), 1)
     chi2 = float(r @ r)
@@ -397,6 +413,17 @@ class NoiseTerms:
     fit_sigma : standard errors of ``fit_coefficients`` (NaN where C = 0).
     reduced_chi2 : weighted residual sum of squares / (points − active terms).
     quality : how well the noise model describes the curve (:class:`FitQuality`).
+
+    Examples
+    --------
+    White rate noise of 3 °/h per sample at 10 Hz: N = 3·√0.1 / 60 = 0.0158 °/√h.
+
+    >>> import numpy as np
+    >>> y = np.random.default_rng(0).normal(0.0, 3.0, 20_000)
+    >>> terms = noise_terms(overlapping_adev(y, 0.1, unit="deg/h"))
+    >>> arw = terms.slope.angle_random_walk
+    >>> print(f"{arw.value:.3g} {arw.unit}")
+    0.0158 deg/sqrt(h)
     """
 
     slope: NoiseTermSet
@@ -415,14 +442,46 @@ class NoiseTerms:
     """Sinusoids found in the record that shape the curve (:func:`annotate_periodic`)."""
 
     def fit_curve(self, tau_s: npt.ArrayLike) -> FloatArray:
-        """Fitted Allan deviation sqrt(Σ C_p τ^p) [unit] at ``tau_s``."""
+        r"""Fitted Allan deviation sqrt(Σ C_p τ^p) [unit] at ``tau_s``.
+
+        Parameters
+        ----------
+        tau_s : array_like
+            Averaging times [s].
+
+        Returns
+        -------
+        numpy.ndarray
+            Fitted Allan deviation [unit of the rate].
+
+        Notes
+        -----
+        .. math:: \sigma(\tau) = \sqrt{\textstyle\sum_{p=-2}^{2} C_p \tau^p}
+
+        References
+        ----------
+        - IEEE Std 952-1997, Annex C (Allan variance noise terms).
+        """
         tau = np.asarray(tau_s, dtype=np.float64)
         powers = np.arange(-2, 3)
         design = tau[:, None] ** powers[None, :]
         return np.asarray(np.sqrt(np.maximum(design @ self.fit_coefficients, 0.0)))
 
     def term_curve(self, name: str, tau_s: npt.ArrayLike) -> FloatArray:
-        """Allan deviation [unit] of one fitted term alone at ``tau_s``."""
+        """Allan deviation [unit] of one fitted term alone at ``tau_s``.
+
+        Parameters
+        ----------
+        name : str
+            Term name, one of ``TERM_NAMES``.
+        tau_s : array_like
+            Averaging times [s].
+
+        Returns
+        -------
+        numpy.ndarray
+            Allan deviation of that term alone [unit of the rate].
+        """
         j = TERM_NAMES.index(name)
         tau = np.asarray(tau_s, dtype=np.float64)
         return np.asarray(np.sqrt(self.fit_coefficients[j] * tau ** float(j - 2)))
@@ -432,7 +491,18 @@ class NoiseTerms:
 
 
 def max_averaging_factor(n_samples: int) -> int:
-    """Largest m with at least two second differences: ``N − 2m ≥ 2`` with N = n + 1."""
+    """Largest m with at least two second differences: ``N − 2m ≥ 2`` with N = n + 1.
+
+    Parameters
+    ----------
+    n_samples : int
+        Number of rate samples n.
+
+    Returns
+    -------
+    int
+        Largest averaging factor m [samples].
+    """
     return max((n_samples - 1) // 2, 0)
 
 
@@ -443,6 +513,20 @@ def averaging_factors(taus: TauSpec, tau0_s: float, n_samples: int) -> IntArray:
     ``"log"``: about ten per decade (``round(10^(k/10))``, duplicates removed);
     an array: τ [s] rounded to the nearest multiple of τ0.  Only m with at least
     two terms (``m ≤ (n − 1)/2``) are kept (same set as allantools' ``oadev``).
+
+    Parameters
+    ----------
+    taus : str or array_like
+        ``"octave"``, ``"decade"``, ``"log"`` or averaging times [s].
+    tau0_s : float
+        Sample interval τ0 [s].
+    n_samples : int
+        Number of rate samples n.
+
+    Returns
+    -------
+    numpy.ndarray
+        Sorted unique averaging factors m [samples].
     """
     m_max = max_averaging_factor(n_samples)
     if m_max < 1:
@@ -520,12 +604,32 @@ def _second_difference_sum(x1: FloatArray, mm: int) -> float:
 
 
 def second_difference_sums(x1: FloatArray, m: IntArray) -> FloatArray:
-    """S(m) for each averaging factor m (see :func:`_second_difference_sum`; ``x1`` the
+    r"""S(m) for each averaging factor m (see :func:`_second_difference_sum`; ``x1`` the
     phase without x_0).
 
     The averaging factors are shared between :data:`_WORKERS` threads (numpy releases
     the GIL inside its loops); BLAS is held to one thread meanwhile, because a
     multi-threaded ``dot`` inside each worker would oversubscribe the cores.
+
+    Parameters
+    ----------
+    x1 : numpy.ndarray
+        Phase (integrated rate) without x_0 [unit·s].
+    m : numpy.ndarray
+        Averaging factors [samples].
+
+    Returns
+    -------
+    numpy.ndarray
+        Sum of squared second differences S(m) per factor [(unit·s)²].
+
+    Notes
+    -----
+    .. math:: S(m) = \sum_{i} (x_{i+2m} - 2x_{i+m} + x_i)^2
+
+    References
+    ----------
+    - NIST SP 1065 (Riley 2008), eq. 11 (overlapping Allan variance from phase).
     """
     ms = [int(v) for v in m.tolist()]
     workers = min(_WORKERS, len(ms))
@@ -551,6 +655,24 @@ def edf_simple(n_phase: npt.ArrayLike, m: npt.ArrayLike, alpha: npt.ArrayLike) -
     * α =  0 (white FM): ``(3(N−1)/2m − 2(N−2)/N) · 4m²/(4m²+5)``
     * α = −1 (flicker FM): ``2(N−2)/(2.3N−4.9)`` for m = 1, ``5N²/(4m(N+3m))`` else
     * α = −2 (random-walk FM): ``(N−2)/(m(N−3)²) · ((N−1)² − 3m(N−1) + 4m²)``
+
+    Parameters
+    ----------
+    n_phase : array_like
+        Number of phase points N.
+    m : array_like
+        Averaging factors [samples].
+    alpha : array_like
+        Power-law noise exponent α (+2 … −2).
+
+    Returns
+    -------
+    numpy.ndarray
+        Equivalent degrees of freedom [1].
+
+    References
+    ----------
+    - NIST SP 1065 (Riley 2008), section 5.3, Table 5.
     """
     N, mm, a = np.broadcast_arrays(
         np.asarray(n_phase, dtype=np.float64),
@@ -757,6 +879,7 @@ class DynamicAllan:
 
     @property
     def stationary(self) -> bool:
+        """True when no (window, τ) cell differs from the whole record's ADEV."""
         return not self.changes
 
     def to_dict(self) -> dict[str, Any]:
@@ -799,7 +922,33 @@ def check_dynamic_work(
     channels: windows × (:data:`DYNAMIC_WINDOW_WORK` + 4 n log2 n) with n samples a
     window.  Beyond ``max_work`` a :class:`ThermocalInputError` naming ``where``,
     ``--dynamic`` and ``--max-work`` (a window the dynamic ADEV refuses anyway costs 0
-    here: it says why).  ``--dynamic 8`` on 1e5 samples is 25 000 windows, ≈ 7 minutes."""
+    here: it says why).  ``--dynamic 8`` on 1e5 samples is 25 000 windows, ≈ 7 minutes.
+
+    Parameters
+    ----------
+    n_samples : int
+        Number of samples.
+    tau0_s : float
+        Sample interval [s].
+    window_s : float
+        Window length [s].
+    max_work : float
+        Largest allowed estimated work [operations].
+    channels : int, optional
+        Number of channels (default 1).
+    where : str, optional
+        File or channel named in the error (default none).
+
+    Returns
+    -------
+    float
+        Estimated work [operations].
+
+    Raises
+    ------
+    ThermocalInputError
+        When the estimate exceeds ``max_work``.
+    """
     if not max_work > 0:
         raise ThermocalInputError(f"--max-work {max_work!r}: give a positive operation count")
     if not (math.isfinite(window_s) and window_s > 0 and tau0_s > 0):
@@ -831,14 +980,26 @@ def dynamic_adev(
     step_s: float | None = None,
 ) -> DynamicAllan:
     """Dynamic Allan deviation: :func:`overlapping_adev` in windows of ``window_s`` [s]
-    stepped by ``step_s`` (default half a window), at the τ of ``whole`` (the whole
-    record's result) that fit a window (L. Galleani & P. Tavella, "The dynamic Allan
-    variance", IEEE Trans. UFFC 56(3), 2009).
+    stepped by ``step_s`` (default half a window), at the τ of ``whole`` that fit a window
+    (Galleani & Tavella, "The dynamic Allan variance", IEEE Trans. UFFC 56(3), 2009).
 
     Stationarity: a window's ADEV and the whole record's differ when their chi-square
-    intervals (NIST SP 1065 eq. 45, each with its own EDF) are disjoint.  With many
-    windows × τ compared, each interval is taken at ``1 − 0.01 / comparisons``
-    (Bonferroni), so a stationary record is flagged with probability ≤ 1 %.
+    intervals (NIST SP 1065 eq. 45, each its own EDF) are disjoint, each taken at
+    ``1 − 0.01 / comparisons`` (Bonferroni): a stationary record is flagged at ≤ 1 %.
+
+    Parameters
+    ----------
+    rate : array_like
+        Rate samples [unit].
+    tau0_s, window_s : float
+        Sample interval and window length [s].
+    whole : AllanResult
+        The whole record's result; ``time_s`` [s], ``step_s`` [s] optional.
+
+    Returns
+    -------
+    DynamicAllan
+        Per-window deviations and the stationarity verdict.
     """
     y = np.asarray(rate, dtype=np.float64).ravel()
     if not (math.isfinite(window_s) and window_s > 0):
@@ -951,6 +1112,16 @@ def term_units(unit: str) -> tuple[float, tuple[tuple[float, str, str], ...]]:
 
     A native coefficient (in unit·s^k, τ in seconds) times ``scale · factor`` is
     the reported value.  See the module docstring for the table.
+
+    Parameters
+    ----------
+    unit : str
+        Unit of the rate, e.g. ``"deg/s"``.
+
+    Returns
+    -------
+    tuple
+        Scale to the base unit and, per term, (factor, unit string, label).
     """
     try:
         u = units.normalize_signal_unit(unit)
@@ -996,6 +1167,22 @@ def nnls_small(a: FloatArray, b: FloatArray) -> FloatArray:
     Least Squares Problems*, 1974, ch. 23, solve the same problem by an active set).  2^k
     small solves for k columns; ``scipy.optimize.nnls`` would cost 0.1–0.3 s of import
     on every ``thermocal allan`` run.
+
+    Parameters
+    ----------
+    a : numpy.ndarray
+        Design matrix, shape (n, k) with small k.
+    b : numpy.ndarray
+        Right-hand side, shape (n,).
+
+    Returns
+    -------
+    numpy.ndarray
+        Non-negative solution x, shape (k,).
+
+    References
+    ----------
+    - Lawson, C. L. & Hanson, R. J. (1974). *Solving Least Squares Problems*, ch. 23.
     """
     k = a.shape[1]
     if k > 12:
@@ -1191,7 +1378,7 @@ def white_stretch(
     edf: npt.ArrayLike,
     allowed: npt.ArrayLike | None = None,
 ) -> WhiteStretch | None:
-    """The −½ stretch of an ADEV curve found in the data, not assumed at the shortest τ.
+    r"""The −½ stretch of an ADEV curve found in the data, not assumed at the shortest τ.
 
     A run of consecutive points (``adev`` [unit] at ``tau_s`` [s], each with its ``edf``)
     through which one line of slope −½ passes within each point's interval
@@ -1206,6 +1393,30 @@ def white_stretch(
     two points.  ``allowed``: the points a run may hold (:func:`noise_terms` passes those
     whose local slope over τ/4 … 4τ is within ±0.25 of −½, so that the wide intervals
     of a few long-τ points do not make a stretch of a curve of another slope).
+
+    Parameters
+    ----------
+    tau_s : array_like
+        Averaging times [s].
+    adev : array_like
+        Allan deviations [unit].
+    edf : array_like
+        Equivalent degrees of freedom of each point [1].
+    allowed : array_like of bool, optional
+        Points a run may hold (default all).
+
+    Returns
+    -------
+    WhiteStretch or None
+        The stretch and its line, or None without a run of two points.
+
+    Notes
+    -----
+    .. math:: \sigma(\tau) = N / \sqrt{\tau}
+
+    References
+    ----------
+    - IEEE Std 952-1997, Annex C.3.
     """
     tau = np.asarray(tau_s, dtype=np.float64)
     ok = np.ones(tau.size, dtype=bool) if allowed is None else np.asarray(allowed, dtype=bool)
@@ -1257,7 +1468,7 @@ def bias_at_minimum(
     label: str,
     edf: FloatArray | None = None,
 ) -> NoiseTerm:
-    """The bias instability at the curve's minimum, always (IEEE Std 952-1997 C.3: the flat
+    r"""The bias instability at the curve's minimum, always (IEEE Std 952-1997 C.3: the flat
     minimum of a bias-instability floor is ``0.6643·B``, so ``B = σ_min / 0.6643``), as
     allan_variance_ros and imu_utils report it.
 
@@ -1270,6 +1481,34 @@ def bias_at_minimum(
     or the last point (the record's end: σ still falls, B is an upper bound).  ``edf``:
     the points' degrees of freedom; those below :data:`BIAS_MIN_EDF` are left out (when
     others remain).
+
+    Parameters
+    ----------
+    tau : numpy.ndarray
+        Averaging times of the usable points [s].
+    dev : numpy.ndarray
+        Allan deviations [unit].
+    lo_ratio, hi_ratio : numpy.ndarray
+        Interval bounds over the deviation [1].
+    conv : float
+        Factor to the term's unit.
+    unit, label : str
+        Unit and label of the term.
+    edf : numpy.ndarray, optional
+        Degrees of freedom of the points (default none).
+
+    Returns
+    -------
+    NoiseTerm
+        Bias instability B with its interval, τ and quality.
+
+    Notes
+    -----
+    .. math:: B = \sigma_{min} / 0.6643
+
+    References
+    ----------
+    - IEEE Std 952-1997, Annex C.3.
     """
     if edf is not None and int(np.count_nonzero(edf >= BIAS_MIN_EDF)) >= 3:
         keep = np.asarray(edf >= BIAS_MIN_EDF)
@@ -1490,7 +1729,20 @@ less than this share of its Allan variance (:meth:`PeriodicTerm.adev_bound`)."""
 def periodic_free(result: AllanResult, periodic: tuple[PeriodicTerm, ...]) -> npt.NDArray[np.bool_]:
     """The points of ``result`` whose Allan variance the sinusoids ``periodic`` that shape
     the curve (:func:`~thermocal.stability.periodic.shaping_terms`) hold less than
-    :data:`PERIODIC_CLEAN_SHARE` of, as a boolean mask (all True without one)."""
+    :data:`PERIODIC_CLEAN_SHARE` of, as a boolean mask (all True without one).
+
+    Parameters
+    ----------
+    result : AllanResult
+        Allan deviation result.
+    periodic : tuple of PeriodicTerm
+        Sinusoids that shape the curve.
+
+    Returns
+    -------
+    numpy.ndarray of bool
+        True at the points free of the sinusoids.
+    """
     free = np.ones(result.tau_s.size, dtype=bool)
     for p in shaping_terms(periodic, result.tau_s, result.adev):
         with np.errstate(invalid="ignore", divide="ignore"):
@@ -1603,12 +1855,35 @@ def noise_terms(
 def annotate_periodic(
     terms: NoiseTerms, result: AllanResult, found: tuple[PeriodicTerm, ...]
 ) -> NoiseTerms:
-    """``terms`` with the periodic terms ``found`` in the record
+    r"""``terms`` with the periodic terms ``found`` in the record
     (:func:`thermocal.stability.periodic.periodic_terms`) that shape its curve
     (:func:`~thermocal.stability.periodic.shaping_terms`: ≥ 5 % of the Allan variance at
     τ = 0.371/f₀) in ``periodic``, and every reason that blamed "another noise process"
     naming them with their frequency and amplitude instead (IEEE Std 952-1997 C.1.7: a
-    sinusoid's Allan deviation A·sin²(πf₀τ)/(πf₀τ) is not in the noise model)."""
+    sinusoid's Allan deviation A·sin²(πf₀τ)/(πf₀τ) is not in the noise model).
+
+    Parameters
+    ----------
+    terms : NoiseTerms
+        Noise terms read from the curve.
+    result : AllanResult
+        Allan deviation result.
+    found : tuple of PeriodicTerm
+        Periodic terms found in the record.
+
+    Returns
+    -------
+    NoiseTerms
+        ``terms`` with the shaping periodic terms and reworded reasons.
+
+    Notes
+    -----
+    .. math:: \sigma(\tau) = A \sin^2(\pi f_0 \tau) / (\pi f_0 \tau)
+
+    References
+    ----------
+    - IEEE Std 952-1997, Annex C.1.7.
+    """
     shaping = shaping_terms(found, result.tau_s, result.adev)
     if not shaping:
         return terms

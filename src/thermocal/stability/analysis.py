@@ -74,9 +74,23 @@ def check_not_stuck(
     rest gives one, a stuck or flat-lined channel does.  ``where`` names the file, ``option``
     the option that names the column, ``consequence`` what a constant means to the caller.
 
+    Parameters
+    ----------
+    values : numpy.ndarray
+        Samples of the column [unit].
+    name : str
+        Column name.
+    where : str
+        File named in the message.
+    option : str, optional
+        Option that names the column (default ``"--signal"``).
+    consequence : str, optional
+        What a constant means to the caller.
+
     Raises
     ------
-    ThermocalInputError : every finite sample equal (at least :data:`STUCK_MIN_SAMPLES`).
+    ThermocalInputError
+        Every finite sample equal (at least :data:`STUCK_MIN_SAMPLES`).
     """
     import numpy as np
 
@@ -133,7 +147,28 @@ def check_tau_list(
     """``--taus`` as a list of τ [s]: refuse one whose every τ lies outside what the record
     reaches (every array would be empty), warn naming the τ left out of a list partly
     outside.  ``n_points``: the longest gap-free stretch's points as each deviation counts
-    them (phase points; ``"adev-rate"``: rate samples); ``names`` the deviations asked."""
+    them (phase points; ``"adev-rate"``: rate samples); ``names`` the deviations asked.
+
+    Parameters
+    ----------
+    taus : sequence of float or str
+        The τ list [s] (a named set passes).
+    tau0_s : float
+        Sample interval [s].
+    n_points : int
+        Points of the longest gap-free stretch.
+    names : sequence of str
+        Deviations asked.
+    where : str
+        File named in the message.
+    spec : str, optional
+        The list as the user wrote it.
+
+    Raises
+    ------
+    ThermocalInputError
+        Every τ outside what the record reaches.
+    """
     import numpy as np
 
     if isinstance(taus, str):
@@ -175,7 +210,18 @@ def _longest(rec: Recording) -> int:
 
 def column_unit(name: str) -> str:
     """A phase column's unit from its name (``phase [s]``, ``angle (deg)``), else ``""``:
-    phase units are not signal (rate) units, so the recording's unit resolver cannot give it."""
+    phase units are not signal (rate) units, so the recording's unit resolver cannot give it.
+
+    Parameters
+    ----------
+    name : str
+        Column name.
+
+    Returns
+    -------
+    str
+        The unit, or ``""``.
+    """
     hit = re.search(r"[\[(]([^\])]+)[\])]\s*$", name)
     return hit.group(1).strip() if hit else ""
 
@@ -183,7 +229,20 @@ def column_unit(name: str) -> str:
 def signal_in_data_unit(rec: Recording, name: str) -> tuple[FloatArray, str]:
     """The signal ``name`` in the data's own unit and that unit: the canonical values
     divided by k of :func:`thermocal.metrics.data_unit_of` (the canonical array itself when
-    k = 1, so a caller may overwrite it)."""
+    k = 1, so a caller may overwrite it).
+
+    Parameters
+    ----------
+    rec : Recording
+        The recording.
+    name : str
+        Signal name.
+
+    Returns
+    -------
+    tuple of (numpy.ndarray, str)
+        Values [unit] and the unit.
+    """
     from thermocal.metrics import data_unit_of
 
     canonical, canon_unit = rec.signal(name)
@@ -293,18 +352,40 @@ def allan_analysis(
 ) -> AllanAnalysis:
     """The stability analysis of the channels ``names`` of ``rec`` (module docstring).
 
-    ``taus``: a named τ set (``octave``, ``decade``, ``log``, ``all``) or a list of τ [s];
-    ``deviations``: registered deviation names (:func:`thermocal.stability.registry.names`;
-    then, or with ``data_type="phase"``, the family replaces the ADEV and noise terms);
-    ``dynamic_s``: the dynamic ADEV's window [s] (rate data, ADEV only); ``bias_correct``:
-    Stable32's bias correction of totdev and htotdev (the family only); ``noise_type``: the
-    power-law exponent α the intervals and bias factors assume at every τ instead of the one
-    identified (−4…2, below −2 the Hadamard deviations only; the family only);
-    ``noise_id``: the identification's rules, ``thermocal`` (default) or ``stable32`` (the
-    family only, :func:`thermocal.stability.family.stability`).  A poor noise-model fit and
-    a non-stationary record are :class:`ConditioningWarning` naming ``where`` (and the
-    channel when there are several).  ``max_work``: the family's operation budget
-    (:func:`thermocal.stability.family.check_work`; None: its default).
+    Parameters
+    ----------
+    rec : Recording
+        The recording; ``names`` : list of str, the channels analysed.
+    taus : str or sequence of float, optional
+        ``octave`` (default), ``decade``, ``log``, ``all`` or a list of τ [s].
+    confidence : float, optional
+        Confidence level of the intervals (default one sigma, 0.683).
+    deviations : sequence of str, optional
+        Registered deviation names (:func:`thermocal.stability.registry.names`); then, or
+        with ``data_type="phase"``, the family replaces the ADEV and noise terms.
+    data_type : str, optional
+        ``"rate"`` (default) or ``"phase"``.
+    dynamic_s : float, optional
+        The dynamic ADEV's window [s] (rate data, ADEV only).
+    where, bias_correct : str, bool, optional
+        File named in messages; Stable32's bias correction of totdev and htotdev.
+    noise_type, noise_id : int, str, optional
+        Power-law α (−4…2) assumed at every τ; identification rules ``thermocal``/``stable32``.
+    max_work : float, optional
+        The family's operation budget (:func:`thermocal.stability.family.check_work`).
+
+    Returns
+    -------
+    AllanAnalysis
+        Per channel the deviations, noise terms and dynamic ADEV.
+
+    Raises
+    ------
+    ParameterError
+        An unknown ``data_type``.
+    ThermocalInputError
+        A confidence, τ list or option the record cannot serve (a poor noise-model fit
+        and a non-stationary record are a :class:`ConditioningWarning`).
     """
     check_confidence(confidence)
     if data_type not in DATA_TYPES:
@@ -497,7 +578,22 @@ def _allan_channel(
 def nonstationary_message(dyn: DynamicAllan, where: str, what: str = "the record") -> str:
     """The warning of a non-stationary record (``dyn.changes`` not empty): how many
     (window, τ) cells differ from the whole record's ADEV beyond both intervals and the
-    largest such change [``dyn.unit``]; ``where`` names the file, ``what`` the series."""
+    largest such change [``dyn.unit``]; ``where`` names the file, ``what`` the series.
+
+    Parameters
+    ----------
+    dyn : DynamicAllan
+        Dynamic ADEV result.
+    where : str
+        File named in the message.
+    what : str, optional
+        The series (default ``"the record"``).
+
+    Returns
+    -------
+    str
+        The warning text.
+    """
     worst = max(dyn.changes, key=lambda c: abs(math.log(c["adev"] / c["whole_adev"])))
     return (
         f"{where}: {what} is not stationary: in {len(dyn.changes)} (window, τ) "
@@ -521,7 +617,20 @@ def motion_in(rec: Recording, gyro: Sequence[str], accel: Sequence[str]) -> str 
     the accelerometer's 1 s mean direction from its median (beyond :data:`STILL_TURN_DEG`;
     when it reads gravity, above 0.5 g), else the largest departure of the gyro's 1 s mean
     rate from its median (beyond :data:`STILL_RATE_DEG_H`).  Columns in raw counts without
-    a scale factor are not judged."""
+    a scale factor are not judged.
+
+    Parameters
+    ----------
+    rec : Recording
+        The recording.
+    gyro, accel : sequence of str
+        Gyro [rate unit] and accelerometer [acceleration unit] columns.
+
+    Returns
+    -------
+    str or None
+        The motion in words, None when still.
+    """
     import numpy as np
 
     w = max(1, round(1.0 / rec.sample_interval_s))
@@ -578,7 +687,32 @@ def imu_noise(
     (:func:`thermocal.stability.noise_model.axis_noise` per axis in the data's own unit,
     :func:`~thermocal.stability.noise_model.noise_model` over them, rate 1/τ0).  A term
     given only as an upper bound is a :class:`ConditioningWarning` naming ``where`` and
-    the axis."""
+    the axis.
+
+    Parameters
+    ----------
+    rec : Recording
+        The recording.
+    gyro, accel : list of str
+        Gyro and accelerometer columns.
+    inflate : float, optional
+        Factor on the densities (default 1).
+    rostopic : str, optional
+        ROS topic of the IMU (default ``"/imu0"``).
+    confidence : float, optional
+        Confidence level of the intervals (default one sigma, 0.683).
+    where : str, optional
+        File named in warnings.
+
+    Returns
+    -------
+    ImuNoise
+        The noise model and its terms per axis.
+
+    References
+    ----------
+    - IEEE Std 952-1997, Annex C (Allan variance noise terms).
+    """
     from thermocal.stability import noise_model as nm
 
     check_confidence(confidence)

@@ -438,7 +438,20 @@ class AllanNoise:
 
     def term(self, name: str, method: Literal["fit", "slope"] = "fit") -> allan.NoiseTerm:
         """One term (``quantization``, ``angle_random_walk``, ``bias_instability``,
-        ``rate_random_walk``, ``rate_ramp``) by ``method``."""
+        ``rate_random_walk``, ``rate_ramp``) by ``method``.
+
+        Parameters
+        ----------
+        name : str
+            Term name.
+        method : {"fit", "slope"}, optional
+            Least-squares fit (default) or slope line.
+
+        Returns
+        -------
+        NoiseTerm
+            The term's value [its unit] and interval.
+        """
         if name not in allan.TERM_NAMES:
             raise ParameterError("name", f"{{name}} {name!r}: use {', '.join(allan.TERM_NAMES)}")
         if method not in ("fit", "slope"):

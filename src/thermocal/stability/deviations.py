@@ -53,7 +53,20 @@ _BLOCK: Final = 1 << 22
 
 
 def max_factor(name: str, n_phase: int) -> int:
-    """Largest averaging factor m with at least one term for N phase points."""
+    """Largest averaging factor m with at least one term for N phase points.
+
+    Parameters
+    ----------
+    name : str
+        Deviation name (``"adev"``, ``"mdev"``, ``"htotdev"`` …).
+    n_phase : int
+        Number of phase points N.
+
+    Returns
+    -------
+    int
+        Largest averaging factor m [samples].
+    """
     if name in ("adev", "oadev", "tierms", "mtie"):
         return (n_phase - 1) // 2 if name in ("adev", "oadev") else n_phase - 1
     if name in ("mdev", "tdev", "mtotdev", "ttotdev"):
@@ -92,7 +105,22 @@ def work(name: str, n_phase: int, m: npt.ArrayLike) -> float:
     * the others: Σ_m 4 N.
 
     These are the sums the kernels here evaluate, so the estimate is their cost to a
-    constant factor (about 1 ns per operation on one 2020s core)."""
+    constant factor (about 1 ns per operation on one 2020s core).
+
+    Parameters
+    ----------
+    name : str
+        Deviation name.
+    n_phase : int
+        Number of phase points N.
+    m : array_like
+        Averaging factors [samples].
+
+    Returns
+    -------
+    float
+        Estimated operations [1].
+    """
     mm = np.asarray(m, dtype=np.float64).ravel()
     mm = mm[(mm >= 1) & (mm <= max_factor(name, n_phase))]
     n = float(n_phase)
@@ -166,7 +194,18 @@ def _difference_sum(
 
 
 def step_small(m: int) -> bool:
-    """Whether x_k … x_{k+2m} of a block of terms lie within two blocks (cache-resident)."""
+    """Whether x_k … x_{k+2m} of a block of terms lie within two blocks (cache-resident).
+
+    Parameters
+    ----------
+    m : int
+        Averaging factor [samples].
+
+    Returns
+    -------
+    bool
+        True when the terms of a block stay cache-resident.
+    """
     return 0 < m < _CHUNK
 
 
@@ -240,7 +279,7 @@ def _prefix_squares(w: FloatArray, lanes: FloatArray) -> tuple[float, float]:
 
 
 def modified_sum(x: FloatArray, m: int, n_terms: int, lane: FloatArray | None = None) -> float:
-    """Σ_{j<n_terms} v_j² of MDEV's inner sums v_j = Σ_{i=j}^{j+m−1} (x_{i+2m} − 2x_{i+m} +
+    r"""Σ_{j<n_terms} v_j² of MDEV's inner sums v_j = Σ_{i=j}^{j+m−1} (x_{i+2m} − 2x_{i+m} +
     x_i) (NIST SP 1065 eq. 14), with no running sum of the phase itself.
 
     v_0 is summed directly (pairwise); then v_{j+1} = v_j + t_j with t_j = x_{j+3m} −
@@ -251,7 +290,32 @@ def modified_sum(x: FloatArray, m: int, n_terms: int, lane: FloatArray | None = 
     does.  At m = 1, v_j is the second difference itself (no running sum): MDEV
     is OADEV to the last digit; at m = 2, 4, 8 the window sums of the second differences
     are taken by doubling (pairwise, log₂ m adds a term).  ``lane``: x in the layout of
-    :func:`lane_layout`, for m a multiple of :data:`_LANES` (:func:`_lane_modified_sum`)."""
+    :func:`lane_layout`, for m a multiple of :data:`_LANES` (:func:`_lane_modified_sum`).
+
+    Parameters
+    ----------
+    x : numpy.ndarray
+        Phase points [unit·s].
+    m : int
+        Averaging factor [samples].
+    n_terms : int
+        Number of inner sums v_j.
+    lane : numpy.ndarray, optional
+        ``x`` in lane layout (default none).
+
+    Returns
+    -------
+    float
+        Sum of squared inner sums [(unit·s)²].
+
+    Notes
+    -----
+    .. math:: v_j = \sum_{i=j}^{j+m-1} (x_{i+2m} - 2x_{i+m} + x_i)
+
+    References
+    ----------
+    - NIST SP 1065 (Riley 2008), eq. 14 (modified Allan variance).
+    """
     if n_terms < 1:
         return 0.0
     if m == 1:
@@ -321,7 +385,18 @@ def lane_layout(x: FloatArray) -> FloatArray:
     """x as a (:data:`_LANES`, ⌈N / L⌉) array: row i, column c holds x_{cL+i} (zero past the
     end).  A shift of the index by m = kL is a shift of k columns, the same in every row: the
     third differences of :func:`_lane_modified_sum` come out already laid in lanes.  Copied
-    in blocks of 1024 columns (a transposed copy of the whole is ≈ 5× slower)."""
+    in blocks of 1024 columns (a transposed copy of the whole is ≈ 5× slower).
+
+    Parameters
+    ----------
+    x : numpy.ndarray
+        Phase points, shape (N,).
+
+    Returns
+    -------
+    numpy.ndarray
+        Array of shape (L, ⌈N / L⌉).
+    """
     cols = -(-x.size // _LANES)
     full = x.size // _LANES
     out = np.zeros((_LANES, cols))
@@ -396,7 +471,22 @@ def _lane_block(
 def lane_group_sums(x: FloatArray, lane: FloatArray, ms: list[int]) -> list[float]:
     """:func:`modified_sum` for several m (multiples of :data:`_LANES`, m/L ≤ half a block,
     N − 3m > :data:`_LANE_CHUNK`) in ONE pass over the lane layout: each block of phase is
-    read from memory once for all of them (the sums are bound by memory, not arithmetic)."""
+    read from memory once for all of them (the sums are bound by memory, not arithmetic).
+
+    Parameters
+    ----------
+    x : numpy.ndarray
+        Phase points [unit·s].
+    lane : numpy.ndarray
+        ``x`` in lane layout.
+    ms : list of int
+        Averaging factors [samples].
+
+    Returns
+    -------
+    list of float
+        :func:`modified_sum` for each factor [(unit·s)²].
+    """
     n = x.size
     ks = [mm // _LANES for mm in ms]
     n_terms = [n - 3 * mm + 1 for mm in ms]
@@ -429,7 +519,26 @@ def difference_sums(
     """:func:`_difference_sum` for each factor m: ``base(m)`` gives (array, offset unit,
     term count) — the phase with m itself, or a decimated phase with 1 — shared between
     :data:`_WORKERS` threads (numpy releases the GIL in its loops; BLAS held to one thread
-    meanwhile).  ``kernel(array, step, n_terms)``: another sum than ``taps``' (MDEV's)."""
+    meanwhile).  ``kernel(array, step, n_terms)``: another sum than ``taps``' (MDEV's).
+
+    Parameters
+    ----------
+    base : callable
+        ``base(m)`` → (array, step, term count).
+    m : numpy.ndarray
+        Averaging factors [samples].
+    taps : tuple of (int, float)
+        Offsets and weights of the difference.
+    nested : bool, optional
+        Whether the sum is nested (default False).
+    kernel : callable, optional
+        Other sum than the taps' (default none).
+
+    Returns
+    -------
+    numpy.ndarray
+        Sum per factor [(unit·s)²].
+    """
 
     def one(mm: int) -> float:
         arr, step, n_terms = base(mm)
@@ -649,7 +758,24 @@ def octave_levels(
 ) -> list[OctaveLevel]:
     """The :class:`OctaveLevel` for m = 1, 2, 4 … ≤ ``m_max`` (while a block remains) of
     rate samples ``y`` with mean ``mean``: each level from the one below in one blocked pass
-    (O(n) in all; no phase array).  ``d1``/``d2``: take the Allan/Hadamard sums too."""
+    (O(n) in all; no phase array).  ``d1``/``d2``: take the Allan/Hadamard sums too.
+
+    Parameters
+    ----------
+    y : numpy.ndarray
+        Rate samples [unit].
+    mean : float
+        Their mean [unit].
+    m_max : int
+        Largest averaging factor [samples].
+    d1, d2 : bool, optional
+        Also take the Allan / Hadamard sums (default False).
+
+    Returns
+    -------
+    list of OctaveLevel
+        One level per octave.
+    """
     out: list[OctaveLevel] = []
     z, offset, m = np.asarray(y, dtype=np.float64), float(mean), 1
     while z.size >= 1 and m <= m_max:
@@ -663,9 +789,32 @@ def octave_levels(
 
 
 def octave_sums(name: str, levels: list[OctaveLevel], m: IntArray) -> tuple[FloatArray, FloatArray]:
-    """(numerator, terms) per m of ``adev``/``hdev`` from one stretch's octave levels, as
+    r"""(numerator, terms) per m of ``adev``/``hdev`` from one stretch's octave levels, as
     :func:`segment_sums` gives them: Σ (τ0 ΔS)² / (2τ²) = Σ (ΔS)² / (2m²) over n//m − 1 terms
-    (adev), Σ (Δ²S)² / (6m²) over n//m − 2 (hdev); (0, 0) where too few blocks remain."""
+    (adev), Σ (Δ²S)² / (6m²) over n//m − 2 (hdev); (0, 0) where too few blocks remain.
+
+    Parameters
+    ----------
+    name : str
+        ``"adev"`` or ``"hdev"``.
+    levels : list of OctaveLevel
+        Levels of :func:`octave_levels`.
+    m : numpy.ndarray
+        Averaging factors [samples].
+
+    Returns
+    -------
+    tuple of numpy.ndarray
+        (numerator, terms) per factor.
+
+    Notes
+    -----
+    .. math:: \sigma_y^2(m\tau_0) = \frac{1}{2m^2 (n/m - 1)} \sum (\Delta S)^2
+
+    References
+    ----------
+    - NIST SP 1065 (Riley 2008), eq. 10 (Allan variance) and eq. 17 (Hadamard variance).
+    """
     d = 2 if name == "adev" else 3
     by_m = {lv.m: lv for lv in levels}
     num, cnt = np.zeros(m.size), np.zeros(m.size)
@@ -684,7 +833,24 @@ def segment_sums(
 ) -> tuple[FloatArray, FloatArray]:
     """(numerator, terms) per m for one gap-free stretch of phase ``x``: the variance is
     numerator / terms (for mtie the numerator is the MTIE itself and terms its window count).
-    A factor beyond :func:`max_factor` (or below 1) gives (0, 0)."""
+    A factor beyond :func:`max_factor` (or below 1) gives (0, 0).
+
+    Parameters
+    ----------
+    name : str
+        Deviation name.
+    x : numpy.ndarray
+        Phase of one gap-free stretch [unit·s].
+    tau0_s : float
+        Sample interval [s].
+    m : numpy.ndarray
+        Averaging factors [samples].
+
+    Returns
+    -------
+    tuple of numpy.ndarray
+        (numerator, terms) per factor.
+    """
     num = np.zeros(m.size)
     cnt = np.zeros(m.size)
     n = x.size
@@ -736,7 +902,22 @@ def segment_sums(
 def pool(
     name: str, parts: list[tuple[FloatArray, FloatArray]], size: int
 ) -> tuple[FloatArray, FloatArray]:
-    """Deviation and term count per m from the stretches' (numerator, terms)."""
+    """Deviation and term count per m from the stretches' (numerator, terms).
+
+    Parameters
+    ----------
+    name : str
+        Deviation name.
+    parts : list of tuple
+        (numerator, terms) of each stretch.
+    size : int
+        Number of factors.
+
+    Returns
+    -------
+    tuple of numpy.ndarray
+        Deviation [unit] and term count per factor.
+    """
     num = np.zeros(size)
     cnt = np.zeros(size)
     for a, b in parts:
@@ -754,13 +935,55 @@ def pool(
 
 
 def theo1_tau(m: npt.ArrayLike, tau0_s: float) -> FloatArray:
-    """Theo1's averaging time τ = 0.75 m τ0 [s]."""
+    r"""Theo1's averaging time τ = 0.75 m τ0 [s].
+
+    Parameters
+    ----------
+    m : array_like
+        Even averaging factors [samples].
+    tau0_s : float
+        Sample interval [s].
+
+    Returns
+    -------
+    numpy.ndarray
+        Averaging times τ [s].
+
+    Notes
+    -----
+    .. math:: \tau = 0.75\, m \tau_0
+
+    References
+    ----------
+    - NIST SP 1065 (Riley 2008), eq. 30 (Theo1).
+    """
     return np.asarray(0.75 * np.asarray(m, dtype=np.float64) * tau0_s)
 
 
 def as_phase(values: FloatArray, tau0_s: float, data_type: str, offset: float = 0.0) -> FloatArray:
-    """Phase points of one stretch: rate y → x_k = τ0 Σ_{i<k} (y_i − offset) (N = n + 1);
-    phase as given, copied (``offset`` unused; the copy may be centred in place)."""
+    r"""Phase points of one stretch: rate y → x_k = τ0 Σ_{i<k} (y_i − offset) (N = n + 1);
+    phase as given, copied (``offset`` unused; the copy may be centred in place).
+
+    Parameters
+    ----------
+    values : numpy.ndarray
+        Rate [unit] or phase [unit·s] samples.
+    tau0_s : float
+        Sample interval [s].
+    data_type : str
+        ``"rate"`` (frequency) or ``"phase"``.
+    offset : float, optional
+        Rate subtracted before integrating [unit] (default 0).
+
+    Returns
+    -------
+    numpy.ndarray
+        Phase points [unit·s].
+
+    Notes
+    -----
+    .. math:: x_k = \tau_0 \sum_{i<k} (y_i - \text{offset})
+    """
     if data_type == "phase":
         return np.array(values, dtype=np.float64)
     x = np.empty(values.size + 1)
@@ -774,7 +997,20 @@ def as_phase(values: FloatArray, tau0_s: float, data_type: str, offset: float = 
 def centred(x: FloatArray, *, inplace: bool = False) -> FloatArray:
     """x minus the straight line through its end points: every variance here cancels a linear
     phase (a constant rate) exactly; removing it keeps the sums free of rounding growth.
-    ``inplace``: in ``x``'s own buffer.  The result's first point is exactly 0."""
+    ``inplace``: in ``x``'s own buffer.  The result's first point is exactly 0.
+
+    Parameters
+    ----------
+    x : numpy.ndarray
+        Phase points [unit·s].
+    inplace : bool, optional
+        Work in ``x``'s buffer (default False).
+
+    Returns
+    -------
+    numpy.ndarray
+        Phase minus the line through its end points [unit·s].
+    """
     if x.size < 2:
         return x
     x0 = float(x[0])

@@ -326,7 +326,26 @@ def edf_simple(n_phase: int, m: int, alpha: int) -> float:
     * α = −1 (flicker FM): ``2(N − 2)²/(2.3N − 4.9)`` at m = 1, ``5N²/(4m(N + 3m))`` above
     * α = −2 (random-walk FM): ``(N − 2)/m · ((N − 1)² − 3m(N − 1) + 4m²)/(N − 3)²``
 
-    NaN outside their domain (N ≤ 2m); α outside −2…2 is refused."""
+    NaN outside their domain (N ≤ 2m); α outside −2…2 is refused.
+
+    Parameters
+    ----------
+    n_phase : int
+        Number of phase points N.
+    m : int
+        Averaging factor [samples].
+    alpha : int
+        Power-law noise exponent α (+2 … −2).
+
+    Returns
+    -------
+    float
+        Equivalent degrees of freedom [1].
+
+    References
+    ----------
+    - NIST SP 1065 (Riley 2008), Table 5 (Howe, Allan & Barnes simple approximations).
+    """
     n = float(n_phase)
     if n <= 2 * m:
         return float("nan")
@@ -369,7 +388,22 @@ def edf_stable32_simple(n_phase: int, m: int, alpha: int) -> float:
 
     The same 1.8–2.1 at EDF 18 as at 924: an offset, not a change of N or m.  Greenhall's
     overlapping Allan/Hadamard EDF, used here before for these cases, put bounds 0.3–30 %
-    off (flicker PM) and 2–2.5 ‰ off (Htot flicker and random-walk FM below m = 16)."""
+    off (flicker PM) and 2–2.5 ‰ off (Htot flicker and random-walk FM below m = 16).
+
+    Parameters
+    ----------
+    n_phase : int
+        Number of phase points N.
+    m : int
+        Averaging factor [samples].
+    alpha : int
+        Power-law noise exponent α (+2 … −2).
+
+    Returns
+    -------
+    float
+        Equivalent degrees of freedom [1].
+    """
     return edf_simple(n_phase, m, alpha) + STABLE32_SIMPLE_OFFSET
 
 
@@ -453,6 +487,24 @@ def edf_mtotdev(n_phase: int, m: int, alpha: int) -> float:
     (α = −1) and predict the other rows (PHASE.DAT m = 16–64, Sr87 m = 10, 20, 40, 100 and
     the frequency-data run) within 0.07 % of EDF (bounds within 2e-5).  SP 1065 Table 8
     (1.10, 1.20 for α = 0) gives EDFs 12–28 % off Stable32's (bounds off 0.4–2 %).
+
+    Parameters
+    ----------
+    n_phase : int
+        Number of phase points N.
+    m : int
+        Averaging factor [samples].
+    alpha : int
+        Power-law noise exponent α (+2 … −2).
+
+    Returns
+    -------
+    float
+        Equivalent degrees of freedom [1].
+
+    References
+    ----------
+    - NIST SP 1065 (Riley 2008), Table 8; Greenhall & Riley 2003.
     """
     if m < MTOT_GREENHALL_BELOW:
         return greenhall_edf(max(min(alpha, 2), -2), 2, m, n_phase, overlapping=True, modified=True)
@@ -486,6 +538,24 @@ def edf_htotdev(n_phase: int, m: int, alpha: int) -> float:
     667.8, 571.9, 348.4, 184.0); Sr87 white FM m = 8, 10: 230.3, 185.5 (230.2, 185.5),
     flicker FM m = 1, 4: 1090, 390 (1090.0, 389.9), random-walk FM m = 2: 627 (626.5).
     Greenhall's overlapping-Hadamard EDF gives 897, 359 and 666 for the last three.
+
+    Parameters
+    ----------
+    n_phase : int
+        Number of phase points N.
+    m : int
+        Averaging factor [samples].
+    alpha : int
+        Power-law noise exponent α (+2 … −2).
+
+    Returns
+    -------
+    float
+        Equivalent degrees of freedom [1].
+
+    References
+    ----------
+    - Howe, D. A. et al. (2000), PTTI, Table 1 (Hadamard total variance).
     """
     if alpha > 0 or (m < HTOT_FORMULA_FROM and alpha >= -2):
         return edf_stable32_simple(n_phase, m, min(alpha, 2))
@@ -522,6 +592,24 @@ def edf_theo1(n_phase: int, m: int, alpha: int) -> float:
     0.56 N (m = 150) the random-walk FM fit gives 0.24 where the simulation gives 1.2: its
     intervals there are far too wide.  Flicker PM/FM were not simulated.  Stable32's own
     Theo1 intervals were not at hand (the PHASE.DAT Theo1 reference prints none).
+
+    Parameters
+    ----------
+    n_phase : int
+        Number of phase points N.
+    m : int
+        Averaging factor [samples].
+    alpha : int
+        Power-law noise exponent α (+2 … −2).
+
+    Returns
+    -------
+    float
+        Equivalent degrees of freedom [1].
+
+    References
+    ----------
+    - Howe & Peppler 2003; Howe & Tasset 2004.
     """
     n = float(n_phase)
     t = 0.75 * m
@@ -567,7 +655,26 @@ class NoiseId:
 
 
 def lag1_autocorrelation(z: FloatArray) -> float:
-    """r1 = Σ (z_n − z̄)(z_{n+1} − z̄) / Σ (z_n − z̄)²  (Riley & Greenhall 2004, eq. 2)."""
+    r"""r1 = Σ (z_n − z̄)(z_{n+1} − z̄) / Σ (z_n − z̄)²  (Riley & Greenhall 2004, eq. 2).
+
+    Parameters
+    ----------
+    z : numpy.ndarray
+        Samples (phase or rate averages).
+
+    Returns
+    -------
+    float
+        Lag-1 autocorrelation r1 [1].
+
+    Notes
+    -----
+    .. math:: r_1 = \frac{\sum (z_n - \bar z)(z_{n+1} - \bar z)}{\sum (z_n - \bar z)^2}
+
+    References
+    ----------
+    - Riley & Greenhall 2004, eq. 2.
+    """
     c = z - z.mean()
     den = float(c @ c)
     return float(c[:-1] @ c[1:]) / den if den > 0 else 0.0
@@ -729,6 +836,41 @@ def identify_noise(
     reads white FM.  Without either, every lag-1 α of PHASE.DAT, Sr87, the Cs 5071A, GPS
     and Keysight 53230A records equals Stable32's.  Frequency drift is therefore not removed
     here: remove it from the data first (as Stable32's users do).
+
+    Parameters
+    ----------
+    x : numpy.ndarray
+        Phase points of one gap-free stretch [unit·s].
+    m : int
+        Averaging factor [samples].
+    dmax : int
+        Difference order: 2 for the Allan family, 3 for Hadamard.
+    phase_input : bool
+        Whether the data were given as phase.
+    rules : IdRules, optional
+        Identification rules (default thermocal's).
+
+    Returns
+    -------
+    NoiseId
+        Noise exponent α and the method that gave it.
+
+    References
+    ----------
+    - Riley & Greenhall 2004 (lag-1 autocorrelation).
+    - Barnes, J. A. (1969), NBS Technical Note 375 (bias functions B1 and B2).
+
+    Examples
+    --------
+    White FM (α = 0) and random-walk FM (α = −2) rate, as phase points:
+
+    >>> import numpy as np
+    >>> w = np.random.default_rng(0).normal(size=4000)
+    >>> identify_noise(np.r_[0.0, np.cumsum(w)], 4, dmax=2, phase_input=False).alpha
+    0
+    >>> rw = np.cumsum(w)
+    >>> identify_noise(np.r_[0.0, np.cumsum(rw)], 4, dmax=2, phase_input=False).alpha
+    -2
     """
     nb = (x.size - 1) // m  # m-averages of the rate: (x_{(k+1)m} − x_{km}) / m
     ym = np.diff(x[: nb * m + 1 : m]) if nb else x[:0].copy()
@@ -744,10 +886,31 @@ def identify_noise(
 
 
 def modified_allan_ratio(x: FloatArray, m: int) -> float:
-    """R(n) = Mod σ²_y(τ) / σ²_y(τ) at τ = m τ0 from the phase ``x`` (both overlapping; τ0
+    r"""R(n) = Mod σ²_y(τ) / σ²_y(τ) at τ = m τ0 from the phase ``x`` (both overlapping; τ0
     cancels): ``(Σ_j s_j² / (m² (N − 3m + 1))) / (Σ_i d_i² / (N − 2m))`` with d_i = x_{i+2m}
     − 2 x_{i+m} + x_i and s_j = Σ_{i=j}^{j+m−1} d_i (NIST SP 1065 eqs. 13 and 14).  NaN when
-    the record is shorter than 3m + 1 points or has no second difference."""
+    the record is shorter than 3m + 1 points or has no second difference.
+
+    Parameters
+    ----------
+    x : numpy.ndarray
+        Phase points [unit·s].
+    m : int
+        Averaging factor [samples].
+
+    Returns
+    -------
+    float
+        Ratio R(n) [1], NaN when undefined.
+
+    Notes
+    -----
+    .. math:: R(n) = \operatorname{Mod}\sigma_y^2(\tau) / \sigma_y^2(\tau)
+
+    References
+    ----------
+    - NIST SP 1065 (Riley 2008), eqs. 13 and 14.
+    """
     n = x.size
     if m < 1 or n < 3 * m + 1:
         return float("nan")
@@ -778,7 +941,22 @@ def split_pm(nid: NoiseId, x: FloatArray, m: int) -> NoiseId:
 
     Stable32 reads flicker PM there on PHASE.DAT's total family at m = 128, Sr87 at m = 100
     and a Keysight 53230A time-interval record at m = 2048, 4096 (allantools' test data),
-    where B1 alone gave white PM."""
+    where B1 alone gave white PM.
+
+    Parameters
+    ----------
+    nid : NoiseId
+        Identification from B1.
+    x : numpy.ndarray
+        Phase points [unit·s].
+    m : int
+        Averaging factor [samples].
+
+    Returns
+    -------
+    NoiseId
+        ``nid`` with white or flicker PM told apart.
+    """
     if nid.method != "b1" or nid.alpha != 2:
         return nid
     r = modified_allan_ratio(x, m)
@@ -800,7 +978,26 @@ def identify_rate_averages(
     (any scale and offset: block sums serve as well).  ``own``: ``z`` may be centred in
     place; ``sums``: its :class:`LagSums` already taken (``z`` is then only read where the
     sums cannot decide: explicit detrending, differencing, B1); ``rules``: see
-    :func:`identify_noise`."""
+    :func:`identify_noise`.
+
+    Parameters
+    ----------
+    z : numpy.ndarray
+        m-averages (or block sums) of the rate.
+    dmax : int
+        Difference order: 2 for the Allan family, 3 for Hadamard.
+    own : bool, optional
+        ``z`` may be centred in place (default False).
+    sums : LagSums, optional
+        Lag sums of ``z`` already taken.
+    rules : IdRules, optional
+        Identification rules (default thermocal's).
+
+    Returns
+    -------
+    NoiseId
+        Noise exponent α and the method that gave it.
+    """
     if z.size >= MIN_ACF_POINTS and not rules.rate_detrend:  # the mean removed, no line
         return _lag1_differenced(lag1_autocorrelation(z), z, dmax - 1, 0, rules.r1_sample)
     if z.size >= MIN_ACF_POINTS:

@@ -49,13 +49,35 @@ the number of averages, bounded by the shorter τ's α) or Stable32's."""
 
 def no_interval(name: str) -> str | None:
     """Why the deviation ``name`` has no interval (its ``low``/``high`` are NaN;
-    ``<name>_interval`` in JSON), or None when it has one."""
+    ``<name>_interval`` in JSON), or None when it has one.
+
+    Parameters
+    ----------
+    name : str
+        Deviation name.
+
+    Returns
+    -------
+    str or None
+        The reason, or None.
+    """
     dev = registry.get(name)
     return dev.interval if dev.edf is None else None
 
 
 def edf_source(name: str) -> str:
-    """Where a deviation's EDF comes from, as the ``<name>_interval`` text states it."""
+    """Where a deviation's EDF comes from, as the ``<name>_interval`` text states it.
+
+    Parameters
+    ----------
+    name : str
+        Deviation name.
+
+    Returns
+    -------
+    str
+        The source of its EDF.
+    """
     return registry.get(name).interval
 
 
@@ -204,7 +226,7 @@ _HTOTVAR_BIAS: Final = {0: -0.005, -1: -0.149, -2: -0.229, -3: -0.283, -4: -0.32
 
 
 def stable32_bias(name: str, alpha: int, m: int, n_phase: int) -> float:
-    """The factor Stable32 multiplies a total deviation by to remove its bias.
+    r"""The factor Stable32 multiplies a total deviation by to remove its bias.
 
     * totdev: ``1/√(1 − a·τ/T)`` with a = 1/(3 ln 2) for flicker FM, 3/4 for random-walk FM,
       0 otherwise, and T = (N − 1) τ0 the record length (D. A. Howe, "Total variance
@@ -218,6 +240,30 @@ def stable32_bias(name: str, alpha: int, m: int, n_phase: int) -> float:
     Checked against Stable32's printed values (which are so corrected): PHASE.DAT's Htot
     (÷√0.995 from m = 2), the Sr87 record's Htot at α = −1, −2 (factors 1.0840, 1.1389) and
     its totdev at α = −1, −2 (m = 1–400: within the five printed digits).
+
+    Parameters
+    ----------
+    name : str
+        Deviation name.
+    alpha : int
+        Power-law noise exponent α.
+    m : int
+        Averaging factor [samples].
+    n_phase : int
+        Number of phase points N.
+
+    Returns
+    -------
+    float
+        Bias factor [1].
+
+    Notes
+    -----
+    .. math:: b_{tot} = 1 / \sqrt{1 - a \tau / T}
+
+    References
+    ----------
+    - Howe 1999 (TOTDEV bias); Howe et al. 2000, PTTI (Htot bias).
     """
     if name == "totdev":
         a = _TOTVAR_BIAS.get(alpha, 0.0)
@@ -274,7 +320,24 @@ def factors(
 ) -> IntArray:
     """Averaging factors for a τ set (``octave``: 1, 2, 4 …; ``decade``: 1, 2, 4, 10, 20,
     40 …; ``log``: ≈10 per decade; ``all``: every m; or τ [s]); theo1: even m with
-    τ = 0.75 m τ0."""
+    τ = 0.75 m τ0.
+
+    Parameters
+    ----------
+    taus : str or array_like
+        Named τ set or averaging times [s].
+    tau0_s : float
+        Sample interval [s].
+    m_max : int
+        Largest averaging factor [samples].
+    theo1 : bool, optional
+        Theo1's even factors (default False).
+
+    Returns
+    -------
+    numpy.ndarray
+        Averaging factors [samples].
+    """
     if m_max < 1:
         return np.zeros(0, dtype=np.int64)
     m: npt.NDArray[np.float64] | IntArray
@@ -477,6 +540,28 @@ def oadev_edf(
     segment, added over the segments (independent estimates).  Reads ``rate`` only (call it
     before a computation that overwrites the buffer); holds the octave block sums of the
     longest segment (octave m) or its phase (other m) while it runs.
+
+    Parameters
+    ----------
+    rate : array_like
+        Rate samples [unit].
+    tau0_s : float
+        Sample interval [s].
+    m : numpy.ndarray
+        Averaging factors [samples].
+    segments : list of slice, optional
+        Gap-free segments (default the whole record).
+    alpha : int, optional
+        Noise exponent α to assume (default identified).
+
+    Returns
+    -------
+    tuple
+        α per factor, how it was found, and the EDF [1].
+
+    References
+    ----------
+    - Greenhall & Riley 2003 (EDF); Riley & Greenhall 2004 (noise identification).
     """
     record = _new_record(rate, tau0_s, "rate", segments, ["oadev"])
     m = np.asarray(m, dtype=np.int64)
@@ -573,7 +658,24 @@ def factor_sets(
 ) -> dict[str, IntArray]:
     """The averaging factors of each deviation for a longest stretch of ``n_long`` phase
     points: ``""`` the common set (every deviation but theo1, up to the largest
-    :func:`.deviations.max_factor`), theo1 its own even set (:func:`factors`)."""
+    :func:`.deviations.max_factor`), theo1 its own even set (:func:`factors`).
+
+    Parameters
+    ----------
+    names : list of str
+        Deviation names.
+    taus : str or array_like
+        Named τ set or averaging times [s].
+    tau0_s : float
+        Sample interval [s].
+    n_long : int
+        Phase points of the longest stretch.
+
+    Returns
+    -------
+    dict of str to numpy.ndarray
+        Averaging factors per set.
+    """
     others = [n for n in names if n != "theo1"]
     top = max(registry.get(n).max_factor(n_long) for n in others) if others else 1
     sets = {"": factors(taus, tau0_s, top)}
@@ -600,7 +702,33 @@ def check_work(
     ``--max-work`` when beyond ``max_work``.  The total family and Theo1 cost O(N·m) per
     factor (NIST SP 1065 eqs. 27–30), so every τ of a long record grows as N³: the refusal
     comes before any work, with the estimate and the costliest deviation (``where``: the
-    file, named first)."""
+    file, named first).
+
+    Parameters
+    ----------
+    names : list of str
+        Deviation names.
+    sets : dict of str to numpy.ndarray
+        Averaging factors (:func:`factor_sets`).
+    sizes : list of int
+        Phase points of each stretch.
+    max_work : float
+        Largest allowed estimate [operations].
+    taus : str or array_like, optional
+        τ set named in the message.
+    where : str, optional
+        File named in the message.
+
+    Returns
+    -------
+    float
+        Estimated operations.
+
+    Raises
+    ------
+    ThermocalInputError
+        When the estimate exceeds ``max_work``.
+    """
     if not math.isfinite(max_work) and max_work > 0:
         return math.nan
     if not max_work > 0:

@@ -84,7 +84,20 @@ _TERM_WORDS: Final = {
 
 def term_words(sensor: str, kind: str) -> str:
     """The term in words for a ``sensor`` (gyro, accel) and ``kind`` (density, walk): an
-    accelerometer's white noise is the velocity random walk, not the angle random walk."""
+    accelerometer's white noise is the velocity random walk, not the angle random walk.
+
+    Parameters
+    ----------
+    sensor : str
+        ``"gyro"`` or ``"accel"``.
+    kind : str
+        ``"density"`` or ``"walk"``.
+
+    Returns
+    -------
+    str
+        The term in words.
+    """
     return _TERM_WORDS[(sensor, kind)]
 
 
@@ -427,6 +440,18 @@ def noise_model(
     References
     ----------
     .. [1] IEEE Std 952-1997, Annex C.
+
+    Examples
+    --------
+    White gyro noise of 0.01 rad/s per sample at 100 Hz: density 0.01·√0.01 = 0.001 rad/s/√Hz.
+
+    >>> import numpy as np
+    >>> y = np.random.default_rng(0).normal(0.0, 0.01, 4_000)
+    >>> ax = axis_noise(y, 0.01, name="gx", sensor="gyro", unit="rad/s")
+    >>> print(f"{ax.density.value:.3g} {ax.density.unit}")
+    0.000998 rad/s/sqrt(Hz)
+    >>> sorted(noise_model([ax], 100.0).chosen)
+    ['gyroscope_noise_density', 'gyroscope_random_walk']
     """
     if not (math.isfinite(inflate) and inflate >= 1.0):
         raise ThermocalInputError(f"--inflate {inflate!r}: give a factor ≥ 1 (1: none)")
@@ -470,7 +495,18 @@ accelerometers from 1 ng/√Hz (seismic sensors) to 10 mg/√Hz (25× an ADXL345
 
 def implausible(model: NoiseModel) -> list[str]:
     """Why ``model``'s update rate or densities cannot be an IMU's (empty: plausible); the
-    bounds are :data:`IMU_RATE_HZ` and :data:`IMU_DENSITY`, each with its source."""
+    bounds are :data:`IMU_RATE_HZ` and :data:`IMU_DENSITY`, each with its source.
+
+    Parameters
+    ----------
+    model : NoiseModel
+        The noise model.
+
+    Returns
+    -------
+    list of str
+        Reasons, empty when plausible.
+    """
     out = []
     lo, hi = IMU_RATE_HZ
     rate = model.update_rate_hz
@@ -514,7 +550,13 @@ def _yaml_float(x: float) -> str:
 
 def kalibr_yaml(model: NoiseModel, source: str) -> str:
     """Kalibr's ``imu.yaml`` text with a comment block per key (term, τ, method, discrete
-    conversion, the axes compared)."""
+    conversion, the axes compared).
+
+    Parameters
+    ----------
+    model, source : NoiseModel, str
+        The model and the file it was computed from.
+    """
     dt = 1.0 / model.update_rate_hz
     lines = [
         f"# IMU noise model for Kalibr, written by thermocal noise from {one_line(source)}",
@@ -614,7 +656,18 @@ def check_kalibr_yaml(text: str) -> None:
     neither blank, nor a comment starting in column 1, nor ``key: value`` of a key of
     :data:`KALIBR_KEYS`, a key written twice (PyYAML keeps the LAST: a second
     ``gyroscope_noise_density`` would win), a numeric key whose value is not a float, a
-    missing key.  The writer's backstop (YAML 1.2 §6.6 comments, §7.4 flow mappings)."""
+    missing key.  The writer's backstop (YAML 1.2 §6.6 comments, §7.4 flow mappings).
+
+    Parameters
+    ----------
+    text : str
+        The ``imu.yaml`` text.
+
+    Raises
+    ------
+    ThermocalInputError
+        On any of the faults above.
+    """
     bad = next((c for c in text if c != "\n" and one_line(c) != c), None)
     if bad is not None:
         raise ThermocalInputError(f"Kalibr imu.yaml: character {bad!r} in the text")
@@ -814,6 +867,18 @@ def lattice_step(
     record is checked: at least 1 − :data:`QUANT_MAX_OFF` of them lie within ``rtol`` of a
     step of the lattice.  A step of at most :data:`QUANT_MIN_ULPS` storage ulps is the
     storage's rounding, not the sensor's.
+
+    Parameters
+    ----------
+    values : array_like
+        Samples [unit].
+    rtol : float, optional
+        Tolerance relative to the step (default :data:`QUANT_LEVEL_TOL`).
+
+    Returns
+    -------
+    tuple of (float, float, int, int) or None
+        (step [unit], offset [unit], levels, finite samples).
     """
     v = np.asarray(values, dtype=np.float64).ravel()
     if not math.isfinite(float(v.sum())):  # a copy of the finite samples only when needed
@@ -900,7 +965,7 @@ def _storage_ulp(probe: npt.NDArray[np.float64], top: float) -> float:
 def output_quantization(
     values: npt.ArrayLike, tau0_s: float, unit: str, terms: NoiseTerms | None = None
 ) -> OutputQuantization | None:
-    """The output quantisation of a rate record in its own unit ``unit`` (sampled every
+    r"""The output quantisation of a rate record in its own unit ``unit`` (sampled every
     ``tau0_s`` [s]) found from the data (:func:`lattice_step`), or None when the samples
     lie on no lattice.  Call it before the Allan deviation overwrites ``values``.
 
@@ -908,6 +973,32 @@ def output_quantization(
     least-squares fit finds a significant τ⁻¹ (Q) term — rounding a rate does not make one,
     carrying the rounding remainder of an integrated output does (IEEE 952 C.1) — else
     ``rate`` (see :class:`OutputQuantization` for both relations).
+
+    Parameters
+    ----------
+    values : array_like
+        Rate samples [``unit``].
+    tau0_s : float
+        Sample interval [s].
+    unit : str
+        Rate unit.
+    terms : NoiseTerms, optional
+        The record's noise terms.
+
+    Returns
+    -------
+    OutputQuantization or None
+        Step, kind and share, or None without a lattice.
+
+    Notes
+    -----
+    .. math:: N_q = \Delta \sqrt{\tau_0 / 12}, \qquad Q = \Delta \tau_0 / \sqrt{12}
+
+    with Δ the step [unit].
+
+    References
+    ----------
+    - IEEE Std 952-1997, Annex C.1 (quantization noise).
     """
     return quantization_from_lattice(lattice_step(values), tau0_s, unit, terms)
 
@@ -918,7 +1009,24 @@ def quantization_from_lattice(
     unit: str,
     terms: NoiseTerms | None = None,
 ) -> OutputQuantization | None:
-    """:func:`output_quantization` from the lattice :func:`lattice_step` found (None: none)."""
+    """:func:`output_quantization` from the lattice :func:`lattice_step` found (None: none).
+
+    Parameters
+    ----------
+    found : tuple or None
+        Result of :func:`lattice_step`.
+    tau0_s : float
+        Sample interval [s].
+    unit : str
+        Rate unit.
+    terms : NoiseTerms, optional
+        The record's noise terms.
+
+    Returns
+    -------
+    OutputQuantization or None
+        As :func:`output_quantization`.
+    """
     if found is None:
         return None
     step, offset, levels, n = found
@@ -959,7 +1067,20 @@ def quantization_from_lattice(
 
 def annotate_quantization(terms: NoiseTerms, quant: OutputQuantization | None) -> NoiseTerms:
     """``terms`` with the quantization term's reason naming a rate quantisation: rounding a
-    rate is white rate noise (inside N), so IEEE 952's τ⁻¹ term stays null."""
+    rate is white rate noise (inside N), so IEEE 952's τ⁻¹ term stays null.
+
+    Parameters
+    ----------
+    terms : NoiseTerms
+        Noise terms.
+    quant : OutputQuantization or None
+        The quantisation found.
+
+    Returns
+    -------
+    NoiseTerms
+        ``terms`` with the quantization reason reworded.
+    """
     if quant is None or quant.kind != "rate":
         return terms
 

@@ -86,14 +86,44 @@ class PeriodicTerm:
     share: float | None = None
 
     def adev(self, tau_s: npt.ArrayLike) -> npt.NDArray[np.float64]:
-        """The sinusoid's Allan deviation A·sin²(πf₀τ)/(πf₀τ) [unit] at ``tau_s`` [s]."""
+        r"""The sinusoid's Allan deviation A·sin²(πf₀τ)/(πf₀τ) [unit] at ``tau_s`` [s].
+
+        Parameters
+        ----------
+        tau_s : array_like
+            Averaging times [s].
+
+        Returns
+        -------
+        numpy.ndarray
+            Allan deviation [unit].
+
+        Notes
+        -----
+        .. math:: \sigma(\tau) = A \sin^2(\pi f_0 \tau) / (\pi f_0 \tau)
+
+        References
+        ----------
+        - IEEE Std 952-1997, Annex C.1.7 (sinusoidal noise).
+        """
         x = math.pi * self.frequency_hz * np.asarray(tau_s, dtype=np.float64)
         return np.asarray(self.amplitude * np.sin(x) ** 2 / x)
 
     def adev_bound(self, tau_s: npt.ArrayLike) -> npt.NDArray[np.float64]:
         """The most the sinusoid adds to the Allan deviation [unit] at ``tau_s`` [s]: its
         own curve A·sin²(πf₀τ)/(πf₀τ) up to its first maximum region (πf₀τ ≤ π/2), its
-        envelope A/(πf₀τ) beyond, where f₀'s resolution leaves the zeros' places unknown."""
+        envelope A/(πf₀τ) beyond, where f₀'s resolution leaves the zeros' places unknown.
+
+        Parameters
+        ----------
+        tau_s : array_like
+            Averaging times [s].
+
+        Returns
+        -------
+        numpy.ndarray
+            Upper bound of the Allan deviation [unit].
+        """
         x = math.pi * self.frequency_hz * np.asarray(tau_s, dtype=np.float64)
         return np.asarray(
             np.where(x <= math.pi / 2, self.amplitude * np.sin(x) ** 2 / x, self.amplitude / x)
@@ -127,11 +157,34 @@ class PeriodicTerm:
 def welch(
     x: npt.NDArray[np.float64], fs: float, seg: int
 ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64], int]:
-    """Welch's one-sided power spectral density [unit²/Hz] of ``x`` sampled at ``fs`` [Hz]:
+    r"""Welch's one-sided power spectral density [unit²/Hz] of ``x`` sampled at ``fs`` [Hz]:
     Hann segments of ``seg`` samples overlapping by half, each with its least-squares line
     removed, ``S = 2 |X|² / (fs Σw²)`` averaged (DC and Nyquist not doubled), as
     ``scipy.signal.welch(x, fs, "hann", seg, detrend="linear")`` (numpy only: scipy.signal
-    costs a command two seconds of import).  Returns (frequencies, S, segments)."""
+    costs a command two seconds of import).  Returns (frequencies, S, segments).
+
+    Parameters
+    ----------
+    x : numpy.ndarray
+        Samples [unit].
+    fs : float
+        Sample rate [Hz].
+    seg : int
+        Segment length [samples].
+
+    Returns
+    -------
+    tuple
+        Frequencies [Hz], PSD [unit²/Hz], number of segments.
+
+    Notes
+    -----
+    .. math:: S = 2 |X|^2 / (f_s \textstyle\sum w^2)
+
+    References
+    ----------
+    - Welch, P. D. (1967), IEEE Trans. Audio Electroacoust. 15(2), 70–73.
+    """
     step = seg // 2
     n_seg = (x.size - seg) // step + 1
     w = 0.5 - 0.5 * np.cos(2.0 * math.pi * np.arange(seg) / seg)  # periodic Hann
@@ -167,6 +220,31 @@ def periodic_terms(
 
     Gaps are the caller's: pass one contiguous stretch (its first :data:`_MAX_SAMPLES`
     samples are read).
+
+    Parameters
+    ----------
+    values : array_like
+        Rate samples [``unit``].
+    tau0_s : float
+        Sample interval [s].
+    unit : str
+        Rate unit.
+    max_terms : int, optional
+        Most sinusoids returned (default 3).
+
+    Returns
+    -------
+    tuple of PeriodicTerm
+        The sinusoids, strongest first.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> t = np.arange(20_000) * 0.1
+    >>> y = np.random.default_rng(0).normal(0.0, 1.0, t.size) + 5.0 * np.sin(np.pi * t)
+    >>> (p,) = periodic_terms(y, 0.1, "deg/h")
+    >>> print(f"{p.frequency_hz:.3g} Hz, {p.amplitude:.3g} {p.unit}")
+    0.5 Hz, 5 deg/h
     """
     x = np.asarray(values, dtype=np.float64).ravel()[:_MAX_SAMPLES]
     x = x[np.isfinite(x)]
@@ -215,7 +293,22 @@ def shaping_terms(
 ) -> tuple[PeriodicTerm, ...]:
     """The terms of ``found`` whose Allan deviation bump holds at least
     :data:`PERIODIC_MIN_SHARE` of the measured Allan variance ``adev`` [unit] at the τ
-    [s] nearest (in log) to their ``tau_peak_s``, each with its ``share``."""
+    [s] nearest (in log) to their ``tau_peak_s``, each with its ``share``.
+
+    Parameters
+    ----------
+    found : tuple of PeriodicTerm
+        Sinusoids found.
+    tau_s : array_like
+        Averaging times [s].
+    adev : array_like
+        Measured Allan deviation [unit].
+
+    Returns
+    -------
+    tuple of PeriodicTerm
+        The terms that shape the curve, each with its share.
+    """
     tau = np.asarray(tau_s, dtype=np.float64)
     dev = np.asarray(adev, dtype=np.float64)
     ok = np.isfinite(dev) & (dev > 0)

@@ -96,7 +96,20 @@ class Deviation:
 
     def estimated_work(self, n_phase: int, m: npt.ArrayLike) -> float:
         """Estimated arithmetic operations on ``n_phase`` phase points at the factors ``m``
-        (those beyond :attr:`max_factor` cost nothing)."""
+        (those beyond :attr:`max_factor` cost nothing).
+
+        Parameters
+        ----------
+        n_phase : int
+            Number of phase points.
+        m : array_like
+            Averaging factors [samples].
+
+        Returns
+        -------
+        float
+            Estimated operations.
+        """
         mm = np.asarray(m, dtype=np.int64).ravel()
         if self.work is not None:
             return self.work(n_phase, mm)
@@ -138,7 +151,13 @@ def register(deviation: Deviation) -> Deviation:
 
 
 def unregister(name: str) -> None:
-    """Remove a deviation added by :func:`register` (tests; built-in ones stay)."""
+    """Remove a deviation added by :func:`register` (tests; built-in ones stay).
+
+    Parameters
+    ----------
+    name : str
+        Deviation name.
+    """
     if name in _BUILT_IN:
         raise ParameterError("deviation", f"{{name}} {name!r} is built in")
     _TABLE.pop(name, None)
@@ -147,10 +166,25 @@ def unregister(name: str) -> None:
 def get(name: str) -> Deviation:
     """The registered deviation ``name``.
 
+    Parameters
+    ----------
+    name : str
+        Deviation name (``"oadev"``, ``"mdev"`` …).
+
+    Returns
+    -------
+    Deviation
+        Its registry entry.
+
     Raises
     ------
     ParameterError
         ``name`` is not registered (the message lists the names).
+
+    Examples
+    --------
+    >>> get("mdev").reference
+    'NIST SP 1065 eq. 14'
     """
     try:
         return _TABLE[name]
