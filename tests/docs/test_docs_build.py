@@ -149,6 +149,16 @@ SOURCES = {
     r"Golub": "G. H. Golub and C. F. Van Loan",
     r"WGS-?84|TR8350": "NIMA TR8350.2",
     r"OWASP": "CSV Injection",
+    r"Lawson": "C. L. Lawson and R. J. Hanson",
+    r"Galleani": "L. Galleani and P. Tavella",
+    r"Kalman 1960|R\. E\. Kalman": "R. E. Kalman",
+    r"Schwarz": "G. Schwarz",
+    r"Sokal": "A. D. Sokal",
+    r"Kay 1993": "S. M. Kay",
+    r"Floyd": "R. W. Floyd and R. L. Rivest",
+    r"Buitinck": "L. Buitinck",
+    r"FIPS 180|FIPS PUB 180": "FIPS PUB 180-4",
+    r"RFC 4180": "RFC 4180",
 }
 """Every published source the package's code cites, and the methods chapter's entry for it."""
 
