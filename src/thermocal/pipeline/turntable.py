@@ -394,10 +394,10 @@ def thermal_runs(
     Raises
     ------
     ThermocalInputError
-        When ``output`` is not ``.json`` or a run cannot be read.
+        When ``output`` is not ``.json``, a run cannot be read, or the soaks cannot
+        support the order (adequacy tests not overridden).
     DesignError
-        When the soaks cannot support the order or the calibration would be refused on
-        reading.
+        When the calibration would be refused on reading.
 
     Notes
     -----
