@@ -79,10 +79,12 @@ class CExport:
 
     @property
     def header_name(self) -> str:
+        """File name of the header, ``<prefix>.h``."""
         return f"{self.prefix}.h"
 
     @property
     def source_name(self) -> str:
+        """File name of the source, ``<prefix>.c``."""
         return f"{self.prefix}.c"
 
     def write(self, directory: str | Path, inputs: Sequence[str | Path] = ()) -> list[Path]:
@@ -273,6 +275,7 @@ class ExportContext:
         return np.array([tr[n] for n in self.model["temperatures"]], dtype=np.float64)
 
     def clamp_arrays(self) -> str:
+        """C arrays ``<P>_T_LO`` and ``<P>_T_HI`` of the fitted temperature range [°C or counts]."""
         rng = self.temp_range()
         return "\n".join(
             [
