@@ -17,7 +17,31 @@ def check_firmware_adequacy(cal: Calibration, path: str | Path, firmware: str | 
     (:func:`thermocal.adequacy.check_for_firmware`), for every triad that recorded the
     check and every channel; for ``firmware="ardupilot"`` also ArduPilot's own minimum
     sweep (:data:`thermocal.adequacy.ARDUPILOT_MIN_SPAN_C` [°C] between the channel's
-    fitted temperature limits, unless the fit recorded ``--allow-narrow``)."""
+    fitted temperature limits, unless the fit recorded ``--allow-narrow``).
+
+    Parameters
+    ----------
+    cal : Calibration
+        The calibration to export.
+    path : str or Path
+        Its file, named in messages.
+    firmware : str or None
+        ``"px4"``, ``"ardupilot"`` or ``None`` (C export).
+
+    Returns
+    -------
+    None
+
+    Raises
+    ------
+    ThermocalInputError
+        When a triad's or channel's data did not support the fit, or the temperature span
+        is narrower than ArduPilot's minimum.
+
+    References
+    ----------
+    - ArduPilot, ``libraries/AP_InertialSensor/AP_InertialSensor_tempcal.cpp``.
+    """
     from thermocal.adequacy import ARDUPILOT_MIN_SPAN_C, check_for_firmware
 
     for tri in cal.triads:

@@ -77,7 +77,28 @@ class AxisPoly:
     relative: bool = False
 
     def offset(self, temp_c: Any) -> Any:
-        """The firmware's offset at ``temp_c`` (clamped to the range) [firmware unit]."""
+        r"""The firmware's offset at ``temp_c`` (clamped to the range) [firmware unit].
+
+        Parameters
+        ----------
+        temp_c : float or array_like
+            Sensor temperature [°C].
+
+        Returns
+        -------
+        float or numpy.ndarray
+            The offset the firmware subtracts [rad/s for a gyro, m/s² for an accel].
+
+        Notes
+        -----
+        .. math:: b(T) = b_0 + b_1 \tau + b_2 \tau^2 + b_3 \tau^3,\quad
+                  \tau = \operatorname{clip}(T, T_\min, T_\max) - T_\mathrm{ref}
+
+        References
+        ----------
+        - PX4-Autopilot, ``src/modules/temperature_compensation/TemperatureCompensation.cpp``.
+        - ArduPilot, ``libraries/AP_InertialSensor/AP_InertialSensor_tempcal.cpp``.
+        """
         t = np.clip(np.asarray(temp_c, dtype=np.float64), self.tmin_c, self.tmax_c) - self.tref_c
         b0, b1, b2, b3 = self.coef
         return b0 + t * (b1 + t * (b2 + t * b3))
@@ -96,8 +117,19 @@ class ParamSet:
     notes: list[str] = field(default_factory=list)
 
     def merge(self, other: ParamSet, label: str) -> None:
-        """Add another instance's parameters (one file for every sensor of a log); its notes
-        are prefixed with ``label``."""
+        """Add another instance's parameters (one file for every sensor of a log).
+
+        Parameters
+        ----------
+        other : ParamSet
+            The parameters of another sensor instance, same format.
+        label : str
+            Prefix of its notes (e.g. the instance's name).
+
+        Returns
+        -------
+        None
+        """
         self.params.update(other.params)
         self.types.update(other.types)
         self.axes += other.axes
@@ -170,7 +202,32 @@ def _check_expressible(name: str, model: TemperatureModel) -> None:
 
 
 def axis_poly(name: str, model: TemperatureModel, kind: str, axis: str, tref_c: float) -> AxisPoly:
-    """One channel as the firmware's cubic about ``tref_c`` in its unit (exact re-expansion)."""
+    """One channel as the firmware's cubic about ``tref_c`` in its unit (exact re-expansion).
+
+    Parameters
+    ----------
+    name : str
+        The channel's name in the calibration.
+    model : TemperatureModel
+        Its fitted polynomial model (at most cubic in one temperature).
+    kind : {"gyro", "accel"}
+        The sensor kind, which fixes the firmware unit (rad/s or m/s²).
+    axis : {"x", "y", "z"}
+        The firmware axis.
+    tref_c : float
+        Reference temperature of the cubic [°C].
+
+    Returns
+    -------
+    AxisPoly
+        The cubic's coefficients [firmware unit / °Cᵏ] and the fitted range [°C]; an accel's
+        is relative to its value at mid-range.
+
+    Raises
+    ------
+    ThermocalInputError
+        When the model is not a polynomial in one temperature of order ≤ 3.
+    """
     _check_expressible(name, model)
     coefs = {c.name: c.value for c in model.coefficients_about(tref_c)}  # type: ignore[attr-defined]
     b = [coefs.get("const", 0.0)] + [
@@ -191,8 +248,28 @@ def axis_poly(name: str, model: TemperatureModel, kind: str, axis: str, tref_c: 
 def map_axes(
     cal: Calibration, gyro: Sequence[str] | None, accel: Sequence[str] | None
 ) -> dict[str, dict[str, str]]:
-    """``{"gyro": {"x": channel, …}, "accel": {…}}`` from ``--gyro``/``--accel`` (channels
-    in x, y, z order) or the channels' roles; each triad complete or absent."""
+    """``{"gyro": {"x": channel, …}, "accel": {…}}`` from ``gyro``/``accel`` or the roles.
+
+    Parameters
+    ----------
+    cal : Calibration
+        The calibration's channels.
+    gyro, accel : sequence of str or None
+        Three channel names in x, y, z order; ``None``: taken from the channels' roles.
+
+    Returns
+    -------
+    dict
+        Per kind present, the channel of each axis; each triad complete or absent.
+
+    Raises
+    ------
+    ParameterError
+        ``gyro``/``accel``: not three channels, repeated, unknown, of the other kind, or
+        a partial triad in the roles.
+    ThermocalInputError
+        No triad found, or a channel in both triads.
+    """
     from thermocal.models.calibration import guess_role
 
     out: dict[str, dict[str, str]] = {}
@@ -262,9 +339,30 @@ def _show(v: float) -> str:
 
 
 def check_values(ps: ParamSet) -> None:
-    """Refuse any parameter the firmware cannot store: a float (type 9) that is NaN,
+    r"""Refuse any parameter the firmware cannot store: a float (type 9) that is NaN,
     infinite or beyond ±:data:`FLOAT32_MAX` (it would be written as ``nan``/``inf`` or
-    become infinite in float32), an int32 (type 6) outside :data:`INT32_RANGE`."""
+    become infinite in float32), an int32 (type 6) outside :data:`INT32_RANGE`.
+
+    Parameters
+    ----------
+    ps : ParamSet
+        The parameters and their MAVLink types.
+
+    Returns
+    -------
+    None
+
+    Raises
+    ------
+    ThermocalInputError
+        Naming the first parameter that cannot be stored.
+
+    References
+    ----------
+    - IEEE Std 754-2019, binary32 format (largest finite value
+      :math:`(2 - 2^{-23})\,2^{127}`).
+    - MAVLink common message set, ``MAV_PARAM_TYPE``.
+    """
     for name, v in ps.params.items():
         if ps.types.get(name, 9) == 6:
             whole = isinstance(v, int) or (math.isfinite(v) and float(v).is_integer())
@@ -284,7 +382,27 @@ def check_documented(ps: ParamSet) -> None:
     """Every parameter of ``ps`` against what the firmwares document of it
     (``documented`` of :data:`thermocal.firmware.formats.FORMATS`): a type other than the one
     documented, or a value outside a ``hard`` range, refused (exit 2) naming the parameter,
-    the value and the source; outside a ground station's @Range: a warning."""
+    the value and the source; outside a ground station's @Range: a warning.
+
+    Parameters
+    ----------
+    ps : ParamSet
+        The parameters and their MAVLink types.
+
+    Returns
+    -------
+    None
+
+    Raises
+    ------
+    ThermocalInputError
+        A type other than documented, or a value outside a hard range.
+
+    Warns
+    -----
+    ThermocalWarning
+        A value outside a documented soft range.
+    """
     import re
 
     for name, v in ps.params.items():

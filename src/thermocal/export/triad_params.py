@@ -81,8 +81,30 @@ class TriadFirmware:
 
 
 def triad_firmware(triad: Triad) -> TriadFirmware:
-    """The triad's offsets and scales at its TREF (module docstring: ``OFF = b``,
-    ``SCALE_i = ((I + E)⁻¹)_ii``)."""
+    r"""The triad's offsets and scales at its TREF (module docstring: ``OFF = b``,
+    ``SCALE_i = ((I + E)⁻¹)_ii``).
+
+    Parameters
+    ----------
+    triad : Triad
+        A calibrated triad with its temperature model.
+
+    Returns
+    -------
+    TriadFirmware
+        Offsets [triad unit] and scales [-] at TREF [°C], with what the firmware loses
+        (misalignment [″], scale [ppm]).
+
+    Notes
+    -----
+    .. math:: \mathrm{OFF} = \mathbf b(T_\mathrm{ref}),\quad
+              \mathrm{SCALE}_i = \left[(I + E(T_\mathrm{ref}))^{-1}\right]_{ii}
+
+    References
+    ----------
+    - PX4-Autopilot, ``src/lib/sensor_calibration`` (``CAL_ACCn_*``, ``CAL_GYROn_*``).
+    - ArduPilot, ``libraries/AP_InertialSensor`` (``INS_ACCOFFS``, ``INS_ACCSCAL``).
+    """
     from thermocal.turntable import thermal
 
     m = triad.model
@@ -226,6 +248,23 @@ def _lost_notes(t: TriadFirmware) -> list[str]:
     return out
 
 
+def _triads_of(
+    cal: Calibration, gyro: Sequence[str] | None, accel: Sequence[str] | None
+) -> dict[str, Triad]:
+    """The calibration's accel and gyro triads by name; refuses none, or axes not theirs."""
+    triads = {t.name: t for t in cal.triads if t.name in ("accel", "gyro")}
+    if not triads:
+        raise ThermocalInputError("the calibration has no accel or gyro triad")
+    for kind, given in (("accel", accel), ("gyro", gyro)):
+        if given and (kind not in triads or tuple(given) != triads[kind].columns):
+            have = ",".join(triads[kind].columns) if kind in triads else "none"
+            raise ThermocalInputError(
+                f"--{kind} {','.join(given)}: the calibration's {kind} triad reads {have}; "
+                "a triad's axes are those it was calibrated on"
+            )
+    return triads
+
+
 def triad_params(
     cal: Calibration,
     fmt: str,
@@ -237,7 +276,33 @@ def triad_params(
 ) -> TriadParams:
     """The firmware parameters of the calibration's ``accel`` and ``gyro`` triads (module
     docstring); warns what the firmware cannot hold, refuses a value outside ArduPilot's
-    range or an instance the firmware does not have."""
+    range or an instance the firmware does not have.
+
+    Parameters
+    ----------
+    cal : Calibration
+        A calibration with an ``accel`` and/or ``gyro`` triad.
+    fmt : {"px4", "ardupilot"}
+        The firmware.
+    instance, device_id : int, optional
+        Sensor instance from 0 (default 0); PX4 device id, an int32 (default ``None``:
+        not written, with a warning).
+    gyro, accel : sequence of str or None, optional
+        Channel names in x, y, z order, checked against the triads' (default ``None``).
+
+    Returns
+    -------
+    TriadParams
+        The parameters and the triads as held.
+
+    Raises
+    ------
+    ParameterError
+        ``format``/``instance``/``device_id``: unknown firmware, an instance it does not
+        have, or a device id outside int32.
+    ThermocalInputError
+        No accel or gyro triad, ``gyro``/``accel`` not its axes, or a value not a float32.
+    """
     if fmt not in FORMATS:
         raise ParameterError("format", f"{{name}} must be px4 or ardupilot, got {fmt!r}")
     n_max = FORMATS[fmt].max_instances  # PX4 CAL_ACC0…3 / CAL_GYRO0…3; ArduPilot three IMUs
@@ -246,16 +311,7 @@ def triad_params(
         raise ParameterError(
             "instance", f"{{name}} {instance}: {fmt} has {have}, instances 0…{n_max - 1}"
         )
-    triads = {t.name: t for t in cal.triads if t.name in ("accel", "gyro")}
-    if not triads:
-        raise ThermocalInputError("the calibration has no accel or gyro triad")
-    for kind, given in (("accel", accel), ("gyro", gyro)):
-        if given and (kind not in triads or tuple(given) != triads[kind].columns):
-            have = ",".join(triads[kind].columns) if kind in triads else "none"
-            raise ThermocalInputError(
-                f"--{kind} {','.join(given)}: the calibration's {kind} triad reads {have}; "
-                "a triad's axes are those it was calibrated on"
-            )
+    triads = _triads_of(cal, gyro, accel)
     params: dict[str, float] = {}
     types: dict[str, int] = {}
     notes: list[str] = []
@@ -308,7 +364,18 @@ def triad_params(
 
 
 def as_dict(tp: TriadParams) -> dict[str, Any]:
-    """The triads as held, for ``--json``."""
+    """The triads as held, for ``--json``.
+
+    Parameters
+    ----------
+    tp : TriadParams
+        The result of :func:`triad_params`.
+
+    Returns
+    -------
+    dict
+        Per kind: offset, scale, tref_c [°C], misalignment lost [″], scale lost [ppm].
+    """
     return {
         t.kind: {"offset": list(t.offset), "scale": list(t.scale), "tref_c": t.tref_c,
                  "misalignment_lost_arcsec": t.misalignment_lost_arcsec,

@@ -145,6 +145,7 @@ class CompensateFileResult:
     outside_calibrated_range: bool = False
 
     def to_dict(self) -> dict[str, Any]:
+        """The fields (``extra`` merged in) as a dict, for ``--json``."""
         d = {k: getattr(self, k) for k in self.__dataclass_fields__ if k != "extra"}
         d.update(self.extra)
         return d
@@ -1004,6 +1005,7 @@ class TriadCompensation:
     count_scale: float | None = None
 
     def to_dict(self) -> dict[str, Any]:
+        """The fields as a dict, for ``--json``."""
         return dataclasses.asdict(self)
 
 

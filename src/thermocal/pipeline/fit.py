@@ -74,7 +74,20 @@ else:
 
 
 def run_temp_names(rec: _recording.Recording, temps: Sequence[str] | None) -> list[str]:
-    """The temperature columns a fit uses: those named, or the file's."""
+    """The temperature columns a fit uses: those named, or the file's.
+
+    Parameters
+    ----------
+    rec : Recording
+        The run as read.
+    temps : sequence of str or None
+        Temperature columns named by the user; ``None`` or empty: every one of the file's.
+
+    Returns
+    -------
+    list of str
+        The temperature column names.
+    """
     return list(temps or ()) or list(rec.temperatures)
 
 
@@ -82,7 +95,23 @@ def check_terms(terms: str | None) -> None:
     """Refuse (:class:`~thermocal.errors.ParameterError`, exit 2) a poly term list beyond the
     hard ceilings: more than :data:`~thermocal.families.MAX_TERMS` terms or a power above
     :data:`~thermocal.families.MAX_ORDER`, before any data is read (the value is checked,
-    not only its type: an integer literal of any length parses)."""
+    not only its type: an integer literal of any length parses).
+
+    Parameters
+    ----------
+    terms : str or None
+        The poly family's term list as given (e.g. ``"T^0,T^1,T^2"``); ``None``: the
+        default terms.
+
+    Returns
+    -------
+    None
+
+    Raises
+    ------
+    ParameterError
+        ``terms``: more than ``MAX_TERMS`` terms, or a power above ``MAX_ORDER``.
+    """
     if terms is None:
         return
     n = terms.count(",") + 1
@@ -101,20 +130,74 @@ _POWER = re.compile(r"\^\s*(\d+)")
 def build_model(family: str, options: Mapping[str, Any]) -> _base.TemperatureModel:
     """Instantiate a registered family from its fit options ``{parameter: value}`` by its
     one option parser (:meth:`TemperatureModel.from_options`: an option the family does
-    not take is refused, for every family; each value checked against its declaration)."""
+    not take is refused, for every family; each value checked against its declaration).
+
+    Parameters
+    ----------
+    family : str
+        Registered family name (e.g. ``"poly"``).
+    options : mapping of str to Any
+        The family's fit options by parameter name.
+
+    Returns
+    -------
+    TemperatureModel
+        The unfitted model.
+
+    Raises
+    ------
+    ParameterError
+        When an option is not the family's or its value is outside its declared bounds.
+    ThermocalInputError
+        When the family is not registered.
+    """
     return _registry.get_model_class(family).from_options(options)
 
 
 def earth_rate_known_input(
     latitude: float | None, axis: str | None, unit: str, where: object
 ) -> float:
-    """Earth rate seen by the sensitive axis [°/h], as a known input of a gyro run.
+    r"""Earth rate seen by the sensitive axis [°/h], as a known input of a gyro run.
 
     ``Ω_axis = Ω u·(0, cos φ, sin φ)`` for the unit axis ``u`` in East-North-Up
     (IEEE Std 952-1997, :func:`thermocal.units.earth_rate_on_axis_deg_h`); 0 without
     ``--latitude``/``--axis``.  Both options are needed together and
     the signal (canonical unit ``unit``) must be a rate: otherwise an input error naming
     ``where`` (the file).
+
+    Parameters
+    ----------
+    latitude : float or None
+        Geodetic latitude of the site [°].
+    axis : str or None
+        The sensitive axis in East-North-Up, e.g. ``"up"``, ``"north"`` or ``"0,0.7,0.7"``.
+    unit : str
+        Canonical unit of the signal (``"deg/h"`` for a gyro).
+    where : object
+        The file, named in the error message.
+
+    Returns
+    -------
+    float
+        The earth rate along the axis [°/h]; 0.0 when neither is given.
+
+    Raises
+    ------
+    ThermocalInputError
+        When only one of ``latitude``/``axis`` is given, or the signal is not a rate.
+
+    Notes
+    -----
+    .. math:: \Omega_\mathrm{axis} = \Omega\,\mathbf u \cdot (0, \cos\varphi, \sin\varphi)
+
+    with :math:`\Omega = 7.292115\times10^{-5}` rad/s (WGS 84) and :math:`\varphi` the
+    latitude.
+
+    References
+    ----------
+    - IEEE Std 952-1997, IEEE Standard Specification Format Guide and Test Procedure for
+      Single-Axis Interferometric Fiber Optic Gyros.
+    - NIMA TR8350.2, Department of Defense World Geodetic System 1984 (WGS 84).
     """
     if latitude is None and axis is None:
         return 0.0
@@ -131,7 +214,24 @@ def earth_rate_known_input(
 def known_input_what(
     latitude: float | None, axis: str | None, other: float | None, gravity: str | None = None
 ) -> str:
-    """What a fit's known input is, for the model file (``inputs.known_input.what``)."""
+    """What a fit's known input is, for the model file (``inputs.known_input.what``).
+
+    Parameters
+    ----------
+    latitude : float or None
+        Site latitude [°] (earth rate removed with ``axis``).
+    axis : str or None
+        Sensitive axis in East-North-Up.
+    other : float or None
+        A further constant known input [signal unit].
+    gravity : str or None, optional
+        Description of the gravity removed, if any (default ``None``).
+
+    Returns
+    -------
+    str
+        The parts joined by ``" + "``, or ``"none"``.
+    """
     parts = []
     if latitude is not None and axis is not None:
         parts.append(f"earth rate at latitude {latitude:g}° on axis {axis}")
@@ -340,13 +440,34 @@ TIME_SCALES = ((1000.0, "ms read as s"), (1.0 / 60.0, "minutes read as s"), (1e-
 def rate_time_doubts(
     runs: Sequence[_rundata.RunData], temp_names: Sequence[str], interval_s: float
 ) -> list[str]:
-    """Why the time axis of runs fitted with Ṫ terms (``temp_names``) looks wrong, one line
+    r"""Why the time axis of runs fitted with Ṫ terms (``temp_names``) looks wrong, one line
     per (run, column): the largest |Ṫ| (the 99th percentile of Ṫ over ``interval_s``,
     :func:`thermocal.adequacy.temperature_rate_c_per_min`) above
     :data:`MAX_CHAMBER_RATE_C_PER_MIN` or below :data:`MIN_RAMP_C_PER_MIN` where a time unit
     1000 or 60 times off (:data:`TIME_SCALES`) would make it a chamber's ramp, or a run
     shorter than the interval.  A wrong time unit scales the Ṫ coefficients by the same
-    factor (time ×1000 under rate terms)."""
+    factor (time ×1000 under rate terms).
+
+    Parameters
+    ----------
+    runs : sequence of RunData
+        The runs to fit.
+    temp_names : sequence of str
+        The temperature columns that carry Ṫ terms.
+    interval_s : float
+        Interval over which Ṫ is taken [s].
+
+    Returns
+    -------
+    list of str
+        One line per doubtful (run, column); empty when every time axis looks right.
+
+    Notes
+    -----
+    .. math:: \dot T_k = \frac{T(t_k) - T(t_k - \Delta t)}{\Delta t}
+
+    judged by the 99th percentile of :math:`|\dot T|` [°C/min].
+    """
     out: list[str] = []
     for run in runs:
         if run.temperature_unit != "degC" or run.time_s.size < 2:
@@ -618,7 +739,30 @@ def _check_options(paths: Sequence[Path], o: FitOptions, output: Path) -> dict[s
 def fit_files(paths: Sequence[Path], options: FitOptions, output: Path) -> FitResult:
     """Fit ``options.model`` on the recordings ``paths`` (one run each) and save it to
     ``output`` (module docstring).  Options are checked before any file is read
-    (:class:`ThermocalInputError`); each file is read once with every channel's column."""
+    (:class:`ThermocalInputError`); each file is read once with every channel's column.
+
+    Parameters
+    ----------
+    paths : sequence of Path
+        The recordings, one run each (or station folders).
+    options : FitOptions
+        Family, its options, columns, known inputs and read options.
+    output : Path
+        The model file to write (JSON).
+
+    Returns
+    -------
+    FitResult
+        The fitted model(s), the adequacy record and the path written.
+
+    Raises
+    ------
+    ThermocalInputError
+        When an option does not fit the data, a file cannot be read, a run is repeated,
+        or the runs cannot support the model asked (adequacy tests not overridden).
+    ParameterError
+        When a family option is out of its bounds.
+    """
     o = options
     family_options = _check_options(paths, o, output)
     names = list(o.signals or ())

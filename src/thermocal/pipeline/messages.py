@@ -24,13 +24,46 @@ else:
 
 
 def one_line(text: object) -> str:
-    """``text`` with every run of white space (newlines included) made one space."""
+    r"""``text`` with every run of white space (newlines included) made one space.
+
+    Parameters
+    ----------
+    text : object
+        Any object; its ``str()`` is used.
+
+    Returns
+    -------
+    str
+        One line, stripped.
+
+    Examples
+    --------
+    >>> one_line("a.csv:\n  no column   'gx'")
+    "a.csv: no column 'gx'"
+    """
     return " ".join(str(text).split())
 
 
 def jsonable(obj: Any) -> Any:
     """Convert results to plain JSON types: dataclasses → dicts, numpy → Python,
-    NaN/inf → ``None``, paths → strings."""
+    NaN/inf → ``None``, paths → strings.
+
+    Parameters
+    ----------
+    obj : Any
+        A result: dataclass, dict, list, tuple, numpy array or scalar, float, path, …
+
+    Returns
+    -------
+    Any
+        The same content in JSON types (nested dicts, lists, numbers, strings, ``None``).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> jsonable({"rms": np.float64(0.25), "nan": float("nan"), "v": np.arange(3)})
+    {'rms': 0.25, 'nan': None, 'v': [0, 1, 2]}
+    """
     if dataclasses.is_dataclass(obj) and not isinstance(obj, type):
         return {f.name: jsonable(getattr(obj, f.name)) for f in dataclasses.fields(obj)}
     if isinstance(obj, dict):
@@ -49,14 +82,36 @@ def jsonable(obj: Any) -> Any:
 
 
 def json_text(obj: Any) -> str:
-    """The one line ``--json`` prints: :func:`jsonable` of ``obj``, newline-terminated."""
+    """The one line ``--json`` prints: :func:`jsonable` of ``obj``, newline-terminated.
+
+    Parameters
+    ----------
+    obj : Any
+        A result (see :func:`jsonable`).
+
+    Returns
+    -------
+    str
+        Compact JSON ending with ``"\\n"``; never ``NaN`` or ``Infinity``.
+    """
     return json.dumps(jsonable(obj), allow_nan=False) + "\n"
 
 
 def warning_lines(caught: Iterable[warnings.WarningMessage]) -> list[str]:
     """The text of each ``warning:`` line the command line prints for ``caught``, each
     message once: thermocal warnings as they are, numerical ``RuntimeWarning``\\ s with their
-    class name in front; other warnings are not shown."""
+    class name in front; other warnings are not shown.
+
+    Parameters
+    ----------
+    caught : iterable of warnings.WarningMessage
+        Warnings recorded by ``warnings.catch_warnings(record=True)``.
+
+    Returns
+    -------
+    list of str
+        The texts, in order, without the ``warning:`` prefix.
+    """
     seen: set[str] = set()
     out: list[str] = []
     for w in caught:
@@ -138,7 +193,31 @@ def error_text(exc: Exception, options: Mapping[str, str] | None = None) -> tupl
     the user's (exit 2: bad input, a missing file, permissions, a full disk) rather than
     thermocal's own failure (exit 1, ``internal: TYPE: message``).  A
     :class:`~thermocal.errors.ParameterError` names the option (:func:`option_name`) where the
-    library names its parameter."""
+    library names its parameter.
+
+    Parameters
+    ----------
+    exc : Exception
+        The exception raised by the library.
+    options : mapping of str to str or None, optional
+        Option name by parameter name where it differs from :func:`option_name`'s rule
+        (default ``None``).
+
+    Returns
+    -------
+    text : str
+        The message, one line, without the ``error:`` prefix.
+    user : bool
+        True for the user's error (exit status 2), False for an internal one (exit 1).
+
+    Examples
+    --------
+    >>> from thermocal.errors import ParameterError
+    >>> error_text(ParameterError("min_dwell", "{name} must be positive, got -1"))
+    ('--min-dwell must be positive, got -1', True)
+    >>> error_text(ZeroDivisionError("division by zero"))
+    ('internal: ZeroDivisionError: division by zero', False)
+    """
     if isinstance(exc, ParameterError):
         text = exc.named(option_name(exc.parameter, options), lambda p: option_name(p, options))
         return one_line(text), True

@@ -30,7 +30,24 @@ from thermocal.writers import write_json
 
 
 def file_sha256(path: str | Path, chunk: int = 1 << 20) -> str:
-    """SHA-256 of a data file (provenance in model files)."""
+    """SHA-256 of a data file (provenance in model files).
+
+    Parameters
+    ----------
+    path : str or Path
+        A data file, or a station's recording folder (its closed parts hashed in order).
+    chunk : int, optional
+        Bytes read at a time [B] (default 1 MiB).
+
+    Returns
+    -------
+    str
+        The hexadecimal digest (64 characters).
+
+    References
+    ----------
+    - FIPS PUB 180-4, Secure Hash Standard (SHS), NIST, 2015.
+    """
     from thermocal.readers.station import is_station_path, station_files
 
     h = hashlib.sha256()
@@ -48,6 +65,40 @@ def save_model(model: TemperatureModel, path: str | Path) -> dict[str, Any]:
     A model holding a non-finite number (NaN or infinity in a coefficient, range or
     statistic) is refused with :class:`DesignError` naming the field: JSON cannot hold it
     and firmware must never load it.
+
+    Parameters
+    ----------
+    model : TemperatureModel
+        A fitted model.
+    path : str or Path
+        The JSON file to write.
+
+    Returns
+    -------
+    dict
+        The model file's content as written.
+
+    Raises
+    ------
+    DesignError
+        When the model holds a non-finite number.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> import numpy as np
+    >>> from thermocal.models import RunData
+    >>> from thermocal.models.poly import PolyModel
+    >>> t = np.arange(0.0, 3600.0, 10.0)
+    >>> temp = 25.0 + 15.0 * np.sin(2 * np.pi * t / 3600.0)
+    >>> run = RunData(t, temp[:, None], 0.5 + 0.02 * temp, ("T1",))
+    >>> model = PolyModel(order=1).fit([run])
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     written = save_model(model, Path(d) / "model.json")
+    ...     back = load_model(Path(d) / "model.json")
+    >>> written["family"], [(c.name, round(c.value, 4)) for c in back.coefficients()]
+    ('poly', [('const', 0.5), ('T1', 0.02)])
     """
     d = model_file_dict(model)
     write_json(path, d)
@@ -55,20 +106,70 @@ def save_model(model: TemperatureModel, path: str | Path) -> dict[str, Any]:
 
 
 def load_model_dict(path: str | Path) -> dict[str, Any]:
-    """Read and verify a model file (format, version, checksum) without building it."""
+    """Read and verify a model file (format, version, checksum) without building it.
+
+    Parameters
+    ----------
+    path : str or Path
+        The model file (JSON).
+
+    Returns
+    -------
+    dict
+        The verified model dict.
+
+    Raises
+    ------
+    ModelFileError
+        When the file is not JSON, not a model file, of an unknown version, or its
+        checksum does not match.
+    """
     p = Path(path)
     d = read_json(p, "model file")
     return verify_model_dict(d, str(p))
 
 
 def load_model(path: str | Path) -> TemperatureModel:
-    """Load and verify a model file; returns the fitted model."""
+    """Load and verify a model file; returns the fitted model.
+
+    Parameters
+    ----------
+    path : str or Path
+        The model file (JSON) written by :func:`save_model`.
+
+    Returns
+    -------
+    TemperatureModel
+        The fitted model of its family.
+
+    Raises
+    ------
+    ModelFileError
+        When the file cannot be verified or is malformed (the message names ``path``).
+    """
     return model_from_dict(load_model_dict(path), path)
 
 
 def model_from_dict(d: dict[str, Any], path: str | Path) -> TemperatureModel:
-    """The fitted model of a verified model dict (:func:`verify_model_dict`); errors name
-    ``path``."""
+    """The fitted model of a verified model dict (:func:`verify_model_dict`).
+
+    Parameters
+    ----------
+    d : dict
+        A verified model dict.
+    path : str or Path
+        The file it came from, named in errors.
+
+    Returns
+    -------
+    TemperatureModel
+        The fitted model.
+
+    Raises
+    ------
+    ModelFileError
+        When the family is unknown or a field is malformed.
+    """
     try:
         return registry.model_from_dict(d)
     except ModelFileError as exc:
@@ -82,7 +183,27 @@ def model_from_dict(d: dict[str, Any], path: str | Path) -> TemperatureModel:
 def save_calibration(cal: Calibration, path: str | Path) -> dict[str, Any]:
     """Write a calibration file (atomically); returns its dict.  The file's own reader
     (:func:`~thermocal.models.calibration.calibration_from_dict`) judges it first: a
-    calibration that reader would refuse is refused here and not written."""
+    calibration that reader would refuse is refused here and not written.
+
+    Parameters
+    ----------
+    cal : Calibration
+        Channels and triads to write.
+    path : str or Path
+        The JSON file to write.
+
+    Returns
+    -------
+    dict
+        The calibration file's content as written.
+
+    Raises
+    ------
+    ThermocalInputError
+        When the calibration has no channel and no triad.
+    DesignError
+        When the file's own reader would refuse it.
+    """
     import json
 
     from thermocal.errors import DesignError
@@ -100,7 +221,23 @@ def save_calibration(cal: Calibration, path: str | Path) -> dict[str, Any]:
 
 def load_calibration(path: str | Path) -> Calibration:
     """A calibration file, or a single-model file as a calibration of one channel (named
-    after the model's signal, in the unit its inputs record)."""
+    after the model's signal, in the unit its inputs record).
+
+    Parameters
+    ----------
+    path : str or Path
+        A calibration file or a model file (JSON).
+
+    Returns
+    -------
+    Calibration
+        Its channels and triads.
+
+    Raises
+    ------
+    ModelFileError
+        When the file is neither a model nor a calibration file, or fails verification.
+    """
     p = Path(path)
     d = read_json(p, "model or calibration file")
     if is_calibration(d):

@@ -95,7 +95,26 @@ def _first_bad(obj: Any) -> tuple[str, str] | None:
 def read_json(path: str | Path, what: str = "model file") -> Any:
     """The parsed JSON of a model or calibration file, within the module's bounds (size,
     nesting, finite numbers); :class:`ModelFileError` ``"FILE: KEY.PATH: reason"``
-    otherwise."""
+    otherwise.
+
+    Parameters
+    ----------
+    path : str or Path
+        The file to read.
+    what : str, optional
+        What the file is, for messages (default ``"model file"``).
+
+    Returns
+    -------
+    Any
+        The parsed JSON.
+
+    Raises
+    ------
+    ModelFileError
+        When the file is special, too large, too deeply nested, not JSON, or holds a
+        non-finite number.
+    """
     p = Path(path)
     refuse_special_input(p, what)  # a FIFO would block the read
     try:

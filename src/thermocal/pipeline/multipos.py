@@ -89,7 +89,24 @@ class MultiposOptions:
     those named above."""
 
     def check(self, n_files: int, poses: Path | None) -> None:
-        """The options' own consistency (before any file is read)."""
+        """The options' own consistency (before any file is read).
+
+        Parameters
+        ----------
+        n_files : int
+            Number of session files given.
+        poses : Path or None
+            The poses file naming sections of a single file, if given.
+
+        Returns
+        -------
+        None
+
+        Raises
+        ------
+        ThermocalInputError
+            When the options contradict each other or the number of files.
+        """
         if self.gyro_model not in ("full", "scale"):
             raise ThermocalInputError(f"--gyro-model {self.gyro_model!r}: full or scale")
         if self.gyro_model != "full" and self.gyro is None:
@@ -491,7 +508,35 @@ def calibrate_files(
 ) -> MultiposResult:
     """Calibrate the sessions ``files`` (one per temperature; ``poses`` the named sections
     of a single file) and write the calibration of triads to ``output`` (module
-    docstring).  Every file's columns must be in one unit per triad."""
+    docstring).  Every file's columns must be in one unit per triad.
+
+    Parameters
+    ----------
+    files : sequence of Path
+        Session recordings, one per temperature.
+    output : Path
+        The calibration file to write (``.json``).
+    opts : MultiposOptions
+        Columns, units, gravity [m/s²], earth rate and model options.
+    poses : Path or None, optional
+        A file naming the static sections of a single recording (default ``None``).
+
+    Returns
+    -------
+    MultiposResult
+        The per-session estimates, the triads' models and the path written.
+
+    Raises
+    ------
+    ThermocalInputError
+        When ``output`` is an input or not ``.json``, the options are inconsistent, or a
+        session cannot support the calibration.
+
+    References
+    ----------
+    - Tedaldi, D., Pretto, A., Menegatti, E., "A robust and easy to implement method for
+      IMU calibration without external equipments", IEEE ICRA 2014, pp. 3042-3049.
+    """
     check_not_input(output, [*files, *([poses] if poses else [])])
     if output.suffix.lower() != ".json":
         raise ThermocalInputError(f"{output}: the calibration is JSON; use a .json name")

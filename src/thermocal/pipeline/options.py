@@ -272,7 +272,18 @@ def family_params(values: Mapping[str, Any]) -> dict[str, Any]:
     """The family options (constructor parameters) of the command-line values ``values``
     (named as the options without dashes, ``rate_interval``, ``select``,
     ``select_method``): ``{parameter: value}`` for the options given (not None; a flag
-    given).  An option the chosen family does not take is kept: the family refuses it."""
+    given).  An option the chosen family does not take is kept: the family refuses it.
+
+    Parameters
+    ----------
+    values : mapping of str to Any
+        The command's parameters by option name without dashes.
+
+    Returns
+    -------
+    dict
+        ``{family parameter: value}`` for the options given.
+    """
     params: dict[str, Any] = {}
     for name, decls in fit_option_table().items():
         first = decls[0][1]
@@ -288,7 +299,20 @@ def family_params(values: Mapping[str, Any]) -> dict[str, Any]:
 def options_of(cls: type[O], values: Mapping[str, Any]) -> O:
     """The options dataclass from a command's parameters, named as its options without
     dashes (``signal`` gives the field ``signals``, ``rate`` the field ``rate_hz``:
-    :func:`thermocal.pipeline.messages.option_name`)."""
+    :func:`thermocal.pipeline.messages.option_name`).
+
+    Parameters
+    ----------
+    cls : type
+        The options dataclass (e.g. ``TurntableOptions``).
+    values : mapping of str to Any
+        The command's parameters by option name without dashes.
+
+    Returns
+    -------
+    instance of ``cls``
+        With the fields given; the others at their defaults.
+    """
     out: dict[str, Any] = {}
     for f in dataclasses.fields(cls):
         key = option_name(f.name)[2:].replace("-", "_")
@@ -351,7 +375,29 @@ def options_from_table(command: str, table: Mapping[str, Any], where: str) -> tu
     "--select"]``, recorded with each unit).  An unknown option, a value of the wrong shape
     or type, or a missing required option is a :class:`ThermocalInputError` naming it
     (``where``: the file and table).  A flag set to false is left at its default; a yes/no
-    family option (``per_run_offset``) set to false is ``--no-per-run-offset``."""
+    family option (``per_run_offset``) set to false is ``--no-per-run-offset``.
+
+    Parameters
+    ----------
+    command : str
+        The command (``"fit"``, ``"validate"`` …).
+    table : mapping of str to Any
+        The options as parsed from the configuration file.
+    where : str
+        The file and table, named in errors.
+
+    Returns
+    -------
+    options : dataclass
+        The command's options.
+    argv : list of str
+        The same options as command-line arguments.
+
+    Raises
+    ------
+    ThermocalInputError
+        An unknown option, a value of the wrong shape or type, or a missing required one.
+    """
     cls = OPTIONS[command]
     kinds = _table_kinds(command)
     fields = {option_name(f.name)[2:]: f.name for f in dataclasses.fields(cls)}

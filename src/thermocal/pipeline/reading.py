@@ -17,7 +17,23 @@ if TYPE_CHECKING:
 
 
 def split_names(text: str | None) -> list[str] | None:
-    """``"T1, T2,T 3"`` → ``["T1", "T2", "T 3"]`` (None stays None)."""
+    """``"T1, T2,T 3"`` → ``["T1", "T2", "T 3"]`` (None stays None).
+
+    Parameters
+    ----------
+    text : str or None
+        Comma-separated names.
+
+    Returns
+    -------
+    list of str or None
+        The names, stripped, empty ones dropped.
+
+    Examples
+    --------
+    >>> split_names("T1, T2,T 3,")
+    ['T1', 'T2', 'T 3']
+    """
     if text is None:
         return None
     names = [t.strip() for t in text.split(",")]
@@ -26,7 +42,30 @@ def split_names(text: str | None) -> list[str] | None:
 
 def split_floats(text: str | None, what: str) -> list[float] | None:
     """``"25, 30"`` → ``[25.0, 30.0]`` (None stays None); an input error naming the option
-    ``what`` when an item is not a number."""
+    ``what`` when an item is not a number.
+
+    Parameters
+    ----------
+    text : str or None
+        Comma-separated numbers.
+    what : str
+        The option, named in the error.
+
+    Returns
+    -------
+    list of float or None
+        The numbers.
+
+    Raises
+    ------
+    ThermocalInputError
+        When an item is not a number.
+
+    Examples
+    --------
+    >>> split_floats("25, 30.5", "--breakpoints")
+    [25.0, 30.5]
+    """
     names = split_names(text)
     if names is None:
         return None

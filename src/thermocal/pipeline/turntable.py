@@ -66,7 +66,22 @@ def check_order(order: int) -> None:
     """Refuse (exit 2) a ``--order`` outside 0 … :data:`thermocal.turntable.thermal.MAX_ORDER`
     (3: a cubic in temperature per parameter, the most a few soaks can support; the number of
     soaks limits it further once the runs are read) before any file is read: typer parses an
-    order of 10²⁰ as a Python int."""
+    order of 10²⁰ as a Python int.
+
+    Parameters
+    ----------
+    order : int
+        Polynomial order in temperature of each calibration parameter [-].
+
+    Returns
+    -------
+    None
+
+    Raises
+    ------
+    ThermocalInputError
+        When ``order`` is below 0 or above ``MAX_ORDER`` (a huge order is shown shortened).
+    """
     if not 0 <= order <= _thermal.MAX_ORDER:
         shown = (
             str(order)
@@ -81,7 +96,25 @@ def check_order(order: int) -> None:
 def read_run(path: Path, o: TurntableOptions) -> Recording:
     """Read one run (:func:`thermocal.readers.read_recording`).  The gyro columns' unit goes
     through the shared resolver: --gyro-unit > file metadata > unit in the column name > °/s
-    (gyro_z in °/s), the last stated in a warning."""
+    (gyro_z in °/s), the last stated in a warning.
+
+    Parameters
+    ----------
+    path : Path
+        The run's file (any registered format).
+    o : TurntableOptions
+        Columns, units and read options of the run.
+
+    Returns
+    -------
+    Recording
+        The run with its gyro columns [°/s unless stated], encoder and temperature columns.
+
+    Raises
+    ------
+    ThermocalInputError
+        When the file cannot be read or a named column is missing.
+    """
     from thermocal.readers.dispatch import read_recording
 
     read = (o.read or ReadOptions()).replace(
@@ -98,7 +131,34 @@ def read_run(path: Path, o: TurntableOptions) -> Recording:
 def calibrate_run(
     path: Path, o: TurntableOptions, *, min_positions: int
 ) -> tuple[Recording, TurntableResult]:
-    """Read one run and calibrate it (:func:`thermocal.turntable.calibrate.calibrate`)."""
+    """Read one run and calibrate it (:func:`thermocal.turntable.calibrate.calibrate`).
+
+    Parameters
+    ----------
+    path : Path
+        The run's file.
+    o : TurntableOptions
+        Columns, units, site latitude [°], noise priors and dwell of the run.
+    min_positions : int
+        Fewest dwell positions accepted [-] (16 for a lone run).
+
+    Returns
+    -------
+    rec : Recording
+        The run as read.
+    result : TurntableResult
+        The estimated scale factors, misalignments and biases with their σ.
+
+    Raises
+    ------
+    ThermocalInputError
+        When the file cannot be read or too few positions are found.
+
+    References
+    ----------
+    - *A method for separating the combined error coefficients of a ring-laser gyro triad
+      based on dual-axis rotation*, Chinese invention patent CN104880182.
+    """
     rec = read_run(path, o)
     res = calibrate(
         rec,
@@ -139,8 +199,21 @@ class SingleRunResult:
 
 
 def triad_summary(tri: _thermal.TriadThermal) -> dict[str, object]:
-    """The JSON of one triad's temperature model (tref_c, order, coefficients
-    with _sigma, loto_rms)."""
+    r"""The JSON of one triad's temperature model (tref_c, order, coefficients
+    with _sigma, loto_rms).
+
+    Parameters
+    ----------
+    tri : TriadThermal
+        The triad's fitted temperature model.
+
+    Returns
+    -------
+    dict
+        ``tref_c`` [°C], ``order``, ``temperature_range_c`` [°C] and per parameter its
+        unit, coefficients (ascending powers of :math:`T - T_\mathrm{ref}`), their σ and
+        the leave-one-temperature-out RMS.
+    """
     return {
         "tref_c": tri.tref_c,
         "order": tri.order,
@@ -189,7 +262,26 @@ def check_as_read(cal: Any, output: Path, hint: str) -> None:
     its range, a well-conditioned ``I + E(T)`` over it, finite numbers …) applied to ``cal``
     before it is written to ``output``: a calibration that its own reader would refuse is
     refused now (:class:`~thermocal.errors.DesignError` naming what failed, ``hint`` the
-    options that get the user further), and nothing is written."""
+    options that get the user further), and nothing is written.
+
+    Parameters
+    ----------
+    cal : Calibration
+        The calibration about to be written.
+    output : Path
+        Where it would be written (named in the message).
+    hint : str
+        The options that get the user further, appended to the message.
+
+    Returns
+    -------
+    None
+
+    Raises
+    ------
+    DesignError
+        When the calibration's own reader would refuse it.
+    """
     import json
 
     from thermocal.errors import DesignError, ModelFileError
@@ -214,7 +306,38 @@ def turntable_calibration(
     to ``output``); several runs, or one with ``opts.temps`` and ``order``/``tref_c`` →
     :class:`ThermalRunsResult` (the calibration written to ``output``, :func:`thermal_runs`).
     Refuses (exit 2) an output that is an input, an order outside 0…3, several runs without
-    a temperature column, and ``order``/``tref_c`` for one run."""
+    a temperature column, and ``order``/``tref_c`` for one run.
+
+    Parameters
+    ----------
+    files : sequence of Path
+        The runs, one per soak temperature when several.
+    output : Path
+        The result (one run) or calibration (several runs) JSON file to write.
+    opts : TurntableOptions
+        Columns, units and rig settings shared by the runs.
+    order : int or None, optional
+        Polynomial order in temperature (0…3); default ``None``: chosen per parameter.
+    tref_c : float or None, optional
+        Reference temperature of the polynomials [°C]; default ``None``: mid-range.
+    overrides : tuple of str, optional
+        Adequacy tests to accept although failed (default none).
+
+    Returns
+    -------
+    SingleRunResult or ThermalRunsResult
+        The result; its ``to_dict()`` is the command's JSON.
+
+    Raises
+    ------
+    ThermocalInputError
+        On the refusals listed above.
+
+    References
+    ----------
+    - *A method for separating the combined error coefficients of a ring-laser gyro triad
+      based on dual-axis rotation*, Chinese invention patent CN104880182.
+    """
     from thermocal.writers import check_not_input, write_json
 
     if order is not None:
@@ -242,11 +365,48 @@ def thermal_runs(
     tref_c: float | None,
     overrides: tuple[str, ...] = (),
 ) -> ThermalRunsResult:
-    """Each run calibrated alone (at least :data:`MIN_POSITIONS_OF_A_SOAK` positions), then
+    r"""Each run calibrated alone (at least :data:`MIN_POSITIONS_OF_A_SOAK` positions), then
     every parameter of each triad as a polynomial in temperature about ``tref_c`` [°C]
     (:func:`thermocal.turntable.thermal.fit_triad`); writes a calibration of triads.  The
     soak temperatures are judged first (:func:`thermocal.adequacy.temperature_tests`: span
-    and distinct soaks for the order asked, 1 when the order is chosen per parameter)."""
+    and distinct soaks for the order asked, 1 when the order is chosen per parameter).
+
+    Parameters
+    ----------
+    files : sequence of Path
+        The runs, one per soak.
+    output : Path
+        The calibration file to write (``.json``).
+    opts : TurntableOptions
+        Columns, units and rig settings shared by the runs.
+    order : int or None
+        Polynomial order in temperature; ``None`` chooses it per parameter.
+    tref_c : float or None
+        Reference temperature [°C]; ``None``: mid-range of the soaks.
+    overrides : tuple of str, optional
+        Adequacy tests to accept although failed (default none).
+
+    Returns
+    -------
+    ThermalRunsResult
+        The runs, the triads' temperature models and the adequacy record.
+
+    Raises
+    ------
+    ThermocalInputError
+        When ``output`` is not ``.json``, a run cannot be read, or the soaks cannot
+        support the order (adequacy tests not overridden).
+    DesignError
+        When the calibration would be refused on reading.
+
+    Notes
+    -----
+    Each parameter :math:`p` (scale factor, misalignment, bias) is fitted as
+
+    .. math:: p(T) = \sum_{k=0}^{n} c_k (T - T_\mathrm{ref})^k
+
+    by weighted least squares on the runs' estimates and their σ.
+    """
     from thermocal.models.calibration import Calibration, Triad
     from thermocal.pipeline.model_file import save_calibration
 

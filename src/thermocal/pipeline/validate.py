@@ -75,7 +75,20 @@ class ValidationReport:
 def modeling_file(model: TemperatureModel, model_file: Path) -> Path | None:
     """The first data file recorded in the model file that still exists: its name, then
     the path given to fit (relative ones tried from the current directory and from the
-    model file's directory)."""
+    model file's directory).
+
+    Parameters
+    ----------
+    model : TemperatureModel
+        The fitted model (its recorded data files).
+    model_file : Path
+        The model file, whose directory relative paths are also tried from.
+
+    Returns
+    -------
+    Path or None
+        The data file found, or ``None``.
+    """
     for entry in model.data_:
         if not isinstance(entry, dict):
             continue
@@ -92,7 +105,25 @@ def modeling_file(model: TemperatureModel, model_file: Path) -> Path | None:
 
 def ambient_c(rec: Recording, name: str) -> FloatArray:
     """The ambient temperature [°C] for r and the hold stages; raw counts with no
-    conversion are used as counts, with a warning (the hold threshold is then per count)."""
+    conversion are used as counts, with a warning (the hold threshold is then per count).
+
+    Parameters
+    ----------
+    rec : Recording
+        The validation recording.
+    name : str
+        The ambient temperature column.
+
+    Returns
+    -------
+    numpy.ndarray
+        The ambient temperature [°C], or raw counts when no conversion is recorded.
+
+    Warns
+    -----
+    UnitWarning
+        When the column is in raw counts with no conversion.
+    """
     if rec.units.get(name) == "counts" and name not in rec.meta.temperature_conversion:
         warnings.warn(
             UnitWarning(
@@ -284,7 +315,34 @@ def validate_files(
     """Judge the model or calibration file ``calibration`` on the recording ``file`` (module
     docstring): correlation r, bias stability and repeatability over the hold stages, rms and
     peak-to-peak, before and after compensation, in the data's own unit
-    (:func:`thermocal.validation.validate`); triads: dwell-mean and move-angle errors."""
+    (:func:`thermocal.validation.validate`); triads: dwell-mean and move-angle errors.
+
+    Parameters
+    ----------
+    calibration : Path
+        A model or calibration file.
+    file : Path
+        The validation recording.
+    options : ValidateOptions or None, optional
+        Columns, stage detection and read options (default ``None``: the defaults).
+
+    Returns
+    -------
+    ValidationReport
+        The figures before and after compensation.
+
+    Raises
+    ------
+    ThermocalInputError
+        When a file cannot be read or does not match the model's columns.
+    ModelFileError
+        When the model or calibration file fails verification.
+
+    References
+    ----------
+    - *A modelling and validation method for the temperature compensation model of a
+      ring-laser gyroscope*, Chinese invention patent, published 2017.
+    """
     from thermocal.pipeline.model_file import load_calibration
 
     o = options if options is not None else ValidateOptions()

@@ -14,7 +14,18 @@ from thermocal.export.c.core import (
 def generate(ctx: ExportContext) -> FamilyCode:
     """Model bank (models/bank.py ``BankStream``): every piecewise-linear model
     evaluated at the clamped T; during ``t − t_first < startup_s`` the residual sums
-    ``Σ (y − f_m)`` pick ``argmin_m |Σ_m/N|``; then the choice is frozen."""
+    ``Σ (y − f_m)`` pick ``argmin_m |Σ_m/N|``; then the choice is frozen.
+
+    Parameters
+    ----------
+    ctx : ExportContext
+        The model dict, C prefix, real type and ring-buffer length.
+
+    Returns
+    -------
+    FamilyCode
+        The family's state fields, constant data and the C bodies of init and update.
+    """
     st = ctx.model["state"]
     P, r = ctx.P, ctx.r
     m = len(st["models"])

@@ -23,7 +23,26 @@ def check_distinct_names(
     """Refuse (:class:`ThermocalInputError`) modules of one file that declare the same C
     name: each ``(original name, module)`` declares the identifiers under its own prefix
     (:func:`thermocal.identifiers.c_names`), the file itself ``top``.  Distinct identifiers
-    can still meet once suffixed (channels ``a`` and ``a_t0``: ``A_T0_ORDER``)."""
+    can still meet once suffixed (channels ``a`` and ``a_t0``: ``A_T0_ORDER``).
+
+    Parameters
+    ----------
+    modules : sequence of (str, CExport)
+        Each channel's (or triad's) original name and its generated module.
+    top : sequence of str
+        The C names the combined file itself declares.
+    what : str
+        What a module is (``"channel"``, ``"triad"``), for the message.
+
+    Returns
+    -------
+    None
+
+    Raises
+    ------
+    ThermocalInputError
+        When two modules (or a module and the file) give the same C name.
+    """
     seen = {n: f"the {what}s' common code" for n in top}
     for name, ex in modules:
         for n in sorted(c_names(ex.header + "\n" + ex.source, ex.prefix)):
@@ -53,6 +72,31 @@ def generate_c_calibration(
     and writing the N compensated values. No allocation; the per-channel functions stay
     callable (``<prefix>_<name>_compensate``). ``sample_interval_s`` sizes the Ṫ buffers
     (None: each channel's fitted interval, :func:`fitted_sample_interval`).
+
+    Parameters
+    ----------
+    channels : sequence of (str, dict, str or None)
+        Channel name, model dict and signal unit of the C functions per channel.
+    prefix : str, optional
+        Prefix of the C identifiers and files (default ``"thermocal_cal"``).
+    real : {"double", "float"}, optional
+        C real type (default ``"double"``).
+    sample_interval_s : float or None, optional
+        Expected sample interval [s]; default ``None``: each channel's fitted one.
+
+    Returns
+    -------
+    CExport
+        The combined header and source.
+
+    Raises
+    ------
+    ThermocalInputError
+        When there is no channel, a real type is unknown, or two channels give one C name.
+    ModelFileError
+        When a channel's family has no C generator.
+    UnitError
+        When a channel's unit does not fit its model.
     """
     if not channels:
         raise ThermocalInputError("a calibration with no channel has no C")
@@ -229,7 +273,18 @@ def _cal_source(cm: _CalModules) -> str:
 
 def fitted_sample_interval(model: dict[str, Any]) -> float | None:
     """The sample interval [s] of the data a model was fitted on (model file
-    ``inputs.sample_interval_s``), or None for files that do not record it."""
+    ``inputs.sample_interval_s``), or None for files that do not record it.
+
+    Parameters
+    ----------
+    model : dict
+        A model dict.
+
+    Returns
+    -------
+    float or None
+        The interval [s], or ``None`` when absent or not positive.
+    """
     v = (model.get("inputs") or {}).get("sample_interval_s")
     return float(v) if isinstance(v, int | float) and v > 0 else None
 
@@ -244,7 +299,37 @@ def export_c(
     unit: str | None = None,
 ) -> tuple[CExport, list[Path]]:
     """Read and verify a model file, generate its C module and write it into ``out_dir``
-    (``unit``: the functions' signal unit, :func:`c_signal_unit`)."""
+    (``unit``: the functions' signal unit, :func:`c_signal_unit`).
+
+    Parameters
+    ----------
+    model_path : str or Path
+        The model file (JSON).
+    out_dir : str or Path
+        Output directory of ``<prefix>.h`` and ``<prefix>.c``.
+    prefix : str or None, optional
+        C prefix; default ``None``: the model file's stem made a C identifier.
+    real : {"double", "float"}, optional
+        C real type (default ``"double"``).
+    sample_interval_s : float, optional
+        Expected sample interval [s] (default 1.0), sizing the rate ring buffer.
+    unit : str or None, optional
+        Signal unit of the functions (default: the unit fitted on).
+
+    Returns
+    -------
+    export : CExport
+        The generated module.
+    paths : list of Path
+        Header and source written.
+
+    Raises
+    ------
+    ModelFileError
+        When the model file cannot be verified or its family has no C generator.
+    ThermocalInputError
+        When an output is the model file or cannot be written.
+    """
     from thermocal.pipeline.model_file import load_model_dict
 
     d = load_model_dict(model_path)

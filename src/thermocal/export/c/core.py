@@ -79,19 +79,41 @@ class CExport:
 
     @property
     def header_name(self) -> str:
+        """File name of the header, ``<prefix>.h``."""
         return f"{self.prefix}.h"
 
     @property
     def source_name(self) -> str:
+        """File name of the source, ``<prefix>.c``."""
         return f"{self.prefix}.c"
 
     def write(self, directory: str | Path, inputs: Sequence[str | Path] = ()) -> list[Path]:
-        """Write header and source into ``directory`` as a pair; returns the paths.
+        """Write header and source into ``directory`` as a pair.
+
         Neither may be one of ``inputs`` (the model file: ``export-c model.c -o .``) nor a
         special file (:func:`thermocal.outputs.check_outputs`).  Both are written whole
         to temporaries beside their targets before either is renamed into place
         (:func:`write_together`): a failure writing either leaves neither new file, and
-        an older pair as it was."""
+        an older pair as it was.
+
+        Parameters
+        ----------
+        directory : str or Path
+            Output directory; created (with its parents) when missing.
+        inputs : sequence of str or Path, optional
+            Input files the outputs must not overwrite (default none).
+
+        Returns
+        -------
+        list of Path
+            The paths written: header first, then source.
+
+        Raises
+        ------
+        ThermocalInputError
+            When an output is an input or a special file, ``directory`` exists and is not a
+            directory, or it cannot be created.
+        """
         from thermocal.errors import ThermocalInputError
         from thermocal.outputs import check_outputs
 
@@ -115,10 +137,22 @@ def _write_text(path: Path, text: str) -> None:
 
 
 def write_together(files: Sequence[tuple[Path, str]]) -> None:
-    """Write text files that only make sense together (a C header and its source): each
-    into its own temporary beside its target (:func:`thermocal.writers.atomic_write_path`),
-    nested, so that every temporary is complete before the first rename; an exception
-    while writing any of them removes every temporary and renames none."""
+    """Write text files that only make sense together (a C header and its source).
+
+    Each goes into its own temporary beside its target
+    (:func:`thermocal.writers.atomic_write_path`), nested, so that every temporary is
+    complete before the first rename; an exception while writing any of them removes every
+    temporary and renames none.
+
+    Parameters
+    ----------
+    files : sequence of (Path, str)
+        The target paths and the whole text of each.
+
+    Returns
+    -------
+    None
+    """
     from thermocal.writers import atomic_write_path
 
     if not files:
@@ -152,7 +186,27 @@ class ExportContext:
         return f"{self.prefix}_real"
 
     def lit(self, x: float) -> str:
-        """A C literal of the real type (17 significant digits, ``f`` suffix for float)."""
+        """A C literal of the real type (17 significant digits, ``f`` suffix for float).
+
+        Parameters
+        ----------
+        x : float
+            The constant [unit of the coefficient it carries].
+
+        Returns
+        -------
+        str
+            The C literal; a float magnitude below ``FLT_MIN`` is written as zero.
+
+        Raises
+        ------
+        ModelFileError
+            When ``x`` is not finite, or exceeds ``FLT_MAX`` for the ``float`` real type.
+
+        References
+        ----------
+        - ISO/IEC 9899:2011 (C11), §5.2.4.2.2 (characteristics of floating types).
+        """
         if not math.isfinite(x):
             raise ModelFileError(f"non-finite coefficient {x!r} cannot be exported")
         if self.real == "float" and abs(x) > FLT_MAX:
@@ -168,7 +222,20 @@ class ExportContext:
         return s + ("f" if self.real == "float" else "")
 
     def array(self, name: str, values: Sequence[float] | npt.ArrayLike) -> str:
-        """``static const <real> NAME[n] = {…};`` (1-D)."""
+        """A C definition ``static const <real> NAME[n] = {…};`` of a 1-D array.
+
+        Parameters
+        ----------
+        name : str
+            C identifier of the array.
+        values : array_like of float
+            The values (flattened); an empty array is written as one zero.
+
+        Returns
+        -------
+        str
+            The C definition, four literals per line.
+        """
         v = np.asarray(values, dtype=np.float64).ravel()
         body = ",\n    ".join(
             ", ".join(self.lit(x) for x in v[i : i + 4]) for i in range(0, v.size, 4)
@@ -178,7 +245,20 @@ class ExportContext:
         )
 
     def array2(self, name: str, values: npt.ArrayLike) -> str:
-        """``static const <real> NAME[a][b] = {{…}, …};``."""
+        """A C definition ``static const <real> NAME[a][b] = {{…}, …};`` of a 2-D array.
+
+        Parameters
+        ----------
+        name : str
+            C identifier of the array.
+        values : array_like of float, shape (a, b)
+            The rows of the array.
+
+        Returns
+        -------
+        str
+            The C definition, one row per line.
+        """
         m = np.asarray(values, dtype=np.float64)
         rows = ",\n    ".join("{" + ", ".join(self.lit(x) for x in row) + "}" for row in m)
         return f"static const {self.r} {name}[{m.shape[0]}][{m.shape[1]}] = {{\n    {rows}\n}};"
@@ -195,6 +275,7 @@ class ExportContext:
         return np.array([tr[n] for n in self.model["temperatures"]], dtype=np.float64)
 
     def clamp_arrays(self) -> str:
+        """C arrays ``<P>_T_LO`` and ``<P>_T_HI`` of the fitted temperature range [°C or counts]."""
         rng = self.temp_range()
         return "\n".join(
             [
@@ -211,7 +292,24 @@ Generator = Callable[[ExportContext], FamilyCode]
 def family_generator(family: str) -> Generator:
     """The C generator a model family declares on its class (``C_GENERATOR``: the module
     of :mod:`thermocal.export.c` whose ``generate(ctx)`` writes its code), so a family's
-    options, chunk context and C code are declared in one place."""
+    options, chunk context and C code are declared in one place.
+
+    Parameters
+    ----------
+    family : str
+        Name of the model family as registered (e.g. ``"poly"``).
+
+    Returns
+    -------
+    callable
+        ``generate(ctx: ExportContext) -> FamilyCode``.
+
+    Raises
+    ------
+    ModelFileError
+        When the family is unknown or declares no C generator (the message lists those
+        that do).
+    """
     import importlib
 
     from thermocal.models.registry import MODEL_REGISTRY
@@ -292,9 +390,29 @@ def c_signal_unit(model: dict[str, Any], unit: str | None = None) -> tuple[str, 
     """The unit the generated functions take ``signal`` and return values in, and the factor
     ``f`` with ``value[model unit] = f · value[that unit]``.
 
-    ``unit`` (``--unit``) else the unit the model was fitted on as given (model file
+    ``unit`` else the unit the model was fitted on as given (model file
     ``inputs.units``, e.g. ``deg/s``), else the model's own unit (older files, raw-count
-    data).  A unit of another kind than the model's, or ``counts``, is a :class:`UnitError`.
+    data).
+
+    Parameters
+    ----------
+    model : dict
+        The model as read from a model file.
+    unit : str or None, optional
+        Signal unit of the generated functions (e.g. ``"deg/s"``, ``"m/s^2"``); default
+        ``None``: the unit the model was fitted on.
+
+    Returns
+    -------
+    unit : str
+        The normalised signal unit of the generated functions.
+    factor : float
+        ``f`` with ``value[model unit] = f · value[unit]`` [model unit per unit].
+
+    Raises
+    ------
+    UnitError
+        When ``unit`` is of another kind than the model's, or either is raw ``counts``.
     """
     mu = units.normalize_signal_unit(str((model.get("signal") or {}).get("unit")))
     if unit is None:
@@ -353,7 +471,7 @@ def generate_c(
     sample_interval_s: float = 1.0,
     unit: str | None = None,
 ) -> CExport:
-    """Generate the C99 header and source of a model dict (see the module docstring).
+    r"""Generate the C99 header and source of a model dict (see the module docstring).
 
     ``sample_interval_s`` is only used to size the Ṫ ring buffer of rate models
     (``<P>_RATE_BUF_LEN`` = ⌈Δt/τ⌉ + 8, overridable with ``-D``); the interval used at
@@ -361,6 +479,43 @@ def generate_c(
     functions (:func:`c_signal_unit`: by default the unit the model was fitted on as
     given); the family code runs in the model's unit and ``<p>_update`` converts its
     input and output with ``<P>_TO_MODEL_UNIT``.
+
+    Parameters
+    ----------
+    model : dict
+        The model as read from a model file (:func:`thermocal.pipeline.model_file.load_model_dict`).
+    prefix : str, optional
+        Prefix of the C identifiers and file names (default ``"thermocal_model"``); made a
+        valid C identifier.
+    real : {"double", "float"}, optional
+        C type of the coefficients and arithmetic (default ``"double"``).
+    sample_interval_s : float, optional
+        Expected sample interval [s] (default 1.0), sizing the rate models' ring buffer:
+
+        .. math:: N_\mathrm{buf} = \lceil \Delta t / \tau \rceil + 8
+
+        with :math:`\Delta t` the model's rate interval [s] and :math:`\tau` this interval.
+    unit : str or None, optional
+        Signal unit of the generated functions (default: the unit fitted on;
+        :func:`c_signal_unit`).
+
+    Returns
+    -------
+    CExport
+        Header and source text, prefix, real type, family and units.
+
+    Raises
+    ------
+    ThermocalInputError
+        When ``real`` is not a known C type or ``sample_interval_s`` is not positive.
+    ModelFileError
+        When the family has no C generator or a coefficient cannot be written.
+    UnitError
+        When ``unit`` does not fit the model's signal.
+
+    References
+    ----------
+    - ISO/IEC 9899:1999 (C99), the language of the generated code.
     """
     if real not in REAL_TYPES:
         raise ThermocalInputError(f"real type must be one of {REAL_TYPES}, got {real!r}")

@@ -102,6 +102,28 @@ def export_c_file(
     file the float build's worst-case error against double measured
     (:func:`measure_float_error`) when a C compiler is found (a warning otherwise).
     Data that did not support the fit are refused (:func:`check_firmware_adequacy`).
+
+    Parameters
+    ----------
+    model_file : str or Path
+        A model or calibration file (JSON).
+    output : str or Path
+        Output directory.
+    use_float, name, sample_interval_s, unit
+        As above; ``sample_interval_s`` in [s], defaults ``False``/``None``.
+
+    Returns
+    -------
+    ExportCResult
+        The module(s) generated, the paths written and the float error when measured.
+
+    Raises
+    ------
+    ThermocalInputError
+        When the file cannot be read, an output is an input, or the data did not support
+        the fit.
+    ModelFileError
+        When a family has no C generator or a coefficient cannot be written.
     """
     from thermocal.models.calibration import is_calibration
     from thermocal.outputs import check_outputs

@@ -22,7 +22,19 @@ from thermocal.recording import FloatArray
 def c_harness(export: CExport) -> str:
     """A small C main: reads ``n`` then ``n`` records of doubles ``(t, T_1..T_k, F)`` from
     a binary file (argv[1]), calls ``init(τ = argv[3])`` and ``update`` on each sample and
-    writes the model values as doubles to argv[2]."""
+    writes the model values as doubles to argv[2].
+
+    Parameters
+    ----------
+    export : CExport
+        The generated module the harness calls.
+
+    Returns
+    -------
+    str
+        C99 source of ``main`` (argv: input, output, sample interval [s], optional known
+        input [signal unit]).
+    """
     p, P, r = export.prefix, export.prefix.upper(), f"{export.prefix}_real"
     return f"""#include <stdio.h>
 #include <stdlib.h>
@@ -83,7 +95,29 @@ def find_compiler() -> str | None:
 
 def compile_harness(export: CExport, directory: str | Path, compiler: str | None = None) -> Path:
     """Write the module and :func:`c_harness` into ``directory`` and compile them with
-    ``cc -O2 -std=c99 -Wall -Wextra -Werror -pedantic``; returns the executable."""
+    ``cc -O2 -std=c99 -Wall -Wextra -Werror -pedantic``; returns the executable.
+
+    Parameters
+    ----------
+    export : CExport
+        The generated module.
+    directory : str or Path
+        Where the sources and the executable are written.
+    compiler : str or None, optional
+        The C compiler; default ``None``: :func:`find_compiler`.
+
+    Returns
+    -------
+    Path
+        The compiled executable.
+
+    Raises
+    ------
+    ThermocalInputError
+        When no C compiler is found.
+    RuntimeError
+        When compilation fails (a defect of the generated code; stderr in the message).
+    """
     cc = compiler or find_compiler()
     if cc is None:
         raise ThermocalInputError("no C compiler (cc, gcc or clang) found")
@@ -108,7 +142,33 @@ def run_harness(
     *,
     known_input: float = 0.0,
 ) -> FloatArray:
-    """Run a compiled harness on samples; returns the model values (n,)."""
+    """Run a compiled harness on samples; returns the model values (n,).
+
+    Parameters
+    ----------
+    exe : str or Path
+        Executable of :func:`compile_harness`.
+    time_s : array_like, shape (n,)
+        Sample times [s].
+    temps_c : array_like, shape (n, k)
+        Temperatures [°C] (or the model's temperature unit), one column per model input.
+    signal : array_like, shape (n,)
+        The measured signal [signal unit of the export].
+    sample_interval_s : float
+        Interval given to ``<p>_init`` [s].
+    known_input : float, optional
+        Known input removed by the module [signal unit] (default 0.0).
+
+    Returns
+    -------
+    numpy.ndarray, shape (n,)
+        The values ``<p>_update`` returns [signal unit].
+
+    Raises
+    ------
+    RuntimeError
+        When the harness exits with a non-zero status.
+    """
     t = np.asarray(time_s, dtype=np.float64)
     T = np.asarray(temps_c, dtype=np.float64).reshape(t.size, -1)
     f = np.asarray(signal, dtype=np.float64)
@@ -146,7 +206,37 @@ def exercise_inputs(
     """Synthetic samples over a model's fitted range, power-on included: every
     temperature channel sweeps its fitted range ±10 % (triangle waves of different
     periods, so rates and clamping occur), a gap of 7 τ after the fraction ``gap_at``
-    of the samples, signal = small noise.  Returns ``(time_s, temps_c (n, k), signal)``."""
+    of the samples, signal = small noise.
+
+    Parameters
+    ----------
+    model : dict
+        A model dict (its ``temperatures`` and ``range.temperature_c``).
+    n : int, optional
+        Number of samples (default 100 000).
+    sample_interval_s : float, optional
+        Sample interval [s] (default 1.0).
+    seed : int, optional
+        Seed of ``numpy.random.default_rng`` (default 0).
+    gap_at : float, optional
+        Fraction of the samples after which the 7-interval gap falls (default 0.6).
+
+    Returns
+    -------
+    time_s : numpy.ndarray, shape (n,)
+        Sample times [s].
+    temps_c : numpy.ndarray, shape (n, k)
+        Temperatures [°C]: each a triangle wave over its range widened by 10 % each side.
+    signal : numpy.ndarray, shape (n,)
+        Gaussian noise of standard deviation 0.01 [signal unit].
+
+    Examples
+    --------
+    >>> m = {"temperatures": ["T1"], "range": {"temperature_c": {"T1": [10.0, 40.0]}}}
+    >>> t, T, f = exercise_inputs(m, n=1000)
+    >>> T.shape, round(float(T.min()), 1), round(float(T.max()), 1), float(t[-1])
+    ((1000, 1), 7.0, 43.0, 1006.0)
+    """
     rng = np.random.default_rng(seed)
     t = np.arange(n, dtype=np.float64) * sample_interval_s
     t[int(gap_at * n) :] += 7.0 * sample_interval_s
@@ -183,7 +273,40 @@ def measure_float_error(
     compiler: str | None = None,
     unit: str | None = None,
 ) -> FloatError:
-    """Compile the double and float builds and compare them on the same inputs."""
+    r"""Compile the double and float builds and compare them on the same inputs.
+
+    Parameters
+    ----------
+    model : dict
+        A model dict (:func:`thermocal.pipeline.model_file.load_model_dict`).
+    prefix : str, optional
+        C prefix (default ``"thermocal_model"``).
+    n : int, optional
+        Number of samples of :func:`exercise_inputs` (default 100 000).
+    sample_interval_s : float, optional
+        Sample interval [s] (default 1.0).
+    compiler : str or None, optional
+        The C compiler; default ``None``: :func:`find_compiler`.
+    unit : str or None, optional
+        Signal unit of the generated functions (default: the unit fitted on).
+
+    Returns
+    -------
+    FloatError
+        The largest absolute and relative differences.
+
+    Raises
+    ------
+    ThermocalInputError
+        When no C compiler is found or the model cannot be exported.
+
+    Notes
+    -----
+    .. math:: e_\mathrm{abs} = \max_k |\hat y^{f}_k - \hat y^{d}_k|,\quad
+              e_\mathrm{rel} = e_\mathrm{abs} / \max_k |\hat y^{d}_k|
+
+    with :math:`\hat y^{f}`, :math:`\hat y^{d}` the float and double builds' outputs.
+    """
     t, T, f = exercise_inputs(model, n, sample_interval_s)
     outs = []
     with tempfile.TemporaryDirectory() as tmp:

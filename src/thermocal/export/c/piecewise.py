@@ -21,6 +21,16 @@ def generate(ctx: ExportContext) -> FamilyCode:
     store their lines in this form, so one generator serves both; a discontinuous
     ``intersect`` model (lines that do not meet) jumps at the kept breakpoint exactly
     as in Python.  Memoryless: the state struct only holds the common fields.
+
+    Parameters
+    ----------
+    ctx : ExportContext
+        The model dict, C prefix, real type and ring-buffer length.
+
+    Returns
+    -------
+    FamilyCode
+        The family's state fields, constant data and the C bodies of init and update.
     """
     d = ctx.model
     st = d["state"]

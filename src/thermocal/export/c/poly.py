@@ -136,7 +136,18 @@ def generate(ctx: ExportContext) -> FamilyCode:
     Ṫ from the raw temperatures, clamp T and Ṫ (rate sensors) to the fitted ranges,
     ``u = (T − c_T)/s_T``, ``v = (Ṫ − c_R)/s_R``, ``w = (T·Ṫ − c_W)/s_W``,
     ``y = Σ_j coef_j u^a v^b w^c + constant`` (powers by repeated multiplication; the sum
-    in :data:`N_ACCUMULATORS` partial sums)."""
+    in :data:`N_ACCUMULATORS` partial sums).
+
+    Parameters
+    ----------
+    ctx : ExportContext
+        The model dict, C prefix, real type and ring-buffer length.
+
+    Returns
+    -------
+    FamilyCode
+        The family's state fields, constant data and the C bodies of init and update.
+    """
     plan = _plan(ctx)
     P, p = ctx.P, ctx.prefix
     data = _data(ctx, plan)

@@ -122,7 +122,38 @@ def _triad_code(p: str, tri: Any, bias_to_data: float, real: str, ident: str) ->
 
 
 def generate_c_triads(triads: Sequence[Any], *, prefix: str, real: str = "double") -> CExport:
-    """The C module of a calibration's triads (module docstring)."""
+    r"""The C module of a calibration's triads (module docstring).
+
+    Parameters
+    ----------
+    triads : sequence of Triad
+        The calibration's triads (name, unit, temperature model).
+    prefix : str
+        Prefix of the C identifiers and files.
+    real : {"double", "float"}, optional
+        C real type of ``x`` and ``out`` (default ``"double"``).
+
+    Returns
+    -------
+    CExport
+        Header and source with one ``<p>_<triad>_correct`` per triad.
+
+    Raises
+    ------
+    ValueError
+        When ``real`` is neither ``"double"`` nor ``"float"``.
+    ThermocalInputError
+        When two triads give one C name.
+
+    Notes
+    -----
+    .. math:: \mathbf{out} = (I + E(T))^{-1}\,(\mathbf x - \mathbf b(T))
+
+    References
+    ----------
+    - *A method for separating the combined error coefficients of a ring-laser gyro triad
+      based on dual-axis rotation*, Chinese invention patent CN104880182.
+    """
     if real not in ("double", "float"):
         raise ValueError("real must be double or float")
     p = c_identifier(prefix)

@@ -17,6 +17,16 @@ def generate(ctx: ExportContext) -> FamilyCode:
 
     T = clamp(T_in); during ``t − t_first < W``: T0 = running mean of T; then frozen;
     a_j = Σ_k b_jk clamp(T0)^k (Horner), ΔF = Σ_j a_j (T − T0)^j (Horner).
+
+    Parameters
+    ----------
+    ctx : ExportContext
+        The model dict, C prefix, real type and ring-buffer length.
+
+    Returns
+    -------
+    FamilyCode
+        The family's state fields, constant data and the C bodies of init and update.
     """
     st = ctx.model["state"]
     b = np.asarray(st["b"], dtype=np.float64)
