@@ -185,8 +185,11 @@ class ValidateOptions:
     @property
     def read_options(self) -> ReadOptions:
         """How the files are read (:class:`thermocal.readers.options.ReadOptions`; the
-        signal column named, the temperatures the file's)."""
-        return _read_options(self)
+        signal column named, the temperatures the file's), as
+        :func:`thermocal.pipeline.reading.read_options_of` builds it from the option strings."""
+        from thermocal.pipeline.reading import read_options_of
+
+        return read_options_of(self)
 
 
 def _conversion(value: object) -> TemperatureConversion:
@@ -199,23 +202,16 @@ def _conversion(value: object) -> TemperatureConversion:
         raise ParameterError("temp_conversion", str(exc)) from None
 
 
-def _read_options(o: FitOptions | ValidateOptions) -> ReadOptions:
-    """The :class:`ReadOptions` of a fit's or a validation's reading fields."""
+def _read_options(o: FitOptions) -> ReadOptions:
+    """The :class:`ReadOptions` of a fit's reading fields."""
     from thermocal.readers.options import ReadOptions
 
-    signals: Any  # ReadOptions takes a column list's text too (a validation's fields)
-    names: Any
-    if isinstance(o, FitOptions):
-        signals, temperatures, names, rate = o.signals, o.temperatures, o.names, o.rate_hz
-    else:
-        signals, temperatures, names, rate = o.signal, None, o.names, o.rate
-    conversion: Any = o.temp_conversion
     return ReadOptions(
-        time=o.time, time_unit=o.time_unit, signals=signals, temperatures=temperatures,
-        signal_unit=o.signal_unit, temp_unit=o.temp_unit, temp_conversion=conversion,
-        topic=o.topic, names=names, rate_hz=rate,
-        on_bad_lines=o.on_bad_lines,  # type: ignore[arg-type]
-        delimiter=o.delimiter, decimal=o.decimal,  # type: ignore[arg-type]
+        time=o.time, time_unit=o.time_unit, signals=o.signals, temperatures=o.temperatures,
+        signal_unit=o.signal_unit, temp_unit=o.temp_unit, temp_conversion=o.temp_conversion,
+        topic=o.topic, names=o.names, rate_hz=o.rate_hz,
+        on_bad_lines=o.on_bad_lines,
+        delimiter=o.delimiter, decimal=o.decimal,
     )  # fmt: skip
 
 

@@ -20,7 +20,7 @@ from typing import TYPE_CHECKING, Any
 
 from thermocal.errors import FileFormatError, ThermocalInputError, ThermocalWarning, UnitWarning
 from thermocal.pipeline.options import ValidateOptions
-from thermocal.pipeline.reading import check_recording, read_options_of, split_names
+from thermocal.pipeline.reading import check_recording, split_names
 from thermocal.readers.formats import file_kind, format_named
 
 if TYPE_CHECKING:
@@ -289,7 +289,7 @@ def _validate_triads(
     from thermocal.pipeline.compensate import read_for_triads
     from thermocal.turntable.calibrate import validate_turntable_run
 
-    rec = read_for_triads(file, cal.triads, read_options_of(o))
+    rec = read_for_triads(file, cal.triads, o.read_options)
     _own_session(cal, file)
     if _mp_validate.is_multipos(cal.triads):  # held-out poses
         results: list[Any] = _mp_validate.validate_held_out_session(
@@ -349,7 +349,7 @@ def validate_files(
     pre = load_calibration(calibration)
     if pre.triads and not pre.channels:
         return _validate_triads(pre, calibration, file, o)
-    ctx = _Context(calibration, file, o, read_options_of(o), {})
+    ctx = _Context(calibration, file, o, o.read_options, {})
     cal = load_calibration(calibration)  # a model file is a calibration of one channel
     cal.require_channels("validate")
     if len(cal.channels) > 1:
