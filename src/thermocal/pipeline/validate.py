@@ -279,24 +279,61 @@ def _own_session(cal: Calibration, file: Path) -> None:
         )
 
 
+def judge_triads(
+    triads: Any,
+    rec: Recording,
+    latitude_deg: float | None,
+    *,
+    static_s: float = 1.0,
+    signal_unit: str | None = None,
+) -> list[Any]:
+    """Triads of a calibration judged on a recording: on held-out poses when the calibration
+    is a multi-position one, else as a turntable run.
+
+    Parameters
+    ----------
+    triads : sequence
+        The calibration's triads.
+    rec : Recording
+        The recording, read with the triads' columns.
+    latitude_deg : float or None
+        Latitude [°] (None: the recording's metadata).
+    static_s : float
+        Shortest still stretch [s] of a held-out pose.
+    signal_unit : str, optional
+        The gyro's unit when the file does not state it.
+
+    Returns
+    -------
+    list
+        One result per triad (:func:`thermocal.multipos.validate.validate_held_out_session`
+        or :func:`thermocal.turntable.calibrate.validate_turntable_run`).
+    """
+    from thermocal.multipos import validate as _mp_validate
+    from thermocal.turntable.calibrate import validate_turntable_run
+
+    if _mp_validate.is_multipos(triads):  # held-out poses
+        return list(
+            _mp_validate.validate_held_out_session(
+                triads, rec, latitude_deg, static_s=static_s, signal_unit=signal_unit
+            )
+        )
+    return list(validate_turntable_run(triads, rec, latitude_deg))
+
+
 def _validate_triads(
     cal: Calibration, model_file: Path, file: Path, o: ValidateOptions
 ) -> ValidationReport:
     """A calibration of triads judged on a turntable run, or on held-out poses
     of a multi-position calibration; a warning per triad for the share of samples
     outside its calibrated temperature range."""
-    from thermocal.multipos import validate as _mp_validate
     from thermocal.pipeline.compensate import read_for_triads
-    from thermocal.turntable.calibrate import validate_turntable_run
 
     rec = read_for_triads(file, cal.triads, o.read_options)
     _own_session(cal, file)
-    if _mp_validate.is_multipos(cal.triads):  # held-out poses
-        results: list[Any] = _mp_validate.validate_held_out_session(
-            cal.triads, rec, o.latitude, static_s=o.static_s, signal_unit=o.signal_unit
-        )
-    else:
-        results = validate_turntable_run(cal.triads, rec, o.latitude)
+    results = judge_triads(
+        cal.triads, rec, o.latitude, static_s=o.static_s, signal_unit=o.signal_unit
+    )
     for r in results:
         if r.outside_range_fraction > 0:
             warnings.warn(
@@ -365,6 +402,7 @@ __all__ = [
     "ChannelValidation",
     "ValidationReport",
     "ambient_c",
+    "judge_triads",
     "modeling_file",
     "validate_files",
 ]

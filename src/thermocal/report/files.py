@@ -267,18 +267,12 @@ def _triad_report(
 ) -> ReportResult:
     """A calibration of triads judged on ``recording`` and reported (``title`` None: the
     triad report's own)."""
-    from thermocal.multipos import validate as _mp_validate
     from thermocal.pipeline.compensate import read_for_triads
+    from thermocal.pipeline.validate import judge_triads
     from thermocal.report.triads import write_triad_report
-    from thermocal.turntable.calibrate import validate_turntable_run
 
     rec = read_for_triads(recording, cal.triads, opts)
-    if _mp_validate.is_multipos(cal.triads):  # held-out poses
-        results: list[Any] = _mp_validate.validate_held_out_session(
-            cal.triads, rec, latitude_deg, signal_unit=opts.signal_unit
-        )
-    else:
-        results = validate_turntable_run(cal.triads, rec, latitude_deg)
+    results = judge_triads(cal.triads, rec, latitude_deg, signal_unit=opts.signal_unit)
     path = write_triad_report(output, cal, cal_path, results, recording, title=title, sensor=sensor)
     return ReportResult(Path(path), "triads")
 
