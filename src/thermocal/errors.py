@@ -8,15 +8,129 @@ of the command line); anything else is an internal failure, exit status 1.
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Iterable
+from typing import Any, Self
 
 
 class ThermocalError(Exception):
     """Base class of thermocal's own exceptions."""
 
 
-class ThermocalInputError(ThermocalError, ValueError):
-    """Bad input: a file, column, value, option or unit the user supplied is wrong."""
+def spell_parameters(
+    template: str, parameters: Iterable[str], spell: Callable[[str], str] | None = None
+) -> str:
+    """``template`` with each ``{parameter}`` written as ``spell(parameter)``.
+
+    The library names its parameters (``rate_hz``); the command line names its options
+    (``--rate``).  A message that names a parameter is kept as a template, and each reader
+    spells the names its own way.
+
+    Parameters
+    ----------
+    template : str
+        The text, with ``{parameter}`` where a parameter's name goes.
+    parameters : iterable of str
+        The parameters the text names; other braces are left as they are.
+    spell : callable, optional
+        What to show for a parameter (its own name without it).
+
+    Returns
+    -------
+    str
+
+    Examples
+    --------
+    >>> spell_parameters("give {rate_hz} [Hz]", ["rate_hz"])
+    'give rate_hz [Hz]'
+    >>> spell_parameters("give {rate_hz} [Hz]", ["rate_hz"], lambda p: "--rate")
+    'give --rate [Hz]'
+    """
+    text = template
+    for p in parameters:
+        text = text.replace("{" + p + "}", spell(p) if spell is not None else p)
+    return text
+
+
+class NamesParameters:
+    """A message that names parameters of the library: kept as a template, so that the
+    command line can show its options where the library shows its parameters.
+
+    Build one with :meth:`naming`; ``str()`` of it names the parameters, :meth:`spelled`
+    the way a caller chooses (the command line: its options).
+
+    Attributes
+    ----------
+    template : str or None
+        The message with ``{parameter}`` placeholders (None: a plain message).
+    parameters : tuple of str
+        The parameters named in ``template``.
+    """
+
+    template: str | None = None
+    parameters: tuple[str, ...] = ()
+
+    @classmethod
+    def naming(cls, template: str, *parameters: str) -> Self:
+        """The exception or warning whose message is ``template`` with ``parameters`` named.
+
+        Parameters
+        ----------
+        template : str
+            The message, with ``{parameter}`` for each of ``parameters``.
+        *parameters : str
+            The library's parameter names (``"rate_hz"``, ``"time_unit"``).
+
+        Returns
+        -------
+        instance of the class
+            Its ``str()`` shows the parameters' own names.
+
+        Examples
+        --------
+        >>> err = ThermocalInputError.naming("time unit not stated: give {time_unit}", "time_unit")
+        >>> str(err)
+        'time unit not stated: give time_unit'
+        >>> err.spelled(lambda p: "--time-unit")
+        'time unit not stated: give --time-unit'
+        """
+        obj = cls(spell_parameters(template, parameters))  # type: ignore[call-arg]
+        obj.template = template
+        obj.parameters = tuple(parameters)
+        return obj
+
+    def spelled(self, spell: Callable[[str], str]) -> str:
+        """The message with ``spell(parameter)`` for each named parameter.
+
+        Parameters
+        ----------
+        spell : callable
+            What to show for a parameter (the command line: its option).
+
+        Returns
+        -------
+        str
+            The message (``str(self)`` when it names no parameter).
+        """
+        if self.template is None:
+            return str(self)
+        return spell_parameters(self.template, self.parameters, spell)
+
+
+def _rebuild(cls: type[Any], args: tuple[Any, ...], state: dict[str, Any]) -> Any:
+    """Unpickle a thermocal exception or warning with its template (the fleet's workers)."""
+    obj = cls(*args)
+    obj.__dict__.update(state)
+    return obj
+
+
+class ThermocalInputError(NamesParameters, ThermocalError, ValueError):
+    """Bad input: a file, column, value, option or unit the user supplied is wrong.
+
+    A message that names parameters of the library is built with :meth:`naming`."""
+
+    def __reduce__(self) -> tuple[Any, ...]:
+        # picklable with its template across processes (the fleet's workers)
+        return (_rebuild, (type(self), self.args, dict(self.__dict__)))
 
 
 class ParameterError(ThermocalInputError):
@@ -53,6 +167,8 @@ class ParameterError(ThermocalInputError):
     '--gravity applies with --gravity-axis only'
     """
 
+    template: str
+
     def __init__(self, parameter: str, message: str, others: tuple[str, ...] = ()) -> None:
         self.parameter = parameter
         self.template = message
@@ -78,6 +194,20 @@ class ParameterError(ThermocalInputError):
         for p in self.others:
             text = text.replace("{" + p + "}", other(p) if other is not None else p)
         return text
+
+    def spelled(self, spell: Callable[[str], str]) -> str:
+        """The message with ``spell(p)`` for the parameter and each of :attr:`others`.
+
+        Parameters
+        ----------
+        spell : callable
+            What to show for a parameter (the command line: its option).
+
+        Returns
+        -------
+        str
+        """
+        return self.named(spell(self.parameter), spell)
 
     def __reduce__(self) -> tuple[type[ParameterError], tuple[str, str, tuple[str, ...]]]:
         # picklable across processes (the fleet's workers)
@@ -116,8 +246,14 @@ class DesignError(ThermocalInputError):
     """A regression or estimation problem that the data cannot determine (singular design)."""
 
 
-class ThermocalWarning(UserWarning):
-    """Base class of thermocal's warnings."""
+class ThermocalWarning(NamesParameters, UserWarning):
+    """Base class of thermocal's warnings.
+
+    A warning that names parameters of the library is built with :meth:`naming`
+    (``warnings.warn(UnitWarning.naming("… give {time_unit}", "time_unit"))``)."""
+
+    def __reduce__(self) -> tuple[Any, ...]:
+        return (_rebuild, (type(self), self.args, dict(self.__dict__)))
 
 
 class GapWarning(ThermocalWarning):

@@ -275,19 +275,19 @@ def handle_errors(fn: Callable[P, R]) -> Callable[P, R]:
             try:
                 result = fn(*args, **kwargs)
             except (typer.Exit, typer.Abort):
-                _show_warnings(caught)
+                _show_warnings(caught, fn)
                 raise
             except KeyboardInterrupt:
-                _show_warnings(caught)
+                _show_warnings(caught, fn)
                 raise typer.Exit(report_interrupted()) from None
             except Exception as exc:  # the mapping the fleet uses too (error_text)
-                _show_warnings(caught)
+                _show_warnings(caught, fn)
                 text, users = error_text(exc, _command_options(fn))
                 if not users and os.environ.get("THERMOCAL_DEBUG"):
                     raise
                 print(f"error: {text}", file=sys.stderr)
                 raise typer.Exit(2 if users else 1) from None
-        _show_warnings(caught)
+        _show_warnings(caught, fn)
         return result
 
     return wrapper
@@ -310,9 +310,12 @@ def _command_options(fn: Callable[..., Any]) -> dict[str, str]:
     return out
 
 
-def _show_warnings(caught: list[warnings.WarningMessage]) -> None:
-    """One ``warning: ...`` line on stderr per message (:func:`warning_lines`)."""
-    for line in warning_lines(caught):
+def _show_warnings(caught: list[warnings.WarningMessage], fn: Callable[..., Any]) -> None:
+    """One ``warning: ...`` line on stderr per message (:func:`warning_lines`), with the
+    options of the command ``fn`` where a warning names the library's parameters."""
+    if not caught:
+        return
+    for line in warning_lines(caught, _command_options(fn)):
         print(f"warning: {line}", file=sys.stderr)
 
 

@@ -15,7 +15,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from thermocal._lazy import LazyModule
-from thermocal.errors import ParameterError, ThermocalInputError, ThermocalWarning
+from thermocal.errors import NamesParameters, ThermocalInputError, ThermocalWarning
 
 if TYPE_CHECKING:
     import numpy as np
@@ -97,15 +97,21 @@ def json_text(obj: Any) -> str:
     return json.dumps(jsonable(obj), allow_nan=False) + "\n"
 
 
-def warning_lines(caught: Iterable[warnings.WarningMessage]) -> list[str]:
+def warning_lines(
+    caught: Iterable[warnings.WarningMessage], options: Mapping[str, str] | None = None
+) -> list[str]:
     """The text of each ``warning:`` line the command line prints for ``caught``, each
-    message once: thermocal warnings as they are, numerical ``RuntimeWarning``\\ s with their
-    class name in front; other warnings are not shown.
+    message once: thermocal warnings as they are, with options where they name the library's
+    parameters (:func:`option_name`), numerical ``RuntimeWarning``\\ s with their class name in
+    front; other warnings are not shown.
 
     Parameters
     ----------
     caught : iterable of warnings.WarningMessage
         Warnings recorded by ``warnings.catch_warnings(record=True)``.
+    options : mapping of str to str, optional
+        ``{parameter: option}`` of the running command where it differs from
+        :func:`option_name`'s rule.
 
     Returns
     -------
@@ -115,7 +121,11 @@ def warning_lines(caught: Iterable[warnings.WarningMessage]) -> list[str]:
     seen: set[str] = set()
     out: list[str] = []
     for w in caught:
-        msg = one_line(w.message)
+        message = w.message
+        if isinstance(message, NamesParameters):
+            msg = one_line(message.spelled(lambda p: option_name(p, options)))
+        else:
+            msg = one_line(message)
         if msg in seen:
             continue
         seen.add(msg)
@@ -192,8 +202,9 @@ def error_text(exc: Exception, options: Mapping[str, str] | None = None) -> tupl
     """The text of the ``error:`` line the command line prints for ``exc`` and whether it is
     the user's (exit 2: bad input, a missing file, permissions, a full disk) rather than
     thermocal's own failure (exit 1, ``internal: TYPE: message``).  A
-    :class:`~thermocal.errors.ParameterError` names the option (:func:`option_name`) where the
-    library names its parameter.
+    :class:`~thermocal.errors.ParameterError`, or any input error built with
+    :meth:`~thermocal.errors.ThermocalInputError.naming`, names the option
+    (:func:`option_name`) where the library names its parameter.
 
     Parameters
     ----------
@@ -215,12 +226,14 @@ def error_text(exc: Exception, options: Mapping[str, str] | None = None) -> tupl
     >>> from thermocal.errors import ParameterError
     >>> error_text(ParameterError("min_dwell", "{name} must be positive, got -1"))
     ('--min-dwell must be positive, got -1', True)
+    >>> from thermocal.errors import UnitError
+    >>> error_text(UnitError.naming("no unit: give {time_unit}", "time_unit"))
+    ('no unit: give --time-unit', True)
     >>> error_text(ZeroDivisionError("division by zero"))
     ('internal: ZeroDivisionError: division by zero', False)
     """
-    if isinstance(exc, ParameterError):
-        text = exc.named(option_name(exc.parameter, options), lambda p: option_name(p, options))
-        return one_line(text), True
+    if isinstance(exc, ThermocalInputError) and exc.template is not None:
+        return one_line(exc.spelled(lambda p: option_name(p, options))), True
     if isinstance(exc, ThermocalInputError | FileNotFoundError | IsADirectoryError):
         return one_line(exc), True
     if isinstance(exc, OSError) and exc.errno in USER_OS_ERRORS:
