@@ -103,23 +103,11 @@ PENDING: dict[str, int] = {
     "stability/noise_model.py": 9,
     "stability/registry.py": 2,
     # reports, fleet, station, demo, generated files
-    "demo/chamber.py": 2,
-    "demo/imu.py": 2,
-    "demo/station.py": 5,
     "export/c/__init__.py": 3,
     "export/c/core.py": 2,
     "export/c/files.py": 7,
     "export/c/warmup.py": 2,
     "export/checks.py": 2,
-    "fleet/batch.py": 10,
-    "fleet/stats.py": 4,
-    "report/analysis.py": 1,
-    "report/build.py": 10,
-    "report/calibration.py": 4,
-    "report/files.py": 17,
-    "station/check.py": 1,
-    "station/recorder.py": 11,
-    "station/run.py": 7,
 }
 
 

@@ -19,7 +19,7 @@ model of a ring-laser gyroscope*
    family, both saved as model files.
 4. **Validation** of both on the validation run (:func:`thermocal.validation.validate`:
    r of the chamber temperatures, hold-stage bias stability and repeatability
-   before and after), saved as the JSON of ``thermocal validate --json``.
+   before and after), saved as the JSON the ``validate`` command prints.
 5. **Compensation** of the validation file with the reported model
    (:func:`thermocal.pipeline.compensate.compensate_file`).
 6. **C export** of both models (:func:`thermocal.export.c.export_c`).
@@ -179,7 +179,7 @@ def _validation_dict(
     mod_path: Path,
     cfg: DemoConfig,
 ) -> dict[str, Any]:
-    """``validate`` on the validation run, as the JSON of ``thermocal validate --json``."""
+    """``validate`` on the validation run, as the JSON the ``validate`` command prints."""
     run = RunData.from_recording(val, SIGNAL, list(model.temp_names_))
     res = validate(
         model,

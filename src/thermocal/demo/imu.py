@@ -1,4 +1,4 @@
-"""``thermocal demo --imu``: the multi-channel workflow on a simulated six-axis MEMS IMU.
+"""The ``imu`` demo: the multi-channel workflow on a simulated six-axis MEMS IMU.
 
 Steps: simulate the ``mems-imu`` scenario's modelling run and its weakly
 correlated validation run (the same unit, :func:`thermocal.simulate.scenario_mems_imu`);
@@ -251,7 +251,7 @@ def run_imu_demo(
             validation_path=str(val_json),
             title="Six-axis MEMS IMU calibration (simulated)",
             sensor=f"mems-imu scenario, seed {seed}",
-            generated_by="thermocal demo --imu",
+            generated_by="thermocal demo --imu",  # cli-words: the command the report records
             extra={TRUE_REMOVED: {c.name: c.removed_pct for c in summaries}},
             notes=(
                 "Simulated unit: one cubic per channel in the die temperature, fitted on the "

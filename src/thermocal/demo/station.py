@@ -9,7 +9,7 @@ modelling run and an independent validation run.  Then ``thermocal fit`` on the 
 recording folder, ``thermocal validate`` on the second and ``thermocal export-c``, all
 through the command line, exactly as a user would.  Prints the fitted slope against the
 simulated truth.  POSIX only (pseudo-terminals).
-"""
+"""  # cli-words: the demo module's own command line
 
 from __future__ import annotations
 
@@ -68,7 +68,7 @@ def run_demo(out: Path, time_scale: float = 200.0) -> dict[str, object]:
     dict
         The paths written and the fitted slopes.
     """
-    from thermocal.errors import ThermocalInputError
+    from thermocal.errors import ParameterError, ThermocalInputError
     from thermocal.export.c.files import export_c_file
     from thermocal.pipeline.fit import fit_files
     from thermocal.pipeline.options import FitOptions, ValidateOptions
@@ -84,7 +84,7 @@ def run_demo(out: Path, time_scale: float = 200.0) -> dict[str, object]:
     from thermocal.writers import write_program
 
     if not (math.isfinite(time_scale) and time_scale > 0):
-        raise ThermocalInputError(f"--time-scale must be a number > 0, got {time_scale}")
+        raise ParameterError("time_scale", f"{{name}} must be a number > 0, got {time_scale}")
     if out.exists() and any(out.iterdir()):
         raise ThermocalInputError(f"{out}: exists and is not empty")
     out.mkdir(parents=True, exist_ok=True)
@@ -123,7 +123,7 @@ def run_demo(out: Path, time_scale: float = 200.0) -> dict[str, object]:
 
 
 def cli(argv: list[str] | None = None) -> int:
-    """``python -m thermocal.demo.station``: parse ``-o`` and ``--time-scale``, run, print the
+    """``python -m thermocal.demo.station``: parse ``-o`` and the time scale, run, print the
     summary.
 
     Parameters
@@ -137,8 +137,8 @@ def cli(argv: list[str] | None = None) -> int:
         The exit status.
     """
     ap = argparse.ArgumentParser(prog="python -m thermocal.demo.station", description=__doc__)
-    ap.add_argument("-o", "--output", type=Path, default=Path("station-demo"))
-    ap.add_argument("--time-scale", type=float, default=200.0)
+    ap.add_argument("-o", "--output", type=Path, default=Path("station-demo"))  # cli-words: its own
+    ap.add_argument("--time-scale", type=float, default=200.0)  # cli-words: its own
     a = ap.parse_args(argv)
     res = run_demo(a.output, a.time_scale)
     print(

@@ -6,12 +6,12 @@ limits (``[limits]``) and one ``[[unit]]`` per device: ``id``, ``modeling`` (its
 optionally ``validation`` (a file); paths are relative to the configuration.
 
 Each unit is one task, :func:`run_unit`: ``thermocal fit`` and, with a validation run,
-``thermocal validate --modeling`` run in the worker's process through the command line's own
-entry point (so a unit gets exactly what the two commands give, options, units and warnings
-included, without a process start-up per unit), in a private temporary directory; the task
-returns the files' bytes and the figures.  The driver (:func:`run_fleet`) writes them under
-``DIR/units/<id>/`` through a temporary directory renamed into place, ``unit.json`` last, so
-a unit directory either is complete or does not exist.
+``thermocal validate`` (given the modelling files) run in the worker's process through the
+command line's own entry point (so a unit gets exactly what the two commands give, options,
+units and warnings included, without a process start-up per unit), in a private temporary
+directory; the task returns the files' bytes and the figures. The driver (:func:`run_fleet`)
+writes them under ``DIR/units/<id>/`` through a temporary directory renamed into place,
+``unit.json`` last, so a unit directory either is complete or does not exist.
 
 Figures are in each channel's data unit (the unit of its column as given: °/s, rad/s, mg,
 g, m/s²…; :func:`channel_figures`), not the model's internal canonical unit (°/h, mg):
@@ -114,7 +114,7 @@ class UnitTask:
 @dataclass
 class UnitOutcome:
     """What a worker hands back for one unit: status, error, warnings, the results (``fit``
-    and ``validation``, as ``--json`` prints them), the files' bytes, seconds."""
+    and ``validation``, as the commands' JSON gives them), the files' bytes, seconds."""
 
     id: str
     status: str
@@ -269,7 +269,7 @@ def channel_figures(
     """Per channel of a calibration (or model) file: ``unit`` (the channel's data unit,
     :func:`shown_unit`), ``unit_as_given``, ``model_unit``, the fit figures
     (:data:`FIT_FIGURES`), the validation figures (:data:`VALIDATION_FIGURES`, from
-    ``thermocal validate --json``) and ``coefficients`` ``{term: value}`` with
+    the JSON of the ``validate`` command) and ``coefficients`` ``{term: value}`` with
     ``coefficient_units``, every signal figure in ``unit``.
 
     The fit's figures are read from the file through the model loader (checksum verified),
@@ -281,7 +281,7 @@ def channel_figures(
     calibration : str or pathlib.Path
         The unit's calibration or model file.
     validation : mapping, optional
-        Its ``thermocal validate --json`` result.
+        Its result, as the JSON of the ``validate`` command.
 
     Returns
     -------
@@ -1080,8 +1080,11 @@ def _ignore_interrupts() -> None:
     signal.signal(signal.SIGINT, signal.SIG_IGN)
 
 
+FORCED: Final = "--force"  # cli-words: the reason the summary records, as the command was asked
+"""Why a unit already calibrated was done again when no input changed (the batch's ``force``)."""
+
 SCHEDULER_SCHEMES: Final = ("tcp", "tls", "ws", "wss", "ucx")
-"""The address schemes of a Dask scheduler ``--scheduler`` takes (``tcp`` when none)."""
+"""The address schemes of a Dask scheduler address (``tcp`` when none)."""
 
 _ADDRESS = re.compile(
     r"^(?:(?P<scheme>[a-z]+)://)?(?P<host>\[[0-9A-Fa-f:.]+\]|[^\s:/\[\]]+):(?P<port>\d{1,5})/?$"
@@ -1091,7 +1094,7 @@ _ADDRESS = re.compile(
 def check_scheduler(address: str) -> str:
     """``address`` when it is a scheduler address ``[SCHEME://]HOST:PORT`` (a scheme of
     :data:`SCHEDULER_SCHEMES`, a port 1–65535), else a :class:`ThermocalInputError` naming
-    ``--scheduler`` (Dask's own parser raised ``ValueError``: exit 1).
+    ``scheduler`` (Dask's own parser raised ``ValueError``: exit 1).
 
     Parameters
     ----------
@@ -1111,10 +1114,11 @@ def check_scheduler(address: str) -> str:
     port = int(m.group("port")) if m else 0
     scheme = (m.group("scheme") if m else None) or "tcp"
     if m is None or not 1 <= port <= 65535 or scheme not in SCHEDULER_SCHEMES:
-        raise ThermocalInputError(
-            f"--scheduler {address!r}: not a scheduler address; give tcp://HOST:PORT (the "
+        raise ThermocalInputError.naming(
+            f"{{scheduler}} {address!r}: not a scheduler address; give tcp://HOST:PORT (the "
             f"address `dask scheduler` prints; schemes {', '.join(SCHEDULER_SCHEMES)}, port "
-            "1-65535)"
+            "1-65535)",
+            "scheduler",
         )
     return address.strip()
 
@@ -1148,15 +1152,17 @@ def dask_executor(address: str) -> Executor:
     try:
         distributed: Any = importlib.import_module("distributed")  # untyped: held as Any
     except ImportError:
-        raise ThermocalInputError(
-            "--scheduler needs Dask distributed: pip install 'thermocal[fleet]'"
+        raise ThermocalInputError.naming(
+            "{scheduler} needs Dask distributed: pip install 'thermocal[fleet]'", "scheduler"
         ) from None
     try:
         with dask_logs_quiet():
             client = distributed.Client(address, timeout=30)
     except (OSError, TimeoutError, ValueError) as exc:
         msg = " ".join(str(exc).split())
-        raise ThermocalInputError(f"--scheduler {address}: cannot connect ({msg})") from None
+        raise ThermocalInputError.naming(
+            f"{{scheduler}} {address}: cannot connect ({msg})", "scheduler"
+        ) from None
 
     def run(tasks: list[UnitTask]) -> Iterator[UnitOutcome]:
         with dask_logs_quiet():
@@ -1292,7 +1298,7 @@ def run_fleet(
             skipped.append(u.id)
             continue
         if reasons is not None:
-            redo[u.id] = "; ".join(reasons) if reasons else "--force"
+            redo[u.id] = "; ".join(reasons) if reasons else FORCED
         todo.append(UnitTask(u, _fit_options(config), config.validate))
     ran: list[str] = []
     failed: list[str] = []

@@ -9,7 +9,7 @@ from collections.abc import Iterable, Mapping, Sequence
 from typing import Any
 
 FIT_FIGURES = ("rms_residual", "condition_number", "n_coefficients", "n_samples")
-"""Per-channel figures of a fit (``thermocal fit --json``), in the summary."""
+"""Per-channel figures of a fit (the JSON of the ``fit`` command), in the summary."""
 
 
 VALIDATION_FIGURES = (
@@ -23,7 +23,7 @@ VALIDATION_FIGURES = (
     "bias_repeatability_before",
     "bias_repeatability_after",
 )
-"""Per-channel figures of a validation (``thermocal validate --json``), in the summary."""
+"""Per-channel figures of a validation (the JSON of the ``validate`` command), in the summary."""
 
 
 FIGURES = FIT_FIGURES + VALIDATION_FIGURES
@@ -204,8 +204,8 @@ def channel_series(figs: Sequence[Mapping[str, Any]]) -> tuple[str, dict[str, li
     Parameters
     ----------
     figs : sequence of mapping
-        One channel's figures per unit (``thermocal fit --json`` and ``validate --json``
-        figures, ``coefficients`` and ``coefficient_units``).
+        One channel's figures per unit (the JSON figures of the ``fit`` and ``validate``
+        commands, ``coefficients`` and ``coefficient_units``).
 
     Returns
     -------

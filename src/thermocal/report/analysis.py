@@ -312,14 +312,14 @@ def _n_means(slices: list[slice], tau0_s: float, averaging_s: float) -> int:
 
 
 def averaging_for(
-    time_s: FloatArray, wanted_s: float, *, given: bool, where: str | None, option: str | None
+    time_s: FloatArray, wanted_s: float, *, given: bool, where: str | None, parameter: str | None
 ) -> tuple[float, str | None]:
     """The averaging time [s] of a report's bias stability and peak-to-peak on a record
     with times ``time_s`` [s], and the note that says why it is not ``wanted_s``.
 
     ``wanted_s`` when the record gives at least two non-overlapping averages of it (never
     across a gap, as :func:`thermocal.metrics.block_means`).  Else, when the user ``given``
-    it, an error naming the file ``where`` and the option ``option``
+    it, an error naming the file ``where`` and the parameter ``parameter``
     (:func:`thermocal.metrics.too_few_averages`); when it is a default, the largest of
     :data:`NICE_AVERAGES_S` giving at least :data:`MIN_FALLBACK_AVERAGES` averages (the
     sample interval if none does), stated in the note.
@@ -334,8 +334,9 @@ def averaging_for(
         Whether the user gave it (else a default).
     where : str, optional
         How a warning names the run.
-    option : str, optional
-        The option that sets it, for the warning.
+    parameter : str, optional
+        The parameter that sets it (``"averaging_s"``), named in the error (the command
+        line shows its option there).
 
     Returns
     -------
@@ -356,7 +357,9 @@ def averaging_for(
         return wanted_s, None
     longest = max(sl.stop - sl.start for sl in slices) * tau0
     if given:
-        raise ThermocalInputError(too_few_averages(where, wanted_s, n, longest, option))
+        named = "{" + parameter + "}" if parameter else None
+        text = too_few_averages(where, wanted_s, n, longest, named)
+        raise ThermocalInputError.naming(text, *([parameter] if parameter else []))
     fits = [a for a in NICE_AVERAGES_S if _n_means(slices, tau0, a) >= MIN_FALLBACK_AVERAGES]
     chosen = max(fits) if fits else tau0
     note = (
@@ -379,7 +382,6 @@ def figures_of_merit(
     drift_bias: float | None = None,
     drift_reference_s: tuple[float, float] | None = None,
     where: str | None = None,
-    average_option: str | None = "--average",
 ) -> FiguresOfMerit:
     """Figures of merit of a rate ``x`` [``unit``, known input included].
 
@@ -389,7 +391,7 @@ def figures_of_merit(
     gaps) removes a stated constant b0, never the run's own mean: ``drift_bias`` when
     given (0 on a compensated output: the model is what removes the bias), else the mean
     over ``drift_reference_s`` (default the first 10 % of the run,
-    :func:`thermocal.metrics.reference_bias`).  ``where`` (the file) and ``average_option``
+    :func:`thermocal.metrics.reference_bias`).  ``where`` (the file) and ``averaging_s``
     are named when the record gives fewer than two averages.
 
     Parameters
@@ -414,8 +416,6 @@ def figures_of_merit(
         Window whose mean is b0 [s since the first sample].
     where : str, optional
         How warnings name the run.
-    average_option : str, optional
-        The option that sets the averaging time, for warnings.
 
     Returns
     -------
@@ -442,7 +442,6 @@ def figures_of_merit(
         temps=[temp_name],
         drift_bias=drift_bias,
         drift_reference_s=drift_reference_s,
-        average_option=average_option,
     )
     sens = m.temperature_sensitivity
     ang: FloatArray | None = None

@@ -11,7 +11,7 @@ and their range of validity, and every warning (extrapolation, correlation
 limit not met, ill-conditioning).
 
 Inputs are what the other commands write: model files (:func:`save_model`
-JSON), validation JSON (``thermocal validate --json``) and recordings.  Every
+JSON), validation JSON (what the ``validate`` command prints) and recordings.  Every
 number that also appears in one of those JSON files is shown from the JSON
 itself (never recomputed), tagged ``data-key``/``data-value`` in the HTML so
 a test can check it.  The report is one HTML file: figures are embedded as
@@ -98,7 +98,7 @@ class ModelEntry:
     model : dict
         The content of a model file (as :func:`thermocal.save_model` writes it).
     validation : dict, optional
-        The JSON object of ``thermocal validate --json`` for that model on the validation
+        The JSON object of the ``validate`` command for that model on the validation
         run.
     path : str, optional
         The model file (provenance).
@@ -138,7 +138,7 @@ class ReportInputs:
     generated_by : str
         The command that made the report.
     averaging_s : float, optional
-        Averaging time of the computed figures [s] (``--average``).
+        Averaging time of the computed figures [s].
     drift_reference_s : tuple of float, optional
         Window [s since the first sample] whose mean is the drift angle's b0 before
         compensation.
@@ -172,7 +172,7 @@ class ReportInputs:
     warnings_caught: tuple[str, ...] = ()
     """``warning:`` lines thermocal printed while reading the runs (shown in the report)."""
     dynamic_s: float | None = None
-    """``--dynamic``: window [s] of the dynamic Allan deviation of the compensated output
+    """Window [s] of the dynamic Allan deviation of the compensated output
     (:func:`thermocal.stability.allan.dynamic_adev`, half-window steps); None: none."""
 
 
@@ -1016,6 +1016,7 @@ def _collect_warnings(
         add(
             "validation",
             "no validation result was given (thermocal validate --json, then --validation): "
+            # cli-words: the commands the report tells its reader to run
             "the report shows figures computed on the recording and states no acceptance "
             "verdict.",
         )
@@ -1066,7 +1067,7 @@ class _Analysis:
     recording_sha256: str | None = None
     dynamic: DynamicAllan | None = None
     """The dynamic ADEV of the compensated output (a
-    :class:`~thermocal.stability.allan.DynamicAllan`, ``--dynamic``) or None."""
+    :class:`~thermocal.stability.allan.DynamicAllan`, ``dynamic_s``) or None."""
     dynamic_warning: str | None = None
     """The non-stationarity warning of :attr:`dynamic` (None: stationary, or no map)."""
     quantization: OutputQuantization | None = None
@@ -1177,9 +1178,9 @@ def _analyse(inputs: ReportInputs) -> _Analysis:
 def _dynamic_of(
     inputs: ReportInputs, main: RunSignals, allan_after: AllanAnalysis, tau0: float, role: str
 ) -> tuple[DynamicAllan | None, str | None]:
-    """``--dynamic``: the dynamic ADEV of the compensated output in windows of
+    """The dynamic ADEV of the compensated output in windows of
     ``inputs.dynamic_s`` [s] (:func:`thermocal.stability.allan.dynamic_adev`, at the whole
-    run's τ and confidence; input errors as ``thermocal allan --dynamic``), and, when it is
+    run's τ and confidence; input errors as the ``allan`` command's dynamic ADEV), and, when it is
     not stationary, the warning (:func:`thermocal.stability.analysis.nonstationary_message`)
     issued as a :class:`~thermocal.errors.ConditioningWarning` (stderr and the report)."""
     if inputs.dynamic_s is None:
@@ -1341,7 +1342,7 @@ def _allan_figure(fs: _FigureSet, an: _Analysis) -> None:
 
 
 def _dynamic_figure(fs: _FigureSet, an: _Analysis) -> None:
-    """``--dynamic``: the heat map of the compensated output's dynamic Allan deviation
+    """The heat map of the compensated output's dynamic Allan deviation
     (:func:`thermocal.report.allan_plots.plot_dynamic`)."""
     import tempfile
 

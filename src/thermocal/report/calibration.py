@@ -8,7 +8,7 @@ shows, for 1 to ~18 channels:
    range, fit residual, condition number; temperature sensitivity (least-squares slope
    over the hold stages) and bias stability before → after, computed here from
    the recording with :func:`thermocal.metrics.compute_metrics`; the validation figures
-   (r, rms before → after) and one verdict per channel when ``thermocal validate --json``
+   (r, rms before → after) and one verdict per channel when the ``validate`` command's JSON
    output is given (no verdict without it);
 2. bias against temperature before and after, one panel per channel
    (:func:`thermocal.report.figures.bias_vs_temperature_grid`);
@@ -66,7 +66,7 @@ class CalibrationReportInputs:
 
     ``recording`` holds every channel's signal column and temperature inputs (the
     validation run, or any run to show the calibration on); ``validation`` is the JSON
-    object of ``thermocal validate CAL FILE --json`` (``{"channels": {NAME: {…}}}``), or a
+    object the ``validate`` command prints for a calibration (``{"channels": {NAME: {…}}}``), or a
     mapping channel → one validation object; ``extra`` adds named per-channel columns to
     the summary table (``{column title: {channel: value}}``, e.g. the demo's share of the
     simulator's true bias removed)."""
@@ -276,7 +276,7 @@ def build_calibration_report(inputs: CalibrationReportInputs) -> str:
     Parameters
     ----------
     inputs : CalibrationReportInputs
-        The calibration, the validation run and the optional ``validate --json`` output.
+        The calibration, the validation run and the optional ``validate`` JSON.
 
     Returns
     -------
@@ -303,7 +303,7 @@ def build_calibration_report(inputs: CalibrationReportInputs) -> str:
     averaging_s = float(inputs.averaging_s or default_avg or DEFAULT_AVERAGING_S)
     averaging_s, avg_note = averaging_for(
         rec.time_s, averaging_s, given=inputs.averaging_s is not None,
-        where=inputs.recording_path or rec.source or rec.name, option="--average",
+        where=inputs.recording_path or rec.source or rec.name, parameter="averaging_s",
     )  # fmt: skip
     # several axes: the earth rate differs per axis, so none is removed (stated below)
     notes = list(inputs.notes) + ([avg_note] if avg_note else [])

@@ -3,7 +3,7 @@ from the files the other commands write (:mod:`thermocal.report`).
 
 :func:`make_report` reads the model files, the validation results and the recordings
 (every recording through :func:`thermocal.readers.read_recording` with the same text-log
-options and ``--topic``), chooses the report (models compared, one calibration of
+options and the log topic), chooses the report (models compared, one calibration of
 channels, or a calibration of triads judged on the recording) and writes it atomically.
 """
 
@@ -41,13 +41,13 @@ def _no_progress(
 
 
 def read_validation_json(path: Path, *, channels: bool = False) -> dict[str, Any]:
-    """A validation result file (``thermocal validate --json`` output) as a dict; with
+    """A validation result file (the ``validate`` command's JSON) as a dict; with
     ``channels`` also the several-channel form ``{"channels": {NAME: {…}}}``.
 
     Parameters
     ----------
     path : pathlib.Path
-        The ``thermocal validate --json`` output.
+        The ``validate`` command's JSON.
     channels : bool
         Expect a calibration's per-channel result.
 
@@ -73,7 +73,7 @@ def read_validation_json(path: Path, *, channels: bool = False) -> dict[str, Any
     if not isinstance(obj, dict) or "bias_stability_before" not in obj:
         raise FileFormatError(
             f"{path}: not a validation result (expected the JSON object of "
-            "`thermocal validate --json`, with bias_stability_before, ...)"
+            "`thermocal validate --json`, with bias_stability_before, ...)"  # cli-words: its writer
         )
     return obj
 
@@ -129,14 +129,31 @@ class ReportResult:
 def _check_counts(
     models: Sequence[Path], validations: Sequence[Path], labels: Sequence[str]
 ) -> None:
-    """One ``--validation`` file and one ``--label`` per ``--model`` file, when given."""
+    """One validation file and one label per model file, when given."""
     if validations and len(validations) != len(models):
-        raise ThermocalInputError(
-            f"{len(validations)} --validation files for {len(models)} --model files; "
-            "give one validation per model, in the same order"
+        raise ThermocalInputError.naming(
+            f"{len(validations)} {{validations}} files for {len(models)} {{models}} files; "
+            "give one validation per model, in the same order",
+            "validations",
+            "models",
         )
     if labels and len(labels) != len(models):
-        raise ThermocalInputError(f"{len(labels)} --label values for {len(models)} --model files")
+        raise ThermocalInputError.naming(
+            f"{len(labels)} {{labels}} values for {len(models)} {{models}} files",
+            "labels",
+            "models",
+        )
+
+
+def _check_dynamic(dynamic_s: float | None, one_channel: bool) -> None:
+    """A dynamic Allan deviation only in the report of one channel."""
+    if dynamic_s is not None and not one_channel:
+        raise ThermocalInputError.naming(
+            "{dynamic_s} maps one channel's compensated output: it applies to the report of a "
+            "single-signal model, not of a calibration of triads or several channels (run "
+            "thermocal allan --dynamic on each channel)",  # cli-words: the command to run
+            "dynamic_s",
+        )
 
 
 def _station_topic(
@@ -184,7 +201,7 @@ def make_report(
     output : pathlib.Path
         The HTML file to write.
     validations, labels : sequence
-        ``thermocal validate --json`` results and labels, one per model, in its order.
+        Results of the ``validate`` command (JSON files) and labels, one per model, in its order.
     signal, title, sensor : str, optional
         The signal column(s) and the headline texts; with a station folder and no
         ``read.topic``, ``sensor`` is also the sensor read.
@@ -218,12 +235,7 @@ def make_report(
     one_channel = not (cal.triads and not cal.channels) and not (
         len(cal.channels) > 1 or len(split_names(signal) or []) > 1
     )
-    if dynamic_s is not None and not one_channel:
-        raise ThermocalInputError(
-            "--dynamic maps one channel's compensated output: it applies to the report of a "
-            "single-signal model, not of a calibration of triads or several channels (run "
-            "thermocal allan --dynamic on each channel)"
-        )
+    _check_dynamic(dynamic_s, one_channel)
     if cal.triads and not cal.channels:  # a turntable calibration over temperature
         return _triad_report(
             cal,
@@ -238,9 +250,10 @@ def make_report(
     cal.require_channels("report")
     if len(cal.channels) > 1 or len(split_names(signal) or []) > 1:
         if len(models) > 1:
-            raise ThermocalInputError(
+            raise ThermocalInputError.naming(
                 f"{models[0]} is a calibration of {len(cal.channels)} channels: give it as the "
-                "only --model (compare calibrations in separate reports)"
+                "only {models} (compare calibrations in separate reports)",
+                "models",
             )
         return _calibration_report(
             cal, models[0], recording, output, opts, bar,
@@ -306,12 +319,12 @@ def _models_report(
             lab = labels[i] if labels else mpath.stem
             entries.append(ModelEntry(lab, mdict, vdict, str(mpath)))
         if len({e.label for e in entries}) != len(entries):
-            raise ThermocalInputError(
-                "two models have the same label (file stem); name them with --label"
+            raise ThermocalInputError.naming(
+                "two models have the same label (file stem); name them with {labels}", "labels"
             )
         sig = signal or (entries[0].model.get("signal") or {}).get("name") or None
         if not sig:
-            raise ThermocalInputError("name the signal column with --signal")
+            raise ThermocalInputError.naming("name the signal column with {signal}", "signal")
         fitted = dict(entries[0].model.get("inputs") or {})  # how the first model's data were
         # the temperature columns every model uses, in the first model's order
         temp_cols: list[str] = []

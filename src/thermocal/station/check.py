@@ -6,7 +6,7 @@ import math
 import time
 from dataclasses import dataclass
 
-from thermocal.errors import ThermocalInputError
+from thermocal.errors import ParameterError, ThermocalInputError
 from thermocal.station.chamber import ChamberError, make_chamber
 from thermocal.station.config import StationConfig
 from thermocal.station.sensors import SerialSensor
@@ -68,7 +68,7 @@ def check_station(cfg: StationConfig, listen_s: float = 3.0) -> StationCheck:
         ``listen_s`` is not positive.
     """
     if not listen_s > 0:
-        raise ThermocalInputError(f"--listen must be > 0 s, got {listen_s}")
+        raise ParameterError("listen_s", f"{{name}} must be > 0 s, got {listen_s}")
     chamber = make_chamber(cfg.chamber)
     temp = sp = math.nan
     err = ""

@@ -60,10 +60,10 @@ STATION_COLUMNS = {
 
 
 RESUME_SENSOR_KEYS = ("names", "units", "delimiter", "decimal", "rate_hz")
-"""The keys of a ``[[sensor]]`` that ``--resume`` must find unchanged."""
+"""The keys of a ``[[sensor]]`` that a resumed run must find unchanged."""
 RESUME_CHAMBER_KEYS = ("setpoint_register", "temperature_register", "register_kind", "scale",
                        "signed")  # fmt: skip
-"""The keys of ``[chamber]`` that ``--resume`` must find unchanged."""
+"""The keys of ``[chamber]`` that a resumed run must find unchanged."""
 
 BAD_TEXT_MAX = 200
 """Characters of a bad line kept in ``SENSOR.bad.txt`` (the rest counted)."""
@@ -163,7 +163,7 @@ class Recorder:
         profile_source: str,
         time_scale: float,
     ) -> None:
-        """Lock and load (``--resume``) or create the folder; declare the streams; record
+        """Lock and load (``resume``) or create the folder; declare the streams; record
         the run."""
         resume = self.resume
         if resume:
@@ -172,9 +172,10 @@ class Recorder:
             self.doc = self._load_for_resume(program)
         else:
             if out_dir.exists() and (not out_dir.is_dir() or any(out_dir.iterdir())):
-                raise ThermocalInputError(
-                    f"{out_dir}: exists and is not empty; continue it with --resume or name "
-                    "another -o"
+                raise ThermocalInputError.naming(
+                    f"{out_dir}: exists and is not empty; continue it with {{resume}} or name "
+                    "another -o",
+                    "resume",
                 )
             self.created = not out_dir.exists()
             try:
@@ -228,9 +229,10 @@ class Recorder:
         except OSError:
             holder = os.read(fd, 32).decode("ascii", "replace").strip() or "?"
             os.close(fd)
-            raise ThermocalInputError(
+            raise ThermocalInputError.naming(
                 f"{self.dir}: another station run (process {holder}) is writing this folder; "
-                "wait for it to end, or stop it, before --resume"
+                "wait for it to end, or stop it, before {resume}",
+                "resume",
             ) from None
         os.ftruncate(fd, 0)
         os.write(fd, str(os.getpid()).encode())
@@ -245,7 +247,7 @@ class Recorder:
     def discard(self) -> None:
         """A new recording whose run never started: remove what it wrote (``station.json``,
         the lock, the folder when this run created it), so the corrected command starts
-        afresh.  A resumed recording is left as it is (``--resume`` accepts it again)."""
+        afresh.  A resumed recording is left as it is (``resume`` accepts it again)."""
         import contextlib
 
         if self.resume:
@@ -266,9 +268,11 @@ class Recorder:
         if [float(x) for x in rec.get("time_s", [])] != [float(x) for x in program[0]] or [
             float(x) for x in rec.get("setpoint_c", [])
         ] != [float(x) for x in program[1]]:
-            raise ThermocalInputError(
-                f"{self.dir}: --resume with another program than the recording's "
-                f"({rec.get('source', '?')}); give the same --profile"
+            raise ThermocalInputError.naming(
+                f"{self.dir}: {{resume}} with another program than the recording's "
+                f"({rec.get('source', '?')}); give the same {{profile}}",
+                "resume",
+                "profile",
             )
         self._same_setup(doc.get("config"))
         for p in self.dir.glob(".*.parquet.tmp"):  # the part open at the crash
@@ -280,18 +284,19 @@ class Recorder:
         return doc
 
     def _same_setup(self, old: Any) -> None:
-        """``--resume`` with the recording's sensors (ids, names, units, rate, separators)
+        """``resume`` with the recording's sensors (ids, names, units, rate, separators)
         and chamber map (registers, scale, sign): the folder is read as one recording, in
         one set of units, so a difference is refused naming the key and both values."""
         new = self.cfg.to_dict()
         old = old if isinstance(old, dict) else {}
-        where = f"{self.dir}: --resume with another STATION.toml than the recording's"
+        where = f"{self.dir}: {{resume}} with another STATION.toml than the recording's"
         old_s = {s.get("id"): s for s in old.get("sensors", []) if isinstance(s, dict)}
         new_s = {s["id"]: s for s in new["sensors"]}
         if sorted(map(str, old_s)) != sorted(new_s):
-            raise ThermocalInputError(
+            raise ThermocalInputError.naming(
                 f"{where}: sensors {sorted(map(str, old_s))} recorded, {sorted(new_s)} given; "
-                "give the same [[sensor]] ids"
+                "give the same [[sensor]] ids",
+                "resume",
             )
         pairs = [(f"sensor {sid!r} {k}", old_s[sid].get(k), new_s[sid][k]) for sid in new_s
                  for k in RESUME_SENSOR_KEYS]  # fmt: skip
@@ -300,9 +305,10 @@ class Recorder:
         for key, was_, now_ in pairs:
             was, now = json.loads(json.dumps(was_)), json.loads(json.dumps(now_))
             if was != now:
-                raise ThermocalInputError(
+                raise ThermocalInputError.naming(
                     f"{where}: {key} was {was!r}, now {now!r} (the folder would be read in "
-                    f"the new setting); give the recording's value or record into another -o"
+                    f"the new setting); give the recording's value or record into another -o",
+                    "resume",
                 )
 
     def _declare_streams(self) -> None:
@@ -508,9 +514,9 @@ class Recorder:
         why = os.strerror(int(code)) if code else (str(exc)[:200] or type(exc).__name__)
         self.write_error = (
             f"{path}: cannot write ({why}): free space (or fix the folder) and continue "
-            "with --resume; the closed parts are kept"
+            "with {resume}; the closed parts are kept"
         )
-        raise ThermocalInputError(self.write_error) from None
+        raise ThermocalInputError.naming(self.write_error, "resume") from None
 
 
 __all__ = [

@@ -2,14 +2,14 @@
 stale sensors, a silent or drifting chamber, and the safe set-point on every way out.
 
 Program time ``p`` [s] runs ``time_scale`` times faster than the host clock:
-``p = p0 + K·(t − t_run)``, ``p0`` = 0 for a new run and, for ``--resume``, the largest
+``p = p0 + K·(t − t_run)``, ``p0`` = 0 for a new run and, for ``resume``, the largest
 ``program_s`` the recording holds (the program continues where the recording ends).  The
 set-point is the program interpolated linearly at ``p`` (``numpy.interp``: steps where the
 program has them, ramps where it ramps), rounded to the register's resolution, and written
 whenever that rounded value changes (``driver = "none"``: each step's goal, once).
 
 The recording's ``time`` is the sensor's own clock (``rate_hz``) or the host's, never the
-program's: with ``--time-scale K`` a real chamber still heats at its own pace, so rates of
+program's: with ``time_scale`` K a real chamber still heats at its own pace, so rates of
 change in the recording are physical; the program time of every row is its ``program_s``
 column, and the metadata's ``station.time_scale`` says the run was accelerated.
 """
@@ -24,7 +24,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Protocol
 
-from thermocal.errors import ThermocalInputError
+from thermocal.errors import ParameterError, ThermocalInputError
 from thermocal.readers.station import CHAMBER_STREAM, closed_parts
 from thermocal.station import clock
 from thermocal.station.chamber import Chamber, ChamberError, make_chamber
@@ -142,7 +142,7 @@ def say(message: str) -> str:
     (a closed pipe, a vanished terminal): then file descriptor 2 is pointed at
     ``os.devnull``, so that no later message (nor Python's flush at exit) raises either.
     Started without a stderr (``2>&-``: ``sys.stderr`` is None) nothing is printed (never
-    on stdout, where ``--json`` writes) and ``""`` is returned: nobody was watching.
+    on stdout, where the JSON goes) and ``""`` is returned: nobody was watching.
 
     Parameters
     ----------
@@ -212,7 +212,7 @@ class RunResult:
     bad lines per sensor, how it ended (``"end"``, ``"interrupted"``, ``"chamber"``), the
     set-points written as ``(program_s, °C)``, the safe set-point written (or None), the
     events, why it was interrupted (``"SIGHUP"``, ``"stderr closed (…)"``; ``""``) and, for
-    ``--resume``, how the previous run ended (:func:`previous_run`)."""
+    ``resume``, how the previous run ended (:func:`previous_run`)."""
 
     out_dir: Path
     program_start_s: float
@@ -442,10 +442,11 @@ class _Loop:
                 self.disp.log(f"warning: {exc}")
             elif now - self.fail_since >= ch_cfg.timeout_s:
                 self.ended = "chamber"
-                raise StationStopped(
+                raise StationStopped.naming(
                     f"{exc}; no answer for {now - self.fail_since:.0f} s (timeout_s "
                     f"{ch_cfg.timeout_s:g}): run stopped at program time {p:.1f} s; "
-                    f"continue with --resume"
+                    "continue with {resume}",
+                    "resume",
                 ) from None
             self.next_poll = now + min(ch_cfg.poll_s, 0.5)
 
@@ -630,7 +631,7 @@ def _open_recorder(
     disp: Display,
 ) -> tuple[Recorder, float, str]:
     """The recorder of ``out_dir``, the program time to start at [s] (0, or where a
-    resumed recording ends) and how the previous run ended (``--resume``)."""
+    resumed recording ends) and how the previous run ended (``resume``)."""
     end_s = float(t_prog[-1])
     p0 = _last_program_s(out_dir) if resume and out_dir.is_dir() else 0.0
     if resume and p0 >= end_s:
@@ -754,7 +755,7 @@ def run_station(
     import numpy as np
 
     if not (math.isfinite(time_scale) and time_scale > 0):
-        raise ThermocalInputError(f"--time-scale must be > 0, got {time_scale}")
+        raise ParameterError("time_scale", f"{{name}} must be > 0, got {time_scale}")
     disp = display or LogDisplay()
     t_prog = np.asarray(program[0], dtype=np.float64)
     c_prog = np.asarray(program[1], dtype=np.float64)
