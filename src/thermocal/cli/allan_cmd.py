@@ -27,26 +27,22 @@ from thermocal.cli.common import (
     TopicOpt,
     check_recording,
     emit,
-    fmt,
     handle_errors,
     read_options,
+    show,
     split_names,
-    stdout,
 )
 from thermocal.errors import ThermocalInputError, UnitWarning
+from thermocal.report import text as _text
 
 if TYPE_CHECKING:
-    import rich.table as _rich_table
-
     import thermocal.readers as _readers
-    import thermocal.stability.allan as _allan
     import thermocal.stability.analysis as _analysis
     import thermocal.stability.api as _api
     import thermocal.stability.family as _family
     import thermocal.stability.registry as _registry
     import thermocal.writers as _writers
 else:
-    _rich_table = LazyModule("rich.table")
     _writers = LazyModule("thermocal.writers")
     _readers = LazyModule("thermocal.readers")
     _analysis = LazyModule("thermocal.stability.analysis")
@@ -119,107 +115,6 @@ def _noise_type(spec: str | None, devs: list[str] | None, data_type: str) -> int
     if devs is not None or data_type == "phase":
         return parse_noise_type(spec, devs or ["oadev"])
     return None if spec is None or spec.strip().lower() in ("", "auto") else 0
-
-
-def _family_human(file: Path, res: "_family.StabilityResult") -> None:
-    for name, c in res.curves.items():
-        corrected = ", bias-corrected as Stable32" if c.bias is not None else ""
-        t = _rich_table.Table(title=f"{file} — {name} [{c.unit}] ({res.data_type} data{corrected})")
-        for col in ("τ [s]", name, "low", "high", "edf", "α", "terms"):
-            t.add_column(col, justify="right")
-        for i in range(c.tau_s.size):
-            if not math.isfinite(float(c.dev[i])):
-                continue
-            t.add_row(
-                fmt(float(c.tau_s[i])), fmt(float(c.dev[i]), 5), fmt(float(c.low[i]), 5),
-                fmt(float(c.high[i]), 5), fmt(float(c.edf[i]), 4), str(int(c.alpha[i])),
-                str(int(c.n_terms[i])),
-            )  # fmt: skip
-        stdout.print(t)
-        why = _family.no_interval(name)
-        if why is not None:
-            stdout.print(f"{name}: interval {why}")
-
-
-def minimum_cell(t: "_allan.NoiseTerm | None") -> str:
-    """The bias instability at the minimum in one table cell: value, unit, τ, quality."""
-    if t is None or t.value is None:
-        return "—"
-    return f"{fmt(t.value)} {t.unit} (τ {fmt(t.tau_s)} s, {t.quality})"
-
-
-def minimum_line(t: "_allan.NoiseTerm | None") -> str | None:
-    """One line for the text output: the bias instability at the minimum and its interval."""
-    if t is None or t.value is None:
-        return None
-    return (
-        f"bias instability at the curve's minimum: {fmt(t.value)} {t.unit} "
-        f"({fmt(t.low)} … {fmt(t.high)}), quality {t.quality}: {t.reason}"
-    )
-
-
-def _emit_channels(
-    file: Path, analysis: "_analysis.AllanAnalysis", as_json: bool, plot: Path | None
-) -> None:
-    """Several channels: ``{"channels": {NAME: {…}}}`` or one noise-term table with a
-    column per channel (the ADEV points are in the JSON and the plots)."""
-    analyses = {n: (c.adev, c.noise) for n, c in analysis.channels.items()}
-    quants = {n: c.quantization for n, c in analysis.channels.items()}
-
-    def human() -> None:
-        t = _rich_table.Table(title=f"{file} — noise terms (least-squares fit), per channel")
-        t.add_column("term")
-        for name in analyses:
-            t.add_column(name, justify="right")
-        first_noise = next(iter(analyses.values()))[1]
-        for key, term in first_noise.fit.terms().items():
-            cells = []
-            for _res, noise in analyses.values():
-                tt = noise.fit.terms()[key]
-                bm = noise.bias_minimum
-                if tt.value is not None:
-                    cells.append(f"{fmt(tt.value)} {tt.unit}")
-                elif key == "bias_instability" and bm is not None and bm.value is not None:
-                    cells.append(f"{fmt(bm.value)} {bm.unit} (minimum; fit: —)")
-                else:
-                    cells.append("—")
-            t.add_row(term.label, *cells)
-            if key == "angle_random_walk":
-                t.add_row(
-                    "  on the −½ stretch",
-                    *[_stretch_cell(n.slope.angle_random_walk) for _r, n in analyses.values()],
-                )
-            elif key == "bias_instability":
-                t.add_row(
-                    "  at the curve's minimum",
-                    *[minimum_cell(n.bias_minimum) for _r, n in analyses.values()],
-                )
-        t.add_row(
-            "fit quality",
-            *[
-                f"{n.quality.quality} (χ²/ν {n.quality.reduced_chi2:.3g})" if n.quality else "—"
-                for _r, n in analyses.values()
-            ],
-        )
-        stdout.print(t)
-        for name, oq in quants.items():
-            if oq is not None:
-                stdout.print(f"{name}: {oq.line()}")
-        for name, (_r, n) in analyses.items():
-            for p in n.periodic:
-                stdout.print(f"{name}: periodic term: {p.words()}")
-        if plot is not None:
-            stdout.print(f"plots written to {plot.stem}_<channel>{plot.suffix} in {plot.parent}")
-
-    emit({"channels": {n: c.to_dict() for n, c in analysis.channels.items()}}, as_json, human)
-
-
-def _stretch_cell(t: "_allan.NoiseTerm") -> str:
-    """The angle random walk on the −½ stretch in one cell: value, unit, τ range."""
-    if t.value is None:
-        return "—"
-    rng = f" (τ {fmt(t.tau_range_s[0])}…{fmt(t.tau_range_s[1])} s)" if t.tau_range_s else ""
-    return f"{fmt(t.value)} {t.unit}{rng}"
 
 
 TausOpt = Annotated[
@@ -396,90 +291,29 @@ def _emit_family(file: Path, res: "_analysis.AllanAnalysis", as_json: bool) -> N
     """``--deviation`` or phase data: one channel's object, or ``{"channels": …}``."""
     if len(res.names) == 1:
         one = res.family[res.names[0]]
-        emit(one.to_dict(), as_json, lambda: _family_human(file, one))
+        emit(one.to_dict(), as_json, lambda: show(_text.family_text(str(file), one)))
         return
+    every = {n: r.to_dict() for n, r in res.family.items()}
+    emit({"channels": every}, as_json, lambda: show(_family_blocks(file, res)))
 
-    def human_all() -> None:
-        for r in res.family.values():
-            _family_human(file, r)
 
-    emit({"channels": {n: r.to_dict() for n, r in res.family.items()}}, as_json, human_all)
+def _family_blocks(file: Path, res: "_analysis.AllanAnalysis") -> "list[_text.Block]":
+    """Every channel's deviation tables, one after the other."""
+    return [b for r in res.family.values() for b in _text.family_text(str(file), r)]
 
 
 def _emit_allan(
     file: Path, analysis: "_analysis.AllanAnalysis", as_json: bool, plot: Path | None
 ) -> None:
-    """The ADEV table and the noise terms of one channel (several: :func:`_emit_channels`)."""
-    names = analysis.names
-    if len(names) > 1:
-        _emit_channels(file, analysis, as_json, plot)
-        return
-    ch = analysis.channels[names[0]]
-    res, noise = ch.adev, ch.noise
-
-    def human() -> None:
-        t1 = _rich_table.Table(title=f"{file} — overlapping Allan deviation [{res.unit}]")
-        for col in ("τ [s]", "ADEV", "low", "high", "terms", "edf"):
-            t1.add_column(col, justify="right")
-        for i in range(res.tau_s.size):
-            t1.add_row(
-                fmt(float(res.tau_s[i])),
-                fmt(float(res.adev[i])),
-                fmt(float(res.adev_low[i])),
-                fmt(float(res.adev_high[i])),
-                str(int(res.n_terms[i])),
-                fmt(float(res.edf[i]), 3),
-            )
-        stdout.print(t1)
-        t2 = _rich_table.Table(title="noise terms")
-        for col in ("term", "fit", "slope lines", "unit", "note"):
-            t2.add_column(col)
-        fit, slope = noise.fit.terms(), noise.slope.terms()
-        poor = noise.quality is not None and noise.quality.quality == "poor"
-        for name in fit:
-            f, s = fit[name], slope[name]
-            note = "poor fit (see the warning)" if poor else (f.reason or s.reason or "")
-            mark = " ?" if poor else ""
-            if name == "angle_random_walk" and s.tau_range_s is not None:
-                note = f"−½ stretch τ {fmt(s.tau_range_s[0])}…{fmt(s.tau_range_s[1])} s; " + note
-            t2.add_row(
-                f.label,
-                fmt(f.value) + (mark if f.value is not None else ""),
-                fmt(s.value) + (mark if s.value is not None else ""),
-                f.unit,
-                note,
-            )
-            bm = noise.bias_minimum
-            if name == "bias_instability" and bm is not None and bm.value is not None:
-                t2.add_row(
-                    "  at the curve's minimum", "", fmt(bm.value), bm.unit,
-                    f"τ = {fmt(bm.tau_s)} s, {bm.quality} (IEEE 952 C.3)",
-                )  # fmt: skip
-        stdout.print(t2)
-        line = minimum_line(noise.bias_minimum)
-        if line is not None:
-            stdout.print(line)
-        for p in noise.periodic:
-            stdout.print(f"periodic term: {p.words()}; {100 * (p.share or 0):.3g} % of σ² there")
-        if noise.shaped_below_s is not None:
-            stdout.print(
-                f"τ < {fmt(noise.shaped_below_s)} s lies below the −½ line (the sensor's own "
-                "filter): left out of the noise terms"
-            )
-        if noise.quality is not None:
-            stdout.print(
-                f"noise-model fit: reduced χ² {noise.quality.reduced_chi2:.3g} on "
-                f"{noise.quality.dof} degrees of freedom — {noise.quality.quality}"
-            )
-        if ch.quantization is not None:
-            stdout.print(ch.quantization.line())
-        dyn = ch.dynamic
-        if dyn is not None:
-            stdout.print(
-                f"dynamic ADEV: {dyn.t_s.size} windows of {dyn.window_s:g} s, "
-                + ("stationary" if dyn.stationary else f"{len(dyn.changes)} changes (warning)")
-            )
+    """The ADEV table and the noise terms of one channel, or the noise terms of several
+    side by side (the ADEV points of several are in the JSON and the plots)."""
+    if len(analysis.names) > 1:
+        tail = []
         if plot is not None:
-            stdout.print(f"plot written to {plot}")
-
-    emit(ch.to_dict(), as_json, human)
+            tail = [f"plots written to {plot.stem}_<channel>{plot.suffix} in {plot.parent}"]
+        obj = {"channels": {n: c.to_dict() for n, c in analysis.channels.items()}}
+        emit(obj, as_json, lambda: show([*_text.allan_channels_text(str(file), analysis), *tail]))
+        return
+    ch = analysis.channels[analysis.names[0]]
+    end = [f"plot written to {plot}"] if plot is not None else []
+    emit(ch.to_dict(), as_json, lambda: show([*_text.allan_text(str(file), ch), *end]))

@@ -13,12 +13,11 @@ from __future__ import annotations
 
 import functools
 import json
-import math
 import os
 import sys
 import typing
 import warnings
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterable, Iterator
 from contextlib import contextmanager
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated, Any, ParamSpec, TypeVar
@@ -35,6 +34,8 @@ from thermocal.pipeline.reading import check_recording as check_recording
 from thermocal.pipeline.reading import read_options as read_options
 from thermocal.pipeline.reading import split_floats as split_floats
 from thermocal.pipeline.reading import split_names as split_names
+from thermocal.report.text import Block
+from thermocal.report.text import fmt as fmt
 
 if TYPE_CHECKING:
     import numpy as np
@@ -343,23 +344,27 @@ def emit(obj: Any, as_json: bool, human: Callable[[], None] | None = None) -> No
         stdout.print_json(json.dumps(jsonable(obj), allow_nan=False))
 
 
-def fmt(x: float | None, digits: int = 4) -> str:
-    """Number for a human table: ``—`` for None/NaN.
+def show(blocks: Iterable[Block]) -> None:
+    """Print a text rendering (:mod:`thermocal.report.text`) on stdout: each line as it is,
+    each table drawn by rich with its title, columns, justification and rows.
 
     Parameters
     ----------
-    x : float or None
-        The number.
-    digits : int
-        Significant digits.
-
-    Returns
-    -------
-    str
+    blocks : iterable of str or TextTable
+        What to print, in order.
     """
-    if x is None or (isinstance(x, float) and not math.isfinite(x)):
-        return "—"
-    return f"{x:.{digits}g}"
+    from rich.table import Table
+
+    for b in blocks:
+        if isinstance(b, str):
+            stdout.print(b)
+            continue
+        t = Table(title=b.title)
+        for name, justify in zip(b.columns, b.justify, strict=True):
+            t.add_column(name, justify="right" if justify == "right" else "left")
+        for row in b.rows:
+            t.add_row(*row)
+        stdout.print(t)
 
 
 @contextmanager

@@ -12,22 +12,16 @@ import typer
 
 from thermocal._lazy import LazyModule
 from thermocal.cli.application import app
-from thermocal.cli.common import JsonOpt, emit, fmt, handle_errors, progress, stdout
+from thermocal.cli.common import JsonOpt, emit, handle_errors, progress, show, stdout
 from thermocal.outputs import check_outputs
 
 if TYPE_CHECKING:
     import rich.markup as _markup
-    import rich.table as _rich_table
 
     import thermocal.demo.chamber as _demo
 else:
     _markup = LazyModule("rich.markup")
-    _rich_table = LazyModule("rich.table")
     _demo = LazyModule("thermocal.demo.chamber")
-
-
-def _pct(value: float | None) -> str:
-    return "—" if value is None else f"{value:+.1f} %"
 
 
 OutputOpt = Annotated[
@@ -101,63 +95,11 @@ def _chamber_demo(output: Path, seed: int, quick: bool, as_json: bool) -> None:
         res = _demo.run_demo(output, seed=seed, config=_demo.QUICK if quick else None,
                        progress=lambda _step: advance(1))  # fmt: skip
 
-    out = {
-        "report": str(res.report_path),
-        "out_dir": str(res.out_dir),
-        "elapsed_s": res.elapsed_s,
-        "timings_s": res.timings_s,
-        "seed": res.seed,
-        "models": [
-            {
-                "label": m.label,
-                "model": str(m.model_path),
-                "validation": str(m.validation_path),
-                "c_files": [str(p) for p in m.c_files],
-                "n_coefficients": m.n_coefficients,
-                "condition_number": m.condition_number,
-                "rms_residual": m.rms_residual,
-                "r": m.r,
-                "weakly_correlated": m.weakly_correlated,
-                "n_stages": m.n_stages,
-                "bias_stability_before": m.bias_stability_before,
-                "bias_stability_after": m.bias_stability_after,
-                "bias_repeatability_before": m.bias_repeatability_before,
-                "bias_repeatability_after": m.bias_repeatability_after,
-                "improvement_pct": m.improvement_pct,
-            }
-            for m in res.models
-        ],
-        "files": [str(p) for p in res.files],
-    }
-
     def human() -> None:
-        models = res.models
-        table = _rich_table.Table(title=f"thermocal demo (seed {res.seed}): validation run, °/h")
-        table.add_column("figure")
-        table.add_column("before", justify="right")
-        for m in models:
-            table.add_column(f"after, {m.label}" + (" *" if m is models[0] else ""),
-                             justify="right")  # fmt: skip
-        table.add_row("coefficients", "", *(str(m.n_coefficients) for m in models))
-        table.add_row("r (limit 0.4)", "", *(fmt(m.r, 3) for m in models))
-        for key, label in (
-            ("bias_stability", "bias stability"),
-            ("bias_repeatability", "bias repeatability"),
-        ):
-            table.add_row(
-                label,
-                fmt(getattr(models[0], f"{key}_before")),
-                *(
-                    f"{fmt(getattr(m, f'{key}_after'))} ({_pct(m.improvement_pct.get(key))})"
-                    for m in models
-                ),
-            )
-        stdout.print(table)
-        stdout.print("* reported model; (…) improvement")
-        stdout.print(f"{len(res.files)} files in {res.out_dir} ({res.elapsed_s:.1f} s)")
+        show(res.text())
         stdout.print(f"report: [bold]{_markup.escape(str(res.report_path))}[/bold]", markup=True)
 
-    emit(out, as_json, human)
+    emit(res.to_dict(), as_json, human)
 
 
 def _imu_demo(output: Path, seed: int, quick: bool, as_json: bool) -> None:
@@ -166,46 +108,13 @@ def _imu_demo(output: Path, seed: int, quick: bool, as_json: bool) -> None:
     with progress("thermocal demo --imu", total=len(IMU_STEPS)) as advance:
         res = run_imu_demo(output, seed=seed, rate_hz=0.2 if quick else 1.0,
                            progress=lambda _step: advance(1))  # fmt: skip
-    out = {
-        "report": str(res.report_path),
-        "calibration": str(res.calibration_path),
-        "out_dir": str(res.out_dir),
-        "elapsed_s": res.elapsed_s,
-        "seed": seed,
-        "channels": {
-            c.name: {
-                "unit": c.unit,
-                "n_coefficients": c.n_coefficients,
-                "rms_residual": c.rms_residual,
-                "condition_number": c.condition_number,
-                "temp_range_c": list(c.temp_range_c),
-                "r": c.r,
-                "bias_stability_before": c.bias_stability_before,
-                "bias_stability_after": c.bias_stability_after,
-                "rms_before": c.rms_before,
-                "rms_after": c.rms_after,
-                "removed_pct": c.removed_pct,
-                "warnings": c.warnings,
-            }
-            for c in res.channels
-        },
-        "files": [str(p) for p in res.files],
-    }
 
     def human() -> None:
-        table = _rich_table.Table(title=f"thermocal demo --imu (seed {seed}): validation run")
-        for col in ("channel", "unit", "r", "rms before", "rms after", "bias removed"):
-            table.add_column(col, justify="left" if col in ("channel", "unit") else "right")
-        for c in res.channels:
-            table.add_row(c.name, c.unit, fmt(c.r, 3), fmt(c.rms_before), fmt(c.rms_after),
-                          f"{c.removed_pct:.1f} %")  # fmt: skip
-        stdout.print(table)
-        stdout.print("bias removed: share of the simulator's true temperature-induced bias")
-        stdout.print(f"{len(res.files)} files in {res.out_dir} ({res.elapsed_s:.1f} s)")
+        show(res.text())
         stdout.print(f"calibration: {_markup.escape(str(res.calibration_path))}")
         stdout.print(f"report: [bold]{_markup.escape(str(res.report_path))}[/bold]", markup=True)
 
-    emit(out, as_json, human)
+    emit(res.to_dict(), as_json, human)
 
 
 def _station_demo(output: Path, time_scale: float, as_json: bool) -> None:

@@ -22,24 +22,23 @@ from thermocal.cli.common import (
     TimeUnitOpt,
     TopicOpt,
     emit,
-    fmt,
     handle_errors,
     one_line,
     read_options,
+    show,
     stdout,
 )
 from thermocal.errors import ThermocalInputError
+from thermocal.report import text as _text
 
 if TYPE_CHECKING:
     import rich.markup as _markup
-    import rich.table as _rich_table
 
     import thermocal.inspection as _inspection
     import thermocal.readers as _readers
     from thermocal import units
 else:
     _markup = LazyModule("rich.markup")
-    _rich_table = LazyModule("rich.table")
     _inspection = LazyModule("thermocal.inspection")
     _readers = LazyModule("thermocal.readers")
     units = LazyModule("thermocal.units")
@@ -110,39 +109,7 @@ def inspect_cmd(
 
 def _print_human(r: "_inspection.Inspection") -> None:
     stdout.print(f"[bold]{_markup.escape(str(r.file))}[/bold]", markup=True)
-    if r.time_ok and r.duration_s is not None:
-        stdout.print(
-            f"{r.n_samples} samples over {fmt(r.duration_s, 6)} s, "
-            f"sample rate {fmt(r.sample_rate_hz, 6)} Hz, {len(r.gaps)} gaps, "
-            f"{r.n_segments} contiguous segments"
-        )
-    elif r.time_ok:
-        stdout.print(f"{r.n_samples} samples: too few for a duration or a sample rate")
-    else:
-        stdout.print(
-            f"{r.n_samples} samples; time is not finite and strictly increasing (see the "
-            "errors below), so duration, sample rate, gaps and segments are not computed"
-        )
-    table = _rich_table.Table("column", "role", "unit", "min", "max", "mean", "NaN", "spikes")
-    for c in r.columns.values():
-        table.add_row(
-            c.name,
-            c.role,
-            c.unit,
-            fmt(c.min, 6),
-            fmt(c.max, 6),
-            fmt(c.mean, 6),
-            str(c.n_nan),
-            str(c.n_spikes),
-        )
-    stdout.print(table)
-    if r.gaps:
-        shown = r.gaps[:10]
-        stdout.print(
-            "gaps (start s, length s): "
-            + ", ".join(f"({g['start_s']:.6g}, {g['length_s']:.6g})" for g in shown)
-            + (f" … {len(r.gaps) - 10} more" if len(r.gaps) > 10 else "")
-        )
+    show(_text.inspection_text(r))
     if not r.problems:
         stdout.print("[green]no problems found[/green]", markup=True)
     for p in r.problems:

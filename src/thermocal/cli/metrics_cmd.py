@@ -1,7 +1,6 @@
 """``thermocal metrics FILE``: bias, bias stability, peak-to-peak, drift angle,
 repeatability and temperature sensitivity of one signal."""
 
-from collections.abc import Callable
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated
 
@@ -31,20 +30,18 @@ from thermocal.cli.common import (
     fmt,
     handle_errors,
     read_options,
+    show,
     split_names,
-    stdout,
 )
 from thermocal.errors import ThermocalInputError
+from thermocal.report import text as _text
 
 if TYPE_CHECKING:
-    import rich.table as _rich_table
-
     import thermocal.metrics as _metrics
     import thermocal.readers as _readers
     from thermocal.metrics import MetricsResult
     from thermocal.recording import Recording
 else:
-    _rich_table = LazyModule("rich.table")
     _metrics = LazyModule("thermocal.metrics")
     _readers = LazyModule("thermocal.readers")
 
@@ -148,72 +145,14 @@ def metrics_cmd(
 
 
 def _emit_metrics(file: Path, results: "dict[str, MetricsResult]", as_json: bool) -> None:
-    """One file: the table of every channel's figures, or their JSON."""
-
-    def human() -> None:
-        many = len(results) > 1
-        table = _rich_table.Table(title=f"{file} — {', '.join(results)}")
-        table.add_column("figure")
-        for name in results:
-            table.add_column(name if many else "value", justify="right")
-        if not many:
-            table.add_column("unit")
-        first = next(iter(results.values()))
-        if many:  # each channel in its own unit: a row of units, no unit column
-            table.add_row("unit", *[r.unit for r in results.values()])
-
-        def row(label: str, get: "Callable[[MetricsResult], float | None]", digits: int = 4,
-                unit: "Callable[[MetricsResult], str]" = lambda r: r.unit) -> None:  # fmt: skip
-            values = [get(r) for r in results.values()]
-            if all(v is None for v in values):
-                return
-            cells = [fmt(v, digits) for v in values]
-            if many:
-                rate_unit = {unit(r) for r in results.values()} - {r.unit for r in results.values()}
-                rate_unit.discard("")
-                table.add_row(
-                    label + (f" [{', '.join(sorted(rate_unit))}]" if rate_unit else ""), *cells
-                )
-            else:
-                table.add_row(label, *cells, unit(first))
-
-        row("bias", lambda r: r.bias, 6)
-        row("  earth rate removed", lambda r: r.earth_rate_removed or None, 6)
-        row(f"bias stability ({first.averaging_s:g} s)", lambda r: r.bias_stability)
-        row(f"peak-to-peak ({first.averaging_s:g} s)", lambda r: r.peak_to_peak)
-        angle_unit = lambda r: r.drift_angle_unit or ""  # noqa: E731
-        row("drift angle, largest |θ|", lambda r: r.drift_angle_max, unit=angle_unit)
-        row("  reached at [s]", lambda r: r.drift_angle_max_time_s, unit=lambda r: "")
-        row("drift angle (end)", lambda r: r.drift_angle, unit=angle_unit)
-        row("  bias b0 removed", lambda r: r.drift_reference.bias if r.drift_reference else None,
-            6)  # fmt: skip
-        row(
-            f"bias repeatability ({len(first.stages)} stages)",
-            lambda r: r.bias_repeatability,
-        )
-        tsu = lambda r: r.temperature_sensitivity.unit if r.temperature_sensitivity else ""  # noqa: E731
-        row(
-            "temp. sensitivity, mean |ΔB/ΔT|",
-            lambda r: (
-                r.temperature_sensitivity.mean_abs_adjacent if r.temperature_sensitivity else None
-            ),
-            unit=tsu,
-        )
-        row(
-            "temp. sensitivity, LS slope",
-            lambda r: r.temperature_sensitivity.ls_slope if r.temperature_sensitivity else None,
-            unit=tsu,
-        )
-        table.add_row(
-            "samples", *[str(r.n_samples) for r in results.values()], *([] if many else [""])
-        )
-        stdout.print(table)
-        ref = first.drift_reference
-        if ref is not None:
-            stdout.print(f"drift angle: {_reference_words(ref)}")
-
+    """One file: the table of every channel's figures (:func:`thermocal.report.text.
+    metrics_text`) and how the drift angle's b0 was chosen, or their JSON."""
+    first = next(iter(results.values()))
+    ref = first.drift_reference
+    tail = [f"drift angle: {_reference_words(ref)}"] if ref is not None else []
+    human = lambda: show([*_text.metrics_text(str(file), results), *tail])  # noqa: E731
     if len(results) == 1:
-        emit(next(iter(results.values())).to_dict(), as_json, human)
+        emit(first.to_dict(), as_json, human)
     else:
         emit({"channels": {n: r.to_dict() for n, r in results.items()}}, as_json, human)
 
@@ -252,21 +191,7 @@ def _emit_runs(res: "_metrics.PowerOnMetrics", as_json: bool) -> None:
     to turn-on: sample standard deviation of the run biases) with
     ``bias_repeatability_low``/``_high`` (68.3 % chi-square interval), all in ``unit``."""
     names, reps = list(res.names), res.repeatability
-
-    def human() -> None:
-        for name, rep in reps.items():
-            t = _rich_table.Table(title=f"{name} — {len(rep.runs)} power-ons [{rep.unit}]")
-            for col in ("run", "bias", f"bias stability ({rep.runs[0].averaging_s:g} s)"):
-                t.add_column(col, justify="right")
-            for f, r in zip(rep.files, rep.runs, strict=True):
-                t.add_row(f, fmt(r.bias, 6), fmt(r.bias_stability))
-            stdout.print(t)
-            stdout.print(
-                f"turn-on to turn-on bias repeatability: {fmt(rep.bias_repeatability)} "
-                f"{rep.unit} (68.3 % interval {fmt(rep.bias_repeatability_low)} … "
-                f"{fmt(rep.bias_repeatability_high)}); mean bias {fmt(rep.bias_mean, 6)} "
-                f"{rep.unit}"
-            )
+    human = lambda: show(_text.power_on_text(res))  # noqa: E731
 
     if len(names) == 1:
         emit(reps[names[0]].to_dict(), as_json, human)

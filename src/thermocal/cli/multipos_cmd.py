@@ -7,7 +7,7 @@ thermal fit).  Writes a calibration of triads, the file type of ``thermocal turn
 
 import math
 from pathlib import Path
-from typing import TYPE_CHECKING, Annotated, Any
+from typing import TYPE_CHECKING, Annotated
 
 import typer
 
@@ -25,23 +25,18 @@ from thermocal.cli.common import (
     TimeOpt,
     TimeUnitOpt,
     emit,
-    fmt,
     handle_errors,
     read_options,
+    show,
     split_names,
-    stdout,
 )
 from thermocal.errors import ThermocalInputError, UnitError
+from thermocal.report import triad_text as _triad_text
 
 if TYPE_CHECKING:
-    import rich.table as _rich_table
-
-    import thermocal.multipos.gyro as _gyro
     import thermocal.pipeline.multipos as _mpf
     import thermocal.units as units
 else:
-    _rich_table = LazyModule("rich.table")
-    _gyro = LazyModule("thermocal.multipos.gyro")
     _mpf = LazyModule("thermocal.pipeline.multipos")
     units = LazyModule("thermocal.units")
 
@@ -178,83 +173,6 @@ GyroModelOpt = Annotated[
 ]
 
 
-def _gyro_misfit(run: dict[str, Any]) -> None:
-    """A line when the motions scatter beyond their noise
-    (:func:`thermocal.multipos.gyro.scatter_beyond_noise`): the gyro's σ are scaled by it."""
-    g = run.get("gyro")
-    if not g or not g["dof"] > 0 or g["reduced_chi2"] is None:
-        return
-    chi2, dof = float(g["reduced_chi2"]), int(g["dof"])
-    if _gyro.scatter_beyond_noise(chi2, dof):
-        stdout.print(
-            f"{run['input']}: the gyro's {g['n_motions']} motions scatter beyond their noise "
-            f"(reduced χ² {fmt(chi2, 3)} on {dof} degrees of freedom, {g['model']} model): "
-            "its σ are scaled by it"
-        )
-
-
-def _explain(out: dict[str, Any]) -> None:
-    """The pose detector's choice, per file: poses found, the still limit and what set
-    it, the stretches rejected and why."""
-    for d in out.get("pose_detection", []):
-        a = d["accel"]
-        stdout.print(
-            f"{d['input']}: {d['n_poses']} poses (window {fmt(d['window_s'], 3)} s, still "
-            f"for ≥ {fmt(d['static_s'], 3)} s below an accelerometer rms of "
-            f"{fmt(a['still_limit_rms'], 3)} {out['unit']}, set by the "
-            + ("noise" if a["limit_set_by"] == "noise" else "motions")
-            + f": noise {', '.join(fmt(v, 3) for v in a['noise_sigma'])}, motions "
-            f"{fmt(a['motion_rms'], 3)}); {len(d['rejected'])} rejected"
-        )
-        for r in d["rejected"]:
-            stdout.print(f"  rejected {r['start']}…{r['end']}: {r['reason']}")
-
-
-def _human(out: dict[str, Any], a_unit: str, output: Path) -> None:
-    """The calibration's tables and what the run said, for a person."""
-    for kind in ("accel", "gyro"):
-        if kind not in out:
-            continue
-        d = out[kind]
-        table = _rich_table.Table(title=f"{kind} triad ({d['method']})")
-        for col in ("parameter", "value", "σ", "unit"):
-            table.add_column(col)
-        for i, ax in enumerate("xyz"):
-            table.add_row(f"bias {ax}", fmt(d["bias"][i], 5), fmt(d["bias_sigma"][i], 3),
-                          d["bias_unit"])  # fmt: skip
-        for i, ax in enumerate("xyz"):
-            table.add_row(f"scale factor {ax}", fmt(d["scale_factor_ppm"][i], 5),
-                          fmt(d["scale_factor_ppm_sigma"][i], 3), "ppm")  # fmt: skip
-        for i, n in enumerate(d["misalignment_names"]):
-            sig = d["misalignment_arcsec_sigma"][i]  # 0: an element the model holds at 0
-            table.add_row(f"misalignment {n}", fmt(d["misalignment_arcsec"][i], 5),
-                          fmt(sig, 3) if sig else "held (not fitted)", "″")  # fmt: skip
-        stdout.print(table)
-    for run in out["runs"]:
-        lean = run.get("gyro", {}).get("turn_axis_lean_deg", 0.0)
-        if lean > 0:
-            stdout.print(
-                f"{run['input']}: the 360° turns lean {fmt(lean, 2)}° off their axes "
-                "(per component, found in the data): counted in the σ, the misalignments "
-                "rest on the motions between poses"
-            )
-    stdout.print(
-        f"{out['n_poses']} poses; gravity-magnitude residual rms "
-        f"{fmt(out['gravity_residual_rms_before'], 3)} → "
-        f"{fmt(out['gravity_residual_rms_after'], 3)} {a_unit}; written {output}"
-    )
-    for run in out["runs"]:
-        _gyro_misfit(run)
-        if run["accel"].get("misfit"):
-            stdout.print(
-                f"{run['input']}: the poses scatter more than their noise (reduced χ² "
-                f"{fmt(run['accel']['reduced_chi2'], 3)}): each pose's σ inflated by a "
-                f"misfit of {fmt(run['accel']['misfit'], 3)} {a_unit}, so that each "
-                "counts as the misfit says"
-            )
-    _explain(out)
-
-
 @app.command("multipos")
 @handle_errors
 def multipos_cmd(
@@ -305,8 +223,7 @@ def multipos_cmd(
         ),
     )  # fmt: skip
     res = _mpf.calibrate_files(files, output, opts, poses)
-    out = res.to_dict()
-    emit(out, as_json, lambda: _human(out, res.accel_unit, output))
+    emit(res.to_dict(), as_json, lambda: show(_triad_text.multipos_text(res, output)))
 
 
 __all__ = ["multipos_cmd"]

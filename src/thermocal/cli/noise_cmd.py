@@ -20,25 +20,23 @@ from thermocal.cli.common import (
     TimeUnitOpt,
     TopicOpt,
     check_recording,
-    fmt,
     handle_errors,
     jsonable,
     read_options,
+    show,
     split_names,
     stdout,
 )
 from thermocal.errors import ThermocalInputError
 from thermocal.identifiers import one_line
+from thermocal.report import text as _text
 
 if TYPE_CHECKING:
-    import rich.table as _rich_table
-
     import thermocal.readers as _readers
     import thermocal.stability.analysis as _analysis
     import thermocal.stability.noise_model as _nm
     import thermocal.writers as _writers
 else:
-    _rich_table = LazyModule("rich.table")
     _writers = LazyModule("thermocal.writers")
     _readers = LazyModule("thermocal.readers")
     _analysis = LazyModule("thermocal.stability.analysis")
@@ -164,26 +162,5 @@ def noise_cmd(
     with _writers.atomic_write(output, "w") as fh:
         fh.write(text + ("" if text.endswith("\n") else "\n"))
 
-    table = _rich_table.Table(title=f"{file} — IMU noise model (continuous time)")
-    for col in (
-        "axis", "noise density", "random walk", "unit (density; walk)", "from",
-        "bias instability (minimum)",
-    ):  # fmt: skip
-        table.add_column(col)
-    for ax in res.axes:
-        bm = ax.terms.bias_minimum
-        d = ax.density
-        how = d.method + (
-            f" τ {fmt(d.tau_range_s[0])}…{fmt(d.tau_range_s[1])} s" if d.tau_range_s else ""
-        )
-        table.add_row(
-            ax.name, fmt(d.value), fmt(ax.walk.value), f"{d.unit}; {ax.walk.unit}",
-            f"{how}; {ax.walk.method}",
-            "—" if bm is None or bm.value is None
-            else f"{fmt(bm.value)} {bm.unit} (τ {fmt(bm.tau_s)} s, {bm.quality})",
-        )  # fmt: skip
-    stdout.print(table)
-    for ax in res.axes:
-        if ax.quantization is not None:
-            stdout.print(f"{ax.name}: {ax.quantization.line()}")
+    show(_text.imu_noise_text(str(file), res))
     stdout.print(f"{out_format} noise model written to {output} (per sensor the largest axis)")

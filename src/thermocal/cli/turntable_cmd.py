@@ -27,25 +27,20 @@ from thermocal.cli.common import (
     TimeUnitOpt,
     TopicOpt,
     emit,
-    fmt,
     handle_errors,
     read_options,
+    show,
     split_names,
-    stdout,
 )
 from thermocal.defaults import overrides_of
 from thermocal.errors import ThermocalInputError
+from thermocal.report import triad_text as _triad_text
 
 if TYPE_CHECKING:
-    import rich.table as _rich_table
-
     import thermocal.pipeline.turntable as _files
-    import thermocal.turntable.model as _model
     import thermocal.writers as _writers
 else:
-    _rich_table = LazyModule("rich.table")
     _files = LazyModule("thermocal.pipeline.turntable")
-    _model = LazyModule("thermocal.turntable.model")
     _writers = LazyModule("thermocal.writers")
 
 DEFAULT_GYRO = ",".join(defaults.DEFAULT_GYRO_COLUMNS)
@@ -199,55 +194,9 @@ def turntable_cmd(
         files, output, opts, order=order, tref_c=tref, overrides=overrides_of(allow_narrow, False)
     )
     if isinstance(res, _files.ThermalRunsResult):
-        emit(res.to_dict(), as_json, lambda: _print_thermal(res))
+        emit(res.to_dict(), as_json, lambda: show(_triad_text.turntable_thermal_text(res)))
     else:
-        emit(res.to_dict(), as_json, lambda: _print_single(res))
-
-
-def _print_single(res: "_files.SingleRunResult") -> None:
-    out = res.to_dict()
-    table = _rich_table.Table(title=f"turntable calibration of {res.input} ({out['method']})")
-    for col in ("coefficient", "value", "σ", "CRB σ", "least squares", "unit"):
-        table.add_column(col)
-    ls = out["least_squares"]
-    groups = (
-        ("bias", "bias_deg_h", "°/h", ("x", "y", "z")),
-        ("scale factor", "scale_factor_ppm", "ppm", ("x", "y", "z")),
-        ("misalignment", "misalignment_arcsec", "″", _model.MISALIGNMENT_NAMES),
-    )
-    for label, key, unit, names in groups:
-        for i, n in enumerate(names):
-            table.add_row(
-                f"{label} {n}",
-                fmt(out[key][i], 5),
-                fmt(out[key + "_sigma"][i], 3),
-                fmt(out["crb"][key][i], 3),
-                fmt(ls[key][i], 5),
-                unit,
-            )
-    stdout.print(table)
-    stdout.print(
-        f"inner-axis azimuth (yx − xy)/2: {fmt(out['inner_axis_azimuth_arcsec'], 4)} ± "
-        f"{fmt(out['inner_axis_azimuth_arcsec_sigma'], 3)} ″; "
-        f"filter/LS agreement {fmt(out['agreement_max_sigma'], 2)} σ; written {res.output}"
-    )
-
-
-def _print_thermal(res: "_files.ThermalRunsResult") -> None:
-    for name, tri in (("gyro", res.gyro), ("accel", res.accel)):
-        if tri is None:
-            continue
-        table = _rich_table.Table(
-            title=f"{name} triad over temperature (TREF {tri.tref_c:g} °C, soaks "
-            f"{', '.join(f'{t:g}' for t in tri.soak_temperatures_c)} °C)"
-        )
-        for col in ("parameter", "unit", "order", "at TREF", "σ", "LOTO rms"):
-            table.add_column(col)
-        for fit in tri.fits:
-            table.add_row(fit.name, fit.unit, str(len(fit.coef) - 1), fmt(fit.coef[0], 5),
-                          fmt(fit.sigma[0], 3), fmt(fit.loto_rms, 3))  # fmt: skip
-        stdout.print(table)
-    stdout.print(f"calibration written: {res.output} (compensate applies it per sample)")
+        emit(res.to_dict(), as_json, lambda: show(_triad_text.turntable_text(res)))
 
 
 __all__ = ["turntable_cmd"]

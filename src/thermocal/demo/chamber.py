@@ -54,6 +54,7 @@ from thermocal.pipeline.model_file import save_model
 from thermocal.profiles import design_validation_profile, rlg_modelling
 from thermocal.recording import Recording
 from thermocal.report import ModelEntry, ReportInputs, write_report
+from thermocal.report.text import Block, TextTable, fmt
 from thermocal.simulate import run_scenario
 from thermocal.validation import validate
 from thermocal.writers import write_json, write_program, write_recording
@@ -155,6 +156,67 @@ class DemoResult:
     seed: int
     warnings: tuple[str, ...] = ()
     extra: dict[str, Any] = field(default_factory=dict)
+
+    def to_dict(self) -> dict[str, Any]:
+        """The result as JSON types: the files, the timings and each model's figures.
+
+        Returns
+        -------
+        dict
+            ``report``, ``out_dir`` (paths as strings), ``elapsed_s`` and ``timings_s``
+            [s], ``seed``, ``models`` (each model's files and validation figures [°/h],
+            improvements [%]) and ``files``.
+        """
+        figures = ("n_coefficients", "condition_number", "rms_residual", "r",
+                   "weakly_correlated", "n_stages", "bias_stability_before",
+                   "bias_stability_after", "bias_repeatability_before",
+                   "bias_repeatability_after", "improvement_pct")  # fmt: skip
+        models = [
+            {"label": m.label, "model": str(m.model_path), "validation": str(m.validation_path),
+             "c_files": [str(p) for p in m.c_files], **{k: getattr(m, k) for k in figures}}
+            for m in self.models
+        ]  # fmt: skip
+        return {
+            "report": str(self.report_path),
+            "out_dir": str(self.out_dir),
+            "elapsed_s": self.elapsed_s,
+            "timings_s": self.timings_s,
+            "seed": self.seed,
+            "models": models,
+            "files": [str(p) for p in self.files],
+        }
+
+    def text(self) -> list[Block]:
+        """The validation figures of both models against the uncompensated run, and where
+        the files went.
+
+        Returns
+        -------
+        list of str or TextTable
+            The table (coefficients, r, bias stability and repeatability before and after
+            [°/h] with the improvement [%]; the reported model marked ``*``) and two lines.
+        """
+        ms = self.models
+        rows = [("coefficients", "", *(str(m.n_coefficients) for m in ms)),
+                ("r (limit 0.4)", "", *(fmt(m.r, 3) for m in ms))]  # fmt: skip
+        for key, label in (("bias_stability", "bias stability"),
+                           ("bias_repeatability", "bias repeatability")):  # fmt: skip
+            after = [f"{fmt(getattr(m, f'{key}_after'))} ({_pct(m.improvement_pct.get(key))})"
+                     for m in ms]  # fmt: skip
+            rows.append((label, fmt(getattr(ms[0], f"{key}_before")), *after))
+        columns = ("figure", "before", *(f"after, {m.label}" + (" *" if m is ms[0] else "")
+                                         for m in ms))  # fmt: skip
+        title = f"thermocal demo (seed {self.seed}): validation run, °/h"
+        return [
+            TextTable(title, columns, tuple(rows), ("left", *("right",) * (len(ms) + 1))),
+            "* reported model; (…) improvement",
+            f"{len(self.files)} files in {self.out_dir} ({self.elapsed_s:.1f} s)",
+        ]
+
+
+def _pct(value: float | None) -> str:
+    """An improvement [%] with its sign, ``—`` for none."""
+    return "—" if value is None else f"{value:+.1f} %"
 
 
 def _fit_poly(run: RunData, cfg: DemoConfig, *, select: bool) -> TemperatureModel:

@@ -33,6 +33,7 @@ from thermocal.models.rundata import RunData, model_inputs
 from thermocal.pipeline.compensate import compensate_channels
 from thermocal.pipeline.model_file import save_calibration
 from thermocal.report.calibration import CalibrationReportInputs, write_calibration_report
+from thermocal.report.text import Block, TextTable, fmt
 from thermocal.simulate import IMU_CHANNELS, SCENARIOS
 from thermocal.validation import validate
 from thermocal.writers import write_json, write_recording
@@ -82,6 +83,52 @@ class ImuDemoResult:
     channels: list[ChannelSummary]
     files: list[Path]
     elapsed_s: float
+    seed: int = 1
+
+    def to_dict(self) -> dict[str, Any]:
+        """The result as JSON types: the files, the seed and each channel's figures.
+
+        Returns
+        -------
+        dict
+            ``report``, ``calibration``, ``out_dir`` (paths as strings), ``elapsed_s`` [s],
+            ``seed``, ``channels`` ``{name: {unit, n_coefficients, rms_residual, …,
+            removed_pct [%], warnings}}`` and ``files``.
+        """
+        keys = ("unit", "n_coefficients", "rms_residual", "condition_number", "temp_range_c",
+                "r", "bias_stability_before", "bias_stability_after", "rms_before",
+                "rms_after", "removed_pct", "warnings")  # fmt: skip
+        return {
+            "report": str(self.report_path),
+            "calibration": str(self.calibration_path),
+            "out_dir": str(self.out_dir),
+            "elapsed_s": self.elapsed_s,
+            "seed": self.seed,
+            "channels": {
+                c.name: {**{k: getattr(c, k) for k in keys}, "temp_range_c": list(c.temp_range_c)}
+                for c in self.channels
+            },
+            "files": [str(p) for p in self.files],
+        }
+
+    def text(self) -> list[Block]:
+        """Each channel's validation figures as a table, and where the files went.
+
+        Returns
+        -------
+        list of str or TextTable
+            The table (r, rms before and after [the channel's unit], the share of the true
+            temperature-induced bias removed [%]) and two lines.
+        """
+        title = f"thermocal demo --imu (seed {self.seed}): validation run"  # cli-words: its name
+        columns = ("channel", "unit", "r", "rms before", "rms after", "bias removed")
+        rows = tuple((c.name, c.unit, fmt(c.r, 3), fmt(c.rms_before), fmt(c.rms_after),
+                      f"{c.removed_pct:.1f} %") for c in self.channels)  # fmt: skip
+        return [
+            TextTable(title, columns, rows, ("left", "left", *("right",) * 4)),
+            "bias removed: share of the simulator's true temperature-induced bias",
+            f"{len(self.files)} files in {self.out_dir} ({self.elapsed_s:.1f} s)",
+        ]
 
 
 def _fit_channels(mod: Recording) -> tuple[Calibration, dict[str, list[str]]]:
@@ -264,7 +311,7 @@ def run_imu_demo(
     )
     files.append(report)
     step(IMU_STEPS[5])
-    return ImuDemoResult(out, report, cal_path, summaries, files, time.perf_counter() - t0)
+    return ImuDemoResult(out, report, cal_path, summaries, files, time.perf_counter() - t0, seed)
 
 
 def _model_in_data_unit(ch: Channel, rec: Any) -> np.ndarray:

@@ -1,0 +1,235 @@
+"""Calibrations of triads as text: the tables and lines of a multi-position or turntable
+calibration, as blocks of :mod:`thermocal.report.text` (lines and
+:class:`~thermocal.report.text.TextTable`), printed by the command line or read in a notebook.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+from thermocal.report.text import Block, TextTable, fmt
+
+if TYPE_CHECKING:
+    from thermocal.pipeline.multipos import MultiposResult
+    from thermocal.pipeline.turntable import SingleRunResult, ThermalRunsResult
+
+
+def _triad_table(kind: str, d: dict[str, Any]) -> TextTable:
+    """One triad's bias, scale factors and misalignments with their σ."""
+    rows = [(f"bias {ax}", fmt(d["bias"][i], 5), fmt(d["bias_sigma"][i], 3), d["bias_unit"])
+            for i, ax in enumerate("xyz")]  # fmt: skip
+    rows += [
+        (f"scale factor {ax}", fmt(d["scale_factor_ppm"][i], 5),
+         fmt(d["scale_factor_ppm_sigma"][i], 3), "ppm")
+        for i, ax in enumerate("xyz")
+    ]  # fmt: skip
+    for i, n in enumerate(d["misalignment_names"]):
+        sig = d["misalignment_arcsec_sigma"][i]  # 0: an element the model holds at 0
+        rows.append((f"misalignment {n}", fmt(d["misalignment_arcsec"][i], 5),
+                     fmt(sig, 3) if sig else "held (not fitted)", "″"))  # fmt: skip
+    columns = ("parameter", "value", "σ", "unit")
+    return TextTable(f"{kind} triad ({d['method']})", columns, tuple(rows), ("left",) * 4)
+
+
+def gyro_misfit_line(run: dict[str, Any]) -> str | None:
+    """The line said when a run's gyro motions scatter beyond their noise
+    (:func:`thermocal.multipos.gyro.scatter_beyond_noise`: the gyro's σ are scaled by the
+    reduced χ²), else None.
+
+    Parameters
+    ----------
+    run : dict
+        One run of a multi-position result's ``runs`` (its ``gyro`` figures).
+
+    Returns
+    -------
+    str or None
+
+    References
+    ----------
+    Ferraris et al. (1995), *Sensors and Materials* 7(5) (gyro scale factors and
+    misalignments from rotations between poses).
+    """
+    from thermocal.multipos.gyro import scatter_beyond_noise
+
+    g = run.get("gyro")
+    if not g or not g["dof"] > 0 or g["reduced_chi2"] is None:
+        return None
+    chi2, dof = float(g["reduced_chi2"]), int(g["dof"])
+    if not scatter_beyond_noise(chi2, dof):
+        return None
+    return (
+        f"{run['input']}: the gyro's {g['n_motions']} motions scatter beyond their noise "
+        f"(reduced χ² {fmt(chi2, 3)} on {dof} degrees of freedom, {g['model']} model): "
+        "its σ are scaled by it"
+    )
+
+
+def pose_detection_lines(out: dict[str, Any]) -> list[str]:
+    """The pose detector's choice, per file: poses found, the still limit and what set it,
+    the stretches rejected and why.
+
+    Parameters
+    ----------
+    out : dict
+        A multi-position result's dictionary (``pose_detection``, ``unit``).
+
+    Returns
+    -------
+    list of str
+
+    References
+    ----------
+    Tedaldi et al. (2014), ICRA (static detector on the accelerometer's variance).
+    """
+    lines = []
+    for d in out.get("pose_detection", []):
+        a = d["accel"]
+        lines.append(
+            f"{d['input']}: {d['n_poses']} poses (window {fmt(d['window_s'], 3)} s, still "
+            f"for ≥ {fmt(d['static_s'], 3)} s below an accelerometer rms of "
+            f"{fmt(a['still_limit_rms'], 3)} {out['unit']}, set by the "
+            + ("noise" if a["limit_set_by"] == "noise" else "motions")
+            + f": noise {', '.join(fmt(v, 3) for v in a['noise_sigma'])}, motions "
+            f"{fmt(a['motion_rms'], 3)}); {len(d['rejected'])} rejected"
+        )
+        lines += [f"  rejected {r['start']}…{r['end']}: {r['reason']}" for r in d["rejected"]]
+    return lines
+
+
+def multipos_text(res: MultiposResult, output: Path | str) -> list[Block]:
+    """A multi-position calibration: each triad's table at TREF, the lean of the 360° turns,
+    the poses and the gravity-magnitude residual before → after, the runs that scatter
+    beyond their noise, and the pose detector's choice.
+
+    Parameters
+    ----------
+    res : thermocal.pipeline.multipos.MultiposResult
+        The calibration (:func:`thermocal.pipeline.multipos.calibrate_files`).
+    output : pathlib.Path or str
+        The calibration file written, named in the summary line.
+
+    Returns
+    -------
+    list of str or TextTable
+
+    References
+    ----------
+    Tedaldi et al. (2014), ICRA; Ferraris et al. (1995), *Sensors and Materials* 7(5).
+    """
+    out, a_unit = res.to_dict(), res.accel_unit
+    blocks: list[Block] = [_triad_table(k, out[k]) for k in ("accel", "gyro") if k in out]
+    for run in out["runs"]:
+        lean = run.get("gyro", {}).get("turn_axis_lean_deg", 0.0)
+        if lean > 0:
+            blocks.append(
+                f"{run['input']}: the 360° turns lean {fmt(lean, 2)}° off their axes "
+                "(per component, found in the data): counted in the σ, the misalignments "
+                "rest on the motions between poses"
+            )
+    blocks.append(
+        f"{out['n_poses']} poses; gravity-magnitude residual rms "
+        f"{fmt(out['gravity_residual_rms_before'], 3)} → "
+        f"{fmt(out['gravity_residual_rms_after'], 3)} {a_unit}; written {output}"
+    )
+    for run in out["runs"]:
+        line = gyro_misfit_line(run)
+        blocks += [line] if line is not None else []
+        if run["accel"].get("misfit"):
+            blocks.append(
+                f"{run['input']}: the poses scatter more than their noise (reduced χ² "
+                f"{fmt(run['accel']['reduced_chi2'], 3)}): each pose's σ inflated by a "
+                f"misfit of {fmt(run['accel']['misfit'], 3)} {a_unit}, so that each "
+                "counts as the misfit says"
+            )
+    return blocks + pose_detection_lines(out)
+
+
+def turntable_text(res: SingleRunResult) -> list[Block]:
+    """One turntable run's calibration: bias, scale factors and misalignments with the
+    filter's σ, the Cramér-Rao bound and the least-squares value, then the inner axis's
+    azimuth and the filter/least-squares agreement.
+
+    Parameters
+    ----------
+    res : thermocal.pipeline.turntable.SingleRunResult
+        The run's calibration.
+
+    Returns
+    -------
+    list of str or TextTable
+
+    References
+    ----------
+    IEEE Std 1431-2004 (rate-table calibration of a gyro triad).
+    """
+    from thermocal.turntable.model import MISALIGNMENT_NAMES
+
+    out = res.to_dict()
+    ls = out["least_squares"]
+    groups = (
+        ("bias", "bias_deg_h", "°/h", ("x", "y", "z")),
+        ("scale factor", "scale_factor_ppm", "ppm", ("x", "y", "z")),
+        ("misalignment", "misalignment_arcsec", "″", MISALIGNMENT_NAMES),
+    )
+    rows = tuple(
+        (f"{label} {n}", fmt(out[key][i], 5), fmt(out[key + "_sigma"][i], 3),
+         fmt(out["crb"][key][i], 3), fmt(ls[key][i], 5), unit)
+        for label, key, unit, names in groups
+        for i, n in enumerate(names)
+    )  # fmt: skip
+    columns = ("coefficient", "value", "σ", "CRB σ", "least squares", "unit")
+    title = f"turntable calibration of {res.input} ({out['method']})"
+    return [
+        TextTable(title, columns, rows, ("left",) * len(columns)),
+        f"inner-axis azimuth (yx − xy)/2: {fmt(out['inner_axis_azimuth_arcsec'], 4)} ± "
+        f"{fmt(out['inner_axis_azimuth_arcsec_sigma'], 3)} ″; "
+        f"filter/LS agreement {fmt(out['agreement_max_sigma'], 2)} σ; written {res.output}",
+    ]
+
+
+def turntable_thermal_text(res: ThermalRunsResult) -> list[Block]:
+    """Soak runs' calibration over temperature: per triad, each parameter's polynomial order,
+    value and σ at TREF and its leave-one-temperature-out rms, then the file written.
+
+    Parameters
+    ----------
+    res : thermocal.pipeline.turntable.ThermalRunsResult
+        The calibration of several soaks.
+
+    Returns
+    -------
+    list of str or TextTable
+
+    References
+    ----------
+    IEEE Std 1431-2004 (rate-table calibration); PX4 ``TemperatureCompensation.cpp``
+    (parameters as polynomials in T − TREF).
+    """
+    blocks: list[Block] = []
+    for name, tri in (("gyro", res.gyro), ("accel", res.accel)):
+        if tri is None:
+            continue
+        title = (
+            f"{name} triad over temperature (TREF {tri.tref_c:g} °C, soaks "
+            f"{', '.join(f'{t:g}' for t in tri.soak_temperatures_c)} °C)"
+        )
+        rows = tuple(
+            (fit.name, fit.unit, str(len(fit.coef) - 1), fmt(fit.coef[0], 5),
+             fmt(fit.sigma[0], 3), fmt(fit.loto_rms, 3))
+            for fit in tri.fits
+        )  # fmt: skip
+        columns = ("parameter", "unit", "order", "at TREF", "σ", "LOTO rms")
+        blocks.append(TextTable(title, columns, rows, ("left",) * len(columns)))
+    blocks.append(f"calibration written: {res.output} (compensate applies it per sample)")
+    return blocks
+
+
+__all__ = [
+    "gyro_misfit_line",
+    "multipos_text",
+    "pose_detection_lines",
+    "turntable_text",
+    "turntable_thermal_text",
+]
