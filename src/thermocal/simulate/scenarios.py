@@ -964,7 +964,19 @@ class SimulateOptions:
 class Simulation:
     """The result of :func:`simulate_scenario`: each recording with its truth, and a label per
     recording (the truth's ``label``, else 1, 2, … when the labels do not tell them
-    apart)."""
+    apart).
+
+    Attributes
+    ----------
+    scenario : str
+        The scenario's name.
+    seed : int
+        Its seed.
+    results : ScenarioResult
+        Each recording with its truth.
+    labels : tuple of str
+        One label per recording.
+    """
 
     scenario: str
     seed: int
