@@ -29,7 +29,12 @@ import numpy.typing as npt
 
 from thermocal import units
 from thermocal._lazy import LazyModule
-from thermocal.errors import MissingValueError, PlausibilityWarning, ThermocalInputError
+from thermocal.errors import (
+    MissingValueError,
+    ParameterError,
+    PlausibilityWarning,
+    ThermocalInputError,
+)
 from thermocal.recording import Recording, contiguous_slices, is_increasing
 
 _Run = TypeVar("_Run")
@@ -85,7 +90,7 @@ class DriftReference:
     ----------
     kind : ``"window"`` — b0 is the mean of ω − Ω_axis over the reference window
         [``start_s``, ``end_s``] (seconds since the first sample); ``"bias"`` — b0 was
-        given (``--drift-bias``); ``"model"`` — a compensation model removed the bias
+        given (``drift_bias``); ``"model"`` — a compensation model removed the bias
         (b0 = 0 on the compensated output).
     start_s, end_s : the window [s since the first sample] (None unless ``"window"``).
     bias : b0 [``unit``], earth rate already removed (comparable with ``bias``).
@@ -160,8 +165,8 @@ class MetricsResult:
     drift_reference: DriftReference | None = None
 
     def to_dict(self) -> dict[str, Any]:
-        """The figures as plain Python values: the object ``thermocal metrics --json``
-        prints for one channel (NaN where it prints null).
+        """The figures as plain Python values: the object the ``metrics`` command prints
+        as JSON for one channel (NaN where it prints null).
 
         Returns
         -------
@@ -385,7 +390,6 @@ def bias_stability(
     *,
     time_s: npt.ArrayLike | None = None,
     where: str | None = None,
-    option: str | None = "--average",
 ) -> float:
     r"""Bias stability: the standard deviation of the averages over ``averaging_s``.
 
@@ -401,8 +405,6 @@ def bias_stability(
         Sample times [s]; no average spans a gap (:func:`block_means`).
     where : str, optional
         The file a refusal names.
-    option : str or None
-        The averaging option of the command that asked (None if it has none).
 
     Returns
     -------
@@ -412,7 +414,8 @@ def bias_stability(
     Raises
     ------
     thermocal.errors.ThermocalInputError
-        Fewer than two averages.
+        Fewer than two averages (the message names ``averaging_s`` with the longest
+        averaging time that gives two).
 
     Notes
     -----
@@ -427,13 +430,19 @@ def bias_stability(
     """
     means = block_means(rate, tau0_s, averaging_s, time_s=time_s)
     if means.size < 2:
-        raise ThermocalInputError(
-            too_few_averages(
-                where, float(averaging_s or tau0_s), means.size,
-                _longest_stretch_s(time_s, tau0_s, np.size(rate)), option,
-            )
+        raise _too_few_averages_error(
+            where, float(averaging_s or tau0_s), means.size,
+            _longest_stretch_s(time_s, tau0_s, np.size(rate)),
         )  # fmt: skip
     return float(np.std(means, ddof=1))
+
+
+def _too_few_averages_error(
+    where: str | None, averaging_s: float, n_means: int, longest_s: float
+) -> ThermocalInputError:
+    """The refusal of :func:`too_few_averages` naming the parameter ``averaging_s``."""
+    text = too_few_averages(where, averaging_s, n_means, longest_s, "{averaging_s}")
+    return ThermocalInputError.naming(text, "averaging_s")
 
 
 def _longest_stretch_s(time_s: npt.ArrayLike | None, tau0_s: float, n: int) -> float:
@@ -445,12 +454,13 @@ def _longest_stretch_s(time_s: npt.ArrayLike | None, tau0_s: float, n: int) -> f
 
 
 def too_few_averages(
-    where: str | None, averaging_s: float, n_means: int, longest_s: float, option: str | None
+    where: str | None, averaging_s: float, n_means: int, longest_s: float, name: str | None
 ) -> str:
     """The message of a record that gives fewer than two ``averaging_s`` averages: the file
-    ``where``, and the command's option ``option`` (e.g. ``--average``) with the longest
-    averaging time that gives two averages (half the longest stretch without a gap
-    ``longest_s`` [s]); without an option, the record's length is what falls short.
+    ``where``, and the name ``name`` of what sets the averaging time (a parameter,
+    ``averaging_s``) with the longest averaging time that gives two averages (half the
+    longest stretch without a gap ``longest_s`` [s]); without a name, the record's length is
+    what falls short.
 
     Parameters
     ----------
@@ -462,18 +472,23 @@ def too_few_averages(
         Number of averages it gives.
     longest_s : float
         Longest gap-free stretch [s].
-    option : str or None
-        Command option to name.
+    name : str or None
+        What sets the averaging time, as the message names it (None: nothing does).
 
     Returns
     -------
     str
         The message.
+
+    Examples
+    --------
+    >>> too_few_averages("a.csv", 600.0, 1, 900.0, "averaging_s").split("; ")[-1]
+    'give averaging_s 450 or less'
     """
     head = f"{where}: " if where else ""
     fix = (
-        f"; give {option} {longest_s / 2.0:.3g} or less"
-        if option and longest_s / 2.0 > 0
+        f"; give {name} {longest_s / 2.0:.3g} or less"
+        if name and longest_s / 2.0 > 0
         else f"; its longest stretch without a gap is {longest_s:.3g} s: record at least "
         f"{2.0 * averaging_s:.3g} s"
     )
@@ -535,8 +550,8 @@ class RunRepeatability:
     unit: str
 
     def to_dict(self) -> dict[str, Any]:
-        """The repeatability as plain Python values: the object ``thermocal metrics FILE
-        FILE… --json`` prints for one channel (NaN where it prints null).
+        """The repeatability as plain Python values: the object the ``metrics`` command
+        prints as JSON for one channel of several files (NaN where it prints null).
 
         Returns
         -------
@@ -661,9 +676,10 @@ def run_repeatability(
     unit = runs[0].unit
     for r, f in zip(runs, files, strict=True):
         if r.unit != unit:
-            raise ThermocalInputError(
+            raise ThermocalInputError.naming(
                 f"{f}: {r.signal} is in {r.unit}, the first run in {unit}; give the runs in "
-                "one unit (--signal-unit)"
+                "one unit ({signal_unit})",
+                "signal_unit",
             )
     biases = [r.bias for r in runs]
     br = bias_repeatability(biases)
@@ -951,7 +967,8 @@ def reference_bias(
     Raises
     ------
     ThermocalInputError
-        When the window holds no sample.
+        When the window is not 0 ≤ start < end or holds no sample (the message names the
+        window as :func:`compute_metrics` does, ``drift_reference_s``).
     """
     t = _as_1d(time_s, "time")
     r = _as_1d(rate, "rate")
@@ -962,9 +979,10 @@ def reference_bias(
     else:
         start, end = float(window_s[0]), float(window_s[1])
         if not (math.isfinite(start) and math.isfinite(end) and end > start >= 0.0):
-            raise ThermocalInputError(
-                f"--drift-reference {start:g},{end:g}: give START,END in seconds since the "
-                "first sample, with 0 ≤ START < END"
+            raise ThermocalInputError.naming(
+                f"{{drift_reference_s}} {start:g},{end:g}: give START,END in seconds since "
+                "the first sample, with 0 ≤ START < END",
+                "drift_reference_s",
             )
     if is_increasing(t):  # the window is one stretch: found by bisection, no copy
         # t_i − t_0 is non-decreasing in i (rounding is monotone): the rows with
@@ -979,9 +997,10 @@ def reference_bias(
         n = int(np.count_nonzero(sel))
         selected = r[sel]
     if n == 0:
-        raise ThermocalInputError(
+        raise ThermocalInputError.naming(
             f"drift reference window {start:g}…{end:g} s holds no sample (the run lasts "
-            f"{duration:g} s from its first sample); choose another --drift-reference"
+            f"{duration:g} s from its first sample); choose another {{drift_reference_s}}",
+            "drift_reference_s",
         )
     b0 = float(np.mean(selected)) - float(earth_rate)
     return DriftReference("window", start, end, b0, unit, n)
@@ -1084,7 +1103,9 @@ def _earth_rate(
     if lat is None and axis is None:
         return 0.0
     if lat is None or ax is None:
-        raise ThermocalInputError("earth-rate removal needs both --latitude and --axis")
+        raise ThermocalInputError.naming(
+            "earth-rate removal needs both {latitude_deg} and {axis}", "latitude_deg", "axis"
+        )
     if canon != "deg/h":
         raise ThermocalInputError(
             f"earth-rate removal applies to gyro rates, but {name!r} is in {unit}"
@@ -1108,17 +1129,23 @@ def _drift(
     an error)."""
     if unit not in RATE_ANGLE_UNITS:
         if drift_bias is not None or drift_reference_s is not None:
-            raise ThermocalInputError(
+            raise ThermocalInputError.naming(
                 f"the drift angle applies to gyro rates, but {name!r} is in {unit}: "
-                "--drift-reference/--drift-bias do not apply"
+                "{drift_reference_s}/{drift_bias} do not apply",
+                "drift_reference_s",
+                "drift_bias",
             )
         return None
     angle_unit, per = RATE_ANGLE_UNITS[unit]
     if drift_bias is not None:
         if drift_reference_s is not None:
-            raise ThermocalInputError("give either --drift-reference or --drift-bias, not both")
+            raise ThermocalInputError.naming(
+                "give either {drift_reference_s} or {drift_bias}, not both",
+                "drift_reference_s",
+                "drift_bias",
+            )
         if not math.isfinite(drift_bias):
-            raise ThermocalInputError(f"--drift-bias must be a number, got {drift_bias!r}")
+            raise ParameterError("drift_bias", f"{{name}} must be a number, got {drift_bias!r}")
         ref = DriftReference("bias", None, None, float(drift_bias), unit)
     else:
         ref = reference_bias(t, values, window_s=drift_reference_s, earth_rate=earth, unit=unit)
@@ -1176,7 +1203,6 @@ def compute_metrics(
     min_hold_s: float = 600.0,
     drift_reference_s: tuple[float, float] | None = None,
     drift_bias: float | None = None,
-    average_option: str | None = "--average",
 ) -> MetricsResult:
     """All figures of merit of one signal of a recording, in the data's own unit
     (:func:`data_unit_of`).
@@ -1196,8 +1222,6 @@ def compute_metrics(
         first sample]; b0 is the mean of ω − Ω_axis over it (:func:`reference_bias`;
         default the first 10 % of the run).
     drift_bias : b0 given instead [data unit, earth rate already removed].
-    average_option : the option of the asking command that sets ``averaging_s`` (named
-        when the record gives fewer than two averages; ``None``: the command has none).
 
     The drift angle ``θ(t) = ∫ (ω − Ω_axis − b0) dt`` (gyros only) is never taken about
     the same run's mean (that makes θ(t_end) ≈ 0 by construction): b0 is the stated
@@ -1216,12 +1240,9 @@ def compute_metrics(
     b0 = bias(values, earth_rate_deg_h=earth)
     means = block_means(values, tau0, avg, time_s=t)
     if means.size < 2:
-        raise ThermocalInputError(
-            too_few_averages(
-                rec.source or rec.name, avg, means.size,
-                _longest_stretch_s(t, tau0, values.size), average_option,
-            )
-        )  # fmt: skip
+        raise _too_few_averages_error(
+            rec.source or rec.name, avg, means.size, _longest_stretch_s(t, tau0, values.size)
+        )
     stab = float(np.std(means, ddof=1))
     p2p = float(np.max(means) - np.min(means))
     drift = _drift(t, values, name, unit, earth, drift_reference_s, drift_bias)
@@ -1331,9 +1352,12 @@ def channel_metrics(
         Figures per channel.
     """
     if len(names) > 1 and options.removes_earth_rate:
-        raise ThermocalInputError(
-            "earth-rate removal (--latitude/--axis) takes one signal at a time: each channel's "
-            "sensitive axis points elsewhere; run metrics per gyro axis with its --axis"
+        raise ThermocalInputError.naming(
+            "earth-rate removal ({latitude_deg}/{axis}) takes one signal at a time: each "
+            "channel's sensitive axis points elsewhere; run metrics per gyro axis with its "
+            "{axis}",
+            "latitude_deg",
+            "axis",
         )
     return {name: options.of(rec, name) for name in names}
 
@@ -1475,8 +1499,10 @@ def power_on_metrics(
         elif these != names:
             raise ThermocalInputError(f"{run}: signals {these} differ from the first run's {names}")
         if len(these) > 1 and options.removes_earth_rate:
-            raise ThermocalInputError(
-                "earth-rate removal (--latitude/--axis) takes one signal at a time"
+            raise ThermocalInputError.naming(
+                "earth-rate removal ({latitude_deg}/{axis}) takes one signal at a time",
+                "latitude_deg",
+                "axis",
             )
         _same_sensor(rec, str(run), sensors)
         _not_a_copy(rec, these, str(run), seen)

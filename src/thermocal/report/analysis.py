@@ -443,7 +443,6 @@ def figures_of_merit(
     drift_bias: float | None = None,
     drift_reference_s: tuple[float, float] | None = None,
     where: str | None = None,
-    average_option: str | None = "--average",
 ) -> FiguresOfMerit:
     """Figures of merit of a rate ``x`` [``unit``, known input included].
 
@@ -453,7 +452,7 @@ def figures_of_merit(
     gaps) removes a stated constant b0, never the run's own mean: ``drift_bias`` when
     given (0 on a compensated output: the model is what removes the bias), else the mean
     over ``drift_reference_s`` (default the first 10 % of the run,
-    :func:`thermocal.metrics.reference_bias`).  ``where`` (the file) and ``average_option``
+    :func:`thermocal.metrics.reference_bias`).  ``where`` (the file) and ``averaging_s``
     are named when the record gives fewer than two averages.
 
     Parameters
@@ -478,8 +477,6 @@ def figures_of_merit(
         Window whose mean is b0 [s since the first sample].
     where : str, optional
         How warnings name the run.
-    average_option : str, optional
-        The option that sets the averaging time, for warnings.
 
     Returns
     -------
@@ -506,7 +503,6 @@ def figures_of_merit(
         temps=[temp_name],
         drift_bias=drift_bias,
         drift_reference_s=drift_reference_s,
-        average_option=average_option,
     )
     sens = m.temperature_sensitivity
     ang: FloatArray | None = None

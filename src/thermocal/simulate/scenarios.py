@@ -119,12 +119,17 @@ def check_sample_budget(n: float, what: str) -> None:
     Raises
     ------
     ThermocalInputError
-        ``n`` is above :data:`MAX_SAMPLES`.
+        ``n`` is above :data:`MAX_SAMPLES` (the message names the parameters that lower it:
+        ``rate_hz``, ``profile``, ``record_s``, ``runs``).
     """
     if not n <= MAX_SAMPLES:
-        raise ThermocalInputError(
+        raise ThermocalInputError.naming(
             f"{what}: {n:.3g} samples to simulate, above the limit of {MAX_SAMPLES:.3g}: "
-            "lower --rate-hz, or shorten the chamber program (--profile, --record-s, --runs)"
+            "lower {rate_hz}, or shorten the chamber program ({profile}, {record_s}, {runs})",
+            "rate_hz",
+            "profile",
+            "record_s",
+            "runs",
         )
 
 
@@ -984,7 +989,7 @@ class Simulation:
     labels: tuple[str, ...]
 
     def truth_document(self, files: Sequence[str], profile: str | None) -> dict[str, Any]:
-        """The ``--truth`` JSON: format, version, scenario, seed, profile and per recording
+        """The truth JSON: format, version, scenario, seed, profile and per recording
         its truth with ``file`` the path it was written to.
 
         Parameters

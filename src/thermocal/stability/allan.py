@@ -19,7 +19,7 @@ Confidence intervals (SP 1065 §5.3, eq. 45): ``edf · σ̂² / χ²_{p}(edf)`` 
 Greenhall & Riley's equivalent degrees of freedom (Greenhall & Riley 2003; SP 1065
 §5.3.3) for the power-law noise type α identified at each τ by the lag-1 autocorrelation
 of the m-averages (Riley & Greenhall 2004; the B1 ratio where too few averages remain) —
-the one implementation of ``thermocal allan --deviation oadev``
+the one implementation of the deviation family's ``oadev``
 (:func:`thermocal.stability.family.oadev_edf`), so both give the same intervals, equal to
 Stable32's (gyro terms: quantization ↔ α = +2, angle random walk ↔ α = 0, bias
 instability ↔ α = −1, rate random walk ↔ α = −2).  SP 1065 Table 5's simple EDF
@@ -345,10 +345,10 @@ class NoiseTermSet:
         return {name: getattr(self, name) for name in TERM_NAMES}
 
     def to_dict(self) -> dict[str, dict[str, Any]]:
-        """Each term's object as ``thermocal allan --json`` prints it under ``noise`` (fit)
-        or ``noise_slope`` (slope lines): ``value``, ``unit``, ``reason``, ``low``,
-        ``high``, ``tau_s``, ``label``, ``quality``, ``method`` (this set's, the word
-        ``noise --format json`` gives) and ``tau_range_s``."""
+        """Each term's object as the ``allan`` command's JSON holds it under ``noise``
+        (fit) or ``noise_slope`` (slope lines): ``value``, ``unit``, ``reason``, ``low``,
+        ``high``, ``tau_s``, ``label``, ``quality``, ``method`` (this set's, the word the
+        noise model's JSON gives) and ``tau_range_s``."""
         return {
             name: {
                 "value": t.value,
@@ -368,7 +368,7 @@ class NoiseTermSet:
 
 def minimum_dict(t: NoiseTerm | None) -> dict[str, Any] | None:
     """The bias instability at the curve's minimum (:func:`bias_at_minimum`) as
-    ``thermocal allan --json`` prints it under ``bias_instability_minimum``.
+    the ``allan`` command's JSON holds it under ``bias_instability_minimum``.
 
     Parameters
     ----------
@@ -830,7 +830,7 @@ def overlapping_adev(
     m = averaging_factors(taus, tau0_s, longest)
     if alpha is not None and alpha not in (-2, -1, 0, 1, 2):
         raise ThermocalInputError(f"noise exponent alpha must be −2…2, got {alpha!r}")
-    # α and EDF per τ exactly as `allan --deviation oadev` has them (one implementation),
+    # α and EDF per τ exactly as the family's oadev has them (one implementation),
     # from the segments that give the sums a term, before the phase may overwrite the rate
     alphas, methods, edf = family.oadev_edf(
         y, tau0_s, m, segments=[sl for sl in slices if sl.stop - sl.start >= 3], alpha=alpha
@@ -883,7 +883,7 @@ class DynamicAllan:
         return not self.changes
 
     def to_dict(self) -> dict[str, Any]:
-        """The object ``thermocal allan --dynamic --json`` prints under ``dynamic``:
+        """The object the ``allan`` command's JSON holds under ``dynamic``:
         ``window_s``, ``step_s``, ``t_s`` (window centres), ``tau_s``, ``adev`` (windows ×
         τ, NaN where a window is too short), ``adev_low``/``adev_high``, ``unit``,
         ``stationary``, ``changes`` and ``test_confidence``."""
@@ -916,13 +916,15 @@ def check_dynamic_work(
     *,
     channels: int = 1,
     where: str = "",
+    parameter: str = "window_s",
 ) -> float:
     """Estimated operations of :func:`dynamic_adev` in windows of ``window_s`` [s] (half a
     window apart) over ``n_samples`` samples every ``tau0_s`` [s], for ``channels``
     channels: windows × (:data:`DYNAMIC_WINDOW_WORK` + 4 n log2 n) with n samples a
-    window.  Beyond ``max_work`` a :class:`ThermocalInputError` naming ``where``,
-    ``--dynamic`` and ``--max-work`` (a window the dynamic ADEV refuses anyway costs 0
-    here: it says why).  ``--dynamic 8`` on 1e5 samples is 25 000 windows, ≈ 7 minutes.
+    window.  Beyond ``max_work`` a :class:`ThermocalInputError` naming ``where``, the
+    window (``parameter``) and ``max_work`` (a window the dynamic ADEV refuses anyway
+    costs 0 here: it says why).  An 8 s window on 1e5 samples at 1 Hz is 25 000 windows,
+    ≈ 7 minutes.
 
     Parameters
     ----------
@@ -938,6 +940,9 @@ def check_dynamic_work(
         Number of channels (default 1).
     where : str, optional
         File or channel named in the error (default none).
+    parameter : str, optional
+        The caller's parameter that sets the window, as the error names it (default
+        ``window_s``; :func:`thermocal.stability.analysis.allan_analysis`: ``dynamic_s``).
 
     Returns
     -------
@@ -950,7 +955,7 @@ def check_dynamic_work(
         When the estimate exceeds ``max_work``.
     """
     if not max_work > 0:
-        raise ThermocalInputError(f"--max-work {max_work!r}: give a positive operation count")
+        raise ParameterError("max_work", f"{{name}} {max_work!r}: give a positive operation count")
     if not (math.isfinite(window_s) and window_s > 0 and tau0_s > 0):
         return 0.0
     n_win = round(window_s / tau0_s)
@@ -960,14 +965,37 @@ def check_dynamic_work(
     windows = (n_samples - n_win) // step + 1
     work = channels * windows * (DYNAMIC_WINDOW_WORK + 4.0 * n_win * math.log2(n_win))
     if work > max_work:
-        raise ThermocalInputError(
+        raise ThermocalInputError.naming(
             (f"{where}: " if where else "")
-            + f"--dynamic {window_s:g} s on {n_samples} samples makes {windows} windows"
+            + f"{{{parameter}}} {window_s:g} s on {n_samples} samples makes {windows} windows"
             + (f" in each of {channels} channels" if channels > 1 else "")
             + f", about {work:.2g} operations, beyond the budget of {max_work:.2g}; give a "
-            f"longer window, or raise --max-work to {math.ceil(work / 1e9) * 1e9:.3g} to run it"
+            f"longer window, or raise {{max_work}} to {math.ceil(work / 1e9) * 1e9:.3g} to "
+            "run it",
+            parameter,
+            "max_work",
         )
     return work
+
+
+def _window_samples(n: int, tau0_s: float, window_s: float, parameter: str) -> int:
+    """Samples in a dynamic ADEV window of ``window_s`` [s]: at least 8, at most ``n // 2``."""
+    if not (math.isfinite(window_s) and window_s > 0):
+        raise ParameterError(parameter, f"{{name}} {window_s!r}: give a window length > 0 [s]")
+    n_win = round(window_s / tau0_s)
+    if n_win < 8:
+        raise ParameterError(
+            parameter,
+            f"{{name}} {window_s:g} s holds {n_win} samples at τ0 = {tau0_s:g} s; give at "
+            "least 8 samples' worth",
+        )
+    if n_win > n // 2:
+        raise ParameterError(
+            parameter,
+            f"{{name}} {window_s:g} s: the record ({n * tau0_s:g} s) holds fewer than "
+            "two windows; give a shorter window",
+        )
+    return int(n_win)
 
 
 def dynamic_adev(
@@ -978,6 +1006,7 @@ def dynamic_adev(
     *,
     time_s: npt.ArrayLike | None = None,
     step_s: float | None = None,
+    parameter: str = "window_s",
 ) -> DynamicAllan:
     """Dynamic Allan deviation: :func:`overlapping_adev` in windows of ``window_s`` [s]
     stepped by ``step_s`` (default half a window), at the τ of ``whole`` that fit a window
@@ -995,31 +1024,30 @@ def dynamic_adev(
         Sample interval and window length [s].
     whole : AllanResult
         The whole record's result; ``time_s`` [s], ``step_s`` [s] optional.
+    parameter : str, optional
+        The caller's parameter that sets the window, as a refusal names it (default
+        ``window_s``).
 
     Returns
     -------
     DynamicAllan
         Per-window deviations and the stationarity verdict.
+
+    Raises
+    ------
+    ThermocalInputError
+        A window that is no length, holds fewer than 8 samples, more than half the record,
+        or no τ of ``whole``.
     """
     y = np.asarray(rate, dtype=np.float64).ravel()
-    if not (math.isfinite(window_s) and window_s > 0):
-        raise ThermocalInputError(f"--dynamic {window_s!r}: give a window length > 0 [s]")
-    n_win = round(window_s / tau0_s)
-    if n_win < 8:
-        raise ThermocalInputError(
-            f"--dynamic {window_s:g} s holds {n_win} samples at τ0 = {tau0_s:g} s; give at "
-            "least 8 samples' worth"
-        )
-    if n_win > y.size // 2:
-        raise ThermocalInputError(
-            f"--dynamic {window_s:g} s: the record ({y.size * tau0_s:g} s) holds fewer than "
-            "two windows; give a shorter window"
-        )
+    n_win = _window_samples(y.size, tau0_s, window_s, parameter)
     step = max(1, round((step_s if step_s is not None else window_s / 2.0) / tau0_s))
     t = None if time_s is None else np.asarray(time_s, dtype=np.float64).ravel()
     m_all = whole.m[whole.m <= max_averaging_factor(n_win)]
     if m_all.size == 0:
-        raise ThermocalInputError(f"--dynamic {window_s:g} s: no τ of the record fits a window")
+        raise ParameterError(
+            parameter, f"{{name}} {window_s:g} s: no τ of the record fits a window"
+        )
     starts = list(range(0, y.size - n_win + 1, step))
     results: list[AllanResult | None] = []
     centres = []

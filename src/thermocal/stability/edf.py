@@ -31,7 +31,7 @@ import numpy as np
 import numpy.typing as npt
 
 from thermocal._lazy import LazyModule
-from thermocal.errors import ThermocalInputError
+from thermocal.errors import ParameterError, ThermocalInputError
 
 # the chi-square quantiles from scipy.special (0.2 s to import), when first needed
 special = LazyModule("scipy.special")
@@ -54,7 +54,8 @@ on its PHASE.DAT: its last octave point, 7 averages, keeps the white FM of the o
 
 STABLE32_B1_MIN_TOTAL: Final = 6
 """Stable32's noise identification (``noise_id="stable32"`` in
-:func:`thermocal.stability.family.stability`, ``allan --noise-id stable32``), read from its
+:func:`thermocal.stability.family.stability`, the ``allan`` command's ``stable32`` noise
+identification), read from its
 printed α columns (none written by thermocal); the evidence is every Stable32 output in
 allantools' and allantoolkit's test data (benchmarks/stable32_conformance.py: with these
 rules all 691 rows with bounds and all 1924 all-τ rows of the OCXO record carry Stable32's
@@ -1090,29 +1091,38 @@ quantiles of a few degrees of freedom run to 0 or to the double range (an interv
 ``[0, ∞)`` printed as numbers)."""
 
 
-def check_confidence(confidence: float, option: str = "--confidence") -> float:
+def check_confidence(confidence: float) -> float:
     """Return ``confidence`` when ``CONFIDENCE_MIN ≤ c ≤ CONFIDENCE_MAX``, else raise
-    :class:`ThermocalInputError` naming ``option`` and the value (a confidence of 1e-300
-    would give an interval of zero width beside the estimate).
+    :class:`~thermocal.errors.ParameterError` naming ``confidence`` and the value (a
+    confidence of 1e-300 would give an interval of zero width beside the estimate).
 
     Parameters
     ----------
     confidence : float
         Confidence level of a two-sided chi-square interval (dimensionless, e.g. 0.683 for
         one sigma, NIST SP 1065 eq. 45).
-    option : str
-        The option's name shown in the error.
 
     Returns
     -------
     float
         ``confidence`` unchanged.
+
+    Raises
+    ------
+    thermocal.errors.ParameterError
+        A confidence outside [``CONFIDENCE_MIN``, ``CONFIDENCE_MAX``].
+
+    Examples
+    --------
+    >>> check_confidence(0.95)
+    0.95
     """
     c = float(confidence)
     if not CONFIDENCE_MIN <= c <= CONFIDENCE_MAX:
-        raise ThermocalInputError(
-            f"{option} {confidence!r}: give a confidence level between {CONFIDENCE_MIN} and "
-            f"{CONFIDENCE_MAX!r} (0.6827 is one sigma, 0.95 two)"
+        raise ParameterError(
+            "confidence",
+            f"{{name}} {confidence!r}: give a confidence level between {CONFIDENCE_MIN} and "
+            f"{CONFIDENCE_MAX!r} (0.6827 is one sigma, 0.95 two)",
         )
     return c
 
