@@ -137,7 +137,7 @@ class UnitOutcome:
     warnings : list of str
         Its ``warning:`` lines.
     fit, validation : dict or None
-        The results, as the ``fit`` and ``validate`` commands print them with ``--json``.
+        The results as JSON objects (the fit's and the validation's ``to_dict()``).
     files : dict of str to bytes
         The files to write, by name.
     seconds : float
