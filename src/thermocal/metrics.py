@@ -73,7 +73,19 @@ class TemperatureSensitivity:
 
 @dataclass(frozen=True)
 class Stage:
-    """A temperature-hold stage: its mean temperature [°C] and bias [unit]."""
+    """A temperature-hold stage: its mean temperature [°C] and bias [unit].
+
+    Attributes
+    ----------
+    start_s, stop_s : float
+        The stage's span [s].
+    mean_temp_c : float
+        Its mean temperature [°C].
+    bias : float
+        Its mean bias [unit].
+    n_samples : int
+        Samples in it.
+    """
 
     start_s: float
     stop_s: float
@@ -111,7 +123,19 @@ class DriftExtreme:
     """The drift angle's end value and its largest magnitude (the FOG thesis).
 
     ``end`` θ(t_end), ``max_abs`` max_t |θ(t)|, reached at ``max_time_s`` [s since the
-    first sample]; all angles in [``unit``]."""
+    first sample]; all angles in [``unit``].
+
+    Attributes
+    ----------
+    end : float
+        θ(t_end) [``unit``].
+    max_abs : float
+        max_t |θ(t)| [``unit``].
+    max_time_s : float
+        When it is reached [s since the first sample].
+    unit : str
+        Unit of the angles.
+    """
 
     end: float
     max_abs: float
@@ -142,6 +166,43 @@ class MetricsResult:
     ``θ(t) = ∫ (ω − Ω_axis − b0) dt`` [``drift_angle_unit``: deg, or rad for rad/s data],
     b0 the constant stated by ``drift_reference`` (trapezoid rule, gaps not integrated;
     gyros only).
+
+    Attributes
+    ----------
+    bias : float
+        Mean of the signal less the earth-rate component [unit].
+    bias_stability : float
+        Standard deviation of the ``averaging_s`` averages [unit].
+    averaging_s : float
+        Averaging time [s].
+    peak_to_peak : float
+        Peak-to-peak of the averages [unit].
+    unit : str
+        The data's own unit.
+    temperature_sensitivity : TemperatureSensitivity or None
+        Bias against temperature over the hold stages (None: fewer than two stages).
+    bias_repeatability : float or None
+        Standard deviation of the stages' biases [unit].
+    stages : tuple of Stage
+        The hold stages.
+    drift_angle : float or None
+        θ at the end [``drift_angle_unit``] (gyros).
+    drift_angle_unit : str or None
+        ``deg``, or ``rad`` for rad/s data.
+    earth_rate_removed : float
+        Earth-rate component taken off the bias [unit].
+    n_samples, n_segments, n_averages : int
+        Samples, gap-free segments and averages.
+    duration_s : float
+        Span of the record [s].
+    signal : str
+        The signal column.
+    drift_angle_max : float or None
+        Largest |θ| [``drift_angle_unit``].
+    drift_angle_max_time_s : float or None
+        When it is reached [s since the first sample].
+    drift_reference : DriftReference or None
+        How b0 was taken.
     """
 
     bias: float
@@ -538,6 +599,23 @@ class RunRepeatability:
     ``runs`` each run's figures (its bias and in-run bias stability); ``bias_repeatability``
     the sample standard deviation of the run biases, ``low``/``high`` its chi-square
     interval at ``confidence`` (:func:`std_interval`); ``bias_mean`` the mean run bias.
+
+    Attributes
+    ----------
+    runs : tuple of MetricsResult
+        Each run's figures.
+    files : tuple of str
+        The runs' files.
+    bias_mean : float
+        Mean of the run biases [unit].
+    bias_repeatability : float
+        Sample standard deviation of the run biases [unit].
+    bias_repeatability_low, bias_repeatability_high : float
+        Its chi-square interval at ``confidence`` [unit].
+    confidence : float
+        Confidence level of the interval.
+    unit : str
+        The data's unit.
     """
 
     runs: tuple[MetricsResult, ...]
@@ -1285,7 +1363,27 @@ class MetricsOptions:
     """The options of :func:`compute_metrics` shared by every channel and run (``metrics``'
     command line): averaging time [s], earth-rate removal (latitude [°], axis), temperature
     columns, hold-stage detection (|Ṫ| [°C/min], shortest hold [s]) and the drift angle's
-    reference window [s] or bias [data unit]."""
+    reference window [s] or bias [data unit].
+
+    Attributes
+    ----------
+    averaging_s : float or None
+        Averaging time [s] (None: the default for the record).
+    latitude_deg : float or None
+        Site latitude [°] (earth-rate removal, with ``axis``).
+    axis : str or None
+        Sensitive axis (``up``, ``north``, … or ``'e,n,u'``).
+    temps : tuple of str or None
+        Temperature columns (None: those of the file).
+    rate_threshold_c_per_min : float
+        |Ṫ| below which a hold stage is found [°C/min].
+    min_hold_s : float
+        Shortest hold stage [s].
+    drift_reference_s : (float, float) or None
+        Window [s since the first sample] whose mean is the drift angle's bias b0.
+    drift_bias : float or None
+        The drift angle's bias b0 given directly [data unit].
+    """
 
     averaging_s: float | None = None
     latitude_deg: float | None = None
@@ -1365,7 +1463,17 @@ def channel_metrics(
 @dataclass(frozen=True, eq=False)
 class PowerOnMetrics:
     """The result of :func:`power_on_metrics`: the channels, each run's figures per channel
-    (in the order of the runs) and the turn-on to turn-on repeatability per channel."""
+    (in the order of the runs) and the turn-on to turn-on repeatability per channel.
+
+    Attributes
+    ----------
+    names : tuple of str
+        The channels.
+    runs : tuple of dict of str to MetricsResult
+        Each run's figures per channel, in the order of the runs.
+    repeatability : dict of str to RunRepeatability
+        Turn-on to turn-on repeatability per channel.
+    """
 
     names: tuple[str, ...]
     runs: tuple[dict[str, MetricsResult], ...]

@@ -203,6 +203,25 @@ class NoiseTerm:
     (``reason`` is ``None`` when ``value`` is present).  ``low``/``high`` bound the
     value at the result's confidence level; ``tau_s`` is where the slope line
     touches the curve (slope method) or ``None`` (fit).
+
+    Attributes
+    ----------
+    value : float or None
+        The coefficient [``unit``] (None: not in the data).
+    unit : str
+        Its unit.
+    reason : str or None
+        Why ``value`` is missing or doubtful.
+    low, high : float or None
+        Its interval at the result's confidence [``unit``].
+    tau_s : float or None
+        Where the slope line touches the curve [s] (slope method).
+    label : str
+        The term's name as shown.
+    quality : str or None
+        ``"poor"`` when the noise model fits the curve badly.
+    tau_range_s : (float, float) or None
+        The τ range the value was read from [s].
     """
 
     value: float | None
@@ -232,6 +251,21 @@ class FitQuality:
     (``{"tau_from_s", "tau_to_s", "side", "mean_sigma"}``; side ``"above"`` = the fitted
     curve lies above the points); ``quality`` ``"good"`` or ``"poor"`` (poor: a misfit
     stretch, or a reduced χ² above :data:`POOR_CHI2`); ``reason`` one line.
+
+    Attributes
+    ----------
+    reduced_chi2 : float
+        Weighted residual sum of squares per degree of freedom.
+    dof : int
+        Degrees of freedom.
+    p_value : float
+        Upper tail of χ²(dof) at the sum.
+    misfits : tuple of dict
+        The one-sided stretches described above.
+    quality : str
+        ``"good"`` or ``"poor"``.
+    reason : str or None
+        Why poor.
     """
 
     reduced_chi2: float
@@ -331,7 +365,15 @@ def fit_quality(tau_s: FloatArray, normalised_residuals: FloatArray, n_active: i
 
 @dataclass(frozen=True)
 class NoiseTermSet:
-    """The five IEEE 952 terms found by one method (``"slope"`` or ``"fit"``)."""
+    """The five IEEE 952 terms found by one method (``"slope"`` or ``"fit"``).
+
+    Attributes
+    ----------
+    method : str
+        ``"slope"`` or ``"fit"``.
+    quantization, angle_random_walk, bias_instability, rate_random_walk, rate_ramp : NoiseTerm
+        The five terms of IEEE Std 952-1997 Annex C.
+    """
 
     method: str
     quantization: NoiseTerm
@@ -864,6 +906,23 @@ class DynamicAllan:
     deviation and the whole record's differ beyond both their intervals at the test's
     confidence ``test_confidence`` (``{"t_s", "tau_s", "adev", "whole_adev"}``);
     ``stationary`` no such change.
+
+    Attributes
+    ----------
+    window_s, step_s : float
+        Window length and step [s].
+    t_s : numpy.ndarray
+        Window centres [s from the first sample].
+    tau_s : numpy.ndarray
+        Averaging times [s].
+    adev, adev_low, adev_high : numpy.ndarray
+        Deviation and its interval, windows × τ [unit] (NaN: window too short for τ).
+    unit : str
+        The data's unit.
+    test_confidence : float
+        Confidence of the change test.
+    changes : tuple of dict
+        The (window, τ) changes described above.
     """
 
     window_s: float
@@ -1392,6 +1451,15 @@ class WhiteStretch:
     the stretch that each lie below its line beyond their intervals (the sensor's own low-pass
     filter shapes the short τ: a sum of noise terms never lies below one of them), 0 when
     none.
+
+    Attributes
+    ----------
+    start, stop : int
+        Index range of the points used.
+    intercept : float
+        c of ``ln σ = c − ½ ln τ``.
+    shaped_stop : int
+        End of the leading points shaped by the sensor's filter (0: none).
     """
 
     start: int

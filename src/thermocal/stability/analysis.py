@@ -257,7 +257,19 @@ def signal_in_data_unit(rec: Recording, name: str) -> tuple[FloatArray, str]:
 class AllanChannel:
     """One channel's overlapping ADEV, its noise terms, (``dynamic_s``) dynamic ADEV and
     the output quantisation found in the samples
-    (:func:`thermocal.stability.noise_model.output_quantization`; None: not quantised)."""
+    (:func:`thermocal.stability.noise_model.output_quantization`; None: not quantised).
+
+    Attributes
+    ----------
+    adev : AllanResult
+        The overlapping Allan deviation.
+    noise : NoiseTerms
+        Its noise terms.
+    dynamic : DynamicAllan or None
+        The dynamic ADEV (when asked).
+    quantization : OutputQuantization or None
+        The output quantisation found (None: not quantised).
+    """
 
     adev: AllanResult
     noise: NoiseTerms
@@ -326,7 +338,17 @@ class AllanChannel:
 class AllanAnalysis:
     """The result of :func:`allan_analysis`: ``channels`` (overlapping ADEV and noise terms,
     the default) or ``family`` (the deviations asked for, or phase data), per channel name
-    in the order asked."""
+    in the order asked.
+
+    Attributes
+    ----------
+    names : tuple of str
+        The channels, in the order asked.
+    channels : dict of str to AllanChannel
+        Overlapping ADEV and noise terms per channel (the default).
+    family : dict of str to StabilityResult
+        The deviations asked for, per channel.
+    """
 
     names: tuple[str, ...]
     channels: dict[str, AllanChannel] = field(default_factory=dict)
@@ -689,7 +711,15 @@ def motion_in(rec: Recording, gyro: Sequence[str], accel: Sequence[str]) -> str 
 
 @dataclass(frozen=True, eq=False)
 class ImuNoise:
-    """The result of :func:`imu_noise`: each axis's terms and the estimator noise model."""
+    """The result of :func:`imu_noise`: each axis's terms and the estimator noise model.
+
+    Attributes
+    ----------
+    axes : tuple of AxisNoise
+        Each axis's terms.
+    model : NoiseModel
+        The estimator noise model.
+    """
 
     axes: tuple[AxisNoise, ...]
     model: NoiseModel

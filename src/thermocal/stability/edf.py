@@ -647,6 +647,17 @@ class NoiseId:
     B1); ``method`` ``"lag1"``, ``"b1"`` or ``"b1-rn"`` (B1 then R(n), :func:`split_pm`)
     (or ``"none"`` when neither could run: α = 0
     assumed); ``d`` differences taken (lag-1 method).
+
+    Attributes
+    ----------
+    alpha : int
+        The power-law exponent α.
+    alpha_float : float
+        The unrounded lag-1 estimate (NaN for B1).
+    method : str
+        ``"lag1"``, ``"b1"``, ``"b1-rn"`` or ``"none"``.
+    d : int
+        Differences taken (lag-1 method).
     """
 
     alpha: int
@@ -743,7 +754,21 @@ def _lag1_linear_detrended(z: FloatArray, *, own: bool = False) -> float:
 @dataclass(frozen=True)
 class LagSums:
     """Sums over a series z of n points, centred (z_c = z − z̄): ``szz`` Σ z_c², ``uz``
-    Σ k z_c,k, ``cross`` Σ z_c,k z_c,k+1, ``first``/``last`` z_c,0 and z_c,n−1."""
+    Σ k z_c,k, ``cross`` Σ z_c,k z_c,k+1, ``first``/``last`` z_c,0 and z_c,n−1.
+
+    Attributes
+    ----------
+    n : int
+        Number of points.
+    szz : float
+        Σ z_c².
+    uz : float
+        Σ k z_c,k.
+    cross : float
+        Σ z_c,k z_c,k+1.
+    first, last : float
+        z_c,0 and z_c,n−1.
+    """
 
     n: int
     szz: float
@@ -798,7 +823,19 @@ class IdRules:
     number of averages); ``b1_min``: the fewest averages B1 reads; ``rate_detrend``: the rate
     averages' line removed before the lag-1 method (else only their mean); ``r1_sample``: r1
     with the sample variance (÷ (n − 1)) under the lag product summed over n − 1 pairs and
-    divided by n, i.e. r1·(n − 1)/n.  Stable32's rules: :data:`STABLE32_B1_MIN_TOTAL`."""
+    divided by n, i.e. r1·(n − 1)/n.  Stable32's rules: :data:`STABLE32_B1_MIN_TOTAL`.
+
+    Attributes
+    ----------
+    b1_n : int or None
+        n of the theoretical B1 (None: the number of averages).
+    b1_min : int
+        Fewest averages B1 reads.
+    rate_detrend : bool
+        Remove the rate averages' line before the lag-1 method.
+    r1_sample : bool
+        r1 as Stable32 computes it (see above).
+    """
 
     b1_n: int | None = None
     b1_min: int = MIN_B1_GROUPS

@@ -114,6 +114,27 @@ class ContinuousTerm:
     does not show the term); ``tau_s`` where the slope line touches the curve (slope), the
     τ of the bounding point (bound), None (fit); ``read_at_tau_s`` where the line is read
     (1 s for white noise, 3 s for random walk); ``quality`` ``good|rough|poor``.
+
+    Attributes
+    ----------
+    value, low, high : float or None
+        The coefficient and its interval [``unit``].
+    unit : str
+        Its SI unit.
+    term : str
+        Which coefficient.
+    method : str
+        ``slope``, ``fit`` or ``bound``.
+    tau_s : float or None
+        Where the line touches the curve or the bounding point [s].
+    read_at_tau_s : float
+        Where the line is read [s].
+    quality : str
+        ``good``, ``rough`` or ``poor``.
+    reason : str or None
+        Why rough or poor.
+    tau_range_s : (float, float) or None
+        The τ range the slope line was fitted on [s].
     """
 
     value: float
@@ -138,6 +159,25 @@ class AxisNoise:
     density, ``walk`` the random-walk strength, both in SI (:data:`SI_UNIT` per √Hz);
     ``quantization`` the output quantisation found in the samples (None: not quantised;
     a rate quantisation's white noise is part of ``density``).
+
+    Attributes
+    ----------
+    name : str
+        The axis (column).
+    sensor : {"gyro", "accel"}
+        Gyroscope or accelerometer.
+    unit : str
+        The data's own unit.
+    allan : AllanResult
+        Its Allan deviation.
+    terms : NoiseTerms
+        Its noise terms.
+    density : ContinuousTerm
+        White-noise density [SI unit/√Hz].
+    walk : ContinuousTerm
+        Random-walk strength [SI unit·√Hz].
+    quantization : OutputQuantization or None
+        The output quantisation found (None: not quantised).
     """
 
     name: str
@@ -156,6 +196,21 @@ class NoiseModel:
 
     ``update_rate_hz`` 1/τ0; ``inflate`` the factor every Kalibr value is multiplied by
     (1: none); ``chosen`` maps a Kalibr key to the axis it came from.
+
+    Attributes
+    ----------
+    axes : tuple of AxisNoise
+        Every axis.
+    update_rate_hz : float
+        1/τ0 [Hz].
+    inflate : float
+        Factor every Kalibr value is multiplied by.
+    rostopic : str
+        The IMU topic written into the Kalibr file.
+    confidence : float
+        Confidence level of the intervals.
+    chosen : dict of str to AxisNoise
+        The axis each Kalibr key came from.
     """
 
     axes: tuple[AxisNoise, ...]
@@ -807,6 +862,31 @@ class OutputQuantization:
     term's variance explained by the quantisation (rate: N_q²/N² with N the slope line's,
     else the fit's; angle: Q²/Q_fit²), None when the
     record shows no such term; ``quality`` ``good`` or ``rough`` with ``reason``.
+
+    Attributes
+    ----------
+    step : float
+        The quantum [``unit``].
+    unit : str
+        The data's own unit.
+    offset : float
+        The lattice's offset [``unit``].
+    levels, n_samples : int
+        Distinct levels used and samples read.
+    kind : str
+        ``"rate"`` or ``"angle"``.
+    white_density, angle_q : float
+        N_q and Q in the noise terms' units.
+    white_density_unit, angle_q_unit : str
+        Those units.
+    share : float or None
+        Fraction of the measured term's variance explained.
+    quality : str
+        ``good`` or ``rough``.
+    reason : str or None
+        Why rough.
+    source : str
+        How the quantisation was found and why its variance is step²/12 (one sentence).
     """
 
     step: float
