@@ -1845,9 +1845,9 @@ MUTANTS: tuple[Mutant, ...] = (
     Mutant(
         "metrics-average-advice-whole-record",
         P + "metrics.py",
-        "{option} {longest_s / 2.0:.3g} or less",
-        "{option} {longest_s:.3g} or less",
-        _t("tempcal_averages", "metrics_averages"),
+        "{name} {longest_s / 2.0:.3g} or less",
+        "{name} {longest_s:.3g} or less",
+        _t("tempcal_averages", "metrics_averages", "metrics_parameter_names"),
         "the advised --average is the whole record (one average), not half",
     ),
     Mutant(

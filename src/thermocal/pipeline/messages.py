@@ -165,12 +165,14 @@ OPTION_OF: dict[str, str] = {
     "start_window_s": "--start-window",
     "select": "--select-method",
     "file_format": "--format",
-    "listen_s": "--listen",
     "averaging_s": "--average",
+    "drift_reference_s": "--drift-reference",
+    "dynamic_s": "--dynamic",
+    "deviations": "--deviation",
+    "listen_s": "--listen",
     "models": "--model",
     "validations": "--validation",
     "labels": "--label",
-    "dynamic_s": "--dynamic",
 }
 """Library parameters whose command-line option is not the parameter's name with dashes
 (``time_unit`` → ``--time-unit`` needs no entry)."""

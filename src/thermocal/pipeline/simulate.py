@@ -1,10 +1,11 @@
-"""Simulated recordings written to files: ``thermocal simulate`` as one library call.
+"""Simulated recordings written to files: the ``simulate`` command as one library call.
 
 :func:`simulate_files` runs a scenario (:func:`thermocal.simulate.simulate_scenario`),
 names its files (:func:`simulation_paths`), refuses outputs over the inputs or on special
 files before and after simulating (:func:`thermocal.outputs.check_outputs`), writes each
 recording (a CSV with its ``.meta.json`` sidecar) and the truth JSON, and returns a
-:class:`SimulatedFiles` whose :meth:`~SimulatedFiles.to_dict` is what ``--json`` prints.
+:class:`SimulatedFiles` whose :meth:`~SimulatedFiles.to_dict` is what the command prints as
+JSON.
 
 Output naming:
 
@@ -139,7 +140,7 @@ class SimulatedFiles:
     truth: Path | None
 
     def to_dict(self) -> dict[str, Any]:
-        """The summary ``thermocal simulate --json`` prints.
+        """The summary the ``simulate`` command prints as JSON.
 
         Returns
         -------
