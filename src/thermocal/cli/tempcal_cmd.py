@@ -12,27 +12,22 @@ from typing import TYPE_CHECKING, Annotated
 
 import typer
 
-from thermocal._lazy import LazyModule
 from thermocal.cli.application import app
 from thermocal.cli.common import (
     AllowMotionOpt,
     AllowNarrowOpt,
     JsonOpt,
     emit,
-    fmt,
     handle_errors,
+    show,
     stdout,
 )
 from thermocal.defaults import overrides_of
+from thermocal.report import firmware_text as _firmware_text
 
 if TYPE_CHECKING:
-    import rich.table as _rich_table
-
     from thermocal.tempcal.ardupilot import ArdupilotTempcalResult
-    from thermocal.tempcal.pipeline import SensorFit
-    from thermocal.tempcal.px4 import OffsetFit, Px4TempcalResult
-else:
-    _rich_table = LazyModule("rich.table")
+    from thermocal.tempcal.px4 import Px4TempcalResult
 
 OutDirOpt = Annotated[Path, typer.Option("-o", "--output", help="Directory to write.")]
 
@@ -64,19 +59,7 @@ def px4_tempcal_cmd(
 
 
 def _print_px4(res: "Px4TempcalResult") -> None:
-    table = _rich_table.Table(title=f"PX4 thermal calibration of {res.log}")
-    for col in ("sensor", "device id", "sweep [°C]", "bins", "hold-out rms x/y/z"):
-        table.add_column(col)
-    rows: list[SensorFit | OffsetFit] = [*res.fits, *res.offset_fits]
-    for f in rows:
-        table.add_row(
-            f"{f.topic}.{f.instance}", str(f.device_id),
-            f"{f.sweep_c[0]:.1f}…{f.sweep_c[1]:.1f}", str(f.n_bins),
-            " / ".join(fmt(v, 3) for v in f.holdout_rms.values()) + f" {f.unit}",
-        )  # fmt: skip
-    stdout.print(table)
-    for n in res.notes:
-        stdout.print(n)
+    show(_firmware_text.px4_tempcal_text(res))
     stdout.print(f"parameters: [bold]{res.params_path}[/bold]", markup=True)
 
 
@@ -103,25 +86,5 @@ def ardupilot_tempcal_cmd(
 
 
 def _print_ardupilot(res: "ArdupilotTempcalResult") -> None:
-    if res.active_found:
-        old_new = _rich_table.Table(title="INS_TCAL coefficients: in the log → new")
-        for col in ("parameter", "old", "new"):
-            old_new.add_column(col)
-        for h in res.hygiene.values():
-            for n, v in h.get("coefficients", {}).items():
-                if v["old"] is not None:
-                    old_new.add_row(n, fmt(v["old"], 6), fmt(v["new"], 6))
-        stdout.print(old_new)
-    table = _rich_table.Table(title=f"ArduPilot thermal calibration of {res.log}")
-    for col in ("IMU", "sensor", "sweep [°C]", "bins", "hold-out rms x/y/z"):
-        table.add_column(col)
-    for f in res.fits:
-        table.add_row(
-            str(f.instance), f.kind, f"{f.sweep_c[0]:.1f}…{f.sweep_c[1]:.1f}",
-            str(f.n_bins),
-            " / ".join(fmt(float(v), 3) for v in f.holdout_rms.values()) + f" {f.unit}",
-        )  # fmt: skip
-    stdout.print(table)
-    for n in res.notes:
-        stdout.print(n)
+    show(_firmware_text.ardupilot_tempcal_text(res))
     stdout.print(f"parameters: [bold]{res.params_path}[/bold]", markup=True)
