@@ -55,10 +55,7 @@ def fleet_cmd(
     Every figure is in its channel's data unit.  Refused (exit 2, nothing written) when an
     output path is, or holds, one of the inputs, or is a special file."""
     cfg = _fleet.load_config(config)
-    if workers is not None and workers < 1:
-        raise ThermocalInputError(f"--workers must be at least 1, got {workers}")
-    if scheduler is not None and workers is not None:
-        raise ThermocalInputError("give --workers or --scheduler, not both")
+    _fleet.check_workers(workers, scheduler)
     _fleet.check_outputs(cfg, output)  # inputs are sacred: before anything is written
     if output.exists() and not output.is_dir():
         raise ThermocalInputError(f"{output}: exists and is not a directory")
@@ -73,39 +70,18 @@ def fleet_cmd(
         res = _fleet.run_fleet(
             cfg, output, workers=n_workers, scheduler=scheduler, force=force, on_unit=on_unit
         )
-    rows = res.rows
-    n_ok = sum(1 for r in rows if r["status"] == "ok")
-    n_failed = sum(1 for r in rows if r["status"] == "failed")
-    n_pass = sum(1 for r in rows if r["status"] == "ok" and r.get("pass") is True)
-    out = {
-        "output": str(output),
-        "units": len(rows),
-        "ok": n_ok,
-        "failed": n_failed,
-        "pending": len(rows) - n_ok - n_failed,
-        "passed": n_pass,
-        "ran": list(res.ran),
-        "skipped": list(res.skipped),
-        "redone": dict(res.redone),
-        "failed_units": {r["id"]: r["error"] for r in rows if r["status"] == "failed"},
-        "summary_csv": str(res.summary_csv),
-        "summary_parquet": str(res.summary_parquet),
-        "report": str(res.html),
-        "interrupted": res.interrupted,
-    }
+    out = res.summary(output)
 
     def human() -> None:
-        stdout.print(
-            f"{len(rows)} units: {n_ok} calibrated ({len(res.ran)} now, {len(res.skipped)} "
-            f"done before), {n_failed} failed, {n_pass} passed"
-        )
-        for uid, why in res.redone.items():
-            stdout.print(f"redone {uid}: {why}", markup=False, highlight=False)
-        stdout.print(f"summary: {res.summary_csv}, {res.summary_parquet}")
-        stdout.print(f"report: {res.html}")
+        lines, n = res.text(), len(res.redone)
+        stdout.print(lines[0])
+        for line in lines[1 : 1 + n]:  # ids and reasons as they are
+            stdout.print(line, markup=False, highlight=False)
+        for line in lines[1 + n :]:
+            stdout.print(line)
 
     emit(out, as_json, human)
     if res.interrupted:
         print(f"error: {res.interrupted}", file=sys.stderr)
-    if n_failed or res.interrupted or out["pending"]:
+    if out["failed"] or res.interrupted or out["pending"]:
         raise typer.Exit(_fleet.EXIT_SOME_FAILED)

@@ -62,7 +62,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Final, TypeVar, cast
 
-from thermocal.errors import ThermocalInputError, ThermocalWarning
+from thermocal.errors import ParameterError, ThermocalInputError, ThermocalWarning
 from thermocal.fleet.config import FleetConfig, Limit, UnitSpec, load_config
 from thermocal.fleet.report import write_fleet_report
 from thermocal.fleet.stats import (
@@ -450,6 +450,90 @@ class FleetResult:
     html: Path
     interrupted: str | None = None
     redone: Mapping[str, str] = field(default_factory=dict)
+
+    def counts(self) -> tuple[int, int, int]:
+        """Units calibrated, failed and passed (calibrated and within every limit).
+
+        Returns
+        -------
+        tuple of int
+            ``(ok, failed, passed)`` over :attr:`rows`; the others are pending.
+        """
+        ok = sum(1 for r in self.rows if r["status"] == "ok")
+        failed = sum(1 for r in self.rows if r["status"] == "failed")
+        passed = sum(1 for r in self.rows if r["status"] == "ok" and r.get("pass") is True)
+        return ok, failed, passed
+
+    def summary(self, output: Path) -> dict[str, Any]:
+        """The batch's outcome as JSON types.
+
+        Parameters
+        ----------
+        output : pathlib.Path
+            The batch's output folder, as given.
+
+        Returns
+        -------
+        dict
+            ``output``, the counts (``units``, ``ok``, ``failed``, ``pending``, ``passed``),
+            the unit ids ``ran`` and ``skipped``, ``redone`` (id → why), ``failed_units``
+            (id → error), the files written and ``interrupted``.
+        """
+        ok, failed, passed = self.counts()
+        rows = self.rows
+        return {
+            "output": str(output),
+            "units": len(rows),
+            "ok": ok,
+            "failed": failed,
+            "pending": len(rows) - ok - failed,
+            "passed": passed,
+            "ran": list(self.ran),
+            "skipped": list(self.skipped),
+            "redone": dict(self.redone),
+            "failed_units": {r["id"]: r["error"] for r in rows if r["status"] == "failed"},
+            "summary_csv": str(self.summary_csv),
+            "summary_parquet": str(self.summary_parquet),
+            "report": str(self.html),
+            "interrupted": self.interrupted,
+        }
+
+    def text(self) -> list[str]:
+        """The batch's outcome in lines: the counts, each unit redone and why, the files.
+
+        Returns
+        -------
+        list of str
+        """
+        ok, failed, passed = self.counts()
+        return [
+            f"{len(self.rows)} units: {ok} calibrated ({len(self.ran)} now, "
+            f"{len(self.skipped)} done before), {failed} failed, {passed} passed",
+            *(f"redone {uid}: {why}" for uid, why in self.redone.items()),
+            f"summary: {self.summary_csv}, {self.summary_parquet}",
+            f"report: {self.html}",
+        ]
+
+
+def check_workers(workers: int | None, scheduler: str | None) -> None:
+    """Refuse a number of local workers below 1, or local workers with a Dask scheduler.
+
+    Parameters
+    ----------
+    workers : int or None
+        Local worker processes asked for (None: the default).
+    scheduler : str or None
+        A Dask scheduler's address (None: local processes).
+
+    Raises
+    ------
+    ParameterError
+        ``workers`` below 1, or both given.
+    """
+    if workers is not None and workers < 1:
+        raise ParameterError("workers", f"{{name}} must be at least 1, got {workers}")
+    if scheduler is not None and workers is not None:
+        raise ParameterError("workers", "give {name} or {scheduler}, not both", ("scheduler",))
 
 
 def unit_dir(out_dir: Path, uid: str) -> Path:
@@ -1402,6 +1486,7 @@ __all__ = [
     "UnitTask",
     "channel_figures",
     "check_outputs",
+    "check_workers",
     "dask_executor",
     "judge",
     "load_config",
