@@ -631,7 +631,7 @@ class ArdupilotTempcalResult:
         return [k for k, h in self.hygiene.items() if h["active_tcal_removed"]]
 
     def to_dict(self) -> dict[str, Any]:
-        """The JSON of ``ardupilot-tempcal --json``."""
+        """The result as a JSON object (what the ``ardupilot-tempcal`` command prints as JSON)."""
         return {
             "log": str(self.log),
             "params": str(self.params_path),
