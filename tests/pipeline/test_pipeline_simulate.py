@@ -3,6 +3,7 @@
 
 from __future__ import annotations
 
+import gzip
 import json
 import shutil
 from pathlib import Path
@@ -86,9 +87,25 @@ def test_a_stem_with_any_registered_csv_suffix_names_several_files(
     assert [Path(f).name for f in printed["files"]] == [
         n.removesuffix(".csv") + ending for n in ref
     ]
-    if ending != ".csv.gz":  # written as plain CSV text whatever the ending
-        for f, n in zip(printed["files"], printed["n_samples"], strict=True):
-            assert read_recording(f).n_samples == n
+    for f, n in zip(printed["files"], printed["n_samples"], strict=True):
+        assert read_recording(f).n_samples == n
+    if ending == ".csv.gz":  # gzip, holding the text -o warm.csv holds
+        for got, name in zip(printed["files"], ref, strict=True):
+            assert Path(got).read_bytes()[:2] == b"\x1f\x8b"
+            assert gzip.decompress(Path(got).read_bytes()) == (tmp_path / "ref" / name).read_bytes()
+
+
+def test_a_csv_gz_that_is_not_gzip_is_refused_in_one_line(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A plain CSV named ``.csv.gz`` (what thermocal wrote before it compressed them)."""
+    bad = tmp_path / "run.csv.gz"
+    bad.write_text("time,gx,T\n0,1,20\n1,2,21\n", encoding="utf-8")
+    assert main(["inspect", str(bad)]) == 2
+    lines = capsys.readouterr().err.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith(
+        f"error: {bad}: named .gz but not a readable gzip"
+    )
 
 
 @pytest.mark.parametrize(
