@@ -723,6 +723,14 @@ MUTANTS: tuple[Mutant, ...] = (
         "ArduPilot coefficients multiplied by 1e-6 instead of divided",
     ),
     Mutant(
+        "params-file-int32-as-float",
+        P + "firmware/formats.py",
+        "shown = str(int(value)) if typ == 6 else repr(float(value))",
+        "shown = str(int(value)) if typ == 9 else repr(float(value))",
+        _t("firmware_formats"),
+        "a parameter file writes int32 parameters as floats (and floats truncated)",
+    ),
+    Mutant(
         "params-ardupilot-tref",
         P + "firmware/formats.py",
         "AP_TREF_C = 35.0",

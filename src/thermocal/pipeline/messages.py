@@ -169,6 +169,8 @@ OPTION_OF: dict[str, str] = {
     "drift_reference_s": "--drift-reference",
     "dynamic_s": "--dynamic",
     "deviations": "--deviation",
+    "sample_interval_s": "--sample-interval",
+    "use_float": "--float",
 }
 """Library parameters whose command-line option is not the parameter's name with dashes
 (``time_unit`` → ``--time-unit`` needs no entry)."""
