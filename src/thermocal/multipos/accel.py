@@ -61,7 +61,27 @@ DISTINCT_DEG: Final = 10.0
 class AccelFit:
     """θ (12: bias [mg], scale factors [ppm], misalignments [″]), its covariance (12×12;
     zero rows for the constrained misalignments), the gravity-magnitude residual rms of the
-    poses before and after [mg], the reduced χ², the method and the number of poses."""
+    poses before and after [mg], the reduced χ², the method and the number of poses.
+
+    Attributes
+    ----------
+    theta : numpy.ndarray, shape (12,)
+        Bias [mg], scale factors [ppm], misalignments [″].
+    cov : numpy.ndarray, shape (12, 12)
+        Its covariance.
+    residual_rms_before_mg, residual_rms_after_mg : float
+        Gravity-magnitude residual rms of the poses [mg].
+    reduced_chi2 : float
+        Reduced χ² [-].
+    method : str
+        How it was fitted.
+    n_poses : int
+        Poses used.
+    residuals_mg : tuple of float
+        Each pose's gravity-magnitude error after calibration [mg].
+    misfit_mg : float
+        Misfit τ added in quadrature to each pose's σ [mg].
+    """
 
     theta: FloatArray
     cov: FloatArray

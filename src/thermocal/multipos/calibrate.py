@@ -153,7 +153,17 @@ def check_gyro_fit(gfit: _gyro.GyroFit, where: str) -> None:
 @dataclass(frozen=True)
 class PoseStats:
     """A static pose: its samples, mean specific force [mg], per-sample white noise σ of
-    each axis [mg] (``var(Δx)/2``), mean rate [rad/s] and rate noise σ [rad/s] (gyro)."""
+    each axis [mg] (``var(Δx)/2``), mean rate [rad/s] and rate noise σ [rad/s] (gyro).
+
+    Attributes
+    ----------
+    section : Section
+        The pose's samples.
+    f_mean_mg, f_sigma_mg : numpy.ndarray, shape (3,)
+        Mean specific force and per-sample white noise σ [mg].
+    w_mean_rad_s, w_sigma_rad_s : numpy.ndarray or None
+        Mean rate and its noise σ [rad/s] (None without a gyro).
+    """
 
     section: Section
     f_mean_mg: FloatArray
@@ -223,7 +233,25 @@ def pose_stats(
 
 @dataclass(frozen=True)
 class SessionResult:
-    """What :func:`calibrate_session` found."""
+    """What :func:`calibrate_session` found.
+
+    Attributes
+    ----------
+    accel : AccelFit
+        The accelerometer triad.
+    gyro : GyroFit or None
+        The gyro triad (None without its columns).
+    poses : tuple of PoseStats
+        The static poses.
+    turns : tuple of Section
+        The named 360° turns.
+    g_mg : float
+        Local gravity [mg].
+    temperature_c : float or None
+        Mean temperature [°C].
+    not_still : tuple of str
+        Poses whose variance is more than twice the quietest's.
+    """
 
     accel: _accel.AccelFit
     gyro: _gyro.GyroFit | None
@@ -650,7 +678,27 @@ def calibrate_session(
 class MultiposValidation:
     """Held-out session figures before (raw) and after compensation: per triad, the rms
     over poses of the gravity-magnitude error [accelerometer unit] or over motions of the
-    rotation-angle error [°] (and its per-axis rms, for the report's table)."""
+    rotation-angle error [°] (and its per-axis rms, for the report's table).
+
+    Attributes
+    ----------
+    triad : str
+        The triad's name.
+    unit : str
+        Unit of the figures.
+    rms_before, rms_after : float
+        Rms error before and after compensation [unit].
+    per_axis_before, per_axis_after : tuple of 3 float
+        Per-axis rms [unit].
+    n : int
+        Poses or motions judged.
+    what : str
+        ``gravity-magnitude error`` or ``rotation-angle error``.
+    outside_range_fraction : float
+        Fraction of samples outside the calibrated temperature range.
+    per_pose, not_judged, input_unit, count_scale, physical_unit
+        As documented on each field.
+    """
 
     triad: str
     unit: str

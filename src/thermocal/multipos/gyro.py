@@ -109,7 +109,19 @@ class Turn:
     """A named 360° turn (module docstring): its ``section``, the sensor axis it is named
     about (``axis`` 0, 1, 2 for ``x_rot``, ``y_rot``, ``z_rot``), the calibrated unit up
     direction during it ``up`` (body axes: the vertical earth rate) and the direction
-    noise ``axis_sigma_rad`` [rad] of the axis across itself."""
+    noise ``axis_sigma_rad`` [rad] of the axis across itself.
+
+    Attributes
+    ----------
+    section : Section
+        The turn's samples.
+    axis : int
+        0, 1, 2 for ``x_rot``, ``y_rot``, ``z_rot``.
+    up : numpy.ndarray, shape (3,)
+        The calibrated unit up direction during it (body axes).
+    axis_sigma_rad : float
+        Direction noise of the axis across itself [rad].
+    """
 
     section: Section
     axis: int
@@ -254,7 +266,25 @@ class GyroFit:
     rms of the motions' gravity-direction residuals before (raw rate, bias removed) and
     after calibration [rad], the reduced χ² and the number of motions and turns used, and
     the turns' axis lean found in the data [rad] (sd per component, 0 when not
-    significant: :func:`_turn_axis_scatter`)."""
+    significant: :func:`_turn_axis_scatter`).
+
+    Attributes
+    ----------
+    theta : numpy.ndarray, shape (12,)
+        Bias [°/h], scale factors [ppm], misalignments [″].
+    cov : numpy.ndarray, shape (12, 12)
+        Its covariance.
+    direction_rms_before_rad, direction_rms_after_rad : float
+        Rms of the motions' gravity-direction residuals [rad].
+    reduced_chi2 : float
+        Reduced χ² [-].
+    n_motions, n_turns : int
+        Motions and turns used.
+    turn_axis_lean_rad : float
+        The turns' axis lean found in the data [rad].
+    model : str
+        ``full`` or ``scale``.
+    """
 
     theta: FloatArray
     cov: FloatArray

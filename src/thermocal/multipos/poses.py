@@ -68,7 +68,17 @@ PERCENTILE: Final = 10.0
 
 @dataclass(frozen=True)
 class Section:
-    """Samples ``start … end − 1`` of a session, named (``pose_3``, ``x_p``, ``z_rot``)."""
+    """Samples ``start … end − 1`` of a session, named (``pose_3``, ``x_p``, ``z_rot``).
+
+    Attributes
+    ----------
+    name : str
+        The section's name.
+    start, end : int
+        Sample indices, ``end`` exclusive.
+    still_ratio : float
+        Mean window variance over the noise floor [-].
+    """
 
     name: str
     start: int
@@ -162,7 +172,25 @@ class _Limit:
 class PoseDetection:
     """What :func:`find_poses` found: the poses, the stretches rejected (too short, moving),
     the window [samples] and sample interval [s], each sensor's noise floor and still limit
-    [its unit²] and the options that set them."""
+    [its unit²] and the options that set them.
+
+    Attributes
+    ----------
+    poses : tuple of Section
+        The poses found.
+    rejected : tuple of Rejected
+        The stretches rejected and why.
+    window : int
+        The variance window [samples].
+    dt_s : float
+        Sample interval [s].
+    accel, gyro : _Limit
+        Each sensor's noise floor and still limit [its unit²] (gyro None without it).
+    threshold, motion_fraction : float
+        The still limit's parameters [-].
+    static_s : float
+        The shortest pose [s].
+    """
 
     poses: tuple[Section, ...]
     rejected: tuple[Rejected, ...]

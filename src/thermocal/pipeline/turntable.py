@@ -209,7 +209,17 @@ def calibrate_run(
 @dataclass(frozen=True)
 class SingleRunResult:
     """One run's calibration (:class:`~thermocal.turntable.calibrate.TurntableResult`), the
-    file it came from and the result JSON written."""
+    file it came from and the result JSON written.
+
+    Attributes
+    ----------
+    input : Path
+        The run.
+    output : Path
+        The result JSON written.
+    result : TurntableResult
+        The calibration.
+    """
 
     input: Path
     output: Path
@@ -258,7 +268,19 @@ def triad_summary(tri: _thermal.TriadThermal) -> dict[str, object]:
 class ThermalRunsResult:
     """Several soak runs' calibration: each run's result, the triads' temperature models
     (``accel`` None without accelerometer columns), the adequacy record of the soaks and the
-    calibration file written."""
+    calibration file written.
+
+    Attributes
+    ----------
+    output : Path
+        The calibration file written.
+    runs : tuple of (Path, TurntableResult)
+        Each soak run.
+    gyro, accel : TriadThermal
+        The triads' temperature models (accel None without its columns).
+    adequacy : dict
+        The adequacy record of the soaks.
+    """
 
     output: Path
     runs: tuple[tuple[Path, TurntableResult], ...]

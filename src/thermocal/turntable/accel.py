@@ -39,7 +39,21 @@ FloatArray = npt.NDArray[np.float64]
 class AccelEstimate:
     """An accelerometer triad's θ (12: bias [mg], scale factor [ppm], misalignment [″]),
     its covariance, the weighted residual rms of the dwell means [mg] and the number of
-    dwells and distinct gravity directions used."""
+    dwells and distinct gravity directions used.
+
+    Attributes
+    ----------
+    theta : numpy.ndarray, shape (12,)
+        Bias [mg], scale factors [ppm], misalignments [″].
+    cov : numpy.ndarray, shape (12, 12)
+        Its covariance.
+    residual_rms_mg : float
+        Weighted residual rms of the dwell means [mg].
+    n_dwells : int
+        Dwells used.
+    condition_number : float
+        Condition number of the scaled design [-].
+    """
 
     theta: FloatArray
     cov: FloatArray

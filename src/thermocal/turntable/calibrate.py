@@ -59,7 +59,15 @@ CONSTRAINTS = (
 
 @dataclass(frozen=True)
 class Estimate:
-    """One estimator's coefficients θ (12, units of :mod:`.model`) and covariance."""
+    """One estimator's coefficients θ (12, units of :mod:`.model`) and covariance.
+
+    Attributes
+    ----------
+    theta : numpy.ndarray, shape (12,)
+        Bias [°/h], scale factors [ppm], misalignments [″].
+    cov : numpy.ndarray, shape (12, 12)
+        Its covariance.
+    """
 
     theta: FloatArray
     cov: FloatArray
@@ -98,7 +106,43 @@ class TurntableResult:
     ``crb`` the Cramér–Rao bound σ of each coefficient for this design and noise (12,
     units of :mod:`.model`), ``agreement`` the largest |θ_KF − θ_LS| / σ_LS,
     ``weak_combinations`` the poorly determined directions found in the design,
-    ``arw_deg_sqrt_h`` the angle random walk of each gyro [°/√h]."""
+    ``arw_deg_sqrt_h`` the angle random walk of each gyro [°/√h].
+
+    Attributes
+    ----------
+    kalman, least_squares : Estimate
+        The reported estimate (the source's filter) and the cross-check.
+    crb : numpy.ndarray, shape (12,)
+        Cramér–Rao bound σ of each coefficient.
+    agreement : float
+        Largest ``|θ_KF − θ_LS| / σ_LS`` [-].
+    latitude_deg : float
+        Latitude used [°].
+    arw_deg_sqrt_h : numpy.ndarray
+        Angle random walk of each axis [°/√h].
+    n_channels, n_states, n_positions, n_dwells : int
+        Channels, filter states, distinct positions and dwells.
+    min_dwell_s, duration_s : float
+        Shortest dwell and run duration [s].
+    chi2_per_dof, normalised_innovation_rms : float
+        Least-squares χ²/dof and the filter's normalised innovation rms [-].
+    weak_combinations : tuple of dict
+        Poorly determined directions of the design.
+    warnings : tuple of str
+        What the run was warned of.
+    encoder_noise_arcsec, encoder_jitter_arcsec : float
+        Encoder noise used and jitter found at rest [″].
+    encoder_noise_source : str
+        ``"option"`` or ``"dwells"``.
+    encoder_quantum_deg : float
+        Reading resolution found [°].
+    accel : AccelEstimate or None
+        The accelerometer triad.
+    gravity_m_s2 : float or None
+        Local gravity used [m/s²].
+    temperature_c, temperature_span_c : float or None
+        Mean temperature and its range over the run [°C].
+    """
 
     kalman: Estimate
     least_squares: Estimate

@@ -169,7 +169,25 @@ class LsEstimate:
 
     ``cov`` is the covariance (known-noise GLS), ``chi2``/``dof`` the whitened
     residual sum of squares and degrees of freedom, ``singular_values`` of the
-    whitened, column-normalised design and ``rank``."""
+    whitened, column-normalised design and ``rank``.
+
+    Attributes
+    ----------
+    theta : numpy.ndarray, shape (12,)
+        The estimate (units of :mod:`.model`).
+    cov : numpy.ndarray, shape (12, 12)
+        Its covariance (known-noise GLS).
+    chi2 : float
+        Whitened residual sum of squares [-].
+    dof : int
+        Degrees of freedom.
+    n_blocks : int
+        Blocks used.
+    singular_values : numpy.ndarray
+        Of the whitened, column-normalised design.
+    rank : int
+        Singular values kept.
+    """
 
     theta: FloatArray
     cov: FloatArray

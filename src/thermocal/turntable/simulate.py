@@ -44,6 +44,15 @@ class TurntableTruth:
     default is a navigation-grade triad whose xy misalignments have an antisymmetric
     part of 20″ (a rotation of the triad about the inner axis relative to the
     encoder zero, ``inner_axis_azimuth_arcsec``).
+
+    Attributes
+    ----------
+    bias_deg_h : tuple of 3 float
+        Biases [°/h].
+    scale_factor_ppm : tuple of 3 float
+        Scale-factor errors [ppm].
+    misalignment_arcsec : tuple of 6 float
+        Misalignments yx, zx, xy, zy, xz, yz [″].
     """
 
     bias_deg_h: tuple[float, float, float] = (0.02, -0.035, 0.015)
