@@ -3349,6 +3349,23 @@ MUTANTS: tuple[Mutant, ...] = (
         AUDIT,
         "simulate multipos --rate-hz 1e12 allocates unchecked: MemoryError, exit 1",
     ),
+    # the triad calibrations' messages: parameters for Python, options on the command line
+    Mutant(
+        "triads-gravity-option-unmapped",
+        P + "pipeline/messages.py",
+        '    "gravity_m_s2": "--gravity",\n',
+        "",
+        ("tests/cli/test_triad_option_names.py",),
+        "multipos names --gravity-m-s2, an option no command has",
+    ),
+    Mutant(
+        "triads-rejection-unspelled",
+        P + "multipos/poses.py",
+        '"reason": r.spelled(spell)}',
+        '"reason": r.spelled()}',
+        ("tests/pipeline/test_multipos_result.py",),
+        "multipos --json's rejected poses name motion_fraction, not --motion-fraction",
+    ),
     # the firmware maths as pure functions (thermocal.firmware)
     Mutant(
         "fw-px4-gyro-relative",

@@ -171,6 +171,9 @@ OPTION_OF: dict[str, str] = {
     "deviations": "--deviation",
     "sample_interval_s": "--sample-interval",
     "use_float": "--float",
+    "gravity_m_s2": "--gravity",
+    "alpha_column": "--alpha",
+    "beta_column": "--beta",
 }
 """Library parameters whose command-line option is not the parameter's name with dashes
 (``time_unit`` → ``--time-unit`` needs no entry)."""
