@@ -121,8 +121,18 @@ class Rejected:
         return self.spelled()
 
     def spelled(self, spell: Callable[[str], str] | None = None) -> str:
-        """Why, with ``spell(parameter)`` for each parameter named (the command line: its
-        option; default the parameter's own name)."""
+        """Why, with ``spell(parameter)`` for each parameter named.
+
+        Parameters
+        ----------
+        spell : callable, optional
+            What to show for a parameter (the command line: its option); default the
+            parameter's own name.
+
+        Returns
+        -------
+        str
+        """
         return spell_parameters(self.template, self.parameters, spell)
 
 
