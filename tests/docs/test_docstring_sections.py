@@ -25,12 +25,9 @@ EXEMPT_BASES = {
 }
 
 PENDING: set[str] = {
-    "export/triad_params.py::TriadFirmware",
-    "export/triad_params.py::TriadParams",
     "inspection.py::ColumnSummary",
     "inspection.py::Inspection",
     "inspection.py::saturated_mask",
-    "multipos/poses.py::PoseDetection.to_dict",
     "pipeline/compensate.py::CalibrationCompensation",
     "pipeline/compensate.py::CompensateFileResult",
     "pipeline/compensate.py::TriadCompensation",

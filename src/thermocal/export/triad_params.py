@@ -67,7 +67,27 @@ class TriadFirmware:
     """One triad as the firmware holds it: ``offset`` [m/s² or rad/s], ``scale`` (the
     diagonal of ``(I + E)⁻¹``; 1 for a gyro, which the firmware does not scale), and what
     is lost: the largest off-diagonal term of ``(I + E)⁻¹`` [″], the largest gyro scale
-    error [ppm] and whether the model depends on temperature."""
+    error [ppm] and whether the model depends on temperature.
+
+    Attributes
+    ----------
+    kind : str
+        ``"accel"`` or ``"gyro"``.
+    offset : (float, float, float)
+        Offset per axis [m/s² or rad/s].
+    scale : (float, float, float)
+        Diagonal of ``(I + E)⁻¹`` (1 for a gyro).
+    misalignment_lost_arcsec : float
+        Largest off-diagonal term of ``(I + E)⁻¹`` the firmware cannot hold [″].
+    scale_lost_ppm : float
+        Largest gyro scale error the firmware cannot hold [ppm].
+    temperature_dependent : bool
+        The model depends on temperature.
+    tref_c : float
+        Temperature at which the values are taken [°C].
+    count_scale : (float, str) or None
+        For a triad calibrated on raw counts: one count is ``value`` ``unit``.
+    """
 
     kind: str
     offset: tuple[float, float, float]
@@ -132,7 +152,21 @@ def triad_firmware(triad: Triad) -> TriadFirmware:
 @dataclass(frozen=True)
 class TriadParams:
     """The parameters of one export (name → value, name → MAVLink type 9 float / 6 int32),
-    the comments written at the top of the file, and each triad as held."""
+    the comments written at the top of the file, and each triad as held.
+
+    Attributes
+    ----------
+    format : str
+        The firmware.
+    params : dict of str to float
+        Parameter name → value.
+    types : dict of str to int
+        Parameter name → MAVLink type (9 float, 6 int32).
+    notes : tuple of str
+        The comments at the top of the file.
+    triads : tuple of TriadFirmware
+        Each triad as the firmware holds it.
+    """
 
     format: str
     params: dict[str, float]

@@ -220,7 +220,19 @@ class PoseDetection:
     ) -> dict[str, Any]:
         """The detection as JSON types; ``*_factor`` multiply a standard deviation into the
         data's unit (variances by its square); ``spell`` writes the parameters a rejection
-        names (:meth:`Rejected.spelled`)."""
+        names (:meth:`Rejected.spelled`).
+
+        Parameters
+        ----------
+        accel_factor, gyro_factor : float
+            Factors from the stored standard deviations into the data's units.
+        spell : callable, optional
+            What to show for a parameter a rejection names (default its own name).
+
+        Returns
+        -------
+        dict
+        """
         out: dict[str, Any] = {
             "window_s": self.window * self.dt_s,
             "still_threshold": self.threshold,
