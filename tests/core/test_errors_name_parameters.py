@@ -63,8 +63,6 @@ PENDING: dict[str, int] = {
     "profiles.py": 5,
     "validation.py": 1,
     # models/export
-    "export/params.py": 16,
-    "firmware/formats.py": 1,
     "models/breakpoints.py": 6,
     "models/calibration.py": 1,
     "models/fitting.py": 2,
@@ -72,32 +70,7 @@ PENDING: dict[str, int] = {
     "models/rundata.py": 2,
     "models/terms.py": 6,
     "models/warmup.py": 3,
-    "tempcal/ardupilot.py": 1,
-    "tempcal/ardupilot_baro.py": 1,
-    "tempcal/compare.py": 2,
-    "tempcal/px4.py": 1,
-    # triads
-    "export/c/triad.py": 3,
-    "export/triad_params.py": 6,
-    "multipos/accel.py": 1,
-    "multipos/calibrate.py": 24,
-    "multipos/gyro.py": 3,
-    "multipos/poses.py": 12,
-    "multipos/simulate.py": 2,
-    "multipos/validate.py": 5,
-    "pipeline/multipos.py": 33,
-    "pipeline/turntable.py": 12,
-    "report/triads.py": 1,
-    "turntable/calibrate.py": 14,
-    "turntable/model.py": 1,
-    "turntable/simulate.py": 1,
-    "turntable/thermal.py": 1,
     # reports, fleet, station, demo, generated files
-    "export/c/__init__.py": 3,
-    "export/c/core.py": 2,
-    "export/c/files.py": 7,
-    "export/c/warmup.py": 2,
-    "export/checks.py": 2,
 }
 
 

@@ -6,9 +6,12 @@ from __future__ import annotations
 
 import math
 
-from thermocal.pipeline.multipos import MultiposResult
 from thermocal.report.text import TextTable
-from thermocal.report.triad_text import gyro_misfit_line, multipos_text, pose_detection_lines
+from thermocal.report.triad_text import (
+    gyro_misfit_line,
+    multipos_summary_text,
+    pose_detection_lines,
+)
 
 
 def _triad(bias: float) -> dict:
@@ -50,8 +53,7 @@ def test_multipos_text_tables_and_summary() -> None:
         "unit": "m/s^2",
         "pose_detection": [],
     }
-    res = MultiposResult(None, summary, "m/s^2")  # type: ignore[arg-type]
-    blocks = multipos_text(res, "cal.json")
+    blocks = multipos_summary_text(summary, "m/s^2", "cal.json")
     table = blocks[0]
     assert isinstance(table, TextTable) and table.title == "accel triad (Tedaldi)"
     assert table.rows[0] == ("bias x", "0.012346", "0.001", "m/s^2")

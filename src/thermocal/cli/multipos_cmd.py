@@ -31,6 +31,7 @@ from thermocal.cli.common import (
     split_names,
 )
 from thermocal.errors import ThermocalInputError, UnitError
+from thermocal.pipeline.messages import option_name
 from thermocal.report import triad_text as _triad_text
 
 if TYPE_CHECKING:
@@ -223,7 +224,8 @@ def multipos_cmd(
         ),
     )  # fmt: skip
     res = _mpf.calibrate_files(files, output, opts, poses)
-    emit(res.to_dict(), as_json, lambda: show(_triad_text.multipos_text(res, output)))
+    emit(res.to_dict(option_name), as_json,
+         lambda: show(_triad_text.multipos_text(res, output, option_name)))  # fmt: skip
 
 
 __all__ = ["multipos_cmd"]

@@ -5,6 +5,7 @@ calibration, as blocks of :mod:`thermocal.report.text` (lines and
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -98,15 +99,41 @@ def pose_detection_lines(out: dict[str, Any]) -> list[str]:
     return lines
 
 
-def multipos_text(res: MultiposResult, output: Path | str) -> list[Block]:
-    """A multi-position calibration: each triad's table at TREF, the lean of the 360° turns,
-    the poses and the gravity-magnitude residual before → after, the runs that scatter
-    beyond their noise, and the pose detector's choice.
+def multipos_text(
+    res: MultiposResult, output: Path | str, spell: Callable[[str], str] | None = None
+) -> list[Block]:
+    """A multi-position calibration as text (:func:`multipos_summary_text` of its
+    dictionary).
 
     Parameters
     ----------
     res : thermocal.pipeline.multipos.MultiposResult
         The calibration (:func:`thermocal.pipeline.multipos.calibrate_files`).
+    output : pathlib.Path or str
+        The calibration file written, named in the summary line.
+    spell : callable, optional
+        How the pose detector's reasons write the parameters they name (default their own
+        names; the command line: its options).
+
+    Returns
+    -------
+    list of str or TextTable
+    """
+    return multipos_summary_text(res.to_dict(spell), res.accel_unit, output)
+
+
+def multipos_summary_text(out: dict[str, Any], a_unit: str, output: Path | str) -> list[Block]:
+    """A multi-position calibration's dictionary as text: each triad's table at TREF, the
+    lean of the 360° turns, the poses and the gravity-magnitude residual before → after, the
+    runs that scatter beyond their noise, and the pose detector's choice.
+
+    Parameters
+    ----------
+    out : dict
+        The calibration as :meth:`thermocal.pipeline.multipos.MultiposResult.to_dict`
+        gives it.
+    a_unit : str
+        The accelerometer's unit.
     output : pathlib.Path or str
         The calibration file written, named in the summary line.
 
@@ -118,7 +145,6 @@ def multipos_text(res: MultiposResult, output: Path | str) -> list[Block]:
     ----------
     Tedaldi et al. (2014), ICRA; Ferraris et al. (1995), *Sensors and Materials* 7(5).
     """
-    out, a_unit = res.to_dict(), res.accel_unit
     blocks: list[Block] = [_triad_table(k, out[k]) for k in ("accel", "gyro") if k in out]
     for run in out["runs"]:
         lean = run.get("gyro", {}).get("turn_axis_lean_deg", 0.0)
@@ -228,6 +254,7 @@ def turntable_thermal_text(res: ThermalRunsResult) -> list[Block]:
 
 __all__ = [
     "gyro_misfit_line",
+    "multipos_summary_text",
     "multipos_text",
     "pose_detection_lines",
     "turntable_text",
