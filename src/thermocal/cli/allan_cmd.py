@@ -11,6 +11,7 @@ import typer
 from thermocal._lazy import LazyModule, prefetch
 from thermocal.cli.application import app
 from thermocal.cli.common import (
+    ConfidenceOpt,
     DecimalOpt,
     DelimiterOpt,
     FileArg,
@@ -121,9 +122,6 @@ TausOpt = Annotated[
     str, typer.Option("--taus", help="Tau set: octave, decade, log, or a list '1,10,100' [s].")
 ]
 PlotOpt = Annotated[Path | None, typer.Option("--plot", help="Write a log-log PNG plot here.")]
-ConfidenceOpt = Annotated[
-    float, typer.Option("--confidence", help="Confidence level of the intervals.")
-]
 HiddenTempsOpt = Annotated[str | None, typer.Option("--temps", hidden=True)]
 DeviationOpt = Annotated[
     str | None,

@@ -223,6 +223,15 @@ TurntableLatitudeOpt = Annotated[
     ),
 ]
 OutOpt = Annotated[Path, typer.Option("-o", "--output", help="Output file.")]
+ConfidenceOpt = Annotated[
+    float, typer.Option("--confidence", help="Confidence level of the intervals.")
+]
+"""``--confidence`` of the commands that give deviations with intervals (allan, noise)."""
+TriadAccelUnitOpt = Annotated[
+    str | None,
+    typer.Option("--accel-unit", help="Accelerometer unit: m/s^2, mg, g (default: file's)."),
+]
+"""``--accel-unit`` of the triad calibrations (multipos, turntable)."""
 
 
 def parse_temp_conversion(text: str) -> units.TemperatureConversion:

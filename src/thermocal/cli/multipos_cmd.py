@@ -24,6 +24,7 @@ from thermocal.cli.common import (
     RateOpt,
     TimeOpt,
     TimeUnitOpt,
+    TriadAccelUnitOpt,
     emit,
     handle_errors,
     read_options,
@@ -83,10 +84,6 @@ MultiposFilesArg = Annotated[
 AccelColsOpt = Annotated[str, typer.Option("--accel", help="Accelerometer x,y,z column names.")]
 GyroColsOpt = Annotated[
     str | None, typer.Option("--gyro", help="Gyro x,y,z column names (also calibrated).")
-]
-AccelUnitOpt = Annotated[
-    str | None,
-    typer.Option("--accel-unit", help="Accelerometer unit: m/s^2, mg, g (default: file's)."),
 ]
 GyroUnitOpt = Annotated[
     str | None,
@@ -181,7 +178,7 @@ def multipos_cmd(
     output: OutOpt,
     accel: AccelColsOpt,
     gyro: GyroColsOpt = None,
-    accel_unit: AccelUnitOpt = None,
+    accel_unit: TriadAccelUnitOpt = None,
     gyro_unit: GyroUnitOpt = None,
     temps: MultiposTempsOpt = None,
     poses: PosesOpt = None,

@@ -10,6 +10,7 @@ import typer
 from thermocal._lazy import LazyModule, prefetch
 from thermocal.cli.application import app
 from thermocal.cli.common import (
+    ConfidenceOpt,
     DecimalOpt,
     DelimiterOpt,
     FileArg,
@@ -80,9 +81,6 @@ InflateOpt = Annotated[
     ),
 ]
 RostopicOpt = Annotated[str, typer.Option("--rostopic", help="Kalibr's rostopic of this IMU.")]
-ConfidenceOpt = Annotated[
-    float, typer.Option("--confidence", help="Confidence level of the intervals.")
-]
 
 
 def _unit_list(gyro_unit: str | None, accel_unit: str | None, n_g: int, n_a: int) -> str | None:

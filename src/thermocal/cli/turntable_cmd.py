@@ -26,6 +26,7 @@ from thermocal.cli.common import (
     TimeOpt,
     TimeUnitOpt,
     TopicOpt,
+    TriadAccelUnitOpt,
     emit,
     handle_errors,
     read_options,
@@ -113,10 +114,6 @@ AccelColsOpt = Annotated[
     str | None,
     typer.Option("--accel", help="Accelerometer x,y,z column names (also calibrated)."),
 ]
-AccelUnitOpt = Annotated[
-    str | None,
-    typer.Option("--accel-unit", help="Accelerometer unit: m/s^2, mg, g (default: file's)."),
-]
 GravityOpt = Annotated[
     float | None,
     typer.Option(
@@ -155,7 +152,7 @@ def turntable_cmd(
     channels: ChannelsOpt = 3,
     temps: SoakTempsOpt = None,
     accel: AccelColsOpt = None,
-    accel_unit: AccelUnitOpt = None,
+    accel_unit: TriadAccelUnitOpt = None,
     gravity: GravityOpt = None,
     order: OrderOpt = None,
     tref: TrefOpt = None,
