@@ -278,7 +278,7 @@ def _prefix_squares(w: FloatArray, lanes: FloatArray) -> tuple[float, float]:
     return float(flat @ flat), float(grid[-1, -1])
 
 
-def modified_sum(x: FloatArray, m: int, n_terms: int, lane: FloatArray | None = None) -> float:
+def modified_sum(x: FloatArray, m: int, n_terms: int) -> float:
     r"""Σ_{j<n_terms} v_j² of MDEV's inner sums v_j = Σ_{i=j}^{j+m−1} (x_{i+2m} − 2x_{i+m} +
     x_i) (NIST SP 1065 eq. 14), with no running sum of the phase itself.
 
@@ -289,8 +289,8 @@ def modified_sum(x: FloatArray, m: int, n_terms: int, lane: FloatArray | None = 
     rounding grows as ε √N relative, not as ε N² |x| / |v| as a running sum of the phase
     does.  At m = 1, v_j is the second difference itself (no running sum): MDEV
     is OADEV to the last digit; at m = 2, 4, 8 the window sums of the second differences
-    are taken by doubling (pairwise, log₂ m adds a term).  ``lane``: x in the layout of
-    :func:`lane_layout`, for m a multiple of :data:`_LANES` (:func:`_lane_modified_sum`).
+    are taken by doubling (pairwise, log₂ m adds a term).  Several m that are multiples of
+    :data:`_LANES` at once: :func:`lane_group_sums`.
 
     Parameters
     ----------
@@ -300,8 +300,6 @@ def modified_sum(x: FloatArray, m: int, n_terms: int, lane: FloatArray | None = 
         Averaging factor [samples].
     n_terms : int
         Number of inner sums v_j.
-    lane : numpy.ndarray, optional
-        ``x`` in lane layout (default none).
 
     Returns
     -------
@@ -325,9 +323,6 @@ def modified_sum(x: FloatArray, m: int, n_terms: int, lane: FloatArray | None = 
     first = x[2 * m : 3 * m] - 2.0 * x[m : 2 * m]
     first += x[:m]
     v = float(np.sum(first))
-    if lane is not None and m % _LANES == 0 and n_terms > _LANE_CHUNK + 1:
-        total, a, v_a = _lane_modified_sum(lane, m, n_terms, v)
-        return total + _modified_tail(x, m, n_terms, a, v_a) - v_a * v_a
     return _modified_tail(x, m, n_terms, 0, v)
 
 
@@ -376,116 +371,150 @@ def _doubling_modified_sum(x: FloatArray, m: int, n_terms: int) -> float:
     return total
 
 
-_LANE_CHUNK: Final = 1 << 18
-"""Terms per block of :func:`_lane_modified_sum` (2 MB buffers: fewer numpy calls a term;
-2¹⁶ and 2¹⁷ measured ≈ 20 % slower on the 10⁷-sample benchmark, 2²⁰ ≈ 30 %)."""
+_LANE_CHUNK: Final = 1 << 17
+"""Terms per block of :func:`_lane_block` (1 MB buffers; 2¹⁶ measured ≈ 15 % slower on the
+10⁷-sample benchmark, 2¹⁸ the same)."""
 
 
-def lane_layout(x: FloatArray) -> FloatArray:
-    """x as a (:data:`_LANES`, ⌈N / L⌉) array: row i, column c holds x_{cL+i} (zero past the
-    end).  A shift of the index by m = kL is a shift of k columns, the same in every row: the
-    third differences of :func:`_lane_modified_sum` come out already laid in lanes.  Copied
-    in blocks of 1024 columns (a transposed copy of the whole is ≈ 5× slower).
+def lane_prefix(x: FloatArray) -> tuple[FloatArray, FloatArray]:
+    r"""The phase in :data:`_LANES` lanes, each column's running sum taken down its rows:
+    ``q[i, c]`` = Σ_{i'≤i} x_{cL+i'} (x taken as zero past its end), and the column totals
+    ``r[c]`` = Σ_i q[i, c].
+
+    Every running sum is over at most L = 16 points, so ``q`` is as small as 16 |x| however
+    long the record.  A shift of the index by m = kL is a shift of k columns, the same in
+    every row: the third difference of ``q`` over k columns is the running sum, down each
+    column, of the third differences t_j of x (:func:`lane_group_sums`).  Built in blocks of
+    4096 columns (a transposed copy of the whole is ≈ 5× slower).
 
     Parameters
     ----------
     x : numpy.ndarray
-        Phase points, shape (N,).
+        Phase points [unit·s], shape (N,).
 
     Returns
     -------
-    numpy.ndarray
-        Array of shape (L, ⌈N / L⌉).
+    tuple of numpy.ndarray
+        ``q`` of shape (L, ⌈N / L⌉) and ``r`` of shape (⌈N / L⌉,) [unit·s].
+
+    Notes
+    -----
+    .. math:: q_{i,c} = \sum_{i'=0}^{i} x_{cL+i'}, \qquad r_c = \sum_{i=0}^{L-1} q_{i,c}
+
+    Examples
+    --------
+    >>> q, r = lane_prefix(np.arange(32.0))
+    >>> q.shape, float(q[1, 0]), float(q[15, 1]), float(r[0])
+    ((16, 2), 1.0, 376.0, 680.0)
     """
     cols = -(-x.size // _LANES)
     full = x.size // _LANES
-    out = np.zeros((_LANES, cols))
+    q = np.zeros((_LANES, cols))
     src = x[: full * _LANES].reshape(full, _LANES)
-    for a in range(0, full, 1024):
-        b = min(a + 1024, full)
-        np.copyto(out[:, a:b], src[a:b].T)
+    for a in range(0, full, 4096):
+        blk = q[:, a : min(a + 4096, full)]
+        np.copyto(blk, src[a : a + blk.shape[1]].T)
+        for i in range(1, _LANES):
+            np.add(blk[i], blk[i - 1], out=blk[i])
     rest = x.size - full * _LANES
     if rest:
-        out[:rest, full] = x[full * _LANES :]
-    return out
-
-
-def _lane_modified_sum(
-    lane: FloatArray, m: int, n_terms: int, v: float
-) -> tuple[float, int, float]:
-    """(Σ_{0≤j≤a} v_j², a, v_a) of :func:`modified_sum` for m a multiple of :data:`_LANES`
-    over whole blocks of :data:`_LANE_CHUNK` terms (a: where they stop), from the phase in
-    :func:`lane_layout` (:func:`_lane_block` per block)."""
-    bufs = _LaneBuffers(m // _LANES)
-    total, a = v * v, 0
-    while a + _LANE_CHUNK <= n_terms - 1:  # t_j for j < n_terms − 1
-        sq, v = _lane_block(lane, m // _LANES, a // _LANES, v, bufs)
-        total += sq
-        a += _LANE_CHUNK
-    return total, a, v
+        q[:rest, full] = x[full * _LANES :]
+        np.cumsum(q[:, full], out=q[:, full])
+    return q, np.ones(_LANES) @ q
 
 
 class _LaneBuffers:
-    """Work arrays of :func:`_lane_block` for column shifts up to ``k``."""
+    """Work arrays of :func:`_lane_block`, nested differences up to a shift of ``k`` columns."""
 
     def __init__(self, k: int) -> None:
         cb = _LANE_CHUNK // _LANES
-        self.nested = 2 * k <= cb
-        self.t = np.empty((_LANES, cb))
-        self.e1 = np.empty((_LANES, cb + 2 * k)) if self.nested else np.empty((_LANES, cb))
-        self.e2 = np.empty((_LANES, cb + k)) if self.nested else self.e1
-        self.ones = np.ones(_LANES)
+        self.p = np.empty((_LANES, cb))
+        self.e1 = np.empty((_LANES, cb + 2 * k))
+        self.e2 = np.empty((_LANES, cb + k))
+        self.off, self.d, self.h = np.empty(cb), np.empty(cb), np.empty(cb)
+
+
+def _nested(k: int) -> bool:
+    """Whether :func:`_lane_block` forms a shift of k columns as differences of differences
+    (three subtractions over the block and 2k columns beyond it) or from the four taps."""
+    return 4 * k <= _LANE_CHUNK // _LANES
 
 
 def _lane_block(
-    lane: FloatArray, k: int, s: int, v: float, bufs: _LaneBuffers
+    q: FloatArray, r: FloatArray, k: int, s: int, v: float, bufs: _LaneBuffers
 ) -> tuple[float, float]:
     """(Σ v_j², v_{a+B}) over j = a + 1 … a + B (a = s L, B = :data:`_LANE_CHUNK`) given
-    v = v_a, m = kL: the third differences t_{a+cL+i} at [i, c] (column shifts of k), summed
-    down the rows (each column a run of L consecutive t), the columns' totals summed along
-    and added with v_a: v_{a+cL+i+1} = off_c + t[i, c]."""
+    v = v_a, m = kL, from :func:`lane_prefix`'s q and r: p = the third difference of q over
+    k columns holds at [i, c] the running sum t_{a+cL} + … + t_{a+cL+i}; the columns' totals
+    (row L − 1) summed along and added to v_a give the offsets: v_{a+cL+i+1} = off_c + p[i, c]."""
     cb = _LANE_CHUNK // _LANES
-    t, e1 = bufs.t, bufs.e1
-    if 2 * k <= cb:
-        e1, e2 = e1[:, : cb + 2 * k], bufs.e2[:, : cb + k]
-        np.subtract(lane[:, s + k : s + cb + 3 * k], lane[:, s : s + cb + 2 * k], out=e1)
+    p = bufs.p
+    if _nested(k):
+        e1, e2 = bufs.e1[:, : cb + 2 * k], bufs.e2[:, : cb + k]
+        np.subtract(q[:, s + k : s + cb + 3 * k], q[:, s : s + cb + 2 * k], out=e1)
         np.subtract(e1[:, k:], e1[:, : cb + k], out=e2)
-        np.subtract(e2[:, k:], e2[:, :cb], out=t)
+        np.subtract(e2[:, k:], e2[:, :cb], out=p)
     else:
-        np.subtract(lane[:, s + 3 * k : s + cb + 3 * k], lane[:, s : s + cb], out=t)
-        np.subtract(lane[:, s + k : s + cb + k], lane[:, s + 2 * k : s + cb + 2 * k], out=e1)
+        e1 = bufs.e1[:, :cb]
+        np.subtract(q[:, s + 3 * k : s + cb + 3 * k], q[:, s : s + cb], out=p)
+        np.subtract(q[:, s + k : s + cb + k], q[:, s + 2 * k : s + cb + 2 * k], out=e1)
         e1 *= 3.0
-        t += e1
-    for i in range(1, _LANES):
-        np.add(t[i], t[i - 1], out=t[i])
-    off = np.cumsum(t[-1])  # v_{a+(c+1)L} − v_a
+        p += e1
+    off = bufs.off
+    np.cumsum(p[-1], out=off)  # v_{a+(c+1)L} − v_a
     v_next = v + float(off[-1])
     off[1:] = off[:-1]
     off[0] = 0.0
-    off += v  # v_j = off_c + t[i, c]: Σ v² = Σ t² + 2 Σ_c off_c Σ_i t[i, c] + L Σ off²
-    flat = t.reshape(-1)
-    sq = float(flat @ flat) + 2.0 * float(bufs.ones @ (t @ off)) + _LANES * float(off @ off)
+    off += v  # v_j = off_c + p[i, c]: Σ v² = Σ p² + 2 Σ_c off_c Σ_i p[i, c] + L Σ off²
+    d, h = bufs.d, bufs.h  # Σ_i p[i, c]: the same third difference of r
+    np.subtract(r[s + 3 * k : s + cb + 3 * k], r[s : s + cb], out=d)
+    np.subtract(r[s + k : s + cb + k], r[s + 2 * k : s + cb + 2 * k], out=h)
+    h *= 3.0
+    d += h
+    flat = p.reshape(-1)
+    sq = float(flat @ flat) + 2.0 * float(d @ off) + _LANES * float(off @ off)
     return sq, v_next
 
 
-def lane_group_sums(x: FloatArray, lane: FloatArray, ms: list[int]) -> list[float]:
-    """:func:`modified_sum` for several m (multiples of :data:`_LANES`, m/L ≤ half a block,
-    N − 3m > :data:`_LANE_CHUNK`) in ONE pass over the lane layout: each block of phase is
+def lane_group_sums(x: FloatArray, q: FloatArray, r: FloatArray, ms: list[int]) -> list[float]:
+    r""":func:`modified_sum` for several m (multiples of :data:`_LANES`, N − 3m >
+    :data:`_LANE_CHUNK`) in ONE pass over :func:`lane_prefix`'s layout: each block of it is
     read from memory once for all of them (the sums are bound by memory, not arithmetic).
+
+    Whole blocks of :data:`_LANE_CHUNK` terms come from the lanes (:func:`_lane_block`), the
+    rest from the phase (the same running sum of third differences, :func:`modified_sum`).
 
     Parameters
     ----------
     x : numpy.ndarray
         Phase points [unit·s].
-    lane : numpy.ndarray
-        ``x`` in lane layout.
+    q, r : numpy.ndarray
+        ``x`` through :func:`lane_prefix`.
     ms : list of int
         Averaging factors [samples].
 
     Returns
     -------
     list of float
-        :func:`modified_sum` for each factor [(unit·s)²].
+        Σ_j v_j² for each factor [(unit·s)²].
+
+    Notes
+    -----
+    With t_j = x_{j+3m} − 3x_{j+2m} + 3x_{j+m} − x_j and m = kL, the third difference of q
+    over k columns is a running sum of L consecutive t:
+
+    .. math:: q_{i,c+3k} - 3q_{i,c+2k} + 3q_{i,c+k} - q_{i,c} = \sum_{i'=0}^{i} t_{cL+i'}
+
+    References
+    ----------
+    - NIST SP 1065 (Riley 2008), eq. 14 (modified Allan variance).
+
+    Examples
+    --------
+    >>> x = np.cumsum(np.random.default_rng(0).standard_normal(140_000))
+    >>> q, r = lane_prefix(x)
+    >>> [f"{s / modified_sum(x, 16, x.size - 47):.12f}" for s in lane_group_sums(x, q, r, [16])]
+    ['1.000000000000']
     """
     n = x.size
     ks = [mm // _LANES for mm in ms]
@@ -496,12 +525,12 @@ def lane_group_sums(x: FloatArray, lane: FloatArray, ms: list[int]) -> list[floa
         first += x[:mm]
         vs.append(float(np.sum(first)))
         totals.append(vs[-1] * vs[-1])
-    bufs = _LaneBuffers(max(ks))
+    bufs = _LaneBuffers(max([k for k in ks if _nested(k)], default=0))
     ends = [(nt - 1) // _LANE_CHUNK * _LANE_CHUNK for nt in n_terms]
     for a in range(0, max(ends), _LANE_CHUNK):
         for i, k in enumerate(ks):
             if a < ends[i]:
-                sq, vs[i] = _lane_block(lane, k, a // _LANES, vs[i], bufs)
+                sq, vs[i] = _lane_block(q, r, k, a // _LANES, vs[i], bufs)
                 totals[i] += sq
     return [
         tot + _modified_tail(x, mm, nt, e, v) - v * v
@@ -514,12 +543,11 @@ def difference_sums(
     m: IntArray,
     taps: tuple[tuple[int, float], ...],
     nested: bool = False,
-    kernel: Callable[[FloatArray, int, int], float] | None = None,
 ) -> FloatArray:
     """:func:`_difference_sum` for each factor m: ``base(m)`` gives (array, offset unit,
     term count) — the phase with m itself, or a decimated phase with 1 — shared between
     :data:`_WORKERS` threads (numpy releases the GIL in its loops; BLAS held to one thread
-    meanwhile).  ``kernel(array, step, n_terms)``: another sum than ``taps``' (MDEV's).
+    meanwhile).
 
     Parameters
     ----------
@@ -531,8 +559,6 @@ def difference_sums(
         Offsets and weights of the difference.
     nested : bool, optional
         Whether the sum is nested (default False).
-    kernel : callable, optional
-        Other sum than the taps' (default none).
 
     Returns
     -------
@@ -542,8 +568,6 @@ def difference_sums(
 
     def one(mm: int) -> float:
         arr, step, n_terms = base(mm)
-        if kernel is not None:
-            return kernel(arr, step, n_terms)
         return _difference_sum(arr, step, n_terms, taps, nested)
 
     ms = [int(v) for v in m.tolist()]
@@ -602,30 +626,28 @@ _OVERLAPPING: Final = {"oadev": (2, SECOND), "ohdev": (3, THIRD), "tierms": (1, 
 
 
 def _modified_sums(x: FloatArray, m: IntArray) -> FloatArray:
-    """:func:`modified_sum` per m: the m of :func:`lane_group_sums` in two groups (one per
-    thread, each one pass over the phase), the lane layout made by a pool thread first (first
-    in the queue: a sum waiting on it never blocks it), the other m by :func:`difference_sums`."""
+    """:func:`modified_sum` per m: the m of :func:`lane_group_sums` in two groups of about
+    equal work (one pass over the lanes each), the lanes made first by a pool thread while
+    the other takes the small m, which are queued before the groups (a group waiting on the
+    lanes never holds a thread the small m could use)."""
     n = x.size
-    lanes = (m % _LANES == 0) & (n - 3 * m > _LANE_CHUNK)
-    grouped = lanes & (2 * (m // _LANES) <= _LANE_CHUNK // _LANES)
+    grouped = (m % _LANES == 0) & (n - 3 * m > _LANE_CHUNK)
     out = np.zeros(m.size)
+    ex = _pool()
     with threadpool_limits(limits=1, user_api="blas"):
-        lane = _pool().submit(lane_layout, x) if np.any(lanes) else None
+        lanes = ex.submit(lane_prefix, x) if np.any(grouped) else None
+        rest = [(i, ex.submit(modified_sum, x, int(m[i]), n - 3 * int(m[i]) + 1))
+                for i in np.flatnonzero(~grouped).tolist()]  # fmt: skip
         idx = np.flatnonzero(grouped)
         jobs = [
-            (part, _pool().submit(lambda g: lane_group_sums(x, lane.result(), g), m[part].tolist()))
+            (part, ex.submit(lambda g: lane_group_sums(x, *lanes.result(), g), m[part].tolist()))
             for part in (idx[0::2], idx[1::2])
-            if part.size and lane is not None
+            if part.size and lanes is not None
         ]
-
-        def mod(arr: FloatArray, step: int, n_terms: int) -> float:
-            ready = lane.result() if lane is not None and step % _LANES == 0 else None
-            return modified_sum(arr, step, n_terms, ready)
-
-        rest = np.flatnonzero(~grouped)
-        out[rest] = difference_sums(lambda mm: (x, mm, n - 3 * mm + 1), m[rest], THIRD, kernel=mod)
-        for part, job in jobs:
-            out[part] = job.result()
+        for i, job in rest:
+            out[i] = job.result()
+        for part, gjob in jobs:
+            out[part] = gjob.result()
     return out
 
 
