@@ -65,13 +65,6 @@ PENDING: dict[str, int] = {
     # models/export
     "export/params.py": 16,
     "firmware/formats.py": 1,
-    "models/breakpoints.py": 6,
-    "models/calibration.py": 1,
-    "models/fitting.py": 2,
-    "models/poly_fit.py": 4,
-    "models/rundata.py": 2,
-    "models/terms.py": 6,
-    "models/warmup.py": 3,
     "tempcal/ardupilot.py": 1,
     "tempcal/ardupilot_baro.py": 1,
     "tempcal/compare.py": 2,

@@ -224,12 +224,13 @@ class Triad:
                 f"--{self.model.kind}-scale VALUE,UNIT"
             )
         elif units.canonical_unit(data_unit) != units.canonical_unit(self.unit):
-            raise UnitError(
+            raise UnitError.naming(
                 f"{where}: the {self.name} triad was calibrated on "
                 f"{'raw counts of ' if self.count_scale is not None else ''}{self.unit} data; "
                 f"its columns {', '.join(map(repr, self.columns))} are read in {data_unit} "
-                "(give --signal-unit one unit per triad column, in the calibration's order, "
-                "or leave it out to take the file's or the calibration's)"
+                "(give {signal_unit} one unit per triad column, in the calibration's order, "
+                "or leave it out to take the file's or the calibration's)",
+                "signal_unit",
             )
         bias_unit = "deg/h" if self.model.kind == "gyro" else "mg"
         to_data = float(units.convert(np.array([1.0]), bias_unit, out_unit)[0])

@@ -193,14 +193,17 @@ def _warn_short_rates(head: PolyBase, rl: list[RunData], n_total: int) -> None:
     n_short = sum(c for c, _ in shares)
     if n_short > SHORT_RATE_WARN_SHARE * n_total:
         warnings.warn(
-            f"poly: {n_short / n_total:.0%} of the samples have a temperature rate taken "
-            f"over less than half the rate interval ({head.rate_interval_s:g} s): the "
-            f"record breaks into {sum(g for _, g in shares)} contiguous segment(s) at "
-            "its gaps (bursts or dropouts), and a rate over a fraction of a second is "
-            "temperature noise; the rate terms and the fitted rate range rest on it. "
-            "Fit a plain polynomial (--order N), average the record to one block per "
-            "burst, or choose --rate-interval shorter than the segments",
-            ConditioningWarning,
+            ConditioningWarning.naming(
+                f"poly: {n_short / n_total:.0%} of the samples have a temperature rate taken "
+                f"over less than half the rate interval ({head.rate_interval_s:g} s): the "
+                f"record breaks into {sum(g for _, g in shares)} contiguous segment(s) at "
+                "its gaps (bursts or dropouts), and a rate over a fraction of a second is "
+                "temperature noise; the rate terms and the fitted rate range rest on it. "
+                "Fit a plain polynomial ({order} N), average the record to one block per "
+                "burst, or choose {rate_interval_s} shorter than the segments",
+                "order",
+                "rate_interval_s",
+            ),
             stacklevel=4,
         )
 
@@ -353,10 +356,12 @@ def _finish_channel(
     cov = corr.tau * (L @ sol.cov @ L.T)
     if sol.condition_number > COND_WARN:
         warnings.warn(
-            f"poly: ill-conditioned design (condition number {sol.condition_number:.3g}); "
-            f"{sol.n_truncated} singular value(s) truncated at rcond={mdl.rcond}; "
-            "consider fewer terms, --select or --ridge",
-            ConditioningWarning,
+            ConditioningWarning.naming(
+                f"poly: ill-conditioned design (condition number {sol.condition_number:.3g}); "
+                f"{sol.n_truncated} singular value(s) truncated at rcond={mdl.rcond}; "
+                "consider fewer terms, stepwise term selection or {ridge}",
+                "ridge",
+            ),
             stacklevel=4,
         )
     tss = s2_ - s1_ * s1_ / n_s

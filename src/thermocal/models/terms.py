@@ -19,12 +19,12 @@ Three parts, all pure numpy/scipy:
    Ṫ³, TṪ, (TṪ)², (TṪ)³ and 1 (each base variable is an affine map of the raw
    one), but the design is far better conditioned.  In general the span of a
    term list is the span of its centred monomials; for hierarchical lists
-   (every lower power present, as in ``seed000`` and ``--order N``) it equals
+   (every lower power present, as in ``seed000`` and ``order=N``) it equals
    the span of the raw monomials.
 
-   Term text (``--terms``): factors joined by ``*``, each ``T<k>``, ``dT<k>``
+   Term text (``terms``): factors joined by ``*``, each ``T<k>``, ``dT<k>``
    or a parenthesised product, with an optional ``^p``; ``k`` is the 1-based
-   position of the sensor in the temperature list (``--temps``).  A raw
+   position of the sensor in the temperature list (``temperatures``).  A raw
    monomial ``T^p Ṫ^q`` is stored as ``c = min(p, q)``, ``a = p − c``,
    ``b = q − c``: ``T1*dT1`` is the coupling base variable w₁, ``(T1*dT1)^2``
    is w₁², ``T1^2*dT1`` is u₁·w₁.  A constant is always part of the model.
@@ -346,9 +346,10 @@ def _parse_monomial(text: str, whole: str) -> dict[tuple[int, str], int]:
             if a is None:
                 if f in ("1", "const") and power == 1:
                     continue
-                raise ThermocalInputError(
-                    f"cannot read term {whole!r}: factor {f!r} is not T<k> or dT<k> "
-                    "(k = position in --temps, from 1)"
+                raise ThermocalInputError.naming(
+                    f"cannot read term {whole!r}: factor {f!r} is not "
+                    "T<k> or dT<k> (k = position in {temperatures}, from 1)",
+                    "temperatures",
                 )
             sensor = int(a.group(2)) - 1
             if sensor < 0:
@@ -410,7 +411,7 @@ def parse_term(text: str, n_sensors: int) -> Term | None:
 def parse_terms(
     spec: str | Sequence[str] | None, n_sensors: int, order: int | None = None
 ) -> list[Term]:
-    """Term list from a ``--terms`` value, or a plain polynomial from ``order``.
+    """Term list from a ``terms`` value (text or list), or a plain polynomial from ``order``.
 
     Parameters
     ----------
@@ -440,7 +441,9 @@ def parse_terms(
         raise ThermocalInputError("the polynomial model needs at least one temperature column")
     if order is not None:
         if spec not in (None, "seed000"):
-            raise ThermocalInputError("give either an explicit term list or --order, not both")
+            raise ThermocalInputError.naming(
+                "give either an explicit term list or {order}, not both", "order"
+            )
         return polynomial_terms(n_sensors, int(order))
     if spec is None or (isinstance(spec, str) and spec.strip() == "seed000"):
         return seed000_terms(n_sensors)

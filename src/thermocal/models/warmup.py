@@ -359,10 +359,11 @@ class WarmupModel(TemperatureModel):
         srt = np.sort(t0_arr)
         n_distinct = 1 + int(np.count_nonzero(np.diff(srt) >= DISTINCT_T0_C))
         if n_distinct < kt + 1:
-            raise DesignError(
+            raise DesignError.naming(
                 f"warmup: t0_order={kt} needs runs at ≥ {kt + 1} distinct start temperatures "
                 f"(≥ {DISTINCT_T0_C:g} °C apart); got {n_distinct} "
-                f"({', '.join(f'{v:.2f}' for v in srt)} °C); add runs or lower --t0-order"
+                f"({', '.join(f'{v:.2f}' for v in srt)} °C); add runs or lower {{t0_order}}",
+                "t0_order",
             )
         return n_distinct
 
@@ -397,9 +398,10 @@ class WarmupModel(TemperatureModel):
         vmat = v[:, None] ** np.arange(n_k)[None, :]
         res2 = lstsq_svd(vmat, a_runs)
         if res2.rank < n_k:
-            raise DesignError(
+            raise DesignError.naming(
                 f"warmup: the start temperatures cannot determine T0 terms up to "
-                f"T0^{kt}; lower --t0-order"
+                f"T0^{kt}; lower {{t0_order}}",
+                "t0_order",
             )
         cond = max(cond, res2.condition_number)
         c_scaled = res2.coef.T  # (n_j, n_k)
@@ -460,9 +462,10 @@ class WarmupModel(TemperatureModel):
             vmat = v[:, None] ** np.arange(n_k)[None, :]
             res0 = lstsq_svd(vmat, res.coef[:n_r])
             if res0.rank < n_k:
-                raise DesignError(
+                raise DesignError.naming(
                     f"warmup: the start temperatures cannot determine T0 terms up to "
-                    f"T0^{kt}; lower --t0-order"
+                    f"T0^{kt}; lower {{t0_order}}",
+                    "t0_order",
                 )
             cond = max(cond, res0.condition_number)
             c_scaled = np.vstack([res0.coef[None, :], res.coef[n_r:].reshape(-1, n_k)])
