@@ -324,7 +324,7 @@ def test_predict_equals_literal_eq1_and_stream_bit_for_bit(terms):
 
 
 def test_predict_does_not_depend_on_the_block_size(monkeypatch):
-    from thermocal.models import poly
+    from thermocal.models import poly_eval
 
     run, _ = make_run(n=5000, gap=True, noise=0.01)
     m = PolyModel(terms=MIXED_TERMS).fit([run])
@@ -332,7 +332,7 @@ def test_predict_does_not_depend_on_the_block_size(monkeypatch):
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", ExtrapolationWarning)
         whole = m.predict(data)
-        monkeypatch.setattr(poly, "PREDICT_BLOCK_ROWS", 97)
+        monkeypatch.setattr(poly_eval, "PREDICT_BLOCK_ROWS", 97)
         small = m.predict(data)
     assert_array_equal(small, whole)
 

@@ -132,7 +132,7 @@ class PiecewiseModel(TemperatureModel):
         intersections) or ``"continuous"`` (hinge-basis least squares).
     temperature : name or 0-based index of the temperature column (default the first).
     per_run_offset : per-run offsets as nuisance parameters; None (default) when the runs
-        overlap in temperature (:func:`thermocal.models.poly.decide_run_offsets`).
+        overlap in temperature (:func:`thermocal.models.fitting.decide_run_offsets`).
 
     Notes
     -----

@@ -52,6 +52,7 @@ if TYPE_CHECKING:
     import thermocal.models.base as _base
     import thermocal.models.calibration as _calibration
     import thermocal.models.poly as _poly
+    import thermocal.models.poly_fit as _poly_fit
     import thermocal.models.registry as _registry
     import thermocal.models.results as _results
     import thermocal.models.rundata as _rundata
@@ -70,6 +71,7 @@ else:
     _calibration = LazyModule("thermocal.models.calibration")
     _files = LazyModule("thermocal.pipeline.model_file")
     _poly = LazyModule("thermocal.models.poly")
+    _poly_fit = LazyModule("thermocal.models.poly_fit")
     _gravity = LazyModule("thermocal.gravity")
     _recording = LazyModule("thermocal.recording")
 
@@ -309,14 +311,16 @@ def _fit_channels(
 ) -> list[tuple[str, _base.TemperatureModel, dict[str, Any], int]]:
     """Fit every channel on the loaded runs (each file read once, by the caller).  Channels
     of the ``poly`` family with the same temperature inputs share one design
-    (:func:`thermocal.models.poly.fit_shared`: Ṫ, features and the design's reduction once;
+    (:func:`thermocal.models.poly_fit.fit_shared`: Ṫ, features and the design's reduction once;
     every model equal, bit for bit, to its own fit)."""
     preps = [_prepare_channel(spec, loaded, sig) for sig in signals]
     if spec.family == "poly" and len(preps) > 1:
         _share_inputs(preps)
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")
-            _poly.fit_shared([cast(_poly.PolyModel, p.est) for p in preps], [p.runs for p in preps])
+            _poly_fit.fit_shared(
+                [cast(_poly.PolyModel, p.est) for p in preps], [p.runs for p in preps]
+            )
         for p in preps:
             p.caught.extend(caught)
     else:
