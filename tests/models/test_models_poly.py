@@ -14,17 +14,15 @@ from thermocal import simulate
 from thermocal.errors import DesignError, ExtrapolationWarning, ThermocalInputError
 from thermocal.models import RunData, get_model_class
 from thermocal.models.poly import PolyModel
-from thermocal.models.terms import (
-    Term,
-    backward_partners,
-    gap_free_slices,
-    parse_terms,
-    seed000_terms,
-    temperature_rates,
-    term_features,
-)
+from thermocal.models.terms import Term, parse_terms, seed000_terms, term_features
 from thermocal.pipeline.model_file import load_model, save_model
-from thermocal.preprocess import block_average, temperature_rate
+from thermocal.preprocess import (
+    backward_partners,
+    block_average,
+    gap_free_slices,
+    temperature_rate,
+    temperature_rates,
+)
 from thermocal.recording import contiguous_slices
 
 NAMES = ("T1", "T2", "T3", "T4")

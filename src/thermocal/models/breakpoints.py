@@ -22,7 +22,7 @@ from thermocal.errors import (
     DesignError,
     ThermocalInputError,
 )
-from thermocal.models.terms import LstsqSolution
+from thermocal.models.lstsq import LstsqSolution
 from thermocal.recording import FloatArray
 
 if TYPE_CHECKING:

@@ -15,9 +15,7 @@ from thermocal.errors import ConditioningWarning, ExtrapolationWarning, Thermoca
 from thermocal.models.base import TemperatureModel
 from thermocal.models.results import FitStats
 from thermocal.models.rundata import RunData
-from thermocal.models.terms import (
-    CHUNK_ROWS,
-)
+from thermocal.models.terms import CHUNK_ROWS
 from thermocal.recording import FloatArray, contiguous_slices
 
 HOLDOUT_BLOCKS = 10

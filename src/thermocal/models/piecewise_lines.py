@@ -25,8 +25,9 @@ from thermocal.models.breakpoints import (
     choose_breakpoints,
     segment_index,
 )
+from thermocal.models.lstsq import Chunk, accumulate_r, solve_r
 from thermocal.models.rundata import RunData
-from thermocal.models.terms import CHUNK_ROWS, Chunk, accumulate_r, solve_r
+from thermocal.models.terms import CHUNK_ROWS
 from thermocal.recording import FloatArray
 
 

@@ -54,7 +54,7 @@ the constant when every ``|c| ≤ s``. Mathematically the same model as eq. (1);
 it differs from the literal sum of the scaled terms by rounding only (~1e-16 relative).
 ``predict`` works in cache-sized blocks of
 :data:`~thermocal.models.poly_eval.PREDICT_BLOCK_ROWS` samples, with Ṫ's partner samples
-found per block by :func:`~thermocal.models.terms.backward_partners` (a slice on regular
+found per block by :func:`~thermocal.preprocess.backward_partners` (a slice on regular
 sampling).
 
 Model-file ``state`` layout (``"layout": "thermocal-poly-1"``), for the C export::
@@ -121,13 +121,7 @@ from thermocal.models.poly_stream import PolyStream
 from thermocal.models.poly_types import PolyBase
 from thermocal.models.results import Coefficient
 from thermocal.models.rundata import RunData
-from thermocal.models.terms import (
-    BaseScaling,
-    Term,
-    monomial_name,
-    parse_terms,
-    raw_expansion,
-)
+from thermocal.models.terms import BaseScaling, Term, monomial_name, parse_terms, raw_expansion
 from thermocal.recording import GAP_FACTOR, FloatArray
 
 MAX_TERM_POWER = 32
@@ -273,7 +267,7 @@ class PolyModel(PolyBase):
         """Temperature-induced signal of every sample [signal unit] (module docstring steps 1–4).
 
         Evaluated in blocks of :data:`~thermocal.models.poly_eval.PREDICT_BLOCK_ROWS` rows
-        (Ṫ partners found per block by :func:`~thermocal.models.terms.backward_partners`;
+        (Ṫ partners found per block by :func:`~thermocal.preprocess.backward_partners`;
         Horner's rule per sensor, :class:`~thermocal.models.poly_types.EvalPlan`); the same
         numbers as :class:`~thermocal.models.poly_stream.PolyStream`.
 
