@@ -121,7 +121,8 @@ from thermocal.models.poly_stream import PolyStream
 from thermocal.models.poly_types import PolyBase
 from thermocal.models.results import Coefficient
 from thermocal.models.rundata import RunData
-from thermocal.models.terms import BaseScaling, Term, monomial_name, parse_terms, raw_expansion
+from thermocal.models.term_scaling import BaseScaling, monomial_name, raw_expansion
+from thermocal.models.terms import Term, parse_terms
 from thermocal.recording import GAP_FACTOR, FloatArray
 
 MAX_TERM_POWER = 32

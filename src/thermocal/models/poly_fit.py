@@ -35,7 +35,8 @@ from thermocal.models.poly_types import PolyBase
 from thermocal.models.residuals import MAX_SAMPLES_PER_SERIES, residual_correlation
 from thermocal.models.results import FitStats
 from thermocal.models.rundata import RunData
-from thermocal.models.terms import BaseScaling, Term, fit_base_scaling, parse_terms, term_features
+from thermocal.models.term_scaling import BaseScaling, fit_base_scaling
+from thermocal.models.terms import Term, parse_terms, term_features
 from thermocal.preprocess import segment_rates
 from thermocal.recording import FloatArray
 

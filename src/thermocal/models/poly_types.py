@@ -20,7 +20,8 @@ from thermocal.errors import ThermocalInputError
 from thermocal.models.base import TemperatureModel
 from thermocal.models.fitting import Block
 from thermocal.models.rundata import RunData
-from thermocal.models.terms import BaseScaling, Term
+from thermocal.models.term_scaling import BaseScaling
+from thermocal.models.terms import Term
 from thermocal.preprocess import RATE_METHODS, segment_rates, temperature_rates
 from thermocal.recording import FloatArray
 
