@@ -307,19 +307,10 @@ class BankModel(TemperatureModel):
         n_res = 0
         for g in groups:
             entry, values, se, cond_g, rss_g = fit_group(
-                g,
-                one,
-                temps,
-                ys,
-                labels,
-                knots,
-                curves,
-                curve_t,
-                error_metric=self.error_metric,
-                tolerance=self.tolerance,
-                hold_min_s=self.hold_min_s,
-                grid_step_c=self.grid_step_c,
-            )
+                g, one, temps, ys, labels, knots, curves, curve_t,
+                error_metric=self.error_metric, tolerance=self.tolerance,
+                hold_min_s=self.hold_min_s, grid_step_c=self.grid_step_c,
+            )  # fmt: skip
             cond = max(cond, cond_g)
             if rss_g is not None:
                 kept_b.append(knots.copy())

@@ -14,7 +14,8 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from thermocal.errors import ThermocalInputError
-from thermocal.models.base import ClampOnce, ModelStream, stream_channel
+from thermocal.models.base import ModelStream
+from thermocal.models.streams import ClampOnce, stream_channel
 from thermocal.recording import FloatArray
 
 if TYPE_CHECKING:

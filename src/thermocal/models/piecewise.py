@@ -71,13 +71,7 @@ from thermocal.errors import (
     ThermocalInputError,
 )
 from thermocal.families import PIECEWISE, FamilyDeclaration
-from thermocal.models.base import (
-    ChunkContext,
-    ClampOnce,
-    ModelStream,
-    TemperatureModel,
-    stream_channel,
-)
+from thermocal.models.base import ChunkContext, ModelStream, TemperatureModel
 from thermocal.models.breakpoints import (
     BreakpointChoice,
     _Lines,
@@ -109,6 +103,7 @@ from thermocal.models.piecewise_lines import (
 from thermocal.models.residuals import MAX_SAMPLES_PER_SERIES, residual_correlation
 from thermocal.models.results import Coefficient, FitStats
 from thermocal.models.rundata import RunData
+from thermocal.models.streams import ClampOnce, stream_channel
 from thermocal.recording import FloatArray
 
 if TYPE_CHECKING:

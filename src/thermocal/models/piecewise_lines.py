@@ -25,7 +25,8 @@ from thermocal.models.breakpoints import (
     choose_breakpoints,
     segment_index,
 )
-from thermocal.models.lstsq import Chunk, accumulate_r, solve_r
+from thermocal.models.lstsq import solve_r
+from thermocal.models.reduction import Chunk, accumulate_r
 from thermocal.models.rundata import RunData
 from thermocal.models.terms import CHUNK_ROWS
 from thermocal.recording import FloatArray
@@ -247,7 +248,20 @@ def solve_lines(
     coef = sol.coef
     offsets = coef[p:]
     const = float(np.mean(offsets))
-    # lines y = a_s + k_s T as a linear map of the solution [coef, offsets]
+    A_int, A_slp = _line_maps(bp, p, m, centre, scale, method)
+    intercepts = A_int @ coef
+    slopes = A_slp @ coef
+    Lmat = np.vstack([A_int, A_slp])
+    line_cov = Lmat @ sol.cov @ Lmat.T
+    return _Lines(intercepts, slopes, line_cov, offsets, const, sol, red.n_total, m)
+
+
+def _line_maps(
+    bp: FloatArray, p: int, m: int, centre: float, scale: float, method: str
+) -> tuple[FloatArray, FloatArray]:
+    """The lines ``y = a_s + k_s T`` as linear maps of the solution ``[coef, offsets]``:
+    (intercepts' map, slopes' map), each (S, p + m)."""
+    S = bp.size + 1
     q = p + m
     A_int = np.zeros((S, q))  # intercepts a_s
     A_slp = np.zeros((S, q))  # slopes k_s
@@ -266,11 +280,7 @@ def solve_lines(
             for i in range(s):  # hinges active in segment s
                 A_slp[s, 1 + i] = 1.0 / scale
                 A_int[s, 1 + i] = -bp[i] / scale
-    intercepts = A_int @ coef
-    slopes = A_slp @ coef
-    Lmat = np.vstack([A_int, A_slp])
-    line_cov = Lmat @ sol.cov @ Lmat.T
-    return _Lines(intercepts, slopes, line_cov, offsets, const, sol, red.n_total, m)
+    return A_int, A_slp
 
 
 def intersections(

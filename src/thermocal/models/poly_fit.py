@@ -23,15 +23,9 @@ from thermocal.models.fitting import (
     run_blocks,
     short_rate_share,
 )
-from thermocal.models.lstsq import (
-    Chunk,
-    LstsqSolution,
-    Reduced,
-    accumulate_targets,
-    forward_select,
-    solve_r,
-)
+from thermocal.models.lstsq import LstsqSolution, forward_select, solve_r
 from thermocal.models.poly_types import PolyBase
+from thermocal.models.reduction import Chunk, Reduced, accumulate_targets
 from thermocal.models.residuals import MAX_SAMPLES_PER_SERIES, residual_correlation
 from thermocal.models.results import FitStats
 from thermocal.models.rundata import RunData
@@ -63,14 +57,14 @@ def fit_shared(models: Sequence[PolyBase], runs_by_model: Sequence[Sequence[RunD
     The work that depends on the temperatures alone — Ṫ, the base-variable scaling, the
     features, the offset decision, the ranges — is done once and the design's Gram matrix
     is accumulated once; only the targets' products are per channel
-    (:func:`~thermocal.models.lstsq.accumulate_targets`), so each channel's reduction is
+    (:func:`~thermocal.models.reduction.accumulate_targets`), so each channel's reduction is
     computed by the operations a single channel gets, bit for bit.  Term selection, the
     solution, the residuals' autocorrelation and the covariance are per channel, so every
     model equals the one :meth:`PolyModel.fit` gives on its own runs.
 
     Steps: check the channels share their inputs (:func:`_shared_runs`); the design
     (:func:`_shared_design`); one pass reducing it (:class:`_DesignPass`,
-    :func:`~thermocal.models.lstsq.accumulate_targets`); per channel the selection and
+    :func:`~thermocal.models.reduction.accumulate_targets`); per channel the selection and
     solution (:func:`_solve_channel`); a second pass for the residuals; per channel the
     covariance and statistics (:func:`_finish_channel`).
 

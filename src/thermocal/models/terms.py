@@ -36,15 +36,16 @@ Three parts, all pure numpy/scipy:
    samples; powers are formed by repeated multiplication so that a one-sample
    block (the streaming twin) gives the same numbers as a long one.
 
-3. **Least squares in chunks** (:mod:`thermocal.models.lstsq`, used with the terms):
-   :func:`~thermocal.models.lstsq.accumulate_r` reduces the design
+3. **Least squares in chunks** (:mod:`thermocal.models.reduction` and
+   :mod:`thermocal.models.lstsq`, used with the terms):
+   :func:`~thermocal.models.reduction.accumulate_r` reduces the design
    ``A = [F | Z | y]`` (F the term features, Z one indicator column per run for
    the per-run offsets, y the target) to its triangular factor ``R_aug`` chunk
    by chunk, either by a chunked Householder QR (R factors stacked and
    re-triangularised, LAPACK ``dgeqrf``) or by accumulating the Gram matrix
    ``AᵀA`` and taking its Cholesky factor (``RᵀR = AᵀA``; the same R up to
    signs).  The Gram path is used only when the column-equilibrated design is
-   well conditioned (κ ≤ :data:`~thermocal.models.lstsq.GRAM_MAX_COND`, so that the κ²ε loss of
+   well conditioned (κ ≤ :data:`~thermocal.models.reduction.GRAM_MAX_COND`, so that the κ²ε loss of
    forming AᵀA stays below ~1e-6 relative); otherwise the data are passed again
    through the QR path.  :func:`~thermocal.models.lstsq.solve_r` then solves the
    column-scaled problem ``min ‖R_s γ − z‖² + n α ‖γ_F‖²`` by SVD (optional ridge α, optional
