@@ -118,3 +118,17 @@ def test_fit_shows_the_option_where_a_warning_names_per_run_offset(
     advice = "Pass --per-run-offset to force offsets"
     assert advice in err
     assert any(advice in w for w in json.loads(out)["warnings"])
+
+
+def test_raw_counts_without_a_count_scale_name_the_scale_parameter() -> None:
+    from types import SimpleNamespace
+
+    from thermocal.models.calibration import Triad
+
+    triad = Triad("gyro", ("gx", "gy", "gz"), "deg/s", "T", SimpleNamespace(kind="gyro"))
+    with pytest.raises(UnitError) as info:
+        triad.input_in({"counts"}, "held.csv")
+    assert str(info.value).endswith("calibrate the counts with multipos gyro_scale VALUE,UNIT")
+    text = error_text(info.value)[0]
+    assert text.endswith("calibrate the counts with multipos --gyro-scale VALUE,UNIT")
+    assert text.startswith("held.csv: the gyro triad's columns are raw counts")

@@ -217,11 +217,13 @@ class Triad:
         if data_unit == "counts" and self.count_scale is not None:
             out_unit, scale = self.unit, float(self.count_scale)
         elif data_unit == "counts":
-            raise UnitError(
+            scale_of = f"{self.model.kind}_scale"  # multipos's parameter of the count scale
+            raise UnitError.naming(
                 f"{where}: the {self.name} triad's columns are raw counts, and the calibration "
                 f"states no count scale (it was calibrated on {self.unit} data): convert the "
                 f"columns to {self.unit}, or calibrate the counts with multipos "
-                f"--{self.model.kind}-scale VALUE,UNIT"
+                f"{{{scale_of}}} VALUE,UNIT",
+                scale_of,
             )
         elif units.canonical_unit(data_unit) != units.canonical_unit(self.unit):
             raise UnitError.naming(
