@@ -64,7 +64,7 @@ import numpy as np
 import numpy.typing as npt
 
 from thermocal.defaults import ALLOW_MOTION, ALLOW_NARROW, overrides_of
-from thermocal.errors import ThermocalInputError, ThermocalWarning
+from thermocal.errors import ThermocalInputError, ThermocalWarning, spell_parameters
 from thermocal.recording import all_finite
 
 FloatArray = npt.NDArray[np.float64]
@@ -119,7 +119,11 @@ class AdequacyTest:
     override : str or None
         The option that overrides a failure; None: it cannot be overridden.
     message : str
-        One line for the user.
+        One line for the user: a template with ``{parameter}`` for each of ``parameters``.
+    parameters : tuple of str, optional
+        The library parameters ``message`` names (``str()`` of the refusal shows their
+        names, the command line its options; :meth:`NamesParameters.naming
+        <thermocal.errors.NamesParameters.naming>`).  Default none.
     """
 
     name: str
@@ -129,6 +133,7 @@ class AdequacyTest:
     verdict: str
     override: str | None
     message: str
+    parameters: tuple[str, ...] = ()
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready dict (non-finite figures → None)."""
@@ -143,7 +148,7 @@ class AdequacyTest:
             "unit": self.unit,
             "verdict": self.verdict,
             "override": self.override,
-            "message": self.message,
+            "message": spell_parameters(self.message, self.parameters),
         }
 
 
@@ -234,19 +239,22 @@ class Adequacy:
                 if hints and all(t.override for t in refused)
                 else ""
             )
-            raise ThermocalInputError(
-                "the data cannot support this fit: " + "; ".join(t.message for t in refused) + hint
+            raise ThermocalInputError.naming(
+                "the data cannot support this fit: " + "; ".join(t.message for t in refused) + hint,
+                *dict.fromkeys(p for t in refused for p in t.parameters),
             )
         for t in self.failed:
             warnings.warn(
-                f"{t.message} — fitted anyway ({t.override}): do not trust this "
-                "calibration beyond what the data cover",
-                ThermocalWarning,
+                ThermocalWarning.naming(
+                    f"{t.message} — fitted anyway ({t.override}): do not trust this "
+                    "calibration beyond what the data cover",
+                    *t.parameters,
+                ),
                 stacklevel=2,
             )
         for t in self.tests:
             if t.verdict == "warn":
-                warnings.warn(t.message, ThermocalWarning, stacklevel=2)
+                warnings.warn(ThermocalWarning.naming(t.message, *t.parameters), stacklevel=2)
         return self
 
 

@@ -1175,7 +1175,7 @@ class ChunkPredictor:
         followers: Sequence[ChunkPredictor],
     ) -> list[FloatArray]:
         """ŷ of this predictor's model and of each follower's (several channels whose
-        ``poly`` models share one evaluation, :func:`thermocal.models.poly.predict_many`):
+        ``poly`` models share one evaluation, :func:`thermocal.models.poly_eval.predict_many`):
         the context is carried once, here; the followers' counts follow.
 
         Parameters
@@ -1262,7 +1262,8 @@ class ChunkPredictor:
         if len(models) == 1:
             y_alls = [np.asarray(self.model.predict(run, extrapolate=self.extrapolate))]
         else:
-            from thermocal.models.poly import PolyModel, predict_many
+            from thermocal.models.poly import PolyModel
+            from thermocal.models.poly_eval import predict_many
 
             y_alls = predict_many(
                 [cast(PolyModel, mdl) for mdl in models], run, extrapolate=self.extrapolate

@@ -953,10 +953,11 @@ def _chunk_outputs(
 
 def _evaluation_groups(plans: Sequence[_ChannelPlan]) -> list[list[_ChannelPlan]]:
     """Channels evaluated together: ``poly`` models with one evaluation key
-    (:func:`thermocal.models.poly.evaluation_key`: same inputs, ranges and term structure,
-    as :func:`~thermocal.models.poly.fit_shared` makes them) and the same temperature
+    (:func:`thermocal.models.poly_eval.evaluation_key`: same inputs, ranges and term structure,
+    as :func:`~thermocal.models.poly_fit.fit_shared` makes them) and the same temperature
     conversions; every other channel alone."""
-    from thermocal.models.poly import PolyModel, evaluation_key
+    from thermocal.models.poly import PolyModel
+    from thermocal.models.poly_eval import evaluation_key
 
     groups: dict[Any, list[_ChannelPlan]] = {}
     out: list[list[_ChannelPlan]] = []

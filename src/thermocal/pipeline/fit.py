@@ -35,12 +35,13 @@ from thermocal import units
 from thermocal.defaults import overrides_of
 from thermocal.errors import (
     ConditioningWarning,
+    NamesParameters,
     ParameterError,
     PlausibilityWarning,
     ThermocalInputError,
 )
 from thermocal.families import MAX_ORDER, MAX_TERMS
-from thermocal.pipeline.messages import one_line
+from thermocal.pipeline.messages import one_line, option_name
 from thermocal.pipeline.options import FitOptions
 from thermocal.pipeline.reading import check_recording
 from thermocal.readers.station import station_sensor_paths
@@ -51,6 +52,7 @@ if TYPE_CHECKING:
     import thermocal.models.base as _base
     import thermocal.models.calibration as _calibration
     import thermocal.models.poly as _poly
+    import thermocal.models.poly_fit as _poly_fit
     import thermocal.models.registry as _registry
     import thermocal.models.results as _results
     import thermocal.models.rundata as _rundata
@@ -69,6 +71,7 @@ else:
     _calibration = LazyModule("thermocal.models.calibration")
     _files = LazyModule("thermocal.pipeline.model_file")
     _poly = LazyModule("thermocal.models.poly")
+    _poly_fit = LazyModule("thermocal.models.poly_fit")
     _gravity = LazyModule("thermocal.gravity")
     _recording = LazyModule("thermocal.recording")
 
@@ -308,14 +311,16 @@ def _fit_channels(
 ) -> list[tuple[str, _base.TemperatureModel, dict[str, Any], int]]:
     """Fit every channel on the loaded runs (each file read once, by the caller).  Channels
     of the ``poly`` family with the same temperature inputs share one design
-    (:func:`thermocal.models.poly.fit_shared`: Ṫ, features and the design's reduction once;
+    (:func:`thermocal.models.poly_fit.fit_shared`: Ṫ, features and the design's reduction once;
     every model equal, bit for bit, to its own fit)."""
     preps = [_prepare_channel(spec, loaded, sig) for sig in signals]
     if spec.family == "poly" and len(preps) > 1:
         _share_inputs(preps)
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")
-            _poly.fit_shared([cast(_poly.PolyModel, p.est) for p in preps], [p.runs for p in preps])
+            _poly_fit.fit_shared(
+                [cast(_poly.PolyModel, p.est) for p in preps], [p.runs for p in preps]
+            )
         for p in preps:
             p.caught.extend(caught)
     else:
@@ -556,13 +561,22 @@ def _judge_fitted(spec: _FitSpec, p: _Prepared) -> None:
     try:
         judged = _adequacy.Adequacy(tests, tuple(spec.overrides), p.sig_name).enforce()
     except ThermocalInputError as exc:  # name the files, as a reader's error does
-        raise ThermocalInputError(f"{', '.join(str(r.name) for r in p.runs)}: {exc}") from None
+        names = ", ".join(str(r.name) for r in p.runs)
+        text = exc.spelled(lambda q: "{" + q + "}")  # the template: still names its parameters
+        raise ThermocalInputError.naming(f"{names}: {text}", *exc.parameters) from None
     rec = p.est.adequacy_
     if rec is None:  # judged before the fit: always a record here
         return
     rec["tests"] = [*rec["tests"], *(t.to_dict() for t in tests)]
     if judged.failed and rec["verdict"] == "pass":
         rec["verdict"] = "overridden"
+
+
+def _spelled(message: Warning | str) -> str:
+    """A warning's text with the command line's options for the parameters it names."""
+    if isinstance(message, NamesParameters):
+        return message.spelled(option_name)
+    return str(message)
 
 
 def _finish_channel(
@@ -586,7 +600,8 @@ def _finish_channel(
         if note and note.get("note"):
             warnings.warn(f"{est.family}: {note['note']}", ConditioningWarning, stacklevel=1)
     all_caught = [*prep.caught, *caught]
-    messages = [one_line(str(w.message)) for w in all_caught]
+    # the --json result speaks to the command line: options where the library names parameters
+    messages = [one_line(_spelled(w.message)) for w in all_caught]
     for w in all_caught:  # hand them on to handle_errors, which prints them on stderr
         warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
 

@@ -234,7 +234,7 @@ def _validate_channel(
 def _validate_channels(ctx: _Context, cal: Calibration) -> ValidationReport:
     """A calibration of several channels: the file read once with every chosen channel's
     column, each channel judged on it."""
-    from thermocal.models.calibration import merged_inputs, temperatures_of
+    from thermocal.models.calibration_inputs import merged_inputs, temperatures_of
 
     o = ctx.o
     chosen = split_names(o.signal) or cal.names
