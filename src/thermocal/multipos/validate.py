@@ -47,7 +47,7 @@ def triad_columns(
     """A triad's three columns of ``rec`` in the physical unit its model takes, and how
     (:class:`~thermocal.models.calibration.TriadInput`).  Each column's unit is resolved as
     ``compensate`` resolves it (:func:`thermocal.units.resolve_unit`: ``unit_options`` (column
-    → the ``--signal-unit`` option's unit, :func:`thermocal.units.per_signal_option`) > the
+    → the ``signal_unit`` parameter's unit, :func:`thermocal.units.per_signal_unit`) > the
     file's metadata or column name > the unit the triad was calibrated on, raw counts for a
     triad with a count scale), and raw counts become ``count_scale · N`` (:meth:`Triad.input_in
     <thermocal.models.calibration.Triad.input_in>`, the path ``compensate`` takes)."""
@@ -75,14 +75,14 @@ def validate_held_out_session(
     latitude_deg: float | None = None,
     *,
     static_s: float = 1.0,
-    signal_unit: str | None = None,
+    signal_unit: str | tuple[str, ...] | None = None,
 ) -> list[MultiposValidation]:
     """A multi-position calibration of triads judged on a held-out session.
 
     ``triads`` the calibration's (one an accelerometer: it gives the poses' up directions),
     ``rec`` the session, ``latitude_deg`` [°] for normal gravity when the calibration recorded
     none, ``static_s`` [s] the shortest pose, ``signal_unit`` one unit for every triad column
-    or one per column (comma-separated, as ``compensate`` takes it).  Returns one
+    or a tuple of one per column, as ``compensate`` takes it.  Returns one
     :class:`MultiposValidation` per triad: before and after compensation, the gravity-magnitude
     error over poses and the rotation-angle error over motions (module docstring; Tedaldi et
     al. 2014).  Raises :class:`~thermocal.errors.ParameterError` for a ``static_s`` not
@@ -110,7 +110,7 @@ def validate_held_out_session(
             raise ParameterError("latitude_deg", f"{rec.name}: give the latitude ({{name}} DEG)")
         g_m_s2 = units.normal_gravity_m_s2(float(lat))
     t = rec.time_s
-    unit_opts = units.per_signal_option(signal_unit, [c for tr in triads for c in tr.columns])
+    unit_opts = units.per_signal_unit(signal_unit, [c for tr in triads for c in tr.columns])
 
     def temp_of(tri: Any) -> Any:
         if tri.temperature:

@@ -408,13 +408,13 @@ def _session(
         time=opts.time,
         time_unit=opts.time_unit,
         signals=(*acc_cols, *(gyr_cols or [])),
-        signal_unit=",".join(u or "" for u in given) if any(given) else None,
+        signal_unit=tuple(u or "" for u in given) if any(given) else None,
         temperatures=(temps,) if temps else None,
     )
     rec = read_recording(
         path, read,
-        ask_units={**dict.fromkeys([] if opts.accel_scale else acc_cols, "--accel-unit"),
-                   **dict.fromkeys([] if opts.gyro_scale else (gyr_cols or []), "--gyro-unit")},
+        ask_units={**dict.fromkeys([] if opts.accel_scale else acc_cols, "accel_unit"),
+                   **dict.fromkeys([] if opts.gyro_scale else (gyr_cols or []), "gyro_unit")},
         implied_units={**dict.fromkeys(acc_cols if opts.accel_scale else [], "counts"),
                        **dict.fromkeys((gyr_cols or []) if opts.gyro_scale else [], "counts")},
     )  # fmt: skip
