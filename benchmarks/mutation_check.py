@@ -731,6 +731,14 @@ MUTANTS: tuple[Mutant, ...] = (
         "ArduPilot coefficients multiplied by 1e-6 instead of divided",
     ),
     Mutant(
+        "params-file-int32-as-float",
+        P + "firmware/formats.py",
+        "shown = str(int(value)) if typ == 6 else repr(float(value))",
+        "shown = str(int(value)) if typ == 9 else repr(float(value))",
+        _t("firmware_formats"),
+        "a parameter file writes int32 parameters as floats (and floats truncated)",
+    ),
+    Mutant(
         "params-ardupilot-tref",
         P + "firmware/formats.py",
         "AP_TREF_C = 35.0",
@@ -1853,9 +1861,9 @@ MUTANTS: tuple[Mutant, ...] = (
     Mutant(
         "metrics-average-advice-whole-record",
         P + "metrics.py",
-        "{option} {longest_s / 2.0:.3g} or less",
-        "{option} {longest_s:.3g} or less",
-        _t("tempcal_averages", "metrics_averages"),
+        "{name} {longest_s / 2.0:.3g} or less",
+        "{name} {longest_s:.3g} or less",
+        _t("tempcal_averages", "metrics_averages", "metrics_parameter_names"),
         "the advised --average is the whole record (one average), not half",
     ),
     Mutant(
@@ -3348,6 +3356,23 @@ MUTANTS: tuple[Mutant, ...] = (
         "if wanted < 0:",
         AUDIT,
         "simulate multipos --rate-hz 1e12 allocates unchecked: MemoryError, exit 1",
+    ),
+    # the triad calibrations' messages: parameters for Python, options on the command line
+    Mutant(
+        "triads-gravity-option-unmapped",
+        P + "pipeline/messages.py",
+        '    "gravity_m_s2": "--gravity",\n',
+        "",
+        ("tests/cli/test_triad_option_names.py",),
+        "multipos names --gravity-m-s2, an option no command has",
+    ),
+    Mutant(
+        "triads-rejection-unspelled",
+        P + "multipos/poses.py",
+        '"reason": r.spelled(spell)}',
+        '"reason": r.spelled()}',
+        ("tests/pipeline/test_multipos_result.py",),
+        "multipos --json's rejected poses name motion_fraction, not --motion-fraction",
     ),
     # the firmware maths as pure functions (thermocal.firmware)
     Mutant(

@@ -647,8 +647,8 @@ def resolve_unit(
         parameter (``"{temp_conversion} (raw counts)"``); default: the role's unit
         parameter (``signal_unit``) and the unit.
     ask : str, optional
-        A parameter's name (``"accel_unit"``): a unit nobody stated is refused, asking
-        for it.
+        A parameter's name (``"accel_unit"``; the command line shows its option): a unit
+        nobody stated is refused, asking for it.
     implied : str, optional
         A unit another option implies (raw ``counts`` with a count scale), taken
         without a warning when nobody states one.
@@ -679,9 +679,10 @@ def resolve_unit(
         return ResolvedUnit(norm(model), "model")
     if implied:
         return ResolvedUnit(norm(implied), "option")
-    if ask:
+    if ask:  # a parameter (the command line shows its option), or an option as it is
+        named = ask if ask.startswith("-") else "{" + ask + "}"
         raise UnitError.naming(
-            f"{prefix}no unit stated for column {column!r}; give {{{ask}}} (or the unit in the "
+            f"{prefix}no unit stated for column {column!r}; give {named} (or the unit in the "
             "file's metadata or column name)",
             ask,
         )

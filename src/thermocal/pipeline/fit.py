@@ -358,7 +358,7 @@ def _prepare_channel(
         _values, run_unit = rec.signal(signal)
         sig_name = signal or rec.signals[0]
         check_not_stuck(
-            rec.column(sig_name), sig_name, str(path), "--signal",
+            rec.column(sig_name), sig_name, str(path), "signals",
             "has no thermal behaviour to model (a flat model of a dead channel)",
         )  # fmt: skip
         if unit and run_unit != unit:

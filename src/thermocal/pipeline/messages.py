@@ -165,6 +165,15 @@ OPTION_OF: dict[str, str] = {
     "start_window_s": "--start-window",
     "select": "--select-method",
     "file_format": "--format",
+    "averaging_s": "--average",
+    "drift_reference_s": "--drift-reference",
+    "dynamic_s": "--dynamic",
+    "deviations": "--deviation",
+    "sample_interval_s": "--sample-interval",
+    "use_float": "--float",
+    "gravity_m_s2": "--gravity",
+    "alpha_column": "--alpha",
+    "beta_column": "--beta",
 }
 """Library parameters whose command-line option is not the parameter's name with dashes
 (``time_unit`` → ``--time-unit`` needs no entry)."""

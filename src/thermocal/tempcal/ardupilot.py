@@ -40,6 +40,7 @@ from thermocal.tempcal.ardupilot_baro import (
     fit_ardupilot_baro,
 )
 from thermocal.tempcal.compare import CoefficientComparison, compare_coefficients
+from thermocal.tempcal.flightlog import DataflashFlightLog, read_ardupilot_log
 from thermocal.tempcal.pipeline import (
     AXES,
     GateWarning,
@@ -62,6 +63,9 @@ from thermocal.tempcal.pipeline import (
 
 MAX_IMUS = 3
 """ArduPilot logs up to three IMUs (``IMU``, instances 0…2)."""
+MESSAGES = ("IMU", "IMU2", "IMU3", "TCLR", "BARO")
+"""The messages the calibration reads of a DataFlash log (``IMU2``/``IMU3``: older firmware's
+second and third IMU; ``TCLR``: the firmware's own learning; ``BARO``: the barometer)."""
 KINDS = (("gyro", "Gyr", "rad/s"), ("accel", "Acc", "m/s^2"))
 """(kind, field prefix of the ``IMU`` message, its unit) per sensor of an IMU."""
 KIND_UNITS = {kind: unit for kind, _prefix, unit in KINDS}
@@ -76,7 +80,19 @@ BARO_REPORT = "report_BARO_0.html"
 class ActiveTcal:
     """An IMU's ``INS_TCAL<n>_*`` found in the log's parameters: ``coefficients[kind]`` the
     3×3 ``c_k`` (row k = 1…3, columns x, y, z, as stored: ×1e-6 in use), the range and the
-    calibration temperatures ``INS_ACC<n>_CALTEMP``/``INS_GYR<n>_CALTEMP`` [°C]."""
+    calibration temperatures ``INS_ACC<n>_CALTEMP``/``INS_GYR<n>_CALTEMP`` [°C].
+
+    Attributes
+    ----------
+    instance : int
+        The IMU (``n`` of ``INS_TCAL<n>``).
+    tmin_c, tmax_c : float
+        ``INS_TCAL<n>_TMIN/TMAX`` [°C].
+    coefficients : dict of str to list of list of float
+        ``c_k`` per sensor kind, rows k = 1…3, columns x, y, z, as stored.
+    caltemp_c : dict of str to float
+        ``INS_ACC<n>_CALTEMP``/``INS_GYR<n>_CALTEMP`` [°C].
+    """
 
     instance: int
     tmin_c: float
@@ -311,7 +327,15 @@ def imu_hygiene_params(name: str, instance: int) -> bool:
 @dataclass(frozen=True)
 class ParamInterval:
     """A stretch of the log ``[start_s, end_s)`` [s, the log's ``TimeUS`` clock; ±inf at the
-    ends] over which the parameters ``params`` were in force."""
+    ends] over which the parameters ``params`` were in force.
+
+    Attributes
+    ----------
+    start_s, end_s : float
+        The stretch [s, ``TimeUS`` clock; ±inf at the ends].
+    params : dict of str to float
+        The parameters in force.
+    """
 
     start_s: float
     end_s: float
@@ -470,7 +494,15 @@ def tclr_points(
 @dataclass(frozen=True)
 class TclrRange:
     """The range ``TMIN…TMAX`` [°C] the firmware saves with its learned coefficients of one
-    IMU (both its sensors: ``INS_TCAL<n>_TMIN/TMAX`` are per IMU), and where it was found."""
+    IMU (both its sensors: ``INS_TCAL<n>_TMIN/TMAX`` are per IMU), and where it was found.
+
+    Attributes
+    ----------
+    tmin_c, tmax_c : float
+        The range [°C].
+    source : str
+        Where it was found.
+    """
 
     tmin_c: float
     tmax_c: float
@@ -605,7 +637,35 @@ class ArdupilotTempcalResult:
     per IMU the active ``INS_TCAL`` removed and its coefficients old → new); per sensor
     (``IMU.Gyr.<n>``/``IMU.Acc.<n>``) the active coefficients against the new ones
     (``previous``) and the firmware's own learning against them (``firmware_learning``,
-    from ``TCLR``); the first barometer's ``TCAL_BARO_EXP`` (``baro``)."""
+    from ``TCLR``); the first barometer's ``TCAL_BARO_EXP`` (``baro``).
+
+    Attributes
+    ----------
+    log : Path
+        The log read.
+    params_path, calibration_path : Path
+        The parameter file and the calibration file.
+    reports : tuple of Path
+        The HTML reports.
+    fits : tuple of SensorFit
+        Every IMU sensor's fit.
+    notes : tuple of str
+        The parameter file's notes.
+    orientation : int
+        ``AHRS_ORIENTATION`` at the end of the log.
+    hygiene : dict
+        Per IMU, the active ``INS_TCAL`` removed and its coefficients old → new.
+    previous : dict of str to CoefficientComparison
+        Per sensor, the active coefficients against the new ones.
+    firmware_learning : dict of str to CoefficientComparison
+        Per sensor, the firmware's learning (``TCLR``) against the new ones.
+    baro : ArdupilotBaroFit or None
+        The first barometer's ``TCAL_BARO_EXP``.
+    rotated : bool
+        Some data were recorded with ``AHRS_ORIENTATION`` ≠ 0.
+    parameter_changes : tuple of dict
+        The changes of the undone parameters during the log.
+    """
 
     log: Path
     params_path: Path
@@ -631,7 +691,7 @@ class ArdupilotTempcalResult:
         return [k for k, h in self.hygiene.items() if h["active_tcal_removed"]]
 
     def to_dict(self) -> dict[str, Any]:
-        """The JSON of ``ardupilot-tempcal --json``."""
+        """The result as a JSON object (what the ``ardupilot-tempcal`` command prints as JSON)."""
         return {
             "log": str(self.log),
             "params": str(self.params_path),
@@ -663,7 +723,7 @@ class _Run:
     """The state of one :func:`ardupilot_tempcal` run across its IMUs."""
 
     log: Path
-    dlog: Any
+    flight: DataflashFlightLog
     overrides: tuple[str, ...]
     params: Any
     out_set: OutputSet
@@ -729,7 +789,6 @@ def ardupilot_tempcal(
     """
     from thermocal.errors import MissingColumnError
     from thermocal.export.params import ParamSet, check_documented, check_values
-    from thermocal.readers.dataflash import dataflash_table, read_dataflash_log
 
     # DIR may hold the log; the files of the set (replaced by name) may not be it
     names = ["calibration.json", FORMATS["ardupilot"].params_file]
@@ -738,13 +797,11 @@ def ardupilot_tempcal(
     check_outputs([output / n for n in names], [log], dirs=[output])
     check_output_dir(output)
     with staged_set(output, reporter) as out_set:  # moved into place whole, or removed
-        dlog = read_dataflash_log(
-            log, ["IMU", "IMU2", "IMU3", "TCLR", "BARO"]
-        )  # the log is read once
-        run = _Run(log, dlog, overrides, ParamSet("ardupilot"), out_set, [], [], {}, {})
+        flight = read_ardupilot_log(log, MESSAGES)  # the log is read once, passed down
+        run = _Run(log, flight, overrides, ParamSet("ardupilot"), out_set, [], [], {}, {})
         for inst in range(MAX_IMUS):
             try:
-                df, _info = dataflash_table(dlog, log, "IMU", inst)
+                df, _info = flight.table("IMU", inst)
             except MissingColumnError:
                 if inst == 0:
                     raise
@@ -847,7 +904,9 @@ def _imu(run: _Run, df: Any, inst: int) -> None:
     run.gates.append(stall_warning(f"IMU.{inst}", time_s, temp_c))
     per_kind: list[tuple[SensorFit, Recording]] = []
     intervals, changes = param_intervals(
-        run.dlog.params, run.dlog.param_changes, lambda n: imu_hygiene_params(n, inst)
+        run.flight.parameters,
+        run.flight.parameter_changes,
+        lambda n: imu_hygiene_params(n, inst),
     )
     prev_params = _previous_params(run, inst, intervals, changes, time_s)
     for kind, prefix, unit in KINDS:
@@ -888,7 +947,7 @@ def _imu(run: _Run, df: Any, inst: int) -> None:
     _hygiene_and_gates(run, inst, ps, prev_params)
     active = ardupilot_active(prev_params, inst)
     fw_range = tclr_range(
-        run.dlog.rows.get("TCLR", []), inst, run.dlog.param_changes, time_s, temp_c
+        run.flight.rows("TCLR"), inst, run.flight.parameter_changes, time_s, temp_c
     )
     for fit, sub_rec in per_kind:
         key = f"{fit.topic}.{inst}"
@@ -898,7 +957,7 @@ def _imu(run: _Run, df: Any, inst: int) -> None:
                 fit.sweep_c,
             )  # fmt: skip
         learned = None if fw_range is None else tclr_comparison(
-            run.dlog.rows.get("TCLR", []), inst, fit.kind,
+            run.flight.rows("TCLR"), inst, fit.kind,
             KIND_UNITS[fit.kind], ps.params, fit.sweep_c, fw_range,
         )  # fmt: skip
         if learned is not None:
@@ -924,7 +983,7 @@ def _baro(run: _Run) -> None:
     from thermocal.errors import MissingColumnError
 
     try:
-        df, _info = _table(run, "BARO", 0)
+        df, _info = run.flight.table("BARO", 0)
     except MissingColumnError:
         return  # no barometer in the log
     require_fields(df, ["Press", "Temp"], run.log, "BARO.0")
@@ -956,7 +1015,7 @@ def _baro(run: _Run) -> None:
         BARO_REPORT,
         baro_report_request(
             fit, temp_c, press_pa, str(run.log), "thermocal ardupilot-tempcal",
-            run.dlog.params_at_end(), said,
+            run.flight.parameters_at_end(), said,
         ),
     )  # fmt: skip
 
@@ -979,13 +1038,6 @@ def _baro_screened(run: _Run, df: Any) -> tuple[FloatArray | None, FloatArray | 
         run.gates.append(judged.left_out)
         return None, None
     return temp_c[judged.keep], press_pa[judged.keep]
-
-
-def _table(run: _Run, name: str, inst: int) -> tuple[Any, dict[str, Any]]:
-    """Instance ``inst`` of message ``name`` from the run's one pass over the log."""
-    from thermocal.readers.dataflash import dataflash_table
-
-    return dataflash_table(run.dlog, run.log, name, inst)
 
 
 def _previous_params(

@@ -5,7 +5,7 @@ recorded (ArduPilot's ``INS_TCAL<n>_*`` in its ``PARM`` messages).  A
 :class:`CoefficientComparison` holds, for one sensor, each parameter old → new with their
 difference, and the correction each set applies over the calibrated range, per axis, as the
 firmware computes it — for the table and figure of the report and the ``previous`` object of
-``--json``.
+the result's JSON (``to_dict``).
 """
 
 from __future__ import annotations
@@ -30,7 +30,31 @@ class CoefficientComparison:
     ``parameters``: (name, old, new) as the firmware stores them; ``temp_c`` the
     temperatures [°C] of the curves; ``old_curve``/``new_curve``: per axis the correction
     each set applies at ``temp_c`` [``unit``, the firmware's unit of the sensor];
-    ``curve_formula`` says how (the firmware's formula, with its source)."""
+    ``curve_formula`` says how (the firmware's formula, with its source).
+
+    Attributes
+    ----------
+    sensor : str
+        The sensor (``IMU.Gyr.0`` …).
+    unit : str
+        The firmware's unit of the sensor.
+    parameters : tuple of (str, float, float)
+        ``(name, old, new)`` as the firmware stores them.
+    temp_c : tuple of float
+        Temperatures of the curves [°C].
+    old_curve, new_curve : mapping of str to tuple of float
+        Per axis, the correction each set applies at ``temp_c`` [``unit``].
+    curve_formula : str
+        How the curves are computed.
+    old_key, new_key : str
+        The sets' names in the JSON.
+    title, old_label : str
+        The report section's title and the old set's label.
+    anchor : str
+        The HTML id of the report's section.
+    intro : str
+        The section's first sentence.
+    """
 
     sensor: str
     unit: str
@@ -53,7 +77,7 @@ class CoefficientComparison:
     )
 
     def to_dict(self) -> dict[str, Any]:
-        """The ``previous`` (or ``firmware_learning``) object of a sensor in ``--json``: per
+        """The ``previous`` (or ``firmware_learning``) object of a sensor in the JSON: per
         parameter old, new (named :attr:`old_key`, :attr:`new_key`) and ``difference`` =
         new − old; the curves per axis [``unit``]."""
         ok, nk = self.old_key, self.new_key

@@ -43,6 +43,19 @@ class FamilyCode:
     ``init`` — statements of ``<p>_init`` (``s`` and ``sample_interval_s`` in scope);
     ``update`` — statements of ``<p>_update`` ending in ``return``;
     ``defines`` — extra ``#define`` lines of the header; ``notes`` — comment lines.
+
+    Attributes
+    ----------
+    state_fields : list of str
+        C declarations of the state struct.
+    data : str
+        Definitions and helpers of the source file.
+    init, update : str
+        Statements of ``<p>_init`` and ``<p>_update``.
+    defines : list of str
+        Extra ``#define`` lines.
+    notes : list of str
+        Comment lines.
     """
 
     state_fields: list[str]
@@ -55,7 +68,27 @@ class FamilyCode:
 
 @dataclass(frozen=True)
 class CExport:
-    """A generated C module: ``header`` (``<prefix>.h``) and ``source`` (``<prefix>.c``)."""
+    """A generated C module: ``header`` (``<prefix>.h``) and ``source`` (``<prefix>.c``).
+
+    Attributes
+    ----------
+    prefix : str
+        The C identifier prefix of every name.
+    real : str
+        ``"double"`` or ``"float"``.
+    header, source : str
+        The text of ``<prefix>.h`` and ``<prefix>.c``.
+    family : str
+        The model family.
+    n_temps : int
+        Number of temperature inputs.
+    unit : str
+        Unit of the functions' signal and results.
+    model_unit : str
+        The model's own unit.
+    temperature_unit : str
+        Unit of the temperature inputs.
+    """
 
     prefix: str
     real: str
@@ -168,7 +201,19 @@ def write_together(files: Sequence[tuple[Path, str]]) -> None:
 
 @dataclass(frozen=True)
 class ExportContext:
-    """What a family generator gets: the model dict, the C prefix and helpers."""
+    """What a family generator gets: the model dict, the C prefix and helpers.
+
+    Attributes
+    ----------
+    model : dict
+        The model as saved.
+    prefix : str
+        The C identifier prefix.
+    real : str
+        ``"double"`` or ``"float"``.
+    rate_buffer_len : int
+        Length of the ring buffer of the rate terms.
+    """
 
     model: dict[str, Any]
     prefix: str
@@ -210,9 +255,10 @@ class ExportContext:
         if not math.isfinite(x):
             raise ModelFileError(f"non-finite coefficient {x!r} cannot be exported")
         if self.real == "float" and abs(x) > FLT_MAX:
-            raise ModelFileError(
+            raise ModelFileError.naming(
                 f"the constant {float(x)!r} is beyond a C float's largest value FLT_MAX = "
-                f"{FLT_MAX:.8g} (C11 §5.2.4.2.2): export it without --float (in double)"
+                f"{FLT_MAX:.8g} (C11 §5.2.4.2.2): export it without {{use_float}} (in double)",
+                "use_float",
             )
         if self.real == "float" and abs(x) < FLT_MIN:
             x = 0.0  # below FLT_MIN: what a float holds of it is 0 (no truncation warning)
@@ -423,9 +469,10 @@ def c_signal_unit(model: dict[str, Any], unit: str | None = None) -> tuple[str, 
         unit = str(given) if ok else mu
     u = units.normalize_signal_unit(unit)
     if u != mu and (units.signal_kind(u) == "raw" or units.signal_kind(mu) == "raw"):
-        raise UnitError(
-            f"export-c --unit {u}: raw counts need the scale factor, the model is in {mu}; "
-            "give a physical unit of the model's kind"
+        raise UnitError.naming(
+            f"{{unit}} {u}: raw counts need the scale factor, the model is in {mu}; "
+            "give a physical unit of the model's kind",
+            "unit",
         )
     return u, float(units.convert(1.0, u, mu))
 
