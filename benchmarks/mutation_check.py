@@ -229,6 +229,14 @@ MUTANTS: tuple[Mutant, ...] = (
         "°/s → °/h by 60 instead of 3600",
     ),
     Mutant(
+        "units-per-signal-order",
+        P + "units.py",
+        "    return {c: u or None for c, u in zip(signals, parts, strict=True)}",
+        "    return {c: u or None for c, u in zip(signals, parts[::-1], strict=True)}",
+        _t("options_signal_units", "units_resolver"),
+        "one unit per signal: the units given to the wrong signals",
+    ),
+    Mutant(
         "units-earth-rate-typo",
         P + "units.py",
         "EARTH_RATE_RAD_S: Final = 7.292115e-5",

@@ -8,7 +8,7 @@ range and NaN count, temperature span, spikes (Hampel test) and the problems of
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -110,7 +110,7 @@ class ColumnSummary:
 
 @dataclass(frozen=True)
 class Inspection:
-    """Summary of a recording (the keys of ``inspect --json``)."""
+    """Summary of a recording (the keys of the ``inspect`` command's JSON output)."""
 
     file: str
     n_samples: int
@@ -136,7 +136,19 @@ class Inspection:
         """Problems that stop the other commands (severity ``error``)."""
         return [p for p in self.problems if p.severity == "error"]
 
-    def to_dict(self) -> dict[str, Any]:
+    def to_dict(self, spell: Callable[[str], str] | None = None) -> dict[str, Any]:
+        """JSON-ready dict; each problem's message names parameters as ``spell`` shows them
+        (:meth:`thermocal.recording.Problem.text`: their own names without it).
+
+        Parameters
+        ----------
+        spell : callable, optional
+            What to show for a parameter (the command line: its option).
+
+        Returns
+        -------
+        dict
+        """
         return {
             "file": self.file,
             "n_samples": self.n_samples,
@@ -148,7 +160,7 @@ class Inspection:
             "n_segments": self.n_segments,
             "columns": {k: v.to_dict() for k, v in self.columns.items()},
             "temperature_span": self.temperature_span,
-            "problems": [p.to_dict() for p in self.problems],
+            "problems": [p.to_dict(spell) for p in self.problems],
             "time_ok": self.time_ok,
             "usable": not self.fatal,
             "timestamp_jitter": (

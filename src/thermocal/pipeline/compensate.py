@@ -72,7 +72,12 @@ from thermocal.models.ranges import outside_range_dict
 from thermocal.models.rundata import check_sensor_id
 from thermocal.outputs import refuse_special_input, sidecar_path, warn_formula_names
 from thermocal.readers.common import default_time_column, names_list
-from thermocal.readers.dispatch import read_recording, read_whole_table, time_hint
+from thermocal.readers.dispatch import (
+    TIME_HINT_PARAMETERS,
+    read_recording,
+    read_whole_table,
+    time_hint,
+)
 from thermocal.readers.formats import FileFormat, file_kind, format_of
 from thermocal.readers.options import ReadOptions
 from thermocal.readers.table import load_sidecar, numeric_column
@@ -528,7 +533,7 @@ def compensate_channels(
     if len(set(sig_list)) != len(sig_list):
         raise ThermocalInputError(f"a signal column appears twice: {sig_list}")
     source = _open_source(src, fmt, r)
-    sig_opts = units.per_signal_option(r.signal_unit, sig_list)
+    sig_opts = units.per_signal_unit(r.signal_unit, sig_list)
     ctx = _FileContext(src, source.names, source.info, source.time_col, source.available,
                        signal_given)  # fmt: skip
     opts = units.UnitOptions(
@@ -617,9 +622,10 @@ def _open_source(src: Path, fmt: FileFormat, read: ReadOptions) -> _Source:
     available = names_list(names)  # the first 20 and how many more (10 000 columns: one line)
     if time_col not in names:
         hint = time_hint(names, (info.get("text_layout") or {}).get("banner") or ())
-        raise MissingColumnError(
+        raise MissingColumnError.naming(
             f"{src}: no time column {time_col!r}; available: {available}"
-            + (hint if time is None else "")
+            + (hint if time is None else ""),
+            *TIME_HINT_PARAMETERS,
         )
     return _Source(src, fmt, names, info, table, time_col, available)
 
@@ -749,7 +755,7 @@ def _channel_plan(
     ctx: _FileContext,
     sig_name: str,
     model: TemperatureModel,
-    signal_unit: str | None,
+    signal_unit: str | tuple[str, ...] | None,
     opts: units.UnitOptions,
     *,
     extrapolate: bool,
@@ -1143,7 +1149,7 @@ def _resolve_triads(
     source: _Source,
     plans: Sequence[_TriadPlan],
     time_unit: str | None,
-    signal_unit: str | None = None,
+    signal_unit: str | tuple[str, ...] | None = None,
 ) -> units.ResolvedInputs:
     """The units of the triads' columns and temperatures resolved once (option > metadata >
     column name > the unit each triad was calibrated on); raw-count temperatures without a

@@ -204,11 +204,13 @@ def _conversion(value: object) -> TemperatureConversion:
 
 def _read_options(o: FitOptions) -> ReadOptions:
     """The :class:`ReadOptions` of a fit's reading fields."""
+    from thermocal.pipeline.reading import split_units
     from thermocal.readers.options import ReadOptions
 
     return ReadOptions(
         time=o.time, time_unit=o.time_unit, signals=o.signals, temperatures=o.temperatures,
-        signal_unit=o.signal_unit, temp_unit=o.temp_unit, temp_conversion=o.temp_conversion,
+        signal_unit=split_units(o.signal_unit), temp_unit=o.temp_unit,
+        temp_conversion=o.temp_conversion,
         topic=o.topic, names=o.names, rate_hz=o.rate_hz,
         on_bad_lines=o.on_bad_lines,
         delimiter=o.delimiter, decimal=o.decimal,

@@ -170,7 +170,7 @@ def _modeling_ambient(
         mrec = read_recording(mod_path, read, model=model)
         for prob in recording.find_problems(mrec, required=[amb]):
             if prob.severity == "error" and (prob.column in (None, "time", amb)):
-                raise ThermocalInputError(f"{mod_path}: {prob.message}")
+                raise ThermocalInputError.naming(f"{mod_path}: {prob.message}", *prob.parameters)
         ctx.modeling[mod_path] = mrec
     return mod_path, (mrec.time_s, ambient_c(mrec, amb))
 
@@ -285,7 +285,7 @@ def judge_triads(
     latitude_deg: float | None,
     *,
     static_s: float = 1.0,
-    signal_unit: str | None = None,
+    signal_unit: str | tuple[str, ...] | None = None,
 ) -> list[Any]:
     """Triads of a calibration judged on a recording: on held-out poses when the calibration
     is a multi-position one, else as a turntable run.
@@ -300,7 +300,7 @@ def judge_triads(
         Latitude [°] (None: the recording's metadata).
     static_s : float
         Shortest still stretch [s] of a held-out pose.
-    signal_unit : str, optional
+    signal_unit : str or tuple of str, optional
         The gyro's unit when the file does not state it.
 
     Returns
@@ -332,7 +332,7 @@ def _validate_triads(
     rec = read_for_triads(file, cal.triads, o.read_options)
     _own_session(cal, file)
     results = judge_triads(
-        cal.triads, rec, o.latitude, static_s=o.static_s, signal_unit=o.signal_unit
+        cal.triads, rec, o.latitude, static_s=o.static_s, signal_unit=o.read_options.signal_unit
     )
     for r in results:
         if r.outside_range_fraction > 0:
