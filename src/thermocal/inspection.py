@@ -64,7 +64,18 @@ def saturated_mask(x: npt.ArrayLike) -> npt.NDArray[np.bool_]:
     in a row (a wrapping counter passes it once); else the stretches where the column sits
     on its maximum or minimum for :data:`RAIL_RUN` samples or more, entered or left by a
     step :data:`RAIL_STEP` times its median step, more than 0.4 of the range from the
-    median."""
+    median.
+
+    Parameters
+    ----------
+    x : array_like
+        One column's samples.
+
+    Returns
+    -------
+    numpy.ndarray of bool
+        True where a sample sits on a rail.
+    """
     a = np.asarray(x, dtype=np.float64)
     out = np.zeros(a.shape, dtype=bool)
     fin = a[np.isfinite(a)]
@@ -92,7 +103,25 @@ def saturated_mask(x: npt.ArrayLike) -> npt.NDArray[np.bool_]:
 
 @dataclass(frozen=True)
 class ColumnSummary:
-    """Range and NaN count of one column (in its own unit)."""
+    """Range and NaN count of one column (in its own unit).
+
+    Attributes
+    ----------
+    name : str
+        The column.
+    role : str
+        ``"signal"``, ``"temperature"`` or ``"other"``.
+    unit : str
+        Its unit.
+    min, max, mean : float or None
+        Its smallest, largest and mean finite values [``unit``] (None: none finite).
+    n_nan : int
+        Number of NaN cells.
+    first_nan_row : int or None
+        The first of them (0-based data row).
+    n_spikes : int
+        Samples found as spikes.
+    """
 
     name: str
     role: str
@@ -110,7 +139,35 @@ class ColumnSummary:
 
 @dataclass(frozen=True)
 class Inspection:
-    """Summary of a recording (the keys of the ``inspect`` command's JSON output)."""
+    """Summary of a recording (the keys of the ``inspect`` command's JSON output).
+
+    Attributes
+    ----------
+    file : str
+        The recording.
+    n_samples : int
+        Number of samples.
+    duration_s : float or None
+        Last minus first time [s].
+    sample_rate_hz : float or None
+        Sample rate [Hz].
+    median_interval_s : float or None
+        Median time step [s].
+    gaps : list of dict
+        The gaps in time.
+    n_segments : int or None
+        Gap-free stretches.
+    columns : dict of str to ColumnSummary
+        Each column's summary.
+    temperature_span : dict
+        [min, max] [°C] per temperature column.
+    problems : list of Problem
+        What is wrong with the recording.
+    time_ok : bool
+        Time is finite and strictly increasing.
+    timestamp_jitter : TimeJitter or None
+        The scatter of the time steps.
+    """
 
     file: str
     n_samples: int

@@ -173,6 +173,15 @@ class Gap:
 
     ``start_s`` is the time of the last sample before the gap (elapsed from the
     first sample when reported by ``inspect``).
+
+    Attributes
+    ----------
+    index : int
+        The sample before the gap.
+    start_s : float
+        Time of that sample [s].
+    length_s : float
+        Time between the two samples [s].
     """
 
     index: int
@@ -188,6 +197,21 @@ class Problem:
     ``row`` is the 0-based data row (not counting the header), when one is at fault.
     ``message`` writes each of ``parameters`` (the library's parameters it names, such as
     ``rate_hz``) as ``{parameter}``; :meth:`text` shows them.
+
+    Attributes
+    ----------
+    kind : str
+        What kind of problem (a short key).
+    message : str
+        The message, with ``{parameter}`` for each of ``parameters``.
+    severity : {"error", "warning"}
+        Whether results would be wrong.
+    column : str or None
+        The column at fault.
+    row : int or None
+        The 0-based data row at fault.
+    parameters : tuple of str
+        The library's parameters the message names.
     """
 
     kind: str
@@ -729,6 +753,21 @@ class TimeScan:
     rounding; otherwise the median step (one O(n) partition).  NaN for fewer than 2 samples
     or a non-finite time.  ``duplicate_rows``/``backward_rows`` are the ``i`` with
     ``Δt_i = 0`` / ``Δt_i < 0``.
+
+    Attributes
+    ----------
+    n : int
+        Number of samples.
+    finite : bool
+        Every time is finite.
+    min_step_s, max_step_s : float
+        Smallest and largest step [s].
+    interval_s : float
+        Nominal sample interval [s].
+    regular : bool
+        The stamps lie on a regular grid.
+    duplicate_rows, backward_rows : numpy.ndarray of intp
+        The ``i`` with ``Δt_i = 0`` and ``Δt_i < 0``.
     """
 
     n: int
@@ -900,6 +939,17 @@ class TimeJitter:
     over the median (``0.3``: the steps scatter ±30 % around it); ``n_same`` the steps of
     zero length (a burst of samples stamped at the same instant by a host);
     ``n_steps`` how many steps were measured.
+
+    Attributes
+    ----------
+    interval_s : float
+        Median step [s].
+    relative : float
+        Half the 5–95 % range of the steps over the median.
+    n_same : int
+        Steps of zero length.
+    n_steps : int
+        Steps measured.
     """
 
     interval_s: float
@@ -1220,7 +1270,17 @@ def _physical_of_counts(
 @dataclass(frozen=True)
 class Extrema:
     """Smallest and largest finite value of a column, their first rows, and the number
-    of finite values (:func:`finite_extrema`)."""
+    of finite values (:func:`finite_extrema`).
+
+    Attributes
+    ----------
+    lo, hi : float
+        Smallest and largest finite value.
+    lo_row, hi_row : int
+        Their first rows.
+    count : int
+        Number of finite values.
+    """
 
     lo: float
     lo_row: int

@@ -93,7 +93,25 @@ def _is_number(field: str, decimal: str, *, empty: bool = False) -> bool:
 class TextLayout:
     """A text log's layout found by :func:`sniff_text`: ``skip`` lines before the header
     (or first data row), the banner lines skipped, the delimiter, the decimal mark, whether
-    the first kept line is a header, the number of fields."""
+    the first kept line is a header, the number of fields.
+
+    Attributes
+    ----------
+    skip : int
+        Lines before the header (or first data row).
+    banner : tuple of str
+        The banner lines skipped.
+    delimiter : str
+        Field delimiter.
+    decimal : str
+        Decimal mark.
+    header : bool
+        The first kept line is a header.
+    n_fields : int
+        Number of fields.
+    text_columns : tuple of int
+        Positions of the fields that hold text.
+    """
 
     skip: int
     banner: tuple[str, ...]
