@@ -145,7 +145,7 @@ class CompensateFileResult:
     outside_calibrated_range: bool = False
 
     def to_dict(self) -> dict[str, Any]:
-        """The fields (``extra`` merged in) as a dict, for ``--json``."""
+        """The fields (``extra`` merged in) as a dict, for the JSON result."""
         d = {k: getattr(self, k) for k in self.__dataclass_fields__ if k != "extra"}
         d.update(self.extra)
         return d
@@ -195,7 +195,7 @@ class _RunningMoments:
 def _source_format(path: str | Path, read: ReadOptions) -> tuple[Path, FileFormat, ReadOptions]:
     """The input of a chunked pass, its registered format and how to read it: a format that
     cannot be read in chunks is refused naming the file, its format and what to do; a
-    station folder's sensor (``DIR`` with ``--sensor ID``) is read as ``DIR/ID``."""
+    station folder's sensor (``DIR`` with ``topic`` ``ID``) is read as ``DIR/ID``."""
     src = Path(path)
     fmt = format_of(src)
     if fmt.chunks == "none":
@@ -207,7 +207,9 @@ def _source_format(path: str | Path, read: ReadOptions) -> tuple[Path, FileForma
     if fmt.locate is not None:
         return fmt.locate(src, read.topic), fmt, read.replace(topic=None)
     if read.topic is not None and "topic" not in fmt.options:
-        raise ThermocalInputError(f"{src}: --topic is for flight-controller logs (.ulg, .bin)")
+        raise ThermocalInputError.naming(
+            f"{src}: {{topic}} is for flight-controller logs (.ulg, .bin)", "topic"
+        )
     return src, fmt, read
 
 
@@ -542,9 +544,10 @@ def compensate_channels(
     ]  # fmt: skip
     t_units = {plan.time_unit for plan in plans}
     if len(t_units) > 1:
-        raise UnitError(
+        raise UnitError.naming(
             f"{src}: the channels' models disagree on the time unit "
-            f"({' and '.join(sorted(t_units))}); give --time-unit"
+            f"({' and '.join(sorted(t_units))}); give {{time_unit}}",
+            "time_unit",
         )
     t_unit = plans[0].time_unit
     out_info = _output_info(source.info, source.time_col, t_unit, plans)
@@ -763,9 +766,10 @@ def _channel_plan(
     model.check_fitted()
     temp_names = list(model.temp_names_)
     if sig_name not in names:
-        raise MissingColumnError(
+        raise MissingColumnError.naming(
             f"{src}: no signal column {sig_name!r} (the model's signal"
-            f"{' given by --signal' if ctx.signal_given else ''}); available: {ctx.available}"
+            f"{' given by {signals}' if ctx.signal_given else ''}); available: {ctx.available}",
+            "signals",
         )
     missing = [c for c in temp_names if c not in names]
     if missing:
@@ -1005,7 +1009,7 @@ class TriadCompensation:
     count_scale: float | None = None
 
     def to_dict(self) -> dict[str, Any]:
-        """The fields as a dict, for ``--json``."""
+        """The fields as a dict, for the JSON result."""
         return dataclasses.asdict(self)
 
 
@@ -1343,7 +1347,7 @@ class CalibrationCompensation:
     """``(channel name, model family, result)``; one entry for ``single``."""
 
     def to_dict(self) -> dict[str, Any]:
-        """The ``thermocal compensate --json`` object."""
+        """The JSON object of the ``compensate`` command."""
         if self.kind == "triads":
             return {"model": self.model_file, "output": self.output,
                     "triads": [d.to_dict() for d in self.triads]}  # fmt: skip
