@@ -73,7 +73,7 @@ from thermocal.models.rundata import check_sensor_id
 from thermocal.outputs import refuse_special_input, sidecar_path, warn_formula_names
 from thermocal.readers.common import default_time_column, names_list
 from thermocal.readers.dispatch import read_recording, read_whole_table, time_hint
-from thermocal.readers.formats import FileFormat, file_kind, format_of
+from thermocal.readers.formats import FileFormat, format_of
 from thermocal.readers.options import ReadOptions
 from thermocal.readers.table import load_sidecar, numeric_column
 from thermocal.recording import (
@@ -1363,18 +1363,13 @@ class CalibrationCompensation:
         }
 
 
-def _split_names(text: str | None) -> list[str]:
-    """``"gx, gy,gz"`` → ``["gx", "gy", "gz"]`` (None or empty: none)."""
-    return [t.strip() for t in (text or "").split(",") if t.strip()]
-
-
 def compensate_calibration_file(
     model_file: str | Path,
     path: str | Path,
     out: str | Path,
     read: ReadOptions | None = None,
     *,
-    signal: str | None = None,
+    signals: tuple[str, ...] | None = None,
     chunk_rows: int = DEFAULT_CHUNK_ROWS,
     extrapolate: bool = False,
     known_input: float = 0.0,
@@ -1396,9 +1391,9 @@ def compensate_calibration_file(
         The output; it may be neither input (nor, for a CSV, may its sidecar).
     read : ReadOptions, optional
         How the recording is read (:class:`~thermocal.readers.options.ReadOptions`).
-    signal : str, optional
-        One channel: its column (default the model's); several: the channels to apply,
-        ``"gx,gy"`` (default all).
+    signals : tuple of str, optional
+        One channel: its column, ``("gx",)`` (default the model's); several: the channels
+        to apply, ``("gx", "gy")`` (default all).
     chunk_rows, extrapolate, known_input, on_progress
         As :func:`compensate_file`.
 
@@ -1416,7 +1411,7 @@ def compensate_calibration_file(
     from thermocal.pipeline.model_file import load_calibration
 
     check_not_input(out, [path, model_file])
-    if file_kind(Path(out)) == "csv":  # the CSV's sidecar must not land on an input either
+    if _CHUNK_WRITERS[written_format(Path(out))].sidecar:  # nor may its sidecar
         check_not_input(sidecar_path(out), [path, model_file])
     cal = load_calibration(model_file)  # a model file is a calibration of one channel
     if cal.triads:
@@ -1433,11 +1428,12 @@ def compensate_calibration_file(
     )  # fmt: skip
     if len(cal.channels) == 1:
         ch = cal.channels[0]
+        signal = ",".join(signals) if signals else None  # one column (a list: none such)
         res = compensate_file(ch.model, path, out, read, signal=signal, **common)
         return CalibrationCompensation(
             str(model_file), str(out), "single", channels=((ch.name, ch.model.family, res),)
         )
-    chosen = _split_names(signal) or cal.names
+    chosen = list(signals or ()) or cal.names
     models = [(cal.channel(n).signal, cal.channel(n).model) for n in chosen]
     results = compensate_channels(models, path, out, read, **common)
     return CalibrationCompensation(
