@@ -165,6 +165,7 @@ OPTION_OF: dict[str, str] = {
     "start_window_s": "--start-window",
     "select": "--select-method",
     "file_format": "--format",
+    "params": "--param",
 }
 """Library parameters whose command-line option is not the parameter's name with dashes
 (``time_unit`` → ``--time-unit`` needs no entry)."""
