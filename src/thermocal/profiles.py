@@ -93,9 +93,13 @@ class Ramp:
             )
         lo, hi = RAMP_RATE_RANGE
         if not lo <= abs(self.rate_c_per_min) <= hi:
-            raise ThermocalInputError(
-                f"ramp rate {self.rate_c_per_min:g} °C/min: a chamber ramps at {lo:g} to "
-                f"{hi:g} °C/min; give a rate in that range"
+            raise ThermocalInputError.naming(
+                f"ramp rate {self.rate_c_per_min:g} °C/min ({{rate_c_per_min}}, "
+                f"{{cycle_rate_c_per_min}}, {{rates_c_per_min}}): a chamber ramps at {lo:g} to "
+                f"{hi:g} °C/min; give a rate in that range",
+                "rate_c_per_min",
+                "cycle_rate_c_per_min",
+                "rates_c_per_min",
             )
 
 

@@ -127,3 +127,14 @@ def test_validate_options_are_typed() -> None:
         ValidateOptions(temp_conversion="0.0625")
     assert info.value.parameter == "temp_conversion"
     assert str(info.value).startswith("temp_conversion")
+
+
+def test_a_ramp_rate_no_chamber_has_names_the_profile_parameters() -> None:
+    from thermocal.profiles import builtin_profile
+
+    with pytest.raises(ThermocalInputError) as info:
+        builtin_profile("fog-slow", rate_c_per_min=1e300)
+    assert "°C/min (rate_c_per_min, cycle_rate_c_per_min, rates_c_per_min): a chamber" in str(
+        info.value
+    )
+    assert "°C/min (--rate, --cycle-rate, --rates): a chamber" in error_text(info.value)[0]

@@ -570,7 +570,10 @@ def _judge_fitted(spec: _FitSpec, p: _Prepared) -> None:
     try:
         judged = _adequacy.Adequacy(tests, tuple(spec.overrides), p.sig_name).enforce()
     except ThermocalInputError as exc:  # name the files, as a reader's error does
-        raise ThermocalInputError(f"{', '.join(str(r.name) for r in p.runs)}: {exc}") from None
+        files = ", ".join(str(r.name) for r in p.runs)
+        if exc.template is None:
+            raise ThermocalInputError(f"{files}: {exc}") from None
+        raise ThermocalInputError.naming(f"{files}: {exc.template}", *exc.parameters) from None
     rec = p.est.adequacy_
     if rec is None:  # judged before the fit: always a record here
         return

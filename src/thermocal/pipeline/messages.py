@@ -166,6 +166,9 @@ OPTION_OF: dict[str, str] = {
     "select": "--select-method",
     "file_format": "--format",
     "params": "--param",
+    "rate_c_per_min": "--rate",
+    "cycle_rate_c_per_min": "--cycle-rate",
+    "rates_c_per_min": "--rates",
 }
 """Library parameters whose command-line option is not the parameter's name with dashes
 (``time_unit`` → ``--time-unit`` needs no entry)."""
