@@ -723,6 +723,14 @@ MUTANTS: tuple[Mutant, ...] = (
         "ArduPilot coefficients multiplied by 1e-6 instead of divided",
     ),
     Mutant(
+        "params-file-int32-as-float",
+        P + "firmware/formats.py",
+        "shown = str(int(value)) if typ == 6 else repr(float(value))",
+        "shown = str(int(value)) if typ == 9 else repr(float(value))",
+        _t("firmware_formats"),
+        "a parameter file writes int32 parameters as floats (and floats truncated)",
+    ),
+    Mutant(
         "params-ardupilot-tref",
         P + "firmware/formats.py",
         "AP_TREF_C = 35.0",
@@ -1845,9 +1853,9 @@ MUTANTS: tuple[Mutant, ...] = (
     Mutant(
         "metrics-average-advice-whole-record",
         P + "metrics.py",
-        "{option} {longest_s / 2.0:.3g} or less",
-        "{option} {longest_s:.3g} or less",
-        _t("tempcal_averages", "metrics_averages"),
+        "{name} {longest_s / 2.0:.3g} or less",
+        "{name} {longest_s:.3g} or less",
+        _t("tempcal_averages", "metrics_averages", "metrics_parameter_names"),
         "the advised --average is the whole record (one average), not half",
     ),
     Mutant(

@@ -29,7 +29,12 @@ import numpy.typing as npt
 
 from thermocal import units
 from thermocal._lazy import LazyModule
-from thermocal.errors import MissingValueError, PlausibilityWarning, ThermocalInputError
+from thermocal.errors import (
+    MissingValueError,
+    ParameterError,
+    PlausibilityWarning,
+    ThermocalInputError,
+)
 from thermocal.recording import Recording, contiguous_slices, is_increasing
 
 _Run = TypeVar("_Run")
@@ -68,7 +73,19 @@ class TemperatureSensitivity:
 
 @dataclass(frozen=True)
 class Stage:
-    """A temperature-hold stage: its mean temperature [°C] and bias [unit]."""
+    """A temperature-hold stage: its mean temperature [°C] and bias [unit].
+
+    Attributes
+    ----------
+    start_s, stop_s : float
+        The stage's span [s].
+    mean_temp_c : float
+        Its mean temperature [°C].
+    bias : float
+        Its mean bias [unit].
+    n_samples : int
+        Samples in it.
+    """
 
     start_s: float
     stop_s: float
@@ -85,7 +102,7 @@ class DriftReference:
     ----------
     kind : ``"window"`` — b0 is the mean of ω − Ω_axis over the reference window
         [``start_s``, ``end_s``] (seconds since the first sample); ``"bias"`` — b0 was
-        given (``--drift-bias``); ``"model"`` — a compensation model removed the bias
+        given (``drift_bias``); ``"model"`` — a compensation model removed the bias
         (b0 = 0 on the compensated output).
     start_s, end_s : the window [s since the first sample] (None unless ``"window"``).
     bias : b0 [``unit``], earth rate already removed (comparable with ``bias``).
@@ -106,7 +123,19 @@ class DriftExtreme:
     """The drift angle's end value and its largest magnitude (the FOG thesis).
 
     ``end`` θ(t_end), ``max_abs`` max_t |θ(t)|, reached at ``max_time_s`` [s since the
-    first sample]; all angles in [``unit``]."""
+    first sample]; all angles in [``unit``].
+
+    Attributes
+    ----------
+    end : float
+        θ(t_end) [``unit``].
+    max_abs : float
+        max_t |θ(t)| [``unit``].
+    max_time_s : float
+        When it is reached [s since the first sample].
+    unit : str
+        Unit of the angles.
+    """
 
     end: float
     max_abs: float
@@ -137,6 +166,43 @@ class MetricsResult:
     ``θ(t) = ∫ (ω − Ω_axis − b0) dt`` [``drift_angle_unit``: deg, or rad for rad/s data],
     b0 the constant stated by ``drift_reference`` (trapezoid rule, gaps not integrated;
     gyros only).
+
+    Attributes
+    ----------
+    bias : float
+        Mean of the signal less the earth-rate component [unit].
+    bias_stability : float
+        Standard deviation of the ``averaging_s`` averages [unit].
+    averaging_s : float
+        Averaging time [s].
+    peak_to_peak : float
+        Peak-to-peak of the averages [unit].
+    unit : str
+        The data's own unit.
+    temperature_sensitivity : TemperatureSensitivity or None
+        Bias against temperature over the hold stages (None: fewer than two stages).
+    bias_repeatability : float or None
+        Standard deviation of the stages' biases [unit].
+    stages : tuple of Stage
+        The hold stages.
+    drift_angle : float or None
+        θ at the end [``drift_angle_unit``] (gyros).
+    drift_angle_unit : str or None
+        ``deg``, or ``rad`` for rad/s data.
+    earth_rate_removed : float
+        Earth-rate component taken off the bias [unit].
+    n_samples, n_segments, n_averages : int
+        Samples, gap-free segments and averages.
+    duration_s : float
+        Span of the record [s].
+    signal : str
+        The signal column.
+    drift_angle_max : float or None
+        Largest |θ| [``drift_angle_unit``].
+    drift_angle_max_time_s : float or None
+        When it is reached [s since the first sample].
+    drift_reference : DriftReference or None
+        How b0 was taken.
     """
 
     bias: float
@@ -160,8 +226,8 @@ class MetricsResult:
     drift_reference: DriftReference | None = None
 
     def to_dict(self) -> dict[str, Any]:
-        """The figures as plain Python values: the object ``thermocal metrics --json``
-        prints for one channel (NaN where it prints null).
+        """The figures as plain Python values: the object the ``metrics`` command prints
+        as JSON for one channel (NaN where it prints null).
 
         Returns
         -------
@@ -385,7 +451,6 @@ def bias_stability(
     *,
     time_s: npt.ArrayLike | None = None,
     where: str | None = None,
-    option: str | None = "--average",
 ) -> float:
     r"""Bias stability: the standard deviation of the averages over ``averaging_s``.
 
@@ -401,8 +466,6 @@ def bias_stability(
         Sample times [s]; no average spans a gap (:func:`block_means`).
     where : str, optional
         The file a refusal names.
-    option : str or None
-        The averaging option of the command that asked (None if it has none).
 
     Returns
     -------
@@ -412,7 +475,8 @@ def bias_stability(
     Raises
     ------
     thermocal.errors.ThermocalInputError
-        Fewer than two averages.
+        Fewer than two averages (the message names ``averaging_s`` with the longest
+        averaging time that gives two).
 
     Notes
     -----
@@ -427,13 +491,19 @@ def bias_stability(
     """
     means = block_means(rate, tau0_s, averaging_s, time_s=time_s)
     if means.size < 2:
-        raise ThermocalInputError(
-            too_few_averages(
-                where, float(averaging_s or tau0_s), means.size,
-                _longest_stretch_s(time_s, tau0_s, np.size(rate)), option,
-            )
+        raise _too_few_averages_error(
+            where, float(averaging_s or tau0_s), means.size,
+            _longest_stretch_s(time_s, tau0_s, np.size(rate)),
         )  # fmt: skip
     return float(np.std(means, ddof=1))
+
+
+def _too_few_averages_error(
+    where: str | None, averaging_s: float, n_means: int, longest_s: float
+) -> ThermocalInputError:
+    """The refusal of :func:`too_few_averages` naming the parameter ``averaging_s``."""
+    text = too_few_averages(where, averaging_s, n_means, longest_s, "{averaging_s}")
+    return ThermocalInputError.naming(text, "averaging_s")
 
 
 def _longest_stretch_s(time_s: npt.ArrayLike | None, tau0_s: float, n: int) -> float:
@@ -445,12 +515,13 @@ def _longest_stretch_s(time_s: npt.ArrayLike | None, tau0_s: float, n: int) -> f
 
 
 def too_few_averages(
-    where: str | None, averaging_s: float, n_means: int, longest_s: float, option: str | None
+    where: str | None, averaging_s: float, n_means: int, longest_s: float, name: str | None
 ) -> str:
     """The message of a record that gives fewer than two ``averaging_s`` averages: the file
-    ``where``, and the command's option ``option`` (e.g. ``--average``) with the longest
-    averaging time that gives two averages (half the longest stretch without a gap
-    ``longest_s`` [s]); without an option, the record's length is what falls short.
+    ``where``, and the name ``name`` of what sets the averaging time (a parameter,
+    ``averaging_s``) with the longest averaging time that gives two averages (half the
+    longest stretch without a gap ``longest_s`` [s]); without a name, the record's length is
+    what falls short.
 
     Parameters
     ----------
@@ -462,18 +533,23 @@ def too_few_averages(
         Number of averages it gives.
     longest_s : float
         Longest gap-free stretch [s].
-    option : str or None
-        Command option to name.
+    name : str or None
+        What sets the averaging time, as the message names it (None: nothing does).
 
     Returns
     -------
     str
         The message.
+
+    Examples
+    --------
+    >>> too_few_averages("a.csv", 600.0, 1, 900.0, "averaging_s").split("; ")[-1]
+    'give averaging_s 450 or less'
     """
     head = f"{where}: " if where else ""
     fix = (
-        f"; give {option} {longest_s / 2.0:.3g} or less"
-        if option and longest_s / 2.0 > 0
+        f"; give {name} {longest_s / 2.0:.3g} or less"
+        if name and longest_s / 2.0 > 0
         else f"; its longest stretch without a gap is {longest_s:.3g} s: record at least "
         f"{2.0 * averaging_s:.3g} s"
     )
@@ -523,6 +599,23 @@ class RunRepeatability:
     ``runs`` each run's figures (its bias and in-run bias stability); ``bias_repeatability``
     the sample standard deviation of the run biases, ``low``/``high`` its chi-square
     interval at ``confidence`` (:func:`std_interval`); ``bias_mean`` the mean run bias.
+
+    Attributes
+    ----------
+    runs : tuple of MetricsResult
+        Each run's figures.
+    files : tuple of str
+        The runs' files.
+    bias_mean : float
+        Mean of the run biases [unit].
+    bias_repeatability : float
+        Sample standard deviation of the run biases [unit].
+    bias_repeatability_low, bias_repeatability_high : float
+        Its chi-square interval at ``confidence`` [unit].
+    confidence : float
+        Confidence level of the interval.
+    unit : str
+        The data's unit.
     """
 
     runs: tuple[MetricsResult, ...]
@@ -535,8 +628,8 @@ class RunRepeatability:
     unit: str
 
     def to_dict(self) -> dict[str, Any]:
-        """The repeatability as plain Python values: the object ``thermocal metrics FILE
-        FILE… --json`` prints for one channel (NaN where it prints null).
+        """The repeatability as plain Python values: the object the ``metrics`` command
+        prints as JSON for one channel of several files (NaN where it prints null).
 
         Returns
         -------
@@ -661,9 +754,10 @@ def run_repeatability(
     unit = runs[0].unit
     for r, f in zip(runs, files, strict=True):
         if r.unit != unit:
-            raise ThermocalInputError(
+            raise ThermocalInputError.naming(
                 f"{f}: {r.signal} is in {r.unit}, the first run in {unit}; give the runs in "
-                "one unit (--signal-unit)"
+                "one unit ({signal_unit})",
+                "signal_unit",
             )
     biases = [r.bias for r in runs]
     br = bias_repeatability(biases)
@@ -951,7 +1045,8 @@ def reference_bias(
     Raises
     ------
     ThermocalInputError
-        When the window holds no sample.
+        When the window is not 0 ≤ start < end or holds no sample (the message names the
+        window as :func:`compute_metrics` does, ``drift_reference_s``).
     """
     t = _as_1d(time_s, "time")
     r = _as_1d(rate, "rate")
@@ -962,9 +1057,10 @@ def reference_bias(
     else:
         start, end = float(window_s[0]), float(window_s[1])
         if not (math.isfinite(start) and math.isfinite(end) and end > start >= 0.0):
-            raise ThermocalInputError(
-                f"--drift-reference {start:g},{end:g}: give START,END in seconds since the "
-                "first sample, with 0 ≤ START < END"
+            raise ThermocalInputError.naming(
+                f"{{drift_reference_s}} {start:g},{end:g}: give START,END in seconds since "
+                "the first sample, with 0 ≤ START < END",
+                "drift_reference_s",
             )
     if is_increasing(t):  # the window is one stretch: found by bisection, no copy
         # t_i − t_0 is non-decreasing in i (rounding is monotone): the rows with
@@ -979,9 +1075,10 @@ def reference_bias(
         n = int(np.count_nonzero(sel))
         selected = r[sel]
     if n == 0:
-        raise ThermocalInputError(
+        raise ThermocalInputError.naming(
             f"drift reference window {start:g}…{end:g} s holds no sample (the run lasts "
-            f"{duration:g} s from its first sample); choose another --drift-reference"
+            f"{duration:g} s from its first sample); choose another {{drift_reference_s}}",
+            "drift_reference_s",
         )
     b0 = float(np.mean(selected)) - float(earth_rate)
     return DriftReference("window", start, end, b0, unit, n)
@@ -1084,7 +1181,9 @@ def _earth_rate(
     if lat is None and axis is None:
         return 0.0
     if lat is None or ax is None:
-        raise ThermocalInputError("earth-rate removal needs both --latitude and --axis")
+        raise ThermocalInputError.naming(
+            "earth-rate removal needs both {latitude_deg} and {axis}", "latitude_deg", "axis"
+        )
     if canon != "deg/h":
         raise ThermocalInputError(
             f"earth-rate removal applies to gyro rates, but {name!r} is in {unit}"
@@ -1108,17 +1207,23 @@ def _drift(
     an error)."""
     if unit not in RATE_ANGLE_UNITS:
         if drift_bias is not None or drift_reference_s is not None:
-            raise ThermocalInputError(
+            raise ThermocalInputError.naming(
                 f"the drift angle applies to gyro rates, but {name!r} is in {unit}: "
-                "--drift-reference/--drift-bias do not apply"
+                "{drift_reference_s}/{drift_bias} do not apply",
+                "drift_reference_s",
+                "drift_bias",
             )
         return None
     angle_unit, per = RATE_ANGLE_UNITS[unit]
     if drift_bias is not None:
         if drift_reference_s is not None:
-            raise ThermocalInputError("give either --drift-reference or --drift-bias, not both")
+            raise ThermocalInputError.naming(
+                "give either {drift_reference_s} or {drift_bias}, not both",
+                "drift_reference_s",
+                "drift_bias",
+            )
         if not math.isfinite(drift_bias):
-            raise ThermocalInputError(f"--drift-bias must be a number, got {drift_bias!r}")
+            raise ParameterError("drift_bias", f"{{name}} must be a number, got {drift_bias!r}")
         ref = DriftReference("bias", None, None, float(drift_bias), unit)
     else:
         ref = reference_bias(t, values, window_s=drift_reference_s, earth_rate=earth, unit=unit)
@@ -1176,7 +1281,6 @@ def compute_metrics(
     min_hold_s: float = 600.0,
     drift_reference_s: tuple[float, float] | None = None,
     drift_bias: float | None = None,
-    average_option: str | None = "--average",
 ) -> MetricsResult:
     """All figures of merit of one signal of a recording, in the data's own unit
     (:func:`data_unit_of`).
@@ -1196,8 +1300,6 @@ def compute_metrics(
         first sample]; b0 is the mean of ω − Ω_axis over it (:func:`reference_bias`;
         default the first 10 % of the run).
     drift_bias : b0 given instead [data unit, earth rate already removed].
-    average_option : the option of the asking command that sets ``averaging_s`` (named
-        when the record gives fewer than two averages; ``None``: the command has none).
 
     The drift angle ``θ(t) = ∫ (ω − Ω_axis − b0) dt`` (gyros only) is never taken about
     the same run's mean (that makes θ(t_end) ≈ 0 by construction): b0 is the stated
@@ -1216,12 +1318,9 @@ def compute_metrics(
     b0 = bias(values, earth_rate_deg_h=earth)
     means = block_means(values, tau0, avg, time_s=t)
     if means.size < 2:
-        raise ThermocalInputError(
-            too_few_averages(
-                rec.source or rec.name, avg, means.size,
-                _longest_stretch_s(t, tau0, values.size), average_option,
-            )
-        )  # fmt: skip
+        raise _too_few_averages_error(
+            rec.source or rec.name, avg, means.size, _longest_stretch_s(t, tau0, values.size)
+        )
     stab = float(np.std(means, ddof=1))
     p2p = float(np.max(means) - np.min(means))
     drift = _drift(t, values, name, unit, earth, drift_reference_s, drift_bias)
@@ -1264,7 +1363,27 @@ class MetricsOptions:
     """The options of :func:`compute_metrics` shared by every channel and run (``metrics``'
     command line): averaging time [s], earth-rate removal (latitude [°], axis), temperature
     columns, hold-stage detection (|Ṫ| [°C/min], shortest hold [s]) and the drift angle's
-    reference window [s] or bias [data unit]."""
+    reference window [s] or bias [data unit].
+
+    Attributes
+    ----------
+    averaging_s : float or None
+        Averaging time [s] (None: the default for the record).
+    latitude_deg : float or None
+        Site latitude [°] (earth-rate removal, with ``axis``).
+    axis : str or None
+        Sensitive axis (``up``, ``north``, … or ``'e,n,u'``).
+    temps : tuple of str or None
+        Temperature columns (None: those of the file).
+    rate_threshold_c_per_min : float
+        |Ṫ| below which a hold stage is found [°C/min].
+    min_hold_s : float
+        Shortest hold stage [s].
+    drift_reference_s : (float, float) or None
+        Window [s since the first sample] whose mean is the drift angle's bias b0.
+    drift_bias : float or None
+        The drift angle's bias b0 given directly [data unit].
+    """
 
     averaging_s: float | None = None
     latitude_deg: float | None = None
@@ -1331,9 +1450,12 @@ def channel_metrics(
         Figures per channel.
     """
     if len(names) > 1 and options.removes_earth_rate:
-        raise ThermocalInputError(
-            "earth-rate removal (--latitude/--axis) takes one signal at a time: each channel's "
-            "sensitive axis points elsewhere; run metrics per gyro axis with its --axis"
+        raise ThermocalInputError.naming(
+            "earth-rate removal ({latitude_deg}/{axis}) takes one signal at a time: each "
+            "channel's sensitive axis points elsewhere; run metrics per gyro axis with its "
+            "{axis}",
+            "latitude_deg",
+            "axis",
         )
     return {name: options.of(rec, name) for name in names}
 
@@ -1341,7 +1463,17 @@ def channel_metrics(
 @dataclass(frozen=True, eq=False)
 class PowerOnMetrics:
     """The result of :func:`power_on_metrics`: the channels, each run's figures per channel
-    (in the order of the runs) and the turn-on to turn-on repeatability per channel."""
+    (in the order of the runs) and the turn-on to turn-on repeatability per channel.
+
+    Attributes
+    ----------
+    names : tuple of str
+        The channels.
+    runs : tuple of dict of str to MetricsResult
+        Each run's figures per channel, in the order of the runs.
+    repeatability : dict of str to RunRepeatability
+        Turn-on to turn-on repeatability per channel.
+    """
 
     names: tuple[str, ...]
     runs: tuple[dict[str, MetricsResult], ...]
@@ -1475,8 +1607,10 @@ def power_on_metrics(
         elif these != names:
             raise ThermocalInputError(f"{run}: signals {these} differ from the first run's {names}")
         if len(these) > 1 and options.removes_earth_rate:
-            raise ThermocalInputError(
-                "earth-rate removal (--latitude/--axis) takes one signal at a time"
+            raise ThermocalInputError.naming(
+                "earth-rate removal ({latitude_deg}/{axis}) takes one signal at a time",
+                "latitude_deg",
+                "axis",
             )
         _same_sensor(rec, str(run), sensors)
         _not_a_copy(rec, these, str(run), seen)

@@ -132,6 +132,17 @@ class BlockAverage:
     ``time_s`` is the mean time of each block's samples, ``values`` the
     block means (rows = blocks, columns = input channels), ``counts`` the
     samples per block and ``segment`` the contiguous segment each block lies in.
+
+    Attributes
+    ----------
+    time_s : numpy.ndarray
+        Mean time of each block's samples [s].
+    values : numpy.ndarray
+        Block means, rows = blocks, columns = the input channels [their units].
+    counts : numpy.ndarray of int64
+        Samples in each block.
+    segment : numpy.ndarray of int64
+        The contiguous segment (between gaps) each block lies in.
     """
 
     time_s: FloatArray

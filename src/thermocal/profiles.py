@@ -57,7 +57,15 @@ DEFAULT_CORRELATION_POINTS = 10_000
 
 @dataclass(frozen=True)
 class Hold:
-    """Keep the current set-point for ``duration_s`` [s]."""
+    """Keep the current set-point for ``duration_s`` [s].
+
+    Attributes
+    ----------
+    duration_s : float
+        Duration [s].
+    label : str
+        Label of the hold.
+    """
 
     duration_s: float
     label: str = ""
@@ -78,6 +86,15 @@ class Ramp:
 
     The duration is ``|target − current| / |rate| · 60`` [s]; the sign of the
     rate is ignored (the direction follows from the target).
+
+    Attributes
+    ----------
+    target_c : float
+        Set-point reached at the end [°C].
+    rate_c_per_min : float
+        Ramp rate [°C/min]; its sign is ignored.
+    label : str
+        Label of the ramp.
     """
 
     target_c: float
@@ -110,6 +127,15 @@ class Cycle:
     When ``label`` is set, the pieces of repetition ``i`` (1-based) are labelled
     ``f"{label}{i}/{piece label}"``, so repetitions can be told apart
     (e.g. ``run3/soak-low``).
+
+    Attributes
+    ----------
+    segments : tuple of Hold, Ramp or Cycle
+        The segments of one repetition.
+    repeats : int
+        Number of repetitions.
+    label : str
+        Prefix of the labels of each repetition ("" : the pieces keep their labels).
     """
 
     segments: tuple[Segment, ...]
@@ -127,7 +153,19 @@ Segment = Hold | Ramp | Cycle
 @dataclass(frozen=True)
 class Piece:
     """One linear piece of an expanded profile: ``start_c`` at ``start_s`` to ``end_c`` at
-    ``end_s`` ([s], [°C]); ``kind`` is ``"hold"`` or ``"ramp"``."""
+    ``end_s`` ([s], [°C]); ``kind`` is ``"hold"`` or ``"ramp"``.
+
+    Attributes
+    ----------
+    start_s, end_s : float
+        Start and end [s] from the profile's start.
+    start_c, end_c : float
+        Set-point at the start and at the end [°C].
+    kind : str
+        ``"hold"`` or ``"ramp"``.
+    label : str
+        The label of the segment it comes from.
+    """
 
     start_s: float
     end_s: float
@@ -150,7 +188,17 @@ class Piece:
 
 @dataclass(frozen=True)
 class Stage:
-    """A constant-temperature stage (hold): ``start_s``..``end_s`` [s] at ``setpoint_c`` [°C]."""
+    """A constant-temperature stage (hold): ``start_s``..``end_s`` [s] at ``setpoint_c`` [°C].
+
+    Attributes
+    ----------
+    start_s, end_s : float
+        Start and end [s] from the profile's start.
+    setpoint_c : float
+        Set-point [°C].
+    label : str
+        Label of the hold.
+    """
 
     start_s: float
     end_s: float
@@ -196,6 +244,17 @@ class Profile:
     """A chamber profile: start set-point ``start_c`` [°C] and a list of segments.
 
     ``params`` records the parameters a built-in profile was made with.
+
+    Attributes
+    ----------
+    start_c : float
+        Set-point at the start [°C].
+    segments : tuple of Hold, Ramp or Cycle
+        The program.
+    name : str
+        The built-in profile's name ("" : a profile of the user's).
+    params : dict
+        The parameters a built-in profile was made with.
     """
 
     start_c: float
@@ -301,6 +360,32 @@ def rlg_modelling(
     Finally a ramp back to ``start_c``.  The default lasts ≈ 65 h; its 3-h soaks at the
     extremes take the sensor further than the 2-h holds of ``rlg-validation``, so a
     model fitted on it covers the validation run without extrapolating.
+
+    Parameters
+    ----------
+    low_c, high_c : float
+        The cycles' ends [°C] (``low_c < high_c``).
+    start_c : float
+        Set-point at the start and at the end [°C].
+    n_temperature_cycles : int
+        Number of cycles of part 1.
+    cycle_rate_c_per_min : float
+        Ramp rate of part 1 [°C/min].
+    hold_s : float
+        Holds at the ends in part 1 [s].
+    rates_c_per_min : sequence of float
+        Ramp rates R of part 2 [°C/min].
+    rate_hold_s : float
+        Holds at the ends in part 2 [s].
+
+    Returns
+    -------
+    Profile
+
+    Raises
+    ------
+    ThermocalInputError
+        ``low_c`` not below ``high_c``.
     """
     if not low_c < high_c:
         raise ThermocalInputError(f"low_c ({low_c}) must be below high_c ({high_c})")
@@ -344,6 +429,26 @@ def rlg_validation(
     From ``start_c``, for each temperature: ramp at ``rate_c_per_min``, hold
     ``hold_s`` (one value or one per hold; label ``hold {T:+g}``); then ramp back
     to ``start_c``.
+
+    Parameters
+    ----------
+    holds_c : sequence of float
+        Hold temperatures [°C], in order.
+    hold_s : float or sequence of float
+        Duration of each hold [s]: one for all or one per hold.
+    rate_c_per_min : float
+        Ramp rate between holds [°C/min].
+    start_c : float
+        Set-point at the start and at the end [°C].
+
+    Returns
+    -------
+    Profile
+
+    Raises
+    ------
+    ThermocalInputError
+        No hold temperature, or a number of durations that is neither 1 nor one per hold.
     """
     holds = [float(h) for h in holds_c]
     if not holds:
@@ -371,7 +476,28 @@ def fog_slow(
     n_cycles: int = 1,
 ) -> Profile:
     """The FOG thesis's slow drift over 15–42 °C: hold at ``low_c``, then ``n_cycles`` × (ramp
-    to ``high_c`` at ``rate_c_per_min``, hold, ramp to ``low_c``, hold); ≈ 12 h by default."""
+    to ``high_c`` at ``rate_c_per_min``, hold, ramp to ``low_c``, hold); ≈ 12 h by default.
+
+    Parameters
+    ----------
+    low_c, high_c : float
+        The range's ends [°C] (``low_c < high_c``).
+    rate_c_per_min : float
+        Ramp rate [°C/min].
+    hold_s : float
+        Hold at each end [s].
+    n_cycles : int
+        Number of cycles.
+
+    Returns
+    -------
+    Profile
+
+    Raises
+    ------
+    ThermocalInputError
+        ``low_c`` not below ``high_c``.
+    """
     if not low_c < high_c:
         raise ThermocalInputError(f"low_c ({low_c}) must be below high_c ({high_c})")
     segs: tuple[Segment, ...] = (
@@ -422,6 +548,28 @@ def mems_warmup(
     For each start temperature T0: ramp to T0, soak ``soak_s`` unpowered (label
     ``soak T0``), then hold ``record_s`` ≥ 6 min with the unit powered (label
     ``power-on T{T0:+g}``, see :func:`power_on_label`).
+
+    Parameters
+    ----------
+    start_temps_c : sequence of float
+        The start temperatures T0 [°C].
+    soak_s : float
+        Unpowered soak at each T0 [s].
+    record_s : float
+        Powered record after each soak [s] (≥ 360 s).
+    transition_rate_c_per_min : float
+        Rate of the ramps between start temperatures [°C/min].
+    start_c : float
+        Set-point at the start [°C].
+
+    Returns
+    -------
+    Profile
+
+    Raises
+    ------
+    ThermocalInputError
+        ``record_s`` below 6 min.
     """
     if record_s < 360:
         raise ThermocalInputError(
@@ -461,6 +609,34 @@ def accel_full_range(
     to ``high_c`` (``ramp``, type-1 data) and soak (``soak-high``), then constant
     points every ``step_c`` from ``low_c`` to ``high_c`` held ``point_hold_s``
     (``point {T:+g}``, type-2 data), and return to ``start_c``.
+
+    Parameters
+    ----------
+    low_c, high_c : float
+        The range's ends [°C] (``low_c < high_c``).
+    soak_s : float
+        Soak at each end [s].
+    rate_c_per_min : float
+        Rate of the ramp from ``low_c`` to ``high_c`` [°C/min].
+    step_c : float
+        Step between the constant points [°C] (> 0).
+    point_hold_s : float
+        Hold at each constant point [s].
+    repeats : int
+        Number of runs.
+    start_c : float
+        Set-point at power-on and at the end of each run [°C].
+    startup_s : float
+        Hold at ``start_c`` after power-on [s].
+
+    Returns
+    -------
+    Profile
+
+    Raises
+    ------
+    ThermocalInputError
+        ``low_c`` not below ``high_c`` or a step that is not positive.
     """
     if not low_c < high_c:
         raise ThermocalInputError(f"low_c ({low_c}) must be below high_c ({high_c})")
@@ -649,6 +825,19 @@ class CorrelationResult:
     r : Pearson coefficient ``Cov(X, Y)/(σ_X σ_Y)``; weakly_correlated : ``r < r_limit``
     (the RLG patent literally; see :func:`correlate`); n : number of common points;
     duration_s : length of the common base [s]; r_limit : the limit used.
+
+    Attributes
+    ----------
+    r : float
+        Pearson coefficient.
+    weakly_correlated : bool
+        ``r < r_limit``.
+    n : int
+        Number of common points.
+    duration_s : float
+        Length of the common base [s].
+    r_limit : float
+        The limit used.
     """
 
     r: float

@@ -93,7 +93,23 @@ from thermocal.recording import FloatArray, median_interval
 
 @dataclass(frozen=True)
 class StageFigures:
-    """Figures of one temperature-hold stage, before and after compensation [signal unit]."""
+    """Figures of one temperature-hold stage, before and after compensation [signal unit].
+
+    Attributes
+    ----------
+    index : int
+        The stage's number, from 0.
+    start_s, stop_s : float
+        Its span [s].
+    mean_temp_c : float
+        Its mean temperature [°C].
+    n_samples, n_averages : int
+        Samples and averages in it.
+    bias_before, bias_after : float
+        Mean bias before and after compensation [unit].
+    bias_stability_before, bias_stability_after : float
+        Standard deviation of the averages before and after [unit].
+    """
 
     index: int
     start_s: float
@@ -123,6 +139,47 @@ class ValidationResult:
     """Result of :func:`validate`; :meth:`to_dict` gives the ``validate`` command's JSON keys.
 
     ``r`` and ``weakly_correlated`` are ``None`` when no modelling history was given.
+
+    Attributes
+    ----------
+    r : float or None
+        Correlation of the validation and modelling temperature histories.
+    weakly_correlated : bool or None
+        ``r < r_limit``.
+    r_limit : float
+        The limit used.
+    n_stages : int
+        Number of hold stages.
+    stages : tuple of StageFigures
+        Each stage's figures.
+    bias_stability_before, bias_stability_after : float
+        RMS over the stages of their bias stabilities, before and after compensation [unit].
+    bias_repeatability_before, bias_repeatability_after : float
+        Standard deviation of the stages' mean biases before and after [unit].
+    rms_before, rms_after : float
+        RMS about their mean of the whole run's averages before and after [unit].
+    peak_to_peak_before, peak_to_peak_after : float
+        Peak-to-peak of the averages before and after [unit].
+    averaging_s : float
+        Averaging time [s].
+    unit : str
+        The signal's unit.
+    n_samples : int
+        Samples validated.
+    warnings : tuple of str
+        The validation's warnings.
+    extra : dict
+        Further figures.
+    absolute_before, absolute_after : AbsoluteFigures or None
+        Per-sample figures of the raw and compensated output about ``zero_reference`` [unit].
+    zero_reference : float
+        The level an ideal sensor would output [unit].
+    zero_reference_what : str
+        What that level is.
+    absolute_worse : tuple of str
+        The absolute figures the compensation made worse (beyond 1 %).
+    outside_range : tuple of RangeExcess
+        How far the run leaves the model's calibrated ranges, per input.
     """
 
     r: float | None

@@ -401,11 +401,20 @@ def _write_parquet(p: Path, data: dict[str, FloatArray], info: dict[str, Any],
 
 def _write_csv(p: Path, data: dict[str, FloatArray], info: dict[str, Any],
                sidecar: bool | None) -> None:  # fmt: skip
-    """A CSV recording (Arrow's writer: shortest exact numbers) and its sidecar."""
+    """A CSV recording (Arrow's writer: shortest exact numbers) and its sidecar; gzip
+    compressed when the name ends ``.gz`` (``run.csv.gz``, as the CSV reader expects)."""
     warn_formula_names(p, data)  # kept exactly: a program reads the names back
     table = pa.table(data)
     opts = pacsv.WriteOptions(include_header=True, quoting_style="needed")
-    atomic_write_path(p, lambda tmp: pacsv.write_csv(table, tmp, write_options=opts))
+
+    def write(tmp: Path) -> None:
+        if p.name.lower().endswith(".gz"):
+            with pa.CompressedOutputStream(str(tmp), "gzip") as out:
+                pacsv.write_csv(table, out, write_options=opts)
+        else:
+            pacsv.write_csv(table, tmp, write_options=opts)
+
+    atomic_write_path(p, write)
     if sidecar is None or sidecar:
         write_json(sidecar_path(p), info)
 

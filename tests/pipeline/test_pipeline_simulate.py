@@ -3,6 +3,7 @@
 
 from __future__ import annotations
 
+import gzip
 import json
 import shutil
 from pathlib import Path
@@ -69,3 +70,56 @@ def test_options_name_the_parameter_and_the_cli_the_option(
     code = main(["simulate", "fog-slow", "-o", str(tmp_path / "x.csv"), *opts])
     assert code == 2
     assert capsys.readouterr().err.strip() == f"error: {cli}"
+
+
+@pytest.mark.parametrize("ending", [".log", ".tsv", ".csv.gz"])
+def test_a_stem_with_any_registered_csv_suffix_names_several_files(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], ending: str
+) -> None:
+    """``-o out/warm.log`` for a scenario of several runs: the suffix is the file-format
+    registry's (a CSV ending it lists), kept after each run's label, as ``-o out/warm.csv``
+    names them; each file reads back with the rows the command printed."""
+    args = ["simulate", "accel-full-range", "--runs", "2", "--seed", "1", "--json"]
+    assert main([*args, "-o", str(tmp_path / "ref" / "warm.csv")]) == 0
+    ref = [Path(f).name for f in json.loads(capsys.readouterr().out)["files"]]
+    assert main([*args, "-o", str(tmp_path / "got" / f"warm{ending}")]) == 0
+    printed = json.loads(capsys.readouterr().out)
+    assert [Path(f).name for f in printed["files"]] == [
+        n.removesuffix(".csv") + ending for n in ref
+    ]
+    for f, n in zip(printed["files"], printed["n_samples"], strict=True):
+        assert read_recording(f).n_samples == n
+    if ending == ".csv.gz":  # gzip, holding the text -o warm.csv holds
+        for got, name in zip(printed["files"], ref, strict=True):
+            assert Path(got).read_bytes()[:2] == b"\x1f\x8b"
+            assert gzip.decompress(Path(got).read_bytes()) == (tmp_path / "ref" / name).read_bytes()
+
+
+def test_a_csv_gz_that_is_not_gzip_is_refused_in_one_line(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A plain CSV named ``.csv.gz`` (what thermocal wrote before it compressed them)."""
+    bad = tmp_path / "run.csv.gz"
+    bad.write_text("time,gx,T\n0,1,20\n1,2,21\n", encoding="utf-8")
+    assert main(["inspect", str(bad)]) == 2
+    lines = capsys.readouterr().err.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith(
+        f"error: {bad}: named .gz but not a readable gzip"
+    )
+
+
+@pytest.mark.parametrize(
+    ("name", "what"), [("warm.ulg", "a PX4 log"), ("warm.bin", "an ArduPilot log")]
+)
+def test_a_log_format_thermocal_only_reads_is_refused_before_simulating(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], name: str, what: str
+) -> None:
+    out = tmp_path / name
+    code = main(["simulate", "accel-full-range", "--runs", "2", "-o", str(out)])
+    lines = capsys.readouterr().err.strip().splitlines()
+    assert code == 2 and len(lines) == 1, lines
+    assert lines[0] == (
+        f"error: {out}: thermocal reads {what} but writes recordings as CSV or Parquet; name "
+        "the output *.csv or *.parquet"
+    )
+    assert list(tmp_path.iterdir()) == []

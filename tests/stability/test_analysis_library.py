@@ -96,7 +96,7 @@ def test_allan_analysis_checks_its_options() -> None:
     rec = _rate_recording()
     with pytest.raises(ThermocalInputError, match="use rate or phase"):
         allan_analysis(rec, ["gx"], data_type="angle")
-    with pytest.raises(ThermocalInputError, match="--dynamic computes"):
+    with pytest.raises(ThermocalInputError, match="dynamic_s computes"):
         allan_analysis(rec, ["gx"], deviations=["mdev"], dynamic_s=100.0)
     assert parse_taus("decade") == "decade"
     assert parse_taus("1, 10,100") == [1.0, 10.0, 100.0]

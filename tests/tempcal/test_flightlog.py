@@ -81,3 +81,78 @@ def test_a_log_without_a_sensor_has_no_instances_and_reads_no_parameters(tmp_pat
     log.write_bytes(ulog_bytes([("sensor_accel", 0, SENSOR_FIELDS, dead)], params={"A": 1}))
     with pytest.warns(Warning, match="temperature all 0"), open_px4_log(log, TOPICS) as flight:
         assert flight.instances == () and dict(flight.parameters) == {}
+
+
+def _dataflash_sweep(path: Path) -> dict[str, Any]:
+    """An ArduPilot log of one IMU over a −10…50 °C sweep (x gyro = 1e-4 rad/s per °C about
+    20 °C, z accel = −g + 2e-3 m/s² per °C), the parameters the recording started with and one
+    changed half-way (``LOG_BITMASK`` 1 → 2)."""
+    from dataflash_writer import IMU_FMT, IMU_LABELS, PARM_FORMAT, dataflash_log, parm
+
+    rng = np.random.default_rng(7)
+    n = 12000
+    t = np.arange(n) * 0.05
+    temp = -10.0 + 60.0 * (0.5 - 0.5 * np.cos(np.pi * t / t[-1]))
+    gx = 1e-4 * (temp - 20.0) + rng.normal(0.0, 2e-4, n)
+    az = -9.80665 + 2e-3 * (temp - 20.0) + rng.normal(0.0, 5e-3, n)
+    imu = [(100, (int(1e6 + ti * 1e6), 0, float(g), 0.0, 0.0, 0.0, 0.0, float(a), 0, 0,
+                  float(tt))) for ti, g, a, tt in zip(t, gx, az, temp, strict=True)]  # fmt: skip
+    msgs = [parm("LOG_BITMASK", 1.0, 500), parm("INS_TCAL1_ENABLE", 0.0, 500)]
+    half = n // 2
+    msgs += [*imu[:half], parm("LOG_BITMASK", 2.0, int(1e6 + t[half] * 1e6)), *imu[half:]]
+    path.write_bytes(dataflash_log([(100, "IMU", IMU_FMT, IMU_LABELS), PARM_FORMAT], msgs))
+    return {"t": t, "temp": temp, "gx": gx, "change_s": 1.0 + t[n // 2]}
+
+
+def test_an_ardupilot_log_is_read_once_into_one_object(tmp_path: Path) -> None:
+    """read_ardupilot_log: the one pass's tables, parameters and changes are those written."""
+    from thermocal.tempcal.flightlog import read_ardupilot_log
+
+    log = tmp_path / "sweep.bin"
+    truth = _dataflash_sweep(log)
+    flight = read_ardupilot_log(log, ("IMU", "TCLR"))
+    df, info = flight.table("IMU", 0)
+    np.testing.assert_allclose(df["TimeUS"] * 1e-6, 1.0 + truth["t"], rtol=0, atol=1e-6)
+    np.testing.assert_allclose(df["GyrX"], truth["gx"], rtol=1e-6, atol=1e-9)  # float32
+    np.testing.assert_allclose(df["T"], truth["temp"], rtol=1e-6)
+    assert info["units"]["GyrX"] == "rad/s" and flight.rows("TCLR") == []
+    assert dict(flight.parameters) == {"LOG_BITMASK": 1.0, "INS_TCAL1_ENABLE": 0.0}
+    [change] = flight.parameter_changes
+    assert (change.name, change.old, change.new) == ("LOG_BITMASK", 1.0, 2.0)
+    assert change.time_s == pytest.approx(truth["change_s"], abs=1e-6)
+    assert flight.parameters_at_end()["LOG_BITMASK"] == 2.0
+
+
+def test_ardupilot_tempcal_reads_its_log_once(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The whole command, as a user runs it, opens the DataFlash log once (pymavlink's
+    reader constructed once), and the gyro's fitted slope is the one written."""
+    import json
+
+    from pymavlink import DFReader
+
+    from thermocal.cli import main
+
+    log = tmp_path / "sweep.bin"
+    _dataflash_sweep(log)
+    opened: list[str] = []
+    real = DFReader.DFReader_binary
+
+    def counting(filename: str, *args: Any, **kwargs: Any) -> Any:
+        opened.append(filename)
+        return real(filename, *args, **kwargs)
+
+    monkeypatch.setattr(DFReader, "DFReader_binary", counting)
+    code = main(["ardupilot-tempcal", str(log), "-o", str(tmp_path / "out"), "--json"])
+    out = capsys.readouterr()
+    assert code == 0, out.err
+    assert opened == [str(log)]
+    params = {}
+    for line in (tmp_path / "out" / "ardupilot.parm").read_text().splitlines():
+        if not line.startswith("#"):
+            name, value = line.split()
+            params[name] = float(value)
+    # the x gyro's slope about 35 °C is c1·1e-6 rad/s per °C: the written 1e-4
+    assert params["INS_TCAL1_GYR1_X"] * 1e-6 == pytest.approx(1e-4, rel=0.05)
+    assert "IMU.Gyr.0" in json.loads(out.out)["sensors"]

@@ -116,7 +116,35 @@ QUICK = DemoConfig(rate_hz=0.2, rates_c_per_min=(2.0, 1.0), n_holds=5, validatio
 
 @dataclass(frozen=True)
 class ModelSummary:
-    """One model of the demo: its files and key validation figures [°/h]."""
+    """One model of the demo: its files and key validation figures [°/h].
+
+    Attributes
+    ----------
+    label : str
+        The model's name in the report.
+    model_path, validation_path : Path
+        The model file and its validation (JSON).
+    c_files : tuple of Path
+        The generated C files.
+    n_coefficients : int
+        Number of coefficients.
+    condition_number : float or None
+        Condition number of the scaled design.
+    rms_residual : float
+        RMS of the fit's residuals [°/h].
+    r : float or None
+        Correlation of the modelling and validation temperature histories.
+    weakly_correlated : bool or None
+        Whether ``r`` is below the limit.
+    n_stages : int
+        Number of hold stages of the validation run.
+    bias_stability_before, bias_stability_after : float or None
+        Bias stability of the validation run before and after compensation [°/h].
+    bias_repeatability_before, bias_repeatability_after : float or None
+        Bias repeatability over the stages before and after compensation [°/h].
+    improvement_pct : dict of str to float or None
+        Improvement of each figure by compensation [%].
+    """
 
     label: str
     model_path: Path
@@ -142,6 +170,31 @@ class DemoResult:
     ``report_path`` is the HTML report; ``models`` the two models (the first is
     the one reported in detail and used for compensation); ``files`` every file
     written; ``timings_s`` the duration of each step [s] and ``elapsed_s`` the total.
+
+    Attributes
+    ----------
+    out_dir : Path
+        The demo's folder.
+    report_path : Path
+        The HTML report.
+    models : tuple of ModelSummary
+        The two models; the first is reported in detail and used for compensation.
+    recordings : dict of str to Path
+        The simulated recordings by role (modelling, validation).
+    compensated_path : Path
+        The compensated validation run.
+    files : tuple of Path
+        Every file written.
+    timings_s : dict of str to float
+        Duration of each step [s].
+    elapsed_s : float
+        Total duration [s].
+    seed : int
+        Seed of the simulation.
+    warnings : tuple of str
+        The warnings the steps gave.
+    extra : dict
+        Further figures of a variant of the demo.
     """
 
     out_dir: Path

@@ -55,7 +55,31 @@ AMBIENT = "T_chamber"
 class ChannelSummary:
     """One channel's figures: ``removed_pct`` share of the true temperature-induced bias
     removed on the validation run (``100 (1 − rms(e)/sd(E))``, e the model's error against
-    the truth E, both centred); validation figures in the channel's data unit."""
+    the truth E, both centred); validation figures in the channel's data unit.
+
+    Attributes
+    ----------
+    name, unit : str
+        The channel and its data unit.
+    n_coefficients : int
+        Number of coefficients of its model.
+    rms_residual : float
+        RMS of the fit's residuals [unit].
+    condition_number : float or None
+        Condition number of the scaled design.
+    temp_range_c : (float, float)
+        Temperature range of the fit [°C].
+    r : float or None
+        Correlation of the modelling and validation temperature histories.
+    bias_stability_before, bias_stability_after : float or None
+        Bias stability of the validation run before and after compensation [unit].
+    rms_before, rms_after : float or None
+        RMS of the validation run's bias about its mean before and after [unit].
+    removed_pct : float
+        Share of the true temperature-induced bias removed [%].
+    warnings : list of str
+        The channel's warnings.
+    """
 
     name: str
     unit: str
@@ -74,7 +98,21 @@ class ChannelSummary:
 
 @dataclass(frozen=True)
 class ImuDemoResult:
-    """Where everything went and the per-channel figures."""
+    """Where everything went and the per-channel figures.
+
+    Attributes
+    ----------
+    out_dir : Path
+        The demo's folder.
+    report_path, calibration_path : Path
+        The HTML report and the calibration file.
+    channels : list of ChannelSummary
+        Each channel's figures.
+    files : list of Path
+        Every file written.
+    elapsed_s : float
+        Total duration [s].
+    """
 
     out_dir: Path
     report_path: Path

@@ -17,7 +17,7 @@ def check_firmware_adequacy(cal: Calibration, path: str | Path, firmware: str | 
     (:func:`thermocal.adequacy.check_for_firmware`), for every triad that recorded the
     check and every channel; for ``firmware="ardupilot"`` also ArduPilot's own minimum
     sweep (:data:`thermocal.adequacy.ARDUPILOT_MIN_SPAN_C` [°C] between the channel's
-    fitted temperature limits, unless the fit recorded ``--allow-narrow``).
+    fitted temperature limits, unless the fit recorded the ``allow_narrow`` override).
 
     Parameters
     ----------
@@ -55,7 +55,8 @@ def check_firmware_adequacy(cal: Calibration, path: str | Path, firmware: str | 
             continue
         rng = ch.model.temp_range_
         span = float(rng[0, 1] - rng[0, 0]) if rng.size else 0.0
-        allowed = "--allow-narrow" in ((record or {}).get("overrides") or [])
+        overrides = (record or {}).get("overrides") or []
+        allowed = "--allow-narrow" in overrides  # cli-words: a fit records overrides as options
         if span < ARDUPILOT_MIN_SPAN_C and not allowed:
             raise ThermocalInputError(
                 f"{where}: the calibration covers {span:.3g} °C; ArduPilot's temperature "

@@ -22,15 +22,15 @@ another family, Ṫ or several temperature inputs, a power above 3, raw-count te
 without a conversion — is refused with what to fit instead.
 
 Accelerometers: gravity is in their data, and from one placement a horizontal bias
-cannot be told from the bench's tilt (:mod:`thermocal.gravity`: a triad fitted with
-``--gravity-axis`` removes gravity along its measured direction, so its model's constant
+cannot be told from the bench's tilt (:mod:`thermocal.gravity`: a triad fitted with a
+``gravity_axis`` removes gravity along its measured direction, so its model's constant
 holds the horizontal biases only relative to the placement's mean; a lone channel's
-direction is not known at all; without ``--gravity-axis`` the constant holds gravity).
+direction is not known at all; without ``gravity_axis`` the constant holds gravity).
 So no absolute accelerometer offset is ever written: the PX4 offset is relative to the
 model's value at the middle of the fitted range (PX4's own script fits accelerometers
 relative to the run's median; the absolute offset is the accelerometer calibration's,
 ``CAL_ACC*``), and ArduPilot's polynomial is relative to the calibration temperature by
-its definition.  The notes say so; a model fitted without ``--gravity-axis`` is also
+its definition.  The notes say so; a model fitted without ``gravity_axis`` is also
 warned.
 
 Refused: a channel given twice or to both triads, a channel of the other kind,
@@ -51,7 +51,7 @@ import numpy as np
 
 from thermocal import units
 from thermocal.errors import ParameterError, ThermocalInputError, ThermocalWarning
-from thermocal.firmware.formats import ARDUPILOT_SCALE, FORMATS, INT32_RANGE
+from thermocal.firmware.formats import ARDUPILOT_SCALE, FORMATS, INT32_RANGE, firmware_format
 from thermocal.models.base import TemperatureModel
 from thermocal.models.calibration import Calibration
 
@@ -136,27 +136,18 @@ class ParamSet:
         self.notes += [f"{label}: {n}" for n in other.notes]
 
     def text(self) -> str:
-        """The file: QGroundControl parameters (PX4) or ``NAME VALUE`` lines (ArduPilot)."""
-        if self.format == "px4":
-            head = [
-                "# Onboard parameters for Vehicle 1",
-                "#",
-                "# thermocal export-params --format px4 (thermal compensation, TC_*)",
-                "#",
-                "# Vehicle-Id Component-Id Name Value Type",
-            ]
-            rows = [
-                f"1\t1\t{n}\t{_num(v, self.types.get(n, 9))}\t{self.types.get(n, 9)}"
-                for n, v in self.params.items()
-            ]
-            return "\n".join(head + rows) + "\n"
-        head = ["# thermocal export-params --format ardupilot (INS_TCAL*)"]
-        rows = [f"{n} {_num(v, self.types.get(n, 9))}" for n, v in self.params.items()]
-        return "\n".join(head + rows) + "\n"
+        """The parameter file: its dialect's layout
+        (:class:`thermocal.firmware.formats.ParamsFileLayout`, a QGroundControl file for PX4,
+        ``NAME VALUE`` lines for ArduPilot) with a line saying what wrote it.
 
-
-def _num(v: float, typ: int) -> str:
-    return str(int(v)) if typ == 6 else repr(float(v))
+        Returns
+        -------
+        str
+        """
+        dialect = firmware_format(self.format)
+        what = f"{dialect.name} ({dialect.layout.thermal})"
+        provenance = f"# thermocal export-params --format {what}"  # cli-words: the file's origin
+        return dialect.layout.text(self.params, self.types, [provenance])
 
 
 def _model_unit_factor(kind: str, model_unit: str) -> float:
@@ -166,38 +157,46 @@ def _model_unit_factor(kind: str, model_unit: str) -> float:
     return float(units.convert(1.0, model_unit, "mg")) * units.MG_TO_MS2
 
 
+def _inexpressible(message: str) -> ThermocalInputError:
+    """The refusal of a channel the firmware formats cannot express, saying what to fit."""
+    return ThermocalInputError.naming(
+        f"{message}; fit it with {{model}} poly {{order}} 3 on one temperature column",
+        "model",
+        "order",
+    )
+
+
 def _check_expressible(name: str, model: TemperatureModel) -> None:
     """Refuse a channel the firmware formats cannot express, saying what to fit instead."""
-    fix = "fit it with --model poly --order 3 on one temperature column"
     if model.family != "poly":
-        raise ThermocalInputError(
+        raise _inexpressible(
             f"channel {name!r}: a {model.family} model cannot be written as firmware "
-            f"parameters (a cubic in T − TREF); {fix}"
+            "parameters (a cubic in T − TREF)"
         )
     temps = list(model.temp_names_)
     if len(temps) != 1:
-        raise ThermocalInputError(
+        raise _inexpressible(
             f"channel {name!r}: the model uses {len(temps)} temperature inputs "
-            f"({', '.join(temps)}); the firmware takes one; {fix}"
+            f"({', '.join(temps)}); the firmware takes one"
         )
     if model.temperature_unit != "degC":
-        raise ThermocalInputError(
+        raise ThermocalInputError.naming(
             f"channel {name!r}: the model is in raw temperature counts; the firmware takes °C: "
-            "refit with --temp-conversion GAIN,OFFSET"
+            "refit with {temp_conversion} GAIN,OFFSET",
+            "temp_conversion",
         )
     for c in model.coefficients_about(0.0):  # type: ignore[attr-defined]
         if c.name == "const":
             continue
         if "rate" in c.name:
-            raise ThermocalInputError(
+            raise _inexpressible(
                 f"channel {name!r}: the model has a temperature-rate term ({c.name}); the "
-                f"firmware has none; {fix}"
+                "firmware has none"
             )
         power = int(c.name.split("^")[1]) if "^" in c.name else 1
         if power > 3:
-            raise ThermocalInputError(
-                f"channel {name!r}: the model has a T^{power} term; the firmware takes a cubic; "
-                f"{fix}"
+            raise _inexpressible(
+                f"channel {name!r}: the model has a T^{power} term; the firmware takes a cubic"
             )
 
 
@@ -317,16 +316,20 @@ def map_axes(
         if found:
             out[kind] = {a: found[a] for a in AXES}
     if not out:
-        raise ThermocalInputError(
+        raise ThermocalInputError.naming(
             "no gyro or accelerometer triad found in the calibration's roles; give "
-            "--gyro X,Y,Z and/or --accel X,Y,Z"
+            "{gyro} X,Y,Z and/or {accel} X,Y,Z",
+            "gyro",
+            "accel",
         )
     if "gyro" in out and "accel" in out:
         both = sorted(set(out["gyro"].values()) & set(out["accel"].values()))
         if both:
-            raise ThermocalInputError(
-                f"--gyro and --accel both take channel {', '.join(map(repr, both))}; a "
-                "channel is one sensor's axis"
+            raise ThermocalInputError.naming(
+                f"{{gyro}} and {{accel}} both take channel {', '.join(map(repr, both))}; a "
+                "channel is one sensor's axis",
+                "gyro",
+                "accel",
             )
     return out
 
@@ -372,9 +375,10 @@ def check_values(ps: ParamSet) -> None:
                     "the firmware stores"
                 )
         elif not (math.isfinite(v) and abs(v) <= FLOAT32_MAX):
-            raise ThermocalInputError(
+            raise ThermocalInputError.naming(
                 f"{name} = {_show(v)}: not a finite float32 (|x| ≤ {FLOAT32_MAX:.8g}), which the "
-                "firmware stores; check the calibration's coefficients, range and --tref"
+                "firmware stores; check the calibration's coefficients, range and {tref_c}",
+                "tref_c",
             )
 
 
@@ -546,10 +550,12 @@ def _accel_notes(
     gravity = [((getattr(m, "inputs_", {}) or {}).get("known_input") or {}) for m in models]
     if not all("gravity" in str(k.get("what", "")) for k in gravity):
         warnings.warn(
-            "accel: fitted without --gravity-axis, so gravity is in the model's constant "
-            "(compensate would take it out); the firmware offsets below are relative, as "
-            "PX4's own script writes them",
-            ThermocalWarning,
+            ThermocalWarning.naming(
+                "accel: fitted without {gravity_axis}, so gravity is in the model's constant "
+                "(compensate would take it out); the firmware offsets below are relative, as "
+                "PX4's own script writes them",
+                "gravity_axis",
+            ),
             stacklevel=3,
         )
         why = "gravity is in the models' constants"
@@ -588,9 +594,11 @@ def _device_id(cal: Calibration, kind: str, given: Mapping[str, int] | None) -> 
                 )
             return int(text)
     warnings.warn(
-        f"{kind}: no numeric device id recorded; TC_*_ID written as 0, which PX4 matches to no "
-        "sensor: give --device-id",
-        ThermocalWarning,
+        ThermocalWarning.naming(
+            f"{kind}: no numeric device id recorded; TC_*_ID written as 0, which PX4 matches "
+            "to no sensor: give {device_id}",
+            "device_id",
+        ),
         stacklevel=3,
     )
     return 0
@@ -755,7 +763,7 @@ class ParamsFileResult:
         return FORMATS[self.format].sensors[kind].unit
 
     def to_dict(self) -> dict[str, Any]:
-        """The ``thermocal export-params --json`` object."""
+        """The result as a JSON object (what the ``export-params`` command prints as JSON)."""
         return {
             "output": self.output,
             "format": self.format,

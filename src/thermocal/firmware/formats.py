@@ -18,7 +18,7 @@ References
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
 
 AP_TREF_C = 35.0
@@ -84,13 +84,77 @@ class SensorParams:
 
 
 @dataclass(frozen=True)
+class ParamsFileLayout:
+    """How a dialect's parameter file is written: the lines its ground station expects
+    around thermocal's comment lines, then one line per parameter.
+
+    Parameters
+    ----------
+    row : str
+        One parameter's line, with ``{name}``, ``{value}`` and ``{type}`` (the MAVLink
+        type: 6 int32, written as an integer; 9 float, written as Python's shortest repr).
+    opening, closing : tuple of str
+        The lines before and after the comment lines.
+    thermal : str
+        What a thermal-compensation file of the dialect holds, for its provenance line.
+
+    References
+    ----------
+    - QGroundControl Developer Guide, *Parameter File Format*
+      (``Vehicle-Id Component-Id Name Value Type``, tab separated), as PX4-Autopilot
+      ``Tools/process_sensor_caldata.py`` writes it.
+    - ArduPilot, ``Tools/scripts/tempcal_IMU.py``: the ``.parm`` file of ``NAME VALUE``
+      lines Mission Planner loads.
+    """
+
+    row: str = "{name} {value}"
+    opening: tuple[str, ...] = ()
+    closing: tuple[str, ...] = ()
+    thermal: str = ""
+
+    def text(
+        self, params: Mapping[str, float], types: Mapping[str, int], comments: Iterable[str] = ()
+    ) -> str:
+        """The file's text: :attr:`opening`, ``comments``, :attr:`closing`, one :attr:`row`
+        per parameter, newline-terminated.
+
+        Parameters
+        ----------
+        params : Mapping[str, float]
+            Name → value [the parameter's unit], in the order written.
+        types : Mapping[str, int]
+            Name → MAVLink type (6 int32, 9 float; 9 when absent).
+        comments : iterable of str
+            Whole comment lines (``# …``) between the opening and the closing.
+
+        Returns
+        -------
+        str
+
+        Examples
+        --------
+        >>> ap = FORMATS["ardupilot"].layout
+        >>> ap.text({"INS_TCAL1_ENABLE": 1, "INS_TCAL1_TMIN": 10}, {"INS_TCAL1_ENABLE": 6})
+        'INS_TCAL1_ENABLE 1\\nINS_TCAL1_TMIN 10.0\\n'
+        >>> FORMATS["px4"].layout.text({"TC_G0_X0_0": 0.25}, {}).splitlines()[-1]
+        '1\\t1\\tTC_G0_X0_0\\t0.25\\t9'
+        """
+        rows = []
+        for name, value in params.items():
+            typ = types.get(name, 9)
+            shown = str(int(value)) if typ == 6 else repr(float(value))
+            rows.append(self.row.format(name=name, value=shown, type=typ))
+        return "\n".join([*self.opening, *comments, *self.closing, *rows]) + "\n"
+
+
+@dataclass(frozen=True)
 class FirmwareFormat:
     """One firmware dialect of thermal-compensation parameters.
 
     Parameters
     ----------
     name : str
-        The name given to ``--format`` and to the library (``"px4"``, ``"ardupilot"``).
+        The dialect's name (``"px4"``, ``"ardupilot"``).
     title : str
         What the parameter file is, for messages.
     params_file : str
@@ -112,6 +176,8 @@ class FirmwareFormat:
     documented : tuple of Documented
         The parameters whose type and values the firmware documents (checked before a
         parameter file is written).
+    layout : ParamsFileLayout
+        How its parameter file is written.
     """
 
     name: str
@@ -124,6 +190,7 @@ class FirmwareFormat:
     sensors: Mapping[str, SensorParams] = field(default_factory=dict)
     source: str = ""
     documented: tuple[Documented, ...] = ()
+    layout: ParamsFileLayout = ParamsFileLayout()
 
 
 FORMATS: dict[str, FirmwareFormat] = {
@@ -143,6 +210,12 @@ FORMATS: dict[str, FirmwareFormat] = {
                        "(src/modules/temperature_compensation parameters)"),
             Documented(r"TC_[GABM][0-3]_ID", 6, INT32_RANGE[0], INT32_RANGE[1], True,
                        "PX4 TC_*<n>_ID: int32 (same parameters)"),
+        ),
+        ParamsFileLayout(
+            "1\t1\t{name}\t{value}\t{type}",
+            ("# Onboard parameters for Vehicle 1", "#"),
+            ("#", "# Vehicle-Id Component-Id Name Value Type"),
+            "thermal compensation, TC_*",
         ),
     ),
     "ardupilot": FirmwareFormat(
@@ -170,6 +243,7 @@ FORMATS: dict[str, FirmwareFormat] = {
                        "ArduPilot TCAL_BARO_EXP: exp_limit_min 0 … exp_limit_max 2 "
                        "(AP_TempCalibration.h)"),
         ),
+        ParamsFileLayout("{name} {value}", thermal="INS_TCAL*"),
     ),
 }  # fmt: skip
 """The firmware dialects by name.  PX4: ``GYRO_COUNT_MAX = ACCEL_COUNT_MAX = 4`` with
@@ -222,6 +296,7 @@ __all__ = [
     "INT32_RANGE",
     "Documented",
     "FirmwareFormat",
+    "ParamsFileLayout",
     "SensorParams",
     "firmware_format",
 ]

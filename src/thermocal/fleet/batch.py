@@ -104,7 +104,17 @@ EXIT_SOME_FAILED = 4
 
 @dataclass(frozen=True)
 class UnitTask:
-    """What a worker needs for one unit (plain data: it travels to Dask workers)."""
+    """What a worker needs for one unit (plain data: it travels to Dask workers).
+
+    Attributes
+    ----------
+    unit : UnitSpec
+        The unit and its files.
+    fit : FitOptions
+        How its model is fitted.
+    validate : ValidateOptions
+        How it is validated.
+    """
 
     unit: UnitSpec
     fit: FitOptions
@@ -114,7 +124,29 @@ class UnitTask:
 @dataclass
 class UnitOutcome:
     """What a worker hands back for one unit: status, error, warnings, the results (``fit``
-    and ``validation``, as ``--json`` prints them), the files' bytes, seconds."""
+    and ``validation``, as ``--json`` prints them), the files' bytes, seconds.
+
+    Attributes
+    ----------
+    id : str
+        The unit.
+    status : str
+        ``"ok"`` or ``"failed"``.
+    error : str or None
+        The ``error:`` line of a failed unit.
+    warnings : list of str
+        Its ``warning:`` lines.
+    fit, validation : dict or None
+        The results as JSON objects (the fit's and the validation's ``to_dict()``).
+    files : dict of str to bytes
+        The files to write, by name.
+    seconds : float
+        Time taken [s].
+    worker : str
+        The worker that did it.
+    figures : dict
+        Per channel, the figures of :func:`channel_figures` [the channel's data unit].
+    """
 
     id: str
     status: str

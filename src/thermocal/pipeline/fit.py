@@ -361,13 +361,10 @@ def _prepare_channel(
     for path, rec in loaded:
         _values, run_unit = rec.signal(signal)
         sig_name = signal or rec.signals[0]
-        try:
-            check_not_stuck(
-                rec.column(sig_name), sig_name, str(path), "{signals}",
-                "has no thermal behaviour to model (a flat model of a dead channel)",
-            )  # fmt: skip
-        except ThermocalInputError as exc:  # the column's parameter, as the command shows it
-            raise ThermocalInputError.naming(str(exc), "signals") from None
+        check_not_stuck(
+            rec.column(sig_name), sig_name, str(path), "signals",
+            "has no thermal behaviour to model (a flat model of a dead channel)",
+        )  # fmt: skip
         if unit and run_unit != unit:
             raise ThermocalInputError(f"{path}: signal unit {run_unit} differs from {unit}")
         unit = run_unit

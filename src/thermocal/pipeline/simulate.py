@@ -1,10 +1,11 @@
-"""Simulated recordings written to files: ``thermocal simulate`` as one library call.
+"""Simulated recordings written to files: the ``simulate`` command as one library call.
 
 :func:`simulate_files` runs a scenario (:func:`thermocal.simulate.simulate_scenario`),
 names its files (:func:`simulation_paths`), refuses outputs over the inputs or on special
 files before and after simulating (:func:`thermocal.outputs.check_outputs`), writes each
 recording (a CSV with its ``.meta.json`` sidecar) and the truth JSON, and returns a
-:class:`SimulatedFiles` whose :meth:`~SimulatedFiles.to_dict` is what ``--json`` prints.
+:class:`SimulatedFiles` whose :meth:`~SimulatedFiles.to_dict` is what the command prints as
+JSON.
 
 Output naming:
 
@@ -25,12 +26,16 @@ from thermocal import defaults
 from thermocal.errors import FileFormatError, ParameterError, ThermocalInputError
 from thermocal.outputs import check_outputs, sidecar_path
 from thermocal.readers import file_kind
+from thermocal.readers.formats import file_suffix, format_named
 from thermocal.readers.program import read_program
 from thermocal.simulate import SimulateOptions, Simulation, simulate_scenario
-from thermocal.writers import check_not_input, write_json, write_recording
-
-FILE_FORMATS = {"csv": ".csv", "parquet": ".parquet"}
-"""The formats of the files written inside an output directory, by name."""
+from thermocal.writers import (
+    RECORDING_WRITERS,
+    check_not_input,
+    write_json,
+    write_recording,
+    written_format,
+)
 
 
 def check_scenario(scenario: str) -> None:
@@ -99,15 +104,12 @@ def simulation_paths(
     if _is_data_file(output):
         if len(labels) == 1:
             return [output]
-        name = output.name
-        suffix = next(
-            s for s in (".csv.gz", ".parquet", ".csv", ".txt", ".pq") if name.lower().endswith(s)
-        )
-        stem = name[: -len(suffix)]
+        suffix = file_suffix(output)  # the registered one: out.csv.gz → out_T+0.csv.gz
+        stem = output.name[: -len(suffix)]
         return [output.with_name(f"{stem}_{lab}{suffix}") for lab in labels]
-    ext = FILE_FORMATS.get(file_format)
-    if ext is None:
+    if file_format not in RECORDING_WRITERS:
         raise ParameterError("file_format", f"{{name}} must be csv or parquet, got {file_format!r}")
+    ext = format_named(file_format).suffixes[0]
     if output.exists() and not output.is_dir():
         raise ThermocalInputError(f"{output}: exists and is not a directory")
     return [output / (f"{scenario}_{lab}{ext}" if lab else f"{scenario}{ext}") for lab in labels]
@@ -117,6 +119,8 @@ def _early_gate(output: Path, truth: Path | None, inputs: list[str | Path]) -> N
     """Refuse outputs over the inputs or on special files before simulating (the files
     named after the results are checked again once known)."""
     files, dirs = ([output], []) if _is_data_file(output) else ([], [output])
+    if files:
+        written_format(output)  # a format thermocal reads but does not write: refused now
     check_outputs([*files, *([truth] if truth is not None else [])], inputs, dirs=dirs)
 
 
@@ -139,7 +143,7 @@ class SimulatedFiles:
     truth: Path | None
 
     def to_dict(self) -> dict[str, Any]:
-        """The summary ``thermocal simulate --json`` prints.
+        """The summary the ``simulate`` command prints as JSON.
 
         Returns
         -------
@@ -222,7 +226,6 @@ def simulate_files(
 
 
 __all__ = [
-    "FILE_FORMATS",
     "SimulatedFiles",
     "check_scenario",
     "simulate_files",

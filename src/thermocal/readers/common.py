@@ -54,6 +54,21 @@ def csv_float_options() -> dict[str, Any]:
     return {"float_precision": "round_trip"} if major < 3 else {}
 
 
+def _head_bytes(p: Path, probe_bytes: int) -> bytes:
+    """The first bytes of the text: decompressed for a name ending ``.gz`` (a file that is
+    not gzip refused in one line)."""
+    if not p.name.lower().endswith(".gz"):
+        with open(p, "rb") as fh:
+            return fh.read(probe_bytes)
+    import gzip
+
+    try:
+        with gzip.open(p, "rb") as fh:
+            return fh.read(probe_bytes)
+    except (gzip.BadGzipFile, EOFError) as exc:
+        raise FileFormatError(f"{p}: named .gz but not a readable gzip file ({exc})") from None
+
+
 def csv_encoding(path: str | Path, probe_bytes: int = 1 << 16) -> str:
     """The text encoding of a CSV file: ``utf-8-sig`` (UTF-8, with or without a byte-order
     mark) when its start decodes as UTF-8, else ``latin-1`` (Western lab PCs and
@@ -90,8 +105,7 @@ def csv_encoding(path: str | Path, probe_bytes: int = 1 << 16) -> str:
     """
     refuse_special_input(path)
     p = Path(path)
-    with open(p, "rb") as fh:
-        head = fh.read(probe_bytes)
+    head = _head_bytes(p, probe_bytes)
     if head.startswith((b"\xff\xfe", b"\xfe\xff")) or b"\x00" in head:
         raise FileFormatError(
             f"{p}: the text is UTF-16 or UTF-32 encoded (NUL bytes); save it as UTF-8 CSV"

@@ -431,6 +431,35 @@ def file_kind(path: str | Path) -> str:
     return _by_suffix(path).name
 
 
+def file_suffix(path: str | Path) -> str:
+    """The registered suffix that ends a file's name (the longest that matches), lower-case:
+    what a file named after it keeps (``out.csv.gz`` → ``out_T+0.csv.gz``).
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        The file.
+
+    Returns
+    -------
+    str
+        A suffix of the format :func:`file_kind` names.
+
+    Raises
+    ------
+    thermocal.errors.FileFormatError
+        No registered format has the file's suffix, or the file is an unfinished output.
+
+    Examples
+    --------
+    >>> from thermocal.readers.formats import file_suffix
+    >>> file_suffix("runs/warm.CSV.gz"), file_suffix("out.pq")
+    ('.csv.gz', '.pq')
+    """
+    name = str(path).lower()
+    return max((s for s in _by_suffix(path).suffixes if name.endswith(s)), key=len)
+
+
 __all__ = [
     "BUILT_IN",
     "COLUMN_FIELDS",
@@ -441,6 +470,7 @@ __all__ = [
     "FormatPluginWarning",
     "Reader",
     "file_kind",
+    "file_suffix",
     "format_named",
     "format_of",
     "registered_formats",

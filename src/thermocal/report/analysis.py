@@ -43,7 +43,33 @@ words of :func:`thermocal.models.results.condition_wording`."""
 
 @dataclass(frozen=True)
 class RunSignals:
-    """The bias of a run before and after compensation by one model [signal unit]."""
+    """The bias of a run before and after compensation by one model [signal unit].
+
+    Attributes
+    ----------
+    time_s : numpy.ndarray
+        Time [s].
+    signal : numpy.ndarray
+        The recorded signal [unit].
+    unit : str
+        Its unit.
+    before : numpy.ndarray
+        The bias before compensation (signal less the known input) [unit].
+    model : numpy.ndarray
+        The model's prediction [unit].
+    after : numpy.ndarray
+        The bias after compensation [unit].
+    temps_c : numpy.ndarray
+        The model's temperature inputs [°C], one column each.
+    temp_names : tuple of str
+        Their names.
+    known_input : float
+        The known input removed (earth rate, gravity) [unit].
+    warnings : tuple of str
+        Warnings of the compensation.
+    model_includes_known_input : bool
+        The model's prediction holds the known input (it was fitted with it).
+    """
 
     time_s: FloatArray
     signal: FloatArray
@@ -207,7 +233,33 @@ class FiguresOfMerit:
     the hold stages (least-squares slope and mean |ΔB/ΔT|) [unit/°C], and the drift
     angle θ(t) = ∫ (ω − Ω − b0) dt [``drift_angle_unit``] (gyros), b0 the constant of
     ``drift_reference``: its curve, end value, largest magnitude and when it is reached
-    [s since the first sample]; and the largest |θ| with no bias removed (b0 = 0)."""
+    [s since the first sample]; and the largest |θ| with no bias removed (b0 = 0).
+
+    Attributes
+    ----------
+    bias : float
+        Bias B0 [unit].
+    bias_stability : float
+        Standard deviation of the ``averaging_s`` averages [unit].
+    averaging_s : float
+        Averaging time [s].
+    peak_to_peak : float
+        Peak-to-peak of the averages [unit].
+    sensitivity_slope, sensitivity_mean_abs : float or None
+        Temperature sensitivity over the hold stages [unit/°C] (None: fewer than two stages).
+    drift_angle : numpy.ndarray or None
+        θ(t) [``drift_angle_unit``] (gyros; None otherwise).
+    drift_angle_end, drift_angle_max : float or None
+        θ at the end, and its largest magnitude [``drift_angle_unit``].
+    drift_angle_max_time_s : float or None
+        When the largest |θ| is reached [s since the first sample].
+    drift_angle_unit : str or None
+        Unit of the drift angle.
+    drift_reference : DriftReference or None
+        How b0 was taken.
+    drift_angle_raw_max : float or None
+        The largest |θ| with no bias removed [``drift_angle_unit``].
+    """
 
     bias: float
     bias_stability: float
@@ -251,7 +303,19 @@ def _in_degrees(value: float | None, unit: str | None) -> float | None:
 class Coverage:
     """How much of a run's span its samples cover: ``span_s`` first to last sample [s],
     ``covered_s`` the span less the gaps [s], ``n_gaps`` and ``gap_s`` their number and
-    total length beyond one sample interval [s] (:func:`coverage_of`)."""
+    total length beyond one sample interval [s] (:func:`coverage_of`).
+
+    Attributes
+    ----------
+    span_s : float
+        First to last sample [s].
+    covered_s : float
+        The span less the gaps [s].
+    n_gaps : int
+        Number of gaps.
+    gap_s : float
+        Their total length beyond one sample interval [s].
+    """
 
     span_s: float
     covered_s: float
@@ -379,7 +443,6 @@ def figures_of_merit(
     drift_bias: float | None = None,
     drift_reference_s: tuple[float, float] | None = None,
     where: str | None = None,
-    average_option: str | None = "--average",
 ) -> FiguresOfMerit:
     """Figures of merit of a rate ``x`` [``unit``, known input included].
 
@@ -389,7 +452,7 @@ def figures_of_merit(
     gaps) removes a stated constant b0, never the run's own mean: ``drift_bias`` when
     given (0 on a compensated output: the model is what removes the bias), else the mean
     over ``drift_reference_s`` (default the first 10 % of the run,
-    :func:`thermocal.metrics.reference_bias`).  ``where`` (the file) and ``average_option``
+    :func:`thermocal.metrics.reference_bias`).  ``where`` (the file) and ``averaging_s``
     are named when the record gives fewer than two averages.
 
     Parameters
@@ -414,8 +477,6 @@ def figures_of_merit(
         Window whose mean is b0 [s since the first sample].
     where : str, optional
         How warnings name the run.
-    average_option : str, optional
-        The option that sets the averaging time, for warnings.
 
     Returns
     -------
@@ -442,7 +503,6 @@ def figures_of_merit(
         temps=[temp_name],
         drift_bias=drift_bias,
         drift_reference_s=drift_reference_s,
-        average_option=average_option,
     )
     sens = m.temperature_sensitivity
     ang: FloatArray | None = None
@@ -569,7 +629,15 @@ NOISE_TERMS = (
 
 @dataclass(frozen=True)
 class AllanAnalysis:
-    """Allan deviation of one series and its noise terms (both IEEE 952 methods)."""
+    """Allan deviation of one series and its noise terms (both IEEE 952 methods).
+
+    Attributes
+    ----------
+    result : AllanResult
+        The Allan deviation.
+    terms : NoiseTerms
+        Its noise terms by both IEEE Std 952 methods.
+    """
 
     result: AllanResult
     terms: NoiseTerms

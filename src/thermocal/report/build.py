@@ -1188,7 +1188,10 @@ def _dynamic_of(
     from thermocal.stability.allan import dynamic_adev
     from thermocal.stability.analysis import nonstationary_message
 
-    dyn = dynamic_adev(main.after, tau0, inputs.dynamic_s, allan_after.result, time_s=main.time_s)
+    dyn = dynamic_adev(
+        main.after, tau0, inputs.dynamic_s, allan_after.result, time_s=main.time_s,
+        parameter="dynamic_s",
+    )  # fmt: skip
     if dyn.stationary:
         return dyn, None
     where = Path(inputs.recording_path).name if inputs.recording_path else "recording"

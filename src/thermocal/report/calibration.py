@@ -69,7 +69,35 @@ class CalibrationReportInputs:
     object of ``thermocal validate CAL FILE --json`` (``{"channels": {NAME: {…}}}``), or a
     mapping channel → one validation object; ``extra`` adds named per-channel columns to
     the summary table (``{column title: {channel: value}}``, e.g. the demo's share of the
-    simulator's true bias removed)."""
+    simulator's true bias removed).
+
+    Attributes
+    ----------
+    calibration : Calibration
+        The calibration reported.
+    recording : Recording
+        The run it is shown on.
+    recording_path, modeling_path, calibration_path, validation_path : str or None
+        The files, as the report names them.
+    validation : mapping or None
+        The validation object(s) described above.
+    title : str
+        The report's title.
+    sensor : str or None
+        The sensor's name.
+    generated_by : str
+        The command or program named as the report's maker.
+    averaging_s : float or None
+        Averaging time of the figures [s] (None: the default).
+    channels : sequence of str or None
+        The channels shown (None: all).
+    extra : mapping
+        The extra summary columns described above.
+    notes : tuple of str
+        Notes shown in the report.
+    appendix : tuple of str
+        HTML sections made by thermocal's report code.
+    """
 
     calibration: Calibration
     recording: Recording

@@ -166,6 +166,19 @@ class TemperaturePanel:
 
     ``time_s`` [s]; ``channels`` name → temperature [°C]; ``chamber`` the chamber
     (ambient) temperature or set-point [°C], drawn dashed, if known.
+
+    Attributes
+    ----------
+    title : str
+        The panel's title (the run).
+    time_s : numpy.ndarray
+        Time [s].
+    channels : dict of str to numpy.ndarray
+        Temperature channel name → temperature [°C].
+    chamber : numpy.ndarray or None
+        Chamber (ambient) temperature or set-point [°C], drawn dashed; None when unknown.
+    chamber_label : str
+        Legend label of ``chamber``.
     """
 
     title: str
@@ -329,7 +342,19 @@ def bias_vs_temperature(
 
 @dataclass(frozen=True)
 class AllanCurve:
-    """An Allan deviation curve: τ [s], σ(τ) and its confidence bounds (signal unit)."""
+    """An Allan deviation curve: τ [s], σ(τ) and its confidence bounds (signal unit).
+
+    Attributes
+    ----------
+    label : str
+        Legend label.
+    tau_s : numpy.ndarray
+        Averaging times τ [s].
+    adev : numpy.ndarray
+        σ(τ) [signal unit].
+    adev_low, adev_high : numpy.ndarray or None
+        Lower and upper confidence bounds of σ(τ) [signal unit]; None: no bounds drawn.
+    """
 
     label: str
     tau_s: FloatArray
@@ -508,7 +533,21 @@ __all__ = [
 
 @dataclass(frozen=True)
 class ChannelBias:
-    """One channel's bias before and after compensation against its temperature."""
+    """One channel's bias before and after compensation against its temperature.
+
+    Attributes
+    ----------
+    name : str
+        The channel.
+    unit : str
+        Its unit.
+    temperature_label : str
+        Name of the temperature on the horizontal axis.
+    temperature_c : numpy.ndarray
+        That temperature [°C].
+    before, after : numpy.ndarray
+        The bias before and after compensation [``unit``].
+    """
 
     name: str
     unit: str

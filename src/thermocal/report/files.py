@@ -120,7 +120,15 @@ def read_run(
 @dataclass(frozen=True)
 class ReportResult:
     """What :func:`make_report` wrote: the HTML file and the kind of report, ``"models"``,
-    ``"calibration"`` or ``"triads"``."""
+    ``"calibration"`` or ``"triads"``.
+
+    Attributes
+    ----------
+    path : Path
+        The HTML file.
+    kind : str
+        ``"models"``, ``"calibration"`` or ``"triads"``.
+    """
 
     path: Path
     kind: str

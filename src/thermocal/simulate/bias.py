@@ -29,6 +29,17 @@ class PiecewiseTerm:
     ``b(T) = s_0 (T − T_ref) + Σ_j (s_{j+1} − s_j) w ln(1 + e^{(T − c_j)/w})`` − its
     value at T_ref: slopes ``slopes`` [unit/°C] between breakpoints ``breakpoints_c``,
     corners rounded over ``smoothing_c`` = w [°C] (softplus).
+
+    Attributes
+    ----------
+    sensor : int
+        Index of the temperature sensor ``T_sensor`` the term depends on.
+    breakpoints_c : tuple of float
+        Breakpoints c_j [°C], increasing.
+    slopes : tuple of float
+        Slopes s_0 … s_n [unit/°C] on either side of the breakpoints (one more than them).
+    smoothing_c : float
+        Corner width w [°C] of the softplus rounding.
     """
 
     sensor: int
@@ -60,7 +71,17 @@ class WarmupTerm:
     ΔT^j``, ``ΔT = T − T0``,
     ``a_j(T0) = b_j0 + b_j1 T0 + b_j2 T0²``; ``coefficients[j−1] = (b_j0, b_j1, b_j2)``;
     ``start`` = ``(c0, c1, c2)`` gives the power-on bias ``c0 + c1 T0 + c2 T0²``.
-    T0 is the sensor temperature at power-on [°C]."""
+    T0 is the sensor temperature at power-on [°C].
+
+    Attributes
+    ----------
+    sensor : int
+        Index of the temperature sensor whose rise ΔT drives the term.
+    coefficients : tuple of (float, float, float)
+        ``(b_j0, b_j1, b_j2)`` of each power j ≥ 1 [unit/°C^j, unit/°C^(j+1), unit/°C^(j+2)].
+    start : (float, float, float)
+        ``(c0, c1, c2)`` of the power-on bias [unit, unit/°C, unit/°C²].
+    """
 
     sensor: int
     coefficients: tuple[tuple[float, float, float], ...]
@@ -100,7 +121,17 @@ class WarmupTerm:
 class HysteresisTerm:
     """Hysteresis: ``amplitude · (T − p)/(width/2)`` with p the play (backlash) operator
     of ``T_sensor`` of width ``width_c`` — ``+amplitude`` on a long heating, ``−amplitude``
-    on cooling."""
+    on cooling.
+
+    Attributes
+    ----------
+    sensor : int
+        Index of the temperature sensor ``T_sensor``.
+    width_c : float
+        Width of the play operator [°C].
+    amplitude : float
+        Half the difference between heating and cooling branches [unit of the sensor].
+    """
 
     sensor: int
     width_c: float
@@ -161,6 +192,23 @@ class BiasModel:
     hysteresis terms), with ``Ṫ`` in [°C/min].  Every polynomial, rate, coupling
     and gradient term lies in the span of the 37-term model of *A modelling and validation
     method for the temperature compensation model of a ring-laser gyroscope*.
+
+    Attributes
+    ----------
+    t_ref_c : float
+        Reference temperature T_ref [°C].
+    poly : tuple of tuple of float
+        ``poly[k][j-1]``: coefficient of (T_k − T_ref)^j [unit/°C^j].
+    rate : tuple of float
+        ``rate[k]``: coefficient of Ṫ_k [unit/(°C/min)].
+    coupling : tuple of float
+        ``coupling[k]``: coefficient of (T_k − T_ref) Ṫ_k [unit/(°C·°C/min)].
+    gradient : tuple of (int, int, float)
+        ``(i, j, g)``: coefficient g [unit/°C] of the difference T_i − T_j.
+    piecewise, warmup, hysteresis : PiecewiseTerm, WarmupTerm, HysteresisTerm or None
+        The optional non-polynomial terms.
+    offset : float
+        Constant bias [unit].
     """
 
     t_ref_c: float = 20.0

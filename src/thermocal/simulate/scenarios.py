@@ -119,12 +119,17 @@ def check_sample_budget(n: float, what: str) -> None:
     Raises
     ------
     ThermocalInputError
-        ``n`` is above :data:`MAX_SAMPLES`.
+        ``n`` is above :data:`MAX_SAMPLES` (the message names the parameters that lower it:
+        ``rate_hz``, ``profile``, ``record_s``, ``runs``).
     """
     if not n <= MAX_SAMPLES:
-        raise ThermocalInputError(
+        raise ThermocalInputError.naming(
             f"{what}: {n:.3g} samples to simulate, above the limit of {MAX_SAMPLES:.3g}: "
-            "lower --rate-hz, or shorten the chamber program (--profile, --record-s, --runs)"
+            "lower {rate_hz}, or shorten the chamber program ({profile}, {record_s}, {runs})",
+            "rate_hz",
+            "profile",
+            "record_s",
+            "runs",
         )
 
 
@@ -964,7 +969,19 @@ class SimulateOptions:
 class Simulation:
     """The result of :func:`simulate_scenario`: each recording with its truth, and a label per
     recording (the truth's ``label``, else 1, 2, … when the labels do not tell them
-    apart)."""
+    apart).
+
+    Attributes
+    ----------
+    scenario : str
+        The scenario's name.
+    seed : int
+        Its seed.
+    results : ScenarioResult
+        Each recording with its truth.
+    labels : tuple of str
+        One label per recording.
+    """
 
     scenario: str
     seed: int
@@ -972,7 +989,7 @@ class Simulation:
     labels: tuple[str, ...]
 
     def truth_document(self, files: Sequence[str], profile: str | None) -> dict[str, Any]:
-        """The ``--truth`` JSON: format, version, scenario, seed, profile and per recording
+        """The truth JSON: format, version, scenario, seed, profile and per recording
         its truth with ``file`` the path it was written to.
 
         Parameters

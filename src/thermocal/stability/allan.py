@@ -19,7 +19,7 @@ Confidence intervals (SP 1065 §5.3, eq. 45): ``edf · σ̂² / χ²_{p}(edf)`` 
 Greenhall & Riley's equivalent degrees of freedom (Greenhall & Riley 2003; SP 1065
 §5.3.3) for the power-law noise type α identified at each τ by the lag-1 autocorrelation
 of the m-averages (Riley & Greenhall 2004; the B1 ratio where too few averages remain) —
-the one implementation of ``thermocal allan --deviation oadev``
+the one implementation of the deviation family's ``oadev``
 (:func:`thermocal.stability.family.oadev_edf`), so both give the same intervals, equal to
 Stable32's (gyro terms: quantization ↔ α = +2, angle random walk ↔ α = 0, bias
 instability ↔ α = −1, rate random walk ↔ α = −2).  SP 1065 Table 5's simple EDF
@@ -203,6 +203,25 @@ class NoiseTerm:
     (``reason`` is ``None`` when ``value`` is present).  ``low``/``high`` bound the
     value at the result's confidence level; ``tau_s`` is where the slope line
     touches the curve (slope method) or ``None`` (fit).
+
+    Attributes
+    ----------
+    value : float or None
+        The coefficient [``unit``] (None: not in the data).
+    unit : str
+        Its unit.
+    reason : str or None
+        Why ``value`` is missing or doubtful.
+    low, high : float or None
+        Its interval at the result's confidence [``unit``].
+    tau_s : float or None
+        Where the slope line touches the curve [s] (slope method).
+    label : str
+        The term's name as shown.
+    quality : str or None
+        ``"poor"`` when the noise model fits the curve badly.
+    tau_range_s : (float, float) or None
+        The τ range the value was read from [s].
     """
 
     value: float | None
@@ -232,6 +251,21 @@ class FitQuality:
     (``{"tau_from_s", "tau_to_s", "side", "mean_sigma"}``; side ``"above"`` = the fitted
     curve lies above the points); ``quality`` ``"good"`` or ``"poor"`` (poor: a misfit
     stretch, or a reduced χ² above :data:`POOR_CHI2`); ``reason`` one line.
+
+    Attributes
+    ----------
+    reduced_chi2 : float
+        Weighted residual sum of squares per degree of freedom.
+    dof : int
+        Degrees of freedom.
+    p_value : float
+        Upper tail of χ²(dof) at the sum.
+    misfits : tuple of dict
+        The one-sided stretches described above.
+    quality : str
+        ``"good"`` or ``"poor"``.
+    reason : str or None
+        Why poor.
     """
 
     reduced_chi2: float
@@ -331,7 +365,15 @@ def fit_quality(tau_s: FloatArray, normalised_residuals: FloatArray, n_active: i
 
 @dataclass(frozen=True)
 class NoiseTermSet:
-    """The five IEEE 952 terms found by one method (``"slope"`` or ``"fit"``)."""
+    """The five IEEE 952 terms found by one method (``"slope"`` or ``"fit"``).
+
+    Attributes
+    ----------
+    method : str
+        ``"slope"`` or ``"fit"``.
+    quantization, angle_random_walk, bias_instability, rate_random_walk, rate_ramp : NoiseTerm
+        The five terms of IEEE Std 952-1997 Annex C.
+    """
 
     method: str
     quantization: NoiseTerm
@@ -345,10 +387,10 @@ class NoiseTermSet:
         return {name: getattr(self, name) for name in TERM_NAMES}
 
     def to_dict(self) -> dict[str, dict[str, Any]]:
-        """Each term's object as ``thermocal allan --json`` prints it under ``noise`` (fit)
-        or ``noise_slope`` (slope lines): ``value``, ``unit``, ``reason``, ``low``,
-        ``high``, ``tau_s``, ``label``, ``quality``, ``method`` (this set's, the word
-        ``noise --format json`` gives) and ``tau_range_s``."""
+        """Each term's object as the ``allan`` command's JSON holds it under ``noise``
+        (fit) or ``noise_slope`` (slope lines): ``value``, ``unit``, ``reason``, ``low``,
+        ``high``, ``tau_s``, ``label``, ``quality``, ``method`` (this set's, the word the
+        noise model's JSON gives) and ``tau_range_s``."""
         return {
             name: {
                 "value": t.value,
@@ -368,7 +410,7 @@ class NoiseTermSet:
 
 def minimum_dict(t: NoiseTerm | None) -> dict[str, Any] | None:
     """The bias instability at the curve's minimum (:func:`bias_at_minimum`) as
-    ``thermocal allan --json`` prints it under ``bias_instability_minimum``.
+    the ``allan`` command's JSON holds it under ``bias_instability_minimum``.
 
     Parameters
     ----------
@@ -830,7 +872,7 @@ def overlapping_adev(
     m = averaging_factors(taus, tau0_s, longest)
     if alpha is not None and alpha not in (-2, -1, 0, 1, 2):
         raise ThermocalInputError(f"noise exponent alpha must be −2…2, got {alpha!r}")
-    # α and EDF per τ exactly as `allan --deviation oadev` has them (one implementation),
+    # α and EDF per τ exactly as the family's oadev has them (one implementation),
     # from the segments that give the sums a term, before the phase may overwrite the rate
     alphas, methods, edf = family.oadev_edf(
         y, tau0_s, m, segments=[sl for sl in slices if sl.stop - sl.start >= 3], alpha=alpha
@@ -864,6 +906,23 @@ class DynamicAllan:
     deviation and the whole record's differ beyond both their intervals at the test's
     confidence ``test_confidence`` (``{"t_s", "tau_s", "adev", "whole_adev"}``);
     ``stationary`` no such change.
+
+    Attributes
+    ----------
+    window_s, step_s : float
+        Window length and step [s].
+    t_s : numpy.ndarray
+        Window centres [s from the first sample].
+    tau_s : numpy.ndarray
+        Averaging times [s].
+    adev, adev_low, adev_high : numpy.ndarray
+        Deviation and its interval, windows × τ [unit] (NaN: window too short for τ).
+    unit : str
+        The data's unit.
+    test_confidence : float
+        Confidence of the change test.
+    changes : tuple of dict
+        The (window, τ) changes described above.
     """
 
     window_s: float
@@ -883,7 +942,7 @@ class DynamicAllan:
         return not self.changes
 
     def to_dict(self) -> dict[str, Any]:
-        """The object ``thermocal allan --dynamic --json`` prints under ``dynamic``:
+        """The object the ``allan`` command's JSON holds under ``dynamic``:
         ``window_s``, ``step_s``, ``t_s`` (window centres), ``tau_s``, ``adev`` (windows ×
         τ, NaN where a window is too short), ``adev_low``/``adev_high``, ``unit``,
         ``stationary``, ``changes`` and ``test_confidence``."""
@@ -916,13 +975,15 @@ def check_dynamic_work(
     *,
     channels: int = 1,
     where: str = "",
+    parameter: str = "window_s",
 ) -> float:
     """Estimated operations of :func:`dynamic_adev` in windows of ``window_s`` [s] (half a
     window apart) over ``n_samples`` samples every ``tau0_s`` [s], for ``channels``
     channels: windows × (:data:`DYNAMIC_WINDOW_WORK` + 4 n log2 n) with n samples a
-    window.  Beyond ``max_work`` a :class:`ThermocalInputError` naming ``where``,
-    ``--dynamic`` and ``--max-work`` (a window the dynamic ADEV refuses anyway costs 0
-    here: it says why).  ``--dynamic 8`` on 1e5 samples is 25 000 windows, ≈ 7 minutes.
+    window.  Beyond ``max_work`` a :class:`ThermocalInputError` naming ``where``, the
+    window (``parameter``) and ``max_work`` (a window the dynamic ADEV refuses anyway
+    costs 0 here: it says why).  An 8 s window on 1e5 samples at 1 Hz is 25 000 windows,
+    ≈ 7 minutes.
 
     Parameters
     ----------
@@ -938,6 +999,9 @@ def check_dynamic_work(
         Number of channels (default 1).
     where : str, optional
         File or channel named in the error (default none).
+    parameter : str, optional
+        The caller's parameter that sets the window, as the error names it (default
+        ``window_s``; :func:`thermocal.stability.analysis.allan_analysis`: ``dynamic_s``).
 
     Returns
     -------
@@ -950,7 +1014,7 @@ def check_dynamic_work(
         When the estimate exceeds ``max_work``.
     """
     if not max_work > 0:
-        raise ThermocalInputError(f"--max-work {max_work!r}: give a positive operation count")
+        raise ParameterError("max_work", f"{{name}} {max_work!r}: give a positive operation count")
     if not (math.isfinite(window_s) and window_s > 0 and tau0_s > 0):
         return 0.0
     n_win = round(window_s / tau0_s)
@@ -960,14 +1024,37 @@ def check_dynamic_work(
     windows = (n_samples - n_win) // step + 1
     work = channels * windows * (DYNAMIC_WINDOW_WORK + 4.0 * n_win * math.log2(n_win))
     if work > max_work:
-        raise ThermocalInputError(
+        raise ThermocalInputError.naming(
             (f"{where}: " if where else "")
-            + f"--dynamic {window_s:g} s on {n_samples} samples makes {windows} windows"
+            + f"{{{parameter}}} {window_s:g} s on {n_samples} samples makes {windows} windows"
             + (f" in each of {channels} channels" if channels > 1 else "")
             + f", about {work:.2g} operations, beyond the budget of {max_work:.2g}; give a "
-            f"longer window, or raise --max-work to {math.ceil(work / 1e9) * 1e9:.3g} to run it"
+            f"longer window, or raise {{max_work}} to {math.ceil(work / 1e9) * 1e9:.3g} to "
+            "run it",
+            parameter,
+            "max_work",
         )
     return work
+
+
+def _window_samples(n: int, tau0_s: float, window_s: float, parameter: str) -> int:
+    """Samples in a dynamic ADEV window of ``window_s`` [s]: at least 8, at most ``n // 2``."""
+    if not (math.isfinite(window_s) and window_s > 0):
+        raise ParameterError(parameter, f"{{name}} {window_s!r}: give a window length > 0 [s]")
+    n_win = round(window_s / tau0_s)
+    if n_win < 8:
+        raise ParameterError(
+            parameter,
+            f"{{name}} {window_s:g} s holds {n_win} samples at τ0 = {tau0_s:g} s; give at "
+            "least 8 samples' worth",
+        )
+    if n_win > n // 2:
+        raise ParameterError(
+            parameter,
+            f"{{name}} {window_s:g} s: the record ({n * tau0_s:g} s) holds fewer than "
+            "two windows; give a shorter window",
+        )
+    return int(n_win)
 
 
 def dynamic_adev(
@@ -978,6 +1065,7 @@ def dynamic_adev(
     *,
     time_s: npt.ArrayLike | None = None,
     step_s: float | None = None,
+    parameter: str = "window_s",
 ) -> DynamicAllan:
     """Dynamic Allan deviation: :func:`overlapping_adev` in windows of ``window_s`` [s]
     stepped by ``step_s`` (default half a window), at the τ of ``whole`` that fit a window
@@ -995,31 +1083,30 @@ def dynamic_adev(
         Sample interval and window length [s].
     whole : AllanResult
         The whole record's result; ``time_s`` [s], ``step_s`` [s] optional.
+    parameter : str, optional
+        The caller's parameter that sets the window, as a refusal names it (default
+        ``window_s``).
 
     Returns
     -------
     DynamicAllan
         Per-window deviations and the stationarity verdict.
+
+    Raises
+    ------
+    ThermocalInputError
+        A window that is no length, holds fewer than 8 samples, more than half the record,
+        or no τ of ``whole``.
     """
     y = np.asarray(rate, dtype=np.float64).ravel()
-    if not (math.isfinite(window_s) and window_s > 0):
-        raise ThermocalInputError(f"--dynamic {window_s!r}: give a window length > 0 [s]")
-    n_win = round(window_s / tau0_s)
-    if n_win < 8:
-        raise ThermocalInputError(
-            f"--dynamic {window_s:g} s holds {n_win} samples at τ0 = {tau0_s:g} s; give at "
-            "least 8 samples' worth"
-        )
-    if n_win > y.size // 2:
-        raise ThermocalInputError(
-            f"--dynamic {window_s:g} s: the record ({y.size * tau0_s:g} s) holds fewer than "
-            "two windows; give a shorter window"
-        )
+    n_win = _window_samples(y.size, tau0_s, window_s, parameter)
     step = max(1, round((step_s if step_s is not None else window_s / 2.0) / tau0_s))
     t = None if time_s is None else np.asarray(time_s, dtype=np.float64).ravel()
     m_all = whole.m[whole.m <= max_averaging_factor(n_win)]
     if m_all.size == 0:
-        raise ThermocalInputError(f"--dynamic {window_s:g} s: no τ of the record fits a window")
+        raise ParameterError(
+            parameter, f"{{name}} {window_s:g} s: no τ of the record fits a window"
+        )
     starts = list(range(0, y.size - n_win + 1, step))
     results: list[AllanResult | None] = []
     centres = []
@@ -1364,6 +1451,15 @@ class WhiteStretch:
     the stretch that each lie below its line beyond their intervals (the sensor's own low-pass
     filter shapes the short τ: a sum of noise terms never lies below one of them), 0 when
     none.
+
+    Attributes
+    ----------
+    start, stop : int
+        Index range of the points used.
+    intercept : float
+        c of ``ln σ = c − ½ ln τ``.
+    shaped_stop : int
+        End of the leading points shaped by the sensor's filter (0: none).
     """
 
     start: int

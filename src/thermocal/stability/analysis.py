@@ -40,7 +40,7 @@ if TYPE_CHECKING:
     FloatArray = npt.NDArray[np.float64]
 
 DATA_TYPES = ("rate", "phase")
-"""``--data-type``: rate data (a rate column) or phase data (an integrated quantity)."""
+"""``data_type``: rate data (a rate column) or phase data (an integrated quantity)."""
 
 
 FEW_LEVELS: Final = 3
@@ -64,15 +64,16 @@ def check_not_stuck(
     values: FloatArray,
     name: str,
     where: str,
-    option: str = "--signal",
+    parameter: str = "signal",
     consequence: str = STUCK_ALLAN,
 ) -> None:
     """Refuse a constant column, warn on one with at most :data:`FEW_LEVELS` values.
 
     A constant record has an Allan deviation of 0 at every τ, a zero-width interval and no
     identifiable noise (the B1 ratio and R(n) of NIST SP 1065 §5.6 are 0/0): no sensor at
-    rest gives one, a stuck or flat-lined channel does.  ``where`` names the file, ``option``
-    the option that names the column, ``consequence`` what a constant means to the caller.
+    rest gives one, a stuck or flat-lined channel does.  ``where`` names the file,
+    ``parameter`` the parameter that names the column, ``consequence`` what a constant means
+    to the caller.
 
     Parameters
     ----------
@@ -82,8 +83,9 @@ def check_not_stuck(
         Column name.
     where : str
         File named in the message.
-    option : str, optional
-        Option that names the column (default ``"--signal"``).
+    parameter : str, optional
+        The caller's parameter that names the column (default ``"signal"``); the refusal
+        names it.
     consequence : str, optional
         What a constant means to the caller.
 
@@ -100,10 +102,11 @@ def check_not_stuck(
         return
     lo, hi = float(finite.min()), float(finite.max())
     if lo == hi:
-        raise ThermocalInputError(
+        raise ThermocalInputError.naming(
             f"{where}: the column {name!r} is constant ({lo:.6g} in all {finite.size} "
             f"samples): a stuck or flat-lined sensor {consequence}; name another column "
-            f"with {option}, or check the sensor"
+            "with {" + parameter + "}, or check the sensor",
+            parameter,
         )
     probe = np.unique(finite[:_LEVEL_PROBE])
     if probe.size > FEW_LEVELS:
@@ -144,7 +147,7 @@ def _tau_range(name: str, tau0_s: float, n_phase: int) -> tuple[float, float, in
 def check_tau_list(
     taus: Any, tau0_s: float, n_points: int, names: Sequence[str], where: str, spec: str = ""
 ) -> None:
-    """``--taus`` as a list of τ [s]: refuse one whose every τ lies outside what the record
+    """``taus`` as a list of τ [s]: refuse one whose every τ lies outside what the record
     reaches (every array would be empty), warn naming the τ left out of a list partly
     outside.  ``n_points``: the longest gap-free stretch's points as each deviation counts
     them (phase points; ``"adev-rate"``: rate samples); ``names`` the deviations asked.
@@ -189,15 +192,15 @@ def check_tau_list(
         "in its longest gap-free stretch)"
     )
     if not inside.any():
-        raise ThermocalInputError(
-            f"{where}: --taus {given}: no τ within the record: {span}; give --taus in that "
-            "range, or a named set (octave, decade, log)"
+        raise ThermocalInputError.naming(
+            f"{where}: {{taus}} {given}: no τ within the record: {span}; give {{taus}} in "
+            "that range, or a named set (octave, decade, log)",
+            "taus",
         )
     if not inside.all():
         out = ", ".join(f"{t:g}" for t in tau[~inside])
         warnings.warn(
-            f"{where}: --taus: τ {out} s left out: {span}",
-            ConditioningWarning,
+            ConditioningWarning.naming(f"{where}: {{taus}}: τ {out} s left out: {span}", "taus"),
             stacklevel=2,
         )
 
@@ -252,9 +255,21 @@ def signal_in_data_unit(rec: Recording, name: str) -> tuple[FloatArray, str]:
 
 @dataclass(frozen=True, eq=False)
 class AllanChannel:
-    """One channel's overlapping ADEV, its noise terms, (``--dynamic``) dynamic ADEV and
+    """One channel's overlapping ADEV, its noise terms, (``dynamic_s``) dynamic ADEV and
     the output quantisation found in the samples
-    (:func:`thermocal.stability.noise_model.output_quantization`; None: not quantised)."""
+    (:func:`thermocal.stability.noise_model.output_quantization`; None: not quantised).
+
+    Attributes
+    ----------
+    adev : AllanResult
+        The overlapping Allan deviation.
+    noise : NoiseTerms
+        Its noise terms.
+    dynamic : DynamicAllan or None
+        The dynamic ADEV (when asked).
+    quantization : OutputQuantization or None
+        The output quantisation found (None: not quantised).
+    """
 
     adev: AllanResult
     noise: NoiseTerms
@@ -262,8 +277,8 @@ class AllanChannel:
     quantization: OutputQuantization | None = None
 
     def to_dict(self) -> dict[str, Any]:
-        """The channel as plain Python values: the object ``thermocal allan --json`` prints
-        (NaN where it prints null).
+        """The channel as plain Python values: the object the ``allan`` command prints as
+        JSON (NaN where it prints null).
 
         Returns
         -------
@@ -297,7 +312,7 @@ class AllanChannel:
             "alpha_method": list(res.alpha_method),
             "interval": f"chi-square, {100 * res.confidence:.1f} %, "
             + edf_source("oadev")
-            + ", α identified per τ (as --deviation oadev)",
+            + ", α identified per τ (as --deviation oadev)",  # cli-words: the allan JSON
             "confidence": res.confidence,
             "tau0_s": res.tau0_s,
             "n_samples": res.n_samples,
@@ -323,7 +338,17 @@ class AllanChannel:
 class AllanAnalysis:
     """The result of :func:`allan_analysis`: ``channels`` (overlapping ADEV and noise terms,
     the default) or ``family`` (the deviations asked for, or phase data), per channel name
-    in the order asked."""
+    in the order asked.
+
+    Attributes
+    ----------
+    names : tuple of str
+        The channels, in the order asked.
+    channels : dict of str to AllanChannel
+        Overlapping ADEV and noise terms per channel (the default).
+    family : dict of str to StabilityResult
+        The deviations asked for, per channel.
+    """
 
     names: tuple[str, ...]
     channels: dict[str, AllanChannel] = field(default_factory=dict)
@@ -331,7 +356,7 @@ class AllanAnalysis:
 
     @property
     def is_family(self) -> bool:
-        """True when the result holds the deviation family (``--deviation``/phase data)."""
+        """True when the result holds the deviation family (``deviations``/phase data)."""
         return bool(self.family)
 
 
@@ -391,9 +416,12 @@ def allan_analysis(
     if data_type not in DATA_TYPES:
         raise ParameterError("data_type", f"{{name}} {data_type!r}: use rate or phase")
     if dynamic_s is not None and (deviations is not None or data_type == "phase"):
-        raise ThermocalInputError(
-            "--dynamic computes the overlapping ADEV of rate data; run it without --deviation "
-            "and --data-type phase"
+        raise ThermocalInputError.naming(
+            "{dynamic_s} computes the overlapping ADEV of rate data; run it without "
+            "{deviations} and {data_type} phase",
+            "dynamic_s",
+            "deviations",
+            "data_type",
         )
     if deviations is not None or data_type == "phase":
         return AllanAnalysis(
@@ -403,20 +431,7 @@ def allan_analysis(
                 noise_id or "thermocal", max_work, where,
             ),
         )  # fmt: skip
-    family_only = [
-        opt
-        for opt, given in (
-            ("--bias-correct (totdev, htotdev)", bias_correct),
-            ("--noise-type", noise_type is not None),
-            ("--noise-id", noise_id is not None),
-        )
-        if given
-    ]
-    if family_only:
-        raise ThermocalInputError(
-            f"{', '.join(family_only)}: for the deviation family's intervals; give the "
-            "deviations with --deviation (the overlapping ADEV: --deviation oadev)"
-        )
+    _refuse_family_only(bias_correct, noise_type, noise_id)
     check_tau_list(taus, rec.sample_interval_s, _longest(rec), ["adev-rate"], where)
     if dynamic_s is not None:  # the windows counted before any work
         from thermocal.stability import allan, family
@@ -424,7 +439,7 @@ def allan_analysis(
         allan.check_dynamic_work(
             rec.n_samples, rec.sample_interval_s, dynamic_s,
             family.DEFAULT_MAX_WORK if max_work is None else max_work,
-            channels=len(names), where=where,
+            channels=len(names), where=where, parameter="dynamic_s",
         )  # fmt: skip
     channels: dict[str, AllanChannel] = {}
     for name in names:  # one read of the file, every channel
@@ -433,6 +448,26 @@ def allan_analysis(
             rec, name, taus, confidence, dynamic_s, names.count(name) == 1, label
         )
     return AllanAnalysis(tuple(names), channels=channels)
+
+
+def _refuse_family_only(bias_correct: bool, noise_type: int | None, noise_id: str | None) -> None:
+    """Refuse the deviation family's parameters given without ``deviations``."""
+    family_only = [
+        (text, parameter)
+        for text, parameter, given in (
+            ("{bias_correct} (totdev, htotdev)", "bias_correct", bias_correct),
+            ("{noise_type}", "noise_type", noise_type is not None),
+            ("{noise_id}", "noise_id", noise_id is not None),
+        )
+        if given
+    ]
+    if family_only:
+        raise ThermocalInputError.naming(
+            f"{', '.join(t for t, _ in family_only)}: for the deviation family's intervals; "
+            "give the deviations with {deviations} (the overlapping ADEV: {deviations} oadev)",
+            *(p for _, p in family_only),
+            "deviations",
+        )
 
 
 def _family(
@@ -481,7 +516,7 @@ def _family(
 
 
 BIAS_CORRECTED: Final = ("totdev", "htotdev")
-"""The deviations ``--bias-correct`` multiplies by Stable32's factor (the others: 1)."""
+"""The deviations ``bias_correct`` multiplies by Stable32's factor (the others: 1)."""
 
 
 def _idle_options(
@@ -491,7 +526,7 @@ def _idle_options(
     alpha: int | None,
     where: str,
 ) -> None:
-    """A warning naming ``--bias-correct`` or ``--noise-type`` where it changed nothing: no
+    """A warning naming ``bias_correct`` or ``noise_type`` where it changed nothing: no
     totdev/htotdev asked, a factor of 1 at every τ (Stable32 corrects totdev for flicker and
     random-walk FM only, htotdev for FM noise from m = 2: :func:`.family.stable32_bias`), or
     no deviation with an interval (MTIE, TIE rms: :func:`.family.no_interval`)."""
@@ -516,13 +551,20 @@ def _idle_options(
         else:
             why = ""
         if why:
-            warnings.warn(f"{where}: --bias-correct changes nothing: {why}", ConditioningWarning, 2)
+            warnings.warn(
+                ConditioningWarning.naming(
+                    f"{where}: {{bias_correct}} changes nothing: {why}", "bias_correct"
+                ),
+                stacklevel=2,
+            )
     if alpha is not None and all(no_interval(d) is not None for d in devs):
         warnings.warn(
-            f"{where}: --noise-type changes nothing: no confidence interval or bias factor "
-            f"uses it ({', '.join(devs)}: none)",
-            ConditioningWarning,
-            2,
+            ConditioningWarning.naming(
+                f"{where}: {{noise_type}} changes nothing: no confidence interval or bias "
+                f"factor uses it ({', '.join(devs)}: none)",
+                "noise_type",
+            ),
+            stacklevel=2,
         )
 
 
@@ -569,7 +611,9 @@ def _allan_channel(
         warnings.warn(f"{where}: {noise.quality.reason}", ConditioningWarning, stacklevel=1)
     if dynamic_s is None:
         return AllanChannel(res, noise, quantization=quant)
-    dyn = allan.dynamic_adev(values, rec.sample_interval_s, dynamic_s, res, time_s=rec.time_s)
+    dyn = allan.dynamic_adev(
+        values, rec.sample_interval_s, dynamic_s, res, time_s=rec.time_s, parameter="dynamic_s"
+    )
     if not dyn.stationary:
         warnings.warn(nonstationary_message(dyn, where), ConditioningWarning, stacklevel=1)
     return AllanChannel(res, noise, dyn, quant)
@@ -667,7 +711,15 @@ def motion_in(rec: Recording, gyro: Sequence[str], accel: Sequence[str]) -> str 
 
 @dataclass(frozen=True, eq=False)
 class ImuNoise:
-    """The result of :func:`imu_noise`: each axis's terms and the estimator noise model."""
+    """The result of :func:`imu_noise`: each axis's terms and the estimator noise model.
+
+    Attributes
+    ----------
+    axes : tuple of AxisNoise
+        Each axis's terms.
+    model : NoiseModel
+        The estimator noise model.
+    """
 
     axes: tuple[AxisNoise, ...]
     model: NoiseModel
@@ -728,7 +780,7 @@ def imu_noise(
     axes = []
     for name in gyro + accel:
         values, unit = signal_in_data_unit(rec, name)
-        check_not_stuck(values, name, where, "--gyro" if name in gyro else "--accel")
+        check_not_stuck(values, name, where, "gyro" if name in gyro else "accel")
         axes.append(
             nm.axis_noise(
                 values, rec.sample_interval_s, name=name,

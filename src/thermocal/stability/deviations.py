@@ -663,7 +663,21 @@ class OctaveLevel:
     asked); ``lag`` the :class:`thermocal.stability.edf.LagSums` of S (noise
     identification).  With phase x_k = τ0 Σ_{i<k}(y_i − ȳ), x_{(j+1)m} − x_{jm} = τ0 S_j:
     the Allan second difference at m is τ0 (S_{j+1} − S_j), the Hadamard third difference
-    τ0 (S_{j+2} − 2S_{j+1} + S_j) (SP 1065 eqs. 7, 17)."""
+    τ0 (S_{j+2} − 2S_{j+1} + S_j) (SP 1065 eqs. 7, 17).
+
+    Attributes
+    ----------
+    m : int
+        Averaging factor 2^k.
+    z : numpy.ndarray
+        The level's series (samples at level 0, block sums above).
+    offset : float
+        ȳ at level 0, else 0.
+    d1, d2 : float
+        Sums of squared first and second differences of S (NaN: not asked).
+    lag : LagSums
+        Lag sums of S (noise identification).
+    """
 
     m: int
     z: FloatArray

@@ -31,7 +31,7 @@ import numpy as np
 import numpy.typing as npt
 
 from thermocal._lazy import LazyModule
-from thermocal.errors import ThermocalInputError
+from thermocal.errors import ParameterError, ThermocalInputError
 
 # the chi-square quantiles from scipy.special (0.2 s to import), when first needed
 special = LazyModule("scipy.special")
@@ -54,7 +54,8 @@ on its PHASE.DAT: its last octave point, 7 averages, keeps the white FM of the o
 
 STABLE32_B1_MIN_TOTAL: Final = 6
 """Stable32's noise identification (``noise_id="stable32"`` in
-:func:`thermocal.stability.family.stability`, ``allan --noise-id stable32``), read from its
+:func:`thermocal.stability.family.stability`, the ``allan`` command's ``stable32`` noise
+identification), read from its
 printed α columns (none written by thermocal); the evidence is every Stable32 output in
 allantools' and allantoolkit's test data (benchmarks/stable32_conformance.py: with these
 rules all 691 rows with bounds and all 1924 all-τ rows of the OCXO record carry Stable32's
@@ -646,6 +647,17 @@ class NoiseId:
     B1); ``method`` ``"lag1"``, ``"b1"`` or ``"b1-rn"`` (B1 then R(n), :func:`split_pm`)
     (or ``"none"`` when neither could run: α = 0
     assumed); ``d`` differences taken (lag-1 method).
+
+    Attributes
+    ----------
+    alpha : int
+        The power-law exponent α.
+    alpha_float : float
+        The unrounded lag-1 estimate (NaN for B1).
+    method : str
+        ``"lag1"``, ``"b1"``, ``"b1-rn"`` or ``"none"``.
+    d : int
+        Differences taken (lag-1 method).
     """
 
     alpha: int
@@ -742,7 +754,21 @@ def _lag1_linear_detrended(z: FloatArray, *, own: bool = False) -> float:
 @dataclass(frozen=True)
 class LagSums:
     """Sums over a series z of n points, centred (z_c = z − z̄): ``szz`` Σ z_c², ``uz``
-    Σ k z_c,k, ``cross`` Σ z_c,k z_c,k+1, ``first``/``last`` z_c,0 and z_c,n−1."""
+    Σ k z_c,k, ``cross`` Σ z_c,k z_c,k+1, ``first``/``last`` z_c,0 and z_c,n−1.
+
+    Attributes
+    ----------
+    n : int
+        Number of points.
+    szz : float
+        Σ z_c².
+    uz : float
+        Σ k z_c,k.
+    cross : float
+        Σ z_c,k z_c,k+1.
+    first, last : float
+        z_c,0 and z_c,n−1.
+    """
 
     n: int
     szz: float
@@ -797,7 +823,19 @@ class IdRules:
     number of averages); ``b1_min``: the fewest averages B1 reads; ``rate_detrend``: the rate
     averages' line removed before the lag-1 method (else only their mean); ``r1_sample``: r1
     with the sample variance (÷ (n − 1)) under the lag product summed over n − 1 pairs and
-    divided by n, i.e. r1·(n − 1)/n.  Stable32's rules: :data:`STABLE32_B1_MIN_TOTAL`."""
+    divided by n, i.e. r1·(n − 1)/n.  Stable32's rules: :data:`STABLE32_B1_MIN_TOTAL`.
+
+    Attributes
+    ----------
+    b1_n : int or None
+        n of the theoretical B1 (None: the number of averages).
+    b1_min : int
+        Fewest averages B1 reads.
+    rate_detrend : bool
+        Remove the rate averages' line before the lag-1 method.
+    r1_sample : bool
+        r1 as Stable32 computes it (see above).
+    """
 
     b1_n: int | None = None
     b1_min: int = MIN_B1_GROUPS
@@ -1090,29 +1128,38 @@ quantiles of a few degrees of freedom run to 0 or to the double range (an interv
 ``[0, ∞)`` printed as numbers)."""
 
 
-def check_confidence(confidence: float, option: str = "--confidence") -> float:
+def check_confidence(confidence: float) -> float:
     """Return ``confidence`` when ``CONFIDENCE_MIN ≤ c ≤ CONFIDENCE_MAX``, else raise
-    :class:`ThermocalInputError` naming ``option`` and the value (a confidence of 1e-300
-    would give an interval of zero width beside the estimate).
+    :class:`~thermocal.errors.ParameterError` naming ``confidence`` and the value (a
+    confidence of 1e-300 would give an interval of zero width beside the estimate).
 
     Parameters
     ----------
     confidence : float
         Confidence level of a two-sided chi-square interval (dimensionless, e.g. 0.683 for
         one sigma, NIST SP 1065 eq. 45).
-    option : str
-        The option's name shown in the error.
 
     Returns
     -------
     float
         ``confidence`` unchanged.
+
+    Raises
+    ------
+    thermocal.errors.ParameterError
+        A confidence outside [``CONFIDENCE_MIN``, ``CONFIDENCE_MAX``].
+
+    Examples
+    --------
+    >>> check_confidence(0.95)
+    0.95
     """
     c = float(confidence)
     if not CONFIDENCE_MIN <= c <= CONFIDENCE_MAX:
-        raise ThermocalInputError(
-            f"{option} {confidence!r}: give a confidence level between {CONFIDENCE_MIN} and "
-            f"{CONFIDENCE_MAX!r} (0.6827 is one sigma, 0.95 two)"
+        raise ParameterError(
+            "confidence",
+            f"{{name}} {confidence!r}: give a confidence level between {CONFIDENCE_MIN} and "
+            f"{CONFIDENCE_MAX!r} (0.6827 is one sigma, 0.95 two)",
         )
     return c
 

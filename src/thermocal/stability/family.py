@@ -1,6 +1,7 @@
 """Several deviations of one record at once, with Greenhall intervals per τ.
 
-:func:`stability` is the library entry of ``thermocal allan --deviation``: it splits the
+:func:`stability` is the library entry of the deviation family (the ``allan`` command with
+deviations named): it splits the
 record at gaps, computes each requested deviation of :mod:`.deviations` per stretch, pools
 them, identifies the power-law noise per τ (:func:`.edf.identify_noise`) and gives each
 point its equivalent degrees of freedom and chi-square interval (NIST SP 1065 eq. 45):
@@ -171,8 +172,8 @@ class StabilityResult:
     noise_id: str = "thermocal"
 
     def to_dict(self) -> dict[str, Any]:
-        """The result as plain Python values: the object ``thermocal allan --deviation
-        --json`` prints (NaN where it prints null).
+        """The result as plain Python values: the object the ``allan`` command prints as JSON
+        for the deviations named (NaN where it prints null).
 
         Returns
         -------
@@ -649,7 +650,7 @@ def _pooled_edf(name: str, m: IntArray, alphas: IntArray, sizes: list[int]) -> F
 
 
 DEFAULT_MAX_WORK: Final = 3e10
-"""Arithmetic operations :func:`stability` takes on before it refuses (``--max-work``):
+"""Arithmetic operations :func:`stability` takes on before it refuses (``max_work``):
 about half a minute on one core (:func:`.deviations.work`: ≈ 1 ns per operation)."""
 
 
@@ -698,8 +699,8 @@ def check_work(
 ) -> float:
     """The estimated operations of the deviations ``names`` at the factors ``sets``
     (:func:`factor_sets`) over stretches of ``sizes`` phase points
-    (:func:`.deviations.work`, summed); a :class:`ThermocalInputError` naming ``--taus`` and
-    ``--max-work`` when beyond ``max_work``.  The total family and Theo1 cost O(N·m) per
+    (:func:`.deviations.work`, summed); a :class:`ThermocalInputError` naming ``deviations``,
+    ``taus`` and ``max_work`` when beyond ``max_work``.  The total family and Theo1 cost O(N·m) per
     factor (NIST SP 1065 eqs. 27–30), so every τ of a long record grows as N³: the refusal
     comes before any work, with the estimate and the costliest deviation (``where``: the
     file, named first).
@@ -738,13 +739,16 @@ def check_work(
     if total > max_work:
         worst = max(per, key=lambda n: per[n])
         spec = taus if isinstance(taus, str) else "(the τ list)"
-        fewer = "a shorter τ list" if spec == "octave" else "--taus octave"
-        raise ThermocalInputError(
+        fewer = "a shorter τ list" if spec == "octave" else "{taus} octave"
+        raise ThermocalInputError.naming(
             (f"{where}: " if where else "")
-            + f"--deviation {','.join(names)} at --taus {spec} on {sum(sizes)} points needs about "
-            f"{total:.2g} operations ({worst}: {per[worst]:.2g}), beyond the "
-            f"budget of {max_work:.2g}; use {fewer} or fewer deviations, or raise --max-work "
-            f"to {_ceil2(total)} to run it"
+            + f"{{deviations}} {','.join(names)} at {{taus}} {spec} on {sum(sizes)} points "
+            f"needs about {total:.2g} operations ({worst}: {per[worst]:.2g}), beyond the "
+            f"budget of {max_work:.2g}; use {fewer} or fewer deviations, or raise "
+            f"{{max_work}} to {_ceil2(total)} to run it",
+            "deviations",
+            "taus",
+            "max_work",
         )
     return total
 

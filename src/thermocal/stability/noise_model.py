@@ -43,7 +43,7 @@ import numpy as np
 import numpy.typing as npt
 
 from thermocal import units
-from thermocal.errors import PlausibilityWarning, ThermocalInputError
+from thermocal.errors import ParameterError, PlausibilityWarning, ThermocalInputError
 from thermocal.identifiers import one_line
 from thermocal.stability.allan import (
     AllanResult,
@@ -114,6 +114,27 @@ class ContinuousTerm:
     does not show the term); ``tau_s`` where the slope line touches the curve (slope), the
     τ of the bounding point (bound), None (fit); ``read_at_tau_s`` where the line is read
     (1 s for white noise, 3 s for random walk); ``quality`` ``good|rough|poor``.
+
+    Attributes
+    ----------
+    value, low, high : float or None
+        The coefficient and its interval [``unit``].
+    unit : str
+        Its SI unit.
+    term : str
+        Which coefficient.
+    method : str
+        ``slope``, ``fit`` or ``bound``.
+    tau_s : float or None
+        Where the line touches the curve or the bounding point [s].
+    read_at_tau_s : float
+        Where the line is read [s].
+    quality : str
+        ``good``, ``rough`` or ``poor``.
+    reason : str or None
+        Why rough or poor.
+    tau_range_s : (float, float) or None
+        The τ range the slope line was fitted on [s].
     """
 
     value: float
@@ -138,6 +159,25 @@ class AxisNoise:
     density, ``walk`` the random-walk strength, both in SI (:data:`SI_UNIT` per √Hz);
     ``quantization`` the output quantisation found in the samples (None: not quantised;
     a rate quantisation's white noise is part of ``density``).
+
+    Attributes
+    ----------
+    name : str
+        The axis (column).
+    sensor : {"gyro", "accel"}
+        Gyroscope or accelerometer.
+    unit : str
+        The data's own unit.
+    allan : AllanResult
+        Its Allan deviation.
+    terms : NoiseTerms
+        Its noise terms.
+    density : ContinuousTerm
+        White-noise density [SI unit/√Hz].
+    walk : ContinuousTerm
+        Random-walk strength [SI unit·√Hz].
+    quantization : OutputQuantization or None
+        The output quantisation found (None: not quantised).
     """
 
     name: str
@@ -156,6 +196,21 @@ class NoiseModel:
 
     ``update_rate_hz`` 1/τ0; ``inflate`` the factor every Kalibr value is multiplied by
     (1: none); ``chosen`` maps a Kalibr key to the axis it came from.
+
+    Attributes
+    ----------
+    axes : tuple of AxisNoise
+        Every axis.
+    update_rate_hz : float
+        1/τ0 [Hz].
+    inflate : float
+        Factor every Kalibr value is multiplied by.
+    rostopic : str
+        The IMU topic written into the Kalibr file.
+    confidence : float
+        Confidence level of the intervals.
+    chosen : dict of str to AxisNoise
+        The axis each Kalibr key came from.
     """
 
     axes: tuple[AxisNoise, ...]
@@ -175,8 +230,8 @@ class NoiseModel:
         return {k: out[k] for k in KALIBR_KEYS if k in out}
 
     def to_dict(self, source: str) -> dict[str, Any]:
-        """The noise model as plain Python values: the file ``thermocal noise --format
-        json`` writes (NaN where it writes null).
+        """The noise model as plain Python values: the file the ``noise`` command writes as
+        JSON (NaN where it writes null).
 
         Parameters
         ----------
@@ -454,11 +509,12 @@ def noise_model(
     ['gyroscope_noise_density', 'gyroscope_random_walk']
     """
     if not (math.isfinite(inflate) and inflate >= 1.0):
-        raise ThermocalInputError(f"--inflate {inflate!r}: give a factor ≥ 1 (1: none)")
+        raise ParameterError("inflate", f"{{name}} {inflate!r}: give a factor ≥ 1 (1: none)")
     _distinct_axes(axes)
     if not ROS_NAME.fullmatch(rostopic):
-        raise ThermocalInputError(
-            f"--rostopic {one_line(repr(rostopic))}: not a ROS topic name (a letter, '/' or "
+        raise ParameterError(
+            "rostopic",
+            f"{{name}} {one_line(repr(rostopic))}: not a ROS topic name (a letter, '/' or "
             "'~', then letters, digits, '_' and '/'; ROS wiki 'Names' 1.1.1), e.g. /imu0",
         )
     chosen: dict[str, AxisNoise] = {}
@@ -470,7 +526,9 @@ def noise_model(
         chosen[f"{prefix}_random_walk"] = max(mine, key=lambda a: a.walk.value)
     model = NoiseModel(tuple(axes), update_rate_hz, inflate, rostopic, confidence, chosen)
     for why in implausible(model):
-        warnings.warn(f"{where}: {why}" if where else why, PlausibilityWarning, stacklevel=2)
+        if where and why.template is not None:
+            why = PlausibilityWarning.naming(f"{where}: {why.template}", *why.parameters)
+        warnings.warn(why, stacklevel=2)
     return model
 
 
@@ -493,7 +551,7 @@ accelerometers from 1 ng/√Hz (seismic sensors) to 10 mg/√Hz (25× an ADXL345
 400 µg/√Hz, its data sheet)."""
 
 
-def implausible(model: NoiseModel) -> list[str]:
+def implausible(model: NoiseModel) -> list[PlausibilityWarning]:
     """Why ``model``'s update rate or densities cannot be an IMU's (empty: plausible); the
     bounds are :data:`IMU_RATE_HZ` and :data:`IMU_DENSITY`, each with its source.
 
@@ -504,27 +562,35 @@ def implausible(model: NoiseModel) -> list[str]:
 
     Returns
     -------
-    list of str
-        Reasons, empty when plausible.
+    list of PlausibilityWarning
+        The reasons (``str()`` of each), empty when plausible; each names the parameters
+        to check (``time_unit``, ``gyro_unit``, ``accel_unit``).
     """
     out = []
     lo, hi = IMU_RATE_HZ
     rate = model.update_rate_hz
     if not lo <= rate <= hi:
         out.append(
-            f"update rate {rate:.6g} Hz (one sample every {1.0 / rate:.6g} s) is outside the "
-            f"{lo:g} Hz … {hi:g} Hz an estimator fuses an IMU at: if the time column is in "
-            "ms or µs, give --time-unit (a time axis ×1000 makes every noise density "
-            "√1000 = 31.6× too large)"
+            PlausibilityWarning.naming(
+                f"update rate {rate:.6g} Hz (one sample every {1.0 / rate:.6g} s) is outside "
+                f"the {lo:g} Hz … {hi:g} Hz an estimator fuses an IMU at: if the time column "
+                "is in ms or µs, give {time_unit} (a time axis ×1000 makes every noise "
+                "density √1000 = 31.6× too large)",
+                "time_unit",
+            )
         )
     for ax in model.axes:
         dlo, dhi = IMU_DENSITY[ax.sensor]
         v = ax.density.value
         if not dlo <= v <= dhi:
             out.append(
-                f"{one_line(ax.name)}: noise density {v:.4g} {ax.density.unit} lies outside "
-                f"the {dlo:g} … {dhi:g} of any {ax.sensor} (check the column's unit "
-                f"--{ax.sensor}-unit and the time unit --time-unit)"
+                PlausibilityWarning.naming(
+                    f"{one_line(ax.name)}: noise density {v:.4g} {ax.density.unit} lies "
+                    f"outside the {dlo:g} … {dhi:g} of any {ax.sensor} (check the column's "
+                    f"unit {{{ax.sensor}_unit}} and the time unit {{time_unit}})",
+                    f"{ax.sensor}_unit",
+                    "time_unit",
+                )
             )
     return out
 
@@ -534,18 +600,29 @@ def _distinct_axes(axes: list[AxisNoise]) -> None:
     gyro's, would give Kalibr one sensor's noise for another's."""
     first: dict[str, str] = {}
     for ax in axes:
-        opt = "--gyro" if ax.sensor == "gyro" else "--accel"
         if ax.name in first:
-            raise ThermocalInputError(
-                f"{opt} {one_line(repr(ax.name))}: column named twice (also in "
-                f"{first[ax.name]}); give three different columns X,Y,Z for each sensor"
+            raise ThermocalInputError.naming(
+                f"{{{ax.sensor}}} {one_line(repr(ax.name))}: column named twice (also in "
+                f"{{{first[ax.name]}}}); give three different columns X,Y,Z for each sensor",
+                *dict.fromkeys((ax.sensor, first[ax.name])),
             )
-        first[ax.name] = opt
+        first[ax.name] = ax.sensor
 
 
 def _yaml_float(x: float) -> str:
     """A float YAML 1.1 (PyYAML) reads as a float: a mantissa with a dot, signed exponent."""
     return f"{x:.6e}"
+
+
+_INFLATED_LINE: Final = (
+    "# Every noise value below is INFLATED ×{:g} (--inflate) over the measured one, for "
+    # cli-words: the imu.yaml the noise command writes names its option
+    "unmodelled effects (vibration, temperature)."
+)
+"""The comment of an inflated ``imu.yaml`` (``str.format`` of the factor)."""
+
+_ROSTOPIC_LINE: Final = "# rostopic: the ROS topic of this IMU in your bag (--rostopic)."
+# cli-words: the imu.yaml the noise command writes names its option (the line above)
 
 
 def kalibr_yaml(model: NoiseModel, source: str) -> str:
@@ -566,10 +643,7 @@ def kalibr_yaml(model: NoiseModel, source: str) -> str:
         "# below is the LARGEST over that sensor's axes.",
     ]
     if model.inflate != 1.0:
-        lines.append(
-            f"# Every noise value below is INFLATED ×{model.inflate:g} (--inflate) over the "
-            "measured one, for unmodelled effects (vibration, temperature)."
-        )
+        lines.append(_INFLATED_LINE.format(model.inflate))
     lines.append("")
     values = model.kalibr()
     for key in KALIBR_KEYS:
@@ -641,7 +715,7 @@ def kalibr_yaml(model: NoiseModel, source: str) -> str:
                 rate = f"{float(model.update_rate_hz):.16e}"
             lines.append(f"{key}: {rate}")
         else:
-            lines.append("# rostopic: the ROS topic of this IMU in your bag (--rostopic).")
+            lines.append(_ROSTOPIC_LINE)
             lines.append(f"{key}: {json.dumps(model.rostopic)}")
         lines.append("")
     text = "\n".join(lines)
@@ -788,6 +862,31 @@ class OutputQuantization:
     term's variance explained by the quantisation (rate: N_q²/N² with N the slope line's,
     else the fit's; angle: Q²/Q_fit²), None when the
     record shows no such term; ``quality`` ``good`` or ``rough`` with ``reason``.
+
+    Attributes
+    ----------
+    step : float
+        The quantum [``unit``].
+    unit : str
+        The data's own unit.
+    offset : float
+        The lattice's offset [``unit``].
+    levels, n_samples : int
+        Distinct levels used and samples read.
+    kind : str
+        ``"rate"`` or ``"angle"``.
+    white_density, angle_q : float
+        N_q and Q in the noise terms' units.
+    white_density_unit, angle_q_unit : str
+        Those units.
+    share : float or None
+        Fraction of the measured term's variance explained.
+    quality : str
+        ``good`` or ``rough``.
+    reason : str or None
+        Why rough.
+    source : str
+        How the quantisation was found and why its variance is step²/12 (one sentence).
     """
 
     step: float

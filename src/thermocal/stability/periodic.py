@@ -74,6 +74,25 @@ class PeriodicTerm:
     ``tau_peak_s`` 0.3710/f₀ [s] where its Allan deviation ``adev_peak`` = 0.7246·A
     [``unit``] is largest; ``share`` that bump's share of the measured Allan variance
     there (None when not compared).
+
+    Attributes
+    ----------
+    frequency_hz : float
+        Frequency f₀ of the sinusoid [Hz].
+    resolution_hz : float
+        The periodogram's bin width [Hz].
+    amplitude : float
+        Amplitude A [``unit``].
+    unit : str
+        Unit of the record.
+    ratio : float
+        The peak's density over the local floor of the periodogram.
+    tau_peak_s : float
+        0.3710/f₀ [s], where the sinusoid's Allan deviation is largest.
+    adev_peak : float
+        0.7246·A [``unit``], that largest Allan deviation.
+    share : float or None
+        The bump's share of the measured Allan variance at ``tau_peak_s`` (None: not compared).
     """
 
     frequency_hz: float

@@ -2,7 +2,7 @@
 
 Each entry (:class:`Deviation`) names the deviation, its sums over one gap-free stretch of
 phase, its largest averaging factor, its equivalent degrees of freedom, the data types it
-takes and its Stable32 name.  The command line (``thermocal allan --deviation``), the
+takes and its Stable32 name.  The command line (the ``allan`` command), the
 library (:func:`thermocal.stability.family.stability`, :func:`thermocal.stability.deviation`)
 and the report read this table; a new deviation is one :func:`register` call.  The built-in
 entries are NIST SP 1065's deviations [1]_ with Greenhall and Riley's EDF [2]_.
@@ -53,7 +53,8 @@ class Deviation:
     Parameters
     ----------
     name : str
-        The name ``--deviation`` and :func:`thermocal.stability.deviation` take (lower case).
+        The name :func:`thermocal.stability.deviation` and the ``deviations`` of
+        :func:`thermocal.stability.analysis.allan_analysis` take (lower case).
     sums : SumsFunction
         Sums of one gap-free stretch of phase ``x`` [unit·s]: ``(x, tau0_s, m) ->
         (numerator, terms)``.

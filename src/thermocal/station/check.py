@@ -15,7 +15,23 @@ from thermocal.station.sensors import SerialSensor
 @dataclass(frozen=True)
 class SensorCheck:
     """A sensor's answer: lines and bad lines seen in ``listen_s``, rate [Hz], the first
-    parsed line, or the error."""
+    parsed line, or the error.
+
+    Attributes
+    ----------
+    id, device : str
+        The sensor and its serial device.
+    ok : bool
+        Good lines were read.
+    rate_hz : float
+        Measured line rate [Hz].
+    lines, bad_lines : int
+        Lines and bad lines seen.
+    first_line : str
+        The first parsed line.
+    error : str
+        The port's error ("" : none).
+    """
 
     id: str
     device: str
@@ -29,7 +45,21 @@ class SensorCheck:
 
 @dataclass(frozen=True)
 class StationCheck:
-    """The chamber's temperature and set-point [°C] (NaN for ``none``) and each sensor."""
+    """The chamber's temperature and set-point [°C] (NaN for ``none``) and each sensor.
+
+    Attributes
+    ----------
+    chamber : str
+        The chamber's driver.
+    chamber_ok : bool
+        The chamber answered.
+    chamber_error : str
+        Its error ("" : none).
+    temperature_c, setpoint_c : float
+        The chamber's temperature and set-point [°C] (NaN for ``none``).
+    sensors : tuple of SensorCheck
+        Each sensor's answer.
+    """
 
     chamber: str
     chamber_ok: bool

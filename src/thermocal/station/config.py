@@ -73,7 +73,49 @@ TIME_NAMES = ("time",)
 
 @dataclass(frozen=True)
 class ChamberConfig:
-    """The ``[chamber]`` table.  Temperatures [°C], times [s]."""
+    """The ``[chamber]`` table.  Temperatures [°C], times [s].
+
+    Attributes
+    ----------
+    driver : str
+        ``"modbus-tcp"``, ``"modbus-rtu"`` or ``"none"`` (no chamber driven).
+    preset : str
+        A controller preset of :mod:`thermocal.station.presets` ("" : registers given here).
+    host : str
+        Modbus TCP host.
+    port : int
+        Modbus TCP port.
+    device : str
+        Serial device of Modbus RTU.
+    baud : int
+        Baud rate of Modbus RTU.
+    unit : int
+        Modbus slave id.
+    setpoint_register : int
+        Holding register written with the set-point.
+    temperature_register : int
+        Register read for the chamber's temperature.
+    register_kind : str
+        ``"holding"`` or ``"input"``: the kind of ``temperature_register``.
+    scale : float
+        [°C per count] of both registers.
+    signed : bool
+        The registers hold 16-bit two's complement values.
+    poll_s : float
+        Polling period [s].
+    safe_setpoint_c : float
+        Set-point written whenever the run stops [°C].
+    timeout_s : float
+        A chamber silent this long stops the run safely [s].
+    io_timeout_s : float
+        Time allowed for one request [s].
+    tolerance_c : float
+        Distance from the set-point [°C] that, held for ``drift_s``, is reported.
+    drift_s : float
+        Program time [s] of that drift.
+    min_c, max_c : float
+        The chamber's range [°C].
+    """
 
     driver: str = "none"
     preset: str = ""
@@ -120,7 +162,29 @@ class ChamberConfig:
 
 @dataclass(frozen=True)
 class SensorConfig:
-    """One ``[[sensor]]``: a serial port sending one sample per text line."""
+    """One ``[[sensor]]``: a serial port sending one sample per text line.
+
+    Attributes
+    ----------
+    id : str
+        The sensor's name (its folder in the recording).
+    device : str
+        Serial device.
+    baud : int
+        Baud rate.
+    names : tuple of str
+        Names of the fields of a line.
+    units : tuple of str
+        Their units.
+    delimiter : str or None
+        Field delimiter (None: white space).
+    decimal : str
+        Decimal mark, ``"."`` or ``","``.
+    rate_hz : float or None
+        Nominal sample rate [Hz] when the lines carry no time (time = line / rate).
+    stale_s : float or None
+        A sensor silent this long is reported [s] (None: ``max(2 s, 20 / rate_hz)``).
+    """
 
     id: str
     device: str
@@ -147,7 +211,19 @@ class SensorConfig:
 
 @dataclass(frozen=True)
 class StationConfig:
-    """A whole ``STATION.toml``."""
+    """A whole ``STATION.toml``.
+
+    Attributes
+    ----------
+    chamber : ChamberConfig
+        The ``[chamber]`` table.
+    sensors : tuple of SensorConfig
+        The ``[[sensor]]`` tables.
+    part_s : float
+        Period [s] at which the recorder closes a Parquet part.
+    source : str
+        The file the configuration was read from.
+    """
 
     chamber: ChamberConfig
     sensors: tuple[SensorConfig, ...]

@@ -82,7 +82,23 @@ class StationStopped(ThermocalInputError):
 
 @dataclass
 class SensorView:
-    """One sensor's line of the live display."""
+    """One sensor's line of the live display.
+
+    Attributes
+    ----------
+    id : str
+        The sensor.
+    rate_hz : float
+        Measured rate [Hz].
+    last : tuple of float
+        The last sample's values.
+    names : tuple of str
+        Their names.
+    bad : int
+        Bad lines so far.
+    samples : int
+        Samples so far.
+    """
 
     id: str
     rate_hz: float
@@ -95,7 +111,25 @@ class SensorView:
 
 @dataclass
 class StationState:
-    """What the live display shows, refreshed by the loop."""
+    """What the live display shows, refreshed by the loop.
+
+    Attributes
+    ----------
+    step, n_steps : int
+        The program step running and their number.
+    program_s, end_s : float
+        Program time now and at the end [s].
+    setpoint_c, chamber_c : float
+        Set-point and chamber temperature [°C] (NaN: not known yet).
+    time_scale : float
+        Program seconds per wall-clock second.
+    sensors : list of SensorView
+        Each sensor's line.
+    samples, parts : int
+        Samples recorded and Parquet parts written.
+    chamber_ok : bool
+        The chamber answers.
+    """
 
     step: int = 0
     n_steps: int = 0
@@ -212,7 +246,33 @@ class RunResult:
     bad lines per sensor, how it ended (``"end"``, ``"interrupted"``, ``"chamber"``), the
     set-points written as ``(program_s, °C)``, the safe set-point written (or None), the
     events, why it was interrupted (``"SIGHUP"``, ``"stderr closed (…)"``; ``""``) and, for
-    ``--resume``, how the previous run ended (:func:`previous_run`)."""
+    ``--resume``, how the previous run ended (:func:`previous_run`).
+
+    Attributes
+    ----------
+    out_dir : Path
+        The recording folder.
+    program_start_s, program_end_s : float
+        Program span covered [s].
+    parts : list of str
+        The Parquet parts written.
+    samples : dict of str to int
+        Samples per stream.
+    bad_lines : dict of str to int
+        Bad lines per sensor.
+    ended : str
+        ``"end"``, ``"interrupted"`` or ``"chamber"``.
+    setpoints : list of (float, float)
+        The set-points written, ``(program time [s], set-point [°C])``.
+    safe_setpoint_c : float or None
+        The safe set-point written at the end [°C] (None: none written).
+    events : list of dict
+        The run's events.
+    stop_reason : str
+        Why it was interrupted (``"SIGHUP"``, ``"stderr closed (…)"``; "" otherwise).
+    previous : str
+        How the previous run ended, for a resumed run.
+    """
 
     out_dir: Path
     program_start_s: float

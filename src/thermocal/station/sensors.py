@@ -44,7 +44,17 @@ class BadLine(ValueError):
 
 @dataclass(frozen=True)
 class LineParser:
-    """Parse one text line into ``len(names)`` floats (see the module docstring)."""
+    """Parse one text line into ``len(names)`` floats (see the module docstring).
+
+    Attributes
+    ----------
+    n_fields : int
+        Number of numbers a good line holds.
+    delimiter : str or None
+        Field delimiter (None: white space).
+    decimal : str
+        Decimal mark, ``"."`` or ``","``.
+    """
 
     n_fields: int
     delimiter: str | None = None
@@ -102,7 +112,25 @@ class LineParser:
 
 @dataclass
 class SensorStats:
-    """What the display and ``station check`` show of a sensor."""
+    """What the display and ``station check`` show of a sensor.
+
+    Attributes
+    ----------
+    lines, good, bad : int
+        Lines read, parsed and refused.
+    last_unix : float
+        Host time of the last good line [s, Unix] (NaN: none yet).
+    last_values : tuple of float
+        Its numbers.
+    first_line : str
+        The first good line read.
+    error : str
+        The port's last error ("" : none).
+    dropped : int
+        Good lines dropped because the recorder could not keep up (backlog full).
+    recent : collections.deque of float
+        Host times of the last 200 good lines [s, Unix] (the measured rate).
+    """
 
     lines: int = 0
     good: int = 0
@@ -124,7 +152,17 @@ class SensorStats:
 @dataclass(frozen=True)
 class Sample:
     """A good line: host time [s, Unix], the line's index in this run (good and bad lines
-    counted) and its numbers."""
+    counted) and its numbers.
+
+    Attributes
+    ----------
+    host_unix : float
+        Host time of the line [s, Unix].
+    index : int
+        The line's index in this run (good and bad lines counted).
+    values : tuple of float
+        Its numbers.
+    """
 
     host_unix: float
     index: int
@@ -133,7 +171,19 @@ class Sample:
 
 @dataclass(frozen=True)
 class Bad:
-    """A bad line kept aside."""
+    """A bad line kept aside.
+
+    Attributes
+    ----------
+    host_unix : float
+        Host time of the line [s, Unix].
+    index : int
+        The line's index in this run.
+    text : str
+        The line as read.
+    reason : str
+        Why it was refused.
+    """
 
     host_unix: float
     index: int

@@ -33,7 +33,25 @@ N_REGISTERS = 400
 
 @dataclass
 class ChamberModel:
-    """First-order chamber: temperature [°C], time constant ``tau_s`` [program s]."""
+    """First-order chamber: temperature [°C], time constant ``tau_s`` [program s].
+
+    Attributes
+    ----------
+    temperature_c : float
+        Temperature now [°C].
+    setpoint_c : float
+        Set-point [°C].
+    tau_s : float
+        Time constant [program s].
+    time_scale : float
+        Program seconds per wall-clock second.
+    last_unix : float
+        Wall-clock time of the last update [s, Unix].
+    writes : list of (float, float)
+        ``(time [s, Unix], set-point [°C])`` of every write.
+    lock : threading.Lock
+        Guards the state across the server's threads.
+    """
 
     temperature_c: float = 25.0
     setpoint_c: float = 25.0
@@ -201,7 +219,19 @@ class SimulatedChamber:
 @dataclass(frozen=True)
 class GyroTruth:
     """The simulated sensor's truth: ``gx = bias_deg_s + slope_deg_s_per_c·(T − 25 °C)``
-    [deg/s], white noise ``noise_deg_s`` (1σ), die temperature lag ``tau_s`` [program s]."""
+    [deg/s], white noise ``noise_deg_s`` (1σ), die temperature lag ``tau_s`` [program s].
+
+    Attributes
+    ----------
+    bias_deg_s : float
+        Bias at 25 °C [deg/s].
+    slope_deg_s_per_c : float
+        Temperature slope [deg/s/°C].
+    noise_deg_s : float
+        White noise, 1σ [deg/s].
+    tau_s : float
+        Die temperature lag [program s].
+    """
 
     bias_deg_s: float = 0.05
     slope_deg_s_per_c: float = 0.002

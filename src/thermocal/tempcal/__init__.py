@@ -3,7 +3,9 @@
 The workflow layer: it reads the log, judges it, fits and writes the calibration set; the
 firmware maths it uses are pure functions in :mod:`thermocal.firmware`.
 
-flightlog  a PX4 log read once (:class:`~thermocal.tempcal.flightlog.FlightLog`), passed down
+flightlog  a log read once and passed down: a PX4 ULog
+           (:class:`~thermocal.tempcal.flightlog.FlightLog`) or an ArduPilot DataFlash log
+           (:class:`~thermocal.tempcal.flightlog.DataflashFlightLog`)
 pipeline   the one pipeline both share: judge the data (:mod:`thermocal.adequacy`), bin, hold-out
            check, fit a cubic per axis, the gates, the output set written whole
 px4        the PX4 dialect: ``sensor_*`` topics, ``TC_*`` parameters, TREF mid-range;

@@ -40,6 +40,7 @@ from thermocal.tempcal.ardupilot_baro import (
     fit_ardupilot_baro,
 )
 from thermocal.tempcal.compare import CoefficientComparison, compare_coefficients
+from thermocal.tempcal.flightlog import DataflashFlightLog, read_ardupilot_log
 from thermocal.tempcal.pipeline import (
     AXES,
     GateWarning,
@@ -62,6 +63,9 @@ from thermocal.tempcal.pipeline import (
 
 MAX_IMUS = 3
 """ArduPilot logs up to three IMUs (``IMU``, instances 0…2)."""
+MESSAGES = ("IMU", "IMU2", "IMU3", "TCLR", "BARO")
+"""The messages the calibration reads of a DataFlash log (``IMU2``/``IMU3``: older firmware's
+second and third IMU; ``TCLR``: the firmware's own learning; ``BARO``: the barometer)."""
 KINDS = (("gyro", "Gyr", "rad/s"), ("accel", "Acc", "m/s^2"))
 """(kind, field prefix of the ``IMU`` message, its unit) per sensor of an IMU."""
 KIND_UNITS = {kind: unit for kind, _prefix, unit in KINDS}
@@ -631,7 +635,7 @@ class ArdupilotTempcalResult:
         return [k for k, h in self.hygiene.items() if h["active_tcal_removed"]]
 
     def to_dict(self) -> dict[str, Any]:
-        """The JSON of ``ardupilot-tempcal --json``."""
+        """The result as a JSON object (what the ``ardupilot-tempcal`` command prints as JSON)."""
         return {
             "log": str(self.log),
             "params": str(self.params_path),
@@ -663,7 +667,7 @@ class _Run:
     """The state of one :func:`ardupilot_tempcal` run across its IMUs."""
 
     log: Path
-    dlog: Any
+    flight: DataflashFlightLog
     overrides: tuple[str, ...]
     params: Any
     out_set: OutputSet
@@ -729,7 +733,6 @@ def ardupilot_tempcal(
     """
     from thermocal.errors import MissingColumnError
     from thermocal.export.params import ParamSet, check_documented, check_values
-    from thermocal.readers.dataflash import dataflash_table, read_dataflash_log
 
     # DIR may hold the log; the files of the set (replaced by name) may not be it
     names = ["calibration.json", FORMATS["ardupilot"].params_file]
@@ -738,13 +741,11 @@ def ardupilot_tempcal(
     check_outputs([output / n for n in names], [log], dirs=[output])
     check_output_dir(output)
     with staged_set(output, reporter) as out_set:  # moved into place whole, or removed
-        dlog = read_dataflash_log(
-            log, ["IMU", "IMU2", "IMU3", "TCLR", "BARO"]
-        )  # the log is read once
-        run = _Run(log, dlog, overrides, ParamSet("ardupilot"), out_set, [], [], {}, {})
+        flight = read_ardupilot_log(log, MESSAGES)  # the log is read once, passed down
+        run = _Run(log, flight, overrides, ParamSet("ardupilot"), out_set, [], [], {}, {})
         for inst in range(MAX_IMUS):
             try:
-                df, _info = dataflash_table(dlog, log, "IMU", inst)
+                df, _info = flight.table("IMU", inst)
             except MissingColumnError:
                 if inst == 0:
                     raise
@@ -847,7 +848,9 @@ def _imu(run: _Run, df: Any, inst: int) -> None:
     run.gates.append(stall_warning(f"IMU.{inst}", time_s, temp_c))
     per_kind: list[tuple[SensorFit, Recording]] = []
     intervals, changes = param_intervals(
-        run.dlog.params, run.dlog.param_changes, lambda n: imu_hygiene_params(n, inst)
+        run.flight.parameters,
+        run.flight.parameter_changes,
+        lambda n: imu_hygiene_params(n, inst),
     )
     prev_params = _previous_params(run, inst, intervals, changes, time_s)
     for kind, prefix, unit in KINDS:
@@ -888,7 +891,7 @@ def _imu(run: _Run, df: Any, inst: int) -> None:
     _hygiene_and_gates(run, inst, ps, prev_params)
     active = ardupilot_active(prev_params, inst)
     fw_range = tclr_range(
-        run.dlog.rows.get("TCLR", []), inst, run.dlog.param_changes, time_s, temp_c
+        run.flight.rows("TCLR"), inst, run.flight.parameter_changes, time_s, temp_c
     )
     for fit, sub_rec in per_kind:
         key = f"{fit.topic}.{inst}"
@@ -898,7 +901,7 @@ def _imu(run: _Run, df: Any, inst: int) -> None:
                 fit.sweep_c,
             )  # fmt: skip
         learned = None if fw_range is None else tclr_comparison(
-            run.dlog.rows.get("TCLR", []), inst, fit.kind,
+            run.flight.rows("TCLR"), inst, fit.kind,
             KIND_UNITS[fit.kind], ps.params, fit.sweep_c, fw_range,
         )  # fmt: skip
         if learned is not None:
@@ -924,7 +927,7 @@ def _baro(run: _Run) -> None:
     from thermocal.errors import MissingColumnError
 
     try:
-        df, _info = _table(run, "BARO", 0)
+        df, _info = run.flight.table("BARO", 0)
     except MissingColumnError:
         return  # no barometer in the log
     require_fields(df, ["Press", "Temp"], run.log, "BARO.0")
@@ -956,7 +959,7 @@ def _baro(run: _Run) -> None:
         BARO_REPORT,
         baro_report_request(
             fit, temp_c, press_pa, str(run.log), "thermocal ardupilot-tempcal",
-            run.dlog.params_at_end(), said,
+            run.flight.parameters_at_end(), said,
         ),
     )  # fmt: skip
 
@@ -979,13 +982,6 @@ def _baro_screened(run: _Run, df: Any) -> tuple[FloatArray | None, FloatArray | 
         run.gates.append(judged.left_out)
         return None, None
     return temp_c[judged.keep], press_pa[judged.keep]
-
-
-def _table(run: _Run, name: str, inst: int) -> tuple[Any, dict[str, Any]]:
-    """Instance ``inst`` of message ``name`` from the run's one pass over the log."""
-    from thermocal.readers.dataflash import dataflash_table
-
-    return dataflash_table(run.dlog, run.log, name, inst)
 
 
 def _previous_params(

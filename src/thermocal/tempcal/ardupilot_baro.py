@@ -161,7 +161,7 @@ class ArdupilotBaroFit:
         )
 
     def to_dict(self) -> dict[str, Any]:
-        """The ``BARO.<n>`` object of ``ardupilot-tempcal --json``."""
+        """The ``BARO.<n>`` object of the ``ardupilot-tempcal`` command's JSON."""
         return {**asdict(self), "parameters": self.params(), "unit": "Pa"}
 
 

@@ -5,7 +5,7 @@ recorded (ArduPilot's ``INS_TCAL<n>_*`` in its ``PARM`` messages).  A
 :class:`CoefficientComparison` holds, for one sensor, each parameter old → new with their
 difference, and the correction each set applies over the calibrated range, per axis, as the
 firmware computes it — for the table and figure of the report and the ``previous`` object of
-``--json``.
+the result's JSON (``to_dict``).
 """
 
 from __future__ import annotations
@@ -53,7 +53,7 @@ class CoefficientComparison:
     )
 
     def to_dict(self) -> dict[str, Any]:
-        """The ``previous`` (or ``firmware_learning``) object of a sensor in ``--json``: per
+        """The ``previous`` (or ``firmware_learning``) object of a sensor in the JSON: per
         parameter old, new (named :attr:`old_key`, :attr:`new_key`) and ``difference`` =
         new − old; the curves per axis [``unit``]."""
         ok, nk = self.old_key, self.new_key

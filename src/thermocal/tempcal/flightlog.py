@@ -1,15 +1,23 @@
-"""A PX4 flight log read once: :class:`FlightLog`, what ``px4-tempcal`` passes down.
+"""A flight controller's log read once, the object the thermal calibration passes down.
 
-:func:`open_px4_log` parses the ULog's sensor topics once (pyulog, within
-:func:`thermocal.readers.ulog.parsed_once`) and gathers what the calibration needs of the
-log: the sensor instances that carry a temperature, the parameters in the log's header and
-those changed during the recording.  Each sensor's data are handed out from that one parse
-(:meth:`FlightLog.recording`, :meth:`FlightLog.table`), so no part of the pipeline opens
-the file again.
+* PX4: :func:`open_px4_log` parses the ULog's sensor topics once (pyulog, within
+  :func:`thermocal.readers.ulog.parsed_once`) into a :class:`FlightLog`: the sensor
+  instances that carry a temperature, the parameters in the log's header and those changed
+  during the recording.  Each sensor's data are handed out from that one parse
+  (:meth:`FlightLog.recording`, :meth:`FlightLog.table`).
+* ArduPilot: :func:`read_ardupilot_log` reads the DataFlash log in one pass (pymavlink,
+  :func:`thermocal.readers.dataflash.read_dataflash_log`) into a
+  :class:`DataflashFlightLog`: the messages kept, the parameters the recording started with
+  and every later change.  Each message instance is handed out from that pass
+  (:meth:`DataflashFlightLog.table`, :meth:`DataflashFlightLog.rows`).
+
+So no part of either pipeline opens the file again.
 
 References
 ----------
 * PX4 ULog File Format, https://docs.px4.io/main/en/dev_log/ulog_file_format.html
+* ArduPilot, *Onboard Message Log Messages* and ``libraries/AP_Logger/LogStructure.h``,
+  https://ardupilot.org/copter/docs/logmessages.html
 """
 
 from __future__ import annotations
@@ -23,6 +31,7 @@ from typing import TYPE_CHECKING, Any
 if TYPE_CHECKING:
     import pandas as pd
 
+    from thermocal.readers.dataflash import DataflashLog, ParamChange
     from thermocal.recording import Recording
 
 
@@ -132,4 +141,108 @@ def open_px4_log(path: Path, topics: tuple[str, ...]) -> Iterator[FlightLog]:
         )
 
 
-__all__ = ["FlightLog", "open_px4_log"]
+@dataclass(frozen=True)
+class DataflashFlightLog:
+    """An ArduPilot DataFlash log as the thermal calibration reads it: one pass over the file.
+
+    Parameters
+    ----------
+    path : Path
+        The log file.
+    messages : tuple of str
+        The message types kept (``IMU``, ``IMU2``, ``IMU3``, ``TCLR``, ``BARO``).
+    passed : thermocal.readers.dataflash.DataflashLog
+        What the one pass kept: the messages' rows, the types seen, the parameters.
+    """
+
+    path: Path
+    messages: tuple[str, ...]
+    passed: DataflashLog
+
+    @property
+    def parameters(self) -> Mapping[str, float]:
+        """The parameters the recording started with (the first ``PARM`` of each name)."""
+        return self.passed.params
+
+    @property
+    def parameter_changes(self) -> tuple[ParamChange, ...]:
+        """Every later ``PARM`` that changed a value, in log order (time [s], old, new)."""
+        return self.passed.param_changes
+
+    def parameters_at_end(self) -> dict[str, float]:
+        """The parameters in force at the end of the log.
+
+        Returns
+        -------
+        dict of str to float
+            Parameter name → the last value set.
+        """
+        return self.passed.params_at_end()
+
+    def rows(self, message: str) -> list[dict[str, float]]:
+        """Every message of type ``message`` (all instances), numeric fields, in log order.
+
+        Parameters
+        ----------
+        message : str
+            A message type among :attr:`messages` (``TCLR``).
+
+        Returns
+        -------
+        list of dict
+            Field name → value; empty when the log has none.
+        """
+        return self.passed.rows.get(message, [])
+
+    def table(self, message: str, instance: int) -> tuple[pd.DataFrame, dict[str, Any]]:
+        """Instance ``instance`` of ``message`` as a table in the firmware's units, served
+        from the log's one pass (:func:`thermocal.readers.dataflash.dataflash_table`).
+
+        Parameters
+        ----------
+        message : str
+            The message type (``IMU``, ``BARO``).
+        instance : int
+            The instance, 0-based (``IMU2`` of older logs is ``IMU`` instance 1).
+
+        Returns
+        -------
+        tuple
+            (the fields as a pandas.DataFrame, what the reader found: time column, units).
+
+        Raises
+        ------
+        thermocal.errors.MissingColumnError
+            No such message instance in the log.
+        """
+        from thermocal.readers.dataflash import dataflash_table
+
+        return dataflash_table(self.passed, self.path, message, instance)
+
+
+def read_ardupilot_log(path: Path, messages: tuple[str, ...]) -> DataflashFlightLog:
+    """The DataFlash log ``path`` read in one pass, keeping ``messages`` and every ``PARM``.
+
+    Parameters
+    ----------
+    path : Path
+        An ArduPilot DataFlash log (``.bin``).
+    messages : tuple of str
+        The message types the calibration takes.
+
+    Returns
+    -------
+    DataflashFlightLog
+
+    Raises
+    ------
+    thermocal.errors.ThermocalInputError
+        The file is not a readable DataFlash log (said by the reader, naming the file), or
+        pymavlink is not installed.
+    """
+    from thermocal.readers.dataflash import read_dataflash_log
+
+    return DataflashFlightLog(Path(path), tuple(messages), read_dataflash_log(path, messages))
+
+
+__all__ = ["DataflashFlightLog", "FlightLog", "open_px4_log", "read_ardupilot_log"]

@@ -221,7 +221,7 @@ class Px4TempcalResult:
     """Per sensor, the log's ``TC_*`` for its device against the new ones."""
 
     def to_dict(self) -> dict[str, Any]:
-        """The JSON of ``px4-tempcal --json``."""
+        """The result as a JSON object (what the ``px4-tempcal`` command prints as JSON)."""
         return {
             "log": str(self.log),
             "params": str(self.params_path),

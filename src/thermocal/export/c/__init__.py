@@ -18,7 +18,7 @@ source file with
   ``update`` returns the model value ŷ (the temperature-induced signal);
   ``compensate`` returns ``signal − ŷ``.  Signal, known input and results are in the
   data's own unit (the unit the model was fitted on as given, model file ``inputs``;
-  ``--unit`` for another of the same kind, :func:`c_signal_unit`), named in every
+  ``unit`` for another of the same kind, :func:`c_signal_unit`), named in every
   function's comment and in ``<P>_SIGNAL_UNIT``; the family arithmetic runs in the
   model's unit behind ``<P>_TO_MODEL_UNIT``.  ``temps_c`` are in the model's temperature
   unit (``<P>_TEMPERATURE_UNIT``: °C, or raw counts for a model fitted in counts); a model
@@ -29,7 +29,7 @@ source file with
 * a comment block with the model file's identity (family, format version,
   thermocal version, checksum, signal, temperatures, data files).
 
-Names come from files and options (columns, channels, temperatures, triads, ``--name``, string
+Names come from files and parameters (columns, channels, temperatures, triads, ``name``, string
 fields of a model file) and may hold anything: every one reaches the C through the one gate,
 :mod:`thermocal.identifiers` (identifiers by :func:`~thermocal.identifiers.c_identifier`,
 names that meet after mapping refused; comment text by
@@ -40,7 +40,7 @@ names that meet after mapping refused; comment text by
 The arithmetic follows the family's ``ModelStream`` operation by operation, so
 the double build agrees with the Python streaming compensator to rounding
 (tests: 1e-9 relative on 10⁵ samples with cc -O2 -std=c99).  Time is ``double``
-in both builds; ``--float`` makes every other quantity ``float`` and its
+in both builds; ``real="float"`` makes every other quantity ``float`` and its
 worst-case error against double is measured (:func:`measure_float_error`).
 Temperatures are always clamped to the fitted range (the Python default,
 ``extrapolate=False``).

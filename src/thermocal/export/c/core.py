@@ -210,9 +210,10 @@ class ExportContext:
         if not math.isfinite(x):
             raise ModelFileError(f"non-finite coefficient {x!r} cannot be exported")
         if self.real == "float" and abs(x) > FLT_MAX:
-            raise ModelFileError(
+            raise ModelFileError.naming(
                 f"the constant {float(x)!r} is beyond a C float's largest value FLT_MAX = "
-                f"{FLT_MAX:.8g} (C11 §5.2.4.2.2): export it without --float (in double)"
+                f"{FLT_MAX:.8g} (C11 §5.2.4.2.2): export it without {{use_float}} (in double)",
+                "use_float",
             )
         if self.real == "float" and abs(x) < FLT_MIN:
             x = 0.0  # below FLT_MIN: what a float holds of it is 0 (no truncation warning)
@@ -423,9 +424,10 @@ def c_signal_unit(model: dict[str, Any], unit: str | None = None) -> tuple[str, 
         unit = str(given) if ok else mu
     u = units.normalize_signal_unit(unit)
     if u != mu and (units.signal_kind(u) == "raw" or units.signal_kind(mu) == "raw"):
-        raise UnitError(
-            f"export-c --unit {u}: raw counts need the scale factor, the model is in {mu}; "
-            "give a physical unit of the model's kind"
+        raise UnitError.naming(
+            f"{{unit}} {u}: raw counts need the scale factor, the model is in {mu}; "
+            "give a physical unit of the model's kind",
+            "unit",
         )
     return u, float(units.convert(1.0, u, mu))
 

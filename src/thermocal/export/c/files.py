@@ -22,7 +22,7 @@ class ExportCResult:
     """What :func:`export_c_file` wrote.  ``kind``: ``"model"`` (one model file),
     ``"calibration"`` (channels; ``channels`` holds ``(name, unit, family)``) or
     ``"triads"`` (``triads`` holds ``(name, unit, columns)``).  ``float_error``: the float
-    build's worst-case error against double (a model with ``--float`` and a compiler)."""
+    build's worst-case error against double (a model with ``use_float`` and a compiler)."""
 
     kind: str
     export: CExport
@@ -32,7 +32,7 @@ class ExportCResult:
     float_error: FloatError | None = None
 
     def to_dict(self) -> dict[str, Any]:
-        """The ``thermocal export-c --json`` object."""
+        """The result as a JSON object (what the ``export-c`` command prints as JSON)."""
         ex, files = self.export, [str(p) for p in self.files]
         if self.kind == "triads":
             return {
@@ -159,10 +159,12 @@ def export_c_file(
             )
             if not math.isfinite(err.max_abs):  # inf − inf or inf − x: the float build overflowed
                 warnings.warn(
-                    f"{path}: the float build's output is not finite where double's is (a "
-                    "result beyond FLT_MAX 3.4028235e+38 over the calibrated range): these "
-                    "float functions are wrong; export without --float (in double)",
-                    ThermocalWarning,
+                    ThermocalWarning.naming(
+                        f"{path}: the float build's output is not finite where double's is (a "
+                        "result beyond FLT_MAX 3.4028235e+38 over the calibrated range): these "
+                        "float functions are wrong; export without {use_float} (in double)",
+                        "use_float",
+                    ),
                     stacklevel=2,
                 )
     return ExportCResult("model", ex, tuple(paths), float_error=err)
@@ -175,11 +177,12 @@ def _default_sample_interval(d: dict[str, Any], path: Path) -> float:
         return fitted
     if d.get("rate"):
         warnings.warn(
-            UnitWarning(
+            UnitWarning.naming(
                 f"{path}: the model file does not record its data's sample "
                 "interval (an older file); the C rate buffer is sized for 1 s samples "
-                "— give --sample-interval, or sampling faster shortens the rate "
-                "interval in the firmware"
+                "— give {sample_interval_s}, or sampling faster shortens the rate "
+                "interval in the firmware",
+                "sample_interval_s",
             ),
             stacklevel=3,
         )
@@ -187,26 +190,28 @@ def _default_sample_interval(d: dict[str, Any], path: Path) -> float:
 
 
 def _warn_unstated_unit(d: dict[str, Any], path: Path) -> None:
-    """Without ``--unit``: warn when the model file does not record its data's unit (the C
+    """Without ``unit``: warn when the model file does not record its data's unit (the C
     then works in the model's) or when the data were raw counts converted by a scale
     factor."""
     sig = d.get("signal") or {}
     given = ((d.get("inputs") or {}).get("units") or {}).get(sig.get("name"))
     if not given:
         warnings.warn(
-            UnitWarning(
+            UnitWarning.naming(
                 f"{path}: the model file does not record the unit its data were "
                 f"in (an older file); the C works in the model's unit {sig.get('unit')} "
-                "(give --unit for another)"
+                "(give {unit} for another)",
+                "unit",
             ),
             stacklevel=3,
         )
     elif given == "counts" and sig.get("unit") != "counts":
         warnings.warn(
-            UnitWarning(
+            UnitWarning.naming(
                 f"{path}: the model was fitted on raw counts converted with a scale "
                 f"factor; the C works in {sig.get('unit')} (convert the counts first, or "
-                "give --unit)"
+                "give {unit})",
+                "unit",
             ),
             stacklevel=3,
         )

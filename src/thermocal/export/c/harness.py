@@ -257,7 +257,17 @@ def exercise_inputs(
 @dataclass(frozen=True)
 class FloatError:
     """Worst-case difference of the float build from the double build on :func:`exercise_inputs`:
-    ``max_abs`` [signal unit], ``max_rel`` (relative to max |ŷ|), ``n_samples``."""
+    ``max_abs`` [signal unit], ``max_rel`` (relative to max |ŷ|), ``n_samples``.
+
+    Attributes
+    ----------
+    max_abs : float
+        Largest |float − double| [signal unit].
+    max_rel : float
+        ``max_abs`` relative to max |ŷ|.
+    n_samples : int
+        Number of samples compared.
+    """
 
     max_abs: float
     max_rel: float

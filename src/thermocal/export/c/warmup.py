@@ -79,7 +79,7 @@ for (j = {nj - 1}; j >= 0; --j) {{
     acc = (j == {nj - 1}) ? a : acc * dt + a;
 }}
 return acc;
-"""
+"""  # cli-words: C's pre-decrement operators (--j, --k) in the generated loop, not options
     return FamilyCode(
         state_fields=[
             "int started;",
