@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import contextlib
 import io
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -22,6 +23,7 @@ from thermocal.errors import ParameterError, ThermocalInputError, ThermocalWarni
 from thermocal.pipeline.fit import earth_rate_known_input, fit_files
 from thermocal.pipeline.messages import error_text, warning_lines
 from thermocal.pipeline.options import FitOptions, ValidateOptions
+from thermocal.pipeline.validate import validate_files
 from thermocal.readers.options import ReadOptions
 from thermocal.units import TemperatureConversion
 
@@ -121,6 +123,7 @@ def test_validate_options_are_typed() -> None:
     assert v.signals == ("gx", "gy") and v.names == ("t", "gx", "gy", "T")
     assert v.temp_conversion == TemperatureConversion(0.0625, -50.0, "int16")
     assert v.signal_unit == ("deg/s", "deg/s")
+    assert ValidateOptions(signal_unit=["deg/h"]).signal_unit == "deg/h"
     assert v.read_options.signals == ("gx", "gy") and v.read_options.rate_hz == 100.0
     assert ValidateOptions().read_options == ReadOptions()
     with pytest.raises(ParameterError) as info:
@@ -138,3 +141,22 @@ def test_a_ramp_rate_no_chamber_has_names_the_profile_parameters() -> None:
         info.value
     )
     assert "°C/min (--rate, --cycle-rate, --rates): a chamber" in error_text(info.value)[0]
+
+
+def test_validate_files_takes_paths_as_text(run_csv: Path, tmp_path: Path) -> None:
+    """A notebook user's strings: the model judged on its own run (the line written into the
+    data removed, so what is left is the seeded noise)."""
+    model = tmp_path / "m.json"
+    options = FitOptions(
+        "poly", {"order": 1}, signals="gx", temperatures="T1", signal_unit="deg/h", temp_unit="degC"
+    )
+    fit_files([run_csv], options, model)
+    v = ValidateOptions(signals=("gx",), signal_unit=("deg/h",), temp_unit="degC")
+    with warnings.catch_warnings(record=True):  # the same run, no hold stages: said
+        warnings.simplefilter("always")
+        out = validate_files(str(model), str(run_csv), v).to_dict()
+    # the sweep's line: 0.02 °/h/°C over a uniform 40 °C sweep has rms 0.02·40/√12 °/h
+    assert out["rms_before"] == pytest.approx(0.02 * 40.0 / np.sqrt(12.0), rel=1e-3)
+    # left: the white noise of 1e-3 °/h in 1 s samples, averaged over 100 s: 1e-4 °/h
+    # (40 averages: the estimate's own scatter is about 11 %)
+    assert out["rms_after"] == pytest.approx(1e-3 / np.sqrt(100.0), rel=0.25)

@@ -179,7 +179,8 @@ class ValidateOptions:
     time, time_unit : str, optional
         The time column and its unit (default: the file's).
     signal_unit : str or tuple of str, optional
-        The signal's unit, or one per signal (default: the file's).
+        The signal's unit, or one per signal (default: the file's); a single unit in a
+        tuple is stored as the unit.
     temp_unit : str, optional
         The temperature columns' unit (default: the file's).
     temp_conversion : TemperatureConversion, optional
@@ -252,7 +253,8 @@ class ValidateOptions:
         for field in ("signals", "names"):
             set_(self, field, _names(getattr(self, field), field))
         if self.signal_unit is not None and not isinstance(self.signal_unit, str):
-            set_(self, "signal_unit", tuple(self.signal_unit))
+            units = tuple(self.signal_unit)
+            set_(self, "signal_unit", units[0] if len(units) == 1 else units)
         if self.temp_conversion is not None:
             set_(self, "temp_conversion", _conversion(self.temp_conversion))
 

@@ -358,7 +358,7 @@ def _validate_triads(
 
 
 def validate_files(
-    calibration: Path, file: Path, options: ValidateOptions | None = None
+    calibration: str | Path, file: str | Path, options: ValidateOptions | None = None
 ) -> ValidationReport:
     """Judge the model or calibration file ``calibration`` on the recording ``file`` (module
     docstring): correlation r, bias stability and repeatability over the hold stages, rms and
@@ -367,9 +367,9 @@ def validate_files(
 
     Parameters
     ----------
-    calibration : Path
+    calibration : str or Path
         A model or calibration file.
-    file : Path
+    file : str or Path
         The validation recording.
     options : ValidateOptions or None, optional
         Columns, stage detection and read options (default ``None``: the defaults).
@@ -394,6 +394,7 @@ def validate_files(
     from thermocal.pipeline.model_file import load_calibration
 
     o = options if options is not None else ValidateOptions()
+    calibration, file = Path(calibration), Path(file)
     pre = load_calibration(calibration)
     if pre.triads and not pre.channels:
         return _validate_triads(pre, calibration, file, o)
