@@ -98,6 +98,42 @@ class NamesParameters:
         obj.parameters = tuple(parameters)
         return obj
 
+    @classmethod
+    def around(
+        cls, exc: BaseException, before: str = "", after: str = "", *parameters: str
+    ) -> Self:
+        """``exc``'s message between ``before`` and ``after``, still naming the parameters
+        that ``exc`` names (a message passed up with the file it concerns put in front).
+
+        Parameters
+        ----------
+        exc : BaseException
+            The exception whose message is kept.
+        before, after : str
+            Text put before and after it, with ``{parameter}`` for each of ``parameters``.
+        *parameters : str
+            The parameters ``before`` and ``after`` name.
+
+        Returns
+        -------
+        instance of the class
+
+        Examples
+        --------
+        >>> inner = ThermocalInputError.naming("lower {static_s}", "static_s")
+        >>> outer = DesignError.around(inner, "a.csv: ", "; or {poses}", "poses")
+        >>> str(outer), outer.spelled(lambda p: "--" + p.replace("_", "-"))
+        ('a.csv: lower static_s; or poses', 'a.csv: lower --static-s; or --poses')
+        """
+        if isinstance(exc, ParameterError):
+            text = exc.template.replace("{name}", "{" + exc.parameter + "}")
+            named: tuple[str, ...] = (exc.parameter, *exc.others)
+        elif isinstance(exc, NamesParameters) and exc.template is not None:
+            text, named = exc.template, exc.parameters
+        else:
+            text, named = str(exc), ()
+        return cls.naming(before + text + after, *named, *parameters)
+
     def spelled(self, spell: Callable[[str], str]) -> str:
         """The message with ``spell(parameter)`` for each named parameter.
 

@@ -637,7 +637,8 @@ def resolve_unit(
     option_name : str, optional
         The option as the user wrote it, for messages.
     ask : str, optional
-        An option's name: a unit nobody stated is refused, asking for it.
+        A parameter's name (``"accel_unit"``; the command line shows its option): a unit
+        nobody stated is refused, asking for it.
     implied : str, optional
         A unit another option implies (raw ``counts`` with a count scale), taken
         without a warning when nobody states one.
@@ -684,10 +685,12 @@ def resolve_unit(
         return ResolvedUnit(norm(model), "model")
     if implied:
         return ResolvedUnit(norm(implied), "option")
-    if ask:
-        raise UnitError(
-            f"{prefix}no unit stated for column {column!r}; give {ask} (or the unit in the "
-            "file's metadata or column name)"
+    if ask:  # a parameter (the command line shows its option), or an option as it is
+        named = ask if ask.startswith("-") else "{" + ask + "}"
+        raise UnitError.naming(
+            f"{prefix}no unit stated for column {column!r}; give {named} (or the unit in the "
+            "file's metadata or column name)",
+            ask,
         )
     chosen = norm(default) if default else DEFAULT_UNITS[role]
     whose = " (the model's unit)" if default else ""

@@ -282,7 +282,7 @@ def test_implausible_gyro_scale_is_warned() -> None:
     assert res.gyro is not None
     np.testing.assert_allclose(res.gyro.theta[3:6], (1.25 * (1 + t0.gyro[3:6] * 1e-6) - 1)
                                * 1e6, atol=2000.0)  # fmt: skip
-    assert any("--gyro-unit" in str(w.message) for w in rec)
+    assert any("gyro_unit" in str(w.message) for w in rec)
 
 
 @pytest.mark.parametrize("form", ["csv", "columns-json"])

@@ -32,6 +32,7 @@ from thermocal.cli.common import (
     stdout,
 )
 from thermocal.errors import ThermocalInputError, UnitError
+from thermocal.pipeline.messages import option_name
 
 if TYPE_CHECKING:
     import rich.table as _rich_table
@@ -305,7 +306,7 @@ def multipos_cmd(
         ),
     )  # fmt: skip
     res = _mpf.calibrate_files(files, output, opts, poses)
-    out = res.to_dict()
+    out = res.to_dict(option_name)
     emit(out, as_json, lambda: _human(out, res.accel_unit, output))
 
 

@@ -65,7 +65,25 @@ FLOAT32_MAX = float(np.finfo(np.float32).max)
 @dataclass(frozen=True)
 class AxisPoly:
     """One axis: polynomial coefficients ``b_k`` of ``(T − tref)^k``, k = 0…3, in the
-    firmware's unit ([rad/s] or [m/s²]), the fitted range and the channel it came from."""
+    firmware's unit ([rad/s] or [m/s²]), the fitted range and the channel it came from.
+
+    Attributes
+    ----------
+    channel : str
+        The channel it came from.
+    kind : str
+        ``"gyro"`` or ``"accel"``.
+    axis : str
+        ``x``, ``y`` or ``z``.
+    tref_c : float
+        Reference temperature [°C].
+    coef : (float, float, float, float)
+        b_0 … b_3 [firmware unit/°C^k].
+    tmin_c, tmax_c : float
+        The fitted range [°C].
+    relative : bool
+        The coefficients are relative to the value at ``tref_c`` (b_0 = 0).
+    """
 
     channel: str
     kind: str  # "gyro" or "accel"
@@ -108,7 +126,21 @@ class AxisPoly:
 class ParamSet:
     """The parameters of one export: ``params`` name → value, ``types`` name → MAVLink
     parameter type (9 float, 6 int32), what the firmware does at the range ends, and the
-    warnings raised."""
+    warnings raised.
+
+    Attributes
+    ----------
+    format : str
+        The firmware (``"px4"`` or ``"ardupilot"``).
+    params : dict of str to float
+        Parameter name → value.
+    types : dict of str to int
+        Parameter name → MAVLink type (9 float, 6 int32).
+    axes : list of AxisPoly
+        The axes the parameters hold.
+    notes : list of str
+        The notes written into the file (range ends, warnings).
+    """
 
     format: str
     params: dict[str, float] = field(default_factory=dict)
@@ -741,7 +773,17 @@ def px4_offset_params(
 @dataclass(frozen=True)
 class ParamsFileResult:
     """What :func:`export_params_file` wrote: the parameter file, its firmware and the
-    parameters (:class:`ParamSet`)."""
+    parameters (:class:`ParamSet`).
+
+    Attributes
+    ----------
+    output : str
+        The parameter file.
+    format : str
+        Its firmware.
+    params : ParamSet
+        The parameters.
+    """
 
     output: str
     format: str

@@ -54,7 +54,7 @@ PX4_ID_TYPE = "int32"
 """``CAL_ACC${i}_ID``, ``CAL_GYRO${i}_ID``: ``type: int32`` (same file)."""
 PLAUSIBLE_NOTE = (
     "a scale this far from 1 or an offset this large is not a sensor's error but a unit or "
-    "range setting off by that factor: check the multipos --accel-unit/--accel-scale"
+    "range setting off by that factor: check the multipos {accel_unit}/{accel_scale}"
 )
 """Why ArduPilot's @Range (:data:`ARDUPILOT_ACCSCAL_RANGE`, :data:`ARDUPILOT_ACCOFFS_RANGE_M_S2`)
 is applied to PX4's values too: the same physical sensor, a MEMS accelerometer whose
@@ -67,7 +67,27 @@ class TriadFirmware:
     """One triad as the firmware holds it: ``offset`` [m/s² or rad/s], ``scale`` (the
     diagonal of ``(I + E)⁻¹``; 1 for a gyro, which the firmware does not scale), and what
     is lost: the largest off-diagonal term of ``(I + E)⁻¹`` [″], the largest gyro scale
-    error [ppm] and whether the model depends on temperature."""
+    error [ppm] and whether the model depends on temperature.
+
+    Attributes
+    ----------
+    kind : str
+        ``"accel"`` or ``"gyro"``.
+    offset : (float, float, float)
+        Offset per axis [m/s² or rad/s].
+    scale : (float, float, float)
+        Diagonal of ``(I + E)⁻¹`` (1 for a gyro).
+    misalignment_lost_arcsec : float
+        Largest off-diagonal term of ``(I + E)⁻¹`` the firmware cannot hold [″].
+    scale_lost_ppm : float
+        Largest gyro scale error the firmware cannot hold [ppm].
+    temperature_dependent : bool
+        The model depends on temperature.
+    tref_c : float
+        Temperature at which the values are taken [°C].
+    count_scale : (float, str) or None
+        For a triad calibrated on raw counts: one count is ``value`` ``unit``.
+    """
 
     kind: str
     offset: tuple[float, float, float]
@@ -132,7 +152,21 @@ def triad_firmware(triad: Triad) -> TriadFirmware:
 @dataclass(frozen=True)
 class TriadParams:
     """The parameters of one export (name → value, name → MAVLink type 9 float / 6 int32),
-    the comments written at the top of the file, and each triad as held."""
+    the comments written at the top of the file, and each triad as held.
+
+    Attributes
+    ----------
+    format : str
+        The firmware.
+    params : dict of str to float
+        Parameter name → value.
+    types : dict of str to int
+        Parameter name → MAVLink type (9 float, 6 int32).
+    notes : tuple of str
+        The comments at the top of the file.
+    triads : tuple of TriadFirmware
+        Each triad as the firmware holds it.
+    """
 
     format: str
     params: dict[str, float]
@@ -146,12 +180,14 @@ class TriadParams:
         comments = [f"# {n}" for n in self.notes]
         if self.format == "px4":
             head = ["# Onboard parameters for Vehicle 1", "#",
-                    "# thermocal export-params --format px4 (sensor calibration, CAL_*)",
+                    "# thermocal export-params --format px4"  # cli-words: provenance
+                    " (sensor calibration, CAL_*)",
                     *comments, "#", "# Vehicle-Id Component-Id Name Value Type"]  # fmt: skip
             rows = [f"1\t1\t{n}\t{_num(v, self.types[n])}\t{self.types[n]}"
                     for n, v in self.params.items()]  # fmt: skip
         else:
-            head = ["# thermocal export-params --format ardupilot (INS_ACC*, INS_GYR*)",
+            head = ["# thermocal export-params --format ardupilot"  # cli-words: provenance
+                    " (INS_ACC*, INS_GYR*)",
                     *comments]  # fmt: skip
             rows = [f"{n} {_num(v, self.types[n])}" for n, v in self.params.items()]
         return "\n".join(head + rows) + "\n"
@@ -190,18 +226,20 @@ def _check_px4_accel(names: Sequence[str], values: Sequence[float], scale: bool)
     rng = ARDUPILOT_ACCSCAL_RANGE if scale else ARDUPILOT_ACCOFFS_RANGE_M_S2
     for n, v in zip(names, values, strict=True):
         if scale and not PX4_ACCSCALE_RANGE[0] <= v <= PX4_ACCSCALE_RANGE[1]:
-            raise ThermocalInputError(
+            raise ThermocalInputError.naming(
                 f"{n} = {v:.6g}: outside PX4's range {PX4_ACCSCALE_RANGE[0]:g}…"
                 f"{PX4_ACCSCALE_RANGE[1]:g} (min/max of CAL_ACC${{i}}_XSCALE in PX4's "
-                f"src/modules/sensors/module.yaml); {PLAUSIBLE_NOTE}"
+                f"src/modules/sensors/module.yaml); {PLAUSIBLE_NOTE}",
+                *("accel_unit", "accel_scale"),
             )
         if not rng[0] <= v <= rng[1]:
             unit = "" if scale else " m/s²"
             px4 = "PX4's metadata allows 0.1…3.0" if scale else "PX4 documents no range"
-            raise ThermocalInputError(
+            raise ThermocalInputError.naming(
                 f"{n} = {v:.6g}{unit}: beyond {rng[0]:g}…{rng[1]:g}{unit}, the range ArduPilot "
                 f"documents for the same calibration (@Range in AP_InertialSensor_Params.cpp; "
-                f"{px4}); {PLAUSIBLE_NOTE}"
+                f"{px4}); {PLAUSIBLE_NOTE}",
+                *("accel_unit", "accel_scale"),
             )
 
 
@@ -329,9 +367,11 @@ def triad_params(
                 params[idn], types[idn] = device_id, 6
             else:
                 warnings.warn(
-                    f"{kind}: {idn} not written (no --device-id): PX4 applies the values only "
-                    f"to the sensor whose device id {idn} holds",
-                    ThermocalWarning,
+                    ThermocalWarning.naming(
+                        f"{kind}: {idn} not written (no {{device_id}}): PX4 applies the values "
+                        f"only to the sensor whose device id {idn} holds",
+                        "device_id",
+                    ),
                     stacklevel=2,
                 )
             if kind == "accel":
@@ -364,7 +404,7 @@ def triad_params(
 
 
 def as_dict(tp: TriadParams) -> dict[str, Any]:
-    """The triads as held, for ``--json``.
+    """The triads as held, as JSON types.
 
     Parameters
     ----------

@@ -61,7 +61,27 @@ DISTINCT_DEG: Final = 10.0
 class AccelFit:
     """θ (12: bias [mg], scale factors [ppm], misalignments [″]), its covariance (12×12;
     zero rows for the constrained misalignments), the gravity-magnitude residual rms of the
-    poses before and after [mg], the reduced χ², the method and the number of poses."""
+    poses before and after [mg], the reduced χ², the method and the number of poses.
+
+    Attributes
+    ----------
+    theta : numpy.ndarray, shape (12,)
+        Bias [mg], scale factors [ppm], misalignments [″].
+    cov : numpy.ndarray, shape (12, 12)
+        Its covariance.
+    residual_rms_before_mg, residual_rms_after_mg : float
+        Gravity-magnitude residual rms of the poses [mg].
+    reduced_chi2 : float
+        Reduced χ² [-].
+    method : str
+        How it was fitted.
+    n_poses : int
+        Poses used.
+    residuals_mg : tuple of float
+        Each pose's gravity-magnitude error after calibration [mg].
+    misfit_mg : float
+        Misfit τ added in quadrature to each pose's σ [mg].
+    """
 
     theta: FloatArray
     cov: FloatArray
@@ -180,7 +200,8 @@ def distinct_directions(f_mg: FloatArray) -> list[FloatArray]:
 
 def _six_faces_hint(u: FloatArray) -> str:
     """Where the distinct directions are the six faces (each within ``DISTINCT_DEG`` of a
-    body axis, up and down), the advice that uses them: a POSES file naming them."""
+    body axis, up and down), the advice that uses them: a POSES file naming them (``{poses}``
+    where the parameter goes)."""
     if len(u) != 6:
         return ""
     near = np.abs(u).max(axis=1) > math.cos(math.radians(DISTINCT_DEG))
@@ -189,7 +210,7 @@ def _six_faces_hint(u: FloatArray) -> str:
         return ""
     return (
         ", or, as they are the six faces (each body axis up and down), name them in a "
-        "--poses file (x_p, x_a, y_p, y_a, z_p, z_a: imucal's section list) for Ferraris's "
+        "{poses} file (x_p, x_a, y_p, y_a, z_p, z_a: imucal's section list) for Ferraris's "
         "six-face closed form"
     )
 
@@ -211,11 +232,12 @@ def check_poses(f_mg: FloatArray) -> None:
     """
     distinct = distinct_directions(f_mg)
     if len(distinct) < MIN_POSES:
-        raise DesignError(
+        raise DesignError.naming(
             f"{len(distinct)} distinct poses (gravity directions more than {DISTINCT_DEG:g}° "
             f"apart) of {len(f_mg)}: the accelerometer's bias, scale factors and misalignments "
             f"need at least {MIN_POSES}; place the board in more orientations"
-            + _six_faces_hint(np.asarray(distinct))
+            + _six_faces_hint(np.asarray(distinct)),
+            "poses",
         )
     w, v = np.linalg.eigh(np.asarray(distinct).T @ np.asarray(distinct) / len(distinct))
     if w[0] < 0.02:
@@ -498,7 +520,19 @@ def fit_six_faces(
 
 
 def to_dict(fit: AccelFit) -> dict[str, Any]:
-    """An accelerometer fit as a JSON-ready dict (biases [mg], ppm, arcsec, with σ)."""
+    """An accelerometer fit as a JSON-ready dict.
+
+    Parameters
+    ----------
+    fit : AccelFit
+        The fit (:func:`fit_accel`, :func:`fit_six_faces`).
+
+    Returns
+    -------
+    dict
+        ``method``, the biases [mg], scale factors [ppm] and misalignments [″], each with
+        its σ.
+    """
     s = fit.sigma
     return {
         "method": fit.method,

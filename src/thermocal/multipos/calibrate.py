@@ -85,21 +85,23 @@ def check_accel_fit(acc: _accel.AccelFit, g_mg: float, where: str) -> None:
     """
     bad = model.scale_factors_beyond(acc.theta)
     if bad:
-        raise DesignError(
+        raise DesignError.naming(
             f"{where}: the accelerometer's scale factors come out {', '.join(bad)} (beyond "
             f"±{SCALE_FACTOR_REFUSED:.0%}: no sensor's; before calibration the poses read "
             f"gravity's magnitude {acc.residual_rms_before_mg / g_mg:.3g} g rms off 1 g): "
-            "the columns are not in the unit declared; give the right --accel-unit (or "
-            "--accel-scale for raw counts); nothing written"
+            "the columns are not in the unit declared; give the right {accel_unit} (or "
+            "{accel_scale} for raw counts); nothing written",
+            *("accel_unit", "accel_scale"),
         )
     before, after = acc.residual_rms_before_mg, acc.residual_rms_after_mg
     if not (after <= ACCEL_RESIDUAL_REFUSED * g_mg and (after < before or after == 0.0)):
-        raise DesignError(
+        raise DesignError.naming(
             f"{where}: the accelerometer fit failed: gravity-magnitude residual rms "
             f"{before:.4g} mg before, {after:.4g} mg after calibration (at most "
             f"{ACCEL_RESIDUAL_REFUSED * g_mg:.4g} mg, and below the one before); check that "
-            "the poses are still and what they are named (--poses), and the accelerometer's "
-            "unit (--accel-unit, --accel-scale); nothing written"
+            "the poses are still and what they are named ({poses}), and the accelerometer's "
+            "unit ({accel_unit}, {accel_scale}); nothing written",
+            *("poses", "accel_unit", "accel_scale"),
         )
 
 
@@ -123,33 +125,45 @@ def check_gyro_fit(gfit: _gyro.GyroFit, where: str) -> None:
     """
     bad = model.scale_factors_beyond(gfit.theta)
     if bad:
-        raise DesignError(
+        raise DesignError.naming(
             f"{where}: the gyro's scale factors come out {', '.join(bad)} (beyond "
             f"±{SCALE_FACTOR_REFUSED:.0%}: no gyro's): the columns are not in the unit "
-            "declared, or not in the accelerometer's axes; give the right --gyro-unit (or "
-            "--gyro-scale for raw counts), or the order and signs of the --gyro and --accel "
-            "columns (x, y, z of one right-handed frame); nothing written"
+            "declared, or not in the accelerometer's axes; give the right {gyro_unit} (or "
+            "{gyro_scale} for raw counts), or the order and signs of the {gyro} and {accel} "
+            "columns (x, y, z of one right-handed frame); nothing written",
+            *("gyro_unit", "gyro_scale", "gyro", "accel"),
         )
     if gfit.n_motions == 0:
         return
     before = math.degrees(gfit.direction_rms_before_rad)
     after = math.degrees(gfit.direction_rms_after_rad)
     if not (after <= GYRO_DIRECTION_REFUSED_DEG and after < before):
-        raise DesignError(
+        raise DesignError.naming(
             f"{where}: the gyro fit failed: the {gfit.n_motions} motions' direction residual "
             f"rms {before:.3g}° before, {after:.3g}° after calibration (at most "
             f"{GYRO_DIRECTION_REFUSED_DEG:g}°, and below the one before); check the gyro's unit "
-            "(--gyro-unit, --gyro-scale), the time's (--time-unit, --rate), the order and "
-            "signs of the --gyro and --accel "
+            "({gyro_unit}, {gyro_scale}), the time's ({time_unit}, {rate_hz}), the order and "
+            "signs of the {gyro} and {accel} "
             "columns (x, y, z of one right-handed frame) and that the poses are what they are "
-            "named (--poses); nothing written"
+            "named ({poses}); nothing written",
+            *("gyro_unit", "gyro_scale", "time_unit", "rate_hz", "gyro", "accel", "poses"),
         )
 
 
 @dataclass(frozen=True)
 class PoseStats:
     """A static pose: its samples, mean specific force [mg], per-sample white noise σ of
-    each axis [mg] (``var(Δx)/2``), mean rate [rad/s] and rate noise σ [rad/s] (gyro)."""
+    each axis [mg] (``var(Δx)/2``), mean rate [rad/s] and rate noise σ [rad/s] (gyro).
+
+    Attributes
+    ----------
+    section : Section
+        The pose's samples.
+    f_mean_mg, f_sigma_mg : numpy.ndarray, shape (3,)
+        Mean specific force and per-sample white noise σ [mg].
+    w_mean_rad_s, w_sigma_rad_s : numpy.ndarray or None
+        Mean rate and its noise σ [rad/s] (None without a gyro).
+    """
 
     section: Section
     f_mean_mg: FloatArray
@@ -219,7 +233,25 @@ def pose_stats(
 
 @dataclass(frozen=True)
 class SessionResult:
-    """What :func:`calibrate_session` found."""
+    """What :func:`calibrate_session` found.
+
+    Attributes
+    ----------
+    accel : AccelFit
+        The accelerometer triad.
+    gyro : GyroFit or None
+        The gyro triad (None without its columns).
+    poses : tuple of PoseStats
+        The static poses.
+    turns : tuple of Section
+        The named 360° turns.
+    g_mg : float
+        Local gravity [mg].
+    temperature_c : float or None
+        Mean temperature [°C].
+    not_still : tuple of str
+        Poses whose variance is more than twice the quietest's.
+    """
 
     accel: _accel.AccelFit
     gyro: _gyro.GyroFit | None
@@ -380,9 +412,10 @@ def _section_warnings(
     still); the names of the poses not still."""
     if turns and not has_gyro:
         warnings.warn(
-            ThermocalWarning(
+            ThermocalWarning.naming(
                 f"{where}: {', '.join(s.name for s in turns)} in {sections_from} are 360° "
-                "turns for the gyro; without its columns (--gyro X,Y,Z) they are not used"
+                "turns for the gyro; without its columns ({gyro} X,Y,Z) they are not used",
+                "gyro",
             ),
             stacklevel=3,
         )
@@ -409,10 +442,11 @@ def _warn_short(
              if s.end - s.start < 2 or t[s.end - 1] - t[s.start] < static_s]  # fmt: skip
     if short:
         warnings.warn(
-            ThermocalWarning(
-                f"{where}: {len(short)} poses in {sections_from} are shorter than --static-s "
+            ThermocalWarning.naming(
+                f"{where}: {len(short)} poses in {sections_from} are shorter than {{static_s}} "
                 f"{static_s:g} s: {', '.join(short[:6])}{' …' if len(short) > 6 else ''}; "
-                "their means and noise rest on few samples (check their start and end)"
+                "their means and noise rest on few samples (check their start and end)",
+                "static_s",
             ),
             stacklevel=3,
         )
@@ -439,10 +473,11 @@ def _warn_implausible(gfit: _gyro.GyroFit, where: str) -> None:
             if abs(th[6 + k] * units.ARCSEC_TO_RAD) > GYRO_E_PLAUSIBLE]  # fmt: skip
     if bad:
         warnings.warn(
-            ThermocalWarning(
+            ThermocalWarning.naming(
                 f"{where}: gyro {', '.join(bad)}: beyond ±{GYRO_E_PLAUSIBLE:.0%} (0.1 rad), "
-                "no gyro's; check the gyro's unit (--gyro-unit, --gyro-scale) and that the "
-                "poses and turns are what they are named (--poses)"
+                "no gyro's; check the gyro's unit ({gyro_unit}, {gyro_scale}) and that the "
+                "poses and turns are what they are named ({poses})",
+                *("gyro_unit", "gyro_scale", "poses"),
             ),
             stacklevel=3,
         )
@@ -455,12 +490,13 @@ def _warn_too_few_motions(gfit: _gyro.GyroFit, where: str) -> None:
         return
     worst = float(np.max(gfit.sigma[3:6])) * units.PPM
     warnings.warn(
-        ThermocalWarning(
+        ThermocalWarning.naming(
             f"{where}: {gfit.n_motions} motions between poses for the gyro's 9 scale factors "
             f"and misalignments leave {gfit.dof} degree(s) of freedom, and they misfit their "
             f"noise (reduced χ² {gfit.reduced_chi2:.3g}): the misfit goes into E (scale "
             f"factor σ up to {worst:.1%}); fit the 3 scale factors only with "
-            "--gyro-model scale (misalignments held at 0), or record more motions"
+            "{gyro_model} scale (misalignments held at 0), or record more motions",
+            "gyro_model",
         ),
         stacklevel=3,
     )
@@ -479,9 +515,12 @@ def _accel_fit(
         try:
             acc = _accel.fit_six_faces(faces, face_sig, g_mg)
         except DesignError as exc:
-            raise DesignError(
-                f"{where}: {exc}; fix their sections in {sections_from} (a POSES file of "
-                "this session?) or the order and signs of the --accel columns"
+            raise DesignError.around(
+                exc,
+                f"{where}: ",
+                f"; fix their sections in {sections_from} (a POSES file of "
+                "this session?) or the order and signs of the {accel} columns",
+                "accel",
             ) from None
         idx: Sequence[int] = tuple(range(12))
         # residuals of the six faces only: map back in pose order
@@ -616,10 +655,11 @@ def calibrate_session(
         _warn_short(t, statics, static_s, where, sections_from)
     stats = pose_stats(a, w, statics)
     if len(stats) < 6:
-        raise DesignError(
+        raise DesignError.naming(
             f"{where}: {len(stats)} static poses found (still for at least {static_s:g} s): "
             f"the accelerometer triad needs at least {_accel.MIN_POSES} distinct poses "
-            "(6 with the six faces named in --poses)"
+            "(6 with the six faces named in {poses})",
+            "poses",
         )
     acc, idx = _accel_fit(stats, g_mg, where, sections_from)
     temp = None
@@ -638,7 +678,27 @@ def calibrate_session(
 class MultiposValidation:
     """Held-out session figures before (raw) and after compensation: per triad, the rms
     over poses of the gravity-magnitude error [accelerometer unit] or over motions of the
-    rotation-angle error [°] (and its per-axis rms, for the report's table)."""
+    rotation-angle error [°] (and its per-axis rms, for the report's table).
+
+    Attributes
+    ----------
+    triad : str
+        The triad's name.
+    unit : str
+        Unit of the figures.
+    rms_before, rms_after : float
+        Rms error before and after compensation [unit].
+    per_axis_before, per_axis_after : tuple of 3 float
+        Per-axis rms [unit].
+    n : int
+        Poses or motions judged.
+    what : str
+        ``gravity-magnitude error`` or ``rotation-angle error``.
+    outside_range_fraction : float
+        Fraction of samples outside the calibrated temperature range.
+    per_pose, not_judged, input_unit, count_scale, physical_unit
+        As documented on each field.
+    """
 
     triad: str
     unit: str

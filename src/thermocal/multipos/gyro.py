@@ -43,8 +43,9 @@ the propagated uncertainties of the gyro bias and of the accelerometer calibrati
 defines ``u`` (``K G C Gᵀ Kᵀ``, ``K = (JᵀJ)⁻¹Jᵀ``).  Rotations all about one axis leave
 ``E_g``'s other columns unseen: refused.
 
-**360° turns** (Ferraris et al., Sensors and Actuators A 46, 1995,
-doi:10.1016/0924-4247(94)00969-1; imucal's ``x_rot``, ``y_rot``, ``z_rot``): a turn
+**360° turns** (Ferraris, Gorini, Grimaldi and Parvis 1994, *Sensors and Actuators A* 42,
+doi:10.1016/0924-4247(94)80031-6; Ferraris et al. 1995; imucal's ``x_rot``, ``y_rot``,
+``z_rot``): a turn
 named about the sensor's axis ``e_j`` (j = x, y, z, whatever pose came before it: users
 do the turns after the six faces) adds
 ``Σ ω_c τ − 2π s e_j − Ω sin L T u = 0``, three linear rows of the same least squares
@@ -109,7 +110,19 @@ class Turn:
     """A named 360° turn (module docstring): its ``section``, the sensor axis it is named
     about (``axis`` 0, 1, 2 for ``x_rot``, ``y_rot``, ``z_rot``), the calibrated unit up
     direction during it ``up`` (body axes: the vertical earth rate) and the direction
-    noise ``axis_sigma_rad`` [rad] of the axis across itself."""
+    noise ``axis_sigma_rad`` [rad] of the axis across itself.
+
+    Attributes
+    ----------
+    section : Section
+        The turn's samples.
+    axis : int
+        0, 1, 2 for ``x_rot``, ``y_rot``, ``z_rot``.
+    up : numpy.ndarray, shape (3,)
+        The calibrated unit up direction during it (body axes).
+    axis_sigma_rad : float
+        Direction noise of the axis across itself [rad].
+    """
 
     section: Section
     axis: int
@@ -231,18 +244,20 @@ def check_turn(
     off = math.degrees(math.acos(min(1.0, abs(float(v[axis])) / ang))) if ang > 0 else 90.0
     if off > TURN_AXIS_TOLERANCE_DEG:
         most = "xyz"[int(np.argmax(np.abs(v)))]
-        raise ThermocalInputError(
+        raise ThermocalInputError.naming(
             f"{where}: the gyro turns {math.degrees(ang):.1f}° mostly about {most} "
             f"({shown}), {off:.1f}° from the sensor's {ax} axis that {name!r} names, "
             f"which must hold one full turn about {ax}: fix the section's name or its "
-            f"start and end in {source} (or the order of the --gyro columns)"
+            f"start and end in {source} (or the order of the {{gyro}} columns)",
+            "gyro",
         )
     if abs(ang / (2.0 * math.pi) - 1.0) > TURN_ANGLE_TOLERANCE:
-        raise ThermocalInputError(
+        raise ThermocalInputError.naming(
             f"{where}: the gyro turns {math.degrees(ang):.1f}° about {ax} ({shown}), not "
             f"one full turn (360° ± {TURN_ANGLE_TOLERANCE:.0%}): fix the section's start "
             f"and end in {source} to hold exactly one turn, or the gyro's unit "
-            "(--gyro-unit, --gyro-scale)"
+            "({gyro_unit}, {gyro_scale})",
+            *("gyro_unit", "gyro_scale"),
         )
 
 
@@ -252,7 +267,25 @@ class GyroFit:
     rms of the motions' gravity-direction residuals before (raw rate, bias removed) and
     after calibration [rad], the reduced χ² and the number of motions and turns used, and
     the turns' axis lean found in the data [rad] (sd per component, 0 when not
-    significant: :func:`_turn_axis_scatter`)."""
+    significant: :func:`_turn_axis_scatter`).
+
+    Attributes
+    ----------
+    theta : numpy.ndarray, shape (12,)
+        Bias [°/h], scale factors [ppm], misalignments [″].
+    cov : numpy.ndarray, shape (12, 12)
+        Its covariance.
+    direction_rms_before_rad, direction_rms_after_rad : float
+        Rms of the motions' gravity-direction residuals [rad].
+    reduced_chi2 : float
+        Reduced χ² [-].
+    n_motions, n_turns : int
+        Motions and turns used.
+    turn_axis_lean_rad : float
+        The turns' axis lean found in the data [rad].
+    model : str
+        ``full`` or ``scale``.
+    """
 
     theta: FloatArray
     cov: FloatArray
@@ -691,14 +724,66 @@ def fit_rotations(
     saturated: npt.NDArray[np.bool_] | None = None,
     model: str = "full",
 ) -> GyroFit:
-    """``E_g`` from the motions between consecutive ``poses`` (module docstring).
+    r"""``E_g`` from the motions between consecutive ``poses`` (module docstring).
 
-    ``up_of(p)`` gives the poses' calibrated unit up directions (m, 3) for accelerometer
-    parameters ``p`` (``accel_free`` at the solution, covariance ``accel_free_cov``);
-    ``dir_sigma_rad`` (m,) the noise of each pose's direction; ``turns`` the 360° turns with
-    their named axes (:class:`Turn`); ``latitude_deg`` (None: unknown) the earth rate's
-    split into the vertical, known, and the horizontal, of unknown heading; ``model`` the
-    elements of E fitted (:data:`GYRO_MODELS`: ``full`` nine, ``scale`` three)."""
+    Parameters
+    ----------
+    rate_rad_s : numpy.ndarray, shape (n, 3)
+        Gyro samples [rad/s].
+    dt_s : numpy.ndarray, shape (n,)
+        Each sample's interval [s].
+    poses : sequence of Section
+        The static poses, in time order.
+    up_of : callable
+        ``up_of(p)``: the poses' calibrated unit up directions (m, 3) for accelerometer
+        parameters ``p``.
+    accel_free, accel_free_cov : numpy.ndarray
+        The accelerometer parameters at the solution and their covariance.
+    bias_rad_s, bias_cov : numpy.ndarray
+        The gyro bias [rad/s] (3,) and its covariance [(rad/s)²].
+    dir_sigma_rad : numpy.ndarray, shape (m,)
+        The noise of each pose's up direction [rad].
+    rate_sigma_rad_s : float
+        The gyro's white noise per sample [rad/s].
+    turns : sequence of Turn, optional
+        The 360° turns with their named axes (default none).
+    latitude_deg : float or None, optional
+        Latitude [°]: the vertical earth rate is known, the horizontal one of unknown
+        heading (None: the earth rate's direction unknown).
+    max_iter : int, optional
+        Gauss–Newton iterations at most (default 8).
+    saturated : numpy.ndarray of bool or None, optional
+        Samples on the gyro's rails (motions across them are left out).
+    model : str, optional
+        The elements of E fitted (:data:`GYRO_MODELS`: ``full`` nine, ``scale`` three).
+
+    Returns
+    -------
+    GyroFit
+        θ (12) and its covariance, direction rms before and after [rad], χ², the motions.
+
+    Raises
+    ------
+    thermocal.errors.ThermocalInputError
+        An unknown ``model``.
+    thermocal.errors.DesignError
+        Too few rotations, or all about one axis.
+
+    Notes
+    -----
+    Each motion between poses :math:`k` and :math:`k+1` gives a residual, minimised over
+    :math:`E_g` by Gauss–Newton:
+
+    .. math:: r_k = u_{k+1} - A_{k+1}^\mathsf{T} A_k^{-\mathsf{T}} u_k, \qquad
+              \omega_c = (I + E_g)^{-1} (\omega - b_g)
+
+    References
+    ----------
+    - Tedaldi, D., Pretto, A., Menegatti, E., "A robust and easy to implement method for IMU
+      calibration without external equipments", Proc. IEEE ICRA 2014, §III-C.
+    - Ferraris, F., Grimaldi, U., Parvis, M., "Procedure for effortless in-field calibration
+      of three-axis rate gyros and accelerometers", Sensors and Materials 7(5), 1995.
+    """
     if model not in GYRO_MODELS:
         raise ThermocalInputError(f"gyro model {model!r}: one of {', '.join(GYRO_MODELS)}")
     dt_med = float(np.median(dt_s))
@@ -707,14 +792,7 @@ def fit_rotations(
     motions = unsaturated(motions, saturated)
     rot = _Rotations(rate_rad_s, dt_s, dt_med, motions, turns, rate_sigma_rad_s,
                      latitude_deg, free=GYRO_MODELS[model])  # fmt: skip
-    three_turns = {tn.axis for tn in turns} == {0, 1, 2}
-    if rot.n_rows < len(rot.free) + 3 and not three_turns:
-        raise DesignError(
-            f"{len(motions)} motions between static poses (none across a gap in time) and "
-            f"{len(turns)} named turns: the gyro's scale factors and misalignments need "
-            "rotations about at least two different axes with a still pose before and "
-            "after each, or the three turns x_rot, y_rot, z_rot"
-        )
+    _check_rotations(rot, len(motions), turns)
     r0, _j, _jb, _a = rot.evaluate(np.zeros((3, 3)), bias_rad_s, up, jac=False)
     e = _solve_error_matrix(rot, bias_rad_s, up, max_iter)
     rot, e = _turn_axis_scatter(rot, e, bias_rad_s, up, max_iter)
@@ -723,21 +801,30 @@ def fit_rotations(
         rot, r, j, jb, held, up_of, accel_free, accel_free_cov, bias_cov
     )
     theta, cov = _coefficients(e, bias_rad_s, bias_cov, cov_p)
-    sw = np.array([math.sqrt(mo.var) for mo in motions])
-    n_m = 3 * len(motions)
-    before = r0[:n_m].reshape(-1, 3) * sw[:, None]
-    after = r[:n_m].reshape(-1, 3) * sw[:, None]
     return GyroFit(
-        theta,
-        cov,
-        float(np.sqrt(np.mean(np.sum(before**2, axis=1)))) if n_m else float("nan"),
-        float(np.sqrt(np.mean(np.sum(after**2, axis=1)))) if n_m else float("nan"),
-        chi2,
-        len(motions),
-        len(turns),
-        math.sqrt(rot.tilt_var),
-        model,
-    )
+        theta, cov, _direction_rms(r0, motions), _direction_rms(r, motions), chi2,
+        len(motions), len(turns), math.sqrt(rot.tilt_var), model,
+    )  # fmt: skip
+
+
+def _direction_rms(r: FloatArray, motions: Sequence[Any]) -> float:
+    """Rms over the motions of their unwhitened direction residuals' norms [rad] (NaN for
+    no motion)."""
+    sw = np.array([math.sqrt(mo.var) for mo in motions])
+    v = r[: 3 * len(motions)].reshape(-1, 3) * sw[:, None]
+    return float(np.sqrt(np.mean(np.sum(v**2, axis=1)))) if len(motions) else float("nan")
+
+
+def _check_rotations(rot: Any, n_motions: int, turns: Sequence[Turn]) -> None:
+    """Refuse rotations that cannot carry the fitted elements of E (:func:`fit_rotations`)."""
+    three_turns = {tn.axis for tn in turns} == {0, 1, 2}
+    if rot.n_rows < len(rot.free) + 3 and not three_turns:
+        raise DesignError(
+            f"{n_motions} motions between static poses (none across a gap in time) and "
+            f"{len(turns)} named turns: the gyro's scale factors and misalignments need "
+            "rotations about at least two different axes with a still pose before and "
+            "after each, or the three turns x_rot, y_rot, z_rot"
+        )
 
 
 def scatter_beyond_noise(reduced_chi2: float, dof: int) -> bool:

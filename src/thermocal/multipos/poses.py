@@ -10,7 +10,7 @@ is the white-noise variance itself when at least a tenth of the session is still
 
     Σ_j v_j  <  max( threshold · Σ_j σ_j² ,  motion_fraction · motion )
 
-(``--still-threshold``, default 5; ``--motion-fraction``, default 0.01): below a few times
+(``still_threshold``, default 5; ``motion_fraction``, default 0.01): below a few times
 the noise, or — for a hand-held board, whose tremor is many times a quiet sensor's noise
 but far below the moves between poses — below a hundredth of the motions' variance
 (a tenth of their rms), so that a low-noise and a noisier sensor on the same board find
@@ -37,6 +37,7 @@ from __future__ import annotations
 
 import itertools
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any, Final
 
@@ -44,7 +45,7 @@ import numpy as np
 import numpy.typing as npt
 
 from thermocal import defaults
-from thermocal.errors import ParameterError, ThermocalInputError
+from thermocal.errors import ParameterError, ThermocalInputError, spell_parameters
 
 FloatArray = npt.NDArray[np.float64]
 
@@ -53,13 +54,13 @@ FACES: Final = ("x_p", "x_a", "y_p", "y_a", "z_p", "z_a")
 TURNS: Final = ("x_rot", "y_rot", "z_rot")
 """Names of the 360° turns about each axis (Ferraris et al. 1995)."""
 WINDOW_S: Final = defaults.POSE_WINDOW_S
-"""Default variance window [s] (``--window-s``)."""
+"""Default variance window [s] (``window_s``)."""
 STILL_THRESHOLD: Final = defaults.POSE_STILL_THRESHOLD
-"""Default still limit in multiples of the noise floor (``--still-threshold``)."""
+"""Default still limit in multiples of the noise floor (``still_threshold``)."""
 MOTION_FRACTION: Final = defaults.POSE_MOTION_FRACTION
-"""Default still limit as a fraction of the motions' variance (``--motion-fraction``)."""
+"""Default still limit as a fraction of the motions' variance (``motion_fraction``)."""
 DRIFT_DEG: Final = defaults.POSE_DRIFT_DEG
-"""Default largest turn of the gravity direction across a pose [°] (``--drift-deg``)."""
+"""Default largest turn of the gravity direction across a pose [°] (``drift_deg``)."""
 PERCENTILE: Final = 10.0
 """The noise floor is read at this percentile of the window variance, the motion at
 ``100 −`` it."""
@@ -67,7 +68,17 @@ PERCENTILE: Final = 10.0
 
 @dataclass(frozen=True)
 class Section:
-    """Samples ``start … end − 1`` of a session, named (``pose_3``, ``x_p``, ``z_rot``)."""
+    """Samples ``start … end − 1`` of a session, named (``pose_3``, ``x_p``, ``z_rot``).
+
+    Attributes
+    ----------
+    name : str
+        The section's name.
+    start, end : int
+        Sample indices, ``end`` exclusive.
+    still_ratio : float
+        Mean window variance over the noise floor [-].
+    """
 
     name: str
     start: int
@@ -86,11 +97,43 @@ class Section:
 
 @dataclass(frozen=True)
 class Rejected:
-    """Samples ``start … end − 1`` that looked still but are not a pose, and why."""
+    """Samples ``start … end − 1`` that looked still but are not a pose, and why.
+
+    Attributes
+    ----------
+    start, end : int
+        The samples rejected, ``end`` exclusive.
+    template : str
+        Why, with ``{parameter}`` where a parameter of :func:`find_poses` that changes it
+        is named.
+    parameters : tuple of str
+        The parameters ``template`` names.
+    """
 
     start: int
     end: int
-    reason: str
+    template: str
+    parameters: tuple[str, ...] = ()
+
+    @property
+    def reason(self) -> str:
+        """Why, naming the parameters of :func:`find_poses` (``static_s``)."""
+        return self.spelled()
+
+    def spelled(self, spell: Callable[[str], str] | None = None) -> str:
+        """Why, with ``spell(parameter)`` for each parameter named.
+
+        Parameters
+        ----------
+        spell : callable, optional
+            What to show for a parameter (the command line: its option); default the
+            parameter's own name.
+
+        Returns
+        -------
+        str
+        """
+        return spell_parameters(self.template, self.parameters, spell)
 
 
 def _running_variance(x: FloatArray, w: int) -> FloatArray:
@@ -139,7 +182,25 @@ class _Limit:
 class PoseDetection:
     """What :func:`find_poses` found: the poses, the stretches rejected (too short, moving),
     the window [samples] and sample interval [s], each sensor's noise floor and still limit
-    [its unit²] and the options that set them."""
+    [its unit²] and the options that set them.
+
+    Attributes
+    ----------
+    poses : tuple of Section
+        The poses found.
+    rejected : tuple of Rejected
+        The stretches rejected and why.
+    window : int
+        The variance window [samples].
+    dt_s : float
+        Sample interval [s].
+    accel, gyro : _Limit
+        Each sensor's noise floor and still limit [its unit²] (gyro None without it).
+    threshold, motion_fraction : float
+        The still limit's parameters [-].
+    static_s : float
+        The shortest pose [s].
+    """
 
     poses: tuple[Section, ...]
     rejected: tuple[Rejected, ...]
@@ -151,9 +212,27 @@ class PoseDetection:
     motion_fraction: float
     static_s: float
 
-    def to_dict(self, accel_factor: float = 1.0, gyro_factor: float = 1.0) -> dict[str, Any]:
-        """The ``--json`` object; ``*_factor`` multiply a standard deviation into the
-        data's unit (variances by its square)."""
+    def to_dict(
+        self,
+        accel_factor: float = 1.0,
+        gyro_factor: float = 1.0,
+        spell: Callable[[str], str] | None = None,
+    ) -> dict[str, Any]:
+        """The detection as JSON types; ``*_factor`` multiply a standard deviation into the
+        data's unit (variances by its square); ``spell`` writes the parameters a rejection
+        names (:meth:`Rejected.spelled`).
+
+        Parameters
+        ----------
+        accel_factor, gyro_factor : float
+            Factors from the stored standard deviations into the data's units.
+        spell : callable, optional
+            What to show for a parameter a rejection names (default its own name).
+
+        Returns
+        -------
+        dict
+        """
         out: dict[str, Any] = {
             "window_s": self.window * self.dt_s,
             "still_threshold": self.threshold,
@@ -162,7 +241,7 @@ class PoseDetection:
             "n_poses": len(self.poses),
             "rejected": [
                 {"start": r.start, "end": r.end, "duration_s": (r.end - r.start) * self.dt_s,
-                 "reason": r.reason}
+                 "reason": r.spelled(spell)}
                 for r in self.rejected
             ],
         }  # fmt: skip
@@ -230,15 +309,15 @@ def _runs(
         if e - s < min_n:
             if e - s >= w:  # a real pause, not a crossing of the limit
                 rejected.append(Rejected(s, e, (
-                    f"too short: {(e - s) * dt:.3g} s still < --static-s {static_s:g} s"
-                )))  # fmt: skip
+                    f"too short: {(e - s) * dt:.3g} s still < {{static_s}} {static_s:g} s"
+                ), ("static_s",)))  # fmt: skip
             continue
         turn = _drift_deg(a[s:e])
         if turn > drift_deg:
             rejected.append(Rejected(s, e, (
                 f"moving: the gravity direction turns {turn:.3g}° across it "
-                f"(> --drift-deg {drift_deg:g})"
-            )))  # fmt: skip
+                f"(> {{drift_deg}} {drift_deg:g})"
+            ), ("drift_deg",)))  # fmt: skip
             continue
         poses.append(Section(f"pose_{len(poses) + 1}", s, e, float(np.mean(score[s:e]))))
     return poses, rejected
@@ -266,9 +345,9 @@ def _tremor(
         )  # fmt: skip
         out.append(Rejected(s, e, (
             f"tremor: the {name}'s variance above the still limit in {frac:.0%} of it (90th "
-            f"percentile {p90:.3g}× the limit); raise --motion-fraction or --still-threshold "
-            "to take it"
-        )))  # fmt: skip
+            f"percentile {p90:.3g}× the limit); raise {{motion_fraction}} or "
+            "{still_threshold} to take it"
+        ), ("motion_fraction", "still_threshold")))  # fmt: skip
     return out
 
 
@@ -375,7 +454,35 @@ def detect_poses(
     window_s: float = WINDOW_S,
     still_threshold: float = STILL_THRESHOLD,
 ) -> list[Section]:
-    """The poses of :func:`find_poses` (its defaults otherwise)."""
+    """The poses of :func:`find_poses` alone (its defaults for the parameters not named here).
+
+    Parameters
+    ----------
+    time_s : array_like, shape (n,)
+        Sample times [s].
+    accel, gyro : array_like, shape (n, 3)
+        Accelerometer samples in any unit; gyro samples in any unit or None.
+    static_s, window_s : float, optional
+        The shortest pose and the moving-variance window [s].
+    still_threshold : float, optional
+        The still limit in multiples of the noise floor [-].
+
+    Returns
+    -------
+    list of Section
+        The poses found, in time order (sample indices, ``end`` exclusive).
+
+    Raises
+    ------
+    thermocal.errors.ParameterError
+        A parameter out of its range.
+
+    References
+    ----------
+    - Tedaldi, D., Pretto, A., Menegatti, E., "A robust and easy to implement method for IMU
+      calibration without external equipments", Proc. IEEE ICRA 2014, pp. 3042-3049
+      (static-interval detection).
+    """
     det = find_poses(time_s, accel, gyro, static_s=static_s, window_s=window_s,
                      still_threshold=still_threshold)  # fmt: skip
     return list(det.poses)
@@ -393,7 +500,7 @@ def _by_section(d: Any, where: str) -> Any:
     return {n: {"start": d["start"][n], "end": d["end"][n]} for n in d["start"]}
 
 
-def parse_poses(d: Any, n_samples: int, where: str = "--poses") -> list[Section]:
+def parse_poses(d: Any, n_samples: int, where: str = "poses") -> list[Section]:
     """The sections of a POSES object (module docstring), in order of ``start``.
 
     Parameters

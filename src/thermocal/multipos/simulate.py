@@ -24,7 +24,7 @@ import numpy.typing as npt
 
 from thermocal import units
 from thermocal.defaults import MAX_SIMULATED_SAMPLES
-from thermocal.errors import ThermocalInputError
+from thermocal.errors import ParameterError
 from thermocal.multipos.geometry import attitude_along, matrix_to_rotvec
 from thermocal.turntable import model
 
@@ -394,9 +394,10 @@ def _body_rates(
         len(cs) * 1.3 * (spec.dwell_s + spec.move_s) + len(turn_after) * spec.turn_s
     )
     if not wanted <= MAX_SIMULATED_SAMPLES:
-        raise ThermocalInputError(
+        raise ParameterError(
+            "rate_hz",
             f"rate_hz {spec.rate_hz:g}: up to {wanted:.3g} samples for {len(cs)} poses, "
-            f"above the limit of {MAX_SIMULATED_SAMPLES:.3g}: lower --rate-hz"
+            f"above the limit of {MAX_SIMULATED_SAMPLES:.3g}: lower {{name}}",
         )
     rates = []
     poses = []
@@ -535,7 +536,7 @@ def simulate_runs(
     ``held-out``, at the first temperature (several runs: midway between the first two),
     for validation.  With ``turns`` every session but the held-out one is a Ferraris
     session (:func:`simulate_ferraris`: the six faces and three 360° turns, one the other
-    way), its truth carrying ``sections``, the POSES file's object for ``--poses``.
+    way), its truth carrying ``sections``, the POSES file's object (``poses``).
 
     Parameters
     ----------

@@ -21,6 +21,7 @@ directions.
 from __future__ import annotations
 
 import dataclasses
+import functools
 import math
 import warnings
 from collections.abc import Mapping, Sequence
@@ -46,11 +47,34 @@ def triad_columns(
 ) -> tuple[Any, Any]:
     """A triad's three columns of ``rec`` in the physical unit its model takes, and how
     (:class:`~thermocal.models.calibration.TriadInput`).  Each column's unit is resolved as
-    ``compensate`` resolves it (:func:`thermocal.units.resolve_unit`: ``unit_options`` (column
-    → the ``--signal-unit`` option's unit, :func:`thermocal.units.per_signal_option`) > the
-    file's metadata or column name > the unit the triad was calibrated on, raw counts for a
-    triad with a count scale), and raw counts become ``count_scale · N`` (:meth:`Triad.input_in
-    <thermocal.models.calibration.Triad.input_in>`, the path ``compensate`` takes)."""
+    the compensation resolves it (:func:`thermocal.units.resolve_unit`: ``unit_options`` >
+    the file's metadata or column name > the unit the triad was calibrated on, raw counts for
+    a triad with a count scale), and raw counts become ``count_scale · N``
+    (:meth:`Triad.input_in <thermocal.models.calibration.Triad.input_in>`).
+
+    Parameters
+    ----------
+    rec : Recording
+        The session.
+    tri : Triad
+        The calibrated triad whose columns are read.
+    unit_options : mapping of str to str or None, optional
+        Column → the unit given for it (:func:`thermocal.units.per_signal_option`).
+
+    Returns
+    -------
+    values : numpy.ndarray, shape (n, 3)
+        The three columns in the model's physical unit.
+    how : TriadInput
+        The unit resolved and the count scale applied.
+
+    Raises
+    ------
+    thermocal.errors.UnitError
+        A column's unit unknown or not the triad's kind.
+    thermocal.errors.ThermocalInputError
+        The columns not finite once converted.
+    """
     opts = unit_options or {}
     found = [
         units.resolve_unit(
@@ -77,48 +101,47 @@ def validate_held_out_session(
     static_s: float = 1.0,
     signal_unit: str | None = None,
 ) -> list[MultiposValidation]:
-    """A multi-position calibration of triads judged on a held-out session.
+    """A multi-position calibration of triads judged on a held-out session: before and
+    after compensation, the gravity-magnitude error over the poses and the rotation-angle
+    error over the motions between them (module docstring).
 
-    ``triads`` the calibration's (one an accelerometer: it gives the poses' up directions),
-    ``rec`` the session, ``latitude_deg`` [°] for normal gravity when the calibration recorded
-    none, ``static_s`` [s] the shortest pose, ``signal_unit`` one unit for every triad column
-    or one per column (comma-separated, as ``compensate`` takes it).  Returns one
-    :class:`MultiposValidation` per triad: before and after compensation, the gravity-magnitude
-    error over poses and the rotation-angle error over motions (module docstring; Tedaldi et
-    al. 2014).  Raises :class:`~thermocal.errors.ParameterError` for a ``static_s`` not
-    positive or a missing latitude."""
+    Parameters
+    ----------
+    triads : sequence of Triad
+        The calibration's triads; one an accelerometer (it gives the poses' up directions).
+    rec : Recording
+        The held-out session.
+    latitude_deg : float or None, optional
+        Latitude [°] for normal gravity when the calibration recorded none.
+    static_s : float, optional
+        Shortest still pose [s] (default 1).
+    signal_unit : str or None, optional
+        One unit for every triad column, or one per column (comma-separated).
+
+    Returns
+    -------
+    list of MultiposValidation
+        One per triad: the figures before and after [the triad's unit or °].
+
+    Raises
+    ------
+    thermocal.errors.ParameterError
+        ``static_s`` not positive, a latitude needed and missing, or no still pose found.
+    thermocal.errors.ThermocalInputError
+        No accelerometer triad, or a column missing.
+
+    References
+    ----------
+    - Tedaldi, D., Pretto, A., Menegatti, E., "A robust and easy to implement method for IMU
+      calibration without external equipments", Proc. IEEE ICRA 2014, pp. 3042-3049.
+    """
     from thermocal.turntable import thermal
 
-    if not (math.isfinite(static_s) and static_s > 0):
-        raise ParameterError(
-            "static_s",
-            f"{rec.name}: {{name}} must be a positive number of seconds, got {static_s!r}",
-        )
     by = {t.model.kind: t for t in triads}
-    acc = by.get("accel")
-    if acc is None:
-        raise ThermocalInputError(
-            f"{rec.name}: a multi-position calibration is validated through its "
-            "accelerometer triad (it gives the poses' up directions); this one has none"
-        )
-    rec.validate(required=[c for t in triads for c in (*t.columns, t.temperature) if c])
-    lat = next((v for v in (latitude_deg, rec.meta.latitude_deg, acc.latitude_deg)
-                if v is not None), None)  # fmt: skip
-    g_m_s2 = acc.model.gravity_m_s2
-    if g_m_s2 is None:
-        if lat is None:
-            raise ParameterError("latitude_deg", f"{rec.name}: give the latitude ({{name}} DEG)")
-        g_m_s2 = units.normal_gravity_m_s2(float(lat))
+    acc, g_m_s2 = _accel_and_gravity(by, triads, rec, latitude_deg, static_s)
     t = rec.time_s
     unit_opts = units.per_signal_option(signal_unit, [c for tr in triads for c in tr.columns])
-
-    def temp_of(tri: Any) -> Any:
-        if tri.temperature:
-            return rec.temperature_c(tri.temperature)
-        return np.full(rec.n_samples, tri.model.tref_c)
-
-    def outside(tri: Any, temp: Any) -> float:
-        return float(np.mean((temp < tri.model.t_lo_c) | (temp > tri.model.t_hi_c)))
+    temp_of = functools.partial(_temp_of, rec)
 
     xa, a_in = triad_columns(rec, acc, unit_opts)
     a_unit = a_in.unit
@@ -135,13 +158,13 @@ def validate_held_out_session(
         xg_c = units.convert(xg_c, g_unit, "rad/s")
     sections = detect_poses(t, xa, xg, static_s=static_s)
     if not sections:
-        raise ThermocalInputError(
+        raise ParameterError(
+            "static_s",
             f"{rec.name}: no still pose of {static_s:g} s or longer found: nothing to judge "
-            "the calibration on (record the sensor still; thermocal validate --static-s "
-            "sets the shortest pose)"
+            "the calibration on (record the sensor still; {name} sets the shortest pose)",
         )
     g = float(units.convert(np.array([g_m_s2]), "m/s^2", a_unit)[0])
-    out = [_accel_figures(acc.name, a_unit, xa, xa_c, sections, g, outside(acc, ta))]
+    out = [_accel_figures(acc.name, a_unit, xa, xa_c, sections, g, _outside(acc, ta))]
     out = _with_input(out, a_in)
     if gyr is None or xg is None or xg_c is None:
         if len(sections) == 1:
@@ -150,7 +173,7 @@ def validate_held_out_session(
     if len(sections) == 1:
         out[0] = dataclasses.replace(out[0], not_judged=ONE_POSE_NOT_JUDGED)
         return _judged([*out, _rate_at_rest(gyr.name, xg, xg_c, sections[0], g_in,
-                                            outside(gyr, temp_of(gyr)))], g, rec.name)  # fmt: skip
+                                            _outside(gyr, temp_of(gyr)))], g, rec.name)  # fmt: skip
     dt = np.diff(t)
     dt = np.concatenate([dt, dt[-1:]])
     vb = rotation_errors(xg, dt, xa, sections) * units.RAD_TO_DEG
@@ -159,7 +182,7 @@ def validate_held_out_session(
     out.append(
         MultiposValidation(
             gyr.name, "deg", float(math.sqrt(np.mean(nb**2))), float(math.sqrt(np.mean(na**2))),
-            _rms3(vb), _rms3(va), len(nb), "rotation-angle error", outside(gyr, temp_of(gyr)),
+            _rms3(vb), _rms3(va), len(nb), "rotation-angle error", _outside(gyr, temp_of(gyr)),
             input_unit=g_in.data_unit, count_scale=g_in.count_scale, physical_unit=g_in.unit,
         )
     )  # fmt: skip
@@ -174,19 +197,20 @@ def _judged(out: list[MultiposValidation], g: float, name: str) -> list[Multipos
     sensor); the figures stand as measured.  Returns ``out`` unchanged."""
     bound = {"gravity-magnitude error": (ACCEL_RESIDUAL_REFUSED * g, "the columns' unit"),
              "rotation-angle error": (GYRO_DIRECTION_REFUSED_DEG, "the gyro's unit, the "
-                                      "time's (--time-unit, --rate)")}  # fmt: skip
+                                      "time's ({time_unit}, {rate_hz})")}  # fmt: skip
     for v in out:
         if v.what not in bound:
             continue
         lim, what = bound[v.what]
         if not v.rms_after <= lim:
             warnings.warn(
-                ThermocalWarning(
+                ThermocalWarning.naming(
                     f"{name}: the {v.triad} triad's {v.what} rms is {v.rms_after:.4g} {v.unit} "
                     f"after compensation ({v.rms_before:.4g} before), beyond the "
                     f"{lim:.4g} {v.unit} a calibration's own fit accepts: this session is not "
-                    f"read as the calibration was made ({what}, the --signal-unit given) "
-                    "or is another sensor's"
+                    f"read as the calibration was made ({what}, the {{signal_unit}} given) "
+                    "or is another sensor's",
+                    *("time_unit", "rate_hz", "signal_unit"),
                 ),
                 stacklevel=3,
             )
@@ -262,8 +286,59 @@ def _rms3(v: Any) -> tuple[float, float, float]:
     return (float(r[0]), float(r[1]), float(r[2]))
 
 
+def _accel_and_gravity(
+    by: dict[str, Any], triads: Sequence[Any], rec: Any, latitude_deg: float | None,
+    static_s: float,
+) -> tuple[Any, float]:  # fmt: skip
+    """The accelerometer triad and local gravity [m/s²] (:func:`validate_held_out_session`'s
+    checks of its inputs)."""
+    if not (math.isfinite(static_s) and static_s > 0):
+        raise ParameterError(
+            "static_s",
+            f"{rec.name}: {{name}} must be a positive number of seconds, got {static_s!r}",
+        )
+    acc = by.get("accel")
+    if acc is None:
+        raise ThermocalInputError(
+            f"{rec.name}: a multi-position calibration is validated through its "
+            "accelerometer triad (it gives the poses' up directions); this one has none"
+        )
+    rec.validate(required=[c for t in triads for c in (*t.columns, t.temperature) if c])
+    lat = next((v for v in (latitude_deg, rec.meta.latitude_deg, acc.latitude_deg)
+                if v is not None), None)  # fmt: skip
+    g_m_s2 = acc.model.gravity_m_s2
+    if g_m_s2 is None:
+        if lat is None:
+            raise ParameterError("latitude_deg", f"{rec.name}: give the latitude ({{name}} DEG)")
+        g_m_s2 = units.normal_gravity_m_s2(float(lat))
+    return acc, float(g_m_s2)
+
+
+def _temp_of(rec: Any, tri: Any) -> Any:
+    """The triad's temperature column [°C], else its TREF at every sample."""
+    if tri.temperature:
+        return rec.temperature_c(tri.temperature)
+    return np.full(rec.n_samples, tri.model.tref_c)
+
+
+def _outside(tri: Any, temp: Any) -> float:
+    """Fraction of the samples outside the triad's calibrated temperature range."""
+    return float(np.mean((temp < tri.model.t_lo_c) | (temp > tri.model.t_hi_c)))
+
+
 def is_multipos(triads: Sequence[Any]) -> bool:
-    """A calibration of triads made by ``thermocal multipos``."""
+    """Whether a calibration of triads was made by the multi-position calibration.
+
+    Parameters
+    ----------
+    triads : sequence of Triad
+        The calibration's triads.
+
+    Returns
+    -------
+    bool
+        True when a triad's model records the multi-position method.
+    """
     return any(getattr(t.model, "method", "turntable") == METHOD for t in triads)
 
 

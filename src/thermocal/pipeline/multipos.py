@@ -10,12 +10,11 @@ and go out (file layer, as :mod:`thermocal.pipeline.compensate` for the compensa
 
 from __future__ import annotations
 
-import copy
 import itertools
 import json
 import math
 import warnings
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
@@ -23,7 +22,7 @@ from typing import Any
 import numpy as np
 
 from thermocal import units
-from thermocal.errors import DesignError, ThermocalInputError, ThermocalWarning
+from thermocal.errors import DesignError, ParameterError, ThermocalInputError, ThermocalWarning
 from thermocal.inspection import saturated_mask
 from thermocal.models.calibration import Calibration, Triad
 from thermocal.multipos.calibrate import METHOD, SessionResult, calibrate_session
@@ -52,10 +51,37 @@ unchanged at every temperature)."""
 
 @dataclass(frozen=True)
 class MultiposOptions:
-    """What ``thermocal multipos`` is told: the accelerometer (and gyro) columns x, y, z and
-    their units (None: the file's), the temperature column, local gravity [m/s²] or
-    latitude [°], the thermal fit's order and TREF [°C], the shortest still pose [s], and
-    the time column and unit."""
+    """How the session files of a multi-position calibration are read and calibrated.
+
+    Attributes
+    ----------
+    accel, gyro : tuple of str
+        The accelerometer's (and gyro's, or None) x, y, z columns.
+    accel_unit, gyro_unit : str or None
+        Their units (None: the file's).
+    temps : str or None
+        The temperature column [°C].
+    gravity_m_s2, latitude_deg : float or None
+        Local gravity [m/s²] or the latitude [°] (WGS-84 normal gravity), not both.
+    order : int or None
+        Polynomial order in temperature (None: chosen per parameter).
+    tref_c : float or None
+        Reference temperature [°C].
+    static_s : float
+        Shortest still pose [s].
+    time, time_unit : str or None
+        The time column and its unit.
+    accel_scale, gyro_scale : tuple of (float, str) or None
+        Raw-count columns: one count is ``value`` ``unit``.
+    window_s, still_threshold, motion_fraction, drift_deg : float
+        The pose detector's parameters (:func:`thermocal.multipos.poses.find_poses`).
+    accel_offset, gyro_offset : float or None
+        Zero of the columns in their own unit.
+    gyro_model : str
+        The gyro's elements of E fitted: ``full`` or ``scale``.
+    read : ReadOptions or None
+        How a text log and its time are read.
+    """
 
     accel: tuple[str, str, str]
     gyro: tuple[str, str, str] | None = None
@@ -71,7 +97,7 @@ class MultiposOptions:
     time_unit: str | None = None
     accel_scale: tuple[float, str] | None = None
     gyro_scale: tuple[float, str] | None = None
-    """Raw-count columns: one count is ``value`` ``unit`` (``--accel-scale 0.061,mg``)."""
+    """Raw-count columns: one count is ``value`` ``unit`` (``accel_scale=(0.061, "mg")``)."""
     window_s: float = WINDOW_S
     still_threshold: float = STILL_THRESHOLD
     motion_fraction: float = MOTION_FRACTION
@@ -79,7 +105,7 @@ class MultiposOptions:
     """The pose detector's options (:func:`thermocal.multipos.poses.find_poses`)."""
     accel_offset: float | None = None
     gyro_offset: float | None = None
-    """Zero of the columns in their own unit (counts: ``--accel-offset 32768`` for unsigned
+    """Zero of the columns in their own unit (counts: ``accel_offset=32768`` for unsigned
     ADC counts); None: none, or mid-scale found in unsigned counts (a warning)."""
     gyro_model: str = "full"
     """The gyro's elements of E fitted (:data:`thermocal.multipos.gyro.GYRO_MODELS`)."""
@@ -108,38 +134,60 @@ class MultiposOptions:
             When the options contradict each other or the number of files.
         """
         if self.gyro_model not in ("full", "scale"):
-            raise ThermocalInputError(f"--gyro-model {self.gyro_model!r}: full or scale")
+            raise ParameterError("gyro_model", f"{{name}} {self.gyro_model!r}: full or scale")
         if self.gyro_model != "full" and self.gyro is None:
-            raise ThermocalInputError(
-                f"--gyro-model {self.gyro_model}: no gyro columns to fit; name them with "
-                "--gyro X,Y,Z"
+            raise ParameterError(
+                "gyro_model",
+                f"{{name}} {self.gyro_model}: no gyro columns to fit; name them with "
+                "{gyro} X,Y,Z",
+                ("gyro",),
             )
         if n_files > 1 and self.temps is None:
-            raise ThermocalInputError(
-                "several files: name their temperature column with --temps (one file per "
-                "temperature)"
+            raise ThermocalInputError.naming(
+                "several files: name their temperature column with {temps} (one file per "
+                "temperature)",
+                "temps",
             )
         if (self.order is not None or self.tref_c is not None) and n_files < 2:
-            raise ThermocalInputError("--order and --tref need several files and --temps")
+            raise ThermocalInputError.naming(
+                "{order} and {tref_c} need several files and {temps}", "order", "tref_c", "temps"
+            )
         if self.gravity_m_s2 is not None and self.latitude_deg is not None:
-            raise ThermocalInputError("give --gravity or --latitude, not both")
+            raise ThermocalInputError.naming(
+                "give {gravity_m_s2} or {latitude_deg}, not both", "gravity_m_s2", "latitude_deg"
+            )
         if self.gravity_m_s2 is not None and not 9.7 <= self.gravity_m_s2 <= 9.9:
-            raise ThermocalInputError(  # '--gravity 1' (in g) scaled every axis by 1/9.8
-                f"--gravity {self.gravity_m_s2:g}: local gravity in m/s² is 9.78-9.83 on the "
-                "earth's surface (1 g = 9.80665 m/s²); give it in m/s², or --latitude DEG"
+            raise ParameterError(  # a gravity of 1 (in g) scaled every axis by 1/9.8
+                "gravity_m_s2",
+                f"{{name}} {self.gravity_m_s2:g}: local gravity in m/s² is 9.78-9.83 on the "
+                "earth's surface (1 g = 9.80665 m/s²); give it in m/s², or {latitude_deg} DEG",
+                ("latitude_deg",),
             )
         if self.static_s is not None and not (math.isfinite(self.static_s) and self.static_s > 0):
-            raise ThermocalInputError(
-                f"--static-s must be a positive number, got {self.static_s!r}"
+            raise ParameterError(
+                "static_s", f"{{name}} must be a positive number, got {self.static_s!r}"
             )
         if poses is not None and n_files > 1:
-            raise ThermocalInputError("--poses names the sections of one file; give one file")
+            raise ParameterError("poses", "{name} names the sections of one file; give one file")
 
 
 @dataclass(frozen=True)
 class SessionRun:
-    """One session file calibrated: its path, result and temperature range [°C] (None
-    without a temperature column)."""
+    """One session file calibrated.
+
+    Attributes
+    ----------
+    path : Path
+        The session file.
+    result : SessionResult
+        Its calibration (:func:`thermocal.multipos.calibrate.calibrate_session`).
+    t_range_c : tuple of float or None
+        Its temperature range [°C] (None without a temperature column).
+    detection : PoseDetection or None
+        The pose detector's choice (None with a POSES file).
+    offsets : dict or None
+        Each triad's zero removed before the directions were judged [its unit].
+    """
 
     path: Path
     result: SessionResult
@@ -152,15 +200,47 @@ class SessionRun:
 
 @dataclass(frozen=True, eq=False)
 class MultiposResult:
-    """The result of :func:`calibrate_files`: the calibration written, the ``--json`` object
-    (``output`` the file written) and the accelerometer's unit."""
+    """The result of :func:`calibrate_files`: the calibration written, each session run,
+    each triad's thermal model, the units and the gravity used; :meth:`to_dict` is its one
+    JSON form.
+
+    Attributes
+    ----------
+    calibration : Calibration
+        The calibration of triads written to ``output``.
+    runs : tuple of SessionRun
+        Each session file calibrated alone.
+    models : dict
+        ``{"accel": TriadThermal, "gyro": TriadThermal}`` (``gyro`` only with its columns).
+    accel_unit : str
+        The accelerometer columns' unit (the figures' unit).
+    gyro_unit : str or None
+        The gyro columns' unit (None without gyro columns).
+    gravity_m_s2 : float
+        Local gravity used [m/s²].
+    output : Path
+        The calibration file written.
+    count_scales : dict
+        ``{triad: (value, unit)}`` of the triads read as raw counts.
+    """
 
     calibration: Calibration
-    summary: dict[str, Any]
+    runs: tuple[SessionRun, ...]
+    models: dict[str, Any]
     accel_unit: str
+    gyro_unit: str | None
+    gravity_m_s2: float
+    output: Path
+    count_scales: dict[str, tuple[float, str]]
 
-    def to_dict(self) -> dict[str, Any]:
-        """The result as ``thermocal multipos --json`` prints it.
+    def to_dict(self, spell: Callable[[str], str] | None = None) -> dict[str, Any]:
+        """The result as JSON types (what the ``multipos`` command prints as JSON).
+
+        Parameters
+        ----------
+        spell : callable, optional
+            How a rejected pose's reason writes the detector's parameters it names
+            (:meth:`thermocal.multipos.poses.Rejected.spelled`; default their own names).
 
         Returns
         -------
@@ -170,7 +250,15 @@ class MultiposResult:
             before and after in the accelerometer's unit, each run's figures and the pose
             detector's choice, and ``output``, the calibration file written.
         """
-        return copy.deepcopy(self.summary)
+        out = _summary(
+            list(self.runs), self.models, self.accel_unit, self.gyro_unit, self.gravity_m_s2,
+            spell,
+        )  # fmt: skip
+        for kind, (value, unit) in self.count_scales.items():
+            if kind in out:  # raw counts: the figures are in the scale's unit
+                out[kind]["count_scale"] = {"value": value, "unit": unit}
+        out["output"] = str(self.output)
+        return out
 
 
 def _unit_of(
@@ -189,22 +277,25 @@ def _unit_of(
     if not option and len(stated) < 3:
         found = set()
     if len(found) != 1 or not next(iter(found)):
-        raise ThermocalInputError(
-            f"{path}: the {kind} columns {cols} state no single unit; give --{kind}-unit"
+        raise ThermocalInputError.naming(
+            f"{path}: the {kind} columns {cols} state no single unit; give {{{kind}_unit}}",
+            f"{kind}_unit",
         )
     unit = str(units.normalize_signal_unit(found.pop()))
     want = "accel" if kind == "accel" else "rate"
     if unit == "counts":
         if scale is None:
             example = "0.061,mg" if kind == "accel" else "0.00763,deg/s"
-            raise ThermocalInputError(
-                f"{path}: the {kind} columns are raw counts; give --{kind}-scale VALUE,UNIT "
-                f"(one count, from the datasheet's sensitivity, e.g. {example})"
+            raise ThermocalInputError.naming(
+                f"{path}: the {kind} columns are raw counts; give {{{kind}_scale}} VALUE,UNIT "
+                f"(one count, from the datasheet's sensitivity, e.g. {example})",
+                f"{kind}_scale",
             )
         return scale[1], scale[0]
     if scale is not None:
-        raise ThermocalInputError(
-            f"{path}: --{kind}-scale is for raw counts; the {kind} columns are in {unit}"
+        raise ThermocalInputError.naming(
+            f"{path}: {{{kind}_scale}} is for raw counts; the {kind} columns are in {unit}",
+            f"{kind}_scale",
         )
     if units.signal_kind(unit) != want:
         what = "an acceleration" if kind == "accel" else "a rate"
@@ -270,9 +361,11 @@ class _Gravity:
             self.latitude_deg = lat
         if self.g_m_s2 is None:
             if lat is None:
-                raise ThermocalInputError(
-                    f"{path}: give the local gravity (--gravity M/S2) or the latitude "
-                    "(--latitude DEG, WGS-84 normal gravity)"
+                raise ThermocalInputError.naming(
+                    f"{path}: give the local gravity ({{gravity_m_s2}} M/S2) or the latitude "
+                    "({latitude_deg} DEG, WGS-84 normal gravity)",
+                    "gravity_m_s2",
+                    "latitude_deg",
                 )
             self.g_m_s2 = units.normal_gravity_m_s2(float(lat))
 
@@ -282,12 +375,14 @@ MID_SCALE = 32768.0
 
 
 def _offset(raw: np.ndarray, given: float | None, unit: str, kind: str, path: Path) -> float:
-    """The triad's zero in its columns' unit: ``--{kind}-offset``, else mid-scale for raw
-    counts that are all in 0…65535 with every column's median in the middle half (unsigned
-    ADC counts, a warning), else 0."""
+    """The triad's zero in its columns' unit: ``given`` (``accel_offset``, ``gyro_offset``),
+    else mid-scale for raw counts that are all in 0…65535 with every column's median in the
+    middle half (unsigned ADC counts, a warning), else 0."""
     if given is not None:
         if not math.isfinite(given):
-            raise ThermocalInputError(f"--{kind}-offset must be a finite number, got {given!r}")
+            raise ParameterError(
+                f"{kind}_offset", f"{{name}} must be a finite number, got {given!r}"
+            )
         return float(given)
     if unit != "counts" or raw.size == 0:
         return 0.0
@@ -298,10 +393,11 @@ def _offset(raw: np.ndarray, given: float | None, unit: str, kind: str, path: Pa
         and np.all(np.abs(med - MID_SCALE) < MID_SCALE / 2)
     ):
         warnings.warn(
-            ThermocalWarning(
+            ThermocalWarning.naming(
                 f"{path}: the {kind} columns look like unsigned counts around mid-scale "
                 f"(medians {', '.join(f'{m:.0f}' for m in med)}): {MID_SCALE:.0f} taken as "
-                f"their zero; give --{kind}-offset (0 for none) to say it"
+                f"their zero; give {{{kind}_offset}} (0 for none) to say it",
+                f"{kind}_offset",
             ),
             stacklevel=3,
         )
@@ -343,17 +439,19 @@ def _with_offsets(res: SessionResult, acc_off_mg: float, gyr_off_deg_h: float) -
 
 def _detect(t: np.ndarray, acc: np.ndarray, w: np.ndarray | None, opts: MultiposOptions,
             path: Path) -> PoseDetection:  # fmt: skip
-    """The poses found in the data (:func:`find_poses` with the command's options); fewer
-    than six refused with what was rejected and the options that change it."""
+    """The poses found in the data (:func:`find_poses` with the detector's options of
+    ``opts``); fewer than six refused with what was rejected and the parameters that change it."""
     det = find_poses(t, acc, w, static_s=opts.static_s, window_s=opts.window_s,
                      still_threshold=opts.still_threshold, motion_fraction=opts.motion_fraction,
                      drift_deg=opts.drift_deg)  # fmt: skip
     if len(det.poses) < 6:
-        why = "; ".join(f"{r.reason} ({r.start}…{r.end})" for r in det.rejected[:4])
-        raise DesignError(
+        why = "; ".join(f"{r.template} ({r.start}…{r.end})" for r in det.rejected[:4])
+        named = tuple(dict.fromkeys(p for r in det.rejected[:4] for p in r.parameters))
+        raise DesignError.naming(
             f"{path}: {len(det.poses)} static poses found (the accelerometer triad needs at "
-            f"least 9 distinct ones){'; rejected: ' + why if why else ''}: lower --static-s, "
-            "raise --still-threshold or --motion-fraction, or name the poses with --poses"
+            f"least 9 distinct ones){'; rejected: ' + why if why else ''}: lower {{static_s}}, "
+            "raise {still_threshold} or {motion_fraction}, or name the poses with {poses}",
+            *dict.fromkeys(("static_s", "still_threshold", "motion_fraction", "poses", *named)),
         )
     return det
 
@@ -413,8 +511,8 @@ def _session(
     )
     rec = read_recording(
         path, read,
-        ask_units={**dict.fromkeys([] if opts.accel_scale else acc_cols, "--accel-unit"),
-                   **dict.fromkeys([] if opts.gyro_scale else (gyr_cols or []), "--gyro-unit")},
+        ask_units={**dict.fromkeys([] if opts.accel_scale else acc_cols, "accel_unit"),
+                   **dict.fromkeys([] if opts.gyro_scale else (gyr_cols or []), "gyro_unit")},
         implied_units={**dict.fromkeys(acc_cols if opts.accel_scale else [], "counts"),
                        **dict.fromkeys((gyr_cols or []) if opts.gyro_scale else [], "counts")},
     )  # fmt: skip
@@ -445,11 +543,10 @@ def _session(
             raise
         offset = (
             "; or, if the raw counts' zero is not 0 (unsigned ADC counts sit around "
-            "mid-scale), give it with --accel-offset (e.g. 32768)"
+            "mid-scale), give it with {accel_offset} (e.g. 32768)"
         )
-        raise DesignError(
-            f"{path}: {exc}{offset if opts.accel_scale is not None else ''}"
-        ) from None
+        after = offset if opts.accel_scale is not None else ""
+        raise DesignError.around(exc, f"{path}: ", after, "accel_offset") from None
     acc_off_mg = float(units.convert(np.array([a_off]), au, "mg")[0]) if a_off else 0.0
     g_off_dh = float(units.convert(np.array([g_off]), str(gu), "deg/h")[0]) if g_off else 0.0
     res = _with_offsets(res, acc_off_mg, g_off_dh)
@@ -559,17 +656,17 @@ def calibrate_files(
     g_unit = g_units.pop() if g_units else None
     triads, models = _fit_triads(runs, opts, a_unit, g_unit, grav)
     cal = Calibration([], triads)
-    check_as_read(cal, output, "check the columns' units (--accel-unit, --gyro-unit, "
-                  "--accel-scale, --gyro-scale) and the poses (--poses), or fit a lower "
-                  "--order")  # fmt: skip
+    check_as_read(cal, output, "check the columns' units ({accel_unit}, {gyro_unit}, "
+                  "{accel_scale}, {gyro_scale}) and the poses ({poses}), or fit a lower "
+                  "{order}", "accel_unit", "gyro_unit", "accel_scale", "gyro_scale", "poses",
+                  "order")  # fmt: skip
     save_calibration(cal, output)
     assert grav.g_m_s2 is not None
-    out = _summary(runs, models, a_unit, g_unit, float(grav.g_m_s2))
-    for kind, sc in (("accel", opts.accel_scale), ("gyro", opts.gyro_scale)):
-        if sc is not None and kind in out:  # raw counts: the figures are in the scale's unit
-            out[kind]["count_scale"] = {"value": sc[0], "unit": sc[1]}
-    out["output"] = str(output)
-    return MultiposResult(cal, out, a_unit)
+    scales = {"accel": opts.accel_scale, "gyro": opts.gyro_scale}
+    return MultiposResult(
+        cal, tuple(runs), models, a_unit, g_unit, float(grav.g_m_s2), output,
+        {k: sc for k, sc in scales.items() if sc is not None},
+    )  # fmt: skip
 
 
 def _triad_dict(theta: Any, sigma: Any, bias_factor: float, bias_unit: str) -> dict[str, Any]:
@@ -586,9 +683,14 @@ def _triad_dict(theta: Any, sigma: Any, bias_factor: float, bias_unit: str) -> d
 
 
 def _summary(
-    runs: list[SessionRun], models: dict[str, Any], a_unit: str, g_unit: str | None, g_m_s2: float
+    runs: list[SessionRun],
+    models: dict[str, Any],
+    a_unit: str,
+    g_unit: str | None,
+    g_m_s2: float,
+    spell: Callable[[str], str] | None = None,
 ) -> dict[str, Any]:
-    """The ``--json`` object: each triad at TREF in the data's units, the
+    """The result's JSON object: each triad at TREF in the data's units, the
     poses, the gravity residuals in the accelerometer's unit, and each run's figures."""
     to_a = float(units.convert(np.array([1.0]), "mg", a_unit)[0])
     to_g = float(units.convert(np.array([1.0]), "deg/h", g_unit)[0]) if g_unit else 1.0
@@ -616,9 +718,9 @@ def _summary(
             del p["mean_specific_force_mg"], p["gravity_residual_mg"]
         if run.detection is not None:
             to_gr = float(units.convert(np.array([1.0]), "rad/s", g_unit)[0]) if g_unit else 1.0
-            rd["pose_detection"] = run.detection.to_dict(to_a, to_gr)
+            rd["pose_detection"] = run.detection.to_dict(to_a, to_gr, spell)
         if run.offsets and any(run.offsets.values()):
-            rd["offset"] = run.offsets
+            rd["offset"] = dict(run.offsets)
         if r.gyro is not None:
             rd["gyro"] = {**_triad_dict(r.gyro.theta, r.gyro.sigma, to_g, str(g_unit)),
                           "method": "rotations between poses"

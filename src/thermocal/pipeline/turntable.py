@@ -20,7 +20,7 @@ from typing import Any
 import numpy as np
 
 from thermocal import adequacy, units
-from thermocal.errors import ThermocalInputError
+from thermocal.errors import ParameterError, ThermocalInputError
 from thermocal.readers.options import ReadOptions
 from thermocal.recording import Recording
 from thermocal.turntable import thermal as _thermal
@@ -33,11 +33,35 @@ distinct attitudes still separate the twelve parameters of each triad."""
 
 @dataclass(frozen=True)
 class TurntableOptions:
-    """What every run of the command is read and calibrated with: the columns (gyro x, y, z;
-    accelerometer x, y, z or None; the temperature or None; encoders α, β), their units
-    (None: the file's, by :func:`thermocal.units.resolve_unit`), the latitude [°], gravity
-    [m/s²], angle random walk [°/√h], encoder noise [″], shortest dwell [s], channels (2 or
-    3), and how the file is read (time column and unit, text-log options, log topic)."""
+    """What every turntable run is read and calibrated with.
+
+    Attributes
+    ----------
+    gyro, accel : tuple of str
+        The gyro's (and accelerometer's, or None) x, y, z columns.
+    temps : str or None
+        The temperature column [°C].
+    latitude, gravity : float or None
+        Site latitude [°] and local gravity [m/s²] (None: the file's, normal gravity).
+    time, time_unit : str or None
+        The time column and its unit.
+    gyro_unit, accel_unit, encoder_unit : str or None
+        The columns' units (None: the file's, :func:`thermocal.units.resolve_unit`).
+    alpha, beta : str
+        The inner- and outer-axis encoder columns.
+    arw, encoder_noise : float or None
+        Angle random walk [°/√h] and encoder noise [″] (None: from the dwells).
+    min_dwell : float
+        Shortest dwell [s].
+    channels : int
+        2 (Δα, Δβ) or 3 (Δα, Δβ, Δγ).
+    read : ReadOptions or None
+        A text log's layout.
+    topic : str or None
+        A flight log's topic.
+    alpha_offset : float
+        The α encoder's reading at the geometry's α = 0 [°].
+    """
 
     gyro: tuple[str, str, str]
     accel: tuple[str, str, str] | None = None
@@ -59,11 +83,11 @@ class TurntableOptions:
     """A text log's layout (``names``, ``rate_hz``, …); the columns are those named above."""
     topic: str | None = None
     alpha_offset: float = 0.0
-    """The α encoder's reading at the geometry's α = 0 [°] (``--alpha-offset``)."""
+    """The α encoder's reading at the geometry's α = 0 [°] (subtracted from the α column)."""
 
 
 def check_order(order: int) -> None:
-    """Refuse (exit 2) a ``--order`` outside 0 … :data:`thermocal.turntable.thermal.MAX_ORDER`
+    """Refuse an ``order`` outside 0 … :data:`thermocal.turntable.thermal.MAX_ORDER`
     (3: a cubic in temperature per parameter, the most a few soaks can support; the number of
     soaks limits it further once the runs are read) before any file is read: typer parses an
     order of 10²⁰ as a Python int.
@@ -88,14 +112,14 @@ def check_order(order: int) -> None:
             if len(str(order)) <= 24
             else f"{str(order)[:20]}… ({len(str(order))} digits)"
         )
-        raise ThermocalInputError(
-            f"--order must be between 0 and {_thermal.MAX_ORDER}, got {shown}"
+        raise ParameterError(
+            "order", f"{{name}} must be between 0 and {_thermal.MAX_ORDER}, got {shown}"
         )
 
 
 def read_run(path: Path, o: TurntableOptions) -> Recording:
     """Read one run (:func:`thermocal.readers.read_recording`).  The gyro columns' unit goes
-    through the shared resolver: --gyro-unit > file metadata > unit in the column name > °/s
+    through the shared resolver: ``o.gyro_unit`` > file metadata > unit in the column name > °/s
     (gyro_z in °/s), the last stated in a warning.
 
     Parameters
@@ -185,7 +209,17 @@ def calibrate_run(
 @dataclass(frozen=True)
 class SingleRunResult:
     """One run's calibration (:class:`~thermocal.turntable.calibrate.TurntableResult`), the
-    file it came from and the result JSON written."""
+    file it came from and the result JSON written.
+
+    Attributes
+    ----------
+    input : Path
+        The run.
+    output : Path
+        The result JSON written.
+    result : TurntableResult
+        The calibration.
+    """
 
     input: Path
     output: Path
@@ -234,7 +268,19 @@ def triad_summary(tri: _thermal.TriadThermal) -> dict[str, object]:
 class ThermalRunsResult:
     """Several soak runs' calibration: each run's result, the triads' temperature models
     (``accel`` None without accelerometer columns), the adequacy record of the soaks and the
-    calibration file written."""
+    calibration file written.
+
+    Attributes
+    ----------
+    output : Path
+        The calibration file written.
+    runs : tuple of (Path, TurntableResult)
+        Each soak run.
+    gyro, accel : TriadThermal
+        The triads' temperature models (accel None without its columns).
+    adequacy : dict
+        The adequacy record of the soaks.
+    """
 
     output: Path
     runs: tuple[tuple[Path, TurntableResult], ...]
@@ -243,7 +289,14 @@ class ThermalRunsResult:
     adequacy: dict[str, Any]
 
     def to_dict(self) -> dict[str, Any]:
-        """The JSON of ``turntable --temps`` with several runs."""
+        """The result as JSON types (what the ``turntable`` command prints for several runs).
+
+        Returns
+        -------
+        dict
+            ``output``, ``format``, each run's figures, each triad's temperature model and
+            the adequacy record.
+        """
         out: dict[str, Any] = {
             "output": str(self.output),
             "format": "thermocal-calibration",
@@ -256,13 +309,13 @@ class ThermalRunsResult:
         return out
 
 
-def check_as_read(cal: Any, output: Path, hint: str) -> None:
+def check_as_read(cal: Any, output: Path, hint: str, *parameters: str) -> None:
     """The checks the calibration file's reader applies
     (:func:`thermocal.models.calibration.calibration_from_dict`: each triad's TREF within
     its range, a well-conditioned ``I + E(T)`` over it, finite numbers …) applied to ``cal``
     before it is written to ``output``: a calibration that its own reader would refuse is
     refused now (:class:`~thermocal.errors.DesignError` naming what failed, ``hint`` the
-    options that get the user further), and nothing is written.
+    parameters that get the user further), and nothing is written.
 
     Parameters
     ----------
@@ -271,7 +324,10 @@ def check_as_read(cal: Any, output: Path, hint: str) -> None:
     output : Path
         Where it would be written (named in the message).
     hint : str
-        The options that get the user further, appended to the message.
+        What gets the user further, appended to the message, with ``{parameter}`` for each
+        of ``parameters``.
+    *parameters : str
+        The parameters ``hint`` names.
 
     Returns
     -------
@@ -290,7 +346,7 @@ def check_as_read(cal: Any, output: Path, hint: str) -> None:
     try:
         calibration_from_dict(json.loads(json.dumps(cal.to_dict())), str(output))
     except (ModelFileError, ValueError) as exc:
-        raise DesignError(f"{exc}; not written: {hint}") from None
+        raise DesignError.around(exc, "", "; not written: " + hint, *parameters) from None
 
 
 def turntable_calibration(
@@ -345,12 +401,15 @@ def turntable_calibration(
     check_not_input(output, list(files))
     if len(files) > 1 or (opts.temps is not None and (order is not None or tref_c is not None)):
         if opts.temps is None:
-            raise ThermocalInputError(
-                "several runs: name their temperature column with --temps (one run per soak)"
+            raise ThermocalInputError.naming(
+                "several runs: name their temperature column with {temps} (one run per soak)",
+                "temps",
             )
         return thermal_runs(files, output, opts, order, tref_c, overrides)
     if order is not None or tref_c is not None:
-        raise ThermocalInputError("--order and --tref need several runs and --temps")
+        raise ThermocalInputError.naming(
+            "{order} and {tref_c} need several runs and {temps}", "order", "tref_c", "temps"
+        )
     _rec, result = calibrate_run(files[0], opts, min_positions=16)
     single = SingleRunResult(files[0], output, result)
     write_json(output, single.to_dict())
@@ -442,8 +501,9 @@ def thermal_runs(
             Triad("accel", opts.accel, str(accel_unit), temps, accel_model, rig, latitude, record)
         )
     cal = Calibration([], triads)
-    check_as_read(cal, output, "check the columns' units (--gyro-unit, --accel-unit) and "
-                  "the runs, or fit a lower --order")  # fmt: skip
+    check_as_read(cal, output, "check the columns' units ({gyro_unit}, {accel_unit}) and "
+                  "the runs, or fit a lower {order}", "gyro_unit", "accel_unit",
+                  "order")  # fmt: skip
     save_calibration(cal, output)
     return ThermalRunsResult(output, tuple(runs), gyro_model, accel_model, record)
 

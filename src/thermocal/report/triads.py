@@ -8,11 +8,11 @@ session's gravity-magnitude and rotation-angle errors
 figures (rms over poses or motions, before → after, the change in %), then per axis.
 
 Against temperature only what was measured against it: a triad calibrated over several
-temperatures (``multipos --temps`` with a file per temperature, or a turntable over
-temperature) gets every parameter plotted against the real run temperatures with the fitted
-polynomial and its ±1σ band, and a table of the runs; a triad calibrated at one temperature,
-or without a temperature column, gets the table only and says so (no point is plotted
-against a temperature nobody measured).  A column with nothing to show (the leave-one-
+temperatures (a multi-position calibration with ``temps`` and a file per temperature, or a
+turntable over temperature) gets every parameter plotted against the real run temperatures
+with the fitted polynomial and its ±1σ band, and a table of the runs; a triad calibrated at
+one temperature, or without a temperature column, gets the table only and says so (no point
+is plotted against a temperature nobody measured).  A column with nothing to show (the leave-one-
 temperature-out rms of a one-temperature calibration) is left out and the reason given.
 One self-contained file; matplotlib and jinja2 are imported here only."""
 

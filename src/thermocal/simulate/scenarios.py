@@ -731,7 +731,7 @@ def scenario_multipos(seed: int, profile: ProfileInput = None, **opts: Any) -> S
     try:
         runs = simulate_runs(scenario_rng("multipos", seed, 2), **opts)
     except (TypeError, ValueError) as exc:
-        raise ThermocalInputError(f"multipos: {exc}") from None
+        raise ThermocalInputError.around(exc, "multipos: ") from None
     return [(rec, _plain({"scenario": "multipos", "seed": int(seed), **t})) for rec, t in runs]
 
 

@@ -80,7 +80,19 @@ BARO_REPORT = "report_BARO_0.html"
 class ActiveTcal:
     """An IMU's ``INS_TCAL<n>_*`` found in the log's parameters: ``coefficients[kind]`` the
     3×3 ``c_k`` (row k = 1…3, columns x, y, z, as stored: ×1e-6 in use), the range and the
-    calibration temperatures ``INS_ACC<n>_CALTEMP``/``INS_GYR<n>_CALTEMP`` [°C]."""
+    calibration temperatures ``INS_ACC<n>_CALTEMP``/``INS_GYR<n>_CALTEMP`` [°C].
+
+    Attributes
+    ----------
+    instance : int
+        The IMU (``n`` of ``INS_TCAL<n>``).
+    tmin_c, tmax_c : float
+        ``INS_TCAL<n>_TMIN/TMAX`` [°C].
+    coefficients : dict of str to list of list of float
+        ``c_k`` per sensor kind, rows k = 1…3, columns x, y, z, as stored.
+    caltemp_c : dict of str to float
+        ``INS_ACC<n>_CALTEMP``/``INS_GYR<n>_CALTEMP`` [°C].
+    """
 
     instance: int
     tmin_c: float
@@ -315,7 +327,15 @@ def imu_hygiene_params(name: str, instance: int) -> bool:
 @dataclass(frozen=True)
 class ParamInterval:
     """A stretch of the log ``[start_s, end_s)`` [s, the log's ``TimeUS`` clock; ±inf at the
-    ends] over which the parameters ``params`` were in force."""
+    ends] over which the parameters ``params`` were in force.
+
+    Attributes
+    ----------
+    start_s, end_s : float
+        The stretch [s, ``TimeUS`` clock; ±inf at the ends].
+    params : dict of str to float
+        The parameters in force.
+    """
 
     start_s: float
     end_s: float
@@ -474,7 +494,15 @@ def tclr_points(
 @dataclass(frozen=True)
 class TclrRange:
     """The range ``TMIN…TMAX`` [°C] the firmware saves with its learned coefficients of one
-    IMU (both its sensors: ``INS_TCAL<n>_TMIN/TMAX`` are per IMU), and where it was found."""
+    IMU (both its sensors: ``INS_TCAL<n>_TMIN/TMAX`` are per IMU), and where it was found.
+
+    Attributes
+    ----------
+    tmin_c, tmax_c : float
+        The range [°C].
+    source : str
+        Where it was found.
+    """
 
     tmin_c: float
     tmax_c: float
@@ -609,7 +637,35 @@ class ArdupilotTempcalResult:
     per IMU the active ``INS_TCAL`` removed and its coefficients old → new); per sensor
     (``IMU.Gyr.<n>``/``IMU.Acc.<n>``) the active coefficients against the new ones
     (``previous``) and the firmware's own learning against them (``firmware_learning``,
-    from ``TCLR``); the first barometer's ``TCAL_BARO_EXP`` (``baro``)."""
+    from ``TCLR``); the first barometer's ``TCAL_BARO_EXP`` (``baro``).
+
+    Attributes
+    ----------
+    log : Path
+        The log read.
+    params_path, calibration_path : Path
+        The parameter file and the calibration file.
+    reports : tuple of Path
+        The HTML reports.
+    fits : tuple of SensorFit
+        Every IMU sensor's fit.
+    notes : tuple of str
+        The parameter file's notes.
+    orientation : int
+        ``AHRS_ORIENTATION`` at the end of the log.
+    hygiene : dict
+        Per IMU, the active ``INS_TCAL`` removed and its coefficients old → new.
+    previous : dict of str to CoefficientComparison
+        Per sensor, the active coefficients against the new ones.
+    firmware_learning : dict of str to CoefficientComparison
+        Per sensor, the firmware's learning (``TCLR``) against the new ones.
+    baro : ArdupilotBaroFit or None
+        The first barometer's ``TCAL_BARO_EXP``.
+    rotated : bool
+        Some data were recorded with ``AHRS_ORIENTATION`` ≠ 0.
+    parameter_changes : tuple of dict
+        The changes of the undone parameters during the log.
+    """
 
     log: Path
     params_path: Path

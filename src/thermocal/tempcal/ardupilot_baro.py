@@ -121,6 +121,23 @@ class ArdupilotBaroFit:
     References
     ----------
     - ArduPilot ``libraries/AP_TempCalibration/AP_TempCalibration.cpp``.
+
+    Attributes
+    ----------
+    instance : int
+        The barometer.
+    sweep_c : (float, float)
+        Its temperature sweep [°C].
+    n_samples, n_bins : int
+        Samples and temperature bins.
+    exponent : float
+        ``TCAL_BARO_EXP``.
+    rms_before_pa, rms_after_pa : float
+        RMS of the bin medians about their mean before and after the correction [Pa].
+    holdout_rms_pa : float
+        RMS of the odd bins about the even bins' fit [Pa].
+    at_limit : bool
+        The exponent lies at a limit of :data:`EXP_LIMITS`.
     """
 
     instance: int
@@ -223,7 +240,27 @@ class ArdupilotBaroReportRequest:
     (the bins' medians, relative to the same medians), the odd bins' temperature
     and residual to the even bins' fit (:func:`fit_ardupilot_baro`'s hold-out), the log's
     own ``TCAL_*`` values (``old``, those present) and the warnings said about this
-    barometer."""
+    barometer.
+
+    Attributes
+    ----------
+    fit : ArdupilotBaroFit
+        The fit.
+    log_path, title, generated_by : str
+        The log, the report's title and its maker.
+    temp_c, before, after : numpy.ndarray
+        The samples' temperature [°C] and residuals [Pa].
+    bin_temp_c, bin_before, bin_after : numpy.ndarray
+        The same per temperature bin.
+    odd_temp_c, odd_residual : numpy.ndarray
+        The odd bins' temperature [°C] and hold-out residual [Pa].
+    holdout_exponent : float
+        The even bins' exponent.
+    old : dict of str to float
+        The log's own ``TCAL_*`` values.
+    warnings : tuple of str
+        The warnings said about this barometer.
+    """
 
     fit: ArdupilotBaroFit
     log_path: str

@@ -30,7 +30,31 @@ class CoefficientComparison:
     ``parameters``: (name, old, new) as the firmware stores them; ``temp_c`` the
     temperatures [°C] of the curves; ``old_curve``/``new_curve``: per axis the correction
     each set applies at ``temp_c`` [``unit``, the firmware's unit of the sensor];
-    ``curve_formula`` says how (the firmware's formula, with its source)."""
+    ``curve_formula`` says how (the firmware's formula, with its source).
+
+    Attributes
+    ----------
+    sensor : str
+        The sensor (``IMU.Gyr.0`` …).
+    unit : str
+        The firmware's unit of the sensor.
+    parameters : tuple of (str, float, float)
+        ``(name, old, new)`` as the firmware stores them.
+    temp_c : tuple of float
+        Temperatures of the curves [°C].
+    old_curve, new_curve : mapping of str to tuple of float
+        Per axis, the correction each set applies at ``temp_c`` [``unit``].
+    curve_formula : str
+        How the curves are computed.
+    old_key, new_key : str
+        The sets' names in the JSON.
+    title, old_label : str
+        The report section's title and the old set's label.
+    anchor : str
+        The HTML id of the report's section.
+    intro : str
+        The section's first sentence.
+    """
 
     sensor: str
     unit: str

@@ -63,7 +63,17 @@ _MAG_UNITS = (("µT", 0.01), ("milligauss", 0.001), ("nT", 1e-5), ("tesla", 1e4)
 @dataclass(frozen=True)
 class Screened:
     """The samples kept (``keep``, a boolean mask) or ``None`` (the sensor left out), and
-    the sentences said (``left_out`` why it was left out, ``notes`` samples set aside)."""
+    the sentences said (``left_out`` why it was left out, ``notes`` samples set aside).
+
+    Attributes
+    ----------
+    keep : numpy.ndarray of bool or None
+        The samples kept (None: the sensor left out).
+    left_out : str or None
+        Why it was left out.
+    notes : tuple of str
+        The samples set aside, said.
+    """
 
     keep: npt.NDArray[np.bool_] | None
     left_out: str | None
@@ -107,7 +117,17 @@ def _set_aside(where: str, what: str, ok: npt.NDArray[np.bool_], raw: FloatArray
 
 @dataclass(frozen=True)
 class Dialect:
-    """How a firmware names the pressure field, its unit's source and its parameters."""
+    """How a firmware names the pressure field, its unit's source and its parameters.
+
+    Attributes
+    ----------
+    field : str
+        The pressure field's name.
+    unit_source : str
+        Where its unit is stated.
+    params : str
+        What the firmware's parameters are called.
+    """
 
     field: str = "pressure"
     unit_source: str = "PX4 logs Pa (SensorBaro.msg)"

@@ -31,7 +31,25 @@ if TYPE_CHECKING:
 class OffsetReportRequest:
     """One barometer's or magnetometer's report: the fit, the samples' temperature [°C] and
     residuals before/after (n, axes) [``fit.unit``], the bins' median temperature [°C] and
-    residuals before/after, the odd bins' temperature and residual to the even bins' fit."""
+    residuals before/after, the odd bins' temperature and residual to the even bins' fit.
+
+    Attributes
+    ----------
+    fit : OffsetFit
+        The fit.
+    log_path, title, generated_by : str
+        The log, the report's title and its maker.
+    axes : tuple of str
+        The axes.
+    temp_c, before, after : numpy.ndarray
+        The samples' temperature [°C] and residuals (n, axes) [``fit.unit``].
+    bin_temp_c, bin_before, bin_after : numpy.ndarray
+        The same per temperature bin.
+    odd_temp_c, odd_residual : numpy.ndarray
+        The odd bins' temperature [°C] and hold-out residual.
+    previous : CoefficientComparison or None
+        The log's ``TC_*`` for this device against the new ones.
+    """
 
     fit: OffsetFit
     log_path: str

@@ -48,7 +48,31 @@ AXES = ("x", "y", "z")
 
 @dataclass
 class SensorFit:
-    """One sensor instance: its topic, device id, sweep, per-axis hold-out rms [its unit]."""
+    """One sensor instance: its topic, device id, sweep, per-axis hold-out rms [its unit].
+
+    Attributes
+    ----------
+    topic : str
+        The log topic.
+    kind : str
+        The sensor kind (gyroscope or accelerometer).
+    instance : int
+        The instance.
+    device_id : int
+        Its device id.
+    unit : str
+        Its unit.
+    sweep_c : (float, float)
+        Its temperature sweep [°C].
+    n_samples, n_bins : int
+        Samples and temperature bins.
+    holdout_rms : dict of str to float
+        Per axis, the rms of the odd bins about the even bins' fit [``unit``].
+    channels : list of Channel
+        The fitted channels.
+    adequacy : dict
+        The data's judgement.
+    """
 
     topic: str
     kind: str
@@ -416,7 +440,27 @@ def require_fields(df: Any, names: Sequence[str], log: Path, where: str) -> None
 @dataclass(frozen=True)
 class ReportRequest:
     """One sensor's report, as :class:`thermocal.report.calibration.CalibrationReportInputs`
-    takes it (the presentation layer writes it: :data:`Reporter`)."""
+    takes it (the presentation layer writes it: :data:`Reporter`).
+
+    Attributes
+    ----------
+    calibration : Calibration
+        The sensor's calibration.
+    recording : Recording
+        Its samples.
+    recording_path, title, generated_by : str
+        The log, the report's title and its maker.
+    sensor : str or None
+        The sensor's name.
+    extra : mapping
+        Extra per-channel columns of the summary table.
+    notes : tuple of str
+        Notes shown in the report.
+    previous : CoefficientComparison or None
+        The coefficients active in the log against the new ones.
+    firmware_learning : CoefficientComparison or None
+        The firmware's own learned coefficients against the new ones.
+    """
 
     calibration: Calibration
     recording: Recording
@@ -477,7 +521,21 @@ class OutputSet:
     :meth:`commit` every report not yet begun there is taken back and built here, the others
     awaited; a report that failed in the worker (or could not be sent to it) is built again
     here, so that its error is raised as without the worker.  The reports are the same
-    either way; the worker's warnings are said again here."""
+    either way; the worker's warnings are said again here.
+
+    Attributes
+    ----------
+    output : Path
+        The set's final folder.
+    stage : Path
+        The folder it is built in.
+    reporter : Reporter or None
+        What writes the reports (None: no reports).
+    reports : list of Path
+        The reports written.
+    workers : int
+        Report worker processes (1, or 0: all here).
+    """
 
     output: Path
     stage: Path

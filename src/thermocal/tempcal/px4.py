@@ -79,7 +79,31 @@ class OffsetFit:
     """A barometer or magnetometer instance: the polynomial about ``tref_c`` per axis
     (``coefficients[axis][k]`` of ``(T − TREF)^k`` [unit], relative to the median of the
     log — the weather's pressure and the Earth's field are in the data, as PX4's own script
-    fits them), judged like the IMU on held-out temperature bins (``holdout_rms`` [unit])."""
+    fits them), judged like the IMU on held-out temperature bins (``holdout_rms`` [unit]).
+
+    Attributes
+    ----------
+    topic, kind : str
+        The log topic and the sensor kind (barometer or magnetometer).
+    instance, device_id : int
+        The instance and its device id.
+    unit : str
+        Its unit.
+    sweep_c : (float, float)
+        Its temperature sweep [°C].
+    tref_c : float
+        Reference temperature [°C].
+    n_samples, n_bins : int
+        Samples and temperature bins.
+    order : int
+        Polynomial order.
+    coefficients : tuple of tuple of float
+        ``coefficients[axis][k]`` [unit/°C^k].
+    holdout_rms : dict of str to float
+        Per axis, the hold-out rms [unit].
+    adequacy : dict
+        The data's judgement.
+    """
 
     topic: str
     kind: str
@@ -208,7 +232,25 @@ def offset_summary(fits: Sequence[OffsetFit]) -> dict[str, Any]:
 @dataclass(frozen=True)
 class Px4TempcalResult:
     """What :func:`px4_tempcal` wrote and found: the files of the set, every IMU instance's
-    fit, every barometer/magnetometer's, the notes of the parameter file."""
+    fit, every barometer/magnetometer's, the notes of the parameter file.
+
+    Attributes
+    ----------
+    log : Path
+        The log read.
+    params_path, calibration_path : Path
+        The parameter file and the calibration file.
+    reports : tuple of Path
+        The HTML reports.
+    fits : tuple of SensorFit
+        Every IMU instance's fit.
+    offset_fits : tuple of OffsetFit
+        Every barometer's and magnetometer's.
+    notes : tuple of str
+        The parameter file's notes.
+    previous : dict of str to CoefficientComparison
+        Per sensor, the log's ``TC_*`` against the new ones.
+    """
 
     log: Path
     params_path: Path

@@ -39,7 +39,21 @@ FloatArray = npt.NDArray[np.float64]
 class AccelEstimate:
     """An accelerometer triad's θ (12: bias [mg], scale factor [ppm], misalignment [″]),
     its covariance, the weighted residual rms of the dwell means [mg] and the number of
-    dwells and distinct gravity directions used."""
+    dwells and distinct gravity directions used.
+
+    Attributes
+    ----------
+    theta : numpy.ndarray, shape (12,)
+        Bias [mg], scale factors [ppm], misalignments [″].
+    cov : numpy.ndarray, shape (12, 12)
+        Its covariance.
+    residual_rms_mg : float
+        Weighted residual rms of the dwell means [mg].
+    n_dwells : int
+        Dwells used.
+    condition_number : float
+        Condition number of the scaled design [-].
+    """
 
     theta: FloatArray
     cov: FloatArray
@@ -80,8 +94,37 @@ class AccelEstimate:
 
 
 def gravity_in_body(alpha_deg: npt.ArrayLike, beta_deg: npt.ArrayLike, g_m_s2: float) -> FloatArray:
-    """Specific force of a triad at rest in body axes [m/s²], ``C_nᵇ (0, 0, g)`` (ENU base,
-    up positive), for encoder angles α, β [°] (arrays of the same shape: (…, 3) out)."""
+    r"""Specific force of a triad at rest in body axes [m/s²] (ENU base, up positive).
+
+    Parameters
+    ----------
+    alpha_deg, beta_deg : array_like
+        Inner- and outer-axis encoder angles [°], of the same shape.
+    g_m_s2 : float
+        Local gravity [m/s²].
+
+    Returns
+    -------
+    numpy.ndarray, shape (..., 3)
+        The specific force in body axes [m/s²].
+
+    Notes
+    -----
+    .. math:: \mathbf f_b = C_n^b \, (0, 0, g)^\mathsf{T}, \qquad
+              C_b^n = R_E(\beta)\, C_0\, R_z(\alpha)
+
+    (:func:`.kinematics.mat_nb`).
+
+    References
+    ----------
+    - *A method for separating the combined error coefficients of a ring-laser gyro triad
+      based on dual-axis rotation*, Chinese invention patent CN104880182.
+
+    Examples
+    --------
+    >>> [round(float(v), 3) + 0.0 for v in gravity_in_body(0.0, 0.0, 9.8)]
+    [0.0, -9.8, 0.0]
+    """
     a = np.deg2rad(np.asarray(alpha_deg, dtype=np.float64))
     b = np.deg2rad(np.asarray(beta_deg, dtype=np.float64))
     c_nb = kinematics.mat_nb(a, b)  # body → base
@@ -95,11 +138,45 @@ def estimate_accel_triad(
     f_true_m_s2: npt.ArrayLike,
     n_samples: npt.ArrayLike,
 ) -> AccelEstimate:
-    """Bias, scale factors and misalignments of an accelerometer triad from dwell means
-    (module docstring): ``f_mean`` (m, 3) measured, ``f_true`` (m, 3) from the attitude,
-    ``n_samples`` (m,) per dwell.  Needs gravity along at least three independent body
-    directions and more dwells than the four unknowns of an axis; a design that cannot
-    separate them is a :class:`DesignError`."""
+    r"""Bias, scale factors and misalignments of an accelerometer triad from dwell means
+    (module docstring).  Needs gravity along at least three independent body directions and
+    more dwells than the four unknowns of an axis.
+
+    Parameters
+    ----------
+    f_mean_m_s2 : array_like, shape (m, 3)
+        Measured mean specific force of each dwell [m/s²].
+    f_true_m_s2 : array_like, shape (m, 3)
+        Specific force of each dwell from its attitude [m/s²] (:func:`gravity_in_body`).
+    n_samples : array_like, shape (m,)
+        Samples averaged in each dwell (the weights).
+
+    Returns
+    -------
+    AccelEstimate
+        θ (12: bias [mg], scale factors [ppm], misalignments [″]), its covariance, the
+        residual rms [mg], the number of dwells and the design's condition number.
+
+    Raises
+    ------
+    thermocal.errors.ThermocalInputError
+        Arrays of the wrong shapes.
+    thermocal.errors.DesignError
+        Fewer than 6 dwells, or gravity not along three independent body directions.
+
+    Notes
+    -----
+    Axis :math:`i` alone, by weighted least squares over the dwells (weights :math:`n_k`):
+
+    .. math:: f_i - f_{\mathrm{true},i} = \sum_j E_{ij}\, f_{\mathrm{true},j} + b_i
+
+    References
+    ----------
+    - IEEE Std 1293-1998, *IEEE Standard Specification Format Guide and Test Procedure for
+      Linear, Single-Axis, Nongyroscopic Accelerometers* (multipoint tumble test).
+    - *A method for separating the combined error coefficients of a ring-laser gyro triad
+      based on dual-axis rotation*, Chinese invention patent CN104880182.
+    """
     f = np.asarray(f_mean_m_s2, dtype=np.float64)
     ft = np.asarray(f_true_m_s2, dtype=np.float64)
     w = np.asarray(n_samples, dtype=np.float64)
@@ -162,8 +239,23 @@ def _unit_factor(i: int, j: int) -> float:
 
 
 def dwell_means(values: FloatArray, dwells: Sequence[Any]) -> tuple[FloatArray, FloatArray]:
-    """Mean of ``values`` (n, k) over each dwell's samples (interval ``[start, stop)`` are
-    the samples ``start+1 … stop``); returns the means (m, k) and the sample counts (m,)."""
+    """Mean of ``values`` over each dwell's samples (intervals ``[start, stop)`` are the
+    samples ``start+1 … stop``).
+
+    Parameters
+    ----------
+    values : numpy.ndarray, shape (n, k)
+        Samples, in any unit.
+    dwells : sequence of Dwell
+        The dwells (:class:`.schedule.Dwell`: ``start``, ``stop`` interval indices).
+
+    Returns
+    -------
+    means : numpy.ndarray, shape (m, k)
+        Each dwell's mean, in the unit of ``values``.
+    counts : numpy.ndarray, shape (m,)
+        Each dwell's number of samples.
+    """
     rows = [values[1:][d.start : d.stop] for d in dwells]
     means = np.asarray([r.mean(axis=0) for r in rows], dtype=np.float64)
     return means, np.asarray([r.shape[0] for r in rows], dtype=np.float64)

@@ -21,7 +21,13 @@ import numpy.typing as npt
 
 from thermocal import units
 from thermocal.defaults import DEFAULT_GYRO_COLUMNS as DEFAULT_GYRO_COLUMNS
-from thermocal.errors import MissingValueError, ParameterError, ThermocalInputError, UnitError
+from thermocal.errors import (
+    MissingValueError,
+    ParameterError,
+    ThermocalInputError,
+    UnitError,
+    spell_parameters,
+)
 from thermocal.recording import Recording
 from thermocal.turntable import accel as accel_mod
 from thermocal.turntable import estimate_ls, kalman, model, schedule
@@ -53,7 +59,15 @@ CONSTRAINTS = (
 
 @dataclass(frozen=True)
 class Estimate:
-    """One estimator's coefficients θ (12, units of :mod:`.model`) and covariance."""
+    """One estimator's coefficients θ (12, units of :mod:`.model`) and covariance.
+
+    Attributes
+    ----------
+    theta : numpy.ndarray, shape (12,)
+        Bias [°/h], scale factors [ppm], misalignments [″].
+    cov : numpy.ndarray, shape (12, 12)
+        Its covariance.
+    """
 
     theta: FloatArray
     cov: FloatArray
@@ -92,7 +106,43 @@ class TurntableResult:
     ``crb`` the Cramér–Rao bound σ of each coefficient for this design and noise (12,
     units of :mod:`.model`), ``agreement`` the largest |θ_KF − θ_LS| / σ_LS,
     ``weak_combinations`` the poorly determined directions found in the design,
-    ``arw_deg_sqrt_h`` the angle random walk of each gyro [°/√h]."""
+    ``arw_deg_sqrt_h`` the angle random walk of each gyro [°/√h].
+
+    Attributes
+    ----------
+    kalman, least_squares : Estimate
+        The reported estimate (the source's filter) and the cross-check.
+    crb : numpy.ndarray, shape (12,)
+        Cramér–Rao bound σ of each coefficient.
+    agreement : float
+        Largest ``|θ_KF − θ_LS| / σ_LS`` [-].
+    latitude_deg : float
+        Latitude used [°].
+    arw_deg_sqrt_h : numpy.ndarray
+        Angle random walk of each axis [°/√h].
+    n_channels, n_states, n_positions, n_dwells : int
+        Channels, filter states, distinct positions and dwells.
+    min_dwell_s, duration_s : float
+        Shortest dwell and run duration [s].
+    chi2_per_dof, normalised_innovation_rms : float
+        Least-squares χ²/dof and the filter's normalised innovation rms [-].
+    weak_combinations : tuple of dict
+        Poorly determined directions of the design.
+    warnings : tuple of str
+        What the run was warned of.
+    encoder_noise_arcsec, encoder_jitter_arcsec : float
+        Encoder noise used and jitter found at rest [″].
+    encoder_noise_source : str
+        ``"option"`` or ``"dwells"``.
+    encoder_quantum_deg : float
+        Reading resolution found [°].
+    accel : AccelEstimate or None
+        The accelerometer triad.
+    gravity_m_s2 : float or None
+        Local gravity used [m/s²].
+    temperature_c, temperature_span_c : float or None
+        Mean temperature and its range over the run [°C].
+    """
 
     kalman: Estimate
     least_squares: Estimate
@@ -177,9 +227,10 @@ def _gyro_rad_s(rec: Recording, cols: Sequence[str], unit: str | None) -> FloatA
         v = rec.column(c)
         u = unit or rec.units.get(c)
         if not u:
-            raise UnitError(
-                f"{rec.name}: no unit is known for the gyro column {c!r}; give --gyro-unit "
-                "(deg/s, deg/h, rad/s) or state it in the file's metadata"
+            raise UnitError.naming(
+                f"{rec.name}: no unit is known for the gyro column {c!r}; give {{gyro_unit}} "
+                "(deg/s, deg/h, rad/s) or state it in the file's metadata",
+                "gyro_unit",
             )
         out.append(units.convert(v, u, "rad/s"))
     return np.column_stack(out)
@@ -308,7 +359,7 @@ AZIMUTH_REFUSED_DEG = 5.0
 """Beyond this [°] (scale factors biased by −3800 ppm, misalignments of 18000″) the run is
 refused: the α encoder's zero is not the geometry's (a table whose inner axis reads 90° at
 the body's α = 0 gave scale factors of −1e6 ppm and misalignments of ±206265″, i.e. the
-rotation itself); ``--alpha-offset`` declares it."""
+rotation itself); ``alpha_offset_deg`` declares it."""
 
 
 def inner_axis_azimuth_deg(theta: npt.ArrayLike) -> float:
@@ -348,35 +399,37 @@ def _check_azimuth(
     theta: FloatArray, name: str, alpha_column: str, offset_deg: float = 0.0
 ) -> str | None:
     """Refuse a run whose fit holds a rotation about the inner axis beyond
-    :data:`AZIMUTH_REFUSED_DEG` (:func:`inner_axis_azimuth_deg`), naming ``--alpha-offset``;
-    the warning's text beyond :data:`AZIMUTH_WARNED_DEG`, else None.  Judged first, when
-    the x-y block of ``I + E`` is ``k·R_z(ψ)`` with ``k`` within :data:`SCALE_FACTOR_REFUSED`
-    of 1 (a quarter turn reads as −100 % scale factors); otherwise a unit is wrong and
-    :func:`_check_fit` says so."""
+    :data:`AZIMUTH_REFUSED_DEG` (:func:`inner_axis_azimuth_deg`), naming ``alpha_offset_deg``;
+    the warning's text (``{alpha_offset_deg}`` where the parameter goes) beyond
+    :data:`AZIMUTH_WARNED_DEG`, else None.  Judged first, when the x-y block of ``I + E``
+    is ``k·R_z(ψ)`` with ``k`` within :data:`SCALE_FACTOR_REFUSED` of 1 (a quarter turn
+    reads as −100 % scale factors); otherwise a unit is wrong and :func:`_check_fit` says
+    so."""
     e = model.error_matrices(np.asarray(theta, dtype=np.float64))
     k = 0.5 * math.hypot(e[1, 0] - e[0, 1], 2.0 + e[0, 0] + e[1, 1])
     if not abs(k - 1.0) <= SCALE_FACTOR_REFUSED:  # the xy block is k·R_z(ψ): a unit's scale
         return None  # first (:func:`_check_fit`), ψ is not defined by it
     psi = inner_axis_azimuth_deg(theta)
-    total = (offset_deg + psi + 180.0) % 360.0 - 180.0  # the --alpha-offset that removes it
+    total = (offset_deg + psi + 180.0) % 360.0 - 180.0  # the alpha_offset_deg that removes it
     what = (
         f"the fit holds a rotation of {psi:+.4g}° of the body about the inner axis (z) "
         f"relative to the geometry (body x East at {alpha_column} = 0): the {alpha_column} "
         "encoder's zero, or the sensor's mounting, is off by that much"
     )
     if abs(psi) > AZIMUTH_REFUSED_DEG:
-        raise ThermocalInputError(
+        raise ParameterError(
+            "alpha_offset_deg",
             f"{name}: {what}; its x and y scale factors "
             f"({(math.cos(math.radians(psi)) - 1) * 1e6:+.3g} ppm) and misalignments yx, xy "
             "would be that rotation, not the sensor's; declare it with "
-            f"--alpha-offset {total:.4g} (the reading at the geometry's α = 0), or re-zero the "
-            "encoder; nothing written"
+            f"{{name}} {total:.4g} (the reading at the geometry's α = 0), or re-zero the "
+            "encoder; nothing written",
         )
     if abs(psi) > AZIMUTH_WARNED_DEG:
         return (
             f"{what}; the x and y scale factors are biased by "
             f"{(math.cos(math.radians(psi)) - 1) * 1e6:+.3g} ppm and yx, xy hold it; declare "
-            f"it with --alpha-offset {total:.4g}"
+            f"it with {{alpha_offset_deg}} {total:.4g}"
         )
     return None
 
@@ -392,25 +445,28 @@ def _check_fit(est: _Estimates, acc: accel_mod.AccelEstimate | None, name: str) 
     """Refuse a run whose fit fails its own checks, before anything is written: a gyro or
     accelerometer scale factor beyond :data:`SCALE_FACTOR_REFUSED`, least-squares residuals
     beyond :data:`RESIDUAL_REFUSED` × the white-noise level."""
-    for kind, theta, opt in (("gyro", est.kf.theta, "--gyro-unit"),
+    for kind, theta, opt in (("gyro", est.kf.theta, "gyro_unit"),
                              ("accelerometer", None if acc is None else acc.theta,
-                              "--accel-unit")):  # fmt: skip
+                              "accel_unit")):  # fmt: skip
         if theta is None:
             continue
         bad = model.scale_factors_beyond(theta)
         if bad:
-            raise ThermocalInputError(
+            raise ThermocalInputError.naming(
                 f"{name}: the {kind}'s scale factors come out {', '.join(bad)} (beyond "
                 f"±{SCALE_FACTOR_REFUSED:.0%}: no sensor's): its columns are not in the unit "
-                f"declared; give the right {opt}; nothing written"
+                f"declared; give the right {{{opt}}}; nothing written",
+                opt,
             )
     ratio = math.sqrt(est.chi2_per_dof) if est.dof > 0 and est.chi2_per_dof > 0 else 0.0
     if not ratio <= RESIDUAL_REFUSED:
-        raise ThermocalInputError(
+        raise ThermocalInputError.naming(
             f"{name}: the fit failed: least-squares residuals {ratio:.3g}× the white-noise "
             f"level (at most {RESIDUAL_REFUSED:g}×): the encoder angles and the earth rate do "
-            "not describe the run as the geometry says; check --latitude, the encoder columns "
-            "(--alpha, --beta, --encoder-unit) and their zeros (--alpha-offset); nothing written"
+            "not describe the run as the geometry says; check {latitude_deg}, the encoder "
+            "columns ({alpha_column}, {beta_column}, {encoder_unit}) and their zeros "
+            "({alpha_offset_deg}); nothing written",
+            *("latitude_deg", "alpha_column", "beta_column", "encoder_unit", "alpha_offset_deg"),
         )
 
 
@@ -519,8 +575,7 @@ def calibrate(
         msgs.extend(_accel_diagnostics(acc_est))
     msgs.extend(_judge(est, acc_est, str(rec.name), (alpha_column, alpha_offset_deg)))
     t_mean, t_span = _soak_temperature(rec, temperature_column)
-    for msg in msgs:
-        warnings.warn(f"{rec.name}: {msg}", TurntableWarning, stacklevel=2)
+    msgs = _warned(msgs, str(rec.name))
     return TurntableResult(
         kalman=estimate_from(est.kf.theta, est.kf.cov),
         least_squares=estimate_from(est.ls.theta, est.ls.cov), crb=est.crb,
@@ -535,6 +590,14 @@ def calibrate(
         encoder_jitter_arcsec=motion.noise_arcsec, encoder_quantum_deg=motion.quantum_deg,
         accel=acc_est, gravity_m_s2=g_local, temperature_c=t_mean, temperature_span_c=t_span,
     )  # fmt: skip
+
+
+def _warned(msgs: list[str], name: str) -> list[str]:
+    """Each message warned (the caller's caller named); the messages with the parameter
+    ``alpha_offset_deg`` written as it is named."""
+    for msg in msgs:
+        warnings.warn(TurntableWarning.naming(f"{name}: {msg}", "alpha_offset_deg"), stacklevel=3)
+    return [spell_parameters(m, ("alpha_offset_deg",)) for m in msgs]
 
 
 def calibrate_arrays(
@@ -742,7 +805,7 @@ def _check_inputs(
 
 def encoder_deg(rec: Recording, column: str, unit: str | None = None) -> FloatArray:
     """An encoder angle column in [°]: its unit resolved like every column's
-    (:func:`thermocal.units.resolve_unit`, role ``angle``: ``unit`` (``--encoder-unit``) >
+    (:func:`thermocal.units.resolve_unit`, role ``angle``: ``unit`` (``encoder_unit``) >
     the file's metadata > the unit in the column's name > ° with a warning), then
     ``θ[°] = θ[unit] · ANGLE_UNITS[unit]``.
 
@@ -884,9 +947,10 @@ def _accel_triad(
     for c in columns:
         u = unit or rec.units.get(c)
         if not u:
-            raise UnitError(
+            raise UnitError.naming(
                 f"{rec.name}: no unit is known for the accelerometer column {c!r}; give "
-                "--accel-unit (m/s^2, mg, g) or state it in the file's metadata"
+                "{accel_unit} (m/s^2, mg, g) or state it in the file's metadata",
+                "accel_unit",
             )
         out.append(units.convert(rec.column(c), u, "m/s^2"))
     f = np.column_stack(out)

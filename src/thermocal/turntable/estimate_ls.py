@@ -78,8 +78,39 @@ def make_blocks(
     max_static_block_s: float | None = None,
     max_move_block_s: float = 1.0,
 ) -> Blocks:
-    """Cut the valid intervals into blocks: static runs whole (or in pieces of at most
-    ``max_static_block_s``), moving runs in pieces of at most ``max_move_block_s``."""
+    r"""Cut the valid intervals into blocks: static runs whole (or in pieces of at most
+    ``max_static_block_s``), moving runs in pieces of at most ``max_move_block_s``.
+
+    Parameters
+    ----------
+    m : IntervalModel
+        The per-interval measurement model of the run (:mod:`.model`, eq. (4)).
+    arw_rad_sqrt_s : array_like
+        Angle random walk of each gyro axis [rad/√s] (scalar or (3,)): the white noise
+        whose covariance each interval carries.
+    max_static_block_s : float or None, optional
+        Longest block at rest [s] (default ``None``: each dwell is one block).
+    max_move_block_s : float, optional
+        Longest block of a rotation [s] (default 1).
+
+    Returns
+    -------
+    Blocks
+        The blocks' index ranges, kinds, durations [s] and their summed measurements
+        [arcsec], regressors and white-noise covariances [arcsec²].
+
+    Notes
+    -----
+    For block :math:`j` and channel :math:`c` the intervals :math:`i` of the block are summed:
+
+    .. math:: Y_{cj} = \sum_i y_{ci} = \Big(\sum_i h_{ci}\Big)\,\theta + W_{cj},
+              \qquad \operatorname{cov} W_j = \sum_i \operatorname{cov} w_i
+
+    References
+    ----------
+    - *A method for separating the combined error coefficients of a ring-laser gyro triad
+      based on dual-axis rotation*, Chinese invention patent CN104880182, eq. (4).
+    """
     starts: list[int] = []
     stops: list[int] = []
     restart: list[bool] = []
@@ -138,7 +169,25 @@ class LsEstimate:
 
     ``cov`` is the covariance (known-noise GLS), ``chi2``/``dof`` the whitened
     residual sum of squares and degrees of freedom, ``singular_values`` of the
-    whitened, column-normalised design and ``rank``."""
+    whitened, column-normalised design and ``rank``.
+
+    Attributes
+    ----------
+    theta : numpy.ndarray, shape (12,)
+        The estimate (units of :mod:`.model`).
+    cov : numpy.ndarray, shape (12, 12)
+        Its covariance (known-noise GLS).
+    chi2 : float
+        Whitened residual sum of squares [-].
+    dof : int
+        Degrees of freedom.
+    n_blocks : int
+        Blocks used.
+    singular_values : numpy.ndarray
+        Of the whitened, column-normalised design.
+    rank : int
+        Singular values kept.
+    """
 
     theta: FloatArray
     cov: FloatArray
@@ -155,10 +204,35 @@ class LsEstimate:
 
 
 def block_covariance(blocks: Blocks, encoder_noise_arcsec: float = 0.0) -> FloatArray:
-    """Joint covariance of all block increments, rows ordered (block, channel) [arcsec²].
+    r"""Joint covariance of all block increments, rows ordered (block, channel) [arcsec²].
 
-    ``C = blockdiag(cov W_j) + σ_e² (D Dᵀ ⊗ diag(1, 1[, 0]))``: a block's start point
-    is the previous block's end point unless the block restarts the integration."""
+    A block's start point is the previous block's end point unless the block restarts the
+    integration, so the encoder noise correlates the α, β increments of neighbours.
+
+    Parameters
+    ----------
+    blocks : Blocks
+        The blocks (:func:`make_blocks`).
+    encoder_noise_arcsec : float, optional
+        Encoder reading noise σ_e [arcsec] (default 0: the blocks are independent).
+
+    Returns
+    -------
+    numpy.ndarray, shape (k·c, k·c)
+        The covariance [arcsec²].
+
+    Notes
+    -----
+    .. math:: C = \operatorname{blockdiag}(\operatorname{cov} W_j)
+              + \sigma_e^2 \, (D D^\mathsf{T} \otimes \operatorname{diag}(1, 1[, 0]))
+
+    with :math:`D` the block/end-point incidence matrix.
+
+    References
+    ----------
+    - S. M. Kay, *Fundamentals of Statistical Signal Processing: Estimation Theory*,
+      Prentice Hall, 1993, §4.5 and §8.3.
+    """
     k, nc = blocks.n, blocks.n_channels
     c = sla.block_diag(*blocks.cov)
     if encoder_noise_arcsec > 0:
@@ -180,11 +254,41 @@ def block_covariance(blocks: Blocks, encoder_noise_arcsec: float = 0.0) -> Float
 def solve_ls(
     blocks: Blocks, *, encoder_noise_arcsec: float = 0.0, rcond: float = 1e-12
 ) -> LsEstimate:
-    """Generalised least squares of θ on the block increments of all channels.
+    r"""Generalised least squares of θ on the block increments of all channels.
 
     Whitened by the Cholesky factor of :func:`block_covariance`; columns are
     normalised before the SVD; singular values below ``rcond`` × the largest are
-    dropped (their directions get an infinite variance)."""
+    dropped (their directions get an infinite variance).
+
+    Parameters
+    ----------
+    blocks : Blocks
+        The blocks (:func:`make_blocks`).
+    encoder_noise_arcsec : float, optional
+        Encoder reading noise σ_e [arcsec] (default 0).
+    rcond : float, optional
+        Relative cut-off of the singular values [-] (default 1e-12).
+
+    Returns
+    -------
+    LsEstimate
+        θ (12: bias [°/h], scale factors [ppm], misalignments [″]), its covariance, the
+        whitened χ², degrees of freedom, singular values and rank.
+
+    Notes
+    -----
+    With :math:`L L^\mathsf{T} = C`, :math:`A = L^{-1} H` and :math:`y = L^{-1} Y`:
+
+    .. math:: \hat\theta = (A^\mathsf{T} A)^{-1} A^\mathsf{T} y, \qquad
+              \operatorname{cov}\hat\theta = (H^\mathsf{T} C^{-1} H)^{-1}
+
+    References
+    ----------
+    - S. M. Kay, *Fundamentals of Statistical Signal Processing: Estimation Theory*,
+      Prentice Hall, 1993, §4.5 and §8.3.
+    - *A method for separating the combined error coefficients of a ring-laser gyro triad
+      based on dual-axis rotation*, Chinese invention patent CN104880182, eq. (4).
+    """
     if encoder_noise_arcsec > 0:
         low = sla.cholesky(block_covariance(blocks, encoder_noise_arcsec), lower=True)
         a = sla.solve_triangular(low, blocks.h.reshape(-1, N_COEFFS), lower=True)

@@ -149,7 +149,23 @@ class KalmanEstimate:
 
     ``theta``/``cov`` the final coefficient estimate and covariance (12); ``sigma_history``
     the coefficient σ after each update (k, 12); ``innovations`` (k, c) [arcsec] and
-    their predicted variances ``innovation_var`` (k, c); ``n_states`` 14 or 15."""
+    their predicted variances ``innovation_var`` (k, c); ``n_states`` 14 or 15.
+
+    Attributes
+    ----------
+    theta : numpy.ndarray, shape (12,)
+        The final coefficient estimate (units of :mod:`.model`).
+    cov : numpy.ndarray, shape (12, 12)
+        Its covariance.
+    time_index : numpy.ndarray of int, shape (k,)
+        The sample interval of each update.
+    sigma_history : numpy.ndarray, shape (k, 12)
+        The coefficients' σ after each update.
+    innovations, innovation_var : numpy.ndarray, shape (k, c)
+        Innovations [arcsec] and their predicted variances [arcsec²].
+    n_states : int
+        14 or 15.
+    """
 
     theta: FloatArray
     cov: FloatArray

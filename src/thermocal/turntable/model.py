@@ -77,7 +77,7 @@ from thermocal.turntable import kinematics
 SCALE_FACTOR_REFUSED: Final = 0.5
 """A fitted scale factor beyond ±50 % is refused, not written, by the turntable and the
 multi-position calibrations alike: the columns are not in the unit they are declared in (a
-°/s gyro declared °/h gave −999722 ppm, declared rad/s +5.6e7 ppm; ``--accel-unit mg`` on
+°/s gyro declared °/h gave −999722 ppm, declared rad/s +5.6e7 ppm; ``accel_unit="mg"`` on
 m/s² data −99 %), or a count scale is wrong by more than a factor 1.5."""
 
 

@@ -197,7 +197,19 @@ class Dwell:
 
     ``start``/``stop`` index the sample intervals (``[start, stop)``), ``alpha_deg``
     and ``beta_deg`` are the angles mod 360 [°], ``duration_s`` the time the
-    position was held [s] (gaps inside it included; they are warned about)."""
+    position was held [s] (gaps inside it included; they are warned about).
+
+    Attributes
+    ----------
+    start, stop : int
+        Sample intervals ``[start, stop)``.
+    start_s : float
+        Start time [s].
+    duration_s : float
+        Time the position was held [s].
+    alpha_deg, beta_deg : float
+        The encoder angles mod 360 [°].
+    """
 
     start: int
     stop: int
@@ -213,7 +225,17 @@ class Segmentation:
 
     ``dwells`` are static runs at least ``pause_s`` long, ``n_positions`` the number
     of distinct (α, β) mod 360 among them, ``alpha_travel_deg``/``beta_travel_deg``
-    the total travel of each axis [°]."""
+    the total travel of each axis [°].
+
+    Attributes
+    ----------
+    dwells : tuple of Dwell
+        Static runs at least ``pause_s`` long.
+    n_positions : int
+        Distinct (α, β) mod 360 among them.
+    alpha_travel_deg, beta_travel_deg : float
+        Total travel of each axis [°].
+    """
 
     dwells: tuple[Dwell, ...]
     n_positions: int
@@ -228,7 +250,19 @@ class Motion:
     ``moving`` per sample interval (n − 1,); ``noise_arcsec`` the white jitter σ of the
     readings at rest [″] (robust, per axis, the larger); ``quantum_deg`` the reading
     resolution [°] when the readings lie on a grid (else 0); ``tolerance_deg`` the band
-    [°] within which an angle counts as held."""
+    [°] within which an angle counts as held.
+
+    Attributes
+    ----------
+    moving : numpy.ndarray of bool, shape (n - 1,)
+        Per sample interval.
+    noise_arcsec : float
+        White jitter σ of the readings at rest [″].
+    quantum_deg : float
+        Reading resolution [°] (0: not on a grid).
+    tolerance_deg : float
+        Band within which an angle counts as held [°].
+    """
 
     moving: npt.NDArray[np.bool_]
     noise_arcsec: float

@@ -22,7 +22,7 @@ import numpy.typing as npt
 
 from thermocal import units
 from thermocal.defaults import MAX_SIMULATED_SAMPLES
-from thermocal.errors import ThermocalInputError
+from thermocal.errors import ParameterError
 from thermocal.recording import Metadata, Recording
 from thermocal.turntable import kinematics, model
 from thermocal.turntable.schedule import POSITIONS_16, build_schedule
@@ -44,6 +44,15 @@ class TurntableTruth:
     default is a navigation-grade triad whose xy misalignments have an antisymmetric
     part of 20″ (a rotation of the triad about the inner axis relative to the
     encoder zero, ``inner_axis_azimuth_arcsec``).
+
+    Attributes
+    ----------
+    bias_deg_h : tuple of 3 float
+        Biases [°/h].
+    scale_factor_ppm : tuple of 3 float
+        Scale-factor errors [ppm].
+    misalignment_arcsec : tuple of 6 float
+        Misalignments yx, zx, xy, zy, xz, yz [″].
     """
 
     bias_deg_h: tuple[float, float, float] = (0.02, -0.035, 0.015)
@@ -108,9 +117,10 @@ def _sampled_motion(
     tau = 1.0 / rate_hz
     wanted = sched.duration_s * rate_hz + 1.0
     if not wanted <= MAX_SIMULATED_SAMPLES:
-        raise ThermocalInputError(
+        raise ParameterError(
+            "rate_hz",
             f"rate_hz {rate_hz:g}: {wanted:.3g} samples over the {sched.duration_s:g} s "
-            f"schedule, above the limit of {MAX_SIMULATED_SAMPLES:.3g}: lower --rate-hz"
+            f"schedule, above the limit of {MAX_SIMULATED_SAMPLES:.3g}: lower {{name}}",
         )
     n = int(np.floor(sched.duration_s * rate_hz)) + 1
     t = np.arange(n, dtype=np.float64) * tau
@@ -142,26 +152,67 @@ def simulate_turntable16(
     beta0_deg: float = 0.0,
     positions_deg: tuple[tuple[float, float], ...] = POSITIONS_16,
 ) -> tuple[Recording, dict[str, Any]]:
-    """Simulate a 16-position turntable run with known truth.
+    r"""Simulate a 16-position turntable run with known truth.
 
-    Returns the recording (``time`` [s], ``gyro_x/y/z`` [°/s, mean rate over the
-    interval ending at each sample], ``alpha_deg``/``beta_deg`` [°, encoder angles
-    at the sample times, wrapped to [0, 360)]) and the JSON-ready truth dict
-    (``bias_deg_h``, ``scale_factor_ppm``, ``misalignment_arcsec``, ``error_matrix``,
-    ``inner_axis_azimuth_arcsec``, physical forms, ``latitude_deg``, ``seed``, …).
+    Parameters
+    ----------
+    seed : int, optional
+        Seed of the noise (default 0).
+    rate_hz : float, optional
+        Sample rate [Hz] (default 100).
+    dwell_s, settle_s : float, optional
+        Dwell at each position and settling after each move [s] (default 60 and 1).
+    move_rate_deg_s : float, optional
+        Table rate during the moves [°/s] (default 10).
+    latitude_deg : float, optional
+        Site latitude [°] (the earth rate; default 40).
+    arw_deg_sqrt_h : float, optional
+        Gyro angle random walk [°/√h] (default 0.003).
+    truth : TurntableTruth or None, optional
+        The triad's errors (default :class:`TurntableTruth`'s).
+    encoder_noise_arcsec : float, optional
+        Encoder reading noise σ [″] (default 0).
+    alpha0_deg, beta0_deg : float, optional
+        Encoder readings at the schedule's zero [°] (default 0).
+    positions_deg : tuple of (float, float), optional
+        The (α, β) positions [°] (default the sixteen of the source).
+
+    Returns
+    -------
+    rec : Recording
+        ``time`` [s], ``gyro_x/y/z`` [°/s, mean rate over the interval ending at each
+        sample], ``alpha_deg``/``beta_deg`` [°, encoder angles at the sample times,
+        wrapped to [0, 360)].
+    truth : dict
+        JSON-ready truth (``bias_deg_h``, ``scale_factor_ppm``, ``misalignment_arcsec``,
+        ``error_matrix``, ``inner_axis_azimuth_arcsec``, ``latitude_deg``, ``seed``, …).
+
+    Raises
+    ------
+    ValueError
+        ``rate_hz`` not positive.
+    thermocal.errors.ParameterError
+        More samples than :data:`MAX_SIMULATED_SAMPLES`.
+
+    Notes
+    -----
+    Each sample's gyro output, with :math:`\omega` the true body rate (table and earth):
+
+    .. math:: \omega_\mathrm{meas} = (I + E)\,\omega + b + n, \qquad
+              \sigma_n = \mathrm{ARW} / \sqrt{\tau}
+
+    References
+    ----------
+    - *A method for separating the combined error coefficients of a ring-laser gyro triad
+      based on dual-axis rotation*, Chinese invention patent CN104880182.
     """
     if rate_hz <= 0:
         raise ValueError("rate_hz must be positive")
     tr = truth if truth is not None else TurntableTruth()
     rng = np.random.default_rng(seed)
-    sched = build_schedule(
-        alpha0_deg=alpha0_deg,
-        beta0_deg=beta0_deg,
-        dwell_s=dwell_s,
-        move_rate_deg_s=move_rate_deg_s,
-        settle_s=settle_s,
-        positions_deg=positions_deg,
-    )
+    sched = build_schedule(alpha0_deg=alpha0_deg, beta0_deg=beta0_deg, dwell_s=dwell_s,
+                           move_rate_deg_s=move_rate_deg_s, settle_s=settle_s,
+                           positions_deg=positions_deg)  # fmt: skip
     tau = 1.0 / rate_hz
     n, t, a_deg, b_deg, omega_true = _sampled_motion(sched, rate_hz, latitude_deg)
     e_mat = tr.error_matrix
@@ -172,8 +223,31 @@ def simulate_turntable16(
     enc_sigma_deg = encoder_noise_arcsec * units.ARCSEC_TO_DEG
     a_enc = a_deg + rng.standard_normal(n) * enc_sigma_deg
     b_enc = b_deg + rng.standard_normal(n) * enc_sigma_deg
-    gyro_deg_s = omega_meas * units.RAD_TO_DEG
-    rec = Recording.from_arrays(
+    rec = _recording16(t, omega_meas * units.RAD_TO_DEG, a_enc, b_enc, tau, latitude_deg, seed)
+    settings = {
+        "latitude_deg": latitude_deg,
+        "seed": seed,
+        "rate_hz": rate_hz,
+        "dwell_s": dwell_s,
+        "move_rate_deg_s": move_rate_deg_s,
+        "arw_deg_sqrt_h": arw_deg_sqrt_h,
+        "encoder_noise_arcsec": encoder_noise_arcsec,
+        "duration_s": float(t[-1]),
+    }
+    return rec, _truth16(tr, settings)
+
+
+def _recording16(
+    t: FloatArray,
+    gyro_deg_s: FloatArray,
+    a_enc: FloatArray,
+    b_enc: FloatArray,
+    tau: float,
+    latitude_deg: float,
+    seed: int,
+) -> Recording:
+    """A run of :func:`simulate_turntable16` as a recording (encoders wrapped to [0, 360))."""
+    return Recording.from_arrays(
         t,
         signals={c: gyro_deg_s[:, k] for k, c in enumerate(GYRO_COLUMNS)},
         signal_unit="deg/s",
@@ -187,17 +261,14 @@ def simulate_turntable16(
             extra={"scenario": "turntable-16"},
         ),
     )
-    truth_dict: dict[str, Any] = {
+
+
+def _truth16(tr: TurntableTruth, settings: dict[str, Any]) -> dict[str, Any]:
+    """The JSON-ready truth of :func:`simulate_turntable16`: the errors, then ``settings``."""
+    return {
         "scenario": "turntable-16",
         **tr.to_dict(),
-        "latitude_deg": latitude_deg,
-        "seed": seed,
-        "rate_hz": rate_hz,
-        "dwell_s": dwell_s,
-        "move_rate_deg_s": move_rate_deg_s,
-        "arw_deg_sqrt_h": arw_deg_sqrt_h,
-        "encoder_noise_arcsec": encoder_noise_arcsec,
-        "duration_s": float(t[-1]),
+        **settings,
         "columns": {
             "time": "time",
             "gyro": list(GYRO_COLUMNS),
@@ -207,7 +278,6 @@ def simulate_turntable16(
         "constraint": "inner encoder zero exact (defines body x azimuth); "
         "inner_axis_azimuth_arcsec = (yx - xy)/2",
     }
-    return rec, truth_dict
 
 
 # --- several soaks: the error model over temperature ------------------------------------
@@ -317,6 +387,91 @@ def _thermal_truth(
     }
 
 
+def _kinematic(
+    positions: tuple[tuple[float, float], ...],
+    dwell_s: float,
+    move_rate_deg_s: float,
+    rate_hz: float,
+    latitude_deg: float,
+    g: float,
+) -> tuple[Any, ...]:
+    """The sampled schedule through ``positions``: samples, times [s], α, β [°], true body
+    rate [rad/s] and true specific force [m/s²]."""
+    sched = build_schedule(
+        dwell_s=dwell_s, move_rate_deg_s=move_rate_deg_s, positions_deg=positions
+    )
+    n, t, a_deg, b_deg, omega = _sampled_motion(sched, rate_hz, latitude_deg)
+    a, b = a_deg * units.DEG_TO_RAD, b_deg * units.DEG_TO_RAD
+    f = np.einsum("nji,j->ni", kinematics.mat_nb(a, b), np.array([0.0, 0.0, g]))
+    return n, t, a_deg, b_deg, omega, f
+
+
+def _thermal_outputs(
+    omega_true: FloatArray,
+    f_true: FloatArray,
+    temp: FloatArray,
+    rng: np.random.Generator,
+    gyro_sigma_rad_s: float,
+    accel_noise_mg: float,
+) -> tuple[FloatArray, FloatArray]:
+    """The gyro [rad/s] and accelerometer [m/s²] outputs with the thermal truth's errors at
+    each sample's temperature and white noise (the gyro's drawn first)."""
+    tg = thermal_theta(GYRO_THERMAL_TRUTH, temp)
+    ta = thermal_theta(ACCEL_THERMAL_TRUTH, temp)
+    e_g = model.error_matrices(tg)
+    e_a = model.error_matrices(ta)
+    n = omega_true.shape[0]
+    gyro = (
+        omega_true
+        + np.einsum("nij,nj->ni", e_g, omega_true)
+        + tg[:, 0:3] * units.DH_TO_RS
+        + rng.standard_normal((n, 3)) * gyro_sigma_rad_s
+    )
+    acc = (
+        f_true
+        + np.einsum("nij,nj->ni", e_a, f_true)
+        + ta[:, 0:3] * units.MG_TO_MS2
+        + rng.standard_normal((n, 3)) * accel_noise_mg * units.MG_TO_MS2
+    )
+    return gyro, acc
+
+
+def _thermal_recording(
+    t: FloatArray,
+    gyro: FloatArray,
+    acc: FloatArray,
+    temp: FloatArray,
+    encoders: tuple[FloatArray, FloatArray],
+    tau: float,
+    latitude_deg: float,
+    run: str,
+) -> Recording:
+    """One run of :func:`simulate_turntable_thermal` as a recording."""
+    return Recording.from_arrays(
+        t,
+        signals={c: gyro[:, k] * units.RAD_TO_DEG for k, c in enumerate(GYRO_COLUMNS)},
+        temperatures={"T_imu": temp},
+        signal_unit="deg/s",
+        other={
+            **{f"accel_{ax}": acc[:, k] for k, ax in enumerate("xyz")},
+            ALPHA_COLUMN: encoders[0],
+            BETA_COLUMN: encoders[1],
+        },
+        other_units={
+            **{f"accel_{ax}": "m/s^2" for ax in "xyz"},
+            ALPHA_COLUMN: "deg",
+            BETA_COLUMN: "deg",
+        },
+        meta=Metadata(
+            sample_interval_s=tau,
+            latitude_deg=latitude_deg,
+            run_id=f"turntable-thermal {run}",
+            notes="simulated 16-position run at a soak temperature (turntable-thermal)",
+            extra={"scenario": "turntable-thermal"},
+        ),
+    )
+
+
 def simulate_turntable_thermal(
     seed: int = 0,
     *,
@@ -332,27 +487,61 @@ def simulate_turntable_thermal(
     encoder_noise_arcsec: float = 0.0,
     drop_position: tuple[str, int] | None = None,
 ) -> list[tuple[Recording, dict[str, Any]]]:
-    """16-position runs at several soak temperatures plus a held-out run at an unseen one,
-    a gyro and an accelerometer triad whose every parameter follows
-    :data:`GYRO_THERMAL_TRUTH` / :data:`ACCEL_THERMAL_TRUTH` and is applied at each sample's
-    temperature; the soak drifts by ``drift_c`` during each run (a chamber that has not
-    quite settled).  Columns: ``time`` [s], ``gyro_x/y/z`` [°/s], ``accel_x/y/z`` [m/s²],
-    ``alpha_deg``/``beta_deg`` [°], ``T_imu`` [°C].  The truth of each run holds the
-    polynomials, the run's mean temperature and θ at it.  ``drop_position`` (label, index)
-    leaves one position out of that run (a run that missed a position)."""
+    r"""16-position runs at several soak temperatures plus a held-out run at an unseen one,
+    of a gyro and an accelerometer triad whose every parameter follows
+    :data:`GYRO_THERMAL_TRUTH` / :data:`ACCEL_THERMAL_TRUTH` at each sample's temperature;
+    the soak drifts by ``drift_c`` during each run (a chamber that has not quite settled).
 
-    def kinematic(positions: tuple[tuple[float, float], ...]) -> tuple[Any, ...]:
-        sched = build_schedule(
-            dwell_s=dwell_s, move_rate_deg_s=move_rate_deg_s, positions_deg=positions
-        )
-        n, t, a_deg, b_deg, omega = _sampled_motion(sched, rate_hz, latitude_deg)
-        a, b = a_deg * units.DEG_TO_RAD, b_deg * units.DEG_TO_RAD
-        f = np.einsum("nji,j->ni", kinematics.mat_nb(a, b), np.array([0.0, 0.0, g]))
-        return n, t, a_deg, b_deg, omega, f
+    Parameters
+    ----------
+    seed : int, optional
+        Seed of the noise (default 0).
+    soaks_c : tuple of float, optional
+        The soak temperatures [°C].
+    held_out_c : float, optional
+        The held-out run's soak [°C] (default 10).
+    drift_c : float, optional
+        Temperature drift across each run [°C] (default 1.5).
+    rate_hz : float, optional
+        Sample rate [Hz] (default 20).
+    dwell_s : float, optional
+        Dwell at each position [s] (default 60).
+    move_rate_deg_s : float, optional
+        Table rate during the moves [°/s] (default 10).
+    latitude_deg : float, optional
+        Site latitude [°] (earth rate and normal gravity; default 40).
+    arw_deg_sqrt_h : float, optional
+        Gyro angle random walk [°/√h] (default 0.01).
+    accel_noise_mg : float, optional
+        Accelerometer white noise per sample [mg] (default 0.05).
+    encoder_noise_arcsec : float, optional
+        Encoder reading noise σ [″] (default 0).
+    drop_position : tuple of (str, int) or None, optional
+        ``(label, index)``: that run misses that position (default none).
 
+    Returns
+    -------
+    list of (Recording, dict)
+        Each run: ``time`` [s], ``gyro_x/y/z`` [°/s], ``accel_x/y/z`` [m/s²],
+        ``alpha_deg``/``beta_deg`` [°], ``T_imu`` [°C]; and its truth (the polynomials, the
+        run's mean temperature and θ at it).
+
+    Notes
+    -----
+    With :math:`\theta(T)` of :func:`thermal_theta` at each sample's temperature:
+
+    .. math:: \omega_\mathrm{meas} = (I + E_g(T))\,\omega + b_g(T) + n_g, \qquad
+              f_\mathrm{meas} = (I + E_a(T))\,f + b_a(T) + n_a
+
+    References
+    ----------
+    - *A method for separating the combined error coefficients of a ring-laser gyro triad
+      based on dual-axis rotation*, Chinese invention patent CN104880182.
+    """
     tau = 1.0 / rate_hz
     g = units.normal_gravity_m_s2(latitude_deg)
-    full = kinematic(POSITIONS_16)
+    motion = (dwell_s, move_rate_deg_s, rate_hz, latitude_deg, g)
+    full = _kinematic(POSITIONS_16, *motion)
     runs = [(f"T{c:+g}", c) for c in soaks_c] + [(f"heldout_T{held_out_c:+g}", held_out_c)]
     ss = np.random.SeedSequence([int(seed), 19])
     out: list[tuple[Recording, dict[str, Any]]] = []
@@ -361,48 +550,17 @@ def simulate_turntable_thermal(
         n, t, a_deg, b_deg, omega_true, f_true = full
         if drop_position is not None and drop_position[0] == label:
             kept = tuple(pos for i, pos in enumerate(POSITIONS_16) if i != drop_position[1])
-            n, t, a_deg, b_deg, omega_true, f_true = kinematic(kept)
+            n, t, a_deg, b_deg, omega_true, f_true = _kinematic(kept, *motion)
         temp = soak + drift_c * (t / t[-1] - 0.5)
-        tg = thermal_theta(GYRO_THERMAL_TRUTH, temp)
-        ta = thermal_theta(ACCEL_THERMAL_TRUTH, temp)
-        e_g = model.error_matrices(tg)
-        e_a = model.error_matrices(ta)
         arw = arw_deg_sqrt_h * units.DEG_TO_RAD / np.sqrt(units.SECONDS_PER_HOUR)
-        gyro = (
-            omega_true
-            + np.einsum("nij,nj->ni", e_g, omega_true)
-            + tg[:, 0:3] * units.DH_TO_RS
-            + rng.standard_normal((n, 3)) * (arw / np.sqrt(tau))
-        )
-        acc = (
-            f_true
-            + np.einsum("nij,nj->ni", e_a, f_true)
-            + ta[:, 0:3] * units.MG_TO_MS2
-            + rng.standard_normal((n, 3)) * accel_noise_mg * units.MG_TO_MS2
+        gyro, acc = _thermal_outputs(
+            omega_true, f_true, temp, rng, arw / np.sqrt(tau), accel_noise_mg
         )
         enc = encoder_noise_arcsec * units.ARCSEC_TO_DEG
-        rec = Recording.from_arrays(
-            t,
-            signals={c: gyro[:, k] * units.RAD_TO_DEG for k, c in enumerate(GYRO_COLUMNS)},
-            temperatures={"T_imu": temp},
-            signal_unit="deg/s",
-            other={
-                **{f"accel_{ax}": acc[:, k] for k, ax in enumerate("xyz")},
-                ALPHA_COLUMN: np.mod(a_deg + rng.standard_normal(n) * enc, 360.0),
-                BETA_COLUMN: np.mod(b_deg + rng.standard_normal(n) * enc, 360.0),
-            },
-            other_units={
-                **{f"accel_{ax}": "m/s^2" for ax in "xyz"},
-                ALPHA_COLUMN: "deg",
-                BETA_COLUMN: "deg",
-            },
-            meta=Metadata(
-                sample_interval_s=tau,
-                latitude_deg=latitude_deg,
-                run_id=f"turntable-thermal seed {seed} {label}",
-                notes="simulated 16-position run at a soak temperature (turntable-thermal)",
-                extra={"scenario": "turntable-thermal"},
-            ),
+        alpha = np.mod(a_deg + rng.standard_normal(n) * enc, 360.0)
+        beta = np.mod(b_deg + rng.standard_normal(n) * enc, 360.0)
+        rec = _thermal_recording(
+            t, gyro, acc, temp, (alpha, beta), tau, latitude_deg, f"seed {seed} {label}"
         )
         truth = _thermal_truth(
             label, soak, float(np.mean(temp)), drift_c, g, latitude_deg, seed, rate_hz,

@@ -378,10 +378,24 @@ def _numbers(v: Any, path: str, n: int | None = None, *, min_len: int = 0) -> No
 def check_triad_dict(d: Any, where: str) -> None:
     """Check a triad model's file form before anything uses it.
 
-    Parameters: ``d`` the parsed JSON object; ``where`` the key-path prefix in errors.
-    Raises :class:`~thermocal.errors.ModelFileError` naming the key path (``where`` +
-    ``.parameters[0].coefficients``).
+    Parameters
+    ----------
+    d : Any
+        The parsed JSON object.
+    where : str
+        The key-path prefix in errors.
 
+    Returns
+    -------
+    None
+
+    Raises
+    ------
+    thermocal.errors.ModelFileError
+        Naming the key path (``where`` + ``.parameters[0].coefficients``).
+
+    Notes
+    -----
     Checked: the format tag and version, ``kind`` (gyro/accel), ``order`` (0…3), a finite
     ``tref_c`` inside or near (:func:`thermocal.models.schema.near_range`) a finite
     ``temperature_range_c`` ``[lo, hi]`` with lo < hi, the twelve parameters in θ's order
@@ -523,7 +537,7 @@ def check_conditioning(triad: TriadThermal, where: str) -> None:
 
 
 def check_tref(tref_c: float, lo: float, hi: float) -> None:
-    """Refuse (exit 2, naming ``--tref``) a reference temperature [°C] that the calibration
+    """Refuse (naming ``tref_c``) a reference temperature [°C] that the calibration
     file's reader would refuse (:func:`check_triad_dict`: finite, inside the soaks'
     range ``[lo, hi]`` or within :func:`thermocal.models.checks.range_margin` of it), before
     anything is fitted or written.

@@ -43,6 +43,19 @@ class FamilyCode:
     ``init`` — statements of ``<p>_init`` (``s`` and ``sample_interval_s`` in scope);
     ``update`` — statements of ``<p>_update`` ending in ``return``;
     ``defines`` — extra ``#define`` lines of the header; ``notes`` — comment lines.
+
+    Attributes
+    ----------
+    state_fields : list of str
+        C declarations of the state struct.
+    data : str
+        Definitions and helpers of the source file.
+    init, update : str
+        Statements of ``<p>_init`` and ``<p>_update``.
+    defines : list of str
+        Extra ``#define`` lines.
+    notes : list of str
+        Comment lines.
     """
 
     state_fields: list[str]
@@ -55,7 +68,27 @@ class FamilyCode:
 
 @dataclass(frozen=True)
 class CExport:
-    """A generated C module: ``header`` (``<prefix>.h``) and ``source`` (``<prefix>.c``)."""
+    """A generated C module: ``header`` (``<prefix>.h``) and ``source`` (``<prefix>.c``).
+
+    Attributes
+    ----------
+    prefix : str
+        The C identifier prefix of every name.
+    real : str
+        ``"double"`` or ``"float"``.
+    header, source : str
+        The text of ``<prefix>.h`` and ``<prefix>.c``.
+    family : str
+        The model family.
+    n_temps : int
+        Number of temperature inputs.
+    unit : str
+        Unit of the functions' signal and results.
+    model_unit : str
+        The model's own unit.
+    temperature_unit : str
+        Unit of the temperature inputs.
+    """
 
     prefix: str
     real: str
@@ -168,7 +201,19 @@ def write_together(files: Sequence[tuple[Path, str]]) -> None:
 
 @dataclass(frozen=True)
 class ExportContext:
-    """What a family generator gets: the model dict, the C prefix and helpers."""
+    """What a family generator gets: the model dict, the C prefix and helpers.
+
+    Attributes
+    ----------
+    model : dict
+        The model as saved.
+    prefix : str
+        The C identifier prefix.
+    real : str
+        ``"double"`` or ``"float"``.
+    rate_buffer_len : int
+        Length of the ring buffer of the rate terms.
+    """
 
     model: dict[str, Any]
     prefix: str

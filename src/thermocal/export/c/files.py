@@ -22,7 +22,23 @@ class ExportCResult:
     """What :func:`export_c_file` wrote.  ``kind``: ``"model"`` (one model file),
     ``"calibration"`` (channels; ``channels`` holds ``(name, unit, family)``) or
     ``"triads"`` (``triads`` holds ``(name, unit, columns)``).  ``float_error``: the float
-    build's worst-case error against double (a model with ``use_float`` and a compiler)."""
+    build's worst-case error against double (a model with ``use_float`` and a compiler).
+
+    Attributes
+    ----------
+    kind : str
+        ``"model"``, ``"calibration"`` or ``"triads"``.
+    export : CExport
+        The generated module.
+    files : tuple of Path
+        The files written.
+    channels : tuple of (str, str, str)
+        ``(name, unit, family)`` of each channel of a calibration.
+    triads : tuple of (str, str, tuple of str)
+        ``(name, unit, columns)`` of each triad.
+    float_error : FloatError or None
+        The float build's worst-case error against double.
+    """
 
     kind: str
     export: CExport

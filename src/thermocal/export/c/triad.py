@@ -8,8 +8,8 @@ calibrated range, every parameter a polynomial in ``T − TREF`` (Horner), ``E``
 determinant (no allocation, no library call; ``I + E`` is within 10⁻³ of the identity, so
 the determinant is near 1).  Matches :func:`thermocal.turntable.thermal.correct`.
 
-A triad calibrated on raw counts (``multipos --accel-scale/--gyro-scale``) takes
-``x`` in its physical unit all the same; the header defines the count scale
+A triad calibrated on raw counts (``accel_scale``/``gyro_scale`` of the multi-position
+calibration) takes ``x`` in its physical unit all the same; the header defines the count scale
 ``<P>_<TRIAD>_COUNT_SCALE`` (one count in that unit) and states the conversion
 ``x = <P>_<TRIAD>_COUNT_SCALE · counts`` that the caller applies to the raw registers first,
 as :func:`thermocal.pipeline.compensate.compensate_triads` does.
@@ -69,7 +69,8 @@ def _triad_code(p: str, tri: Any, bias_to_data: float, real: str, ident: str) ->
         "    int k, j;",
         "    for (k = 0; k < 12; ++k) {",
         f"        double acc = {P}_COEF[k][{order - 1}];",
-        f"        for (j = {order - 2}; j >= 0; --j) acc = acc * dt + {P}_COEF[k][j];",
+        f"        for (j = {order - 2}; j >= 0; --j) acc = acc * dt"  # cli-words: C's --j
+        f" + {P}_COEF[k][j];",
         "        th[k] = acc;",
         "    }",
         "    m[0][0] = 1.0 + th[3] * 1e-6;",
