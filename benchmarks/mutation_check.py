@@ -3488,6 +3488,30 @@ MUTANTS: tuple[Mutant, ...] = (
         ("tests/readers/test_readers_writers_registry.py",),
         "a recording written as CSV under a .ulg or .bin name",
     ),
+    Mutant(
+        "fit-param-given-twice-taken",
+        P + "cli/fit_cmd.py",
+        "        if name in out or given.get(name) is not None:",
+        "        if name in out:",
+        _t("fit_param"),
+        "--order 2 --param order=2: the option set twice, one value silently kept",
+    ),
+    Mutant(
+        "fit-param-bounds-unchecked",
+        P + "cli/fit_cmd.py",
+        "out[name] = declared[name].check(_param_text(declared[name], value))",
+        "out[name] = _param_text(declared[name], value)",
+        _t("fit_param"),
+        "a --param value out of its declared bounds not refused as --param",
+    ),
+    Mutant(
+        "fit-param-no-is-yes",
+        P + "cli/fit_cmd.py",
+        '"no": False,',
+        '"no": True,',
+        _t("fit_param"),
+        "--param per_run_offset=no read as yes",
+    ),
 )
 
 

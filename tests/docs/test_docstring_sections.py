@@ -30,7 +30,6 @@ PENDING: set[str] = {
     "pipeline/compensate.py::TriadCompensation",
     "pipeline/fit.py::FitResult",
     "pipeline/fit.py::FittedChannel",
-    "pipeline/options.py::ValidateOptions",
     "pipeline/validate.py::ChannelValidation",
     "pipeline/validate.py::ValidationReport",
 }

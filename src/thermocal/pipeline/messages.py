@@ -174,6 +174,10 @@ OPTION_OF: dict[str, str] = {
     "gravity_m_s2": "--gravity",
     "alpha_column": "--alpha",
     "beta_column": "--beta",
+    "params": "--param",
+    "rate_c_per_min": "--rate",
+    "cycle_rate_c_per_min": "--cycle-rate",
+    "rates_c_per_min": "--rates",
 }
 """Library parameters whose command-line option is not the parameter's name with dashes
 (``time_unit`` → ``--time-unit`` needs no entry)."""
