@@ -11,7 +11,7 @@ Usage::
 Data: :func:`bench_fit.make_data` (10⁷ samples at 1 s, four lagged temperature sensors,
 seed000-shaped truth) and five more channels on the same temperatures with other
 coefficients and noise.  Fit: the 37-term ``poly`` (seed000) — one channel by
-``PolyModel.fit``, six by :func:`thermocal.models.poly.fit_shared`, and six one after the
+``PolyModel.fit``, six by :func:`thermocal.models.poly_fit.fit_shared`, and six one after the
 other (what a fit per channel costs).  File: a Parquet file with the time, the four
 temperatures and six signals; ``compensate_channels`` Parquet → Parquet with one channel
 and with six.
@@ -33,7 +33,8 @@ import pandas as pd
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from bench_fit import make_data
-from thermocal.models.poly import PolyModel, fit_shared
+from thermocal.models.poly import PolyModel
+from thermocal.models.poly_fit import fit_shared
 from thermocal.models.rundata import RunData
 from thermocal.pipeline.compensate import compensate_channels
 from thermocal.readers.options import ReadOptions

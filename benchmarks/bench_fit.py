@@ -31,7 +31,7 @@ import numpy as np
 
 from thermocal.models import RunData
 from thermocal.models.poly import PolyModel
-from thermocal.models.terms import backward_rates
+from thermocal.preprocess import backward_rates
 
 
 def make_data(n: int, seed: int = 0) -> RunData:

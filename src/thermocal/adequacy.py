@@ -2,23 +2,23 @@
 
 A temperature calibration is only as good as the sweep it was fitted on.  Before a fit,
 :func:`judge` measures what the recording offers against what the model needs and returns
-an :class:`Adequacy` record: each test's figure, threshold and verdict.  ``fit``,
-``px4-tempcal``, ``ardupilot-tempcal``, ``turntable`` (over temperature) and ``fleet``
-(through ``fit``) call it; the record is stored in the model file (key ``adequacy``) and
-printed with ``--json``; ``export-params`` and ``export-c`` refuse a calibration whose
-record failed without an override (:func:`check_for_firmware`).
+an :class:`Adequacy` record: each test's figure, threshold and verdict.  The fits of
+thermocal (a chamber fit, PX4's and ArduPilot's temperature calibrations, a turntable over
+temperature, a production batch) call it; the record is stored in the model file (key
+``adequacy``) and in the fit's JSON result; firmware parameters and C export refuse a
+calibration whose record failed without an override (:func:`check_for_firmware`).
 
 The tests (figures over every run of a channel together):
 
 ``samples_per_coefficient``
     n / p, the samples per fitted coefficient.  n ≤ p cannot be fitted (refused, no
     override); n / p < :data:`MIN_SAMPLES_PER_COEFFICIENT` is refused unless
-    ``--allow-narrow``.
+    ``allow_narrow``.
 ``temperature_span``
     The span of each temperature column between its 0.1 and 99.9 percentiles [°C] (a
     few spikes do not make a range) against :data:`MIN_SPAN_PER_ORDER_C` × the model's
     polynomial order in T: a cubic over 0.3 °C extrapolates its own noise (the constant
-    of such a fit was 5e8 °/h).  ``--allow-narrow`` overrides.
+    of such a fit was 5e8 °/h).  ``allow_narrow`` overrides.
 ``distinct_temperatures``
     Occupied temperature bins (``max(span / 20, 0.1 °C)`` wide, at least
     :data:`MIN_SAMPLES_PER_BIN` samples each) against order + 1: fewer cannot determine
@@ -30,14 +30,14 @@ The tests (figures over every run of a channel together):
 ``rate_range``
     Models with Ṫ terms: the span of Ṫ [°C/min] (1–99 percentiles, Ṫ over
     :data:`RATE_INTERVAL_S`) against :data:`MIN_RATE_SPAN_C_PER_MIN`; a sweep at one rate
-    cannot separate Ṫ terms from the constant.  ``--allow-narrow`` overrides.
+    cannot separate Ṫ terms from the constant.  ``allow_narrow`` overrides.
 ``stillness``
     Motion told from thermal drift (:func:`stillness`): one-second block means against a
     running median over :data:`STILL_WINDOW_S` (slow thermal drift follows the median,
     a bump or a turn does not), judged against the sensor's own noise (the scatter within
     the blocks) and an absolute floor (:data:`MOTION_FLOOR_DEG_S`, :data:`MOTION_FLOOR_MG`).
     Moving more than :data:`MAX_MOVING_SHARE` of the time (a flight log) is refused unless
-    ``--allow-motion``; shorter episodes are named with their times in a warning.
+    ``allow_motion``; shorter episodes are named with their times in a warning.
 ``firmware_minimum``
     The firmware's own minimum sweep (ArduPilot's learning requires
     :data:`ARDUPILOT_MIN_SPAN_C` °C).
@@ -64,14 +64,14 @@ import numpy as np
 import numpy.typing as npt
 
 from thermocal.defaults import ALLOW_MOTION, ALLOW_NARROW, overrides_of
-from thermocal.errors import ThermocalInputError, ThermocalWarning
+from thermocal.errors import ThermocalInputError, ThermocalWarning, spell_parameters
 from thermocal.recording import all_finite
 
 FloatArray = npt.NDArray[np.float64]
 
 
 MIN_SAMPLES_PER_COEFFICIENT = 10.0
-"""Fewest samples per fitted coefficient accepted without ``--allow-narrow``."""
+"""Fewest samples per fitted coefficient accepted without ``allow_narrow``."""
 MIN_SPAN_PER_ORDER_C = 5.0
 """Temperature span needed per polynomial order [°C]: a line 5 °C, a cubic 15 °C."""
 N_SPAN_BINS = 20
@@ -94,7 +94,7 @@ motion [mg] (about 1.1° of tilt)."""
 ROTATING_DEG_S = 20.0
 """A gyro whose median rate exceeds this is turning, not drifting [°/s]."""
 MAX_MOVING_SHARE = 0.02
-"""Moving more than this share of the time is refused without ``--allow-motion``."""
+"""Moving more than this share of the time is refused without ``allow_motion``."""
 ARDUPILOT_MIN_SPAN_C = 10.0
 """ArduPilot's temperature-calibration learning needs at least this sweep [°C]."""
 DEG_H_PER_DEG_S = 3600.0
@@ -117,9 +117,15 @@ class AdequacyTest:
     verdict : str
         ``"pass"``, ``"warn"``, ``"fail"`` or ``"n/a"``.
     override : str or None
-        The option that overrides a failure; None: it cannot be overridden.
+        The override that allows a failure (:data:`ALLOW_NARROW`, :data:`ALLOW_MOTION`, as
+        a model file records it; the parameter of that name allows it: ``allow_narrow``); None:
+        it cannot be overridden.
     message : str
-        One line for the user.
+        One line for the user: a template with ``{parameter}`` for each of ``parameters``.
+    parameters : tuple of str, optional
+        The library parameters ``message`` names (``str()`` of the refusal shows their
+        names, the command line its options; :meth:`NamesParameters.naming
+        <thermocal.errors.NamesParameters.naming>`).  Default none.
     """
 
     name: str
@@ -129,6 +135,7 @@ class AdequacyTest:
     verdict: str
     override: str | None
     message: str
+    parameters: tuple[str, ...] = ()
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready dict (non-finite figures → None)."""
@@ -143,7 +150,7 @@ class AdequacyTest:
             "unit": self.unit,
             "verdict": self.verdict,
             "override": self.override,
-            "message": self.message,
+            "message": spell_parameters(self.message, self.parameters),
         }
 
 
@@ -228,26 +235,37 @@ class Adequacy:
         """
         refused = self.refused
         if refused:
-            hints = sorted({t.override for t in refused if t.override})
+            hints = sorted({_parameter_of(t.override) for t in refused if t.override})
             hint = (
-                f" (to fit anyway, knowingly: {' '.join(hints)})"
+                " (to fit anyway, knowingly: " + " ".join(f"{{{h}}}" for h in hints) + ")"
                 if hints and all(t.override for t in refused)
                 else ""
             )
-            raise ThermocalInputError(
-                "the data cannot support this fit: " + "; ".join(t.message for t in refused) + hint
+            raise ThermocalInputError.naming(
+                "the data cannot support this fit: " + "; ".join(t.message for t in refused) + hint,
+                *dict.fromkeys(
+                    [*(p for t in refused for p in t.parameters), *(hints if hint else ())]
+                ),
             )
         for t in self.failed:
+            allow = _parameter_of(t.override or "")
             warnings.warn(
-                f"{t.message} — fitted anyway ({t.override}): do not trust this "
-                "calibration beyond what the data cover",
-                ThermocalWarning,
+                ThermocalWarning.naming(
+                    f"{t.message} — fitted anyway ({{{allow}}}): do not trust this "
+                    "calibration beyond what the data cover",
+                    *dict.fromkeys((*t.parameters, allow)),
+                ),
                 stacklevel=2,
             )
         for t in self.tests:
             if t.verdict == "warn":
-                warnings.warn(t.message, ThermocalWarning, stacklevel=2)
+                warnings.warn(ThermocalWarning.naming(t.message, *t.parameters), stacklevel=2)
         return self
+
+
+def _parameter_of(override: str) -> str:
+    """The parameter that allows an override as a model file records it (``allow_narrow``)."""
+    return override.lstrip("-").replace("-", "_")
 
 
 def from_dict(d: Any) -> dict[str, Any] | None:

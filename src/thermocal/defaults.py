@@ -1,6 +1,6 @@
 """Defaults and names the command line shows in its help, kept free of numpy.
 
-``thermocal --help`` registers every command without importing the maths: the
+The command line's help registers every command without importing the maths: the
 values a command's help or defaults show live here, and the modules that use them import them
 from here (one definition each)."""
 
@@ -28,11 +28,11 @@ POSE_MOTION_FRACTION: Final = 0.01
 POSE_DRIFT_DEG: Final = 2.0
 """``thermocal multipos``'s pose detector (:func:`thermocal.multipos.poses.find_poses`):
 variance window [s], still limit in noise variances and in the motions' variance, the
-largest turn across a pose [°] (``--window-s``, ``--still-threshold``,
-``--motion-fraction``, ``--drift-deg``)."""
+largest turn across a pose [°] (parameters ``window_s``, ``still_threshold``,
+``motion_fraction``, ``drift_deg``)."""
 
 DEFAULT_GYRO_COLUMNS: Final = ("gyro_x", "gyro_y", "gyro_z")
-"""Gyro columns of a turntable recording (``thermocal turntable --gyro``)."""
+"""Gyro columns of a turntable recording (``gyro_columns`` of the turntable calibration)."""
 
 SCENARIO_NAMES: Final = (
     "rlg-modelling",
@@ -52,10 +52,12 @@ PROGRAM_SETPOINT: Final = "setpoint_c"
 """Columns of a chamber program CSV (:func:`thermocal.readers.program.read_program`)."""
 
 
-ALLOW_NARROW: Final = "--allow-narrow"
-"""The override of the adequacy tests of the sweep (span, samples, Ṫ range)."""
-ALLOW_MOTION: Final = "--allow-motion"
-"""The override of the adequacy test of stillness."""
+ALLOW_NARROW: Final = "--allow-narrow"  # cli-words: the override as model files record it
+"""The override of the adequacy tests of the sweep (span, samples, Ṫ range), as a model file
+records it (parameter ``allow_narrow``)."""
+ALLOW_MOTION: Final = "--allow-motion"  # cli-words: the override as model files record it
+"""The override of the adequacy test of stillness, as a model file records it (parameter
+``allow_motion``)."""
 
 
 def overrides_of(allow_narrow: bool, allow_motion: bool) -> tuple[str, ...]:
@@ -64,19 +66,20 @@ def overrides_of(allow_narrow: bool, allow_motion: bool) -> tuple[str, ...]:
     Parameters
     ----------
     allow_narrow : bool
-        Whether the sweep's adequacy tests were overridden (``--allow-narrow``).
+        Whether the sweep's adequacy tests were overridden.
     allow_motion : bool
-        Whether the stillness test was overridden (``--allow-motion``).
+        Whether the stillness test was overridden.
 
     Returns
     -------
     tuple of str
-        The options given, in that order.
+        The overrides given, in that order, as a model file records them
+        (:data:`ALLOW_NARROW`, :data:`ALLOW_MOTION`).
 
     Examples
     --------
-    >>> overrides_of(True, False)
-    ('--allow-narrow',)
+    >>> overrides_of(True, False) == (ALLOW_NARROW,)
+    True
     """
     return tuple(o for o, on in ((ALLOW_NARROW, allow_narrow), (ALLOW_MOTION, allow_motion)) if on)
 
@@ -85,6 +88,6 @@ MAX_SIMULATED_SAMPLES: Final = 20_000_000
 """The most samples one call of a simulator makes (duration × rate, summed over the files
 it writes): 2e7 samples, about 1.6 GB of float64 over the ~10 arrays a scenario builds
 (the built-in programs at their own rates hold ≤ 2.4e5).  More is refused before any
-array is allocated: ``simulate --rate-hz 1e9`` asked for 1.66 PiB and ended in a
+array is allocated: a simulation at ``rate_hz`` = 1e9 asked for 1.66 PiB and ended in a
 MemoryError.  Shared by the chamber scenarios, the turntable and the multi-position
 simulators."""

@@ -4,7 +4,7 @@ A model family is a class of :mod:`thermocal.models` (the maths); what the rest 
 asks of it — its name, its fit options with their bounds and help texts, what it needs of
 the data, whether firmware can run it — is a :class:`FamilyDeclaration` the class carries as
 ``declaration``.  The declarations of the built-in families live here so that
-``thermocal fit --help`` can show every option without importing numpy; the class points to
+the ``fit`` command's help can show every option without importing numpy; the class points to
 its declaration, and :data:`BUILTIN_FAMILIES` is the one registration line of each built-in
 family (:mod:`thermocal.models.registry` imports the classes from it).  A family from
 another package declares itself on its class and registers through the entry-point group
@@ -16,8 +16,8 @@ Examples
 >>> MODEL_FAMILIES
 ('poly', 'piecewise', 'warmup', 'bank')
 >>> order = next(o for o in BUILTIN_FAMILIES[0].options if o.name == "order")
->>> order.check(3), order.cli
-(3, '--order')
+>>> order.check(3), order.kind
+(3, 'int')
 """
 
 from __future__ import annotations
@@ -76,11 +76,11 @@ class FamilyOption:
         The values a ``"str"`` option takes (empty: any).
     option : str, optional
         The command line's name without dashes, when it is not ``name``
-        (``rate_interval_s`` → ``rate_interval``, shown ``--rate-interval``).
+        (``rate_interval_s`` → ``rate_interval``, shown with dashes).
     switch : str, optional
-        A choice given on the command line as a flag ``--NAME`` with a second option
-        ``--SWITCH`` choosing the value (``--select --select-method holdout``); the first
-        choice is the default.
+        A choice given on the command line as a flag (``NAME``) with a second option
+        (``SWITCH``) choosing the value (``select`` with ``select_method`` ``holdout``); the
+        first choice is the default.
     """
 
     name: str
@@ -100,7 +100,7 @@ class FamilyOption:
 
     @property
     def cli(self) -> str:
-        """The command-line option (``--rate-interval``)."""
+        """The option of the ``fit`` command: :attr:`field` with dashes, two in front."""
         return "--" + self.field.replace("_", "-")
 
     def check(self, value: Any) -> Any:
@@ -174,7 +174,7 @@ class FamilyDeclaration:
     Parameters
     ----------
     name : str
-        The family's name (``thermocal fit --model NAME``, the model file's ``family``).
+        The family's name (the ``model`` of a fit, the model file's ``family``).
     model_class : str
         Where the class is, ``"module:Class"`` (imported only when the family is used).
     summary : str
@@ -218,7 +218,7 @@ class FamilyDeclaration:
         raise KeyError(name)
 
 
-_ORDER = "T, …, T^order per temperature, instead of --terms"
+_ORDER = "T, …, T^order per temperature, instead of --terms"  # cli-words: the command's help
 _PER_RUN = "one turn-on offset per run (nuisance parameters)"
 
 POLY: Final = FamilyDeclaration(
@@ -320,7 +320,7 @@ BANK: Final = FamilyDeclaration(
 """``bank``: :class:`thermocal.models.bank.BankModel`."""
 
 BUILTIN_FAMILIES: Final = (POLY, PIECEWISE, WARMUP, BANK)
-"""The built-in families, one registration each, in the order ``thermocal fit --help``
+"""The built-in families, one registration each, in the order the ``fit`` command's help
 lists them."""
 
 MODEL_FAMILIES: Final = tuple(f.name for f in BUILTIN_FAMILIES)

@@ -3,7 +3,7 @@
 A static accelerometer triad reads the specific force of gravity plus its bias:
 ``f = g·u + b(T)`` [mg], ``u`` the unit vector of "up" in the body frame, ``g`` the local
 gravity (WGS-84 normal gravity, :func:`thermocal.units.normal_gravity_m_s2`, or given).
-``fit --gravity-axis`` removes ``g·u_i`` from each axis as a known input, so that the fitted
+A fit given ``gravity_axis`` removes ``g·u_i`` from each axis as a known input, so that the fitted
 model is the bias alone and compensation keeps gravity.
 
 **The direction is measured, not assumed.**  A bench is never exactly level: a board tilted
@@ -58,7 +58,7 @@ from 0 (lone channels) or the triad's magnitude from g, before the orientation i
 PLACEMENT_TOLERANCE_DEG = 5.0
 """Runs whose mean gravity directions agree within this angle [°] are one placement."""
 NO_GRAVITY_MG = 500.0
-"""Without ``--gravity-axis``, an accelerometer whose mean exceeds this [mg] has gravity in
+"""Without ``gravity_axis``, an accelerometer whose mean exceeds this [mg] has gravity in
 its data (said in a warning)."""
 AXES = ("x", "y", "z")
 
@@ -216,9 +216,13 @@ def local_gravity_m_s2(
     if latitude is not None:
         return units.normal_gravity_m_s2(latitude)
     warnings.warn(
-        f"--gravity-axis without --gravity or --latitude: assuming standard gravity "
-        f"{units.STANDARD_GRAVITY_M_S2} m/s² (local gravity differs by up to 0.3 %)",
-        ThermocalWarning,
+        ThermocalWarning.naming(
+            f"{{gravity_axis}} without {{gravity}} or {{latitude}}: assuming standard gravity "
+            f"{units.STANDARD_GRAVITY_M_S2} m/s² (local gravity differs by up to 0.3 %)",
+            "gravity_axis",
+            "gravity",
+            "latitude",
+        ),
         stacklevel=3,
     )
     return units.STANDARD_GRAVITY_M_S2
@@ -482,12 +486,15 @@ def _warn_lone_channel(
         )
     if run == 0:
         warnings.warn(
-            f"--gravity-axis {gravity_axis}: {name} is fitted without the other axes of its "
-            "accelerometer triad, so the gravity direction is unknown: its known input "
-            f"assumes {gravity_axis} exactly up ({g_mg:+.1f} mg) and a tilt's share of gravity "
-            "stays in the model's constant; export-params writes no absolute accelerometer "
-            "offset from it (fit x, y and z together to measure the direction)",
-            ThermocalWarning,
+            ThermocalWarning.naming(
+                f"{{gravity_axis}} {gravity_axis}: {name} is fitted without the other axes of "
+                "its accelerometer triad, so the gravity direction is unknown: its known input "
+                f"assumes {gravity_axis} exactly up ({g_mg:+.1f} mg) and a tilt's share of "
+                "gravity stays in the model's constant; export-params writes no absolute "
+                "accelerometer offset from it (fit x, y and z together to measure the "
+                "direction)",
+                "gravity_axis",
+            ),
             stacklevel=3,
         )
 
@@ -542,10 +549,13 @@ def channel_gravity(
         mean = _finite_mean(values_mg, path, name)
         if abs(mean) > NO_GRAVITY_MG:
             warnings.warn(
-                f"{path}: {name} reads {mean:.1f} mg on average: gravity is in the data; "
-                "without --gravity-axis the model's constant holds it and compensation "
-                f"takes it out ({name}_comp ≈ 0); give --gravity-axis (the axis pointing up)",
-                ThermocalWarning,
+                ThermocalWarning.naming(
+                    f"{path}: {name} reads {mean:.1f} mg on average: gravity is in the data; "
+                    "without {gravity_axis} the model's constant holds it and compensation "
+                    f"takes it out ({name}_comp ≈ 0); give {{gravity_axis}} (the axis pointing "
+                    "up)",
+                    "gravity_axis",
+                ),
                 stacklevel=2,
             )
         return GravityInput(0.0)

@@ -1,6 +1,6 @@
 """The one gate between names from files or options and generated code.
 
-A column, channel, temperature or triad name, a ``--name`` prefix or a string field of a
+A column, channel, temperature or triad name, a module prefix (``name``) or a string field of a
 model file can hold anything: ``*/``, a newline followed by ``#error``, a backslash that
 splices the next line, a trigraph ``??/``, quotes, non-ASCII text, a C keyword, 300
 characters.  Everything thermocal writes into C passes through one of these functions:
@@ -38,7 +38,7 @@ hash of the whole original, so two long names that differ only at the end stay d
 
 MAX_PREFIX_LEN = 2 * MAX_IDENTIFIER_LEN + 1
 """Longest prefix of a generated module: a calibration's ``<prefix>_<channel>``, two
-identifiers of the gate joined by ``_`` (a longer ``--name`` is shortened as above)."""
+identifiers of the gate joined by ``_`` (a longer ``name`` is shortened as above)."""
 
 _HASH_LEN = 8
 

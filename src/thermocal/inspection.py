@@ -8,7 +8,7 @@ range and NaN count, temperature span, spikes (Hampel test) and the problems of
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -64,7 +64,18 @@ def saturated_mask(x: npt.ArrayLike) -> npt.NDArray[np.bool_]:
     in a row (a wrapping counter passes it once); else the stretches where the column sits
     on its maximum or minimum for :data:`RAIL_RUN` samples or more, entered or left by a
     step :data:`RAIL_STEP` times its median step, more than 0.4 of the range from the
-    median."""
+    median.
+
+    Parameters
+    ----------
+    x : array_like
+        One column's samples.
+
+    Returns
+    -------
+    numpy.ndarray of bool
+        True where a sample sits on a rail.
+    """
     a = np.asarray(x, dtype=np.float64)
     out = np.zeros(a.shape, dtype=bool)
     fin = a[np.isfinite(a)]
@@ -92,7 +103,25 @@ def saturated_mask(x: npt.ArrayLike) -> npt.NDArray[np.bool_]:
 
 @dataclass(frozen=True)
 class ColumnSummary:
-    """Range and NaN count of one column (in its own unit)."""
+    """Range and NaN count of one column (in its own unit).
+
+    Attributes
+    ----------
+    name : str
+        The column.
+    role : str
+        ``"signal"``, ``"temperature"`` or ``"other"``.
+    unit : str
+        Its unit.
+    min, max, mean : float or None
+        Its smallest, largest and mean finite values [``unit``] (None: none finite).
+    n_nan : int
+        Number of NaN cells.
+    first_nan_row : int or None
+        The first of them (0-based data row).
+    n_spikes : int
+        Samples found as spikes.
+    """
 
     name: str
     role: str
@@ -110,7 +139,35 @@ class ColumnSummary:
 
 @dataclass(frozen=True)
 class Inspection:
-    """Summary of a recording (the keys of ``inspect --json``)."""
+    """Summary of a recording (the keys of the ``inspect`` command's JSON output).
+
+    Attributes
+    ----------
+    file : str
+        The recording.
+    n_samples : int
+        Number of samples.
+    duration_s : float or None
+        Last minus first time [s].
+    sample_rate_hz : float or None
+        Sample rate [Hz].
+    median_interval_s : float or None
+        Median time step [s].
+    gaps : list of dict
+        The gaps in time.
+    n_segments : int or None
+        Gap-free stretches.
+    columns : dict of str to ColumnSummary
+        Each column's summary.
+    temperature_span : dict
+        [min, max] [°C] per temperature column.
+    problems : list of Problem
+        What is wrong with the recording.
+    time_ok : bool
+        Time is finite and strictly increasing.
+    timestamp_jitter : TimeJitter or None
+        The scatter of the time steps.
+    """
 
     file: str
     n_samples: int
@@ -136,7 +193,19 @@ class Inspection:
         """Problems that stop the other commands (severity ``error``)."""
         return [p for p in self.problems if p.severity == "error"]
 
-    def to_dict(self) -> dict[str, Any]:
+    def to_dict(self, spell: Callable[[str], str] | None = None) -> dict[str, Any]:
+        """JSON-ready dict; each problem's message names parameters as ``spell`` shows them
+        (:meth:`thermocal.recording.Problem.text`: their own names without it).
+
+        Parameters
+        ----------
+        spell : callable, optional
+            What to show for a parameter (the command line: its option).
+
+        Returns
+        -------
+        dict
+        """
         return {
             "file": self.file,
             "n_samples": self.n_samples,
@@ -148,7 +217,7 @@ class Inspection:
             "n_segments": self.n_segments,
             "columns": {k: v.to_dict() for k, v in self.columns.items()},
             "temperature_span": self.temperature_span,
-            "problems": [p.to_dict() for p in self.problems],
+            "problems": [p.to_dict(spell) for p in self.problems],
             "time_ok": self.time_ok,
             "usable": not self.fatal,
             "timestamp_jitter": (

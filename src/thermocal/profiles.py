@@ -110,9 +110,13 @@ class Ramp:
             )
         lo, hi = RAMP_RATE_RANGE
         if not lo <= abs(self.rate_c_per_min) <= hi:
-            raise ThermocalInputError(
-                f"ramp rate {self.rate_c_per_min:g} °C/min (--rate, --cycle-rate, --rates): "
-                f"a chamber ramps at {lo:g} to {hi:g} °C/min; give a rate in that range"
+            raise ThermocalInputError.naming(
+                f"ramp rate {self.rate_c_per_min:g} °C/min ({{rate_c_per_min}}, "
+                f"{{cycle_rate_c_per_min}}, {{rates_c_per_min}}): a chamber ramps at {lo:g} to "
+                f"{hi:g} °C/min; give a rate in that range",
+                "rate_c_per_min",
+                "cycle_rate_c_per_min",
+                "rates_c_per_min",
             )
 
 
@@ -843,7 +847,7 @@ class CorrelationResult:
     r_limit: float = WEAK_CORRELATION_LIMIT
 
     def to_dict(self) -> dict[str, Any]:
-        """The result as plain Python values, as ``thermocal profile correlate --json``
+        """The result as plain Python values, as the ``profile correlate`` command's JSON
         prints it (before the columns' names): ``r``, ``weakly_correlated``, ``r_limit``,
         ``n`` and ``duration_s`` [s]."""
         return {
@@ -858,7 +862,7 @@ class CorrelationResult:
 def program_summary(
     profile: Profile, time_s: npt.ArrayLike, setpoint_c: npt.ArrayLike, file: str
 ) -> dict[str, Any]:
-    """What ``thermocal profile NAME --json`` prints of a written chamber program.
+    """What the ``profile`` command's JSON prints of a written chamber program.
 
     Parameters
     ----------

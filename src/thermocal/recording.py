@@ -33,6 +33,7 @@ from thermocal.errors import (
     TimestampError,
     TimestampWarning,
     UnitError,
+    spell_parameters,
 )
 
 META_KEY = "thermocal"
@@ -172,6 +173,15 @@ class Gap:
 
     ``start_s`` is the time of the last sample before the gap (elapsed from the
     first sample when reported by ``inspect``).
+
+    Attributes
+    ----------
+    index : int
+        The sample before the gap.
+    start_s : float
+        Time of that sample [s].
+    length_s : float
+        Time between the two samples [s].
     """
 
     index: int
@@ -185,6 +195,23 @@ class Problem:
 
     ``severity`` is ``"error"`` (results would be wrong) or ``"warning"``.
     ``row`` is the 0-based data row (not counting the header), when one is at fault.
+    ``message`` writes each of ``parameters`` (the library's parameters it names, such as
+    ``rate_hz``) as ``{parameter}``; :meth:`text` shows them.
+
+    Attributes
+    ----------
+    kind : str
+        What kind of problem (a short key).
+    message : str
+        The message, with ``{parameter}`` for each of ``parameters``.
+    severity : {"error", "warning"}
+        Whether results would be wrong.
+    column : str or None
+        The column at fault.
+    row : int or None
+        The 0-based data row at fault.
+    parameters : tuple of str
+        The library's parameters the message names.
     """
 
     kind: str
@@ -192,10 +219,38 @@ class Problem:
     severity: Literal["error", "warning"] = "error"
     column: str | None = None
     row: int | None = None
+    parameters: tuple[str, ...] = ()
 
-    def to_dict(self) -> dict[str, Any]:
-        """JSON-ready dict of the set fields."""
-        return {k: v for k, v in dataclasses.asdict(self).items() if v is not None}
+    def text(self, spell: Callable[[str], str] | None = None) -> str:
+        """The message with each parameter as ``spell(parameter)`` (its own name without).
+
+        Parameters
+        ----------
+        spell : callable, optional
+            What to show for a parameter (the command line: its option).
+
+        Returns
+        -------
+        str
+        """
+        return spell_parameters(self.message, self.parameters, spell)
+
+    def to_dict(self, spell: Callable[[str], str] | None = None) -> dict[str, Any]:
+        """JSON-ready dict of the set fields, the message as :meth:`text` shows it.
+
+        Parameters
+        ----------
+        spell : callable, optional
+            As :meth:`text`.
+
+        Returns
+        -------
+        dict
+        """
+        d = dataclasses.asdict(self)
+        d.pop("parameters")
+        d["message"] = self.text(spell)
+        return {k: v for k, v in d.items() if v is not None}
 
 
 @dataclass
@@ -458,10 +513,11 @@ class Recording:
             return values
         conv = self.meta.temperature_conversion.get(name)
         if conv is None:
-            raise UnitError(
+            raise UnitError.naming(
                 f"{self.name}: temperature column {name!r} is in raw counts and no "
-                "conversion to °C is given (--temp-conversion GAIN,OFFSET[,int16], or "
-                "temperature_conversion in the file's metadata)"
+                "conversion to °C is given ({temp_conversion} GAIN,OFFSET[,int16], or "
+                "temperature_conversion in the file's metadata)",
+                "temp_conversion",
             )
         return units.temperature_conversion(conv).to_celsius(values, f"{self.name}: {name!r}")
 
@@ -485,10 +541,12 @@ class Recording:
         """
         unit = self.units.get(name)
         if not unit or units.normalize_temperature_unit(unit) != "counts":
-            raise UnitError(
+            raise UnitError.naming(
                 f"{self.name}: the model's temperatures are raw counts, but column {name!r} "
-                f"is in {unit or 'an unknown unit'}; give the data in counts (--temp-unit "
-                "counts) or refit the model with --temp-conversion"
+                f"is in {unit or 'an unknown unit'}; give the data in counts ({{temp_unit}} "
+                "counts) or refit the model with {temp_conversion}",
+                "temp_unit",
+                "temp_conversion",
             )
         return self.column(name)
 
@@ -633,10 +691,11 @@ class Recording:
         """
         problems = find_problems(self, required=required)
         for p in problems:
+            text = f"{self.name}: {p.message}"
             if p.severity == "warning" and p.kind.startswith("implausible"):
-                warnings.warn(PlausibilityWarning(f"{self.name}: {p.message}"), stacklevel=2)
+                warnings.warn(PlausibilityWarning.naming(text, *p.parameters), stacklevel=2)
             elif p.kind == "timestamp_jitter" and not any(q.severity == "error" for q in problems):
-                warnings.warn(TimestampWarning(f"{self.name}: {p.message}"), stacklevel=2)
+                warnings.warn(TimestampWarning.naming(text, *p.parameters), stacklevel=2)
         for p in problems:
             if p.severity == "error":
                 cls = {
@@ -646,7 +705,7 @@ class Recording:
                     "backwards_time": TimestampError,
                     "nonfinite_time": TimestampError,
                 }.get(p.kind, ThermocalInputError)
-                raise cls(f"{self.name}: {p.message}")
+                raise cls.naming(f"{self.name}: {p.message}", *p.parameters)
 
 
 # --- pure helpers --------------------------------------------------------------------
@@ -694,6 +753,21 @@ class TimeScan:
     rounding; otherwise the median step (one O(n) partition).  NaN for fewer than 2 samples
     or a non-finite time.  ``duplicate_rows``/``backward_rows`` are the ``i`` with
     ``Δt_i = 0`` / ``Δt_i < 0``.
+
+    Attributes
+    ----------
+    n : int
+        Number of samples.
+    finite : bool
+        Every time is finite.
+    min_step_s, max_step_s : float
+        Smallest and largest step [s].
+    interval_s : float
+        Nominal sample interval [s].
+    regular : bool
+        The stamps lie on a regular grid.
+    duplicate_rows, backward_rows : numpy.ndarray of intp
+        The ``i`` with ``Δt_i = 0`` and ``Δt_i < 0``.
     """
 
     n: int
@@ -851,7 +925,7 @@ def contiguous_slices(
 
 JITTER_RELATIVE = 0.1
 """Time steps scattered by more than this fraction of their median (half the 5–95 %
-range) are host-timestamp jitter, reported with ``--rate`` as the remedy."""
+range) are host-timestamp jitter, reported with ``rate_hz`` as the remedy."""
 JITTER_STEPS = 1 << 20
 """Steps of the time column (its first) that the jitter is measured on: bounded memory."""
 
@@ -865,6 +939,17 @@ class TimeJitter:
     over the median (``0.3``: the steps scatter ±30 % around it); ``n_same`` the steps of
     zero length (a burst of samples stamped at the same instant by a host);
     ``n_steps`` how many steps were measured.
+
+    Attributes
+    ----------
+    interval_s : float
+        Median step [s].
+    relative : float
+        Half the 5–95 % range of the steps over the median.
+    n_same : int
+        Steps of zero length.
+    n_steps : int
+        Steps measured.
     """
 
     interval_s: float
@@ -882,7 +967,8 @@ class TimeJitter:
         return {**dataclasses.asdict(self), "significant": self.significant}
 
     def message(self) -> str:
-        """What a ``warning:`` says of it, with the remedy."""
+        """What a warning says of it, with the remedy (``{rate_hz}`` where it names that
+        parameter, as :class:`Problem` writes it)."""
         same = (
             f", {self.n_same} samples stamped at the same instant as the one before"
             if self.n_same
@@ -891,7 +977,8 @@ class TimeJitter:
         return (
             f"timestamp jitter: the sample intervals scatter ±{100 * self.relative:.3g} % "
             f"(5–95 %) around their median {self.interval_s:.6g} s{same} (host timestamps, "
-            "e.g. Bluetooth?); give --rate HZ to take the samples at the sensor's nominal rate"
+            "e.g. Bluetooth?); give {rate_hz} HZ to take the samples at the sensor's nominal "
+            "rate"
         )
 
 
@@ -1021,8 +1108,8 @@ def _nan_problems(rec: Recording) -> list[Problem]:
     return probs
 
 
-RATE_HINT = "host timestamps? give --rate HZ to take the samples at the sensor's nominal rate"
-"""What a duplicate timestamp's message says to do."""
+RATE_HINT = "host timestamps? give {rate_hz} HZ to take the samples at the sensor's nominal rate"
+"""What a duplicate timestamp's message says to do (``{rate_hz}``: the parameter)."""
 
 
 def _jitter_problems(t: FloatArray, found: list[Problem]) -> list[Problem]:
@@ -1033,7 +1120,15 @@ def _jitter_problems(t: FloatArray, found: list[Problem]) -> list[Problem]:
     jit = time_jitter(t)
     if jit is None or not jit.significant:
         return []
-    return [Problem("timestamp_jitter", jit.message(), severity="warning", column="time")]
+    return [
+        Problem(
+            "timestamp_jitter",
+            jit.message(),
+            severity="warning",
+            column="time",
+            parameters=("rate_hz",),
+        )
+    ]
 
 
 def find_problems(rec: Recording, required: list[str] | None = None) -> list[Problem]:
@@ -1089,6 +1184,7 @@ def find_problems(rec: Recording, required: list[str] | None = None) -> list[Pro
                     f"({dup.size} duplicates in all; {RATE_HINT})",
                     column="time",
                     row=int(dup[0] + 1),
+                    parameters=("rate_hz",),
                 )
             )
         if back.size:
@@ -1174,7 +1270,17 @@ def _physical_of_counts(
 @dataclass(frozen=True)
 class Extrema:
     """Smallest and largest finite value of a column, their first rows, and the number
-    of finite values (:func:`finite_extrema`)."""
+    of finite values (:func:`finite_extrema`).
+
+    Attributes
+    ----------
+    lo, hi : float
+        Smallest and largest finite value.
+    lo_row, hi_row : int
+        Their first rows.
+    count : int
+        Number of finite values.
+    """
 
     lo: float
     lo_row: int
@@ -1391,7 +1497,7 @@ def _temperature_problems(rec: Recording, name: str) -> list[Problem]:
         if lo >= 173.0 and hi <= 473.0:
             hint = "kelvin? give the data in °C"
         elif np.all(vals == np.round(vals)) and hi > 1000.0:
-            hint = "raw ADC counts? give --temp-unit counts and --temp-conversion"
+            hint = "raw ADC counts? give {temp_unit} counts and {temp_conversion}"
         else:
             hint = "check the unit and the conversion"
         probs.append(
@@ -1402,6 +1508,7 @@ def _temperature_problems(rec: Recording, name: str) -> list[Problem]:
                 severity="warning",
                 column=name,
                 row=bad_row,
+                parameters=("temp_unit", "temp_conversion"),
             )
         )
     return probs
@@ -1489,12 +1596,13 @@ def _count_problems(rec: Recording, name: str) -> list[Problem]:
             "implausible_counts",
             f"signal column {name!r} is declared in counts, but {fractional:,} of its "
             f"{finite:,} values are not integers (row {first}: {float(arr[first]):.6g}): a "
-            "count is an integer; physical values need their unit (--signal-unit deg/s, mg, "
+            "count is an integer; physical values need their unit ({signal_unit} deg/s, mg, "
             "…), averaged counts one count's size (scale_factor and scale_factor_unit in the "
             "file's metadata, FILE.meta.json)",
             severity="warning",
             column=name,
             row=first,
+            parameters=("signal_unit",),
         )
     ]
 
@@ -1648,9 +1756,9 @@ def _sample_interval_problems(rec: Recording) -> list[Problem]:
     if abs(ratio - 1.0) <= SAMPLE_INTERVAL_TOLERANCE:
         return []
     if abs(ratio / 1000.0 - 1.0) < 0.1 or abs(ratio * 1000.0 - 1.0) < 0.1:
-        hint = "the time unit is off by 1000: ms read as s or s as ms? state --time-unit"
+        hint = "the time unit is off by 1000: ms read as s or s as ms? state {time_unit}"
     elif abs(ratio / 1e6 - 1.0) < 0.1 or abs(ratio * 1e6 - 1.0) < 0.1:
-        hint = "the time unit is off by 10⁶: µs read as s? state --time-unit"
+        hint = "the time unit is off by 10⁶: µs read as s? state {time_unit}"
     else:
         hint = "decimated, averaged or mislabelled data?"
     return [
@@ -1661,5 +1769,6 @@ def _sample_interval_problems(rec: Recording) -> list[Problem]:
             f"({1.0 / stated:.6g} Hz) ({hint})",
             severity="warning",
             column="time",
+            parameters=("time_unit",),
         )
     ]

@@ -372,7 +372,7 @@ class TemperatureConversion(NamedTuple):
 
 
 def temperature_conversion(
-    value: object, what: str = "temperature conversion"
+    value: object, what: str = "temperature conversion", parameters: tuple[str, ...] = ()
 ) -> TemperatureConversion:
     """A :class:`TemperatureConversion` from its file form or its text.
 
@@ -383,7 +383,10 @@ def temperature_conversion(
         :class:`TemperatureConversion`, or the text ``"GAIN,OFFSET[,int16]"``;
         gain [°C/count], offset [°C].
     what : str, optional
-        What is being read, named in messages.
+        What is being read, named in messages; ``{parameter}`` where it names one of
+        ``parameters`` (``"{temp_conversion}"``).
+    parameters : tuple of str, optional
+        The library's parameters ``what`` names (:meth:`UnitError.naming`).
 
     Returns
     -------
@@ -417,13 +420,15 @@ def temperature_conversion(
         f"got {value!r}"
     )
     if len(parts) != 2 or encoding not in TEMPERATURE_ENCODINGS:
-        raise UnitError(usage)
+        raise UnitError.naming(usage, *parameters)
     try:
         gain, offset = (float(p) for p in parts)
     except (TypeError, ValueError):
-        raise UnitError(usage) from None
+        raise UnitError.naming(usage, *parameters) from None
     if not (math.isfinite(gain) and math.isfinite(offset)) or gain == 0.0:
-        raise UnitError(f"{what} gain must be finite and non-zero, offset finite; got {value!r}")
+        raise UnitError.naming(
+            f"{what} gain must be finite and non-zero, offset finite; got {value!r}", *parameters
+        )
     return TemperatureConversion(gain, offset, encoding)
 
 
@@ -446,12 +451,13 @@ DEFAULT_UNITS: Final[dict[str, str]] = {
 """What a column is taken to be in when nothing states its unit — always said in a
 ``warning:`` line, never assumed silently."""
 
-_UNIT_OPTION: Final[dict[str, str]] = {
-    "time": "--time-unit",
-    "signal": "--signal-unit",
-    "temperature": "--temp-unit",
-    "angle": "--encoder-unit",
+_UNIT_PARAMETER: Final[dict[str, str]] = {
+    "time": "time_unit",
+    "signal": "signal_unit",
+    "temperature": "temp_unit",
+    "angle": "encoder_unit",
 }
+"""The parameter that states the unit of a column of each role, named in messages."""
 _TIME_ALIASES: Final = {"sec": "s", "secs": "s", "msec": "ms", "usec": "us", "µs": "us"}
 _NAME_BRACKET = re.compile(r"[\[(]\s*([^\])]+?)\s*[\])]\s*$")
 """A unit in brackets at the end of a name; the reference of :func:`_bracket_unit`, which
@@ -477,6 +483,8 @@ def _bracket_unit(text: str) -> tuple[int, str] | None:
 
 
 _NAME_SEPARATORS = re.compile(r"[\s_]+")
+_PLACEHOLDER = re.compile(r"\{([a-z_][a-z0-9_]*)\}")
+"""A parameter's place in a message template (``{temp_conversion}``)."""
 
 
 def _normalize_time_alias(unit: str) -> str:
@@ -635,7 +643,9 @@ def resolve_unit(
     where : str, optional
         The file, named in messages.
     option_name : str, optional
-        The option as the user wrote it, for messages.
+        What stated ``option``, for messages, with ``{parameter}`` where it names a
+        parameter (``"{temp_conversion} (raw counts)"``); default: the role's unit
+        parameter (``signal_unit``) and the unit.
     ask : str, optional
         A parameter's name (``"accel_unit"``; the command line shows its option): a unit
         nobody stated is refused, asking for it.
@@ -655,26 +665,10 @@ def resolve_unit(
     norm = _normalizer(role)
     prefix = f"{where}: " if where else ""
     meta = norm(metadata) if metadata else None
+    param = _UNIT_PARAMETER[role]
     if option:
         opt = norm(option)
-        said = option_name or f"{_UNIT_OPTION[role]} {opt}"
-        if meta is not None and meta != opt:
-            warnings.warn(
-                UnitWarning(
-                    f"{prefix}{said} contradicts the file's metadata, which says column "
-                    f"{column!r} is in {meta}; using {opt}"
-                ),
-                stacklevel=2,
-            )
-        named = unit_in_column_name(column, role) if meta is None else None
-        if named is not None and named != opt:
-            warnings.warn(
-                UnitWarning(
-                    f"{prefix}{said} contradicts the column name {column!r}, which says "
-                    f"{named}; using {opt} (drop {_UNIT_OPTION[role]} if the name is right)"
-                ),
-                stacklevel=2,
-            )
+        _warn_contradicted(column, role, opt, meta, prefix, option_name)
         return ResolvedUnit(opt, "option")
     if meta is not None:
         return ResolvedUnit(meta, "metadata")
@@ -695,13 +689,48 @@ def resolve_unit(
     chosen = norm(default) if default else DEFAULT_UNITS[role]
     whose = " (the model's unit)" if default else ""
     warnings.warn(
-        UnitWarning(
+        UnitWarning.naming(
             f"{prefix}no unit stated for the {role} column {column!r}; assuming {chosen}{whose} "
-            f"(give {_UNIT_OPTION[role]}, or the unit in the file's metadata or column name)"
+            f"(give {{{param}}}, or the unit in the file's metadata or column name)",
+            param,
         ),
         stacklevel=2,
     )
     return ResolvedUnit(chosen, "default")
+
+
+def _warn_contradicted(
+    column: str,
+    role: UnitRole,
+    opt: str,
+    meta: str | None,
+    prefix: str,
+    option_name: str | None,
+) -> None:
+    """A warning when the stated unit ``opt`` contradicts the file's metadata or the unit
+    in the column's name (the stated one is used)."""
+    param = _UNIT_PARAMETER[role]
+    said = option_name or f"{{{param}}} {opt}"
+    named_params = (param, *_PLACEHOLDER.findall(option_name or ""))
+    if meta is not None and meta != opt:
+        warnings.warn(
+            UnitWarning.naming(
+                f"{prefix}{said} contradicts the file's metadata, which says column "
+                f"{column!r} is in {meta}; using {opt}",
+                *named_params,
+            ),
+            stacklevel=3,
+        )
+    named = unit_in_column_name(column, role) if meta is None else None
+    if named is not None and named != opt:
+        warnings.warn(
+            UnitWarning.naming(
+                f"{prefix}{said} contradicts the column name {column!r}, which says "
+                f"{named}; using {opt} (drop {{{param}}} if the name is right)",
+                *named_params,
+            ),
+            stacklevel=3,
+        )
 
 
 @dataclass(frozen=True)
@@ -750,10 +779,11 @@ def resolve_temperature_conversion(
     if option is not None:
         if metadata is not None and tuple(metadata) != tuple(option):
             warnings.warn(
-                UnitWarning(
-                    f"{where + ': ' if where else ''}--temp-conversion ({option.describe()}) "
+                UnitWarning.naming(
+                    f"{where + ': ' if where else ''}{{temp_conversion}} ({option.describe()}) "
                     f"contradicts the file's metadata for column {column!r} "
-                    f"({metadata.describe()}); using the option"
+                    f"({metadata.describe()}); using the option",
+                    "temp_conversion",
                 ),
                 stacklevel=2,
             )
@@ -767,29 +797,31 @@ def resolve_temperature_conversion(
 
 @dataclass(frozen=True)
 class UnitOptions:
-    """What the command line says about units (``None``: the option was not given).
+    """What the caller states about units (``None``: not stated).
 
     Attributes
     ----------
     time_unit, temp_unit : str or None
         Unit of the time column and of every temperature column.
-    signal_unit : str or None
-        One unit for every signal, or ``U1,…,Un``, one per signal.
+    signal_unit : str or tuple of str or None
+        One unit for every signal, or one per signal (:func:`per_signal_unit`).
     temp_conversion : TemperatureConversion or None
         Applies to every temperature column and implies raw counts.
     ask : mapping of str to str
-        Signal column → the option to ask for when nothing states its unit.
+        Signal column → the parameter to ask for (``"accel_unit"``) when nothing states
+        its unit.
     implied : mapping of str to str
         Signal column → the unit another option implies when nothing states one.
     """
 
     time_unit: str | None = None
-    signal_unit: str | None = None
+    signal_unit: str | tuple[str, ...] | None = None
     temp_unit: str | None = None
     temp_conversion: TemperatureConversion | None = None
     ask: Mapping[str, str] = field(default_factory=dict)
-    """Signal column → the option to ask for when nothing states its unit (no default is
-    assumed: ``multipos`` asks for its accelerometer's unit rather than assume a rate)."""
+    """Signal column → the parameter to ask for when nothing states its unit (no default is
+    assumed: a multi-position calibration asks for its accelerometer's unit rather than
+    assume a rate)."""
     implied: Mapping[str, str] = field(default_factory=dict)
     """Signal column → the unit another option implies when nothing states one (``counts``
     for the columns of a triad given a count scale)."""
@@ -925,41 +957,55 @@ class ResolvedInputs:
         ]
 
 
-def per_signal_option(option: str | None, signals: Sequence[str]) -> dict[str, str | None]:
-    """One unit for every signal, or one per signal (comma-separated).
+def per_signal_unit(
+    signal_unit: str | Sequence[str] | None,
+    signals: Sequence[str],
+    parameter: str = "signal_unit",
+) -> dict[str, str | None]:
+    """The stated unit of each signal: one unit for every signal, or one per signal.
 
     Parameters
     ----------
-    option : str or None
-        ``"U"`` or ``"U1,…,Un"``.
+    signal_unit : str or sequence of str or None
+        One unit for every signal (``"deg/s"``), or one per signal, in the order of
+        ``signals`` (``("rad/s", "deg/s")``; an empty string states none for its signal);
+        None states none.  A sequence of one unit is one unit for every signal.
     signals : sequence of str
         The signal columns.
+    parameter : str, optional
+        The caller's parameter that gave ``signal_unit``, named in the error.
 
     Returns
     -------
     dict of str to str or None
-        Signal → its unit (None when ``option`` is not given).
+        Signal → its stated unit (None when none is stated).
 
     Raises
     ------
     UnitError
-        A number of units that is neither 1 nor the number of signals.
+        A number of units that is neither 1 nor the number of signals (naming
+        ``parameter``).
+
+    Examples
+    --------
+    >>> per_signal_unit(("rad/s", "deg/s"), ["gx", "gy"])
+    {'gx': 'rad/s', 'gy': 'deg/s'}
+    >>> per_signal_unit("deg/s", ["gx", "gy"])
+    {'gx': 'deg/s', 'gy': 'deg/s'}
     """
-    return _per_signal(option, signals)
-
-
-def _per_signal(option: str | None, signals: Sequence[str]) -> dict[str, str | None]:
-    if not option:
+    if not signal_unit:
         return dict.fromkeys(signals)
-    parts = [p.strip() for p in option.split(",")]
+    given = [signal_unit] if isinstance(signal_unit, str) else signal_unit
+    parts = [str(u).strip() for u in given]
     if len(parts) == 1:
-        return dict.fromkeys(signals, parts[0])
+        return dict.fromkeys(signals, parts[0] or None)
     if len(parts) != len(signals):
-        raise UnitError(
-            f"--signal-unit gives {len(parts)} units for {len(signals)} signals "
-            f"({', '.join(map(repr, signals))}); give one unit, or one per signal"
+        raise UnitError.naming(
+            f"{{{parameter}}} gives {len(parts)} units for {len(signals)} signals "
+            f"({', '.join(map(repr, signals))}); give one unit, or one per signal",
+            parameter,
         )
-    return dict(zip(signals, parts, strict=True))
+    return {c: u or None for c, u in zip(signals, parts, strict=True)}
 
 
 def resolve_inputs(
@@ -1012,7 +1058,7 @@ def resolve_inputs(
         model=mod.time_unit,
         where=where,
     )
-    sig_opts = _per_signal(opt.signal_unit, signals)
+    sig_opts = per_signal_unit(opt.signal_unit, signals)
     sig_res = {
         c: resolve_unit(
             c,
@@ -1031,11 +1077,13 @@ def resolve_inputs(
     opt_name: str | None = None
     if opt.temp_conversion is not None:
         if t_opt and normalize_temperature_unit(t_opt) != "counts":
-            raise UnitError(
-                f"--temp-conversion converts raw counts, but --temp-unit {t_opt} says the "
-                "temperatures are °C already; give one or the other"
+            raise UnitError.naming(
+                f"{{temp_conversion}} converts raw counts, but {{temp_unit}} {t_opt} says the "
+                "temperatures are °C already; give one or the other",
+                "temp_conversion",
+                "temp_unit",
             )
-        t_opt, opt_name = "counts", "--temp-conversion (raw counts)"
+        t_opt, opt_name = "counts", "{temp_conversion} (raw counts)"
     tmp_res: dict[str, ResolvedUnit] = {}
     conv_res: dict[str, ResolvedConversion] = {}
     for c in temperatures:
@@ -1467,9 +1515,10 @@ def parse_gravity_axis(text: str) -> tuple[str, float]:
     sign = -1.0 if key.startswith("-") else 1.0
     letter = key.lstrip("+-")
     if letter not in ("x", "y", "z"):
-        raise UnitError(
-            f"--gravity-axis: expected the body axis pointing up, +x, -x, +y, -y, +z or -z; "
-            f"got {text!r}"
+        raise UnitError.naming(
+            f"{{gravity_axis}}: expected the body axis pointing up, +x, -x, +y, -y, +z or -z; "
+            f"got {text!r}",
+            "gravity_axis",
         )
     return letter, sign
 

@@ -136,7 +136,7 @@ class StageFigures:
 
 @dataclass(frozen=True)
 class ValidationResult:
-    """Result of :func:`validate`; :meth:`to_dict` gives ``thermocal validate --json``'s keys.
+    """Result of :func:`validate`; :meth:`to_dict` gives the ``validate`` command's JSON keys.
 
     ``r`` and ``weakly_correlated`` are ``None`` when no modelling history was given.
 

@@ -1,4 +1,4 @@
-"""``thermocal turntable`` command line (INTERFACE.md)."""
+"""``thermocal turntable`` command line."""
 
 from __future__ import annotations
 

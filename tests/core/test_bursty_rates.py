@@ -14,7 +14,7 @@ import pandas as pd
 import pytest
 
 from thermocal.cli import main
-from thermocal.models.poly import short_rate_share
+from thermocal.models.fitting import short_rate_share
 
 
 def _bursty(path: Path, seed: int = 0) -> None:

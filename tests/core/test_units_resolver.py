@@ -49,7 +49,7 @@ def test_each_level_wins_over_the_next() -> None:
     r3 = resolve_inputs("time (s)", [], [], file=StatedUnits("ms"))
     assert r3.time.unit == "ms"
     # the option beats everything (and says so where it contradicts the file)
-    with pytest.warns(UnitWarning, match=r"--time-unit s contradicts the file's metadata.*ms"):
+    with pytest.warns(UnitWarning, match=r"time_unit s contradicts the file's metadata.*ms"):
         r4 = resolve_inputs("t", ["g"], [], options=UnitOptions(time_unit="s"), file=MS)
     assert (r4.time.unit, r4.time.source) == ("s", "option")
 
@@ -76,12 +76,12 @@ def test_temp_conversion_option_means_raw_counts() -> None:
     assert r.temperatures["T1"].unit == "counts"  # type: ignore[attr-defined]
     assert r.conversions["T1"].conversion == conv  # type: ignore[attr-defined]
     assert r.conversions["T1"].source == "option"  # type: ignore[attr-defined]
-    with pytest.raises(UnitError, match="--temp-conversion converts raw counts"):
+    with pytest.raises(UnitError, match="temp_conversion converts raw counts, but temp_unit degC"):
         resolve_inputs(
             "t [s]", [], ["T1"], options=UnitOptions(temp_unit="degC", temp_conversion=conv)
         )
     # the file says °C: the option wins, with a warning naming both
-    with pytest.warns(UnitWarning, match=r"--temp-conversion \(raw counts\) contradicts"):
+    with pytest.warns(UnitWarning, match=r"temp_conversion \(raw counts\) contradicts"):
         r = resolve_inputs(
             "t [s]", [], ["T1"], options=UnitOptions(temp_conversion=conv),
             file=StatedUnits(columns={"T1": "degC"}),
@@ -109,10 +109,10 @@ def test_conversion_order_and_contradiction() -> None:
 
 
 def test_one_unit_per_signal() -> None:
-    r = resolve_inputs("t [s]", ["a", "b"], [], options=UnitOptions(signal_unit="deg/s,mg"))
+    r = resolve_inputs("t [s]", ["a", "b"], [], options=UnitOptions(signal_unit=("deg/s", "mg")))
     assert (r.signals["a"].unit, r.signals["b"].unit) == ("deg/s", "mg")
     with pytest.raises(UnitError, match="2 units for 3 signals"):
-        resolve_inputs("t [s]", ["a", "b", "c"], [], options=UnitOptions(signal_unit="g,mg"))
+        resolve_inputs("t [s]", ["a", "b", "c"], [], options=UnitOptions(signal_unit=("g", "mg")))
 
 
 def test_file_metadata_reading() -> None:

@@ -137,6 +137,7 @@ SOURCES = {
     r"Howe & Tasset|Howe and Tasset": "Howe and T. N. Tasset",
     r"Tedaldi": "Tedaldi, A. Pretto and E. Menegatti",
     r"Ferraris": "Ferraris, U. Grimaldi and M. Parvis",
+    r"Gorini": "Ferraris, I. Gorini, U. Grimaldi and M. Parvis",
     r"process_sensor_caldata": "Tools/process_sensor_caldata.py",
     r"TemperatureCompensation\.cpp": "TemperatureCompensation.cpp",
     r"AP_InertialSensor_tempcal": "AP_InertialSensor_tempcal.cpp",

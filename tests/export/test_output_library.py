@@ -166,3 +166,24 @@ def test_export_params_file_writes_the_parameters_it_returns(tmp_path: Path) -> 
     assert {a["tref_c"] for a in d["axes"]} == {30.0}
     with pytest.raises(ThermocalInputError):  # the output may not be the calibration
         export_params_file(cal, "px4", cal)
+
+
+def test_compensate_calibration_file_takes_the_channels_as_a_tuple(tmp_path: Path) -> None:
+    """``signals=("gy",)`` applies gy alone (its line, written into the data, is the model);
+    a CSV output whose sidecar would land on the model file is refused before any write."""
+    src, df = _data(tmp_path)
+    cal_path = tmp_path / "cal.json"
+    save_calibration(Calibration([_channel(df, n) for n in SLOPES]), cal_path)
+    out = tmp_path / "out.csv"
+    read = ReadOptions(time_unit="s", signal_unit="deg/h", temp_unit="degC")
+    run = _quiet(compensate_calibration_file, cal_path, src, out, read, signals=("gy",))
+    assert run.kind == "channels" and [name for name, _f, _r in run.channels] == ["gy"]
+    got = pd.read_csv(out)
+    assert "gx_comp" not in got.columns
+    line = 0.6 + SLOPES["gy"] * (df["T"].to_numpy() - 25.0)
+    np.testing.assert_allclose(got["gy_model"], line, rtol=0, atol=1e-9)
+    side_on_model = tmp_path / "o.csv.meta.json"
+    side_on_model.write_bytes(cal_path.read_bytes())
+    with pytest.raises(ThermocalInputError, match=r"meta\.json"):
+        _quiet(compensate_calibration_file, side_on_model, src, tmp_path / "o.csv", read)
+    assert not (tmp_path / "o.csv").exists()

@@ -2,7 +2,9 @@
 model family"): the test writes a package ``toyfam`` in a temporary folder — one class, a
 constant plus a line in the first temperature, carrying its declaration — and one
 registration line, the entry point ``toy = toyfam:ToyModel`` of group
-``thermocal.families`` in ``toyfam-0.1.dist-info/entry_points.txt``.  With that folder on
+``thermocal.families`` in ``toyfam-0.1.dist-info/entry_points.txt``.  Its option ``t0_c``
+(the temperature the line is written about) has no option of its own on the command line:
+``fit --param t0_c=25`` sets it.  With that folder on
 ``PYTHONPATH``, ``thermocal fit --model toy``, ``validate`` and ``compensate`` run in a
 fresh interpreter on simulated data (``thermocal simulate fog-slow``), touching no file of
 thermocal.  The numbers are checked against the simulator's truth (``truth_bias``) and
@@ -22,7 +24,7 @@ import pandas as pd
 import pytest
 
 TOY = '''
-"""A toy family: y = c0 + c1·T1 (order 1) or y = c0 (order 0)."""
+"""A toy family: y = c0 + c1·(T1 − t0_c) (order 1) or y = c0 (order 0)."""
 from typing import ClassVar
 
 import numpy as np
@@ -34,7 +36,8 @@ DECLARATION = FamilyDeclaration(
     "toy",
     "toyfam:ToyModel",
     "a constant plus a line in the first temperature",
-    (FamilyOption("order", "int", "0: a constant; 1: a constant plus a line", 0, 1),),
+    (FamilyOption("order", "int", "0: a constant; 1: a constant plus a line", 0, 1),
+     FamilyOption("t0_c", "float", "temperature the line is written about [°C]", -50, 150)),
     "a line in the first temperature column",
 )
 
@@ -53,14 +56,16 @@ class _Stream(ModelStream):
 class ToyModel(TemperatureModel):
     declaration: ClassVar[FamilyDeclaration] = DECLARATION
 
-    def __init__(self, order: int = 1) -> None:
+    def __init__(self, order: int = 1, t0_c: float = 0.0) -> None:
         self.order = order
+        self.t0_c = t0_c
 
     def value(self, t):
+        t = t - self.t0_c
         return self.coef_[0] + (self.coef_[1] * t if self.order else 0.0 * t)
 
     def fit(self, runs):
-        t = np.concatenate([r.temps_c[:, 0] for r in runs])
+        t = np.concatenate([r.temps_c[:, 0] for r in runs]) - self.t0_c
         y = np.concatenate([r.target() for r in runs])
         design = np.column_stack([np.ones_like(t), t][: self.order + 1])
         coef, *_ = np.linalg.lstsq(design, y, rcond=None)
@@ -122,9 +127,9 @@ def runs(tmp_path_factory: pytest.TempPathFactory) -> Path:
     return d
 
 
-def _line(frame: pd.DataFrame, column: str) -> np.ndarray:
-    """Least squares of ``column`` on a constant and T1, written here: [c0, c1]."""
-    t = frame["T1"].to_numpy()
+def _line(frame: pd.DataFrame, column: str, t0_c: float = 0.0) -> np.ndarray:
+    """Least squares of ``column`` on a constant and T1 − t0_c, written here: [c0, c1]."""
+    t = frame["T1"].to_numpy() - t0_c
     design = np.column_stack([np.ones_like(t), t])
     return np.linalg.lstsq(design, frame[column].to_numpy(), rcond=None)[0]
 
@@ -176,7 +181,37 @@ def test_the_plugin_declares_its_bounds_and_the_cli_shows_the_option(runs: Path)
     )
     done = _thermocal([*base, "--segments", "3"], plugins)
     assert done.returncode == 2
-    assert "segments does not apply to model 'toy' (it takes: order)" in done.stderr
+    assert "segments does not apply to model 'toy' (it takes: order, t0_c)" in done.stderr
+
+
+def test_a_plugin_option_without_a_cli_option_is_set_with_param(runs: Path) -> None:
+    """``--param t0_c=25`` reaches the toy family's constructor: the saved line is written
+    about 25 °C (c0 is the value at 25 °C, least squares on T1 − 25 here), the slope is the
+    same; an unknown name and a value outside the declared bounds are one error line each,
+    listing the family's options."""
+    plugins, model = runs / "plugins", runs / "toy25.json"
+    base = ["fit", str(runs / "mod.csv"), "--model", "toy", "--signal", "gyro", "--temps", "T1"]
+    fit = _thermocal([*base, "--param", "t0_c=25", "-o", str(model), "--json"], plugins)
+    assert fit.returncode == 0, fit.stderr
+    got = {c["name"]: c["value"] for c in json.loads(fit.stdout)["coefficients"]}
+    mod = pd.read_csv(runs / "mod.csv")
+    c0, c1 = _line(mod, "gyro", 25.0)
+    assert got == pytest.approx({"c0": c0, "c1": c1}, rel=1e-9)
+    c0_zero, c1_zero = _line(mod, "gyro")
+    assert c0 == pytest.approx(c0_zero + 25.0 * c1_zero, rel=1e-9)  # the same line
+    saved = json.loads(model.read_text(encoding="utf-8"))
+    assert saved["params"]["t0_c"] == 25.0
+
+    bad = str(runs / "bad.json")
+    for arg, line in (
+        ("gain=2", "error: --param 'gain=2': give NAME=VALUE, NAME an option of model 'toy' "
+                   "(it takes: order, t0_c)"),
+        ("t0_c=400", "error: --param t0_c must be between -50 and 150, got 400.0 "
+                     "(model 'toy' takes: order, t0_c)"),
+    ):  # fmt: skip
+        done = _thermocal([*base, "--param", arg, "-o", bad], plugins)
+        assert done.returncode == 2 and done.stderr.strip().splitlines() == [line], done.stderr
+    assert not Path(bad).exists()
 
 
 def test_a_broken_plugin_is_one_warning_and_skipped(tmp_path: Path) -> None:

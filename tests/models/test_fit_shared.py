@@ -10,7 +10,8 @@ import numpy as np
 import pytest
 
 from thermocal.errors import ExtrapolationWarning, ThermocalInputError
-from thermocal.models.poly import PolyModel, fit_shared
+from thermocal.models.poly import PolyModel
+from thermocal.models.poly_fit import fit_shared
 from thermocal.models.rundata import RunData
 
 
@@ -98,7 +99,7 @@ def test_models_with_other_parameters_are_refused() -> None:
     "params", [{"terms": "seed000"}, {"order": 3}, {"order": 2, "rate_method": "centred"}]
 )
 def test_predict_many_equals_each_predict_with_gaps_and_clamping(params: dict) -> None:
-    from thermocal.models.poly import evaluation_key, predict_many
+    from thermocal.models.poly_eval import evaluation_key, predict_many
 
     chans = _channels(_runs(5))
     models = [PolyModel(**params) for _ in chans]
@@ -116,7 +117,7 @@ def test_predict_many_equals_each_predict_with_gaps_and_clamping(params: dict) -
 
 
 def test_predict_many_evaluates_models_of_other_structure_one_by_one() -> None:
-    from thermocal.models.poly import predict_many
+    from thermocal.models.poly_eval import predict_many
 
     base = _runs(6)
     a, b = PolyModel(order=2).fit(base), PolyModel(order=3).fit(base)

@@ -10,14 +10,9 @@ import pytest
 
 from thermocal.errors import DesignError, ExtrapolationWarning, ThermocalInputError
 from thermocal.models import get_model_class
-from thermocal.models.bank import (
-    BankModel,
-    Selection,
-    cluster_runs,
-    curve_distance,
-    hat_basis,
-    pwl_evaluate,
-)
+from thermocal.models.bank import BankModel
+from thermocal.models.bank_curves import cluster_runs, curve_distance, hat_basis, pwl_evaluate
+from thermocal.models.bank_select import Selection
 from thermocal.models.base import ModelStream
 from thermocal.models.rundata import RunData
 from thermocal.pipeline.model_file import load_model, save_model

@@ -14,17 +14,15 @@ from thermocal import simulate
 from thermocal.errors import DesignError, ExtrapolationWarning, ThermocalInputError
 from thermocal.models import RunData, get_model_class
 from thermocal.models.poly import PolyModel
-from thermocal.models.terms import (
-    Term,
-    backward_partners,
-    gap_free_slices,
-    parse_terms,
-    seed000_terms,
-    temperature_rates,
-    term_features,
-)
+from thermocal.models.terms import Term, parse_terms, seed000_terms, term_features
 from thermocal.pipeline.model_file import load_model, save_model
-from thermocal.preprocess import block_average, temperature_rate
+from thermocal.preprocess import (
+    backward_partners,
+    block_average,
+    gap_free_slices,
+    temperature_rate,
+    temperature_rates,
+)
 from thermocal.recording import contiguous_slices
 
 NAMES = ("T1", "T2", "T3", "T4")
@@ -324,7 +322,7 @@ def test_predict_equals_literal_eq1_and_stream_bit_for_bit(terms):
 
 
 def test_predict_does_not_depend_on_the_block_size(monkeypatch):
-    from thermocal.models import poly
+    from thermocal.models import poly_eval
 
     run, _ = make_run(n=5000, gap=True, noise=0.01)
     m = PolyModel(terms=MIXED_TERMS).fit([run])
@@ -332,7 +330,7 @@ def test_predict_does_not_depend_on_the_block_size(monkeypatch):
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", ExtrapolationWarning)
         whole = m.predict(data)
-        monkeypatch.setattr(poly, "PREDICT_BLOCK_ROWS", 97)
+        monkeypatch.setattr(poly_eval, "PREDICT_BLOCK_ROWS", 97)
         small = m.predict(data)
     assert_array_equal(small, whole)
 

@@ -20,7 +20,7 @@ import pytest
 from thermocal.cli import main
 from thermocal.errors import ConditioningWarning
 from thermocal.models import RunData
-from thermocal.models.poly import decide_run_offsets, run_overlap_groups
+from thermocal.models.fitting import decide_run_offsets, run_overlap_groups
 
 SLOPE = 69.0  # °/h/°C, the truth
 DRIFT = -150.0  # °/h, turn-on drift amplitude, settling with a 20 min time constant

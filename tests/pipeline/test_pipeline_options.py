@@ -31,7 +31,7 @@ def test_fit_options_hold_typed_values() -> None:
         names=("t", "gx", "gy", "T1", "T2"), rate_hz=200.0,
     )  # fmt: skip
     assert FitOptions("poly", signals="").signals is None  # no name: the file's signal
-    v = ValidateOptions(signal="gz", rate=50.0, on_bad_lines="skip", decimal=",")
+    v = ValidateOptions(signals="gz", rate_hz=50.0, on_bad_lines="skip", decimal=",")
     assert v.read_options == ReadOptions(
         signals=("gz",), rate_hz=50.0, on_bad_lines="skip", decimal=","
     )

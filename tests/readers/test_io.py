@@ -152,7 +152,7 @@ def test_sidecar_options_and_cli_override(tmp_path: Path) -> None:
     assert rec.unit_sources == {"<time>": "default", "w": "metadata", "T": "metadata"}
     assert rec.meta.latitude_deg == 45.0
     # an option that contradicts the file's metadata wins, with a warning naming both
-    with pytest.warns(UnitWarning, match="--signal-unit deg/h contradicts the file's metadata"):
+    with pytest.warns(UnitWarning, match="signal_unit deg/h contradicts the file's metadata"):
         rec = read_recording(path, ReadOptions(signal_unit="deg/h", time_unit="s"))
     assert rec.units["w"] == "deg/h"
 

@@ -48,7 +48,8 @@ def test_inspect_names_the_real_time_column_once(
     with pytest.warns(UnitWarning) as caught:  # the library: one read, the real name
         rec = read_recording(path, guess_temperatures=True)
     said = [str(w.message) for w in caught]
-    assert [m for m in said if "time column" in m] == [timing[0].removeprefix("warning: ")]
+    library = timing[0].removeprefix("warning: ").replace("--time-unit", "time_unit")
+    assert [m for m in said if "time column" in m] == [library]  # the parameter's name
     assert rec.temperatures == ("temp",) and rec.unit_sources["temp"] == "default"
 
 
@@ -207,9 +208,9 @@ def test_multipos_asks_for_the_accel_unit(
         f"error: {IMUCAL}: no unit stated for column 'acc_x'; give --accel-unit (or the unit "
         "in the file's metadata or column name)"
     )
-    with pytest.raises(UnitError, match="give --accel-unit"):
+    with pytest.raises(UnitError, match="give accel_unit"):
         read_recording(
-            IMUCAL, _rate(102.4).replace(signals=["acc_x"]), ask_units={"acc_x": "--accel-unit"}
+            IMUCAL, _rate(102.4).replace(signals=["acc_x"]), ask_units={"acc_x": "accel_unit"}
         )
 
 
@@ -283,7 +284,7 @@ def test_jitter_without_bursts_is_a_warning_of_every_command(tmp_path: Path) -> 
     path = tmp_path / "bt.csv"
     _bluetooth(path, [], bursts=False)
     rec = read_recording(path, ReadOptions(time_unit="s", signals=["gx"], signal_unit="deg/s"))
-    with pytest.warns(TimestampWarning, match=r"scatter ±\d+(\.\d+)? % .* give --rate HZ"):
+    with pytest.warns(TimestampWarning, match=r"scatter ±\d+(\.\d+)? % .* give rate_hz HZ"):
         rec.validate()
     jit = rec.time_jitter()
     assert jit is not None and 0.2 < jit.relative < 0.4 and jit.n_same == 0
@@ -477,7 +478,7 @@ def test_rate_the_stamps_contradict_is_said(tmp_path: Path) -> None:
     path = tmp_path / "bt.csv"
     _bluetooth(path, [], bursts=False, ms=False)
     with pytest.warns(
-        TimestampWarning, match=r"--rate 102\.4 Hz, but .* \((99\.9\d*|100) Hz\) and 9\d more"
+        TimestampWarning, match=r"rate_hz 102\.4 Hz, but .* \((99\.9\d*|100) Hz\) and 9\d more"
     ):
         read_recording(path, _rate(102.4).replace(time_unit="s", signals=["gx"], signal_unit="g"))
     with warnings.catch_warnings():

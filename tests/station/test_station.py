@@ -369,3 +369,15 @@ def test_station_errors_are_one_line(
         "error: the test station needs pymodbus, which is not installed: "
         "pip install 'thermocal[station]'"
     )
+
+
+@pytest.mark.parametrize("unit", [248, 255, -1])
+def test_a_modbus_slave_id_beyond_247_is_refused(unit: int) -> None:
+    """Modbus over serial line (Modbus Organization, V1.02, §2.2): individual slave
+    addresses are 1…247 (0 broadcast); 248…255 are reserved.  The id is a plain TOML
+    integer, so a typo lands there first."""
+    from thermocal.errors import ThermocalInputError
+
+    with pytest.raises(ThermocalInputError, match=r"unit \(slave id\) must be 0\.\.247"):
+        parse_station(_toml(1, [("imu", "/dev/null")], unit=unit))
+    assert parse_station(_toml(1, [("imu", "/dev/null")], unit=247)).chamber.unit == 247

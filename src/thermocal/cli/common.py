@@ -26,13 +26,12 @@ import typer
 
 from thermocal._lazy import LazyModule
 from thermocal.cli.interrupt import report_interrupted
-from thermocal.errors import ThermocalWarning
+from thermocal.errors import ThermocalInputError, ThermocalWarning
 from thermocal.pipeline.messages import error_text, warning_lines
 from thermocal.pipeline.messages import jsonable as jsonable
 from thermocal.pipeline.messages import one_line as one_line
 from thermocal.pipeline.reading import check_recording as check_recording
 from thermocal.pipeline.reading import read_options as read_options
-from thermocal.pipeline.reading import split_floats as split_floats
 from thermocal.pipeline.reading import split_names as split_names
 from thermocal.report.text import Block
 from thermocal.report.text import fmt as fmt
@@ -49,6 +48,43 @@ else:
 
 P = ParamSpec("P")
 R = TypeVar("R")
+
+
+def split_floats(text: str | None, option: str) -> list[float] | None:
+    """``"25, 30"`` → ``[25.0, 30.0]`` (None stays None); an input error naming ``option``
+    when an item is not a number.
+
+    Parameters
+    ----------
+    text : str or None
+        The option's comma-separated numbers.
+    option : str
+        The option, named in the error (``"--breakpoints"``).
+
+    Returns
+    -------
+    list of float or None
+        The numbers.
+
+    Raises
+    ------
+    ThermocalInputError
+        When an item is not a number.
+
+    Examples
+    --------
+    >>> split_floats("25, 30.5", "--breakpoints")
+    [25.0, 30.5]
+    """
+    names = split_names(text)
+    if names is None:
+        return None
+    try:
+        return [float(v) for v in names]
+    except ValueError:
+        raise ThermocalInputError(
+            f"{option}: expected comma-separated numbers, got {text!r}"
+        ) from None
 
 
 WIDTH_OFF_TERMINAL = 10_000
@@ -314,7 +350,9 @@ def _command_options(fn: Callable[..., Any]) -> dict[str, str]:
     out: dict[str, str] = {}
     for name, hint in hints.items():
         for info in getattr(hint, "__metadata__", ()):
-            decls = [d for d in getattr(info, "param_decls", None) or () if d.startswith("--")]
+            first = getattr(info, "default", None)  # Annotated: the first declaration
+            given = (first, *(getattr(info, "param_decls", None) or ()))
+            decls = [d for d in given if isinstance(d, str) and d.startswith("--")]
             if isinstance(info, typer.models.OptionInfo):
                 out[name] = decls[0] if decls else "--" + name.replace("_", "-")
     return out

@@ -36,6 +36,7 @@ from thermocal.cli.common import (
     handle_errors,
     progress,
     read_options,
+    split_names,
     stdout,
 )
 
@@ -88,7 +89,8 @@ def compensate_cmd(
             on_bad_lines=t_bad, delimiter=t_delim, decimal=t_dec,
         )  # fmt: skip
         run = _compensate.compensate_calibration_file(
-            model_file, file, output, read, signal=signal, chunk_rows=chunk_rows,
+            model_file, file, output, read, signals=tuple(split_names(signal) or ()) or None,
+            chunk_rows=chunk_rows,
             extrapolate=extrapolate, known_input=known_input, on_progress=advance,
         )  # fmt: skip
     show = {"triads": _show_triads, "single": _show_single, "channels": _show_channels}

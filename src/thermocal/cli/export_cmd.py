@@ -56,7 +56,8 @@ def export_c_cmd(
     """Write MODEL as a C99 header and source (no dynamic allocation) into DIR."""
     res = _export_c_files.export_c_file(
         model_file, output, use_float=use_float, name=name,
-        sample_interval_s=sample_interval, unit=unit,
+        sample_interval_s=sample_interval,
+        unit=tuple(u.strip() for u in unit.split(",")) if unit and "," in unit else unit,
     )  # fmt: skip
     emit(res.to_dict(), as_json, lambda: _show_c(res))
 

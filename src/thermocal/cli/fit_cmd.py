@@ -63,7 +63,7 @@ from thermocal.cli.common import (
     split_floats,
     stdout,
 )
-from thermocal.errors import ThermocalInputError
+from thermocal.errors import ParameterError, ThermocalInputError
 from thermocal.families import MODEL_FAMILIES, FamilyOption, fit_option_table
 from thermocal.pipeline.options import FitOptions, family_params, options_of
 
@@ -130,6 +130,17 @@ TrefOpt = Annotated[
     ),
 ]
 
+ParamOpt = Annotated[
+    list[str] | None,
+    typer.Option(
+        "--param",
+        metavar="NAME=VALUE",
+        help="Any option the chosen family declares, by its parameter name, e.g. --param "
+        "rate_interval_s=30 (repeatable; a plugin family's options too); checked against "
+        "the family's declared type and bounds.",
+    ),
+]
+
 
 _FAMILY_FIELDS = fit_option_table()
 """The family options of ``fit``, by option name without dashes: built from the families'
@@ -191,12 +202,59 @@ def _family_values(values: dict[str, Any]) -> dict[str, Any]:
     return out
 
 
+def _param_text(option: FamilyOption, text: str) -> Any:
+    """``--param``'s VALUE as the option's declared type (left as text when it is not one:
+    the declaration's check then refuses it, naming the parameter)."""
+    parse: dict[str, Any] = {
+        "int": int, "float": float, "floats": lambda t: tuple(float(v) for v in t.split(",")),
+        "bool": lambda t: {"true": True, "yes": True, "1": True, "false": False, "no": False,
+                           "0": False}[t.lower()],
+    }  # fmt: skip
+    try:
+        return parse.get(option.kind, str)(text)
+    except (ValueError, KeyError):
+        return text
+
+
+def _param_values(model: str, texts: list[str], given: dict[str, Any]) -> dict[str, Any]:
+    """The family options of ``--param NAME=VALUE`` (NAME a constructor parameter the family
+    ``model`` declares, a plugin's too), each checked against its declaration; an unknown
+    NAME, a missing ``=``, an option given twice or a value out of bounds is one error line
+    naming ``--param`` and the family's options."""
+    if not texts:
+        return {}
+    from thermocal.models.registry import get_model_class
+
+    declared = {o.name: o for o in get_model_class(model).declaration.options}
+    takes = ", ".join(declared) or "none"
+    out: dict[str, Any] = {}
+    for text in texts:
+        name, eq, value = (part.strip() for part in text.partition("="))
+        if not eq or name not in declared:
+            raise ThermocalInputError(
+                f"--param {text!r}: give NAME=VALUE, NAME an option of model {model!r} "
+                f"(it takes: {takes})"
+            )
+        if name in out or given.get(name) is not None:
+            raise ThermocalInputError(f"--param {text!r}: the option {name} is given twice")
+        try:
+            out[name] = declared[name].check(_param_text(declared[name], value))
+        except ParameterError as exc:
+            raise ThermocalInputError(
+                f"{exc.named('--param ' + name)} (model {model!r} takes: {takes})"
+            ) from None
+    return out
+
+
 def fit_cmd(**values: Any) -> None:
     """Fit a temperature-compensation model on one or several runs and save it."""
     files, output, as_json = values.pop("files"), values.pop("output"), values.pop("as_json")
+    texts = values.pop("param") or []
     values = _family_values(values)
     options = options_of(FitOptions, values)
-    options = dataclasses.replace(options, params=family_params(values))
+    params = family_params(values)
+    params |= _param_values(options.model, texts, params)
+    options = dataclasses.replace(options, params=params)
     result = _fit.fit_files(files, options, output)
     if result.calibration:
         emit(result.to_dict(), as_json, lambda: _human_channels(result.channels, output))
@@ -220,7 +278,7 @@ _COMMON_LAST = (
     ("allow_narrow", AllowNarrowOpt, False), ("allow_motion", AllowMotionOpt, False),
     ("names", NamesOpt, None), ("topic", TopicOpt, None), ("rate", RateOpt, None),
     ("on_bad_lines", OnBadLinesOpt, "error"), ("delimiter", DelimiterOpt, None),
-    ("decimal", DecimalOpt, None), ("as_json", JsonOpt, False),
+    ("decimal", DecimalOpt, None), ("param", ParamOpt, None), ("as_json", JsonOpt, False),
 )  # fmt: skip
 """The options of ``fit`` every family shares, around the families' own."""
 

@@ -29,6 +29,7 @@ from thermocal.cli.common import (
     stdout,
 )
 from thermocal.errors import ThermocalInputError
+from thermocal.pipeline.messages import option_name
 from thermocal.report import text as _text
 
 if TYPE_CHECKING:
@@ -94,17 +95,21 @@ def inspect_cmd(
         guess_temperatures=True,
     )
     result = _inspection.inspect_recording(rec, skipped)
-    emit(result.to_dict(), as_json, lambda: _print_human(result))
+    emit(result.to_dict(option_name), as_json, lambda: _print_human(result))
     # raised as input errors, so that the common handler prints the warnings first and
     # the one error: line last (exit 2)
     errors = result.fatal
     if errors:
         more = f" ({len(errors) - 1} more errors)" if len(errors) > 1 else ""
-        raise ThermocalInputError(f"{file}: {one_line(errors[0].message)}{more}")
+        raise ThermocalInputError.naming(
+            f"{file}: {one_line(errors[0].message)}{more}", *errors[0].parameters
+        )
     warns = [p for p in result.problems if p.severity == "warning"]
     if strict and warns:
         more = f" ({len(warns) - 1} more warnings)" if len(warns) > 1 else ""
-        raise ThermocalInputError(f"{file}: --strict: {one_line(warns[0].message)}{more}")
+        raise ThermocalInputError.naming(
+            f"{file}: --strict: {one_line(warns[0].message)}{more}", *warns[0].parameters
+        )
 
 
 def _print_human(r: "_inspection.Inspection") -> None:
@@ -114,4 +119,5 @@ def _print_human(r: "_inspection.Inspection") -> None:
         stdout.print("[green]no problems found[/green]", markup=True)
     for p in r.problems:
         colour = "red" if p.severity == "error" else "yellow"
-        stdout.print(f"[{colour}]{p.severity}[/{colour}]: {_markup.escape(p.message)}", markup=True)
+        text = _markup.escape(p.text(option_name))
+        stdout.print(f"[{colour}]{p.severity}[/{colour}]: {text}", markup=True)

@@ -83,7 +83,9 @@ InflateOpt = Annotated[
 RostopicOpt = Annotated[str, typer.Option("--rostopic", help="Kalibr's rostopic of this IMU.")]
 
 
-def _unit_list(gyro_unit: str | None, accel_unit: str | None, n_g: int, n_a: int) -> str | None:
+def _unit_list(
+    gyro_unit: str | None, accel_unit: str | None, n_g: int, n_a: int
+) -> tuple[str, ...] | None:
     """``--gyro-unit``/``--accel-unit`` as the recording's per-column unit list (None: the
     file's own units); both or neither."""
     if gyro_unit is None and accel_unit is None:
@@ -93,7 +95,7 @@ def _unit_list(gyro_unit: str | None, accel_unit: str | None, n_g: int, n_a: int
             "give both --gyro-unit and --accel-unit, or neither (units from the column "
             "names or the file's metadata)"
         )
-    return ",".join([gyro_unit] * n_g + [accel_unit or ""] * n_a)
+    return tuple([gyro_unit] * n_g + [accel_unit or ""] * n_a)
 
 
 @app.command("noise")
@@ -145,8 +147,8 @@ def noise_cmd(
         file,
         read,
         keep_other=False,
-        ask_units={**dict.fromkeys(g_names, "--gyro-unit"),
-                   **dict.fromkeys(a_names, "--accel-unit")},
+        ask_units={**dict.fromkeys(g_names, "gyro_unit"),
+                   **dict.fromkeys(a_names, "accel_unit")},
     )  # fmt: skip
     check_recording(rec, read)
     res = _analysis.imu_noise(

@@ -230,26 +230,30 @@ def temperature_inputs(
         conv = resolved.conversions[c]
         if model.temperature_unit == "counts":
             if r.unit != "counts":
-                raise UnitError(
+                raise UnitError.naming(
                     f"{prefix}the model's temperatures are raw counts (it was fitted without a "
                     f"conversion), but column {c!r} is in {r.unit}; give raw-count data "
-                    "(--temp-unit counts) or refit the model with --temp-conversion"
+                    "({temp_unit} counts) or refit the model with {temp_conversion}",
+                    "temp_unit",
+                    "temp_conversion",
                 )
             if conv.source == "option":
                 warnings.warn(
-                    UnitWarning(
-                        f"{prefix}the model's temperatures are raw counts; --temp-conversion "
-                        f"is not used for column {c!r}"
+                    UnitWarning.naming(
+                        f"{prefix}the model's temperatures are raw counts; {{temp_conversion}} "
+                        f"is not used for column {c!r}",
+                        "temp_conversion",
                     ),
                     stacklevel=3,
                 )
             out[c] = None
         elif r.unit == "counts":
             if conv.conversion is None:
-                raise UnitError(
+                raise UnitError.naming(
                     f"{prefix}temperature column {c!r} is in raw counts and no conversion to "
-                    "°C is given (--temp-conversion GAIN,OFFSET[,int16], the file's metadata, "
-                    "or a model fitted with one)"
+                    "°C is given ({temp_conversion} GAIN,OFFSET[,int16], the file's metadata, "
+                    "or a model fitted with one)",
+                    "temp_conversion",
                 )
             out[c] = conv.conversion
         else:
@@ -600,7 +604,7 @@ def _kept_in_bias(model: TemperatureModel, latitude_deg: float, axis: str) -> st
     return (
         f"; {KEPT_IN_BIAS} (thermocal fit --latitude {latitude_deg:g} --axis {axis}), so its "
         "compensation takes that rate off as bias"
-    )
+    )  # cli-words: the command that refits the model
 
 
 def zero_reference(
@@ -642,7 +646,8 @@ def zero_reference(
       for Single-Axis Interferometric Fiber Optic Gyros* (earth-rate input).
     """
     if known_input:
-        return float(known_input), "the known input given (--known-input)"
+        given = "the known input given (--known-input)"
+        return float(known_input), given  # cli-words: the words validate's reports record
     mu = units.normalize_signal_unit(model.signal_unit)
     if (
         meta is not None
@@ -1175,7 +1180,7 @@ class ChunkPredictor:
         followers: Sequence[ChunkPredictor],
     ) -> list[FloatArray]:
         """ŷ of this predictor's model and of each follower's (several channels whose
-        ``poly`` models share one evaluation, :func:`thermocal.models.poly.predict_many`):
+        ``poly`` models share one evaluation, :func:`thermocal.models.poly_eval.predict_many`):
         the context is carried once, here; the followers' counts follow.
 
         Parameters
@@ -1262,7 +1267,8 @@ class ChunkPredictor:
         if len(models) == 1:
             y_alls = [np.asarray(self.model.predict(run, extrapolate=self.extrapolate))]
         else:
-            from thermocal.models.poly import PolyModel, predict_many
+            from thermocal.models.poly import PolyModel
+            from thermocal.models.poly_eval import predict_many
 
             y_alls = predict_many(
                 [cast(PolyModel, mdl) for mdl in models], run, extrapolate=self.extrapolate

@@ -66,20 +66,22 @@ Evaluation of model m (firmware twin): ``j`` = the segment holding T (clamped
 to ``[x_0, x_K]``; the last segment for T = x_K), ``f = v_j + (v_{j+1} − v_j)/(x_{j+1} − x_j)
 · (T − x_j)``.  Selection: keep ``Σ_i (y_i − f_m(T_i))`` and the count N per model
 during the start-up window, choose ``argmin_m |Σ/N|`` (first index on ties).
+
+This module holds the estimator, :class:`BankModel`; the curve maths (piecewise-linear
+evaluation, hat basis, binned curves, clustering, one group's fit) are in
+:mod:`thermocal.models.bank_curves`, the choice at power-on (:class:`Selection`) and the
+streaming twin (:class:`BankStream`) in :mod:`thermocal.models.bank_select`.
 """
 
 from __future__ import annotations
 
-import bisect
 import math
 import warnings
 from collections.abc import Sequence
-from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any, ClassVar, Self
+from typing import Any, ClassVar, Self
 
 import numpy as np
 
-from thermocal._lazy import LazyModule
 from thermocal.adequacy import Needs
 from thermocal.errors import (
     ConditioningWarning,
@@ -88,13 +90,16 @@ from thermocal.errors import (
     ThermocalInputError,
 )
 from thermocal.families import BANK, FamilyDeclaration
-from thermocal.models.base import (
-    ChunkContext,
-    ClampOnce,
-    ModelStream,
-    TemperatureModel,
-    stream_channel,
+from thermocal.models.bank_curves import (
+    binned_curve,
+    cluster_runs,
+    common_range,
+    curve_distance,
+    fit_group,
+    pwl_evaluate,
 )
+from thermocal.models.bank_select import BankStream, Selection, selection_of
+from thermocal.models.base import ChunkContext, ModelStream, TemperatureModel
 from thermocal.models.checks import (
     ascending,
     fields,
@@ -105,242 +110,13 @@ from thermocal.models.checks import (
     sensor_param,
     string,
 )
-from thermocal.models.numerics import channel_index, lstsq_svd, single_channel
+from thermocal.models.numerics import channel_index, single_channel
 from thermocal.models.results import Coefficient, FitStats
 from thermocal.models.rundata import RunData
 from thermocal.models.warmup import CONDITION_WARN
-from thermocal.preprocess import segment_holds
 from thermocal.recording import FloatArray
 
-if TYPE_CHECKING:
-    from scipy.cluster import hierarchy as _hierarchy
-    from scipy.spatial import distance as _distance
-else:
-    _hierarchy = LazyModule("scipy.cluster.hierarchy")
-    _distance = LazyModule("scipy.spatial.distance")
-
 ERROR_METRICS = ("max", "rms")
-
-
-# --- pure functions --------------------------------------------------------------------------
-
-
-def pwl_evaluate(breakpoints_c: FloatArray, values: FloatArray, temp_c: FloatArray) -> FloatArray:
-    """Continuous piecewise-linear function through ``(x_j, v_j)`` at ``T``::
-
-        f(T) = v_j + (v_{j+1} − v_j)/(x_{j+1} − x_j) · (T − x_j),   x_j ≤ T < x_{j+1}
-
-    with the end segments extended linearly outside ``[x_0, x_K]`` (callers clamp
-    first when they do not want to extrapolate).
-
-    Parameters
-    ----------
-    breakpoints_c : numpy.ndarray
-        Ascending breakpoints x_0 … x_K [°C].
-    values : numpy.ndarray
-        Value at each breakpoint [signal unit].
-    temp_c : numpy.ndarray
-        Temperatures T [°C].
-
-    Returns
-    -------
-    numpy.ndarray
-        f(T) [signal unit], the shape of ``temp_c``.
-
-    References
-    ----------
-    - *Design and engineering implementation of a fibre-optic-gyro line-of-sight
-      stabilisation system*, master's thesis, chapter 3 "Fibre-optic gyroscope".
-    - *Adaptive accelerometer temperature compensation method for inertial navigation*,
-      Chinese invention patent, filed 2019-10-29, published 2020-02-21.
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> pwl_evaluate(np.array([0.0, 10.0, 20.0]), np.array([0.0, 1.0, 3.0]),
-    ...              np.array([5.0, 15.0, 25.0])).tolist()
-    [0.5, 2.0, 4.0]
-    """
-    x = breakpoints_c
-    j = np.clip(np.searchsorted(x, temp_c, side="right") - 1, 0, x.size - 2)
-    slope = (values[j + 1] - values[j]) / (x[j + 1] - x[j])
-    out: FloatArray = values[j] + slope * (temp_c - x[j])
-    return out
-
-
-def hat_basis(breakpoints_c: FloatArray, temp_c: FloatArray) -> FloatArray:
-    """Design matrix (n, K+1) of the continuous piecewise-linear hat functions:
-    column j is 1 at x_j, 0 at the other breakpoints, linear between (so the
-    least-squares coefficients are the values at the breakpoints).
-
-    Parameters
-    ----------
-    breakpoints_c : numpy.ndarray
-        Ascending breakpoints, shape (K+1,) [°C].
-    temp_c : numpy.ndarray
-        Temperatures, shape (n,) [°C] (clamped to the breakpoints' range).
-
-    Returns
-    -------
-    numpy.ndarray
-        Shape (n, K+1); each row sums to 1.
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> hat_basis(np.array([0.0, 10.0, 20.0]), np.array([5.0])).tolist()
-    [[0.5, 0.5, 0.0]]
-    """
-    x = breakpoints_c
-    t = np.clip(temp_c, x[0], x[-1])
-    j = np.clip(np.searchsorted(x, t, side="right") - 1, 0, x.size - 2)
-    w = (t - x[j]) / (x[j + 1] - x[j])
-    basis = np.zeros((t.size, x.size))
-    rows = np.arange(t.size)
-    basis[rows, j] = 1.0 - w
-    basis[rows, j + 1] += w
-    return basis
-
-
-def binned_curve(
-    temp_c: FloatArray, y: FloatArray, edges_c: FloatArray
-) -> tuple[FloatArray, FloatArray, FloatArray]:
-    """Bin means of ``y`` and ``T`` on temperature bins ``edges_c``: returns
-    ``(mean_y, mean_T, count)`` per bin (NaN for an empty bin).
-
-    Parameters
-    ----------
-    temp_c : numpy.ndarray
-        Temperatures, shape (n,) [°C].
-    y : numpy.ndarray
-        Output, shape (n,) [signal unit].
-    edges_c : numpy.ndarray
-        Bin edges [°C], ascending.
-
-    Returns
-    -------
-    mean_y : numpy.ndarray
-        Bin means of y [signal unit].
-    mean_T : numpy.ndarray
-        Bin means of T [°C].
-    count : numpy.ndarray
-        Samples per bin.
-    """
-    nb = edges_c.size - 1
-    idx = np.clip(np.searchsorted(edges_c, temp_c, side="right") - 1, 0, nb - 1)
-    cnt = np.bincount(idx, minlength=nb).astype(np.float64)
-    sy = np.bincount(idx, weights=y, minlength=nb)
-    st = np.bincount(idx, weights=temp_c, minlength=nb)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        return sy / cnt, st / cnt, cnt
-
-
-def curve_distance(curves: FloatArray) -> FloatArray:
-    """Pairwise max-deviation ``d_ij = max_b |c_i(b) − c_j(b)|`` over the bins where
-    both runs have data (inf when they share none).
-
-    Parameters
-    ----------
-    curves : numpy.ndarray
-        Binned curves, shape (runs, bins) [signal unit], NaN where empty.
-
-    Returns
-    -------
-    numpy.ndarray
-        Distance matrix (runs, runs) [signal unit].
-
-    Notes
-    -----
-    .. math:: d_{ij} = \\max_b |c_i(b) - c_j(b)|
-    """
-    diff = np.abs(curves[:, None, :] - curves[None, :, :])
-    both = np.isfinite(diff)
-    d = np.where(both, diff, -np.inf).max(axis=2)
-    d[~both.any(axis=2)] = np.inf
-    np.fill_diagonal(d, 0.0)
-    return np.asarray(d, dtype=np.float64)
-
-
-def cluster_runs(distance: FloatArray, threshold: float) -> list[list[int]]:
-    """Complete-linkage agglomerative clustering: every pair inside a group is
-    within ``threshold``.  Groups are ordered by their first run.
-
-    Parameters
-    ----------
-    distance : numpy.ndarray
-        Distance matrix (:func:`curve_distance`) [signal unit].
-    threshold : float
-        Largest distance inside a group [signal unit] (1 mg in the source document).
-
-    Returns
-    -------
-    list of list of int
-        Run indices per group.
-
-    References
-    ----------
-    - *Adaptive accelerometer temperature compensation method for inertial navigation*,
-      Chinese invention patent, filed 2019-10-29, published 2020-02-21.
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> d = np.array([[0.0, 0.1, 3.0], [0.1, 0.0, 3.1], [3.0, 3.1, 0.0]])
-    >>> cluster_runs(d, 1.0)
-    [[0, 1], [2]]
-    """
-    n = distance.shape[0]
-    if n == 1:
-        return [[0]]
-    finite = np.where(np.isfinite(distance), distance, 1e300)
-    z = _hierarchy.linkage(_distance.squareform(finite, checks=False), method="complete")
-    labels = _hierarchy.fcluster(z, t=threshold, criterion="distance")
-    groups: dict[int, list[int]] = {}
-    for i, lab in enumerate(labels):
-        groups.setdefault(int(lab), []).append(i)
-    return sorted(groups.values(), key=lambda g: g[0])
-
-
-@dataclass(frozen=True)
-class Selection:
-    """The model chosen at power-on.
-
-    Attributes
-    ----------
-    index : int
-        Index of the chosen model in the bank.
-    deviations : tuple of float
-        D_m of every model [signal unit].
-    margin : float
-        Runner-up − best deviation [signal unit] (inf with one model).
-    n_samples : int
-        Start-up samples used.
-    complete : bool
-        True once the start-up window (``startup_s``) was full.
-    """
-
-    index: int
-    deviations: tuple[float, ...]
-    margin: float
-    n_samples: int
-    complete: bool
-
-    def to_dict(self) -> dict[str, Any]:
-        """JSON form of the selection."""
-        return {
-            "index": self.index,
-            "deviations": list(self.deviations),
-            "margin": self.margin if math.isfinite(self.margin) else None,
-            "n_samples": self.n_samples,
-            "complete": self.complete,
-        }
-
-
-def _selection(dev: FloatArray, n: int, complete: bool) -> Selection:
-    order = np.argsort(dev, kind="stable")
-    best = int(np.argmin(dev))
-    margin = float(dev[order[1]] - dev[best]) if dev.size > 1 else math.inf
-    return Selection(best, tuple(float(v) for v in dev), margin, n, complete)
 
 
 # --- the model ------------------------------------------------------------------------------
@@ -506,7 +282,7 @@ class BankModel(TemperatureModel):
         ys = [r.target() for r in one]
         labels = [r.name or f"run {i}" for i, r in enumerate(one)]
 
-        t_lo, t_hi = self._common_range(temps, labels)
+        t_lo, t_hi = common_range(temps, labels, float(self.grid_step_c))
 
         # 1-2: binned curves and clustering
         nb = max(1, math.ceil((t_hi - t_lo) / self.grid_step_c))
@@ -530,9 +306,11 @@ class BankModel(TemperatureModel):
         resid_sq = 0.0
         n_res = 0
         for g in groups:
-            entry, values, se, cond_g, rss_g = self._fit_group(
-                g, one, temps, ys, labels, knots, curves, curve_t
-            )
+            entry, values, se, cond_g, rss_g = fit_group(
+                g, one, temps, ys, labels, knots, curves, curve_t,
+                error_metric=self.error_metric, tolerance=self.tolerance,
+                hold_min_s=self.hold_min_s, grid_step_c=self.grid_step_c,
+            )  # fmt: skip
             cond = max(cond, cond_g)
             if rss_g is not None:
                 kept_b.append(knots.copy())
@@ -611,114 +389,6 @@ class BankModel(TemperatureModel):
             ),
         )
 
-    def _common_range(self, temps: list[FloatArray], labels: list[str]) -> tuple[float, float]:
-        """The temperature range every run covers (to within two grid steps) [°C]; runs
-        over different ranges, or a span of one grid step or less, are a design error."""
-        lo = np.array([t.min() for t in temps])
-        hi = np.array([t.max() for t in temps])
-        t_lo, t_hi = float(lo.min()), float(hi.max())
-        slack = 2.0 * float(self.grid_step_c)
-        short = [i for i in range(len(temps)) if lo[i] > t_lo + slack or hi[i] < t_hi - slack]
-        if short:
-            ranges = "; ".join(f"{labels[i]} {lo[i]:.1f}…{hi[i]:.1f} °C" for i in range(len(temps)))
-            raise DesignError(
-                f"bank: the runs cover different temperature ranges ({ranges}); every run "
-                f"must cover {t_lo:.1f}…{t_hi:.1f} °C to within {slack:g} °C, because the "
-                "characteristic curves are compared at the same temperatures"
-            )
-        if not t_hi - t_lo > self.grid_step_c:
-            raise DesignError(
-                f"bank: the runs span only {t_hi - t_lo:.2f} °C; at least more than one "
-                f"grid step ({self.grid_step_c:g} °C) is needed"
-            )
-        return t_lo, t_hi
-
-    def _fit_group(
-        self,
-        g: list[int],
-        one: list[RunData],
-        temps: list[FloatArray],
-        ys: list[FloatArray],
-        labels: list[str],
-        knots: FloatArray,
-        curves: FloatArray,
-        curve_t: FloatArray,
-    ) -> tuple[dict[str, Any], FloatArray, FloatArray | None, float, tuple[float, int] | None]:
-        """Step 3–4 for one group: the piecewise-linear values at the knots (least squares
-        on the group's samples) and their fit error against the characteristic lines;
-        returns (entry, values, standard errors, condition number, (RSS, n) of the samples
-        when the fit error is below the tolerance, else None)."""
-        nk = knots.size
-        tg = np.concatenate([temps[i] for i in g])
-        yg = np.concatenate([ys[i] for i in g])
-        x = hat_basis(knots, tg)
-        res = lstsq_svd(x, yg)
-        if res.rank < nk:
-            empty = [c for c in res.null_columns]
-            where = ", ".join(f"{knots[c]:.1f} °C" for c in empty)
-            raise DesignError(
-                f"bank: group of {', '.join(labels[i] for i in g)}: no data to determine "
-                f"the piecewise-linear value(s) at {where}; increase knot_spacing_c"
-            )
-        values = res.coef
-        se = (
-            np.sqrt(np.maximum(np.diag(res.cov_unit) * float(res.sigma2), 0.0))
-            if res.dof > 0
-            else None
-        )
-        # 4: check against the characteristic lines
-        pts_t, pts_y, check = self._characteristic_points(
-            [one[i] for i in g],
-            [temps[i] for i in g],
-            [ys[i] for i in g],
-            curves[g],
-            curve_t[g],
-        )
-        err = pts_y - pwl_evaluate(knots, values, pts_t)
-        fit_error = (
-            float(np.max(np.abs(err)))
-            if self.error_metric == "max"
-            else float(np.sqrt(np.mean(err**2)))
-        )
-        entry = {
-            "runs": [labels[i] for i in g],
-            "fit_error": fit_error,
-            "check": check,
-            "n_check_points": int(pts_t.size),
-        }
-        kept = None
-        if fit_error < self.tolerance:
-            r = yg - x @ values
-            kept = (float(np.sum(r**2)), int(r.size))
-        return entry, values, se, float(res.condition_number), kept
-
-    def _characteristic_points(
-        self,
-        runs: Sequence[RunData],
-        temps: Sequence[FloatArray],
-        ys: Sequence[FloatArray],
-        curves: FloatArray,
-        curve_t: FloatArray,
-    ) -> tuple[FloatArray, FloatArray, str]:
-        """Characteristic lines of a group: hold means (≥ 3 distinct temperatures)
-        or the group's mean binned curve."""
-        pts: list[tuple[float, float]] = []
-        for r, t, y in zip(runs, temps, ys, strict=True):
-            for seg in segment_holds(r.time_s, t, min_duration_s=self.hold_min_s):
-                if seg.kind == "hold":
-                    pts.append((float(np.mean(t[seg.slice])), float(np.mean(y[seg.slice]))))
-        if pts:
-            arr = np.array(sorted(pts))
-            # merge holds at the same temperature (within a grid step)
-            split = np.flatnonzero(np.diff(arr[:, 0]) > self.grid_step_c) + 1
-            groups = np.split(arr, split)
-            if len(groups) >= 3:
-                mt = np.array([g[:, 0].mean() for g in groups])
-                my = np.array([g[:, 1].mean() for g in groups])
-                return mt, my, "holds"
-        ok = np.isfinite(curves).all(axis=0)
-        return curve_t[:, ok].mean(axis=0), curves[:, ok].mean(axis=0), "curve"
-
     # -- use --
     def _model_matrix(self, temp_c: FloatArray) -> FloatArray:
         """(n, M): every model evaluated at every temperature."""
@@ -775,7 +445,7 @@ class BankModel(TemperatureModel):
         temp = self._prepare(run, extrapolate)
         f = self._model_matrix(temp[: self._startup_count(run)])
         dev, _choice, m = self._run_selection(run, f)
-        self.selection_ = _selection(dev[-1], m, m < run.n_samples)
+        self.selection_ = selection_of(dev[-1], m, m < run.n_samples)
         return self.selection_
 
     def predict(self, run: RunData, *, extrapolate: bool = False) -> FloatArray:
@@ -802,7 +472,7 @@ class BankModel(TemperatureModel):
         temp = self._prepare(run, extrapolate)
         f = self._model_matrix(temp[: self._startup_count(run)])  # every model, start-up only
         dev, choice, m = self._run_selection(run, f)
-        self.selection_ = _selection(dev[-1], m, m < run.n_samples)
+        self.selection_ = selection_of(dev[-1], m, m < run.n_samples)
         out = np.empty(run.n_samples)
         out[:m] = f[np.arange(m), choice]
         c = int(choice[-1])
@@ -919,109 +589,3 @@ class BankModel(TemperatureModel):
         self.model_info_ = [{k: v for k, v in m.items() if k not in skip} for m in models]
         self.rejected_ = list(state.get("rejected", []))
         self.groups_ = [list(g) for g in state.get("groups", [])]
-
-
-class BankStream(ModelStream):
-    """Streaming twin of :meth:`BankModel.predict`, in plain Python floats: running
-    residual sums per model during the start-up window, then the frozen choice (only
-    the chosen model is evaluated after it).  The same operations as ``predict``
-    (:func:`pwl_evaluate`, the cumulative sums of ``_run_selection``), so the same numbers.
-
-    ``temps_c`` holds either one value (the model's channel) or the fitted run's
-    channels (``sensor`` picks).  ``signal`` (raw; ``known_input`` is subtracted) is
-    required during the start-up window.  ``selection`` is the current :class:`Selection`.
-    Warns once per stream when a temperature leaves the fitted range.
-
-    Parameters
-    ----------
-    model : BankModel
-        The fitted bank.
-    extrapolate : bool, optional
-        Default False.
-    known_input : float, optional
-        Known input subtracted from the signal [signal unit].  Default 0.
-    """
-
-    def __init__(
-        self, model: BankModel, *, extrapolate: bool = False, known_input: float = 0.0
-    ) -> None:
-        self.model = model
-        self.extrapolate = extrapolate
-        self.known_input = float(known_input)
-        self._col = int(model.sensor)
-        lo, hi = (float(v) for v in model.temp_range_[0])
-        self._clamp = ClampOnce(lo, hi, extrapolate=extrapolate)
-        self._startup = float(model.startup_s)
-        self._xs = [[float(x) for x in b] for b in model.breakpoints_]
-        self._vs = [[float(v) for v in vals] for vals in model.values_]
-        self.reset()
-
-    def reset(self) -> None:
-        """Forget everything (a new power-on): the start-up selection starts again."""
-        n = len(self._vs)
-        self._t_first: float | None = None
-        self._sums = [0.0] * n
-        self._count = 0
-        self._frozen = False
-        self._choice = 0
-        self._dev = [math.nan] * n
-        self._clamp.warned = False
-
-    @property
-    def selection(self) -> Selection:
-        """The current :class:`Selection`."""
-        return _selection(np.array(self._dev, dtype=np.float64), self._count, self._frozen)
-
-    def _value(self, m: int, temp: float) -> float:
-        """Model m at T: :func:`pwl_evaluate` on one float (same operations)."""
-        x, v = self._xs[m], self._vs[m]
-        j = min(max(bisect.bisect_right(x, temp) - 1, 0), len(x) - 2)
-        slope = (v[j + 1] - v[j]) / (x[j + 1] - x[j])
-        return v[j] + slope * (temp - x[j])
-
-    def update(self, time_s: float, temps_c: FloatArray, signal: float | None = None) -> float:
-        """Model value for one sample (see :meth:`ModelStream.update`).
-
-        Parameters
-        ----------
-        time_s : float
-            Sample time [s].
-        temps_c : numpy.ndarray
-            Temperatures [°C].
-        signal : float, optional
-            Raw signal [signal unit]; required during the start-up window.
-
-        Returns
-        -------
-        float
-            The selected model's value [signal unit].
-
-        Raises
-        ------
-        thermocal.errors.ThermocalInputError
-            No signal during the start-up window.
-        """
-        temp = self._clamp(stream_channel(temps_c, self._col))
-        t = float(time_s)
-        if self._t_first is None:
-            self._t_first = t
-        if not self._frozen and t - self._t_first < self._startup:
-            if signal is None:
-                raise ThermocalInputError(
-                    "bank: selecting a model at power-on needs the measured signal"
-                )
-            y = float(signal) - self.known_input
-            f = [self._value(m, temp) for m in range(len(self._vs))]
-            self._count += 1
-            sums = self._sums
-            best = 0
-            for m, fm in enumerate(f):
-                sums[m] = sums[m] + (y - fm)
-                dev = abs(sums[m] / self._count)
-                self._dev[m] = dev
-                if dev < self._dev[best]:
-                    best = m
-            self._choice = best
-            return f[best]
-        self._frozen = True
-        return self._value(self._choice, temp)

@@ -8,54 +8,13 @@ signal (bias, or scale-factor error, [Seed-RLG]) in the signal's canonical unit;
 the one registry, :data:`thermocal.models.registry.MODEL_REGISTRY`, which
 sits above them: this module knows no family.
 
-A model file is a self-describing, versioned JSON object::
-
-    {
-      "format": "thermocal-model", "format_version": 3,
-      "family": "poly", "thermocal_version": "0.1.0",
-      "created_utc": "...",
-      "signal": {"name": "gyro", "unit": "deg/h", "target": "bias"},
-      "temperatures": ["T1", "T2", "T3", "T4"], "temperature_unit": "degC",
-      "rate": {"method": "backward", "interval_s": 60.0},
-      "params": {...constructor arguments...},
-      "state": {...learned values, family specific...},
-      "coefficients": [{"name": "T1", "value": ..., "stderr": ...}, ...],
-      "range": {"temperature_c": {"T1": [lo, hi], ...}, "temperature_unit": "degC",
-                "rate_c_per_min": {"T1": [lo, hi], ...}},
-      "fit": {"rms_residual": ..., "condition_number": ..., "n_samples": ..., ...},
-      "data": [{"file": "run1.csv", "sha256": "..."}],
-      "inputs": {"time_unit": "ms", "units": {"gyro": "deg/s", "T1": "counts"},
-                 "unit_sources": {"<time>": "metadata", "gyro": "option", ...},
-                 "temperature_conversion": {"T1": [0.0625, -50.0, "int16"]},
-                 "temperature_unit": "degC", "known_input": {...},
-                 "temperature_rate": {...}, "scale_factor": {...}},
-      "checksum": "sha256 of the canonical JSON of everything above"
-    }
-
-``signal.unit`` is the canonical unit the maths use ([°/h] or [mg]); ``inputs`` (format
-version 2, completed in 3) is how the fitted data were written: the time unit, each
-column's unit as given (e.g. ``deg/s``), raw-count temperature conversions, the known
-input removed and the Ṫ definition.  ``temperature_unit`` is ``counts`` for a model fitted
-on raw-count temperatures without a conversion: its ranges (``range.temperature_c``) and
-coefficients are then in counts, and applying it needs raw-count data.  compensate,
-validate, report and export-c use ``inputs`` where the command line and the data file are
-silent (:meth:`TemperatureModel.input_units`).  Older files load; what they did not
-record is unknown and falls to the resolver's stated default.
-
-Loading checks the format tag, the version (a newer version is refused with a
-clear error), the family (must be registered) and the checksum (a corrupted or
-hand-edited file is refused).  The checksum guards against accidents (truncation, a
-hand edit, a bit flip), not against tampering: anyone can recompute it.  So the content
-is checked too, before anything uses it: the reader's bounds (:mod:`thermocal.models.
-filecheck`: 64 MiB, nesting depth 32, finite numbers only, integers within ±2⁵³) and each
-section's types and shapes (:func:`thermocal.models.schema.verify_model_dict`; triads:
-:func:`thermocal.turntable.thermal.check_triad_dict`), every error naming the key path.
+The model file's layout, its format tag, version and checksum are described in
+:mod:`thermocal.models.format`, which writes and reads the dict of a model.
 """
 
 from __future__ import annotations
 
 import copy
-import datetime as _dt
 import functools
 import inspect
 import warnings
@@ -69,95 +28,17 @@ import numpy as np
 from thermocal.adequacy import Needs
 from thermocal.errors import (
     ExtrapolationWarning,
-    ModelFileError,
     ThermocalInputError,
 )
 from thermocal.families import FamilyDeclaration
-from thermocal.models.format import MODEL_FORMAT, MODEL_FORMAT_VERSION, _jsonify, check_model_header
+from thermocal.models.format import model_content, restore_model
 from thermocal.models.results import Coefficient, FitStats
 from thermocal.models.rundata import RunData, _run_units
 from thermocal.recording import FloatArray
 from thermocal.units import (
     DEFAULT_UNITS,
-    LEGACY_TEMPERATURE_UNIT,
     StatedUnits,
-    normalize_signal_unit,
-    normalize_temperature_unit,
 )
-
-# --- helpers for single-temperature streams --------------------------------------------------
-
-
-def stream_channel(temps_c: FloatArray | float, column: int) -> float:
-    """The model's temperature [°C] from one sample's ``temps_c``.
-
-    Parameters
-    ----------
-    temps_c : numpy.ndarray or float
-        One sample's temperatures [°C]: a single value, or one per fitted column.
-    column : int
-        Index of the model's column among the fitted columns.
-
-    Returns
-    -------
-    float
-        The only value, or the value at ``column`` when every fitted column is given [°C].
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> stream_channel(25.0, 1), stream_channel(np.array([20.0, 30.0]), 1)
-    (25.0, 30.0)
-    """
-    if type(temps_c) is np.ndarray and temps_c.dtype == np.float64 and temps_c.ndim == 1:
-        arr = temps_c
-    else:
-        arr = np.atleast_1d(np.asarray(temps_c, dtype=np.float64)).reshape(-1)
-    return float(arr.item(0) if arr.size == 1 else arr.item(column))
-
-
-class ClampOnce:
-    """Clamp one temperature to the fitted range ``[lo, hi]`` [°C] sample by sample, with
-    one :class:`ExtrapolationWarning` per stream (``extrapolate=True``: warn, keep T).
-
-    Parameters
-    ----------
-    lo, hi : float
-        The fitted temperature range [°C] (or [counts] for a model in counts).
-    extrapolate : bool
-        True: keep a temperature outside the range (and warn once); False: clamp it.
-
-    Notes
-    -----
-    .. math:: T_\\mathrm{used} = \\min(\\max(T, T_\\mathrm{lo}), T_\\mathrm{hi})
-
-    the clamping PX4 (``TemperatureCompensation.cpp``) and ArduPilot
-    (``AP_InertialSensor_tempcal.cpp``) apply outside the calibrated range.
-    """
-
-    __slots__ = ("extrapolate", "hi", "lo", "warned")
-
-    def __init__(self, lo: float, hi: float, *, extrapolate: bool) -> None:
-        self.lo = float(lo)
-        self.hi = float(hi)
-        self.extrapolate = extrapolate
-        self.warned = False
-
-    def __call__(self, x: float) -> float:
-        if x < self.lo or x > self.hi:
-            if not self.warned:
-                self.warned = True
-                action = "extrapolating" if self.extrapolate else "clamped to the fitted range"
-                warnings.warn(
-                    f"temperature {x:.2f} °C outside the model's fitted range "
-                    f"{self.lo:.2f}…{self.hi:.2f}; {action}",
-                    ExtrapolationWarning,
-                    stacklevel=3,
-                )
-            if not self.extrapolate:
-                x = min(max(x, self.lo), self.hi)
-        return x
-
 
 # --- the contract ----------------------------------------------------------------------------
 
@@ -650,80 +531,14 @@ class TemperatureModel(ABC):
         Returns
         -------
         dict
-            JSON-ready content in the layout of the module docstring.
+            JSON-ready content in the layout of :mod:`thermocal.models.format`.
 
         Raises
         ------
         thermocal.errors.ThermocalInputError
             The model is not fitted.
         """
-        from thermocal._version import __version__
-
-        self.check_fitted()
-        params = _jsonify(self.get_params())
-        state = _jsonify(self._state())
-        d: dict[str, Any] = {
-            "format": MODEL_FORMAT,
-            "format_version": MODEL_FORMAT_VERSION,
-            "family": self.family,
-            "thermocal_version": __version__,
-            "created_utc": _dt.datetime.now(_dt.UTC).strftime("%Y-%m-%dT%H:%M:%SZ"),
-            "signal": {"name": self.signal_name, "unit": self.signal_unit, "target": self.target},
-            "temperatures": list(self.temp_names_),
-            "temperature_unit": self.temperature_unit,
-            "rate": (
-                {
-                    "method": params.get("rate_method", "backward"),
-                    "interval_s": params.get("rate_interval_s", 60.0),
-                }
-                if self.uses_rate
-                else None
-            ),
-            "params": params,
-            "state": state,
-            "coefficients": [c.to_dict() for c in self.coefficients()],
-            "range": {
-                "temperature_c": {
-                    n: [float(a), float(b)]
-                    for n, (a, b) in zip(self.temp_names_, self.temp_range_, strict=True)
-                },
-                "rate_c_per_min": (
-                    {
-                        n: [float(a), float(b)]
-                        for n, (a, b) in zip(self.temp_names_, self.rate_range_, strict=True)
-                    }
-                    if self.rate_range_ is not None
-                    else None
-                ),
-            },
-            "fit": _jsonify(self.stats_.to_dict()),
-            "data": _jsonify(self.data_),
-            "inputs": _jsonify(self._inputs_record(params, bool(state.get("uses_rate", True)))),
-        }
-        if self.adequacy_ is not None:
-            d["adequacy"] = _jsonify(self.adequacy_)
-        d["range"]["temperature_unit"] = self.temperature_unit
-        return d
-
-    def _inputs_record(self, params: dict[str, Any], rate_used: bool) -> dict[str, Any]:
-        """The model file's ``inputs``: what the caller recorded (:func:`model_inputs`) with
-        the temperature unit of the model and the Ṫ definition of rate models."""
-        out = dict(getattr(self, "inputs_", {}) or {})
-        out["temperature_unit"] = self.temperature_unit
-        if self.uses_rate and rate_used:
-            tu = self.temperature_unit
-            method = params.get("rate_method", "backward")
-            interval = params.get("rate_interval_s", 60.0)
-            out["temperature_rate"] = {
-                "method": method,
-                "interval_s": interval,
-                "unit": f"{tu}/min",
-                "definition": (
-                    f"Ṫ = ΔT/Δt × 60 [{tu}/min] of the raw temperatures over {interval} s "
-                    f"({method} difference), within a contiguous (gap-free) segment"
-                ),
-            }
-        return out
+        return model_content(self)
 
     @classmethod
     def from_dict(cls, d: dict[str, Any]) -> Self:
@@ -746,48 +561,4 @@ class TemperatureModel(ABC):
         thermocal.errors.ModelFileError
             Wrong format tag, a newer format version, or a dict of another family.
         """
-        check_model_header(d)
-        if not cls.family or str(d["family"]) != cls.family:
-            raise ModelFileError(
-                f"a model of family {d['family']!r} is not a {cls.family or cls.__name__!r} "
-                "model (thermocal.models.registry.model_from_dict reads any family)"
-            )
-        model = cls(**d.get("params", {}))
-        model._set_state(d["state"])
-        model.temp_names_ = tuple(d["temperatures"])
-        tr = d["range"]["temperature_c"]
-        model.temp_range_ = np.array([tr[n] for n in model.temp_names_], dtype=np.float64)
-        rr = d["range"].get("rate_c_per_min")
-        model.rate_range_ = (
-            np.array([rr[n] for n in model.temp_names_], dtype=np.float64) if rr else None
-        )
-        fit = dict(d["fit"])
-        known = {
-            "n_samples",
-            "n_coefficients",
-            "rms_residual",
-            "condition_number",
-            "r_squared",
-            "dof",
-        }
-        model.stats_ = FitStats(
-            n_samples=int(fit.get("n_samples", 0)),
-            n_coefficients=int(fit.get("n_coefficients", 0)),
-            rms_residual=float(fit.get("rms_residual", float("nan"))),
-            condition_number=fit.get("condition_number"),
-            r_squared=fit.get("r_squared"),
-            dof=fit.get("dof"),
-            extra={k: v for k, v in fit.items() if k not in known},
-        )
-        model.data_ = list(d.get("data", []))
-        model.inputs_ = dict(d.get("inputs") or {})  # format version 1 files: unknown
-        adequacy = d.get("adequacy")
-        model.adequacy_ = dict(adequacy) if isinstance(adequacy, dict) else None
-        sig = d.get("signal") or {}
-        model.signal_name = sig.get("name", "signal")
-        model.signal_unit = normalize_signal_unit(str(sig["unit"]))  # required by the schema
-        model.target = sig.get("target", "bias")
-        tu = d.get("temperature_unit")
-        # files before format version 3 were always fitted in °C (and say so)
-        model.temperature_unit = normalize_temperature_unit(str(tu or LEGACY_TEMPERATURE_UNIT))
-        return model
+        return restore_model(cls, d)

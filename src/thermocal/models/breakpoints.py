@@ -22,7 +22,7 @@ from thermocal.errors import (
     DesignError,
     ThermocalInputError,
 )
-from thermocal.models.terms import LstsqSolution
+from thermocal.models.lstsq import LstsqSolution
 from thermocal.recording import FloatArray
 
 if TYPE_CHECKING:
@@ -364,9 +364,9 @@ def segment_tests(
     ``[b_j, b_{j+1})`` of the final ``breakpoints_c`` [°C] (``lo``/``hi`` the range's ends).
     Raw-count temperatures (``unit`` not °C): the span is not judged (as
     :func:`thermocal.adequacy.temperature_tests`).  Each message names the segment and the
-    option that helps: move or drop a breakpoint
-    (``--breakpoints``, when ``given``) or fewer ``--segments``; a failed span or sample
-    count can be fitted anyway with ``--allow-narrow`` (recorded, and ``export-c`` warns).
+    parameter that helps: move or drop a breakpoint (``breakpoints``, when ``given``) or
+    fewer ``segments``; a failed span or sample count can be fitted anyway with the
+    ``allow_narrow`` override (recorded in the adequacy record).
 
     Parameters
     ----------
@@ -394,12 +394,12 @@ def segment_tests(
         idx = segment_index(np.asarray(breakpoints_c, dtype=np.float64), x)
         for k in range(n_seg):
             parts[k].append(x[idx == k])
-    fix = (
-        "move or drop a breakpoint (--breakpoints)"
+    fix, named = (
+        ("move or drop a breakpoint ({breakpoints})", ("breakpoints",))
         if given
-        else f"ask fewer --segments (--segments {n_seg - 1})"
+        else (f"ask fewer {{segments}} ({{segments}} {n_seg - 1})", ("segments",))
         if n_seg > 1
-        else "record a wider sweep"
+        else ("record a wider sweep", ())
     )
     out: list[AdequacyTest] = []
     for k in range(n_seg):
@@ -414,6 +414,7 @@ def segment_tests(
                 t,
                 name=f"segment_{k + 1}_{t.name}",
                 message=t.message.removesuffix(": record a wider sweep") + f": {fix}",
+                parameters=named,
             )
             if t.verdict != "pass"
             else dataclasses.replace(t, name=f"segment_{k + 1}_{t.name}")

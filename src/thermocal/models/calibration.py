@@ -26,7 +26,7 @@ from __future__ import annotations
 
 import datetime as _dt
 import math
-from collections.abc import Collection, Sequence
+from collections.abc import Collection
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -217,19 +217,22 @@ class Triad:
         if data_unit == "counts" and self.count_scale is not None:
             out_unit, scale = self.unit, float(self.count_scale)
         elif data_unit == "counts":
-            raise UnitError(
+            scale_of = f"{self.model.kind}_scale"  # multipos's parameter of the count scale
+            raise UnitError.naming(
                 f"{where}: the {self.name} triad's columns are raw counts, and the calibration "
                 f"states no count scale (it was calibrated on {self.unit} data): convert the "
                 f"columns to {self.unit}, or calibrate the counts with multipos "
-                f"--{self.model.kind}-scale VALUE,UNIT"
+                f"{{{scale_of}}} VALUE,UNIT",
+                scale_of,
             )
         elif units.canonical_unit(data_unit) != units.canonical_unit(self.unit):
-            raise UnitError(
+            raise UnitError.naming(
                 f"{where}: the {self.name} triad was calibrated on "
                 f"{'raw counts of ' if self.count_scale is not None else ''}{self.unit} data; "
                 f"its columns {', '.join(map(repr, self.columns))} are read in {data_unit} "
-                "(give --signal-unit one unit per triad column, in the calibration's order, "
-                "or leave it out to take the file's or the calibration's)"
+                "(give {signal_unit} one unit per triad column, in the calibration's order, "
+                "or leave it out to take the file's or the calibration's)",
+                "signal_unit",
             )
         bias_unit = "deg/h" if self.model.kind == "gyro" else "mg"
         to_data = float(units.convert(np.array([1.0]), bias_unit, out_unit)[0])
@@ -548,59 +551,6 @@ def _count_scale_from_dict(cs: Any, unit: str, at: str) -> float | None:
     return float(value)
 
 
-def temperatures_of(cal: Calibration, names: Sequence[str] | None = None) -> list[str]:
-    """Every temperature input of the chosen channels, in first-seen order.
-
-    Parameters
-    ----------
-    cal : Calibration
-        The calibration.
-    names : sequence of str, optional
-        Channels to use; None (default): all.
-
-    Returns
-    -------
-    list of str
-    """
-    out: list[str] = []
-    for n in names or cal.names:
-        for t in cal.channel(n).model.temp_names_:
-            if t not in out:
-                out.append(str(t))
-    return out
-
-
-def merged_inputs(cal: Calibration, names: Sequence[str] | None = None) -> dict[str, Any]:
-    """The chosen channels' recorded inputs (units, conversions, time unit) merged into one
-    model-file ``inputs`` object, to read a recording once for all of them; the first
-    channel's wins where two disagree (each channel's unit is checked again when its model
-    is applied).
-
-    Parameters
-    ----------
-    cal : Calibration
-        The calibration.
-    names : sequence of str, optional
-        Channels to use; None (default): all.
-
-    Returns
-    -------
-    dict
-        One model-file ``inputs`` object.
-    """
-    out: dict[str, Any] = {}
-    units_: dict[str, Any] = {}
-    conv: dict[str, Any] = {}
-    for n in reversed(list(names or cal.names)):
-        inp = dict(getattr(cal.channel(n).model, "inputs_", {}) or {})
-        units_.update(inp.get("units") or {})
-        conv.update(inp.get("temperature_conversion") or {})
-        out.update(inp)
-    out["units"] = units_
-    out["temperature_conversion"] = conv
-    return out
-
-
 __all__ = [
     "CALIBRATION_FORMAT",
     "CALIBRATION_FORMAT_VERSION",
@@ -609,6 +559,4 @@ __all__ = [
     "calibration_from_dict",
     "guess_role",
     "is_calibration",
-    "merged_inputs",
-    "temperatures_of",
 ]

@@ -15,9 +15,7 @@ from thermocal.errors import ConditioningWarning, ExtrapolationWarning, Thermoca
 from thermocal.models.base import TemperatureModel
 from thermocal.models.results import FitStats
 from thermocal.models.rundata import RunData
-from thermocal.models.terms import (
-    CHUNK_ROWS,
-)
+from thermocal.models.terms import CHUNK_ROWS
 from thermocal.recording import FloatArray, contiguous_slices
 
 HOLDOUT_BLOCKS = 10
@@ -227,16 +225,20 @@ def decide_run_offsets(
     )
     if requested is True:
         warnings.warn(
-            why + "; per-run offsets kept as asked (--per-run-offset): distrust the slope and "
-            "its standard error, or record runs that share temperatures",
-            ConditioningWarning,
+            ConditioningWarning.naming(
+                why + "; per-run offsets kept as asked ({per_run_offset}): distrust "
+                "the slope and its standard error, or record runs that share temperatures",
+                "per_run_offset",
+            ),
             stacklevel=3,
         )
         return OffsetDecision(True, True, False, named, ranges, why)
     warnings.warn(
-        why + "; fitting one common offset instead (pooled). Pass --per-run-offset to force "
-        "offsets, or record runs that share temperatures",
-        ConditioningWarning,
+        ConditioningWarning.naming(
+            why + "; fitting one common offset instead (pooled). Pass "
+            "{per_run_offset} to force offsets, or record runs that share temperatures",
+            "per_run_offset",
+        ),
         stacklevel=3,
     )
     return OffsetDecision(False, None, False, named, ranges, why + "; pooled")

@@ -48,14 +48,18 @@ Model-file ``state`` layout (``"layout": "thermocal-piecewise-1"``), for the C e
 
 Evaluation of one sample: ``T`` clamped to ``range.temperature_c`` of the
 file; ``j`` = number of breakpoints ``≤ T``; ``y = intercepts[j] + slopes[j]·T``.
+
+This module holds the estimator, :class:`PiecewiseModel`, and its streaming twin; the lines'
+maths (initial breakpoints, segment checks, the chunked least squares, the intersections)
+are in :mod:`thermocal.models.piecewise_lines`, the choice of breakpoints from the data in
+:mod:`thermocal.models.breakpoints`.
 """
 
 from __future__ import annotations
 
 import bisect
 import math
-import warnings
-from collections.abc import Iterator, Sequence
+from collections.abc import Sequence
 from typing import TYPE_CHECKING, Any, ClassVar, Self
 
 import numpy as np
@@ -63,28 +67,15 @@ import numpy as np
 from thermocal._lazy import LazyModule
 from thermocal.adequacy import AdequacyTest, Needs
 from thermocal.errors import (
-    DesignError,
     ModelFileError,
     ThermocalInputError,
-    ThermocalWarning,
 )
 from thermocal.families import PIECEWISE, FamilyDeclaration
-from thermocal.models.base import (
-    ChunkContext,
-    ClampOnce,
-    ModelStream,
-    TemperatureModel,
-    stream_channel,
-)
+from thermocal.models.base import ChunkContext, ModelStream, TemperatureModel
 from thermocal.models.breakpoints import (
-    MIN_SEGMENT_BINS,
-    MIN_SEGMENT_SAMPLES,
-    MIN_SEGMENT_WIDTH_FRACTION,
     BreakpointChoice,
     _Lines,
-    choose_breakpoints,
     evaluate_lines,
-    segment_index,
     segment_tests,
 )
 from thermocal.models.checks import (
@@ -103,10 +94,16 @@ from thermocal.models.fitting import (
     decide_run_offsets,
     record_ranges,
 )
+from thermocal.models.piecewise_lines import (
+    check_segments,
+    initial_breakpoints,
+    intersections,
+    solve_lines,
+)
 from thermocal.models.residuals import MAX_SAMPLES_PER_SERIES, residual_correlation
 from thermocal.models.results import Coefficient, FitStats
 from thermocal.models.rundata import RunData
-from thermocal.models.terms import CHUNK_ROWS, Chunk, accumulate_r, solve_r
+from thermocal.models.streams import ClampOnce, stream_channel
 from thermocal.recording import FloatArray
 
 if TYPE_CHECKING:
@@ -130,7 +127,7 @@ class PiecewiseModel(TemperatureModel):
         intersections) or ``"continuous"`` (hinge-basis least squares).
     temperature : name or 0-based index of the temperature column (default the first).
     per_run_offset : per-run offsets as nuisance parameters; None (default) when the runs
-        overlap in temperature (:func:`thermocal.models.poly.decide_run_offsets`).
+        overlap in temperature (:func:`thermocal.models.fitting.decide_run_offsets`).
 
     Notes
     -----
@@ -251,10 +248,13 @@ class PiecewiseModel(TemperatureModel):
     def fit(self, runs: Sequence[RunData]) -> Self:
         """Fit eq. (1) on one or several runs (module docstring); returns ``self``.
 
-        Steps: the initial breakpoints, given or chosen by BIC (:meth:`_initial_breakpoints`);
-        every segment checked to hold a line (:meth:`_check_segments`); the lines by
-        chunked least squares (:meth:`_solve_lines`); the breakpoints moved to where
-        adjacent lines meet (intersect method, :meth:`_intersections`); residuals,
+        Steps (:mod:`thermocal.models.piecewise_lines`): the initial breakpoints, given
+        or chosen by BIC (:func:`~thermocal.models.piecewise_lines.initial_breakpoints`);
+        every segment checked to hold a line
+        (:func:`~thermocal.models.piecewise_lines.check_segments`); the lines by chunked
+        least squares (:func:`~thermocal.models.piecewise_lines.solve_lines`); the
+        breakpoints moved to where adjacent lines meet (intersect method,
+        :func:`~thermocal.models.piecewise_lines.intersections`); residuals,
         their correlation and the statistics (:meth:`_set_fitted`); every final segment
         judged by the common adequacy rules (:func:`segment_tests`, ``segment_tests_``).
 
@@ -287,11 +287,13 @@ class PiecewiseModel(TemperatureModel):
         decision = decide_run_offsets(self.per_run_offset, rl, self.family, column=j)
         lo = min(float(x.min()) for x in xs)
         hi = max(float(x.max()) for x in xs)
-        bps, choice = self._initial_breakpoints(xs, ys, decision.used, lo, hi)
+        bps, choice = initial_breakpoints(
+            xs, ys, decision.used, lo, hi, breakpoints=self.breakpoints, segments=self.segments
+        )
         bp = np.asarray(bps, dtype=np.float64)
-        self._check_segments(bp, xs, lo, hi)
-        lines = self._solve_lines(xs, ys, bp, rl, decision.used, lo, hi)
-        final, discontinuities = self._intersections(bp, lines, lo, hi)
+        check_segments(bp, xs, lo, hi)
+        lines = solve_lines(xs, ys, bp, rl, decision.used, lo, hi, self.method)
+        final, discontinuities = intersections(bp, lines, lo, hi, self.method)
         self._set_fitted(rl, names, j, xs, ys, bp, final, discontinuities, lines, decision,
                          choice)  # fmt: skip
         self.segment_tests_ = segment_tests(
@@ -299,193 +301,6 @@ class PiecewiseModel(TemperatureModel):
             unit="°C" if rl[0].temperature_unit == "degC" else str(rl[0].temperature_unit),
         )  # fmt: skip
         return self
-
-    def _initial_breakpoints(
-        self, xs: list[FloatArray], ys: list[FloatArray], use_offsets: bool, lo: float, hi: float
-    ) -> tuple[list[float], BreakpointChoice | None]:
-        """The breakpoints given (checked inside the data's range), or the number of
-        segments the data support, chosen by BIC (a warning when fewer than asked)."""
-        choice: BreakpointChoice | None = None
-        if self.breakpoints is not None:
-            bps = sorted(float(b) for b in self.breakpoints)
-            for b in bps:
-                if not lo < b < hi:
-                    raise DesignError(
-                        f"breakpoint {b:g} °C is outside the data's temperature range "
-                        f"{lo:.2f}…{hi:.2f} °C"
-                    )
-            if len(set(bps)) != len(bps):
-                raise ThermocalInputError("breakpoints must be distinct")
-        else:
-            n_seg = 3 if self.segments is None else int(self.segments)
-            choice = choose_breakpoints(xs, ys, n_seg, per_run_offset=use_offsets)
-            bps = choice.breakpoints_c
-            if choice.reduced:
-                reasons = []
-                if choice.supported < n_seg:
-                    reasons.append(
-                        f"segments of ≥ {MIN_SEGMENT_WIDTH_FRACTION:.0%} of the "
-                        f"{lo:.4g}…{hi:.4g} °C range with ≥ {MIN_SEGMENT_SAMPLES} samples over "
-                        f"≥ {MIN_SEGMENT_BINS} distinct temperatures allow at most "
-                        f"{choice.supported}"
-                    )
-                if choice.chosen < choice.supported:
-                    reasons.append("more breakpoints do not lower the BIC")
-                what = (
-                    "the data are a line"
-                    if choice.chosen == 1
-                    else f"the data support {choice.chosen}"
-                )
-                warnings.warn(
-                    f"piecewise: {n_seg} segments asked for, {choice.chosen} fitted: {what} ("
-                    + "; ".join(reasons)
-                    + "; BIC by number of segments: "
-                    + ", ".join(f"{k}: {v:.1f}" for k, v in enumerate(choice.bic, start=1))
-                    + ")",
-                    ThermocalWarning,
-                    stacklevel=2,
-                )
-        return list(bps), choice
-
-    @staticmethod
-    def _check_segments(bp: FloatArray, xs: list[FloatArray], lo: float, hi: float) -> None:
-        """Every segment holds at least two distinct temperatures (a line is determined)."""
-        S = bp.size + 1
-        seg_edges = [lo, *bp.tolist(), hi]
-        labels = [f"{seg_edges[s]:.4g}–{seg_edges[s + 1]:.4g} °C" for s in range(S)]
-        counts = np.zeros(S, dtype=np.int64)
-        for x in xs:
-            counts += np.bincount(segment_index(bp, x), minlength=S)
-        spans = np.zeros(S)
-        for x in xs:
-            seg = segment_index(bp, x)
-            for s_ in range(S):
-                xs_ = x[seg == s_]
-                if xs_.size:
-                    spans[s_] = max(spans[s_], float(np.ptp(xs_)))
-        for s in range(S):
-            if counts[s] < 2 or not spans[s] > 1e-9 * max(1.0, abs(hi)):
-                raise DesignError(
-                    f"segment {labels[s]} has {int(counts[s])} sample(s) over "
-                    f"{spans[s]:.3g} °C; a line needs at least 2 distinct temperatures "
-                    "(move or drop a breakpoint)"
-                )
-
-    def _solve_lines(
-        self,
-        xs: list[FloatArray],
-        ys: list[FloatArray],
-        bp: FloatArray,
-        rl: list[RunData],
-        use_offsets: bool,
-        lo: float,
-        hi: float,
-    ) -> _Lines:
-        """The segments' lines ``y = a_s + k_s T`` by chunked least squares (Householder QR),
-        with their covariance."""
-        S = bp.size + 1
-        bps = bp.tolist()
-        seg_edges = [lo, *bps, hi]
-        labels = [f"{seg_edges[s]:.4g}–{seg_edges[s + 1]:.4g} °C" for s in range(S)]
-        m = len(rl) if use_offsets else 1
-        centre = 0.5 * (lo + hi)
-        scale = max(0.5 * (hi - lo), 1e-12)
-        if self.method == "intersect":
-            # features: slope of each segment, then intercept steps of segments 2..S
-            p = S + (S - 1)
-            names_f = [f"slope[{lab}]" for lab in labels] + [f"level[{lab}]" for lab in labels[1:]]
-        else:
-            p = 1 + bp.size
-            names_f = ["slope"] + [f"hinge[{b:.4g}]" for b in bps]
-        names_all = names_f + (
-            [f"offset[{r.name or i + 1}]" for i, r in enumerate(rl)] if use_offsets else ["const"]
-        )
-
-        def features(x: FloatArray, out: FloatArray) -> None:
-            u = (x - centre) / scale
-            if self.method == "intersect":
-                seg = segment_index(bp, x)
-                for s in range(S):
-                    np.multiply(u, seg == s, out=out[:, s])
-                for s in range(1, S):
-                    out[:, S + s - 1] = seg == s
-            else:
-                out[:, 0] = u
-                for i, b in enumerate(bp):
-                    np.maximum(0.0, (x - b) / scale, out=out[:, 1 + i])
-
-        def make_chunks() -> Iterator[Chunk]:
-            bufs: dict[int, FloatArray] = {}
-            for i, (x, y) in enumerate(zip(xs, ys, strict=True)):
-                g = i if use_offsets else 0
-                for a in range(0, x.size, CHUNK_ROWS):
-                    b = min(x.size, a + CHUNK_ROWS)
-                    c = b - a
-                    if c not in bufs:
-                        bufs[c] = np.empty((c, p + 2), order="F")
-                        bufs[c][:, p] = 1.0
-                    A = bufs[c]
-                    features(x[a:b], A[:, :p])
-                    A[:, p + 1] = y[a:b]
-                    yield A, g, 0
-
-        red = accumulate_r(make_chunks, p, m, solver="qr")
-        sol = solve_r(red.combined(), red.n_total, names_all)
-        coef = sol.coef
-        offsets = coef[p:]
-        const = float(np.mean(offsets))
-        # lines y = a_s + k_s T as a linear map of the solution [coef, offsets]
-        q = p + m
-        A_int = np.zeros((S, q))  # intercepts a_s
-        A_slp = np.zeros((S, q))  # slopes k_s
-        A_int[:, p:] = 1.0 / m
-        if self.method == "intersect":
-            for s in range(S):
-                A_slp[s, s] = 1.0 / scale
-                A_int[s, s] = -centre / scale
-                if s > 0:
-                    A_int[s, S + s - 1] = 1.0
-        else:
-            # y = const + s0 (T − c)/σ + Σ_i d_i max(0, T − b_i)/σ
-            for s in range(S):
-                A_slp[s, 0] = 1.0 / scale
-                A_int[s, 0] = -centre / scale
-                for i in range(s):  # hinges active in segment s
-                    A_slp[s, 1 + i] = 1.0 / scale
-                    A_int[s, 1 + i] = -bp[i] / scale
-        intercepts = A_int @ coef
-        slopes = A_slp @ coef
-        Lmat = np.vstack([A_int, A_slp])
-        line_cov = Lmat @ sol.cov @ Lmat.T
-        return _Lines(intercepts, slopes, line_cov, offsets, const, sol, red.n_total, m)
-
-    def _intersections(
-        self, bp: FloatArray, lines: _Lines, lo: float, hi: float
-    ) -> tuple[FloatArray, list[float]]:
-        """Intersect method: each breakpoint moved to where the adjacent lines meet, when
-        that lies between its neighbours; the others kept (the model jumps there)."""
-        intercepts, slopes = lines.intercepts, lines.slopes
-        final = bp.copy()
-        discontinuities: list[float] = []
-        if self.method == "intersect":
-            for i in range(bp.size):
-                ds = slopes[i] - slopes[i + 1]
-                x_star = (intercepts[i + 1] - intercepts[i]) / ds if ds != 0 else math.nan
-                left = final[i - 1] if i > 0 else lo
-                right = bp[i + 1] if i + 1 < bp.size else hi
-                if math.isfinite(x_star) and left < x_star < right:
-                    final[i] = x_star
-                else:
-                    discontinuities.append(float(bp[i]))
-            if discontinuities:
-                warnings.warn(
-                    "piecewise: adjacent lines do not intersect between their segments at "
-                    + ", ".join(f"{b:g} °C" for b in discontinuities)
-                    + "; the given breakpoint is kept and the model jumps there",
-                    ThermocalWarning,
-                    stacklevel=2,
-                )
-        return final, discontinuities
 
     def _set_fitted(
         self,

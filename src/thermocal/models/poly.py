@@ -34,7 +34,7 @@ see :func:`thermocal.preprocess.temperature_rate`.  ``"forward"`` and
 ``"centred"`` forms may be chosen for batch use (not for streaming).
 
 Evaluation, in order, for every sample (this is what :meth:`PolyModel.predict`,
-:class:`PolyStream` and the generated C code compute):
+:class:`~thermocal.models.poly_stream.PolyStream` and the generated C code compute):
 
 1. Ṫ_k from the *raw* temperatures (rule above) [°C/min];
 2. clamp T_k to the fitted range ``range.temperature_c`` and Ṫ_k to
@@ -44,17 +44,18 @@ Evaluation, in order, for every sample (this is what :meth:`PolyModel.predict`,
    ``w_k`` built from the clamped T_k·Ṫ_k;
 4. ``y = constant + Σ_j coef[j] · u^t_power · v^rate_power · w^coupling_power``.
 
-How steps 3–4 are computed (:class:`EvalPlan`; the same operations in
-:meth:`PolyModel.predict` on numpy blocks and in :class:`PolyStream` on Python
-floats, so the two agree to the last bit): the scales are folded into the
-coefficients and the pure powers of each variable summed by Horner's rule in the
-centred variable, e.g. ``((a₃/s³·d + a₂/s²)·d + a₁/s)·d`` with ``d = T − c_T``;
-the centres of Ṫ and T·Ṫ (near 0) are folded into the coefficients and the
-constant when every ``|c| ≤ s``.  Mathematically the same model as eq. (1);
-numerically it differs from the literal sum of the scaled terms by rounding only
-(~1e-16 relative).  ``predict`` works in cache-sized blocks of
-:data:`PREDICT_BLOCK_ROWS` samples, with Ṫ's partner samples found per block by
-:func:`~thermocal.models.terms.backward_partners` (a slice on regular sampling).
+How steps 3–4 are computed (:class:`~thermocal.models.poly_types.EvalPlan`; the same
+operations in :meth:`PolyModel.predict` on numpy blocks and in
+:class:`~thermocal.models.poly_stream.PolyStream` on Python floats, so the two agree to the
+last bit): the scales are folded into the coefficients and the pure powers of each variable
+summed by Horner's rule in the centred variable, e.g. ``((a₃/s³·d + a₂/s²)·d + a₁/s)·d``
+with ``d = T − c_T``; the centres of Ṫ and T·Ṫ (near 0) are folded into the coefficients and
+the constant when every ``|c| ≤ s``. Mathematically the same model as eq. (1); numerically
+it differs from the literal sum of the scaled terms by rounding only (~1e-16 relative).
+``predict`` works in cache-sized blocks of
+:data:`~thermocal.models.poly_eval.PREDICT_BLOCK_ROWS` samples, with Ṫ's partner samples
+found per block by :func:`~thermocal.preprocess.backward_partners` (a slice on regular
+sampling).
 
 Model-file ``state`` layout (``"layout": "thermocal-poly-1"``), for the C export::
 
@@ -93,17 +94,15 @@ checks and ranges shared with the other families are in :mod:`thermocal.models.f
 from __future__ import annotations
 
 import math
-import warnings
-from collections import deque
 from collections.abc import Sequence
 from typing import Any, ClassVar, Self
 
 import numpy as np
 
 from thermocal.adequacy import Needs
-from thermocal.errors import ExtrapolationWarning, ModelFileError, ThermocalInputError
+from thermocal.errors import ModelFileError, ThermocalInputError
 from thermocal.families import POLY, FamilyDeclaration
-from thermocal.models.base import ChunkContext, ModelStream
+from thermocal.models.base import ChunkContext
 from thermocal.models.checks import (
     boolean,
     fields,
@@ -116,69 +115,15 @@ from thermocal.models.checks import (
     same_length,
     string,
 )
-from thermocal.models.fitting import (  # shared with piecewise; re-exported
-    OffsetDecision as OffsetDecision,
-)
-from thermocal.models.fitting import (
-    check_runs as check_runs,
-)
-from thermocal.models.fitting import (
-    decide_run_offsets as decide_run_offsets,
-)
-from thermocal.models.fitting import (
-    record_ranges as record_ranges,
-)
-from thermocal.models.fitting import (
-    run_blocks as run_blocks,
-)
-from thermocal.models.fitting import (
-    run_overlap_groups as run_overlap_groups,
-)
-from thermocal.models.fitting import (
-    short_rate_share as short_rate_share,
-)
-from thermocal.models.fitting import (
-    warn_rate_range as warn_rate_range,
-)
-from thermocal.models.poly_eval import (
-    PREDICT_BLOCK_ROWS as PREDICT_BLOCK_ROWS,
-)
 from thermocal.models.poly_eval import evaluate
-from thermocal.models.poly_eval import (
-    evaluation_key as evaluation_key,
-)
-from thermocal.models.poly_eval import (
-    predict_many as predict_many,
-)
-from thermocal.models.poly_eval import (
-    warn_temperature_range as warn_temperature_range,
-)
-from thermocal.models.poly_fit import COND_WARN as COND_WARN
-from thermocal.models.poly_fit import fit_shared as fit_shared
-from thermocal.models.poly_types import (
-    DEFAULT_NOISE_THRESHOLD as DEFAULT_NOISE_THRESHOLD,
-)
-from thermocal.models.poly_types import (
-    DEFAULT_RCOND as DEFAULT_RCOND,
-)
-from thermocal.models.poly_types import (
-    EvalPlan as EvalPlan,
-)
+from thermocal.models.poly_fit import fit_shared
+from thermocal.models.poly_stream import PolyStream
 from thermocal.models.poly_types import PolyBase
-from thermocal.models.poly_types import (
-    build_plan as build_plan,
-)
 from thermocal.models.results import Coefficient
 from thermocal.models.rundata import RunData
-from thermocal.models.terms import (
-    BaseScaling,
-    Term,
-    monomial_name,
-    parse_terms,
-    raw_expansion,
-)
+from thermocal.models.term_scaling import BaseScaling, monomial_name, raw_expansion
+from thermocal.models.terms import Term, parse_terms
 from thermocal.recording import GAP_FACTOR, FloatArray
-from thermocal.units import SECONDS_PER_MINUTE
 
 MAX_TERM_POWER = 32
 """Highest power of a poly term's base variable accepted in a file (a polynomial of
@@ -209,7 +154,8 @@ class PolyModel(PolyBase):
     ridge : ridge α on the unit-RMS term columns (0 = none).
     rcond : truncation threshold of the SVD solution (relative to s_max).
     per_run_offset : one turn-on offset per run, estimated as nuisance parameters; None
-        (default) when the runs overlap in temperature (:func:`decide_run_offsets`).
+        (default) when the runs overlap in temperature
+        (:func:`~thermocal.models.fitting.decide_run_offsets`).
     solver : ``"auto"`` (Gram when well conditioned, else chunked QR), ``"qr"``, ``"gram"``.
     noise_threshold : a component below ``rcond`` is kept when ``|uᵢᵀz| > k σ̂`` (None: never).
 
@@ -265,7 +211,8 @@ class PolyModel(PolyBase):
 
         Works through each run in blocks of :data:`~thermocal.models.terms.CHUNK_ROWS`
         samples (Ṫ, features and the reduction per block), so memory stays at the
-        input arrays plus a few MB.  :func:`fit_shared` fits several channels at once.
+        input arrays plus a few MB.  :func:`~thermocal.models.poly_fit.fit_shared` fits
+        several channels at once.
 
         Parameters
         ----------
@@ -320,9 +267,10 @@ class PolyModel(PolyBase):
     def predict(self, run: RunData, *, extrapolate: bool = False) -> FloatArray:
         """Temperature-induced signal of every sample [signal unit] (module docstring steps 1–4).
 
-        Evaluated in blocks of :data:`PREDICT_BLOCK_ROWS` rows (Ṫ partners found per
-        block by :func:`~thermocal.models.terms.backward_partners`; Horner's rule per
-        sensor, :class:`EvalPlan`); the same numbers as :class:`PolyStream`.
+        Evaluated in blocks of :data:`~thermocal.models.poly_eval.PREDICT_BLOCK_ROWS` rows
+        (Ṫ partners found per block by :func:`~thermocal.preprocess.backward_partners`;
+        Horner's rule per sensor, :class:`~thermocal.models.poly_types.EvalPlan`); the same
+        numbers as :class:`~thermocal.models.poly_stream.PolyStream`.
 
         Parameters
         ----------
@@ -565,155 +513,3 @@ def _monomial_unit(signal_unit: str, P: int, Q: int) -> str:
     if Q:
         unit += "/(degC/min)" + (f"^{Q}" if Q > 1 else "")
     return unit
-
-
-class PolyStream(ModelStream):
-    """Sample-by-sample :class:`PolyModel` (module docstring steps 1–4), in plain Python
-    floats: the same operations as :meth:`PolyModel.predict` (:class:`EvalPlan`).
-
-    Keeps the samples of the last Δt of the current contiguous segment for the
-    backward rate (a ring buffer; the partner is the oldest sample with
-    ``t_j ≥ t − Δt``, as ``searchsorted`` in the batch); a step longer than
-    ``GAP_FACTOR × sample_interval_s`` starts a new segment (rate restarts from 0).
-    Warns once per stream (per kind: temperature, rate) when a sample leaves the
-    fitted range.
-
-    Parameters
-    ----------
-    model : PolyModel
-        The fitted model.
-    sample_interval_s : float
-        Nominal sample interval [s].
-    extrapolate : bool
-        Keep out-of-range inputs (and warn).
-
-    Raises
-    ------
-    thermocal.errors.ThermocalInputError
-        A sample interval that is not positive.
-    """
-
-    def __init__(self, model: PolyModel, sample_interval_s: float, *, extrapolate: bool) -> None:
-        if not sample_interval_s > 0:
-            raise ThermocalInputError(f"sample interval must be positive, got {sample_interval_s}")
-        plan = model._plan()
-        self.model = model
-        self.extrapolate = extrapolate
-        self.gap_s = GAP_FACTOR * float(sample_interval_s)
-        self.interval_s = float(model.rate_interval_s)
-        self.uses_rate = bool(plan.rate_sensors)
-        self._k = int(model.temp_range_.shape[0])
-        self._t_lo: list[float] = [float(v) for v in model.temp_range_[:, 0]]
-        self._t_hi: list[float] = [float(v) for v in model.temp_range_[:, 1]]
-        self._t_bounds = list(zip(range(self._k), self._t_lo, self._t_hi, strict=True))
-        rr = model.rate_range_
-        # (column, lo, hi) of every Ṫ the terms use; ±inf without a fitted rate range
-        self._rate_spec: list[tuple[int, float, float]] = [
-            (j, float(rr[j, 0]), float(rr[j, 1])) if rr is not None else (j, -math.inf, math.inf)
-            for j in plan.rate_sensors
-        ]
-        self._const = plan.constant
-        self._rows = plan.py_rows
-        self.reset()
-
-    def reset(self) -> None:
-        """Forget everything (a new power-on): the Ṫ history restarts."""
-        self._times: deque[float] = deque()
-        self._hist: deque[list[float]] = deque()
-        self._last_t: float | None = None
-        self._warned_t = False
-        self._warned_r = False
-
-    def _warn(self, what: str) -> None:
-        action = "extrapolating" if self.extrapolate else "clamped to the fitted range"
-        warnings.warn(
-            f"{what} outside the model's fitted range; {action}", ExtrapolationWarning, stacklevel=3
-        )
-
-    def update(self, time_s: float, temps_c: FloatArray, signal: float | None = None) -> float:
-        """Model value for one sample (see :meth:`ModelStream.update`).
-
-        Parameters
-        ----------
-        time_s : float
-            Sample time [s].
-        temps_c : numpy.ndarray
-            Temperatures [°C].
-        signal : float, optional
-            Not used.
-
-        Returns
-        -------
-        float
-            [signal unit].
-        """
-        t = float(time_s)
-        if type(temps_c) is np.ndarray and temps_c.dtype == np.float64 and temps_c.ndim == 1:
-            row: list[float] = temps_c.tolist()
-        else:
-            row = np.asarray(temps_c, dtype=np.float64).reshape(-1).tolist()
-        if len(row) != self._k:
-            raise ThermocalInputError(
-                f"poly model uses {self._k} temperature channels; the sample has {len(row)}"
-            )
-        rates = row  # placeholder, replaced when the model uses Ṫ
-        if self.uses_rate:
-            times, hist = self._times, self._hist
-            if self._last_t is not None and t - self._last_t > self.gap_s:
-                times.clear()
-                hist.clear()
-            self._last_t = t
-            times.append(t)
-            hist.append(row)
-            x = t - self.interval_s
-            while times[0] < x:
-                times.popleft()
-                hist.popleft()
-            span = t - times[0]
-            rates = [0.0] * self._k
-            old = hist[0]
-            for j, lo, hi in self._rate_spec:
-                r = (row[j] - old[j]) / span * SECONDS_PER_MINUTE if span > 0 else 0.0
-                if r < lo or r > hi:
-                    if not self._warned_r:
-                        self._warned_r = True
-                        self._warn("temperature rate")
-                    if not self.extrapolate:
-                        r = lo if r < lo else hi
-                rates[j] = r
-        temps = row
-        for j, lo, hi in self._t_bounds:
-            v = row[j]
-            if v < lo or v > hi:
-                if not self._warned_t:
-                    self._warned_t = True
-                    self._warn("temperature")
-                if not self.extrapolate:
-                    if temps is row:
-                        temps = list(row)
-                    temps[j] = lo if v < lo else hi
-        y = self._const
-        for col, tc, rc, wc, polys, mixed in self._rows:
-            temp = temps[col]
-            s: float | None = None
-            for kind, top, rest in polys:
-                if kind == 0:
-                    d = temp - tc
-                elif kind == 1:
-                    d = rates[col] - rc
-                else:
-                    d = temp * rates[col] - wc
-                acc = d * top
-                for cp in rest:
-                    acc = (acc + cp) * d
-                s = acc if s is None else s + acc
-            if s is None:
-                s = 0.0
-            for cf, factors in mixed:
-                ds = [temp - tc, rates[col] - rc, temp * rates[col] - wc]
-                m = ds[factors[0]] * cf
-                for f in factors[1:]:
-                    m = m * ds[f]
-                s = s + m
-            y = y + s
-        return y

@@ -16,12 +16,7 @@ from thermocal.errors import ExtrapolationWarning
 from thermocal.models.fitting import warn_rate_range
 from thermocal.models.poly_types import EvalPlan, PolyBase
 from thermocal.models.rundata import RunData
-from thermocal.models.terms import (
-    backward_partners,
-    gap_free_slices,
-    step_range,
-    temperature_rates,
-)
+from thermocal.preprocess import backward_partners, gap_free_slices, step_range, temperature_rates
 from thermocal.recording import FloatArray
 from thermocal.units import SECONDS_PER_MINUTE
 

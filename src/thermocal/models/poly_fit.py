@@ -23,24 +23,15 @@ from thermocal.models.fitting import (
     run_blocks,
     short_rate_share,
 )
+from thermocal.models.lstsq import LstsqSolution, forward_select, solve_r
 from thermocal.models.poly_types import PolyBase
+from thermocal.models.reduction import Chunk, Reduced, accumulate_targets
 from thermocal.models.residuals import MAX_SAMPLES_PER_SERIES, residual_correlation
 from thermocal.models.results import FitStats
 from thermocal.models.rundata import RunData
-from thermocal.models.terms import (
-    BaseScaling,
-    Chunk,
-    LstsqSolution,
-    Reduced,
-    Term,
-    accumulate_targets,
-    fit_base_scaling,
-    forward_select,
-    parse_terms,
-    segment_rates,
-    solve_r,
-    term_features,
-)
+from thermocal.models.term_scaling import BaseScaling, fit_base_scaling
+from thermocal.models.terms import Term, parse_terms, term_features
+from thermocal.preprocess import segment_rates
 from thermocal.recording import FloatArray
 
 COND_WARN = 1.0e8
@@ -66,14 +57,14 @@ def fit_shared(models: Sequence[PolyBase], runs_by_model: Sequence[Sequence[RunD
     The work that depends on the temperatures alone — Ṫ, the base-variable scaling, the
     features, the offset decision, the ranges — is done once and the design's Gram matrix
     is accumulated once; only the targets' products are per channel
-    (:func:`~thermocal.models.terms.accumulate_targets`), so each channel's reduction is
+    (:func:`~thermocal.models.reduction.accumulate_targets`), so each channel's reduction is
     computed by the operations a single channel gets, bit for bit.  Term selection, the
     solution, the residuals' autocorrelation and the covariance are per channel, so every
     model equals the one :meth:`PolyModel.fit` gives on its own runs.
 
     Steps: check the channels share their inputs (:func:`_shared_runs`); the design
     (:func:`_shared_design`); one pass reducing it (:class:`_DesignPass`,
-    :func:`~thermocal.models.terms.accumulate_targets`); per channel the selection and
+    :func:`~thermocal.models.reduction.accumulate_targets`); per channel the selection and
     solution (:func:`_solve_channel`); a second pass for the residuals; per channel the
     covariance and statistics (:func:`_finish_channel`).
 
@@ -193,14 +184,17 @@ def _warn_short_rates(head: PolyBase, rl: list[RunData], n_total: int) -> None:
     n_short = sum(c for c, _ in shares)
     if n_short > SHORT_RATE_WARN_SHARE * n_total:
         warnings.warn(
-            f"poly: {n_short / n_total:.0%} of the samples have a temperature rate taken "
-            f"over less than half the rate interval ({head.rate_interval_s:g} s): the "
-            f"record breaks into {sum(g for _, g in shares)} contiguous segment(s) at "
-            "its gaps (bursts or dropouts), and a rate over a fraction of a second is "
-            "temperature noise; the rate terms and the fitted rate range rest on it. "
-            "Fit a plain polynomial (--order N), average the record to one block per "
-            "burst, or choose --rate-interval shorter than the segments",
-            ConditioningWarning,
+            ConditioningWarning.naming(
+                f"poly: {n_short / n_total:.0%} of the samples have a temperature rate taken "
+                f"over less than half the rate interval ({head.rate_interval_s:g} s): the "
+                f"record breaks into {sum(g for _, g in shares)} contiguous segment(s) at "
+                "its gaps (bursts or dropouts), and a rate over a fraction of a second is "
+                "temperature noise; the rate terms and the fitted rate range rest on it. "
+                "Fit a plain polynomial ({order} N), average the record to one block per "
+                "burst, or choose {rate_interval_s} shorter than the segments",
+                "order",
+                "rate_interval_s",
+            ),
             stacklevel=4,
         )
 
@@ -353,10 +347,12 @@ def _finish_channel(
     cov = corr.tau * (L @ sol.cov @ L.T)
     if sol.condition_number > COND_WARN:
         warnings.warn(
-            f"poly: ill-conditioned design (condition number {sol.condition_number:.3g}); "
-            f"{sol.n_truncated} singular value(s) truncated at rcond={mdl.rcond}; "
-            "consider fewer terms, --select or --ridge",
-            ConditioningWarning,
+            ConditioningWarning.naming(
+                f"poly: ill-conditioned design (condition number {sol.condition_number:.3g}); "
+                f"{sol.n_truncated} singular value(s) truncated at rcond={mdl.rcond}; "
+                "consider fewer terms, stepwise term selection or {ridge}",
+                "ridge",
+            ),
             stacklevel=4,
         )
     tss = s2_ - s1_ * s1_ / n_s

@@ -20,8 +20,9 @@ from thermocal.errors import ThermocalInputError
 from thermocal.models.base import TemperatureModel
 from thermocal.models.fitting import Block
 from thermocal.models.rundata import RunData
-from thermocal.models.terms import BaseScaling, Term, segment_rates, temperature_rates
-from thermocal.preprocess import RATE_METHODS
+from thermocal.models.term_scaling import BaseScaling
+from thermocal.models.terms import Term
+from thermocal.preprocess import RATE_METHODS, segment_rates, temperature_rates
 from thermocal.recording import FloatArray
 
 DEFAULT_RCOND = 1.0e-3

@@ -214,10 +214,11 @@ def _auto_temperature_unit(rec: Recording, names: Sequence[str]) -> Literal["deg
     if not raw:
         return "degC"
     if len(raw) < len(names):
-        raise UnitError(
+        raise UnitError.naming(
             f"{rec.name}: temperature column(s) {', '.join(map(repr, raw))} are raw counts "
             "without a conversion, the others are in °C; a model takes one temperature "
-            "unit: give --temp-conversion GAIN,OFFSET[,int16] for the counts"
+            "unit: give {temp_conversion} GAIN,OFFSET[,int16] for the counts",
+            "temp_conversion",
         )
     warnings.warn(
         UnitWarning(
@@ -238,9 +239,10 @@ def _run_units(runs: Sequence[RunData]) -> tuple[str | None, str]:
         raise UnitError(f"the runs' signals are in different units: {', '.join(sorted(sig))}")
     temp = {r.temperature_unit for r in runs}
     if len(temp) > 1:
-        raise UnitError(
+        raise UnitError.naming(
             "some runs give temperatures in °C and some in raw counts without a conversion; "
-            "give --temp-conversion for the counts"
+            "give {temp_conversion} for the counts",
+            "temp_conversion",
         )
     return (next(iter(sig)) if sig else None), (next(iter(temp)) if temp else "degC")
 

@@ -19,32 +19,36 @@ Three parts, all pure numpy/scipy:
    Ṫ³, TṪ, (TṪ)², (TṪ)³ and 1 (each base variable is an affine map of the raw
    one), but the design is far better conditioned.  In general the span of a
    term list is the span of its centred monomials; for hierarchical lists
-   (every lower power present, as in ``seed000`` and ``--order N``) it equals
+   (every lower power present, as in ``seed000`` and ``order=N``) it equals
    the span of the raw monomials.
 
-   Term text (``--terms``): factors joined by ``*``, each ``T<k>``, ``dT<k>``
+   Term text (``terms``): factors joined by ``*``, each ``T<k>``, ``dT<k>``
    or a parenthesised product, with an optional ``^p``; ``k`` is the 1-based
-   position of the sensor in the temperature list (``--temps``).  A raw
+   position of the sensor in the temperature list (``temperatures``).  A raw
    monomial ``T^p Ṫ^q`` is stored as ``c = min(p, q)``, ``a = p − c``,
    ``b = q − c``: ``T1*dT1`` is the coupling base variable w₁, ``(T1*dT1)^2``
    is w₁², ``T1^2*dT1`` is u₁·w₁.  A constant is always part of the model.
+
+   The base variables' centres and scales (:class:`~thermocal.models.term_scaling.BaseScaling`)
+   and the expansion into raw monomials are in :mod:`thermocal.models.term_scaling`.
 
 2. **Features**: :func:`term_features` evaluates the terms for a block of
    samples; powers are formed by repeated multiplication so that a one-sample
    block (the streaming twin) gives the same numbers as a long one.
 
-3. **Least squares in chunks** (:mod:`thermocal.models.lstsq`, re-exported here):
-   :func:`accumulate_r` reduces the design
+3. **Least squares in chunks** (:mod:`thermocal.models.reduction` and
+   :mod:`thermocal.models.lstsq`, used with the terms):
+   :func:`~thermocal.models.reduction.accumulate_r` reduces the design
    ``A = [F | Z | y]`` (F the term features, Z one indicator column per run for
    the per-run offsets, y the target) to its triangular factor ``R_aug`` chunk
    by chunk, either by a chunked Householder QR (R factors stacked and
    re-triangularised, LAPACK ``dgeqrf``) or by accumulating the Gram matrix
    ``AᵀA`` and taking its Cholesky factor (``RᵀR = AᵀA``; the same R up to
    signs).  The Gram path is used only when the column-equilibrated design is
-   well conditioned (κ ≤ :data:`GRAM_MAX_COND`, so that the κ²ε loss of
+   well conditioned (κ ≤ :data:`~thermocal.models.reduction.GRAM_MAX_COND`, so that the κ²ε loss of
    forming AᵀA stays below ~1e-6 relative); otherwise the data are passed again
-   through the QR path.  :func:`solve_r` then solves the column-scaled problem
-   ``min ‖R_s γ − z‖² + n α ‖γ_F‖²`` by SVD (optional ridge α, optional
+   through the QR path.  :func:`~thermocal.models.lstsq.solve_r` then solves the
+   column-scaled problem ``min ‖R_s γ − z‖² + n α ‖γ_F‖²`` by SVD (optional ridge α, optional
    truncation of singular values below ``rcond · s_max``), and gives the
    coefficient covariance ``σ² V S⁻² Vᵀ`` (from the SVD, no inverse of AᵀA).
    Golub & Van Loan, *Matrix Computations*, 4th ed., §5.3 (least squares by QR
@@ -53,7 +57,6 @@ Three parts, all pure numpy/scipy:
 
 from __future__ import annotations
 
-import math
 import re
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -61,73 +64,8 @@ from typing import Any
 
 import numpy as np
 
-from thermocal.errors import DesignError, ThermocalInputError
-from thermocal.models.lstsq import (  # re-exported: the least squares used with the terms
-    GRAM_MAX_COND as GRAM_MAX_COND,
-)
-from thermocal.models.lstsq import (
-    SINGULAR_RCOND as SINGULAR_RCOND,
-)
-from thermocal.models.lstsq import (
-    Chunk as Chunk,
-)
-from thermocal.models.lstsq import (
-    LstsqSolution as LstsqSolution,
-)
-from thermocal.models.lstsq import (
-    Reduced as Reduced,
-)
-from thermocal.models.lstsq import (
-    Selection as Selection,
-)
-from thermocal.models.lstsq import (
-    accumulate_r as accumulate_r,
-)
-from thermocal.models.lstsq import (
-    accumulate_targets as accumulate_targets,
-)
-from thermocal.models.lstsq import (
-    column_scales as column_scales,
-)
-from thermocal.models.lstsq import (
-    forward_select as forward_select,
-)
-from thermocal.models.lstsq import (
-    holdout_rss as holdout_rss,
-)
-from thermocal.models.lstsq import (
-    scaled_condition as scaled_condition,
-)
-from thermocal.models.lstsq import (
-    singular_error as singular_error,
-)
-from thermocal.models.lstsq import (
-    solve_r as solve_r,
-)
-from thermocal.models.lstsq import (
-    subset_rss as subset_rss,
-)
-from thermocal.preprocess import (  # Ṫ has one implementation, in preprocess
-    RATE_BLOCK_ROWS as RATE_BLOCK_ROWS,
-)
-from thermocal.preprocess import (
-    backward_partners as backward_partners,
-)
-from thermocal.preprocess import (
-    backward_rates as backward_rates,
-)
-from thermocal.preprocess import (
-    gap_free_slices as gap_free_slices,
-)
-from thermocal.preprocess import (
-    segment_rates as segment_rates,
-)
-from thermocal.preprocess import (
-    step_range as step_range,
-)
-from thermocal.preprocess import (
-    temperature_rates as temperature_rates,
-)
+from thermocal.errors import ThermocalInputError
+from thermocal.models.term_scaling import BaseScaling
 from thermocal.recording import FloatArray
 
 CHUNK_ROWS = 32768
@@ -346,9 +284,10 @@ def _parse_monomial(text: str, whole: str) -> dict[tuple[int, str], int]:
             if a is None:
                 if f in ("1", "const") and power == 1:
                     continue
-                raise ThermocalInputError(
-                    f"cannot read term {whole!r}: factor {f!r} is not T<k> or dT<k> "
-                    "(k = position in --temps, from 1)"
+                raise ThermocalInputError.naming(
+                    f"cannot read term {whole!r}: factor {f!r} is not "
+                    "T<k> or dT<k> (k = position in {temperatures}, from 1)",
+                    "temperatures",
                 )
             sensor = int(a.group(2)) - 1
             if sensor < 0:
@@ -410,7 +349,7 @@ def parse_term(text: str, n_sensors: int) -> Term | None:
 def parse_terms(
     spec: str | Sequence[str] | None, n_sensors: int, order: int | None = None
 ) -> list[Term]:
-    """Term list from a ``--terms`` value, or a plain polynomial from ``order``.
+    """Term list from a ``terms`` value (text or list), or a plain polynomial from ``order``.
 
     Parameters
     ----------
@@ -440,7 +379,9 @@ def parse_terms(
         raise ThermocalInputError("the polynomial model needs at least one temperature column")
     if order is not None:
         if spec not in (None, "seed000"):
-            raise ThermocalInputError("give either an explicit term list or --order, not both")
+            raise ThermocalInputError.naming(
+                "give either an explicit term list or {order}, not both", "order"
+            )
         return polynomial_terms(n_sensors, int(order))
     if spec is None or (isinstance(spec, str) and spec.strip() == "seed000"):
         return seed000_terms(n_sensors)
@@ -460,159 +401,7 @@ def parse_terms(
     return terms
 
 
-# --- base variables and features -------------------------------------------------------------
-
-
-@dataclass(frozen=True)
-class BaseScaling:
-    """Centres and scales of the base variables of eq. (1), per sensor.
-
-    Unused base variables have centre 0 and scale 1.
-
-    Attributes
-    ----------
-    t_center, t_scale : numpy.ndarray
-        Centre and scale of T per sensor, shape (k,) [°C].
-    rate_center, rate_scale : numpy.ndarray
-        Centre and scale of Ṫ per sensor, shape (k,) [°C/min].
-    coupling_center, coupling_scale : numpy.ndarray
-        Centre and scale of TṪ per sensor, shape (k,) [°C²/min].
-    """
-
-    t_center: FloatArray
-    t_scale: FloatArray
-    rate_center: FloatArray
-    rate_scale: FloatArray
-    coupling_center: FloatArray
-    coupling_scale: FloatArray
-
-    def to_list(self, names: Sequence[str]) -> list[dict[str, Any]]:
-        """One JSON-ready dict per sensor.
-
-        Parameters
-        ----------
-        names : sequence of str
-            The sensors' column names.
-
-        Returns
-        -------
-        list of dict
-        """
-        return [
-            {
-                "name": names[k] if k < len(names) else f"T{k + 1}",
-                "t_center": float(self.t_center[k]),
-                "t_scale": float(self.t_scale[k]),
-                "rate_center": float(self.rate_center[k]),
-                "rate_scale": float(self.rate_scale[k]),
-                "coupling_center": float(self.coupling_center[k]),
-                "coupling_scale": float(self.coupling_scale[k]),
-            }
-            for k in range(self.t_center.size)
-        ]
-
-    @classmethod
-    def from_list(cls, items: Sequence[dict[str, Any]]) -> BaseScaling:
-        """Inverse of :meth:`to_list`.
-
-        Parameters
-        ----------
-        items : sequence of dict
-            One dict per sensor.
-
-        Returns
-        -------
-        BaseScaling
-        """
-
-        def col(key: str) -> FloatArray:
-            return np.array([float(d[key]) for d in items], dtype=np.float64)
-
-        return cls(
-            col("t_center"),
-            col("t_scale"),
-            col("rate_center"),
-            col("rate_scale"),
-            col("coupling_center"),
-            col("coupling_scale"),
-        )
-
-
-def fit_base_scaling(
-    temps: Sequence[FloatArray], rates: Sequence[FloatArray] | None, terms: Sequence[Term]
-) -> BaseScaling:
-    """Means and standard deviations of T, Ṫ, TṪ over all runs, for the sensors the terms use.
-
-    Parameters
-    ----------
-    temps : sequence of numpy.ndarray
-        Temperatures per run, each (n_r, k) [°C].
-    rates : sequence of numpy.ndarray or None
-        Ṫ per run, each (n_r, k) [°C/min]; needed when a term uses Ṫ.
-    terms : sequence of Term
-        The model's terms.
-
-    Returns
-    -------
-    BaseScaling
-
-    Raises
-    ------
-    thermocal.errors.DesignError
-        A base variable the terms need does not vary, naming the terms.
-
-    Notes
-    -----
-    .. math:: c = \\frac{1}{N}\\sum_i x_i, \\qquad s = \\sqrt{\\frac{1}{N}\\sum_i (x_i - c)^2}
-    """
-    k = temps[0].shape[1]
-    tc, ts = np.zeros(k), np.ones(k)
-    rc, rs = np.zeros(k), np.ones(k)
-    wc, ws = np.zeros(k), np.ones(k)
-    n = sum(t.shape[0] for t in temps)
-
-    def mean_std(values: list[FloatArray]) -> tuple[float, float]:
-        m = sum(float(np.sum(v)) for v in values) / n
-        ss = 0.0
-        for v in values:
-            d = v - m
-            ss += float(np.dot(d, d))
-        return m, math.sqrt(ss / n)
-
-    for j in range(k):
-        used = [t for t in terms if t.sensor == j]
-        for kind in ("T", "dT", "T*dT"):
-            if kind == "T":
-                users = [t for t in used if t.t_power > 0]
-            elif kind == "dT":
-                users = [t for t in used if t.rate_power > 0]
-            else:
-                users = [t for t in used if t.coupling_power > 0]
-            if not users:
-                continue
-            if kind == "T":
-                vals = [t[:, j] for t in temps]
-            elif rates is None:
-                raise ThermocalInputError("rate terms need the temperature rate")
-            elif kind == "dT":
-                vals = [r[:, j] for r in rates]
-            else:
-                vals = [t[:, j] * r[:, j] for t, r in zip(temps, rates, strict=True)]
-            m, s = mean_std(vals)
-            if not s > 1e-12 * max(1.0, abs(m)):
-                what = {"T": f"T{j + 1}", "dT": f"dT{j + 1}"}.get(kind, f"T{j + 1}*dT{j + 1}")
-                raise DesignError(
-                    f"base variable {what} is constant over the fitted data, so term(s) "
-                    + ", ".join(t.name for t in users)
-                    + " cannot be determined; drop them or use data where it varies"
-                )
-            if kind == "T":
-                tc[j], ts[j] = m, s
-            elif kind == "dT":
-                rc[j], rs[j] = m, s
-            else:
-                wc[j], ws[j] = m, s
-    return BaseScaling(tc, ts, rc, rs, wc, ws)
+# --- features ----------------------------------------------------------------------------
 
 
 def term_features(
@@ -650,6 +439,7 @@ def term_features(
     Examples
     --------
     >>> import numpy as np
+    >>> from thermocal.models.term_scaling import fit_base_scaling
     >>> temps = 20.0 + 10.0 * np.random.default_rng(0).random((50, 1))
     >>> terms = parse_terms("T1,T1^2", 1)
     >>> features = term_features(terms, fit_base_scaling([temps], None, terms), temps, None)
@@ -712,99 +502,3 @@ def term_features(
             kind, p = factors[-1]
             np.multiply(acc, power(t.sensor, kind, p, None), out=dest)
     return out
-
-
-def raw_expansion(
-    terms: Sequence[Term], scaling: BaseScaling
-) -> tuple[list[tuple[int, int, int]], FloatArray]:
-    """Map scaled-basis term coefficients to raw-monomial coefficients.
-
-    Expands ``u^a v^b w^c`` (eq. 1) binomially into monomials ``T^P Ṫ^Q``
-    (``P = i + l``, ``Q = j + l`` for ``T^i Ṫ^j (TṪ)^l``).  Returns the list of
-    monomials ``(sensor, P, Q)`` (``(-1, 0, 0)`` = constant, first) and the
-    matrix M with ``raw = M @ [constant, term coefficients...]``.
-
-    Parameters
-    ----------
-    terms : sequence of Term
-        The terms.
-    scaling : BaseScaling
-        Their centres and scales.
-
-    Returns
-    -------
-    monomials : list of tuple of int
-        ``(sensor, P, Q)`` per raw monomial, the constant ``(-1, 0, 0)`` first.
-    M : numpy.ndarray
-        Shape (n_monomials, 1 + n_terms).
-
-    Notes
-    -----
-    .. math:: \\left(\\frac{x - c}{s}\\right)^p
-              = \\sum_{i=0}^{p} \\binom{p}{i} \\frac{x^i (-c)^{p-i}}{s^p}
-    """
-    keys: list[tuple[int, int, int]] = [(-1, 0, 0)]
-    index: dict[tuple[int, int, int], int] = {(-1, 0, 0): 0}
-    cols: list[dict[int, float]] = [{0: 1.0}]
-    for t in terms:
-        k = t.sensor
-
-        def expand(power: int, center: float, scale: float) -> list[tuple[int, float]]:
-            # ((x − c)/s)^p = Σ_i C(p,i) x^i (−c)^(p−i) / s^p
-            return [
-                (i, math.comb(power, i) * (-center) ** (power - i) / scale**power)
-                for i in range(power + 1)
-            ]
-
-        eu = expand(t.t_power, float(scaling.t_center[k]), float(scaling.t_scale[k]))
-        ev = expand(t.rate_power, float(scaling.rate_center[k]), float(scaling.rate_scale[k]))
-        ew = expand(
-            t.coupling_power, float(scaling.coupling_center[k]), float(scaling.coupling_scale[k])
-        )
-        col: dict[int, float] = {}
-        for i, cu in eu:
-            for j, cv in ev:
-                for l, cw in ew:
-                    P, Q = i + l, j + l
-                    key = (-1, 0, 0) if P == 0 and Q == 0 else (k, P, Q)
-                    if key not in index:
-                        index[key] = len(keys)
-                        keys.append(key)
-                    col[index[key]] = col.get(index[key], 0.0) + cu * cv * cw
-        cols.append(col)
-    M = np.zeros((len(keys), len(cols)))
-    for jc, col in enumerate(cols):
-        for i, v in col.items():
-            M[i, jc] = v
-    return keys, M
-
-
-def monomial_name(key: tuple[int, int, int]) -> str:
-    """Name of a raw monomial ``T_k^P Ṫ_k^Q``: ``const``, ``T1^2``, ``(T1*dT1)^2``, ``T1^2*dT1``.
-
-    Parameters
-    ----------
-    key : tuple of int
-        ``(sensor, P, Q)``; sensor −1 is the constant.
-
-    Returns
-    -------
-    str
-
-    Examples
-    --------
-    >>> monomial_name((-1, 0, 0)), monomial_name((0, 2, 1))
-    ('const', 'T1^2*dT1')
-    """
-    k, P, Q = key
-    if k < 0:
-        return "const"
-    s = k + 1
-    if P == Q:
-        return f"T{s}*dT{s}" if P == 1 else f"(T{s}*dT{s})^{P}"
-    parts = []
-    if P:
-        parts.append(f"T{s}" if P == 1 else f"T{s}^{P}")
-    if Q:
-        parts.append(f"dT{s}" if Q == 1 else f"dT{s}^{Q}")
-    return "*".join(parts)

@@ -30,7 +30,7 @@ to the physical ``b``.  ``method="two_stage"`` is the seed's procedure (a_j per
 run, then a_j against T0); ``method="joint"`` fits ``ΔF = Σ_j Σ_k b_jk T0^k ΔT^j``
 to all samples of all runs at once (same model, one least-squares problem).
 Stage 2 needs runs at ≥ ``t0_order + 1`` distinct start temperatures (start
-temperatures closer than :data:`DISTINCT_T0_C` count as one), otherwise
+temperatures closer than :data:`~thermocal.models.warmup_fit.DISTINCT_T0_C` count as one), otherwise
 :class:`~thermocal.errors.DesignError`.
 
 Out of range: the temperature is clamped to the channel's fitted range and T0 to
@@ -59,11 +59,15 @@ Evaluation (firmware twin), per sample: ``Tc = clamp(T, range)``; while
 ``t − t_first < start_window_s``: ``sum += Tc; n += 1``; ``T0 = sum/n`` (frozen
 afterwards); ``a_j = Σ_k b_jk clamp(T0, t0_range_c)^k`` (Horner in T0);
 ``ΔF = Σ_j a_j (Tc − T0)^j`` (Horner in ΔT).
+
+This module holds the estimator, :class:`WarmupModel`; the fit maths (start values, the
+two-stage and joint solutions in scaled variables, the evaluation) are in
+:mod:`thermocal.models.warmup_fit`, the streaming twin (:class:`WarmupStream`) in
+:mod:`thermocal.models.warmup_stream`.
 """
 
 from __future__ import annotations
 
-import dataclasses
 import math
 import warnings
 from collections.abc import Sequence
@@ -98,16 +102,21 @@ from thermocal.models.numerics import (
     _window_count,
     channel_index,
     horner,
-    lstsq_svd,
     running_start_mean,
     single_channel,
 )
 from thermocal.models.results import Coefficient, FitStats
 from thermocal.models.rundata import RunData
+from thermocal.models.warmup_fit import (
+    ScaledFit,
+    distinct_start_temperatures,
+    evaluate,
+    fit_joint,
+    fit_two_stage,
+    start_values,
+)
+from thermocal.models.warmup_stream import WarmupStream
 from thermocal.recording import FloatArray
-
-DISTINCT_T0_C = 1.0
-"""Start temperatures closer than this [°C] count as one start temperature."""
 
 CONDITION_WARN = 1e10
 """A scaled design with a 2-norm condition number above this gets a ConditioningWarning."""
@@ -117,19 +126,6 @@ METHODS = ("two_stage", "joint")
 
 
 # --- the model ------------------------------------------------------------------------------
-
-
-@dataclasses.dataclass(frozen=True)
-class _ScaledFit:
-    """The warm-up fit in scaled variables: c (n_j × n_k), its covariance (None without
-    residual degrees of freedom), the degrees of freedom, the worst condition number and
-    the per-run stage-1 coefficients (two-stage only)."""
-
-    c_scaled: FloatArray
-    cov_c: FloatArray | None
-    dof: int
-    cond: float
-    run_coefs: FloatArray | None
 
 
 class WarmupModel(TemperatureModel):
@@ -263,9 +259,6 @@ class WarmupModel(TemperatureModel):
     def _j0(self) -> int:
         return 0 if self.include_a0 else 1
 
-    def _term_name(self, j: int, k: int) -> str:
-        return f"b{j}{k} (ΔT^{j}·T0^{k})"
-
     # -- fit --
     def fit(self, runs: Sequence[RunData]) -> Self:
         """Fit the b matrix to several power-on runs ([Seed-Plan]).
@@ -273,8 +266,10 @@ class WarmupModel(TemperatureModel):
         Stage 1 (per run, post-window samples): ``ΔF = Σ_j a_j ΔT^j`` by least
         squares.  Stage 2: ``a_j = Σ_k b_jk T0^k`` over the runs by least squares
         (``method="joint"``: both at once).  Steps: the runs' start values and
-        post-window changes (:meth:`_start_values`), the distinct start temperatures,
-        the scaled fit (:meth:`_fit_two_stage` or :meth:`_fit_joint`), the physical b
+        post-window changes (:func:`~thermocal.models.warmup_fit.start_values`), the
+        distinct start temperatures, the scaled fit
+        (:func:`~thermocal.models.warmup_fit.fit_two_stage` or
+        :func:`~thermocal.models.warmup_fit.fit_joint`), the physical b
         with standard errors and the statistics (:meth:`_set_fitted`).
 
         Parameters
@@ -302,9 +297,11 @@ class WarmupModel(TemperatureModel):
             raise ThermocalInputError(
                 f"warmup: the runs name the temperature channel differently: {sorted(names)}"
             )
-        t0s, f0s, dts, dfs = self._start_values(one)
+        t0s, f0s, dts, dfs = start_values(
+            one, order=int(self.order), j0=self._j0, start_window_s=self.start_window_s
+        )
         t0_arr = np.array(t0s)
-        n_distinct = self._distinct_start_temperatures(t0_arr)
+        n_distinct = distinct_start_temperatures(t0_arr, int(self.t0_order))
         all_dt = np.concatenate(dts)
         s_dt = float(np.max(np.abs(all_dt)))
         if not s_dt > 0:
@@ -314,10 +311,19 @@ class WarmupModel(TemperatureModel):
             )
         mu = float(np.mean(t0_arr))
         sig = float(np.max(np.abs(t0_arr - mu))) or 1.0
+        powers = {"order": int(self.order), "t0_order": int(self.t0_order), "j0": self._j0}
         scaled = (
-            self._fit_two_stage(one, dts, dfs, t0_arr, s_dt, mu, sig)
+            fit_two_stage(one, dts, dfs, t0_arr, (s_dt, mu, sig), **powers)
             if self.method == "two_stage"
-            else self._fit_joint(one, dts, dfs, t0s, t0_arr, all_dt, s_dt, mu, sig)
+            else fit_joint(
+                one,
+                dts,
+                dfs,
+                t0s,
+                (s_dt, mu, sig),
+                **powers,
+                per_run_offset=bool(self.per_run_offset),
+            )
         )
         if scaled.cond > CONDITION_WARN:
             warnings.warn(
@@ -328,160 +334,10 @@ class WarmupModel(TemperatureModel):
         self._set_fitted(one, scaled, t0s, f0s, dts, dfs, s_dt, mu, sig, n_distinct)
         return self
 
-    def _start_values(
-        self, one: list[RunData]
-    ) -> tuple[list[float], list[float], list[FloatArray], list[FloatArray]]:
-        """Per run: T0 and F0 (means over the start window) and the post-window ΔT, ΔF."""
-        n_j = int(self.order) + 1 - self._j0
-        t0s, f0s, dts, dfs = [], [], [], []
-        for r in one:
-            temp = r.temps_c[:, 0]
-            y = r.target()
-            m = _window_count(r.time_s, self.start_window_s)
-            t0 = float(running_start_mean(r.time_s, temp, self.start_window_s)[-1])
-            f0 = float(running_start_mean(r.time_s, y, self.start_window_s)[-1])
-            if r.n_samples - m < n_j:
-                raise DesignError(
-                    f"warmup: {r.name or 'run'} has {r.n_samples - m} samples after the "
-                    f"{self.start_window_s:g} s start window; at least {n_j} are needed "
-                    f"(order {self.order})"
-                )
-            t0s.append(t0)
-            f0s.append(f0)
-            dts.append(temp[m:] - t0)
-            dfs.append(y[m:] - f0)
-        return t0s, f0s, dts, dfs
-
-    def _distinct_start_temperatures(self, t0_arr: FloatArray) -> int:
-        """How many start temperatures ≥ DISTINCT_T0_C apart (greedy on the sorted T0s);
-        refuses fewer than the T0 order needs."""
-        kt = int(self.t0_order)
-        srt = np.sort(t0_arr)
-        n_distinct = 1 + int(np.count_nonzero(np.diff(srt) >= DISTINCT_T0_C))
-        if n_distinct < kt + 1:
-            raise DesignError(
-                f"warmup: t0_order={kt} needs runs at ≥ {kt + 1} distinct start temperatures "
-                f"(≥ {DISTINCT_T0_C:g} °C apart); got {n_distinct} "
-                f"({', '.join(f'{v:.2f}' for v in srt)} °C); add runs or lower --t0-order"
-            )
-        return n_distinct
-
-    def _fit_two_stage(
-        self,
-        one: list[RunData],
-        dts: list[FloatArray],
-        dfs: list[FloatArray],
-        t0_arr: FloatArray,
-        s_dt: float,
-        mu: float,
-        sig: float,
-    ) -> _ScaledFit:
-        """Stage 1 per run, stage 2 across runs, in the scaled variables."""
-        order, kt, j0 = int(self.order), int(self.t0_order), self._j0
-        n_j, n_k = order + 1 - j0, kt + 1
-        powers_j = np.arange(j0, order + 1)
-        a_runs = np.empty((len(one), n_j))
-        cond = 0.0
-        for i, (dt, df) in enumerate(zip(dts, dfs, strict=True)):
-            x = (dt / s_dt)[:, None] ** powers_j[None, :]
-            res = lstsq_svd(x, df)
-            if res.rank < n_j:
-                terms = ", ".join(f"ΔT^{powers_j[c]}" for c in res.null_columns)
-                raise DesignError(
-                    f"warmup: {one[i].name or f'run {i}'}: term(s) {terms} cannot be "
-                    f"determined (ΔT takes too few distinct values after the start window)"
-                )
-            cond = max(cond, res.condition_number)
-            a_runs[i] = res.coef
-        v = (t0_arr - mu) / sig
-        vmat = v[:, None] ** np.arange(n_k)[None, :]
-        res2 = lstsq_svd(vmat, a_runs)
-        if res2.rank < n_k:
-            raise DesignError(
-                f"warmup: the start temperatures cannot determine T0 terms up to "
-                f"T0^{kt}; lower --t0-order"
-            )
-        cond = max(cond, res2.condition_number)
-        c_scaled = res2.coef.T  # (n_j, n_k)
-        # cov(vec c) block-diagonal over j (per-coefficient residual variance)
-        cov_c: FloatArray | None = (
-            np.asarray(np.kron(np.diag(res2.sigma2), res2.cov_unit), dtype=np.float64)
-            if res2.dof > 0
-            else None
-        )
-        dof = res2.dof
-        run_coefs: FloatArray | None = a_runs
-        return _ScaledFit(c_scaled, cov_c, int(dof), float(cond), run_coefs)
-
-    def _fit_joint(
-        self,
-        one: list[RunData],
-        dts: list[FloatArray],
-        dfs: list[FloatArray],
-        t0s: list[float],
-        t0_arr: FloatArray,
-        all_dt: FloatArray,
-        s_dt: float,
-        mu: float,
-        sig: float,
-    ) -> _ScaledFit:
-        """Both stages in one least-squares problem (per-run a0 as nuisance parameters
-        when asked)."""
-        order, kt, j0 = int(self.order), int(self.t0_order), self._j0
-        n_j, n_k = order + 1 - j0, kt + 1
-        powers_j = np.arange(j0, order + 1)
-        u = np.concatenate(
-            [np.full(dt.size, (t0 - mu) / sig) for dt, t0 in zip(dts, t0s, strict=True)]
-        )
-        w = all_dt / s_dt
-        offsets = bool(self.per_run_offset) and j0 == 0
-        slope_j = powers_j[1:] if offsets else powers_j
-        cols = [w**j * u**k for j in slope_j for k in range(n_k)]
-        labels = [self._term_name(int(j), k) for j in slope_j for k in range(n_k)]
-        if offsets:
-            # per-run a0 as nuisance parameters (turn-on F0 noise stays out of the slopes)
-            run_id = np.concatenate([np.full(dt.size, i) for i, dt in enumerate(dts)])
-            ind = [(run_id == i).astype(np.float64) for i in range(len(dts))]
-            cols = ind + cols
-            run_labels = [f"a0 of {r.name or f'run {i}'}" for i, r in enumerate(one)]
-            labels = run_labels + labels
-        x = np.column_stack(cols)
-        res = lstsq_svd(x, np.concatenate(dfs))
-        if res.rank < x.shape[1]:
-            bad = ", ".join(labels[c] for c in res.null_columns)
-            raise DesignError(f"warmup: singular joint design; term(s) {bad}")
-        cond = res.condition_number
-        dof = res.dof
-        if offsets:
-            n_r = len(dts)
-            cov_all = res.sigma2 * res.cov_unit if res.dof > 0 else None
-            # a0(T0) = Σ_k b_0k T0^k fitted to the per-run offsets (as in stage 2)
-            v = (t0_arr - mu) / sig
-            vmat = v[:, None] ** np.arange(n_k)[None, :]
-            res0 = lstsq_svd(vmat, res.coef[:n_r])
-            if res0.rank < n_k:
-                raise DesignError(
-                    f"warmup: the start temperatures cannot determine T0 terms up to "
-                    f"T0^{kt}; lower --t0-order"
-                )
-            cond = max(cond, res0.condition_number)
-            c_scaled = np.vstack([res0.coef[None, :], res.coef[n_r:].reshape(-1, n_k)])
-            if cov_all is not None and res0.dof > 0:
-                cov_c = np.zeros((n_j * n_k, n_j * n_k))
-                cov_c[:n_k, :n_k] = float(res0.sigma2) * res0.cov_unit
-                cov_c[n_k:, n_k:] = cov_all[n_r:, n_r:]
-            else:
-                cov_c = None
-        else:
-            c_scaled = res.coef.reshape(n_j, n_k)
-            cov_c = res.sigma2 * res.cov_unit if res.dof > 0 else None
-        run_coefs = None
-        return _ScaledFit(c_scaled, cov_c, int(dof), float(cond), run_coefs)
-
     def _set_fitted(
         self,
         one: list[RunData],
-        scaled: _ScaledFit,
+        scaled: ScaledFit,
         t0s: list[float],
         f0s: list[float],
         dts: list[FloatArray],
@@ -528,7 +384,7 @@ class WarmupModel(TemperatureModel):
         )
         resid = np.concatenate(
             [
-                df - _evaluate(b, np.full(dt.size, t0), dt)
+                df - evaluate(b, np.full(dt.size, t0), dt)
                 for dt, df, t0 in zip(dts, dfs, t0s, strict=True)
             ]
         )
@@ -582,9 +438,9 @@ class WarmupModel(TemperatureModel):
         # T0 is constant after the start window: a_j(T0) once, the same numbers
         m = _window_count(run.time_s, float(self.start_window_s))
         out = np.empty(run.n_samples)
-        out[:m] = _evaluate(self.b_, t0c[:m], temp[:m] - t0[:m])
+        out[:m] = evaluate(self.b_, t0c[:m], temp[:m] - t0[:m])
         if run.n_samples > m:
-            out[m:] = _evaluate(self.b_, t0c[m : m + 1], temp[m:] - t0[m])
+            out[m:] = evaluate(self.b_, t0c[m : m + 1], temp[m:] - t0[m])
         return out
 
     DURATION_MARGIN: ClassVar[float] = 1.1
@@ -740,146 +596,3 @@ class WarmupModel(TemperatureModel):
         self.start_outputs_ = np.array(state.get("start_outputs", []), dtype=np.float64)
         rc = state.get("run_coefficients")
         self.run_coefficients_ = None if rc is None else np.array(rc, dtype=np.float64)
-
-
-def _evaluate(b: FloatArray, t0: FloatArray, dt: FloatArray) -> FloatArray:
-    """``ΔF = Σ_j a_j(T0) ΔT^j`` with ``a_j(T0) = Σ_k b_jk T0^k`` (Horner in both)."""
-    a = [horner(b[j], t0) for j in range(b.shape[0])]
-    out = a[-1]
-    for aj in a[-2::-1]:
-        out = out * dt + aj
-    return out
-
-
-def _horner_py(coef: Sequence[float], x: float) -> float:
-    """:func:`horner` on one Python float (the same operations, in the same order)."""
-    acc = coef[-1]
-    for c in coef[-2::-1]:
-        acc = acc * x + c
-    return acc
-
-
-class WarmupStream(ModelStream):
-    """Streaming twin of :meth:`WarmupModel.predict`, in plain Python floats: keeps the
-    start-window sum of T (running mean T0, frozen when the window is full) and, once
-    frozen, the coefficients ``a_j(T0)``.  The same operations as ``predict``
-    (:func:`running_start_mean`, :func:`horner`, :func:`_evaluate`), so the same numbers.
-
-    ``temps_c`` holds either one value (the model's channel) or the channels of the
-    fitted runs (``sensor`` picks); the signal is not used.  Warns once per stream (per
-    kind: temperature, start temperature) when a value leaves the fitted range.
-
-    Parameters
-    ----------
-    model : WarmupModel
-        The fitted model.
-    extrapolate : bool, optional
-        Default False.
-    """
-
-    def __init__(self, model: WarmupModel, *, extrapolate: bool = False) -> None:
-        self.model = model
-        self.extrapolate = extrapolate
-        self._col = int(model.sensor)
-        self._lo = float(model.temp_range_[0, 0])
-        self._hi = float(model.temp_range_[0, 1])
-        self._t0_lo, self._t0_hi = (float(v) for v in model.t0_range_)
-        self._window = float(model.start_window_s)
-        self._b = [[float(v) for v in row] for row in model.b_]
-        span = model.duration_range_s_
-        self._max_span = None if span is None else model.DURATION_MARGIN * float(span[1])
-        self.reset()
-
-    def reset(self) -> None:
-        """Forget everything (a new power-on): T0 is captured again."""
-        self._t_first: float | None = None
-        self._sum = 0.0
-        self._count = 0
-        self._frozen = False
-        self._t0 = math.nan
-        self._a: list[float] | None = None  # a_j(T0) once T0 is frozen
-        self._warned_t = False
-        self._warned_t0 = False
-        self._warned_span = False
-
-    @property
-    def t0_c(self) -> float:
-        """The start temperature T0 [°C] so far (running mean until frozen)."""
-        return self._t0
-
-    def _warn(self, what: str) -> None:
-        action = "extrapolating" if self.extrapolate else "clamped to the fitted range"
-        warnings.warn(
-            f"{what} outside the model's fitted range; {action}",
-            ExtrapolationWarning,
-            stacklevel=3,
-        )
-
-    def _coefficients(self, t0: float) -> list[float]:
-        """``a_j(clamp(T0))`` (with the T0 range warning)."""
-        t0c = t0
-        if t0 < self._t0_lo or t0 > self._t0_hi:
-            if not self._warned_t0:
-                self._warned_t0 = True
-                self._warn("start temperature T0")
-            if not self.extrapolate:
-                t0c = min(max(t0, self._t0_lo), self._t0_hi)
-        return [_horner_py(bj, t0c) for bj in self._b]
-
-    def update(self, time_s: float, temps_c: FloatArray, signal: float | None = None) -> float:
-        """Model value for one sample (see :meth:`ModelStream.update`).
-
-        Parameters
-        ----------
-        time_s : float
-            Sample time [s].
-        temps_c : numpy.ndarray
-            Temperatures [°C].
-        signal : float, optional
-            Not used.
-
-        Returns
-        -------
-        float
-            [signal unit].
-        """
-        if type(temps_c) is np.ndarray and temps_c.dtype == np.float64 and temps_c.ndim == 1:
-            arr = temps_c
-        else:
-            arr = np.asarray(temps_c, dtype=np.float64).reshape(-1)
-        # one value: the model's channel; several: the fitted run's channels, use ``sensor``
-        temp = float(arr.item(0) if arr.size == 1 else arr.item(self._col))
-        if temp < self._lo or temp > self._hi:
-            if not self._warned_t:
-                self._warned_t = True
-                self._warn("temperature")
-            if not self.extrapolate:
-                temp = min(max(temp, self._lo), self._hi)
-        t = float(time_s)
-        if self._t_first is None:
-            self._t_first = t
-        if (
-            not self._warned_span
-            and self._max_span is not None
-            and t - self._t_first > self._max_span
-        ):
-            self._warned_span = True
-            self.model.check_duration(t - self._t_first)
-        if not self._frozen and t - self._t_first < self._window:
-            self._sum = self._sum + temp
-            self._count += 1
-            self._t0 = self._sum / self._count
-            a = self._coefficients(self._t0)
-        else:
-            if not self._frozen:
-                self._frozen = True
-                if self._count == 0:  # pragma: no cover - the first sample is always in
-                    self._t0 = temp
-            if self._a is None:
-                self._a = self._coefficients(self._t0)
-            a = self._a
-        dt = temp - self._t0
-        out = a[-1]
-        for aj in a[-2::-1]:
-            out = out * dt + aj
-        return out

@@ -43,8 +43,9 @@ the propagated uncertainties of the gyro bias and of the accelerometer calibrati
 defines ``u`` (``K G C Gᵀ Kᵀ``, ``K = (JᵀJ)⁻¹Jᵀ``).  Rotations all about one axis leave
 ``E_g``'s other columns unseen: refused.
 
-**360° turns** (Ferraris et al., Sensors and Actuators A 46, 1995,
-doi:10.1016/0924-4247(94)00969-1; imucal's ``x_rot``, ``y_rot``, ``z_rot``): a turn
+**360° turns** (Ferraris, Gorini, Grimaldi and Parvis 1994, *Sensors and Actuators A* 42,
+doi:10.1016/0924-4247(94)80031-6; Ferraris et al. 1995; imucal's ``x_rot``, ``y_rot``,
+``z_rot``): a turn
 named about the sensor's axis ``e_j`` (j = x, y, z, whatever pose came before it: users
 do the turns after the six faces) adds
 ``Σ ω_c τ − 2π s e_j − Ω sin L T u = 0``, three linear rows of the same least squares

@@ -59,7 +59,7 @@ def triad_columns(
     tri : Triad
         The calibrated triad whose columns are read.
     unit_options : mapping of str to str or None, optional
-        Column → the unit given for it (:func:`thermocal.units.per_signal_option`).
+        Column → the unit given for it (:func:`thermocal.units.per_signal_unit`).
 
     Returns
     -------
@@ -99,7 +99,7 @@ def validate_held_out_session(
     latitude_deg: float | None = None,
     *,
     static_s: float = 1.0,
-    signal_unit: str | None = None,
+    signal_unit: str | tuple[str, ...] | None = None,
 ) -> list[MultiposValidation]:
     """A multi-position calibration of triads judged on a held-out session: before and
     after compensation, the gravity-magnitude error over the poses and the rotation-angle
@@ -115,8 +115,8 @@ def validate_held_out_session(
         Latitude [°] for normal gravity when the calibration recorded none.
     static_s : float, optional
         Shortest still pose [s] (default 1).
-    signal_unit : str or None, optional
-        One unit for every triad column, or one per column (comma-separated).
+    signal_unit : str or tuple of str or None, optional
+        One unit for every triad column, or a tuple of one per column.
 
     Returns
     -------
@@ -140,7 +140,7 @@ def validate_held_out_session(
     by = {t.model.kind: t for t in triads}
     acc, g_m_s2 = _accel_and_gravity(by, triads, rec, latitude_deg, static_s)
     t = rec.time_s
-    unit_opts = units.per_signal_option(signal_unit, [c for tr in triads for c in tr.columns])
+    unit_opts = units.per_signal_unit(signal_unit, [c for tr in triads for c in tr.columns])
     temp_of = functools.partial(_temp_of, rec)
 
     xa, a_in = triad_columns(rec, acc, unit_opts)

@@ -14,5 +14,5 @@ compensate :func:`compensate_calibration_file`: a model or calibration applied t
            in chunks with constant memory
 messages   JSON-ready values and warning lines as the command line prints them
 
-Nothing heavy is imported here: ``thermocal fit --help`` loads not even numpy.
+Nothing heavy is imported here: the help of the ``fit`` command loads not even numpy.
 """

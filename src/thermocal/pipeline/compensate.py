@@ -72,8 +72,13 @@ from thermocal.models.ranges import outside_range_dict
 from thermocal.models.rundata import check_sensor_id
 from thermocal.outputs import refuse_special_input, sidecar_path, warn_formula_names
 from thermocal.readers.common import default_time_column, names_list
-from thermocal.readers.dispatch import read_recording, read_whole_table, time_hint
-from thermocal.readers.formats import FileFormat, file_kind, format_of
+from thermocal.readers.dispatch import (
+    TIME_HINT_PARAMETERS,
+    read_recording,
+    read_whole_table,
+    time_hint,
+)
+from thermocal.readers.formats import FileFormat, format_of
 from thermocal.readers.options import ReadOptions
 from thermocal.readers.table import load_sidecar, numeric_column
 from thermocal.recording import (
@@ -145,7 +150,7 @@ class CompensateFileResult:
     outside_calibrated_range: bool = False
 
     def to_dict(self) -> dict[str, Any]:
-        """The fields (``extra`` merged in) as a dict, for ``--json``."""
+        """The fields (``extra`` merged in) as a dict, for the JSON result."""
         d = {k: getattr(self, k) for k in self.__dataclass_fields__ if k != "extra"}
         d.update(self.extra)
         return d
@@ -195,7 +200,7 @@ class _RunningMoments:
 def _source_format(path: str | Path, read: ReadOptions) -> tuple[Path, FileFormat, ReadOptions]:
     """The input of a chunked pass, its registered format and how to read it: a format that
     cannot be read in chunks is refused naming the file, its format and what to do; a
-    station folder's sensor (``DIR`` with ``--sensor ID``) is read as ``DIR/ID``."""
+    station folder's sensor (``DIR`` with ``topic`` ``ID``) is read as ``DIR/ID``."""
     src = Path(path)
     fmt = format_of(src)
     if fmt.chunks == "none":
@@ -207,7 +212,9 @@ def _source_format(path: str | Path, read: ReadOptions) -> tuple[Path, FileForma
     if fmt.locate is not None:
         return fmt.locate(src, read.topic), fmt, read.replace(topic=None)
     if read.topic is not None and "topic" not in fmt.options:
-        raise ThermocalInputError(f"{src}: --topic is for flight-controller logs (.ulg, .bin)")
+        raise ThermocalInputError.naming(
+            f"{src}: {{topic}} is for flight-controller logs (.ulg, .bin)", "topic"
+        )
     return src, fmt, read
 
 
@@ -528,7 +535,7 @@ def compensate_channels(
     if len(set(sig_list)) != len(sig_list):
         raise ThermocalInputError(f"a signal column appears twice: {sig_list}")
     source = _open_source(src, fmt, r)
-    sig_opts = units.per_signal_option(r.signal_unit, sig_list)
+    sig_opts = units.per_signal_unit(r.signal_unit, sig_list)
     ctx = _FileContext(src, source.names, source.info, source.time_col, source.available,
                        signal_given)  # fmt: skip
     opts = units.UnitOptions(
@@ -542,9 +549,10 @@ def compensate_channels(
     ]  # fmt: skip
     t_units = {plan.time_unit for plan in plans}
     if len(t_units) > 1:
-        raise UnitError(
+        raise UnitError.naming(
             f"{src}: the channels' models disagree on the time unit "
-            f"({' and '.join(sorted(t_units))}); give --time-unit"
+            f"({' and '.join(sorted(t_units))}); give {{time_unit}}",
+            "time_unit",
         )
     t_unit = plans[0].time_unit
     out_info = _output_info(source.info, source.time_col, t_unit, plans)
@@ -617,9 +625,10 @@ def _open_source(src: Path, fmt: FileFormat, read: ReadOptions) -> _Source:
     available = names_list(names)  # the first 20 and how many more (10 000 columns: one line)
     if time_col not in names:
         hint = time_hint(names, (info.get("text_layout") or {}).get("banner") or ())
-        raise MissingColumnError(
+        raise MissingColumnError.naming(
             f"{src}: no time column {time_col!r}; available: {available}"
-            + (hint if time is None else "")
+            + (hint if time is None else ""),
+            *TIME_HINT_PARAMETERS,
         )
     return _Source(src, fmt, names, info, table, time_col, available)
 
@@ -749,7 +758,7 @@ def _channel_plan(
     ctx: _FileContext,
     sig_name: str,
     model: TemperatureModel,
-    signal_unit: str | None,
+    signal_unit: str | tuple[str, ...] | None,
     opts: units.UnitOptions,
     *,
     extrapolate: bool,
@@ -763,9 +772,10 @@ def _channel_plan(
     model.check_fitted()
     temp_names = list(model.temp_names_)
     if sig_name not in names:
-        raise MissingColumnError(
+        raise MissingColumnError.naming(
             f"{src}: no signal column {sig_name!r} (the model's signal"
-            f"{' given by --signal' if ctx.signal_given else ''}); available: {ctx.available}"
+            f"{' given by {signals}' if ctx.signal_given else ''}); available: {ctx.available}",
+            "signals",
         )
     missing = [c for c in temp_names if c not in names]
     if missing:
@@ -953,10 +963,11 @@ def _chunk_outputs(
 
 def _evaluation_groups(plans: Sequence[_ChannelPlan]) -> list[list[_ChannelPlan]]:
     """Channels evaluated together: ``poly`` models with one evaluation key
-    (:func:`thermocal.models.poly.evaluation_key`: same inputs, ranges and term structure,
-    as :func:`~thermocal.models.poly.fit_shared` makes them) and the same temperature
+    (:func:`thermocal.models.poly_eval.evaluation_key`: same inputs, ranges and term structure,
+    as :func:`~thermocal.models.poly_fit.fit_shared` makes them) and the same temperature
     conversions; every other channel alone."""
-    from thermocal.models.poly import PolyModel, evaluation_key
+    from thermocal.models.poly import PolyModel
+    from thermocal.models.poly_eval import evaluation_key
 
     groups: dict[Any, list[_ChannelPlan]] = {}
     out: list[list[_ChannelPlan]] = []
@@ -1005,7 +1016,7 @@ class TriadCompensation:
     count_scale: float | None = None
 
     def to_dict(self) -> dict[str, Any]:
-        """The fields as a dict, for ``--json``."""
+        """The fields as a dict, for the JSON result."""
         return dataclasses.asdict(self)
 
 
@@ -1142,7 +1153,7 @@ def _resolve_triads(
     source: _Source,
     plans: Sequence[_TriadPlan],
     time_unit: str | None,
-    signal_unit: str | None = None,
+    signal_unit: str | tuple[str, ...] | None = None,
 ) -> units.ResolvedInputs:
     """The units of the triads' columns and temperatures resolved once (option > metadata >
     column name > the unit each triad was calibrated on); raw-count temperatures without a
@@ -1343,7 +1354,7 @@ class CalibrationCompensation:
     """``(channel name, model family, result)``; one entry for ``single``."""
 
     def to_dict(self) -> dict[str, Any]:
-        """The ``thermocal compensate --json`` object."""
+        """The JSON object of the ``compensate`` command."""
         if self.kind == "triads":
             return {"model": self.model_file, "output": self.output,
                     "triads": [d.to_dict() for d in self.triads]}  # fmt: skip
@@ -1359,18 +1370,13 @@ class CalibrationCompensation:
         }
 
 
-def _split_names(text: str | None) -> list[str]:
-    """``"gx, gy,gz"`` → ``["gx", "gy", "gz"]`` (None or empty: none)."""
-    return [t.strip() for t in (text or "").split(",") if t.strip()]
-
-
 def compensate_calibration_file(
     model_file: str | Path,
     path: str | Path,
     out: str | Path,
     read: ReadOptions | None = None,
     *,
-    signal: str | None = None,
+    signals: tuple[str, ...] | None = None,
     chunk_rows: int = DEFAULT_CHUNK_ROWS,
     extrapolate: bool = False,
     known_input: float = 0.0,
@@ -1392,9 +1398,9 @@ def compensate_calibration_file(
         The output; it may be neither input (nor, for a CSV, may its sidecar).
     read : ReadOptions, optional
         How the recording is read (:class:`~thermocal.readers.options.ReadOptions`).
-    signal : str, optional
-        One channel: its column (default the model's); several: the channels to apply,
-        ``"gx,gy"`` (default all).
+    signals : tuple of str, optional
+        One channel: its column, ``("gx",)`` (default the model's); several: the channels
+        to apply, ``("gx", "gy")`` (default all).
     chunk_rows, extrapolate, known_input, on_progress
         As :func:`compensate_file`.
 
@@ -1412,7 +1418,7 @@ def compensate_calibration_file(
     from thermocal.pipeline.model_file import load_calibration
 
     check_not_input(out, [path, model_file])
-    if file_kind(Path(out)) == "csv":  # the CSV's sidecar must not land on an input either
+    if _CHUNK_WRITERS[written_format(Path(out))].sidecar:  # nor may its sidecar
         check_not_input(sidecar_path(out), [path, model_file])
     cal = load_calibration(model_file)  # a model file is a calibration of one channel
     if cal.triads:
@@ -1429,11 +1435,12 @@ def compensate_calibration_file(
     )  # fmt: skip
     if len(cal.channels) == 1:
         ch = cal.channels[0]
+        signal = ",".join(signals) if signals else None  # one column (a list: none such)
         res = compensate_file(ch.model, path, out, read, signal=signal, **common)
         return CalibrationCompensation(
             str(model_file), str(out), "single", channels=((ch.name, ch.model.family, res),)
         )
-    chosen = _split_names(signal) or cal.names
+    chosen = list(signals or ()) or cal.names
     models = [(cal.channel(n).signal, cal.channel(n).model) for n in chosen]
     results = compensate_channels(models, path, out, read, **common)
     return CalibrationCompensation(

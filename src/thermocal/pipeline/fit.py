@@ -35,12 +35,13 @@ from thermocal import units
 from thermocal.defaults import overrides_of
 from thermocal.errors import (
     ConditioningWarning,
+    NamesParameters,
     ParameterError,
     PlausibilityWarning,
     ThermocalInputError,
 )
 from thermocal.families import MAX_ORDER, MAX_TERMS
-from thermocal.pipeline.messages import one_line
+from thermocal.pipeline.messages import one_line, option_name
 from thermocal.pipeline.options import FitOptions
 from thermocal.pipeline.reading import check_recording
 from thermocal.readers.station import station_sensor_paths
@@ -51,6 +52,7 @@ if TYPE_CHECKING:
     import thermocal.models.base as _base
     import thermocal.models.calibration as _calibration
     import thermocal.models.poly as _poly
+    import thermocal.models.poly_fit as _poly_fit
     import thermocal.models.registry as _registry
     import thermocal.models.results as _results
     import thermocal.models.rundata as _rundata
@@ -69,6 +71,7 @@ else:
     _calibration = LazyModule("thermocal.models.calibration")
     _files = LazyModule("thermocal.pipeline.model_file")
     _poly = LazyModule("thermocal.models.poly")
+    _poly_fit = LazyModule("thermocal.models.poly_fit")
     _gravity = LazyModule("thermocal.gravity")
     _recording = LazyModule("thermocal.recording")
 
@@ -161,7 +164,7 @@ def earth_rate_known_input(
 
     ``Ω_axis = Ω u·(0, cos φ, sin φ)`` for the unit axis ``u`` in East-North-Up
     (IEEE Std 952-1997, :func:`thermocal.units.earth_rate_on_axis_deg_h`); 0 without
-    ``--latitude``/``--axis``.  Both options are needed together and
+    ``latitude``/``axis``.  Both are needed together and
     the signal (canonical unit ``unit``) must be a rate: otherwise an input error naming
     ``where`` (the file).
 
@@ -202,11 +205,15 @@ def earth_rate_known_input(
     if latitude is None and axis is None:
         return 0.0
     if latitude is None or axis is None:
-        raise ThermocalInputError("earth-rate removal needs both --latitude and --axis")
+        raise ThermocalInputError.naming(
+            "earth-rate removal needs both {latitude} and {axis}", "latitude", "axis"
+        )
     if units.canonical_unit(unit) != "deg/h":
-        raise ThermocalInputError(
-            f"{where}: --latitude/--axis remove the earth rate from a gyro signal; "
-            f"this signal is in {unit}"
+        raise ThermocalInputError.naming(
+            f"{where}: {{latitude}}/{{axis}} remove the earth rate from a gyro signal; "
+            f"this signal is in {unit}",
+            "latitude",
+            "axis",
         )
     return units.earth_rate_on_axis_deg_h(latitude, units.parse_axis(axis))
 
@@ -238,7 +245,7 @@ def known_input_what(
     if gravity:
         parts.append(gravity)
     if other:
-        parts.append(f"--known-input {other:g}")
+        parts.append(f"--known-input {other:g}")  # cli-words: the provenance a model records
     return " + ".join(parts) or "none"
 
 
@@ -264,7 +271,7 @@ class _FitSpec:
 def _local_gravity(
     gravity_axis: str | None, gravity: float | None, latitude: float | None
 ) -> float | None:
-    """The local gravity [m/s²] for ``--gravity-axis``
+    """The local gravity [m/s²] for ``gravity_axis``
     (:func:`thermocal.gravity.local_gravity_m_s2`)."""
     return _gravity.local_gravity_m_s2(gravity_axis, gravity, latitude)
 
@@ -297,7 +304,7 @@ class _Prepared:
 def _fit_channel(
     spec: _FitSpec, loaded: list[tuple[Path, _recording.Recording]], signal: str | None
 ) -> tuple[_base.TemperatureModel, dict[str, Any], int]:
-    """Fit one channel on the loaded runs; returns the model, its ``--json`` result and
+    """Fit one channel on the loaded runs; returns the model, its JSON result and
     the number of runs. Warnings are printed (by handle_errors) and listed in the result."""
     ((_n, est, result, n_runs),) = _fit_channels(spec, loaded, [signal])
     return est, result, n_runs
@@ -308,14 +315,16 @@ def _fit_channels(
 ) -> list[tuple[str, _base.TemperatureModel, dict[str, Any], int]]:
     """Fit every channel on the loaded runs (each file read once, by the caller).  Channels
     of the ``poly`` family with the same temperature inputs share one design
-    (:func:`thermocal.models.poly.fit_shared`: Ṫ, features and the design's reduction once;
+    (:func:`thermocal.models.poly_fit.fit_shared`: Ṫ, features and the design's reduction once;
     every model equal, bit for bit, to its own fit)."""
     preps = [_prepare_channel(spec, loaded, sig) for sig in signals]
     if spec.family == "poly" and len(preps) > 1:
         _share_inputs(preps)
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")
-            _poly.fit_shared([cast(_poly.PolyModel, p.est) for p in preps], [p.runs for p in preps])
+            _poly_fit.fit_shared(
+                [cast(_poly.PolyModel, p.est) for p in preps], [p.runs for p in preps]
+            )
         for p in preps:
             p.caught.extend(caught)
     else:
@@ -403,10 +412,10 @@ def _prepare_channel(
 
     names = list(runs[0].temp_names) if runs else []
     rate_names = [n for n in est.data_needs(names, len(runs)).rate if n in names] if runs else []
-    for line in rate_time_doubts(
+    for doubt in rate_time_doubts(
         runs, rate_names, float(spec.options.get("rate_interval_s") or 60.0)
     ):  # before the judgement: its refusal would drop a warning caught with it
-        warnings.warn(line, PlausibilityWarning, stacklevel=1)
+        warnings.warn(doubt, stacklevel=1)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         est.adequacy_ = _judge_channel(spec, est, runs, sig_name, first_inputs, unit)
@@ -439,8 +448,8 @@ TIME_SCALES = ((1000.0, "ms read as s"), (1.0 / 60.0, "minutes read as s"), (1e-
 
 def rate_time_doubts(
     runs: Sequence[_rundata.RunData], temp_names: Sequence[str], interval_s: float
-) -> list[str]:
-    r"""Why the time axis of runs fitted with Ṫ terms (``temp_names``) looks wrong, one line
+) -> list[PlausibilityWarning]:
+    r"""Why the time axis of runs fitted with Ṫ terms (``temp_names``) looks wrong, one warning
     per (run, column): the largest |Ṫ| (the 99th percentile of Ṫ over ``interval_s``,
     :func:`thermocal.adequacy.temperature_rate_c_per_min`) above
     :data:`MAX_CHAMBER_RATE_C_PER_MIN` or below :data:`MIN_RAMP_C_PER_MIN` where a time unit
@@ -459,8 +468,9 @@ def rate_time_doubts(
 
     Returns
     -------
-    list of str
-        One line per doubtful (run, column); empty when every time axis looks right.
+    list of PlausibilityWarning
+        One per doubtful (run, column), naming the parameter ``time_unit``; empty when every
+        time axis looks right.
 
     Notes
     -----
@@ -468,7 +478,7 @@ def rate_time_doubts(
 
     judged by the 99th percentile of :math:`|\dot T|` [°C/min].
     """
-    out: list[str] = []
+    out: list[PlausibilityWarning] = []
     for run in runs:
         if run.temperature_unit != "degC" or run.time_s.size < 2:
             continue
@@ -484,8 +494,11 @@ def rate_time_doubts(
             rates = rates[np.isfinite(rates)]
             if rates.size == 0:
                 out.append(
-                    f"{where}: the record spans {span_s:.4g} s, too short for Ṫ: is its time "
-                    "unit right? (check --time-unit)"
+                    PlausibilityWarning.naming(
+                        f"{where}: the record spans {span_s:.4g} s, too short for Ṫ: is its "
+                        "time unit right? (check {time_unit})",
+                        "time_unit",
+                    )
                 )
                 continue
             peak = float(np.percentile(np.abs(rates), 99.0))
@@ -500,10 +513,13 @@ def rate_time_doubts(
             if peak > MAX_CHAMBER_RATE_C_PER_MIN or (peak < MIN_RAMP_C_PER_MIN and fits):
                 hint = f" ({fits[0][1]}: {peak * fits[0][0]:.3g} °C/min)" if fits else ""
                 out.append(
-                    f"{where}: Ṫ reaches {peak:.3g} °C/min over a record of {span_s:.4g} s; "
-                    f"a chamber ramps at {MIN_RAMP_C_PER_MIN:g}–{MAX_CHAMBER_RATE_C_PER_MIN:g} "
-                    f"°C/min: is the time unit right{hint}? The Ṫ coefficients scale with "
-                    "it (check --time-unit)"
+                    PlausibilityWarning.naming(
+                        f"{where}: Ṫ reaches {peak:.3g} °C/min over a record of {span_s:.4g} "
+                        f"s; a chamber ramps at {MIN_RAMP_C_PER_MIN:g}–"
+                        f"{MAX_CHAMBER_RATE_C_PER_MIN:g} °C/min: is the time unit right{hint}? "
+                        "The Ṫ coefficients scale with it (check {time_unit})",
+                        "time_unit",
+                    )
                 )
     return out
 
@@ -556,7 +572,8 @@ def _judge_fitted(spec: _FitSpec, p: _Prepared) -> None:
     try:
         judged = _adequacy.Adequacy(tests, tuple(spec.overrides), p.sig_name).enforce()
     except ThermocalInputError as exc:  # name the files, as a reader's error does
-        raise ThermocalInputError(f"{', '.join(str(r.name) for r in p.runs)}: {exc}") from None
+        files = ", ".join(str(r.name) for r in p.runs)
+        raise ThermocalInputError.around(exc, f"{files}: ") from None
     rec = p.est.adequacy_
     if rec is None:  # judged before the fit: always a record here
         return
@@ -565,10 +582,17 @@ def _judge_fitted(spec: _FitSpec, p: _Prepared) -> None:
         rec["verdict"] = "overridden"
 
 
+def _spelled(message: Warning | str) -> str:
+    """A warning's text with the command line's options for the parameters it names."""
+    if isinstance(message, NamesParameters):
+        return message.spelled(option_name)
+    return str(message)
+
+
 def _finish_channel(
     spec: _FitSpec, prep: _Prepared
 ) -> tuple[_base.TemperatureModel, dict[str, Any], int]:
-    """After the fit: the fit-quality warnings, the model's metadata, the ``--json`` result."""
+    """After the fit: the fit-quality warnings, the model's metadata, the JSON result."""
     est, runs, first_inputs, provenance = prep.est, prep.runs, prep.first_inputs, prep.provenance
     unit, sig_name, target = prep.unit, prep.sig_name, spec.target
     with warnings.catch_warnings(record=True) as caught:
@@ -586,7 +610,8 @@ def _finish_channel(
         if note and note.get("note"):
             warnings.warn(f"{est.family}: {note['note']}", ConditioningWarning, stacklevel=1)
     all_caught = [*prep.caught, *caught]
-    messages = [one_line(str(w.message)) for w in all_caught]
+    # the --json result speaks to the command line: options where the library names parameters
+    messages = [one_line(_spelled(w.message)) for w in all_caught]
     for w in all_caught:  # hand them on to handle_errors, which prints them on stderr
         warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
 
@@ -652,8 +677,8 @@ def _finish_channel(
 
 @dataclass(frozen=True)
 class FittedChannel:
-    """One channel fitted by :func:`fit_files`: its model, its ``--json`` figures (the
-    ``fit --json`` keys; ``rms_residual`` in the data's own unit) and the number of runs."""
+    """One channel fitted by :func:`fit_files`: its model, its figures (the keys of the
+    ``fit`` command's JSON; ``rms_residual`` in the data's own unit) and the number of runs."""
 
     name: str
     model: _base.TemperatureModel
@@ -676,7 +701,7 @@ class FitResult:
         return [w for ch in self.channels for w in ch.figures["warnings"]]
 
     def to_dict(self) -> dict[str, Any]:
-        """``thermocal fit --json``: one channel's figures with ``output``, or ``{"output",
+        """The ``fit`` command's JSON: one channel's figures with ``output``, or ``{"output",
         "format": "thermocal-calibration", "channels": {name: figures}}``."""
         if not self.calibration:
             return self.channels[0].figures
@@ -710,9 +735,11 @@ def _check_numbers(o: FitOptions) -> None:
     infinite ``known_input``.  The family's own options are checked by their declarations
     (:meth:`thermocal.families.FamilyOption.check`)."""
     if o.latitude is not None and not -90.0 <= o.latitude <= 90.0:
-        raise ThermocalInputError(f"--latitude must be within ±90°, got {o.latitude}")
+        raise ParameterError("latitude", f"{{name}} must be within ±90°, got {o.latitude}")
     if o.known_input is not None and not np.isfinite(o.known_input):
-        raise ThermocalInputError(f"--known-input must be a finite number, got {o.known_input}")
+        raise ParameterError(
+            "known_input", f"{{name}} must be a finite number, got {o.known_input}"
+        )
 
 
 def _check_options(paths: Sequence[Path], o: FitOptions, output: Path) -> dict[str, Any]:
@@ -728,10 +755,11 @@ def _check_options(paths: Sequence[Path], o: FitOptions, output: Path) -> dict[s
     _check_numbers(o)
     build_model(o.model, options)  # refuse options that do not apply before reading
     if len(o.signals or ()) > 1 and o.axis is not None:
-        raise ThermocalInputError(
-            "earth-rate removal (--axis) takes one signal at a time: each gyro's sensitive "
-            "axis points elsewhere; fit the gyros one by one with their --axis, or leave the "
-            "earth rate in the bias"
+        raise ParameterError(
+            "axis",
+            "earth-rate removal ({name}) takes one signal at a time: each gyro's sensitive "
+            "axis points elsewhere; fit the gyros one by one with their {name}, or leave the "
+            "earth rate in the bias",
         )
     return options
 
@@ -775,8 +803,9 @@ def fit_files(paths: Sequence[Path], options: FitOptions, output: Path) -> FitRe
         for path in station_sensor_paths(paths, o.topic)
     ]
     if o.tref is not None and o.model != "poly":
-        raise ThermocalInputError(
-            f"--tref applies to the poly family (coefficients about TREF), not {o.model!r}"
+        raise ParameterError(
+            "tref",
+            f"{{name}} applies to the poly family (coefficients about TREF), not {o.model!r}",
         )
     _distinct_runs([path for path, _rec in loaded])
     spec = _FitSpec(o.model, family_options, o.temperatures, o.latitude, o.axis, o.known_input,

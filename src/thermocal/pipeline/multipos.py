@@ -506,7 +506,7 @@ def _session(
         time=opts.time,
         time_unit=opts.time_unit,
         signals=(*acc_cols, *(gyr_cols or [])),
-        signal_unit=",".join(u or "" for u in given) if any(given) else None,
+        signal_unit=tuple(u or "" for u in given) if any(given) else None,
         temperatures=(temps,) if temps else None,
     )
     rec = read_recording(

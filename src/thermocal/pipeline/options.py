@@ -1,13 +1,14 @@
 """The options of ``thermocal fit`` and ``thermocal validate`` as frozen dataclasses.
 
-One field per long option of the command, named as the option without its dashes
-(``--time-unit`` → ``time_unit``), with the command's default; a fit's family options are
+One field per long option of the command, named as the option without its dashes and
+with underscores (the option of ``time_unit`` is written with a dash), with the command's
+default; a fit's family options are
 one field, ``params`` (constructor parameter → value, as the family declares them in
 :mod:`thermocal.families`).  The command line builds them from its parameters, a fleet
 configuration from its ``[fit]``/``[validate]`` tables (:func:`options_from_table`), and a
 test checks that the fields, the families' declared options and the command's options are
-the same set.  What the command takes besides (its files, ``-o``, ``--json``) is not an
-option here.
+the same set.  What the command takes besides (its files, its output, its JSON switch) is
+not an option here.
 """
 
 from __future__ import annotations
@@ -150,46 +151,118 @@ class FitOptions:
     @property
     def read_options(self) -> ReadOptions:
         """How the files are read (:class:`thermocal.readers.options.ReadOptions`)."""
-        return _read_options(self)
+        return _read_options(self, self.temperatures)
 
 
 @dataclass(frozen=True)
 class ValidateOptions:
-    """``thermocal validate`` (:func:`thermocal.pipeline.validate.validate_files`).
-    The text-log options (``names``, ``rate``, ``on_bad_lines``, ``delimiter``, ``decimal``)
-    apply to the validated file and to the ``modeling`` file alike; the log ``topic`` to each
-    of them that is a flight-controller log (a CSV modelling run of a logged test)."""
+    """The options of a validation (:func:`thermocal.pipeline.validate.validate_files`,
+    ``thermocal validate``).
+
+    The text-log fields (``names``, ``rate_hz``, ``on_bad_lines``, ``delimiter``,
+    ``decimal``) apply to the validated file and to the ``modeling`` file alike; the log
+    ``topic`` to each of them that is a flight-controller log (a CSV modelling run of a
+    logged test).
+
+    Parameters
+    ----------
+    modeling : Path, optional
+        The modelling test's recording (default: the model file's data file).
+    ambient : str, optional
+        The temperature column compared by r and used to find the hold stages (default:
+        the model's first temperature column).
+    averaging : float
+        Averaging time of the stability figures [s].
+    signals : tuple of str, optional
+        The channels judged (default: the model's); a comma-separated text is accepted and
+        stored as a tuple.
+    time, time_unit : str, optional
+        The time column and its unit (default: the file's).
+    signal_unit : str or tuple of str, optional
+        The signal's unit, or one per signal (default: the file's); a single unit in a
+        tuple is stored as the unit.
+    temp_unit : str, optional
+        The temperature columns' unit (default: the file's).
+    temp_conversion : TemperatureConversion, optional
+        Raw counts → °C, :math:`T = g\\,v + o` (the text ``"GAIN,OFFSET[,int16]"`` is
+        accepted).
+    stage_rate : float
+        Hold detection: the largest temperature rate of a hold [°C/min].
+    min_stage : float
+        Hold detection: shortest stage [s].
+    settle : float
+        Time cut from the start of each stage [s].
+    extrapolate : bool
+        Evaluate the model outside its fitted temperature range (with a warning).
+    names : tuple of str, optional
+        Column names of a text log without a header row (a comma-separated text is
+        accepted).
+    rate_hz : float, optional
+        Sample rate [Hz] of a log without a time column.
+    on_bad_lines : {"error", "skip"}
+        A mangled line of a text log: an error naming it, or dropped and counted.
+    delimiter : str, optional
+        Field separator of a text log (detected when None).
+    decimal : {".", ","}, optional
+        Decimal mark of a text log (detected when None).
+    topic : str, optional
+        Flight-controller log topic, or a station recording's sensor.
+    latitude : float, optional
+        Test-site latitude [°] of a turntable run judging a triad calibration.
+    static_s : float
+        A multi-position calibration's held-out session: shortest still pose [s].
+
+    Raises
+    ------
+    thermocal.errors.ParameterError
+        A column list, unit list or temperature conversion no validation can use, naming
+        the field.
+
+    Examples
+    --------
+    >>> from thermocal.pipeline.options import ValidateOptions
+    >>> v = ValidateOptions(signals="gz", rate_hz=50.0, on_bad_lines="skip")
+    >>> v.signals, v.read_options.rate_hz
+    (('gz',), 50.0)
+    """
 
     modeling: Path | None = None
     ambient: str | None = None
     averaging: float = DEFAULT_AVERAGING_S
-    signal: str | None = None
+    signals: tuple[str, ...] | None = None
     time: str | None = None
     time_unit: str | None = None
-    signal_unit: str | None = None
+    signal_unit: str | tuple[str, ...] | None = None
     temp_unit: str | None = None
-    temp_conversion: str | None = None
+    temp_conversion: TemperatureConversion | None = None
     stage_rate: float = 0.05
     min_stage: float = 600.0
     settle: float = 0.0
     extrapolate: bool = False
-    names: str | None = None
-    rate: float | None = None
-    on_bad_lines: str = "error"
+    names: tuple[str, ...] | None = None
+    rate_hz: float | None = None
+    on_bad_lines: Literal["error", "skip"] = "error"
     delimiter: str | None = None
-    decimal: str | None = None
+    decimal: Literal[".", ","] | None = None
     topic: str | None = None
     latitude: float | None = None
     static_s: float = 1.0
 
+    def __post_init__(self) -> None:
+        set_ = object.__setattr__  # frozen: normalise in place once
+        for field in ("signals", "names"):
+            set_(self, field, _names(getattr(self, field), field))
+        if self.signal_unit is not None and not isinstance(self.signal_unit, str):
+            units = tuple(self.signal_unit)
+            set_(self, "signal_unit", units[0] if len(units) == 1 else units)
+        if self.temp_conversion is not None:
+            set_(self, "temp_conversion", _conversion(self.temp_conversion))
+
     @property
     def read_options(self) -> ReadOptions:
         """How the files are read (:class:`thermocal.readers.options.ReadOptions`; the
-        signal column named, the temperatures the file's), as
-        :func:`thermocal.pipeline.reading.read_options_of` builds it from the option strings."""
-        from thermocal.pipeline.reading import read_options_of
-
-        return read_options_of(self)
+        signal columns named, the temperatures the file's)."""
+        return _read_options(self, None)
 
 
 def _conversion(value: object) -> TemperatureConversion:
@@ -202,24 +275,29 @@ def _conversion(value: object) -> TemperatureConversion:
         raise ParameterError("temp_conversion", str(exc)) from None
 
 
-def _read_options(o: FitOptions) -> ReadOptions:
-    """The :class:`ReadOptions` of a fit's reading fields."""
+def _read_options(
+    o: FitOptions | ValidateOptions, temperatures: tuple[str, ...] | None
+) -> ReadOptions:
+    """The :class:`ReadOptions` of a fit's or a validation's reading fields."""
+    from thermocal.pipeline.reading import split_units
     from thermocal.readers.options import ReadOptions
 
-    return ReadOptions(
-        time=o.time, time_unit=o.time_unit, signals=o.signals, temperatures=o.temperatures,
-        signal_unit=o.signal_unit, temp_unit=o.temp_unit, temp_conversion=o.temp_conversion,
+    given: dict[str, Any] = dict(
+        time=o.time, time_unit=o.time_unit, signals=o.signals, temperatures=temperatures,
+        signal_unit=split_units(o.signal_unit), temp_unit=o.temp_unit,
+        temp_conversion=o.temp_conversion,
         topic=o.topic, names=o.names, rate_hz=o.rate_hz,
         on_bad_lines=o.on_bad_lines,
         delimiter=o.delimiter, decimal=o.decimal,
     )  # fmt: skip
+    return ReadOptions(**given)
 
 
 ALIASES: dict[str, dict[str, str]] = {
     "fit": {"sensor": "topic"},
     "validate": {"average": "averaging", "sensor": "topic"},
 }
-"""Second names of an option (``--average`` is ``--averaging``), per command."""
+"""Second names of an option (``average`` is ``averaging``), per command."""
 
 NOT_IN_TABLES = frozenset({"modeling", "params"})
 """Options a fleet sets itself (the unit's own modelling file)."""
@@ -356,22 +434,22 @@ def _table_kinds(command: str) -> dict[str, str]:
 
 
 def _table_flag(name: str, kind: str, value: Any, where: str) -> tuple[list[str], bool]:
-    """A flag's command-line arguments and value (``tristate``: false is ``--no-NAME``)."""
+    """A flag's command-line arguments and value (``tristate``: false is the ``no-`` flag)."""
     if not isinstance(value, bool):
         raise ThermocalInputError(f"{where}: {name} is a flag: write true or false")
     if kind == "tristate":
         return [f"--{name}" if value else f"--no-{name}"], value
-    return ([f"--{name}"] if value else []), value
+    return ([f"--{name}"] if value else []), value  # cli-words: a batch records its command line
 
 
 def options_from_table(command: str, table: Mapping[str, Any], where: str) -> tuple[Any, list[str]]:
     """A fleet configuration's table of ``command`` options (``{"model": "poly", "order": 2,
     "signal": ["gx", "gy"], "select": true}``) → the options dataclass and the same options
-    as command-line arguments (``["--model", "poly", "--order", "2", "--signal", "gx,gy",
-    "--select"]``, recorded with each unit).  An unknown option, a value of the wrong shape
+    as command-line arguments (each option with two dashes and its value as text, a list
+    joined by commas; recorded with each unit).  An unknown option, a value of the wrong shape
     or type, or a missing required option is a :class:`ThermocalInputError` naming it
     (``where``: the file and table).  A flag set to false is left at its default; a yes/no
-    family option (``per_run_offset``) set to false is ``--no-per-run-offset``.
+    family option (``per_run_offset``) set to false is its ``no-`` flag.
 
     Parameters
     ----------

@@ -40,50 +40,13 @@ def split_names(text: str | None) -> list[str] | None:
     return [n for n in names if n]
 
 
-def split_floats(text: str | None, what: str) -> list[float] | None:
-    """``"25, 30"`` → ``[25.0, 30.0]`` (None stays None); an input error naming the option
-    ``what`` when an item is not a number.
-
-    Parameters
-    ----------
-    text : str or None
-        Comma-separated numbers.
-    what : str
-        The option, named in the error.
-
-    Returns
-    -------
-    list of float or None
-        The numbers.
-
-    Raises
-    ------
-    ThermocalInputError
-        When an item is not a number.
-
-    Examples
-    --------
-    >>> split_floats("25, 30.5", "--breakpoints")
-    [25.0, 30.5]
-    """
-    names = split_names(text)
-    if names is None:
-        return None
-    try:
-        return [float(v) for v in names]
-    except ValueError:
-        raise ThermocalInputError(
-            f"{what}: expected comma-separated numbers, got {text!r}"
-        ) from None
-
-
 def read_options(
     *,
     time: str | None = None,
     time_unit: str | None = None,
     signal: str | None = None,
     temps: str | None = None,
-    signal_unit: str | None = None,
+    signal_unit: str | tuple[str, ...] | None = None,
     temp_unit: str | None = None,
     temp_conversion: str | None = None,
     topic: str | None = None,
@@ -93,23 +56,26 @@ def read_options(
     delimiter: str | None = None,
     decimal: str | None = None,
 ) -> ReadOptions:
-    """The :class:`~thermocal.readers.options.ReadOptions` of the command-line options that
-    say how a file is read.
+    """The :class:`~thermocal.readers.options.ReadOptions` of the texts a user typed to say
+    how a file is read (each parameter named after its field of ``ReadOptions``, or after
+    the command line's spelling where the two differ: ``signal``, ``temps``, ``rate``).
 
     Parameters
     ----------
-    time, time_unit, signal_unit, temp_unit, topic, delimiter, decimal : str, optional
-        ``--time``, ``--time-unit``, ``--signal-unit``, ``--temp-unit``, ``--topic``,
-        ``--delimiter``, ``--decimal`` as given.
+    time, time_unit, temp_unit, topic, delimiter, decimal : str, optional
+        As the fields of the same names.
+    signal_unit : str or tuple of str, optional
+        One unit for every signal, or ``"U1,…,Un"`` (or a tuple), one per signal in the
+        order of ``signal``.
     signal, temps, names : str, optional
-        ``--signal``, ``--temps``, ``--names``: comma-separated column names (an empty
-        ``--signal`` is none given; an empty ``--temps`` states there is none).
+        Comma-separated column names (an empty ``signal`` is none given; an empty
+        ``temps`` states there is none).
     temp_conversion : str, optional
-        ``--temp-conversion GAIN,OFFSET[,int16]``: raw counts → °C.
+        ``"GAIN,OFFSET[,int16]"``: raw counts → °C.
     rate : float, optional
-        ``--rate`` [Hz].
+        Sample rate [Hz] of a log without a time column (field ``rate_hz``).
     on_bad_lines : str
-        ``--on-bad-lines``: ``error`` or ``skip``.
+        ``"error"`` or ``"skip"``.
 
     Returns
     -------
@@ -118,9 +84,15 @@ def read_options(
     Raises
     ------
     thermocal.errors.UnitError
-        ``temp_conversion`` is not ``GAIN,OFFSET[,int16]`` (named ``--temp-conversion``).
+        ``temp_conversion`` is not ``GAIN,OFFSET[,int16]`` (naming ``temp_conversion``).
     thermocal.errors.ParameterError
         A value no file can have, naming the :class:`ReadOptions` field.
+
+    Examples
+    --------
+    >>> r = read_options(signal="gx, gy", signal_unit="rad/s,deg/s", rate=100.0)
+    >>> r.signals, r.signal_unit, r.rate_hz
+    (('gx', 'gy'), ('rad/s', 'deg/s'), 100.0)
     """
     from thermocal import units
     from thermocal.readers.options import ReadOptions
@@ -128,16 +100,44 @@ def read_options(
     conv = (
         None
         if temp_conversion is None
-        else units.temperature_conversion(temp_conversion, "--temp-conversion")
+        else units.temperature_conversion(
+            temp_conversion, "{temp_conversion}", ("temp_conversion",)
+        )
     )
     return ReadOptions(
         time=time, time_unit=time_unit,
         signals=tuple(split_names(signal) or ()) if signal else None,
         temperatures=tuple(split_names(temps) or ()) if temps is not None else None,
-        signal_unit=signal_unit, temp_unit=temp_unit, temp_conversion=conv, topic=topic,
+        signal_unit=split_units(signal_unit), temp_unit=temp_unit, temp_conversion=conv,
+        topic=topic,
         names=names, rate_hz=rate, on_bad_lines=on_bad_lines,  # type: ignore[arg-type]
         delimiter=delimiter, decimal=decimal,  # type: ignore[arg-type]
     )  # fmt: skip
+
+
+def split_units(text: str | tuple[str, ...] | None) -> str | tuple[str, ...] | None:
+    """The signal units a user typed: ``"U1,…,Un"`` → one unit per signal (a tuple);
+    one unit (stripped), a tuple or None as given.
+
+    Parameters
+    ----------
+    text : str or tuple of str or None
+        ``"deg/s"`` (one unit for every signal) or ``"rad/s, deg/s"`` (one per signal; an
+        empty item states none for its signal).
+
+    Returns
+    -------
+    str or tuple of str or None
+        What :attr:`ReadOptions.signal_unit <thermocal.readers.options.ReadOptions>` takes.
+
+    Examples
+    --------
+    >>> split_units("rad/s, deg/s"), split_units(" deg/s")
+    (('rad/s', 'deg/s'), 'deg/s')
+    """
+    if isinstance(text, str) and "," in text:
+        return tuple(u.strip() for u in text.split(","))
+    return text.strip() if isinstance(text, str) else text
 
 
 def read_options_of(o: Any) -> ReadOptions:
@@ -149,7 +149,7 @@ def read_options_of(o: Any) -> ReadOptions:
         ``FitOptions``, ``ValidateOptions`` or any object with (some of) the fields
         ``time``, ``time_unit``, ``signal``, ``temps``, ``signal_unit``, ``temp_unit``,
         ``temp_conversion``, ``topic``, ``names``, ``rate``, ``on_bad_lines``,
-        ``delimiter``, ``decimal`` (the options' strings).
+        ``delimiter``, ``decimal`` (the texts as typed).
 
     Returns
     -------
@@ -178,7 +178,7 @@ def check_recording(
     read : ReadOptions, optional
         How it was read (to list the file's columns when no signal is named).
     require_signal : bool
-        A recording with no signal at all is an input error naming ``--signal`` and the
+        A recording with no signal at all is an input error naming ``signals`` and the
         available columns.
     validate : bool
         The time column must be finite and strictly increasing and the signal and
@@ -202,9 +202,10 @@ def check_recording(
             names = _all_columns(path, read)
         from thermocal.readers.common import names_list
 
-        raise ThermocalInputError(
-            f"{path}: name the signal column with --signal; available: "
-            + (names_list(names) or "see thermocal inspect FILE")  # 20 and how many more
+        raise ThermocalInputError.naming(
+            f"{path}: name the signal column with {{signals}}; available: "
+            + (names_list(names) or "see thermocal inspect FILE"),  # 20 and how many more
+            "signals",
         )
     if validate:
         rec.validate()
@@ -246,6 +247,6 @@ __all__ = [
     "check_recording",
     "read_options",
     "read_options_of",
-    "split_floats",
     "split_names",
+    "split_units",
 ]

@@ -18,9 +18,15 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from thermocal.errors import FileFormatError, ThermocalInputError, ThermocalWarning, UnitWarning
+from thermocal.errors import (
+    FileFormatError,
+    ParameterError,
+    ThermocalInputError,
+    ThermocalWarning,
+    UnitWarning,
+)
 from thermocal.pipeline.options import ValidateOptions
-from thermocal.pipeline.reading import check_recording, split_names
+from thermocal.pipeline.reading import check_recording
 from thermocal.readers.formats import file_kind, format_named
 
 if TYPE_CHECKING:
@@ -34,7 +40,7 @@ if TYPE_CHECKING:
 @dataclass(frozen=True)
 class ChannelValidation:
     """One channel judged: its model, the :class:`~thermocal.validation.ValidationResult`
-    (in the data's own unit) and its ``--json`` object (``figures``)."""
+    (in the data's own unit) and its JSON object (``figures``)."""
 
     name: str
     model: TemperatureModel
@@ -54,7 +60,7 @@ class ValidationReport:
     triads: tuple[Any, ...] = ()
 
     def to_dict(self) -> dict[str, Any]:
-        """``thermocal validate --json``: one channel's figures; ``{"channels": {name:
+        """The ``validate`` command's JSON: one channel's figures; ``{"channels": {name:
         figures}}`` for several; ``{"model", "file", "family": "triads", "triads"}``."""
         if self.triads:
             return {
@@ -126,9 +132,10 @@ def ambient_c(rec: Recording, name: str) -> FloatArray:
     """
     if rec.units.get(name) == "counts" and name not in rec.meta.temperature_conversion:
         warnings.warn(
-            UnitWarning(
+            UnitWarning.naming(
                 f"{rec.name}: the ambient column {name!r} is in raw counts with no conversion: "
-                "hold stages are found with --stage-rate in counts/min"
+                "hold stages are found with {stage_rate} in counts/min",
+                "stage_rate",
             ),
             stacklevel=2,
         )
@@ -170,13 +177,13 @@ def _modeling_ambient(
         mrec = read_recording(mod_path, read, model=model)
         for prob in recording.find_problems(mrec, required=[amb]):
             if prob.severity == "error" and (prob.column in (None, "time", amb)):
-                raise ThermocalInputError(f"{mod_path}: {prob.message}")
+                raise ThermocalInputError.naming(f"{mod_path}: {prob.message}", *prob.parameters)
         ctx.modeling[mod_path] = mrec
     return mod_path, (mrec.time_s, ambient_c(mrec, amb))
 
 
 def _is_log(path: Path) -> bool:
-    """A flight-controller log (``.ulg``, ``.bin``), which ``--topic`` applies to; a station
+    """A flight-controller log (``.ulg``, ``.bin``), which ``topic`` applies to; a station
     folder, a CSV or Parquet file is not (and a name no reader accepts is said by the reader)."""
     try:
         return "topic" in format_named(file_kind(path)).options
@@ -187,7 +194,7 @@ def _is_log(path: Path) -> bool:
 def _validate_channel(
     ctx: _Context, model: TemperatureModel, sig: str, rec: Recording | None = None
 ) -> tuple[ValidationResult, dict[str, Any]]:
-    """Validate one model on its signal column; (result, --json object).  ``rec``: the
+    """Validate one model on its signal column; (result, JSON object).  ``rec``: the
     file already read (several channels: once for all of them)."""
     from thermocal import validation
     from thermocal.compensate import kernels as compensate
@@ -234,10 +241,10 @@ def _validate_channel(
 def _validate_channels(ctx: _Context, cal: Calibration) -> ValidationReport:
     """A calibration of several channels: the file read once with every chosen channel's
     column, each channel judged on it."""
-    from thermocal.models.calibration import merged_inputs, temperatures_of
+    from thermocal.models.calibration_inputs import merged_inputs, temperatures_of
 
     o = ctx.o
-    chosen = split_names(o.signal) or cal.names
+    chosen = list(o.signals or ()) or cal.names
     missing = [n for n in chosen if n not in cal.names]
     if missing:
         raise ThermocalInputError(
@@ -285,7 +292,7 @@ def judge_triads(
     latitude_deg: float | None,
     *,
     static_s: float = 1.0,
-    signal_unit: str | None = None,
+    signal_unit: str | tuple[str, ...] | None = None,
 ) -> list[Any]:
     """Triads of a calibration judged on a recording: on held-out poses when the calibration
     is a multi-position one, else as a turntable run.
@@ -300,7 +307,7 @@ def judge_triads(
         Latitude [°] (None: the recording's metadata).
     static_s : float
         Shortest still stretch [s] of a held-out pose.
-    signal_unit : str, optional
+    signal_unit : str or tuple of str, optional
         The gyro's unit when the file does not state it.
 
     Returns
@@ -331,8 +338,12 @@ def _validate_triads(
 
     rec = read_for_triads(file, cal.triads, o.read_options)
     _own_session(cal, file)
+    if o.signal_unit is not None and not isinstance(o.signal_unit, str):
+        raise ParameterError(
+            "signal_unit", f"{{name}} takes one unit for a triad calibration, got {o.signal_unit}"
+        )
     results = judge_triads(
-        cal.triads, rec, o.latitude, static_s=o.static_s, signal_unit=o.signal_unit
+        cal.triads, rec, o.latitude, static_s=o.static_s, signal_unit=o.read_options.signal_unit
     )
     for r in results:
         if r.outside_range_fraction > 0:
@@ -347,7 +358,7 @@ def _validate_triads(
 
 
 def validate_files(
-    calibration: Path, file: Path, options: ValidateOptions | None = None
+    calibration: str | Path, file: str | Path, options: ValidateOptions | None = None
 ) -> ValidationReport:
     """Judge the model or calibration file ``calibration`` on the recording ``file`` (module
     docstring): correlation r, bias stability and repeatability over the hold stages, rms and
@@ -356,9 +367,9 @@ def validate_files(
 
     Parameters
     ----------
-    calibration : Path
+    calibration : str or Path
         A model or calibration file.
-    file : Path
+    file : str or Path
         The validation recording.
     options : ValidateOptions or None, optional
         Columns, stage detection and read options (default ``None``: the defaults).
@@ -383,6 +394,7 @@ def validate_files(
     from thermocal.pipeline.model_file import load_calibration
 
     o = options if options is not None else ValidateOptions()
+    calibration, file = Path(calibration), Path(file)
     pre = load_calibration(calibration)
     if pre.triads and not pre.channels:
         return _validate_triads(pre, calibration, file, o)
@@ -392,7 +404,8 @@ def validate_files(
     if len(cal.channels) > 1:
         return _validate_channels(ctx, cal)
     model = cal.channels[0].model
-    res, out = _validate_channel(ctx, model, o.signal or model.signal_name)
+    signal = ",".join(o.signals) if o.signals else model.signal_name  # one column
+    res, out = _validate_channel(ctx, model, signal)
     return ValidationReport(
         calibration, file, (ChannelValidation(model.signal_name, model, res, out),)
     )

@@ -609,7 +609,7 @@ def named_like_temperature(name: str) -> bool:
 
 
 def default_time_column(names: Sequence[str], stated: str | None = None) -> str:
-    """The time column when ``--time`` is not given: ``stated`` (the sidecar's), else
+    """The time column when ``time`` is not given: ``stated`` (the sidecar's), else
     ``time`` if present, else the one column whose name, with any unit stripped
     (:func:`thermocal.units.unit_in_column_name`), is one of :data:`TIME_COLUMN_NAMES`.
     Several candidates, or none, give ``"time"`` (and so a missing-column error that
@@ -656,10 +656,10 @@ def default_time_column(names: Sequence[str], stated: str | None = None) -> str:
 # --- flight-controller logs: topics ---------------------------------------------------------
 
 DEFAULT_ULOG_TOPIC = "sensor_gyro.0"
-"""The PX4 ULog topic read when ``--topic`` is not given (:mod:`thermocal.readers.ulog`)."""
+"""The PX4 ULog topic read when ``topic`` is not given (:mod:`thermocal.readers.ulog`)."""
 
 DEFAULT_DATAFLASH_TOPIC = "IMU.0"
-"""The ArduPilot DataFlash message read when ``--topic`` is not given
+"""The ArduPilot DataFlash message read when ``topic`` is not given
 (:mod:`thermocal.readers.dataflash`)."""
 
 
@@ -692,8 +692,8 @@ def parse_topic(topic: str | None, default: str = DEFAULT_ULOG_TOPIC) -> tuple[s
     text = (topic or default).strip()
     name, _, inst = text.partition(".")
     if not name or (inst and not inst.isdigit()):
-        raise ThermocalInputError(
-            f"--topic must be NAME or NAME.N (e.g. sensor_gyro.0), got {text!r}"
+        raise ThermocalInputError.naming(
+            f"{{topic}} must be NAME or NAME.N (e.g. sensor_gyro.0), got {text!r}", "topic"
         )
     return name, int(inst or 0)
 

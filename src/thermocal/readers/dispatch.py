@@ -112,15 +112,19 @@ def read_whole_table(path: str | Path, read: ReadOptions) -> tuple[pd.DataFrame,
     Raises
     ------
     thermocal.errors.ThermocalInputError
-        A field of ``read`` that does not apply to the file's format (named by its option).
+        A field of ``read`` that does not apply to the file's format (named).
     """
     p = Path(path)
     fmt = format_of(p)
     if read.topic is not None and "topic" not in fmt.options:
-        raise ThermocalInputError(f"{p}: --topic is for flight-controller logs (.ulg, .bin)")
+        raise ThermocalInputError.naming(
+            f"{p}: {{topic}} is for flight-controller logs (.ulg, .bin)", "topic"
+        )
     if read.text_layout_given and not fmt.options >= TEXT_FIELDS:
-        raise ThermocalInputError(
-            f"{p}: --names, --rate, --on-bad-lines, --delimiter and --decimal are for text logs"
+        raise ThermocalInputError.naming(
+            f"{p}: {{names}}, {{rate_hz}}, {{on_bad_lines}}, {{delimiter}} and {{decimal}} are "
+            "for text logs",
+            *_TEXT_LAYOUT,
         )
     obj, file_meta = read_table(p, read, fmt)
     info: dict[str, Any] = {**file_meta, **load_sidecar(p)}
@@ -135,15 +139,19 @@ def read_whole_table(path: str | Path, read: ReadOptions) -> tuple[pd.DataFrame,
     return obj, info
 
 
+_TEXT_LAYOUT: tuple[str, ...] = ("names", "rate_hz", "on_bad_lines", "delimiter", "decimal")
+"""The :class:`ReadOptions` fields of a text log's layout, as messages name them."""
+
+
 def _fc_log_unknown_units(
     p: Path,
     info: dict[str, Any],
     sig_names: Sequence[str],
-    option: str | None,
+    option: str | tuple[str, ...] | None,
     model: units.StatedUnits | None,
 ) -> None:
     """A flight-controller log's field whose unit neither the firmware's message definition
-    known here (:data:`PX4_UNITS`, :data:`ARDUPILOT_UNITS`), nor ``--signal-unit``, the column
+    known here (:data:`PX4_UNITS`, :data:`ARDUPILOT_UNITS`), nor ``signal_unit``, the column
     name or the model states is read as raw values (``counts``, not converted) with a
     :class:`~thermocal.errors.UnitWarning` — never guessed as °/h."""
     if option:
@@ -157,10 +165,11 @@ def _fc_log_unknown_units(
             continue
         known[c] = "counts"
         warnings.warn(
-            UnitWarning(
+            UnitWarning.naming(
                 f"{p}: the unit of field {c!r} of {topic} is not known from the firmware's "
                 "message definition: read as raw values (counts), not converted; give "
-                "--signal-unit"
+                "{signal_unit}",
+                "signal_unit",
             ),
             stacklevel=3,
         )
@@ -178,9 +187,9 @@ def _open_table(p: Path, read: ReadOptions) -> tuple[pd.DataFrame | ParquetColum
             "`thermocal station run` wrote it: it holds station.json)"
         )
     if read.topic is not None and "topic" not in fmt.options:
-        raise ThermocalInputError(
-            f"{p}: --topic/--sensor is for flight-controller logs (.ulg, .bin) and station "
-            "recordings"
+        raise ThermocalInputError.naming(
+            f"{p}: {{topic}} is for flight-controller logs (.ulg, .bin) and station recordings",
+            "topic",
         )
     obj, file_meta = read_table(p, read, fmt)
     side = load_sidecar(p)
@@ -253,10 +262,12 @@ _BANNER_RATE = re.compile(
 
 
 def time_hint(names: list[str], banner: Sequence[str] = ()) -> str:
-    """What to give when no time column is found: ``--time`` or ``--rate``, naming a
-    sample counter (the time with ``--rate``), a rate the file's banner states
+    """What to give when no time column is found: ``time`` or ``rate_hz``, naming a
+    sample counter (the time with ``rate_hz``), a rate the file's banner states
     (``banner``: its lines) or a column named like a temperature (not time) among
-    ``names``.
+    ``names``.  A template: ``{time}`` and ``{rate_hz}`` stand for the parameters
+    (:data:`TIME_HINT_PARAMETERS`; build the message with
+    :meth:`~thermocal.errors.ThermocalInputError.naming`).
 
     Parameters
     ----------
@@ -274,21 +285,27 @@ def time_hint(names: list[str], banner: Sequence[str] = ()) -> str:
     --------
     >>> from thermocal.readers.dispatch import time_hint
     >>> time_hint(["n", "gyro"], ["rate: 50 Hz"])
-    " (the file's banner says 'rate: 50 Hz': give --rate 50)"
+    " (the file's banner says 'rate: 50 Hz': give {rate_hz} 50)"
     """
     counter = counter_column(names)
     temp_like = [n for n in names if named_like_temperature(n)]
     stated = [(b, m.group(4)) for b in banner if (m := _BANNER_RATE.match(b))]
     if stated:
         line, hz = stated[0]
-        return f" (the file's banner says {line.strip()!r}: give --rate {hz})"
+        return f" (the file's banner says {line.strip()!r}: give {{rate_hz}} {hz})"
     if counter is not None:
-        why = f"; {short_name(counter)} is a sample counter: give --rate HZ"
+        why = f"; {short_name(counter)} is a sample counter: give {{rate_hz}} HZ"
     elif temp_like:
         why = f"; {short_name(temp_like[0])} is named like a temperature, not time"
     else:
         why = ""
-    return f" (name the time column with --time, or give --rate HZ for a log without one{why})"
+    return (
+        f" (name the time column with {{time}}, or give {{rate_hz}} HZ for a log without one{why})"
+    )
+
+
+TIME_HINT_PARAMETERS: tuple[str, ...] = ("time", "rate_hz")
+"""The parameters a :func:`time_hint` names."""
 
 
 def _roles(
@@ -322,8 +339,9 @@ def _roles(
             same = [n for n in names if units.strip_unit_from_name(n) == c.strip()]
             if len(same) == 1 and not hint:  # 'acc_x' for the file's 'acc_x [counts]'
                 hint = f" (did you mean {same[0]!r}? give the name as the file writes it)"
-            raise MissingColumnError(
-                f"{p}: no column {short_name(c)}; available: {names_list(names)}{hint}"
+            raise MissingColumnError.naming(
+                f"{p}: no column {short_name(c)}; available: {names_list(names)}{hint}",
+                *TIME_HINT_PARAMETERS,
             )
     return time_col, sig_names, tmp_names
 
@@ -359,7 +377,7 @@ def _n_rows(p: Path, obj: pd.DataFrame | ParquetColumns, names: list[str]) -> in
 def _time_s(
     p: Path, col: str, t: FloatArray, unit: str, mode: str | None, text: ReadOptions
 ) -> FloatArray:
-    """The time column ``t`` (as read, in ``unit``) in seconds: with ``--rate`` a sample
+    """The time column ``t`` (as read, in ``unit``) in seconds: with ``rate_hz`` a sample
     counter's ``n / rate`` (``mode`` ``"counter"``) or host stamps at the nominal rate
     (``"stamps"``), as :func:`~thermocal.readers.text.rate_time` found them."""
     rate = text.rate_hz
@@ -373,49 +391,53 @@ def _time_s(
 
 
 STAMPS_RATE_RANGE = (0.8, 3.0)
-"""With ``--rate`` on a file with a time column, the mean step of its stamps must lie
+"""With ``rate_hz`` on a file with a time column, the mean step of its stamps must lie
 within these multiples of the nominal period (fewer samples than the rate: some lost;
 more, or far fewer: the wrong rate or time unit)."""
 
 
 STAMPS_RATE_TOLERANCE = 0.005
-"""With ``--rate`` on host timestamps, a rate the stamps' span contradicts by more than
+"""With ``rate_hz`` on host timestamps, a rate the stamps' span contradicts by more than
 this fraction (lost samples counted) is stated in a warning: a wrong nominal rate lifts the
 latency floor by a period every few dozen samples, read as samples lost."""
 
 
 def _stamps_at_rate(p: Path, col: str, t: FloatArray, rate_hz: float) -> FloatArray:
-    """``--rate`` on a file whose time column holds host timestamps [s]: the samples at the
+    """``rate_hz`` on a file whose time column holds host timestamps [s]: the samples at the
     sensor's nominal rate (:func:`thermocal.recording.nominal_time`, lost samples kept as
     gaps); refused when the stamps are not finite or their mean step is not near the
     nominal period (:data:`STAMPS_RATE_RANGE`)."""
     if t.size < 2:
         return t
     if not all_finite(t):
-        raise ThermocalInputError(
-            f"{p}: the time column {col!r} has missing or non-finite values; --rate "
-            f"{rate_hz:g} Hz takes the samples at the nominal rate only from finite stamps"
+        raise ThermocalInputError.naming(
+            f"{p}: the time column {col!r} has missing or non-finite values; {{rate_hz}} "
+            f"{rate_hz:g} Hz takes the samples at the nominal rate only from finite stamps",
+            "rate_hz",
         )
     mean_step = float(t[-1] - t[0]) / (t.size - 1)
     lo, hi = STAMPS_RATE_RANGE
     if not lo / rate_hz <= mean_step <= hi / rate_hz:
-        raise ThermocalInputError(
-            f"{p}: --rate {rate_hz:g} Hz given but the file has a time column {col!r} whose "
-            f"samples are {mean_step:.6g} s apart on average ({1.0 / mean_step:.6g} Hz); "
-            "check --rate and --time-unit, or drop --rate"
+        raise ThermocalInputError.naming(
+            f"{p}: {{rate_hz}} {rate_hz:g} Hz given but the file has a time column {col!r} "
+            f"whose samples are {mean_step:.6g} s apart on average ({1.0 / mean_step:.6g} Hz); "
+            "check {rate_hz} and {time_unit}, or drop {rate_hz}"
             if mean_step > 0
-            else f"{p}: --rate {rate_hz:g} Hz given but the file has a time column {col!r} "
-            "that does not advance; drop --rate"
+            else f"{p}: {{rate_hz}} {rate_hz:g} Hz given but the file has a time column {col!r} "
+            "that does not advance; drop {rate_hz}",
+            "rate_hz",
+            "time_unit",
         )
     out, lost = nominal_time(t, rate_hz)
     seen_hz = (t.size - 1 + lost) / float(t[-1] - t[0])
     if abs(seen_hz / rate_hz - 1.0) > STAMPS_RATE_TOLERANCE:
         warnings.warn(
-            TimestampWarning(
-                f"{p}: --rate {rate_hz:g} Hz, but the time column {col!r} spans "
+            TimestampWarning.naming(
+                f"{p}: {{rate_hz}} {rate_hz:g} Hz, but the time column {col!r} spans "
                 f"{float(t[-1] - t[0]):.6g} s for {t.size} samples "
                 f"({(t.size - 1) / float(t[-1] - t[0]):.6g} Hz) and {lost} more would be lost "
-                "at that rate; check --rate (the nominal rate, not a rounded one)"
+                "at that rate; check {rate_hz} (the nominal rate, not a rounded one)",
+                "rate_hz",
             ),
             stacklevel=3,
         )
@@ -490,9 +512,9 @@ def read_recording(
     guess_temperatures : bool
         No temperatures given or in a sidecar: those named like one.
     ask_units, implied_units : dict, optional
-        Signal column → the option a :class:`~thermocal.errors.UnitError` asks for, or the
-        unit another option implies (``counts``: a count scale), where nothing states its
-        unit (:class:`thermocal.units.UnitOptions`).
+        Signal column → the parameter a :class:`~thermocal.errors.UnitError` asks for
+        (``"accel_unit"``), or the unit another parameter implies (``counts``: a count
+        scale), where nothing states its unit (:class:`thermocal.units.UnitOptions`).
 
     Returns
     -------

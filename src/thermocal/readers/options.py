@@ -3,7 +3,7 @@
 :class:`ReadOptions` carries what a user states about a recording — its columns, their units,
 the raw-count temperature conversion, the log topic and how a text log is laid out.  Every
 call that reads a file takes one (``read=ReadOptions(...)``); the command line builds it from
-its options (``--time``, ``--signal``, ``--temps``, ``--rate``, …).  What is not stated is
+its own options.  What is not stated is
 read from the file (sidecar, Parquet metadata, column names), as :mod:`thermocal.units`
 resolves it.
 """
@@ -38,6 +38,16 @@ def _names(value: str | Iterable[str] | None, parameter: str) -> tuple[str, ...]
     return tuple(out)
 
 
+def _units(value: Iterable[str]) -> tuple[str, ...]:
+    """One unit per signal, as a tuple of strings."""
+    out = tuple(value)
+    if not all(isinstance(u, str) for u in out):
+        raise ParameterError(
+            "signal_unit", f"{{name}} holds one unit, or one per signal; got {out!r}"
+        )
+    return out
+
+
 @dataclass(frozen=True)
 class ReadOptions:
     """How to read a recording; every field left ``None`` is taken from the file.
@@ -53,9 +63,11 @@ class ReadOptions:
         string (``"gx,gy,gz"``) or a list is accepted and stored as a tuple.
     temperatures : tuple of str, optional
         Temperature columns, as ``signals``.
-    signal_unit : str, optional
+    signal_unit : str or tuple of str, optional
         Unit of the signal columns (``"deg/h"``, ``"deg/s"``, ``"rad/s"``, ``"mg"``,
-        ``"m/s^2"``, ``"g"``, ``"counts"``, …).
+        ``"m/s^2"``, ``"g"``, ``"counts"``, …): one for every signal, or a tuple of one
+        per signal in the order of ``signals`` (an empty string states none for its
+        signal; a list is stored as a tuple).
     temp_unit : str, optional
         Unit of the temperature columns (``"degC"``, ``"K"``, ``"degF"``, ``"counts"``).
     temp_conversion : TemperatureConversion, optional
@@ -96,7 +108,7 @@ class ReadOptions:
     time_unit: str | None = None
     signals: tuple[str, ...] | None = None
     temperatures: tuple[str, ...] | None = None
-    signal_unit: str | None = None
+    signal_unit: str | tuple[str, ...] | None = None
     temp_unit: str | None = None
     temp_conversion: TemperatureConversion | None = None
     topic: str | None = None
@@ -110,11 +122,15 @@ class ReadOptions:
         set_ = object.__setattr__  # frozen: normalise in place once
         for field in ("signals", "temperatures", "names"):
             set_(self, field, _names(getattr(self, field), field))
+        if self.signal_unit is not None and not isinstance(self.signal_unit, str):
+            set_(self, "signal_unit", _units(self.signal_unit))
         if self.temp_conversion is not None:
             set_(
                 self,
                 "temp_conversion",
-                temperature_conversion(self.temp_conversion, "temp_conversion"),
+                temperature_conversion(
+                    self.temp_conversion, "{temp_conversion}", ("temp_conversion",)
+                ),
             )
         if self.on_bad_lines not in ("error", "skip"):
             raise ParameterError(

@@ -129,10 +129,11 @@ def read_history(
         elif defaults.PROGRAM_SETPOINT in rec.columns:
             column = defaults.PROGRAM_SETPOINT
         else:
-            raise MissingColumnError(
-                f"{path}: no temperature column known; name one with --column (available: "
+            raise MissingColumnError.naming(
+                f"{path}: no temperature column known; name one with {{column}} (available: "
                 + ", ".join(repr(c) for c in rec.columns)
-                + ")"
+                + ")",
+                "column",
             )
     values = rec.temperature_c(column) if column in rec.temperatures else rec.column(column)
     return rec.time_s, values, column

@@ -151,9 +151,10 @@ def _stream_of(path: Path) -> tuple[Path, str]:
         doc = read_station_json(path)
         ids = sensor_ids(doc)
         if len(ids) != 1:
-            raise FileFormatError(
+            raise FileFormatError.naming(
                 f"{path}: a station recording of {len(ids)} sensors ({', '.join(ids)}); "
-                f"name one with --sensor ID or as {path}/ID (or {path}/{CHAMBER_STREAM})"
+                f"name one with {{sensor}} ID or as {path}/ID (or {path}/{CHAMBER_STREAM})",
+                "sensor",
             )
         return path, ids[0]
     doc = read_station_json(path.parent)
@@ -167,10 +168,10 @@ def _stream_of(path: Path) -> tuple[Path, str]:
 
 
 def with_sensor(path: Path, sensor: str | None) -> Path:
-    """``DIR/SENSOR`` for ``--sensor SENSOR`` (every command reads
-    DIR as one recording, with --sensor ID when there are several).  ``path`` is ``DIR`` or
+    """``DIR/SENSOR`` for the sensor ``sensor`` (a station recording folder ``DIR`` is read
+    as one recording, of the sensor named when there are several).  ``path`` is ``DIR`` or
     ``DIR/ID``; without ``sensor`` it is returned as it is.  A sensor the recording does not
-    have, or ``DIR/A`` with ``--sensor B``, is a :class:`FileFormatError` naming the sensors.
+    have, or ``DIR/A`` with ``sensor="B"``, is a :class:`FileFormatError` naming the sensors.
 
     Parameters
     ----------
@@ -193,8 +194,9 @@ def with_sensor(path: Path, sensor: str | None) -> Path:
         return path
     if not path.is_dir():
         if path.name != sensor:
-            raise FileFormatError(
-                f"{path}: names sensor {path.name!r} and --sensor names {sensor!r}; give one"
+            raise FileFormatError.naming(
+                f"{path}: names sensor {path.name!r} and {{sensor}} names {sensor!r}; give one",
+                "sensor",
             )
         return path
     ids = sensor_ids(read_station_json(path))

@@ -93,7 +93,25 @@ def _is_number(field: str, decimal: str, *, empty: bool = False) -> bool:
 class TextLayout:
     """A text log's layout found by :func:`sniff_text`: ``skip`` lines before the header
     (or first data row), the banner lines skipped, the delimiter, the decimal mark, whether
-    the first kept line is a header, the number of fields."""
+    the first kept line is a header, the number of fields.
+
+    Attributes
+    ----------
+    skip : int
+        Lines before the header (or first data row).
+    banner : tuple of str
+        The banner lines skipped.
+    delimiter : str
+        Field delimiter.
+    decimal : str
+        Decimal mark.
+    header : bool
+        The first kept line is a header.
+    n_fields : int
+        Number of fields.
+    text_columns : tuple of int
+        Positions of the fields that hold text.
+    """
 
     skip: int
     banner: tuple[str, ...]
@@ -136,7 +154,7 @@ def sniff_text(lines: Sequence[str], opts: ReadOptions | None = None) -> TextLay
     first line with m fields that is numeric (empty fields: missing values), or that names
     the columns (no field a number) and is followed by a line of m fields (the header); the
     lines before are skipped, those but ``#`` comments as a banner (a terminal's, a
-    logger's). Lines further down that do not fit are mangled lines, for ``--on-bad-lines``.
+    logger's). Lines further down that do not fit are mangled lines, for ``on_bad_lines``.
     The decimal mark is ``,`` when the delimiter is not a comma and the data parse with
     ``,`` but not with ``.``.
 
@@ -174,9 +192,11 @@ def sniff_text(lines: Sequence[str], opts: ReadOptions | None = None) -> TextLay
         ):
             best = (0, 0, " ")
         else:
-            raise FileFormatError(
+            raise FileFormatError.naming(
                 "no lines with two or more fields were found (is it a data log? give "
-                "--delimiter and --decimal if it uses others than , ; tab blanks)"
+                "{delimiter} and {decimal} if it uses others than , ; tab blanks)",
+                "delimiter",
+                "decimal",
             )
     d = best[2]
     counts_d = [len(_split(x, d)) for x in body]
@@ -214,9 +234,11 @@ def sniff_text(lines: Sequence[str], opts: ReadOptions | None = None) -> TextLay
         is_names = all(f and not _is_number(f, dec) for f in names)
         if is_names and nxt is not None and len(_split(nxt, d)) == m:
             return TextLayout(k, _banner(lines[:k]), d, dec, True, m, texts[dec])
-    raise FileFormatError(
-        f"no line of {m} numeric fields separated by {d!r} was found (give --delimiter and "
-        "--decimal if the log uses others)"
+    raise FileFormatError.naming(
+        f"no line of {m} numeric fields separated by {d!r} was found (give {{delimiter}} and "
+        "{decimal} if the log uses others)",
+        "delimiter",
+        "decimal",
     )
 
 
@@ -433,10 +455,11 @@ def csv_chunk_options(path: Path, encoding: str) -> dict[str, Any]:
     if lay.plain:
         return {}
     if not lay.header:
-        raise ThermocalInputError(
+        raise ThermocalInputError.naming(
             f"{path}: no header row (line {lay.skip + 1} is data); compensate needs named "
-            "columns: add a header line, or read it with --names in another command and "
-            "write it out"
+            "columns: add a header line, or read it with {names} in another command and "
+            "write it out",
+            "names",
         )
     warnings.warn(
         TextLayoutWarning(
@@ -454,32 +477,36 @@ def csv_chunk_options(path: Path, encoding: str) -> dict[str, Any]:
 
 
 def _column_names(path: Path, head: list[str], lay: TextLayout, o: ReadOptions) -> list[str]:
-    """The header row's names, or ``--names`` for a file without one (refused with a
+    """The header row's names, or ``names`` for a file without one (refused with a
     header, or when their number is not the number of fields)."""
     if lay.header:
         names = [c.strip() for c in _split(head[lay.skip], lay.delimiter)]
         check_unique_names(path, names)
         if o.names is not None:
-            raise ThermocalInputError(
-                f"{path}: the file has a header row ({', '.join(names)}); --names is for "
-                "files without one"
+            raise ThermocalInputError.naming(
+                f"{path}: the file has a header row ({', '.join(names)}); {{names}} is for "
+                "files without one",
+                "names",
             )
     elif o.names is None:
         what = (
-            "name its column with --names NAME (and give --rate HZ: no time column)"
+            "name its column with {names} NAME (and give {rate_hz} HZ: no time column)"
             if lay.n_fields == 1
-            else f"name its {lay.n_fields} columns with --names a,b,c"
+            else f"name its {lay.n_fields} columns with {{names}} a,b,c"
         )
-        raise ThermocalInputError(
+        raise ThermocalInputError.naming(
             f"{path}: no header row (line {lay.skip + 1} is data: "
-            f"{head[lay.skip].strip()[:60]!r}); {what}"
+            f"{head[lay.skip].strip()[:60]!r}); {what}",
+            "names",
+            "rate_hz",
         )
     else:
         names = list(o.names)
         if len(names) != lay.n_fields:
-            raise ThermocalInputError(
-                f"{path}: --names gives {len(names)} names for {lay.n_fields} columns "
-                f"(line {lay.skip + 1}: {head[lay.skip].strip()[:60]!r})"
+            raise ThermocalInputError.naming(
+                f"{path}: {{names}} gives {len(names)} names for {lay.n_fields} columns "
+                f"(line {lay.skip + 1}: {head[lay.skip].strip()[:60]!r})",
+                "names",
             )
     return names
 
@@ -530,9 +557,10 @@ def _data_rows(
                 linenos.append(lineno)
             except ValueError as exc:
                 if on_bad_lines == "error":
-                    raise FileFormatError(
+                    raise FileFormatError.naming(
                         f"{path}: line {lineno} is not a data row ({exc}): {text.strip()[:80]!r}; "
-                        "fix it or pass --on-bad-lines skip to drop such lines"
+                        "fix it or pass {on_bad_lines} skip to drop such lines",
+                        "on_bad_lines",
                     ) from None
                 bad.append((lineno, text))
     return rows, ordinal, bad, texts, linenos
@@ -542,7 +570,7 @@ def read_text(
     path: Path, encoding: str, opts: ReadOptions | None
 ) -> tuple[pd.DataFrame, dict[str, Any]]:
     """A text log as a DataFrame of floats: banner skipped, delimiter and decimal mark
-    detected (or given), header taken from ``--names`` when the file has none, mangled
+    detected (or given), header taken from ``names`` when the file has none, mangled
     lines (another number of fields, a non-number) refused naming the first or, with
     ``on_bad_lines="skip"``, dropped and counted.  Warnings say what was skipped.
 
@@ -576,7 +604,7 @@ def read_text(
     try:
         lay = sniff_text(head, o)
     except FileFormatError as exc:
-        raise FileFormatError(f"{path}: {exc}") from None
+        raise FileFormatError.naming(f"{path}: {exc.template or exc}", *exc.parameters) from None
     names = _column_names(path, head, lay, o)
     check_column_count(path, len(names))
     rows, ordinal, bad, texts, linenos = _data_rows(path, encoding, lay, len(names), o.on_bad_lines)
@@ -586,7 +614,7 @@ def read_text(
     df.attrs["file_lines"] = np.asarray(linenos, dtype=np.int64)  # for messages
     for j, values in texts.items():  # kept as text: refused only where a command uses it
         df[names[j]] = pd.Series(values, dtype=object)
-    # --rate: time = data-line number / rate, so a dropped line leaves a gap, not a shift
+    # rate_hz: time = data-line number / rate, so a dropped line leaves a gap, not a shift
     df.attrs["row_index"] = np.asarray(ordinal, dtype=np.float64)
     report: dict[str, Any] = {
         "text_layout": {
@@ -600,9 +628,11 @@ def read_text(
     }
     if (lay.delimiter != "," and lay.n_fields > 1) or lay.decimal != ".":
         warnings.warn(
-            TextLayoutWarning(
+            TextLayoutWarning.naming(
                 f"{path}: read as {delimiter_name(lay.delimiter)}-separated text with decimal "
-                f"mark {lay.decimal!r} (give --delimiter/--decimal if that is wrong)"
+                f"mark {lay.decimal!r} (give {{delimiter}}/{{decimal}} if that is wrong)",
+                "delimiter",
+                "decimal",
             ),
             stacklevel=3,
         )
@@ -617,8 +647,10 @@ def read_text(
     if bad:
         shown = ", ".join(str(ln) for ln, _t in bad[:5]) + (" …" if len(bad) > 5 else "")
         warnings.warn(
-            TextLayoutWarning(
-                f"{path}: {len(bad)} mangled line(s) dropped (--on-bad-lines skip): line(s) {shown}"
+            TextLayoutWarning.naming(
+                f"{path}: {len(bad)} mangled line(s) dropped ({{on_bad_lines}} skip): "
+                f"line(s) {shown}",
+                "on_bad_lines",
             ),
             stacklevel=3,
         )
@@ -637,7 +669,7 @@ COUNTER_COLUMN_NAMES = (
     "seq",
     "n",
 )
-"""Names a sample counter goes by (compared without case): with ``--rate`` such a column is
+"""Names a sample counter goes by (compared without case): with ``rate_hz`` such a column is
 the time, ``counter / rate`` (imucal's sessions: ``n_samples``)."""
 
 
@@ -669,10 +701,10 @@ def rate_time(
     *,
     allow_column: bool = True,
 ) -> tuple[Any, list[str], str, str | None, str]:
-    r"""``--rate``: the time of each sample at the stated rate, and how it is found (the
+    r"""``rate_hz``: the time of each sample at the stated rate, and how it is found (the
     last item): ``"rows"`` — a file without a time column gets ``time = row / rate`` [s],
     the row counted among the log's data lines (a mangled line dropped leaves a gap);
-    ``"counter"`` — a sample counter (``--time N``, or the one column named like one,
+    ``"counter"`` — a sample counter (``time="N"``, or the one column named like one,
     :data:`COUNTER_COLUMN_NAMES`) is the time, ``counter / rate`` (:func:`counter_time`);
     ``"stamps"`` — a time column (host timestamps) is replaced by the nominal grid
     (:func:`thermocal.recording.nominal_time`).  The last two are read by the caller;
@@ -726,23 +758,31 @@ def rate_time(
             and units.unit_in_column_name(col, "time") is None
         )
         if not allow_column:
-            raise ThermocalInputError(
-                f"{p}: --rate {text.rate_hz:g} Hz given but the file has a time column "
-                f"{col!r}; drop --rate"
+            raise ThermocalInputError.naming(
+                f"{p}: {{rate_hz}} {text.rate_hz:g} Hz given but the file has a time column "
+                f"{col!r}; drop {{rate_hz}}"
                 if not is_counter
                 else f"{p}: this command streams the file and cannot take the sample counter "
                 f"{col!r} as time; add a time column (time = {col} / {text.rate_hz:g} Hz) "
-                "and drop --rate"
+                "and drop {rate_hz}",
+                "rate_hz",
             )
         if is_counter and time_unit not in (None, "s"):
-            raise ThermocalInputError(
-                f"{p}: --rate {text.rate_hz:g} Hz counts the samples of {col!r}; drop --time-unit"
+            raise ThermocalInputError.naming(
+                f"{p}: {{rate_hz}} {text.rate_hz:g} Hz counts the samples of {col!r}; "
+                "drop {time_unit}",
+                "rate_hz",
+                "time_unit",
             )
         return obj, names, col, time_unit, "counter" if is_counter else "stamps"
     if isinstance(obj, ParquetColumns):
-        raise ThermocalInputError(f"{p}: --rate is for text logs; a Parquet file has its time")
+        raise ThermocalInputError.naming(
+            f"{p}: {{rate_hz}} is for text logs; a Parquet file has its time", "rate_hz"
+        )
     if time_unit not in (None, "s"):
-        raise ThermocalInputError("--rate gives the time in seconds; drop --time-unit")
+        raise ThermocalInputError.naming(
+            "{rate_hz} gives the time in seconds; drop {time_unit}", "rate_hz", "time_unit"
+        )
     rows = obj.attrs.get("row_index")
     if rows is None or len(rows) != len(obj):
         rows = np.arange(len(obj), dtype=np.float64)
@@ -793,9 +833,12 @@ def counter_time(p: Path, col: str, counts: FloatArray, rate_hz: float) -> Float
     whole = fin & (counts == np.round(counts))
     if not bool(whole.all()):
         row = int(np.argmin(whole))
-        raise ThermocalInputError(
-            f"{p}: --rate {rate_hz:g} Hz takes {col!r} for a sample counter, but row {row} "
-            f"holds {float(counts[row])!r}, not a whole number; name the time column with --time"
+        raise ThermocalInputError.naming(
+            f"{p}: {{rate_hz}} {rate_hz:g} Hz takes {col!r} for a sample counter, but row {row} "
+            f"holds {float(counts[row])!r}, not a whole number; name the time column with "
+            "{time}",
+            "rate_hz",
+            "time",
         )
     steps = np.diff(counts)
     if steps.size and not bool((steps > 0).all()):

@@ -392,7 +392,7 @@ def _calibration_report(
 ) -> ReportResult:
     """A calibration's report: the recording read once for every chosen channel
     (:func:`thermocal.report.calibration.build_calibration_report`)."""
-    from thermocal.models.calibration import merged_inputs, temperatures_of
+    from thermocal.models.calibration_inputs import merged_inputs, temperatures_of
     from thermocal.report.calibration import CalibrationReportInputs, write_calibration_report
 
     names = split_names(signal) or cal.names

@@ -278,7 +278,7 @@ def _prefix_squares(w: FloatArray, lanes: FloatArray) -> tuple[float, float]:
     return float(flat @ flat), float(grid[-1, -1])
 
 
-def modified_sum(x: FloatArray, m: int, n_terms: int, lane: FloatArray | None = None) -> float:
+def modified_sum(x: FloatArray, m: int, n_terms: int) -> float:
     r"""Σ_{j<n_terms} v_j² of MDEV's inner sums v_j = Σ_{i=j}^{j+m−1} (x_{i+2m} − 2x_{i+m} +
     x_i) (NIST SP 1065 eq. 14), with no running sum of the phase itself.
 
@@ -288,9 +288,9 @@ def modified_sum(x: FloatArray, m: int, n_terms: int, lane: FloatArray | None = 
     :data:`_MOD_CHUNK` terms.  Every partial sum is a v_j itself, as small as the deviation:
     rounding grows as ε √N relative, not as ε N² |x| / |v| as a running sum of the phase
     does.  At m = 1, v_j is the second difference itself (no running sum): MDEV
-    is OADEV to the last digit; at m = 2, 4, 8 the window sums of the second differences
-    are taken by doubling (pairwise, log₂ m adds a term).  ``lane``: x in the layout of
-    :func:`lane_layout`, for m a multiple of :data:`_LANES` (:func:`_lane_modified_sum`).
+    is OADEV to the last digit; at m = 2, 4, 8, 16 v_j is the second difference of the
+    window sums of m phase points, taken by doubling (:func:`_window_modified_sums`).  For
+    m a multiple of :data:`_RUN` the same sums come faster from :func:`lane_modified_sum`.
 
     Parameters
     ----------
@@ -300,8 +300,6 @@ def modified_sum(x: FloatArray, m: int, n_terms: int, lane: FloatArray | None = 
         Averaging factor [samples].
     n_terms : int
         Number of inner sums v_j.
-    lane : numpy.ndarray, optional
-        ``x`` in lane layout (default none).
 
     Returns
     -------
@@ -320,14 +318,11 @@ def modified_sum(x: FloatArray, m: int, n_terms: int, lane: FloatArray | None = 
         return 0.0
     if m == 1:
         return _nested_difference_sum(x, 1, n_terms, 2)
-    if m in (2, 4, 8):
-        return _doubling_modified_sum(x, m, n_terms)
+    if m in (2, 4, 8, 16):
+        return _window_modified_sums(x, [m], [n_terms])[0]
     first = x[2 * m : 3 * m] - 2.0 * x[m : 2 * m]
     first += x[:m]
     v = float(np.sum(first))
-    if lane is not None and m % _LANES == 0 and n_terms > _LANE_CHUNK + 1:
-        total, a, v_a = _lane_modified_sum(lane, m, n_terms, v)
-        return total + _modified_tail(x, m, n_terms, a, v_a) - v_a * v_a
     return _modified_tail(x, m, n_terms, 0, v)
 
 
@@ -352,161 +347,236 @@ def _modified_tail(x: FloatArray, m: int, n_terms: int, start: int, v: float) ->
     return total
 
 
-def _doubling_modified_sum(x: FloatArray, m: int, n_terms: int) -> float:
-    """:func:`modified_sum` for m = 2, 4, 8: v_j as the window sum of m second differences
-    d_i = x_{i+2m} − 2x_{i+m} + x_i (nested: two subtractions), formed by doubling (w ← w_i +
-    w_{i+k} for k = 1, 2, … m/2), in blocks of :data:`_MOD_CHUNK` terms."""
-    size = min(_MOD_CHUNK, n_terms)
-    e1, e2 = np.empty(size + 3 * m), np.empty(size + 2 * m)
-    total = 0.0
-    for a in range(0, n_terms, _MOD_CHUNK):
-        n_b = min(a + _MOD_CHUNK, n_terms) - a
-        w = n_b + m - 1  # second differences d_a … d_{a+n_b+m−2}
-        d1 = e1[: w + m]
-        np.subtract(x[a + m : a + w + 2 * m], x[a : a + w + m], out=d1)
-        d = e2[:w]
-        np.subtract(d1[m : m + w], d1[:w], out=d)
-        k = 1
-        while k < m:  # d[i] ← Σ of 2k consecutive second differences from i
-            np.add(d[: w - k], d[k:w], out=d[: w - k])
-            w -= k
-            k *= 2
-        v = d[:n_b]
-        total += float(v @ v)
-    return total
+def _window_modified_sums(x: FloatArray, ms: list[int], n_terms: list[int]) -> list[float]:
+    r""":func:`modified_sum` for m in 2, 4, 8, 16 (ascending) in one pass over the phase:
+    v_j = S_{j+2m} − 2S_{j+m} + S_j with S_j = Σ_{i<m} x_{j+i} the window sums of m points,
+    each width from the one below by doubling (S^{2w}_j = S^w_j + S^w_{j+w}), in blocks of
+    :data:`_MOD_CHUNK` terms.  The window sums are no larger than m |x| (no running sum),
+    and every width reads the phase once for all of them.  m = 2 as the pair sums of its
+    second differences d_i = x_{i+4} − 2x_{i+2} + x_i (to the digits of m = 1)."""
+    n, top = x.size, ms[-1]
+    widths = [w for w in (2, 4, 8, 16) if w <= top]
+    most = max(n_terms)
+    size = min(_MOD_CHUNK, most)
+    sums = {w: np.empty(size + 3 * top) for w in widths}
+    e1, e2 = np.empty(size + 2 * top + 3), np.empty(size + 1)
+    totals = [0.0] * len(ms)
+    for a in range(0, most, _MOD_CHUNK):
+        nb = min(_MOD_CHUNK, most - a)
+        below, span = x[a:], n - a  # S^1 = x; the windows of width w that fit: span − w + 1
+        for w in widths:
+            cur = sums[w][: min(nb + 3 * top - w, span - w + 1)]
+            np.add(below[: cur.size], below[w // 2 : w // 2 + cur.size], out=cur)
+            below = cur
+            if w not in ms:
+                continue
+            i = ms.index(w)
+            nt = min(nb, n_terms[i] - a)
+            if nt <= 0:
+                continue
+            if w == 2:  # v_j = d_j + d_{j+1}
+                d1 = e1[: nt + 3]
+                np.subtract(x[a + 2 : a + nt + 5], x[a : a + nt + 3], out=d1)
+                d = e2[: nt + 1]
+                np.subtract(d1[2:], d1[: nt + 1], out=d)
+                np.add(d[:nt], d[1:], out=d[:nt])
+                totals[i] += float(d[:nt] @ d[:nt])
+                continue
+            d1 = e1[: nt + w]
+            np.subtract(cur[w : 2 * w + nt], cur[: nt + w], out=d1)
+            v = e2[:nt]
+            np.subtract(d1[w:], d1[:nt], out=v)
+            totals[i] += float(v @ v)
+    return totals
 
 
-_LANE_CHUNK: Final = 1 << 18
-"""Terms per block of :func:`_lane_modified_sum` (2 MB buffers: fewer numpy calls a term;
-2¹⁶ and 2¹⁷ measured ≈ 20 % slower on the 10⁷-sample benchmark, 2²⁰ ≈ 30 %)."""
+_RUN: Final = 32
+"""Points per run of :func:`lane_prefix`: the offsets of :func:`lane_modified_sum` cost 1/L
+of its work (16, 32, 64: 13.6, 11.9, 12.4 ms at m = 64 on 10⁷ points, :func:`lane_prefix`
+30, 30, 44 ms)."""
+
+_PREFIX_BLOCK: Final = 1 << 17
+"""Points per block of :func:`lane_prefix` (1 MB, cache-resident)."""
+
+_LANE_MIN: Final = 1 << 17
+"""Fewest third differences (N − 3m) for which :func:`lane_modified_sum` is used."""
 
 
-def lane_layout(x: FloatArray) -> FloatArray:
-    """x as a (:data:`_LANES`, ⌈N / L⌉) array: row i, column c holds x_{cL+i} (zero past the
-    end).  A shift of the index by m = kL is a shift of k columns, the same in every row: the
-    third differences of :func:`_lane_modified_sum` come out already laid in lanes.  Copied
-    in blocks of 1024 columns (a transposed copy of the whole is ≈ 5× slower).
+def lane_prefix(x: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
+    r"""The phase cut into runs of :data:`_RUN` points, each run's running sum: ``q[c, i]``
+    = Σ_{i'≤i} x_{cL+i'} (x taken as zero past its end), the runs' totals ``q[c, L − 1]``
+    (contiguous) and the sums ``r[c]`` = Σ_i q[c, i].
+
+    Every running sum is over at most L = 32 points, so ``q`` is as small as 32 |x| however
+    long the record.  A shift of the index by m = kL is a shift of k rows, the same in every
+    column: the third difference of ``q`` over k rows is the running sum, along each run, of
+    the third differences t_j of x (:func:`lane_modified_sum`).  Taken column by column in
+    blocks of :data:`_PREFIX_BLOCK` points (cache-resident).
 
     Parameters
     ----------
     x : numpy.ndarray
-        Phase points, shape (N,).
+        Phase points [unit·s], shape (N,).
 
     Returns
     -------
-    numpy.ndarray
-        Array of shape (L, ⌈N / L⌉).
+    tuple of numpy.ndarray
+        ``q`` of shape (⌈N / L⌉, L), the totals and ``r``, each of shape (⌈N / L⌉,)
+        [unit·s].
+
+    Notes
+    -----
+    .. math:: q_{c,i} = \sum_{i'=0}^{i} x_{cL+i'}, \qquad r_c = \sum_{i=0}^{L-1} q_{c,i}
+
+    Examples
+    --------
+    >>> q, totals, r = lane_prefix(np.arange(64.0))
+    >>> q.shape, float(q[0, 1]), totals.tolist(), float(r[0])
+    ((2, 32), 1.0, [496.0, 1520.0], 5456.0)
     """
-    cols = -(-x.size // _LANES)
-    full = x.size // _LANES
-    out = np.zeros((_LANES, cols))
-    src = x[: full * _LANES].reshape(full, _LANES)
-    for a in range(0, full, 1024):
-        b = min(a + 1024, full)
-        np.copyto(out[:, a:b], src[a:b].T)
-    rest = x.size - full * _LANES
-    if rest:
-        out[:rest, full] = x[full * _LANES :]
-    return out
+    runs, full = -(-x.size // _RUN), x.size // _RUN
+    q, totals = np.empty((runs, _RUN)), np.empty(runs)
+    src = x[: full * _RUN].reshape(full, _RUN)
+    if runs > full:  # the last run, zero past the end of x
+        q[full] = 0.0
+        q[full, : x.size - full * _RUN] = x[full * _RUN :]
+    rows = _PREFIX_BLOCK // _RUN
+    for a in range(0, runs, rows):
+        blk = q[a : a + rows]
+        np.copyto(blk[: max(0, min(rows, full - a))], src[a : a + rows])
+        for i in range(1, _RUN):
+            np.add(blk[:, i], blk[:, i - 1], out=blk[:, i])
+        np.copyto(totals[a : a + rows], blk[:, -1])
+    return q, totals, q @ np.ones(_RUN)
 
 
-def _lane_modified_sum(
-    lane: FloatArray, m: int, n_terms: int, v: float
-) -> tuple[float, int, float]:
-    """(Σ_{0≤j≤a} v_j², a, v_a) of :func:`modified_sum` for m a multiple of :data:`_LANES`
-    over whole blocks of :data:`_LANE_CHUNK` terms (a: where they stop), from the phase in
-    :func:`lane_layout` (:func:`_lane_block` per block)."""
-    bufs = _LaneBuffers(m // _LANES)
-    total, a = v * v, 0
-    while a + _LANE_CHUNK <= n_terms - 1:  # t_j for j < n_terms − 1
-        sq, v = _lane_block(lane, m // _LANES, a // _LANES, v, bufs)
-        total += sq
-        a += _LANE_CHUNK
-    return total, a, v
+_RUN_BLOCK: Final = 1 << 15
+"""Runs per block of the offsets of :func:`lane_modified_sum` (256 kB buffers)."""
+
+_NESTED_MAX: Final = 1024
+"""Largest m for which :func:`lane_modified_sum` takes third differences as differences of
+differences (beyond, the 2m extra terms a block cost more than the fourth tap: 12.8 vs
+13.7 ms at m = 1024, 14.5 vs 13.9 ms at 2048 on 10⁷ points)."""
 
 
-class _LaneBuffers:
-    """Work arrays of :func:`_lane_block` for column shifts up to ``k``."""
+def _third(
+    a: FloatArray, k: int, s: int, out: FloatArray, e1: FloatArray, e2: FloatArray, nested: bool
+) -> None:
+    """out[c − s] = a[c + 3k] − 3a[c + 2k] + 3a[c + k] − a[c] for c in [s, s + out.size):
+    ``nested``: as differences of differences over the block and 2k beyond (three
+    subtractions a term; ``e1``, ``e2`` of out.size + 2k, + k), else from the four taps
+    (``e1`` of out.size)."""
+    nb = out.size
+    if nested:
+        d1, d2 = e1[: nb + 2 * k], e2[: nb + k]
+        np.subtract(a[s + k : s + nb + 3 * k], a[s : s + nb + 2 * k], out=d1)
+        np.subtract(d1[k:], d1[: nb + k], out=d2)
+        np.subtract(d2[k:], d2[:nb], out=out)
+        return
+    work = e1[:nb]
+    np.subtract(a[s + 3 * k : s + nb + 3 * k], a[s : s + nb], out=out)
+    np.subtract(a[s + k : s + nb + k], a[s + 2 * k : s + nb + 2 * k], out=work)
+    work *= 3.0
+    out += work
 
-    def __init__(self, k: int) -> None:
-        cb = _LANE_CHUNK // _LANES
-        self.nested = 2 * k <= cb
-        self.t = np.empty((_LANES, cb))
-        self.e1 = np.empty((_LANES, cb + 2 * k)) if self.nested else np.empty((_LANES, cb))
-        self.e2 = np.empty((_LANES, cb + k)) if self.nested else self.e1
-        self.ones = np.ones(_LANES)
+
+def _third_squares(a: FloatArray, m: int, n_terms: int) -> float:
+    """Σ_{j<n_terms} (a_{j+3m} − 3a_{j+2m} + 3a_{j+m} − a_j)², in blocks of :data:`_CHUNK`
+    terms (:func:`_third`; up to :data:`_NESTED_MAX` nested: :func:`_nested_difference_sum`)."""
+    if m <= _NESTED_MAX:
+        return _nested_difference_sum(a, m, n_terms, 3)
+    size = min(_CHUNK, n_terms)
+    out, work = np.empty(size), np.empty(size)
+    total = 0.0
+    for s in range(0, n_terms, _CHUNK):
+        t = out[: min(_CHUNK, n_terms - s)]
+        _third(a, m, s, t, work, work, nested=False)
+        total += float(t @ t)
+    return total
 
 
-def _lane_block(
-    lane: FloatArray, k: int, s: int, v: float, bufs: _LaneBuffers
+def _lane_offsets(
+    lanes: tuple[FloatArray, FloatArray, FloatArray], k: int, runs: int, v: float
 ) -> tuple[float, float]:
-    """(Σ v_j², v_{a+B}) over j = a + 1 … a + B (a = s L, B = :data:`_LANE_CHUNK`) given
-    v = v_a, m = kL: the third differences t_{a+cL+i} at [i, c] (column shifts of k), summed
-    down the rows (each column a run of L consecutive t), the columns' totals summed along
-    and added with v_a: v_{a+cL+i+1} = off_c + t[i, c]."""
-    cb = _LANE_CHUNK // _LANES
-    t, e1 = bufs.t, bufs.e1
-    if 2 * k <= cb:
-        e1, e2 = e1[:, : cb + 2 * k], bufs.e2[:, : cb + k]
-        np.subtract(lane[:, s + k : s + cb + 3 * k], lane[:, s : s + cb + 2 * k], out=e1)
-        np.subtract(e1[:, k:], e1[:, : cb + k], out=e2)
-        np.subtract(e2[:, k:], e2[:, :cb], out=t)
-    else:
-        np.subtract(lane[:, s + 3 * k : s + cb + 3 * k], lane[:, s : s + cb], out=t)
-        np.subtract(lane[:, s + k : s + cb + k], lane[:, s + 2 * k : s + cb + 2 * k], out=e1)
-        e1 *= 3.0
-        t += e1
-    for i in range(1, _LANES):
-        np.add(t[i], t[i - 1], out=t[i])
-    off = np.cumsum(t[-1])  # v_{a+(c+1)L} − v_a
-    v_next = v + float(off[-1])
-    off[1:] = off[:-1]
-    off[0] = 0.0
-    off += v  # v_j = off_c + t[i, c]: Σ v² = Σ t² + 2 Σ_c off_c Σ_i t[i, c] + L Σ off²
-    flat = t.reshape(-1)
-    sq = float(flat @ flat) + 2.0 * float(bufs.ones @ (t @ off)) + _LANES * float(off @ off)
-    return sq, v_next
+    """(Σ_c 2 off_c d_c + L off_c², v_0 + Σ_c T_c) over the runs c < ``runs`` of
+    :func:`lane_modified_sum`: T_c, d_c the third differences over k runs of the runs'
+    totals and sums (:func:`lane_prefix`), off_c = v_0 + Σ_{c'<c} T_{c'} (``v`` = v_0), in
+    blocks of :data:`_RUN_BLOCK` runs, the running sum carried from block to block."""
+    _, totals, r = lanes
+    size = min(_RUN_BLOCK, runs)
+    off, d = np.empty(size + 1), np.empty(size)
+    e1, e2 = np.empty(size + 2 * k), np.empty(size + k)
+    nested = k * _RUN <= _NESTED_MAX
+    total = 0.0
+    for s in range(0, runs, _RUN_BLOCK):
+        nb = min(_RUN_BLOCK, runs - s)
+        off[0] = v  # then T_s … T_{s+nb−1}: their running sum is off_s … off_{s+nb}
+        _third(totals, k, s, off[1 : nb + 1], e1, e2, nested)
+        np.cumsum(off[: nb + 1], out=off[: nb + 1])
+        v = float(off[nb])
+        _third(r, k, s, d[:nb], e1, e2, nested)
+        o = off[:nb]
+        total += 2.0 * float(o @ d[:nb]) + _RUN * float(o @ o)
+    return total, v
 
 
-def lane_group_sums(x: FloatArray, lane: FloatArray, ms: list[int]) -> list[float]:
-    """:func:`modified_sum` for several m (multiples of :data:`_LANES`, m/L ≤ half a block,
-    N − 3m > :data:`_LANE_CHUNK`) in ONE pass over the lane layout: each block of phase is
-    read from memory once for all of them (the sums are bound by memory, not arithmetic).
+def lane_modified_sum(
+    x: FloatArray, lanes: tuple[FloatArray, FloatArray, FloatArray], m: int
+) -> float:
+    r""":func:`modified_sum` over all N − 3m + 1 inner sums for m a multiple of
+    :data:`_RUN`, from :func:`lane_prefix`'s layout of x: the running sum of the third
+    differences taken L at a time by the third difference of q (one pass over it, as
+    OHDEV's sums), the runs' offsets from its totals (1/L of the work).
 
     Parameters
     ----------
     x : numpy.ndarray
         Phase points [unit·s].
-    lane : numpy.ndarray
-        ``x`` in lane layout.
-    ms : list of int
-        Averaging factors [samples].
+    lanes : tuple of numpy.ndarray
+        ``x`` through :func:`lane_prefix`.
+    m : int
+        Averaging factor [samples], a multiple of :data:`_RUN`.
 
     Returns
     -------
-    list of float
-        :func:`modified_sum` for each factor [(unit·s)²].
+    float
+        Σ_j v_j² [(unit·s)²].
+
+    Notes
+    -----
+    With t_j = x_{j+3m} − 3x_{j+2m} + 3x_{j+m} − x_j and m = kL, the third difference of q
+    over k runs is the running sum of the t along a run, p_{c,i}; with the runs' offsets
+    off_c = v_0 + Σ_{c'<c} p_{c',L−1}, v_{cL+i+1} = off_c + p_{c,i} and
+
+    .. math:: \sum_{c,i} v_{cL+i+1}^2 = \sum_{c,i} p_{c,i}^2
+              + 2\sum_c \mathrm{off}_c \sum_i p_{c,i} + L \sum_c \mathrm{off}_c^2
+
+    where Σ_i p_{c,i} is the same third difference of r and p_{c,L−1} of the totals.
+
+    References
+    ----------
+    - NIST SP 1065 (Riley 2008), eq. 14 (modified Allan variance).
+
+    Examples
+    --------
+    >>> x = np.cumsum(np.random.default_rng(0).standard_normal(140_000))
+    >>> ratio = lane_modified_sum(x, lane_prefix(x), 32) / modified_sum(x, 32, x.size - 95)
+    >>> f"{ratio:.12f}"
+    '1.000000000000'
     """
     n = x.size
-    ks = [mm // _LANES for mm in ms]
-    n_terms = [n - 3 * mm + 1 for mm in ms]
-    vs, totals = [], []
-    for mm in ms:
-        first = x[2 * mm : 3 * mm] - 2.0 * x[mm : 2 * mm]
-        first += x[:mm]
-        vs.append(float(np.sum(first)))
-        totals.append(vs[-1] * vs[-1])
-    bufs = _LaneBuffers(max(ks))
-    ends = [(nt - 1) // _LANE_CHUNK * _LANE_CHUNK for nt in n_terms]
-    for a in range(0, max(ends), _LANE_CHUNK):
-        for i, k in enumerate(ks):
-            if a < ends[i]:
-                sq, vs[i] = _lane_block(lane, k, a // _LANES, vs[i], bufs)
-                totals[i] += sq
-    return [
-        tot + _modified_tail(x, mm, nt, e, v) - v * v
-        for tot, mm, nt, e, v in zip(totals, ms, n_terms, ends, vs, strict=True)
-    ]
+    runs = (n - 3 * m) // _RUN  # whole runs of t_j, j < N − 3m
+    k, totals = m // _RUN, lanes[1]
+    d1 = totals[k : 3 * k] - totals[: 2 * k]  # v_0 from the runs' totals (k, not m, terms)
+    v = float(np.sum(d1[k:] - d1[:k]))
+    flat = lanes[0].reshape(-1)
+    total = v * v + _third_squares(flat, m, runs * _RUN)
+    cross, v = _lane_offsets(lanes, k, runs, v)
+    j = runs * _RUN  # v_j known; the last t_j, j < N − 3m, fewer than L
+    t = x[j + 3 * m : n] - x[j : n - 3 * m]
+    t -= 3.0 * (x[j + 2 * m : n - m] - x[j + m : n - 2 * m])
+    rest = v + np.cumsum(t)
+    return total + cross + float(rest @ rest)
 
 
 def difference_sums(
@@ -514,12 +584,11 @@ def difference_sums(
     m: IntArray,
     taps: tuple[tuple[int, float], ...],
     nested: bool = False,
-    kernel: Callable[[FloatArray, int, int], float] | None = None,
 ) -> FloatArray:
     """:func:`_difference_sum` for each factor m: ``base(m)`` gives (array, offset unit,
     term count) — the phase with m itself, or a decimated phase with 1 — shared between
     :data:`_WORKERS` threads (numpy releases the GIL in its loops; BLAS held to one thread
-    meanwhile).  ``kernel(array, step, n_terms)``: another sum than ``taps``' (MDEV's).
+    meanwhile).
 
     Parameters
     ----------
@@ -531,8 +600,6 @@ def difference_sums(
         Offsets and weights of the difference.
     nested : bool, optional
         Whether the sum is nested (default False).
-    kernel : callable, optional
-        Other sum than the taps' (default none).
 
     Returns
     -------
@@ -542,8 +609,6 @@ def difference_sums(
 
     def one(mm: int) -> float:
         arr, step, n_terms = base(mm)
-        if kernel is not None:
-            return kernel(arr, step, n_terms)
         return _difference_sum(arr, step, n_terms, taps, nested)
 
     ms = [int(v) for v in m.tolist()]
@@ -602,30 +667,29 @@ _OVERLAPPING: Final = {"oadev": (2, SECOND), "ohdev": (3, THIRD), "tierms": (1, 
 
 
 def _modified_sums(x: FloatArray, m: IntArray) -> FloatArray:
-    """:func:`modified_sum` per m: the m of :func:`lane_group_sums` in two groups (one per
-    thread, each one pass over the phase), the lane layout made by a pool thread first (first
-    in the queue: a sum waiting on it never blocks it), the other m by :func:`difference_sums`."""
+    """:func:`modified_sum` per m, shared between the pool's threads: the runs of
+    :func:`lane_prefix` made first (first in the queue: no factor waiting on them holds a
+    thread before they are begun), m = 2, 4, 8, 16 together (:func:`_window_modified_sums`)
+    and the other small m next, then the m of :func:`lane_modified_sum`."""
     n = x.size
-    lanes = (m % _LANES == 0) & (n - 3 * m > _LANE_CHUNK)
-    grouped = lanes & (2 * (m // _LANES) <= _LANE_CHUNK // _LANES)
+    laned = (m % _RUN == 0) & (n - 3 * m >= _LANE_MIN)
+    window = ~laned & np.isin(m, (2, 4, 8, 16))
+    ex = _pool()
     out = np.zeros(m.size)
     with threadpool_limits(limits=1, user_api="blas"):
-        lane = _pool().submit(lane_layout, x) if np.any(lanes) else None
-        idx = np.flatnonzero(grouped)
-        jobs = [
-            (part, _pool().submit(lambda g: lane_group_sums(x, lane.result(), g), m[part].tolist()))
-            for part in (idx[0::2], idx[1::2])
-            if part.size and lane is not None
-        ]
-
-        def mod(arr: FloatArray, step: int, n_terms: int) -> float:
-            ready = lane.result() if lane is not None and step % _LANES == 0 else None
-            return modified_sum(arr, step, n_terms, ready)
-
-        rest = np.flatnonzero(~grouped)
-        out[rest] = difference_sums(lambda mm: (x, mm, n - 3 * mm + 1), m[rest], THIRD, kernel=mod)
-        for part, job in jobs:
-            out[part] = job.result()
+        lanes = ex.submit(lane_prefix, x) if np.any(laned) else None
+        wi = np.flatnonzero(window)
+        wi = wi[np.argsort(m[wi], kind="stable")]
+        mw = m[wi].tolist()
+        chain = ex.submit(_window_modified_sums, x, mw, [n - 3 * w + 1 for w in mw]) if mw else None
+        rest = np.flatnonzero(~laned & ~window).tolist()
+        jobs = [ex.submit(modified_sum, x, int(m[i]), n - 3 * int(m[i]) + 1) for i in rest]
+        idx = np.flatnonzero(laned).tolist()
+        if lanes is not None:
+            jobs += [ex.submit(lane_modified_sum, x, lanes.result(), int(m[i])) for i in idx]
+        out[rest + idx] = [job.result() for job in jobs]
+        if chain is not None:
+            out[wi] = chain.result()
     return out
 
 

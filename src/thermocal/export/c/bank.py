@@ -12,7 +12,7 @@ from thermocal.export.c.core import (
 
 
 def generate(ctx: ExportContext) -> FamilyCode:
-    """Model bank (models/bank.py ``BankStream``): every piecewise-linear model
+    """Model bank (models/bank_select.py ``BankStream``): every piecewise-linear model
     evaluated at the clamped T; during ``t − t_first < startup_s`` the residual sums
     ``Σ (y − f_m)`` pick ``argmin_m |Σ_m/N|``; then the choice is frozen.
 

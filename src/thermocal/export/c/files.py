@@ -104,7 +104,7 @@ def export_c_file(
     use_float: bool = False,
     name: str | None = None,
     sample_interval_s: float | None = None,
-    unit: str | None = None,
+    unit: str | tuple[str, ...] | None = None,
 ) -> ExportCResult:
     """``thermocal export-c``: write the C99 header and source of a model or calibration
     file into the directory ``output`` (:class:`CExport`, written as a pair).
@@ -126,7 +126,8 @@ def export_c_file(
     output : str or Path
         Output directory.
     use_float, name, sample_interval_s, unit
-        As above; ``sample_interval_s`` in [s], defaults ``False``/``None``.
+        As above; ``sample_interval_s`` in [s], defaults ``False``/``None``; ``unit`` one
+        unit, or for a calibration a tuple of one per channel.
 
     Returns
     -------
@@ -149,6 +150,10 @@ def export_c_file(
     check_outputs([], [path], dirs=[out_dir])  # the files themselves: when named
     if is_calibration(_read_json(path)):
         return _export_calibration(path, out_dir, name, real, sample_interval_s, unit)
+    if isinstance(unit, tuple):  # a model file has one signal
+        from thermocal import units
+
+        unit = units.per_signal_unit(unit, [str(path)], "unit")[str(path)]
     from thermocal.adequacy import check_for_firmware
     from thermocal.pipeline.model_file import load_model_dict
 
@@ -239,7 +244,7 @@ def _export_calibration(
     name: str | None,
     real: str,
     sample_interval_s: float | None,
-    unit: str | None,
+    unit: str | tuple[str, ...] | None,
 ) -> ExportCResult:
     """A calibration's C: one header and one source for every channel, each channel in
     its data's unit (``unit`` applies one unit to every channel, or one per channel); or
@@ -259,7 +264,7 @@ def _export_calibration(
         triads = tuple((t.name, t.unit, tuple(t.columns)) for t in cal.triads)
         return ExportCResult("triads", ex, tuple(paths), triads=triads)
     cal.require_channels("export-c")
-    unit_of = units.per_signal_option(unit, cal.names)
+    unit_of = units.per_signal_unit(unit, cal.names, "unit")
     channels = [(c.name, model_file_dict(c.model), unit_of[c.name] or c.unit) for c in cal.channels]
     ex = generate_c_calibration(
         channels, prefix=prefix, real=real, sample_interval_s=sample_interval_s

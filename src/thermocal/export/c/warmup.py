@@ -13,7 +13,7 @@ from thermocal.identifiers import c_comment
 
 
 def generate(ctx: ExportContext) -> FamilyCode:
-    """Warm-up model (models/warmup.py ``WarmupStream``):
+    """Warm-up model (models/warmup_stream.py ``WarmupStream``):
 
     T = clamp(T_in); during ``t − t_first < W``: T0 = running mean of T; then frozen;
     a_j = Σ_k b_jk clamp(T0)^k (Horner), ΔF = Σ_j a_j (T − T0)^j (Horner).
