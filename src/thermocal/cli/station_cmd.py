@@ -44,10 +44,6 @@ StationArg = Annotated[
 ]
 
 
-def _nan_none(v: float) -> float | None:
-    return None if v != v else v
-
-
 @station_app.command("check")
 @handle_errors
 def check_cmd(
@@ -62,49 +58,11 @@ def check_cmd(
     answer."""
     cfg = _config.load_station(station)
     res = _check.check_station(cfg, listen)
-    out: dict[str, Any] = {
-        "chamber": {
-            "driver": res.chamber,
-            "ok": res.chamber_ok,
-            "temperature_c": _nan_none(res.temperature_c),
-            "setpoint_c": _nan_none(res.setpoint_c),
-            "error": res.chamber_error or None,
-        },
-        "sensors": [
-            {
-                "id": s.id,
-                "device": s.device,
-                "ok": s.ok,
-                "rate_hz": _nan_none(s.rate_hz),
-                "lines": s.lines,
-                "bad_lines": s.bad_lines,
-                "first_line": s.first_line or None,
-                "error": s.error or None,
-            }
-            for s in res.sensors
-        ],
-    }
+    out = res.to_dict()
 
     def human() -> None:
-        c = out["chamber"]
-        stdout.print(
-            f"chamber {res.chamber}: "
-            + (
-                f"temperature {c['temperature_c']} °C, set-point {c['setpoint_c']} °C"
-                if res.chamber_ok
-                else f"NO ANSWER: {res.chamber_error}"
-            )
-        )
-        for s in res.sensors:
-            rate = "—" if s.rate_hz != s.rate_hz else f"{s.rate_hz:.1f} Hz"
-            stdout.print(
-                f"sensor {s.id} ({s.device}): "
-                + (
-                    f"{rate}, {s.lines} lines ({s.bad_lines} bad), first: {s.first_line}"
-                    if s.ok
-                    else f"NO ANSWER: {s.error}"
-                )
-            )
+        for line in res.text():
+            stdout.print(line)
 
     emit(out, as_json, human)
     if res.failed:

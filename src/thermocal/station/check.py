@@ -5,6 +5,7 @@ from __future__ import annotations
 import math
 import time
 from dataclasses import dataclass
+from typing import Any
 
 from thermocal.errors import ParameterError, ThermocalInputError
 from thermocal.station.chamber import ChamberError, make_chamber
@@ -74,6 +75,51 @@ class StationCheck:
         out = [] if self.chamber_ok else [f"chamber ({self.chamber_error})"]
         out += [f"sensor {s.id} ({s.error})" for s in self.sensors if not s.ok]
         return out
+
+    def to_dict(self) -> dict[str, Any]:
+        """The answers as JSON types (NaN and "" as None).
+
+        Returns
+        -------
+        dict
+            ``chamber`` (driver, ok, temperature_c and setpoint_c [°C], error) and
+            ``sensors`` (each one's id, device, ok, rate_hz [Hz], lines, bad_lines,
+            first_line, error).
+        """
+        chamber = {"driver": self.chamber, "ok": self.chamber_ok,
+                   "temperature_c": _nan_none(self.temperature_c),
+                   "setpoint_c": _nan_none(self.setpoint_c),
+                   "error": self.chamber_error or None}  # fmt: skip
+        sensors = [
+            {"id": s.id, "device": s.device, "ok": s.ok, "rate_hz": _nan_none(s.rate_hz),
+             "lines": s.lines, "bad_lines": s.bad_lines, "first_line": s.first_line or None,
+             "error": s.error or None}
+            for s in self.sensors
+        ]  # fmt: skip
+        return {"chamber": chamber, "sensors": sensors}
+
+    def text(self) -> list[str]:
+        """One line for the chamber and one per sensor: what each answered, or its error.
+
+        Returns
+        -------
+        list of str
+        """
+        c = self.to_dict()["chamber"]
+        head = (f"temperature {c['temperature_c']} °C, set-point {c['setpoint_c']} °C"
+                if self.chamber_ok else f"NO ANSWER: {self.chamber_error}")  # fmt: skip
+        lines = [f"chamber {self.chamber}: {head}"]
+        for s in self.sensors:
+            rate = "—" if s.rate_hz != s.rate_hz else f"{s.rate_hz:.1f} Hz"
+            said = (f"{rate}, {s.lines} lines ({s.bad_lines} bad), first: {s.first_line}"
+                    if s.ok else f"NO ANSWER: {s.error}")  # fmt: skip
+            lines.append(f"sensor {s.id} ({s.device}): {said}")
+        return lines
+
+
+def _nan_none(v: float) -> float | None:
+    """None for NaN."""
+    return None if v != v else v
 
 
 def check_station(cfg: StationConfig, listen_s: float = 3.0) -> StationCheck:
