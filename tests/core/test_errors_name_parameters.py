@@ -34,13 +34,6 @@ WHOLE_FILES = {
     "errors.py",
 }
 
-# Files not yet rewritten, with the number of option strings each still holds: the number may
-# only fall, and the entry goes when it reaches 0.
-PENDING: dict[str, int] = {
-    # models/export
-    # reports, fleet, station, demo, generated files
-}
-
 
 def _option_strings() -> dict[str, list[tuple[int, str]]]:
     """Every option-like string below ``thermocal`` outside ``cli/``, by file."""
@@ -63,19 +56,7 @@ def _option_strings() -> dict[str, list[tuple[int, str]]]:
 
 def test_the_library_names_no_option_of_the_command_line() -> None:
     found = _option_strings()
-    over = {rel: hits for rel, hits in found.items() if len(hits) > PENDING.get(rel, 0)}
-    assert over == {}, "options named in the library (name the parameter; see this module)"
-
-
-def test_pending_files_only_shrink() -> None:
-    """An entry of PENDING above its file's count is stale: lower it (or remove it at 0)."""
-    found = _option_strings()
-    stale = {
-        rel: (n, len(found.get(rel, [])))
-        for rel, n in PENDING.items()
-        if n != len(found.get(rel, []))
-    }
-    assert stale == {}
+    assert found == {}, "options named in the library (name the parameter; see this module)"
 
 
 def test_the_scan_sees_an_option() -> None:

@@ -230,3 +230,24 @@ def test_simulate_scenario_numbers_runs_whose_labels_collide(
         sc, "run_scenario", lambda *a, **k: [(rec, {"label": "T+25"}), (rec, {"label": "T-5"})]
     )
     assert simulate_scenario("fog-slow", 0, None, SimulateOptions()).labels == ("T+25", "T-5")
+
+
+@pytest.mark.parametrize("deviations", [None, ["oadev", "mdev"]])
+def test_allan_analysis_leaves_the_callers_arrays_as_they_were(
+    deviations: list[str] | None,
+) -> None:
+    """A notebook user's arrays are theirs: ``Recording.from_arrays`` keeps them without a
+    copy, and the analysis must not accumulate its phase in them (the ``allan`` command, which
+    reads its own recording, asks for that with ``overwrite=True``)."""
+    y = np.random.default_rng(3).normal(0.0, 1.0, 20_000)
+    kept = y.copy()
+    rec = Recording.from_arrays(np.arange(y.size) * 0.01, {"gx": y}, {})
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        res = allan_analysis(rec, ["gx"], deviations=deviations)
+        assert np.array_equal(y, kept)
+        if deviations is None:  # the overlapping ADEV at τ0 = rms of first differences / √2
+            first = float(res.channels["gx"].adev.adev[0])
+            assert first == pytest.approx(np.sqrt(np.mean(np.diff(kept) ** 2) / 2), rel=1e-9)
+            allan_analysis(rec, ["gx"], overwrite=True)  # the command's way: given up
+            assert not np.array_equal(y, kept)

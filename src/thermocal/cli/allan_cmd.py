@@ -276,6 +276,7 @@ def allan_cmd(
         bias_correct=bias_correct, noise_type=_noise_type(noise_type, devs, data_type),
         noise_id=noise_id,
         max_work=max_work,
+        overwrite=True,  # the recording read here is not used after the analysis
     )  # fmt: skip
     if res.is_family:
         _emit_family(file, res, as_json)

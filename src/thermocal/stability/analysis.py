@@ -374,6 +374,7 @@ def allan_analysis(
     noise_type: int | None = None,
     noise_id: str | None = None,
     max_work: float | None = None,
+    overwrite: bool = False,
 ) -> AllanAnalysis:
     """The stability analysis of the channels ``names`` of ``rec`` (module docstring).
 
@@ -398,6 +399,10 @@ def allan_analysis(
         Power-law α (−4…2) assumed at every τ; identification rules ``thermocal``/``stable32``.
     max_work : float, optional
         The family's operation budget (:func:`thermocal.stability.family.check_work`).
+    overwrite : bool, optional
+        Accumulate the phase in the recording's own signal buffers (no memory per sample):
+        ``rec``'s values are changed.  Only for a recording nothing reads afterwards (the
+        ``allan`` command's, read from a file); default False leaves ``rec`` as it was.
 
     Returns
     -------
@@ -445,7 +450,7 @@ def allan_analysis(
     for name in names:  # one read of the file, every channel
         label = where + (f" [{name}]" if len(names) > 1 else "")
         channels[name] = _allan_channel(
-            rec, name, taus, confidence, dynamic_s, names.count(name) == 1, label
+            rec, name, taus, confidence, dynamic_s, overwrite and names.count(name) == 1, label
         )
     return AllanAnalysis(tuple(names), channels=channels)
 
@@ -574,7 +579,7 @@ def _allan_channel(
     taus: Any,
     confidence: float,
     dynamic_s: float | None,
-    named_once: bool,
+    overwrite: bool,
     where: str,
 ) -> AllanChannel:
     """One channel's ADEV, noise terms and dynamic ADEV, with their warnings."""
@@ -597,11 +602,12 @@ def _allan_channel(
         segments=rec.segments(),  # one scan of the time column for every channel
         unit=unit,
         confidence=confidence,
-        # the phase is accumulated in the column's own buffer (no memory per sample):
-        # the column is not used again unless the channel is named twice or the
-        # dynamic ADEV reads the rate after it (it did, on the floor's numpy/pyarrow,
-        # where the buffer is writeable: windows of phase, found by the floor check)
-        overwrite=named_once and dynamic_s is None,
+        # the phase is accumulated in the column's own buffer (no memory per sample) only
+        # when the caller gives the recording up and the column is not used again: not
+        # when the channel is named twice or the dynamic ADEV reads the rate after it (it
+        # did, on the floor's numpy/pyarrow, where the buffer is writeable: windows of
+        # phase, found by the floor check)
+        overwrite=overwrite and dynamic_s is None,
     )
     noise = allan.noise_terms(res, periodic=found)
     quant = nm.quantization_from_lattice(lattice, rec.sample_interval_s, unit, noise)
