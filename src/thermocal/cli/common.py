@@ -34,7 +34,6 @@ from thermocal.pipeline.reading import check_recording as check_recording
 from thermocal.pipeline.reading import read_options as read_options
 from thermocal.pipeline.reading import split_names as split_names
 from thermocal.report.text import Block
-from thermocal.report.text import fmt as fmt
 
 if TYPE_CHECKING:
     import numpy as np

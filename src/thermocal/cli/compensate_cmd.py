@@ -32,13 +32,13 @@ from thermocal.cli.common import (
     TimeUnitOpt,
     TopicOpt,
     emit,
-    fmt,
     handle_errors,
     progress,
     read_options,
     split_names,
     stdout,
 )
+from thermocal.report.text import fmt
 
 if TYPE_CHECKING:
     import rich.table as _rich_table

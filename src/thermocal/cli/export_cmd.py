@@ -14,7 +14,8 @@ import typer
 
 from thermocal._lazy import LazyModule
 from thermocal.cli.application import app
-from thermocal.cli.common import JsonOpt, ModelArg, emit, fmt, handle_errors, stdout
+from thermocal.cli.common import JsonOpt, ModelArg, emit, handle_errors, stdout
+from thermocal.report.text import fmt
 
 if TYPE_CHECKING:
     import thermocal.export.c.files as _export_c_files

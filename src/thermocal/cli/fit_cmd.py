@@ -58,7 +58,6 @@ from thermocal.cli.common import (
     TimeUnitOpt,
     TopicOpt,
     emit,
-    fmt,
     handle_errors,
     split_floats,
     stdout,
@@ -66,6 +65,7 @@ from thermocal.cli.common import (
 from thermocal.errors import ParameterError, ThermocalInputError
 from thermocal.families import MODEL_FAMILIES, FamilyOption, fit_option_table
 from thermocal.pipeline.options import FitOptions, family_params, options_of
+from thermocal.report.text import fmt
 
 if TYPE_CHECKING:
     import rich.table as _rich_table

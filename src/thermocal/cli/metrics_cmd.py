@@ -27,7 +27,6 @@ from thermocal.cli.common import (
     TopicOpt,
     check_recording,
     emit,
-    fmt,
     handle_errors,
     read_options,
     show,
@@ -35,6 +34,7 @@ from thermocal.cli.common import (
 )
 from thermocal.errors import ThermocalInputError
 from thermocal.report import text as _text
+from thermocal.report.text import fmt
 
 if TYPE_CHECKING:
     import thermocal.metrics as _metrics

@@ -40,11 +40,11 @@ from thermocal.cli.common import (
     TopicOpt,
     TurntableLatitudeOpt,
     emit,
-    fmt,
     handle_errors,
     stdout,
 )
 from thermocal.pipeline.options import ValidateOptions, options_of
+from thermocal.report.text import fmt
 
 if TYPE_CHECKING:
     import rich.table as _rich_table
