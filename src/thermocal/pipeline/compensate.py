@@ -112,7 +112,42 @@ COMP_SUFFIX = "_comp"
 
 @dataclass(frozen=True)
 class CompensateFileResult:
-    """Summary of :func:`compensate_file`."""
+    """Summary of :func:`compensate_file`.
+
+    Attributes
+    ----------
+    output : str
+        The output written.
+    n_rows, n_chunks : int
+        Rows compensated and chunks read.
+    signal : str
+        The signal column.
+    model_column, comp_column : str
+        The columns added: the model's prediction and the compensated signal.
+    unit : str
+        The data's unit.
+    streamed : bool
+        The family has no chunk-context rule: the file was compensated sample by sample
+        (:class:`StreamingCompensator`, exact but slower).
+    rms_before, rms_after : float
+        RMS about the mean before and after [data unit].
+    extra : dict
+        Further figures.
+    mean_before, mean_after : float
+        Mean error about ``zero_reference`` [data unit].
+    rms_about_zero_before, rms_about_zero_after : float
+        RMS about ``zero_reference`` [data unit].
+    max_abs_before, max_abs_after : float
+        Largest |error| about ``zero_reference`` [data unit].
+    zero_reference : dict
+        ``{value, unit, what}``: the level an ideal sensor would output.
+    absolute_error_worse : bool
+        The compensation made the rms about zero or the largest |error| worse by over 1 %.
+    outside_range : dict
+        How far the file leaves the model's calibrated ranges, per input.
+    outside_calibrated_range : bool
+        The file leaves them.
+    """
 
     output: str
     n_rows: int
@@ -1005,7 +1040,23 @@ class TriadCompensation:
     """What :func:`compensate_triads` did for one triad: its columns, the added ones, the
     unit of the added ones, the share of samples outside the calibrated temperature range,
     the unit of the input columns and, for raw counts, the count scale applied (one count
-    is ``count_scale`` ``unit``; None for columns already in a physical unit)."""
+    is ``count_scale`` ``unit``; None for columns already in a physical unit).
+
+    Attributes
+    ----------
+    triad : str
+        The triad.
+    columns, comp_columns : tuple of str
+        Its input columns and the columns added.
+    unit : str
+        Unit of the added columns.
+    outside_range_fraction : float
+        Share of samples outside the calibrated temperature range.
+    input_unit : str
+        Unit of the input columns.
+    count_scale : float or None
+        For raw counts, one count in ``unit`` (None: a physical unit).
+    """
 
     triad: str
     columns: tuple[str, ...]
@@ -1343,7 +1394,21 @@ class CalibrationCompensation:
     """What :func:`compensate_calibration_file` did: the calibration file applied, the
     output written and, by the calibration's content, either ``triads`` (a turntable
     calibration), ``single`` (one channel: its family and result) or ``channels`` (each
-    chosen channel's name, family and result, one pass)."""
+    chosen channel's name, family and result, one pass).
+
+    Attributes
+    ----------
+    model_file : str
+        The model or calibration file applied.
+    output : str
+        The output written.
+    kind : str
+        ``"triads"``, ``"single"`` or ``"channels"``.
+    triads : tuple of TriadCompensation
+        Each triad (``triads``).
+    channels : tuple of (str, str, CompensateFileResult)
+        ``(channel name, model family, result)`` (``single``, ``channels``).
+    """
 
     model_file: str
     output: str

@@ -678,7 +678,19 @@ def _finish_channel(
 @dataclass(frozen=True)
 class FittedChannel:
     """One channel fitted by :func:`fit_files`: its model, its figures (the keys of the
-    ``fit`` command's JSON; ``rms_residual`` in the data's own unit) and the number of runs."""
+    ``fit`` command's JSON; ``rms_residual`` in the data's own unit) and the number of runs.
+
+    Attributes
+    ----------
+    name : str
+        The channel.
+    model : TemperatureModel
+        Its fitted model.
+    figures : dict
+        The keys of the ``fit`` command's JSON.
+    n_runs : int
+        Runs fitted.
+    """
 
     name: str
     model: _base.TemperatureModel
@@ -689,7 +701,17 @@ class FittedChannel:
 @dataclass(frozen=True)
 class FitResult:
     """What :func:`fit_files` fitted and wrote: the file ``output``, a model file for one
-    channel or a calibration file (``calibration``) for several, and each channel."""
+    channel or a calibration file (``calibration``) for several, and each channel.
+
+    Attributes
+    ----------
+    output : Path
+        The model or calibration file written.
+    channels : tuple of FittedChannel
+        Each channel.
+    calibration : bool
+        ``output`` is a calibration file of several channels.
+    """
 
     output: Path
     channels: tuple[FittedChannel, ...]

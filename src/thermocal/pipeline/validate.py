@@ -40,7 +40,19 @@ if TYPE_CHECKING:
 @dataclass(frozen=True)
 class ChannelValidation:
     """One channel judged: its model, the :class:`~thermocal.validation.ValidationResult`
-    (in the data's own unit) and its JSON object (``figures``)."""
+    (in the data's own unit) and its JSON object (``figures``).
+
+    Attributes
+    ----------
+    name : str
+        The channel.
+    model : TemperatureModel
+        Its model.
+    result : ValidationResult
+        The validation, in the data's own unit.
+    figures : dict
+        Its JSON object.
+    """
 
     name: str
     model: TemperatureModel
@@ -51,7 +63,21 @@ class ChannelValidation:
 @dataclass(frozen=True)
 class ValidationReport:
     """What :func:`validate_files` found: per channel (``several``: a calibration of several
-    channels), or per triad (``triads``: a calibration of triads on a turntable run)."""
+    channels), or per triad (``triads``: a calibration of triads on a turntable run).
+
+    Attributes
+    ----------
+    model_file : Path
+        The model or calibration file.
+    file : Path
+        The validation run.
+    channels : tuple of ChannelValidation
+        Each channel.
+    several : bool
+        A calibration of several channels.
+    triads : tuple
+        Each triad's judgement (a calibration of triads).
+    """
 
     model_file: Path
     file: Path
