@@ -359,7 +359,7 @@ MUTANTS: tuple[Mutant, ...] = (
     ),
     Mutant(
         "turntable-arw-units",
-        P + "turntable/calibrate.py",
+        P + "turntable/calibration.py",
         "out: FloatArray = arw * units.DEG_TO_RAD / np.sqrt(units.SECONDS_PER_HOUR)",
         "out: FloatArray = arw * units.DEG_TO_RAD / units.SECONDS_PER_HOUR",
         TT_CAL,
@@ -367,7 +367,7 @@ MUTANTS: tuple[Mutant, ...] = (
     ),
     Mutant(
         "turntable-azimuth-quantum-sign",
-        P + "turntable/calibrate.py",
+        P + "turntable/calibration.py",
         'v[6 + model.MISALIGNMENT_NAMES.index("xy")] = -1.0',
         'v[6 + model.MISALIGNMENT_NAMES.index("xy")] = 1.0',
         TT_CAL,
@@ -520,7 +520,7 @@ MUTANTS: tuple[Mutant, ...] = (
     ),
     Mutant(
         "turntable-arw-tau",
-        P + "turntable/calibrate.py",
+        P + "turntable/calibration.py",
         "out: FloatArray = np.sqrt(ss / dof * tau_med)",
         "out: FloatArray = np.sqrt(ss / dof / tau_med)",
         TT_CAL,
@@ -528,7 +528,7 @@ MUTANTS: tuple[Mutant, ...] = (
     ),
     Mutant(
         "turntable-arw-dof",
-        P + "turntable/calibrate.py",
+        P + "turntable/calibration.py",
         "dof += g.shape[0] - 1",
         "dof += g.shape[0]",
         TT_CAL,
@@ -576,7 +576,7 @@ MUTANTS: tuple[Mutant, ...] = (
     ),
     Mutant(
         "turntable-chi2-warning-threshold",
-        P + "turntable/calibrate.py",
+        P + "turntable/calibration.py",
         "chi2 > 1.0 + 5.0 * np.sqrt(2.0 / est.dof)",
         "chi2 > 1.0 + 5000.0 * np.sqrt(2.0 / est.dof)",
         TT_CAL,
@@ -1220,7 +1220,7 @@ MUTANTS: tuple[Mutant, ...] = (
     # the triads' calibration from arrays, and errors that name parameters
     Mutant(
         "i40c-tt-arrays-gyro-unit-ignored",
-        P + "turntable/calibrate.py",
+        P + "turntable/calibration.py",
         'alpha_column="alpha", beta_column="beta", gyro_unit=gyro_unit,',
         'alpha_column="alpha", beta_column="beta", gyro_unit="deg/s",',
         ("tests/turntable/test_turntable_calibrate_arrays.py",),
@@ -1228,7 +1228,7 @@ MUTANTS: tuple[Mutant, ...] = (
     ),
     Mutant(
         "i40c-tt-arrays-encoders-swapped",
-        P + "turntable/calibrate.py",
+        P + "turntable/calibration.py",
         'other={"alpha": alpha, "beta": beta},',
         'other={"alpha": beta, "beta": alpha},',
         ("tests/turntable/test_turntable_calibrate_arrays.py",),
@@ -2921,7 +2921,7 @@ MUTANTS: tuple[Mutant, ...] = (
     ),
     Mutant(
         "h39mp-azimuth-refused",
-        P + "turntable/calibrate.py",
+        P + "turntable/calibration.py",
         "AZIMUTH_REFUSED_DEG = 5.0",
         "AZIMUTH_REFUSED_DEG = 500.0",
         H39MP,
@@ -2929,7 +2929,7 @@ MUTANTS: tuple[Mutant, ...] = (
     ),
     Mutant(
         "h39mp-azimuth-sign",
-        P + "turntable/calibrate.py",
+        P + "turntable/calibration.py",
         "np.arctan2(e[1, 0] - e[0, 1], 2.0 + e[0, 0] + e[1, 1])",
         "np.arctan2(e[0, 1] - e[1, 0], 2.0 + e[0, 0] + e[1, 1])",
         H39MP,
@@ -2937,7 +2937,7 @@ MUTANTS: tuple[Mutant, ...] = (
     ),
     Mutant(
         "h39mp-azimuth-warned",
-        P + "turntable/calibrate.py",
+        P + "turntable/calibration.py",
         "AZIMUTH_WARNED_DEG = 1.0",
         "AZIMUTH_WARNED_DEG = 4.0",
         H39MP,
@@ -2945,7 +2945,7 @@ MUTANTS: tuple[Mutant, ...] = (
     ),
     Mutant(
         "h39mp-tt-scale-refused",
-        P + "turntable/calibrate.py",
+        P + "turntable/calibration.py",
         "bad = model.scale_factors_beyond(theta)",
         "bad = []",
         H39MP,
@@ -2953,7 +2953,7 @@ MUTANTS: tuple[Mutant, ...] = (
     ),
     Mutant(
         "h39mp-tt-residual-refused",
-        P + "turntable/calibrate.py",
+        P + "turntable/calibration.py",
         "RESIDUAL_REFUSED = 20.0",
         "RESIDUAL_REFUSED = 200.0",
         H39MP,
@@ -2961,7 +2961,7 @@ MUTANTS: tuple[Mutant, ...] = (
     ),
     Mutant(
         "h39mp-tt-azimuth-before-unit",
-        P + "turntable/calibrate.py",
+        P + "turntable/calibration.py",
         "if not abs(k - 1.0) <= SCALE_FACTOR_REFUSED:",
         "if False:",
         H39MP,

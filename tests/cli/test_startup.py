@@ -108,7 +108,7 @@ def test_the_help_names_are_the_libraries_names() -> None:
     from thermocal import defaults, profiles, validation
     from thermocal.pipeline import compensate
     from thermocal.simulate import SCENARIOS
-    from thermocal.turntable.calibrate import DEFAULT_GYRO_COLUMNS
+    from thermocal.turntable.calibration import DEFAULT_GYRO_COLUMNS
 
     assert tuple(SCENARIOS) == defaults.SCENARIO_NAMES
     assert compensate.DEFAULT_CHUNK_ROWS is defaults.DEFAULT_CHUNK_ROWS

@@ -14,7 +14,7 @@ import pytest
 from thermocal.cli import main
 from thermocal.errors import ThermocalInputError
 from thermocal.pipeline.multipos import MultiposOptions, calibrate_files
-from thermocal.turntable.calibrate import calibrate
+from thermocal.turntable.calibration import calibrate
 from thermocal.turntable.simulate import simulate_turntable16
 from thermocal.writers import write_recording
 

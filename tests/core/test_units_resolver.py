@@ -163,7 +163,7 @@ the commands pass the resolved unit.)"""
 KNOWN = {
     # INTERFACE.md "Turntable geometry": gyro columns in [°/s] by default (the turntable
     # engineer's file); reported to the lead, not this issue's to change.
-    "turntable/calibrate.py:_gyro_rad_s",
+    "turntable/calibration.py:_gyro_rad_s",
 }
 
 

@@ -16,7 +16,7 @@ import pytest
 
 from thermocal.errors import DesignError
 from thermocal.turntable import accel, calibrate, simulate_turntable16
-from thermocal.turntable.calibrate import estimate_arw
+from thermocal.turntable.calibration import estimate_arw
 from thermocal.turntable.model import MISALIGNMENT_NAMES, error_matrices
 from thermocal.turntable.schedule import (
     POSITIONS_16,

@@ -16,7 +16,7 @@ import pytest
 
 from thermocal.cli import main
 from thermocal.recording import Recording
-from thermocal.turntable.calibrate import TurntableResult, calibrate
+from thermocal.turntable.calibration import TurntableResult, calibrate
 from thermocal.turntable.model import coeffs_from_error_matrix
 from thermocal.turntable.schedule import detect_motion
 from thermocal.turntable.simulate import simulate_turntable16

@@ -91,7 +91,7 @@ def test_pipeline_standard_errors_match_the_scatter_over_seeds() -> None:
     pessimistic by half)."""
     import warnings
 
-    from thermocal.turntable.calibrate import calibrate
+    from thermocal.turntable.calibration import calibrate
     from thermocal.turntable.simulate import (
         ACCEL_THERMAL_TRUTH,
         GYRO_THERMAL_TRUTH,

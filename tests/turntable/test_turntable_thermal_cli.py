@@ -22,7 +22,7 @@ import pytest
 
 from thermocal.cli import main
 from thermocal.readers.dispatch import read_recording
-from thermocal.turntable.calibrate import calibrate
+from thermocal.turntable.calibration import calibrate
 from thermocal.turntable.schedule import detect_motion, segment
 from thermocal.turntable.simulate import (
     ACCEL_THERMAL_TRUTH,

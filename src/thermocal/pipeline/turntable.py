@@ -1,7 +1,7 @@
 """The turntable at the file layer's edge: ``thermocal turntable FILE...`` as one library call.
 
 One run (:func:`turntable_calibration` with one file): the gyro triad's bias, scale factor
-and misalignment (:func:`thermocal.turntable.calibrate.calibrate`), written as the
+and misalignment (:func:`thermocal.turntable.calibration.calibrate`), written as the
 result JSON.  Several runs at soak temperatures: each run calibrated alone, then
 every parameter of each triad as a polynomial in temperature
 (:func:`thermocal.turntable.thermal.fit_triad`), judged first
@@ -24,7 +24,7 @@ from thermocal.errors import ParameterError, ThermocalInputError
 from thermocal.readers.options import ReadOptions
 from thermocal.recording import Recording
 from thermocal.turntable import thermal as _thermal
-from thermocal.turntable.calibrate import TurntableResult, calibrate
+from thermocal.turntable.calibration import TurntableResult, calibrate
 
 MIN_POSITIONS_OF_A_SOAK = 12
 """A soak run missing a few of the sixteen positions is still used (with a warning): twelve
@@ -155,7 +155,7 @@ def read_run(path: Path, o: TurntableOptions) -> Recording:
 def calibrate_run(
     path: Path, o: TurntableOptions, *, min_positions: int
 ) -> tuple[Recording, TurntableResult]:
-    """Read one run and calibrate it (:func:`thermocal.turntable.calibrate.calibrate`).
+    """Read one run and calibrate it (:func:`thermocal.turntable.calibration.calibrate`).
 
     Parameters
     ----------
@@ -208,7 +208,7 @@ def calibrate_run(
 
 @dataclass(frozen=True)
 class SingleRunResult:
-    """One run's calibration (:class:`~thermocal.turntable.calibrate.TurntableResult`), the
+    """One run's calibration (:class:`~thermocal.turntable.calibration.TurntableResult`), the
     file it came from and the result JSON written.
 
     Attributes

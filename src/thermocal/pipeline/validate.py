@@ -340,10 +340,10 @@ def judge_triads(
     -------
     list
         One result per triad (:func:`thermocal.multipos.validate.validate_held_out_session`
-        or :func:`thermocal.turntable.calibrate.validate_turntable_run`).
+        or :func:`thermocal.turntable.calibration.validate_turntable_run`).
     """
     from thermocal.multipos import validate as _mp_validate
-    from thermocal.turntable.calibrate import validate_turntable_run
+    from thermocal.turntable.calibration import validate_turntable_run
 
     if _mp_validate.is_multipos(triads):  # held-out poses
         return list(

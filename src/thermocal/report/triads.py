@@ -2,7 +2,7 @@
 in the calibration's own units (a bias in the triad's unit, °/s for a °/s calibration; scale
 factors [ppm], misalignments [″]) with their σ, and, on an independent run, the figures
 before and after compensation: a turntable run's dwell-mean and move-angle errors
-(:func:`thermocal.turntable.calibrate.validate_turntable_run`) or a multipos held-out
+(:func:`thermocal.turntable.calibration.validate_turntable_run`) or a multipos held-out
 session's gravity-magnitude and rotation-angle errors
 (:func:`thermocal.multipos.validate.validate_held_out_session`), first as the absolute
 figures (rms over poses or motions, before → after, the change in %), then per axis.

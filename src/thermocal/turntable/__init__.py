@@ -13,7 +13,7 @@ Modules: :mod:`.kinematics` (frames, the true body rate from the encoder angles)
 :mod:`.schedule` (the 16 positions, design checks, motion detection), :mod:`.model` (error
 model, measurement model, Cramér–Rao bound), :mod:`.simulate` (runs with a known truth),
 :mod:`.estimate_ls` (batch least squares), :mod:`.kalman` (14/15-state filter),
-:mod:`.calibrate` (one run end to end, the validation on another run), :mod:`.accel` (the
+:mod:`.calibration` (one run end to end, the validation on another run), :mod:`.accel` (the
 accelerometer triad from the dwells), :mod:`.thermal` (every coefficient over temperature).
 
 Notes
@@ -65,7 +65,7 @@ A simulated run with known coefficients, calibrated from a recording:
 
 from __future__ import annotations
 
-from thermocal.turntable.calibrate import (
+from thermocal.turntable.calibration import (
     TurntableResult,
     calibrate,
     calibrate_arrays,
