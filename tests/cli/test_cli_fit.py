@@ -1,4 +1,4 @@
-"""``thermocal fit`` through the command line (INTERFACE.md)."""
+"""``thermocal fit`` through the command line."""
 
 from __future__ import annotations
 
@@ -106,6 +106,11 @@ def test_fit_piecewise_human_output(tmp_path, capsys):
         (["--model", "piecewise", "--signal", "gyro", "--breakpoints", "x"], "--breakpoints"),
         (["--model", "poly", "--signal", "gyro", "--latitude", "45"], "--axis"),
         (["--model", "poly", "--signal", "gyro", "--target", "drift"], "--target"),
+        # a criterion without the selection it chooses for was silently ignored
+        (
+            ["--model", "poly", "--signal", "gyro", "--select-method", "holdout"],
+            "--select-method holdout chooses how --select works, but --select is not given",
+        ),
     ],
 )
 def test_bad_input_exit_2(tmp_path, capsys, extra, message):

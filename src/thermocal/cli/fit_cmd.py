@@ -175,14 +175,28 @@ def _family_parameters() -> list[inspect.Parameter]:
         if first.switch:
             add(field, bool, typer.Option(cli, help=text), False)
             switch = "--" + first.switch.replace("_", "-")
-            choice = f"{' | '.join(first.choices)} (with {cli})."
-            add(first.switch, str, typer.Option(switch, help=choice), first.choices[0])
+            choice = f"{' | '.join(first.choices)} (with {cli}; default {first.choices[0]})."
+            add(first.switch, str | None, typer.Option(switch, help=choice), None)
         elif first.kind == "bool":
             add(field, bool | None, typer.Option(f"{cli}/{_negated(cli)}", help=text), None)
         else:
             kind = {"int": int, "float": float}.get(first.kind, str)
             add(field, kind | None, typer.Option(cli, help=text), None)
     return out
+
+
+def _check_switches(values: dict[str, Any]) -> None:
+    """A switch's choice given without the switch (``--select-method holdout`` without
+    ``--select``) would be ignored: one error line naming both."""
+    for field, decls in _FAMILY_FIELDS.items():
+        first = decls[0][1]
+        chosen = values.get(first.switch) if first.switch else None
+        if chosen is not None and not values.get(field):
+            switch = "--" + str(first.switch).replace("_", "-")
+            raise ThermocalInputError(
+                f"{switch} {chosen} chooses how {first.cli} works, but {first.cli} is not "
+                f"given: add {first.cli} (or leave {switch} out)"
+            )
 
 
 def _family_values(values: dict[str, Any]) -> dict[str, Any]:
@@ -250,6 +264,7 @@ def fit_cmd(**values: Any) -> None:
     """Fit a temperature-compensation model on one or several runs and save it."""
     files, output, as_json = values.pop("files"), values.pop("output"), values.pop("as_json")
     texts = values.pop("param") or []
+    _check_switches(values)
     values = _family_values(values)
     options = options_of(FitOptions, values)
     params = family_params(values)
