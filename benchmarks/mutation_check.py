@@ -912,10 +912,12 @@ MUTANTS: tuple[Mutant, ...] = (
     Mutant(
         "stability-mdev-third-difference-taps",
         P + "stability/deviations.py",
-        "    u *= 3.0\n",
-        "    u *= 2.0\n",
+        "        np.subtract(d1[k:], d1[: nb + k], out=d2)\n",
+        "        np.subtract(d1[k:], d1[: nb + k] * 0.5, out=d2)\n",
         _t("deviation_digits"),
-        "MDEV's slide x_{j+3m} − 3x_{j+2m} + 3x_{j+m} − x_j with 2 for 3 (m above 4096)",
+        "MDEV's third differences x_{j+3m} − 3x_{j+2m} + 3x_{j+m} − x_j as differences of "
+        "differences with the second one halved (the taps' 3 is w8-lane-third-taps: one "
+        "kernel, _third, serves both since the tail's twin was merged into it)",
     ),
     Mutant(
         "stability-mdev-first-inner-sum",

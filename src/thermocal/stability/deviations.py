@@ -229,27 +229,6 @@ def _nested_difference_sum(x: FloatArray, m: int, n_terms: int, d: int) -> float
     return total
 
 
-def _third_differences(
-    x: FloatArray, m: int, a: int, out: FloatArray, tmp: FloatArray, tmp2: FloatArray
-) -> None:
-    """t_k = x_{k+3m} − 3x_{k+2m} + 3x_{k+m} − x_k for k in [a, a + out.size), into ``out``:
-    below :data:`_MOD_CHUNK` / 16 as differences of differences over the block and 2m beyond
-    (three subtractions a term), else from the four taps."""
-    n_b = out.size
-    if 16 * m <= _MOD_CHUNK:
-        e1 = tmp[: n_b + 2 * m]
-        np.subtract(x[a + m : a + n_b + 3 * m], x[a : a + n_b + 2 * m], out=e1)
-        e2 = tmp2[: n_b + m]
-        np.subtract(e1[m:], e1[: n_b + m], out=e2)
-        np.subtract(e2[m:], e2[:n_b], out=out)
-        return
-    u = tmp[:n_b]
-    np.subtract(x[a + 3 * m : a + n_b + 3 * m], x[a : a + n_b], out=out)
-    np.subtract(x[a + m : a + n_b + m], x[a + 2 * m : a + n_b + 2 * m], out=u)
-    u *= 3.0
-    out += u
-
-
 _MOD_CHUNK: Final = 1 << 16
 """Terms per block of :func:`modified_sum` (its five buffers stay in the L2 cache)."""
 
@@ -331,7 +310,8 @@ def _modified_tail(x: FloatArray, m: int, n_terms: int, start: int, v: float) ->
     :data:`_MOD_CHUNK` terms: the third differences t_j, their running sum from v in
     :data:`_LANES` lanes (:func:`_prefix_squares`)."""
     size = min(_MOD_CHUNK, n_terms - start)
-    extra = 2 * m if 16 * m <= _MOD_CHUNK else 0
+    nested = 16 * m <= _MOD_CHUNK  # the 2m extra terms a block cost less than a fourth tap
+    extra = 2 * m if nested else 0
     buf, lanes = np.empty(size + 1), np.empty(size)
     tmp, tmp2 = np.empty(size + extra), np.empty(size + extra)
     total = 0.0
@@ -339,7 +319,7 @@ def _modified_tail(x: FloatArray, m: int, n_terms: int, start: int, v: float) ->
         n_b = min(a + _MOD_CHUNK, n_terms) - a
         n_t = min(n_b, n_terms - 1 - a)  # t_j exists for j < n_terms − 1
         buf[0] = v  # then t_a … t_{a+n_t−1}: their running sum is v_a … v_{a+n_t}
-        _third_differences(x, m, a, buf[1 : n_t + 1], tmp, tmp2)
+        _third(x, m, a, buf[1 : n_t + 1], tmp, tmp2, nested)
         sq, last = _prefix_squares(buf[:n_b], lanes)
         total += sq
         if n_t == n_b:  # the next block's first inner sum
