@@ -35,13 +35,12 @@ from thermocal import units
 from thermocal.defaults import overrides_of
 from thermocal.errors import (
     ConditioningWarning,
-    NamesParameters,
     ParameterError,
     PlausibilityWarning,
     ThermocalInputError,
 )
 from thermocal.families import MAX_ORDER, MAX_TERMS
-from thermocal.pipeline.messages import one_line, option_name
+from thermocal.pipeline.messages import warning_text
 from thermocal.pipeline.options import FitOptions
 from thermocal.pipeline.reading import check_recording
 from thermocal.readers.station import station_sensor_paths
@@ -582,13 +581,6 @@ def _judge_fitted(spec: _FitSpec, p: _Prepared) -> None:
         rec["verdict"] = "overridden"
 
 
-def _spelled(message: Warning | str) -> str:
-    """A warning's text with the command line's options for the parameters it names."""
-    if isinstance(message, NamesParameters):
-        return message.spelled(option_name)
-    return str(message)
-
-
 def _finish_channel(
     spec: _FitSpec, prep: _Prepared
 ) -> tuple[_base.TemperatureModel, dict[str, Any], int]:
@@ -611,7 +603,7 @@ def _finish_channel(
             warnings.warn(f"{est.family}: {note['note']}", ConditioningWarning, stacklevel=1)
     all_caught = [*prep.caught, *caught]
     # the --json result speaks to the command line: options where the library names parameters
-    messages = [one_line(_spelled(w.message)) for w in all_caught]
+    messages = [warning_text(w.message) for w in all_caught]
     for w in all_caught:  # hand them on to handle_errors, which prints them on stderr
         warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
 

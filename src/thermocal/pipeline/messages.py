@@ -97,6 +97,33 @@ def json_text(obj: Any) -> str:
     return json.dumps(jsonable(obj), allow_nan=False) + "\n"
 
 
+def warning_text(message: Warning | str, options: Mapping[str, str] | None = None) -> str:
+    """One warning's text as the command line shows it: one line, with options where it
+    names the library's parameters (:func:`option_name`).
+
+    Parameters
+    ----------
+    message : Warning or str
+        A caught warning's ``message``.
+    options : mapping of str to str, optional
+        ``{parameter: option}`` of the running command where it differs from
+        :func:`option_name`'s rule.
+
+    Returns
+    -------
+    str
+
+    Examples
+    --------
+    >>> from thermocal.errors import UnitWarning
+    >>> warning_text(UnitWarning.naming("host clock?   give {rate_hz}", "rate_hz"))
+    'host clock? give --rate'
+    """
+    if isinstance(message, NamesParameters):
+        return one_line(message.spelled(lambda p: option_name(p, options)))
+    return one_line(message)
+
+
 def warning_lines(
     caught: Iterable[warnings.WarningMessage], options: Mapping[str, str] | None = None
 ) -> list[str]:
@@ -121,11 +148,7 @@ def warning_lines(
     seen: set[str] = set()
     out: list[str] = []
     for w in caught:
-        message = w.message
-        if isinstance(message, NamesParameters):
-            msg = one_line(message.spelled(lambda p: option_name(p, options)))
-        else:
-            msg = one_line(message)
+        msg = warning_text(w.message, options)
         if msg in seen:
             continue
         seen.add(msg)
@@ -268,4 +291,5 @@ __all__ = [
     "one_line",
     "option_name",
     "warning_lines",
+    "warning_text",
 ]
