@@ -50,6 +50,7 @@ from thermocal.models.base import TemperatureModel
 from thermocal.models.registry import make_model
 from thermocal.models.rundata import RunData
 from thermocal.pipeline.compensate import compensate_file
+from thermocal.pipeline.messages import warning_text
 from thermocal.pipeline.model_file import save_model
 from thermocal.profiles import design_validation_profile, rlg_modelling
 from thermocal.recording import Recording
@@ -350,7 +351,7 @@ def _fit_models(
     ):
         n0 = len(caught)
         model = _fit_poly(run_m, cfg, select=select)
-        fit_warnings += [f"{label} fit: {' '.join(str(w.message).split())}" for w in caught[n0:]]
+        fit_warnings += [f"{label} fit: {warning_text(w.message)}" for w in caught[n0:]]
         path = out / "models" / f"{label}.json"
         model_dicts[label] = save_model(model, path)
         fitted[label] = model
@@ -540,7 +541,7 @@ def run_demo(
         )  # fmt: skip
         written.append(report_path)
         done(DEMO_STEPS[7])
-    msgs = tuple(dict.fromkeys(" ".join(str(w.message).split()) for w in caught))
+    msgs = tuple(dict.fromkeys(warning_text(w.message) for w in caught))
 
     summaries = [
         _summary_of(lab, model_paths[lab], val_paths[lab], c_files[lab], model_dicts[lab],

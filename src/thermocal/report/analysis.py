@@ -23,6 +23,7 @@ from thermocal.metrics import (
 )
 from thermocal.models.registry import model_from_dict
 from thermocal.models.rundata import RunData
+from thermocal.pipeline.messages import warning_text
 from thermocal.recording import FloatArray, Metadata, Recording
 from thermocal.stability.allan import (
     AllanResult,
@@ -195,7 +196,7 @@ def apply_model(model_dict: dict[str, Any], rec: Recording, signal: str | None) 
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         pred = np.asarray(model.predict(run), dtype=np.float64) / factor
-    msgs = tuple(dict.fromkeys(" ".join(str(w.message).split()) for w in caught))
+    msgs = tuple(dict.fromkeys(warning_text(w.message) for w in caught))
     before = x - known
     # A model fitted on the raw output (known input not removed) carries the earth
     # rate in its constant.  The fit's provenance says what was removed (``thermocal fit``

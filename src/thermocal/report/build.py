@@ -42,6 +42,7 @@ from thermocal.defaults import DEFAULT_AVERAGING_S, WEAK_CORRELATION_LIMIT
 from thermocal.errors import ThermocalInputError, ThermocalWarning
 from thermocal.metrics import data_unit_of
 from thermocal.models.results import condition_wording
+from thermocal.pipeline.messages import warning_text
 from thermocal.readers.common import sha256_of
 from thermocal.recording import Recording
 from thermocal.report.analysis import (
@@ -1656,7 +1657,7 @@ def build_report(inputs: ReportInputs) -> str:
     runs.append(_run_info(an.role, rec, inputs.recording_path, signal, unit))
     summary = _summary(primary, an.fom_before, an.fom_after, unit)
     run_warnings = [
-        " ".join(str(w.message).split()) for w in caught if issubclass(w.category, ThermocalWarning)
+        warning_text(w.message) for w in caught if issubclass(w.category, ThermocalWarning)
     ]
     ctx = {
         "title": inputs.title,

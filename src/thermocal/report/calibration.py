@@ -37,6 +37,7 @@ from thermocal.defaults import DEFAULT_AVERAGING_S
 from thermocal.errors import ThermocalInputError
 from thermocal.models.calibration import Calibration
 from thermocal.models.format import model_file_dict
+from thermocal.pipeline.messages import warning_text
 from thermocal.readers.common import sha256_of
 from thermocal.recording import Recording
 from thermocal.report.analysis import (
@@ -179,7 +180,7 @@ def _channel_merits(
         )
         fom = [_figures_in(stab, slope, k) for stab, slope in shown]
         allan = [allan_of(rec.time_s, x, tau0, unit) for x in (before, after)]
-    return fom, allan, [" ".join(str(w.message).split()) for w in caught]
+    return fom, allan, [warning_text(w.message) for w in caught]
 
 
 def _channel_notes(

@@ -18,6 +18,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from thermocal.errors import FileFormatError, ThermocalInputError, ThermocalWarning
+from thermocal.pipeline.messages import warning_text
 from thermocal.pipeline.reading import split_names
 
 if TYPE_CHECKING:
@@ -350,9 +351,7 @@ def _models_report(
         for w in caught:
             warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
         read_warnings = tuple(
-            " ".join(str(w.message).split())
-            for w in caught
-            if issubclass(w.category, ThermocalWarning)
+            warning_text(w.message) for w in caught if issubclass(w.category, ThermocalWarning)
         )
         advance(1)
         inputs = ReportInputs(
