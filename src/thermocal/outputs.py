@@ -399,7 +399,7 @@ def warn_formula_names(path: str | Path, names: Iterable[str], what: str = "colu
     Parameters
     ----------
     path : str or pathlib.Path
-        The output; only a ``.csv`` is concerned.
+        The output; only a CSV (``.csv``, or ``.csv.gz`` unpacked into one) is concerned.
     names : iterable of str
         The column (or other) names written into it.
     what : str
@@ -414,7 +414,7 @@ def warn_formula_names(path: str | Path, names: Iterable[str], what: str = "colu
 
     from thermocal.errors import ThermocalWarning
 
-    if Path(path).suffix.lower() != ".csv":
+    if not Path(path).name.lower().endswith((".csv", ".csv.gz")):
         return
     risky = [n for n in names if formula_risk(n)]
     if risky:
