@@ -3514,6 +3514,22 @@ MUTANTS: tuple[Mutant, ...] = (
         _t("fit_param"),
         "--param per_run_offset=no read as yes",
     ),
+    Mutant(
+        "cli-summary-cut-short",
+        P + "cli/application.py",
+        'if word.endswith(".") or len(" ".join(kept)) > SUMMARY_CHARACTERS:',
+        'if word.endswith(".") or len(" ".join(kept)) > SUMMARY_CHARACTERS // 2:',
+        _t("cli_application"),
+        "the commands' summaries cut at 50 characters: the list shortens less than it should",
+    ),
+    Mutant(
+        "cli-list-without-summaries",
+        P + "cli/application.py",
+        "if set(COMMAND_SUMMARIES) <= set(real):",
+        "if True:",
+        _t("cli_application"),
+        "thermocal --help lists only the registered commands (none)",
+    ),
 )
 
 
