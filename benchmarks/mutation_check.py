@@ -3530,6 +3530,14 @@ MUTANTS: tuple[Mutant, ...] = (
         _t("cli_application"),
         "thermocal --help lists only the registered commands (none)",
     ),
+    Mutant(
+        "cli-root-help-flag-coerced",
+        P + "cli/application.py",
+        'if option is not None and getattr(option, "_runtime_param", False) is None:',
+        "if False:",
+        _t("cli_application"),
+        "a command's --help imports pydantic for the root's --help flag left out",
+    ),
 )
 
 

@@ -73,3 +73,18 @@ def test_help_before_a_command_lists_every_command() -> None:
     assert lazy[0] == 0  # type: ignore[index]
     listed = [line.split()[0] for line in lazy[1].split("Commands:")[1].splitlines() if line]  # type: ignore[index]
     assert listed == list(COMMAND_SUMMARIES)
+
+
+def test_a_commands_help_loads_no_pydantic() -> None:
+    """A command's ``--help`` needs no coercion of values: typer ≥ 0.28 builds a pydantic
+    adapter for the root's ``--help`` flag left out, unless the root takes it as given."""
+    commands = sorted(set(cli.COMMANDS) - {"profile", "station"})  # groups: typer's own
+    code = (
+        "import contextlib, io, sys\n"
+        "from thermocal.cli import main\n"
+        "with contextlib.redirect_stdout(io.StringIO()):\n"
+        f"    codes = [main([c, '--help']) for c in {commands!r}]\n"
+        "print(sum(codes), 'pydantic' in sys.modules, 'importlib.metadata' in sys.modules)"
+    )
+    res = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert res.stdout.split() == ["0", "False", "False"]

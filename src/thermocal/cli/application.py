@@ -96,9 +96,27 @@ def summary_of(help_text: str | None) -> str:
     return " ".join(kept)
 
 
+class _FlagAsGiven:
+    """The coercion of the root's ``--help`` flag: its value as click parsed it (True, False
+    or None when not given)."""
+
+    def coerce(self, value: Any, param: Any, ctx: Any) -> Any:
+        """The value unchanged."""
+        return value
+
+
 class ListedGroup(TyperGroup):
     """The root group: lists every command, from :data:`COMMAND_SUMMARIES` for those whose
     module is not registered."""
+
+    def get_help_option(self, ctx: Any) -> Any:
+        """The ``--help`` option, its value taken as given: typer ≥ 0.28 builds a pydantic
+        adapter to coerce a flag left out (None, returned as None), which imports pydantic
+        and scans the installed distributions' entry points before any command runs."""
+        option: Any = super().get_help_option(ctx)
+        if option is not None and getattr(option, "_runtime_param", False) is None:
+            option._runtime_param = _FlagAsGiven()
+        return option
 
     def format_commands(self, ctx: Any, formatter: Any) -> None:
         """The ``Commands`` section of the help, as the registered modules would write it."""
