@@ -3538,6 +3538,30 @@ MUTANTS: tuple[Mutant, ...] = (
         _t("cli_application"),
         "a command's --help imports pydantic for the root's --help flag left out",
     ),
+    Mutant(
+        "outputs-replaced-only-equal",
+        P + "outputs.py",
+        "if parts[: len(top)] == top:",
+        "if parts == top:",
+        _t("outputs_replaced"),
+        "an input deeper inside a folder the run deletes is not seen",
+    ),
+    Mutant(
+        "outputs-replaced-string-prefix",
+        P + "outputs.py",
+        "if parts[: len(top)] == top:",
+        'if "".join(parts).startswith("".join(top)):',
+        _t("outputs_replaced"),
+        "units/u1 taken to contain units/u10's input",
+    ),
+    Mutant(
+        "fleet-worker-digests-dropped",
+        P + "fleet/batch.py",
+        "hashed = inputs.get(outcome.id) or outcome.inputs or None",
+        "hashed = inputs.get(outcome.id) or outcome.inputs",
+        _t("fleet_inputs"),
+        "a unit whose outcome carries no digests recorded with no inputs",
+    ),
 )
 
 
