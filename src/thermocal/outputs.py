@@ -35,6 +35,7 @@ import stat
 from collections.abc import Iterable
 from dataclasses import dataclass
 from pathlib import Path
+from typing import NoReturn
 
 from thermocal.errors import ThermocalInputError
 
@@ -237,6 +238,65 @@ def _temporaries(target: Path) -> list[Path]:
     return sorted(parent.glob(f".{glob.escape(target.name)}.*{TEMP_SUFFIX}"))
 
 
+class _OutputCheck:
+    """The inputs of one :func:`check_outputs` call, indexed once for its rules."""
+
+    def __init__(self, inputs: list[str | Path], what: str) -> None:
+        ins = _inputs(inputs)
+        self.what = what
+        self.by_inode: dict[tuple[int, int] | None, _Input] = {
+            i.inode: i for i in ins if i.inode is not None
+        }
+        self.stations = _station_folders(inputs)
+        self.in_parts = [(i, _parts(i.resolved)) for i in ins]  # a batch: units x inputs
+        self.by_path: dict[Path, _Input] = {}
+        for i in ins:
+            self.by_path.setdefault(i.resolved, i)  # the first input of that path names it
+
+    def refuse(self, target: Path, why: str) -> NoReturn:
+        """Raise the refusal of ``target``."""
+        raise ThermocalInputError(f"{target}: refusing to write {self.what} there: {why}")
+
+    def not_input(self, target: Path, folder: bool = False) -> None:
+        """``target`` is written: not a special file, in no station folder, not an input."""
+        why = special_reason(target)
+        if why is not None:
+            self.refuse(target, why)
+        r = target.resolve()
+        inside = next((d for d in self.stations if r.is_relative_to(d)), None)
+        if inside is not None:
+            self.refuse(target, f"it is inside the input station recording {inside}")
+        hit = self.by_path.get(r)
+        link = ""
+        if hit is None and target.exists():
+            hit = self.by_inode.get(_inode(target))
+            link = " (the same file: a hard link)"
+        if hit is not None and folder:
+            self.refuse(target, f"it is {hit.label}{link}, not a directory")
+        if hit is not None:
+            raise ThermocalInputError(f"{target}: refusing to write over {hit.label}{link}")
+
+    def holds_no_input(self, folder: Path, is_dir: bool = True) -> None:
+        """``folder`` is replaced or deleted: no input may be in it."""
+        self.not_input(folder, folder=is_dir)
+        top = _parts(folder.resolve())
+        for i, parts in self.in_parts:
+            if parts[: len(top)] == top:  # inside (or equal to) the folder
+                self.refuse(folder, f"it contains {i.label}, which would be deleted")
+        if not folder.is_dir():
+            return
+        for root, subdirs, files in os.walk(folder.resolve()):
+            for name in (*files, *subdirs):
+                hit = self.by_inode.get(_inode(Path(root) / name, follow=False))
+                if hit is not None:
+                    self.refuse(folder, f"it holds {Path(root) / name}, which is {hit.label}")
+
+    def no_stale_input(self, target: Path) -> None:
+        """No leftover temporary of ``target`` (removed on the next write) is an input."""
+        for tmp in _temporaries(target):
+            self.holds_no_input(tmp, is_dir=False)
+
+
 def check_outputs(
     outputs: Iterable[str | Path],
     inputs: Iterable[str | Path],
@@ -274,73 +334,22 @@ def check_outputs(
     ...         print(str(err).replace(tmp, "TMP"))
     TMP/run.csv: refusing to write over the input file TMP/run.csv
     """
-    ins = _inputs(inputs)
-    by_inode: dict[tuple[int, int] | None, _Input] = {
-        i.inode: i for i in ins if i.inode is not None
-    }
-
-    stations = _station_folders(inputs)
-    in_parts = [(i, _parts(i.resolved)) for i in ins]  # a batch: units x inputs comparisons
-    by_path: dict[Path, _Input] = {}
-    for i in ins:
-        by_path.setdefault(i.resolved, i)  # the first input of that path names it
-
-    def refuse(target: Path, why: str) -> None:
-        raise ThermocalInputError(f"{target}: refusing to write {what} there: {why}")
-
-    def not_input(target: Path, folder: bool = False) -> None:
-        why = special_reason(target)
-        if why is not None:
-            refuse(target, why)
-        r = target.resolve()
-        inside = next((d for d in stations if r.is_relative_to(d)), None)
-        if inside is not None:
-            refuse(target, f"it is inside the input station recording {inside}")
-        hit = by_path.get(r)
-        link = ""
-        if hit is None and target.exists():
-            hit = by_inode.get(_inode(target))
-            link = " (the same file: a hard link)"
-        if hit is not None and folder:
-            refuse(target, f"it is {hit.label}{link}, not a directory")
-        if hit is not None:
-            raise ThermocalInputError(f"{target}: refusing to write over {hit.label}{link}")
-
-    def holds_no_input(folder: Path, is_dir: bool = True) -> None:
-        """``folder`` is replaced or deleted: no input may be in it."""
-        not_input(folder, folder=is_dir)
-        r = folder.resolve()
-        top = _parts(r)
-        for i, parts in in_parts:
-            if parts[: len(top)] == top:  # inside (or equal to) the folder
-                refuse(folder, f"it contains {i.label}, which would be deleted")
-        if not folder.is_dir():
-            return
-        for root, subdirs, files in os.walk(r):
-            for name in (*files, *subdirs):
-                hit = by_inode.get(_inode(Path(root) / name, follow=False))
-                if hit is not None:
-                    refuse(folder, f"it holds {Path(root) / name}, which is {hit.label}")
-
-    def no_stale_input(target: Path) -> None:
-        for tmp in _temporaries(target):
-            holds_no_input(tmp, is_dir=False)
-
+    check = _OutputCheck(list(inputs), what)
     for d in (Path(x) for x in dirs):
-        not_input(d, folder=True)
+        check.not_input(d, folder=True)
         if d.exists() and not d.is_dir():
             raise ThermocalInputError(f"{d}: exists and is not a directory")
-        no_stale_input(d)
+        check.no_stale_input(d)
     for d in (Path(x) for x in replaced):
-        holds_no_input(d)
+        check.holds_no_input(d)
         if d.exists() and not d.is_dir():
             raise ThermocalInputError(f"{d}: exists and is not a directory")
-        no_stale_input(d)
+        check.no_stale_input(d)
     for f in (Path(x) for x in outputs):
-        not_input(f)
+        check.not_input(f)
         if f.is_dir():
             raise ThermocalInputError(f"{f}: is a directory, expected a file name")
-        no_stale_input(f)
+        check.no_stale_input(f)
 
 
 FORMULA_TRIGGERS: tuple[str, ...] = ("=", "+", "-", "@", "\t", "\r")

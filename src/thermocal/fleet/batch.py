@@ -1362,6 +1362,32 @@ def lost_unit(task: UnitTask, exc: BaseException) -> UnitOutcome:
     )
 
 
+def _plan(
+    config: FleetConfig, out: Path, force: bool
+) -> tuple[list[UnitTask], list[str], dict[str, str], dict[str, dict[str, str | None]]]:
+    """What :func:`run_fleet` does with each unit: the tasks to run, the units skipped (done
+    and still right), why each unit run before is redone, and the input digests taken
+    (a unit never run is hashed where it runs)."""
+    todo: list[UnitTask] = []
+    skipped: list[str] = []
+    redo: dict[str, str] = {}
+    inputs: dict[str, dict[str, str | None]] = {}
+    for u in config.units:
+        folder = unit_dir(out, u.id)
+        if not (folder.exists() or folder.is_symlink()):
+            todo.append(UnitTask(u, _fit_options(config), config.validate))
+            continue
+        inputs[u.id] = unit_inputs(u)
+        reasons = stale_reasons(out, config, u, inputs[u.id])
+        if reasons is not None and not reasons and not force:
+            skipped.append(u.id)
+            continue
+        if reasons is not None:
+            redo[u.id] = "; ".join(reasons) if reasons else FORCED
+        todo.append(UnitTask(u, _fit_options(config), config.validate))
+    return todo, skipped, redo, inputs
+
+
 def run_fleet(
     config: FleetConfig,
     out_dir: str | Path,
@@ -1409,23 +1435,7 @@ def run_fleet(
     run = executor or (dask_executor(scheduler) if scheduler else local_executor(workers))
     out.mkdir(parents=True, exist_ok=True)
     _clean_stale(out / "units")
-    todo: list[UnitTask] = []
-    skipped: list[str] = []
-    redo: dict[str, str] = {}
-    inputs: dict[str, dict[str, str | None]] = {}
-    for u in config.units:
-        folder = unit_dir(out, u.id)
-        if not (folder.exists() or folder.is_symlink()):  # never run: hashed where it runs
-            todo.append(UnitTask(u, _fit_options(config), config.validate))
-            continue
-        inputs[u.id] = unit_inputs(u)
-        reasons = stale_reasons(out, config, u, inputs[u.id])
-        if reasons is not None and not reasons and not force:
-            skipped.append(u.id)
-            continue
-        if reasons is not None:
-            redo[u.id] = "; ".join(reasons) if reasons else FORCED
-        todo.append(UnitTask(u, _fit_options(config), config.validate))
+    todo, skipped, redo, inputs = _plan(config, out, force)
     ran: list[str] = []
     failed: list[str] = []
     interrupted: str | None = None
