@@ -55,6 +55,7 @@ def write_sensor_report(path: Path, req: AnyReportRequest) -> None:
             appendix=tuple(
                 comparison_html(c) for c in (req.previous, req.firmware_learning) if c is not None
             ),
+            allan=req.allan,
         ),
     )  # fmt: skip
 

@@ -460,6 +460,9 @@ class ReportRequest:
         The coefficients active in the log against the new ones.
     firmware_learning : CoefficientComparison or None
         The firmware's own learned coefficients against the new ones.
+    allan : bool
+        Draw each channel's Allan deviation before and after compensation with its noise
+        terms (default False: left out; most of a report's cost on a long log).
     """
 
     calibration: Calibration
@@ -474,6 +477,8 @@ class ReportRequest:
     """The coefficients active in the log against the new ones (a table and figure)."""
     firmware_learning: CoefficientComparison | None = None
     """The firmware's own learned coefficients (ArduPilot ``TCLR``) against the new ones."""
+    allan: bool = False
+    """Each channel's Allan deviation section drawn (False: left out, not computed)."""
 
 
 AnyReportRequest = ReportRequest | OffsetReportRequest | ArdupilotBaroReportRequest
