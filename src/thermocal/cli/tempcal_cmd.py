@@ -44,6 +44,14 @@ def px4_tempcal_cmd(
     allow_narrow: AllowNarrowOpt = False,
     allow_motion: AllowMotionOpt = False,
     as_json: JsonOpt = False,
+    allan: Annotated[
+        bool,
+        typer.Option(
+            "--allan",
+            help="Draw each axis's Allan deviation before and after compensation in the "
+            "gyro and accelerometer reports (slower on a long log).",
+        ),
+    ] = False,
 ) -> None:
     """Fit every gyro and accelerometer instance of a PX4 log as PX4 would (a cubic per axis
     about TREF), robust to spikes, with equal weight across the temperature range and
@@ -53,7 +61,7 @@ def px4_tempcal_cmd(
 
     res = px4_tempcal(
         log, output, tref_c=tref, overrides=overrides_of(allow_narrow, allow_motion),
-        reporter=write_sensor_report,
+        reporter=write_sensor_report, allan=allan,
     )  # fmt: skip
     emit(res.to_dict(), as_json, lambda: _print_px4(res))
 
