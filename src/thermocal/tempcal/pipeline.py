@@ -548,7 +548,7 @@ class OutputSet:
     reports: list[Path] = field(default_factory=list)
     workers: int = 0
     _pool: Any = None
-    _pending: list[tuple[Any, Path, AnyReportRequest]] = field(default_factory=list)
+    _pending: list[tuple[Any, Path, AnyReportRequest | None]] = field(default_factory=list)
 
     def report(self, name: str, request: AnyReportRequest) -> None:
         """Write the report ``name`` into the stage (when a reporter is given).
@@ -569,10 +569,19 @@ class OutputSet:
         if self.workers > 0 and _n_samples(request) >= PARALLEL_MIN_SAMPLES:
             if self._pool is None:
                 self._pool = _report_pool()
+            self._forget_written()
             fut = self._pool.submit(_report_job, self.reporter, self.stage / name, request)
             self._pending.append((fut, self.stage / name, request))
             return
         self.reporter(self.stage / name, request)
+
+    def _forget_written(self) -> None:
+        """The requests of reports the worker has written are not kept (their recordings'
+        memory given back); a report not begun or failed keeps its request."""
+        self._pending = [
+            (fut, path, None if fut.done() and _succeeded(fut) else request)
+            for fut, path, request in self._pending
+        ]
 
     def finish_reports(self) -> None:
         """Every report of the set written: those not begun by the worker are built here,
@@ -585,6 +594,7 @@ class OutputSet:
         for fut, path, request in reversed(pending):  # the last first: the worker goes on
             if not fut.cancel():  # begun (or done) there, and so every one before it
                 break
+            assert request is not None  # kept: not done
             self.reporter(path, request)  # type: ignore[misc]
         for fut, path, request in pending:
             if fut.cancelled():
@@ -592,6 +602,7 @@ class OutputSet:
             try:
                 said = fut.result()
             except Exception:  # failed there (or not sent): here, with its own error
+                assert request is not None  # kept: failed
                 self.reporter(path, request)  # type: ignore[misc]
                 continue
             for message, filename, lineno in said:
@@ -625,6 +636,11 @@ class OutputSet:
         with atomic_write(self.stage / params_name, "w") as fh:
             fh.write(params_text)
         commit_directory(self.stage, self.output)
+
+
+def _succeeded(fut: Any) -> bool:
+    """A finished future without an exception."""
+    return not fut.cancelled() and fut.exception() is None
 
 
 def _report_pool() -> Any:
