@@ -529,18 +529,23 @@ def _imu_instance(
     Allan section); ``found`` (series, motions) gets its (time [s], x/y/z in the canonical
     unit) and its stillness result for the step check across instances."""
     from thermocal.export.params import export_params
+    from thermocal.readers.ulog import release_parsed_topic
 
     kind = "gyro" if name == "sensor_gyro" else "accel"
     where = f"{name}.{inst}"
     log = flight.path
     rec = flight.recording(where)
+    release_parsed_topic(log, where)  # read once: its raw messages are not needed again
     series, motions = found
     fit = fit_sensor(rec, name, kind, inst, overrides=overrides, motions=motions)
     temp_c = rec.temperature_c("temperature")
-    series[where] = (rec.time_s, np.column_stack([rec.signal(a)[0] for a in AXES]))
+    # the step check across instances reads the stillness result (motions), not the values
+    series[where] = (rec.time_s, np.empty((0, len(AXES))))
     gates = [stall_warning(where, rec.time_s, temp_c)]
     if kind == "gyro":
-        gates.append(gyro_unit_warning(f"{log}: {where}", series[where][1]))
+        vals = np.column_stack([rec.signal(a)[0] for a in AXES])
+        gates.append(gyro_unit_warning(f"{log}: {where}", vals))
+        del vals
     if tref_c is not None:
         gates.append(end_warning(where, "TREF", tref_c, *fit.sweep_c))
     sub = Calibration(fit.channels)
@@ -553,6 +558,11 @@ def _imu_instance(
     prev = old.compare(
         where, ps.params, kind, inst, fit.device_id, "rad/s" if kind == "gyro" else "m/s^2",
         fit.sweep_c,
+    )  # fmt: skip
+    shown = (*AXES, "temperature")  # what the report reads: the device id column left here
+    rec = dataclasses.replace(
+        rec, columns={k: v for k, v in rec.columns.items() if k in shown},
+        units={k: u for k, u in rec.units.items() if k in shown},
     )  # fmt: skip
     out_set.report(
         f"report_{name}_{inst}.html",
