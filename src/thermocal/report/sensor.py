@@ -68,6 +68,9 @@ def _warm_reports() -> None:
 
     from thermocal.report import calibration as _calibration  # noqa: F401
     from thermocal.report import figures as F
+    from thermocal.report.build import _env
+
+    _env().get_template("calibration.html.j2")  # compiled once, here
 
     tau = np.logspace(-2, 3, 12)
     F.allan_grid([("x", "unit", [F.AllanCurve("before", tau, 1.0 / tau, None, None)])] * 3)
