@@ -2472,6 +2472,22 @@ MUTANTS: tuple[Mutant, ...] = (
         "fast ULog reader takes each msg_id's last data message for its first",
     ),
     Mutant(
+        "ulog-fast-run-one-too-far",
+        P + "readers/ulog_fast.py",
+        "return at[:m], pos + m * step",
+        "return at[: m + 1], pos + (m + 1) * step",
+        _t("ulog_fast"),
+        "a run of equal-size messages takes the first message of another size as one of them",
+    ),
+    Mutant(
+        "ulog-fast-u16-high-byte-dropped",
+        P + "readers/ulog_fast.py",
+        'every = np.ndarray((max(arr.size - 1, 0),), "<u2", arr, 0, (1,))',
+        'every = np.ndarray((max(arr.size - 1, 0),), "<u1", arr, 0, (1,))',
+        _t("ulog_fast"),
+        "the msg_ids and sizes of data messages read from their low byte only",
+    ),
+    Mutant(
         "fw-baro-no-upper-bound",
         P + "tempcal/offset_gates.py",
         "ok = finite & (p >= lo) & (p <= hi)",
