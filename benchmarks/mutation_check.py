@@ -2472,6 +2472,22 @@ MUTANTS: tuple[Mutant, ...] = (
         "fast ULog reader takes each msg_id's last data message for its first",
     ),
     Mutant(
+        "adequacy-nan-median-upper-middle",
+        P + "adequacy.py",
+        "    hi = c // 2\n",
+        "    hi = (c + 1) // 2\n",
+        _t("adequacy_medians"),
+        "the windows' medians of an even count take the middle one above for the lower",
+    ),
+    Mutant(
+        "adequacy-block-median-upper-middle",
+        P + "adequacy.py",
+        "lo_i, hi_i = (counts - 1) // 2, counts // 2",
+        "lo_i, hi_i = counts // 2, counts // 2",
+        _t("adequacy_medians"),
+        "irregular blocks of an even count: the median is the middle one above",
+    ),
+    Mutant(
         "ulog-fast-run-one-too-far",
         P + "readers/ulog_fast.py",
         "return at[:m], pos + m * step",
