@@ -703,10 +703,18 @@ def report_worker(reporter: Reporter | None, log: Path) -> Iterator[Any]:
 
 
 def report_workers() -> int:
-    """Worker processes for reports: 1 on a machine with two cores or more, else 0."""
+    """Worker processes for reports: 1 when the machine has a core to spare (two cores or
+    more, the load average at least one below their number), else 0: on a busy machine a
+    second process only competes for the same cores and costs its own start (imports,
+    the recordings sent to it), so the reports are built here."""
     import os
 
-    return 1 if (os.cpu_count() or 1) > 1 else 0
+    cores = os.cpu_count() or 1
+    try:
+        load = os.getloadavg()[0]
+    except (AttributeError, OSError):  # no load average here (Windows)
+        load = 0.0
+    return 1 if cores - load >= 1.0 else 0
 
 
 def check_output_dir(output: Path) -> None:
@@ -750,7 +758,8 @@ def staged_set(output: Path, reporter: Reporter | None, pool: Any = None) -> Ite
     """
     from thermocal.writers import discard_staging, staging_directory
 
-    out = OutputSet(output, staging_directory(output), reporter, workers=report_workers())
+    workers = 1 if pool is not None else report_workers()  # the worker started: used
+    out = OutputSet(output, staging_directory(output), reporter, workers=workers)
     out._pool = pool
     try:
         yield out
