@@ -292,19 +292,44 @@ def residuals(ours: dict[str, float], px4: dict[str, float]) -> list[tuple[str, 
     return rows
 
 
-def _race(cmds: dict[str, list[str]], repeat: int) -> dict[str, tuple[float, float]]:
-    """Best wall time [s] and peak resident memory [MB] of each command, run ``repeat``
-    times interleaved (one of each in turn, so that a change of the machine's load falls on
-    all of them alike): :func:`_harness.measure`, each a fresh process."""
-    from _harness import measure
+_CPU_WRAPPER = r"""
+import resource, subprocess, sys, time
+t0 = time.perf_counter()
+proc = subprocess.run(sys.argv[1:], stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+dt = time.perf_counter() - t0
+ru = resource.getrusage(resource.RUSAGE_CHILDREN)
+print(f"{proc.returncode} {ru.ru_maxrss} {dt:.4f} {ru.ru_utime + ru.ru_stime:.4f}")
+if proc.returncode:
+    print(proc.stderr[-2000:], file=sys.stderr)
+"""
+"""``_harness.WRAPPER`` with the CPU time [s] of the child and its own children added (user
++ system): on a loaded machine the wall time is mostly waiting for a core, the CPU time
+is what the program costs."""
 
-    best: dict[str, tuple[float, float]] = {}
+
+def _measure(cmd: list[str]) -> tuple[float, float, float]:
+    """(wall [s], peak resident memory of the largest process [MB], CPU [s]) of one run."""
+    import subprocess
+
+    res = subprocess.run([sys.executable, "-c", _CPU_WRAPPER, *cmd], capture_output=True,
+                         text=True, check=False)  # fmt: skip
+    code, peak_kb, wall, cpu = res.stdout.split()
+    if int(code) != 0:
+        raise SystemExit(f"{cmd} failed: {res.stderr}")
+    return float(wall), int(peak_kb) / 1024.0, float(cpu)
+
+
+def _race(cmds: dict[str, list[str]], repeat: int) -> dict[str, tuple[float, float, float]]:
+    """Best wall time [s], peak resident memory [MB] and least CPU time [s] of each command,
+    run ``repeat`` times interleaved (one of each in turn, so that a change of the machine's
+    load falls on all of them alike), each a fresh process."""
+    best: dict[str, tuple[float, float, float]] = {}
     for r in range(repeat):
         for name, cmd in cmds.items():
-            t, mb = measure(cmd)
-            old = best.get(name, (math.inf, 0.0))
-            best[name] = (min(old[0], t), max(old[1], mb))
-            print(f"  run {r + 1}/{repeat} {name:<16} {t:7.2f} s {mb:7.0f} MB "
+            t, mb, cpu = _measure(cmd)
+            old = best.get(name, (math.inf, 0.0, math.inf))
+            best[name] = (min(old[0], t), max(old[1], mb), min(old[2], cpu))
+            print(f"  run {r + 1}/{repeat} {name:<16} {t:7.2f} s {mb:7.0f} MB cpu {cpu:6.2f} s "
                   f"(load {os.getloadavg()[0]:.2f})", flush=True)  # fmt: skip
     return best
 
@@ -411,28 +436,30 @@ def main() -> None:
 
 
 def _speed_table(
-    a: argparse.Namespace, best: dict[str, tuple[float, float]], log: Path, work: Path,
+    a: argparse.Namespace, best: dict[str, tuple[float, float, float]], log: Path, work: Path,
     mb_log: float,
 ) -> None:  # fmt: skip
     """The times and memories side by side, the ratios, the targets (issue 41, item 1)."""
     how = "as the script runs it" if a.as_script else "with its PDF" if a.plots else "bare"
-    t_px4, _mb_px4 = best["PX4 algorithm"]
-    print(f"{'program':<26} {'best s':>8} {'peak MB':>8} {'ratio to PX4':>13}")
-    for name, (t, mb) in best.items():
+    t_px4, _mb_px4, cpu_px4 = best["PX4 algorithm"]
+    print(
+        f"{'program':<38} {'best s':>8} {'peak MB':>8} {'CPU s':>7} {'ratio':>6} {'CPU ratio':>9}"
+    )
+    for name, (t, mb, cpu) in best.items():
         label = f"PX4 algorithm ({how})" if name == "PX4 algorithm" else name
-        print(f"{label:<26} {t:8.2f} {mb:8.0f} {t / t_px4:13.2f}")
-    t_ours, mb_ours = best["thermocal"]
+        print(f"{label:<38} {t:8.2f} {mb:8.0f} {cpu:7.2f} {t / t_px4:6.2f} {cpu / cpu_px4:9.2f}")
+    t_ours, mb_ours, cpu_ours = best["thermocal"]
     print(f"time: thermocal px4-tempcal {t_ours:.2f} s, PX4 algorithm {how} {t_px4:.2f} s, "
-          f"ratio {t_ours / t_px4:.2f} (speed-up {t_px4 / t_ours:.2f}x)")  # fmt: skip
+          f"ratio {t_ours / t_px4:.2f} (speed-up {t_px4 / t_ours:.2f}x); CPU {cpu_ours:.2f} s "
+          f"against {cpu_px4:.2f} s, ratio {cpu_ours / cpu_px4:.2f}")  # fmt: skip
     if "thermocal before" in best:
-        t_old, mb_old = best["thermocal before"]
+        t_old, mb_old, cpu_old = best["thermocal before"]
         print(f"before -> after: {t_old:.2f} s -> {t_ours:.2f} s ({t_old / t_ours:.2f}x), "
+              f"CPU {cpu_old:.2f} -> {cpu_ours:.2f} s, "
               f"peak {mb_old:.0f} -> {mb_ours:.0f} MB")  # fmt: skip
     tiny = work / "hard_tiny.ulg"
     tiny.write_bytes(hard_log(SIZES["tiny"])[0])
-    from _harness import measure
-
-    base = min(measure(_ours(None, tiny, work / f"out_tiny{i}"))[1] for i in range(2))
+    base = min(_measure(_ours(None, tiny, work / f"out_tiny{i}"))[1] for i in range(2))
     above = mb_ours - base
     print(f"memory: peak {mb_ours:.0f} MB on the {mb_log:.1f} MB log, {base:.0f} MB on a "
           f"{tiny.stat().st_size / 1e6:.2f} MB log: {above:.0f} MB above, "
