@@ -36,9 +36,7 @@ def _log(tmp_path: Path, n: int = 6000) -> Path:
     return log
 
 
-def _run(
-    log: Path, out: Path, capsys: pytest.CaptureFixture[str], *extra: str
-) -> dict[str, Any]:
+def _run(log: Path, out: Path, capsys: pytest.CaptureFixture[str], *extra: str) -> dict[str, Any]:
     code = main(["px4-tempcal", str(log), "-o", str(out), "--json", *extra])
     captured = capsys.readouterr()
     assert code == 0, captured.err
