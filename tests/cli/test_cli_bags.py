@@ -227,6 +227,19 @@ def test_headers_claiming_huge_counts(tmp_path: Path, capsys: pytest.CaptureFixt
         assert _hash(p) == before
 
 
+def test_an_mcap_of_ros1_messages_is_named(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``mcap convert`` of a ROS 1 bag gives schemas encoded ``ros1msg`` (MCAP's
+    well-known encodings); rosbags reads ROS 2 definitions only."""
+    bare = Path(shutil.copy(storage_file(_small(tmp_path, "mcap")), tmp_path / "r1.mcap"))
+    data = bare.read_bytes()
+    assert data.count(b"ros2msg") == 2  # the schema record, and its copy in the summary
+    bare.write_bytes(data.replace(b"ros2msg", b"ros1msg"))
+    line = _refused(bare, capsys, "--topic", "/imu")
+    assert "message definitions are 'ros1msg', not ROS 2" in line
+
+
 def test_without_the_extra_one_error_line(
     bags: dict[str, Path], tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
     capsys: pytest.CaptureFixture[str],

@@ -338,6 +338,12 @@ def _unreadable(path: Path, exc: BaseException) -> str:
             f"{path}: a ROS 2 bag folder needs its metadata.yaml (not found); give the "
             ".db3 or .mcap storage file itself instead"
         )
+    if isinstance(exc, KeyError) and exc.args and exc.args[0] not in ("ros2msg", "ros2idl"):
+        return (
+            f"{path}: an MCAP file whose message definitions are {exc.args[0]!r}, not ROS 2 "
+            "(ros2msg, ros2idl): not read; record it with ROS 2 (ros2 bag record -s mcap) "
+            "or give the ROS 1 .bag it was converted from"
+        )
     return f"{path}: not a readable ROS bag or MCAP file ({msg})"
 
 
