@@ -59,8 +59,8 @@ def bags(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Path]:
     topic = _received(header, values)
     out = {k: write_bag(base / ("imu.bag" if k == "ros1" else k), k, [topic]) for k in KINDS}
     out["bare.mcap"] = shutil.copy(storage_file(out["mcap"]), base / "bare.mcap")
-    # the same samples in time order, the time as the sensor stamped it [s]
-    cols = {"time": (header - T0_NS) / 1e9 + (T0_NS / NS)}
+    # the same samples in time order, the time as the sensor stamped it [s from the first]
+    cols = {"time": (header - T0_NS) / 1e9}
     for i, c in enumerate((*GYRO.split(","), *ACCEL.split(","))):
         cols[c] = values[:, i]
     frame = pd.DataFrame(cols)

@@ -396,8 +396,9 @@ def _repair(path: Path, topic: str, s: _Series, stamp: Stamp) -> _Repaired:
 
 
 def _seconds(t_ns: np.ndarray) -> FloatArray:
-    """Stamps [ns] as seconds: whole seconds plus the nanoseconds [s]."""
-    return (t_ns // _NS).astype(np.float64) + (t_ns % _NS).astype(np.float64) * 1e-9
+    """Stamps [ns] as seconds since the first [s] (exact to the nanosecond for 104 days,
+    where seconds since 1970 in float64 keep only a quarter of a microsecond)."""
+    return (t_ns - t_ns[0]).astype(np.float64) / 1e9
 
 
 def _join(imu_ns: np.ndarray, temp: _Repaired) -> FloatArray:
@@ -420,7 +421,8 @@ def read_bag(
     ``accel_x/y/z`` (``linear_acceleration`` [m/s²]); a ``sensor_msgs/Temperature`` topic
     ``temperature`` [°C], joined to the IMU's stamps (linear between its readings, NaN
     outside them) when it is the bag's only one or is named.  ``time`` [s] is each
-    message's header stamp (``sec + nanosec·1e-9``) or the bag's receive time.  Stamps out
+    message's header stamp or the bag's receive time, in seconds since the first (the
+    first, in ns since 1970, is the metadata's ``time_origin_ns``).  Stamps out
     of order are sorted (stably) and exact duplicates (same stamp and values) dropped, both
     counted in a warning.  Needs ``rosbags`` (``pip install 'thermocal[bags]'``).
 
@@ -497,6 +499,7 @@ def read_bag(
     units_ = {k: u for k, u in BAG_UNITS.items() if k in df.columns}
     info: dict[str, Any] = {"time": "time", "time_unit": "s", "units": units_}
     info["bag_topic"] = first if temp is None else f"{first},{temp}"
+    info["metadata"] = {"time_origin_ns": int(main.time_ns[0]), "stamp": stamp}
     return df, info
 
 
