@@ -398,7 +398,8 @@ def _repair(path: Path, topic: str, s: _Series, stamp: Stamp) -> _Repaired:
 def _seconds(t_ns: np.ndarray) -> FloatArray:
     """Stamps [ns] as seconds since the first [s] (exact to the nanosecond for 104 days,
     where seconds since 1970 in float64 keep only a quarter of a microsecond)."""
-    return (t_ns - t_ns[0]).astype(np.float64) / 1e9
+    out: FloatArray = (t_ns - t_ns[0]).astype(np.float64) / 1e9
+    return out
 
 
 def _join(imu_ns: np.ndarray, temp: _Repaired) -> FloatArray:
