@@ -247,3 +247,44 @@ def test_without_the_extra_one_error_line(
     monkeypatch.setitem(sys.modules, "rosbags.highlevel", None)
     line = _refused(bags["ros1"], capsys, "--topic", "/imu")
     assert "pip install 'thermocal[bags]'" in line
+
+
+def test_fit_of_a_bag_folder_equals_the_fit_of_the_csv(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A gyro of known slope 2e-4 rad/s/°C over a 10…50 °C sweep read at 1 Hz: the model
+    fitted from the ROS 2 bag folder (hashed file by file in its provenance) is the model
+    of the same samples in a CSV, the temperature interpolated here with numpy."""
+    import json
+
+    import pandas as pd
+
+    rng = np.random.default_rng(5)
+    n, rate = 4000, 10.0
+    t_s = np.arange(n) / rate
+    header = T0_NS + np.arange(n, dtype=np.int64) * 100_000_000
+    th = T0_NS + np.arange(-1, 402, dtype=np.int64) * NS
+    temp = 10.0 + 0.1 * (th - T0_NS) / NS
+    temp_at = np.interp(t_s, (th - T0_NS) / NS, temp)
+    gyro = 1e-3 + 2e-4 * (temp_at - 25.0) + rng.normal(0.0, 1e-4, n)
+    values = np.column_stack([gyro, np.zeros((n, 4)), np.full(n, 9.81)])
+    bag = write_bag(tmp_path / "sweep", "sqlite3", [
+        Topic("/imu", "sensor_msgs/msg/Imu", header, header, values),
+        Topic("/temp", "sensor_msgs/msg/Temperature", th, th, temp.reshape(-1, 1)),
+    ])  # fmt: skip
+    csv = tmp_path / "sweep.csv"
+    pd.DataFrame({"time": t_s, "gyro_x": gyro, "temperature": temp_at}).to_csv(
+        csv, index=False, float_format="%.17g"
+    )
+    fit = ["fit", "--model", "poly", "--order", "1", "--signal", "gyro_x",
+           "--temps", "temperature"]  # fmt: skip
+    assert main([*fit, str(bag), "--topic", "/imu", "-o", str(tmp_path / "b.json")]) == 0
+    assert main([*fit, str(csv), "--signal-unit", "rad/s", "--temp-unit", "degC",
+                 "-o", str(tmp_path / "c.json")]) == 0  # fmt: skip
+    b, c = (json.loads((tmp_path / f).read_text()) for f in ("b.json", "c.json"))
+    for cb, cc in zip(b["coefficients"], c["coefficients"], strict=True):
+        assert cb["name"] == cc["name"] and cb["unit"] == cc["unit"]
+        assert cb["value"] == pytest.approx(cc["value"], rel=1e-9, abs=1e-9)
+    slope = next(x for x in b["coefficients"] if x["name"] == "T1")
+    assert slope["unit"] == "deg/h/degC"  # 2e-4 rad/s/°C = 41.25 °/h/°C
+    assert slope["value"] == pytest.approx(math.degrees(2e-4) * 3600, rel=0.01)

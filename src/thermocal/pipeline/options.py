@@ -95,6 +95,9 @@ class FitOptions:
         Field separator of a text log (detected when None).
     decimal : {".", ","}, optional
         Decimal mark of a text log (detected when None).
+    stamp : {"header", "receive"}
+        Time of a ROS bag's messages: their header stamp (default) or the bag's receive
+        time.
 
     Raises
     ------
@@ -136,6 +139,7 @@ class FitOptions:
     on_bad_lines: Literal["error", "skip"] = "error"
     delimiter: str | None = None
     decimal: Literal[".", ","] | None = None
+    stamp: Literal["header", "receive"] = "header"
 
     def __post_init__(self) -> None:
         set_ = object.__setattr__  # frozen: normalise in place once
@@ -288,7 +292,7 @@ def _read_options(
         temp_conversion=o.temp_conversion,
         topic=o.topic, names=o.names, rate_hz=o.rate_hz,
         on_bad_lines=o.on_bad_lines,
-        delimiter=o.delimiter, decimal=o.decimal,
+        delimiter=o.delimiter, decimal=o.decimal, stamp=getattr(o, "stamp", "header"),
     )  # fmt: skip
     return ReadOptions(**given)
 
