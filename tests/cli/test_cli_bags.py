@@ -176,6 +176,11 @@ def test_empty_bags_and_a_folder_without_metadata(
     for kind in KINDS:
         path = write_bag(tmp_path / ("e.bag" if kind == "ros1" else f"e{kind}"), kind, [])
         assert "the bag holds no topics" in _refused(path, capsys)
+        none = Topic("/imu", "sensor_msgs/msg/Imu", np.zeros(0, np.int64),
+                     np.zeros(0, np.int64), np.zeros((0, 6)))  # fmt: skip
+        path = write_bag(tmp_path / ("n.bag" if kind == "ros1" else f"n{kind}"), kind, [none])
+        line = _refused(path, capsys)
+        assert "topic /imu holds no messages; choose another with --topic" in line
     folder = _small(tmp_path, "sqlite3")
     (folder / "metadata.yaml").unlink()
     line = _refused(folder, capsys)
