@@ -330,6 +330,11 @@ def _size(path: Path) -> int:
     return path.stat().st_size
 
 
+_OTHER_SCHEMAS = frozenset({"ros1msg", "protobuf", "flatbuffer", "jsonschema"})
+"""MCAP's well-known schema encodings other than ROS 2's (MCAP specification, appendix:
+well-known encodings), which rosbags does not read."""
+
+
 def _unreadable(path: Path, exc: BaseException) -> str:
     """One line for a bag rosbags could not read."""
     msg = " ".join(str(exc).split())[:200] or type(exc).__name__
@@ -338,7 +343,7 @@ def _unreadable(path: Path, exc: BaseException) -> str:
             f"{path}: a ROS 2 bag folder needs its metadata.yaml (not found); give the "
             ".db3 or .mcap storage file itself instead"
         )
-    if isinstance(exc, KeyError) and exc.args and exc.args[0] not in ("ros2msg", "ros2idl"):
+    if isinstance(exc, KeyError) and exc.args and exc.args[0] in _OTHER_SCHEMAS:
         return (
             f"{path}: an MCAP file whose message definitions are {exc.args[0]!r}, not ROS 2 "
             "(ros2msg, ros2idl): not read; record it with ROS 2 (ros2 bag record -s mcap) "
