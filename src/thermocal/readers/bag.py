@@ -365,11 +365,10 @@ class _Repaired:
 def _repair(path: Path, topic: str, s: _Series, stamp: Stamp) -> _Repaired:
     """Stamps sorted (stably), exact duplicates (same stamp, same values) dropped; a stamp
     repeated with other values is an error."""
-    header = np.concatenate(s.header) if s.header else np.empty(0, np.int64)
-    receive = np.concatenate(s.receive) if s.receive else np.empty(0, np.int64)
-    s.header, s.receive = [], []
-    t = header if stamp == "header" else receive
-    del header, receive
+    chosen = s.header if stamp == "header" else s.receive
+    s.header, s.receive = [], []  # the other stamps released unread
+    t = np.concatenate(chosen) if chosen else np.empty(0, np.int64)
+    del chosen
     back = int(np.count_nonzero(np.diff(t) < 0))
     order = np.argsort(t, kind="stable") if back else None
     if order is not None:
