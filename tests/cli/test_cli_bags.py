@@ -285,7 +285,7 @@ def test_fit_of_a_bag_folder_equals_the_fit_of_the_csv(
            "--temps", "temperature"]  # fmt: skip
     assert main([*fit, str(bag), "--topic", "/imu", "-o", str(tmp_path / "b.json")]) == 0
     assert main([*fit, str(csv), "--signal-unit", "rad/s", "--temp-unit", "degC",
-                 "-o", str(tmp_path / "c.json")]) == 0  # fmt: skip
+                 "--time-unit", "s", "-o", str(tmp_path / "c.json")]) == 0  # fmt: skip
     b, c = (json.loads((tmp_path / f).read_text()) for f in ("b.json", "c.json"))
     for cb, cc in zip(b["coefficients"], c["coefficients"], strict=True):
         assert cb["name"] == cc["name"] and cb["unit"] == cc["unit"]
@@ -293,3 +293,12 @@ def test_fit_of_a_bag_folder_equals_the_fit_of_the_csv(
     slope = next(x for x in b["coefficients"] if x["name"] == "T1")
     assert slope["unit"] == "deg/h/degC"  # 2e-4 rad/s/°C = 41.25 °/h/°C
     assert slope["value"] == pytest.approx(math.degrees(2e-4) * 3600, rel=0.01)
+    # compensated from the bag (the receive stamps are the header stamps here), in the
+    # file's unit: the slope gone, the residual the simulated noise (1e-4 rad/s)
+    for stamp in ("header", "receive"):
+        out = tmp_path / f"comp_{stamp}.csv"
+        assert main(["compensate", str(tmp_path / "b.json"), str(bag), "--topic", "/imu",
+                     "--stamp", stamp, "-o", str(out)]) == 0  # fmt: skip
+        comp = pd.read_csv(out)["gyro_x_comp"].to_numpy()
+        assert np.std(comp) == pytest.approx(1e-4, rel=0.05)
+        assert abs(np.polyfit(temp_at, comp, 1)[0]) < 0.02 * 2e-4
