@@ -467,10 +467,10 @@ def read_bag(
 
     References
     ----------
-    - Open Robotics, ``sensor_msgs/Imu`` and ``sensor_msgs/Temperature`` message
-      definitions (``common_msgs``, ``common_interfaces``); REP 103, *Standard Units of
-      Measure and Coordinate Conventions*.
-    - Foxglove, *MCAP file format specification*; ROS Wiki, *Bags/Format/2.0*.
+    - T. Foote and M. Purvis, *REP 103: Standard Units of Measure and Coordinate
+      Conventions*, 2010; the ``sensor_msgs/Imu`` and ``sensor_msgs/Temperature`` message
+      definitions (ROS ``common_msgs``, ROS 2 ``common_interfaces``).
+    - ROS Wiki, *Bags/Format/2.0*; Foxglove, *MCAP File Format Specification*.
 
     Examples
     --------
