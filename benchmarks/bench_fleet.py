@@ -6,10 +6,15 @@
   ``make_model("poly", order=1)``, save the model) — the anchor, measured in the same run;
   the ratio fleet/loop (target ≤ 1.5, the default run; the fleet also writes the summary and
   the report, ≈ 1.4 s the loop does not) and the scaling from one worker to the default;
+  beside it, the loop of what ``thermocal fit`` does per unit (``fit_files``: the same fit
+  with the command's checks of the data, the fleet's work per unit), to tell the fleet's own
+  cost from the command's; best of 3 interleaved rounds (every job once per round), with
+  ``--before SRC`` the fleet of an older tree in the same rounds;
 * 20 units × 10⁷ samples with two workers: wall time and the peak resident memory of the
   driver and of its worker processes (``RUSAGE_CHILDREN``: the largest worker).
 
-Run: ``.venv/bin/python benchmarks/bench_fleet.py [--units 200] [--rows 100000] [--skip-big]``.
+Run: ``.venv/bin/python benchmarks/bench_fleet.py [--units 200] [--rows 100000] [--skip-big]
+[--quick] [--repeat 3] [--before OLD/src]``.
 Files go to ``benchmarks/_data/fleet_*`` (git-ignored).
 """
 
@@ -22,6 +27,7 @@ import shutil
 import subprocess
 import sys
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -58,60 +64,116 @@ def write_batch(units: int, rows: int) -> Path:
     return cfg
 
 
-def library_loop(cfg: Path, out: Path) -> float:
-    """The anchor: one process, per unit read + fit + save, no fleet machinery."""
-    code = f"""
-import time, tomllib
+LOOP_CODE = """
+import sys, time, tomllib
 from pathlib import Path
 from threadpoolctl import threadpool_limits
 from thermocal.readers.dispatch import read_recording
 from thermocal.models.base import RunData
 from thermocal.models.registry import make_model
 from thermocal.pipeline.model_file import save_model
-cfg = Path({str(cfg)!r}); out = Path({str(out)!r}); out.mkdir(parents=True, exist_ok=True)
+from thermocal.fleet.config import load_config
+from thermocal.pipeline.fit import fit_files
+cfg = Path(sys.argv[1]); out = Path(sys.argv[2]); out.mkdir(parents=True, exist_ok=True)
+pipeline = sys.argv[3] == "pipeline"
 doc = tomllib.loads(cfg.read_text())
+opts = load_config(cfg).fit
 t0 = time.perf_counter()
 with threadpool_limits(limits=1):
     for u in doc["unit"]:
-        rec = read_recording(cfg.parent / u["modeling"][0])
+        path = cfg.parent / u["modeling"][0]
+        if pipeline:
+            fit_files([path], opts, out / (u["id"] + ".json"))
+            continue
+        rec = read_recording(path)
         model = make_model("poly", order=1).fit([RunData.from_recording(rec, "gyro", ["T1"])])
         save_model(model, out / (u["id"] + ".json"))
 print(time.perf_counter() - t0)
 """
-    res = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+
+
+def library_loop(cfg: Path, out: Path, pipeline: bool = False) -> float:
+    """The anchor: one process, per unit read + fit + save, no fleet machinery (timed
+    after the imports).  ``pipeline``: per unit what ``thermocal fit`` does instead
+    (:func:`thermocal.pipeline.fit.fit_files`: the same fit with the command's checks of
+    the data, its warnings and the model file with its provenance), the work the fleet
+    asks of each unit."""
+    kind = "pipeline" if pipeline else "loop"
+    cmd = [sys.executable, "-c", LOOP_CODE, str(cfg), str(out), kind]
+    res = subprocess.run(cmd, capture_output=True, text=True, check=True)
     return float(res.stdout.split()[-1])
 
 
-def fleet(cfg: Path, out: Path, workers: int | None) -> tuple[float, float]:
+def fleet(cfg: Path, out: Path, workers: int | None, src: str | None = None) -> tuple[float, float]:
     """(wall seconds, peak MB of the largest process) of ``thermocal fleet`` (``workers``
-    None: the default, one worker process per CPU)."""
+    None: the default, one worker process per CPU; ``src``: the package of that folder)."""
     shutil.rmtree(out, ignore_errors=True)
     cmd = [*THERMOCAL, "fleet", str(cfg), "-o", str(out)]
     if workers is not None:
         cmd += ["--workers", str(workers)]
-    return measure(cmd)
+    if src is None:
+        return measure(cmd)
+    old = os.environ.get("PYTHONPATH")
+    os.environ["PYTHONPATH"] = src  # measure() passes this environment on
+    try:
+        return measure(cmd)
+    finally:
+        if old is None:
+            del os.environ["PYTHONPATH"]
+        else:
+            os.environ["PYTHONPATH"] = old
+
+
+def rounds(cfg: Path, repeat: int, before: str | None) -> dict[str, tuple[float, float]]:
+    """Best of ``repeat`` interleaved rounds (each: every job once, in turn) of the anchors
+    and the fleet, (seconds, peak MB); with ``before``, the fleet of that tree too."""
+    jobs: dict[str, Any] = {
+        "loop": lambda: (library_loop(cfg, DATA / "fleet_loop_out"), 0.0),
+        "pipeline": lambda: (library_loop(cfg, DATA / "fleet_loop_out", pipeline=True), 0.0),
+        "fleet": lambda: fleet(cfg, DATA / "fleet_out_2", None),
+        "fleet -w1": lambda: fleet(cfg, DATA / "fleet_out_1", 1),
+    }
+    if before is not None:
+        jobs["fleet (before)"] = lambda: fleet(cfg, DATA / "fleet_out_2", None, before)
+        jobs["fleet -w1 (before)"] = lambda: fleet(cfg, DATA / "fleet_out_1", 1, before)
+    best: dict[str, tuple[float, float]] = {}
+    for _ in range(repeat):
+        for name, job in jobs.items():
+            t, mb = job()
+            if name not in best or t < best[name][0]:
+                best[name] = (t, mb)
+    return best
 
 
 def main() -> int:
     ap = argparse.ArgumentParser()
     ap.add_argument("--units", type=int, default=200)
     ap.add_argument("--rows", type=int, default=100_000)
+    ap.add_argument("--quick", action="store_true", help="60 units, best of 2")
+    ap.add_argument("--repeat", type=int, default=3, help="interleaved rounds (best of)")
+    ap.add_argument("--before", metavar="SRC", help="also the fleet of the package in SRC")
     ap.add_argument("--skip-big", action="store_true", help="skip 20 units × 10⁷ samples")
     args = ap.parse_args()
+    units, repeat = (60, 2) if args.quick else (args.units, args.repeat)
     print(f"load average {os.getloadavg()[0]:.2f}, {os.cpu_count()} cores")
-    cfg = write_batch(args.units, args.rows)
-    t_loop = library_loop(cfg, DATA / "fleet_loop_out")
-    t1, mb1 = fleet(cfg, DATA / "fleet_out_1", 1)
-    t2, mb2 = fleet(cfg, DATA / "fleet_out_2", None)
-    print(f"{args.units} units x {args.rows} samples:")
-    print(f"  library loop, one process           {t_loop:7.2f} s")
-    print(f"  thermocal fleet --workers 1         {t1:7.2f} s  ({t1 / t_loop:.2f}x the loop; "
-          f"peak {mb1:.0f} MB)")  # fmt: skip
-    print(f"  thermocal fleet (default: {os.cpu_count()} workers) {t2:7.2f} s  "
-          f"({t2 / t_loop:.2f}x the loop; {t1 / t2:.2f}x faster than 1 worker; "
-          f"peak {mb2:.0f} MB)")  # fmt: skip
+    cfg = write_batch(units, args.rows)
+    best = rounds(cfg, repeat, args.before)
+    t_loop, t_pipe = best["loop"][0], best["pipeline"][0]
+    print(f"{units} units x {args.rows} samples, best of {repeat} interleaved rounds "
+          f"(load {os.getloadavg()[0]:.2f} at the end):")  # fmt: skip
+    print(f"  library loop (read, fit, save), one process   {t_loop:7.2f} s")
+    print(f"  fit pipeline loop (fit_files), one process     {t_pipe:7.2f} s  "
+          f"({t_pipe / t_loop:.2f}x the library loop)")  # fmt: skip
+    for name in best:
+        if not name.startswith("fleet"):
+            continue
+        t, mb = best[name]
+        label = f"thermocal {name}".replace("-w1", "--workers 1")
+        print(f"  {label:<46s} {t:7.2f} s  ({t / t_loop:.2f}x the loop, "
+              f"{t / t_pipe:.2f}x the pipeline loop; peak {mb:.0f} MB)")  # fmt: skip
+    t2 = best["fleet"][0]
     ok = t2 / t_loop <= 1.5
-    print(f"  target (fleet, default workers, within 1.5x the library loop): "
+    print(f"  target (fleet, default {os.cpu_count()} workers, within 1.5x the library loop): "
           f"{'met' if ok else 'NOT met'}")  # fmt: skip
     if not args.skip_big:
         big = write_batch(20, 10_000_000)

@@ -191,6 +191,12 @@ def refuse_special(path: str | Path, what: str = "the output") -> None:
         raise ThermocalInputError(f"{path}: refusing to write {what} there: {why}")
 
 
+def _parts(resolved: Path) -> tuple[str, ...]:
+    """The components of a resolved path as ``is_relative_to`` compares them (case folded
+    where the system folds case), for a comparison by tuple prefix."""
+    return tuple(os.path.normcase(part) for part in resolved.parts)
+
+
 def _inputs(inputs: Iterable[str | Path]) -> list[_Input]:
     from thermocal.outputs import sidecar_path
 
@@ -274,6 +280,10 @@ def check_outputs(
     }
 
     stations = _station_folders(inputs)
+    in_parts = [(i, _parts(i.resolved)) for i in ins]  # a batch: units x inputs comparisons
+    by_path: dict[Path, _Input] = {}
+    for i in ins:
+        by_path.setdefault(i.resolved, i)  # the first input of that path names it
 
     def refuse(target: Path, why: str) -> None:
         raise ThermocalInputError(f"{target}: refusing to write {what} there: {why}")
@@ -286,7 +296,7 @@ def check_outputs(
         inside = next((d for d in stations if r.is_relative_to(d)), None)
         if inside is not None:
             refuse(target, f"it is inside the input station recording {inside}")
-        hit = next((i for i in ins if i.resolved == r), None)
+        hit = by_path.get(r)
         link = ""
         if hit is None and target.exists():
             hit = by_inode.get(_inode(target))
@@ -300,8 +310,9 @@ def check_outputs(
         """``folder`` is replaced or deleted: no input may be in it."""
         not_input(folder, folder=is_dir)
         r = folder.resolve()
-        for i in ins:
-            if i.resolved.is_relative_to(r):
+        top = _parts(r)
+        for i, parts in in_parts:
+            if parts[: len(top)] == top:  # inside (or equal to) the folder
                 refuse(folder, f"it contains {i.label}, which would be deleted")
         if not folder.is_dir():
             return
@@ -399,7 +410,7 @@ def warn_formula_names(path: str | Path, names: Iterable[str], what: str = "colu
     Parameters
     ----------
     path : str or pathlib.Path
-        The output; only a ``.csv`` is concerned.
+        The output; only a CSV (``.csv``, or ``.csv.gz`` unpacked into one) is concerned.
     names : iterable of str
         The column (or other) names written into it.
     what : str
@@ -414,7 +425,7 @@ def warn_formula_names(path: str | Path, names: Iterable[str], what: str = "colu
 
     from thermocal.errors import ThermocalWarning
 
-    if Path(path).suffix.lower() != ".csv":
+    if not Path(path).name.lower().endswith((".csv", ".csv.gz")):
         return
     risky = [n for n in names if formula_risk(n)]
     if risky:

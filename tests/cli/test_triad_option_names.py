@@ -5,6 +5,7 @@ whose least-squares residuals are far beyond the white noise)."""
 
 from __future__ import annotations
 
+import json
 import warnings
 from pathlib import Path
 
@@ -67,3 +68,26 @@ def test_a_run_at_the_other_latitude_names_the_encoders_both_ways(
         "zeros (--alpha-offset); nothing written"
     )
     assert not (tmp_path / "res.json").exists()
+
+
+def test_an_encoder_zero_off_by_two_degrees_is_warned_with_the_option_in_the_json(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The α encoder read 2° more than the geometry's angle (an encoder zero off, the case
+    the warning is for): the library's result names ``alpha_offset_deg``; the command's
+    ``--json`` and its ``warning:`` line name ``--alpha-offset``, with the same value."""
+    rec, _ = simulate_turntable16(3, rate_hz=10.0, dwell_s=20.0, latitude_deg=40.0)
+    rec = rec.with_columns({"alpha_deg": rec.columns["alpha_deg"] + 2.0}, {"alpha_deg": "deg"})
+    with pytest.warns(UserWarning, match="alpha_offset_deg"):
+        res = calibrate(rec, latitude_deg=40.0, min_dwell_s=15.0)
+    (said,) = [w for w in res.warnings if "encoder's zero" in w]
+    assert "declare it with alpha_offset_deg " in said and "--alpha-offset" not in said
+    f = tmp_path / "run.csv"
+    write_recording(rec, f)
+    code = main(["turntable", str(f), "--latitude", "40", "--min-dwell", "15",
+                 "-o", str(tmp_path / "res.json"), "--json"])  # fmt: skip
+    assert code == 0
+    out, err = capsys.readouterr()
+    (shown,) = [w for w in json.loads(out)["warnings"] if "encoder's zero" in w]
+    assert shown == said.replace("alpha_offset_deg", "--alpha-offset")
+    assert any("--alpha-offset" in ln for ln in err.splitlines() if ln.startswith("warning:"))

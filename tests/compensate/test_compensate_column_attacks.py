@@ -4,6 +4,7 @@ and in Parquet without one."""
 
 from __future__ import annotations
 
+import gzip
 import hashlib
 from pathlib import Path
 
@@ -78,12 +79,14 @@ def _injected_run(path: Path, name: str = INJECTED) -> tuple[np.ndarray, np.ndar
     return back["T"].to_numpy(), back[name].to_numpy()
 
 
+@pytest.mark.parametrize("out_name", ["out.csv", "out.csv.gz"])
 def test_compensate_csv_keeps_a_formula_name_and_warns(
-    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], out_name: str
 ) -> None:
     """compensate's CSV is data for a program: the column name round-trips exactly, and one
-    ``warning:`` names the output, the column and the risk; the compensated values are the
-    residual of a straight line fitted here with numpy."""
+    ``warning:`` names the output, the column and the risk (a gzip CSV too: unpacked, a
+    spreadsheet opens it); the compensated values are the residual of a straight line
+    fitted here with numpy."""
     temp, sig = _injected_run(tmp_path / "d.csv")
     model = tmp_path / "m.json"
     code = main(["fit", str(tmp_path / "d.csv"), "--model", "poly", "--order", "1",
@@ -92,7 +95,7 @@ def test_compensate_csv_keeps_a_formula_name_and_warns(
     assert code == 0, capsys.readouterr().err
     capsys.readouterr()
     before = _digests(tmp_path)
-    out = tmp_path / "out.csv"
+    out = tmp_path / out_name
     code = main(["compensate", str(model), str(tmp_path / "d.csv"), "-o", str(out)])
     _o, err = capsys.readouterr()
     assert code == 0, err
@@ -120,3 +123,23 @@ def test_compensate_parquet_with_a_formula_name_says_nothing(
     code = main(["compensate", str(model), str(tmp_path / "d.csv"), "-o", str(out)])
     _o, err = capsys.readouterr()
     assert code == 0 and "warning:" not in err, err
+
+
+def test_compensate_to_csv_gz_writes_gzip_of_the_same_csv(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """An output named ``.csv.gz`` is a gzip stream whose content is byte for byte the
+    ``.csv`` output (it was written as plain text under the ``.gz`` name); no file name or
+    time in its header, so two runs give the same bytes."""
+    _injected_run(tmp_path / "d.csv", name="gyro")
+    model = tmp_path / "m.json"
+    assert main(["fit", str(tmp_path / "d.csv"), "--model", "poly", "--order", "1",
+                 "--signal", "gyro", "--signal-unit", "deg/s", "--time-unit", "s",
+                 "--temps", "T", "--temp-unit", "degC", "-o", str(model)]) == 0  # fmt: skip
+    outs = [tmp_path / n for n in ("o.csv", "o1.csv.gz", "o2.csv.gz")]
+    for out in outs:
+        assert main(["compensate", str(model), str(tmp_path / "d.csv"), "-o", str(out)]) == 0
+    capsys.readouterr()
+    plain, gz1, gz2 = (p.read_bytes() for p in outs)
+    assert gz1[:2] == b"\x1f\x8b" and gzip.decompress(gz1) == plain
+    assert gz1 == gz2

@@ -397,7 +397,7 @@ def test_nothing_below_the_cli_imports_it() -> None:
     bad = [
         f"{m}:{imp.line} imports {imp.target}"
         for m in sorted(graph)
-        if not _in(m, (CLI,))
+        if not _in(m, (CLI, "thermocal.__main__"))  # ``python -m thermocal`` runs the CLI
         for imp in graph[m].imports
         if _in(imp.target, (CLI,))
     ]

@@ -27,7 +27,7 @@ def test_to_dict_turns_nan_and_empty_into_none() -> None:
 
 def test_text_one_line_each() -> None:
     assert _check().text() == [
-        "chamber modbus: temperature 25.5 °C, set-point None °C",
+        "chamber modbus: temperature 25.5 °C, set-point not reported",
         "sensor imu (/dev/ttyUSB0): 100.0 Hz, 20 lines (1 bad), first: 1,2,3",
         "sensor baro (/dev/ttyUSB1): NO ANSWER: no data",
     ]

@@ -68,11 +68,13 @@ def _register(modules: tuple[str, ...] = COMMAND_MODULES) -> None:
 
 
 def _modules_for(args: list[str]) -> tuple[str, ...]:
-    """The command modules a run needs: the named command's; none for ``--version``
-    alone; all for help, no command or an unknown one."""
+    """The command modules a run needs: the named command's; none without a command
+    (``--version``, ``--help`` and no arguments list the commands from their summaries,
+    :data:`~thermocal.cli.application.COMMAND_SUMMARIES`); all for an unknown command (the
+    error suggests the names close to it)."""
     first = next((a for a in args if not a.startswith("-")), None)
     if first is None:
-        return () if "--version" in args and "--help" not in args else COMMAND_MODULES
+        return ()
     mod = COMMANDS.get(first)
     return (mod,) if mod is not None else COMMAND_MODULES
 
@@ -110,6 +112,24 @@ def _click_command() -> Any:
     if key not in _CLICK:
         _CLICK[key] = typer.main.get_command(_app)
     return _CLICK[key]
+
+
+def command_summaries() -> dict[str, str]:
+    """Each command's summary as the registered modules give it (every module imported), in
+    the order ``--help`` lists them: what
+    :data:`~thermocal.cli.application.COMMAND_SUMMARIES` must hold.
+
+    Returns
+    -------
+    dict of str to str
+        Command name → the part of its help its summary shows
+        (:func:`~thermocal.cli.application.summary_of`).
+    """
+    from thermocal.cli.application import summary_of
+
+    _register()
+    group = _click_command()
+    return {name: summary_of(cmd.help) for name, cmd in group.commands.items()}
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -150,4 +170,4 @@ def main(argv: list[str] | None = None) -> int:
     return result if isinstance(result, int) else 0
 
 
-__all__ = ["app", "main"]
+__all__ = ["app", "command_summaries", "main"]

@@ -36,6 +36,7 @@ from thermocal.cli.common import (
 )
 from thermocal.defaults import overrides_of
 from thermocal.errors import ThermocalInputError
+from thermocal.pipeline.messages import option_name
 from thermocal.report import triad_text as _triad_text
 
 if TYPE_CHECKING:
@@ -194,9 +195,11 @@ def turntable_cmd(
         files, output, opts, order=order, tref_c=tref, overrides=overrides_of(allow_narrow, False)
     )
     if isinstance(res, _files.ThermalRunsResult):
-        emit(res.to_dict(), as_json, lambda: show(_triad_text.turntable_thermal_text(res)))
+        emit(
+            res.to_dict(option_name), as_json, lambda: show(_triad_text.turntable_thermal_text(res))
+        )
     else:
-        emit(res.to_dict(), as_json, lambda: show(_triad_text.turntable_text(res)))
+        emit(res.to_dict(option_name), as_json, lambda: show(_triad_text.turntable_text(res)))
 
 
 __all__ = ["turntable_cmd"]

@@ -31,6 +31,7 @@ from thermocal.models.format import model_file_dict
 from thermocal.models.poly import PolyModel
 from thermocal.models.rundata import RunData, model_inputs
 from thermocal.pipeline.compensate import compensate_channels
+from thermocal.pipeline.messages import warning_text
 from thermocal.pipeline.model_file import save_calibration
 from thermocal.report.calibration import CalibrationReportInputs, write_calibration_report
 from thermocal.report.text import Block, TextTable, fmt
@@ -186,7 +187,7 @@ def _fit_channels(mod: Recording) -> tuple[Calibration, dict[str, list[str]]]:
         what = f"gravity {g_mg:+g} mg ({GRAVITY_AXIS} up)" if g_mg else "none"
         model.inputs_ = model_inputs(mod, name, [TEMP], known_input=g_mg, known_input_what=what)
         channels.append(Channel(name, name, unit, model, guess_role(name, unit)))
-        fit_warnings[name] = [str(w.message) for w in caught]
+        fit_warnings[name] = [warning_text(w.message) for w in caught]
     return Calibration(channels), fit_warnings
 
 
@@ -206,7 +207,7 @@ def _validate_channels(
                 zero_reference=zero_reference(ch.model, val.meta),  # as thermocal validate
             )  # fmt: skip
         results[ch.name] = res.in_unit(mrun.data_unit, mrun.factor)
-        fit_warnings[ch.name] += [str(w.message) for w in caught]
+        fit_warnings[ch.name] += [warning_text(w.message) for w in caught]
     return results
 
 

@@ -62,6 +62,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Final, TypeVar, cast
 
+from thermocal._lazy import prefetch
 from thermocal.errors import ParameterError, ThermocalInputError, ThermocalWarning
 from thermocal.fleet.config import FleetConfig, Limit, UnitSpec, load_config
 from thermocal.fleet.report import write_fleet_report
@@ -146,6 +147,8 @@ class UnitOutcome:
         The worker that did it.
     figures : dict
         Per channel, the figures of :func:`channel_figures` [the channel's data unit].
+    inputs : dict of str to str or None
+        SHA-256 of the unit's inputs (:func:`unit_inputs`), taken before it was fitted.
     """
 
     id: str
@@ -159,6 +162,8 @@ class UnitOutcome:
     worker: str = ""
     figures: dict[str, dict[str, Any]] = field(default_factory=dict)
     """Per channel, in the channel's data unit (:func:`channel_figures`)."""
+    inputs: dict[str, str | None] = field(default_factory=dict)
+    """SHA-256 of the unit's inputs, taken where it ran (the workers hash in parallel)."""
 
 
 _CAPTURE_LOCK = threading.Lock()
@@ -214,6 +219,7 @@ def run_unit(task: UnitTask) -> UnitOutcome:
     t0 = time.perf_counter()
     u = task.unit
     outcome = UnitOutcome(u.id, "failed", worker=f"{os.uname().nodename}:{os.getpid()}")
+    outcome.inputs = unit_inputs(u)  # before the fit: a file changed during it is seen stale
     with (
         _CAPTURE_LOCK,
         threadpool_limits(limits=1),
@@ -1408,6 +1414,10 @@ def run_fleet(
     redo: dict[str, str] = {}
     inputs: dict[str, dict[str, str | None]] = {}
     for u in config.units:
+        folder = unit_dir(out, u.id)
+        if not (folder.exists() or folder.is_symlink()):  # never run: hashed where it runs
+            todo.append(UnitTask(u, _fit_options(config), config.validate))
+            continue
         inputs[u.id] = unit_inputs(u)
         reasons = stale_reasons(out, config, u, inputs[u.id])
         if reasons is not None and not reasons and not force:
@@ -1420,9 +1430,12 @@ def run_fleet(
     failed: list[str] = []
     interrupted: str | None = None
     try:
+        if workers > 1 or scheduler:  # the driver waits for the workers meanwhile
+            prefetch("pandas", "matplotlib.figure")  # for the summary and the report
         for outcome in run(todo):
+            hashed = inputs.get(outcome.id) or outcome.inputs or None
             record = unit_record(
-                outcome, config, inputs=inputs[outcome.id], redone_because=redo.get(outcome.id)
+                outcome, config, inputs=hashed, redone_because=redo.get(outcome.id)
             )
             write_unit(out, outcome, record)
             ran.append(outcome.id)

@@ -31,6 +31,8 @@ column's own unit.  A model and data of different kinds (°/h against mg) is a
 from __future__ import annotations
 
 import dataclasses
+import gzip
+import io
 import json
 import math
 import warnings
@@ -388,11 +390,35 @@ class _CsvChunks:
             self._fh.close()
 
 
+class _GzipCsvChunks(_CsvChunks):
+    """Writes chunks to a gzip-compressed CSV file (``out.csv.gz``): no name or time in the
+    gzip header, so the same input gives the same bytes."""
+
+    def write(self, chunk: pd.DataFrame | pa.RecordBatch) -> None:
+        if self._fh is None:
+            self._file = open(self.tmp, "wb")  # noqa: SIM115
+            raw = gzip.GzipFile(filename="", mode="wb", fileobj=self._file, mtime=0)
+            self._fh = io.TextIOWrapper(raw, encoding="utf-8", newline="")
+        super().write(chunk)
+
+    def close(self) -> None:
+        if self._fh is not None:
+            self._fh.close()  # flushes and ends the gzip stream, which leaves the file open
+            self._file.close()
+
+
 _CHUNK_WRITERS: dict[str, type[_ParquetChunks] | type[_CsvChunks]] = {
     "parquet": _ParquetChunks,
     "csv": _CsvChunks,
 }
 """The chunked writer of each output format :func:`thermocal.writers.written_format` names."""
+
+
+def _chunk_writer(kind_out: str, dst: Path) -> type[_ParquetChunks] | type[_CsvChunks]:
+    """The chunked writer of ``dst``: its format's, gzip-compressed for a ``.csv.gz``."""
+    if kind_out == "csv" and dst.name.lower().endswith(".gz"):
+        return _GzipCsvChunks
+    return _CHUNK_WRITERS[kind_out]
 
 
 def compensate_file(
@@ -595,7 +621,7 @@ def compensate_channels(
     state = _PassState()
     run = _ChannelPass(source, plans, _evaluation_groups(plans), units.TIME_UNITS[t_unit],
                        chunk_rows, on_progress, state)  # fmt: skip
-    atomic_write_path(dst, lambda tmp: run.write(tmp, kind_out, out_info))
+    atomic_write_path(dst, lambda tmp: run.write(tmp, _chunk_writer(kind_out, dst), out_info))
     if _CHUNK_WRITERS[kind_out].sidecar:
         write_json(sidecar_path(dst), out_info)
     for plan in plans:
@@ -700,12 +726,14 @@ class _ChannelPass:
     on_progress: Callable[[int], None] | None
     state: _PassState
 
-    def write(self, tmp: Path, kind_out: str, out_info: dict[str, Any]) -> None:
+    def write(
+        self, tmp: Path, writer: type[_ParquetChunks] | type[_CsvChunks], out_info: dict[str, Any]
+    ) -> None:
         """Every chunk compensated and written to ``tmp``; the previous chunk is written on
         a second thread while this one is computed (pyarrow and numpy release the GIL);
         one chunk in flight, errors re-raised here."""
         src, state = self.source.src, self.state
-        w = _CHUNK_WRITERS[kind_out](tmp, out_info)
+        w = writer(tmp, out_info)
         pool = ThreadPoolExecutor(max_workers=1, thread_name_prefix="thermocal-write")
         pending: Future[None] | None = None
         try:
@@ -1174,8 +1202,8 @@ def compensate_triads(
     warn_formula_names(dst, source.names)
     state = _PassState()
     atomic_write_path(
-        dst, lambda tmp: _write_triads(tmp, source, kind_out, out_info, plans, resolved,
-                                       chunk_rows, state)
+        dst, lambda tmp: _write_triads(tmp, source, _chunk_writer(kind_out, dst), out_info,
+                                       plans, resolved, chunk_rows, state)
     )  # fmt: skip
     if _CHUNK_WRITERS[kind_out].sidecar:
         write_json(sidecar_path(dst), out_info)
@@ -1239,7 +1267,7 @@ def _triad_temperatures(plans: Sequence[_TriadPlan]) -> list[str]:
 def _write_triads(
     tmp: Path,
     source: _Source,
-    kind_out: str,
+    writer: type[_ParquetChunks] | type[_CsvChunks],
     out_info: dict[str, Any],
     plans: Sequence[_TriadPlan],
     resolved: units.ResolvedInputs,
@@ -1253,7 +1281,7 @@ def _write_triads(
     src = source.src
     t_factor = units.TIME_UNITS[resolved.time.unit]
     temp_names = _triad_temperatures(plans)
-    w = _CHUNK_WRITERS[kind_out](tmp, out_info)
+    w = writer(tmp, out_info)
     try:
         for chunk in source.chunks(chunk_rows):
             row0 = state.rows

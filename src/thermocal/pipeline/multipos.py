@@ -306,12 +306,14 @@ def _unit_of(
 def _read_poses(poses: Path | None) -> dict[str, Any] | None:
     """The POSES file's JSON object (None without one); a ``.csv`` is imucal's section list
     as pandas writes it (``section_list.to_csv``: a header ``,start,end`` and one row
-    ``name,i,j`` per section)."""
+    ``name,i,j`` per section), and so is a file of another name (``.txt``, none) whose text
+    is not a JSON object or list."""
     if poses is None:
         return None
     try:
         text = poses.read_text(encoding="utf-8")
-        if poses.suffix.lower() == ".csv":
+        suffix = poses.suffix.lower()
+        if suffix == ".csv" or (suffix != ".json" and not text.lstrip().startswith(("{", "["))):
             return _poses_csv(text, poses)
         doc: dict[str, Any] = json.loads(text)
     except (OSError, UnicodeDecodeError, ValueError) as exc:  # a 5000-digit integer too

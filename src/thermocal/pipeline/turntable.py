@@ -12,7 +12,7 @@ options as every other command (text logs, ULog/DataFlash topics).
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -225,9 +225,9 @@ class SingleRunResult:
     output: Path
     result: TurntableResult
 
-    def to_dict(self) -> dict[str, Any]:
-        """The result JSON, with ``input``."""
-        out: dict[str, Any] = self.result.to_dict()
+    def to_dict(self, spell: Callable[[str], str] | None = None) -> dict[str, Any]:
+        """The result JSON, with ``input``; ``spell`` as :meth:`TurntableResult.to_dict`."""
+        out: dict[str, Any] = self.result.to_dict(spell)
         out["input"] = str(self.input)
         return out
 
@@ -288,8 +288,13 @@ class ThermalRunsResult:
     accel: _thermal.TriadThermal | None
     adequacy: dict[str, Any]
 
-    def to_dict(self) -> dict[str, Any]:
+    def to_dict(self, spell: Callable[[str], str] | None = None) -> dict[str, Any]:
         """The result as JSON types (what the ``turntable`` command prints for several runs).
+
+        Parameters
+        ----------
+        spell : callable, optional
+            How the runs' warnings name a parameter (:meth:`TurntableResult.to_dict`).
 
         Returns
         -------
@@ -300,7 +305,7 @@ class ThermalRunsResult:
         out: dict[str, Any] = {
             "output": str(self.output),
             "format": "thermocal-calibration",
-            "runs": [{"input": str(f), **r.to_dict()} for f, r in self.runs],
+            "runs": [{"input": str(f), **r.to_dict(spell)} for f, r in self.runs],
             "gyro": triad_summary(self.gyro),
             "adequacy": self.adequacy,
         }

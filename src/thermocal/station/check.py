@@ -106,7 +106,7 @@ class StationCheck:
         list of str
         """
         c = self.to_dict()["chamber"]
-        head = (f"temperature {c['temperature_c']} °C, set-point {c['setpoint_c']} °C"
+        head = (f"temperature {_celsius(c['temperature_c'])}, set-point {_celsius(c['setpoint_c'])}"
                 if self.chamber_ok else f"NO ANSWER: {self.chamber_error}")  # fmt: skip
         lines = [f"chamber {self.chamber}: {head}"]
         for s in self.sensors:
@@ -115,6 +115,11 @@ class StationCheck:
                     if s.ok else f"NO ANSWER: {s.error}")  # fmt: skip
             lines.append(f"sensor {s.id} ({s.device}): {said}")
         return lines
+
+
+def _celsius(v: float | None) -> str:
+    """A temperature [°C] as shown, or "not reported" for a chamber that gives none."""
+    return "not reported" if v is None else f"{v} °C"
 
 
 def _nan_none(v: float) -> float | None:

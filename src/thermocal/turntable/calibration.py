@@ -12,7 +12,7 @@ from __future__ import annotations
 import dataclasses
 import math
 import warnings
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -129,7 +129,10 @@ class TurntableResult:
     weak_combinations : tuple of dict
         Poorly determined directions of the design.
     warnings : tuple of str
-        What the run was warned of.
+        What the run was warned of (parameters named as the library names them).
+    warning_templates : tuple of str
+        The same texts with ``{alpha_offset_deg}`` where the parameter goes, for a reader
+        that names it its own way (:meth:`to_dict`'s ``spell``).
     encoder_noise_arcsec, encoder_jitter_arcsec : float
         Encoder noise used and jitter found at rest [″].
     encoder_noise_source : str
@@ -160,6 +163,7 @@ class TurntableResult:
     normalised_innovation_rms: float
     weak_combinations: tuple[dict[str, Any], ...] = ()
     warnings: tuple[str, ...] = field(default=())
+    warning_templates: tuple[str, ...] = field(default=(), repr=False, compare=False)
     encoder_noise_arcsec: float = 0.0
     """σ of one encoder reading used by the filter and least squares [″]."""
     encoder_noise_source: str = "option"
@@ -177,8 +181,19 @@ class TurntableResult:
     temperature_span_c: float | None = None
     """Its range over the run (max − min) [°C]: a soak that drifts during the run."""
 
-    def to_dict(self) -> dict[str, Any]:
-        """JSON-ready dict of the result file's keys (from the Kalman filter)."""
+    def to_dict(self, spell: Callable[[str], str] | None = None) -> dict[str, Any]:
+        """JSON-ready dict of the result file's keys (from the Kalman filter).
+
+        Parameters
+        ----------
+        spell : callable, optional
+            How the warnings name a parameter (the command line: its option); without it,
+            as :attr:`warnings` (the parameter's own name).
+
+        Returns
+        -------
+        dict
+        """
         out: dict[str, Any] = {"format": RESULT_FORMAT, "version": RESULT_VERSION}
         out.update(self.kalman.to_dict())
         out["misalignment_names"] = list(model.MISALIGNMENT_NAMES)
@@ -209,7 +224,11 @@ class TurntableResult:
         out["unobservable"] = [dict(c) for c in CONSTRAINTS] + [
             dict(c) for c in self.weak_combinations
         ]
-        out["warnings"] = list(self.warnings)
+        out["warnings"] = (
+            [spell_parameters(m, ("alpha_offset_deg",), spell) for m in self.warning_templates]
+            if spell is not None and self.warning_templates
+            else list(self.warnings)
+        )
         if self.accel is not None:  # keys added only when asked: single-run JSON unchanged
             out["accel"] = self.accel.to_dict()
             out["gravity_m_s2"] = self.gravity_m_s2
@@ -575,6 +594,7 @@ def calibrate(
         msgs.extend(_accel_diagnostics(acc_est))
     msgs.extend(_judge(est, acc_est, str(rec.name), (alpha_column, alpha_offset_deg)))
     t_mean, t_span = _soak_temperature(rec, temperature_column)
+    templates = tuple(msgs)
     msgs = _warned(msgs, str(rec.name))
     return TurntableResult(
         kalman=estimate_from(est.kf.theta, est.kf.cov),
@@ -585,7 +605,7 @@ def calibrate(
         n_dwells=len(seg.dwells), min_dwell_s=float(min(d.duration_s for d in seg.dwells)),
         duration_s=rec.duration_s, chi2_per_dof=est.chi2_per_dof,
         normalised_innovation_rms=est.kf.normalised_innovation_rms,
-        weak_combinations=est.weak, warnings=tuple(msgs),
+        weak_combinations=est.weak, warnings=tuple(msgs), warning_templates=templates,
         encoder_noise_arcsec=float(encoder_noise_arcsec), encoder_noise_source=noise_source,
         encoder_jitter_arcsec=motion.noise_arcsec, encoder_quantum_deg=motion.quantum_deg,
         accel=acc_est, gravity_m_s2=g_local, temperature_c=t_mean, temperature_span_c=t_span,
