@@ -34,6 +34,7 @@ PAGES = (
     "tutorials/production-batch",
     "tutorials/station",
     "tutorials/notebook-poly",
+    "tutorials/ros-bags",
     "methods",
     "gallery",
     "cli",

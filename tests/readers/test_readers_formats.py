@@ -51,7 +51,8 @@ def test_a_station_folder_is_sniffed_before_suffixes(tmp_path: Path) -> None:
 def test_which_formats_stream_and_take_a_topic() -> None:
     by = {f.name: f for f in registered_formats()}
     assert {n for n, f in by.items() if f.chunks == "stream"} == {"csv", "parquet", "station"}
-    assert {n for n, f in by.items() if "topic" in f.options} == {"ulog", "dataflash", "station"}
+    topics = {"ulog", "dataflash", "station", "rosbag"}
+    assert {n for n, f in by.items() if "topic" in f.options} == topics
     assert "names" in by["csv"].options and "names" not in by["parquet"].options
     assert format_named("ulog").title == "a PX4 log"
     with pytest.raises(ParameterError, match="format 'xls' is not registered"):

@@ -21,6 +21,7 @@ from thermocal.cli.common import (
     RateOpt,
     SignalOpt,
     SignalUnitOpt,
+    StampOpt,
     TempConversionOpt,
     TempUnitOpt,
     TimeOpt,
@@ -232,6 +233,7 @@ def allan_cmd(
     temps: HiddenTempsOpt = None,
     t_names: NamesOpt = None,
     topic: TopicOpt = None,
+    stamp: StampOpt = "header",
     t_rate: RateOpt = None,
     t_bad: OnBadLinesOpt = "error",
     t_delim: DelimiterOpt = None,
@@ -263,7 +265,7 @@ def allan_cmd(
             temps=temps if temps is not None else "",  # no temperature column is read
             signal_unit=signal_unit, temp_unit=temp_unit, temp_conversion=temp_conversion,
             topic=topic, names=t_names, rate=t_rate, on_bad_lines=t_bad, delimiter=t_delim,
-            decimal=t_dec,
+            decimal=t_dec, stamp=stamp,
         )  # fmt: skip
         # the Allan deviation uses the time and the signal only
         rec = check_recording(_readers.read_recording(file, read, keep_other=False), read)

@@ -144,7 +144,8 @@ TopicOpt = Annotated[
         "--topic",
         "--sensor",
         help="Flight-controller log: the message/topic instance, NAME[.N] (default "
-        "sensor_gyro.0 for a .ulg); station recording folder: the sensor's ID.",
+        "sensor_gyro.0 for a .ulg); station recording folder: the sensor's ID; ROS bag or "
+        "MCAP: the Imu topic, or IMU_TOPIC,TEMPERATURE_TOPIC.",
     ),
 ]
 LogTopicOpt = Annotated[
@@ -156,6 +157,14 @@ LogTopicOpt = Annotated[
     ),
 ]
 """``--topic`` without ``--sensor`` (``report`` has its own ``--sensor``: the report's label)."""
+StampOpt = Annotated[
+    str,
+    typer.Option(
+        "--stamp",
+        help="ROS bag or MCAP: the time of each message, header (its header stamp, when the "
+        "sensor sampled) or receive (when the recorder wrote it).",
+    ),
+]
 NamesOpt = Annotated[
     str | None,
     typer.Option("--names", help="Text logs without a header row: the column names, a,b,c."),

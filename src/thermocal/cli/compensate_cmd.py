@@ -26,6 +26,7 @@ from thermocal.cli.common import (
     OutOpt,
     RateOpt,
     SignalUnitOpt,
+    StampOpt,
     TempConversionOpt,
     TempUnitOpt,
     TimeOpt,
@@ -74,6 +75,7 @@ def compensate_cmd(
         int, typer.Option("--chunk-rows", help="Rows read and written at a time.")
     ] = defaults.DEFAULT_CHUNK_ROWS,
     topic: TopicOpt = None,
+    stamp: StampOpt = "header",
     t_names: NamesOpt = None,
     t_rate: RateOpt = None,
     t_bad: OnBadLinesOpt = "error",
@@ -86,7 +88,7 @@ def compensate_cmd(
         read = read_options(
             time=time, time_unit=time_unit, signal_unit=signal_unit, temp_unit=temp_unit,
             temp_conversion=temp_conversion, topic=topic, names=t_names, rate=t_rate,
-            on_bad_lines=t_bad, delimiter=t_delim, decimal=t_dec,
+            on_bad_lines=t_bad, delimiter=t_delim, decimal=t_dec, stamp=stamp,
         )  # fmt: skip
         run = _compensate.compensate_calibration_file(
             model_file, file, output, read, signals=tuple(split_names(signal) or ()) or None,

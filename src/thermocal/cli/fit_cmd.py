@@ -51,6 +51,7 @@ from thermocal.cli.common import (
     RateOpt,
     SignalOpt,
     SignalUnitOpt,
+    StampOpt,
     TempConversionOpt,
     TempsOpt,
     TempUnitOpt,
@@ -293,7 +294,8 @@ _COMMON_LAST = (
     ("allow_narrow", AllowNarrowOpt, False), ("allow_motion", AllowMotionOpt, False),
     ("names", NamesOpt, None), ("topic", TopicOpt, None), ("rate", RateOpt, None),
     ("on_bad_lines", OnBadLinesOpt, "error"), ("delimiter", DelimiterOpt, None),
-    ("decimal", DecimalOpt, None), ("param", ParamOpt, None), ("as_json", JsonOpt, False),
+    ("decimal", DecimalOpt, None), ("stamp", StampOpt, "header"), ("param", ParamOpt, None),
+    ("as_json", JsonOpt, False),
 )  # fmt: skip
 """The options of ``fit`` every family shares, around the families' own."""
 

@@ -15,6 +15,7 @@ from thermocal.cli.common import (
     OnBadLinesOpt,
     RateOpt,
     SignalUnitOpt,
+    StampOpt,
     TempConversionOpt,
     TempsOpt,
     TempUnitOpt,
@@ -68,6 +69,7 @@ def inspect_cmd(
     ] = False,
     t_names: NamesOpt = None,
     topic: TopicOpt = None,
+    stamp: StampOpt = "header",
     t_rate: RateOpt = None,
     t_bad: OnBadLinesOpt = "error",
     t_delim: DelimiterOpt = None,
@@ -86,7 +88,7 @@ def inspect_cmd(
     read = read_options(
         time=time, time_unit=time_unit, signal=signal, temps=temps, signal_unit=signal_unit,
         temp_unit=temp_unit, temp_conversion=temp_conversion, topic=topic, names=t_names,
-        rate=t_rate, on_bad_lines=t_bad, delimiter=t_delim, decimal=t_dec,
+        rate=t_rate, on_bad_lines=t_bad, delimiter=t_delim, decimal=t_dec, stamp=stamp,
     )  # fmt: skip
     rec = _readers.read_recording(
         file,

@@ -19,6 +19,7 @@ from thermocal.cli.common import (
     RateOpt,
     SignalOpt,
     SignalUnitOpt,
+    StampOpt,
     TempConversionOpt,
     TempsOpt,
     TempUnitOpt,
@@ -102,6 +103,7 @@ def metrics_cmd(
     temp_conversion: TempConversionOpt = None,
     t_names: NamesOpt = None,
     topic: TopicOpt = None,
+    stamp: StampOpt = "header",
     t_rate: RateOpt = None,
     t_bad: OnBadLinesOpt = "error",
     t_delim: DelimiterOpt = None,
@@ -120,7 +122,7 @@ def metrics_cmd(
             time=time, time_unit=time_unit, signal=signal, temps=temps,
             signal_unit=signal_unit, temp_unit=temp_unit, temp_conversion=temp_conversion,
             topic=topic, names=t_names, rate=t_rate, on_bad_lines=t_bad, delimiter=t_delim,
-            decimal=t_dec,
+            decimal=t_dec, stamp=stamp,
         )  # fmt: skip
         # metrics use the signal and the temperatures only
         return check_recording(_readers.read_recording(file, r, keep_other=False), r)

@@ -17,6 +17,7 @@ from thermocal.cli.common import (
     NamesOpt,
     OnBadLinesOpt,
     RateOpt,
+    StampOpt,
     TimeOpt,
     TimeUnitOpt,
     TopicOpt,
@@ -115,6 +116,7 @@ def noise_cmd(
     time_unit: TimeUnitOpt = None,
     t_names: NamesOpt = None,
     topic: TopicOpt = None,
+    stamp: StampOpt = "header",
     t_rate: RateOpt = None,
     t_bad: OnBadLinesOpt = "error",
     t_delim: DelimiterOpt = None,
@@ -141,7 +143,7 @@ def noise_cmd(
         time=time, time_unit=time_unit, signal=",".join(g_names + a_names),
         signal_unit=_unit_list(gyro_unit, accel_unit, len(g_names), len(a_names)),
         topic=topic, names=t_names, rate=t_rate, on_bad_lines=t_bad, delimiter=t_delim,
-            decimal=t_dec,
+            decimal=t_dec, stamp=stamp,
     )  # fmt: skip
     rec = _readers.read_recording(
         file,

@@ -26,6 +26,7 @@ from thermocal.cli.common import (
     NamesOpt,
     OnBadLinesOpt,
     OutOpt,
+    StampOpt,
     TopicOpt,
     emit,
     handle_errors,
@@ -303,6 +304,7 @@ def correlate_cmd(
     ] = 10_000,
     t_names: NamesOpt = None,
     topic: TopicOpt = None,
+    stamp: StampOpt = "header",
     t_rate: TextRateOpt = None,
     t_bad: OnBadLinesOpt = "error",
     t_delim: DelimiterOpt = None,
@@ -317,6 +319,7 @@ def correlate_cmd(
         on_bad_lines=t_bad,
         delimiter=t_delim,
         decimal=t_dec,
+        stamp=stamp,
     )
     ta, xa, ca = _program.read_history(file_a, column, read)
     tb, xb, cb = _program.read_history(file_b, column_b if column_b is not None else column, read)

@@ -24,6 +24,7 @@ from thermocal.cli.common import (
     OnBadLinesOpt,
     RateOpt,
     SignalUnitOpt,
+    StampOpt,
     TempConversionOpt,
     TempUnitOpt,
     TimeOpt,
@@ -93,6 +94,7 @@ def report_cmd(
         ),
     ] = None,
     topic: LogTopicOpt = None,
+    stamp: StampOpt = "header",
     t_names: NamesOpt = None,
     t_rate: RateOpt = None,
     t_bad: OnBadLinesOpt = "error",
@@ -117,7 +119,7 @@ def report_cmd(
     read = read_options(
         time=time, time_unit=time_unit, signal_unit=signal_unit, temp_unit=temp_unit,
         temp_conversion=temp_conversion, topic=topic, names=t_names, rate=t_rate,
-        on_bad_lines=t_bad, delimiter=t_delim, decimal=t_dec,
+        on_bad_lines=t_bad, delimiter=t_delim, decimal=t_dec, stamp=stamp,
     )  # fmt: skip
     res = _report_files.make_report(
         model, recording, output, validations=list(validation or []), modeling=modeling,

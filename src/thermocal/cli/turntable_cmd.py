@@ -23,6 +23,7 @@ from thermocal.cli.common import (
     OnBadLinesOpt,
     OutOpt,
     RateOpt,
+    StampOpt,
     TimeOpt,
     TimeUnitOpt,
     TopicOpt,
@@ -160,6 +161,7 @@ def turntable_cmd(
     allow_narrow: AllowNarrowOpt = False,
     t_names: NamesOpt = None,
     topic: TopicOpt = None,
+    stamp: StampOpt = "header",
     t_rate: RateOpt = None,
     t_bad: OnBadLinesOpt = "error",
     t_delim: DelimiterOpt = None,
@@ -183,7 +185,8 @@ def turntable_cmd(
         temps, latitude, time, time_unit, gyro_unit, accel_unit, gravity, alpha, beta,
         encoder_unit, arw, encoder_noise, min_dwell, channels,
         read_options(
-            names=t_names, rate=t_rate, on_bad_lines=t_bad, delimiter=t_delim, decimal=t_dec
+            names=t_names, rate=t_rate, on_bad_lines=t_bad, delimiter=t_delim, decimal=t_dec,
+            stamp=stamp,
         ),
         topic,
         alpha_offset,

@@ -35,7 +35,8 @@ def file_sha256(path: str | Path, chunk: int = 1 << 20) -> str:
     Parameters
     ----------
     path : str or Path
-        A data file, or a station's recording folder (its closed parts hashed in order).
+        A data file, a station's recording folder (its closed parts hashed in order) or
+        another folder read as one recording (a ROS 2 bag: its files, by name).
     chunk : int, optional
         Bytes read at a time [B] (default 1 MiB).
 
@@ -51,8 +52,11 @@ def file_sha256(path: str | Path, chunk: int = 1 << 20) -> str:
     from thermocal.readers.station import is_station_path, station_files
 
     h = hashlib.sha256()
-    # a station's recording folder (DIR or DIR/SENSOR): its closed parts, in order
-    for f in station_files(Path(path)) if is_station_path(Path(path)) else [Path(path)]:
+    p = Path(path)
+    # a station's recording folder (DIR or DIR/SENSOR): its closed parts, in order; another
+    # folder a format reads (a ROS 2 bag): its files by name
+    files = [p] if not p.is_dir() else sorted(f for f in p.iterdir() if f.is_file())
+    for f in station_files(p) if is_station_path(p) else files:
         with open(f, "rb") as fh:
             while block := fh.read(chunk):
                 h.update(block)

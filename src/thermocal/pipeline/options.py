@@ -95,6 +95,9 @@ class FitOptions:
         Field separator of a text log (detected when None).
     decimal : {".", ","}, optional
         Decimal mark of a text log (detected when None).
+    stamp : {"header", "receive"}
+        Time of a ROS bag's messages: their header stamp (default) or the bag's receive
+        time.
 
     Raises
     ------
@@ -136,6 +139,7 @@ class FitOptions:
     on_bad_lines: Literal["error", "skip"] = "error"
     delimiter: str | None = None
     decimal: Literal[".", ","] | None = None
+    stamp: Literal["header", "receive"] = "header"
 
     def __post_init__(self) -> None:
         set_ = object.__setattr__  # frozen: normalise in place once
@@ -207,6 +211,9 @@ class ValidateOptions:
         Decimal mark of a text log (detected when None).
     topic : str, optional
         Flight-controller log topic, or a station recording's sensor.
+    stamp : {"header", "receive"}
+        Time of a ROS bag's messages: their header stamp (default) or the bag's receive
+        time.
     latitude : float, optional
         Test-site latitude [°] of a turntable run judging a triad calibration.
     static_s : float
@@ -245,6 +252,7 @@ class ValidateOptions:
     delimiter: str | None = None
     decimal: Literal[".", ","] | None = None
     topic: str | None = None
+    stamp: Literal["header", "receive"] = "header"
     latitude: float | None = None
     static_s: float = 1.0
 
@@ -288,7 +296,7 @@ def _read_options(
         temp_conversion=o.temp_conversion,
         topic=o.topic, names=o.names, rate_hz=o.rate_hz,
         on_bad_lines=o.on_bad_lines,
-        delimiter=o.delimiter, decimal=o.decimal,
+        delimiter=o.delimiter, decimal=o.decimal, stamp=o.stamp,
     )  # fmt: skip
     return ReadOptions(**given)
 

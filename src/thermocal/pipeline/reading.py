@@ -55,6 +55,7 @@ def read_options(
     on_bad_lines: str = "error",
     delimiter: str | None = None,
     decimal: str | None = None,
+    stamp: str = "header",
 ) -> ReadOptions:
     """The :class:`~thermocal.readers.options.ReadOptions` of the texts a user typed to say
     how a file is read (each parameter named after its field of ``ReadOptions``, or after
@@ -76,6 +77,8 @@ def read_options(
         Sample rate [Hz] of a log without a time column (field ``rate_hz``).
     on_bad_lines : str
         ``"error"`` or ``"skip"``.
+    stamp : str
+        ``"header"`` or ``"receive"``: the time of a ROS bag's messages.
 
     Returns
     -------
@@ -112,6 +115,7 @@ def read_options(
         topic=topic,
         names=names, rate_hz=rate, on_bad_lines=on_bad_lines,  # type: ignore[arg-type]
         delimiter=delimiter, decimal=decimal,  # type: ignore[arg-type]
+        stamp=stamp,  # type: ignore[arg-type]
     )  # fmt: skip
 
 

@@ -8,6 +8,7 @@ module                 format
 ``ulog``               PX4 ULog, by topic and instance
 ``dataflash``          ArduPilot DataFlash ``.bin``, by message
 ``station``            the folder ``thermocal station run`` writes
+``bag``                ROS 1 bags, ROS 2 bag folders and MCAP files (``rosbags``)
 ``chunks``             the formats read a chunk at a time (CSV, Parquet, station)
 ``formats``            the file-format registry (:class:`FileFormat`, entry points)
 ``options``            :class:`ReadOptions`, how a file is read

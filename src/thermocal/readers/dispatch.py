@@ -29,7 +29,7 @@ from thermocal.readers.common import (
     names_list,
     short_name,
 )
-from thermocal.readers.formats import TEXT_FIELDS, FileFormat, format_of
+from thermocal.readers.formats import TEXT_FIELDS, FileFormat, format_of, registered_formats
 from thermocal.readers.options import ReadOptions
 from thermocal.readers.station import is_station_path
 from thermocal.readers.table import ParquetColumns, load_sidecar, numeric_column
@@ -181,6 +181,8 @@ def _open_table(p: Path, read: ReadOptions) -> tuple[pd.DataFrame | ParquetColum
     it.  A FIFO, device or socket is refused before it is opened, a plain directory named."""
     refuse_special_input(p)
     fmt = format_of(p) if not p.is_dir() or is_station_path(p) else None
+    if fmt is None and p.is_dir():  # a folder another format recognises (a ROS 2 bag)
+        fmt = next((f for f in registered_formats() if f.sniff and f.sniff(p)), None)
     if fmt is None:
         raise FileFormatError(
             f"{p}: is a directory, not a recording file (a folder is read only when "
@@ -191,6 +193,8 @@ def _open_table(p: Path, read: ReadOptions) -> tuple[pd.DataFrame | ParquetColum
             f"{p}: {{topic}} is for flight-controller logs (.ulg, .bin) and station recordings",
             "topic",
         )
+    if read.stamp != "header" and "stamp" not in fmt.options:
+        raise ThermocalInputError.naming(f"{p}: {{stamp}} is for ROS bags and MCAP files", "stamp")
     obj, file_meta = read_table(p, read, fmt)
     side = load_sidecar(p)
     info: dict[str, Any] = {**file_meta, **side}

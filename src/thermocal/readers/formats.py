@@ -234,6 +234,20 @@ def _read_dataflash(path: Path, read: ReadOptions) -> tuple[Any, dict[str, Any]]
     return read_dataflash(path, read.topic)
 
 
+def _read_bag(path: Path, read: ReadOptions) -> tuple[Any, dict[str, Any]]:
+    """One topic of a ROS 1 or ROS 2 bag or an MCAP file (:func:`.bag.read_bag`)."""
+    from thermocal.readers.bag import read_bag
+
+    return read_bag(path, read.topic, read.stamp)
+
+
+def _is_ros2_bag(path: Path) -> bool:
+    """A ROS 2 bag folder (:func:`.bag.is_ros2_bag`)."""
+    from thermocal.readers.bag import is_ros2_bag
+
+    return is_ros2_bag(path)
+
+
 def _read_station(path: Path, read: ReadOptions) -> tuple[Any, dict[str, Any]]:
     """A station's recording folder, ``DIR`` or ``DIR/SENSOR`` (``topic``: the sensor)."""
     return read_station_table(with_sensor(path, read.topic))
@@ -253,6 +267,10 @@ BUILT_IN: tuple[FileFormat, ...] = (
     FileFormat(
         "dataflash", "an ArduPilot log", _read_dataflash, (".bin",),
         options=COLUMN_FIELDS | {"topic"},
+    ),
+    FileFormat(
+        "rosbag", "a ROS bag or MCAP file", _read_bag, (".bag", ".mcap", ".db3"),
+        options=COLUMN_FIELDS | {"topic", "stamp"}, sniff=_is_ros2_bag,
     ),
     FileFormat(
         "csv", "a CSV file or text log", _read_csv,
@@ -348,7 +366,8 @@ def _unknown_format_message(path: str | Path) -> str:
     more = "".join(f", {', '.join(f.suffixes)} for {f.title}" for f in plugins)
     return (
         f"{path}: not a CSV or Parquet file (expected extension .csv, or .txt, .log, .tsv, "
-        f".dat for a text log, .parquet, .ulg for a PX4 log or .bin for an ArduPilot log{more})"
+        f".dat for a text log, .parquet, .ulg for a PX4 log, .bin for an ArduPilot log or "
+        f".bag, .mcap for a ROS bag{more})"
     )
 
 

@@ -87,6 +87,9 @@ class ReadOptions:
         Field separator of a text log (detected when None: ``,`` ``;`` tab or blanks).
     decimal : {".", ","}, optional
         Decimal mark of a text log (detected when None).
+    stamp : {"header", "receive"}
+        Time of a ROS bag's messages: their header stamp (default) or the bag's receive
+        time.
 
     Raises
     ------
@@ -117,6 +120,7 @@ class ReadOptions:
     on_bad_lines: Literal["error", "skip"] = "error"
     delimiter: str | None = None
     decimal: Literal[".", ","] | None = None
+    stamp: Literal["header", "receive"] = "header"
 
     def __post_init__(self) -> None:
         set_ = object.__setattr__  # frozen: normalise in place once
@@ -151,6 +155,8 @@ class ReadOptions:
                 )
         if self.decimal not in (None, ".", ","):
             raise ParameterError("decimal", f"{{name}} must be . or , — got {self.decimal!r}")
+        if self.stamp not in ("header", "receive"):
+            raise ParameterError("stamp", f"{{name}} must be header or receive, got {self.stamp!r}")
         if self.names is not None and len(set(self.names)) != len(self.names):
             raise ParameterError("names", f"{{name}} repeats a name: {list(self.names)}")
 
