@@ -42,6 +42,7 @@ from threadpoolctl import threadpool_limits
 
 from thermocal._lazy import LazyModule
 from thermocal.stability import edf as ed
+from thermocal.stability import total as _total
 
 ndimage = LazyModule("scipy.ndimage")
 
@@ -599,7 +600,21 @@ def difference_sums(
     return np.asarray(vals, dtype=np.float64)
 
 
+_TOT_DIRECT: Final = 2
+"""Largest averaging factor whose total-family sum is evaluated subsequence by subsequence
+(:func:`_tot_direct`, the same numbers as ever); above it :func:`.total.tot_sum`."""
+
+
 def _tot_kernel(z: FloatArray, m: int) -> tuple[float, int]:
+    """Σ_n (1/6m) Σ_{j<6m} v_j² of the total family (NIST SP 1065 eqs. 27, 29) and the number
+    of subsequences: directly for m ≤ :data:`_TOT_DIRECT`, else in O(N log m)
+    (:func:`.total.tot_sum`)."""
+    if m > _TOT_DIRECT:
+        return _total.tot_sum(z, m)
+    return _tot_direct(z, m)
+
+
+def _tot_direct(z: FloatArray, m: int) -> tuple[float, int]:
     """Σ_n (1/6m) Σ_{j<6m} ((S1 − 2S2 + S3)/m)² over the N − 3m + 1 subsequences of 3m
     points of ``z``, each with its half-mean linear trend removed and extended by even
     reflection to 9m points (S1, S2, S3 the sums of consecutive m-point blocks from j)."""
