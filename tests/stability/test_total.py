@@ -119,3 +119,68 @@ def test_total_family_through_the_command_line_on_a_gapped_file(
             want = np.sqrt(sum(s for s, _ in ht) / 6.0 / sum(k for _, k in ht))
         assert res["htotdev"][i] == pytest.approx(want, rel=1e-11)
     assert max(round(t) for t in res["tau_s"]) >= 64  # the fast kernel's factors
+
+
+def test_total_sums_report_progress_and_reuse_a_series_sums() -> None:
+    """Several factors at once: the same sums as one at a time, the :func:`total.reporting`
+    callback receives operations adding up to the work estimate of every factor, and a
+    second call on the same series (TTOT after MTOT) returns the same numbers."""
+    z = np.cumsum(np.random.default_rng(3).standard_normal(2001))
+    ms = [1, 2, 3, 8, 64, 666, 667, 668]
+    seen: list[float] = []
+    with total.reporting(seen.append):
+        got = total.tot_sums(z, ms)
+    assert got[-1] == (0.0, 0)  # 3m > N: no subsequence
+    for (s, k), m in zip(got[:-1], ms, strict=False):
+        want, kk = _direct(z, m)
+        assert k == kk and s == pytest.approx(want, rel=1e-10)
+    assert sum(seen) == pytest.approx(sum(total.cost(2001, m) for m in ms), rel=1e-12)
+    assert total.tot_sums(z, ms) == got
+
+
+def test_ctrl_c_during_the_total_family_exits_130(tmp_path: Path) -> None:
+    """SIGINT while ``allan --deviation mtotdev,htotdev`` runs on 2e5 points: exit 130, one
+    line on stderr and no traceback (the factors running in threads stop at their next
+    chunk)."""
+    import os
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    path = tmp_path / "phase.csv"
+    x = np.cumsum(np.random.default_rng(9).standard_normal(200_000))
+    np.savetxt(path, np.c_[np.arange(x.size), x], delimiter=",", header="time,x", comments="")
+    code = "import sys; from thermocal.cli import main; sys.exit(main(sys.argv[1:]))"
+    argv = [sys.executable, "-c", code, "allan", str(path), "--signal", "x", "--data-type",
+            "phase", "--time-unit", "s", "--deviation", "mtotdev,htotdev", "--taus", "all",
+            "--max-work", "1e15"]  # fmt: skip
+    env = {**os.environ, "PYTHONPATH": str(Path(total.__file__).parents[2])}
+    proc = subprocess.Popen(
+        argv,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        env=env,
+        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),  # as from a shell
+    )
+    try:
+        time.sleep(6.0)  # read, and well into the factors (every τ: hours of work)
+        assert proc.poll() is None
+        os.kill(proc.pid, signal.SIGINT)
+        out, err = proc.communicate(timeout=120)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+    assert proc.returncode == 130, err
+    assert b"Traceback" not in err and out == b""
+    assert err.decode().splitlines()[-1] == "interrupted: nothing written"
+
+
+def test_the_work_estimate_counts_subsequences_and_points() -> None:
+    """The estimate behind ``--max-work``: at m ≤ 2 ten operations per point of the
+    N − 3m + 1 subsequences of 9m points; above, 400 per point of the series; nothing when
+    3m exceeds N + 1."""
+    assert total.cost(61, 2) == 10.0 * 9 * 2 * (61 - 6 + 1)
+    assert total.cost(61, 1) == 10.0 * 9 * 1 * (61 - 3 + 1)
+    assert total.cost(2001, 667) == 400.0 * 2001  # one subsequence
+    assert total.cost(2001, 668) == 0.0
