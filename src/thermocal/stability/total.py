@@ -70,10 +70,6 @@ from typing import Final
 import numpy as np
 import numpy.typing as npt
 
-from thermocal._lazy import LazyModule
-
-signal = LazyModule("scipy.signal")
-
 FloatArray = npt.NDArray[np.float64]
 
 _SPANS: Final = 3
@@ -398,6 +394,16 @@ def _regime_sum(pp: FloatArray, terms: _Terms, j0: int, j1: int, ln: int, lb: in
     return total
 
 
+def _correlate(rows: FloatArray, c: FloatArray, ln: int) -> FloatArray:
+    """Σ_i c_i rows[:, n + i] for n < ``ln`` (one FFT per row; no wrap: the FFT's length
+    covers the row)."""
+    size = 1 << int(rows.shape[1] - 1).bit_length()
+    spec = np.fft.rfft(rows, size, axis=1)
+    spec *= np.conj(np.fft.rfft(c, size))[None, :]
+    out: FloatArray = np.fft.irfft(spec, size, axis=1)[:, :ln]
+    return out
+
+
 def _rows_sum(
     z: FloatArray,
     m: int,
@@ -422,7 +428,7 @@ def _rows_sum(
     nn = np.arange(ln)
     slope = ((q[:, nn + 3 * m] - q[:, nn + h2]) - (q[:, nn + h1] - q[:, nn])) / (h1 * h2)
     c, bb = ramp
-    xc = signal.fftconvolve(zr[:, : ln + 3 * m - 1], c[None, ::-1], mode="valid", axes=1)
+    xc = _correlate(zr, c, ln)
     total += -2.0 * float(np.einsum("ij,ij->", slope, xc)) + bb * float(
         np.einsum("ij,ij->", slope, slope)
     )
