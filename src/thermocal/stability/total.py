@@ -347,22 +347,29 @@ def _row_line(v: FloatArray) -> FloatArray:
     return out
 
 
+def _combine(pp: FloatArray, terms: list[tuple[float, int]], width: int) -> FloatArray:
+    """Σ coef · pp[:, start : start + width] over the (coef, start) ``terms``."""
+    out = np.zeros((pp.shape[0], width))
+    for coef, start in terms:
+        part = pp[:, start : start + width]
+        if coef == 1.0:
+            out += part
+        elif coef == -1.0:
+            out -= part
+        else:
+            out += coef * part
+    return out
+
+
 def _regime_sum(pp: FloatArray, terms: _Terms, j0: int, j1: int, ln: int, lb: int) -> float:
     """Σ_rows Σ_{n<ln} Σ_{j0≤j≤j1} (A(n+j) + B(n−j) + C(n))² from the rows' P (``pp``)."""
     rows = pp.shape[0]
     nj = j1 - j0 + 1
     ra = np.arange(j0, lb + j1)  # r = n + j
     sa = np.arange(-j1, lb - j0)  # s = n − j
-    a = np.zeros((rows, ra.size))
-    b = np.zeros((rows, sa.size))
-    c = np.zeros((rows, ln))
-    for coef, kap, sig in terms:
-        if sig > 0:
-            a += coef * pp[:, j0 + kap : j0 + kap + ra.size]
-        elif sig < 0:
-            b += coef * pp[:, kap - j1 : kap - j1 + sa.size]
-        else:
-            c += coef * pp[:, kap : kap + ln]
+    a = _combine(pp, [(cf, j0 + kp) for cf, kp, sg in terms if sg > 0], ra.size)
+    b = _combine(pp, [(cf, kp - j1) for cf, kp, sg in terms if sg < 0], sa.size)
+    c = _combine(pp, [(cf, kp) for cf, kp, sg in terms if sg == 0], ln)
     # weights of A(r)²: #j in [max(j0, r − ln + 1), min(j1, r)]; of B(s)²: with n = s + j < ln
     ja = np.maximum(j0, ra - ln + 1)
     jb = np.minimum(j1, ra)
@@ -390,7 +397,7 @@ def _regime_sum(pp: FloatArray, terms: _Terms, j0: int, j1: int, ln: int, lb: in
     lo_i = ra[ok] - 2 * jb[ok] - sa[0]
     cross = q2[:, hi_i]
     cross -= q2[:, lo_i]
-    total += 2.0 * float(np.einsum("ij,ij->", a[:, ok], cross))
+    total += 2.0 * float(np.einsum("ij,ij->", a if ok.size == ra.size else a[:, ok], cross))
     return total
 
 
