@@ -1,6 +1,6 @@
 r"""The total family's sums (MTOT, TTOT, HTOT) in O(N log m) per averaging factor.
 
-NIST SP 1065 eq. 27 (Riley 2008; Howe & Vernotte's modified total variance): for each of the
+NIST SP 1065 eq. 27 (Riley 2008, the modified total variance): for each of the
 N − 3m + 1 subsequences ``w_i = z_{n+i}`` (i < 3m) of a series ``z`` (phase for MTOT and
 TTOT, the rate for HTOT, eq. 29), the linear trend fitted by its half means is removed, the
 result is extended by even reflection at both ends to 9m points ``ξ_p`` and the 6m modified
@@ -9,10 +9,11 @@ second differences of m-point averages are squared and averaged:
 .. math::
 
     T(m) = \sum_{n=0}^{N-3m} \frac{1}{6m} \sum_{j=0}^{6m-1} v_j(n)^2, \qquad
-    v_j = \frac{1}{m^2} \sum_{t=0}^{3m-1} g_t\, \xi_{j+t},
+    v_j = \frac{1}{m} \sum_{t=0}^{3m-1} g_t\, \xi_{j+t},
 
 with ``g_t`` = 1, −2, 1 on ``t`` in [0, m), [m, 2m), [2m, 3m).  A direct evaluation costs
-O(m) per subsequence, O(N·m) per factor.  Here (:func:`tot_sum`):
+O(m) per subsequence, O(N·m) per factor; :func:`tot_sum` costs O(N log m) per factor, as
+the notes below derive.
 
 Notes
 -----
@@ -52,8 +53,6 @@ so the cancellation is bounded by the row's length over m, not by N.
 References
 ----------
 NIST SP 1065, W. J. Riley, *Handbook of Frequency Stability Analysis* (2008), eqs. 27–29.
-D. A. Howe and F. Vernotte, "Generalization of the total variance approach to the modified
-Allan variance", Proc. 31st PTTI Meeting (1999).
 """
 
 from __future__ import annotations
