@@ -1,8 +1,10 @@
 """``thermocal allan FILE``: overlapping Allan deviation, confidence intervals and
 IEEE 952 noise terms by slope lines and by least squares."""
 
+import contextlib
 import math
 import warnings
+from collections.abc import Iterator
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated
 
@@ -30,6 +32,7 @@ from thermocal.cli.common import (
     check_recording,
     emit,
     handle_errors,
+    progress,
     read_options,
     show,
     split_names,
@@ -43,6 +46,7 @@ if TYPE_CHECKING:
     import thermocal.stability.api as _api
     import thermocal.stability.family as _family
     import thermocal.stability.registry as _registry
+    import thermocal.stability.total as _total
     import thermocal.writers as _writers
 else:
     _writers = LazyModule("thermocal.writers")
@@ -51,6 +55,7 @@ else:
     _family = LazyModule("thermocal.stability.family")
     _registry = LazyModule("thermocal.stability.registry")
     _api = LazyModule("thermocal.stability.api")
+    _total = LazyModule("thermocal.stability.total")
 
 
 def parse_taus(text: str) -> str | list[float]:
@@ -184,8 +189,8 @@ MaxWorkOpt = Annotated[
         "--max-work",
         help="With --deviation or --dynamic: the arithmetic operations the deviations or "
         "the dynamic ADEV's windows may take (default 3e10, about half a minute); a request "
-        "estimated beyond it is refused before it starts (the total family and theo1 grow "
-        "as N·m per τ).",
+        "estimated beyond it is refused before it starts (theo1 grows as N·m per τ, the "
+        "total family as N).",
     ),
 ]
 
@@ -272,20 +277,31 @@ def allan_cmd(
     _check_plot(plot, file)
     tau_spec = parse_taus(taus)
     devs = parse_deviations(deviation) if deviation is not None else None
-    res = _analysis.allan_analysis(
-        rec, split_names(signal) or [rec.signals[0]], taus=tau_spec, confidence=confidence,
-        deviations=devs, data_type=data_type, dynamic_s=dynamic, where=str(file),
-        bias_correct=bias_correct, noise_type=_noise_type(noise_type, devs, data_type),
-        noise_id=noise_id,
-        max_work=max_work,
-        overwrite=True,  # the recording read here is not used after the analysis
-    )  # fmt: skip
+    with _total_bar(devs):
+        res = _analysis.allan_analysis(
+            rec, split_names(signal) or [rec.signals[0]], taus=tau_spec, confidence=confidence,
+            deviations=devs, data_type=data_type, dynamic_s=dynamic, where=str(file),
+            bias_correct=bias_correct, noise_type=_noise_type(noise_type, devs, data_type),
+            noise_id=noise_id,
+            max_work=max_work,
+            overwrite=True,  # the recording read here is not used after the analysis
+        )  # fmt: skip
     if res.is_family:
         _emit_family(file, res, as_json)
         return
     if plot is not None:
         _write_plots(file, plot, res)
     _emit_allan(file, res, as_json, plot)
+
+
+@contextlib.contextmanager
+def _total_bar(devs: list[str] | None) -> Iterator[None]:
+    """A progress bar (terminal only) while the total family is computed."""
+    if not devs or not {"mtotdev", "ttotdev", "htotdev"} & set(devs):
+        yield
+        return
+    with progress("total deviations") as advance, _total.reporting(advance):
+        yield
 
 
 def _emit_family(file: Path, res: "_analysis.AllanAnalysis", as_json: bool) -> None:

@@ -42,14 +42,12 @@ from threadpoolctl import threadpool_limits
 
 from thermocal._lazy import LazyModule
 from thermocal.stability import edf as ed
+from thermocal.stability import total as _total
 
 ndimage = LazyModule("scipy.ndimage")
 
 FloatArray = npt.NDArray[np.float64]
 IntArray = npt.NDArray[np.int64]
-
-_BLOCK: Final = 1 << 22
-"""Elements per block of the O(N·m) kernels (mtotdev, htotdev, theo1)."""
 
 
 def max_factor(name: str, n_phase: int) -> int:
@@ -82,11 +80,11 @@ def max_factor(name: str, n_phase: int) -> int:
     raise ValueError(name)
 
 
-WORK_PER_TERM: Final = {"mtotdev": 90.0, "ttotdev": 90.0, "htotdev": 90.0, "theo1": 4.0}
-"""Arithmetic operations per (subsequence, point) of the O(N·m) kernels: the total family
-handles 9m points per subsequence with about 10 operations each (detrend, centre, reflect,
-running sum, block second difference, square); Theo1 3 subtractions and a multiply-add per
-(i, δ) pair.  Every other deviation: :data:`WORK_PER_POINT` per phase point and factor."""
+WORK_PER_TERM: Final = {"theo1": 4.0}
+"""Arithmetic operations per (term, lag) of the O(N·m) kernel: Theo1 3 subtractions and a
+multiply-add per (i, δ) pair.  The total family: :func:`.total.cost` per factor (90 per
+(subsequence, point) of 9m points at m ≤ 2, :data:`.total.PER_POINT` per phase point
+above); every other deviation: :data:`WORK_PER_POINT` per phase point and factor."""
 
 WORK_PER_POINT: Final = 4.0
 """Operations per phase point and averaging factor of the O(N) deviations (a difference
@@ -98,8 +96,9 @@ def work(name: str, n_phase: int, m: npt.ArrayLike) -> float:
     ``n_phase`` phase points at the factors ``m`` (those beyond :func:`max_factor` cost
     nothing).
 
-    * mtotdev, ttotdev: Σ_m 90 m (N − 3m + 1) — N − 3m + 1 subsequences of 9m points
-      (NIST SP 1065 eq. 27);
+    * mtotdev, ttotdev: Σ_m 90 m (N − 3m + 1) at m ≤ 2 (N − 3m + 1 subsequences of 9m
+      points, NIST SP 1065 eq. 27), 400 N above (:func:`.total.tot_sum`, O(N log m) per
+      factor), over the m with at least one subsequence;
     * htotdev: the same on the N − 1 rate points (eq. 29; m = 1 is ohdev);
     * theo1: Σ_m 4 (m/2)(N − m) over even m — m/2 lags δ per term (eq. 30);
     * the others: Σ_m 4 N.
@@ -128,8 +127,7 @@ def work(name: str, n_phase: int, m: npt.ArrayLike) -> float:
         pts = n - 1.0 if name == "htotdev" else n
         big = mm[mm > 1] if name == "htotdev" else mm
         ones = float(np.sum(mm == 1)) * WORK_PER_POINT * n if name == "htotdev" else 0.0
-        subs = np.maximum(pts - 3.0 * big + 1.0, 0.0)
-        return float(np.sum(WORK_PER_TERM[name] * big * subs)) + ones
+        return sum(_total.cost(int(pts), int(v)) for v in big.tolist()) + ones
     if name == "theo1":
         even = mm[mm % 2 == 0]
         return float(np.sum(WORK_PER_TERM[name] * (even / 2.0) * (n - even)))
@@ -600,30 +598,9 @@ def difference_sums(
 
 
 def _tot_kernel(z: FloatArray, m: int) -> tuple[float, int]:
-    """Σ_n (1/6m) Σ_{j<6m} ((S1 − 2S2 + S3)/m)² over the N − 3m + 1 subsequences of 3m
-    points of ``z``, each with its half-mean linear trend removed and extended by even
-    reflection to 9m points (S1, S2, S3 the sums of consecutive m-point blocks from j)."""
-    n_sub = z.size - 3 * m + 1
-    if n_sub < 1:
-        return 0.0, 0
-    w = np.lib.stride_tricks.sliding_window_view(z, 3 * m)
-    h1, h2 = (3 * m) // 2, (3 * m + 1) // 2
-    idx = np.arange(3 * m, dtype=np.float64)
-    rows = max(1, _BLOCK // (9 * m))
-    total = 0.0
-    for a in range(0, n_sub, rows):
-        blk = w[a : a + rows]
-        slope = (blk[:, h2:].mean(axis=1) - blk[:, :h1].mean(axis=1)) / h2
-        x0 = blk - slope[:, None] * idx[None, :]
-        x0 = x0 - x0.mean(axis=1, keepdims=True)
-        flip = x0[:, ::-1]
-        xs = np.concatenate([flip, x0, flip], axis=1)
-        cs = np.zeros((xs.shape[0], xs.shape[1] + 1))
-        np.cumsum(xs, axis=1, out=cs[:, 1:])
-        s = cs[:, m:] - cs[:, :-m]  # block sums starting at j, j = 0 … 8m
-        v = (s[:, : 6 * m] - 2.0 * s[:, m : 7 * m] + s[:, 2 * m : 8 * m]) / m
-        total += float(np.einsum("ij,ij->", v, v)) / (6.0 * m)
-    return total, n_sub
+    """Σ_n (1/6m) Σ_{j<6m} v_j² of the total family (NIST SP 1065 eqs. 27, 29) and the number
+    of subsequences (:func:`.total.tot_sum`)."""
+    return _total.tot_sums(z, [m])[0]
 
 
 def _theo1_sum(x: FloatArray, m: int) -> float:
@@ -931,15 +908,18 @@ def segment_sums(
             num[ok] = sums
         cnt[ok] = terms
         return num, cnt
+    if name in ("mtotdev", "ttotdev", "htotdev"):  # every factor at once, two at a time
+        z = np.diff(x) / tau0_s if name == "htotdev" else x
+        tot = _total.tot_sums(z, [int(v) for v in m[ok]])
     for i in ok.tolist():
         mm = int(m[i])
         tau_s = mm * tau0_s
         if name in ("mtotdev", "ttotdev"):
-            s, k = _tot_kernel(x, mm)
+            s, k = tot.pop(0)
             val = s / (2.0 * tau_s * tau_s)
             num[i], cnt[i] = (val * tau_s * tau_s / 3.0 if name == "ttotdev" else val), k
         elif name == "htotdev":
-            s, k = _tot_kernel(np.diff(x) / tau0_s, mm)
+            s, k = tot.pop(0)
             num[i], cnt[i] = s / 6.0, k
         elif name == "theo1":
             if mm % 2:

@@ -700,10 +700,10 @@ def check_work(
     """The estimated operations of the deviations ``names`` at the factors ``sets``
     (:func:`factor_sets`) over stretches of ``sizes`` phase points
     (:func:`.deviations.work`, summed); a :class:`ThermocalInputError` naming ``deviations``,
-    ``taus`` and ``max_work`` when beyond ``max_work``.  The total family and Theo1 cost O(N·m) per
-    factor (NIST SP 1065 eqs. 27–30), so every τ of a long record grows as N³: the refusal
-    comes before any work, with the estimate and the costliest deviation (``where``: the
-    file, named first).
+    ``taus`` and ``max_work`` when beyond ``max_work``.  Theo1 costs O(N·m) per factor (NIST
+    SP 1065 eq. 30; the total family O(N log m), eqs. 27–29), so its every τ of a long record
+    grows as N³: the refusal comes before any work, with the estimate and the costliest
+    deviation (``where``: the file, named first).
 
     Parameters
     ----------
