@@ -1089,6 +1089,8 @@ def _nan_problems(rec: Recording) -> list[Problem]:
     or temperature column, a warning in another."""
     probs: list[Problem] = []
     for name, arr in rec.columns.items():
+        if all_finite(arr):  # the usual case: no mask as long as the column
+            continue
         nan = ~np.isfinite(arr)
         n_nan = int(np.count_nonzero(nan))
         if n_nan:

@@ -129,6 +129,7 @@ class ParquetColumns:
                 pos += k
         except (pa.ArrowInvalid, OSError):
             return  # a damaged file: column by column, the error names the column
+        pa.default_memory_pool().release_unused()  # the decoders' pages: nothing holds them
         if pos == self.num_rows:
             self._read.update(out)
 
@@ -177,6 +178,7 @@ class ParquetColumns:
                 out[pos : pos + k] = arrow_chunk_f64(chunk)  # nulls → NaN
                 pos += k
             del col
+        pa.default_memory_pool().release_unused()
         if pos != self.num_rows:
             raise pa.ArrowInvalid(f"column {name!r} has {pos} rows, the file {self.num_rows}")
         return out
