@@ -575,7 +575,9 @@ class Recording:
             raise MissingColumnError(f"{self.name}: no temperature columns named")
         if len(names) == 1:  # one column: a view of it (no copy; the (n, 1) array is read)
             return self.temperature_c(names[0]).reshape(-1, 1)
-        return np.column_stack([self.temperature_c(n) for n in names])
+        cols = [self.temperature_c(n) for n in names]
+        side = _side_by_side(cols)  # columns of one block as read: a view of them
+        return side if side is not None else np.column_stack(cols)
 
     def _default(self, name: str | None, pool: tuple[str, ...], what: str) -> str:
         if name is not None:
@@ -713,6 +715,28 @@ class Recording:
 
 DIFF_BLOCK = 1 << 18
 """Rows per block when time steps are scanned block by block (bounded working memory)."""
+
+
+def _side_by_side(cols: list[FloatArray]) -> FloatArray | None:
+    """The ``(n, k)`` read-only view of k float64 columns that lie evenly spaced in one
+    buffer (the column-major block a reader filled), or None when they do not."""
+    c0 = cols[0]
+    base = c0.base
+    if base is None or c0.ndim != 1 or c0.dtype != np.float64 or c0.size == 0:
+        return None
+    n = c0.size
+    addr = [c.__array_interface__["data"][0] for c in cols]
+    gap = addr[1] - addr[0]
+    same = all(
+        c.base is base and c.ndim == 1 and c.size == n and c.strides == (8,) and c.dtype == c0.dtype
+        for c in cols
+    )
+    if not same or gap < 8 * n or any(b - a != gap for a, b in itertools.pairwise(addr)):
+        return None
+    view: FloatArray = np.lib.stride_tricks.as_strided(
+        c0, shape=(n, len(cols)), strides=(8, gap), writeable=False
+    )
+    return view
 
 
 def time_steps(time_s: FloatArray, block: int = DIFF_BLOCK) -> Iterator[tuple[int, FloatArray]]:

@@ -94,7 +94,10 @@ class ParquetColumns:
         """Read the integer and floating-point columns among ``names`` together, one row
         group at a time (pyarrow decodes the columns of a row group on several threads);
         :meth:`column_f64` then hands each one over.  Peak memory: the results plus one
-        row group of these columns.
+        row group of these columns.  The first (the time axis, converted on its own) is an
+        array of its own; the others are the columns of one column-major block, so that
+        consecutive ones are an ``(n, k)`` array without a copy
+        (:meth:`thermocal.recording.Recording.temperatures_c`).
 
         Parameters
         ----------
@@ -114,7 +117,12 @@ class ParquetColumns:
         ]
         if len(todo) < 2:
             return
-        out = {n: np.empty(self.num_rows, dtype=np.float64) for n in todo}
+        out = {todo[0]: np.empty(self.num_rows, dtype=np.float64)}
+        # the others side by side in one column-major block: each a contiguous column, and
+        # a run of them (the temperatures) an (n, k) array without a copy
+        block = np.empty((self.num_rows, len(todo) - 1), dtype=np.float64, order="F")
+        out.update((n, block[:, j]) for j, n in enumerate(todo[1:]))
+        del block
         pos = 0
         try:
             for i in range(self._pf.num_row_groups):
