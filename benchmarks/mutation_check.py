@@ -3666,6 +3666,29 @@ MUTANTS: tuple[Mutant, ...] = (
         _t("fleet_inputs"),
         "a unit whose outcome carries no digests recorded with no inputs",
     ),
+        "rate-blocks-offset",
+        P + "adequacy.py",
+        "        np.subtract(tc[a:b], part, out=part)",
+        "        np.subtract(tc[a - i0 : b - i0], part, out=part)",
+        _t("adequacy_rate_blocks"),
+        "Ṫ interpolated in blocks subtracts T(t − Δ) from the wrong samples",
+    ),
+    Mutant(
+        "saturation-runs-split-at-blocks",
+        P + "inspection.py",
+        "            if out and out[-1][1] == b0 + s0:",
+        "            if False:",
+        _t("inspection_saturation"),
+        "a stretch on a rail across a block's edge counted as two shorter ones",
+    ),
+    Mutant(
+        "median-of-parts-lower-middle",
+        P + "recording.py",
+        "            return float(np.mean(part[[i, j]])) if i != j else float(part[i])",
+        "            return float(part[i])",
+        _t("inspection_saturation"),
+        "median of an even count of values selected in parts: the lower middle, not the mean",
+    ),
 )
 
 

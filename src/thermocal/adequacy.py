@@ -514,10 +514,28 @@ def temperature_rate_c_per_min(
     if time_s.size < 2:
         return np.empty(0)
     keep = time_s >= time_s[0] + interval_s
-    if not keep.any():
+    i0 = int(np.argmax(keep))
+    if not keep[i0]:
         return np.empty(0)
-    back = np.interp(time_s[keep] - interval_s, time_s, temps)
-    return (temps[keep] - back) / interval_s * 60.0  # type: ignore[no-any-return]
+    if not keep[i0:].all():  # a time axis out of order: the samples kept picked out
+        back = np.interp(time_s[keep] - interval_s, time_s, temps)
+        return (temps[keep] - back) / interval_s * 60.0  # type: ignore[no-any-return]
+    # increasing time: the samples kept are a tail; T(t − Δ) interpolated a block at a time
+    # into the result (np.interp's values, without its slope table as long as the column)
+    tc = np.ascontiguousarray(temps)
+    out = np.empty(time_s.size - i0)
+    for a in range(i0, time_s.size, _RATE_BLOCK):
+        b = min(time_s.size, a + _RATE_BLOCK)
+        part = out[a - i0 : b - i0]
+        part[:] = np.interp(time_s[a:b] - interval_s, time_s, tc)
+        np.subtract(tc[a:b], part, out=part)
+    out /= interval_s
+    out *= 60.0
+    return out
+
+
+_RATE_BLOCK = 1 << 16
+"""Samples per block of :func:`temperature_rate_c_per_min`."""
 
 
 def rate_test(rates_c_per_min: FloatArray, name: str) -> AdequacyTest:

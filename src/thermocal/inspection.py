@@ -8,7 +8,7 @@ range and NaN count, temperature span, spikes (Hampel test) and the problems of
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -18,17 +18,20 @@ from numpy.lib.stride_tricks import sliding_window_view
 
 from thermocal.errors import ThermocalInputError
 from thermocal.recording import (
+    DIFF_BLOCK,
     GAP_FACTOR,
     FloatArray,
     Problem,
     Recording,
     TimeJitter,
+    all_finite,
     contiguous_slices,
     find_gaps,
     find_problems,
     finite_extrema,
     median_in_blocks,
     median_interval,
+    median_of_parts,
 )
 
 SPIKE_THRESHOLD = 8.0
@@ -41,21 +44,56 @@ RAIL_RUN = 3
 """Any other column: its extreme held this many samples in a row, far from the bulk."""
 
 
-def _longest_run(m: npt.NDArray[np.bool_]) -> int:
-    if not m.any():
-        return 0
-    e = np.flatnonzero(np.diff(np.concatenate([[0], m.astype(np.int8), [0]])))
-    return int((e[1::2] - e[0::2]).max())
-
-
 RAIL_STEP = 10.0
 """…entered or left by a step this many times the column's median step (a smooth peak
 of a motion flattens out instead)."""
 
 
-def _runs(m: npt.NDArray[np.bool_]) -> list[tuple[int, int]]:
-    e = np.flatnonzero(np.diff(np.concatenate([[0], m.astype(np.int8), [0]])))
-    return [(int(a), int(b)) for a, b in zip(e[0::2], e[1::2], strict=True)]
+def _runs_at(a: FloatArray, v: float, block: int = DIFF_BLOCK) -> list[tuple[int, int]]:
+    """The stretches ``[start, end)`` where ``a == v``, found block by block (no mask or
+    index array as long as the column)."""
+    out: list[tuple[int, int]] = []
+    for b0 in range(0, a.size, block):
+        idx = np.flatnonzero(a[b0 : b0 + block] == v)
+        if idx.size == 0:
+            continue
+        cut = np.flatnonzero(np.diff(idx) != 1)
+        starts = [int(idx[0]), *(int(i) for i in idx[cut + 1])]
+        ends = [*(int(i) + 1 for i in idx[cut]), int(idx[-1]) + 1]
+        for s0, e0 in zip(starts, ends, strict=True):
+            if out and out[-1][1] == b0 + s0:  # continues across the block's edge
+                out[-1] = (out[-1][0], b0 + e0)
+            else:
+                out.append((b0 + s0, b0 + e0))
+    return out
+
+
+def _all_integer(a: FloatArray, block: int = DIFF_BLOCK) -> bool:
+    """Whether every finite value of ``a`` is an integer, in blocks."""
+    for b0 in range(0, a.size, block):
+        part = a[b0 : b0 + block]
+        fin = part[np.isfinite(part)]
+        if not bool(np.all(fin == np.round(fin))):
+            return False
+    return True
+
+
+def _finite_parts(a: FloatArray, block: int = DIFF_BLOCK) -> Iterator[FloatArray]:
+    """The finite values of ``a`` in order, a block at a time."""
+    for b0 in range(0, a.size, block):
+        part = a[b0 : b0 + block]
+        yield part if all_finite(part) else part[np.isfinite(part)]
+
+
+def _nonzero_steps(a: FloatArray, block: int = DIFF_BLOCK) -> Iterator[FloatArray]:
+    """``|Δ|`` between consecutive finite values of ``a`` where nonzero, a block at a time."""
+    last: FloatArray = np.empty(0)
+    for fin in _finite_parts(a, block):
+        if fin.size == 0:
+            continue
+        d = np.abs(np.diff(np.concatenate([last, fin])))
+        last = fin[-1:].copy()
+        yield d[d > 0]
 
 
 def saturated_mask(x: npt.ArrayLike) -> npt.NDArray[np.bool_]:
@@ -78,22 +116,24 @@ def saturated_mask(x: npt.ArrayLike) -> npt.NDArray[np.bool_]:
     """
     a = np.asarray(x, dtype=np.float64)
     out = np.zeros(a.shape, dtype=bool)
-    fin = a[np.isfinite(a)]
-    if fin.size < 2:
+    ext = finite_extrema(a)  # in blocks: no copy of the column's finite values
+    if ext is None or ext.count < 2:
         return out
-    hi, lo = float(fin.max()), float(fin.min())
-    is_int = bool(np.all(fin == np.round(fin)))
-    med = float(np.median(fin))
-    d = np.abs(np.diff(fin))
-    step = float(np.median(d[d > 0])) if np.any(d > 0) else 0.0
+    hi, lo = ext.hi, ext.lo
+    is_int = _all_integer(a)
+    med = median_of_parts(lambda: _finite_parts(a), ext.count)
+    n_steps = sum(d.size for d in _nonzero_steps(a))
+    step = median_of_parts(lambda: _nonzero_steps(a), n_steps) if n_steps else 0.0
     for v in {hi, lo}:
-        at = a == v
-        if is_int and v in RAIL_VALUES and _longest_run(at) >= 2:  # a counter passes once
-            out |= at
+        runs = _runs_at(a, v)
+        longest = max((e0 - s0 for s0, e0 in runs), default=0)
+        if is_int and v in RAIL_VALUES and longest >= 2:  # a counter passes once
+            for s0, e0 in runs:
+                out[s0:e0] = True
             continue
         if abs(v - med) <= 0.4 * (hi - lo):
             continue
-        for s0, e0 in _runs(at):
+        for s0, e0 in runs:
             jumps = [abs(v - a[s0 - 1])] if s0 > 0 else []
             jumps += [abs(v - a[e0])] if e0 < a.size else []
             if e0 - s0 >= RAIL_RUN and max(jumps, default=0.0) > RAIL_STEP * step:
@@ -349,7 +389,7 @@ def _saturation_problems(name: str, arr: FloatArray) -> list[Problem]:
     if not n:
         return []
     first = int(np.argmax(sat))
-    runs = int(np.count_nonzero(np.diff(np.concatenate([[0], sat.astype(np.int8)])) == 1))
+    runs = int(np.count_nonzero(np.diff(sat.view(np.int8), prepend=np.int8(0)) == 1))
     vals = ", ".join(f"{v:g}" for v in sorted({float(v) for v in arr[sat]}))
     return [
         Problem(

@@ -575,7 +575,9 @@ class Recording:
             raise MissingColumnError(f"{self.name}: no temperature columns named")
         if len(names) == 1:  # one column: a view of it (no copy; the (n, 1) array is read)
             return self.temperature_c(names[0]).reshape(-1, 1)
-        return np.column_stack([self.temperature_c(n) for n in names])
+        cols = [self.temperature_c(n) for n in names]
+        side = _side_by_side(cols)  # columns of one block as read: a view of them
+        return side if side is not None else np.column_stack(cols)
 
     def _default(self, name: str | None, pool: tuple[str, ...], what: str) -> str:
         if name is not None:
@@ -713,6 +715,28 @@ class Recording:
 
 DIFF_BLOCK = 1 << 18
 """Rows per block when time steps are scanned block by block (bounded working memory)."""
+
+
+def _side_by_side(cols: list[FloatArray]) -> FloatArray | None:
+    """The ``(n, k)`` read-only view of k float64 columns that lie evenly spaced in one
+    buffer (the column-major block a reader filled), or None when they do not."""
+    c0 = cols[0]
+    base = c0.base
+    if base is None or c0.ndim != 1 or c0.dtype != np.float64 or c0.size == 0:
+        return None
+    n = c0.size
+    addr = [c.__array_interface__["data"][0] for c in cols]
+    gap = addr[1] - addr[0]
+    same = all(
+        c.base is base and c.ndim == 1 and c.size == n and c.strides == (8,) and c.dtype == c0.dtype
+        for c in cols
+    )
+    if not same or gap < 8 * n or any(b - a != gap for a, b in itertools.pairwise(addr)):
+        return None
+    view: FloatArray = np.lib.stride_tricks.as_strided(
+        c0, shape=(n, len(cols)), strides=(8, gap), writeable=False
+    )
+    return view
 
 
 def time_steps(time_s: FloatArray, block: int = DIFF_BLOCK) -> Iterator[tuple[int, FloatArray]]:
@@ -1089,6 +1113,8 @@ def _nan_problems(rec: Recording) -> list[Problem]:
     or temperature column, a warning in another."""
     probs: list[Problem] = []
     for name, arr in rec.columns.items():
+        if all_finite(arr):  # the usual case: no mask as long as the column
+            continue
         nan = ~np.isfinite(arr)
         n_nan = int(np.count_nonzero(nan))
         if n_nan:
@@ -1331,17 +1357,64 @@ def median_in_blocks(
     >>> median_in_blocks(lambda a, b: x[a:b], 11, block=2)
     5.0
     """
+    return median_of_parts(
+        lambda: (values(a, min(n, a + block)) for a in range(0, n, block)), n, block
+    )
+
+
+def median_of_parts(
+    parts: Callable[[], Iterator[FloatArray]], n: int, block: int = MEDIAN_BLOCK
+) -> float:
+    """The exact median of ``n`` values handed over in parts, in bounded memory.
+
+    :func:`median_in_blocks` for values that are not rows of one array (the nonzero steps
+    of a column between its finite samples, say): ``parts()`` yields them in order, in
+    parts of any length, and is called once per pass (two to five passes).  Up to
+    ``4 × block`` values are gathered and handed to ``np.median``.
+
+    Parameters
+    ----------
+    parts : callable
+        Returns an iterator over the parts (NaN-free; the caller checks), together ``n``
+        values.
+    n : int
+        Number of values.
+    block : int, optional
+        Values at or below ``4 × block`` are gathered whole (default :data:`MEDIAN_BLOCK`).
+
+    Returns
+    -------
+    float
+        ``np.median`` of the n values [their unit].
+
+    Notes
+    -----
+    Selection by bracketing: a strided sample gives bounds :math:`lo \\le hi` around its
+    median; one pass counts the values below ``lo`` and keeps those in ``[lo, hi]``; the
+    order statistics :math:`\\lfloor (n-1)/2 \\rfloor` and :math:`\\lfloor n/2 \\rfloor` are
+    selected among the kept ones (their mean for an even ``n``, as ``np.median`` forms it).
+
+    References
+    ----------
+    - R. W. Floyd and R. L. Rivest, "Expected time bounds for selection",
+      Communications of the ACM 18(3), pp. 165-172, 1975.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> median_of_parts(lambda: iter([np.array([3.0, 1.0]), np.array([2.0, 5.0])]), 4)
+    2.5
+    """
     if n <= 4 * block:
-        return float(np.median(values(0, n), overwrite_input=True))
+        return float(np.median(np.concatenate([np.empty(0), *parts()]), overwrite_input=True))
     k_lo, k_hi = (n - 1) // 2, n // 2
     step = max(1, n // 65536)
-    sample = np.sort(
-        np.concatenate(
-            [  # copies: a strided view would keep its whole block alive
-                values(a, min(n, a + block))[(-a) % step :: step].copy() for a in range(0, n, block)
-            ]
-        )
-    )
+    samples: list[FloatArray] = []
+    a = 0
+    for v in parts():  # copies: a strided view would keep its whole part alive
+        samples.append(v[(-a) % step :: step].copy())
+        a += v.size
+    sample = np.sort(np.concatenate(samples))
     m = sample.size
     widen = 0.01
     for _ in range(3):
@@ -1349,8 +1422,7 @@ def median_in_blocks(
         hi = sample[min(m - 1, int(m * (0.5 + widen)))]
         below = 0
         kept: list[FloatArray] = []
-        for a in range(0, n, block):
-            v = values(a, min(n, a + block))
+        for v in parts():
             below += int(np.count_nonzero(v < lo))
             kept.append(v[(v >= lo) & (v <= hi)])
         mid = np.concatenate(kept)
@@ -1359,7 +1431,7 @@ def median_in_blocks(
             part = np.partition(mid, [i, j])
             return float(np.mean(part[[i, j]])) if i != j else float(part[i])
         widen *= 4.0
-    whole = np.concatenate([values(a, min(n, a + block)) for a in range(0, n, block)])
+    whole = np.concatenate(list(parts()))
     return float(np.median(whole, overwrite_input=True))
 
 

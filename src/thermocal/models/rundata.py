@@ -19,7 +19,7 @@ from thermocal.errors import (
     UnitError,
     UnitWarning,
 )
-from thermocal.recording import FloatArray, Recording
+from thermocal.recording import FloatArray, Recording, all_finite
 from thermocal.units import (
     canonical_unit,
 )
@@ -184,6 +184,8 @@ class RunData:
         for label, arr in [("time", rec.time_s), ("temperatures", temps_c)] + (
             [("signal", sig)] if sig is not None else []
         ):
+            if all_finite(arr):  # the usual case: no mask as long as the data
+                continue
             bad = ~np.isfinite(arr)
             if bad.any():
                 row = int(np.argwhere(bad)[0][0])

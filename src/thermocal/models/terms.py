@@ -481,9 +481,14 @@ def term_features(
                 dest[...] = x
                 return dest
             return x
-        prev = power(j, kind, p - 1, None)
-        res = np.multiply(prev, x, out=dest) if dest is not None else prev * x
-        powers[key] = res
+        # x^p from the highest power at hand, one product at a time (a loop, not a recursion:
+        # a closure calling itself is a reference cycle that would keep this block's powers
+        # and temperatures alive until the cycle collector runs)
+        q = max(r for r in range(1, p) if (j, kind, r) in powers)
+        res = powers[(j, kind, q)]
+        for r in range(q + 1, p + 1):
+            res = np.multiply(res, x, out=dest) if r == p and dest is not None else res * x
+            powers[(j, kind, r)] = res
         return res
 
     for col, t in enumerate(terms):

@@ -26,6 +26,7 @@ import re
 import warnings
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
+from functools import partial
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, cast
 
@@ -44,6 +45,7 @@ from thermocal.pipeline.messages import warning_text
 from thermocal.pipeline.options import FitOptions
 from thermocal.pipeline.reading import check_recording
 from thermocal.readers.station import station_sensor_paths
+from thermocal.recording import FloatArray, all_finite, median_in_blocks
 
 if TYPE_CHECKING:
     import thermocal.adequacy as _adequacy
@@ -445,6 +447,11 @@ TIME_SCALES = ((1000.0, "ms read as s"), (1.0 / 60.0, "minutes read as s"), (1e-
 """Time-unit mistakes the Ṫ check names: the factor Ṫ would change by, and the mistake."""
 
 
+def _steps(t: FloatArray, a: int, b: int) -> FloatArray:
+    """The steps ``t[a + 1 : b + 1] − t[a : b]``."""
+    return np.diff(t[a : b + 1])
+
+
 def rate_time_doubts(
     runs: Sequence[_rundata.RunData], temp_names: Sequence[str], interval_s: float
 ) -> list[PlausibilityWarning]:
@@ -484,13 +491,15 @@ def rate_time_doubts(
         span_s = float(run.time_s[-1] - run.time_s[0])
         # Ṫ over the interval, or over 1 % of a record too short for it (a time axis read
         # 1000× short spans ramps in one interval), never below 3 samples' steps
-        step = float(np.median(np.diff(run.time_s)))
+        # np.median of the steps, selected block by block (no array of them)
+        step = median_in_blocks(partial(_steps, run.time_s), run.time_s.size - 1)
         delta = max(3.0 * step, min(interval_s, span_s / 100.0))
         for name in temp_names:
             j = list(run.temp_names).index(name)
             where = f"{run.name}: {name}"
             rates = _adequacy.temperature_rate_c_per_min(run.time_s, run.temps_c[:, j], delta)
-            rates = rates[np.isfinite(rates)]
+            if not all_finite(rates):
+                rates = rates[np.isfinite(rates)]
             if rates.size == 0:
                 out.append(
                     PlausibilityWarning.naming(
@@ -500,7 +509,8 @@ def rate_time_doubts(
                     )
                 )
                 continue
-            peak = float(np.percentile(np.abs(rates), 99.0))
+            # |Ṫ| in place and partitioned by the percentile: the rates are this loop's own
+            peak = float(np.percentile(np.abs(rates, out=rates), 99.0, overwrite_input=True))
             fits = sorted(
                 (
                     (k, what)

@@ -94,7 +94,10 @@ class ParquetColumns:
         """Read the integer and floating-point columns among ``names`` together, one row
         group at a time (pyarrow decodes the columns of a row group on several threads);
         :meth:`column_f64` then hands each one over.  Peak memory: the results plus one
-        row group of these columns.
+        row group of these columns.  The first (the time axis, converted on its own) is an
+        array of its own; the others are the columns of one column-major block, so that
+        consecutive ones are an ``(n, k)`` array without a copy
+        (:meth:`thermocal.recording.Recording.temperatures_c`).
 
         Parameters
         ----------
@@ -114,7 +117,12 @@ class ParquetColumns:
         ]
         if len(todo) < 2:
             return
-        out = {n: np.empty(self.num_rows, dtype=np.float64) for n in todo}
+        out = {todo[0]: np.empty(self.num_rows, dtype=np.float64)}
+        # the others side by side in one column-major block: each a contiguous column, and
+        # a run of them (the temperatures) an (n, k) array without a copy
+        block = np.empty((self.num_rows, len(todo) - 1), dtype=np.float64, order="F")
+        out.update((n, block[:, j]) for j, n in enumerate(todo[1:]))
+        del block
         pos = 0
         try:
             for i in range(self._pf.num_row_groups):
@@ -129,6 +137,7 @@ class ParquetColumns:
                 pos += k
         except (pa.ArrowInvalid, OSError):
             return  # a damaged file: column by column, the error names the column
+        pa.default_memory_pool().release_unused()  # the decoders' pages: nothing holds them
         if pos == self.num_rows:
             self._read.update(out)
 
@@ -177,6 +186,7 @@ class ParquetColumns:
                 out[pos : pos + k] = arrow_chunk_f64(chunk)  # nulls → NaN
                 pos += k
             del col
+        pa.default_memory_pool().release_unused()
         if pos != self.num_rows:
             raise pa.ArrowInvalid(f"column {name!r} has {pos} rows, the file {self.num_rows}")
         return out
