@@ -3666,6 +3666,7 @@ MUTANTS: tuple[Mutant, ...] = (
         _t("fleet_inputs"),
         "a unit whose outcome carries no digests recorded with no inputs",
     ),
+    Mutant(
         "rate-blocks-offset",
         P + "adequacy.py",
         "        np.subtract(tc[a:b], part, out=part)",
