@@ -404,6 +404,57 @@ def parse_terms(
 # --- features ----------------------------------------------------------------------------
 
 
+class _Powers:
+    """The scaled bases (u, v, w of each temperature) of one block and their powers, each
+    made once (a plain object, no closure: nothing keeps the block alive after it)."""
+
+    def __init__(
+        self, scaling: BaseScaling, temps_c: FloatArray, rates_c_per_min: FloatArray | None
+    ) -> None:
+        self.scaling, self.temps_c, self.rates = scaling, temps_c, rates_c_per_min
+        self.made: dict[tuple[int, str, int], FloatArray] = {}
+
+    def base(self, j: int, kind: str) -> FloatArray:
+        """The scaled u (T), v (Ṫ) or w (T·Ṫ) of temperature ``j``."""
+        key = (j, kind, 1)
+        if key not in self.made:
+            sc, T = self.scaling, self.temps_c[:, j]
+            if kind == "u":
+                x = (T - sc.t_center[j]) / sc.t_scale[j]
+            else:
+                if self.rates is None:
+                    raise ThermocalInputError("rate terms need the temperature rate")
+                R = self.rates[:, j]
+                if kind == "v":
+                    x = (R - sc.rate_center[j]) / sc.rate_scale[j]
+                else:
+                    x = (T * R - sc.coupling_center[j]) / sc.coupling_scale[j]
+            self.made[key] = x
+        return self.made[key]
+
+    def power(self, j: int, kind: str, p: int, dest: FloatArray | None) -> FloatArray:
+        """``base(j, kind)**p`` by repeated products from the highest power at hand, written
+        into ``dest`` when given."""
+        key = (j, kind, p)
+        if key in self.made:
+            if dest is not None:
+                dest[...] = self.made[key]
+                return dest
+            return self.made[key]
+        x = self.base(j, kind)
+        if p == 1:
+            if dest is not None:
+                dest[...] = x
+                return dest
+            return x
+        q = max(r for r in range(1, p) if (j, kind, r) in self.made)
+        res = self.made[(j, kind, q)]
+        for r in range(q + 1, p + 1):
+            res = np.multiply(res, x, out=dest) if r == p and dest is not None else res * x
+            self.made[(j, kind, r)] = res
+        return res
+
+
 def term_features(
     terms: Sequence[Term],
     scaling: BaseScaling,
@@ -449,48 +500,7 @@ def term_features(
     n = temps_c.shape[0]
     if out is None:
         out = np.empty((n, len(terms)), dtype=np.float64, order="F")
-    powers: dict[tuple[int, str, int], FloatArray] = {}
-
-    def base(j: int, kind: str) -> FloatArray:
-        key = (j, kind, 1)
-        if key not in powers:
-            T = temps_c[:, j]
-            if kind == "u":
-                x = (T - scaling.t_center[j]) / scaling.t_scale[j]
-            else:
-                if rates_c_per_min is None:
-                    raise ThermocalInputError("rate terms need the temperature rate")
-                R = rates_c_per_min[:, j]
-                if kind == "v":
-                    x = (R - scaling.rate_center[j]) / scaling.rate_scale[j]
-                else:
-                    x = (T * R - scaling.coupling_center[j]) / scaling.coupling_scale[j]
-            powers[key] = x
-        return powers[key]
-
-    def power(j: int, kind: str, p: int, dest: FloatArray | None) -> FloatArray:
-        key = (j, kind, p)
-        if key in powers:
-            if dest is not None:
-                dest[...] = powers[key]
-                return dest
-            return powers[key]
-        x = base(j, kind)
-        if p == 1:
-            if dest is not None:
-                dest[...] = x
-                return dest
-            return x
-        # x^p from the highest power at hand, one product at a time (a loop, not a recursion:
-        # a closure calling itself is a reference cycle that would keep this block's powers
-        # and temperatures alive until the cycle collector runs)
-        q = max(r for r in range(1, p) if (j, kind, r) in powers)
-        res = powers[(j, kind, q)]
-        for r in range(q + 1, p + 1):
-            res = np.multiply(res, x, out=dest) if r == p and dest is not None else res * x
-            powers[(j, kind, r)] = res
-        return res
-
+    powers = _Powers(scaling, temps_c, rates_c_per_min)
     for col, t in enumerate(terms):
         factors = [
             (kind, p)
@@ -499,11 +509,11 @@ def term_features(
         ]
         dest = out[:, col]
         if len(factors) == 1:
-            power(t.sensor, factors[0][0], factors[0][1], dest)
+            powers.power(t.sensor, factors[0][0], factors[0][1], dest)
         else:
-            acc = power(t.sensor, factors[0][0], factors[0][1], None)
+            acc = powers.power(t.sensor, factors[0][0], factors[0][1], None)
             for kind, p in factors[1:-1]:
-                acc = acc * power(t.sensor, kind, p, None)
+                acc = acc * powers.power(t.sensor, kind, p, None)
             kind, p = factors[-1]
-            np.multiply(acc, power(t.sensor, kind, p, None), out=dest)
+            np.multiply(acc, powers.power(t.sensor, kind, p, None), out=dest)
     return out

@@ -226,7 +226,17 @@ class SingleRunResult:
     result: TurntableResult
 
     def to_dict(self, spell: Callable[[str], str] | None = None) -> dict[str, Any]:
-        """The result JSON, with ``input``; ``spell`` as :meth:`TurntableResult.to_dict`."""
+        """The result JSON, with ``input``.
+
+        Parameters
+        ----------
+        spell : callable, optional
+            How the warnings name a parameter (:meth:`TurntableResult.to_dict`).
+
+        Returns
+        -------
+        dict
+        """
         out: dict[str, Any] = self.result.to_dict(spell)
         out["input"] = str(self.input)
         return out
