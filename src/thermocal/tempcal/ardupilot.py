@@ -53,6 +53,7 @@ from thermocal.tempcal.pipeline import (
     end_warning,
     fit_sensor,
     gyro_unit_warning,
+    report_worker,
     require_fields,
     staged_set,
     stall_warning,
@@ -737,6 +738,9 @@ class _Run:
     previous: dict[str, CoefficientComparison] = dataclasses.field(default_factory=dict)
     learning: dict[str, CoefficientComparison] = dataclasses.field(default_factory=dict)
     baro: ArdupilotBaroFit | None = None
+    motions: dict[str, Any] = dataclasses.field(default_factory=dict)
+    """Each instance's stillness from its fit (:func:`.pipeline.fit_sensor`), for the step
+    warnings (computed once)."""
 
 
 def ardupilot_tempcal(
@@ -796,7 +800,10 @@ def ardupilot_tempcal(
     names.append(BARO_REPORT)
     check_outputs([output / n for n in names], [log], dirs=[output])
     check_output_dir(output)
-    with staged_set(output, reporter) as out_set:  # moved into place whole, or removed
+    with (
+        report_worker(reporter, log) as pool,  # starts while the log is read
+        staged_set(output, reporter, pool) as out_set,  # moved into place whole, or removed
+    ):
         flight = read_ardupilot_log(log, MESSAGES)  # the log is read once, passed down
         run = _Run(log, flight, overrides, ParamSet("ardupilot"), out_set, [], [], {}, {})
         for inst in range(MAX_IMUS):
@@ -810,7 +817,7 @@ def ardupilot_tempcal(
         if not run.fits:
             raise ThermocalInputError(f"{log}: no IMU with a usable temperature in the log")
         _baro(run)
-        run.gates.extend(step_warnings(run.fits, run.series))
+        run.gates.extend(step_warnings(run.fits, run.series, run.motions))
         warn_gates(run.gates)
         check_values(run.params)
         check_documented(run.params)
@@ -929,8 +936,9 @@ def _imu(run: _Run, df: Any, inst: int) -> None:
         sub_rec.source = str(run.log)
         sub_rec.validate()
         fit = fit_sensor(
-            sub_rec, f"IMU.{prefix}", kind, inst, overrides=run.overrides, firmware="ardupilot"
-        )
+            sub_rec, f"IMU.{prefix}", kind, inst, overrides=run.overrides,
+            firmware="ardupilot", motions=run.motions,
+        )  # fmt: skip
         run.fits.append(fit)
         per_kind.append((fit, sub_rec))
         if kind == "gyro":
