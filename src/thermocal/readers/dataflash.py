@@ -474,17 +474,31 @@ def _columns_table(
     cols = log.columns.get(name)
     if cols is not None:
         inst_col = cols.get("I")
-        mask = None if inst_col is None else np.trunc(inst_col) == inst
-        if inst_col is not None or inst == 0:
-            n = int(mask.sum()) if mask is not None else len(next(iter(cols.values())))
-            if n:
-                return pd.DataFrame(
-                    {k: v if mask is None else v[mask] for k, v in cols.items()}
-                ), name
+        if inst_col is not None:
+            rows = np.flatnonzero(np.trunc(inst_col) == inst)
+            if rows.size:
+                return _frame(cols, rows), name
+        elif inst == 0 and len(next(iter(cols.values()))):
+            return _frame(cols, None), name
     old = log.columns.get(legacy) if legacy is not None else None
     if old is not None and "I" not in old and len(next(iter(old.values()))):
-        return pd.DataFrame({k: v.copy() for k, v in old.items()}), str(legacy)
+        return _frame(old, None), str(legacy)
     return None, name
+
+
+def _frame(
+    cols: dict[str, npt.NDArray[np.float64]], rows: npt.NDArray[np.intp] | None
+) -> pd.DataFrame:
+    """The columns (those ``rows``; None: all) as one float64 frame, gathered straight into
+    the frame's block (fields × rows, no second copy)."""
+    n = len(next(iter(cols.values()))) if rows is None else rows.size
+    block = np.empty((len(cols), n))
+    for j, v in enumerate(cols.values()):
+        if rows is None:
+            block[j] = v
+        else:
+            np.take(v, rows, out=block[j])
+    return pd.DataFrame(block.T, columns=list(cols), copy=False)
 
 
 def read_dataflash(path: Path, topic: str | None) -> tuple[pd.DataFrame, dict[str, Any]]:
