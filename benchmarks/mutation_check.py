@@ -2182,6 +2182,14 @@ MUTANTS: tuple[Mutant, ...] = (
         "a log with damage after its last whole message read by the fixed-format parser as sound",
     ),
     Mutant(
+        "dataflash-walk-keeps-payload-starts",
+        P + "readers/dataflash.py",
+        "        led[succ[on[:n]]] = True",
+        "        led[:] = True",
+        _t("dataflash_fast"),
+        "A3 95 inside a payload taken for a message start by the walk at once",
+    ),
+    Mutant(
         "bounds-dataflash-special-unchecked",
         P + "readers/dataflash.py",
         'refuse_special_input(p, "DataFlash log")',

@@ -150,3 +150,31 @@ def test_a_format_of_the_wrong_length_is_left_to_pymavlink(
         warnings.simplefilter("ignore")
         dataflash.read_dataflash_log(path, ["ALL"])
     assert opened == [str(path)]
+
+
+def test_a_message_start_inside_a_payload_is_not_a_message(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Payload bytes that read ``A3 95 <type>`` (a message start, an FMT start) are passed
+    over by the walk at once, as by pymavlink's reader."""
+    path, raw = _log(tmp_path, 60)
+    data = bytearray(path.read_bytes())
+    size = struct.calcsize(ALL_STRUCT)
+    for k, fake in ((5, b"\xa3\x95\x64\x00"), (17, b"\xa3\x95\x80\x64"), (30, b"\xa3\x95\x81\x00")):
+        at = data.index(raw[k]) + 3 + struct.calcsize("<QBbhHi")  # the I4 field
+        data[at : at + 4] = fake
+        raw[k] = bytes(data[at - 3 - struct.calcsize("<QBbhHi") : at + size])
+    path.write_bytes(bytes(data))
+    u8 = np.frombuffer(bytes(data), np.uint8)
+    at_once = dataflash._walk_at_once(bytes(data), u8)
+    walked = dataflash._walk(bytes(data))
+    assert at_once is not None and walked is not None
+    assert at_once[0].tolist() == walked[0] and at_once[2] == walked[2] == len(data)
+    opened = _no_pymavlink(monkeypatch)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", PlausibilityWarning)
+        fast = dataflash.read_dataflash_log(path, ["ALL"])
+        ref = dataflash._pymavlink_pass(path, ["ALL"])
+    assert opened == [str(path)]  # the second read only
+    assert fast.message_rows("ALL") == ref.rows["ALL"] and len(ref.rows["ALL"]) == 60
+    assert fast.message_rows("ALL")[5]["I4"] == float(0x0064_95A3)

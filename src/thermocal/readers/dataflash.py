@@ -680,6 +680,81 @@ def _walk(buf: bytes) -> tuple[list[int], dict[int, _Format], int] | None:
     return starts, formats, pos  # type: ignore[return-value]
 
 
+_CHAIN_PASSES = 16
+"""Passes of :func:`_walk_at_once` before it leaves a log to :func:`_walk`."""
+
+
+def _walk_at_once(
+    raw: bytes, u8: npt.NDArray[np.uint8]
+) -> tuple[npt.NDArray[np.int64], dict[int, _Format], int] | None:
+    """:func:`_walk`'s answer without a Python step per message, or None when it cannot
+    tell (then :func:`_walk` decides).  Every ``A3 95`` is a candidate start (a payload may
+    hold one too); with the lengths of the ``FMT`` candidates, each candidate's successor is
+    the candidate its message ends at, and the messages of the log are the candidates the
+    first leads to: all of them, less (pass by pass) those no kept candidate leads to (a
+    start inside a payload; a few passes in a sound log).  Taken only when the ``FMT`` messages
+    on that chain are the definitions used, each before its type's first message."""
+    size = u8.size
+    if size < 3:
+        return None
+    cand = np.flatnonzero((u8[:-2] == _HEAD[0]) & (u8[1:-1] == _HEAD[1]))
+    if cand.size == 0 or cand[0] != 0:
+        return None
+    lengths = np.zeros(256, dtype=np.int64)
+    lengths[_FMT_TYPE] = _FMT_DEF[1]
+    seen: dict[int, _Format] = {}
+    for p in cand[(u8[cand + 2] == _FMT_TYPE) & (cand + _FMT_DEF[1] <= size)].tolist():
+        trial: dict[int, _Format] = dict(seen)
+        if _define(raw, p, trial):  # a candidate that is no definition is skipped here
+            seen = trial
+            lengths[raw[p + 3]] = raw[p + 4]
+    n = cand.size
+    step = lengths[u8[cand + 2]]
+    nxt = cand + step
+    ok = (step > 0) & (nxt <= size)
+    j = np.minimum(np.searchsorted(cand, nxt), n - 1)
+    succ = np.where(ok & (cand[j] == nxt), j, n)  # n: no successor
+    on = np.ones(n + 1, dtype=bool)
+    for _ in range(_CHAIN_PASSES):  # keep the candidates some kept one leads to
+        led = np.zeros(n + 1, dtype=bool)
+        led[succ[on[:n]]] = True
+        led[0] = True
+        if np.array_equal(led[:n], on[:n]):
+            break
+        on = led
+    else:
+        return None  # a long chain that no message leads to (damage): the walk decides
+    chain = np.flatnonzero(on[:n])
+    last = int(chain[-1])
+    end = int(nxt[last]) if ok[last] else int(cand[last])
+    starts = cand[chain] if ok[last] else cand[chain[:-1]]
+    tail = raw[end:]
+    if starts.size == 0 or (tail and not (len(tail) < DATAFLASH_PADDING and len(set(tail)) == 1)):
+        return None
+    return _chain_defined(raw, starts, end, lengths)
+
+
+def _chain_defined(
+    raw: bytes, starts: npt.NDArray[np.int64], end: int, lengths: npt.NDArray[np.int64]
+) -> tuple[npt.NDArray[np.int64], dict[int, _Format], int] | None:
+    """The chain of :func:`_walk_at_once` if its own ``FMT`` messages define every type it
+    holds, each before the type's first message, with the lengths it was walked by."""
+    types = np.frombuffer(raw, np.uint8)[starts + 2]
+    formats = {_FMT_TYPE: _format(*_FMT_DEF[:3], _FMT_DEF[3])}
+    first_def: dict[int, int] = {}
+    for k in np.flatnonzero(types == _FMT_TYPE).tolist():
+        p = int(starts[k])
+        if not _define(raw, p, formats):  # type: ignore[arg-type]
+            return None
+        first_def.setdefault(raw[p + 3], k)
+    used, first_use = np.unique(types, return_index=True)
+    for t, k in zip(used.tolist(), first_use.tolist(), strict=True):
+        f = formats.get(t)
+        if f is None or f.length != lengths[t] or (t != _FMT_TYPE and first_def.get(t, k) >= k):
+            return None
+    return starts, formats, end  # type: ignore[return-value]
+
+
 def _units_sound(
     buf: bytes, at: npt.NDArray[np.int64], fmtu: _Format, formats: dict[int, _Format]
 ) -> bool:
@@ -722,13 +797,13 @@ def _fast_pass(path: Path, keep: set[str]) -> DataflashLog | None:
         buf = path.read_bytes()
     except OSError:
         return None
-    walked = _walk(buf)
+    u8 = np.frombuffer(buf, np.uint8)
+    walked = _walk_at_once(buf, u8) or _walk(buf)
     if walked is None:
         return None
     starts_list, formats, end = walked
     starts = np.asarray(starts_list, dtype=np.int64)
     del starts_list
-    u8 = np.frombuffer(buf, np.uint8)
     types = u8[starts + 2]
     present = np.flatnonzero(np.bincount(types, minlength=256))
     by_name = {formats[t].name: t for t in present.tolist()}

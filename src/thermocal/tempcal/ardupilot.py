@@ -433,6 +433,10 @@ def ardupilot_raw_intervals(
         When an interval's ``AHRS_ORIENTATION`` is not an integer.
     """
     out = np.asarray(xyz, dtype=np.float64).copy()
+    if len(intervals) == 1:  # no change in the log: every sample at once, no regrouping
+        part, active, code = ardupilot_raw(intervals[0].params, instance, kind, temp_c, out)
+        out[:] = part
+        return out, [active], [code]
     actives: list[ActiveTcal | None] = []
     codes: list[int] = []
     # each sample's interval, the samples grouped by it (one pass, not a mask per interval:
