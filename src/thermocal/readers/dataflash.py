@@ -132,8 +132,9 @@ class DataflashLog:
     param_changes : tuple of ParamChange
         Later changes of a parameter's value, in log order.
     columns : dict of str to dict of str to numpy.ndarray
-        Per wanted message type, its numeric fields as float64 columns in log order (logs
-        read by the fixed-format parser, :func:`_fast_pass`), the values pymavlink gives.
+        Per wanted message type, its numeric fields as columns in log order (logs read by
+        the fixed-format parser, :func:`_fast_pass`): in their logged types (the scaled ones
+        float64), each value exactly pymavlink's once made a float64.
     """
 
     rows: dict[str, list[dict[str, float]]]
@@ -141,7 +142,7 @@ class DataflashLog:
     params: dict[str, float]
     notes: tuple[str, ...]
     param_changes: tuple[ParamChange, ...] = ()
-    columns: dict[str, dict[str, npt.NDArray[np.float64]]] = field(default_factory=dict)
+    columns: dict[str, dict[str, npt.NDArray[Any]]] = field(default_factory=dict)
 
     def message_rows(self, name: str) -> list[dict[str, float]]:
         """Every message of type ``name`` (all instances), numeric fields, in log order,
@@ -475,7 +476,8 @@ def _columns_table(
     if cols is not None:
         inst_col = cols.get("I")
         if inst_col is not None:
-            rows = np.flatnonzero(np.trunc(inst_col) == inst)
+            whole = np.trunc(inst_col) if inst_col.dtype.kind == "f" else inst_col
+            rows = np.flatnonzero(whole == inst)
             if rows.size:
                 return _frame(cols, rows), name
         elif inst == 0 and len(next(iter(cols.values()))):
@@ -486,18 +488,13 @@ def _columns_table(
     return None, name
 
 
-def _frame(
-    cols: dict[str, npt.NDArray[np.float64]], rows: npt.NDArray[np.intp] | None
-) -> pd.DataFrame:
+def _frame(cols: dict[str, npt.NDArray[Any]], rows: npt.NDArray[np.intp] | None) -> pd.DataFrame:
     """The columns (those ``rows``; None: all) as one float64 frame, gathered straight into
     the frame's block (fields × rows, no second copy)."""
     n = len(next(iter(cols.values()))) if rows is None else rows.size
     block = np.empty((len(cols), n))
     for j, v in enumerate(cols.values()):
-        if rows is None:
-            block[j] = v
-        else:
-            np.take(v, rows, out=block[j])
+        block[j] = v if rows is None else v[rows]  # float64 on the way in
     return pd.DataFrame(block.T, columns=list(cols), copy=False)
 
 
@@ -697,7 +694,8 @@ def _walk_at_once(
     size = u8.size
     if size < 3:
         return None
-    cand = np.flatnonzero((u8[:-2] == _HEAD[0]) & (u8[1:-1] == _HEAD[1]))
+    cand = np.flatnonzero(u8[:-2] == _HEAD[0])  # one byte mask at a time: less memory
+    cand = cand[u8[cand + 1] == _HEAD[1]]
     if cand.size == 0 or cand[0] != 0:
         return None
     lengths = np.zeros(256, dtype=np.int64)
@@ -780,11 +778,15 @@ def _units_sound(
     return True
 
 
-def _numeric(rec: npt.NDArray[Any], fmt: _Format, col: str) -> npt.NDArray[np.float64]:
-    """One numeric field of ``rec`` as float64, scaled as pymavlink scales it."""
+def _numeric(
+    rec: npt.NDArray[Any], fmt: _Format, col: str, *, native: bool = False
+) -> npt.NDArray[Any]:
+    """One numeric field of ``rec`` as float64, scaled as pymavlink scales it (``native``:
+    an unscaled field in its logged type, a copy; float64 gives pymavlink's value)."""
     divisor = _CODES[fmt.chars[fmt.columns.index(col)]][1]
-    v = rec[col].astype(np.float64)
-    return v / divisor if divisor is not None else v
+    if divisor is not None:
+        return rec[col].astype(np.float64) / divisor
+    return rec[col].copy() if native else rec[col].astype(np.float64)
 
 
 def _fast_pass(path: Path, keep: set[str]) -> DataflashLog | None:
@@ -813,7 +815,7 @@ def _fast_pass(path: Path, keep: set[str]) -> DataflashLog | None:
         t = by_name["FMTU"]
         if not _units_sound(buf, starts[types == t], formats[t], formats):
             return None
-    columns: dict[str, dict[str, npt.NDArray[np.float64]]] = {}
+    columns: dict[str, dict[str, npt.NDArray[Any]]] = {}
     stamp = np.full(starts.size, np.nan)
     for t in present.tolist():
         fmt = formats[t]
@@ -825,7 +827,7 @@ def _fast_pass(path: Path, keep: set[str]) -> DataflashLog | None:
             stamp[where] = _numeric(rec, fmt, "TimeUS")
         if fmt.name in keep:
             columns[fmt.name] = {
-                c: _numeric(rec, fmt, c)
+                c: _numeric(rec, fmt, c, native=True)
                 for c, ch in zip(fmt.columns, fmt.chars, strict=True)
                 if ch not in _TEXT
             }
