@@ -33,11 +33,19 @@ seconds of rotation rate and of gravity on other axes), one logging drop-out of 
 Usage::
 
     PYTHONPATH=src .venv/bin/python benchmarks/bench_px4_algorithm.py [--size small|large]
-        [--plots | --as-script | --parse] [--keep DIR]
+        [--plots | --as-script | --parse] [--keep DIR] [--repeat N | --quick]
+        [--before OLD/src]
 
-``small`` ≈ 5 MB (seconds), ``large`` ≈ 50 MB (the issue's size).  Timed (wall, each a fresh
-process as a user runs it): ``thermocal px4-tempcal LOG -o DIR`` (reports included) and this
-file's ``--px4-only LOG`` (PX4's algorithm; with ``--plots``, its PDF too).
+``small`` ≈ 5 MB (seconds), ``large`` ≈ 50 MB (the issue's size).  Timed (wall and peak
+resident memory of each a fresh process as a user runs it, ``_harness.measure``), best of
+``--repeat`` (3) runs interleaved: ``thermocal px4-tempcal LOG -o DIR`` (reports included),
+with ``--before`` the same command from another source tree (the code before a change), and
+this file's ``--px4-only LOG`` (PX4's algorithm; with ``--plots`` its PDF too, with
+``--as-script`` as the script runs it).  Printed: the ratio thermocal/PX4 and the speed-up,
+before → after, and the memory of the command above that of the same command on a tiny log
+(≈ 1 MB) against the log's size (issue 41, item 1: at most 1/1.5 of the script's time, at
+most 2× the log's size).  The load average is printed at the start, after each run and at
+the end.
 """
 
 from __future__ import annotations
@@ -45,7 +53,6 @@ from __future__ import annotations
 import argparse
 import math
 import os
-import subprocess
 import sys
 import tempfile
 import time
@@ -61,8 +68,9 @@ MEDIAN_SAMPLES = 31
 """PX4's running-median length (``medfilt(data, 31)``)."""
 PX4_BINS = 2000
 """PX4's number of equal temperature bins (``resampleWithDeltaX``: ``nbInterval``)."""
-SIZES = {"small": 40_000, "large": 380_000}
-"""Samples per topic instance: 4 instances × 33 bytes a message → ≈ 5 MB and ≈ 50 MB."""
+SIZES = {"tiny": 8_000, "small": 40_000, "large": 380_000}
+"""Samples per topic instance: 4 instances × 33 bytes a message → ≈ 1, 5 and 50 MB (the
+tiny log: the memory baseline of the command)."""
 
 _REC = np.dtype(
     [("size", "<u2"), ("kind", "u1"), ("msg_id", "<u2"), ("timestamp", "<u8"),
@@ -284,14 +292,67 @@ def residuals(ours: dict[str, float], px4: dict[str, float]) -> list[tuple[str, 
     return rows
 
 
-def _timed(cmd: list[str]) -> float:
-    env = {**os.environ, "PYTHONPATH": str(Path(__file__).resolve().parents[1] / "src")}
-    t0 = time.perf_counter()
-    run = subprocess.run(cmd, capture_output=True, text=True, env=env, check=False)
-    dt = time.perf_counter() - t0
-    if run.returncode != 0:
-        sys.exit(f"failed ({run.returncode}): {' '.join(cmd)}\n{run.stderr[-2000:]}")
-    return dt
+_CPU_WRAPPER = r"""
+import resource, subprocess, sys, time
+t0 = time.perf_counter()
+proc = subprocess.run(sys.argv[1:], stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+dt = time.perf_counter() - t0
+ru = resource.getrusage(resource.RUSAGE_CHILDREN)
+print(f"{proc.returncode} {ru.ru_maxrss} {dt:.4f} {ru.ru_utime + ru.ru_stime:.4f}")
+if proc.returncode:
+    print(proc.stderr[-2000:], file=sys.stderr)
+"""
+"""``_harness.WRAPPER`` with the CPU time [s] of the child and its own children added (user
++ system): on a loaded machine the wall time is mostly waiting for a core, the CPU time
+is what the program costs."""
+
+
+def _measure(cmd: list[str]) -> tuple[float, float, float]:
+    """(wall [s], peak resident memory of the largest process [MB], CPU [s]) of one run."""
+    import subprocess
+
+    res = subprocess.run([sys.executable, "-c", _CPU_WRAPPER, *cmd], capture_output=True,
+                         text=True, check=False)  # fmt: skip
+    code, peak_kb, wall, cpu = res.stdout.split()
+    if int(code) != 0:
+        raise SystemExit(f"{cmd} failed: {res.stderr}")
+    return float(wall), int(peak_kb) / 1024.0, float(cpu)
+
+
+def _race(cmds: dict[str, list[str]], repeat: int) -> dict[str, tuple[float, float, float]]:
+    """Best wall time [s], peak resident memory [MB] and least CPU time [s] of each command,
+    run ``repeat`` times interleaved (one of each in turn, so that a change of the machine's
+    load falls on all of them alike), each a fresh process."""
+    best: dict[str, tuple[float, float, float]] = {}
+    for r in range(repeat):
+        for name, cmd in cmds.items():
+            t, mb, cpu = _measure(cmd)
+            old = best.get(name, (math.inf, 0.0, math.inf))
+            best[name] = (min(old[0], t), max(old[1], mb), min(old[2], cpu))
+            print(f"  run {r + 1}/{repeat} {name:<16} {t:7.2f} s {mb:7.0f} MB cpu {cpu:6.2f} s "
+                  f"(load {os.getloadavg()[0]:.2f})", flush=True)  # fmt: skip
+    return best
+
+
+def _compiled(trees: list[Path]) -> None:
+    """Each source tree timed byte-compiled first (``compileall``, written even under
+    ``PYTHONDONTWRITEBYTECODE``), as an installed package is: else every run compiles
+    thermocal's modules again (≈ 1 s of CPU) while PX4's script imports only installed
+    packages."""
+    import compileall
+
+    for tree in trees:
+        compileall.compile_dir(str(tree), quiet=1)
+
+
+def _ours(tree: Path | None, log: Path, out: Path, *extra: str) -> list[str]:
+    """``thermocal px4-tempcal LOG -o OUT`` as a user runs it, from this tree or ``tree``
+    (the code before a change: its ``src``)."""
+    from _harness import THERMOCAL
+
+    env = [] if tree is None else ["env", f"PYTHONPATH={tree}"]
+    return [*env, *THERMOCAL, "px4-tempcal", str(log), "-o", str(out), "--allow-motion",
+            "--json", *extra]  # fmt: skip
 
 
 def _time_parse(log: Path) -> None:
@@ -335,6 +396,14 @@ def main() -> None:
         help="only time the ULog parse of the log's four sensor topics: pyulog against "
         "thermocal's fast reader (readers.ulog_fast), same process, best of 3 each, warm",
     )
+    ap.add_argument("--repeat", type=int, default=3, help="runs of each program (best of)")
+    ap.add_argument("--quick", action="store_true", help="one run of each")
+    ap.add_argument(
+        "--before",
+        type=Path,
+        help="also time thermocal from this src folder (the code before a change: "
+        "git archive BASE src | tar -x -C DIR, then DIR/src), interleaved",
+    )
     ap.add_argument("--px4-only", type=Path, help=argparse.SUPPRESS)
     ap.add_argument("--out", type=Path, help=argparse.SUPPRESS)
     a = ap.parse_args()
@@ -349,32 +418,70 @@ def main() -> None:
     log = work / f"hard_{a.size}.ulg"
     data, _truth = hard_log(SIZES[a.size])
     log.write_bytes(data)
-    print(f"log {log}: {log.stat().st_size / 1e6:.1f} MB, {SIZES[a.size]} samples per instance")
+    mb_log = log.stat().st_size / 1e6
+    print(f"log {log}: {mb_log:.1f} MB, {SIZES[a.size]} samples per instance")
     print(f"load average before: {os.getloadavg()[0]:.2f}")
     if a.parse:
         _time_parse(log)
         return
-    exe = str(Path(sys.executable).parent / "thermocal")
-    cmd = [exe, "px4-tempcal", str(log), "-o", str(work / "out"), "--allow-motion", "--json"]
-    t_ours = _timed(cmd)  # the bumps are motion: refused without --allow-motion
+    os.environ["PYTHONPATH"] = str(Path(__file__).resolve().parents[1] / "src")
+    _compiled([Path(os.environ["PYTHONPATH"]), *([a.before] if a.before else [])])
     px4_params = work / "px4_algorithm.params"
-    child = [sys.executable, __file__, "--px4-only", str(log), "--out", str(px4_params)]
-    t_px4 = _timed(
-        child + (["--plots"] if a.plots else []) + (["--as-script"] if a.as_script else [])
-    )
+    px4 = [sys.executable, __file__, "--px4-only", str(log), "--out", str(px4_params)]
+    px4 += (["--plots"] if a.plots else []) + (["--as-script"] if a.as_script else [])
+    cmds = {"thermocal": _ours(None, log, work / "out")}
+    if a.before is not None:
+        cmds["thermocal before"] = _ours(a.before, log, work / "out_before")
+    cmds["PX4 algorithm"] = px4
+    best = _race(cmds, 1 if a.quick else a.repeat)
     rows = residuals(read_params(work / "out" / "px4.params"), read_params(px4_params))
     print(f"{'axis':<10} {'thermocal':>12} {'PX4 algo':>12} {'ratio':>7}")
-    for name, ours, px4 in rows:
+    for name, ours, theirs in rows:
         unit = "rad/s" if name.startswith("gyro") else "m/s²"
-        print(f"{name:<10} {ours:12.3e} {px4:12.3e} {ours / px4:7.2f}  {unit}")
+        print(f"{name:<10} {ours:12.3e} {theirs:12.3e} {ours / theirs:7.2f}  {unit}")
     ratios = [o / p for _n, o, p in rows]
     geo = float(np.exp(np.mean(np.log(ratios))))
     print(f"ratio thermocal/PX4: geometric mean over the axes {geo:.2f}, worst axis "
           f"{max(ratios):.2f} (targets: <= 0.8, every axis <= 1)")  # fmt: skip
-    how = "as the script runs it " if a.as_script else "(with its PDF) " if a.plots else ""
-    print(f"time: thermocal px4-tempcal {t_ours:.2f} s, PX4 algorithm {how}{t_px4:.2f} s, "
-          f"ratio {t_ours / t_px4:.2f}")  # fmt: skip
+    _speed_table(a, best, log, work, mb_log)
     print(f"load average after: {os.getloadavg()[0]:.2f}")
+
+
+def _speed_table(
+    a: argparse.Namespace, best: dict[str, tuple[float, float, float]], log: Path, work: Path,
+    mb_log: float,
+) -> None:  # fmt: skip
+    """The times and memories side by side, the ratios, the targets (issue 41, item 1)."""
+    how = "as the script runs it" if a.as_script else "with its PDF" if a.plots else "bare"
+    t_px4, _mb_px4, cpu_px4 = best["PX4 algorithm"]
+    print(
+        f"{'program':<38} {'best s':>8} {'peak MB':>8} {'CPU s':>7} {'ratio':>6} {'CPU ratio':>9}"
+    )
+    for name, (t, mb, cpu) in best.items():
+        label = f"PX4 algorithm ({how})" if name == "PX4 algorithm" else name
+        print(f"{label:<38} {t:8.2f} {mb:8.0f} {cpu:7.2f} {t / t_px4:6.2f} {cpu / cpu_px4:9.2f}")
+    t_ours, mb_ours, cpu_ours = best["thermocal"]
+    print(f"time: thermocal px4-tempcal {t_ours:.2f} s, PX4 algorithm {how} {t_px4:.2f} s, "
+          f"ratio {t_ours / t_px4:.2f} (speed-up {t_px4 / t_ours:.2f}x); CPU {cpu_ours:.2f} s "
+          f"against {cpu_px4:.2f} s, ratio {cpu_ours / cpu_px4:.2f}")  # fmt: skip
+    if "thermocal before" in best:
+        t_old, mb_old, cpu_old = best["thermocal before"]
+        print(f"before -> after: {t_old:.2f} s -> {t_ours:.2f} s ({t_old / t_ours:.2f}x), "
+              f"CPU {cpu_old:.2f} -> {cpu_ours:.2f} s, "
+              f"peak {mb_old:.0f} -> {mb_ours:.0f} MB")  # fmt: skip
+    tiny = work / "hard_tiny.ulg"
+    tiny.write_bytes(hard_log(SIZES["tiny"])[0])
+    base = min(_measure(_ours(None, tiny, work / f"out_tiny{i}"))[1] for i in range(2))
+    above = mb_ours - base
+    print(f"memory: peak {mb_ours:.0f} MB on the {mb_log:.1f} MB log, {base:.0f} MB on a "
+          f"{tiny.stat().st_size / 1e6:.2f} MB log: {above:.0f} MB above, "
+          f"{above / mb_log:.2f}x the log (peak RSS of the largest process, wrapper's "
+          "RUSAGE_CHILDREN)")  # fmt: skip
+    if a.as_script:
+        ok = t_ours / t_px4 <= 1 / 1.5
+        print(f"target (<= 0.667 of PX4's script's time): {'met' if ok else 'NOT met'}")
+        print(f"target (<= 2x the log's size above a tiny log's): "
+              f"{'met' if above <= 2 * mb_log else 'NOT met'}")  # fmt: skip
 
 
 if __name__ == "__main__":

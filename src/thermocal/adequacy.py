@@ -651,14 +651,20 @@ def _block_stats(
     every = max(1, idx.size // SIGMA_SAMPLES)  # the noise from an even subsample
     inv = np.searchsorted(starts, np.arange(0, idx.size, every), side="right") - 1
     equal = bool(np.all(counts == counts[0]))
+    if not equal:  # each block a row, padded with NaN (sorted last, as in the block alone)
+        rows = np.repeat(np.arange(starts.size), counts)
+        at = (rows, np.arange(idx.size) - starts[rows])
+        lo_i, hi_i = (counts - 1) // 2, counts // 2
+        block = np.full((starts.size, int(counts.max())), np.nan)
     for j in range(m):
         if equal:  # the common case: a regular record
             med[:, j] = np.median(v[:, j].reshape(starts.size, int(counts[0])), axis=1)
         else:
-            sv = v[np.lexsort((v[:, j], idx)), j]  # idx is sorted: blocks stay in place
-            lo_i = starts + (counts - 1) // 2
-            hi_i = starts + counts // 2
-            med[:, j] = 0.5 * (sv[lo_i] + sv[hi_i])
+            block.fill(np.nan)
+            block[at] = v[:, j]
+            block.sort(axis=1)
+            every_block = np.arange(starts.size)
+            med[:, j] = 0.5 * (block[every_block, lo_i] + block[every_block, hi_i])
         dev = v[::every, j] - med[inv, j]
         sigma[j] = 1.4826 * float(np.median(np.abs(dev)))
     return time_s[0] + idx[starts] * block_s, counts.astype(np.float64), med, sigma
@@ -711,13 +717,25 @@ def _ragged_medians(
     padded = np.vstack([x, np.full((1, m), np.nan)])
     step = max(1, 2_000_000 // (width * m))
     cols = np.arange(width)
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", RuntimeWarning)  # an empty window: NaN, not used
-        for a in range(0, lo.size, step):
-            rows = lo[a : a + step, None] + cols
-            rows = np.where(rows < hi[a : a + step, None], rows, n)
-            out[a : a + step] = np.nanmedian(padded[rows], axis=1)
+    for a in range(0, lo.size, step):
+        rows = lo[a : a + step, None] + cols
+        rows = np.where(rows < hi[a : a + step, None], rows, n)
+        out[a : a + step] = _nan_medians(padded[rows])
     return out
+
+
+def _nan_medians(w: FloatArray) -> FloatArray:
+    """``np.nanmedian(w, axis=1)`` of windows (k, width, m), the same numbers at once: each
+    window sorted (NaN last), the middle one or the mean of the middle two of what is not
+    NaN; NaN for an all-NaN window."""
+    w = np.sort(w, axis=1)
+    c = np.sum(~np.isnan(w), axis=1)  # (k, m)
+    lo = np.maximum(c - 1, 0) // 2
+    hi = c // 2
+    a = np.take_along_axis(w, lo[:, None, :], axis=1)[:, 0, :]
+    b = np.take_along_axis(w, np.minimum(hi, w.shape[1] - 1)[:, None, :], axis=1)[:, 0, :]
+    med: FloatArray = np.where(c > 0, (a + b) / 2.0, np.nan)
+    return med
 
 
 def _runs_of(mask: npt.NDArray[np.bool_]) -> list[tuple[int, int]]:

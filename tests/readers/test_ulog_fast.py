@@ -247,3 +247,31 @@ def test_damaged_logs_take_pyulogs_path_and_keep_their_notes(
     read = ulog_mod._parse_ulog_file(clean, ["sensor_gyro"])
     assert len(taken) == 1 and read.ulog is taken[0] is not None
     assert (read.damaged, read.skipped, read.notes) == (False, False, ())
+
+
+def _walk(buf: bytes, start: int) -> tuple[list[int], int]:
+    """The message chain walked one message at a time (the file format's definition)."""
+    out, pos = [], start
+    while pos <= len(buf) - 3:
+        out.append(pos)
+        pos += 3 + struct.unpack_from("<H", buf, pos)[0]
+    return out, pos
+
+
+def test_message_offsets_along_runs_of_one_size() -> None:
+    # runs of equal sizes (longer than the streak that starts a run check, longer than a
+    # first check, ending one message after a check), mixed sizes, empty payloads, a cut end
+    rng = np.random.default_rng(41)
+    for trial in range(200):
+        parts = []
+        while sum(map(len, parts)) < 30_000:
+            size = int(rng.choice([0, 1, 5, 28, 40, 300]))
+            reps = int(rng.choice([1, 2, 9, 33, 41, 700]))
+            payload = bytes(rng.integers(0, 256, size, dtype=np.uint8))
+            parts.append(_msg("D", payload) * reps)
+        buf = b"".join(parts)
+        buf = buf[: len(buf) - int(rng.integers(0, 40))]
+        for start in (0, 3):
+            want, end = _walk(buf, start)
+            got, got_end = ulog_fast.message_offsets(buf, start)
+            assert (got.tolist(), got_end) == (want, end), (trial, start)

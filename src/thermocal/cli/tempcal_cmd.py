@@ -31,6 +31,25 @@ if TYPE_CHECKING:
 
 OutDirOpt = Annotated[Path, typer.Option("-o", "--output", help="Directory to write.")]
 
+M_MMAP_THRESHOLD = -3
+"""glibc's ``mallopt`` parameter of the size from which a block is a mapping of its own."""
+
+
+def _freed_arrays_given_back() -> None:
+    """On glibc, every block of 128 KiB or more (a log's arrays and their temporaries) a
+    mapping of its own, returned to the system when freed: ``mallopt(M_MMAP_THRESHOLD)``,
+    which also stops glibc from raising that threshold to the size of each large block
+    freed (then the next temporaries come from the heap, which keeps them: ~20 MB of a
+    50 MB log's peak).  Elsewhere nothing."""
+    import contextlib
+    import ctypes
+    import sys
+
+    if not sys.platform.startswith("linux"):
+        return
+    with contextlib.suppress(OSError, AttributeError):  # not glibc
+        ctypes.CDLL("libc.so.6").mallopt(M_MMAP_THRESHOLD, 128 * 1024)
+
 
 @app.command("px4-tempcal")
 @handle_errors
@@ -44,6 +63,14 @@ def px4_tempcal_cmd(
     allow_narrow: AllowNarrowOpt = False,
     allow_motion: AllowMotionOpt = False,
     as_json: JsonOpt = False,
+    allan: Annotated[
+        bool,
+        typer.Option(
+            "--allan",
+            help="Draw each axis's Allan deviation before and after compensation in the "
+            "gyro and accelerometer reports (slower on a long log).",
+        ),
+    ] = False,
 ) -> None:
     """Fit every gyro and accelerometer instance of a PX4 log as PX4 would (a cubic per axis
     about TREF), robust to spikes, with equal weight across the temperature range and
@@ -51,9 +78,11 @@ def px4_tempcal_cmd(
     from thermocal.report.sensor import write_sensor_report
     from thermocal.tempcal.px4 import px4_tempcal
 
+    _freed_arrays_given_back()
+
     res = px4_tempcal(
         log, output, tref_c=tref, overrides=overrides_of(allow_narrow, allow_motion),
-        reporter=write_sensor_report,
+        reporter=write_sensor_report, allan=allan,
     )  # fmt: skip
     emit(res.to_dict(), as_json, lambda: _print_px4(res))
 
@@ -77,6 +106,8 @@ def ardupilot_tempcal_cmd(
     and reports (the polynomial about 35 °C without constant, as the firmware takes it)."""
     from thermocal.report.sensor import write_sensor_report
     from thermocal.tempcal.ardupilot import ardupilot_tempcal
+
+    _freed_arrays_given_back()
 
     res = ardupilot_tempcal(
         log, output, overrides=overrides_of(allow_narrow, allow_motion),

@@ -114,6 +114,41 @@ def parsed_once(path: str | Path, names: Sequence[str]) -> Iterator[None]:
         _PARSED.reset(token)
 
 
+def release_parsed_topic(path: str | Path, topic: str) -> bool:
+    """Within :func:`parsed_once`, drop one topic instance's data from the block's parse of
+    ``path`` (a caller that has read it and will not read it again gives its memory back:
+    the instance's raw messages, about its share of the log's size).  A later read of that
+    instance within the block says it is not in the log.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        The ULog file.
+    topic : str
+        The topic instance, ``NAME.N``.
+
+    Returns
+    -------
+    bool
+        True when the instance was parsed and is now dropped; False outside the block, or
+        when the log has not been parsed or has no such instance.
+    """
+    cache = _PARSED.get()
+    if cache is None:
+        return False
+    name, inst = parse_topic(topic)
+    where = Path(path).resolve()
+    for (at, _have), read in cache.items():
+        if at != where or read is None:
+            continue
+        data = read.ulog.data_list
+        keep = [d for d in data if not (d.name == name and d.multi_id == inst)]
+        if len(keep) < len(data):
+            data[:] = keep
+            return True
+    return False
+
+
 def _parse_ulog(path: Path, names: list[str] | None) -> _ULogRead:
     """Parse a ULog (:func:`_parse_ulog_file`), or, within :func:`parsed_once` for this file
     and a superset of ``names``, take the block's one parse."""

@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import base64
 import datetime as _dt
+import functools
 import math
 import re
 import warnings
@@ -1026,6 +1027,7 @@ def _collect_warnings(
     return out
 
 
+@functools.cache  # one environment: each template compiled once per process, not per report
 def _env() -> Any:
     import jinja2
 

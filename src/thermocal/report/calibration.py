@@ -98,6 +98,10 @@ class CalibrationReportInputs:
         Notes shown in the report.
     appendix : tuple of str
         HTML sections made by thermocal's report code.
+    allan : bool
+        Draw the Allan deviation section (default True); False leaves it out, and its
+        cost (an overlapping Allan deviation, noise identification and confidence
+        intervals per channel, before and after compensation).
     """
 
     calibration: Calibration
@@ -117,6 +121,8 @@ class CalibrationReportInputs:
     appendix: tuple[str, ...] = ()
     """Sections of HTML made by thermocal's report code (e.g.
     :func:`thermocal.report.tempcal.comparison_html`), shown before the warnings."""
+    allan: bool = True
+    """The Allan deviation section drawn (False: left out, not computed)."""
 
 
 def _validation_of(v: Mapping[str, Any] | None, name: str, single: bool) -> dict[str, Any] | None:
@@ -162,10 +168,11 @@ def _figures_in(stab: float | None, slope: float | None, k: float) -> dict[str, 
 
 
 def _channel_merits(
-    rec: Any, applied: Any, k: float, unit: str, averaging_s: float, tau0: float
+    rec: Any, applied: Any, k: float, unit: str, averaging_s: float, tau0: float | None
 ) -> tuple[list[dict[str, float | None]], list[Any], list[str]]:
     """One channel's figures of merit (in the data's unit) and Allan deviations before and
-    after compensation, and the warnings raised while computing them (one line each)."""
+    after compensation (none when ``tau0`` is None: not asked for), and the warnings raised
+    while computing them (one line each)."""
     before, after = applied.before / k, applied.after / k
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
@@ -179,7 +186,9 @@ def _channel_merits(
             temp_c=applied.temps_c[:, 0],
         )
         fom = [_figures_in(stab, slope, k) for stab, slope in shown]
-        allan = [allan_of(rec.time_s, x, tau0, unit) for x in (before, after)]
+        allan = (
+            [] if tau0 is None else [allan_of(rec.time_s, x, tau0, unit) for x in (before, after)]
+        )
     return fom, allan, [warning_text(w.message) for w in caught]
 
 
@@ -236,7 +245,9 @@ def _channel_section(
     before, after = applied.before / k, applied.after / k
     t_name = applied.temp_names[0]
     t_c = applied.temps_c[:, 0]
-    fom, allan, caught = _channel_merits(rec, applied, k, unit, averaging_s, tau0)
+    fom, allan, caught = _channel_merits(
+        rec, applied, k, unit, averaging_s, tau0 if inputs.allan else None
+    )
     stats = md.get("fit") or {}
     cond = stats.get("condition_number")
     rms_fit = stats.get("rms_residual")
@@ -246,11 +257,6 @@ def _channel_section(
     adequacy = adequacy_rows(md.get("adequacy"), f"channels.{name}.adequacy", name)
     msgs = [*applied.warnings, *caught, *_channel_notes(cond, v, unit, adequacy)]
     vclass, vtext = _verdict(v)
-    terms = [a.terms.fit for a in allan]
-    curves = [
-        F.AllanCurve(lab, a.result.tau_s, a.result.adev, a.result.adev_low, a.result.adev_high)
-        for lab, a in zip(("before", "after"), allan, strict=True)
-    ]
     role = ch.role or {}
     key = f"channels.{name}"
     return {
@@ -279,14 +285,7 @@ def _channel_section(
         "stability_improvement": improvement_pct(
             fom[0]["bias_stability"], fom[1]["bias_stability"]
         ),
-        # IEEE Std 952-1997 Annex C: B at the curve's minimum, always; N on the −½ stretch
-        "bi_before": allan[0].terms.bias_minimum or terms[0].bias_instability,
-        "bi_after": allan[1].terms.bias_minimum or terms[1].bias_instability,
-        "rw_after": (
-            allan[1].terms.slope.angle_random_walk
-            if allan[1].terms.slope.angle_random_walk.value is not None
-            else terms[1].angle_random_walk
-        ),
+        **_noise_terms(name, unit, allan),
         "validation": v,
         "absolute_change": _absolute_change(v, key),
         "adequacy": adequacy,
@@ -295,6 +294,29 @@ def _channel_section(
         "warnings": list(dict.fromkeys(msgs)),
         "extra": {k: vals.get(name) for k, vals in inputs.extra.items()},
         "_bias": F.ChannelBias(name, unit_label(unit), t_name, t_c, before, after),
+    }
+
+
+def _noise_terms(name: str, unit: str, allan: list[Any]) -> dict[str, Any]:
+    """The Allan section's entries of a channel (none without its Allan deviations)."""
+    from thermocal.report import figures as F
+
+    if not allan:
+        return {}
+    terms = [a.terms.fit for a in allan]
+    curves = [
+        F.AllanCurve(lab, a.result.tau_s, a.result.adev, a.result.adev_low, a.result.adev_high)
+        for lab, a in zip(("before", "after"), allan, strict=True)
+    ]
+    return {
+        # IEEE Std 952-1997 Annex C: B at the curve's minimum, always; N on the −½ stretch
+        "bi_before": allan[0].terms.bias_minimum or terms[0].bias_instability,
+        "bi_after": allan[1].terms.bias_minimum or terms[1].bias_instability,
+        "rw_after": (
+            allan[1].terms.slope.angle_random_walk
+            if allan[1].terms.slope.angle_random_walk.value is not None
+            else terms[1].angle_random_walk
+        ),
         "_allan": (name, unit_label(unit), curves),
     }
 
@@ -348,7 +370,7 @@ def build_calibration_report(inputs: CalibrationReportInputs) -> str:
     tau0 = rec.sample_interval_s
     sections = [_channel_section(inputs, n, averaging_s, tau0) for n in names]
     grid = F.bias_vs_temperature_grid([s.pop("_bias") for s in sections])
-    allan = F.allan_grid([s.pop("_allan") for s in sections])
+    allan = F.allan_grid([s.pop("_allan") for s in sections]) if inputs.allan else None
     files = [
         (label, path, sha256_of(path))
         for label, path in (
@@ -385,7 +407,7 @@ def build_calibration_report(inputs: CalibrationReportInputs) -> str:
             tau0=tau0,
             warning_list=[(w, chans) for w, chans in warned.items()],
             grid=_b64(grid),
-            allan=_b64(allan),
+            allan=_b64(allan) if allan is not None else None,
             files=files,
             notes=notes,
             appendix=list(inputs.appendix),

@@ -55,21 +55,25 @@ def write_sensor_report(path: Path, req: AnyReportRequest) -> None:
             appendix=tuple(
                 comparison_html(c) for c in (req.previous, req.firmware_learning) if c is not None
             ),
+            allan=req.allan,
         ),
     )  # fmt: skip
 
 
 def _warm_reports() -> None:
     """What the first report costs beyond its own work (the report modules imported, a
-    log-axis figure drawn: fonts and tick labels), paid by the report worker while the log
-    is read (:func:`thermocal.tempcal.pipeline.report_worker`)."""
+    bias grid drawn: fonts and tick labels; the template compiled), paid by the report
+    worker while the log is read (:func:`thermocal.tempcal.pipeline.report_worker`)."""
     import numpy as np
 
     from thermocal.report import calibration as _calibration  # noqa: F401
     from thermocal.report import figures as F
+    from thermocal.report.build import _env
 
-    tau = np.logspace(-2, 3, 12)
-    F.allan_grid([("x", "unit", [F.AllanCurve("before", tau, 1.0 / tau, None, None)])] * 3)
+    _env().get_template("calibration.html.j2")  # compiled once, here
+
+    t = np.linspace(0.0, 1.0, 50)
+    F.bias_vs_temperature_grid([F.ChannelBias("x", "unit", "T", t, t, t)] * 3)
 
 
 write_sensor_report.warm = _warm_reports  # type: ignore[attr-defined]

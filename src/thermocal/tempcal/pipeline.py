@@ -460,6 +460,9 @@ class ReportRequest:
         The coefficients active in the log against the new ones.
     firmware_learning : CoefficientComparison or None
         The firmware's own learned coefficients against the new ones.
+    allan : bool
+        Draw each channel's Allan deviation before and after compensation with its noise
+        terms (default False: left out; most of a report's cost on a long log).
     """
 
     calibration: Calibration
@@ -474,6 +477,8 @@ class ReportRequest:
     """The coefficients active in the log against the new ones (a table and figure)."""
     firmware_learning: CoefficientComparison | None = None
     """The firmware's own learned coefficients (ArduPilot ``TCLR``) against the new ones."""
+    allan: bool = False
+    """Each channel's Allan deviation section drawn (False: left out, not computed)."""
 
 
 AnyReportRequest = ReportRequest | OffsetReportRequest | ArdupilotBaroReportRequest
@@ -543,7 +548,7 @@ class OutputSet:
     reports: list[Path] = field(default_factory=list)
     workers: int = 0
     _pool: Any = None
-    _pending: list[tuple[Any, Path, AnyReportRequest]] = field(default_factory=list)
+    _pending: list[tuple[Any, Path, AnyReportRequest | None]] = field(default_factory=list)
 
     def report(self, name: str, request: AnyReportRequest) -> None:
         """Write the report ``name`` into the stage (when a reporter is given).
@@ -564,10 +569,19 @@ class OutputSet:
         if self.workers > 0 and _n_samples(request) >= PARALLEL_MIN_SAMPLES:
             if self._pool is None:
                 self._pool = _report_pool()
+            self._forget_written()
             fut = self._pool.submit(_report_job, self.reporter, self.stage / name, request)
             self._pending.append((fut, self.stage / name, request))
             return
         self.reporter(self.stage / name, request)
+
+    def _forget_written(self) -> None:
+        """The requests of reports the worker has written are not kept (their recordings'
+        memory given back); a report not begun or failed keeps its request."""
+        self._pending = [
+            (fut, path, None if fut.done() and _succeeded(fut) else request)
+            for fut, path, request in self._pending
+        ]
 
     def finish_reports(self) -> None:
         """Every report of the set written: those not begun by the worker are built here,
@@ -580,6 +594,7 @@ class OutputSet:
         for fut, path, request in reversed(pending):  # the last first: the worker goes on
             if not fut.cancel():  # begun (or done) there, and so every one before it
                 break
+            assert request is not None  # kept: not done
             self.reporter(path, request)  # type: ignore[misc]
         for fut, path, request in pending:
             if fut.cancelled():
@@ -587,6 +602,7 @@ class OutputSet:
             try:
                 said = fut.result()
             except Exception:  # failed there (or not sent): here, with its own error
+                assert request is not None  # kept: failed
                 self.reporter(path, request)  # type: ignore[misc]
                 continue
             for message, filename, lineno in said:
@@ -620,6 +636,11 @@ class OutputSet:
         with atomic_write(self.stage / params_name, "w") as fh:
             fh.write(params_text)
         commit_directory(self.stage, self.output)
+
+
+def _succeeded(fut: Any) -> bool:
+    """A finished future without an exception."""
+    return not fut.cancelled() and fut.exception() is None
 
 
 def _report_pool() -> Any:
@@ -682,10 +703,18 @@ def report_worker(reporter: Reporter | None, log: Path) -> Iterator[Any]:
 
 
 def report_workers() -> int:
-    """Worker processes for reports: 1 on a machine with two cores or more, else 0."""
+    """Worker processes for reports: 1 when the machine has a core to spare (two cores or
+    more, the load average at least one below their number), else 0: on a busy machine a
+    second process only competes for the same cores and costs its own start (imports,
+    the recordings sent to it), so the reports are built here."""
     import os
 
-    return 1 if (os.cpu_count() or 1) > 1 else 0
+    cores = os.cpu_count() or 1
+    try:
+        load = os.getloadavg()[0]
+    except (AttributeError, OSError):  # no load average here (Windows)
+        load = 0.0
+    return 1 if cores - load >= 1.0 else 0
 
 
 def check_output_dir(output: Path) -> None:
@@ -729,7 +758,8 @@ def staged_set(output: Path, reporter: Reporter | None, pool: Any = None) -> Ite
     """
     from thermocal.writers import discard_staging, staging_directory
 
-    out = OutputSet(output, staging_directory(output), reporter, workers=report_workers())
+    workers = 1 if pool is not None else report_workers()  # the worker started: used
+    out = OutputSet(output, staging_directory(output), reporter, workers=workers)
     out._pool = pool
     try:
         yield out

@@ -278,6 +278,11 @@ class Px4TempcalResult:
 
 
 NO_SENSOR = "no sensor_gyro or sensor_accel topic with a temperature in the log"
+NO_ALLAN = (
+    "The Allan deviation of each axis is not drawn; "
+    "thermocal px4-tempcal LOG -o DIR --allan draws it."  # cli-words: the command that draws it
+)
+"""The report's note when its Allan section is left out (``allan`` False)."""
 
 
 def px4_tempcal(
@@ -287,6 +292,7 @@ def px4_tempcal(
     tref_c: float | None = None,
     overrides: tuple[str, ...] = (),
     reporter: Reporter | None = None,
+    allan: bool = False,
 ) -> Px4TempcalResult:
     """PX4's thermal calibration of every sensor instance of a ULog, written as one set.
 
@@ -304,6 +310,10 @@ def px4_tempcal(
         Adequacy checks let through (``"narrow"``, ``"motion"``).
     reporter : callable, optional
         Writes one report (the presentation layer's); None: no report written.
+    allan : bool, optional
+        The gyro and accelerometer reports draw each axis's overlapping Allan deviation
+        before and after compensation with its noise terms (IEEE Std 952-1997 Annex C);
+        default False: left out (on a long log, most of a report's cost).
 
     Returns
     -------
@@ -348,7 +358,7 @@ def px4_tempcal(
         report_worker(reporter, log) as pool,  # starts while the log is read
         open_px4_log(log, (*TOPICS, *OFFSET_TOPICS)) as flight,  # the log is parsed once
     ):
-        return _px4_tempcal(flight, output, tref_c, overrides, reporter, pool)
+        return _px4_tempcal(flight, output, tref_c, overrides, reporter, pool, allan)
 
 
 def _px4_tempcal(
@@ -358,6 +368,7 @@ def _px4_tempcal(
     overrides: tuple[str, ...],
     reporter: Reporter | None,
     pool: Any = None,
+    allan: bool = False,
 ) -> Px4TempcalResult:
     """:func:`px4_tempcal` after its output checks (``pool``: the report worker)."""
     from thermocal.export.params import ParamSet
@@ -383,8 +394,9 @@ def _px4_tempcal(
                     offset_fits.append(ofit)
                 continue
             fit, more = _imu_instance(
-                flight, name, inst, tref_c, overrides, params, out_set, (series, motions), old
-            )
+                flight, name, inst, tref_c, overrides, params, out_set, (series, motions), old,
+                allan,
+            )  # fmt: skip
             fits.append(fit)
             gates.extend(more)
         gates.extend(step_warnings(fits, series, motions))
@@ -510,24 +522,30 @@ def _imu_instance(
     out_set: OutputSet,
     found: tuple[dict[str, tuple[FloatArray, FloatArray]], dict[str, adequacy.Motion]],
     old: _Prior,
+    allan: bool = False,
 ) -> tuple[SensorFit, list[str | None]]:
     """A gyro or accelerometer instance through the pipeline: read, fit, its gates, its
-    ``TC_G``/``TC_A`` parameters merged into ``params``, its report; ``found`` (series,
-    motions) gets its (time [s], x/y/z in the canonical unit) and its stillness result for
-    the step check across instances."""
+    ``TC_G``/``TC_A`` parameters merged into ``params``, its report (``allan``: with its
+    Allan section); ``found`` (series, motions) gets its (time [s], x/y/z in the canonical
+    unit) and its stillness result for the step check across instances."""
     from thermocal.export.params import export_params
+    from thermocal.readers.ulog import release_parsed_topic
 
     kind = "gyro" if name == "sensor_gyro" else "accel"
     where = f"{name}.{inst}"
     log = flight.path
     rec = flight.recording(where)
+    release_parsed_topic(log, where)  # read once: its raw messages are not needed again
     series, motions = found
     fit = fit_sensor(rec, name, kind, inst, overrides=overrides, motions=motions)
     temp_c = rec.temperature_c("temperature")
-    series[where] = (rec.time_s, np.column_stack([rec.signal(a)[0] for a in AXES]))
+    # the step check across instances reads the stillness result (motions), not the values
+    series[where] = (rec.time_s, np.empty((0, len(AXES))))
     gates = [stall_warning(where, rec.time_s, temp_c)]
     if kind == "gyro":
-        gates.append(gyro_unit_warning(f"{log}: {where}", series[where][1]))
+        vals = np.column_stack([rec.signal(a)[0] for a in AXES])
+        gates.append(gyro_unit_warning(f"{log}: {where}", vals))
+        del vals
     if tref_c is not None:
         gates.append(end_warning(where, "TREF", tref_c, *fit.sweep_c))
     sub = Calibration(fit.channels)
@@ -540,6 +558,11 @@ def _imu_instance(
     prev = old.compare(
         where, ps.params, kind, inst, fit.device_id, "rad/s" if kind == "gyro" else "m/s^2",
         fit.sweep_c,
+    )  # fmt: skip
+    shown = (*AXES, "temperature")  # what the report reads: the device id column left here
+    rec = dataclasses.replace(
+        rec, columns={k: v for k, v in rec.columns.items() if k in shown},
+        units={k: u for k, u in rec.units.items() if k in shown},
     )  # fmt: skip
     out_set.report(
         f"report_{name}_{inst}.html",
@@ -556,8 +579,10 @@ def _imu_instance(
                 "'hold-out rms' is the rms of a cubic fitted to the even bins on the odd "
                 "ones, in the canonical unit (°/h or mg).",
                 *(f"Firmware: {n}" for n in ps.notes),
+                *(() if allan else (NO_ALLAN,)),
             ),
             previous=prev,
+            allan=allan,
         ),
     )  # fmt: skip
     return fit, gates
