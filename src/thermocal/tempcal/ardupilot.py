@@ -70,6 +70,11 @@ second and third IMU; ``TCLR``: the firmware's own learning; ``BARO``: the barom
 KINDS = (("gyro", "Gyr", "rad/s"), ("accel", "Acc", "m/s^2"))
 """(kind, field prefix of the ``IMU`` message, its unit) per sensor of an IMU."""
 KIND_UNITS = {kind: unit for kind, _prefix, unit in KINDS}
+NO_ALLAN = (
+    "The Allan deviation of each axis is not drawn; "
+    "thermocal ardupilot-tempcal LOG -o DIR --allan draws it."  # cli-words: its command
+)
+"""The report's note when its Allan section is left out (``allan`` False)."""
 BARO_REPORT = "report_BARO_0.html"
 """The report of the first barometer's ``TCAL_BARO_EXP``."""
 
@@ -742,13 +747,20 @@ class _Run:
     previous: dict[str, CoefficientComparison] = dataclasses.field(default_factory=dict)
     learning: dict[str, CoefficientComparison] = dataclasses.field(default_factory=dict)
     baro: ArdupilotBaroFit | None = None
+    allan: bool = False
+    """The gyro and accelerometer reports draw each axis's Allan deviation."""
     motions: dict[str, Any] = dataclasses.field(default_factory=dict)
     """Each instance's stillness from its fit (:func:`.pipeline.fit_sensor`), for the step
     warnings (computed once)."""
 
 
 def ardupilot_tempcal(
-    log: Path, output: Path, *, overrides: tuple[str, ...] = (), reporter: Reporter | None = None
+    log: Path,
+    output: Path,
+    *,
+    overrides: tuple[str, ...] = (),
+    reporter: Reporter | None = None,
+    allan: bool = False,
 ) -> ArdupilotTempcalResult:
     """ArduPilot's thermal calibration of every IMU of a DataFlash log, written as one set.
 
@@ -764,6 +776,10 @@ def ardupilot_tempcal(
         Adequacy checks let through (``"narrow"``, ``"motion"``).
     reporter : callable, optional
         Writes one report (the presentation layer's); None: no report written.
+    allan : bool, optional
+        The gyro and accelerometer reports draw each axis's overlapping Allan deviation
+        before and after compensation with its noise terms (IEEE Std 952-1997 Annex C);
+        default False: left out (on a long log, most of a report's cost).
 
     Returns
     -------
@@ -810,6 +826,7 @@ def ardupilot_tempcal(
     ):
         flight = read_ardupilot_log(log, MESSAGES)  # the log is read once, passed down
         run = _Run(log, flight, overrides, ParamSet("ardupilot"), out_set, [], [], {}, {})
+        run.allan = allan
         for inst in range(MAX_IMUS):
             try:
                 df, _info = flight.table("IMU", inst)
@@ -980,9 +997,9 @@ def _imu(run: _Run, df: Any, inst: int) -> None:
                 calibration=Calibration(fit.channels), recording=sub_rec,
                 recording_path=str(run.log), title=f"ArduPilot thermal calibration — IMU {inst} "
                 f"{fit.kind}", generated_by="thermocal ardupilot-tempcal",
-                notes=tuple(f"Firmware: {n}" for n in ps.notes),
+                notes=(*(f"Firmware: {n}" for n in ps.notes), *(() if run.allan else (NO_ALLAN,))),
                 previous=run.previous.get(key),
-                firmware_learning=run.learning.get(key),
+                firmware_learning=run.learning.get(key), allan=run.allan,
             ),
         )  # fmt: skip
 
