@@ -789,6 +789,35 @@ def _numeric(
     return rec[col].copy() if native else rec[col].astype(np.float64)
 
 
+_CHUNK_ROWS = 1 << 16
+"""Messages of one type parsed at a time by :func:`_parsed` (their bytes gathered: a few MB)."""
+
+
+def _parsed(
+    u8: npt.NDArray[np.uint8], at: npt.NDArray[np.int64], fmt: _Format, fields: bool
+) -> tuple[npt.NDArray[np.float64] | None, dict[str, npt.NDArray[Any]]]:
+    """The messages of one type starting at ``at``: their ``TimeUS`` as float64 (None
+    without one) and, with ``fields``, every numeric field (:func:`_numeric`, native),
+    :data:`_CHUNK_ROWS` messages at a time."""
+    win = np.lib.stride_tricks.sliding_window_view(u8, fmt.length)
+    timed = "TimeUS" in fmt.columns and fmt.chars[fmt.columns.index("TimeUS")] not in _TEXT
+    times = np.empty(at.size) if timed else None
+    cols: dict[str, npt.NDArray[Any]] = {}
+    if fields:
+        for c, ch in zip(fmt.columns, fmt.chars, strict=True):
+            if ch not in _TEXT:
+                scaled = _CODES[ch][1] is not None
+                cols[c] = np.empty(at.size, np.float64 if scaled else fmt.record[c])
+    for a in range(0, at.size, _CHUNK_ROWS):
+        b = min(a + _CHUNK_ROWS, at.size)
+        rec = win[at[a:b]].view(fmt.record).reshape(-1)
+        if times is not None:
+            times[a:b] = _numeric(rec, fmt, "TimeUS")
+        for c, arr in cols.items():
+            arr[a:b] = _numeric(rec, fmt, c, native=True)
+    return times, cols
+
+
 def _fast_pass(path: Path, keep: set[str]) -> DataflashLog | None:
     """Read a sound DataFlash log without pymavlink: the messages walked once by their
     lengths (:func:`_walk`), each wanted type's fields parsed at once as numpy records, the
@@ -820,17 +849,11 @@ def _fast_pass(path: Path, keep: set[str]) -> DataflashLog | None:
     for t in present.tolist():
         fmt = formats[t]
         where = np.flatnonzero(types == t)
-        recs = np.lib.stride_tricks.sliding_window_view(u8, fmt.length)[starts[where]]
-        rec = recs.view(fmt.record).reshape(-1)
-        del recs
-        if "TimeUS" in fmt.columns and fmt.chars[fmt.columns.index("TimeUS")] not in _TEXT:
-            stamp[where] = _numeric(rec, fmt, "TimeUS")
+        times, cols = _parsed(u8, starts[where], fmt, fmt.name in keep)
+        if times is not None:
+            stamp[where] = times
         if fmt.name in keep:
-            columns[fmt.name] = {
-                c: _numeric(rec, fmt, c, native=True)
-                for c, ch in zip(fmt.columns, fmt.chars, strict=True)
-                if ch not in _TEXT
-            }
+            columns[fmt.name] = cols
     names_seen = frozenset(formats[t].name for t in present.tolist())
     params: dict[str, float] = {}
     changes: list[ParamChange] = []
