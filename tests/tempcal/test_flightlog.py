@@ -126,24 +126,33 @@ def test_an_ardupilot_log_is_read_once_into_one_object(tmp_path: Path) -> None:
 def test_ardupilot_tempcal_reads_its_log_once(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    """The whole command, as a user runs it, opens the DataFlash log once (pymavlink's
-    reader constructed once), and the gyro's fitted slope is the one written."""
+    """The whole command, as a user runs it, opens the DataFlash log once (the fixed-format
+    parser or pymavlink's reader, together once), and the gyro's fitted slope is the one
+    written."""
     import json
 
     from pymavlink import DFReader
 
     from thermocal.cli import main
+    from thermocal.readers import dataflash
 
     log = tmp_path / "sweep.bin"
     _dataflash_sweep(log)
     opened: list[str] = []
-    real = DFReader.DFReader_binary
+    real, real_fast = DFReader.DFReader_binary, dataflash._fast_pass
 
     def counting(filename: str, *args: Any, **kwargs: Any) -> Any:
         opened.append(filename)
         return real(filename, *args, **kwargs)
 
+    def counting_fast(path: Path, *args: Any, **kwargs: Any) -> Any:
+        passed = real_fast(path, *args, **kwargs)
+        if passed is not None:  # read: pymavlink is not asked
+            opened.append(str(path))
+        return passed
+
     monkeypatch.setattr(DFReader, "DFReader_binary", counting)
+    monkeypatch.setattr(dataflash, "_fast_pass", counting_fast)
     code = main(["ardupilot-tempcal", str(log), "-o", str(tmp_path / "out"), "--json"])
     out = capsys.readouterr()
     assert code == 0, out.err

@@ -100,6 +100,14 @@ def ardupilot_tempcal_cmd(
     allow_narrow: AllowNarrowOpt = False,
     allow_motion: AllowMotionOpt = False,
     as_json: JsonOpt = False,
+    allan: Annotated[
+        bool,
+        typer.Option(
+            "--allan",
+            help="Draw each axis's Allan deviation before and after compensation in the "
+            "gyro and accelerometer reports (slower on a long log).",
+        ),
+    ] = False,
 ) -> None:
     """ArduPilot's thermal calibration from one DataFlash log: every IMU instance's gyro
     and accelerometer fitted as in px4-tempcal, written as INS_TCAL* (.parm), a calibration
@@ -111,7 +119,7 @@ def ardupilot_tempcal_cmd(
 
     res = ardupilot_tempcal(
         log, output, overrides=overrides_of(allow_narrow, allow_motion),
-        reporter=write_sensor_report,
+        reporter=write_sensor_report, allan=allan,
     )  # fmt: skip
     emit(res.to_dict(), as_json, lambda: _print_ardupilot(res))
 

@@ -1,4 +1,7 @@
-"""ArduPilot DataFlash (.bin) logs (pymavlink), read by message with the firmware's units."""
+"""ArduPilot DataFlash (.bin) logs, read by message with the firmware's units: a sound log
+by a fixed-format parser (numpy records of each wanted message type, one walk over the
+file), any other by pymavlink (which skips damage and says so); the same values either
+way."""
 
 from __future__ import annotations
 
@@ -7,11 +10,12 @@ import gc
 import math
 import warnings
 from collections.abc import Iterator, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
+import numpy.typing as npt
 
 from thermocal._lazy import LazyModule
 from thermocal.errors import (
@@ -118,7 +122,7 @@ class DataflashLog:
     Attributes
     ----------
     rows : dict of str to list of dict
-        Per wanted message type, its messages' numeric fields.
+        Per wanted message type, its messages' numeric fields (logs read by pymavlink).
     names_seen : frozenset of str
         Every message type in the log.
     params : dict of str to float
@@ -127,6 +131,10 @@ class DataflashLog:
         What was lost to damage.
     param_changes : tuple of ParamChange
         Later changes of a parameter's value, in log order.
+    columns : dict of str to dict of str to numpy.ndarray
+        Per wanted message type, its numeric fields as columns in log order (logs read by
+        the fixed-format parser, :func:`_fast_pass`): in their logged types (the scaled ones
+        float64), each value exactly pymavlink's once made a float64.
     """
 
     rows: dict[str, list[dict[str, float]]]
@@ -134,6 +142,28 @@ class DataflashLog:
     params: dict[str, float]
     notes: tuple[str, ...]
     param_changes: tuple[ParamChange, ...] = ()
+    columns: dict[str, dict[str, npt.NDArray[Any]]] = field(default_factory=dict)
+
+    def message_rows(self, name: str) -> list[dict[str, float]]:
+        """Every message of type ``name`` (all instances), numeric fields, in log order,
+        whichever way the log was read (:attr:`rows` or :attr:`columns`).
+
+        Parameters
+        ----------
+        name : str
+            A wanted message type.
+
+        Returns
+        -------
+        list of dict
+            Field name → value; empty when the log has none.
+        """
+        cols = self.columns.get(name)
+        if cols is None:
+            return self.rows.get(name, [])
+        names = list(cols)
+        rows = zip(*cols.values(), strict=True)
+        return [dict(zip(names, map(float, vals), strict=True)) for vals in rows]
 
     def params_at_end(self) -> dict[str, float]:
         """The parameters in force at the end of the log (initial values and every change).
@@ -239,10 +269,20 @@ def read_dataflash_log(path: str | Path, messages: Sequence[str]) -> DataflashLo
 
 def _read_dataflash_log(path: str | Path, messages: Sequence[str]) -> DataflashLog:
     """Read an ArduPilot DataFlash log once, keeping the messages named in ``messages`` and
-    every ``PARM``.  pymavlink's printed complaints are captured; bytes of the file that are
-    not whole messages (file size − Σ message lengths, trailing padding of one fill byte
-    excepted) are lost and said in a warning with their share.  Needs ``pymavlink``
-    (``pip install 'thermocal[logs]'``)."""
+    every ``PARM``: a sound log by the fixed-format parser (:func:`_fast_pass`), any other
+    (damage, formats it does not take) by pymavlink (:func:`_pymavlink_pass`), the same
+    values either way."""
+    path = Path(path)
+    passed = _fast_pass(path, set(messages))
+    return _pymavlink_pass(path, messages) if passed is None else passed
+
+
+def _pymavlink_pass(path: str | Path, messages: Sequence[str]) -> DataflashLog:
+    """Read an ArduPilot DataFlash log once with pymavlink, keeping the messages named in
+    ``messages`` and every ``PARM``.  pymavlink's printed complaints are captured; bytes of
+    the file that are not whole messages (file size − Σ message lengths, trailing padding of
+    one fill byte excepted) are lost and said in a warning with their share.  Needs
+    ``pymavlink`` (``pip install 'thermocal[logs]'``)."""
     try:
         from pymavlink import DFReader
     except ImportError:
@@ -298,7 +338,9 @@ def _read_dataflash_log(path: str | Path, messages: Sequence[str]) -> DataflashL
                     )
                 elif mtype == "PARM":
                     with contextlib.suppress(AttributeError, TypeError, ValueError):
-                        backwards += _parm(m, params, current, changes, t_max_us)
+                        name, value = str(m.Name), float(m.Value)
+                        t_us = getattr(m, "TimeUS", 0)
+                        backwards += _parm(name, value, t_us, params, current, changes, t_max_us)
                 t_us = getattr(m, "TimeUS", None)
                 if isinstance(t_us, int | float) and t_us > t_max_us:
                     t_max_us = float(t_us)
@@ -307,15 +349,7 @@ def _read_dataflash_log(path: str | Path, messages: Sequence[str]) -> DataflashL
                 h = getattr(log, attr, None)
                 if h is not None:
                     h.close()
-    if backwards:
-        warnings.warn(
-            PlausibilityWarning(
-                f"{path}: {backwards} parameter change(s) carry a TimeUS earlier than data "
-                "logged before them (the clock went backwards): each is taken at the latest "
-                "time logged before it, where the firmware applied it"
-            ),
-            stacklevel=3,
-        )
+    _warn_backwards(path, backwards)
     notes = _dataflash_loss(path, size, accounted, last_end)
     said = noise.summary("pymavlink")
     if said and notes:
@@ -324,24 +358,38 @@ def _read_dataflash_log(path: str | Path, messages: Sequence[str]) -> DataflashL
     return DataflashLog(rows, frozenset(names_seen), params, tuple(notes), tuple(changes))
 
 
+def _warn_backwards(path: Path, backwards: int) -> None:
+    """The warning on parameter changes stamped before data already logged (if any)."""
+    if backwards:
+        warnings.warn(
+            PlausibilityWarning(
+                f"{path}: {backwards} parameter change(s) carry a TimeUS earlier than data "
+                "logged before them (the clock went backwards): each is taken at the latest "
+                "time logged before it, where the firmware applied it"
+            ),
+            stacklevel=5,
+        )
+
+
 def _parm(
-    m: Any,
+    name: str,
+    value: float,
+    stamp_us: Any,
     first: dict[str, float],
     current: dict[str, float],
     changes: list[ParamChange],
     t_floor_us: float = -math.inf,
 ) -> int:
-    """One ``PARM`` (LogStructure.h "TimeUS,Name,Value"): the first value of a name is its
-    initial value (the log's parameter dump at start); a later one with another value is a
-    change, at ``TimeUS`` — or at ``t_floor_us``, the latest time logged before it, when its
-    stamp is earlier (a parameter takes effect where it is logged).  Returns 1 for a change
-    so moved, else 0."""
-    name, value = str(m.Name), float(m.Value)
+    """One ``PARM`` (LogStructure.h "TimeUS,Name,Value"; ``stamp_us`` its TimeUS [µs]): the
+    first value of a name is its initial value (the log's parameter dump at start); a later
+    one with another value is a change, at ``TimeUS`` — or at ``t_floor_us``, the latest time
+    logged before it, when its stamp is earlier (a parameter takes effect where it is
+    logged).  Returns 1 for a change so moved, else 0."""
     moved = 0
     if name not in current:
         first[name] = value
     elif value != current[name] and not (value != value and current[name] != current[name]):
-        t_us = float(getattr(m, "TimeUS", 0))
+        t_us = float(stamp_us)
         if t_us < t_floor_us:
             t_us, moved = t_floor_us, 1
         changes.append(ParamChange(t_us * 1e-6, name, current[name], value))
@@ -382,19 +430,22 @@ def dataflash_table(
         Messages without ``TimeUS`` (a damaged format definition).
     """
     legacy = f"{name}{inst + 1}" if inst > 0 else None  # IMU2 = IMU.1 in older logs
-    rows = [r for r in log.rows.get(name, []) if int(r.get("I", 0)) == inst]
-    source = name
-    if not rows and legacy:
-        rows = [r for r in log.rows.get(legacy, []) if "I" not in r]
-        source = legacy
-    if not rows:
+    if name in log.columns or (legacy is not None and legacy in log.columns):
+        df, source = _columns_table(log, name, legacy, inst)
+    else:
+        rows = [r for r in log.rows.get(name, []) if int(r.get("I", 0)) == inst]
+        source = name
+        if not rows and legacy:
+            rows = [r for r in log.rows.get(legacy, []) if "I" not in r]
+            source = legacy
+        df = pd.DataFrame(rows).astype(np.float64) if rows else None
+    if df is None:
         raise MissingColumnError(
             f"{path}: no {name} messages of instance {inst} in the log"
             + (" (they may be in its damaged part)" if log.notes else "")
             + "; it has: "
             + (", ".join(sorted(log.names_seen - {"FMT", "FMTU", "UNIT", "MULT"})) or "none")
         )
-    df = pd.DataFrame(rows).astype(np.float64)
     if "TimeUS" not in df.columns:  # a damaged FMT message renames the fields
         raise FileFormatError(
             f"{path}: the {source} messages have no TimeUS field (their format definition is "
@@ -413,6 +464,38 @@ def dataflash_table(
     info["dataflash_source"] = source
     info["fc_log"] = True
     return df, info
+
+
+def _columns_table(
+    log: DataflashLog, name: str, legacy: str | None, inst: int
+) -> tuple[pd.DataFrame | None, str]:
+    """:func:`dataflash_table`'s selection from :attr:`DataflashLog.columns`: the messages
+    ``name`` of instance ``inst`` (no ``I`` field: instance 0), else those of ``legacy``
+    without an ``I`` field; (None, name) when there are none."""
+    cols = log.columns.get(name)
+    if cols is not None:
+        inst_col = cols.get("I")
+        if inst_col is not None:
+            whole = np.trunc(inst_col) if inst_col.dtype.kind == "f" else inst_col
+            rows = np.flatnonzero(whole == inst)
+            if rows.size:
+                return _frame(cols, rows), name
+        elif inst == 0 and len(next(iter(cols.values()))):
+            return _frame(cols, None), name
+    old = log.columns.get(legacy) if legacy is not None else None
+    if old is not None and "I" not in old and len(next(iter(old.values()))):
+        return _frame(old, None), str(legacy)
+    return None, name
+
+
+def _frame(cols: dict[str, npt.NDArray[Any]], rows: npt.NDArray[np.intp] | None) -> pd.DataFrame:
+    """The columns (those ``rows``; None: all) as one float64 frame, gathered straight into
+    the frame's block (fields × rows, no second copy)."""
+    n = len(next(iter(cols.values()))) if rows is None else rows.size
+    block = np.empty((len(cols), n))
+    for j, v in enumerate(cols.values()):
+        block[j] = v if rows is None else v[rows]  # float64 on the way in
+    return pd.DataFrame(block.T, columns=list(cols), copy=False)
 
 
 def read_dataflash(path: Path, topic: str | None) -> tuple[pd.DataFrame, dict[str, Any]]:
@@ -475,3 +558,348 @@ def _dataflash_loss(path: Path, size: int, accounted: int, last_end: int) -> lis
                 "whole message (the file is cut or damaged at its end)"
             )
     return notes
+
+
+# --- the fixed-format parser ----------------------------------------------------------------
+
+_HEAD = (0xA3, 0x95)
+"""The two bytes that open every DataFlash message (``HEAD_BYTE1``, ``HEAD_BYTE2``)."""
+_FMT_TYPE = 0x80
+_FMT_DEF = ("FMT", 89, "BBnNZ", ("Type", "Length", "Name", "Format", "Columns"))
+"""The format of ``FMT`` itself (LogStructure.h ``LOG_FORMAT_MSG``: type, length, name,
+format characters, labels), known before the log defines it."""
+_CODES: dict[str, tuple[str, float | None]] = {
+    "a": ("S64", None), "b": ("i1", None), "B": ("u1", None), "g": ("<f2", None),
+    "h": ("<i2", None), "H": ("<u2", None), "i": ("<i4", None), "I": ("<u4", None),
+    "f": ("<f4", None), "n": ("S4", None), "N": ("S16", None), "Z": ("S64", None),
+    "c": ("<i2", 100.0), "C": ("<u2", 100.0), "e": ("<i4", 100.0), "E": ("<u4", 100.0),
+    "L": ("<i4", 1.0 / 1.0e-7), "d": ("<f8", None), "M": ("i1", None), "q": ("<i8", None),
+    "Q": ("<u8", None),
+}  # fmt: skip
+"""DataFlash format characters (AP_Logger/LogStructure.h) → (little-endian numpy type, the
+divisor of a scaled field: ``c``/``C``/``e``/``E`` ×100, ``L`` ×1e7, divided as pymavlink
+divides them).  ``a`` (int16[32]) and the strings ``n``/``N``/``Z`` are not numeric."""
+_TEXT = frozenset("anNZ")
+
+
+@dataclass(frozen=True)
+class _Format:
+    """One message type's definition (an ``FMT`` message): name, length [bytes, header
+    included], format characters, labels, and the numpy record of its payload."""
+
+    name: str
+    length: int
+    chars: str
+    columns: tuple[str, ...]
+    record: np.dtype[Any]
+
+
+def _format(name: str, length: int, chars: str, columns: tuple[str, ...]) -> _Format | None:
+    """A definition the fixed-format parser takes, or None (unknown character, length not
+    the fields' size, labels not one per field or repeated: left to pymavlink)."""
+    if any(c not in _CODES for c in chars) or len(columns) != len(chars) or not chars:
+        return None
+    if len(set(columns)) != len(columns):
+        return None
+    if "TimeUS" in columns and chars[columns.index("TimeUS")] in _TEXT:
+        return None
+    offsets, pos = [], 3
+    for c in chars:
+        offsets.append(pos)
+        pos += np.dtype(_CODES[c][0]).itemsize
+    if pos != length:
+        return None
+    record = np.dtype(
+        {"names": list(columns), "formats": [_CODES[c][0] for c in chars],
+         "offsets": offsets, "itemsize": length}
+    )  # fmt: skip
+    return _Format(name, length, chars, columns, record)
+
+
+def _text(raw: bytes) -> str:
+    """A string field as pymavlink decodes it (UTF-8, else Latin-1; cut at the first NUL)."""
+    try:
+        s = raw.decode("utf-8")
+    except UnicodeDecodeError:
+        s = raw.decode("ISO-8859-1")
+    return s.split("\0", 1)[0]
+
+
+def _define(buf: bytes, pos: int, formats: dict[int, _Format]) -> bool:
+    """Take the ``FMT`` message at ``pos`` into ``formats``; False when the parser cannot
+    (a definition it does not take, or one that changes a type already defined)."""
+    ftype, length = buf[pos + 3], buf[pos + 4]
+    name = buf[pos + 5 : pos + 9].decode("utf-8", "backslashreplace").split("\0", 1)[0]
+    chars = buf[pos + 9 : pos + 25].decode("utf-8", "backslashreplace").split("\0", 1)[0]
+    cols = buf[pos + 25 : pos + 89].decode("utf-8", "backslashreplace").split("\0", 1)[0]
+    new = _format(name, length, chars, tuple(cols.split(",")))
+    if new is None or (name == "FMT") != (ftype == _FMT_TYPE):
+        return False
+    old = formats.get(ftype)
+    if old is not None and (old.name, old.length, old.chars, old.columns) != (
+        new.name,
+        new.length,
+        new.chars,
+        new.columns,
+    ):
+        return False
+    formats.setdefault(ftype, new)
+    return True
+
+
+def _walk(buf: bytes) -> tuple[list[int], dict[int, _Format], int] | None:
+    """Every message's start in a sound log, its formats and where the messages end; None
+    when a byte is not where a message should start before the end (damage: left to
+    pymavlink, which skips it and says so)."""
+    formats = {_FMT_TYPE: _format(*_FMT_DEF[:3], _FMT_DEF[3])}
+    assert formats[_FMT_TYPE] is not None
+    lengths = [0] * 256
+    lengths[_FMT_TYPE] = _FMT_DEF[1]
+    size, pos = len(buf), 0
+    starts: list[int] = []
+    add = starts.append
+    while pos + 3 <= size:
+        if buf[pos] != 0xA3 or buf[pos + 1] != 0x95:
+            break
+        t = buf[pos + 2]
+        n = lengths[t]
+        if n == 0 or pos + n > size:
+            break
+        if t == _FMT_TYPE:
+            if not _define(buf, pos, formats):  # type: ignore[arg-type]
+                return None
+            lengths[buf[pos + 3]] = buf[pos + 4]
+        add(pos)
+        pos += n
+    tail = buf[pos:]
+    if not starts or (tail and not (len(tail) < DATAFLASH_PADDING and len(set(tail)) == 1)):
+        return None
+    return starts, formats, pos  # type: ignore[return-value]
+
+
+_CHAIN_PASSES = 16
+"""Passes of :func:`_walk_at_once` before it leaves a log to :func:`_walk`."""
+
+
+def _walk_at_once(
+    raw: bytes, u8: npt.NDArray[np.uint8]
+) -> tuple[npt.NDArray[np.int64], dict[int, _Format], int] | None:
+    """:func:`_walk`'s answer without a Python step per message, or None when it cannot
+    tell (then :func:`_walk` decides).  Every ``A3 95`` is a candidate start (a payload may
+    hold one too); with the lengths of the ``FMT`` candidates, each candidate's successor is
+    the candidate its message ends at, and the messages of the log are the candidates the
+    first leads to: all of them, less (pass by pass) those no kept candidate leads to (a
+    start inside a payload; a few passes in a sound log).  Taken only when the ``FMT`` messages
+    on that chain are the definitions used, each before its type's first message."""
+    size = u8.size
+    if size < 3:
+        return None
+    cand = np.flatnonzero(u8[:-2] == _HEAD[0])  # one byte mask at a time: less memory
+    cand = cand[u8[cand + 1] == _HEAD[1]]
+    if cand.size == 0 or cand[0] != 0:
+        return None
+    lengths = np.zeros(256, dtype=np.int64)
+    lengths[_FMT_TYPE] = _FMT_DEF[1]
+    seen: dict[int, _Format] = {}
+    for p in cand[(u8[cand + 2] == _FMT_TYPE) & (cand + _FMT_DEF[1] <= size)].tolist():
+        trial: dict[int, _Format] = dict(seen)
+        if _define(raw, p, trial):  # a candidate that is no definition is skipped here
+            seen = trial
+            lengths[raw[p + 3]] = raw[p + 4]
+    n = cand.size
+    step = lengths[u8[cand + 2]]
+    nxt = cand + step
+    ok = (step > 0) & (nxt <= size)
+    j = np.minimum(np.searchsorted(cand, nxt), n - 1)
+    succ = np.where(ok & (cand[j] == nxt), j, n)  # n: no successor
+    on = np.ones(n + 1, dtype=bool)
+    for _ in range(_CHAIN_PASSES):  # keep the candidates some kept one leads to
+        led = np.zeros(n + 1, dtype=bool)
+        led[succ[on[:n]]] = True
+        led[0] = True
+        if np.array_equal(led[:n], on[:n]):
+            break
+        on = led
+    else:
+        return None  # a long chain that no message leads to (damage): the walk decides
+    chain = np.flatnonzero(on[:n])
+    last = int(chain[-1])
+    end = int(nxt[last]) if ok[last] else int(cand[last])
+    starts = cand[chain] if ok[last] else cand[chain[:-1]]
+    tail = raw[end:]
+    if starts.size == 0 or (tail and not (len(tail) < DATAFLASH_PADDING and len(set(tail)) == 1)):
+        return None
+    return _chain_defined(raw, starts, end, lengths)
+
+
+def _chain_defined(
+    raw: bytes, starts: npt.NDArray[np.int64], end: int, lengths: npt.NDArray[np.int64]
+) -> tuple[npt.NDArray[np.int64], dict[int, _Format], int] | None:
+    """The chain of :func:`_walk_at_once` if its own ``FMT`` messages define every type it
+    holds, each before the type's first message, with the lengths it was walked by."""
+    types = np.frombuffer(raw, np.uint8)[starts + 2]
+    formats = {_FMT_TYPE: _format(*_FMT_DEF[:3], _FMT_DEF[3])}
+    first_def: dict[int, int] = {}
+    for k in np.flatnonzero(types == _FMT_TYPE).tolist():
+        p = int(starts[k])
+        if not _define(raw, p, formats):  # type: ignore[arg-type]
+            return None
+        first_def.setdefault(raw[p + 3], k)
+    used, first_use = np.unique(types, return_index=True)
+    for t, k in zip(used.tolist(), first_use.tolist(), strict=True):
+        f = formats.get(t)
+        if f is None or f.length != lengths[t] or (t != _FMT_TYPE and first_def.get(t, k) >= k):
+            return None
+    return starts, formats, end  # type: ignore[return-value]
+
+
+def _units_sound(
+    buf: bytes, at: npt.NDArray[np.int64], fmtu: _Format, formats: dict[int, _Format]
+) -> bool:
+    """Whether pymavlink takes every ``FMTU`` (units of a type) without failing: an
+    instance mark ``#`` within the type's labels, multipliers for every label."""
+    recs = np.lib.stride_tricks.sliding_window_view(np.frombuffer(buf, np.uint8), fmtu.length)
+    rec = recs[at].copy().view(fmtu.record).reshape(-1)
+    units = rec["UnitIds"] if "UnitIds" in fmtu.columns else None
+    mults = rec["MultIds"] if "MultIds" in fmtu.columns else None
+    for i in range(rec.size):
+        for key in fmtu.columns[:2]:
+            v = rec[key][i]
+            if isinstance(v, bytes | np.bytes_):
+                continue
+            target = formats.get(int(v))
+            if target is None:
+                continue
+            n = len(target.columns)
+            if units is not None and _text(bytes(units[i])).find("#") >= n:
+                return False
+            if mults is not None and len(_text(bytes(mults[i]))) < n:
+                return False
+    return True
+
+
+def _numeric(
+    rec: npt.NDArray[Any], fmt: _Format, col: str, *, native: bool = False
+) -> npt.NDArray[Any]:
+    """One numeric field of ``rec`` as float64, scaled as pymavlink scales it (``native``:
+    an unscaled field in its logged type, a copy; float64 gives pymavlink's value)."""
+    divisor = _CODES[fmt.chars[fmt.columns.index(col)]][1]
+    if divisor is not None:
+        return rec[col].astype(np.float64) / divisor
+    return rec[col].copy() if native else rec[col].astype(np.float64)
+
+
+_CHUNK_ROWS = 1 << 16
+"""Messages of one type parsed at a time by :func:`_parsed` (their bytes gathered: a few MB)."""
+
+
+def _parsed(
+    u8: npt.NDArray[np.uint8], at: npt.NDArray[np.int64], fmt: _Format, fields: bool
+) -> tuple[npt.NDArray[np.float64] | None, dict[str, npt.NDArray[Any]]]:
+    """The messages of one type starting at ``at``: their ``TimeUS`` as float64 (None
+    without one) and, with ``fields``, every numeric field (:func:`_numeric`, native),
+    :data:`_CHUNK_ROWS` messages at a time."""
+    win = np.lib.stride_tricks.sliding_window_view(u8, fmt.length)
+    timed = "TimeUS" in fmt.columns and fmt.chars[fmt.columns.index("TimeUS")] not in _TEXT
+    times = np.empty(at.size) if timed else None
+    cols: dict[str, npt.NDArray[Any]] = {}
+    if fields:
+        for c, ch in zip(fmt.columns, fmt.chars, strict=True):
+            if ch not in _TEXT:
+                scaled = _CODES[ch][1] is not None
+                cols[c] = np.empty(at.size, np.float64 if scaled else fmt.record[c])
+    for a in range(0, at.size, _CHUNK_ROWS):
+        b = min(a + _CHUNK_ROWS, at.size)
+        rec = win[at[a:b]].view(fmt.record).reshape(-1)
+        if times is not None:
+            times[a:b] = _numeric(rec, fmt, "TimeUS")
+        for c, arr in cols.items():
+            arr[a:b] = _numeric(rec, fmt, c, native=True)
+    return times, cols
+
+
+def _fast_pass(path: Path, keep: set[str]) -> DataflashLog | None:
+    """Read a sound DataFlash log without pymavlink: the messages walked once by their
+    lengths (:func:`_walk`), each wanted type's fields parsed at once as numpy records, the
+    ``PARM`` messages in order; None when the log needs pymavlink (damage, a cut end, a
+    format this parser does not take).  The values are pymavlink's: the same field types,
+    the same scaling, the same parameter floors."""
+    try:
+        buf = path.read_bytes()
+    except OSError:
+        return None
+    u8 = np.frombuffer(buf, np.uint8)
+    walked = _walk_at_once(buf, u8) or _walk(buf)
+    if walked is None:
+        return None
+    starts_list, formats, end = walked
+    starts = np.asarray(starts_list, dtype=np.int64)
+    del starts_list
+    types = u8[starts + 2]
+    present = np.flatnonzero(np.bincount(types, minlength=256))
+    by_name = {formats[t].name: t for t in present.tolist()}
+    if len(by_name) != present.size or not _parm_sound(formats, by_name):
+        return None  # two types of one name, or a PARM this parser does not read
+    if "FMTU" in by_name:
+        t = by_name["FMTU"]
+        if not _units_sound(buf, starts[types == t], formats[t], formats):
+            return None
+    columns: dict[str, dict[str, npt.NDArray[Any]]] = {}
+    stamp = np.full(starts.size, np.nan)
+    for t in present.tolist():
+        fmt = formats[t]
+        where = np.flatnonzero(types == t)
+        times, cols = _parsed(u8, starts[where], fmt, fmt.name in keep)
+        if times is not None:
+            stamp[where] = times
+        if fmt.name in keep:
+            columns[fmt.name] = cols
+    names_seen = frozenset(formats[t].name for t in present.tolist())
+    params: dict[str, float] = {}
+    changes: list[ParamChange] = []
+    backwards = 0
+    if "PARM" in by_name and "PARM" not in keep:
+        backwards = _fast_params(u8, starts, types, stamp, formats[by_name["PARM"]],
+                                 by_name["PARM"], params, changes)  # fmt: skip
+    _warn_backwards(path, backwards)
+    notes = _dataflash_loss(path, len(buf), end, end)
+    warn_damage(path, notes)
+    rows: dict[str, list[dict[str, float]]] = {m: [] for m in keep}
+    return DataflashLog(rows, names_seen, params, tuple(notes), tuple(changes), columns)
+
+
+def _parm_sound(formats: dict[int, _Format], by_name: dict[str, int]) -> bool:
+    """Whether the log's ``PARM`` (if any) has a text ``Name`` and a numeric ``Value``."""
+    if "PARM" not in by_name:
+        return True
+    fmt = formats[by_name["PARM"]]
+    if "Name" not in fmt.columns or "Value" not in fmt.columns:
+        return False
+    kinds = {c: ch in _TEXT for c, ch in zip(fmt.columns, fmt.chars, strict=True)}
+    return kinds["Name"] and not kinds["Value"]
+
+
+def _fast_params(
+    u8: npt.NDArray[np.uint8],
+    starts: npt.NDArray[np.int64],
+    types: npt.NDArray[np.uint8],
+    stamp: npt.NDArray[np.float64],
+    fmt: _Format,
+    ptype: int,
+    params: dict[str, float],
+    changes: list[ParamChange],
+) -> int:
+    """The ``PARM`` messages in log order through :func:`_parm`, each floored at the latest
+    ``TimeUS`` of the messages before it; returns the number of changes so moved."""
+    where = np.flatnonzero(types == ptype)
+    floor = np.fmax.accumulate(np.concatenate(([-math.inf], stamp)))[where]
+    raw = np.lib.stride_tricks.sliding_window_view(u8, fmt.length)[starts[where]]
+    rec: npt.NDArray[Any] = raw.view(fmt.record).reshape(-1)
+    values = _numeric(rec, fmt, "Value").tolist()
+    stamps = stamp[where].tolist() if "TimeUS" in fmt.columns else [0.0] * where.size
+    current: dict[str, float] = {}
+    moved = 0
+    for raw, value, t_us, lo in zip(rec["Name"].tolist(), values, stamps, floor.tolist(),
+                                    strict=True):  # fmt: skip
+        moved += _parm(_text(raw), value, t_us, params, current, changes, lo)
+    return moved

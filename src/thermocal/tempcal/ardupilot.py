@@ -53,6 +53,7 @@ from thermocal.tempcal.pipeline import (
     end_warning,
     fit_sensor,
     gyro_unit_warning,
+    report_worker,
     require_fields,
     staged_set,
     stall_warning,
@@ -69,6 +70,11 @@ second and third IMU; ``TCLR``: the firmware's own learning; ``BARO``: the barom
 KINDS = (("gyro", "Gyr", "rad/s"), ("accel", "Acc", "m/s^2"))
 """(kind, field prefix of the ``IMU`` message, its unit) per sensor of an IMU."""
 KIND_UNITS = {kind: unit for kind, _prefix, unit in KINDS}
+NO_ALLAN = (
+    "The Allan deviation of each axis is not drawn; "
+    "thermocal ardupilot-tempcal LOG -o DIR --allan draws it."  # cli-words: its command
+)
+"""The report's note when its Allan section is left out (``allan`` False)."""
 BARO_REPORT = "report_BARO_0.html"
 """The report of the first barometer's ``TCAL_BARO_EXP``."""
 
@@ -432,6 +438,10 @@ def ardupilot_raw_intervals(
         When an interval's ``AHRS_ORIENTATION`` is not an integer.
     """
     out = np.asarray(xyz, dtype=np.float64).copy()
+    if len(intervals) == 1:  # no change in the log: every sample at once, no regrouping
+        part, active, code = ardupilot_raw(intervals[0].params, instance, kind, temp_c, out)
+        out[:] = part
+        return out, [active], [code]
     actives: list[ActiveTcal | None] = []
     codes: list[int] = []
     # each sample's interval, the samples grouped by it (one pass, not a mask per interval:
@@ -737,10 +747,20 @@ class _Run:
     previous: dict[str, CoefficientComparison] = dataclasses.field(default_factory=dict)
     learning: dict[str, CoefficientComparison] = dataclasses.field(default_factory=dict)
     baro: ArdupilotBaroFit | None = None
+    allan: bool = False
+    """The gyro and accelerometer reports draw each axis's Allan deviation."""
+    motions: dict[str, Any] = dataclasses.field(default_factory=dict)
+    """Each instance's stillness from its fit (:func:`.pipeline.fit_sensor`), for the step
+    warnings (computed once)."""
 
 
 def ardupilot_tempcal(
-    log: Path, output: Path, *, overrides: tuple[str, ...] = (), reporter: Reporter | None = None
+    log: Path,
+    output: Path,
+    *,
+    overrides: tuple[str, ...] = (),
+    reporter: Reporter | None = None,
+    allan: bool = False,
 ) -> ArdupilotTempcalResult:
     """ArduPilot's thermal calibration of every IMU of a DataFlash log, written as one set.
 
@@ -756,6 +776,10 @@ def ardupilot_tempcal(
         Adequacy checks let through (``"narrow"``, ``"motion"``).
     reporter : callable, optional
         Writes one report (the presentation layer's); None: no report written.
+    allan : bool, optional
+        The gyro and accelerometer reports draw each axis's overlapping Allan deviation
+        before and after compensation with its noise terms (IEEE Std 952-1997 Annex C);
+        default False: left out (on a long log, most of a report's cost).
 
     Returns
     -------
@@ -796,9 +820,13 @@ def ardupilot_tempcal(
     names.append(BARO_REPORT)
     check_outputs([output / n for n in names], [log], dirs=[output])
     check_output_dir(output)
-    with staged_set(output, reporter) as out_set:  # moved into place whole, or removed
+    with (
+        report_worker(reporter, log) as pool,  # starts while the log is read
+        staged_set(output, reporter, pool) as out_set,  # moved into place whole, or removed
+    ):
         flight = read_ardupilot_log(log, MESSAGES)  # the log is read once, passed down
         run = _Run(log, flight, overrides, ParamSet("ardupilot"), out_set, [], [], {}, {})
+        run.allan = allan
         for inst in range(MAX_IMUS):
             try:
                 df, _info = flight.table("IMU", inst)
@@ -810,7 +838,7 @@ def ardupilot_tempcal(
         if not run.fits:
             raise ThermocalInputError(f"{log}: no IMU with a usable temperature in the log")
         _baro(run)
-        run.gates.extend(step_warnings(run.fits, run.series))
+        run.gates.extend(step_warnings(run.fits, run.series, run.motions))
         warn_gates(run.gates)
         check_values(run.params)
         check_documented(run.params)
@@ -929,16 +957,17 @@ def _imu(run: _Run, df: Any, inst: int) -> None:
         sub_rec.source = str(run.log)
         sub_rec.validate()
         fit = fit_sensor(
-            sub_rec, f"IMU.{prefix}", kind, inst, overrides=run.overrides, firmware="ardupilot"
-        )
+            sub_rec, f"IMU.{prefix}", kind, inst, overrides=run.overrides,
+            firmware="ardupilot", motions=run.motions,
+        )  # fmt: skip
         run.fits.append(fit)
         per_kind.append((fit, sub_rec))
         if kind == "gyro":
             vals = np.column_stack([sub_rec.signal(a)[0] for a in AXES])
             run.gates.append(gyro_unit_warning(f"{run.log}: IMU.{inst} gyro", vals))
-        run.series[f"{fit.topic}.{inst}"] = (
-            time_s, np.column_stack([sub_rec.signal(a)[0] for a in AXES])
-        )  # fmt: skip
+            del vals
+        # the step check across instances reads the stillness result (motions), not values
+        run.series[f"{fit.topic}.{inst}"] = (time_s, np.empty((0, len(AXES))))
     sub = Calibration([ch for f, _r in per_kind for ch in f.channels])
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
@@ -968,9 +997,9 @@ def _imu(run: _Run, df: Any, inst: int) -> None:
                 calibration=Calibration(fit.channels), recording=sub_rec,
                 recording_path=str(run.log), title=f"ArduPilot thermal calibration — IMU {inst} "
                 f"{fit.kind}", generated_by="thermocal ardupilot-tempcal",
-                notes=tuple(f"Firmware: {n}" for n in ps.notes),
+                notes=(*(f"Firmware: {n}" for n in ps.notes), *(() if run.allan else (NO_ALLAN,))),
                 previous=run.previous.get(key),
-                firmware_learning=run.learning.get(key),
+                firmware_learning=run.learning.get(key), allan=run.allan,
             ),
         )  # fmt: skip
 

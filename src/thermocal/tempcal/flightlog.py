@@ -5,8 +5,8 @@
   instances that carry a temperature, the parameters in the log's header and those changed
   during the recording.  Each sensor's data are handed out from that one parse
   (:meth:`FlightLog.recording`, :meth:`FlightLog.table`).
-* ArduPilot: :func:`read_ardupilot_log` reads the DataFlash log in one pass (pymavlink,
-  :func:`thermocal.readers.dataflash.read_dataflash_log`) into a
+* ArduPilot: :func:`read_ardupilot_log` reads the DataFlash log in one pass
+  (:func:`thermocal.readers.dataflash.read_dataflash_log`) into a
   :class:`DataflashFlightLog`: the messages kept, the parameters the recording started with
   and every later change.  Each message instance is handed out from that pass
   (:meth:`DataflashFlightLog.table`, :meth:`DataflashFlightLog.rows`).
@@ -192,7 +192,7 @@ class DataflashFlightLog:
         list of dict
             Field name → value; empty when the log has none.
         """
-        return self.passed.rows.get(message, [])
+        return self.passed.message_rows(message)
 
     def table(self, message: str, instance: int) -> tuple[pd.DataFrame, dict[str, Any]]:
         """Instance ``instance`` of ``message`` as a table in the firmware's units, served
