@@ -582,7 +582,25 @@ def _allan_channel(
     overwrite: bool,
     where: str,
 ) -> AllanChannel:
-    """One channel's ADEV, noise terms and dynamic ADEV, with their warnings."""
+    """One channel's ADEV, noise terms and dynamic ADEV, with their warnings (BLAS on one
+    thread: the kernels' many short dots on threads of their own; OpenBLAS's idle threads
+    spin and take the cores from them)."""
+    from threadpoolctl import threadpool_limits
+
+    with threadpool_limits(limits=1, user_api="blas"):
+        return _channel_analysis(rec, name, taus, confidence, dynamic_s, overwrite, where)
+
+
+def _channel_analysis(
+    rec: Recording,
+    name: str,
+    taus: Any,
+    confidence: float,
+    dynamic_s: float | None,
+    overwrite: bool,
+    where: str,
+) -> AllanChannel:
+    """:func:`_allan_channel`'s work."""
     from thermocal.stability import allan
     from thermocal.stability import noise_model as nm
     from thermocal.stability.periodic import periodic_terms
