@@ -936,6 +936,22 @@ MUTANTS: tuple[Mutant, ...] = (
         "total-deviation second difference S1 − 2S2 − S3",
     ),
     Mutant(
+        "stability-totdev-left-reflection",
+        P + "stability/deviations.py",
+        "np.subtract(2.0 * x[0], x[n - 1 - b : n - 1 - a][::-1]",
+        "np.subtract(2.0 * x[1], x[n - 1 - b : n - 1 - a][::-1]",
+        _t("deviations_totdev_memory", "stability_reference"),
+        "totdev's left odd reflection about x_1 instead of x_0 (blocks of the extension)",
+    ),
+    Mutant(
+        "stability-totdev-long-m-taps",
+        P + "stability/deviations.py",
+        "np.multiply(_reflected(x, base + a + m, base + b + m, uu), 2.0, out=uu)",
+        "np.multiply(_reflected(x, base + a + m, base + b + m, uu), 1.0, out=uu)",
+        _t("deviations_totdev_memory", "stability_reference"),
+        "totdev at m of a block or more: the middle tap weighted 1 instead of 2",
+    ),
+    Mutant(
         "stability-theo1-tau",
         P + "stability/deviations.py",
         "return np.asarray(0.75 * np.asarray(m, dtype=np.float64) * tau0_s)",
