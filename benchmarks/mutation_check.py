@@ -952,6 +952,14 @@ MUTANTS: tuple[Mutant, ...] = (
         "totdev at m of a block or more: the middle tap weighted 1 instead of 2",
     ),
     Mutant(
+        "stability-lag1-in-place-centring",
+        P + "stability/edf.py",
+        "    np.subtract(c, c.mean(), out=c)\n",
+        "    np.subtract(c, 0.5 * c.mean(), out=c)\n",
+        _t("family_phase_memory", "noise_id_stable32", "stability_reference"),
+        "the lag-1 test of phase data on the phase centred by half its mean",
+    ),
+    Mutant(
         "stability-theo1-tau",
         P + "stability/deviations.py",
         "return np.asarray(0.75 * np.asarray(m, dtype=np.float64) * tau0_s)",
@@ -1002,10 +1010,8 @@ MUTANTS: tuple[Mutant, ...] = (
     Mutant(
         "stability-lag1-phase-detrend",
         P + "stability/edf.py",
-        "        zc = z - z.mean()\n"
-        "        return _lag1_differenced(lag1_autocorrelation(zc), zc, dmax, 2, rules.r1_sample)",
-        "        zc = _detrend(z, 1)\n"
-        "        return _lag1_differenced(lag1_autocorrelation(zc), zc, dmax, 2, rules.r1_sample)",
+        "        zc = z - z.mean()\n        r1 = _lag1_in_place(zc)",
+        "        zc = _detrend(z, 1)\n        r1 = _lag1_in_place(zc)",
         STAB + _t("noise_id_stable32"),
         "lag-1 identification of phase data removes a line (Stable32 removes nothing)",
     ),
