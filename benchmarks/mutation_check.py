@@ -954,10 +954,12 @@ MUTANTS: tuple[Mutant, ...] = (
     Mutant(
         "stability-lag1-in-place-centring",
         P + "stability/edf.py",
-        "    np.subtract(c, c.mean(), out=c)\n",
-        "    np.subtract(c, 0.5 * c.mean(), out=c)\n",
+        "    np.subtract(c, c.mean(), out=c)\n    den = float(c @ c)\n"
+        "    return float(c[:-1] @ c[1:])",
+        "    np.subtract(c, c.mean(), out=c)\n    den = float(c @ c)\n"
+        "    return float(c[1:] @ c[:-1] * 0.5)",
         _t("family_phase_memory", "noise_id_stable32", "stability_reference"),
-        "the lag-1 test of phase data on the phase centred by half its mean",
+        "the lag-1 test of phase data (centred in place) with r1 halved",
     ),
     Mutant(
         "stability-theo1-tau",
