@@ -962,6 +962,14 @@ MUTANTS: tuple[Mutant, ...] = (
         "the lag-1 test of phase data (centred in place) with r1 halved",
     ),
     Mutant(
+        "stability-stable32-rate-r1-from-sums",
+        P + "stability/edf.py",
+        "r1 = sums.cross / sums.szz if",
+        "r1 = sums.szz / sums.szz if",
+        _t("family_phase_memory", "noise_id_stable32"),
+        "Stable32's lag-1 test of rate averages from the octave sums: r1 = 1 whatever the noise",
+    ),
+    Mutant(
         "stability-theo1-tau",
         P + "stability/deviations.py",
         "return np.asarray(0.75 * np.asarray(m, dtype=np.float64) * tau0_s)",

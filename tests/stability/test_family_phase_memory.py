@@ -45,3 +45,25 @@ def test_phase_record_kept_without_overwrite() -> None:
     before = phase.copy()
     family.stability(phase, 1.0, ["oadev", "tierms"], data_type="phase")
     assert np.array_equal(phase, before)
+
+
+def test_stable32_rate_identification_takes_no_centred_copy() -> None:
+    # Stable32's lag-1 test on rate averages (mean removed) reads Σ z_c z_c' / Σ z_c² from
+    # the octave pass's sums: no centred copy of the 8 B-a-sample level 0
+    n = 6_000_000
+    rng = np.random.default_rng(2)
+    y = rng.standard_normal(n) + 7.0  # white FM: α = 0 wherever the lag-1 test decides
+    tracemalloc.start()
+    try:
+        got = family.stability(y, 0.01, ["oadev"], noise_id="stable32")
+        _cur, peak = tracemalloc.get_traced_memory()
+    finally:
+        tracemalloc.stop()
+    curve = got.curves["oadev"]
+    lag1 = [
+        a for a, how in zip(curve.alpha.tolist(), curve.alpha_method, strict=True) if how == "lag1"
+    ]
+    assert len(lag1) >= 15 and set(lag1[:12]) == {0}  # m ≤ 2048: thousands of averages
+    # the phase (8 B a sample) and the octave levels above 0 (8 B in all); the centred
+    # copy of level 0 was 8 B more
+    assert peak < 21 * n, peak / n

@@ -1048,7 +1048,11 @@ def identify_rate_averages(
         Noise exponent α and the method that gave it.
     """
     if z.size >= MIN_ACF_POINTS and not rules.rate_detrend:  # the mean removed, no line
-        return _lag1_differenced(lag1_autocorrelation(z), z, dmax - 1, 0, rules.r1_sample)
+        if sums is not None:  # Σ z_c,k z_c,k+1 / Σ z_c² of the sums: no centred copy
+            r1 = sums.cross / sums.szz if sums.szz > 0 else 0.0
+        else:
+            r1 = lag1_autocorrelation(z)
+        return _lag1_differenced(r1, z, dmax - 1, 0, rules.r1_sample)
     if z.size >= MIN_ACF_POINTS:
         r1 = _lag1_from_sums(sums) if sums is not None else None
         if r1 is None:  # r1 of the detrended averages from sums (no detrended copy)
