@@ -964,10 +964,10 @@ MUTANTS: tuple[Mutant, ...] = (
     Mutant(
         "stability-stable32-rate-r1-from-sums",
         P + "stability/edf.py",
-        "r1 = sums.cross / sums.szz if",
-        "r1 = sums.szz / sums.szz if",
+        "r1_mean = sums.cross / sums.szz if",
+        "r1_mean = 0.0 * sums.cross / sums.szz if",
         _t("family_phase_memory", "noise_id_stable32"),
-        "Stable32's lag-1 test of rate averages from the octave sums: r1 = 1 whatever the noise",
+        "Stable32's lag-1 test of rate averages from the octave sums: r1 = 0 whatever the noise",
     ),
     Mutant(
         "stability-theo1-tau",

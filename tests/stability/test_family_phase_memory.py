@@ -67,3 +67,8 @@ def test_stable32_rate_identification_takes_no_centred_copy() -> None:
     # the phase (8 B a sample) and the octave levels above 0 (8 B in all); the centred
     # copy of level 0 was 8 B more
     assert peak < 21 * n, peak / n
+    # random-walk FM: r1 of the rate averages near 1, α = −2 (Riley & Greenhall 2004)
+    rw = np.cumsum(rng.standard_normal(200_000))
+    walk = family.stability(rw, 0.01, ["oadev"], noise_id="stable32").curves["oadev"]
+    assert walk.alpha_method[:8] == ("lag1",) * 8
+    assert walk.alpha[:8].tolist() == [-2] * 8

@@ -1049,10 +1049,10 @@ def identify_rate_averages(
     """
     if z.size >= MIN_ACF_POINTS and not rules.rate_detrend:  # the mean removed, no line
         if sums is not None:  # Σ z_c,k z_c,k+1 / Σ z_c² of the sums: no centred copy
-            r1 = sums.cross / sums.szz if sums.szz > 0 else 0.0
+            r1_mean = sums.cross / sums.szz if sums.szz > 0 else 0.0
         else:
-            r1 = lag1_autocorrelation(z)
-        return _lag1_differenced(r1, z, dmax - 1, 0, rules.r1_sample)
+            r1_mean = lag1_autocorrelation(z)
+        return _lag1_differenced(r1_mean, z, dmax - 1, 0, rules.r1_sample)
     if z.size >= MIN_ACF_POINTS:
         r1 = _lag1_from_sums(sums) if sums is not None else None
         if r1 is None:  # r1 of the detrended averages from sums (no detrended copy)
