@@ -958,7 +958,7 @@ MUTANTS: tuple[Mutant, ...] = (
         "    return float(c[:-1] @ c[1:])",
         "    np.subtract(c, c.mean(), out=c)\n    den = float(c @ c)\n"
         "    return float(c[1:] @ c[:-1] * 0.5)",
-        _t("family_phase_memory", "noise_id_stable32", "stability_reference"),
+        _t("family_memory", "noise_id_stable32", "stability_reference"),
         "the lag-1 test of phase data (centred in place) with r1 halved",
     ),
     Mutant(
@@ -966,7 +966,7 @@ MUTANTS: tuple[Mutant, ...] = (
         P + "stability/edf.py",
         "r1_mean = sums.cross / sums.szz if",
         "r1_mean = 0.0 * sums.cross / sums.szz if",
-        _t("family_phase_memory", "noise_id_stable32"),
+        _t("family_memory", "noise_id_stable32"),
         "Stable32's lag-1 test of rate averages from the octave sums: r1 = 0 whatever the noise",
     ),
     Mutant(

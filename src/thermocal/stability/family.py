@@ -504,10 +504,8 @@ class _Record:
             parts = [dv.octave_sums(name, self.levels(i), m) for i in range(len(self.kept))]
         else:
             dev = registry.get(name)
-            parts = [
-                dev.sums(xr if dev.raw_phase else xc, self.tau0_s, m)
-                for xr, xc in zip(self.phases(), self.centred(), strict=True)
-            ]
+            xs = self.phases() if dev.raw_phase else self.centred()  # no centred copy unasked
+            parts = [dev.sums(x, self.tau0_s, m) for x in xs]
         return dv.pool(name, parts, m.size)
 
 

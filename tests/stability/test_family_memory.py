@@ -72,3 +72,21 @@ def test_stable32_rate_identification_takes_no_centred_copy() -> None:
     walk = family.stability(rw, 0.01, ["oadev"], noise_id="stable32").curves["oadev"]
     assert walk.alpha_method[:8] == ("lag1",) * 8
     assert walk.alpha[:8].tolist() == [-2] * 8
+
+
+def test_tierms_of_rate_takes_no_centred_copy() -> None:
+    # TIE rms reads the raw phase: the centred copy the other deviations read is not made
+    n = 3_000_000
+    rng = np.random.default_rng(6)
+    y = rng.standard_normal(n) + 7.0  # white FM of unit σ, τ0 = 1 s
+    tracemalloc.start()
+    try:
+        got = family.stability(y, 1.0, ["tierms"], [1.0, 4.0])
+        _cur, peak = tracemalloc.get_traced_memory()
+    finally:
+        tracemalloc.stop()
+    # TIE rms of the rate integrated about its mean: x_{k+m} − x_k sums m samples of unit
+    # variance, rms √m (ITU-T G.810)
+    assert got.curves["tierms"].dev.tolist() == pytest.approx([1.0, 2.0], rel=2e-3)
+    # the phase (8 B a sample) and the octave levels (8 B); the centred copy was 8 B more
+    assert peak < 21 * n, peak / n
