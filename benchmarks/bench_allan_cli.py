@@ -231,6 +231,7 @@ def main() -> None:
     ap.add_argument("--deviations", help="comma-separated, of " + ", ".join(DEVIATIONS))
     ap.add_argument("--data-types", default="rate,phase")
     ap.add_argument("--before", type=Path, help="another tree's src, run side by side")
+    ap.add_argument("--ours", type=Path, default=SRC, help="the src measured (default this tree's)")
     ap.add_argument("--memory-only", action="store_true", help="no allantools runs")
     ap.add_argument(
         "--compare-json",
@@ -242,7 +243,7 @@ def main() -> None:
     if args.deviations:
         devs = args.deviations.split(",")
     kinds = ["rate"] if args.quick else args.data_types.split(",")
-    envs = {"ours": child_env(SRC, "pycache")}
+    envs = {"ours": child_env(args.ours.resolve(), "pycache")}
     if args.before is not None:
         envs["before"] = child_env(args.before.resolve(), "pycache_before")
     if args.compare_json:
