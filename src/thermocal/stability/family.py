@@ -856,24 +856,19 @@ def stability(
         ``unit*s``; phase data deviations in ``unit/s``, time deviations in ``unit``.
     segments : list of slice, optional
         The gap-free index ranges (default: one), pooled; their EDFs add.
-    unit : str
-        Unit of ``values``.
-    confidence : float
-        Confidence level of the intervals (default 0.683, ±1σ).
+    unit, confidence : str, float
+        Unit of ``values``; confidence level of the intervals (default 0.683, ±1σ).
     alpha : int, optional
         The noise exponent α of the EDF at every τ instead of the identified one.
     bias_correct : bool
         Multiply totdev and htotdev by Stable32's bias factor (:func:`stable32_bias`).
     noise_id : {"thermocal", "stable32"}
         The identification's rules (:func:`_noise_exponents`).
-    max_work : float
-        Arithmetic operations allowed before the request is refused (:func:`check_work`).
-    where : str
-        The file the refusals name.
+    max_work, where : float, str
+        Operations allowed before the request is refused (:func:`check_work`); the file
+        the refusals name.
     overwrite : bool
-        Phase data: the phase may be centred in ``values``' own buffer (a writeable float64
-        array the caller no longer needs: its values are destroyed; no copy of the record).
-        Rate data are never changed.
+        Phase data may be centred in ``values``' own buffer (destroyed; rate: never).
 
     Returns
     -------
