@@ -960,6 +960,40 @@ MUTANTS: tuple[Mutant, ...] = (
         "fast MTOT kernel: the half-mean slope over h1 instead of h2 (odd 3m)",
     ),
     Mutant(
+        "stability-totdev-left-reflection",
+        P + "stability/deviations.py",
+        "np.subtract(2.0 * x[0], x[n - 1 - b : n - 1 - a][::-1]",
+        "np.subtract(2.0 * x[1], x[n - 1 - b : n - 1 - a][::-1]",
+        _t("deviations_totdev_memory", "stability_reference"),
+        "totdev's left odd reflection about x_1 instead of x_0 (blocks of the extension)",
+    ),
+    Mutant(
+        "stability-totdev-long-m-taps",
+        P + "stability/deviations.py",
+        "np.multiply(_reflected(x, base + a + m, base + b + m, uu), 2.0, out=uu)",
+        "np.multiply(_reflected(x, base + a + m, base + b + m, uu), 1.0, out=uu)",
+        _t("deviations_totdev_memory", "stability_reference"),
+        "totdev at m of a block or more: the middle tap weighted 1 instead of 2",
+    ),
+    Mutant(
+        "stability-lag1-in-place-centring",
+        P + "stability/edf.py",
+        "    np.subtract(c, c.mean(), out=c)\n    den = float(c @ c)\n"
+        "    return float(c[:-1] @ c[1:])",
+        "    np.subtract(c, c.mean(), out=c)\n    den = float(c @ c)\n"
+        "    return float(c[1:] @ c[:-1] * 0.5)",
+        _t("family_memory", "noise_id_stable32", "stability_reference"),
+        "the lag-1 test of phase data (centred in place) with r1 halved",
+    ),
+    Mutant(
+        "stability-stable32-rate-r1-from-sums",
+        P + "stability/edf.py",
+        "r1_mean = sums.cross / sums.szz if",
+        "r1_mean = 0.0 * sums.cross / sums.szz if",
+        _t("family_memory", "noise_id_stable32"),
+        "Stable32's lag-1 test of rate averages from the octave sums: r1 = 0 whatever the noise",
+    ),
+    Mutant(
         "stability-theo1-tau",
         P + "stability/deviations.py",
         "return np.asarray(0.75 * np.asarray(m, dtype=np.float64) * tau0_s)",
@@ -1010,10 +1044,8 @@ MUTANTS: tuple[Mutant, ...] = (
     Mutant(
         "stability-lag1-phase-detrend",
         P + "stability/edf.py",
-        "        zc = z - z.mean()\n"
-        "        return _lag1_differenced(lag1_autocorrelation(zc), zc, dmax, 2, rules.r1_sample)",
-        "        zc = _detrend(z, 1)\n"
-        "        return _lag1_differenced(lag1_autocorrelation(zc), zc, dmax, 2, rules.r1_sample)",
+        "        zc = z - z.mean()\n        r1 = _lag1_in_place(zc)",
+        "        zc = _detrend(z, 1)\n        r1 = _lag1_in_place(zc)",
         STAB + _t("noise_id_stable32"),
         "lag-1 identification of phase data removes a line (Stable32 removes nothing)",
     ),

@@ -874,9 +874,10 @@ def overlapping_adev(
         raise ThermocalInputError(f"noise exponent alpha must be −2…2, got {alpha!r}")
     # α and EDF per τ exactly as the family's oadev has them (one implementation),
     # from the segments that give the sums a term, before the phase may overwrite the rate
-    alphas, methods, edf = family.oadev_edf(
-        y, tau0_s, m, segments=[sl for sl in slices if sl.stop - sl.start >= 3], alpha=alpha
-    )
+    with threadpool_limits(limits=1, user_api="blas"):  # the pyramid's dots on our threads
+        alphas, methods, edf = family.oadev_edf(
+            y, tau0_s, m, segments=[sl for sl in slices if sl.stop - sl.start >= 3], alpha=alpha
+        )
     sums, n_terms, used, segs, _seg_terms = _pooled_sums(y, slices, m, overwrite)
 
     avar = sums / (2.0 * m.astype(np.float64) ** 2 * n_terms)

@@ -433,7 +433,7 @@ def allan_analysis(
             tuple(names),
             family=_family(
                 rec, names, taus, confidence, deviations, data_type, bias_correct, noise_type,
-                noise_id or "thermocal", max_work, where,
+                noise_id or "thermocal", max_work, where, overwrite,
             ),
         )  # fmt: skip
     _refuse_family_only(bias_correct, noise_type, noise_id)
@@ -487,8 +487,10 @@ def _family(
     noise_id: str = "thermocal",
     max_work: float | None = None,
     where: str = "",
+    overwrite: bool = False,
 ) -> dict[str, StabilityResult]:
-    """The deviations of every channel (phase data: the column as given, in its own unit)."""
+    """The deviations of every channel (phase data: the column as given, in its own unit;
+    ``overwrite``: centred in the recording's own buffer when the channel is named once)."""
     from thermocal.stability import family
 
     devs = list(dict.fromkeys(deviations or ["oadev"]))
@@ -515,6 +517,7 @@ def _family(
             segments=rec.segments(), unit=unit, confidence=confidence, bias_correct=bias_correct,
             alpha=alpha, noise_id=noise_id,
             where=where, max_work=family.DEFAULT_MAX_WORK if max_work is None else max_work,
+            overwrite=overwrite and names.count(name) == 1,
         )  # fmt: skip
     _idle_options(results, devs, bias_correct, alpha, where)
     return results
@@ -582,7 +585,25 @@ def _allan_channel(
     overwrite: bool,
     where: str,
 ) -> AllanChannel:
-    """One channel's ADEV, noise terms and dynamic ADEV, with their warnings."""
+    """One channel's ADEV, noise terms and dynamic ADEV, with their warnings (BLAS on one
+    thread: the kernels' many short dots on threads of their own; OpenBLAS's idle threads
+    spin and take the cores from them)."""
+    from threadpoolctl import threadpool_limits
+
+    with threadpool_limits(limits=1, user_api="blas"):
+        return _channel_analysis(rec, name, taus, confidence, dynamic_s, overwrite, where)
+
+
+def _channel_analysis(
+    rec: Recording,
+    name: str,
+    taus: Any,
+    confidence: float,
+    dynamic_s: float | None,
+    overwrite: bool,
+    where: str,
+) -> AllanChannel:
+    """:func:`_allan_channel`'s work."""
     from thermocal.stability import allan
     from thermocal.stability import noise_model as nm
     from thermocal.stability.periodic import periodic_terms

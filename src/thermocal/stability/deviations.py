@@ -667,11 +667,63 @@ def _fast_sums(name: str, x: FloatArray, m: IntArray) -> tuple[FloatArray, Float
     if name in ("mdev", "tdev"):  # inner sums slid along by third differences
         return _modified_sums(x, m), (n - 3 * m + 1).astype(np.float64)
     # totdev: the series extended by odd reflection at both ends, N − 2 terms centred on it
-    ext = np.concatenate([2.0 * x[0] - x[n - 2 : 0 : -1], x, 2.0 * x[-1] - x[-2:0:-1]])
-    mid = n - 2
-    c = mid + 1
-    sums = difference_sums(lambda mm: (ext[c - mm :], mm, mid), m, SECOND)
-    return sums, np.full(m.size, float(mid))
+    ms = [int(v) for v in m.tolist()]
+    with threadpool_limits(limits=1, user_api="blas"):
+        if len(ms) <= 1 or _WORKERS <= 1:
+            sums = np.array([_totdev_sum(x, mm) for mm in ms], dtype=np.float64)
+        else:
+            sums = np.asarray(list(_pool().map(lambda mm: _totdev_sum(x, mm), ms)))
+    return sums, np.full(m.size, float(n - 2))
+
+
+def _reflected(x: FloatArray, lo: int, hi: int, out: FloatArray) -> FloatArray:
+    """``ext[lo:hi]`` of x extended by odd reflection at both ends, written into ``out``
+    (``ext`` = 2x₀ − x_{N−2} … 2x₀ − x_1, x, 2x_{N−1} − x_{N−2} … 2x_{N−1} − x_1: 3N − 4
+    points, never built whole)."""
+    n = x.size
+    res = out[: hi - lo]
+    a, b = max(lo, 0), min(hi, n - 2)  # the left reflection: ext[e] = 2x₀ − x[N − 2 − e]
+    if a < b:
+        np.subtract(2.0 * x[0], x[n - 1 - b : n - 1 - a][::-1], out=res[a - lo : b - lo])
+    a, b = max(lo, n - 2), min(hi, 2 * n - 2)  # x itself
+    if a < b:
+        res[a - lo : b - lo] = x[a - n + 2 : b - n + 2]
+    a, b = max(lo, 2 * n - 2), hi  # the right reflection: ext[e] = 2x_{N−1} − x[3N − 4 − e]
+    if a < b:
+        np.subtract(2.0 * x[-1], x[3 * n - 3 - b : 3 * n - 3 - a][::-1], out=res[a - lo : b - lo])
+    return res
+
+
+def _totdev_sum(x: FloatArray, m: int) -> float:
+    """Σ_k (e_{k+2m} − 2e_{k+m} + e_k)² over the N − 2 terms centred on x of its odd
+    reflection e (:func:`_reflected`), block by block of :data:`_CHUNK` terms: the same
+    arithmetic, block for block, as :func:`_difference_sum` on the extended series, from
+    buffers of a few blocks (the extension held 24 bytes a sample)."""
+    n_terms = x.size - 2
+    base = x.size - 1 - m  # ext index of the first term's first tap
+    size = min(_CHUNK, max(n_terms, 1))
+    total = 0.0
+    if step_small(m):  # as _nested_difference_sum, d = 2
+        seg, cur, nxt = np.empty(size + 2 * m), np.empty(size + m), np.empty(size)
+        for a in range(0, n_terms, _CHUNK):
+            n_b = min(a + _CHUNK, n_terms) - a
+            e = _reflected(x, base + a, base + a + n_b + 2 * m, seg)
+            c = cur[: n_b + m]
+            np.subtract(e[m:], e[: n_b + m], out=c)
+            d = nxt[:n_b]
+            np.subtract(c[m : m + n_b], c[:n_b], out=d)
+            total += float(d @ d)
+        return total
+    t, u, far = np.empty(size), np.empty(size), np.empty(size)
+    for a in range(0, n_terms, _CHUNK):  # taps SECOND: x_{k+2m} + x_k − 2 x_{k+m}
+        b = min(a + _CHUNK, n_terms)
+        tt, uu = t[: b - a], u[: b - a]
+        first = _reflected(x, base + a + 2 * m, base + b + 2 * m, far)
+        np.add(first, _reflected(x, base + a, base + b, uu), out=tt)
+        np.multiply(_reflected(x, base + a + m, base + b + m, uu), 2.0, out=uu)
+        tt -= uu
+        total += float(tt @ tt)
+    return total
 
 
 @dataclass(frozen=True, eq=False)

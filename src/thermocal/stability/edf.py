@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import itertools
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Final
 
@@ -910,17 +911,27 @@ def identify_noise(
     >>> identify_noise(np.r_[0.0, np.cumsum(rw)], 4, dmax=2, phase_input=False).alpha
     -2
     """
+    if phase_input and x[:: max(m, 1)].size >= MIN_ACF_POINTS:
+        z = x[:: max(m, 1)]
+        zc = z - z.mean()
+        r1 = _lag1_in_place(zc)  # one centred copy at a time: made again if differenced
+        del zc
+        return _lag1_differenced(r1, lambda: z - z.mean(), dmax, 2, rules.r1_sample, z.size)
     nb = (x.size - 1) // m  # m-averages of the rate: (x_{(k+1)m} − x_{km}) / m
     ym = np.diff(x[: nb * m + 1 : m]) if nb else x[:0].copy()
     if m > 1:
         ym /= m
     if not phase_input:
         return split_pm(identify_rate_averages(ym, dmax=dmax, own=True, rules=rules), x, m)
-    z = x[:: max(m, 1)]
-    if z.size >= MIN_ACF_POINTS:
-        zc = z - z.mean()
-        return _lag1_differenced(lag1_autocorrelation(zc), zc, dmax, 2, rules.r1_sample)
     return split_pm(_b1_identify(ym, dmax, n_theory=rules.b1_n, min_groups=rules.b1_min), x, m)
+
+
+def _lag1_in_place(c: FloatArray) -> float:
+    """:func:`lag1_autocorrelation` of ``c`` with ``c`` itself centred in place (the same
+    arithmetic: no second copy)."""
+    np.subtract(c, c.mean(), out=c)
+    den = float(c @ c)
+    return float(c[:-1] @ c[1:]) / den if den > 0 else 0.0
 
 
 def modified_allan_ratio(x: FloatArray, m: int) -> float:
@@ -1037,7 +1048,11 @@ def identify_rate_averages(
         Noise exponent α and the method that gave it.
     """
     if z.size >= MIN_ACF_POINTS and not rules.rate_detrend:  # the mean removed, no line
-        return _lag1_differenced(lag1_autocorrelation(z), z, dmax - 1, 0, rules.r1_sample)
+        if sums is not None:  # Σ z_c,k z_c,k+1 / Σ z_c² of the sums: no centred copy
+            r1_mean = sums.cross / sums.szz if sums.szz > 0 else 0.0
+        else:
+            r1_mean = lag1_autocorrelation(z)
+        return _lag1_differenced(r1_mean, z, dmax - 1, 0, rules.r1_sample)
     if z.size >= MIN_ACF_POINTS:
         r1 = _lag1_from_sums(sums) if sums is not None else None
         if r1 is None:  # r1 of the detrended averages from sums (no detrended copy)
@@ -1076,21 +1091,32 @@ def _lag1_of_difference(z: FloatArray, d: int) -> float:
     return num / den if den > 0 else 0.0
 
 
-def _lag1_differenced(r1: float, z: FloatArray, dm: int, add: int, sample: bool = False) -> NoiseId:
+def _lag1_differenced(
+    r1: float,
+    z: FloatArray | Callable[[], FloatArray],
+    dm: int,
+    add: int,
+    sample: bool = False,
+    n_points: int = 0,
+) -> NoiseId:
     """Riley & Greenhall's rule: difference ``z`` until ρ = r1/(1 + r1) < 0.25 or d = dm;
     α = −round(2ρ) − 2d + ``add`` (the differences' r1 by :func:`_lag1_of_difference`: a
     10⁷-sample m = 1 level needs no differenced copy).  ``sample``: every r1 (of n points)
-    taken as r1·(n − 1)/n, Stable32's normalisation (:class:`IdRules`)."""
+    taken as r1·(n − 1)/n, Stable32's normalisation (:class:`IdRules`).  ``z`` may be a
+    function making the series of ``n_points`` points when first differenced."""
     d = 0
+    size = z.size if isinstance(z, np.ndarray) else n_points
     while True:
         if sample:
-            n = z.size - d
+            n = size - d
             r1 = r1 * (n - 1) / n if n > 1 else r1
         rho = r1 / (1.0 + r1) if r1 > -1.0 else 0.0
         if rho < 0.25 or d >= dm:
             a = -round(2.0 * rho) - 2 * d + add
             return NoiseId(int(a), -2.0 * (rho + d) + add, "lag1", d)
         d += 1
+        if not isinstance(z, np.ndarray):
+            z = z()
         r1 = _lag1_of_difference(z, d)
 
 

@@ -429,6 +429,8 @@ class _Record:
         self._means: dict[int, float] = {}
         self.m_max = 0
         """Octave levels up to this factor (0: no octave levels; set by the caller)."""
+        self.own = False
+        """The caller gave ``y`` up: phase data are centred in its own buffer."""
 
     def set_octave(self, m: IntArray) -> None:
         """Rate data at octave factors only (every m a power of 2): adev, hdev and the noise
@@ -446,8 +448,12 @@ class _Record:
         self._means[i] = mean
 
     def phases(self) -> list[FloatArray]:
+        """Each stretch's phase (phase data given up by the caller: the stretch itself)."""
         if self._phases is None:
             rate = self.data_type == "rate"
+            if not rate and self.own:
+                self._phases = [self.y[sl] for sl in self.kept]
+                return self._phases
             self._phases = [
                 dv.as_phase(self.y[sl], self.tau0_s, self.data_type, self.mean(i) if rate else 0.0)
                 for i, sl in enumerate(self.kept)
@@ -498,10 +504,8 @@ class _Record:
             parts = [dv.octave_sums(name, self.levels(i), m) for i in range(len(self.kept))]
         else:
             dev = registry.get(name)
-            parts = [
-                dev.sums(xr if dev.raw_phase else xc, self.tau0_s, m)
-                for xr, xc in zip(self.phases(), self.centred(), strict=True)
-            ]
+            xs = self.phases() if dev.raw_phase else self.centred()  # no centred copy unasked
+            parts = [dev.sums(x, self.tau0_s, m) for x in xs]
         return dv.pool(name, parts, m.size)
 
 
@@ -511,10 +515,13 @@ def _new_record(
     data_type: str,
     segments: list[slice] | None,
     names: list[str],
+    overwrite: bool = False,
 ) -> _Record:
-    """The checked record (:func:`_stretches`) with the whole record's mean preset."""
+    """The checked record (:func:`_stretches`) with the whole record's mean preset;
+    ``overwrite``: the caller's own writeable float64 buffer may be changed."""
     y, kept, total = _stretches(values, tau0_s, data_type, segments)
     record = _Record(y, kept, tau0_s, data_type, names)
+    record.own = overwrite and y is values and bool(y.flags.writeable)
     if len(kept) == 1 and kept[0].indices(y.size)[:2] == (0, y.size):
         record.preset_mean(0, total / y.size)  # numpy's mean: the same sum over n
     return record
@@ -830,6 +837,7 @@ def stability(
     noise_id: str = "thermocal",
     max_work: float = DEFAULT_MAX_WORK,
     where: str = "",
+    overwrite: bool = False,
 ) -> StabilityResult:
     r"""Several deviations of one record of rate or phase data, with chi-square intervals.
 
@@ -848,20 +856,19 @@ def stability(
         ``unit*s``; phase data deviations in ``unit/s``, time deviations in ``unit``.
     segments : list of slice, optional
         The gap-free index ranges (default: one), pooled; their EDFs add.
-    unit : str
-        Unit of ``values``.
-    confidence : float
-        Confidence level of the intervals (default 0.683, ±1σ).
+    unit, confidence : str, float
+        Unit of ``values``; confidence level of the intervals (default 0.683, ±1σ).
     alpha : int, optional
         The noise exponent α of the EDF at every τ instead of the identified one.
     bias_correct : bool
         Multiply totdev and htotdev by Stable32's bias factor (:func:`stable32_bias`).
     noise_id : {"thermocal", "stable32"}
         The identification's rules (:func:`_noise_exponents`).
-    max_work : float
-        Arithmetic operations allowed before the request is refused (:func:`check_work`).
-    where : str
-        The file the refusals name.
+    max_work, where : float, str
+        Operations allowed before the request is refused (:func:`check_work`); the file
+        the refusals name.
+    overwrite : bool
+        Phase data may be centred in ``values``' own buffer (destroyed; rate: never).
 
     Returns
     -------
@@ -899,7 +906,7 @@ def stability(
     """
     with threadpool_limits(limits=1, user_api="blas"):  # many short dots: BLAS threads wait
         _check_request(names, data_type, noise_id)
-        record = _new_record(values, tau0_s, data_type, segments, names)
+        record = _new_record(values, tau0_s, data_type, segments, names, overwrite)
         sets = factor_sets(names, taus, tau0_s, max(record.sizes))
         check_work(names, sets, record.sizes, max_work, taus, where)
         m_common = sets[""]

@@ -211,11 +211,20 @@ def welch(
     tt = float(t @ t)
     view = np.lib.stride_tricks.sliding_window_view(x, seg)[::step][:n_seg]
     acc = np.zeros(seg // 2 + 1)
+    rows = min(32, n_seg)  # 32 segments a block, in two reused buffers (no page faults)
+    buf, line = np.empty((rows, seg)), np.empty((rows, seg))
+    power = np.empty((rows, seg // 2 + 1))
     for a in range(0, n_seg, 32):
-        block = view[a : a + 32]
-        block = block - block.mean(axis=1, keepdims=True)
-        block = block - np.outer(block @ t / tt, t)
-        acc += np.sum(np.abs(np.fft.rfft(block * w, axis=1)) ** 2, axis=0)
+        seen = view[a : a + 32]
+        k = seen.shape[0]
+        block, lin, pw = buf[:k], line[:k], power[:k]
+        np.subtract(seen, seen.mean(axis=1, keepdims=True), out=block)
+        np.multiply((block @ t / tt)[:, None], t[None, :], out=lin)
+        np.subtract(block, lin, out=block)
+        np.multiply(block, w, out=block)
+        np.abs(np.fft.rfft(block, axis=1), out=pw)
+        np.square(pw, out=pw)
+        acc += np.sum(pw, axis=0)
     psd = acc / n_seg * 2.0 / (fs * float(w @ w))
     psd[0] /= 2.0
     if seg % 2 == 0:
