@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import itertools
 import math
+import os
 import tempfile
 import warnings
 from collections.abc import Callable, Iterator, Sequence
@@ -100,13 +101,15 @@ def needs_streaming(
 
 
 class _RawFile:
-    """float64 values appended to a file, read back by index range (no memory map: the
-    memory used is the window read, whatever the file's length)."""
+    """float64 values appended to a file, read back by index range with ``pread`` (no
+    memory map: the memory used is the window read, whatever the file's length; several
+    threads may read at once)."""
 
     def __init__(self, path: Path) -> None:
         self.path = path
         self.size = 0
         self._out: Any = open(path, "wb")  # noqa: SIM115 (closed by finish)
+        self._fd = -1
 
     def write(self, values: FloatArray) -> None:
         np.ascontiguousarray(values, dtype=np.float64).tofile(self._out)
@@ -116,33 +119,48 @@ class _RawFile:
         if self._out is not None:
             self._out.close()
             self._out = None
+            self._fd = os.open(self.path, os.O_RDONLY)
         return self
+
+    def close(self) -> None:
+        self.finish()
+        if self._fd >= 0:
+            os.close(self._fd)
+            self._fd = -1
 
     def read(self, start: int, stop: int) -> FloatArray:
         stop = min(stop, self.size)
         out = np.empty(max(stop - start, 0), dtype=np.float64)
-        if out.size:
-            with open(self.path, "rb") as fh:
-                fh.seek(start * 8)
-                got = fh.readinto(out.data.cast("B"))
-            if got != out.nbytes:
+        view, pos = out.data.cast("B"), 0
+        while pos < out.nbytes:
+            got = os.preadv(self._fd, [view[pos:]], start * 8 + pos)
+            if got <= 0:
                 raise OSError(f"{self.path}: short read")
+            pos += got
         return out
 
 
 class _TempStore:
-    """Temporary files in one folder (:class:`thermocal.stability.streaming.BlockStore`)."""
+    """Temporary files in one folder (:class:`thermocal.stability.streaming.BlockStore`);
+    :meth:`close` closes every one still open (an analysis that fails or is interrupted)."""
 
     def __init__(self, folder: Path) -> None:
         self.folder = folder
+        self.files: list[_RawFile] = []
 
     def create(self, name: str) -> _RawFile:
-        return _RawFile(self.folder / f"{name}.f64")
+        f = _RawFile(self.folder / f"{name}.f64")
+        self.files.append(f)
+        return f
 
     def remove(self, source: BlockSource) -> None:
         if isinstance(source, _RawFile):
-            source.finish()
+            source.close()
             source.path.unlink(missing_ok=True)
+
+    def close(self) -> None:
+        for f in self.files:
+            f.close()
 
 
 class _HeadColumns(ParquetColumns):
@@ -288,14 +306,17 @@ def _median(steps: dict[float, int]) -> float:
     return float(np.mean([lo_v, hi_v]))
 
 
-def _chunks(plan: _Plan) -> Iterator[tuple[FloatArray, FloatArray]]:
-    """(time [s], signal as read) a batch of rows at a time, only these two columns."""
+def _chunks(plan: _Plan, signal: bool = True) -> Iterator[tuple[FloatArray, FloatArray]]:
+    """(time [s], signal as read) a batch of rows at a time, only these columns (the
+    signal empty when not asked)."""
     pf = pq.ParquetFile(plan.path, buffer_size=1 << 20, pre_buffer=False)
-    for batch in pf.iter_batches(batch_size=CHUNK_ROWS, columns=[plan.time_col, plan.signal]):
-        t = np.concatenate([arrow_chunk_f64(batch.column(plan.time_col))])
+    cols = [plan.time_col, plan.signal] if signal else [plan.time_col]
+    for batch in pf.iter_batches(batch_size=CHUNK_ROWS, columns=cols):
+        t = np.asarray(arrow_chunk_f64(batch.column(plan.time_col)), dtype=np.float64)
         if plan.time_factor != 1.0:
             t = t * plan.time_factor
-        yield t, arrow_chunk_f64(batch.column(plan.signal))
+        raw = arrow_chunk_f64(batch.column(plan.signal)) if signal else np.zeros(0)
+        yield t, raw
 
 
 def _in_data_unit(plan: _Plan, t: FloatArray, raw: FloatArray) -> tuple[FloatArray, str]:
@@ -312,10 +333,9 @@ def _in_data_unit(plan: _Plan, t: FloatArray, raw: FloatArray) -> tuple[FloatArr
 
 @dataclass
 class _Spooled:
-    """The record's samples and times in temporary files, with what the pass found."""
+    """The record's samples in a temporary file, with what the pass found."""
 
     rate: BlockSource
-    time: BlockSource
     times: _TimePass
     unit: str
 
@@ -324,7 +344,7 @@ def _spool(
     plan: _Plan, store: _TempStore, summary: Any, advance: Callable[[float], None]
 ) -> _Spooled:
     """Pass 1: every row group of the two columns checked and stored."""
-    rate, time = store.create("rate"), store.create("time")
+    rate = store.create("rate")
     times = _TimePass()
     unit, row0 = "", 0
     for t, raw in _chunks(plan):
@@ -338,36 +358,33 @@ def _spool(
             )
         summary.add(v)
         rate.write(v)
-        time.write(t)
         row0 += int(t.size)
         advance(t.size)
-    return _Spooled(rate.finish(), time.finish(), times, unit)
+    return _Spooled(rate.finish(), times, unit)
 
 
-def _segments(sp: _Spooled, where: Path) -> tuple[list[slice], float]:
+def _segments(plan: _Plan, times: _TimePass) -> tuple[list[slice], float]:
     """The gap-free stretches (:func:`thermocal.recording.contiguous_slices`: a step longer
-    than 1.5 nominal steps is a gap) and the nominal step, the gaps said in one warning."""
+    than 1.5 nominal steps is a gap; the time column read again only when there is one)
+    and the nominal step, the gaps said in one warning."""
     from thermocal.recording import GAP_FACTOR
 
-    tp, n = sp.times, sp.time.size
+    n, where = times.n, plan.path
     if n < 2:
         return [slice(0, n)], math.nan
-    med = tp.interval(where)
+    med = times.interval(where)
     bounds, starts, total = [0], [], 0.0
-    if n >= 3 and med > 0 and tp.hi > GAP_FACTOR * med:
-        from thermocal.stability.streaming import WINDOW
-
-        prev = math.nan
-        for a in range(0, n, WINDOW):
-            t = sp.time.read(a, a + WINDOW)
-            tt = np.concatenate(([prev], t)) if a else t  # the step into the window too
+    if n >= 3 and med > 0 and times.hi > GAP_FACTOR * med:
+        prev, a = math.nan, 0
+        for t, _raw in _chunks(plan, signal=False):
+            tt = np.concatenate(([prev], t)) if a else t  # the step into the chunk too
             dt = np.diff(tt)
             base = a - 1 if a else a
             for i in np.flatnonzero(dt > GAP_FACTOR * med).tolist():
                 bounds.append(base + i + 1)
-                starts.append(float(tt[i]) - tp.first)
+                starts.append(float(tt[i]) - times.first)
                 total += float(dt[i])
-            prev = float(t[-1])
+            prev, a = float(t[-1]), a + int(t.size)
     bounds.append(n)
     if len(bounds) > 2:
         warnings.warn(
@@ -439,22 +456,27 @@ def allan_streamed(
     spool_share = 0.15
     with tempfile.TemporaryDirectory(prefix="thermocal-allan-", dir=scratch_dir) as d:
         store = _TempStore(Path(d))
-        summary = streaming.ValueSummary(plan.n_rows)
-        rows = max(plan.n_rows, 1)
-        sp = _spool(
-            plan, store, summary, lambda k: progress(spool_share * k / rows) if progress else None
-        )
-        segments, med = _segments(sp, p)
-        store.remove(sp.time)
-        tau0 = plan.head.meta.sample_interval_s or med
-        record = streaming.StreamedRecord(sp.rate, float(tau0), tuple(segments))
-        ch = streaming.streamed_channel(
-            record, summary, plan.signal, sp.unit, taus=taus,
-            confidence=ONE_SIGMA_CONFIDENCE if confidence is None else confidence,
-            where=where, store=store,
-            progress=(lambda f: progress((1 - spool_share) * f)) if progress else None,
-        )  # fmt: skip
-        store.remove(sp.rate)
+        try:
+            summary = streaming.ValueSummary(plan.n_rows)
+            rows = max(plan.n_rows, 1)
+            sp = _spool(
+                plan,
+                store,
+                summary,
+                lambda k: progress(spool_share * k / rows) if progress else None,
+            )
+            segments, med = _segments(plan, sp.times)
+            tau0 = plan.head.meta.sample_interval_s or med
+            record = streaming.StreamedRecord(sp.rate, float(tau0), tuple(segments))
+            ch = streaming.streamed_channel(
+                record, summary, plan.signal, sp.unit, taus=taus,
+                confidence=ONE_SIGMA_CONFIDENCE if confidence is None else confidence,
+                where=where, store=store,
+                progress=(lambda f: progress((1 - spool_share) * f)) if progress else None,
+            )  # fmt: skip
+            store.remove(sp.rate)
+        finally:
+            store.close()
     return AllanAnalysis((plan.signal,), channels={plan.signal: ch})
 
 

@@ -24,6 +24,7 @@ from __future__ import annotations
 import math
 import warnings
 from collections.abc import Callable, Sequence
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 from typing import Any, Final, Protocol
 
@@ -135,6 +136,11 @@ class _Work:
             self.progress(amount / self.total)
         self.done += amount
 
+    def finish(self) -> None:
+        """The rest of the estimate, at the end (the passes' lengths were estimated)."""
+        if self.done < self.total:
+            self.advance(self.total - self.done)
+
 
 @dataclass(frozen=True)
 class StreamedRecord:
@@ -245,16 +251,30 @@ def _level_sums(
     return s1, s2, sl, sk
 
 
-def _level(z: BlockSource, offset: float, m: int, nxt: BlockWriter | None, work: _Work) -> _Level:
-    """Level m's lag sums (:func:`thermocal.stability.deviations._level_pass`: halves on
-    long levels, as there) and the next level into ``nxt``."""
+def _level(
+    z: BlockSource, offset: float, m: int, store: BlockStore | None, work: _Work
+) -> tuple[_Level, BlockSource | None]:
+    """Level m's lag sums (:func:`thermocal.stability.deviations._level_pass`: the halves of
+    a long level on two threads, as there) and the next level (in ``store``; None: not
+    asked)."""
     n = z.size
+    nxt: BlockSource | None = None
     if n >= dv._SPLIT and dv._WORKERS > 1:
         half = (n // 2) & ~1
-        parts = [_level_sums(z, offset, lo, hi, nxt) for lo, hi in ((0, half), (half, n))]
+        outs = [store.create(f"level-{2 * m}-{i}") if store else None for i in (0, 1)]
+        with ThreadPoolExecutor(max_workers=2) as pool:
+            jobs = [
+                pool.submit(_level_sums, z, offset, lo, hi, out)
+                for (lo, hi), out in zip(((0, half), (half, n)), outs, strict=True)
+            ]
+            parts = [j.result() for j in jobs]
         s1, s2, sl, sk = (p + q for p, q in zip(*parts, strict=True))
+        if store is not None:
+            nxt = _Concat([o.finish() for o in outs if o is not None])
     else:
-        s1, s2, sl, sk = _level_sums(z, offset, 0, n, nxt)
+        out = store.create(f"level-{2 * m}") if store else None
+        s1, s2, sl, sk = _level_sums(z, offset, 0, n, out)
+        nxt = out.finish() if out is not None else None
     work.advance(n)
     delta = s1 / n
     first = float(z.read(0, 1)[0]) - offset - delta
@@ -267,7 +287,35 @@ def _level(z: BlockSource, offset: float, m: int, nxt: BlockWriter | None, work:
         first,
         last,
     )
-    return _Level(m, z, lag)
+    return _Level(m, z, lag), nxt
+
+
+class _Concat:
+    """Sources one after the other, read as one."""
+
+    def __init__(self, parts: list[BlockSource]) -> None:
+        self.parts = parts
+        self.starts = [0]
+        for p in parts:
+            self.starts.append(self.starts[-1] + p.size)
+        self.size = self.starts[-1]
+
+    def read(self, start: int, stop: int) -> FloatArray:
+        stop = min(stop, self.size)
+        got = []
+        for p, a in zip(self.parts, self.starts, strict=False):
+            lo, hi = max(start - a, 0), min(stop - a, p.size)
+            if hi > lo:
+                got.append(p.read(lo, hi))
+        if len(got) == 1:
+            return got[0]
+        return np.concatenate(got) if got else np.zeros(0)
+
+
+def _release(store: BlockStore, src: BlockSource) -> None:
+    """Release a store, or each part of a :class:`_Concat`."""
+    for part in src.parts if isinstance(src, _Concat) else [src]:
+        store.remove(part)
 
 
 def _levels(
@@ -279,11 +327,12 @@ def _levels(
     out: list[_Level] = []
     offset, m = float(mean), 1
     while z.size >= 1 and m <= m_max:
-        nxt = store.create(f"level-{2 * m}") if 2 * m <= m_max and z.size >= 2 else None
-        out.append(_level(z, offset, m, nxt, work))
+        more = 2 * m <= m_max and z.size >= 2
+        lv, nxt = _level(z, offset, m, store if more else None, work)
+        out.append(lv)
         if nxt is None:
             break
-        z, offset, m = nxt.finish(), 0.0, 2 * m
+        z, offset, m = nxt, 0.0, 2 * m
     return out
 
 
@@ -453,9 +502,10 @@ def streamed_adev(
         alphas, methods = family._noise_exponents("oadev", m, ident, None, {})  # type: ignore[arg-type]
     finally:
         for lv in levels[1:]:
-            store.remove(lv.z)
+            _release(store, lv.z)
     edf = family._pooled_edf("oadev", m, alphas, sizes)
     sums, n_terms, used, segs = _pooled_sums(record.rate, slices, means, m, store, work)
+    work.finish()
     avar = sums / (2.0 * m.astype(np.float64) ** 2 * n_terms)
     adev = np.sqrt(avar)
     tau = np.asarray(m * float(record.tau0_s), dtype=np.float64)
@@ -493,9 +543,16 @@ def _pooled_sums(
         if not np.any(ok):
             continue
         x1 = _phase_store(src, sl, mean, store, work)
-        try:
+        ms = [int(mm) for mm in m[ok].tolist()]
+        try:  # the factors shared by two threads, as in memory (numpy releases the GIL)
             with threadpool_limits(limits=1, user_api="blas"):
-                vals = [_second_difference_sum(x1, int(mm), work) for mm in m[ok].tolist()]
+                if allan._WORKERS > 1 and len(ms) > 1:
+                    with ThreadPoolExecutor(max_workers=allan._WORKERS) as pool:
+                        vals = list(
+                            pool.map(_second_difference_sum, [x1] * len(ms), ms, [work] * len(ms))
+                        )
+                else:
+                    vals = [_second_difference_sum(x1, mm, work) for mm in ms]
         finally:
             store.remove(x1)
         sums[ok] += np.asarray(vals)
@@ -537,6 +594,8 @@ class ValueSummary:
         taken = sum(h.size for h in self.head)
         if taken < _LEVEL_PROBE:
             self.head.append(v[: _LEVEL_PROBE - taken].copy())
+            if np.unique(np.concatenate(self.head)).size > FEW_LEVELS:
+                self.levels = None  # many levels already: the whole's are not counted
         if self.levels is not None:
             self.levels.update(np.unique(v).tolist())
             if len(self.levels) > FEW_LEVELS:
