@@ -42,6 +42,7 @@ if TYPE_CHECKING:
     import pyarrow as pa
     import pyarrow.parquet as pq
 
+    from thermocal.metrics import MetricsOptions, MetricsResult
     from thermocal.recording import Recording
     from thermocal.stability.analysis import AllanAnalysis
     from thermocal.stability.streaming import BlockSource
@@ -341,9 +342,14 @@ class _Spooled:
 
 
 def _spool(
-    plan: _Plan, store: _TempStore, summary: Any, advance: Callable[[float], None]
+    plan: _Plan,
+    store: _TempStore,
+    summary: Any,
+    advance: Callable[[float], None],
+    time: _RawFile | None = None,
 ) -> _Spooled:
-    """Pass 1: every row group of the two columns checked and stored."""
+    """Pass 1: every row group of the two columns checked and stored (the time too when
+    a store for it is given)."""
     rate = store.create("rate")
     times = _TimePass()
     unit, row0 = "", 0
@@ -358,6 +364,8 @@ def _spool(
             )
         summary.add(v)
         rate.write(v)
+        if time is not None:
+            time.write(t)
         row0 += int(t.size)
         advance(t.size)
     return _Spooled(rate.finish(), times, unit)
@@ -480,4 +488,86 @@ def allan_streamed(
     return AllanAnalysis((plan.signal,), channels={plan.signal: ch})
 
 
-__all__ = ["allan_streamed", "needs_streaming"]
+def metrics_streamed(
+    path: str | Path,
+    read: ReadOptions,
+    signal: str | None,
+    options: MetricsOptions,
+    *,
+    scratch_dir: str | Path | None = None,
+    progress: Callable[[float], None] | None = None,
+) -> dict[str, MetricsResult]:
+    """``thermocal metrics`` of one rate channel of a Parquet file of any length, without
+    temperatures, in bounded memory: its time and signal read a row group at a time into
+    temporary files (removed at the end, on failure or interruption), then
+    :func:`thermocal.metrics_streaming.streamed_metrics`.
+
+    Parameters
+    ----------
+    path : str or Path
+        The Parquet file.
+    read : ReadOptions
+        How it is read (columns, units).
+    signal : str, optional
+        The channel (default the file's first signal).
+    options : MetricsOptions
+        Averaging time, earth-rate removal, the drift angle's reference (no temperatures).
+    scratch_dir : str or Path, optional
+        Folder of the temporary files (default ``$TMPDIR``; about 16 bytes a row).
+    progress : callable, optional
+        Called with each fraction of the work done.
+
+    Returns
+    -------
+    dict of str to MetricsResult
+        The channel's figures.
+
+    Raises
+    ------
+    thermocal.errors.ThermocalInputError
+        What the in-memory metrics refuse, and temperature columns (their hold stages are
+        computed in memory only).
+    """
+    from thermocal import metrics as mt
+    from thermocal.metrics_streaming import streamed_metrics
+    from thermocal.stability import streaming
+
+    p = Path(path)
+    plan = _plan(p, read, signal)
+    if options.temps or plan.head.temperatures:
+        names = ", ".join(options.temps or plan.head.temperatures)
+        raise ThermocalInputError.naming(
+            f"{p}: a record analysed window by window has no temperature hold stages; "
+            f"drop the temperature column(s) {names} ({{temps}}), or cut the record",
+            "temps",
+        )
+    canon = plan.head.signal(plan.signal)[1]
+    unit, k = mt.data_unit_of(plan.head, plan.signal, canon)
+    earth = mt._earth_rate(
+        plan.head, plan.signal, canon, unit, k, options.latitude_deg, options.axis
+    )
+    share = 0.6
+    with tempfile.TemporaryDirectory(prefix="thermocal-metrics-", dir=scratch_dir) as d:
+        store = _TempStore(Path(d))
+        try:
+            rows = max(plan.n_rows, 1)
+            times = store.create("time")
+            sp = _spool(
+                plan, store, streaming.ValueSummary(plan.n_rows),
+                lambda n: progress(share * n / rows) if progress else None, time=times,
+            )  # fmt: skip
+            segments, med = _segments(plan, sp.times)
+            time = times.finish()
+            res = streamed_metrics(
+                time, sp.rate, segments, float(plan.head.meta.sample_interval_s or med),
+                name=plan.signal, unit=sp.unit, earth_rate=earth,
+                averaging_s=options.averaging_s, drift_reference_s=options.drift_reference_s,
+                drift_bias=options.drift_bias, store=store, where=str(p),
+                progress=(lambda f: progress((1 - share) * f)) if progress else None,
+            )  # fmt: skip
+        finally:
+            store.close()
+    return {plan.signal: res}
+
+
+__all__ = ["allan_streamed", "metrics_streamed", "needs_streaming"]
