@@ -3565,8 +3565,8 @@ MUTANTS: tuple[Mutant, ...] = (
     Mutant(
         "streamed-metrics-std-ddof",
         P + "metrics_streaming.py",
-        "math.fsum(sq) / (n - 1)",
-        "math.fsum(sq) / n",
+        "exact_sum(means, 0, n, squares) / (n - 1)",
+        "exact_sum(means, 0, n, squares) / n",
         _t("metrics_streaming"),
         "the streamed bias stability with ddof 0",
     ),

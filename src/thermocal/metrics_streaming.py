@@ -21,7 +21,7 @@ import numpy.typing as npt
 
 from thermocal import metrics as mt
 from thermocal.errors import ParameterError, ThermocalInputError
-from thermocal.stability.streaming import ArrayStore, BlockSource, BlockStore
+from thermocal.stability.streaming import ArrayStore, BlockSource, BlockStore, exact_sum
 
 FloatArray = npt.NDArray[np.float64]
 
@@ -38,9 +38,8 @@ def _windows(start: int, stop: int, size: int = WINDOW) -> list[tuple[int, int]]
 
 
 def _mean(src: BlockSource, start: int, stop: int) -> float:
-    """The mean of values [start, stop) (window sums added exactly)."""
-    parts = [float(src.read(a, b).sum()) for a, b in _windows(start, stop)]
-    return math.fsum(parts) / (stop - start)
+    """The mean of values [start, stop), numpy's (its pairwise sum, then / n)."""
+    return exact_sum(src, start, stop) / (stop - start)
 
 
 def _block_means(
@@ -63,13 +62,16 @@ def _std_and_range(means: BlockSource) -> tuple[float, float]:
     """Sample standard deviation (ddof 1, two passes as numpy's) and max − min."""
     n = means.size
     mu = _mean(means, 0, n)
-    sq, lo, hi = [], math.inf, -math.inf
+    lo, hi = math.inf, -math.inf
     for a, b in _windows(0, n):
         x = means.read(a, b)
         lo, hi = min(lo, float(x.min())), max(hi, float(x.max()))
+
+    def squares(x: FloatArray) -> FloatArray:
         x -= mu
-        sq.append(float(x @ x))
-    return math.sqrt(math.fsum(sq) / (n - 1)), hi - lo
+        return np.multiply(x, x, out=x)
+
+    return math.sqrt(exact_sum(means, 0, n, squares) / (n - 1)), hi - lo
 
 
 def _reference_window(

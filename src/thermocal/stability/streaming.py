@@ -161,10 +161,40 @@ class StreamedRecord:
     segments: tuple[slice, ...]
 
 
-def _sum(src: BlockSource, start: int, stop: int) -> float:
-    """Σ values[start:stop] as the sum of per-window numpy sums (exact to rounding)."""
-    parts = [float(src.read(a, min(a + WINDOW, stop)).sum()) for a in range(start, stop, WINDOW)]
-    return math.fsum(parts)
+def exact_sum(
+    src: BlockSource,
+    start: int,
+    stop: int,
+    transform: Callable[[FloatArray], FloatArray] | None = None,
+) -> float:
+    """Σ values[start:stop] (of ``transform(values)`` when given) with numpy's own rounding:
+    its pairwise summation splits n into halves rounded down to a multiple of 8 until a part
+    fits a window, and each part is summed by numpy (the same tree, so the same bits as
+    ``values[start:stop].sum()`` on the whole array).
+
+    Parameters
+    ----------
+    src : BlockSource
+        The values.
+    start, stop : int
+        The index range.
+    transform : callable, optional
+        Applied to each part before it is summed (elementwise).
+
+    Returns
+    -------
+    float
+        The sum.
+    """
+    n = stop - start
+    if n <= WINDOW:
+        part = src.read(start, stop)
+        return float(np.add.reduce(transform(part) if transform is not None else part))
+    half = n // 2
+    half -= half % 8
+    return exact_sum(src, start, start + half, transform) + exact_sum(
+        src, start + half, stop, transform
+    )
 
 
 def _phase_store(
@@ -520,7 +550,7 @@ def streamed_adev(
 def _segment_mean(src: BlockSource, sl: slice, work: _Work) -> float:
     """A stretch's mean sample."""
     n = sl.stop - sl.start
-    total = _sum(src, sl.start, sl.stop)
+    total = exact_sum(src, sl.start, sl.stop)
     work.advance(n)
     return float(total / n)
 
@@ -766,6 +796,7 @@ __all__ = [
     "BlockWriter",
     "StreamedRecord",
     "ValueSummary",
+    "exact_sum",
     "lattice_step",
     "streamed_adev",
     "streamed_channel",
