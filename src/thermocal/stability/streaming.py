@@ -21,7 +21,9 @@ References
 
 from __future__ import annotations
 
+import functools
 import math
+import threading
 import warnings
 from collections.abc import Callable, Sequence
 from concurrent.futures import ThreadPoolExecutor
@@ -125,11 +127,32 @@ class ArraySource:
         return np.array(self.values[start:stop], dtype=np.float64)
 
 
+class _Stopped(Exception):
+    """A worker thread stopped by an interruption of the caller."""
+
+
 class _Work:
     """Progress in fractions of the whole analysis, from passes weighted by their length."""
 
     def __init__(self, progress: Progress | None, total: float) -> None:
         self.progress, self.total, self.done = progress, max(total, 1.0), 0.0
+        self.stop = threading.Event()
+        """Set when the caller is interrupted: the worker threads end at their next window."""
+
+    def check(self) -> None:
+        """Raise in a worker thread once the analysis is stopped."""
+        if self.stop.is_set():
+            raise _Stopped
+
+    def pooled(self, calls: list[Callable[[], Any]]) -> list[Any]:
+        """Run ``calls`` on two threads; an interruption (Ctrl-C) stops them both."""
+        with ThreadPoolExecutor(max_workers=2) as pool:
+            jobs = [pool.submit(c) for c in calls]
+            try:
+                return [j.result() for j in jobs]
+            except BaseException:
+                self.stop.set()
+                raise
 
     def advance(self, amount: float) -> None:
         if self.progress is not None and amount > 0:
@@ -226,6 +249,7 @@ def _second_difference_sum(x1: BlockSource, mm: int, work: _Work) -> float:
     buf2 = np.empty(size, dtype=np.float64)
     total = 0.0
     for wa in range(0, n_terms, WINDOW):
+        work.check()
         wb = min(wa + WINDOW, n_terms)
         lo_w = max(wa, 1) - 1  # x1 index of the first x_k read (k ≥ 1)
         if 2 * mm <= WINDOW:  # one span holds the three taps
@@ -260,7 +284,12 @@ class _Level:
 
 
 def _level_sums(
-    z: BlockSource, offset: float, lo: int, hi: int, nxt: BlockWriter | None
+    z: BlockSource,
+    offset: float,
+    lo: int,
+    hi: int,
+    nxt: BlockWriter | None,
+    work: _Work | None = None,
 ) -> tuple[float, float, float, float]:
     """Σ c, Σ c², Σ c_k c_{k+1}, Σ k c_k over the terms starting in [lo, hi) (c = z −
     offset) by :func:`thermocal.stability.deviations._level_range` on windows, writing the
@@ -268,6 +297,8 @@ def _level_sums(
     s1 = s2 = sl = sk = 0.0
     n = z.size
     for wa in range(lo, hi, WINDOW):
+        if work is not None:
+            work.check()
         wb = min(wa + WINDOW, hi)
         zw = z.read(wa, min(wb + 2, n))
         half = np.empty((wb - wa) // 2) if nxt is not None else None
@@ -292,12 +323,12 @@ def _level(
     if n >= dv._SPLIT and dv._WORKERS > 1:
         half = (n // 2) & ~1
         outs = [store.create(f"level-{2 * m}-{i}") if store else None for i in (0, 1)]
-        with ThreadPoolExecutor(max_workers=2) as pool:
-            jobs = [
-                pool.submit(_level_sums, z, offset, lo, hi, out)
+        parts = work.pooled(
+            [
+                functools.partial(_level_sums, z, offset, lo, hi, out, work)
                 for (lo, hi), out in zip(((0, half), (half, n)), outs, strict=True)
             ]
-            parts = [j.result() for j in jobs]
+        )
         s1, s2, sl, sk = (p + q for p, q in zip(*parts, strict=True))
         if store is not None:
             nxt = _Concat([o.finish() for o in outs if o is not None])
@@ -577,10 +608,9 @@ def _pooled_sums(
         try:  # the factors shared by two threads, as in memory (numpy releases the GIL)
             with threadpool_limits(limits=1, user_api="blas"):
                 if allan._WORKERS > 1 and len(ms) > 1:
-                    with ThreadPoolExecutor(max_workers=allan._WORKERS) as pool:
-                        vals = list(
-                            pool.map(_second_difference_sum, [x1] * len(ms), ms, [work] * len(ms))
-                        )
+                    vals = work.pooled(
+                        [functools.partial(_second_difference_sum, x1, mm, work) for mm in ms]
+                    )
                 else:
                     vals = [_second_difference_sum(x1, mm, work) for mm in ms]
         finally:
