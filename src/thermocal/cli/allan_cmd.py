@@ -4,7 +4,7 @@ IEEE 952 noise terms by slope lines and by least squares."""
 import contextlib
 import math
 import warnings
-from collections.abc import Iterator
+from collections.abc import Iterator, Mapping
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated
 
@@ -41,6 +41,7 @@ from thermocal.errors import ThermocalInputError, UnitWarning
 from thermocal.report import text as _text
 
 if TYPE_CHECKING:
+    import thermocal.pipeline.large as _large
     import thermocal.readers as _readers
     import thermocal.stability.analysis as _analysis
     import thermocal.stability.api as _api
@@ -49,6 +50,7 @@ if TYPE_CHECKING:
     import thermocal.stability.total as _total
     import thermocal.writers as _writers
 else:
+    _large = LazyModule("thermocal.pipeline.large")
     _writers = LazyModule("thermocal.writers")
     _readers = LazyModule("thermocal.readers")
     _analysis = LazyModule("thermocal.stability.analysis")
@@ -195,6 +197,37 @@ MaxWorkOpt = Annotated[
 ]
 
 
+StreamOpt = Annotated[
+    bool,
+    typer.Option(
+        "--stream",
+        help="Read the Parquet file a row group at a time and analyse it window by window "
+        "from temporary files (bounded memory, any length; the default analysis only). "
+        "Chosen by itself when the file would not fit in memory (THERMOCAL_MEMORY_LIMIT).",
+    ),
+]
+
+
+def _streamed(file: Path, forced: bool, signal: str | None, others: Mapping[str, object]) -> bool:
+    """Whether this run is analysed window by window (``--stream``, or a Parquet file too
+    large for memory), refusing the options only the in-memory analysis has."""
+    if not (forced or _large.needs_streaming(file)):
+        return False
+    given = [k for k, v in others.items() if v not in (None, False, "rate", "octave", "error")]
+    names = split_names(signal) or []
+    if len(names) > 1:
+        given.append("--signal with several columns")
+    if file.suffix.lower() not in (".parquet", ".pq"):
+        raise ThermocalInputError(f"{file}: --stream reads Parquet files; convert it to Parquet")
+    if given:
+        why = "--stream given" if forced else "the file is larger than the memory available"
+        raise ThermocalInputError(
+            f"{file}: analysed window by window ({why}), which takes the default analysis "
+            f"of one channel at octave τ only; drop {', '.join(given)}, or cut the record"
+        )
+    return True
+
+
 def _check_plot(plot: Path | None, file: Path) -> None:
     """``--plot``: a PNG, SVG or PDF file name that is not the input."""
     if plot is None:
@@ -250,6 +283,7 @@ def allan_cmd(
     noise_type: NoiseTypeOpt = None,
     noise_id: NoiseIdOpt = None,
     max_work: MaxWorkOpt = None,
+    stream: StreamOpt = False,
     as_json: JsonOpt = False,
 ) -> None:
     """Overlapping Allan deviation with chi-square confidence intervals and the noise
@@ -275,6 +309,24 @@ def allan_cmd(
             topic=topic, names=t_names, rate=t_rate, on_bad_lines=t_bad, delimiter=t_delim,
             decimal=t_dec, stamp=stamp,
         )  # fmt: skip
+        others = {
+            "--deviation": deviation, "--data-type": data_type, "--dynamic": dynamic,
+            "--bias-correct": bias_correct, "--noise-type": noise_type,
+            "--noise-id": noise_id, "--max-work": max_work, "--rate": t_rate,
+        }  # fmt: skip
+        if _streamed(file, stream, signal, others):
+            _check_plot(plot, file)
+            tau_spec = parse_taus(taus)
+            one_name = (split_names(signal) or [""])[0] or None
+            with progress("allan (window by window)", total=1.0) as advance:
+                res = _large.allan_streamed(
+                    file, read, one_name, taus=tau_spec,
+                    confidence=confidence, where=str(file), progress=advance,
+                )  # fmt: skip
+            if plot is not None:
+                _write_plots(file, plot, res)
+            _emit_allan(file, res, as_json, plot)
+            return
         # the Allan deviation uses the time and the signal only
         rec = check_recording(_readers.read_recording(file, read, keep_other=False), read)
     _check_plot(plot, file)

@@ -29,6 +29,7 @@ from thermocal.cli.common import (
     check_recording,
     emit,
     handle_errors,
+    progress,
     read_options,
     show,
     split_names,
@@ -39,11 +40,13 @@ from thermocal.report.text import fmt
 
 if TYPE_CHECKING:
     import thermocal.metrics as _metrics
+    import thermocal.pipeline.large as _large
     import thermocal.readers as _readers
     from thermocal.metrics import MetricsResult
     from thermocal.recording import Recording
 else:
     _metrics = LazyModule("thermocal.metrics")
+    _large = LazyModule("thermocal.pipeline.large")
     _readers = LazyModule("thermocal.readers")
 
 
@@ -82,6 +85,16 @@ DriftBiasOpt = Annotated[
     ),
 ]
 
+StreamOpt = Annotated[
+    bool,
+    typer.Option(
+        "--stream",
+        help="Read the Parquet file a row group at a time and compute the figures from "
+        "temporary files (bounded memory, any length; one signal, no --temps). Chosen by "
+        "itself when the file would not fit in memory (THERMOCAL_MEMORY_LIMIT).",
+    ),
+]
+
 
 @app.command("metrics")
 @handle_errors
@@ -108,6 +121,7 @@ def metrics_cmd(
     t_bad: OnBadLinesOpt = "error",
     t_delim: DelimiterOpt = None,
     t_dec: DecimalOpt = None,
+    stream: StreamOpt = False,
     as_json: JsonOpt = False,
 ) -> None:
     """Figures of merit: bias (earth rate removed with --latitude and --axis), bias
@@ -140,10 +154,41 @@ def metrics_cmd(
         _emit_runs(res, as_json)
         return
     file = files[0]
+    if stream or _large.needs_streaming(file):
+        _streamed(file, options(), split_names(signal) or [], t_rate, stream, as_json, read_options(
+            time=time, time_unit=time_unit, signal=signal, temps=temps,
+            signal_unit=signal_unit, temp_unit=temp_unit, temp_conversion=temp_conversion,
+            topic=topic, names=t_names, rate=t_rate,
+        ))  # fmt: skip
+        return
     rec = read(file)
     opts = options()
     results = _metrics.channel_metrics(rec, split_names(signal) or [rec.signals[0]], opts)
     _emit_metrics(file, results, as_json)
+
+
+def _streamed(
+    file: Path,
+    opts: "_metrics.MetricsOptions",
+    names: list[str],
+    rate: float | None,
+    forced: bool,
+    as_json: bool,
+    read: "_readers.ReadOptions",
+) -> None:
+    """One file too large for memory (or ``--stream``): its figures from temporary files."""
+    why = "--stream given" if forced else "the file is larger than the memory available"
+    if file.suffix.lower() not in (".parquet", ".pq"):
+        raise ThermocalInputError(f"{file}: --stream reads Parquet files; convert it to Parquet")
+    if len(names) > 1 or rate is not None:
+        raise ThermocalInputError(
+            f"{file}: computed window by window ({why}), which takes one signal and the "
+            f"file's time column; drop {'--rate' if rate is not None else 'all but one --signal'}"
+        )
+    with progress("metrics (window by window)", total=1.0) as advance:
+        res = _large.metrics_streamed(file, read, names[0] if names else None, opts,
+                                      progress=advance)  # fmt: skip
+    _emit_metrics(file, res, as_json)
 
 
 def _emit_metrics(file: Path, results: "dict[str, MetricsResult]", as_json: bool) -> None:
