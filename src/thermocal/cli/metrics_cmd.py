@@ -154,7 +154,9 @@ def metrics_cmd(
         _emit_runs(res, as_json)
         return
     file = files[0]
-    if stream or _large.needs_streaming(file):
+    # temperature hold stages are computed in memory only: a record too large for memory
+    # with --temps gets the reader's refusal (naming the memory limit), not the stream's
+    if stream or (not temps and _large.needs_streaming(file)):
         _streamed(file, options(), split_names(signal) or [], t_rate, stream, as_json, read_options(
             time=time, time_unit=time_unit, signal=signal, temps=temps,
             signal_unit=signal_unit, temp_unit=temp_unit, temp_conversion=temp_conversion,

@@ -58,7 +58,17 @@ class BlockSource(Protocol):
     size: int
 
     def read(self, start: int, stop: int) -> FloatArray:
-        """Values ``start`` … ``stop − 1`` as a new float64 array."""
+        """Values ``start`` … ``stop − 1`` as a new float64 array.
+
+        Parameters
+        ----------
+        start, stop : int
+            First index and one past the last [samples].
+
+        Returns
+        -------
+        numpy.ndarray
+        """
         ...
 
 
@@ -66,7 +76,13 @@ class BlockWriter(Protocol):
     """A store being filled in order, one window after the other."""
 
     def write(self, values: FloatArray) -> None:
-        """Append ``values``."""
+        """Append ``values``.
+
+        Parameters
+        ----------
+        values : numpy.ndarray
+            The next window, in order.
+        """
         ...
 
     def finish(self) -> BlockSource:
@@ -78,11 +94,27 @@ class BlockStore(Protocol):
     """Where the intermediate series are kept (temporary files, or memory in tests)."""
 
     def create(self, name: str) -> BlockWriter:
-        """A new empty store named ``name`` (unique within the analysis)."""
+        """A new empty store named ``name`` (unique within the analysis).
+
+        Parameters
+        ----------
+        name : str
+            The store's name.
+
+        Returns
+        -------
+        BlockWriter
+        """
         ...
 
     def remove(self, source: BlockSource) -> None:
-        """Release a store no longer needed."""
+        """Release a store no longer needed.
+
+        Parameters
+        ----------
+        source : BlockSource
+            The finished store.
+        """
         ...
 
 
@@ -91,11 +123,27 @@ class ArrayStore:
     windows, concatenated when finished."""
 
     def create(self, name: str) -> BlockWriter:
-        """A new store (``name`` unused)."""
+        """A new store.
+
+        Parameters
+        ----------
+        name : str
+            Unused (the store lives in memory).
+
+        Returns
+        -------
+        BlockWriter
+        """
         return _ArrayWriter()
 
     def remove(self, source: BlockSource) -> None:
-        """Nothing to release."""
+        """Nothing to release.
+
+        Parameters
+        ----------
+        source : BlockSource
+            The finished store.
+        """
 
 
 @dataclass
@@ -123,7 +171,17 @@ class ArraySource:
         self.size = int(self.values.size)
 
     def read(self, start: int, stop: int) -> FloatArray:
-        """A copy of ``values[start:stop]``."""
+        """A copy of ``values[start:stop]``.
+
+        Parameters
+        ----------
+        start, stop : int
+            First index and one past the last [samples].
+
+        Returns
+        -------
+        numpy.ndarray
+        """
         return np.array(self.values[start:stop], dtype=np.float64)
 
 
@@ -644,7 +702,13 @@ class ValueSummary:
     probe: list[FloatArray] = field(default_factory=list)
 
     def add(self, v: FloatArray) -> None:
-        """Take the next window of (finite) samples."""
+        """Take the next window of (finite) samples.
+
+        Parameters
+        ----------
+        v : numpy.ndarray
+            The window [the data's unit].
+        """
         from thermocal.stability.analysis import _LEVEL_PROBE, FEW_LEVELS
         from thermocal.stability.noise_model import _QUANT_PROBE
 
@@ -666,7 +730,15 @@ class ValueSummary:
         self.n += int(v.size)
 
     def check_not_stuck(self, name: str, where: str) -> None:
-        """:func:`thermocal.stability.analysis.check_not_stuck` on the whole record."""
+        """:func:`thermocal.stability.analysis.check_not_stuck` on the whole record.
+
+        Parameters
+        ----------
+        name : str
+            The signal's name.
+        where : str
+            The file, for the message.
+        """
         from thermocal.stability import analysis as an
 
         if self.n < an.STUCK_MIN_SAMPLES:
