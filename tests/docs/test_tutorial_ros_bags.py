@@ -32,7 +32,10 @@ def test_ros_bag_tutorial_prints_what_the_page_shows(
     assert len(pairs) == 5
     for printed, shown in pairs:
         assert _numbers(printed) == _numbers(shown)
-        assert printed.strip() == shown.strip()
+        # rich versions differ in the spaces padding a table's title line: compare lines
+        # without their trailing spaces
+        lines = [ln.rstrip() for ln in printed.strip().splitlines()]
+        assert lines == [ln.rstrip() for ln in shown.strip().splitlines()]
 
 
 def test_ros_bag_tutorial_figures_are_the_simulated_truth(

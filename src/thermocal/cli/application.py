@@ -118,6 +118,23 @@ class ListedGroup(TyperGroup):
             option._runtime_param = _FlagAsGiven()
         return option
 
+    def list_commands(self, ctx: Any) -> list[str]:
+        """The commands in the order of :data:`COMMAND_SUMMARIES` (older typer versions sort
+        them by name), then any other registered one.
+
+        Parameters
+        ----------
+        ctx : click.Context
+            The context.
+
+        Returns
+        -------
+        list of str
+        """
+        names = list(self.commands)
+        listed = [n for n in COMMAND_SUMMARIES if n in self.commands]
+        return listed + [n for n in names if n not in COMMAND_SUMMARIES]
+
     def format_commands(self, ctx: Any, formatter: Any) -> None:
         """The ``Commands`` section of the help, as the registered modules would write it."""
         real = self.commands
