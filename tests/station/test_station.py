@@ -221,7 +221,9 @@ def test_sigkill_loses_only_the_open_part_and_resume_continues(
     assert res.program_start_s == pytest.approx(program_reached)
     assert not list(out.glob(".*.tmp"))
     first_p, first_v = res.setpoints[0]
-    assert first_p - program_reached < 0.2 * k  # within the first loop turns
+    # within the first loop turns: a second of wall time at k (a CI machine running two test
+    # workers on two cores took half a second for the first turn after the resume)
+    assert first_p - program_reached < 1.0 * k
     assert first_v == pytest.approx(round(_program(first_p) / SCALE) * SCALE, abs=1.5 * SCALE)
     assert sim.writes[n_before][1] == pytest.approx(first_v)
     # the recording reads as one, across both runs, time increasing
