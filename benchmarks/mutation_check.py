@@ -3810,6 +3810,22 @@ MUTANTS: tuple[Mutant, ...] = (
         _t("metrics_streaming"),
         "the streamed bias stability with ddof 0",
     ),
+    Mutant(
+        "gsens-vertical-earth-rate",
+        P + "multipos/gsens.py",
+        "        y = y - units.EARTH_RATE_RAD_S",
+        "        y = y + 0 * units.EARTH_RATE_RAD_S",
+        _t("gsens"),
+        "the vertical earth rate left in the poses' rates: taken for a g-sensitivity",
+    ),
+    Mutant(
+        "gsens-force-sign",
+        P + "multipos/gsens.py",
+        "x = np.column_stack([np.ones(m), f])",
+        "x = np.column_stack([np.ones(m), -f])",
+        _t("gsens"),
+        "the g-sensitivity with the specific force's sign reversed",
+    ),
 )
 
 
