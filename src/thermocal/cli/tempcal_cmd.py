@@ -26,10 +26,36 @@ from thermocal.defaults import overrides_of
 from thermocal.report import firmware_text as _firmware_text
 
 if TYPE_CHECKING:
+    from thermocal.heater import HeaterOptions
     from thermocal.tempcal.ardupilot import ArdupilotTempcalResult
     from thermocal.tempcal.px4 import Px4TempcalResult
 
 OutDirOpt = Annotated[Path, typer.Option("-o", "--output", help="Directory to write.")]
+HeaterOpt = Annotated[
+    str,
+    typer.Option(
+        "--heater",
+        help="A heated IMU's hold at its set-point (within ±0.5 °C for 60 s): cut (fit the "
+        "sweep up to the set-point, say the range is cut), refuse (a range cut by the "
+        "heater is an error) or ignore (no hold looked for).",
+    ),
+]
+HeaterSetpointOpt = Annotated[
+    float | None,
+    typer.Option(
+        "--heater-setpoint",
+        help="The heater's set-point [°C] (default: the log's SENS_IMU_TEMP or "
+        "BRD_HEAT_TARG, else inferred from the log's plateau).",
+    ),
+]
+
+
+def heater_options(heater: str, setpoint: float | None) -> "HeaterOptions":
+    """``--heater`` and ``--heater-setpoint`` as the library's options."""
+    from thermocal.heater import HeaterOptions
+
+    return HeaterOptions(heater, setpoint)  # type: ignore[arg-type]  # checked by HeaterOptions
+
 
 M_MMAP_THRESHOLD = -3
 """glibc's ``mallopt`` parameter of the size from which a block is a mapping of its own."""
@@ -71,6 +97,8 @@ def px4_tempcal_cmd(
             "gyro and accelerometer reports (slower on a long log).",
         ),
     ] = False,
+    heater: HeaterOpt = "cut",
+    heater_setpoint: HeaterSetpointOpt = None,
 ) -> None:
     """Fit every gyro and accelerometer instance of a PX4 log as PX4 would (a cubic per axis
     about TREF), robust to spikes, with equal weight across the temperature range and
@@ -83,6 +111,7 @@ def px4_tempcal_cmd(
     res = px4_tempcal(
         log, output, tref_c=tref, overrides=overrides_of(allow_narrow, allow_motion),
         reporter=write_sensor_report, allan=allan,
+        heater=heater_options(heater, heater_setpoint),
     )  # fmt: skip
     emit(res.to_dict(), as_json, lambda: _print_px4(res))
 
@@ -108,6 +137,8 @@ def ardupilot_tempcal_cmd(
             "gyro and accelerometer reports (slower on a long log).",
         ),
     ] = False,
+    heater: HeaterOpt = "cut",
+    heater_setpoint: HeaterSetpointOpt = None,
 ) -> None:
     """ArduPilot's thermal calibration from one DataFlash log: every IMU instance's gyro
     and accelerometer fitted as in px4-tempcal, written as INS_TCAL* (.parm), a calibration
@@ -120,6 +151,7 @@ def ardupilot_tempcal_cmd(
     res = ardupilot_tempcal(
         log, output, overrides=overrides_of(allow_narrow, allow_motion),
         reporter=write_sensor_report, allan=allan,
+        heater=heater_options(heater, heater_setpoint),
     )  # fmt: skip
     emit(res.to_dict(), as_json, lambda: _print_ardupilot(res))
 
