@@ -3810,6 +3810,38 @@ MUTANTS: tuple[Mutant, ...] = (
         _t("metrics_streaming"),
         "the streamed bias stability with ddof 0",
     ),
+    Mutant(
+        "heater-hold-not-thinned",
+        P + "heater.py",
+        "want = n_in if span <= 0 else max(MIN_HOLD_KEEP",
+        "want = n_in if span > 0 else max(MIN_HOLD_KEEP",
+        _t("heater", "fit_heater"),
+        "a heater's hold kept whole: its samples outweigh the sweep in fit",
+    ),
+    Mutant(
+        "heater-overshoot-absolute",
+        P + "heater.py",
+        "overshoot, over_at = float(seg[k] - sp)",
+        "overshoot, over_at = float(seg[k])",
+        _t("heater", "tempcal_heater"),
+        "the overshoot given as the peak temperature, not its excess over the set-point",
+    ),
+    Mutant(
+        "heater-band-doubled",
+        P + "heater.py",
+        "runs = _runs(np.abs(temp_c - level_c) <= band_c, time_s, GAP_S)",
+        "runs = _runs(np.abs(temp_c - level_c) <= 2 * band_c, time_s, GAP_S)",
+        _t("heater"),
+        "the hold's band twice as wide as asked: settling and the band held understated",
+    ),
+    Mutant(
+        "heater-range-never-cut",
+        P + "heater.py",
+        "range_cut=bool(float(np.max(temp_c)) <= sp + band_c + overshoot)",
+        "range_cut=bool(float(np.max(temp_c)) < sp)",
+        _t("heater", "tempcal_heater"),
+        "a range ending at the heater's set-point not said to be cut",
+    ),
 )
 
 

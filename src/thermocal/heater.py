@@ -24,6 +24,7 @@ import numpy as np
 import numpy.typing as npt
 
 from thermocal.errors import ParameterError, ThermocalInputError, ThermocalWarning
+from thermocal.recording import Recording
 
 FloatArray = npt.NDArray[np.float64]
 
@@ -86,7 +87,8 @@ class HeaterOptions:
     Raises
     ------
     thermocal.errors.ParameterError
-        A band or duration not positive, a policy not one of the three.
+        A band or duration not positive, a policy not one of the three, a set-point not a
+        finite temperature.
     """
 
     policy: HeaterPolicy = HeaterPolicy.CUT
@@ -101,6 +103,11 @@ class HeaterOptions:
             raise ParameterError(
                 "heater", f"{{name}} must be cut, refuse or ignore, got {self.policy!r}"
             ) from None
+        if self.setpoint_c is not None and not -273.15 < self.setpoint_c < math.inf:
+            raise ParameterError(
+                "heater_setpoint",
+                f"{{name}} must be a finite temperature above −273.15 °C, got {self.setpoint_c}",
+            )
         if not self.band_c > 0:
             raise ParameterError("heater_band", f"{{name}} must be positive, got {self.band_c:g}")
         if not self.min_hold_s > 0:
@@ -492,7 +499,8 @@ def thin_hold(time_s: FloatArray, temp_c: FloatArray, hold: HeaterHold) -> npt.N
     Notes
     -----
     The sweep outside the hold has :math:`\rho = n_{sweep} / (T_{max} - T_{min})` samples
-    per °C; the hold spans :math:`w = \max(h_{hi} - h_{lo}, 0.1)` °C and keeps
+    per °C; the hold spans :math:`w = \max(P_{95} - P_5, 0.1)` °C (the central 90 % of its
+    temperatures: its overshoot's tail and the thermometer's extremes left out) and keeps
     :math:`n = \max(20, \lceil \rho w \rceil)` of its samples, evenly spaced in time — the
     same density per °C as the sweep, so that it weighs no more in a least-squares fit
     than any other stretch of the range of its width.
@@ -510,7 +518,8 @@ def thin_hold(time_s: FloatArray, temp_c: FloatArray, hold: HeaterHold) -> npt.N
     inside = hold_mask(t, hold)
     keep = ~inside
     span = hold.sweep_c[1] - hold.sweep_c[0]
-    width = max(hold.held_c[1] - hold.held_c[0], 0.1)
+    p5, p95 = np.percentile(np.asarray(temp_c, dtype=np.float64)[inside], [5.0, 95.0])
+    width = max(float(p95 - p5), 0.1)
     n_in = int(np.count_nonzero(inside))
     want = n_in if span <= 0 else max(MIN_HOLD_KEEP, math.ceil(hold.n_sweep / span * width))
     idx = np.flatnonzero(inside)
@@ -520,11 +529,7 @@ def thin_hold(time_s: FloatArray, temp_c: FloatArray, hold: HeaterHold) -> npt.N
     return keep
 
 
-HEATER_OFF = {
-    "px4": "SENS_EN_THERMAL=0",
-    "ardupilot": "BRD_HEAT_TARG=-1",
-    None: "its controller off",
-}
+HEATER_OFF = {"px4": "SENS_EN_THERMAL=0", "ardupilot": "BRD_HEAT_TARG=-1"}
 """How to calibrate with the heater off, per firmware (None: any other recording)."""
 
 
@@ -575,6 +580,20 @@ def hold_sentence(hold: HeaterHold) -> str:
         f"{hold.overshoot_at_s:.1f} s, settled {hold.settling_s:.1f} s after reaching it"
         + (f", heater off at {hold.heater_off_s:.1f} s" if hold.heater_off_s is not None else "")
     )
+
+
+def _never_held(
+    where: str, temp_c: FloatArray, setpoint_c: float | None, source: str
+) -> HeaterJudgement:
+    """No hold: a set-point known but never held is said (a warning and a note)."""
+    if setpoint_c is None:
+        return HeaterJudgement(None, None, (), ())
+    said = (
+        f"{where}: the heater's set-point {setpoint_c:.1f} °C ({source}) is never held (the "
+        f"temperature peaks at {float(np.max(temp_c)):.1f} °C): no hold found, the sweep is "
+        "fitted as it is",
+    )
+    return HeaterJudgement(None, None, said, said)
 
 
 def judge_heater(
@@ -640,36 +659,75 @@ def judge_heater(
         )  # fmt: skip
     if hold is None:
         hold = find_heater_hold(time_s, temp_c, band_c=band_c, min_hold_s=min_hold_s)
-    off = HEATER_OFF.get(firmware, HEATER_OFF[None])
+    off = f" ({HEATER_OFF[firmware]})" if firmware in HEATER_OFF else ""
+    beyond = (
+        "above TMAX the firmware clamps the temperature: no correction beyond"
+        if firmware in HEATER_OFF
+        else "beyond it the model extrapolates"
+    )
     if hold is None:
-        said: tuple[str, ...] = ()
-        if setpoint_c is not None:
-            said = (
-                f"{where}: the heater's set-point {setpoint_c:.1f} °C ({setpoint_source}) is "
-                f"never held (the temperature peaks at {float(np.max(temp_c)):.1f} °C): no "
-                "hold found, the sweep is fitted as it is",
-            )
-        return HeaterJudgement(None, None, said, said)
+        return _never_held(where, temp_c, setpoint_c, setpoint_source)
     if hold.sweep_c[1] - hold.sweep_c[0] < MIN_SWEEP_C:
         raise ThermocalInputError(
             f"{where}: the temperature sits at the heater's set-point {hold.setpoint_c:.1f} °C "
             f"({hold.setpoint_source}) for the whole log: no sweep to calibrate; record again "
-            f"from a cold start with the heater off ({off})"
+            f"from a cold start with the heater off{off}"
         )
     sentence = hold_sentence(hold)
     notes = [sentence]
-    said = ()
+    said: tuple[str, ...] = ()
     if hold.range_cut:
-        cut = (
-            f"{where}: {sentence}: the calibrated range ends at the set-point (the log's "
-            f"highest temperature {float(np.max(temp_c)):.1f} °C; above TMAX the firmware "
-            "clamps the temperature: no correction beyond); to calibrate above it record "
-            f"with the heater off ({off}) or its set-point raised"
+        tail = (
+            "the calibrated range ends at the set-point (the log's highest temperature "
+            f"{float(np.max(temp_c)):.1f} °C; {beyond}); to calibrate above it record with "
+            f"the heater off{off} or its set-point raised"
         )
+        cut = f"{where}: {sentence}: {tail}"
         if policy is HeaterPolicy.REFUSE:
             raise ThermocalInputError.naming(
                 cut + ", or give {heater} cut to calibrate up to the set-point", "heater"
             )
         said = (cut,)
-        notes.append(cut.split(": ", 1)[1].split(": ", 1)[-1])
+        notes.append(tail)
     return HeaterJudgement(hold, thin_hold(time_s, temp_c, hold), tuple(notes), said)
+
+
+def thin_recording(
+    rec: Recording,
+    options: HeaterOptions,
+    *,
+    where: str,
+    temperature: str | None = None,
+) -> tuple[Recording, HeaterJudgement]:
+    """A recording with its heater's hold thinned to the sweep's density (:func:`thin_hold`).
+
+    Parameters
+    ----------
+    rec : thermocal.recording.Recording
+        The recording (any: a CSV of a heated sensor, a flight-controller log).
+    options : HeaterOptions
+        The policy, a set-point (default inferred), band and shortest hold.
+    where : str
+        The recording's name in messages.
+    temperature : str, optional
+        The temperature column the hold is looked for in (default the first).
+
+    Returns
+    -------
+    recording : thermocal.recording.Recording
+        ``rec`` itself when no hold is found, else its samples kept.
+    judgement : HeaterJudgement
+        The hold, notes and warnings.
+
+    Raises
+    ------
+    thermocal.errors.ThermocalInputError
+        As :func:`judge_heater`: nothing but the hold, or a cut range refused.
+    """
+    judged = judge_heater(
+        rec.time_s, rec.temperature_c(temperature), where=where, policy=options.policy,
+        setpoint_c=options.setpoint_c, band_c=options.band_c, min_hold_s=options.min_hold_s,
+    )  # fmt: skip
+    if judged.keep is None:
+        return rec, judged
+    return rec.select(judged.keep), judged

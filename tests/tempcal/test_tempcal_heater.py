@@ -181,3 +181,48 @@ def test_ardupilot_old_parameter_name_and_heater_disabled(
     code, out, err = run(["ardupilot-tempcal", str(off), "-o", str(tmp_path / "p"), "--json"],
                          capsys)  # fmt: skip
     assert code == 0 and json.loads(out)["sensors"]["IMU.Acc.0"]["heater"] is None
+
+
+def test_the_tutorial_heated_log(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """docs/tutorials/fc-params.md's heated board: the hold within 1 s of its simulator's
+    truth, and the warning the page shows is the one printed."""
+    root = Path(__file__).resolve().parents[2]
+    (tmp_path / "docs").symlink_to(root / "docs", target_is_directory=True)
+    with pytest.MonkeyPatch.context() as mp:
+        mp.chdir(tmp_path)
+        code, out, err = run(["px4-tempcal", "docs/tutorials/data/heated.ulg", "-o", "heated",
+                              "--json"], capsys)  # fmt: skip
+    assert code == 0, err
+    truth = heated_truth(7, rate_hz=1.0)  # what make_fc_logs.py wrote
+    hold = json.loads(out)["sensors"]["sensor_gyro.0"]["heater"]
+    assert abs(hold["reached_s"] - truth["reached_s"]) < 1.0
+    page = (root / "docs" / "tutorials" / "fc-params.md").read_text(encoding="utf-8")
+    shown = [ln for ln in page.splitlines() if ln.startswith("warning: ") and "heated" in ln]
+    assert len(shown) == 1 and shown[0] in err.splitlines()
+
+
+@pytest.mark.parametrize(
+    ("option", "value", "words"),
+    [
+        ("--heater", "off", "--heater must be cut, refuse or ignore, got 'off'"),
+        ("--heater-setpoint", "nan", "--heater-setpoint must be a finite temperature"),
+        ("--heater-setpoint", "inf", "--heater-setpoint must be a finite temperature"),
+        ("--heater-setpoint", "-300", "--heater-setpoint must be a finite temperature"),
+    ],
+)
+@pytest.mark.parametrize("command", ["px4-tempcal", "ardupilot-tempcal"])
+def test_hostile_heater_options(
+    px4_heated: dict, tmp_path: Path, capsys: pytest.CaptureFixture[str], command: str,
+    option: str, value: str, words: str,
+) -> None:  # fmt: skip
+    log = px4_heated["log"]
+    if command == "ardupilot-tempcal":
+        log = tmp_path / "h.bin"
+        log.write_bytes(heated_dataflash(heated_truth(1, hold_s=120.0), {"BRD_HEAT_TARG": 55.0}))
+    before = hashlib.sha256(log.read_bytes()).hexdigest()
+    code, _o, err = run([command, str(log), "-o", str(tmp_path / "o"), option, value], capsys)
+    assert code == 2
+    lines = err.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("error: ") and words in lines[0], err
+    assert not (tmp_path / "o").exists()
+    assert hashlib.sha256(log.read_bytes()).hexdigest() == before

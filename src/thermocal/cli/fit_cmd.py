@@ -44,6 +44,8 @@ from thermocal.cli.common import (
     AxisOpt,
     DecimalOpt,
     DelimiterOpt,
+    HeaterOpt,
+    HeaterSetpointOpt,
     JsonOpt,
     LatitudeOpt,
     NamesOpt,
@@ -294,7 +296,9 @@ _COMMON_LAST = (
     ("allow_narrow", AllowNarrowOpt, False), ("allow_motion", AllowMotionOpt, False),
     ("names", NamesOpt, None), ("topic", TopicOpt, None), ("rate", RateOpt, None),
     ("on_bad_lines", OnBadLinesOpt, "error"), ("delimiter", DelimiterOpt, None),
-    ("decimal", DecimalOpt, None), ("stamp", StampOpt, "header"), ("param", ParamOpt, None),
+    ("decimal", DecimalOpt, None), ("stamp", StampOpt, "header"),
+    ("heater", HeaterOpt, "cut"), ("heater_setpoint", HeaterSetpointOpt, None),
+    ("param", ParamOpt, None),
     ("as_json", JsonOpt, False),
 )  # fmt: skip
 """The options of ``fit`` every family shares, around the families' own."""

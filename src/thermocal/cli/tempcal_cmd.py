@@ -16,6 +16,8 @@ from thermocal.cli.application import app
 from thermocal.cli.common import (
     AllowMotionOpt,
     AllowNarrowOpt,
+    HeaterOpt,
+    HeaterSetpointOpt,
     JsonOpt,
     emit,
     handle_errors,
@@ -31,23 +33,6 @@ if TYPE_CHECKING:
     from thermocal.tempcal.px4 import Px4TempcalResult
 
 OutDirOpt = Annotated[Path, typer.Option("-o", "--output", help="Directory to write.")]
-HeaterOpt = Annotated[
-    str,
-    typer.Option(
-        "--heater",
-        help="A heated IMU's hold at its set-point (within ±0.5 °C for 60 s): cut (fit the "
-        "sweep up to the set-point, say the range is cut), refuse (a range cut by the "
-        "heater is an error) or ignore (no hold looked for).",
-    ),
-]
-HeaterSetpointOpt = Annotated[
-    float | None,
-    typer.Option(
-        "--heater-setpoint",
-        help="The heater's set-point [°C] (default: the log's SENS_IMU_TEMP or "
-        "BRD_HEAT_TARG, else inferred from the log's plateau).",
-    ),
-]
 
 
 def heater_options(heater: str, setpoint: float | None) -> "HeaterOptions":
