@@ -39,6 +39,10 @@ MIN_SWEEP_C = 2.0
 """Below this span [°C] of the temperatures outside the hold there is no sweep to fit."""
 MIN_HOLD_KEEP = 20
 """A thinned hold keeps at least this many samples."""
+MIN_INFERRED_SWEEP_C = 10.0
+"""An inferred hold needs this sweep outside it [°C] (ArduPilot's minimum learning range):
+a self-heating warm-up of a few degrees, a turntable's or a chamber's hold at one
+temperature have plateaus too, and no heater."""
 
 HEATER_PARAMS: dict[str, tuple[tuple[str, ...], str | None, str]] = {
     "px4": (("SENS_IMU_TEMP",), "SENS_EN_THERMAL", "SENS_EN_THERMAL=0"),
@@ -278,7 +282,8 @@ def _infer_setpoint(
     the record spends the most time; it is a heater's hold when it lasts ``min_hold_s``,
     nothing outside it stays ``max(min_hold_s, hold / 4)`` in any other window of the same
     width away from the hold (a chamber's step program has several plateaus, a cold soak
-    among them; a heater one), and no sample outside it
+    among them; a heater one), the temperatures outside it span
+    :data:`MIN_INFERRED_SWEEP_C`, and no sample outside it
     is more than ``2 band_c`` above it except an overshoot before the hold.
     """
     dt = np.diff(time_s, append=time_s[-1])
@@ -301,6 +306,8 @@ def _infer_setpoint(
     out[run[0] : run[1] + 1] = False
     if np.any(temp_c[run[1] + 1 :] > level + 2 * band_c):
         return None  # hotter after the plateau: a step of a program, not a heater's hold
+    if not out.any() or float(np.ptp(temp_c[out])) < MIN_INFERRED_SWEEP_C:
+        return None  # a plateau with no sweep to speak of: a warm-up, a hold, no heater
     far = out & (np.abs(temp_c - level) > 2 * band_c)
     rest, _ = np.histogram(temp_c[far], bins=edges, weights=dt[far])
     held_s = float(time_s[run[1]] - time_s[run[0]])
@@ -667,7 +674,7 @@ def judge_heater(
     )
     if hold is None:
         return _never_held(where, temp_c, setpoint_c, setpoint_source)
-    if hold.sweep_c[1] - hold.sweep_c[0] < MIN_SWEEP_C:
+    if hold.sweep_c[1] - hold.sweep_c[0] < MIN_SWEEP_C:  # a set-point given or logged
         raise ThermocalInputError(
             f"{where}: the temperature sits at the heater's set-point {hold.setpoint_c:.1f} °C "
             f"({hold.setpoint_source}) for the whole log: no sweep to calibrate; record again "

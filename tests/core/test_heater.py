@@ -58,7 +58,18 @@ def test_a_log_at_the_setpoint_is_refused_naming_the_heater_parameter() -> None:
     with pytest.raises(ThermocalInputError, match=r"no sweep.*SENS_EN_THERMAL=0"):
         judge_heater(tr["time_s"], tr["temp"], where="log", setpoint_c=55.0, firmware="px4")
     with pytest.raises(ThermocalInputError, match=r"BRD_HEAT_TARG=-1"):
-        judge_heater(tr["time_s"], tr["temp"], where="log", firmware="ardupilot")
+        judge_heater(tr["time_s"], tr["temp"], where="log", setpoint_c=55.0, firmware="ardupilot")
+    # no set-point known: a plateau without a sweep is no heater's (the adequacy judges it)
+    assert judge_heater(tr["time_s"], tr["temp"], where="log", firmware="px4").hold is None
+
+
+def test_plateaus_of_other_tests_are_no_heater() -> None:
+    # a MEMS gyro's self-heating warm-up: 8 °C in a first-order rise (τ = 120 s), then flat
+    t = np.arange(0.0, 1800.0, 0.5)
+    warmup = 25.0 + 8.0 * (1.0 - np.exp(-t / 120.0))
+    assert find_heater_hold(t, warmup) is None
+    # a turntable's or a multi-position session at one temperature
+    assert find_heater_hold(t, np.full(t.size, 25.0)) is None
 
 
 def test_refuse_names_the_policy_and_ignore_looks_for_nothing() -> None:

@@ -143,10 +143,15 @@ def test_a_csv_at_the_setpoint_is_refused(
     rows = "\n".join(f"{a:.3f},{0.01 * c:.6f},{c:.4f}" for a, c in zip(tr["time_s"], tr["temp"],
                                                                        strict=True))  # fmt: skip
     path.write_text("time,gyro_x,temperature\n" + rows + "\n")
-    code, _o, err = _run(["fit", str(path), *ARGS, "-o", str(tmp_path / "m.json")], capsys)
+    out = str(tmp_path / "m.json")
+    code, _o, err = _run(["fit", str(path), *ARGS, "-o", out, "--heater-setpoint", "55"], capsys)
     assert code == 2
     lines = err.strip().splitlines()
     assert len(lines) == 1 and "no sweep to calibrate" in lines[0]
+    # no set-point given: a plateau without a sweep is no heater's; the data's judgement
+    # refuses the narrow span, naming its override
+    code, _o, err = _run(["fit", str(path), *ARGS, "-o", out], capsys)
+    assert code == 2 and "heater" not in err and "--allow-narrow" in err
 
 
 @pytest.mark.parametrize(

@@ -872,6 +872,8 @@ def _heater_holds(
     from thermocal.heater import HeaterOptions, HeaterWarning, thin_recording
 
     heater = HeaterOptions(o.heater, o.heater_setpoint)  # type: ignore[arg-type]
+    if o.model == "warmup" and o.heater_setpoint is None:  # its plateau is what it models
+        return loaded, {}, []
     temp = (o.temperatures or (None,))[0]
     out, holds, said = [], {}, []
     for path, rec in loaded:

@@ -104,7 +104,8 @@ class FitOptions:
         not looked for.
     heater_setpoint : float, optional
         The heater's set-point [°C]; default inferred from the one plateau at the top of
-        the first temperature column.
+        the first temperature column after a 10 °C sweep (never for the warmup family,
+        whose plateau is what it models).
 
     Raises
     ------
