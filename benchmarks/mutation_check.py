@@ -3835,6 +3835,14 @@ MUTANTS: tuple[Mutant, ...] = (
         "the hold's band twice as wide as asked: settling and the band held understated",
     ),
     Mutant(
+        "heater-inferred-without-sweep",
+        P + "heater.py",
+        "MIN_INFERRED_SWEEP_C = 10.0",
+        "MIN_INFERRED_SWEEP_C = 1.0",
+        _t("heater"),
+        "a self-heating warm-up's plateau taken for a heater's hold",
+    ),
+    Mutant(
         "heater-range-never-cut",
         P + "heater.py",
         "range_cut=bool(float(np.max(temp_c)) <= sp + band_c + overshoot)",
