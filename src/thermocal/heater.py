@@ -112,9 +112,9 @@ class HeaterOptions:
                 "heater_setpoint",
                 f"{{name}} must be a finite temperature above −273.15 °C, got {self.setpoint_c}",
             )
-        if not self.band_c > 0:
+        if not 0 < self.band_c < math.inf:
             raise ParameterError("heater_band", f"{{name}} must be positive, got {self.band_c:g}")
-        if not self.min_hold_s > 0:
+        if not 0 < self.min_hold_s < math.inf:
             raise ParameterError(
                 "heater_min_hold", f"{{name}} must be positive, got {self.min_hold_s:g}"
             )

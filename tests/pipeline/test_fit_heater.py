@@ -156,7 +156,13 @@ def test_a_csv_at_the_setpoint_is_refused(
 
 @pytest.mark.parametrize(
     ("option", "value"),
-    [("--heater-setpoint", "nan"), ("--heater-setpoint", "-1e9"), ("--heater", "")],
+    [
+        ("--heater-setpoint", "nan"),
+        ("--heater-setpoint", "-1e9"),
+        ("--heater", ""),
+        ("--heater-band", "0"),
+        ("--heater-min-hold", "inf"),
+    ],
 )
 def test_hostile_heater_options_of_fit(
     heated_csv: dict, capsys: pytest.CaptureFixture[str], option: str, value: str

@@ -226,3 +226,26 @@ def test_hostile_heater_options(
     assert len(lines) == 1 and lines[0].startswith("error: ") and words in lines[0], err
     assert not (tmp_path / "o").exists()
     assert hashlib.sha256(log.read_bytes()).hexdigest() == before
+
+
+def test_whole_degree_thermometer_with_a_wider_band(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A thermometer that reads whole degrees (some Bosch parts): the set-point is reached
+    within half a degree's step of the ramp (0.5 °C / 0.06 °C/s = 8.3 s), and the band
+    held reads as whole degrees."""
+    tr = heated_truth(3)
+    tr["temp"] = np.round(tr["temp"])
+    log = tmp_path / "whole.ulg"
+    log.write_bytes(heated_ulog(tr, PX4_HEATER))
+    code, out, err = run(["px4-tempcal", str(log), "-o", str(tmp_path / "o"), "--json",
+                          "--heater-band", "1", "--heater-min-hold", "120"], capsys)  # fmt: skip
+    assert code == 0, err
+    hold = json.loads(out)["sensors"]["sensor_gyro.0"]["heater"]
+    assert hold["band_c"] == 1.0 and hold["hold_s"] >= 120.0
+    assert abs(hold["reached_s"] - tr["reached_s"]) < 0.5 / 0.06 + 0.5
+    assert all(float(v).is_integer() for v in hold["held_c"])
+    for option, value in (("--heater-band", "0"), ("--heater-min-hold", "-1")):
+        code, _o, err = run(["px4-tempcal", str(log), "-o", str(tmp_path / "x"), option, value],
+                            capsys)  # fmt: skip
+        assert code == 2 and err.startswith(f"error: {option} must be positive"), err

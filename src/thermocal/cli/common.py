@@ -476,3 +476,15 @@ HeaterSetpointOpt = Annotated[
         "from the one plateau at the top of the temperature).",
     ),
 ]
+HeaterBandOpt = Annotated[
+    float,
+    typer.Option(
+        "--heater-band",
+        help="Half-width [°C] of the band a heater's hold stays in (default 0.5; 1 for a "
+        "thermometer that reads whole degrees).",
+    ),
+]
+HeaterMinHoldOpt = Annotated[
+    float,
+    typer.Option("--heater-min-hold", help="Shortest heater hold [s] (default 60)."),
+]

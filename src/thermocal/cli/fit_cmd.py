@@ -44,6 +44,8 @@ from thermocal.cli.common import (
     AxisOpt,
     DecimalOpt,
     DelimiterOpt,
+    HeaterBandOpt,
+    HeaterMinHoldOpt,
     HeaterOpt,
     HeaterSetpointOpt,
     JsonOpt,
@@ -298,6 +300,7 @@ _COMMON_LAST = (
     ("on_bad_lines", OnBadLinesOpt, "error"), ("delimiter", DelimiterOpt, None),
     ("decimal", DecimalOpt, None), ("stamp", StampOpt, "header"),
     ("heater", HeaterOpt, "cut"), ("heater_setpoint", HeaterSetpointOpt, None),
+    ("heater_band", HeaterBandOpt, 0.5), ("heater_min_hold", HeaterMinHoldOpt, 60.0),
     ("param", ParamOpt, None),
     ("as_json", JsonOpt, False),
 )  # fmt: skip

@@ -16,6 +16,8 @@ from thermocal.cli.application import app
 from thermocal.cli.common import (
     AllowMotionOpt,
     AllowNarrowOpt,
+    HeaterBandOpt,
+    HeaterMinHoldOpt,
     HeaterOpt,
     HeaterSetpointOpt,
     JsonOpt,
@@ -35,11 +37,14 @@ if TYPE_CHECKING:
 OutDirOpt = Annotated[Path, typer.Option("-o", "--output", help="Directory to write.")]
 
 
-def heater_options(heater: str, setpoint: float | None) -> "HeaterOptions":
-    """``--heater`` and ``--heater-setpoint`` as the library's options."""
+def heater_options(
+    heater: str, setpoint: float | None, band: float, min_hold: float
+) -> "HeaterOptions":
+    """``--heater``, ``--heater-setpoint``, ``--heater-band`` and ``--heater-min-hold`` as
+    the library's options."""
     from thermocal.heater import HeaterOptions
 
-    return HeaterOptions(heater, setpoint)  # type: ignore[arg-type]  # checked by HeaterOptions
+    return HeaterOptions(heater, setpoint, band, min_hold)  # type: ignore[arg-type]
 
 
 M_MMAP_THRESHOLD = -3
@@ -84,6 +89,8 @@ def px4_tempcal_cmd(
     ] = False,
     heater: HeaterOpt = "cut",
     heater_setpoint: HeaterSetpointOpt = None,
+    heater_band: HeaterBandOpt = 0.5,
+    heater_min_hold: HeaterMinHoldOpt = 60.0,
 ) -> None:
     """Fit every gyro and accelerometer instance of a PX4 log as PX4 would (a cubic per axis
     about TREF), robust to spikes, with equal weight across the temperature range and
@@ -96,7 +103,7 @@ def px4_tempcal_cmd(
     res = px4_tempcal(
         log, output, tref_c=tref, overrides=overrides_of(allow_narrow, allow_motion),
         reporter=write_sensor_report, allan=allan,
-        heater=heater_options(heater, heater_setpoint),
+        heater=heater_options(heater, heater_setpoint, heater_band, heater_min_hold),
     )  # fmt: skip
     emit(res.to_dict(), as_json, lambda: _print_px4(res))
 
@@ -124,6 +131,8 @@ def ardupilot_tempcal_cmd(
     ] = False,
     heater: HeaterOpt = "cut",
     heater_setpoint: HeaterSetpointOpt = None,
+    heater_band: HeaterBandOpt = 0.5,
+    heater_min_hold: HeaterMinHoldOpt = 60.0,
 ) -> None:
     """ArduPilot's thermal calibration from one DataFlash log: every IMU instance's gyro
     and accelerometer fitted as in px4-tempcal, written as INS_TCAL* (.parm), a calibration
@@ -136,7 +145,7 @@ def ardupilot_tempcal_cmd(
     res = ardupilot_tempcal(
         log, output, overrides=overrides_of(allow_narrow, allow_motion),
         reporter=write_sensor_report, allan=allan,
-        heater=heater_options(heater, heater_setpoint),
+        heater=heater_options(heater, heater_setpoint, heater_band, heater_min_hold),
     )  # fmt: skip
     emit(res.to_dict(), as_json, lambda: _print_ardupilot(res))
 

@@ -871,7 +871,7 @@ def _heater_holds(
     sweep's density; the holds found by file name (JSON) and their warnings, also said."""
     from thermocal.heater import HeaterOptions, HeaterWarning, thin_recording
 
-    heater = HeaterOptions(o.heater, o.heater_setpoint)  # type: ignore[arg-type]
+    heater = HeaterOptions(o.heater, o.heater_setpoint, o.heater_band, o.heater_min_hold)  # type: ignore[arg-type]
     if o.model == "warmup" and o.heater_setpoint is None:  # its plateau is what it models
         return loaded, {}, []
     temp = (o.temperatures or (None,))[0]

@@ -106,6 +106,8 @@ class FitOptions:
         The heater's set-point [°C]; default inferred from the one plateau at the top of
         the first temperature column after a 10 °C sweep (never for the warmup family,
         whose plateau is what it models).
+    heater_band, heater_min_hold : float
+        The hold's half-width [°C] (default 0.5) and shortest duration [s] (default 60).
 
     Raises
     ------
@@ -151,6 +153,8 @@ class FitOptions:
     stamp: Literal["header", "receive"] = "header"
     heater: Literal["cut", "refuse", "ignore"] = "cut"
     heater_setpoint: float | None = None
+    heater_band: float = 0.5
+    heater_min_hold: float = 60.0
 
     def __post_init__(self) -> None:
         set_ = object.__setattr__  # frozen: normalise in place once
@@ -164,6 +168,9 @@ class FitOptions:
                 "heater_setpoint",
                 f"{{name}} must be a finite temperature above −273.15 °C, got {sp}",
             )
+        for name in ("heater_band", "heater_min_hold"):
+            if not 0.0 < getattr(self, name) < float("inf"):
+                raise ParameterError(name, f"{{name}} must be positive, got {getattr(self, name)}")
         for field in ("signals", "temperatures", "names"):
             set_(self, field, _names(getattr(self, field), field))
         if self.temp_conversion is not None:
