@@ -3826,6 +3826,46 @@ MUTANTS: tuple[Mutant, ...] = (
         _t("gsens"),
         "the g-sensitivity with the specific force's sign reversed",
     ),
+    Mutant(
+        "heater-hold-not-thinned",
+        P + "heater.py",
+        "want = n_in if span <= 0 else max(MIN_HOLD_KEEP",
+        "want = n_in if span > 0 else max(MIN_HOLD_KEEP",
+        _t("heater", "fit_heater"),
+        "a heater's hold kept whole: its samples outweigh the sweep in fit",
+    ),
+    Mutant(
+        "heater-overshoot-absolute",
+        P + "heater.py",
+        "overshoot, over_at = float(seg[k] - sp)",
+        "overshoot, over_at = float(seg[k])",
+        _t("heater", "tempcal_heater"),
+        "the overshoot given as the peak temperature, not its excess over the set-point",
+    ),
+    Mutant(
+        "heater-band-doubled",
+        P + "heater.py",
+        "runs = _runs(np.abs(temp_c - level_c) <= band_c, time_s, GAP_S)",
+        "runs = _runs(np.abs(temp_c - level_c) <= 2 * band_c, time_s, GAP_S)",
+        _t("heater"),
+        "the hold's band twice as wide as asked: settling and the band held understated",
+    ),
+    Mutant(
+        "heater-inferred-without-sweep",
+        P + "heater.py",
+        "MIN_INFERRED_SWEEP_C = 10.0",
+        "MIN_INFERRED_SWEEP_C = 1.0",
+        _t("heater"),
+        "a self-heating warm-up's plateau taken for a heater's hold",
+    ),
+    Mutant(
+        "heater-range-never-cut",
+        P + "heater.py",
+        "range_cut=bool(float(np.max(temp_c)) <= sp + band_c + overshoot)",
+        "range_cut=bool(float(np.max(temp_c)) < sp)",
+        _t("heater", "tempcal_heater"),
+        "a range ending at the heater's set-point not said to be cut",
+    ),
 )
 
 

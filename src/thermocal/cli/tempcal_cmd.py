@@ -16,6 +16,10 @@ from thermocal.cli.application import app
 from thermocal.cli.common import (
     AllowMotionOpt,
     AllowNarrowOpt,
+    HeaterBandOpt,
+    HeaterMinHoldOpt,
+    HeaterOpt,
+    HeaterSetpointOpt,
     JsonOpt,
     emit,
     handle_errors,
@@ -26,10 +30,22 @@ from thermocal.defaults import overrides_of
 from thermocal.report import firmware_text as _firmware_text
 
 if TYPE_CHECKING:
+    from thermocal.heater import HeaterOptions
     from thermocal.tempcal.ardupilot import ArdupilotTempcalResult
     from thermocal.tempcal.px4 import Px4TempcalResult
 
 OutDirOpt = Annotated[Path, typer.Option("-o", "--output", help="Directory to write.")]
+
+
+def heater_options(
+    heater: str, setpoint: float | None, band: float, min_hold: float
+) -> "HeaterOptions":
+    """``--heater``, ``--heater-setpoint``, ``--heater-band`` and ``--heater-min-hold`` as
+    the library's options."""
+    from thermocal.heater import HeaterOptions
+
+    return HeaterOptions(heater, setpoint, band, min_hold)  # type: ignore[arg-type]
+
 
 M_MMAP_THRESHOLD = -3
 """glibc's ``mallopt`` parameter of the size from which a block is a mapping of its own."""
@@ -71,6 +87,10 @@ def px4_tempcal_cmd(
             "gyro and accelerometer reports (slower on a long log).",
         ),
     ] = False,
+    heater: HeaterOpt = "cut",
+    heater_setpoint: HeaterSetpointOpt = None,
+    heater_band: HeaterBandOpt = 0.5,
+    heater_min_hold: HeaterMinHoldOpt = 60.0,
 ) -> None:
     """Fit every gyro and accelerometer instance of a PX4 log as PX4 would (a cubic per axis
     about TREF), robust to spikes, with equal weight across the temperature range and
@@ -83,6 +103,7 @@ def px4_tempcal_cmd(
     res = px4_tempcal(
         log, output, tref_c=tref, overrides=overrides_of(allow_narrow, allow_motion),
         reporter=write_sensor_report, allan=allan,
+        heater=heater_options(heater, heater_setpoint, heater_band, heater_min_hold),
     )  # fmt: skip
     emit(res.to_dict(), as_json, lambda: _print_px4(res))
 
@@ -108,6 +129,10 @@ def ardupilot_tempcal_cmd(
             "gyro and accelerometer reports (slower on a long log).",
         ),
     ] = False,
+    heater: HeaterOpt = "cut",
+    heater_setpoint: HeaterSetpointOpt = None,
+    heater_band: HeaterBandOpt = 0.5,
+    heater_min_hold: HeaterMinHoldOpt = 60.0,
 ) -> None:
     """ArduPilot's thermal calibration from one DataFlash log: every IMU instance's gyro
     and accelerometer fitted as in px4-tempcal, written as INS_TCAL* (.parm), a calibration
@@ -120,6 +145,7 @@ def ardupilot_tempcal_cmd(
     res = ardupilot_tempcal(
         log, output, overrides=overrides_of(allow_narrow, allow_motion),
         reporter=write_sensor_report, allan=allan,
+        heater=heater_options(heater, heater_setpoint, heater_band, heater_min_hold),
     )  # fmt: skip
     emit(res.to_dict(), as_json, lambda: _print_ardupilot(res))
 

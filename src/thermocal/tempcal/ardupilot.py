@@ -31,6 +31,7 @@ from thermocal.firmware.ardupilot import (
     tclr_learned,
 )
 from thermocal.firmware.formats import AP_TREF_C, FORMATS
+from thermocal.heater import HeaterOptions
 from thermocal.models.calibration import Calibration
 from thermocal.outputs import check_outputs
 from thermocal.recording import FloatArray, Recording
@@ -41,6 +42,7 @@ from thermocal.tempcal.ardupilot_baro import (
 )
 from thermocal.tempcal.compare import CoefficientComparison, compare_coefficients
 from thermocal.tempcal.flightlog import DataflashFlightLog, read_ardupilot_log
+from thermocal.tempcal.heated import judge_instance
 from thermocal.tempcal.pipeline import (
     AXES,
     GateWarning,
@@ -749,6 +751,8 @@ class _Run:
     baro: ArdupilotBaroFit | None = None
     allan: bool = False
     """The gyro and accelerometer reports draw each axis's Allan deviation."""
+    heater: HeaterOptions = dataclasses.field(default_factory=HeaterOptions)
+    """How each IMU's heater hold is looked for (:func:`.heated.judge_instance`)."""
     motions: dict[str, Any] = dataclasses.field(default_factory=dict)
     """Each instance's stillness from its fit (:func:`.pipeline.fit_sensor`), for the step
     warnings (computed once)."""
@@ -761,6 +765,7 @@ def ardupilot_tempcal(
     overrides: tuple[str, ...] = (),
     reporter: Reporter | None = None,
     allan: bool = False,
+    heater: HeaterOptions | None = None,
 ) -> ArdupilotTempcalResult:
     """ArduPilot's thermal calibration of every IMU of a DataFlash log, written as one set.
 
@@ -780,6 +785,9 @@ def ardupilot_tempcal(
         The gyro and accelerometer reports draw each axis's overlapping Allan deviation
         before and after compensation with its noise terms (IEEE Std 952-1997 Annex C);
         default False: left out (on a long log, most of a report's cost).
+    heater : HeaterOptions, optional
+        The heater's hold (:class:`thermocal.heater.HeaterOptions`; default: the set-point
+        ``BRD_HEAT_TARG``/``BRD_IMU_TARGTEMP`` unless −1, else inferred).
 
     Returns
     -------
@@ -811,7 +819,6 @@ def ardupilot_tempcal(
       https://github.com/ArduPilot/ardupilot/blob/master/libraries/AP_InertialSensor/AP_InertialSensor_tempcal.cpp
     * ArduPilot, ``libraries/AP_TempCalibration/AP_TempCalibration.cpp`` (the barometer).
     """
-    from thermocal.errors import MissingColumnError
     from thermocal.export.params import ParamSet, check_documented, check_values
 
     # DIR may hold the log; the files of the set (replaced by name) may not be it
@@ -826,15 +833,8 @@ def ardupilot_tempcal(
     ):
         flight = read_ardupilot_log(log, MESSAGES)  # the log is read once, passed down
         run = _Run(log, flight, overrides, ParamSet("ardupilot"), out_set, [], [], {}, {})
-        run.allan = allan
-        for inst in range(MAX_IMUS):
-            try:
-                df, _info = flight.table("IMU", inst)
-            except MissingColumnError:
-                if inst == 0:
-                    raise
-                break
-            _imu(run, df, inst)
+        run.allan, run.heater = allan, heater or HeaterOptions()
+        _imus(run)
         if not run.fits:
             raise ThermocalInputError(f"{log}: no IMU with a usable temperature in the log")
         _baro(run)
@@ -852,6 +852,20 @@ def ardupilot_tempcal(
         tuple(run.fits), tuple(notes), run.orientation, run.hygiene, run.previous,
         run.learning, run.baro, run.rotated, _changes_said(run),
     )  # fmt: skip
+
+
+def _imus(run: _Run) -> None:
+    """Every IMU instance of the log through :func:`_imu` (instance 0 must be there)."""
+    from thermocal.errors import MissingColumnError
+
+    for inst in range(MAX_IMUS):
+        try:
+            df, _info = run.flight.table("IMU", inst)
+        except MissingColumnError:
+            if inst == 0:
+                raise
+            break
+        _imu(run, df, inst)
 
 
 def _run_notes(run: _Run) -> list[str]:
@@ -929,7 +943,12 @@ def _imu(run: _Run, df: Any, inst: int) -> None:
     if temp_c is None:
         return
     time_s = df["TimeUS"].to_numpy() * 1e-6
-    run.gates.append(stall_warning(f"IMU.{inst}", time_s, temp_c))
+    held = judge_instance(
+        f"{run.log}: IMU.{inst}", time_s, temp_c, run.flight.parameters, "ardupilot", run.heater
+    )
+    run.gates.extend(held.warnings)
+    if held.hold is None or held.hold.setpoint_source == "inferred":  # a stall, or a heater?
+        run.gates.append(stall_warning(f"IMU.{inst}", time_s, temp_c))
     per_kind: list[tuple[SensorFit, Recording]] = []
     intervals, changes = param_intervals(
         run.flight.parameters,
@@ -960,6 +979,7 @@ def _imu(run: _Run, df: Any, inst: int) -> None:
             sub_rec, f"IMU.{prefix}", kind, inst, overrides=run.overrides,
             firmware="ardupilot", motions=run.motions,
         )  # fmt: skip
+        fit.heater = held.to_dict()
         run.fits.append(fit)
         per_kind.append((fit, sub_rec))
         if kind == "gyro":
@@ -973,6 +993,7 @@ def _imu(run: _Run, df: Any, inst: int) -> None:
         warnings.simplefilter("ignore")
         ps = export_params(sub, "ardupilot", instance=inst)
     run.params.merge(ps, f"IMU.{inst}")
+    run.params.notes.extend(f"IMU.{inst}: {n}" for n in held.notes if held.hold is not None)
     _hygiene_and_gates(run, inst, ps, prev_params)
     active = ardupilot_active(prev_params, inst)
     fw_range = tclr_range(
@@ -997,7 +1018,10 @@ def _imu(run: _Run, df: Any, inst: int) -> None:
                 calibration=Calibration(fit.channels), recording=sub_rec,
                 recording_path=str(run.log), title=f"ArduPilot thermal calibration — IMU {inst} "
                 f"{fit.kind}", generated_by="thermocal ardupilot-tempcal",
-                notes=(*(f"Firmware: {n}" for n in ps.notes), *(() if run.allan else (NO_ALLAN,))),
+                notes=(
+                    *(f"Firmware: {n}" for n in ps.notes), *(f"Heater: {n}" for n in held.notes),
+                    *(() if run.allan else (NO_ALLAN,)),
+                ),
                 previous=run.previous.get(key),
                 firmware_learning=run.learning.get(key), allan=run.allan,
             ),

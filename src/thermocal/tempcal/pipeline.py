@@ -72,6 +72,8 @@ class SensorFit:
         The fitted channels.
     adequacy : dict
         The data's judgement.
+    heater : dict or None
+        The heater's hold (:class:`thermocal.heater.HeaterHold`), None: none found.
     """
 
     topic: str
@@ -85,6 +87,9 @@ class SensorFit:
     holdout_rms: dict[str, float] = field(default_factory=dict)
     channels: list[Channel] = field(default_factory=list)
     adequacy: dict[str, Any] = field(default_factory=dict)
+    heater: dict[str, Any] | None = None
+    """The heater's hold found in its temperature (:meth:`thermocal.heater.HeaterHold.to_dict`),
+    None: none."""
 
 
 def _cubic(t: FloatArray, y: FloatArray, unit: str, name: str) -> PolyModel:

@@ -38,6 +38,7 @@ from thermocal import adequacy
 from thermocal.errors import ParameterError, ThermocalInputError
 from thermocal.firmware.formats import FORMATS
 from thermocal.firmware.px4 import px4_coefficients
+from thermocal.heater import HeaterOptions
 from thermocal.models.calibration import Calibration
 from thermocal.outputs import check_outputs
 from thermocal.recording import FloatArray
@@ -293,6 +294,7 @@ def px4_tempcal(
     overrides: tuple[str, ...] = (),
     reporter: Reporter | None = None,
     allan: bool = False,
+    heater: HeaterOptions | None = None,
 ) -> Px4TempcalResult:
     """PX4's thermal calibration of every sensor instance of a ULog, written as one set.
 
@@ -314,6 +316,10 @@ def px4_tempcal(
         The gyro and accelerometer reports draw each axis's overlapping Allan deviation
         before and after compensation with its noise terms (IEEE Std 952-1997 Annex C);
         default False: left out (on a long log, most of a report's cost).
+    heater : HeaterOptions, optional
+        How a heater's hold is looked for (default: the set-point ``SENS_IMU_TEMP`` when
+        ``SENS_EN_THERMAL`` is on, else inferred; ±0.5 °C for 60 s; a cut range said,
+        :class:`thermocal.heater.HeaterOptions`).
 
     Returns
     -------
@@ -358,7 +364,9 @@ def px4_tempcal(
         report_worker(reporter, log) as pool,  # starts while the log is read
         open_px4_log(log, (*TOPICS, *OFFSET_TOPICS)) as flight,  # the log is parsed once
     ):
-        return _px4_tempcal(flight, output, tref_c, overrides, reporter, pool, allan)
+        return _px4_tempcal(
+            flight, output, tref_c, overrides, reporter, pool, allan, heater or HeaterOptions()
+        )
 
 
 def _px4_tempcal(
@@ -369,6 +377,7 @@ def _px4_tempcal(
     reporter: Reporter | None,
     pool: Any = None,
     allan: bool = False,
+    heater: HeaterOptions | None = None,
 ) -> Px4TempcalResult:
     """:func:`px4_tempcal` after its output checks (``pool``: the report worker)."""
     from thermocal.export.params import ParamSet
@@ -395,7 +404,7 @@ def _px4_tempcal(
                 continue
             fit, more = _imu_instance(
                 flight, name, inst, tref_c, overrides, params, out_set, (series, motions), old,
-                allan,
+                allan, heater or HeaterOptions(),
             )  # fmt: skip
             fits.append(fit)
             gates.extend(more)
@@ -523,13 +532,16 @@ def _imu_instance(
     found: tuple[dict[str, tuple[FloatArray, FloatArray]], dict[str, adequacy.Motion]],
     old: _Prior,
     allan: bool = False,
+    heater: HeaterOptions | None = None,
 ) -> tuple[SensorFit, list[str | None]]:
     """A gyro or accelerometer instance through the pipeline: read, fit, its gates, its
     ``TC_G``/``TC_A`` parameters merged into ``params``, its report (``allan``: with its
     Allan section); ``found`` (series, motions) gets its (time [s], x/y/z in the canonical
-    unit) and its stillness result for the step check across instances."""
+    unit) and its stillness result for the step check across instances; ``heater``: how its
+    heater's hold is looked for (:func:`.heated.judge_instance`)."""
     from thermocal.export.params import export_params
     from thermocal.readers.ulog import release_parsed_topic
+    from thermocal.tempcal.heated import judge_instance
 
     kind = "gyro" if name == "sensor_gyro" else "accel"
     where = f"{name}.{inst}"
@@ -537,11 +549,17 @@ def _imu_instance(
     rec = flight.recording(where)
     release_parsed_topic(log, where)  # read once: its raw messages are not needed again
     series, motions = found
-    fit = fit_sensor(rec, name, kind, inst, overrides=overrides, motions=motions)
     temp_c = rec.temperature_c("temperature")
+    held = judge_instance(
+        f"{log}: {where}", rec.time_s, temp_c, flight.parameters, "px4", heater or HeaterOptions()
+    )
+    fit = fit_sensor(rec, name, kind, inst, overrides=overrides, motions=motions)
+    fit.heater = held.to_dict()
     # the step check across instances reads the stillness result (motions), not the values
     series[where] = (rec.time_s, np.empty((0, len(AXES))))
-    gates = [stall_warning(where, rec.time_s, temp_c)]
+    gates: list[str | None] = [*held.warnings]
+    if held.hold is None or held.hold.setpoint_source == "inferred":  # a stall, or a heater?
+        gates.append(stall_warning(where, rec.time_s, temp_c))
     if kind == "gyro":
         vals = np.column_stack([rec.signal(a)[0] for a in AXES])
         gates.append(gyro_unit_warning(f"{log}: {where}", vals))
@@ -555,6 +573,7 @@ def _imu_instance(
             sub, "px4", instance=inst, device_id={kind: fit.device_id}, tref_c=tref_c
         )
     params.merge(ps, where)
+    params.notes.extend(f"{where}: {n}" for n in held.notes if held.hold is not None)
     prev = old.compare(
         where, ps.params, kind, inst, fit.device_id, "rad/s" if kind == "gyro" else "m/s^2",
         fit.sweep_c,
@@ -579,6 +598,7 @@ def _imu_instance(
                 "'hold-out rms' is the rms of a cubic fitted to the even bins on the odd "
                 "ones, in the canonical unit (°/h or mg).",
                 *(f"Firmware: {n}" for n in ps.notes),
+                *(f"Heater: {n}" for n in held.notes),
                 *(() if allan else (NO_ALLAN,)),
             ),
             previous=prev,
