@@ -30,6 +30,15 @@ if TYPE_CHECKING:
     from thermocal.tempcal.px4 import Px4TempcalResult
 
 OutDirOpt = Annotated[Path, typer.Option("-o", "--output", help="Directory to write.")]
+EmulateOpt = Annotated[
+    bool,
+    typer.Option(
+        "--emulate-learning",
+        help="Also run the firmware's own temperature learning on the log's samples, as its "
+        "source defines it: would it have completed, why not, what it would store against "
+        "thermocal's fit (and, for ArduPilot, its TCLR points against the log's).",
+    ),
+]
 
 M_MMAP_THRESHOLD = -3
 """glibc's ``mallopt`` parameter of the size from which a block is a mapping of its own."""
@@ -108,6 +117,7 @@ def ardupilot_tempcal_cmd(
             "gyro and accelerometer reports (slower on a long log).",
         ),
     ] = False,
+    emulate_learning: EmulateOpt = False,
 ) -> None:
     """ArduPilot's thermal calibration from one DataFlash log: every IMU instance's gyro
     and accelerometer fitted as in px4-tempcal, written as INS_TCAL* (.parm), a calibration
@@ -119,11 +129,15 @@ def ardupilot_tempcal_cmd(
 
     res = ardupilot_tempcal(
         log, output, overrides=overrides_of(allow_narrow, allow_motion),
-        reporter=write_sensor_report, allan=allan,
+        reporter=write_sensor_report, allan=allan, emulate_learning=emulate_learning,
     )  # fmt: skip
     emit(res.to_dict(), as_json, lambda: _print_ardupilot(res))
 
 
 def _print_ardupilot(res: "ArdupilotTempcalResult") -> None:
     show(_firmware_text.ardupilot_tempcal_text(res))
+    if res.emulated_learning:
+        from thermocal.report.learning_text import ardupilot_learning_text
+
+        show(ardupilot_learning_text(res.emulated_learning))
     stdout.print(f"parameters: [bold]{res.params_path}[/bold]", markup=True)

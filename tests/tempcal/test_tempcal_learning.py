@@ -1,0 +1,131 @@
+"""``ardupilot-tempcal --emulate-learning``: the firmware's in-flight learning emulated on a
+DataFlash log whose ``TCLR`` messages were written by the test's own restatement of the
+firmware (tests/helpers/learning_reference.py, from ``AP_InertialSensor_tempcal.cpp``), at
+the time each window closed; the log's ``IMU.AHz`` says the driver ran 40× the log's rate."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from dataflash_writer import NEW_IMU_FMT, NEW_IMU_LABELS, PARM_FORMAT, dataflash_log, parm
+from learning_reference import reference_learning, sweep
+from test_fc_reports import TCLR_FORMAT, TCLR_TYPE, run_cli
+
+RATE_HZ = 25.0
+DRIVER_HZ = 1000.0
+
+
+def learning_log(
+    path: Path, n: int, tmax: float, tclr_temp_offset: float = 0.0, nan_every: int = 0
+) -> dict:
+    t, temp, acc, gyr = sweep(n, RATE_HZ, 15.0, 0.02, seed=11)
+    # what the log stores: float32 (the reader gives these values back exactly)
+    temp, acc, gyr = (np.asarray(a, np.float32).astype(np.float64) for a in (temp, acc, gyr))
+    g, st = reference_learning(t, temp, acc, gyr, tmax, DRIVER_HZ / RATE_HZ)
+    time_us = np.round(t * 1e6).astype(np.int64)
+    closing: dict[int, list] = {}
+    for stype in (0, 1):
+        for temp_c, x, y, z, n_s, i in st[stype]["pts_i"]:
+            closing.setdefault(i, []).append((stype, temp_c + tclr_temp_offset, x, y, z, n_s))
+    msgs: list = [parm("INS_TCAL1_ENABLE", 2), parm("INS_TCAL1_TMAX", tmax)]
+    for i in range(t.size):
+        tc = float("nan") if nan_every and i % nan_every == 7 else float(temp[i])
+        msgs.append((100, (int(time_us[i]), 0, *gyr[i], *acc[i], 0, 0, tc, 1, 1,
+                           int(DRIVER_HZ), int(DRIVER_HZ))))  # fmt: skip
+        for stype, tc, x, y, z, n_s in closing.get(i, []):
+            msgs.append((TCLR_TYPE, (int(time_us[i]), 0, stype, tc, x, y, z, n_s)))
+    path.write_bytes(
+        dataflash_log([PARM_FORMAT, TCLR_FORMAT, (100, "IMU", NEW_IMU_FMT, NEW_IMU_LABELS)], msgs)
+    )
+    return g
+
+
+def test_emulated_learning_equals_the_logged_tclr(tmp_path: Path) -> None:
+    log = tmp_path / "learn.bin"
+    g = learning_log(log, 60_000, 45.0)
+    assert g["outcome"] == "completed"
+    before = log.read_bytes()
+    code, text = run_cli(["ardupilot-tempcal", str(log), "-o", str(tmp_path / "out"),
+                          "--json", "--emulate-learning"])  # fmt: skip
+    assert code == 0, text
+    assert log.read_bytes() == before
+    em = json.loads(text)["emulated_learning"]["IMU.0"]
+    assert em["outcome"] == "completed" and em["completed"] is True
+    assert em["samples_per_sample"] == pytest.approx(DRIVER_HZ / RATE_HZ)
+    for k, v in g["stored"].items():
+        assert em["stored"][k] == pytest.approx(v, rel=1e-5, abs=1e-6), k
+    for kind in ("accel", "gyro"):
+        m = em["tclr"][kind]
+        assert m["n_matched"] == m["n_logged"] == m["n_emulated"] > 40
+        assert m["max_temp_diff_c"] < 1e-5 and m["max_value_diff"] < 1e-6
+        assert m["max_time_diff_s"] == 0.0
+    # beside thermocal's own fit: both corrections agree to the noise over the learned range
+    assert em["max_difference_to_thermocal"]["gyro"] < 2e-4  # rad/s
+    html = (tmp_path / "out" / "report_IMU_0_gyro.html").read_text()
+    assert 'id="emulated-learning"' in html
+
+
+def test_emulated_learning_text_and_a_shifted_tclr(tmp_path: Path) -> None:
+    """TCLR points 0.3 °C off what the firmware computes: the largest difference is said."""
+    log = tmp_path / "off.bin"
+    learning_log(log, 60_000, 45.0, tclr_temp_offset=0.3)
+    code, text = run_cli(["ardupilot-tempcal", str(log), "-o", str(tmp_path / "out"),
+                          "--emulate-learning"])  # fmt: skip
+    assert code == 0, text
+    assert "IMU.0 firmware learning (emulated): completed: the temperature reached" in text
+    code, text = run_cli(["ardupilot-tempcal", str(log), "-o", str(tmp_path / "o2"), "--json",
+                          "--emulate-learning"])  # fmt: skip
+    m = json.loads(text)["emulated_learning"]["IMU.0"]["tclr"]["gyro"]
+    assert m["max_temp_diff_c"] == pytest.approx(0.3, abs=1e-4)
+
+
+def test_emulated_learning_short_sweep_says_why(tmp_path: Path) -> None:
+    log = tmp_path / "short.bin"
+    g = learning_log(log, 60_000, 75.0)  # 15 → 63 °C: never reaches TMAX 75
+    assert g["outcome"] is None and g["stored"]
+    code, text = run_cli(["ardupilot-tempcal", str(log), "-o", str(tmp_path / "out"), "--json",
+                          "--emulate-learning"])  # fmt: skip
+    assert code == 0, text
+    em = json.loads(text)["emulated_learning"]["IMU.0"]
+    assert em["outcome"] == "not completed" and em["partial"] is True
+    assert "below INS_TCAL1_TMAX 75.0 °C" in em["reason"]
+    for k, v in g["stored"].items():
+        assert em["stored"][k] == pytest.approx(v, rel=1e-5, abs=1e-6), k
+
+
+def test_without_the_option_nothing_changes(tmp_path: Path) -> None:
+    log = tmp_path / "plain.bin"
+    learning_log(log, 30_000, 45.0)
+    code, text = run_cli(["ardupilot-tempcal", str(log), "-o", str(tmp_path / "out"), "--json"])
+    assert code == 0, text
+    assert "emulated_learning" not in json.loads(text)
+
+
+@pytest.mark.parametrize("case", ["zero-bytes", "nan-samples"])
+def test_emulate_learning_hostile_logs(tmp_path: Path, case: str) -> None:
+    """A broken log (empty; NaN temperatures, which the calibration refuses before the
+    emulation): exit 2 with one line naming the log, the log untouched."""
+    import contextlib
+    import hashlib
+    import io
+
+    from thermocal.cli import main
+
+    log = tmp_path / "l.bin"
+    if case == "zero-bytes":
+        log.write_bytes(b"")
+    else:
+        learning_log(log, 30_000, 45.0, nan_every=1000)
+    before = hashlib.sha256(log.read_bytes()).hexdigest()
+    err, out = io.StringIO(), io.StringIO()
+    with contextlib.redirect_stderr(err), contextlib.redirect_stdout(out):
+        code = main(["ardupilot-tempcal", str(log), "-o", str(tmp_path / "o"), "--json",
+                     "--emulate-learning"])  # fmt: skip
+    assert hashlib.sha256(log.read_bytes()).hexdigest() == before
+    assert code == 2 and out.getvalue() == ""
+    lines = [x for x in err.getvalue().splitlines() if x.strip()]
+    assert len(lines) == 1 and lines[0].startswith("error:") and "l.bin" in lines[0]
