@@ -230,7 +230,8 @@ def _other_runs(t: Path) -> list[tuple[str, Any]]:
     (t / "batch.toml").write_text(FLEET_TOML)
     px4 = t / "px4"
     return [
-        ("px4-tempcal", _run(["px4-tempcal", str(LOGS / "sweep.ulg"), "-o", str(px4)])),
+        ("px4-tempcal", _run(["px4-tempcal", str(LOGS / "sweep.ulg"), "-o", str(px4),
+                              "--emulate-learning"])),
         ("ardupilot-tempcal", _run(["ardupilot-tempcal", str(LOGS / "sweep.bin"),
                                     "-o", str(t / "ap"), "--emulate-learning"])),
         ("export-params", _run(["export-params", str(px4 / "calibration.json"),

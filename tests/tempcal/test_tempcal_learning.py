@@ -129,3 +129,67 @@ def test_emulate_learning_hostile_logs(tmp_path: Path, case: str) -> None:
     assert code == 2 and out.getvalue() == ""
     lines = [x for x in err.getvalue().splitlines() if x.strip()]
     assert len(lines) == 1 and lines[0].startswith("error:") and "l.bin" in lines[0]
+
+
+# --- px4-tempcal --emulate-learning ----------------------------------------------------------
+
+
+def px4_log(path: Path, params: dict) -> tuple:
+    from ulog_writer import SENSOR_FIELDS, ulog_bytes
+
+    t, temp, acc, gyr = sweep(50_000, 20.0, 6.0, 0.012, seed=12)  # 6 → 36 °C from 5 s
+    temp, acc, gyr = (np.asarray(a, np.float32).astype(np.float64) for a in (temp, acc, gyr))
+    us = np.round(t * 1e6).astype(np.int64)
+    topics = [
+        (name, 0, SENSOR_FIELDS,
+         [(int(us[i]), dev, *v[i], float(temp[i])) for i in range(t.size)])
+        for name, dev, v in (("sensor_gyro", 7, gyr), ("sensor_accel", 9, acc))
+    ]  # fmt: skip
+    path.write_bytes(ulog_bytes(topics, params=params))
+    return t, temp, acc, gyr
+
+
+def test_px4_emulation_equals_the_restated_firmware(tmp_path: Path) -> None:
+    from learning_reference import reference_px4
+
+    log = tmp_path / "cal.ulg"
+    t, temp, acc, gyr = px4_log(log, {"SYS_CAL_TDEL": 20, "SYS_CAL_TMIN": 5, "SYS_CAL_TMAX": 10})
+    code, text = run_cli(["px4-tempcal", str(log), "-o", str(tmp_path / "out"), "--json",
+                          "--emulate-learning"])  # fmt: skip
+    assert code == 0, text
+    em = json.loads(text)["emulated_learning"]
+    assert em["completed"] is True and em["reason"].startswith("completed")
+    for where, kind, v, tag in (("sensor_gyro.0", "gyro", gyr, "G"),
+                                ("sensor_accel.0", "accel", acc, "A")):  # fmt: skip
+        outcome, (low, high, ref, p) = reference_px4(t, temp, v, 20, 5, 10, kind == "accel")
+        s = em["sensors"][where]
+        assert outcome == s["outcome"] == "completed"
+        assert s["limits"] == {"SYS_CAL_TDEL": 20.0, "SYS_CAL_TMIN": 5.0, "SYS_CAL_TMAX": 10.0}
+        st = s["stored"]
+        assert st[f"TC_{tag}0_TMIN"] == float(low) and st[f"TC_{tag}0_TMAX"] == float(high)
+        assert st[f"TC_{tag}0_TREF"] == pytest.approx(float(ref), abs=1e-6)
+        assert st[f"TC_{tag}0_ID"] == (7 if kind == "gyro" else 9)
+        for axis in range(3):
+            for k in range(4):
+                got = st[f"TC_{tag}0_X{3 - k}_{axis}"]
+                assert got == pytest.approx(p[k, axis], rel=1e-5, abs=1e-12), (where, axis, k)
+    assert em["sensors"]["sensor_gyro.0"]["max_difference_to_thermocal"] < 2e-4  # rad/s
+
+
+def test_px4_emulation_too_hot_and_short(tmp_path: Path) -> None:
+    log = tmp_path / "hot.ulg"
+    px4_log(log, {"SYS_CAL_TDEL": 20, "SYS_CAL_TMIN": 5, "SYS_CAL_TMAX": 5})
+    code, text = run_cli(["px4-tempcal", str(log), "-o", str(tmp_path / "a"),
+                          "--emulate-learning"])  # fmt: skip
+    assert code == 0, text
+    assert "too hot: the calibration started at 6.1 °C, above SYS_CAL_TMAX 5 °C" in text
+    log2 = tmp_path / "short.ulg"
+    px4_log(log2, {"SYS_CAL_TDEL": 40})
+    code, text = run_cli(["px4-tempcal", str(log2), "-o", str(tmp_path / "b"), "--json",
+                          "--emulate-learning"])  # fmt: skip
+    em = json.loads(text)["emulated_learning"]
+    assert em["completed"] is False and "PX4 writes nothing" in em["reason"]
+    g = em["sensors"]["sensor_gyro.0"]
+    rise = g["high_c"] - g["low_c"]
+    assert 29.0 < rise < 31.0 and g["progress"] == int(rise / 40 * 100)
+    assert g["reason"].startswith(f"not completed: the temperature rose {rise:.1f} °C of the 40")

@@ -80,6 +80,7 @@ def px4_tempcal_cmd(
             "gyro and accelerometer reports (slower on a long log).",
         ),
     ] = False,
+    emulate_learning: EmulateOpt = False,
 ) -> None:
     """Fit every gyro and accelerometer instance of a PX4 log as PX4 would (a cubic per axis
     about TREF), robust to spikes, with equal weight across the temperature range and
@@ -91,13 +92,17 @@ def px4_tempcal_cmd(
 
     res = px4_tempcal(
         log, output, tref_c=tref, overrides=overrides_of(allow_narrow, allow_motion),
-        reporter=write_sensor_report, allan=allan,
+        reporter=write_sensor_report, allan=allan, emulate_learning=emulate_learning,
     )  # fmt: skip
     emit(res.to_dict(), as_json, lambda: _print_px4(res))
 
 
 def _print_px4(res: "Px4TempcalResult") -> None:
     show(_firmware_text.px4_tempcal_text(res))
+    if res.emulated_learning:
+        from thermocal.report.learning_text import px4_learning_text
+
+        show(px4_learning_text(res.emulated_learning))
     stdout.print(f"parameters: [bold]{res.params_path}[/bold]", markup=True)
 
 

@@ -736,7 +736,7 @@ def _px4_accumulate(
         stored = _px4_params(kind, instance, res, float(low), float(high), float(ref),
                              device_id)  # fmt: skip
         reason = (
-            f"completed: the temperature rose {float(high - low):.1f} °C (more than SYS_CAL_TDEL "
+            f"completed: the temperature rose {float(high - low):.2f} °C (more than SYS_CAL_TDEL "
             f"{tdel_c:g} °C) from {float(low):.1f} °C; {rest.size} samples fitted"
         )
     else:

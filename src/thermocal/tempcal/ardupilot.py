@@ -793,10 +793,7 @@ def ardupilot_tempcal(
         before and after compensation with its noise terms (IEEE Std 952-1997 Annex C);
         default False: left out (on a long log, most of a report's cost).
     emulate_learning : bool, optional
-        Also emulate the firmware's in-flight learning (``INS_TCAL<n>_ENABLE`` = 2) on each
-        IMU's samples (:func:`thermocal.tempcal.learning.emulate_ardupilot`): whether it
-        would have completed, why not, what it would store against thermocal's fit, its
-        ``TCLR`` points against the log's; default False.
+        Also emulate the firmware's learning on each IMU (:mod:`thermocal.tempcal.learning`).
 
     Returns
     -------
@@ -832,9 +829,8 @@ def ardupilot_tempcal(
     from thermocal.export.params import ParamSet, check_documented, check_values
 
     # DIR may hold the log; the files of the set (replaced by name) may not be it
-    names = ["calibration.json", FORMATS["ardupilot"].params_file]
+    names = ["calibration.json", FORMATS["ardupilot"].params_file, BARO_REPORT]
     names += [f"report_IMU_{i}_{k}.html" for i in range(MAX_IMUS) for k in ("gyro", "accel")]
-    names.append(BARO_REPORT)
     check_outputs([output / n for n in names], [log], dirs=[output])
     check_output_dir(output)
     with (
@@ -862,12 +858,11 @@ def ardupilot_tempcal(
         out_set.commit(
             calibration_of(run.fits), FORMATS["ardupilot"].params_file, run.params.text()
         )
-    notes = _run_notes(run)
     return ArdupilotTempcalResult(
         log, output / FORMATS["ardupilot"].params_file, output / "calibration.json",
-        tuple(out_set.reports),
-        tuple(run.fits), tuple(notes), run.orientation, run.hygiene, run.previous,
-        run.learning, run.baro, run.rotated, _changes_said(run), run.emulated,
+        tuple(out_set.reports), tuple(run.fits), tuple(_run_notes(run)), run.orientation,
+        run.hygiene, run.previous, run.learning, run.baro, run.rotated, _changes_said(run),
+        run.emulated,
     )  # fmt: skip
 
 

@@ -1,6 +1,7 @@
 """The firmware's own learning emulated on a flight-controller log, beside the offline fit.
 
-``ardupilot-tempcal --emulate-learning`` and ``px4-tempcal --emulate-learning`` run
+With ``emulate_learning``, :func:`thermocal.tempcal.ardupilot.ardupilot_tempcal` and
+:func:`thermocal.tempcal.px4.px4_tempcal` run
 :func:`thermocal.firmware.learning.ardupilot_learning` (per IMU) and
 :func:`thermocal.firmware.learning.px4_oncal` (per gyro and accelerometer instance) on the
 samples the calibration read, and set what each firmware would have stored beside
@@ -174,7 +175,19 @@ class ArdupilotEmulation:
     tclr: dict[str, TclrMatch]
 
     def max_difference(self, kind: str) -> float:
-        """The largest difference of the two corrections of ``kind`` [rad/s or m/s²]."""
+        """The largest difference of the two corrections of ``kind``.
+
+        Parameters
+        ----------
+        kind : str
+            ``"gyro"`` or ``"accel"``.
+
+        Returns
+        -------
+        float
+            max |emulated − thermocal| over the axes and the common range [rad/s or m/s²];
+            NaN when nothing would be stored.
+        """
         c = self.against_thermocal.get(kind)
         if c is None:
             return float("nan")
@@ -411,6 +424,43 @@ def emulate_px4(
     return Px4Emulation(oncal, limits, against)
 
 
+def px4_overall(emulated: Mapping[str, Px4Emulation]) -> dict[str, Any]:
+    """The whole on-board calibration's end: PX4 writes parameters only when every sensor
+    instance of every calibrator is done, and aborts all at a start above ``SYS_CAL_TMAX``.
+
+    Parameters
+    ----------
+    emulated : mapping of str to Px4Emulation
+        Per sensor instance (``sensor_gyro.<n>`` …).
+
+    Returns
+    -------
+    dict
+        ``completed`` (bool), ``reason`` (str) and ``sensors`` (each instance's emulation as
+        plain values), the JSON of the PX4 calibration's emulated learning.
+
+    References
+    ----------
+    - PX4-Autopilot ``temperature_calibration/task.cpp`` (``task_main``) and ``common.h``
+      (``update``).
+    """
+    hot = [k for k, e in emulated.items() if e.oncal.outcome == "too hot"]
+    short = [k for k, e in emulated.items() if not e.oncal.completed]
+    if hot:
+        reason = (f"aborted: {', '.join(hot)} started above SYS_CAL_TMAX; PX4 writes nothing "
+                  "(cool the board below it and restart)")  # fmt: skip
+    elif short:
+        reason = ("not completed: " + "; ".join(f"{k} {emulated[k].oncal.reason}" for k in short)
+                  + "; PX4 writes nothing until every sensor is done")  # fmt: skip
+    else:
+        reason = "completed: every sensor rose more than SYS_CAL_TDEL; the TC_* parameters written"
+    return {
+        "completed": not (hot or short),
+        "reason": reason,
+        "sensors": {k: e.to_dict() for k, e in emulated.items()},
+    }
+
+
 __all__ = [
     "ArdupilotEmulation",
     "Px4Emulation",
@@ -418,5 +468,6 @@ __all__ = [
     "emulate_ardupilot",
     "emulate_px4",
     "match_tclr",
+    "px4_overall",
     "samples_per_logged",
 ]
