@@ -36,6 +36,8 @@ def ardupilot_learning_text(emulated: Mapping[str, ArdupilotEmulation]) -> list[
     rows = []
     for key, em in emulated.items():
         blocks.append(f"{key} firmware learning (emulated): {em.learning.reason}")
+        if em.note:
+            blocks.append(f"{key}: {em.note}")
         for kind, unit in (("gyro", "rad/s"), ("accel", "m/s^2")):
             m = em.tclr.get(kind)
             rows.append((

@@ -167,12 +167,15 @@ class ArdupilotEmulation:
     tclr : dict of str to TclrMatch
         Per sensor kind, the emulated points against the logged ones (empty without
         ``TCLR`` of this IMU).
+    note : str
+        What limits the emulation (a log slower than the driver without its rate), or "".
     """
 
     learning: ArdupilotLearning
     samples_per_sample: float
     against_thermocal: dict[str, CoefficientComparison]
     tclr: dict[str, TclrMatch]
+    note: str = ""
 
     def max_difference(self, kind: str) -> float:
         """The largest difference of the two corrections of ``kind``.
@@ -204,6 +207,7 @@ class ArdupilotEmulation:
                 k: self.max_difference(k) for k in self.against_thermocal
             },
             "tclr": {k: m.to_dict() for k, m in self.tclr.items()},
+            "note": self.note,
         }
 
 
@@ -311,7 +315,16 @@ def emulate_ardupilot(
                 np.array([float(r["Temp"]) for r in rows]),
                 np.array([[float(r["X"]), float(r["Y"]), float(r["Z"])] for r in rows]),
             )  # fmt: skip
-    return ArdupilotEmulation(learning, samples_per_sample, against, tclr)
+    note = ""
+    dt = np.diff(np.asarray(time_s, dtype=np.float64))
+    rate = 1.0 / float(np.median(dt[dt > 0])) if np.any(dt > 0) else float("nan")
+    if samples_per_sample == 1.0 and rate < 100.0:
+        note = (
+            f"each logged sample ({rate:.3g} Hz) taken as one the learner saw (no driver rate "
+            "in the log): the firmware sees its driver's samples (about 1 kHz), so its "
+            "windows close sooner and its filter lags less than emulated here"
+        )
+    return ArdupilotEmulation(learning, samples_per_sample, against, tclr, note)
 
 
 @dataclass(frozen=True)
