@@ -20,8 +20,9 @@ DRIVER_HZ = 1000.0
 
 
 def learning_log(
-    path: Path, n: int, tmax: float, tclr_temp_offset: float = 0.0, nan_every: int = 0
-) -> dict:
+    path: Path, n: int, tmax: float, tclr_temp_offset: float = 0.0, nan_every: int = 0,
+    first: int = 0,
+) -> dict:  # fmt: skip
     t, temp, acc, gyr = sweep(n, RATE_HZ, 15.0, 0.02, seed=11)
     # what the log stores: float32 (the reader gives these values back exactly)
     temp, acc, gyr = (np.asarray(a, np.float32).astype(np.float64) for a in (temp, acc, gyr))
@@ -32,7 +33,7 @@ def learning_log(
         for temp_c, x, y, z, n_s, i in st[stype]["pts_i"]:
             closing.setdefault(i, []).append((stype, temp_c + tclr_temp_offset, x, y, z, n_s))
     msgs: list = [parm("INS_TCAL1_ENABLE", 2), parm("INS_TCAL1_TMAX", tmax)]
-    for i in range(t.size):
+    for i in range(first, t.size):  # the log starts at sample ``first``, the learning at 0
         tc = float("nan") if nan_every and i % nan_every == 7 else float(temp[i])
         msgs.append((100, (int(time_us[i]), 0, *gyr[i], *acc[i], 0, 0, tc, 1, 1,
                            int(DRIVER_HZ), int(DRIVER_HZ))))  # fmt: skip
@@ -193,3 +194,19 @@ def test_px4_emulation_too_hot_and_short(tmp_path: Path) -> None:
     rise = g["high_c"] - g["low_c"]
     assert 29.0 < rise < 31.0 and g["progress"] == int(rise / 40 * 100)
     assert g["reason"].startswith(f"not completed: the temperature rose {rise:.1f} °C of the 40")
+
+
+def test_a_log_started_after_the_learning_is_said(tmp_path: Path) -> None:
+    """The firmware learned from boot; the log starts 400 s later (with the TCLR the
+    firmware wrote from then on): the emulation, started at the log's first sample, closes
+    other windows, and says so."""
+    log = tmp_path / "late.bin"
+    learning_log(log, 60_000, 45.0, first=10_000)
+    code, text = run_cli(["ardupilot-tempcal", str(log), "-o", str(tmp_path / "out"), "--json",
+                          "--emulate-learning"])  # fmt: skip
+    assert code == 0, text
+    em = json.loads(text)["emulated_learning"]["IMU.0"]
+    m = em["tclr"]["gyro"]
+    assert m["n_matched"] < m["n_logged"]
+    assert f"{m['n_logged'] - m['n_matched']} of {m['n_logged']} gyro" in em["note"]
+    assert "starts at boot" in em["note"]

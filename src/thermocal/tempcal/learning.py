@@ -324,6 +324,14 @@ def emulate_ardupilot(
             "in the log): the firmware sees its driver's samples (about 1 kHz), so its "
             "windows close sooner and its filter lags less than emulated here"
         )
+    unpaired = [f"{m.n_logged - m.n_matched} of {m.n_logged} {k}" for k, m in tclr.items()
+                if m.n_matched < m.n_logged]  # fmt: skip
+    if unpaired:
+        note = "; ".join(x for x in (note, (
+            "logged TCLR points without an emulated one within 1 s ("
+            + ", ".join(unpaired) + "): the firmware's learning starts at boot, so a log that "
+            "starts later (or a driver rate other than emulated) closes other windows"
+        )) if x)  # fmt: skip
     return ArdupilotEmulation(learning, samples_per_sample, against, tclr, note)
 
 
