@@ -230,9 +230,10 @@ def _other_runs(t: Path) -> list[tuple[str, Any]]:
     (t / "batch.toml").write_text(FLEET_TOML)
     px4 = t / "px4"
     return [
-        ("px4-tempcal", _run(["px4-tempcal", str(LOGS / "sweep.ulg"), "-o", str(px4)])),
+        ("px4-tempcal", _run(["px4-tempcal", str(LOGS / "sweep.ulg"), "-o", str(px4),
+                              "--emulate-learning"])),
         ("ardupilot-tempcal", _run(["ardupilot-tempcal", str(LOGS / "sweep.bin"),
-                                    "-o", str(t / "ap")])),
+                                    "-o", str(t / "ap"), "--emulate-learning"])),
         ("export-params", _run(["export-params", str(px4 / "calibration.json"),
                                 "--format", "px4", "-o", str(t / "x.params")])),
         ("turntable", _run(["turntable", str(t / "tt.csv"), "-o", str(t / "tt.json"),

@@ -35,6 +35,15 @@ if TYPE_CHECKING:
     from thermocal.tempcal.px4 import Px4TempcalResult
 
 OutDirOpt = Annotated[Path, typer.Option("-o", "--output", help="Directory to write.")]
+EmulateOpt = Annotated[
+    bool,
+    typer.Option(
+        "--emulate-learning",
+        help="Also run the firmware's own temperature learning on the log's samples, as its "
+        "source defines it: would it have completed, why not, what it would store against "
+        "thermocal's fit (and, for ArduPilot, its TCLR points against the log's).",
+    ),
+]
 
 
 def heater_options(
@@ -91,6 +100,7 @@ def px4_tempcal_cmd(
     heater_setpoint: HeaterSetpointOpt = None,
     heater_band: HeaterBandOpt = 0.5,
     heater_min_hold: HeaterMinHoldOpt = 60.0,
+    emulate_learning: EmulateOpt = False,
 ) -> None:
     """Fit every gyro and accelerometer instance of a PX4 log as PX4 would (a cubic per axis
     about TREF), robust to spikes, with equal weight across the temperature range and
@@ -102,7 +112,7 @@ def px4_tempcal_cmd(
 
     res = px4_tempcal(
         log, output, tref_c=tref, overrides=overrides_of(allow_narrow, allow_motion),
-        reporter=write_sensor_report, allan=allan,
+        reporter=write_sensor_report, allan=allan, emulate_learning=emulate_learning,
         heater=heater_options(heater, heater_setpoint, heater_band, heater_min_hold),
     )  # fmt: skip
     emit(res.to_dict(), as_json, lambda: _print_px4(res))
@@ -110,6 +120,10 @@ def px4_tempcal_cmd(
 
 def _print_px4(res: "Px4TempcalResult") -> None:
     show(_firmware_text.px4_tempcal_text(res))
+    if res.emulated_learning:
+        from thermocal.report.learning_text import px4_learning_text
+
+        show(px4_learning_text(res.emulated_learning))
     stdout.print(f"parameters: [bold]{res.params_path}[/bold]", markup=True)
 
 
@@ -133,6 +147,7 @@ def ardupilot_tempcal_cmd(
     heater_setpoint: HeaterSetpointOpt = None,
     heater_band: HeaterBandOpt = 0.5,
     heater_min_hold: HeaterMinHoldOpt = 60.0,
+    emulate_learning: EmulateOpt = False,
 ) -> None:
     """ArduPilot's thermal calibration from one DataFlash log: every IMU instance's gyro
     and accelerometer fitted as in px4-tempcal, written as INS_TCAL* (.parm), a calibration
@@ -144,7 +159,7 @@ def ardupilot_tempcal_cmd(
 
     res = ardupilot_tempcal(
         log, output, overrides=overrides_of(allow_narrow, allow_motion),
-        reporter=write_sensor_report, allan=allan,
+        reporter=write_sensor_report, allan=allan, emulate_learning=emulate_learning,
         heater=heater_options(heater, heater_setpoint, heater_band, heater_min_hold),
     )  # fmt: skip
     emit(res.to_dict(), as_json, lambda: _print_ardupilot(res))
@@ -152,4 +167,8 @@ def ardupilot_tempcal_cmd(
 
 def _print_ardupilot(res: "ArdupilotTempcalResult") -> None:
     show(_firmware_text.ardupilot_tempcal_text(res))
+    if res.emulated_learning:
+        from thermocal.report.learning_text import ardupilot_learning_text
+
+        show(ardupilot_learning_text(res.emulated_learning))
     stdout.print(f"parameters: [bold]{res.params_path}[/bold]", markup=True)

@@ -43,6 +43,7 @@ from thermocal.tempcal.ardupilot_baro import (
 from thermocal.tempcal.compare import CoefficientComparison, compare_coefficients
 from thermocal.tempcal.flightlog import DataflashFlightLog, read_ardupilot_log
 from thermocal.tempcal.heated import judge_instance
+from thermocal.tempcal.learning import ArdupilotEmulation
 from thermocal.tempcal.pipeline import (
     AXES,
     GateWarning,
@@ -696,6 +697,9 @@ class ArdupilotTempcalResult:
     parameter_changes: tuple[dict[str, Any], ...] = ()
     """The changes during the log of the parameters undone (``time_s`` [s], ``name``,
     ``old``, ``new``); the data were undone per interval."""
+    emulated_learning: dict[str, ArdupilotEmulation] = dataclasses.field(default_factory=dict)
+    """Per IMU (``IMU.<n>``), the firmware's in-flight learning emulated on the log
+    (``emulate_learning``; :mod:`thermocal.tempcal.learning`)."""
 
     @property
     def active_found(self) -> list[str]:
@@ -727,7 +731,11 @@ class ArdupilotTempcalResult:
                 "parameter_changes": list(self.parameter_changes),
                 "imus": self.hygiene,
             },
-        }
+        } | (
+            {"emulated_learning": {k: e.to_dict() for k, e in self.emulated_learning.items()}}
+            if self.emulated_learning
+            else {}
+        )
 
 
 @dataclass
@@ -756,6 +764,9 @@ class _Run:
     motions: dict[str, Any] = dataclasses.field(default_factory=dict)
     """Each instance's stillness from its fit (:func:`.pipeline.fit_sensor`), for the step
     warnings (computed once)."""
+    emulate: bool = False
+    """The firmware's in-flight learning is emulated on each IMU."""
+    emulated: dict[str, ArdupilotEmulation] = dataclasses.field(default_factory=dict)
 
 
 def ardupilot_tempcal(
@@ -766,6 +777,7 @@ def ardupilot_tempcal(
     reporter: Reporter | None = None,
     allan: bool = False,
     heater: HeaterOptions | None = None,
+    emulate_learning: bool = False,
 ) -> ArdupilotTempcalResult:
     """ArduPilot's thermal calibration of every IMU of a DataFlash log, written as one set.
 
@@ -788,6 +800,8 @@ def ardupilot_tempcal(
     heater : HeaterOptions, optional
         The heater's hold (:class:`thermocal.heater.HeaterOptions`; default: the set-point
         ``BRD_HEAT_TARG``/``BRD_IMU_TARGTEMP`` unless −1, else inferred).
+    emulate_learning : bool, optional
+        Also emulate the firmware's learning on each IMU (:mod:`thermocal.tempcal.learning`).
 
     Returns
     -------
@@ -822,9 +836,8 @@ def ardupilot_tempcal(
     from thermocal.export.params import ParamSet, check_documented, check_values
 
     # DIR may hold the log; the files of the set (replaced by name) may not be it
-    names = ["calibration.json", FORMATS["ardupilot"].params_file]
+    names = ["calibration.json", FORMATS["ardupilot"].params_file, BARO_REPORT]
     names += [f"report_IMU_{i}_{k}.html" for i in range(MAX_IMUS) for k in ("gyro", "accel")]
-    names.append(BARO_REPORT)
     check_outputs([output / n for n in names], [log], dirs=[output])
     check_output_dir(output)
     with (
@@ -834,6 +847,7 @@ def ardupilot_tempcal(
         flight = read_ardupilot_log(log, MESSAGES)  # the log is read once, passed down
         run = _Run(log, flight, overrides, ParamSet("ardupilot"), out_set, [], [], {}, {})
         run.allan, run.heater = allan, heater or HeaterOptions()
+        run.emulate = emulate_learning
         _imus(run)
         if not run.fits:
             raise ThermocalInputError(f"{log}: no IMU with a usable temperature in the log")
@@ -845,12 +859,11 @@ def ardupilot_tempcal(
         out_set.commit(
             calibration_of(run.fits), FORMATS["ardupilot"].params_file, run.params.text()
         )
-    notes = _run_notes(run)
     return ArdupilotTempcalResult(
         log, output / FORMATS["ardupilot"].params_file, output / "calibration.json",
-        tuple(out_set.reports),
-        tuple(run.fits), tuple(notes), run.orientation, run.hygiene, run.previous,
-        run.learning, run.baro, run.rotated, _changes_said(run),
+        tuple(out_set.reports), tuple(run.fits), tuple(_run_notes(run)), run.orientation,
+        run.hygiene, run.previous, run.learning, run.baro, run.rotated, _changes_said(run),
+        run.emulated,
     )  # fmt: skip
 
 
@@ -950,6 +963,7 @@ def _imu(run: _Run, df: Any, inst: int) -> None:
     if held.hold is None or held.hold.setpoint_source == "inferred":  # a stall, or a heater?
         run.gates.append(stall_warning(f"IMU.{inst}", time_s, temp_c))
     per_kind: list[tuple[SensorFit, Recording]] = []
+    raw: dict[str, FloatArray] = {}  # what the firmware's learner is fed, per kind
     intervals, changes = param_intervals(
         run.flight.parameters,
         run.flight.parameter_changes,
@@ -959,6 +973,7 @@ def _imu(run: _Run, df: Any, inst: int) -> None:
     for kind, prefix, unit in KINDS:
         xyz = np.column_stack([df[f"{prefix}{a.upper()}"].to_numpy() for a in AXES])
         xyz, actives, codes = ardupilot_raw_intervals(intervals, inst, kind, time_s, temp_c, xyz)
+        raw[kind] = xyz
         run.orientation = codes[-1]
         run.rotated = run.rotated or any(codes)
         active = ardupilot_active(prev_params, inst)
@@ -999,6 +1014,7 @@ def _imu(run: _Run, df: Any, inst: int) -> None:
     fw_range = tclr_range(
         run.flight.rows("TCLR"), inst, run.flight.parameter_changes, time_s, temp_c
     )
+    emulated = _emulate(run, inst, df, time_s, temp_c, raw, ps.params) if run.emulate else None
     for fit, sub_rec in per_kind:
         key = f"{fit.topic}.{inst}"
         if active is not None:  # the log's coefficients against the new ones
@@ -1024,8 +1040,32 @@ def _imu(run: _Run, df: Any, inst: int) -> None:
                 ),
                 previous=run.previous.get(key),
                 firmware_learning=run.learning.get(key), allan=run.allan,
+                emulated_learning=emulated.against_thermocal.get(fit.kind) if emulated else None,
             ),
         )  # fmt: skip
+
+
+def _emulate(
+    run: _Run, inst: int, df: Any, time_s: FloatArray, temp_c: FloatArray,
+    raw: dict[str, FloatArray], new_params: Mapping[str, float],
+) -> ArdupilotEmulation:  # fmt: skip
+    """The firmware's learning of IMU ``inst`` emulated (:func:`.learning.emulate_ardupilot`),
+    fed at the driver's rate ``AHz`` of the ``IMU`` message when the log has it."""
+    from thermocal.tempcal.learning import emulate_ardupilot, samples_per_logged
+
+    ok = np.isfinite(time_s) & np.isfinite(temp_c)  # samples the firmware could not use
+    for v in raw.values():
+        ok &= np.isfinite(v).all(axis=1)
+    em = emulate_ardupilot(
+        inst, time_s[ok], temp_c[ok], {k: v[ok] for k, v in raw.items()},
+        parameters=run.flight.parameters, new_params=new_params,
+        tclr_rows=run.flight.rows("TCLR"),
+        samples_per_sample=samples_per_logged(
+            time_s[ok], df["AHz"].to_numpy()[ok] if "AHz" in df.columns else None
+        ),
+    )  # fmt: skip
+    run.emulated[f"IMU.{inst}"] = em
+    return em
 
 
 def _baro(run: _Run) -> None:

@@ -465,6 +465,9 @@ class ReportRequest:
         The coefficients active in the log against the new ones.
     firmware_learning : CoefficientComparison or None
         The firmware's own learned coefficients against the new ones.
+    emulated_learning : CoefficientComparison or None
+        What the firmware's own learning, emulated on the log, would store against the new
+        ones.
     allan : bool
         Draw each channel's Allan deviation before and after compensation with its noise
         terms (default False: left out; most of a report's cost on a long log).
@@ -484,6 +487,9 @@ class ReportRequest:
     """The firmware's own learned coefficients (ArduPilot ``TCLR``) against the new ones."""
     allan: bool = False
     """Each channel's Allan deviation section drawn (False: left out, not computed)."""
+    emulated_learning: CoefficientComparison | None = None
+    """What the firmware's own learning, emulated on the log, would store against the new
+    coefficients (:mod:`thermocal.tempcal.learning`)."""
 
 
 AnyReportRequest = ReportRequest | OffsetReportRequest | ArdupilotBaroReportRequest

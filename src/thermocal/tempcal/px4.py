@@ -41,9 +41,10 @@ from thermocal.firmware.px4 import px4_coefficients
 from thermocal.heater import HeaterOptions
 from thermocal.models.calibration import Calibration
 from thermocal.outputs import check_outputs
-from thermocal.recording import FloatArray
+from thermocal.recording import FloatArray, Recording
 from thermocal.tempcal.compare import CoefficientComparison, px4_comparison
 from thermocal.tempcal.flightlog import FlightLog, open_px4_log
+from thermocal.tempcal.learning import Px4Emulation, px4_overall
 from thermocal.tempcal.pipeline import (
     AXES,
     OutputSet,
@@ -262,6 +263,9 @@ class Px4TempcalResult:
     notes: tuple[str, ...]
     previous: dict[str, CoefficientComparison] = dataclasses.field(default_factory=dict)
     """Per sensor, the log's ``TC_*`` for its device against the new ones."""
+    emulated_learning: dict[str, Px4Emulation] = dataclasses.field(default_factory=dict)
+    """Per gyro and accelerometer instance, PX4's on-board temperature calibration emulated
+    on the log (``emulate_learning``; :mod:`thermocal.tempcal.learning`)."""
 
     def to_dict(self) -> dict[str, Any]:
         """The result as a JSON object (what the ``px4-tempcal`` command prints as JSON)."""
@@ -275,7 +279,11 @@ class Px4TempcalResult:
                 for k, v in {**summary(self.fits), **offset_summary(self.offset_fits)}.items()
             },
             "notes": list(self.notes),
-        }
+        } | (
+            {"emulated_learning": px4_overall(self.emulated_learning)}
+            if self.emulated_learning
+            else {}
+        )
 
 
 NO_SENSOR = "no sensor_gyro or sensor_accel topic with a temperature in the log"
@@ -295,6 +303,7 @@ def px4_tempcal(
     reporter: Reporter | None = None,
     allan: bool = False,
     heater: HeaterOptions | None = None,
+    emulate_learning: bool = False,
 ) -> Px4TempcalResult:
     """PX4's thermal calibration of every sensor instance of a ULog, written as one set.
 
@@ -320,6 +329,11 @@ def px4_tempcal(
         How a heater's hold is looked for (default: the set-point ``SENS_IMU_TEMP`` when
         ``SENS_EN_THERMAL`` is on, else inferred; ±0.5 °C for 60 s; a cut range said,
         :class:`thermocal.heater.HeaterOptions`).
+    emulate_learning : bool, optional
+        Also emulate PX4's on-board temperature calibration (``SYS_CAL_TDEL``,
+        ``SYS_CAL_TMIN``, ``SYS_CAL_TMAX`` from the log, else PX4's defaults) on each gyro
+        and accelerometer instance (:func:`thermocal.tempcal.learning.emulate_px4`);
+        default False.
 
     Returns
     -------
@@ -365,8 +379,9 @@ def px4_tempcal(
         open_px4_log(log, (*TOPICS, *OFFSET_TOPICS)) as flight,  # the log is parsed once
     ):
         return _px4_tempcal(
-            flight, output, tref_c, overrides, reporter, pool, allan, heater or HeaterOptions()
-        )
+            flight, output, tref_c, overrides, reporter, pool, allan,
+            heater or HeaterOptions(), {} if emulate_learning else None,
+        )  # fmt: skip
 
 
 def _px4_tempcal(
@@ -378,8 +393,10 @@ def _px4_tempcal(
     pool: Any = None,
     allan: bool = False,
     heater: HeaterOptions | None = None,
+    emulated: dict[str, Px4Emulation] | None = None,
 ) -> Px4TempcalResult:
-    """:func:`px4_tempcal` after its output checks (``pool``: the report worker)."""
+    """:func:`px4_tempcal` after its output checks (``pool``: the report worker;
+    ``emulated``: filled with the on-board calibration emulated, when given)."""
     from thermocal.export.params import ParamSet
 
     log, topics = flight.path, flight.instances
@@ -404,7 +421,7 @@ def _px4_tempcal(
                 continue
             fit, more = _imu_instance(
                 flight, name, inst, tref_c, overrides, params, out_set, (series, motions), old,
-                allan, heater or HeaterOptions(),
+                allan, heater or HeaterOptions(), emulated,
             )  # fmt: skip
             fits.append(fit)
             gates.extend(more)
@@ -421,7 +438,7 @@ def _px4_tempcal(
     return Px4TempcalResult(
         log, output / FORMATS["px4"].params_file, output / "calibration.json",
         tuple(out_set.reports),
-        tuple(fits), tuple(offset_fits), tuple(params.notes), old.found,
+        tuple(fits), tuple(offset_fits), tuple(params.notes), old.found, emulated or {},
     )  # fmt: skip
 
 
@@ -533,6 +550,7 @@ def _imu_instance(
     old: _Prior,
     allan: bool = False,
     heater: HeaterOptions | None = None,
+    emulated: dict[str, Px4Emulation] | None = None,
 ) -> tuple[SensorFit, list[str | None]]:
     """A gyro or accelerometer instance through the pipeline: read, fit, its gates, its
     ``TC_G``/``TC_A`` parameters merged into ``params``, its report (``allan``: with its
@@ -578,6 +596,9 @@ def _imu_instance(
         where, ps.params, kind, inst, fit.device_id, "rad/s" if kind == "gyro" else "m/s^2",
         fit.sweep_c,
     )  # fmt: skip
+    em = None if emulated is None else _emulate(flight, rec, where, kind, inst, fit, ps.params)
+    if em is not None and emulated is not None:
+        emulated[where] = em
     shown = (*AXES, "temperature")  # what the report reads: the device id column left here
     rec = dataclasses.replace(
         rec, columns={k: v for k, v in rec.columns.items() if k in shown},
@@ -603,9 +624,27 @@ def _imu_instance(
             ),
             previous=prev,
             allan=allan,
+            emulated_learning=None if em is None else em.against_thermocal,
         ),
     )  # fmt: skip
     return fit, gates
+
+
+def _emulate(
+    flight: FlightLog, rec: Recording, where: str, kind: str, inst: int, fit: SensorFit,
+    new_params: Any,
+) -> Px4Emulation:  # fmt: skip
+    """PX4's on-board calibration of one instance emulated on its samples in PX4's units
+    (rad/s, m/s²; the time since boot)."""
+    from thermocal.tempcal.learning import emulate_px4
+    from thermocal.units import convert
+
+    unit = "rad/s" if kind == "gyro" else "m/s^2"
+    vals = np.column_stack([convert(*rec.signal(a), unit, where) for a in AXES])
+    return emulate_px4(
+        kind, inst, rec.time_s, vals, rec.temperature_c("temperature"),
+        parameters=flight.parameters, new_params=new_params, device_id=fit.device_id,
+    )  # fmt: skip
 
 
 __all__ = [
