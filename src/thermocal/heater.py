@@ -393,6 +393,9 @@ def find_heater_hold(
         raise ParameterError("band_c", f"{{name}} must be positive, got {band_c:g}")
     if not min_hold_s > 0:
         raise ParameterError("min_hold_s", f"{{name}} must be positive, got {min_hold_s:g}")
+    ok = np.isfinite(time_s) & np.isfinite(temp_c)  # a reading lost: the others still tell
+    if not ok.all():
+        time_s, temp_c = time_s[ok], temp_c[ok]
     if temp_c.size < 2:
         return None
     if setpoint_c is None:

@@ -164,3 +164,22 @@ def test_bad_options_name_their_parameter() -> None:
         find_heater_hold(np.arange(3.0), np.zeros(3), band_c=0.0)
     with pytest.raises(ParameterError, match="heater_min_hold must be positive"):
         HeaterOptions(min_hold_s=-1.0)
+
+
+def test_lost_readings_are_left_out_not_fatal() -> None:
+    """A log whose thermometer drops readings (NaN every 1000th sample, as a DataFlash log
+    with lost IMU temperatures): the hold is the one found without them; it raised
+    ``arange: cannot compute length`` (an internal error, exit 1, through the commands)."""
+    import numpy as np
+
+    from thermocal.heater import find_heater_hold
+
+    t = np.arange(0.0, 600.0, 0.1)
+    temp = np.minimum(20.0 + 0.2 * t, 55.0)
+    clean = find_heater_hold(t, temp)
+    lost = temp.copy()
+    lost[::1000] = np.nan
+    found = find_heater_hold(t, lost)
+    assert clean is not None and found is not None
+    assert abs(found.reached_s - clean.reached_s) < 0.2
+    assert abs(found.hold_s - clean.hold_s) < 0.2
