@@ -811,7 +811,6 @@ def ardupilot_tempcal(
       https://github.com/ArduPilot/ardupilot/blob/master/libraries/AP_InertialSensor/AP_InertialSensor_tempcal.cpp
     * ArduPilot, ``libraries/AP_TempCalibration/AP_TempCalibration.cpp`` (the barometer).
     """
-    from thermocal.errors import MissingColumnError
     from thermocal.export.params import ParamSet, check_documented, check_values
 
     # DIR may hold the log; the files of the set (replaced by name) may not be it
@@ -827,14 +826,7 @@ def ardupilot_tempcal(
         flight = read_ardupilot_log(log, MESSAGES)  # the log is read once, passed down
         run = _Run(log, flight, overrides, ParamSet("ardupilot"), out_set, [], [], {}, {})
         run.allan = allan
-        for inst in range(MAX_IMUS):
-            try:
-                df, _info = flight.table("IMU", inst)
-            except MissingColumnError:
-                if inst == 0:
-                    raise
-                break
-            _imu(run, df, inst)
+        _imus(run)
         if not run.fits:
             raise ThermocalInputError(f"{log}: no IMU with a usable temperature in the log")
         _baro(run)
@@ -897,9 +889,74 @@ def _changes_said(run: _Run) -> tuple[dict[str, Any], ...]:
     return tuple(sorted(seen.values(), key=lambda c: float(c["time_s"])))
 
 
-def _imu_temperature(run: _Run, df: Any, inst: int) -> FloatArray | None:
+_IMU_FIELDS = ("T", "Temp", *(f"{p}{a}" for p in ("Gyr", "Acc") for a in "XYZ"))
+"""The fields of ``IMU`` the calibration reads (besides ``TimeUS``)."""
+
+
+@dataclass
+class _ImuData:
+    """One IMU's samples as its fits take them, copied out of the log's table (which is
+    then dropped): times [s], temperatures [°C], the logged vectors per kind (n, 3); or the
+    sentence it is left out with, or the error it is refused with (each said at its turn)."""
+
+    inst: int
+    time_s: FloatArray | None = None
+    temp_c: FloatArray | None = None
+    xyz: dict[str, FloatArray] = dataclasses.field(default_factory=dict)
+    left_out: str | None = None
+    error: ThermocalInputError | None = None
+
+
+def _imu_data(run: _Run, inst: int) -> _ImuData:
+    """IMU ``inst``'s samples (:class:`_ImuData`) from a table of only the fields read;
+    raises ``MissingColumnError`` when the log has no such instance."""
+    df, _info = run.flight.table("IMU", inst, _IMU_FIELDS)
+    if not {"T", "Temp"} & set(df.columns) or not set(_IMU_FIELDS[2:]) <= set(df.columns):
+        df, _info = run.flight.table("IMU", inst)  # every field: the refusal names them
+    try:
+        temp_c = _imu_temperature(run, df, inst)
+    except ThermocalInputError as exc:
+        return _ImuData(inst, error=exc)
+    if isinstance(temp_c, str):
+        return _ImuData(inst, left_out=temp_c)
+    xyz = {
+        kind: np.column_stack([df[f"{prefix}{a.upper()}"].to_numpy() for a in AXES])
+        for kind, prefix, _unit in KINDS
+    }
+    return _ImuData(inst, df["TimeUS"].to_numpy() * 1e-6, temp_c, xyz)
+
+
+def _imus(run: _Run) -> None:
+    """Every IMU of the log through :func:`_imu`, in turn.  Each one's samples are copied
+    out of the log first (:func:`_imu_data`) and the log's rows released, so that the fits
+    and the reports hold the samples once; each IMU's are given back after its turn."""
+    from thermocal.errors import MissingColumnError
+
+    datas: list[_ImuData] = []
+    for inst in range(MAX_IMUS):
+        try:
+            datas.append(_imu_data(run, inst))
+        except MissingColumnError:
+            if inst == 0:
+                raise
+            break
+    for name in ("IMU", "IMU2", "IMU3"):  # the rows of the log, all copied out
+        run.flight.release(name)
+    while datas:
+        data = datas.pop(0)
+        if data.error is not None:
+            raise data.error
+        if data.left_out is not None:
+            warnings.warn(GateWarning(data.left_out), stacklevel=2)
+            continue
+        _imu(run, data)
+        del data
+
+
+def _imu_temperature(run: _Run, df: Any, inst: int) -> FloatArray | str:
     """The temperature of IMU ``inst`` [°C] (field ``T``, ``Temp`` in Copter 3.4–3.6;
-    refused when neither is there); None, with a warning, when it is all 0 or NaN."""
+    refused when neither is there); the sentence it is left out with when it is all 0 or
+    NaN."""
     tcol = next((c for c in ("T", "Temp") if c in df.columns), None)
     if tcol is None:  # LogStructure.h: ``T`` (``Temp`` in Copter 3.4–3.6)
         raise ThermocalInputError(
@@ -907,28 +964,23 @@ def _imu_temperature(run: _Run, df: Any, inst: int) -> FloatArray | None:
             + ", ".join(map(str, df.columns))
         )
     require_fields(df, [f"{p}{a}" for p in ("Gyr", "Acc") for a in "XYZ"], run.log, f"IMU.{inst}")
-    temp_c: FloatArray = df[tcol].to_numpy()
+    # a copy: a view would keep the table's whole float64 block (every field) alive
+    temp_c: FloatArray = df[tcol].to_numpy(dtype=np.float64, copy=True)
     if not np.isfinite(temp_c).any() or np.all(temp_c[np.isfinite(temp_c)] == 0):
-        warnings.warn(
-            GateWarning(
-                f"{run.log}: IMU.{inst} left out: its temperature is all 0 or NaN (a sensor "
-                "without a thermometer cannot be calibrated over temperature)"
-            ),
-            stacklevel=3,
+        return (
+            f"{run.log}: IMU.{inst} left out: its temperature is all 0 or NaN (a sensor "
+            "without a thermometer cannot be calibrated over temperature)"
         )
-        return None
     return temp_c
 
 
-def _imu(run: _Run, df: Any, inst: int) -> None:
+def _imu(run: _Run, data: _ImuData) -> None:
     """One IMU: its gyro and accelerometer back to the sensor frame (:func:`ardupilot_raw`)
     and through the pipeline, its ``INS_TCAL<n>`` parameters, hygiene, gates and reports."""
     from thermocal.export.params import export_params
 
-    temp_c = _imu_temperature(run, df, inst)
-    if temp_c is None:
-        return
-    time_s = df["TimeUS"].to_numpy() * 1e-6
+    inst, time_s, temp_c = data.inst, data.time_s, data.temp_c
+    assert time_s is not None and temp_c is not None
     run.gates.append(stall_warning(f"IMU.{inst}", time_s, temp_c))
     per_kind: list[tuple[SensorFit, Recording]] = []
     intervals, changes = param_intervals(
@@ -938,7 +990,7 @@ def _imu(run: _Run, df: Any, inst: int) -> None:
     )
     prev_params = _previous_params(run, inst, intervals, changes, time_s)
     for kind, prefix, unit in KINDS:
-        xyz = np.column_stack([df[f"{prefix}{a.upper()}"].to_numpy() for a in AXES])
+        xyz = data.xyz.pop(kind)  # the logged copy given back once undone
         xyz, actives, codes = ardupilot_raw_intervals(intervals, inst, kind, time_s, temp_c, xyz)
         run.orientation = codes[-1]
         run.rotated = run.rotated or any(codes)
