@@ -1428,10 +1428,13 @@ def run_fleet(
     ------
     ThermocalInputError
         An output is, or holds, an input (:func:`check_outputs`, before anything is
-        written); the scheduler's address is not one.
+        written); the output exists and is not a directory; the scheduler's address is
+        not one.
     """
     out = Path(out_dir)
     check_outputs(config, out)
+    if out.exists() and not out.is_dir():
+        raise ThermocalInputError(f"{out}: exists and is not a directory")
     run = executor or (dask_executor(scheduler) if scheduler else local_executor(workers))
     out.mkdir(parents=True, exist_ok=True)
     _clean_stale(out / "units")
