@@ -2226,7 +2226,7 @@ MUTANTS: tuple[Mutant, ...] = (
         P + "pipeline/model_file.py",
         "    if p.is_file():  # a plain file",
         "    if False:  # a plain file",
-        _t("fleet_hash_once"),
+        _t("fleet_reads_once"),
         "a fleet unit's input read again for each digest of it (the provenance's, the fit's)",
     ),
     Mutant(

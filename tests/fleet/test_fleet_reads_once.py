@@ -1,6 +1,7 @@
-"""The fleet reads each input's bytes once for its digests: the SHA-256 the fleet records
-(``unit.json``) and the one in the model file's provenance are the same digest of the same
-file, taken once per process (the bytes hashed equal the inputs' sizes, not a multiple)."""
+"""The fleet reads what it needs once: each input's bytes for its digests (the SHA-256 the
+fleet records in ``unit.json`` and the one in the model file's provenance are the same
+digest of the same file, taken once per process: the bytes hashed equal the inputs' sizes,
+not a multiple), and each unit's ``unit.json`` for the summary and the report."""
 
 from __future__ import annotations
 
@@ -51,3 +52,24 @@ def test_each_input_hashed_once(tmp_path: Path, monkeypatch: pytest.MonkeyPatch)
     for path in (runs["b"].path, val.path):
         want = hashlib.new("sha256", path.read_bytes()).hexdigest()
         assert unit["inputs"][str(path)] == want
+
+
+def test_each_unit_json_read_once_at_the_end(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    for seed, uid in enumerate("abc"):
+        write_run(tmp_path / f"{uid}.csv", seed)
+    units = {uid: (f"{uid}.csv", None) for uid in "abc"}
+    (tmp_path / "batch.toml").write_text(config_text(units))
+    reads: list[str] = []
+    real = batch.read_unit
+
+    def counted(out_dir: Path, uid: str) -> dict[str, Any] | None:
+        reads.append(uid)
+        return real(out_dir, uid)
+
+    monkeypatch.setattr(batch, "read_unit", counted)
+    res = batch.run_fleet(load_config(tmp_path / "batch.toml"), tmp_path / "out")
+    assert sorted(reads) == ["a", "b", "c"]  # a first run: the summary's and report's reads
+    assert [r["id"] for r in res.rows] == ["a", "b", "c"]
+    assert [r["status"] for r in res.rows] == ["ok", "ok", "ok"]
