@@ -920,10 +920,18 @@ def _imu_data(run: _Run, inst: int) -> _ImuData:
     if isinstance(temp_c, str):
         return _ImuData(inst, left_out=temp_c)
     xyz = {
-        kind: np.column_stack([df[f"{prefix}{a.upper()}"].to_numpy() for a in AXES])
+        kind: _compact(np.column_stack([df[f"{prefix}{a.upper()}"].to_numpy() for a in AXES]))
         for kind, prefix, _unit in KINDS
     }
-    return _ImuData(inst, df["TimeUS"].to_numpy() * 1e-6, temp_c, xyz)
+    return _ImuData(inst, df["TimeUS"].to_numpy() * 1e-6, _compact(temp_c), xyz)
+
+
+def _compact(x: FloatArray) -> Any:
+    """``x`` held as float32 while it waits for its turn when that keeps every value (the
+    log's float32 fields, made float64 by the reader): half the memory, the same numbers
+    once made float64 again; else ``x`` as it is."""
+    x32 = x.astype(np.float32)
+    return x32 if np.array_equal(x32, x, equal_nan=True) else x
 
 
 def _imus(run: _Run) -> None:
@@ -979,8 +987,9 @@ def _imu(run: _Run, data: _ImuData) -> None:
     and through the pipeline, its ``INS_TCAL<n>`` parameters, hygiene, gates and reports."""
     from thermocal.export.params import export_params
 
-    inst, time_s, temp_c = data.inst, data.time_s, data.temp_c
-    assert time_s is not None and temp_c is not None
+    assert data.time_s is not None and data.temp_c is not None
+    inst, time_s = data.inst, data.time_s
+    temp_c: FloatArray = data.temp_c.astype(np.float64)  # exact: see _compact
     run.gates.append(stall_warning(f"IMU.{inst}", time_s, temp_c))
     per_kind: list[tuple[SensorFit, Recording]] = []
     intervals, changes = param_intervals(
@@ -990,7 +999,7 @@ def _imu(run: _Run, data: _ImuData) -> None:
     )
     prev_params = _previous_params(run, inst, intervals, changes, time_s)
     for kind, prefix, unit in KINDS:
-        xyz = data.xyz.pop(kind)  # the logged copy given back once undone
+        xyz = data.xyz.pop(kind).astype(np.float64)  # exact (_compact); given back once undone
         xyz, actives, codes = ardupilot_raw_intervals(intervals, inst, kind, time_s, temp_c, xyz)
         run.orientation = codes[-1]
         run.rotated = run.rotated or any(codes)
