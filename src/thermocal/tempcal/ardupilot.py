@@ -943,11 +943,16 @@ def _imus(run: _Run) -> None:
     datas: list[_ImuData] = []
     for inst in range(MAX_IMUS):
         try:
-            datas.append(_imu_data(run, inst))
+            data = _imu_data(run, inst)
         except MissingColumnError:
             if inst == 0:
                 raise
             break
+        except ThermocalInputError as exc:  # refused at its turn, after the IMUs before it
+            data = _ImuData(inst, error=exc)
+        datas.append(data)
+        if data.error is not None:
+            break  # the run stops there: no later IMU is read
     for name in ("IMU", "IMU2", "IMU3"):  # the rows of the log, all copied out
         run.flight.release(name)
     while datas:
