@@ -2214,6 +2214,22 @@ MUTANTS: tuple[Mutant, ...] = (
         "THERMOCAL_MEMORY_LIMIT=0 (or nan, inf) taken as a limit of 0 bytes",
     ),
     Mutant(
+        "dataflash-table-fields-ignored",
+        P + "readers/dataflash.py",
+        'keep = None if fields is None else {"TimeUS", *fields}',
+        "keep = None",
+        _t("dataflash_fields"),
+        "a DataFlash table asked for some fields builds every field (the memory of them all)",
+    ),
+    Mutant(
+        "file-sha256-not-cached",
+        P + "pipeline/model_file.py",
+        "    if p.is_file():  # a plain file",
+        "    if False:  # a plain file",
+        _t("fleet_reads_once"),
+        "a fleet unit's input read again for each digest of it (the provenance's, the fit's)",
+    ),
+    Mutant(
         "dataflash-fast-centi-divisor",
         P + "readers/dataflash.py",
         '"c": ("<i2", 100.0)',

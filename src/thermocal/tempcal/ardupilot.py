@@ -867,20 +867,6 @@ def ardupilot_tempcal(
     )  # fmt: skip
 
 
-def _imus(run: _Run) -> None:
-    """Every IMU instance of the log through :func:`_imu` (instance 0 must be there)."""
-    from thermocal.errors import MissingColumnError
-
-    for inst in range(MAX_IMUS):
-        try:
-            df, _info = run.flight.table("IMU", inst)
-        except MissingColumnError:
-            if inst == 0:
-                raise
-            break
-        _imu(run, df, inst)
-
-
 def _run_notes(run: _Run) -> list[str]:
     """The notes of an :func:`ardupilot_tempcal` run: the parameter file's, the log's
     hygiene (an active ``INS_TCAL`` removed, a rotation undone), the firmware's learning
@@ -924,9 +910,92 @@ def _changes_said(run: _Run) -> tuple[dict[str, Any], ...]:
     return tuple(sorted(seen.values(), key=lambda c: float(c["time_s"])))
 
 
-def _imu_temperature(run: _Run, df: Any, inst: int) -> FloatArray | None:
+_IMU_FIELDS = ("T", "Temp", *(f"{p}{a}" for p in ("Gyr", "Acc") for a in "XYZ"), "AHz")
+"""The fields of ``IMU`` the calibration reads (besides ``TimeUS``; ``AHz``, the driver's
+rate, only when the log has it: the learning's emulation reads it)."""
+
+
+@dataclass
+class _ImuData:
+    """One IMU's samples as its fits take them, copied out of the log's table (which is
+    then dropped): times [s], temperatures [°C], the logged vectors per kind (n, 3); or the
+    sentence it is left out with, or the error it is refused with (each said at its turn)."""
+
+    inst: int
+    time_s: FloatArray | None = None
+    temp_c: FloatArray | None = None
+    xyz: dict[str, FloatArray] = dataclasses.field(default_factory=dict)
+    left_out: str | None = None
+    error: ThermocalInputError | None = None
+    ahz: FloatArray | None = None
+    """The driver's sample rate ``AHz`` [Hz] per row, when the log has it and the firmware's
+    learning is emulated (:func:`_emulate`)."""
+
+
+def _imu_data(run: _Run, inst: int) -> _ImuData:
+    """IMU ``inst``'s samples (:class:`_ImuData`) from a table of only the fields read;
+    raises ``MissingColumnError`` when the log has no such instance."""
+    df, _info = run.flight.table("IMU", inst, _IMU_FIELDS)
+    if not {"T", "Temp"} & set(df.columns) or not set(_IMU_FIELDS[2:8]) <= set(df.columns):
+        df, _info = run.flight.table("IMU", inst)  # every field: the refusal names them
+    try:
+        temp_c = _imu_temperature(run, df, inst)
+    except ThermocalInputError as exc:
+        return _ImuData(inst, error=exc)
+    if isinstance(temp_c, str):
+        return _ImuData(inst, left_out=temp_c)
+    xyz = {
+        kind: _compact(np.column_stack([df[f"{prefix}{a.upper()}"].to_numpy() for a in AXES]))
+        for kind, prefix, _unit in KINDS
+    }
+    ahz = df["AHz"].to_numpy() if run.emulate and "AHz" in df.columns else None
+    return _ImuData(inst, df["TimeUS"].to_numpy() * 1e-6, _compact(temp_c), xyz, ahz=ahz)
+
+
+def _compact(x: FloatArray) -> Any:
+    """``x`` held as float32 while it waits for its turn when that keeps every value (the
+    log's float32 fields, made float64 by the reader): half the memory, the same numbers
+    once made float64 again; else ``x`` as it is."""
+    x32 = x.astype(np.float32)
+    return x32 if np.array_equal(x32, x, equal_nan=True) else x
+
+
+def _imus(run: _Run) -> None:
+    """Every IMU of the log through :func:`_imu`, in turn.  Each one's samples are copied
+    out of the log first (:func:`_imu_data`) and the log's rows released, so that the fits
+    and the reports hold the samples once; each IMU's are given back after its turn."""
+    from thermocal.errors import MissingColumnError
+
+    datas: list[_ImuData] = []
+    for inst in range(MAX_IMUS):
+        try:
+            data = _imu_data(run, inst)
+        except MissingColumnError:
+            if inst == 0:
+                raise
+            break
+        except ThermocalInputError as exc:  # refused at its turn, after the IMUs before it
+            data = _ImuData(inst, error=exc)
+        datas.append(data)
+        if data.error is not None:
+            break  # the run stops there: no later IMU is read
+    for name in ("IMU", "IMU2", "IMU3"):  # the rows of the log, all copied out
+        run.flight.release(name)
+    while datas:
+        data = datas.pop(0)
+        if data.error is not None:
+            raise data.error
+        if data.left_out is not None:
+            warnings.warn(GateWarning(data.left_out), stacklevel=2)
+            continue
+        _imu(run, data)
+        del data
+
+
+def _imu_temperature(run: _Run, df: Any, inst: int) -> FloatArray | str:
     """The temperature of IMU ``inst`` [°C] (field ``T``, ``Temp`` in Copter 3.4–3.6;
-    refused when neither is there); None, with a warning, when it is all 0 or NaN."""
+    refused when neither is there); the sentence it is left out with when it is all 0 or
+    NaN."""
     tcol = next((c for c in ("T", "Temp") if c in df.columns), None)
     if tcol is None:  # LogStructure.h: ``T`` (``Temp`` in Copter 3.4–3.6)
         raise ThermocalInputError(
@@ -934,28 +1003,24 @@ def _imu_temperature(run: _Run, df: Any, inst: int) -> FloatArray | None:
             + ", ".join(map(str, df.columns))
         )
     require_fields(df, [f"{p}{a}" for p in ("Gyr", "Acc") for a in "XYZ"], run.log, f"IMU.{inst}")
-    temp_c: FloatArray = df[tcol].to_numpy()
+    # a copy: a view would keep the table's whole float64 block (every field) alive
+    temp_c: FloatArray = df[tcol].to_numpy(dtype=np.float64, copy=True)
     if not np.isfinite(temp_c).any() or np.all(temp_c[np.isfinite(temp_c)] == 0):
-        warnings.warn(
-            GateWarning(
-                f"{run.log}: IMU.{inst} left out: its temperature is all 0 or NaN (a sensor "
-                "without a thermometer cannot be calibrated over temperature)"
-            ),
-            stacklevel=3,
+        return (
+            f"{run.log}: IMU.{inst} left out: its temperature is all 0 or NaN (a sensor "
+            "without a thermometer cannot be calibrated over temperature)"
         )
-        return None
     return temp_c
 
 
-def _imu(run: _Run, df: Any, inst: int) -> None:
+def _imu(run: _Run, data: _ImuData) -> None:
     """One IMU: its gyro and accelerometer back to the sensor frame (:func:`ardupilot_raw`)
     and through the pipeline, its ``INS_TCAL<n>`` parameters, hygiene, gates and reports."""
     from thermocal.export.params import export_params
 
-    temp_c = _imu_temperature(run, df, inst)
-    if temp_c is None:
-        return
-    time_s = df["TimeUS"].to_numpy() * 1e-6
+    assert data.time_s is not None and data.temp_c is not None
+    inst, time_s = data.inst, data.time_s
+    temp_c: FloatArray = data.temp_c.astype(np.float64)  # exact: see _compact
     held = judge_instance(
         f"{run.log}: IMU.{inst}", time_s, temp_c, run.flight.parameters, "ardupilot", run.heater
     )
@@ -971,9 +1036,10 @@ def _imu(run: _Run, df: Any, inst: int) -> None:
     )
     prev_params = _previous_params(run, inst, intervals, changes, time_s)
     for kind, prefix, unit in KINDS:
-        xyz = np.column_stack([df[f"{prefix}{a.upper()}"].to_numpy() for a in AXES])
+        xyz = data.xyz.pop(kind).astype(np.float64)  # exact (_compact); given back once undone
         xyz, actives, codes = ardupilot_raw_intervals(intervals, inst, kind, time_s, temp_c, xyz)
-        raw[kind] = xyz
+        if run.emulate:
+            raw[kind] = xyz
         run.orientation = codes[-1]
         run.rotated = run.rotated or any(codes)
         active = ardupilot_active(prev_params, inst)
@@ -1014,7 +1080,9 @@ def _imu(run: _Run, df: Any, inst: int) -> None:
     fw_range = tclr_range(
         run.flight.rows("TCLR"), inst, run.flight.parameter_changes, time_s, temp_c
     )
-    emulated = _emulate(run, inst, df, time_s, temp_c, raw, ps.params) if run.emulate else None
+    emulated = (
+        _emulate(run, inst, data.ahz, time_s, temp_c, raw, ps.params) if run.emulate else None
+    )
     for fit, sub_rec in per_kind:
         key = f"{fit.topic}.{inst}"
         if active is not None:  # the log's coefficients against the new ones
@@ -1046,7 +1114,7 @@ def _imu(run: _Run, df: Any, inst: int) -> None:
 
 
 def _emulate(
-    run: _Run, inst: int, df: Any, time_s: FloatArray, temp_c: FloatArray,
+    run: _Run, inst: int, ahz: FloatArray | None, time_s: FloatArray, temp_c: FloatArray,
     raw: dict[str, FloatArray], new_params: Mapping[str, float],
 ) -> ArdupilotEmulation:  # fmt: skip
     """The firmware's learning of IMU ``inst`` emulated (:func:`.learning.emulate_ardupilot`),
@@ -1061,7 +1129,7 @@ def _emulate(
         parameters=run.flight.parameters, new_params=new_params,
         tclr_rows=run.flight.rows("TCLR"),
         samples_per_sample=samples_per_logged(
-            time_s[ok], df["AHz"].to_numpy()[ok] if "AHz" in df.columns else None
+            time_s[ok], None if ahz is None else ahz[ok]
         ),
     )  # fmt: skip
     run.emulated[f"IMU.{inst}"] = em
