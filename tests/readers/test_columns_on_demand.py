@@ -96,3 +96,14 @@ def test_a_nan_in_a_temperature_refused_as_by_a_whole_read(tmp_path: Path) -> No
         read_recording(path, read, columns_on_demand=True).validate()
     assert str(lazy.value) == str(whole.value)
     assert "'T3'" in str(lazy.value) and "1234" in str(lazy.value)
+
+
+def test_time_and_two_columns_are_read_whole(tmp_path: Path) -> None:
+    """Reading on demand holds time and two columns at a time: a file of no more is read
+    whole (every use would read a column again for no memory saved)."""
+    read = ReadOptions(signals=("gyro",), temperatures=("T1",))
+    rec = read_recording(_file(tmp_path), read, keep_other=False, columns_on_demand=True)
+    assert type(rec.columns) is dict and list(rec.columns) == ["gyro", "T1"]
+    read = ReadOptions(signals=("gyro",), temperatures=("T1", "T2"))
+    rec = read_recording(_file(tmp_path), read, keep_other=False, columns_on_demand=True)
+    assert isinstance(rec.columns, ColumnsOnDemand)

@@ -33,6 +33,7 @@ from thermocal.readers.formats import TEXT_FIELDS, FileFormat, format_of, regist
 from thermocal.readers.options import ReadOptions
 from thermocal.readers.station import is_station_path
 from thermocal.readers.table import (
+    ON_DEMAND_MIN_COLUMNS,
     ColumnsOnDemand,
     ParquetColumns,
     load_sidecar,
@@ -593,8 +594,8 @@ def read_recording(
         (``"accel_unit"``), or the unit another parameter implies (``counts``: a count
         scale), where nothing states its unit (:class:`thermocal.units.UnitOptions`).
     columns_on_demand : bool, optional
-        A Parquet file's columns read at each use, one held at a time (other formats:
-        ignored; :class:`~thermocal.readers.table.ColumnsOnDemand`).
+        A Parquet file's columns read at each use, one held at a time, when more than
+        :data:`~thermocal.readers.table.ON_DEMAND_MIN_COLUMNS` are used (time included).
 
     Returns
     -------
@@ -700,8 +701,9 @@ def table_recording(
     resolved = _resolve_units(p, info, (time_col, sig_names, tmp_names), options, meta, stated)
     n_used = len(names) if keep_other else 1 + len(sig_names) + len(tmp_names)
     t, cols = _read_columns(
-        p, obj, (n_rows, n_used), time_col, [*sig_names, *tmp_names], columns_on_demand
-    )
+        p, obj, (n_rows, n_used), time_col, [*sig_names, *tmp_names],
+        columns_on_demand and n_used > ON_DEMAND_MIN_COLUMNS,
+    )  # fmt: skip
     t = _time_s(p, time_col, t, resolved.time.unit, mode, r)
     unit_map: dict[str, str] = resolved.units()
     md.temperature_conversion = _conversions(md, tmp_names, resolved)

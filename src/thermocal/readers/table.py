@@ -211,6 +211,12 @@ class ParquetColumns:
         return out
 
 
+ON_DEMAND_MIN_COLUMNS = 3
+"""Columns used (time included) up to which a Parquet file is read whole even where its
+columns could be read on demand (:class:`ColumnsOnDemand`): time and two columns are what
+reading on demand holds at a time anyway, and every use would read a column again."""
+
+
 class ColumnsOnDemand(MutableMapping[str, FloatArray]):
     """The numeric columns of a Parquet file, each read as float64 when it is asked for
     and not kept beyond the next one: a recording's columns for a command that uses them
