@@ -117,3 +117,29 @@ def test_metrics_gap_and_step_figures(
     assert d["n_samples"] == N and d["n_segments"] == 2
     gyro = pq.read_table(path).column("gyro").to_numpy()
     assert d["bias"] == pytest.approx(float(np.mean(gyro)), rel=1e-12)
+
+
+@pytest.mark.parametrize("command", ["inspect", "metrics"])
+def test_a_file_too_large_whole_is_read_on_demand(
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+    monkeypatch: pytest.MonkeyPatch,
+    command: str,
+) -> None:
+    """Six columns of 6000 rows need 6000 × (6 · 8 + 40) B = 528 000 B whole, and
+    6000 × (3 · 8 + 40) B = 384 000 B on demand (time and two columns held): with 450 kB
+    the file is inspected, its figures those of a whole read; with 350 kB it is refused
+    naming the memory limit."""
+    path = _file(tmp_path)
+    args = [command, str(path), *TEMPS, "--json"]
+    args += ["--signal", "gyro"] if command == "metrics" else []
+    assert main(args) == 0
+    whole = capsys.readouterr()
+    monkeypatch.setenv("THERMOCAL_MEMORY_LIMIT", "450000")
+    assert main(args) == 0
+    assert capsys.readouterr() == whole
+    monkeypatch.setenv("THERMOCAL_MEMORY_LIMIT", "350000")
+    assert main(args) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err[-1].startswith(f"error: {path}: reading 6,000 rows of 3 column(s)")
+    assert "THERMOCAL_MEMORY_LIMIT" in err[-1]

@@ -424,9 +424,10 @@ def _read_columns(
     """The time column (in the file's unit) and the ``named`` columns as float64; a Parquet
     file is read column by column, only these, once its ``n_used`` columns of ``n_rows``
     (``size``) are known to fit in memory; ``on_demand``: its numeric columns read when
-    asked for (:class:`ColumnsOnDemand`)."""
+    asked for (:class:`ColumnsOnDemand`), three columns' memory needed at most."""
     if isinstance(obj, ParquetColumns):  # read column by column: only what is used
-        check_memory(p, *size)
+        n_rows, n_used = size  # on demand: time and two columns held at a time
+        check_memory(p, n_rows, min(n_used, ON_DEMAND_MIN_COLUMNS) if on_demand else n_used)
         if on_demand:
             lazy = ColumnsOnDemand(obj, p)
             t = numeric_column(obj, time_col, p)
