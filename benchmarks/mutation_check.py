@@ -3954,6 +3954,24 @@ MUTANTS: tuple[Mutant, ...] = (
         _t("tempcal_learning"),
         "the TCLR temperature difference signed, not its magnitude",
     ),
+    Mutant(
+        "on-demand-column-cache-any-name",
+        P + "readers/table.py",
+        "if self._last is not None and self._last[0] == name:\n            return self._last[1]",
+        "if self._last is not None and self._last[0] in self._names:\n"
+        "            return self._last[1]",
+        _t("columns_on_demand", "cli_columns_on_demand"),
+        "a column read on demand answered with the last one read, whatever its name",
+    ),
+    Mutant(
+        "on-demand-column-kept",
+        P + "readers/table.py",
+        "        self._last = (name, values)\n        return values",
+        "        self._last = (name, values)\n        self._given[name] = values\n"
+        "        return values",
+        _t("columns_on_demand"),
+        "every column read on demand kept (the memory of a whole read)",
+    ),
 )
 
 
