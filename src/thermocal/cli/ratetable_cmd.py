@@ -101,6 +101,10 @@ TempGapOpt = Annotated[
         "--temp-gap", help="One file: plateaus further apart than this [°C] are two ladders."
     ),
 ]
+OneDirectionOpt = Annotated[
+    bool,
+    typer.Option("--one-direction", help="Accept a ladder in one direction only (no asymmetry)."),
+]
 ResultOpt = Annotated[
     Path | None, typer.Option("-o", "--output", help="Also write the result as JSON here.")
 ]
@@ -111,7 +115,7 @@ ResultOpt = Annotated[
 def ratetable_cmd(
     files: FilesArg,
     gyro: GyroOpt = "gyro",
-    gyro_unit: GyroUnitOpt = None,
+    signal_unit: GyroUnitOpt = None,
     rate_column: RateColumnOpt = None,
     rates_dps: RatesOpt = None,
     schedule: ScheduleOpt = None,
@@ -121,6 +125,7 @@ def ratetable_cmd(
     window_s: WindowOpt = 0.5,
     small_fraction: SmallOpt = 0.01,
     temp_gap_c: TempGapOpt = 3.0,
+    one_direction: OneDirectionOpt = False,
     output: ResultOpt = None,
     time: TimeOpt = None,
     time_unit: TimeUnitOpt = None,
@@ -139,7 +144,7 @@ def ratetable_cmd(
     rates = split_floats(rates_dps, "--rates")
     opts = _files.RateTableOptions(
         gyro,
-        gyro_unit,
+        signal_unit,
         rate_column,
         tuple(rates) if rates is not None else None,
         temps,
@@ -153,6 +158,7 @@ def ratetable_cmd(
         read_options(
             names=t_names, rate=t_rate, on_bad_lines=t_bad, delimiter=t_delim, decimal=t_dec
         ),
+        one_direction,
     )
     res = _files.ratetable_files(files, opts, schedule=schedule)
     if output is not None:

@@ -7,6 +7,7 @@ compute the scale-factor figures of each ladder and the temperature coefficient
 from __future__ import annotations
 
 import math
+import warnings
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -15,7 +16,7 @@ from typing import Any
 import numpy as np
 
 from thermocal import units
-from thermocal.errors import DesignError, ParameterError, ThermocalInputError
+from thermocal.errors import DesignError, ParameterError, ThermocalInputError, ThermocalWarning
 from thermocal.ratetable.analysis import (
     SMALL_FRACTION,
     LadderResult,
@@ -75,6 +76,8 @@ class RateTableOptions:
         The time column and its unit.
     read : ReadOptions or None
         How a text log is read.
+    one_direction : bool
+        Accept a ladder in one direction only (no asymmetry); refused otherwise.
     """
 
     gyro: str = "gyro"
@@ -90,6 +93,8 @@ class RateTableOptions:
     time: str | None = None
     time_unit: str | None = None
     read: ReadOptions | None = None
+    one_direction: bool = False
+    """Accept a ladder run in one direction only (no asymmetry)."""
 
     def __post_init__(self) -> None:
         for name in ("settle_s", "min_plateau_s", "window_s", "temp_gap_c"):
@@ -303,13 +308,16 @@ def _detect(
     if opts.rates_dps is None:
         raise DesignError.naming(
             f"{path}: {len(d.plateaus)} plateaus found in the output, but their rates are not "
-            "known; give them with {rates} (°/s, in the order the table ran them), or the "
+            "known; give them with {rates_dps} (°/s, in the order the table ran them), or the "
             "table's rate column with {rate_column}, or a {schedule}",
             "rates_dps",
             "rate_column",
             "schedule",
         )
-    return match_rates(d, opts.rates_dps)
+    try:
+        return match_rates(d, opts.rates_dps)
+    except DesignError as exc:
+        raise DesignError.around(exc, f"{path}: ") from None
 
 
 def _check_given(d: Detection, rates: Sequence[float], path: Path) -> None:
@@ -355,6 +363,16 @@ def _check_fit(ladder: LadderResult, unit: str, where: str) -> None:
             "rate_column",
         )
     k = abs(ladder.scale_factor)
+    if unit == "deg/s" and ladder.scale_factor < 0:
+        warnings.warn(
+            ThermocalWarning.naming(
+                f"{where}: scale factor {ladder.scale_factor:.6g}: the gyro's input axis points "
+                "against the table's positive rate, or the rates are given in reverse order "
+                "({rates_dps})",
+                "rates_dps",
+            ),
+            stacklevel=3,
+        )
     if unit != "deg/s" or K_UNIT_RANGE[0] <= k <= K_UNIT_RANGE[1]:
         return
     hint = ""
@@ -449,6 +467,16 @@ def ratetable_files(
             small_fraction=opts.small_fraction,
         )
         _check_fit(ld, unit, str(paths[0]))
+        if (
+            ld.asymmetry.value is None
+            and not opts.one_direction
+            and "only" in str(ld.asymmetry.reason)
+        ):
+            raise DesignError.naming(
+                f"{paths[0]}: {ld.asymmetry.reason}; run the ladder both ways, or give "
+                "{one_direction} for the other figures without it",
+                "one_direction",
+            )
         ladders.append(ld)
     tc = None
     if len(ladders) > 1:

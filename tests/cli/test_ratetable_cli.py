@@ -1,0 +1,194 @@
+"""``thermocal simulate ratetable`` and ``thermocal ratetable``: the figures against the
+simulator's truth (numpy.polyfit on its noise-free plateau outputs), the plateaus found from
+the output with ``--rates``, and the one-line refusals of what a user can get wrong."""
+
+from __future__ import annotations
+
+import hashlib
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from thermocal.cli import main
+from thermocal.ratetable.simulate import simulate_ladder
+from thermocal.writers import write_recording
+
+LADDER = (-200.0, -50.0, -10.0, 0.0, 10.0, 50.0, 200.0)
+
+
+def _sha(p: Path) -> str:
+    return hashlib.sha256(p.read_bytes()).hexdigest()
+
+
+def _one_line_error(capsys: pytest.CaptureFixture[str], *words: str) -> str:
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith("error: "), err
+    for w in words:
+        assert w in err[0], err[0]
+    return err[0]
+
+
+@pytest.fixture(scope="module")
+def sim(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, dict]:
+    d = tmp_path_factory.mktemp("rt")
+    assert main(["simulate", "ratetable", "--runs", "3", "-o", str(d / "rt"),
+                 "--truth", str(d / "truth.json")]) == 0  # fmt: skip
+    return d, json.loads((d / "truth.json").read_text())
+
+
+@pytest.fixture(scope="module")
+def ladder_csv(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, dict]:
+    """A ladder without a rate column: the plateaus come from the output."""
+    d = tmp_path_factory.mktemp("rt2")
+    rec, truth = simulate_ladder(np.random.default_rng(7), rates_dps=LADDER, dwell_s=10.0,
+                                 rate_hz=50.0, cubic_ppm=300.0, asymmetry_ppm=-250.0)  # fmt: skip
+    del rec.columns["table_rate"]
+    path = d / "ladder.csv"
+    write_recording(rec, path)
+    return path, truth
+
+
+def test_simulated_ladders_recovered_through_the_cli(
+    sim: tuple[Path, dict], tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    d, truth = sim
+    files = sorted(str(p) for p in (d / "rt").glob("*.csv"))
+    before = [_sha(Path(f)) for f in files]
+    out = tmp_path / "res.json"
+    args = ["ratetable", *files, "--rate-column", "table_rate", "--temps", "temp", "-o", str(out)]
+    assert main([*args, "--json"]) == 0
+    res = json.loads(capsys.readouterr().out)
+    assert json.loads(out.read_text()) == res
+    assert [_sha(Path(f)) for f in files] == before
+    assert len(res["ladders"]) == 3
+    by_file = {Path(t["file"]).name: t for t in truth["files"]}
+    for ld, f in zip(res["ladders"], res["files"], strict=True):
+        tr = by_file[Path(f).name]
+        w = np.array([p["rate_dps"] for p in tr["plateaus"]])
+        y = np.array(tr["outputs"])
+        keep = np.ones(w.size, bool)
+        keep[30] = False  # the plateau the operator cut short (4 s, below --min-plateau)
+        k = np.polyfit(w[keep], y[keep], 1)[0]
+        assert abs(ld["scale_factor"] - k) < 4 * ld["scale_factor_sigma"]
+        assert ld["asymmetry_ppm"]["value"] > 0  # positive asymmetry and quadratic term
+        thr = ld["threshold_dps"]
+        assert thr["above_dps"] < tr["dead_zone_dps"] <= thr["value"]  # 0.01 < 0.015 ≤ 0.02
+        assert ld["repeatability_ppm"]["value"] is not None  # up and back down
+    tc = res["temperature_coefficient"]
+    want = truth["files"][0]["tc_ppm_per_c"] / (1 + 40e-6 * (tc["tref_c"] - 25.0))
+    assert abs(tc["ppm_per_c"] - want) < 4 * tc["sigma_ppm_per_c"]
+    assert all(len(p["dropped"]) == 1 for p in res["plateaus"])
+
+
+def test_text_output_is_the_spec_sheet(
+    sim: tuple[Path, dict], capsys: pytest.CaptureFixture[str]
+) -> None:
+    d, _ = sim
+    f = sorted((d / "rt").glob("*.csv"))[1]
+    assert main(["ratetable", str(f), "--rate-column", "table_rate"]) == 0
+    out = capsys.readouterr().out
+    for line in ("scale factor", "scale-factor nonlinearity", "asymmetry", "input threshold",
+                 "resolution", "repeatability", "per rate", "settling"):  # fmt: skip
+        assert line in out
+
+
+def test_plateaus_from_the_output_with_rates(
+    ladder_csv: tuple[Path, dict], capsys: pytest.CaptureFixture[str]
+) -> None:
+    path, truth = ladder_csv
+    rates = ",".join(f"{r:g}" for r in LADDER)
+    assert main(["ratetable", str(path), f"--rates={rates}", "--json"]) == 0
+    res = json.loads(capsys.readouterr().out)
+    ld = res["ladders"][0]
+    w = np.array(LADDER)
+    k = np.polyfit(w, np.array(truth["outputs"]), 1)[0]
+    assert abs(ld["scale_factor"] - k) < 4 * ld["scale_factor_sigma"]
+    assert ld["asymmetry_ppm"]["value"] < 0  # the sign of the simulated asymmetry
+    assert res["plateaus"][0]["source"] == "output"
+    for p, t in zip(res["plateaus"][0]["plateaus"], truth["plateaus"], strict=True):
+        assert t["start_s"] <= p["start_s"] <= t["start_s"] + 2.0  # settling left out
+        assert p["end_s"] <= t["end_s"] + 0.5
+
+
+@pytest.mark.parametrize(
+    ("extra", "words"),
+    [
+        (["--rates=-200,-50,0,50,200"], ("plateaus found", "--rates")),
+        (["--rates=200,50,10,0,-10,-50,-200,5"], ("--rates",)),
+        (["--rates=-200,-50,10,0,-10,50,200"], ("--rates",)),
+        (["--rates=-3.49,-0.873,-0.175,0,0.175,0.873,3.49"], ("rad/s", "--gyro-unit")),
+        ([], ("--rates", "--rate-column", "--schedule")),
+        (["--rate-column", "nope"], ("nope", "--rate-column")),
+        (["--rates=-200,-50,-10,0,10,50,200", "--min-plateau", "500"], ("--min-plateau",)),
+        (["--rates=-200,-50,-10,0,10,50,200", "--settle", "-1"], ("--settle",)),
+        (["--rates=-200,x"], ("--rates",)),
+    ],
+)
+def test_user_errors_exit_2_with_one_line(
+    ladder_csv: tuple[Path, dict], extra: list[str], words: tuple[str, ...],
+    capsys: pytest.CaptureFixture[str],
+) -> None:  # fmt: skip
+    path, _ = ladder_csv
+    before = _sha(path)
+    assert main(["ratetable", str(path), *extra]) == 2
+    _one_line_error(capsys, *words)
+    assert _sha(path) == before
+
+
+def test_one_direction_refused_unless_asked(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    rec, _ = simulate_ladder(np.random.default_rng(3), rates_dps=(0.0, 10.0, 100.0, 300.0),
+                             dwell_s=8.0, rate_hz=50.0)  # fmt: skip
+    f = tmp_path / "up.csv"
+    write_recording(rec, f)
+    assert main(["ratetable", str(f), "--rate-column", "table_rate"]) == 2
+    _one_line_error(capsys, "only positive rates", "--one-direction")
+    assert main(["ratetable", str(f), "--rate-column", "table_rate", "--one-direction"]) == 0
+    assert "asymmetry: not computed" in capsys.readouterr().out
+
+
+def test_several_files_need_temps_and_distinct_temperatures(
+    sim: tuple[Path, dict], tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    d, _ = sim
+    f = sorted((d / "rt").glob("*.csv"))[0]
+    assert main(["ratetable", str(f), str(f), "--rate-column", "table_rate"]) == 2
+    _one_line_error(capsys, "--temps")
+    assert main(["ratetable", str(f), str(f), "--rate-column", "table_rate",
+                 "--temps", "temp"]) == 2  # fmt: skip
+    _one_line_error(capsys, "two or more temperatures", "--temps")
+
+
+def test_schedule_and_output_over_input(
+    ladder_csv: tuple[Path, dict], tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    path, truth = ladder_csv
+    sched = tmp_path / "sched.csv"
+    rows = [f"{p['start_s'] + 1},{p['end_s']},{p['rate_dps']}" for p in truth["plateaus"]]
+    sched.write_text("start_s,end_s,rate_dps\n" + "\n".join(rows) + "\n")
+    assert main(["ratetable", str(path), "--schedule", str(sched), "--json"]) == 0
+    res = json.loads(capsys.readouterr().out)
+    assert res["plateaus"][0]["source"] == "schedule"
+    assert len(res["ladders"][0]["rates"]) == len(LADDER)
+    before = _sha(path)
+    assert main(["ratetable", str(path), "--schedule", str(sched), "-o", str(path)]) == 2
+    _one_line_error(capsys)
+    assert _sha(path) == before
+    sched.write_text("0,10\n")
+    assert main(["ratetable", str(path), "--schedule", str(sched)]) == 2
+    _one_line_error(capsys, "start_s,end_s,rate_dps")
+
+
+def test_reversed_ladder_warns(
+    ladder_csv: tuple[Path, dict], capsys: pytest.CaptureFixture[str]
+) -> None:
+    path, _ = ladder_csv
+    rates = ",".join(f"{r:g}" for r in LADDER[::-1])
+    assert main(["ratetable", str(path), f"--rates={rates}", "--json"]) == 0
+    cap = capsys.readouterr()
+    assert json.loads(cap.out)["ladders"][0]["scale_factor"] < 0
+    warn = [ln for ln in cap.err.splitlines() if ln.startswith("warning: ")]
+    assert len(warn) == 1 and "reverse order" in warn[0] and "--rates" in warn[0]
