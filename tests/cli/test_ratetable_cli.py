@@ -192,3 +192,22 @@ def test_reversed_ladder_warns(
     assert json.loads(cap.out)["ladders"][0]["scale_factor"] < 0
     warn = [ln for ln in cap.err.splitlines() if ln.startswith("warning: ")]
     assert len(warn) == 1 and "reverse order" in warn[0] and "--rates" in warn[0]
+
+
+def test_report_is_a_self_contained_spec_sheet(
+    sim: tuple[Path, dict], tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    d, _ = sim
+    files = sorted(str(p) for p in (d / "rt").glob("*.csv"))
+    rep = tmp_path / "rt.html"
+    args = ["ratetable", *files, "--rate-column", "table_rate", "--temps", "temp"]
+    assert main([*args, "--report", str(rep)]) == 0
+    capsys.readouterr()
+    html = rep.read_text(encoding="utf-8")
+    for fig in ("fig-ratetable-nonlinearity", "fig-ratetable-temperature"):
+        assert f'id="{fig}" src="data:image/png;base64,' in html
+    assert "scale-factor temperature coefficient" in html and "http" not in html
+    assert main([*args, "--report", str(rep), "-o", str(rep)]) == 2
+    _one_line_error(capsys, "--report")
+    assert main([*args, "--report", files[0]]) == 2
+    _one_line_error(capsys)

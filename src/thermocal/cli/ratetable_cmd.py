@@ -28,13 +28,16 @@ from thermocal.cli.common import (
     show,
     split_floats,
 )
+from thermocal.errors import ThermocalInputError
 
 if TYPE_CHECKING:
     import thermocal.pipeline.ratetable as _files
+    import thermocal.report.ratetable as _report
     import thermocal.report.ratetable_text as _text
     import thermocal.writers as _writers
 else:
     _files = LazyModule("thermocal.pipeline.ratetable")
+    _report = LazyModule("thermocal.report.ratetable")
     _text = LazyModule("thermocal.report.ratetable_text")
     _writers = LazyModule("thermocal.writers")
 
@@ -105,6 +108,10 @@ OneDirectionOpt = Annotated[
     bool,
     typer.Option("--one-direction", help="Accept a ladder in one direction only (no asymmetry)."),
 ]
+ReportOpt = Annotated[
+    Path | None,
+    typer.Option("--report", help="Also write the spec sheet as a self-contained HTML page."),
+]
 ResultOpt = Annotated[
     Path | None, typer.Option("-o", "--output", help="Also write the result as JSON here.")
 ]
@@ -127,6 +134,7 @@ def ratetable_cmd(
     temp_gap_c: TempGapOpt = 3.0,
     one_direction: OneDirectionOpt = False,
     output: ResultOpt = None,
+    report: ReportOpt = None,
     time: TimeOpt = None,
     time_unit: TimeUnitOpt = None,
     t_names: NamesOpt = None,
@@ -139,8 +147,12 @@ def ratetable_cmd(
     """Gyro scale factor, nonlinearity, asymmetry, bias per rate, input threshold and
     resolution from a rate-table ladder (IEEE Std 952/1431); with --temps at several
     temperatures, the scale factor's temperature coefficient."""
-    if output is not None:
-        _writers.check_not_input(output, [*files, *([schedule] if schedule else [])])
+    inputs: list[str | Path] = [*files, *([schedule] if schedule else [])]
+    for out in (output, report):
+        if out is not None:
+            _writers.check_not_input(out, inputs)
+    if output is not None and output == report:
+        raise ThermocalInputError("-o and --report name the same file; give two files")
     rates = split_floats(rates_dps, "--rates")
     opts = _files.RateTableOptions(
         gyro,
@@ -163,6 +175,8 @@ def ratetable_cmd(
     res = _files.ratetable_files(files, opts, schedule=schedule)
     if output is not None:
         _writers.write_json(output, res.to_dict())
+    if report is not None:
+        _writers.write_html(report, _report.ratetable_html(res))
     emit(res.to_dict(), as_json, lambda: show(_text.ratetable_text(res)))
 
 
