@@ -3866,6 +3866,14 @@ MUTANTS: tuple[Mutant, ...] = (
         _t("ratetable_cli"),
         "rate table: a gyro reading against the table's sense refused as out of order",
     ),
+    Mutant(
+        "ratetable-settling-kept",
+        P + "ratetable/plateaus.py",
+        'a2 = int(np.searchsorted(t, t[a] + settle_s, side="left"))',
+        "a2 = a",
+        _t("ratetable_plateaus"),
+        "rate table: the settling after each change of rate kept in the plateau",
+    ),
 )
 
 

@@ -211,3 +211,29 @@ def test_report_is_a_self_contained_spec_sheet(
     _one_line_error(capsys, "--report")
     assert main([*args, "--report", files[0]]) == 2
     _one_line_error(capsys)
+
+
+def test_one_file_with_two_temperatures(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    from thermocal.recording import Recording
+
+    rng = np.random.default_rng(11)
+    kw = {"rates_dps": LADDER, "dwell_s": 8.0, "rate_hz": 50.0, "tc_ppm_per_c": 100.0}
+    a, _ = simulate_ladder(rng, temperature_c=-10.0, **kw)  # type: ignore[arg-type]
+    b, _ = simulate_ladder(rng, temperature_c=40.0, **kw)  # type: ignore[arg-type]
+    t = np.concatenate([a.time_s, b.time_s + a.time_s[-1] + 600.0])  # a soak between
+    cols = {c: np.concatenate([a.columns[c], b.columns[c]]) for c in ("gyro", "table_rate", "temp")}
+    rec = Recording.from_arrays(t, {"gyro": cols["gyro"]}, {"temp": cols["temp"]},
+                                signal_unit="deg/s", other={"table_rate": cols["table_rate"]},
+                                other_units={"table_rate": "deg/s"})  # fmt: skip
+    f = tmp_path / "both.csv"
+    write_recording(rec, f)
+    assert main(["ratetable", str(f), "--rate-column", "table_rate", "--temps", "temp",
+                 "--json"]) == 0  # fmt: skip
+    res = json.loads(capsys.readouterr().out)
+    assert [round(ld["temperature_c"]) for ld in res["ladders"]] == [-10, 40]
+    tc = res["temperature_coefficient"]
+    want = 100.0 / (1 + 100e-6 * (tc["tref_c"] - 25.0))
+    assert abs(tc["ppm_per_c"] - want) < 4 * tc["sigma_ppm_per_c"]
+    assert main(["ratetable", str(f), "--rate-column", "table_rate", "--temps", "temp",
+                 "--temp-gap", "100", "--json"]) == 0  # fmt: skip
+    assert len(json.loads(capsys.readouterr().out)["ladders"]) == 1
