@@ -3874,6 +3874,14 @@ MUTANTS: tuple[Mutant, ...] = (
         _t("ratetable_plateaus"),
         "rate table: the settling after each change of rate kept in the plateau",
     ),
+    Mutant(
+        "ratetable-correlated-noise-unsaid",
+        P + "pipeline/ratetable.py",
+        "CORRELATED_RATIO = 2.0",
+        "CORRELATED_RATIO = 1e9",
+        _t("ratetable_cli"),
+        "rate table: plateaus with a random walk reported with white-noise uncertainties, unsaid",
+    ),
 )
 
 

@@ -237,3 +237,14 @@ def test_one_file_with_two_temperatures(tmp_path: Path, capsys: pytest.CaptureFi
     assert main(["ratetable", str(f), "--rate-column", "table_rate", "--temps", "temp",
                  "--temp-gap", "100", "--json"]) == 0  # fmt: skip
     assert len(json.loads(capsys.readouterr().out)["ladders"]) == 1
+
+
+def test_correlated_noise_is_said(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    rng = np.random.default_rng(5)
+    rec, _ = simulate_ladder(rng, rates_dps=LADDER, dwell_s=20.0, rate_hz=50.0, noise_dps=0.001)
+    rec.columns["gyro"] = rec.columns["gyro"] + np.cumsum(rng.normal(0.0, 2e-4, rec.n_samples))
+    f = tmp_path / "walk.csv"
+    write_recording(rec, f)
+    assert main(["ratetable", str(f), "--rate-column", "table_rate"]) == 0
+    warn = [ln for ln in capsys.readouterr().err.splitlines() if ln.startswith("warning: ")]
+    assert len(warn) == 1 and "correlated" in warn[0] and "too small" in warn[0]

@@ -40,6 +40,9 @@ from thermocal.readers.options import ReadOptions
 
 TEMP_GAP_C = 3.0
 """Plateaus of one file whose temperatures differ by more than this [°C] are two ladders."""
+CORRELATED_RATIO = 2.0
+"""Median ratio of the block-means to the white-noise standard error above which the
+plateaus' noise is said to be correlated (a warning)."""
 MAX_DEVIATION_FS = 0.05
 """A plateau further off the least-squares line than this fraction of full scale is a rate
 given wrong (no gyro is 5 % nonlinear), not a nonlinearity."""
@@ -336,6 +339,25 @@ def _check_given(d: Detection, rates: Sequence[float], path: Path) -> None:
         )
 
 
+def _check_noise(dets: Sequence[Detection]) -> None:
+    """A warning when the plateaus' noise is correlated: the median ratio of the block-means
+    standard error to the white-noise one above ``CORRELATED_RATIO``."""
+    ratios = [
+        p.se_blocks / p.se for d in dets for p in d.plateaus if p.se_blocks is not None and p.se > 0
+    ]
+    if not ratios or float(np.median(ratios)) <= CORRELATED_RATIO:
+        return
+    r = float(np.median(ratios))
+    warnings.warn(
+        ThermocalWarning.naming(
+            f"the plateaus' noise is correlated: their means scatter {r:.1f}x more than white "
+            "noise of their spread would (block means); the uncertainties assume white noise "
+            "and are too small by about that factor",
+        ),
+        stacklevel=3,
+    )
+
+
 def _groups(dets: Sequence[Detection], gap_c: float, has_t: bool) -> list[list[Plateau]]:
     """Plateaus grouped into ladders: one per file, or by temperature within one file."""
     if len(dets) > 1 or not has_t:
@@ -456,6 +478,7 @@ def ratetable_files(
             f"the files' gyro outputs are in {sorted(out_units)}; give {{gyro_unit}}", "gyro_unit"
         )
     unit = out_units.pop()
+    _check_noise(dets)
     ladders = []
     for g in _groups(dets, opts.temp_gap_c, opts.temps is not None):
         ts = [p.temperature_c for p in g if p.temperature_c is not None]

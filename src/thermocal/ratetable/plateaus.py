@@ -16,6 +16,7 @@ in the output with the rates the user gives and refuses a ladder that does not f
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -38,6 +39,8 @@ RATE_DECIMALS = 4
 """A plateau's rate read from the table's rate column is rounded to 0.1 m°/s."""
 DROPPED_S = 1.0
 """Steady stretches at least this long but too short for a plateau are reported [s]."""
+BLOCKS = 10
+"""Blocks of a plateau whose means give the standard error without assuming white noise."""
 ORDER_SIGMAS = 5.0
 """Two plateaus out of the given rates' order by more than this many standard errors: refused."""
 
@@ -62,6 +65,10 @@ class Plateau:
         Number of samples.
     temperature_c : float or None
         Mean temperature [°C], None without a temperature.
+    se_blocks : float or None
+        Standard error of the mean from ``BLOCKS`` block means [output unit] (None with
+        fewer than ``BLOCKS`` × 10 samples): larger than :attr:`se` when the noise is
+        correlated (flicker, random walk).
     """
 
     start_s: float
@@ -73,6 +80,7 @@ class Plateau:
     sd: float
     n: int
     temperature_c: float | None = None
+    se_blocks: float | None = None
 
     @property
     def se(self) -> float:
@@ -147,6 +155,7 @@ def _summarise(
                 float(np.std(seg, ddof=1)),
                 int(seg.size),
                 tc,
+                _se_blocks(seg),
             )
         )
     return out, dropped
@@ -224,7 +233,16 @@ def plateaus_from_rate(
 
 def _with_rate(p: Plateau, rate: float) -> Plateau:
     """The plateau with its applied rate set."""
-    return Plateau(p.start_s, p.end_s, p.i0, p.i1, rate, p.mean, p.sd, p.n, p.temperature_c)
+    return dataclasses.replace(p, rate_dps=rate)
+
+
+def _se_blocks(seg: FloatArray) -> float | None:
+    """Standard error of the mean from ``BLOCKS`` consecutive block means (batch means)."""
+    m = seg.size // BLOCKS
+    if m < 10:
+        return None
+    means = seg[: m * BLOCKS].reshape(BLOCKS, m).mean(axis=1)
+    return float(np.std(means, ddof=1) / np.sqrt(BLOCKS))
 
 
 def _noise_sigma(y: FloatArray) -> float:
