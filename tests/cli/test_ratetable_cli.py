@@ -248,3 +248,17 @@ def test_correlated_noise_is_said(tmp_path: Path, capsys: pytest.CaptureFixture[
     assert main(["ratetable", str(f), "--rate-column", "table_rate"]) == 0
     warn = [ln for ln in capsys.readouterr().err.splitlines() if ln.startswith("warning: ")]
     assert len(warn) == 1 and "correlated" in warn[0] and "too small" in warn[0]
+
+
+def test_ladders_that_differ_between_temperatures_refused(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    files = []
+    for t, ladder in ((0.0, LADDER), (40.0, (-200.0, -10.0, 0.0, 10.0, 200.0))):
+        rec, _ = simulate_ladder(np.random.default_rng(int(t)), rates_dps=ladder, dwell_s=8.0,
+                                 rate_hz=50.0, temperature_c=t)  # fmt: skip
+        files.append(tmp_path / f"T{t:+.0f}.csv")
+        write_recording(rec, files[-1])
+    args = ["ratetable", *map(str, files), "--rate-column", "table_rate", "--temps", "temp"]
+    assert main(args) == 2
+    _one_line_error(capsys, "do not hold the same rates", "-50, 50", "--temps")

@@ -425,9 +425,10 @@ def _check_ladders(ladders: Sequence[LadderResult]) -> None:
             raise DesignError.naming(
                 f"the ladders at {ladders[0].temperature_c:.1f} °C and {ld.temperature_c:.1f} °C "
                 f"do not hold the same rates (differ at {', '.join(f'{x:g}' for x in diff)} "
-                "°/s): run the same ladder at every temperature, or give the common rates "
-                "with {rates_dps}",
-                "rates_dps",
+                "°/s; the scale factor of a nonlinear gyro depends on the ladder): run the "
+                "same ladder at every temperature, or give the files one at a time without "
+                "{temps}",
+                "temps",
             )
 
 
@@ -480,7 +481,8 @@ def ratetable_files(
     unit = out_units.pop()
     _check_noise(dets)
     ladders = []
-    for g in _groups(dets, opts.temp_gap_c, opts.temps is not None):
+    for gi, g in enumerate(_groups(dets, opts.temp_gap_c, opts.temps is not None)):
+        where = str(paths[gi] if len(paths) > 1 else paths[0])
         ts = [p.temperature_c for p in g if p.temperature_c is not None]
         ld = analyse_ladder(
             [p.rate_dps for p in g],
@@ -489,14 +491,14 @@ def ratetable_files(
             temperature_c=float(np.mean(ts)) if ts else None,
             small_fraction=opts.small_fraction,
         )
-        _check_fit(ld, unit, str(paths[0]))
+        _check_fit(ld, unit, where)
         if (
             ld.asymmetry.value is None
             and not opts.one_direction
             and "only" in str(ld.asymmetry.reason)
         ):
             raise DesignError.naming(
-                f"{paths[0]}: {ld.asymmetry.reason}; run the ladder both ways, or give "
+                f"{where}: {ld.asymmetry.reason}; run the ladder both ways, or give "
                 "{one_direction} for the other figures without it",
                 "one_direction",
             )
