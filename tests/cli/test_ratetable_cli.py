@@ -262,3 +262,26 @@ def test_ladders_that_differ_between_temperatures_refused(
     args = ["ratetable", *map(str, files), "--rate-column", "table_rate", "--temps", "temp"]
     assert main(args) == 2
     _one_line_error(capsys, "do not hold the same rates", "-50, 50", "--temps")
+
+
+def test_noisy_rate_column_needs_the_rate_tolerance(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    rng = np.random.default_rng(9)
+    rec, truth = simulate_ladder(rng, rates_dps=LADDER, dwell_s=10.0, rate_hz=50.0,
+                                 cubic_ppm=200.0, repeats=2)  # fmt: skip
+    rec.columns["table_rate"] = rec.columns["table_rate"] + rng.normal(0, 0.003, rec.n_samples)
+    f = tmp_path / "noisy.csv"
+    write_recording(rec, f)
+    args = ["ratetable", str(f), "--rate-column", "table_rate"]
+    assert main(args) == 2
+    _one_line_error(capsys, "--rate-tolerance", "--min-plateau")
+    assert main([*args, "--rate-tolerance", "0.05", "--json"]) == 0
+    ld = json.loads(capsys.readouterr().out)["ladders"][0]
+    assert [r["rate_dps"] for r in ld["rates"]] == sorted(LADDER)  # visits rounded together
+    assert ld["repeatability_ppm"]["value"] is not None
+    w = np.array([p["rate_dps"] for p in truth["plateaus"]])
+    k = np.polyfit(w, np.array(truth["outputs"]), 1)[0]
+    assert abs(ld["scale_factor"] - k) < 4 * ld["scale_factor_sigma"]
+    assert main([*args, "--rate-tolerance", "-1"]) == 2
+    _one_line_error(capsys, "--rate-tolerance")

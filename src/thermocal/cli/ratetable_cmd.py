@@ -108,6 +108,14 @@ OneDirectionOpt = Annotated[
     bool,
     typer.Option("--one-direction", help="Accept a ladder in one direction only (no asymmetry)."),
 ]
+RateToleranceOpt = Annotated[
+    float,
+    typer.Option(
+        "--rate-tolerance",
+        help="Largest change of --rate-column between two samples of a plateau [°/s] (a "
+        "noisy encoder rate needs more).",
+    ),
+]
 ReportOpt = Annotated[
     Path | None,
     typer.Option("--report", help="Also write the spec sheet as a self-contained HTML page."),
@@ -133,6 +141,7 @@ def ratetable_cmd(
     small_fraction: SmallOpt = 0.01,
     temp_gap_c: TempGapOpt = 3.0,
     one_direction: OneDirectionOpt = False,
+    tolerance_dps: RateToleranceOpt = 1e-3,
     output: ResultOpt = None,
     report: ReportOpt = None,
     time: TimeOpt = None,
@@ -171,6 +180,7 @@ def ratetable_cmd(
             names=t_names, rate=t_rate, on_bad_lines=t_bad, delimiter=t_delim, decimal=t_dec
         ),
         one_direction,
+        tolerance_dps,
     )
     res = _files.ratetable_files(files, opts, schedule=schedule)
     if output is not None:

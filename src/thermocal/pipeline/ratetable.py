@@ -81,6 +81,9 @@ class RateTableOptions:
         How a text log is read.
     one_direction : bool
         Accept a ladder in one direction only (no asymmetry); refused otherwise.
+    tolerance_dps : float
+        Largest change of the table's rate column between two samples of one plateau [°/s]
+        (:func:`thermocal.ratetable.plateaus.plateaus_from_rate`).
     """
 
     gyro: str = "gyro"
@@ -98,9 +101,11 @@ class RateTableOptions:
     read: ReadOptions | None = None
     one_direction: bool = False
     """Accept a ladder run in one direction only (no asymmetry)."""
+    tolerance_dps: float = 1e-3
+    """Largest change of the table's rate column between two samples of a plateau [°/s]."""
 
     def __post_init__(self) -> None:
-        for name in ("settle_s", "min_plateau_s", "window_s", "temp_gap_c"):
+        for name in ("settle_s", "min_plateau_s", "window_s", "temp_gap_c", "tolerance_dps"):
             v = getattr(self, name)
             ok = math.isfinite(v) and (v >= 0 if name == "settle_s" else v > 0)
             if not ok:
@@ -296,6 +301,7 @@ def _detect(
             min_plateau_s=opts.min_plateau_s,
             temperature_c=temp,
             settle_s=settle,
+            tolerance_dps=opts.tolerance_dps,
         )
         if opts.rates_dps is not None:
             _check_given(d, opts.rates_dps, path)

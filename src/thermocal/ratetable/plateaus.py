@@ -17,6 +17,7 @@ in the output with the rates the user gives and refuses a ladder that does not f
 from __future__ import annotations
 
 import dataclasses
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -35,8 +36,6 @@ WINDOW_S = 0.5
 """Window of the output-based detector [s]."""
 STEADY_SIGMAS = 6.0
 """Window means within this many standard errors of each other are one plateau."""
-RATE_DECIMALS = 4
-"""A plateau's rate read from the table's rate column is rounded to 0.1 m°/s."""
 DROPPED_S = 1.0
 """Steady stretches at least this long but too short for a plateau are reported [s]."""
 BLOCKS = 10
@@ -194,8 +193,9 @@ def plateaus_from_rate(
     Returns
     -------
     Detection
-        Each plateau's rate is the mean of the rate column over it, rounded to
-        ``RATE_DECIMALS`` decimals of °/s (the repeated visits of a rate are one rate).
+        Each plateau's rate is the mean of the rate column over it, rounded to the decimal
+        of ``tolerance_dps`` (three decimals of °/s by default), so that the repeated visits
+        of a rate are one rate.
 
     Raises
     ------
@@ -220,11 +220,15 @@ def plateaus_from_rate(
     spans = [(a, b + 1) for a, b in _runs(still)]
     temp = None if temperature_c is None else np.asarray(temperature_c, float)
     pl, dropped = _summarise(t, y, spans, [0.0] * len(spans), temp, settle_s, min_plateau_s)
-    pl = [_with_rate(p, round(float(np.mean(r[p.i0 : p.i1])), RATE_DECIMALS)) for p in pl]
+    decimals = max(0, math.ceil(-math.log10(tolerance_dps)))
+    pl = [_with_rate(p, round(float(np.mean(r[p.i0 : p.i1])), decimals)) for p in pl]
     if not pl:
         raise DesignError.naming(
-            f"no plateau of at least {min_plateau_s:g} s where the table's rate holds still; "
-            "lower {min_plateau_s} or give the plateaus with {schedule}",
+            f"no plateau of at least {min_plateau_s:g} s where the table's rate holds still "
+            f"(changes by at most {tolerance_dps:g} °/s a sample); a noisy rate column needs a "
+            "larger {tolerance_dps}; or lower {min_plateau_s}, or give the plateaus with "
+            "{schedule}",
+            "tolerance_dps",
             "min_plateau_s",
             "schedule",
         )
