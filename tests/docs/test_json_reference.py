@@ -224,6 +224,8 @@ def _imu_runs(t: Path) -> list[tuple[str, Any]]:
 def _other_runs(t: Path) -> list[tuple[str, Any]]:
     """Flight-controller logs, the turntable, multipos, a batch and the demonstrations."""
     _run(["simulate", "turntable-16", "-o", str(t / "tt.csv")])
+    _run(["simulate", "ratetable", "--runs", "2", "-o", str(t / "rt")])
+    rt = sorted(str(p) for p in (t / "rt").glob("*.csv"))
     for seed in (1, 2):
         _run(["simulate", "fog-slow", "-o", str(t / f"SN{seed}.csv"), "--seed", str(seed),
               "--rate-hz", "0.1"])  # fmt: skip
@@ -244,6 +246,7 @@ def _other_runs(t: Path) -> list[tuple[str, Any]]:
                            "--accel-unit", "m/s^2", "--gyro", "gyr_x,gyr_y,gyr_z",
                            "--gyro-unit", "deg/s", "--gravity", "9.81",
                            "-o", str(t / "mp.json")])),
+        ("ratetable", _run(["ratetable", *rt, "--rate-column", "table_rate", "--temps", "temp"])),
         ("fleet", _run(["fleet", str(t / "batch.toml"), "-o", str(t / "bo"), "--workers", "1"])),
         ("demo", _run(["demo", "--quick", "-o", str(t / "d1")])),
         ("demo", _run(["demo", "--quick", "--imu", "-o", str(t / "d2")])),

@@ -39,6 +39,7 @@ COMMANDS: dict[str, str] = {
     "ardupilot-tempcal": "tempcal_cmd",
     "turntable": "turntable_cmd",
     "multipos": "multipos_cmd",
+    "ratetable": "ratetable_cmd",
     "report": "report_cmd",
     "fleet": "fleet_cmd",
     "demo": "demo_cmd",
