@@ -8,6 +8,7 @@ from typing import TYPE_CHECKING, Annotated
 import typer
 
 from thermocal._lazy import LazyModule, prefetch
+from thermocal.cli import noise_sheet as _sheet
 from thermocal.cli.application import app
 from thermocal.cli.common import (
     ConfidenceOpt,
@@ -61,7 +62,19 @@ def _triad(text: str | None, option: str, taken: list[str] | None = None) -> lis
     return names
 
 
-GyroColsOpt = Annotated[str, typer.Option("--gyro", help="Gyro columns X,Y,Z.")]
+GyroColsOpt = Annotated[
+    str | None,
+    typer.Option("--gyro", help="Gyro columns X,Y,Z (required but with --from-datasheet)."),
+]
+FromDatasheetOpt = Annotated[
+    bool,
+    typer.Option(
+        "--from-datasheet",
+        help="FILE holds data-sheet figures (TOML: update_rate_hz = 200, gyro_noise_density = "
+        '"0.014 deg/s/sqrt(Hz)", accel_noise_density = "175 ug/sqrt(Hz)", gyro_random_walk or '
+        "gyro_bias_instability, the same for accel): the Kalibr file from them, units converted.",
+    ),
+]
 NoiseOutOpt = Annotated[Path, typer.Option("-o", "--output", help="Output file.")]
 AccelColsOpt = Annotated[str | None, typer.Option("--accel", help="Accelerometer columns X,Y,Z.")]
 GyroUnitOpt = Annotated[
@@ -103,8 +116,8 @@ def _unit_list(
 @handle_errors
 def noise_cmd(
     file: FileArg,
-    gyro: GyroColsOpt,
     output: NoiseOutOpt,
+    gyro: GyroColsOpt = None,
     accel: AccelColsOpt = None,
     gyro_unit: GyroUnitOpt = None,
     accel_unit: AccelUnitOpt = None,
@@ -121,6 +134,7 @@ def noise_cmd(
     t_bad: OnBadLinesOpt = "error",
     t_delim: DelimiterOpt = None,
     t_dec: DecimalOpt = None,
+    from_datasheet: FromDatasheetOpt = False,
 ) -> None:
     """IMU noise model for estimators: per axis the white-noise density (the −½ line of
     the Allan deviation at τ = 1 s) and the random walk (+½ line at τ = 3 s, or the
@@ -129,6 +143,14 @@ def noise_cmd(
     prefetch("scipy.special", "scipy.linalg", "rich.table")
     if out_format not in ("kalibr", "json"):
         raise ThermocalInputError(f"--format {out_format!r}: use kalibr or json")
+    if from_datasheet:
+        _sheet.from_datasheet(file, output, out_format, inflate=inflate, rostopic=rostopic)
+        return
+    if gyro is None:
+        raise ThermocalInputError(
+            "give the gyro columns with --gyro X,Y,Z (or --from-datasheet with a file of "
+            "data-sheet figures)"
+        )
     g_names = _triad(gyro, "--gyro")
     a_names = _triad(accel, "--accel", g_names)
     if out_format == "kalibr" and not a_names:
