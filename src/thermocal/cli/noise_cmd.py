@@ -9,6 +9,7 @@ import typer
 
 from thermocal._lazy import LazyModule, prefetch
 from thermocal.cli import noise_sheet as _sheet
+from thermocal.cli import noise_temps as _temps
 from thermocal.cli.application import app
 from thermocal.cli.common import (
     ConfidenceOpt,
@@ -94,6 +95,29 @@ InflateOpt = Annotated[
         "--inflate", help="Multiply every Kalibr noise value by this (≥ 1; stated in the file)."
     ),
 ]
+NoiseTempsOpt = Annotated[
+    str | None,
+    typer.Option(
+        "--temps",
+        help="Temperature column: the noise terms per temperature bin (--temp-bins), their "
+        "trend against temperature, and with --at-temperature the model at one temperature.",
+    ),
+]
+TempBinsOpt = Annotated[
+    str | None,
+    typer.Option(
+        "--temp-bins",
+        help="With --temps: a bin width in °C (default 5) or the edges (10,25,40,55).",
+    ),
+]
+AtTemperatureOpt = Annotated[
+    float | None,
+    typer.Option(
+        "--at-temperature",
+        help="With --temps: the model at this temperature [°C], each axis interpolated "
+        "between the bins around it, with the inflation the record supports.",
+    ),
+]
 RostopicOpt = Annotated[str, typer.Option("--rostopic", help="Kalibr's rostopic of this IMU.")]
 
 
@@ -135,6 +159,9 @@ def noise_cmd(
     t_delim: DelimiterOpt = None,
     t_dec: DecimalOpt = None,
     from_datasheet: FromDatasheetOpt = False,
+    temps: NoiseTempsOpt = None,
+    edges_c: TempBinsOpt = None,
+    temperature_c: AtTemperatureOpt = None,
 ) -> None:
     """IMU noise model for estimators: per axis the white-noise density (the −½ line of
     the Allan deviation at τ = 1 s) and the random walk (+½ line at τ = 3 s, or the
@@ -146,6 +173,10 @@ def noise_cmd(
     if from_datasheet:
         _sheet.from_datasheet(file, output, out_format, inflate=inflate, rostopic=rostopic)
         return
+    if temps is None and (edges_c is not None or temperature_c is not None):
+        raise ThermocalInputError(
+            "--temp-bins and --at-temperature apply with --temps COLUMN (the IMU's thermometer)"
+        )
     if gyro is None:
         raise ThermocalInputError(
             "give the gyro columns with --gyro X,Y,Z (or --from-datasheet with a file of "
@@ -165,7 +196,7 @@ def noise_cmd(
         time=time, time_unit=time_unit, signal=",".join(g_names + a_names),
         signal_unit=_unit_list(gyro_unit, accel_unit, len(g_names), len(a_names)),
         topic=topic, names=t_names, rate=t_rate, on_bad_lines=t_bad, delimiter=t_delim,
-            decimal=t_dec, stamp=stamp,
+            decimal=t_dec, stamp=stamp, **({"temps": temps} if temps is not None else {}),
     )  # fmt: skip
     rec = _readers.read_recording(
         file,
@@ -175,6 +206,11 @@ def noise_cmd(
                    **dict.fromkeys(a_names, "accel_unit")},
     )  # fmt: skip
     check_recording(rec, read)
+    if temps is not None:
+        opts = {"out_format": out_format, "temperature_c": temperature_c, "inflate": inflate,
+                "rostopic": rostopic, "confidence": confidence}  # fmt: skip
+        _temps.by_temperature(file, rec, (g_names, a_names), temps, edges_c, opts, output)
+        return
     res = _analysis.imu_noise(
         rec, g_names, a_names, inflate=inflate, rostopic=rostopic, confidence=confidence,
         where=str(file),

@@ -9,6 +9,7 @@ from thermocal.report.text import Block, TextTable, fmt
 
 if TYPE_CHECKING:
     from thermocal.stability.datasheet import DatasheetNoise
+    from thermocal.stability.noise_temperature import NoiseAtTemperature, NoiseOverTemperature
 
 
 def datasheet_noise_text(where: str, model: DatasheetNoise) -> list[Block]:
@@ -37,3 +38,50 @@ def datasheet_noise_text(where: str, model: DatasheetNoise) -> list[Block]:
     )
     out: list[Block] = [TextTable(title, columns, tuple(rows), ("left",) * len(columns))]
     return out + list(model.notes)
+
+
+def noise_by_temperature_text(
+    where: str, res: NoiseOverTemperature, at: NoiseAtTemperature | None
+) -> list[Block]:
+    """The noise per temperature bin (per axis N and K in SI, B at the minimum in the
+    data's unit, each with its interval), refused bins with the reason, the trends, and
+    the model at a temperature with the inflation the record supports.
+
+    Parameters
+    ----------
+    where : str
+        The file the title names.
+    res : thermocal.stability.noise_temperature.NoiseOverTemperature
+        The noise per bin.
+    at : thermocal.stability.noise_temperature.NoiseAtTemperature or None
+        The model at a temperature (None: not asked).
+
+    Returns
+    -------
+    list of str or TextTable
+    """
+    columns = ("bin [°C]", "mean [°C]", "s", "axis", "noise density [interval]",
+               "random walk [interval]", "bias instability (minimum) [interval]")  # fmt: skip
+    rows = []
+    for b in res.bins:
+        span = f"{b.low_c:g}…{b.high_c:g}"
+        if b.refused is not None:
+            rows.append((span, "—", f"{b.duration_s:.0f}", "—", "refused: " + b.refused, "", ""))
+            continue
+        for a in b.axes:
+            d, w, m = a.density, a.walk, a.terms.bias_minimum
+            bcell = "—" if m is None else f"{fmt(m.value)} [{fmt(m.low)}, {fmt(m.high)}] {m.unit}"
+            dcell = f"{fmt(d.value)} [{fmt(d.low)}, {fmt(d.high)}]"
+            wcell = f"{fmt(w.value)} [{fmt(w.low)}, {fmt(w.high)}] {w.method}"
+            rows.append(
+                (span, f"{b.mean_c:.2f}", f"{b.duration_s:.0f}", a.name, dcell, wcell, bcell)
+            )
+    title = (f"{where} — noise per bin of {res.temperature} (continuous time, SI; "
+             f"{res.confidence * 100:.1f} % intervals)")  # fmt: skip
+    out: list[Block] = [TextTable(title, columns, tuple(rows), ("left",) * len(columns))]
+    out += [f"trend {t.axis} {t.term}: {t.words}" for t in res.trends]
+    if at is not None:
+        vals = ", ".join(f"{k} {v:.4g} ({at.axis_of[k]})" for k, v in at.values.items())
+        out.append(f"at {at.temperature_c:g} °C (inflation included ×{at.inflate:g}): {vals}")
+        out += [f"inflation {i.key} ×{i.factor:.3g} ({i.reason}): {i.words}" for i in at.advice]
+    return out
