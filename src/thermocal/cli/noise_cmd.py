@@ -8,6 +8,7 @@ from typing import TYPE_CHECKING, Annotated
 import typer
 
 from thermocal._lazy import LazyModule, prefetch
+from thermocal.cli import noise_psd as _psd_out
 from thermocal.cli import noise_sheet as _sheet
 from thermocal.cli import noise_temps as _temps
 from thermocal.cli.application import app
@@ -118,6 +119,14 @@ AtTemperatureOpt = Annotated[
         "between the bins around it, with the inflation the record supports.",
     ),
 ]
+PsdOpt = Annotated[
+    Path | None,
+    typer.Option(
+        "--psd",
+        help="Also the PSD (Welch, one-sided, data unit/√Hz) of every axis, written to this "
+        "CSV; its white level beside the Allan deviation's, and where the two disagree.",
+    ),
+]
 RostopicOpt = Annotated[str, typer.Option("--rostopic", help="Kalibr's rostopic of this IMU.")]
 
 
@@ -162,6 +171,7 @@ def noise_cmd(
     temps: NoiseTempsOpt = None,
     edges_c: TempBinsOpt = None,
     temperature_c: AtTemperatureOpt = None,
+    psd: PsdOpt = None,
 ) -> None:
     """IMU noise model for estimators: per axis the white-noise density (the −½ line of
     the Allan deviation at τ = 1 s) and the random walk (+½ line at τ = 3 s, or the
@@ -190,6 +200,8 @@ def noise_cmd(
             "(or --format json for the gyro alone)"
         )
     _writers.check_not_input(output, [file])
+    if psd is not None:
+        _psd_out.check(psd, file, output)
     if output.is_dir():
         raise ThermocalInputError(f"{output}: is a directory, expected a file name")
     read = read_options(
@@ -223,4 +235,6 @@ def noise_cmd(
         fh.write(text + ("" if text.endswith("\n") else "\n"))
 
     show(_text.imu_noise_text(str(file), res))
+    if psd is not None:
+        _psd_out.write(rec, res.model.axes, psd)
     stdout.print(f"{out_format} noise model written to {output} (per sensor the largest axis)")

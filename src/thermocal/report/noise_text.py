@@ -3,6 +3,7 @@ data-sheet figures, the noise per temperature bin and its trend, the PSD beside 
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from typing import TYPE_CHECKING
 
 from thermocal.report.text import Block, TextTable, fmt
@@ -10,6 +11,7 @@ from thermocal.report.text import Block, TextTable, fmt
 if TYPE_CHECKING:
     from thermocal.stability.datasheet import DatasheetNoise
     from thermocal.stability.noise_temperature import NoiseAtTemperature, NoiseOverTemperature
+    from thermocal.stability.psd import AxisPsd
 
 
 def datasheet_noise_text(where: str, model: DatasheetNoise) -> list[Block]:
@@ -85,3 +87,27 @@ def noise_by_temperature_text(
         out.append(f"at {at.temperature_c:g} °C (inflation included ×{at.inflate:g}): {vals}")
         out += [f"inflation {i.key} ×{i.factor:.3g} ({i.reason}): {i.words}" for i in at.advice]
     return out
+
+
+def psd_text(res: Sequence[AxisPsd]) -> list[Block]:
+    """Per axis the PSD's white level (one-sided ASD in the data's unit/√Hz, and N in SI),
+    the Allan deviation's N, their ratio and the comparison in words.
+
+    Parameters
+    ----------
+    res : sequence of thermocal.stability.psd.AxisPsd
+        The axes' PSDs (:func:`thermocal.stability.psd.imu_psd`).
+
+    Returns
+    -------
+    list of str or TextTable
+    """
+    columns = ("axis", "PSD white ASD (one-sided)", "N from PSD", "N from ADEV", "ratio", "")
+    rows = tuple(
+        (p.name, f"{fmt(p.white_asd)} {p.unit}/sqrt(Hz)", fmt(p.psd_density),
+         fmt(p.adev_density), f"{p.ratio:.3f}", "agree" if p.agree else "DISAGREE")
+        for p in res
+    )  # fmt: skip
+    title = "White noise: the PSD's flat part (N = ASD/√2) beside the Allan deviation's −½ line"
+    out: list[Block] = [TextTable(title, columns, rows, ("left",) * len(columns))]
+    return out + [f"{p.name}: {p.words}" for p in res]
