@@ -21,6 +21,7 @@ from thermocal.cli.common import (
     OnBadLinesOpt,
     RateOpt,
     StampOpt,
+    TempUnitOpt,
     TimeOpt,
     TimeUnitOpt,
     TopicOpt,
@@ -169,6 +170,7 @@ def noise_cmd(
     t_dec: DecimalOpt = None,
     from_datasheet: FromDatasheetOpt = False,
     temps: NoiseTempsOpt = None,
+    temp_unit: TempUnitOpt = None,
     edges_c: TempBinsOpt = None,
     temperature_c: AtTemperatureOpt = None,
     psd: PsdOpt = None,
@@ -208,7 +210,8 @@ def noise_cmd(
         time=time, time_unit=time_unit, signal=",".join(g_names + a_names),
         signal_unit=_unit_list(gyro_unit, accel_unit, len(g_names), len(a_names)),
         topic=topic, names=t_names, rate=t_rate, on_bad_lines=t_bad, delimiter=t_delim,
-            decimal=t_dec, stamp=stamp, **({"temps": temps} if temps is not None else {}),
+            decimal=t_dec, stamp=stamp, temp_unit=temp_unit,
+            **({"temps": temps} if temps is not None else {}),
     )  # fmt: skip
     rec = _readers.read_recording(
         file,
