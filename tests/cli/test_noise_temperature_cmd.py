@@ -100,3 +100,23 @@ def test_nan_temperature_column(tmp_path: Path, capsys: pytest.CaptureFixture[st
     assert main(_args(path, tmp_path / "x.json", "--format", "json")) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and err[0].startswith("error: ") and "imu temp" in err[0], err
+
+
+def test_allan_per_temperature_bin(
+    csv: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``allan --temps COL --temp-bins EDGES --json``: the same bins for one signal, each N
+    within 4 % of the simulator's N at the bin's mean temperature."""
+    args = ["allan", str(csv), "--time", "time [s]", "--signal", "gx [rad/s]",
+            "--temps", "imu temp [degC]", "--temp-bins", "0,20,40,60", "--json"]  # fmt: skip
+    assert main(args) == 0
+    d = json.loads(capsys.readouterr().out)
+    assert d["temperature"] == "imu temp [degC]" and len(d["bins"]) == 3
+    for b in d["bins"]:
+        n = b["axes"]["gx [rad/s]"]["noise_density"]
+        assert n["value"] == pytest.approx(float(gyro_density(b["mean_c"])), rel=0.04)
+    gx = next(t for t in d["trends"] if t["term"] == "noise_density")
+    assert gx["significant"] and abs(gx["slope_per_c"] - 2e-6) <= 3 * gx["slope_sigma"]
+    assert main(args[:-5] + ["--temp-bins", "5"]) == 2  # bins without a temperature column
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "--temps" in err[0]

@@ -87,8 +87,9 @@ class BinNoise:
     runs : int
         Runs used.
     rate_c_per_min : float
-        Mean |dT/dt| over the runs used [°C/min] (0 on a hold; the bias's thermal drift at
-        this rate is part of the bin's random walk and bias instability).
+        The runs' temperature ranges summed over their duration [°C/min] (about 0 on a
+        hold; the bias's thermal drift at this rate is part of the bin's random walk and
+        bias instability).
     axes : tuple of AxisNoise
         Per axis its terms (empty when refused).
     refused : str or None
@@ -414,8 +415,8 @@ def _one_bin(
         )
         return BinNoise(lo, hi, math.nan, dur, len(runs), math.nan, (), why)
     tt = np.concatenate([t[r] for r in runs])
-    rate = float(np.mean([abs(t[r.stop - 1] - t[r.start]) / ((r.stop - r.start) * tau0_s)
-                          for r in runs])) * units.SECONDS_PER_MINUTE  # fmt: skip
+    span = sum(float(np.ptp(t[r])) for r in runs)  # each run's temperature range
+    rate = span / dur * units.SECONDS_PER_MINUTE
     clock = np.arange(t.size, dtype=np.float64) * tau0_s  # the runs are honoured with a clock
     done = tuple(
         axis_noise(
@@ -862,3 +863,62 @@ def at_temperature_yaml(
     text = "\n".join(lines)
     check_kalibr_yaml(text)
     return text
+
+
+def signals_by_temperature(
+    rec: Recording,
+    names: Sequence[str],
+    temperature: str,
+    edges_c: Sequence[float] | None = None,
+    *,
+    width_c: float = 5.0,
+    confidence: float = ONE_SIGMA_CONFIDENCE,
+    where: str = "",
+) -> NoiseOverTemperature:
+    """The noise terms per temperature bin of rate or acceleration signals, each taken as a
+    gyro or an accelerometer by its unit (:func:`imu_noise_by_temperature`).
+
+    Parameters
+    ----------
+    rec : Recording
+        The recording.
+    names : sequence of str
+        The signals (a rate or an acceleration unit each).
+    temperature : str
+        The temperature column.
+    edges_c : sequence of float, optional
+        Bin edges [°C] (default: bins of ``width_c``).
+    width_c : float, optional
+        Bin width [°C] (default 5).
+    confidence : float, optional
+        Confidence level of the intervals.
+    where : str, optional
+        The file errors name.
+
+    Returns
+    -------
+    NoiseOverTemperature
+
+    Raises
+    ------
+    thermocal.errors.ThermocalInputError
+        A signal neither a rate nor an acceleration (raw counts: give its unit).
+    """
+    from thermocal.stability.analysis import signal_in_data_unit
+
+    gyro, accel = [], []
+    for n in names:
+        unit = units.normalize_signal_unit(signal_in_data_unit(rec, n)[1])
+        if unit in units.RATE_UNITS:
+            gyro.append(n)
+        elif unit in units.ACCEL_UNITS:
+            accel.append(n)
+        else:
+            raise ThermocalInputError(
+                f"{where}: signal {n!r} is in {unit!r}: the noise terms per temperature need "
+                "a rate or an acceleration unit (give it with --signal-unit)"
+            )
+    return imu_noise_by_temperature(
+        rec, gyro, accel, temperature, edges_c, width_c=width_c, confidence=confidence,
+        where=where,
+    )  # fmt: skip
