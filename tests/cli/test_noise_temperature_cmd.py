@@ -117,6 +117,6 @@ def test_allan_per_temperature_bin(
         assert n["value"] == pytest.approx(float(gyro_density(b["mean_c"])), rel=0.04)
     gx = next(t for t in d["trends"] if t["term"] == "noise_density")
     assert gx["significant"] and abs(gx["slope_per_c"] - 2e-6) <= 3 * gx["slope_sigma"]
-    assert main(args[:-5] + ["--temp-bins", "5"]) == 2  # bins without a temperature column
+    assert main([*args[:-5], "--temp-bins", "5"]) == 2  # bins without a temperature column
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "--temps" in err[0]
