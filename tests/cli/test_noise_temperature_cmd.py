@@ -120,3 +120,18 @@ def test_allan_per_temperature_bin(
     assert main([*args[:-5], "--temp-bins", "5"]) == 2  # bins without a temperature column
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "--temps" in err[0]
+
+
+def test_plot_against_temperature(
+    csv: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    png = tmp_path / "t.png"
+    args = _args(csv, tmp_path / "t.json", "--temp-bins", "0,20,40,60", "--format", "json")
+    assert main([*args, "--plot", str(png)]) == 0
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert main([*args, "--plot", str(tmp_path / "t.json")]) == 2  # the same file as -o
+    no_temps = ["noise", str(csv), "--time", "time [s]", "--gyro", GYRO, "--accel", ACCEL,
+                "--format", "json", "-o", str(tmp_path / "u.json"), "--plot", str(png)]  # fmt: skip
+    assert main(no_temps) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 2 and "--temps" in err[1]

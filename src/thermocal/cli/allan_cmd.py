@@ -343,10 +343,10 @@ def allan_cmd(
             return
         # the Allan deviation uses the time and the signal only
         rec = check_recording(_readers.read_recording(file, read, keep_other=False), read)
-    if edges_c is not None:
-        _by_temperature(file, rec, signal, temps, edges_c, confidence, as_json)
-        return
     _check_plot(plot, file)
+    if edges_c is not None:
+        _by_temperature(file, rec, signal, temps, (edges_c, plot), confidence, as_json)
+        return
     tau_spec = parse_taus(taus)
     devs = parse_deviations(deviation) if deviation is not None else None
     with _total_bar(devs):
@@ -367,8 +367,8 @@ def allan_cmd(
 
 
 def _by_temperature(
-    file: Path, rec: "Recording", signal: str | None, temps: str | None, bins: str,
-    confidence: float, as_json: bool,
+    file: Path, rec: "Recording", signal: str | None, temps: str | None,
+    bins_plot: tuple[str, Path | None], confidence: float, as_json: bool,
 ) -> None:  # fmt: skip
     """``--temps COL --temp-bins …``: the noise terms per temperature bin."""
     from thermocal.cli.noise_temps import parse_bins
@@ -377,11 +377,15 @@ def _by_temperature(
 
     if not temps:
         raise ThermocalInputError("--temp-bins applies with --temps COLUMN (the thermometer)")
-    edges, width = parse_bins(bins)
+    edges, width = parse_bins(bins_plot[0])
     res = signals_by_temperature(
         rec, split_names(signal) or [rec.signals[0]], (split_names(temps) or [""])[0], edges,
         width_c=width, confidence=confidence, where=str(file),
     )  # fmt: skip
+    if bins_plot[1] is not None:
+        from thermocal.report.noise_plots import plot_noise_by_temperature
+
+        plot_noise_by_temperature(res, bins_plot[1], title=f"{file.name}: noise per temperature")
     emit(res.to_dict(), as_json, lambda: show(noise_by_temperature_text(str(file), res, None)))
 
 

@@ -120,6 +120,14 @@ AtTemperatureOpt = Annotated[
         "between the bins around it, with the inflation the record supports.",
     ),
 ]
+NoisePlotOpt = Annotated[
+    Path | None,
+    typer.Option(
+        "--plot",
+        help="With --temps: a PNG of N, K and B per bin against temperature, with their "
+        "intervals and significant trends.",
+    ),
+]
 PsdOpt = Annotated[
     Path | None,
     typer.Option(
@@ -174,6 +182,7 @@ def noise_cmd(
     edges_c: TempBinsOpt = None,
     temperature_c: AtTemperatureOpt = None,
     psd: PsdOpt = None,
+    plot: NoisePlotOpt = None,
 ) -> None:
     """IMU noise model for estimators: per axis the white-noise density (the −½ line of
     the Allan deviation at τ = 1 s) and the random walk (+½ line at τ = 3 s, or the
@@ -185,10 +194,15 @@ def noise_cmd(
     if from_datasheet:
         _sheet.from_datasheet(file, output, out_format, inflate=inflate, rostopic=rostopic)
         return
-    if temps is None and (edges_c is not None or temperature_c is not None):
+    if temps is None and (edges_c is not None or temperature_c is not None or plot is not None):
         raise ThermocalInputError(
-            "--temp-bins and --at-temperature apply with --temps COLUMN (the IMU's thermometer)"
+            "--temp-bins, --at-temperature and --plot apply with --temps COLUMN (the IMU's "
+            "thermometer)"
         )
+    if plot is not None:
+        _writers.check_not_input(plot, [file])
+        if plot.resolve() == output.resolve() or plot.is_dir():
+            raise ThermocalInputError(f"--plot {plot}: give a PNG file name other than -o")
     if gyro is None:
         raise ThermocalInputError(
             "give the gyro columns with --gyro X,Y,Z (or --from-datasheet with a file of "
@@ -223,7 +237,7 @@ def noise_cmd(
     check_recording(rec, read)
     if temps is not None:
         opts = {"out_format": out_format, "temperature_c": temperature_c, "inflate": inflate,
-                "rostopic": rostopic, "confidence": confidence}  # fmt: skip
+                "rostopic": rostopic, "confidence": confidence, "plot": plot}  # fmt: skip
         _temps.by_temperature(file, rec, (g_names, a_names), temps, edges_c, opts, output)
         return
     res = _analysis.imu_noise(

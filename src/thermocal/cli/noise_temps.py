@@ -77,4 +77,9 @@ def by_temperature(
     with _writers.atomic_write(output, "w") as fh:
         fh.write(text + ("" if text.endswith("\n") else "\n"))
     show(_text.noise_by_temperature_text(str(file), res, at))
+    if opts.get("plot") is not None:
+        from thermocal.report.noise_plots import plot_noise_by_temperature
+
+        plot_noise_by_temperature(res, opts["plot"], title=f"{file.name}: noise per temperature")
+        stdout.print(f"plot written to {opts['plot']}")
     stdout.print(f"{out_format} noise per temperature written to {output}")

@@ -138,7 +138,9 @@ class Trend:
     slope_sigma : float or None
         Its standard error [``unit``/°C] (Birge-scaled).
     value_at_mean : float or None
-        The line at the bins' weighted mean temperature [``unit``].
+        The line at ``mean_c`` [``unit``].
+    mean_c : float or None
+        The bins' weighted mean temperature [°C].
     relative_per_c : float or None
         ``slope_per_c / value_at_mean`` [1/°C].
     significant : bool
@@ -156,6 +158,7 @@ class Trend:
     slope_per_c: float | None
     slope_sigma: float | None
     value_at_mean: float | None
+    mean_c: float | None
     relative_per_c: float | None
     significant: bool
     bins: int
@@ -496,7 +499,7 @@ def _line(
             f"no trend: {len(pts)} of {n_bins} bins measure it (a random walk given only as "
             "a bound is not a measurement)"
         )
-        return Trend(axis, term, unit, None, None, None, None, False, len(pts), why)
+        return Trend(axis, term, unit, None, None, None, None, None, False, len(pts), why)
     tc = np.array([p[0] for p in pts])
     v = np.array([p[1][0] for p in pts])
     sig = np.array([max((p[1][2] - p[1][1]) / (2.0 * z), 1e-300) for p in pts])
@@ -505,7 +508,7 @@ def _line(
     sxx = float(np.sum(w * (tc - tm) ** 2))
     if sxx <= 0.0:
         why = "no trend: every bin used has the same mean temperature"
-        return Trend(axis, term, unit, None, None, None, None, False, len(pts), why)
+        return Trend(axis, term, unit, None, None, None, None, None, False, len(pts), why)
     slope = float(np.sum(w * (tc - tm) * v) / sxx)
     mean = float(np.sum(w * v) / np.sum(w))
     se = 1.0 / math.sqrt(sxx)
@@ -517,7 +520,7 @@ def _line(
     words = f"{rel * 100:+.2g} %/°C ± {se / abs(mean) * 100:.2g} %/°C over {len(pts)} bins: " + (
         "significant" if sig_ok else f"not significant (below {SIGNIFICANT_T:g} σ)"
     )
-    return Trend(axis, term, unit, slope, se, mean, rel, sig_ok, len(pts), words)
+    return Trend(axis, term, unit, slope, se, mean, tm, rel, sig_ok, len(pts), words)
 
 
 def imu_noise_by_temperature(
