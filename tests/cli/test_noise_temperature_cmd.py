@@ -75,6 +75,10 @@ def test_kalibr_at_a_temperature(csv: Path, tmp_path: Path) -> None:
         (["--temp-bins", "0,20,40,60", "--at-temperature", "80"], "--at-temperature 80"),
         (["--temp-bins", "warm", "--format", "json"], "--temp-bins 'warm'"),
         (["--temp-bins", "0,20,40,60"], "--at-temperature T"),  # kalibr needs a temperature
+        (["--temp-bins", "nan", "--format", "json"], "--temp-bins nan"),
+        (["--temp-bins", "0.0001", "--format", "json"], "--temp-bins 0.0001 °C makes"),
+        (["--temp-bins", "10,nan,30", "--format", "json"], "--temp-bins (10.0, nan, 30.0)"),
+        (["--temp-bins", "0,20,40,60", "--at-temperature", "nan"], "--at-temperature nan"),
     ],
 )
 def test_hostile_is_one_line(

@@ -11,6 +11,11 @@ noise is dominated by white noise and a random walk": the minimum of
 ``σ²(τ) = N²/τ + K²τ/3`` is ``σ_min² = 2NK/√3`` at ``τ = √3 N/K``, so
 ``K = √3 σ_min² / (2N)`` — an upper bound of K when flicker noise (the real bias
 instability) makes part of the floor.
+
+A data sheet's density is taken as N, as the Kalibr wiki reads it.  Where a data sheet
+defines its density as the one-sided amplitude spectral density of the output, white noise
+of coefficient N has the one-sided ASD √2·N (:mod:`thermocal.stability.psd`), and N is the
+density over √2: the value written is then √2 too large, on the safe side.
 """
 
 from __future__ import annotations
