@@ -919,7 +919,7 @@ def signals_by_temperature(
         else:
             raise ThermocalInputError(
                 f"{where}: signal {n!r} is in {unit!r}: the noise terms per temperature need "
-                "a rate or an acceleration unit (give it with --signal-unit)"
+                "a rate or an acceleration unit: state the unit the file is read with"
             )
     return imu_noise_by_temperature(
         rec, gyro, accel, temperature, edges_c, width_c=width_c, confidence=confidence,
