@@ -434,7 +434,8 @@ def datasheet_noise(
 
     Examples
     --------
-    ADIS16448 data-sheet figures (as quoted in Kalibr issue 63):
+    ADIS16448 data-sheet figures (as quoted in the Kalibr thread "Obtaining IMU parameters
+    from datasheet", https://github.com/ethz-asl/kalibr/issues/63):
 
     >>> m = datasheet_noise({"gyro_noise_density": (0.66, "deg/sqrt(h)"),
     ...                      "accel_noise_density": (0.11, "m/s/sqrt(h)"),
