@@ -349,7 +349,7 @@ def noise_by_temperature(
 
     >>> import numpy as np
     >>> rng = np.random.default_rng(0)
-    >>> t = np.repeat([20.0, 40.0], 20_000)
+    >>> t = np.repeat([20.0, 40.0], 15_000)
     >>> y = rng.normal(0.0, 1.0, t.size) * np.where(t < 30, 1e-3, 2e-3) / np.sqrt(0.01)
     >>> r = noise_by_temperature([AxisSamples("gx", "gyro", "rad/s", y)], t, 0.01,
     ...                          (15.0, 30.0, 45.0))

@@ -257,7 +257,7 @@ def axis_psd(
     --------
     >>> import numpy as np
     >>> from thermocal.stability.noise_model import axis_noise
-    >>> y = np.random.default_rng(0).normal(0.0, 0.01, 60_000)
+    >>> y = np.random.default_rng(0).normal(0.0, 0.01, 20_000)
     >>> ax = axis_noise(y, 0.01, name="gx", sensor="gyro", unit="rad/s")
     >>> p = axis_psd(y, 0.01, ax)
     >>> print(round(p.ratio, 2), p.agree)
