@@ -99,3 +99,38 @@ def test_bad_temperatures_and_edges() -> None:
     assert bin_edges([21.3, 24.9, 38.2], 5.0) == (20.0, 25.0, 30.0, 35.0, 40.0)
     with pytest.raises(ParameterError, match="bins"):
         bin_edges([0.0, 100.0], 0.01)
+
+
+def test_simulator_temperature_dependent_arw_recovered() -> None:
+    """thermocal's own simulator (``NoiseParams.white_density_per_c``): the MEMS gyro preset
+    (N = 9 °/h·√s at 25 °C, flicker B = 3 °/h, self-heating die) with N growing 2 %/°C, a
+    chamber held at 0, 25 and 50 °C for 50 min each; the die thermometer read to 0.5 °C.
+    Each bin's 95 % interval holds N at the bin's mean die temperature and the slope is the
+    simulated N·0.02 per °C within 3σ."""
+    import dataclasses
+
+    from thermocal.simulate import MEMS_GYRO, simulate_thermal
+    from thermocal.simulate.sensors import simulate_sensor
+
+    noise = dataclasses.replace(MEMS_GYRO.noise, white_density_per_c=0.02)
+    preset = dataclasses.replace(MEMS_GYRO, noise=noise)
+    fs = 10.0
+    t = np.arange(0.0, 3 * 3600.0, 1 / fs)
+    prog_t = np.array([0.0, 600, 3600, 4200, 7200, 7800, 10800])
+    prog_c = np.array([0.0, 0, 0, 25, 25, 50, 50])
+    th = simulate_thermal(t, prog_t, prog_c, preset.network, warmed_up=True)
+    out = simulate_sensor(th, preset, np.random.default_rng(3))
+    die = th.temperatures_c[:, 0]
+    axes = [AxisSamples("g", "gyro", "deg/h", out.signal - out.truth_rate)]
+    res = noise_by_temperature(axes, np.round(die * 2) / 2, 1 / fs, (-10.0, 12.5, 37.5, 62.5),
+                               confidence=0.95)  # fmt: skip
+    to_si = math.pi / 180 / 3600  # °/h·√s → rad/s/√Hz
+    assert len(res.used) == 3
+    for b in res.used:
+        truth = 9.0 * (1 + 0.02 * (b.mean_c - 25.0)) * to_si
+        d = b.axis("g").density
+        assert d.low is not None and d.high is not None
+        assert d.low <= truth <= d.high and d.value == pytest.approx(truth, rel=0.03)
+    tr = next(x for x in res.trends if x.term == "noise_density")
+    assert tr.significant and tr.slope_per_c is not None and tr.slope_sigma is not None
+    assert abs(tr.slope_per_c - 9.0 * 0.02 * to_si) <= 3.0 * tr.slope_sigma
