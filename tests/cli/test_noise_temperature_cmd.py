@@ -79,6 +79,7 @@ def test_kalibr_at_a_temperature(csv: Path, tmp_path: Path) -> None:
         (["--temp-bins", "0.0001", "--format", "json"], "--temp-bins 0.0001 °C makes"),
         (["--temp-bins", "10,nan,30", "--format", "json"], "--temp-bins (10.0, nan, 30.0)"),
         (["--temp-bins", "0,20,40,60", "--at-temperature", "nan"], "--at-temperature nan"),
+        (["--format", "json", "--psd", "p.csv"], "--psd is of the whole record"),
     ],
 )
 def test_hostile_is_one_line(
@@ -139,3 +140,20 @@ def test_plot_against_temperature(
     assert main(no_temps) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 2 and "--temps" in err[1]
+
+
+def test_options_that_do_not_go_together(
+    csv: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    allan = ["allan", str(csv), "--time", "time [s]", "--signal", "gx [rad/s]",
+             "--temps", "imu temp [degC]", "--temp-bins", "20"]  # fmt: skip
+    assert main([*allan, "--deviation", "mdev"]) == 2
+    assert main([*allan, "--data-type", "phase"]) == 2
+    sheet = tmp_path / "s.toml"
+    sheet.write_text("update_rate_hz = 100\n", encoding="utf-8")
+    assert main(["noise", str(sheet), "--from-datasheet", "--temps", "T", "-o",
+                 str(tmp_path / "x.yaml")]) == 2  # fmt: skip
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 3
+    assert "drop --deviation" in err[0] and "drop --data-type" in err[1]
+    assert "drop --temps" in err[2]

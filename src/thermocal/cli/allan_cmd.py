@@ -345,7 +345,9 @@ def allan_cmd(
         rec = check_recording(_readers.read_recording(file, read, keep_other=False), read)
     _check_plot(plot, file)
     if edges_c is not None:
-        _by_temperature(file, rec, signal, temps, (edges_c, plot), confidence, as_json)
+        others = {"--deviation": deviation, "--dynamic": dynamic, "--noise-type": noise_type,
+                  "--data-type": None if data_type == "rate" else data_type}  # fmt: skip
+        _by_temperature(file, rec, signal, temps, (edges_c, plot, others), confidence, as_json)
         return
     tau_spec = parse_taus(taus)
     devs = parse_deviations(deviation) if deviation is not None else None
@@ -368,15 +370,22 @@ def allan_cmd(
 
 def _by_temperature(
     file: Path, rec: "Recording", signal: str | None, temps: str | None,
-    bins_plot: tuple[str, Path | None], confidence: float, as_json: bool,
+    bins_plot: tuple[str, Path | None, Mapping[str, object]], confidence: float, as_json: bool,
 ) -> None:  # fmt: skip
-    """``--temps COL --temp-bins …``: the noise terms per temperature bin."""
+    """``--temps COL --temp-bins …``: the noise terms per temperature bin (of the default
+    analysis: the options of the others refused)."""
     from thermocal.cli.noise_temps import parse_bins
     from thermocal.report.noise_text import noise_by_temperature_text
     from thermocal.stability.noise_temperature import signals_by_temperature
 
     if not temps:
         raise ThermocalInputError("--temp-bins applies with --temps COLUMN (the thermometer)")
+    given = [k for k, v in bins_plot[2].items() if v is not None]
+    if given:
+        raise ThermocalInputError(
+            f"--temp-bins gives the noise terms per bin of the default analysis: drop "
+            f"{', '.join(given)}"
+        )
     edges, width = parse_bins(bins_plot[0])
     res = signals_by_temperature(
         rec, split_names(signal) or [rec.signals[0]], (split_names(temps) or [""])[0], edges,

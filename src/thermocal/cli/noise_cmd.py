@@ -154,6 +154,31 @@ def _unit_list(
     return tuple([gyro_unit] * n_g + [accel_unit or ""] * n_a)
 
 
+def _check_temps_options(
+    file: Path,
+    output: Path,
+    temps: str | None,
+    others: tuple[object, object, Path | None, Path | None],
+) -> None:
+    """``--temp-bins``, ``--at-temperature`` and ``--plot`` need ``--temps``; ``--psd`` is
+    of the whole record; the plot is neither an input nor ``-o``."""
+    edges_c, temperature_c, plot, psd = others
+    if temps is None and (edges_c is not None or temperature_c is not None or plot is not None):
+        raise ThermocalInputError(
+            "--temp-bins, --at-temperature and --plot apply with --temps COLUMN (the IMU's "
+            "thermometer)"
+        )
+    if temps is not None and psd is not None:
+        raise ThermocalInputError(
+            "--psd is of the whole record: run it without --temps (the bins' white levels "
+            "are in the --temps table)"
+        )
+    if plot is not None:
+        _writers.check_not_input(plot, [file])
+        if plot.resolve() == output.resolve() or plot.is_dir():
+            raise ThermocalInputError(f"--plot {plot}: give a PNG file name other than -o")
+
+
 @app.command("noise")
 @handle_errors
 def noise_cmd(
@@ -192,17 +217,11 @@ def noise_cmd(
     if out_format not in ("kalibr", "json"):
         raise ThermocalInputError(f"--format {out_format!r}: use kalibr or json")
     if from_datasheet:
+        given = {"--gyro": gyro, "--accel": accel, "--temps": temps, "--psd": psd, "--plot": plot}
+        _sheet.refuse_recording_options(given)
         _sheet.from_datasheet(file, output, out_format, inflate=inflate, rostopic=rostopic)
         return
-    if temps is None and (edges_c is not None or temperature_c is not None or plot is not None):
-        raise ThermocalInputError(
-            "--temp-bins, --at-temperature and --plot apply with --temps COLUMN (the IMU's "
-            "thermometer)"
-        )
-    if plot is not None:
-        _writers.check_not_input(plot, [file])
-        if plot.resolve() == output.resolve() or plot.is_dir():
-            raise ThermocalInputError(f"--plot {plot}: give a PNG file name other than -o")
+    _check_temps_options(file, output, temps, (edges_c, temperature_c, plot, psd))
     if gyro is None:
         raise ThermocalInputError(
             "give the gyro columns with --gyro X,Y,Z (or --from-datasheet with a file of "

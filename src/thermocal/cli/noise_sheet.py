@@ -6,6 +6,7 @@ from __future__ import annotations
 import json
 import re
 import tomllib
+from collections.abc import Mapping
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -58,6 +59,15 @@ def read_sheet(path: Path) -> tuple[dict[str, tuple[float, str]], float]:
             )
         figures[str(key)] = (float(m[1]), m[2])
     return figures, float(rate)
+
+
+def refuse_recording_options(given: Mapping[str, object]) -> None:
+    """Refuse the options of a recording given with ``--from-datasheet``."""
+    extra = [k for k, v in given.items() if v is not None]
+    if extra:
+        raise ThermocalInputError(
+            f"--from-datasheet reads figures, not a recording: drop {', '.join(extra)}"
+        )
 
 
 def from_datasheet(
