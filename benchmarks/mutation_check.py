@@ -4044,6 +4044,47 @@ MUTANTS: tuple[Mutant, ...] = (
         _t("ratetable_cli"),
         "rate table: plateaus with a random walk reported with white-noise uncertainties, unsaid",
     ),
+    # --- noise over temperature, the PSD, data sheets ------------------------------------
+    Mutant(
+        "datasheet-sqrt-hour",
+        P + "stability/datasheet.py",
+        "_SQRT_H: Final = math.sqrt(units.SECONDS_PER_HOUR)",
+        "_SQRT_H: Final = units.SECONDS_PER_HOUR",
+        _t("datasheet", "noise_datasheet"),
+        "°/√h read as if √h were 3600 s, not 60 √s",
+    ),
+    Mutant(
+        "datasheet-walk-from-bias-sqrt3",
+        P + "stability/datasheet.py",
+        "k = math.sqrt(3.0) * bias.si**2 / (2.0 * density.si)",
+        "k = bias.si**2 / (2.0 * density.si)",
+        _t("datasheet"),
+        "K from the bias stability without the √3 of the Allan minimum",
+    ),
+    Mutant(
+        "noise-temperature-interp-weights",
+        P + "stability/noise_temperature.py",
+        "return (1.0 - w) * ta.value + w * tb.value",
+        "return w * ta.value + (1.0 - w) * tb.value",
+        _t("noise_temperature"),
+        "the model at a temperature interpolated with the weights swapped",
+    ),
+    Mutant(
+        "noise-temperature-significance",
+        P + "stability/noise_temperature.py",
+        "SIGNIFICANT_T: Final = 2.0",
+        "SIGNIFICANT_T: Final = 0.0",
+        _t("noise_temperature"),
+        "every trend called significant",
+    ),
+    Mutant(
+        "psd-one-sided-half",
+        P + "stability/psd.py",
+        "n_psd = math.sqrt(level / 2.0) * si",
+        "n_psd = math.sqrt(level) * si",
+        _t("psd", "noise_psd"),
+        "the PSD's N without the one-sided factor 2",
+    ),
 )
 
 

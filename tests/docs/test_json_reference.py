@@ -217,6 +217,7 @@ def _imu_runs(t: Path) -> list[tuple[str, Any]]:
         ("allan", _run(["allan", val, "--signal", "gx,gy"])),
         ("allan", _run(["allan", val, "--signal", "gx", "--deviation", "mdev,hdev"])),
         ("allan", _run(["allan", val, "--signal", "gx", "--dynamic", "20000"])),
+        ("allan", _run(["allan", val, "--signal", "gx", "--temps", "T_die", "--temp-bins", "20"])),
         ("metrics", _run(["metrics", *runs, "--signal", "gyro"])),
     ]  # fmt: skip
 
