@@ -273,6 +273,11 @@ def _longest_run(
     return max(runs, key=lambda r: time_s[r[1]] - time_s[r[0]])
 
 
+MAX_WINDOWS = 100_000
+"""Most band-wide temperature windows searched for a plateau (10 000 °C at 0.1 °C): a
+temperature spanning more is a damaged record, and no set-point is inferred from it."""
+
+
 def _infer_setpoint(
     time_s: FloatArray, temp_c: FloatArray, band_c: float, min_hold_s: float
 ) -> float | None:
@@ -287,7 +292,10 @@ def _infer_setpoint(
     is more than ``2 band_c`` above it except an overshoot before the hold.
     """
     dt = np.diff(time_s, append=time_s[-1])
-    edges = np.arange(np.min(temp_c), np.max(temp_c) + 2 * band_c, band_c)
+    lo, hi = float(np.min(temp_c)), float(np.max(temp_c))
+    if (hi - lo) / band_c > MAX_WINDOWS:  # no thermometer of a board spans this: no plateau
+        return None
+    edges = np.arange(lo, hi + 2 * band_c, band_c)
     if edges.size < 3:
         return None
     spent, _ = np.histogram(temp_c, bins=edges, weights=dt)
@@ -725,7 +733,8 @@ def thin_recording(
     Returns
     -------
     recording : thermocal.recording.Recording
-        ``rec`` itself when no hold is found, else its samples kept.
+        ``rec`` itself when no hold is found (or its temperature is in raw counts without a
+        conversion to °C and no set-point is given: nothing to judge), else its samples kept.
     judgement : HeaterJudgement
         The hold, notes and warnings.
 
@@ -734,8 +743,16 @@ def thin_recording(
     thermocal.errors.ThermocalInputError
         As :func:`judge_heater`: nothing but the hold, or a cut range refused.
     """
+    from thermocal.errors import UnitError
+
+    try:
+        temp_c = rec.temperature_c(temperature)
+    except UnitError:  # raw counts without a conversion: a model in counts, no °C to judge
+        if options.setpoint_c is not None:
+            raise
+        return rec, HeaterJudgement(None, None, (), ())
     judged = judge_heater(
-        rec.time_s, rec.temperature_c(temperature), where=where, policy=options.policy,
+        rec.time_s, temp_c, where=where, policy=options.policy,
         setpoint_c=options.setpoint_c, band_c=options.band_c, min_hold_s=options.min_hold_s,
     )  # fmt: skip
     if judged.keep is None:

@@ -183,3 +183,17 @@ def test_lost_readings_are_left_out_not_fatal() -> None:
     assert clean is not None and found is not None
     assert abs(found.reached_s - clean.reached_s) < 0.2
     assert abs(found.hold_s - clean.hold_s) < 0.2
+
+
+def test_a_damaged_temperature_range_infers_no_setpoint() -> None:
+    """A damaged log whose temperature field reads 1e9 °C in one row: the plateau search
+    asked for 17e9 windows (MemoryError: 128 GiB, an internal error through ardupilot-tempcal);
+    no set-point is inferred from a range no thermometer spans."""
+    import numpy as np
+
+    from thermocal.heater import find_heater_hold
+
+    t = np.arange(0.0, 600.0, 0.1)
+    temp = np.minimum(20.0 + 0.2 * t, 55.0)
+    temp[100] = 1e9
+    assert find_heater_hold(t, temp) is None

@@ -39,6 +39,7 @@ def test_every_tutorial_is_executed_here() -> None:
     assert sorted(p.name for p in TUTORIALS.glob("*.md")) == [
         "chamber-to-c.md",  # tests/docs/test_tutorials_a.py
         "fc-params.md",  # tests/docs/test_tutorials_b.py
+        "firmware-learning.md",  # tests/docs/test_tutorial_firmware_learning.py
         "multipos-imucal.md",
         "noise-for-estimator.md",  # tests/docs/test_tutorials_a.py
         "notebook-allan.md",  # tests/docs/test_tutorial_notebook_allan.py

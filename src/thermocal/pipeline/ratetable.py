@@ -246,7 +246,7 @@ def _read(path: Path, opts: RateTableOptions) -> tuple[Any, np.ndarray, str, np.
     rec = read_recording(path, read, ask_units={opts.gyro: "gyro_unit"})
     rec.validate(required=[opts.gyro, *([opts.temps] if opts.temps else [])])
     y = np.asarray(rec.columns[opts.gyro], float)
-    unit = units.normalize_signal_unit(rec.units.get(opts.gyro) or "counts")
+    unit = units.normalize_signal_unit(rec.units[opts.gyro])  # resolved, or asked for
     kind = units.signal_kind(unit)
     if kind == "accel":
         raise ThermocalInputError.naming(
