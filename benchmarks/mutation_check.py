@@ -3810,6 +3810,30 @@ MUTANTS: tuple[Mutant, ...] = (
         _t("metrics_streaming"),
         "the streamed bias stability with ddof 0",
     ),
+    Mutant(
+        "thermometer-knot-at-new-level",
+        P + "thermometer.py",
+        "kv = np.where(one, (a + b) / 2, b)",
+        "kv = np.where(one, b, b)",
+        _t("thermometer"),
+        "a one-level change placed at the new level, not the boundary between the two",
+    ),
+    Mutant(
+        "thermometer-knot-at-first-sight",
+        P + "thermometer.py",
+        "kt = np.where(one, ti - gap / 2, ti)",
+        "kt = np.where(one, ti, ti)",
+        _t("thermometer"),
+        "a crossing placed where the new level is first seen, not midway in the update interval",
+    ),
+    Mutant(
+        "thermometer-lattice-share-any",
+        P + "thermometer.py",
+        "return g if np.mean(on) >= LATTICE_SHARE else None",
+        "return g if np.mean(on) >= 0.5 else None",
+        _t("thermometer"),
+        "a continuous thermometer half on a lattice called quantised",
+    ),
 )
 
 

@@ -175,3 +175,29 @@ def test_borrowed_thermometer_joined_by_time() -> None:
     assert keep.mean() == pytest.approx(0.5, abs=0.001)
     with pytest.raises(ThermocalInputError, match="do not overlap"):
         borrowed_temperature(t, tb + 5000, baro, source="sensor_baro.0")
+
+
+def test_a_slow_lattice_reconstructed_without_lag() -> None:
+    """A steady 1.8 °C/min ramp read every 1.28 s on a 0.125 °C lattice: the crossing is
+    placed midway in the update interval, so the reconstruction has no lag (a crossing put
+    where the new level is first seen lags 0.64 s: 0.019 °C)."""
+    t = np.arange(0, 1200.0, 0.01)
+    true = 20.0 + 0.03 * t
+    upd = np.floor((t - 0.5) / 1.28) * 1.28 + 0.5
+    reading = 0.125 * np.round(np.interp(np.maximum(upd, 0), t, true) / 0.125)
+    th = describe_thermometer(t, reading)
+    assert th.slow and th.update_period_s == pytest.approx(1.28, abs=0.01)
+    rec = reconstruct_temperature(t, reading)
+    inner = (t > 60) & (t < 1140)
+    assert abs(np.mean((rec.temp_c - true)[inner])) < 0.005
+    assert np.mean((reading - true)[inner]) < -0.015  # the held reading lags
+
+
+def test_a_partly_lattice_thermometer_is_not_quantised() -> None:
+    """60 % of the readings on a 0.5 °C lattice, 40 % anywhere: no lattice (99 % needed)."""
+    rng = np.random.default_rng(4)
+    v = np.where(
+        rng.random(10000) < 0.6, 0.5 * rng.integers(40, 80, 10000), rng.uniform(20, 40, 10000)
+    )
+    assert lattice_step(v) is None
+    assert lattice_step(0.5 * rng.integers(40, 80, 10000)) == pytest.approx(0.5, abs=1e-9)

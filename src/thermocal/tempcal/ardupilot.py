@@ -61,6 +61,14 @@ from thermocal.tempcal.pipeline import (
     summary,
     warn_gates,
 )
+from thermocal.tempcal.thermometers import (
+    TemperatureMode,
+    TempsFrom,
+    ThermometerPlan,
+    ardupilot_plan,
+    record_thermometer,
+    sensor_temperature,
+)
 
 MAX_IMUS = 3
 """ArduPilot logs up to three IMUs (``IMU``, instances 0…2)."""
@@ -752,6 +760,8 @@ class _Run:
     motions: dict[str, Any] = dataclasses.field(default_factory=dict)
     """Each instance's stillness from its fit (:func:`.pipeline.fit_sensor`), for the step
     warnings (computed once)."""
+    plan: ThermometerPlan = dataclasses.field(default_factory=ThermometerPlan)
+    """The temperature each IMU is fitted on (:mod:`.thermometers`)."""
 
 
 def ardupilot_tempcal(
@@ -761,6 +771,8 @@ def ardupilot_tempcal(
     overrides: tuple[str, ...] = (),
     reporter: Reporter | None = None,
     allan: bool = False,
+    temperature: TemperatureMode = "reconstructed",
+    temps_from: TempsFrom | None = None,
 ) -> ArdupilotTempcalResult:
     """ArduPilot's thermal calibration of every IMU of a DataFlash log, written as one set.
 
@@ -780,6 +792,12 @@ def ardupilot_tempcal(
         The gyro and accelerometer reports draw each axis's overlapping Allan deviation
         before and after compensation with its noise terms (IEEE Std 952-1997 Annex C);
         default False: left out (on a long log, most of a report's cost).
+    temperature : {"reconstructed", "raw"}, optional
+        A quantised or slow thermometer (:mod:`thermocal.thermometer`) is fitted on the
+        temperature reconstructed at each sample (default), or on its reading as logged.
+    temps_from : TempsFrom, optional
+        Calibrate against another IMU's (or ``BARO`` 0's) thermometer, joined by time
+        (:func:`.thermometers.sensor_temperature`); default each IMU its own.
 
     Returns
     -------
@@ -811,7 +829,6 @@ def ardupilot_tempcal(
       https://github.com/ArduPilot/ardupilot/blob/master/libraries/AP_InertialSensor/AP_InertialSensor_tempcal.cpp
     * ArduPilot, ``libraries/AP_TempCalibration/AP_TempCalibration.cpp`` (the barometer).
     """
-    from thermocal.errors import MissingColumnError
     from thermocal.export.params import ParamSet, check_documented, check_values
 
     # DIR may hold the log; the files of the set (replaced by name) may not be it
@@ -827,14 +844,8 @@ def ardupilot_tempcal(
         flight = read_ardupilot_log(log, MESSAGES)  # the log is read once, passed down
         run = _Run(log, flight, overrides, ParamSet("ardupilot"), out_set, [], [], {}, {})
         run.allan = allan
-        for inst in range(MAX_IMUS):
-            try:
-                df, _info = flight.table("IMU", inst)
-            except MissingColumnError:
-                if inst == 0:
-                    raise
-                break
-            _imu(run, df, inst)
+        run.plan = ardupilot_plan(flight, temperature, temps_from)
+        _each_imu(run)
         if not run.fits:
             raise ThermocalInputError(f"{log}: no IMU with a usable temperature in the log")
         _baro(run)
@@ -852,6 +863,20 @@ def ardupilot_tempcal(
         tuple(run.fits), tuple(notes), run.orientation, run.hygiene, run.previous,
         run.learning, run.baro, run.rotated, _changes_said(run),
     )  # fmt: skip
+
+
+def _each_imu(run: _Run) -> None:
+    """Every ``IMU`` instance of the log through :func:`_imu` (instance 0 must be there)."""
+    from thermocal.errors import MissingColumnError
+
+    for inst in range(MAX_IMUS):
+        try:
+            df, _info = run.flight.table("IMU", inst)
+        except MissingColumnError:
+            if inst == 0:
+                raise
+            break
+        _imu(run, df, inst)
 
 
 def _run_notes(run: _Run) -> list[str]:
@@ -956,10 +981,17 @@ def _imu(run: _Run, df: Any, inst: int) -> None:
         )  # fmt: skip
         sub_rec.source = str(run.log)
         sub_rec.validate()
+        sub_rec, thermo = sensor_temperature(
+            sub_rec, f"IMU.{inst}", temperature=run.plan.temperature,
+            source=run.plan.source_for(kind, inst),
+        )  # fmt: skip
         fit = fit_sensor(
             sub_rec, f"IMU.{prefix}", kind, inst, overrides=run.overrides,
             firmware="ardupilot", motions=run.motions,
         )  # fmt: skip
+        said = record_thermometer(fit, thermo, f"IMU.{inst}")
+        if said and kind == "gyro":  # one thermometer per IMU: said once
+            run.params.notes.append(said)
         run.fits.append(fit)
         per_kind.append((fit, sub_rec))
         if kind == "gyro":

@@ -72,6 +72,9 @@ class SensorFit:
         The fitted channels.
     adequacy : dict
         The data's judgement.
+    thermometer : dict
+        The temperature fitted on: its thermometer (lattice step, update period), whether
+        reconstructed, and whose (:func:`.thermometers.sensor_temperature`).
     """
 
     topic: str
@@ -85,6 +88,7 @@ class SensorFit:
     holdout_rms: dict[str, float] = field(default_factory=dict)
     channels: list[Channel] = field(default_factory=list)
     adequacy: dict[str, Any] = field(default_factory=dict)
+    thermometer: dict[str, Any] = field(default_factory=dict)
 
 
 def _cubic(t: FloatArray, y: FloatArray, unit: str, name: str) -> PolyModel:

@@ -62,6 +62,14 @@ from thermocal.tempcal.pipeline import (
     summary,
     warn_gates,
 )
+from thermocal.tempcal.thermometers import (
+    TemperatureMode,
+    TempsFrom,
+    ThermometerPlan,
+    px4_plan,
+    record_thermometer,
+    sensor_temperature,
+)
 
 TOPICS = ("sensor_gyro", "sensor_accel")
 
@@ -293,6 +301,8 @@ def px4_tempcal(
     overrides: tuple[str, ...] = (),
     reporter: Reporter | None = None,
     allan: bool = False,
+    temperature: TemperatureMode = "reconstructed",
+    temps_from: TempsFrom | None = None,
 ) -> Px4TempcalResult:
     """PX4's thermal calibration of every sensor instance of a ULog, written as one set.
 
@@ -314,6 +324,12 @@ def px4_tempcal(
         The gyro and accelerometer reports draw each axis's overlapping Allan deviation
         before and after compensation with its noise terms (IEEE Std 952-1997 Annex C);
         default False: left out (on a long log, most of a report's cost).
+    temperature : {"reconstructed", "raw"}, optional
+        A quantised or slow thermometer (:mod:`thermocal.thermometer`) is fitted on the
+        temperature reconstructed at each sample (default), or on its reading as logged.
+    temps_from : TempsFrom, optional
+        Calibrate against another instance's (or the first barometer's) thermometer, joined
+        by time (:func:`.thermometers.sensor_temperature`); default each its own.
 
     Returns
     -------
@@ -358,7 +374,8 @@ def px4_tempcal(
         report_worker(reporter, log) as pool,  # starts while the log is read
         open_px4_log(log, (*TOPICS, *OFFSET_TOPICS)) as flight,  # the log is parsed once
     ):
-        return _px4_tempcal(flight, output, tref_c, overrides, reporter, pool, allan)
+        plan = px4_plan(flight, temperature, temps_from)
+        return _px4_tempcal(flight, output, tref_c, overrides, reporter, pool, allan, plan)
 
 
 def _px4_tempcal(
@@ -369,8 +386,10 @@ def _px4_tempcal(
     reporter: Reporter | None,
     pool: Any = None,
     allan: bool = False,
+    plan: ThermometerPlan | None = None,
 ) -> Px4TempcalResult:
-    """:func:`px4_tempcal` after its output checks (``pool``: the report worker)."""
+    """:func:`px4_tempcal` after its output checks (``pool``: the report worker; ``plan``:
+    the temperature each instance is fitted on)."""
     from thermocal.export.params import ParamSet
 
     log, topics = flight.path, flight.instances
@@ -395,7 +414,7 @@ def _px4_tempcal(
                 continue
             fit, more = _imu_instance(
                 flight, name, inst, tref_c, overrides, params, out_set, (series, motions), old,
-                allan,
+                allan, plan or ThermometerPlan(),
             )  # fmt: skip
             fits.append(fit)
             gates.extend(more)
@@ -523,11 +542,13 @@ def _imu_instance(
     found: tuple[dict[str, tuple[FloatArray, FloatArray]], dict[str, adequacy.Motion]],
     old: _Prior,
     allan: bool = False,
+    plan: ThermometerPlan | None = None,
 ) -> tuple[SensorFit, list[str | None]]:
     """A gyro or accelerometer instance through the pipeline: read, fit, its gates, its
     ``TC_G``/``TC_A`` parameters merged into ``params``, its report (``allan``: with its
     Allan section); ``found`` (series, motions) gets its (time [s], x/y/z in the canonical
-    unit) and its stillness result for the step check across instances."""
+    unit) and its stillness result for the step check across instances; ``plan``: the
+    temperature it is fitted on."""
     from thermocal.export.params import export_params
     from thermocal.readers.ulog import release_parsed_topic
 
@@ -537,7 +558,12 @@ def _imu_instance(
     rec = flight.recording(where)
     release_parsed_topic(log, where)  # read once: its raw messages are not needed again
     series, motions = found
+    plan = plan or ThermometerPlan()
+    rec, thermo = sensor_temperature(
+        rec, where, temperature=plan.temperature, source=plan.source_for(kind, inst)
+    )
     fit = fit_sensor(rec, name, kind, inst, overrides=overrides, motions=motions)
+    said = record_thermometer(fit, thermo, where)
     temp_c = rec.temperature_c("temperature")
     # the step check across instances reads the stillness result (motions), not the values
     series[where] = (rec.time_s, np.empty((0, len(AXES))))
@@ -555,6 +581,8 @@ def _imu_instance(
             sub, "px4", instance=inst, device_id={kind: fit.device_id}, tref_c=tref_c
         )
     params.merge(ps, where)
+    if said:
+        params.notes.append(said)
     prev = old.compare(
         where, ps.params, kind, inst, fit.device_id, "rad/s" if kind == "gyro" else "m/s^2",
         fit.sweep_c,
@@ -579,6 +607,7 @@ def _imu_instance(
                 "'hold-out rms' is the rms of a cubic fitted to the even bins on the odd "
                 "ones, in the canonical unit (°/h or mg).",
                 *(f"Firmware: {n}" for n in ps.notes),
+                *((f"Temperature: {said}",) if said else ()),
                 *(() if allan else (NO_ALLAN,)),
             ),
             previous=prev,
