@@ -22,6 +22,7 @@ Pure functions on arrays; no file is read here.
 from __future__ import annotations
 
 import warnings
+from collections.abc import Sequence
 from dataclasses import asdict, dataclass
 from typing import Any, Literal
 
@@ -29,7 +30,7 @@ import numpy as np
 import numpy.typing as npt
 
 from thermocal.errors import ParameterError, ThermocalInputError, ThermocalWarning
-from thermocal.recording import FloatArray
+from thermocal.recording import FloatArray, Recording
 
 MIN_STEP_C = 0.1
 """A lattice step from which a thermometer is called quantised [°C]."""
@@ -628,6 +629,60 @@ def borrowed_temperature(
     return rec, keep
 
 
+def reconstruct_columns(
+    rec: Recording, names: Sequence[str], *, mode: TemperatureMode = "reconstructed"
+) -> tuple[Recording, list[dict[str, Any]]]:
+    """A recording's temperature columns with a quantised or slow thermometer reconstructed.
+
+    Each column is judged in °C (:meth:`thermocal.recording.Recording.temperature_c`) and
+    reconstructed (:func:`reconstruct_temperature`); the result goes back into the column's
+    own unit (°F, K, raw counts) through the affine map between the two, so the model file
+    keeps the unit the data were given in.
+
+    Parameters
+    ----------
+    rec : thermocal.recording.Recording
+        A recording.
+    names : sequence of str
+        Its temperature columns to look at.
+    mode : {"reconstructed", "raw"}, optional
+        ``"raw"``: the columns are left as they are (what they are is still returned).
+
+    Returns
+    -------
+    (Recording, list of dict)
+        The recording (a copy when a column changed), and per column
+        :meth:`Reconstruction.to_dict` with ``column`` and ``file``.
+
+    Raises
+    ------
+    ParameterError
+        ``mode`` unknown.
+    """
+    if mode not in ("reconstructed", "raw"):
+        raise ParameterError("temperature", f"{{name}} must be reconstructed or raw, got {mode!r}")
+    new: dict[str, FloatArray] = {}
+    said = []
+    for name in names:
+        own = np.asarray(rec.column(name), dtype=np.float64)
+        in_c = np.asarray(rec.temperature_c(name), dtype=np.float64)
+        ok = np.isfinite(in_c) & np.isfinite(own)
+        if np.unique(in_c[ok]).size < 2:
+            continue  # constant or empty: the data's judgement refuses it
+        made = reconstruct_temperature(rec.time_s, in_c, mode=mode)
+        said.append({"file": rec.name, "column": name, **made.to_dict()})
+        if made.used != "reconstructed":
+            continue
+        slope, icpt = np.polyfit(own[ok], in_c[ok], 1)
+        if not np.allclose(icpt + slope * own[ok], in_c[ok], rtol=0, atol=1e-6):
+            said[-1].update(temperature="raw", note=f"{made.note}; not affine in its unit: kept")
+            continue  # int16 wrap-around: not one affine map
+        new[name] = (made.temp_c - icpt) / slope
+    if not new:
+        return rec, said
+    return rec.with_columns(new, {n: rec.units.get(n, "degC") for n in new}), said
+
+
 __all__ = [
     "MIN_PERIOD_S",
     "MIN_STEP_C",
@@ -638,6 +693,7 @@ __all__ = [
     "borrowed_temperature",
     "describe_thermometer",
     "lattice_step",
+    "reconstruct_columns",
     "reconstruct_temperature",
     "temperature_knots",
     "update_period",

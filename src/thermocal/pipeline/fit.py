@@ -788,6 +788,33 @@ def _check_options(paths: Sequence[Path], o: FitOptions, output: Path) -> dict[s
     return options
 
 
+def _thermometers(
+    loaded: list[tuple[Path, _recording.Recording]], o: FitOptions
+) -> tuple[list[tuple[Path, _recording.Recording]], list[dict[str, Any]]]:
+    """Each run's temperature columns with a quantised or slow thermometer reconstructed
+    (``o.temperature``; :func:`thermocal.thermometer.reconstruct_columns`), each one
+    reconstructed said in a warning; what every column's thermometer is."""
+    from thermocal.thermometer import ThermometerWarning, reconstruct_columns
+
+    out, said = [], []
+    for path, rec in loaded:
+        names = run_temp_names(rec, o.temperatures)
+        rec, rows = reconstruct_columns(rec, names, mode=o.temperature)
+        for r in rows:
+            if r["temperature"] == "reconstructed":
+                warnings.warn(
+                    ThermometerWarning.naming(
+                        f"{path}: {r['column']!r}: {r['note']}; give {{temperature}} raw to "
+                        "fit it as logged",
+                        "temperature",
+                    ),
+                    stacklevel=3,
+                )
+        out.append((path, rec))
+        said.extend(rows)
+    return out, said
+
+
 def fit_files(paths: Sequence[Path], options: FitOptions, output: Path) -> FitResult:
     """Fit ``options.model`` on the recordings ``paths`` (one run each) and save it to
     ``output`` (module docstring).  Options are checked before any file is read
@@ -832,6 +859,7 @@ def fit_files(paths: Sequence[Path], options: FitOptions, output: Path) -> FitRe
             f"{{name}} applies to the poly family (coefficients about TREF), not {o.model!r}",
         )
     _distinct_runs([path for path, _rec in loaded])
+    loaded, thermo = _thermometers(loaded, o)
     spec = _FitSpec(o.model, family_options, o.temperatures, o.latitude, o.axis, o.known_input,
                     o.target, o.gravity_axis, g_local, o.tref,
                     _gravity.triad_gravity(loaded, names, o.gravity_axis, g_local),
@@ -840,6 +868,7 @@ def fit_files(paths: Sequence[Path], options: FitOptions, output: Path) -> FitRe
         est, result, n_runs = _fit_channel(spec, loaded, names[0] if names else None)
         _files.save_model(est, output)
         result["output"] = str(output)
+        result["thermometers"] = thermo
         return FitResult(output, (FittedChannel(est.signal_name, est, result, n_runs),), False)
     fitted = _fit_channels(spec, loaded, names)
     cal = _calibration.Calibration(
@@ -855,7 +884,9 @@ def fit_files(paths: Sequence[Path], options: FitOptions, output: Path) -> FitRe
         ]
     )
     _files.save_calibration(cal, output)
-    channels = tuple(FittedChannel(name, est, res, n) for name, est, res, n in fitted)
+    channels = tuple(
+        FittedChannel(name, est, {**res, "thermometers": thermo}, n) for name, est, res, n in fitted
+    )
     return FitResult(output, channels, True)
 
 

@@ -98,6 +98,10 @@ class FitOptions:
     stamp : {"header", "receive"}
         Time of a ROS bag's messages: their header stamp (default) or the bag's receive
         time.
+    temperature : {"reconstructed", "raw"}
+        A quantised or slow thermometer (:mod:`thermocal.thermometer`: a lattice of 0.1 °C or
+        more, or updated every second or slower) fitted on the temperature reconstructed at
+        each sample (default), or on its reading as logged.
 
     Raises
     ------
@@ -140,9 +144,14 @@ class FitOptions:
     delimiter: str | None = None
     decimal: Literal[".", ","] | None = None
     stamp: Literal["header", "receive"] = "header"
+    temperature: Literal["reconstructed", "raw"] = "reconstructed"
 
     def __post_init__(self) -> None:
         set_ = object.__setattr__  # frozen: normalise in place once
+        if self.temperature not in ("reconstructed", "raw"):
+            raise ParameterError(
+                "temperature", f"{{name}} must be reconstructed or raw, got {self.temperature!r}"
+            )
         for field in ("signals", "temperatures", "names"):
             set_(self, field, _names(getattr(self, field), field))
         if self.temp_conversion is not None:

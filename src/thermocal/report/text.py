@@ -465,8 +465,8 @@ def inspection_text(r: Inspection) -> list[Block]:
     for name, th in r.thermometers.items():
         if th is not None and (th["quantised"] or th["slow"]):
             out.append(
-                f"temperature {name!r}: the thermometer is {th['kind']}; px4-tempcal and "
-                "ardupilot-tempcal fit on the temperature reconstructed at each sample"
+                f"temperature {name!r}: the thermometer is {th['kind']}; fit, px4-tempcal "
+                "and ardupilot-tempcal fit on the temperature reconstructed at each sample"
             )
     if r.gaps:
         out.append(
