@@ -225,3 +225,36 @@ def test_ardupilot_whole_degrees_and_borrowed(
     )
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "--temps-from names BARO.0" in err[0] and "IMU.0, IMU.1" in err[0], err
+
+
+BARO = [("uint64_t", "timestamp"), ("uint32_t", "device_id"), ("float", "pressure"),
+        ("float", "temperature")]  # fmt: skip
+"""PX4 ``msg/SensorBaro.msg`` (the fields read)."""
+
+
+def test_px4_gyro_against_the_barometer_thermometer(logs: dict) -> None:
+    """A whole-degree gyro 0 and a barometer at 10 Hz (its own instants, 0.01 °C noise) whose
+    thermometer reads the true temperature: ``--temps-from baro`` fits the gyro on it; PX4's
+    correction leaves a residual on the true temperature within 1.1× of the reference fit's."""
+    d = logs["d"]
+    ts = (1e6 + logs["t"] * 1e6).astype(np.int64)
+    tb = np.arange(0.0, logs["t"][-1], 0.1) + 0.037
+    rng = np.random.default_rng(3)
+    baro_t = np.interp(tb, logs["t"], logs["true"]) + rng.normal(0, 0.01, tb.size)
+    press = 101325.0 + 5.0 * (baro_t - 20.0) + rng.normal(0, 1.0, tb.size)
+    rows_b = [(int(1e6 + s * 1e6), 22, float(p), float(c))
+              for s, p, c in zip(tb, press, baro_t, strict=True)]  # fmt: skip
+    log = d / "baro.ulg"
+    log.write_bytes(ulog_bytes([
+        ("sensor_gyro", 0, SENSOR_FIELDS, _rows(ts, 11, logs["meas"], np.round(logs["true"]))),
+        ("sensor_baro", 0, BARO, rows_b),
+    ]))  # fmt: skip
+    code, out = _run(["px4-tempcal", str(log), "-o", str(d / "baro"), "--temps-from", "baro"])
+    assert code == 0
+    th = out["sensors"]["sensor_gyro.0"]["thermometer"]
+    assert th["source"] == "sensor_baro.0" and not th["quantised"]
+    assert th["samples_kept"] >= logs["t"].size - 2
+    if not (d / "ref" / "px4.params").exists():
+        assert _run(["px4-tempcal", str(logs["ref"]), "-o", str(d / "ref")])[0] == 0
+    p_ref, p_bar = _params(d / "ref" / "px4.params"), _params(d / "baro" / "px4.params")
+    assert _residual(p_bar, logs) <= 1.1 * _residual(p_ref, logs)
