@@ -3834,6 +3834,14 @@ MUTANTS: tuple[Mutant, ...] = (
         _t("thermometer"),
         "a continuous thermometer half on a lattice called quantised",
     ),
+    Mutant(
+        "borrowed-thermometer-apart-unsaid",
+        P + "tempcal/thermometers.py",
+        "if abs(med) > APART_C or spread > APART_C:",
+        "if abs(med) > 10 * APART_C or spread > APART_C:",
+        _t("tempcal_thermometers"),
+        "an own thermometer 3 °C from the borrowed one not said",
+    ),
 )
 
 

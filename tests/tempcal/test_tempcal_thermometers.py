@@ -14,6 +14,7 @@ from __future__ import annotations
 import contextlib
 import io
 import json
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -258,3 +259,28 @@ def test_px4_gyro_against_the_barometer_thermometer(logs: dict) -> None:
         assert _run(["px4-tempcal", str(logs["ref"]), "-o", str(d / "ref")])[0] == 0
     p_ref, p_bar = _params(d / "ref" / "px4.params"), _params(d / "baro" / "px4.params")
     assert _residual(p_bar, logs) <= 1.1 * _residual(p_ref, logs)
+
+
+def test_borrowed_thermometer_reading_apart_is_said() -> None:
+    """The sensor's own thermometer 3 °C above the borrowed one: the median difference is
+    recorded and said in a warning."""
+    from thermocal.recording import Recording
+    from thermocal.tempcal.thermometers import TemperatureSeries, sensor_temperature
+    from thermocal.thermometer import ThermometerWarning
+
+    t = np.arange(0, 600.0, 0.01)
+    true = 20.0 + 0.02 * t
+    rec = Recording.from_arrays(
+        t, {a: np.zeros(t.size) for a in "xyz"}, {"temperature": true + 3.0},
+        signal_unit="rad/s",
+    )  # fmt: skip
+    src = TemperatureSeries("sensor_baro.0", t[::10], true[::10])
+    with pytest.warns(ThermometerWarning, match=r"reads \+3.00 °C from sensor_baro.0's"):
+        out, said = sensor_temperature(rec, "sensor_gyro.0", source=src)
+    assert said["own_minus_source_c"] == pytest.approx(3.0, abs=1e-9)
+    assert np.allclose(out.temperature_c("temperature"), true, rtol=0, atol=2e-3)  # end held
+    close = TemperatureSeries("sensor_baro.0", t[::10], true[::10] + 2.9)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        _out, said = sensor_temperature(rec, "sensor_gyro.0", source=close)
+    assert said["own_minus_source_c"] == pytest.approx(0.1, abs=1e-9)

@@ -148,12 +148,19 @@ def sensor_temperature(
         The recording with its ``temperature`` replaced (and rows left out when borrowed),
         and what was done: the thermometer's description
         (:meth:`thermocal.thermometer.Reconstruction.to_dict`), ``source`` (where the
-        temperature came from) and ``samples_kept``.
+        temperature came from), ``samples_kept`` and ``own_minus_source_c`` (borrowed: the
+        median of the sensor's own reading less the borrowed one [°C]; else None).
 
     Raises
     ------
     ThermocalInputError
         ``temperature`` unknown; a borrowed thermometer that does not overlap the record.
+
+    Warns
+    -----
+    ThermometerWarning
+        The borrowed thermometer covers only part of the record, or reads more than
+        :data:`APART_C` from the sensor's own (median or spread).
 
     Notes
     -----
@@ -170,7 +177,10 @@ def sensor_temperature(
             return rec, {}
         made = reconstruct_temperature(rec.time_s, own, mode=temperature)
         out = rec.with_columns({"temperature": made.temp_c}, {"temperature": "degC"})
-        return out, {**made.to_dict(), "source": where, "samples_kept": int(own.size)}
+        return out, {
+            **made.to_dict(), "source": where, "samples_kept": int(own.size),
+            "own_minus_source_c": None,
+        }  # fmt: skip
     try:
         with warnings.catch_warnings(record=True) as said:
             warnings.simplefilter("always", ThermometerWarning)
@@ -191,7 +201,37 @@ def sensor_temperature(
         warnings.warn(ThermometerWarning(f"{where}: {w.message}"), stacklevel=2)
     out = rec.select(keep) if not keep.all() else rec
     out = out.with_columns({"temperature": made.temp_c}, {"temperature": "degC"})
-    return out, {**made.to_dict(), "source": source.name, "samples_kept": int(keep.sum())}
+    apart = _apart(where, source.name, own[keep], made.temp_c)
+    return out, {
+        **made.to_dict(), "source": source.name, "samples_kept": int(keep.sum()),
+        "own_minus_source_c": apart,
+    }  # fmt: skip
+
+
+APART_C = 1.0
+"""Own and borrowed thermometers further apart than this (median, or the 95th percentile
+about it) are said in a warning [°C]."""
+
+
+def _apart(where: str, source: str, own: FloatArray, borrowed: FloatArray) -> float | None:
+    """The median of own − borrowed [°C] (None: no finite own reading), a warning when the
+    two read apart by more than :data:`APART_C` (in flight the firmware reads its own)."""
+    d = own - borrowed
+    d = d[np.isfinite(d)]
+    if d.size == 0:
+        return None
+    med = float(np.median(d))
+    spread = float(np.percentile(np.abs(d - med), 95))
+    if abs(med) > APART_C or spread > APART_C:
+        warnings.warn(
+            ThermometerWarning(
+                f"{where}: its own thermometer reads {med:+.2f} °C from {source}'s (95 % "
+                f"within ±{spread:.2f} °C about that): in flight the firmware compensates "
+                "with its own, so the correction will be applied at other temperatures"
+            ),
+            stacklevel=3,
+        )
+    return med
 
 
 @dataclass(frozen=True)
