@@ -284,3 +284,30 @@ def test_borrowed_thermometer_reading_apart_is_said() -> None:
         warnings.simplefilter("error")
         _out, said = sensor_temperature(rec, "sensor_gyro.0", source=close)
     assert said["own_minus_source_c"] == pytest.approx(0.1, abs=1e-9)
+
+
+def test_ardupilot_imu_against_the_barometer(tmp_path: Path) -> None:
+    """The barometer log of :func:`test_fc_reports.baro_log` (IMU temperature continuous,
+    BARO.0's ``Temp`` the same in hundredths of a degree, 10 µs later): ``--temps-from baro``
+    fits IMU 0 on BARO.0's thermometer; the two agree (median own − borrowed within the
+    rounding) and the coefficients are those of the IMU's own thermometer."""
+    from test_fc_reports import baro_log
+
+    log = tmp_path / "baro.bin"
+    baro_log(log, 1.35, +1.0)
+    code, own = _run(["ardupilot-tempcal", str(log), "-o", str(tmp_path / "own")])
+    assert code == 0
+    code, bor = _run(["ardupilot-tempcal", str(log), "-o", str(tmp_path / "bor"),
+                      "--temps-from", "baro"])  # fmt: skip
+    assert code == 0
+    th = bor["sensors"]["IMU.Gyr.0"]["thermometer"]
+    assert th["source"] == "BARO.0" and th["samples_kept"] == 12000
+    assert abs(th["own_minus_source_c"]) <= 0.005
+    assert own["sensors"]["IMU.Gyr.0"]["thermometer"]["own_minus_source_c"] is None
+    p_own, p_bor = (
+        _parm(tmp_path / "own" / "ardupilot.parm"),
+        _parm(tmp_path / "bor" / "ardupilot.parm"),
+    )
+    for ax in "XYZ":
+        key = f"INS_TCAL1_GYR1_{ax}"
+        assert p_bor[key] == pytest.approx(p_own[key], rel=0.02, abs=1.0), key
