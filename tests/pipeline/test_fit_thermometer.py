@@ -16,6 +16,7 @@ import pytest
 
 from thermocal.cli import main
 from thermocal.pipeline.fit import fit_files
+from thermocal.pipeline.model_file import load_model
 from thermocal.pipeline.options import FitOptions
 from thermocal.thermometer import ThermometerWarning
 
@@ -59,6 +60,8 @@ def test_fit_reconstructs_a_whole_degree_thermometer(
     assert th["step_c"] == pytest.approx(1.0, abs=1e-9) and th["temperature"] == "reconstructed"
     raw = _fit(f["whole"], tmp_path / "w.json", "--temperature", "raw")
     assert raw["thermometers"][0]["temperature"] == "raw"
+    model = load_model(tmp_path / "r.json")  # the model file records it, and reads back
+    assert model.inputs_["thermometers"][0]["temperature"] == "reconstructed"
     assert rec["rms_residual"] <= 1.1 * truth["rms_residual"]
     assert raw["rms_residual"] >= 1.25 * truth["rms_residual"]  # the staircase
 

@@ -22,6 +22,7 @@ import pytest
 
 from dataflash_writer import imu_log
 from thermocal.cli import main
+from thermocal.pipeline.model_file import load_calibration
 from ulog_writer import SENSOR_FIELDS, ulog_bytes
 
 RATE_HZ = 20.0
@@ -108,6 +109,8 @@ def test_px4_reconstructed_raw_and_borrowed(logs: dict) -> None:
     assert any("sensor_gyro.0: the thermometer is quantised" in n for n in rec["notes"])
     cal = json.loads((d / "rec" / "calibration.json").read_text())
     assert "0.125" in json.dumps(cal)  # the calibration records the thermometer
+    channel = load_calibration(d / "rec" / "calibration.json").channels[0]  # and reads back
+    assert channel.model.inputs_["thermometer"]["step_c"] == pytest.approx(0.125, abs=1e-9)
     p_ref, p_rec = _params(d / "ref" / "px4.params"), _params(d / "rec" / "px4.params")
     assert _residual(p_rec, logs) <= 1.1 * _residual(p_ref, logs)
     code, raw = _run(["px4-tempcal", str(logs["two"]), "-o", str(d / "raw"),

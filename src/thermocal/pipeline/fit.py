@@ -815,6 +815,11 @@ def _thermometers(
     return out, said
 
 
+def _recorded(thermo: list[dict[str, Any]]) -> list[dict[str, Any]]:
+    """What the model file keeps of each run's thermometers (not the file's path)."""
+    return [{k: v for k, v in r.items() if k != "file"} for r in thermo]
+
+
 def fit_files(paths: Sequence[Path], options: FitOptions, output: Path) -> FitResult:
     """Fit ``options.model`` on the recordings ``paths`` (one run each) and save it to
     ``output`` (module docstring).  Options are checked before any file is read
@@ -866,11 +871,14 @@ def fit_files(paths: Sequence[Path], options: FitOptions, output: Path) -> FitRe
                     overrides_of(o.allow_narrow, o.allow_motion))  # fmt: skip
     if len(names) <= 1:
         est, result, n_runs = _fit_channel(spec, loaded, names[0] if names else None)
+        est.inputs_ = {**(est.inputs_ or {}), "thermometers": _recorded(thermo)}
         _files.save_model(est, output)
         result["output"] = str(output)
         result["thermometers"] = thermo
         return FitResult(output, (FittedChannel(est.signal_name, est, result, n_runs),), False)
     fitted = _fit_channels(spec, loaded, names)
+    for _name, est, _res, _n in fitted:
+        est.inputs_ = {**(est.inputs_ or {}), "thermometers": _recorded(thermo)}
     cal = _calibration.Calibration(
         [
             _calibration.Channel(
